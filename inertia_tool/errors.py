@@ -1,0 +1,121 @@
+"""Named exceptions and warnings of inertia_tool, in one place.
+
+Every error raised on purpose by the package derives from :class:`InertiaToolError` and also
+from the built-in exception a caller would naturally catch (``ValueError``, ``OSError``), so
+``except ValueError`` keeps working.  Messages say what was expected and what was found.
+
+The command line maps them to exit codes (see ``docs/conventions.md`` and the README):
+
+====================  =========  ==============================================
+exception             exit code  meaning
+====================  =========  ==============================================
+UsageError            2          bad command-line arguments or API parameters
+MeshReadError         3          the file cannot be read or parsed as a mesh
+InvalidMeshError      3          the mesh is read but is not a closed solid
+PhysicsError          4          the numbers are valid input but the request
+                                 cannot be satisfied (e.g. a singular top)
+====================  =========  ==============================================
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "InertiaToolError",
+    "UsageError",
+    "UnitsError",
+    "MaterialError",
+    "MeshReadError",
+    "InvalidMeshError",
+    "PhysicsError",
+    "InertiaToolWarning",
+    "MeshRepairedWarning",
+    "InsideOutWarning",
+    "DegenerateFacesWarning",
+    "NearlyEqualMomentsWarning",
+    "PhysicalValidityWarning",
+    "OverlapWarning",
+    "TrailingDataWarning",
+]
+
+
+class InertiaToolError(Exception):
+    """Base class of every error that inertia_tool raises on purpose."""
+
+    exit_code = 1
+
+
+class UsageError(InertiaToolError, ValueError):
+    """A parameter is missing, malformed or contradicts another one."""
+
+    exit_code = 2
+
+
+class UnitsError(UsageError):
+    """A unit or quantity string is not understood (e.g. ``--units furlong``)."""
+
+
+class MaterialError(UsageError):
+    """A material name is not in the documented table (see ``inertia_tool.units.MATERIALS``)."""
+
+
+class MeshReadError(InertiaToolError, OSError):
+    """A file cannot be opened or parsed as a triangle mesh.
+
+    The message names the file and what was wrong with its bytes.
+    """
+
+    exit_code = 3
+
+
+class InvalidMeshError(InertiaToolError, ValueError):
+    """A mesh was read but does not bound a solid (open, non-manifold, empty, flat, ...).
+
+    Attributes
+    ----------
+    details : dict
+        Machine-readable counts (``boundary_edges``, ``nonmanifold_edges`` ...) where known.
+    """
+
+    exit_code = 3
+
+    def __init__(self, message: str, details: dict | None = None):
+        super().__init__(message)
+        self.details = dict(details or {})
+
+
+class PhysicsError(InertiaToolError, ValueError):
+    """The input is well formed but the physical request has no valid answer."""
+
+    exit_code = 4
+
+
+class InertiaToolWarning(UserWarning):
+    """Base class of the soft problems inertia_tool reports (it computed a result, but assumed something)."""
+
+
+class MeshRepairedWarning(InertiaToolWarning):
+    """The mesh was changed (holes closed, winding fixed) before integration, at the user's request."""
+
+
+class InsideOutWarning(InertiaToolWarning):
+    """A shell had inward-facing normals (negative volume) and was flipped."""
+
+
+class DegenerateFacesWarning(InertiaToolWarning):
+    """Zero-area faces were found; they contribute nothing and were ignored."""
+
+
+class NearlyEqualMomentsWarning(InertiaToolWarning):
+    """Two principal moments agree within the tolerance: the axes in their plane are a free choice."""
+
+
+class PhysicalValidityWarning(InertiaToolWarning):
+    """Principal moments fail positivity or the triangle inequality beyond round-off."""
+
+
+class OverlapWarning(InertiaToolWarning):
+    """Two shells overlap, so some volume is counted twice."""
+
+
+class TrailingDataWarning(InertiaToolWarning):
+    """A file carried bytes after the data its header announced; they were ignored."""
