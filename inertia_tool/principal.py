@@ -1,0 +1,149 @@
+"""Principal moments and right-handed principal axes of an inertia tensor (Eq. 4.25).
+
+Pure functions on SI arrays.  Conventions (ascending moments, axes as columns of a proper rotation,
+sign choice, degenerate planes) are on ``docs/conventions.md``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import UsageError
+
+__all__ = ["PrincipalAxes", "principal_axes", "DEFAULT_EQUAL_RTOL"]
+
+#: Default relative tolerance under which two principal moments count as equal (relative to the largest).
+DEFAULT_EQUAL_RTOL = 1e-6
+
+
+@dataclass(frozen=True)
+class PrincipalAxes:
+    """Principal moments and axes of an inertia tensor about a stated point.
+
+    Attributes
+    ----------
+    moments : (3,) float
+        Principal moments ``I1 ≤ I2 ≤ I3`` in kg·m².
+    axes : (3, 3) float
+        Proper rotation (det +1); column ``k`` is the unit axis of ``moments[k]`` in mesh axes, so
+        ``tensor = axes @ diag(moments) @ axes.T``.
+    reference_point : (3,) float
+        Point the tensor is taken about, m, mesh axes (the centre of mass for ``MassProperties.principal``).
+    mass : float
+        kg; ``nan`` when unknown (then ``radii_of_gyration`` is nan).
+    equal_pairs : tuple of (int, int)
+        Index pairs of moments equal within ``rtol``; the axes within such a plane are a free choice.
+    rtol : float
+        Relative tolerance (of the largest moment) used for ``equal_pairs``.
+    """
+
+    moments: np.ndarray
+    axes: np.ndarray
+    reference_point: np.ndarray
+    mass: float
+    equal_pairs: tuple
+    rtol: float
+
+    @property
+    def radii_of_gyration(self) -> np.ndarray:
+        """(3,) m: ``k_i = √(I_i / m)``."""
+        return np.sqrt(np.clip(self.moments, 0.0, None) / self.mass)
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """(3, 3): the same matrix as ``axes`` (principal-frame components → mesh components)."""
+        return self.axes
+
+    @property
+    def is_axisymmetric(self) -> bool:
+        """True when exactly two moments are equal within ``rtol``."""
+        return len(self.equal_pairs) == 1
+
+    @property
+    def is_spherical(self) -> bool:
+        """True when all three moments are equal within ``rtol``."""
+        return len(self.equal_pairs) == 3
+
+    @property
+    def triangle_inequality_margin(self) -> float:
+        """``(I1 + I2 − I3) / I3``: ≥ 0 for every physical body (0 for a flat plate)."""
+        i1, i2, i3 = self.moments
+        return float((i1 + i2 - i3) / i3) if i3 > 0 else float("nan")
+
+
+def _canonical_sign(v: np.ndarray) -> np.ndarray:
+    k = int(np.argmax(np.abs(v)))
+    return -v if v[k] < 0 else v
+
+
+def _plane_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two deterministic unit vectors spanning the plane ⟂ ``normal``: the mesh axis most
+    orthogonal to ``normal``, projected into the plane, then ``normal × first``."""
+    k = int(np.argmin(np.abs(normal)))
+    e = np.zeros(3)
+    e[k] = 1.0
+    first = e - normal * (normal @ e)
+    first /= np.linalg.norm(first)
+    return first, np.cross(normal, first)
+
+
+def principal_axes(tensor, *, reference_point=None, mass: float = float("nan"),
+                   rtol: float = DEFAULT_EQUAL_RTOL) -> PrincipalAxes:
+    """Diagonalise a symmetric inertia tensor.
+
+    Parameters
+    ----------
+    tensor : (3, 3) array_like
+        Inertia tensor in kg·m² (tensor convention, off-diagonals −∫xy dm).
+    reference_point : (3,) array_like, optional
+        Point the tensor is about (carried into the result); default the origin.
+    mass : float, optional
+        kg, for radii of gyration.
+    rtol : float
+        Two moments ``I_a, I_b`` count as equal when ``|I_a − I_b| ≤ rtol · max(I)``.  In an equal pair the
+        axes are replaced by a deterministic basis of their plane (see ``docs/conventions.md``) instead of
+        the arbitrary one the eigen-solver returns.
+
+    Returns
+    -------
+    PrincipalAxes
+    """
+    t = np.asarray(tensor, dtype=np.float64)
+    if t.shape != (3, 3):
+        raise UsageError(f"Expected `tensor` to have shape (3, 3), got {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise UsageError("Expected a finite inertia tensor, got NaN or infinity")
+    if not rtol >= 0:
+        raise UsageError(f"Expected `rtol` >= 0, got {rtol}")
+    t = 0.5 * (t + t.T)
+    moments, vecs = np.linalg.eigh(t)
+    scale = max(abs(moments[-1]), np.finfo(float).tiny)
+    eq01 = abs(moments[1] - moments[0]) <= rtol * scale
+    eq12 = abs(moments[2] - moments[1]) <= rtol * scale
+    eq02 = abs(moments[2] - moments[0]) <= rtol * scale
+    pairs = tuple(p for p, flag in (((0, 1), eq01), ((1, 2), eq12), ((0, 2), eq02)) if flag)
+    if eq01 and eq12 or eq02:
+        axes = np.eye(3)
+        pairs = ((0, 1), (1, 2), (0, 2))
+    elif eq01:
+        a3 = _canonical_sign(vecs[:, 2])
+        a1, a2 = _plane_basis(a3)
+        axes = np.column_stack([a1, a2, a3])
+    elif eq12:
+        a1 = _canonical_sign(vecs[:, 0])
+        a2, a3 = _plane_basis(a1)
+        axes = np.column_stack([a1, a2, a3])
+    else:
+        a1 = _canonical_sign(vecs[:, 0])
+        a2 = _canonical_sign(vecs[:, 1])
+        axes = np.column_stack([a1, a2, np.cross(a1, a2)])
+    # re-orthonormalise (eigh returns orthonormal vectors to round-off; keep det exactly +1 in spirit)
+    q, r = np.linalg.qr(axes)
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 2] = -q[:, 2]
+    ref = np.zeros(3) if reference_point is None else np.asarray(reference_point, dtype=np.float64).reshape(3)
+    return PrincipalAxes(moments=moments, axes=q, reference_point=ref, mass=float(mass),
+                         equal_pairs=pairs, rtol=float(rtol))

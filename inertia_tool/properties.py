@@ -1,0 +1,233 @@
+"""Mass properties of a rigid body: the frozen result object and its algebra.
+
+``MassProperties`` holds mass, volume, centre of mass and the inertia tensor about the centre of mass
+(mesh axes, SI, tensor convention: off-diagonals −∫xy dm).  Everything else is derived on demand:
+inertia about another point (parallel-axis theorem, Eqs. 4.16–4.17), moment about an axis, principal axes
+(Eq. 4.25), a rigidly moved copy, sums of bodies and point masses.  See ``docs/conventions.md``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from .errors import UsageError
+from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
+
+__all__ = ["MassProperties", "InertiaTensor", "point_mass", "combine", "parallel_axis_shift"]
+
+
+def _vec3(x, name: str) -> np.ndarray:
+    a = np.asarray(x, dtype=np.float64)
+    if a.shape != (3,):
+        raise UsageError(f"Expected `{name}` to have shape (3,), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise UsageError(f"Expected `{name}` to be finite, got {a.tolist()}")
+    return a
+
+
+def parallel_axis_shift(mass: float, offset) -> np.ndarray:
+    """Inertia of a point mass ``mass`` at ``offset`` from the reference point, (3, 3) kg·m².
+
+    ``M [(b·b) δ_ij − b_i b_j]``: the term added to the central tensor by the parallel-axis theorem,
+    Eq. (4.16) with ``b = point − centre of mass`` (the sign of ``b`` does not matter).
+    """
+    b = np.asarray(offset, dtype=np.float64)
+    return mass * ((b @ b) * np.eye(3) - np.outer(b, b))
+
+
+@dataclass(frozen=True)
+class InertiaTensor:
+    """An inertia tensor together with the point it is taken about.
+
+    Attributes
+    ----------
+    tensor : (3, 3) float
+        kg·m², mesh axes, tensor convention (off-diagonals −∫xy dm).
+    reference_point : (3,) float
+        m, mesh axes.
+    """
+
+    tensor: np.ndarray
+    reference_point: np.ndarray
+
+    def __array__(self, dtype=None, copy=None):
+        return np.asarray(self.tensor, dtype=dtype)
+
+    def moment_about(self, direction) -> float:
+        """Moment of inertia ``n̂·I·n̂`` about the line through ``reference_point`` along ``direction``, kg·m²."""
+        n = _vec3(direction, "direction")
+        norm = np.linalg.norm(n)
+        if norm == 0:
+            raise UsageError("Expected a non-zero `direction`, got (0, 0, 0)")
+        n = n / norm
+        return float(n @ self.tensor @ n)
+
+    def principal(self, *, rtol: float = DEFAULT_EQUAL_RTOL) -> PrincipalAxes:
+        """Principal moments and axes about ``reference_point``."""
+        return principal_axes(self.tensor, reference_point=self.reference_point, rtol=rtol)
+
+
+@dataclass(frozen=True)
+class MassProperties:
+    """Mass properties of a rigid body, SI, mesh axes.
+
+    Attributes
+    ----------
+    mass : float
+        kg.
+    volume : float
+        m³ of material (0 for point masses).
+    center_of_mass : (3,) float
+        m, mesh axes.
+    inertia : (3, 3) float
+        kg·m² about ``center_of_mass``, mesh axes, tensor convention (off-diagonals −∫xy dm).
+    surface_area : float
+        m² of the bounding surface (0 for point masses; the sum over parts for an assembly).
+    density : float
+        kg/m³: ``mass / volume`` for a homogeneous body; the mean for an assembly; ``nan`` without volume.
+    name : str
+        Label for reports (file name, part name); informational.
+    mesh : object, optional
+        Mesh diagnostics (``inertia_tool.checks.MeshReport``) when the body came from a mesh.
+    parts : tuple of MassProperties
+        The bodies this one was combined from (disconnected shells of a mesh, parts of an assembly).
+    """
+
+    mass: float
+    volume: float
+    center_of_mass: np.ndarray
+    inertia: np.ndarray
+    surface_area: float = 0.0
+    density: float = float("nan")
+    name: str = ""
+    mesh: object = field(default=None, repr=False, compare=False)
+    parts: tuple = field(default=(), repr=False, compare=False)
+
+    def __post_init__(self):
+        com = np.array(self.center_of_mass, dtype=np.float64).reshape(3)
+        ten = np.array(self.inertia, dtype=np.float64).reshape(3, 3)
+        com.flags.writeable = False
+        ten.flags.writeable = False
+        object.__setattr__(self, "center_of_mass", com)
+        object.__setattr__(self, "inertia", ten)
+        object.__setattr__(self, "mass", float(self.mass))
+        object.__setattr__(self, "volume", float(self.volume))
+        object.__setattr__(self, "surface_area", float(self.surface_area))
+        object.__setattr__(self, "density", float(self.density))
+
+    # -- derived quantities -------------------------------------------------------------------------
+    @cached_property
+    def principal(self) -> PrincipalAxes:
+        """Principal moments (ascending) and right-handed axes about the centre of mass (Eq. 4.25)."""
+        return principal_axes(self.inertia, reference_point=self.center_of_mass, mass=self.mass)
+
+    def principal_axes(self, *, rtol: float = DEFAULT_EQUAL_RTOL) -> PrincipalAxes:
+        """Principal axes about the centre of mass with an explicit equality tolerance ``rtol``."""
+        return principal_axes(self.inertia, reference_point=self.center_of_mass, mass=self.mass, rtol=rtol)
+
+    @property
+    def central_inertia(self) -> InertiaTensor:
+        """The inertia tensor about the centre of mass, with its reference point."""
+        return InertiaTensor(self.inertia, self.center_of_mass)
+
+    def inertia_about(self, point) -> InertiaTensor:
+        """Inertia tensor about ``point`` (m, mesh axes) by the parallel-axis theorem, Eq. (4.16).
+
+        ``I^(p) = I^(cm) + M [(p−R)² δ_ij − (p−R)_i (p−R)_j]``.  The result converts to a (3, 3) array with
+        ``np.asarray`` and carries ``reference_point``.
+        """
+        p = _vec3(point, "point")
+        return InertiaTensor(self.inertia + parallel_axis_shift(self.mass, p - self.center_of_mass), p)
+
+    def moment_about_axis(self, direction, point=None) -> float:
+        """Moment of inertia about the line through ``point`` along ``direction``, kg·m² (Eq. 4.17).
+
+        ``n̂·I^(cm)·n̂ + M |n̂ × (p − R)|²``; ``point`` defaults to the centre of mass.
+        """
+        n = _vec3(direction, "direction")
+        norm = np.linalg.norm(n)
+        if norm == 0:
+            raise UsageError("Expected a non-zero `direction`, got (0, 0, 0)")
+        n = n / norm
+        p = self.center_of_mass if point is None else _vec3(point, "point")
+        d = np.cross(n, p - self.center_of_mass)
+        return float(n @ self.inertia @ n + self.mass * (d @ d))
+
+    def transformed(self, rotation=None, translation=None) -> "MassProperties":
+        """The same body moved rigidly: ``x ↦ R x + t``.
+
+        Parameters
+        ----------
+        rotation : (3, 3) array_like, optional
+            Proper rotation (active).  Default identity.
+        translation : (3,) array_like, optional
+            m.  Default zero.
+
+        Returns a new ``MassProperties`` with ``center_of_mass = R c + t`` and ``inertia = R I Rᵀ``.
+        """
+        r = np.eye(3) if rotation is None else np.asarray(rotation, dtype=np.float64)
+        if r.shape != (3, 3):
+            raise UsageError(f"Expected `rotation` to have shape (3, 3), got {r.shape}")
+        if not np.allclose(r @ r.T, np.eye(3), atol=1e-9) or np.linalg.det(r) < 0:
+            raise UsageError("Expected `rotation` to be a proper rotation matrix (orthogonal, det +1)")
+        t = np.zeros(3) if translation is None else _vec3(translation, "translation")
+        return MassProperties(mass=self.mass, volume=self.volume, center_of_mass=r @ self.center_of_mass + t,
+                              inertia=r @ self.inertia @ r.T, surface_area=self.surface_area,
+                              density=self.density, name=self.name)
+
+    def with_mass(self, mass: float) -> "MassProperties":
+        """The same geometry with its density scaled so that the total mass is ``mass`` kg."""
+        if not (np.isfinite(mass) and mass > 0):
+            raise UsageError(f"Expected a positive finite mass, got {mass}")
+        if not self.mass > 0:
+            raise UsageError("Cannot rescale a body of zero mass")
+        k = mass / self.mass
+        return MassProperties(mass=mass, volume=self.volume, center_of_mass=self.center_of_mass,
+                              inertia=self.inertia * k, surface_area=self.surface_area,
+                              density=self.density * k, name=self.name, mesh=self.mesh,
+                              parts=tuple(p.with_mass(p.mass * k) for p in self.parts if p.mass > 0))
+
+    def __add__(self, other: "MassProperties") -> "MassProperties":
+        if not isinstance(other, MassProperties):
+            return NotImplemented
+        return combine([self, other])
+
+    def __radd__(self, other):
+        if other == 0:        # allows sum([...])
+            return self
+        return NotImplemented
+
+
+def point_mass(mass: float, position, *, name: str = "point mass") -> MassProperties:
+    """A point mass (``mass`` kg at ``position`` m) as ``MassProperties``: zero volume and central inertia."""
+    if not (np.isfinite(mass) and mass >= 0):
+        raise UsageError(f"Expected a non-negative finite mass, got {mass}")
+    return MassProperties(mass=mass, volume=0.0, center_of_mass=_vec3(position, "position"),
+                          inertia=np.zeros((3, 3)), name=name)
+
+
+def combine(bodies, *, name: str = "assembly") -> MassProperties:
+    """Rigidly join bodies (and point masses) into one: masses add, the centre of mass is the mass-weighted
+    mean, and each central tensor is moved to the common centre of mass by the parallel-axis theorem (Eq. 4.16).
+
+    Parameters
+    ----------
+    bodies : iterable of MassProperties
+        With negative masses allowed (removed material), as long as the total is positive.
+    """
+    bodies = list(bodies)
+    if not bodies:
+        raise UsageError("Expected at least one body to combine, got none")
+    total = sum(b.mass for b in bodies)
+    if not total > 0:
+        raise UsageError(f"Expected a positive total mass, got {total}")
+    com = sum(b.mass * b.center_of_mass for b in bodies) / total
+    ten = sum(b.inertia + parallel_axis_shift(b.mass, b.center_of_mass - com) for b in bodies)
+    volume = sum(b.volume for b in bodies)
+    density = total / volume if volume > 0 else float("nan")
+    return MassProperties(mass=total, volume=volume, center_of_mass=com, inertia=0.5 * (ten + ten.T),
+                          surface_area=sum(b.surface_area for b in bodies), density=density, name=name,
+                          parts=tuple(bodies))

@@ -1,0 +1,167 @@
+"""Units and materials: the boundary where user quantities become SI.
+
+The engine never sees anything but metres, kilograms, seconds and radians.  This module turns
+``"mm"``, ``"aluminium"``, ``"5rev/s"``, ``"3000rpm"``, ``"30s"`` or ``"2mm"`` into SI numbers.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from .errors import MaterialError, UnitsError
+
+__all__ = ["LENGTH_UNITS", "MATERIALS", "length_scale", "material_density", "parse_length",
+           "parse_angular_rate", "parse_duration", "parse_mass", "parse_density"]
+
+#: Length units accepted for mesh coordinates, as metres per unit.
+LENGTH_UNITS = {
+    "m": 1.0,
+    "cm": 1e-2,
+    "mm": 1e-3,
+    "um": 1e-6,
+    "in": 0.0254,
+    "ft": 0.3048,
+}
+_LENGTH_ALIASES = {"meter": "m", "meters": "m", "metre": "m", "metres": "m", "millimeter": "mm",
+                   "millimeters": "mm", "millimetre": "mm", "millimetres": "mm", "centimeter": "cm",
+                   "centimeters": "cm", "centimetre": "cm", "centimetres": "cm", "inch": "in", "inches": "in",
+                   "foot": "ft", "feet": "ft", "µm": "um", "micron": "um", "microns": "um"}
+
+#: Nominal densities in kg/m³ at room temperature.  Typical handbook values; real alloys and prints vary by a
+#: few per cent (printed parts far more, with infill) — pass ``density=`` for a measured value.
+MATERIALS = {
+    "aluminium": 2700.0,       # pure / 6061-T6: 2700
+    "steel": 7850.0,           # carbon steel
+    "stainless steel": 8000.0,  # 304/316: 7900-8000
+    "cast iron": 7200.0,
+    "titanium": 4430.0,        # Ti-6Al-4V
+    "brass": 8500.0,
+    "bronze": 8800.0,
+    "copper": 8960.0,
+    "magnesium": 1740.0,
+    "lead": 11340.0,
+    "tungsten": 19300.0,
+    "gold": 19300.0,
+    "pla": 1240.0,
+    "abs": 1040.0,
+    "petg": 1270.0,
+    "nylon": 1140.0,           # PA6/PA12: 1010-1150
+    "polycarbonate": 1200.0,
+    "acrylic": 1180.0,         # PMMA
+    "hdpe": 950.0,
+    "tpu": 1210.0,
+    "carbon fibre composite": 1600.0,
+    "oak": 750.0,
+    "pine": 500.0,
+    "glass": 2500.0,
+    "concrete": 2400.0,
+    "water": 1000.0,
+}
+_MATERIAL_ALIASES = {"aluminum": "aluminium", "al": "aluminium", "stainless": "stainless steel",
+                     "stainless-steel": "stainless steel", "stainless_steel": "stainless steel", "ss": "stainless steel",
+                     "ti": "titanium", "cu": "copper", "pa": "nylon", "pa12": "nylon", "pc": "polycarbonate",
+                     "pmma": "acrylic", "cast-iron": "cast iron", "carbon fiber composite": "carbon fibre composite",
+                     "cfrp": "carbon fibre composite"}
+
+
+def length_scale(unit: str) -> float:
+    """Metres per ``unit`` (``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft`` and spelled-out aliases)."""
+    key = str(unit).strip().lower()
+    key = _LENGTH_ALIASES.get(key, key)
+    if key not in LENGTH_UNITS:
+        raise UnitsError(f"Expected a length unit among {', '.join(LENGTH_UNITS)}, got {unit!r}")
+    return LENGTH_UNITS[key]
+
+
+def material_density(name: str) -> float:
+    """Density in kg/m³ of a material from :data:`MATERIALS` (case-insensitive, common aliases accepted)."""
+    key = " ".join(str(name).strip().lower().replace("_", " ").split())
+    key = _MATERIAL_ALIASES.get(key, key)
+    if key not in MATERIALS:
+        raise MaterialError(f"Unknown material {name!r}; expected one of: {', '.join(sorted(MATERIALS))} "
+                            "(or give a density in kg/m³)")
+    return MATERIALS[key]
+
+
+_NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+
+
+def _split(text: str, what: str) -> tuple[float, str]:
+    m = re.fullmatch(r"\s*" + _NUM + r"\s*([^\d\s].*?)?\s*", str(text))
+    if not m:
+        raise UnitsError(f"Expected {what} like '12.5' or '12.5 unit', got {text!r}")
+    value = float(m.group(1))
+    if not math.isfinite(value):
+        raise UnitsError(f"Expected a finite {what}, got {text!r}")
+    return value, (m.group(2) or "").strip().lower()
+
+
+def parse_length(text, default_unit: str = "m") -> float:
+    """``"2mm"`` → 0.002 (m).  A bare number is in ``default_unit``."""
+    if isinstance(text, (int, float)):
+        return float(text) * length_scale(default_unit)
+    value, unit = _split(text, "a length")
+    return value * length_scale(unit or default_unit)
+
+
+_RATE = {"rad/s": 1.0, "rad/sec": 1.0, "rev/s": 2 * math.pi, "hz": 2 * math.pi, "rps": 2 * math.pi,
+         "rpm": 2 * math.pi / 60.0, "rev/min": 2 * math.pi / 60.0, "deg/s": math.pi / 180.0}
+
+
+def parse_angular_rate(text, default_unit: str = "rad/s") -> float:
+    """``"5rev/s"`` → 31.4159 (rad/s); accepts rad/s, rev/s, Hz, rps, rpm, rev/min, deg/s."""
+    if isinstance(text, (int, float)):
+        value, unit = float(text), default_unit
+    else:
+        value, unit = _split(text, "an angular rate")
+        unit = unit or default_unit
+    if unit not in _RATE:
+        raise UnitsError(f"Expected an angular-rate unit among {', '.join(_RATE)}, got {unit!r}")
+    return value * _RATE[unit]
+
+
+_TIME = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0}
+
+
+def parse_duration(text, default_unit: str = "s") -> float:
+    """``"30s"`` → 30.0, ``"2min"`` → 120.0 (s)."""
+    if isinstance(text, (int, float)):
+        value, unit = float(text), default_unit
+    else:
+        value, unit = _split(text, "a duration")
+        unit = unit or default_unit
+    if unit not in _TIME:
+        raise UnitsError(f"Expected a time unit among {', '.join(_TIME)}, got {unit!r}")
+    return value * _TIME[unit]
+
+
+_MASS = {"kg": 1.0, "g": 1e-3, "mg": 1e-6, "lb": 0.45359237, "t": 1000.0}
+
+
+def parse_mass(text, default_unit: str = "kg") -> float:
+    """``"412g"`` → 0.412 (kg); accepts kg, g, mg, lb, t."""
+    if isinstance(text, (int, float)):
+        value, unit = float(text), default_unit
+    else:
+        value, unit = _split(text, "a mass")
+        unit = unit or default_unit
+    if unit not in _MASS:
+        raise UnitsError(f"Expected a mass unit among {', '.join(_MASS)}, got {unit!r}")
+    return value * _MASS[unit]
+
+
+_DENSITY = {"kg/m3": 1.0, "kg/m^3": 1.0, "g/cm3": 1000.0, "g/cm^3": 1000.0, "g/cc": 1000.0,
+            "g/ml": 1000.0, "kg/l": 1000.0, "lb/in3": 27679.9047, "lb/ft3": 16.0184634}
+
+
+def parse_density(text, default_unit: str = "kg/m3") -> float:
+    """``"7850"`` → 7850.0, ``"1.24g/cm3"`` → 1240.0 (kg/m³)."""
+    if isinstance(text, (int, float)):
+        value, unit = float(text), default_unit
+    else:
+        value, unit = _split(text, "a density")
+        unit = unit or default_unit
+    if unit not in _DENSITY:
+        raise UnitsError(f"Expected a density unit among {', '.join(_DENSITY)}, got {unit!r}")
+    return value * _DENSITY[unit]

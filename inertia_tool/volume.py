@@ -1,0 +1,180 @@
+"""Volume integrals of a closed triangle mesh by signed tetrahedra.
+
+Each triangle ``(a, b, c)`` (counter-clockwise seen from outside) and a reference point ``o`` span a
+tetrahedron of signed volume ``v = (a−o)·((b−o)×(c−o))/6``.  For a tetrahedron with one vertex at the
+origin and the others at ``p1, p2, p3`` the moments of a unit density are exact polynomials of the
+vertices (Tonon, F., "Explicit exact formulas for the 3-D tetrahedron inertia tensor in terms of its vertex
+coordinates", J. Math. Stat. 1 (2004) 8–11; the same identity is the covariance form of Blow & Binstock):
+
+* ``∫ 1 dV = v``
+* ``∫ x_i dV = v (p1 + p2 + p3)_i / 4``
+* ``∫ x_i x_j dV = v/20 · [ Σ_k p_k,i p_k,j + s_i s_j ]`` with ``s = p1 + p2 + p3``
+
+Summing over the faces gives the integrals over the polyhedron exactly (the contributions outside the
+solid cancel in pairs), which is Eq. (4.13) of the chapter made discrete.  The inertia tensor follows as
+``I = tr(C) 𝟙 − C`` from the second-moment matrix ``C_ij = ∫ x_i x_j dV`` (Eq. 4.11).
+
+Precision: the reference point is chosen near the body (the mean of the vertex bounding box) and the
+coordinates are made relative to it before any product is formed, so a part far from the origin keeps
+all its digits (a unit cube at 1e8 keeps its central tensor to ~1e-16 relative).
+
+Memory: faces are processed in chunks of ``chunk_size`` so temporaries stay bounded.
+
+Everything here is pure: SI numpy arrays in, numpy arrays out.  See ``docs/conventions.md``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia"]
+
+_DEFAULT_CHUNK = 1 << 18
+
+
+@dataclass(frozen=True)
+class VolumeMoments:
+    """Zeroth, first and second volume moments of a solid (unit density).
+
+    Attributes
+    ----------
+    volume : float
+        ``∫ dV`` in m³ (signed: negative for an inside-out surface).
+    centroid : (3,) float
+        ``∫ x dV / V`` in m, mesh axes (NaN when the volume is zero).
+    second_moment : (3, 3) float
+        ``C_ij = ∫ (x−c)_i (x−c)_j dV`` in m⁵ about the centroid ``c``, mesh axes.
+    area : float
+        Surface area in m² (sum of triangle areas).
+    """
+
+    volume: float
+    centroid: np.ndarray
+    second_moment: np.ndarray
+    area: float
+
+
+def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chunk_size: int,
+                labels: np.ndarray | None = None, n_labels: int = 1):
+    """Accumulate per-label raw sums about ``origin``.
+
+    Returns arrays ``vol (L,)``, ``first (L, 3)``, ``second (L, 3, 3)``, ``area (L,)`` where the sums are
+    ``Σ v``, ``Σ v s / 4`` and ``Σ v/20 (Σ p pᵀ + s sᵀ)`` over the faces of each label.
+    """
+    vol = np.zeros(n_labels)
+    first = np.zeros((n_labels, 3))
+    second = np.zeros((n_labels, 6))
+    area = np.zeros(n_labels)
+    iu = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))
+    n_faces = len(faces)
+    for start in range(0, n_faces, chunk_size):
+        f = faces[start:start + chunk_size]
+        p1 = vertices[f[:, 0]] - origin
+        p2 = vertices[f[:, 1]] - origin
+        p3 = vertices[f[:, 2]] - origin
+        cross = np.cross(p2, p3)
+        v = np.einsum("ij,ij->i", p1, cross) / 6.0
+        s = p1 + p2 + p3
+        # six independent entries of Σ_k p_k p_kᵀ + s sᵀ
+        quad = np.empty((len(f), 6))
+        for col, (i, j) in enumerate(zip(*iu)):
+            quad[:, col] = p1[:, i] * p1[:, j] + p2[:, i] * p2[:, j] + p3[:, i] * p3[:, j] + s[:, i] * s[:, j]
+        tri_area = 0.5 * np.linalg.norm(np.cross(p2 - p1, p3 - p1), axis=1)
+        if labels is None:
+            vol[0] += v.sum()
+            first[0] += v @ s / 4.0
+            second[0] += v @ quad / 20.0
+            area[0] += tri_area.sum()
+        else:
+            lab = labels[start:start + chunk_size]
+            vol += np.bincount(lab, weights=v, minlength=n_labels)
+            area += np.bincount(lab, weights=tri_area, minlength=n_labels)
+            for i in range(3):
+                first[:, i] += np.bincount(lab, weights=v * s[:, i], minlength=n_labels) / 4.0
+            for col in range(6):
+                second[:, col] += np.bincount(lab, weights=v * quad[:, col], minlength=n_labels) / 20.0
+    full = np.empty((n_labels, 3, 3))
+    for col, (i, j) in enumerate(zip(*iu)):
+        full[:, i, j] = second[:, col]
+        full[:, j, i] = second[:, col]
+    return vol, first, full, area
+
+
+def _finish(vol: float, first: np.ndarray, second: np.ndarray, area: float, origin: np.ndarray) -> VolumeMoments:
+    if vol != 0.0:
+        d = first / vol                       # centroid relative to origin
+        central = second - vol * np.outer(d, d)
+        central = 0.5 * (central + central.T)
+        centroid = origin + d
+    else:
+        centroid = np.full(3, np.nan)
+        central = second.copy()
+    return VolumeMoments(volume=float(vol), centroid=centroid, second_moment=central, area=float(area))
+
+
+def reference_point(vertices: np.ndarray) -> np.ndarray:
+    """A point near the body: the centre of the vertex bounding box, (3,) m."""
+    if len(vertices) == 0:
+        return np.zeros(3)
+    return 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
+
+
+def volume_moments(vertices: np.ndarray, faces: np.ndarray, *, origin: np.ndarray | None = None,
+                   chunk_size: int = _DEFAULT_CHUNK) -> VolumeMoments:
+    """Exact volume, centroid and central second moment of the polyhedron bounded by ``faces``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        Vertex coordinates in m.
+    faces : (m, 3) int
+        Triangles, counter-clockwise seen from outside (outward normals).
+    origin : (3,) float, optional
+        Reference point of the tetrahedra; defaults to the bounding-box centre, which keeps precision for
+        parts far from the origin.  Any point gives the same result up to round-off.
+    chunk_size : int
+        Faces processed per vectorised step (bounds temporary memory at about 400 bytes per face).
+
+    Returns
+    -------
+    VolumeMoments
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces)
+    o = reference_point(vertices) if origin is None else np.asarray(origin, dtype=np.float64)
+    vol, first, second, area = _tetra_sums(vertices, faces, o, max(1, int(chunk_size)))
+    return _finish(vol[0], first[0], second[0], area[0], o)
+
+
+def body_volume_moments(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n_labels: int, *,
+                        origin: np.ndarray | None = None, chunk_size: int = _DEFAULT_CHUNK) -> list[VolumeMoments]:
+    """Like :func:`volume_moments` but separately for each group of faces (``labels[i]`` in ``[0, n_labels)``).
+
+    Used for meshes with several shells (bodies and cavities); one pass over the faces.
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    o = reference_point(vertices) if origin is None else np.asarray(origin, dtype=np.float64)
+    vol, first, second, area = _tetra_sums(vertices, np.asarray(faces), o, max(1, int(chunk_size)),
+                                           labels=np.asarray(labels, dtype=np.intp), n_labels=n_labels)
+    return [_finish(vol[k], first[k], second[k], area[k], o) for k in range(n_labels)]
+
+
+def second_moment_to_inertia(second_moment: np.ndarray, density: float = 1.0) -> np.ndarray:
+    """Inertia tensor ``I = ρ (tr(C) 𝟙 − C)`` from the second-moment matrix ``C`` (Eq. 4.11/4.13).
+
+    Parameters
+    ----------
+    second_moment : (3, 3) float
+        ``C_ij = ∫ x_i x_j dV`` in m⁵ about some point.
+    density : float
+        kg/m³.
+
+    Returns
+    -------
+    (3, 3) float
+        kg·m² about the same point; off-diagonals are −∫xy dm (tensor convention).
+    """
+    c = np.asarray(second_moment, dtype=np.float64)
+    return density * (np.trace(c) * np.eye(3) - c)
