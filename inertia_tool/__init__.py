@@ -13,12 +13,17 @@ from .errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, Mes
                      UsageError)
 from .principal import PrincipalAxes, principal_axes
 from .properties import InertiaTensor, MassProperties, combine, point_mass
+from .pipeline import assembly, mass_properties
+from .checks import MeshReport
 
 __version__ = "0.1.0"
 
 __all__ = [
     "__version__",
+    "mass_properties",
+    "assembly",
     "MassProperties",
+    "MeshReport",
     "InertiaTensor",
     "PrincipalAxes",
     "principal_axes",

@@ -1,0 +1,361 @@
+"""From a mesh source to ``MassProperties``: read → weld → check → integrate → assemble.
+
+This is the public entry point of the engine (``inertia_tool.mass_properties``).  Each stage lives in its
+own module (``io``, ``weld``, ``checks``, ``volume``, ``properties``); this module only routes between them
+and decides what to do with what the checks found: refuse (open, non-manifold, inconsistently wound,
+flat), repair on request, flip an inside-out shell with a warning, count a nested negative shell as a cavity,
+warn about overlapping bodies.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .checks import MeshReport, degenerate_faces, edge_topology, shell_labels, winding_number
+from .errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
+                     OverlapWarning, UsageError)
+from .io import DEFAULT_MAX_FACES, RawMesh, load_mesh
+from .properties import MassProperties, combine
+from .units import material_density
+from .volume import VolumeMoments, body_volume_moments, reference_point, second_moment_to_inertia
+from .weld import weld_tolerance
+
+__all__ = ["mass_properties", "assembly", "resolve_density", "DEFAULT_DENSITY", "DEFAULT_MERGE_TOLERANCE",
+           "prepare_mesh", "PreparedMesh"]
+
+#: Density used when none of density / material / mass is given (water), kg/m³.  Reports say so.
+DEFAULT_DENSITY = 1000.0
+
+#: Relative (to the bounding-box diagonal) grid spacing for welding nearly coincident vertices when exact
+#: welding leaves the surface open.
+DEFAULT_MERGE_TOLERANCE = 1e-6
+
+#: Shells with |volume| below this fraction of the bounding-box diagonal cubed are flat.
+_FLAT_RTOL = 1e-12
+
+#: Upper bound on triangle-point solid-angle evaluations spent on cavity / overlap classification.
+_WINDING_BUDGET = 200_000_000
+
+
+@dataclass(frozen=True)
+class PreparedMesh:
+    """A checked mesh ready for integration, with its shells classified.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float64
+        m, mesh axes.
+    faces : (m, 3) int
+        Outward-wound after any flips.
+    labels : (m,) int
+        Shell of each face.
+    shells : tuple of VolumeMoments
+        Per-shell unit-density moments (after flips; cavities have negative volume).
+    owner : (k,) int
+        For each shell, the body it belongs to (a cavity belongs to the body around it).
+    report : MeshReport
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    labels: np.ndarray
+    shells: tuple
+    owner: np.ndarray
+    report: MeshReport
+
+
+def resolve_density(*, density=None, material=None, mass=None) -> tuple[float | None, str]:
+    """Decide the density from at most one of ``density`` (kg/m³), ``material`` (name) or ``mass`` (kg).
+
+    Returns ``(density or None when a target mass is used, description)``.
+    """
+    given = [x is not None for x in (density, material, mass)]
+    if sum(given) > 1:
+        raise UsageError("Give at most one of density, material and mass")
+    if density is not None:
+        if not (np.isfinite(density) and density > 0):
+            raise UsageError(f"Expected a positive finite density in kg/m³, got {density}")
+        return float(density), f"{float(density):g} kg/m³"
+    if material is not None:
+        rho = material_density(material)
+        return rho, f"{material} ({rho:g} kg/m³)"
+    if mass is not None:
+        if not (np.isfinite(mass) and mass > 0):
+            raise UsageError(f"Expected a positive finite mass in kg, got {mass}")
+        return None, f"scaled to a total mass of {float(mass):g} kg"
+    return DEFAULT_DENSITY, f"{DEFAULT_DENSITY:g} kg/m³ (default: water; give a density, material or mass)"
+
+
+def _describe_edges(topo, source: str) -> str:
+    parts = []
+    if topo.boundary_edges:
+        parts.append(f"{topo.boundary_edges:,} boundary edges (holes)")
+    if topo.nonmanifold_edges:
+        parts.append(f"{topo.nonmanifold_edges:,} non-manifold edges (shared by 3+ faces)")
+    if topo.misoriented_edges:
+        parts.append(f"{topo.misoriented_edges:,} edges with inconsistent winding (flipped faces)")
+    where = ""
+    if len(topo.sample):
+        a, b = topo.sample[0]
+        where = f", e.g. the edge ({a[0]:.6g}, {a[1]:.6g}, {a[2]:.6g})–({b[0]:.6g}, {b[1]:.6g}, {b[2]:.6g}) m"
+    return f"{source}: not a closed, consistently wound solid: {'; '.join(parts)}{where}; use --repair to fix"
+
+
+def _repair(vertices, faces, source):
+    """Close holes and fix winding with trimesh; returns new arrays and the list of actions."""
+    import trimesh
+
+    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
+    actions = []
+    before_faces = len(mesh.faces)
+    if not mesh.is_winding_consistent:
+        trimesh.repair.fix_winding(mesh)
+        actions.append("made the winding consistent")
+    if not mesh.is_watertight:
+        trimesh.repair.fill_holes(mesh)
+        if len(mesh.faces) != before_faces:
+            actions.append(f"filled holes with {len(mesh.faces) - before_faces} new triangles")
+    if not (mesh.is_watertight and mesh.is_winding_consistent):
+        raise InvalidMeshError(f"{source}: could not be repaired into a closed solid "
+                               "(holes too complex or non-manifold edges remain)")
+    return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces), actions
+
+
+def _signed_volume(vertices, faces) -> float:
+    o = reference_point(vertices)
+    a = vertices[faces[:, 0]] - o
+    return float(np.einsum("ij,ij->i", a, np.cross(vertices[faces[:, 1]] - o, vertices[faces[:, 2]] - o)).sum() / 6)
+
+
+def _classify_shells(vertices, faces, labels, n_shells, shells, diag):
+    """Flip inside-out shells, attach cavities to their bodies, detect overlaps.
+
+    Returns (shells, owner, flipped, cavities, overlaps, face_flip_mask_per_shell).
+    """
+    vols = np.array([s.volume for s in shells])
+    flip = np.zeros(n_shells, dtype=bool)
+    owner = np.arange(n_shells)
+    if n_shells == 1:
+        flip[0] = vols[0] < 0
+        return flip, owner, 0, 0
+    # bounding boxes per shell and one probe point per shell (centroid of its first face)
+    order = np.argsort(labels, kind="stable")
+    starts = np.searchsorted(labels[order], np.arange(n_shells))
+    corner = vertices[faces[order]]
+    lo = np.minimum.reduceat(corner.min(axis=1), starts, axis=0)
+    hi = np.maximum.reduceat(corner.max(axis=1), starts, axis=0)
+    probe = corner[starts].mean(axis=1)
+    face_count = np.diff(np.r_[starts, len(faces)])
+    sign = np.sign(vols)
+    if vols.sum() < 0:
+        # the whole mesh is inside out: flip every shell first
+        sign = -sign
+        flip[:] = True
+    winding = np.zeros(n_shells)
+    budget = _WINDING_BUDGET
+    for s in range(n_shells):
+        inside_box = np.all((probe[s] >= lo) & (probe[s] <= hi), axis=1)
+        inside_box[s] = False
+        for t in np.flatnonzero(inside_box):
+            budget -= face_count[t]
+            if budget < 0:
+                break
+            orient = -1.0 if flip[t] else 1.0
+            w = orient * winding_number(probe[s], vertices, faces[order[starts[t]:starts[t] + face_count[t]]])
+            winding[s] += w
+            if sign[s] < 0 and w > 0.5 and sign[t] > 0:
+                owner[s] = t
+    cavities = 0
+    overlaps = 0
+    for s in range(n_shells):
+        inside_material = winding[s] > 0.5
+        if sign[s] < 0:
+            if inside_material:
+                cavities += 1           # a void inside a body: keep its negative volume
+            else:
+                flip[s] = not flip[s]   # an inside-out body on its own: flip it
+                owner[s] = s
+        elif inside_material:
+            overlaps += 1
+    return flip, owner, cavities, overlaps
+
+
+def prepare_mesh(raw: RawMesh, *, repair: bool = False,
+                 merge_tolerance: float = DEFAULT_MERGE_TOLERANCE) -> PreparedMesh:
+    """Check a raw mesh and classify its shells (see the module docstring for the policy)."""
+    source = raw.source
+    v, f = raw.vertices, raw.faces
+    if len(f) == 0:
+        raise InvalidMeshError(f"{source}: the mesh has no triangles")
+    repeated, zero_area = degenerate_faces(v, f)
+    n_repeated = int(np.count_nonzero(repeated))
+    if n_repeated == len(f):
+        raise InvalidMeshError(f"{source}: all {len(f):,} triangles are degenerate (no area); nothing to integrate")
+    if n_repeated:
+        f = f[~repeated]
+        warnings.warn(DegenerateFacesWarning(f"{source}: {n_repeated:,} degenerate triangles (a repeated corner) "
+                                             "were ignored"), stacklevel=3)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    diag = float(np.linalg.norm(hi - lo))
+    if not diag > 0:
+        raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")
+    topo = edge_topology(f, len(v), v)
+    watertight = topo.oriented
+    welded = None
+    if not topo.closed and merge_tolerance and merge_tolerance > 0:
+        tol = merge_tolerance * diag
+        f2 = weld_tolerance(v, f, tol)
+        keep = ~((f2[:, 0] == f2[:, 1]) | (f2[:, 1] == f2[:, 2]) | (f2[:, 2] == f2[:, 0]))
+        f2 = f2[keep]
+        topo2 = edge_topology(f2, len(v), v)
+        if topo2.closed:
+            f, topo, welded = f2, topo2, tol
+            watertight = topo.oriented
+    repaired = False
+    actions: list[str] = []
+    volume_change = None
+    if not topo.oriented:
+        if not repair:
+            raise InvalidMeshError(_describe_edges(topo, source),
+                                   details={"boundary_edges": topo.boundary_edges,
+                                            "nonmanifold_edges": topo.nonmanifold_edges,
+                                            "misoriented_edges": topo.misoriented_edges})
+        before = _signed_volume(v, f)
+        v, f, actions = _repair(v, f, source)
+        after = _signed_volume(v, f)
+        volume_change = (abs(after) - abs(before)) / abs(after) if after else None
+        repaired = bool(actions)
+        if repaired:
+            change = f"; volume changed by {100 * volume_change:+.3g}%" if volume_change is not None else ""
+            warnings.warn(MeshRepairedWarning(f"{source}: repaired: {', '.join(actions)}{change}"), stacklevel=3)
+    labels, n_shells = shell_labels(f, len(v))
+    shells = body_volume_moments(v, f, labels, n_shells)
+    flat = [k for k, s in enumerate(shells) if abs(s.volume) <= _FLAT_RTOL * diag ** 3]
+    if flat:
+        what = "the mesh encloses" if n_shells == 1 else f"{len(flat)} of {n_shells} shells enclose"
+        raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface)")
+    flip, owner, cavities, overlaps = _classify_shells(v, f, labels, n_shells, shells, diag)
+    if flip.any():
+        face_flip = flip[labels]
+        f = f.copy()
+        f[face_flip] = f[face_flip][:, ::-1]
+        shells = [VolumeMoments(-s.volume, s.centroid, -s.second_moment, s.area) if flip[k] else s
+                  for k, s in enumerate(shells)]
+        n_flipped = int(np.count_nonzero(flip))
+        what = "the mesh is" if n_shells == 1 or n_flipped == n_shells else f"{n_flipped} of {n_shells} shells are"
+        warnings.warn(InsideOutWarning(f"{source}: {what} inside out (normals point inward); flipped"),
+                      stacklevel=3)
+    if overlaps:
+        warnings.warn(OverlapWarning(f"{source}: {overlaps} bod{'y lies' if overlaps == 1 else 'ies lie'} inside "
+                                     "another body; the overlapping volume is counted twice"), stacklevel=3)
+    bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
+    report = MeshReport(source=source, units=raw.units, file_faces=raw.file_faces, vertices=len(v), faces=len(f),
+                        degenerate_faces=n_repeated, zero_area_faces=zero_area, bodies=bodies, cavities=cavities,
+                        flipped_shells=int(np.count_nonzero(flip)), overlapping_shells=overlaps,
+                        watertight=watertight, welded_tolerance=welded, repaired=repaired,
+                        repair_actions=tuple(actions), repair_volume_change=volume_change,
+                        bbox_min=v.min(axis=0), bbox_max=v.max(axis=0))
+    return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
+
+
+def _shell_properties(s: VolumeMoments, density: float, name: str) -> MassProperties:
+    return MassProperties(mass=density * s.volume, volume=s.volume, center_of_mass=s.centroid,
+                          inertia=second_moment_to_inertia(s.second_moment, density), surface_area=s.area,
+                          density=density, name=name)
+
+
+def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassProperties]:
+    bodies = []
+    owners = np.unique(prepared.owner)
+    for b in owners:
+        members = [prepared.shells[k] for k in np.flatnonzero(prepared.owner == b)]
+        props = [_shell_properties(s, density, name) for s in members]
+        body = props[0] if len(props) == 1 else combine(props, name=name)
+        bodies.append(MassProperties(mass=body.mass, volume=body.volume, center_of_mass=body.center_of_mass,
+                                     inertia=body.inertia, surface_area=body.surface_area, density=density,
+                                     name=f"{name} body {len(bodies) + 1}" if len(owners) > 1 else name))
+    return bodies
+
+
+def mass_properties(source, *, units: str = "m", density: float | None = None, material: str | None = None,
+                    mass: float | None = None, repair: bool = False,
+                    merge_tolerance: float = DEFAULT_MERGE_TOLERANCE, max_faces: int = DEFAULT_MAX_FACES,
+                    name: str | None = None) -> MassProperties:
+    """Mass properties of the solid bounded by a triangle mesh, exact for the polyhedron.
+
+    Parameters
+    ----------
+    source : str or os.PathLike or trimesh.Trimesh or (vertices, faces)
+        The mesh (see :func:`inertia_tool.io.load_mesh`).
+    units : str
+        Length unit of the mesh coordinates: ``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft``.
+    density : float, optional
+        kg/m³.
+    material : str, optional
+        Name from :data:`inertia_tool.units.MATERIALS` (e.g. ``"aluminium"``, ``"steel"``, ``"PLA"``).
+    mass : float, optional
+        Target total mass in kg; the density is set to ``mass / volume``.
+        At most one of ``density``, ``material``, ``mass``; none means 1000 kg/m³ (water).
+    repair : bool
+        Close holes and fix inconsistent winding (through trimesh) instead of refusing the mesh; the
+        mesh report says what changed and by how much the volume moved.
+    merge_tolerance : float
+        Relative (to the bounding-box diagonal) spacing for welding nearly coincident vertices when
+        bit-exact welding leaves the surface open; 0 disables it.
+    max_faces : int
+        Refuse meshes with more triangles (memory guard).
+    name : str, optional
+        Label for reports; defaults to the source.
+
+    Returns
+    -------
+    MassProperties
+        SI; ``inertia`` about the centre of mass in mesh axes (tensor convention).  ``mesh`` holds the
+        :class:`~inertia_tool.checks.MeshReport`; ``parts`` the bodies when the mesh has several.
+
+    Raises
+    ------
+    MeshReadError, InvalidMeshError, UsageError
+    """
+    rho, _ = resolve_density(density=density, material=material, mass=mass)
+    raw = load_mesh(source, units=units, max_faces=max_faces)
+    prepared = prepare_mesh(raw, repair=repair, merge_tolerance=merge_tolerance)
+    label = name or raw.source
+    bodies = _bodies(prepared, rho if rho is not None else 1.0, label)
+    total = bodies[0] if len(bodies) == 1 else combine(bodies, name=label)
+    result = MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
+                            inertia=total.inertia, surface_area=total.surface_area,
+                            density=rho if rho is not None else 1.0, name=label, mesh=prepared.report,
+                            parts=tuple(bodies) if len(bodies) > 1 else ())
+    if rho is None:
+        result = result.with_mass(mass)
+    return result
+
+
+def assembly(parts, *, units: str = "m", mass: float | None = None, **options) -> MassProperties:
+    """Combine several meshes, each with its own material, into one rigid body.
+
+    Parameters
+    ----------
+    parts : iterable of dict
+        Each ``{"source": path_or_mesh, "density": kg/m³}`` or ``{"source": ..., "material": name}``
+        (optionally ``"units"`` and ``"name"``).
+    units : str
+        Default length unit of the parts.
+    mass : float, optional
+        Scale the whole assembly to this total mass (kg), keeping the density ratios.
+    **options
+        Passed to :func:`mass_properties` (``repair``, ``merge_tolerance``, ``max_faces``).
+    """
+    bodies = []
+    for spec in parts:
+        spec = dict(spec)
+        src = spec.pop("source")
+        bodies.append(mass_properties(src, units=spec.pop("units", units), **spec, **options))
+    if not bodies:
+        raise UsageError("Expected at least one part in the assembly")
+    total = bodies[0] if len(bodies) == 1 else combine(bodies, name="assembly")
+    return total.with_mass(mass) if mass is not None else total

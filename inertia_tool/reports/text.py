@@ -1,0 +1,90 @@
+"""Human-readable text report of ``analyze``.  Formatting only: every number comes from the engine."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..properties import MassProperties
+from .serialize import TENSOR_CONVENTION
+
+__all__ = ["format_mass_properties"]
+
+
+def _num(x: float) -> str:
+    return f"{x:.6g}"
+
+
+def _clean(a, rel: float = 1e-12) -> np.ndarray:
+    """Display only: entries below ``rel`` times the largest magnitude print as 0 (round-off, not data)."""
+    a = np.asarray(a, dtype=float)
+    scale = np.max(np.abs(a)) if a.size else 0.0
+    return np.where(np.abs(a) <= rel * scale, 0.0, a) + 0.0
+
+
+def _vec(v) -> str:
+    return "(" + ", ".join(f"{x: .6g}" for x in _clean(v)) + ")"
+
+
+def _matrix(m, indent: str) -> list[str]:
+    m = _clean(m)
+    return [indent + "[" + "  ".join(f"{x: .6e}" for x in row) + " ]" for row in m]
+
+
+def format_mass_properties(props: MassProperties, *, density_source: str | None = None) -> str:
+    """Multi-line report: units, volume, mass, COM, inertia (about COM and mesh origin), principal axes,
+    radii of gyration, physical checks and mesh diagnostics."""
+    pa = props.principal
+    lines = [f"Mass properties of {props.name}"]
+    mesh = props.mesh
+    unit_note = f" (mesh coordinates in {mesh.units}, converted)" if mesh is not None else ""
+    lines.append(f"  units: SI — m, kg, kg·m²{unit_note}")
+    if density_source:
+        lines.append(f"  density:          {density_source}")
+    lines.append(f"  volume:           {_num(props.volume)} m³")
+    lines.append(f"  mass:             {_num(props.mass)} kg")
+    lines.append(f"  surface area:     {_num(props.surface_area)} m²")
+    lines.append(f"  centre of mass:   {_vec(props.center_of_mass)} m")
+    lines.append(f"  inertia about the centre of mass, mesh axes (kg·m²; {TENSOR_CONVENTION}):")
+    lines += _matrix(props.inertia, "    ")
+    lines.append("  inertia about the mesh origin (0, 0, 0), mesh axes (kg·m²):")
+    lines += _matrix(np.asarray(props.inertia_about(np.zeros(3))), "    ")
+    lines.append("  (entries below 1e-12 of the largest in a vector or matrix are shown as 0)")
+    lines.append("  principal moments (ascending) and axes (unit vectors, mesh axes, right-handed):")
+    for k in range(3):
+        lines.append(f"    I{k + 1} = {pa.moments[k]:.6e} kg·m²   axis {_vec(pa.axes[:, k])}   "
+                     f"radius of gyration {_num(pa.radii_of_gyration[k])} m")
+    if pa.is_spherical:
+        lines.append(f"    all three moments are equal within {pa.rtol:g}: every axis through the centre of mass "
+                     "is principal (axes shown are the mesh axes)")
+    elif pa.is_axisymmetric:
+        i, j = pa.equal_pairs[0]
+        lines.append(f"    I{i + 1} and I{j + 1} are equal within {pa.rtol:g} (axisymmetric): any axis in their plane "
+                     "is principal; the two shown are one choice")
+    margin = pa.triangle_inequality_margin
+    ok = np.all(pa.moments > 0) and margin >= -1e-9
+    lines.append(f"  checks: moments positive: {'yes' if np.all(pa.moments > 0) else 'NO'}; "
+                 f"triangle inequality I1 + I2 ≥ I3: {'yes' if margin >= -1e-9 else 'NO'} "
+                 f"(margin {margin:.3g}){'' if ok else '  <- not a physical body'}")
+    if props.parts:
+        lines.append(f"  bodies ({len(props.parts)}):")
+        for b in props.parts:
+            lines.append(f"    {b.name}: mass {_num(b.mass)} kg, volume {_num(b.volume)} m³, "
+                         f"centre of mass {_vec(b.center_of_mass)} m")
+    if mesh is not None:
+        lines.append("  mesh:")
+        lines.append(f"    faces {mesh.faces:,} (file {mesh.file_faces:,}), vertices {mesh.vertices:,}, "
+                     f"bodies {mesh.bodies}, cavities {mesh.cavities}")
+        lines.append(f"    watertight and consistently wound as read: {'yes' if mesh.watertight else 'no'}"
+                     f"; degenerate faces ignored: {mesh.degenerate_faces}; zero-area faces: {mesh.zero_area_faces}")
+        if mesh.welded_tolerance is not None:
+            lines.append(f"    nearly coincident vertices welded within {mesh.welded_tolerance:.3g} m")
+        if mesh.flipped_shells:
+            lines.append(f"    inside-out shells flipped: {mesh.flipped_shells}")
+        if mesh.overlapping_shells:
+            lines.append(f"    overlapping bodies (volume counted twice): {mesh.overlapping_shells}")
+        if mesh.repaired:
+            change = (f", volume changed by {100 * mesh.repair_volume_change:+.3g}%"
+                      if mesh.repair_volume_change is not None else "")
+            lines.append(f"    repaired: {', '.join(mesh.repair_actions)}{change}")
+        lines.append(f"    bounding box: {_vec(mesh.bbox_min)} – {_vec(mesh.bbox_max)} m")
+    return "\n".join(lines)

@@ -1,0 +1,37 @@
+import numpy as np
+import pytest
+import trimesh
+
+
+@pytest.fixture
+def box_mesh():
+    """Axis-aligned box 1 x 2 x 3 m centred at the origin (trimesh, outward winding)."""
+    return trimesh.creation.box([1.0, 2.0, 3.0])
+
+
+def box_arrays(extents=(1.0, 2.0, 3.0), center=(0.0, 0.0, 0.0)):
+    m = trimesh.creation.box(extents)
+    return np.asarray(m.vertices) + np.asarray(center), np.asarray(m.faces)
+
+
+def write_binary_stl(path, vertices, faces, header=b"", extra=b""):
+    tri = np.asarray(vertices, dtype=np.float32)[np.asarray(faces)]
+    rec = np.zeros(len(tri), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = tri
+    with open(path, "wb") as fh:
+        fh.write(header.ljust(80, b" ")[:80])
+        fh.write(np.uint32(len(tri)).tobytes())
+        fh.write(rec.tobytes())
+        fh.write(extra)
+
+
+def write_ascii_stl(path, vertices, faces, newline="\n"):
+    tri = np.asarray(vertices, dtype=float)[np.asarray(faces)]
+    lines = ["solid test"]
+    for t in tri:
+        lines += ["  facet normal 0 0 0", "    outer loop"]
+        lines += [f"      vertex {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in t]
+        lines += ["    endloop", "  endfacet"]
+    lines.append("endsolid test")
+    with open(path, "w", newline="") as fh:
+        fh.write(newline.join(lines) + newline)

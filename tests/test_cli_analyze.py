@@ -1,0 +1,105 @@
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import box_arrays, write_binary_stl
+from inertia_tool.cli import main
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+@pytest.fixture
+def box_stl(tmp_path):
+    p = tmp_path / "box.stl"
+    write_binary_stl(p, *box_arrays((10.0, 20.0, 30.0), center=(5.0, 0.0, 0.0)))
+    return str(p)
+
+
+def test_json_has_the_documented_keys_in_si(box_stl, capsys):
+    assert main(["analyze", box_stl, "--units", "mm", "--material", "aluminium", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("mass", "volume", "center_of_mass", "inertia", "principal_moments", "principal_axes", "units", "mesh"):
+        assert key in out
+    m = 2700 * 6e-6
+    assert out["mass"] == pytest.approx(m, rel=1e-6)
+    assert out["volume"] == pytest.approx(6e-6, rel=1e-6)
+    np.testing.assert_allclose(out["center_of_mass"], [0.005, 0, 0], atol=1e-9)
+    np.testing.assert_allclose(np.diag(out["inertia"]), m * np.array([0.02**2 + 0.03**2, 0.01**2 + 0.03**2,
+                                                                       0.01**2 + 0.02**2]) / 12, rtol=1e-6)
+    assert out["principal_moments"] == sorted(out["principal_moments"])
+    axes = np.array(out["principal_axes"])
+    assert np.linalg.det(axes.T) == pytest.approx(1.0)
+    assert out["mesh"]["watertight"] is True and out["mesh"]["bodies"] == 1
+
+
+def test_text_report_states_units_and_sections(box_stl, capsys):
+    assert main(["analyze", box_stl, "--units", "mm", "--density", "1000"]) == 0
+    text = capsys.readouterr().out
+    for needle in ("units: SI", "centre of mass", "about the mesh origin", "principal moments", "radius of gyration",
+                   "watertight"):
+        assert needle in text
+
+
+def test_assembly_with_part_materials(tmp_path, capsys):
+    a, b = tmp_path / "a.stl", tmp_path / "b.stl"
+    write_binary_stl(a, *box_arrays((1.0, 1.0, 1.0)))
+    write_binary_stl(b, *box_arrays((1.0, 1.0, 1.0), center=(2.0, 0, 0)))
+    assert main(["analyze", f"{a}:steel", f"{b}:1000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mass"] == pytest.approx(8850.0)
+    assert len(out["bodies"]) == 2
+
+
+@pytest.mark.parametrize("argv, code, message", [
+    (["analyze", "/definitely/missing.stl"], 3, "no such file"),
+    (["analyze", "BOX", "--units", "furlong"], 2, "length unit"),
+    (["analyze", "BOX", "--material", "unobtainium"], 2, "Unknown material"),
+    (["analyze", "BOX", "--density", "-5"], 2, "positive"),
+    (["analyze"], 2, "required"),
+])
+def test_errors_are_one_line_with_documented_exit_codes(box_stl, capsys, argv, code, message):
+    argv = [box_stl if a == "BOX" else a for a in argv]
+    with pytest.raises(SystemExit) if code == 2 and len(argv) == 1 else _nullcontext() as ctx:
+        rc = main(argv)
+    if ctx is not None and hasattr(ctx, "value"):
+        rc = ctx.value.code
+    assert rc == code
+    err = capsys.readouterr().err
+    assert message in err
+    assert "Traceback" not in err
+
+
+class _nullcontext:
+    def __enter__(self):
+        return None
+
+    def __exit__(self, *exc):
+        return False
+
+
+def test_open_mesh_exit_3_and_no_traceback_end_to_end(tmp_path):
+    v, f = box_arrays()
+    p = tmp_path / "open.stl"
+    write_binary_stl(p, v, f[1:])
+    r = subprocess.run([sys.executable, "-m", "inertia_tool.cli", "analyze", str(p)], capture_output=True, text=True,
+                       env={**os.environ, "PYTHONPATH": ROOT})
+    assert r.returncode == 3
+    assert "boundary edges" in r.stderr and str(p) in r.stderr
+    assert "Traceback" not in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
+def test_warnings_go_to_stderr_and_json(tmp_path, capsys):
+    v, f = box_arrays()
+    p = tmp_path / "inv.stl"
+    write_binary_stl(p, v, f[:, ::-1])
+    assert main(["analyze", str(p), "--json"]) == 0
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    assert out["volume"] == pytest.approx(6.0)
+    assert any("inside out" in w for w in out["warnings"])
+    assert "inside out" in cap.err

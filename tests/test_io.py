@@ -1,0 +1,145 @@
+import os
+import warnings
+
+import numpy as np
+import pytest
+import trimesh
+
+from conftest import box_arrays, write_ascii_stl, write_binary_stl
+from inertia_tool.errors import MeshReadError, TrailingDataWarning, UsageError
+from inertia_tool.io import load_mesh, read_stl
+
+
+def _same_triangles(raw, vertices, faces, scale=1.0):
+    got = np.sort(np.sort(raw.vertices[raw.faces].reshape(-1, 9), axis=1), axis=0)
+    want = np.sort(np.sort(np.asarray(vertices, dtype=np.float32).astype(float)[faces].reshape(-1, 9) * scale,
+                           axis=1), axis=0)
+    np.testing.assert_allclose(got, want, rtol=1e-15, atol=0)
+
+
+def test_binary_stl_matches_source_and_welds(tmp_path):
+    v, f = box_arrays()
+    p = tmp_path / "box.stl"
+    write_binary_stl(p, v, f)
+    raw = load_mesh(p)
+    assert len(raw.vertices) == 8 and len(raw.faces) == 12 and raw.file_faces == 12
+    _same_triangles(raw, v, f)
+
+
+def test_binary_stl_with_solid_header_is_read_as_binary(tmp_path):
+    v, f = box_arrays()
+    p = tmp_path / "box.stl"
+    write_binary_stl(p, v, f, header=b"solid exported by a CAD tool")
+    raw = load_mesh(p)
+    assert len(raw.faces) == 12
+
+
+@pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"])
+def test_ascii_stl_any_line_ending(tmp_path, newline):
+    v, f = box_arrays()
+    p = tmp_path / "box.stl"
+    write_ascii_stl(p, v, f, newline=newline)
+    raw = load_mesh(p)
+    assert len(raw.faces) == 12 and len(raw.vertices) == 8
+
+
+def test_units_scale_coordinates(tmp_path):
+    v, f = box_arrays()
+    p = tmp_path / "box.stl"
+    write_binary_stl(p, v, f)
+    raw = load_mesh(p, units="mm")
+    _same_triangles(raw, v, f, scale=1e-3)
+
+
+def test_trailing_bytes_are_accepted_with_a_warning(tmp_path):
+    v, f = box_arrays()
+    p = tmp_path / "box.stl"
+    write_binary_stl(p, v, f, extra=b"\x00" * 17)
+    with pytest.warns(TrailingDataWarning, match="17 bytes"):
+        raw = load_mesh(p)
+    assert len(raw.faces) == 12
+
+
+def test_header_claiming_too_many_triangles_is_refused_before_allocation(tmp_path):
+    p = tmp_path / "liar.stl"
+    with open(p, "wb") as fh:
+        fh.write(b"\0" * 80 + np.uint32(10**9).tobytes() + b"\0" * 500)
+    with pytest.raises(MeshReadError, match="announces 1,000,000,000 triangles"):
+        load_mesh(p)
+
+
+def test_truncated_binary_is_refused(tmp_path):
+    v, f = box_arrays()
+    p = tmp_path / "box.stl"
+    write_binary_stl(p, v, f)
+    data = open(p, "rb").read()
+    open(p, "wb").write(data[:-30])
+    with pytest.raises(MeshReadError, match=str(p)):
+        load_mesh(p)
+
+
+@pytest.mark.parametrize("content, message", [(b"", "empty file"), (b"solid x\nendsolid x\n", "without any 'vertex'")])
+def test_empty_inputs(tmp_path, content, message):
+    p = tmp_path / "e.stl"
+    p.write_bytes(content)
+    with pytest.raises(MeshReadError, match=message):
+        load_mesh(p)
+
+
+def test_nan_coordinates_are_refused(tmp_path):
+    v, f = box_arrays()
+    v = v.copy()
+    v[0, 0] = np.nan
+    p = tmp_path / "nan.stl"
+    write_ascii_stl(p, v, f)
+    with pytest.raises(MeshReadError, match="NaN"):
+        load_mesh(p)
+
+
+def test_directory_and_missing_file(tmp_path):
+    with pytest.raises(MeshReadError, match="directory"):
+        load_mesh(tmp_path)
+    with pytest.raises(MeshReadError, match="no such file"):
+        load_mesh(tmp_path / "nope.stl")
+
+
+def test_max_faces_guard(tmp_path):
+    v, f = box_arrays()
+    p = tmp_path / "box.stl"
+    write_binary_stl(p, v, f)
+    with pytest.raises(MeshReadError, match="max-faces"):
+        load_mesh(p, max_faces=5)
+
+
+def test_obj_through_trimesh(tmp_path):
+    m = trimesh.creation.box([1, 2, 3])
+    p = tmp_path / "box.obj"
+    m.export(p)
+    raw = load_mesh(p, units="cm")
+    assert len(raw.faces) == 12
+    np.testing.assert_allclose(raw.vertices.max(axis=0), [0.005, 0.01, 0.015])
+
+
+def test_arrays_and_trimesh_objects(box_mesh):
+    raw = load_mesh(box_mesh)
+    assert len(raw.faces) == 12
+    raw = load_mesh((box_mesh.vertices, box_mesh.faces), units="mm")
+    np.testing.assert_allclose(raw.vertices, box_mesh.vertices * 1e-3)
+    with pytest.raises(UsageError, match="shape"):
+        load_mesh((np.zeros((3, 2)), np.zeros((1, 3), dtype=int)))
+    with pytest.raises(UsageError, match="face indices"):
+        load_mesh((np.zeros((3, 3)), np.array([[0, 1, 5]])))
+
+
+def test_unknown_suffix(tmp_path):
+    p = tmp_path / "mesh.xyz"
+    p.write_text("1 2 3\n")
+    with pytest.raises(MeshReadError, match="unsupported file type"):
+        load_mesh(p)
+
+
+def test_png_renamed_stl_is_refused(tmp_path):
+    p = tmp_path / "picture.stl"
+    p.write_bytes(b"\x89PNG\r\n\x1a\n" + os.urandom(300))
+    with pytest.raises(MeshReadError):
+        load_mesh(p)

@@ -1,0 +1,35 @@
+import numpy as np
+
+from inertia_tool.weld import weld_exact, weld_tolerance
+
+
+def test_weld_exact_recovers_shared_vertices_of_trimesh_icosphere():
+    import trimesh
+    m = trimesh.creation.icosphere(subdivisions=3)
+    corners = m.triangles.astype(np.float32)
+    v, f = weld_exact(corners)
+    assert len(v) == len(m.vertices)
+    np.testing.assert_array_equal(v[f], corners.astype(np.float64))
+
+
+def test_weld_exact_treats_negative_zero_as_zero():
+    corners = np.array([[[0.0, 0, 0], [1, 0, 0], [0, 1, 0]], [[-0.0, 0, 0], [0, 1, 0], [1, 0, 0]]])
+    v, f = weld_exact(corners)
+    assert len(v) == 3
+    assert f[0, 0] == f[1, 0]
+
+
+def test_weld_exact_keeps_points_one_ulp_apart_distinct():
+    x = np.float32(1.0)
+    y = np.nextafter(x, np.float32(2))
+    corners = np.array([[[x, 0, 0], [0, 1, 0], [0, 0, 1]], [[y, 0, 0], [0, 1, 0], [0, 0, 1]]], dtype=np.float32)
+    v, _ = weld_exact(corners)
+    assert len(v) == 4
+
+
+def test_weld_tolerance_merges_rounding_noise_only():
+    v = np.array([[0.0, 0, 0], [1e-9, 0, 0], [1.0, 0, 0], [0, 1, 0]])
+    f = np.array([[0, 2, 3], [1, 3, 2]])
+    g = weld_tolerance(v, f, 1e-6)
+    assert g[0, 0] == g[1, 0]
+    assert len(np.unique(g)) == 3
