@@ -20,7 +20,7 @@ import numpy as np
 
 from .errors import MeshReadError, TrailingDataWarning, UsageError
 from .units import length_scale
-from .weld import weld_exact
+from .weld import weld_exact, weld_exact_stream
 
 __all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "SUPPORTED_SUFFIXES"]
 
@@ -80,32 +80,46 @@ def _looks_ascii_stl(head: bytes) -> bool:
                                       or len(head) < 84)
 
 
-def _read_binary_stl(path: str, size: int, max_faces: int) -> tuple[np.ndarray, int]:
-    """Return the (m, 3, 3) float32 corner array of a binary STL, read in chunks."""
+def _binary_stl_count(path: str, size: int, max_faces: int) -> int:
+    """Validate a binary STL's header against its size (before allocating) and return the triangle count."""
     if size < 84:
         raise _fail(path, f"too short for a binary STL ({size} bytes; the header alone is 84)")
     with open(path, "rb") as fh:
         fh.seek(80)
         n = int(np.frombuffer(fh.read(4), dtype="<u4")[0])
-        available = (size - 84) // 50
-        if n > available:
-            raise _fail(path, f"binary STL header announces {n:,} triangles but the file holds at most "
-                              f"{available:,} ({size:,} bytes): truncated or not an STL")
-        _check_face_budget(path, n, max_faces)
-        extra = size - 84 - 50 * n
-        if extra:
-            warnings.warn(TrailingDataWarning(f"{path}: {extra:,} bytes after the {n:,} triangles the header "
-                                              "announces were ignored"), stacklevel=3)
-        corners = np.empty((n, 3, 3), dtype=np.float32)
-        done = 0
-        while done < n:
-            k = min(_CHUNK_FACES, n - done)
-            rec = np.fromfile(fh, dtype=_STL_RECORD, count=k)
-            if len(rec) != k:
-                raise _fail(path, f"ended after {done + len(rec):,} of {n:,} triangles")
-            corners[done:done + k] = rec["v"]
-            done += k
-    return corners, n
+    available = (size - 84) // 50
+    if n > available:
+        raise _fail(path, f"binary STL header announces {n:,} triangles but the file holds at most "
+                          f"{available:,} ({size:,} bytes): truncated or not an STL")
+    _check_face_budget(path, n, max_faces)
+    extra = size - 84 - 50 * n
+    if extra:
+        warnings.warn(TrailingDataWarning(f"{path}: {extra:,} bytes after the {n:,} triangles the header "
+                                          "announces were ignored"), stacklevel=4)
+    return n
+
+
+def _binary_stl_chunks(path: str, n: int):
+    """A factory of iterators over the corners of a binary STL, ``(k, 3)`` float32 chunks in file order.
+
+    Each call re-reads the file in bounded chunks (the second read comes from the page cache), so the whole
+    triangle soup is never held in memory.
+    """
+    def chunks():
+        with open(path, "rb") as fh:
+            fh.seek(84)
+            done = 0
+            while done < n:
+                k = min(_CHUNK_FACES, n - done)
+                rec = np.fromfile(fh, dtype=_STL_RECORD, count=k)
+                if len(rec) != k:
+                    raise _fail(path, f"ended after {done + len(rec):,} of {n:,} triangles")
+                corners = np.ascontiguousarray(rec["v"]).reshape(-1, 3)
+                if not np.all(np.isfinite(corners)):
+                    raise _fail(path, "triangles have NaN or infinite coordinates")
+                done += k
+                yield corners
+    return chunks
 
 
 _VERTEX_RE = re.compile(rb"^\s*vertex\s+(\S+)\s+(\S+)\s+(\S+)\s*$", re.MULTILINE | re.IGNORECASE)
@@ -178,11 +192,12 @@ def read_stl(path, *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, n
         n = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else -1
         binary_size_matches = n >= 0 and 84 + 50 * n == size
     if binary_size_matches or not _looks_ascii_stl(head):
-        corners, n = _read_binary_stl(path, size, max_faces)
-    else:
-        corners, n = _read_ascii_stl(path, size, max_faces)
-    if n == 0:
-        raise _fail(path, "STL holds no triangles (empty mesh)")
+        n = _binary_stl_count(path, size, max_faces)
+        if n == 0:
+            raise _fail(path, "STL holds no triangles (empty mesh)")
+        vertices, faces = weld_exact_stream(_binary_stl_chunks(path, n), 3 * n)
+        return vertices, faces, n
+    corners, n = _read_ascii_stl(path, size, max_faces)
     if not np.all(np.isfinite(corners)):
         bad = int(np.count_nonzero(~np.isfinite(corners).all(axis=(1, 2))))
         raise _fail(path, f"{bad:,} triangles have NaN or infinite coordinates")

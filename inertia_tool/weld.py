@@ -2,90 +2,126 @@
 
 STL stores every triangle with its own three corners; topology checks need to know which corners are the
 same vertex.  ``weld_exact`` merges corners whose coordinates are bit-identical (what every exporter writes
-for a shared corner), in bounded memory; ``weld_tolerance`` merges vertices closer than a tolerance on a
-grid, for meshes whose exporter rounded shared corners differently.  Welding never moves a coordinate that
-the integrals use: ``weld_exact`` keeps the exact values, ``weld_tolerance`` only changes connectivity.
+for a shared corner); ``weld_tolerance`` merges vertices closer than a tolerance on a grid, for meshes whose
+exporter rounded shared corners differently.  Welding never moves a coordinate that the integrals use:
+``weld_exact`` keeps the exact values, ``weld_tolerance`` moves corners by less than its tolerance.
+
+Memory: ``weld_exact_stream`` reads the corners in chunks (twice) and holds only 64-bit keys and 32-bit
+indices, about 72 bytes per triangle at its peak, so a 5M-face binary STL never exists as a float64 soup.
 """
 
 from __future__ import annotations
 
+from typing import Callable, Iterable
+
 import numpy as np
 
-__all__ = ["weld_exact", "weld_tolerance"]
+__all__ = ["weld_exact", "weld_exact_stream", "weld_tolerance"]
 
 _CHUNK = 1 << 21
 _MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xC2B2AE3D27D4EB4F), np.uint64(0x165667B19E3779F9))
 
 
 def _hash_rows(rows: np.ndarray) -> np.ndarray:
-    """64-bit hash of each row's exact bit pattern, (k,) uint64.  Collisions are checked by the caller."""
+    """64-bit key of each row's exact bit pattern, (k,) uint64.  Collisions are checked by the caller.
+
+    float32 rows: the x and y bit patterns fill the key exactly and z is mixed in, so only points that
+    differ in z *and* collide in the mix share a key; float64 rows: a multiply-xor mix of the three.
+    """
     rows = rows + rows.dtype.type(0)  # -0.0 -> +0.0 so that equal values hash equally
-    if rows.dtype == np.float32:
-        bits = rows.view(np.uint32).astype(np.uint64)
-    elif rows.dtype == np.float64:
-        bits = rows.view(np.uint64)
-    else:
-        bits = rows.astype(np.int64).view(np.uint64)
     with np.errstate(over="ignore"):
+        if rows.dtype == np.float32:
+            bits = rows.view(np.uint32)
+            h = (bits[:, 0].astype(np.uint64) << np.uint64(32)) | bits[:, 1]
+            h ^= bits[:, 2].astype(np.uint64) * _MIX[0]
+            return h
+        bits = rows.astype(np.float64, copy=False).view(np.uint64)
         h = bits[:, 0] * _MIX[0]
-        h ^= (h >> np.uint64(29))
+        h ^= h >> np.uint64(29)
         h += bits[:, 1] * _MIX[1]
-        h ^= (h >> np.uint64(31))
+        h ^= h >> np.uint64(31)
         h += bits[:, 2] * _MIX[2]
-        h ^= (h >> np.uint64(32))
-    return h
+        h ^= h >> np.uint64(32)
+        return h
 
 
 def _index_dtype(n: int):
     return np.int32 if n < 2**31 - 1 else np.int64
 
 
-def _unique_rows_fallback(points: np.ndarray):
-    uniq, inverse = np.unique(points, axis=0, return_inverse=True)
-    return uniq.astype(np.float64), inverse.reshape(-1)
-
-
-def weld_exact(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Merge bit-identical triangle corners.
+def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int) -> tuple[np.ndarray, np.ndarray]:
+    """Weld a stream of points (triangle corners in order) by exact equality.
 
     Parameters
     ----------
-    corners : (m, 3, 3) float32 or float64
-        Triangle corners (a triangle soup).
+    chunks : callable
+        Returns a fresh iterator over ``(k, 3)`` float arrays whose concatenation is the ``n_points`` corners,
+        three per triangle.  It is called up to three times (keys, coordinates, collision check).
+    n_points : int
+        Total number of points (a multiple of 3).
 
     Returns
     -------
     vertices : (n, 3) float64
-        Distinct corner positions (exact values of the input).
-    faces : (m, 3) int32 or int64
-        Indices into ``vertices``.
+        Distinct positions, exact values of the input.
+    faces : (n_points // 3, 3) int32 or int64
     """
-    m = len(corners)
-    flat = corners.reshape(-1, 3)
-    k = len(flat)
-    keys = np.empty(k, dtype=np.uint64)
-    for s in range(0, k, _CHUNK):
-        keys[s:s + _CHUNK] = _hash_rows(flat[s:s + _CHUNK])
-    ordered = np.sort(keys)
-    first = np.empty(k, dtype=bool)
-    first[0] = True
-    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
-    uniq = ordered[first]
-    del ordered, first
-    idx_t = _index_dtype(len(uniq))
-    inverse = np.empty(k, dtype=idx_t)
-    for s in range(0, k, _CHUNK):
-        inverse[s:s + _CHUNK] = np.searchsorted(uniq, keys[s:s + _CHUNK])
+    keys = np.empty(n_points, dtype=np.uint64)
+    s = 0
+    for c in chunks():
+        keys[s:s + len(c)] = _hash_rows(c)
+        s += len(c)
+    if s != n_points:
+        raise ValueError(f"expected {n_points} points from the stream, got {s}")
+    order = np.argsort(keys)
+    ordered = keys[order]
     del keys
-    vertices = np.empty((len(uniq), 3), dtype=np.float64)
-    for s in range(0, k, _CHUNK):
-        vertices[inverse[s:s + _CHUNK]] = flat[s:s + _CHUNK]
-    # a hash collision would map two different points to one vertex: verify, fall back if so
-    for s in range(0, k, _CHUNK):
-        if not np.array_equal(vertices[inverse[s:s + _CHUNK]], flat[s:s + _CHUNK].astype(np.float64) + 0.0):
-            uniq_pts, inv = _unique_rows_fallback(flat.astype(np.float64) + 0.0)
-            return uniq_pts, inv.astype(_index_dtype(len(uniq_pts))).reshape(m, 3)
-    return vertices, inverse.reshape(m, 3)
+    step = np.empty(n_points, dtype=bool)
+    step[0] = False
+    np.not_equal(ordered[1:], ordered[:-1], out=step[1:])
+    del ordered
+    n_unique = int(np.count_nonzero(step)) + 1
+    idx_t = _index_dtype(n_unique)
+    group = np.cumsum(step, dtype=idx_t)
+    del step
+    inverse = np.empty(n_points, dtype=idx_t)
+    inverse[order] = group
+    del order, group
+    vertices = np.empty((n_unique, 3), dtype=np.float64)
+    s = 0
+    for c in chunks():
+        vertices[inverse[s:s + len(c)]] = c
+        s += len(c)
+    # a key collision would map two different points to one vertex: verify, fall back if so
+    s = 0
+    for c in chunks():
+        if not np.array_equal(vertices[inverse[s:s + len(c)]], c.astype(np.float64) + 0.0):
+            pts = np.concatenate([x.astype(np.float64) + 0.0 for x in chunks()])
+            uniq, inv = np.unique(pts, axis=0, return_inverse=True)
+            return uniq, inv.reshape(-1).astype(_index_dtype(len(uniq))).reshape(-1, 3)
+        s += len(c)
+    return vertices, inverse.reshape(-1, 3)
+
+
+def weld_exact(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Merge bit-identical triangle corners of an in-memory soup.
+
+    Parameters
+    ----------
+    corners : (m, 3, 3) float32 or float64
+        Triangle corners.
+
+    Returns
+    -------
+    vertices : (n, 3) float64
+    faces : (m, 3) int32 or int64
+    """
+    flat = np.asarray(corners).reshape(-1, 3)
+
+    def chunks():
+        for s in range(0, len(flat), _CHUNK):
+            yield flat[s:s + _CHUNK]
+    return weld_exact_stream(chunks, len(flat))
 
 
 def weld_tolerance(vertices: np.ndarray, faces: np.ndarray, tolerance: float) -> np.ndarray:
