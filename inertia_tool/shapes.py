@@ -682,8 +682,9 @@ def octahedron(half_x: float, half_y: float, half_z: float, *, center=None) -> R
     ``V = 8abc/6 = 4abc/3`` and ``∫x² dV = 8a³bc/60 = Va²/10``.  All products vanish by the mirror
     symmetries, so the tensor about the centre is diagonal (the coordinate axes are principal) with
     ``I_xx = M(b² + c²)/10``, ``I_yy = M(a² + c²)/10``, ``I_zz = M(a² + b²)/10`` (Eq. 4.13).  With
-    ``a < b < h`` the largest moment is about ``z`` and the smallest about ``x``: steady spins about ``x`` or
-    ``z`` are stable, about ``y`` unstable (exercise 4.9b, §4.4.1).
+    ``a < b < h`` the largest moment is ``I_xx`` (about the shortest diagonal), the smallest ``I_zz`` (about the
+    longest) and ``I_yy`` is intermediate: steady spins about the ``x`` or ``z`` diagonal are stable, about ``y``
+    unstable (exercise 4.9b, §4.4.1); only ``x`` survives dissipation.
     Area: 8 congruent faces with corners ``(a,0,0), (0,b,0), (0,0,c)``, each ``½√(a²b² + b²c² + c²a²)``.
     """
     a, b, cz = _positive(half_x, "half_x"), _positive(half_y, "half_y"), _positive(half_z, "half_z")
