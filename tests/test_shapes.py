@@ -284,3 +284,37 @@ def test_hollow_sphere_shells_have_opposite_orientation():
     outer, inner = body_volume_moments(s.vertices, s.faces, labels, 2)
     assert outer.volume > 0 > inner.volume
     assert outer.volume + inner.volume == pytest.approx(s.mesh_exact.volume, rel=1e-14)
+
+
+# -- the committed sample meshes -------------------------------------------------------------------------
+
+def _sample_table():
+    import importlib.util
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[1] / "meshes" / "make_meshes.py"
+    spec = importlib.util.spec_from_file_location("make_meshes", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.HERE, module.SAMPLES
+
+
+MESH_DIR, SAMPLES = _sample_table()
+
+
+@pytest.mark.parametrize("name", sorted(SAMPLES))
+def test_sample_mesh_files_are_current_and_exact(tmp_path, name):
+    """meshes/*.stl are byte-identical to what ``python meshes/make_meshes.py`` writes, stay under 200 KB,
+    and integrate (read back in mm, float32) to the closed-form polyhedron values within 1e-6."""
+    solid = SAMPLES[name][0]()
+    committed = MESH_DIR / name
+    fresh = shapes.write_stl(solid, tmp_path / name, units="mm")
+    assert committed.read_bytes() == fresh.read_bytes()
+    assert committed.stat().st_size < 200 * 1024
+    loaded = trimesh.load(committed, file_type="stl")            # merges float32-equal vertices
+    m, inertia = _engine(np.asarray(loaded.vertices) * 1e-3, np.asarray(loaded.faces))
+    e = solid.mesh_exact
+    assert m.volume == pytest.approx(e.volume, rel=1e-6)
+    assert np.abs(m.centroid - e.center_of_mass).max() <= 1e-6 * np.ptp(solid.vertices, axis=0).max()
+    assert np.abs(inertia - e.inertia).max() <= 1e-6 * np.abs(e.inertia).max()
+    assert "mm" in (MESH_DIR / "README.md").read_text(encoding="utf-8")
+    assert f"`{name}`" in (MESH_DIR / "README.md").read_text(encoding="utf-8")
