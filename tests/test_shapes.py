@@ -11,7 +11,7 @@ import pytest
 import trimesh
 from scipy import integrate
 
-from inertia_tool import shapes
+from inertia_tool import mass_properties, shapes
 from inertia_tool.errors import UsageError
 from inertia_tool.volume import body_volume_moments, second_moment_to_inertia, volume_moments
 
@@ -304,17 +304,18 @@ MESH_DIR, SAMPLES = _sample_table()
 @pytest.mark.parametrize("name", sorted(SAMPLES))
 def test_sample_mesh_files_are_current_and_exact(tmp_path, name):
     """meshes/*.stl are byte-identical to what ``python meshes/make_meshes.py`` writes, stay under 200 KB,
-    and integrate (read back in mm, float32) to the closed-form polyhedron values within 1e-6."""
+    and ``inertia_tool.mass_properties(..., units="mm")`` reads them back (float32) to the closed-form
+    polyhedron values within 1e-6."""
     solid = SAMPLES[name][0]()
     committed = MESH_DIR / name
     fresh = shapes.write_stl(solid, tmp_path / name, units="mm")
     assert committed.read_bytes() == fresh.read_bytes()
     assert committed.stat().st_size < 200 * 1024
-    loaded = trimesh.load(committed, file_type="stl")            # merges float32-equal vertices
-    m, inertia = _engine(np.asarray(loaded.vertices) * 1e-3, np.asarray(loaded.faces))
+    props = mass_properties(committed, units="mm", density=1.0)          # the project's own reader
     e = solid.mesh_exact
-    assert m.volume == pytest.approx(e.volume, rel=1e-6)
-    assert np.abs(m.centroid - e.center_of_mass).max() <= 1e-6 * np.ptp(solid.vertices, axis=0).max()
-    assert np.abs(inertia - e.inertia).max() <= 1e-6 * np.abs(e.inertia).max()
+    assert props.volume == pytest.approx(e.volume, rel=1e-6)
+    assert np.abs(props.center_of_mass - e.center_of_mass).max() <= 1e-6 * np.ptp(solid.vertices, axis=0).max()
+    assert np.abs(props.inertia - e.inertia).max() <= 1e-6 * np.abs(e.inertia).max()
+    assert props.surface_area == pytest.approx(e.surface_area, rel=1e-6)
     assert "mm" in (MESH_DIR / "README.md").read_text(encoding="utf-8")
     assert f"`{name}`" in (MESH_DIR / "README.md").read_text(encoding="utf-8")

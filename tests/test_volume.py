@@ -83,7 +83,7 @@ def _ideal_errors(solid):
 @pytest.mark.parametrize("n", [32, 64])
 def test_cone_exercise_4_6_converges_second_order(n):
     """The n-segment cone mesh against I_zz = 3MR²/10, I_xx = 3M(R² + h²/4)/20 (exercise 4.6): the error
-    is O(1/n²), so doubling n divides it by ≈ 4 (measured 3.994–3.999 at n = 32 → 64, 3.983–3.998 at 64 → 128)."""
+    is O(1/n²), so doubling n divides it by ≈ 4 (measured 3.983–3.994 at n = 32 → 64, 3.996–3.999 at 64 → 128)."""
     coarse = _ideal_errors(shapes.cone(0.02, 0.05, segments=n))
     fine = _ideal_errors(shapes.cone(0.02, 0.05, segments=2 * n))
     assert np.all(coarse < 0) and np.all(fine < 0)       # inscribed: always too small
@@ -95,7 +95,7 @@ def test_cone_exercise_4_6_converges_second_order(n):
 @pytest.mark.parametrize("n", [32, 64])
 def test_torus_converges_second_order(n):
     """Torus mesh (n sectors, n/2 tube sides) against V = 2π²Rr², I_zz = M(R² + 3r²/4), I_xx = M(R²/2 + 5r²/8):
-    doubling both resolutions divides the error by ≈ 4 (measured 3.95–3.99 at 32 → 64, 3.99 at 64 → 128)."""
+    doubling both resolutions divides the error by ≈ 4 (measured 3.949–3.965 at 32 → 64, 3.987–3.991 at 64 → 128)."""
     coarse = _ideal_errors(shapes.torus(0.04, 0.01, segments=n, rings=n // 2))
     fine = _ideal_errors(shapes.torus(0.04, 0.01, segments=2 * n, rings=n))
     ratio = coarse / fine
