@@ -296,11 +296,11 @@ def test_matches_trimesh_on_random_convex_hulls(seed):
     ours = _props(v, f)
     mesh = trimesh.Trimesh(v, f, process=False)
     theirs = mesh.mass_properties
-    assert ours.volume == pytest.approx(theirs.volume, rel=1e-10)
+    assert ours.volume == pytest.approx(theirs.volume, rel=1e-12)        # measured ≤ 5e-16 over 50 hulls
     np.testing.assert_allclose(ours.center_of_mass, theirs.center_mass, rtol=0,
-                               atol=1e-10 * np.ptp(v, axis=0).max())
-    assert _rel(ours.inertia, theirs.inertia) <= 1e-10
-    assert ours.surface_area == pytest.approx(mesh.area, rel=1e-10)
+                               atol=1e-12 * np.ptp(v, axis=0).max())
+    assert _rel(ours.inertia, theirs.inertia) <= 1e-12
+    assert ours.surface_area == pytest.approx(mesh.area, rel=1e-12)
 
 
 # -- property tests --------------------------------------------------------------------------------------
