@@ -15,6 +15,7 @@ from .principal import PrincipalAxes, principal_axes
 from .properties import InertiaTensor, MassProperties, combine, point_mass
 from .pipeline import assembly, mass_properties
 from .checks import MeshReport
+from . import shapes
 
 __version__ = "0.1.0"
 
@@ -35,4 +36,5 @@ __all__ = [
     "MeshReadError",
     "PhysicsError",
     "UsageError",
+    "shapes",
 ]
