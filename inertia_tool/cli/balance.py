@@ -40,7 +40,8 @@ def register(subparsers) -> None:
                     "verified by re-analysing the part with them. All lengths on this command line (axis point, "
                     "planes, radius, bearings) are in the mesh unit given by --units unless they carry a unit "
                     "(e.g. 40mm). Axial positions are measured along the axis direction from the axis point.")
-    p.add_argument("file", metavar="FILE", help="mesh file: STL, OBJ, PLY, OFF, 3MF")
+    p.add_argument("files", nargs="+", metavar="FILE", help="mesh file(s): STL, OBJ, PLY, OFF, 3MF; "
+                                                           "FILE:material or FILE:density for an assembly")
     add_material_options(p)
     add_mesh_options(p)
     s = p.add_argument_group("shaft and correction")
@@ -96,8 +97,12 @@ def run(args) -> int:
     bearings = None if args.bearings is None else _lengths(args.bearings, unit, "bearings", (2,))
     radius = parse_length(args.radius, default_unit=unit)
     speed = parse_angular_rate(args.rpm, default_unit="rpm")
-    if args.report is not None and os.path.exists(args.report) and not args.force:
-        raise UsageError(f"{args.report} exists; use --force to overwrite it")
+    if not speed > 0:
+        raise UsageError(f"Expected a positive --rpm (the service speed), got {args.rpm!r}")
+    if args.report is not None:
+        _report_paths(args.report, 0)
+        if os.path.exists(args.report) and not args.force:
+            raise UsageError(f"{args.report} exists; use --force to overwrite it")
 
     props, _ = load_from_args(args)
     report = balance(props, axis_point=axis_point, axis_direction=direction, speed=speed, planes=planes,

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from ..balance import ISO_GRADES, BalanceReport, PlaneUnbalance
+from .serialize import to_jsonable
 
 __all__ = ["balance_dict", "format_balance_text", "balance_markdown", "balance_html", "polar_svg"]
 
@@ -30,7 +31,8 @@ _KIND_TEXT = {
 
 
 def _deg(rad: float) -> float:
-    return math.degrees(rad) % 360.0
+    """Degrees in [0, 360) rounded to 0.1 (so that 359.99° prints as 0.0°, not 360.0°)."""
+    return round(math.degrees(rad), 1) % 360.0
 
 
 def _vec_angle(v) -> float:
@@ -72,18 +74,6 @@ def _same_positions(a, b) -> bool:
 
 
 # ---- JSON ----------------------------------------------------------------------------------------------
-def _plain(x):
-    if isinstance(x, np.ndarray):
-        return [_plain(v) for v in x.tolist()]
-    if isinstance(x, (float, np.floating)):
-        return float(x) if math.isfinite(x) else None
-    if isinstance(x, (list, tuple)):
-        return [_plain(v) for v in x]
-    if isinstance(x, dict):
-        return {k: _plain(v) for k, v in x.items()}
-    return x
-
-
 def _state_dict(state) -> dict:
     return {
         "kind": state.kind,
@@ -111,7 +101,7 @@ def _plane_dict(p: PlaneUnbalance) -> dict:
 def balance_dict(report: BalanceReport) -> dict:
     """The ``balance --json`` object: SI units, shaft-frame vectors, angles in rad from shaft x towards y."""
     g = report.quality_grade
-    return _plain({
+    return to_jsonable({
         "name": report.name,
         "units": {"length": "m", "mass": "kg", "unbalance": "kg*m", "moment_unbalance": "kg*m^2",
                   "force": "N", "torque": "N*m", "angle": "rad", "speed": "rad/s", "grade": "mm/s"},
