@@ -125,3 +125,17 @@ def test_end_to_end_subprocess(wheel):
     out = json.loads(proc.stdout)
     assert out["achieved_grade"] == rep.achieved_grade.name
     assert out["achieved_value"] == pytest.approx(rep.achieved_value, rel=1e-12)
+
+
+def test_wheel_sample_matches_its_generator(wheel):
+    sys.path.insert(0, os.path.join(ROOT, "meshes"))
+    try:
+        from make_wheel import LUMP_SIZE, make_wheel
+    finally:
+        sys.path.pop(0)
+    fresh = it.mass_properties(make_wheel(), units="mm", material="steel")
+    assert fresh.mass == pytest.approx(wheel.mass, rel=1e-6)          # the STL stores float32 coordinates
+    np.testing.assert_allclose(fresh.center_of_mass, wheel.center_of_mass, atol=1e-8)
+    assert wheel.mesh.bodies == 2
+    lump = 7850 * np.prod(LUMP_SIZE) * 1e-9
+    assert lump == pytest.approx(0.0374, abs=1e-4)                   # the README's "37 g lump"
