@@ -7,6 +7,8 @@ Public API (SI units everywhere; conventions in ``docs/conventions.md``)::
     props.mass, props.volume, props.center_of_mass, props.inertia
     props.inertia_about([0, 0, 0]); props.moment_about_axis([0, 0, 1], point=[0, 0, 0])
     props.principal.moments, props.principal.axes
+    it.balance(props, axis_point=[0, 0, 0], axis_direction=[0, 0, 1], rpm=3000, planes=(-0.04, 0.04),
+               radius=0.18, grade="G6.3", bearings=(-0.12, 0.12)).corrections
 """
 
 from .errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
@@ -16,6 +18,7 @@ from .properties import InertiaTensor, MassProperties, combine, point_mass
 from .pipeline import assembly, mass_properties
 from .checks import MeshReport
 from . import shapes
+from .balance import BalanceReport, Correction, balance
 
 __version__ = "0.1.0"
 
@@ -25,6 +28,9 @@ __all__ = [
     "assembly",
     "MassProperties",
     "MeshReport",
+    "balance",
+    "BalanceReport",
+    "Correction",
     "InertiaTensor",
     "PrincipalAxes",
     "principal_axes",

@@ -27,7 +27,7 @@ EXIT_MESH = 3
 EXIT_PHYSICS = 4
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ["analyze"]
+SUBCOMMANDS = ["analyze", "balance"]
 
 
 class _Parser(argparse.ArgumentParser):

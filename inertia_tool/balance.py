@@ -1,0 +1,677 @@
+"""Static and dynamic balancing of a rigid rotor about a given shaft axis (the chapter's "Tire balancing", §4.3.2).
+
+A body turning on an axle is **statically balanced** when its centre of mass lies on the axis and
+**dynamically balanced** when the axis is also a principal axis; small masses placed on the rim make it so.
+This module turns that into the numbers a balancing technician uses: static and couple unbalance, the
+ISO 21940-2 kind of unbalance, rotating bearing loads at speed, the ISO 21940-11 tolerance for a balance
+quality grade, and the correction masses in one or two planes, verified by re-analysing the corrected body.
+
+Pure engine: SI numpy arrays in, frozen dataclasses out (see ``docs/conventions.md``, "Shaft frame").
+
+Notation (all in the shaft frame, lengths measured from ``axis_point``):
+
+* A vector ``v`` perpendicular to the shaft is also written as the complex number ``v_x + i v_y``.
+* Static (resultant) unbalance ``U = ∫ r⊥ dm = M e`` (kg·m), ``e`` the offset of the centre of mass.
+* Moment of unbalance about ``axis_point``: ``W = ∫ z r⊥ dm = −(J_xz, J_yz)`` (kg·m²), where ``J`` is the
+  inertia tensor about ``axis_point`` in shaft axes (tensor convention, ``J_xz = −∫xz dm``).
+* Couple unbalance: the moment of unbalance about the centre-of-mass plane, ``W_c = W − z_c U``.
+* A point mass ``m`` at radius ``r``, angle ``θ`` and axial position ``z`` adds ``m r e^{iθ}`` to ``U`` and
+  ``z m r e^{iθ}`` to ``W``; the body is balanced when ``U = 0`` and ``W = 0``.
+
+Dynamics at constant speed ``Ω`` about the fixed axis (Eq. 4.26 with ``ω = Ω ẑ``, ``ω̇ = 0``): the supports
+exert on the rotor the force ``F = −Ω² U`` (centripetal, Eq. for ``R̈`` in §4.3.2) and, about ``axis_point``,
+the torque ``τ = ω × (J ω) = Ω² (−J_yz, J_xz, 0)``.  Both rotate with the part.  Gravity is not included.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import UsageError
+from .properties import MassProperties, combine, point_mass
+
+__all__ = ["BalanceGrade", "ISO_GRADES", "ShaftFrame", "shaft_frame", "PlaneUnbalance", "Correction",
+           "UnbalanceState", "BalanceReport", "balance", "permissible_unbalance", "balance_grade", "unbalance_state",
+           "UNBALANCE_KINDS"]
+
+#: The kinds of unbalance of ISO 21940-2 (plus ``balanced`` when both parts are within the tolerance).
+UNBALANCE_KINDS = ("balanced", "static", "couple", "quasi-static", "dynamic")
+
+
+@dataclass(frozen=True)
+class BalanceGrade:
+    """A balance quality grade of ISO 21940-11.
+
+    Attributes
+    ----------
+    name : str
+        ``"G 6.3"``.
+    value : float
+        The grade number ``e_per·Ω`` in mm/s (6.3 for G 6.3).
+    typical_parts : str
+        Examples of rotors usually balanced to this grade (paraphrased from the standard's table).
+    """
+
+    name: str
+    value: float
+    typical_parts: str
+
+    @property
+    def speed_eccentricity(self) -> float:
+        """The grade as ``e_per·Ω`` in SI, m/s."""
+        return self.value * 1e-3
+
+
+#: ISO 21940-11:2016 balance quality grades (Table 1 of the standard, typical rotors paraphrased).
+ISO_GRADES = (
+    BalanceGrade("G 0.4", 0.4, "gyroscopes, spindles and armatures of high-precision systems"),
+    BalanceGrade("G 1", 1.0, "small electric armatures for special needs, tape-recorder and phonograph drives, "
+                             "grinding-machine drives"),
+    BalanceGrade("G 2.5", 2.5, "gas and steam turbines, turbo-generators and -compressors, machine-tool drives, "
+                               "computer disk drives, medium and large armatures with special needs"),
+    BalanceGrade("G 6.3", 6.3, "general machinery: pump impellers, fans, flywheels, electric motor rotors, "
+                               "machine-tool parts, gears of process plant, parts of process machinery"),
+    BalanceGrade("G 16", 16.0, "drive shafts with special needs, parts of agricultural and crushing machinery, "
+                               "car engine components with special needs"),
+    BalanceGrade("G 40", 40.0, "car wheels and rims, wheel sets, drive shafts, crankshafts of elastically "
+                               "mounted fast four-stroke engines"),
+    BalanceGrade("G 100", 100.0, "complete engines of cars, trucks and locomotives; crankshafts of fast diesel "
+                                 "engines with six or more cylinders"),
+    BalanceGrade("G 250", 250.0, "crankshafts of fast four-cylinder diesel engines, rigidly mounted"),
+    BalanceGrade("G 630", 630.0, "crankshafts of large four-stroke engines, rigidly mounted; elastically "
+                                 "mounted marine diesel engines"),
+    BalanceGrade("G 1600", 1600.0, "crankshafts of large two-stroke engines, rigidly mounted"),
+    BalanceGrade("G 4000", 4000.0, "crankshafts of slow marine diesel engines with an odd number of cylinders, "
+                                   "rigidly mounted"),
+)
+
+
+def balance_grade(value) -> BalanceGrade:
+    """The standard grade named by ``value``: ``"G6.3"``, ``"G 6.3"``, ``"6.3"`` or ``6.3``.
+
+    Raises
+    ------
+    UsageError
+        When ``value`` is not one of the eleven grades of ISO 21940-11.
+    """
+    if isinstance(value, BalanceGrade):
+        return value
+    text = str(value).strip().upper().replace(" ", "")
+    if text.startswith("G"):
+        text = text[1:]
+    try:
+        number = float(text)
+    except ValueError:
+        number = float("nan")
+    for g in ISO_GRADES:
+        if math.isclose(g.value, number, rel_tol=1e-9):
+            return g
+    names = ", ".join(g.name.replace(" ", "") for g in ISO_GRADES)
+    raise UsageError(f"Expected a balance quality grade of ISO 21940-11 ({names}), got {value!r}")
+
+
+def permissible_unbalance(mass: float, speed: float, quality_grade) -> float:
+    """Permissible residual unbalance ``U_per = G·m/Ω`` of ISO 21940-11, in kg·m.
+
+    Parameters
+    ----------
+    mass : float
+        Rotor mass, kg.
+    speed : float
+        Maximum service speed Ω, rad/s.
+    quality_grade : BalanceGrade, str or float
+        ``"G6.3"``; the grade number is ``e_per·Ω`` in mm/s.
+
+    Returns
+    -------
+    float
+        kg·m (multiply by 1e6 for g·mm).  1 kg at 3000 rpm, G 6.3: 2.005e-5 kg·m = 20.05 g·mm.
+    """
+    g = balance_grade(quality_grade)
+    _check_positive(mass, "mass", "kg")
+    _check_positive(speed, "speed", "rad/s")
+    return g.speed_eccentricity * mass / speed
+
+
+def _check_positive(value, name: str, unit: str) -> float:
+    v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise UsageError(f"Expected `{name}` to be a positive finite number ({unit}), got {value!r}")
+    return v
+
+
+# --------------------------------------------------------------------------------------------------------
+# Shaft frame
+# --------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ShaftFrame:
+    """The frame balancing works in: origin on the shaft, z along it, rotating with the part.
+
+    Attributes
+    ----------
+    origin : (3,) float
+        ``axis_point``, m, mesh axes.
+    axes : (3, 3) float
+        Proper rotation whose columns are the shaft x, y, z axes in mesh axes.  z is the unit
+        ``axis_direction``; x is the mesh axis most orthogonal to z (smallest ``|e_i·z|``, the first on a
+        tie) with its z component removed, normalised; y = z × x.  Angles run from x towards y.
+    """
+
+    origin: np.ndarray
+    axes: np.ndarray
+
+    def to_shaft(self, point) -> np.ndarray:
+        """Shaft-frame coordinates (m) of a mesh-axes point (m); works on (..., 3) arrays."""
+        return (np.asarray(point, dtype=np.float64) - self.origin) @ self.axes
+
+    def to_mesh(self, shaft_point) -> np.ndarray:
+        """Mesh-axes point (m) of shaft-frame coordinates (m); works on (..., 3) arrays."""
+        return self.origin + np.asarray(shaft_point, dtype=np.float64) @ self.axes.T
+
+    def vector_to_mesh(self, shaft_vector) -> np.ndarray:
+        """Mesh-axes components of a shaft-frame vector."""
+        return np.asarray(shaft_vector, dtype=np.float64) @ self.axes.T
+
+
+def _readonly(a) -> np.ndarray:
+    a = np.array(a, dtype=np.float64)
+    a.flags.writeable = False
+    return a
+
+
+def shaft_frame(axis_point, axis_direction) -> ShaftFrame:
+    """Build the :class:`ShaftFrame` of a shaft through ``axis_point`` (m) along ``axis_direction``."""
+    origin = np.asarray(axis_point, dtype=np.float64)
+    z = np.asarray(axis_direction, dtype=np.float64)
+    if origin.shape != (3,) or not np.all(np.isfinite(origin)):
+        raise UsageError(f"Expected `axis_point` to be 3 finite numbers, got {np.asarray(axis_point).tolist()}")
+    if z.shape != (3,) or not np.all(np.isfinite(z)) or np.linalg.norm(z) == 0:
+        raise UsageError(f"Expected `axis_direction` to be 3 finite numbers, not all zero, got "
+                         f"{np.asarray(axis_direction).tolist()}")
+    z = z / np.linalg.norm(z)
+    k = int(np.argmin(np.abs(z)))          # first mesh axis most orthogonal to the shaft
+    x = np.eye(3)[k] - z[k] * z
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    return ShaftFrame(origin=_readonly(origin), axes=_readonly(np.column_stack([x, y, z])))
+
+
+# --------------------------------------------------------------------------------------------------------
+# Unbalance state of a body about a shaft
+# --------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class UnbalanceState:
+    """How a body is (un)balanced about a shaft.  Vectors are in the shaft frame (their z component is 0
+    for the transverse ones); reference point ``axis_point`` unless a name says otherwise.
+
+    Attributes
+    ----------
+    mass : float
+        kg.
+    center_of_mass : (3,) float
+        m, shaft frame.
+    offset : float
+        Distance of the centre of mass from the shaft, m (``|e|``).
+    static_unbalance : (3,) float
+        ``U = M e`` (x, y, 0), kg·m, shaft frame.
+    moment_unbalance : (3,) float
+        ``W = ∫ z r⊥ dm`` about ``axis_point`` (x, y, 0), kg·m², shaft frame.
+    couple_unbalance : (3,) float
+        ``W_c = W − z_c U``: the moment of unbalance about the plane of the centre of mass, kg·m².
+    products_of_inertia : (2,) float
+        ``(J_xz, J_yz)`` about ``axis_point`` in shaft axes, kg·m², tensor convention (−∫xz dm).
+    principal_axis : (3,) float
+        Unit central principal axis nearest the shaft (mesh axes, oriented with positive shaft z).
+    tilt : float
+        Angle between that principal axis and the shaft, rad.
+    tilt_angle : float
+        Direction the principal axis leans towards, rad from shaft x towards y (0 when ``tilt`` is 0).
+    axis_distance : float
+        Shortest distance between the principal-axis line (through the centre of mass) and the shaft, m.
+    kind : str
+        One of :data:`UNBALANCE_KINDS` (ISO 21940-2), judged with the tolerances given to :func:`balance`.
+    """
+
+    mass: float
+    center_of_mass: np.ndarray
+    offset: float
+    static_unbalance: np.ndarray
+    moment_unbalance: np.ndarray
+    couple_unbalance: np.ndarray
+    products_of_inertia: np.ndarray
+    principal_axis: np.ndarray
+    tilt: float
+    tilt_angle: float
+    axis_distance: float
+    kind: str
+
+    def bearing_torque(self, speed: float) -> np.ndarray:
+        """Torque (N·m, shaft frame, about ``axis_point``) the supports exert on the rotor at speed Ω (rad/s).
+
+        Eq. (4.26) with ``ω = Ω ẑ`` constant: ``τ = ω × (J ω) = Ω² (−J_yz, J_xz, 0)``; it rotates with the part.
+        """
+        jxz, jyz = self.products_of_inertia
+        return speed ** 2 * np.array([-jyz, jxz, 0.0])
+
+
+def _nearest_principal_axis(inertia: np.ndarray, z: np.ndarray, rtol: float) -> np.ndarray:
+    """Unit central principal axis closest to ``z`` (mesh axes); within a degenerate eigenspace, the
+    projection of ``z`` onto it (every direction there is principal)."""
+    values, vectors = np.linalg.eigh(0.5 * (inertia + inertia.T))
+    scale = max(abs(values).max(), 1e-300)
+    best, best_norm = z, -1.0
+    for k in range(3):
+        group = [j for j in range(3) if abs(values[j] - values[k]) <= rtol * scale]
+        basis = vectors[:, group]
+        proj = basis @ (basis.T @ z)
+        norm = float(np.linalg.norm(proj))
+        if norm > best_norm:
+            best, best_norm = proj / norm if norm > 0 else vectors[:, k], norm
+    return best if best @ z >= 0 else -best
+
+
+def unbalance_state(props: MassProperties, frame: ShaftFrame, *, offset_tol: float | None = None,
+                    tilt_tol: float = 1e-8, equal_rtol: float = 1e-9) -> UnbalanceState:
+    """Static and couple unbalance of ``props`` about the shaft ``frame``, and its ISO 21940-2 kind.
+
+    Parameters
+    ----------
+    props : MassProperties
+        The body, SI, mesh axes.
+    frame : ShaftFrame
+        The shaft.
+    offset_tol : float, optional
+        Offsets (m) of the centre of mass, and distances between the principal axis and the shaft, at or
+        below this count as zero when judging the kind.  Default ``1e-9`` × the body's RMS radius
+        ``√(tr I_cm / M)``.
+    tilt_tol : float
+        Tilts (rad) at or below this count as zero.
+    equal_rtol : float
+        Relative tolerance under which principal moments count as equal (then the nearest principal axis
+        is the projection of the shaft onto their common eigenspace).
+
+    Notes
+    -----
+    ISO 21940-2 kinds, from the central principal axis nearest the shaft:
+    *static* — parallel to the shaft, displaced; *couple* — tilted, crossing the shaft at the centre of
+    mass (which is on the shaft); *quasi-static* — tilted, crossing the shaft elsewhere; *dynamic* — skew
+    to the shaft.  The kind is a statement about the unbalance before any tolerance of a grade.
+    """
+    rot = frame.axes
+    z_hat = rot[:, 2]
+    com = frame.to_shaft(props.center_of_mass)
+    mass = props.mass
+    about = np.asarray(props.inertia_about(frame.origin))
+    j_shaft = rot.T @ about @ rot
+    products = np.array([j_shaft[0, 2], j_shaft[1, 2]])
+    u_static = mass * np.array([com[0], com[1], 0.0])
+    w_moment = np.array([-products[0], -products[1], 0.0])
+    w_couple = w_moment - com[2] * u_static
+    offset = float(math.hypot(com[0], com[1]))
+
+    axis = _nearest_principal_axis(props.inertia, z_hat, equal_rtol)
+    axis_shaft = rot.T @ axis
+    tilt = float(math.atan2(math.hypot(axis_shaft[0], axis_shaft[1]), axis_shaft[2]))
+    tilt_angle = float(math.atan2(axis_shaft[1], axis_shaft[0]) % (2 * math.pi)) if tilt > 0 else 0.0
+    cross = np.cross(axis_shaft, [0.0, 0.0, 1.0])
+    cross_norm = float(np.linalg.norm(cross))
+    distance = abs(float(com @ cross)) / cross_norm if cross_norm > 0 else offset
+
+    if offset_tol is None:
+        rms = math.sqrt(max(np.trace(props.inertia), 0.0) / mass) if mass > 0 else 0.0
+        offset_tol = 1e-9 * rms
+    displaced = offset > offset_tol
+    tilted = tilt > tilt_tol
+    if not displaced and not tilted:
+        kind = "balanced"
+    elif not tilted:
+        kind = "static"
+    elif not displaced:
+        kind = "couple"
+    elif distance <= offset_tol:
+        kind = "quasi-static"
+    else:
+        kind = "dynamic"
+    return UnbalanceState(mass=mass, center_of_mass=_readonly(com), offset=offset,
+                          static_unbalance=_readonly(u_static), moment_unbalance=_readonly(w_moment),
+                          couple_unbalance=_readonly(w_couple), products_of_inertia=_readonly(products),
+                          principal_axis=_readonly(axis), tilt=tilt, tilt_angle=tilt_angle,
+                          axis_distance=float(distance), kind=kind)
+
+
+# --------------------------------------------------------------------------------------------------------
+# Planes, corrections, report
+# --------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PlaneUnbalance:
+    """The unbalance of the body as seen in one plane perpendicular to the shaft.
+
+    Attributes
+    ----------
+    position : float
+        Axial position of the plane, m from ``axis_point`` along the shaft.
+    unbalance : (3,) float
+        Equivalent unbalance in this plane (x, y, 0), kg·m, shaft frame: with the partner plane it
+        reproduces ``U`` and ``W`` (two-plane resolution) or it is ``U`` itself (one plane).
+    permissible : float
+        Allocated permissible residual unbalance ``U_per`` for this plane, kg·m (``nan`` without a grade).
+    share : float
+        Fraction of the rotor's ``U_per`` allocated to this plane (ISO 21940-11 lever rule, clamped).
+    force : (3,) float
+        Rotating load the rotor puts on a bearing in this plane at the analysed speed, ``Ω² × unbalance``, N,
+        shaft frame at the instant the rotating frame coincides with it (meaningful for bearing planes).
+    """
+
+    position: float
+    unbalance: np.ndarray
+    permissible: float
+    share: float
+    force: np.ndarray
+
+    @property
+    def magnitude(self) -> float:
+        """``|unbalance|``, kg·m."""
+        return float(math.hypot(self.unbalance[0], self.unbalance[1]))
+
+    @property
+    def angle(self) -> float:
+        """Angle of the unbalance, rad in [0, 2π), from shaft x towards y."""
+        return float(math.atan2(self.unbalance[1], self.unbalance[0]) % (2 * math.pi))
+
+    @property
+    def within_tolerance(self) -> bool:
+        """``magnitude ≤ permissible`` (False without a grade)."""
+        return bool(self.magnitude <= self.permissible)
+
+
+@dataclass(frozen=True)
+class Correction:
+    """A correction mass that balances the body.
+
+    Attributes
+    ----------
+    plane : float
+        Axial position of the correction plane, m from ``axis_point``.
+    mass : float
+        kg to **add** (positive) at ``position``; removing the same mass at ``removal_position`` does the same.
+    radius : float
+        m from the shaft.
+    angle : float
+        rad in [0, 2π), from shaft x towards y, where the mass is added.
+    position : (3,) float
+        Where the added mass goes, m, mesh axes.
+    removal_angle : float
+        ``angle + π`` (mod 2π): where the same mass is removed instead.
+    removal_position : (3,) float
+        The removal point, m, mesh axes.
+    """
+
+    plane: float
+    mass: float
+    radius: float
+    angle: float
+    position: np.ndarray
+    removal_angle: float
+    removal_position: np.ndarray
+
+
+@dataclass(frozen=True)
+class BalanceReport:
+    """Everything about balancing one rotor at one speed (SI; shaft-frame vectors unless stated).
+
+    Attributes
+    ----------
+    name : str
+        The body's name.
+    frame : ShaftFrame
+        The shaft: ``axis_point`` and the shaft axes (see ``docs/conventions.md``).
+    speed : float
+        Ω, rad/s (the maximum service speed for the grade).
+    initial : UnbalanceState
+        Static and couple unbalance, principal-axis tilt and ISO 21940-2 kind of the body as it is.
+    torque : (3,) float
+        Torque the supports exert on the rotor at Ω about ``axis_point``, N·m (Eq. 4.26), rotating with it.
+    force : (3,) float
+        Total force the supports exert on the rotor, ``−Ω² U``, N (centripetal), rotating with it.
+    quality_grade : BalanceGrade or None
+        The grade asked for.
+    permissible_unbalance : float
+        ``U_per = G·M/Ω``, kg·m (``nan`` without a grade).
+    tolerance_planes : tuple of PlaneUnbalance
+        Where the tolerance is checked: the bearing planes when ``bearings`` are given (ISO 21940-11's
+        recommended reference planes), else the correction plane(s).  Their ``force`` is the bearing load.
+    achieved_value : float
+        The smallest grade number (mm/s) the body meets as it is: ``max_k |U_k| Ω / (share_k M)`` in mm/s.
+    achieved_grade : BalanceGrade or None
+        The finest standard grade with ``value ≥ achieved_value`` (None when worse than G 4000).
+    correction_planes : tuple of PlaneUnbalance
+        The body's unbalance resolved into the correction plane(s).
+    corrections : tuple of Correction
+        Masses to add (one per correction plane) so that ``U`` (and ``W`` with two planes) vanish.
+    single_plane : bool
+        True for a static (one-plane) correction: the couple unbalance is left as it is.
+    corrected : UnbalanceState
+        Verification: the body plus the correction point masses, re-analysed by the engine.
+    corrected_value : float
+        ``achieved_value`` of the corrected body, mm/s.
+    corrected_grade : BalanceGrade or None
+        Standard grade the corrected body meets.
+    notes : tuple of str
+        Caveats (centre of mass outside the tolerance planes, clamped allocation, ...).
+    """
+
+    name: str
+    frame: ShaftFrame
+    speed: float
+    initial: UnbalanceState
+    torque: np.ndarray
+    force: np.ndarray
+    quality_grade: BalanceGrade | None
+    permissible_unbalance: float
+    tolerance_planes: tuple
+    achieved_value: float
+    achieved_grade: BalanceGrade | None
+    correction_planes: tuple
+    corrections: tuple
+    single_plane: bool
+    corrected: UnbalanceState
+    corrected_value: float
+    corrected_grade: BalanceGrade | None
+    notes: tuple
+
+    @property
+    def mass(self) -> float:
+        """Rotor mass, kg."""
+        return self.initial.mass
+
+    @property
+    def rpm(self) -> float:
+        """Speed in revolutions per minute."""
+        return self.speed * 60.0 / (2 * math.pi)
+
+
+def _resolve(u: np.ndarray, w: np.ndarray, planes) -> list[np.ndarray]:
+    """Split resultant ``U`` and moment ``W`` into equivalent unbalances in 1 or 2 planes.
+
+    Two planes: ``U_1 + U_2 = U``, ``z_1 U_1 + z_2 U_2 = W`` → ``U_1 = (z_2 U − W)/(z_2 − z_1)``,
+    ``U_2 = (W − z_1 U)/(z_2 − z_1)``.  One plane: ``U_1 = U``.
+    """
+    if len(planes) == 1:
+        return [u.copy()]
+    z1, z2 = planes
+    return [(z2 * u - w) / (z2 - z1), (w - z1 * u) / (z2 - z1)]
+
+
+def _shares(planes, z_com: float) -> tuple[list[float], list[str]]:
+    """ISO 21940-11 allocation of ``U_per`` to two tolerance planes by the lever rule, limited to 0.3..0.7."""
+    if len(planes) == 1:
+        return [1.0], []
+    za, zb = planes
+    length = zb - za
+    share_a = (zb - z_com) / length
+    notes = []
+    if not 0.0 <= share_a <= 1.0:
+        notes.append("the centre of mass lies outside the tolerance planes (overhung rotor): ISO 21940-11 "
+                     "treats such rotors separately; the simple lever rule with its 0.3/0.7 limits is used here")
+    clamped = min(max(share_a, 0.3), 0.7)
+    if clamped != share_a and 0.0 <= share_a <= 1.0:
+        notes.append(f"the lever-rule share {share_a:.2f}/{1 - share_a:.2f} was limited to "
+                     f"{clamped:.1f}/{1 - clamped:.1f} (ISO 21940-11: no plane below 0.3 or above 0.7 of U_per)")
+    return [clamped, 1.0 - clamped], notes
+
+
+def _plane_data(state: UnbalanceState, planes, speed: float, u_per: float, shares) -> tuple:
+    parts = _resolve(state.static_unbalance, state.moment_unbalance, planes)
+    return tuple(PlaneUnbalance(position=float(z), unbalance=_readonly(p), permissible=u_per * s, share=s,
+                                force=_readonly(speed ** 2 * p))
+                 for z, p, s in zip(planes, parts, shares))
+
+
+def _achieved(planes: tuple, mass: float, speed: float) -> tuple[float, BalanceGrade | None]:
+    value = max(p.magnitude * speed / (p.share * mass) for p in planes) * 1e3   # mm/s
+    for g in ISO_GRADES:
+        if value <= g.value:
+            return value, g
+    return value, None
+
+
+def _axial_positions(values, name: str, count) -> tuple[float, ...]:
+    arr = np.atleast_1d(np.asarray(values, dtype=np.float64)).ravel()
+    if arr.size not in count or not np.all(np.isfinite(arr)):
+        want = " or ".join(str(c) for c in count)
+        raise UsageError(f"Expected `{name}` to be {want} finite axial position(s) in m, got "
+                         f"{np.asarray(values).tolist()}")
+    return tuple(float(v) for v in arr)
+
+
+def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | None = None,
+            speed: float | None = None, planes=None, radius: float, grade=None, bearings=None,
+            single_plane: bool = False, max_axis_offset: float = 1.0, offset_tol: float | None = None,
+            tilt_tol: float = 1e-8) -> BalanceReport:
+    """Balancing report of a rigid rotor turning about a given shaft (§4.3.2 "Tire balancing", Eq. 4.26,
+    ISO 21940-2 and ISO 21940-11).
+
+    Parameters
+    ----------
+    props : MassProperties
+        The rotor, SI, mesh axes.
+    axis_point : (3,) array_like
+        A point of the shaft, m, mesh axes; the origin of the shaft frame and of the axial positions.
+    axis_direction : (3,) array_like
+        Direction of the shaft (any length), mesh axes.
+    rpm, speed : float
+        Service speed in rev/min **or** Ω in rad/s (exactly one; positive).
+    planes : float or sequence of 1 or 2 floats
+        Axial positions of the correction planes, m from ``axis_point`` along the shaft.  One plane means a
+        single-plane (static) correction; with ``single_plane=True`` and no ``planes`` the plane of the
+        centre of mass is used.
+    radius : float
+        Radius at which correction masses go, m (positive).
+    grade : str, float or BalanceGrade, optional
+        ISO 21940-11 balance quality grade (``"G6.3"``).  Without it no tolerance is checked.
+    bearings : sequence of 2 floats, optional
+        Axial positions of the bearings, m from ``axis_point``.  They become the tolerance planes and the
+        report gives the rotating bearing loads.
+    single_plane : bool
+        Static correction in one plane (narrow discs); the couple unbalance stays.
+    max_axis_offset : float
+        Refuse a shaft whose distance from the centre of mass exceeds this multiple of the body's largest
+        central radius of gyration (such an axis does not pass near the part).
+    offset_tol, tilt_tol : float
+        Tolerances of the kind classification, see :func:`unbalance_state`.
+
+    Returns
+    -------
+    BalanceReport
+
+    Raises
+    ------
+    UsageError
+        Non-positive speed or radius, coinciding planes or bearings, a shaft far from the part, an unknown
+        grade, or malformed vectors.
+
+    Notes
+    -----
+    Two-plane correction: masses ``m_k`` at radius ``r`` and angles ``θ_k`` in planes ``z_k`` with
+    ``c_k = m_k r e^{iθ_k}`` must cancel ``U`` and ``W``: ``c_1 + c_2 = −U``, ``z_1 c_1 + z_2 c_2 = −W``,
+    so ``c_k = −U_k`` (the body's equivalent unbalance in plane ``k``, see :class:`PlaneUnbalance`).
+    Then the centre of mass is on the shaft and ``J_xz = J_yz = 0``: the shaft is a principal axis.
+    Removing ``m_k`` at ``θ_k + π`` has the same effect.
+    """
+    frame = shaft_frame(axis_point, axis_direction)
+    if (rpm is None) == (speed is None):
+        raise UsageError("Expected exactly one of `rpm` (rev/min) and `speed` (rad/s)")
+    omega = _check_positive(speed, "speed", "rad/s") if speed is not None else \
+        _check_positive(rpm, "rpm", "rev/min") * 2 * math.pi / 60.0
+    r = float(radius)
+    if not (math.isfinite(r) and r > 0):
+        raise UsageError(f"Expected a positive correction `radius` in m, got {radius!r}")
+    _check_positive(props.mass, "props.mass", "kg")
+    quality = None if grade is None else balance_grade(grade)
+
+    state = unbalance_state(props, frame, offset_tol=offset_tol, tilt_tol=tilt_tol)
+    k_max = math.sqrt(max(np.linalg.eigvalsh(props.inertia).max(), 0.0) / props.mass)
+    if state.offset > max_axis_offset * k_max:
+        raise UsageError(f"The shaft axis passes {state.offset:.6g} m from the centre of mass, more than "
+                         f"{max_axis_offset:g} × the largest radius of gyration ({k_max:.6g} m): expected an "
+                         "axis through the part (check --axis-point, --axis-direction and --units)")
+    length_scale = max(k_max, r)
+    if planes is None:
+        if not single_plane:
+            raise UsageError("Expected two correction `planes` (or one with single_plane=True)")
+        planes_t = (float(state.center_of_mass[2]),)
+    else:
+        planes_t = _axial_positions(planes, "planes", (1,) if single_plane else (1, 2))
+    if len(planes_t) == 1:
+        single_plane = True
+    elif abs(planes_t[1] - planes_t[0]) <= 1e-9 * length_scale:
+        raise UsageError(f"The correction planes coincide (both at {planes_t[0]:.6g} m): expected two distinct "
+                         "axial positions")
+    bearings_t = None
+    if bearings is not None:
+        bearings_t = _axial_positions(bearings, "bearings", (2,))
+        if abs(bearings_t[1] - bearings_t[0]) <= 1e-9 * length_scale:
+            raise UsageError(f"The bearings coincide (both at {bearings_t[0]:.6g} m): expected two distinct "
+                             "axial positions")
+
+    u_per = permissible_unbalance(props.mass, omega, quality) if quality is not None else float("nan")
+    notes = []
+    tol_positions = bearings_t if bearings_t is not None else planes_t
+    shares, share_notes = _shares(tol_positions, float(state.center_of_mass[2]))
+    notes += share_notes
+    if single_plane and bearings_t is None:
+        notes.append("single-plane check: the whole U_per applies to the static unbalance; the couple "
+                     "unbalance is not toleranced (give --bearings to check it)")
+    tolerance = _plane_data(state, tol_positions, omega, u_per, shares)
+    corr_shares = shares if bearings_t is None else _shares(planes_t, float(state.center_of_mass[2]))[0]
+    correction_planes = _plane_data(state, planes_t, omega, u_per, corr_shares)
+
+    corrections = []
+    for plane in correction_planes:
+        c = -plane.unbalance
+        mag = float(math.hypot(c[0], c[1]))
+        ang = float(math.atan2(c[1], c[0]) % (2 * math.pi)) if mag > 0 else 0.0
+        rem = (ang + math.pi) % (2 * math.pi)
+        pos = frame.to_mesh([r * math.cos(ang), r * math.sin(ang), plane.position])
+        rpos = frame.to_mesh([r * math.cos(rem), r * math.sin(rem), plane.position])
+        corrections.append(Correction(plane=plane.position, mass=mag / r, radius=r, angle=ang,
+                                      position=_readonly(pos), removal_angle=rem,
+                                      removal_position=_readonly(rpos)))
+
+    corrected_body = combine([props] + [point_mass(c.mass, c.position, name="correction") for c in corrections],
+                             name=props.name)
+    corrected = unbalance_state(corrected_body, frame, offset_tol=offset_tol, tilt_tol=tilt_tol)
+    corrected_tolerance = _plane_data(corrected, tol_positions, omega, u_per, shares)
+
+    achieved_value, achieved = _achieved(tolerance, props.mass, omega)
+    corrected_value, corrected_grade = _achieved(corrected_tolerance, corrected_body.mass, omega)
+    return BalanceReport(name=props.name, frame=frame, speed=omega, initial=state,
+                         torque=_readonly(state.bearing_torque(omega)),
+                         force=_readonly(-omega ** 2 * state.static_unbalance), quality_grade=quality,
+                         permissible_unbalance=u_per, tolerance_planes=tolerance, achieved_value=achieved_value,
+                         achieved_grade=achieved, correction_planes=correction_planes,
+                         corrections=tuple(corrections), single_plane=single_plane, corrected=corrected,
+                         corrected_value=corrected_value, corrected_grade=corrected_grade, notes=tuple(notes))

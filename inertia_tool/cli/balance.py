@@ -1,0 +1,132 @@
+"""``inertia-tool balance FILE ...``: the dynamic-balancing report (text, JSON, HTML or Markdown).
+
+Routing and formatting only: lengths given on the command line are converted to SI here, the engine is
+``inertia_tool.balance.balance`` and the writers are in ``inertia_tool.reports.balance``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+
+from ..balance import ISO_GRADES, balance
+from ..errors import UsageError
+from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
+from ..units import parse_angular_rate, parse_length
+from .analyze import add_material_options, add_mesh_options, load_from_args
+
+__all__ = ["register", "run"]
+
+# Values such as "-40,40" or "-5,0,0" start with "-" but are numbers, not options.
+_NEGATIVE_LIST = re.compile(r"^-(\d|\.\d)[\d.eE+\-,]*[a-zA-Zµ]*$")
+
+
+def _lengths(text: str, unit: str, name: str, count) -> list[float]:
+    items = [t for t in str(text).replace(";", ",").split(",")]
+    if len(items) not in count:
+        want = " or ".join(str(c) for c in count)
+        raise UsageError(f"Expected --{name} to be {want} comma-separated length(s), got {text!r}")
+    return [parse_length(t.strip(), default_unit=unit) for t in items]
+
+
+def register(subparsers) -> None:
+    grades = ", ".join(g.name.replace(" ", "") for g in ISO_GRADES)
+    p = subparsers.add_parser(
+        "balance", help="static/couple unbalance, ISO 21940-11 tolerance and correction masses about a shaft",
+        description="Balancing report of a rigid rotor turning about a given shaft: static and couple unbalance, "
+                    "ISO 21940-2 kind, rotating bearing loads and the torque of Eq. (4.26), the permissible "
+                    "residual unbalance of an ISO 21940-11 grade, and correction masses in one or two planes, "
+                    "verified by re-analysing the part with them. All lengths on this command line (axis point, "
+                    "planes, radius, bearings) are in the mesh unit given by --units unless they carry a unit "
+                    "(e.g. 40mm). Axial positions are measured along the axis direction from the axis point.")
+    p.add_argument("files", nargs="+", metavar="FILE", help="mesh file(s): STL, OBJ, PLY, OFF, 3MF; "
+                                                           "FILE:material or FILE:density for an assembly")
+    add_material_options(p)
+    add_mesh_options(p)
+    s = p.add_argument_group("shaft and correction")
+    s.add_argument("--axis-point", default="0,0,0", metavar="X,Y,Z",
+                   help="a point of the shaft, mesh coordinates in --units (default 0,0,0)")
+    s.add_argument("--axis-direction", default="0,0,1", metavar="DX,DY,DZ",
+                   help="direction of the shaft, mesh axes (default 0,0,1)")
+    s.add_argument("--rpm", required=True, metavar="SPEED",
+                   help="maximum service speed, rev/min (or with a unit: 50Hz, 314rad/s)")
+    s.add_argument("--planes", metavar="Z1,Z2",
+                   help="axial positions of the two correction planes (one with --single-plane), in --units")
+    s.add_argument("--radius", required=True, metavar="R", help="radius of the correction masses, in --units")
+    s.add_argument("--single-plane", action="store_true",
+                   help="static correction in one plane (narrow discs); without --planes, the plane of the "
+                        "centre of mass")
+    s.add_argument("--grade", metavar="G", help=f"ISO 21940-11 balance quality grade: {grades}")
+    s.add_argument("--bearings", metavar="ZA,ZB",
+                   help="axial positions of the two bearings, in --units: the tolerance is checked there and "
+                        "the report gives the rotating bearing loads")
+    o = p.add_argument_group("output")
+    o.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of the text report")
+    o.add_argument("--report", metavar="FILE.html|FILE.md",
+                   help="also write an HTML (self-contained, with polar plots) or Markdown report")
+    o.add_argument("--force", action="store_true", help="overwrite an existing --report file")
+    p._negative_number_matcher = _NEGATIVE_LIST     # so that "--planes -40,40" is a value, not an option
+    p.set_defaults(func=run)
+
+
+def _report_paths(path: str, count: int) -> tuple[str, list[str]]:
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in (".html", ".htm", ".md", ".markdown"):
+        raise UsageError(f"Expected --report to end in .html or .md, got {path!r}")
+    svgs = []
+    if ext in (".md", ".markdown"):
+        stem = os.path.splitext(path)[0]
+        svgs = [f"{stem}-plane{k + 1}.svg" for k in range(count)]
+    return ext, svgs
+
+
+def run(args) -> int:
+    unit = args.units
+    axis_point = _lengths(args.axis_point, unit, "axis-point", (3,))
+    try:
+        direction = [float(t) for t in str(args.axis_direction).split(",")]
+    except ValueError:
+        direction = []
+    if len(direction) != 3:
+        raise UsageError(f"Expected --axis-direction to be 3 comma-separated numbers, got {args.axis_direction!r}")
+    planes = None if args.planes is None else _lengths(args.planes, unit, "planes",
+                                                       (1,) if args.single_plane else (1, 2))
+    if planes is None and not args.single_plane:
+        raise UsageError("Expected --planes Z1,Z2 (or --single-plane)")
+    bearings = None if args.bearings is None else _lengths(args.bearings, unit, "bearings", (2,))
+    radius = parse_length(args.radius, default_unit=unit)
+    speed = parse_angular_rate(args.rpm, default_unit="rpm")
+    if not speed > 0:
+        raise UsageError(f"Expected a positive --rpm (the service speed), got {args.rpm!r}")
+    if args.report is not None:
+        _report_paths(args.report, 0)
+        if os.path.exists(args.report) and not args.force:
+            raise UsageError(f"{args.report} exists; use --force to overwrite it")
+
+    props, _ = load_from_args(args)
+    report = balance(props, axis_point=axis_point, axis_direction=direction, speed=speed, planes=planes,
+                     radius=radius, grade=args.grade, bearings=bearings, single_plane=args.single_plane)
+
+    if args.json:
+        print(json.dumps(balance_dict(report), indent=2, ensure_ascii=False))
+    else:
+        print(format_balance_text(report), end="")
+    if args.report is not None:
+        ext, svgs = _report_paths(args.report, len(report.corrections))
+        for name in svgs:
+            if os.path.exists(name) and not args.force:
+                raise UsageError(f"{name} exists; use --force to overwrite it")
+        try:
+            if ext in (".html", ".htm"):
+                text = balance_html(report)
+            else:
+                for k, name in enumerate(svgs):
+                    with open(name, "w", encoding="utf-8") as fh:
+                        fh.write(polar_svg(report, k))
+                text = balance_markdown(report, svg_links=[os.path.basename(n) for n in svgs])
+            with open(args.report, "w", encoding="utf-8") as fh:
+                fh.write(text)
+        except OSError as exc:
+            raise UsageError(f"Cannot write the report {args.report!r}: {exc.strerror or exc}") from None
+    return 0
