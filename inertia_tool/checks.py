@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["EdgeTopology", "MeshReport", "degenerate_faces", "edge_topology", "shell_labels", "winding_number"]
+__all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "winding_number"]
 
 
 @dataclass(frozen=True)
@@ -111,38 +111,56 @@ class MeshReport:
     bbox_max: np.ndarray
 
 
-def degenerate_faces(vertices: np.ndarray, faces: np.ndarray, *, area_rtol: float = 1e-14):
-    """Classify degenerate triangles.
+def repeated_corner_faces(faces: np.ndarray) -> np.ndarray:
+    """(m,) bool: triangles with a repeated vertex index.
 
-    Parameters
-    ----------
-    vertices : (n, 3) float
-    faces : (m, 3) int
-    area_rtol : float
-        A triangle counts as zero-area when twice its area is below ``area_rtol · L²`` with ``L`` the
-        bounding-box diagonal.
-
-    Returns
-    -------
-    repeated : (m,) bool
-        Faces with a repeated vertex index (dropped: they add nothing and break the edge census).
-    zero_area : int
-        Count of other faces whose area is zero (collinear corners; kept, as they may close a T-junction).
+    They enclose nothing and break the edge census, so the pipeline drops and counts them.  Triangles with
+    three distinct but collinear corners (zero area) are kept — they may close a T-junction — and are
+    counted by the integration pass (``VolumeMoments.zero_area_faces``).
     """
     f = faces
-    repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])
-    if len(vertices) == 0:
-        return repeated, 0
-    diag2 = float(np.sum((vertices.max(axis=0) - vertices.min(axis=0)) ** 2))
-    zero = 0
+    return (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])
+
+
+def _edge_keys(faces: np.ndarray, n_vertices: int) -> np.ndarray:
+    """Directed-edge keys ``(min·n + max)·2 + [a > b]``, (3m,) int64, sorted."""
+    n = np.int64(max(int(n_vertices), 1))
+    m = len(faces)
+    key = np.empty(3 * m, dtype=np.int64)
+    step = 1 << 18
+    for k, (i, j) in enumerate(((0, 1), (1, 2), (2, 0))):
+        for s in range(0, m, step):
+            a = faces[s:s + step, i].astype(np.int64)
+            b = faces[s:s + step, j].astype(np.int64)
+            out = key[k * m + s:k * m + min(s + step, m)]
+            np.minimum(a, b, out=out)
+            out *= n
+            out += np.maximum(a, b)
+            out *= 2
+            out += a > b
+    key.sort()
+    return key
+
+
+def _all_paired(key: np.ndarray) -> bool:
+    """Fast path: True when every undirected edge occurs exactly twice, once in each direction.
+
+    In the sorted key array that means pairs ``(2e, 2e+1)`` at positions ``2i, 2i+1`` with distinct
+    edges from one pair to the next.  Checked in chunks, no large temporaries.
+    """
+    if len(key) % 2:
+        return False
+    even, odd = key[0::2], key[1::2]
     step = 1 << 20
-    for s in range(0, len(f), step):
-        fc = f[s:s + step]
-        a = vertices[fc[:, 0]]
-        cr = np.cross(vertices[fc[:, 1]] - a, vertices[fc[:, 2]] - a)
-        tiny = np.einsum("ij,ij->i", cr, cr) <= (area_rtol * diag2) ** 2
-        zero += int(np.count_nonzero(tiny & ~repeated[s:s + step]))
-    return repeated, zero
+    for s in range(0, len(even), step):
+        e = even[s:s + step]
+        o = odd[s:s + step]
+        if not (np.all((e & 1) == 0) and np.all(o == e + 1)):
+            return False
+        nxt = even[s + 1:s + step + 1]
+        if not np.all(nxt > o[:len(nxt)]):
+            return False
+    return True
 
 
 def edge_topology(faces: np.ndarray, n_vertices: int, vertices: np.ndarray | None = None) -> EdgeTopology:
@@ -159,18 +177,13 @@ def edge_topology(faces: np.ndarray, n_vertices: int, vertices: np.ndarray | Non
     vertices : (n, 3) float, optional
         Only used to report where the offending edges are.
     """
-    n = np.int64(max(int(n_vertices), 1))
-    key = np.empty(3 * len(faces), dtype=np.int64)
-    m = len(faces)
-    for k, (i, j) in enumerate(((0, 1), (1, 2), (2, 0))):
-        a = faces[:, i].astype(np.int64)
-        b = faces[:, j].astype(np.int64)
-        lo = np.minimum(a, b)
-        hi = np.maximum(a, b)
-        key[k * m:(k + 1) * m] = (lo * n + hi) * 2 + (a > b)
-    key.sort()
-    if len(key) == 0:
+    if len(faces) == 0:
         return EdgeTopology(0, 0, 0, 0, np.zeros((0, 2, 3)))
+    key = _edge_keys(faces, n_vertices)
+    if _all_paired(key):
+        return EdgeTopology(edges=len(key) // 2, boundary_edges=0, nonmanifold_edges=0, misoriented_edges=0,
+                            sample=np.zeros((0, 2, 3)))
+    n = np.int64(max(int(n_vertices), 1))
     undirected = key >> 1
     starts = np.flatnonzero(np.r_[True, undirected[1:] != undirected[:-1]])
     lengths = np.diff(np.r_[starts, len(key)])
@@ -193,7 +206,7 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     Returns
     -------
     labels : (m,) int
-        Shell index of each face, numbered ``0..count-1`` in order of first appearance.
+        Shell index of each face, ``0..count-1`` (numbered by the smallest vertex index of the shell).
     count : int
     """
     from scipy.sparse import coo_matrix
@@ -202,15 +215,19 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     m = len(faces)
     if m == 0:
         return np.zeros(0, dtype=np.intp), 0
-    rows = np.concatenate([faces[:, 0], faces[:, 1]])
-    cols = np.concatenate([faces[:, 1], faces[:, 2]])
-    graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(n_vertices, n_vertices)).tocsr()
-    _, vertex_label = connected_components(graph, directed=False)
+    # each face links corner 0 to corners 1 and 2: enough to connect all three
+    rows = np.repeat(np.asarray(faces[:, 0]), 2)
+    cols = np.asarray(faces[:, 1:]).reshape(-1)
+    graph = coo_matrix((np.ones(2 * m, dtype=np.int8), (rows, cols)), shape=(n_vertices, n_vertices)).tocsr()
+    del rows, cols
+    count, vertex_label = connected_components(graph, directed=True, connection="weak")
     face_label = vertex_label[faces[:, 0]]
-    # renumber in order of first appearance, keeping only labels that own faces
-    _, first, inverse = np.unique(face_label, return_index=True, return_inverse=True)
-    order = np.argsort(np.argsort(first))
-    return order[inverse].astype(np.intp), len(first)
+    if count == 1:
+        return np.zeros(m, dtype=np.intp), 1
+    present = np.zeros(count, dtype=bool)
+    present[face_label] = True
+    remap = np.cumsum(present) - 1
+    return remap[face_label].astype(np.intp), int(present.sum())
 
 
 def winding_number(point, vertices: np.ndarray, faces: np.ndarray) -> float:

@@ -31,7 +31,7 @@ DEFAULT_MAX_FACES = 50_000_000
 SUPPORTED_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".3mf", ".glb", ".gltf")
 
 _STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
-_CHUNK_FACES = 1 << 20
+_CHUNK_FACES = 1 << 17
 
 
 @dataclass(frozen=True)

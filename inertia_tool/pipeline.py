@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import MeshReport, degenerate_faces, edge_topology, shell_labels, winding_number
+from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels, winding_number
 from .errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
                      OverlapWarning, UsageError)
 from .io import DEFAULT_MAX_FACES, RawMesh, load_mesh
@@ -190,7 +190,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
     v, f = raw.vertices, raw.faces
     if len(f) == 0:
         raise InvalidMeshError(f"{source}: the mesh has no triangles")
-    repeated, zero_area = degenerate_faces(v, f)
+    repeated = repeated_corner_faces(f)
     n_repeated = int(np.count_nonzero(repeated))
     if n_repeated == len(f):
         raise InvalidMeshError(f"{source}: all {len(f):,} triangles are degenerate (no area); nothing to integrate")
@@ -242,7 +242,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
         face_flip = flip[labels]
         f = f.copy()
         f[face_flip] = f[face_flip][:, ::-1]
-        shells = [VolumeMoments(-s.volume, s.centroid, -s.second_moment, s.area) if flip[k] else s
+        shells = [VolumeMoments(-s.volume, s.centroid, -s.second_moment, s.area, s.zero_area_faces) if flip[k] else s
                   for k, s in enumerate(shells)]
         n_flipped = int(np.count_nonzero(flip))
         what = "the mesh is" if n_shells == 1 or n_flipped == n_shells else f"{n_flipped} of {n_shells} shells are"
@@ -253,7 +253,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
                                      "another body; the overlapping volume is counted twice"), stacklevel=3)
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
     report = MeshReport(source=source, units=raw.units, file_faces=raw.file_faces, vertices=len(v), faces=len(f),
-                        degenerate_faces=n_repeated, zero_area_faces=zero_area, bodies=bodies, cavities=cavities,
+                        degenerate_faces=n_repeated, zero_area_faces=sum(s.zero_area_faces for s in shells), bodies=bodies, cavities=cavities,
                         flipped_shells=int(np.count_nonzero(flip)), overlapping_shells=overlaps,
                         watertight=watertight, welded_tolerance=welded, repaired=repaired,
                         repair_actions=tuple(actions), repair_volume_change=volume_change,

@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 from conftest import box_arrays
-from inertia_tool.checks import degenerate_faces, edge_topology, shell_labels, winding_number
+from inertia_tool.checks import edge_topology, repeated_corner_faces, shell_labels, winding_number
+from inertia_tool.volume import volume_moments
 
 
 def test_closed_box_is_oriented():
@@ -44,9 +45,8 @@ def test_fin_makes_a_nonmanifold_edge():
 def test_degenerate_faces_are_split_into_repeated_and_zero_area():
     v = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]])
     f = np.array([[0, 1, 3], [0, 0, 1], [0, 1, 2]])
-    repeated, zero = degenerate_faces(v, f)
-    np.testing.assert_array_equal(repeated, [False, True, False])
-    assert zero == 1
+    np.testing.assert_array_equal(repeated_corner_faces(f), [False, True, False])
+    assert volume_moments(v, f).zero_area_faces == 2  # the repeated-corner face and the collinear one
 
 
 def test_shell_labels_two_boxes():

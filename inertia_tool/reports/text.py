@@ -14,15 +14,16 @@ def _num(x: float) -> str:
     return f"{x:.6g}"
 
 
-def _clean(a, rel: float = 1e-12) -> np.ndarray:
-    """Display only: entries below ``rel`` times the largest magnitude print as 0 (round-off, not data)."""
+def _clean(a, rel: float = 1e-12, scale: float = 0.0) -> np.ndarray:
+    """Display only: entries below ``rel`` times the largest magnitude (or ``scale``, if larger) print as 0
+    (round-off, not data)."""
     a = np.asarray(a, dtype=float)
-    scale = np.max(np.abs(a)) if a.size else 0.0
+    scale = max(np.max(np.abs(a)) if a.size else 0.0, scale)
     return np.where(np.abs(a) <= rel * scale, 0.0, a) + 0.0
 
 
-def _vec(v) -> str:
-    return "(" + ", ".join(f"{x: .6g}" for x in _clean(v)) + ")"
+def _vec(v, scale: float = 0.0) -> str:
+    return "(" + ", ".join(f"{x: .6g}" for x in _clean(v, scale=scale)) + ")"
 
 
 def _matrix(m, indent: str) -> list[str]:
@@ -36,6 +37,7 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
     pa = props.principal
     lines = [f"Mass properties of {props.name}"]
     mesh = props.mesh
+    size = float(np.linalg.norm(mesh.bbox_max - mesh.bbox_min)) if mesh is not None else 0.0
     unit_note = f" (mesh coordinates in {mesh.units}, converted)" if mesh is not None else ""
     lines.append(f"  units: SI — m, kg, kg·m²{unit_note}")
     if density_source:
@@ -43,12 +45,12 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
     lines.append(f"  volume:           {_num(props.volume)} m³")
     lines.append(f"  mass:             {_num(props.mass)} kg")
     lines.append(f"  surface area:     {_num(props.surface_area)} m²")
-    lines.append(f"  centre of mass:   {_vec(props.center_of_mass)} m")
+    lines.append(f"  centre of mass:   {_vec(props.center_of_mass, size)} m")
     lines.append(f"  inertia about the centre of mass, mesh axes (kg·m²; {TENSOR_CONVENTION}):")
     lines += _matrix(props.inertia, "    ")
     lines.append("  inertia about the mesh origin (0, 0, 0), mesh axes (kg·m²):")
     lines += _matrix(np.asarray(props.inertia_about(np.zeros(3))), "    ")
-    lines.append("  (entries below 1e-12 of the largest in a vector or matrix are shown as 0)")
+    lines.append("  (entries below 1e-12 of the largest in a vector or matrix, or of the part size, are shown as 0)")
     lines.append("  principal moments (ascending) and axes (unit vectors, mesh axes, right-handed):")
     for k in range(3):
         lines.append(f"    I{k + 1} = {pa.moments[k]:.6e} kg·m²   axis {_vec(pa.axes[:, k])}   "
