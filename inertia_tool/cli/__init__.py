@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 import warnings
 
@@ -30,7 +31,16 @@ EXIT_PHYSICS = 4
 SUBCOMMANDS = ["analyze", "balance"]
 
 
+# Values such as "-40,40", "-5,0,0" or "-20deg" start with "-" but are numbers, not options.
+_NEGATIVE_VALUE = re.compile(r"^-(\d|\.\d)[\d.eE+\-,]*[a-zA-Zµ/%]*$")
+
+
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # argparse treats "-40,40" as an option unless it matches this private pattern
+        self._negative_number_matcher = _NEGATIVE_VALUE
+
     def error(self, message):  # one line, exit code 2, as documented
         self.print_usage(sys.stderr)
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 
 from ..balance import ISO_GRADES, balance
 from ..errors import UsageError
@@ -17,10 +16,6 @@ from ..units import parse_angular_rate, parse_length
 from .analyze import add_material_options, add_mesh_options, load_from_args
 
 __all__ = ["register", "run"]
-
-# Values such as "-40,40" or "-5,0,0" start with "-" but are numbers, not options.
-_NEGATIVE_LIST = re.compile(r"^-(\d|\.\d)[\d.eE+\-,]*[a-zA-Zµ]*$")
-
 
 def _lengths(text: str, unit: str, name: str, count) -> list[float]:
     items = [t for t in str(text).replace(";", ",").split(",")]
@@ -66,7 +61,6 @@ def register(subparsers) -> None:
     o.add_argument("--report", metavar="FILE.html|FILE.md",
                    help="also write an HTML (self-contained, with polar plots) or Markdown report")
     o.add_argument("--force", action="store_true", help="overwrite an existing --report file")
-    p._negative_number_matcher = _NEGATIVE_LIST     # so that "--planes -40,40" is a value, not an option
     p.set_defaults(func=run)
 
 
