@@ -16,7 +16,7 @@ import numpy as np
 
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels, winding_number
 from .errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
-                     OverlapWarning, UsageError)
+                     OverlapWarning, PhysicalValidityWarning, UsageError)
 from .io import DEFAULT_MAX_FACES, RawMesh, load_mesh
 from .properties import MassProperties, combine
 from .units import material_density
@@ -332,7 +332,21 @@ def mass_properties(source, *, units: str = "m", density: float | None = None, m
                             parts=tuple(bodies) if len(bodies) > 1 else ())
     if rho is None:
         result = result.with_mass(mass)
+    _check_physical(result)
     return result
+
+
+def _check_physical(props: MassProperties, rtol: float = 1e-9) -> None:
+    """Warn when the principal moments fail positivity or the triangle inequality beyond round-off.
+
+    For a real body ``I_k > 0`` and ``I1 + I2 ≥ I3`` (the perpendicular-axis theorem of §4.3.2 turned into an
+    inequality); failing them means a mesh problem the checks did not catch (e.g. overlapping shells).
+    """
+    i1, i2, i3 = props.principal.moments
+    if not (i1 > -rtol * i3 and i1 + i2 >= i3 * (1 - rtol)):
+        warnings.warn(PhysicalValidityWarning(
+            f"{props.name}: principal moments ({i1:.6g}, {i2:.6g}, {i3:.6g}) kg·m² violate positivity or the "
+            "triangle inequality I1 + I2 ≥ I3: the mesh does not describe a physical body"), stacklevel=3)
 
 
 def assembly(parts, *, units: str = "m", mass: float | None = None, **options) -> MassProperties:

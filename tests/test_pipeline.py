@@ -159,3 +159,16 @@ def test_trimesh_cross_check_on_random_convex_hulls():
         assert p.volume == pytest.approx(mp["volume"], rel=1e-12)
         np.testing.assert_allclose(p.center_of_mass, mp["center_mass"], rtol=1e-10, atol=1e-12)
         np.testing.assert_allclose(p.inertia, mp["inertia"], rtol=1e-9, atol=1e-12)
+
+
+def test_unphysical_moments_warn():
+    from inertia_tool.errors import PhysicalValidityWarning
+    from inertia_tool.pipeline import _check_physical
+    from inertia_tool.properties import MassProperties
+    bad = MassProperties(mass=1.0, volume=1.0, center_of_mass=[0, 0, 0], inertia=np.diag([1.0, 1.0, 3.0]), name="x")
+    with pytest.warns(PhysicalValidityWarning, match="triangle inequality"):
+        _check_physical(bad)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _check_physical(MassProperties(1.0, 1.0, [0, 0, 0], np.diag([1.0, 2.0, 3.0])))  # a flat plate: boundary
