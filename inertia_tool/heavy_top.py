@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -75,6 +75,13 @@ class HeavyTopReport:
     precession_rate_slow, precession_rate_fast : float or None
         Steady precession rates φ̇ at θ0 from ``I1 cos θ φ̇² − I3 ω3 φ̇ + M g l = 0`` (smaller and larger
         magnitude); ``None`` where no real root exists (too little spin) or, for the fast rate, at θ = π/2.
+    pivot : (3,) float or None
+        The pivot, m, mesh axes (set by :func:`heavy_top_from_mesh`).
+    symmetry_axis : (3,) float or None
+        Unit vector pivot → centre of mass, mesh axes (set by :func:`heavy_top_from_mesh`).
+    transverse_asymmetry : float
+        ``(I1b − I1a)/I1`` of the two moments transverse to the symmetry axis about the pivot, plus the
+        off-axis coupling ``|I n̂ − I3 n̂|/I1`` (0 for a true symmetric top; set by :func:`heavy_top_from_mesh`).
     """
 
     transverse_moment: float
@@ -100,6 +107,14 @@ class HeavyTopReport:
     sleeping_margin: float
     precession_rate_slow: float | None
     precession_rate_fast: float | None
+    pivot: np.ndarray | None = None
+    symmetry_axis: np.ndarray | None = None
+    transverse_asymmetry: float = 0.0
+
+    @property
+    def critical_sleeping_spin(self) -> float:
+        """Spin ω3 (rad/s) above which the upright top is stable: ``√(4 I1 M g l) / I3``."""
+        return math.sqrt(4.0 * self.transverse_moment * self.mass * self.gravity * self.length) / self.axial_moment
 
     def f(self, u):
         """The cubic ``f(u) = (1 − u²)(α − β u) − (b − a u)²`` of Eq. (4.40), 1/s²; ``u`` array_like."""
@@ -135,6 +150,25 @@ class TopTrajectory:
     theta: np.ndarray
     phi: np.ndarray
     energy: np.ndarray
+
+    def measured_nutation_period(self) -> float:
+        """Mean interval between upward crossings of the mid-level ``(min θ + max θ)/2``, s (linear
+        interpolation between samples); ``nan`` with fewer than two crossings or no visible nutation."""
+        lo, hi = float(self.theta.min()), float(self.theta.max())
+        if hi - lo <= 1e-9 * max(1.0, hi):
+            return math.nan
+        crossings = _upward_crossings(self.t, self.theta, 0.5 * (lo + hi))
+        return float(np.diff(crossings).mean()) if len(crossings) >= 2 else math.nan
+
+    def measured_precession_rate(self) -> float:
+        """Mean precession rate ``(φ_end − φ_start)/(t_end − t_start)``, rad/s (unwrapped azimuth)."""
+        return float((self.phi[-1] - self.phi[0]) / (self.t[-1] - self.t[0]))
+
+
+def _upward_crossings(t: np.ndarray, y: np.ndarray, level: float) -> np.ndarray:
+    """Times where ``y`` crosses ``level`` upwards, linearly interpolated between samples."""
+    idx = np.nonzero((y[:-1] < level) & (y[1:] >= level))[0]
+    return t[idx] + (level - y[idx]) * (t[idx + 1] - t[idx]) / (y[idx + 1] - y[idx])
 
 
 def _quadratic_roots(qa: float, qb: float, qc: float) -> tuple[float, float]:
@@ -411,5 +445,7 @@ def heavy_top_from_mesh(props, pivot, *, theta0: float, omega3: float, theta_dot
                       f"{transverse[1]:.6g} kg·m² differ by {spread / i1:.2%}, off-axis coupling "
                       f"{coupling / i1:.2%} of I1 (tolerance {rtol:g}); the analysis uses their mean",
                       AsymmetricTopWarning, stacklevel=2)
-    return heavy_top(i1, i3, props.mass, length, theta0=theta0, omega3=omega3, theta_dot0=theta_dot0,
-                     phi_dot0=phi_dot0, g=g, kind_atol=kind_atol)
+    report = heavy_top(i1, i3, props.mass, length, theta0=theta0, omega3=omega3, theta_dot0=theta_dot0,
+                       phi_dot0=phi_dot0, g=g, kind_atol=kind_atol)
+    return replace(report, pivot=np.asarray(pivot, dtype=float).copy(), symmetry_axis=n,
+                   transverse_asymmetry=(spread + coupling) / i1)
