@@ -7,10 +7,12 @@ Public API (SI units everywhere; conventions in ``docs/conventions.md``)::
     props.mass, props.volume, props.center_of_mass, props.inertia
     props.inertia_about([0, 0, 0]); props.moment_about_axis([0, 0, 1], point=[0, 0, 0])
     props.principal.moments, props.principal.axes
+    traj = it.simulate(props, angular_velocity=[0.1, 1.0, 0.05], t=np.linspace(0, 10, 101))
 """
 
 from .errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
                      UsageError)
+from .dynamics import Trajectory, herpolhode, plot_trajectory, polhode, simulate
 from .principal import PrincipalAxes, principal_axes
 from .properties import InertiaTensor, MassProperties, combine, point_mass
 
@@ -24,6 +26,11 @@ __all__ = [
     "principal_axes",
     "combine",
     "point_mass",
+    "simulate",
+    "Trajectory",
+    "polhode",
+    "herpolhode",
+    "plot_trajectory",
     "InertiaToolError",
     "InertiaToolWarning",
     "InvalidMeshError",
