@@ -9,10 +9,12 @@ Public API (SI units everywhere; conventions in ``docs/conventions.md``)::
     props.principal.moments, props.principal.axes
     it.balance(props, axis_point=[0, 0, 0], axis_direction=[0, 0, 1], rpm=3000, planes=(-0.04, 0.04),
                radius=0.18, grade="G6.3", bearings=(-0.12, 0.12)).corrections
+    traj = it.simulate(props, angular_velocity=[0.1, 1.0, 0.05], t=np.linspace(0, 10, 101))
 """
 
 from .errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
                      UsageError)
+from .dynamics import Trajectory, herpolhode, plot_trajectory, polhode, simulate
 from .principal import PrincipalAxes, principal_axes
 from .properties import InertiaTensor, MassProperties, combine, point_mass
 from .pipeline import assembly, mass_properties
@@ -36,6 +38,11 @@ __all__ = [
     "principal_axes",
     "combine",
     "point_mass",
+    "simulate",
+    "Trajectory",
+    "polhode",
+    "herpolhode",
+    "plot_trajectory",
     "InertiaToolError",
     "InertiaToolWarning",
     "InvalidMeshError",
