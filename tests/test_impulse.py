@@ -120,3 +120,28 @@ def test_bad_input():
         apply_impulse(cone, [1, 0, float("nan")], [0, 0, 0])
     with pytest.raises(PhysicsError):
         apply_impulse(point_mass(1.0, [0, 0, 0]), [1, 0, 0], [0, 0, 1])
+
+
+@pytest.mark.parametrize("method", ["exact", "numerical"])
+def test_cone_apex_path_after_the_blow_matches_free_precession(method):
+    """Exercise 4.6(c): after the blow the apex circles the fixed L at |L|/I1 while the COM drifts at P/M.
+
+    The simulated motion (inertia_tool.dynamics.simulate, closed form or numerical) composed by position_of
+    must reproduce the closed form of the free symmetric top.
+    """
+    cone = _analytic_cone()
+    hit = apply_impulse(cone, [0.02, 0, 0], [0, 0, HEIGHT], angular_velocity=[0, 0, 40.0])
+    t = np.linspace(0, 1.5, 601)
+    traj = hit.motion(t, method=method)
+    np.testing.assert_allclose(traj.angular_momentum, np.tile(hit.angular_momentum, (len(t), 1)),
+                               rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(hit.position_of([0, 0, HEIGHT], t, traj), _apex_path_closed_form(hit, t),
+                               atol=1e-9)
+    # in the body, ω circles the symmetry axis at Ω = (I3 − I1)/I1 ω3 (§4.4.1) with ω3 fixed
+    ixx, izz = cone.inertia[0, 0], cone.inertia[2, 2]
+    big_omega = (izz - ixx) / ixx * 40.0
+    w = traj.angular_velocity
+    np.testing.assert_allclose(w[:, 2], 40.0, rtol=1e-9)
+    transverse = hit.delta_angular_velocity[1]
+    np.testing.assert_allclose(w[:, 0], -transverse * np.sin(big_omega * t), atol=1e-8 * abs(transverse) + 1e-12)
+    np.testing.assert_allclose(w[:, 1], transverse * np.cos(big_omega * t), atol=1e-8 * abs(transverse) + 1e-12)
