@@ -133,3 +133,21 @@ def test_end_to_end_subprocess():
                          capture_output=True, text=True, env=env, timeout=120)
     assert run.returncode == 0, run.stderr
     assert "flip interval" in run.stdout and "Traceback" not in run.stderr
+
+
+def test_analyze_reports_stability_section_for_the_octahedron(tmp_path, capsys):
+    """``analyze`` carries the stability section: exercise 4.9(b) for the octahedron with h > b > a."""
+    from conftest import write_binary_stl
+    from test_stability import _octahedron
+
+    path = tmp_path / "octahedron.stl"
+    write_binary_stl(path, *_octahedron(20.0, 30.0, 50.0))
+    out = _json(capsys, ["analyze", str(path), "--units", "mm", "--material", "aluminium", "--json"])
+    stab = out["stability"]
+    assert [s["kind"] for s in stab] == ["stable", "unstable", "stable"]
+    assert [s["moment"] for s in stab] == pytest.approx(out["principal_moments"], rel=1e-12)
+    for s, expected in zip(stab, ([0, 0, 1], [0, 1, 0], [1, 0, 0])):
+        assert np.abs(s["axis"]) == pytest.approx(expected, abs=1e-9)
+    assert [s["dissipation_stable"] for s in stab] == [False, False, True]
+    assert main(["analyze", str(path), "--units", "mm"]) == 0
+    assert "major-axis rule" in capsys.readouterr().out
