@@ -265,7 +265,8 @@ def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL, triangle_rtol: float = 1e-
         :data:`inertia_tool.principal.DEFAULT_EQUAL_RTOL`).  This only decides the *label* ("marginal"
         vs "stable"/"unstable"); ``turns_to_grow`` stays continuous across it.
     triangle_rtol : float
-        Relative slack for the triangle inequality ``I1 + I2 ≥ I3`` before a ``PhysicalValidityWarning``.
+        Relative slack for the triangle inequality ``I1 + I2 ≥ I3`` before a ``PhysicalValidityWarning``
+        (bare moments and ``PrincipalAxes`` only; ``mass_properties`` already checks bodies it loads).
 
     Returns
     -------
@@ -284,7 +285,8 @@ def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL, triangle_rtol: float = 1e-
     if not np.all(moments > 0):
         raise PhysicsError(f"Expected three positive principal moments, got {moments.tolist()} kg·m² "
                            "(a body with a zero moment is a line; spin stability is undefined)")
-    if moments[0] + moments[1] < moments[2] * (1.0 - triangle_rtol):
+    # (a MassProperties from a mesh was already checked by the pipeline; do not warn twice)
+    if not isinstance(x, MassProperties) and moments[0] + moments[1] < moments[2] * (1.0 - triangle_rtol):
         warnings.warn(f"principal moments {moments.tolist()} violate I1 + I2 >= I3; no rigid body has them",
                       PhysicalValidityWarning, stacklevel=2)
     tol = rtol * moments[2]
