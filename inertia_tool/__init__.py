@@ -9,16 +9,23 @@ Public API (SI units everywhere; conventions in ``docs/conventions.md``)::
     props.principal.moments, props.principal.axes
     it.balance(props, axis_point=[0, 0, 0], axis_direction=[0, 0, 1], rpm=3000, planes=(-0.04, 0.04),
                radius=0.18, grade="G6.3", bearings=(-0.12, 0.12)).corrections
+    traj = it.simulate(props, angular_velocity=[0.1, 1.0, 0.05], t=np.linspace(0, 10, 101))
+    it.stability(props).kinds; it.heavy_top_from_mesh(props, pivot=[0, 0, 0], theta0=0.3, omega3=300)
 """
 
 from .errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
                      UsageError)
+from .dynamics import Trajectory, herpolhode, plot_trajectory, polhode, simulate
 from .principal import PrincipalAxes, principal_axes
 from .properties import InertiaTensor, MassProperties, combine, point_mass
 from .pipeline import assembly, mass_properties
 from .checks import MeshReport
 from . import shapes
 from .balance import BalanceReport, Correction, balance
+from .stability import AxisStability, StabilityReport, polhode_period, stability
+from .heavy_top import HeavyTopReport, heavy_top, heavy_top_from_mesh
+from .impulse import ImpulseResult, apply_impulse
+from .spin import SpinExperiment, spin_experiment
 
 __version__ = "0.1.0"
 
@@ -36,6 +43,22 @@ __all__ = [
     "principal_axes",
     "combine",
     "point_mass",
+    "simulate",
+    "Trajectory",
+    "polhode",
+    "herpolhode",
+    "plot_trajectory",
+    "stability",
+    "StabilityReport",
+    "AxisStability",
+    "polhode_period",
+    "heavy_top",
+    "heavy_top_from_mesh",
+    "HeavyTopReport",
+    "apply_impulse",
+    "ImpulseResult",
+    "spin_experiment",
+    "SpinExperiment",
     "InertiaToolError",
     "InertiaToolWarning",
     "InvalidMeshError",

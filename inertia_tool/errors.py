@@ -35,6 +35,7 @@ __all__ = [
     "PhysicalValidityWarning",
     "OverlapWarning",
     "TrailingDataWarning",
+    "AsymmetricTopWarning",
 ]
 
 
@@ -119,3 +120,8 @@ class OverlapWarning(InertiaToolWarning):
 
 class TrailingDataWarning(InertiaToolWarning):
     """A file carried bytes after the data its header announced; they were ignored."""
+
+
+class AsymmetricTopWarning(InertiaToolWarning):
+    """A body analysed as a symmetric top is not one: its two moments transverse to the pivot→centre-of-mass
+    axis differ (or that axis is not principal about the pivot) beyond the tolerance; their mean was used."""

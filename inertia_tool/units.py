@@ -12,7 +12,7 @@ import re
 from .errors import MaterialError, UnitsError
 
 __all__ = ["LENGTH_UNITS", "MATERIALS", "length_scale", "material_density", "parse_length",
-           "parse_angular_rate", "parse_duration", "parse_mass", "parse_density"]
+           "parse_angular_rate", "parse_duration", "parse_mass", "parse_density", "parse_angle", "parse_vector"]
 
 #: Length units accepted for mesh coordinates, as metres per unit.
 LENGTH_UNITS = {
@@ -165,3 +165,30 @@ def parse_density(text, default_unit: str = "kg/m3") -> float:
     if unit not in _DENSITY:
         raise UnitsError(f"Expected a density unit among {', '.join(_DENSITY)}, got {unit!r}")
     return value * _DENSITY[unit]
+
+
+_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0, "°": math.pi / 180.0, "degree": math.pi / 180.0,
+          "degrees": math.pi / 180.0, "mrad": 1e-3, "rev": 2 * math.pi, "turn": 2 * math.pi}
+
+
+def parse_angle(text, default_unit: str = "rad") -> float:
+    """``"20deg"`` → 0.349 (rad); accepts rad, deg (or °), mrad, rev/turn."""
+    if isinstance(text, (int, float)):
+        value, unit = float(text), default_unit
+    else:
+        value, unit = _split(text, "an angle")
+        unit = unit or default_unit
+    if unit not in _ANGLE:
+        raise UnitsError(f"Expected an angle unit among rad, deg, mrad, rev, got {unit!r}")
+    return value * _ANGLE[unit]
+
+
+def parse_vector(text, default_unit: str = "m") -> tuple[float, float, float]:
+    """``"0,0,-12.5"`` or ``"0,0,-12.5mm"`` → three lengths in m (a unit on any component applies to it;
+    a unit after the last one applies to bare components too)."""
+    parts = [p.strip() for p in str(text).split(",")]
+    if len(parts) != 3 or not all(parts):
+        raise UnitsError(f"Expected three comma-separated lengths like '0,0,12.5', got {text!r}")
+    trailing = _split(parts[-1], "a length")[1]
+    unit = trailing or default_unit
+    return tuple(parse_length(p, unit) for p in parts)

@@ -7,12 +7,14 @@ import os
 import sys
 import warnings
 
-from ..errors import InertiaToolWarning, UsageError
+from ..errors import InertiaToolWarning, PhysicsError, UsageError
 from ..io import DEFAULT_MAX_FACES
 from ..pipeline import DEFAULT_MERGE_TOLERANCE, assembly, mass_properties, resolve_density
 from ..properties import combine
 from ..reports.serialize import mass_properties_dict
+from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
+from ..stability import stability
 from ..units import MATERIALS, parse_density, parse_mass
 
 __all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args"]
@@ -108,11 +110,22 @@ def run(args) -> int:
     messages = [str(w.message) for w in caught if issubclass(w.category, InertiaToolWarning)]
     for w in caught:          # hand them on so the command line prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    stab, stab_error = _stability_section(props)
     if args.json:
         out = mass_properties_dict(props, density_source=described)
+        out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
         out["warnings"] = messages
         json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     else:
         print(format_mass_properties(props, density_source=described))
+        print("\n".join(format_stability(stab)) if stab is not None else f"  spin stability: {stab_error}")
     return 0
+
+
+def _stability_section(props):
+    """Spin stability of the principal axes for the report, or ``(None, reason)`` when undefined."""
+    try:
+        return stability(props), None
+    except PhysicsError as exc:
+        return None, f"undefined ({exc})"

@@ -1,0 +1,200 @@
+"""Text and JSON-ready forms of the stability, heavy-top and spin-experiment results.  Formatting only."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..heavy_top import HeavyTopReport, TopTrajectory
+from ..stability import StabilityReport
+from .serialize import to_jsonable
+
+__all__ = ["stability_dict", "format_stability", "heavy_top_dict", "format_heavy_top", "spin_dict",
+           "format_spin", "DEFAULT_REPORT_PERTURBATION"]
+
+#: Relative perturbation used for the "turns to grow" figure in reports.
+DEFAULT_REPORT_PERTURBATION = 1e-3
+
+_KIND_TEXT = {
+    "stable": "stable (wobbles)",
+    "unstable": "UNSTABLE (tumbles: ε grows exponentially)",
+    "marginal": "marginal (two equal moments: ε grows linearly)",
+    "neutral": "neutral (all moments equal: any axis is steady)",
+}
+
+
+def _g(x, digits: int = 4) -> str:
+    if x is None:
+        return "—"
+    if isinstance(x, float) and math.isinf(x):
+        return "never"
+    return f"{x:.{digits}g}"
+
+
+def _vec(v) -> str:
+    v = np.asarray(v, dtype=float)
+    v = np.where(np.abs(v) <= 1e-12 * max(np.max(np.abs(v)), 1e-300), 0.0, v) + 0.0
+    return "(" + ", ".join(f"{x: .4f}" for x in v) + ")"
+
+
+def stability_dict(report: StabilityReport, *, perturbation: float = DEFAULT_REPORT_PERTURBATION) -> list:
+    """The ``stability`` list of the JSON reports: one object per principal axis, ascending moment."""
+    out = []
+    for e in report.axes:
+        out.append({
+            "axis_name": e.name,
+            "moment": e.moment,
+            "axis": e.axis,
+            "kind": e.kind,
+            "coefficient": e.coefficient,
+            "growth_rate_per_unit_spin": e.growth_rate_per_unit_spin,
+            "e_folding_turns": e.e_folding_turns,
+            "wobble_frequency_per_unit_spin": e.wobble_frequency_per_unit_spin,
+            "wobble_period_turns": e.wobble_period_turns,
+            "wobble_amplification": e.wobble_amplification,
+            "perturbation": perturbation,
+            "turns_to_grow": e.turns_to_grow(perturbation, 1.0),
+            "dissipation_stable": e.dissipation_stable,
+        })
+    return to_jsonable(out)
+
+
+def format_stability(report: StabilityReport, *, perturbation: float = DEFAULT_REPORT_PERTURBATION) -> list[str]:
+    """Lines of the "spin stability" section (§4.4.1)."""
+    lines = ["  spin stability about the principal axes (§4.4.1; ε̈ = c ω² ε; "
+             f"equal moments within {report.rtol:g}):"]
+    for e in report.axes:
+        detail = f"c = {e.coefficient:+.4g}"
+        if e.kind == "stable":
+            detail += f", wobble period {_g(e.wobble_period_turns)} turns"
+            if e.wobble_amplification > 10:
+                detail += f", a small perturbation can grow ×{_g(e.wobble_amplification, 3)}"
+        elif e.kind in ("unstable", "marginal"):
+            detail += (f", a {perturbation:g} wobble reaches order one in "
+                       f"{_g(e.turns_to_grow(perturbation, 1.0))} turns")
+        lines.append(f"    I{e.index + 1} {e.name:<12} {e.moment:.6e} kg·m²  axis {_vec(e.axis)}  "
+                     f"{_KIND_TEXT[e.kind]}; {detail}")
+    stable = [e for e in report.axes if e.dissipation_stable]
+    names = " or ".join(f"I{e.index + 1} ({e.name})" for e in stable)
+    lines.append(f"    with energy loss (flexing, fluid): only spin about {names} lasts (major-axis rule)")
+    return lines
+
+
+def heavy_top_dict(top: HeavyTopReport, trajectory: TopTrajectory | None = None) -> dict:
+    """JSON-ready ``top`` object (SI); with a ``trajectory``, a ``simulation`` summary."""
+    out = to_jsonable(top)
+    out["critical_sleeping_spin"] = to_jsonable(top.critical_sleeping_spin)
+    if trajectory is not None:
+        out["simulation"] = to_jsonable({
+            "duration": float(trajectory.t[-1]),
+            "samples": int(len(trajectory.t)),
+            "theta_min": float(trajectory.theta.min()),
+            "theta_max": float(trajectory.theta.max()),
+            "nutation_period": trajectory.measured_nutation_period(),
+            "mean_precession_rate": trajectory.measured_precession_rate(),
+            "relative_energy_drift": float(np.ptp(trajectory.energy) / max(abs(trajectory.energy).max(), 1e-300)),
+        })
+    return out
+
+
+def _deg(x: float) -> str:
+    return f"{math.degrees(x):.4g}°"
+
+
+def format_heavy_top(top: HeavyTopReport, trajectory: TopTrajectory | None = None, *, name: str = "") -> str:
+    """Multi-line text report of the heavy-top analysis (and simulation)."""
+    lines = [f"Heavy symmetric top{': ' + name if name else ''} (§4.4.3)"]
+    if top.pivot is not None:
+        lines.append(f"  pivot {_vec(top.pivot)} m; symmetry axis pivot → centre of mass {_vec(top.symmetry_axis)}"
+                     " (mesh axes)")
+    lines.append(f"  mass {top.mass:.6g} kg, l = {top.length:.6g} m, g = {top.gravity:g} m/s²")
+    lines.append(f"  about the pivot: I1 = {top.transverse_moment:.6e} kg·m² (transverse), "
+                 f"I3 = {top.axial_moment:.6e} kg·m² (axial)")
+    if top.transverse_asymmetry > 1e-9:
+        lines.append(f"  transverse asymmetry {top.transverse_asymmetry:.2e} (0 for a true symmetric top)")
+    lines.append(f"  start: spin ω3 = {top.omega3:.6g} rad/s ({top.omega3 / (2 * math.pi):.4g} rev/s), "
+                 f"tilt θ0 = {_deg(top.theta0)}, θ̇0 = {top.theta_dot0:g} rad/s, φ̇0 = {top.phi_dot0:g} rad/s")
+    crit = top.critical_sleeping_spin
+    lines.append(f"  upright (sleeping) top: {'stable' if top.sleeping_stable else 'UNSTABLE'} — "
+                 f"I3²ω3²/(4 I1 M g l) = {top.sleeping_margin:.4g} (needs > 1: spin above {crit:.4g} rad/s = "
+                 f"{crit / (2 * math.pi):.4g} rev/s)")
+    lines.append(f"  nutation: θ between {_deg(top.theta_min)} and {_deg(top.theta_max)}, "
+                 f"period {_g(top.nutation_period, 6)} s")
+    kinds = {"looping": "looping (Fig. 4.3a: precession reverses at θ_max)",
+             "undulating": "undulating (Fig. 4.3b: precession keeps its direction)",
+             "cusp": "cusps (Fig. 4.3c: precession stops at θ_min, as when released from rest)",
+             "steady": "steady (no nutation)", "planar": "none (no spin and no azimuthal motion)"}
+    lines.append(f"  path of the axis: {kinds[top.precession_kind]}")
+    if top.precession_rate_slow is None:
+        lines.append("  steady precession at θ0: impossible (too little spin)")
+    else:
+        fast = "" if top.precession_rate_fast is None else f", fast {top.precession_rate_fast:.6g} rad/s"
+        lines.append(f"  steady precession at θ0: slow {top.precession_rate_slow:.6g} rad/s{fast}")
+    if trajectory is not None:
+        measured = trajectory.measured_nutation_period()
+        drift = float(np.ptp(trajectory.energy) / max(abs(trajectory.energy).max(), 1e-300))
+        lines.append(f"  simulated {trajectory.t[-1]:.4g} s: θ between {_deg(trajectory.theta.min())} and "
+                     f"{_deg(trajectory.theta.max())}, nutation period {_g(measured, 6)} s, mean precession "
+                     f"{trajectory.measured_precession_rate():.6g} rad/s, energy drift {drift:.1e}")
+    return "\n".join(lines)
+
+
+def spin_dict(experiment) -> dict:
+    """JSON-ready ``spin`` object of a :class:`inertia_tool.spin.SpinExperiment`."""
+    e = experiment
+    return to_jsonable({
+        "axis_name": e.axis.name,
+        "moment": e.axis.moment,
+        "axis": e.axis.axis,
+        "kind": e.axis.kind,
+        "coefficient": e.axis.coefficient,
+        "rate": e.rate,
+        "perturbation": e.perturbation,
+        "initial_angular_velocity": e.initial_angular_velocity,
+        "predicted": {
+            "linear_period": e.predicted_linear_period,
+            "time_to_grow": e.predicted_time_to_grow,
+            "turns_to_grow": e.axis.turns_to_grow(e.perturbation, 1.0),
+            "polhode_period": e.predicted_polhode_period,
+            "period": e.predicted_period,
+        },
+        "simulated": {
+            "duration": float(e.trajectory.t[-1]),
+            "samples": int(len(e.trajectory.t)),
+            "method": e.trajectory.method,
+            "period": e.measured_period,
+            "events": e.measured_events,
+            "first_flip_time": e.first_flip_time,
+            "max_tilt": e.max_tilt,
+            "relative_energy_drift": e.energy_drift,
+        },
+        "period_kind": e.period_kind,
+    })
+
+
+def format_spin(experiment, *, name: str = "") -> str:
+    """Text report of a spin experiment: classification, predicted and simulated period."""
+    e = experiment
+    a = e.axis
+    turn = 2 * math.pi / e.rate
+    lines = [f"Spin about the {a.name} axis{' of ' + name if name else ''} (I{a.index + 1} = {a.moment:.6e} kg·m², "
+             f"axis {_vec(a.axis)} mesh axes)",
+             f"  spin {e.rate:.6g} rad/s ({e.rate / (2 * math.pi):.4g} rev/s, one turn {turn:.4g} s), "
+             f"perturbation {e.perturbation:g} of the spin on each transverse axis",
+             f"  classification: {_KIND_TEXT[a.kind]}; c = {a.coefficient:+.4g} (§4.4.1)"]
+    what = "flip interval (time between flips)" if e.period_kind == "flip" else "wobble period"
+    if a.kind == "stable":
+        lines.append(f"  predicted (linear): wobble period {_g(e.predicted_linear_period, 6)} s "
+                     f"({_g(a.wobble_period_turns)} turns)")
+    elif a.kind in ("unstable", "marginal"):
+        lines.append(f"  predicted (linear): the {e.perturbation:g} wobble reaches order one after "
+                     f"{_g(e.predicted_time_to_grow, 6)} s ({_g(a.turns_to_grow(e.perturbation, 1.0))} turns)")
+    lines.append(f"  predicted (exact, Landau–Lifshitz §37): {what} {_g(e.predicted_period, 6)} s")
+    lines.append(f"  simulated {e.trajectory.t[-1]:.4g} s ({e.trajectory.method}, {len(e.trajectory.t)} samples): "
+                 f"{what} {_g(e.measured_period, 6)} s from {e.measured_events} events; largest tilt of the "
+                 f"spin axis {math.degrees(e.max_tilt):.3g}°; energy drift {e.energy_drift:.1e}")
+    if e.period_kind == "flip":
+        lines.append(f"  first flip after {_g(e.first_flip_time, 6)} s" if e.first_flip_time is not None
+                     else "  no flip within the simulated time")
+    return "\n".join(lines)

@@ -1,0 +1,282 @@
+"""Rotation representations of the chapter: z-y-z Euler angles, axis-angle, unit quaternions.
+
+Pure functions on numpy arrays (leading dimensions broadcast).  Conventions (``docs/conventions.md``):
+
+* ``A`` is the chapter's **passive** matrix mapping space components to body components, ``V' = A V``
+  (Eq. 4.3); its rows are the body axes in space coordinates (Eq. 4.2).
+* Euler angles are the chapter's z-y-z sequence ``A(φ, θ, ψ) = R_z(ψ) R_y(θ) R_z(φ)`` (Eq. 4.31) with the
+  passive ``R_z``, ``R_y`` of Eqs. (4.29)-(4.30); ``θ ∈ [0, π]``, ``φ, ψ ∈ [0, 2π)``.
+* The **orientation** of a body is the active rotation ``Q = Aᵀ`` (body components → space components),
+  stored as a scalar-first unit quaternion ``q = (w, x, y, z)`` with ``w ≥ 0`` where a sign must be chosen.
+  In scipy's language ``Q = Rotation.from_euler("ZYZ", [φ, θ, ψ]).as_matrix()`` (intrinsic z-y'-z'') and
+  ``Rotation.from_quat(np.roll(q, -1))`` (scipy is scalar-last).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import UsageError
+
+__all__ = [
+    "rotation_z",
+    "rotation_y",
+    "euler_to_matrix",
+    "matrix_to_euler",
+    "euler_rates_to_angular_velocity",
+    "axis_angle_to_matrix",
+    "matrix_to_axis_angle",
+    "quaternion_to_matrix",
+    "matrix_to_quaternion",
+    "quaternion_multiply",
+    "quaternion_conjugate",
+    "rotation_vector_to_quaternion",
+    "euler_to_quaternion",
+    "quaternion_to_euler",
+    "skew",
+]
+
+_TWO_PI = 2.0 * np.pi
+
+
+def _as_quaternion(q, name: str = "q") -> np.ndarray:
+    a = np.asarray(q, dtype=np.float64)
+    if a.shape[-1:] != (4,):
+        raise UsageError(f"Expected `{name}` to have shape (..., 4), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise UsageError(f"Expected `{name}` to be finite")
+    return a
+
+
+def _as_matrix(m, name: str = "matrix") -> np.ndarray:
+    a = np.asarray(m, dtype=np.float64)
+    if a.shape[-2:] != (3, 3):
+        raise UsageError(f"Expected `{name}` to have shape (..., 3, 3), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise UsageError(f"Expected `{name}` to be finite")
+    return a
+
+
+def skew(vector) -> np.ndarray:
+    """Cross-product matrix ``[v]×`` with ``[v]× b = v × b``; (..., 3) → (..., 3, 3).
+
+    In the chapter's notation ``Ω'_ij = Σ_k ε_ijk ω'_k`` (§4.2) is ``−[ω']×``.
+    """
+    v = np.asarray(vector, dtype=np.float64)
+    z = np.zeros_like(v[..., 0])
+    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1),
+                     np.stack([v[..., 2], z, -v[..., 0]], -1),
+                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
+
+
+def rotation_z(angle) -> np.ndarray:
+    """Passive rotation about z, Eq. (4.29): ``[[c, s, 0], [−s, c, 0], [0, 0, 1]]``; (...) → (..., 3, 3)."""
+    a = np.asarray(angle, dtype=np.float64)
+    c, s, o, z = np.cos(a), np.sin(a), np.ones_like(a), np.zeros_like(a)
+    return np.stack([np.stack([c, s, z], -1), np.stack([-s, c, z], -1), np.stack([z, z, o], -1)], -2)
+
+
+def rotation_y(angle) -> np.ndarray:
+    """Passive rotation about y, Eq. (4.30): ``[[c, 0, −s], [0, 1, 0], [s, 0, c]]``; (...) → (..., 3, 3)."""
+    a = np.asarray(angle, dtype=np.float64)
+    c, s, o, z = np.cos(a), np.sin(a), np.ones_like(a), np.zeros_like(a)
+    return np.stack([np.stack([c, z, -s], -1), np.stack([z, o, z], -1), np.stack([s, z, c], -1)], -2)
+
+
+def euler_to_matrix(phi, theta, psi) -> np.ndarray:
+    """The chapter's ``A(φ, θ, ψ) = R_z(ψ) R_y(θ) R_z(φ)``, Eq. (4.31) (space → body components).
+
+    Parameters
+    ----------
+    phi, theta, psi : array_like, broadcastable
+        Euler angles in radians.
+
+    Returns
+    -------
+    (..., 3, 3) float
+    """
+    return rotation_z(psi) @ rotation_y(theta) @ rotation_z(phi)
+
+
+def matrix_to_euler(matrix, *, gimbal_atol: float = 1e-12):
+    """Euler angles ``(φ, θ, ψ)`` of a passive matrix ``A`` (inverse of :func:`euler_to_matrix`).
+
+    From Eq. (4.31): ``cos θ = A33``, ``(A31, A32) = sin θ (cos φ, sin φ)``,
+    ``(−A13, A23) = sin θ (cos ψ, sin ψ)``.  Ranges: ``θ ∈ [0, π]``, ``φ, ψ ∈ [0, 2π)`` (§4.4.2).
+
+    Gimbal cases (footnote 16: only ``φ ± ψ`` is defined when ``sin θ ≤ gimbal_atol``): we return
+    ``ψ = 0`` and, for ``θ = 0`` (``A = R_z(φ + ψ)``), ``φ = atan2(A12, A11)``; for ``θ = π``
+    (``A = R_z(ψ − φ) R_y(π)``), ``φ = atan2(−A12, −A11)``.
+
+    Parameters
+    ----------
+    matrix : (..., 3, 3) array_like
+        Proper rotation matrices ``A``.
+    gimbal_atol : float
+        ``sin θ`` at or below which the gimbal branch is used.
+
+    Returns
+    -------
+    phi, theta, psi : (...) float arrays, radians
+    """
+    a = _as_matrix(matrix)
+    sin_theta = np.hypot(a[..., 2, 0], a[..., 2, 1])
+    theta = np.arctan2(sin_theta, a[..., 2, 2])
+    phi = np.arctan2(a[..., 2, 1], a[..., 2, 0])
+    psi = np.arctan2(a[..., 1, 2], -a[..., 0, 2])
+    gimbal = sin_theta <= gimbal_atol
+    up = a[..., 2, 2] > 0
+    phi = np.where(gimbal & up, np.arctan2(a[..., 0, 1], a[..., 0, 0]), phi)
+    phi = np.where(gimbal & ~up, np.arctan2(-a[..., 0, 1], -a[..., 0, 0]), phi)
+    psi = np.where(gimbal, 0.0, psi)
+    return np.mod(phi, _TWO_PI), theta, np.mod(psi, _TWO_PI)
+
+
+def euler_rates_to_angular_velocity(phi, theta, psi, phi_dot, theta_dot, psi_dot) -> np.ndarray:
+    """Body components of the angular velocity from Euler angles and rates, Eq. (4.33).
+
+    ``ω'_1 = θ̇ sin ψ − φ̇ sin θ cos ψ``, ``ω'_2 = θ̇ cos ψ + φ̇ sin θ sin ψ``, ``ω'_3 = ψ̇ + φ̇ cos θ``;
+    these are the components of ``Ω' = −A d(A⁻¹)/dt`` (Eq. 4.32, §4.2).
+
+    Returns
+    -------
+    (..., 3) float, rad/s, body axes.
+    """
+    phi, theta, psi, phi_dot, theta_dot, psi_dot = np.broadcast_arrays(
+        *(np.asarray(x, dtype=np.float64) for x in (phi, theta, psi, phi_dot, theta_dot, psi_dot)))
+    return np.stack([theta_dot * np.sin(psi) - phi_dot * np.sin(theta) * np.cos(psi),
+                     theta_dot * np.cos(psi) + phi_dot * np.sin(theta) * np.sin(psi),
+                     psi_dot + phi_dot * np.cos(theta)], -1)
+
+
+def _unit_axis(axis) -> np.ndarray:
+    n = np.asarray(axis, dtype=np.float64)
+    if n.shape[-1:] != (3,):
+        raise UsageError(f"Expected `axis` to have shape (..., 3), got {n.shape}")
+    norm = np.linalg.norm(n, axis=-1, keepdims=True)
+    if not np.all(norm > 0) or not np.all(np.isfinite(norm)):
+        raise UsageError("Expected a finite non-zero `axis`")
+    return n / norm
+
+
+def axis_angle_to_matrix(axis, angle) -> np.ndarray:
+    """Passive matrix ``A`` of a counter-clockwise rotation by ``angle`` about ``axis`` (exercise 4.5).
+
+    ``A_ij = δ_ij cos θ + n_i n_j (1 − cos θ) − ε_ijk n_k sin θ``.  The active rotation (body → space) is
+    its transpose.
+
+    Parameters
+    ----------
+    axis : (..., 3) array_like
+        Rotation axis (normalised here).
+    angle : (...) array_like
+        Radians.
+
+    Returns
+    -------
+    (..., 3, 3) float
+    """
+    n = _unit_axis(axis)
+    th = np.asarray(angle, dtype=np.float64)[..., None, None]
+    return (np.cos(th) * np.eye(3) + (1.0 - np.cos(th)) * n[..., :, None] * n[..., None, :]
+            - np.sin(th) * skew(n))
+
+
+def matrix_to_axis_angle(matrix):
+    """Axis and angle of a passive matrix ``A`` (inverse of :func:`axis_angle_to_matrix`).
+
+    Computed through the quaternion of ``Aᵀ`` (robust near 0 and π).  Returns ``(axis (..., 3),
+    angle (...) ∈ [0, π])``; for the identity the axis is ``(0, 0, 1)``.
+    """
+    q = matrix_to_quaternion(np.swapaxes(_as_matrix(matrix), -1, -2))
+    vec_norm = np.linalg.norm(q[..., 1:], axis=-1)
+    angle = 2.0 * np.arctan2(vec_norm, q[..., 0])
+    safe = np.where(vec_norm > 0, vec_norm, 1.0)[..., None]
+    axis = np.where(vec_norm[..., None] > 0, q[..., 1:] / safe, np.array([0.0, 0.0, 1.0]))
+    return axis, angle
+
+
+def quaternion_to_matrix(quaternion) -> np.ndarray:
+    """Active rotation matrix ``Q`` (body → space) of scalar-first unit quaternions; ``A = Qᵀ``.
+
+    ``Q = (w² − v·v) 𝟙 + 2 v vᵀ + 2 w [v]×`` for ``q = (w, v)`` (normalised here).
+
+    Returns
+    -------
+    (..., 3, 3) float
+    """
+    q = _as_quaternion(quaternion, "quaternion")
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
+
+
+def matrix_to_quaternion(matrix) -> np.ndarray:
+    """Scalar-first unit quaternion (``w ≥ 0``) of an active rotation matrix ``Q`` (Shepperd's method).
+
+    Picks the largest of ``4w², 4x², 4y², 4z²`` (from the trace and the diagonal) to divide by, so the
+    result is accurate for every rotation.
+
+    Returns
+    -------
+    (..., 4) float
+    """
+    m = _as_matrix(matrix)
+    m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
+    cand = np.stack([1 + m00 + m11 + m22, 1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22], -1)
+    k = np.argmax(cand, axis=-1)
+    d21, d02, d10 = m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]
+    s01, s02, s12 = m[..., 0, 1] + m[..., 1, 0], m[..., 0, 2] + m[..., 2, 0], m[..., 1, 2] + m[..., 2, 1]
+    options = np.stack([
+        np.stack([cand[..., 0], d21, d02, d10], -1),
+        np.stack([d21, cand[..., 1], s01, s02], -1),
+        np.stack([d02, s01, cand[..., 2], s12], -1),
+        np.stack([d10, s02, s12, cand[..., 3]], -1)], -2)
+    q = np.take_along_axis(options, k[..., None, None], axis=-2)[..., 0, :]
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    return np.where(q[..., :1] < 0, -q, q)
+
+
+def quaternion_multiply(p, q) -> np.ndarray:
+    """Hamilton product ``p ⊗ q`` of scalar-first quaternions (matrix of ``p ⊗ q`` = ``Q_p Q_q``)."""
+    p = _as_quaternion(p, "p")
+    q = _as_quaternion(q, "q")
+    pw, pv = p[..., :1], p[..., 1:]
+    qw, qv = q[..., :1], q[..., 1:]
+    w = pw * qw - np.sum(pv * qv, axis=-1, keepdims=True)
+    v = pw * qv + qw * pv + np.cross(pv, qv)
+    return np.concatenate([w, v], -1)
+
+
+def quaternion_conjugate(q) -> np.ndarray:
+    """``(w, −x, −y, −z)``: the inverse rotation for a unit quaternion."""
+    q = _as_quaternion(q)
+    return q * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def rotation_vector_to_quaternion(rotation_vector) -> np.ndarray:
+    """Quaternion ``exp(v/2) = (cos(|v|/2), sin(|v|/2) v/|v|)`` of an active rotation by ``|v|`` about ``v``.
+
+    Uses the series of ``sin(x/2)/x`` below ``|v| = 1e-4`` (exact to round-off).
+    """
+    v = np.asarray(rotation_vector, dtype=np.float64)
+    if v.shape[-1:] != (3,):
+        raise UsageError(f"Expected `rotation_vector` to have shape (..., 3), got {v.shape}")
+    angle = np.linalg.norm(v, axis=-1, keepdims=True)
+    small = angle < 1e-4
+    safe = np.where(small, 1.0, angle)
+    half_sinc = np.where(small, 0.5 - angle * angle / 48.0, np.sin(0.5 * safe) / safe)
+    return np.concatenate([np.cos(0.5 * angle), half_sinc * v], -1)
+
+
+def euler_to_quaternion(phi, theta, psi) -> np.ndarray:
+    """Quaternion of the orientation ``Q = A(φ, θ, ψ)ᵀ`` (Eq. 4.31); (...) → (..., 4)."""
+    return matrix_to_quaternion(np.swapaxes(euler_to_matrix(phi, theta, psi), -1, -2))
+
+
+def quaternion_to_euler(quaternion, *, gimbal_atol: float = 1e-12):
+    """Euler angles ``(φ, θ, ψ)`` of the orientation quaternion (``A = Qᵀ``); see :func:`matrix_to_euler`."""
+    return matrix_to_euler(np.swapaxes(quaternion_to_matrix(quaternion), -1, -2), gimbal_atol=gimbal_atol)
