@@ -97,6 +97,18 @@ def _split(text: str, what: str) -> tuple[float, str]:
     return value, (m.group(2) or "").strip().lower()
 
 
+def _parse_with_table(text, table: dict, what: str, default_unit: str) -> float:
+    """Number with an optional unit from ``table`` (unit → SI factor); a bare number is in ``default_unit``."""
+    if isinstance(text, (int, float)):
+        value, unit = float(text), default_unit
+    else:
+        value, unit = _split(text, what)
+        unit = unit or default_unit
+    if unit not in table:
+        raise UnitsError(f"Expected {what} unit among {', '.join(table)}, got {unit!r}")
+    return value * table[unit]
+
+
 def parse_length(text, default_unit: str = "m") -> float:
     """``"2mm"`` → 0.002 (m).  A bare number is in ``default_unit``."""
     if isinstance(text, (int, float)):
@@ -111,14 +123,7 @@ _RATE = {"rad/s": 1.0, "rad/sec": 1.0, "rev/s": 2 * math.pi, "hz": 2 * math.pi, 
 
 def parse_angular_rate(text, default_unit: str = "rad/s") -> float:
     """``"5rev/s"`` → 31.4159 (rad/s); accepts rad/s, rev/s, Hz, rps, rpm, rev/min, deg/s."""
-    if isinstance(text, (int, float)):
-        value, unit = float(text), default_unit
-    else:
-        value, unit = _split(text, "an angular rate")
-        unit = unit or default_unit
-    if unit not in _RATE:
-        raise UnitsError(f"Expected an angular-rate unit among {', '.join(_RATE)}, got {unit!r}")
-    return value * _RATE[unit]
+    return _parse_with_table(text, _RATE, "an angular-rate", default_unit)
 
 
 _TIME = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0}
@@ -126,14 +131,7 @@ _TIME = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0}
 
 def parse_duration(text, default_unit: str = "s") -> float:
     """``"30s"`` → 30.0, ``"2min"`` → 120.0 (s)."""
-    if isinstance(text, (int, float)):
-        value, unit = float(text), default_unit
-    else:
-        value, unit = _split(text, "a duration")
-        unit = unit or default_unit
-    if unit not in _TIME:
-        raise UnitsError(f"Expected a time unit among {', '.join(_TIME)}, got {unit!r}")
-    return value * _TIME[unit]
+    return _parse_with_table(text, _TIME, "a time", default_unit)
 
 
 _MASS = {"kg": 1.0, "g": 1e-3, "mg": 1e-6, "lb": 0.45359237, "t": 1000.0}
@@ -141,14 +139,7 @@ _MASS = {"kg": 1.0, "g": 1e-3, "mg": 1e-6, "lb": 0.45359237, "t": 1000.0}
 
 def parse_mass(text, default_unit: str = "kg") -> float:
     """``"412g"`` → 0.412 (kg); accepts kg, g, mg, lb, t."""
-    if isinstance(text, (int, float)):
-        value, unit = float(text), default_unit
-    else:
-        value, unit = _split(text, "a mass")
-        unit = unit or default_unit
-    if unit not in _MASS:
-        raise UnitsError(f"Expected a mass unit among {', '.join(_MASS)}, got {unit!r}")
-    return value * _MASS[unit]
+    return _parse_with_table(text, _MASS, "a mass", default_unit)
 
 
 _DENSITY = {"kg/m3": 1.0, "kg/m^3": 1.0, "g/cm3": 1000.0, "g/cm^3": 1000.0, "g/cc": 1000.0,
@@ -157,14 +148,7 @@ _DENSITY = {"kg/m3": 1.0, "kg/m^3": 1.0, "g/cm3": 1000.0, "g/cm^3": 1000.0, "g/c
 
 def parse_density(text, default_unit: str = "kg/m3") -> float:
     """``"7850"`` → 7850.0, ``"1.24g/cm3"`` → 1240.0 (kg/m³)."""
-    if isinstance(text, (int, float)):
-        value, unit = float(text), default_unit
-    else:
-        value, unit = _split(text, "a density")
-        unit = unit or default_unit
-    if unit not in _DENSITY:
-        raise UnitsError(f"Expected a density unit among {', '.join(_DENSITY)}, got {unit!r}")
-    return value * _DENSITY[unit]
+    return _parse_with_table(text, _DENSITY, "a density", default_unit)
 
 
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0, "°": math.pi / 180.0, "degree": math.pi / 180.0,
@@ -173,14 +157,7 @@ _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0, "°": math.pi / 180.0, "degree": m
 
 def parse_angle(text, default_unit: str = "rad") -> float:
     """``"20deg"`` → 0.349 (rad); accepts rad, deg (or °), mrad, rev/turn."""
-    if isinstance(text, (int, float)):
-        value, unit = float(text), default_unit
-    else:
-        value, unit = _split(text, "an angle")
-        unit = unit or default_unit
-    if unit not in _ANGLE:
-        raise UnitsError(f"Expected an angle unit among rad, deg, mrad, rev, got {unit!r}")
-    return value * _ANGLE[unit]
+    return _parse_with_table(text, _ANGLE, "an angle", default_unit)
 
 
 def parse_vector(text, default_unit: str = "m") -> tuple[float, float, float]:
