@@ -17,9 +17,11 @@ A straight segment ``(p, q)`` of length ``L`` (a wire) gives in the same way
 A flat triangular plate of thickness ``t`` centred on its triangle (a prism) adds the through-thickness
 term ``t²/12 · A n nᵀ`` to the second moment (``n`` the unit normal), exactly.  The inertia tensor then
 follows from the second moment ``C`` as ``I = ρ t (tr C 𝟙 − C)``, Eqs. (4.11)/(4.13) of the chapter with the
-volume element ``t dA``.  Summing over the faces is exact for the union of the flat plates; where two faces
+volume element ``t dA``.  Summing over the faces is exact for the union of the flat plates.  Where two faces
 meet at an angle the plates leave a thin wedge open on the convex side and overlap by the same wedge on
-the concave side, so the volume is right to order ``t²`` per edge and the error is of order ``t³``.
+the concave side: the volume stays right to order ``t²``, but material moves from the outer to the inner
+side, so a curved wall (or a bend) of radius ``R`` is off by a relative ``O((t/R)²)`` (for a sphere the
+moments are low by ``(t/R)²/3``; see tests/test_surface.py).
 
 Unlike the volume integral, none of this needs a closed or consistently wound surface: an open sheet
 (sheet metal, a bracket) is as valid as the surface of a hollow part, and the winding does not matter.

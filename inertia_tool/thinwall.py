@@ -77,7 +77,8 @@ def shell_mass_properties(source, *, thickness: float, units: str = "m", density
     MassProperties
         ``mass = ρ t A``; ``volume = t A`` (material volume); ``inertia`` about the centre of mass in mesh
         axes (tensor convention); ``surface_area = A`` (the mid-surface).  Exact for the union of flat
-        triangular plates of thickness ``t``; see :mod:`inertia_tool.surface` for the error at bends.
+        triangular plates of thickness ``t``; a wall curved or bent at radius ``R`` errs by a relative
+        ``O((t/R)²)`` (see :mod:`inertia_tool.surface`).
 
     Raises
     ------

@@ -14,7 +14,7 @@ def model_summary(model: str, *, thickness: float | None = None, printed: Printe
         out.update(thickness=thickness,
                    approximation="mass rho*t*A on the mesh taken as the mid-surface of a wall of constant "
                                  "thickness t; exact for flat triangular plates of thickness t (including the "
-                                 "t^2/12 through-thickness term); bends err at order t^3 per unit edge length")
+                                 "t^2/12 through-thickness term); curved or bent walls (radius R) err by O((t/R)^2)")
     elif model == "printed" and printed is not None:
         out.update(skin=printed.skin, infill=printed.infill, envelope_volume=printed.envelope_volume,
                    skin_volume_first_order=printed.skin_volume, offset_coefficient=printed.offset_coefficient,
@@ -31,7 +31,7 @@ def format_model_note(summary: dict) -> str:
     if model == "shell":
         return (f"  model: thin shell, wall thickness {summary['thickness'] * 1e3:.6g} mm on the mesh as mid-surface\n"
                 "    mass ρ·t·A; exact for flat triangular plates of thickness t (with the t²/12 through-thickness "
-                "term);\n    where faces meet at an angle the error is of order t³ per unit edge length")
+                "term);\n    walls curved or bent at radius R err by a relative O((t/R)²), e.g. −(t/R)²/3 for a sphere")
     if model == "printed":
         e = summary["mass_error_estimate"]
         order = summary["inertia_error_order"]
