@@ -94,3 +94,43 @@ def test_skin_thicker_than_the_part_is_refused(block):
 def test_bad_parameters(block, skin, infill):
     with pytest.raises(UsageError):
         printed_part(block, skin=skin, infill=infill, density=RHO)
+
+
+# -- command line ----------------------------------------------------------------------------------------------
+
+@pytest.fixture
+def block_stl(tmp_path):
+    from conftest import write_binary_stl
+    box = trimesh.creation.box([A * 1000, B * 1000, C * 1000])
+    p = tmp_path / "block.stl"
+    write_binary_stl(p, box.vertices, box.faces)
+    return str(p)
+
+
+def test_cli_printed_json_states_the_model(block_stl, capsys):
+    import json
+    from inertia_tool.cli import main
+    assert main(["analyze", block_stl, "--units", "mm", "--material", "pla", "--shell", "1.2mm", "--infill", "20%",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    ref = printed_part(trimesh.creation.box([A, B, C]), skin=0.0012, infill=0.2, density=RHO)
+    assert out["mass"] == pytest.approx(ref.properties.mass, rel=1e-6)
+    assert out["model"]["model"] == "printed" and out["model"]["infill"] == pytest.approx(0.2)
+    assert out["model"]["mass_error_estimate"] == pytest.approx(ref.mass_error_estimate, rel=1e-6)
+
+
+def test_cli_printed_text_states_the_error(block_stl, capsys):
+    from inertia_tool.cli import main
+    assert main(["analyze", block_stl, "--units", "mm", "--material", "pla", "--shell", "1.2", "--infill", "0.2"]) == 0
+    text = capsys.readouterr().out
+    assert "model: printed part, skin 1.2 mm, infill 20%" in text and "estimated error" in text
+
+
+@pytest.mark.parametrize("args", [["--shell", "1mm"], ["--infill", "20%"], ["--thickness", "2mm"],
+                                  ["--model", "shell"], ["--model", "shell", "--thickness", "1mm", "--shell", "1mm",
+                                                         "--infill", "20%"],
+                                  ["--shell", "1mm", "--infill", "120%"], ["--shell", "1 furlong", "--infill", "20%"]])
+def test_cli_contradictory_model_options_exit_2(block_stl, args, capsys):
+    from inertia_tool.cli import main
+    assert main(["analyze", block_stl, "--units", "mm", *args]) == 2
+    assert "error" in capsys.readouterr().err

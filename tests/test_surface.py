@@ -203,3 +203,24 @@ def test_rigid_motion_rotates_the_tensor(angles, shift):
     moved = shell_mass_properties((mesh.vertices @ rot.T + shift, mesh.faces), thickness=0.01, density=10.0)
     np.testing.assert_allclose(moved.center_of_mass, rot @ base.center_of_mass + shift, atol=1e-12)
     np.testing.assert_allclose(moved.inertia, rot @ base.inertia @ rot.T, atol=1e-12 * np.abs(base.inertia).max())
+
+
+def test_cli_shell_model_end_to_end(tmp_path):
+    """``analyze --model shell --thickness 2mm`` in a subprocess: mass ρ t A of a 100 × 50 × 20 mm box surface."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from conftest import write_binary_stl
+    box = trimesh.creation.box([100.0, 50.0, 20.0])
+    p = tmp_path / "casing.stl"
+    write_binary_stl(p, box.vertices, box.faces)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    run = subprocess.run([sys.executable, "-m", "inertia_tool.cli", "analyze", str(p), "--units", "mm", "--material",
+                          "steel", "--model", "shell", "--thickness", "2mm", "--json"], capture_output=True, text=True,
+                         env={**os.environ, "PYTHONPATH": root}, timeout=120)
+    assert run.returncode == 0, run.stderr
+    out = json.loads(run.stdout)
+    area = 2 * (0.1 * 0.05 + 0.1 * 0.02 + 0.05 * 0.02)
+    assert out["mass"] == pytest.approx(7850 * 0.002 * area, rel=1e-6)
+    assert out["model"] == {"model": "shell", "thickness": pytest.approx(0.002), "approximation": out["model"]["approximation"]}

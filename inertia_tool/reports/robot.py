@@ -48,6 +48,13 @@ def _position(frame: InertialFrame) -> np.ndarray:
     return p
 
 
+def _unitless(x) -> np.ndarray:
+    """Display only: angles and quaternion components below 1e-14 (round-off) print as 0."""
+    a = np.array(x, dtype=float)
+    a[np.abs(a) < 1e-14] = 0.0
+    return a
+
+
 def _comment(frame: InertialFrame, fmt: str, source: str | None, angle_note: str) -> str:
     parts = [f"inertia-tool: {fmt} <inertial> of {source}" if source else f"inertia-tool: {fmt} <inertial>"]
     parts.append("SI units (m, kg, kg*m^2); the link frame is the mesh frame")
@@ -76,7 +83,7 @@ def format_urdf(frame: InertialFrame, *, source: str | None = None, digits: int 
     lines = [
         _comment(frame, "URDF", source, "rpy: R = Rz(yaw) Ry(pitch) Rx(roll), fixed axes"),
         "<inertial>",
-        f'  <origin xyz="{_nums(_position(frame), digits)}" rpy="{_nums(frame.rpy, digits)}"/>',
+        f'  <origin xyz="{_nums(_position(frame), digits)}" rpy="{_nums(_unitless(frame.rpy), digits)}"/>',
         f'  <mass value="{_num(frame.mass, digits)}"/>',
         f'  <inertia ixx="{_num(t[0, 0], digits)}" ixy="{_num(t[0, 1], digits)}" ixz="{_num(t[0, 2], digits)}" '
         f'iyy="{_num(t[1, 1], digits)}" iyz="{_num(t[1, 2], digits)}" izz="{_num(t[2, 2], digits)}"/>',
@@ -93,7 +100,7 @@ def format_sdf(frame: InertialFrame, *, source: str | None = None, digits: int =
     lines = [
         _comment(frame, "SDFormat", source, "pose: x y z roll pitch yaw, R = Rz(yaw) Ry(pitch) Rx(roll)"),
         "<inertial>",
-        f"  <pose>{_nums(_position(frame), digits)} {_nums(frame.rpy, digits)}</pose>",
+        f"  <pose>{_nums(_position(frame), digits)} {_nums(_unitless(frame.rpy), digits)}</pose>",
         f"  <mass>{_num(frame.mass, digits)}</mass>",
         "  <inertia>",
         *[f"    <{n}>{_num(t[i, j], digits)}</{n}>" for n, i, j in names],
@@ -110,7 +117,7 @@ def format_mjcf(frame: InertialFrame, *, source: str | None = None, digits: int 
     t = _products(frame)
     attrs = [f'pos="{_nums(_position(frame), digits)}"']
     if frame.frame == "principal":
-        attrs.append(f'quat="{_nums(frame.quaternion, digits)}"')
+        attrs.append(f'quat="{_nums(_unitless(frame.quaternion), digits)}"')
         attrs.append(f'mass="{_num(frame.mass, digits)}"')
         attrs.append(f'diaginertia="{_nums(np.diag(t), digits)}"')
         note = "quat: w x y z (scalar first) of the principal axes"
