@@ -60,12 +60,15 @@ class SurfaceMoments:
     normal_moment : (3, 3) float
         ``Σ_faces A_f n_f n_fᵀ`` in m² (``n_f`` the unit normal; sign-free): multiplied by ``t³/12`` it is
         the through-thickness second moment of plates of thickness ``t``.
+    zero_area_faces : int
+        Triangles whose area is below ``area_rtol`` times the squared bounding-box diagonal (they add nothing).
     """
 
     area: float
     centroid: np.ndarray
     second_moment: np.ndarray
     normal_moment: np.ndarray
+    zero_area_faces: int = 0
 
 
 @dataclass(frozen=True)
@@ -103,7 +106,8 @@ def _central(total: float, first: np.ndarray, second: np.ndarray, origin: np.nda
     return origin + d, 0.5 * (central + central.T)
 
 
-def surface_moments(vertices, faces, *, origin=None, chunk_size: int = _DEFAULT_CHUNK) -> SurfaceMoments:
+def surface_moments(vertices, faces, *, origin=None, chunk_size: int = _DEFAULT_CHUNK,
+                    area_rtol: float = 1e-14) -> SurfaceMoments:
     """Exact area, centroid, central second moment and normal moment of a triangulated surface.
 
     Parameters
@@ -117,6 +121,9 @@ def surface_moments(vertices, faces, *, origin=None, chunk_size: int = _DEFAULT_
         the origin).  Any point gives the same result up to round-off.
     chunk_size : int
         Faces processed per vectorised step (bounds temporary memory).
+    area_rtol : float
+        A triangle counts as zero-area (reported, contributes nothing) when twice its area is below
+        ``area_rtol · L²`` with ``L`` the bounding-box diagonal.
 
     Returns
     -------
@@ -134,12 +141,15 @@ def surface_moments(vertices, faces, *, origin=None, chunk_size: int = _DEFAULT_
     first = np.zeros(3)
     second = np.zeros(6)
     normal = np.zeros(6)
+    zero = 0
+    diag2 = float(np.sum((v.max(axis=0) - v.min(axis=0)) ** 2)) if len(v) else 0.0
     step = max(1, int(chunk_size))
     for start in range(0, len(f), step):
         fc = f[start:start + step]
         p1, p2, p3 = v[fc[:, 0]] - o, v[fc[:, 1]] - o, v[fc[:, 2]] - o
         cross = np.cross(p2 - p1, p3 - p1)
         a = 0.5 * np.linalg.norm(cross, axis=1)
+        zero += int(np.count_nonzero(2.0 * a <= area_rtol * diag2))
         s = p1 + p2 + p3
         area += a.sum()
         first += a @ s / 3.0
@@ -151,7 +161,7 @@ def surface_moments(vertices, faces, *, origin=None, chunk_size: int = _DEFAULT_
             normal[col] += np.sum(np.where(a > 0, cross[:, i] * cross[:, j] / (4.0 * safe), 0.0))
     centroid, central = _central(float(area), first, _symmetric(second), o)
     return SurfaceMoments(area=float(area), centroid=centroid, second_moment=central,
-                          normal_moment=_symmetric(normal))
+                          normal_moment=_symmetric(normal), zero_area_faces=zero)
 
 
 def curve_moments(points, segments, *, origin=None) -> CurveMoments:

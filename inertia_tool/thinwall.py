@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import MeshReport, degenerate_faces, edge_topology, shell_labels
+from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .errors import InvalidMeshError, PhysicsError, UsageError
 from .io import DEFAULT_MAX_FACES, load_mesh
 from .pipeline import DEFAULT_MERGE_TOLERANCE, prepare_mesh, resolve_density
@@ -90,11 +90,12 @@ def shell_mass_properties(source, *, thickness: float, units: str = "m", density
     v, f = raw.vertices, raw.faces
     if len(f) == 0:
         raise InvalidMeshError(f"{raw.source}: the mesh has no triangles")
-    repeated, zero_area = degenerate_faces(v, f)
+    repeated = repeated_corner_faces(f)
     f = f[~repeated]
     if len(f) == 0:
         raise InvalidMeshError(f"{raw.source}: all triangles are degenerate (no area)")
     sm = surface_moments(v, f)
+    zero_area = sm.zero_area_faces
     if not sm.area > 0:
         raise InvalidMeshError(f"{raw.source}: the surface has no area")
     topo = edge_topology(f, len(v), v)
