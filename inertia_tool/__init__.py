@@ -11,6 +11,9 @@ Public API (SI units everywhere; conventions in ``docs/conventions.md``)::
                radius=0.18, grade="G6.3", bearings=(-0.12, 0.12)).corrections
     traj = it.simulate(props, angular_velocity=[0.1, 1.0, 0.05], t=np.linspace(0, 10, 101))
     it.stability(props).kinds; it.heavy_top_from_mesh(props, pivot=[0, 0, 0], theta0=0.3, omega3=300)
+    it.inertial_frame(props, "principal")          # for URDF / SDF / MJCF, checked like Gazebo and MuJoCo
+    it.shell_mass_properties("casing.stl", thickness=0.002, units="mm", material="steel")
+    it.printed_part("bracket.stl", skin=0.0012, infill=0.2, units="mm", material="PLA").properties
 """
 
 from .errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
@@ -26,6 +29,8 @@ from .stability import AxisStability, StabilityReport, polhode_period, stability
 from .heavy_top import HeavyTopReport, heavy_top, heavy_top_from_mesh
 from .impulse import ImpulseResult, apply_impulse
 from .spin import SpinExperiment, spin_experiment
+from .inertial import InertialFrame, MomentCheck, check_moments, inertial_frame
+from .thinwall import PrintedPart, printed_part, shell_mass_properties
 
 __version__ = "0.1.0"
 
@@ -59,6 +64,13 @@ __all__ = [
     "ImpulseResult",
     "spin_experiment",
     "SpinExperiment",
+    "shell_mass_properties",
+    "printed_part",
+    "PrintedPart",
+    "inertial_frame",
+    "InertialFrame",
+    "check_moments",
+    "MomentCheck",
     "InertiaToolError",
     "InertiaToolWarning",
     "InvalidMeshError",

@@ -12,7 +12,7 @@ import re
 from .errors import MaterialError, UnitsError
 
 __all__ = ["LENGTH_UNITS", "MATERIALS", "length_scale", "material_density", "parse_length",
-           "parse_angular_rate", "parse_duration", "parse_mass", "parse_density", "parse_angle", "parse_vector"]
+           "parse_angular_rate", "parse_duration", "parse_mass", "parse_density", "parse_angle", "parse_vector", "parse_fraction"]
 
 #: Length units accepted for mesh coordinates, as metres per unit.
 LENGTH_UNITS = {
@@ -169,3 +169,18 @@ def parse_vector(text, default_unit: str = "m") -> tuple[float, float, float]:
     trailing = _split(parts[-1], "a length")[1]
     unit = trailing or default_unit
     return tuple(parse_length(p, unit) for p in parts)
+
+
+def parse_fraction(text) -> float:
+    """``"20%"`` → 0.2, ``"0.2"`` → 0.2 (a fraction in [0, 1]; a bare number above 1 is refused, not guessed)."""
+    if isinstance(text, (int, float)):
+        value, unit = float(text), ""
+    else:
+        value, unit = _split(text, "a fraction")
+    if unit in ("%", "percent"):
+        value /= 100.0
+    elif unit:
+        raise UnitsError(f"Expected a fraction like '0.2' or '20%', got {text!r}")
+    if not 0.0 <= value <= 1.0:
+        raise UnitsError(f"Expected a fraction between 0 and 1 (0% to 100%), got {text!r}")
+    return value

@@ -1,4 +1,5 @@
-"""``inertia-tool analyze FILE [FILE:material ...]``: mass properties report (text or JSON)."""
+"""``inertia-tool analyze FILE [FILE:material ...]``: mass properties report (text, JSON, URDF/SDF/MJCF
+``<inertial>`` blocks, CAD-style report), for solids, thin shells and printed parts."""
 
 from __future__ import annotations
 
@@ -11,13 +12,21 @@ from ..errors import InertiaToolWarning, PhysicsError, UsageError
 from ..io import DEFAULT_MAX_FACES
 from ..pipeline import DEFAULT_MERGE_TOLERANCE, assembly, mass_properties, resolve_density
 from ..properties import combine
-from ..reports.serialize import mass_properties_dict
+from ..reports.serialize import mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
 from ..stability import stability
 from ..units import MATERIALS, parse_density, parse_mass
+# issue 6: exports and thin-walled models
+from ..inertial import FRAMES, inertial_frame
+from ..reports.cad import CAD_UNITS, format_cad_report
+from ..reports.models import format_model_note, model_summary
+from ..reports.robot import ROBOT_FORMATS, format_inertial
+from ..thinwall import printed_part, shell_mass_properties
+from ..units import parse_fraction, parse_length
 
-__all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args"]
+__all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args",
+           "add_output_options", "add_model_options", "output_format", "load_model_from_args", "FORMATS"]
 
 
 def split_part_spec(spec: str) -> tuple[str, str | None]:
@@ -99,27 +108,43 @@ def register(subparsers) -> None:
                                                            "FILE:material or FILE:density for an assembly")
     add_material_options(p)
     add_mesh_options(p)
-    p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of the text report")
+    p.add_argument("--json", action="store_true", help="print one JSON object (SI); same as --format json")
+    add_output_options(p)
+    add_model_options(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
+    fmt = output_format(args)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", InertiaToolWarning)
-        props, described = load_from_args(args)
+        props, described, model = load_model_from_args(args)
     messages = [str(w.message) for w in caught if issubclass(w.category, InertiaToolWarning)]
     for w in caught:          # hand them on so the command line prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    stab, stab_error = _stability_section(props)
-    if args.json:
+    stab, stab_error = _stability_section(props) if fmt in ("json", "text") else (None, None)
+    if fmt == "json":
         out = mass_properties_dict(props, density_source=described)
         out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
+        if model["model"] != "solid":
+            out["model"] = to_jsonable(model)
         out["warnings"] = messages
         json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
+    elif fmt in ROBOT_FORMATS:
+        frame = inertial_frame(props, args.frame)
+        print(format_inertial(frame, fmt, source=f"{props.name}: {described}{_model_words(model)}"))
+    elif fmt == "cad":
+        print(format_cad_report(props, units=args.cad_units, density_source=described))
+        note = format_model_note(model)
+        if note:
+            print("\n" + note.strip())
     else:
         print(format_mass_properties(props, density_source=described))
         print("\n".join(format_stability(stab)) if stab is not None else f"  spin stability: {stab_error}")
+        note = format_model_note(model)
+        if note:
+            print(note)
     return 0
 
 
@@ -129,3 +154,87 @@ def _stability_section(props):
         return stability(props), None
     except PhysicsError as exc:
         return None, f"undefined ({exc})"
+
+
+# -- output formats and thin-walled models (issue 6: exports, shells, printed parts) ---------------------------
+
+#: Values of ``--format``.
+FORMATS = ("text", "json") + ROBOT_FORMATS + ("cad",)
+
+
+def add_output_options(parser) -> None:
+    """``--format``, ``--frame``, ``--cad-units``."""
+    g = parser.add_argument_group("output")
+    g.add_argument("--format", choices=FORMATS, default=None,
+                   help="text report (default), json, an <inertial> block for urdf, sdf or mjcf (MuJoCo), "
+                        "or cad: a SolidWorks-style mass properties report (positive tensor notation)")
+    g.add_argument("--frame", choices=FRAMES, default="principal",
+                   help="inertial frame of urdf/sdf/mjcf: principal axes with a diagonal tensor (default) or "
+                        "mesh-aligned axes with the full tensor")
+    g.add_argument("--cad-units", choices=tuple(CAD_UNITS), default="kg-m",
+                   help="display units of --format cad (default kg-m; g-mm is SolidWorks' default)")
+
+
+def add_model_options(parser) -> None:
+    """``--model``, ``--thickness``, ``--shell``, ``--infill``."""
+    g = parser.add_argument_group("thin-walled and printed parts")
+    g.add_argument("--model", choices=("solid", "shell"), default="solid",
+                   help="solid (default): the mesh bounds homogeneous material; shell: the mesh is the "
+                        "mid-surface of a wall of --thickness (sheet metal, thin-walled parts; open meshes allowed)")
+    g.add_argument("--thickness", metavar="LEN", help="wall thickness of --model shell, e.g. 2mm "
+                                                      "(a bare number is in --units)")
+    g.add_argument("--shell", metavar="LEN", help="3D print: solid skin thickness, e.g. 1.2mm (with --infill)")
+    g.add_argument("--infill", metavar="FRACTION", help="3D print: core fill fraction, e.g. 20%% or 0.2 (with --shell)")
+
+
+def output_format(args) -> str:
+    """The requested output format; ``--json`` is an alias of ``--format json``."""
+    fmt = getattr(args, "format", None)
+    if getattr(args, "json", False):
+        if fmt not in (None, "json"):
+            raise UsageError(f"--json contradicts --format {fmt}; give one of them")
+        return "json"
+    return fmt or "text"
+
+
+def load_model_from_args(args):
+    """Like :func:`load_from_args`, honouring ``--model shell --thickness`` and ``--shell --infill``.
+
+    Returns ``(props, density description, model summary dict)``.
+    """
+    model = getattr(args, "model", "solid") or "solid"
+    thickness, skin, infill = (getattr(args, k, None) for k in ("thickness", "shell", "infill"))
+    if model == "solid" and thickness is not None:
+        raise UsageError("--thickness needs --model shell (for a printed part use --shell and --infill)")
+    if (skin is None) != (infill is None):
+        raise UsageError("a printed part needs both --shell (skin thickness) and --infill (core fraction)")
+    if model == "shell" and thickness is None:
+        raise UsageError("--model shell needs --thickness (e.g. --thickness 2mm)")
+    if model == "shell" and skin is not None:
+        raise UsageError("--model shell takes --thickness; --shell/--infill describe a printed solid")
+    if model == "solid" and skin is None:
+        props, described = load_from_args(args)
+        return props, described, model_summary("solid")
+    files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
+    if len(files) != 1:
+        raise UsageError("the shell and printed-part models take one mesh file, not an assembly")
+    density = parse_density(args.density) if args.density is not None else None
+    mass = parse_mass(args.mass) if args.mass is not None else None
+    _, described = resolve_density(density=density, material=args.material, mass=mass)
+    common = dict(units=args.units, density=density, material=args.material, mass=mass, max_faces=args.max_faces)
+    if model == "shell":
+        t = parse_length(thickness, default_unit=args.units)
+        props = shell_mass_properties(files[0], thickness=t, **common)
+        return props, described, model_summary("shell", thickness=t)
+    printed = printed_part(files[0], skin=parse_length(skin, default_unit=args.units), infill=parse_fraction(infill),
+                           repair=args.repair, merge_tolerance=args.merge_tolerance, **common)
+    return printed.properties, described, model_summary("printed", printed=printed)
+
+
+def _model_words(model: dict) -> str:
+    if model["model"] == "shell":
+        return f"; thin shell {model['thickness']:g} m"
+    if model["model"] == "printed":
+        return (f"; printed: skin {model['skin']:g} m, infill {100 * model['infill']:g}% "
+                f"(first-order model, mass error about {100 * model['mass_error_estimate']:.2g}%)")
+    return ""

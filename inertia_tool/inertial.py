@@ -1,0 +1,257 @@
+"""The inertial frame a simulator wants, and the checks simulators apply before accepting it.
+
+URDF, SDFormat and MuJoCo all describe a link's mass properties as a mass, an *inertial frame* (origin at
+the centre of mass, some orientation relative to the link frame) and an inertia tensor about the centre of
+mass in that frame.  This module builds that frame from :class:`~inertia_tool.properties.MassProperties`
+(the mesh axes are taken as the link frame), converts its orientation to the angles and quaternions the
+formats use, and checks the principal moments the way the simulators do.  Formatting is in
+``inertia_tool.reports.robot``.
+
+Conventions (``docs/conventions.md``):
+
+* ``rotation`` has the inertial frame's axes as columns, in link (mesh) axes: it maps inertial-frame
+  components to link components, ``I_link = R I_frame Rᵀ`` (the active rotation of Eq. 4.25).
+* URDF/SDF ``rpy``: fixed-axis roll, pitch, yaw, ``R = R_z(yaw) R_y(pitch) R_x(roll)`` with *active*
+  elementary rotations (note: the chapter's Eqs. 4.29–4.30 are passive; ``R_z`` here is their transpose).
+* MuJoCo ``quat``: scalar-first ``(w, x, y, z)`` of the same ``R``, with ``w ≥ 0``.
+* Products of inertia stay in the tensor convention (``ixy = −∫xy dm``), which is what URDF, SDFormat and
+  MuJoCo's ``fullinertia`` expect; :func:`positive_tensor_notation` gives the CAD sign.
+
+Validity (what the simulators check).  gz-math ``MassMatrix3::ValidMoments`` (used by Gazebo and
+libsdformat) accepts principal moments ``I1, I2, I3`` when every ``I_k + ε ≥ 0`` and every
+``I_a + I_b + ε ≥ I_c``, with ``ε = tolerance · DBL_EPSILON · ½ |I1 + I2 + I3|`` and the default
+``tolerance = 10`` (``GZ_MASSMATRIX3_DEFAULT_TOLERANCE``; gz-math ``include/gz/math/MassMatrix3.hh``,
+``Epsilon()`` and ``ValidMoments()``).  MuJoCo's compiler refuses moments not larger than
+``mjMINVAL = 1e-15`` on moving bodies and ``A + B < C`` without tolerance ("inertia must satisfy
+A + B >= C"; checked with mujoco 4.0).  :func:`check_moments` applies the union: each moment must exceed
+``max(ε, min_moment)`` and the triangle inequality must hold within ``ε``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .errors import PhysicsError, UsageError
+from .properties import MassProperties
+
+__all__ = ["InertialFrame", "MomentCheck", "inertial_frame", "check_moments", "rpy_from_matrix",
+           "quaternion_from_matrix", "positive_tensor_notation", "GAZEBO_TOLERANCE", "MUJOCO_MINVAL", "FRAMES"]
+
+#: gz-math's ``GZ_MASSMATRIX3_DEFAULT_TOLERANCE``: multiple of machine epsilon times ½ tr(I) accepted as round-off.
+GAZEBO_TOLERANCE = 10.0
+
+#: MuJoCo's ``mjMINVAL``: masses and principal moments of moving bodies must exceed it (kg, kg·m²).
+MUJOCO_MINVAL = 1e-15
+
+#: Inertial frame orientations: the principal frame (diagonal tensor) or the link/mesh axes (full tensor).
+FRAMES = ("principal", "mesh")
+
+
+@dataclass(frozen=True)
+class MomentCheck:
+    """Principal moments judged the way Gazebo (gz-math) and MuJoCo judge them.
+
+    Attributes
+    ----------
+    moments : (3,) float
+        Principal moments, ascending, kg·m².
+    epsilon : float
+        gz-math's round-off allowance ``tolerance · DBL_EPSILON · ½ |ΣI|``, kg·m².
+    min_moment : float
+        Absolute floor every moment must exceed (MuJoCo's ``mjMINVAL``), kg·m².
+    positive : bool
+        Every moment exceeds ``max(epsilon, min_moment)``.
+    triangle : bool
+        ``I_a + I_b + epsilon ≥ I_c`` for all three orderings.
+    triangle_margin : float
+        ``I1 + I2 − I3``, kg·m² (the binding one of the three inequalities for ascending moments).
+    """
+
+    moments: np.ndarray
+    epsilon: float
+    min_moment: float
+    positive: bool
+    triangle: bool
+    triangle_margin: float
+
+    @property
+    def ok(self) -> bool:
+        """Both checks pass."""
+        return self.positive and self.triangle
+
+    def problem(self) -> str:
+        """One sentence naming the failed check(s) with the numbers; empty when ``ok``."""
+        i1, i2, i3 = self.moments
+        parts = []
+        if not self.positive:
+            parts.append(f"principal moments must be positive (> {max(self.epsilon, self.min_moment):.3g} kg·m²)")
+        if not self.triangle:
+            parts.append(f"the triangle inequality I1 + I2 ≥ I3 fails: {i1:.6g} + {i2:.6g} − {i3:.6g} = "
+                         f"{self.triangle_margin:.3g} kg·m² (allowed round-off {self.epsilon:.3g})")
+        if not parts:
+            return ""
+        return (f"principal moments I1, I2, I3 = {i1:.6g}, {i2:.6g}, {i3:.6g} kg·m²: " + "; ".join(parts)
+                + " — simulators (Gazebo's MassMatrix3::ValidMoments, MuJoCo's compiler) reject this inertia")
+
+
+def check_moments(moments, *, tolerance: float = GAZEBO_TOLERANCE, min_moment: float = MUJOCO_MINVAL) -> MomentCheck:
+    """Check principal moments for positivity and the triangle inequality (see the module docstring).
+
+    Parameters
+    ----------
+    moments : (3,) array_like
+        Principal moments in kg·m² (any order).
+    tolerance : float
+        gz-math's tolerance factor (default 10): ``ε = tolerance · DBL_EPSILON · ½ |ΣI|``.
+    min_moment : float
+        Absolute floor in kg·m² (default MuJoCo's ``mjMINVAL`` = 1e-15); 0 to check Gazebo only.
+
+    Returns
+    -------
+    MomentCheck
+    """
+    m = np.sort(np.asarray(moments, dtype=np.float64).reshape(3))
+    if not np.all(np.isfinite(m)):
+        raise UsageError(f"Expected finite principal moments, got {m.tolist()}")
+    eps = float(tolerance) * np.finfo(np.float64).eps * 0.5 * abs(float(m.sum()))
+    floor = max(eps, float(min_moment))
+    positive = bool(np.all(m > floor))
+    i1, i2, i3 = m
+    triangle = bool(i1 + i2 + eps >= i3 and i2 + i3 + eps >= i1 and i3 + i1 + eps >= i2)
+    return MomentCheck(moments=m, epsilon=eps, min_moment=float(min_moment), positive=positive, triangle=triangle,
+                       triangle_margin=float(i1 + i2 - i3))
+
+
+def rpy_from_matrix(rotation) -> np.ndarray:
+    """Fixed-axis roll, pitch, yaw (rad) with ``R = R_z(yaw) R_y(pitch) R_x(roll)`` (URDF/SDF ``rpy``).
+
+    Parameters
+    ----------
+    rotation : (3, 3) array_like
+        Proper rotation, active (maps frame components to parent components).
+
+    Returns
+    -------
+    (3,) float
+        ``(roll, pitch, yaw)``; pitch in [−π/2, π/2].
+    """
+    return Rotation.from_matrix(_rotation(rotation)).as_euler("xyz")  # lower case: extrinsic (fixed) axes
+
+
+def quaternion_from_matrix(rotation) -> np.ndarray:
+    """Unit quaternion ``(w, x, y, z)`` (scalar first, ``w ≥ 0``) of an active rotation matrix (MuJoCo ``quat``)."""
+    q = np.roll(Rotation.from_matrix(_rotation(rotation)).as_quat(), 1)
+    return -q if q[0] < 0 else q
+
+
+def positive_tensor_notation(tensor) -> np.ndarray:
+    """The inertia matrix with the CAD sign of the products: diagonal unchanged, off-diagonals ``+∫xy dm``.
+
+    SolidWorks and most CAD reports ("positive tensor notation") list ``Lxy = +∫xy dm``; the tensor
+    convention used everywhere else in inertia_tool has ``I_xy = −∫xy dm``.  The result is *not* an inertia
+    tensor (it does not transform as one); use it for display only.
+    """
+    t = np.asarray(tensor, dtype=np.float64)
+    if t.shape != (3, 3):
+        raise UsageError(f"Expected `tensor` to have shape (3, 3), got {t.shape}")
+    return 2.0 * np.diag(np.diag(t)) - t
+
+
+def _rotation(rotation) -> np.ndarray:
+    r = np.asarray(rotation, dtype=np.float64)
+    if r.shape != (3, 3):
+        raise UsageError(f"Expected `rotation` to have shape (3, 3), got {r.shape}")
+    if not np.allclose(r @ r.T, np.eye(3), atol=1e-9) or np.linalg.det(r) < 0:
+        raise UsageError("Expected `rotation` to be a proper rotation matrix (orthogonal, det +1)")
+    return r
+
+
+@dataclass(frozen=True)
+class InertialFrame:
+    """Mass, centre of mass and inertia in the frame a simulator's ``<inertial>`` element describes.
+
+    Attributes
+    ----------
+    mass : float
+        kg.
+    position : (3,) float
+        Origin of the inertial frame = centre of mass, m, in link (mesh) axes.
+    rotation : (3, 3) float
+        Proper rotation whose columns are the inertial frame's axes in link axes (identity for ``"mesh"``).
+    inertia : (3, 3) float
+        kg·m² about the centre of mass, in the inertial frame's axes, tensor convention (−∫xy dm);
+        diagonal ``diag(I1, I2, I3)`` (ascending) for ``"principal"``.
+    frame : str
+        ``"principal"`` or ``"mesh"``.
+    check : MomentCheck
+        The validity check of the principal moments (passed, or the frame would not have been built).
+    """
+
+    mass: float
+    position: np.ndarray
+    rotation: np.ndarray
+    inertia: np.ndarray
+    frame: str
+    check: MomentCheck
+
+    @property
+    def rpy(self) -> np.ndarray:
+        """(3,) rad: URDF/SDF fixed-axis roll, pitch, yaw of ``rotation``."""
+        return rpy_from_matrix(self.rotation)
+
+    @property
+    def quaternion(self) -> np.ndarray:
+        """(4,) scalar-first ``(w, x, y, z)`` of ``rotation`` (MuJoCo ``quat``), ``w ≥ 0``."""
+        return quaternion_from_matrix(self.rotation)
+
+    @property
+    def principal_moments(self) -> np.ndarray:
+        """(3,) kg·m², ascending."""
+        return self.check.moments
+
+
+def inertial_frame(props: MassProperties, frame: str = "principal", *, tolerance: float = GAZEBO_TOLERANCE,
+                   min_moment: float = MUJOCO_MINVAL) -> InertialFrame:
+    """The inertial frame of ``props`` for a simulator, after checking that a simulator would accept it.
+
+    Parameters
+    ----------
+    props : MassProperties
+        The body; its mesh axes are taken as the link frame.
+    frame : {"principal", "mesh"}
+        ``"principal"``: axes along the principal axes (``props.principal.axes``, Eq. 4.25), diagonal tensor.
+        ``"mesh"``: axes parallel to the mesh axes, full tensor.
+    tolerance, min_moment : float
+        Passed to :func:`check_moments`.
+
+    Returns
+    -------
+    InertialFrame
+
+    Raises
+    ------
+    PhysicsError
+        When the mass is not positive or the principal moments fail :func:`check_moments` (the message
+        lists the moments).  The frame cannot fix that: the check is on frame-independent moments.
+    UsageError
+        For an unknown ``frame``.
+    """
+    if frame not in FRAMES:
+        raise UsageError(f"Expected `frame` to be one of {', '.join(FRAMES)}, got {frame!r}")
+    if not (np.isfinite(props.mass) and props.mass > max(float(min_moment), 0.0)):
+        raise PhysicsError(f"{props.name or 'body'}: mass {props.mass:.6g} kg: simulators need a positive mass")
+    pa = props.principal
+    check = check_moments(pa.moments, tolerance=tolerance, min_moment=min_moment)
+    if not check.ok:
+        raise PhysicsError(f"{props.name or 'body'}: {check.problem()}")
+    if frame == "principal":
+        rotation = pa.axes
+        inertia = np.diag(pa.moments)
+    else:
+        rotation = np.eye(3)
+        inertia = props.inertia
+    return InertialFrame(mass=props.mass, position=props.center_of_mass.copy(), rotation=np.array(rotation),
+                         inertia=np.array(inertia), frame=frame, check=check)
