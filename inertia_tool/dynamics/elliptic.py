@@ -5,7 +5,8 @@ near-separatrix regime ``m → 1`` (where ``1 − m`` cannot be recovered from `
 ``scipy.special.ellipj`` loses accuracy) is computed from the accurately known ``m1``:
 
 * :func:`jacobi_sn_cn_dn` — arithmetic-geometric-mean (descending Landen) algorithm started from
-  ``b0 = √m1`` (Abramowitz & Stegun 16.4), after reducing the argument by the half-period ``2K`` so the
+  ``b0 = √m1`` (Abramowitz & Stegun 16.4; the ``arcsin`` of the descent written as a well-conditioned
+  ``arctan2``), after reducing the argument by the half-period ``2K`` so the
   recursion only sees ``|u| ≤ K``; ``dn = √(cn² + m1 sn²)`` (no cancellation near ``m = 1``).
   At ``m1 = 0`` the closed forms ``sn = tanh``, ``cn = dn = sech`` are used.
 * :func:`elliptic_f_from_sn_cn` — the elliptic argument ``u = F(am u | m)`` from a point ``(sn, cn)`` on the
@@ -59,17 +60,22 @@ def jacobi_sn_cn_dn(u, m: float, m1: float):
     r, j = _reduce(u, k)
     sign = np.where(np.mod(j, 2.0) == 0.0, 1.0, -1.0)  # sn(u + 2K) = −sn u, cn(u + 2K) = −cn u
     a, b, c = 1.0, np.sqrt(m1), np.sqrt(m)
-    a_list, c_list = [a], [c]
+    a_list, b_list, c_list = [a], [b], [c]
     for _ in range(_AGM_MAX_STEPS):
         if abs(c) <= 1e-17 * a:
             break
         a, b, c = 0.5 * (a + b), np.sqrt(a * b), 0.5 * (a - b)
         a_list.append(a)
+        b_list.append(b)
         c_list.append(c)
     n_steps = len(a_list) - 1
     phi = (2.0 ** n_steps) * a_list[-1] * r
     for i in range(n_steps, 0, -1):
-        phi = 0.5 * (phi + np.arcsin(np.clip(c_list[i] * np.sin(phi) / a_list[i], -1.0, 1.0)))
+        # asin(c sin φ / a) as atan2(c sin φ, √(a² cos² φ + b² sin² φ)) using a² − c² = b²: no loss of
+        # accuracy where the argument of asin is near ±1 (which happens for m → 1).
+        s_phi, c_phi = np.sin(phi), np.cos(phi)
+        phi = 0.5 * (phi + np.arctan2(c_list[i] * s_phi,
+                                      np.sqrt((a_list[i] * c_phi) ** 2 + (b_list[i] * s_phi) ** 2)))
     sn, cn = np.sin(phi), np.cos(phi)
     dn = np.sqrt(cn * cn + m1 * sn * sn)
     return sign * sn, sign * cn, dn

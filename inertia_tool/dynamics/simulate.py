@@ -7,7 +7,7 @@ import numpy as np
 from ..errors import UsageError
 from ..rotations import matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix
 from .integrate import DEFAULT_COLUMNS, integrate_rigid_body
-from .torque_free import torque_free_motion
+from .torque_free import ELLIPTIC_M1_FLOOR, free_body_parameters, torque_free_motion
 from .trajectory import Trajectory, resolve_body
 
 __all__ = ["simulate", "METHODS"]
@@ -69,7 +69,8 @@ def simulate(body, angular_velocity, t, *, torque=None, method: str = "auto", or
     method : {"auto", "exact", "numerical"}
         ``"exact"``: closed form (Landau–Lifshitz §37 / Celledoni et al. 2008; torque-free only);
         ``"numerical"``: extrapolated midpoint integration (:mod:`.integrate`); ``"auto"``: exact when
-        ``torque`` is None, else numerical.
+        ``torque`` is None (except within ~1e-14 of the separatrix, ``1 − m < torque_free.ELLIPTIC_M1_FLOOR``,
+        where the closed-form orientation loses accuracy), else numerical.
     orientation : (4,) array_like, optional
         Scalar-first unit quaternion of body (mesh axes) → space at ``t[0]``; default identity (space frame
         = mesh axes at ``t[0]``).
@@ -103,6 +104,10 @@ def simulate(body, angular_velocity, t, *, torque=None, method: str = "auto", or
     q0 = _check_orientation(orientation)
     tensor = axes @ np.diag(moments) @ axes.T
     use_exact = method == "exact" or (method == "auto" and torque is None)
+    if method == "auto" and use_exact:
+        params = free_body_parameters(moments, axes.T @ omega_mesh)
+        if params.case == "elliptic" and params.complementary_parameter < ELLIPTIC_M1_FLOOR:
+            use_exact = False  # see torque_free.ELLIPTIC_M1_FLOOR
     if use_exact:
         q_axes = matrix_to_quaternion(axes)  # principal → mesh
         omega_p, q_p, case = torque_free_motion(moments, axes.T @ omega_mesh, times,

@@ -51,10 +51,20 @@ from ..rotations import matrix_to_quaternion, quaternion_multiply, quaternion_to
     rotation_vector_to_quaternion
 from .elliptic import complete_k, elliptic_f_from_sn_cn, elliptic_pi_of_argument, jacobi_sn_cn_dn
 
-__all__ = ["FreeBodyParameters", "free_body_parameters", "torque_free_motion", "FREE_CASES"]
+__all__ = ["ELLIPTIC_M1_FLOOR", "FreeBodyParameters", "free_body_parameters", "torque_free_motion", "precession_angle", "FREE_CASES"]
 
 #: Names of the closed forms :func:`torque_free_motion` may use.
 FREE_CASES = ("spherical", "axisymmetric", "principal-axis spin", "elliptic", "separatrix")
+
+#: Off-axis components below this fraction of |ω| are treated as zero (their squares would underflow in the
+#: invariants); the state is then a steady spin about a principal axis.
+NEGLIGIBLE_COMPONENT = 1e-150
+
+#: Below this ``1 − m`` (a state within ~1e-14 of the intermediate axis, or of the separatrix) the
+#: angle ``am u`` near the quarter period is only known to absolute round-off while ``cn u`` is smaller than
+#: that, and the precession integral Π loses accuracy (ω(t) itself stays exact).  ``simulate(method="auto")``
+#: integrates such states numerically instead.
+ELLIPTIC_M1_FLOOR = 1e-28
 
 _RELABEL = np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])
 _FLIP_13 = np.diag([-1.0, 1.0, -1.0])
@@ -124,7 +134,7 @@ def _classify(moments, w) -> str:
         return "spherical"
     if i1 == i2 or i2 == i3:
         return "axisymmetric"
-    if np.count_nonzero(w) <= 1:
+    if np.count_nonzero(np.abs(w) > NEGLIGIBLE_COMPONENT * np.max(np.abs(w))) <= 1:
         return "principal-axis spin"
     return "elliptic"
 
@@ -232,6 +242,48 @@ def _nodal_frames(big_l):
     return np.stack([row1, row2, row3], -2)
 
 
+def _precession(ic, wc, tau, u, u0, lam, m, m1):
+    """ψ(t) − ψ(0) = M τ/I3 + M (I3 − I1)/(I1 I3 λ) [Π(n; am u) − Π(n; am u0)] (canonical labels)."""
+    j1, j2, j3 = ic
+    mom = float(np.linalg.norm(ic * wc))
+    n = -j3 * (j2 - j1) / (j1 * (j3 - j2))
+    big_pi = elliptic_pi_of_argument(u, n, m, m1) - elliptic_pi_of_argument(np.array([u0]), n, m, m1)[0]
+    return mom * tau / j3 + mom * (j3 - j1) / (j1 * j3 * lam) * big_pi
+
+
+def precession_angle(moments, angular_velocity, t):
+    """Angle ψ(t) − ψ(t[0]) turned about ``L`` by the nodal frame of LL §37 (elliptic and separatrix cases).
+
+    ``ψ̇ = M (I_a ω_a² + I_b ω_b²) / (I_a² ω_a² + I_b² ω_b²)`` where ``a, b`` are the two principal axes other
+    than the one the polhode circles (:attr:`FreeBodyParameters.circled_axis`), evaluated in closed form
+    (module docstring).  Exposed for verification against quadrature.
+
+    Parameters
+    ----------
+    moments : (3,) array_like
+        Distinct principal moments, ascending, kg·m².
+    angular_velocity : (3,) array_like
+        Principal-frame angular velocity at ``t[0]``, rad/s (not along a principal axis).
+    t : (N,) array_like
+        Times, s.
+
+    Returns
+    -------
+    (N,) float, rad
+    """
+    moments, w = _check_inputs(moments, angular_velocity)
+    if _classify(moments, w) != "elliptic":
+        raise UsageError("precession_angle needs distinct moments and ω off the principal axes")
+    tau = np.asarray(t, dtype=np.float64) - float(np.asarray(t, dtype=np.float64).ravel()[0])
+    p, ic, wc = _canonical(moments, w)
+    a, b, _, lam, m, m1 = _elliptic_constants(ic, wc)
+    if m1 == 0.0 and wc[0] < 0.0:
+        wc = _FLIP_12 @ wc
+    sigma = 1.0 if ic[2] > ic[1] else -1.0
+    u0 = elliptic_f_from_sn_cn(sigma * wc[1] / b, wc[0] / a, m, m1)
+    return _precession(ic, wc, tau, lam * tau + u0, u0, lam, m, m1)
+
+
 def _elliptic_motion(moments, w, tau, q0):
     p, ic, wc = _canonical(moments, w)
     a, b, c, lam, m, m1 = _elliptic_constants(ic, wc)
@@ -244,11 +296,7 @@ def _elliptic_motion(moments, w, tau, q0):
     sn, cn, dn = jacobi_sn_cn_dn(u, m, m1)
     omega_c = np.stack([a * cn, sigma * b * sn, c * dn], -1)
     omega_c[tau == 0.0] = wc  # the exact initial state (removes round-off of the inversion)
-    j1, j2, j3 = ic
-    mom = float(np.linalg.norm(ic * wc))
-    n = -j3 * (j2 - j1) / (j1 * (j3 - j2))
-    big_pi = elliptic_pi_of_argument(u, n, m, m1) - elliptic_pi_of_argument(np.array([u0]), n, m, m1)[0]
-    psi = mom * tau / j3 + mom * (j3 - j1) / (j1 * j3 * lam) * big_pi
+    psi = _precession(ic, wc, tau, u, u0, lam, m, m1)
     frames = _nodal_frames(omega_c * ic)
     w0_frame = _nodal_frames((ic * wc)[None, :])[0]
     cz, sz, zero, one = np.cos(psi), np.sin(psi), np.zeros_like(psi), np.ones_like(psi)
@@ -290,12 +338,18 @@ def torque_free_motion(moments, angular_velocity, t, *, orientation=None):
     if q0.shape != (4,) or not np.all(np.isfinite(q0)) or np.linalg.norm(q0) == 0:
         raise UsageError(f"Expected `orientation` to be a finite non-zero quaternion of shape (4,), got {q0}")
     q0 = q0 / np.linalg.norm(q0)
-    tau = t - t[0]
+    # Scale invariance ω(t; c ω0) = c ω(c t; ω0), Q(t; c ω0) = Q(c t; ω0): solve with max |ω0| = 1 so no
+    # square of a component under- or overflows.
+    scale = float(np.max(np.abs(w)))
+    if scale > 0.0:
+        w = w / scale
+    tau = (t - t[0]) * (scale if scale > 0.0 else 1.0)
     case = _classify(moments, w)
     if case == "spherical":
         omega, q = _axisymmetric_motion(moments, w, tau, q0, 2, moments[2])
     elif case == "principal-axis spin":
         k = int(np.argmax(np.abs(w)))
+        w = np.where(np.arange(3) == k, w, 0.0)
         omega, q = _axisymmetric_motion(moments, w, tau, q0, k, moments[k])
     elif case == "axisymmetric":
         k, i_perp = (2, moments[0]) if moments[0] == moments[1] else (0, moments[2])
@@ -303,4 +357,4 @@ def torque_free_motion(moments, angular_velocity, t, *, orientation=None):
     else:
         omega, q, case = _elliptic_motion(moments, w, tau, q0)
     q = np.where(q[:, :1] < 0, -q, q)
-    return omega, q, case
+    return omega * (scale if scale > 0.0 else 1.0), q, case
