@@ -56,7 +56,8 @@ def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int)
     ----------
     chunks : callable
         Returns a fresh iterator over ``(k, 3)`` float arrays whose concatenation is the ``n_points`` corners,
-        three per triangle.  It is called up to three times (keys, coordinates, collision check).
+        three per triangle.  It is called twice (keys; coordinates with the collision check), and once
+        more only if a key collision forces the exact fallback.
     n_points : int
         Total number of points (a multiple of 3).
 
@@ -87,18 +88,20 @@ def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int)
     inverse = np.empty(n_points, dtype=idx_t)
     inverse[order] = group
     del order, group
+    # fill the vertices; the first point written to a slot owns it, and every point is compared with its
+    # slot's owner, so a key collision (two different points, one key) cannot go unnoticed
     vertices = np.empty((n_unique, 3), dtype=np.float64)
+    written = np.zeros(n_unique, dtype=bool)
     s = 0
     for c in chunks():
-        vertices[inverse[s:s + len(c)]] = c
-        s += len(c)
-    # a key collision would map two different points to one vertex: verify, fall back if so
-    s = 0
-    for c in chunks():
-        if not np.array_equal(vertices[inverse[s:s + len(c)]], c.astype(np.float64) + 0.0):
+        inv = inverse[s:s + len(c)]
+        fresh = ~written[inv]
+        vertices[inv[fresh]] = c[fresh]
+        written[inv] = True
+        if not np.array_equal(vertices[inv], c.astype(np.float64) + 0.0):
             pts = np.concatenate([x.astype(np.float64) + 0.0 for x in chunks()])
-            uniq, inv = np.unique(pts, axis=0, return_inverse=True)
-            return uniq, inv.reshape(-1).astype(_index_dtype(len(uniq))).reshape(-1, 3)
+            uniq, inv_all = np.unique(pts, axis=0, return_inverse=True)
+            return uniq, inv_all.reshape(-1).astype(_index_dtype(len(uniq))).reshape(-1, 3)
         s += len(c)
     return vertices, inverse.reshape(-1, 3)
 

@@ -33,3 +33,15 @@ def test_weld_tolerance_merges_rounding_noise_only():
     g = weld_tolerance(v, f, 1e-6)
     assert g[0, 0] == g[1, 0]
     assert len(np.unique(g)) == 3
+
+
+def test_key_collision_falls_back_to_exact_grouping(monkeypatch):
+    import inertia_tool.weld as weld
+
+    def constant_key(rows):
+        return np.zeros(len(rows), dtype=np.uint64)   # every point collides
+    monkeypatch.setattr(weld, "_hash_rows", constant_key)
+    corners = np.array([[[0.0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0.0, 0, 0], [0, 1, 0], [0, 0, 1]]])
+    v, f = weld.weld_exact(corners)
+    assert len(v) == 4
+    np.testing.assert_array_equal(v[f], corners)
