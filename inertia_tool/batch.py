@@ -228,7 +228,7 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
     dict
         ``status`` is ``"ok"`` (numbers filled in), ``"error"`` (an ``InertiaToolError``: unreadable or
         invalid mesh; ``error_type`` and ``error`` say why) or ``"internal_error"`` (any other exception,
-        retried on resume).  ``warnings`` joins the soft problems with ``" | "``; ``seconds`` is the time
+        retried on resume).  ``warnings`` (``None`` when there are none) joins the soft problems with ``" | "``; ``seconds`` is the time
         spent on this file.
     """
     start = time.perf_counter()
@@ -256,7 +256,7 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
             faces=int(mesh.faces), bodies=int(mesh.bodies), cavities=int(mesh.cavities),
             watertight=bool(mesh.watertight), repaired=bool(mesh.repaired),
             warnings=" | ".join(_one_line(w.message) for w in caught
-                                if issubclass(w.category, InertiaToolWarning)),
+                                if issubclass(w.category, InertiaToolWarning)) or None,
         )
         for k in range(3):
             for c, name in enumerate("xyz"):
