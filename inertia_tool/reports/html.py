@@ -72,7 +72,7 @@ font-variant-numeric:tabular-nums}th{background:#f4f4f4;text-align:left}td.l{tex
 .views{display:flex;flex-wrap:wrap;gap:12px}.views figure{margin:0}.views figcaption{text-align:center;
 font-size:.9em;color:#444}svg{background:#fff;border:1px solid #ddd}.warn{color:#8a4b00}
 .stable{color:#1a7f37}.unstable{color:#b42318;font-weight:600}.marginal{color:#8a4b00}.neutral{color:#555}
-.legend span{display:inline-block;margin-right:1.2em}
+.legend>span{display:inline-block;margin-right:1.2em}.swatch{font-weight:700}
 """
 
 
@@ -463,9 +463,9 @@ def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_
     figure = "".join(f"<figure>{svg}<figcaption>{_e(t)}</figcaption></figure>"
                      for svg, (t, *_rest) in zip(views, VIEWS))
     legend = ('<p class="legend">'
-              + "".join(f'<span><b style="color:{_AXIS_COLOURS[k]}">━</b> principal axis {k + 1} '
+              + "".join(f'<span><span class="swatch" style="color:{_AXIS_COLOURS[k]}">━</span> principal axis {k + 1} '
                         f"(I{k + 1} = {pa.moments[k]:.4g} kg·m²)</span>" for k in range(3))
-              + '<span>⊕ centre of mass</span><span><b style="color:#ff7f0e">┅</b> equivalent inertia '
+              + '<span>⊕ centre of mass</span><span><span class="swatch" style="color:#ff7f0e">┅</span> equivalent inertia '
                 "ellipsoid (uniform solid ellipsoid with the same mass and principal moments)</span>"
                 "<span>grey: silhouette and feature edges</span></p>")
     parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
