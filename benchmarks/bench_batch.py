@@ -1,6 +1,6 @@
 """Throughput of ``inertia-tool batch``: files/s with 1 process, 2 processes and a Dask LocalCluster(2).
 
-Generates N binary STL files (default 200: icospheres of 1,280-20,480 triangles, boxes, tori, cylinders; 0.1-1 MB)
+Generates N binary STL files (default 200: icospheres of 5,120-20,480 triangles, boxes, tori of 2k-18k, cylinders of 1k-4k; 0.6 kB-1 MB)
 in a temporary directory, then runs the same batch three ways, each into a fresh JSONL file, and prints files/s
 and the speed-up over one process.  The Dask cluster's start-up is timed separately (not in files/s).
 
@@ -45,15 +45,15 @@ def make_meshes(directory: str, count: int, seed: int = 0) -> int:
     for k in range(count):
         kind = k % 4
         if kind == 0:
-            m = trimesh.creation.icosphere(subdivisions=int(rng.integers(3, 6)), radius=float(rng.uniform(5, 50)))
+            m = trimesh.creation.icosphere(subdivisions=int(rng.integers(4, 6)), radius=float(rng.uniform(5, 50)))
         elif kind == 1:
             m = trimesh.creation.box(rng.uniform(5, 80, 3))
         elif kind == 2:
             m = trimesh.creation.torus(float(rng.uniform(20, 40)), float(rng.uniform(3, 10)),
-                                       major_sections=int(rng.integers(32, 96)), minor_sections=int(rng.integers(16, 48)))
+                                       major_sections=int(rng.integers(64, 192)), minor_sections=int(rng.integers(16, 48)))
         else:
             m = trimesh.creation.cylinder(radius=float(rng.uniform(3, 30)), height=float(rng.uniform(5, 90)),
-                                          sections=int(rng.integers(64, 512)))
+                                          sections=int(rng.integers(256, 1024)))
         m.apply_translation(rng.uniform(-100, 100, 3))
         _write_stl(os.path.join(directory, f"part{k:04d}.stl"), m)
         faces += len(m.faces)
@@ -80,7 +80,8 @@ def main() -> None:
         files = discover_files(mesh_dir)
         size = sum(os.path.getsize(f) for f in files)
         print(f"{len(files)} STL files, {faces:,} triangles, {size / 1e6:.1f} MB; {platform.processor() or platform.machine()}, "
-              f"{os.cpu_count()} CPUs, Python {platform.python_version()}")
+              f"{os.cpu_count()} CPUs, Python {platform.python_version()}, load average before "
+              f"{os.getloadavg()[0]:.2f} (other work on the machine slows the parallel runs)")
         results = {}
         for label, kw in [("1 process (in-process)", dict(jobs=1)), ("2 processes (ProcessPoolExecutor)", dict(jobs=2))]:
             results[label] = min(_run(files, os.path.join(tmp, f"{label[:1]}_{r}.jsonl"), **kw) for r in range(args.repeat))
