@@ -28,9 +28,11 @@ import time
 import warnings
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, field
+from typing import cast
 
 import numpy as np
 
+from .checks import MeshReport
 from .errors import InertiaToolError, InertiaToolWarning, UsageError
 from .io import DEFAULT_MAX_FACES, SUPPORTED_SUFFIXES
 from .pipeline import DEFAULT_MERGE_TOLERANCE, mass_properties, resolve_density
@@ -195,7 +197,7 @@ def file_sha256(path: str | os.PathLike) -> str:
     return h.hexdigest()
 
 
-def _one_line(text: str, limit: int = 500) -> str:
+def _one_line(text: object, limit: int = 500) -> str:
     text = " ".join(str(text).split())
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
@@ -244,7 +246,7 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
                                     merge_tolerance=options.merge_tolerance, max_faces=options.max_faces)
         pa = props.principal
         inertia = np.asarray(props.inertia)
-        mesh = props.mesh
+        mesh = cast(MeshReport, props.mesh)         # MassProperties.mesh is typed `object`
         row.update(
             status="ok", density=_finite(props.density), density_source=described,
             mass=_finite(props.mass), volume=_finite(props.volume), surface_area=_finite(props.surface_area),
@@ -362,7 +364,7 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
             record(analyze_file(path, options, digest))
     else:
         own = executor is None
-        pool = cf.ProcessPoolExecutor(max_workers=jobs) if own else executor
+        pool: cf.Executor = cf.ProcessPoolExecutor(max_workers=jobs) if executor is None else executor
         limit = max_in_flight or 4 * jobs
         try:
             pending: dict = {}

@@ -29,10 +29,12 @@ import math
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
 from ..ellipsoid import equivalent_ellipsoid_semi_axes
+from ..checks import MeshReport
 from ..errors import InertiaToolError, UsageError
 from ..properties import MassProperties
 from .serialize import TENSOR_CONVENTION
@@ -401,7 +403,7 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
         sections.append(HtmlSection(f"Bodies ({len(props.parts)})",
                                     _table(["body", "mass (kg)", "volume (m³)", "centre of mass (m)"], rows),
                                     "bodies"))
-    mesh = props.mesh
+    mesh = cast("MeshReport | None", props.mesh)        # MassProperties.mesh is typed `object`
     if mesh is not None:
         rows = [["faces", f"{mesh.faces:,} (file {mesh.file_faces:,})"], ["vertices", f"{mesh.vertices:,}"],
                 ["bodies / cavities", f"{mesh.bodies} / {mesh.cavities}"],

@@ -16,6 +16,7 @@ import io
 import json
 import os
 from dataclasses import dataclass
+from typing import BinaryIO
 
 from ..batch import ROW_FIELDS, SCHEMA
 from ..errors import UsageError
@@ -141,7 +142,7 @@ class ResultsFile:
     format: str
     previous_rows: list
     repaired_tail: bool
-    _fh: object = None
+    _fh: BinaryIO | None = None
 
     def write_row(self, row: dict) -> None:
         """Append one row as one line, flush and fsync (so a crash loses at most the row being written)."""
@@ -151,6 +152,8 @@ class ResultsFile:
             buf = io.StringIO()
             csv.writer(buf, lineterminator="").writerow([_csv_cell(row.get(k)) for k in ROW_FIELDS])
             line = buf.getvalue()
+        if self._fh is None:
+            raise ValueError(f"{self.path}: the results file is closed")
         self._fh.write((line + "\n").encode("utf-8"))
         self._fh.flush()
         os.fsync(self._fh.fileno())
@@ -190,15 +193,15 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30) -> Result
         size = os.path.getsize(path)
         if size > max_bytes:
             raise UsageError(f"{path}: {size:,} bytes, more than the {max_bytes:,} a results file may have here")
-        with open(path, "rb") as fh:
-            data = fh.read()
+        with open(path, "rb") as existing:
+            data = existing.read()
     lines, keep, torn = _complete_lines(path, data, fmt)
     rows = _parse_jsonl(lines, path) if fmt == "jsonl" else _parse_csv(lines, path)
     if fmt == "csv" and data and not lines:
         # only a torn header: nothing of ours to keep, but it must look like the start of our header
         if not ",".join(ROW_FIELDS).encode().startswith(data.strip()):
             raise UsageError(f"{path}: not a results file of inertia-tool batch; refusing to append to it")
-    fh = open(path, "r+b" if data else "wb")
+    fh: BinaryIO = open(path, "r+b" if data else "wb")
     if torn:
         fh.truncate(keep)
     fh.seek(keep)
