@@ -69,8 +69,8 @@ body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,Helvetica,Arial,sans-
 max-width:1040px;padding:0 1em;color:#222;line-height:1.4}
 h1{font-size:1.5em;margin-bottom:.2em}h2{font-size:1.15em;border-bottom:1px solid #ccc;padding-bottom:.2em;
 margin-top:1.6em}.muted{color:#666;font-size:.9em}
-table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ddd;padding:.25em .6em;text-align:right;
-font-variant-numeric:tabular-nums}th{background:#f4f4f4;text-align:left}td.l{text-align:left}
+table{border-collapse:collapse;margin:.5em 0;display:block;overflow-x:auto;max-width:100%}td,th{border:1px solid #ddd;padding:.25em .6em;text-align:right;
+font-variant-numeric:tabular-nums;white-space:nowrap}td.l{white-space:normal}th{white-space:normal;background:#f4f4f4;text-align:left}td.l{text-align:left}
 .views{display:flex;flex-wrap:wrap;gap:12px}.views figure{margin:0}.views figcaption{text-align:center;
 font-size:.9em;color:#444}svg{background:#fff;border:1px solid #ddd}.warn{color:#8a4b00}
 .stable{color:#1a7f37}.unstable{color:#b42318;font-weight:600}.marginal{color:#8a4b00}.neutral{color:#555}
@@ -344,15 +344,17 @@ def stability_section(props: MassProperties) -> HtmlSection | None:
             detail = f"grows linearly; 1e-3 → 1 in {_num(ax.turns_to_grow(1e-3, 1.0), 4)} turns"
         else:
             detail = "every axis is a steady spin"
+        axis = "(" + ", ".join(_num(x, 4) for x in _clean(ax.axis)) + ")"
         rows.append([f'<span style="color:{_AXIS_COLOURS[ax.index]}">■</span> {ax.index + 1} ({_e(ax.name)})',
-                     f"{ax.moment:.6e}", *_vec_cells(ax.axis), f'<span class="{_e(ax.kind)}">{_e(ax.kind)}</span>',
+                     f"{ax.moment:.6e}", axis, f'<span class="{_e(ax.kind)}">{_e(ax.kind)}</span>',
                      _num(ax.coefficient, 4), _e(detail), "yes" if ax.dissipation_stable else "no"])
     body = ("<p>Torque-free spin about each principal axis, linearised Euler equations (§4.4.1): a small "
             "wobble ε obeys ε̈ = c ω² ε with c = (I<sub>i</sub> − I<sub>k</sub>)(I<sub>k</sub> − I<sub>j</sub>)"
             "/(I<sub>i</sub> I<sub>j</sub>). <em>With energy loss</em> only the axis of largest moment stays "
             "stable (major-axis rule).</p>"
-            + _table(["axis", "moment (kg·m²)", "x", "y", "z", "free spin", "c", "what a small wobble does",
-                      "stable with energy loss"], rows, left_cols=1, text_cols=(5, 7, 8)))
+            + _table(["axis", "moment (kg·m²)", "direction (mesh axes)", "free spin", "c",
+                      "what a small wobble does", "stable with energy loss"], rows, left_cols=1,
+                     text_cols=(3, 5, 6)))
     return HtmlSection("Spin stability", body, "stability")
 
 
@@ -379,8 +381,8 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
     sections.append(HtmlSection("Inertia tensor", body, "inertia"))
     rows = []
     for k in range(3):
-        rows.append([f'<span style="color:{_AXIS_COLOURS[k]}">■</span> I{k + 1}', f"{pa.moments[k]:.6e}",
-                     *_vec_cells(pa.axes[:, k]), _num(pa.radii_of_gyration[k]),
+        rows.append([f'<span style="color:{_AXIS_COLOURS[k]}">■</span>&nbsp;I{k + 1}', f"{pa.moments[k]:.6e}",
+                     "(" + ", ".join(_vec_cells(pa.axes[:, k])) + ")", _num(pa.radii_of_gyration[k]),
                      _num(semi[k]) if semi is not None else "—"])
     notes = []
     if pa.is_spherical:
@@ -393,7 +395,7 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
     positive = bool(np.all(pa.moments > 0))
     notes.append(f"Checks: moments positive: {'yes' if positive else 'NO'}; triangle inequality I1 + I2 ≥ I3: "
                  f"{'yes' if margin >= -1e-9 else 'NO'} (margin {_num(margin, 3)}).")
-    body = (_table(["", "moment (kg·m²)", "axis x", "axis y", "axis z", "radius of gyration (m)",
+    body = (_table(["", "moment (kg·m²)", "unit axis (mesh axes)", "radius of gyration (m)",
                     "equivalent-ellipsoid semi-axis (m)"], rows)
             + "".join(f"<p>{_e(n)}</p>" for n in notes))
     sections.append(HtmlSection("Principal axes (ascending moments, right-handed)", body, "principal"))
