@@ -275,8 +275,8 @@ def test_progress_plain_lines_when_not_a_terminal():
 def test_killed_run_leaves_a_valid_file_and_resume_completes(tmp_path):
     d = tmp_path / "many"
     d.mkdir()
-    sphere = trimesh.creation.icosphere(subdivisions=4)
-    for k in range(30):
+    sphere = trimesh.creation.icosphere(subdivisions=5)       # 20,480 triangles: ~10 ms a file
+    for k in range(40):
         write_binary_stl(d / f"s{k:02d}.stl", np.asarray(sphere.vertices) * (1 + k), sphere.faces)
     out = tmp_path / "r.jsonl"
     env = {**os.environ, "PYTHONPATH": ROOT}
@@ -293,6 +293,7 @@ def test_killed_run_leaves_a_valid_file_and_resume_completes(tmp_path):
     with open_results(out) as r:
         before = len(r.previous_rows)
     assert before >= 3
+    print(f"killed after {before} of 40 rows")
     done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     rows = _rows(out)
