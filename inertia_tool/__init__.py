@@ -31,6 +31,8 @@ from .impulse import ImpulseResult, apply_impulse
 from .spin import SpinExperiment, spin_experiment
 from .inertial import InertialFrame, MomentCheck, check_moments, inertial_frame
 from .thinwall import PrintedPart, printed_part, shell_mass_properties
+from .batch import BatchOptions, BatchSummary, analyze_file, run_batch
+from .ellipsoid import equivalent_ellipsoid_semi_axes
 
 __version__ = "0.1.0"
 
@@ -78,4 +80,9 @@ __all__ = [
     "PhysicsError",
     "UsageError",
     "shapes",
+    "BatchOptions",
+    "BatchSummary",
+    "analyze_file",
+    "run_batch",
+    "equivalent_ellipsoid_semi_axes",
 ]

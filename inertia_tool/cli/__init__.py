@@ -28,7 +28,7 @@ EXIT_MESH = 3
 EXIT_PHYSICS = 4
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ["analyze", "balance", "spin", "top"]
+SUBCOMMANDS = ["analyze", "balance", "spin", "top", "batch"]
 
 
 # Values such as "-40,40", "-5,0,0" or "-20deg" start with "-" but are numbers, not options.

@@ -24,6 +24,7 @@ from ..reports.models import format_model_note, model_summary
 from ..reports.robot import ROBOT_FORMATS, format_inertial
 from ..thinwall import printed_part, shell_mass_properties
 from ..units import parse_fraction, parse_length
+from .report_option import add_report_options, write_report_from_args
 
 __all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args",
            "add_output_options", "add_model_options", "output_format", "load_model_from_args", "FORMATS"]
@@ -111,6 +112,7 @@ def register(subparsers) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object (SI); same as --format json")
     add_output_options(p)
     add_model_options(p)
+    add_report_options(p)
     p.set_defaults(func=run)
 
 
@@ -122,6 +124,7 @@ def run(args) -> int:
     messages = [str(w.message) for w in caught if issubclass(w.category, InertiaToolWarning)]
     for w in caught:          # hand them on so the command line prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    write_report_from_args(args, props, described, messages)
     stab, stab_error = _stability_section(props) if fmt in ("json", "text") else (None, None)
     if fmt == "json":
         out = mass_properties_dict(props, density_source=described)

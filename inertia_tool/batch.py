@@ -1,0 +1,407 @@
+"""Batch analysis of many meshes: the per-file work, the result-row schema and the runner.
+
+One row per file, flat so that JSONL and CSV carry the same columns (:data:`ROW_FIELDS`).  The work for one
+file (:func:`analyze_file`) is pure and picklable so it can run in-process, in a process pool or on a Dask
+cluster; it never raises: an :class:`~inertia_tool.errors.InertiaToolError` becomes a row with
+``status="error"`` and any other exception a row with ``status="internal_error"`` (the batch goes on).
+
+Resuming: every row carries the SHA-256 of the file's bytes and a key of the options that change the numbers
+(:meth:`BatchOptions.key`).  A file counts as done when a previous row has the same path, content hash and
+options key and a status of ``"ok"`` or ``"error"`` (an ``InertiaToolError`` is a property of the file, so it
+is not retried); ``"internal_error"`` rows are retried.  A changed file or a changed ``--density`` recomputes.
+
+Writing rows (JSONL/CSV, append-only, fsync'd per row) is in :mod:`inertia_tool.reports.rows`; the progress
+bar is the command line's.  All numbers in a row are SI (m, kg, kg·m²), inertia about the centre of mass in
+mesh axes with the tensor sign convention of ``docs/conventions.md``.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import glob
+import hashlib
+import json
+import math
+import os
+import platform
+import time
+import warnings
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import asdict, dataclass, field
+from typing import cast
+
+import numpy as np
+
+from .checks import MeshReport
+from .errors import InertiaToolError, InertiaToolWarning, UsageError
+from .io import DEFAULT_MAX_FACES, SUPPORTED_SUFFIXES
+from .pipeline import DEFAULT_MERGE_TOLERANCE, mass_properties, resolve_density
+
+__all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "analyze_file", "discover_files",
+           "file_sha256", "run_batch", "DONE_STATUSES"]
+
+#: Schema identifier written in every row (``schema`` column); bump it when columns change meaning.
+SCHEMA = "inertia_tool.batch/1"
+
+#: Row statuses that count as done when resuming (``internal_error`` is retried).
+DONE_STATUSES = ("ok", "error")
+
+#: The columns of a result row, in order.  Units: m, m², m³, kg, kg/m³, kg·m², s.
+ROW_FIELDS = (
+    "schema", "path", "status", "error_type", "error", "sha256", "options_key",
+    "units", "density", "density_source",
+    "mass", "volume", "surface_area",
+    "com_x", "com_y", "com_z",
+    # inertia about the centre of mass, mesh axes, tensor convention (off-diagonals are -∫xy dm)
+    "ixx", "iyy", "izz", "ixy", "ixz", "iyz",
+    # principal moments (ascending) and their unit axes (mesh axes, right-handed)
+    "i1", "i2", "i3",
+    "axis1_x", "axis1_y", "axis1_z", "axis2_x", "axis2_y", "axis2_z", "axis3_x", "axis3_y", "axis3_z",
+    "faces", "bodies", "cavities", "watertight", "repaired", "warnings", "seconds", "worker",
+)
+
+#: Bytes read at a time when hashing a file.
+_HASH_CHUNK = 1 << 20
+
+
+@dataclass(frozen=True)
+class BatchOptions:
+    """What to do with every file of a batch (the same for all files).
+
+    Attributes
+    ----------
+    units : str
+        Length unit of the mesh coordinates (``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft``).
+    density : float, optional
+        kg/m³.  At most one of ``density``, ``material``, ``mass``; none means water (1000 kg/m³).
+    material : str, optional
+        Material name (``inertia_tool.units.MATERIALS``).
+    mass : float, optional
+        Target mass of *each* part, kg.
+    repair : bool
+        Repair open or inconsistently wound meshes instead of refusing them.
+    merge_tolerance : float
+        Relative welding tolerance (see :func:`inertia_tool.mass_properties`).
+    max_faces : int
+        Refuse meshes with more triangles.
+    """
+
+    units: str = "m"
+    density: float | None = None
+    material: str | None = None
+    mass: float | None = None
+    repair: bool = False
+    merge_tolerance: float = DEFAULT_MERGE_TOLERANCE
+    max_faces: int = DEFAULT_MAX_FACES
+
+    def validate(self) -> None:
+        """Raise :class:`UsageError` now (once) rather than once per file."""
+        from .units import length_scale
+        length_scale(self.units)
+        resolve_density(density=self.density, material=self.material, mass=self.mass)
+        if not (self.max_faces > 0):
+            raise UsageError(f"Expected a positive max_faces, got {self.max_faces}")
+
+    def key(self) -> str:
+        """16 hex digits identifying every option that changes the numbers (all of them, ``max_faces``
+        included: it decides whether a file fails)."""
+        text = json.dumps(asdict(self), sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class BatchSummary:
+    """What a batch run did.
+
+    Attributes
+    ----------
+    ok, failed, skipped : int
+        Files analysed successfully in this run, files that failed (``error`` or ``internal_error``) in this
+        run, and files skipped because a previous run had done them.
+    skipped_failed : int
+        Of the skipped files, those whose earlier row is an ``error`` (a bad file stays bad).
+    total_mass : float
+        kg: sum of the masses of the ``ok`` files of this batch, including skipped ones done before.
+    seconds : float
+        Wall time of this run, s.
+    failures : tuple of (str, str)
+        ``(path, message)`` of the files that failed in this run.
+    """
+
+    ok: int
+    failed: int
+    skipped: int
+    skipped_failed: int
+    total_mass: float
+    seconds: float
+    failures: tuple = field(default=(), repr=False)
+
+    @property
+    def computed(self) -> int:
+        """Files analysed in this run (ok + failed)."""
+        return self.ok + self.failed
+
+    @property
+    def files_per_second(self) -> float:
+        """Analysed files per second of wall time in this run (0 when nothing was analysed)."""
+        return self.computed / self.seconds if self.seconds > 0 and self.computed else 0.0
+
+
+def discover_files(spec: str | os.PathLike, *, suffixes: Sequence[str] = SUPPORTED_SUFFIXES,
+                   max_files: int = 10_000_000) -> list[str]:
+    """The mesh files named by a directory (searched recursively) or a glob pattern, sorted, absolute.
+
+    Parameters
+    ----------
+    spec : str or path
+        A directory, a glob (``"parts/**/*.stl"``; ``**`` recurses) or a single file.
+    suffixes : sequence of str
+        File suffixes taken from a directory (case-insensitive).  A glob or a file is taken as given.
+    max_files : int
+        Refuse to list more (guards against pointing at ``/``).
+
+    Raises
+    ------
+    UsageError
+        If nothing matches or there are more than ``max_files`` files.
+    """
+    spec = os.fspath(spec)
+    suffixes = tuple(s.lower() for s in suffixes)
+    found: list[str] = []
+    if os.path.isdir(spec):
+        for root, dirs, names in os.walk(spec):
+            dirs.sort()
+            for n in sorted(names):
+                if n.lower().endswith(suffixes):
+                    found.append(os.path.join(root, n))
+                    if len(found) > max_files:
+                        raise UsageError(f"{spec}: more than {max_files:,} mesh files; narrow the pattern")
+    elif os.path.isfile(spec):
+        found = [spec]
+    else:
+        found = [p for p in glob.iglob(spec, recursive=True) if os.path.isfile(p)]
+        if len(found) > max_files:
+            raise UsageError(f"{spec}: more than {max_files:,} files match; narrow the pattern")
+    if not found:
+        raise UsageError(f"Expected a directory holding mesh files ({', '.join(suffixes)}) or a glob that "
+                         f"matches files, got {spec!r} (nothing found)")
+    return sorted({os.path.abspath(p) for p in found})
+
+
+def file_sha256(path: str | os.PathLike) -> str:
+    """Hex SHA-256 of a file's bytes (read in 1 MiB chunks)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while chunk := fh.read(_HASH_CHUNK):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def _one_line(text: object, limit: int = 500) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _finite(x) -> float | None:
+    v = float(x)
+    return v if math.isfinite(v) else None
+
+
+def _empty_row(path: str, sha256: str | None, options: BatchOptions) -> dict:
+    row = dict.fromkeys(ROW_FIELDS)
+    row.update(schema=SCHEMA, path=path, sha256=sha256, options_key=options.key(), units=options.units,
+               worker=f"{platform.node()}:{os.getpid()}")
+    return row
+
+
+def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) -> dict:
+    """Mass properties of one mesh file as a result row (:data:`ROW_FIELDS`); never raises.
+
+    Parameters
+    ----------
+    path : str
+        Mesh file.
+    options : BatchOptions
+    sha256 : str, optional
+        The file's content hash if the caller already has it; computed here otherwise.
+
+    Returns
+    -------
+    dict
+        ``status`` is ``"ok"`` (numbers filled in), ``"error"`` (an ``InertiaToolError``: unreadable or
+        invalid mesh; ``error_type`` and ``error`` say why) or ``"internal_error"`` (any other exception,
+        retried on resume).  ``warnings`` (``None`` when there are none) joins the soft problems with ``" | "``; ``seconds`` is the time
+        spent on this file.
+    """
+    start = time.perf_counter()
+    row = _empty_row(path, sha256, options)
+    try:
+        if row["sha256"] is None:
+            row["sha256"] = file_sha256(path)
+        _, described = resolve_density(density=options.density, material=options.material, mass=options.mass)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", InertiaToolWarning)
+            props = mass_properties(path, units=options.units, density=options.density,
+                                    material=options.material, mass=options.mass, repair=options.repair,
+                                    merge_tolerance=options.merge_tolerance, max_faces=options.max_faces)
+        pa = props.principal
+        inertia = np.asarray(props.inertia)
+        mesh = cast(MeshReport, props.mesh)         # MassProperties.mesh is typed `object`
+        row.update(
+            status="ok", density=_finite(props.density), density_source=described,
+            mass=_finite(props.mass), volume=_finite(props.volume), surface_area=_finite(props.surface_area),
+            com_x=_finite(props.center_of_mass[0]), com_y=_finite(props.center_of_mass[1]),
+            com_z=_finite(props.center_of_mass[2]),
+            ixx=_finite(inertia[0, 0]), iyy=_finite(inertia[1, 1]), izz=_finite(inertia[2, 2]),
+            ixy=_finite(inertia[0, 1]), ixz=_finite(inertia[0, 2]), iyz=_finite(inertia[1, 2]),
+            i1=_finite(pa.moments[0]), i2=_finite(pa.moments[1]), i3=_finite(pa.moments[2]),
+            faces=int(mesh.faces), bodies=int(mesh.bodies), cavities=int(mesh.cavities),
+            watertight=bool(mesh.watertight), repaired=bool(mesh.repaired),
+            warnings=" | ".join(_one_line(w.message) for w in caught
+                                if issubclass(w.category, InertiaToolWarning)) or None,
+        )
+        for k in range(3):
+            for c, name in enumerate("xyz"):
+                row[f"axis{k + 1}_{name}"] = _finite(pa.axes[c, k])
+    except InertiaToolError as exc:
+        row.update(status="error", error_type=type(exc).__name__, error=_one_line(exc))
+    except Exception as exc:  # noqa: BLE001 - one bad file must never stop a batch
+        row.update(status="internal_error", error_type=type(exc).__name__, error=_one_line(exc))
+    row["seconds"] = round(time.perf_counter() - start, 6)
+    return row
+
+
+def _done_keys(previous_rows: Iterable[dict]) -> dict:
+    """``{(path, sha256, options_key): row}`` of previous rows that count as done."""
+    done = {}
+    for r in previous_rows:
+        if r.get("status") in DONE_STATUSES:
+            done[(r.get("path"), r.get("sha256"), r.get("options_key"))] = r
+    return done
+
+
+def _as_float(x) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return 0.0
+    return v if math.isfinite(v) else 0.0
+
+
+def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[dict], None], *,
+              previous_rows: Iterable[dict] = (), jobs: int = 1, executor: cf.Executor | None = None,
+              progress: Callable[[int, int, int, int], None] | None = None,
+              max_in_flight: int | None = None) -> BatchSummary:
+    """Analyse ``files`` and hand each row to ``write_row`` as soon as it is ready (completion order).
+
+    Parameters
+    ----------
+    files : sequence of str
+        Mesh files (see :func:`discover_files`).
+    options : BatchOptions
+    write_row : callable(dict)
+        Called once per analysed file, in the calling process (so it can append to one file safely).
+    previous_rows : iterable of dict
+        Rows of an earlier run (read back from the output); files done there are skipped.
+    jobs : int
+        1 runs in this process; N > 1 uses a pool of N processes (``ProcessPoolExecutor``).
+    executor : concurrent.futures.Executor, optional
+        Run on this executor instead (e.g. a Dask ``Client.get_executor()``); ``jobs`` then only sets the
+        number of files in flight.
+    progress : callable(done, total, ok, failed), optional
+        Called after every file (skipped ones included, at the start).
+    max_in_flight : int, optional
+        Files submitted but not finished at most (default ``4 * jobs``), so memory stays bounded for huge
+        batches.
+
+    Returns
+    -------
+    BatchSummary
+    """
+    if jobs < 1:
+        raise UsageError(f"Expected --jobs >= 1, got {jobs}")
+    options.validate()
+    start = time.perf_counter()
+    done = _done_keys(previous_rows)
+    key = options.key()
+    todo: list[tuple[str, str | None]] = []
+    skipped = skipped_failed = 0
+    total_mass = 0.0
+    failures: list[tuple[str, str]] = []
+    ok = failed = 0
+    total = len(files)
+    for path in files:
+        try:
+            digest = file_sha256(path)
+        except OSError:
+            digest = None                                      # analyze_file writes the error row
+        prev = done.get((path, digest, key)) if digest is not None else None
+        if prev is not None:
+            skipped += 1
+            if prev.get("status") == "ok":
+                total_mass += _as_float(prev.get("mass"))
+            else:
+                skipped_failed += 1
+        else:
+            todo.append((path, digest))
+    if progress:
+        progress(skipped, total, ok, failed)
+
+    def record(row: dict) -> None:
+        nonlocal ok, failed, total_mass
+        write_row(row)
+        if row["status"] == "ok":
+            ok += 1
+            total_mass += _as_float(row["mass"])
+        else:
+            failed += 1
+            failures.append((row["path"], f"{row['error_type']}: {row['error']}"))
+        if progress:
+            progress(skipped + ok + failed, total, ok, failed)
+
+    if executor is None and jobs == 1:
+        for path, digest in todo:
+            record(analyze_file(path, options, digest))
+    else:
+        own = executor is None
+        pool: cf.Executor = cf.ProcessPoolExecutor(max_workers=jobs) if executor is None else executor
+        limit = max_in_flight or 4 * jobs
+        try:
+            pending: dict = {}
+            queue = iter(todo)
+            exhausted = False
+            # bounded: each pass submits or completes at least one of the len(todo) files
+            for _ in range(2 * len(todo) + 2):
+                while not exhausted and len(pending) < limit:
+                    nxt = next(queue, None)
+                    if nxt is None:
+                        exhausted = True
+                        break
+                    try:
+                        fut = pool.submit(analyze_file, nxt[0], options, nxt[1])
+                    except cf.process.BrokenProcessPool:
+                        if not own:
+                            raise
+                        # a worker died hard (e.g. killed for memory): start a fresh pool and go on
+                        pool.shutdown(wait=False, cancel_futures=True)
+                        pool = cf.ProcessPoolExecutor(max_workers=jobs)
+                        fut = pool.submit(analyze_file, nxt[0], options, nxt[1])
+                    pending[fut] = nxt
+                if not pending:
+                    break
+                finished, _ = cf.wait(list(pending), return_when=cf.FIRST_COMPLETED)
+                for fut in finished:
+                    path, digest = pending.pop(fut)
+                    try:
+                        row = fut.result()
+                    except Exception as exc:  # noqa: BLE001 - a dead worker is a failed file, not a dead batch
+                        row = _empty_row(path, digest, options)
+                        row.update(status="internal_error", error_type=type(exc).__name__,
+                                   error=_one_line(exc) or "worker failed")
+                    record(row)
+        finally:
+            if own:
+                pool.shutdown(wait=True, cancel_futures=True)
+    return BatchSummary(ok=ok, failed=failed, skipped=skipped, skipped_failed=skipped_failed,
+                        total_mass=total_mass,
+                        seconds=time.perf_counter() - start, failures=tuple(failures))

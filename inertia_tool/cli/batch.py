@@ -1,0 +1,163 @@
+"""``inertia-tool batch DIR_OR_GLOB --out results.jsonl|csv``: mass properties of many meshes.
+
+Routing, the progress bar and the summary only; the per-file work and the runner are
+:mod:`inertia_tool.batch`, the result files :mod:`inertia_tool.reports.rows`.
+
+Exit codes: 0 when every file is done without error (this run or an earlier one), 3 when some file failed,
+in this run or in the earlier row it was skipped for (its row says why), 2 for bad arguments or an ``--out`` that is not a results file of the same kind.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from ..batch import BatchOptions, discover_files, run_batch
+from ..errors import UsageError
+from ..reports.rows import open_results, results_format
+from ..units import parse_density, parse_mass
+from .analyze import add_material_options, add_mesh_options
+
+__all__ = ["register", "run", "Progress", "dask_executor"]
+
+#: Exit code when at least one file failed.
+EXIT_SOME_FAILED = 3
+
+
+class Progress:
+    """A progress display on a stream: a redrawn bar on a terminal, plain periodic lines otherwise.
+
+    Parameters
+    ----------
+    stream : file
+        Usually ``sys.stderr``.
+    interval : float
+        Seconds between plain lines when ``stream`` is not a terminal (the last state is always printed).
+    width : int
+        Characters of the bar.
+    """
+
+    def __init__(self, stream=None, *, interval: float = 5.0, width: int = 30):
+        self.stream = stream if stream is not None else sys.stderr
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.interval = interval
+        self.width = width
+        self.start = time.perf_counter()
+        self.first = None
+        self.last_line = -1e300
+        self.state = (0, 0, 0, 0)
+
+    def _text(self, done, total, ok, failed) -> str:
+        elapsed = time.perf_counter() - self.start
+        computed = ok + failed
+        rate = computed / elapsed if elapsed > 0 and computed else 0.0
+        eta = f", ETA {((total - done) / rate):.0f} s" if rate > 0 and done < total else ""
+        return f"{done}/{total} files ({ok} ok, {failed} failed), {rate:.1f} files/s{eta}"
+
+    def __call__(self, done: int, total: int, ok: int, failed: int) -> None:
+        self.state = (done, total, ok, failed)
+        now = time.perf_counter()
+        if self.tty:
+            filled = int(self.width * done / total) if total else self.width
+            bar = "#" * filled + "." * (self.width - filled)
+            self.stream.write(f"\r[{bar}] {self._text(done, total, ok, failed)}\x1b[K")
+            self.stream.flush()
+        elif now - self.last_line >= self.interval or done == total:
+            self.last_line = now
+            self.stream.write(f"batch: {self._text(done, total, ok, failed)}\n")
+            self.stream.flush()
+
+    def close(self) -> None:
+        """End the bar's line on a terminal."""
+        if self.tty:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def dask_executor(address: str, jobs: int):
+    """A ``concurrent.futures`` executor on a Dask cluster and a function that shuts it down.
+
+    ``"local"`` starts a ``LocalCluster`` of ``jobs`` single-threaded worker processes without a
+    dashboard; anything else is a scheduler address (``tcp://host:8786``) for ``Client``.  The files must be
+    readable at the same paths on the workers (a shared file system).
+    """
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise UsageError('--dask needs dask.distributed: pip install "inertia-tool[dask]" '
+                         '(or "dask[distributed]")') from None
+    if address == "local":
+        cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None)
+        client = Client(cluster)
+    else:
+        cluster = None
+        try:
+            client = Client(address, timeout="20s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise UsageError(f"--dask {address}: cannot connect to a Dask scheduler ({exc})") from None
+
+    def shutdown():
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+    return client.get_executor(), shutdown
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "batch", help="mass properties of many meshes into one JSONL/CSV file (parallel, resumable)",
+        description="Analyse every mesh in a directory (recursively) or matching a glob; one row per file "
+                    "(numbers or the error) appended to --out and flushed per file, so a killed run can be "
+                    "resumed: files already done (same path, same SHA-256 of the content, same options) "
+                    "are skipped.")
+    p.add_argument("source", metavar="DIR_OR_GLOB", help="directory (searched recursively) or glob, e.g. "
+                                                          "'parts/**/*.stl' (quote it)")
+    p.add_argument("--out", required=True, metavar="FILE", help="results file: *.jsonl or *.csv (appended to)")
+    p.add_argument("--jobs", "-j", type=int, default=1, metavar="N",
+                   help="worker processes (default 1: in this process); with --dask, the LocalCluster size")
+    p.add_argument("--dask", metavar="ADDRESS",
+                   help="run on a Dask cluster: 'local' for a LocalCluster of --jobs workers on this machine, or "
+                        "a scheduler address tcp://host:8786 (needs the 'dask' extra)")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress display")
+    add_material_options(p)
+    add_mesh_options(p)
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    results_format(args.out)                      # a bad suffix is a usage error before any work
+    options = BatchOptions(units=args.units,
+                           density=parse_density(args.density) if args.density is not None else None,
+                           material=args.material,
+                           mass=parse_mass(args.mass) if args.mass is not None else None,
+                           repair=args.repair, merge_tolerance=args.merge_tolerance, max_faces=args.max_faces)
+    options.validate()
+    if args.jobs < 1:
+        raise UsageError(f"Expected --jobs >= 1, got {args.jobs}")
+    files = discover_files(args.source)
+    executor, shutdown = (None, None)
+    with open_results(args.out) as out:
+        if out.repaired_tail:
+            print(f"batch: {args.out}: cut off a torn last line left by an interrupted run", file=sys.stderr)
+        if args.dask:
+            executor, shutdown = dask_executor(args.dask, args.jobs)
+        progress = None if args.quiet else Progress(sys.stderr)
+        try:
+            summary = run_batch(files, options, out.write_row, previous_rows=out.previous_rows, jobs=args.jobs,
+                                executor=executor, progress=progress)
+        finally:
+            if progress is not None:
+                progress.close()
+            if shutdown is not None:
+                shutdown()
+    where = f"Dask ({args.dask})" if args.dask else f"{args.jobs} process{'es' if args.jobs > 1 else ''}"
+    print(f"batch: {len(files)} files: {summary.ok} ok, {summary.failed} failed, {summary.skipped} skipped "
+          f"(done before{f', {summary.skipped_failed} of them failed' if summary.skipped_failed else ''}); total mass of the ok files {summary.total_mass:.6g} kg; "
+          f"{summary.seconds:.2f} s, {summary.files_per_second:.1f} files/s on {where}; rows in {args.out}",
+          file=sys.stderr)
+    for path, message in summary.failures[:10]:
+        print(f"batch: failed: {path}: {message}", file=sys.stderr)
+    if len(summary.failures) > 10:
+        print(f"batch: ... and {len(summary.failures) - 10} more failures (see {args.out})", file=sys.stderr)
+    return EXIT_SOME_FAILED if summary.failed or summary.skipped_failed else 0

@@ -1,0 +1,39 @@
+"""``--report FILE.html`` / ``--force`` for commands that show one part (used by ``analyze``).
+
+Routing only: it reads the mesh geometry again for the drawing and hands everything to
+:mod:`inertia_tool.reports.html`.
+"""
+
+from __future__ import annotations
+
+import os
+
+from ..io import load_mesh
+from ..reports.html import html_report, write_html_report
+
+__all__ = ["add_report_options", "write_report_from_args"]
+
+
+def add_report_options(parser) -> None:
+    """Add ``--report FILE.html`` and ``--force`` to ``parser``."""
+    g = parser.add_argument_group("report")
+    g.add_argument("--report", metavar="FILE.html",
+                   help="also write a self-contained HTML report (tables, three views with the centre of mass, "
+                        "principal axes and inertia ellipsoid; stability where available)")
+    g.add_argument("--force", action="store_true", help="let --report replace an existing file")
+
+
+def write_report_from_args(args, props, density_source: str | None, warnings=()) -> None:
+    """Write the HTML report asked for by ``args.report`` (no-op without it)."""
+    if not getattr(args, "report", None):
+        return
+    if os.path.exists(args.report) and not args.force:   # refuse before re-reading meshes
+        write_html_report(args.report, "", force=False)
+    from .analyze import split_part_spec
+    files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
+    meshes = []
+    for spec in files:
+        raw = load_mesh(split_part_spec(spec)[0], units=args.units, max_faces=args.max_faces)
+        meshes.append((raw.vertices, raw.faces))
+    document = html_report(props, meshes=meshes, density_source=density_source, warnings=list(warnings))
+    write_html_report(args.report, document, force=args.force)

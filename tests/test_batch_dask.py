@@ -1,0 +1,65 @@
+"""``batch --dask local``: the same rows from a Dask LocalCluster of 2 worker processes."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+import trimesh
+
+from conftest import write_binary_stl
+from inertia_tool.batch import BatchOptions, discover_files, run_batch
+from inertia_tool.cli import main
+from inertia_tool.reports.rows import open_results
+
+distributed = pytest.importorskip("dask.distributed", reason="the 'dask' extra is not installed")
+
+
+@pytest.fixture
+def meshes(tmp_path):
+    d = tmp_path / "m"
+    d.mkdir()
+    for k in range(6):
+        m = trimesh.creation.box([1 + k, 2, 3]) if k % 2 else trimesh.creation.icosphere(2, radius=1 + k)
+        write_binary_stl(d / f"part{k}.stl", m.vertices, m.faces)
+    (d / "broken.stl").write_bytes(b"solid broken\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\n")
+    return d
+
+
+def _strip(rows):
+    return sorted(json.dumps({k: v for k, v in r.items() if k not in ("seconds", "worker")}) for r in rows)
+
+
+def test_local_cluster_matches_in_process_rows(meshes):
+    from inertia_tool.cli.batch import dask_executor
+
+    files = discover_files(meshes)
+    local_rows, dask_rows = [], []
+    run_batch(files, BatchOptions(units="mm", density=1240.0), local_rows.append)
+    executor, shutdown = dask_executor("local", 2)
+    try:
+        summary = run_batch(files, BatchOptions(units="mm", density=1240.0), dask_rows.append, jobs=2,
+                            executor=executor)
+    finally:
+        shutdown()
+    assert (summary.ok, summary.failed) == (6, 1)
+    assert _strip(dask_rows) == _strip(local_rows)
+    workers = {r["worker"] for r in dask_rows}
+    assert 1 <= len(workers) <= 2 and all(not w.endswith(f":{os.getpid()}") for w in workers)  # ran on workers
+    box = [r for r in dask_rows if r["path"].endswith("part1.stl")][0]
+    mass = 1240.0 * 2e-3 * 2e-3 * 3e-3
+    assert box["mass"] == pytest.approx(mass, rel=1e-6)
+    assert box["izz"] == pytest.approx(mass / 12 * (4e-6 + 4e-6), rel=1e-5)
+
+
+def test_cli_dask_local_resumes_a_process_pool_run(meshes, tmp_path, capsys):
+    out = tmp_path / "r.jsonl"
+    assert main(["batch", str(meshes / "part*.stl"), "--out", str(out), "--jobs", "2"]) == 0
+    capsys.readouterr()
+    code = main(["batch", str(meshes), "--out", str(out), "--jobs", "2", "--dask", "local"])
+    err = capsys.readouterr().err
+    assert code == 3                  # broken.stl failed
+    assert "0 ok, 1 failed, 6 skipped" in err and "Dask (local)" in err
+    with open_results(out) as r:
+        rows = r.previous_rows
+    assert len(rows) == 7 and np.isfinite([r["mass"] for r in rows if r["status"] == "ok"]).all()
