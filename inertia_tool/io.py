@@ -100,7 +100,8 @@ def _binary_stl_count(path: str, size: int, max_faces: int) -> int:
 
 
 def _binary_stl_chunks(path: str, n: int):
-    """A factory of iterators over the corners of a binary STL, ``(k, 3)`` float32 chunks in file order.
+    """A factory of iterators over the corners of a binary STL, ``(k, 4)`` float32 chunks ``(x, y, z, 0)``
+    in file order (the padded layout lets ``weld`` hash a corner as two 64-bit words).
 
     Each call re-reads the file in bounded chunks (the second read comes from the page cache), so the whole
     triangle soup is never held in memory.
@@ -114,7 +115,8 @@ def _binary_stl_chunks(path: str, n: int):
                 rec = np.fromfile(fh, dtype=_STL_RECORD, count=k)
                 if len(rec) != k:
                     raise _fail(path, f"ended after {done + len(rec):,} of {n:,} triangles")
-                corners = np.ascontiguousarray(rec["v"]).reshape(-1, 3)
+                corners = np.zeros((3 * k, 4), dtype=np.float32)   # (x, y, z, 0): see weld._hash_rows
+                corners[:, :3] = rec["v"].reshape(-1, 3)
                 if not np.all(np.isfinite(corners)):
                     raise _fail(path, "triangles have NaN or infinite coordinates")
                 done += k

@@ -28,6 +28,15 @@ def _hash_rows(rows: np.ndarray) -> np.ndarray:
     float32 rows: the x and y bit patterns fill the key exactly and z is mixed in, so only points that
     differ in z *and* collide in the mix share a key; float64 rows: a multiply-xor mix of the three.
     """
+    if rows.dtype == np.float32 and rows.ndim == 2 and rows.shape[1] == 4 and rows.flags.c_contiguous:
+        # padded layout (x, y, z, 0): the (x, y) pair is one uint64 word and z the other
+        bits = rows.view(np.uint32)
+        bits[bits == 0x80000000] = 0     # -0.0 -> +0.0 in place (the chunk is the caller's scratch buffer)
+        words = bits.view(np.uint64)
+        with np.errstate(over="ignore"):
+            h = words[:, 1] * _MIX[0]
+        h ^= words[:, 0]
+        return h
     rows = rows + rows.dtype.type(0)  # -0.0 -> +0.0 so that equal values hash equally
     with np.errstate(over="ignore"):
         if rows.dtype == np.float32:
@@ -55,7 +64,8 @@ def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int)
     Parameters
     ----------
     chunks : callable
-        Returns a fresh iterator over ``(k, 3)`` float arrays whose concatenation is the ``n_points`` corners,
+        Returns a fresh iterator over ``(k, 3)`` float arrays whose concatenation is the ``n_points`` corners
+        (or ``(k, 4)`` C-contiguous float32 scratch arrays with a zero last column: a faster layout),
         three per triangle.  It is called twice (keys; coordinates with the collision check), and once
         more only if a key collision forces the exact fallback.
     n_points : int
@@ -94,12 +104,13 @@ def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int)
     written = np.zeros(n_unique, dtype=bool)
     s = 0
     for c in chunks():
+        c = c[:, :3]
         inv = inverse[s:s + len(c)]
         fresh = ~written[inv]
         vertices[inv[fresh]] = c[fresh]
         written[inv] = True
         if not np.array_equal(vertices[inv], c.astype(np.float64) + 0.0):
-            pts = np.concatenate([x.astype(np.float64) + 0.0 for x in chunks()])
+            pts = np.concatenate([x[:, :3].astype(np.float64) + 0.0 for x in chunks()])
             uniq, inv_all = np.unique(pts, axis=0, return_inverse=True)
             return uniq, inv_all.reshape(-1).astype(_index_dtype(len(uniq))).reshape(-1, 3)
         s += len(c)

@@ -143,3 +143,16 @@ def test_png_renamed_stl_is_refused(tmp_path):
     p.write_bytes(b"\x89PNG\r\n\x1a\n" + os.urandom(300))
     with pytest.raises(MeshReadError):
         load_mesh(p)
+
+
+def test_binary_stl_negative_zero_corner_welds_with_positive_zero(tmp_path):
+    v, f = box_arrays((2.0, 2.0, 2.0), center=(1.0, 1.0, 1.0))   # corners on the coordinate planes
+    tri = v[f].astype(np.float32)
+    tri[tri == 0] = np.float32(-0.0) * (np.arange(tri.size).reshape(tri.shape)[tri == 0] % 2)  # mix -0.0 and 0.0
+    rec = np.zeros(len(tri), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = tri
+    p = tmp_path / "signed_zero.stl"
+    p.write_bytes(b" " * 80 + np.uint32(len(tri)).tobytes() + rec.tobytes())
+    assert np.signbit(tri).any()
+    raw = load_mesh(p)
+    assert len(raw.vertices) == 8
