@@ -63,8 +63,11 @@ def run(path, args=()):
     proc = subprocess.run([sys.executable, "-c", _LAUNCH, "analyze", path, "--json", *args],
                           capture_output=True, env=env)
     err = proc.stderr.decode("utf-8", "replace")
-    err, _, peak = err.rpartition("\n@peak-rss ")
-    return proc.returncode, proc.stdout.decode(), err, time.perf_counter() - start, int(peak or 0)
+    head, marker, peak = err.rpartition("\n@peak-rss ")
+    if marker:
+        err = head
+    return (proc.returncode, proc.stdout.decode(), err, time.perf_counter() - start,
+            int(peak) if marker and peak.strip().isdigit() else 0)
 
 
 def write_big_ascii(path, n_triangles):
