@@ -76,7 +76,7 @@ class MeshReport:
     flipped_shells : int
         Shells that were inside out (negative volume, not inside another shell) and were flipped.
     overlapping_shells : int
-        Bodies found inside another body (their volume counts twice).
+        Bodies found overlapping another body (the shared volume counts twice).
     watertight : bool
         Closed and consistently wound as read (before any repair).
     welded_tolerance : float or None

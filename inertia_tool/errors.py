@@ -36,6 +36,7 @@ __all__ = [
     "OverlapWarning",
     "TrailingDataWarning",
     "AsymmetricTopWarning",
+    "MalformedTextWarning",
 ]
 
 
@@ -125,3 +126,11 @@ class TrailingDataWarning(InertiaToolWarning):
 class AsymmetricTopWarning(InertiaToolWarning):
     """A body analysed as a symmetric top is not one: its two moments transverse to the pivot→centre-of-mass
     axis differ (or that axis is not principal about the pivot) beyond the tolerance; their mean was used."""
+
+
+class MalformedTextWarning(InertiaToolWarning):
+    """A text mesh file had lines that were not understood or structure keywords missing.
+
+    The geometry lines were still unambiguous (e.g. three ``vertex`` lines per ``facet`` in an ASCII STL),
+    so they were read; the warning says what was skipped.
+    """

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import MeshReadError, TrailingDataWarning, UsageError
+from .errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, UsageError
 from .units import length_scale
 from .weld import weld_exact, weld_exact_stream
 
@@ -59,8 +59,13 @@ class RawMesh:
     file_faces: int = 0
 
 
-def _fail(path: str, problem: str) -> MeshReadError:
-    return MeshReadError(f"{path}: {problem}")
+def _display(path) -> str:
+    """A printable form of a file name (undecodable bytes of a non-UTF-8 name become U+FFFD)."""
+    return os.fsencode(path).decode("utf-8", "replace")
+
+
+def _fail(path, problem: str) -> MeshReadError:
+    return MeshReadError(f"{_display(path)}: {problem}")
 
 
 def _check_face_budget(path: str, n: int, max_faces: int) -> None:
@@ -94,8 +99,8 @@ def _binary_stl_count(path: str, size: int, max_faces: int) -> int:
     _check_face_budget(path, n, max_faces)
     extra = size - 84 - 50 * n
     if extra:
-        warnings.warn(TrailingDataWarning(f"{path}: {extra:,} bytes after the {n:,} triangles the header "
-                                          "announces were ignored"), stacklevel=4)
+        warnings.warn(TrailingDataWarning(f"{_display(path)}: {extra:,} bytes after the {n:,} triangles the "
+                                          "header announces were ignored"), stacklevel=4)
     return n
 
 
@@ -124,52 +129,139 @@ def _binary_stl_chunks(path: str, n: int):
     return chunks
 
 
-_VERTEX_RE = re.compile(rb"^\s*vertex\s+(\S+)\s+(\S+)\s+(\S+)\s*$", re.MULTILINE | re.IGNORECASE)
+_VERTEX_RE = re.compile(rb"^[ \t]*vertex[ \t]+(\S+)[ \t]+(\S+)[ \t]+(\S+)[ \t]*$", re.MULTILINE | re.IGNORECASE)
+_FIRST_WORD_RE = re.compile(rb"^[ \t]*([^ \t\n]{0,12})", re.MULTILINE)
+_STL_KEYWORDS = (b"solid", b"endsolid", b"facet", b"endfacet", b"outer", b"endloop", b"vertex", b"")
+
+#: Bytes read per step when streaming a text file.
+_BLOCK_BYTES = 1 << 24
+#: Longest text line accepted (a longer one means the file is not the text format it claims to be).
+MAX_LINE_BYTES = 1 << 20
+
+
+def _text_blocks(fh, path: str, *, block_bytes: int = _BLOCK_BYTES, max_line: int = MAX_LINE_BYTES):
+    """Yield the bytes of a text file in blocks of whole lines, every line ending normalised to ``\n``.
+
+    Reads fixed-size byte blocks and splits on any of ``\r\n``, ``\r`` (old Mac) and ``\n`` itself, carrying
+    the partial last line into the next block, so memory stays bounded by ``block_bytes + max_line`` however
+    the lines end.  A line longer than ``max_line`` is refused (the file is not line-structured text).
+    """
+    carry = b""
+    for _ in range(1 << 40):  # bounded by the file size: each pass consumes up to block_bytes
+        chunk = fh.read(block_bytes)
+        if not chunk:
+            break
+        data = carry + chunk
+        hold = b""
+        if data.endswith(b"\r"):  # may be the first half of a \r\n split across blocks
+            data, hold = data[:-1], b"\r"
+        data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+        cut = data.rfind(b"\n")
+        if cut < 0:
+            carry = data + hold
+        else:
+            yield data[:cut + 1]
+            carry = data[cut + 1:] + hold
+        if len(carry) > max_line:
+            raise _fail(path, f"a line is longer than {max_line:,} bytes: not a text mesh file")
+    carry = carry.replace(b"\r", b"\n")
+    if carry:
+        yield carry if carry.endswith(b"\n") else carry + b"\n"
+
+
+def _bad_line(path: str, block: bytes, first_line: int, pos: int, problem: str) -> MeshReadError:
+    """Error naming the line that holds byte ``pos`` of ``block`` (``first_line`` is the block's first line)."""
+    start = block.rfind(b"\n", 0, pos) + 1
+    stop = block.find(b"\n", pos)
+    text = block[start:stop if stop >= 0 else len(block)].strip()[:60].decode("utf-8", "replace")
+    line = first_line + block.count(b"\n", 0, start)
+    return _fail(path, f"line {line}: {problem}: {text!r}")
 
 
 def _read_ascii_stl(path: str, size: int, max_faces: int) -> tuple[np.ndarray, int]:
-    """Stream an ASCII STL; only ``vertex`` lines carry data, in groups of three per facet."""
-    # a vertex line has at least ~20 bytes: bound the corner count by the file size before allocating
-    _check_face_budget(path, size // 60, max_faces) if size // 60 > max_faces else None
+    """Stream an ASCII STL, checking its structure: exactly three ``vertex`` lines per ``facet``.
+
+    Unknown lines and missing ``outer loop`` / ``endloop`` / ``endfacet`` lines are tolerated with one
+    :class:`TrailingDataWarning`-style warning; anything that would change which corners form a triangle
+    (a facet with two or four vertices, a vertex outside a facet, an unparsable coordinate) is refused.
+    """
     blocks = []
     count = 0
-    line_no = 0
+    line_no = 1
+    open_count = None        # vertices so far in the facet still open at the end of a block
+    facets = 0
+    tallies = dict.fromkeys((b"outer", b"endloop", b"endfacet"), 0)
+    garbage = 0
+    first_garbage = ""
     with open(path, "rb") as fh:
-        while True:
-            lines = fh.readlines(1 << 24)
-            if not lines:
-                break
-            data = b"".join(lines).replace(b"\r\n", b"\n").replace(b"\r", b"\n")
-            lines = data.split(b"\n")
-            found = _VERTEX_RE.findall(data)
-            n_vertex_words = len(re.findall(rb"\bvertex\b", data, re.IGNORECASE))
-            if n_vertex_words != len(found):
-                # locate the first malformed vertex line for the message
-                for i, line in enumerate(lines):
-                    if re.search(rb"\bvertex\b", line, re.IGNORECASE) and not _VERTEX_RE.match(line):
-                        raise _fail(path, f"line {line_no + i + 1}: malformed vertex line "
-                                          f"{line.strip()[:60].decode('latin-1')!r}")
+        for block in _text_blocks(fh, path):
+            words = np.char.lower(np.array(_FIRST_WORD_RE.findall(block), dtype="S12"))
+            is_facet = words == b"facet"
+            is_vertex = words == b"vertex"
+            known = np.isin(words, np.array(_STL_KEYWORDS, dtype="S12"))
+            if not known.all():
+                if not garbage:
+                    k = int(np.argmax(~known))
+                    first_garbage = f" (first: line {line_no + k})"
+                garbage += int(np.count_nonzero(~known))
+            for key in tallies:
+                tallies[key] += int(np.count_nonzero(words == key))
+            # vertices per facet: id 0 is the facet left open by the previous block (if any), the last id
+            # stays open into the next block; every facet in between is complete and must have 3
+            facet_id = np.cumsum(is_facet)
+            n_new = int(facet_id[-1]) if len(facet_id) else 0
+            per_facet = np.bincount(facet_id[is_vertex], minlength=n_new + 1)
+            if open_count is None:
+                if per_facet[0]:
+                    k = int(np.argmax(is_vertex))
+                    raise _fail(path, f"line {line_no + k}: 'vertex' outside a 'facet'")
+                complete = per_facet[1:n_new]
+                complete_lines = np.flatnonzero(is_facet)[:-1]
+            else:
+                per_facet[0] += open_count
+                complete = per_facet[:n_new]
+                complete_lines = np.r_[-1, np.flatnonzero(is_facet)[:-1]] if n_new else np.zeros(0, int)
+            bad = np.flatnonzero(complete != 3)
+            if len(bad):
+                k = int(complete_lines[bad[0]])
+                where = f"line {line_no + k}" if k >= 0 else "a facet before this block"
+                raise _fail(path, f"{where}: a facet has {int(complete[bad[0]])} vertices instead of 3")
+            if n_new or open_count is not None:
+                open_count = int(per_facet[-1])
+                if open_count > 3:
+                    raise _fail(path, f"line {line_no + len(words) - 1}: a facet has more than 3 vertices")
+            facets += int(np.count_nonzero(is_facet))
+            found = _VERTEX_RE.findall(block)
+            if len(found) != int(np.count_nonzero(is_vertex)):
+                for m_pos in re.finditer(rb"(?im)^[ \t]*vertex\b[^\n]*", block):
+                    if not _VERTEX_RE.fullmatch(m_pos.group(0)):
+                        raise _bad_line(path, block, line_no, m_pos.start(), "malformed vertex line")
+                raise _fail(path, "malformed vertex line")
             if found:
                 try:
                     arr = np.array(found, dtype=np.float64)
                 except ValueError:
-                    for i, line in enumerate(lines):
-                        m = _VERTEX_RE.match(line)
-                        if m:
-                            try:
-                                [float(x) for x in m.groups()]
-                            except ValueError:
-                                raise _fail(path, f"line {line_no + i + 1}: vertex coordinate is not a number: "
-                                                  f"{line.strip()[:60].decode('latin-1')!r}") from None
+                    for m_pos in _VERTEX_RE.finditer(block):
+                        try:
+                            [float(x) for x in m_pos.groups()]
+                        except ValueError:
+                            raise _bad_line(path, block, line_no, m_pos.start(),
+                                            "vertex coordinate is not a number") from None
                     raise _fail(path, "vertex coordinates are not numbers") from None
                 blocks.append(arr)
                 count += len(arr)
                 _check_face_budget(path, count // 3, max_faces)
-            line_no += len(lines)
+            line_no += block.count(b"\n")
     if count == 0:
         raise _fail(path, "ASCII STL without any 'vertex' line (empty mesh)")
-    if count % 3:
-        raise _fail(path, f"ASCII STL has {count:,} vertex lines, not a multiple of 3")
+    if open_count not in (None, 3):
+        raise _fail(path, f"the last facet has {open_count} vertices instead of 3 (truncated?)")
+    missing = [f"{facets - n:,} facets lack '{k.decode()}{' loop' if k == b'outer' else ''}'"
+               for k, n in tallies.items() if n < facets]
+    if garbage or missing:
+        what = ([f"{garbage:,} unrecognised lines were ignored{first_garbage}"] if garbage else []) + missing
+        warnings.warn(MalformedTextWarning(f"{_display(path)}: {'; '.join(what)}; read the 'vertex' lines by facet"),
+                      stacklevel=4)
     corners = np.concatenate(blocks).reshape(-1, 3, 3)
     return corners, len(corners)
 
@@ -183,23 +275,33 @@ def read_stl(path, *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, n
     faces : (m, 3) int
     file_faces : int
     """
-    path = os.fspath(path)
+    path = os.fsdecode(os.fspath(path))
     size = os.path.getsize(path)
     if size == 0:
         raise _fail(path, "empty file (0 bytes)")
     with open(path, "rb") as fh:
         head = fh.read(4096)
-    binary_size_matches = False
-    if size >= 84:
-        n = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else -1
-        binary_size_matches = n >= 0 and 84 + 50 * n == size
-    if binary_size_matches or not _looks_ascii_stl(head):
+    announced = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else -1
+
+    def binary():
         n = _binary_stl_count(path, size, max_faces)
         if n == 0:
             raise _fail(path, "STL holds no triangles (empty mesh)")
         vertices, faces = weld_exact_stream(_binary_stl_chunks(path, n), 3 * n)
         return vertices, faces, n
-    corners, n = _read_ascii_stl(path, size, max_faces)
+
+    if (announced >= 0 and 84 + 50 * announced == size) or not _looks_ascii_stl(head):
+        return binary()
+    try:
+        corners, n = _read_ascii_stl(path, size, max_faces)
+    except MeshReadError as ascii_error:
+        # a binary STL whose header starts with "solid" and which carries trailing bytes
+        if not 0 < announced <= (size - 84) // 50:
+            raise
+        try:
+            return binary()
+        except MeshReadError:
+            raise ascii_error from None
     if not np.all(np.isfinite(corners)):
         bad = int(np.count_nonzero(~np.isfinite(corners).all(axis=(1, 2))))
         raise _fail(path, f"{bad:,} triangles have NaN or infinite coordinates")
@@ -207,9 +309,256 @@ def read_stl(path, *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, n
     return vertices, faces, n
 
 
-# -- other formats through trimesh ----------------------------------------------------------------------
+# -- OBJ ------------------------------------------------------------------------------------------------
+
+#: OBJ statements that carry nothing for a solid's mass properties (texture, normals, groups, materials,
+#: free-form geometry); they are skipped silently.  Anything else unknown is counted and warned about.
+_OBJ_SKIPPED = frozenset(b"vt vn vp o g s usemtl mtllib cstype deg bmat step curv curv2 surf parm trim hole "
+                         b"scrv sp end con mg bevel c_interp d_interp lod maplib usemap shadow_obj trace_obj "
+                         b"ctech stech call csh".split())
+
+
+def _obj_vertex_block(path: str, tokens: list, first_line: int) -> np.ndarray:
+    try:
+        return np.array(tokens, dtype=np.float64).reshape(-1, 3)
+    except ValueError:
+        for tok in tokens:
+            try:
+                float(tok)
+            except ValueError:
+                raise _fail(path, f"a vertex coordinate after line {first_line} is not a number: "
+                                  f"{tok[:40].decode('utf-8', 'replace')!r}") from None
+        raise _fail(path, "vertex coordinates are not numbers") from None
+
+
+def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """Stream a Wavefront OBJ: ``v`` lines and ``f`` polygons (1-based or negative relative indices).
+
+    Polygons with more than three corners are fan-triangulated from their first corner (exact for planar
+    polygons).  Index 0, a relative index before the first vertex, or an index past the last vertex is
+    refused with the line named, never dropped: a dropped face would silently change the volume.
+
+    Returns ``vertices (n, 3)``, ``faces (m, 3)`` and the number of polygons in the file.
+    """
+    vertex_blocks, face_blocks = [], []
+    nv = n_tri = n_poly = loose = garbage = 0
+    first_garbage = ""
+    line_no = 0
+    pending = b""
+    max_vertices = 3 * max_faces + 3
+    with open(path, "rb") as fh:
+        for block in _text_blocks(fh, path):
+            coords: list = []
+            tri: list = []
+            block_start = line_no + 1
+            lines = block.split(b"\n")
+            lines.pop()  # every block ends with a newline
+            for raw in lines:
+                line_no += 1
+                if pending:
+                    raw, pending = pending + raw, b""
+                if raw.endswith(b"\\"):
+                    pending = raw[:-1] + b" "
+                    if len(pending) > MAX_LINE_BYTES:
+                        raise _fail(path, f"line {line_no}: continued line longer than {MAX_LINE_BYTES:,} bytes")
+                    continue
+                parts = raw.split()
+                if not parts or parts[0][:1] == b"#":
+                    continue
+                key = parts[0]
+                if key == b"v":
+                    if len(parts) < 4:
+                        raise _fail(path, f"line {line_no}: a vertex needs 3 coordinates, found {len(parts) - 1}")
+                    coords.extend(parts[1:4])
+                    nv += 1
+                    if nv > max_vertices:
+                        raise _fail(path, f"holds more than {max_vertices:,} vertices (3 × --max-faces)")
+                elif key == b"f":
+                    k = len(parts) - 1
+                    if k < 3:
+                        raise _fail(path, f"line {line_no}: a face needs at least 3 vertices, found {k}")
+                    idx = []
+                    for tok in parts[1:]:
+                        try:
+                            i = int(tok.split(b"/", 1)[0])
+                        except ValueError:
+                            raise _fail(path, f"line {line_no}: face index "
+                                              f"{tok[:40].decode('utf-8', 'replace')!r} is not an integer") from None
+                        if 0 < i <= max_vertices:
+                            idx.append(i - 1)
+                        elif i > 0:
+                            raise _fail(path, f"line {line_no}: face index {str(i)[:24]} is past any vertex this file may "
+                                              f"hold ({max_vertices:,} = 3 × --max-faces)")
+                        elif i < 0 and -i <= nv:
+                            idx.append(nv + i)
+                        elif i < 0:
+                            raise _fail(path, f"line {line_no}: relative face index {i} points before the first "
+                                              f"vertex ({nv:,} defined so far)")
+                        else:
+                            raise _fail(path, f"line {line_no}: face index 0 (OBJ indices start at 1)")
+                    if k == 3:
+                        tri.extend(idx)
+                    else:
+                        first = idx[0]
+                        for j in range(1, k - 1):
+                            tri.extend((first, idx[j], idx[j + 1]))
+                    n_poly += 1
+                    n_tri += k - 2
+                    _check_face_budget(path, n_tri, max_faces)
+                elif key in (b"l", b"p"):
+                    loose += 1
+                elif key not in _OBJ_SKIPPED:
+                    if not garbage:
+                        first_garbage = f" (first: line {line_no})"
+                    garbage += 1
+            if coords:
+                vertex_blocks.append(_obj_vertex_block(path, coords, block_start))
+            if tri:
+                face_blocks.append(np.array(tri, dtype=np.int64).reshape(-1, 3))
+    if not face_blocks:
+        if nv == 0:
+            raise _fail(path, "no vertices and no faces (empty mesh)")
+        what = "points and lines only" if loose else "vertices only"
+        raise _fail(path, f"contains no faces ({nv:,} vertices, {what}: a point cloud, not a solid)")
+    vertices = np.concatenate(vertex_blocks) if vertex_blocks else np.zeros((0, 3))
+    faces = np.concatenate(face_blocks)
+    top = int(faces.max())
+    if top >= nv:
+        raise _fail(path, f"face index {top + 1:,} is past the last vertex ({nv:,} defined)")
+    if garbage:
+        warnings.warn(MalformedTextWarning(f"{_display(path)}: {garbage:,} unrecognised lines were ignored"
+                                           f"{first_garbage}"), stacklevel=4)
+    faces = faces.astype(np.int32) if nv < 2**31 - 1 else faces
+    return vertices, faces, n_poly
+
+
+# -- other formats through trimesh, with their headers checked first ------------------------------------
+
+_PLY_TYPE_BYTES = {b"char": 1, b"int8": 1, b"uchar": 1, b"uint8": 1, b"short": 2, b"int16": 2, b"ushort": 2,
+                   b"uint16": 2, b"int": 4, b"int32": 4, b"uint": 4, b"uint32": 4, b"float": 4, b"float32": 4,
+                   b"double": 8, b"float64": 8}
+
+#: 3MF (zip) members inflating more than this many times their compressed size are refused as zip bombs
+#: (applied to members above ``_ZIP_RATIO_MIN_BYTES``; real 3MF XML compresses about 5–20 : 1).
+MAX_ZIP_RATIO = 100
+_ZIP_RATIO_MIN_BYTES = 1 << 20
+#: Inflated 3MF bytes allowed per face of ``max_faces`` (XML spends ~60–120 bytes per triangle and vertex).
+_ZIP_BYTES_PER_FACE = 200
+_ZIP_BYTES_SLACK = 64 << 20
+
+
+def _header_count(path: str, word: bytes) -> int:
+    try:
+        n = int(word)
+    except ValueError:
+        raise _fail(path, f"header count {word[:20].decode('utf-8', 'replace')!r} is not an integer") from None
+    if n < 0:
+        raise _fail(path, f"header count {n} is negative")
+    return n
+
+
+def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
+    """Check what a PLY header announces against the file size before any parser allocates for it."""
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16)
+    end = head.find(b"end_header")
+    if not head.startswith(b"ply") or end < 0:
+        raise _fail(path, "not a PLY file (no 'ply' magic, or no 'end_header' within 64 KiB)")
+    fmt = None
+    elements: list = []
+    for line in head[:end].replace(b"\r", b"\n").split(b"\n")[1:]:
+        parts = line.split()
+        if not parts:
+            continue
+        if parts[0] == b"format" and len(parts) >= 2:
+            fmt = parts[1]
+        elif parts[0] == b"element":
+            if len(parts) != 3:
+                raise _fail(path, f"malformed PLY element line {line[:60].decode('utf-8', 'replace')!r}")
+            elements.append([parts[1], _header_count(path, parts[2]), 0])
+        elif parts[0] == b"property":
+            if not elements:
+                raise _fail(path, "PLY property before any element")
+            kind = parts[2] if parts[1:2] == [b"list"] and len(parts) >= 3 else parts[1:2][0] if len(parts) > 1 else b""
+            if kind not in _PLY_TYPE_BYTES:
+                raise _fail(path, f"unknown PLY property type {kind[:20].decode('utf-8', 'replace')!r}")
+            elements[-1][2] += 2 if fmt == b"ascii" else _PLY_TYPE_BYTES[kind]
+    if fmt not in (b"ascii", b"binary_little_endian", b"binary_big_endian"):
+        raise _fail(path, f"unknown PLY format {fmt!r}")
+    body = size - (end + len(b"end_header") + 1)
+    need = sum(count * max(per, 1) for _, count, per in elements)
+    counts = {name.decode("utf-8", "replace"): count for name, count, _ in elements}
+    if need > body:
+        claimed = ", ".join(f"{c:,} {n}" for n, c in counts.items())
+        raise _fail(path, f"PLY header announces {claimed} (at least {need:,} bytes of data) but the file holds "
+                          f"only {max(body, 0):,}: truncated or lying header")
+    _check_face_budget(path, counts.get("face", 0), max_faces)
+    if counts.get("vertex", 0) > 3 * max_faces + 3:
+        raise _fail(path, f"holds {counts['vertex']:,} vertices, more than 3 × --max-faces")
+    return counts
+
+
+def _check_off_header(path: str, size: int, max_faces: int) -> dict:
+    """Check the vertex and face counts of an OFF header against the file size."""
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16)
+    words = []
+    for line in head.replace(b"\r", b"\n").split(b"\n")[:1000]:
+        words += line.split(b"#", 1)[0].split()
+        if len(words) >= 4:
+            break
+    if not words or not words[0].endswith(b"OFF"):
+        raise _fail(path, "not an OFF file (no 'OFF' keyword at the start)")
+    if len(words) < 3:
+        raise _fail(path, "OFF header without vertex and face counts")
+    nv, nf = _header_count(path, words[1]), _header_count(path, words[2])
+    if 6 * nv + 8 * nf > size:
+        raise _fail(path, f"OFF header announces {nv:,} vertices and {nf:,} faces but the file has only {size:,} "
+                          "bytes: truncated or lying header")
+    _check_face_budget(path, nf, max_faces)
+    return {"vertex": nv, "face": nf}
+
+
+def _check_zip(path: str, max_faces: int) -> dict:
+    """Refuse a 3MF whose members would inflate beyond the limits, from the zip's central directory only.
+
+    Python's zipfile never returns more than a member's declared ``file_size`` (it stops there and checks
+    the CRC), so limits on the declared sizes also bound what trimesh can inflate.
+    """
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as zf:
+            infos = zf.infolist()
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError) as exc:
+        raise _fail(path, f"not a valid 3MF (zip) archive ({str(exc)[:100]})") from None
+    if len(infos) > 10_000:
+        raise _fail(path, f"3MF archive has {len(infos):,} members; refused")
+    total = sum(i.file_size for i in infos)
+    limit = _ZIP_BYTES_PER_FACE * max_faces + _ZIP_BYTES_SLACK
+    for i in infos:
+        if i.file_size > _ZIP_RATIO_MIN_BYTES and i.file_size > MAX_ZIP_RATIO * max(i.compress_size, 1):
+            raise _fail(path, f"3MF member {i.filename[:60]!r} would inflate {i.file_size / max(i.compress_size, 1):,.0f}"
+                              f":1 ({i.compress_size:,} → {i.file_size:,} bytes), over the {MAX_ZIP_RATIO}:1 limit: "
+                              "refused as a zip bomb before inflating")
+    if total > limit:
+        raise _fail(path, f"3MF archive would inflate to {total:,} bytes, more than the {limit:,} allowed for "
+                          f"--max-faces {max_faces:,}; refused before inflating")
+    return {}
+
+
+_HEADER_CHECKS = {".ply": _check_ply_header, ".off": _check_off_header}
+
 
 def _read_with_trimesh(path: str, max_faces: int):
+    size = os.path.getsize(path)
+    suffix = os.path.splitext(path)[1].lower()
+    if suffix in _HEADER_CHECKS:
+        counts = _HEADER_CHECKS[suffix](path, size, max_faces)
+    elif suffix == ".3mf":
+        counts = _check_zip(path, max_faces)
+    else:
+        counts = {}
     try:
         import trimesh
     except ImportError as exc:  # pragma: no cover - trimesh is a dependency
@@ -218,18 +567,20 @@ def _read_with_trimesh(path: str, max_faces: int):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             loaded = trimesh.load(path, process=False, force=None)
+            if isinstance(loaded, trimesh.Scene):
+                geoms = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)] if loaded.geometry else []
+                if not geoms:
+                    raise _fail(path, "contains no triangle mesh (empty scene or only points/lines)")
+                loaded = trimesh.util.concatenate(geoms) if len(geoms) > 1 else geoms[0]
     except MeshReadError:
+        raise
+    except MemoryError:
         raise
     except Exception as exc:  # noqa: BLE001 - any parser failure is a read error with the file named
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise _fail(path, f"could not be parsed ({msg[:200]})") from None
-    if isinstance(loaded, trimesh.Scene):
-        geoms = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)] if loaded.geometry else []
-        if not geoms:
-            raise _fail(path, "contains no triangle mesh (empty scene or only points/lines)")
-        loaded = trimesh.util.concatenate(geoms)
     if not isinstance(loaded, trimesh.Trimesh):
-        raise _fail(path, f"contains no triangle mesh (found {type(loaded).__name__})")
+        raise _fail(path, f"contains no triangle mesh (found {type(loaded).__name__}: a point cloud or lines)")
     v = np.asarray(loaded.vertices, dtype=np.float64)
     f = np.asarray(loaded.faces)
     if len(f) == 0:
@@ -239,6 +590,11 @@ def _read_with_trimesh(path: str, max_faces: int):
         raise _fail(path, f"faces are not triangles (shape {f.shape})")
     if f.min() < 0 or f.max() >= len(v):
         raise _fail(path, f"face indices out of range (0..{len(v) - 1})")
+    if "vertex" in counts and len(v) != counts["vertex"]:
+        raise _fail(path, f"the header announces {counts['vertex']:,} vertices but {len(v):,} were read")
+    if "face" in counts and len(f) < counts["face"]:
+        raise _fail(path, f"the header announces {counts['face']:,} faces but only {len(f):,} triangles were read "
+                          "(faces dropped or truncated file)")
     if not np.all(np.isfinite(v)):
         raise _fail(path, "vertices have NaN or infinite coordinates")
     return v, f
@@ -250,43 +606,55 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
     Parameters
     ----------
     source : str or os.PathLike or trimesh.Trimesh or (vertices, faces)
-        A file (format from its suffix; STL read natively), a ``trimesh.Trimesh``, or a pair of arrays
-        ``vertices (n, 3)`` and ``faces (m, 3)``.
+        A file (format from its suffix; STL and OBJ read natively, streaming), a ``trimesh.Trimesh``, or a
+        pair of arrays ``vertices (n, 3)`` and ``faces (m, 3)``.
     units : str
         Length unit of the coordinates (``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft``).
     max_faces : int
-        Refuse sources with more triangles than this (protects memory).
+        Refuse sources with more triangles than this (protects memory).  What a file *announces* (an STL,
+        PLY or OFF header, a 3MF's inflated size) is checked against its size and this limit before
+        anything is allocated for it.
 
     Returns
     -------
     RawMesh
+        ``source`` is the file name made printable (undecodable bytes replaced).
 
     Raises
     ------
     MeshReadError
-        The file does not exist, is a directory, is empty, truncated, not a mesh, or too large.
+        The file does not exist, is a directory, is empty, truncated, not a mesh, lies about its
+        contents, or is too large.
     UsageError
-        Bad ``units`` or malformed arrays.
+        Bad ``units``, ``max_faces`` or malformed arrays.
     """
     scale = length_scale(units)
-    if isinstance(source, (str, os.PathLike)):
-        path = os.fspath(source)
-        if not os.path.exists(path):
-            raise _fail(path, "no such file")
-        if os.path.isdir(path):
-            raise _fail(path, "is a directory, not a mesh file")
+    if not (isinstance(max_faces, (int, np.integer)) and max_faces > 0):
+        raise UsageError(f"Expected a positive integer `max_faces`, got {max_faces!r}")
+    if isinstance(source, (str, bytes, os.PathLike)):
+        path = os.fsdecode(os.fspath(source))
         try:
+            if not os.path.exists(path):
+                raise _fail(path, "no such file")
+            if os.path.isdir(path):
+                raise _fail(path, "is a directory, not a mesh file")
+            if not os.path.isfile(path):
+                raise _fail(path, "is not a regular file (device, pipe or socket)")
             suffix = os.path.splitext(path)[1].lower()
+            if suffix not in SUPPORTED_SUFFIXES:
+                raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
+                                  f"{', '.join(SUPPORTED_SUFFIXES)}")
+            if os.path.getsize(path) == 0:
+                raise _fail(path, "empty file (0 bytes)")
             if suffix == ".stl":
                 vertices, faces, n = read_stl(path, max_faces=max_faces)
-            elif suffix in SUPPORTED_SUFFIXES:
-                if os.path.getsize(path) == 0:
-                    raise _fail(path, "empty file (0 bytes)")
+            elif suffix == ".obj":
+                vertices, faces, n = _read_obj(path, max_faces)
+                if not np.all(np.isfinite(vertices)):
+                    raise _fail(path, "vertices have NaN or infinite coordinates")
+            else:
                 vertices, faces = _read_with_trimesh(path, max_faces)
                 n = len(faces)
-            else:
-                raise _fail(path, f"unsupported file type {suffix or '(no suffix)'!r}; expected one of "
-                                  f"{', '.join(SUPPORTED_SUFFIXES)}")
         except PermissionError:
             raise _fail(path, "permission denied") from None
         except IsADirectoryError:
@@ -297,7 +665,7 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
             if isinstance(exc, MeshReadError):
                 raise
             raise _fail(path, f"cannot be read ({exc.strerror or exc})") from None
-        name = path
+        name = _display(path)
     else:
         vertices, faces, name = _from_object(source)
         n = len(faces)

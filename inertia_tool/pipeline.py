@@ -16,7 +16,7 @@ import numpy as np
 
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels, winding_number
 from .errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
-                     OverlapWarning, PhysicalValidityWarning, UsageError)
+                     NearlyEqualMomentsWarning, OverlapWarning, PhysicalValidityWarning, UsageError)
 from .io import DEFAULT_MAX_FACES, RawMesh, load_mesh
 from .properties import MassProperties, combine
 from .units import material_density
@@ -35,6 +35,16 @@ DEFAULT_MERGE_TOLERANCE = 1e-6
 
 #: Shells with |volume| below this fraction of the bounding-box diagonal cubed are flat.
 _FLAT_RTOL = 1e-12
+
+#: Largest |coordinate| (m) accepted: the second moments grow like L⁵ and must stay far from float64
+#: overflow (1.8e308) for any density; 1e30 m is already beyond the observable universe.
+MAX_COORDINATE = 1e30
+
+#: Smallest bounding-box diagonal (m) accepted: below it L⁵ approaches float64 underflow.
+MIN_EXTENT = 1e-30
+
+#: Relative precision (of the largest principal moment) under which the smallest one is only round-off.
+_NEEDLE_RTOL = 1e-10
 
 #: Upper bound on triangle-point solid-angle evaluations spent on cavity / overlap classification.
 _WINDING_BUDGET = 200_000_000
@@ -169,18 +179,101 @@ def _classify_shells(vertices, faces, labels, n_shells, shells, diag):
             if sign[s] < 0 and w > 0.5 and sign[t] > 0:
                 owner[s] = t
     cavities = 0
-    overlaps = 0
+    overlapped = np.zeros(n_shells, dtype=bool)
+    cavity = np.zeros(n_shells, dtype=bool)
     for s in range(n_shells):
         inside_material = winding[s] > 0.5
         if sign[s] < 0:
             if inside_material:
                 cavities += 1           # a void inside a body: keep its negative volume
+                cavity[s] = True
             else:
                 flip[s] = not flip[s]   # an inside-out body on its own: flip it
                 owner[s] = s
         elif inside_material:
-            overlaps += 1
-    return flip, owner, cavities, overlaps
+            overlapped[s] = True
+    if budget > 0:
+        overlapped |= _overlap_probes(vertices, faces, order, starts, face_count, lo, hi, flip, ~cavity,
+                                      diag, budget)
+    return flip, owner, cavities, int(np.count_nonzero(overlapped))
+
+
+def _overlap_probes(vertices, faces, order, starts, face_count, lo, hi, flip, body, diag, budget,
+                    probes_per_shell: int = 16, nudge: float = 1e-6):
+    """Bodies with material of another body just inside their surface (partial overlaps).
+
+    The centroids of each body's ``probes_per_shell`` largest faces, moved ``nudge · diag`` inward, are
+    tested against every other body whose bounding box holds them (winding number > 1/2 means inside).
+    Catches overlaps whose vertices all lie outside the other body (two crossing bars); an overlap that
+    no probe reaches stays undetected.  Spends at most ``budget`` triangle-point evaluations.
+    """
+    n_shells = len(starts)
+    found = np.zeros(n_shells, dtype=bool)
+    for s in np.flatnonzero(body):
+        others = np.flatnonzero(np.all(lo <= hi[s], axis=1) & np.all(hi >= lo[s], axis=1))
+        others = others[others != s]
+        if not np.any(body[others]):
+            continue
+        f = faces[order[starts[s]:starts[s] + face_count[s]]]
+        a, b, c = vertices[f[:, 0]], vertices[f[:, 1]], vertices[f[:, 2]]
+        normal = np.cross(b - a, c - a)
+        length = np.linalg.norm(normal, axis=1)
+        pick = np.argsort(-length, kind="stable")[:probes_per_shell]
+        pick = pick[length[pick] > 0]
+        outward = normal[pick] / length[pick, None] * (-1.0 if flip[s] else 1.0)
+        points = (a[pick] + b[pick] + c[pick]) / 3.0 - nudge * diag * outward
+        material = np.zeros(len(points))   # signed count of the other shells' material at each probe
+        for t in others:
+            faces_t = faces[order[starts[t]:starts[t] + face_count[t]]]
+            orient = -1.0 if flip[t] else 1.0   # cavities stay inward-wound and count negative
+            for k in np.flatnonzero(np.all((points >= lo[t]) & (points <= hi[t]), axis=1)):
+                budget -= face_count[t]
+                if budget < 0:
+                    return found
+                material[k] += orient * winding_number(points[k], vertices, faces_t)
+        found[s] = bool(np.any(material > 0.5))
+    return found
+
+
+def _check_magnitude(vertices, source: str) -> None:
+    """Refuse coordinates whose volume integrals (∝ L⁵) would overflow or underflow float64."""
+    top = float(np.max(np.abs(vertices))) if len(vertices) else 0.0
+    if not top <= MAX_COORDINATE:
+        raise InvalidMeshError(f"{source}: coordinates reach {top:.3g} m, beyond the ±{MAX_COORDINATE:g} m the "
+                               "volume integrals can hold without overflow (check --units)")
+    span = vertices.max(axis=0) - vertices.min(axis=0)
+    diag = float(np.hypot(np.hypot(span[0], span[1]), span[2]))   # no underflow in the squares
+    if 0 < diag < MIN_EXTENT:
+        raise InvalidMeshError(f"{source}: the mesh spans only {diag:.3g} m, below the {MIN_EXTENT:g} m the "
+                               "volume integrals can hold without underflow (check --units)")
+
+
+def _check_finite(props: MassProperties, source: str) -> None:
+    """Refuse a result with a non-finite number (never print inf or NaN as a mass property)."""
+    values = np.r_[props.mass, props.volume, props.center_of_mass, props.inertia.ravel(), props.surface_area]
+    if not np.all(np.isfinite(values)):
+        raise InvalidMeshError(f"{source}: the mass properties overflow or are undefined (non-finite values); "
+                               "check the coordinates' size and --units")
+
+
+def _warn_about_principal(props: MassProperties, source: str) -> None:
+    """Name the principal-axis results that are a choice (equal moments) or at round-off level (needle)."""
+    pa = props.principal
+    if len(pa.equal_pairs) >= 2:
+        warnings.warn(NearlyEqualMomentsWarning(
+            f"{source}: all three principal moments are equal within {pa.rtol:g} (relative); any axes are "
+            "principal, the ones reported are an arbitrary choice"), stacklevel=3)
+    elif pa.equal_pairs:
+        a, b = pa.equal_pairs[0]
+        warnings.warn(NearlyEqualMomentsWarning(
+            f"{source}: principal moments I{a + 1} and I{b + 1} are equal within {pa.rtol:g} (relative); the "
+            "axes in their plane are an arbitrary choice"), stacklevel=3)
+    top = float(np.max(np.abs(pa.moments)))
+    if top > 0 and pa.moments[0] <= _NEEDLE_RTOL * top:
+        digits = -np.log10(np.finfo(float).eps * top / max(abs(pa.moments[0]), np.finfo(float).tiny))
+        warnings.warn(PhysicalValidityWarning(
+            f"{source}: the smallest principal moment ({pa.moments[0]:.3g} kg·m²) is below {_NEEDLE_RTOL:g} of "
+            f"the largest (a needle); it carries only about {max(digits, 0):.0f} correct digits"), stacklevel=3)
 
 
 def prepare_mesh(raw: RawMesh, *, repair: bool = False,
@@ -190,6 +283,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
     v, f = raw.vertices, raw.faces
     if len(f) == 0:
         raise InvalidMeshError(f"{source}: the mesh has no triangles")
+    _check_magnitude(v, source)
     repeated = repeated_corner_faces(f)
     n_repeated = int(np.count_nonzero(repeated))
     if n_repeated == len(f):
@@ -211,7 +305,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
         keep = ~((f2[:, 0] == f2[:, 1]) | (f2[:, 1] == f2[:, 2]) | (f2[:, 2] == f2[:, 0]))
         f2 = f2[keep]
         topo2 = edge_topology(f2, len(v), v)
-        if topo2.closed:
+        if topo2.closed and len(f2):  # welding must not collapse the whole surface
             f, topo, welded = f2, topo2, tol
             watertight = topo.oriented
     repaired = False
@@ -232,6 +326,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
             change = f"; volume changed by {100 * volume_change:+.3g}%" if volume_change is not None else ""
             warnings.warn(MeshRepairedWarning(f"{source}: repaired: {', '.join(actions)}{change}"), stacklevel=3)
     labels, n_shells = shell_labels(f, len(v))
+    if n_shells == 0:
+        raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
     shells = body_volume_moments(v, f, labels, n_shells)
     flat = [k for k, s in enumerate(shells) if abs(s.volume) <= _FLAT_RTOL * diag ** 3]
     if flat:
@@ -249,7 +345,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
         warnings.warn(InsideOutWarning(f"{source}: {what} inside out (normals point inward); flipped"),
                       stacklevel=3)
     if overlaps:
-        warnings.warn(OverlapWarning(f"{source}: {overlaps} bod{'y lies' if overlaps == 1 else 'ies lie'} inside "
+        warnings.warn(OverlapWarning(f"{source}: {overlaps} bod{'y overlaps' if overlaps == 1 else 'ies overlap'} "
                                      "another body; the overlapping volume is counted twice"), stacklevel=3)
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
     report = MeshReport(source=source, units=raw.units, file_faces=raw.file_faces, vertices=len(v), faces=len(f),
@@ -321,6 +417,12 @@ def mass_properties(source, *, units: str = "m", density: float | None = None, m
     MeshReadError, InvalidMeshError, UsageError
     """
     rho, _ = resolve_density(density=density, material=material, mass=mass)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):   # non-finite results refused below
+        return _mass_properties(source, rho, mass, units=units, repair=repair, merge_tolerance=merge_tolerance,
+                                max_faces=max_faces, name=name)
+
+
+def _mass_properties(source, rho, mass, *, units, repair, merge_tolerance, max_faces, name) -> MassProperties:
     raw = load_mesh(source, units=units, max_faces=max_faces)
     prepared = prepare_mesh(raw, repair=repair, merge_tolerance=merge_tolerance)
     label = name or raw.source
@@ -332,7 +434,9 @@ def mass_properties(source, *, units: str = "m", density: float | None = None, m
                             parts=tuple(bodies) if len(bodies) > 1 else ())
     if rho is None:
         result = result.with_mass(mass)
+    _check_finite(result, label)
     _check_physical(result)
+    _warn_about_principal(result, label)
     return result
 
 
