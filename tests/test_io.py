@@ -156,3 +156,12 @@ def test_binary_stl_negative_zero_corner_welds_with_positive_zero(tmp_path):
     assert np.signbit(tri).any()
     raw = load_mesh(p)
     assert len(raw.vertices) == 8
+
+
+def test_3mf_through_trimesh(tmp_path):
+    m = trimesh.creation.box([10.0, 20.0, 30.0])
+    p = tmp_path / "box.3mf"
+    m.export(p)
+    raw = load_mesh(p, units="mm")
+    assert len(raw.faces) == 12
+    np.testing.assert_allclose(np.ptp(raw.vertices, axis=0), [0.01, 0.02, 0.03], rtol=1e-12)
