@@ -10,11 +10,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
 from .errors import UsageError
 from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .checks import MeshReport
 
 __all__ = ["MassProperties", "InertiaTensor", "point_mass", "combine", "parallel_axis_shift"]
 
@@ -90,7 +94,7 @@ class MassProperties:
         kg/m³: ``mass / volume`` for a homogeneous body; the mean for an assembly; ``nan`` without volume.
     name : str
         Label for reports (file name, part name); informational.
-    mesh : object, optional
+    mesh : MeshReport or None
         Mesh diagnostics (``inertia_tool.checks.MeshReport``) when the body came from a mesh.
     parts : tuple of MassProperties
         The bodies this one was combined from (disconnected shells of a mesh, parts of an assembly).
@@ -103,7 +107,7 @@ class MassProperties:
     surface_area: float = 0.0
     density: float = float("nan")
     name: str = ""
-    mesh: object = field(default=None, repr=False, compare=False)
+    mesh: Optional["MeshReport"] = field(default=None, repr=False, compare=False)
     parts: tuple = field(default=(), repr=False, compare=False)
 
     def __post_init__(self):
