@@ -66,7 +66,10 @@ def _format_warning(w: warnings.WarningMessage) -> str:
 def main(argv=None) -> int:
     """Entry point of the ``inertia-tool`` console script; returns the exit code."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:      # --help, --version, or a usage error already printed in one line
+        return int(exc.code or 0) if not isinstance(exc.code, str) else EXIT_USAGE
     debug = os.environ.get("INERTIA_TOOL_DEBUG") == "1"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", InertiaToolWarning)
