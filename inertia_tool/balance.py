@@ -547,9 +547,40 @@ def _axial_positions(values, name: str, count) -> tuple[float, ...]:
     return tuple(float(v) for v in arr)
 
 
+def _line_meets_box(point: np.ndarray, direction: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
+    """Whether the infinite line ``point + s·direction`` crosses the axis-aligned box ``[lo, hi]`` (slabs)."""
+    s_min, s_max = -np.inf, np.inf
+    for k in range(3):
+        if abs(direction[k]) < 1e-300:
+            if not lo[k] <= point[k] <= hi[k]:
+                return False
+            continue
+        a = (lo[k] - point[k]) / direction[k]
+        b = (hi[k] - point[k]) / direction[k]
+        s_min = max(s_min, min(a, b))
+        s_max = min(s_max, max(a, b))
+    return s_min <= s_max
+
+
+def _check_shaft_meets_part(props: MassProperties, frame, offset: float, k_max: float, max_axis_offset: float):
+    """Refuse a shaft that misses the part (see ``balance``'s ``max_axis_offset``)."""
+    mesh = props.mesh
+    if mesh is not None:
+        lo, hi = np.asarray(mesh.bbox_min, float), np.asarray(mesh.bbox_max, float)
+        pad = 0.01 * float(np.linalg.norm(hi - lo))
+        if not _line_meets_box(frame.origin, frame.axes[:, 2], lo - pad, hi + pad):
+            raise UsageError(f"The shaft axis does not pass through the part (it misses its bounding box "
+                             f"{np.round(lo, 6).tolist()}–{np.round(hi, 6).tolist()} m; it passes {offset:.6g} m "
+                             "from the centre of mass): check --axis-point, --axis-direction and --units")
+    elif offset > max_axis_offset * k_max:
+        raise UsageError(f"The shaft axis passes {offset:.6g} m from the centre of mass, more than "
+                         f"{max_axis_offset:g} × the largest radius of gyration ({k_max:.6g} m): expected an "
+                         "axis through the part")
+
+
 def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | None = None,
             speed: float | None = None, planes=None, radius: float, grade=None, bearings=None,
-            single_plane: bool = False, max_axis_offset: float = 1.0, offset_tol: float | None = None,
+            single_plane: bool = False, max_axis_offset: float = 10.0, offset_tol: float | None = None,
             tilt_tol: float = 1e-8) -> BalanceReport:
     """Balancing report of a rigid rotor turning about a given shaft (§4.3.2 "Tire balancing", Eq. 4.26,
     ISO 21940-2 and ISO 21940-11).
@@ -564,10 +595,10 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
         Direction of the shaft (any length), mesh axes.
     rpm, speed : float
         Service speed in rev/min **or** Ω in rad/s (exactly one; positive).
-    planes : float or sequence of 1 or 2 floats
-        Axial positions of the correction planes, m from ``axis_point`` along the shaft.  One plane means a
-        single-plane (static) correction; with ``single_plane=True`` and no ``planes`` the plane of the
-        centre of mass is used.
+    planes : sequence of 2 floats, or 1 float with ``single_plane=True``
+        Axial positions of the correction planes, m from ``axis_point`` along the shaft.  A single-plane
+        (static) correction needs ``single_plane=True``; then without ``planes`` the plane of the centre of
+        mass is used.
     radius : float
         Radius at which correction masses go, m (positive).
     grade : str, float or BalanceGrade, optional
@@ -578,8 +609,10 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
     single_plane : bool
         Static correction in one plane (narrow discs); the couple unbalance stays.
     max_axis_offset : float
-        Refuse a shaft whose distance from the centre of mass exceeds this multiple of the body's largest
-        central radius of gyration (such an axis does not pass near the part).
+        A shaft must pass through the part: when the body came from a mesh, the shaft line must cross its
+        bounding box (enlarged by 1 % of its diagonal); otherwise its distance from the centre of mass may not
+        exceed this multiple of the largest central radius of gyration.  Eccentric cams, crank arms and
+        counterweights turning about a shaft through them are accepted.
     offset_tol, tilt_tol : float
         Tolerances of the kind classification, see :func:`unbalance_state`.
 
@@ -614,19 +647,18 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
 
     state = unbalance_state(props, frame, offset_tol=offset_tol, tilt_tol=tilt_tol)
     k_max = math.sqrt(max(np.linalg.eigvalsh(props.inertia).max(), 0.0) / props.mass)
-    if state.offset > max_axis_offset * k_max:
-        raise UsageError(f"The shaft axis passes {state.offset:.6g} m from the centre of mass, more than "
-                         f"{max_axis_offset:g} × the largest radius of gyration ({k_max:.6g} m): expected an "
-                         "axis through the part (check --axis-point, --axis-direction and --units)")
+    _check_shaft_meets_part(props, frame, state.offset, k_max, max_axis_offset)
     length_scale = max(k_max, r)
     if planes is None:
         if not single_plane:
             raise UsageError("Expected two correction `planes` (or one with single_plane=True)")
         planes_t = (float(state.center_of_mass[2]),)
     else:
-        planes_t = _axial_positions(planes, "planes", (1,) if single_plane else (1, 2))
+        planes_t = _axial_positions(planes, "planes", (1, 2) if single_plane else (2,))
     if len(planes_t) == 1:
-        single_plane = True
+        pass
+    elif single_plane:
+        raise UsageError("Expected one correction plane with single_plane=True, got two")
     elif abs(planes_t[1] - planes_t[0]) <= 1e-9 * length_scale:
         raise UsageError(f"The correction planes coincide (both at {planes_t[0]:.6g} m): expected two distinct "
                          "axial positions")

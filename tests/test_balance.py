@@ -268,3 +268,32 @@ def test_corrections_move_with_the_body(rotvec, shift):
 def test_errors(disc, kw, match):
     with pytest.raises(UsageError, match=match):
         _run(disc, **kw)
+
+
+# ---- shaft through an eccentric part (review finding: cams and crank arms are normal balancing jobs) ---------
+@pytest.fixture(scope="module")
+def cam():
+    """A steel disc of radius 40 mm, 10 mm thick, centred 30 mm off the z axis (an eccentric cam), from a mesh."""
+    from inertia_tool import mass_properties
+    mesh = trimesh.creation.cylinder(radius=0.04, height=0.01, sections=64)
+    mesh.apply_translation([0.03, 0.0, 0.0])
+    return mass_properties(mesh, density=STEEL)
+
+
+def test_eccentric_cam_on_a_shaft_through_it_is_balanced(cam):
+    rep = _run(cam, planes=(-0.004, 0.004), radius=0.02)
+    assert rep.initial.kind in ("static", "quasi-static", "dynamic")
+    assert rep.initial.offset == pytest.approx(0.03, rel=1e-3)
+    np.testing.assert_allclose(rep.corrected.static_unbalance, 0, atol=1e-12 * cam.mass * 0.03)
+
+
+def test_shaft_missing_the_part_is_refused(cam):
+    with pytest.raises(UsageError, match="does not pass through the part"):
+        _run(cam, axis_point=[0.2, 0.0, 0.0], planes=(-0.004, 0.004), radius=0.02)
+
+
+def test_one_plane_needs_single_plane(disc):
+    with pytest.raises(UsageError, match="planes"):
+        _run(disc, planes=(0.01,))
+    with pytest.raises(UsageError, match="one correction plane"):
+        _run(disc, planes=(-0.01, 0.01), single_plane=True)
