@@ -160,8 +160,15 @@ class TopTrajectory:
         crossings = _upward_crossings(self.t, self.theta, 0.5 * (lo + hi))
         return float(np.diff(crossings).mean()) if len(crossings) >= 2 else math.nan
 
-    def measured_precession_rate(self) -> float:
-        """Mean precession rate ``(φ_end − φ_start)/(t_end − t_start)``, rad/s (unwrapped azimuth)."""
+    def measured_precession_rate(self, *, pole_tol: float = 1e-3) -> float:
+        """Mean precession rate ``(φ_end − φ_start)/(t_end − t_start)``, rad/s (unwrapped azimuth).
+
+        ``nan`` when the axis comes within ``pole_tol`` (in sin θ) of the vertical: the azimuth φ is undefined
+        there (a top hanging still, a pendulum swinging through the vertical) and its unwrapped jumps are
+        not a precession.
+        """
+        if float(np.min(np.abs(np.sin(self.theta)))) < pole_tol:
+            return math.nan
         return float((self.phi[-1] - self.phi[0]) / (self.t[-1] - self.t[0]))
 
 

@@ -197,3 +197,13 @@ def test_bad_arguments():
         heavy_top(-1.0, I3, M, L, theta0=0.1, omega3=1.0)
     with pytest.raises(UsageError):
         heavy_top(I1, I3, M, L, theta0=float("nan"), omega3=1.0)
+
+
+def test_precession_rate_is_undefined_when_the_axis_passes_the_vertical():
+    # a non-spinning top released at 20°: a pendulum swinging through θ = π; φ jumps by π there
+    falling = heavy_top(1e-4, 5e-5, 0.2, 0.03, theta0=math.radians(20), omega3=0.0)
+    assert math.isnan(falling.simulate(duration=1.0, samples=2001).measured_precession_rate())
+    # a fast top far from the vertical has a well-defined mean precession close to the slow steady rate
+    fast = heavy_top(1e-4, 5e-5, 0.2, 0.03, theta0=math.radians(30), omega3=600.0)
+    traj = fast.simulate(duration=2.0, samples=20001)
+    assert traj.measured_precession_rate() == pytest.approx(fast.precession_rate_slow, rel=0.02)

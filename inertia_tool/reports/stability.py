@@ -98,6 +98,12 @@ def heavy_top_dict(top: HeavyTopReport, trajectory: TopTrajectory | None = None)
     return out
 
 
+def _precession_text(rate: float) -> str:
+    if not math.isfinite(rate):
+        return "undefined (the axis passes through the vertical)"
+    return f"{rate:.6g} rad/s"
+
+
 def _deg(x: float) -> str:
     return f"{math.degrees(x):.4g}°"
 
@@ -121,7 +127,7 @@ def format_heavy_top(top: HeavyTopReport, trajectory: TopTrajectory | None = Non
                  f"{crit / (2 * math.pi):.4g} rev/s)")
     lines.append(f"  nutation: θ between {_deg(top.theta_min)} and {_deg(top.theta_max)}, "
                  f"period {_g(top.nutation_period, 6)} s")
-    kinds = {"looping": "looping (Fig. 4.3a: precession reverses at θ_max)",
+    kinds = {"looping": "looping (Fig. 4.3a: the precession has opposite signs at θ_min and θ_max)",
              "undulating": "undulating (Fig. 4.3b: precession keeps its direction)",
              "cusp": "cusps (Fig. 4.3c: precession stops at θ_min, as when released from rest)",
              "steady": "steady (no nutation)", "planar": "none (no spin and no azimuthal motion)"}
@@ -136,7 +142,7 @@ def format_heavy_top(top: HeavyTopReport, trajectory: TopTrajectory | None = Non
         drift = float(np.ptp(trajectory.energy) / max(abs(trajectory.energy).max(), 1e-300))
         lines.append(f"  simulated {trajectory.t[-1]:.4g} s: θ between {_deg(trajectory.theta.min())} and "
                      f"{_deg(trajectory.theta.max())}, nutation period {_g(measured, 6)} s, mean precession "
-                     f"{trajectory.measured_precession_rate():.6g} rad/s, energy drift {drift:.1e}")
+                     f"{_precession_text(trajectory.measured_precession_rate())}, energy drift {drift:.1e}")
     return "\n".join(lines)
 
 
