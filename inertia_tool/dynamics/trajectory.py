@@ -36,7 +36,8 @@ class Trajectory:
     energy : (N,) float
         Rotational kinetic energy ``½ ω·I·ω`` (Eq. 4.14), J.
     method : str
-        ``"exact:<case>"`` (closed form, case from ``torque_free.FREE_CASES``) or ``"numerical:gbs"``.
+        ``"exact:<case>"`` (closed form, case from ``torque_free.FREE_CASES``), ``"numerical:gbs"`` or
+        ``"splitting:<scheme>"`` (scheme from ``splitting.SCHEMES``).
     moments : (3,) float
         Principal moments used, ascending, kg·m².
     axes : (3, 3) float
