@@ -93,7 +93,7 @@ def _split(text: str, what: str) -> tuple[float, str]:
         raise UnitsError(f"Expected {what} like '12.5' or '12.5 unit', got {text!r}")
     value = float(m.group(1))
     if not math.isfinite(value):
-        raise UnitsError(f"Expected a finite {what}, got {text!r}")
+        raise UnitsError(f"Expected {what} that is a finite number, got {text!r}")
     return value, (m.group(2) or "").strip().lower()
 
 
@@ -147,7 +147,12 @@ _DENSITY = {"kg/m3": 1.0, "kg/m^3": 1.0, "g/cm3": 1000.0, "g/cm^3": 1000.0, "g/c
 
 
 def parse_density(text, default_unit: str = "kg/m3") -> float:
-    """``"7850"`` → 7850.0, ``"1.24g/cm3"`` → 1240.0 (kg/m³)."""
+    """``"7850"`` → 7850.0, ``"1.24g/cm3"`` → 1240.0, ``"7850 kg/m³"`` → 7850.0 (kg/m³).
+
+    Units: kg/m3, g/cm3 (g/cc, g/ml, kg/l), lb/in3, lb/ft3; ``³`` may stand for ``3`` or ``^3`` (the tool
+    prints densities as ``kg/m³``, so its own output reads back)."""
+    if not isinstance(text, (int, float)):
+        text = str(text).replace("³", "3")
     return _parse_with_table(text, _DENSITY, "a density", default_unit)
 
 

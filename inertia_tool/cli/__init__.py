@@ -31,8 +31,10 @@ EXIT_PHYSICS = 4
 SUBCOMMANDS = ["analyze", "balance", "spin", "top", "batch"]
 
 
-# Values such as "-40,40", "-5,0,0" or "-20deg" start with "-" but are numbers, not options.
-_NEGATIVE_VALUE = re.compile(r"^-(\d|\.\d)[\d.eE+\-,]*[a-zA-Zµ/%]*$")
+# Values such as "-40,40", "-5,0,0", "-20deg", "-2mm,0,0" or "-40mm,40mm" start with "-" but are numbers
+# (each comma-separated item a number, possibly signed, with any unit glued on), not options.  No option of
+# this tool starts with "-" and a digit, so nothing real is shadowed.
+_NEGATIVE_VALUE = re.compile(r"^-\.?\d[^\s,]*(,[-+]?\.?\d[^\s,]*)*$")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -41,9 +43,9 @@ class _Parser(argparse.ArgumentParser):
         # argparse treats "-40,40" as an option unless it matches this private pattern
         self._negative_number_matcher = _NEGATIVE_VALUE
 
-    def error(self, message):  # one line, exit code 2, as documented
-        self.print_usage(sys.stderr)
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+    def error(self, message):  # one line, exit code 2, as documented (no usage block)
+        message = " ".join(str(message).split())
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -56,6 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for name in SUBCOMMANDS:
         importlib.import_module(f"{__name__}.{name}").register(sub)
+    parser.set_defaults(_subparsers=sub.choices)
     return parser
 
 
@@ -67,10 +70,14 @@ def main(argv=None) -> int:
     """Entry point of the ``inertia-tool`` console script; returns the exit code."""
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
+        args, extra = parser.parse_known_args(argv)
+        if extra:   # reported by the subcommand's parser, so that the line names the command and its --help
+            owner = args._subparsers.get(getattr(args, "command", None), parser)
+            owner.error(f"unrecognized arguments: {' '.join(extra)}")
     except SystemExit as exc:      # --help, --version, or a usage error already printed in one line
         return int(exc.code or 0) if not isinstance(exc.code, str) else EXIT_USAGE
     debug = os.environ.get("INERTIA_TOOL_DEBUG") == "1"
+    error_line = None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", InertiaToolWarning)
         try:
@@ -78,22 +85,26 @@ def main(argv=None) -> int:
         except InertiaToolError as exc:
             if debug:
                 raise
-            print(f"inertia-tool: error: {exc}", file=sys.stderr)
+            error_line = f"inertia-tool: error: {exc}"
             code = exc.exit_code
         except KeyboardInterrupt:
             print("inertia-tool: interrupted", file=sys.stderr)
             code = 130
         except MemoryError:
-            print("inertia-tool: error: out of memory (try --max-faces or a smaller mesh)", file=sys.stderr)
+            error_line = "inertia-tool: error: out of memory (try --max-faces or a smaller mesh)"
             code = EXIT_INTERNAL
         except BrokenPipeError:
             code = EXIT_OK
         except Exception as exc:  # noqa: BLE001 - last line of defence: one line, never a traceback
             if debug:
                 raise
-            print(f"inertia-tool: internal error: {type(exc).__name__}: {exc} "
-                  "(please report it; INERTIA_TOOL_DEBUG=1 shows the traceback)", file=sys.stderr)
+            error_line = (f"inertia-tool: internal error: {type(exc).__name__}: {exc} "
+                          "(please report it; INERTIA_TOOL_DEBUG=1 shows the traceback)")
             code = EXIT_INTERNAL
+    if error_line is not None:
+        # a failed command prints one line: warnings about a result that was never produced are dropped
+        print(error_line.replace("\n", " "), file=sys.stderr)
+        return int(code)
     for w in caught:
         if issubclass(w.category, InertiaToolWarning):
             print(f"inertia-tool: {_format_warning(w)}", file=sys.stderr)

@@ -4,13 +4,14 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import sys
 import warnings
 
 from ..errors import InertiaToolWarning, PhysicsError, UsageError
 from ..io import DEFAULT_MAX_FACES
-from ..pipeline import DEFAULT_MERGE_TOLERANCE, assembly, mass_properties, resolve_density
+from ..pipeline import DEFAULT_DENSITY, DEFAULT_MERGE_TOLERANCE, assembly, mass_properties, resolve_density
 from ..properties import combine
 from ..reports.serialize import mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
@@ -24,18 +25,25 @@ from ..reports.models import format_model_note, model_summary
 from ..reports.robot import ROBOT_FORMATS, format_inertial
 from ..thinwall import printed_part, shell_mass_properties
 from ..units import parse_fraction, parse_length
-from .report_option import add_report_options, write_report_from_args
+from .report_option import add_report_options, check_report_path, write_report_from_args
 
 __all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args",
            "add_output_options", "add_model_options", "output_format", "load_model_from_args", "FORMATS"]
 
 
 def split_part_spec(spec: str) -> tuple[str, str | None]:
-    """``"lid.stl:abs"`` → ``("lid.stl", "abs")``; a path that exists as given is never split."""
-    if os.path.exists(spec) or ":" not in spec:
+    """``"lid.stl:abs"`` → ``("lid.stl", "abs")``, ``"lid.stl:1.24g/cm3"`` → ``("lid.stl", "1.24g/cm3")``.
+
+    A path that exists as given is never split.  Otherwise the split is at the last ``:`` whatever follows it
+    (a density unit may contain ``/``), except after a lone drive letter (``C:\\parts\\a.stl``, ``C:/a.stl``):
+    that is a Windows path, reported as missing by the reader.
+    """
+    if ":" not in spec or os.path.exists(spec):
         return spec, None
     path, _, what = spec.rpartition(":")
-    if not path or os.sep in what or "/" in what:
+    if not path or not what.strip():
+        return spec, None
+    if len(path) == 1 and path.isalpha() and what[:1] in ("\\", "/"):
         return spec, None
     return path, what
 
@@ -71,8 +79,25 @@ def _part_density(what: str) -> dict:
         return {"material": what}
 
 
+def check_mesh_options(args) -> None:
+    """Refuse a negative or non-finite ``--merge-tolerance`` and a non-positive ``--max-faces`` (exit 2)."""
+    tol = getattr(args, "merge_tolerance", 0.0)
+    if not (math.isfinite(tol) and tol >= 0):
+        raise UsageError(f"--merge-tolerance must be a finite number >= 0 (0 turns tolerant welding off), "
+                         f"got {tol:g}")
+    faces = getattr(args, "max_faces", 1)
+    if faces < 1:
+        raise UsageError(f"--max-faces must be at least 1, got {faces}")
+
+
 def load_from_args(args):
-    """Mass properties of the ``files`` in ``args`` (one part or an assembly) and the density description."""
+    """Mass properties of the ``files`` in ``args`` (one part or an assembly) and the density description.
+
+    In an assembly, a global ``--density``/``--material`` is the default of the parts named without their own
+    ``:material`` or ``:density`` (the description says so); when every part has its own, a global one would
+    be ignored and is refused as contradictory (:class:`UsageError`).
+    """
+    check_mesh_options(args)
     density = parse_density(args.density) if args.density is not None else None
     mass = parse_mass(args.mass) if args.mass is not None else None
     options = dict(repair=args.repair, merge_tolerance=args.merge_tolerance, max_faces=args.max_faces)
@@ -83,20 +108,35 @@ def load_from_args(args):
         props = mass_properties(specs[0][0], units=args.units, density=density, material=args.material,
                                 mass=mass, **options)
         return props, described
-    parts = []
+    default = None
+    if density is not None or args.material is not None:
+        option = f"--density {args.density}" if density is not None else f"--material {args.material}"
+        if all(what is not None for _, what in specs):
+            raise UsageError(f"{option} would apply to no part: every FILE has its own :material or :density "
+                             "(drop the option, or name a part without its own to give it this default)")
+        default, default_text = resolve_density(density=density, material=args.material)
+    parts, own = [], []
     for path, what in specs:
         if what is not None:
             parts.append({"source": path, **_part_density(what)})
-        elif density is not None or args.material is not None:
-            parts.append({"source": path, "density": density, "material": args.material})
+            own.append(what)
+        elif density is not None:
+            parts.append({"source": path, "density": density})
+        elif args.material is not None:
+            parts.append({"source": path, "material": args.material})
         else:
             parts.append({"source": path})
-    for p in parts:
-        for k in ("density", "material"):
-            if k in p and p[k] is None:
-                del p[k]
     props = assembly(parts, units=args.units, mass=mass, **options)
-    described = "per part" + (f", scaled to a total mass of {mass:g} kg" if mass is not None else "")
+    if len(specs) == 1:
+        described = resolve_density(**_part_density(own[0]))[1]
+    else:
+        described = "per part"
+        if default is not None:
+            described += f"; {default_text} for the parts without their own"
+        elif len(own) < len(specs):
+            described += f"; {DEFAULT_DENSITY:g} kg/m³ (water) for the parts without their own"
+    if mass is not None:
+        described += f", scaled to a total mass of {mass:g} kg"
     return props, described
 
 
@@ -118,6 +158,7 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     fmt = output_format(args)
+    check_report_path(args)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", InertiaToolWarning)
         props, described, model = load_model_from_args(args)
@@ -135,10 +176,10 @@ def run(args) -> int:
         json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     elif fmt in ROBOT_FORMATS:
-        frame = inertial_frame(props, args.frame)
+        frame = inertial_frame(props, args.frame or "principal")
         print(format_inertial(frame, fmt, source=f"{props.name}: {described}{_model_words(model)}"))
     elif fmt == "cad":
-        print(format_cad_report(props, units=args.cad_units, density_source=described))
+        print(format_cad_report(props, units=args.cad_units or "kg-m", density_source=described))
         note = format_model_note(model)
         if note:
             print("\n" + note.strip())
@@ -171,10 +212,10 @@ def add_output_options(parser) -> None:
     g.add_argument("--format", choices=FORMATS, default=None,
                    help="text report (default), json, an <inertial> block for urdf, sdf or mjcf (MuJoCo), "
                         "or cad: a SolidWorks-style mass properties report (positive tensor notation)")
-    g.add_argument("--frame", choices=FRAMES, default="principal",
+    g.add_argument("--frame", choices=FRAMES, default=None,
                    help="inertial frame of urdf/sdf/mjcf: principal axes with a diagonal tensor (default) or "
                         "mesh-aligned axes with the full tensor")
-    g.add_argument("--cad-units", choices=tuple(CAD_UNITS), default="kg-m",
+    g.add_argument("--cad-units", choices=tuple(CAD_UNITS), default=None,
                    help="display units of --format cad (default kg-m; g-mm is SolidWorks' default)")
 
 
@@ -191,13 +232,22 @@ def add_model_options(parser) -> None:
 
 
 def output_format(args) -> str:
-    """The requested output format; ``--json`` is an alias of ``--format json``."""
+    """The requested output format; ``--json`` is an alias of ``--format json``.
+
+    ``--frame`` only means something to urdf/sdf/mjcf and ``--cad-units`` to cad: given with another format
+    they would be ignored, so they are refused (:class:`UsageError`).
+    """
     fmt = getattr(args, "format", None)
     if getattr(args, "json", False):
         if fmt not in (None, "json"):
             raise UsageError(f"--json contradicts --format {fmt}; give one of them")
-        return "json"
-    return fmt or "text"
+        fmt = "json"
+    fmt = fmt or "text"
+    if getattr(args, "frame", None) is not None and fmt not in ROBOT_FORMATS:
+        raise UsageError(f"--frame applies to --format {', '.join(ROBOT_FORMATS)} only, not to {fmt} output")
+    if getattr(args, "cad_units", None) is not None and fmt != "cad":
+        raise UsageError(f"--cad-units applies to --format cad only, not to {fmt} output")
+    return fmt
 
 
 def load_model_from_args(args):
@@ -215,6 +265,7 @@ def load_model_from_args(args):
         raise UsageError("--model shell needs --thickness (e.g. --thickness 2mm)")
     if model == "shell" and skin is not None:
         raise UsageError("--model shell takes --thickness; --shell/--infill describe a printed solid")
+    check_mesh_options(args)
     if model == "solid" and skin is None:
         props, described = load_from_args(args)
         return props, described, model_summary("solid")

@@ -16,7 +16,7 @@ from ..batch import BatchOptions, discover_files, run_batch
 from ..errors import UsageError
 from ..reports.rows import open_results, results_format
 from ..units import parse_density, parse_mass
-from .analyze import add_material_options, add_mesh_options
+from .analyze import add_material_options, add_mesh_options, check_mesh_options
 
 __all__ = ["register", "run", "Progress", "dask_executor"]
 
@@ -127,6 +127,7 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     results_format(args.out)                      # a bad suffix is a usage error before any work
+    check_mesh_options(args)
     options = BatchOptions(units=args.units,
                            density=parse_density(args.density) if args.density is not None else None,
                            material=args.material,

@@ -8,10 +8,14 @@ from __future__ import annotations
 
 import os
 
+from ..errors import UsageError
 from ..io import load_mesh
 from ..reports.html import html_report, write_html_report
 
-__all__ = ["add_report_options", "write_report_from_args"]
+__all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES"]
+
+#: Suffixes of ``--report`` (the only writer here is HTML).
+REPORT_SUFFIXES = (".html", ".htm")
 
 
 def add_report_options(parser) -> None:
@@ -23,12 +27,24 @@ def add_report_options(parser) -> None:
     g.add_argument("--force", action="store_true", help="let --report replace an existing file")
 
 
+def check_report_path(args) -> None:
+    """Refuse, before any work, a ``--report`` that is not ``*.html``/``*.htm`` or that exists without
+    ``--force`` (:class:`UsageError`, exit 2)."""
+    path = getattr(args, "report", None)
+    if not path:
+        return
+    if os.path.splitext(path)[1].lower() not in REPORT_SUFFIXES:
+        raise UsageError(f"--report writes HTML: expected a file name ending in "
+                         f"{' or '.join(REPORT_SUFFIXES)}, got {path!r}")
+    if os.path.exists(path) and not getattr(args, "force", False):
+        raise UsageError(f"{path}: exists; refusing to overwrite it (use --force)")
+
+
 def write_report_from_args(args, props, density_source: str | None, warnings=()) -> None:
     """Write the HTML report asked for by ``args.report`` (no-op without it)."""
     if not getattr(args, "report", None):
         return
-    if os.path.exists(args.report) and not args.force:   # refuse before re-reading meshes
-        write_html_report(args.report, "", force=False)
+    check_report_path(args)   # refuse before re-reading meshes
     from .analyze import split_part_spec
     files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
     meshes = []

@@ -193,20 +193,30 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30) -> Result
         size = os.path.getsize(path)
         if size > max_bytes:
             raise UsageError(f"{path}: {size:,} bytes, more than the {max_bytes:,} a results file may have here")
-        with open(path, "rb") as existing:
-            data = existing.read()
+        try:
+            with open(path, "rb") as existing:
+                data = existing.read()
+        except OSError as exc:
+            raise UsageError(f"{path}: cannot read the results file ({exc.strerror or exc})") from None
     lines, keep, torn = _complete_lines(path, data, fmt)
     rows = _parse_jsonl(lines, path) if fmt == "jsonl" else _parse_csv(lines, path)
     if fmt == "csv" and data and not lines:
         # only a torn header: nothing of ours to keep, but it must look like the start of our header
         if not ",".join(ROW_FIELDS).encode().startswith(data.strip()):
             raise UsageError(f"{path}: not a results file of inertia-tool batch; refusing to append to it")
-    fh: BinaryIO = open(path, "r+b" if data else "wb")
-    if torn:
-        fh.truncate(keep)
-    fh.seek(keep)
-    if fmt == "csv" and keep == 0:
-        fh.write((",".join(ROW_FIELDS) + "\n").encode())
-        fh.flush()
-        os.fsync(fh.fileno())
+    try:
+        fh: BinaryIO = open(path, "r+b" if data else "wb")
+    except OSError as exc:
+        raise UsageError(f"{path}: cannot write the results file ({exc.strerror or exc})") from None
+    try:
+        if torn:
+            fh.truncate(keep)
+        fh.seek(keep)
+        if fmt == "csv" and keep == 0:
+            fh.write((",".join(ROW_FIELDS) + "\n").encode())
+            fh.flush()
+            os.fsync(fh.fileno())
+    except OSError as exc:
+        fh.close()
+        raise UsageError(f"{path}: cannot write the results file ({exc.strerror or exc})") from None
     return ResultsFile(path=path, format=fmt, previous_rows=rows, repaired_tail=torn, _fh=fh)
