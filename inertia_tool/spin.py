@@ -16,10 +16,14 @@ from .errors import UsageError
 from .stability import AxisStability, StabilityReport, polhode_period, stability
 from .principal import DEFAULT_EQUAL_RTOL
 
-__all__ = ["SpinExperiment", "spin_experiment", "SAMPLES_PER_TURN"]
+__all__ = ["SpinExperiment", "spin_experiment", "SAMPLES_PER_TURN", "MIN_SAMPLES_PER_PERIOD"]
 
 #: Default sampling density of the simulated trajectory (samples per revolution of the spin).
 SAMPLES_PER_TURN = 64
+
+#: Fewest samples per predicted flip interval or wobble period for the measured one to mean anything
+#: (below a few per period sign changes alias and the "measured" period is wrong without any sign of it).
+MIN_SAMPLES_PER_PERIOD = 16
 
 
 @dataclass(frozen=True)
@@ -97,7 +101,8 @@ def _crossings(t: np.ndarray, y: np.ndarray, *, upward_only: bool) -> np.ndarray
 
 def spin_experiment(props, about, rate: float, *, perturbation: float = 1e-3, duration: float = 30.0,
                     samples: int | None = None, rtol: float = DEFAULT_EQUAL_RTOL, method: str = "auto",
-                    max_samples: int = 400_001) -> SpinExperiment:
+                    max_samples: int = 400_001,
+                    min_samples_per_period: float = MIN_SAMPLES_PER_PERIOD) -> SpinExperiment:
     """Spin ``props`` about a principal axis, predict the flip or wobble period and simulate it.
 
     Parameters
@@ -121,6 +126,9 @@ def spin_experiment(props, about, rate: float, *, perturbation: float = 1e-3, du
         independent numerical integration).
     max_samples : int
         Upper bound on the number of samples.
+    min_samples_per_period : float
+        Refuse (:class:`UsageError`) a sampling with fewer samples per predicted period (flip interval or
+        wobble period): the measured period would alias to a wrong value.
 
     Returns
     -------
@@ -147,11 +155,23 @@ def spin_experiment(props, about, rate: float, *, perturbation: float = 1e-3, du
     n = samples if samples is not None else int(min(max(2001, math.ceil(turns * SAMPLES_PER_TURN) + 1), max_samples))
     if not 2 <= n <= max_samples:
         raise UsageError(f"Expected 2 <= samples <= {max_samples}, got {n}")
+    polhode = polhode_period(report.moments, w_principal)
+    if entry.kind != "neutral":
+        period = polhode if entry.kind == "stable" else polhode / 2.0
+        per_period = (n - 1) * period / duration
+        if math.isfinite(period) and per_period < min_samples_per_period:
+            what = "wobble period" if entry.kind == "stable" else "flip interval"
+            longest = (n - 1) * period / min_samples_per_period
+            need = math.ceil(min_samples_per_period * duration / period) + 1
+            raise UsageError(
+                f"Undersampled: {n} samples over {duration:g} s are {per_period:.3g} per predicted {what} of "
+                f"{period:.6g} s, fewer than the {min_samples_per_period:g} needed to measure it (the result "
+                f"would alias): shorten the duration to at most {longest:.6g} s (--duration) or use at least "
+                f"{need} samples (--samples{f', at most {max_samples}' if need > max_samples else ''})")
     t = np.linspace(0.0, duration, n)
     traj = simulate(props, w_mesh, t, method=method)
 
     omega_p = np.asarray(traj.angular_velocity) @ axes       # components along the classified axes
-    polhode = polhode_period(report.moments, w_principal)
     linear_period = None
     time_to_grow = None
     first_flip = None

@@ -119,7 +119,7 @@ def test_top_sleeping_criterion_and_asymmetric_warning(capsys):
     (["spin", T_HANDLE, "--perturbation", "0"], 2, "perturbation"),
     (["top", TOP, "--units", "mm", "--pivot", "1,2", "--spin", "5rev/s"], 2, "three comma-separated"),
     (["top", T_HANDLE, "--units", "mm", "--pivot", "0,0,35", "--spin", "5rev/s"], 4, "centre of mass"),
-    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "5rev/s", "--tilt", "200deg"], 2, "theta0"),
+    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "5rev/s", "--tilt", "200deg"], 2, "--tilt must be between 0 and 180 deg"),
 ])
 def test_bad_input_exit_codes(capsys, argv, code, message):
     assert main(argv) == code

@@ -14,6 +14,7 @@ from ..errors import UsageError
 from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length
 from .analyze import add_material_options, add_mesh_options, load_from_args
+from .report_option import check_output_file
 
 __all__ = ["register", "run"]
 
@@ -84,8 +85,11 @@ def run(args) -> int:
         direction = []
     if len(direction) != 3:
         raise UsageError(f"Expected --axis-direction to be 3 comma-separated numbers, got {args.axis_direction!r}")
+    if args.planes is not None and not args.single_plane and len(str(args.planes).replace(";", ",").split(",")) == 1:
+        raise UsageError(f"--planes {args.planes} is one plane: a two-plane (static and couple) correction needs "
+                         "two, --planes Z1,Z2; for a static-only correction in one plane add --single-plane")
     planes = None if args.planes is None else _lengths(args.planes, unit, "planes",
-                                                       (1,) if args.single_plane else (1, 2))
+                                                       (1,) if args.single_plane else (2,))
     if planes is None and not args.single_plane:
         raise UsageError("Expected --planes Z1,Z2 (or --single-plane)")
     bearings = None if args.bearings is None else _lengths(args.bearings, unit, "bearings", (2,))
@@ -95,8 +99,7 @@ def run(args) -> int:
         raise UsageError(f"Expected a positive --rpm (the service speed), got {args.rpm!r}")
     if args.report is not None:
         _report_paths(args.report, 0)
-        if os.path.exists(args.report) and not args.force:
-            raise UsageError(f"{args.report} exists; use --force to overwrite it")
+        check_output_file(args.report, "--report", args.force)
 
     props, _ = load_from_args(args)
     report = balance(props, axis_point=axis_point, axis_direction=direction, speed=speed, planes=planes,

@@ -12,7 +12,8 @@ from ..errors import UsageError
 from ..io import load_mesh
 from ..reports.html import html_report, write_html_report
 
-__all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES"]
+__all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES",
+           "check_output_file"]
 
 #: Suffixes of ``--report`` (the only writer here is HTML).
 REPORT_SUFFIXES = (".html", ".htm")
@@ -27,6 +28,20 @@ def add_report_options(parser) -> None:
     g.add_argument("--force", action="store_true", help="let --report replace an existing file")
 
 
+def check_output_file(path: str | None, option: str, force: bool) -> None:
+    """The rule of every file this command line writes: refuse (:class:`UsageError`, exit 2), before any work,
+    to replace an existing file without ``--force``, to write over a directory, or into a missing directory."""
+    if not path:
+        return
+    if os.path.isdir(path):
+        raise UsageError(f"{option} {path}: is a directory")
+    if os.path.exists(path) and not force:
+        raise UsageError(f"{option} {path}: exists; refusing to overwrite it (use --force)")
+    parent = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(parent):
+        raise UsageError(f"{option} {path}: cannot write it (no such directory: {parent})")
+
+
 def check_report_path(args) -> None:
     """Refuse, before any work, a ``--report`` that is not ``*.html``/``*.htm`` or that exists without
     ``--force`` (:class:`UsageError`, exit 2)."""
@@ -36,8 +51,7 @@ def check_report_path(args) -> None:
     if os.path.splitext(path)[1].lower() not in REPORT_SUFFIXES:
         raise UsageError(f"--report writes HTML: expected a file name ending in "
                          f"{' or '.join(REPORT_SUFFIXES)}, got {path!r}")
-    if os.path.exists(path) and not getattr(args, "force", False):
-        raise UsageError(f"{path}: exists; refusing to overwrite it (use --force)")
+    check_output_file(path, "--report", getattr(args, "force", False))
 
 
 def write_report_from_args(args, props, density_source: str | None, warnings=()) -> None:

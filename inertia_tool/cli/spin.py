@@ -14,9 +14,15 @@ from ..reports.serialize import to_jsonable
 from ..spin import spin_experiment
 from ..stability import AXIS_NAMES
 from ..units import parse_angular_rate, parse_duration
+from ..principal import DEFAULT_EQUAL_RTOL
 from .analyze import add_material_options, add_mesh_options, load_from_args
+from .options import require_range
+from .report_option import check_output_file
 
-__all__ = ["register", "run"]
+__all__ = ["register", "run", "MAX_SAMPLES"]
+
+#: Most samples of the simulated trajectory (bounds memory and time).
+MAX_SAMPLES = 400_001
 
 
 def register(subparsers) -> None:
@@ -33,17 +39,20 @@ def register(subparsers) -> None:
     p.add_argument("--rate", default="5rev/s", metavar="RATE",
                    help="spin rate: rad/s, rev/s, Hz, rpm, deg/s (default 5rev/s)")
     p.add_argument("--perturbation", type=float, default=1e-3, metavar="EPS",
-                   help="relative transverse angular velocity added on each other principal axis (default 1e-3)")
+                   help="relative transverse angular velocity added on each other principal axis, "
+                        "0 < EPS < 1 (default 1e-3)")
     p.add_argument("--duration", default="30s", metavar="TIME", help="simulated time: s, ms, min (default 30s)")
     p.add_argument("--samples", type=int, default=None, metavar="N",
-                   help="samples of the simulated trajectory (default 64 per turn, at least 2001)")
+                   help="samples of the simulated trajectory (default 64 per turn, at least 2001, at most "
+                        f"{MAX_SAMPLES}; at least 16 per predicted period)")
     p.add_argument("--method", choices=("auto", "exact", "numerical"), default="auto",
                    help="simulation: closed form (auto/exact) or numerical integration (default auto)")
-    p.add_argument("--rtol", type=float, default=1e-6, metavar="REL",
-                   help="relative tolerance for equal moments (default 1e-6 of the largest)")
+    p.add_argument("--rtol", type=float, default=DEFAULT_EQUAL_RTOL, metavar="REL",
+                   help=f"relative tolerance for equal moments (default {DEFAULT_EQUAL_RTOL:g} of the largest)")
     p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of text")
     p.add_argument("--csv", metavar="OUT.csv", help="write the simulated trajectory as CSV")
     p.add_argument("--plot", metavar="OUT.png", help="plot the simulated angular velocity (needs matplotlib)")
+    p.add_argument("--force", action="store_true", help="let --csv and --plot replace existing files")
     p.set_defaults(func=run)
 
 
@@ -84,11 +93,18 @@ def _plot(path: str, experiment) -> None:
 
 
 def run(args) -> int:
+    require_range(args.perturbation, "--perturbation", low=0, high=1, low_open=True, high_open=True)
+    require_range(args.rtol, "--rtol", low=0, high=1, high_open=True)
+    if args.samples is not None and not 2 <= args.samples <= MAX_SAMPLES:
+        raise UsageError(f"--samples must be between 2 and {MAX_SAMPLES}, got {args.samples}")
+    rate = require_range(parse_angular_rate(args.rate), "--rate", low=0, low_open=True, typed=args.rate)
+    duration = require_range(parse_duration(args.duration), "--duration", low=0, low_open=True,
+                             typed=args.duration)
+    check_output_file(args.csv, "--csv", args.force)
+    check_output_file(args.plot, "--plot", args.force)
     props, described = load_from_args(args)
-    rate = parse_angular_rate(args.rate)
-    duration = parse_duration(args.duration)
     experiment = spin_experiment(props, args.about, rate, perturbation=args.perturbation, duration=duration,
-                                 samples=args.samples, rtol=args.rtol, method=args.method)
+                                 samples=args.samples, rtol=args.rtol, method=args.method, max_samples=MAX_SAMPLES)
     if args.csv:
         _write_csv(args.csv, experiment.trajectory)
     if args.plot:

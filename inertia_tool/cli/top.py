@@ -14,11 +14,20 @@ from ..reports.stability import format_heavy_top, heavy_top_dict
 from ..reports.serialize import to_jsonable
 from ..units import parse_angle, parse_angular_rate, parse_duration, parse_vector
 from .analyze import add_material_options, add_mesh_options, load_from_args
+from .options import require_range
+from .report_option import check_output_file
 
-__all__ = ["register", "run"]
+__all__ = ["register", "run", "MAX_SAMPLES", "MIN_SAMPLES_PER_PERIOD"]
 
 #: Simulated nutation periods when ``--duration`` is not given.
 DEFAULT_PERIODS = 5
+
+#: Most samples of the simulated trajectory (bounds memory).
+MAX_SAMPLES = 400_001
+
+#: Fewest samples per nutation period (or per turn of the spin when there is no nutation) of a simulation:
+#: fewer alias the measured period, and bound the integrator's work (its steps follow the fastest motion).
+MIN_SAMPLES_PER_PERIOD = 16
 
 
 def register(subparsers) -> None:
@@ -44,11 +53,14 @@ def register(subparsers) -> None:
                    help="relative tolerance for the two transverse moments about the pivot (default 1e-3)")
     p.add_argument("--duration", default=None, metavar="TIME",
                    help=f"simulated time (default {DEFAULT_PERIODS} nutation periods, at most 10 s)")
-    p.add_argument("--samples", type=int, default=4001, metavar="N", help="simulation samples (default 4001)")
+    p.add_argument("--samples", type=int, default=4001, metavar="N",
+                   help=f"simulation samples (default 4001, at most {MAX_SAMPLES}, at least "
+                        f"{MIN_SAMPLES_PER_PERIOD} per nutation period)")
     p.add_argument("--no-simulate", action="store_true", help="analysis only")
     p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of text")
     p.add_argument("--csv", metavar="OUT.csv", help="write the simulated axis path as CSV")
     p.add_argument("--plot", metavar="OUT.png", help="plot θ(t) and the path of the axis (needs matplotlib)")
+    p.add_argument("--force", action="store_true", help="let --csv and --plot replace existing files")
     p.set_defaults(func=run)
 
 
@@ -89,24 +101,54 @@ def _plot(path: str, top, traj) -> None:
         plt.close(fig)
 
 
+def _check_sampling(top, duration: float, samples: int) -> None:
+    """Refuse a simulation with fewer than :data:`MIN_SAMPLES_PER_PERIOD` samples per nutation period (per
+    turn of the spin when the nutation period is not finite)."""
+    period, what = top.nutation_period, "nutation period"
+    if not (math.isfinite(period) and period > 0):
+        period, what = (2 * math.pi / abs(top.omega3), "turn of the spin") if top.omega3 else (math.inf, "")
+    per_period = (samples - 1) * period / duration
+    if math.isfinite(period) and per_period < MIN_SAMPLES_PER_PERIOD:
+        longest = (samples - 1) * period / MIN_SAMPLES_PER_PERIOD
+        need = math.ceil(MIN_SAMPLES_PER_PERIOD * duration / period) + 1
+        raise UsageError(f"Undersampled: {samples} samples over {duration:g} s are {per_period:.3g} per {what} "
+                         f"({period:.6g} s), fewer than the {MIN_SAMPLES_PER_PERIOD} needed: shorten --duration to "
+                         f"at most {longest:.6g} s or use at least {need} --samples"
+                         + (f" (at most {MAX_SAMPLES})" if need > MAX_SAMPLES else ""))
+
+
 def run(args) -> int:
+    tilt = parse_angle(args.tilt, default_unit="deg")
+    if not (math.isfinite(tilt) and 0.0 <= tilt <= math.pi):
+        raise UsageError(f"--tilt must be between 0 and 180 deg (0 and π rad) from the vertical, got {args.tilt} "
+                         f"(= {math.degrees(tilt):.6g} deg)")
+    require_range(args.gravity, "--gravity", low=0, low_open=True, unit="m/s²")
+    require_range(args.symmetry_rtol, "--symmetry-rtol", low=0, high=1, high_open=True)
+    if not 2 <= args.samples <= MAX_SAMPLES:
+        raise UsageError(f"--samples must be between 2 and {MAX_SAMPLES}, got {args.samples}")
+    duration = None
+    if args.duration is not None:
+        duration = require_range(parse_duration(args.duration), "--duration", low=0, low_open=True,
+                                 typed=args.duration)
+    if args.no_simulate and (args.csv or args.plot):
+        raise UsageError("--csv and --plot need the simulation (drop --no-simulate)")
+    check_output_file(args.csv, "--csv", args.force)
+    check_output_file(args.plot, "--plot", args.force)
     props, described = load_from_args(args)
     pivot = np.array(parse_vector(args.pivot, default_unit=args.units))
-    top = heavy_top_from_mesh(props, pivot, theta0=parse_angle(args.tilt, default_unit="deg"),
+    top = heavy_top_from_mesh(props, pivot, theta0=tilt,
                               omega3=parse_angular_rate(args.spin),
                               theta_dot0=parse_angular_rate(args.nutation),
                               phi_dot0=parse_angular_rate(args.precession), g=args.gravity, rtol=args.symmetry_rtol)
     traj = None
     if not args.no_simulate:
-        if args.duration is not None:
-            duration = parse_duration(args.duration)
+        if duration is not None:
+            _check_sampling(top, duration, args.samples)
         elif math.isfinite(top.nutation_period):
             duration = min(DEFAULT_PERIODS * top.nutation_period, 10.0)
         else:
             duration = 10.0
         traj = top.simulate(duration, samples=args.samples)
-    elif args.csv or args.plot:
-        raise UsageError("--csv and --plot need the simulation (drop --no-simulate)")
     if args.csv:
         _write_csv(args.csv, traj)
     if args.plot:

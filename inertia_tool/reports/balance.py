@@ -128,7 +128,9 @@ def balance_dict(report: BalanceReport) -> dict:
                          "position": c.position, "removal_angle": c.removal_angle,
                          "removal_position": c.removal_position} for c in report.corrections],
         "verification": {**_state_dict(report.corrected), "achieved_value": report.corrected_value,
-                         "achieved_grade": None if report.corrected_grade is None else report.corrected_grade.name},
+                         "achieved_grade": None if report.corrected_grade is None else report.corrected_grade.name,
+                         "couple_corrected": not _couple_left(report),
+                         "summary": _verification_text(report)},
         "notes": list(report.notes),
     })
 
@@ -193,10 +195,22 @@ _CORR_HEAD = ["plane", "z [mm]", "unbalance [g·mm]", "at [°]", "add [g]", "rad
               "or remove at [°]", "add position (mesh, mm)"]
 
 
+def _couple_left(report: BalanceReport) -> bool:
+    """A single-plane (static) correction that leaves a couple unbalance (ISO 21940-2 kind not balanced/static)."""
+    return report.single_plane and report.corrected.kind not in ("balanced", "static")
+
+
 def _verification_text(report: BalanceReport) -> str:
     v = report.corrected
-    return (f"static {_num(_mag(v.static_unbalance) * _G_MM)} g·mm, couple {_num(_mag(v.couple_unbalance) * _G_MM2)} "
-            f"g·mm², kind {v.kind}, meets {_grade_name(report.corrected_grade, report.corrected_value)}")
+    head = (f"static {_num(_mag(v.static_unbalance) * _G_MM)} g·mm, couple {_num(_mag(v.couple_unbalance) * _G_MM2)} "
+            f"g·mm², kind {v.kind}")
+    if _couple_left(report):
+        bearings = len(report.tolerance_planes) == 2   # the bearing check includes the couple
+        where = (f"; at the bearings it meets {_grade_name(report.corrected_grade, report.corrected_value)}"
+                 if bearings else "")
+        return (f"{head}, couple not corrected (a single-plane correction removes the static unbalance only; "
+                f"two --planes correct both){where}")
+    return f"{head}, meets {_grade_name(report.corrected_grade, report.corrected_value)}"
 
 
 def _header(report: BalanceReport) -> list[tuple[str, str]]:

@@ -32,6 +32,13 @@ def _g(x, digits: int = 4) -> str:
     return f"{x:.{digits}g}"
 
 
+def _period(x, none: str, digits: int = 6) -> str:
+    """``"0.0219 s"``, or ``none`` when the period is infinite or undefined (nothing recurs / not seen)."""
+    if x is None or not math.isfinite(x):
+        return none
+    return f"{x:.{digits}g} s"
+
+
 def _vec(v) -> str:
     v = np.asarray(v, dtype=float)
     v = np.where(np.abs(v) <= 1e-12 * max(np.max(np.abs(v)), 1e-300), 0.0, v) + 0.0
@@ -126,7 +133,8 @@ def format_heavy_top(top: HeavyTopReport, trajectory: TopTrajectory | None = Non
                  f"I3²ω3²/(4 I1 M g l) = {top.sleeping_margin:.4g} (needs > 1: spin above {crit:.4g} rad/s = "
                  f"{crit / (2 * math.pi):.4g} rev/s)")
     lines.append(f"  nutation: θ between {_deg(top.theta_min)} and {_deg(top.theta_max)}, "
-                 f"period {_g(top.nutation_period, 6)} s")
+                 + ("period " + _period(top.nutation_period, "") if math.isfinite(top.nutation_period)
+                    else "no nutation period (θ never returns)"))
     kinds = {"looping": "looping (Fig. 4.3a: the precession has opposite signs at θ_min and θ_max)",
              "undulating": "undulating (Fig. 4.3b: precession keeps its direction)",
              "cusp": "cusps (Fig. 4.3c: precession stops at θ_min, as when released from rest)",
@@ -141,7 +149,9 @@ def format_heavy_top(top: HeavyTopReport, trajectory: TopTrajectory | None = Non
         measured = trajectory.measured_nutation_period()
         drift = float(np.ptp(trajectory.energy) / max(abs(trajectory.energy).max(), 1e-300))
         lines.append(f"  simulated {trajectory.t[-1]:.4g} s: θ between {_deg(trajectory.theta.min())} and "
-                     f"{_deg(trajectory.theta.max())}, nutation period {_g(measured, 6)} s, mean precession "
+                     f"{_deg(trajectory.theta.max())}, "
+                     + (f"nutation period {measured:.6g} s" if math.isfinite(measured)
+                        else "no nutation period seen within the simulated time") + ", mean precession "
                      f"{_precession_text(trajectory.measured_precession_rate())}, energy drift {drift:.1e}")
     return "\n".join(lines)
 
@@ -196,9 +206,18 @@ def format_spin(experiment, *, name: str = "") -> str:
     elif a.kind in ("unstable", "marginal"):
         lines.append(f"  predicted (linear): the {e.perturbation:g} wobble reaches order one after "
                      f"{_g(e.predicted_time_to_grow, 6)} s ({_g(a.turns_to_grow(e.perturbation, 1.0))} turns)")
-    lines.append(f"  predicted (exact, Landau–Lifshitz §37): {what} {_g(e.predicted_period, 6)} s")
+    lines.append(f"  predicted (exact, Landau–Lifshitz §37): "
+                 + (f"{what} {_period(e.predicted_period, '')}" if math.isfinite(e.predicted_period)
+                    else "nothing recurs (no flip, no wobble)"))
+    event = "flip" if e.period_kind == "flip" else "upward crossing"
+    if math.isfinite(e.measured_period):
+        seen = f"{what} {e.measured_period:.6g} s from {e.measured_events} events"
+    elif e.measured_events == 1:
+        seen = f"one {event} only, no {what} within the simulated time (two are needed)"
+    else:
+        seen = f"no {event} within the simulated time, so no {what}"
     lines.append(f"  simulated {e.trajectory.t[-1]:.4g} s ({e.trajectory.method}, {len(e.trajectory.t)} samples): "
-                 f"{what} {_g(e.measured_period, 6)} s from {e.measured_events} events; largest tilt of the "
+                 f"{seen}; largest tilt of the "
                  f"spin axis {math.degrees(e.max_tilt):.3g}°; energy drift {e.energy_drift:.1e}")
     if e.period_kind == "flip":
         lines.append(f"  first flip after {_g(e.first_flip_time, 6)} s" if e.first_flip_time is not None
