@@ -139,3 +139,40 @@ def test_wheel_sample_matches_its_generator(wheel):
     assert wheel.mesh.bodies == 2
     lump = 7850 * np.prod(LUMP_SIZE) * 1e-9
     assert lump == pytest.approx(0.0374, abs=1e-4)                   # the README's "37 g lump"
+
+
+# -- one plane needs --single-plane; a single-plane correction says the couple is left ------------------------
+
+SHAFT = ["balance", WHEEL, "--units", "mm", "--material", "steel", "--rpm", "3000", "--radius", "150",
+         "--grade", "G6.3"]
+
+
+def test_one_plane_without_single_plane_is_a_usage_error(capsys):
+    assert main(SHAFT + ["--planes", "-40mm"]) == 2
+    err = capsys.readouterr().err
+    assert "--single-plane" in err and "two" in err and err.count("\n") == 1
+    assert main(SHAFT + ["--planes", "-40,0,40"]) == 2
+    assert "2 comma-separated" in capsys.readouterr().err
+
+
+def test_single_plane_verification_says_couple_not_corrected(wheel, capsys):
+    out = _json(capsys, SHAFT + ["--single-plane"])
+    v = out["verification"]
+    assert v["kind"] in ("couple", "quasi-static", "dynamic")          # the wheel's 0.2° tilt stays
+    assert v["couple_corrected"] is False and "couple not corrected" in v["summary"]
+    assert v["static_unbalance_magnitude"] < 1e-9 * out["initial"]["static_unbalance_magnitude"]
+    assert main(SHAFT + ["--single-plane"]) == 0
+    text = capsys.readouterr().out
+    line = text.split("Verification")[1].splitlines()[1]
+    assert "couple not corrected" in line and "meets" not in line
+    # with bearings the tolerance includes the couple, so the grade there is quoted, and is poor
+    out = _json(capsys, SHAFT + ["--single-plane", "--bearings", "-120mm,120mm"])
+    assert "couple not corrected" in out["verification"]["summary"]
+    assert "at the bearings it meets" in out["verification"]["summary"]
+    assert out["verification"]["achieved_value"] > 6.3
+
+
+def test_two_plane_verification_quotes_the_grade(capsys):
+    out = _json(capsys, SHAFT + ["--planes", "-40mm,40mm"])
+    assert out["verification"]["couple_corrected"] is True
+    assert "meets G 0.4" in out["verification"]["summary"]

@@ -151,3 +151,83 @@ def test_analyze_reports_stability_section_for_the_octahedron(tmp_path, capsys):
     assert [s["dissipation_stable"] for s in stab] == [False, False, True]
     assert main(["analyze", str(path), "--units", "mm"]) == 0
     assert "major-axis rule" in capsys.readouterr().out
+
+
+# -- sampling, option ranges and wording (reviewer's UX findings) ----------------------------------------------
+
+BOX = os.path.join(ROOT, "meshes", "box.stl")
+
+
+def test_spin_refuses_an_undersampled_simulation(capsys):
+    # 400001 samples over 1e6 s are 0.45 per predicted flip interval (1.1185 s): the "measured" 10.6 s was an alias
+    assert main(["spin", BOX, "--units", "mm", "--duration", "1e6s"]) == 2
+    err = capsys.readouterr().err
+    assert "Undersampled" in err and "--duration" in err and "--samples" in err and err.count("\n") == 1
+    assert main(["spin", BOX, "--units", "mm", "--duration", "30s", "--samples", "10"]) == 2
+    assert "at least 431 samples" in capsys.readouterr().err
+
+
+def test_spin_engine_sampling_bound_and_well_sampled_measurement():
+    props = it.mass_properties(BOX, units="mm")
+    with pytest.raises(it.UsageError, match="Undersampled"):
+        it.spin_experiment(props, "intermediate", 10 * math.pi, duration=1e6)
+    # just above the bound (16 per flip interval) the measured interval still matches the prediction
+    e = it.spin_experiment(props, "intermediate", 10 * math.pi, duration=60.0, samples=int(60 / 1.11851 * 17) + 1)
+    assert e.measured_period == pytest.approx(e.predicted_period, rel=5e-3)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["spin", BOX, "--perturbation", "2"], "--perturbation must be between 0 and 1 (exclusive), got 2"),
+    (["spin", BOX, "--perturbation", "1"], "--perturbation must be between 0 and 1"),
+    (["spin", BOX, "--perturbation", "nan"], "--perturbation must be"),
+    (["spin", BOX, "--rtol", "-1"], "--rtol must be >= 0 and < 1, got -1"),
+    (["spin", BOX, "--rate", "-5rev/s"], "--rate must be positive, got -5rev/s"),
+    (["spin", BOX, "--duration", "0s"], "--duration must be positive, got 0s"),
+    (["spin", BOX, "--samples", "1"], "--samples must be between 2 and 400001"),
+    (["spin", BOX, "--merge-tolerance", "-1"], "--merge-tolerance must be"),
+    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "5rev/s", "--symmetry-rtol", "-1"],
+     "--symmetry-rtol must be >= 0 and < 1, got -1"),
+    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "5rev/s", "--gravity", "0"],
+     "--gravity must be positive"),
+    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "5rev/s", "--tilt", "200deg"],
+     "--tilt must be between 0 and 180 deg (0 and π rad) from the vertical, got 200deg"),
+    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "5rev/s", "--tilt", "-0.1rad"],
+     "--tilt must be between 0 and 180 deg"),
+    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "5rev/s", "--samples", "100000000"],
+     "--samples must be between 2 and 400001"),
+    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "50rev/s", "--tilt", "20", "--duration", "1e6s"],
+     "Undersampled"),
+])
+def test_numeric_options_are_checked_with_their_names(capsys, argv, message):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+
+
+def test_spin_rtol_default_is_the_library_default():
+    from inertia_tool.cli import build_parser
+    from inertia_tool.principal import DEFAULT_EQUAL_RTOL
+    assert build_parser().parse_args(["spin", BOX]).rtol == DEFAULT_EQUAL_RTOL
+
+
+def test_spin_report_without_flips_says_so(capsys):
+    assert main(["spin", BOX, "--units", "mm", "--duration", "0.5s"]) == 0     # first flip at 0.63 s
+    out = capsys.readouterr().out
+    assert "no flip within the simulated time" in out
+    assert "nan" not in out and "never s" not in out
+    assert main(["spin", BOX, "--units", "mm", "--duration", "0.9s", "--samples", "2000"]) == 0
+    out = capsys.readouterr().out
+    assert "one flip only" in out and "nan" not in out
+
+
+def test_top_report_without_nutation_says_so(capsys):
+    import dataclasses
+    from inertia_tool.reports.stability import format_heavy_top
+    assert main(["top", TOP, "--units", "mm", "--material", "steel", "--pivot", "0,0,0", "--spin", "50rev/s",
+                 "--tilt", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "no nutation period seen within the simulated time" in out and "nan" not in out
+    props = it.mass_properties(TOP, units="mm", material="steel")
+    top = it.heavy_top_from_mesh(props, [0, 0, 0], theta0=0.3, omega3=300.0)
+    text = format_heavy_top(dataclasses.replace(top, nutation_period=math.inf))
+    assert "no nutation period (θ never returns)" in text and "never s" not in text
