@@ -176,3 +176,8 @@ def test_two_plane_verification_quotes_the_grade(capsys):
     out = _json(capsys, SHAFT + ["--planes", "-40mm,40mm"])
     assert out["verification"]["couple_corrected"] is True
     assert "meets G 0.4" in out["verification"]["summary"]
+
+
+def test_radius_checked_with_the_option_name(capsys):
+    assert main(SHAFT[:-4] + ["--radius", "-5mm", "--grade", "G6.3", "--planes", "-40,40"]) == 2
+    assert "--radius must be positive, got -5mm" in capsys.readouterr().err

@@ -14,6 +14,7 @@ from ..errors import UsageError
 from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length
 from .analyze import add_material_options, add_mesh_options, load_from_args
+from .options import require_range
 from .report_option import check_output_file
 
 __all__ = ["register", "run"]
@@ -93,7 +94,8 @@ def run(args) -> int:
     if planes is None and not args.single_plane:
         raise UsageError("Expected --planes Z1,Z2 (or --single-plane)")
     bearings = None if args.bearings is None else _lengths(args.bearings, unit, "bearings", (2,))
-    radius = parse_length(args.radius, default_unit=unit)
+    radius = require_range(parse_length(args.radius, default_unit=unit), "--radius", low=0, low_open=True,
+                           typed=args.radius)
     speed = parse_angular_rate(args.rpm, default_unit="rpm")
     if not speed > 0:
         raise UsageError(f"Expected a positive --rpm (the service speed), got {args.rpm!r}")
