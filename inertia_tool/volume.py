@@ -35,7 +35,7 @@ import numpy as np
 
 from ._native import accel, faces_for_c
 
-__all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia"]
+__all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box"]
 
 _DEFAULT_CHUNK = 1 << 15
 
@@ -154,17 +154,31 @@ def _finish(vol: float, first: np.ndarray, second: np.ndarray, area: float, orig
                          zero_area_faces=int(zero))
 
 
+def bounding_box(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Corners ``(lo, hi)`` of the axis-aligned bounding box of (n, 3) vertices, each (3,), same unit.
+
+    Reduced column by column (exactly ``vertices.min(axis=0)`` and ``.max(axis=0)``, several times faster on
+    millions of vertices than a reduction over the short axis).
+    """
+    v = np.asarray(vertices)
+    lo = np.array([v[:, i].min() for i in range(3)], dtype=np.float64)
+    hi = np.array([v[:, i].max() for i in range(3)], dtype=np.float64)
+    return lo, hi
+
+
 def reference_point(vertices: np.ndarray) -> np.ndarray:
     """A point near the body: the centre of the vertex bounding box, (3,) m."""
     if len(vertices) == 0:
         return np.zeros(3)
-    return 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
+    lo, hi = bounding_box(vertices)
+    return 0.5 * (lo + hi)
 
 
 def _area_floor(vertices: np.ndarray, area_rtol: float) -> float:
     if len(vertices) == 0:
         return 0.0
-    return area_rtol * float(np.sum((vertices.max(axis=0) - vertices.min(axis=0)) ** 2))
+    lo, hi = bounding_box(vertices)
+    return area_rtol * float(np.sum((hi - lo) ** 2))
 
 
 def volume_moments(vertices: np.ndarray, faces: np.ndarray, *, origin: np.ndarray | None = None,
