@@ -316,6 +316,10 @@ Welder_init(WelderObject *w, PyObject *args, PyObject *kwds)
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "s|n", kwlist, &dtype, &expected)) {
         return -1;
     }
+    if (w->slots != NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "Welder is already initialised");
+        return -1;
+    }
     if (strcmp(dtype, "float32") == 0) {
         w->wide = 0;
     }
@@ -324,10 +328,6 @@ Welder_init(WelderObject *w, PyObject *args, PyObject *kwds)
     }
     else {
         PyErr_Format(PyExc_ValueError, "Expected dtype 'float32' or 'float64', got '%s'", dtype);
-        return -1;
-    }
-    if (w->slots != NULL) {
-        PyErr_SetString(PyExc_RuntimeError, "Welder is already initialised");
         return -1;
     }
     if (expected < 0) {

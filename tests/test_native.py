@@ -272,6 +272,8 @@ def test_kernels_refuse_malformed_arguments():
     with pytest.raises(ValueError):
         lib.Welder("float16")
     w = lib.Welder("float32")
+    with pytest.raises(RuntimeError):
+        w.__init__("float64")                                     # re-initialising would mix key widths
     with pytest.raises(ValueError):
         w.feed(np.zeros((3, 3)), np.empty(3, np.int32))           # float64 into a float32 welder
     with pytest.raises(ValueError):
