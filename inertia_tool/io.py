@@ -6,7 +6,8 @@ a :class:`~inertia_tool.errors.MeshReadError` naming the file.  Topology checks 
 
 Binary STL is read directly with numpy in bounded chunks (much faster than a general loader), and shared
 corners are welded exactly (bit-identical coordinates) into an indexed mesh on the way, so the triangle
-soup never has to exist in float64.
+soup never has to exist in float64.  With the C extension (``inertia_tool._native``) the welder reads the
+corners straight from each chunk of file records, in one pass.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, UsageError
+from ._native import accel
 from .units import length_scale
 from .weld import weld_exact, weld_exact_stream
 
@@ -104,13 +106,27 @@ def _binary_stl_count(path: str, size: int, max_faces: int) -> int:
     return n
 
 
-def _binary_stl_chunks(path: str, n: int):
-    """A factory of iterators over the corners of a binary STL, ``(k, 4)`` float32 chunks ``(x, y, z, 0)``
-    in file order (the padded layout lets ``weld`` hash a corner as two 64-bit words).
+def _binary_stl_chunks(path: str, n: int, *, padded: bool = True):
+    """A factory of iterators over the corners of a binary STL, in file order.
 
-    Each call re-reads the file in bounded chunks (the second read comes from the page cache), so the whole
-    triangle soup is never held in memory.
+    ``padded``: ``(k, 4)`` float32 copies ``(x, y, z, 0)`` checked for NaN and infinity (the layout lets the
+    numpy welder hash a corner as two 64-bit words); otherwise ``(k, 3, 3)`` float32 views into the chunk's
+    50-byte records, unchecked (the caller checks the welded vertices).  Each call re-reads the file in
+    bounded chunks (a second read comes from the page cache), so the whole triangle soup is never held in
+    memory.
     """
+    def views():
+        with open(path, "rb") as fh:
+            fh.seek(84)
+            done = 0
+            while done < n:
+                k = min(_CHUNK_FACES, n - done)
+                rec = np.fromfile(fh, dtype=_STL_RECORD, count=k)
+                if len(rec) != k:
+                    raise _fail(path, f"ended after {done + len(rec):,} of {n:,} triangles")
+                done += k
+                yield rec["v"]
+
     def chunks():
         with open(path, "rb") as fh:
             fh.seek(84)
@@ -126,7 +142,7 @@ def _binary_stl_chunks(path: str, n: int):
                     raise _fail(path, "triangles have NaN or infinite coordinates")
                 done += k
                 yield corners
-    return chunks
+    return chunks if padded else views
 
 
 _VERTEX_RE = re.compile(rb"^[ \t]*vertex[ \t]+(\S+)[ \t]+(\S+)[ \t]+(\S+)[ \t]*$", re.MULTILINE | re.IGNORECASE)
@@ -287,7 +303,9 @@ def read_stl(path, *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, n
         n = _binary_stl_count(path, size, max_faces)
         if n == 0:
             raise _fail(path, "STL holds no triangles (empty mesh)")
-        vertices, faces = weld_exact_stream(_binary_stl_chunks(path, n), 3 * n)
+        vertices, faces = weld_exact_stream(_binary_stl_chunks(path, n, padded=accel() is None), 3 * n)
+        if not np.all(np.isfinite(vertices)):
+            raise _fail(path, "triangles have NaN or infinite coordinates")
         return vertices, faces, n
 
     if (announced >= 0 and 84 + 50 * announced == size) or not _looks_ascii_stl(head):

@@ -20,7 +20,7 @@ from .errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError,
 from .io import DEFAULT_MAX_FACES, RawMesh, load_mesh
 from .properties import MassProperties, combine
 from .units import material_density
-from .volume import VolumeMoments, body_volume_moments, reference_point, second_moment_to_inertia
+from .volume import VolumeMoments, body_volume_moments, bounding_box, reference_point, second_moment_to_inertia
 from .weld import weld_tolerance
 
 __all__ = ["mass_properties", "assembly", "resolve_density", "DEFAULT_DENSITY", "DEFAULT_MERGE_TOLERANCE",
@@ -237,11 +237,14 @@ def _overlap_probes(vertices, faces, order, starts, face_count, lo, hi, flip, bo
 
 def _check_magnitude(vertices, source: str) -> None:
     """Refuse coordinates whose volume integrals (∝ L⁵) would overflow or underflow float64."""
-    top = float(np.max(np.abs(vertices))) if len(vertices) else 0.0
+    if not len(vertices):
+        return
+    lo, hi = bounding_box(vertices)
+    top = float(np.max(np.abs(np.r_[lo, hi])))    # = max |coordinate| (NaN propagates)
     if not top <= MAX_COORDINATE:
         raise InvalidMeshError(f"{source}: coordinates reach {top:.3g} m, beyond the ±{MAX_COORDINATE:g} m the "
                                "volume integrals can hold without overflow (check --units)")
-    span = vertices.max(axis=0) - vertices.min(axis=0)
+    span = hi - lo
     diag = float(np.hypot(np.hypot(span[0], span[1]), span[2]))   # no underflow in the squares
     if 0 < diag < MIN_EXTENT:
         raise InvalidMeshError(f"{source}: the mesh spans only {diag:.3g} m, below the {MIN_EXTENT:g} m the "
@@ -292,7 +295,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
         f = f[~repeated]
         warnings.warn(DegenerateFacesWarning(f"{source}: {n_repeated:,} degenerate triangles (a repeated corner) "
                                              "were ignored"), stacklevel=3)
-    lo, hi = v.min(axis=0), v.max(axis=0)
+    lo, hi = bounding_box(v)
     diag = float(np.linalg.norm(hi - lo))
     if not diag > 0:
         raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")
@@ -348,12 +351,13 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
         warnings.warn(OverlapWarning(f"{source}: {overlaps} bod{'y overlaps' if overlaps == 1 else 'ies overlap'} "
                                      "another body; the overlapping volume is counted twice"), stacklevel=3)
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
+    bbox_min, bbox_max = bounding_box(v)
     report = MeshReport(source=source, units=raw.units, file_faces=raw.file_faces, vertices=len(v), faces=len(f),
                         degenerate_faces=n_repeated, zero_area_faces=sum(s.zero_area_faces for s in shells), bodies=bodies, cavities=cavities,
                         flipped_shells=int(np.count_nonzero(flip)), overlapping_shells=overlaps,
                         watertight=watertight, welded_tolerance=welded, repaired=repaired,
                         repair_actions=tuple(actions), repair_volume_change=volume_change,
-                        bbox_min=v.min(axis=0), bbox_max=v.max(axis=0))
+                        bbox_min=bbox_min, bbox_max=bbox_max)
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
 
 

@@ -6,8 +6,13 @@ for a shared corner); ``weld_tolerance`` merges vertices closer than a tolerance
 exporter rounded shared corners differently.  Welding never moves a coordinate that the integrals use:
 ``weld_exact`` keeps the exact values, ``weld_tolerance`` moves corners by less than its tolerance.
 
-Memory: ``weld_exact_stream`` reads the corners in chunks (twice) and holds only 64-bit keys and 32-bit
-indices, about 72 bytes per triangle at its peak, so a 5M-face binary STL never exists as a float64 soup.
+Vertices are numbered in order of first appearance in the corner stream, whichever path welds them.
+
+Two implementations give identical results: the C extension's ``Welder`` (an open-addressing hash table on
+the exact 12 or 24 bytes of a point, fed chunk by chunk in one pass, about 12 bytes per triangle beyond
+the output; see ``inertia_tool._native``) and the numpy reference below, which reads the corners in
+chunks (twice) and holds only 64-bit keys and 32-bit indices, about 72 bytes per triangle at its peak.
+Either way a 5M-face binary STL never exists as a float64 soup.
 """
 
 from __future__ import annotations
@@ -15,6 +20,8 @@ from __future__ import annotations
 from typing import Callable, Iterable
 
 import numpy as np
+
+from ._native import accel
 
 __all__ = ["weld_exact", "weld_exact_stream", "weld_tolerance"]
 
@@ -58,25 +65,77 @@ def _index_dtype(n: int):
     return np.int32 if n < 2**31 - 1 else np.int64
 
 
+def _renumber_by_first_appearance(inverse: np.ndarray, first: np.ndarray) -> None:
+    """Renumber group ids in place so that they increase with each group's first position.
+
+    ``inverse`` (k,) holds each point's group, ``first`` (g,) each group's first position in ``inverse``.
+    """
+    mark = np.zeros(len(inverse), dtype=bool)
+    mark[first] = True
+    firsts = np.flatnonzero(mark)          # first positions in increasing order
+    del mark
+    new_id = np.empty(len(first), dtype=inverse.dtype)
+    new_id[inverse[firsts]] = np.arange(len(first), dtype=inverse.dtype)
+    del firsts
+    for s in range(0, len(inverse), _CHUNK):
+        inverse[s:s + _CHUNK] = new_id[inverse[s:s + _CHUNK]]
+
+
+def _weld_stream_c(lib, chunks: Callable[[], Iterable[np.ndarray]], n_points: int):
+    """``weld_exact_stream`` on the C extension's hash table: one pass, no keys array, no sort."""
+    index = np.empty(n_points, dtype=np.int32)
+    welder = None
+    wide = False
+    s = 0
+    for c in chunks():
+        c = np.asarray(c)
+        if c.ndim == 2 and c.shape[1] == 4:
+            c = c[:, :3]                       # the padded (x, y, z, 0) layout of the numpy path
+        if welder is None:
+            wide = c.dtype != np.float32
+            welder = lib.Welder("float64" if wide else "float32", n_points // 6)
+        if c.dtype != (np.float64 if wide else np.float32) or not c.dtype.isnative:
+            if not wide and c.dtype != np.float32:
+                raise ValueError(f"Expected every chunk as float32 like the first one, got {c.dtype}")
+            c = c.astype(np.float64 if wide else np.float32)
+        k = c.size // 3
+        if s + k > n_points:
+            raise ValueError(f"expected {n_points} points from the stream, got more")
+        welder.feed(c, index[s:s + k])
+        s += k
+    if s != n_points:
+        raise ValueError(f"expected {n_points} points from the stream, got {s}")
+    vertices = np.empty((welder.count if welder is not None else 0, 3), dtype=np.float64)
+    if welder is not None:
+        welder.vertices_into(vertices)
+    return vertices, index.reshape(-1, 3)
+
+
 def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int) -> tuple[np.ndarray, np.ndarray]:
     """Weld a stream of points (triangle corners in order) by exact equality.
 
     Parameters
     ----------
     chunks : callable
-        Returns a fresh iterator over ``(k, 3)`` float arrays whose concatenation is the ``n_points`` corners
-        (or ``(k, 4)`` C-contiguous float32 scratch arrays with a zero last column: a faster layout),
-        three per triangle.  It is called twice (keys; coordinates with the collision check), and once
-        more only if a key collision forces the exact fallback.
+        Returns a fresh iterator over float arrays whose last axis is (x, y, z) — ``(k, 3)``, or ``(k, j, 3)``
+        with any strides (the C path welds a view into the file's records), or ``(k, 4)`` C-contiguous
+        float32 scratch arrays with a zero last column (a faster layout for the numpy path, which modifies
+        them) — whose concatenation is the ``n_points`` corners, three per triangle.  The C path calls it
+        once; the numpy path twice (keys; coordinates with the collision check), and once more only if a
+        key collision forces the exact fallback.
     n_points : int
         Total number of points (a multiple of 3).
 
     Returns
     -------
     vertices : (n, 3) float64
-        Distinct positions, exact values of the input.
+        Distinct positions, exact values of the input (-0.0 and +0.0 are one point), numbered in order of
+        first appearance.
     faces : (n_points // 3, 3) int32 or int64
     """
+    lib = accel()
+    if lib is not None and n_points < 2**31 - 1:
+        return _weld_stream_c(lib, chunks, n_points)
     keys = np.empty(n_points, dtype=np.uint64)
     s = 0
     for c in chunks():
@@ -88,16 +147,20 @@ def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int)
     ordered = keys[order]
     del keys
     step = np.empty(n_points, dtype=bool)
-    step[0] = False
+    step[0] = True
     np.not_equal(ordered[1:], ordered[:-1], out=step[1:])
     del ordered
-    n_unique = int(np.count_nonzero(step)) + 1
+    first = np.minimum.reduceat(order, np.flatnonzero(step))   # each group's first point
+    step[0] = False
+    n_unique = len(first)
     idx_t = _index_dtype(n_unique)
     group = np.cumsum(step, dtype=idx_t)
     del step
     inverse = np.empty(n_points, dtype=idx_t)
     inverse[order] = group
     del order, group
+    _renumber_by_first_appearance(inverse, first)
+    del first
     # fill the vertices; the first point written to a slot owns it, and every point is compared with its
     # slot's owner, so a key collision (two different points, one key) cannot go unnoticed
     vertices = np.empty((n_unique, 3), dtype=np.float64)
@@ -111,8 +174,10 @@ def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int)
         written[inv] = True
         if not np.array_equal(vertices[inv], c.astype(np.float64) + 0.0):
             pts = np.concatenate([x[:, :3].astype(np.float64) + 0.0 for x in chunks()])
-            uniq, inv_all = np.unique(pts, axis=0, return_inverse=True)
-            return uniq, inv_all.reshape(-1).astype(_index_dtype(len(uniq))).reshape(-1, 3)
+            uniq, first, inv_all = np.unique(pts, axis=0, return_index=True, return_inverse=True)
+            inv_all = inv_all.reshape(-1).astype(_index_dtype(len(uniq)))
+            _renumber_by_first_appearance(inv_all, first)
+            return uniq[np.argsort(first)], inv_all.reshape(-1, 3)
         s += len(c)
     return vertices, inverse.reshape(-1, 3)
 

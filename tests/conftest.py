@@ -1,3 +1,5 @@
+import os
+
 import numpy as np
 import pytest
 import trimesh
@@ -35,3 +37,30 @@ def write_ascii_stl(path, vertices, faces, newline="\n"):
     lines.append("endsolid test")
     with open(path, "w", newline="") as fh:
         fh.write(newline.join(lines) + newline)
+
+
+try:
+    from inertia_tool import _accel  # noqa: F401  (the optional C extension)
+    HAVE_ACCEL = True
+except ImportError:
+    HAVE_ACCEL = False
+
+#: CI sets this so that a silently failed build of the C extension fails the suite instead of skipping.
+REQUIRE_ACCEL = os.environ.get("INERTIA_TOOL_REQUIRE_ACCEL", "") not in ("", "0")
+
+
+@pytest.fixture(params=["c", "numpy"])
+def engine_path(request, monkeypatch):
+    """Run a test on the C extension's kernels and on the pure-numpy path (the reference).
+
+    Engine test modules apply it to every test with ``pytestmark = pytest.mark.usefixtures("engine_path")``.
+    """
+    if request.param == "c":
+        if not HAVE_ACCEL:
+            if REQUIRE_ACCEL:
+                pytest.fail("inertia_tool._accel is not built but INERTIA_TOOL_REQUIRE_ACCEL is set")
+            pytest.skip("inertia_tool._accel is not built (no C compiler at install time)")
+        monkeypatch.delenv("INERTIA_TOOL_NO_ACCEL", raising=False)
+    else:
+        monkeypatch.setenv("INERTIA_TOOL_NO_ACCEL", "1")
+    return request.param

@@ -6,6 +6,10 @@ from inertia_tool.checks import edge_topology, repeated_corner_faces, shell_labe
 from inertia_tool.volume import volume_moments
 
 
+# every test runs on the C extension (when built) and on the pure-numpy path
+pytestmark = pytest.mark.usefixtures("engine_path")
+
+
 def test_closed_box_is_oriented():
     v, f = box_arrays()
     t = edge_topology(f, len(v), v)

@@ -27,6 +27,10 @@ from inertia_tool.volume import second_moment_to_inertia, volume_moments
 REGRESSIONS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "regressions")
 
 
+# every test runs on the C extension (when built) and on the pure-numpy path
+pytestmark = pytest.mark.usefixtures("engine_path")
+
+
 def run_cli(*argv):
     out, err = io.StringIO(), io.StringIO()
     with redirect_stdout(out), redirect_stderr(err):

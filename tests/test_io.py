@@ -10,6 +10,10 @@ from inertia_tool.errors import MeshReadError, TrailingDataWarning, UsageError
 from inertia_tool.io import load_mesh, read_stl
 
 
+# every test runs on the C extension (when built) and on the pure-numpy path
+pytestmark = pytest.mark.usefixtures("engine_path")
+
+
 def _same_triangles(raw, vertices, faces, scale=1.0):
     got = np.sort(np.sort(raw.vertices[raw.faces].reshape(-1, 9), axis=1), axis=0)
     want = np.sort(np.sort(np.asarray(vertices, dtype=np.float32).astype(float)[faces].reshape(-1, 9) * scale,

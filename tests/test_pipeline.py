@@ -8,6 +8,10 @@ from inertia_tool.errors import (DegenerateFacesWarning, InsideOutWarning, Inval
                                  OverlapWarning, UsageError)
 
 
+# every test runs on the C extension (when built) and on the pure-numpy path
+pytestmark = pytest.mark.usefixtures("engine_path")
+
+
 def _concat(*meshes):
     v, f, n = [], [], 0
     for vv, ff in meshes:

@@ -18,6 +18,10 @@ from inertia_tool.properties import MassProperties
 from inertia_tool.volume import body_volume_moments, second_moment_to_inertia, volume_moments
 
 
+# every test runs on the C extension (when built) and on the pure-numpy path
+pytestmark = pytest.mark.usefixtures("engine_path")
+
+
 def _props(vertices, faces, **kwargs) -> MassProperties:
     """Unit-density MassProperties of a closed mesh from the engine."""
     m = volume_moments(vertices, faces, **kwargs)

@@ -1,6 +1,11 @@
 import numpy as np
+import pytest
 
 from inertia_tool.weld import weld_exact, weld_tolerance
+
+
+# every test runs on the C extension (when built) and on the pure-numpy path
+pytestmark = pytest.mark.usefixtures("engine_path")
 
 
 def test_weld_exact_recovers_shared_vertices_of_trimesh_icosphere():
@@ -38,6 +43,7 @@ def test_weld_tolerance_merges_rounding_noise_only():
 def test_key_collision_falls_back_to_exact_grouping(monkeypatch):
     import inertia_tool.weld as weld
 
+    monkeypatch.setenv("INERTIA_TOOL_NO_ACCEL", "1")    # the 64-bit keys exist only on the numpy path
     def constant_key(rows):
         return np.zeros(len(rows), dtype=np.uint64)   # every point collides
     monkeypatch.setattr(weld, "_hash_rows", constant_key)

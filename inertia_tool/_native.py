@@ -1,0 +1,43 @@
+"""The boundary to the optional C extension ``inertia_tool._accel``.
+
+The engine's hot loops (exact welding, the edge census, shell labels, the tetrahedron sums) have two
+implementations: C kernels in ``_accel.c`` (built by ``pip install`` when a C compiler is present) and the
+pure-numpy code of ``weld``, ``checks`` and ``volume``, which is the reference and the fallback.  Each of those
+modules asks :func:`accel` at call time which one to run.  Set the environment variable
+``INERTIA_TOOL_NO_ACCEL=1`` to force the numpy path (results are identical, or equal to round-off for the
+integrals, which the C kernel sums with compensation).
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+__all__ = ["accel", "faces_for_c"]
+
+#: Environment variable that, set to anything but "" or "0", forces the pure-numpy path.
+NO_ACCEL_ENV = "INERTIA_TOOL_NO_ACCEL"
+
+_MODULE: list = []   # the import result, cached: [module or None]
+
+
+def accel():
+    """The ``inertia_tool._accel`` module, or None when it is not built or ``INERTIA_TOOL_NO_ACCEL`` is set."""
+    if os.environ.get(NO_ACCEL_ENV, "").strip() not in ("", "0"):
+        return None
+    if not _MODULE:
+        try:
+            from . import _accel
+        except ImportError:
+            _accel = None
+        _MODULE.append(_accel)
+    return _MODULE[0]
+
+
+def faces_for_c(faces) -> np.ndarray:
+    """Faces as a C-contiguous, native-order (m, 3) int32 or int64 array (what the C kernels accept)."""
+    f = np.asarray(faces)
+    if f.dtype not in (np.dtype(np.int32), np.dtype(np.int64)):
+        f = f.astype(np.int64)
+    return np.ascontiguousarray(f)

@@ -1,0 +1,305 @@
+"""The optional C extension (inertia_tool._accel, chosen by inertia_tool._native) against the numpy reference.
+
+Welding, the edge census and shell labels must agree exactly with the numpy path (same vertex numbering,
+same counts, same sample edges); the compensated tetrahedron sums to round-off.  The kernels must refuse
+malformed arguments with an exception, never crash: out-of-range indices, wrong dtypes or shapes, NaN.
+"""
+
+import threading
+
+import numpy as np
+import pytest
+import trimesh
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from conftest import HAVE_ACCEL, REQUIRE_ACCEL, box_arrays, write_binary_stl
+from inertia_tool import _native
+from inertia_tool.checks import edge_topology, shell_labels
+from inertia_tool.io import load_mesh
+from inertia_tool.volume import body_volume_moments, volume_moments
+from inertia_tool.weld import weld_exact
+
+needs_accel = pytest.mark.skipif(not HAVE_ACCEL and not REQUIRE_ACCEL, reason="inertia_tool._accel is not built")
+
+
+def both(monkeypatch, fn):
+    """``fn()`` on the C path and on the numpy path."""
+    monkeypatch.delenv(_native.NO_ACCEL_ENV, raising=False)
+    c = fn()
+    monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
+    ref = fn()
+    monkeypatch.delenv(_native.NO_ACCEL_ENV)
+    return c, ref
+
+
+def test_switch_forces_numpy(monkeypatch):
+    monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
+    assert _native.accel() is None
+    monkeypatch.setenv(_native.NO_ACCEL_ENV, "0")
+    assert (_native.accel() is not None) == HAVE_ACCEL
+
+
+def test_ci_builds_the_extension():
+    """Under CI (INERTIA_TOOL_REQUIRE_ACCEL=1, set by .ci/run) the extension must have been built and load."""
+    if not REQUIRE_ACCEL:
+        pytest.skip("INERTIA_TOOL_REQUIRE_ACCEL is not set")
+    assert _native.accel() is not None
+
+
+def _soup(seed=0):
+    """Corners of an icosphere with shuffled faces, -0.0 at some zero coordinates, and a detached tetrahedron."""
+    m = trimesh.creation.icosphere(subdivisions=4, radius=2.0)
+    v = np.asarray(m.vertices).copy()
+    v[np.abs(v) < 1e-12] = 0.0
+    corners = v[m.faces]
+    rng = np.random.default_rng(seed)
+    corners = corners[rng.permutation(len(corners))]
+    corners[::7][corners[::7] == 0.0] = -0.0
+    tet = trimesh.creation.box([0.1, 0.2, 0.3]).triangles + 10.0
+    return np.concatenate([corners, tet])
+
+
+@needs_accel
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_weld_identical_on_both_paths(monkeypatch, dtype):
+    corners = _soup().astype(dtype)
+    (vc, fc), (vn, fn) = both(monkeypatch, lambda: weld_exact(corners))
+    np.testing.assert_array_equal(vc, vn)
+    np.testing.assert_array_equal(fc, fn)
+    np.testing.assert_array_equal(vc[fc], corners.astype(np.float64) + 0.0)
+    first = np.unique(fc.reshape(-1), return_index=True)[1]
+    assert np.all(np.diff(first) > 0)      # numbered by first appearance
+
+
+@needs_accel
+def test_weld_keeps_one_ulp_apart_and_merges_signed_zero_in_float64(monkeypatch):
+    x = 1.0
+    y = np.nextafter(x, 2.0)
+    corners = np.array([[[x, 0, 0], [0, 1, 0], [0, 0, -0.0]], [[y, 0, 0], [0, 1, 0], [0, 0, 0.0]]])
+    (vc, fc), (vn, fn) = both(monkeypatch, lambda: weld_exact(corners))
+    assert len(vc) == len(vn) == 4
+    np.testing.assert_array_equal(fc, fn)
+
+
+@needs_accel
+def test_binary_stl_read_identically(monkeypatch, tmp_path):
+    corners = _soup(1).astype(np.float32)
+    path = tmp_path / "soup.stl"
+    v = corners.reshape(-1, 3)
+    write_binary_stl(path, v, np.arange(len(v)).reshape(-1, 3))
+    c, ref = both(monkeypatch, lambda: load_mesh(path, units="mm"))
+    np.testing.assert_array_equal(c.vertices, ref.vertices)
+    np.testing.assert_array_equal(c.faces, ref.faces)
+
+
+@needs_accel
+def test_welder_nan_payloads_are_points_not_crashes():
+    lib = _native.accel()
+    nan_a = np.frombuffer(np.uint32(0x7FC00000).tobytes(), np.float32)[0]
+    nan_b = np.frombuffer(np.uint32(0x7FC00001).tobytes(), np.float32)[0]
+    pts = np.array([[nan_a, 0, 0], [nan_b, 0, 0], [nan_a, 0, 0], [np.inf, -np.inf, 0]], dtype=np.float32)
+    w = lib.Welder("float32", 0)
+    ids = np.empty(4, np.int32)
+    w.feed(pts, ids)
+    assert list(ids) == [0, 1, 0, 2]        # bit patterns: two NaN payloads stay distinct
+    out = np.empty((w.count, 3))
+    w.vertices_into(out)
+    assert np.isnan(out[:2, 0]).all() and np.isinf(out[2, :2]).all()
+
+
+def test_nan_in_binary_stl_refused_on_both_paths(tmp_path, engine_path):
+    from inertia_tool.errors import MeshReadError
+    v, f = box_arrays()
+    v = v.copy()
+    v[3, 1] = np.nan
+    write_binary_stl(tmp_path / "nan.stl", v, f)
+    with pytest.raises(MeshReadError, match="NaN or infinite"):
+        load_mesh(tmp_path / "nan.stl")
+
+
+@needs_accel
+def test_welder_table_grows_from_a_small_hint():
+    lib = _native.accel()
+    pts = np.random.default_rng(2).integers(0, 60, size=(200_000, 3)).astype(np.float32)
+    w = lib.Welder("float32", 1)
+    ids = np.empty(len(pts), np.int32)
+    for s in range(0, len(pts), 30_000):          # several feeds, one table
+        w.feed(pts[s:s + 30_000], ids[s:s + 30_000])
+    out = np.empty((w.count, 3))
+    w.vertices_into(out)
+    assert w.count == len(np.unique(pts, axis=0)) and w.points == len(pts)
+    np.testing.assert_array_equal(out[ids], pts)
+
+
+_faces = st.integers(2, 12).flatmap(lambda n: st.tuples(
+    st.just(n), st.lists(st.tuples(*[st.integers(0, n - 1)] * 3), min_size=1, max_size=40)))
+
+
+@needs_accel
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(case=_faces)
+def test_edge_census_identical_on_random_face_sets(monkeypatch, case):
+    """Random faces over a few vertices: holes, fins, flips, duplicated faces, even repeated corners."""
+    n, faces = case
+    f = np.array(faces, dtype=np.int64)
+    v = np.random.default_rng(n).random((n, 3))
+    c, ref = both(monkeypatch, lambda: edge_topology(f, n, v))
+    assert (c.edges, c.boundary_edges, c.nonmanifold_edges, c.misoriented_edges) == \
+        (ref.edges, ref.boundary_edges, ref.nonmanifold_edges, ref.misoriented_edges)
+    np.testing.assert_array_equal(c.sample, ref.sample)
+
+
+@needs_accel
+def test_edge_census_on_a_high_degree_fan(monkeypatch):
+    """A cone with 40,000 sides: its apex is in every side face (no quadratic scan of a vertex's edges)."""
+    k = 40_000
+    t = np.linspace(0, 2 * np.pi, k, endpoint=False)
+    v = np.vstack([[0, 0, 1.0], [0, 0, 0.0], np.c_[np.cos(t), np.sin(t), np.zeros(k)]])
+    ring = 2 + np.arange(k)
+    nxt = 2 + (np.arange(k) + 1) % k
+    f = np.vstack([np.c_[np.zeros(k, int), ring, nxt], np.c_[np.ones(k, int), nxt, ring]])
+    f_open = f[1:]
+    for faces in (f, f_open):
+        c, ref = both(monkeypatch, lambda: edge_topology(faces, len(v), v))
+        assert (c.edges, c.boundary_edges, c.misoriented_edges) == (ref.edges, ref.boundary_edges,
+                                                                     ref.misoriented_edges)
+        np.testing.assert_array_equal(c.sample, ref.sample)
+    assert c.boundary_edges == 3
+
+
+@needs_accel
+def test_shell_labels_identical_with_shuffled_shells_and_loose_vertices(monkeypatch):
+    rng = np.random.default_rng(3)
+    parts, n = [], 0
+    for k in range(6):
+        v, f = box_arrays(center=(3.0 * k, 0, 0))
+        parts.append(f + n + 2)       # two loose vertices before each box
+        n += len(v) + 2
+    faces = np.concatenate(parts)
+    perm = rng.permutation(n)         # scatter the vertex numbering
+    faces = perm[faces][rng.permutation(len(faces))]
+    (lc, kc), (ln, kn) = both(monkeypatch, lambda: shell_labels(faces, n))
+    assert kc == kn == 6
+    np.testing.assert_array_equal(lc, ln)
+
+
+def _rel(a, b):
+    return float(np.max(np.abs(np.asarray(a) - np.asarray(b))) / max(np.max(np.abs(b)), 1e-300))
+
+
+@needs_accel
+@pytest.mark.parametrize("offset", [0.0, 1e3])
+def test_tetra_sums_agree_to_round_off(monkeypatch, offset):
+    """An icosphere of 327,680 faces (the benchmark meshes' kind), at the origin and far from it."""
+    m = trimesh.creation.icosphere(subdivisions=7, radius=50.0)
+    v = np.asarray(m.vertices, dtype=np.float32).astype(float) + offset
+    f = np.asarray(m.faces)
+    c, ref = both(monkeypatch, lambda: volume_moments(v, f))
+    assert c.volume == pytest.approx(ref.volume, rel=1e-13)
+    assert c.area == pytest.approx(ref.area, rel=1e-13)
+    np.testing.assert_allclose(c.centroid, ref.centroid, rtol=0, atol=1e-13 * 100.0)
+    assert _rel(c.second_moment, ref.second_moment) < 1e-13
+    assert c.zero_area_faces == ref.zero_area_faces
+
+
+@needs_accel
+def test_tetra_sums_per_label_agree(monkeypatch):
+    """Per-shell sums in one labelled pass about one origin, against the numpy labelled pass and the numpy
+    single-shell pass.  Shells away from the origin lose digits when the sums are moved to their centroid
+    (C − V d dᵀ), so the second moments are compared relative to the raw sum's size ``|C| + V |d|²``."""
+    from inertia_tool.volume import reference_point
+    shells = [trimesh.creation.icosphere(subdivisions=4, radius=r) for r in (1.0, 0.5, 2.0)]
+    v = np.concatenate([np.asarray(s.vertices) + 5.0 * k for k, s in enumerate(shells)])
+    offs = np.cumsum([0] + [len(s.vertices) for s in shells])
+    f = np.concatenate([np.asarray(s.faces) + offs[k] for k, s in enumerate(shells)])
+    f[len(shells[0].faces):len(shells[0].faces) + len(shells[1].faces)] = \
+        f[len(shells[0].faces):len(shells[0].faces) + len(shells[1].faces), ::-1]    # a cavity-like inward shell
+    labels = np.repeat(np.arange(3), [len(s.faces) for s in shells])
+    c, ref = both(monkeypatch, lambda: body_volume_moments(v, f, labels, 3))
+    monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
+    single = [volume_moments(v, f[labels == k], origin=reference_point(v)) for k in range(3)]
+
+    o = reference_point(v)
+    for a, b, s in zip(c, ref, single):
+        raw = np.max(np.abs(s.second_moment)) + abs(s.volume) * float(np.sum((s.centroid - o) ** 2))
+        for other in (b, s):
+            assert a.volume == pytest.approx(other.volume, rel=1e-13)
+            np.testing.assert_allclose(a.centroid, other.centroid, rtol=0, atol=1e-13 * 20)
+            assert np.max(np.abs(a.second_moment - other.second_moment)) < 1e-13 * raw
+    assert c[1].volume < 0
+
+
+@needs_accel
+def test_kernels_refuse_malformed_arguments():
+    lib = _native.accel()
+    v, f = box_arrays()
+    f = np.ascontiguousarray(f, dtype=np.int64)
+    bad = f.copy()
+    bad[5, 1] = len(v)
+    neg = f.copy()
+    neg[0, 0] = -1
+    sums, zero = np.empty((1, 11)), np.empty(1, np.int64)
+    for faces in (bad, neg):
+        with pytest.raises(ValueError, match="face indices"):
+            lib.edge_census(faces, len(v))
+        with pytest.raises(ValueError, match="face indices"):
+            lib.shell_labels(faces, len(v), np.empty(len(f), np.int64))
+        with pytest.raises(ValueError, match="face indices"):
+            lib.tetra_sums(v, faces, (0.0, 0.0, 0.0), 0.0, None, sums, zero)
+    with pytest.raises(ValueError):
+        lib.edge_census(f.astype(np.float64), len(v))            # float faces
+    with pytest.raises(ValueError):
+        lib.edge_census(f.astype(">i8"), len(v))                 # foreign byte order
+    with pytest.raises(ValueError):
+        lib.edge_census(f[:, :2].copy(), len(v))                 # not triangles
+    with pytest.raises(ValueError):
+        lib.edge_census(f, -1)
+    with pytest.raises(ValueError):
+        lib.edge_census(f, 2**40)
+    with pytest.raises(ValueError):
+        lib.shell_labels(f, len(v), np.empty(len(f) - 1, np.int64))   # short output
+    with pytest.raises(ValueError, match="labels"):
+        lib.tetra_sums(v, f, (0.0, 0.0, 0.0), 0.0, np.full(len(f), 7), np.empty((2, 11)), np.empty(2, np.int64))
+    with pytest.raises(ValueError):
+        lib.tetra_sums(v.astype(np.float32), f, (0.0, 0.0, 0.0), 0.0, None, sums, zero)
+    with pytest.raises((ValueError, BufferError)):
+        lib.tetra_sums(v, f, (0.0, 0.0, 0.0), 0.0, None, sums, np.empty(1, np.int64)[::1].view(np.float64))
+    readonly = np.empty(len(f), np.int64)
+    readonly.flags.writeable = False
+    with pytest.raises((ValueError, BufferError)):
+        lib.shell_labels(f, len(v), readonly)
+    with pytest.raises(ValueError):
+        lib.Welder("float16")
+    w = lib.Welder("float32")
+    with pytest.raises(RuntimeError):
+        w.__init__("float64")                                     # re-initialising would mix key widths
+    with pytest.raises(ValueError):
+        w.feed(np.zeros((3, 3)), np.empty(3, np.int32))           # float64 into a float32 welder
+    with pytest.raises(ValueError):
+        w.feed(np.zeros((3, 3), np.float32), np.empty(2, np.int32))   # output too short
+    with pytest.raises(ValueError):
+        w.vertices_into(np.empty((5, 3)))
+    with pytest.raises(RuntimeError):
+        lib.Welder.__new__(lib.Welder).feed(np.zeros((3, 3), np.float32), np.empty(3, np.int32))
+
+
+@needs_accel
+def test_kernels_run_concurrently_in_threads():
+    """The GIL is released inside the loops; separate welders and censuses in threads give the same results."""
+    lib = _native.accel()
+    pts = np.random.default_rng(4).integers(0, 50, size=(300_000, 3)).astype(np.float32)
+    results = [None] * 4
+
+    def work(i):
+        w = lib.Welder("float32", 0)
+        ids = np.empty(len(pts), np.int32)
+        w.feed(pts, ids)
+        results[i] = ids
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results[1:]:
+        np.testing.assert_array_equal(r, results[0])
