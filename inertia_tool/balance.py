@@ -32,6 +32,7 @@ import numpy as np
 
 from .errors import UsageError
 from .properties import MassProperties, combine, point_mass
+from .rotations import perpendicular_basis
 
 __all__ = ["BalanceGrade", "ISO_GRADES", "ShaftFrame", "shaft_frame", "PlaneUnbalance", "Correction",
            "UnbalanceState", "BalanceReport", "balance", "permissible_unbalance", "balance_grade", "unbalance_state",
@@ -192,10 +193,7 @@ def shaft_frame(axis_point, axis_direction) -> ShaftFrame:
         raise UsageError(f"Expected `axis_direction` to be 3 finite numbers, not all zero, got "
                          f"{np.asarray(axis_direction).tolist()}")
     z = z / np.linalg.norm(z)
-    k = int(np.argmin(np.abs(z)))          # first mesh axis most orthogonal to the shaft
-    x = np.eye(3)[k] - z[k] * z
-    x /= np.linalg.norm(x)
-    y = np.cross(z, x)
+    x, y = perpendicular_basis(z)          # x: the mesh axis most orthogonal to the shaft, projected
     return ShaftFrame(origin=_readonly(origin), axes=_readonly(np.column_stack([x, y, z])))
 
 

@@ -36,6 +36,7 @@ from scipy.spatial.transform import Rotation
 
 from .errors import PhysicsError, UsageError
 from .properties import MassProperties
+from .rotations import matrix_to_quaternion
 
 __all__ = ["InertialFrame", "MomentCheck", "inertial_frame", "check_moments", "rpy_from_matrix",
            "quaternion_from_matrix", "positive_tensor_notation", "GAZEBO_TOLERANCE", "MUJOCO_MINVAL", "FRAMES"]
@@ -143,8 +144,7 @@ def rpy_from_matrix(rotation) -> np.ndarray:
 
 def quaternion_from_matrix(rotation) -> np.ndarray:
     """Unit quaternion ``(w, x, y, z)`` (scalar first, ``w ≥ 0``) of an active rotation matrix (MuJoCo ``quat``)."""
-    q = np.roll(Rotation.from_matrix(_rotation(rotation)).as_quat(), 1)
-    return -q if q[0] < 0 else q
+    return matrix_to_quaternion(_rotation(rotation))
 
 
 def positive_tensor_notation(tensor) -> np.ndarray:

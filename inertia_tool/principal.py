@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import UsageError
+from .rotations import perpendicular_basis
 
 __all__ = ["PrincipalAxes", "principal_axes", "DEFAULT_EQUAL_RTOL"]
 
@@ -78,17 +79,6 @@ def _canonical_sign(v: np.ndarray) -> np.ndarray:
     return -v if v[k] < 0 else v
 
 
-def _plane_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two deterministic unit vectors spanning the plane ⟂ ``normal``: the mesh axis most
-    orthogonal to ``normal``, projected into the plane, then ``normal × first``."""
-    k = int(np.argmin(np.abs(normal)))
-    e = np.zeros(3)
-    e[k] = 1.0
-    first = e - normal * (normal @ e)
-    first /= np.linalg.norm(first)
-    return first, np.cross(normal, first)
-
-
 def principal_axes(tensor, *, reference_point=None, mass: float = float("nan"),
                    rtol: float = DEFAULT_EQUAL_RTOL) -> PrincipalAxes:
     """Diagonalise a symmetric inertia tensor.
@@ -129,11 +119,11 @@ def principal_axes(tensor, *, reference_point=None, mass: float = float("nan"),
         pairs = ((0, 1), (1, 2), (0, 2))
     elif eq01:
         a3 = _canonical_sign(vecs[:, 2])
-        a1, a2 = _plane_basis(a3)
+        a1, a2 = perpendicular_basis(a3)
         axes = np.column_stack([a1, a2, a3])
     elif eq12:
         a1 = _canonical_sign(vecs[:, 0])
-        a2, a3 = _plane_basis(a1)
+        a2, a3 = perpendicular_basis(a1)
         axes = np.column_stack([a1, a2, a3])
     else:
         a1 = _canonical_sign(vecs[:, 0])

@@ -19,6 +19,7 @@ import numpy as np
 from .errors import UsageError
 
 __all__ = [
+    "perpendicular_basis",
     "rotation_z",
     "rotation_y",
     "euler_to_matrix",
@@ -280,3 +281,19 @@ def euler_to_quaternion(phi, theta, psi) -> np.ndarray:
 def quaternion_to_euler(quaternion, *, gimbal_atol: float = 1e-12):
     """Euler angles ``(φ, θ, ψ)`` of the orientation quaternion (``A = Qᵀ``); see :func:`matrix_to_euler`."""
     return matrix_to_euler(np.swapaxes(quaternion_to_matrix(quaternion), -1, -2), gimbal_atol=gimbal_atol)
+
+
+def perpendicular_basis(normal) -> tuple[np.ndarray, np.ndarray]:
+    """Deterministic orthonormal basis ``(e1, e2)`` of the plane ⟂ the unit vector ``normal``.
+
+    ``e1`` is the coordinate axis most orthogonal to ``normal`` (smallest ``|normal_k|``, the first on a tie),
+    projected into the plane and normalised; ``e2 = normal × e1``, so ``(e1, e2, normal)`` is right-handed.
+    Used wherever a free choice of axes must be reproducible (equal principal moments, the shaft frame,
+    the invariant plane); see ``docs/conventions.md``.
+    """
+    n = np.asarray(normal, dtype=np.float64)
+    k = int(np.argmin(np.abs(n)))
+    e1 = -n[k] * n
+    e1[k] += 1.0
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(n, e1)

@@ -155,3 +155,15 @@ def test_bad_shapes_raise_usage_error():
         rot.matrix_to_euler(np.eye(2))
     with pytest.raises(UsageError):
         rot.axis_angle_to_matrix([0, 0, 0], 1.0)
+
+
+def test_perpendicular_basis_is_right_handed_and_deterministic():
+    from inertia_tool.rotations import perpendicular_basis
+    rng = np.random.default_rng(3)
+    for n in list(np.eye(3)) + [v / np.linalg.norm(v) for v in rng.normal(size=(20, 3))]:
+        e1, e2 = perpendicular_basis(n)
+        frame = np.column_stack([e1, e2, n])
+        np.testing.assert_allclose(frame.T @ frame, np.eye(3), atol=1e-15)
+        assert np.linalg.det(frame) == pytest.approx(1.0, abs=1e-14)
+    e1, _ = perpendicular_basis(np.array([0.0, 0.0, 1.0]))
+    np.testing.assert_array_equal(e1, [1.0, 0.0, 0.0])      # the first mesh axis most orthogonal to z

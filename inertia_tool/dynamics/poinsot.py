@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
+from ..rotations import perpendicular_basis
 from .simulate import simulate
 from .torque_free import free_body_parameters
 from .trajectory import resolve_body
@@ -88,9 +89,6 @@ def herpolhode(body, angular_velocity, t, *, orientation=None):
     traj = simulate(body, angular_velocity, t, orientation=orientation)
     points = traj.angular_velocity_space
     normal, distance = invariant_plane(body, angular_velocity, orientation=orientation)
-    k = int(np.argmin(np.abs(normal)))
-    e1 = np.eye(3)[k] - normal * normal[k]
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(normal, e1)
+    e1, e2 = perpendicular_basis(normal)
     rel = points - distance * normal
     return points, np.stack([rel @ e1, rel @ e2], -1)
