@@ -427,6 +427,12 @@ def mass_properties(source, *, units: str = "m", density: float | None = None, m
 
 
 def _mass_properties(source, rho, mass, *, units, repair, merge_tolerance, max_faces, name) -> MassProperties:
+    return _part(source, rho, mass, units=units, repair=repair, merge_tolerance=merge_tolerance,
+                 max_faces=max_faces, name=name)[0]
+
+
+def _part(source, rho, mass, *, units, repair, merge_tolerance, max_faces, name, warn_principal=True):
+    """Mass properties of one mesh and its checked mesh (for cross-part checks of an assembly)."""
     raw = load_mesh(source, units=units, max_faces=max_faces)
     prepared = prepare_mesh(raw, repair=repair, merge_tolerance=merge_tolerance)
     label = name or raw.source
@@ -440,8 +446,9 @@ def _mass_properties(source, rho, mass, *, units, repair, merge_tolerance, max_f
         result = result.with_mass(mass)
     _check_finite(result, label)
     _check_physical(result)
-    _warn_about_principal(result, label)
-    return result
+    if warn_principal:
+        _warn_about_principal(result, label)
+    return result, prepared
 
 
 def _check_physical(props: MassProperties, rtol: float = 1e-9) -> None:
@@ -472,12 +479,48 @@ def assembly(parts, *, units: str = "m", mass: float | None = None, **options) -
     **options
         Passed to :func:`mass_properties` (``repair``, ``merge_tolerance``, ``max_faces``).
     """
-    bodies = []
+    bodies, meshes = [], []
     for spec in parts:
         spec = dict(spec)
         src = spec.pop("source")
-        bodies.append(mass_properties(src, units=spec.pop("units", units), **spec, **options))
+        rho, _ = resolve_density(density=spec.pop("density", None), material=spec.pop("material", None),
+                                 mass=spec.pop("mass", None))
+        opts = {"repair": False, "merge_tolerance": DEFAULT_MERGE_TOLERANCE, "max_faces": DEFAULT_MAX_FACES,
+                **options}
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            # equal moments of one part say nothing about the assembly: checked once on the whole below
+            props, prepared = _part(src, rho, None, units=spec.pop("units", units), name=spec.pop("name", None),
+                                    warn_principal=False, **opts)
+        bodies.append(props)
+        meshes.append(prepared)
     if not bodies:
         raise UsageError("Expected at least one part in the assembly")
-    total = bodies[0] if len(bodies) == 1 else combine(bodies, name="assembly")
-    return total.with_mass(mass) if mass is not None else total
+    if len(bodies) == 1:
+        total = bodies[0]
+    else:
+        total = combine(bodies, name="assembly")
+        _warn_about_part_overlaps(meshes, [b.name for b in bodies])
+    total = total.with_mass(mass) if mass is not None else total
+    _warn_about_principal(total, total.name)
+    return total
+
+
+def _warn_about_part_overlaps(meshes, names) -> None:
+    """Warn when the parts of an assembly overlap each other (their shared volume counts twice).
+
+    The parts' checked meshes are put side by side and the shell classification of :func:`prepare_mesh` is
+    run on the whole: bodies found inside another body beyond those already inside their own part overlap
+    across parts.
+    """
+    offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
+    label_offsets = np.cumsum([0] + [len(m.shells) for m in meshes[:-1]])
+    vertices = np.vstack([m.vertices for m in meshes])
+    faces = np.vstack([m.faces.astype(np.int64) + o for m, o in zip(meshes, offsets)])
+    labels = np.concatenate([m.labels + o for m, o in zip(meshes, label_offsets)])
+    shells = [s for m in meshes for s in m.shells]
+    diag = float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
+    _, _, _, overlaps = _classify_shells(vertices, faces, labels, len(shells), shells, diag)
+    within = sum(m.report.overlapping_shells for m in meshes)
+    if overlaps > within:
+        warnings.warn(OverlapWarning(f"assembly of {', '.join(names)}: parts overlap each other; the shared "
+                                     "volume is counted once per part"), stacklevel=3)

@@ -176,3 +176,17 @@ def test_unphysical_moments_warn():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         _check_physical(MassProperties(1.0, 1.0, [0, 0, 0], np.diag([1.0, 2.0, 3.0])))  # a flat plate: boundary
+
+
+def test_assembly_warns_when_parts_overlap_and_not_otherwise(tmp_path):
+    import warnings
+    a, b, c = tmp_path / "a.stl", tmp_path / "b.stl", tmp_path / "c.stl"
+    write_binary_stl(a, *box_arrays((1.0, 1.0, 1.0)))
+    write_binary_stl(b, *box_arrays((1.0, 1.0, 1.0), center=(3.0, 0, 0)))
+    write_binary_stl(c, *box_arrays((1.0, 1.0, 1.0), center=(0.5, 0.5, 0.5)))   # crosses a
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", OverlapWarning)
+        assembly([{"source": str(a), "density": 1.0}, {"source": str(b), "density": 2.0}])
+    with pytest.warns(OverlapWarning, match="parts overlap"):
+        asm = assembly([{"source": str(a), "density": 1.0}, {"source": str(c), "density": 2.0}])
+    assert asm.mass == pytest.approx(3.0)      # the numbers stay those of the parts as given
