@@ -72,10 +72,13 @@ class MeshReadError(InertiaToolError, OSError):
 class InvalidMeshError(InertiaToolError, ValueError):
     """A mesh was read but does not bound a solid (open, non-manifold, empty, flat, ...).
 
-    Attributes
+    Parameters
     ----------
-    details : dict
-        Machine-readable counts (``boundary_edges``, ``nonmanifold_edges`` ...) where known.
+    message : str
+        One line naming the file and the problem.
+    details : dict, optional
+        Machine-readable counts (``boundary_edges``, ``nonmanifold_edges`` ...) where known; kept as the
+        ``details`` attribute.
     """
 
     exit_code = 3

@@ -206,7 +206,8 @@ class MassProperties:
 
 
 def point_mass(mass: float, position, *, name: str = "point mass") -> MassProperties:
-    """A point mass (``mass`` kg at ``position`` m) as ``MassProperties``: zero volume and central inertia."""
+    """A point mass (``mass`` kg at ``position`` m, mesh axes) as ``MassProperties``: zero volume and zero
+    central inertia; ``name`` labels it in reports."""
     if not (np.isfinite(mass) and mass >= 0):
         raise UsageError(f"Expected a non-negative finite mass, got {mass}")
     return MassProperties(mass=mass, volume=0.0, center_of_mass=_vec3(position, "position"),
@@ -221,6 +222,8 @@ def combine(bodies, *, name: str = "assembly") -> MassProperties:
     ----------
     bodies : iterable of MassProperties
         With negative masses allowed (removed material), as long as the total is positive.
+    name : str
+        Label of the combined body in reports.
     """
     bodies = list(bodies)
     if not bodies:
