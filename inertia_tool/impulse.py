@@ -18,18 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import PhysicsError, UsageError
-from .properties import MassProperties
+from .properties import MassProperties, as_vector3
 
 __all__ = ["ImpulseResult", "apply_impulse"]
-
-
-def _vector(x, name: str) -> np.ndarray:
-    a = np.array(x, dtype=np.float64)
-    if a.shape != (3,):
-        raise UsageError(f"Expected `{name}` to have shape (3,), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise UsageError(f"Expected `{name}` to be finite, got {a.tolist()}")
-    return a
 
 
 @dataclass(frozen=True)
@@ -79,7 +70,7 @@ class ImpulseResult:
         (scalar-first quaternions ``trajectory.orientation``, see ``docs/conventions.md``).
         """
         from scipy.spatial.transform import Rotation
-        p = _vector(point, "point") - np.array(self.body.center_of_mass)
+        p = as_vector3(point, "point") - np.array(self.body.center_of_mass)
         t = np.asarray(t, dtype=float).reshape(-1)
         q = np.asarray(trajectory.orientation, dtype=float)
         rotated = Rotation.from_quat(np.roll(q, -1, axis=1)).apply(p)
@@ -134,10 +125,10 @@ def apply_impulse(props: MassProperties, impulse, point, *, angular_velocity=(0.
     """
     if not isinstance(props, MassProperties):
         raise UsageError(f"Expected MassProperties, got {type(props).__name__}")
-    p = _vector(impulse, "impulse")
-    x = _vector(point, "point")
-    w0 = _vector(angular_velocity, "angular_velocity")
-    v0 = _vector(velocity, "velocity")
+    p = as_vector3(impulse, "impulse")
+    x = as_vector3(point, "point")
+    w0 = as_vector3(angular_velocity, "angular_velocity")
+    v0 = as_vector3(velocity, "velocity")
     if not props.mass > 0:
         raise PhysicsError(f"Expected a body with positive mass, got {props.mass} kg")
     inertia = np.asarray(props.inertia, dtype=float)

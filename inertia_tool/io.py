@@ -128,20 +128,12 @@ def _binary_stl_chunks(path: str, n: int, *, padded: bool = True):
                 yield rec["v"]
 
     def chunks():
-        with open(path, "rb") as fh:
-            fh.seek(84)
-            done = 0
-            while done < n:
-                k = min(_CHUNK_FACES, n - done)
-                rec = np.fromfile(fh, dtype=_STL_RECORD, count=k)
-                if len(rec) != k:
-                    raise _fail(path, f"ended after {done + len(rec):,} of {n:,} triangles")
-                corners = np.zeros((3 * k, 4), dtype=np.float32)   # (x, y, z, 0): see weld._hash_rows
-                corners[:, :3] = rec["v"].reshape(-1, 3)
-                if not np.all(np.isfinite(corners)):
-                    raise _fail(path, "triangles have NaN or infinite coordinates")
-                done += k
-                yield corners
+        for v in views():
+            corners = np.zeros((3 * len(v), 4), dtype=np.float32)   # (x, y, z, 0): see weld._hash_rows
+            corners[:, :3] = v.reshape(-1, 3)
+            if not np.all(np.isfinite(corners)):
+                raise _fail(path, "triangles have NaN or infinite coordinates")
+            yield corners
     return chunks if padded else views
 
 

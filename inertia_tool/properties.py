@@ -23,8 +23,12 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["MassProperties", "InertiaTensor", "point_mass", "combine", "parallel_axis_shift"]
 
 
-def _vec3(x, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=np.float64)
+def as_vector3(x, name: str) -> np.ndarray:
+    """A fresh (3,) float64 copy of ``x``, or a UsageError naming ``name`` (shape or non-finite values).
+
+    The one input check for 3-vectors of the public API (points, directions, angular velocities, impulses).
+    """
+    a = np.array(x, dtype=np.float64)
     if a.shape != (3,):
         raise UsageError(f"Expected `{name}` to have shape (3,), got {a.shape}")
     if not np.all(np.isfinite(a)):
@@ -62,7 +66,7 @@ class InertiaTensor:
 
     def moment_about(self, direction) -> float:
         """Moment of inertia ``n̂·I·n̂`` about the line through ``reference_point`` along ``direction``, kg·m²."""
-        n = _vec3(direction, "direction")
+        n = as_vector3(direction, "direction")
         norm = np.linalg.norm(n)
         if norm == 0:
             raise UsageError("Expected a non-zero `direction`, got (0, 0, 0)")
@@ -143,7 +147,7 @@ class MassProperties:
         ``I^(p) = I^(cm) + M [(p−R)² δ_ij − (p−R)_i (p−R)_j]``.  The result converts to a (3, 3) array with
         ``np.asarray`` and carries ``reference_point``.
         """
-        p = _vec3(point, "point")
+        p = as_vector3(point, "point")
         return InertiaTensor(self.inertia + parallel_axis_shift(self.mass, p - self.center_of_mass), p)
 
     def moment_about_axis(self, direction, point=None) -> float:
@@ -151,12 +155,12 @@ class MassProperties:
 
         ``n̂·I^(cm)·n̂ + M |n̂ × (p − R)|²``; ``point`` defaults to the centre of mass.
         """
-        n = _vec3(direction, "direction")
+        n = as_vector3(direction, "direction")
         norm = np.linalg.norm(n)
         if norm == 0:
             raise UsageError("Expected a non-zero `direction`, got (0, 0, 0)")
         n = n / norm
-        p = self.center_of_mass if point is None else _vec3(point, "point")
+        p = self.center_of_mass if point is None else as_vector3(point, "point")
         d = np.cross(n, p - self.center_of_mass)
         return float(n @ self.inertia @ n + self.mass * (d @ d))
 
@@ -177,7 +181,7 @@ class MassProperties:
             raise UsageError(f"Expected `rotation` to have shape (3, 3), got {r.shape}")
         if not np.allclose(r @ r.T, np.eye(3), atol=1e-9) or np.linalg.det(r) < 0:
             raise UsageError("Expected `rotation` to be a proper rotation matrix (orthogonal, det +1)")
-        t = np.zeros(3) if translation is None else _vec3(translation, "translation")
+        t = np.zeros(3) if translation is None else as_vector3(translation, "translation")
         return MassProperties(mass=self.mass, volume=self.volume, center_of_mass=r @ self.center_of_mass + t,
                               inertia=r @ self.inertia @ r.T, surface_area=self.surface_area,
                               density=self.density, name=self.name)
@@ -210,7 +214,7 @@ def point_mass(mass: float, position, *, name: str = "point mass") -> MassProper
     central inertia; ``name`` labels it in reports."""
     if not (np.isfinite(mass) and mass >= 0):
         raise UsageError(f"Expected a non-negative finite mass, got {mass}")
-    return MassProperties(mass=mass, volume=0.0, center_of_mass=_vec3(position, "position"),
+    return MassProperties(mass=mass, volume=0.0, center_of_mass=as_vector3(position, "position"),
                           inertia=np.zeros((3, 3)), name=name)
 
 

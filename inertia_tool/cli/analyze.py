@@ -12,7 +12,6 @@ import warnings
 from ..errors import InertiaToolWarning, PhysicsError, UsageError
 from ..io import DEFAULT_MAX_FACES
 from ..pipeline import DEFAULT_DENSITY, DEFAULT_MERGE_TOLERANCE, assembly, mass_properties, resolve_density
-from ..properties import combine
 from ..reports.serialize import mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
+from ..properties import as_vector3
 from ..rotations import matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix
 from .integrate import DEFAULT_COLUMNS, integrate_rigid_body
 from .splitting import DEFAULT_SCHEME, SCHEMES, integrate_splitting
@@ -26,15 +27,6 @@ def _check_times(t) -> np.ndarray:
     if np.any(np.diff(times) <= 0):
         raise UsageError("Expected strictly increasing times `t`")
     return times
-
-
-def _check_vector(x, name: str) -> np.ndarray:
-    v = np.asarray(x, dtype=np.float64)
-    if v.shape != (3,):
-        raise UsageError(f"Expected `{name}` to have shape (3,), got {v.shape}")
-    if not np.all(np.isfinite(v)):
-        raise UsageError(f"Expected `{name}` to be finite, got {v.tolist()}")
-    return v
 
 
 def _check_orientation(orientation) -> np.ndarray:
@@ -133,7 +125,7 @@ def simulate(body, angular_velocity, t, *, torque=None, method: str = "auto", or
     principal = resolve_body(body)
     moments = np.asarray(principal.moments, dtype=np.float64)
     axes = np.asarray(principal.axes, dtype=np.float64)
-    omega_mesh = _check_vector(angular_velocity, "angular_velocity")
+    omega_mesh = as_vector3(angular_velocity, "angular_velocity")
     times = _check_times(t)
     q0 = _check_orientation(orientation)
     tensor = axes @ np.diag(moments) @ axes.T

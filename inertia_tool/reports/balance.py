@@ -11,7 +11,6 @@ from __future__ import annotations
 import html
 import math
 
-import numpy as np
 
 from ..balance import ISO_GRADES, BalanceReport, PlaneUnbalance
 from .serialize import to_jsonable

@@ -206,7 +206,7 @@ def format_spin(experiment, *, name: str = "") -> str:
     elif a.kind in ("unstable", "marginal"):
         lines.append(f"  predicted (linear): the {e.perturbation:g} wobble reaches order one after "
                      f"{_g(e.predicted_time_to_grow, 6)} s ({_g(a.turns_to_grow(e.perturbation, 1.0))} turns)")
-    lines.append(f"  predicted (exact, Landau–Lifshitz §37): "
+    lines.append("  predicted (exact, Landau–Lifshitz §37): "
                  + (f"{what} {_period(e.predicted_period, '')}" if math.isfinite(e.predicted_period)
                     else "nothing recurs (no flip, no wobble)"))
     event = "flip" if e.period_kind == "flip" else "upward crossing"
