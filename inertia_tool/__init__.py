@@ -18,21 +18,48 @@ Public API (SI units everywhere; conventions in ``docs/conventions.md``)::
 
 from .errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
                      UsageError)
-from .dynamics import Trajectory, herpolhode, plot_trajectory, polhode, simulate
 from .principal import PrincipalAxes, principal_axes
 from .properties import InertiaTensor, MassProperties, combine, point_mass
 from .pipeline import assembly, mass_properties
 from .checks import MeshReport
-from . import shapes
+# names that are also submodules must be bound eagerly (importing a submodule rebinds the package attribute)
 from .balance import BalanceReport, Correction, balance
 from .stability import AxisStability, StabilityReport, polhode_period, stability
 from .heavy_top import HeavyTopReport, heavy_top, heavy_top_from_mesh
-from .impulse import ImpulseResult, apply_impulse
-from .spin import SpinExperiment, spin_experiment
-from .inertial import InertialFrame, MomentCheck, check_moments, inertial_frame
-from .thinwall import PrintedPart, printed_part, shell_mass_properties
-from .batch import BatchOptions, BatchSummary, analyze_file, run_batch
-from .ellipsoid import equivalent_ellipsoid_semi_axes
+
+# The rest of the public API is imported on first use (PEP 562), so `inertia-tool analyze` does not pay for
+# scipy.integrate, scipy.special and the dynamics when it never calls them.
+_LAZY = {
+    "shapes": (".shapes", None),
+    "simulate": (".dynamics", "simulate"), "Trajectory": (".dynamics", "Trajectory"),
+    "polhode": (".dynamics", "polhode"), "herpolhode": (".dynamics", "herpolhode"),
+    "plot_trajectory": (".dynamics", "plot_trajectory"),
+    "apply_impulse": (".impulse", "apply_impulse"), "ImpulseResult": (".impulse", "ImpulseResult"),
+    "spin_experiment": (".spin", "spin_experiment"), "SpinExperiment": (".spin", "SpinExperiment"),
+    "inertial_frame": (".inertial", "inertial_frame"), "InertialFrame": (".inertial", "InertialFrame"),
+    "check_moments": (".inertial", "check_moments"), "MomentCheck": (".inertial", "MomentCheck"),
+    "printed_part": (".thinwall", "printed_part"), "PrintedPart": (".thinwall", "PrintedPart"),
+    "shell_mass_properties": (".thinwall", "shell_mass_properties"),
+    "BatchOptions": (".batch", "BatchOptions"), "BatchSummary": (".batch", "BatchSummary"),
+    "analyze_file": (".batch", "analyze_file"), "run_batch": (".batch", "run_batch"),
+    "equivalent_ellipsoid_semi_axes": (".ellipsoid", "equivalent_ellipsoid_semi_axes"),
+}
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'inertia_tool' has no attribute {name!r}")
+    import importlib
+    module_name, attribute = _LAZY[name]
+    module = importlib.import_module(module_name, __name__)
+    value = module if attribute is None else getattr(module, attribute)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __version__ = "0.1.0"
 

@@ -23,9 +23,6 @@ import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
-from scipy.special import ellipk, ellipkm1
 
 from .errors import AsymmetricTopWarning, PhysicsError, UsageError
 from .properties import MassProperties
@@ -214,6 +211,7 @@ def _cubic_roots(a: float, b: float, alpha: float, beta: float, u0: float, phi_d
         if beta == 0.0:                  # quadratic f: only two finite roots
             return roots[0], roots[1], math.inf
         return roots[0], roots[1], roots[2]
+    from scipy.optimize import brentq   # scipy imported on use: keeps `analyze` fast to start
     u_x = brentq(f, -1.0, u0, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=500)
     u_n = brentq(f, u0, 1.0, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=500)
     if beta == 0.0:
@@ -238,6 +236,7 @@ def _nutation_period(u_x: float, u_n: float, u_u: float, alpha: float, beta: flo
     one_minus_m = (u_u - u_n) / span
     if one_minus_m <= 0.0:
         return math.inf
+    from scipy.special import ellipk, ellipkm1
     kval = float(ellipkm1(one_minus_m)) if one_minus_m < 0.5 else float(ellipk(1.0 - one_minus_m))
     return 4.0 * kval / math.sqrt(beta * span)
 
@@ -379,6 +378,7 @@ def simulate_top(top: HeavyTopReport, duration: float, *, samples: int = 2001, r
         return np.concatenate([np.cross(lvec, n) / i1, mgl * np.cross(zhat, n)])
 
     t = np.linspace(0.0, float(duration), int(samples))
+    from scipy.integrate import solve_ivp
     sol = solve_ivp(rhs, (0.0, float(duration)), np.concatenate([n0, l0]), method="DOP853", t_eval=t,
                     rtol=rtol, atol=atol)
     if not sol.success:

@@ -32,7 +32,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .errors import PhysicsError, UsageError
 from .properties import MassProperties
@@ -139,6 +138,7 @@ def rpy_from_matrix(rotation) -> np.ndarray:
     (3,) float
         ``(roll, pitch, yaw)``; pitch in [−π/2, π/2].
     """
+    from scipy.spatial.transform import Rotation   # imported on use: plain `analyze` never needs it
     return Rotation.from_matrix(_rotation(rotation)).as_euler("xyz")  # lower case: extrinsic (fixed) axes
 
 

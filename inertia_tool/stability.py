@@ -32,7 +32,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import ellipk, ellipkm1
 
 from .errors import PhysicalValidityWarning, PhysicsError, UsageError
 from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes
@@ -372,5 +371,6 @@ def polhode_period(moments, angular_velocity) -> float:
     if rate2 <= 0:
         return math.inf
     one_minus_m = min(max(one_minus_m, 0.0), 1.0)
+    from scipy.special import ellipk, ellipkm1   # imported here: `analyze` never needs it
     kval = float(ellipkm1(one_minus_m)) if one_minus_m < 0.5 else float(ellipk(1.0 - one_minus_m))
     return 4.0 * kval / math.sqrt(rate2)

@@ -27,3 +27,15 @@ def test_all_names_exist_and_are_unique():
     assert len(set(it.__all__)) == len(it.__all__)
     for name in it.__all__:
         assert hasattr(it, name), name
+
+
+def test_public_names_stay_functions_after_every_submodule_is_imported():
+    # importing a submodule rebinds the package attribute of the same name (balance, stability, heavy_top)
+    import importlib
+    import pkgutil
+    for info in pkgutil.walk_packages(it.__path__, "inertia_tool."):
+        if info.name.endswith("__main__"):
+            continue
+        importlib.import_module(info.name)
+    modules = [name for name in it.__all__ if inspect.ismodule(getattr(it, name))]
+    assert modules == ["shapes"]

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..heavy_top import HeavyTopReport, TopTrajectory
+if TYPE_CHECKING:  # pragma: no cover - annotations only; keeps scipy.integrate out of `analyze`
+    from ..heavy_top import HeavyTopReport, TopTrajectory
+
 from ..stability import StabilityReport
 from .serialize import to_jsonable
 
