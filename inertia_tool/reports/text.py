@@ -71,7 +71,7 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
         lines.append(f"  bodies ({len(props.parts)}):")
         for b in props.parts:
             lines.append(f"    {b.name}: mass {_num(b.mass)} kg, volume {_num(b.volume)} m³, "
-                         f"centre of mass {_vec(b.center_of_mass)} m")
+                         f"centre of mass {_vec(b.center_of_mass, size)} m")
     if mesh is not None:
         lines.append("  mesh:")
         lines.append(f"    faces {mesh.faces:,} (file {mesh.file_faces:,}), vertices {mesh.vertices:,}, "
