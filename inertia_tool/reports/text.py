@@ -22,8 +22,14 @@ def _clean(a, rel: float = 1e-12, scale: float = 0.0) -> np.ndarray:
     return np.where(np.abs(a) <= rel * scale, 0.0, a) + 0.0
 
 
-def _vec(v, scale: float = 0.0) -> str:
-    return "(" + ", ".join(f"{x: .6g}" for x in _clean(v, scale=scale)) + ")"
+def _vec(v, scale: float = 0.0, rel: float = 1e-12) -> str:
+    return "(" + ", ".join(f"{x: .6g}" for x in _clean(v, rel=rel, scale=scale)) + ")"
+
+
+def _position(v, size: float) -> str:
+    """A point, with coordinates below 1e-10 of the part size shown as 0 (float32 STL coordinates carry
+    ~6e-8 relative precision, so such offsets are round-off of the integration, not geometry)."""
+    return _vec(v, size, rel=1e-10)
 
 
 def _matrix(m, indent: str) -> list[str]:
@@ -45,12 +51,12 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
     lines.append(f"  volume:           {_num(props.volume)} m³")
     lines.append(f"  mass:             {_num(props.mass)} kg")
     lines.append(f"  surface area:     {_num(props.surface_area)} m²")
-    lines.append(f"  centre of mass:   {_vec(props.center_of_mass, size)} m")
+    lines.append(f"  centre of mass:   {_position(props.center_of_mass, size)} m")
     lines.append(f"  inertia about the centre of mass, mesh axes (kg·m²; {TENSOR_CONVENTION}):")
     lines += _matrix(props.inertia, "    ")
     lines.append("  inertia about the mesh origin (0, 0, 0), mesh axes (kg·m²):")
     lines += _matrix(np.asarray(props.inertia_about(np.zeros(3))), "    ")
-    lines.append("  (entries below 1e-12 of the largest in a vector or matrix, or of the part size, are shown as 0)")
+    lines.append("  (shown as 0: matrix and axis entries below 1e-12 of the largest, coordinates below 1e-10 of the part size)")
     lines.append("  principal moments (ascending) and axes (unit vectors, mesh axes, right-handed):")
     for k in range(3):
         lines.append(f"    I{k + 1} = {pa.moments[k]:.6e} kg·m²   axis {_vec(pa.axes[:, k])}   "
@@ -71,7 +77,7 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
         lines.append(f"  bodies ({len(props.parts)}):")
         for b in props.parts:
             lines.append(f"    {b.name}: mass {_num(b.mass)} kg, volume {_num(b.volume)} m³, "
-                         f"centre of mass {_vec(b.center_of_mass, size)} m")
+                         f"centre of mass {_position(b.center_of_mass, size)} m")
     if mesh is not None:
         lines.append("  mesh:")
         lines.append(f"    faces {mesh.faces:,} (file {mesh.file_faces:,}), vertices {mesh.vertices:,}, "
