@@ -335,6 +335,10 @@ def heavy_top(I1: float, I3: float, mass: float, length: float, *, theta0: float
                           precession_rate_slow=slow, precession_rate_fast=fast)
 
 
+#: Most output samples of :func:`simulate_top` (bounds memory and the integrator's work).
+MAX_TOP_SAMPLES = 400_001
+
+
 def simulate_top(top: HeavyTopReport, duration: float, *, samples: int = 2001, rtol: float = 1e-10,
                  atol: float = 1e-12) -> TopTrajectory:
     """Integrate the heavy symmetric top in vector form and return the path of its symmetry axis.
@@ -352,7 +356,7 @@ def simulate_top(top: HeavyTopReport, duration: float, *, samples: int = 2001, r
     duration : float
         s, > 0.
     samples : int
-        Number of output times, evenly spaced in ``[0, duration]``.
+        Number of output times, evenly spaced in ``[0, duration]``; 2 to :data:`MAX_TOP_SAMPLES`.
     rtol, atol : float
         Tolerances of the DOP853 integrator (``scipy.integrate.solve_ivp``).
 
@@ -362,8 +366,8 @@ def simulate_top(top: HeavyTopReport, duration: float, *, samples: int = 2001, r
     """
     if not (duration > 0 and math.isfinite(duration)):
         raise UsageError(f"Expected a positive finite `duration`, got {duration!r}")
-    if int(samples) < 2:
-        raise UsageError(f"Expected `samples` >= 2, got {samples!r}")
+    if not 2 <= int(samples) <= MAX_TOP_SAMPLES:
+        raise UsageError(f"Expected 2 <= `samples` <= {MAX_TOP_SAMPLES}, got {samples!r}")
     i1, i3 = top.transverse_moment, top.axial_moment
     mgl = top.mass * top.gravity * top.length
     th = top.theta0

@@ -166,8 +166,8 @@ def spin_experiment(props, about, rate: float, *, perturbation: float = 1e-3, du
             raise UsageError(
                 f"Undersampled: {n} samples over {duration:g} s are {per_period:.3g} per predicted {what} of "
                 f"{period:.6g} s, fewer than the {min_samples_per_period:g} needed to measure it (the result "
-                f"would alias): shorten the duration to at most {longest:.6g} s (--duration) or use at least "
-                f"{need} samples (--samples{f', at most {max_samples}' if need > max_samples else ''})")
+                f"would alias): shorten the duration to at most {longest:.6g} s or use at least {need} samples"
+                f"{f' (at most {max_samples} are allowed)' if need > max_samples else ''}")
     t = np.linspace(0.0, duration, n)
     traj = simulate(props, w_mesh, t, method=method)
 

@@ -162,7 +162,7 @@ def test_spin_refuses_an_undersampled_simulation(capsys):
     # 400001 samples over 1e6 s are 0.45 per predicted flip interval (1.1185 s): the "measured" 10.6 s was an alias
     assert main(["spin", BOX, "--units", "mm", "--duration", "1e6s"]) == 2
     err = capsys.readouterr().err
-    assert "Undersampled" in err and "--duration" in err and "--samples" in err and err.count("\n") == 1
+    assert "Undersampled" in err and "duration" in err and "samples" in err and err.count("\n") == 1
     assert main(["spin", BOX, "--units", "mm", "--duration", "30s", "--samples", "10"]) == 2
     assert "at least 431 samples" in capsys.readouterr().err
 
