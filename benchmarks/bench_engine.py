@@ -30,27 +30,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 OUT = os.path.join(HERE, "out")
 
-CHILD_OURS = r"""
-import resource, sys, time, io, contextlib
-def peak():
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-t = time.perf_counter()
-from inertia_tool.cli import main
-buf = io.StringIO()
-with contextlib.redirect_stdout(buf):
-    rc = main(["analyze", sys.argv[1], "--json"])
-dt = time.perf_counter() - t
-print(rc, dt, peak())
-"""
-
-CHILD_TRIMESH = r"""
+# every child reports its own peak resident memory (VmHWM; ru_maxrss would include the parent's at the fork)
+_PEAK = r"""
 import resource, sys, time
 def peak():
     try:
@@ -61,6 +42,20 @@ def peak():
     except OSError:
         pass
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+"""
+
+CHILD_OURS = _PEAK + r"""
+import io, contextlib
+t = time.perf_counter()
+from inertia_tool.cli import main
+buf = io.StringIO()
+with contextlib.redirect_stdout(buf):
+    rc = main(["analyze", sys.argv[1], "--json"])
+dt = time.perf_counter() - t
+print(rc, dt, peak())
+"""
+
+CHILD_TRIMESH = _PEAK + r"""
 t = time.perf_counter()
 import trimesh
 m = trimesh.load(sys.argv[1])

@@ -876,6 +876,8 @@ accel_tetra_sums(PyObject *self, PyObject *args)
         return NULL;
     }
     Py_buffer vv, fv, lv, sv, zv;
+    double *acc = NULL;
+    PyObject *result = NULL;
     int have_labels = labels_obj != Py_None, label_size = 0, size;
     Py_ssize_t m;
     if (PyObject_GetBuffer(vert_obj, &vv, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
@@ -933,7 +935,7 @@ accel_tetra_sums(PyObject *self, PyObject *args)
         PyErr_NoMemory();
         goto fail;
     }
-    double *acc = (double *)calloc((size_t)n_labels * 2 * NSUMS, sizeof(double));
+    acc = (double *)calloc((size_t)n_labels * 2 * NSUMS, sizeof(double));
     if (acc == NULL) {
         PyErr_NoMemory();
         goto fail;
@@ -986,7 +988,6 @@ accel_tetra_sums(PyObject *self, PyObject *args)
     }
     Py_END_ALLOW_THREADS
     if (bad_label >= 0) {
-        free(acc);
         PyErr_Format(PyExc_ValueError, "Expected labels in 0..%zd, got %lld at position %zd", n_labels - 1,
                      (long long)index_at(lab, label_size, (size_t)bad_label), bad_label);
         goto fail;
@@ -995,6 +996,9 @@ accel_tetra_sums(PyObject *self, PyObject *args)
     for (Py_ssize_t k = 0; k < n_labels * NSUMS; k++) {
         sums[k] = acc[2 * k] + acc[2 * k + 1];
     }
+    result = Py_None;
+    Py_INCREF(result);
+fail:
     free(acc);
     PyBuffer_Release(&vv);
     PyBuffer_Release(&fv);
@@ -1003,16 +1007,7 @@ accel_tetra_sums(PyObject *self, PyObject *args)
     if (have_labels) {
         PyBuffer_Release(&lv);
     }
-    Py_RETURN_NONE;
-fail:
-    PyBuffer_Release(&vv);
-    PyBuffer_Release(&fv);
-    PyBuffer_Release(&sv);
-    PyBuffer_Release(&zv);
-    if (have_labels) {
-        PyBuffer_Release(&lv);
-    }
-    return NULL;
+    return result;
 }
 
 /* ======================================================================================================

@@ -16,7 +16,7 @@ from .errors import UsageError
 from .stability import AxisStability, StabilityReport, polhode_period, stability
 from .principal import DEFAULT_EQUAL_RTOL
 
-__all__ = ["SpinExperiment", "spin_experiment", "SAMPLES_PER_TURN", "MIN_SAMPLES_PER_PERIOD"]
+__all__ = ["SpinExperiment", "spin_experiment", "SAMPLES_PER_TURN", "MIN_SAMPLES_PER_PERIOD", "MAX_SAMPLES"]
 
 #: Default sampling density of the simulated trajectory (samples per revolution of the spin).
 SAMPLES_PER_TURN = 64
@@ -90,6 +90,9 @@ class SpinExperiment:
     energy_drift: float
 
 
+#: Most output samples of a spin experiment (bounds memory and time).
+MAX_SAMPLES = 400_001
+
 def _crossings(t: np.ndarray, y: np.ndarray, *, upward_only: bool) -> np.ndarray:
     """Times where ``y`` changes sign (or only goes − → +), linearly interpolated."""
     if upward_only:
@@ -101,7 +104,7 @@ def _crossings(t: np.ndarray, y: np.ndarray, *, upward_only: bool) -> np.ndarray
 
 def spin_experiment(props, about, rate: float, *, perturbation: float = 1e-3, duration: float = 30.0,
                     samples: int | None = None, rtol: float = DEFAULT_EQUAL_RTOL, method: str = "auto",
-                    max_samples: int = 400_001,
+                    max_samples: int = MAX_SAMPLES,
                     min_samples_per_period: float = MIN_SAMPLES_PER_PERIOD) -> SpinExperiment:
     """Spin ``props`` about a principal axis, predict the flip or wobble period and simulate it.
 

@@ -11,18 +11,16 @@ import json
 import math
 import os
 import re
-from types import SimpleNamespace
 from contextlib import redirect_stderr, redirect_stdout
 
 import numpy as np
 import pytest
 
-from corpus.make_corpus import ENTRIES, box, make_corpus, prism, write_ascii_stl, write_binary_stl, write_obj
+from corpus.make_corpus import ENTRIES, box, exact_reference, make_corpus, prism, write_ascii_stl, write_binary_stl, write_obj
 from inertia_tool import mass_properties
 from inertia_tool.cli import main
 from inertia_tool.errors import InvalidMeshError, MeshReadError
 from inertia_tool.io import load_mesh
-from inertia_tool.volume import second_moment_to_inertia, volume_moments
 
 REGRESSIONS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "regressions")
 
@@ -42,20 +40,6 @@ def run_cli(*argv):
 def corpus(tmp_path_factory):
     return {e.name: e for e in make_corpus(tmp_path_factory.mktemp("corpus"))}
 
-
-def _expected(bodies):
-    """The exact engine (signed-tetrahedron integrals, no reading, welding or shell logic) on the clean copy.
-
-    ``bodies`` are outward-wound closed shells (a cavity wound inward); overlapping bodies count twice.
-    """
-    vertices, faces, offset = [], [], 0
-    for v, f in bodies:
-        vertices.append(np.asarray(v, dtype=float))
-        faces.append(np.asarray(f) + offset)
-        offset += len(v)
-    m = volume_moments(np.concatenate(vertices), np.concatenate(faces))
-    return SimpleNamespace(mass=1000.0 * m.volume, volume=m.volume, center_of_mass=m.centroid,
-                           inertia=second_moment_to_inertia(m.second_moment, 1000.0))
 
 
 def check_contract(path, code, out, err):
@@ -92,7 +76,7 @@ def test_corpus_entry(corpus, name):
     else:
         assert any(re.search(e.says, w) for w in warnings), warnings
     assert all(os.fsencode(e.path).decode("utf-8", "replace") in w for w in warnings)
-    want = _expected(e.reference)
+    want = exact_reference(e.reference)
     assert result["mass"] == pytest.approx(want.mass, rel=1e-12)
     assert result["volume"] == pytest.approx(want.volume, rel=1e-12)
     size = float(np.linalg.norm(np.ptp(np.concatenate([v for v, _ in e.reference]), axis=0)))

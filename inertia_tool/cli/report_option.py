@@ -67,3 +67,14 @@ def write_report_from_args(args, props, density_source: str | None, warnings=())
         meshes.append((raw.vertices, raw.faces))
     document = html_report(props, meshes=meshes, density_source=density_source, warnings=list(warnings))
     write_html_report(args.report, document, force=args.force)
+
+
+def save_figure(fig, path: str, *, dpi: int = 120) -> None:
+    """Write a matplotlib figure to ``path`` and close it; an OS error becomes a one-line UsageError."""
+    import matplotlib.pyplot as plt
+    try:
+        fig.savefig(path, dpi=dpi)
+    except OSError as exc:
+        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from exc
+    finally:
+        plt.close(fig)

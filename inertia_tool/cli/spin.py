@@ -11,18 +11,16 @@ import numpy as np
 from ..errors import UsageError
 from ..reports.stability import format_spin, format_stability, spin_dict, stability_dict
 from ..reports.serialize import to_jsonable
-from ..spin import spin_experiment
+from ..spin import MAX_SAMPLES, spin_experiment
 from ..stability import AXIS_NAMES
 from ..units import parse_angular_rate, parse_duration
 from ..principal import DEFAULT_EQUAL_RTOL
 from .analyze import add_material_options, add_mesh_options, load_from_args
 from .options import require_range
-from .report_option import check_output_file
+from .report_option import check_output_file, save_figure
 
 __all__ = ["register", "run", "MAX_SAMPLES"]
 
-#: Most samples of the simulated trajectory (bounds memory and time).
-MAX_SAMPLES = 400_001
 
 
 def register(subparsers) -> None:
@@ -84,12 +82,7 @@ def _plot(path: str, experiment) -> None:
     ax.set_title(f"spin about the {experiment.axis.name} axis: {experiment.axis.kind}")
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
-    try:
-        fig.savefig(path, dpi=120)
-    except OSError as exc:
-        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from exc
-    finally:
-        plt.close(fig)
+    save_figure(fig, path)
 
 
 def run(args) -> int:

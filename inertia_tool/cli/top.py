@@ -10,21 +10,20 @@ import warnings
 import numpy as np
 
 from ..errors import NearlyEqualMomentsWarning, UsageError
+from ..heavy_top import MAX_TOP_SAMPLES as MAX_SAMPLES
 from ..heavy_top import STANDARD_GRAVITY, heavy_top_from_mesh
 from ..reports.stability import format_heavy_top, heavy_top_dict
 from ..reports.serialize import to_jsonable
 from ..units import parse_angle, parse_angular_rate, parse_duration, parse_vector
 from .analyze import add_material_options, add_mesh_options, load_from_args
 from .options import require_range
-from .report_option import check_output_file
+from .report_option import check_output_file, save_figure
 
 __all__ = ["register", "run", "MAX_SAMPLES", "MIN_SAMPLES_PER_PERIOD"]
 
 #: Simulated nutation periods when ``--duration`` is not given.
 DEFAULT_PERIODS = 5
 
-#: Most samples of the simulated trajectory (bounds memory).
-MAX_SAMPLES = 400_001
 
 #: Fewest samples per nutation period (or per turn of the spin when there is no nutation) of a simulation:
 #: fewer alias the measured period, and bound the integrator's work (its steps follow the fastest motion).
@@ -94,12 +93,7 @@ def _plot(path: str, top, traj) -> None:
     a2.set_ylabel("axis y")
     a2.set_title(f"axis seen from above: {top.precession_kind}")
     fig.tight_layout()
-    try:
-        fig.savefig(path, dpi=120)
-    except OSError as exc:
-        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from exc
-    finally:
-        plt.close(fig)
+    save_figure(fig, path)
 
 
 def _check_sampling(top, duration: float, samples: int) -> None:

@@ -26,19 +26,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path[:0] = [HERE, ROOT]
 
-from make_corpus import make_corpus, prism  # noqa: E402
-
-from inertia_tool.volume import second_moment_to_inertia, volume_moments  # noqa: E402
-
-
-def reference(bodies, density=1000.0):
-    vertices, faces, offset = [], [], 0
-    for v, f in bodies:
-        vertices.append(np.asarray(v, dtype=float))
-        faces.append(np.asarray(f) + offset)
-        offset += len(v)
-    m = volume_moments(np.concatenate(vertices), np.concatenate(faces))
-    return density * m.volume, m.centroid, second_moment_to_inertia(m.second_moment, density)
+from make_corpus import exact_reference, make_corpus, prism  # noqa: E402
 
 
 _LAUNCH = """
@@ -113,7 +101,8 @@ def main(argv):
                     problems.append("error is not one line naming the file")
             if code == 0 and ref is not None:
                 r = json.loads(out)
-                mass, com, inertia = reference(ref)
+                want = exact_reference(ref)
+                mass, com, inertia = want.mass, want.center_of_mass, want.inertia
                 scale = np.abs(inertia).max()
                 size = np.ptp(np.concatenate([v for v, _ in ref]), axis=0).max()
                 if not (abs(r["mass"] - mass) <= 1e-12 * mass

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Entry", "ENTRIES", "make_corpus", "box", "write_binary_stl", "write_ascii_stl", "write_obj"]
+__all__ = ["Entry", "ENTRIES", "make_corpus", "exact_reference", "box", "write_binary_stl", "write_ascii_stl", "write_obj"]
 
 
 @dataclass
@@ -76,6 +76,24 @@ def prism(n=64, radius=0.5, height=2.0):
     top = np.c_[np.full(n, 2 * n + 1), n + i, n + j]
     side = np.r_[np.c_[i, j, n + j], np.c_[i, n + j, n + i]]
     return v, np.r_[bottom, top, side]
+
+
+def exact_reference(bodies, density=1000.0):
+    """What an accepted corpus file must give: the exact engine (signed-tetrahedron integrals, no reading,
+    welding or shell logic) on the clean ``bodies`` — outward-wound closed shells, a cavity wound inward,
+    overlapping bodies counted twice.  Returns ``mass`` (kg), ``volume`` (m³), ``center_of_mass`` (m) and
+    ``inertia`` (kg·m² about the centre of mass) at ``density`` kg/m³."""
+    from types import SimpleNamespace
+
+    from inertia_tool.volume import second_moment_to_inertia, volume_moments
+    vertices, faces, offset = [], [], 0
+    for v, f in bodies:
+        vertices.append(np.asarray(v, dtype=float))
+        faces.append(np.asarray(f) + offset)
+        offset += len(v)
+    m = volume_moments(np.concatenate(vertices), np.concatenate(faces))
+    return SimpleNamespace(mass=density * m.volume, volume=m.volume, center_of_mass=m.centroid,
+                           inertia=second_moment_to_inertia(m.second_moment, density))
 
 
 def write_binary_stl(path, vertices, faces, header=b"binary corpus", extra=b"", count=None):
