@@ -71,3 +71,17 @@ def engine_path(request, monkeypatch):
     else:
         monkeypatch.setenv("INERTIA_TOOL_NO_ACCEL", "1")
     return request.param
+
+
+def assert_tensor_close(actual, desired, rtol, err_msg=""):
+    """Compare two computed tensors with a tolerance scaled to the tensor, not entry by entry.
+
+    A relative tolerance alone fails on entries that are round-off zeros (an off-diagonal of -7.5e-38 against
+    0.0 is a perfect match for a tensor of norm 1e-5, but infinitely far in relative terms); an absolute one
+    alone means nothing across units.  Every entry must agree to ``rtol`` times the larger Frobenius norm of
+    the two tensors, plus ``rtol`` relative to itself.
+    """
+    actual = np.asarray(actual, dtype=float)
+    desired = np.asarray(desired, dtype=float)
+    scale = max(np.linalg.norm(actual), np.linalg.norm(desired))
+    np.testing.assert_allclose(actual, desired, rtol=rtol, atol=rtol * scale, err_msg=err_msg)

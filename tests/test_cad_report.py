@@ -13,6 +13,7 @@ from inertia_tool.cli import main
 from inertia_tool.errors import UsageError
 from inertia_tool.inertial import positive_tensor_notation
 from inertia_tool.reports.cad import format_cad_report
+from conftest import assert_tensor_close
 
 
 @pytest.fixture(scope="module")
@@ -59,8 +60,7 @@ def test_values_and_output_coordinate_system(props):
     assert _value(text, "Surface area") == pytest.approx(2 * (8e-4 + 4e-4 + 2e-4), rel=1e-7)
     np.testing.assert_allclose([_value(text, c) for c in "XYZ"], [0.1, -0.05, 0.02], rtol=1e-7)
     about = _tensor(text, "I", "Taken at the output coordinate system")
-    np.testing.assert_allclose(about, positive_tensor_notation(np.asarray(props.inertia_about(np.zeros(3)))),
-                               rtol=1e-7)
+    assert_tensor_close(about, positive_tensor_notation(np.asarray(props.inertia_about(np.zeros(3)))), rtol=1e-7)
     moments = [_value(text, f"P{c}") for c in "xyz"]
     np.testing.assert_allclose(moments, props.principal.moments, rtol=1e-7)
     assert moments == sorted(moments)
@@ -75,7 +75,7 @@ def test_gram_millimetre_units(props):
     assert _value(text, "Volume") == pytest.approx(8000.0, rel=1e-7)
     assert _value(text, "X") == pytest.approx(100.0, rel=1e-7)
     central = _tensor(text, "L", "Taken at the center of mass and aligned")
-    np.testing.assert_allclose(central, positive_tensor_notation(props.inertia) * 1e9, rtol=1e-7)
+    assert_tensor_close(central, positive_tensor_notation(props.inertia) * 1e9, rtol=1e-7)
 
 
 def test_positive_tensor_notation_only_flips_products():

@@ -7,6 +7,7 @@ import trimesh
 from inertia_tool import mass_properties
 from inertia_tool.errors import PhysicsError, UsageError
 from inertia_tool.thinwall import printed_part
+from conftest import assert_tensor_close
 
 A, B, C, RHO = 0.08, 0.05, 0.03, 1240.0   # a PLA block, m and kg/m³
 
@@ -81,8 +82,7 @@ def test_weighed_print_scales_density(block):
     part = printed_part(block, skin=0.0012, infill=0.15, mass=0.05)
     assert part.properties.mass == pytest.approx(0.05)
     ref = printed_part(block, skin=0.0012, infill=0.15, density=RHO)
-    np.testing.assert_allclose(part.properties.inertia, ref.properties.inertia * 0.05 / ref.properties.mass,
-                               rtol=1e-12)
+    assert_tensor_close(part.properties.inertia, ref.properties.inertia * 0.05 / ref.properties.mass, rtol=1e-12)
 
 
 def test_skin_thicker_than_the_part_is_refused(block):
