@@ -24,8 +24,9 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import numpy as np  # noqa: E402
 import trimesh  # noqa: E402
 
-from inertia_tool.batch import BatchOptions, discover_files, run_batch  # noqa: E402
-from inertia_tool.reports.rows import open_results  # noqa: E402
+from inertia_tool.mesh import LoadOptions
+from inertia_tool.batch.runner import BatchOptions, discover_files, run_batch  # noqa: E402
+from inertia_tool.batch.rows import open_results  # noqa: E402
 
 
 def _write_stl(path, mesh):
@@ -62,7 +63,7 @@ def make_meshes(directory: str, count: int, seed: int = 0) -> int:
 
 def _run(files, out, **kw):
     with open_results(out) as r:
-        summary = run_batch(files, BatchOptions(units="mm", density=1240.0), r.write_row, **kw)
+        summary = run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1240.0), r.write_row, **kw)
     if summary.ok != len(files):
         raise SystemExit(f"benchmark: {summary.failed} files failed")
     return summary.seconds

@@ -1,4 +1,4 @@
-"""Tests of inertia_tool.balance: hand-computed corrections, ISO 21940-11 examples, kinds, bearing loads."""
+"""Tests of inertia_tool.balancing.rotor: hand-computed corrections, ISO 21940-11 examples, kinds, bearing loads."""
 
 import math
 
@@ -9,11 +9,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from inertia_tool.balance import (ISO_GRADES, balance, balance_grade, permissible_unbalance, shaft_frame,
+from inertia_tool.balancing.rotor import (ISO_GRADES, balance, balance_grade, permissible_unbalance, shaft_frame,
                                   unbalance_state)
 from inertia_tool.errors import UsageError
-from inertia_tool.properties import MassProperties, combine, point_mass
-from inertia_tool.volume import second_moment_to_inertia, volume_moments
+from inertia_tool.mass.properties import MassProperties, combine, point_mass
+from inertia_tool.mass.volume import second_moment_to_inertia, volume_moments
 
 STEEL = 7850.0
 Z = [0.0, 0.0, 1.0]

@@ -1,4 +1,4 @@
-"""Batch engine (inertia_tool.batch), result files (reports.rows) and the ``batch`` command."""
+"""Batch engine (inertia_tool.batch.runner), result files (reports.rows) and the ``batch`` command."""
 
 import json
 import os
@@ -12,13 +12,14 @@ import pytest
 import trimesh
 
 from conftest import write_binary_stl
-from inertia_tool import batch as batch_mod
+from inertia_tool.mesh import LoadOptions
+from inertia_tool.batch import runner as batch_mod
 from inertia_tool import mass_properties
-from inertia_tool.batch import (ROW_FIELDS, SCHEMA, BatchOptions, analyze_file, discover_files, file_sha256,
+from inertia_tool.batch.runner import (ROW_FIELDS, SCHEMA, BatchOptions, analyze_file, discover_files, file_sha256,
                                 run_batch)
 from inertia_tool.cli import main
 from inertia_tool.errors import UsageError
-from inertia_tool.reports.rows import open_results
+from inertia_tool.batch.rows import open_results
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -66,7 +67,7 @@ def test_analyze_file_box_closed_form(parts):
     d, boxes, _ = parts
     path = next(iter(boxes))
     a, b, c = (x * 1e-3 for x in boxes[path])
-    row = analyze_file(path, BatchOptions(units="mm", density=1240.0))
+    row = analyze_file(path, BatchOptions(load=LoadOptions(units="mm"), density=1240.0))
     assert set(row) == set(ROW_FIELDS)
     assert row["status"] == "ok" and row["schema"] == SCHEMA
     mass = 1240.0 * a * b * c
@@ -82,7 +83,7 @@ def test_analyze_file_box_closed_form(parts):
 def test_corrupt_file_is_an_error_row_and_the_batch_goes_on(parts):
     d, boxes, bad = parts
     rows = []
-    summary = run_batch(discover_files(d), BatchOptions(units="mm"), rows.append)
+    summary = run_batch(discover_files(d), BatchOptions(load=LoadOptions(units="mm")), rows.append)
     assert summary.ok == 4 and summary.failed == 1 and summary.skipped == 0
     by_path = {r["path"]: r for r in rows}
     assert by_path[bad]["status"] == "error" and by_path[bad]["error_type"] == "MeshReadError"
@@ -110,7 +111,7 @@ def test_resume_skips_done_files_by_hash_and_options(parts, tmp_path, suffix):
     d, boxes, bad = parts
     out = tmp_path / f"results.{suffix}"
     files = discover_files(d)
-    opts = BatchOptions(units="mm", density=1240.0)
+    opts = BatchOptions(load=LoadOptions(units="mm"), density=1240.0)
     with open_results(out) as r:
         first = run_batch(files, opts, r.write_row, previous_rows=r.previous_rows)
     assert (first.ok, first.failed, first.skipped) == (4, 1, 0)
@@ -126,7 +127,7 @@ def test_resume_skips_done_files_by_hash_and_options(parts, tmp_path, suffix):
     assert (third.ok, third.skipped) == (1, 4)
     # a changed option that affects the numbers recomputes everything
     with open_results(out) as r:
-        fourth = run_batch(files, BatchOptions(units="mm", density=7850.0), r.write_row,
+        fourth = run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=7850.0), r.write_row,
                            previous_rows=r.previous_rows)
     assert (fourth.ok, fourth.failed, fourth.skipped) == (4, 1, 0)
     rows = _rows(out)
@@ -158,7 +159,7 @@ def test_round_trip_keeps_every_value(parts, tmp_path, suffix):
         def write(row):
             rows.append(row)
             r.write_row(row)
-        run_batch(discover_files(d), BatchOptions(units="mm", material="pla"), write)
+        run_batch(discover_files(d), BatchOptions(load=LoadOptions(units="mm"), material="pla"), write)
     back = _rows(out)
     assert back == rows          # floats written with repr(): bit-exact
 
@@ -226,8 +227,8 @@ def test_process_pool_gives_the_same_rows_as_in_process(parts):
     d, boxes, _ = parts
     files = discover_files(d)
     one, two = [], []
-    s1 = run_batch(files, BatchOptions(units="mm"), one.append, jobs=1)
-    s2 = run_batch(files, BatchOptions(units="mm"), two.append, jobs=2, max_in_flight=2)
+    s1 = run_batch(files, BatchOptions(load=LoadOptions(units="mm")), one.append, jobs=1)
+    s2 = run_batch(files, BatchOptions(load=LoadOptions(units="mm")), two.append, jobs=2, max_in_flight=2)
     assert (s1.ok, s1.failed) == (s2.ok, s2.failed) == (4, 1)
     strip = lambda r: {k: v for k, v in r.items() if k not in ("seconds", "worker")}  # noqa: E731
     assert sorted(map(json.dumps, map(strip, one))) == sorted(map(json.dumps, map(strip, two)))
@@ -237,7 +238,7 @@ def test_process_pool_gives_the_same_rows_as_in_process(parts):
 def test_row_numbers_match_mass_properties(parts):
     d, boxes, _ = parts
     path = sorted(boxes)[3]
-    row = analyze_file(path, BatchOptions(units="mm", mass=0.25))
+    row = analyze_file(path, BatchOptions(load=LoadOptions(units="mm"), mass=0.25))
     props = mass_properties(path, units="mm", mass=0.25)
     assert row["mass"] == pytest.approx(0.25, rel=1e-12)
     np.testing.assert_allclose(np.array([[row[f"axis{k}_{c}"] for k in (1, 2, 3)] for c in "xyz"]),

@@ -8,9 +8,10 @@ import pytest
 import trimesh
 
 from conftest import write_binary_stl
-from inertia_tool.batch import BatchOptions, discover_files, run_batch
+from inertia_tool.mesh import LoadOptions
+from inertia_tool.batch.runner import BatchOptions, discover_files, run_batch
 from inertia_tool.cli import main
-from inertia_tool.reports.rows import open_results
+from inertia_tool.batch.rows import open_results
 
 distributed = pytest.importorskip("dask.distributed", reason="the 'dask' extra is not installed")
 
@@ -35,10 +36,10 @@ def test_local_cluster_matches_in_process_rows(meshes):
 
     files = discover_files(meshes)
     local_rows, dask_rows = [], []
-    run_batch(files, BatchOptions(units="mm", density=1240.0), local_rows.append)
+    run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1240.0), local_rows.append)
     executor, shutdown = dask_executor("local", 2)
     try:
-        summary = run_batch(files, BatchOptions(units="mm", density=1240.0), dask_rows.append, jobs=2,
+        summary = run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1240.0), dask_rows.append, jobs=2,
                             executor=executor)
     finally:
         shutdown()

@@ -11,7 +11,7 @@ from conftest import write_binary_stl
 from inertia_tool import mass_properties
 from inertia_tool.cli import main
 from inertia_tool.errors import UsageError
-from inertia_tool.inertial import positive_tensor_notation
+from inertia_tool.robot.inertial import positive_tensor_notation
 from inertia_tool.reports.cad import format_cad_report
 from conftest import assert_tensor_close
 

@@ -38,7 +38,7 @@ def test_json_matches_the_python_api_and_balances_the_wheel(wheel, capsys):
     # the wheel was made with a 0.2° tilt: the nearest principal axis is tilted by about that much
     assert np.degrees(out["initial"]["tilt"]) == pytest.approx(0.2, abs=0.01)
     # apply the JSON corrections ourselves: static and couple unbalance vanish to round-off
-    fixed = it.combine([wheel] + [it.point_mass(c["mass"], c["position"]) for c in out["corrections"]])
+    fixed = it.mass.combine([wheel] + [it.mass.point_mass(c["mass"], c["position"]) for c in out["corrections"]])
     u0 = out["initial"]["static_unbalance_magnitude"]
     assert np.linalg.norm(fixed.mass * fixed.center_of_mass[:2]) < 1e-10 * u0
     j = np.asarray(fixed.inertia_about([0, 0, 0]))

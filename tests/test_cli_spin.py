@@ -169,10 +169,10 @@ def test_spin_refuses_an_undersampled_simulation(capsys):
 
 def test_spin_engine_sampling_bound_and_well_sampled_measurement():
     props = it.mass_properties(BOX, units="mm")
-    with pytest.raises(it.UsageError, match="Undersampled"):
-        it.spin_experiment(props, "intermediate", 10 * math.pi, duration=1e6)
+    with pytest.raises(it.errors.UsageError, match="Undersampled"):
+        it.dynamics.spin_experiment(props, "intermediate", 10 * math.pi, duration=1e6)
     # just above the bound (16 per flip interval) the measured interval still matches the prediction
-    e = it.spin_experiment(props, "intermediate", 10 * math.pi, duration=60.0, samples=int(60 / 1.11851 * 17) + 1)
+    e = it.dynamics.spin_experiment(props, "intermediate", 10 * math.pi, duration=60.0, samples=int(60 / 1.11851 * 17) + 1)
     assert e.measured_period == pytest.approx(e.predicted_period, rel=5e-3)
 
 
@@ -206,7 +206,7 @@ def test_numeric_options_are_checked_with_their_names(capsys, argv, message):
 
 def test_spin_rtol_default_is_the_library_default():
     from inertia_tool.cli import build_parser
-    from inertia_tool.principal import DEFAULT_EQUAL_RTOL
+    from inertia_tool.mass.principal import DEFAULT_EQUAL_RTOL
     assert build_parser().parse_args(["spin", BOX]).rtol == DEFAULT_EQUAL_RTOL
 
 
@@ -228,6 +228,6 @@ def test_top_report_without_nutation_says_so(capsys):
     out = capsys.readouterr().out
     assert "no nutation period seen within the simulated time" in out and "nan" not in out
     props = it.mass_properties(TOP, units="mm", material="steel")
-    top = it.heavy_top_from_mesh(props, [0, 0, 0], theta0=0.3, omega3=300.0)
+    top = it.dynamics.heavy_top_on_pivot(props, [0, 0, 0], theta0=0.3, omega3=300.0)
     text = format_heavy_top(dataclasses.replace(top, nutation_period=math.inf))
     assert "no nutation period (θ never returns)" in text and "never s" not in text

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from conftest import box_arrays
-from inertia_tool import mass_properties, point_mass
-from inertia_tool.volume import volume_moments
+from inertia_tool import mass_properties
+from inertia_tool.mass import point_mass
+from inertia_tool.mass.volume import volume_moments
 from conftest import assert_tensor_close
 
 

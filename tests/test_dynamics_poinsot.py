@@ -10,7 +10,7 @@ from inertia_tool.dynamics import invariant_plane
 def test_polhode_is_closed_and_on_the_ellipsoid_and_L_sphere():
     tensor = np.diag([1.0, 2.0, 3.0])
     w0 = np.array([0.1, 1.0, 0.05])
-    t, w = it.polhode(tensor, w0, samples=201)
+    t, w = it.dynamics.polhode(tensor, w0, samples=201)
     two_t = w0 @ tensor @ w0
     np.testing.assert_allclose(np.einsum("ni,ij,nj->n", w, tensor, w), two_t, rtol=1e-13)
     np.testing.assert_allclose(np.linalg.norm(w @ tensor, axis=1), np.linalg.norm(tensor @ w0), rtol=1e-13)
@@ -22,7 +22,7 @@ def test_herpolhode_on_invariant_plane_and_rate_for_symmetric_body():
     moments = [1.0, 1.0, 2.5]
     w0 = np.array([0.4, 0.0, 1.0])
     t = np.linspace(0, 10, 201)
-    points, xy = it.herpolhode(moments, w0, t)
+    points, xy = it.dynamics.herpolhode(moments, w0, t)
     normal, distance = invariant_plane(moments, w0)
     np.testing.assert_allclose(points @ normal, distance, rtol=1e-13)
     radius = np.hypot(xy[:, 0], xy[:, 1])

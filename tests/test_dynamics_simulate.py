@@ -35,7 +35,7 @@ def test_body_argument_forms_agree():
     w0 = [0.3, -0.2, 0.9]
     a = it.simulate([2.0, 1.0, 3.0], w0, t)
     b = it.simulate(np.diag([2.0, 1.0, 3.0]), w0, t)
-    c = it.simulate(it.principal_axes(np.diag([2.0, 1.0, 3.0])), w0, t)
+    c = it.simulate(it.mass.principal_axes(np.diag([2.0, 1.0, 3.0])), w0, t)
     for other in (b, c):
         np.testing.assert_allclose(other.angular_velocity, a.angular_velocity, atol=1e-13)
         np.testing.assert_allclose(other.rotation_matrices, a.rotation_matrices, atol=1e-13)
@@ -43,8 +43,8 @@ def test_body_argument_forms_agree():
 
 
 def test_mass_properties_body_uses_principal():
-    props = it.point_mass(2.0, [0.5, 0.0, 0.0]) + it.point_mass(2.0, [-0.5, 0.0, 0.0]) \
-        + it.point_mass(1.0, [0.0, 0.7, 0.0]) + it.point_mass(1.0, [0.0, -0.7, 0.3])
+    props = it.mass.point_mass(2.0, [0.5, 0.0, 0.0]) + it.mass.point_mass(2.0, [-0.5, 0.0, 0.0]) \
+        + it.mass.point_mass(1.0, [0.0, 0.7, 0.0]) + it.mass.point_mass(1.0, [0.0, -0.7, 0.3])
     traj = it.simulate(props, [0.2, 0.3, 1.0], np.linspace(0, 3, 4))
     np.testing.assert_allclose(traj.tensor, props.inertia if hasattr(props.inertia, "shape") else
                                np.asarray(props.inertia), atol=1e-12)

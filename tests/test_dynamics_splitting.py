@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 import inertia_tool as it
 from inertia_tool.dynamics.splitting import SCHEMES, integrate_splitting
 from inertia_tool.errors import UsageError
-from inertia_tool.heavy_top import heavy_top, simulate_top
+from inertia_tool.dynamics.top import heavy_top, simulate_top
 from inertia_tool.rotations import quaternion_to_matrix
 
 from dynamics_reference import dop853

@@ -1,4 +1,4 @@
-"""Equivalent inertia ellipsoid (inertia_tool.ellipsoid)."""
+"""Equivalent inertia ellipsoid (inertia_tool.mass.ellipsoid)."""
 
 import numpy as np
 import pytest
@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from inertia_tool import mass_properties
-from inertia_tool.ellipsoid import equivalent_ellipsoid_semi_axes
+from inertia_tool.mass.ellipsoid import equivalent_ellipsoid_semi_axes
 from inertia_tool.errors import PhysicsError, UsageError
 
 

@@ -7,8 +7,8 @@ import pytest
 from scipy.integrate import quad, solve_ivp
 
 from inertia_tool.errors import AsymmetricTopWarning, PhysicsError, UsageError
-from inertia_tool.heavy_top import heavy_top, heavy_top_from_mesh
-from inertia_tool.properties import MassProperties
+from inertia_tool.dynamics.top import heavy_top, heavy_top_on_pivot
+from inertia_tool.mass.properties import MassProperties
 
 # a toy top: I1 about the pivot, I3 axial, 0.5 kg with its centre of mass 4 cm above the tip
 I1, I3, M, L = 1.2e-3, 6.0e-4, 0.5, 0.04
@@ -173,7 +173,7 @@ def test_from_mesh_properties_cylinder_on_its_base():
     props = MassProperties(mass=mass, volume=math.pi * radius ** 2 * height,
                            center_of_mass=base + [0, height / 2, 0],
                            inertia=np.diag([central_transverse, axial, central_transverse]))
-    top = heavy_top_from_mesh(props, base, theta0=0.3, omega3=100.0)
+    top = heavy_top_on_pivot(props, base, theta0=0.3, omega3=100.0)
     assert top.length == pytest.approx(height / 2)
     assert top.axial_moment == pytest.approx(axial, rel=1e-12)
     assert top.transverse_moment == pytest.approx(central_transverse + mass * (height / 2) ** 2, rel=1e-12)
@@ -185,9 +185,9 @@ def test_from_mesh_properties_cylinder_on_its_base():
 def test_from_mesh_asymmetric_warns_and_pivot_at_com_fails():
     props = MassProperties(mass=1.0, volume=1e-3, center_of_mass=[0, 0, 0.1], inertia=np.diag([1e-3, 2e-3, 5e-4]))
     with pytest.warns(AsymmetricTopWarning, match="not a symmetric top"):
-        heavy_top_from_mesh(props, [0, 0, 0], theta0=0.2, omega3=50.0)
+        heavy_top_on_pivot(props, [0, 0, 0], theta0=0.2, omega3=50.0)
     with pytest.raises(PhysicsError):
-        heavy_top_from_mesh(props, [0, 0, 0.1], theta0=0.2, omega3=50.0)
+        heavy_top_on_pivot(props, [0, 0, 0.1], theta0=0.2, omega3=50.0)
 
 
 def test_bad_arguments():

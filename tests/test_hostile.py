@@ -20,7 +20,7 @@ from corpus.make_corpus import ENTRIES, box, exact_reference, make_corpus, prism
 from inertia_tool import mass_properties
 from inertia_tool.cli import main
 from inertia_tool.errors import InvalidMeshError, MeshReadError
-from inertia_tool.io import load_mesh
+from inertia_tool.mesh.read import load_mesh
 
 REGRESSIONS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "regressions")
 
@@ -109,7 +109,7 @@ def test_non_utf8_file_name_prints_in_one_line(tmp_path, capsys):
 @pytest.mark.parametrize("newline", [b"\n", b"\r\n", b"\r"])
 def test_ascii_stl_streams_across_block_boundaries(tmp_path, monkeypatch, newline):
     """Tiny read blocks split lines (and \\r\\n pairs) everywhere; the result must not change."""
-    import inertia_tool.io as mesh_io
+    import inertia_tool.mesh.read as mesh_io
     v, f = prism(n=20)
     p = tmp_path / "p.stl"
     write_ascii_stl(p, v, f, newline=newline)
@@ -123,7 +123,7 @@ def test_ascii_stl_streams_across_block_boundaries(tmp_path, monkeypatch, newlin
 
 def test_old_mac_file_is_read_in_bounded_blocks(tmp_path, monkeypatch):
     """A CR-only file is many lines, not one giant line: no block ever exceeds the block size + a line."""
-    import inertia_tool.io as mesh_io
+    import inertia_tool.mesh.read as mesh_io
     v, f = prism(n=200)
     p = tmp_path / "mac.stl"
     write_ascii_stl(p, v, f, newline=b"\r")
@@ -180,7 +180,7 @@ def test_max_faces_guards_every_format(tmp_path):
 
 def test_binary_header_claim_is_checked_before_allocation(tmp_path, monkeypatch):
     """A lying count must be refused without numpy ever being asked for the announced array."""
-    import inertia_tool.io as mesh_io
+    import inertia_tool.mesh.read as mesh_io
     p = tmp_path / "liar.stl"
     write_binary_stl(p, *box(), count=4_000_000_000)
     calls = []

@@ -143,14 +143,14 @@ def test_edge_count_is_bounded_for_large_meshes():
 
 
 def test_stability_section_absent_when_module_missing(monkeypatch):
-    monkeypatch.setitem(sys.modules, "inertia_tool.stability", None)      # import now raises ImportError
+    monkeypatch.setitem(sys.modules, "inertia_tool.dynamics.spin_stability", None)      # import now raises ImportError
     m = _t_handle()
     doc = html_report(mass_properties(m), meshes=[(m.vertices, m.faces)])
     assert "Spin stability" not in _parse(doc).headings
 
 
 def test_stability_section_present_with_the_real_module():
-    stability_mod = pytest.importorskip("inertia_tool.stability", reason="inertia_tool.stability not merged yet")
+    stability_mod = pytest.importorskip("inertia_tool.dynamics.spin_stability", reason="inertia_tool.dynamics.spin_stability not merged yet")
     m = _t_handle()
     props = mass_properties(m)
     p = _parse(html_report(props, meshes=[(m.vertices, m.faces)]))

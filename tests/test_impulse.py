@@ -10,9 +10,9 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from inertia_tool.errors import PhysicsError, UsageError
-from inertia_tool.impulse import apply_impulse
-from inertia_tool.properties import MassProperties, point_mass
-from inertia_tool.volume import second_moment_to_inertia, volume_moments
+from inertia_tool.dynamics.impulse import apply_impulse
+from inertia_tool.mass.properties import MassProperties, point_mass
+from inertia_tool.mass.volume import second_moment_to_inertia, volume_moments
 
 RADIUS, HEIGHT, DENSITY = 0.03, 0.08, 2700.0
 
@@ -126,7 +126,7 @@ def test_bad_input():
 def test_cone_apex_path_after_the_blow_matches_free_precession(method):
     """Exercise 4.6(c): after the blow the apex circles the fixed L at |L|/I1 while the COM drifts at P/M.
 
-    The simulated motion (inertia_tool.dynamics.simulate, closed form or numerical) composed by position_of
+    The simulated motion (inertia_tool.dynamics.simulation, closed form or numerical) composed by position_of
     must reproduce the closed form of the free symmetric top.
     """
     cone = _analytic_cone()

@@ -7,7 +7,7 @@ import trimesh
 
 from conftest import box_arrays, write_ascii_stl, write_binary_stl
 from inertia_tool.errors import MeshReadError, TrailingDataWarning, UsageError
-from inertia_tool.io import load_mesh, read_stl
+from inertia_tool.mesh.read import load_mesh, read_stl
 
 
 # every test runs on the C extension (when built) and on the pure-numpy path

@@ -168,8 +168,8 @@ def test_trimesh_cross_check_on_random_convex_hulls():
 
 def test_unphysical_moments_warn():
     from inertia_tool.errors import PhysicalValidityWarning
-    from inertia_tool.pipeline import _check_physical
-    from inertia_tool.properties import MassProperties
+    from inertia_tool.mass.pipeline import _check_physical
+    from inertia_tool.mass.properties import MassProperties
     bad = MassProperties(mass=1.0, volume=1.0, center_of_mass=[0, 0, 0], inertia=np.diag([1.0, 1.0, 3.0]), name="x")
     with pytest.warns(PhysicalValidityWarning, match="triangle inequality"):
         _check_physical(bad)

@@ -5,7 +5,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from inertia_tool.errors import UsageError
-from inertia_tool.principal import principal_axes
+from inertia_tool.mass.principal import principal_axes
 
 
 def _random_rotation(seed):

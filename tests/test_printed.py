@@ -6,7 +6,7 @@ import trimesh
 
 from inertia_tool import mass_properties
 from inertia_tool.errors import PhysicsError, UsageError
-from inertia_tool.thinwall import printed_part
+from inertia_tool.mass.thinwall import printed_part
 from conftest import assert_tensor_close
 
 A, B, C, RHO = 0.08, 0.05, 0.03, 1240.0   # a PLA block, m and kg/m³

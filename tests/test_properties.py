@@ -4,7 +4,8 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from conftest import box_arrays
-from inertia_tool import combine, mass_properties, point_mass
+from inertia_tool import mass_properties
+from inertia_tool.mass import combine, point_mass
 from inertia_tool.errors import UsageError
 from conftest import assert_tensor_close
 
@@ -24,7 +25,7 @@ def test_parallel_axis_theorem_against_direct_integration():
     p = mass_properties((v, f))
     point = np.array([1.0, 2.0, -3.0])
     about = np.asarray(p.inertia_about(point))
-    from inertia_tool.volume import volume_moments
+    from inertia_tool.mass.volume import volume_moments
     vm = volume_moments(v - point, f)
     d = vm.centroid
     second_about_point = vm.second_moment + vm.volume * np.outer(d, d)

@@ -12,10 +12,10 @@ from conftest import write_binary_stl
 from inertia_tool import mass_properties
 from inertia_tool.cli import main
 from inertia_tool.errors import PhysicsError, UsageError
-from inertia_tool.inertial import (GAZEBO_TOLERANCE, check_moments, inertial_frame, quaternion_from_matrix,
+from inertia_tool.robot.inertial import (GAZEBO_TOLERANCE, check_moments, inertial_frame, quaternion_from_matrix,
                                    rpy_from_matrix)
-from inertia_tool.properties import MassProperties
-from inertia_tool.reports.robot import format_inertial, format_mjcf, format_sdf, format_urdf
+from inertia_tool.mass.properties import MassProperties
+from inertia_tool.robot.formats import format_inertial, format_mjcf, format_sdf, format_urdf
 
 
 def _rx(a):
@@ -125,7 +125,7 @@ def test_mjcf_fullinertia_order(tilted):
 def test_thin_plate_shell_is_accepted_by_mujoco():
     """A flat plate sits on the triangle-inequality boundary; with the t²/12 term it is inside, and MuJoCo agrees."""
     mujoco = pytest.importorskip("mujoco")
-    from inertia_tool.thinwall import shell_mass_properties
+    from inertia_tool.mass.thinwall import shell_mass_properties
     v = np.array([[0, 0, 0], [0.2, 0, 0], [0.2, 0.1, 0], [0, 0.1, 0]], dtype=float)
     plate = shell_mass_properties((v, np.array([[0, 1, 2], [0, 2, 3]])), thickness=0.001, material="steel")
     frame = inertial_frame(plate)

@@ -1,4 +1,4 @@
-"""Tests of inertia_tool.shapes: the meshes are valid closed solids, ``mesh_exact`` is the polyhedron the mesh
+"""Tests of inertia_tool.mass.shapes: the meshes are valid closed solids, ``mesh_exact`` is the polyhedron the mesh
 bounds (checked against the signed-tetrahedron engine), and ``exact`` is the ideal solid (checked against
 scipy quadrature of the solid of revolution and against Richardson extrapolation of ``mesh_exact``)."""
 
@@ -11,9 +11,10 @@ import pytest
 import trimesh
 from scipy import integrate
 
-from inertia_tool import mass_properties, shapes
+from inertia_tool import mass_properties
+from inertia_tool.mass import shapes
 from inertia_tool.errors import UsageError
-from inertia_tool.volume import body_volume_moments, second_moment_to_inertia, volume_moments
+from inertia_tool.mass.volume import body_volume_moments, second_moment_to_inertia, volume_moments
 
 # Small resolutions keep the suite fast; every constructor appears once.
 SOLIDS = {

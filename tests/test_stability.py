@@ -11,10 +11,10 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
 from inertia_tool.errors import PhysicalValidityWarning, PhysicsError, UsageError
-from inertia_tool.principal import principal_axes
-from inertia_tool.properties import MassProperties
-from inertia_tool.stability import polhode_period, stability
-from inertia_tool.volume import second_moment_to_inertia, volume_moments
+from inertia_tool.mass.principal import principal_axes
+from inertia_tool.mass.properties import MassProperties
+from inertia_tool.dynamics.spin_stability import polhode_period, stability
+from inertia_tool.mass.volume import second_moment_to_inertia, volume_moments
 
 
 def _octahedron(a, b, c):

@@ -1,4 +1,4 @@
-"""Surface and curve moments (inertia_tool.surface) and the shell model (thinwall.shell_mass_properties)."""
+"""Surface and curve moments (inertia_tool.mass.surface) and the shell model (thinwall.shell_mass_properties)."""
 
 import numpy as np
 import pytest
@@ -9,9 +9,9 @@ from scipy import integrate
 from scipy.spatial.transform import Rotation
 
 from inertia_tool.errors import UsageError
-from inertia_tool.surface import (curve_moments, inward_offset_coefficient, shell_inertia, surface_moments,
+from inertia_tool.mass.surface import (curve_moments, inward_offset_coefficient, shell_inertia, surface_moments,
                                   wire_inertia)
-from inertia_tool.thinwall import shell_mass_properties
+from inertia_tool.mass.thinwall import shell_mass_properties
 from conftest import assert_tensor_close
 
 

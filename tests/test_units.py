@@ -16,7 +16,7 @@ def test_density_spellings(text, expected):
 
 
 def test_printed_density_reads_back():
-    from inertia_tool.pipeline import resolve_density
+    from inertia_tool.mass.pipeline import resolve_density
     _, text = resolve_density(density=2712.5)          # "2712.5 kg/m³", as the reports print it
     assert parse_density(text) == 2712.5
 

@@ -1,4 +1,4 @@
-"""Reference tests of the signed-tetrahedron engine (inertia_tool.volume) against closed forms (the chapter's
+"""Reference tests of the signed-tetrahedron engine (inertia_tool.mass.volume) against closed forms (the chapter's
 exercises 4.6 and 4.9 and §4.3.2), Tonon (2004)'s published tetrahedron, trimesh, an independent
 surface-quadrature integrator, and hypothesis property tests (rotation, translation, scaling)."""
 
@@ -13,9 +13,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from inertia_tool import shapes
-from inertia_tool.properties import MassProperties
-from inertia_tool.volume import body_volume_moments, second_moment_to_inertia, volume_moments
+from inertia_tool.mass import shapes
+from inertia_tool.mass.properties import MassProperties
+from inertia_tool.mass.volume import body_volume_moments, second_moment_to_inertia, volume_moments
 from conftest import assert_tensor_close
 
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from inertia_tool.weld import weld_exact, weld_tolerance
+from inertia_tool.mesh.weld import weld_exact, weld_tolerance
 
 
 # every test runs on the C extension (when built) and on the pure-numpy path
@@ -41,7 +41,7 @@ def test_weld_tolerance_merges_rounding_noise_only():
 
 
 def test_key_collision_falls_back_to_exact_grouping(monkeypatch):
-    import inertia_tool.weld as weld
+    import inertia_tool.mesh.weld as weld
 
     monkeypatch.setenv("INERTIA_TOOL_NO_ACCEL", "1")    # the 64-bit keys exist only on the numpy path
     def constant_key(rows):

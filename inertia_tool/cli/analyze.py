@@ -10,19 +10,21 @@ import sys
 import warnings
 
 from ..errors import InertiaToolWarning, PhysicsError, UsageError
-from ..io import DEFAULT_MAX_FACES
-from ..pipeline import DEFAULT_DENSITY, DEFAULT_MERGE_TOLERANCE, assembly, mass_properties, resolve_density
+from ..mesh.options import DEFAULT_MAX_FACES
+from ..mass.pipeline import DEFAULT_DENSITY, assembly, mass_properties, resolve_density
+from ..mesh.options import LoadOptions
+from ..tolerances import MERGE_TOLERANCE
 from ..reports.serialize import mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
-from ..stability import stability
+from ..dynamics.spin_stability import stability
 from ..units import MATERIALS, parse_density, parse_mass
 # issue 6: exports and thin-walled models
-from ..inertial import FRAMES, inertial_frame
+from ..robot.inertial import FRAMES, inertial_frame
 from ..reports.cad import CAD_UNITS, format_cad_report
 from ..reports.models import format_model_note, model_summary
-from ..reports.robot import ROBOT_FORMATS, format_inertial
-from ..thinwall import printed_part, shell_mass_properties
+from ..robot.formats import ROBOT_FORMATS, format_inertial
+from ..mass.thinwall import printed_part, shell_mass_properties
 from ..units import parse_fraction, parse_length
 from .report_option import add_report_options, check_report_path, write_report_from_args
 
@@ -64,9 +66,9 @@ def add_mesh_options(parser) -> None:
     g = parser.add_argument_group("mesh checks")
     g.add_argument("--repair", action="store_true",
                    help="close holes and fix inconsistent winding instead of refusing the mesh")
-    g.add_argument("--merge-tolerance", type=float, default=DEFAULT_MERGE_TOLERANCE, metavar="REL",
+    g.add_argument("--merge-tolerance", type=float, default=MERGE_TOLERANCE, metavar="REL",
                    help="relative tolerance (of the bounding-box diagonal) for welding nearly coincident "
-                        f"vertices when exact welding leaves the surface open (default {DEFAULT_MERGE_TOLERANCE:g}; 0 off)")
+                        f"vertices when exact welding leaves the surface open (default {MERGE_TOLERANCE:g}; 0 off)")
     g.add_argument("--max-faces", type=int, default=DEFAULT_MAX_FACES, metavar="N",
                    help=f"refuse meshes with more triangles (default {DEFAULT_MAX_FACES:,})")
 
@@ -89,6 +91,14 @@ def check_mesh_options(args) -> None:
         raise UsageError(f"--max-faces must be at least 1, got {faces}")
 
 
+def load_options_from_args(args) -> LoadOptions:
+    """The one :class:`LoadOptions` of a command, from ``--units`` and the mesh-check options."""
+    check_mesh_options(args)
+    return LoadOptions(units=args.units, repair=bool(getattr(args, "repair", False)),
+                       merge_tolerance=getattr(args, "merge_tolerance", MERGE_TOLERANCE),
+                       max_faces=getattr(args, "max_faces", DEFAULT_MAX_FACES))
+
+
 def load_from_args(args):
     """Mass properties of the ``files`` in ``args`` (one part or an assembly) and the density description.
 
@@ -96,16 +106,14 @@ def load_from_args(args):
     ``:material`` or ``:density`` (the description says so); when every part has its own, a global one would
     be ignored and is refused as contradictory (:class:`UsageError`).
     """
-    check_mesh_options(args)
+    options = load_options_from_args(args)
     density = parse_density(args.density) if args.density is not None else None
     mass = parse_mass(args.mass) if args.mass is not None else None
-    options = dict(repair=args.repair, merge_tolerance=args.merge_tolerance, max_faces=args.max_faces)
     files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
     specs = [split_part_spec(f) for f in files]
     if len(specs) == 1 and specs[0][1] is None:
         _, described = resolve_density(density=density, material=args.material, mass=mass)
-        props = mass_properties(specs[0][0], units=args.units, density=density, material=args.material,
-                                mass=mass, **options)
+        props = mass_properties(specs[0][0], density=density, material=args.material, mass=mass, options=options)
         return props, described
     default = None
     if density is not None or args.material is not None:
@@ -125,7 +133,7 @@ def load_from_args(args):
             parts.append({"source": path, "material": args.material})
         else:
             parts.append({"source": path})
-    props = assembly(parts, units=args.units, mass=mass, **options)
+    props = assembly(parts, mass=mass, options=options)
     if len(specs) == 1:
         described = resolve_density(**_part_density(own[0]))[1]
     else:
@@ -264,7 +272,7 @@ def load_model_from_args(args):
         raise UsageError("--model shell needs --thickness (e.g. --thickness 2mm)")
     if model == "shell" and skin is not None:
         raise UsageError("--model shell takes --thickness; --shell/--infill describe a printed solid")
-    check_mesh_options(args)
+    options = load_options_from_args(args)
     if model == "solid" and skin is None:
         props, described = load_from_args(args)
         return props, described, model_summary("solid")
@@ -274,13 +282,14 @@ def load_model_from_args(args):
     density = parse_density(args.density) if args.density is not None else None
     mass = parse_mass(args.mass) if args.mass is not None else None
     _, described = resolve_density(density=density, material=args.material, mass=mass)
-    common = dict(units=args.units, density=density, material=args.material, mass=mass, max_faces=args.max_faces)
+    common = dict(density=density, material=args.material, mass=mass)
     if model == "shell":
         t = parse_length(thickness, default_unit=args.units)
-        props = shell_mass_properties(files[0], thickness=t, **common)
+        props = shell_mass_properties(files[0], thickness=t, units=options.units, max_faces=options.max_faces,
+                                      **common)
         return props, described, model_summary("shell", thickness=t)
     printed = printed_part(files[0], skin=parse_length(skin, default_unit=args.units), infill=parse_fraction(infill),
-                           repair=args.repair, merge_tolerance=args.merge_tolerance, **common)
+                           options=options, **common)
     return printed.properties, described, model_summary("printed", printed=printed)
 
 

@@ -1,7 +1,7 @@
 """``inertia-tool balance FILE ...``: the dynamic-balancing report (text, JSON, HTML or Markdown).
 
 Routing and formatting only: lengths given on the command line are converted to SI here, the engine is
-``inertia_tool.balance.balance`` and the writers are in ``inertia_tool.reports.balance``.
+``inertia_tool.balancing.rotor.balance`` and the writers are in ``inertia_tool.reports.balance``.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 import os
 
-from ..balance import ISO_GRADES, balance
+from ..balancing.rotor import ISO_GRADES, balance
 from ..errors import UsageError
 from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length

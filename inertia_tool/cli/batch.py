@@ -1,7 +1,7 @@
 """``inertia-tool batch DIR_OR_GLOB --out results.jsonl|csv``: mass properties of many meshes.
 
 Routing, the progress bar and the summary only; the per-file work and the runner are
-:mod:`inertia_tool.batch`, the result files :mod:`inertia_tool.reports.rows`.
+:mod:`inertia_tool.batch.runner`, the result files :mod:`inertia_tool.batch.rows`.
 
 Exit codes: 0 when every file is done without error (this run or an earlier one), 3 when some file failed,
 in this run or in the earlier row it was skipped for (its row says why), 2 for bad arguments or an ``--out`` that is not a results file of the same kind.
@@ -12,11 +12,11 @@ from __future__ import annotations
 import sys
 import time
 
-from ..batch import BatchOptions, discover_files, run_batch
+from ..batch.runner import BatchOptions, discover_files, run_batch
 from ..errors import UsageError
-from ..reports.rows import open_results, results_format
+from ..batch.rows import open_results, results_format
 from ..units import parse_density, parse_mass
-from .analyze import add_material_options, add_mesh_options, check_mesh_options
+from .analyze import add_material_options, add_mesh_options, load_options_from_args
 
 __all__ = ["register", "run", "Progress", "dask_executor"]
 
@@ -127,12 +127,10 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     results_format(args.out)                      # a bad suffix is a usage error before any work
-    check_mesh_options(args)
-    options = BatchOptions(units=args.units,
+    options = BatchOptions(load=load_options_from_args(args),
                            density=parse_density(args.density) if args.density is not None else None,
                            material=args.material,
-                           mass=parse_mass(args.mass) if args.mass is not None else None,
-                           repair=args.repair, merge_tolerance=args.merge_tolerance, max_faces=args.max_faces)
+                           mass=parse_mass(args.mass) if args.mass is not None else None)
     options.validate()
     if args.jobs < 1:
         raise UsageError(f"Expected --jobs >= 1, got {args.jobs}")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 
 from ..errors import UsageError
-from ..io import load_mesh
+from ..mesh.read import load_mesh
 from ..reports.html import html_report, write_html_report
 
 __all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES",

@@ -11,10 +11,10 @@ import numpy as np
 from ..errors import UsageError
 from ..reports.stability import format_spin, format_stability, spin_dict, stability_dict
 from ..reports.serialize import to_jsonable
-from ..spin import MAX_SAMPLES, spin_experiment
-from ..stability import AXIS_NAMES
+from ..dynamics.experiment import MAX_SAMPLES, spin_experiment
+from ..dynamics.spin_stability import AXIS_NAMES
 from ..units import parse_angular_rate, parse_duration
-from ..principal import DEFAULT_EQUAL_RTOL
+from ..mass.principal import DEFAULT_EQUAL_RTOL
 from .analyze import add_material_options, add_mesh_options, load_from_args
 from .options import require_range
 from .report_option import check_output_file, save_figure

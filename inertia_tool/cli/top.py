@@ -10,8 +10,8 @@ import warnings
 import numpy as np
 
 from ..errors import NearlyEqualMomentsWarning, UsageError
-from ..heavy_top import MAX_TOP_SAMPLES as MAX_SAMPLES
-from ..heavy_top import STANDARD_GRAVITY, heavy_top_from_mesh
+from ..dynamics.top import MAX_TOP_SAMPLES as MAX_SAMPLES
+from ..dynamics.top import STANDARD_GRAVITY, heavy_top_on_pivot
 from ..reports.stability import format_heavy_top, heavy_top_dict
 from ..reports.serialize import to_jsonable
 from ..units import parse_angle, parse_angular_rate, parse_duration, parse_vector
@@ -130,11 +130,11 @@ def run(args) -> int:
     check_output_file(args.csv, "--csv", args.force)
     check_output_file(args.plot, "--plot", args.force)
     with warnings.catch_warnings():
-        # a symmetric top has two equal moments by design; heavy_top_from_mesh reports its own asymmetry
+        # a symmetric top has two equal moments by design; heavy_top_on_pivot reports its own asymmetry
         warnings.simplefilter("ignore", NearlyEqualMomentsWarning)
         props, described = load_from_args(args)
     pivot = np.array(parse_vector(args.pivot, default_unit=args.units))
-    top = heavy_top_from_mesh(props, pivot, theta0=tilt,
+    top = heavy_top_on_pivot(props, pivot, theta0=tilt,
                               omega3=parse_angular_rate(args.spin),
                               theta_dot0=parse_angular_rate(args.nutation),
                               phi_dot0=parse_angular_rate(args.precession), g=args.gravity, rtol=args.symmetry_rtol)

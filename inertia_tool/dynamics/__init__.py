@@ -1,18 +1,44 @@
-"""Rigid-body dynamics: exact torque-free motion, numerical integration with torque, Poinsot construction.
+"""Rigid-body dynamics: stability of free spin, exact torque-free motion, integration with torque, the heavy top.
 
-Stages (one module each): :mod:`.elliptic` (special functions) → :mod:`.torque_free` (closed forms, principal
+Stages (one module each): :mod:`.spin_stability` (the ε analysis of §4.4.1) and :mod:`.experiment` (predict and
+simulate a perturbed spin); :mod:`.elliptic` (special functions) → :mod:`.torque_free` (closed forms, principal
 frame) and :mod:`.integrate` (numerical, with torque), :mod:`.free_flow` (one exact free step) →
-:mod:`.splitting` (exact free flow + torque kicks, for torques of time and orientation only) → :mod:`.simulate` (public entry, frames) →
-:mod:`.trajectory` (result), :mod:`.poinsot` (polhode/herpolhode), :mod:`.plot` (matplotlib figure).
+:mod:`.splitting` (exact free flow + torque kicks) → :mod:`.simulation` (public entry, frames) →
+:mod:`.trajectory` (result), :mod:`.poinsot` (polhode/herpolhode), :mod:`.plot` (matplotlib figure);
+:mod:`.top` (the heavy symmetric top, §4.4.3) and :mod:`.impulse` (a sudden blow).
+
+The names below load on first use (PEP 562): the simulation stages import ``scipy.special`` and
+``scipy.integrate`` (about 0.2 s), which ``inertia-tool analyze`` and the stability analysis never need.
 """
 
-from .plot import plot_trajectory
-from .poinsot import herpolhode, invariant_plane, polhode
-from .simulate import METHODS, simulate
-from .splitting import SCHEMES, SplittingScheme
-from .torque_free import FreeBodyParameters, free_body_parameters, torque_free_motion
-from .trajectory import Trajectory
+import importlib
 
-__all__ = ["simulate", "Trajectory", "METHODS", "polhode", "herpolhode", "invariant_plane",
-           "plot_trajectory", "free_body_parameters", "FreeBodyParameters", "torque_free_motion", "SCHEMES",
-           "SplittingScheme"]
+_PUBLIC = {
+    "stability": ".spin_stability", "StabilityReport": ".spin_stability", "AxisStability": ".spin_stability",
+    "polhode_period": ".spin_stability",
+    "simulate": ".simulation", "METHODS": ".simulation",
+    "Trajectory": ".trajectory",
+    "polhode": ".poinsot", "herpolhode": ".poinsot", "invariant_plane": ".poinsot",
+    "plot_trajectory": ".plot",
+    "free_body_parameters": ".torque_free", "FreeBodyParameters": ".torque_free",
+    "torque_free_motion": ".torque_free",
+    "SCHEMES": ".splitting", "SplittingScheme": ".splitting",
+    "heavy_top": ".top", "heavy_top_on_pivot": ".top", "HeavyTopReport": ".top", "simulate_top": ".top",
+    "TopTrajectory": ".top",
+    "apply_impulse": ".impulse", "ImpulseResult": ".impulse",
+    "spin_experiment": ".experiment", "SpinExperiment": ".experiment",
+}
+
+__all__ = sorted(_PUBLIC)
+
+
+def __getattr__(name):
+    if name not in _PUBLIC:
+        raise AttributeError(f"module 'inertia_tool.dynamics' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_PUBLIC[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_PUBLIC))

@@ -23,7 +23,7 @@ def plot_trajectory(trajectory, path, *, dpi: int = 120):
     Parameters
     ----------
     trajectory : Trajectory
-        Result of :func:`~inertia_tool.dynamics.simulate.simulate`.
+        Result of :func:`~inertia_tool.dynamics.simulation.simulate`.
     path : str or path-like
         Output image file (format from the suffix: .png, .pdf, .svg).
     dpi : int

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..rotations import perpendicular_basis
-from .simulate import simulate
+from .simulation import simulate
 from .torque_free import free_body_parameters
 from .trajectory import resolve_body
 
@@ -24,7 +24,7 @@ def polhode(body, angular_velocity, *, samples: int = 257, separatrix_span: floa
     Parameters
     ----------
     body : MassProperties, PrincipalAxes, (3,) or (3, 3) array_like
-        As for :func:`~inertia_tool.dynamics.simulate.simulate`.
+        As for :func:`~inertia_tool.dynamics.simulation.simulate`.
     angular_velocity : (3,) array_like
         A point of the polhode, mesh axes, rad/s.
     samples : int
@@ -58,7 +58,13 @@ def polhode(body, angular_velocity, *, samples: int = 257, separatrix_span: floa
 
 
 def invariant_plane(body, angular_velocity, *, orientation=None):
-    """Unit normal ``L̂`` (space frame) and distance ``2T/|L|`` (rad/s) of the invariant plane at ``t = 0``."""
+    """Unit normal ``L̂`` (space frame) and distance ``2T/|L|`` (rad/s) of the invariant plane at ``t = 0``.
+
+    Parameters
+    ----------
+    body, angular_velocity, orientation
+        As for :func:`~inertia_tool.dynamics.simulation.simulate` (torque-free).
+    """
     traj = simulate(body, angular_velocity, [0.0], orientation=orientation)
     big_l = traj.angular_momentum[0]
     mom = np.linalg.norm(big_l)
@@ -73,7 +79,7 @@ def herpolhode(body, angular_velocity, t, *, orientation=None):
     Parameters
     ----------
     body, angular_velocity, orientation
-        As for :func:`~inertia_tool.dynamics.simulate.simulate` (torque-free).
+        As for :func:`~inertia_tool.dynamics.simulation.simulate` (torque-free).
     t : (N,) array_like
         Increasing times, s.
 

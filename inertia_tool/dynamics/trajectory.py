@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import UsageError
-from ..principal import PrincipalAxes, principal_axes
+from ..mass.principal import PrincipalAxes, principal_axes
 from ..rotations import quaternion_to_matrix
 
 __all__ = ["Trajectory", "resolve_body"]

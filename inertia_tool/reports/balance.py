@@ -1,4 +1,4 @@
-"""Writers of the dynamic-balancing report (``inertia_tool.balance.BalanceReport``): text, JSON-ready dict,
+"""Writers of the dynamic-balancing report (``inertia_tool.balancing.rotor.BalanceReport``): text, JSON-ready dict,
 Markdown and HTML with an inline SVG polar plot per correction plane.  Formatting only; every number comes
 from the engine.
 
@@ -12,7 +12,7 @@ import html
 import math
 
 
-from ..balance import ISO_GRADES, BalanceReport, PlaneUnbalance
+from ..balancing.rotor import ISO_GRADES, BalanceReport, PlaneUnbalance
 from .serialize import to_jsonable
 
 __all__ = ["balance_dict", "format_balance_text", "balance_markdown", "balance_html", "polar_svg"]

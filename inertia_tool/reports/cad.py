@@ -2,7 +2,7 @@
 
 Formatting and display units only.  Products of inertia are printed in **positive tensor notation**
 (``Lxy = +∫xy dm``), as SolidWorks does, and the report says so; the conversion from the tensor convention
-is :func:`inertia_tool.inertial.positive_tensor_notation`.  The "output coordinate system" is the mesh axes
+is :func:`inertia_tool.robot.inertial.positive_tensor_notation`.  The "output coordinate system" is the mesh axes
 with the mesh origin.
 """
 
@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
-from ..inertial import positive_tensor_notation
-from ..properties import MassProperties
+from ..robot.inertial import positive_tensor_notation
+from ..mass.properties import MassProperties
 
 __all__ = ["format_cad_report", "CAD_UNITS"]
 

@@ -10,14 +10,14 @@ of the projected vertices for a large mesh) with
   centre of mass with a length of 0.6 of the part's largest half-extent; an axis pointing out of the page
   is a circle),
 * the **equivalent inertia ellipsoid**: the uniform solid ellipsoid with the part's mass and principal
-  moments (semi-axes ``a_k = √(5 (I_i + I_j − I_k) / 2m)``, :mod:`inertia_tool.ellipsoid`), projected to
+  moments (semi-axes ``a_k = √(5 (I_i + I_j − I_k) / 2m)``, :mod:`inertia_tool.mass.ellipsoid`), projected to
   its outline ellipse.  It is drawn to the part's scale; its long axis is axis 1 (smallest moment).
 
 Formatting only: every number comes from the engine.  All text (file names too) is escaped.
 
 Sections: the tables of the text report are always there.  Optional sections are built by the functions
 in :data:`SECTION_BUILDERS` (``builder(props) -> HtmlSection | None``); a builder returns ``None`` when its
-module is not installed, so the stability section (``inertia_tool.stability``) appears when that module is
+module is not installed, so the stability section (``inertia_tool.dynamics.spin_stability``) appears when that module is
 importable.  Other capabilities plug in the same way (see ``docs/html-report.md``).
 """
 
@@ -33,10 +33,10 @@ from typing import cast
 
 import numpy as np
 
-from ..ellipsoid import equivalent_ellipsoid_semi_axes
-from ..checks import MeshReport
+from ..mass.ellipsoid import equivalent_ellipsoid_semi_axes
+from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, UsageError
-from ..properties import MassProperties
+from ..mass.properties import MassProperties
 from .serialize import TENSOR_CONVENTION
 
 __all__ = ["HtmlSection", "SECTION_BUILDERS", "html_report", "write_html_report", "svg_views", "VIEWS",
@@ -323,10 +323,10 @@ def svg_views(props: MassProperties, meshes: Sequence[tuple] = (), *, max_edges:
 # -- sections -------------------------------------------------------------------------------------------
 
 def stability_section(props: MassProperties) -> HtmlSection | None:
-    """Spin stability of the three principal axes (§4.4.1), or ``None`` when ``inertia_tool.stability`` is
+    """Spin stability of the three principal axes (§4.4.1), or ``None`` when ``inertia_tool.dynamics.spin_stability`` is
     not installed (or the body has no meaningful spin stability)."""
     try:
-        from ..stability import stability
+        from ..dynamics.spin_stability import stability
     except ImportError:
         return None
     try:

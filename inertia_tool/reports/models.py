@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..thinwall import PrintedPart
+from ..mass.thinwall import PrintedPart
 
 __all__ = ["model_summary", "format_model_note"]
 

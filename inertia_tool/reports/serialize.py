@@ -7,8 +7,8 @@ from dataclasses import fields, is_dataclass
 
 import numpy as np
 
-from ..checks import MeshReport
-from ..properties import MassProperties
+from ..mesh.checks import MeshReport
+from ..mass.properties import MassProperties
 
 __all__ = ["to_jsonable", "mass_properties_dict", "mesh_report_dict", "TENSOR_CONVENTION"]
 

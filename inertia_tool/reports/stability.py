@@ -8,9 +8,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover - annotations only; keeps scipy.integrate out of `analyze`
-    from ..heavy_top import HeavyTopReport, TopTrajectory
+    from ..dynamics.top import HeavyTopReport, TopTrajectory
 
-from ..stability import StabilityReport
+from ..dynamics.spin_stability import StabilityReport
 from .serialize import to_jsonable
 
 __all__ = ["stability_dict", "format_stability", "heavy_top_dict", "format_heavy_top", "spin_dict",
@@ -160,7 +160,7 @@ def format_heavy_top(top: HeavyTopReport, trajectory: TopTrajectory | None = Non
 
 
 def spin_dict(experiment) -> dict:
-    """JSON-ready ``spin`` object of a :class:`inertia_tool.spin.SpinExperiment`."""
+    """JSON-ready ``spin`` object of a :class:`inertia_tool.dynamics.experiment.SpinExperiment`."""
     e = experiment
     return to_jsonable({
         "axis_name": e.axis.name,

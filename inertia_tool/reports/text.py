@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..properties import MassProperties
+from ..mass.properties import MassProperties
 from .serialize import TENSOR_CONVENTION
 
 __all__ = ["format_mass_properties"]

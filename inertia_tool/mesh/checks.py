@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._native import accel, faces_for_c
+from .._native import accel, faces_for_c
 
 __all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "winding_number"]
 

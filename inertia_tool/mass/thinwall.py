@@ -34,10 +34,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
-from .errors import InvalidMeshError, PhysicsError, UsageError
-from .io import DEFAULT_MAX_FACES, load_mesh
-from .pipeline import DEFAULT_MERGE_TOLERANCE, prepare_mesh, resolve_density
+from ..mesh.checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
+from ..errors import InvalidMeshError, PhysicsError, UsageError
+from ..mesh.options import LoadOptions
+from ..mesh.prepare import prepare_mesh
+from ..mesh.read import load_mesh
+from .pipeline import resolve_density
 from .properties import MassProperties
 from .surface import inward_offset_coefficient, shell_inertia, surface_moments
 from .volume import second_moment_to_inertia, volume_moments
@@ -52,9 +54,9 @@ def _positive_length(value, name: str) -> float:
     return x
 
 
-def shell_mass_properties(source, *, thickness: float, units: str = "m", density: float | None = None,
-                          material: str | None = None, mass: float | None = None,
-                          max_faces: int = DEFAULT_MAX_FACES, name: str | None = None) -> MassProperties:
+def shell_mass_properties(source, *, thickness: float, density: float | None = None,
+                          material: str | None = None, mass: float | None = None, name: str | None = None,
+                          options: LoadOptions | None = None, **load_options) -> MassProperties:
     """Mass properties of a thin wall of constant ``thickness`` whose mid-surface is the mesh.
 
     Parameters
@@ -63,14 +65,15 @@ def shell_mass_properties(source, *, thickness: float, units: str = "m", density
         The mid-surface (open or closed; any winding).
     thickness : float
         Wall thickness in m (SI; the command line parses ``2mm``).
-    units : str
-        Length unit of the mesh coordinates.
     density, material, mass
         As in :func:`inertia_tool.mass_properties` (at most one; none means 1000 kg/m³).
-    max_faces : int
-        Refuse meshes with more triangles.
     name : str, optional
         Label for reports.
+    options : LoadOptions, optional
+        How to read the mesh (``units``, ``max_faces``; the surface need not be closed, so ``repair`` and
+        ``merge_tolerance`` do not apply).
+    **load_options
+        Fields of :class:`~inertia_tool.mesh.options.LoadOptions`, overriding those of ``options``.
 
     Returns
     -------
@@ -78,15 +81,16 @@ def shell_mass_properties(source, *, thickness: float, units: str = "m", density
         ``mass = ρ t A``; ``volume = t A`` (material volume); ``inertia`` about the centre of mass in mesh
         axes (tensor convention); ``surface_area = A`` (the mid-surface).  Exact for the union of flat
         triangular plates of thickness ``t``; a wall curved or bent at radius ``R`` errs by a relative
-        ``O((t/R)²)`` (see :mod:`inertia_tool.surface`).
+        ``O((t/R)²)`` (see :mod:`inertia_tool.mass.surface`).
 
     Raises
     ------
     MeshReadError, InvalidMeshError, UsageError
     """
     t = _positive_length(thickness, "thickness")
+    opts = LoadOptions.build(options, **load_options)
     rho, _ = resolve_density(density=density, material=material, mass=mass)
-    raw = load_mesh(source, units=units, max_faces=max_faces)
+    raw = load_mesh(source, units=opts.units, max_faces=opts.max_faces)
     v, f = raw.vertices, raw.faces
     if len(f) == 0:
         raise InvalidMeshError(f"{raw.source}: the mesh has no triangles")
@@ -149,10 +153,9 @@ class PrintedPart:
     inertia_error_order: str
 
 
-def printed_part(source, *, skin: float, infill: float, units: str = "m", density: float | None = None,
-                 material: str | None = None, mass: float | None = None, repair: bool = False,
-                 merge_tolerance: float = DEFAULT_MERGE_TOLERANCE, max_faces: int = DEFAULT_MAX_FACES,
-                 name: str | None = None) -> PrintedPart:
+def printed_part(source, *, skin: float, infill: float, density: float | None = None,
+                 material: str | None = None, mass: float | None = None, name: str | None = None,
+                 options: LoadOptions | None = None, **load_options) -> PrintedPart:
     """Mass properties of a 3D-printed part: solid skin of thickness ``skin``, core filled to ``infill``.
 
     First order in the skin thickness; see the module docstring for the formulas and the error.
@@ -165,13 +168,15 @@ def printed_part(source, *, skin: float, infill: float, units: str = "m", densit
         Skin (shell, perimeter) thickness in m.
     infill : float
         Fill fraction of the core in [0, 1] (0.2 for 20 %).
-    units : str
-        Length unit of the mesh coordinates.
     density, material, mass
         Material density (of the filament), as in :func:`inertia_tool.mass_properties`; ``mass`` scales the
         density so that the printed part has that mass (a weighed print).
-    repair, merge_tolerance, max_faces, name
-        As in :func:`inertia_tool.mass_properties`.
+    name : str, optional
+        Label for reports.
+    options : LoadOptions, optional
+        How to read and check the mesh.
+    **load_options
+        Fields of :class:`~inertia_tool.mesh.options.LoadOptions`, overriding those of ``options``.
 
     Returns
     -------
@@ -188,9 +193,10 @@ def printed_part(source, *, skin: float, infill: float, units: str = "m", densit
     f_in = float(infill)
     if not 0.0 <= f_in <= 1.0:
         raise UsageError(f"Expected `infill` between 0 and 1, got {infill}")
+    opts = LoadOptions.build(options, **load_options)
     rho, _ = resolve_density(density=density, material=material, mass=mass)
-    raw = load_mesh(source, units=units, max_faces=max_faces)
-    prepared = prepare_mesh(raw, repair=repair, merge_tolerance=merge_tolerance)
+    raw = load_mesh(source, units=opts.units, max_faces=opts.max_faces)
+    prepared = prepare_mesh(raw, repair=opts.repair, merge_tolerance=opts.merge_tolerance)
     v, f = prepared.vertices, prepared.faces
     solid = volume_moments(v, f)
     sm = surface_moments(v, f, origin=solid.centroid)

@@ -5,7 +5,7 @@ at most one torn last line.  :func:`open_results` reads an existing file back (f
 last line off (the file then ends with a complete row again) and refuses a file that is not a previous
 result file of the same kind, so that ``--out`` never clobbers unrelated data.
 
-Columns are :data:`inertia_tool.batch.ROW_FIELDS`.  In CSV, empty cells are missing values (``None`` in
+Columns are :data:`inertia_tool.batch.runner.ROW_FIELDS`.  In CSV, empty cells are missing values (``None`` in
 JSON); booleans are ``true``/``false``; text is kept on one line by the batch engine.
 """
 
@@ -18,7 +18,7 @@ import os
 from dataclasses import dataclass
 from typing import BinaryIO
 
-from ..batch import ROW_FIELDS, SCHEMA
+from .runner import ROW_FIELDS, SCHEMA
 from ..errors import UsageError
 
 __all__ = ["ResultsFile", "open_results", "results_format", "FORMATS"]

@@ -14,11 +14,11 @@ from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
-from .errors import UsageError
+from ..errors import UsageError
 from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .checks import MeshReport
+    from ..mesh.checks import MeshReport
 
 __all__ = ["MassProperties", "InertiaTensor", "point_mass", "combine", "parallel_axis_shift"]
 
@@ -99,7 +99,7 @@ class MassProperties:
     name : str
         Label for reports (file name, part name); informational.
     mesh : MeshReport or None
-        Mesh diagnostics (``inertia_tool.checks.MeshReport``) when the body came from a mesh.
+        Mesh diagnostics (``inertia_tool.mesh.checks.MeshReport``) when the body came from a mesh.
     parts : tuple of MassProperties
         The bodies this one was combined from (disconnected shells of a mesh, parts of an assembly).
     """
@@ -210,8 +210,17 @@ class MassProperties:
 
 
 def point_mass(mass: float, position, *, name: str = "point mass") -> MassProperties:
-    """A point mass (``mass`` kg at ``position`` m, mesh axes) as ``MassProperties``: zero volume and zero
-    central inertia; ``name`` labels it in reports."""
+    """A point mass as ``MassProperties``: zero volume and zero central inertia.
+
+    Parameters
+    ----------
+    mass : float
+        kg, non-negative.
+    position : (3,) array_like
+        m, mesh axes.
+    name : str
+        Label in reports.
+    """
     if not (np.isfinite(mass) and mass >= 0):
         raise UsageError(f"Expected a non-negative finite mass, got {mass}")
     return MassProperties(mass=mass, volume=0.0, center_of_mass=as_vector3(position, "position"),

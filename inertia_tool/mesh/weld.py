@@ -21,7 +21,7 @@ from typing import Callable, Iterable
 
 import numpy as np
 
-from ._native import accel
+from .._native import accel
 
 __all__ = ["weld_exact", "weld_exact_stream", "weld_tolerance"]
 

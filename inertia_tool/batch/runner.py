@@ -10,7 +10,7 @@ Resuming: every row carries the SHA-256 of the file's bytes and a key of the opt
 options key and a status of ``"ok"`` or ``"error"`` (an ``InertiaToolError`` is a property of the file, so it
 is not retried); ``"internal_error"`` rows are retried.  A changed file or a changed ``--density`` recomputes.
 
-Writing rows (JSONL/CSV, append-only, fsync'd per row) is in :mod:`inertia_tool.reports.rows`; the progress
+Writing rows (JSONL/CSV, append-only, fsync'd per row) is in :mod:`inertia_tool.batch.rows`; the progress
 bar is the command line's.  All numbers in a row are SI (m, kg, kg·m²), inertia about the centre of mass in
 mesh axes with the tensor sign convention of ``docs/conventions.md``.
 """
@@ -32,10 +32,11 @@ from typing import cast
 
 import numpy as np
 
-from .checks import MeshReport
-from .errors import InertiaToolError, InertiaToolWarning, UsageError
-from .io import DEFAULT_MAX_FACES, SUPPORTED_SUFFIXES
-from .pipeline import DEFAULT_MERGE_TOLERANCE, mass_properties, resolve_density
+from ..mesh.checks import MeshReport
+from ..errors import InertiaToolError, InertiaToolWarning, UsageError
+from ..mesh.options import LoadOptions
+from ..mesh.read import SUPPORTED_SUFFIXES
+from ..mass.pipeline import mass_properties, resolve_density
 
 __all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "analyze_file", "discover_files",
            "file_sha256", "run_batch", "DONE_STATUSES"]
@@ -70,42 +71,33 @@ class BatchOptions:
 
     Attributes
     ----------
-    units : str
-        Length unit of the mesh coordinates (``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft``).
+    load : LoadOptions
+        How every mesh is read and checked (units, repair, merge tolerance, face limit).
     density : float, optional
         kg/m³.  At most one of ``density``, ``material``, ``mass``; none means water (1000 kg/m³).
     material : str, optional
         Material name (``inertia_tool.units.MATERIALS``).
     mass : float, optional
         Target mass of *each* part, kg.
-    repair : bool
-        Repair open or inconsistently wound meshes instead of refusing them.
-    merge_tolerance : float
-        Relative welding tolerance (see :func:`inertia_tool.mass_properties`).
-    max_faces : int
-        Refuse meshes with more triangles.
     """
 
-    units: str = "m"
+    load: LoadOptions = field(default_factory=LoadOptions)
     density: float | None = None
     material: str | None = None
     mass: float | None = None
-    repair: bool = False
-    merge_tolerance: float = DEFAULT_MERGE_TOLERANCE
-    max_faces: int = DEFAULT_MAX_FACES
 
     def validate(self) -> None:
         """Raise :class:`UsageError` now (once) rather than once per file."""
-        from .units import length_scale
-        length_scale(self.units)
+        if not isinstance(self.load, LoadOptions):
+            raise UsageError(f"Expected `load` to be a LoadOptions, got {type(self.load).__name__}")
         resolve_density(density=self.density, material=self.material, mass=self.mass)
-        if not (self.max_faces > 0):
-            raise UsageError(f"Expected a positive max_faces, got {self.max_faces}")
 
     def key(self) -> str:
         """16 hex digits identifying every option that changes the numbers (all of them, ``max_faces``
-        included: it decides whether a file fails)."""
-        text = json.dumps(asdict(self), sort_keys=True, default=str)
+        included: it decides whether a file fails).  Computed from the flat field names, so result files
+        written before the options were grouped resume unchanged."""
+        flat = {**asdict(self.load), "density": self.density, "material": self.material, "mass": self.mass}
+        text = json.dumps(flat, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -209,7 +201,7 @@ def _finite(x) -> float | None:
 
 def _empty_row(path: str, sha256: str | None, options: BatchOptions) -> dict:
     row = dict.fromkeys(ROW_FIELDS)
-    row.update(schema=SCHEMA, path=path, sha256=sha256, options_key=options.key(), units=options.units,
+    row.update(schema=SCHEMA, path=path, sha256=sha256, options_key=options.key(), units=options.load.units,
                worker=f"{platform.node()}:{os.getpid()}")
     return row
 
@@ -241,9 +233,8 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
         _, described = resolve_density(density=options.density, material=options.material, mass=options.mass)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", InertiaToolWarning)
-            props = mass_properties(path, units=options.units, density=options.density,
-                                    material=options.material, mass=options.mass, repair=options.repair,
-                                    merge_tolerance=options.merge_tolerance, max_faces=options.max_faces)
+            props = mass_properties(path, density=options.density, material=options.material, mass=options.mass,
+                                    options=options.load)
         pa = props.principal
         inertia = np.asarray(props.inertia)
         mesh = cast(MeshReport, props.mesh)         # MassProperties.mesh is typed `object`

@@ -1,7 +1,7 @@
 """The spin experiment: spin a body about one principal axis with a small perturbation, predict what happens
 (§4.4.1 and the exact polhode period) and check it against a simulation of the torque-free motion.
 
-This module only wires :mod:`inertia_tool.stability` (prediction) to :mod:`inertia_tool.dynamics`
+This module only wires :mod:`inertia_tool.dynamics.spin_stability` (prediction) to :mod:`inertia_tool.dynamics`
 (simulation) and measures the simulated period; it is what ``inertia-tool spin`` runs.
 """
 
@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import UsageError
-from .stability import AxisStability, StabilityReport, polhode_period, stability
-from .principal import DEFAULT_EQUAL_RTOL
+from ..errors import UsageError
+from .spin_stability import AxisStability, StabilityReport, polhode_period, stability
+from ..mass.principal import DEFAULT_EQUAL_RTOL
 
 __all__ = ["SpinExperiment", "spin_experiment", "SAMPLES_PER_TURN", "MIN_SAMPLES_PER_PERIOD", "MAX_SAMPLES"]
 
@@ -53,12 +53,12 @@ class SpinExperiment:
         Unstable/marginal axes: time for the ε0 perturbation to reach order one (linearised,
         ``AxisStability.turns_to_grow``), s.
     predicted_polhode_period : float
-        Exact period of the body angular velocity (:func:`inertia_tool.stability.polhode_period`), s.
+        Exact period of the body angular velocity (:func:`inertia_tool.dynamics.spin_stability.polhode_period`), s.
     predicted_period : float
         The prediction comparable with ``measured_period``: the polhode period for a wobble, half of it for
         flips (the body flips twice per period), s; ``inf`` when nothing recurs.
     trajectory : Trajectory
-        The simulation (``inertia_tool.dynamics.simulate``).
+        The simulation (``inertia_tool.dynamics.simulation``).
     measured_period : float
         Mean interval between flips (sign changes of ``ω · â_k``) or between upward zero crossings of
         ``ω · â_i`` (wobble), s; ``nan`` with fewer than two events.
@@ -123,9 +123,9 @@ def spin_experiment(props, about, rate: float, *, perturbation: float = 1e-3, du
     samples : int, optional
         Output samples; default ``SAMPLES_PER_TURN`` per revolution, at least 2001, at most ``max_samples``.
     rtol : float
-        Equality tolerance of the classification (see :func:`inertia_tool.stability.stability`).
+        Equality tolerance of the classification (see :func:`inertia_tool.dynamics.spin_stability.stability`).
     method : str
-        Passed to ``inertia_tool.dynamics.simulate`` (``"auto"``: exact closed form, ``"numerical"``: an
+        Passed to ``inertia_tool.dynamics.simulation`` (``"auto"``: exact closed form, ``"numerical"``: an
         independent numerical integration).
     max_samples : int
         Upper bound on the number of samples.
@@ -137,7 +137,7 @@ def spin_experiment(props, about, rate: float, *, perturbation: float = 1e-3, du
     -------
     SpinExperiment
     """
-    from .dynamics import simulate
+    from .simulation import simulate
 
     if not (rate > 0 and math.isfinite(rate)):
         raise UsageError(f"Expected a positive finite spin rate, got {rate!r} rad/s")

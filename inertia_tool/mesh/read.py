@@ -19,15 +19,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, UsageError
-from ._native import accel
-from .units import length_scale
+from ..errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, UsageError
+from .._native import accel
+from ..units import length_scale
+from .options import DEFAULT_MAX_FACES
 from .weld import weld_exact, weld_exact_stream
 
 __all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "SUPPORTED_SUFFIXES"]
 
-#: Default guard on the number of triangles a file may hold (about 5 GB of working memory at the limit).
-DEFAULT_MAX_FACES = 50_000_000
 
 #: File suffixes handled (STL natively, the rest through trimesh).
 SUPPORTED_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".3mf", ".glb", ".gltf")

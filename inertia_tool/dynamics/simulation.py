@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
-from ..properties import as_vector3
+from ..mass.properties import as_vector3
 from ..rotations import matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix
 from .integrate import DEFAULT_COLUMNS, integrate_rigid_body
 from .splitting import DEFAULT_SCHEME, SCHEMES, integrate_splitting

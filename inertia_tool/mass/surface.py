@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import UsageError
+from ..errors import UsageError
 from .volume import reference_point, second_moment_to_inertia
 
 __all__ = ["SurfaceMoments", "CurveMoments", "surface_moments", "curve_moments", "shell_second_moment",

@@ -2,10 +2,10 @@
 
 URDF, SDFormat and MuJoCo all describe a link's mass properties as a mass, an *inertial frame* (origin at
 the centre of mass, some orientation relative to the link frame) and an inertia tensor about the centre of
-mass in that frame.  This module builds that frame from :class:`~inertia_tool.properties.MassProperties`
+mass in that frame.  This module builds that frame from :class:`~inertia_tool.mass.properties.MassProperties`
 (the mesh axes are taken as the link frame), converts its orientation to the angles and quaternions the
 formats use, and checks the principal moments the way the simulators do.  Formatting is in
-``inertia_tool.reports.robot``.
+``inertia_tool.robot.formats``.
 
 Conventions (``docs/conventions.md``):
 
@@ -33,9 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import PhysicsError, UsageError
-from .properties import MassProperties
-from .rotations import matrix_to_quaternion
+from ..errors import PhysicsError, UsageError
+from ..mass.properties import MassProperties
+from ..rotations import matrix_to_quaternion
 
 __all__ = ["InertialFrame", "MomentCheck", "inertial_frame", "check_moments", "rpy_from_matrix",
            "quaternion_from_matrix", "positive_tensor_notation", "GAZEBO_TOLERANCE", "MUJOCO_MINVAL", "FRAMES"]

@@ -24,10 +24,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .errors import AsymmetricTopWarning, PhysicsError, UsageError
-from .properties import MassProperties
+from ..errors import AsymmetricTopWarning, PhysicsError, UsageError
+from ..mass.properties import MassProperties
 
-__all__ = ["HeavyTopReport", "TopTrajectory", "heavy_top", "heavy_top_from_mesh", "simulate_top",
+__all__ = ["HeavyTopReport", "TopTrajectory", "heavy_top", "heavy_top_on_pivot", "simulate_top",
            "STANDARD_GRAVITY", "PRECESSION_KINDS"]
 
 #: m/s², the conventional standard acceleration of gravity.
@@ -73,12 +73,12 @@ class HeavyTopReport:
         Steady precession rates φ̇ at θ0 from ``I1 cos θ φ̇² − I3 ω3 φ̇ + M g l = 0`` (smaller and larger
         magnitude); ``None`` where no real root exists (too little spin) or, for the fast rate, at θ = π/2.
     pivot : (3,) float or None
-        The pivot, m, mesh axes (set by :func:`heavy_top_from_mesh`).
+        The pivot, m, mesh axes (set by :func:`heavy_top_on_pivot`).
     symmetry_axis : (3,) float or None
-        Unit vector pivot → centre of mass, mesh axes (set by :func:`heavy_top_from_mesh`).
+        Unit vector pivot → centre of mass, mesh axes (set by :func:`heavy_top_on_pivot`).
     transverse_asymmetry : float
         ``(I1b − I1a)/I1`` of the two moments transverse to the symmetry axis about the pivot, plus the
-        off-axis coupling ``|I n̂ − I3 n̂|/I1`` (0 for a true symmetric top; set by :func:`heavy_top_from_mesh`).
+        off-axis coupling ``|I n̂ − I3 n̂|/I1`` (0 for a true symmetric top; set by :func:`heavy_top_on_pivot`).
     """
 
     transverse_moment: float
@@ -398,9 +398,9 @@ def simulate_top(top: HeavyTopReport, duration: float, *, samples: int = 2001, r
     return TopTrajectory(t=t, axis=n, angular_momentum=lv, theta=theta, phi=phi, energy=energy)
 
 
-def heavy_top_from_mesh(props, pivot, *, theta0: float, omega3: float, theta_dot0: float = 0.0,
-                        phi_dot0: float = 0.0, g: float = STANDARD_GRAVITY, rtol: float = 1e-3,
-                        kind_atol: float = 1e-9, **mass_properties_kwargs) -> HeavyTopReport:
+def heavy_top_on_pivot(props: MassProperties, pivot, *, theta0: float, omega3: float, theta_dot0: float = 0.0,
+                       phi_dot0: float = 0.0, g: float = STANDARD_GRAVITY, rtol: float = 1e-3,
+                       kind_atol: float = 1e-9) -> HeavyTopReport:
     """Analyse a body spinning on a fixed ``pivot`` as a heavy symmetric top.
 
     The inertia about the pivot follows from the parallel-axis theorem (``MassProperties.inertia_about``,
@@ -409,9 +409,8 @@ def heavy_top_from_mesh(props, pivot, *, theta0: float, omega3: float, theta_dot
 
     Parameters
     ----------
-    props : MassProperties or path
-        The body, or a mesh file handed to ``inertia_tool.mass_properties`` with ``mass_properties_kwargs``
-        (``units=``, ``density=``/``material=``/``mass=``).
+    props : MassProperties
+        The body (load a mesh first with :func:`inertia_tool.mass_properties`).
     pivot : (3,) array_like
         The fixed point, m, mesh axes.
     theta0, omega3, theta_dot0, phi_dot0, g, kind_atol
@@ -430,17 +429,15 @@ def heavy_top_from_mesh(props, pivot, *, theta0: float, omega3: float, theta_dot
         If the pivot is at the centre of mass (no gravity torque and no defined symmetry axis).
     """
     if not isinstance(props, MassProperties):
-        from . import mass_properties as _load          # the mesh pipeline (inertia_tool.mass_properties)
-        props = _load(props, **mass_properties_kwargs)
-    elif mass_properties_kwargs:
-        raise UsageError(f"Unexpected keyword arguments for MassProperties input: {sorted(mass_properties_kwargs)}")
+        raise UsageError(f"Expected `props` to be a MassProperties (load the mesh with mass_properties first), "
+                         f"got {type(props).__name__}")
     tensor = np.asarray(props.inertia_about(pivot).tensor)
     offset = props.center_of_mass - np.asarray(pivot, dtype=float)
     length = float(np.linalg.norm(offset))
     gyration = math.sqrt(max(float(np.trace(props.inertia)), 0.0) / props.mass)   # body size, m
     if length <= 1e-9 * gyration:
         raise PhysicsError("The pivot is at the centre of mass: gravity exerts no torque and the symmetry axis "
-                           "(pivot → centre of mass) is undefined; use inertia_tool.stability for a free body")
+                           "(pivot → centre of mass) is undefined; use inertia_tool.dynamics.spin_stability for a free body")
     n = offset / length
     i3 = float(n @ tensor @ n)
     e1 = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])

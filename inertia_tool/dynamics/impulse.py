@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import PhysicsError, UsageError
-from .properties import MassProperties, as_vector3
+from ..errors import PhysicsError, UsageError
+from ..mass.properties import MassProperties, as_vector3
 
 __all__ = ["ImpulseResult", "apply_impulse"]
 
@@ -77,7 +77,7 @@ class ImpulseResult:
         return self.body.center_of_mass + np.outer(t, self.velocity) + rotated
 
     def motion(self, t, **options):
-        """The ensuing torque-free motion, integrated by ``inertia_tool.dynamics.simulate``.
+        """The ensuing torque-free motion, integrated by ``inertia_tool.dynamics.simulation``.
 
         Parameters
         ----------
@@ -92,7 +92,7 @@ class ImpulseResult:
             Angular velocity (body axes = mesh axes), orientation (body→space quaternions), angular
             momentum (space) and energy at ``t``; the centre of mass moves uniformly at ``velocity``.
         """
-        from .dynamics import simulate
+        from .simulation import simulate
         return simulate(self.body, self.angular_velocity, t, **options)
 
 

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import UsageError
-from .rotations import perpendicular_basis
+from ..errors import UsageError
+from ..rotations import perpendicular_basis
 
 __all__ = ["PrincipalAxes", "principal_axes", "DEFAULT_EQUAL_RTOL"]
 

@@ -33,9 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import PhysicalValidityWarning, PhysicsError, UsageError
-from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes
-from .properties import MassProperties
+from ..errors import PhysicalValidityWarning, PhysicsError, UsageError
+from ..mass.principal import DEFAULT_EQUAL_RTOL, PrincipalAxes
+from ..mass.properties import MassProperties
 
 __all__ = ["AxisStability", "StabilityReport", "stability", "polhode_period", "KINDS", "AXIS_NAMES"]
 
@@ -261,7 +261,7 @@ def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL, triangle_rtol: float = 1e-
         kg·m² in any order (then ``axis`` is the principal-frame unit vector of each moment as given).
     rtol : float
         Two moments ``I_a, I_b`` count as equal when ``|I_a − I_b| ≤ rtol · max(I)`` (default 1e-6, as
-        :data:`inertia_tool.principal.DEFAULT_EQUAL_RTOL`).  This only decides the *label* ("marginal"
+        :data:`inertia_tool.mass.principal.DEFAULT_EQUAL_RTOL`).  This only decides the *label* ("marginal"
         vs "stable"/"unstable"); ``turns_to_grow`` stays continuous across it.
     triangle_rtol : float
         Relative slack for the triangle inequality ``I1 + I2 ≥ I3`` before a ``PhysicalValidityWarning``

@@ -71,9 +71,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import UsageError
+from ..errors import UsageError
 from .properties import MassProperties
-from .units import length_scale
+from ..units import length_scale
 
 __all__ = [
     "ReferenceSolid",

@@ -1,6 +1,6 @@
 """``<inertial>`` blocks for URDF, SDFormat and MuJoCo MJCF.  Formatting only.
 
-Every number comes from :class:`inertia_tool.inertial.InertialFrame` (already checked for what the
+Every number comes from :class:`inertia_tool.robot.inertial.InertialFrame` (already checked for what the
 simulators check).  SI units; products of inertia in the tensor convention (``ixy = −∫xy dm``), which is
 what the three formats define.  The mesh axes are the link (body) frame.
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
-from ..inertial import InertialFrame
+from .inertial import InertialFrame
 
 __all__ = ["format_urdf", "format_sdf", "format_mjcf", "ROBOT_FORMATS", "format_inertial"]
 
@@ -129,7 +129,19 @@ def format_mjcf(frame: InertialFrame, *, source: str | None = None, digits: int 
 
 
 def format_inertial(frame: InertialFrame, fmt: str, *, source: str | None = None, digits: int = 12) -> str:
-    """Dispatch on ``fmt`` in :data:`ROBOT_FORMATS`."""
+    """The ``<inertial>`` block of ``frame`` in the simulator format ``fmt``.
+
+    Parameters
+    ----------
+    frame : InertialFrame
+        The checked inertial (:func:`~inertia_tool.robot.inertial.inertial_frame`).
+    fmt : str
+        One of :data:`ROBOT_FORMATS` (``"urdf"``, ``"sdf"``, ``"mjcf"``).
+    source : str, optional
+        Description for the leading XML comment (file, material).
+    digits : int
+        Significant digits of every number.
+    """
     writers = {"urdf": format_urdf, "sdf": format_sdf, "mjcf": format_mjcf}
     if fmt not in writers:
         raise UsageError(f"Expected a format among {', '.join(ROBOT_FORMATS)}, got {fmt!r}")

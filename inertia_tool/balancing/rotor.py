@@ -30,9 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import UsageError
-from .properties import MassProperties, combine, point_mass
-from .rotations import perpendicular_basis
+from ..errors import UsageError
+from ..mass.properties import MassProperties, combine, point_mass
+from ..rotations import perpendicular_basis
 
 __all__ = ["BalanceGrade", "ISO_GRADES", "ShaftFrame", "shaft_frame", "PlaneUnbalance", "Correction",
            "UnbalanceState", "BalanceReport", "balance", "permissible_unbalance", "balance_grade", "unbalance_state",
@@ -92,6 +92,11 @@ ISO_GRADES = (
 
 def balance_grade(value) -> BalanceGrade:
     """The standard grade named by ``value``: ``"G6.3"``, ``"G 6.3"``, ``"6.3"`` or ``6.3``.
+
+    Parameters
+    ----------
+    value : str or float or BalanceGrade
+        The grade's name or its number (mm/s); a ``BalanceGrade`` is returned as it is.
 
     Raises
     ------

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._native import accel, faces_for_c
+from .._native import accel, faces_for_c
 
 __all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box"]
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import PhysicsError, UsageError
+from ..errors import PhysicsError, UsageError
 
 __all__ = ["equivalent_ellipsoid_semi_axes"]
 

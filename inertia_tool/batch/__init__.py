@@ -1,0 +1,5 @@
+"""Many meshes at once: the per-file work and runner (:mod:`.runner`) and the result files (:mod:`.rows`)."""
+
+from .runner import BatchOptions, BatchSummary, analyze_file, discover_files, run_batch
+
+__all__ = ["BatchOptions", "BatchSummary", "analyze_file", "discover_files", "run_batch"]

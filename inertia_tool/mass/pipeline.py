@@ -1,0 +1,246 @@
+"""From a mesh source to ``MassProperties``: read → prepare → integrate → assemble.
+
+This is the public entry point of the engine (``inertia_tool.mass_properties``).  Reading
+(:mod:`inertia_tool.mesh.read`) and the decisions about what the triangles mean as a solid
+(:mod:`inertia_tool.mesh.prepare`) happen in the mesh layer; this module turns the prepared shells into
+bodies with a density, checks the result (finite, physically valid) and names the principal-axis results
+that are a choice (equal moments) or at round-off (needles).
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from ..errors import InvalidMeshError, NearlyEqualMomentsWarning, OverlapWarning, PhysicalValidityWarning, UsageError
+from ..mesh.options import LoadOptions
+from ..mesh.prepare import PreparedMesh, classify_shells, prepare_mesh
+from ..mesh.read import load_mesh
+from ..tolerances import NEEDLE_RTOL, TRIANGLE_INEQUALITY_RTOL
+from ..units import material_density
+from .properties import MassProperties, combine
+from .volume import VolumeMoments, second_moment_to_inertia
+
+__all__ = ["mass_properties", "assembly", "resolve_density", "DEFAULT_DENSITY"]
+
+#: Density used when none of density / material / mass is given (water), kg/m³.  Reports say so.
+DEFAULT_DENSITY = 1000.0
+
+
+
+def resolve_density(*, density=None, material=None, mass=None) -> tuple[float | None, str]:
+    """Decide the density from at most one of ``density``, ``material`` or ``mass``.
+
+    Parameters
+    ----------
+    density : float, optional
+        kg/m³, positive and finite.
+    material : str, optional
+        A name from :data:`inertia_tool.units.MATERIALS`.
+    mass : float, optional
+        A target total mass, kg: the density follows from the volume later.
+
+    Returns
+    -------
+    (float or None, str)
+        The density (``None`` when a target mass is used; 1000 kg/m³ when nothing is given) and a description
+        for reports.
+    """
+    given = [x is not None for x in (density, material, mass)]
+    if sum(given) > 1:
+        raise UsageError("Give at most one of density, material and mass")
+    if density is not None:
+        if not (np.isfinite(density) and density > 0):
+            raise UsageError(f"Expected a positive finite density in kg/m³, got {density}")
+        return float(density), f"{float(density):g} kg/m³"
+    if material is not None:
+        rho = material_density(material)
+        return rho, f"{material} ({rho:g} kg/m³)"
+    if mass is not None:
+        if not (np.isfinite(mass) and mass > 0):
+            raise UsageError(f"Expected a positive finite mass in kg, got {mass}")
+        return None, f"scaled to a total mass of {float(mass):g} kg"
+    return DEFAULT_DENSITY, f"{DEFAULT_DENSITY:g} kg/m³ (default: water; give a density, material or mass)"
+
+
+def _check_finite(props: MassProperties, source: str) -> None:
+    """Refuse a result with a non-finite number (never print inf or NaN as a mass property)."""
+    values = np.r_[props.mass, props.volume, props.center_of_mass, props.inertia.ravel(), props.surface_area]
+    if not np.all(np.isfinite(values)):
+        raise InvalidMeshError(f"{source}: the mass properties overflow or are undefined (non-finite values); "
+                               "check the coordinates' size and the length unit")
+
+
+def _warn_about_principal(props: MassProperties, source: str) -> None:
+    """Name the principal-axis results that are a choice (equal moments) or at round-off level (needle)."""
+    pa = props.principal
+    if len(pa.equal_pairs) >= 2:
+        warnings.warn(NearlyEqualMomentsWarning(
+            f"{source}: all three principal moments are equal within {pa.rtol:g} (relative); any axes are "
+            "principal, the ones reported are an arbitrary choice"), stacklevel=3)
+    elif pa.equal_pairs:
+        a, b = pa.equal_pairs[0]
+        warnings.warn(NearlyEqualMomentsWarning(
+            f"{source}: principal moments I{a + 1} and I{b + 1} are equal within {pa.rtol:g} (relative); the "
+            "axes in their plane are an arbitrary choice"), stacklevel=3)
+    top = float(np.max(np.abs(pa.moments)))
+    if top > 0 and pa.moments[0] <= NEEDLE_RTOL * top:
+        digits = -np.log10(np.finfo(float).eps * top / max(abs(pa.moments[0]), np.finfo(float).tiny))
+        warnings.warn(PhysicalValidityWarning(
+            f"{source}: the smallest principal moment ({pa.moments[0]:.3g} kg·m²) is below {NEEDLE_RTOL:g} of "
+            f"the largest (a needle); it carries only about {max(digits, 0):.0f} correct digits"), stacklevel=3)
+
+
+def _shell_properties(s: VolumeMoments, density: float, name: str) -> MassProperties:
+    return MassProperties(mass=density * s.volume, volume=s.volume, center_of_mass=s.centroid,
+                          inertia=second_moment_to_inertia(s.second_moment, density), surface_area=s.area,
+                          density=density, name=name)
+
+
+def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassProperties]:
+    bodies = []
+    owners = np.unique(prepared.owner)
+    for b in owners:
+        members = [prepared.shells[k] for k in np.flatnonzero(prepared.owner == b)]
+        props = [_shell_properties(s, density, name) for s in members]
+        body = props[0] if len(props) == 1 else combine(props, name=name)
+        bodies.append(MassProperties(mass=body.mass, volume=body.volume, center_of_mass=body.center_of_mass,
+                                     inertia=body.inertia, surface_area=body.surface_area, density=density,
+                                     name=f"{name} body {len(bodies) + 1}" if len(owners) > 1 else name))
+    return bodies
+
+
+def mass_properties(source, *, density: float | None = None, material: str | None = None,
+                    mass: float | None = None, name: str | None = None, options: LoadOptions | None = None,
+                    **load_options) -> MassProperties:
+    """Mass properties of the solid bounded by a triangle mesh, exact for the polyhedron.
+
+    Parameters
+    ----------
+    source : str or os.PathLike or trimesh.Trimesh or (vertices, faces)
+        The mesh (see :func:`inertia_tool.mesh.read.load_mesh`).
+    density : float, optional
+        kg/m³.
+    material : str, optional
+        Name from :data:`inertia_tool.units.MATERIALS` (e.g. ``"aluminium"``, ``"steel"``, ``"PLA"``).
+    mass : float, optional
+        Target total mass in kg; the density is set to ``mass / volume``.
+        At most one of ``density``, ``material``, ``mass``; none means 1000 kg/m³ (water).
+    name : str, optional
+        Label for reports; defaults to the source.
+    options : LoadOptions, optional
+        How to read and check the mesh (units, repair, merge tolerance, face limit).
+    **load_options
+        Fields of :class:`~inertia_tool.mesh.options.LoadOptions` (``units="mm"``, ``repair=True``, ...),
+        a shortcut that overrides those of ``options``.
+
+    Returns
+    -------
+    MassProperties
+        SI; ``inertia`` about the centre of mass in mesh axes (tensor convention).  ``mesh`` holds the
+        :class:`~inertia_tool.mesh.checks.MeshReport`; ``parts`` the bodies when the mesh has several.
+
+    Raises
+    ------
+    MeshReadError, InvalidMeshError, UsageError
+    """
+    opts = LoadOptions.build(options, **load_options)
+    rho, _ = resolve_density(density=density, material=material, mass=mass)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):   # non-finite results refused below
+        return _part(source, rho, mass, opts, name=name)[0]
+
+
+def _part(source, rho, mass, options: LoadOptions, *, name, warn_principal=True):
+    """Mass properties of one mesh and its checked mesh (for cross-part checks of an assembly)."""
+    raw = load_mesh(source, units=options.units, max_faces=options.max_faces)
+    prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance)
+    label = name or raw.source
+    bodies = _bodies(prepared, rho if rho is not None else 1.0, label)
+    total = bodies[0] if len(bodies) == 1 else combine(bodies, name=label)
+    result = MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
+                            inertia=total.inertia, surface_area=total.surface_area,
+                            density=rho if rho is not None else 1.0, name=label, mesh=prepared.report,
+                            parts=tuple(bodies) if len(bodies) > 1 else ())
+    if rho is None:
+        result = result.with_mass(mass)
+    _check_finite(result, label)
+    _check_physical(result)
+    if warn_principal:
+        _warn_about_principal(result, label)
+    return result, prepared
+
+
+def _check_physical(props: MassProperties, rtol: float = TRIANGLE_INEQUALITY_RTOL) -> None:
+    """Warn when the principal moments fail positivity or the triangle inequality beyond round-off.
+
+    For a real body ``I_k > 0`` and ``I1 + I2 ≥ I3`` (the perpendicular-axis theorem of §4.3.2 turned into an
+    inequality); failing them means a mesh problem the checks did not catch (e.g. overlapping shells).
+    """
+    i1, i2, i3 = props.principal.moments
+    if not (i1 > -rtol * i3 and i1 + i2 >= i3 * (1 - rtol)):
+        warnings.warn(PhysicalValidityWarning(
+            f"{props.name}: principal moments ({i1:.6g}, {i2:.6g}, {i3:.6g}) kg·m² violate positivity or the "
+            "triangle inequality I1 + I2 ≥ I3: the mesh does not describe a physical body"), stacklevel=3)
+
+
+def assembly(parts, *, mass: float | None = None, options: LoadOptions | None = None,
+             **load_options) -> MassProperties:
+    """Combine several meshes, each with its own material, into one rigid body.
+
+    Parameters
+    ----------
+    parts : iterable of dict
+        Each ``{"source": path_or_mesh, "density": kg/m³}`` or ``{"source": ..., "material": name}``
+        (optionally ``"units"`` and ``"name"``; a part's ``"units"`` overrides the options' units).
+    mass : float, optional
+        Scale the whole assembly to this total mass (kg), keeping the density ratios.
+    options : LoadOptions, optional
+        How to read and check every part.
+    **load_options
+        Fields of :class:`~inertia_tool.mesh.options.LoadOptions`, overriding those of ``options``.
+    """
+    opts = LoadOptions.build(options, **load_options)
+    bodies, meshes = [], []
+    for spec in parts:
+        spec = dict(spec)
+        src = spec.pop("source")
+        rho, _ = resolve_density(density=spec.pop("density", None), material=spec.pop("material", None),
+                                 mass=spec.pop("mass", None))
+        part_options = opts.replace(units=spec.pop("units")) if "units" in spec else opts
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            # equal moments of one part say nothing about the assembly: checked once on the whole below
+            props, prepared = _part(src, rho, None, part_options, name=spec.pop("name", None), warn_principal=False)
+        bodies.append(props)
+        meshes.append(prepared)
+    if not bodies:
+        raise UsageError("Expected at least one part in the assembly")
+    if len(bodies) == 1:
+        total = bodies[0]
+    else:
+        total = combine(bodies, name="assembly")
+        _warn_about_part_overlaps(meshes, [b.name for b in bodies])
+    total = total.with_mass(mass) if mass is not None else total
+    _warn_about_principal(total, total.name)
+    return total
+
+
+def _warn_about_part_overlaps(meshes, names) -> None:
+    """Warn when the parts of an assembly overlap each other (their shared volume counts twice).
+
+    The parts' checked meshes are put side by side and the shell classification of :func:`prepare_mesh` is
+    run on the whole: bodies found inside another body beyond those already inside their own part overlap
+    across parts.
+    """
+    offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
+    label_offsets = np.cumsum([0] + [len(m.shells) for m in meshes[:-1]])
+    vertices = np.vstack([m.vertices for m in meshes])
+    faces = np.vstack([m.faces.astype(np.int64) + o for m, o in zip(meshes, offsets)])
+    labels = np.concatenate([m.labels + o for m, o in zip(meshes, label_offsets)])
+    shells = [s for m in meshes for s in m.shells]
+    diag = float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
+    _, _, _, overlaps = classify_shells(vertices, faces, labels, len(shells), shells, diag)
+    within = sum(m.report.overlapping_shells for m in meshes)
+    if overlaps > within:
+        warnings.warn(OverlapWarning(f"assembly of {', '.join(names)}: parts overlap each other; the shared "
+                                     "volume is counted once per part"), stacklevel=3)

@@ -1,0 +1,75 @@
+"""``LoadOptions``: how a mesh source becomes a checked solid — one definition for every entry point.
+
+``mass_properties``, ``assembly``, the thin-walled models, batch runs and the command line all take these
+options through this one object (or its fields as keyword arguments, a shortcut that builds one), so a new
+option is added once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from ..errors import UsageError
+from ..tolerances import MERGE_TOLERANCE
+from ..units import length_scale
+
+__all__ = ["LoadOptions", "DEFAULT_MAX_FACES"]
+
+#: Default guard on the number of triangles a file may hold (about 5 GB of working memory at the limit).
+DEFAULT_MAX_FACES = 50_000_000
+
+
+@dataclass(frozen=True)
+class LoadOptions:
+    """How to read and check a mesh.  Immutable; build variants with :meth:`replace`.
+
+    Attributes
+    ----------
+    units : str
+        Length unit of the mesh coordinates: ``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft`` (converted to
+        metres on reading; everything after is SI).
+    repair : bool
+        Give an estimate for a mesh that does not bound a solid (holes, inconsistent winding) instead of
+        refusing it; the mesh report says what was done.
+    merge_tolerance : float
+        Spacing of the tolerance weld, relative to the bounding-box diagonal, used when the bit-exact weld
+        leaves the surface open; 0 disables it (default :data:`inertia_tool.tolerances.MERGE_TOLERANCE`).
+    max_faces : int
+        Refuse sources with more triangles than this (a memory guard checked before allocating).
+    """
+
+    units: str = "m"
+    repair: bool = False
+    merge_tolerance: float = MERGE_TOLERANCE
+    max_faces: int = DEFAULT_MAX_FACES
+
+    def __post_init__(self) -> None:
+        length_scale(self.units)                      # raises UnitsError for an unknown unit
+        if not isinstance(self.repair, (bool, np.bool_)):
+            raise UsageError(f"Expected `repair` to be True or False, got {self.repair!r}")
+        tol = self.merge_tolerance
+        if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)) \
+                or not (np.isfinite(tol) and 0 <= tol < 0.1):
+            raise UsageError(f"Expected `merge_tolerance` to be a number in [0, 0.1) (relative to the "
+                             f"bounding-box diagonal), got {tol!r}")
+        if isinstance(self.max_faces, bool) or not (isinstance(self.max_faces, (int, np.integer))
+                                                    and self.max_faces > 0):
+            raise UsageError(f"Expected `max_faces` to be a positive integer, got {self.max_faces!r}")
+
+    def replace(self, **changes) -> LoadOptions:
+        """A copy with some fields changed (validated like a new one)."""
+        return replace(self, **changes)
+
+    @classmethod
+    def build(cls, options: LoadOptions | None = None, **overrides) -> LoadOptions:
+        """``options`` (or the defaults) with keyword overrides; unknown names raise :class:`UsageError`."""
+        names = {f.name for f in fields(cls)}
+        unknown = sorted(set(overrides) - names)
+        if unknown:
+            raise UsageError(f"Expected load options among {', '.join(sorted(names))}, got {', '.join(unknown)}")
+        if options is not None and not isinstance(options, LoadOptions):
+            raise UsageError(f"Expected `options` to be a LoadOptions, got {type(options).__name__}")
+        base = options if options is not None else cls()
+        return replace(base, **overrides) if overrides else base

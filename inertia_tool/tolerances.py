@@ -1,0 +1,36 @@
+"""Every numerical tolerance of the package, named and documented in one place.
+
+Each is the *default* of a keyword argument of the function that uses it (STYLE §9: no global tolerance
+object; a caller who needs another value passes it).  All are relative, dimensionless, and state what they are
+relative to.
+"""
+
+#: Two principal moments count as equal when ``|I_a − I_b| ≤ EQUAL_MOMENTS_RTOL · max(I)``.  Decides labels
+#: ("symmetric", "marginal"), the deterministic basis of an equal-moment plane and the
+#: :class:`~inertia_tool.errors.NearlyEqualMomentsWarning`.  A faceted solid of revolution with a few hundred
+#: segments has moments equal to about 1e-7, so 1e-6 calls it symmetric.
+EQUAL_MOMENTS_RTOL = 1e-6
+
+#: Slack of the physical-validity checks ``I_k > 0`` and ``I_1 + I_2 ≥ I_3`` (the perpendicular-axis theorem
+#: of Chapter 4, "Rigid Body Motion", §4.3, turned into an inequality), relative to the largest moment.  A flat
+#: plate meets the triangle inequality with equality, so round-off must not count against it.
+TRIANGLE_INEQUALITY_RTOL = 1e-9
+
+#: Spacing of the tolerance weld that joins nearly coincident vertices when the bit-exact weld leaves the
+#: surface open, relative to the bounding-box diagonal.
+MERGE_TOLERANCE = 1e-6
+
+#: A shell whose |volume| is at most ``FLAT_RTOL · diagonal³`` encloses nothing (a sheet or a collapsed
+#: surface).
+FLAT_RTOL = 1e-12
+
+#: A body whose smallest principal moment is at most ``NEEDLE_RTOL`` of the largest is a needle to round-off:
+#: its smallest moment carries no correct digit.
+NEEDLE_RTOL = 1e-10
+
+#: A matrix passed as a rotation must satisfy ``‖R Rᵀ − 1‖∞ ≤ ROTATION_ATOL`` and ``det R > 0``.
+ROTATION_ATOL = 1e-9
+
+#: Display only: tensor products and coordinates below ``DISPLAY_ZERO_RTOL`` of the body's scale print as 0
+#: (round-off, not data).  Never applied to a computed value that is returned.
+DISPLAY_ZERO_RTOL = 1e-12
