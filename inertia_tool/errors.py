@@ -4,17 +4,18 @@ Every error raised on purpose by the package derives from :class:`InertiaToolErr
 from the built-in exception a caller would naturally catch (``ValueError``, ``OSError``), so
 ``except ValueError`` keeps working.  Messages say what was expected and what was found.
 
-The command line maps them to exit codes (see ``docs/conventions.md`` and the README):
+====================  ==============================================
+exception             meaning
+====================  ==============================================
+UsageError            bad parameters (units, materials: subclasses)
+MeshReadError         the file cannot be read or parsed as a mesh
+InvalidMeshError      the mesh is read but does not bound a solid
+PhysicsError          valid input, but the request cannot be met
+                      (e.g. a singular top)
+====================  ==============================================
 
-====================  =========  ==============================================
-exception             exit code  meaning
-====================  =========  ==============================================
-UsageError            2          bad command-line arguments or API parameters
-MeshReadError         3          the file cannot be read or parsed as a mesh
-InvalidMeshError      3          the mesh is read but is not a closed solid
-PhysicsError          4          the numbers are valid input but the request
-                                 cannot be satisfied (e.g. a singular top)
-====================  =========  ==============================================
+Messages name API parameters in backticks (`` `max_faces` ``, `` `repair=True` ``); the command line maps the
+exception types to exit codes and the parameter names to its options (``inertia_tool.cli``).
 """
 
 from __future__ import annotations
@@ -43,13 +44,11 @@ __all__ = [
 class InertiaToolError(Exception):
     """Base class of every error that inertia_tool raises on purpose."""
 
-    exit_code = 1
 
 
 class UsageError(InertiaToolError, ValueError):
     """A parameter is missing, malformed or contradicts another one."""
 
-    exit_code = 2
 
 
 class UnitsError(UsageError):
@@ -66,7 +65,6 @@ class MeshReadError(InertiaToolError, OSError):
     The message names the file and what was wrong with its bytes.
     """
 
-    exit_code = 3
 
 
 class InvalidMeshError(InertiaToolError, ValueError):
@@ -81,7 +79,6 @@ class InvalidMeshError(InertiaToolError, ValueError):
         ``details`` attribute.
     """
 
-    exit_code = 3
 
     def __init__(self, message: str, details: dict | None = None):
         super().__init__(message)
@@ -91,7 +88,6 @@ class InvalidMeshError(InertiaToolError, ValueError):
 class PhysicsError(InertiaToolError, ValueError):
     """The input is well formed but the physical request has no valid answer."""
 
-    exit_code = 4
 
 
 class InertiaToolWarning(UserWarning):

@@ -157,3 +157,27 @@ def test_batch_out_unwritable_subprocess(tmp_path):
     assert r.returncode == 2
     assert r.stderr.strip() == ("inertia-tool: error: /nonexistent/d.jsonl: cannot write the results file "
                                 "(No such file or directory)")
+
+
+def test_engine_messages_name_parameters_and_the_cli_names_options():
+    from inertia_tool.cli import build_parser, speak_options
+    from inertia_tool.mass.pipeline import mass_properties
+    from inertia_tool.errors import MeshReadError
+    import numpy as np
+    import trimesh
+    box = trimesh.creation.box([1.0, 1.0, 1.0])
+    with pytest.raises(MeshReadError) as info:
+        mass_properties((np.asarray(box.vertices), np.asarray(box.faces)), max_faces=3)
+    assert "`max_faces`" in str(info.value) and "--" not in str(info.value)
+    analyze = build_parser()._defaults["_subparsers"]["analyze"]
+    assert "--max-faces" in speak_options(str(info.value), analyze)
+    assert speak_options("use `repair=True` or `nothing_known`", analyze) == "use --repair or nothing_known"
+
+
+@pytest.mark.parametrize("exc, code", [("UsageError", 2), ("UnitsError", 2), ("MaterialError", 2), ("MeshReadError", 3),
+                                       ("InvalidMeshError", 3), ("PhysicsError", 4), ("InertiaToolError", 1)])
+def test_exit_codes_come_from_one_table_by_exception_type(exc, code):
+    from inertia_tool import errors
+    from inertia_tool.cli import exit_code
+    assert exit_code(getattr(errors, exc)("x")) == code
+    assert not hasattr(getattr(errors, exc), "exit_code")

@@ -173,7 +173,7 @@ def test_max_faces_guards_every_format(tmp_path):
     ascii_path = tmp_path / "a.stl"
     write_ascii_stl(ascii_path, v, f)
     for p in [*paths.values(), ascii_path]:
-        with pytest.raises(MeshReadError, match="max-faces"):
+        with pytest.raises(MeshReadError, match="`max_faces`"):
             load_mesh(p, max_faces=11)
         assert len(load_mesh(p, max_faces=12).faces) == 12
 

@@ -111,7 +111,7 @@ def test_max_faces_guard(tmp_path):
     v, f = box_arrays()
     p = tmp_path / "box.stl"
     write_binary_stl(p, v, f)
-    with pytest.raises(MeshReadError, match="max-faces"):
+    with pytest.raises(MeshReadError, match="`max_faces`"):
         load_mesh(p, max_faces=5)
 
 

@@ -574,7 +574,7 @@ def _check_shaft_meets_part(props: MassProperties, frame, offset: float, k_max: 
         if not _line_meets_box(frame.origin, frame.axes[:, 2], lo - pad, hi + pad):
             raise UsageError(f"The shaft axis does not pass through the part (it misses its bounding box "
                              f"{np.round(lo, 6).tolist()}–{np.round(hi, 6).tolist()} m; it passes {offset:.6g} m "
-                             "from the centre of mass): check --axis-point, --axis-direction and --units")
+                             "from the centre of mass): check `axis_point`, `axis_direction` and the length `units`")
     elif offset > max_axis_offset * k_max:
         raise UsageError(f"The shaft axis passes {offset:.6g} m from the centre of mass, more than "
                          f"{max_axis_offset:g} × the largest radius of gyration ({k_max:.6g} m): expected an "
@@ -679,7 +679,7 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
     notes += share_notes
     if single_plane and bearings_t is None:
         notes.append("single-plane check: the whole U_per applies to the static unbalance; the couple "
-                     "unbalance is not toleranced (give --bearings to check it)")
+                     "unbalance is not toleranced (give `bearings` to check it)")
     tolerance = _plane_data(state, tol_positions, omega, u_per, shares)
     corr_shares = shares if bearings_t is None else _shares(planes_t, float(state.center_of_mass[2]))[0]
     correction_planes = _plane_data(state, planes_t, omega, u_per, corr_shares)

@@ -36,7 +36,7 @@ def results_format(path: str | os.PathLike) -> str:
     """``"jsonl"`` or ``"csv"`` from the suffix of ``path``; :class:`UsageError` otherwise."""
     suffix = os.path.splitext(os.fspath(path))[1].lower()
     if suffix not in FORMATS:
-        raise UsageError(f"Expected --out to end in .jsonl or .csv, got {os.fspath(path)!r}")
+        raise UsageError(f"Expected the results file to end in .jsonl or .csv, got {os.fspath(path)!r}")
     return FORMATS[suffix]
 
 
@@ -71,10 +71,10 @@ def _parse_jsonl(lines: list[bytes], path: str) -> list[dict]:
             row = json.loads(line)
         except ValueError:
             raise UsageError(f"{path}: line {n} is not JSON; not a results file of inertia-tool batch "
-                             "(refusing to append to it; choose another --out)") from None
+                             "(refusing to append to it; choose another results file)") from None
         if not isinstance(row, dict) or row.get("schema") != SCHEMA:
             raise UsageError(f"{path}: line {n} is not a row of schema {SCHEMA}; not a results file of "
-                             "inertia-tool batch (refusing to append to it; choose another --out)")
+                             "inertia-tool batch (refusing to append to it; choose another results file)")
         rows.append(row)
     return rows
 
@@ -87,7 +87,7 @@ def _parse_csv(lines: list[bytes], path: str) -> list[dict]:
     header = next(reader, None)
     if header != list(ROW_FIELDS):
         raise UsageError(f"{path}: its header is not the inertia-tool batch header ({SCHEMA}); not a results "
-                         "file of this kind (refusing to append to it; choose another --out)")
+                         "file of this kind (refusing to append to it; choose another results file)")
     rows = []
     for n, cells in enumerate(reader, 2):
         if not cells:

@@ -8,7 +8,7 @@ cluster; it never raises: an :class:`~inertia_tool.errors.InertiaToolError` beco
 Resuming: every row carries the SHA-256 of the file's bytes and a key of the options that change the numbers
 (:meth:`BatchOptions.key`).  A file counts as done when a previous row has the same path, content hash and
 options key and a status of ``"ok"`` or ``"error"`` (an ``InertiaToolError`` is a property of the file, so it
-is not retried); ``"internal_error"`` rows are retried.  A changed file or a changed ``--density`` recomputes.
+is not retried); ``"internal_error"`` rows are retried.  A changed file or a changed density recomputes.
 
 Writing rows (JSONL/CSV, append-only, fsync'd per row) is in :mod:`inertia_tool.batch.rows`; the progress
 bar is the command line's.  All numbers in a row are SI (m, kg, kg·m²), inertia about the centre of mass in
@@ -310,7 +310,7 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
     BatchSummary
     """
     if jobs < 1:
-        raise UsageError(f"Expected --jobs >= 1, got {jobs}")
+        raise UsageError(f"Expected `jobs` >= 1, got {jobs}")
     options.validate()
     start = time.perf_counter()
     done = _done_keys(previous_rows)

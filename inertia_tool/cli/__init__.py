@@ -3,9 +3,11 @@
 Routing and formatting only; every number comes from the engine.  Each subcommand lives in its own module
 in this package exposing ``register(subparsers)``, which adds a parser whose ``func(args) -> int`` runs it.
 
-Exit codes (README, ``inertia_tool.errors``): 0 success, 2 usage error, 3 unreadable or invalid mesh,
-4 a physically impossible request, 1 an unexpected internal error (reported in one line, never a traceback;
-``INERTIA_TOOL_DEBUG=1`` shows the traceback).
+Exit codes (README): 0 success, 2 usage error, 3 unreadable or invalid mesh, 4 a physically impossible
+request, 1 an unexpected internal error (reported in one line, never a traceback; ``INERTIA_TOOL_DEBUG=1``
+shows the traceback).  :data:`EXIT_CODES` maps the engine's exception types to them, and
+:func:`speak_options` turns the API parameter names in engine messages into this command's options: the
+engine knows nothing of either.
 """
 
 from __future__ import annotations
@@ -17,15 +19,64 @@ import re
 import sys
 import warnings
 
-from ..errors import InertiaToolError, InertiaToolWarning
+from ..errors import InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError, UsageError
 
-__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_INTERNAL", "EXIT_USAGE", "EXIT_MESH", "EXIT_PHYSICS"]
+__all__ = ["main", "build_parser", "exit_code", "speak_options", "EXIT_CODES", "EXIT_OK", "EXIT_INTERNAL",
+           "EXIT_USAGE", "EXIT_MESH", "EXIT_PHYSICS"]
 
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_USAGE = 2
 EXIT_MESH = 3
 EXIT_PHYSICS = 4
+
+#: Exit code of each exception type; the most specific class of an exception's MRO that is listed wins.
+EXIT_CODES = {
+    UsageError: EXIT_USAGE,
+    MeshReadError: EXIT_MESH,
+    InvalidMeshError: EXIT_MESH,
+    PhysicsError: EXIT_PHYSICS,
+    InertiaToolError: EXIT_INTERNAL,
+}
+
+#: API parameter names whose option is not simply ``--name-with-dashes`` of a parser's ``dest``.
+PARAMETER_OPTIONS = {
+    "units": "--units",
+    "axis_point": "--axis-point",
+    "axis_direction": "--axis-direction",
+    "force": "--force",
+}
+
+_PARAMETER = re.compile(r"`(\w+)(=True)?`")
+
+
+def exit_code(exc: BaseException) -> int:
+    """The exit code of an engine exception (:data:`EXIT_CODES`)."""
+    for cls in type(exc).__mro__:
+        if cls in EXIT_CODES:
+            return EXIT_CODES[cls]
+    return EXIT_INTERNAL
+
+
+def _options_of(parser) -> dict:
+    """``dest → option string`` of a parser's optional arguments (the long form)."""
+    names = {}
+    for action in getattr(parser, "_actions", ()):
+        longs = [o for o in action.option_strings if o.startswith("--")]
+        if longs:
+            names[action.dest] = longs[0]
+    return names
+
+
+def speak_options(message: str, parser=None) -> str:
+    """Engine message → command-line message: `` `name` `` and `` `name=True` `` become the option of
+    ``parser`` (or of :data:`PARAMETER_OPTIONS`) that sets that parameter; other names lose their backticks."""
+    options = {**PARAMETER_OPTIONS, **(_options_of(parser) if parser is not None else {})}
+
+    def option(match):
+        name = match.group(1)
+        return options.get(name, name)
+    return _PARAMETER.sub(option, message)
 
 #: Subcommand modules, in the order ``--help`` lists them.
 SUBCOMMANDS = ["analyze", "balance", "spin", "top", "batch"]
@@ -85,8 +136,9 @@ def main(argv=None) -> int:
         except InertiaToolError as exc:
             if debug:
                 raise
-            error_line = f"inertia-tool: error: {exc}"
-            code = exc.exit_code
+            owner = args._subparsers.get(getattr(args, "command", None))
+            error_line = f"inertia-tool: error: {speak_options(str(exc), owner)}"
+            code = exit_code(exc)
         except KeyboardInterrupt:
             print("inertia-tool: interrupted", file=sys.stderr)
             code = 130
@@ -107,7 +159,8 @@ def main(argv=None) -> int:
         return int(code)
     for w in caught:
         if issubclass(w.category, InertiaToolWarning):
-            print(f"inertia-tool: {_format_warning(w)}", file=sys.stderr)
+            owner = args._subparsers.get(getattr(args, "command", None))
+            print(f"inertia-tool: {speak_options(_format_warning(w), owner)}", file=sys.stderr)
     return int(code or 0)
 
 

@@ -76,7 +76,7 @@ def _describe_edges(topo, source: str) -> str:
     if len(topo.sample):
         a, b = topo.sample[0]
         where = f", e.g. the edge ({a[0]:.6g}, {a[1]:.6g}, {a[2]:.6g})–({b[0]:.6g}, {b[1]:.6g}, {b[2]:.6g}) m"
-    return f"{source}: not a closed, consistently wound solid: {'; '.join(parts)}{where}; use --repair to fix"
+    return f"{source}: not a closed, consistently wound solid: {'; '.join(parts)}{where}; `repair=True` gives a bounded estimate"
 
 
 def _repair(vertices, faces, source):
@@ -208,12 +208,12 @@ def _check_magnitude(vertices, source: str) -> None:
     top = float(np.max(np.abs(np.r_[lo, hi])))    # = max |coordinate| (NaN propagates)
     if not top <= MAX_COORDINATE:
         raise InvalidMeshError(f"{source}: coordinates reach {top:.3g} m, beyond the ±{MAX_COORDINATE:g} m the "
-                               "volume integrals can hold without overflow (check --units)")
+                               "volume integrals can hold without overflow (check the length `units`)")
     span = hi - lo
     diag = float(np.hypot(np.hypot(span[0], span[1]), span[2]))   # no underflow in the squares
     if 0 < diag < MIN_EXTENT:
         raise InvalidMeshError(f"{source}: the mesh spans only {diag:.3g} m, below the {MIN_EXTENT:g} m the "
-                               "volume integrals can hold without underflow (check --units)")
+                               "volume integrals can hold without underflow (check the length `units`)")
 
 
 def prepare_mesh(raw: RawMesh, *, repair: bool = False,

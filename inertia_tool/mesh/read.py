@@ -71,7 +71,7 @@ def _fail(path, problem: str) -> MeshReadError:
 
 def _check_face_budget(path: str, n: int, max_faces: int) -> None:
     if n > max_faces:
-        raise _fail(path, f"holds {n:,} triangles, more than --max-faces {max_faces:,} allows")
+        raise _fail(path, f"holds {n:,} triangles, more than `max_faces` ({max_faces:,}) allows")
 
 
 # -- STL ------------------------------------------------------------------------------------------------
@@ -381,7 +381,7 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
                     coords.extend(parts[1:4])
                     nv += 1
                     if nv > max_vertices:
-                        raise _fail(path, f"holds more than {max_vertices:,} vertices (3 × --max-faces)")
+                        raise _fail(path, f"holds more than {max_vertices:,} vertices (3 × `max_faces`)")
                 elif key == b"f":
                     k = len(parts) - 1
                     if k < 3:
@@ -397,7 +397,7 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
                             idx.append(i - 1)
                         elif i > 0:
                             raise _fail(path, f"line {line_no}: face index {str(i)[:24]} is past any vertex this file may "
-                                              f"hold ({max_vertices:,} = 3 × --max-faces)")
+                                              f"hold ({max_vertices:,} = 3 × `max_faces`)")
                         elif i < 0 and -i <= nv:
                             idx.append(nv + i)
                         elif i < 0:
@@ -503,7 +503,7 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
                           f"only {max(body, 0):,}: truncated or lying header")
     _check_face_budget(path, counts.get("face", 0), max_faces)
     if counts.get("vertex", 0) > 3 * max_faces + 3:
-        raise _fail(path, f"holds {counts['vertex']:,} vertices, more than 3 × --max-faces")
+        raise _fail(path, f"holds {counts['vertex']:,} vertices, more than 3 × `max_faces`")
     return counts
 
 
@@ -552,7 +552,7 @@ def _check_zip(path: str, max_faces: int) -> dict:
                               "refused as a zip bomb before inflating")
     if total > limit:
         raise _fail(path, f"3MF archive would inflate to {total:,} bytes, more than the {limit:,} allowed for "
-                          f"--max-faces {max_faces:,}; refused before inflating")
+                          f"`max_faces` ({max_faces:,}); refused before inflating")
     return {}
 
 
@@ -669,7 +669,7 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
         except IsADirectoryError:
             raise _fail(path, "is a directory, not a mesh file") from None
         except MemoryError:
-            raise _fail(path, "too large to read into memory (see --max-faces)") from None
+            raise _fail(path, "too large to read into memory (see `max_faces`)") from None
         except OSError as exc:
             if isinstance(exc, MeshReadError):
                 raise

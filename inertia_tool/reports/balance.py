@@ -208,7 +208,7 @@ def _verification_text(report: BalanceReport) -> str:
         where = (f"; at the bearings it meets {_grade_name(report.corrected_grade, report.corrected_value)}"
                  if bearings else "")
         return (f"{head}, couple not corrected (a single-plane correction removes the static unbalance only; "
-                f"two --planes correct both){where}")
+                f"two correction planes correct both){where}")
     return f"{head}, meets {_grade_name(report.corrected_grade, report.corrected_value)}"
 
 
@@ -233,7 +233,7 @@ def _grade_lines(report: BalanceReport) -> list[str]:
         lines.append(f"grade {g.name} (typical: {g.typical_parts})")
         lines.append(f"U_per = G·M/Ω = {_num(report.permissible_unbalance * _G_MM)} g·mm (e_per = {_num(e_per)} µm)")
     else:
-        lines.append("no grade given (--grade G6.3 checks a tolerance); shares below are the lever rule")
+        lines.append("no grade given (a grade such as G6.3 checks a tolerance); shares below are the lever rule")
     a = report.achieved_grade
     lines.append(f"as it is, the part meets {_grade_name(a, report.achieved_value)}"
                  + (f" (typical: {a.typical_parts})" if a is not None else ""))

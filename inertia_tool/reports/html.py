@@ -494,7 +494,7 @@ def write_html_report(path: str | os.PathLike, document: str, *, force: bool = F
     ``force``.  Written to a temporary file beside it and renamed, so a failure never leaves half a report."""
     path = os.fspath(path)
     if os.path.exists(path) and not force:
-        raise UsageError(f"{path}: exists; refusing to overwrite it (use --force)")
+        raise UsageError(f"{path}: exists; refusing to overwrite it (`force=True` overwrites it)")
     if os.path.isdir(path):
         raise UsageError(f"{path}: is a directory")
     tmp = f"{path}.tmp-{os.getpid()}"

@@ -553,7 +553,7 @@ def _(path):
     return [(v1, f1), (v2, f2[:, ::-1])]
 
 
-@entry("max-faces.stl", "more triangles than --max-faces", 3, r"holds 12 triangles, more than --max-faces 10",
+@entry("max-faces.stl", "more triangles than --max-faces", 3, r"holds 12 triangles, more than --max-faces \(10\) allows",
        args=("--max-faces", "10"))
 def _(path):
     write_binary_stl(path, *box())
