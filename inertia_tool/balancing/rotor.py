@@ -26,10 +26,11 @@ the torque ``τ = ω × (J ω) = Ω² (−J_yz, J_xz, 0)``.  Both rotate with th
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import UsageError
 from ..mass.properties import MassProperties, combine, point_mass
 from ..rotations import perpendicular_basis
@@ -42,7 +43,7 @@ __all__ = ["BalanceGrade", "ISO_GRADES", "ShaftFrame", "shaft_frame", "PlaneUnba
 UNBALANCE_KINDS = ("balanced", "static", "couple", "quasi-static", "dynamic")
 
 
-@dataclass(frozen=True)
+@frozen_value
 class BalanceGrade:
     """A balance quality grade of ISO 21940-11.
 
@@ -152,7 +153,7 @@ def _check_positive(value, name: str, unit: str) -> float:
 # --------------------------------------------------------------------------------------------------------
 # Shaft frame
 # --------------------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
+@frozen_value
 class ShaftFrame:
     """The frame balancing works in: origin on the shaft, z along it, rotating with the part.
 
@@ -205,7 +206,7 @@ def shaft_frame(axis_point, axis_direction) -> ShaftFrame:
 # --------------------------------------------------------------------------------------------------------
 # Unbalance state of a body about a shaft
 # --------------------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
+@frozen_value
 class UnbalanceState:
     """How a body is (un)balanced about a shaft.  Vectors are in the shaft frame (their z component is 0
     for the transverse ones); reference point ``axis_point`` unless a name says otherwise.
@@ -348,7 +349,7 @@ def unbalance_state(props: MassProperties, frame: ShaftFrame, *, offset_tol: flo
 # --------------------------------------------------------------------------------------------------------
 # Planes, corrections, report
 # --------------------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
+@frozen_value
 class PlaneUnbalance:
     """The unbalance of the body as seen in one plane perpendicular to the shaft.
 
@@ -390,7 +391,7 @@ class PlaneUnbalance:
         return bool(self.magnitude <= self.permissible)
 
 
-@dataclass(frozen=True)
+@frozen_value
 class Correction:
     """A correction mass that balances the body.
 
@@ -421,7 +422,7 @@ class Correction:
     removal_position: np.ndarray
 
 
-@dataclass(frozen=True)
+@frozen_value
 class BalanceReport:
     """Everything about balancing one rotor at one speed (SI; shaft-frame vectors unless stated).
 

@@ -27,11 +27,12 @@ import platform
 import time
 import warnings
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, field
 from typing import cast
 
 import numpy as np
 
+from ..values import frozen_value
 from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, InertiaToolWarning, UsageError
 from ..mesh.options import LoadOptions
@@ -65,7 +66,7 @@ ROW_FIELDS = (
 _HASH_CHUNK = 1 << 20
 
 
-@dataclass(frozen=True)
+@frozen_value
 class BatchOptions:
     """What to do with every file of a batch (the same for all files).
 
@@ -101,7 +102,7 @@ class BatchOptions:
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-@dataclass(frozen=True)
+@frozen_value
 class BatchSummary:
     """What a batch run did.
 

@@ -8,10 +8,11 @@ This module only wires :mod:`inertia_tool.dynamics.spin_stability` (prediction) 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import UsageError
 from .spin_stability import AxisStability, StabilityReport, polhode_period, stability
 from ..mass.principal import DEFAULT_EQUAL_RTOL
@@ -26,7 +27,7 @@ SAMPLES_PER_TURN = 64
 MIN_SAMPLES_PER_PERIOD = 16
 
 
-@dataclass(frozen=True)
+@frozen_value
 class SpinExperiment:
     """A perturbed spin about a principal axis: prediction and simulation.
 

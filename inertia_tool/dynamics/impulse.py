@@ -13,17 +13,18 @@ What follows is torque-free motion, which :mod:`inertia_tool.dynamics` integrate
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import PhysicsError, UsageError
 from ..mass.properties import MassProperties, as_vector3
 
 __all__ = ["ImpulseResult", "apply_impulse"]
 
 
-@dataclass(frozen=True)
+@frozen_value
 class ImpulseResult:
     """State of a body just after an impulse.
 

@@ -29,12 +29,13 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import PhysicalValidityWarning, PhysicsError, UsageError
-from ..mass.principal import DEFAULT_EQUAL_RTOL, PrincipalAxes
+from ..mass.principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
 from ..mass.properties import MassProperties
 
 __all__ = ["AxisStability", "StabilityReport", "stability", "polhode_period", "KINDS", "AXIS_NAMES"]
@@ -85,7 +86,7 @@ def _growth_argument(p: float, q: float, ratio: float) -> float:
     return max(0.0, y) / root
 
 
-@dataclass(frozen=True)
+@frozen_value
 class AxisStability:
     """Stability of steady spin about one principal axis.
 
@@ -187,7 +188,7 @@ class AxisStability:
         return _growth_argument(p, q, final / initial) / (2.0 * math.pi)
 
 
-@dataclass(frozen=True)
+@frozen_value
 class StabilityReport:
     """Spin stability about the three principal axes.
 
@@ -240,7 +241,7 @@ class StabilityReport:
 
 def _moments_and_axes(x, rtol: float):
     if isinstance(x, MassProperties):
-        pa = x.principal_axes(rtol=rtol)
+        pa = principal_axes(x.inertia, reference_point=x.center_of_mass, mass=x.mass, rtol=rtol)
         return np.array(pa.moments, dtype=float), np.array(pa.axes, dtype=float), pa.reference_point
     if isinstance(x, PrincipalAxes):
         return np.array(x.moments, dtype=float), np.array(x.axes, dtype=float), np.array(x.reference_point)

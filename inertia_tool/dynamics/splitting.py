@@ -47,10 +47,11 @@ integrator, and as ``rtol``/``atol`` of :mod:`.integrate`).  ``max_step`` bounds
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import PhysicsError, UsageError
 from ..rotations import matrix_to_quaternion
 from .free_flow import free_flow_step
@@ -58,7 +59,7 @@ from .free_flow import free_flow_step
 __all__ = ["SplittingScheme", "SCHEMES", "DEFAULT_SCHEME", "integrate_splitting"]
 
 
-@dataclass(frozen=True)
+@frozen_value
 class SplittingScheme:
     """A symmetric composition ``e^{b1 h B} e^{a1 h A} … e^{a_s h A} e^{b_{s+1} h B}`` (kick first and last).
 

@@ -20,10 +20,11 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import AsymmetricTopWarning, PhysicsError, UsageError
 from ..mass.properties import MassProperties
 
@@ -37,7 +38,7 @@ STANDARD_GRAVITY = 9.80665
 PRECESSION_KINDS = ("looping", "undulating", "cusp", "steady", "planar")
 
 
-@dataclass(frozen=True)
+@frozen_value
 class HeavyTopReport:
     """Analysis of a heavy symmetric top (§4.4.3).  All angles in rad, rates in rad/s, times in s.
 
@@ -123,7 +124,7 @@ class HeavyTopReport:
         return simulate_top(self, duration, samples=samples, rtol=rtol, atol=atol)
 
 
-@dataclass(frozen=True)
+@frozen_value
 class TopTrajectory:
     """Motion of the symmetry axis of a heavy top, sampled at ``t``.
 

@@ -42,10 +42,11 @@ turn uniformly about the fixed ω.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import UsageError
 from ..rotations import matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix, \
     rotation_vector_to_quaternion
@@ -72,7 +73,7 @@ _FLIP_13 = np.diag([-1.0, 1.0, -1.0])
 _FLIP_12 = np.diag([-1.0, -1.0, 1.0])
 
 
-@dataclass(frozen=True)
+@frozen_value
 class FreeBodyParameters:
     """Constants of the elliptic (Landau–Lifshitz §37) solution for one initial state.
 

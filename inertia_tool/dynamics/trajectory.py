@@ -7,10 +7,11 @@ axes; the *space frame* is inertial and coincides with the mesh axes when the or
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import UsageError
 from ..mass.principal import PrincipalAxes, principal_axes
 from ..rotations import quaternion_to_matrix
@@ -18,7 +19,7 @@ from ..rotations import quaternion_to_matrix
 __all__ = ["Trajectory", "resolve_body"]
 
 
-@dataclass(frozen=True)
+@frozen_value
 class Trajectory:
     """Motion of a rigid body about its centre of mass, sampled at the requested times.
 

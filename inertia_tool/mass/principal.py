@@ -6,20 +6,23 @@ sign choice, degenerate planes) are on ``docs/conventions.md``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import UsageError
 from ..rotations import perpendicular_basis
+from ..tolerances import EQUAL_MOMENTS_RTOL
 
 __all__ = ["PrincipalAxes", "principal_axes", "DEFAULT_EQUAL_RTOL"]
 
-#: Default relative tolerance under which two principal moments count as equal (relative to the largest).
-DEFAULT_EQUAL_RTOL = 1e-6
+#: Default relative tolerance under which two principal moments count as equal (relative to the largest);
+#: the same number as :data:`inertia_tool.tolerances.EQUAL_MOMENTS_RTOL`, under the name callers import.
+DEFAULT_EQUAL_RTOL = EQUAL_MOMENTS_RTOL
 
 
-@dataclass(frozen=True)
+@frozen_value
 class PrincipalAxes:
     """Principal moments and axes of an inertia tensor about a stated point.
 

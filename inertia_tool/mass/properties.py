@@ -8,12 +8,13 @@ inertia about another point (parallel-axis theorem, Eqs. 4.16–4.17), moment ab
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from functools import cached_property
 from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import UsageError
 from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
 
@@ -46,7 +47,7 @@ def parallel_axis_shift(mass: float, offset) -> np.ndarray:
     return mass * ((b @ b) * np.eye(3) - np.outer(b, b))
 
 
-@dataclass(frozen=True)
+@frozen_value
 class InertiaTensor:
     """An inertia tensor together with the point it is taken about.
 
@@ -78,7 +79,7 @@ class InertiaTensor:
         return principal_axes(self.tensor, reference_point=self.reference_point, rtol=rtol)
 
 
-@dataclass(frozen=True)
+@frozen_value
 class MassProperties:
     """Mass properties of a rigid body, SI, mesh axes.
 
@@ -129,12 +130,12 @@ class MassProperties:
     # -- derived quantities -------------------------------------------------------------------------
     @cached_property
     def principal(self) -> PrincipalAxes:
-        """Principal moments (ascending) and right-handed axes about the centre of mass (Eq. 4.25)."""
-        return principal_axes(self.inertia, reference_point=self.center_of_mass, mass=self.mass)
+        """Principal moments (ascending) and right-handed axes about the centre of mass (Eq. 4.25).
 
-    def principal_axes(self, *, rtol: float = DEFAULT_EQUAL_RTOL) -> PrincipalAxes:
-        """Principal axes about the centre of mass with an explicit equality tolerance ``rtol``."""
-        return principal_axes(self.inertia, reference_point=self.center_of_mass, mass=self.mass, rtol=rtol)
+        Equal moments are judged with :data:`~inertia_tool.tolerances.EQUAL_MOMENTS_RTOL`; for another
+        tolerance call :func:`~inertia_tool.mass.principal.principal_axes` on ``inertia`` (its arrays are
+        read-only, so caching it is safe)."""
+        return principal_axes(self.inertia, reference_point=self.center_of_mass, mass=self.mass)
 
     @property
     def central_inertia(self) -> InertiaTensor:

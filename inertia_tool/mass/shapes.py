@@ -66,11 +66,12 @@ from __future__ import annotations
 
 import math
 import struct
-from dataclasses import dataclass
+
 from pathlib import Path
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import UsageError
 from .properties import MassProperties
 from ..units import length_scale
@@ -100,7 +101,7 @@ DEFAULT_SPHERE_RINGS = 64
 DEFAULT_TORUS_RINGS = 32
 
 
-@dataclass(frozen=True)
+@frozen_value
 class ReferenceSolid:
     """A closed triangle mesh with the analytic mass properties of the solid it approximates.
 

@@ -31,10 +31,11 @@ Pure functions on SI numpy arrays.  See ``docs/conventions.md``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import UsageError
 from .volume import reference_point, second_moment_to_inertia
 
@@ -45,7 +46,7 @@ _DEFAULT_CHUNK = 1 << 18
 _IU = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))
 
 
-@dataclass(frozen=True)
+@frozen_value
 class SurfaceMoments:
     """Zeroth, first and second moments of a surface (unit areal density).
 
@@ -71,7 +72,7 @@ class SurfaceMoments:
     zero_area_faces: int = 0
 
 
-@dataclass(frozen=True)
+@frozen_value
 class CurveMoments:
     """Zeroth, first and second moments of a polyline (unit linear density).
 

@@ -30,10 +30,11 @@ See ``docs/conventions.md`` for units and signs.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..mesh.checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from ..errors import InvalidMeshError, PhysicsError, UsageError
 from ..mesh.options import LoadOptions
@@ -117,7 +118,7 @@ def shell_mass_properties(source, *, thickness: float, density: float | None = N
     return props.with_mass(mass) if rho is None else props
 
 
-@dataclass(frozen=True)
+@frozen_value
 class PrintedPart:
     """A printed part (solid skin, partially filled core) and the size of its approximation.
 

@@ -29,10 +29,11 @@ Everything here is pure: SI numpy arrays in, numpy arrays out.  See ``docs/conve
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from .._native import accel, faces_for_c
 
 __all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box"]
@@ -40,7 +41,7 @@ __all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_mom
 _DEFAULT_CHUNK = 1 << 15
 
 
-@dataclass(frozen=True)
+@frozen_value
 class VolumeMoments:
     """Zeroth, first and second volume moments of a solid (unit density).
 

@@ -9,16 +9,17 @@ with identical results; the numpy code here is the reference and the fallback.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..values import frozen_value
 from .._native import accel, faces_for_c
 
 __all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "winding_number"]
 
 
-@dataclass(frozen=True)
+@frozen_value
 class EdgeTopology:
     """Edge census of an indexed triangle mesh.
 
@@ -53,7 +54,7 @@ class EdgeTopology:
         return self.closed and self.misoriented_edges == 0
 
 
-@dataclass(frozen=True)
+@frozen_value
 class MeshReport:
     """What the checks found and what was done about it.
 

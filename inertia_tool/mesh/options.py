@@ -7,10 +7,11 @@ option is added once.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import fields, replace
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import UsageError
 from ..tolerances import MERGE_TOLERANCE
 from ..units import length_scale
@@ -21,7 +22,7 @@ __all__ = ["LoadOptions", "DEFAULT_MAX_FACES"]
 DEFAULT_MAX_FACES = 50_000_000
 
 
-@dataclass(frozen=True)
+@frozen_value
 class LoadOptions:
     """How to read and check a mesh.  Immutable; build variants with :meth:`replace`.
 

@@ -11,10 +11,11 @@ sign of each shell), so that the faces are integrated once.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning, OverlapWarning
 from ..mass.volume import VolumeMoments, body_volume_moments, bounding_box, reference_point
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
@@ -37,7 +38,7 @@ MIN_EXTENT = 1e-30
 _WINDING_BUDGET = 200_000_000
 
 
-@dataclass(frozen=True)
+@frozen_value
 class PreparedMesh:
     """A checked mesh ready for integration, with its shells classified.
 

@@ -15,10 +15,11 @@ from __future__ import annotations
 import os
 import re
 import warnings
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, UsageError
 from .._native import accel
 from ..units import length_scale
@@ -35,7 +36,7 @@ _STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", 
 _CHUNK_FACES = 1 << 17
 
 
-@dataclass(frozen=True)
+@frozen_value
 class RawMesh:
     """An indexed triangle mesh as read, in metres.
 

@@ -29,10 +29,11 @@ A + B >= C"; checked with mujoco 4.0).  :func:`check_moments` applies the union:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+
 
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import PhysicsError, UsageError
 from ..mass.properties import MassProperties
 from ..rotations import matrix_to_quaternion
@@ -50,7 +51,7 @@ MUJOCO_MINVAL = 1e-15
 FRAMES = ("principal", "mesh")
 
 
-@dataclass(frozen=True)
+@frozen_value
 class MomentCheck:
     """Principal moments judged the way Gazebo (gz-math) and MuJoCo judge them.
 
@@ -169,7 +170,7 @@ def _rotation(rotation) -> np.ndarray:
     return r
 
 
-@dataclass(frozen=True)
+@frozen_value
 class InertialFrame:
     """Mass, centre of mass and inertia in the frame a simulator's ``<inertial>`` element describes.
 

@@ -1,0 +1,90 @@
+"""Result values that cannot be corrupted: frozen dataclasses with read-only arrays and equality by value.
+
+Every result object of the package (``MassProperties``, ``PrincipalAxes``, ``StabilityReport``, ...) is declared
+with :func:`frozen_value` instead of ``@dataclass(frozen=True)``.  That adds what a plain frozen dataclass
+lacks when it holds numpy arrays:
+
+- every ``np.ndarray`` field is stored read-only (``flags.writeable = False``): small arrays (at most
+  :data:`COPY_LIMIT` elements: vectors, tensors) as a copy, so the caller's array cannot change the value
+  later; large ones (mesh vertices and faces) as a read-only view, so a 5-million-face mesh is not copied;
+- ``==`` compares field by field, arrays exactly (``np.array_equal`` with NaN equal to NaN), where a plain
+  dataclass raises "the truth value of an array is ambiguous"; fields declared ``compare=False`` are skipped;
+- ``hash`` is consistent with ``==``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+__all__ = ["frozen_value", "readonly", "COPY_LIMIT"]
+
+#: Arrays with at most this many elements are copied when stored; larger ones are stored as read-only views.
+COPY_LIMIT = 4096
+
+
+def readonly(array) -> np.ndarray:
+    """``array`` as a read-only ndarray: a copy when small (≤ :data:`COPY_LIMIT` elements), else a view."""
+    a = np.asarray(array)
+    a = a.copy() if a.size <= COPY_LIMIT else a.view()
+    a.flags.writeable = False
+    return a
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        if a.shape != b.shape:
+            return False
+        try:
+            return bool(np.array_equal(a, b, equal_nan=True))
+        except TypeError:                      # non-numeric dtypes have no NaN
+            return bool(np.array_equal(a, b))
+    if isinstance(a, (tuple, list)) and isinstance(b, (tuple, list)):
+        return type(a) is type(b) and len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if isinstance(a, float) and isinstance(b, float) and a != a and b != b:
+        return True                            # NaN fields (e.g. the density of a point mass) are equal
+    return bool(a == b)
+
+
+def _key(value):
+    if isinstance(value, np.ndarray):
+        return (value.shape, str(value.dtype), value.tobytes())
+    if isinstance(value, (tuple, list)):
+        return tuple(_key(v) for v in value)
+    if isinstance(value, float) and value != value:
+        return "nan"
+    return value
+
+
+def _eq(self, other):
+    if other.__class__ is not self.__class__:
+        return NotImplemented
+    return all(_same(getattr(self, f.name), getattr(other, f.name))
+               for f in dataclasses.fields(self) if f.compare)
+
+
+def _hash(self):
+    return hash((self.__class__.__name__,) + tuple(_key(getattr(self, f.name))
+                                                   for f in dataclasses.fields(self) if f.compare))
+
+
+def frozen_value(cls):
+    """Class decorator: a frozen dataclass whose arrays are read-only, with equality and hash by value."""
+    own_post_init = cls.__dict__.get("__post_init__")
+
+    def __post_init__(self):
+        if own_post_init is not None:
+            own_post_init(self)
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, np.ndarray) and value.flags.writeable:
+                object.__setattr__(self, f.name, readonly(value))
+
+    # set before the dataclass is made: its generated __init__ calls __post_init__ only if it exists then
+    cls.__post_init__ = __post_init__
+    cls = dataclasses.dataclass(frozen=True, eq=False)(cls)
+    cls.__eq__ = _eq
+    cls.__hash__ = _hash
+    return cls
