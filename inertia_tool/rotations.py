@@ -10,6 +10,12 @@ Pure functions on numpy arrays (leading dimensions broadcast).  Conventions (``d
   stored as a scalar-first unit quaternion ``q = (w, x, y, z)`` with ``w ≥ 0`` where a sign must be chosen.
   In scipy's language ``Q = Rotation.from_euler("ZYZ", [φ, θ, ψ]).as_matrix()`` (intrinsic z-y'-z'') and
   ``Rotation.from_quat(np.roll(q, -1))`` (scipy is scalar-last).
+
+The conversions between representations are scipy's (:class:`scipy.spatial.transform.Rotation`, imported on
+first use so that ``analyze`` does not pay for it); this module only states the chapter's conventions and
+translates to and from them.  The chapter's own formulas (Eqs. 4.29–4.33, exercise 4.5) are kept where they
+are the definition (``rotation_z``, ``rotation_y``, ``euler_rates_to_angular_velocity``) and checked against
+scipy in ``tests/test_rotations.py``.
 """
 
 from __future__ import annotations
@@ -84,8 +90,22 @@ def rotation_y(angle) -> np.ndarray:
     return np.stack([np.stack([c, z, -s], -1), np.stack([z, o, z], -1), np.stack([s, z, c], -1)], -2)
 
 
+def _rotation(active_matrices=None, *, quaternions=None, rotvecs=None, euler=None):
+    """scipy ``Rotation`` of a stack of active matrices / scalar-first quaternions / rotation vectors / angles."""
+    from scipy.spatial.transform import Rotation
+    if active_matrices is not None:
+        return Rotation.from_matrix(active_matrices.reshape(-1, 3, 3))
+    if quaternions is not None:
+        return Rotation.from_quat(np.roll(quaternions.reshape(-1, 4), -1, axis=-1))
+    if rotvecs is not None:
+        return Rotation.from_rotvec(rotvecs.reshape(-1, 3))
+    return Rotation.from_euler("ZYZ", euler.reshape(-1, 3))
+
+
 def euler_to_matrix(phi, theta, psi) -> np.ndarray:
     """The chapter's ``A(φ, θ, ψ) = R_z(ψ) R_y(θ) R_z(φ)``, Eq. (4.31) (space → body components).
+
+    ``A`` is the transpose of scipy's intrinsic ``Rotation.from_euler("ZYZ", [φ, θ, ψ])``.
 
     Parameters
     ----------
@@ -96,7 +116,11 @@ def euler_to_matrix(phi, theta, psi) -> np.ndarray:
     -------
     (..., 3, 3) float
     """
-    return rotation_z(psi) @ rotation_y(theta) @ rotation_z(phi)
+    angles = np.stack(np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (phi, theta, psi))), -1)
+    if not np.all(np.isfinite(angles)):
+        raise UsageError("Expected finite Euler angles")
+    active = _rotation(euler=angles).as_matrix()
+    return np.swapaxes(active, -1, -2).reshape(angles.shape[:-1] + (3, 3))
 
 
 def matrix_to_euler(matrix, *, gimbal_atol: float = 1e-12):
@@ -163,8 +187,8 @@ def _unit_axis(axis) -> np.ndarray:
 def axis_angle_to_matrix(axis, angle) -> np.ndarray:
     """Passive matrix ``A`` of a counter-clockwise rotation by ``angle`` about ``axis`` (exercise 4.5).
 
-    ``A_ij = δ_ij cos θ + n_i n_j (1 − cos θ) − ε_ijk n_k sin θ``.  The active rotation (body → space) is
-    its transpose.
+    ``A_ij = δ_ij cos θ + n_i n_j (1 − cos θ) − ε_ijk n_k sin θ``: the transpose of scipy's
+    ``Rotation.from_rotvec(θ n̂)`` (the active rotation, body → space).
 
     Parameters
     ----------
@@ -178,67 +202,51 @@ def axis_angle_to_matrix(axis, angle) -> np.ndarray:
     (..., 3, 3) float
     """
     n = _unit_axis(axis)
-    th = np.asarray(angle, dtype=np.float64)[..., None, None]
-    return (np.cos(th) * np.eye(3) + (1.0 - np.cos(th)) * n[..., :, None] * n[..., None, :]
-            - np.sin(th) * skew(n))
+    th = np.asarray(angle, dtype=np.float64)
+    rotvec = n * th[..., None]
+    active = _rotation(rotvecs=rotvec).as_matrix()
+    return np.swapaxes(active, -1, -2).reshape(rotvec.shape[:-1] + (3, 3))
 
 
 def matrix_to_axis_angle(matrix):
     """Axis and angle of a passive matrix ``A`` (inverse of :func:`axis_angle_to_matrix`).
 
-    Computed through the quaternion of ``Aᵀ`` (robust near 0 and π).  Returns ``(axis (..., 3),
-    angle (...) ∈ [0, π])``; for the identity the axis is ``(0, 0, 1)``.
+    Returns ``(axis (..., 3), angle (...) ∈ [0, π])``; for the identity the axis is ``(0, 0, 1)``.
     """
-    q = matrix_to_quaternion(np.swapaxes(_as_matrix(matrix), -1, -2))
-    vec_norm = np.linalg.norm(q[..., 1:], axis=-1)
-    angle = 2.0 * np.arctan2(vec_norm, q[..., 0])
-    safe = np.where(vec_norm > 0, vec_norm, 1.0)[..., None]
-    axis = np.where(vec_norm[..., None] > 0, q[..., 1:] / safe, np.array([0.0, 0.0, 1.0]))
+    a = _as_matrix(matrix)
+    rotvec = _rotation(np.swapaxes(a, -1, -2)).as_rotvec().reshape(a.shape[:-2] + (3,))
+    angle = np.linalg.norm(rotvec, axis=-1)
+    safe = np.where(angle > 0, angle, 1.0)[..., None]
+    axis = np.where(angle[..., None] > 0, rotvec / safe, np.array([0.0, 0.0, 1.0]))
     return axis, angle
 
 
 def quaternion_to_matrix(quaternion) -> np.ndarray:
-    """Active rotation matrix ``Q`` (body → space) of scalar-first unit quaternions; ``A = Qᵀ``.
+    """Active rotation matrix ``Q`` (body → space) of scalar-first quaternions (normalised here); ``A = Qᵀ``.
 
-    ``Q = (w² − v·v) 𝟙 + 2 v vᵀ + 2 w [v]×`` for ``q = (w, v)`` (normalised here).
+    ``Q = (w² − v·v) 𝟙 + 2 v vᵀ + 2 w [v]×`` for ``q = (w, v)``: scipy's ``Rotation.from_quat`` after moving
+    the scalar last.
 
     Returns
     -------
     (..., 3, 3) float
     """
     q = _as_quaternion(quaternion, "quaternion")
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
+    if not np.all(np.linalg.norm(q, axis=-1) > 0):
+        raise UsageError("Expected non-zero quaternions")
+    return _rotation(quaternions=q).as_matrix().reshape(q.shape[:-1] + (3, 3))
 
 
 def matrix_to_quaternion(matrix) -> np.ndarray:
-    """Scalar-first unit quaternion (``w ≥ 0``) of an active rotation matrix ``Q`` (Shepperd's method).
-
-    Picks the largest of ``4w², 4x², 4y², 4z²`` (from the trace and the diagonal) to divide by, so the
-    result is accurate for every rotation.
+    """Scalar-first unit quaternion (``w ≥ 0``) of an active rotation matrix ``Q`` (scipy's, canonical).
 
     Returns
     -------
     (..., 4) float
     """
     m = _as_matrix(matrix)
-    m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
-    cand = np.stack([1 + m00 + m11 + m22, 1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22], -1)
-    k = np.argmax(cand, axis=-1)
-    d21, d02, d10 = m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]
-    s01, s02, s12 = m[..., 0, 1] + m[..., 1, 0], m[..., 0, 2] + m[..., 2, 0], m[..., 1, 2] + m[..., 2, 1]
-    options = np.stack([
-        np.stack([cand[..., 0], d21, d02, d10], -1),
-        np.stack([d21, cand[..., 1], s01, s02], -1),
-        np.stack([d02, s01, cand[..., 2], s12], -1),
-        np.stack([d10, s02, s12, cand[..., 3]], -1)], -2)
-    q = np.take_along_axis(options, k[..., None, None], axis=-2)[..., 0, :]
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    return np.where(q[..., :1] < 0, -q, q)
+    q = np.roll(_rotation(m).as_quat(canonical=True), 1, axis=-1)
+    return q.reshape(m.shape[:-2] + (4,))
 
 
 def quaternion_multiply(p, q) -> np.ndarray:

@@ -26,7 +26,17 @@ _AGM_MAX_STEPS = 60
 
 
 def complete_k(m1: float) -> float:
-    """Complete elliptic integral ``K(m)`` from the complementary parameter ``m1 = 1 − m`` (> 0)."""
+    """Complete elliptic integral ``K(m)`` from the complementary parameter ``m1 = 1 − m`` ∈ [0, 1].
+
+    The one K of the package (the free body's polhode period, the top's nutation period, the exact free
+    flow).  scipy's ``ellipkm1`` keeps full relative precision as ``m → 1`` (``m1 → 0``), where
+    ``ellipk(1 − m1)`` would lose the digits of ``m1``; ``K → ∞`` at ``m1 = 0`` (the separatrix).
+
+    Parameters
+    ----------
+    m1 : float
+        ``1 − m``.
+    """
     return float(ellipkm1(m1))
 
 

@@ -34,9 +34,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.special import ellipj, ellipkm1, elliprf, elliprj
+from scipy.special import ellipj, elliprf, elliprj
 
-from .elliptic import jacobi_sn_cn_dn
+from .elliptic import complete_k, jacobi_sn_cn_dn
 from .torque_free import NEGLIGIBLE_COMPONENT, torque_free_motion
 
 __all__ = ["free_flow_step", "NEAR_SEPARATRIX_M1"]
@@ -193,7 +193,7 @@ def free_flow_step(moments, angular_velocity, orientation, h):
     norm = math.hypot(s0, c0)
     s0, c0 = s0 / norm, c0 / norm
     d0 = math.sqrt(c0 * c0 + m1 * s0 * s0)
-    kk = float(ellipkm1(m1))
+    kk = complete_k(m1)
     v = lam * h
     turns = math.floor(v / (2.0 * kk))       # whole half-periods of sn: am advances by π each
     vr = v - 2.0 * kk * turns

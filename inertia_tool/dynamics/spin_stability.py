@@ -326,7 +326,7 @@ def polhode_period(moments, angular_velocity) -> float:
     * ``L² < 2E I2`` (around the minor axis): exchange ``I1 ↔ I3``;
 
     ``K`` is the complete elliptic integral of the first kind with parameter ``m``, evaluated through
-    ``1 − m = (I3 − I1)(L² − 2E I2)/((I3 − I2)(L² − 2E I1))`` (``ellipkm1``) so that orbits near the
+    ``1 − m = (I3 − I1)(L² − 2E I2)/((I3 − I2)(L² − 2E I1))`` (through :func:`~inertia_tool.dynamics.elliptic.complete_k`) so that orbits near the
     separatrix keep their digits.  For spin near the intermediate axis the body flips twice per period
     (the intermediate-axis, or Dzhanibekov, effect): the interval between flips is ``T/2``.  An
     axisymmetric body (``I1 = I2`` or ``I2 = I3``) gives ``T = 2π/|Ω|``, Ω of §4.4.1.
@@ -372,6 +372,5 @@ def polhode_period(moments, angular_velocity) -> float:
     if rate2 <= 0:
         return math.inf
     one_minus_m = min(max(one_minus_m, 0.0), 1.0)
-    from scipy.special import ellipk, ellipkm1   # imported here: `analyze` never needs it
-    kval = float(ellipkm1(one_minus_m)) if one_minus_m < 0.5 else float(ellipk(1.0 - one_minus_m))
-    return 4.0 * kval / math.sqrt(rate2)
+    from .elliptic import complete_k   # scipy.special on first use: `analyze` never needs it
+    return 4.0 * complete_k(one_minus_m) / math.sqrt(rate2)

@@ -237,9 +237,8 @@ def _nutation_period(u_x: float, u_n: float, u_u: float, alpha: float, beta: flo
     one_minus_m = (u_u - u_n) / span
     if one_minus_m <= 0.0:
         return math.inf
-    from scipy.special import ellipk, ellipkm1
-    kval = float(ellipkm1(one_minus_m)) if one_minus_m < 0.5 else float(ellipk(1.0 - one_minus_m))
-    return 4.0 * kval / math.sqrt(beta * span)
+    from .elliptic import complete_k   # scipy.special on first use: `analyze` never needs it
+    return 4.0 * complete_k(one_minus_m) / math.sqrt(beta * span)
 
 
 def _steady_precession(i1: float, i3: float, omega3: float, mgl: float, theta: float):
