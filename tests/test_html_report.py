@@ -142,34 +142,35 @@ def test_edge_count_is_bounded_for_large_meshes():
     assert sum(len(v) for v in views) < 60_000
 
 
-def test_stability_section_absent_when_module_missing(monkeypatch):
-    monkeypatch.setitem(sys.modules, "inertia_tool.dynamics.spin_stability", None)      # import now raises ImportError
+def test_report_computes_nothing_it_is_not_given(monkeypatch):
+    # formatting only: without a stability verdict there is no stability section, and the writer never
+    # imports the stability engine to make one
+    monkeypatch.setitem(sys.modules, "inertia_tool.dynamics.spin_stability", None)   # importing it would raise
     m = _t_handle()
     doc = html_report(mass_properties(m), meshes=[(m.vertices, m.faces)])
     assert "Spin stability" not in _parse(doc).headings
 
 
-def test_stability_section_present_with_the_real_module():
-    stability_mod = pytest.importorskip("inertia_tool.dynamics.spin_stability", reason="inertia_tool.dynamics.spin_stability not merged yet")
+def test_stability_section_prints_the_verdict_it_is_given():
+    from inertia_tool import stability
     m = _t_handle()
     props = mass_properties(m)
-    p = _parse(html_report(props, meshes=[(m.vertices, m.faces)]))
+    verdict = stability(props)
+    p = _parse(html_report(props, meshes=[(m.vertices, m.faces)], stability=verdict))
     assert "Spin stability" in p.headings
     kinds = [t for t in p.text if t in ("stable", "unstable", "marginal", "neutral")]
-    assert kinds == list(stability_mod.stability(props).kinds) == ["stable", "unstable", "stable"]
+    assert kinds == list(verdict.kinds) == ["stable", "unstable", "stable"]
+    undefined = _parse(html_report(props, stability="undefined <for a point mass>"))
+    assert "undefined <for a point mass>" in undefined.text
 
 
-def test_extra_builders_plug_in_and_are_escaped():
+def test_extra_sections_plug_in_and_are_escaped():
     box = trimesh.creation.box([1, 2, 3])
     props = mass_properties(box)
-
-    def balance_like(pr):
-        return HtmlSection(f"Balance <{pr.mass:.3g} kg>", "<p>corrections here</p>", "bal ance")
-
-    doc = html_report(props, builders=[balance_like, lambda pr: None])
+    section = HtmlSection(f"Balance <{props.mass:.3g} kg>", "<p>corrections here</p>", "bal ance")
+    doc = html_report(props, extra_sections=[section])
     p = _parse(doc)
     assert "Balance <6e+03 kg>" in p.headings and 'id="balance"' in doc
-    assert html_mod.stability_section in html_mod.SECTION_BUILDERS
 
 
 def test_cli_report_refuses_to_overwrite_without_force(tmp_path, capsys):

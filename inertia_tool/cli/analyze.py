@@ -13,6 +13,7 @@ from ..errors import InertiaToolWarning, PhysicsError, UsageError
 from ..mesh.options import DEFAULT_MAX_FACES
 from ..mass.pipeline import DEFAULT_DENSITY, assembly, mass_properties, resolve_density
 from ..mesh.options import LoadOptions
+from ..mesh.read import load_mesh
 from ..tolerances import MERGE_TOLERANCE
 from ..reports.serialize import mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
@@ -28,7 +29,7 @@ from ..mass.thinwall import printed_part, shell_mass_properties
 from ..units import parse_fraction, parse_length
 from .report_option import add_report_options, check_report_path, write_report_from_args
 
-__all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args",
+__all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args", "read_meshes",
            "add_output_options", "add_model_options", "output_format", "load_model_from_args", "FORMATS"]
 
 
@@ -99,9 +100,19 @@ def load_options_from_args(args) -> LoadOptions:
                        max_faces=getattr(args, "max_faces", DEFAULT_MAX_FACES))
 
 
-def load_from_args(args):
+def read_meshes(args) -> list:
+    """Read every FILE of ``args`` once, at the edge, into :class:`~inertia_tool.mesh.read.RawMesh` (metres).
+
+    The engine and the report writers then take these objects, so nothing reads a file twice."""
+    options = load_options_from_args(args)
+    files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
+    return [load_mesh(split_part_spec(f)[0], units=options.units, max_faces=options.max_faces) for f in files]
+
+
+def load_from_args(args, meshes=None):
     """Mass properties of the ``files`` in ``args`` (one part or an assembly) and the density description.
 
+    ``meshes``: the files already read by :func:`read_meshes` (one per FILE), used instead of reading them.
     In an assembly, a global ``--density``/``--material`` is the default of the parts named without their own
     ``:material`` or ``:density`` (the description says so); when every part has its own, a global one would
     be ignored and is refused as contradictory (:class:`UsageError`).
@@ -111,6 +122,8 @@ def load_from_args(args):
     mass = parse_mass(args.mass) if args.mass is not None else None
     files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
     specs = [split_part_spec(f) for f in files]
+    if meshes is not None:
+        specs = [(raw, what) for raw, (_, what) in zip(meshes, specs)]
     if len(specs) == 1 and specs[0][1] is None:
         _, described = resolve_density(density=density, material=args.material, mass=mass)
         props = mass_properties(specs[0][0], density=density, material=args.material, mass=mass, options=options)
@@ -168,12 +181,14 @@ def run(args) -> int:
     check_report_path(args)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", InertiaToolWarning)
-        props, described, model = load_model_from_args(args)
+        meshes = read_meshes(args)
+        props, described, model = load_model_from_args(args, meshes)
     messages = [str(w.message) for w in caught if issubclass(w.category, InertiaToolWarning)]
     for w in caught:          # hand them on so the command line prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    write_report_from_args(args, props, described, messages)
-    stab, stab_error = _stability_section(props) if fmt in ("json", "text") else (None, None)
+    stab, stab_error = _stability_section(props) if fmt in ("json", "text") or args.report else (None, None)
+    write_report_from_args(args, props, described, messages, meshes=meshes,
+                           stability=stab if stab is not None else stab_error)
     if fmt == "json":
         out = mass_properties_dict(props, density_source=described)
         out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
@@ -257,7 +272,7 @@ def output_format(args) -> str:
     return fmt
 
 
-def load_model_from_args(args):
+def load_model_from_args(args, meshes=None):
     """Like :func:`load_from_args`, honouring ``--model shell --thickness`` and ``--shell --infill``.
 
     Returns ``(props, density description, model summary dict)``.
@@ -274,7 +289,7 @@ def load_model_from_args(args):
         raise UsageError("--model shell takes --thickness; --shell/--infill describe a printed solid")
     options = load_options_from_args(args)
     if model == "solid" and skin is None:
-        props, described = load_from_args(args)
+        props, described = load_from_args(args, meshes)
         return props, described, model_summary("solid")
     files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
     if len(files) != 1:
@@ -285,10 +300,10 @@ def load_model_from_args(args):
     common = dict(density=density, material=args.material, mass=mass)
     if model == "shell":
         t = parse_length(thickness, default_unit=args.units)
-        props = shell_mass_properties(files[0], thickness=t, units=options.units, max_faces=options.max_faces,
+        props = shell_mass_properties(meshes[0] if meshes else files[0], thickness=t, units=options.units, max_faces=options.max_faces,
                                       **common)
         return props, described, model_summary("shell", thickness=t)
-    printed = printed_part(files[0], skin=parse_length(skin, default_unit=args.units), infill=parse_fraction(infill),
+    printed = printed_part(meshes[0] if meshes else files[0], skin=parse_length(skin, default_unit=args.units), infill=parse_fraction(infill),
                            options=options, **common)
     return printed.properties, described, model_summary("printed", printed=printed)
 

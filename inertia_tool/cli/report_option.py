@@ -1,7 +1,7 @@
 """``--report FILE.html`` / ``--force`` for commands that show one part (used by ``analyze``).
 
-Routing only: it reads the mesh geometry again for the drawing and hands everything to
-:mod:`inertia_tool.reports.html`.
+Routing only: the command hands over the meshes it read and the verdicts it computed, and this module passes
+them to :mod:`inertia_tool.reports.html`.
 """
 
 from __future__ import annotations
@@ -9,7 +9,6 @@ from __future__ import annotations
 import os
 
 from ..errors import UsageError
-from ..mesh.read import load_mesh
 from ..reports.html import html_report, write_html_report
 
 __all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES",
@@ -54,18 +53,15 @@ def check_report_path(args) -> None:
     check_output_file(path, "--report", getattr(args, "force", False))
 
 
-def write_report_from_args(args, props, density_source: str | None, warnings=()) -> None:
-    """Write the HTML report asked for by ``args.report`` (no-op without it)."""
+def write_report_from_args(args, props, density_source: str | None, warnings=(), *, meshes=(),
+                           stability=None) -> None:
+    """Write the HTML report asked for by ``args.report`` (no-op without it): ``meshes`` are the
+    ``RawMesh`` objects the command read, ``stability`` its verdict (or the reason it is undefined)."""
     if not getattr(args, "report", None):
         return
-    check_report_path(args)   # refuse before re-reading meshes
-    from .analyze import split_part_spec
-    files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
-    meshes = []
-    for spec in files:
-        raw = load_mesh(split_part_spec(spec)[0], units=args.units, max_faces=args.max_faces)
-        meshes.append((raw.vertices, raw.faces))
-    document = html_report(props, meshes=meshes, density_source=density_source, warnings=list(warnings))
+    check_report_path(args)
+    document = html_report(props, meshes=[(m.vertices, m.faces) for m in meshes], density_source=density_source,
+                           warnings=list(warnings), stability=stability)
     write_html_report(args.report, document, force=args.force)
 
 

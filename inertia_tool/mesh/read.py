@@ -615,9 +615,10 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
 
     Parameters
     ----------
-    source : str or os.PathLike or trimesh.Trimesh or (vertices, faces)
-        A file (format from its suffix; STL and OBJ read natively, streaming), a ``trimesh.Trimesh``, or a
-        pair of arrays ``vertices (n, 3)`` and ``faces (m, 3)``.
+    source : str or os.PathLike or trimesh.Trimesh or (vertices, faces) or RawMesh
+        A file (format from its suffix; STL and OBJ read natively, streaming), a ``trimesh.Trimesh``, a
+        pair of arrays ``vertices (n, 3)`` and ``faces (m, 3)``, or a ``RawMesh`` read before (returned as
+        it is: it is already in metres, so ``units`` does not apply to it; the face limit still does).
     units : str
         Length unit of the coordinates (``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft``).
     max_faces : int
@@ -641,6 +642,11 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
     scale = length_scale(units)
     if not (isinstance(max_faces, (int, np.integer)) and max_faces > 0):
         raise UsageError(f"Expected a positive integer `max_faces`, got {max_faces!r}")
+    if isinstance(source, RawMesh):
+        if len(source.faces) > max_faces:
+            raise UsageError(f"{source.source}: holds {len(source.faces):,} triangles, more than `max_faces` "
+                             f"({max_faces:,}) allows")
+        return source
     if isinstance(source, (str, bytes, os.PathLike)):
         path = os.fsdecode(os.fspath(source))
         try:

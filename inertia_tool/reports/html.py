@@ -13,12 +13,11 @@ of the projected vertices for a large mesh) with
   moments (semi-axes ``a_k = √(5 (I_i + I_j − I_k) / 2m)``, :mod:`inertia_tool.mass.ellipsoid`), projected to
   its outline ellipse.  It is drawn to the part's scale; its long axis is axis 1 (smallest moment).
 
-Formatting only: every number comes from the engine.  All text (file names too) is escaped.
+Formatting only: every number and verdict comes from the engine; the caller computes them (the spin
+stability as a ``StabilityReport``) and passes the geometry to draw.  All text (file names too) is escaped.
 
-Sections: the tables of the text report are always there.  Optional sections are built by the functions
-in :data:`SECTION_BUILDERS` (``builder(props) -> HtmlSection | None``); a builder returns ``None`` when its
-module is not installed, so the stability section (``inertia_tool.dynamics.spin_stability``) appears when that module is
-importable.  Other capabilities plug in the same way (see ``docs/html-report.md``).
+Sections: the tables of the text report are always there, then the stability verdict when given, then any
+``extra_sections`` other capabilities format themselves (see ``docs/html-report.md``).
 """
 
 from __future__ import annotations
@@ -27,7 +26,7 @@ import datetime as _dt
 import html
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import cast
 
@@ -39,7 +38,7 @@ from ..errors import InertiaToolError, UsageError
 from ..mass.properties import MassProperties
 from .serialize import TENSOR_CONVENTION
 
-__all__ = ["HtmlSection", "SECTION_BUILDERS", "html_report", "write_html_report", "svg_views", "VIEWS",
+__all__ = ["HtmlSection", "html_report", "write_html_report", "svg_views", "VIEWS",
            "stability_section", "DEFAULT_MAX_EDGES", "DEFAULT_MAX_FILL_FACES"]
 
 #: Segments drawn per view at most (the longest projected ones are kept), so a 10-million-face part
@@ -322,17 +321,11 @@ def svg_views(props: MassProperties, meshes: Sequence[tuple] = (), *, max_edges:
 
 # -- sections -------------------------------------------------------------------------------------------
 
-def stability_section(props: MassProperties) -> HtmlSection | None:
-    """Spin stability of the three principal axes (§4.4.1), or ``None`` when ``inertia_tool.dynamics.spin_stability`` is
-    not installed (or the body has no meaningful spin stability)."""
-    try:
-        from ..dynamics.spin_stability import stability
-    except ImportError:
-        return None
-    try:
-        report = stability(props)
-    except InertiaToolError as exc:
-        return HtmlSection("Spin stability", f'<p class="warn">{_e(exc)}</p>', "stability")
+def stability_section(report) -> HtmlSection:
+    """Spin stability of the three principal axes (§4.4.1) from a
+    :class:`~inertia_tool.dynamics.spin_stability.StabilityReport`, or the reason it is undefined (a str)."""
+    if isinstance(report, str):
+        return HtmlSection("Spin stability", f'<p class="warn">{_e(report)}</p>', "stability")
     rows = []
     for ax in report.axes:
         if ax.kind == "stable":
@@ -356,11 +349,6 @@ def stability_section(props: MassProperties) -> HtmlSection | None:
                       "what a small wobble does", "stable with energy loss"], rows, left_cols=1,
                      text_cols=(3, 5, 6)))
     return HtmlSection("Spin stability", body, "stability")
-
-
-#: Optional section builders, called in order with the ``MassProperties``; each returns an
-#: :class:`HtmlSection` or ``None``.  Append yours (``docs/html-report.md``).
-SECTION_BUILDERS: list[Callable[[MassProperties], HtmlSection | None]] = [stability_section]
 
 
 def _core_sections(props: MassProperties, density_source: str | None, semi) -> list[HtmlSection]:
@@ -427,9 +415,8 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
 
 
 def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_source: str | None = None,
-                warnings: Sequence[str] = (), builders: Sequence[Callable] | None = None,
-                extra_sections: Sequence[HtmlSection] = (), max_edges: int = DEFAULT_MAX_EDGES,
-                generated: str | None = None) -> str:
+                warnings: Sequence[str] = (), stability=None, extra_sections: Sequence[HtmlSection] = (),
+                max_edges: int = DEFAULT_MAX_EDGES, generated: str | None = None) -> str:
     """The complete HTML document (a string).
 
     Parameters
@@ -441,10 +428,11 @@ def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_
         How the density was chosen (shown as is, escaped).
     warnings : sequence of str
         Soft problems to list.
-    builders : sequence of callable, optional
-        Optional section builders; default :data:`SECTION_BUILDERS`.
+    stability : StabilityReport or str, optional
+        The spin-stability verdict (:func:`inertia_tool.stability`) or the reason it is undefined; omitted
+        when ``None``.  Formatting only: the caller computes it.
     extra_sections : sequence of HtmlSection
-        Appended after the built ones.
+        Appended after the built ones (other capabilities' sections, formatted by their callers).
     max_edges : int
         Cap on drawn segments per view.
     generated : str, optional
@@ -456,10 +444,8 @@ def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_
     except InertiaToolError:
         semi = None
     sections = _core_sections(props, density_source, semi)
-    for build in (SECTION_BUILDERS if builders is None else builders):
-        s = build(props)
-        if s is not None:
-            sections.append(s)
+    if stability is not None:
+        sections.append(stability_section(stability))
     sections.extend(extra_sections)
     views = svg_views(props, meshes, max_edges=max_edges)
     stamp = generated or _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
