@@ -16,6 +16,7 @@ import numpy as np
 
 from ..values import frozen_value
 from ..errors import UsageError
+from ..tolerances import ROTATION_ATOL
 from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -175,12 +176,15 @@ class MassProperties:
         translation : (3,) array_like, optional
             m.  Default zero.
 
-        Returns a new ``MassProperties`` with ``center_of_mass = R c + t`` and ``inertia = R I Rᵀ``.
+        Returns
+        -------
+        MassProperties
+            A new body with ``center_of_mass = R c + t`` and ``inertia = R I Rᵀ``.
         """
         r = np.eye(3) if rotation is None else np.asarray(rotation, dtype=np.float64)
         if r.shape != (3, 3):
             raise UsageError(f"Expected `rotation` to have shape (3, 3), got {r.shape}")
-        if not np.allclose(r @ r.T, np.eye(3), atol=1e-9) or np.linalg.det(r) < 0:
+        if not np.allclose(r @ r.T, np.eye(3), atol=ROTATION_ATOL) or np.linalg.det(r) < 0:
             raise UsageError("Expected `rotation` to be a proper rotation matrix (orthogonal, det +1)")
         t = np.zeros(3) if translation is None else as_vector3(translation, "translation")
         return MassProperties(mass=self.mass, volume=self.volume, center_of_mass=r @ self.center_of_mass + t,
