@@ -94,7 +94,10 @@ def _rotation(active_matrices=None, *, quaternions=None, rotvecs=None, euler=Non
     """scipy ``Rotation`` of a stack of active matrices / scalar-first quaternions / rotation vectors / angles."""
     from scipy.spatial.transform import Rotation
     if active_matrices is not None:
-        return Rotation.from_matrix(active_matrices.reshape(-1, 3, 3))
+        stack = active_matrices.reshape(-1, 3, 3)
+        if not np.all(np.linalg.det(stack) > 0):
+            raise UsageError("Expected proper rotation matrices (det +1), got a reflection or a singular matrix")
+        return Rotation.from_matrix(stack)
     if quaternions is not None:
         return Rotation.from_quat(np.roll(quaternions.reshape(-1, 4), -1, axis=-1))
     if rotvecs is not None:

@@ -178,17 +178,20 @@ def test_max_faces_guards_every_format(tmp_path):
         assert len(load_mesh(p, max_faces=12).faces) == 12
 
 
-def test_binary_header_claim_is_checked_before_allocation(tmp_path, monkeypatch):
-    """A lying count must be refused without numpy ever being asked for the announced array."""
-    import inertia_tool.mesh.read as mesh_io
+def test_binary_header_claim_is_checked_before_allocation(tmp_path):
+    """A lying count must be refused before anything it would size is allocated: the peak of traced memory
+    (numpy reports its buffers to tracemalloc) stays far below the 200 GB the header announces."""
+    import tracemalloc
     p = tmp_path / "liar.stl"
     write_binary_stl(p, *box(), count=4_000_000_000)
-    calls = []
-    real_empty = np.empty
-    monkeypatch.setattr(mesh_io.np, "empty", lambda *a, **k: calls.append(a) or real_empty(*a, **k))
-    with pytest.raises(MeshReadError, match="announces 4,000,000,000 triangles"):
-        load_mesh(p)
-    assert not calls
+    tracemalloc.start()
+    try:
+        with pytest.raises(MeshReadError, match="announces 4,000,000,000 triangles"):
+            load_mesh(p)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 8 << 20, f"{peak / 2**20:.1f} MiB allocated before refusing"
 
 
 # -- numerical edge cases ---------------------------------------------------------------------------------
