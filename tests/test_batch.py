@@ -273,6 +273,7 @@ def test_progress_plain_lines_when_not_a_terminal():
     assert len(lines) == 2 and "\r" not in buf.getvalue()
 
 
+@pytest.mark.slow
 def test_killed_run_leaves_a_valid_file_and_resume_completes(tmp_path):
     d = tmp_path / "many"
     d.mkdir()

@@ -31,6 +31,7 @@ def _strip(rows):
     return sorted(json.dumps({k: v for k, v in r.items() if k not in ("seconds", "worker")}) for r in rows)
 
 
+@pytest.mark.slow
 def test_local_cluster_matches_in_process_rows(meshes):
     from inertia_tool.cli.batch import dask_executor
 
@@ -53,6 +54,7 @@ def test_local_cluster_matches_in_process_rows(meshes):
     assert box["izz"] == pytest.approx(mass / 12 * (4e-6 + 4e-6), rel=1e-5)
 
 
+@pytest.mark.slow
 def test_cli_dask_local_resumes_a_process_pool_run(meshes, tmp_path, capsys):
     out = tmp_path / "r.jsonl"
     assert main(["batch", str(meshes / "part*.stl"), "--out", str(out), "--jobs", "2"]) == 0

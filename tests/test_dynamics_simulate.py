@@ -74,6 +74,7 @@ def test_constant_torque_along_spin_of_sphere_closed_form():
     np.testing.assert_allclose(traj.rotation_matrices, expected, atol=1e-11)
 
 
+@pytest.mark.slow
 def test_gravity_gradient_torque_against_dop853_and_work_energy():
     """Orientation-dependent torque (space-fixed field expressed in body axes); dT/dt = ω·τ (§4.4.1)."""
     def torque(t, q, w):

@@ -85,6 +85,7 @@ def test_gravity_gradient_in_rotated_mesh_axes_agrees_with_dop853():
     assert max_error(tight.angular_velocity, tight.orientation, w_ref, q_ref) < 1e-11
 
 
+@pytest.mark.slow
 def test_heavy_symmetric_top_agrees_with_heavy_top_simulation():
     """Top about its pivot (I1 = I2): τ_body = −M g l e3 × ẑ_b; θ(t) = acos(n_z) against heavy_top.simulate_top
     (vector form, DOP853), and the nutation period of the analytic report (Eqs. 4.36–4.40)."""
@@ -122,6 +123,7 @@ def test_quaternion_stays_unit_with_long_steps():
     assert np.max(np.abs(np.linalg.norm(q, axis=1) - 1.0)) < 1e-14
 
 
+@pytest.mark.slow
 def test_total_energy_of_conservative_torque_bounded_and_of_method_order():
     """Symplectic: the total energy ½ω·Iω + V error oscillates without drift, and shrinks as h^p."""
     torque, potential = gravity_gradient(TENSOR, 0.5)

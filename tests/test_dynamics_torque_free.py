@@ -103,6 +103,7 @@ def _psi_rate(moments, w, circled):
 
 @pytest.mark.parametrize("moments,w0", [((1.0, 2.0, 3.0), (0.1, 1.0, 0.05)), ((1.0, 2.0, 3.0), (0.3, 0.5, 1.0)),
                                         ((0.7, 1.5, 2.0), (0.4, -1.2, 0.3))])
+@pytest.mark.slow
 def test_precession_angle_against_quadrature(moments, w0):
     params = free_body_parameters(moments, w0)
     rate = lambda s: _psi_rate(moments, torque_free_motion(moments, w0, np.array([0.0, s]))[0][-1],
@@ -128,6 +129,7 @@ def test_precession_quasi_periodic_accumulation_at_t_1000():
     assert precession_angle(moments, w0, [0.0, 1000.0])[-1] == pytest.approx(expected, rel=1e-13)
 
 
+@pytest.mark.slow
 def test_orientation_at_t_1000_against_independent_integration():
     """Orientation target of issue 3 (1e-11).  The reference is a DOP853 integration of q̇ = ½ q⊗ω *driven by
     the exact ω(t)* (so only the kinematics is integrated), restarted at every period of ω from the exact
