@@ -9,6 +9,9 @@ exception             meaning
 ====================  ==============================================
 UsageError            bad parameters (units, materials: subclasses)
 MeshReadError         the file cannot be read or parsed as a mesh
+RobotDescriptionError a robot description (URDF, xacro, SDF, MJCF)
+                      cannot be read, or names a mesh that cannot
+                      be found
 InvalidMeshError      the mesh is read but does not bound a solid
 PhysicsError          valid input, but the request cannot be met
                       (e.g. a singular top)
@@ -26,6 +29,7 @@ __all__ = [
     "UnitsError",
     "MaterialError",
     "MeshReadError",
+    "RobotDescriptionError",
     "InvalidMeshError",
     "PhysicsError",
     "InertiaToolWarning",
@@ -65,6 +69,13 @@ class MeshReadError(InertiaToolError, OSError):
     The message names the file and what was wrong with its bytes.
     """
 
+
+
+class RobotDescriptionError(InertiaToolError, ValueError):
+    """A robot description (URDF, xacro, SDFormat, MJCF) cannot be read or refers to something that is not there.
+
+    The message names the file and, where it applies, the link and the URI that could not be resolved.
+    """
 
 
 class InvalidMeshError(InertiaToolError, ValueError):

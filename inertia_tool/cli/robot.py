@@ -1,0 +1,97 @@
+"""``inertia-tool robot ROBOT``: per-link mass properties from a robot description's geometry, an audit of
+the declared inertials, and optionally a corrected copy of the description."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+
+from ..errors import UsageError
+from ..reports.robot_audit import format_robot_report, robot_report_dict
+from ..robot.audit import audit
+from ..robot.description import GEOMETRY_KINDS, read_robot
+from ..robot.geometry import link_inertials
+from ..robot.write import write_corrected
+from ..units import MATERIALS, parse_density
+from .report_option import check_output_file
+
+__all__ = ["register", "run", "parse_packages", "parse_mappings"]
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "robot", help="link mass properties from a URDF/xacro/SDF/MJCF's geometry; audit and correct <inertial>",
+        description="Read a robot description (URDF, xacro, SDFormat, MuJoCo MJCF), compute every link's mass, "
+                    "centre of mass and inertia tensor from its collision (or visual) geometry in the link frame, "
+                    "compare them with the declared <inertial> elements, and optionally write a copy of the "
+                    "description with corrected <inertial> elements (origin at the centre of mass, rpy 0, full "
+                    "tensor). See docs/robots.md.")
+    p.add_argument("robot", metavar="ROBOT", help="*.urdf, *.xacro, *.sdf, or MuJoCo *.xml")
+    p.add_argument("--package", action="append", default=[], metavar="NAME=DIR",
+                   help="directory of package NAME for package://NAME/... URIs (repeatable; ROS_PACKAGE_PATH is "
+                        "searched after these)")
+    p.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE",
+                   help="xacro argument (repeatable)")
+    p.add_argument("--geometry", choices=GEOMETRY_KINDS, default="collision",
+                   help="which geometry of each link to integrate (default: collision)")
+    m = p.add_mutually_exclusive_group(required=True)
+    m.add_argument("--density", metavar="RHO", help="density of every link, kg/m³ by default (or e.g. 2.7g/cm3)")
+    m.add_argument("--material", metavar="NAME", help=f"material of every link: {', '.join(sorted(MATERIALS))}")
+    m.add_argument("--keep-mass", action="store_true",
+                   help="keep each link's declared mass and take its distribution from the geometry "
+                        "(the implied density is reported)")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    p.add_argument("--write", metavar="OUT", help="write a copy of the description with corrected <inertial> elements")
+    p.add_argument("--force", action="store_true", help="let --write replace an existing file")
+    p.set_defaults(func=run)
+
+
+def parse_packages(items) -> dict:
+    """``["ur_description=/path", ...]`` → ``{"ur_description": "/path"}``; UsageError naming the item."""
+    packages = {}
+    for item in items:
+        name, sep, directory = item.partition("=")
+        if not sep or not name or not directory:
+            raise UsageError(f"--package expects NAME=DIR, got {item!r}")
+        if not os.path.isdir(directory):
+            raise UsageError(f"--package {item}: {directory} is not a directory")
+        packages[name] = directory
+    return packages
+
+
+def parse_mappings(items) -> dict:
+    """``["prefix:=ur5_", ...]`` → ``{"prefix": "ur5_"}``; UsageError naming the item."""
+    mappings = {}
+    for item in items:
+        name, sep, value = item.partition(":=")
+        if not sep or not name:
+            raise UsageError(f"--arg expects NAME:=VALUE, got {item!r}")
+        mappings[name] = value
+    return mappings
+
+
+def run(args) -> int:
+    packages = parse_packages(args.package)
+    mappings = parse_mappings(args.arg)
+    if args.force and not args.write:
+        raise UsageError("--force only applies to --write")
+    check_output_file(args.write, "--write", args.force)
+    density = parse_density(args.density) if args.density is not None else None
+    robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings)
+    inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass)
+    audits = audit(robot, inertials, keep_mass=args.keep_mass)
+    if args.write:
+        basis = next((r.basis for r in inertials if r.properties is not None), "")
+        note = "declared masses kept" if args.keep_mass else f"density {basis}"
+        changed = write_corrected(robot, inertials, args.write, force=args.force, note=note)
+        skipped = [r.name for r in inertials if r.properties is None]
+        message = f"wrote {args.write}: <inertial> of {len(changed)} links corrected"
+        if skipped:
+            message += f"; left as they were: {', '.join(skipped)}"
+        print(message, file=sys.stderr)
+    if args.json:
+        print(json.dumps(robot_report_dict(robot, inertials, audits), indent=2, ensure_ascii=False))
+    else:
+        print(format_robot_report(robot, inertials, audits))
+    return 0

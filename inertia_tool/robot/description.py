@@ -1,0 +1,540 @@
+"""Robot descriptions (URDF, xacro, SDFormat, MJCF) read into one model of links, geometry and inertials.
+
+Every format ends up as a :class:`RobotDescription`: per link, the geometry elements of the chosen kind
+(collision or visual) with their pose in the **link frame** and their size in metres, and the declared
+``<inertial>`` converted to the link frame (centre of mass, tensor about it in link axes).  Meshes are
+resolved to files here (``inertia_tool.robot.resolve``), so a missing mesh is reported before any work.
+
+Conventions (``docs/conventions.md``):
+
+* URDF ``<origin xyz rpy>`` and SDFormat ``<pose>x y z roll pitch yaw</pose>``: fixed-axis roll, pitch, yaw,
+  ``R = R_z(yaw) R_y(pitch) R_x(roll)`` with active elementary rotations; a point ``p`` of the element frame
+  is ``R p + xyz`` in the link frame.
+* A ``<cylinder>`` (and ``<capsule>``) has its axis along the element's z, centred on its origin; ``length``
+  is the cylindrical part (a capsule adds a hemisphere of ``radius`` at each end).  ``<box size>`` is the
+  full edge lengths.  ``<mesh scale>`` multiplies the file coordinates (metres) axis by axis, before the pose.
+* The declared inertia is given in the inertial frame (``I_frame``); in link axes it is ``R I_frame Rᵀ``.
+
+xacro files (``*.xacro``) are expanded with the ``xacro`` package (``mappings`` are its ``name:=value``
+arguments; ``$(find NAME)`` resolves through ``packages`` and ``ROS_PACKAGE_PATH``).  MJCF is read by
+``inertia_tool.robot.mjcf``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import RobotDescriptionError, UsageError
+from .resolve import package_directory, resolve_uri
+
+__all__ = ["GeometryElement", "DeclaredInertial", "LinkGeometry", "RobotDescription", "read_robot",
+           "rpy_to_matrix", "GEOMETRY_KINDS", "ROBOT_SUFFIXES", "PRIMITIVES"]
+
+#: Which geometry of a link to take: ``<collision>`` (default; usually simpler, closed meshes) or ``<visual>``.
+GEOMETRY_KINDS = ("collision", "visual")
+
+#: Primitive shapes with closed-form mass properties.
+PRIMITIVES = ("box", "cylinder", "sphere", "capsule", "ellipsoid")
+
+#: Description formats by suffix.
+ROBOT_SUFFIXES = {".urdf": "urdf", ".xacro": "xacro", ".sdf": "sdf", ".world": "sdf", ".xml": "mjcf",
+                  ".mjcf": "mjcf"}
+
+#: Largest description file read (bytes); descriptions are text of a few hundred KB at most.
+MAX_DESCRIPTION_BYTES = 64 << 20
+
+
+def rpy_to_matrix(rpy) -> np.ndarray:
+    """Active rotation of fixed-axis roll, pitch, yaw (rad): ``R = R_z(yaw) R_y(pitch) R_x(roll)`` (URDF/SDF).
+
+    Parameters
+    ----------
+    rpy : (3,) array_like
+        ``(roll, pitch, yaw)`` in rad.
+
+    Returns
+    -------
+    (3, 3) float
+        Columns are the rotated frame's axes in parent components.
+    """
+    r, p, y = (float(a) for a in rpy)
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+    return rz @ ry @ rx
+
+
+def _frozen(a, shape) -> np.ndarray:
+    out = np.array(a, dtype=np.float64).reshape(shape)
+    out.flags.writeable = False
+    return out
+
+
+@dataclass(frozen=True)
+class GeometryElement:
+    """One ``<collision>`` or ``<visual>`` geometry of a link (MJCF: one ``<geom>``).
+
+    Attributes
+    ----------
+    kind : str
+        ``"box"``, ``"cylinder"``, ``"sphere"``, ``"capsule"``, ``"ellipsoid"`` or ``"mesh"``.
+    rotation : (3, 3) float
+        Columns are the element frame's axes in link axes (active).
+    translation : (3,) float
+        Origin of the element frame in the link frame, m.
+    size : tuple of float
+        m.  box: full edge lengths ``(x, y, z)``; cylinder, capsule: ``(radius, length)`` with ``length`` the
+        cylindrical part along the element z; sphere: ``(radius,)``; ellipsoid: semi-axes ``(a, b, c)``;
+        mesh: ``()``.
+    mesh : str or None
+        Absolute path of the mesh file (``kind == "mesh"``).
+    uri : str or None
+        The mesh as written in the description (for messages).
+    scale : (3,) float
+        Mesh scale factors per axis (1 for primitives).
+    name : str
+        Label: the element's ``name`` or ``"collision 1"``, ``"visual 2"`` ...
+    """
+
+    kind: str
+    rotation: np.ndarray
+    translation: np.ndarray
+    size: tuple = ()
+    mesh: str | None = None
+    uri: str | None = None
+    scale: np.ndarray = field(default_factory=lambda: np.ones(3))
+    name: str = ""
+
+    def __post_init__(self):
+        object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))
+        object.__setattr__(self, "translation", _frozen(self.translation, (3,)))
+        object.__setattr__(self, "scale", _frozen(self.scale, (3,)))
+        object.__setattr__(self, "size", tuple(float(s) for s in self.size))
+
+
+@dataclass(frozen=True)
+class DeclaredInertial:
+    """A link's ``<inertial>`` as the description declares it, in the link frame.
+
+    Attributes
+    ----------
+    mass : float
+        kg.
+    center_of_mass : (3,) float
+        m, link frame (the inertial frame's origin).
+    inertia : (3, 3) float
+        kg·m² about ``center_of_mass``, **link axes** (``R I_frame Rᵀ``), tensor convention (−∫xy dm).
+    rotation : (3, 3) float
+        The declared inertial frame's axes (columns) in link axes.
+    inertia_in_frame : (3, 3) float
+        kg·m², the tensor as written (inertial-frame axes).
+    """
+
+    mass: float
+    center_of_mass: np.ndarray
+    inertia: np.ndarray
+    rotation: np.ndarray
+    inertia_in_frame: np.ndarray
+
+    def __post_init__(self):
+        object.__setattr__(self, "mass", float(self.mass))
+        for name, shape in (("center_of_mass", (3,)), ("inertia", (3, 3)), ("rotation", (3, 3)),
+                            ("inertia_in_frame", (3, 3))):
+            object.__setattr__(self, name, _frozen(getattr(self, name), shape))
+
+
+@dataclass(frozen=True)
+class LinkGeometry:
+    """A link (MJCF: a body): its geometry elements of the chosen kind and its declared inertial.
+
+    Attributes
+    ----------
+    name : str
+    elements : tuple of GeometryElement
+        Empty for a link without geometry of that kind (a frame, a virtual link).
+    declared : DeclaredInertial or None
+        None when the description has no ``<inertial>`` for the link.
+    """
+
+    name: str
+    elements: tuple
+    declared: DeclaredInertial | None
+
+
+@dataclass(frozen=True)
+class RobotDescription:
+    """A robot description reduced to what mass properties need.
+
+    Attributes
+    ----------
+    name : str
+        The robot / model name.
+    source : str
+        The file read.
+    format : str
+        ``"urdf"``, ``"xacro"`` (expanded to URDF), ``"sdf"`` or ``"mjcf"``.
+    geometry : str
+        ``"collision"`` or ``"visual"``: which elements ``links`` hold.
+    links : tuple of LinkGeometry
+        In document order.
+    document : bytes
+        The XML that was parsed (for xacro: the expanded URDF); ``write_corrected`` edits it.
+    """
+
+    name: str
+    source: str
+    format: str
+    geometry: str
+    links: tuple
+    document: bytes = field(repr=False, default=b"")
+
+    def link(self, name: str) -> LinkGeometry:
+        """The link called ``name`` (KeyError naming the known links if absent)."""
+        for link in self.links:
+            if link.name == name:
+                return link
+        raise KeyError(f"no link {name!r}; links: {', '.join(l.name for l in self.links)}")
+
+
+# -- shared parsing helpers ------------------------------------------------------------------------------
+
+def _fail(source: str, problem: str) -> RobotDescriptionError:
+    return RobotDescriptionError(f"{source}: {problem}")
+
+
+def _numbers(text, count: int, what: str, source: str, default=None) -> np.ndarray:
+    if text is None:
+        if default is None:
+            raise _fail(source, f"{what}: missing")
+        return np.array(default, dtype=np.float64)
+    try:
+        values = np.array([float(t) for t in str(text).split()], dtype=np.float64)
+    except ValueError:
+        raise _fail(source, f"{what}: expected {count} numbers, got {str(text)[:80]!r}") from None
+    if values.shape != (count,) or not np.all(np.isfinite(values)):
+        raise _fail(source, f"{what}: expected {count} finite numbers, got {str(text)[:80]!r}")
+    return values
+
+
+def _positive(value: float, what: str, source: str) -> float:
+    if not (math.isfinite(value) and value > 0):
+        raise _fail(source, f"{what}: expected a positive size, got {value:g}")
+    return float(value)
+
+
+def parse_xml(data: bytes, source: str):
+    """An lxml tree of ``data`` keeping comments and whitespace; no entity expansion, no network."""
+    from lxml import etree
+    parser = etree.XMLParser(remove_blank_text=False, remove_comments=False, resolve_entities=False,
+                             no_network=True, huge_tree=False)
+    try:
+        return etree.fromstring(data, parser).getroottree()
+    except etree.XMLSyntaxError as exc:
+        raise _fail(source, f"not well-formed XML ({exc})") from None
+
+
+def _read_bytes(path: str) -> bytes:
+    if not os.path.isfile(path):
+        raise _fail(path, "no such file" if not os.path.exists(path) else "is not a regular file")
+    size = os.path.getsize(path)
+    if size > MAX_DESCRIPTION_BYTES:
+        raise _fail(path, f"{size:,} bytes, more than the {MAX_DESCRIPTION_BYTES:,} a robot description may have")
+    with open(path, "rb") as fh:
+        return fh.read()
+
+
+# -- xacro -------------------------------------------------------------------------------------------------
+
+@contextlib.contextmanager
+def _xacro_find(packages: dict):
+    """Make xacro's ``$(find NAME)`` use ``packages`` and ROS_PACKAGE_PATH instead of an installed ROS."""
+    from xacro import substitution_args
+    original = substitution_args._eval_find
+
+    def find(name):
+        directory = package_directory(name, packages)
+        if directory is None:
+            raise RobotDescriptionError(f"$(find {name}): package {name!r} is not among the packages given and "
+                                        "not on ROS_PACKAGE_PATH")
+        return directory
+
+    substitution_args._eval_find = find
+    try:
+        yield
+    finally:
+        substitution_args._eval_find = original
+
+
+def _expand_xacro(path: str, mappings: dict, packages: dict) -> bytes:
+    try:
+        import xacro
+    except ImportError:
+        raise _fail(path, "expanding xacro needs the xacro package (pip install xacro)") from None
+    try:
+        with _xacro_find(packages):
+            doc = xacro.process_file(path, mappings={str(k): str(v) for k, v in mappings.items()})
+    except RobotDescriptionError as exc:
+        raise _fail(path, str(exc)) from None
+    except Exception as exc:  # noqa: BLE001 - xacro raises many kinds; all mean "cannot expand"
+        text = " ".join(str(exc).split()) or type(exc).__name__
+        raise _fail(path, f"xacro expansion failed ({text[:200]})") from None
+    return doc.toxml(encoding="utf-8")
+
+
+# -- URDF --------------------------------------------------------------------------------------------------
+
+def _urdf_origin(element, what: str, source: str) -> tuple[np.ndarray, np.ndarray]:
+    origin = element.find("origin") if element is not None else None
+    if origin is None:
+        return np.eye(3), np.zeros(3)
+    xyz = _numbers(origin.get("xyz"), 3, f"{what} <origin xyz>", source, default=(0, 0, 0))
+    rpy = _numbers(origin.get("rpy"), 3, f"{what} <origin rpy>", source, default=(0, 0, 0))
+    return rpy_to_matrix(rpy), xyz
+
+
+def _tensor(ixx, ixy, ixz, iyy, iyz, izz) -> np.ndarray:
+    return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], dtype=np.float64)
+
+
+def _declared(mass: float, rotation, position, tensor, what: str, source: str) -> DeclaredInertial:
+    if not math.isfinite(mass):
+        raise _fail(source, f"{what}: mass is not a finite number")
+    if not np.all(np.isfinite(tensor)):
+        raise _fail(source, f"{what}: inertia has non-finite entries")
+    return DeclaredInertial(mass=mass, center_of_mass=position, inertia=rotation @ tensor @ rotation.T,
+                            rotation=rotation, inertia_in_frame=tensor)
+
+
+def _urdf_inertial(link, source: str) -> DeclaredInertial | None:
+    inertial = link.find("inertial")
+    if inertial is None:
+        return None
+    what = f"link {link.get('name')!r} <inertial>"
+    rotation, position = _urdf_origin(inertial, what, source)
+    mass_el = inertial.find("mass")
+    mass = _numbers(mass_el.get("value") if mass_el is not None else None, 1, f"{what} <mass value>", source)[0]
+    ie = inertial.find("inertia")
+    if ie is None:
+        raise _fail(source, f"{what}: no <inertia>")
+    values = [_numbers(ie.get(k), 1, f"{what} <inertia {k}>", source, default=(0.0,))[0]
+              for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")]
+    return _declared(mass, rotation, position, _tensor(*values), what, source)
+
+
+def _urdf_geometry(element, link_name: str, label: str, base: str, packages: dict, source: str):
+    geometry = element.find("geometry")
+    what = f"link {link_name!r} {label}"
+    shapes = [c for c in geometry if isinstance(c.tag, str)] if geometry is not None else []
+    if len(shapes) != 1:
+        raise _fail(source, f"{what}: expected one shape inside <geometry>, found {len(shapes)}")
+    shape = shapes[0]
+    rotation, translation = _urdf_origin(element, what, source)
+    kind = shape.tag
+    name = element.get("name") or label
+    if kind == "box":
+        size = tuple(_positive(v, f"{what} <box size>", source)
+                     for v in _numbers(shape.get("size"), 3, f"{what} <box size>", source))
+        return GeometryElement("box", rotation, translation, size=size, name=name)
+    if kind in ("cylinder", "capsule"):
+        r = _positive(_numbers(shape.get("radius"), 1, f"{what} <{kind} radius>", source)[0], f"{what} radius", source)
+        h = _numbers(shape.get("length"), 1, f"{what} <{kind} length>", source)[0]
+        if not (math.isfinite(h) and (h > 0 or (kind == "capsule" and h == 0))):
+            raise _fail(source, f"{what}: <{kind} length> must be positive, got {h:g}")
+        return GeometryElement(kind, rotation, translation, size=(r, h), name=name)
+    if kind == "sphere":
+        r = _positive(_numbers(shape.get("radius"), 1, f"{what} <sphere radius>", source)[0], f"{what} radius", source)
+        return GeometryElement("sphere", rotation, translation, size=(r,), name=name)
+    if kind == "mesh":
+        uri = shape.get("filename")
+        if not uri:
+            raise _fail(source, f"{what}: <mesh> without a filename")
+        scale = _numbers(shape.get("scale"), 3, f"{what} <mesh scale>", source, default=(1, 1, 1))
+        path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name)
+        return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name)
+    raise _fail(source, f"{what}: unsupported geometry <{kind}> (expected box, cylinder, sphere, capsule or mesh)")
+
+
+def _read_urdf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
+    if root.tag != "robot":
+        raise _fail(source, f"not a URDF: the root element is <{root.tag}>, expected <robot>")
+    links = []
+    for link in root.iter("link"):
+        if link.getparent() is not root:
+            continue
+        name = link.get("name")
+        if not name:
+            raise _fail(source, "a <link> without a name")
+        elements = tuple(_urdf_geometry(el, name, f"{geometry} {k + 1}", base, packages, source)
+                         for k, el in enumerate(link.findall(geometry)))
+        links.append(LinkGeometry(name=name, elements=elements, declared=_urdf_inertial(link, source)))
+    return root.get("name", ""), tuple(links)
+
+
+# -- SDFormat ----------------------------------------------------------------------------------------------
+
+def _sdf_pose(element, what: str, source: str) -> tuple[np.ndarray, np.ndarray]:
+    pose = element.find("pose") if element is not None else None
+    if pose is None:
+        return np.eye(3), np.zeros(3)
+    relative = pose.get("relative_to")
+    if relative not in (None, ""):
+        parent = element.getparent()
+        own_link = parent.get("name") if parent is not None and parent.tag == "link" else None
+        if element.tag != "link" and relative != own_link:
+            raise _fail(source, f"{what}: <pose relative_to={relative!r}> (only poses relative to the link are "
+                                "supported)")
+    text = (pose.text or "").strip()
+    values = _numbers(text or "0 0 0 0 0 0", 6, f"{what} <pose>", source)
+    rpy = values[3:]
+    if pose.get("degrees") == "true":
+        rpy = np.radians(rpy)
+    if pose.get("rotation_format", "euler_rpy") != "euler_rpy":
+        raise _fail(source, f"{what}: <pose rotation_format={pose.get('rotation_format')!r}> is not supported")
+    return rpy_to_matrix(rpy), values[:3]
+
+
+def _sdf_number(element, tag: str, what: str, source: str, default=None) -> float:
+    child = element.find(tag) if element is not None else None
+    return float(_numbers(child.text if child is not None else None, 1, f"{what} <{tag}>", source,
+                          default=None if default is None else (default,))[0])
+
+
+def _sdf_inertial(link, source: str) -> DeclaredInertial | None:
+    inertial = link.find("inertial")
+    if inertial is None:
+        return None
+    what = f"link {link.get('name')!r} <inertial>"
+    rotation, position = _sdf_pose(inertial, what, source)
+    mass = _sdf_number(inertial, "mass", what, source, default=1.0)
+    ie = inertial.find("inertia")
+    values = [_sdf_number(ie, k, what, source, default=1.0 if k in ("ixx", "iyy", "izz") else 0.0)
+              for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")]
+    return _declared(mass, rotation, position, _tensor(*values), what, source)
+
+
+def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict, source: str):
+    what = f"link {link_name!r} {label}"
+    geometry = element.find("geometry")
+    shapes = [c for c in geometry if isinstance(c.tag, str)] if geometry is not None else []
+    if len(shapes) != 1:
+        raise _fail(source, f"{what}: expected one shape inside <geometry>, found {len(shapes)}")
+    shape = shapes[0]
+    rotation, translation = _sdf_pose(element, what, source)
+    name = element.get("name") or label
+    kind = shape.tag
+    if kind == "box":
+        size = _numbers(shape.findtext("size"), 3, f"{what} <box><size>", source)
+        return GeometryElement("box", rotation, translation, size=[_positive(s, what, source) for s in size], name=name)
+    if kind in ("cylinder", "capsule"):
+        r = _positive(_sdf_number(shape, "radius", what, source), f"{what} radius", source)
+        h = _sdf_number(shape, "length", what, source)
+        return GeometryElement(kind, rotation, translation, size=(r, _positive(h, f"{what} length", source)), name=name)
+    if kind == "sphere":
+        r = _positive(_sdf_number(shape, "radius", what, source), f"{what} radius", source)
+        return GeometryElement("sphere", rotation, translation, size=(r,), name=name)
+    if kind == "ellipsoid":
+        radii = _numbers(shape.findtext("radii"), 3, f"{what} <ellipsoid><radii>", source)
+        return GeometryElement("ellipsoid", rotation, translation, size=[_positive(s, what, source) for s in radii],
+                               name=name)
+    if kind == "mesh":
+        uri = (shape.findtext("uri") or "").strip()
+        if not uri:
+            raise _fail(source, f"{what}: <mesh> without a <uri>")
+        if shape.find("submesh") is not None:
+            raise _fail(source, f"{what}: <mesh><submesh> is not supported")
+        scale = _numbers(shape.findtext("scale"), 3, f"{what} <mesh><scale>", source, default=(1, 1, 1))
+        path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name)
+        return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name)
+    raise _fail(source, f"{what}: unsupported geometry <{kind}> (expected box, cylinder, sphere, capsule, "
+                        "ellipsoid or mesh)")
+
+
+def _read_sdf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
+    if root.tag != "sdf":
+        raise _fail(source, f"not an SDFormat file: the root element is <{root.tag}>, expected <sdf>")
+    models = root.findall("model") + root.findall("world/model")
+    if len(models) != 1:
+        raise _fail(source, f"expected one <model>, found {len(models)}")
+    model = models[0]
+    if model.find("include") is not None or model.find("model") is not None:
+        raise _fail(source, "nested <model> and <include> are not supported; give the included model's file")
+    links = []
+    for link in model.findall("link"):
+        name = link.get("name")
+        if not name:
+            raise _fail(source, "a <link> without a name")
+        elements = tuple(_sdf_geometry(el, name, f"{geometry} {k + 1}", base, packages, source)
+                         for k, el in enumerate(link.findall(geometry)))
+        links.append(LinkGeometry(name=name, elements=elements, declared=_sdf_inertial(link, source)))
+    return model.get("name", ""), tuple(links)
+
+
+# -- entry point -------------------------------------------------------------------------------------------
+
+def _detect(path: str) -> str:
+    fmt = ROBOT_SUFFIXES.get(os.path.splitext(path)[1].lower())
+    if fmt is None:
+        raise _fail(path, f"unknown robot description type {os.path.splitext(path)[1] or '(no suffix)'!r}; "
+                          f"expected one of {', '.join(sorted(ROBOT_SUFFIXES))}")
+    return fmt
+
+
+def read_robot(path, *, packages: dict | None = None, geometry: str = "collision",
+               mappings: dict | None = None) -> RobotDescription:
+    """Read a URDF, xacro, SDFormat or MJCF file into a :class:`RobotDescription`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``*.urdf``, ``*.xacro`` (``*.urdf.xacro``), ``*.sdf``, ``*.world`` or ``*.xml``/``*.mjcf`` (MuJoCo).
+    packages : dict, optional
+        Package name → directory, for ``package://NAME/...`` (and ``model://``, ``$(find NAME)``); looked up
+        before ``ROS_PACKAGE_PATH``.
+    geometry : {"collision", "visual"}
+        Which geometry elements to keep (MJCF: geoms that collide, ``contype``/``conaffinity`` not both 0, or
+        the others).
+    mappings : dict, optional
+        xacro arguments (``name → value``, the ``name:=value`` of the xacro command line).
+
+    Returns
+    -------
+    RobotDescription
+
+    Raises
+    ------
+    RobotDescriptionError
+        Unreadable or malformed file, unsupported construct, or a mesh that cannot be resolved (the message
+        names the link and the URI).
+    UsageError
+        Bad ``geometry``, or ``mappings`` for a file that is not xacro.
+    """
+    if geometry not in GEOMETRY_KINDS:
+        raise UsageError(f"Expected `geometry` to be one of {', '.join(GEOMETRY_KINDS)}, got {geometry!r}")
+    source = os.fsdecode(os.fspath(path))
+    packages = dict(packages or {})
+    data = _read_bytes(source)
+    fmt = _detect(source)
+    if mappings and fmt != "xacro":
+        raise UsageError(f"xacro arguments given for {source}, which is not a xacro file")
+    if fmt == "xacro":
+        data = _expand_xacro(source, mappings or {}, packages)
+    root = parse_xml(data, source).getroot()
+    base = os.path.dirname(os.path.abspath(source))
+    if fmt == "mjcf":    # *.xml: the root element says which format it is
+        fmt = {"robot": "urdf", "sdf": "sdf"}.get(root.tag, "mjcf")
+    if fmt == "mjcf":
+        from .mjcf import read_mjcf
+        name, links = read_mjcf(root, source, base, packages, geometry)
+    elif fmt in ("urdf", "xacro"):
+        name, links = _read_urdf(root, source, base, packages, geometry)
+    else:
+        name, links = _read_sdf(root, source, base, packages, geometry)
+    if not links:
+        raise _fail(source, "no links found")
+    return RobotDescription(name=name, source=source, format=fmt, geometry=geometry, links=links, document=data)

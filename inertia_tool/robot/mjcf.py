@@ -1,0 +1,296 @@
+"""MuJoCo MJCF bodies and geoms as :class:`~inertia_tool.robot.description.LinkGeometry` (one link per body).
+
+What is read (MuJoCo XML reference, "MJCF"): ``<compiler angle eulerseq meshdir assetdir>`` (angles in
+**degrees** unless ``angle="radian"``, MuJoCo's default), ``<default>`` classes (nested, ``class`` and
+``childclass``) for ``<geom>`` and ``<mesh>`` attributes, ``<asset><mesh name file scale>``, and under
+``<worldbody>`` every ``<body>`` (``<frame>`` elements compose their pose into the geoms they hold).  A geom's
+frame is ``pos`` and one of ``quat`` (w x y z), ``axisangle``, ``euler`` (sequence ``eulerseq``: lower case
+letters rotate with the frame, upper case stay fixed), ``xyaxes``, ``zaxis``; or ``fromto`` for capsules,
+cylinders, boxes and ellipsoids (the axis runs from the first point to the second).  Sizes are MuJoCo's
+half-sizes: box half-edges, cylinder and capsule ``radius half-length``, ellipsoid semi-axes.
+
+Collision geoms are those with ``contype`` or ``conaffinity`` non-zero (MuJoCo's default is 1); the others
+are visual.  Geoms directly in ``<worldbody>`` belong to no body and are skipped.  ``<include>``, inline mesh
+vertices and height fields are refused with a message.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from ..errors import RobotDescriptionError
+from .description import DeclaredInertial, GeometryElement, LinkGeometry, _numbers, _positive
+from .resolve import resolve_uri
+
+__all__ = ["read_mjcf", "orientation_matrix"]
+
+_GEOM_KINDS = {"box": "box", "sphere": "sphere", "cylinder": "cylinder", "capsule": "capsule",
+               "ellipsoid": "ellipsoid", "mesh": "mesh"}
+
+
+def _fail(source: str, problem: str) -> RobotDescriptionError:
+    return RobotDescriptionError(f"{source}: {problem}")
+
+
+def _quaternion_matrix(q) -> np.ndarray:
+    w, x, y, z = np.asarray(q, dtype=np.float64) / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def _axis_angle(axis, angle: float) -> np.ndarray:
+    n = np.asarray(axis, dtype=np.float64)
+    n = n / np.linalg.norm(n)
+    k = np.array([[0, -n[2], n[1]], [n[2], 0, -n[0]], [-n[1], n[0], 0]])
+    return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * (k @ k)
+
+
+def _z_to(direction) -> np.ndarray:
+    """The minimal rotation taking +z onto ``direction`` (MuJoCo's ``zaxis`` and ``fromto`` frames)."""
+    d = np.asarray(direction, dtype=np.float64)
+    d = d / np.linalg.norm(d)
+    axis = np.cross([0.0, 0.0, 1.0], d)
+    s, c = np.linalg.norm(axis), float(d[2])
+    if s < 1e-14:
+        return np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
+    return _axis_angle(axis, math.atan2(s, c))
+
+
+def orientation_matrix(attrs: dict, *, degrees: bool, eulerseq: str, what: str, source: str) -> np.ndarray:
+    """Active rotation (frame axes as columns, in parent axes) from MJCF orientation attributes.
+
+    Parameters
+    ----------
+    attrs : dict
+        Attribute values (strings) after defaults: ``quat`` (w x y z), ``axisangle``, ``euler``, ``xyaxes``,
+        ``zaxis``; at most one of them.
+    degrees : bool
+        ``<compiler angle="degree">`` (MuJoCo's default) or radians.
+    eulerseq : str
+        ``<compiler eulerseq>``, three of ``xyzXYZ``: lower case rotate with the frame (intrinsic).
+    """
+    given = [k for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis") if attrs.get(k) is not None]
+    if len(given) > 1:
+        raise _fail(source, f"{what}: more than one orientation ({', '.join(given)})")
+    if not given:
+        return np.eye(3)
+    key = given[0]
+    unit = math.pi / 180.0 if degrees else 1.0
+    if key == "quat":
+        q = _numbers(attrs[key], 4, f"{what} quat", source)
+        if not np.linalg.norm(q) > 0:
+            raise _fail(source, f"{what}: quat of zero length")
+        return _quaternion_matrix(q)
+    if key == "axisangle":
+        a = _numbers(attrs[key], 4, f"{what} axisangle", source)
+        if not np.linalg.norm(a[:3]) > 0:
+            raise _fail(source, f"{what}: axisangle with a zero axis")
+        return _axis_angle(a[:3], a[3] * unit)
+    if key == "euler":
+        from scipy.spatial.transform import Rotation
+        angles = _numbers(attrs[key], 3, f"{what} euler", source) * unit
+        seq = eulerseq.swapcase()          # MuJoCo: lower = intrinsic; scipy: upper = intrinsic
+        return Rotation.from_euler(seq, angles).as_matrix()
+    if key == "xyaxes":
+        a = _numbers(attrs[key], 6, f"{what} xyaxes", source)
+        x = a[:3] / np.linalg.norm(a[:3])
+        y = a[3:] - (a[3:] @ x) * x
+        if not (np.linalg.norm(a[:3]) > 0 and np.linalg.norm(y) > 0):
+            raise _fail(source, f"{what}: xyaxes are zero or parallel")
+        y = y / np.linalg.norm(y)
+        return np.column_stack([x, y, np.cross(x, y)])
+    z = _numbers(attrs[key], 3, f"{what} zaxis", source)
+    if not np.linalg.norm(z) > 0:
+        raise _fail(source, f"{what}: zaxis of zero length")
+    return _z_to(z)
+
+
+class _Defaults:
+    """MJCF default classes: class name → {element tag → attributes}, each merged with its parents."""
+
+    def __init__(self, root, source: str):
+        self.classes: dict = {}
+        for top in root.findall("default"):
+            self._collect(top, {}, source)
+        self.classes.setdefault("main", {})
+
+    def _collect(self, element, inherited: dict, source: str) -> None:
+        name = element.get("class", "main")
+        merged = {tag: dict(attrs) for tag, attrs in inherited.items()}
+        for child in element:
+            if isinstance(child.tag, str) and child.tag != "default":
+                merged.setdefault(child.tag, {}).update(child.attrib)
+        self.classes[name] = merged
+        for child in element.findall("default"):
+            if not child.get("class"):
+                raise _fail(source, "a nested <default> without a class")
+            self._collect(child, merged, source)
+
+    def attributes(self, element, class_name: str, source: str) -> dict:
+        name = element.get("class", class_name)
+        if name not in self.classes:
+            raise _fail(source, f"<{element.tag}> uses the undefined default class {name!r}")
+        attrs = dict(self.classes[name].get(element.tag, {}))
+        attrs.update(element.attrib)
+        attrs.pop("class", None)
+        return attrs
+
+
+def _compiler(root) -> tuple[bool, str, str, str]:
+    compiler = root.find("compiler")
+    get = (compiler.get if compiler is not None else (lambda k, d=None: d))
+    degrees = get("angle", "degree") != "radian"
+    return degrees, get("eulerseq", "xyz"), get("meshdir", None), get("assetdir", None)
+
+
+def _meshes(root, defaults: _Defaults, base: str, meshdir: str, packages: dict, source: str) -> dict:
+    meshes = {}
+    for asset in root.findall("asset"):
+        for mesh in asset.findall("mesh"):
+            attrs = defaults.attributes(mesh, "main", source)
+            if attrs.get("vertex") or attrs.get("face"):
+                raise _fail(source, f"<mesh name={attrs.get('name')!r}> with inline vertices is not supported")
+            if attrs.get("refpos") or attrs.get("refquat"):
+                raise _fail(source, f"<mesh name={attrs.get('name')!r}>: refpos/refquat are not supported")
+            file = attrs.get("file")
+            if not file:
+                raise _fail(source, f"<mesh name={attrs.get('name')!r}> without a file")
+            name = attrs.get("name") or os.path.splitext(os.path.basename(file))[0]
+            scale = _numbers(attrs.get("scale"), 3, f"<mesh name={name!r}> scale", source, default=(1, 1, 1))
+            meshes[name] = (file, scale)
+    return meshes
+
+
+def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, mesh_base: str, packages: dict, compiler,
+          source: str) -> GeometryElement:
+    degrees, eulerseq = compiler
+    what = f"body {link!r} {label}"
+    kind = _GEOM_KINDS.get(attrs.get("type", "sphere"))
+    if kind is None:
+        raise _fail(source, f"{what}: geom type {attrs.get('type')!r} is not supported")
+    rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=what, source=source)
+    position = _numbers(attrs.get("pos"), 3, f"{what} pos", source, default=(0, 0, 0))
+    size = [float(s) for s in (attrs.get("size") or "").split()]
+    half_length = None
+    if attrs.get("fromto") is not None and kind in ("capsule", "cylinder", "box", "ellipsoid"):
+        ends = _numbers(attrs["fromto"], 6, f"{what} fromto", source)
+        axis = ends[3:] - ends[:3]
+        if not np.linalg.norm(axis) > 0:
+            raise _fail(source, f"{what}: fromto with coincident ends")
+        rotation, position, half_length = _z_to(axis), 0.5 * (ends[:3] + ends[3:]), 0.5 * np.linalg.norm(axis)
+    frame_rotation, frame_translation = pose
+    rotation, position = frame_rotation @ rotation, frame_rotation @ position + frame_translation
+    name = attrs.get("name") or label
+
+    def need(count):
+        if len(size) < count:
+            raise _fail(source, f"{what}: {kind} needs {count} size values, got {attrs.get('size')!r}")
+        return [_positive(s, f"{what} size", source) for s in size[:count]]
+
+    if kind == "mesh":
+        mesh_name = attrs.get("mesh")
+        if mesh_name not in meshes:
+            raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
+        file, scale = meshes[mesh_name]
+        path = resolve_uri(file, base=mesh_base, packages=packages, source=source, link=link)
+        return GeometryElement("mesh", rotation, position, mesh=path, uri=file, scale=scale, name=name)
+    if kind == "sphere":
+        return GeometryElement("sphere", rotation, position, size=need(1), name=name)
+    if kind in ("capsule", "cylinder"):
+        radius = need(1)[0]
+        half = half_length if half_length is not None else need(2)[1]
+        return GeometryElement(kind, rotation, position, size=(radius, 2.0 * half), name=name)
+    if kind == "box":
+        if half_length is not None:
+            half = need(2)
+            return GeometryElement("box", rotation, position, size=(2 * half[0], 2 * half[1], 2 * half_length),
+                                   name=name)
+        return GeometryElement("box", rotation, position, size=[2 * s for s in need(3)], name=name)
+    if half_length is not None:
+        half = need(2)
+        return GeometryElement("ellipsoid", rotation, position, size=(half[0], half[1], half_length), name=name)
+    return GeometryElement("ellipsoid", rotation, position, size=need(3), name=name)
+
+
+def _inertial(body, name: str, compiler, source: str) -> DeclaredInertial | None:
+    inertial = body.find("inertial")
+    if inertial is None:
+        return None
+    degrees, eulerseq = compiler
+    what = f"body {name!r} <inertial>"
+    attrs = dict(inertial.attrib)
+    position = _numbers(attrs.get("pos"), 3, f"{what} pos", source)
+    mass = _numbers(attrs.get("mass"), 1, f"{what} mass", source)[0]
+    if attrs.get("fullinertia") is not None:
+        if any(attrs.get(k) is not None for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis")):
+            raise _fail(source, f"{what}: fullinertia together with an orientation (MuJoCo refuses it)")
+        m11, m22, m33, m12, m13, m23 = _numbers(attrs["fullinertia"], 6, f"{what} fullinertia", source)
+        rotation = np.eye(3)
+        tensor = np.array([[m11, m12, m13], [m12, m22, m23], [m13, m23, m33]])
+    else:
+        rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=what, source=source)
+        tensor = np.diag(_numbers(attrs.get("diaginertia"), 3, f"{what} diaginertia", source))
+    return DeclaredInertial(mass=mass, center_of_mass=position, inertia=rotation @ tensor @ rotation.T,
+                            rotation=rotation, inertia_in_frame=tensor)
+
+
+def _is_collision(attrs: dict) -> bool:
+    return int(float(attrs.get("contype", "1"))) != 0 or int(float(attrs.get("conaffinity", "1"))) != 0
+
+
+def _child_bodies(element, class_name: str):
+    """The ``<body>`` children of ``element``, looking through ``<frame>`` elements, with their default class."""
+    for child in element:
+        if child.tag == "body":
+            yield child, class_name
+        elif child.tag == "frame":
+            yield from _child_bodies(child, child.get("childclass", class_name))
+
+
+def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
+    """Bodies of an MJCF ``<mujoco>`` tree as links (see the module docstring); returns ``(model, links)``."""
+    if root.tag != "mujoco":
+        raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
+    if root.find(".//include") is not None:
+        raise _fail(source, "<include> is not supported; give a file with the included parts merged")
+    degrees, eulerseq, meshdir, assetdir = _compiler(root)
+    mesh_base = os.path.join(base, meshdir or assetdir or "")
+    defaults = _Defaults(root, source)
+    meshes = _meshes(root, defaults, base, mesh_base, packages, source)
+    compiler = (degrees, eulerseq)
+    links = []
+    counter = [0]
+
+    def walk_body(body, class_name: str) -> None:
+        counter[0] += 1
+        name = body.get("name") or f"body {counter[0]}"
+        child_class = body.get("childclass", class_name)
+        elements = []
+        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements)
+        links.append(LinkGeometry(name=name, elements=tuple(elements), declared=_inertial(body, name, compiler, source)))
+        for child, cls in _child_bodies(body, child_class):
+            walk_body(child, cls)
+
+    def collect(element, link: str, class_name: str, pose, elements: list) -> None:
+        for child in element:
+            if child.tag == "geom":
+                attrs = defaults.attributes(child, class_name, source)
+                if _is_collision(attrs) == (geometry == "collision"):
+                    label = f"geom {len(elements) + 1}"
+                    elements.append(_geom(attrs, pose, label, link, meshes, mesh_base, packages, compiler, source))
+            elif child.tag == "frame":
+                attrs = dict(child.attrib)
+                rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=f"body {link!r} frame",
+                                              source=source)
+                position = _numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", source, default=(0, 0, 0))
+                composed = (pose[0] @ rotation, pose[0] @ position + pose[1])
+                collect(child, link, child.get("childclass", class_name), composed, elements)
+
+    for world in root.findall("worldbody"):
+        for body, cls in _child_bodies(world, "main"):
+            walk_body(body, cls)
+    return root.get("model", ""), tuple(links)
