@@ -1,0 +1,12 @@
+"""Paths of the robot descriptions bundled in tests/data (see tests/data/README.md) shared by the robot tests."""
+
+from pathlib import Path
+
+DATA = Path(__file__).parent / "data" / "robots"
+#: Root of the ``example-robot-data`` package files (its ``package://example-robot-data/...`` URIs).
+ERD = DATA / "example-robot-data"
+PACKAGES = {"example-robot-data": str(ERD)}
+UR5 = ERD / "robots" / "ur_description" / "urdf" / "ur5_robot.urdf"
+PANDA = ERD / "robots" / "panda_description" / "urdf" / "panda.urdf"
+UR5_MESHES = ERD / "robots" / "ur_description" / "meshes" / "ur5" / "collision"
+PANDA_MESHES = ERD / "robots" / "panda_description" / "meshes" / "collision"

@@ -1,0 +1,63 @@
+"""``inertia-tool robot``: JSON, table, --write, and one-line errors with the documented exit codes."""
+
+import json
+
+import numpy as np
+import pytest
+
+from inertia_tool.cli import main
+
+from conftest import assert_tensor_close
+from robot_data import ERD, PANDA, UR5
+
+PKG = f"example-robot-data={ERD}"
+
+
+def test_json_lists_every_link_with_declared_and_audit(capsys):
+    assert main(["robot", str(UR5), "--package", PKG, "--material", "aluminium", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["format"] == "urdf" and out["geometry"] == "collision"
+    links = {l["name"]: l for l in out["links"]}
+    upper = links["upper_arm_link"]
+    assert upper["density"] == 2700.0 and upper["mass"] == pytest.approx(2700.0 * upper["volume"])
+    assert np.asarray(upper["inertia"]).shape == (3, 3)
+    assert upper["declared"]["mass"] == 8.393 and upper["declared"]["center_of_mass"] == [0, 0, 0.28]
+    assert set(upper["audit"]) >= {"com_distance", "inertia_difference", "declared_positive_definite",
+                                   "declared_triangle_inequality", "implied_density", "com_inside_geometry", "issues"}
+    assert links["world"]["mass"] is None and links["world"]["declared"] is None
+
+
+def test_keep_mass_table_and_write(tmp_path, capsys):
+    out = tmp_path / "panda_fixed.urdf"
+    assert main(["robot", str(PANDA), "--package", PKG, "--keep-mass", "--write", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert "panda_link1" in captured.out and "declared masses kept" in captured.out
+    assert f"wrote {out}" in captured.err
+    assert main(["robot", str(out), "--package", PKG, "--keep-mass", "--json"]) == 0
+    again = {l["name"]: l for l in json.loads(capsys.readouterr().out)["links"]}
+    link = again["panda_link3"]
+    assert link["audit"]["com_distance"] < 1e-15 and link["audit"]["inertia_difference"] < 1e-14
+    assert_tensor_close(link["declared"]["inertia"], link["inertia"], 1e-14)
+    # an existing file is not replaced without --force
+    assert main(["robot", str(PANDA), "--package", PKG, "--keep-mass", "--write", str(out)]) == 2
+    assert "exists" in capsys.readouterr().err
+
+
+def test_unresolved_uri_is_one_line_exit_3(capsys, monkeypatch):
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    assert main(["robot", str(UR5), "--density", "2700"]) == 3
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "link 'base_link'" in err
+    assert "package://example-robot-data/robots/ur_description/meshes/ur5/collision/base.stl" in err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--density", "1", "--keep-mass"], "not allowed with"),
+    ([], "one of the arguments --density --material --keep-mass is required"),
+    (["--density", "1", "--package", "nodir"], "--package expects NAME=DIR"),
+    (["--density", "1", "--arg", "x=1"], "--arg expects NAME:=VALUE"),
+    (["--density", "1", "--force"], "--force only applies to --write"),
+])
+def test_usage_errors(argv, message, capsys):
+    assert main(["robot", str(UR5), "--package", PKG] + argv) == 2
+    assert message in capsys.readouterr().err

@@ -1,0 +1,159 @@
+"""Link mass properties from geometry (inertia_tool.robot.geometry): closed forms, poses, scale, sums,
+and MuJoCo's own inertia-from-geometry as the independent reference for MJCF."""
+
+import numpy as np
+import pytest
+import trimesh
+
+import inertia_tool as it
+from inertia_tool import shapes
+from inertia_tool.errors import UsageError
+from inertia_tool.io import load_mesh
+from inertia_tool.robot import link_inertials, read_robot
+from inertia_tool.robot.description import GeometryElement, LinkGeometry, rpy_to_matrix
+from inertia_tool.robot.geometry import (element_mass_properties, link_mass_properties, points_inside_element,
+                                         _capsule, _ellipsoid, _scaled)
+
+from conftest import assert_tensor_close
+from robot_data import PACKAGES, UR5
+
+
+def _element(kind, size=(), rpy=(0, 0, 0), xyz=(0, 0, 0), **kw):
+    return GeometryElement(kind, rpy_to_matrix(rpy), xyz, size=size, **kw)
+
+
+def test_capsule_closed_form_against_fine_meshes():
+    # independent: trimesh's capsule meshes integrated by the engine approach the closed form as O(1/n²), so
+    # Richardson extrapolation of n = 64 and 128, (4 P₁₂₈ − P₆₄)/3, must agree far better than either mesh
+    r, length = 0.03, 0.1
+    props = []
+    for n in (64, 128):
+        mesh = trimesh.creation.capsule(height=length, radius=r, count=[n, n])
+        mesh.merge_vertices()                         # trimesh leaves the seam vertices duplicated
+        props.append(it.mass_properties(mesh, density=1.0))
+    exact = _capsule(r, length)
+    assert abs(props[1].volume / exact.volume - 1) < 1e-3
+    assert (4 * props[1].volume - props[0].volume) / 3 == pytest.approx(exact.volume, rel=1e-5)
+    assert_tensor_close((4 * props[1].inertia - props[0].inertia) / 3, exact.inertia, 2e-5)
+
+
+def test_ellipsoid_is_a_scaled_sphere():
+    # the mesh-scale rule (|det S| S Σ S) applied to a sphere must give the ellipsoid's closed form
+    sphere = shapes.sphere(1.0, segments=3, rings=2).exact
+    scaled = _scaled(sphere, [0.3, 0.4, 0.5])
+    exact = _ellipsoid(0.3, 0.4, 0.5)
+    assert scaled.volume == pytest.approx(exact.volume, rel=1e-14)
+    assert_tensor_close(scaled.inertia, exact.inertia, 1e-14)
+
+
+def test_two_boxes_side_by_side_are_one_box():
+    # parallel-axis sum in the link frame: two unit cubes at x = 0.5 and 1.5 are the 2×1×1 box centred at x = 1
+    link = LinkGeometry("l", (_element("box", (1, 1, 1), xyz=(0.5, 0, 0)), _element("box", (1, 1, 1), xyz=(1.5, 0, 0))),
+                        None)
+    props = link_mass_properties(link)
+    exact = shapes.box(2, 1, 1, center=(1, 0, 0)).exact
+    assert props.mass == pytest.approx(exact.mass, rel=1e-15)
+    np.testing.assert_allclose(props.center_of_mass, exact.center_of_mass, atol=1e-15)
+    assert_tensor_close(props.inertia, exact.inertia, 1e-14)
+
+
+def test_rolled_cylinder_turns_its_axis():
+    # roll of +90° about x takes the cylinder axis z to -y: the axial moment MR²/2 appears in I_yy
+    r, h = 0.05, 0.4
+    props = element_mass_properties(_element("cylinder", (r, h), rpy=(np.pi / 2, 0, 0), xyz=(0, 0, 1)))
+    m = np.pi * r * r * h
+    assert_tensor_close(props.inertia, np.diag([m * (r * r / 4 + h * h / 12), m * r * r / 2, m * (r * r / 4 + h * h / 12)]),
+                        1e-14)
+    np.testing.assert_allclose(props.center_of_mass, [0, 0, 1], atol=1e-15)
+
+
+def test_mesh_element_with_origin_and_scale(tmp_path):
+    # a cylinder mesh written in mm, read through <mesh scale="0.001 ..."> and an origin, against mesh_exact
+    solid = shapes.cylinder(20.0, 50.0, segments=64)
+    path = tmp_path / "cyl.stl"
+    shapes.write_stl(solid, path)
+    rpy, xyz, s = (0.3, -0.2, 1.1), (0.1, 0.2, 0.3), (0.001, 0.002, 0.001)
+    props = element_mass_properties(_element("mesh", rpy=rpy, xyz=xyz, mesh=str(path), scale=s))
+    # reference: scale the file's (float32) vertices, then move them, then integrate
+    raw = load_mesh(path)
+    verts = (raw.vertices * s) @ rpy_to_matrix(rpy).T + xyz
+    reference = it.mass_properties((verts, raw.faces), density=1.0)
+    assert props.volume == pytest.approx(reference.volume, rel=1e-12)
+    np.testing.assert_allclose(props.center_of_mass, reference.center_of_mass, atol=1e-14)
+    assert_tensor_close(props.inertia, reference.inertia, 1e-11)
+
+
+def test_mirrored_mesh_scale_keeps_a_positive_volume(tmp_path):
+    solid = shapes.box(1, 2, 3, center=(1, 0, 0))
+    path = tmp_path / "box.stl"
+    shapes.write_stl(solid, path)
+    props = element_mass_properties(_element("mesh", mesh=str(path), scale=(-1, 1, 1)))
+    assert props.volume == pytest.approx(6.0)
+    np.testing.assert_allclose(props.center_of_mass, [-1, 0, 0], atol=1e-14)
+
+
+def test_inside_tests_of_the_primitives():
+    cap = _element("capsule", (0.1, 0.4), rpy=(0, np.pi / 2, 0))      # axis along x
+    assert points_inside_element(cap, [0.29, 0, 0]) and not points_inside_element(cap, [0.31, 0, 0])
+    box = _element("box", (1, 2, 3), xyz=(5, 0, 0))
+    assert points_inside_element(box, [5.4, 0.9, 1.4]) and not points_inside_element(box, [4.4, 0, 0])
+
+
+def test_density_material_keep_mass_are_exclusive():
+    robot = read_robot(UR5, packages=PACKAGES)
+    with pytest.raises(UsageError):
+        link_inertials(robot, density=1000, keep_mass=True)
+    with pytest.raises(UsageError):
+        link_inertials(robot)
+
+
+def test_keep_mass_reports_the_implied_density():
+    robot = read_robot(UR5, packages=PACKAGES)
+    by_name = {r.name: r for r in link_inertials(robot, keep_mass=True)}
+    upper = by_name["upper_arm_link"]
+    assert upper.properties.mass == 8.393
+    assert upper.density == pytest.approx(8.393 / upper.properties.volume)
+    steel = {r.name: r for r in link_inertials(robot, material="steel")}["upper_arm_link"]
+    # same shape: the tensors differ only by the mass ratio
+    assert_tensor_close(upper.properties.inertia, steel.properties.inertia * (8.393 / steel.properties.mass), 1e-13)
+    assert by_name["world"].properties is None and "no collision geometry" in by_name["world"].problem
+
+
+MJCF = """<mujoco model="t">
+  <compiler angle="degree"/>
+  <asset><mesh name="m" file="{mesh}" scale="0.001 0.002 0.001"/></asset>
+  <default><geom density="1000"/><default class="c"><geom type="capsule" size="0.02 0.05"/></default></default>
+  <worldbody>
+    <body name="a" pos="0 0 1">
+      <freejoint/>
+      <geom type="box" size="0.1 0.05 0.02" pos="0.1 0 0" euler="10 20 30"/>
+      <geom class="c" pos="0 0.1 0" axisangle="1 1 0 40"/>
+      <geom type="cylinder" fromto="0 0 0 0.1 0.2 0.3" size="0.03"/>
+      <geom type="ellipsoid" size="0.03 0.04 0.05" quat="0.9 0.1 0.2 0.3" pos="0 0 -0.1"/>
+      <frame pos="0.2 0 0" euler="0 0 90"><geom type="sphere" size="0.04" pos="-0.1 0 0"/></frame>
+      <geom type="mesh" mesh="m" pos="0 -0.2 0" xyaxes="0 1 0 -1 0 0"/>
+      <body name="b" pos="0 0 0.5"><joint type="ball"/><geom type="box" size="0.01 0.02 0.03" zaxis="1 1 1"/></body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_mjcf_bodies_match_mujocos_inertia_from_geometry(tmp_path):
+    # independent code: MuJoCo's compiler computes each body's inertia from its geoms (density 1000 here)
+    mujoco = pytest.importorskip("mujoco")
+    mesh = tmp_path / "cone.stl"
+    shapes.write_stl(shapes.cone(20.0, 50.0, segments=48), mesh)
+    path = tmp_path / "t.xml"
+    path.write_text(MJCF.format(mesh=mesh))
+    model = mujoco.MjModel.from_xml_path(str(path))
+    ours = {r.name: r.properties for r in link_inertials(read_robot(path), density=1000)}
+    for body in ("a", "b"):
+        i = model.body(body).id
+        rot = np.zeros(9)
+        mujoco.mju_quat2Mat(rot, model.body_iquat[i])
+        rot = rot.reshape(3, 3)
+        tensor = rot @ np.diag(model.body_inertia[i]) @ rot.T
+        assert ours[body].mass == pytest.approx(model.body_mass[i], rel=1e-12)
+        np.testing.assert_allclose(ours[body].center_of_mass, model.body_ipos[i], atol=1e-12)
+        assert_tensor_close(ours[body].inertia, tensor, 1e-10)
