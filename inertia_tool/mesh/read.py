@@ -22,15 +22,23 @@ import numpy as np
 from ..values import frozen_value
 from ..errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, UsageError
 from .._native import accel
-from ..units import length_scale
+from ..units import LENGTH_UNITS, length_scale
 from .options import DEFAULT_MAX_FACES
 from .weld import weld_exact, weld_exact_stream
 
 __all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "SUPPORTED_SUFFIXES"]
 
 
-#: File suffixes handled (STL natively, the rest through trimesh).
-SUPPORTED_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".3mf", ".glb", ".gltf")
+#: File suffixes handled (STL natively, the rest through trimesh; COLLADA needs pycollada).
+SUPPORTED_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".3mf", ".glb", ".gltf", ".dae", ".zae")
+
+#: Compressed single-mesh files: ``part.stl.gz``, ``part.obj.bz2``, or a ``.zip`` holding exactly one mesh.
+COMPRESSED_SUFFIXES = (".gz", ".bz2", ".zip")
+
+#: Formats whose files declare their length unit (3MF ``<model unit>``, default millimetre by the 3MF
+#: specification; COLLADA ``<asset><unit meter>``; glTF is metres by its specification).  The declared unit
+#: wins over the default ``units="m"``; an explicit other ``units`` that contradicts it is refused.
+DECLARES_UNITS = (".3mf", ".dae", ".zae", ".glb", ".gltf")
 
 _STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
 _CHUNK_FACES = 1 << 17
@@ -49,7 +57,7 @@ class RawMesh:
     source : str
         File path or a description of the object it came from (for messages).
     units : str
-        Length unit of the file coordinates.
+        Length unit of the file coordinates (the unit the file declares, where its format has one).
     file_faces : int
         Number of triangles the source held (before any cleaning).
     """
@@ -560,12 +568,32 @@ def _check_zip(path: str, max_faces: int) -> dict:
 _HEADER_CHECKS = {".ply": _check_ply_header, ".off": _check_off_header}
 
 
+def _declared_scale(path: str, suffix: str, loaded) -> tuple[float, str] | None:
+    """Metres per file unit and the unit's name, for formats that declare one (:data:`DECLARES_UNITS`)."""
+    if suffix in (".glb", ".gltf"):
+        return 1.0, "m"
+    units = getattr(loaded, "units", None)
+    if suffix not in DECLARES_UNITS or not units:
+        return None
+    from trimesh.units import unit_conversion
+    try:
+        scale = float(unit_conversion(str(units), "meters"))
+    except Exception:  # noqa: BLE001 - trimesh raises ValueError/KeyError for names it does not know
+        raise _fail(path, f"declares an unknown length unit {str(units)[:40]!r}") from None
+    if not (np.isfinite(scale) and scale > 0):
+        raise _fail(path, f"declares an invalid length unit {str(units)[:40]!r}")
+    for name, value in LENGTH_UNITS.items():      # snap "centimeter" → 0.01 exactly (trimesh gives 0.00999…)
+        if abs(scale - value) <= 1e-12 * value:
+            return value, name
+    return scale, f"{scale:g} m"
+
+
 def _read_with_trimesh(path: str, max_faces: int):
     size = os.path.getsize(path)
     suffix = os.path.splitext(path)[1].lower()
     if suffix in _HEADER_CHECKS:
         counts = _HEADER_CHECKS[suffix](path, size, max_faces)
-    elif suffix == ".3mf":
+    elif suffix in (".3mf", ".zae"):
         counts = _check_zip(path, max_faces)
     else:
         counts = {}
@@ -573,11 +601,17 @@ def _read_with_trimesh(path: str, max_faces: int):
         import trimesh
     except ImportError as exc:  # pragma: no cover - trimesh is a dependency
         raise _fail(path, "reading this format needs trimesh (pip install trimesh)") from exc
+    if suffix in (".dae", ".zae"):
+        try:
+            import collada  # noqa: F401 - trimesh reads COLLADA through pycollada
+        except ImportError:
+            raise _fail(path, "reading COLLADA needs pycollada (pip install pycollada)") from None
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             loaded = trimesh.load(path, process=False, force=None)
-            if isinstance(loaded, trimesh.Scene):
+            declared = _declared_scale(path, suffix, loaded)
+            if isinstance(loaded, trimesh.Scene):   # dump() applies every node's transform
                 geoms = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)] if loaded.geometry else []
                 if not geoms:
                     raise _fail(path, "contains no triangle mesh (empty scene or only points/lines)")
@@ -607,7 +641,7 @@ def _read_with_trimesh(path: str, max_faces: int):
                           "(faces dropped or truncated file)")
     if not np.all(np.isfinite(v)):
         raise _fail(path, "vertices have NaN or infinite coordinates")
-    return v, f
+    return v, f, declared
 
 
 def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -> RawMesh:
@@ -657,11 +691,25 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
             if not os.path.isfile(path):
                 raise _fail(path, "is not a regular file (device, pipe or socket)")
             suffix = os.path.splitext(path)[1].lower()
+            if suffix in COMPRESSED_SUFFIXES:
+                if os.path.getsize(path) == 0:
+                    raise _fail(path, "empty file (0 bytes)")
+                from .decompress import decompressed
+                with decompressed(path, max_bytes=_ZIP_BYTES_PER_FACE * max_faces + _ZIP_BYTES_SLACK,
+                                  max_ratio=MAX_ZIP_RATIO, min_ratio_bytes=_ZIP_RATIO_MIN_BYTES,
+                                  suffixes=SUPPORTED_SUFFIXES) as (inner, member):
+                    try:
+                        raw = load_mesh(inner, units=units, max_faces=max_faces)
+                    except MeshReadError as exc:
+                        raise MeshReadError(str(exc).replace(inner, f"{_display(path)}:{member}", 1)) from None
+                return RawMesh(vertices=raw.vertices, faces=raw.faces, source=_display(path), units=raw.units,
+                               file_faces=raw.file_faces)
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
-                                  f"{', '.join(SUPPORTED_SUFFIXES)}")
+                                  f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
             if os.path.getsize(path) == 0:
                 raise _fail(path, "empty file (0 bytes)")
+            declared = None
             if suffix == ".stl":
                 vertices, faces, n = read_stl(path, max_faces=max_faces)
             elif suffix == ".obj":
@@ -669,7 +717,7 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "vertices have NaN or infinite coordinates")
             else:
-                vertices, faces = _read_with_trimesh(path, max_faces)
+                vertices, faces, declared = _read_with_trimesh(path, max_faces)
                 n = len(faces)
         except PermissionError:
             raise _fail(path, "permission denied") from None
@@ -682,6 +730,8 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
                 raise
             raise _fail(path, f"cannot be read ({exc.strerror or exc})") from None
         name = _display(path)
+        if declared is not None:
+            scale, units = _declared_units_win(name, declared, units, scale)
     else:
         vertices, faces, name = _from_object(source)
         n = len(faces)
@@ -689,6 +739,16 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
     if scale != 1.0:
         vertices = vertices * scale
     return RawMesh(vertices=vertices, faces=faces, source=name, units=str(units), file_faces=n)
+
+
+def _declared_units_win(name: str, declared: tuple[float, str], units: str, scale: float) -> tuple[float, str]:
+    """The rule of :data:`DECLARES_UNITS`: the file's declared unit replaces the default metres; an explicit
+    other ``units`` that disagrees with it is refused (:class:`UsageError`) rather than applied twice."""
+    file_scale, file_unit = declared
+    if scale != 1.0 and abs(scale - file_scale) > 1e-12 * file_scale:
+        raise UsageError(f"{name}: the file declares its length unit as {file_unit} ({file_scale:g} m) but "
+                         f"units={units!r} was given; the declared unit is used when units are left at metres")
+    return file_scale, file_unit
 
 
 def _from_object(source):

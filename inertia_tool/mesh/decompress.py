@@ -1,0 +1,107 @@
+"""Compressed single-mesh files (``part.stl.gz``, ``part.obj.bz2``, ``parts.zip`` with one mesh), inflated
+with bounds into a temporary file for the readers.
+
+The hostile-input rules of the readers (README, "Bad input") apply: the output is counted while it is
+produced, and inflating stops — and the file is refused as a decompression bomb — as soon as it exceeds
+``max_bytes`` or, above ``min_ratio_bytes``, ``max_ratio`` times the compressed size.  Nothing larger than
+the limit is ever written or held in memory (16 MiB blocks).  A zip must hold exactly one member with a mesh
+suffix (other members are refused, not guessed among); its sizes are checked from the central directory
+before inflating, and again while inflating (a lying directory cannot get past the count).
+"""
+
+from __future__ import annotations
+
+import bz2
+import contextlib
+import gzip
+import os
+import shutil
+import tempfile
+import zipfile
+import zlib
+
+from ..errors import MeshReadError
+
+__all__ = ["decompressed", "BLOCK_BYTES"]
+
+#: Bytes inflated per step.
+BLOCK_BYTES = 16 << 20
+
+
+def _fail(path: str, problem: str) -> MeshReadError:
+    return MeshReadError(f"{os.fsencode(path).decode('utf-8', 'replace')}: {problem}")
+
+
+def _copy_bounded(src, dst, path: str, compressed: int, max_bytes: int, max_ratio: float, min_ratio_bytes: int) -> None:
+    total = 0
+    limit = max_bytes
+    if compressed * max_ratio >= min_ratio_bytes:
+        limit = min(limit, int(compressed * max_ratio))
+    limit = max(limit, min(max_bytes, min_ratio_bytes))
+    while True:
+        block = src.read(BLOCK_BYTES)
+        if not block:
+            return
+        total += len(block)
+        if total > limit:
+            raise _fail(path, f"inflates beyond {limit:,} bytes ({compressed:,} compressed; limits: {max_ratio:g}:1 "
+                              f"above {min_ratio_bytes:,} bytes and {max_bytes:,} bytes in all): refused as a "
+                              "decompression bomb")
+        dst.write(block)
+
+
+@contextlib.contextmanager
+def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes: int, suffixes):
+    """Context manager yielding ``(inflated_path, member_name)`` in a temporary directory removed afterwards.
+
+    Parameters
+    ----------
+    path : str
+        ``*.gz``, ``*.bz2`` (the inner name is the file name without that suffix) or ``*.zip``.
+    max_bytes : int
+        Largest inflated size accepted.
+    max_ratio : float
+        Largest inflated/compressed ratio accepted once the output passes ``min_ratio_bytes``.
+    suffixes : sequence of str
+        Mesh suffixes the inner file may have.
+
+    Raises
+    ------
+    MeshReadError
+        Corrupt archive, no or several meshes in a zip, a nested compressed file, or a decompression bomb.
+    """
+    outer = os.path.splitext(path)[1].lower()
+    compressed = os.path.getsize(path)
+    with tempfile.TemporaryDirectory(prefix="inertia-tool-") as tmp:
+        try:
+            if outer == ".zip":
+                with zipfile.ZipFile(path) as zf:
+                    members = [i for i in zf.infolist() if not i.is_dir()]
+                    meshes = [i for i in members if os.path.splitext(i.filename)[1].lower() in suffixes]
+                    if len(meshes) != 1 or len(members) != 1:
+                        names = ", ".join(i.filename[:60] for i in members[:5]) or "nothing"
+                        raise _fail(path, f"a zip must hold exactly one mesh file; it holds {names}")
+                    info = meshes[0]
+                    member = os.path.basename(info.filename)
+                    ratio_limit = max(int(info.compress_size * max_ratio), min_ratio_bytes)
+                    if info.file_size > min(max_bytes, ratio_limit):
+                        raise _fail(path, f"member {member[:60]!r} would inflate to {info.file_size:,} bytes from "
+                                          f"{info.compress_size:,}: refused as a decompression bomb before inflating")
+                    target = os.path.join(tmp, member)
+                    with zf.open(info) as src, open(target, "wb") as dst:
+                        _copy_bounded(src, dst, path, info.compress_size, max_bytes, max_ratio, min_ratio_bytes)
+            else:
+                member = os.path.basename(path)[:-len(outer)]
+                if os.path.splitext(member)[1].lower() not in suffixes:
+                    raise _fail(path, f"the compressed file {member[:60]!r} is not a mesh with a known suffix "
+                                      f"({', '.join(suffixes)})")
+                opener = gzip.open if outer == ".gz" else bz2.open
+                target = os.path.join(tmp, member)
+                with opener(path, "rb") as src, open(target, "wb") as dst:
+                    _copy_bounded(src, dst, path, compressed, max_bytes, max_ratio, min_ratio_bytes)
+        except MeshReadError:
+            raise
+        except (OSError, EOFError, zipfile.BadZipFile, zlib.error, ValueError) as exc:
+            raise _fail(path, f"cannot be decompressed ({str(exc)[:120] or type(exc).__name__})") from None
+        yield target, member
+        shutil.rmtree(tmp, ignore_errors=True)
