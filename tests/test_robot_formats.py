@@ -70,7 +70,7 @@ def test_urdf_block_reproduces_the_engine(tilted, frame):
     np.testing.assert_allclose(xyz, tilted.center_of_mass, rtol=1e-11)
     assert mass == pytest.approx(tilted.mass, rel=1e-11)
     if frame == "principal":
-        np.testing.assert_allclose(np.diag(tensor), tilted.principal.moments, rtol=1e-11)
+        np.testing.assert_allclose(np.sort(np.diag(tensor)), tilted.principal.moments, rtol=1e-11)
         assert np.count_nonzero(tensor - np.diag(np.diag(tensor))) == 0
     else:
         np.testing.assert_allclose(rpy, 0.0)
@@ -234,3 +234,64 @@ def test_cli_refuses_a_needle_with_exit_code_4(tmp_path, capsys):
                  "--format", "mjcf"])
     err = capsys.readouterr().err
     assert code == 4 and "principal moments" in err
+
+
+# -- the principal frame nearest the link frame (docs/conventions.md) -------------------------------------
+
+from hypothesis import given, settings, strategies as st   # noqa: E402
+from scipy.spatial.transform import Rotation                # noqa: E402
+
+from inertia_tool.inertial import _SIGNED_PERMUTATIONS, principal_frame_nearest   # noqa: E402
+from inertia_tool.principal import principal_axes            # noqa: E402
+
+
+def test_aligned_box_keeps_the_link_axes_not_the_ascending_order():
+    # a 0.1 × 0.3 × 0.2 box along the link axes: ascending order would be (y, z, x) — rpy of ±90° for no reason
+    box = trimesh.creation.box([0.1, 0.3, 0.2])
+    props = mass_properties((box.vertices, box.faces), density=1000)
+    assert not np.allclose(np.abs(props.principal.axes), np.eye(3))          # the sorted frame is permuted
+    frame = inertial_frame(props, "principal")
+    np.testing.assert_allclose(frame.rotation, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(frame.rpy, 0.0, atol=1e-12)
+    np.testing.assert_allclose(np.diag(frame.inertia), np.diag(props.inertia), rtol=1e-12)
+
+
+def test_slightly_turned_link_gets_the_small_rotation():
+    box = trimesh.creation.box([0.1, 0.3, 0.2])
+    turn = Rotation.from_euler("xyz", [0.05, -0.03, 0.08]).as_matrix()
+    props = mass_properties((box.vertices @ turn.T, box.faces), density=1000)
+    frame = inertial_frame(props, "principal")
+    np.testing.assert_allclose(frame.rotation, turn, atol=1e-9)
+    np.testing.assert_allclose(frame.rpy, [0.05, -0.03, 0.08], atol=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(0.5, 3.0), min_size=3, max_size=3, unique=True),
+       st.lists(st.floats(-1, 1), min_size=4, max_size=4).filter(lambda q: np.linalg.norm(q) > 0.1))
+def test_nearest_frame_is_the_largest_trace_of_all_24(moments, quat):
+    rot = Rotation.from_quat(quat).as_matrix()
+    tensor = rot @ np.diag(sorted(moments)) @ rot.T
+    pa = principal_axes(tensor)
+    if pa.equal_pairs:
+        return
+    r = principal_frame_nearest(pa)
+    assert np.linalg.det(r) == pytest.approx(1.0, abs=1e-12)
+    diag = r.T @ tensor @ r
+    np.testing.assert_allclose(diag - np.diag(np.diag(diag)), 0.0, atol=1e-12 * max(moments))
+    assert np.trace(r) >= max(np.trace(pa.axes @ p) for p in _SIGNED_PERMUTATIONS) - 1e-12
+
+
+def test_axisymmetric_and_spherical_links_keep_the_link_axes():
+    cylinder = trimesh.creation.cylinder(radius=0.05, height=0.3, sections=64)
+    props = mass_properties((cylinder.vertices, cylinder.faces), density=1000)
+    assert props.principal.equal_pairs                                   # I_xx = I_yy
+    np.testing.assert_allclose(inertial_frame(props, "principal").rotation, np.eye(3), atol=1e-12)
+    # tilted by 0.1 rad about x: the unique axis follows the tilt; the plane keeps x
+    tilt = Rotation.from_euler("x", 0.1).as_matrix()
+    tilted = mass_properties((cylinder.vertices @ tilt.T, cylinder.faces), density=1000)
+    r = inertial_frame(tilted, "principal").rotation
+    np.testing.assert_allclose(r, tilt, atol=1e-9)
+    cube = trimesh.creation.box([0.2, 0.2, 0.2])
+    turned = Rotation.from_euler("xyz", [0.3, 0.2, 0.1]).as_matrix()
+    props = mass_properties((cube.vertices @ turned.T, cube.faces), density=1000)
+    np.testing.assert_allclose(inertial_frame(props, "principal").rotation, np.eye(3))

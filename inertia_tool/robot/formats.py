@@ -18,7 +18,7 @@ __all__ = ["format_urdf", "format_sdf", "format_mjcf", "ROBOT_FORMATS", "format_
 ROBOT_FORMATS = ("urdf", "sdf", "mjcf")
 
 _FRAME_TEXT = {
-    "principal": "principal axes at the centre of mass (diagonal tensor, I1 <= I2 <= I3)",
+    "principal": "principal axes at the centre of mass, the rotation nearest the link frame (diagonal tensor)",
     "mesh": "centre of mass, axes parallel to the mesh (link) axes (full tensor)",
 }
 

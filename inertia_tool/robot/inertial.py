@@ -39,7 +39,8 @@ from ..mass.properties import MassProperties
 from ..rotations import matrix_to_quaternion
 
 __all__ = ["InertialFrame", "MomentCheck", "inertial_frame", "check_moments", "rpy_from_matrix",
-           "quaternion_from_matrix", "positive_tensor_notation", "GAZEBO_TOLERANCE", "MUJOCO_MINVAL", "FRAMES"]
+           "quaternion_from_matrix", "positive_tensor_notation", "principal_frame_nearest", "GAZEBO_TOLERANCE",
+           "MUJOCO_MINVAL", "FRAMES"]
 
 #: gz-math's ``GZ_MASSMATRIX3_DEFAULT_TOLERANCE``: multiple of machine epsilon times ½ tr(I) accepted as round-off.
 GAZEBO_TOLERANCE = 10.0
@@ -161,6 +162,84 @@ def positive_tensor_notation(tensor) -> np.ndarray:
     return 2.0 * np.diag(np.diag(t)) - t
 
 
+def _signed_permutations() -> list:
+    """The 24 signed permutation matrices with det +1, in a fixed order (identity first)."""
+    from itertools import permutations, product
+    out = []
+    for perm in permutations(range(3)):
+        for signs in product((1.0, -1.0), repeat=3):
+            p = np.zeros((3, 3))
+            p[list(perm), range(3)] = signs
+            if np.linalg.det(p) > 0:
+                out.append(p)
+    return out
+
+
+_SIGNED_PERMUTATIONS = _signed_permutations()
+
+
+def _plane_fit(columns, slots, target_det: float) -> np.ndarray:
+    """2×2 orthogonal ``Q`` with det ``target_det`` maximising ``Σ_k e_slot(k) · (columns Q)_k`` (Procrustes)."""
+    c = np.stack([columns.T @ np.eye(3)[:, k] for k in slots], axis=1)     # c[:, k] = columnsᵀ e_slot(k)
+    u, _, vt = np.linalg.svd(c)
+    d = target_det * np.linalg.det(u) * np.linalg.det(vt)
+    return u @ np.diag([1.0, d]) @ vt
+
+
+def principal_frame_nearest(principal) -> np.ndarray:
+    """The principal frame closest to the link frame: the rotation with the largest trace among those whose
+    columns are principal axes.
+
+    Eigenvectors fix the principal frame only up to the order and signs of its axes: 24 proper rotations
+    ``A P`` (``P`` a signed permutation with det +1) diagonalise the tensor.  Sorting by moment, as
+    :class:`~inertia_tool.principal.PrincipalAxes` does, can turn a link that is almost aligned with its own
+    frame into an inertial frame rotated by 90° (rpy near ±π/2, close to gimbal lock).  This picks the one
+    with ``max trace(A P)`` (the smallest rotation angle from the link frame, since ``tr R = 1 + 2 cos θ``);
+    exact ties go to the first in a fixed enumeration.  Where two moments are equal within
+    ``principal.rtol``, every basis of their plane is principal: the unique axis takes the slot and sign that
+    maximise the trace and the plane's two axes are the orthogonal Procrustes fit to the remaining link
+    axes, so an axisymmetric link aligned with its frame keeps the link axes exactly.  Three equal moments
+    give the identity.
+
+    Parameters
+    ----------
+    principal : PrincipalAxes
+
+    Returns
+    -------
+    (3, 3) float
+        Proper rotation; columns are principal axes in link axes.
+    """
+    axes = np.asarray(principal.axes, dtype=np.float64)
+    pairs = tuple(principal.equal_pairs)
+    if len(pairs) >= 3:
+        return np.eye(3)
+    if not pairs:
+        best = axes
+        for p in _SIGNED_PERMUTATIONS[1:]:
+            candidate = axes @ p
+            if np.trace(candidate) > np.trace(best) + 1e-12:
+                best = candidate
+        return best
+    pair = pairs[0]
+    unique = ({0, 1, 2} - set(pair)).pop()
+    u = axes[:, unique]
+    plane = axes[:, list(pair)]
+    best, best_trace = None, -np.inf
+    for slot in range(3):
+        others = [k for k in range(3) if k != slot]
+        for sign in (1.0, -1.0):
+            r = np.zeros((3, 3))
+            r[:, slot] = sign * u
+            r[:, others] = plane
+            q = _plane_fit(plane, others, float(np.sign(np.linalg.det(r))))
+            r[:, others] = plane @ q
+            trace = float(np.trace(r))
+            if trace > best_trace + 1e-12:
+                best, best_trace = r, trace
+    return best
+
+
 def _rotation(rotation) -> np.ndarray:
     r = np.asarray(rotation, dtype=np.float64)
     if r.shape != (3, 3):
@@ -184,7 +263,8 @@ class InertialFrame:
         Proper rotation whose columns are the inertial frame's axes in link axes (identity for ``"mesh"``).
     inertia : (3, 3) float
         kg·m² about the centre of mass, in the inertial frame's axes, tensor convention (−∫xy dm);
-        diagonal ``diag(I1, I2, I3)`` (ascending) for ``"principal"``.
+        diagonal for ``"principal"``, with the moments in the order of the frame's axes (the frame is the
+        principal frame nearest the link frame, :func:`principal_frame_nearest`, not sorted by moment).
     frame : str
         ``"principal"`` or ``"mesh"``.
     check : MomentCheck
@@ -223,7 +303,8 @@ def inertial_frame(props: MassProperties, frame: str = "principal", *, tolerance
     props : MassProperties
         The body; its mesh axes are taken as the link frame.
     frame : {"principal", "mesh"}
-        ``"principal"``: axes along the principal axes (``props.principal.axes``, Eq. 4.25), diagonal tensor.
+        ``"principal"``: axes along the principal axes (Eq. 4.25), ordered and signed to be nearest the link
+        frame (:func:`principal_frame_nearest`), diagonal tensor.
         ``"mesh"``: axes parallel to the mesh axes, full tensor.
     tolerance, min_moment : float
         Passed to :func:`check_moments`.
@@ -249,8 +330,8 @@ def inertial_frame(props: MassProperties, frame: str = "principal", *, tolerance
     if not check.ok:
         raise PhysicsError(f"{props.name or 'body'}: {check.problem()}")
     if frame == "principal":
-        rotation = pa.axes
-        inertia = np.diag(pa.moments)
+        rotation = principal_frame_nearest(pa)
+        inertia = np.diag(np.diag(rotation.T @ props.inertia @ rotation))
     else:
         rotation = np.eye(3)
         inertia = props.inertia
