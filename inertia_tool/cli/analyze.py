@@ -22,6 +22,9 @@ from ..dynamics.spin_stability import stability
 from ..units import MATERIALS, parse_density, parse_mass
 # issue 6: exports and thin-walled models
 from ..robot.inertial import FRAMES, inertial_frame
+from ..mesh.cad import BREP_SUFFIXES, has_ocp
+from ..mass.brep import compare as brep_compare
+from ..reports.brep import brep_comparison_dict, format_brep_comparison
 from ..reports.cad import CAD_UNITS, format_cad_report
 from ..reports.models import format_model_note, model_summary
 from ..robot.formats import ROBOT_FORMATS, format_inertial
@@ -189,8 +192,11 @@ def run(args) -> int:
     stab, stab_error = _stability_section(props) if fmt in ("json", "text") or args.report else (None, None)
     write_report_from_args(args, props, described, messages, meshes=meshes,
                            stability=stab if stab is not None else stab_error)
+    cad = _brep_section(args) if fmt in ("json", "text") else None
     if fmt == "json":
         out = mass_properties_dict(props, density_source=described)
+        if cad is not None:
+            out["brep"] = brep_comparison_dict(cad, props.density)
         out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
         if model["model"] != "solid":
             out["model"] = to_jsonable(model)
@@ -207,11 +213,24 @@ def run(args) -> int:
             print("\n" + note.strip())
     else:
         print(format_mass_properties(props, density_source=described))
+        if cad is not None:
+            print(format_brep_comparison(cad, props.density))
         print("\n".join(format_stability(stab)) if stab is not None else f"  spin stability: {stab_error}")
         note = format_model_note(model)
         if note:
             print(note)
     return 0
+
+
+def _brep_section(args):
+    """For one STEP/IGES solid with OCP installed: the exact B-rep properties against the tessellation."""
+    files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
+    if len(files) != 1 or getattr(args, "model", "solid") != "solid" or getattr(args, "shell", None):
+        return None
+    path = split_part_spec(files[0])[0]
+    if os.path.splitext(path)[1].lower() not in BREP_SUFFIXES or not has_ocp():
+        return None
+    return brep_compare(path)
 
 
 def _stability_section(props):

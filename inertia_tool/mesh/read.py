@@ -29,8 +29,10 @@ from .weld import weld_exact, weld_exact_stream
 __all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "SUPPORTED_SUFFIXES"]
 
 
-#: File suffixes handled (STL natively, the rest through trimesh; COLLADA needs pycollada).
-SUPPORTED_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".3mf", ".glb", ".gltf", ".dae", ".zae")
+#: File suffixes handled (STL natively, the rest through trimesh; COLLADA needs pycollada; STEP/IGES are
+#: tessellated through OpenCASCADE, ``inertia_tool.mesh.cad``).
+SUPPORTED_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".3mf", ".glb", ".gltf", ".dae", ".zae",
+                      ".step", ".stp", ".iges", ".igs")
 
 #: Compressed single-mesh files: ``part.stl.gz``, ``part.obj.bz2``, or a ``.zip`` holding exactly one mesh.
 COMPRESSED_SUFFIXES = (".gz", ".bz2", ".zip")
@@ -716,6 +718,12 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
                 vertices, faces, n = _read_obj(path, max_faces)
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "vertices have NaN or infinite coordinates")
+            elif suffix in (".step", ".stp", ".iges", ".igs"):
+                from .cad import tessellated_arrays
+                vertices, faces, _, _ = tessellated_arrays(path)
+                _check_face_budget(path, len(faces), max_faces)
+                declared = (1.0, "m")           # the CAD reader converts the file's unit to metres
+                n = len(faces)
             else:
                 vertices, faces, declared = _read_with_trimesh(path, max_faces)
                 n = len(faces)

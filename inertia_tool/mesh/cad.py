@@ -1,0 +1,199 @@
+"""STEP and IGES parts read through OpenCASCADE and tessellated at a stated chord tolerance.
+
+The exact B-rep mass properties and the comparison with the tessellation are in
+:mod:`inertia_tool.mass.brep`.
+
+Two back ends, both OpenCASCADE:
+
+* **OCP** (``pip install cadquery-ocp-novtk``, the ``[cad]`` extra): reads STEP/IGES into a B-rep in metres
+  (the file's own length unit is converted by the reader, ``xstep.cascade.unit = M``), tessellates it with
+  ``BRepMesh_IncrementalMesh`` and integrates the exact solid with ``BRepGProp.VolumeProperties_s``
+  (Gauss integration on the B-rep faces; its ``MatrixOfInertia`` is about the centre of mass in the tensor
+  convention, ``Ixy = −∫xy dm``, checked in the tests).
+* **cascadio** (``pip install cascadio``): STEP → GLB at the same tolerances, read by the glTF reader (no
+  exact properties).  Used only when OCP is missing.
+
+Tessellation error.  Every triangle of the mesh lies within the chord tolerance ``δ`` (``linear_deflection``,
+m) of the true surface, so the solid between the two surfaces is a layer no thicker than ``δ``: the volume
+differs by at most ``A·δ`` (``A`` the surface area) and the centre of mass by at most ``A·δ·(|c| + L)/V``
+for a part of size ``L``.  :class:`BrepComparison` states ``A·δ/V`` as the bound of the relative volume error
+next to the differences actually found.  ``angular_deflection`` (rad) also limits each curved face's
+triangles; the smaller of the two governs.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+
+import numpy as np
+
+from ..errors import MeshReadError, UsageError
+
+__all__ = ["BREP_SUFFIXES", "DEFAULT_CHORD_RTOL", "DEFAULT_ANGULAR_DEFLECTION", "read_brep", "tessellate",
+           "chord_tolerance", "tessellated_arrays", "has_ocp"]
+
+#: CAD exchange suffixes read as B-reps.
+BREP_SUFFIXES = (".step", ".stp", ".iges", ".igs")
+
+#: Default chord tolerance as a fraction of the bounding-box diagonal.
+DEFAULT_CHORD_RTOL = 1e-4
+
+#: Default angular deflection of the tessellation, rad.
+DEFAULT_ANGULAR_DEFLECTION = 0.1
+
+
+def has_ocp() -> bool:
+    """Whether OCP (OpenCASCADE's Python bindings) is importable."""
+    try:
+        import OCP.BRepGProp  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _fail(path: str, problem: str) -> MeshReadError:
+    return MeshReadError(f"{os.fsencode(path).decode('utf-8', 'replace')}: {problem}")
+
+
+@contextlib.contextmanager
+def _quiet():
+    """OpenCASCADE prints progress banners on stdout (fd 1); keep them off our output."""
+    import sys
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+            yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def read_brep(path) -> object:
+    """The B-rep (``TopoDS_Shape``, metres) of a STEP or IGES file; needs OCP."""
+    path = os.fsdecode(os.fspath(path))
+    try:
+        from OCP.IFSelect import IFSelect_ReturnStatus
+        from OCP.IGESControl import IGESControl_Reader
+        from OCP.Interface import Interface_Static
+        from OCP.STEPControl import STEPControl_Reader
+    except ImportError:
+        raise _fail(path, "reading STEP/IGES exactly needs OCP (pip install cadquery-ocp-novtk, or the [cad] "
+                          "extra)") from None
+    if not os.path.isfile(path):
+        raise _fail(path, "no such file")
+    suffix = os.path.splitext(path)[1].lower()
+    # the reader's constructor initialises the exchange parameters (xstep.cascade.unit back to MM the first
+    # time), so the target unit is set after it and restored afterwards
+    reader = STEPControl_Reader() if suffix in (".step", ".stp") else IGESControl_Reader()
+    previous = Interface_Static.CVal_s("xstep.cascade.unit")
+    Interface_Static.SetCVal_s("xstep.cascade.unit", "M")
+    try:
+        with _quiet():
+            status = reader.ReadFile(path)
+            if status != IFSelect_ReturnStatus.IFSelect_RetDone:
+                raise _fail(path, f"not a readable {'STEP' if suffix in ('.step', '.stp') else 'IGES'} file "
+                                  f"({status.name})")
+            reader.TransferRoots()
+            shape = reader.OneShape()
+    finally:
+        Interface_Static.SetCVal_s("xstep.cascade.unit", previous or "MM")
+    if shape is None or shape.IsNull():
+        raise _fail(path, "holds no shape")
+    return shape
+
+
+def _bounding_diagonal(shape) -> float:
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+    box = Bnd_Box()
+    BRepBndLib.Add_s(shape, box)
+    return float(box.CornerMin().Distance(box.CornerMax()))
+
+
+def chord_tolerance(shape, chord: float | None = None) -> float:
+    """The chord tolerance in m: ``chord`` if given, else :data:`DEFAULT_CHORD_RTOL` × bounding-box diagonal."""
+    if chord is not None:
+        if not (np.isfinite(chord) and chord > 0):
+            raise UsageError(f"Expected a positive finite chord tolerance in m, got {chord}")
+        return float(chord)
+    return DEFAULT_CHORD_RTOL * _bounding_diagonal(shape)
+
+
+def tessellate(shape, *, chord: float, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION):
+    """Triangles of the B-rep (``BRepMesh_IncrementalMesh``): ``(vertices (n, 3) m, faces (m, 3))``, outward.
+
+    Each B-rep face is meshed on its own; reversed faces have their triangles flipped so the normals point
+    out of the solid, and each face's location is applied.  Vertices on shared edges coincide (the mesher
+    shares edge discretisations), so the mesh reader welds them into a closed surface.
+    """
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.TopoDS import TopoDS
+    BRepMesh_IncrementalMesh(shape, chord, False, angular_deflection, True)
+    vertices, faces, offset = [], [], 0
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        face = TopoDS.Face(explorer.Current())
+        location = TopLoc_Location()
+        triangulation = BRep_Tool.Triangulation_s(face, location)
+        explorer.Next()
+        if triangulation is None:
+            continue
+        transform = location.Transformation()
+        nodes = np.array([triangulation.Node(i).Transformed(transform).Coord()
+                          for i in range(1, triangulation.NbNodes() + 1)], dtype=np.float64)
+        tris = np.array([triangulation.Triangle(i).Get() for i in range(1, triangulation.NbTriangles() + 1)],
+                        dtype=np.int64) - 1
+        if face.Orientation() == TopAbs_REVERSED:
+            tris = tris[:, ::-1]
+        vertices.append(nodes)
+        faces.append(tris + offset)
+        offset += len(nodes)
+    if not faces:
+        raise UsageError("the shape has no faces to tessellate")
+    return np.vstack(vertices), np.vstack(faces)
+
+
+def _cascadio_arrays(path: str, chord: float, angular_deflection: float):
+    import tempfile
+    try:
+        import cascadio
+    except ImportError:
+        raise _fail(path, "reading STEP needs OCP or cascadio (pip install cadquery-ocp-novtk, or cascadio)") from None
+    if os.path.splitext(path)[1].lower() not in (".step", ".stp"):
+        raise _fail(path, "reading IGES needs OCP (pip install cadquery-ocp-novtk); cascadio reads STEP only")
+    from .read import _read_with_trimesh
+    with tempfile.TemporaryDirectory(prefix="inertia-tool-") as tmp:
+        glb = os.path.join(tmp, "part.glb")
+        with _quiet():   # cascadio's tolerance is in OpenCASCADE's working unit, mm; its GLB is in metres
+            cascadio.step_to_glb(path, glb, tol_linear=chord * 1e3, tol_angular=angular_deflection,
+                                 tol_relative=False)
+        if not os.path.isfile(glb):
+            raise _fail(path, "cascadio could not convert the file")
+        vertices, faces, _ = _read_with_trimesh(glb, 1 << 62)
+    return vertices, faces
+
+
+def tessellated_arrays(path, *, chord: float | None = None, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION):
+    """``(vertices m, faces, chord m, backend)`` of a STEP/IGES file: OCP if installed, else cascadio.
+
+    Without ``chord`` and with cascadio, the default tolerance is relative to the file's size as cascadio
+    reports it after a first coarse conversion.
+    """
+    path = os.fsdecode(os.fspath(path))
+    if has_ocp():
+        shape = read_brep(path)
+        tol = chord_tolerance(shape, chord)
+        vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection)
+        return vertices, faces, tol, "OCP"
+    if chord is None:
+        v, _ = _cascadio_arrays(path, 1e-3, 0.5)
+        chord = DEFAULT_CHORD_RTOL * float(np.linalg.norm(np.ptp(v, axis=0)))
+    vertices, faces = _cascadio_arrays(path, chord, angular_deflection)
+    return vertices, faces, float(chord), "cascadio"

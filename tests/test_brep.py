@@ -1,0 +1,113 @@
+"""STEP and IGES through OpenCASCADE (inertia_tool.mesh.cad, inertia_tool.mass.brep): exact B-rep mass properties, the tessellation and
+the bound on its error, on a part made here with OCP whose closed form is known (a cylinder with a hole)."""
+
+import numpy as np
+import pytest
+
+import inertia_tool as it
+from inertia_tool.mass import brep, shapes
+from inertia_tool.mesh import cad
+from inertia_tool.errors import UsageError
+
+from conftest import assert_tensor_close
+
+OCP = pytest.importorskip("OCP", reason="OCP (pip install cadquery-ocp-novtk, the [cad] extra) is not installed")
+
+R_OUT, R_IN, HEIGHT = 40.0, 15.0, 100.0          # mm, as written in the files
+
+
+def _washer_shape():
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+    axis = gp_Ax2(gp_Pnt(0, 0, -HEIGHT / 2), gp_Dir(0, 0, 1))
+    return BRepAlgoAPI_Cut(BRepPrimAPI_MakeCylinder(axis, R_OUT, HEIGHT).Shape(),
+                           BRepPrimAPI_MakeCylinder(axis, R_IN, HEIGHT).Shape()).Shape()
+
+
+@pytest.fixture(scope="module")
+def washer_files(tmp_path_factory):
+    """The washer as STEP and IGES, in millimetres (OpenCASCADE's default unit for both)."""
+    from OCP.IGESControl import IGESControl_Writer
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    d = tmp_path_factory.mktemp("cad")
+    shape = _washer_shape()
+    with cad._quiet():
+        writer = STEPControl_Writer()
+        writer.Transfer(shape, STEPControl_AsIs)
+        writer.Write(str(d / "washer.step"))
+        iges = IGESControl_Writer("MM", 1)
+        iges.AddShape(shape)
+        iges.ComputeModel()
+        iges.Write(str(d / "washer.igs"))
+    assert "SI_UNIT(.MILLI.,.METRE.)" in (d / "washer.step").read_text()
+    return {"step": d / "washer.step", "iges": d / "washer.igs"}
+
+
+EXACT = shapes.washer(R_OUT / 1e3, R_IN / 1e3, HEIGHT / 1e3).exact      # the ideal solid, metres
+
+
+@pytest.mark.parametrize("kind", ["step", "iges"])
+def test_exact_brep_properties_are_the_closed_form_in_metres(washer_files, kind):
+    exact = brep.exact_mass_properties(cad.read_brep(washer_files[kind]))
+    assert exact.volume == pytest.approx(EXACT.volume, rel=1e-12)
+    np.testing.assert_allclose(exact.center_of_mass, 0.0, atol=1e-15)
+    assert_tensor_close(exact.inertia, EXACT.inertia, 1e-12)
+
+
+@pytest.mark.parametrize("kind", ["step", "iges"])
+def test_tessellation_agrees_within_its_stated_bound(washer_files, kind):
+    cmp = brep.compare(washer_files[kind])
+    assert cmp.chord == pytest.approx(cad.DEFAULT_CHORD_RTOL * np.sqrt(0.08 ** 2 + 0.08 ** 2 + 0.1 ** 2), rel=1e-3)
+    assert 0 < cmp.volume_error <= cmp.volume_bound          # the bound A·δ/V holds and is not vacuous
+    assert cmp.volume_bound < 0.01
+    assert cmp.inertia_error <= 2 * cmp.volume_bound and cmp.com_error < 1e-12
+    # a finer chord shrinks the error
+    finer = brep.compare(washer_files[kind], chord=cmp.chord / 10, angular_deflection=0.02)
+    assert finer.volume_error < cmp.volume_error / 4 and finer.volume_error <= finer.volume_bound
+
+
+def test_products_of_inertia_use_the_tensor_sign():
+    # a box along x = y: ∫xy dm > 0, so the tensor element is negative; OCP's matrix and our engine on the
+    # (exact, planar) tessellation agree entry by entry
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Trsf
+    turn = gp_Trsf()
+    turn.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), np.pi / 4)
+    shape = BRepBuilderAPI_Transform(BRepPrimAPI_MakeBox(0.3, 0.05, 0.05).Shape(), turn, True).Shape()
+    exact = brep.exact_mass_properties(shape)
+    vertices, faces = cad.tessellate(shape, chord=1e-3)
+    mesh = it.mass_properties((vertices, faces), density=1.0)
+    assert exact.inertia[0, 1] < 0
+    assert_tensor_close(mesh.inertia, exact.inertia, 1e-12)
+    np.testing.assert_allclose(mesh.center_of_mass, exact.center_of_mass, atol=1e-15)
+
+
+def test_step_reads_like_any_mesh_and_refuses_a_contradicting_unit(washer_files):
+    props = it.mass_properties(washer_files["step"], material="steel")
+    assert props.mesh.units == "m"
+    assert props.mass == pytest.approx(7850 * EXACT.volume, rel=brep.compare(washer_files["step"]).volume_bound)
+    with pytest.raises(UsageError, match="declares its length unit"):
+        it.mass_properties(washer_files["step"], units="mm")
+
+
+def test_cascadio_tessellates_step_when_ocp_is_missing(washer_files, monkeypatch):
+    pytest.importorskip("cascadio")
+    monkeypatch.setattr(cad, "has_ocp", lambda: False)
+    vertices, faces, chord, backend = cad.tessellated_arrays(washer_files["step"], chord=1e-4, angular_deflection=0.2)
+    assert backend == "cascadio" and chord == 1e-4
+    mesh = it.mass_properties((vertices, faces), density=1.0)
+    bound = EXACT.surface_area * chord / EXACT.volume
+    assert abs(mesh.volume / EXACT.volume - 1) <= bound
+    assert_tensor_close(mesh.inertia, EXACT.inertia, 2 * bound)
+
+
+def test_analyze_reports_the_brep_and_the_tessellation_error(washer_files, capsys):
+    from inertia_tool.cli import main
+    assert main(["analyze", str(washer_files["step"]), "--material", "steel", "--json"]) == 0
+    import json
+    out = json.loads(capsys.readouterr().out)
+    assert out["brep"]["exact"]["mass"] == pytest.approx(7850 * EXACT.volume, rel=1e-12)
+    assert out["brep"]["volume_error"] <= out["brep"]["volume_error_bound"]
+    assert abs(out["mass"] / out["brep"]["exact"]["mass"] - 1) == pytest.approx(out["brep"]["volume_error"], rel=1e-6)
