@@ -11,6 +11,7 @@ import pytest
 
 from conftest import box_arrays, write_binary_stl
 from inertia_tool.cli import _NEGATIVE_VALUE, build_parser, main
+from robot_data import ERD, UR5
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MESHES = os.path.join(ROOT, "meshes")
@@ -119,6 +120,7 @@ WRITERS = [
      "--report", "r.html"),
     (["balance", WHEEL, "--units", "mm", "--rpm", "3000", "--radius", "150", "--planes", "-40,40"],
      "--report", "r.md"),
+    (["robot", str(UR5), "--package", f"example-robot-data={ERD}", "--keep-mass"], "--write", "r.urdf"),
 ]
 
 

@@ -6,7 +6,8 @@ produced, and inflating stops — and the file is refused as a decompression bom
 ``max_bytes`` or, above ``min_ratio_bytes``, ``max_ratio`` times the compressed size.  Nothing larger than
 the limit is ever written or held in memory (16 MiB blocks).  A zip must hold exactly one member with a mesh
 suffix (other members are refused, not guessed among); its sizes are checked from the central directory
-before inflating, and again while inflating (a lying directory cannot get past the count).
+before inflating (for gzip, the size its trailer announces), and again while inflating (a lying directory
+or trailer cannot get past the count).
 """
 
 from __future__ import annotations
@@ -34,10 +35,7 @@ def _fail(path: str, problem: str) -> MeshReadError:
 
 def _copy_bounded(src, dst, path: str, compressed: int, max_bytes: int, max_ratio: float, min_ratio_bytes: int) -> None:
     total = 0
-    limit = max_bytes
-    if compressed * max_ratio >= min_ratio_bytes:
-        limit = min(limit, int(compressed * max_ratio))
-    limit = max(limit, min(max_bytes, min_ratio_bytes))
+    limit = min(max_bytes, max(int(compressed * max_ratio), min_ratio_bytes))
     while True:
         block = src.read(BLOCK_BYTES)
         if not block:
@@ -95,6 +93,14 @@ def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes
                 if os.path.splitext(member)[1].lower() not in suffixes:
                     raise _fail(path, f"the compressed file {member[:60]!r} is not a mesh with a known suffix "
                                       f"({', '.join(suffixes)})")
+                if outer == ".gz" and compressed >= 18:        # ISIZE trailer: size mod 2³², a cheap first look
+                    with open(path, "rb") as fh:
+                        fh.seek(-4, os.SEEK_END)
+                        announced = int.from_bytes(fh.read(4), "little")
+                    ratio_limit = max(int(compressed * max_ratio), min_ratio_bytes)
+                    if announced > min(max_bytes, ratio_limit):
+                        raise _fail(path, f"announces {announced:,} bytes inflated from {compressed:,}: refused as a "
+                                          "decompression bomb before inflating")
                 opener = gzip.open if outer == ".gz" else bz2.open
                 target = os.path.join(tmp, member)
                 with opener(path, "rb") as src, open(target, "wb") as dst:

@@ -575,6 +575,28 @@ def _(path):
     open(path, "wb").write(b"<model>not zipped</model>\n")
 
 
+@entry("bomb.stl.gz", "gzip bomb (2 MB inflating to 2 GiB)", 3, r"refused as a decompression bomb before inflating",
+       shown="announces N bytes inflated from N: refused as a decompression bomb before inflating")
+def _(path):
+    deflated, crc, size = _zeros_bomb(2 << 30)
+    header = b"\x1f\x8b\x08\x00\x00\x00\x00\x00\x02\xff"
+    open(path, "wb").write(header + deflated + struct.pack("<II", crc, size & 0xFFFFFFFF))
+
+
+@entry("bomb.stl.bz2", "bzip2 bomb (inflating without limit)", 3, r"inflates beyond [\d,]+ bytes .* decompression bomb",
+       shown="inflates beyond N bytes (…): refused as a decompression bomb")
+def _(path):
+    import bz2
+    open(path, "wb").write(bz2.compress(b"\0" * (64 << 20), 9))
+
+
+@entry("two-meshes.zip", "a zip with two meshes", 3, r"a zip must hold exactly one mesh file")
+def _(path):
+    data = b"solid a\nendsolid a\n"
+    _zip(path, [("a.stl", _deflate(data), len(data), zlib.crc32(data)),
+                ("b.stl", _deflate(data), len(data), zlib.crc32(data))])
+
+
 def make_corpus(directory) -> list[Entry]:
     """Write every corpus file into ``directory``; returns the entries with their clean bodies.
 
