@@ -11,9 +11,9 @@ import pytest
 import trimesh
 
 import inertia_tool as it
-from inertia_tool import shapes
+from inertia_tool.mass import shapes
 from inertia_tool.errors import MeshReadError, UsageError
-from inertia_tool.io import load_mesh
+from inertia_tool.mesh.read import load_mesh
 
 from conftest import assert_tensor_close
 from robot_data import ERD, UR5_MESHES

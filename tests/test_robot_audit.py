@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from inertia_tool import shapes
-from inertia_tool.robot import audit, link_inertials, read_robot
+from inertia_tool.mass import shapes
+from inertia_tool.robot import audit_links as audit, link_inertials, read_robot
 
 from robot_data import PACKAGES, UR5
 

@@ -241,8 +241,8 @@ def test_cli_refuses_a_needle_with_exit_code_4(tmp_path, capsys):
 from hypothesis import given, settings, strategies as st   # noqa: E402
 from scipy.spatial.transform import Rotation                # noqa: E402
 
-from inertia_tool.inertial import _SIGNED_PERMUTATIONS, principal_frame_nearest   # noqa: E402
-from inertia_tool.principal import principal_axes            # noqa: E402
+from inertia_tool.robot.inertial import _SIGNED_PERMUTATIONS, principal_frame_nearest   # noqa: E402
+from inertia_tool.mass.principal import principal_axes            # noqa: E402
 
 
 def test_aligned_box_keeps_the_link_axes_not_the_ascending_order():

@@ -6,9 +6,9 @@ import pytest
 import trimesh
 
 import inertia_tool as it
-from inertia_tool import shapes
+from inertia_tool.mass import shapes
 from inertia_tool.errors import UsageError
-from inertia_tool.io import load_mesh
+from inertia_tool.mesh.read import load_mesh
 from inertia_tool.robot import link_inertials, read_robot
 from inertia_tool.robot.description import GeometryElement, LinkGeometry, rpy_to_matrix
 from inertia_tool.robot.geometry import (element_mass_properties, link_mass_properties, points_inside_element,

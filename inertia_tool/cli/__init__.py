@@ -19,7 +19,8 @@ import re
 import sys
 import warnings
 
-from ..errors import InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError, UsageError
+from ..errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
+                      RobotDescriptionError, UsageError)
 
 __all__ = ["main", "build_parser", "exit_code", "speak_options", "EXIT_CODES", "EXIT_OK", "EXIT_INTERNAL",
            "EXIT_USAGE", "EXIT_MESH", "EXIT_PHYSICS"]
@@ -34,6 +35,7 @@ EXIT_PHYSICS = 4
 EXIT_CODES = {
     UsageError: EXIT_USAGE,
     MeshReadError: EXIT_MESH,
+    RobotDescriptionError: EXIT_MESH,
     InvalidMeshError: EXIT_MESH,
     PhysicsError: EXIT_PHYSICS,
     InertiaToolError: EXIT_INTERNAL,

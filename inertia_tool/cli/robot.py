@@ -9,7 +9,7 @@ import sys
 
 from ..errors import UsageError
 from ..reports.robot_audit import format_robot_report, robot_report_dict
-from ..robot.audit import audit
+from ..robot.audit import audit_links
 from ..robot.description import GEOMETRY_KINDS, read_robot
 from ..robot.geometry import link_inertials
 from ..robot.write import write_corrected
@@ -80,7 +80,7 @@ def run(args) -> int:
     density = parse_density(args.density) if args.density is not None else None
     robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings)
     inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass)
-    audits = audit(robot, inertials, keep_mass=args.keep_mass)
+    audits = audit_links(robot, inertials, keep_mass=args.keep_mass)
     if args.write:
         basis = next((r.basis for r in inertials if r.properties is not None), "")
         note = "declared masses kept" if args.keep_mass else f"density {basis}"

@@ -9,11 +9,11 @@ tests against this package's integration of an exact, planar tessellation).
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..mesh.cad import DEFAULT_ANGULAR_DEFLECTION, chord_tolerance, read_brep, tessellate
+from ..values import frozen_value
 from .properties import MassProperties
 
 __all__ = ["exact_mass_properties", "BrepComparison", "compare"]
@@ -34,7 +34,7 @@ def exact_mass_properties(shape, *, name: str = "") -> MassProperties:
                           inertia=0.5 * (tensor + tensor.T), surface_area=area_props.Mass(), density=1.0, name=name)
 
 
-@dataclass(frozen=True)
+@frozen_value
 class BrepComparison:
     """Exact B-rep mass properties against those of its tessellation (both unit density, metres).
 

@@ -755,7 +755,7 @@ def _declared_units_win(name: str, declared: tuple[float, str], units: str, scal
     file_scale, file_unit = declared
     if scale != 1.0 and abs(scale - file_scale) > 1e-12 * file_scale:
         raise UsageError(f"{name}: the file declares its length unit as {file_unit} ({file_scale:g} m) but "
-                         f"units={units!r} was given; the declared unit is used when units are left at metres")
+                         f"`units` {units!r} was given; the declared unit is used when `units` is left at m")
     return file_scale, file_unit
 
 

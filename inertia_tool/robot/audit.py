@@ -9,7 +9,7 @@ For each link with both a declared inertial and a geometry result (:class:`LinkI
   compared at equal mass, both about their own centre of mass in link axes (Frobenius norm, so a tensor
   that is right but expressed in swapped or rotated axes shows up);
 * the declared tensor's validity: positive principal moments and the triangle inequality ``I1 + I2 ≥ I3``
-  (:func:`inertia_tool.inertial.check_moments`, the checks Gazebo and MuJoCo apply);
+  (:func:`inertia_tool.robot.inertial.check_moments`, the checks Gazebo and MuJoCo apply);
 * the implied density ``declared mass / geometry volume`` against the range of the material table
   (:data:`inertia_tool.units.MATERIALS`, 500–19300 kg/m³): outside it, mass and geometry disagree (a
   collision hull much larger than the part, a mass in grams, a mesh in millimetres);
@@ -22,17 +22,17 @@ Every threshold is a keyword argument; an issue is a sentence in ``LinkAudit.iss
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
-from ..inertial import MomentCheck, check_moments
-from ..properties import MassProperties
+from ..mass.properties import MassProperties
 from ..units import MATERIALS
+from ..values import frozen_value
 from .description import DeclaredInertial, RobotDescription
 from .geometry import LinkInertial, element_bounds, points_inside_element
+from .inertial import MomentCheck, check_moments
 
-__all__ = ["LinkAudit", "audit", "DENSITY_RANGE", "DEFAULT_COM_TOLERANCE", "DEFAULT_INERTIA_TOLERANCE",
+__all__ = ["LinkAudit", "audit_links", "DENSITY_RANGE", "DEFAULT_COM_TOLERANCE", "DEFAULT_INERTIA_TOLERANCE",
            "DEFAULT_MASS_TOLERANCE"]
 
 #: (lowest, highest) density of the material table, kg/m³.
@@ -48,7 +48,7 @@ DEFAULT_INERTIA_TOLERANCE = 0.25
 DEFAULT_MASS_TOLERANCE = 0.25
 
 
-@dataclass(frozen=True)
+@frozen_value
 class LinkAudit:
     """One link's declared inertial judged against its geometry.
 
@@ -110,7 +110,7 @@ def _declared_check(declared: DeclaredInertial) -> MomentCheck | None:
     return check_moments(np.linalg.eigvalsh(tensor), min_moment=0.0)
 
 
-def audit(robot: RobotDescription, inertials, *, com_tolerance: float = DEFAULT_COM_TOLERANCE,
+def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DEFAULT_COM_TOLERANCE,
           inertia_tolerance: float = DEFAULT_INERTIA_TOLERANCE, mass_tolerance: float = DEFAULT_MASS_TOLERANCE,
           keep_mass: bool = False) -> tuple:
     """Audit every link of ``robot`` against the geometry results ``inertials`` (:func:`link_inertials`).

@@ -25,11 +25,12 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
 from ..errors import RobotDescriptionError, UsageError
+from ..values import frozen_value
 from .resolve import package_directory, resolve_uri
 
 __all__ = ["GeometryElement", "DeclaredInertial", "LinkGeometry", "RobotDescription", "read_robot",
@@ -76,7 +77,7 @@ def _frozen(a, shape) -> np.ndarray:
     return out
 
 
-@dataclass(frozen=True)
+@frozen_value
 class GeometryElement:
     """One ``<collision>`` or ``<visual>`` geometry of a link (MJCF: one ``<geom>``).
 
@@ -118,7 +119,7 @@ class GeometryElement:
         object.__setattr__(self, "size", tuple(float(s) for s in self.size))
 
 
-@dataclass(frozen=True)
+@frozen_value
 class DeclaredInertial:
     """A link's ``<inertial>`` as the description declares it, in the link frame.
 
@@ -149,7 +150,7 @@ class DeclaredInertial:
             object.__setattr__(self, name, _frozen(getattr(self, name), shape))
 
 
-@dataclass(frozen=True)
+@frozen_value
 class LinkGeometry:
     """A link (MJCF: a body): its geometry elements of the chosen kind and its declared inertial.
 
@@ -167,7 +168,7 @@ class LinkGeometry:
     declared: DeclaredInertial | None
 
 
-@dataclass(frozen=True)
+@frozen_value
 class RobotDescription:
     """A robot description reduced to what mass properties need.
 

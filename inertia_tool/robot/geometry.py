@@ -2,14 +2,14 @@
 
 Every element is first taken at unit density in its own frame, then scaled (meshes), then moved into the
 link frame (``x ↦ R x + t``: centre ``R c + t``, tensor ``R I Rᵀ``), and the elements of a link are summed
-with the parallel-axis theorem (Eq. 4.16, :func:`inertia_tool.properties.combine`).  Overlapping elements
+with the parallel-axis theorem (Eq. 4.16, :func:`inertia_tool.mass.properties.combine`).  Overlapping elements
 are counted twice (as a simulator's inertia-from-geometry does).
 
 Closed forms (unit density, about the element's centre, element axes; M = V):
 
-* box ``a × b × c``: ``I_xx = M(b² + c²)/12`` (cyclic) — :func:`inertia_tool.shapes.box`;
-* cylinder (R, h) along z: ``I_zz = MR²/2``, ``I_xx = M(R²/4 + h²/12)`` — :func:`inertia_tool.shapes.cylinder`;
-* sphere (r): ``2Mr²/5`` — :func:`inertia_tool.shapes.sphere`;
+* box ``a × b × c``: ``I_xx = M(b² + c²)/12`` (cyclic) — :func:`inertia_tool.mass.shapes.box`;
+* cylinder (R, h) along z: ``I_zz = MR²/2``, ``I_xx = M(R²/4 + h²/12)`` — :func:`inertia_tool.mass.shapes.cylinder`;
+* sphere (r): ``2Mr²/5`` — :func:`inertia_tool.mass.shapes.sphere`;
 * ellipsoid (a, b, c): ``V = 4πabc/3``, ``I_xx = M(b² + c²)/5`` (cyclic): the unit sphere's ``∫x² dV = V/5``
   stretched by ``a²``;
 * capsule (R, cylinder length L) along z: the cylinder plus two hemispheres of mass ``m_h = 2πR³/3`` whose
@@ -25,14 +25,14 @@ the tensor is ``I = tr(Σ) 1 − Σ`` (Eq. 4.13).  A negative factor (a mirrored
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InvalidMeshError, MeshReadError, UsageError
-from ..pipeline import mass_properties, resolve_density
-from ..properties import MassProperties, combine
-from .. import shapes
+from ..mass import shapes
+from ..mass.pipeline import mass_properties, resolve_density
+from ..mass.properties import MassProperties, combine
+from ..values import frozen_value
 from .description import GeometryElement, LinkGeometry, RobotDescription
 
 __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", "LinkInertial", "mesh_properties",
@@ -139,7 +139,7 @@ def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None) -> Ma
                           inertia=total.inertia, surface_area=total.surface_area, density=1.0, name=link.name)
 
 
-@dataclass(frozen=True)
+@frozen_value
 class LinkInertial:
     """The mass properties a link's geometry implies.
 
@@ -223,7 +223,7 @@ def link_inertials(robot: RobotDescription, *, density: float | None = None, mat
 # -- where the geometry is (for the audit) -----------------------------------------------------------------
 
 def _mesh_vertices_faces(element: GeometryElement):
-    from ..io import load_mesh
+    from ..mesh.read import load_mesh
     raw = load_mesh(element.mesh)
     return raw.vertices * element.scale, raw.faces
 
@@ -265,6 +265,6 @@ def points_inside_element(element: GeometryElement, point) -> bool:
         z = float(np.clip(local[2], -0.5 * size[1], 0.5 * size[1]))
         d = local - np.array([0.0, 0.0, z])
         return bool(d @ d <= size[0] ** 2)
-    from ..checks import winding_number
+    from ..mesh.checks import winding_number
     v, f = _mesh_vertices_faces(element)
     return abs(winding_number(local, v, f)) >= 0.5

@@ -209,6 +209,24 @@ _START_TAG = re.compile(rb"<[^\s/>]+(?:\s+[^\s=/>]+\s*=\s*(?:\"[^\"]*\"|'[^']*')
 def write_corrected(robot: RobotDescription, inertials, path, *, force: bool = False, note: str = "") -> tuple:
     """Write :func:`corrected_document` to ``path`` atomically; returns the names of the corrected links.
 
+    Parameters
+    ----------
+    robot : RobotDescription
+        The description read by :func:`~inertia_tool.robot.read_robot` (its ``document`` is edited).
+    inertials : sequence of LinkInertial
+        From :func:`~inertia_tool.robot.link_inertials`; links without ``properties`` are left untouched.
+    path : str or os.PathLike
+        The file to write (a temporary file beside it is renamed onto it).
+    force : bool
+        Replace an existing file (also the input itself).
+    note : str
+        Appended to the provenance comment (e.g. the density basis).
+
+    Returns
+    -------
+    tuple of str
+        The links whose ``<inertial>`` was written.
+
     Raises
     ------
     UsageError
