@@ -1,6 +1,7 @@
 """``inertia-tool robot``: JSON, table, --write, and one-line errors with the documented exit codes."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -61,3 +62,26 @@ def test_unresolved_uri_is_one_line_exit_3(capsys, monkeypatch):
 def test_usage_errors(argv, message, capsys):
     assert main(["robot", str(UR5), "--package", PKG] + argv) == 2
     assert message in capsys.readouterr().err
+
+
+def test_xacro_input_writes_the_expanded_urdf(tmp_path, capsys):
+    mujoco = pytest.importorskip("mujoco")
+    src = tmp_path / "rod.urdf.xacro"
+    src.write_text('<?xml version="1.0"?>\n<robot name="rod" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+                   '  <xacro:arg name="len" default="0.4"/>\n'
+                   '  <link name="rod">\n    <collision><origin xyz="0 0 ${$(arg len)/2}" rpy="0 0 0"/>\n'
+                   '      <geometry><cylinder radius="0.02" length="$(arg len)"/></geometry></collision>\n'
+                   '  </link>\n</robot>\n')
+    out = tmp_path / "rod.urdf"
+    assert main(["robot", str(src), "--arg", "len:=0.3", "--material", "steel", "--write", str(out)]) == 0
+    capsys.readouterr()
+    assert "xacro:" not in out.read_text().split("-->", 1)[-1].replace('xmlns:xacro', '')
+    text = out.read_text().replace('<robot name="rod"', '<robot name="rod"', 1)
+    text = re.sub(r"(<robot[^>]*>)", r'\1<mujoco><compiler fusestatic="false"/></mujoco>', text, count=1)
+    model = mujoco.MjModel.from_xml_string(text)              # fusestatic off: a lone link stays a body
+    mass = 7850 * np.pi * 0.02 ** 2 * 0.3
+    body = model.body("rod").id
+    assert model.body_mass[body] == pytest.approx(mass, rel=1e-12)
+    np.testing.assert_allclose(model.body_ipos[body], [0, 0, 0.15], atol=1e-15)
+    np.testing.assert_allclose(np.sort(model.body_inertia[body]),
+                               sorted([mass * 0.02 ** 2 / 2] + [mass * (0.02 ** 2 / 4 + 0.3 ** 2 / 12)] * 2), rtol=1e-12)

@@ -182,3 +182,14 @@ def test_error_inside_an_archive_names_the_archive_and_member(tmp_path):
     with pytest.raises(MeshReadError) as exc:
         load_mesh(path)
     assert str(exc.value).startswith(f"{path}:t.stl")
+
+
+def test_zipped_collada_zae(tmp_path):
+    # .zae: a zip holding the .dae and a manifest naming it (COLLADA 1.5)
+    zae = tmp_path / "wrist3.zae"
+    with zipfile.ZipFile(zae, "w", zipfile.ZIP_DEFLATED) as zf:
+        zf.write(DAE, "wrist3.dae")
+        zf.writestr("manifest.xml", "<?xml version='1.0'?><dae_root>./wrist3.dae</dae_root>")
+    zipped, plain = load_mesh(zae), load_mesh(DAE)
+    assert zipped.units == "m" and len(zipped.faces) == len(plain.faces)
+    np.testing.assert_array_equal(np.sort(zipped.vertices, axis=0), np.sort(plain.vertices, axis=0))

@@ -189,7 +189,7 @@ def link_inertials(robot: RobotDescription, *, density: float | None = None, mat
     """
     chosen = sum([density is not None, material is not None, bool(keep_mass)])
     if chosen != 1:
-        raise UsageError("Give exactly one of density, material and keep_mass")
+        raise UsageError("Give exactly one of `density`, `material` and `keep_mass`")
     rho, basis = (None, "") if keep_mass else resolve_density(density=density, material=material)
     cache: dict = {}
     out = []
