@@ -46,11 +46,11 @@ def test_written_urdf_loads_in_mujoco_with_the_computed_inertias(name, tmp_path)
         assert model.body_mass[i] == pytest.approx(props.mass, rel=1e-12)
         np.testing.assert_allclose(model.body_ipos[i], props.center_of_mass, atol=1e-12)
         # MuJoCo diagonalises: principal moments, and the full tensor rebuilt from body_iquat
-        np.testing.assert_allclose(np.sort(model.body_inertia[i]), props.principal.moments, rtol=1e-9)
+        np.testing.assert_allclose(np.sort(model.body_inertia[i]), props.principal.moments, rtol=1e-12)
         rot = np.zeros(9)
         mujoco.mju_quat2Mat(rot, model.body_iquat[i])
         rot = rot.reshape(3, 3)
-        assert_tensor_close(rot @ np.diag(model.body_inertia[i]) @ rot.T, props.inertia, 1e-9)
+        assert_tensor_close(rot @ np.diag(model.body_inertia[i]) @ rot.T, props.inertia, 1e-12)
 
 
 def test_written_urdf_gives_pinocchio_the_same_inertias(tmp_path):
@@ -86,16 +86,48 @@ def _without_inertials(data: bytes) -> bytes:
     return etree.tostring(tree, method="c14n")
 
 
-def test_everything_but_the_inertials_is_kept(tmp_path):
-    robot, ours, out = _corrected("ur5", tmp_path)
-    original, written = UR5.read_bytes(), out.read_bytes()
-    assert _without_inertials(original) == _without_inertials(written)
-    # byte level: the prolog (declaration, banner comments) and every line outside <inertial> are identical
-    old_lines, new_lines = original.decode().splitlines(), written.decode().splitlines()
-    changed = [l for l in old_lines if l not in new_lines]
-    assert changed and all(re.match(r"\s*<(origin|inertia) ", l) for l in changed), changed
-    assert len(new_lines) == len(old_lines) + 1          # the provenance comment
-    assert written.startswith(original[:original.index(b"<robot")])
+def _outside_inertials(data: bytes) -> bytes:
+    """The bytes with every <inertial>…</inertial> and the provenance comment cut out."""
+    data = re.sub(rb"[ \t]*<!-- inertia-tool robot:.*?-->\r?\n", b"", data, flags=re.S)
+    return re.sub(rb"<inertial\b.*?</inertial>|<inertial\b[^>]*/>", b"", data, flags=re.S)
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda"])
+def test_every_byte_outside_the_inertials_is_kept(name, tmp_path):
+    robot, ours, out = _corrected(name, tmp_path)
+    original, written = ROBOTS[name][0].read_bytes(), out.read_bytes()
+    assert _outside_inertials(original) == _outside_inertials(written)
+    assert _without_inertials(original) == _without_inertials(written)        # and as XML, canonically
+    assert len(written.splitlines()) == len(original.splitlines()) + 1        # the provenance comment
+
+
+def test_missing_inertials_are_inserted_in_the_style_of_the_file(tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<?xml version="1.0"?>\n<robot name=\'r\'>\n    <!-- a comment, kept -->\n    <link name=\'a\'>\n'
+                    '        <collision>\n            <geometry><box size=\'0.1 0.2 0.3\' /></geometry>\n'
+                    '        </collision>\n    </link>\n    <link name="b"/>\n</robot>\n')
+    robot = read_robot(urdf)
+    inertials = link_inertials(robot, density=1000)
+    text = corrected_document(robot, inertials).decode()
+    assert "<box size='0.1 0.2 0.3' />" in text and "<!-- a comment, kept -->" in text
+    assert "\n        <inertial>\n            <origin" in text and text.endswith("    </link>\n    <link name=\"b\"/>\n</robot>\n")
+    declared = read_robot_from_text(tmp_path, text).link("a").declared
+    assert declared.mass == pytest.approx(1000 * 0.006)
+    mjcf = tmp_path / "m.xml"
+    mjcf.write_text('<mujoco>\n  <worldbody>\n    <body name="b">\n      <freejoint/>\n'
+                    '      <geom type="sphere" size="0.1"/>\n    </body>\n  </worldbody>\n</mujoco>\n')
+    robot = read_robot(mjcf)
+    text = corrected_document(robot, link_inertials(robot, density=1000)).decode()
+    assert '<body name="b">\n      <inertial pos="0.0 0.0 0.0" mass=' in text
+    model = mujoco.MjModel.from_xml_string(text)
+    assert model.body_mass[1] == pytest.approx(1000 * 4 / 3 * np.pi * 0.001, rel=1e-14)
+
+
+def read_robot_from_text(directory, text):
+    path = directory / "again.urdf"
+    path.write_text(text)
+    return read_robot(path)
 
 
 def test_corrected_values_read_back_as_declared(tmp_path):

@@ -1,13 +1,14 @@
 """A copy of a robot description with corrected ``<inertial>`` elements, everything else left as it was.
 
-The description is edited as an XML tree (lxml, comments and whitespace kept) and only the inertial of each
-link with a geometry result is touched: its origin moves to the centre of mass, its orientation is the link
-frame (**rpy 0**, MJCF: no ``quat``) and the **full tensor** is written (products of inertia in the tensor
-convention, ``ixy = −∫xy dm``, which URDF, SDFormat and MuJoCo's ``fullinertia`` use).  Attribute order,
-comments, indentation and every other element are kept; the XML declaration line is copied from the
-input.  lxml may still normalise a few bytes (quotes around attribute values, ``<a />`` to ``<a/>``,
-character references); the tests measure it on the bundled robots.  One comment inside the root element
-says which links were recomputed and from what.
+Only the inertial of each link with a geometry result is touched: its origin moves to the centre of mass, its
+orientation is the link frame (**rpy 0**, MJCF: no ``quat``) and the **full tensor** is written (products of
+inertia in the tensor convention, ``ixy = −∫xy dm``, which URDF, SDFormat and MuJoCo's ``fullinertia`` use).
+The new element is built on the lxml tree of the description and its text is spliced into the input's bytes
+in place of the old element (or inserted where there was none: last in a URDF/SDF link, first in an MJCF
+body), so every other byte — declaration, comments, indentation, attribute order and quoting — is the
+input's.  One comment after the root's start tag says which links were recomputed and from what.  (If the
+elements cannot be matched to the text — a non-UTF-8 encoding, entities — the whole tree is serialised by
+lxml instead, which keeps all of that except the spelling of a few tags and quotes.)
 
 The file is written atomically (a temporary file beside it, then ``os.replace``) and never over an
 existing file (including the input) unless ``force``.  For xacro input the *expanded* URDF is written.
@@ -46,60 +47,64 @@ def _clean(props):
     return com, tensor
 
 
-def _indent_of(element) -> str:
-    """The whitespace before ``element`` (its indentation) or two spaces deeper than its parent."""
+def _whitespace_before(element) -> str | None:
+    """The whitespace text right before ``element`` (its parent's text or its previous sibling's tail)."""
     prev = element.getprevious()
     text = prev.tail if prev is not None else element.getparent().text if element.getparent() is not None else None
-    if text and text.strip() == "":
-        return text
-    return "\n  "
+    return text if text is not None and not text.strip() else None
 
 
-def _child(parent, tag: str, indent: str):
-    """The first ``<tag>`` child of ``parent``, created (indented like its siblings) if missing."""
+def _layout(element) -> tuple[str, str]:
+    """``(own, step)``: the newline-and-indentation before ``element`` and one indentation step of the file."""
+    own = (_whitespace_before(element) if element.getparent() is not None else None) or "\n"
+    first = element[0] if len(element) else None
+    inner = _whitespace_before(first) if first is not None else None
+    if inner and inner.startswith(own) and len(inner) > len(own):
+        return own, inner[len(own):]
+    parent = element.getparent()
+    return own, (_layout(parent)[1] if parent is not None else "  ")   # no children yet: the parent's step
+
+
+def _child(parent, tag: str):
+    """The first ``<tag>`` child of ``parent``, created last (indented like the file) if missing."""
     from lxml import etree
     found = parent.find(tag)
     if found is not None:
         return found
+    own, step = _layout(parent)
     child = etree.SubElement(parent, tag)
     if len(parent) == 1:
-        parent.text = indent + "  "
-        child.tail = indent
+        parent.text = own + step
     else:
-        before = parent[-2]
-        child.tail = before.tail
-        before.tail = indent + "  "
+        parent[-2].tail = own + step
+    child.tail = own
     return child
 
 
-def _new_inertial(link, indent: str):
+def _inertial_of(link):
+    """The link's ``<inertial>``; a new one, last among its children, when it has none."""
     from lxml import etree
-    inertial = etree.Element("inertial")
-    children = [c for c in link]
-    if children:
-        last = children[-1]
-        inertial.tail = last.tail
-        last.tail = indent + "  "
-        link.append(inertial)
+    inertial = link.find("inertial")
+    if inertial is not None:
+        return inertial
+    own, step = _layout(link)
+    inertial = etree.SubElement(link, "inertial")
+    if len(link) == 1:
+        link.text = own + step
     else:
-        link.text = indent + "  "
-        inertial.tail = indent
-        link.append(inertial)
+        link[-2].tail = own + step
+    inertial.tail = own
     return inertial
 
 
 def _urdf_inertial(link, props) -> None:
     com, t = _clean(props)
-    inertial = link.find("inertial")
-    indent = _indent_of(link)
-    if inertial is None:
-        inertial = _new_inertial(link, indent)
-    inner = indent + "  "
-    origin = _child(inertial, "origin", inner)
+    inertial = _inertial_of(link)
+    origin = _child(inertial, "origin")
     origin.set("xyz", " ".join(_num(c) for c in com))
     origin.set("rpy", "0 0 0")
-    _child(inertial, "mass", inner).set("value", _num(props.mass))
-    inertia = _child(inertial, "inertia", inner)
+    _child(inertial, "mass").set("value", _num(props.mass))
+    inertia = _child(inertial, "inertia")
     for key, (i, j) in (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)), ("iyz", (1, 2)),
                         ("izz", (2, 2))):
         inertia.set(key, _num(t[i, j]))
@@ -107,20 +112,16 @@ def _urdf_inertial(link, props) -> None:
 
 def _sdf_inertial(link, props) -> None:
     com, t = _clean(props)
-    inertial = link.find("inertial")
-    indent = _indent_of(link)
-    if inertial is None:
-        inertial = _new_inertial(link, indent)
-    inner = indent + "  "
-    pose = _child(inertial, "pose", inner)
+    inertial = _inertial_of(link)
+    pose = _child(inertial, "pose")
     pose.text = " ".join(_num(c) for c in com) + " 0 0 0"
     pose.attrib.pop("degrees", None)
     pose.attrib.pop("rotation_format", None)
-    _child(inertial, "mass", inner).text = _num(props.mass)
-    inertia = _child(inertial, "inertia", inner)
+    _child(inertial, "mass").text = _num(props.mass)
+    inertia = _child(inertial, "inertia")
     for key, (i, j) in (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)), ("iyz", (1, 2)),
                         ("izz", (2, 2))):
-        _child(inertia, key, inner + "  ").text = _num(t[i, j])
+        _child(inertia, key).text = _num(t[i, j])
 
 
 def _mjcf_inertial(body, props) -> None:
@@ -128,10 +129,10 @@ def _mjcf_inertial(body, props) -> None:
     com, t = _clean(props)
     inertial = body.find("inertial")
     if inertial is None:
+        own, step = _layout(body)
         inertial = etree.Element("inertial")
-        indent = _indent_of(body) + "  "
-        inertial.tail = body.text if body.text and not body.text.strip() else indent
-        body.text = body.text if body.text and not body.text.strip() else indent
+        inertial.tail = body.text if body.text is not None and not body.text.strip() and len(body) else own
+        body.text = own + step
         body.insert(0, inertial)
     for key in _ORIENTATION_KEYS:
         inertial.attrib.pop(key, None)
@@ -156,35 +157,139 @@ def _links(root, fmt: str):
 def corrected_document(robot: RobotDescription, inertials, *, note: str = "") -> bytes:
     """The description's bytes with the inertials of the links in ``inertials`` replaced.
 
+    Only the bytes of each replaced ``<inertial>`` element change (a missing one is inserted), plus one
+    provenance comment after the root's start tag; every other byte is the input's.  Where the elements cannot
+    be matched to the text (an encoding other than UTF-8/ASCII, an entity that hides markup), the whole tree is
+    serialised by lxml instead, which keeps comments, whitespace and attribute order but may normalise
+    ``<a />`` to ``<a/>`` and the quotes.
+
     Parameters
     ----------
     robot : RobotDescription
+        The description (its ``document`` is edited).
     inertials : sequence of LinkInertial
         Links with ``properties`` None are left untouched.
     note : str
         Appended to the provenance comment (e.g. the density basis).
+
+    Returns
+    -------
+    bytes
+        The corrected document.
     """
     from lxml import etree
     tree = parse_xml(robot.document, robot.source)
     root = tree.getroot()
     elements = _links(root, robot.format)
     writer = {"urdf": _urdf_inertial, "xacro": _urdf_inertial, "sdf": _sdf_inertial, "mjcf": _mjcf_inertial}[robot.format]
+    before = list(root.iter("inertial"))
     changed = []
     for result in inertials:
         if result.properties is None or result.name not in elements:
             continue
         writer(elements[result.name], result.properties)
         changed.append(result.name)
+    comment_text = (f" inertia-tool robot: <inertial> of {len(changed)} link{'s' if len(changed) != 1 else ''} "
+                    f"recomputed from the {robot.geometry} "
+                    f"geometry{' (' + note + ')' if note else ''}: origin at the centre of mass, axes of the link "
+                    "frame (rpy 0), full tensor about the centre of mass, SI, ixy = -(integral of x*y dm) "
+                    ).replace("--", "- -")
+    spliced = _splice_text(robot, root, before, [elements[n] for n in changed], comment_text) if changed else None
+    if spliced is not None:
+        return spliced
     if changed:
-        comment = etree.Comment(
-            f" inertia-tool robot: <inertial> of {len(changed)} links recomputed from the {robot.geometry} geometry"
-            f"{' (' + note + ')' if note else ''}: origin at the centre of mass, axes of the link frame (rpy 0), "
-            "full tensor about the centre of mass, SI, ixy = -(integral of x*y dm) ".replace("--", "- -"))
+        comment = etree.Comment(comment_text)
         comment.tail = root.text if root.text and not root.text.strip() else "\n"
         root.insert(0, comment)
         if root.text is None or root.text.strip():
             root.text = "\n"
     return _splice(robot.document, etree.tostring(root, encoding="utf-8"), root.tag)
+
+
+_MARKUP_TO_HIDE = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>", re.DOTALL)
+
+
+def _tag_spans(masked: str, tag: str) -> list:
+    """``(start, end_of_start_tag, end)`` of every ``<tag>`` element in ``masked`` text (comments blanked);
+    ``end`` is after ``</tag>`` or the self-closing ``/>`` (tags of this kind must not nest)."""
+    spans = []
+    for m in re.finditer(rf"<{tag}(?:\s(?:\"[^\"]*\"|'[^']*'|[^'\">])*)?/?>", masked):
+        if m.group(0).endswith("/>"):
+            spans.append((m.start(), m.end(), m.end()))
+            continue
+        close = masked.find(f"</{tag}>", m.end())
+        if close < 0:
+            return []
+        spans.append((m.start(), m.end(), close + len(tag) + 3))
+    return spans
+
+
+def _line_indent(text: str, position: int) -> str:
+    line_start = text.rfind("\n", 0, position) + 1
+    prefix = text[line_start:position]
+    return prefix if not prefix.strip() else ""
+
+
+def _splice_text(robot: RobotDescription, root, before: list, links: list, comment_text: str) -> bytes | None:
+    """Byte-preserving edit: replace/insert only the changed inertials; None when the text cannot be matched."""
+    from lxml import etree
+    try:
+        text = robot.document.decode("utf-8")
+    except UnicodeDecodeError:
+        return None
+    if "<!ENTITY" in text:
+        return None
+    masked = _MARKUP_TO_HIDE.sub(lambda m: " " * len(m.group(0)), text)
+    inertial_spans = _tag_spans(masked, "inertial")
+    container = "body" if robot.format == "mjcf" else "link"
+    containers = list(root.iter(container))
+    container_spans = _tag_spans(masked, container) if container == "link" else [
+        (m.start(), m.end(), m.end()) for m in re.finditer(r"<body(?:\s(?:\"[^\"]*\"|'[^']*'|[^'\">])*)?>", masked)]
+    if len(inertial_spans) != len(before) or len(container_spans) != len(containers):
+        return None
+    edits = []
+    for element in links:
+        inertial = element.find("inertial")
+        serialized = etree.tostring(inertial, encoding="unicode", with_tail=False)
+        if any(inertial is b for b in before):
+            k = next(i for i, b in enumerate(before) if b is inertial)
+            start, _, end = inertial_spans[k]
+            edits.append((start, end, serialized))
+            continue
+        start, start_end, end = container_spans[next(i for i, c in enumerate(containers) if c is element)]
+        before_it = _whitespace_before(inertial) or ""
+        if container == "body":                 # MJCF: the inertial goes first, after the body's start tag
+            edits.append((start_end, start_end, before_it + serialized))
+            continue
+        if start_end == end:                    # a self-closing link holds no geometry: never changed
+            return None
+        close = end - len(container) - 3        # at "</link>"
+        closing_indent = _line_indent(text, close)
+        if closing_indent and before_it.startswith("\n"):   # a line of its own, above "</link>"
+            line_start = close - len(closing_indent)
+            edits.append((line_start, line_start, before_it[1:] + serialized + "\n"))
+        else:
+            edits.append((close, close, serialized))
+    root_start = _START_TAG_TEXT.match(masked, _prolog_end(masked))
+    if root_start is None or root_start.group(0).endswith("/>"):
+        return None
+    edits.append((root_start.end(), root_start.end(),
+                  f"\n{_first_child_indent(text, root_start.end())}<!--{comment_text}-->"))
+    out = text
+    for start, end, replacement in sorted(edits, key=lambda e: e[0], reverse=True):
+        out = out[:start] + replacement + out[end:]
+    return out.encode("utf-8")
+
+
+def _prolog_end(masked: str) -> int:
+    m = re.match(r"\s*(?:<!DOCTYPE[^>\[]*(?:\[.*?\])?\s*>\s*)?", masked, re.DOTALL)
+    return m.end()
+
+
+def _first_child_indent(text: str, position: int) -> str:
+    """The indentation of the line after ``position`` (the root's first child), or two spaces."""
+    m = re.match(r"[ \t]*\r?\n([ \t]*)", text[position:])
+    return m.group(1) if m and m.group(1) else "  "
 
 
 _PROLOG = re.compile(rb"(?:\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>\[]*(?:\[.*?\])?\s*>)*", re.DOTALL)
@@ -203,7 +308,9 @@ def _splice(original: bytes, element: bytes, tag: str) -> bytes:
     return original[:start] + element + original[end:]
 
 
-_START_TAG = re.compile(rb"<[^\s/>]+(?:\s+[^\s=/>]+\s*=\s*(?:\"[^\"]*\"|'[^']*'))*\s*/?>")
+_START_TAG_PATTERN = r"<[^\s/>!?]+(?:\s+[^\s=/>]+\s*=\s*(?:\"[^\"]*\"|'[^']*'))*\s*/?>"
+_START_TAG = re.compile(_START_TAG_PATTERN.encode())
+_START_TAG_TEXT = re.compile(_START_TAG_PATTERN)
 
 
 def write_corrected(robot: RobotDescription, inertials, path, *, force: bool = False, note: str = "") -> tuple:
