@@ -10,3 +10,6 @@ UR5 = ERD / "robots" / "ur_description" / "urdf" / "ur5_robot.urdf"
 PANDA = ERD / "robots" / "panda_description" / "urdf" / "panda.urdf"
 UR5_MESHES = ERD / "robots" / "ur_description" / "meshes" / "ur5" / "collision"
 PANDA_MESHES = ERD / "robots" / "panda_description" / "meshes" / "collision"
+#: Cassie (Agility Robotics, via DAIRLab cassie-gazebo-sim, ISC): an SDFormat 1.x model whose collision geometry
+#: is all primitives.
+CASSIE_SDF = ERD / "robots" / "cassie_description" / "robots" / "cassie_simple.sdf"

@@ -157,3 +157,24 @@ def test_mjcf_bodies_match_mujocos_inertia_from_geometry(tmp_path):
         assert ours[body].mass == pytest.approx(model.body_mass[i], rel=1e-12)
         np.testing.assert_allclose(ours[body].center_of_mass, model.body_ipos[i], atol=1e-12)
         assert_tensor_close(ours[body].inertia, tensor, 1e-10)
+
+
+def test_cassie_sdf_primitives_in_closed_form():
+    # a real SDFormat model: the pelvis is a sphere r = 0.14 at (0.02, 0, 0.04); the left hip pitch a cylinder
+    # r = 0.06, l = 0.18 posed at (0.053, 0, -0.0379) with pitch 1.57 rad (its axis turned towards x)
+    from robot_data import CASSIE_SDF
+    robot = read_robot(CASSIE_SDF)
+    assert robot.format == "sdf" and len(robot.links) == 23
+    ours = {r.name: r.properties for r in link_inertials(robot, density=1000) if r.properties is not None}
+    assert len(ours) == 9
+    pelvis = ours["pelvis"]
+    m = 1000 * 4 / 3 * np.pi * 0.14 ** 3
+    assert pelvis.mass == pytest.approx(m, rel=1e-14)
+    np.testing.assert_allclose(pelvis.center_of_mass, [0.02, 0, 0.04], atol=1e-16)
+    assert_tensor_close(pelvis.inertia, np.eye(3) * 0.4 * m * 0.14 ** 2, 1e-14)
+    hip = ours["left-hip-pitch"]
+    m = 1000 * np.pi * 0.06 ** 2 * 0.18
+    pitch = rpy_to_matrix([0, 1.57, 0])
+    local = np.diag([m * (0.06 ** 2 / 4 + 0.18 ** 2 / 12)] * 2 + [m * 0.06 ** 2 / 2])
+    np.testing.assert_allclose(hip.center_of_mass, [0.053, 0, -0.0379], atol=1e-16)
+    assert_tensor_close(hip.inertia, pitch @ local @ pitch.T, 1e-14)

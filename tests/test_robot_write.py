@@ -180,3 +180,20 @@ def test_never_overwrites_without_force_and_leaves_no_temporary_file(tmp_path):
     robot_copy = read_robot(copy, packages=PACKAGES)
     with pytest.raises(UsageError, match="is the input description"):
         write_corrected(robot_copy, inertials, copy)
+
+
+def test_real_sdf_is_corrected_in_place(tmp_path):
+    from robot_data import CASSIE_SDF
+    robot = read_robot(CASSIE_SDF)
+    inertials = link_inertials(robot, keep_mass=True)
+    out = tmp_path / "cassie_fixed.sdf"
+    write_corrected(robot, inertials, out)
+    assert _outside_inertials(CASSIE_SDF.read_bytes()) == _outside_inertials(out.read_bytes())
+    again = read_robot(out)
+    for result in inertials:
+        if result.properties is None:
+            continue
+        declared = again.link(result.name).declared
+        assert declared.mass == result.properties.mass
+        np.testing.assert_allclose(declared.center_of_mass, result.properties.center_of_mass, rtol=0, atol=1e-15)
+        assert_tensor_close(declared.inertia, result.properties.inertia, 1e-15)
