@@ -85,3 +85,19 @@ def test_xacro_input_writes_the_expanded_urdf(tmp_path, capsys):
     np.testing.assert_allclose(model.body_ipos[body], [0, 0, 0.15], atol=1e-15)
     np.testing.assert_allclose(np.sort(model.body_inertia[body]),
                                sorted([mass * 0.02 ** 2 / 2] + [mass * (0.02 ** 2 / 4 + 0.3 ** 2 / 12)] * 2), rtol=1e-12)
+
+
+def test_an_open_link_mesh_is_reported_with_the_option_that_repairs_it(tmp_path, capsys):
+    from conftest import box_arrays, write_binary_stl
+    v, f = box_arrays((0.1, 0.1, 0.1))
+    write_binary_stl(tmp_path / "open.stl", v, f[:-1])
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r"><link name="holed"><collision><geometry><mesh filename="open.stl"/>'
+                    '</geometry></collision></link></robot>')
+    assert main(["robot", str(urdf), "--density", "1000"]) == 0
+    out = capsys.readouterr().out
+    assert "holed: mesh needs repair" in out and "--repair" in out and "`" not in out
+    assert main(["robot", str(urdf), "--density", "1000", "--repair", "--json"]) == 0
+    captured = capsys.readouterr()
+    link = json.loads(captured.out)["links"][0]
+    assert link["problem"] is None and link["mass"] > 0 and "repaired" in captured.err

@@ -178,3 +178,18 @@ def test_cassie_sdf_primitives_in_closed_form():
     local = np.diag([m * (0.06 ** 2 / 4 + 0.18 ** 2 / 12)] * 2 + [m * 0.06 ** 2 / 2])
     np.testing.assert_allclose(hip.center_of_mass, [0.053, 0, -0.0379], atol=1e-16)
     assert_tensor_close(hip.inertia, pitch @ local @ pitch.T, 1e-14)
+
+
+def test_a_link_whose_mesh_is_open_says_so_and_the_others_still_compute(tmp_path):
+    from conftest import box_arrays, write_binary_stl
+    v, f = box_arrays((0.1, 0.1, 0.1))
+    write_binary_stl(tmp_path / "open.stl", v, f[:-1])                   # one triangle missing: a hole
+    write_binary_stl(tmp_path / "closed.stl", v, f)
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r"><link name="holed"><collision><geometry><mesh filename="open.stl"/></geometry>'
+                    '</collision></link><link name="fine"><collision><geometry><mesh filename="closed.stl"/>'
+                    '</geometry></collision></link></robot>')
+    holed, fine = link_inertials(read_robot(urdf), density=1000)
+    assert holed.properties is None and "mesh needs repair" in holed.problem and "open.stl" in holed.problem
+    assert "boundary edges" in holed.problem
+    assert fine.properties.mass == pytest.approx(1.0, rel=1e-7)                # float32 STL corners

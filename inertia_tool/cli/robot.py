@@ -14,6 +14,7 @@ from ..robot.description import GEOMETRY_KINDS, read_robot
 from ..robot.geometry import link_inertials
 from ..robot.write import write_corrected
 from ..units import MATERIALS, parse_density
+from . import speak_options
 from .report_option import check_output_file
 
 __all__ = ["register", "run", "parse_packages", "parse_mappings"]
@@ -41,10 +42,12 @@ def register(subparsers) -> None:
     m.add_argument("--keep-mass", action="store_true",
                    help="keep each link's declared mass and take its distribution from the geometry "
                         "(the implied density is reported)")
+    p.add_argument("--repair", action="store_true",
+                   help="repair open or inconsistently wound link meshes instead of reporting them (warned)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     p.add_argument("--write", metavar="OUT", help="write a copy of the description with corrected <inertial> elements")
     p.add_argument("--force", action="store_true", help="let --write replace an existing file")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, robot_parser=p)
 
 
 def parse_packages(items) -> dict:
@@ -79,7 +82,8 @@ def run(args) -> int:
     check_output_file(args.write, "--write", args.force)
     density = parse_density(args.density) if args.density is not None else None
     robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings)
-    inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass)
+    inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
+                               repair=args.repair)
     audits = audit_links(robot, inertials, keep_mass=args.keep_mass)
     if args.write:
         basis = next((r.basis for r in inertials if r.properties is not None), "")
@@ -93,5 +97,6 @@ def run(args) -> int:
     if args.json:
         print(json.dumps(robot_report_dict(robot, inertials, audits), indent=2, ensure_ascii=False))
     else:
-        print(format_robot_report(robot, inertials, audits))
+        # engine sentences name API parameters (`repair=True`); here they name this command's options
+        print(speak_options(format_robot_report(robot, inertials, audits), getattr(args, "robot_parser", None)))
     return 0

@@ -39,13 +39,25 @@ __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", 
            "points_inside_element", "element_bounds"]
 
 
-def mesh_properties(path: str) -> MassProperties:
+def mesh_properties(path: str, *, repair: bool = False) -> MassProperties:
     """Unit-density mass properties of the mesh file ``path`` (metres, file axes).
 
-    The one place where the robot tools call the mesh engine: a mesh that is not a closed solid raises
-    :class:`InvalidMeshError` (the caller reports the link).
+    The one place where the robot tools call the mesh engine.
+
+    Parameters
+    ----------
+    path : str
+        The mesh file.
+    repair : bool
+        Let the engine repair an open or inconsistently wound mesh (``LoadOptions.repair``) instead of raising
+        :class:`InvalidMeshError` (the caller then reports the link).
+
+    Returns
+    -------
+    MassProperties
+        Unit density: ``mass == volume``.
     """
-    return mass_properties(path, density=1.0)
+    return mass_properties(path, density=1.0, repair=repair)
 
 
 def _capsule(radius: float, length: float) -> MassProperties:
@@ -83,7 +95,8 @@ def _scaled(props: MassProperties, scale) -> MassProperties:
                           inertia=np.trace(sigma) * np.eye(3) - sigma, density=1.0, name=props.name)
 
 
-def element_mass_properties(element: GeometryElement, *, cache: dict | None = None) -> MassProperties:
+def element_mass_properties(element: GeometryElement, *, cache: dict | None = None,
+                            repair: bool = False) -> MassProperties:
     """Unit-density mass properties of one geometry element, in the **link frame**.
 
     Parameters
@@ -91,6 +104,8 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     element : GeometryElement
     cache : dict, optional
         Mesh path → unit-density properties, shared between the elements of one robot.
+    repair : bool
+        Passed to :func:`mesh_properties`.
 
     Returns
     -------
@@ -117,7 +132,7 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
         if cache is not None and element.mesh in cache:
             local = cache[element.mesh]
         else:
-            local = mesh_properties(element.mesh)
+            local = mesh_properties(element.mesh, repair=repair)
             if cache is not None:
                 cache[element.mesh] = local
         local = _scaled(local, element.scale)
@@ -126,14 +141,25 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
 
-def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None) -> MassProperties:
+def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repair: bool = False) -> MassProperties:
     """Unit-density mass properties of all the link's elements together, link frame (parallel-axis sum).
 
-    Raises :class:`UsageError` for a link without geometry.
+    Parameters
+    ----------
+    link : LinkGeometry
+    cache : dict, optional
+        Mesh path → unit-density properties, shared between links.
+    repair : bool
+        Passed to :func:`mesh_properties`.
+
+    Returns
+    -------
+    MassProperties
+        Unit density, link frame.  Raises :class:`UsageError` for a link without geometry.
     """
     if not link.elements:
         raise UsageError(f"Expected link {link.name!r} to have geometry, got none")
-    parts = [element_mass_properties(e, cache=cache) for e in link.elements]
+    parts = [element_mass_properties(e, cache=cache, repair=repair) for e in link.elements]
     total = parts[0] if len(parts) == 1 else combine(parts, name=link.name)
     return MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
                           inertia=total.inertia, surface_area=total.surface_area, density=1.0, name=link.name)
@@ -167,7 +193,7 @@ class LinkInertial:
 
 
 def link_inertials(robot: RobotDescription, *, density: float | None = None, material: str | None = None,
-                   keep_mass: bool = False) -> tuple:
+                   keep_mass: bool = False, repair: bool = False) -> tuple:
     """Mass properties of every link from its geometry, in the link frame.
 
     Parameters
@@ -180,6 +206,9 @@ def link_inertials(robot: RobotDescription, *, density: float | None = None, mat
     keep_mass : bool
         Keep each link's declared mass and take the shape from the geometry (the implied density is
         reported).  Exactly one of ``density``, ``material``, ``keep_mass``.
+    repair : bool
+        Repair open or inconsistently wound meshes (the engine's ``repair``; it warns what it changed) instead
+        of reporting the link as needing repair.
 
     Returns
     -------
@@ -198,7 +227,7 @@ def link_inertials(robot: RobotDescription, *, density: float | None = None, mat
             out.append(LinkInertial(link.name, None, float("nan"), basis, f"no {robot.geometry} geometry"))
             continue
         try:
-            unit = link_mass_properties(link, cache=cache)
+            unit = link_mass_properties(link, cache=cache, repair=repair)
         except (InvalidMeshError, MeshReadError) as exc:
             out.append(LinkInertial(link.name, None, float("nan"), basis,
                                     f"mesh needs repair or cannot be read: {exc}"))
