@@ -13,3 +13,5 @@ PANDA_MESHES = ERD / "robots" / "panda_description" / "meshes" / "collision"
 #: Cassie (Agility Robotics, via DAIRLab cassie-gazebo-sim, ISC): an SDFormat 1.x model whose collision geometry
 #: is all primitives.
 CASSIE_SDF = ERD / "robots" / "cassie_description" / "robots" / "cassie_simple.sdf"
+#: MuJoCo models of the Gymnasium environments (MIT): MJCF with default classes, capsules from `fromto`, no meshes.
+GYM = DATA / "gymnasium"

@@ -193,3 +193,24 @@ def test_a_link_whose_mesh_is_open_says_so_and_the_others_still_compute(tmp_path
     assert holed.properties is None and "mesh needs repair" in holed.problem and "open.stl" in holed.problem
     assert "boundary edges" in holed.problem
     assert fine.properties.mass == pytest.approx(1.0, rel=1e-7)                # float32 STL corners
+
+
+@pytest.mark.parametrize("model", ["humanoid.xml", "walker2d.xml"])
+def test_gymnasium_mjcf_models_match_mujocos_inertia_from_geometry(model):
+    # real MJCF files (Gymnasium 1.4.0): every body's mass, centre and tensor from its geoms at 1000 kg/m³,
+    # against MuJoCo's compiler on the same file (inertiafromgeom="true"; geoms without their own density)
+    mujoco = pytest.importorskip("mujoco")
+    from robot_data import GYM
+    compiled = mujoco.MjModel.from_xml_path(str(GYM / model))
+    robot = read_robot(GYM / model)
+    assert not any(l.elements for l in read_robot(GYM / model, geometry="visual").links)   # all geoms collide
+    ours = {r.name: r.properties for r in link_inertials(robot, density=1000)}
+    assert len(ours) == compiled.nbody - 1
+    for name, props in ours.items():
+        i = compiled.body(name).id
+        rot = np.zeros(9)
+        mujoco.mju_quat2Mat(rot, compiled.body_iquat[i])
+        rot = rot.reshape(3, 3)
+        assert props.mass == pytest.approx(compiled.body_mass[i], rel=1e-13)
+        np.testing.assert_allclose(props.center_of_mass, compiled.body_ipos[i], atol=1e-14)
+        assert_tensor_close(props.inertia, rot @ np.diag(compiled.body_inertia[i]) @ rot.T, 1e-12)

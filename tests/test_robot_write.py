@@ -89,7 +89,7 @@ def _without_inertials(data: bytes) -> bytes:
 def _outside_inertials(data: bytes) -> bytes:
     """The bytes with every <inertial>…</inertial> and the provenance comment cut out."""
     data = re.sub(rb"[ \t]*<!-- inertia-tool robot:.*?-->\r?\n", b"", data, flags=re.S)
-    return re.sub(rb"<inertial\b.*?</inertial>|<inertial\b[^>]*/>", b"", data, flags=re.S)
+    return re.sub(rb"\r?\n[ \t]*(?:<inertial\b[^>]*/>|<inertial\b.*?</inertial>)", b"", data, flags=re.S)
 
 
 @pytest.mark.parametrize("name", ["ur5", "panda"])
@@ -196,4 +196,20 @@ def test_real_sdf_is_corrected_in_place(tmp_path):
         declared = again.link(result.name).declared
         assert declared.mass == result.properties.mass
         np.testing.assert_allclose(declared.center_of_mass, result.properties.center_of_mass, rtol=0, atol=1e-15)
+        assert_tensor_close(declared.inertia, result.properties.inertia, 1e-15)
+
+
+def test_real_mjcf_gets_inertials_inserted_and_reads_back(tmp_path):
+    # Gymnasium's humanoid has no <inertial> (MuJoCo infers them): each body gets one, first, indented
+    from robot_data import GYM
+    source = GYM / "humanoid.xml"
+    robot = read_robot(source)
+    inertials = link_inertials(robot, density=1000)
+    out = tmp_path / "humanoid.xml"
+    write_corrected(robot, inertials, out)
+    assert _outside_inertials(source.read_bytes()) == _outside_inertials(out.read_bytes())
+    again = read_robot(out)
+    for result in inertials:
+        declared = again.link(result.name).declared
+        assert declared.mass == result.properties.mass
         assert_tensor_close(declared.inertia, result.properties.inertia, 1e-15)
