@@ -185,3 +185,16 @@ def test_malformed_and_unknown_files(tmp_path):
                  "</link></robot>")
     with pytest.raises(RobotDescriptionError, match="expected a positive size"):
         read_robot(f)
+
+
+LAUGHS = ('<?xml version="1.0"?>\n<!DOCTYPE r [\n <!ENTITY a "aaaaaaaaaa">\n'
+          + "".join(f' <!ENTITY {c} "{("&" + p + ";") * 10}">\n' for p, c in zip("abcdefgh", "bcdefghi"))
+          + ']>\n<robot name="&i;"><link name="a"/></robot>\n')
+
+
+@pytest.mark.parametrize("suffix", [".urdf", ".urdf.xacro"])
+def test_billion_laughs_is_refused_not_expanded(tmp_path, suffix):
+    f = tmp_path / f"laughs{suffix}"
+    f.write_text(LAUGHS)                          # 10⁹ bytes if expanded
+    with pytest.raises(RobotDescriptionError, match="amplification"):
+        read_robot(f)
