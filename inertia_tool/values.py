@@ -15,8 +15,20 @@ lacks when it holds numpy arrays:
 from __future__ import annotations
 
 import dataclasses
+import sys
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
+
+if sys.version_info >= (3, 11):
+    from typing import dataclass_transform
+elif TYPE_CHECKING:                                # pragma: no cover
+    from typing_extensions import dataclass_transform
+else:                                              # Python 3.10 at run time: the marker is for type checkers only
+    def dataclass_transform(**_kwargs: Any):
+        return lambda decorator: decorator
+
+_T = TypeVar("_T")
 
 __all__ = ["frozen_value", "readonly", "COPY_LIMIT"]
 
@@ -24,7 +36,7 @@ __all__ = ["frozen_value", "readonly", "COPY_LIMIT"]
 COPY_LIMIT = 4096
 
 
-def readonly(array) -> np.ndarray:
+def readonly(array: Any) -> np.ndarray:
     """``array`` as a read-only ndarray: a copy when small (≤ :data:`COPY_LIMIT` elements), else a view."""
     a = np.asarray(array)
     a = a.copy() if a.size <= COPY_LIMIT else a.view()
@@ -70,7 +82,8 @@ def _hash(self):
                                                    for f in dataclasses.fields(self) if f.compare))
 
 
-def frozen_value(cls):
+@dataclass_transform(frozen_default=True, eq_default=False)
+def frozen_value(cls: type[_T]) -> type[_T]:
     """Class decorator: a frozen dataclass whose arrays are read-only, with equality and hash by value."""
     own_post_init = cls.__dict__.get("__post_init__")
 
