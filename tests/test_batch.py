@@ -301,3 +301,192 @@ def test_killed_run_leaves_a_valid_file_and_resume_completes(tmp_path):
     rows = _rows(out)
     assert sorted(r["path"] for r in rows) == discover_files(d)    # one row per file, none twice
     assert f"{before} skipped" in done.stderr
+
+
+# -- issue 11: one writer, quoted names, torn tails, workers that die with the batch --------------------------
+
+def _children(pid):
+    """Pids whose parent is ``pid`` (Linux /proc)."""
+    out = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as fh:
+                    stat = fh.read()
+            except OSError:
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                out.append(int(entry))
+    return out
+
+
+def _alive(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+_SLOW_BATCH = """
+import sys, time
+import inertia_tool.batch as b
+real = b.analyze_file
+def slow(path, options, sha256=None):
+    time.sleep(float(sys.argv[1]))
+    return real(path, options, sha256)
+b.analyze_file = slow
+from inertia_tool.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def _slow_batch(tmp_path, seconds, *args):
+    script = tmp_path / "slow_batch.py"
+    script.write_text(_SLOW_BATCH)
+    env = {**os.environ, "PYTHONPATH": ROOT}
+    return subprocess.Popen([sys.executable, str(script), str(seconds), "batch", *map(str, args)], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_killed_parent_takes_its_pool_workers_with_it(parts, tmp_path):
+    d, boxes, _ = parts
+    proc = _slow_batch(tmp_path, 60, d, "--out", tmp_path / "r.jsonl", "-j", "2", "-q")
+    try:
+        workers = []
+        for _ in range(300):                                   # up to 30 s for the pool to start
+            workers = _children(proc.pid)
+            if len(workers) >= 2:
+                break
+            time.sleep(0.1)
+        assert len(workers) >= 2, proc.stderr.read() if proc.poll() is not None else "no workers"
+    finally:
+        proc.kill()
+        proc.wait()
+    for _ in range(50):                                        # 5 s
+        if not any(_alive(w) for w in workers):
+            break
+        time.sleep(0.1)
+    left = [w for w in workers if _alive(w)]
+    for w in left:
+        os.kill(w, signal.SIGKILL)
+    assert not left, f"pool workers {left} outlived their killed parent"
+
+
+def test_watchdog_exits_a_worker_whose_parent_is_gone(tmp_path):
+    """The portable fallback (no prctl): the watchdog thread alone ends an orphaned worker."""
+    if not hasattr(os, "fork"):
+        pytest.skip("needs fork")
+    # a middle process forks the worker, lets the worker register it as the parent, then dies
+    middle = ("import os, sys, time\n"
+              "import inertia_tool.batch as b\n"
+              "b.sys.platform = 'other'\n"
+              "parent = os.getpid()\n"
+              "pid = os.fork()\n"
+              "if pid == 0:\n"
+              "    b._exit_with_parent(parent)\n"
+              "    time.sleep(30)\n"
+              "    os._exit(0)\n"
+              "print(pid, flush=True)\n"
+              "time.sleep(1.0)\n")                              # the worker's watchdog is running; exit now
+    env = {**os.environ, "PYTHONPATH": ROOT}
+    done = subprocess.run([sys.executable, "-c", middle], env=env, capture_output=True, text=True, timeout=30)
+    worker = int(done.stdout.split()[0])
+    for _ in range(50):
+        if not _alive(worker):
+            break
+        time.sleep(0.1)
+    alive = _alive(worker)
+    if alive:
+        os.kill(worker, signal.SIGKILL)
+    assert not alive, "the watchdog did not end the orphaned worker"
+
+
+@pytest.mark.parametrize("suffix", ["jsonl", "csv"])
+def test_second_batch_on_the_same_results_file_is_refused_and_nothing_is_lost(parts, tmp_path, suffix):
+    """Two runs on one results file: the second is refused (exit 2, one line naming the first's pid), the
+    file has no corrupt line, and a resume completes every file once."""
+    d, boxes, bad = parts
+    out = tmp_path / f"r.{suffix}"
+    first = _slow_batch(tmp_path, 0.5, d, "--out", out, "-q")
+    try:
+        for _ in range(300):
+            if out.exists() and out.stat().st_size > 0:
+                break
+            time.sleep(0.05)
+        second = subprocess.run([sys.executable, "-m", "inertia_tool.cli", "batch", str(d), "--out", str(out)],
+                                env={**os.environ, "PYTHONPATH": ROOT}, capture_output=True, text=True,
+                                timeout=120)
+        assert first.poll() is None, "the first run ended before the second started; the test proves nothing"
+        assert second.returncode == 2, second.stderr
+        lines = second.stderr.strip().splitlines()
+        assert len(lines) == 1 and f"is being written by another batch run (pid {first.pid})" in lines[0]
+    finally:
+        first.communicate(timeout=120)
+    assert first.returncode == 3                   # the corrupt file
+    rows = _rows(out)                              # parses every record: no corrupt line
+    assert sorted(r["path"] for r in rows) == discover_files(d)
+    again = main(["batch", str(d), "--out", str(out), "-q"])
+    assert again == 3 and len(_rows(out)) == len(rows)
+
+
+def test_results_file_lock_is_released_on_close(tmp_path):
+    from inertia_tool.reports.rows import ResultsFileBusy
+    out = tmp_path / "r.jsonl"
+    with open_results(out):
+        with pytest.raises(ResultsFileBusy, match=r"being written by another batch run \(pid \d+\)"):
+            open_results(out)              # a second open file description conflicts, even in one process
+    with open_results(out) as r:
+        assert r.previous_rows == []
+
+
+@pytest.mark.parametrize("suffix", ["jsonl", "csv"])
+def test_file_names_with_newlines_quotes_and_commas_round_trip(tmp_path, suffix):
+    d = tmp_path / "odd"
+    d.mkdir()
+    m = trimesh.creation.box((1, 2, 3))
+    names = ['a\nb.stl', 'c,"d".stl', 'e\r\nf.stl', "plain.stl"]
+    for n in names:
+        write_binary_stl(d / n, m.vertices, m.faces)
+    out = tmp_path / f"r.{suffix}"
+    assert main(["batch", str(d), "--out", str(out), "-q"]) == 0
+    rows = _rows(out)
+    assert sorted(r["path"] for r in rows) == discover_files(d) and all(r["status"] == "ok" for r in rows)
+    if suffix == "csv":
+        import csv
+        with open(out, newline="", encoding="utf-8") as fh:
+            table = list(csv.reader(fh))
+        assert len(table) == 1 + len(names) and {len(r) for r in table} == {len(ROW_FIELDS)}
+    assert main(["batch", str(d), "--out", str(out), "-q"]) == 0      # resume reads them back: all skipped
+    assert len(_rows(out)) == len(names)
+
+
+@pytest.mark.parametrize("suffix", ["jsonl", "csv"])
+def test_torn_last_line_is_reported_not_refused(parts, tmp_path, suffix, capsys):
+    d, boxes, _ = parts
+    out = tmp_path / f"r.{suffix}"
+    assert main(["batch", str(d / "box*.stl"), "--out", str(out), "-q"]) == 0
+    whole = out.read_bytes()
+    last = whole.splitlines(keepends=True)[-1]
+    torn = last[: len(last) // 2] + b"\n"                                  # row cut, then a newline
+    out.write_bytes(whole[: len(whole) - len(last)] + torn)
+    capsys.readouterr()
+    assert main(["batch", str(d / "box*.stl"), "--out", str(out), "-q"]) == 0
+    err = capsys.readouterr().err
+    assert f"ignored a torn last line ({len(torn)} bytes) — the previous run was interrupted" in err
+    assert "1 ok" in err and len(_rows(out)) == 4 and out.read_bytes().startswith(whole[: len(whole) - len(last)])
+
+
+def test_csv_record_torn_inside_a_quoted_line_break(tmp_path):
+    from inertia_tool.reports.rows import format_row, read_rows
+    row = dict.fromkeys(ROW_FIELDS)
+    row.update(schema=SCHEMA, path="x\ny.stl", status="ok", mass=1.5, faces=12, watertight=True)
+    header = (",".join(ROW_FIELDS) + "\n").encode()
+    record = format_row(row, "csv")
+    assert record.count(b"\n") == 2
+    rows, torn = read_rows(header + record, "csv", "r.csv")
+    assert torn == 0 and rows[0]["path"] == "x\ny.stl" and rows[0]["mass"] == 1.5
+    cut = record[: record.index(b"\n") + 1]                       # ends in the quoted line break
+    rows, torn = read_rows(header + record + cut, "csv", "r.csv")
+    assert len(rows) == 1 and torn == len(cut)

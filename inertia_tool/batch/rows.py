@@ -1,12 +1,21 @@
 """Append-only result files of ``inertia-tool batch``: JSON Lines or CSV, one row per file.
 
-Crash safety: each row is written as one complete line, then flushed and ``fsync``'d, so a killed run leaves
-at most one torn last line.  :func:`open_results` reads an existing file back (for resuming), cuts a torn
-last line off (the file then ends with a complete row again) and refuses a file that is not a previous
-result file of the same kind, so that ``--out`` never clobbers unrelated data.
+One writer at a time: :func:`open_results` takes an exclusive, non-blocking lock on the file
+(``fcntl.flock`` on POSIX, ``msvcrt.locking`` on Windows) and holds it until :meth:`ResultsFile.close`; a
+second batch run on the same file is refused with :class:`ResultsFileBusy` ("FILE is being written by
+another batch run (pid N)") instead of interleaving its rows with the first run's.  The lock is released by
+the operating system when the process dies, so a killed run never leaves a stale lock.
+
+Crash safety: the file is opened with ``O_APPEND`` and each row is written as one complete record in one
+``write`` call, then ``fsync``'d, so a killed run leaves at most one torn last record.  :func:`open_results`
+reads an existing file back (for resuming) under the lock, cuts a torn last record off (the file then ends
+with a complete row again; :attr:`ResultsFile.torn_bytes` says how much was cut) and refuses a file that is
+not a previous result file of the same kind, so that a run never clobbers unrelated data.
 
 Columns are :data:`inertia_tool.batch.runner.ROW_FIELDS`.  In CSV, empty cells are missing values (``None`` in
-JSON); booleans are ``true``/``false``; text is kept on one line by the batch engine.
+JSON); booleans are ``true``/``false``; a cell holding the delimiter, a quote or a line break (a file name
+may hold any of them) is quoted as the ``csv`` module does by default (``QUOTE_MINIMAL``), so a record can
+span several physical lines.
 """
 
 from __future__ import annotations
@@ -15,13 +24,13 @@ import csv
 import io
 import json
 import os
+import sys
 from dataclasses import dataclass
-from typing import BinaryIO
 
 from .runner import ROW_FIELDS, SCHEMA
 from ..errors import UsageError
 
-__all__ = ["ResultsFile", "open_results", "results_format", "FORMATS"]
+__all__ = ["ResultsFile", "ResultsFileBusy", "open_results", "results_format", "FORMATS"]
 
 #: Output formats by file suffix.
 FORMATS = {".jsonl": "jsonl", ".ndjson": "jsonl", ".csv": "csv"}
@@ -30,6 +39,10 @@ _INT_FIELDS = {"faces", "bodies", "cavities"}
 _BOOL_FIELDS = {"watertight", "repaired"}
 _TEXT_FIELDS = {"schema", "path", "status", "error_type", "error", "sha256", "options_key", "units",
                 "density_source", "warnings", "worker"}
+
+
+class ResultsFileBusy(UsageError):
+    """Another process holds the lock of the results file (a second batch run on the same results file)."""
 
 
 def results_format(path: str | os.PathLike) -> str:
@@ -62,70 +75,144 @@ def _csv_cell(value) -> str:
     return str(value)
 
 
-def _parse_jsonl(lines: list[bytes], path: str) -> list[dict]:
-    rows = []
-    for n, line in enumerate(lines, 1):
-        if not line.strip():
-            continue
-        try:
-            row = json.loads(line)
-        except ValueError:
-            raise UsageError(f"{path}: line {n} is not JSON; not a results file of inertia-tool batch "
-                             "(refusing to append to it; choose another results file)") from None
-        if not isinstance(row, dict) or row.get("schema") != SCHEMA:
-            raise UsageError(f"{path}: line {n} is not a row of schema {SCHEMA}; not a results file of "
-                             "inertia-tool batch (refusing to append to it; choose another results file)")
-        rows.append(row)
-    return rows
+def format_row(row: dict, fmt: str) -> bytes:
+    """One row as the bytes of one complete record, ending in ``\\n`` (JSONL: one line; CSV: quoted cells
+    may hold line breaks)."""
+    if fmt == "jsonl":
+        line = json.dumps({k: row.get(k) for k in ROW_FIELDS}, ensure_ascii=False, allow_nan=False) + "\n"
+    else:
+        buf = io.StringIO()
+        csv.writer(buf, lineterminator="\n").writerow([_csv_cell(row.get(k)) for k in ROW_FIELDS])
+        line = buf.getvalue()
+    return line.encode("utf-8")
 
 
-def _parse_csv(lines: list[bytes], path: str) -> list[dict]:
-    if not lines:
-        return []
-    text = b"".join(lines).decode("utf-8", errors="replace")
-    reader = csv.reader(io.StringIO(text))
-    header = next(reader, None)
-    if header != list(ROW_FIELDS):
-        raise UsageError(f"{path}: its header is not the inertia-tool batch header ({SCHEMA}); not a results "
-                         "file of this kind (refusing to append to it; choose another results file)")
-    rows = []
-    for n, cells in enumerate(reader, 2):
-        if not cells:
-            continue
-        if len(cells) != len(ROW_FIELDS) or cells[0] != SCHEMA:
-            raise UsageError(f"{path}: line {n} has {len(cells)} cells, expected {len(ROW_FIELDS)} "
-                             f"({SCHEMA}); refusing to append to it")
-        try:
-            rows.append({k: _csv_value(k, v) for k, v in zip(ROW_FIELDS, cells)})
-        except ValueError as exc:
-            raise UsageError(f"{path}: line {n}: {exc}; refusing to append to it") from None
-    return rows
+# -- reading back ---------------------------------------------------------------------------------------
 
+def _records(data: bytes, fmt: str) -> list[bytes]:
+    """Split ``data`` into records, each ending in ``\\n`` except possibly a torn last one.
 
-def _complete_lines(path: str, data: bytes, fmt: str) -> tuple[list[bytes], int, bool]:
-    """Split into complete lines; return them, the byte length they cover, and whether a torn tail was cut.
-
-    A last line without its newline is torn (rows are written with their newline in one call).  So is a
-    JSONL last line that does not parse even though it ends in a newline (a partly flushed block).
+    JSONL: one record per line.  CSV: a line break inside a quoted cell does not end the record; with
+    quotes escaped by doubling, a record ends at the first ``\\n`` after which the count of ``"`` so far
+    is even.
     """
-    keep = data.rfind(b"\n") + 1
-    torn = keep < len(data)
-    lines = data[:keep].splitlines(keepends=True)
-    if fmt == "jsonl" and lines:
-        last = lines[-1]
-        try:
-            json.loads(last)
-        except ValueError:
-            if len(lines) > 1 or not last.strip():
-                keep -= len(last)
-                lines = lines[:-1]
-                torn = True
-    return lines, keep, torn
+    lines = data.splitlines(keepends=True)
+    if fmt == "jsonl":
+        return lines
+    out, pending, quotes = [], b"", 0
+    for line in lines:
+        pending += line
+        quotes += line.count(b'"')
+        if quotes % 2 == 0 and line.endswith(b"\n"):
+            out.append(pending)
+            pending, quotes = b"", 0
+    if pending:
+        out.append(pending)
+    return out
 
+
+def _parse_record(record: bytes, fmt: str):
+    """A row dict, ``"header"`` for the CSV header, or a string saying why ``record`` is not a row."""
+    text = record.decode("utf-8", errors="replace")
+    if fmt == "jsonl":
+        try:
+            row = json.loads(text)
+        except ValueError:
+            return "is not JSON"
+        if not isinstance(row, dict) or row.get("schema") != SCHEMA:
+            return f"is not a row of schema {SCHEMA}"
+        return row
+    try:
+        cells = next(csv.reader(io.StringIO(text), strict=True), [])
+    except csv.Error as exc:
+        return f"is not CSV ({exc})"
+    if cells == list(ROW_FIELDS):
+        return "header"
+    if len(cells) != len(ROW_FIELDS) or cells[0] != SCHEMA:
+        return f"has {len(cells)} cells, expected {len(ROW_FIELDS)} ({SCHEMA})"
+    try:
+        return {k: _csv_value(k, v) for k, v in zip(ROW_FIELDS, cells)}
+    except ValueError as exc:
+        return f"has a bad cell ({exc})"
+
+
+def read_rows(data: bytes, fmt: str, path: str) -> tuple[list[dict], int]:
+    """The rows of a results file's bytes and the length of the torn tail (0 when there is none).
+
+    The last record is torn when it lacks its final ``\\n`` or does not parse (a run killed while writing
+    it); any other record that is not a row of :data:`SCHEMA`, or a CSV file whose first record is not the
+    header, means the file is not ours: :class:`UsageError`, the file untouched.
+    """
+    records = _records(data, fmt)
+    refuse = "not a results file of inertia-tool batch (refusing to append to it; choose another results file)"
+    torn = 0
+    if records:
+        last = records[-1]
+        if not last.endswith(b"\n") or (last.strip() and isinstance(_parse_record(last, fmt), str)):
+            torn = len(last)
+            records = records[:-1]
+            # a file of one torn record has not shown it is ours: it must be the start of what we write
+            start = (",".join(ROW_FIELDS) if fmt == "csv" else json.dumps({"schema": SCHEMA})[:-1]).encode()
+            if not records and not (start.startswith(last.strip()) or last.startswith(start)):
+                raise UsageError(f"{path}: {refuse}")
+    if fmt == "csv" and records and _parse_record(records[0], fmt) != "header":
+        raise UsageError(f"{path}: its header is not the inertia-tool batch header ({SCHEMA}); {refuse}")
+    rows = []
+    line = 1
+    for k, record in enumerate(records):
+        if record.strip() and not (fmt == "csv" and k == 0):
+            got = _parse_record(record, fmt)
+            if isinstance(got, str):
+                raise UsageError(f"{path}: line {line} {got}; {refuse}")
+            rows.append(got)
+        line += record.count(b"\n")
+    return rows, torn
+
+
+# -- the lock -------------------------------------------------------------------------------------------
+
+def _holder_pid(fd: int) -> int | None:
+    """The pid holding a lock on the file of ``fd``, from ``/proc/locks`` (Linux); None elsewhere."""
+    try:
+        st = os.fstat(fd)
+        wanted = f"{os.major(st.st_dev):02x}:{os.minor(st.st_dev):02x}:{st.st_ino}"
+        with open("/proc/locks", encoding="ascii", errors="replace") as fh:
+            for line in fh:
+                parts = line.split()
+                # "1: FLOCK  ADVISORY  WRITE 12345 08:01:123456 0 EOF" (blocked waiters carry "->")
+                if "->" not in parts and len(parts) >= 6 and parts[5] == wanted and parts[4].isdigit():
+                    return int(parts[4])
+    except (OSError, ValueError, AttributeError):
+        pass
+    return None
+
+
+def _lock(fd: int, path: str) -> None:
+    """Take the exclusive writer lock of the results file or raise :class:`ResultsFileBusy`."""
+    if sys.platform == "win32":                                          # pragma: no cover - Windows
+        import msvcrt
+        try:
+            os.lseek(fd, 0, os.SEEK_SET)
+            msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)                       # the first byte marks the writer
+        except OSError:
+            raise ResultsFileBusy(f"{path} is being written by another batch run (pid unknown); wait for it "
+                                  "or choose another results file") from None
+        return
+    import fcntl
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        pid = _holder_pid(fd)
+        raise ResultsFileBusy(f"{path} is being written by another batch run "
+                              f"(pid {pid if pid is not None else 'unknown'}); wait for it or choose another "
+                              "results file") from None
+
+
+# -- the open file --------------------------------------------------------------------------------------
 
 @dataclass
 class ResultsFile:
-    """An open, append-only results file.
+    """An open, locked, append-only results file.
 
     Attributes
     ----------
@@ -134,35 +221,34 @@ class ResultsFile:
         ``"jsonl"`` or ``"csv"``.
     previous_rows : list of dict
         Rows already in the file when it was opened (for resuming).
-    repaired_tail : bool
-        True when a torn last line (a killed run) was cut off on opening.
+    torn_bytes : int
+        Length of the torn last record (a killed run) cut off on opening; 0 when there was none.
     """
 
     path: str
     format: str
     previous_rows: list
-    repaired_tail: bool
-    _fh: BinaryIO | None = None
+    torn_bytes: int = 0
+    _fd: int | None = None
+
+    @property
+    def repaired_tail(self) -> bool:
+        """True when a torn last record was cut off on opening."""
+        return self.torn_bytes > 0
 
     def write_row(self, row: dict) -> None:
-        """Append one row as one line, flush and fsync (so a crash loses at most the row being written)."""
-        if self.format == "jsonl":
-            line = json.dumps({k: row.get(k) for k in ROW_FIELDS}, ensure_ascii=False, allow_nan=False)
-        else:
-            buf = io.StringIO()
-            csv.writer(buf, lineterminator="").writerow([_csv_cell(row.get(k)) for k in ROW_FIELDS])
-            line = buf.getvalue()
-        if self._fh is None:
+        """Append one row as one record in one ``write`` (``O_APPEND``), then fsync, so that a crash loses at
+        most the row being written."""
+        if self._fd is None:
             raise ValueError(f"{self.path}: the results file is closed")
-        self._fh.write((line + "\n").encode("utf-8"))
-        self._fh.flush()
-        os.fsync(self._fh.fileno())
+        _write_all(self._fd, format_row(row, self.format))
+        os.fsync(self._fd)
 
     def close(self) -> None:
-        """Close the file."""
-        if self._fh is not None:
-            self._fh.close()
-            self._fh = None
+        """Close the file (which releases the lock)."""
+        if self._fd is not None:
+            os.close(self._fd)
+            self._fd = None
 
     def __enter__(self) -> "ResultsFile":
         return self
@@ -171,11 +257,21 @@ class ResultsFile:
         self.close()
 
 
+def _write_all(fd: int, data: bytes) -> None:
+    """``os.write`` until every byte is written (a regular file takes it in one call; the loop is bounded by
+    the length, each call writing at least one byte or raising)."""
+    view = memoryview(data)
+    for _ in range(len(data) + 1):
+        if not view:
+            return
+        view = view[os.write(fd, view):]
+
+
 def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30) -> ResultsFile:
-    """Open ``path`` for appending rows, reading back what a previous run wrote.
+    """Open ``path`` for appending rows, locked against other writers, reading back what a previous run wrote.
 
     A new file gets the CSV header (CSV) or nothing (JSONL).  An existing file must be a results file of the
-    same format and schema, else :class:`UsageError` (it is left untouched).  A torn last line is cut off.
+    same format and schema, else :class:`UsageError` (it is left untouched).  A torn last record is cut off.
 
     Parameters
     ----------
@@ -183,40 +279,53 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30) -> Result
         ``*.jsonl`` / ``*.ndjson`` or ``*.csv``.
     max_bytes : int
         Refuse to read back a larger existing file.
+
+    Raises
+    ------
+    ResultsFileBusy
+        Another process (a second batch run) is writing the file.
+    UsageError
+        Not a results file of this kind, not a regular file, too large, or not readable/writable.
     """
     path = os.fspath(path)
     fmt = results_format(path)
-    data = b""
-    if os.path.exists(path):
-        if not os.path.isfile(path):
-            raise UsageError(f"{path}: exists and is not a regular file")
-        size = os.path.getsize(path)
+    if os.path.exists(path) and not os.path.isfile(path):
+        raise UsageError(f"{path}: exists and is not a regular file")
+    flags = os.O_RDWR | os.O_CREAT | os.O_APPEND | getattr(os, "O_BINARY", 0) | getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(path, flags, 0o666)
+    except OSError as exc:
+        raise UsageError(f"{path}: cannot write the results file ({exc.strerror or exc})") from None
+    try:
+        _lock(fd, path)
+        size = os.fstat(fd).st_size
         if size > max_bytes:
             raise UsageError(f"{path}: {size:,} bytes, more than the {max_bytes:,} a results file may have here")
-        try:
-            with open(path, "rb") as existing:
-                data = existing.read()
-        except OSError as exc:
-            raise UsageError(f"{path}: cannot read the results file ({exc.strerror or exc})") from None
-    lines, keep, torn = _complete_lines(path, data, fmt)
-    rows = _parse_jsonl(lines, path) if fmt == "jsonl" else _parse_csv(lines, path)
-    if fmt == "csv" and data and not lines:
-        # only a torn header: nothing of ours to keep, but it must look like the start of our header
-        if not ",".join(ROW_FIELDS).encode().startswith(data.strip()):
-            raise UsageError(f"{path}: not a results file of inertia-tool batch; refusing to append to it")
-    try:
-        fh: BinaryIO = open(path, "r+b" if data else "wb")
-    except OSError as exc:
-        raise UsageError(f"{path}: cannot write the results file ({exc.strerror or exc})") from None
-    try:
+        data = os.pread(fd, size, 0) if hasattr(os, "pread") else _read_from_start(fd, size)
+        rows, torn = read_rows(data, fmt, path)
         if torn:
-            fh.truncate(keep)
-        fh.seek(keep)
-        if fmt == "csv" and keep == 0:
-            fh.write((",".join(ROW_FIELDS) + "\n").encode())
-            fh.flush()
-            os.fsync(fh.fileno())
+            os.ftruncate(fd, size - torn)
+        if fmt == "csv" and size - torn == 0:
+            _write_all(fd, (",".join(ROW_FIELDS) + "\n").encode())
+        os.fsync(fd)
+    except UsageError:
+        os.close(fd)
+        raise
     except OSError as exc:
-        fh.close()
-        raise UsageError(f"{path}: cannot write the results file ({exc.strerror or exc})") from None
-    return ResultsFile(path=path, format=fmt, previous_rows=rows, repaired_tail=torn, _fh=fh)
+        os.close(fd)
+        raise UsageError(f"{path}: cannot use the results file ({exc.strerror or exc})") from None
+    return ResultsFile(path=path, format=fmt, previous_rows=rows, torn_bytes=torn, _fd=fd)
+
+
+def _read_from_start(fd: int, size: int) -> bytes:                      # pragma: no cover - Windows
+    os.lseek(fd, 0, os.SEEK_SET)
+    chunks, left = [], size
+    for _ in range(size + 1):
+        if left <= 0:
+            break
+        chunk = os.read(fd, left)
+        if not chunk:
+            break
+        chunks.append(chunk)
+        left -= len(chunk)
+    return b"".join(chunks)

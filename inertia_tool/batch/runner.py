@@ -24,6 +24,7 @@ import json
 import math
 import os
 import platform
+import sys
 import time
 import warnings
 from collections.abc import Callable, Iterable, Sequence
@@ -263,6 +264,64 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
     return row
 
 
+#: Seconds between the checks of the pool workers' watchdog that their parent (the batch run) is alive.
+_WATCHDOG_SECONDS = 0.5
+
+_PR_SET_PDEATHSIG = 1            # <linux/prctl.h>
+
+
+def _exit_with_parent(parent_pid: int) -> None:
+    """Pool-worker initializer: end this worker when the batch process that started it dies.
+
+    A killed parent (``kill -9``, out of memory) cannot shut its pool down, and orphaned workers would go on
+    analysing files nobody collects.  On Linux the kernel sends SIGKILL on the parent's death
+    (``prctl(PR_SET_PDEATHSIG)``); everywhere, a daemon thread polls ``os.getppid()`` every
+    :data:`_WATCHDOG_SECONDS` and exits when the worker has been re-parented.
+    """
+    import signal
+    import threading
+
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):
+            pass                                                # the watchdog below still works
+    # with the fork start method the parent is the batch process; with spawn or forkserver it may be a
+    # helper process: watch both the actual parent and the batch process
+    watched = os.getppid()
+
+    def orphaned() -> bool:
+        if os.getppid() != watched:
+            return True
+        if os.name != "posix":              # os.kill(pid, 0) would terminate the process on Windows
+            return False
+        try:
+            os.kill(parent_pid, 0)
+        except ProcessLookupError:
+            return True
+        except OSError:                                         # exists, but not ours to signal
+            pass
+        return False
+
+    if orphaned():                                              # the parent died before prctl took effect
+        os._exit(1)
+
+    def watch() -> None:
+        while True:                                             # ends with the process (daemon thread)
+            if orphaned():
+                os._exit(1)
+            time.sleep(_WATCHDOG_SECONDS)
+
+    threading.Thread(target=watch, name="inertia-tool-parent-watchdog", daemon=True).start()
+
+
+def _process_pool(jobs: int) -> cf.ProcessPoolExecutor:
+    """A pool of ``jobs`` worker processes that exit when this process dies (:func:`_exit_with_parent`)."""
+    return cf.ProcessPoolExecutor(max_workers=jobs, initializer=_exit_with_parent, initargs=(os.getpid(),))
+
+
 def _done_keys(previous_rows: Iterable[dict]) -> dict:
     """``{(path, sha256, options_key): row}`` of previous rows that count as done."""
     done = {}
@@ -356,7 +415,7 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
             record(analyze_file(path, options, digest))
     else:
         own = executor is None
-        pool: cf.Executor = cf.ProcessPoolExecutor(max_workers=jobs) if executor is None else executor
+        pool: cf.Executor = _process_pool(jobs) if executor is None else executor
         limit = max_in_flight or 4 * jobs
         try:
             pending: dict = {}
@@ -376,7 +435,7 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
                             raise
                         # a worker died hard (e.g. killed for memory): start a fresh pool and go on
                         pool.shutdown(wait=False, cancel_futures=True)
-                        pool = cf.ProcessPoolExecutor(max_workers=jobs)
+                        pool = _process_pool(jobs)
                         fut = pool.submit(analyze_file, nxt[0], options, nxt[1])
                     pending[fut] = nxt
                 if not pending:

@@ -137,8 +137,9 @@ def run(args) -> int:
     files = discover_files(args.source)
     executor, shutdown = (None, None)
     with open_results(args.out) as out:
-        if out.repaired_tail:
-            print(f"batch: {args.out}: cut off a torn last line left by an interrupted run", file=sys.stderr)
+        if out.torn_bytes:
+            print(f"batch: warning: {args.out}: ignored a torn last line ({out.torn_bytes} bytes) — the previous "
+                  "run was interrupted", file=sys.stderr)
         if args.dask:
             executor, shutdown = dask_executor(args.dask, args.jobs)
         progress = None if args.quiet else Progress(sys.stderr)
