@@ -11,11 +11,11 @@ import os
 
 from ..balancing.rotor import ISO_GRADES, balance
 from ..errors import UsageError
+from ..reports.output import check_targets, write_files
 from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length
 from .analyze import add_material_options, add_mesh_options, load_from_args
 from .options import require_range
-from .report_option import check_output_file
 
 __all__ = ["register", "run"]
 
@@ -99,33 +99,24 @@ def run(args) -> int:
     speed = parse_angular_rate(args.rpm, default_unit="rpm")
     if not speed > 0:
         raise UsageError(f"Expected a positive --rpm (the service speed), got {args.rpm!r}")
-    if args.report is not None:
-        _report_paths(args.report, 0)
-        check_output_file(args.report, "--report", args.force)
+    if args.report is not None:      # every file the report will write, checked before any work
+        _, svgs = _report_paths(args.report, 1 if args.single_plane else 2)
+        check_targets([(args.report, "--report")] + [(name, "--report") for name in svgs], force=args.force)
 
     props, _ = load_from_args(args)
     report = balance(props, axis_point=axis_point, axis_direction=direction, speed=speed, planes=planes,
                      radius=radius, grade=args.grade, bearings=bearings, single_plane=args.single_plane)
 
+    if args.report is not None:       # written before anything is printed, so a failure prints one line only
+        ext, svgs = _report_paths(args.report, len(report.corrections))
+        if ext in (".html", ".htm"):
+            files = {args.report: balance_html(report)}
+        else:   # the plots first, so the Markdown never links to a plot that is not there
+            files = {name: polar_svg(report, k) for k, name in enumerate(svgs)}
+            files[args.report] = balance_markdown(report, svg_links=[os.path.basename(n) for n in svgs])
+        write_files(files, force=args.force, label="--report")
     if args.json:
         print(json.dumps(balance_dict(report), indent=2, ensure_ascii=False))
     else:
         print(format_balance_text(report), end="")
-    if args.report is not None:
-        ext, svgs = _report_paths(args.report, len(report.corrections))
-        for name in svgs:
-            if os.path.exists(name) and not args.force:
-                raise UsageError(f"{name} exists; use --force to overwrite it")
-        try:
-            if ext in (".html", ".htm"):
-                text = balance_html(report)
-            else:
-                for k, name in enumerate(svgs):
-                    with open(name, "w", encoding="utf-8") as fh:
-                        fh.write(polar_svg(report, k))
-                text = balance_markdown(report, svg_links=[os.path.basename(n) for n in svgs])
-            with open(args.report, "w", encoding="utf-8") as fh:
-                fh.write(text)
-        except OSError as exc:
-            raise UsageError(f"Cannot write the report {args.report!r}: {exc.strerror or exc}") from None
     return 0

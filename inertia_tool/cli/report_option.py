@@ -10,6 +10,7 @@ import os
 
 from ..errors import UsageError
 from ..reports.html import html_report, write_html_report
+from ..reports.output import atomic_target, check_targets
 
 __all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES",
            "check_output_file"]
@@ -28,17 +29,10 @@ def add_report_options(parser) -> None:
 
 
 def check_output_file(path: str | None, option: str, force: bool) -> None:
-    """The rule of every file this command line writes: refuse (:class:`UsageError`, exit 2), before any work,
-    to replace an existing file without ``--force``, to write over a directory, or into a missing directory."""
-    if not path:
-        return
-    if os.path.isdir(path):
-        raise UsageError(f"{option} {path}: is a directory")
-    if os.path.exists(path) and not force:
-        raise UsageError(f"{option} {path}: exists; refusing to overwrite it (use --force)")
-    parent = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(parent):
-        raise UsageError(f"{option} {path}: cannot write it (no such directory: {parent})")
+    """The rule of every file this command line writes (:func:`inertia_tool.reports.output.check_targets`):
+    refuse (:class:`UsageError`, exit 2), before any work, to replace an existing file without ``--force``,
+    to write over a directory, or into a missing directory."""
+    check_targets([(path, option)], force=force)
 
 
 def check_report_path(args) -> None:
@@ -66,11 +60,11 @@ def write_report_from_args(args, props, density_source: str | None, warnings=(),
 
 
 def save_figure(fig, path: str, *, dpi: int = 120) -> None:
-    """Write a matplotlib figure to ``path`` and close it; an OS error becomes a one-line UsageError."""
+    """Write a matplotlib figure to ``path`` atomically (the format from its suffix) and close it; an OS error
+    becomes a one-line :class:`~inertia_tool.reports.output.OutputFileError`."""
     import matplotlib.pyplot as plt
     try:
-        fig.savefig(path, dpi=dpi)
-    except OSError as exc:
-        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from exc
+        with atomic_target(path) as tmp:
+            fig.savefig(tmp, dpi=dpi)
     finally:
         plt.close(fig)

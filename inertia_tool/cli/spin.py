@@ -16,8 +16,9 @@ from ..dynamics.spin_stability import AXIS_NAMES
 from ..units import parse_angular_rate, parse_duration
 from ..mass.principal import DEFAULT_EQUAL_RTOL
 from .analyze import add_material_options, add_mesh_options, load_from_args
+from ..reports.output import atomic_target, check_targets
 from .options import require_range
-from .report_option import check_output_file, save_figure
+from .report_option import save_figure
 
 __all__ = ["register", "run", "MAX_SAMPLES"]
 
@@ -58,10 +59,8 @@ def _write_csv(path: str, traj) -> None:
     data = np.column_stack([traj.t, traj.angular_velocity, traj.orientation, traj.angular_momentum, traj.energy])
     header = ("t_s,omega_x_rad_s,omega_y_rad_s,omega_z_rad_s,q_w,q_x,q_y,q_z,"
               "L_x_kg_m2_s,L_y_kg_m2_s,L_z_kg_m2_s,energy_J")
-    try:
-        np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.10g")
-    except OSError as exc:
-        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from exc
+    with atomic_target(path, label="--csv") as tmp:
+        np.savetxt(tmp, data, delimiter=",", header=header, comments="", fmt="%.10g")
 
 
 def _plot(path: str, experiment) -> None:
@@ -93,8 +92,7 @@ def run(args) -> int:
     rate = require_range(parse_angular_rate(args.rate), "--rate", low=0, low_open=True, typed=args.rate)
     duration = require_range(parse_duration(args.duration), "--duration", low=0, low_open=True,
                              typed=args.duration)
-    check_output_file(args.csv, "--csv", args.force)
-    check_output_file(args.plot, "--plot", args.force)
+    check_targets([(args.csv, "--csv"), (args.plot, "--plot")], force=args.force)
     props, described = load_from_args(args)
     experiment = spin_experiment(props, args.about, rate, perturbation=args.perturbation, duration=duration,
                                  samples=args.samples, rtol=args.rtol, method=args.method, max_samples=MAX_SAMPLES)

@@ -16,8 +16,9 @@ from ..reports.stability import format_heavy_top, heavy_top_dict
 from ..reports.serialize import to_jsonable
 from ..units import parse_angle, parse_angular_rate, parse_duration, parse_vector
 from .analyze import add_material_options, add_mesh_options, load_from_args
+from ..reports.output import atomic_target, check_targets
 from .options import require_range
-from .report_option import check_output_file, save_figure
+from .report_option import save_figure
 
 __all__ = ["register", "run", "MAX_SAMPLES", "MIN_SAMPLES_PER_PERIOD"]
 
@@ -67,10 +68,8 @@ def register(subparsers) -> None:
 def _write_csv(path: str, traj) -> None:
     data = np.column_stack([traj.t, traj.theta, traj.phi, traj.axis, traj.angular_momentum, traj.energy])
     header = "t_s,theta_rad,phi_rad,axis_x,axis_y,axis_z,L_x_kg_m2_s,L_y_kg_m2_s,L_z_kg_m2_s,energy_J"
-    try:
-        np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.10g")
-    except OSError as exc:
-        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from exc
+    with atomic_target(path, label="--csv") as tmp:
+        np.savetxt(tmp, data, delimiter=",", header=header, comments="", fmt="%.10g")
 
 
 def _plot(path: str, top, traj) -> None:
@@ -127,8 +126,7 @@ def run(args) -> int:
                                  typed=args.duration)
     if args.no_simulate and (args.csv or args.plot):
         raise UsageError("--csv and --plot need the simulation (drop --no-simulate)")
-    check_output_file(args.csv, "--csv", args.force)
-    check_output_file(args.plot, "--plot", args.force)
+    check_targets([(args.csv, "--csv"), (args.plot, "--plot")], force=args.force)
     with warnings.catch_warnings():
         # a symmetric top has two equal moments by design; heavy_top_on_pivot reports its own asymmetry
         warnings.simplefilter("ignore", NearlyEqualMomentsWarning)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
+from ..reports.output import atomic_target
 
 __all__ = ["plot_trajectory"]
 
@@ -68,5 +69,8 @@ def plot_trajectory(trajectory, path, *, dpi: int = 120):
     ax4.set_ylabel("(|L| − |L0|)/|L0|")
     fig.suptitle(f"inertia_tool trajectory ({trajectory.method})")
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
+    try:
+        with atomic_target(path) as tmp:
+            fig.savefig(tmp, dpi=dpi)
+    finally:
+        plt.close(fig)

@@ -74,6 +74,7 @@ import numpy as np
 from ..values import frozen_value
 from ..errors import UsageError
 from .properties import MassProperties
+from ..reports.output import write_bytes
 from ..units import length_scale
 
 __all__ = [
@@ -712,7 +713,8 @@ def octahedron(half_x: float, half_y: float, half_z: float, *, center=None) -> R
 # -- output -------------------------------------------------------------------------------------------
 
 def write_stl(solid: ReferenceSolid, path, *, binary: bool = True, units: str = "m") -> Path:
-    """Write ``solid``'s mesh as an STL file.
+    """Write ``solid``'s mesh as an STL file (atomically, replacing an existing file:
+    :func:`inertia_tool.reports.output.write_bytes`).
 
     Parameters
     ----------
@@ -744,10 +746,7 @@ def write_stl(solid: ReferenceSolid, path, *, binary: bool = True, units: str = 
         data["normal"] = normals
         data["vertices"] = tri
         header = f"inertia_tool {solid.name} units={units}".encode("ascii", "replace")[:80].ljust(80, b" ")
-        with open(path, "wb") as handle:
-            handle.write(header)
-            handle.write(struct.pack("<I", len(tri)))
-            handle.write(data.tobytes())
+        write_bytes(path, header + struct.pack("<I", len(tri)) + data.tobytes())
     else:
         label = "".join(ch if ch.isalnum() else "_" for ch in solid.name)
         lines = [f"solid {label}"]
@@ -758,5 +757,5 @@ def write_stl(solid: ReferenceSolid, path, *, binary: bool = True, units: str = 
             lines.append("    endloop")
             lines.append("  endfacet")
         lines.append(f"endsolid {label}")
-        path.write_text("\n".join(lines) + "\n", encoding="ascii")
+        write_bytes(path, ("\n".join(lines) + "\n").encode("ascii"))
     return path

@@ -36,6 +36,7 @@ from ..mass.ellipsoid import equivalent_ellipsoid_semi_axes
 from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, UsageError
 from ..mass.properties import MassProperties
+from .output import check_targets, write_text
 from .serialize import TENSOR_CONVENTION
 
 __all__ = ["HtmlSection", "html_report", "write_html_report", "svg_views", "VIEWS",
@@ -476,19 +477,8 @@ def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_
 
 
 def write_html_report(path: str | os.PathLike, document: str, *, force: bool = False) -> None:
-    """Write ``document`` to ``path``; refuse (:class:`UsageError`) to replace an existing file unless
-    ``force``.  Written to a temporary file beside it and renamed, so a failure never leaves half a report."""
-    path = os.fspath(path)
-    if os.path.exists(path) and not force:
-        raise UsageError(f"{path}: exists; refusing to overwrite it (`force=True` overwrites it)")
-    if os.path.isdir(path):
-        raise UsageError(f"{path}: is a directory")
-    tmp = f"{path}.tmp-{os.getpid()}"
-    try:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(document)
-        os.replace(tmp, path)
-    except OSError as exc:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise UsageError(f"{path}: cannot write the report ({exc.strerror or exc})") from None
+    """Write ``document`` to ``path`` through the one output writer (:mod:`inertia_tool.reports.output`):
+    refuse to replace an existing file unless ``force``, write atomically (a failure never leaves half a
+    report)."""
+    check_targets([os.fspath(path)], force=force)
+    write_text(path, document)

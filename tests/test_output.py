@@ -1,0 +1,132 @@
+"""The one output writer (inertia_tool.reports.output) and the commands that write files through it."""
+
+import os
+
+import numpy as np
+import pytest
+
+from inertia_tool.cli import main
+from inertia_tool.reports import output
+from inertia_tool.reports.output import OutputFileError, atomic_target, check_targets, write_files, write_text
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+WHEEL = os.path.join(ROOT, "meshes", "unbalanced_wheel.stl")
+T_HANDLE = os.path.join(ROOT, "meshes", "t_handle.stl")
+BALANCE = ["balance", WHEEL, "--units", "mm", "--material", "steel", "--rpm", "3000", "--planes", "-40,40",
+           "--radius", "180"]
+SPIN = ["spin", T_HANDLE, "--units", "mm", "--density", "7850", "--rate", "300rpm", "--duration", "1s",
+        "--samples", "501"]
+
+
+def _names(folder):
+    return sorted(os.listdir(folder))
+
+
+def test_write_text_replaces_atomically_and_leaves_no_temporary(tmp_path):
+    target = tmp_path / "a.md"
+    write_text(target, "first\n")
+    write_text(target, "second\n")
+    assert target.read_text() == "second\n" and _names(tmp_path) == ["a.md"]
+
+
+def test_a_failure_while_writing_keeps_the_old_file_and_removes_the_temporary(tmp_path):
+    target = tmp_path / "traj.csv"
+    target.write_text("old\n")
+    with pytest.raises(RuntimeError):
+        with atomic_target(target) as tmp:
+            with open(tmp, "w") as fh:
+                fh.write("half a fi")
+            raise RuntimeError("the writer died")
+    assert target.read_text() == "old\n" and _names(tmp_path) == ["traj.csv"]
+
+
+def test_an_os_error_on_rename_is_one_line_and_removes_the_temporary(tmp_path, monkeypatch):
+    target = tmp_path / "r.html"
+    target.write_text("old")
+
+    def full_disk(src, dst):
+        raise OSError(28, "No space left on device")
+    monkeypatch.setattr(output.os, "replace", full_disk)
+    with pytest.raises(OutputFileError, match=r"r\.html: cannot write it \(No space left on device\)"):
+        write_text(target, "new")
+    assert target.read_text() == "old" and _names(tmp_path) == ["r.html"]
+
+
+def test_check_targets_refuses_before_any_write(tmp_path):
+    (tmp_path / "b.svg").write_text("keep")
+    files = {str(tmp_path / "a.svg"): "<svg/>", str(tmp_path / "b.svg"): "<svg/>", str(tmp_path / "r.md"): "x"}
+    with pytest.raises(OutputFileError, match=r"b\.svg: exists; refusing to overwrite it \(`force=True` overwrites it\)"):
+        write_files(files)
+    assert _names(tmp_path) == ["b.svg"]                       # a.svg (checked first) was not written either
+    with pytest.raises(OutputFileError, match="is a directory"):
+        check_targets([str(tmp_path)])
+    with pytest.raises(OutputFileError, match="no such directory"):
+        check_targets([str(tmp_path / "missing" / "x.csv")])
+    with pytest.raises(OutputFileError, match="named twice"):
+        check_targets([str(tmp_path / "x.csv"), str(tmp_path / "x.csv")], force=True)
+    write_files(files, force=True)
+    assert (tmp_path / "b.svg").read_text() == "<svg/>"
+
+
+def test_written_files_get_the_usual_permissions(tmp_path):
+    if os.name != "posix":
+        pytest.skip("POSIX modes")
+    mask = os.umask(0o022)
+    try:
+        write_text(tmp_path / "r.md", "x")
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "r.md").stat().st_mode & 0o777 == 0o644
+
+
+def test_balance_markdown_checks_every_file_before_printing_or_writing(tmp_path, capsys):
+    """Before: the report was printed and plane 1's SVG written, then the existing plane 2 SVG refused."""
+    report = tmp_path / "wheel.md"
+    (tmp_path / "wheel-plane2.svg").write_text("keep")
+    assert main(BALANCE + ["--report", str(report)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and len(captured.err.strip().splitlines()) == 1
+    assert "wheel-plane2.svg: exists" in captured.err
+    assert _names(tmp_path) == ["wheel-plane2.svg"] and (tmp_path / "wheel-plane2.svg").read_text() == "keep"
+    assert main(BALANCE + ["--report", str(report), "--force"]) == 0
+    assert _names(tmp_path) == ["wheel-plane1.svg", "wheel-plane2.svg", "wheel.md"]
+
+
+def test_balance_write_failure_prints_nothing_and_leaves_no_partial_file(tmp_path, monkeypatch, capsys):
+    report = tmp_path / "wheel.html"
+
+    def full_disk(src, dst):
+        raise OSError(28, "No space left on device")
+    monkeypatch.setattr(output.os, "replace", full_disk)
+    assert main(BALANCE + ["--report", str(report)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "No space left on device" in captured.err
+    assert _names(tmp_path) == []
+
+
+@pytest.mark.parametrize("command", ["spin", "top"])
+def test_trajectory_csv_is_atomic(tmp_path, monkeypatch, capsys, command):
+    """Before: np.savetxt wrote straight onto the target, so a failure left half a CSV over the old one."""
+    target = tmp_path / "traj.csv"
+    target.write_text("old\n")
+    real = np.savetxt
+
+    def dies_half_way(path, data, **kw):
+        real(path, data[: len(data) // 2], **kw)
+        raise OSError(28, "No space left on device")
+    monkeypatch.setattr(np, "savetxt", dies_half_way)
+    argv = SPIN if command == "spin" else ["top", os.path.join(ROOT, "meshes", "spinning_top.stl"), "--units",
+                                           "mm", "--pivot", "0,0,0", "--spin", "50rev/s", "--tilt", "20deg"]
+    assert main(argv + ["--csv", str(target), "--force"]) == 2
+    assert "No space left on device" in capsys.readouterr().err
+    assert target.read_text() == "old\n" and _names(tmp_path) == ["traj.csv"]
+
+
+def test_spin_plot_goes_through_the_atomic_writer(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    png = tmp_path / "spin.png"
+    assert main(SPIN + ["--plot", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and _names(tmp_path) == ["spin.png"]
+    capsys.readouterr()
+    assert main(SPIN + ["--plot", str(png), "--csv", str(png), "--force"]) == 2       # one file named twice
+    assert "named twice" in capsys.readouterr().err
