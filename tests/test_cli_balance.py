@@ -181,3 +181,27 @@ def test_two_plane_verification_quotes_the_grade(capsys):
 def test_radius_checked_with_the_option_name(capsys):
     assert main(SHAFT[:-4] + ["--radius", "-5mm", "--grade", "G6.3", "--planes", "-40,40"]) == 2
     assert "--radius must be positive, got -5mm" in capsys.readouterr().err
+
+
+def test_hostile_file_name_is_escaped_in_markdown_and_html(tmp_path):
+    """Before: the name went raw into the Markdown report (a live <script>, a '|' that split the table)."""
+    import shutil
+    name = "<script>alert(1)|x_*y*.stl"
+    part = tmp_path / name
+    shutil.copy(WHEEL, part)
+    argv = [a if a != WHEEL else str(part) for a in BASE]
+    md, page = tmp_path / "r.md", tmp_path / "r.html"
+    assert main(argv + ["--report", str(md)]) == 0
+    assert main(argv + ["--report", str(page)]) == 0
+    text = md.read_text(encoding="utf-8")
+    assert "<script" not in text and "&lt;script&gt;" in text
+    assert r"\|x\_\*y\*.stl" in text
+    row = next(line for line in text.splitlines() if line.startswith("| part |"))
+    assert row.replace(r"\|", "").count("|") == 3                     # still one row of two cells
+    html_text = page.read_text(encoding="utf-8")
+    assert "<script" not in html_text and "&lt;script&gt;alert(1)|x_*y*.stl" in html_text
+
+
+def test_markdown_escaping_helper():
+    from inertia_tool.reports.escape import escape_markdown
+    assert escape_markdown("a|b\nc <d> & [e](f) `g`") == r"a\|b c &lt;d&gt; &amp; \[e\](f) \`g\`"

@@ -8,11 +8,11 @@ g·mm², forces in N, torques in N·m, angles in degrees from the shaft x axis t
 
 from __future__ import annotations
 
-import html
 import math
 
 
 from ..balancing.rotor import ISO_GRADES, BalanceReport, PlaneUnbalance
+from .escape import escape_html, escape_markdown
 from .serialize import to_jsonable
 
 __all__ = ["balance_dict", "format_balance_text", "balance_markdown", "balance_html", "polar_svg"]
@@ -319,34 +319,43 @@ def polar_svg(report: BalanceReport, index: int, *, size: int = 260) -> str:
 
 # ---- Markdown ------------------------------------------------------------------------------------------
 def _md_table(head, rows) -> list[str]:
-    return ["| " + " | ".join(head) + " |", "|" + "|".join("---" for _ in head) + "|"] + \
-        ["| " + " | ".join(r) + " |" for r in rows]
+    m = escape_markdown
+    return ["| " + " | ".join(map(m, head)) + " |", "|" + "|".join("---" for _ in head) + "|"] + \
+        ["| " + " | ".join(map(m, r)) + " |" for r in rows]
 
 
 def balance_markdown(report: BalanceReport, *, svg_links=()) -> str:
-    """The report as Markdown; ``svg_links`` are file names of polar plots written next to it."""
-    out = [f"# Balancing report: {report.name or 'part'}", ""]
+    """The report as Markdown; ``svg_links`` are file names of polar plots written next to it.  Every text
+    cell, the part name and the notes are escaped (:func:`inertia_tool.reports.escape.escape_markdown`)."""
+    m = escape_markdown
+    out = [f"# Balancing report: {m(report.name or 'part')}", ""]
     out += _md_table(["", ""], [[k, v] for k, v in _header(report)])
     out += ["", "## Unbalance as it is", ""] + _md_table(["quantity", "value"], [list(r) for r in _summary_rows(report)])
     out += ["", f"## Loads at {report.rpm:.6g} rpm", "", "They rotate with the part; gravity is not included.", ""]
     out += _md_table(["quantity", "value"], [list(r) for r in _load_rows(report)])
-    out += ["", "## ISO 21940-11 tolerance", ""] + [f"- {x}" for x in _grade_lines(report)] + [""]
+    out += ["", "## ISO 21940-11 tolerance", ""] + [f"- {m(x)}" for x in _grade_lines(report)] + [""]
     out += _md_table(_TOL_HEAD, _tolerance_rows(report))
     out += ["", "## " + ("Single-plane (static) correction" if report.single_plane else "Two-plane correction"), ""]
     out += _md_table(_CORR_HEAD, _correction_rows(report))
-    out += [""] + [f"![polar plot, plane {k + 1}]({name})" for k, name in enumerate(svg_links)]
-    out += ["", "## Verification", "", "Part plus correction masses, re-analysed: " + _verification_text(report)]
+    out += [""] + [f"![polar plot, plane {k + 1}](<{_link(name)}>)" for k, name in enumerate(svg_links)]
+    out += ["", "## Verification", "", "Part plus correction masses, re-analysed: " + m(_verification_text(report))]
     out += ["", "## Balance quality grades (ISO 21940-11)", ""]
     out += _md_table(["grade", "e·Ω [mm/s]", "typical rotors"], [[g.name, f"{g.value:g}", g.typical_parts]
                                                                    for g in ISO_GRADES])
     if report.notes:
-        out += ["", "## Notes", ""] + [f"- {n}" for n in report.notes]
+        out += ["", "## Notes", ""] + [f"- {m(n)}" for n in report.notes]
     return "\n".join(out) + "\n"
+
+
+def _link(name: str) -> str:
+    """A file name as a CommonMark link destination in ``<...>``: percent-encode what would end it."""
+    from urllib.parse import quote
+    return quote(name, safe="/-_.~!$'*+,;=:@")
 
 
 # ---- HTML ----------------------------------------------------------------------------------------------
 def _html_table(head, rows, highlight: str | None = None) -> str:
-    e = html.escape
+    e = escape_html
     th = "".join(f"<th>{e(h)}</th>" for h in head)
     body = []
     for r in rows:
@@ -357,7 +366,7 @@ def _html_table(head, rows, highlight: str | None = None) -> str:
 
 def balance_html(report: BalanceReport) -> str:
     """A self-contained HTML page (no scripts, no external files) with tables and polar plots."""
-    e = html.escape
+    e = escape_html
     title = f"Balancing report: {report.name or 'part'}"
     plots = "".join(f'<figure>{polar_svg(report, k)}</figure>' for k in range(len(report.corrections)))
     grades = _html_table(["grade", "e·Ω [mm/s]", "typical rotors"],

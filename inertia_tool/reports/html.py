@@ -23,7 +23,6 @@ Sections: the tables of the text report are always there, then the stability ver
 from __future__ import annotations
 
 import datetime as _dt
-import html
 import math
 import os
 from collections.abc import Sequence
@@ -36,6 +35,7 @@ from ..mass.ellipsoid import equivalent_ellipsoid_semi_axes
 from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, UsageError
 from ..mass.properties import MassProperties
+from .escape import escape_html
 from .output import check_targets, write_text
 from .serialize import TENSOR_CONVENTION
 
@@ -87,7 +87,8 @@ class HtmlSection:
     title : str
         Plain text (escaped when written).
     body : str
-        HTML fragment.  Builders must escape any text they put in it (``html.escape``).
+        HTML fragment.  Builders must escape any text they put in it
+        (:func:`inertia_tool.reports.escape.escape_html`).
     anchor : str
         ``id`` of the section (letters, digits and ``-``).
     """
@@ -97,8 +98,7 @@ class HtmlSection:
     anchor: str
 
 
-def _e(x) -> str:
-    return html.escape(str(x), quote=True)
+_e = escape_html
 
 
 def _num(x: float, digits: int = 6) -> str:
