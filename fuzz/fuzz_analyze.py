@@ -12,6 +12,8 @@ Run (seeds from the hostile corpus, ~100 000 inputs)::
         -artifact_prefix=fuzz/crashes/ fuzz/work
 
 Every input that ever crashed is kept in ``tests/regressions/`` and replayed by ``tests/test_hostile.py``.
+``run_one`` (the checks of one input) is also used without atheris by ``fuzz/sanitize_replay.py``, the
+bounded replay that ``scripts/sanitize.sh`` runs under AddressSanitizer and UndefinedBehaviorSanitizer.
 """
 
 from __future__ import annotations
@@ -28,9 +30,12 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 
-import atheris  # noqa: E402
+if __name__ == "__main__":
+    import atheris  # noqa: E402
 
-with atheris.instrument_imports(include=["inertia_tool"]):
+    with atheris.instrument_imports(include=["inertia_tool"]):
+        from inertia_tool.cli import main  # noqa: E402
+else:   # imported for its checks (run_one) by fuzz/sanitize_replay.py, without atheris
     from inertia_tool.cli import main  # noqa: E402
 
 SUFFIXES = (".stl", ".obj", ".ply", ".off")

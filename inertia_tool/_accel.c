@@ -481,7 +481,7 @@ Welder_vertices_into(WelderObject *w, PyObject *out_obj)
     }
     double *v = (double *)out.buf;
     Py_BEGIN_ALLOW_THREADS
-    if (w->wide) {
+    if (w->wide && w->count > 0) {      /* no memcpy of 0 bytes: keys (and out) may be NULL then */
         memcpy(v, w->keys, w->count * 24);
     }
     else {

@@ -169,3 +169,30 @@ def test_3mf_through_trimesh(tmp_path):
     raw = load_mesh(p, units="mm")
     assert len(raw.faces) == 12
     np.testing.assert_allclose(np.ptp(raw.vertices, axis=0), [0.01, 0.02, 0.03], rtol=1e-12)
+
+
+@pytest.mark.skipif(not hasattr(os, "symlink"), reason="needs symbolic links")
+def test_symlink_loop_broken_link_and_not_a_directory_say_why(tmp_path):
+    """Before: a symbolic link loop was reported as "no such file"."""
+    loop = tmp_path / "loop.stl"
+    os.symlink(loop, loop)
+    with pytest.raises(MeshReadError, match=r"loop\.stl: symbolic link loop"):
+        load_mesh(loop)
+    broken = tmp_path / "broken.stl"
+    os.symlink(tmp_path / "missing.stl", broken)
+    with pytest.raises(MeshReadError, match=r"broken\.stl: broken symbolic link"):
+        load_mesh(broken)
+    with pytest.raises(MeshReadError, match=r"missing\.stl: no such file"):
+        load_mesh(tmp_path / "missing.stl")
+    (tmp_path / "plain").write_text("x")
+    with pytest.raises(MeshReadError, match="a component of the path is not a directory"):
+        load_mesh(tmp_path / "plain" / "a.stl")
+
+
+@pytest.mark.skipif(not hasattr(os, "symlink"), reason="needs symbolic links")
+def test_batch_reports_a_symlink_loop_as_a_file_error_not_an_internal_one(tmp_path):
+    from inertia_tool.batch import BatchOptions, analyze_file
+    loop = tmp_path / "loop.stl"
+    os.symlink(loop, loop)
+    row = analyze_file(str(loop), BatchOptions())
+    assert row["status"] == "error" and "symbolic link loop" in row["error"]

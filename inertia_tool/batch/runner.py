@@ -35,9 +35,9 @@ import numpy as np
 
 from ..values import frozen_value
 from ..mesh.checks import MeshReport
-from ..errors import InertiaToolError, InertiaToolWarning, UsageError
+from ..errors import InertiaToolError, InertiaToolWarning, MeshReadError, UsageError
 from ..mesh.options import LoadOptions
-from ..mesh.read import SUPPORTED_SUFFIXES
+from ..mesh.read import SUPPORTED_SUFFIXES, os_error_reason
 from ..mass.pipeline import mass_properties, resolve_density
 
 __all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "analyze_file", "discover_files",
@@ -231,7 +231,10 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
     row = _empty_row(path, sha256, options)
     try:
         if row["sha256"] is None:
-            row["sha256"] = file_sha256(path)
+            try:
+                row["sha256"] = file_sha256(path)
+            except OSError as exc:       # unreadable: a property of the file, reported like the reader does
+                raise MeshReadError(f"{path}: cannot be read ({os_error_reason(exc, path)})") from None
         _, described = resolve_density(density=options.density, material=options.material, mass=options.mass)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", InertiaToolWarning)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 import warnings
 
 
@@ -26,7 +27,7 @@ from ..units import LENGTH_UNITS, length_scale
 from .options import DEFAULT_MAX_FACES
 from .weld import weld_exact, weld_exact_stream
 
-__all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "SUPPORTED_SUFFIXES"]
+__all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "SUPPORTED_SUFFIXES", "os_error_reason"]
 
 
 #: File suffixes handled (STL natively, the rest through trimesh; COLLADA needs pycollada; STEP/IGES are
@@ -78,6 +79,30 @@ def _display(path) -> str:
 
 def _fail(path, problem: str) -> MeshReadError:
     return MeshReadError(f"{_display(path)}: {problem}")
+
+
+def os_error_reason(exc: OSError, path=None) -> str:
+    """The operating system's reason for ``exc`` in words, for a one-line message about ``path``.
+
+    ``ENOENT`` of a path that is itself a symbolic link says the link is broken; ``ELOOP`` says "symbolic
+    link loop" (not "no such file", which ``os.path.exists`` would suggest); anything else gives its
+    ``strerror``.
+    """
+    import errno
+    code = exc.errno
+    if code == errno.ENOENT:
+        if path is not None and os.path.islink(path):
+            return "broken symbolic link (its target does not exist)"
+        return "no such file"
+    if code == errno.ELOOP:
+        return "symbolic link loop (too many levels of symbolic links)"
+    if code in (errno.EACCES, errno.EPERM):
+        return "permission denied"
+    if code == errno.ENOTDIR:
+        return "a component of the path is not a directory"
+    if code == errno.ENAMETOOLONG:
+        return "file name too long"
+    return exc.strerror or str(exc) or type(exc).__name__
 
 
 def _check_face_budget(path: str, n: int, max_faces: int) -> None:
@@ -686,11 +711,13 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
     if isinstance(source, (str, bytes, os.PathLike)):
         path = os.fsdecode(os.fspath(source))
         try:
-            if not os.path.exists(path):
-                raise _fail(path, "no such file")
-            if os.path.isdir(path):
+            try:
+                mode = os.stat(path).st_mode
+            except OSError as exc:
+                raise _fail(path, os_error_reason(exc, path)) from None
+            if stat.S_ISDIR(mode):
                 raise _fail(path, "is a directory, not a mesh file")
-            if not os.path.isfile(path):
+            if not stat.S_ISREG(mode):
                 raise _fail(path, "is not a regular file (device, pipe or socket)")
             suffix = os.path.splitext(path)[1].lower()
             if suffix in COMPRESSED_SUFFIXES:
@@ -736,7 +763,7 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
         except OSError as exc:
             if isinstance(exc, MeshReadError):
                 raise
-            raise _fail(path, f"cannot be read ({exc.strerror or exc})") from None
+            raise _fail(path, f"cannot be read ({os_error_reason(exc, path)})") from None
         name = _display(path)
         if declared is not None:
             scale, units = _declared_units_win(name, declared, units, scale)
