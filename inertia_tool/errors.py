@@ -101,6 +101,24 @@ class PhysicsError(InertiaToolError, ValueError):
 
 
 
+class NonFiniteResultError(PhysicsError, OverflowError):
+    """A result does not fit a float64: it overflows to infinity, becomes NaN, or underflows to zero, because
+    an input (a density, a speed, a length) lies outside any physically meaningful range.
+
+    Raised by the engine instead of returning the number or failing with a bare ``OverflowError``.
+    """
+
+    @classmethod
+    def check(cls, what: str, value, *, because: str = "") -> None:
+        """Raise unless every entry of ``value`` is finite; the message names ``what`` and ``because``."""
+        import numpy as np
+        a = np.asarray(value, dtype=np.float64)
+        if not np.all(np.isfinite(a)):
+            bad = a[~np.isfinite(a)].ravel()[0]
+            raise cls(f"{what} is {bad} (not representable as a float64)"
+                      + (f": {because}" if because else ": an input is outside any physically meaningful range"))
+
+
 class InertiaToolWarning(UserWarning):
     """Base class of the soft problems inertia_tool reports (it computed a result, but assumed something)."""
 

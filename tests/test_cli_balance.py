@@ -180,7 +180,7 @@ def test_two_plane_verification_quotes_the_grade(capsys):
 
 def test_radius_checked_with_the_option_name(capsys):
     assert main(SHAFT[:-4] + ["--radius", "-5mm", "--grade", "G6.3", "--planes", "-40,40"]) == 2
-    assert "--radius must be positive, got -5mm" in capsys.readouterr().err
+    assert "--radius must be between 1e-09 and 1e+06 m, got -5mm" in capsys.readouterr().err
 
 
 def test_hostile_file_name_is_escaped_in_markdown_and_html(tmp_path):

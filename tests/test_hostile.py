@@ -19,7 +19,7 @@ import pytest
 from corpus.make_corpus import ENTRIES, box, exact_reference, make_corpus, prism, write_ascii_stl, write_binary_stl, write_obj
 from inertia_tool import mass_properties
 from inertia_tool.cli import main
-from inertia_tool.errors import InvalidMeshError, MeshReadError
+from inertia_tool.errors import InvalidMeshError, MeshReadError, NonFiniteResultError, UsageError
 from inertia_tool.mesh.read import load_mesh
 
 REGRESSIONS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "regressions")
@@ -256,8 +256,9 @@ def test_overflowing_and_underflowing_sizes_are_refused():
 
 
 def test_result_with_huge_density_overflowing_is_refused():
+    """The mass overflows because of the density: a named physics error (exit 4), not a mesh error."""
     v, f = box()
-    with pytest.raises(InvalidMeshError, match="non-finite"):
+    with pytest.raises(NonFiniteResultError, match="the mass is inf"):
         mass_properties((v * 1e29, f), density=1e300)
 
 
@@ -359,3 +360,75 @@ def _seed_facts():
 
 
 _SEED_TRIANGLES, _SEED_MASS = _seed_facts()
+
+
+# -- issue 11: edge numbers -----------------------------------------------------------------------------
+
+WHEEL = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "meshes", "unbalanced_wheel.stl")
+BALANCE = ["balance", WHEEL, "--units", "mm", "--planes=-40,40", "--radius", "180"]
+
+
+@pytest.mark.parametrize("argv, option", [
+    (BALANCE + ["--rpm", "1e300"], "--rpm must be between"),                  # was an internal OverflowError
+    (BALANCE + ["--rpm", "3000", "--density", "5e-324"], "--density must be between 0.1 and 100000 kg/m³"),
+    (BALANCE + ["--rpm", "3000", "--density", "1e300"], "--density must be"),
+    (BALANCE + ["--rpm", "3000", "--mass", "1e300"], "--mass must be between 1e-12 and 1e+09 kg"),
+    (BALANCE + ["--rpm", "3000", "--radius", "1e-300"], "--radius must be between 1e-09 and 1e+06 m"),
+    (BALANCE + ["--rpm", "3000", "--axis-point", "1e300,0,0"], "--axis-point must be at most 1e+06 m"),
+    (BALANCE + ["--rpm", "3000", "--bearings", "0,1e307"], "--bearings must be at most"),
+    (["analyze", WHEEL + ":5e-324"], "the density of " + WHEEL + " must be between"),
+    (["analyze", WHEEL, "--model", "shell", "--thickness", "1e-300"], "--thickness must be between"),
+    (["analyze", WHEEL, "--max-faces", "1000000000"], "--max-faces must be between 1 and 715,827,882"),
+    (["spin", WHEEL, "--rate", "1e300"], "--rate must be between"),
+    (["spin", WHEEL, "--duration", "1e300"], "--duration must be between"),
+    (["top", WHEEL, "--pivot", "0,0,0", "--spin", "1e300"], "--spin must be at most"),
+    (["top", WHEEL, "--pivot", "0,0,1e300", "--spin", "5rev/s"], "--pivot must be at most"),
+    (["top", WHEEL, "--pivot", "0,0,0", "--spin", "5rev/s", "--gravity", "1e300"], "--gravity must be between"),
+    (["batch", WHEEL, "--out", "never.jsonl", "--density", "5e-324"], "--density must be between"),
+    (["batch", WHEEL, "--out", "never.jsonl", "--jobs", "100000"], "--jobs must be between 1 and 1,024"),
+])
+def test_numeric_options_outside_their_physical_range_exit_2_in_one_line(argv, option, capsys):
+    from inertia_tool.cli import main
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and option in err[0] and "internal error" not in err[0]
+    assert not os.path.exists("never.jsonl")
+
+
+def test_option_table_bounds_are_finite_and_ordered():
+    from inertia_tool.cli.options import OPTION_RANGES
+    for name, rng in OPTION_RANGES.items():
+        assert 0 <= rng.low < rng.high < 1e300 and rng.reason, name
+
+
+def test_engine_refuses_overflowing_results_with_a_named_error():
+    """Through the Python API, where no option table stands in front: a named error, never inf or a bare
+    OverflowError."""
+    import importlib
+    balance_mod = importlib.import_module("inertia_tool.balance")
+    props = mass_properties(WHEEL, units="mm", material="steel")
+    with pytest.raises(NonFiniteResultError, match="Ω²"):
+        balance_mod.balance(props, axis_point=[0, 0, 0], axis_direction=[0, 0, 1], rpm=1e300, planes=[-0.04, 0.04],
+                            radius=0.18)
+    with pytest.raises(NonFiniteResultError, match="mass underflows"):
+        mass_properties(WHEEL, units="mm", density=5e-324)
+    assert issubclass(NonFiniteResultError, OverflowError) and NonFiniteResultError.exit_code == 4
+
+
+def test_stl_announcing_more_triangles_than_32_bit_indices_hold_is_refused_from_its_header(tmp_path, monkeypatch):
+    """A binary STL claiming 715,827,883 triangles with max_faces raised: refused from the header (a sparse
+    file of the right size; nothing read or allocated), not an internal error in the welder."""
+    from inertia_tool import io as io_mod
+    from inertia_tool.io import MAX_SUPPORTED_FACES, read_stl
+    n = MAX_SUPPORTED_FACES + 1
+    path = tmp_path / "huge.stl"
+    with open(path, "wb") as fh:
+        fh.write(b"\0" * 80 + n.to_bytes(4, "little"))
+        fh.truncate(84 + 50 * n)                                   # sparse: ~36 GB that take no space
+    def no_weld(*a, **k):
+        raise AssertionError("welding started")
+    monkeypatch.setattr(io_mod, "weld_exact_stream", no_weld)
+    with pytest.raises(MeshReadError, match=r"715,827,883 triangles, more than the 715,827,882 this reader"):
+        read_stl(path, max_faces=10**12)
+    with pytest.raises(UsageError, match="max_faces"):
+        io_mod.load_mesh(path, max_faces=10**12)

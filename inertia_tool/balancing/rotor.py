@@ -31,7 +31,7 @@ import math
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import UsageError
+from ..errors import NonFiniteResultError, UsageError
 from ..mass.properties import MassProperties, combine, point_mass
 from ..rotations import perpendicular_basis
 
@@ -643,6 +643,8 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
         raise UsageError("Expected exactly one of `rpm` (rev/min) and `speed` (rad/s)")
     omega = _check_positive(speed, "speed", "rad/s") if speed is not None else \
         _check_positive(rpm, "rpm", "rev/min") * 2 * math.pi / 60.0
+    NonFiniteResultError.check(f"the squared speed Ω² at Ω = {omega:g} rad/s", omega * omega,
+                               because="the rotating loads (∝ Ω²) overflow; the speed is outside any physical range")
     r = float(radius)
     if not (math.isfinite(r) and r > 0):
         raise UsageError(f"Expected a positive correction `radius` in m, got {radius!r}")
@@ -704,10 +706,15 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
 
     achieved_value, achieved = _achieved(tolerance, props.mass, omega)
     corrected_value, corrected_grade = _achieved(corrected_tolerance, corrected_body.mass, omega)
-    return BalanceReport(name=props.name, frame=frame, speed=omega, initial=state,
-                         torque=_readonly(state.bearing_torque(omega)),
-                         force=_readonly(-omega ** 2 * state.static_unbalance), quality_grade=quality,
-                         permissible_unbalance=u_per, tolerance_planes=tolerance, achieved_value=achieved_value,
-                         achieved_grade=achieved, correction_planes=correction_planes,
-                         corrections=tuple(corrections), single_plane=single_plane, corrected=corrected,
-                         corrected_value=corrected_value, corrected_grade=corrected_grade, notes=tuple(notes))
+    report = BalanceReport(name=props.name, frame=frame, speed=omega, initial=state,
+                           torque=_readonly(state.bearing_torque(omega)),
+                           force=_readonly(-omega ** 2 * state.static_unbalance), quality_grade=quality,
+                           permissible_unbalance=u_per, tolerance_planes=tolerance, achieved_value=achieved_value,
+                           achieved_grade=achieved, correction_planes=correction_planes,
+                           corrections=tuple(corrections), single_plane=single_plane, corrected=corrected,
+                           corrected_value=corrected_value, corrected_grade=corrected_grade, notes=tuple(notes))
+    for what, value in (("rotating force", report.force), ("torque of the supports", report.torque),
+                        ("correction masses", [c.mass for c in corrections]),
+                        ("plane loads", [p.force for p in tolerance] or 0.0)):
+        NonFiniteResultError.check(f"{props.name or 'part'}: the {what}", value)
+    return report

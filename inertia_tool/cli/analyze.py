@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import json
-import math
 import os
 import sys
 import warnings
@@ -19,7 +18,7 @@ from ..reports.serialize import mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
 from ..dynamics.spin_stability import stability
-from ..units import MATERIALS, parse_density, parse_mass
+from ..units import MATERIALS, parse_density
 # issue 6: exports and thin-walled models
 from ..robot.inertial import FRAMES, inertial_frame
 from ..mesh.cad import BREP_SUFFIXES, has_ocp
@@ -30,6 +29,7 @@ from ..reports.models import format_model_note, model_summary
 from ..robot.formats import ROBOT_FORMATS, format_inertial
 from ..mass.thinwall import printed_part, shell_mass_properties
 from ..units import parse_fraction, parse_length
+from .options import check_option, density_and_mass
 from .report_option import add_report_options, check_report_path, write_report_from_args
 
 __all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args", "read_meshes",
@@ -77,22 +77,19 @@ def add_mesh_options(parser) -> None:
                    help=f"refuse meshes with more triangles (default {DEFAULT_MAX_FACES:,})")
 
 
-def _part_density(what: str) -> dict:
+def _part_density(what: str, path: str = "") -> dict:
     try:
-        return {"density": parse_density(what)}
+        density = parse_density(what)
     except UsageError:
         return {"material": what}
+    return {"density": check_option("--density", density, typed=what,
+                                    label=f"the density of {path}" if path else None)}
 
 
 def check_mesh_options(args) -> None:
-    """Refuse a negative or non-finite ``--merge-tolerance`` and a non-positive ``--max-faces`` (exit 2)."""
-    tol = getattr(args, "merge_tolerance", 0.0)
-    if not (math.isfinite(tol) and tol >= 0):
-        raise UsageError(f"--merge-tolerance must be a finite number >= 0 (0 turns tolerant welding off), "
-                         f"got {tol:g}")
-    faces = getattr(args, "max_faces", 1)
-    if faces < 1:
-        raise UsageError(f"--max-faces must be at least 1, got {faces}")
+    """Refuse a ``--merge-tolerance`` or ``--max-faces`` outside :data:`.options.OPTION_RANGES` (exit 2)."""
+    check_option("--merge-tolerance", getattr(args, "merge_tolerance", 0.0))
+    check_option("--max-faces", getattr(args, "max_faces", 1))
 
 
 def load_options_from_args(args) -> LoadOptions:
@@ -121,8 +118,7 @@ def load_from_args(args, meshes=None):
     be ignored and is refused as contradictory (:class:`UsageError`).
     """
     options = load_options_from_args(args)
-    density = parse_density(args.density) if args.density is not None else None
-    mass = parse_mass(args.mass) if args.mass is not None else None
+    density, mass = density_and_mass(args)
     files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
     specs = [split_part_spec(f) for f in files]
     if meshes is not None:
@@ -141,7 +137,7 @@ def load_from_args(args, meshes=None):
     parts, own = [], []
     for path, what in specs:
         if what is not None:
-            parts.append({"source": path, **_part_density(what)})
+            parts.append({"source": path, **_part_density(what, path)})
             own.append(what)
         elif density is not None:
             parts.append({"source": path, "density": density})
@@ -313,16 +309,16 @@ def load_model_from_args(args, meshes=None):
     files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
     if len(files) != 1:
         raise UsageError("the shell and printed-part models take one mesh file, not an assembly")
-    density = parse_density(args.density) if args.density is not None else None
-    mass = parse_mass(args.mass) if args.mass is not None else None
+    density, mass = density_and_mass(args)
     _, described = resolve_density(density=density, material=args.material, mass=mass)
     common = dict(density=density, material=args.material, mass=mass)
     if model == "shell":
-        t = parse_length(thickness, default_unit=args.units)
-        props = shell_mass_properties(meshes[0] if meshes else files[0], thickness=t, units=options.units, max_faces=options.max_faces,
-                                      **common)
+        t = check_option("--thickness", parse_length(thickness, default_unit=args.units), typed=thickness)
+        props = shell_mass_properties(meshes[0] if meshes else files[0], thickness=t, units=options.units,
+                                      max_faces=options.max_faces, **common)
         return props, described, model_summary("shell", thickness=t)
-    printed = printed_part(meshes[0] if meshes else files[0], skin=parse_length(skin, default_unit=args.units), infill=parse_fraction(infill),
+    skin_m = check_option("--shell", parse_length(skin, default_unit=args.units), typed=skin)
+    printed = printed_part(meshes[0] if meshes else files[0], skin=skin_m, infill=parse_fraction(infill),
                            options=options, **common)
     return printed.properties, described, model_summary("printed", printed=printed)
 

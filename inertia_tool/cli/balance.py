@@ -15,7 +15,7 @@ from ..reports.output import check_targets, write_files
 from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length
 from .analyze import add_material_options, add_mesh_options, load_from_args
-from .options import require_range
+from .options import check_option
 
 __all__ = ["register", "run"]
 
@@ -24,7 +24,7 @@ def _lengths(text: str, unit: str, name: str, count) -> list[float]:
     if len(items) not in count:
         want = " or ".join(str(c) for c in count)
         raise UsageError(f"Expected --{name} to be {want} comma-separated length(s), got {text!r}")
-    return [parse_length(t.strip(), default_unit=unit) for t in items]
+    return check_option(f"--{name}", [parse_length(t.strip(), default_unit=unit) for t in items], typed=text)
 
 
 def register(subparsers) -> None:
@@ -94,11 +94,8 @@ def run(args) -> int:
     if planes is None and not args.single_plane:
         raise UsageError("Expected --planes Z1,Z2 (or --single-plane)")
     bearings = None if args.bearings is None else _lengths(args.bearings, unit, "bearings", (2,))
-    radius = require_range(parse_length(args.radius, default_unit=unit), "--radius", low=0, low_open=True,
-                           typed=args.radius)
-    speed = parse_angular_rate(args.rpm, default_unit="rpm")
-    if not speed > 0:
-        raise UsageError(f"Expected a positive --rpm (the service speed), got {args.rpm!r}")
+    radius = check_option("--radius", parse_length(args.radius, default_unit=unit), typed=args.radius)
+    speed = check_option("--rpm", parse_angular_rate(args.rpm, default_unit="rpm"), typed=args.rpm)
     if args.report is not None:      # every file the report will write, checked before any work
         _, svgs = _report_paths(args.report, 1 if args.single_plane else 2)
         check_targets([(args.report, "--report")] + [(name, "--report") for name in svgs], force=args.force)

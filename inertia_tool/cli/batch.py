@@ -15,7 +15,7 @@ import time
 from ..batch.runner import BatchOptions, discover_files, run_batch
 from ..errors import UsageError
 from ..batch.rows import open_results, results_format
-from ..units import parse_density, parse_mass
+from .options import check_option, density_and_mass
 from .analyze import add_material_options, add_mesh_options, load_options_from_args
 
 __all__ = ["register", "run", "Progress", "dask_executor"]
@@ -127,10 +127,9 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     results_format(args.out)                      # a bad suffix is a usage error before any work
-    options = BatchOptions(load=load_options_from_args(args),
-                           density=parse_density(args.density) if args.density is not None else None,
-                           material=args.material,
-                           mass=parse_mass(args.mass) if args.mass is not None else None)
+    density, mass = density_and_mass(args)
+    check_option("--jobs", args.jobs)
+    options = BatchOptions(load=load_options_from_args(args), density=density, material=args.material, mass=mass)
     options.validate()
     if args.jobs < 1:
         raise UsageError(f"Expected --jobs >= 1, got {args.jobs}")

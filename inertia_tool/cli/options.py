@@ -1,16 +1,126 @@
 """Range checks of numeric command-line options, with the option's name and the value as typed.
 
-Routing only: the engine checks its own parameters too, but in its own terms (SI, parameter names); these
-messages speak the user's language (``--perturbation must be between 0 and 1 (exclusive), got 2``).
+Routing only: the engine checks its own parameters too, but in its own terms (SI, parameter names) and
+refuses results that overflow (:class:`~inertia_tool.errors.NonFiniteResultError`); these messages speak the
+user's language (``--perturbation must be between 0 and 1 (exclusive), got 2``).
+
+:data:`OPTION_RANGES` is the one table of physically meaningful ranges of the numeric options (SI, after
+unit parsing), each with its reason; the README's "Bad input" section prints it.  A value outside is
+refused before any work (exit 2, one line naming the option and the accepted range).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from ..errors import UsageError
+from ..io import MAX_SUPPORTED_FACES
 
-__all__ = ["require_range"]
+__all__ = ["require_range", "OptionRange", "OPTION_RANGES", "check_option", "density_and_mass"]
+
+_RPM = 2 * math.pi / 60          # rad/s per rev/min
+
+
+@dataclass(frozen=True)
+class OptionRange:
+    """The accepted values of one numeric option.
+
+    Attributes
+    ----------
+    low, high : float
+        Bounds in SI (``unit``), inclusive; of the magnitude when ``signed``.
+    unit : str
+        SI unit of the bounds.
+    reason : str
+        Why these bounds (what lies at each end).
+    signed : bool
+        A signed quantity (a coordinate, a rate that may be negative): ``|value|`` must be at most ``high``;
+        ``low`` is then 0.
+    shown : str
+        The range as the user usually writes it (e.g. ``"1e-4 to 1e7 rpm"``), when not in SI.
+    """
+
+    low: float
+    high: float
+    unit: str
+    reason: str
+    signed: bool = False
+    shown: str = ""
+
+    def text(self) -> str:
+        """The accepted range in words, e.g. ``between 0.1 and 1e+05 kg/m³``."""
+        def num(x):
+            return f"{x:,}" if isinstance(x, int) else f"{x:g}"
+        if self.signed:
+            rule = f"at most {num(self.high)} {self.unit} in magnitude"
+        else:
+            rule = f"between {num(self.low)} and {num(self.high)} {self.unit}"
+        return f"{rule} ({self.shown})" if self.shown else rule
+
+
+_LENGTH = OptionRange(1e-9, 1e6, "m", "a nanometre (the size of a molecule) to 1000 km")
+_COORDINATE = OptionRange(0.0, 1e6, "m", "a point within 1000 km of the mesh origin", signed=True)
+_SPEED = OptionRange(1e-4 * _RPM, 1e7 * _RPM, "rad/s", "1e-4 rpm (a turn a week) to 1e7 rpm (beyond the "
+                     "fastest machine rotors, ~1e6 rpm)", shown="1e-4 to 1e7 rpm")
+_SIGNED_RATE = OptionRange(0.0, 1e7 * _RPM, "rad/s", "as the speeds, either sense, 0 allowed", signed=True,
+                           shown="|rate| up to 1e7 rpm")
+
+#: Physically meaningful ranges of the numeric options, SI after unit parsing (one table; README prints it).
+OPTION_RANGES: dict[str, OptionRange] = {
+    "--density": OptionRange(0.1, 1e5, "kg/m³", "below the lightest solids (aerogels, ~0.16 kg/m³) to 4x the "
+                             "densest element (osmium, 22,590 kg/m³)"),
+    "--mass": OptionRange(1e-12, 1e9, "kg", "a nanogram (a micro-machined part) to a million tonnes"),
+    "--radius": _LENGTH,
+    "--thickness": _LENGTH,
+    "--shell": _LENGTH,
+    "--axis-point": _COORDINATE,
+    "--planes": _COORDINATE,
+    "--bearings": _COORDINATE,
+    "--pivot": _COORDINATE,
+    "--rpm": _SPEED,
+    "--rate": _SPEED,
+    "--spin": _SIGNED_RATE,
+    "--precession": _SIGNED_RATE,
+    "--nutation": _SIGNED_RATE,
+    "--duration": OptionRange(1e-6, 1e6, "s", "a microsecond to 11.6 days of simulated motion"),
+    "--gravity": OptionRange(1e-6, 1e4, "m/s²", "microgravity to 1000 g"),
+    "--merge-tolerance": OptionRange(0.0, 0.1, "(of the bounding-box diagonal)",
+                                     "0 turns tolerant welding off; welding across a tenth of the part is "
+                                     "no longer rounding noise"),
+    "--max-faces": OptionRange(1, MAX_SUPPORTED_FACES, "triangles",
+                               "the reader indexes corners with 32-bit integers (3 x faces < 2^31)"),
+    "--jobs": OptionRange(1, 1024, "processes", "one process to a large machine"),
+}
+
+
+def check_option(option: str, value, *, typed=None, label: str | None = None):
+    """Return ``value`` (a number or a sequence of numbers, SI) if it lies in ``OPTION_RANGES[option]``,
+    else raise :class:`UsageError` naming ``option`` (or ``label``), the accepted range and what the user
+    typed."""
+    rng = OPTION_RANGES[option]
+    values = list(value) if isinstance(value, (list, tuple)) else [value]
+    for v in values:
+        ok = isinstance(v, (int, float)) and math.isfinite(v)
+        if ok and rng.signed:
+            ok = abs(v) <= rng.high
+        elif ok:
+            ok = rng.low <= v <= rng.high
+        if not ok:
+            shown = typed if typed is not None else (f"{v:g}" if isinstance(v, (int, float)) else repr(v))
+            raise UsageError(f"{label or option} must be {rng.text()}, got {shown}")
+    return value
+
+
+def density_and_mass(args) -> tuple[float | None, float | None]:
+    """``--density`` and ``--mass`` of ``args`` parsed (units) and checked against :data:`OPTION_RANGES`."""
+    from ..units import parse_density, parse_mass
+    density = mass = None
+    if getattr(args, "density", None) is not None:
+        density = check_option("--density", parse_density(args.density), typed=args.density)
+    if getattr(args, "mass", None) is not None:
+        mass = check_option("--mass", parse_mass(args.mass), typed=args.mass)
+    return density, mass
 
 
 def require_range(value: float, option: str, *, low: float | None = None, high: float | None = None,

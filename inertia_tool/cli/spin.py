@@ -17,7 +17,7 @@ from ..units import parse_angular_rate, parse_duration
 from ..mass.principal import DEFAULT_EQUAL_RTOL
 from .analyze import add_material_options, add_mesh_options, load_from_args
 from ..reports.output import atomic_target, check_targets
-from .options import require_range
+from .options import check_option, require_range
 from .report_option import save_figure
 
 __all__ = ["register", "run", "MAX_SAMPLES"]
@@ -89,9 +89,8 @@ def run(args) -> int:
     require_range(args.rtol, "--rtol", low=0, high=1, high_open=True)
     if args.samples is not None and not 2 <= args.samples <= MAX_SAMPLES:
         raise UsageError(f"--samples must be between 2 and {MAX_SAMPLES}, got {args.samples}")
-    rate = require_range(parse_angular_rate(args.rate), "--rate", low=0, low_open=True, typed=args.rate)
-    duration = require_range(parse_duration(args.duration), "--duration", low=0, low_open=True,
-                             typed=args.duration)
+    rate = check_option("--rate", parse_angular_rate(args.rate), typed=args.rate)
+    duration = check_option("--duration", parse_duration(args.duration), typed=args.duration)
     check_targets([(args.csv, "--csv"), (args.plot, "--plot")], force=args.force)
     props, described = load_from_args(args)
     experiment = spin_experiment(props, args.about, rate, perturbation=args.perturbation, duration=duration,

@@ -17,7 +17,7 @@ from ..reports.serialize import to_jsonable
 from ..units import parse_angle, parse_angular_rate, parse_duration, parse_vector
 from .analyze import add_material_options, add_mesh_options, load_from_args
 from ..reports.output import atomic_target, check_targets
-from .options import require_range
+from .options import check_option, require_range
 from .report_option import save_figure
 
 __all__ = ["register", "run", "MAX_SAMPLES", "MIN_SAMPLES_PER_PERIOD"]
@@ -116,14 +116,13 @@ def run(args) -> int:
     if not (math.isfinite(tilt) and 0.0 <= tilt <= math.pi):
         raise UsageError(f"--tilt must be between 0 and 180 deg (0 and π rad) from the vertical, got {args.tilt} "
                          f"(= {math.degrees(tilt):.6g} deg)")
-    require_range(args.gravity, "--gravity", low=0, low_open=True, unit="m/s²")
+    check_option("--gravity", args.gravity)
     require_range(args.symmetry_rtol, "--symmetry-rtol", low=0, high=1, high_open=True)
     if not 2 <= args.samples <= MAX_SAMPLES:
         raise UsageError(f"--samples must be between 2 and {MAX_SAMPLES}, got {args.samples}")
     duration = None
     if args.duration is not None:
-        duration = require_range(parse_duration(args.duration), "--duration", low=0, low_open=True,
-                                 typed=args.duration)
+        duration = check_option("--duration", parse_duration(args.duration), typed=args.duration)
     if args.no_simulate and (args.csv or args.plot):
         raise UsageError("--csv and --plot need the simulation (drop --no-simulate)")
     check_targets([(args.csv, "--csv"), (args.plot, "--plot")], force=args.force)
@@ -131,11 +130,12 @@ def run(args) -> int:
         # a symmetric top has two equal moments by design; heavy_top_on_pivot reports its own asymmetry
         warnings.simplefilter("ignore", NearlyEqualMomentsWarning)
         props, described = load_from_args(args)
-    pivot = np.array(parse_vector(args.pivot, default_unit=args.units))
-    top = heavy_top_on_pivot(props, pivot, theta0=tilt,
-                              omega3=parse_angular_rate(args.spin),
-                              theta_dot0=parse_angular_rate(args.nutation),
-                              phi_dot0=parse_angular_rate(args.precession), g=args.gravity, rtol=args.symmetry_rtol)
+    pivot = np.array(check_option("--pivot", list(parse_vector(args.pivot, default_unit=args.units)),
+                                  typed=args.pivot))
+    rates = {name: check_option(f"--{name}", parse_angular_rate(getattr(args, name)), typed=getattr(args, name))
+             for name in ("spin", "nutation", "precession")}
+    top = heavy_top_on_pivot(props, pivot, theta0=tilt, omega3=rates["spin"], theta_dot0=rates["nutation"],
+                             phi_dot0=rates["precession"], g=args.gravity, rtol=args.symmetry_rtol)
     traj = None
     if not args.no_simulate:
         if duration is not None:

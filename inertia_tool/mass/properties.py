@@ -8,6 +8,7 @@ inertia about another point (parallel-axis theorem, Eqs. 4.16–4.17), moment ab
 
 from __future__ import annotations
 
+import sys
 from dataclasses import field
 from functools import cached_property
 from typing import TYPE_CHECKING, Optional
@@ -15,7 +16,7 @@ from typing import TYPE_CHECKING, Optional
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import UsageError
+from ..errors import NonFiniteResultError, UsageError
 from ..tolerances import ROTATION_ATOL
 from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
 
@@ -127,6 +128,13 @@ class MassProperties:
         object.__setattr__(self, "volume", float(self.volume))
         object.__setattr__(self, "surface_area", float(self.surface_area))
         object.__setattr__(self, "density", float(self.density))
+        for what, value in (("mass", self.mass), ("volume", self.volume), ("centre of mass", com),
+                            ("inertia tensor", ten), ("surface area", self.surface_area)):
+            NonFiniteResultError.check(f"{self.name or 'body'}: the {what}", value)
+        if self.volume > 0 and self.density > 0 and self.mass < sys.float_info.min:
+            raise NonFiniteResultError(f"{self.name or 'body'}: the mass underflows to {self.mass:g} kg (density "
+                                       f"{self.density:g} kg/m³ times volume {self.volume:g} m³): the density "
+                                       "is outside any physically meaningful range")
 
     # -- derived quantities -------------------------------------------------------------------------
     @cached_property

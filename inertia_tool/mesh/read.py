@@ -27,8 +27,14 @@ from ..units import LENGTH_UNITS, length_scale
 from .options import DEFAULT_MAX_FACES
 from .weld import weld_exact, weld_exact_stream
 
-__all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "SUPPORTED_SUFFIXES", "os_error_reason"]
+__all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "MAX_SUPPORTED_FACES", "SUPPORTED_SUFFIXES",
+           "os_error_reason"]
 
+
+#: Most triangles any reader accepts, whatever ``max_faces`` says: the welders number the 3 corners of every
+#: triangle with 32-bit integers, so 3 x faces must stay below 2^31 (715,827,882 triangles, ~36 GB of
+#: binary STL).  A file announcing more is refused from its header, before anything is allocated.
+MAX_SUPPORTED_FACES = (2**31 - 1) // 3
 
 #: File suffixes handled (STL natively, the rest through trimesh; COLLADA needs pycollada; STEP/IGES are
 #: tessellated through OpenCASCADE, ``inertia_tool.mesh.cad``).
@@ -106,6 +112,9 @@ def os_error_reason(exc: OSError, path=None) -> str:
 
 
 def _check_face_budget(path: str, n: int, max_faces: int) -> None:
+    if n > MAX_SUPPORTED_FACES:
+        raise _fail(path, f"holds {n:,} triangles, more than the {MAX_SUPPORTED_FACES:,} this reader supports "
+                          "(corner indices must fit 32 bits)")
     if n > max_faces:
         raise _fail(path, f"holds {n:,} triangles, more than `max_faces` ({max_faces:,}) allows")
 
@@ -701,8 +710,9 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
         Bad ``units``, ``max_faces`` or malformed arrays.
     """
     scale = length_scale(units)
-    if not (isinstance(max_faces, (int, np.integer)) and max_faces > 0):
-        raise UsageError(f"Expected a positive integer `max_faces`, got {max_faces!r}")
+    if not (isinstance(max_faces, (int, np.integer)) and 0 < max_faces <= MAX_SUPPORTED_FACES):
+        raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,} (corner "
+                         f"indices must fit 32 bits), got {max_faces!r}")
     if isinstance(source, RawMesh):
         if len(source.faces) > max_faces:
             raise UsageError(f"{source.source}: holds {len(source.faces):,} triangles, more than `max_faces` "

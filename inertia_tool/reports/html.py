@@ -33,7 +33,7 @@ import numpy as np
 
 from ..mass.ellipsoid import equivalent_ellipsoid_semi_axes
 from ..mesh.checks import MeshReport
-from ..errors import InertiaToolError, UsageError
+from ..errors import InertiaToolError
 from ..mass.properties import MassProperties
 from .escape import escape_html
 from .output import check_targets, write_text
