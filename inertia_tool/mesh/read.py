@@ -496,9 +496,22 @@ _PLY_TYPE_BYTES = {b"char": 1, b"int8": 1, b"uchar": 1, b"uint8": 1, b"short": 2
 #: (applied to members above ``_ZIP_RATIO_MIN_BYTES``; real 3MF XML compresses about 5–20 : 1).
 MAX_ZIP_RATIO = 100
 _ZIP_RATIO_MIN_BYTES = 1 << 20
-#: Inflated 3MF bytes allowed per face of ``max_faces`` (XML spends ~60–120 bytes per triangle and vertex).
-_ZIP_BYTES_PER_FACE = 200
-_ZIP_BYTES_SLACK = 64 << 20
+#: Inflated bytes of the 3MF model parts allowed per face of ``max_faces``: a vertex line of a 3MF model is
+#: ~55 bytes and a triangle line ~45, so a welded mesh (two triangles per vertex) spends ~75 bytes per
+#: triangle and an unwelded corner soup (three vertices per triangle) ~210; 256 covers both.
+ZIP_BYTES_PER_FACE = 256
+#: Fixed allowance on top (XML header, metadata, a small model's attributes).
+ZIP_BYTES_SLACK = 16 << 20
+#: Members of a 3MF archive at most (counted from its central directory, before anything is inflated).
+MAX_ZIP_MEMBERS = 10_000
+#: Largest relationships part read (``*.rels``, a few hundred bytes in practice).
+_MAX_RELS_BYTES = 1 << 20
+
+
+def zip_inflate_limit(max_faces: int) -> int:
+    """Bytes the model parts of a 3MF may inflate to: ``ZIP_BYTES_PER_FACE * max_faces + ZIP_BYTES_SLACK``
+    (256 B per face + 16 MiB; 12.8 GB at the default 50 million faces)."""
+    return ZIP_BYTES_PER_FACE * int(max_faces) + ZIP_BYTES_SLACK
 
 
 def _header_count(path: str, word: bytes) -> int:
@@ -573,32 +586,108 @@ def _check_off_header(path: str, size: int, max_faces: int) -> dict:
     return {"vertex": nv, "face": nf}
 
 
-def _check_zip(path: str, max_faces: int) -> dict:
-    """Refuse a 3MF whose members would inflate beyond the limits, from the zip's central directory only.
+def _relationship_targets(data: bytes) -> list[str]:
+    """The ``Target`` of every ``Relationship`` of an OPC relationships part, without a leading ``/``."""
+    import xml.etree.ElementTree as ET
+    try:
+        root = ET.fromstring(data)
+    except ET.ParseError:
+        return []
+    return [r.attrib["Target"].lstrip("/") for r in root.iter() if r.tag.endswith("Relationship")
+            and "Target" in r.attrib]
 
-    Python's zipfile never returns more than a member's declared ``file_size`` (it stops there and checks
-    the CRC), so limits on the declared sizes also bound what trimesh can inflate.
-    """
+
+def _model_members(path: str, zf, infos) -> list:
+    """The members of a 3MF that hold geometry, the only ones read: the root model (the first
+    ``3D/3dmodel.model``, as trimesh takes it), the parts its relationships point at, and any other
+    ``*.model`` part (a component's ``path`` may name one).  Thumbnails, textures, metadata and anything
+    else are never inflated."""
+    roots = [i for i in infos if "3d/3dmodel.model" in i.filename.lower()]
+    if not roots:
+        raise _fail(path, "3MF archive without a 3D/3dmodel.model part: not a 3MF")
+    root = roots[0]
+    by_name = {i.filename: i for i in infos}
+    head, tail = os.path.split(root.filename)
+    wanted = {root.filename}
+    rels = by_name.get(f"{head}/_rels/{tail}.rels" if head else f"_rels/{tail}.rels")
+    if rels is not None and rels.file_size <= _MAX_RELS_BYTES:
+        wanted.update(t for t in _relationship_targets(zf.read(rels)) if t in by_name)
+    wanted.update(i.filename for i in infos if i.filename.lower().endswith(".model"))
+    return [i for i in infos if i.filename in wanted]
+
+
+def _check_zip_members(path: str, count: int, members, what: str = "") -> None:
+    """Refuse, from the central directory, an archive of more than :data:`MAX_ZIP_MEMBERS` members (``count``)
+    or one of ``members`` inflating more than :data:`MAX_ZIP_RATIO` : 1; ``what`` prefixes the messages."""
+    if count > MAX_ZIP_MEMBERS:
+        raise _fail(path, f"{what}archive has {count:,} members, more than the {MAX_ZIP_MEMBERS:,} allowed; "
+                          "refused before inflating")
+    for i in members:
+        if i.file_size > _ZIP_RATIO_MIN_BYTES and i.file_size > MAX_ZIP_RATIO * max(i.compress_size, 1):
+            raise _fail(path, f"{what}member {i.filename[:60]!r} would inflate "
+                              f"{i.file_size / max(i.compress_size, 1):,.0f}:1 ({i.compress_size:,} → "
+                              f"{i.file_size:,} bytes), over the {MAX_ZIP_RATIO}:1 limit: refused as a zip bomb "
+                              "before inflating")
+
+
+def _check_zip(path: str, max_faces: int) -> dict:
+    """Refuse a zipped mesh (``.zae``) whose members would inflate beyond the limits, from the central
+    directory only: :func:`_check_zip_members` and all members together within :func:`zip_inflate_limit`."""
     import zipfile
 
     try:
         with zipfile.ZipFile(path) as zf:
             infos = zf.infolist()
     except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError) as exc:
-        raise _fail(path, f"not a valid 3MF (zip) archive ({str(exc)[:100]})") from None
-    if len(infos) > 10_000:
-        raise _fail(path, f"3MF archive has {len(infos):,} members; refused")
+        raise _fail(path, f"not a valid zip archive ({str(exc)[:100]})") from None
+    _check_zip_members(path, len(infos), infos)
     total = sum(i.file_size for i in infos)
-    limit = _ZIP_BYTES_PER_FACE * max_faces + _ZIP_BYTES_SLACK
-    for i in infos:
-        if i.file_size > _ZIP_RATIO_MIN_BYTES and i.file_size > MAX_ZIP_RATIO * max(i.compress_size, 1):
-            raise _fail(path, f"3MF member {i.filename[:60]!r} would inflate {i.file_size / max(i.compress_size, 1):,.0f}"
-                              f":1 ({i.compress_size:,} → {i.file_size:,} bytes), over the {MAX_ZIP_RATIO}:1 limit: "
-                              "refused as a zip bomb before inflating")
+    limit = zip_inflate_limit(max_faces)
     if total > limit:
-        raise _fail(path, f"3MF archive would inflate to {total:,} bytes, more than the {limit:,} allowed for "
+        raise _fail(path, f"archive would inflate to {total:,} bytes, more than the {limit:,} allowed for "
                           f"`max_faces` ({max_faces:,}); refused before inflating")
     return {}
+
+
+def _read_3mf_models(path: str, max_faces: int):
+    """The model parts of a 3MF as a new in-memory archive (stored, not compressed) for trimesh.
+
+    Refused from the zip's central directory, before anything is inflated: more than
+    :data:`MAX_ZIP_MEMBERS` members, a model member inflating more than :data:`MAX_ZIP_RATIO` : 1, or model
+    parts inflating to more than :func:`zip_inflate_limit` ``(max_faces)`` bytes in all.  Python's zipfile
+    never returns more than a member's declared ``file_size`` (it stops there and checks the CRC), so limits
+    on the declared sizes bound what is inflated.  Members the model does not reference are not read.
+    """
+    import io
+    import zipfile
+    import zlib
+
+    try:
+        with zipfile.ZipFile(path) as zf:
+            infos = zf.infolist()
+            if len(infos) > MAX_ZIP_MEMBERS:
+                _check_zip_members(path, len(infos), (), "3MF ")
+            models = _model_members(path, zf, infos)
+            _check_zip_members(path, len(infos), models, "3MF ")
+            total = sum(i.file_size for i in models)
+            limit = zip_inflate_limit(max_faces)
+            if total > limit:
+                raise _fail(path, f"3MF model parts would inflate to {total:,} bytes, more than the {limit:,} "
+                                  f"allowed for `max_faces` ({max_faces:,}); refused before inflating")
+            buffer = io.BytesIO()
+            with zipfile.ZipFile(buffer, "w", zipfile.ZIP_STORED) as out:
+                for i in models:
+                    with zf.open(i) as src, out.open(i.filename, "w", force_zip64=True) as dst:
+                        for _ in range(i.file_size // (1 << 20) + 2):    # bounded by the declared size
+                            block = src.read(1 << 20)
+                            if not block:
+                                break
+                            dst.write(block)
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError, NotImplementedError,
+            zlib.error) as exc:
+        raise _fail(path, f"not a valid 3MF (zip) archive ({str(exc)[:100]})") from None
+    buffer.seek(0)
+    return buffer
 
 
 _HEADER_CHECKS = {".ply": _check_ply_header, ".off": _check_off_header}
@@ -629,10 +718,11 @@ def _read_with_trimesh(path: str, max_faces: int):
     suffix = os.path.splitext(path)[1].lower()
     if suffix in _HEADER_CHECKS:
         counts = _HEADER_CHECKS[suffix](path, size, max_faces)
-    elif suffix in (".3mf", ".zae"):
+    elif suffix == ".zae":
         counts = _check_zip(path, max_faces)
     else:
         counts = {}
+    source, kind = (_read_3mf_models(path, max_faces), "3mf") if suffix == ".3mf" else (path, None)
     try:
         import trimesh
     except ImportError as exc:  # pragma: no cover - trimesh is a dependency
@@ -645,7 +735,7 @@ def _read_with_trimesh(path: str, max_faces: int):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            loaded = trimesh.load(path, process=False, force=None)
+            loaded = trimesh.load(source, file_type=kind, process=False, force=None)
             declared = _declared_scale(path, suffix, loaded)
             if isinstance(loaded, trimesh.Scene):   # dump() applies every node's transform
                 geoms = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)] if loaded.geometry else []
@@ -734,7 +824,7 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
                 if os.path.getsize(path) == 0:
                     raise _fail(path, "empty file (0 bytes)")
                 from .decompress import decompressed
-                with decompressed(path, max_bytes=_ZIP_BYTES_PER_FACE * max_faces + _ZIP_BYTES_SLACK,
+                with decompressed(path, max_bytes=zip_inflate_limit(max_faces),
                                   max_ratio=MAX_ZIP_RATIO, min_ratio_bytes=_ZIP_RATIO_MIN_BYTES,
                                   suffixes=SUPPORTED_SUFFIXES) as (inner, member):
                     try:
