@@ -330,7 +330,7 @@ def _alive(pid):
 
 _SLOW_BATCH = """
 import sys, time
-import inertia_tool.batch as b
+import inertia_tool.batch.runner as b
 real = b.analyze_file
 def slow(path, options, sha256=None):
     time.sleep(float(sys.argv[1]))
@@ -380,7 +380,7 @@ def test_watchdog_exits_a_worker_whose_parent_is_gone(tmp_path):
         pytest.skip("needs fork")
     # a middle process forks the worker, lets the worker register it as the parent, then dies
     middle = ("import os, sys, time\n"
-              "import inertia_tool.batch as b\n"
+              "import inertia_tool.batch.runner as b\n"
               "b.sys.platform = 'other'\n"
               "parent = os.getpid()\n"
               "pid = os.fork()\n"
@@ -432,7 +432,7 @@ def test_second_batch_on_the_same_results_file_is_refused_and_nothing_is_lost(pa
 
 
 def test_results_file_lock_is_released_on_close(tmp_path):
-    from inertia_tool.reports.rows import ResultsFileBusy
+    from inertia_tool.batch.rows import ResultsFileBusy
     out = tmp_path / "r.jsonl"
     with open_results(out):
         with pytest.raises(ResultsFileBusy, match=r"being written by another batch run \(pid \d+\)"):
@@ -479,7 +479,7 @@ def test_torn_last_line_is_reported_not_refused(parts, tmp_path, suffix, capsys)
 
 
 def test_csv_record_torn_inside_a_quoted_line_break(tmp_path):
-    from inertia_tool.reports.rows import format_row, read_rows
+    from inertia_tool.batch.rows import format_row, read_rows
     row = dict.fromkeys(ROW_FIELDS)
     row.update(schema=SCHEMA, path="x\ny.stl", status="ok", mass=1.5, faces=12, watertight=True)
     header = (",".join(ROW_FIELDS) + "\n").encode()

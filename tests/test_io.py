@@ -191,7 +191,7 @@ def test_symlink_loop_broken_link_and_not_a_directory_say_why(tmp_path):
 
 @pytest.mark.skipif(not hasattr(os, "symlink"), reason="needs symbolic links")
 def test_batch_reports_a_symlink_loop_as_a_file_error_not_an_internal_one(tmp_path):
-    from inertia_tool.batch import BatchOptions, analyze_file
+    from inertia_tool.batch.runner import BatchOptions, analyze_file
     loop = tmp_path / "loop.stl"
     os.symlink(loop, loop)
     row = analyze_file(str(loop), BatchOptions())
@@ -238,7 +238,7 @@ def test_3mf_members_the_model_does_not_reference_are_never_inflated(tmp_path):
 
 
 def test_3mf_model_parts_are_bounded_by_the_face_limit(tmp_path):
-    from inertia_tool.io import zip_inflate_limit
+    from inertia_tool.mesh.read import zip_inflate_limit
     p = tmp_path / "models.3mf"
     _3mf_with_junk(p, 0)
     import zipfile

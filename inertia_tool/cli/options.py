@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import UsageError
-from ..io import MAX_SUPPORTED_FACES
+from ..mesh.read import MAX_SUPPORTED_FACES
 
 __all__ = ["require_range", "OptionRange", "OPTION_RANGES", "check_option", "density_and_mass"]
 
