@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import UsageError
-from ..mesh.read import MAX_SUPPORTED_FACES
+from ..mesh.options import MAX_SUPPORTED_FACES
 
 __all__ = ["require_range", "OptionRange", "OPTION_RANGES", "check_option", "density_and_mass"]
 
@@ -34,6 +34,8 @@ class OptionRange:
         SI unit of the bounds.
     reason : str
         Why these bounds (what lies at each end).
+    below : bool
+        The upper bound is excluded.
     signed : bool
         A signed quantity (a coordinate, a rate that may be negative): ``|value|`` must be at most ``high``;
         ``low`` is then 0.
@@ -47,6 +49,7 @@ class OptionRange:
     reason: str
     signed: bool = False
     shown: str = ""
+    below: bool = False
 
     def text(self) -> str:
         """The accepted range in words, e.g. ``between 0.1 and 1e+05 kg/m³``."""
@@ -56,6 +59,8 @@ class OptionRange:
             rule = f"at most {num(self.high)} {self.unit} in magnitude"
         else:
             rule = f"between {num(self.low)} and {num(self.high)} {self.unit}"
+            if self.below:
+                rule = f"at least {num(self.low)} and below {num(self.high)} {self.unit}"
         return f"{rule} ({self.shown})" if self.shown else rule
 
 
@@ -64,7 +69,7 @@ _COORDINATE = OptionRange(0.0, 1e6, "m", "a point within 1000 km of the mesh ori
 _SPEED = OptionRange(1e-4 * _RPM, 1e7 * _RPM, "rad/s", "1e-4 rpm (a turn a week) to 1e7 rpm (beyond the "
                      "fastest machine rotors, ~1e6 rpm)", shown="1e-4 to 1e7 rpm")
 _SIGNED_RATE = OptionRange(0.0, 1e7 * _RPM, "rad/s", "as the speeds, either sense, 0 allowed", signed=True,
-                           shown="|rate| up to 1e7 rpm")
+                           shown="up to ±1e7 rpm")
 
 #: Physically meaningful ranges of the numeric options, SI after unit parsing (one table; README prints it).
 OPTION_RANGES: dict[str, OptionRange] = {
@@ -87,7 +92,7 @@ OPTION_RANGES: dict[str, OptionRange] = {
     "--gravity": OptionRange(1e-6, 1e4, "m/s²", "microgravity to 1000 g"),
     "--merge-tolerance": OptionRange(0.0, 0.1, "(of the bounding-box diagonal)",
                                      "0 turns tolerant welding off; welding across a tenth of the part is "
-                                     "no longer rounding noise"),
+                                     "no longer rounding noise", below=True),
     "--max-faces": OptionRange(1, MAX_SUPPORTED_FACES, "triangles",
                                "the reader indexes corners with 32-bit integers (3 x faces < 2^31)"),
     "--jobs": OptionRange(1, 1024, "processes", "one process to a large machine"),
@@ -105,7 +110,7 @@ def check_option(option: str, value, *, typed=None, label: str | None = None):
         if ok and rng.signed:
             ok = abs(v) <= rng.high
         elif ok:
-            ok = rng.low <= v <= rng.high
+            ok = rng.low <= v and (v < rng.high if rng.below else v <= rng.high)
         if not ok:
             shown = typed if typed is not None else (f"{v:g}" if isinstance(v, (int, float)) else repr(v))
             raise UsageError(f"{label or option} must be {rng.text()}, got {shown}")

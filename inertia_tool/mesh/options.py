@@ -16,10 +16,17 @@ from ..errors import UsageError
 from ..tolerances import MERGE_TOLERANCE
 from ..units import length_scale
 
-__all__ = ["LoadOptions", "DEFAULT_MAX_FACES"]
+__all__ = ["LoadOptions", "DEFAULT_MAX_FACES", "MAX_SUPPORTED_FACES"]
 
-#: Default guard on the number of triangles a file may hold (about 5 GB of working memory at the limit).
+#: Default guard on the number of triangles a file may hold.  Peak memory at the limit (README, "Bad input";
+#: ``benchmarks/bench_memory.py``): binary STL ~63 MiB + 37 B per face with the C extension (1.8 GiB at
+#: 50M), 77 B per face on the numpy path; a 3MF, parsed by trimesh, ~1.6 kB per face.
 DEFAULT_MAX_FACES = 50_000_000
+
+#: Most triangles any reader accepts, whatever ``max_faces`` says: the welders number the 3 corners of every
+#: triangle with 32-bit integers, so 3 x faces must stay below 2^31 (715,827,882 triangles, ~36 GB of
+#: binary STL).  A file announcing more is refused from its header, before anything is allocated.
+MAX_SUPPORTED_FACES = (2**31 - 1) // 3
 
 
 @frozen_value
@@ -56,8 +63,9 @@ class LoadOptions:
             raise UsageError(f"Expected `merge_tolerance` to be a number in [0, 0.1) (relative to the "
                              f"bounding-box diagonal), got {tol!r}")
         if isinstance(self.max_faces, bool) or not (isinstance(self.max_faces, (int, np.integer))
-                                                    and self.max_faces > 0):
-            raise UsageError(f"Expected `max_faces` to be a positive integer, got {self.max_faces!r}")
+                                                    and 0 < self.max_faces <= MAX_SUPPORTED_FACES):
+            raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,} (corner "
+                             f"indices must fit 32 bits), got {self.max_faces!r}")
 
     def replace(self, **changes) -> LoadOptions:
         """A copy with some fields changed (validated like a new one)."""

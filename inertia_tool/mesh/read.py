@@ -24,17 +24,13 @@ from ..values import frozen_value
 from ..errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, UsageError
 from .._native import accel
 from ..units import LENGTH_UNITS, length_scale
-from .options import DEFAULT_MAX_FACES
+from .options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
 from .weld import weld_exact, weld_exact_stream
 
 __all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "MAX_SUPPORTED_FACES", "SUPPORTED_SUFFIXES",
            "os_error_reason"]
 
 
-#: Most triangles any reader accepts, whatever ``max_faces`` says: the welders number the 3 corners of every
-#: triangle with 32-bit integers, so 3 x faces must stay below 2^31 (715,827,882 triangles, ~36 GB of
-#: binary STL).  A file announcing more is refused from its header, before anything is allocated.
-MAX_SUPPORTED_FACES = (2**31 - 1) // 3
 
 #: File suffixes handled (STL natively, the rest through trimesh; COLLADA needs pycollada; STEP/IGES are
 #: tessellated through OpenCASCADE, ``inertia_tool.mesh.cad``).
