@@ -99,6 +99,14 @@ OPTION_RANGES: dict[str, OptionRange] = {
 }
 
 
+def _same_number(typed, value) -> bool:
+    """Whether what the user typed is already ``value`` (a bare number in the range's unit)."""
+    try:
+        return float(str(typed)) == value
+    except ValueError:
+        return False
+
+
 def check_option(option: str, value, *, typed=None, label: str | None = None):
     """Return ``value`` (a number or a sequence of numbers, SI) if it lies in ``OPTION_RANGES[option]``,
     else raise :class:`UsageError` naming ``option`` (or ``label``), the accepted range and what the user
@@ -112,7 +120,10 @@ def check_option(option: str, value, *, typed=None, label: str | None = None):
         elif ok:
             ok = rng.low <= v and (v < rng.high if rng.below else v <= rng.high)
         if not ok:
-            shown = typed if typed is not None else (f"{v:g}" if isinstance(v, (int, float)) else repr(v))
+            si = f"{v:g}" if isinstance(v, (int, float)) else repr(v)
+            shown = si if typed is None else str(typed)
+            if typed is not None and len(values) == 1 and not _same_number(typed, v):
+                shown += f" (= {si} {rng.unit})"            # the value in the unit of the range
             raise UsageError(f"{label or option} must be {rng.text()}, got {shown}")
     return value
 
