@@ -77,13 +77,14 @@ def add_mesh_options(parser) -> None:
                    help=f"refuse meshes with more triangles (default {DEFAULT_MAX_FACES:,})")
 
 
-def _part_density(what: str, path: str = "") -> dict:
+def _part_density(what: str, source=None) -> dict:
     try:
         density = parse_density(what)
     except UsageError:
         return {"material": what}
+    name = getattr(source, "source", source)          # a file name, or the RawMesh read from it
     return {"density": check_option("--density", density, typed=what,
-                                    label=f"the density of {path}" if path else None)}
+                                    label=f"the density of {name}" if name else None)}
 
 
 def check_mesh_options(args) -> None:

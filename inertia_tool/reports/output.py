@@ -98,6 +98,13 @@ def atomic_target(path: str | os.PathLike, *, label: str | None = None) -> Itera
     ``path`` (``os.replace``); on any exception it is removed and ``path`` is left untouched.  The overwrite
     rule is :func:`check_targets`' (call it first); this only writes.
 
+    Parameters
+    ----------
+    path : str or path
+        The file to produce.
+    label : str, optional
+        Prefix of messages (the option that named the file, e.g. ``"--csv"``).
+
     Raises
     ------
     OutputFileError
@@ -140,7 +147,17 @@ def _default_mode() -> int | None:
 
 
 def write_bytes(path: str | os.PathLike, data: bytes, *, label: str | None = None) -> None:
-    """Write ``data`` to ``path`` atomically (:func:`atomic_target`)."""
+    """Write ``data`` to ``path`` atomically (:func:`atomic_target`).
+
+    Parameters
+    ----------
+    path : str or path
+        The file to produce (replaced if it exists: check it first with :func:`check_targets`).
+    data : bytes
+        Its content.
+    label : str, optional
+        Prefix of messages.
+    """
     with atomic_target(path, label=label) as tmp:
         with open(tmp, "wb") as fh:
             fh.write(data)
@@ -148,7 +165,17 @@ def write_bytes(path: str | os.PathLike, data: bytes, *, label: str | None = Non
 
 
 def write_text(path: str | os.PathLike, text: str, *, label: str | None = None) -> None:
-    """Write ``text`` as UTF-8 to ``path`` atomically (``\\n`` line ends on every platform)."""
+    """Write ``text`` as UTF-8 to ``path`` atomically (``\\n`` line ends on every platform).
+
+    Parameters
+    ----------
+    path : str or path
+        The file to produce (replaced if it exists: check it first with :func:`check_targets`).
+    text : str
+        Its content.
+    label : str, optional
+        Prefix of messages.
+    """
     write_bytes(path, text.encode("utf-8"), label=label)
 
 
@@ -157,6 +184,15 @@ def write_files(files: Mapping[str, str | bytes], *, force: bool = False, label:
 
     Each file is atomic on its own; a failure part-way leaves the files already written complete and the
     rest untouched.
+
+    Parameters
+    ----------
+    files : mapping of path to str or bytes
+        Every file of the command and its content (text is written as UTF-8), in the order to write them.
+    force : bool
+        Allow replacing existing files.
+    label : str, optional
+        Prefix of messages.
     """
     check_targets([(p, label) for p in files], force=force)
     for path, content in files.items():
