@@ -412,6 +412,12 @@ def test_engine_refuses_overflowing_results_with_a_named_error():
                             radius=0.18)
     with pytest.raises(NonFiniteResultError, match="mass underflows"):
         mass_properties(WHEEL, units="mm", density=5e-324)
+    from inertia_tool.dynamics.experiment import spin_experiment
+    from inertia_tool.dynamics.top import heavy_top
+    with pytest.raises(NonFiniteResultError, match="kinetic energy"):        # returned inf energies before
+        spin_experiment(props, "intermediate", 1e300, duration=1.0, samples=2001)
+    with pytest.raises(NonFiniteResultError, match="largest rate"):          # a bare OverflowError before
+        heavy_top(1.0, 2.0, 1.0, 0.1, theta0=0.3, omega3=1e300)
     from inertia_tool.cli import exit_code
     assert issubclass(NonFiniteResultError, OverflowError) and exit_code(NonFiniteResultError("x")) == 4
 

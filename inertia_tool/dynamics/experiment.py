@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import UsageError
+from ..errors import NonFiniteResultError, UsageError
 from .spin_stability import AxisStability, StabilityReport, polhode_period, stability
 from ..mass.principal import DEFAULT_EQUAL_RTOL
 
@@ -147,6 +147,9 @@ def spin_experiment(props, about, rate: float, *, perturbation: float = 1e-3, du
     if not (duration > 0 and math.isfinite(duration)):
         raise UsageError(f"Expected a positive finite duration, got {duration!r} s")
     report = stability(props, rtol=rtol)
+    NonFiniteResultError.check(f"the kinetic energy at {rate:g} rad/s",
+                               0.5 * float(np.max(report.moments)) * rate * rate * (1.0 + 2.0 * perturbation ** 2),
+                               because="the spin rate is outside any physical range")
     entry = report.about(about)
     k = entry.index
     i, j = (k + 1) % 3, (k + 2) % 3

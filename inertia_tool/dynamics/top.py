@@ -25,7 +25,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import AsymmetricTopWarning, PhysicsError, UsageError
+from ..errors import AsymmetricTopWarning, NonFiniteResultError, PhysicsError, UsageError
 from ..mass.properties import MassProperties
 
 __all__ = ["HeavyTopReport", "TopTrajectory", "heavy_top", "heavy_top_on_pivot", "simulate_top",
@@ -301,6 +301,11 @@ def heavy_top(I1: float, I3: float, mass: float, length: float, *, theta0: float
     mgl = float(mass) * float(g) * float(length)
     u0, s = math.cos(theta0), math.sin(theta0)
     a = i3 * omega3 / i1
+    # the analysis squares and cubes these (energies, the cubic f(u)): refuse what a float64 cannot hold
+    largest = max(abs(a), abs(phi_dot0), abs(theta_dot0), math.sqrt(2.0 * mgl / i1), abs(i3 * omega3))
+    NonFiniteResultError.check(f"the cube of the top's largest rate or angular momentum ({largest:g})",
+                               largest * largest * largest * 1e3,
+                               because="the spin, precession or nutation rate is outside any physical range")
     b = phi_dot0 * s * s + a * u0
     beta = 2.0 * mgl / i1
     alpha = theta_dot0 ** 2 + (phi_dot0 * s) ** 2 + beta * u0
