@@ -5,7 +5,7 @@ refuses results that overflow (:class:`~inertia_tool.errors.NonFiniteResultError
 user's language (``--perturbation must be between 0 and 1 (exclusive), got 2``).
 
 :data:`OPTION_RANGES` is the one table of physically meaningful ranges of the numeric options (SI, after
-unit parsing), each with its reason; the README's "Bad input" section prints it.  A value outside is
+unit parsing), each with its reason; ``docs/bad-input.md`` prints it.  A value outside is
 refused before any work (exit 2, one line naming the option and the accepted range).
 """
 
@@ -71,7 +71,7 @@ _SPEED = OptionRange(1e-4 * _RPM, 1e7 * _RPM, "rad/s", "1e-4 rpm (a turn a week)
 _SIGNED_RATE = OptionRange(0.0, 1e7 * _RPM, "rad/s", "as the speeds, either sense, 0 allowed", signed=True,
                            shown="up to ±1e7 rpm")
 
-#: Physically meaningful ranges of the numeric options, SI after unit parsing (one table; README prints it).
+#: Physically meaningful ranges of the numeric options, SI after unit parsing (docs/bad-input.md prints it).
 OPTION_RANGES: dict[str, OptionRange] = {
     "--density": OptionRange(0.1, 1e5, "kg/m³", "below the lightest solids (aerogels, ~0.16 kg/m³) to 4x the "
                              "densest element (osmium, 22,590 kg/m³)"),
