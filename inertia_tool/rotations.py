@@ -308,3 +308,123 @@ def perpendicular_basis(normal) -> tuple[np.ndarray, np.ndarray]:
     e1[k] += 1.0
     e1 /= np.linalg.norm(e1)
     return e1, np.cross(n, e1)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Cayley–Klein parameters and the SU(2) → SO(3) double cover (Chapter 4, "Rigid Body Motion", exercise 4.11).
+#
+# A rotation of the unit sphere, seen through the stereographic projection from the north pole
+# ``ξ = (x + i y)/(1 − z)`` (exercise 4.11a), is the Möbius map ``ξ ↦ (α ξ + β)/(γ ξ + δ)`` (4.11b) with
+# ``U = [[α, β], [γ, δ]]`` in SU(2): ``δ = ᾱ``, ``γ = −β̄``, ``|α|² + |β|² = 1``.  Composition of maps is the matrix
+# product (4.11c), and ``U`` and ``−U`` give the same map: SU(2) covers SO(3) twice.
+#
+# For the active rotation ``Q`` of the scalar-first unit quaternion ``(w, x, y, z)`` (module conventions):
+#     α = w + i z,   β = −y + i x,   γ = y + i x,   δ = w − i z,
+# i.e. ``U = conj(w 𝟙 − i (x σ_x + y σ_y + z σ_z))`` with the Pauli matrices σ.  These are the Cayley–Klein
+# parameters of ``Q`` for this projection (Goldstein's α…δ describe the passive ``A`` with another projection and
+# differ by conjugations).  ``Q`` is read back from ``U`` without quaternions, as
+#     Q_ij = ½ tr(σ_i V σ_j V†),   V = conj(U).
+# ---------------------------------------------------------------------------------------------------------------
+
+__all__ += ["quaternion_to_cayley_klein", "cayley_klein_to_quaternion", "cayley_klein_to_matrix",
+            "stereographic_projection", "inverse_stereographic_projection", "moebius_transform"]
+
+_PAULI = np.array([[[0, 1], [1, 0]], [[0, -1j], [1j, 0]], [[1, 0], [0, -1]]], dtype=np.complex128)
+
+
+def _as_su2(matrix, atol: float) -> np.ndarray:
+    u = np.asarray(matrix, dtype=np.complex128)
+    if u.shape[-2:] != (2, 2):
+        raise UsageError(f"Expected `cayley_klein` to have shape (..., 2, 2), got {u.shape}")
+    if not np.all(np.isfinite(u)):
+        raise UsageError("Expected `cayley_klein` to be finite")
+    alpha, beta, gamma, delta = u[..., 0, 0], u[..., 0, 1], u[..., 1, 0], u[..., 1, 1]
+    deviation = np.max(np.abs(np.stack([delta - np.conj(alpha), gamma + np.conj(beta),
+                                        alpha * delta - beta * gamma - 1.0])))
+    if deviation > atol:
+        raise UsageError(f"Expected a matrix of SU(2) (δ = conj α, γ = −conj β, αδ − βγ = 1 within {atol:g}), "
+                         f"got a deviation of {deviation:.3g}")
+    return u
+
+
+def quaternion_to_cayley_klein(quaternion) -> np.ndarray:
+    """Cayley–Klein matrix ``U = [[α, β], [γ, δ]]`` ∈ SU(2) of the rotation of a scalar-first quaternion.
+
+    ``α = w + i z``, ``β = −y + i x``, ``γ = y + i x``, ``δ = w − i z`` (see the block comment above): the
+    Möbius map of ``U`` acting on ``ξ = (x + i y)/(1 − z)`` rotates the unit sphere by the active ``Q`` of the
+    quaternion (exercise 4.11).  ``q`` and ``−q`` give ``U`` and ``−U``.
+
+    Returns
+    -------
+    (..., 2, 2) complex
+    """
+    q = _as_quaternion(quaternion, "quaternion")
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.stack([np.stack([w + 1j * z, -y + 1j * x], -1), np.stack([y + 1j * x, w - 1j * z], -1)], -2)
+
+
+def cayley_klein_to_quaternion(cayley_klein, *, atol: float = 1e-9) -> np.ndarray:
+    """Scalar-first unit quaternion (``w ≥ 0``) of a Cayley–Klein matrix; ``U`` and ``−U`` give the same one.
+
+    Parameters
+    ----------
+    cayley_klein : (..., 2, 2) complex
+        A matrix of SU(2), checked to ``atol``.
+    """
+    u = _as_su2(cayley_klein, atol)
+    alpha, beta = u[..., 0, 0], u[..., 0, 1]
+    q = np.stack([alpha.real, beta.imag, -beta.real, alpha.imag], -1)
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    return np.where(q[..., :1] < 0, -q, q)
+
+
+def cayley_klein_to_matrix(cayley_klein, *, atol: float = 1e-9) -> np.ndarray:
+    """Active rotation ``Q`` of a Cayley–Klein matrix: ``Q_ij = ½ tr(σ_i V σ_j V†)``, ``V = conj(U)``.
+
+    The map SU(2) → SO(3) is a homomorphism (``Q(U1 U2) = Q(U1) Q(U2)``) and two-to-one (``Q(−U) = Q(U)``).
+
+    Returns
+    -------
+    (..., 3, 3) float
+    """
+    v = np.conj(_as_su2(cayley_klein, atol))
+    v_dagger = np.conj(np.swapaxes(v, -1, -2))
+    # (σ_i V σ_j V†) traced: sum over the 2×2 indices
+    m = np.einsum("iab,...bc,jcd,...da->...ij", _PAULI, v, _PAULI, v_dagger)
+    return 0.5 * m.real
+
+
+def stereographic_projection(points) -> np.ndarray:
+    """``ξ = (x + i y)/(1 − z)`` of points on the unit sphere (exercise 4.11a); the north pole maps to ``inf``.
+
+    Parameters
+    ----------
+    points : (..., 3) array_like
+        Unit vectors.
+
+    Returns
+    -------
+    (...) complex
+    """
+    p = np.asarray(points, dtype=np.float64)
+    if p.shape[-1:] != (3,):
+        raise UsageError(f"Expected `points` to have shape (..., 3), got {p.shape}")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return (p[..., 0] + 1j * p[..., 1]) / (1.0 - p[..., 2])
+
+
+def inverse_stereographic_projection(xi) -> np.ndarray:
+    """Point of the unit sphere whose projection is ``ξ``: ``(2 Re ξ, 2 Im ξ, |ξ|² − 1)/(|ξ|² + 1)``."""
+    xi = np.asarray(xi, dtype=np.complex128)
+    r2 = np.abs(xi) ** 2
+    return np.stack([2 * xi.real, 2 * xi.imag, r2 - 1.0], -1) / (r2 + 1.0)[..., None]
+
+
+def moebius_transform(cayley_klein, xi) -> np.ndarray:
+    """``(α ξ + β)/(γ ξ + δ)`` (exercise 4.11b); ``cayley_klein`` (2, 2), ``xi`` any shape of complex."""
+    u = np.asarray(cayley_klein, dtype=np.complex128)
+    if u.shape != (2, 2):
+        raise UsageError(f"Expected `cayley_klein` to have shape (2, 2), got {u.shape}")
+    xi = np.asarray(xi, dtype=np.complex128)
+    return (u[0, 0] * xi + u[0, 1]) / (u[1, 0] * xi + u[1, 1])
