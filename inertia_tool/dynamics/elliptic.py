@@ -13,6 +13,11 @@ near-separatrix regime ``m → 1`` (where ``1 − m`` cannot be recovered from `
   circle, via Carlson's ``R_F`` (DLMF 19.25.5), continued over ``cn < 0``.
 * :func:`elliptic_pi_of_argument` — ``∫₀ᵘ dv / (1 − n sn² v)`` = Π(n; am u | m) with Carlson's ``R_F``,
   ``R_J`` (DLMF 19.25.14) and its quasi-periodicity ``Π(n; φ + jπ) = Π(n; φ) + 2j Π(n | m)``.
+* :func:`jacobi_sn_complex` — ``sn`` of a complex argument by the addition theorem (A&S 16.21.1).
+* :func:`weierstrass_p` — Weierstrass' ℘ from its invariants ``g2, g3`` (real, ``Δ = g2³ − 27 g3² > 0``), as
+  ``℘(z) = e3 + (e1 − e3) / sn²(√(e1 − e3) z | m)``, ``m = (e2 − e3)/(e1 − e3)`` (A&S 18.9.11), with the roots
+  ``e1 > e2 > e3`` of ``4e³ − g2 e − g3``; half-periods ``ω1 = K/√(e1 − e3)``, ``ω3 = i K'/√(e1 − e3)``
+  (:func:`weierstrass_half_periods`).  Used by the heavy top of exercise 4.10 (``dynamics.top_motion``).
 """
 
 from __future__ import annotations
@@ -20,7 +25,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import ellipkm1, elliprf, elliprj
 
-__all__ = ["complete_k", "jacobi_sn_cn_dn", "elliptic_f_from_sn_cn", "elliptic_pi_of_argument"]
+from ..errors import UsageError
+
+__all__ = ["complete_k", "jacobi_sn_cn_dn", "elliptic_f_from_sn_cn", "elliptic_pi_of_argument", "jacobi_sn_complex",
+           "weierstrass_roots", "weierstrass_half_periods", "weierstrass_p", "weierstrass_p_derivative"]
 
 _AGM_MAX_STEPS = 60
 
@@ -142,3 +150,91 @@ def elliptic_pi_of_argument(u, n: float, m: float, m1: float):
                                                                                       1.0 - n * s2)
     complete = float(elliprf(0.0, m1, 1.0) + (n / 3.0) * elliprj(0.0, m1, 1.0, 1.0 - n))
     return incomplete + 2.0 * j * complete
+
+
+def jacobi_sn_complex(z, m: float, m1: float):
+    """``sn(x + i y | m)`` for complex ``z`` (A&S 16.21.1):
+
+    ``sn = (s d1 + i c d s1 c1) / (c1² + m s² s1²)`` with ``s, c, d`` of ``(x | m)`` and ``s1, c1, d1`` of
+    ``(y | m1)`` (Jacobi's imaginary transformation).  ``0 < m < 1``.
+
+    Returns
+    -------
+    complex ndarray (shape of ``z``); ``inf`` at the poles ``2jK + i(2k + 1)K'``.
+    """
+    z = np.asarray(z, dtype=np.complex128)
+    s, c, d = jacobi_sn_cn_dn(z.real, m, m1)
+    s1, c1, d1 = jacobi_sn_cn_dn(z.imag, m1, m)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return (s * d1 + 1j * c * d * s1 * c1) / (c1 * c1 + m * s * s * s1 * s1)
+
+
+def weierstrass_roots(g2: float, g3: float) -> tuple[float, float, float]:
+    """Roots ``e1 > e2 > e3`` of ``4e³ − g2 e − g3`` (real invariants with ``Δ = g2³ − 27 g3² > 0``).
+
+    Trigonometric form: ``e_k = 2√(g2/12) cos((acos(27 g3 / √(27 g2³)) − 2πk)/3)``, ``k = 0, 1, 2``; the roots
+    sum to zero.
+
+    Raises
+    ------
+    UsageError
+        If the invariants are not finite or ``Δ ≤ 0`` (a lattice that is not rectangular: not implemented).
+    """
+    if not (np.isfinite(g2) and np.isfinite(g3)):
+        raise UsageError(f"Expected finite invariants g2, g3, got {g2!r}, {g3!r}")
+    disc = g2 ** 3 - 27.0 * g3 ** 2
+    if not (g2 > 0 and disc > 0):
+        raise UsageError(f"Expected a rectangular lattice, Δ = g2³ − 27 g3² > 0, got g2 = {g2!r}, g3 = {g3!r} "
+                         f"(Δ = {disc:.6g})")
+    r = 2.0 * np.sqrt(g2 / 12.0)
+    angle = np.arccos(np.clip(27.0 * g3 / np.sqrt(27.0 * g2 ** 3), -1.0, 1.0)) / 3.0
+    e1, e2, e3 = (r * np.cos(angle - 2.0 * np.pi * k / 3.0) for k in (0, 1, 2))
+    e1, e2, e3 = sorted((float(e1), float(e2), float(e3)), reverse=True)
+    return e1, e2, e3
+
+
+def _lattice(g2: float, g3: float):
+    e1, e2, e3 = weierstrass_roots(g2, g3)
+    span = e1 - e3
+    m, m1 = (e2 - e3) / span, (e1 - e2) / span
+    return e1, e2, e3, np.sqrt(span), m, m1
+
+
+def weierstrass_half_periods(g2: float, g3: float) -> tuple[float, complex]:
+    """Half-periods ``(ω1, ω3) = (K(m), i K(m1)) / √(e1 − e3)`` of ℘ for real ``g2, g3`` with ``Δ > 0``:
+    ``℘(ω1) = e1``, ``℘(ω1 + ω3) = e2``, ``℘(ω3) = e3``."""
+    _, _, _, root, m, m1 = _lattice(g2, g3)
+    return float(complete_k(m1)) / root, 1j * float(complete_k(m)) / root
+
+
+def weierstrass_p(z, g2: float, g3: float):
+    """Weierstrass' ``℘(z; g2, g3)`` for complex ``z``, real invariants with ``Δ > 0`` (A&S 18.9.11).
+
+    ``℘(z) = e3 + (e1 − e3) / sn²(√(e1 − e3) z | m)``, ``m = (e2 − e3)/(e1 − e3)``; it satisfies
+    ``℘′² = 4℘³ − g2 ℘ − g3`` and has double poles on the lattice ``2jω1 + 2kω3``.  With
+    ``g2 = 60 Σ′ w⁻⁴``, ``g3 = 140 Σ′ w⁻⁶`` over the lattice points ``w`` (Chapter 4 exercise 4.10 writes the
+    sums without the factors 60 and 140).
+
+    Returns
+    -------
+    complex ndarray (shape of ``z``)
+    """
+    e1, e2, e3, root, m, m1 = _lattice(g2, g3)
+    sn = jacobi_sn_complex(root * np.asarray(z, dtype=np.complex128), m, m1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return e3 + (e1 - e3) / (sn * sn)
+
+
+def weierstrass_p_derivative(z, g2: float, g3: float):
+    """``℘′(z) = −2 (e1 − e3)^{3/2} cn dn / sn³`` at ``√(e1 − e3) z`` (derivative of :func:`weierstrass_p`)."""
+    e1, e2, e3, root, m, m1 = _lattice(g2, g3)
+    w = root * np.asarray(z, dtype=np.complex128)
+    sn = jacobi_sn_complex(w, m, m1)
+    # cn and dn of the complex argument from sn: choose the branches by continuity through the real formulas
+    s, c, d = jacobi_sn_cn_dn(w.real, m, m1)
+    s1, c1, d1 = jacobi_sn_cn_dn(w.imag, m1, m)
+    den = c1 * c1 + m * s * s * s1 * s1
+    cn = (c * c1 - 1j * s * d * s1 * d1) / den          # A&S 16.21.2
+    dn = (d * c1 * d1 - 1j * m * s * c * s1) / den       # A&S 16.21.3
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return -2.0 * root ** 3 * cn * dn / sn ** 3
