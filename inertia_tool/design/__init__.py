@@ -1,0 +1,1 @@
+"""Designing the inside of a part (placeholder, filled below)."""
