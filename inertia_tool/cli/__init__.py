@@ -81,7 +81,7 @@ def speak_options(message: str, parser=None) -> str:
     return _PARAMETER.sub(option, message)
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ["analyze", "balance", "spin", "top", "batch", "robot"]
+SUBCOMMANDS = ["analyze", "balance", "spin", "top", "spin_it", "batch", "robot"]
 
 
 # Values such as "-40,40", "-5,0,0", "-20deg", "-2mm,0,0" or "-40mm,40mm" start with "-" but are numbers

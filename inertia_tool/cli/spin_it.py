@@ -1,0 +1,111 @@
+"""``inertia-tool spin-it FILE --axis 0,0,1 --mode yoyo|top --wall 2mm``: hollow a part so that it spins."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+
+import numpy as np
+
+from ..errors import UsageError
+from ..units import length_scale, parse_density, parse_length, parse_mass, parse_vector
+from .analyze import add_material_options
+from .report_option import check_output_file
+
+__all__ = ["register", "run", "OUTPUT_SUFFIXES"]
+
+#: Mesh formats ``--out`` writes (through trimesh): STL in the ``--units`` of the input, 3MF in millimetres.
+OUTPUT_SUFFIXES = (".stl", ".3mf")
+
+
+def register(subparsers) -> None:
+    from ..design.hollow import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
+    p = subparsers.add_parser(
+        "spin-it", help="hollow a part so that it spins stably as a yo-yo or a top",
+        description="Design the inside of a part (Bächer et al., Spin-It, 2014; Hafner et al., Spin-It Faster, "
+                    "2024): a cavity bounded by a quadric, keeping a minimum wall, so that the part spins stably "
+                    "about the given axis — as a yo-yo (free spin, Chapter 4 §4.4.1: the axis a principal axis of "
+                    "largest moment, through the centre of mass) or a top on a pivot (§4.4.3: centre of mass on "
+                    "the axis, equal transverse moments, low sleeping-top spin). The hollowed mesh is re-analysed "
+                    "exactly; the report compares before and after.")
+    p.add_argument("files", metavar="FILE", help="closed mesh: STL, OBJ, PLY, OFF, 3MF")
+    add_material_options(p)
+    p.add_argument("--axis", required=True, metavar="X,Y,Z", help="spin axis direction (unitless, normalised)")
+    p.add_argument("--mode", choices=("yoyo", "top"), default="yoyo", help="yoyo (free spin) or top (on a pivot)")
+    p.add_argument("--through", metavar="X,Y,Z",
+                   help="yo-yo: a point of the axis (in --units unless a unit is given); the centre of mass is "
+                        "pulled onto that line. Without it only the direction counts")
+    p.add_argument("--pivot", metavar="X,Y,Z", help="top: the pivot point (in --units unless a unit is given)")
+    p.add_argument("--wall", required=True, metavar="LENGTH",
+                   help="minimum wall thickness, e.g. 2mm (a bare number is in --units)")
+    p.add_argument("--resolution", type=int, default=DEFAULT_RESOLUTION, metavar="N",
+                   help=f"voxel cells across the largest extent ({MIN_RESOLUTION} to {MAX_RESOLUTION}, "
+                        f"default {DEFAULT_RESOLUTION})")
+    p.add_argument("--out", metavar="OUT.stl|OUT.3mf",
+                   help="write the hollowed part (STL in --units, 3MF in millimetres)")
+    p.add_argument("--force", action="store_true", help="let --out replace an existing file")
+    p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of text")
+    p.set_defaults(func=run)
+
+
+def _direction(text: str) -> np.ndarray:
+    parts = [s.strip() for s in str(text).split(",")]
+    try:
+        v = np.array([float(s) for s in parts])
+    except ValueError:
+        v = np.zeros(0)
+    if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.linalg.norm(v) > 0:
+        raise UsageError(f"--axis must be three numbers, not all zero, like 0,0,1; got {text!r}")
+    return v
+
+
+def _write(path: str, vertices, faces, units: str, force: bool) -> None:
+    import trimesh
+
+    suffix = os.path.splitext(path)[1].lower()
+    scale = length_scale("mm") if suffix == ".3mf" else length_scale(units)
+    mesh = trimesh.Trimesh(np.asarray(vertices) / scale, np.asarray(faces), process=False)
+    if os.path.exists(path) and not force:
+        raise UsageError(f"--out {path}: exists; refusing to overwrite it (use --force)")
+    tmp = f"{path}.tmp-{os.getpid()}{suffix}"
+    try:
+        mesh.export(tmp, file_type=suffix[1:])
+        os.replace(tmp, path)
+    except OSError as exc:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise UsageError(f"--out {path}: cannot write it ({exc.strerror or exc})") from None
+
+
+def run(args) -> int:
+    from ..design import spin_it
+    from ..reports.spin_it import format_spin_it_text, spin_it_dict
+
+    if args.out:
+        if os.path.splitext(args.out)[1].lower() not in OUTPUT_SUFFIXES:
+            raise UsageError(f"--out writes {' or '.join(OUTPUT_SUFFIXES)}, got {args.out!r}")
+        check_output_file(args.out, "--out", args.force)
+    if args.mode == "top" and args.pivot is None:
+        raise UsageError("--mode top needs --pivot X,Y,Z")
+    if args.mode == "top" and args.through is not None:
+        raise UsageError("--through is for --mode yoyo; a top's axis passes through its --pivot")
+    if args.mode == "yoyo" and args.pivot is not None:
+        raise UsageError("--pivot is for --mode top")
+    wall = parse_length(args.wall, args.units)
+    if not wall > 0:
+        raise UsageError(f"--wall must be positive, got {args.wall}")
+    result = spin_it(args.files, axis=_direction(args.axis), mode=args.mode, wall=wall,
+                     through=parse_vector(args.through, args.units) if args.through else None,
+                     pivot=parse_vector(args.pivot, args.units) if args.pivot else None, units=args.units,
+                     density=parse_density(args.density) if args.density is not None else None,
+                     material=args.material, mass=parse_mass(args.mass) if args.mass is not None else None,
+                     resolution=args.resolution)
+    if args.out:
+        _write(args.out, result.vertices, result.faces, args.units, args.force)
+    if args.json:
+        json.dump(spin_it_dict(result, output=args.out), sys.stdout, indent=2, ensure_ascii=False)
+        sys.stdout.write("\n")
+    else:
+        sys.stdout.write(format_spin_it_text(result, name=args.files, output=args.out))
+    return 0
