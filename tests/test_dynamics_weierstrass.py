@@ -9,7 +9,7 @@ from inertia_tool.dynamics.elliptic import (weierstrass_half_periods, weierstras
                                             weierstrass_roots)
 from inertia_tool.dynamics.top_motion import top_cos_theta, top_weierstrass_invariants
 from inertia_tool.errors import PhysicsError, UsageError
-from inertia_tool.heavy_top import heavy_top
+from inertia_tool.dynamics.top import heavy_top
 
 G2, G3 = 7.0, 1.3          # Δ = 343 − 45.6 > 0: a rectangular lattice
 

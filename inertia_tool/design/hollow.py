@@ -79,9 +79,9 @@ class SpinDesignMetrics:
         ``√(−c)`` is the wobble frequency per unit spin.
     sleeping_threshold : float or None
         Top: the spin ``√(4 I1 M g l)/I3`` (rad/s) above which the upright top sleeps (§4.4.3, from
-        ``inertia_tool.heavy_top``); ``None`` for a yo-yo.
+        ``inertia_tool.dynamics.top``); ``None`` for a yo-yo.
     transverse_asymmetry : float or None
-        Top: ``inertia_tool.heavy_top``'s measure of how far the body is from a symmetric top about the pivot
+        Top: ``inertia_tool.dynamics.top``'s measure of how far the body is from a symmetric top about the pivot
         (0 for a symmetric top); ``None`` for a yo-yo.
     height : float or None
         Top: distance ``l`` from the pivot to the centre of mass, m.
@@ -179,7 +179,7 @@ def design_frame(axis) -> np.ndarray:
 def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80665) -> SpinDesignMetrics:
     """:class:`SpinDesignMetrics` of ``props`` for spinning about ``axis`` (yo-yo: through ``origin`` if given;
     top: ``origin`` is the pivot)."""
-    from ..stability import stability
+    from ..dynamics.spin_stability import stability
 
     axis = _unit(axis, "axis")
     report = stability(props)
@@ -200,10 +200,10 @@ def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80
                                  moment_ratio=float(central[2, 2] / transverse[1]),
                                  axis_tilt=float(math.acos(min(1.0, cosines[nearest]))), axis_offset=offset,
                                  nearest_principal=entry.name, epsilon_coefficient=float(entry.coefficient))
-    from ..heavy_top import heavy_top_from_mesh
+    from ..dynamics.top import heavy_top_on_pivot
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AsymmetricTopWarning)      # reported as transverse_asymmetry
-        top = heavy_top_from_mesh(props, origin, theta0=0.0, omega3=1.0, g=gravity)
+        top = heavy_top_on_pivot(props, origin, theta0=0.0, omega3=1.0, g=gravity)
     return SpinDesignMetrics(mass=props.mass, axis_moment=top.axial_moment, next_moment=top.transverse_moment,
                              moment_ratio=top.axial_moment / top.transverse_moment,
                              axis_tilt=float(math.acos(min(1.0, abs(top.symmetry_axis @ axis)))),
@@ -215,8 +215,9 @@ def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80
 
 def _load(source, units: str, density, material, mass):
     """Checked vertices and faces (m, outward-wound) and the exact mass properties of the solid part."""
-    from ..io import load_mesh
-    from ..pipeline import mass_properties, prepare_mesh, resolve_density
+    from ..mass.pipeline import mass_properties, resolve_density
+    from ..mesh.prepare import prepare_mesh
+    from ..mesh.read import load_mesh
 
     rho, _ = resolve_density(density=density, material=material, mass=mass)
     raw = load_mesh(source, units=units)
@@ -422,7 +423,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
                                          wall)
     else:
         out_v, out_f, measured = vertices, faces, math.inf
-    from ..pipeline import mass_properties
+    from ..mass.pipeline import mass_properties
     after = mass_properties((out_v, out_f), density=rho, name=f"{name} (hollowed)")
     metric_origin = origin if (mode == "top" or through is not None) else None
     return SpinItResult(mode=mode, axis=axis, origin=origin, wall=float(wall), vertices=out_v, faces=out_f,

@@ -11,11 +11,11 @@ oscillates between ``u_X`` and ``u_N`` is ``℘`` on the line through the imagin
     u(t) = c + (4/β) ℘(t − ω3),     t = 0 at the bottom of a wobble (θ = θ_max, u = u_X),
 
 doubly periodic with real period ``T = 2ω1`` — the nutation period ``4K(m)/√(β(u_U − u_X))`` of
-``inertia_tool.heavy_top`` — and imaginary period ``τ``.  (Exercise 4.10(g) writes ``u = β ℘(t − iτ/2) + c``;
+``inertia_tool.dynamics.top`` — and imaginary period ``τ``.  (Exercise 4.10(g) writes ``u = β ℘(t − iτ/2) + c``;
 matching the ``u³`` coefficients gives the factor ``4/β`` used here.)
 
 The top is described by any object with the attributes ``a, b, alpha, beta`` of
-``inertia_tool.heavy_top.HeavyTopReport`` (1/s, 1/s²).
+``inertia_tool.dynamics.top.HeavyTopReport`` (1/s, 1/s²).
 """
 
 from __future__ import annotations
