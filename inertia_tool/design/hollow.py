@@ -46,6 +46,10 @@ MIN_RESOLUTION, MAX_RESOLUTION = 12, 128
 #: centres; the margin covers the linear interpolation of the level set between them).
 DEPTH_MARGIN = 0.5
 
+#: Edges of the cavity mesh shorter than this fraction of a cell are collapsed (``Manifold.simplify``), so
+#: that a float32 STL of the result keeps every vertex distinct.
+SNAP = 1e-3
+
 #: Attempts at meshing the cavity, each with half a cell more margin if the measured wall came out thin.
 MAX_MESH_ATTEMPTS = 4
 
@@ -132,6 +136,12 @@ class SpinItResult:
         Voxel edge, m.
     allowed_cells, removed_cells : int
         Cells deep enough to be removed, and removed by the optimum.
+    objective_before, objective_after : float
+        The mode's objective (``design.moments``) of the solid part and of the re-analysed hollowed part.
+    optimisation_seconds : float
+        Time spent optimising the quadric.
+    objective_evaluations : int
+        Evaluations of the objective in all optimisations.
     seconds : float
         Wall-clock time of the whole design.
     """
@@ -152,6 +162,10 @@ class SpinItResult:
     cell_size: float
     allowed_cells: int
     removed_cells: int
+    objective_before: float
+    objective_after: float
+    optimisation_seconds: float
+    objective_evaluations: int
     seconds: float
 
 
@@ -242,8 +256,9 @@ def _exact_near_wall(grid, vertices, faces, wall: float):
 
 
 def _cavity_field(grid, cavity: QuadricCavity, origin, frame, threshold: float):
-    """The scalar field ``min(depth − threshold, −q · half_extent)`` (m, positive inside the cavity) as a
-    Python callable of mesh coordinates, for ``Manifold.level_set``: trilinear depth from the grid."""
+    """The scalar field ``min(depth − threshold, −q · half_extent)`` (m, positive inside the cavity), its
+    crease rounded over a quarter cell, as a Python callable of mesh coordinates for ``Manifold.level_set``;
+    the depth is trilinear between the grid's cell centres."""
     sd = grid.signed_distance
     nx, ny, nz = sd.shape
     flat = sd.ravel().tolist()
@@ -257,6 +272,7 @@ def _cavity_field(grid, cavity: QuadricCavity, origin, frame, threshold: float):
     a = (r.T / half).tolist()
     b = ((-(r.T @ np.asarray(origin)) - c) / half).tolist()
     stride_x, stride_y = ny * nz, nz
+    smooth = 0.25 * grid.spacing
 
     def field(x, y, z):
         gx, gy, gz = (x - ox) * inv, (y - oy) * inv, (z - oz) * inv
@@ -277,7 +293,10 @@ def _cavity_field(grid, cavity: QuadricCavity, origin, frame, threshold: float):
         w = a[2][0] * x + a[2][1] * y + a[2][2] * z + b[2]
         q = (t[0] + t[1] * u + t[2] * v + t[3] * w + t[4] * u * u + t[5] * v * v + t[6] * w * w
              + t[7] * u * v + t[8] * u * w + t[9] * v * w)
-        return min(depth - threshold, -q * half)
+        deep, inner = depth - threshold, -q * half
+        # smooth minimum (rounds the crease where the wall meets the quadric, so the two sheets of the
+        # marching tetrahedra do not pinch at a shared point): min(d, e) − k log(1 + exp(−|d − e|/k))
+        return min(deep, inner) - smooth * math.log1p(math.exp(-abs(deep - inner) / smooth))
 
     return field
 
@@ -295,8 +314,31 @@ def _arrays_of(manifold):
     return np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3], np.asarray(mesh.tri_verts, dtype=np.int64)
 
 
+def _separate_pinches(vertices, faces, distance: float):
+    """Move apart vertices that share a position (float32), each by ``distance`` along its outward normal.
+
+    Marching tetrahedra can leave two sheets of the cavity touching at one point, as two distinct vertices at
+    the same position: a valid manifold, but a mesh file welds them into a non-manifold vertex.  Moving each
+    copy outward (into the cavity it bounds) separates the sheets by ``2 distance``.
+    """
+    v = np.array(vertices, dtype=np.float64)
+    _, inverse, counts = np.unique(v.astype(np.float32), axis=0, return_inverse=True, return_counts=True)
+    shared = counts[inverse.ravel()] > 1
+    if not np.any(shared):
+        return v, faces
+    tri = v[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    vertex_normal = np.zeros_like(v)
+    for k in range(3):
+        np.add.at(vertex_normal, faces[:, k], normal)
+    length = np.linalg.norm(vertex_normal[shared], axis=1)
+    v[shared] += distance * vertex_normal[shared] / np.where(length > 0, length, 1.0)[:, None]
+    return v, faces
+
+
 def _hollow(vertices, faces, grid, cavity, removed_centres, origin, frame, wall: float):
-    """Mesh the cavity, check the wall exactly, subtract; returns (vertices, faces, measured_wall)."""
+    """Mesh the cavity, check the wall exactly, subtract, separate pinches; returns (vertices, faces,
+    measured_wall)."""
     try:
         import manifold3d
     except ImportError as exc:                # pragma: no cover - a dependency of the package
@@ -307,25 +349,26 @@ def _hollow(vertices, faces, grid, cavity, removed_centres, origin, frame, wall:
     margin = DEPTH_MARGIN * h
     for _ in range(MAX_MESH_ATTEMPTS):
         field = _cavity_field(grid, cavity, origin, frame, wall + margin)
-        hole = manifold3d.Manifold.level_set(field, [*lo, *hi], h)
+        # marching tetrahedra can leave vertices closer than a float32 STL can tell apart: merge them
+        hole = manifold3d.Manifold.level_set(field, [*lo, *hi], h).simplify(SNAP * h)
         if hole.is_empty():
             return vertices, faces, math.inf
         hole_v, _ = _arrays_of(hole)
         measured = float(surface_distance(hole_v, vertices, faces, cutoff=wall + h).min())
-        if measured >= wall:
+        if measured >= wall + SNAP * h:          # pinches are separated by SNAP·h below
             break
         margin += 0.5 * h
     else:
-        raise PhysicsError(f"could not keep a wall of {wall:g} m: the thinnest came out {measured:g} m after "
-                           f"{MAX_MESH_ATTEMPTS} attempts")
+        raise PhysicsError(f"could not mesh a cavity keeping a wall of {wall:g} m: the thinnest came out "
+                           f"{measured:g} m after {MAX_MESH_ATTEMPTS} attempts")
     part = _manifold_of(vertices, faces)
     if part.status() != manifold3d.Error.NoError:
         raise PhysicsError(f"the part is not a manifold solid for the boolean ({part.status()})")
     result = part - hole
     if result.status() != manifold3d.Error.NoError:
         raise PhysicsError(f"the boolean subtraction failed ({result.status()})")
-    out_v, out_f = _arrays_of(result)
-    return out_v, out_f, measured
+    out_v, out_f = _separate_pinches(*_arrays_of(result), SNAP * h)
+    return out_v, out_f, measured - SNAP * h
 
 
 def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivot=None, units: str = "m",
@@ -386,6 +429,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         pivot = _point(pivot, "pivot")
     elif pivot is not None:
         raise UsageError("`pivot` is for mode 'top'")
+    from ..mass.pipeline import mass_properties
     vertices, faces, before, name = _load(source, units, density, material, mass)
     size = float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
     extent = float(np.max(vertices.max(axis=0) - vertices.min(axis=0)))
@@ -418,13 +462,11 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
             return OBJECTIVES["top"](mu, size=size, center_weight=center_weight, product_weight=product_weight,
                                      reference_threshold=reference)
     cavity = optimize_quadric_cavity(objective, mu_part, points, h, size=size)
+    out_v, out_f, measured, after = vertices, faces, math.inf, before
     if np.any(cavity.removed):
         out_v, out_f, measured = _hollow(vertices, faces, grid, cavity, centres[cavity.removed], origin, frame,
                                          wall)
-    else:
-        out_v, out_f, measured = vertices, faces, math.inf
-    from ..mass.pipeline import mass_properties
-    after = mass_properties((out_v, out_f), density=rho, name=f"{name} (hollowed)")
+        after = mass_properties((out_v, out_f), density=rho, name=f"{name} (hollowed)")
     metric_origin = origin if (mode == "top" or through is not None) else None
     return SpinItResult(mode=mode, axis=axis, origin=origin, wall=float(wall), vertices=out_v, faces=out_f,
                         before=before, after=after,
@@ -432,4 +474,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
                         metrics_after=design_metrics(after, mode, axis, metric_origin, gravity=gravity),
                         measured_wall=measured, cavity_volume=float(before.volume - after.volume), cavity=cavity,
                         cell_size=h, allowed_cells=int(len(points)), removed_cells=int(cavity.removed.sum()),
+                        objective_before=float(objective(mu_part)),
+                        objective_after=float(objective(moment_vector(after, origin, frame) / rho)),
+                        optimisation_seconds=cavity.seconds, objective_evaluations=cavity.evaluations,
                         seconds=time.perf_counter() - started)
