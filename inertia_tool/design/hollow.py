@@ -50,6 +50,9 @@ DEPTH_MARGIN = 0.5
 #: that a float32 STL of the result keeps every vertex distinct.
 SNAP = 1e-3
 
+#: Smallest separate void kept, in cell volumes.
+MIN_VOID_CELLS = 8
+
 #: Attempts at meshing the cavity, each with half a cell more margin if the measured wall came out thin.
 MAX_MESH_ATTEMPTS = 4
 
@@ -351,6 +354,10 @@ def _hollow(vertices, faces, grid, cavity, removed_centres, origin, frame, wall:
         field = _cavity_field(grid, cavity, origin, frame, wall + margin)
         # marching tetrahedra can leave vertices closer than a float32 STL can tell apart: merge them
         hole = manifold3d.Manifold.level_set(field, [*lo, *hi], h).simplify(SNAP * h)
+        # slivers the marching tetrahedra leave where the field grazes zero: voids smaller than (2h)³ change
+        # the moments by nothing measurable and no print could be emptied of them
+        pieces = [piece for piece in hole.decompose() if piece.volume() >= MIN_VOID_CELLS * h ** 3]
+        hole = manifold3d.Manifold.batch_boolean(pieces, manifold3d.OpType.Add) if pieces else manifold3d.Manifold()
         if hole.is_empty():
             return vertices, faces, math.inf
         hole_v, _ = _arrays_of(hole)
