@@ -11,7 +11,8 @@ its indicator on the cells smoothed as ``σ(−q/τ)`` (logistic) so that ``f`` 
 width ``τ`` is annealed down to half a cell and the final cavity is the sharp ``q < 0``.  Starts: the
 first-order quadric ``q = −∇f(μ_part) · ψ`` (carve wherever removing material helps) and a central ball;
 BFGS (scipy; 10 unknowns) with the analytic gradient ``∂f/∂θ = −∇f · Σ_i ψ_i σ′_i ∂(−q_i/τ)/∂θ``, ``∇f`` by forward
-differences in the 10 moments.
+differences in the 10 moments.  Finally the sharp cavity is polished by the fixed point of its optimality
+condition (Hafner et al.: the cavity is where the first-order quadric at its own moments is negative).
 """
 
 from __future__ import annotations
@@ -28,6 +29,9 @@ __all__ = ["QuadricCavity", "optimize_quadric_cavity", "quadric_values"]
 #: Sigmoid widths (in units of the normalised coordinate) of the annealing stages, before the last one at
 #: half a cell.
 ANNEALING = (0.3, 0.1, 0.03)
+
+#: Most fixed-point steps of the optimality condition after the annealing (each one objective gradient).
+MAX_POLISH_STEPS = 30
 
 #: Most BFGS iterations per annealing stage and start.
 MAX_ITERATIONS_PER_STAGE = 40
@@ -163,10 +167,32 @@ def optimize_quadric_cavity(objective, mu_part, points, spacing: float, *, size:
         removed = np.einsum("ij,j->i", phi, theta) < 0
         return counted(mu_part - psi[removed].sum(axis=0)), removed
 
-    # starts: the first-order quadric (carve where removing material lowers f) and a central ball
-    g0 = _gradient_in_moments(counted, mu_part, scales, solid_value)
-    first_order, *_ = np.linalg.lstsq(phi, -(psi @ g0), rcond=None)
-    starts = [first_order, np.array([-0.25, 0, 0, 0, 1, 1, 1, 0, 0, 0], dtype=float)]
+    # ψ·g is a quadratic polynomial: its coefficients in the monomials of x̂ are fitted exactly on a few cells
+    sample = np.unique(np.linspace(0, len(pts) - 1, min(len(pts), 200)).astype(int))
+
+    def first_order(mu, value):
+        """The quadric of cells whose removal lowers f to first order at μ: q = −∇f(μ) · ψ."""
+        g = _gradient_in_moments(counted, mu, scales, value)
+        theta, *_ = np.linalg.lstsq(phi[sample], -np.einsum("ij,j->i", psi[sample], g), rcond=None)
+        return theta / max(np.linalg.norm(theta), 1e-300)
+
+    def polish(theta, value, removed):
+        """Fixed-point iteration of the optimality condition (the cavity is where the first-order quadric at
+        its own moments is negative), accepting only improvements; plain or averaged with the current θ."""
+        for _ in range(MAX_POLISH_STEPS):
+            target = first_order(mu_part - psi[removed].sum(axis=0), value)
+            for trial in (target, theta + target):
+                trial = trial / np.linalg.norm(trial)
+                trial_value, trial_removed = sharp(trial)
+                if trial_value < value:
+                    theta, value, removed = trial, trial_value, trial_removed
+                    break
+            else:
+                break
+        return theta, value, removed
+
+    # starts: the first-order quadric at the solid part (carve where removing material lowers f), a ball
+    starts = [first_order(mu_part, solid_value), np.array([-0.25, 0, 0, 0, 1, 1, 1, 0, 0, 0], dtype=float)]
     cell = spacing / half
     schedule = [t for t in ANNEALING if t > 0.5 * cell] + [0.5 * cell]
     best_value, best_theta, best_removed = solid_value, None, np.zeros(len(pts), bool)
@@ -178,7 +204,7 @@ def optimize_quadric_cavity(objective, mu_part, points, spacing: float, *, size:
             result = minimize(smooth, theta, args=(tau,), jac=True, method="BFGS",
                               options={"maxiter": MAX_ITERATIONS_PER_STAGE, "gtol": 1e-9})
             theta = result.x / np.linalg.norm(result.x)
-        value, removed = sharp(theta)
+        theta, value, removed = polish(theta, *sharp(theta))
         if value < best_value:
             best_value, best_theta, best_removed = value, theta, removed
     if best_theta is None:
