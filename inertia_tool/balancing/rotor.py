@@ -465,6 +465,15 @@ class BalanceReport:
         Standard grade the corrected body meets.
     notes : tuple of str
         Caveats (centre of mass outside the tolerance planes, clamped allocation, ...).
+    drillings : tuple of DrilledHole
+        With ``drill_diameter``: the holes that do the corrections' work by removing material
+        (:mod:`.drilling`); empty otherwise.
+    drilled : UnbalanceState or None
+        Verification of the drilling: the body less the exact drilled cylinders, re-analysed.
+    drilled_value : float
+        ``achieved_value`` of the drilled body, mm/s (``nan`` without drilling).
+    drilled_grade : BalanceGrade or None
+        Standard grade the drilled body meets.
     """
 
     name: str
@@ -485,6 +494,10 @@ class BalanceReport:
     corrected_value: float
     corrected_grade: BalanceGrade | None
     notes: tuple
+    drillings: tuple = ()
+    drilled: UnbalanceState | None = None
+    drilled_value: float = float("nan")
+    drilled_grade: BalanceGrade | None = None
 
     @property
     def mass(self) -> float:
@@ -585,7 +598,7 @@ def _check_shaft_meets_part(props: MassProperties, frame, offset: float, k_max: 
 def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | None = None,
             speed: float | None = None, planes=None, radius: float, grade=None, bearings=None,
             single_plane: bool = False, max_axis_offset: float = 10.0, offset_tol: float | None = None,
-            tilt_tol: float = 1e-8) -> BalanceReport:
+            tilt_tol: float = 1e-8, drill_diameter: float | None = None, part_mesh=None) -> BalanceReport:
     """Balancing report of a rigid rotor turning about a given shaft (§4.3.2 "Tire balancing", Eq. 4.26,
     ISO 21940-2 and ISO 21940-11).
 
@@ -619,6 +632,12 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
         counterweights turning about a shaft through them are accepted.
     offset_tol, tilt_tol : float
         Tolerances of the kind classification, see :func:`unbalance_state`.
+    drill_diameter : float, optional
+        Also propose removing material: each correction becomes a hole of this diameter (m) drilled parallel
+        to the shaft at ``radius``, at the removal angle, from the correction plane (:mod:`.drilling`).
+    part_mesh : (vertices, faces), optional
+        The part's closed surface (m, mesh axes), to check with the winding number that each hole lies
+        inside the part.
 
     Returns
     -------
@@ -706,13 +725,28 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
 
     achieved_value, achieved = _achieved(tolerance, props.mass, omega)
     corrected_value, corrected_grade = _achieved(corrected_tolerance, corrected_body.mass, omega)
+    drilling = {}
+    if drill_diameter is not None:
+        from .drilling import drill_holes, remove_cylinders
+        holes = drill_holes(props, frame, planes_t, r, float(drill_diameter), state.static_unbalance,
+                            state.moment_unbalance, part_mesh=part_mesh)
+        drilled_body = remove_cylinders(props, holes)
+        drilled = unbalance_state(drilled_body, frame, offset_tol=offset_tol, tilt_tol=tilt_tol)
+        drilled_value, drilled_grade = _achieved(_plane_data(drilled, tol_positions, omega, u_per, shares),
+                                                 drilled_body.mass, omega)
+        if not any(h.inside_checked for h in holes):
+            notes.append("the holes were not checked to lie inside the part (give `part_mesh`)")
+        drilling = dict(drillings=holes, drilled=drilled, drilled_value=drilled_value, drilled_grade=drilled_grade)
+    elif part_mesh is not None:
+        raise UsageError("`part_mesh` is only used to check drilled holes: give `drill_diameter` too")
     report = BalanceReport(name=props.name, frame=frame, speed=omega, initial=state,
                            torque=_readonly(state.bearing_torque(omega)),
                            force=_readonly(-omega ** 2 * state.static_unbalance), quality_grade=quality,
                            permissible_unbalance=u_per, tolerance_planes=tolerance, achieved_value=achieved_value,
                            achieved_grade=achieved, correction_planes=correction_planes,
                            corrections=tuple(corrections), single_plane=single_plane, corrected=corrected,
-                           corrected_value=corrected_value, corrected_grade=corrected_grade, notes=tuple(notes))
+                           corrected_value=corrected_value, corrected_grade=corrected_grade, notes=tuple(notes),
+                           **drilling)
     for what, value in (("rotating force", report.force), ("torque of the supports", report.torque),
                         ("correction masses", [c.mass for c in corrections]),
                         ("plane loads", [p.force for p in tolerance] or 0.0)):

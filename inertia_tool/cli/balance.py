@@ -14,7 +14,7 @@ from ..errors import UsageError
 from ..reports.output import check_targets, write_files
 from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length
-from .analyze import add_material_options, add_mesh_options, load_from_args
+from .analyze import add_material_options, add_mesh_options, load_from_args, split_part_spec
 from .options import check_option
 
 __all__ = ["register", "run"]
@@ -58,6 +58,10 @@ def register(subparsers) -> None:
     s.add_argument("--bearings", metavar="ZA,ZB",
                    help="axial positions of the two bearings, in --units: the tolerance is checked there and "
                         "the report gives the rotating bearing loads")
+    s.add_argument("--drill", metavar="DIAMETER",
+                   help="also propose removing material: each correction as a hole of this diameter drilled "
+                        "parallel to the shaft at --radius from its plane, e.g. 6mm (in --units); checked to lie "
+                        "inside the part")
     o = p.add_argument_group("output")
     o.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of the text report")
     o.add_argument("--report", metavar="FILE.html|FILE.md",
@@ -100,9 +104,21 @@ def run(args) -> int:
         _, svgs = _report_paths(args.report, 1 if args.single_plane else 2)
         check_targets([(args.report, "--report")] + [(name, "--report") for name in svgs], force=args.force)
 
+    drill = None
+    if args.drill is not None:
+        drill = check_option("--radius", parse_length(args.drill, default_unit=unit), typed=args.drill,
+                             label="--drill")             # a length in the range of --radius
     props, _ = load_from_args(args)
+    part_mesh = None
+    if drill is not None:
+        if len(args.files) != 1:
+            raise UsageError("--drill needs a single part (an assembly has no one material to drill)")
+        from ..mesh.read import load_mesh
+        raw = load_mesh(split_part_spec(args.files[0])[0], units=unit, max_faces=args.max_faces)
+        part_mesh = (raw.vertices, raw.faces)
     report = balance(props, axis_point=axis_point, axis_direction=direction, speed=speed, planes=planes,
-                     radius=radius, grade=args.grade, bearings=bearings, single_plane=args.single_plane)
+                     radius=radius, grade=args.grade, bearings=bearings, single_plane=args.single_plane,
+                     drill_diameter=drill, part_mesh=part_mesh)
 
     if args.report is not None:       # written before anything is printed, so a failure prints one line only
         ext, svgs = _report_paths(args.report, len(report.corrections))

@@ -130,6 +130,12 @@ def balance_dict(report: BalanceReport) -> dict:
                          "achieved_grade": None if report.corrected_grade is None else report.corrected_grade.name,
                          "couple_corrected": not _couple_left(report),
                          "summary": _verification_text(report)},
+        "drillings": [{"plane": h.plane, "angle": h.angle, "radius": h.radius, "diameter": h.diameter,
+                       "depth": h.depth, "direction": h.direction, "mass": h.mass, "entry": h.entry, "axis": h.axis,
+                       "centroid": h.centroid, "inside_checked": h.inside_checked} for h in report.drillings],
+        "drilled_verification": None if report.drilled is None else {
+            **_state_dict(report.drilled), "achieved_value": report.drilled_value,
+            "achieved_grade": None if report.drilled_grade is None else report.drilled_grade.name},
         "notes": list(report.notes),
     })
 
@@ -260,6 +266,18 @@ def format_balance_text(report: BalanceReport) -> str:
     title = "Single-plane (static) correction" if report.single_plane else "Two-plane correction"
     lines += ["", title] + _table_text(_CORR_HEAD, _correction_rows(report))
     lines += ["", "Verification (part + correction masses re-analysed)", "  " + _verification_text(report)]
+    if report.drillings:
+        lines += ["", "Or remove material: drill parallel to the shaft from each correction plane"]
+        rows = [[str(k), f"{h.plane * 1e3:.4g}", f"{h.diameter * 1e3:.4g}", f"{h.depth * 1e3:.4g}",
+                 "+z" if h.direction > 0 else "−z", f"{h.radius * 1e3:.4g}", f"{_deg(h.angle):.1f}",
+                 _num(h.mass * 1e3), "yes" if h.inside_checked else "not checked"]
+                for k, h in enumerate(report.drillings, start=1)]
+        lines += _table_text(["hole", "from z [mm]", "Ø [mm]", "depth [mm]", "towards", "radius [mm]", "at [°]",
+                              "removes [g]", "inside the part"], rows)
+        d = report.drilled
+        lines += ["  verification (part less the drilled cylinders re-analysed): static "
+                  f"{_num(_mag(d.static_unbalance) * _G_MM)} g·mm, couple {_num(_mag(d.couple_unbalance) * _G_MM2)} "
+                  f"g·mm², kind {d.kind}, meets {_grade_name(report.drilled_grade, report.drilled_value)}"]
     if report.notes:
         lines += ["", "Notes"] + [f"  - {n}" for n in report.notes]
     return "\n".join(lines) + "\n"
