@@ -19,7 +19,7 @@ TOP_LEVEL = {
 
 #: The subpackages whose ``__all__`` is public API (documented parameter by parameter below).
 SUBPACKAGES = ["inertia_tool.mesh", "inertia_tool.mass", "inertia_tool.dynamics", "inertia_tool.balancing",
-               "inertia_tool.robot", "inertia_tool.batch"]
+               "inertia_tool.robot", "inertia_tool.batch", "inertia_tool.design"]
 
 
 def test_top_level_surface_is_pinned():

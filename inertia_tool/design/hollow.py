@@ -194,8 +194,25 @@ def design_frame(axis) -> np.ndarray:
 
 
 def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80665) -> SpinDesignMetrics:
-    """:class:`SpinDesignMetrics` of ``props`` for spinning about ``axis`` (yo-yo: through ``origin`` if given;
-    top: ``origin`` is the pivot)."""
+    """:class:`SpinDesignMetrics` of a body spinning about an axis.
+
+    Parameters
+    ----------
+    props : MassProperties
+        The body.
+    mode : {"yoyo", "top"}
+        Free spin (§4.4.1) or heavy top on a pivot (§4.4.3).
+    axis : (3,) array_like
+        Spin axis direction, mesh axes.
+    origin : (3,) array_like, optional
+        Yo-yo: a point of the axis (``None``: only the direction counts); top: the pivot (required). m.
+    gravity : float
+        m/s², for the sleeping-top threshold.
+
+    Returns
+    -------
+    SpinDesignMetrics
+    """
     from ..dynamics.spin_stability import stability
 
     axis = _unit(axis, "axis")

@@ -215,6 +215,13 @@ def weierstrass_p(z, g2: float, g3: float):
     ``g2 = 60 Σ′ w⁻⁴``, ``g3 = 140 Σ′ w⁻⁶`` over the lattice points ``w`` (Chapter 4 exercise 4.10 writes the
     sums without the factors 60 and 140).
 
+    Parameters
+    ----------
+    z : array_like
+        Complex (or real) argument.
+    g2, g3 : float
+        Real invariants with ``g2³ − 27 g3² > 0``.
+
     Returns
     -------
     complex ndarray (shape of ``z``)

@@ -57,6 +57,14 @@ def free_precession_rate(transverse_moment: float, axial_moment: float, spin: fl
 
 
 def free_precession_period(transverse_moment: float, axial_moment: float, spin: float) -> float:
-    """``2π / |Ω|``, s (``inf`` for ``I1 = I3`` or no spin): e.g. the Chandler period of a rigid Earth."""
+    """``2π / |Ω|``, s (``inf`` for ``I1 = I3`` or no spin): e.g. the Chandler period of a rigid Earth.
+
+    Parameters
+    ----------
+    transverse_moment, axial_moment : float
+        ``I1 = I2`` and ``I3`` (same unit, only the ratio enters).
+    spin : float
+        ``ω3``, rad/s.
+    """
     rate = free_precession_rate(transverse_moment, axial_moment, spin)
     return math.inf if rate == 0.0 else 2.0 * math.pi / abs(rate)

@@ -31,6 +31,11 @@ __all__ = ["top_weierstrass_invariants", "top_cos_theta"]
 def top_weierstrass_invariants(top) -> tuple[float, float, float]:
     """``(g2, g3, c)`` of the substitution ``u = c + (4/β) P`` for a heavy top (module docstring).
 
+    Parameters
+    ----------
+    top : HeavyTopReport
+        Supplies ``a, b, alpha, beta``.
+
     Raises
     ------
     PhysicsError
