@@ -365,7 +365,10 @@ def quaternion_to_cayley_klein(quaternion) -> np.ndarray:
 
 
 def cayley_klein_to_quaternion(cayley_klein, *, atol: float = 1e-9) -> np.ndarray:
-    """Scalar-first unit quaternion (``w ≥ 0``) of a Cayley–Klein matrix; ``U`` and ``−U`` give the same one.
+    """Scalar-first unit quaternion of a Cayley–Klein matrix; ``U`` and ``−U`` give the same one.
+
+    The sign is fixed by the first non-zero component of ``(w, x, y, z)`` being positive (``w > 0`` unless the
+    rotation is a half turn).
 
     Parameters
     ----------
@@ -376,7 +379,10 @@ def cayley_klein_to_quaternion(cayley_klein, *, atol: float = 1e-9) -> np.ndarra
     alpha, beta = u[..., 0, 0], u[..., 0, 1]
     q = np.stack([alpha.real, beta.imag, -beta.real, alpha.imag], -1)
     q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    return np.where(q[..., :1] < 0, -q, q)
+    tiny = np.abs(q) <= 1e-15
+    first = np.argmax(~tiny, axis=-1)[..., None]
+    sign = np.sign(np.take_along_axis(q, first, axis=-1))
+    return np.where(tiny, 0.0, q) * sign
 
 
 def cayley_klein_to_matrix(cayley_klein, *, atol: float = 1e-9) -> np.ndarray:

@@ -25,7 +25,7 @@ def test_su2_matrix_gives_the_quaternion_rotation_and_scipy(q):
     np.testing.assert_allclose(rotation, quaternion_to_matrix(q), atol=1e-12)
     np.testing.assert_allclose(rotation, Rotation.from_quat(np.roll(q, -1)).as_matrix(), atol=1e-12)
     back = cayley_klein_to_quaternion(u)
-    np.testing.assert_allclose(back, q if q[0] >= 0 else -q, atol=1e-12)
+    assert np.allclose(back, q, atol=1e-12) or np.allclose(back, -q, atol=1e-12)
 
 
 @settings(max_examples=60)
@@ -58,6 +58,14 @@ def test_moebius_map_of_the_projection_is_the_rotation_of_the_sphere(q):
     u = quaternion_to_cayley_klein(q)
     np.testing.assert_allclose(moebius_transform(u, stereographic_projection(points[keep])),
                                stereographic_projection(rotated[keep]), rtol=1e-9, atol=1e-9)
+
+
+def test_half_turn_has_one_quaternion_for_both_signs():
+    """w = 0 (a half turn): ±q are both "w ≥ 0"; the first non-zero component decides."""
+    for q in ([0.0, 0.0, 0.0, 1.0], [0.0, 0.6, -0.8, 0.0]):
+        u = quaternion_to_cayley_klein(q)
+        np.testing.assert_array_equal(cayley_klein_to_quaternion(u), cayley_klein_to_quaternion(-u))
+    np.testing.assert_allclose(cayley_klein_to_quaternion(quaternion_to_cayley_klein([0, 0, 0, -1.0])), [0, 0, 0, 1])
 
 
 def test_rotation_by_two_pi_is_minus_identity_in_su2():
