@@ -20,7 +20,7 @@ OUTPUT_SUFFIXES = (".stl", ".3mf")
 
 
 def register(subparsers) -> None:
-    from ..design.hollow import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
+    from ..design.limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
     p = subparsers.add_parser(
         "spin-it", help="hollow a part so that it spins stably as a yo-yo or a top",
         description="Design the inside of a part (Bächer et al., Spin-It, 2014; Hafner et al., Spin-It Faster, "

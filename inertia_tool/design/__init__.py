@@ -4,8 +4,25 @@ Every mass moment is linear in the density field, so a cavity can be placed to m
 user wants: :func:`spin_it` hollows a part into a yo-yo (stable free spin about a chosen axis) or a top
 (a heavy symmetric top on a pivot).  Stages: :mod:`.grid` (voxels, depth) → :mod:`.moments` (moment vector,
 objectives) → :mod:`.optimize` (quadric cavity) → :mod:`.hollow` (mesh, boolean, verification).
+
+The names load on first use (PEP 562), so the command line does not import the design stages to start.
 """
 
-from .hollow import SpinDesignMetrics, SpinItResult, design_metrics, spin_it
+import importlib
 
-__all__ = ["spin_it", "SpinItResult", "SpinDesignMetrics", "design_metrics"]
+_PUBLIC = {"spin_it": ".hollow", "SpinItResult": ".hollow", "SpinDesignMetrics": ".hollow",
+           "design_metrics": ".hollow"}
+
+__all__ = sorted(_PUBLIC)
+
+
+def __getattr__(name):
+    if name not in _PUBLIC:
+        raise AttributeError(f"module 'inertia_tool.design' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_PUBLIC[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_PUBLIC))

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..errors import AsymmetricTopWarning, PhysicsError, UsageError
 from .grid import interior_grid, surface_distance
+from .limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
 from .moments import OBJECTIVES, frame_quantities, moment_vector, top_threshold_measure
 from .optimize import QuadricCavity, optimize_quadric_cavity
 
@@ -36,11 +37,6 @@ __all__ = ["SpinDesignMetrics", "SpinItResult", "spin_it", "design_metrics", "MO
 #: ``"yoyo"`` (free spin, §4.4.1) and ``"top"`` (heavy symmetric top on a pivot, §4.4.3).
 MODES = ("yoyo", "top")
 
-#: Cells across the part's largest extent.
-DEFAULT_RESOLUTION = 48
-
-#: Bounds of ``resolution`` (work and memory grow as its cube).
-MIN_RESOLUTION, MAX_RESOLUTION = 12, 128
 
 #: Cells of extra depth asked of the cavity beyond the wall (the depths near the wall are exact at the cell
 #: centres; the margin covers the linear interpolation of the level set between them).
