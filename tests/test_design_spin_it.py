@@ -206,6 +206,11 @@ def test_cli_spin_it_writes_a_hollow_part_and_json(tmp_path, capsys):
     assert main(["spin-it", str(src), "--units", "mm", "--axis", "0,0,1", "--wall", "2", "--out", str(out)]) == 2
     assert main(["spin-it", str(src), "--units", "mm", "--axis", "0,0,1", "--wall", "2", "--mode", "top"]) == 2
     assert "--pivot" in capsys.readouterr().err
+    pytest.importorskip("matplotlib")
+    png = tmp_path / "sections.png"
+    assert main(["spin-it", str(src), "--units", "mm", "--axis", "0,0,1", "--wall", "2mm", "--resolution", "24",
+                 "--plot", str(png)]) == 0
+    assert png.stat().st_size > 10_000 and png.read_bytes()[:4] == b"\x89PNG"
 
 
 def test_bad_parameters_are_refused():

@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import UsageError
 from ..units import length_scale, parse_density, parse_length, parse_mass, parse_vector
 from .analyze import add_material_options
-from .report_option import check_output_file
+from .report_option import check_output_file, save_figure
 
 __all__ = ["register", "run", "OUTPUT_SUFFIXES"]
 
@@ -44,7 +44,9 @@ def register(subparsers) -> None:
                         f"default {DEFAULT_RESOLUTION})")
     p.add_argument("--out", metavar="OUT.stl|OUT.3mf",
                    help="write the hollowed part (STL in --units, 3MF in millimetres)")
-    p.add_argument("--force", action="store_true", help="let --out replace an existing file")
+    p.add_argument("--plot", metavar="OUT.png",
+                   help="draw sections of the hollowed part through and across the axis (needs matplotlib)")
+    p.add_argument("--force", action="store_true", help="let --out and --plot replace existing files")
     p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of text")
     p.set_defaults(func=run)
 
@@ -86,6 +88,7 @@ def run(args) -> int:
         if os.path.splitext(args.out)[1].lower() not in OUTPUT_SUFFIXES:
             raise UsageError(f"--out writes {' or '.join(OUTPUT_SUFFIXES)}, got {args.out!r}")
         check_output_file(args.out, "--out", args.force)
+    check_output_file(args.plot, "--plot", args.force)
     if args.mode == "top" and args.pivot is None:
         raise UsageError("--mode top needs --pivot X,Y,Z")
     if args.mode == "top" and args.through is not None:
@@ -103,6 +106,13 @@ def run(args) -> int:
                      resolution=args.resolution)
     if args.out:
         _write(args.out, result.vertices, result.faces, args.units, args.force)
+    if args.plot:
+        try:
+            from ..reports.spin_it import spin_it_figure
+            figure = spin_it_figure(result)
+        except ImportError as exc:
+            raise UsageError("--plot needs matplotlib (pip install 'inertia-tool[plots]')") from exc
+        save_figure(figure, args.plot)
     if args.json:
         json.dump(spin_it_dict(result, output=args.out), sys.stdout, indent=2, ensure_ascii=False)
         sys.stdout.write("\n")

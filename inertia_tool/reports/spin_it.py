@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .serialize import mass_properties_dict, to_jsonable
 
-__all__ = ["spin_it_dict", "format_spin_it_text"]
+__all__ = ["spin_it_dict", "format_spin_it_text", "spin_it_figure"]
 
 
 def _metrics_dict(m) -> dict:
@@ -99,3 +101,70 @@ def format_spin_it_text(result, *, name: str = "", output: str | None = None) ->
     if output:
         lines += ["", f"  wrote {output}"]
     return "\n".join(lines) + "\n"
+
+
+def _section_polygons(vertices, faces, origin, frame, plane: str, height: float):
+    """Polygons (list of (k, 2) arrays, design-frame coordinates in mm) of the section of a closed mesh by the
+    plane ``y' = 0`` (``plane="axial"``: it contains the spin axis and ``e1``) or ``z' = height``
+    (``"transverse"``), through manifold3d's slicer."""
+    import manifold3d
+
+    local = (np.asarray(vertices) - origin) @ frame                  # design frame: z' along the axis
+    if plane == "axial":
+        local = np.column_stack([local[:, 0], local[:, 2], -local[:, 1]])   # (x', z', −y'): a proper rotation
+        height = 0.0
+    mesh = manifold3d.Mesh64(vert_properties=np.array(local, dtype=np.float64, order="C"),
+                             tri_verts=np.array(faces, dtype=np.uint64, order="C"))
+    section = manifold3d.Manifold(mesh).slice(float(height))
+    return [np.asarray(p) * 1e3 for p in section.to_polygons()]
+
+
+def spin_it_figure(result):
+    """A matplotlib figure: sections of the part before (outline) and after (filled, with its cavity) through
+    the spin axis and across it at the centre of mass, in the design frame (mm); centre of mass before and
+    after marked.  Needs matplotlib and manifold3d."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path
+
+    frame = np.column_stack(_design_axes(result.axis))
+    com_b = (result.before.center_of_mass - result.origin) @ frame * 1e3
+    com_a = (result.after.center_of_mass - result.origin) @ frame * 1e3
+    fig, panels = plt.subplots(1, 2, figsize=(11, 5))
+    for ax, plane, title in ((panels[0], "axial", "section through the axis (x′, axis)"),
+                             (panels[1], "transverse", "section across the axis at the centre of mass (x′, y′)")):
+        height = com_a[2] * 1e-3
+        polygons = _section_polygons(result.vertices, result.faces, result.origin, frame, plane, height)
+        if polygons:
+            codes, points = [], []
+            for poly in polygons:
+                points += list(poly) + [poly[0]]
+                codes += [Path.MOVETO] + [Path.LINETO] * (len(poly) - 1) + [Path.CLOSEPOLY]
+            ax.add_patch(PathPatch(Path(np.array(points), codes), facecolor="#9cc3e6", edgecolor="#1f4e79",
+                                   lw=0.8, label="hollowed part (cavity white)"))
+        pick = (0, 2) if plane == "axial" else (0, 1)
+        ax.plot(*com_b[list(pick)], "x", color="#c00000", ms=9, mew=2, label="centre of mass before")
+        ax.plot(*com_a[list(pick)], "+", color="#006000", ms=11, mew=2, label="centre of mass after")
+        if plane == "axial":
+            ax.axvline(0.0, color="k", lw=0.6, ls="--", label="spin axis")
+        else:
+            ax.plot(0.0, 0.0, "o", color="k", ms=4, label="spin axis")
+        ax.set_aspect("equal")
+        ax.autoscale_view()
+        ax.set_xlabel("x′ (mm)")
+        ax.set_ylabel("along the axis (mm)" if plane == "axial" else "y′ (mm)")
+        ax.set_title(title, fontsize=10)
+    handles, labels = panels[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=9, frameon=False)
+    kind = "yo-yo" if result.mode == "yoyo" else "top"
+    fig.suptitle(f"spin-it ({kind}): wall ≥ {result.wall * 1e3:.3g} mm, {result.cavity_volume * 1e6:.3g} cm³ removed")
+    fig.tight_layout(rect=(0, 0.1, 1, 1))
+    return fig
+
+
+def _design_axes(axis):
+    from ..rotations import perpendicular_basis
+    e1, e2 = perpendicular_basis(np.asarray(axis, dtype=float))
+    return e1, e2, np.asarray(axis, dtype=float)
