@@ -223,3 +223,55 @@ def test_bad_parameters_are_refused():
         spin_it((v, f), axis=[0, 0, 0], wall=0.002)
     with pytest.raises(UsageError, match="wall"):
         spin_it((v, f), axis=[0, 0, 1], wall=-1.0)
+
+
+# -- dense insert (two quadrics) ---------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def top_with_insert():
+    v, f = asymmetric_top()
+    return spin_it((v, f), axis=[0, 0, 1], pivot=[0, 0, 0], mode="top", wall=0.0015, material="PLA",
+                   resolution=32, insert_density=7850.0)
+
+
+@pytest.mark.slow
+def test_steel_insert_makes_the_top_symmetric_and_lowers_its_sleeping_spin(top, top_with_insert):
+    b, a, hollow_only = top_with_insert.metrics_before, top_with_insert.metrics_after, top.metrics_after
+    assert top_with_insert.insert is not None
+    assert a.transverse_asymmetry < b.transverse_asymmetry / 4            # 0.19 → ~0.02
+    assert a.transverse_asymmetry < hollow_only.transverse_asymmetry / 2
+    assert a.axis_offset < b.axis_offset / 4
+    assert a.sleeping_threshold < 0.95 * b.sleeping_threshold             # 89 → ~77 rad/s
+    assert top_with_insert.objective_after < top.objective_after
+
+
+@pytest.mark.slow
+def test_insert_is_verified_as_two_bodies_inside_the_wall(top_with_insert):
+    r = top_with_insert
+    shell = mass_properties((r.vertices, r.faces), density=r.before.density)
+    insert = mass_properties((r.insert_vertices, r.insert_faces), density=7850.0)
+    assert r.after.mass == pytest.approx(shell.mass + insert.mass, rel=1e-12)
+    np.testing.assert_allclose(r.after.center_of_mass,
+                               (shell.mass * shell.center_of_mass + insert.mass * insert.center_of_mass)
+                               / (shell.mass + insert.mass), atol=1e-12)
+    # the insert fills part of the pocket: shell and insert together are no more than the solid part
+    assert shell.volume + insert.volume <= r.before.volume * (1 + 1e-9)
+    v, f = asymmetric_top()
+    assert surface_distance(r.insert_vertices, v, f, cutoff=0.01).min() >= r.wall
+
+
+@pytest.mark.slow
+def test_cli_insert_writes_a_two_material_3mf(tmp_path, capsys):
+    import trimesh
+    v, f = asymmetric_top()
+    src = tmp_path / "top.stl"
+    trimesh.Trimesh(v * 1000, f, process=False).export(src)
+    out = tmp_path / "top.3mf"
+    args = ["spin-it", str(src), "--units", "mm", "--material", "PLA", "--axis", "0,0,1", "--mode", "top",
+            "--pivot", "0,0,0", "--wall", "1.5mm", "--resolution", "24", "--insert", "steel"]
+    assert main(args + ["--out", str(tmp_path / "top.stl.out.stl")]) == 2      # two materials need 3MF
+    assert main(args + ["--out", str(out), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    scene = trimesh.load(out)
+    volumes = sorted(g.volume for g in scene.geometry.values())                 # mm³
+    assert len(volumes) == 2 and all(g.is_watertight for g in scene.geometry.values())
+    assert volumes[0] * 1e-9 == pytest.approx(data["insert"]["volume_m3"], rel=1e-6)

@@ -39,6 +39,9 @@ def register(subparsers) -> None:
     p.add_argument("--pivot", metavar="X,Y,Z", help="top: the pivot point (in --units unless a unit is given)")
     p.add_argument("--wall", required=True, metavar="LENGTH",
                    help="minimum wall thickness, e.g. 2mm (a bare number is in --units)")
+    p.add_argument("--insert", metavar="MATERIAL|DENSITY",
+                   help="allow a dense insert of this material (e.g. steel or 7850) beside the cavity: a second "
+                        "quadric region; written with --out as a two-material 3MF")
     p.add_argument("--resolution", type=int, default=DEFAULT_RESOLUTION, metavar="N",
                    help=f"voxel cells across the largest extent ({MIN_RESOLUTION} to {MAX_RESOLUTION}, "
                         f"default {DEFAULT_RESOLUTION})")
@@ -60,6 +63,24 @@ def _direction(text: str) -> np.ndarray:
     if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.linalg.norm(v) > 0:
         raise UsageError(f"--axis must be three numbers, not all zero, like 0,0,1; got {text!r}")
     return v
+
+
+def _insert_density(text: str) -> float:
+    try:
+        return parse_density(text)
+    except UsageError:
+        from ..units import material_density
+        return material_density(text)
+
+
+def _write_two_materials(path: str, result, material: str, insert: str, force: bool) -> None:
+    from ..reports.mesh_3mf import write_3mf
+    mm = length_scale("mm")
+    write_3mf(path, [
+        {"name": "part", "material": material, "color": "#9CC3E6FF", "vertices": result.vertices / mm,
+         "faces": result.faces},
+        {"name": "insert", "material": insert, "color": "#595959FF", "vertices": result.insert_vertices / mm,
+         "faces": result.insert_faces}], force=force)
 
 
 def _write(path: str, vertices, faces, units: str, force: bool) -> None:
@@ -89,6 +110,9 @@ def run(args) -> int:
             raise UsageError(f"--out writes {' or '.join(OUTPUT_SUFFIXES)}, got {args.out!r}")
         check_output_file(args.out, "--out", args.force)
     check_output_file(args.plot, "--plot", args.force)
+    insert_density = _insert_density(args.insert) if args.insert is not None else None
+    if insert_density is not None and args.out and not args.out.lower().endswith(".3mf"):
+        raise UsageError(f"--insert makes a two-material part: --out must be a .3mf file, got {args.out!r}")
     if args.mode == "top" and args.pivot is None:
         raise UsageError("--mode top needs --pivot X,Y,Z")
     if args.mode == "top" and args.through is not None:
@@ -103,8 +127,10 @@ def run(args) -> int:
                      pivot=parse_vector(args.pivot, args.units) if args.pivot else None, units=args.units,
                      density=parse_density(args.density) if args.density is not None else None,
                      material=args.material, mass=parse_mass(args.mass) if args.mass is not None else None,
-                     resolution=args.resolution)
-    if args.out:
+                     resolution=args.resolution, insert_density=insert_density)
+    if args.out and result.insert_vertices is not None:
+        _write_two_materials(args.out, result, args.material or "part", args.insert, args.force)
+    elif args.out:
         _write(args.out, result.vertices, result.faces, args.units, args.force)
     if args.plot:
         try:

@@ -143,6 +143,12 @@ class SpinItResult:
         Evaluations of the objective in all optimisations.
     seconds : float
         Wall-clock time of the whole design.
+    insert_vertices, insert_faces : (k, 3) float, (l, 3) int, or None
+        The dense insert (m, mesh axes), when one was asked for and helps; it fills a pocket of the part.
+    insert : MassProperties or None
+        The insert alone, re-analysed at ``insert_density`` (``after`` includes it).
+    insert_density : float or None
+        kg/m³ of the insert material.
     """
 
     mode: str
@@ -166,6 +172,10 @@ class SpinItResult:
     optimisation_seconds: float
     objective_evaluations: int
     seconds: float
+    insert_vertices: np.ndarray | None = None
+    insert_faces: np.ndarray | None = None
+    insert: object = None
+    insert_density: float | None = None
 
 
 def _unit(vector, name: str) -> np.ndarray:
@@ -271,9 +281,10 @@ def _exact_near_wall(grid, vertices, faces, wall: float):
     return replace(grid, signed_distance=depth)
 
 
-def _cavity_field(grid, cavity: QuadricCavity, origin, frame, threshold: float):
-    """The scalar field ``min(depth − threshold, −q · half_extent)`` (m, positive inside the cavity), its
-    crease rounded over a quarter cell, as a Python callable of mesh coordinates for ``Manifold.level_set``;
+def _cavity_field(grid, terms, centre, half: float, origin, frame, threshold: float):
+    """The scalar field ``min(depth − threshold, −s_k q_k · half_extent …)`` (m, positive inside the region), for
+    the quadric ``terms`` ``[(coefficients, s_k)]`` (``s = +1``: inside where ``q < 0``; ``−1``: outside it),
+    creases rounded over a quarter cell, as a Python callable of mesh coordinates for ``Manifold.level_set``;
     the depth is trilinear between the grid's cell centres."""
     sd = grid.signed_distance
     nx, ny, nz = sd.shape
@@ -281,9 +292,8 @@ def _cavity_field(grid, cavity: QuadricCavity, origin, frame, threshold: float):
     ox, oy, oz = (float(c) for c in grid.origin)
     inv = 1.0 / grid.spacing
     r = frame
-    c = cavity.centre
-    half = cavity.half_extent
-    t = (cavity.coefficients / np.linalg.norm(cavity.coefficients)).tolist()
+    c = centre
+    quadrics = [((np.asarray(t) / np.linalg.norm(t)).tolist(), float(sign)) for t, sign in terms]
     # frame coordinates, normalised: x̂ = (Rᵀ (x − o) − centre)/half = A x + b
     a = (r.T / half).tolist()
     b = ((-(r.T @ np.asarray(origin)) - c) / half).tolist()
@@ -307,12 +317,15 @@ def _cavity_field(grid, cavity: QuadricCavity, origin, frame, threshold: float):
         u = a[0][0] * x + a[0][1] * y + a[0][2] * z + b[0]
         v = a[1][0] * x + a[1][1] * y + a[1][2] * z + b[1]
         w = a[2][0] * x + a[2][1] * y + a[2][2] * z + b[2]
-        q = (t[0] + t[1] * u + t[2] * v + t[3] * w + t[4] * u * u + t[5] * v * v + t[6] * w * w
-             + t[7] * u * v + t[8] * u * w + t[9] * v * w)
-        deep, inner = depth - threshold, -q * half
-        # smooth minimum (rounds the crease where the wall meets the quadric, so the two sheets of the
-        # marching tetrahedra do not pinch at a shared point): min(d, e) − k log(1 + exp(−|d − e|/k))
-        return min(deep, inner) - smooth * math.log1p(math.exp(-abs(deep - inner) / smooth))
+        value = depth - threshold
+        for t, sign in quadrics:
+            q = (t[0] + t[1] * u + t[2] * v + t[3] * w + t[4] * u * u + t[5] * v * v + t[6] * w * w
+                 + t[7] * u * v + t[8] * u * w + t[9] * v * w)
+            inner = -sign * q * half
+            # smooth minimum (rounds the crease where the wall meets the quadric, so the two sheets of the
+            # marching tetrahedra do not pinch at a shared point): min(d, e) − k log(1 + exp(−|d − e|/k))
+            value = min(value, inner) - smooth * math.log1p(math.exp(-abs(value - inner) / smooth))
+        return value
 
     return field
 
@@ -352,49 +365,80 @@ def _separate_pinches(vertices, faces, distance: float):
     return v, faces
 
 
-def _hollow(vertices, faces, grid, cavity, removed_centres, origin, frame, wall: float):
-    """Mesh the cavity, check the wall exactly, subtract, separate pinches; returns (vertices, faces,
-    measured_wall)."""
+def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wall: float):
+    """A closed mesh (manifold) of the region of ``terms`` deeper than the wall, from ``Manifold.level_set``,
+    with its wall measured exactly; remeshed deeper (up to ``MAX_MESH_ATTEMPTS``) if thinner than ``wall``.
+    Returns (manifold or None when empty, measured wall)."""
+    import manifold3d
+
+    h = grid.spacing
+    lo = cells.min(axis=0) - 2 * h
+    hi = cells.max(axis=0) + 2 * h
+    margin = DEPTH_MARGIN * h
+    for _ in range(MAX_MESH_ATTEMPTS):
+        field = _cavity_field(grid, terms, centre, half, origin, frame, wall + margin)
+        # marching tetrahedra can leave vertices closer than a float32 STL can tell apart: merge them
+        region = manifold3d.Manifold.level_set(field, [*lo, *hi], h).simplify(SNAP * h)
+        # slivers the marching tetrahedra leave where the field grazes zero: voids smaller than (2h)³ change
+        # the moments by nothing measurable and no print could be emptied of them
+        pieces = [piece for piece in region.decompose() if piece.volume() >= MIN_VOID_CELLS * h ** 3]
+        if not pieces:
+            return None, math.inf
+        region = manifold3d.Manifold.batch_boolean(pieces, manifold3d.OpType.Add)
+        region_v, _ = _arrays_of(region)
+        measured = float(surface_distance(region_v, vertices, faces, cutoff=wall + h).min())
+        if measured >= wall + SNAP * h:          # pinches are separated by SNAP·h below
+            return region, measured - SNAP * h
+        margin += 0.5 * h
+    raise PhysicsError(f"could not mesh a cavity keeping a wall of {wall:g} m: the thinnest came out "
+                       f"{measured:g} m after {MAX_MESH_ATTEMPTS} attempts")
+
+
+def _hollow(vertices, faces, grid, design, centres, origin, frame, wall: float):
+    """Mesh the cavity (and the insert), check the wall exactly, subtract, separate pinches.
+
+    ``design`` is a :class:`QuadricCavity` or a :class:`~.insert.QuadricInsert`.  Returns (vertices, faces,
+    insert vertices or None, insert faces or None, measured wall)."""
     try:
         import manifold3d
     except ImportError as exc:                # pragma: no cover - a dependency of the package
         raise UsageError("spin_it needs manifold3d (pip install manifold3d)") from exc
+    cavity = design if isinstance(design, QuadricCavity) else design.cavity
+    inserted = getattr(design, "inserted", None)
     h = grid.spacing
-    lo = removed_centres.min(axis=0) - 2 * h
-    hi = removed_centres.max(axis=0) + 2 * h
-    margin = DEPTH_MARGIN * h
-    for _ in range(MAX_MESH_ATTEMPTS):
-        field = _cavity_field(grid, cavity, origin, frame, wall + margin)
-        # marching tetrahedra can leave vertices closer than a float32 STL can tell apart: merge them
-        hole = manifold3d.Manifold.level_set(field, [*lo, *hi], h).simplify(SNAP * h)
-        # slivers the marching tetrahedra leave where the field grazes zero: voids smaller than (2h)³ change
-        # the moments by nothing measurable and no print could be emptied of them
-        pieces = [piece for piece in hole.decompose() if piece.volume() >= MIN_VOID_CELLS * h ** 3]
-        hole = manifold3d.Manifold.batch_boolean(pieces, manifold3d.OpType.Add) if pieces else manifold3d.Manifold()
-        if hole.is_empty():
-            return vertices, faces, math.inf
-        hole_v, _ = _arrays_of(hole)
-        measured = float(surface_distance(hole_v, vertices, faces, cutoff=wall + h).min())
-        if measured >= wall + SNAP * h:          # pinches are separated by SNAP·h below
-            break
-        margin += 0.5 * h
-    else:
-        raise PhysicsError(f"could not mesh a cavity keeping a wall of {wall:g} m: the thinnest came out "
-                           f"{measured:g} m after {MAX_MESH_ATTEMPTS} attempts")
+    walls = [math.inf]
+    insert = hole = None
+    if inserted is not None and np.any(inserted):
+        insert, measured = _region(grid, [(design.insert_coefficients, 1.0)], cavity.centre, cavity.half_extent,
+                                   centres[inserted], vertices, faces, origin, frame, wall)
+        walls.append(measured)
+    in_q1 = cavity.removed if inserted is None else cavity.removed | (inserted & (cavity.values(
+        (centres - origin) @ frame) < 0))
+    if np.any(in_q1):
+        hole, measured = _region(grid, [(cavity.coefficients, 1.0)], cavity.centre, cavity.half_extent,
+                                 centres[in_q1], vertices, faces, origin, frame, wall)
+        walls.append(measured)
+    if hole is None and insert is None:
+        return vertices, faces, None, None, math.inf
+    # the pocket is the union of both regions: the part keeps none of it, the insert fills its own share
+    pocket = hole if insert is None else (insert if hole is None else hole + insert)
     part = _manifold_of(vertices, faces)
     if part.status() != manifold3d.Error.NoError:
         raise PhysicsError(f"the part is not a manifold solid for the boolean ({part.status()})")
-    result = part - hole
+    result = part - pocket
     if result.status() != manifold3d.Error.NoError:
         raise PhysicsError(f"the boolean subtraction failed ({result.status()})")
     out_v, out_f = _separate_pinches(*_arrays_of(result), SNAP * h)
-    return out_v, out_f, measured - SNAP * h
+    ins_v = ins_f = None
+    if insert is not None:
+        ins_v, ins_f = _separate_pinches(*_arrays_of(insert), SNAP * h)
+    return out_v, out_f, ins_v, ins_f, min(walls)
 
 
 def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivot=None, units: str = "m",
             density: float | None = None, material: str | None = None, mass: float | None = None,
             resolution: int = DEFAULT_RESOLUTION, center_weight: float = 1e4, product_weight: float = 1e4,
-            gravity: float = 9.80665) -> SpinItResult:
+            gravity: float = 9.80665, insert_density: float | None = None) -> SpinItResult:
     """Hollow a part so that it spins stably about ``axis`` (Bächer et al. 2014; Hafner et al. 2024).
 
     Parameters
@@ -424,6 +468,9 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         (see ``design.moments``).
     gravity : float
         m/s², for the sleeping-top threshold.
+    insert_density : float, optional
+        kg/m³ of a denser material that may fill part of the interior (a second quadric region,
+        ``design.insert``); it must exceed the part's density.
 
     Returns
     -------
@@ -451,6 +498,9 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         raise UsageError("`pivot` is for mode 'top'")
     from ..mass.pipeline import mass_properties
     vertices, faces, before, name = _load(source, units, density, material, mass)
+    if insert_density is not None and not (isinstance(insert_density, (int, float)) and math.isfinite(insert_density)
+                                           and insert_density > before.density):
+        raise UsageError(f"Expected `insert_density` above the part's {before.density:g} kg/m³, got {insert_density!r}")
     size = float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
     extent = float(np.max(vertices.max(axis=0) - vertices.min(axis=0)))
     if mode == "yoyo":
@@ -482,19 +532,31 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
             return OBJECTIVES["top"](mu, size=size, center_weight=center_weight, product_weight=product_weight,
                                      reference_threshold=reference)
     cavity = optimize_quadric_cavity(objective, mu_part, points, h, size=size)
-    out_v, out_f, measured, after = vertices, faces, math.inf, before
-    if np.any(cavity.removed):
-        out_v, out_f, measured = _hollow(vertices, faces, grid, cavity, centres[cavity.removed], origin, frame,
-                                         wall)
+    design = cavity
+    if insert_density is not None and len(points):
+        from .insert import optimize_cavity_and_insert
+        design = optimize_cavity_and_insert(objective, mu_part, points, h, cavity, size=size,
+                                            density_ratio=insert_density / rho)
+        cavity = design.cavity
+    out_v, out_f, ins_v, ins_f, measured = _hollow(vertices, faces, grid, design, centres, origin, frame, wall)
+    after = before
+    insert_props = None
+    if out_v is not vertices:
         after = mass_properties((out_v, out_f), density=rho, name=f"{name} (hollowed)")
+    if ins_v is not None:
+        from ..mass.properties import combine
+        insert_props = mass_properties((ins_v, ins_f), density=float(insert_density), name=f"{name} (insert)")
+        after = combine([after, insert_props], name=f"{name} (hollowed, with insert)")
     metric_origin = origin if (mode == "top" or through is not None) else None
     return SpinItResult(mode=mode, axis=axis, origin=origin, wall=float(wall), vertices=out_v, faces=out_f,
                         before=before, after=after,
                         metrics_before=design_metrics(before, mode, axis, metric_origin, gravity=gravity),
                         metrics_after=design_metrics(after, mode, axis, metric_origin, gravity=gravity),
-                        measured_wall=measured, cavity_volume=float(before.volume - after.volume), cavity=cavity,
+                        measured_wall=measured,
+                        cavity_volume=float(before.volume - after.volume), cavity=cavity,
                         cell_size=h, allowed_cells=int(len(points)), removed_cells=int(cavity.removed.sum()),
                         objective_before=float(objective(mu_part)),
                         objective_after=float(objective(moment_vector(after, origin, frame) / rho)),
                         optimisation_seconds=cavity.seconds, objective_evaluations=cavity.evaluations,
-                        seconds=time.perf_counter() - started)
+                        seconds=time.perf_counter() - started, insert_vertices=ins_v, insert_faces=ins_f,
+                        insert=insert_props, insert_density=None if insert_density is None else float(insert_density))

@@ -38,6 +38,9 @@ def spin_it_dict(result, *, output: str | None = None) -> dict:
                    mass_properties_dict(result.before)},
         "after": {"metrics": _metrics_dict(result.metrics_after), "mass_properties":
                   mass_properties_dict(result.after)},
+        "insert": None if result.insert is None else {
+            "density_kg_m3": result.insert_density, "volume_m3": result.insert.volume, "mass_kg": result.insert.mass,
+            "mass_properties": mass_properties_dict(result.insert)},
         "output": output,
         "verified": "after = exact re-analysis of the hollowed mesh",
     }
@@ -69,6 +72,11 @@ def format_spin_it_text(result, *, name: str = "", output: str | None = None) ->
              f"({result.objective_evaluations} objective evaluations), {result.seconds:.2f} s in all",
              f"  objective {result.objective_before:.4g} → {result.objective_after:.4g} (exact moments)",
              "  every 'after' number is the exact re-analysis of the hollowed mesh", ""]
+    if result.insert is not None:
+        lines.insert(5, f"  insert: {result.insert.volume * 1e6:.4g} cm³ of {result.insert_density:g} kg/m³ "
+                        f"({result.insert.mass * 1e3:.4g} g), a second quadric region; 'after' includes it")
+    elif result.insert_density is not None:
+        lines.insert(5, f"  insert of {result.insert_density:g} kg/m³ allowed, but none helps: cavity only")
     if result.mode == "yoyo":
         rows = [("mass", f"{before.mass * 1e3:.4g} g", f"{after.mass * 1e3:.4g} g"),
                 ("I_axis (about the COM) kg·m²", _g(before.axis_moment), _g(after.axis_moment)),
@@ -136,14 +144,20 @@ def spin_it_figure(result):
     for ax, plane, title in ((panels[0], "axial", "section through the axis (x′, axis)"),
                              (panels[1], "transverse", "section across the axis at the centre of mass (x′, y′)")):
         height = com_a[2] * 1e-3
-        polygons = _section_polygons(result.vertices, result.faces, result.origin, frame, plane, height)
-        if polygons:
+        bodies = [(result.vertices, result.faces, "#9cc3e6", "#1f4e79", "hollowed part (cavity white)")]
+        if result.insert_vertices is not None:
+            bodies.append((result.insert_vertices, result.insert_faces, "#595959", "#202020",
+                           f"insert ({result.insert_density:g} kg/m³)"))
+        for verts, tris, face, edge, label in bodies:
+            polygons = _section_polygons(verts, tris, result.origin, frame, plane, height)
+            if not polygons:
+                continue
             codes, points = [], []
             for poly in polygons:
                 points += list(poly) + [poly[0]]
                 codes += [Path.MOVETO] + [Path.LINETO] * (len(poly) - 1) + [Path.CLOSEPOLY]
-            ax.add_patch(PathPatch(Path(np.array(points), codes), facecolor="#9cc3e6", edgecolor="#1f4e79",
-                                   lw=0.8, label="hollowed part (cavity white)"))
+            ax.add_patch(PathPatch(Path(np.array(points), codes), facecolor=face, edgecolor=edge, lw=0.8,
+                                   label=label))
         pick = (0, 2) if plane == "axial" else (0, 1)
         ax.plot(*com_b[list(pick)], "x", color="#c00000", ms=9, mew=2, label="centre of mass before")
         ax.plot(*com_a[list(pick)], "+", color="#006000", ms=11, mew=2, label="centre of mass after")
@@ -156,10 +170,15 @@ def spin_it_figure(result):
         ax.set_xlabel("x′ (mm)")
         ax.set_ylabel("along the axis (mm)" if plane == "axial" else "y′ (mm)")
         ax.set_title(title, fontsize=10)
-    handles, labels = panels[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=9, frameon=False)
+    seen = {}
+    for panel in panels:
+        for handle, label in zip(*panel.get_legend_handles_labels()):
+            seen.setdefault(label, handle)
+    fig.legend(list(seen.values()), list(seen.keys()), loc="lower center", ncol=5, fontsize=9, frameon=False)
     kind = "yo-yo" if result.mode == "yoyo" else "top"
-    fig.suptitle(f"spin-it ({kind}): wall ≥ {result.wall * 1e3:.3g} mm, {result.cavity_volume * 1e6:.3g} cm³ removed")
+    fig.suptitle(f"spin-it ({kind}): wall ≥ {result.wall * 1e3:.3g} mm, {result.cavity_volume * 1e6:.3g} cm³ of "
+                 f"material removed" + ("" if result.insert is None else
+                                        f", {result.insert.mass * 1e3:.3g} g insert"))
     fig.tight_layout(rect=(0, 0.1, 1, 1))
     return fig
 
