@@ -1,0 +1,189 @@
+"""The cavity (and insert) as closed meshes, subtracted from the part with a robust boolean (manifold3d).
+
+* :func:`_cavity_field` — the region ``depth ≥ wall + margin`` and ``s_k q_k < 0`` as a scalar field (trilinear
+  depth from the grid, quadrics analytic, creases rounded by a smooth minimum) for ``Manifold.level_set``
+  (marching tetrahedra);
+* :func:`_region` — its mesh, slivers dropped, the wall measured exactly from every vertex
+  (``design.grid.surface_distance``) and the mesh remade deeper when it is too thin;
+* :func:`cut_pocket` — pocket = cavity ∪ insert, ``part − pocket``, pinched vertices separated.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import PhysicsError, UsageError
+from .grid import surface_distance
+from .optimize import QuadricCavity
+
+__all__ = ["cut_pocket", "DEPTH_MARGIN", "SNAP", "MIN_VOID_CELLS", "MAX_MESH_ATTEMPTS"]
+
+#: Cells of extra depth asked of the cavity beyond the wall (the depths near the wall are exact at the cell
+#: centres; the margin covers the linear interpolation of the level set between them).
+DEPTH_MARGIN = 0.5
+
+#: Edges of the cavity mesh shorter than this fraction of a cell are collapsed (``Manifold.simplify``), so
+#: that a float32 STL of the result keeps every vertex distinct.
+SNAP = 1e-3
+
+#: Smallest separate void kept, in cell volumes.
+MIN_VOID_CELLS = 8
+
+#: Attempts at meshing the cavity, each with half a cell more margin if the measured wall came out thin.
+MAX_MESH_ATTEMPTS = 4
+
+
+def _cavity_field(grid, terms, centre, half: float, origin, frame, threshold: float):
+    """The scalar field ``min(depth − threshold, −s_k q_k · half_extent …)`` (m, positive inside the region), for
+    the quadric ``terms`` ``[(coefficients, s_k)]`` (``s = +1``: inside where ``q < 0``; ``−1``: outside it),
+    creases rounded over a quarter cell, as a Python callable of mesh coordinates for ``Manifold.level_set``;
+    the depth is trilinear between the grid's cell centres."""
+    sd = grid.signed_distance
+    nx, ny, nz = sd.shape
+    flat = sd.ravel().tolist()
+    ox, oy, oz = (float(c) for c in grid.origin)
+    inv = 1.0 / grid.spacing
+    r = frame
+    c = centre
+    quadrics = [((np.asarray(t) / np.linalg.norm(t)).tolist(), float(sign)) for t, sign in terms]
+    # frame coordinates, normalised: x̂ = (Rᵀ (x − o) − centre)/half = A x + b
+    a = (r.T / half).tolist()
+    b = ((-(r.T @ np.asarray(origin)) - c) / half).tolist()
+    stride_x, stride_y = ny * nz, nz
+    smooth = 0.25 * grid.spacing
+
+    def field(x, y, z):
+        gx, gy, gz = (x - ox) * inv, (y - oy) * inv, (z - oz) * inv
+        i = min(max(int(math.floor(gx)), 0), nx - 2)
+        j = min(max(int(math.floor(gy)), 0), ny - 2)
+        k = min(max(int(math.floor(gz)), 0), nz - 2)
+        fx = min(max(gx - i, 0.0), 1.0)
+        fy = min(max(gy - j, 0.0), 1.0)
+        fz = min(max(gz - k, 0.0), 1.0)
+        base = i * stride_x + j * stride_y + k
+        c00 = flat[base] * (1 - fz) + flat[base + 1] * fz
+        c01 = flat[base + stride_y] * (1 - fz) + flat[base + stride_y + 1] * fz
+        c10 = flat[base + stride_x] * (1 - fz) + flat[base + stride_x + 1] * fz
+        c11 = flat[base + stride_x + stride_y] * (1 - fz) + flat[base + stride_x + stride_y + 1] * fz
+        depth = (c00 * (1 - fy) + c01 * fy) * (1 - fx) + (c10 * (1 - fy) + c11 * fy) * fx
+        u = a[0][0] * x + a[0][1] * y + a[0][2] * z + b[0]
+        v = a[1][0] * x + a[1][1] * y + a[1][2] * z + b[1]
+        w = a[2][0] * x + a[2][1] * y + a[2][2] * z + b[2]
+        value = depth - threshold
+        for t, sign in quadrics:
+            q = (t[0] + t[1] * u + t[2] * v + t[3] * w + t[4] * u * u + t[5] * v * v + t[6] * w * w
+                 + t[7] * u * v + t[8] * u * w + t[9] * v * w)
+            inner = -sign * q * half
+            # smooth minimum (rounds the crease where the wall meets the quadric, so the two sheets of the
+            # marching tetrahedra do not pinch at a shared point): min(d, e) − k log(1 + exp(−|d − e|/k))
+            value = min(value, inner) - smooth * math.log1p(math.exp(-abs(value - inner) / smooth))
+        return value
+
+    return field
+
+
+def _manifold_of(vertices, faces):
+    import manifold3d
+
+    mesh = manifold3d.Mesh64(vert_properties=np.array(vertices, dtype=np.float64, order="C"),   # writable copies
+                             tri_verts=np.array(faces, dtype=np.uint64, order="C"))
+    return manifold3d.Manifold(mesh)
+
+
+def _arrays_of(manifold):
+    mesh = manifold.to_mesh64()
+    return np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3], np.asarray(mesh.tri_verts, dtype=np.int64)
+
+
+def _separate_pinches(vertices, faces, distance: float):
+    """Move apart vertices that share a position (float32), each by ``distance`` along its outward normal.
+
+    Marching tetrahedra can leave two sheets of the cavity touching at one point, as two distinct vertices at
+    the same position: a valid manifold, but a mesh file welds them into a non-manifold vertex.  Moving each
+    copy outward (into the cavity it bounds) separates the sheets by ``2 distance``.
+    """
+    v = np.array(vertices, dtype=np.float64)
+    _, inverse, counts = np.unique(v.astype(np.float32), axis=0, return_inverse=True, return_counts=True)
+    shared = counts[inverse.ravel()] > 1
+    if not np.any(shared):
+        return v, faces
+    tri = v[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    vertex_normal = np.zeros_like(v)
+    for k in range(3):
+        np.add.at(vertex_normal, faces[:, k], normal)
+    length = np.linalg.norm(vertex_normal[shared], axis=1)
+    v[shared] += distance * vertex_normal[shared] / np.where(length > 0, length, 1.0)[:, None]
+    return v, faces
+
+
+def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wall: float):
+    """A closed mesh (manifold) of the region of ``terms`` deeper than the wall, from ``Manifold.level_set``,
+    with its wall measured exactly; remeshed deeper (up to ``MAX_MESH_ATTEMPTS``) if thinner than ``wall``.
+    Returns (manifold or None when empty, measured wall)."""
+    import manifold3d
+
+    h = grid.spacing
+    lo = cells.min(axis=0) - 2 * h
+    hi = cells.max(axis=0) + 2 * h
+    margin = DEPTH_MARGIN * h
+    for _ in range(MAX_MESH_ATTEMPTS):
+        field = _cavity_field(grid, terms, centre, half, origin, frame, wall + margin)
+        # marching tetrahedra can leave vertices closer than a float32 STL can tell apart: merge them
+        region = manifold3d.Manifold.level_set(field, [*lo, *hi], h).simplify(SNAP * h)
+        # slivers the marching tetrahedra leave where the field grazes zero: voids smaller than (2h)³ change
+        # the moments by nothing measurable and no print could be emptied of them
+        pieces = [piece for piece in region.decompose() if piece.volume() >= MIN_VOID_CELLS * h ** 3]
+        if not pieces:
+            return None, math.inf
+        region = manifold3d.Manifold.batch_boolean(pieces, manifold3d.OpType.Add)
+        region_v, _ = _arrays_of(region)
+        measured = float(surface_distance(region_v, vertices, faces, cutoff=wall + h).min())
+        if measured >= wall + SNAP * h:          # pinches are separated by SNAP·h below
+            return region, measured - SNAP * h
+        margin += 0.5 * h
+    raise PhysicsError(f"could not mesh a cavity keeping a wall of {wall:g} m: the thinnest came out "
+                       f"{measured:g} m after {MAX_MESH_ATTEMPTS} attempts")
+
+
+def cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall: float):
+    """Mesh the cavity (and the insert), check the wall exactly, subtract, separate pinches.
+
+    ``design`` is a :class:`QuadricCavity` or a :class:`~.insert.QuadricInsert`.  Returns (vertices, faces,
+    insert vertices or None, insert faces or None, measured wall)."""
+    try:
+        import manifold3d
+    except ImportError as exc:                # pragma: no cover - a dependency of the package
+        raise UsageError("spin_it needs manifold3d (pip install manifold3d)") from exc
+    cavity = design if isinstance(design, QuadricCavity) else design.cavity
+    inserted = getattr(design, "inserted", None)
+    h = grid.spacing
+    walls = [math.inf]
+    insert = hole = None
+    if inserted is not None and np.any(inserted):
+        insert, measured = _region(grid, [(design.insert_coefficients, 1.0)], cavity.centre, cavity.half_extent,
+                                   centres[inserted], vertices, faces, origin, frame, wall)
+        walls.append(measured)
+    in_q1 = cavity.removed if inserted is None else cavity.removed | (inserted & (cavity.values(
+        (centres - origin) @ frame) < 0))
+    if np.any(in_q1):
+        hole, measured = _region(grid, [(cavity.coefficients, 1.0)], cavity.centre, cavity.half_extent,
+                                 centres[in_q1], vertices, faces, origin, frame, wall)
+        walls.append(measured)
+    if hole is None and insert is None:
+        return vertices, faces, None, None, math.inf
+    # the pocket is the union of both regions: the part keeps none of it, the insert fills its own share
+    pocket = hole if insert is None else (insert if hole is None else hole + insert)
+    part = _manifold_of(vertices, faces)
+    if part.status() != manifold3d.Error.NoError:
+        raise PhysicsError(f"the part is not a manifold solid for the boolean ({part.status()})")
+    result = part - pocket
+    if result.status() != manifold3d.Error.NoError:
+        raise PhysicsError(f"the boolean subtraction failed ({result.status()})")
+    out_v, out_f = _separate_pinches(*_arrays_of(result), SNAP * h)
+    ins_v = ins_f = None
+    if insert is not None:
+        ins_v, ins_f = _separate_pinches(*_arrays_of(insert), SNAP * h)
+    return out_v, out_f, ins_v, ins_f, min(walls)
