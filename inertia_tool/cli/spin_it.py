@@ -11,7 +11,8 @@ import numpy as np
 from ..errors import UsageError
 from ..units import length_scale, parse_density, parse_length, parse_mass, parse_vector
 from .analyze import add_material_options
-from .report_option import check_output_file, save_figure
+from ..reports.output import check_targets
+from .report_option import save_figure
 
 __all__ = ["register", "run", "OUTPUT_SUFFIXES"]
 
@@ -73,43 +74,34 @@ def _insert_density(text: str) -> float:
         return material_density(text)
 
 
-def _write_two_materials(path: str, result, material: str, insert: str, force: bool) -> None:
+def _write_two_materials(path: str, result, material: str, insert: str) -> None:
     from ..reports.mesh_3mf import write_3mf
     mm = length_scale("mm")
     write_3mf(path, [
         {"name": "part", "material": material, "color": "#9CC3E6FF", "vertices": result.vertices / mm,
          "faces": result.faces},
         {"name": "insert", "material": insert, "color": "#595959FF", "vertices": result.insert_vertices / mm,
-         "faces": result.insert_faces}], force=force)
+         "faces": result.insert_faces}], label="--out")
 
 
-def _write(path: str, vertices, faces, units: str, force: bool) -> None:
+def _write(path: str, vertices, faces, units: str) -> None:
     import trimesh
 
+    from ..reports.output import atomic_target
     suffix = os.path.splitext(path)[1].lower()
     scale = length_scale("mm") if suffix == ".3mf" else length_scale(units)
     mesh = trimesh.Trimesh(np.asarray(vertices) / scale, np.asarray(faces), process=False)
-    if os.path.exists(path) and not force:
-        raise UsageError(f"--out {path}: exists; refusing to overwrite it (use --force)")
-    tmp = f"{path}.tmp-{os.getpid()}{suffix}"
-    try:
+    with atomic_target(path, label="--out") as tmp:
         mesh.export(tmp, file_type=suffix[1:])
-        os.replace(tmp, path)
-    except OSError as exc:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise UsageError(f"--out {path}: cannot write it ({exc.strerror or exc})") from None
 
 
 def run(args) -> int:
     from ..design import spin_it
     from ..reports.spin_it import format_spin_it_text, spin_it_dict
 
-    if args.out:
-        if os.path.splitext(args.out)[1].lower() not in OUTPUT_SUFFIXES:
-            raise UsageError(f"--out writes {' or '.join(OUTPUT_SUFFIXES)}, got {args.out!r}")
-        check_output_file(args.out, "--out", args.force)
-    check_output_file(args.plot, "--plot", args.force)
+    if args.out and os.path.splitext(args.out)[1].lower() not in OUTPUT_SUFFIXES:
+        raise UsageError(f"--out writes {' or '.join(OUTPUT_SUFFIXES)}, got {args.out!r}")
+    check_targets([(args.out, "--out"), (args.plot, "--plot")], force=args.force)
     insert_density = _insert_density(args.insert) if args.insert is not None else None
     if insert_density is not None and args.out and not args.out.lower().endswith(".3mf"):
         raise UsageError(f"--insert makes a two-material part: --out must be a .3mf file, got {args.out!r}")
@@ -129,9 +121,9 @@ def run(args) -> int:
                      material=args.material, mass=parse_mass(args.mass) if args.mass is not None else None,
                      resolution=args.resolution, insert_density=insert_density)
     if args.out and result.insert_vertices is not None:
-        _write_two_materials(args.out, result, args.material or "part", args.insert, args.force)
+        _write_two_materials(args.out, result, args.material or "part", args.insert)
     elif args.out:
-        _write(args.out, result.vertices, result.faces, args.units, args.force)
+        _write(args.out, result.vertices, result.faces, args.units)
     if args.plot:
         try:
             from ..reports.spin_it import spin_it_figure

@@ -4,12 +4,9 @@ build.  Used by ``spin-it --out part.3mf`` for a hollowed part with a dense inse
 
 from __future__ import annotations
 
-import os
 import zipfile
 
 import numpy as np
-
-from ..errors import UsageError
 
 __all__ = ["write_3mf"]
 
@@ -59,32 +56,26 @@ def _model(objects) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_3mf(path, objects, *, force: bool = False) -> None:
-    """Write bodies of different materials as one 3MF package (millimetres).
+def write_3mf(path, objects, *, label: str | None = None) -> None:
+    """Write bodies of different materials as one 3MF package (millimetres), atomically
+    (:func:`inertia_tool.reports.output.atomic_target`; check the target first with ``check_targets``).
 
     Parameters
     ----------
     path : str or path-like
-        Output file; written to a temporary file beside it and renamed.
+        Output file.
     objects : sequence of dict
         ``{"name", "material", "color" ("#RRGGBBAA"), "vertices" ((n, 3) float, **millimetres**),
         "faces" ((m, 3) int, outward-wound)}``.
-    force : bool
-        Replace an existing file.
+    label : str, optional
+        The option that named the file, for messages (``"--out"``).
     """
-    path = os.fspath(path)
-    if os.path.exists(path) and not force:
-        raise UsageError(f"{path}: exists; refusing to overwrite it (use --force)")
+    from .output import atomic_target
+
     cleaned = [{**o, "vertices": np.asarray(o["vertices"], dtype=float), "faces": np.asarray(o["faces"], dtype=int)}
                for o in objects]
-    tmp = f"{path}.tmp-{os.getpid()}"
-    try:
+    with atomic_target(path, label=label) as tmp:
         with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as archive:
             archive.writestr("[Content_Types].xml", _CONTENT_TYPES)
             archive.writestr("_rels/.rels", _RELS)
             archive.writestr("3D/3dmodel.model", _model(cleaned))
-        os.replace(tmp, path)
-    except OSError as exc:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise UsageError(f"{path}: cannot write it ({exc.strerror or exc})") from None
