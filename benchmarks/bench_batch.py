@@ -1,6 +1,7 @@
 """Throughput of ``inertia-tool batch``: files/s with 1 process, 2 processes and a Dask LocalCluster(2).
 
-Generates N binary STL files (default 200: icospheres of 5,120-20,480 triangles, boxes, tori of 2k-18k, cylinders of 1k-4k; 0.6 kB-1 MB)
+Generates N binary STL files (default 200: icospheres of 5,120-20,480 triangles, boxes, tori of 2k-18k,
+cylinders of 1k-4k; 0.6 kB-1 MB)
 in a temporary directory, then runs the same batch three ways, each into a fresh JSONL file, and prints files/s
 and the speed-up over one process.  The Dask cluster's start-up is timed separately (not in files/s).
 
@@ -51,7 +52,8 @@ def make_meshes(directory: str, count: int, seed: int = 0) -> int:
             m = trimesh.creation.box(rng.uniform(5, 80, 3))
         elif kind == 2:
             m = trimesh.creation.torus(float(rng.uniform(20, 40)), float(rng.uniform(3, 10)),
-                                       major_sections=int(rng.integers(64, 192)), minor_sections=int(rng.integers(16, 48)))
+                                       major_sections=int(rng.integers(64, 192)),
+                                       minor_sections=int(rng.integers(16, 48)))
         else:
             m = trimesh.creation.cylinder(radius=float(rng.uniform(3, 30)), height=float(rng.uniform(5, 90)),
                                           sections=int(rng.integers(256, 1024)))
@@ -80,12 +82,15 @@ def main() -> None:
         faces = make_meshes(mesh_dir, args.files)
         files = discover_files(mesh_dir)
         size = sum(os.path.getsize(f) for f in files)
-        print(f"{len(files)} STL files, {faces:,} triangles, {size / 1e6:.1f} MB; {platform.processor() or platform.machine()}, "
+        print(f"{len(files)} STL files, {faces:,} triangles, {size / 1e6:.1f} MB; "
+              f"{platform.processor() or platform.machine()}, "
               f"{os.cpu_count()} CPUs, Python {platform.python_version()}, load average before "
               f"{os.getloadavg()[0]:.2f} (other work on the machine slows the parallel runs)")
         results = {}
-        for label, kw in [("1 process (in-process)", dict(jobs=1)), ("2 processes (ProcessPoolExecutor)", dict(jobs=2))]:
-            results[label] = min(_run(files, os.path.join(tmp, f"{label[:1]}_{r}.jsonl"), **kw) for r in range(args.repeat))
+        for label, kw in [("1 process (in-process)", dict(jobs=1)),
+                          ("2 processes (ProcessPoolExecutor)", dict(jobs=2))]:
+            results[label] = min(_run(files, os.path.join(tmp, f"{label[:1]}_{r}.jsonl"), **kw)
+                                 for r in range(args.repeat))
         try:
             from inertia_tool.cli.batch import dask_executor
             t0 = time.perf_counter()
@@ -93,7 +98,8 @@ def main() -> None:
             startup = time.perf_counter() - t0
             try:
                 results["Dask LocalCluster(2 workers)"] = min(
-                    _run(files, os.path.join(tmp, f"d_{r}.jsonl"), jobs=2, executor=executor) for r in range(args.repeat))
+                    _run(files, os.path.join(tmp, f"d_{r}.jsonl"), jobs=2, executor=executor)
+                    for r in range(args.repeat))
             finally:
                 shutdown()
         except ImportError:

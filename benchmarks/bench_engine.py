@@ -7,7 +7,8 @@ in fresh subprocesses (imports included, as a user would see it):
 * ``trimesh.load(FILE)`` + ``mesh.mass_properties`` (trimesh's own loader and integrator),
 
 and reports wall time and peak resident memory of each (VmHWM of the child's own address space: ru_maxrss
-would also count the benchmark process's memory at the fork, which exec inherits on Linux), the ratio, and the file size.  Also times
+would also count the benchmark process's memory at the fork, which exec inherits on Linux), the ratio, and the
+file size.  Also times
 the integration kernels alone on the same indexed mesh (in-process, best of 3).
 
     python benchmarks/bench_engine.py [--sizes 8 9] [--repeat 3]
@@ -115,7 +116,8 @@ def _timed(fn):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", type=int, nargs="+", default=[8, 9], help="icosphere subdivisions (8: 1.3M, 9: 5.2M faces)")
+    ap.add_argument("--sizes", type=int, nargs="+", default=[8, 9],
+                    help="icosphere subdivisions (8: 1.3M, 9: 5.2M faces)")
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
     rows = []

@@ -12,7 +12,8 @@ import re
 from .errors import MaterialError, UnitsError
 
 __all__ = ["LENGTH_UNITS", "MATERIALS", "length_scale", "material_density", "parse_length",
-           "parse_angular_rate", "parse_duration", "parse_mass", "parse_density", "parse_angle", "parse_vector", "parse_fraction"]
+           "parse_angular_rate", "parse_duration", "parse_mass", "parse_density", "parse_angle", "parse_vector",
+           "parse_fraction"]
 
 #: Length units accepted for mesh coordinates, as metres per unit.
 LENGTH_UNITS = {
@@ -59,7 +60,8 @@ MATERIALS = {
     "water": 1000.0,
 }
 _MATERIAL_ALIASES = {"aluminum": "aluminium", "al": "aluminium", "stainless": "stainless steel",
-                     "stainless-steel": "stainless steel", "stainless_steel": "stainless steel", "ss": "stainless steel",
+                     "stainless-steel": "stainless steel", "stainless_steel": "stainless steel",
+                     "ss": "stainless steel",
                      "ti": "titanium", "cu": "copper", "pa": "nylon", "pa12": "nylon", "pc": "polycarbonate",
                      "pmma": "acrylic", "cast-iron": "cast iron", "carbon fiber composite": "carbon fibre composite",
                      "cfrp": "carbon fibre composite"}

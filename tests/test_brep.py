@@ -1,4 +1,5 @@
-"""STEP and IGES through OpenCASCADE (inertia_tool.mesh.cad, inertia_tool.mass.brep): exact B-rep mass properties, the tessellation and
+"""STEP and IGES through OpenCASCADE (inertia_tool.mesh.cad, inertia_tool.mass.brep): exact B-rep mass properties,
+the tessellation and
 the bound on its error, on a part made here with OCP whose closed form is known (a cylinder with a hole)."""
 
 import numpy as np

@@ -9,7 +9,6 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import box_arrays, write_binary_stl
 from inertia_tool.cli import _NEGATIVE_VALUE, build_parser, main
 from robot_data import ERD, UR5
 

@@ -18,7 +18,7 @@ def test_json_lists_every_link_with_declared_and_audit(capsys):
     assert main(["robot", str(UR5), "--package", PKG, "--material", "aluminium", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["format"] == "urdf" and out["geometry"] == "collision"
-    links = {l["name"]: l for l in out["links"]}
+    links = {link["name"]: link for link in out["links"]}
     upper = links["upper_arm_link"]
     assert upper["density"] == 2700.0 and upper["mass"] == pytest.approx(2700.0 * upper["volume"])
     assert np.asarray(upper["inertia"]).shape == (3, 3)
@@ -35,7 +35,7 @@ def test_keep_mass_table_and_write(tmp_path, capsys):
     assert "panda_link1" in captured.out and "declared masses kept" in captured.out
     assert f"wrote {out}" in captured.err
     assert main(["robot", str(out), "--package", PKG, "--keep-mass", "--json"]) == 0
-    again = {l["name"]: l for l in json.loads(capsys.readouterr().out)["links"]}
+    again = {link["name"]: link for link in json.loads(capsys.readouterr().out)["links"]}
     link = again["panda_link3"]
     assert link["audit"]["com_distance"] < 1e-15 and link["audit"]["inertia_difference"] < 1e-14
     assert_tensor_close(link["declared"]["inertia"], link["inertia"], 1e-14)
@@ -84,7 +84,8 @@ def test_xacro_input_writes_the_expanded_urdf(tmp_path, capsys):
     assert model.body_mass[body] == pytest.approx(mass, rel=1e-12)
     np.testing.assert_allclose(model.body_ipos[body], [0, 0, 0.15], atol=1e-15)
     np.testing.assert_allclose(np.sort(model.body_inertia[body]),
-                               sorted([mass * 0.02 ** 2 / 2] + [mass * (0.02 ** 2 / 4 + 0.3 ** 2 / 12)] * 2), rtol=1e-12)
+                               sorted([mass * 0.02 ** 2 / 2] + [mass * (0.02 ** 2 / 4 + 0.3 ** 2 / 12)] * 2),
+                               rtol=1e-12)
 
 
 def test_an_open_link_mesh_is_reported_with_the_option_that_repairs_it(tmp_path, capsys):

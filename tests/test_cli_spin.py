@@ -119,7 +119,8 @@ def test_top_sleeping_criterion_and_asymmetric_warning(capsys):
     (["spin", T_HANDLE, "--perturbation", "0"], 2, "perturbation"),
     (["top", TOP, "--units", "mm", "--pivot", "1,2", "--spin", "5rev/s"], 2, "three comma-separated"),
     (["top", T_HANDLE, "--units", "mm", "--pivot", "0,0,35", "--spin", "5rev/s"], 4, "centre of mass"),
-    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "5rev/s", "--tilt", "200deg"], 2, "--tilt must be between 0 and 180 deg"),
+    (["top", TOP, "--units", "mm", "--pivot", "0,0,0", "--spin", "5rev/s", "--tilt", "200deg"], 2,
+     "--tilt must be between 0 and 180 deg"),
 ])
 def test_bad_input_exit_codes(capsys, argv, code, message):
     assert main(argv) == code
@@ -172,7 +173,8 @@ def test_spin_engine_sampling_bound_and_well_sampled_measurement():
     with pytest.raises(it.errors.UsageError, match="Undersampled"):
         it.dynamics.spin_experiment(props, "intermediate", 10 * math.pi, duration=1e6)
     # just above the bound (16 per flip interval) the measured interval still matches the prediction
-    e = it.dynamics.spin_experiment(props, "intermediate", 10 * math.pi, duration=60.0, samples=int(60 / 1.11851 * 17) + 1)
+    e = it.dynamics.spin_experiment(props, "intermediate", 10 * math.pi, duration=60.0,
+                                    samples=int(60 / 1.11851 * 17) + 1)
     assert e.measured_period == pytest.approx(e.predicted_period, rel=5e-3)
 
 

@@ -18,7 +18,7 @@ def _commands():
         if line.startswith("```"):
             inside = not inside
             continue
-        if inside and line.startswith("inertia-tool robot tests/") or inside and line.startswith("inertia-tool robot /tmp/"):
+        if inside and (line.startswith("inertia-tool robot tests/") or line.startswith("inertia-tool robot /tmp/")):
             lines.append(line)
     return lines
 

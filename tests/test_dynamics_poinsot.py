@@ -1,7 +1,6 @@
 """Polhode on the inertia ellipsoid and herpolhode on the invariant plane (§4.4.1, Poinsot construction)."""
 
 import numpy as np
-import pytest
 
 import inertia_tool as it
 from inertia_tool.dynamics import invariant_plane

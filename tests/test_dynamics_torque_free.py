@@ -7,7 +7,8 @@ from hypothesis import assume, given, settings, strategies as st
 from scipy.integrate import quad, solve_ivp
 
 from inertia_tool.dynamics.integrate import integrate_rigid_body
-from inertia_tool.dynamics.torque_free import ELLIPTIC_M1_FLOOR, free_body_parameters, precession_angle, torque_free_motion
+from inertia_tool.dynamics.torque_free import (ELLIPTIC_M1_FLOOR, free_body_parameters, precession_angle,
+                                               torque_free_motion)
 from inertia_tool.errors import UsageError
 from inertia_tool.rotations import quaternion_to_matrix
 
@@ -107,7 +108,8 @@ def _psi_rate(moments, w, circled):
 def test_precession_angle_against_quadrature(moments, w0):
     params = free_body_parameters(moments, w0)
     rate = lambda s: _psi_rate(moments, torque_free_motion(moments, w0, np.array([0.0, s]))[0][-1],
-                               params.circled_axis) if s > 0 else _psi_rate(moments, np.asarray(w0), params.circled_axis)
+                               params.circled_axis) if s > 0 else _psi_rate(moments, np.asarray(w0),
+                                                                            params.circled_axis)
     for t_end in [0.7, 5.0, 23.0]:
         ref, _ = quad(rate, 0.0, t_end, limit=500, epsabs=1e-13, epsrel=1e-13)
         assert precession_angle(moments, w0, [0.0, t_end])[-1] == pytest.approx(ref, rel=1e-12)
@@ -226,7 +228,8 @@ def test_near_separatrix_m_close_to_one(eps):
     moments = (1.0, 2.0, 3.0)
     w0 = (eps, 1.0, eps)
     params = free_body_parameters(moments, w0)
-    assert params.complementary_parameter == pytest.approx(2 * eps ** 2, rel=1e-6)  # (I3−I1)(M²−2E I2)/((I3−I2)(M²−2E I1))
+    # (I3−I1)(M²−2E I2)/((I3−I2)(M²−2E I1))
+    assert params.complementary_parameter == pytest.approx(2 * eps ** 2, rel=1e-6)
     t = np.linspace(0.0, min(2 * params.flip_time, 60.0), 121)
     w, q, _ = torque_free_motion(moments, w0, t)
     for k in (0, 37, 60, 103, 120):  # 50-digit evaluation of the closed form (DOP853 loses ~1/eps here)

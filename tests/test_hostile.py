@@ -16,7 +16,8 @@ from contextlib import redirect_stderr, redirect_stdout
 import numpy as np
 import pytest
 
-from corpus.make_corpus import ENTRIES, box, exact_reference, make_corpus, prism, write_ascii_stl, write_binary_stl, write_obj
+from corpus.make_corpus import (ENTRIES, box, exact_reference, make_corpus, prism, write_ascii_stl, write_binary_stl,
+                                write_obj)
 from inertia_tool import mass_properties
 from inertia_tool.cli import main
 from inertia_tool.errors import InvalidMeshError, MeshReadError, NonFiniteResultError, UsageError
@@ -89,7 +90,8 @@ def test_corpus_covers_the_issue_list():
     kinds = " ".join(e.kind for e in ENTRIES)
     for needed in ("zero-byte", "directory", "PNG", "10⁹", "mid-record", "trailing bytes", "\"solid\"",
                    "garbage", "NaN", "infinite", "1e308", "endloop", "Windows", "old-Mac", "non-UTF-8",
-                   "negative", "past the last vertex", "quads and n-gons", "claims more faces", "empty mesh", "point cloud", "flat",
+                   "negative", "past the last vertex", "quads and n-gons", "claims more faces", "empty mesh",
+                   "point cloud", "flat",
                    "degenerate", "open box", "face flipped", "inside-out box", "non-manifold",
                    "one inside out", "overlapping cubes", "zip bomb", "1 µm", "1 km", "float32", "1e8",
                    "axisymmetric", "needle", "--max-faces"):

@@ -13,7 +13,6 @@ import trimesh
 from conftest import write_binary_stl
 from inertia_tool import mass_properties
 from inertia_tool.cli import main
-from inertia_tool.reports import html as html_mod
 from inertia_tool.reports.html import HtmlSection, html_report, svg_views
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

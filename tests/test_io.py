@@ -1,5 +1,4 @@
 import os
-import warnings
 
 import numpy as np
 import pytest
@@ -7,7 +6,7 @@ import trimesh
 
 from conftest import box_arrays, write_ascii_stl, write_binary_stl
 from inertia_tool.errors import MeshReadError, TrailingDataWarning, UsageError
-from inertia_tool.mesh.read import load_mesh, read_stl
+from inertia_tool.mesh.read import load_mesh
 
 
 # every test runs on the C extension (when built) and on the pure-numpy path

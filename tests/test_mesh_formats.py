@@ -3,7 +3,6 @@ OBJ groups, compressed single-mesh files with bounded decompression."""
 
 import bz2
 import gzip
-import io
 import zipfile
 
 import numpy as np

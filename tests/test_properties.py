@@ -1,3 +1,5 @@
+import dataclasses
+
 import numpy as np
 import pytest
 import trimesh
@@ -84,7 +86,7 @@ def test_with_mass_scales_density_and_inertia():
 
 def test_results_are_frozen():
     p = mass_properties(box_arrays())
-    with pytest.raises(Exception):
+    with pytest.raises(dataclasses.FrozenInstanceError):
         p.mass = 3.0
     with pytest.raises(ValueError):
         p.inertia[0, 0] = 1.0

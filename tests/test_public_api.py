@@ -58,7 +58,8 @@ def documented_names(doc: str) -> set[str]:
 
 
 def test_documented_names_reads_numpydoc_entries_not_substrings():
-    doc = "Parameters\n----------\nalpha : float\n    uses beta in the text.\ngamma, delta\n    two.\n**extra\n    more.\n"
+    doc = ("Parameters\n----------\nalpha : float\n    uses beta in the text.\ngamma, delta\n    two.\n**extra\n"
+           "    more.\n")
     assert documented_names(doc) == {"alpha", "gamma", "delta", "extra"}
 
 

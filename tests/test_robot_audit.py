@@ -51,7 +51,8 @@ def test_triangle_inequality_violation_and_moved_com_are_flagged(tmp_path):
 
 def test_com_in_the_box_but_outside_the_material_of_a_ring(tmp_path):
     # a ring of 8 boxes around z: its centre of mass (the origin) is in the bounding box but not in the material
-    boxes = "".join(f'<collision><origin xyz="{0.1 * np.cos(t):.17g} {0.1 * np.sin(t):.17g} 0" rpy="0 0 {t:.17g}"/><geometry>'
+    boxes = "".join(f'<collision><origin xyz="{0.1 * np.cos(t):.17g} {0.1 * np.sin(t):.17g} 0" rpy="0 0 {t:.17g}"/>'
+                    '<geometry>'
                     '<box size="0.02 0.08 0.02"/></geometry></collision>' for t in np.arange(8) * np.pi / 4)
     f = tmp_path / "ring.urdf"
     f.write_text(f'<robot name="r"><link name="ring"><inertial><origin xyz="0 0 0"/><mass value="1"/>'

@@ -43,7 +43,7 @@ def test_mjcf_euler_lower_case_rotates_with_the_frame():
 def test_ur5_links_meshes_and_declared_inertials():
     robot = read_robot(UR5, packages=PACKAGES)
     assert robot.format == "urdf" and robot.name == "ur5" and robot.geometry == "collision"
-    names = [l.name for l in robot.links]
+    names = [link.name for link in robot.links]
     assert names[:7] == ["base_link", "shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link",
                          "wrist_2_link", "wrist_3_link"]
     upper = robot.link("upper_arm_link")
@@ -59,7 +59,8 @@ def test_ur5_links_meshes_and_declared_inertials():
 def test_declared_inertia_is_rotated_into_link_axes(tmp_path):
     f = tmp_path / "r.urdf"
     f.write_text('<robot name="r"><link name="a"><inertial><origin xyz="1 2 3" rpy="0 0 1.5707963267948966"/>'
-                 '<mass value="2"/><inertia ixx="1" ixy="0" ixz="0" iyy="2" iyz="0" izz="3"/></inertial></link></robot>')
+                 '<mass value="2"/><inertia ixx="1" ixy="0" ixz="0" iyy="2" iyz="0" izz="3"/></inertial>'
+                 '</link></robot>')
     d = read_robot(f).link("a").declared
     assert_tensor_close(d.inertia, np.diag([2.0, 1.0, 3.0]), 1e-14)   # x and y swap under a 90° yaw
     np.testing.assert_array_equal(d.center_of_mass, [1, 2, 3])
@@ -70,7 +71,8 @@ def test_unresolved_package_names_the_link_and_the_uri(monkeypatch):
     with pytest.raises(RobotDescriptionError) as exc:
         read_robot(UR5)
     msg = str(exc.value)
-    assert "link 'base_link'" in msg and "package://example-robot-data/robots/ur_description/meshes/ur5/collision/base.stl" in msg
+    assert "link 'base_link'" in msg
+    assert "package://example-robot-data/robots/ur_description/meshes/ur5/collision/base.stl" in msg
     assert "\n" not in msg
 
 
@@ -86,8 +88,10 @@ def test_file_uri_relative_path_and_missing_file(tmp_path):
     os.symlink(stl, tmp_path / "b.stl")
     f.write_text(f'<robot name="r"><link name="a"><collision><geometry><mesh filename="file://{stl}"/></geometry>'
                  '</collision><collision><geometry><mesh filename="b.stl"/></geometry></collision></link>'
-                 '<link name="c"><collision><geometry><mesh filename="missing.stl"/></geometry></collision></link></robot>')
-    with pytest.raises(RobotDescriptionError, match=r"link 'c': mesh 'missing.stl': resolves to .*missing.stl, which does not exist"):
+                 '<link name="c"><collision><geometry><mesh filename="missing.stl"/></geometry></collision>'
+                 '</link></robot>')
+    with pytest.raises(RobotDescriptionError,
+                       match=r"link 'c': mesh 'missing.stl': resolves to .*missing.stl, which does not exist"):
         read_robot(f)
     f.write_text(f.read_text().replace('<link name="c"><collision><geometry><mesh filename="missing.stl"/></geometry>'
                                        '</collision></link>', ""))
@@ -116,7 +120,9 @@ XACRO = """<?xml version="1.0"?>
   </xacro:macro>
   <xacro:rod name="upper" length="0.4"/>
   <xacro:rod name="lower" length="0.3"/>
-  <link name="tool"><collision><geometry><mesh filename="$(find example-robot-data)/robots/ur_description/meshes/ur5/collision/wrist3.stl"/></geometry></collision></link>
+  <link name="tool"><collision><geometry>
+    <mesh filename="$(find example-robot-data)/robots/ur_description/meshes/ur5/collision/wrist3.stl"/>
+  </geometry></collision></link>
 </robot>
 """
 
@@ -125,7 +131,7 @@ def test_xacro_is_expanded_with_arguments_and_find(tmp_path):
     f = tmp_path / "arm.urdf.xacro"
     f.write_text(XACRO)
     robot = read_robot(f, packages=PACKAGES, mappings={"radius": "0.02"})
-    assert robot.format == "xacro" and [l.name for l in robot.links] == ["upper", "lower", "tool"]
+    assert robot.format == "xacro" and [link.name for link in robot.links] == ["upper", "lower", "tool"]
     lower = robot.link("lower").elements[0]
     assert lower.kind == "cylinder" and lower.size == (0.02, 0.3)
     np.testing.assert_allclose(lower.translation, [0, 0, 0.15])

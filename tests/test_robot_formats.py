@@ -134,7 +134,8 @@ def test_thin_plate_shell_is_accepted_by_mujoco():
                                    "</mujoco>")
 
 
-def _fake(moments, rotation=np.eye(3)):
+def _fake(moments, rotation=None):
+    rotation = np.eye(3) if rotation is None else rotation
     return MassProperties(mass=1.0, volume=1e-3, center_of_mass=[0, 0, 0],
                           inertia=rotation @ np.diag(moments) @ rotation.T, name="fake")
 
@@ -239,7 +240,6 @@ def test_cli_refuses_a_needle_with_exit_code_4(tmp_path, capsys):
 # -- the principal frame nearest the link frame (docs/conventions.md) -------------------------------------
 
 from hypothesis import given, settings, strategies as st   # noqa: E402
-from scipy.spatial.transform import Rotation                # noqa: E402
 
 from inertia_tool.robot.inertial import _SIGNED_PERMUTATIONS, principal_frame_nearest   # noqa: E402
 from inertia_tool.mass.principal import principal_axes            # noqa: E402

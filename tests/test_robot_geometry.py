@@ -62,7 +62,8 @@ def test_rolled_cylinder_turns_its_axis():
     r, h = 0.05, 0.4
     props = element_mass_properties(_element("cylinder", (r, h), rpy=(np.pi / 2, 0, 0), xyz=(0, 0, 1)))
     m = np.pi * r * r * h
-    assert_tensor_close(props.inertia, np.diag([m * (r * r / 4 + h * h / 12), m * r * r / 2, m * (r * r / 4 + h * h / 12)]),
+    assert_tensor_close(props.inertia,
+                        np.diag([m * (r * r / 4 + h * h / 12), m * r * r / 2, m * (r * r / 4 + h * h / 12)]),
                         1e-14)
     np.testing.assert_allclose(props.center_of_mass, [0, 0, 1], atol=1e-15)
 
@@ -203,7 +204,7 @@ def test_gymnasium_mjcf_models_match_mujocos_inertia_from_geometry(model):
     from robot_data import GYM
     compiled = mujoco.MjModel.from_xml_path(str(GYM / model))
     robot = read_robot(GYM / model)
-    assert not any(l.elements for l in read_robot(GYM / model, geometry="visual").links)   # all geoms collide
+    assert not any(link.elements for link in read_robot(GYM / model, geometry="visual").links)   # all geoms collide
     ours = {r.name: r.properties for r in link_inertials(robot, density=1000)}
     assert len(ours) == compiled.nbody - 1
     for name, props in ours.items():

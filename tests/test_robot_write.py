@@ -111,7 +111,8 @@ def test_missing_inertials_are_inserted_in_the_style_of_the_file(tmp_path):
     inertials = link_inertials(robot, density=1000)
     text = corrected_document(robot, inertials).decode()
     assert "<box size='0.1 0.2 0.3' />" in text and "<!-- a comment, kept -->" in text
-    assert "\n        <inertial>\n            <origin" in text and text.endswith("    </link>\n    <link name=\"b\"/>\n</robot>\n")
+    assert "\n        <inertial>\n            <origin" in text
+    assert text.endswith("    </link>\n    <link name=\"b\"/>\n</robot>\n")
     declared = read_robot_from_text(tmp_path, text).link("a").declared
     assert declared.mass == pytest.approx(1000 * 0.006)
     mjcf = tmp_path / "m.xml"

@@ -219,7 +219,8 @@ def test_richardson_extrapolated_mesh_exact_reaches_exact(factory):
 
 def test_center_moves_vertices_and_center_of_mass():
     c = np.array([0.1, -0.2, 0.3])
-    base, moved = shapes.torus(0.04, 0.01, segments=12, rings=6), shapes.torus(0.04, 0.01, segments=12, rings=6, center=c)
+    base = shapes.torus(0.04, 0.01, segments=12, rings=6)
+    moved = shapes.torus(0.04, 0.01, segments=12, rings=6, center=c)
     np.testing.assert_allclose(moved.vertices, base.vertices + c, rtol=0, atol=1e-17)
     np.testing.assert_array_equal(moved.exact.center_of_mass, c)
     np.testing.assert_allclose(moved.mesh_exact.center_of_mass, c, rtol=0, atol=1e-17)

@@ -91,7 +91,8 @@ def test_rates_closed_forms():
     entry = stability([i1, i2, i3]).axes[1]
     p, q = entry.cross_coefficients
     assert p == pytest.approx(q, rel=1e-12)
-    assert entry.turns_to_grow(1e-3, 1.0) == pytest.approx(math.log(1000) / (2 * math.pi * math.sqrt(entry.coefficient)),
+    assert entry.turns_to_grow(1e-3, 1.0) == pytest.approx(
+        math.log(1000) / (2 * math.pi * math.sqrt(entry.coefficient)),
                                                            rel=1e-9)
 
 
@@ -105,7 +106,7 @@ def _linear_turns(p, q, initial, final, max_turns=1e5):
         return np.max(np.abs(starts @ phi.T))
 
     xs = np.linspace(0.0, 2 * math.pi * max_turns, 2001)   # coarse scan up to the first crossing
-    for lo, hi in zip(xs[:-1], xs[1:]):
+    for lo, hi in zip(xs[:-1], xs[1:]):   # noqa: B007 (lo brackets the crossing after the loop)
         if reach(hi) >= final:
             break
     else:

@@ -224,4 +224,5 @@ def test_cli_shell_model_end_to_end(tmp_path):
     out = json.loads(run.stdout)
     area = 2 * (0.1 * 0.05 + 0.1 * 0.02 + 0.05 * 0.02)
     assert out["mass"] == pytest.approx(7850 * 0.002 * area, rel=1e-6)
-    assert out["model"] == {"model": "shell", "thickness": pytest.approx(0.002), "approximation": out["model"]["approximation"]}
+    assert out["model"] == {"model": "shell", "thickness": pytest.approx(0.002),
+                            "approximation": out["model"]["approximation"]}

@@ -224,7 +224,8 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
     dict
         ``status`` is ``"ok"`` (numbers filled in), ``"error"`` (an ``InertiaToolError``: unreadable or
         invalid mesh; ``error_type`` and ``error`` say why) or ``"internal_error"`` (any other exception,
-        retried on resume).  ``warnings`` (``None`` when there are none) joins the soft problems with ``" | "``; ``seconds`` is the time
+        retried on resume).  ``warnings`` (``None`` when there are none) joins the soft problems with
+        ``" | "``; ``seconds`` is the time
         spent on this file.
     """
     start = time.perf_counter()

@@ -4,7 +4,8 @@ Routing, the progress bar and the summary only; the per-file work and the runner
 :mod:`inertia_tool.batch.runner`, the result files :mod:`inertia_tool.batch.rows`.
 
 Exit codes: 0 when every file is done without error (this run or an earlier one), 3 when some file failed,
-in this run or in the earlier row it was skipped for (its row says why), 2 for bad arguments or an ``--out`` that is not a results file of the same kind.
+in this run or in the earlier row it was skipped for (its row says why), 2 for bad arguments or an ``--out`` that
+is not a results file of the same kind.
 """
 
 from __future__ import annotations
@@ -152,7 +153,8 @@ def run(args) -> int:
                 shutdown()
     where = f"Dask ({args.dask})" if args.dask else f"{args.jobs} process{'es' if args.jobs > 1 else ''}"
     print(f"batch: {len(files)} files: {summary.ok} ok, {summary.failed} failed, {summary.skipped} skipped "
-          f"(done before{f', {summary.skipped_failed} of them failed' if summary.skipped_failed else ''}); total mass of the ok files {summary.total_mass:.6g} kg; "
+          f"(done before{f', {summary.skipped_failed} of them failed' if summary.skipped_failed else ''}); "
+          f"total mass of the ok files {summary.total_mass:.6g} kg; "
           f"{summary.seconds:.2f} s, {summary.files_per_second:.1f} files/s on {where}; rows in {args.out}",
           file=sys.stderr)
     for path, message in summary.failures[:10]:

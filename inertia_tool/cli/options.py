@@ -155,7 +155,8 @@ def require_range(value: float, option: str, *, low: float | None = None, high: 
             if low_open != high_open:
                 rule = f"{'>' if low_open else '>='} {low:g} and {'<' if high_open else '<='} {high:g}{u}"
         elif low is not None:
-            rule = f"{'>' if low_open else '>='} {low:g}{u}" if low != 0 or not low_open else f"positive{u and ' (' + unit + ')'}"
+            rule = (f"{'>' if low_open else '>='} {low:g}{u}" if low != 0 or not low_open
+                    else f"positive{u and ' (' + unit + ')'}")
         elif high is not None:
             rule = f"{'<' if high_open else '<='} {high:g}{u}"
         else:

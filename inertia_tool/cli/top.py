@@ -45,7 +45,8 @@ def register(subparsers) -> None:
                    help="pivot point in mesh coordinates (in --units unless a unit is given, e.g. 0,0,-2mm)")
     p.add_argument("--spin", required=True, metavar="RATE", help="spin about the symmetry axis, e.g. 50rev/s")
     p.add_argument("--tilt", default="0deg", metavar="ANGLE",
-                   help="initial tilt of the symmetry axis from the vertical, e.g. 20deg or 0.3rad (bare number: degrees; default 0)")
+                   help="initial tilt of the symmetry axis from the vertical, e.g. 20deg or 0.3rad "
+                        "(bare number: degrees; default 0)")
     p.add_argument("--precession", default="0", metavar="RATE", help="initial precession rate φ̇ (default 0)")
     p.add_argument("--nutation", default="0", metavar="RATE", help="initial tilting rate θ̇ (default 0)")
     p.add_argument("--gravity", type=float, default=STANDARD_GRAVITY, metavar="G",

@@ -326,7 +326,8 @@ def polhode_period(moments, angular_velocity) -> float:
     * ``L² < 2E I2`` (around the minor axis): exchange ``I1 ↔ I3``;
 
     ``K`` is the complete elliptic integral of the first kind with parameter ``m``, evaluated through
-    ``1 − m = (I3 − I1)(L² − 2E I2)/((I3 − I2)(L² − 2E I1))`` (through :func:`~inertia_tool.dynamics.elliptic.complete_k`) so that orbits near the
+    ``1 − m = (I3 − I1)(L² − 2E I2)/((I3 − I2)(L² − 2E I1))`` (through
+    :func:`~inertia_tool.dynamics.elliptic.complete_k`) so that orbits near the
     separatrix keep their digits.  For spin near the intermediate axis the body flips twice per period
     (the intermediate-axis, or Dzhanibekov, effect): the interval between flips is ``T/2``.  An
     axisymmetric body (``I1 = I2`` or ``I2 = I3``) gives ``T = 2π/|Ω|``, Ω of §4.4.1.

@@ -41,7 +41,8 @@ method stays small only while the step is constant) taken on the first step and 
 after it, scaled RMS norm ``atol + rtol·|y|`` over ``(ω, q)`` as in :mod:`.integrate`, new
 ``h = h·clip(0.9 err^{−1/(p+1)}, 0.2, 4)``; a probed step that fails the tolerance is redone with the smaller
 step.  The estimate is of the *local* error; the global error of a long run is larger (as for any
-integrator, and as ``rtol``/``atol`` of :mod:`.integrate`).  ``max_step`` bounds it; ``step`` fixes it (no error control).
+integrator, and as ``rtol``/``atol`` of :mod:`.integrate`).  ``max_step`` bounds it; ``step`` fixes it (no error
+control).
 """
 
 from __future__ import annotations

@@ -442,7 +442,8 @@ def heavy_top_on_pivot(props: MassProperties, pivot, *, theta0: float, omega3: f
     gyration = math.sqrt(max(float(np.trace(props.inertia)), 0.0) / props.mass)   # body size, m
     if length <= 1e-9 * gyration:
         raise PhysicsError("The pivot is at the centre of mass: gravity exerts no torque and the symmetry axis "
-                           "(pivot → centre of mass) is undefined; use inertia_tool.dynamics.spin_stability for a free body")
+                           "(pivot → centre of mass) is undefined; use inertia_tool.dynamics.spin_stability "
+                           "for a free body")
     n = offset / length
     i3 = float(n @ tensor @ n)
     e1 = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])

@@ -52,7 +52,8 @@ from ..rotations import matrix_to_quaternion, quaternion_multiply, quaternion_to
     rotation_vector_to_quaternion
 from .elliptic import complete_k, elliptic_f_from_sn_cn, elliptic_pi_of_argument, jacobi_sn_cn_dn
 
-__all__ = ["ELLIPTIC_M1_FLOOR", "FreeBodyParameters", "free_body_parameters", "torque_free_motion", "precession_angle", "FREE_CASES"]
+__all__ = ["ELLIPTIC_M1_FLOOR", "FreeBodyParameters", "free_body_parameters", "torque_free_motion", "precession_angle",
+           "FREE_CASES"]
 
 #: Names of the closed forms :func:`torque_free_motion` may use.
 FREE_CASES = ("spherical", "axisymmetric", "principal-axis spin", "elliptic", "separatrix")

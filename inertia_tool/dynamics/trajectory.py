@@ -92,7 +92,7 @@ def resolve_body(body) -> PrincipalAxes:
     """
     if isinstance(body, PrincipalAxes):
         result = body
-    elif hasattr(body, "principal") and isinstance(getattr(body, "principal"), PrincipalAxes):
+    elif hasattr(body, "principal") and isinstance(body.principal, PrincipalAxes):
         result = body.principal
     else:
         arr = np.asarray(body, dtype=np.float64)

@@ -17,9 +17,9 @@ Closed forms used below (M the mass, all about the centre of mass)
 ------------------------------------------------------------------
 Axisymmetric solids (about the symmetry axis ``z`` / about any transverse axis through the centre of mass):
 
-============================  ========================================  =================================================
+============================  ========================================  ============================================
 solid                         I_zz                                      I_xx = I_yy
-============================  ========================================  =================================================
+============================  ========================================  ============================================
 cone (R, h), ex. 4.6          3MR²/10                                   3M(R² + h²/4)/20
 regular n-gonal pyramid       6kMR²/5                                   3kMR²/5 + 3Mh²/80,  k = (2 + cos(2π/n))/12
 cylinder (R, h)               MR²/2                                     M(R²/4 + h²/12)
@@ -29,7 +29,7 @@ torus (R, r)                  M(R² + 3r²/4)                             M(R²/
 thin ring (r → 0), §4.3.2     MR²                                       MR²/2
 sphere (r)                    2Mr²/5                                    2Mr²/5
 hollow sphere (r_o, r_i)      (8π/15)ρ(r_o⁵ − r_i⁵)                     same
-============================  ========================================  =================================================
+============================  ========================================  ============================================
 
 Box ``a × b × c``: ``I_xx = M(b² + c²)/12`` (cyclic).  Octahedron ``|x|/a + |y|/b + |z|/c ≤ 1`` (exercise 4.9):
 ``I_xx = M(b² + c²)/10`` (cyclic).  All products of inertia vanish (mirror symmetry in every coordinate plane
@@ -274,7 +274,8 @@ def _revolved_polyhedron(profile: np.ndarray, segments: int, center: np.ndarray,
     nxt = np.roll(profile, -1, axis=0)
     half = 0.5 * theta
     area = segments * math.sin(half) * float(np.sum(
-        (profile[:, 0] + nxt[:, 0]) * np.hypot(nxt[:, 1] - profile[:, 1], (nxt[:, 0] - profile[:, 0]) * math.cos(half))))
+        (profile[:, 0] + nxt[:, 0])
+        * np.hypot(nxt[:, 1] - profile[:, 1], (nxt[:, 0] - profile[:, 0]) * math.cos(half))))
     i_xx = 0.5 * radial + zz
     return _props(volume, center + np.array([0.0, 0.0, z_c]), (i_xx, i_xx, radial), area, name)
 
@@ -483,7 +484,8 @@ def washer(outer_radius: float, inner_radius: float, height: float, *, segments:
     mass = math.pi * (outer_radius ** 2 - inner_radius ** 2) * height
     i_zz = 0.5 * mass * r2
     i_xx = mass * (r2 / 4.0 + height ** 2 / 12.0)
-    area = 2.0 * math.pi * (outer_radius ** 2 - inner_radius ** 2) + 2.0 * math.pi * (outer_radius + inner_radius) * height
+    area = (2.0 * math.pi * (outer_radius ** 2 - inner_radius ** 2)
+            + 2.0 * math.pi * (outer_radius + inner_radius) * height)
     name = f"washer(R_o={outer_radius:g}, R_i={inner_radius:g}, h={height:g}, n={segments})"
     exact = _props(mass, c, (i_xx, i_xx, i_zz), area, name)
     z = height / 2.0

@@ -77,7 +77,8 @@ def _describe_edges(topo, source: str) -> str:
     if len(topo.sample):
         a, b = topo.sample[0]
         where = f", e.g. the edge ({a[0]:.6g}, {a[1]:.6g}, {a[2]:.6g})–({b[0]:.6g}, {b[1]:.6g}, {b[2]:.6g}) m"
-    return f"{source}: not a closed, consistently wound solid: {'; '.join(parts)}{where}; `repair=True` gives a bounded estimate"
+    return (f"{source}: not a closed, consistently wound solid: {'; '.join(parts)}{where}; "
+            "`repair=True` gives a bounded estimate")
 
 
 def _repair(vertices, faces, source):
@@ -226,7 +227,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
     raw : RawMesh
         Vertices in metres and faces, from :func:`~inertia_tool.mesh.read.load_mesh`.
     repair : bool
-        Estimate instead of refusing a mesh that does not bound a solid (see :class:`~inertia_tool.mesh.options.LoadOptions`).
+        Estimate instead of refusing a mesh that does not bound a solid (see
+        :class:`~inertia_tool.mesh.options.LoadOptions`).
     merge_tolerance : float
         Tolerance-weld spacing relative to the bounding-box diagonal; 0 disables it.
 
@@ -310,7 +312,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
     bbox_min, bbox_max = bounding_box(v)
     report = MeshReport(source=source, units=raw.units, file_faces=raw.file_faces, vertices=len(v), faces=len(f),
-                        degenerate_faces=n_repeated, zero_area_faces=sum(s.zero_area_faces for s in shells), bodies=bodies, cavities=cavities,
+                        degenerate_faces=n_repeated, zero_area_faces=sum(s.zero_area_faces for s in shells),
+                        bodies=bodies, cavities=cavities,
                         flipped_shells=int(np.count_nonzero(flip)), overlapping_shells=overlaps,
                         watertight=watertight, welded_tolerance=welded, repaired=repaired,
                         repair_actions=tuple(actions), repair_volume_change=volume_change,

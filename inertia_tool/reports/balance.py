@@ -149,14 +149,16 @@ def _summary_rows(report: BalanceReport) -> list[tuple[str, str]]:
         ("centre of mass (shaft frame)", f"({com[0]:.4g}, {com[1]:.4g}, {com[2]:.4g}) mm; "
                                           f"offset from the shaft e = {_num(s.offset * 1e3)} mm"),
         ("static unbalance U = M·e", f"{_num(_mag(s.static_unbalance) * _G_MM)} g·mm at "
-                                     f"{_deg(_vec_angle(s.static_unbalance)):.1f}°  (x {_num(s.static_unbalance[0] * _G_MM)}, "
+                                     f"{_deg(_vec_angle(s.static_unbalance)):.1f}°  "
+                                     f"(x {_num(s.static_unbalance[0] * _G_MM)}, "
                                      f"y {_num(s.static_unbalance[1] * _G_MM)} g·mm)"),
         ("couple unbalance (about the c.o.m. plane)", f"{_num(_mag(s.couple_unbalance) * _G_MM2)} g·mm² at "
                                                        f"{_deg(_vec_angle(s.couple_unbalance)):.1f}°"),
         ("products of inertia J_xz, J_yz", f"{_num(s.products_of_inertia[0])}, {_num(s.products_of_inertia[1])} "
                                            "kg·m² (about the axis point, shaft axes, −∫xz dm)"),
-        ("tilt of the nearest central principal axis", f"{math.degrees(s.tilt):.4g}° towards {_deg(s.tilt_angle):.1f}°; "
-                                                       f"closest approach to the shaft {_num(s.axis_distance * 1e3)} mm"),
+        ("tilt of the nearest central principal axis",
+         f"{math.degrees(s.tilt):.4g}° towards {_deg(s.tilt_angle):.1f}°; "
+         f"closest approach to the shaft {_num(s.axis_distance * 1e3)} mm"),
     ]
     return rows
 
@@ -190,7 +192,8 @@ def _correction_rows(report: BalanceReport) -> list[list[str]]:
     for k, (c, p) in enumerate(zip(report.corrections, report.correction_planes), start=1):
         pos = c.position * 1e3
         rows.append([str(k), f"{c.plane * 1e3:.4g}", _num(p.magnitude * _G_MM), f"{_deg(p.angle):.1f}",
-                     _num(c.mass * 1e3), f"{c.radius * 1e3:.4g}", f"{_deg(c.angle):.1f}", f"{_deg(c.removal_angle):.1f}",
+                     _num(c.mass * 1e3), f"{c.radius * 1e3:.4g}", f"{_deg(c.angle):.1f}",
+                     f"{_deg(c.removal_angle):.1f}",
                      f"({pos[0]:.4g}, {pos[1]:.4g}, {pos[2]:.4g})"])
     return rows
 
@@ -225,7 +228,8 @@ def _header(report: BalanceReport) -> list[tuple[str, str]]:
     return [
         ("part", f"{report.name or '(unnamed)'}: {_num(report.mass)} kg"),
         ("speed", f"{report.rpm:.6g} rpm (Ω = {report.speed:.6g} rad/s)"),
-        ("shaft", f"through ({o[0]:.4g}, {o[1]:.4g}, {o[2]:.4g}) mm along ({ax[0, 2]:.4g}, {ax[1, 2]:.4g}, {ax[2, 2]:.4g})"),
+        ("shaft", f"through ({o[0]:.4g}, {o[1]:.4g}, {o[2]:.4g}) mm "
+                  f"along ({ax[0, 2]:.4g}, {ax[1, 2]:.4g}, {ax[2, 2]:.4g})"),
         ("shaft frame", f"x = ({ax[0, 0]:.4g}, {ax[1, 0]:.4g}, {ax[2, 0]:.4g}), y = ({ax[0, 1]:.4g}, {ax[1, 1]:.4g}, "
                         f"{ax[2, 1]:.4g}) in mesh axes; angles from x towards y"),
     ]
@@ -320,7 +324,8 @@ def polar_svg(report: BalanceReport, index: int, *, size: int = 260) -> str:
     if plane.magnitude > 0 and scale > 0:
         x, y = pt(plane.magnitude * scale, plane.angle)
         parts.append(f'<line x1="{c}" y1="{c}" x2="{x:.1f}" y2="{y:.1f}" stroke="#c22" stroke-width="3">'
-                     f'<title>unbalance {_num(plane.magnitude * _G_MM)} g·mm at {_deg(plane.angle):.1f}°</title></line>')
+                     f'<title>unbalance {_num(plane.magnitude * _G_MM)} g·mm at {_deg(plane.angle):.1f}°'
+                     '</title></line>')
         parts.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="3.5" fill="#c22"/>')
     if corr.mass > 0:
         ax, ay = pt(rim, corr.angle)
@@ -348,7 +353,8 @@ def balance_markdown(report: BalanceReport, *, svg_links=()) -> str:
     m = escape_markdown
     out = [f"# Balancing report: {m(report.name or 'part')}", ""]
     out += _md_table(["", ""], [[k, v] for k, v in _header(report)])
-    out += ["", "## Unbalance as it is", ""] + _md_table(["quantity", "value"], [list(r) for r in _summary_rows(report)])
+    out += ["", "## Unbalance as it is", ""] + _md_table(["quantity", "value"],
+                                                         [list(r) for r in _summary_rows(report)])
     out += ["", f"## Loads at {report.rpm:.6g} rpm", "", "They rotate with the part; gravity is not included.", ""]
     out += _md_table(["quantity", "value"], [list(r) for r in _load_rows(report)])
     out += ["", "## ISO 21940-11 tolerance", ""] + [f"- {m(x)}" for x in _grade_lines(report)] + [""]

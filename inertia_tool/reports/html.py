@@ -69,7 +69,8 @@ body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,Helvetica,Arial,sans-
 max-width:1040px;padding:0 1em;color:#222;line-height:1.4}
 h1{font-size:1.5em;margin-bottom:.2em}h2{font-size:1.15em;border-bottom:1px solid #ccc;padding-bottom:.2em;
 margin-top:1.6em}.muted{color:#666;font-size:.9em}
-table{border-collapse:collapse;margin:.5em 0;display:block;overflow-x:auto;max-width:100%}td,th{border:1px solid #ddd;padding:.25em .6em;text-align:right;
+table{border-collapse:collapse;margin:.5em 0;display:block;overflow-x:auto;max-width:100%}
+td,th{border:1px solid #ddd;padding:.25em .6em;text-align:right;
 font-variant-numeric:tabular-nums;white-space:nowrap}td.l{white-space:normal}th{white-space:normal;background:#f4f4f4;text-align:left}td.l{text-align:left}
 .views{display:flex;flex-wrap:wrap;gap:12px}.views figure{margin:0}.views figcaption{text-align:center;
 font-size:.9em;color:#444}svg{background:#fff;border:1px solid #ddd}.warn{color:#8a4b00}
@@ -456,7 +457,8 @@ def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_
     legend = ('<p class="legend">'
               + "".join(f'<span><span class="swatch" style="color:{_AXIS_COLOURS[k]}">━</span> principal axis {k + 1} '
                         f"(I{k + 1} = {pa.moments[k]:.4g} kg·m²)</span>" for k in range(3))
-              + '<span>⊕ centre of mass</span><span><span class="swatch" style="color:#ff7f0e">┅</span> equivalent inertia '
+              + '<span>⊕ centre of mass</span><span><span class="swatch" style="color:#ff7f0e">┅</span> '
+                "equivalent inertia "
                 "ellipsoid (uniform solid ellipsoid with the same mass and principal moments)</span>"
                 "<span>grey: silhouette and feature edges</span></p>")
     parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',

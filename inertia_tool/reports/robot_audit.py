@@ -44,7 +44,7 @@ def _audit_dict(audit: LinkAudit) -> dict:
 def robot_report_dict(robot: RobotDescription, inertials, audits) -> dict:
     """The ``robot --json`` object: ``{"robot", "source", "format", "geometry", "units", "links": [...]}``."""
     links = []
-    link_geometry = {l.name: l for l in robot.links}
+    link_geometry = {link.name: link for link in robot.links}
     for result, audit in zip(inertials, audits):
         props = result.properties
         geometry = link_geometry[result.name]

@@ -56,7 +56,8 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
     lines += _matrix(props.inertia, "    ")
     lines.append("  inertia about the mesh origin (0, 0, 0), mesh axes (kg·m²):")
     lines += _matrix(np.asarray(props.inertia_about(np.zeros(3))), "    ")
-    lines.append("  (shown as 0: matrix and axis entries below 1e-12 of the largest, coordinates below 1e-10 of the part size)")
+    lines.append("  (shown as 0: matrix and axis entries below 1e-12 of the largest, coordinates below 1e-10 of "
+                 "the part size)")
     lines.append("  principal moments (ascending) and axes (unit vectors, mesh axes, right-handed):")
     for k in range(3):
         lines.append(f"    I{k + 1} = {pa.moments[k]:.6e} kg·m²   axis {_vec(pa.axes[:, k])}   "

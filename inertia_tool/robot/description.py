@@ -200,7 +200,7 @@ class RobotDescription:
         for link in self.links:
             if link.name == name:
                 return link
-        raise KeyError(f"no link {name!r}; links: {', '.join(l.name for l in self.links)}")
+        raise KeyError(f"no link {name!r}; links: {', '.join(link.name for link in self.links)}")
 
 
 # -- shared parsing helpers ------------------------------------------------------------------------------

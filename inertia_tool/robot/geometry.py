@@ -137,7 +137,8 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
                 cache[element.mesh] = local
         local = _scaled(local, element.scale)
     else:
-        raise UsageError(f"Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, mesh, got {kind!r}")
+        raise UsageError("Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, mesh, "
+                         f"got {kind!r}")
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
 

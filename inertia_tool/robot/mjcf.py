@@ -271,7 +271,8 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
         child_class = body.get("childclass", class_name)
         elements = []
         collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements)
-        links.append(LinkGeometry(name=name, elements=tuple(elements), declared=_inertial(body, name, compiler, source)))
+        links.append(LinkGeometry(name=name, elements=tuple(elements),
+                                  declared=_inertial(body, name, compiler, source)))
         for child, cls in _child_bodies(body, child_class):
             walk_body(child, cls)
 

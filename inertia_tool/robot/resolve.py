@@ -70,7 +70,8 @@ def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) 
         name, _, inner = rest.partition("/")
         directory = package_directory(name, packages, scheme=scheme)
         if directory is None:
-            searched = "ROS_PACKAGE_PATH" if scheme == "package" else "ROS_PACKAGE_PATH, GZ_SIM_RESOURCE_PATH, GAZEBO_MODEL_PATH"
+            searched = ("ROS_PACKAGE_PATH" if scheme == "package"
+                        else "ROS_PACKAGE_PATH, GZ_SIM_RESOURCE_PATH, GAZEBO_MODEL_PATH")
             raise RobotDescriptionError(f"{where}: cannot resolve package {name!r} (not among the packages given, "
                                         f"not found on {searched})")
         path = os.path.join(directory, unquote(inner))

@@ -144,10 +144,10 @@ def _mjcf_inertial(body, props) -> None:
 def _links(root, fmt: str):
     """Link (URDF/SDF) or body (MJCF) elements by name, in document order."""
     if fmt in ("urdf", "xacro"):
-        return {l.get("name"): l for l in root.findall("link")}
+        return {link.get("name"): link for link in root.findall("link")}
     if fmt == "sdf":
         models = root.findall("model") + root.findall("world/model")
-        return {l.get("name"): l for l in models[0].findall("link")}
+        return {link.get("name"): link for link in models[0].findall("link")}
     bodies = {}
     for k, body in enumerate(root.iter("body")):
         bodies[body.get("name") or f"body {k + 1}"] = body
@@ -181,7 +181,8 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "") ->
     tree = parse_xml(robot.document, robot.source)
     root = tree.getroot()
     elements = _links(root, robot.format)
-    writer = {"urdf": _urdf_inertial, "xacro": _urdf_inertial, "sdf": _sdf_inertial, "mjcf": _mjcf_inertial}[robot.format]
+    writer = {"urdf": _urdf_inertial, "xacro": _urdf_inertial, "sdf": _sdf_inertial,
+              "mjcf": _mjcf_inertial}[robot.format]
     before = list(root.iter("inertial"))
     changed = []
     for result in inertials:

@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Entry", "ENTRIES", "make_corpus", "exact_reference", "box", "write_binary_stl", "write_ascii_stl", "write_obj"]
+__all__ = ["Entry", "ENTRIES", "make_corpus", "exact_reference", "box", "write_binary_stl", "write_ascii_stl",
+           "write_obj"]
 
 
 @dataclass
@@ -553,7 +554,8 @@ def _(path):
     return [(v1, f1), (v2, f2[:, ::-1])]
 
 
-@entry("max-faces.stl", "more triangles than --max-faces", 3, r"holds 12 triangles, more than --max-faces \(10\) allows",
+@entry("max-faces.stl", "more triangles than --max-faces", 3,
+       r"holds 12 triangles, more than --max-faces \(10\) allows",
        args=("--max-faces", "10"))
 def _(path):
     write_binary_stl(path, *box())
