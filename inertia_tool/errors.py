@@ -23,6 +23,8 @@ exception types to exit codes and the parameter names to its options (``inertia_
 
 from __future__ import annotations
 
+from typing import Any
+
 __all__ = [
     "InertiaToolError",
     "UsageError",
@@ -91,7 +93,7 @@ class InvalidMeshError(InertiaToolError, ValueError):
     """
 
 
-    def __init__(self, message: str, details: dict | None = None):
+    def __init__(self, message: str, details: dict[str, Any] | None = None):
         super().__init__(message)
         self.details = dict(details or {})
 

@@ -20,9 +20,15 @@ scipy in ``tests/test_rotations.py``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .errors import UsageError
+
+if TYPE_CHECKING:                       # scipy has no type information: Rotation is Any to the checker
+    from scipy.spatial.transform import Rotation
 
 __all__ = [
     "perpendicular_basis",
@@ -46,7 +52,7 @@ __all__ = [
 _TWO_PI = 2.0 * np.pi
 
 
-def _as_quaternion(q, name: str = "q") -> np.ndarray:
+def _as_quaternion(q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
     a = np.asarray(q, dtype=np.float64)
     if a.shape[-1:] != (4,):
         raise UsageError(f"Expected `{name}` to have shape (..., 4), got {a.shape}")
@@ -55,7 +61,7 @@ def _as_quaternion(q, name: str = "q") -> np.ndarray:
     return a
 
 
-def _as_matrix(m, name: str = "matrix") -> np.ndarray:
+def _as_matrix(m: ArrayLike, name: str = "matrix") -> NDArray[np.float64]:
     a = np.asarray(m, dtype=np.float64)
     if a.shape[-2:] != (3, 3):
         raise UsageError(f"Expected `{name}` to have shape (..., 3, 3), got {a.shape}")
@@ -64,7 +70,7 @@ def _as_matrix(m, name: str = "matrix") -> np.ndarray:
     return a
 
 
-def skew(vector) -> np.ndarray:
+def skew(vector: ArrayLike) -> np.ndarray:
     """Cross-product matrix ``[v]×`` with ``[v]× b = v × b``; (..., 3) → (..., 3, 3).
 
     In the chapter's notation ``Ω'_ij = Σ_k ε_ijk ω'_k`` (§4.2) is ``−[ω']×``.
@@ -76,21 +82,22 @@ def skew(vector) -> np.ndarray:
                      np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
 
 
-def rotation_z(angle) -> np.ndarray:
+def rotation_z(angle: ArrayLike) -> np.ndarray:
     """Passive rotation about z, Eq. (4.29): ``[[c, s, 0], [−s, c, 0], [0, 0, 1]]``; (...) → (..., 3, 3)."""
     a = np.asarray(angle, dtype=np.float64)
     c, s, o, z = np.cos(a), np.sin(a), np.ones_like(a), np.zeros_like(a)
     return np.stack([np.stack([c, s, z], -1), np.stack([-s, c, z], -1), np.stack([z, z, o], -1)], -2)
 
 
-def rotation_y(angle) -> np.ndarray:
+def rotation_y(angle: ArrayLike) -> np.ndarray:
     """Passive rotation about y, Eq. (4.30): ``[[c, 0, −s], [0, 1, 0], [s, 0, c]]``; (...) → (..., 3, 3)."""
     a = np.asarray(angle, dtype=np.float64)
     c, s, o, z = np.cos(a), np.sin(a), np.ones_like(a), np.zeros_like(a)
     return np.stack([np.stack([c, z, -s], -1), np.stack([z, o, z], -1), np.stack([s, z, c], -1)], -2)
 
 
-def _rotation(active_matrices=None, *, quaternions=None, rotvecs=None, euler=None):
+def _rotation(active_matrices: np.ndarray | None = None, *, quaternions: np.ndarray | None = None,
+              rotvecs: np.ndarray | None = None, euler: np.ndarray | None = None) -> Rotation:
     """scipy ``Rotation`` of a stack of active matrices / scalar-first quaternions / rotation vectors / angles."""
     from scipy.spatial.transform import Rotation
     if active_matrices is not None:
@@ -102,10 +109,11 @@ def _rotation(active_matrices=None, *, quaternions=None, rotvecs=None, euler=Non
         return Rotation.from_quat(np.roll(quaternions.reshape(-1, 4), -1, axis=-1))
     if rotvecs is not None:
         return Rotation.from_rotvec(rotvecs.reshape(-1, 3))
+    assert euler is not None, "_rotation needs one of its four arguments"   # internal: callers pass one
     return Rotation.from_euler("ZYZ", euler.reshape(-1, 3))
 
 
-def euler_to_matrix(phi, theta, psi) -> np.ndarray:
+def euler_to_matrix(phi: ArrayLike, theta: ArrayLike, psi: ArrayLike) -> np.ndarray:
     """The chapter's ``A(φ, θ, ψ) = R_z(ψ) R_y(θ) R_z(φ)``, Eq. (4.31) (space → body components).
 
     ``A`` is the transpose of scipy's intrinsic ``Rotation.from_euler("ZYZ", [φ, θ, ψ])``.
@@ -122,11 +130,11 @@ def euler_to_matrix(phi, theta, psi) -> np.ndarray:
     angles = np.stack(np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (phi, theta, psi))), -1)
     if not np.all(np.isfinite(angles)):
         raise UsageError("Expected finite Euler angles")
-    active = _rotation(euler=angles).as_matrix()
+    active: np.ndarray = _rotation(euler=angles).as_matrix()
     return np.swapaxes(active, -1, -2).reshape(angles.shape[:-1] + (3, 3))
 
 
-def matrix_to_euler(matrix, *, gimbal_atol: float = 1e-12):
+def matrix_to_euler(matrix: ArrayLike, *, gimbal_atol: float = 1e-12) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Euler angles ``(φ, θ, ψ)`` of a passive matrix ``A`` (inverse of :func:`euler_to_matrix`).
 
     From Eq. (4.31): ``cos θ = A33``, ``(A31, A32) = sin θ (cos φ, sin φ)``,
@@ -160,7 +168,8 @@ def matrix_to_euler(matrix, *, gimbal_atol: float = 1e-12):
     return np.mod(phi, _TWO_PI), theta, np.mod(psi, _TWO_PI)
 
 
-def euler_rates_to_angular_velocity(phi, theta, psi, phi_dot, theta_dot, psi_dot) -> np.ndarray:
+def euler_rates_to_angular_velocity(phi: ArrayLike, theta: ArrayLike, psi: ArrayLike, phi_dot: ArrayLike,
+                                    theta_dot: ArrayLike, psi_dot: ArrayLike) -> np.ndarray:
     """Body components of the angular velocity from Euler angles and rates, Eq. (4.33).
 
     ``ω'_1 = θ̇ sin ψ − φ̇ sin θ cos ψ``, ``ω'_2 = θ̇ cos ψ + φ̇ sin θ sin ψ``, ``ω'_3 = ψ̇ + φ̇ cos θ``;
@@ -177,17 +186,17 @@ def euler_rates_to_angular_velocity(phi, theta, psi, phi_dot, theta_dot, psi_dot
                      psi_dot + phi_dot * np.cos(theta)], -1)
 
 
-def _unit_axis(axis) -> np.ndarray:
+def _unit_axis(axis: ArrayLike) -> np.ndarray:
     n = np.asarray(axis, dtype=np.float64)
     if n.shape[-1:] != (3,):
         raise UsageError(f"Expected `axis` to have shape (..., 3), got {n.shape}")
-    norm = np.linalg.norm(n, axis=-1, keepdims=True)
+    norm: NDArray[np.float64] = np.linalg.norm(n, axis=-1, keepdims=True)
     if not np.all(norm > 0) or not np.all(np.isfinite(norm)):
         raise UsageError("Expected a finite non-zero `axis`")
     return n / norm
 
 
-def axis_angle_to_matrix(axis, angle) -> np.ndarray:
+def axis_angle_to_matrix(axis: ArrayLike, angle: ArrayLike) -> np.ndarray:
     """Passive matrix ``A`` of a counter-clockwise rotation by ``angle`` about ``axis`` (exercise 4.5).
 
     ``A_ij = δ_ij cos θ + n_i n_j (1 − cos θ) − ε_ijk n_k sin θ``: the transpose of scipy's
@@ -207,24 +216,24 @@ def axis_angle_to_matrix(axis, angle) -> np.ndarray:
     n = _unit_axis(axis)
     th = np.asarray(angle, dtype=np.float64)
     rotvec = n * th[..., None]
-    active = _rotation(rotvecs=rotvec).as_matrix()
+    active: np.ndarray = _rotation(rotvecs=rotvec).as_matrix()
     return np.swapaxes(active, -1, -2).reshape(rotvec.shape[:-1] + (3, 3))
 
 
-def matrix_to_axis_angle(matrix):
+def matrix_to_axis_angle(matrix: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Axis and angle of a passive matrix ``A`` (inverse of :func:`axis_angle_to_matrix`).
 
     Returns ``(axis (..., 3), angle (...) ∈ [0, π])``; for the identity the axis is ``(0, 0, 1)``.
     """
     a = _as_matrix(matrix)
-    rotvec = _rotation(np.swapaxes(a, -1, -2)).as_rotvec().reshape(a.shape[:-2] + (3,))
+    rotvec: np.ndarray = _rotation(np.swapaxes(a, -1, -2)).as_rotvec().reshape(a.shape[:-2] + (3,))
     angle = np.linalg.norm(rotvec, axis=-1)
     safe = np.where(angle > 0, angle, 1.0)[..., None]
     axis = np.where(angle[..., None] > 0, rotvec / safe, np.array([0.0, 0.0, 1.0]))
     return axis, angle
 
 
-def quaternion_to_matrix(quaternion) -> np.ndarray:
+def quaternion_to_matrix(quaternion: ArrayLike) -> np.ndarray:
     """Active rotation matrix ``Q`` (body → space) of scalar-first quaternions (normalised here); ``A = Qᵀ``.
 
     ``Q = (w² − v·v) 𝟙 + 2 v vᵀ + 2 w [v]×`` for ``q = (w, v)``: scipy's ``Rotation.from_quat`` after moving
@@ -237,10 +246,11 @@ def quaternion_to_matrix(quaternion) -> np.ndarray:
     q = _as_quaternion(quaternion, "quaternion")
     if not np.all(np.linalg.norm(q, axis=-1) > 0):
         raise UsageError("Expected non-zero quaternions")
-    return _rotation(quaternions=q).as_matrix().reshape(q.shape[:-1] + (3, 3))
+    active: np.ndarray = _rotation(quaternions=q).as_matrix()
+    return active.reshape(q.shape[:-1] + (3, 3))
 
 
-def matrix_to_quaternion(matrix) -> np.ndarray:
+def matrix_to_quaternion(matrix: ArrayLike) -> np.ndarray:
     """Scalar-first unit quaternion (``w ≥ 0``) of an active rotation matrix ``Q`` (scipy's, canonical).
 
     Returns
@@ -248,11 +258,11 @@ def matrix_to_quaternion(matrix) -> np.ndarray:
     (..., 4) float
     """
     m = _as_matrix(matrix)
-    q = np.roll(_rotation(m).as_quat(canonical=True), 1, axis=-1)
+    q: np.ndarray = np.roll(_rotation(m).as_quat(canonical=True), 1, axis=-1)
     return q.reshape(m.shape[:-2] + (4,))
 
 
-def quaternion_multiply(p, q) -> np.ndarray:
+def quaternion_multiply(p: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Hamilton product ``p ⊗ q`` of scalar-first quaternions (matrix of ``p ⊗ q`` = ``Q_p Q_q``)."""
     p = _as_quaternion(p, "p")
     q = _as_quaternion(q, "q")
@@ -263,13 +273,13 @@ def quaternion_multiply(p, q) -> np.ndarray:
     return np.concatenate([w, v], -1)
 
 
-def quaternion_conjugate(q) -> np.ndarray:
+def quaternion_conjugate(q: ArrayLike) -> np.ndarray:
     """``(w, −x, −y, −z)``: the inverse rotation for a unit quaternion."""
-    q = _as_quaternion(q)
-    return q * np.array([1.0, -1.0, -1.0, -1.0])
+    unit = _as_quaternion(q)
+    return unit * np.array([1.0, -1.0, -1.0, -1.0])
 
 
-def rotation_vector_to_quaternion(rotation_vector) -> np.ndarray:
+def rotation_vector_to_quaternion(rotation_vector: ArrayLike) -> np.ndarray:
     """Quaternion ``exp(v/2) = (cos(|v|/2), sin(|v|/2) v/|v|)`` of an active rotation by ``|v|`` about ``v``.
 
     Uses the series of ``sin(x/2)/x`` below ``|v| = 1e-4`` (exact to round-off).
@@ -277,24 +287,25 @@ def rotation_vector_to_quaternion(rotation_vector) -> np.ndarray:
     v = np.asarray(rotation_vector, dtype=np.float64)
     if v.shape[-1:] != (3,):
         raise UsageError(f"Expected `rotation_vector` to have shape (..., 3), got {v.shape}")
-    angle = np.linalg.norm(v, axis=-1, keepdims=True)
+    angle: NDArray[np.float64] = np.linalg.norm(v, axis=-1, keepdims=True)
     small = angle < 1e-4
     safe = np.where(small, 1.0, angle)
     half_sinc = np.where(small, 0.5 - angle * angle / 48.0, np.sin(0.5 * safe) / safe)
     return np.concatenate([np.cos(0.5 * angle), half_sinc * v], -1)
 
 
-def euler_to_quaternion(phi, theta, psi) -> np.ndarray:
+def euler_to_quaternion(phi: ArrayLike, theta: ArrayLike, psi: ArrayLike) -> np.ndarray:
     """Quaternion of the orientation ``Q = A(φ, θ, ψ)ᵀ`` (Eq. 4.31); (...) → (..., 4)."""
     return matrix_to_quaternion(np.swapaxes(euler_to_matrix(phi, theta, psi), -1, -2))
 
 
-def quaternion_to_euler(quaternion, *, gimbal_atol: float = 1e-12):
+def quaternion_to_euler(quaternion: ArrayLike, *,
+                        gimbal_atol: float = 1e-12) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Euler angles ``(φ, θ, ψ)`` of the orientation quaternion (``A = Qᵀ``); see :func:`matrix_to_euler`."""
     return matrix_to_euler(np.swapaxes(quaternion_to_matrix(quaternion), -1, -2), gimbal_atol=gimbal_atol)
 
 
-def perpendicular_basis(normal) -> tuple[np.ndarray, np.ndarray]:
+def perpendicular_basis(normal: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Deterministic orthonormal basis ``(e1, e2)`` of the plane ⟂ the unit vector ``normal``.
 
     ``e1`` is the coordinate axis most orthogonal to ``normal`` (smallest ``|normal_k|``, the first on a tie),

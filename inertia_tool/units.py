@@ -99,7 +99,7 @@ def _split(text: str, what: str) -> tuple[float, str]:
     return value, (m.group(2) or "").strip().lower()
 
 
-def _parse_with_table(text, table: dict, what: str, default_unit: str) -> float:
+def _parse_with_table(text: str | float, table: dict[str, float], what: str, default_unit: str) -> float:
     """Number with an optional unit from ``table`` (unit → SI factor); a bare number is in ``default_unit``."""
     if isinstance(text, (int, float)):
         value, unit = float(text), default_unit
@@ -111,7 +111,7 @@ def _parse_with_table(text, table: dict, what: str, default_unit: str) -> float:
     return value * table[unit]
 
 
-def parse_length(text, default_unit: str = "m") -> float:
+def parse_length(text: str | float, default_unit: str = "m") -> float:
     """``"2mm"`` → 0.002 (m).  A bare number is in ``default_unit``."""
     if isinstance(text, (int, float)):
         return float(text) * length_scale(default_unit)
@@ -123,7 +123,7 @@ _RATE = {"rad/s": 1.0, "rad/sec": 1.0, "rev/s": 2 * math.pi, "hz": 2 * math.pi, 
          "rpm": 2 * math.pi / 60.0, "rev/min": 2 * math.pi / 60.0, "deg/s": math.pi / 180.0}
 
 
-def parse_angular_rate(text, default_unit: str = "rad/s") -> float:
+def parse_angular_rate(text: str | float, default_unit: str = "rad/s") -> float:
     """``"5rev/s"`` → 31.4159 (rad/s); accepts rad/s, rev/s, Hz, rps, rpm, rev/min, deg/s."""
     return _parse_with_table(text, _RATE, "an angular-rate", default_unit)
 
@@ -131,7 +131,7 @@ def parse_angular_rate(text, default_unit: str = "rad/s") -> float:
 _TIME = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0}
 
 
-def parse_duration(text, default_unit: str = "s") -> float:
+def parse_duration(text: str | float, default_unit: str = "s") -> float:
     """``"30s"`` → 30.0, ``"2min"`` → 120.0 (s)."""
     return _parse_with_table(text, _TIME, "a time", default_unit)
 
@@ -139,7 +139,7 @@ def parse_duration(text, default_unit: str = "s") -> float:
 _MASS = {"kg": 1.0, "g": 1e-3, "mg": 1e-6, "lb": 0.45359237, "t": 1000.0}
 
 
-def parse_mass(text, default_unit: str = "kg") -> float:
+def parse_mass(text: str | float, default_unit: str = "kg") -> float:
     """``"412g"`` → 0.412 (kg); accepts kg, g, mg, lb, t."""
     return _parse_with_table(text, _MASS, "a mass", default_unit)
 
@@ -148,7 +148,7 @@ _DENSITY = {"kg/m3": 1.0, "kg/m^3": 1.0, "g/cm3": 1000.0, "g/cm^3": 1000.0, "g/c
             "g/ml": 1000.0, "kg/l": 1000.0, "lb/in3": 27679.9047, "lb/ft3": 16.0184634}
 
 
-def parse_density(text, default_unit: str = "kg/m3") -> float:
+def parse_density(text: str | float, default_unit: str = "kg/m3") -> float:
     """``"7850"`` → 7850.0, ``"1.24g/cm3"`` → 1240.0, ``"7850 kg/m³"`` → 7850.0 (kg/m³).
 
     Units: kg/m3, g/cm3 (g/cc, g/ml, kg/l), lb/in3, lb/ft3; ``³`` may stand for ``3`` or ``^3`` (the tool
@@ -162,12 +162,12 @@ _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0, "°": math.pi / 180.0, "degree": m
           "degrees": math.pi / 180.0, "mrad": 1e-3, "rev": 2 * math.pi, "turn": 2 * math.pi}
 
 
-def parse_angle(text, default_unit: str = "rad") -> float:
+def parse_angle(text: str | float, default_unit: str = "rad") -> float:
     """``"20deg"`` → 0.349 (rad); accepts rad, deg (or °), mrad, rev/turn."""
     return _parse_with_table(text, _ANGLE, "an angle", default_unit)
 
 
-def parse_vector(text, default_unit: str = "m") -> tuple[float, float, float]:
+def parse_vector(text: str, default_unit: str = "m") -> tuple[float, float, float]:
     """``"0,0,-12.5"`` or ``"0,0,-12.5mm"`` → three lengths in m (a unit on any component applies to it;
     a unit after the last one applies to bare components too)."""
     parts = [p.strip() for p in str(text).split(",")]
@@ -175,10 +175,11 @@ def parse_vector(text, default_unit: str = "m") -> tuple[float, float, float]:
         raise UnitsError(f"Expected three comma-separated lengths like '0,0,12.5', got {text!r}")
     trailing = _split(parts[-1], "a length")[1]
     unit = trailing or default_unit
-    return tuple(parse_length(p, unit) for p in parts)
+    x, y, z = (parse_length(p, unit) for p in parts)
+    return x, y, z
 
 
-def parse_fraction(text) -> float:
+def parse_fraction(text: str | float) -> float:
     """``"20%"`` → 0.2, ``"0.2"`` → 0.2 (a fraction in [0, 1]; a bare number above 1 is refused, not guessed)."""
     if isinstance(text, (int, float)):
         value, unit = float(text), ""

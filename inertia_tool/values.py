@@ -38,13 +38,13 @@ COPY_LIMIT = 4096
 
 def readonly(array: Any) -> np.ndarray:
     """``array`` as a read-only ndarray: a copy when small (≤ :data:`COPY_LIMIT` elements), else a view."""
-    a = np.asarray(array)
+    a: np.ndarray = np.asarray(array)
     a = a.copy() if a.size <= COPY_LIMIT else a.view()
     a.flags.writeable = False
     return a
 
 
-def _same(a, b) -> bool:
+def _same(a: Any, b: Any) -> bool:
     if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
         a, b = np.asarray(a), np.asarray(b)
         if a.shape != b.shape:
@@ -60,7 +60,7 @@ def _same(a, b) -> bool:
     return bool(a == b)
 
 
-def _key(value):
+def _key(value: Any) -> object:
     if isinstance(value, np.ndarray):
         return (value.shape, str(value.dtype), value.tobytes())
     if isinstance(value, (tuple, list)):
@@ -70,14 +70,15 @@ def _key(value):
     return value
 
 
-def _eq(self, other):
+def _eq(self: Any, other: Any) -> bool:
     if other.__class__ is not self.__class__:
-        return NotImplemented
+        # mypy treats NotImplemented as Any outside a method named __eq__ (its type derives from Any)
+        return NotImplemented  # type: ignore[no-any-return]
     return all(_same(getattr(self, f.name), getattr(other, f.name))
                for f in dataclasses.fields(self) if f.compare)
 
 
-def _hash(self):
+def _hash(self: Any) -> int:
     return hash((self.__class__.__name__,) + tuple(_key(getattr(self, f.name))
                                                    for f in dataclasses.fields(self) if f.compare))
 
@@ -87,7 +88,7 @@ def frozen_value(cls: type[_T]) -> type[_T]:
     """Class decorator: a frozen dataclass whose arrays are read-only, with equality and hash by value."""
     own_post_init = cls.__dict__.get("__post_init__")
 
-    def __post_init__(self):
+    def __post_init__(self: Any) -> None:
         if own_post_init is not None:
             own_post_init(self)
         for f in dataclasses.fields(self):
@@ -95,9 +96,12 @@ def frozen_value(cls: type[_T]) -> type[_T]:
             if isinstance(value, np.ndarray) and value.flags.writeable:
                 object.__setattr__(self, f.name, readonly(value))
 
+    # the class is being built: methods are added to it dynamically, which a type checker cannot follow
+    built: Any = cls
     # set before the dataclass is made: its generated __init__ calls __post_init__ only if it exists then
-    cls.__post_init__ = __post_init__
-    cls = dataclasses.dataclass(frozen=True, eq=False)(cls)
-    cls.__eq__ = _eq
-    cls.__hash__ = _hash
-    return cls
+    built.__post_init__ = __post_init__
+    built = dataclasses.dataclass(frozen=True, eq=False)(built)
+    built.__eq__ = _eq
+    built.__hash__ = _hash
+    result: type[_T] = built
+    return result

@@ -8,6 +8,7 @@ option is added once.
 from __future__ import annotations
 
 from dataclasses import fields, replace
+from typing import Any
 
 import numpy as np
 
@@ -67,12 +68,12 @@ class LoadOptions:
             raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,} (corner "
                              f"indices must fit 32 bits), got {self.max_faces!r}")
 
-    def replace(self, **changes) -> LoadOptions:
+    def replace(self, **changes: Any) -> LoadOptions:
         """A copy with some fields changed (validated like a new one)."""
         return replace(self, **changes)
 
     @classmethod
-    def build(cls, options: LoadOptions | None = None, **overrides) -> LoadOptions:
+    def build(cls, options: LoadOptions | None = None, **overrides: Any) -> LoadOptions:
         """``options`` (or the defaults) with keyword overrides; unknown names raise :class:`UsageError`."""
         names = {f.name for f in fields(cls)}
         unknown = sorted(set(overrides) - names)
