@@ -275,8 +275,8 @@ def quaternion_multiply(p: ArrayLike, q: ArrayLike) -> np.ndarray:
 
 def quaternion_conjugate(q: ArrayLike) -> np.ndarray:
     """``(w, −x, −y, −z)``: the inverse rotation for a unit quaternion."""
-    unit = _as_quaternion(q)
-    return unit * np.array([1.0, -1.0, -1.0, -1.0])
+    q = _as_quaternion(q)
+    return q * np.array([1.0, -1.0, -1.0, -1.0], dtype=np.float64)
 
 
 def rotation_vector_to_quaternion(rotation_vector: ArrayLike) -> np.ndarray:
