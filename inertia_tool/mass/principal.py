@@ -9,6 +9,7 @@ from __future__ import annotations
 
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..values import frozen_value
 from ..errors import UsageError
@@ -43,11 +44,11 @@ class PrincipalAxes:
         Relative tolerance (of the largest moment) used for ``equal_pairs``.
     """
 
-    moments: np.ndarray
-    axes: np.ndarray
-    reference_point: np.ndarray
+    moments: NDArray[np.float64]
+    axes: NDArray[np.float64]
+    reference_point: NDArray[np.float64]
     mass: float
-    equal_pairs: tuple
+    equal_pairs: tuple[tuple[int, int], ...]
     rtol: float
 
     @property
@@ -77,12 +78,12 @@ class PrincipalAxes:
         return float((i1 + i2 - i3) / i3) if i3 > 0 else float("nan")
 
 
-def _canonical_sign(v: np.ndarray) -> np.ndarray:
+def _canonical_sign(v: NDArray[np.float64]) -> NDArray[np.float64]:
     k = int(np.argmax(np.abs(v)))
     return -v if v[k] < 0 else v
 
 
-def principal_axes(tensor, *, reference_point=None, mass: float = float("nan"),
+def principal_axes(tensor: ArrayLike, *, reference_point: ArrayLike | None = None, mass: float = float("nan"),
                    rtol: float = DEFAULT_EQUAL_RTOL) -> PrincipalAxes:
     """Diagonalise a symmetric inertia tensor.
 

@@ -11,9 +11,10 @@ from __future__ import annotations
 import sys
 from dataclasses import field
 from functools import cached_property
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Iterable, Optional
 
 import numpy as np
+from numpy.typing import ArrayLike, DTypeLike, NDArray
 
 from ..values import frozen_value
 from ..errors import NonFiniteResultError, UsageError
@@ -26,7 +27,7 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["MassProperties", "InertiaTensor", "point_mass", "combine", "parallel_axis_shift"]
 
 
-def as_vector3(x, name: str) -> np.ndarray:
+def as_vector3(x: ArrayLike, name: str) -> NDArray[np.float64]:
     """A fresh (3,) float64 copy of ``x``, or a UsageError naming ``name`` (shape or non-finite values).
 
     The one input check for 3-vectors of the public API (points, directions, angular velocities, impulses).
@@ -39,7 +40,7 @@ def as_vector3(x, name: str) -> np.ndarray:
     return a
 
 
-def parallel_axis_shift(mass: float, offset) -> np.ndarray:
+def parallel_axis_shift(mass: float, offset: ArrayLike) -> np.ndarray:
     """Inertia of a point mass ``mass`` at ``offset`` from the reference point, (3, 3) kg·m².
 
     ``M [(b·b) δ_ij − b_i b_j]``: the term added to the central tensor by the parallel-axis theorem,
@@ -61,13 +62,13 @@ class InertiaTensor:
         m, mesh axes.
     """
 
-    tensor: np.ndarray
-    reference_point: np.ndarray
+    tensor: NDArray[np.float64]
+    reference_point: NDArray[np.float64]
 
-    def __array__(self, dtype=None, copy=None):
+    def __array__(self, dtype: DTypeLike | None = None, copy: bool | None = None) -> np.ndarray:
         return np.asarray(self.tensor, dtype=dtype)
 
-    def moment_about(self, direction) -> float:
+    def moment_about(self, direction: ArrayLike) -> float:
         """Moment of inertia ``n̂·I·n̂`` about the line through ``reference_point`` along ``direction``, kg·m²."""
         n = as_vector3(direction, "direction")
         norm = np.linalg.norm(n)
@@ -109,15 +110,15 @@ class MassProperties:
 
     mass: float
     volume: float
-    center_of_mass: np.ndarray
-    inertia: np.ndarray
+    center_of_mass: NDArray[np.float64]
+    inertia: NDArray[np.float64]
     surface_area: float = 0.0
     density: float = float("nan")
     name: str = ""
     mesh: Optional["MeshReport"] = field(default=None, repr=False, compare=False)
-    parts: tuple = field(default=(), repr=False, compare=False)
+    parts: tuple[MassProperties, ...] = field(default=(), repr=False, compare=False)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         com = np.array(self.center_of_mass, dtype=np.float64).reshape(3)
         ten = np.array(self.inertia, dtype=np.float64).reshape(3, 3)
         com.flags.writeable = False
@@ -151,7 +152,7 @@ class MassProperties:
         """The inertia tensor about the centre of mass, with its reference point."""
         return InertiaTensor(self.inertia, self.center_of_mass)
 
-    def inertia_about(self, point) -> InertiaTensor:
+    def inertia_about(self, point: ArrayLike) -> InertiaTensor:
         """Inertia tensor about ``point`` (m, mesh axes) by the parallel-axis theorem, Eq. (4.16).
 
         ``I^(p) = I^(cm) + M [(p−R)² δ_ij − (p−R)_i (p−R)_j]``.  The result converts to a (3, 3) array with
@@ -160,7 +161,7 @@ class MassProperties:
         p = as_vector3(point, "point")
         return InertiaTensor(self.inertia + parallel_axis_shift(self.mass, p - self.center_of_mass), p)
 
-    def moment_about_axis(self, direction, point=None) -> float:
+    def moment_about_axis(self, direction: ArrayLike, point: ArrayLike | None = None) -> float:
         """Moment of inertia about the line through ``point`` along ``direction``, kg·m² (Eq. 4.17).
 
         ``n̂·I^(cm)·n̂ + M |n̂ × (p − R)|²``; ``point`` defaults to the centre of mass.
@@ -174,7 +175,7 @@ class MassProperties:
         d = np.cross(n, p - self.center_of_mass)
         return float(n @ self.inertia @ n + self.mass * (d @ d))
 
-    def transformed(self, rotation=None, translation=None) -> "MassProperties":
+    def transformed(self, rotation: ArrayLike | None = None, translation: ArrayLike | None = None) -> "MassProperties":
         """The same body moved rigidly: ``x ↦ R x + t``.
 
         Parameters
@@ -216,13 +217,13 @@ class MassProperties:
             return NotImplemented
         return combine([self, other])
 
-    def __radd__(self, other):
+    def __radd__(self, other: object) -> MassProperties:
         if other == 0:        # allows sum([...])
             return self
         return NotImplemented
 
 
-def point_mass(mass: float, position, *, name: str = "point mass") -> MassProperties:
+def point_mass(mass: float, position: ArrayLike, *, name: str = "point mass") -> MassProperties:
     """A point mass as ``MassProperties``: zero volume and zero central inertia.
 
     Parameters
@@ -240,7 +241,7 @@ def point_mass(mass: float, position, *, name: str = "point mass") -> MassProper
                           inertia=np.zeros((3, 3)), name=name)
 
 
-def combine(bodies, *, name: str = "assembly") -> MassProperties:
+def combine(bodies: Iterable[MassProperties], *, name: str = "assembly") -> MassProperties:
     """Rigidly join bodies (and point masses) into one: masses add, the centre of mass is the mass-weighted
     mean, and each central tensor is moved to the common centre of mass by the parallel-axis theorem (Eq. 4.16).
 
@@ -257,8 +258,9 @@ def combine(bodies, *, name: str = "assembly") -> MassProperties:
     total = sum(b.mass for b in bodies)
     if not total > 0:
         raise UsageError(f"Expected a positive total mass, got {total}")
-    com = sum(b.mass * b.center_of_mass for b in bodies) / total
-    ten = sum(b.inertia + parallel_axis_shift(b.mass, b.center_of_mass - com) for b in bodies)
+    # the start values are the zeros sum() would add anyway (as int 0); as arrays they keep the type an array
+    com = sum((b.mass * b.center_of_mass for b in bodies), np.zeros(3)) / total
+    ten = sum((b.inertia + parallel_axis_shift(b.mass, b.center_of_mass - com) for b in bodies), np.zeros((3, 3)))
     volume = sum(b.volume for b in bodies)
     density = total / volume if volume > 0 else float("nan")
     return MassProperties(mass=total, volume=volume, center_of_mass=com, inertia=0.5 * (ten + ten.T),
