@@ -11,6 +11,7 @@ integrals, which the C kernel sums with compensation).
 from __future__ import annotations
 
 import os
+from types import ModuleType
 
 import numpy as np
 
@@ -19,10 +20,10 @@ __all__ = ["accel", "faces_for_c"]
 #: Environment variable that, set to anything but "" or "0", forces the pure-numpy path.
 NO_ACCEL_ENV = "INERTIA_TOOL_NO_ACCEL"
 
-_MODULE: list = []   # the import result, cached: [module or None]
+_MODULE: list[ModuleType | None] = []   # the import result, cached: [module or None]
 
 
-def accel():
+def accel() -> ModuleType | None:
     """The ``inertia_tool._accel`` module, or None when it is not built or ``INERTIA_TOOL_NO_ACCEL`` is set."""
     if os.environ.get(NO_ACCEL_ENV, "").strip() not in ("", "0"):
         return None

@@ -9,13 +9,14 @@ moment.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import PhysicsError, UsageError
 
 __all__ = ["equivalent_ellipsoid_semi_axes"]
 
 
-def equivalent_ellipsoid_semi_axes(moments, mass: float, *, rtol: float = 1e-9) -> np.ndarray:
+def equivalent_ellipsoid_semi_axes(moments: ArrayLike, mass: float, *, rtol: float = 1e-9) -> np.ndarray:
     """Semi-axes of the uniform solid ellipsoid with mass ``mass`` and principal moments ``moments``.
 
     A solid ellipsoid of semi-axes ``a_1, a_2, a_3`` and mass ``m`` has ``I_1 = m (a_2² + a_3²)/5`` and
@@ -51,4 +52,5 @@ def equivalent_ellipsoid_semi_axes(moments, mass: float, *, rtol: float = 1e-9) 
     if np.any(combos < -rtol * np.max(np.abs(m_))):
         raise PhysicsError(f"Principal moments {m_.tolist()} kg·m² violate the triangle inequality; "
                            "no ellipsoid (no body) has them")
-    return np.sqrt(np.clip(combos, 0.0, None) * 5.0 / (2.0 * mass))
+    semi_axes: NDArray[np.float64] = np.sqrt(np.clip(combos, 0.0, None) * 5.0 / (2.0 * mass))
+    return semi_axes

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..values import frozen_value
 from ..errors import UsageError
@@ -98,7 +99,8 @@ def _symmetric(six: np.ndarray) -> np.ndarray:
     return full
 
 
-def _central(total: float, first: np.ndarray, second: np.ndarray, origin: np.ndarray):
+def _central(total: float, first: np.ndarray, second: np.ndarray,
+             origin: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Centroid and central second moment from raw sums about ``origin`` (parallel-axis shift)."""
     if not total > 0:
         raise UsageError(f"Expected a surface or curve of positive extent, got a total of {total}")
@@ -107,7 +109,7 @@ def _central(total: float, first: np.ndarray, second: np.ndarray, origin: np.nda
     return origin + d, 0.5 * (central + central.T)
 
 
-def surface_moments(vertices, faces, *, origin=None, chunk_size: int = _DEFAULT_CHUNK,
+def surface_moments(vertices: ArrayLike, faces: ArrayLike, *, origin: ArrayLike | None = None, chunk_size: int = _DEFAULT_CHUNK,
                     area_rtol: float = 1e-14) -> SurfaceMoments:
     """Exact area, centroid, central second moment and normal moment of a triangulated surface.
 
@@ -165,7 +167,7 @@ def surface_moments(vertices, faces, *, origin=None, chunk_size: int = _DEFAULT_
                           normal_moment=_symmetric(normal), zero_area_faces=zero)
 
 
-def curve_moments(points, segments, *, origin=None) -> CurveMoments:
+def curve_moments(points: ArrayLike, segments: ArrayLike, *, origin: ArrayLike | None = None) -> CurveMoments:
     """Exact length, centroid and central second moment of a polyline (a wire of straight segments).
 
     Parameters
@@ -228,7 +230,7 @@ def wire_inertia(moments: CurveMoments, linear_density: float) -> np.ndarray:
     return second_moment_to_inertia(moments.second_moment, linear_density)
 
 
-def inward_offset_coefficient(vertices, faces) -> float:
+def inward_offset_coefficient(vertices: ArrayLike, faces: ArrayLike) -> float:
     """Second-order coefficient ``K`` of the volume between a closed surface and its inward offset.
 
     Moving every face of a closed, outward-wound polyhedron inward by ``s`` along its normal removes the

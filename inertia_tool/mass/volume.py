@@ -29,9 +29,10 @@ Everything here is pure: SI numpy arrays in, numpy arrays out.  See ``docs/conve
 
 from __future__ import annotations
 
-
+from types import ModuleType
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..values import frozen_value
 from .._native import accel, faces_for_c
@@ -68,9 +69,12 @@ class VolumeMoments:
 
 _PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
+#: Per-label raw sums: volume (L,), first moment (L, 3), second moment (L, 3, 3), area (L,), zero-area faces (L,).
+_Sums = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]
+
 
 def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chunk_size: int,
-                labels: np.ndarray | None = None, n_labels: int = 1, area_floor: float = 0.0):
+                labels: np.ndarray | None = None, n_labels: int = 1, area_floor: float = 0.0) -> _Sums:
     """Accumulate per-label raw sums about ``origin``.
 
     Returns arrays ``vol (L,)``, ``first (L, 3)``, ``second (L, 3, 3)``, ``area (L,)``, ``zero (L,)`` where
@@ -128,7 +132,8 @@ def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chu
     return vol, first, second, area, zero
 
 
-def _tetra_sums_c(lib, vertices, faces, origin, labels, n_labels, area_floor):
+def _tetra_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray,
+                  labels: np.ndarray | None, n_labels: int, area_floor: float) -> _Sums:
     """``_tetra_sums`` on the C extension: the same sums in one pass, compensated; same return values."""
     sums = np.empty((n_labels, 11))
     zero = np.empty(n_labels, dtype=np.int64)
@@ -155,7 +160,7 @@ def _finish(vol: float, first: np.ndarray, second: np.ndarray, area: float, orig
                          zero_area_faces=int(zero))
 
 
-def bounding_box(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def bounding_box(vertices: np.ndarray) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Corners ``(lo, hi)`` of the axis-aligned bounding box of (n, 3) vertices, each (3,), same unit.
 
     Reduced column by column (exactly ``vertices.min(axis=0)`` and ``.max(axis=0)``, several times faster on
@@ -246,4 +251,5 @@ def second_moment_to_inertia(second_moment: np.ndarray, density: float = 1.0) ->
         kg·m² about the same point; off-diagonals are −∫xy dm (tensor convention).
     """
     c = np.asarray(second_moment, dtype=np.float64)
-    return density * (np.trace(c) * np.eye(3) - c)
+    inertia: NDArray[np.float64] = density * (np.trace(c) * np.eye(3) - c)
+    return inertia
