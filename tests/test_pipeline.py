@@ -155,6 +155,18 @@ def test_assembly_matches_union_with_two_materials(tmp_path):
     assert_tensor_close(asm.inertia, (pa + pb).inertia, rtol=1e-14)
 
 
+def test_assembly_part_given_by_its_mass():
+    # a part's "mass" sets its density from its own volume (it raised a TypeError before: found by mypy)
+    a = box_arrays((1.0, 1.0, 1.0))
+    b = box_arrays((1.0, 1.0, 2.0), center=(2.0, 0.0, 0.0))
+    asm = assembly([{"source": a, "mass": 3.0}, {"source": b, "density": 500.0}])
+    assert asm.mass == pytest.approx(3.0 + 1000.0, rel=1e-14)
+    assert asm.parts[0].density == pytest.approx(3.0, rel=1e-14)
+    pa = mass_properties(a, mass=3.0)
+    pb = mass_properties(b, density=500.0)
+    assert_tensor_close(asm.inertia, (pa + pb).inertia, rtol=1e-14)
+
+
 def test_trimesh_cross_check_on_random_convex_hulls():
     rng = np.random.default_rng(5)
     for _ in range(5):

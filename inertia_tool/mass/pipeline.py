@@ -10,6 +10,7 @@ that are a choice (equal moments) or at round-off (needles).
 from __future__ import annotations
 
 import warnings
+from typing import TYPE_CHECKING, Any, Iterable, Mapping, TypeAlias
 
 import numpy as np
 
@@ -22,14 +23,27 @@ from ..units import material_density
 from .properties import MassProperties, combine
 from .volume import VolumeMoments, second_moment_to_inertia
 
+if TYPE_CHECKING:  # pragma: no cover
+    import os
+
+    import trimesh
+    from numpy.typing import ArrayLike
+
+    from ..mesh.read import RawMesh
+
 __all__ = ["mass_properties", "assembly", "resolve_density", "DEFAULT_DENSITY"]
+
+#: What :func:`~inertia_tool.mesh.read.load_mesh` reads: a file, a ``trimesh.Trimesh``, a pair of arrays
+#: ``vertices (n, 3)`` and ``faces (m, 3)``, or a ``RawMesh`` read before.
+MeshSource: TypeAlias = "str | os.PathLike[str] | trimesh.Trimesh | tuple[ArrayLike, ArrayLike] | RawMesh"
 
 #: Density used when none of density / material / mass is given (water), kg/m³.  Reports say so.
 DEFAULT_DENSITY = 1000.0
 
 
 
-def resolve_density(*, density=None, material=None, mass=None) -> tuple[float | None, str]:
+def resolve_density(*, density: float | None = None, material: str | None = None,
+                    mass: float | None = None) -> tuple[float | None, str]:
     """Decide the density from at most one of ``density``, ``material`` or ``mass``.
 
     Parameters
@@ -99,7 +113,7 @@ def _shell_properties(s: VolumeMoments, density: float, name: str) -> MassProper
 
 
 def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassProperties]:
-    bodies = []
+    bodies: list[MassProperties] = []
     owners = np.unique(prepared.owner)
     for b in owners:
         members = [prepared.shells[k] for k in np.flatnonzero(prepared.owner == b)]
@@ -111,9 +125,9 @@ def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassPrope
     return bodies
 
 
-def mass_properties(source, *, density: float | None = None, material: str | None = None,
+def mass_properties(source: MeshSource, *, density: float | None = None, material: str | None = None,
                     mass: float | None = None, name: str | None = None, options: LoadOptions | None = None,
-                    **load_options) -> MassProperties:
+                    **load_options: Any) -> MassProperties:
     """Mass properties of the solid bounded by a triangle mesh, exact for the polyhedron.
 
     Parameters
@@ -151,7 +165,8 @@ def mass_properties(source, *, density: float | None = None, material: str | Non
         return _part(source, rho, mass, opts, name=name)[0]
 
 
-def _part(source, rho, mass, options: LoadOptions, *, name, warn_principal=True):
+def _part(source: MeshSource, rho: float | None, mass: float | None, options: LoadOptions, *, name: str | None,
+          warn_principal: bool = True) -> tuple[MassProperties, PreparedMesh]:
     """Mass properties of one mesh and its checked mesh (for cross-part checks of an assembly)."""
     raw = load_mesh(source, units=options.units, max_faces=options.max_faces)
     prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance)
@@ -163,6 +178,7 @@ def _part(source, rho, mass, options: LoadOptions, *, name, warn_principal=True)
                             density=rho if rho is not None else 1.0, name=label, mesh=prepared.report,
                             parts=tuple(bodies) if len(bodies) > 1 else ())
     if rho is None:
+        assert mass is not None, "resolve_density leaves the density open only for a target mass"
         result = result.with_mass(mass)
     _check_finite(result, label)
     _check_physical(result)
@@ -184,14 +200,15 @@ def _check_physical(props: MassProperties, rtol: float = TRIANGLE_INEQUALITY_RTO
             "triangle inequality I1 + I2 ≥ I3: the mesh does not describe a physical body"), stacklevel=3)
 
 
-def assembly(parts, *, mass: float | None = None, options: LoadOptions | None = None,
-             **load_options) -> MassProperties:
+def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, options: LoadOptions | None = None,
+             **load_options: Any) -> MassProperties:
     """Combine several meshes, each with its own material, into one rigid body.
 
     Parameters
     ----------
     parts : iterable of dict
-        Each ``{"source": path_or_mesh, "density": kg/m³}`` or ``{"source": ..., "material": name}``
+        Each ``{"source": path_or_mesh, "density": kg/m³}``, ``{"source": ..., "material": name}`` or
+        ``{"source": ..., "mass": kg}``
         (optionally ``"units"`` and ``"name"``; a part's ``"units"`` overrides the options' units).
     mass : float, optional
         Scale the whole assembly to this total mass (kg), keeping the density ratios.
@@ -201,16 +218,19 @@ def assembly(parts, *, mass: float | None = None, options: LoadOptions | None = 
         Fields of :class:`~inertia_tool.mesh.options.LoadOptions`, overriding those of ``options``.
     """
     opts = LoadOptions.build(options, **load_options)
-    bodies, meshes = [], []
+    bodies: list[MassProperties] = []
+    meshes: list[PreparedMesh] = []
     for spec in parts:
         spec = dict(spec)
         src = spec.pop("source")
+        part_mass = spec.pop("mass", None)
         rho, _ = resolve_density(density=spec.pop("density", None), material=spec.pop("material", None),
-                                 mass=spec.pop("mass", None))
+                                 mass=part_mass)
         part_options = opts.replace(units=spec.pop("units")) if "units" in spec else opts
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             # equal moments of one part say nothing about the assembly: checked once on the whole below
-            props, prepared = _part(src, rho, None, part_options, name=spec.pop("name", None), warn_principal=False)
+            props, prepared = _part(src, rho, part_mass, part_options, name=spec.pop("name", None),
+                                    warn_principal=False)
         bodies.append(props)
         meshes.append(prepared)
     if not bodies:
@@ -225,7 +245,7 @@ def assembly(parts, *, mass: float | None = None, options: LoadOptions | None = 
     return total
 
 
-def _warn_about_part_overlaps(meshes, names) -> None:
+def _warn_about_part_overlaps(meshes: list[PreparedMesh], names: list[str]) -> None:
     """Warn when the parts of an assembly overlap each other (their shared volume counts twice).
 
     The parts' checked meshes are put side by side and the shell classification of :func:`prepare_mesh` is

@@ -109,8 +109,8 @@ def _central(total: float, first: np.ndarray, second: np.ndarray,
     return origin + d, 0.5 * (central + central.T)
 
 
-def surface_moments(vertices: ArrayLike, faces: ArrayLike, *, origin: ArrayLike | None = None, chunk_size: int = _DEFAULT_CHUNK,
-                    area_rtol: float = 1e-14) -> SurfaceMoments:
+def surface_moments(vertices: ArrayLike, faces: ArrayLike, *, origin: ArrayLike | None = None,
+                    chunk_size: int = _DEFAULT_CHUNK, area_rtol: float = 1e-14) -> SurfaceMoments:
     """Exact area, centroid, central second moment and normal moment of a triangulated surface.
 
     Parameters
