@@ -9,6 +9,7 @@ tests against this package's integration of an exact, planar tessellation).
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -16,10 +17,13 @@ from ..mesh.cad import DEFAULT_ANGULAR_DEFLECTION, chord_tolerance, read_brep, t
 from ..values import frozen_value
 from .properties import MassProperties
 
+if TYPE_CHECKING:  # pragma: no cover
+    from OCP.TopoDS import TopoDS_Shape     # OCP has no type information: Any to the checker
+
 __all__ = ["exact_mass_properties", "BrepComparison", "compare"]
 
 
-def exact_mass_properties(shape, *, name: str = "") -> MassProperties:
+def exact_mass_properties(shape: TopoDS_Shape, *, name: str = "") -> MassProperties:
     """Unit-density mass properties of the B-rep solid (``BRepGProp.VolumeProperties_s``), metres."""
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
@@ -71,7 +75,7 @@ class BrepComparison:
     inertia_error: float
 
 
-def compare(path, *, chord: float | None = None,
+def compare(path: str | os.PathLike[str], *, chord: float | None = None,
             angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION) -> BrepComparison:
     """Read a STEP/IGES part with OCP, integrate the B-rep exactly and its tessellation, and compare."""
     from .pipeline import mass_properties

@@ -30,7 +30,7 @@ See ``docs/conventions.md`` for units and signs.
 
 from __future__ import annotations
 
-
+from typing import Any
 
 import numpy as np
 
@@ -40,7 +40,7 @@ from ..errors import InvalidMeshError, PhysicsError, UsageError
 from ..mesh.options import LoadOptions
 from ..mesh.prepare import prepare_mesh
 from ..mesh.read import load_mesh
-from .pipeline import resolve_density
+from .pipeline import MeshSource, resolve_density
 from .properties import MassProperties
 from .surface import inward_offset_coefficient, shell_inertia, surface_moments
 from .volume import second_moment_to_inertia, volume_moments
@@ -48,16 +48,16 @@ from .volume import second_moment_to_inertia, volume_moments
 __all__ = ["shell_mass_properties", "printed_part", "PrintedPart"]
 
 
-def _positive_length(value, name: str) -> float:
+def _positive_length(value: float, name: str) -> float:
     x = float(value)
     if not (np.isfinite(x) and x > 0):
         raise UsageError(f"Expected `{name}` to be a positive finite length in m, got {value}")
     return x
 
 
-def shell_mass_properties(source, *, thickness: float, density: float | None = None,
+def shell_mass_properties(source: MeshSource, *, thickness: float, density: float | None = None,
                           material: str | None = None, mass: float | None = None, name: str | None = None,
-                          options: LoadOptions | None = None, **load_options) -> MassProperties:
+                          options: LoadOptions | None = None, **load_options: Any) -> MassProperties:
     """Mass properties of a thin wall of constant ``thickness`` whose mid-surface is the mesh.
 
     Parameters
@@ -115,7 +115,10 @@ def shell_mass_properties(source, *, thickness: float, density: float | None = N
     props = MassProperties(mass=rho_used * t * sm.area, volume=t * sm.area, center_of_mass=sm.centroid,
                            inertia=shell_inertia(sm, t, rho_used), surface_area=sm.area, density=rho_used,
                            name=name or raw.source, mesh=report)
-    return props.with_mass(mass) if rho is None else props
+    if rho is None:
+        assert mass is not None, "resolve_density leaves the density open only for a target mass"
+        return props.with_mass(mass)
+    return props
 
 
 @frozen_value
@@ -154,9 +157,9 @@ class PrintedPart:
     inertia_error_order: str
 
 
-def printed_part(source, *, skin: float, infill: float, density: float | None = None,
+def printed_part(source: MeshSource, *, skin: float, infill: float, density: float | None = None,
                  material: str | None = None, mass: float | None = None, name: str | None = None,
-                 options: LoadOptions | None = None, **load_options) -> PrintedPart:
+                 options: LoadOptions | None = None, **load_options: Any) -> PrintedPart:
     """Mass properties of a 3D-printed part: solid skin of thickness ``skin``, core filled to ``infill``.
 
     First order in the skin thickness; see the module docstring for the formulas and the error.
@@ -223,6 +226,7 @@ def printed_part(source, *, skin: float, infill: float, density: float | None = 
     props = MassProperties(mass=total, volume=volume, center_of_mass=com, inertia=0.5 * (inertia + inertia.T),
                            surface_area=sm.area, density=rho_used, name=name or raw.source, mesh=prepared.report)
     if rho is None:
+        assert mass is not None, "resolve_density leaves the density open only for a target mass"
         props = props.with_mass(mass)
     error = (1.0 - f_in) * k * s * s / (f_in * solid.volume + (1.0 - f_in) * skin_volume)
     return PrintedPart(properties=props, skin=s, infill=f_in, envelope_volume=solid.volume, skin_volume=skin_volume,
