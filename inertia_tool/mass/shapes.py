@@ -65,11 +65,13 @@ error by 4); an icosphere only refines by factors of 4 in face count and has no 
 from __future__ import annotations
 
 import math
+import os
 import struct
 
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..values import frozen_value
 from ..errors import UsageError
@@ -130,7 +132,7 @@ class ReferenceSolid:
     exact: MassProperties
     mesh_exact: MassProperties
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         v = np.array(self.vertices, dtype=np.float64).reshape(-1, 3)
         f = np.array(self.faces, dtype=np.int64).reshape(-1, 3)
         v.flags.writeable = False
@@ -141,7 +143,7 @@ class ReferenceSolid:
 
 # -- input checks -------------------------------------------------------------------------------------
 
-def _positive(value, name: str) -> float:
+def _positive(value: float, name: str) -> float:
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -151,7 +153,7 @@ def _positive(value, name: str) -> float:
     return x
 
 
-def _count(value, name: str, minimum: int) -> int:
+def _count(value: int, name: str, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise UsageError(f"Expected `{name}` to be an integer >= {minimum}, got {value!r}")
     if value < minimum:
@@ -159,7 +161,7 @@ def _count(value, name: str, minimum: int) -> int:
     return int(value)
 
 
-def _center(center) -> np.ndarray:
+def _center(center: ArrayLike | None) -> np.ndarray:
     if center is None:
         return np.zeros(3)
     c = np.asarray(center, dtype=np.float64)
@@ -168,7 +170,7 @@ def _center(center) -> np.ndarray:
     return c
 
 
-def _props(volume: float, center: np.ndarray, moments, area: float, name: str) -> MassProperties:
+def _props(volume: float, center: np.ndarray, moments: ArrayLike, area: float, name: str) -> MassProperties:
     """Unit-density ``MassProperties`` with a diagonal central tensor ``moments = (I_xx, I_yy, I_zz)``."""
     return MassProperties(mass=volume, volume=volume, center_of_mass=center, inertia=np.diag(moments),
                           surface_area=area, density=1.0, name=name)
@@ -280,14 +282,16 @@ def _revolved_polyhedron(profile: np.ndarray, segments: int, center: np.ndarray,
     return _props(volume, center + np.array([0.0, 0.0, z_c]), (i_xx, i_xx, radial), area, name)
 
 
-def _revolved_solid(name: str, profile, segments: int, center: np.ndarray, exact: MassProperties) -> ReferenceSolid:
+def _revolved_solid(name: str, profile: ArrayLike, segments: int, center: np.ndarray,
+                    exact: MassProperties) -> ReferenceSolid:
     profile = np.asarray(profile, dtype=np.float64)
     vertices, faces = _revolve(profile, segments, center)
     mesh_exact = _revolved_polyhedron(profile, segments, center, name + " [mesh]")
     return ReferenceSolid(name=name, vertices=vertices, faces=faces, exact=exact, mesh_exact=mesh_exact)
 
 
-def _circle_arc(radius: float, count: int, start: float, stop: float, center=(0.0, 0.0)) -> np.ndarray:
+def _circle_arc(radius: float, count: int, start: float, stop: float,
+                center: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """``count + 1`` points ``(ρ, z) = center + radius (sin α, −cos α)`` for α from ``start`` to ``stop``;
     ρ forced to exactly 0 where ``sin α`` is 0 (poles)."""
     alpha = np.linspace(start, stop, count + 1)
@@ -298,7 +302,8 @@ def _circle_arc(radius: float, count: int, start: float, stop: float, center=(0.
 
 # -- public constructors ------------------------------------------------------------------------------
 
-def cone(radius: float, height: float, *, segments: int = DEFAULT_SEGMENTS, center=None) -> ReferenceSolid:
+def cone(radius: float, height: float, *, segments: int = DEFAULT_SEGMENTS,
+         center: ArrayLike | None = None) -> ReferenceSolid:
     """Right circular cone (exercise 4.6), axis ``+z`` from the base to the apex.
 
     Parameters
@@ -339,7 +344,7 @@ def cone(radius: float, height: float, *, segments: int = DEFAULT_SEGMENTS, cent
     return _revolved_solid(name, profile, segments, c, exact)
 
 
-def pyramid(circumradius: float, height: float, sides: int, *, center=None) -> ReferenceSolid:
+def pyramid(circumradius: float, height: float, sides: int, *, center: ArrayLike | None = None) -> ReferenceSolid:
     """Right pyramid over a regular ``sides``-gon (exercise 4.6 with a polygonal base), apex on ``+z``.
 
     Parameters
@@ -382,7 +387,8 @@ def pyramid(circumradius: float, height: float, sides: int, *, center=None) -> R
     return ReferenceSolid(name, solid.vertices, solid.faces, exact, exact)
 
 
-def cylinder(radius: float, height: float, *, segments: int = DEFAULT_SEGMENTS, center=None) -> ReferenceSolid:
+def cylinder(radius: float, height: float, *, segments: int = DEFAULT_SEGMENTS,
+             center: ArrayLike | None = None) -> ReferenceSolid:
     """Solid circular cylinder, axis ``z``.
 
     Parameters
@@ -414,7 +420,7 @@ def cylinder(radius: float, height: float, *, segments: int = DEFAULT_SEGMENTS, 
     return _revolved_solid(name, profile, segments, c, exact)
 
 
-def prism(circumradius: float, height: float, sides: int, *, center=None) -> ReferenceSolid:
+def prism(circumradius: float, height: float, sides: int, *, center: ArrayLike | None = None) -> ReferenceSolid:
     """Right prism over a regular ``sides``-gon, axis ``z``; the first corner on ``+x``.
 
     Parameters
@@ -451,7 +457,7 @@ def prism(circumradius: float, height: float, sides: int, *, center=None) -> Ref
 
 
 def washer(outer_radius: float, inner_radius: float, height: float, *, segments: int = DEFAULT_SEGMENTS,
-           center=None) -> ReferenceSolid:
+           center: ArrayLike | None = None) -> ReferenceSolid:
     """Washer / hollow cylinder: the annulus ``R_i ≤ ρ ≤ R_o`` extruded over ``|z| ≤ h/2``.
 
     One closed surface of genus 1: the outer wall faces away from the axis, the inner wall (the hole)
@@ -498,7 +504,7 @@ hollow_cylinder = washer
 
 
 def torus(major_radius: float, minor_radius: float, *, segments: int = DEFAULT_SEGMENTS,
-          rings: int = DEFAULT_TORUS_RINGS, center=None) -> ReferenceSolid:
+          rings: int = DEFAULT_TORUS_RINGS, center: ArrayLike | None = None) -> ReferenceSolid:
     """Solid torus (ring) around ``z``: the disc ``(ρ − R)² + z² ≤ r²`` swept around the axis.
 
     Parameters
@@ -540,7 +546,7 @@ def torus(major_radius: float, minor_radius: float, *, segments: int = DEFAULT_S
 
 
 def thin_ring(radius: float, wire_radius: float, *, segments: int = 256, rings: int = 8,
-              center=None) -> ReferenceSolid:
+              center: ArrayLike | None = None) -> ReferenceSolid:
     """A thin ring (§4.3.2): a torus of major radius ``radius`` and tiny tube radius ``wire_radius``.
 
     ``exact`` is the torus of :func:`torus`; as ``wire_radius/radius → 0`` its moments tend to the chapter's
@@ -568,7 +574,7 @@ def thin_ring(radius: float, wire_radius: float, *, segments: int = 256, rings: 
 
 
 def sphere(radius: float, *, segments: int = DEFAULT_SEGMENTS, rings: int = DEFAULT_SPHERE_RINGS,
-           center=None) -> ReferenceSolid:
+           center: ArrayLike | None = None) -> ReferenceSolid:
     """Solid sphere as a UV mesh (see the module notes for why UV rather than an icosphere).
 
     Parameters
@@ -600,7 +606,7 @@ def sphere(radius: float, *, segments: int = DEFAULT_SEGMENTS, rings: int = DEFA
 
 
 def hollow_sphere(outer_radius: float, inner_radius: float, *, segments: int = DEFAULT_SEGMENTS,
-                  rings: int = DEFAULT_SPHERE_RINGS, center=None) -> ReferenceSolid:
+                  rings: int = DEFAULT_SPHERE_RINGS, center: ArrayLike | None = None) -> ReferenceSolid:
     """Spherical shell ``r_i ≤ |x| ≤ r_o``: two closed UV shells, the outer facing out, the inner facing into
     the cavity (away from the material).
 
@@ -634,7 +640,7 @@ def hollow_sphere(outer_radius: float, inner_radius: float, *, segments: int = D
     return _revolved_solid(name, np.vstack([outer, inner]), segments, c, exact)
 
 
-def box(length_x: float, length_y: float, length_z: float, *, center=None) -> ReferenceSolid:
+def box(length_x: float, length_y: float, length_z: float, *, center: ArrayLike | None = None) -> ReferenceSolid:
     """Rectangular box with edges along the axes (12 triangles).
 
     Parameters
@@ -668,7 +674,7 @@ def box(length_x: float, length_y: float, length_z: float, *, center=None) -> Re
     return ReferenceSolid(name, vertices, faces, exact, exact)
 
 
-def octahedron(half_x: float, half_y: float, half_z: float, *, center=None) -> ReferenceSolid:
+def octahedron(half_x: float, half_y: float, half_z: float, *, center: ArrayLike | None = None) -> ReferenceSolid:
     """The octahedron ``|x|/a + |y|/b + |z|/c ≤ 1`` of exercise 4.9 (8 triangles).
 
     Parameters
@@ -714,7 +720,7 @@ def octahedron(half_x: float, half_y: float, half_z: float, *, center=None) -> R
 
 # -- output -------------------------------------------------------------------------------------------
 
-def write_stl(solid: ReferenceSolid, path, *, binary: bool = True, units: str = "m") -> Path:
+def write_stl(solid: ReferenceSolid, path: str | os.PathLike[str], *, binary: bool = True, units: str = "m") -> Path:
     """Write ``solid``'s mesh as an STL file (atomically, replacing an existing file:
     :func:`inertia_tool.reports.output.write_bytes`).
 
