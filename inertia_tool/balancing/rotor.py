@@ -677,7 +677,7 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
     if planes is None:
         if not single_plane:
             raise UsageError("Expected two correction `planes` (or one with single_plane=True)")
-        planes_t = (float(state.center_of_mass[2]),)
+        planes_t: tuple[float, ...] = (float(state.center_of_mass[2]),)
     else:
         planes_t = _axial_positions(planes, "planes", (1, 2) if single_plane else (2,))
     if len(planes_t) == 1:

@@ -186,7 +186,9 @@ def spin_experiment(props, about, rate: float, *, perturbation: float = 1e-3, du
         kind, predicted, measured, events = "none", math.inf, math.nan, 0
     elif entry.kind == "stable":
         kind = "wobble"
-        linear_period = 2 * math.pi / (entry.wobble_frequency_per_unit_spin * rate)
+        wobble = entry.wobble_frequency_per_unit_spin
+        assert wobble is not None, "a stable axis has a wobble frequency"
+        linear_period = 2 * math.pi / (wobble * rate)
         predicted = polhode
         times = _crossings(t, omega_p[:, i], upward_only=True)
         events = len(times)

@@ -27,12 +27,10 @@ import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import cast
 
 import numpy as np
 
 from ..mass.ellipsoid import equivalent_ellipsoid_semi_axes
-from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError
 from ..mass.properties import MassProperties
 from .escape import escape_html
@@ -395,7 +393,7 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
         sections.append(HtmlSection(f"Bodies ({len(props.parts)})",
                                     _table(["body", "mass (kg)", "volume (m³)", "centre of mass (m)"], rows),
                                     "bodies"))
-    mesh = cast("MeshReport | None", props.mesh)        # MassProperties.mesh is typed `object`
+    mesh = props.mesh
     if mesh is not None:
         rows = [["faces", f"{mesh.faces:,} (file {mesh.file_faces:,})"], ["vertices", f"{mesh.vertices:,}"],
                 ["bodies / cavities", f"{mesh.bodies} / {mesh.cavities}"],

@@ -431,7 +431,8 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
     kind = shape.tag
     if kind == "box":
         size = _numbers(shape.findtext("size"), 3, f"{what} <box><size>", source)
-        return GeometryElement("box", rotation, translation, size=[_positive(s, what, source) for s in size], name=name)
+        return GeometryElement("box", rotation, translation, size=tuple(_positive(s, what, source) for s in size),
+                               name=name)
     if kind in ("cylinder", "capsule"):
         r = _positive(_sdf_number(shape, "radius", what, source), f"{what} radius", source)
         h = _sdf_number(shape, "length", what, source)
@@ -441,8 +442,8 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
         return GeometryElement("sphere", rotation, translation, size=(r,), name=name)
     if kind == "ellipsoid":
         radii = _numbers(shape.findtext("radii"), 3, f"{what} <ellipsoid><radii>", source)
-        return GeometryElement("ellipsoid", rotation, translation, size=[_positive(s, what, source) for s in radii],
-                               name=name)
+        return GeometryElement("ellipsoid", rotation, translation,
+                               size=tuple(_positive(s, what, source) for s in radii), name=name)
     if kind == "mesh":
         uri = (shape.findtext("uri") or "").strip()
         if not uri:

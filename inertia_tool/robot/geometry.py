@@ -132,6 +132,7 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
         if cache is not None and element.mesh in cache:
             local = cache[element.mesh]
         else:
+            assert element.mesh is not None, "a mesh element carries the path of its file"
             local = mesh_properties(element.mesh, repair=repair)
             if cache is not None:
                 cache[element.mesh] = local
@@ -243,6 +244,7 @@ def link_inertials(robot: RobotDescription, *, density: float | None = None, mat
             props = unit.with_mass(link.declared.mass)
             out.append(LinkInertial(link.name, props, props.mass / props.volume, "declared masses kept"))
         else:
+            assert rho is not None, "resolve_density gives a density when no target mass is asked"
             props = MassProperties(mass=unit.mass * rho, volume=unit.volume, center_of_mass=unit.center_of_mass,
                                    inertia=unit.inertia * rho, surface_area=unit.surface_area, density=rho,
                                    name=link.name)

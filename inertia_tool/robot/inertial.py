@@ -225,7 +225,7 @@ def principal_frame_nearest(principal) -> np.ndarray:
     unique = ({0, 1, 2} - set(pair)).pop()
     u = axes[:, unique]
     plane = axes[:, list(pair)]
-    best, best_trace = None, -np.inf
+    best, best_trace = axes, -np.inf        # replaced by the first candidate (its trace is finite)
     for slot in range(3):
         others = [k for k in range(3) if k != slot]
         for sign in (1.0, -1.0):

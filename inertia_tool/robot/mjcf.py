@@ -209,7 +209,7 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, mesh_base: str
             half = need(2)
             return GeometryElement("box", rotation, position, size=(2 * half[0], 2 * half[1], 2 * half_length),
                                    name=name)
-        return GeometryElement("box", rotation, position, size=[2 * s for s in need(3)], name=name)
+        return GeometryElement("box", rotation, position, size=tuple(2 * s for s in need(3)), name=name)
     if half_length is not None:
         half = need(2)
         return GeometryElement("ellipsoid", rotation, position, size=(half[0], half[1], half_length), name=name)
@@ -269,7 +269,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
         counter[0] += 1
         name = body.get("name") or f"body {counter[0]}"
         child_class = body.get("childclass", class_name)
-        elements = []
+        elements: list[GeometryElement] = []
         collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements)
         links.append(LinkGeometry(name=name, elements=tuple(elements),
                                   declared=_inertial(body, name, compiler, source)))

@@ -284,7 +284,7 @@ def _splice_text(robot: RobotDescription, root, before: list, links: list, comme
 
 def _prolog_end(masked: str) -> int:
     m = re.match(r"\s*(?:<!DOCTYPE[^>\[]*(?:\[.*?\])?\s*>\s*)?", masked, re.DOTALL)
-    return m.end()
+    return m.end() if m else 0          # the pattern matches the empty string: m is never None
 
 
 def _first_child_indent(text: str, position: int) -> str:
@@ -299,7 +299,8 @@ _PROLOG = re.compile(rb"(?:\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>\[]*(?:\[.*?\])?
 def _splice(original: bytes, element: bytes, tag: str) -> bytes:
     """``element`` (the serialised root) between the input's own prolog and epilog, byte for byte: the XML
     declaration, comments before the root, and whatever follows its end tag."""
-    start = _PROLOG.match(original).end()
+    prolog = _PROLOG.match(original)
+    start = prolog.end() if prolog else 0      # the pattern matches the empty string: never None
     end_tag = f"</{tag}>".encode()
     close = original.rfind(end_tag)
     end = close + len(end_tag) if close >= 0 else len(original.rstrip())
