@@ -23,7 +23,10 @@ exception types to exit codes and the parameter names to its options (``inertia_
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # pragma: no cover
+    from numpy.typing import ArrayLike
 
 __all__ = [
     "InertiaToolError",
@@ -111,7 +114,7 @@ class NonFiniteResultError(PhysicsError, OverflowError):
     """
 
     @classmethod
-    def check(cls, what: str, value, *, because: str = "") -> None:
+    def check(cls, what: str, value: ArrayLike, *, because: str = "") -> None:
         """Raise unless every entry of ``value`` is finite; the message names ``what`` and ``because``."""
         import numpy as np
         a = np.asarray(value, dtype=np.float64)

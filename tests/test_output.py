@@ -55,7 +55,8 @@ def test_an_os_error_on_rename_is_one_line_and_removes_the_temporary(tmp_path, m
 def test_check_targets_refuses_before_any_write(tmp_path):
     (tmp_path / "b.svg").write_text("keep")
     files = {str(tmp_path / "a.svg"): "<svg/>", str(tmp_path / "b.svg"): "<svg/>", str(tmp_path / "r.md"): "x"}
-    with pytest.raises(OutputFileError, match=r"b\.svg: exists; refusing to overwrite it \(`force=True` overwrites it\)"):
+    with pytest.raises(OutputFileError,
+                       match=r"b\.svg: exists; refusing to overwrite it \(`force=True` overwrites it\)"):
         write_files(files)
     assert _names(tmp_path) == ["b.svg"]                       # a.svg (checked first) was not written either
     with pytest.raises(OutputFileError, match="is a directory"):

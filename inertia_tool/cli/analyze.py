@@ -32,7 +32,8 @@ from ..units import parse_fraction, parse_length
 from .options import check_option, density_and_mass
 from .report_option import add_report_options, check_report_path, write_report_from_args
 
-__all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args", "read_meshes",
+__all__ = ["register", "run", "split_part_spec", "add_material_options", "add_mesh_options", "load_from_args",
+           "read_meshes",
            "add_output_options", "add_model_options", "output_format", "load_model_from_args", "FORMATS"]
 
 

@@ -437,8 +437,8 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
                         if 0 < i <= max_vertices:
                             idx.append(i - 1)
                         elif i > 0:
-                            raise _fail(path, f"line {line_no}: face index {str(i)[:24]} is past any vertex this file may "
-                                              f"hold ({max_vertices:,} = 3 × `max_faces`)")
+                            raise _fail(path, f"line {line_no}: face index {str(i)[:24]} is past any vertex "
+                                              f"this file may hold ({max_vertices:,} = 3 × `max_faces`)")
                         elif i < 0 and -i <= nv:
                             idx.append(nv + i)
                         elif i < 0:
@@ -903,4 +903,5 @@ def _from_object(source):
         if not np.all(np.isfinite(v)):
             raise UsageError("Expected finite vertex coordinates, got NaN or infinity")
         return v, f, "<arrays>"
-    raise UsageError(f"Expected a file path, a trimesh.Trimesh or a (vertices, faces) pair, got {type(source).__name__}")
+    raise UsageError("Expected a file path, a trimesh.Trimesh or a (vertices, faces) pair, "
+                     f"got {type(source).__name__}")

@@ -37,7 +37,7 @@ def _label(path: str, label: str | None) -> str:
     return f"{label} {path}" if label else path
 
 
-def check_targets(targets: Sequence[str | tuple[str, str | None]], *, force: bool = False) -> None:
+def check_targets(targets: Sequence[str | None | tuple[str | None, str | None]], *, force: bool = False) -> None:
     """Refuse, before anything is written, any target that cannot be written as asked.
 
     Parameters
