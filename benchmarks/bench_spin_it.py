@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from inertia_tool.design import spin_it  # noqa: E402
 from inertia_tool.design.grid import interior_grid  # noqa: E402
 from inertia_tool.design.hollow import DEPTH_MARGIN, _exact_near_wall, design_frame  # noqa: E402
-from inertia_tool.design.moments import (cell_moment_rows, frame_quantities, moment_vector,  # noqa: E402
+from inertia_tool.design.moments import (cell_moment_rows, moment_vector,  # noqa: E402
                                          top_objective, top_threshold_measure, yoyo_objective)
 from inertia_tool.design.optimize import _gradient_in_moments, _moment_scales, optimize_quadric_cavity  # noqa: E402
 from inertia_tool.mass.pipeline import mass_properties  # noqa: E402
@@ -132,8 +132,9 @@ def main():
             result = spin_it((vertices, faces), material="PLA", resolution=resolution, **spec)
             total = time.perf_counter() - started
             print(f"  resolution {resolution}: {total:.2f} s in all (optimisation {result.optimisation_seconds:.2f} s, "
-                  f"{result.allowed_cells} cells, {result.removed_cells} removed), wall {result.measured_wall * 1e3:.3f} "
-                  f"mm ≥ {result.wall * 1e3:.1f} mm; objective {result.objective_before:.4g} → "
+                  f"{result.allowed_cells} cells, {result.removed_cells} removed), "
+                  f"wall {result.measured_wall * 1e3:.3f} mm ≥ {result.wall * 1e3:.1f} mm; "
+                  f"objective {result.objective_before:.4g} → "
                   f"{result.objective_after:.4g} (exact)")
             if resolution == resolutions[0]:
                 print("    " + _row("before", result.metrics_before, spec["mode"]))
@@ -150,7 +151,8 @@ def main():
         mu_part, points, h, size, objective = _cells_problem(vertices, faces, spec, resolution)
         quadric = optimize_quadric_cavity(objective, mu_part, points, h, size=size)
         relaxed, relaxed_seconds, iterations = voxel_relaxation(objective, mu_part, points, h, size)
-        print(f"  cells at resolution {resolution} ({len(points)} cells), objective {quadric.objective_solid:.4g} solid:")
+        print(f"  cells at resolution {resolution} ({len(points)} cells), "
+              f"objective {quadric.objective_solid:.4g} solid:")
         print(f"    quadric (10 unknowns):       objective {quadric.objective:.4g} in {quadric.seconds:.2f} s")
         print(f"    voxel relaxation ({len(points)} unknowns, {iterations} L-BFGS-B iterations): objective "
               f"{relaxed:.4g} in {relaxed_seconds:.2f} s")

@@ -343,7 +343,7 @@ __all__ += ["quaternion_to_cayley_klein", "cayley_klein_to_quaternion", "cayley_
 _PAULI = np.array([[[0, 1], [1, 0]], [[0, -1j], [1j, 0]], [[1, 0], [0, -1]]], dtype=np.complex128)
 
 
-def _as_su2(matrix, atol: float) -> np.ndarray:
+def _as_su2(matrix: ArrayLike, atol: float) -> NDArray[np.complex128]:
     u = np.asarray(matrix, dtype=np.complex128)
     if u.shape[-2:] != (2, 2):
         raise UsageError(f"Expected `cayley_klein` to have shape (..., 2, 2), got {u.shape}")
@@ -358,7 +358,7 @@ def _as_su2(matrix, atol: float) -> np.ndarray:
     return u
 
 
-def quaternion_to_cayley_klein(quaternion) -> np.ndarray:
+def quaternion_to_cayley_klein(quaternion: ArrayLike) -> np.ndarray:
     """Cayley–Klein matrix ``U = [[α, β], [γ, δ]]`` ∈ SU(2) of the rotation of a scalar-first quaternion.
 
     ``α = w + i z``, ``β = −y + i x``, ``γ = y + i x``, ``δ = w − i z`` (see the block comment above): the
@@ -375,7 +375,7 @@ def quaternion_to_cayley_klein(quaternion) -> np.ndarray:
     return np.stack([np.stack([w + 1j * z, -y + 1j * x], -1), np.stack([y + 1j * x, w - 1j * z], -1)], -2)
 
 
-def cayley_klein_to_quaternion(cayley_klein, *, atol: float = 1e-9) -> np.ndarray:
+def cayley_klein_to_quaternion(cayley_klein: ArrayLike, *, atol: float = 1e-9) -> np.ndarray:
     """Scalar-first unit quaternion of a Cayley–Klein matrix; ``U`` and ``−U`` give the same one.
 
     The sign is fixed by the first non-zero component of ``(w, x, y, z)`` being positive (``w > 0`` unless the
@@ -393,10 +393,11 @@ def cayley_klein_to_quaternion(cayley_klein, *, atol: float = 1e-9) -> np.ndarra
     tiny = np.abs(q) <= 1e-15
     first = np.argmax(~tiny, axis=-1)[..., None]
     sign = np.sign(np.take_along_axis(q, first, axis=-1))
-    return np.where(tiny, 0.0, q) * sign
+    quaternion: NDArray[np.float64] = np.where(tiny, 0.0, q) * sign
+    return quaternion
 
 
-def cayley_klein_to_matrix(cayley_klein, *, atol: float = 1e-9) -> np.ndarray:
+def cayley_klein_to_matrix(cayley_klein: ArrayLike, *, atol: float = 1e-9) -> np.ndarray:
     """Active rotation ``Q`` of a Cayley–Klein matrix: ``Q_ij = ½ tr(σ_i V σ_j V†)``, ``V = conj(U)``.
 
     The map SU(2) → SO(3) is a homomorphism (``Q(U1 U2) = Q(U1) Q(U2)``) and two-to-one (``Q(−U) = Q(U)``).
@@ -408,11 +409,11 @@ def cayley_klein_to_matrix(cayley_klein, *, atol: float = 1e-9) -> np.ndarray:
     v = np.conj(_as_su2(cayley_klein, atol))
     v_dagger = np.conj(np.swapaxes(v, -1, -2))
     # (σ_i V σ_j V†) traced: sum over the 2×2 indices
-    m = np.einsum("iab,...bc,jcd,...da->...ij", _PAULI, v, _PAULI, v_dagger)
+    m: NDArray[np.complex128] = np.einsum("iab,...bc,jcd,...da->...ij", _PAULI, v, _PAULI, v_dagger)
     return 0.5 * m.real
 
 
-def stereographic_projection(points) -> np.ndarray:
+def stereographic_projection(points: ArrayLike) -> np.ndarray:
     """``ξ = (x + i y)/(1 − z)`` of points on the unit sphere (exercise 4.11a); the north pole maps to ``inf``.
 
     Parameters
@@ -428,20 +429,23 @@ def stereographic_projection(points) -> np.ndarray:
     if p.shape[-1:] != (3,):
         raise UsageError(f"Expected `points` to have shape (..., 3), got {p.shape}")
     with np.errstate(divide="ignore", invalid="ignore"):
-        return (p[..., 0] + 1j * p[..., 1]) / (1.0 - p[..., 2])
+        xi: np.ndarray = (p[..., 0] + 1j * p[..., 1]) / (1.0 - p[..., 2])
+    return xi
 
 
-def inverse_stereographic_projection(xi) -> np.ndarray:
+def inverse_stereographic_projection(xi: ArrayLike) -> np.ndarray:
     """Point of the unit sphere whose projection is ``ξ``: ``(2 Re ξ, 2 Im ξ, |ξ|² − 1)/(|ξ|² + 1)``."""
     xi = np.asarray(xi, dtype=np.complex128)
     r2 = np.abs(xi) ** 2
-    return np.stack([2 * xi.real, 2 * xi.imag, r2 - 1.0], -1) / (r2 + 1.0)[..., None]
+    point: NDArray[np.float64] = np.stack([2 * xi.real, 2 * xi.imag, r2 - 1.0], -1) / (r2 + 1.0)[..., None]
+    return point
 
 
-def moebius_transform(cayley_klein, xi) -> np.ndarray:
+def moebius_transform(cayley_klein: ArrayLike, xi: ArrayLike) -> np.ndarray:
     """``(α ξ + β)/(γ ξ + δ)`` (exercise 4.11b); ``cayley_klein`` (2, 2), ``xi`` any shape of complex."""
     u = np.asarray(cayley_klein, dtype=np.complex128)
     if u.shape != (2, 2):
         raise UsageError(f"Expected `cayley_klein` to have shape (2, 2), got {u.shape}")
     xi = np.asarray(xi, dtype=np.complex128)
-    return (u[0, 0] * xi + u[0, 1]) / (u[1, 0] * xi + u[1, 1])
+    image: NDArray[np.complex128] = (u[0, 0] * xi + u[0, 1]) / (u[1, 0] * xi + u[1, 1])
+    return image

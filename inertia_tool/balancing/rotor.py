@@ -26,7 +26,7 @@ the torque ``τ = ω × (J ω) = Ω² (−J_yz, J_xz, 0)``.  Both rotate with th
 from __future__ import annotations
 
 import math
-
+from typing import Any
 
 import numpy as np
 
@@ -725,7 +725,7 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
 
     achieved_value, achieved = _achieved(tolerance, props.mass, omega)
     corrected_value, corrected_grade = _achieved(corrected_tolerance, corrected_body.mass, omega)
-    drilling = {}
+    drilling: dict[str, Any] = {}
     if drill_diameter is not None:
         from .drilling import drill_holes, remove_cylinders
         holes = drill_holes(props, frame, planes_t, r, float(drill_diameter), state.static_unbalance,

@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -92,7 +93,7 @@ def _manifold_of(vertices, faces):
     return manifold3d.Manifold(mesh)
 
 
-def _arrays_of(manifold):
+def _arrays_of(manifold: Any) -> tuple[np.ndarray, np.ndarray]:
     mesh = manifold.to_mesh64()
     return np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3], np.asarray(mesh.tri_verts, dtype=np.int64)
 

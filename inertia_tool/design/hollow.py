@@ -23,6 +23,7 @@ import math
 import time
 import warnings
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,6 +33,9 @@ from .grid import interior_grid, surface_distance
 from .limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
 from .moments import OBJECTIVES, frame_quantities, moment_vector, top_threshold_measure
 from .optimize import QuadricCavity, optimize_quadric_cavity
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .insert import QuadricInsert
 
 __all__ = ["SpinDesignMetrics", "SpinItResult", "spin_it", "design_metrics", "MODES", "DEFAULT_RESOLUTION"]
 
@@ -366,7 +370,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
             return OBJECTIVES["top"](mu, size=size, center_weight=center_weight, product_weight=product_weight,
                                      reference_threshold=reference)
     cavity = optimize_quadric_cavity(objective, mu_part, points, h, size=size)
-    design = cavity
+    design: QuadricCavity | QuadricInsert = cavity
     if insert_density is not None and len(points):
         from .insert import optimize_cavity_and_insert
         design = optimize_cavity_and_insert(objective, mu_part, points, h, cavity, size=size,
@@ -378,6 +382,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     if out_v is not vertices:
         after = mass_properties((out_v, out_f), density=rho, name=f"{name} (hollowed)")
     if ins_v is not None:
+        assert insert_density is not None, "an insert is made only when its density is given"
         from ..mass.properties import combine
         insert_props = mass_properties((ins_v, ins_f), density=float(insert_density), name=f"{name} (insert)")
         after = combine([after, insert_props], name=f"{name} (hollowed, with insert)")

@@ -25,6 +25,8 @@ The objectives of the spin designs are functions of ``μ`` alone (Hafner et al.,
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from ..errors import PhysicsError
@@ -104,4 +106,5 @@ def top_threshold_measure(mu) -> float:
     return float(0.5 * (i[0, 0] + i[1, 1]) * m * c[2] / i[2, 2] ** 2)
 
 
-OBJECTIVES = {"yoyo": yoyo_objective, "top": top_objective}
+#: The objectives by design mode; each takes the part's moment vector and its keyword weights.
+OBJECTIVES: dict[str, Callable[..., float]] = {"yoyo": yoyo_objective, "top": top_objective}

@@ -279,6 +279,7 @@ def format_balance_text(report: BalanceReport) -> str:
         lines += _table_text(["hole", "from z [mm]", "Ø [mm]", "depth [mm]", "towards", "radius [mm]", "at [°]",
                               "removes [g]", "inside the part"], rows)
         d = report.drilled
+        assert d is not None, "a balance report with drillings holds their verification"
         lines += ["  verification (part less the drilled cylinders re-analysed): static "
                   f"{_num(_mag(d.static_unbalance) * _G_MM)} g·mm, couple {_num(_mag(d.couple_unbalance) * _G_MM2)} "
                   f"g·mm², kind {d.kind}, meets {_grade_name(report.drilled_grade, report.drilled_value)}"]

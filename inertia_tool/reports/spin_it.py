@@ -65,10 +65,12 @@ def format_spin_it_text(result, *, name: str = "", output: str | None = None) ->
                                                   "through the centre of mass")
     lines = [f"spin-it {name}: {mode}",
              f"  axis ({ax}), {where} ({org}) mm",
-             f"  wall: {_mm(result.wall)} asked, thinnest {_mm(result.measured_wall) if math.isfinite(result.measured_wall) else '— (no cavity)'}"
+             f"  wall: {_mm(result.wall)} asked, thinnest "
+             f"{_mm(result.measured_wall) if math.isfinite(result.measured_wall) else '— (no cavity)'}"
              " measured (cavity vertices to the outer surface)",
-             f"  cavity: {result.cavity_volume * 1e6:.4g} cm³ removed, {result.removed_cells} of {result.allowed_cells} "
-             f"cells of {_mm(result.cell_size)}; optimised in {result.optimisation_seconds:.2f} s "
+             f"  cavity: {result.cavity_volume * 1e6:.4g} cm³ removed, "
+             f"{result.removed_cells} of {result.allowed_cells} cells of {_mm(result.cell_size)}; "
+             f"optimised in {result.optimisation_seconds:.2f} s "
              f"({result.objective_evaluations} objective evaluations), {result.seconds:.2f} s in all",
              f"  objective {result.objective_before:.4g} → {result.objective_after:.4g} (exact moments)",
              "  every 'after' number is the exact re-analysis of the hollowed mesh", ""]
