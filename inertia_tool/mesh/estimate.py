@@ -200,38 +200,37 @@ def _cube_moments(centres: np.ndarray, h: float):
     return vol, c, second
 
 
-def _surface_cells(vertices, faces, lo, h, dims):
-    """(cells,) bool: cells the surface may pass through.
+def _surface_cells(vertices, faces, lo, h, dims, spacing=0.25):
+    """(cells,) bool: every cell the surface passes through (and a thin margin around it).
 
-    Samples on each triangle spaced at most h/2 apart mark their cells; any cell the surface crosses is then
-    within one cell of a marked one, so the marks are dilated by one cell in all 26 directions.
+    Each triangle is sampled on a barycentric grid whose sub-triangles have edges of at most
+    ``δ = spacing · h``, so every point of the surface lies within ``δ`` of a sample; a cell the surface
+    crosses therefore meets the cube of half-side ``δ`` around some sample, and the cells those cubes touch
+    are marked (a cube smaller than a cell touches exactly the cells holding its 8 corners).
     """
     v = vertices
     a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
+    delta = spacing * h
     longest = np.max(np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
                                np.linalg.norm(a - c, axis=1)]), axis=0)
-    steps = np.maximum(1, np.ceil(longest / (0.5 * h)).astype(np.int64))
+    steps = np.maximum(1, np.ceil(longest / delta).astype(np.int64))
+    limit = np.array(dims) - 1
     marked = np.zeros(int(np.prod(dims)), dtype=bool)
+    offsets = delta * np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
     for n in np.unique(steps):
-        sel = steps == n
+        sel = np.flatnonzero(steps == n)
         i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
         keep = i + j <= n
         s, t = (i[keep] / n), (j[keep] / n)
-        pts = (a[sel, None] * (1 - s - t)[None, :, None] + b[sel, None] * s[None, :, None]
-               + c[sel, None] * t[None, :, None]).reshape(-1, 3)
-        idx = np.clip(np.floor((pts - lo) / h).astype(np.int64), 0, np.array(dims) - 1)
-        marked[np.ravel_multi_index(idx.T, dims)] = True
-    grid = marked.reshape(dims)
-    for axis in range(3):            # one-cell dilation along each axis in turn: all 26 neighbours
-        grown = grid.copy()
-        lead = [slice(None)] * 3
-        rest = [slice(None)] * 3
-        lead[axis], rest[axis] = slice(1, None), slice(None, -1)
-        grown[tuple(lead)] |= grid[tuple(rest)]
-        grown[tuple(rest)] |= grid[tuple(lead)]
-        grid = grown
-    dilated = grid
-    return dilated.reshape(-1)
+        per = max(1, (1 << 20) // len(s))
+        for k in range(0, len(sel), per):
+            ids = sel[k:k + per]
+            pts = (a[ids, None] * (1 - s - t)[None, :, None] + b[ids, None] * s[None, :, None]
+                   + c[ids, None] * t[None, :, None]).reshape(-1, 3)
+            for off in offsets:
+                idx = np.clip(np.floor((pts + off - lo) / h).astype(np.int64), 0, limit)
+                marked[np.ravel_multi_index(idx.T, dims)] = True
+    return marked
 
 
 def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64, w_low: float = 0.1,
