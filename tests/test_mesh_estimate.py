@@ -7,7 +7,7 @@ import trimesh
 from conftest import box_arrays
 from inertia_tool.mesh.estimate import boundary_edges, patched_estimate, winding_estimate
 from inertia_tool.mesh.winding import winding_numbers
-from inertia_tool.volume import volume_moments
+from inertia_tool.mass.volume import volume_moments
 
 
 def test_winding_numbers_of_a_sphere_direct_sum():

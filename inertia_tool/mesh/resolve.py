@@ -73,15 +73,24 @@ def _drop_collapsed(faces):
     return faces[~((faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0]))]
 
 
-def _describe(census: EdgeBalance, welded: float | None) -> str:
+def _describe(census: EdgeBalance, welded: float | None, vertices: np.ndarray, faces: np.ndarray) -> str:
+    from .estimate import boundary_edges
+
     parts = []
     if census.boundary_edges:
         parts.append(f"{census.boundary_edges:,} boundary edges (holes or cracks)")
+    if census.nonmanifold_edges:
+        parts.append(f"{census.nonmanifold_edges:,} non-manifold edges (shared by 3+ faces)")
     other = census.unbalanced_edges - census.boundary_edges
     if other:
-        parts.append(f"{other:,} edges where the faces on either side do not match up (non-manifold or flipped)")
+        parts.append(f"{other:,} edges used more often in one direction than the other")
     after = f" after welding vertices within {welded:.3g} m" if welded else ""
-    return "; ".join(parts) + after
+    edges = boundary_edges(faces, len(vertices))
+    where = ""
+    if len(edges):
+        a, b = vertices[edges[0, 0]], vertices[edges[0, 1]]
+        where = f", e.g. the edge ({a[0]:.6g}, {a[1]:.6g}, {a[2]:.6g})–({b[0]:.6g}, {b[1]:.6g}, {b[2]:.6g}) m"
+    return "; ".join(parts) + after + where
 
 
 def _touching_note(census: EdgeBalance) -> tuple:
@@ -103,7 +112,7 @@ def _dedupe(faces: np.ndarray) -> tuple[np.ndarray, int]:
 
 
 def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
-                    merge_tolerance: float, moments) -> Resolution:
+                    merge_tolerance: float, moments, force_estimate: bool = False) -> Resolution:
     """Read a surface that failed the manifold check as a solid (exact), as an estimate (repair), or refuse.
 
     Parameters
@@ -122,6 +131,9 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         Relative (to ``diag``) distance for merging vertices; 0 disables the weld.
     moments : callable
         ``moments(vertices, faces) -> VolumeMoments`` (the exact integrator).
+    force_estimate : bool
+        Go straight to the winding-number estimate (a balanced surface whose overlapping bodies the boolean
+        could not unite).
 
     Returns
     -------
@@ -136,6 +148,12 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     f = np.asarray(faces)
     n = len(v)
     census = edge_balance(f, n)
+    if force_estimate:
+        grid = winding_estimate(v, f)
+        if not grid.volume > 0:
+            raise InvalidMeshError(f"{source}: the surface encloses no volume")
+        return Resolution(v, f, grid.method, ("the bodies overlap and their union could not be formed", grid.detail),
+                          0, None, census.nonmanifold_edges, estimate=grid)
     if census.balanced:
         return Resolution(v, f, "exact", _touching_note(census), 0, None, census.nonmanifold_edges)
     oriented = orient_consistently(f, n, v)
@@ -163,7 +181,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                     return Resolution(v, again.faces, "welded", notes + _touching_note(census), again.flipped_faces,
                                       tol, census.nonmanifold_edges)
     if not repair:
-        raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded)}; repair=True gives a "
+        raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}; repair=True gives a "
                                "bounded estimate",
                                details={"boundary_edges": census.boundary_edges,
                                         "unbalanced_edges": census.unbalanced_edges,
