@@ -38,6 +38,7 @@ from ..mass.properties import MassProperties
 from .escape import escape_html
 from .output import check_targets, write_text
 from .serialize import TENSOR_CONVENTION
+from .text import method_line
 
 __all__ = ["HtmlSection", "html_report", "write_html_report", "svg_views", "VIEWS",
            "stability_section", "DEFAULT_MAX_EDGES", "DEFAULT_MAX_FILL_FACES"]
@@ -354,7 +355,8 @@ def stability_section(report) -> HtmlSection:
 
 def _core_sections(props: MassProperties, density_source: str | None, semi) -> list[HtmlSection]:
     pa = props.principal
-    summary = [["mass", _num(props.mass), "kg"], ["volume", _num(props.volume), "m³"],
+    summary = [["result", _e(method_line(props.mesh)), ""],
+               ["mass", _num(props.mass), "kg"], ["volume", _num(props.volume), "m³"],
                ["surface area", _num(props.surface_area), "m²"], ["density", _num(props.density), "kg/m³"]]
     if density_source:
         summary.append(["density from", _e(density_source), ""])
@@ -396,7 +398,8 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
                                     "bodies"))
     mesh = cast("MeshReport | None", props.mesh)        # MassProperties.mesh is typed `object`
     if mesh is not None:
-        rows = [["faces", f"{mesh.faces:,} (file {mesh.file_faces:,})"], ["vertices", f"{mesh.vertices:,}"],
+        rows = [["result", _e(method_line(mesh))],
+                ["faces", f"{mesh.faces:,} (file {mesh.file_faces:,})"], ["vertices", f"{mesh.vertices:,}"],
                 ["bodies / cavities", f"{mesh.bodies} / {mesh.cavities}"],
                 ["watertight and consistently wound as read", "yes" if mesh.watertight else "no"],
                 ["degenerate faces ignored / zero-area faces", f"{mesh.degenerate_faces} / {mesh.zero_area_faces}"],
@@ -407,8 +410,11 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
         if mesh.flipped_shells:
             rows.append(["inside-out shells flipped", str(mesh.flipped_shells)])
         if mesh.overlapping_shells:
-            rows.append(["overlapping bodies (volume counted twice)", str(mesh.overlapping_shells)])
-        if mesh.repaired:
+            how = "united, shared volume counted once" if mesh.method == "union" else "volume counted twice"
+            rows.append([f"overlapping bodies ({how})", str(mesh.overlapping_shells)])
+        for note in mesh.notes:
+            rows.append(["note", _e(note)])
+        if mesh.repaired and not mesh.notes:
             rows.append(["repaired", _e(", ".join(mesh.repair_actions))])
         sections.append(HtmlSection(f"Mesh ({mesh.units} coordinates, converted to m)", _table(None, rows),
                                     "mesh"))
