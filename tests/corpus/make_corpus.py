@@ -492,7 +492,7 @@ def _(path):
 
 
 @entry("open-box.stl", "an open box (one face missing)", 3,
-       r"4 boundary edges \(holes or cracks\).*repair=True gives a bounded estimate")
+       r"4 boundary edges \(holes or cracks\).*--repair gives a bounded estimate")
 def _(path):
     v, f = box()
     write_binary_stl(path, v, f[2:])
