@@ -72,49 +72,62 @@ def triangles_meet(t1: np.ndarray, t2: np.ndarray, eps: float = 0.0) -> np.ndarr
 def _grid_pairs(lo, hi, query, max_pairs, pad):
     """Face pairs whose padded bounding boxes overlap, at least one face in ``query``: (a, b) or None.
 
-    A uniform grid with cells about twice the median box size; every face is entered in each cell its box
-    overlaps, and the faces sharing a cell are paired.  Returns None when the cell entries or pairs would
-    exceed ``max_pairs`` (the caller then lets the boolean decide).
+    A uniform grid with cells the median box size; every face is entered in each cell its box
+    overlaps (only cells that some query face reaches are kept), and the faces sharing a cell are paired.
+    A pair is reported only in the cell holding the low corner of the two boxes' intersection, so each
+    pair comes out once.  Returns None when the cell entries or pairs would exceed ``max_pairs`` (the caller
+    then lets the boolean decide).
     """
     lo, hi = lo - pad, hi + pad
     m = len(lo)
     extent = np.max(hi - lo, axis=1)
-    h = max(2.0 * float(np.median(extent)), float(np.max(hi.max(axis=0) - lo.min(axis=0))) / 2048, pad)
+    h = max(float(np.median(extent)), float(np.max(hi.max(axis=0) - lo.min(axis=0))) / 2048, pad)
     origin = lo.min(axis=0)
     i0 = np.floor((lo - origin) / h).astype(np.int64)
     i1 = np.floor((hi - origin) / h).astype(np.int64)
+    dims = i1.max(axis=0) + 1
     span = i1 - i0 + 1
     cells = span.prod(axis=1)
-    total = int(cells.sum())
-    if total > max_pairs:
+    if int(cells.sum()) > max_pairs:
         return None
-    face = np.repeat(np.arange(m), cells)
-    k = np.arange(total) - np.repeat(np.cumsum(cells) - cells, cells)
-    sy, sz = span[face, 1], span[face, 2]
-    cx = i0[face, 0] + k // (sy * sz)
-    cy = i0[face, 1] + (k // sz) % sy
-    cz = i0[face, 2] + k % sz
-    dims = i1.max(axis=0) + 1
-    key = (cx * dims[1] + cy) * dims[2] + cz
+
+    def entries(faces):
+        c = cells[faces]
+        face = np.repeat(faces, c)
+        k = np.arange(len(face)) - np.repeat(np.cumsum(c) - c, c)
+        sy, sz = span[face, 1], span[face, 2]
+        key = ((i0[face, 0] + k // (sy * sz)) * dims[1] + i0[face, 1] + (k // sz) % sy) * dims[2] \
+            + i0[face, 2] + k % sz
+        return face, key
+
+    q_face, q_key = entries(np.flatnonzero(query))
+    o_face, o_key = entries(np.flatnonzero(~query))
+    wanted = np.unique(q_key)
+    near = np.isin(o_key, wanted, assume_unique=False)
+    face = np.r_[q_face, o_face[near]]
+    key = np.r_[q_key, o_key[near]]
     order = np.argsort(key, kind="stable")
     key, face = key[order], face[order]
+    total = len(key)
     starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
     size = np.diff(np.r_[starts, total])
     pos = np.arange(total)
-    group_end = np.repeat(starts + size, size)
-    later = group_end - pos - 1                          # partners after each entry in its cell
+    later = np.repeat(starts + size, size) - pos - 1      # partners after each entry in its cell
     n_pairs = int(later.sum())
     if n_pairs > max_pairs:
         return None
-    a = np.repeat(face, later)
+    first = np.repeat(pos, later)
     offset = np.arange(n_pairs) - np.repeat(np.cumsum(later) - later, later)
-    b = face[np.repeat(pos, later) + 1 + offset]
-    wanted = (query[a] | query[b]) & (a != b)
-    a, b = a[wanted], b[wanted]
-    a, b = np.minimum(a, b), np.maximum(a, b)
-    overlap = np.all((lo[a] <= hi[b]) & (lo[b] <= hi[a]), axis=1)
-    pair = np.unique(a[overlap] * np.int64(m) + b[overlap])
-    return pair // m, pair % m
+    a, b = face[first], face[first + 1 + offset]
+    cell = key[first]
+    del first, offset
+    keep = (query[a] | query[b]) & (a != b)
+    keep &= np.all((lo[a] <= hi[b]) & (lo[b] <= hi[a]), axis=1)
+    a, b, cell = a[keep], b[keep], cell[keep]
+    corner = np.floor((np.maximum(lo[a], lo[b]) - origin) / h).astype(np.int64)
+    home = (corner[:, 0] * dims[1] + corner[:, 1]) * dims[2] + corner[:, 2]
+    once = home == cell
+    return a[once], b[once]
 
 
 def crossing_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, query: np.ndarray, *,
