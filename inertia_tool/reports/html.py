@@ -355,13 +355,13 @@ def stability_section(report) -> HtmlSection:
 
 def _core_sections(props: MassProperties, density_source: str | None, semi) -> list[HtmlSection]:
     pa = props.principal
-    summary = [["result", _e(method_line(props.mesh)), ""],
-               ["mass", _num(props.mass), "kg"], ["volume", _num(props.volume), "m³"],
+    summary = [["mass", _num(props.mass), "kg"], ["volume", _num(props.volume), "m³"],
                ["surface area", _num(props.surface_area), "m²"], ["density", _num(props.density), "kg/m³"]]
     if density_source:
         summary.append(["density from", _e(density_source), ""])
     summary.append(["centre of mass", "(" + ", ".join(_vec_cells(props.center_of_mass)) + ")", "m"])
-    sections = [HtmlSection("Mass properties", _table(None, summary), "mass")]
+    verdict = f"<p><strong>Result:</strong> {_e(method_line(props.mesh))}</p>"
+    sections = [HtmlSection("Mass properties", verdict + _table(None, summary), "mass")]
     ten = _clean(props.inertia)
     origin = _clean(np.asarray(props.inertia_about(np.zeros(3))))
     tensor_rows = [[_AXIS_LETTERS[i]] + [f"{x:.6e}" for x in ten[i]] for i in range(3)]
@@ -398,7 +398,10 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
                                     "bodies"))
     mesh = cast("MeshReport | None", props.mesh)        # MassProperties.mesh is typed `object`
     if mesh is not None:
-        rows = [["result", _e(method_line(mesh))],
+        u = mesh.uncertainty
+        bounds = ("none: exact for the polyhedron" if u is None else
+                  f"mass ±{100 * u.mass:.3g}%, centre of mass {u.center_of_mass:.3g} m, inertia ±{100 * u.inertia:.3g}%")
+        rows = [["method", _e(mesh.method)], ["uncertainty", _e(bounds)],
                 ["faces", f"{mesh.faces:,} (file {mesh.file_faces:,})"], ["vertices", f"{mesh.vertices:,}"],
                 ["bodies / cavities", f"{mesh.bodies} / {mesh.cavities}"],
                 ["watertight and consistently wound as read", "yes" if mesh.watertight else "no"],
