@@ -82,9 +82,11 @@ def ray_winding(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, gro
     order = np.argsort(points[:, 1], kind="stable")
     sorted_y = points[order, 1]
     f = np.asarray(faces, dtype=np.int64)
-    ys = vertices[:, 1][f]
-    lo = np.searchsorted(sorted_y, ys.min(axis=1), side="left")
-    hi = np.searchsorted(sorted_y, ys.max(axis=1), side="right")
+    y = vertices[:, 1]
+    y0, y1, y2 = y[f[:, 0]], y[f[:, 1]], y[f[:, 2]]
+    lo = np.searchsorted(sorted_y, np.minimum(np.minimum(y0, y1), y2), side="left")
+    hi = np.searchsorted(sorted_y, np.maximum(np.maximum(y0, y1), y2), side="right")
+    del y0, y1, y2
     counts = hi - lo
     candidates = np.flatnonzero(counts)
     keys, signs = [], []
@@ -159,7 +161,18 @@ class Nesting:
 def _probe_faces(faces, vertices, labels, n_shells, rank):
     """Index of the face of each shell with the ``rank``-th largest area (the last one when fewer), (s,)."""
     v = vertices
-    area = np.linalg.norm(np.cross(v[faces[:, 1]] - v[faces[:, 0]], v[faces[:, 2]] - v[faces[:, 0]]), axis=1)
+    e1 = v[faces[:, 1]] - v[faces[:, 0]]
+    e2 = v[faces[:, 2]] - v[faces[:, 0]]
+    area = ((e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]) ** 2 + (e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]) ** 2
+            + (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) ** 2)          # squared doubled area: same order
+    del e1, e2
+    if rank == 0:
+        order = np.argsort(labels, kind="stable")             # labels come grouped: nearly linear
+        starts = np.searchsorted(labels[order], np.arange(n_shells))
+        best = np.maximum.reduceat(area[order], starts)
+        is_best = area[order] == np.repeat(best, np.diff(np.r_[starts, len(order)]))
+        first = np.flatnonzero(is_best)
+        return order[first[np.searchsorted(first, starts)]]
     order = np.lexsort((-area, labels))
     starts = np.searchsorted(labels[order], np.arange(n_shells))
     ends = np.r_[starts[1:], len(faces)]

@@ -118,11 +118,12 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
     owner[lonely] = np.flatnonzero(lonely)
     # a shell every probe of which lies on another surface touches it: an overlap candidate for the boolean
     overlapped = ((sign > 0) & inside_material) | nest.undecided
-    lo = np.full((n_shells, 3), np.inf)
-    hi = np.full((n_shells, 3), -np.inf)
-    corner = vertices[faces]
-    np.minimum.at(lo, labels, corner.min(axis=1))
-    np.maximum.at(hi, labels, corner.max(axis=1))
+    order = np.argsort(labels, kind="stable")
+    starts = np.searchsorted(labels[order], np.arange(n_shells))
+    p0, p1, p2 = (vertices[faces[order, k]] for k in range(3))
+    lo = np.minimum.reduceat(np.minimum(np.minimum(p0, p1), p2), starts, axis=0)
+    hi = np.maximum.reduceat(np.maximum(np.maximum(p0, p1), p2), starts, axis=0)
+    del p0, p1, p2
     boxes_meet = np.all(lo[:, None] <= hi[None], axis=2) & np.all(lo[None] <= hi[:, None], axis=2)
     np.fill_diagonal(boxes_meet, False)
     if boxes_meet.any():

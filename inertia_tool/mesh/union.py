@@ -69,6 +69,30 @@ def triangles_meet(t1: np.ndarray, t2: np.ndarray, eps: float = 0.0) -> np.ndarr
     return hit
 
 
+def _near_query(lo, hi, query, origin, size, coarse=64):
+    """Indices of the non-query faces whose box may overlap a query face's box.
+
+    A coarse occupancy grid (``coarse`` cells a side) marks the cells the query boxes reach; a face inside one
+    coarse cell is kept when that cell is marked, a face spanning several is kept regardless (conservative).
+    """
+    h = size / coarse if size > 0 else 1.0
+    c0 = np.clip(np.floor((lo - origin) / h).astype(np.int64), 0, coarse - 1)
+    c1 = np.clip(np.floor((hi - origin) / h).astype(np.int64), 0, coarse - 1)
+    marked = np.zeros((coarse, coarse, coarse), dtype=bool)
+    q = np.flatnonzero(query)
+    one = (c0[q, 0] == c1[q, 0]) & (c0[q, 1] == c1[q, 1]) & (c0[q, 2] == c1[q, 2])
+    marked[c0[q[one], 0], c0[q[one], 1], c0[q[one], 2]] = True
+    for f in q[~one]:           # faces spanning several coarse cells: few (cells are 1/64 of the part)
+        marked[c0[f, 0]:c1[f, 0] + 1, c0[f, 1]:c1[f, 1] + 1, c0[f, 2]:c1[f, 2] + 1] = True
+    other = np.flatnonzero(~query)
+    d0, d1 = c0[other], c1[other]
+    single = (d0[:, 0] == d1[:, 0]) & (d0[:, 1] == d1[:, 1]) & (d0[:, 2] == d1[:, 2])
+    keep = ~single
+    cell = c0[other[single]]
+    keep[single] = marked[cell[:, 0], cell[:, 1], cell[:, 2]]
+    return other[keep]
+
+
 def _grid_pairs(lo, hi, query, max_pairs, pad):
     """Face pairs whose padded bounding boxes overlap, at least one face in ``query``: (a, b) or None.
 
@@ -101,7 +125,7 @@ def _grid_pairs(lo, hi, query, max_pairs, pad):
         return face, key
 
     q_face, q_key = entries(np.flatnonzero(query))
-    o_face, o_key = entries(np.flatnonzero(~query))
+    o_face, o_key = entries(_near_query(lo, hi, query, origin, float(np.max(hi.max(axis=0) - origin))))
     wanted = np.unique(q_key)
     near = np.isin(o_key, wanted, assume_unique=False)
     face = np.r_[q_face, o_face[near]]
@@ -163,8 +187,11 @@ def crossing_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
     v = v - centre
     diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
-    tri = v[f]
-    pairs = _grid_pairs(tri.min(axis=1), tri.max(axis=1), np.asarray(query, dtype=bool), max_pairs, 1e-9 * diag)
+    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    lo = np.minimum(np.minimum(p0, p1), p2)
+    hi = np.maximum(np.maximum(p0, p1), p2)
+    del p0, p1, p2
+    pairs = _grid_pairs(lo, hi, np.asarray(query, dtype=bool), max_pairs, 1e-9 * diag)
     if pairs is None:
         return None
     a, b = pairs
@@ -177,7 +204,7 @@ def crossing_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     step = 1 << 20
     for s in range(0, len(a), step):
         aa, bb = a[s:s + step], b[s:s + step]
-        meet = triangles_meet(tri[aa], tri[bb], eps)
+        meet = triangles_meet(v[f[aa]], v[f[bb]], eps)
         found[labels[aa[meet]]] = True
         found[labels[bb[meet]]] = True
     return found
