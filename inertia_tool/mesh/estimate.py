@@ -136,14 +136,19 @@ def _loops(edges: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
 
 
 def _hull_volume(points: np.ndarray) -> float:
+    """Volume of the convex hull of the points; when Qhull cannot build it, the (larger) volume of their
+    bounding box in the principal frame, so the bound never shrinks on a precision failure."""
     from scipy.spatial import ConvexHull, QhullError
 
     if len(points) < 4:
         return 0.0
+    centred = points - points.mean(axis=0)
     try:
         return float(ConvexHull(points).volume)
-    except (QhullError, ValueError):     # flat or collinear: no volume
-        return 0.0
+    except (QhullError, ValueError):
+        _, _, axes = np.linalg.svd(centred, full_matrices=False)
+        span = np.ptp(centred @ axes.T, axis=0)
+        return float(np.prod(span))     # exactly 0 for a flat or collinear loop
 
 
 def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments) -> Estimate:

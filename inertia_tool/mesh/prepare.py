@@ -40,6 +40,9 @@ MIN_EXTENT = 1e-30
 #: Ways to count overlapping bodies: their union (the physical solid) or the sum of their integrals.
 OVERLAP_MODES = ("union", "sum")
 
+#: Work bound of the surface-crossing test: candidate face pairs per face (beyond it the boolean decides).
+CROSSING_PAIRS_PER_FACE = 16
+
 #: Overlap confirmed when the union's volume falls short of the summed volume by more than this (relative).
 UNION_VOLUME_RTOL = 1e-9
 
@@ -71,7 +74,8 @@ class PreparedMesh:
     report: MeshReport
 
 
-def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: str = "mesh"):
+def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: str = "mesh",
+                    check_crossing: bool = True, pairs_per_face: int = CROSSING_PAIRS_PER_FACE):
     """Flip inside-out shells, attach cavities to their bodies, find overlapping bodies.
 
     Every shell is classified, always: the winding number of every other shell at a point of each shell
@@ -79,7 +83,9 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
     about one pass over the faces however many shells there are.  A shell all of whose probe points lie on
     other shells' surfaces counts as an overlap candidate (the boolean union then decides).  Bodies whose surfaces touch or cross
     another shell's surface are found by triangle–triangle tests (:func:`~.union.crossing_shells`) on the
-    faces of all but the largest shell.
+    faces of all but the largest shell, within a work bound of ``pairs_per_face`` candidate pairs per face;
+    beyond it (CAD fans of long triangles) every shell whose box meets another's is a candidate and the
+    boolean union decides (``check_crossing=False`` goes there directly).
 
     Returns
     -------
@@ -126,10 +132,13 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
     del p0, p1, p2
     boxes_meet = np.all(lo[:, None] <= hi[None], axis=2) & np.all(lo[None] <= hi[:, None], axis=2)
     np.fill_diagonal(boxes_meet, False)
-    if boxes_meet.any():
+    if boxes_meet.any() and not check_crossing:
+        overlapped |= boxes_meet.any(axis=1)
+    elif boxes_meet.any():
         largest = int(np.argmax(np.bincount(labels, minlength=n_shells)))
         query = labels != largest
-        crossing = crossing_shells(vertices, faces, labels, query)
+        crossing = crossing_shells(vertices, faces, labels, query,
+                                   max_pairs=max(pairs_per_face * len(faces), 1 << 16))
         if crossing is None:            # too many candidate pairs to test: let the boolean decide
             crossing = boxes_meet.any(axis=1)
         overlapped |= crossing
@@ -222,7 +231,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         what = "the mesh encloses" if n_shells == 1 else f"{len(flat)} of {n_shells} shells enclose"
         raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
                                "thin-walled part use the shell model with a wall thickness")
-    flip, owner, cavities, overlaps = classify_shells(v, f, labels, n_shells, shells, diag, source=source)
+    flip, owner, cavities, overlaps = classify_shells(v, f, labels, n_shells, shells, diag, source=source,
+                                                      check_crossing=not found.nonmanifold_edges)
     if flip.any():
         face_flip = flip[labels]
         f = f.copy()
@@ -235,7 +245,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                       stacklevel=3)
     method, notes = found.method, list(found.notes)
     if overlaps or found.nonmanifold_edges:
-        united = _unite(v, f, shells, source, repair)
+        united = _unite(v, f, labels, owner, source, repair)
         summed = sum(s.volume for s in shells)
         if united is not None and abs(united.volume - summed) <= UNION_VOLUME_RTOL * abs(summed):
             overlaps = 0                      # surfaces touch, no volume is shared
@@ -267,18 +277,23 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
 
 
-def _unite(vertices, faces, shells, source, repair):
-    """The union of the closed pieces (a :class:`~.union.UnionSurface`), or None when the boolean refuses."""
+def _unite(vertices, faces, labels, owner, source, repair):
+    """The union of the closed pieces (a :class:`~.union.UnionSurface`), or None when the boolean refuses.
+
+    Each piece belongs to the body that owns its shell, so cavities are cut from their own body only.
+    """
     groups, n_groups = closed_groups(faces, len(vertices))
     pieces = body_volume_moments(vertices, faces, groups, n_groups)
     volume = np.array([p.volume for p in pieces])
     lo, hi = bounding_box(vertices)
     solid = np.abs(volume) > FLAT_RTOL * float(np.linalg.norm(hi - lo)) ** 3    # sheets (a face and its reverse)
+    shell_of_group = np.zeros(n_groups, dtype=np.int64)
+    shell_of_group[groups] = labels
     keep = solid[groups]
     _, groups = np.unique(groups[keep], return_inverse=True)
     try:
         return union_surface(vertices, faces[keep], groups.reshape(-1), int(np.count_nonzero(solid)),
-                             volume[solid] > 0)
+                             volume[solid] > 0, body=np.asarray(owner)[shell_of_group[solid]])
     except UnionError as exc:
         if repair:
             return None

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InvalidMeshError
+from ..tolerances import FLAT_RTOL
 from .estimate import Estimate, patched_estimate, winding_estimate
 from .merge import merge_close_vertices
 from .orient import EdgeBalance, edge_balance, orient_consistently
@@ -198,13 +199,14 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         if census.balanced:
             return Resolution(v, unique, "deduplicated", tuple(notes) + _touching_note(census), flipped, welded,
                               census.nonmanifold_edges)
+    flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
     patched = patched_estimate(v, unique, moments)
     best = patched
-    if not (patched.volume > 0 and patched.uncertainty.mass <= PATCH_PREFERRED_RTOL):
+    if not (patched.volume > flat and patched.uncertainty.mass <= PATCH_PREFERRED_RTOL):
         grid = winding_estimate(v, unique)
-        if grid.volume > 0 and not (patched.volume > 0 and patched.uncertainty.mass <= grid.uncertainty.mass):
+        if grid.volume > flat and not (patched.volume > flat and patched.uncertainty.mass <= grid.uncertainty.mass):
             best = grid
-    if not best.volume > 0:
+    if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
                                "thin-walled part use the shell model with a wall thickness")
     notes.append(best.detail)

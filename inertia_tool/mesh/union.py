@@ -93,65 +93,86 @@ def _near_query(lo, hi, query, origin, size, coarse=64):
     return other[keep]
 
 
+def _cells(faces, lo, hi, origin, h, dims):
+    """Grid entries (face, cell key) of ``faces`` on cells of side ``h`` covering their boxes."""
+    i0 = np.floor((lo[faces] - origin) / h).astype(np.int64)
+    i1 = np.floor((hi[faces] - origin) / h).astype(np.int64)
+    span = i1 - i0 + 1
+    count = span[:, 0] * span[:, 1] * span[:, 2]
+    which = np.repeat(np.arange(len(faces)), count)
+    k = np.arange(len(which)) - np.repeat(np.cumsum(count) - count, count)
+    sy, sz = span[which, 1], span[which, 2]
+    key = ((i0[which, 0] + k // (sy * sz)) * dims[1] + i0[which, 1] + (k // sz) % sy) * dims[2] + i0[which, 2] + k % sz
+    return faces[which], key
+
+
+def _home(a, b, lo, origin, h, dims):
+    """Cell key (side ``h``) of the low corner of the intersection of the boxes of faces a and b."""
+    c = np.floor((np.maximum(lo[a], lo[b]) - origin) / h).astype(np.int64)
+    return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+
+
 def _grid_pairs(lo, hi, query, max_pairs, pad):
     """Face pairs whose padded bounding boxes overlap, at least one face in ``query``: (a, b) or None.
 
-    A uniform grid with cells the median box size; every face is entered in each cell its box
-    overlaps (only cells that some query face reaches are kept), and the faces sharing a cell are paired.
-    A pair is reported only in the cell holding the low corner of the two boxes' intersection, so each
-    pair comes out once.  Returns None when the cell entries or pairs would exceed ``max_pairs`` (the caller
-    then lets the boolean decide).
+    A hierarchical grid: faces are sorted into levels by size (level ``L`` holds boxes at most ``h·2^L``
+    across, ``h`` the median), each level has its own grid of cells ``h·2^L`` (a box spans at most 2 cells
+    a side there), and every face is paired with the faces of its own level sharing a cell and with the
+    larger levels' faces through their grids.  A pair is reported only in the cell holding the low corner of
+    the two boxes' intersection, so it comes out once.  Faces far from every query face are dropped first
+    (coarse occupancy grid).  Returns None beyond ``max_pairs`` candidate pairs (the caller then lets the
+    boolean decide).
     """
     lo, hi = lo - pad, hi + pad
-    m = len(lo)
-    extent = np.max(hi - lo, axis=1)
-    h = max(float(np.median(extent)), float(np.max(hi.max(axis=0) - lo.min(axis=0))) / 2048, pad)
     origin = lo.min(axis=0)
-    i0 = np.floor((lo - origin) / h).astype(np.int64)
-    i1 = np.floor((hi - origin) / h).astype(np.int64)
-    dims = i1.max(axis=0) + 1
-    span = i1 - i0 + 1
-    cells = span.prod(axis=1)
-    if int(cells.sum()) > max_pairs:
-        return None
-
-    def entries(faces):
-        c = cells[faces]
-        face = np.repeat(faces, c)
-        k = np.arange(len(face)) - np.repeat(np.cumsum(c) - c, c)
-        sy, sz = span[face, 1], span[face, 2]
-        key = ((i0[face, 0] + k // (sy * sz)) * dims[1] + i0[face, 1] + (k // sz) % sy) * dims[2] \
-            + i0[face, 2] + k % sz
-        return face, key
-
-    q_face, q_key = entries(np.flatnonzero(query))
-    o_face, o_key = entries(_near_query(lo, hi, query, origin, float(np.max(hi.max(axis=0) - origin))))
-    wanted = np.unique(q_key)
-    near = np.isin(o_key, wanted, assume_unique=False)
-    face = np.r_[q_face, o_face[near]]
-    key = np.r_[q_key, o_key[near]]
-    order = np.argsort(key, kind="stable")
-    key, face = key[order], face[order]
-    total = len(key)
-    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-    size = np.diff(np.r_[starts, total])
-    pos = np.arange(total)
-    later = np.repeat(starts + size, size) - pos - 1      # partners after each entry in its cell
-    n_pairs = int(later.sum())
-    if n_pairs > max_pairs:
-        return None
-    first = np.repeat(pos, later)
-    offset = np.arange(n_pairs) - np.repeat(np.cumsum(later) - later, later)
-    a, b = face[first], face[first + 1 + offset]
-    cell = key[first]
-    del first, offset
-    keep = (query[a] | query[b]) & (a != b)
-    keep &= np.all((lo[a] <= hi[b]) & (lo[b] <= hi[a]), axis=1)
-    a, b, cell = a[keep], b[keep], cell[keep]
-    corner = np.floor((np.maximum(lo[a], lo[b]) - origin) / h).astype(np.int64)
-    home = (corner[:, 0] * dims[1] + corner[:, 1]) * dims[2] + corner[:, 2]
-    once = home == cell
-    return a[once], b[once]
+    size = float(np.max(hi.max(axis=0) - origin))
+    d = hi - lo
+    extent = np.maximum(np.maximum(d[:, 0], d[:, 1]), d[:, 2])
+    h0 = max(float(np.median(extent)), size / 4096, pad)
+    level = np.ceil(np.log2(np.maximum(extent, h0) / h0)).astype(np.int64)
+    keep = np.zeros(len(lo), dtype=bool)
+    keep[np.flatnonzero(query)] = True
+    keep[_near_query(lo, hi, query, origin, size)] = True
+    out_a, out_b, total = [], [], 0
+    for top in np.unique(level[keep]):
+        h = h0 * 2.0 ** top
+        dims = np.full(3, int(np.floor(size / h)) + 2, dtype=np.int64)
+        members = np.flatnonzero(keep & (level == top))
+        fb, kb = _cells(members, lo, hi, origin, h, dims)
+        order = np.argsort(kb, kind="stable")
+        fb, kb = fb[order], kb[order]
+        # the same level: pairs within each cell
+        starts = np.flatnonzero(np.r_[True, kb[1:] != kb[:-1]]) if len(kb) else np.zeros(0, dtype=np.int64)
+        size_of = np.diff(np.r_[starts, len(kb)])
+        later = np.repeat(starts + size_of, size_of) - np.arange(len(kb)) - 1
+        n_same = int(later.sum())
+        # smaller levels through this level's grid (only their query faces when this level has none)
+        smaller = keep & (level < top)
+        if not query[members].any():
+            smaller &= query
+        fa, ka = _cells(np.flatnonzero(smaller), lo, hi, origin, h, dims)
+        left = np.searchsorted(kb, ka, side="left")
+        run = np.searchsorted(kb, ka, side="right") - left
+        n_cross = int(run.sum())
+        total += n_same + n_cross
+        if total > max_pairs:
+            return None
+        first = np.repeat(np.arange(len(kb)), later)
+        offset = np.arange(n_same) - np.repeat(np.cumsum(later) - later, later)
+        partner = np.repeat(left, run) + (np.arange(n_cross) - np.repeat(np.cumsum(run) - run, run))
+        a = np.r_[fb[first], np.repeat(fa, run)]
+        b = np.r_[fb[first + 1 + offset], fb[partner]]
+        cell = np.r_[kb[first], kb[partner]]
+        ok = (query[a] | query[b]) & (a != b)
+        ok &= np.all(lo[a] <= hi[b], axis=1) & np.all(lo[b] <= hi[a], axis=1)
+        a, b, cell = a[ok], b[ok], cell[ok]
+        once = _home(a, b, lo, origin, h, dims) == cell
+        out_a.append(a[once])
+        out_b.append(b[once])
+    if not out_a:
+        e = np.zeros(0, dtype=np.int64)
+        return e, e
+    return np.concatenate(out_a), np.concatenate(out_b)
 
 
 def crossing_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, query: np.ndarray, *,
@@ -299,8 +320,8 @@ def _manifold(m3, vertices, faces):
 
 
 def union_surface(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n_groups: int,
-                  outward: np.ndarray) -> UnionSurface:
-    """Union of the outward pieces minus the union of the inward ones (cavities).
+                  outward: np.ndarray, body: np.ndarray | None = None) -> UnionSurface:
+    """The solid of overlapping pieces: per body, its outward pieces united minus its inward ones; all united.
 
     Parameters
     ----------
@@ -310,7 +331,10 @@ def union_surface(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
         Closed piece of each face (see :func:`closed_groups`).
     n_groups : int
     outward : (n_groups,) bool
-        Whether each piece is wound outward (a body); inward pieces are cavities.
+        Whether each piece is wound outward (material); inward pieces are cavities.
+    body : (n_groups,) int, optional
+        The body each piece belongs to (a cavity belongs to the body around it); cavities are subtracted
+        from their own body only, so a part sitting inside another part's void stays.  Default: one body.
 
     Returns
     -------
@@ -326,25 +350,27 @@ def union_surface(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
         raise UnionError("the union of overlapping bodies needs the manifold3d package") from exc
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
+    body = np.zeros(n_groups, dtype=np.int64) if body is None else np.asarray(body)
     centre = 0.5 * (v.min(axis=0) + v.max(axis=0))   # the boolean works near the origin
     local = v - centre
     order = np.argsort(groups, kind="stable")
     starts = np.searchsorted(groups[order], np.arange(n_groups + 1))
-    bodies, cavities = [], []
-    for g in range(n_groups):
-        piece = f[order[starts[g]:starts[g + 1]]]
-        if not len(piece):
+    solids = []
+    for b in np.unique(body):
+        material, voids = [], []
+        for g in np.flatnonzero(body == b):
+            piece = f[order[starts[g]:starts[g + 1]]]
+            if len(piece):
+                (material if outward[g] else voids).append(_manifold(m3, local, piece if outward[g] else piece[:, ::-1]))
+        if not material:
             continue
-        if outward[g]:
-            bodies.append(_manifold(m3, local, piece))
-        else:
-            cavities.append(_manifold(m3, local, piece[:, ::-1]))
-    if not bodies:
+        solid = m3.Manifold.batch_boolean(material, m3.OpType.Add) if len(material) > 1 else material[0]
+        if voids:
+            solid = solid - (m3.Manifold.batch_boolean(voids, m3.OpType.Add) if len(voids) > 1 else voids[0])
+        solids.append(solid)
+    if not solids:
         raise UnionError("no outward-wound piece to unite")
-    solid = m3.Manifold.batch_boolean(bodies, m3.OpType.Add) if len(bodies) > 1 else bodies[0]
-    if cavities:
-        hole = m3.Manifold.batch_boolean(cavities, m3.OpType.Add) if len(cavities) > 1 else cavities[0]
-        solid = solid - hole
+    solid = m3.Manifold.batch_boolean(solids, m3.OpType.Add) if len(solids) > 1 else solids[0]
     out = solid.to_mesh64()
     verts = np.asarray(out.vert_properties, dtype=np.float64)[:, :3] + centre
     tris = np.asarray(out.tri_verts, dtype=np.int64).reshape(-1, 3)
