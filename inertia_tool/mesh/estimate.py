@@ -23,14 +23,14 @@ largest distance from the centre of mass to a point of the doubtful region and `
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from ..values import frozen_value
 
 __all__ = ["Uncertainty", "Estimate", "boundary_edges", "patched_estimate", "winding_estimate", "uncertainty_from"]
 
 
-@dataclass(frozen=True)
+@frozen_value
 class Uncertainty:
     """Bounds on mass properties that are estimated rather than exact.
 
@@ -52,7 +52,7 @@ class Uncertainty:
     volume_in_doubt: float
 
 
-@dataclass(frozen=True)
+@frozen_value
 class Estimate:
     """Unit-density moments of an estimated solid with their bounds.
 

@@ -11,14 +11,14 @@ returned so the caller can state it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from ..values import frozen_value
 
 __all__ = ["Merge", "merge_close_vertices"]
 
 
-@dataclass(frozen=True)
+@frozen_value
 class Merge:
     """Result of :func:`merge_close_vertices`.
 

@@ -17,9 +17,9 @@ Probes left undecided after ``tries`` attempts are reported, never guessed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from ..values import frozen_value
 
 __all__ = ["Nesting", "shell_nesting", "ray_winding"]
 
@@ -136,7 +136,7 @@ def ray_winding(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, gro
     return unique[keep] // n_groups, unique[keep] % n_groups, winding[keep], degenerate
 
 
-@dataclass(frozen=True)
+@frozen_value
 class Nesting:
     """Winding numbers of the shells at one point of each shell.
 

@@ -15,9 +15,9 @@ pass over a doubled face graph (no Python loop over faces).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from ..values import frozen_value
 
 __all__ = ["EdgeBalance", "edge_balance", "Orientation", "orient_consistently"]
 
@@ -34,7 +34,7 @@ def _directed_keys(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.n
     return np.minimum(a, b) * n + np.maximum(a, b), a > b
 
 
-@dataclass(frozen=True)
+@frozen_value
 class EdgeBalance:
     """Directed-edge census: is the surface a cycle (every directed edge matched by a reverse one)?
 
@@ -89,7 +89,7 @@ def edge_balance(faces: np.ndarray, n_vertices: int) -> EdgeBalance:
                        unbalanced_edges=int(np.count_nonzero(net)))
 
 
-@dataclass(frozen=True)
+@frozen_value
 class Orientation:
     """Result of :func:`orient_consistently`.
 

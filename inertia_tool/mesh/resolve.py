@@ -20,10 +20,9 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from ..values import frozen_value
 from ..errors import InvalidMeshError
 from ..tolerances import FLAT_RTOL
 from .estimate import Estimate, patched_estimate, winding_estimate
@@ -36,7 +35,7 @@ __all__ = ["Resolution", "resolve_surface", "PATCH_PREFERRED_RTOL"]
 PATCH_PREFERRED_RTOL = 1e-3
 
 
-@dataclass(frozen=True)
+@frozen_value
 class Resolution:
     """How a surface that is not a clean 2-manifold was read as a solid.
 

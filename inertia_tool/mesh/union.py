@@ -22,9 +22,9 @@ manifold output for manifold inputs, with symbolic perturbation for coplanar and
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from ..values import frozen_value
 
 __all__ = ["crossing_shells", "closed_groups", "union_surface", "UnionSurface", "UnionError"]
 
@@ -289,7 +289,7 @@ def closed_groups(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     return labels.reshape(-1).astype(np.intp), int(labels.max()) + 1 if m else 0
 
 
-@dataclass(frozen=True)
+@frozen_value
 class UnionSurface:
     """The boundary of the union, as produced by manifold3d.
 
