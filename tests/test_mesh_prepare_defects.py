@@ -107,7 +107,7 @@ def test_open_box_refused_in_one_line_then_bounded_with_repair():
     v, f = box_arrays((1.0, 2.0, 3.0))
     normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     gone = (normals[:, 0] > 0) | (normals[:, 1] > 0)           # two adjacent sides missing
-    with pytest.raises(InvalidMeshError, match="repair=True gives a bounded estimate") as e:
+    with pytest.raises(InvalidMeshError, match="`repair=True` gives a bounded estimate") as e:
         mass_properties((v, f[~gone]))
     assert "\n" not in str(e.value)
     with pytest.warns(MeshRepairedWarning):

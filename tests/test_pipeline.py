@@ -83,7 +83,7 @@ def test_ball_inside_a_hollow_is_not_an_overlap():
 
 def test_open_mesh_is_refused_with_counts_and_location():
     v, f = box_arrays()
-    with pytest.raises(InvalidMeshError, match=r"3 boundary edges .* e\.g\. the edge .*repair=True gives a "
+    with pytest.raises(InvalidMeshError, match=r"3 boundary edges .* e\.g\. the edge .*`repair=True` gives a "
                                                r"bounded estimate") as e:
         mass_properties((v, f[1:]))
     assert e.value.details["boundary_edges"] == 3

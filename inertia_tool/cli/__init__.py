@@ -119,18 +119,6 @@ def _format_warning(w: warnings.WarningMessage) -> str:
     return f"warning: {w.message}"
 
 
-#: Engine messages name API parameters; the command line says the options that set them.
-_PARAMETER_TO_OPTION = (("repair=True", "--repair"), ("overlap='sum'", "--overlap sum"),
-                        ("overlap='union'", "--overlap union"))
-
-
-def _cli_words(message: str) -> str:
-    """An engine message with its parameter names replaced by the command-line options."""
-    for parameter, option in _PARAMETER_TO_OPTION:
-        message = message.replace(parameter, option)
-    return message
-
-
 def main(argv=None) -> int:
     """Entry point of the ``inertia-tool`` console script; returns the exit code."""
     parser = build_parser()
@@ -151,7 +139,7 @@ def main(argv=None) -> int:
             if debug:
                 raise
             owner = args._subparsers.get(getattr(args, "command", None))
-            error_line = f"inertia-tool: error: {speak_options(_cli_words(str(exc)), owner)}"
+            error_line = f"inertia-tool: error: {speak_options(str(exc), owner)}"
             code = exit_code(exc)
         except KeyboardInterrupt:
             print("inertia-tool: interrupted", file=sys.stderr)
@@ -174,7 +162,7 @@ def main(argv=None) -> int:
     for w in caught:
         if issubclass(w.category, InertiaToolWarning):
             owner = args._subparsers.get(getattr(args, "command", None))
-            print(f"inertia-tool: {speak_options(_cli_words(_format_warning(w)), owner)}", file=sys.stderr)
+            print(f"inertia-tool: {speak_options(_format_warning(w), owner)}", file=sys.stderr)
     return int(code or 0)
 
 

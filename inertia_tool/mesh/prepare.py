@@ -230,7 +230,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if flat:
         what = "the mesh encloses" if n_shells == 1 else f"{len(flat)} of {n_shells} shells enclose"
         raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
-                               "thin-walled part use the shell model with a wall thickness")
+                               "thin-walled part use the shell model with a wall `thickness`")
     flip, owner, cavities, overlaps = classify_shells(v, f, labels, n_shells, shells, diag, source=source,
                                                       check_crossing=not found.nonmanifold_edges)
     if flip.any():
@@ -256,7 +256,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         elif overlap == "sum":
             method = "sum"
             notes.append(f"overlapping bodies: their integrals are added, so {summed - united.volume:.6g} m³ of "
-                         "shared volume is counted twice (overlap='sum')")
+                         "shared volume is counted twice (`overlap` 'sum')")
             warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
         else:
             notes.append(f"overlapping bodies united by a boolean: {summed - united.volume:.6g} m³ shared volume "
@@ -297,8 +297,8 @@ def _unite(vertices, faces, labels, owner, source, repair):
     except UnionError as exc:
         if repair:
             return None
-        raise InvalidMeshError(f"{source}: overlapping bodies whose union cannot be formed ({exc}); overlap='sum' "
-                               "adds them (shared volume counted twice), repair=True gives a bounded estimate") from None
+        raise InvalidMeshError(f"{source}: overlapping bodies whose union cannot be formed ({exc}); `overlap` 'sum' "
+                               "adds them (shared volume counted twice), `repair=True` gives a bounded estimate") from None
 
 
 def _estimated(found: Resolution, common: dict) -> PreparedMesh:

@@ -181,7 +181,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                     return Resolution(v, again.faces, "welded", notes + _touching_note(census), again.flipped_faces,
                                       tol, census.nonmanifold_edges)
     if not repair:
-        raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}; repair=True gives a "
+        raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}; `repair=True` gives a "
                                "bounded estimate",
                                details={"boundary_edges": census.boundary_edges,
                                         "unbalanced_edges": census.unbalanced_edges,
@@ -207,7 +207,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
             best = grid
     if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
-                               "thin-walled part use the shell model with a wall thickness")
+                               "thin-walled part use the shell model with a wall `thickness`")
     notes.append(best.detail)
     return Resolution(best.vertices, best.faces, best.method, tuple(notes), flipped, welded,
                       edge_balance(best.faces, len(best.vertices)).nonmanifold_edges if best.method == "patched"
