@@ -205,13 +205,13 @@ def _cube_moments(centres: np.ndarray, h: float):
     return vol, c, second
 
 
-def _surface_cells(vertices, faces, lo, h, dims, spacing=0.25):
+def _surface_cells(vertices, faces, lo, h, dims, spacing=0.5):
     """(cells,) bool: every cell the surface passes through (and a thin margin around it).
 
     Each triangle is sampled on a barycentric grid whose sub-triangles have edges of at most
     ``δ = spacing · h``, so every point of the surface lies within ``δ`` of a sample; a cell the surface
     crosses therefore meets the cube of half-side ``δ`` around some sample, and the cells those cubes touch
-    are marked (a cube smaller than a cell touches exactly the cells holding its 8 corners).
+    are marked (a cube no larger than a cell touches exactly the cells holding its 8 corners).
     """
     v = vertices
     a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
