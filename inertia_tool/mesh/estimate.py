@@ -170,14 +170,18 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments) -> Estima
     f = np.asarray(faces, dtype=np.int64)
     edges = boundary_edges(f, len(v))
     label, n_loops = _loops(edges, len(v)) if len(edges) else (np.zeros(0, dtype=np.int64), 0)
+    # the distinct vertices of each loop, grouped: (loop, vertex) pairs sorted by loop
+    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0) if n_loops \
+        else np.zeros((0, 2), dtype=np.int64)
+    loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
+    size = np.bincount(loop_of, minlength=n_loops)
     apex = np.zeros((n_loops, 3))
+    for i in range(3):
+        apex[:, i] = np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) / np.maximum(size, 1)
+    starts = np.r_[0, np.cumsum(size)[:-1]] if n_loops else np.zeros(0, dtype=np.int64)
     doubt = 0.0
-    hull_points = []
-    for k in range(n_loops):
-        ids = np.unique(edges[label == k])
-        apex[k] = v[ids].mean(axis=0)
-        doubt += _hull_volume(v[ids])
-        hull_points.append(v[ids])
+    for k in np.flatnonzero(size >= 4):        # 3 or fewer points span no volume
+        doubt += _hull_volume(v[vertex_of[starts[k]:starts[k] + size[k]]])
     cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
     pv = np.vstack([v, apex])
     pf = np.vstack([f, cap])
@@ -187,7 +191,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments) -> Estima
         pf = pf[:, ::-1]
         closed = moments(pv, pf)
     area = moments(v, f).area
-    far = max((float(np.max(np.linalg.norm(p - closed.centroid, axis=1))) for p in hull_points), default=0.0)
+    far = float(np.max(np.linalg.norm(v[vertex_of] - closed.centroid, axis=1))) if len(vertex_of) else 0.0
     unc = uncertainty_from(closed.volume, closed.centroid, closed.second_moment, doubt, far)
     detail = (f"{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) closed by cones to "
               "their centroids; bounded by the loops' convex hulls")
