@@ -73,6 +73,8 @@ class Estimate:
         One line on what was done (loops patched, grid size).
     vertices, faces : arrays
         The closed surface integrated (the patched mesh), or the input for the winding estimate.
+    far : float
+        Largest distance from ``centroid`` to the region in doubt, m (enters the bounds).
     """
 
     volume: float
@@ -84,6 +86,7 @@ class Estimate:
     detail: str
     vertices: np.ndarray
     faces: np.ndarray
+    far: float = 0.0
 
 
 def uncertainty_from(volume: float, centroid: np.ndarray, second_moment: np.ndarray, doubt: float,
@@ -196,7 +199,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments) -> Estima
     detail = (f"{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) closed by cones to "
               "their centroids; bounded by the loops' convex hulls")
     return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,
-                    uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf)
+                    uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far)
 
 
 def _cube_moments(centres: np.ndarray, h: float):
@@ -293,4 +296,4 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
     detail = (f"winding number > 1/2 on a {dims[0]}×{dims[1]}×{dims[2]} grid of {h:.3g} m cells ({how}); "
               f"{int(np.count_nonzero(doubtful)):,} cells undecided")
     return Estimate(volume=vol, centroid=c, second_moment=second, area=area, uncertainty=unc, method="winding",
-                    detail=detail, vertices=v, faces=f)
+                    detail=detail, vertices=v, faces=f, far=far)

@@ -23,6 +23,7 @@ from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .nesting import shell_nesting
+from .estimate import uncertainty_from
 from .resolve import Resolution, resolve_surface
 from .union import UnionError, closed_groups, crossing_shells, union_surface
 
@@ -220,8 +221,11 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     common = dict(source=source, units=raw.units, file_faces=raw.file_faces, degenerate_faces=n_repeated,
                   watertight=watertight, welded_tolerance=found.welded_tolerance, flipped_faces=found.flipped_faces,
                   nonmanifold_edges=found.nonmanifold_edges)
-    if found.estimate is not None:
+    patched = found.estimate if found.estimate is not None and found.estimate.method == "patched" else None
+    if found.estimate is not None and patched is None:
         return _estimated(found, common)
+    # a patched surface is closed: its shells are classified and overlaps united like any other, and the
+    # bounds of the patches carry over to the result
     labels, n_shells = shell_labels(f, len(v))
     if n_shells == 0:
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
@@ -269,12 +273,27 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             flip, owner, cavities, _ = classify_shells(v, f, labels, n_shells, shells, diag, source=source)
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
     bbox_min, bbox_max = bounding_box(v)
+    uncertainty = None
+    if patched is not None:
+        total = _total(shells)
+        uncertainty = uncertainty_from(total.volume, total.centroid, total.second_moment,
+                                       patched.uncertainty.volume_in_doubt, patched.far)
+        method = "patched"
     report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
                         bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),
-                        overlapping_shells=overlaps, repaired=False, repair_actions=(),
+                        overlapping_shells=overlaps, repaired=patched is not None,
+                        repair_actions=tuple(notes) if patched is not None else (),
                         repair_volume_change=None, bbox_min=bbox_min, bbox_max=bbox_max, method=method,
-                        notes=tuple(notes), **common)
+                        uncertainty=uncertainty, notes=tuple(notes), **common)
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
+
+
+def _total(shells) -> VolumeMoments:
+    """The moments of all shells together (cavities negative): volume, centroid, central second moment."""
+    volume = sum(s.volume for s in shells)
+    centroid = sum(s.volume * s.centroid for s in shells) / volume
+    second = sum(s.second_moment + s.volume * np.outer(s.centroid - centroid, s.centroid - centroid) for s in shells)
+    return VolumeMoments(volume=volume, centroid=centroid, second_moment=second, area=sum(s.area for s in shells))
 
 
 def _unite(vertices, faces, labels, owner, source, repair):
