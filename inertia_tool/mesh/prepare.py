@@ -217,7 +217,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         v, f = found.vertices, found.faces
         if found.method != "exact" or found.notes:
             warning = MeshRepairedWarning if found.estimate is not None else MeshResolvedWarning
-            warnings.warn(warning(f"{source}: {found.method}: {'; '.join(found.notes)}"), stacklevel=3)
+            what = f"repaired ({found.method}, an estimate)" if found.estimate is not None else found.method
+            warnings.warn(warning(f"{source}: {what}: {'; '.join(found.notes)}"), stacklevel=3)
     common = dict(source=source, units=raw.units, file_faces=raw.file_faces, degenerate_faces=n_repeated,
                   watertight=watertight, welded_tolerance=found.welded_tolerance, flipped_faces=found.flipped_faces,
                   nonmanifold_edges=found.nonmanifold_edges)
