@@ -40,6 +40,7 @@ __all__ = [
     "InertiaToolWarning",
     "MeshRepairedWarning",
     "InsideOutWarning",
+    "MeshResolvedWarning",
     "DegenerateFacesWarning",
     "NearlyEqualMomentsWarning",
     "PhysicalValidityWarning",
@@ -130,6 +131,12 @@ class InertiaToolWarning(UserWarning):
 
 class MeshRepairedWarning(InertiaToolWarning):
     """The mesh was changed (holes closed, winding fixed) before integration, at the user's request."""
+
+
+class MeshResolvedWarning(InertiaToolWarning):
+    """The mesh is not a clean 2-manifold but defines a solid exactly: bodies touching along an edge or at a
+    vertex, faces wound the wrong way (turned), vertex copies a rounding apart (welded).  The mass properties
+    are exact; the mesh report's ``method`` and ``notes`` say what was found."""
 
 
 class InsideOutWarning(InertiaToolWarning):

@@ -5,7 +5,7 @@ import trimesh
 from conftest import box_arrays, write_binary_stl
 from inertia_tool import assembly, mass_properties
 from inertia_tool.errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
-                                 OverlapWarning, UsageError)
+                                 MeshResolvedWarning, OverlapWarning, UsageError)
 from conftest import assert_tensor_close
 
 
@@ -59,10 +59,14 @@ def test_one_inside_out_body_among_two():
     assert p.volume == pytest.approx(12.0) and p.mesh.bodies == 2
 
 
-def test_overlapping_bodies_warn():
-    with pytest.warns(OverlapWarning):
+def test_overlapping_bodies_warn_and_are_united():
+    with pytest.warns(OverlapWarning, match="united"):
         p = mass_properties(_concat(box_arrays((2.0, 2.0, 2.0)), box_arrays((1.0, 1.0, 1.0))))
-    assert p.mesh.overlapping_shells == 1
+    assert p.mesh.overlapping_shells == 1 and p.mesh.method == "union"
+    assert p.volume == pytest.approx(8.0, rel=1e-14)            # the inner box adds nothing to the union
+    with pytest.warns(OverlapWarning, match="counted twice"):
+        p = mass_properties(_concat(box_arrays((2.0, 2.0, 2.0)), box_arrays((1.0, 1.0, 1.0))), overlap="sum")
+    assert p.mesh.method == "sum" and p.volume == pytest.approx(9.0, rel=1e-14)
 
 
 def test_ball_inside_a_hollow_is_not_an_overlap():
@@ -79,7 +83,8 @@ def test_ball_inside_a_hollow_is_not_an_overlap():
 
 def test_open_mesh_is_refused_with_counts_and_location():
     v, f = box_arrays()
-    with pytest.raises(InvalidMeshError, match=r"3 boundary edges .* e\.g\. the edge") as e:
+    with pytest.raises(InvalidMeshError, match=r"3 boundary edges .* e\.g\. the edge .*`repair=True` gives a "
+                                               r"bounded estimate") as e:
         mass_properties((v, f[1:]))
     assert e.value.details["boundary_edges"] == 3
 
@@ -92,15 +97,14 @@ def test_open_mesh_repaired_on_request():
     assert p.mesh.repaired and p.mesh.repair_actions
 
 
-def test_flipped_face_refused_then_repaired():
+def test_flipped_face_is_turned_and_exact_without_repair():
     v, f = box_arrays()
     f = f.copy()
     f[3] = f[3, ::-1]
-    with pytest.raises(InvalidMeshError, match="inconsistent winding"):
-        mass_properties((v, f))
-    with pytest.warns(MeshRepairedWarning, match="winding"):
-        p = mass_properties((v, f), repair=True)
+    with pytest.warns(MeshResolvedWarning, match="1 faces were wound the wrong way"):
+        p = mass_properties((v, f))
     assert p.volume == pytest.approx(6.0, rel=1e-14)
+    assert p.mesh.method == "oriented" and p.mesh.flipped_faces == 1 and p.mesh.uncertainty is None
 
 
 def test_degenerate_faces_ignored_and_counted():

@@ -67,10 +67,14 @@ def add_material_options(parser) -> None:
 
 
 def add_mesh_options(parser) -> None:
-    """``--repair``, ``--merge-tolerance``, ``--max-faces``."""
+    """``--repair``, ``--overlap``, ``--merge-tolerance``, ``--max-faces``."""
     g = parser.add_argument_group("mesh checks")
     g.add_argument("--repair", action="store_true",
-                   help="close holes and fix inconsistent winding instead of refusing the mesh")
+                   help="give a bounded estimate (method and uncertainty in the report) for a mesh with holes, "
+                        "cracks or stray pieces instead of refusing it")
+    g.add_argument("--overlap", choices=("union", "sum"), default="union",
+                   help="overlapping bodies: integrate their union (default) or add them, counting shared "
+                        "material twice")
     g.add_argument("--merge-tolerance", type=float, default=MERGE_TOLERANCE, metavar="REL",
                    help="relative tolerance (of the bounding-box diagonal) for welding nearly coincident "
                         f"vertices when exact welding leaves the surface open (default {MERGE_TOLERANCE:g}; 0 off)")
@@ -98,6 +102,7 @@ def load_options_from_args(args) -> LoadOptions:
     """The one :class:`LoadOptions` of a command, from ``--units`` and the mesh-check options."""
     check_mesh_options(args)
     return LoadOptions(units=args.units, repair=bool(getattr(args, "repair", False)),
+                       overlap=getattr(args, "overlap", "union"),
                        merge_tolerance=getattr(args, "merge_tolerance", MERGE_TOLERANCE),
                        max_faces=getattr(args, "max_faces", DEFAULT_MAX_FACES))
 

@@ -169,7 +169,8 @@ def _part(source: MeshSource, rho: float | None, mass: float | None, options: Lo
           warn_principal: bool = True) -> tuple[MassProperties, PreparedMesh]:
     """Mass properties of one mesh and its checked mesh (for cross-part checks of an assembly)."""
     raw = load_mesh(source, units=options.units, max_faces=options.max_faces)
-    prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance)
+    prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance,
+                            overlap=options.overlap)
     label = name or raw.source
     bodies = _bodies(prepared, rho if rho is not None else 1.0, label)
     total = bodies[0] if len(bodies) == 1 else combine(bodies, name=label)

@@ -200,7 +200,7 @@ def printed_part(source: MeshSource, *, skin: float, infill: float, density: flo
     opts = LoadOptions.build(options, **load_options)
     rho, _ = resolve_density(density=density, material=material, mass=mass)
     raw = load_mesh(source, units=opts.units, max_faces=opts.max_faces)
-    prepared = prepare_mesh(raw, repair=opts.repair, merge_tolerance=opts.merge_tolerance)
+    prepared = prepare_mesh(raw, repair=opts.repair, merge_tolerance=opts.merge_tolerance, overlap=opts.overlap)
     v, f = prepared.vertices, prepared.faces
     solid = volume_moments(v, f)
     sm = surface_moments(v, f, origin=solid.centroid)

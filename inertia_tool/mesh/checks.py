@@ -15,6 +15,7 @@ import numpy as np
 
 from ..values import frozen_value
 from .._native import accel, faces_for_c
+from .estimate import Uncertainty
 
 __all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "winding_number"]
 
@@ -94,6 +95,22 @@ class MeshReport:
         Relative change of the signed volume (about the bounding-box centre) caused by the repair.
     bbox_min, bbox_max : (3,) float
         Bounding box, m, mesh axes.
+    method : str
+        How the solid was obtained from the surface: ``"exact"`` (the surface integral as it stands),
+        ``"oriented"`` (faces wound the wrong way turned, then exact), ``"welded"`` (vertices closer than
+        ``welded_tolerance`` merged, then exact), ``"deduplicated"`` (repeated faces dropped, then exact),
+        ``"union"`` (overlapping bodies united by a boolean, then exact), ``"sum"`` (overlapping bodies'
+        integrals added: shared volume counted twice, on request), ``"patched"`` / ``"winding"`` (estimates
+        of ``repair=True``, see ``uncertainty``).
+    uncertainty : Uncertainty or None
+        Bounds when ``method`` is an estimate (``mass`` relative, ``center_of_mass`` m, ``inertia`` relative
+        Frobenius); None when the result is exact for the polyhedron.
+    notes : tuple of str
+        What was found and done, one sentence each (non-manifold edges, flipped faces, welds, overlaps).
+    flipped_faces : int
+        Faces turned to agree with their neighbours.
+    nonmanifold_edges : int
+        Edges shared by more than two faces in the integrated surface (bodies or walls touching).
     """
 
     source: str
@@ -114,6 +131,16 @@ class MeshReport:
     repair_volume_change: float | None
     bbox_min: np.ndarray
     bbox_max: np.ndarray
+    method: str = "exact"
+    uncertainty: Uncertainty | None = None
+    notes: tuple = ()
+    flipped_faces: int = 0
+    nonmanifold_edges: int = 0
+
+    @property
+    def exact(self) -> bool:
+        """The mass properties are exact for the polyhedron integrated (no estimate)."""
+        return self.uncertainty is None
 
 
 def repeated_corner_faces(faces: np.ndarray) -> np.ndarray:

@@ -40,8 +40,13 @@ class LoadOptions:
         Length unit of the mesh coordinates: ``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft`` (converted to
         metres on reading; everything after is SI).
     repair : bool
-        Give an estimate for a mesh that does not bound a solid (holes, inconsistent winding) instead of
-        refusing it; the mesh report says what was done.
+        Give a bounded estimate for a mesh that does not bound a solid (holes, cracks, stray pieces) instead
+        of refusing it; the mesh report's ``method`` and ``uncertainty`` say what was done and how far off
+        the answer can be.  Meshes that define a solid exactly (touching bodies, flipped faces, vertex
+        copies a rounding apart) are exact without it.
+    overlap : str
+        Overlapping bodies: ``"union"`` integrates their union, the physical solid (default); ``"sum"`` adds
+        their integrals, counting shared material twice on purpose (said in the report).
     merge_tolerance : float
         Spacing of the tolerance weld, relative to the bounding-box diagonal, used when the bit-exact weld
         leaves the surface open; 0 disables it (default :data:`inertia_tool.tolerances.MERGE_TOLERANCE`).
@@ -51,6 +56,7 @@ class LoadOptions:
 
     units: str = "m"
     repair: bool = False
+    overlap: str = "union"
     merge_tolerance: float = MERGE_TOLERANCE
     max_faces: int = DEFAULT_MAX_FACES
 
@@ -58,6 +64,8 @@ class LoadOptions:
         length_scale(self.units)                      # raises UnitsError for an unknown unit
         if not isinstance(self.repair, (bool, np.bool_)):
             raise UsageError(f"Expected `repair` to be True or False, got {self.repair!r}")
+        if self.overlap not in ("union", "sum"):
+            raise UsageError(f"Expected `overlap` to be 'union' or 'sum', got {self.overlap!r}")
         tol = self.merge_tolerance
         if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)) \
                 or not (np.isfinite(tol) and 0 <= tol < 0.1):

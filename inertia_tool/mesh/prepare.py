@@ -13,15 +13,21 @@ from __future__ import annotations
 import warnings
 
 
+from typing import Any
+
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning, OverlapWarning
-from ..mass.volume import VolumeMoments, body_volume_moments, bounding_box, reference_point
+from ..errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
+                      MeshResolvedWarning, OverlapWarning, UsageError)
+from ..mass.volume import VolumeMoments, body_volume_moments, bounding_box, volume_moments
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
-from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels, winding_number
+from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
-from .weld import weld_tolerance
+from .nesting import shell_nesting
+from .estimate import uncertainty_from
+from .resolve import Resolution, resolve_surface
+from .union import UnionError, closed_groups, crossing_shells, union_surface
 
 __all__ = ["PreparedMesh", "prepare_mesh", "classify_shells", "MAX_COORDINATE", "MIN_EXTENT"]
 
@@ -34,8 +40,14 @@ MAX_COORDINATE = 1e30
 MIN_EXTENT = 1e-30
 
 
-#: Upper bound on triangle-point solid-angle evaluations spent on cavity / overlap classification.
-_WINDING_BUDGET = 200_000_000
+#: Ways to count overlapping bodies: their union (the physical solid) or the sum of their integrals.
+OVERLAP_MODES = ("union", "sum")
+
+#: Work bound of the surface-crossing test: candidate face pairs per face (beyond it the boolean decides).
+CROSSING_PAIRS_PER_FACE = 16
+
+#: Overlap confirmed when the union's volume falls short of the summed volume by more than this (relative).
+UNION_VOLUME_RTOL = 1e-9
 
 
 @frozen_value
@@ -65,52 +77,30 @@ class PreparedMesh:
     report: MeshReport
 
 
-def _describe_edges(topo, source: str) -> str:
-    parts = []
-    if topo.boundary_edges:
-        parts.append(f"{topo.boundary_edges:,} boundary edges (holes)")
-    if topo.nonmanifold_edges:
-        parts.append(f"{topo.nonmanifold_edges:,} non-manifold edges (shared by 3+ faces)")
-    if topo.misoriented_edges:
-        parts.append(f"{topo.misoriented_edges:,} edges with inconsistent winding (flipped faces)")
-    where = ""
-    if len(topo.sample):
-        a, b = topo.sample[0]
-        where = f", e.g. the edge ({a[0]:.6g}, {a[1]:.6g}, {a[2]:.6g})–({b[0]:.6g}, {b[1]:.6g}, {b[2]:.6g}) m"
-    return (f"{source}: not a closed, consistently wound solid: {'; '.join(parts)}{where}; "
-            "`repair=True` gives a bounded estimate")
+def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: str = "mesh",
+                    check_crossing: bool = True, pairs_per_face: int = CROSSING_PAIRS_PER_FACE):
+    """Flip inside-out shells, attach cavities to their bodies, find overlapping bodies.
 
+    Every shell is classified, always: the winding number of every other shell at a point of each shell
+    comes from exact ray crossings against a sorted index of the faces (:func:`~.nesting.shell_nesting`),
+    about one pass over the faces however many shells there are.  A shell all of whose probe points lie on
+    other shells' surfaces counts as an overlap candidate (the boolean union then decides).  Bodies whose surfaces
+    touch or cross
+    another shell's surface are found by triangle–triangle tests (:func:`~.union.crossing_shells`) on the
+    faces of all but the largest shell, within a work bound of ``pairs_per_face`` candidate pairs per face;
+    beyond it (CAD fans of long triangles) every shell whose box meets another's is a candidate and the
+    boolean union decides (``check_crossing=False`` goes there directly).
 
-def _repair(vertices, faces, source):
-    """Close holes and fix winding with trimesh; returns new arrays and the list of actions."""
-    import trimesh
-
-    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
-    actions = []
-    before_faces = len(mesh.faces)
-    if not mesh.is_winding_consistent:
-        trimesh.repair.fix_winding(mesh)
-        actions.append("made the winding consistent")
-    if not mesh.is_watertight:
-        trimesh.repair.fill_holes(mesh)
-        if len(mesh.faces) != before_faces:
-            actions.append(f"filled holes with {len(mesh.faces) - before_faces} new triangles")
-    if not (mesh.is_watertight and mesh.is_winding_consistent):
-        raise InvalidMeshError(f"{source}: could not be repaired into a closed solid "
-                               "(holes too complex or non-manifold edges remain)")
-    return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces), actions
-
-
-def _signed_volume(vertices, faces) -> float:
-    o = reference_point(vertices)
-    a = vertices[faces[:, 0]] - o
-    return float(np.einsum("ij,ij->i", a, np.cross(vertices[faces[:, 1]] - o, vertices[faces[:, 2]] - o)).sum() / 6)
-
-
-def classify_shells(vertices, faces, labels, n_shells, shells, diag):
-    """Flip inside-out shells, attach cavities to their bodies, detect overlaps.
-
-    Returns (shells, owner, flipped, cavities, overlaps, face_flip_mask_per_shell).
+    Returns
+    -------
+    flip : (s,) bool
+        Shells to turn inside out.
+    owner : (s,) int
+        Body each shell belongs to.
+    cavities : int
+    overlaps : int
+        Shells inside another body's material or whose surface meets another shell's (a candidate overlap,
+        for the boolean union to confirm).
     """
     vols = np.array([s.volume for s in shells])
     flip = np.zeros(n_shells, dtype=bool)
@@ -118,88 +108,45 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag):
     if n_shells == 1:
         flip[0] = vols[0] < 0
         return flip, owner, 0, 0
-    # bounding boxes per shell and one probe point per shell (centroid of its first face)
-    order = np.argsort(labels, kind="stable")
-    starts = np.searchsorted(labels[order], np.arange(n_shells))
-    corner = vertices[faces[order]]
-    lo = np.minimum.reduceat(corner.min(axis=1), starts, axis=0)
-    hi = np.maximum.reduceat(corner.max(axis=1), starts, axis=0)
-    probe = corner[starts].mean(axis=1)
-    face_count = np.diff(np.r_[starts, len(faces)])
     sign = np.sign(vols)
     if vols.sum() < 0:
         # the whole mesh is inside out: flip every shell first
         sign = -sign
         flip[:] = True
-    winding = np.zeros(n_shells)
-    budget = _WINDING_BUDGET
-    for s in range(n_shells):
-        inside_box = np.all((probe[s] >= lo) & (probe[s] <= hi), axis=1)
-        inside_box[s] = False
-        for t in np.flatnonzero(inside_box):
-            budget -= face_count[t]
-            if budget < 0:
-                break
-            orient = -1.0 if flip[t] else 1.0
-            w = orient * winding_number(probe[s], vertices, faces[order[starts[t]:starts[t] + face_count[t]]])
-            winding[s] += w
-            if sign[s] < 0 and w > 0.5 and sign[t] > 0:
-                owner[s] = t
-    cavities = 0
-    overlapped = np.zeros(n_shells, dtype=bool)
-    cavity = np.zeros(n_shells, dtype=bool)
-    for s in range(n_shells):
-        inside_material = winding[s] > 0.5
-        if sign[s] < 0:
-            if inside_material:
-                cavities += 1           # a void inside a body: keep its negative volume
-                cavity[s] = True
-            else:
-                flip[s] = not flip[s]   # an inside-out body on its own: flip it
-                owner[s] = s
-        elif inside_material:
-            overlapped[s] = True
-    if budget > 0:
-        overlapped |= _overlap_probes(vertices, faces, order, starts, face_count, lo, hi, flip, ~cavity,
-                                      diag, budget)
-    return flip, owner, cavities, int(np.count_nonzero(overlapped))
-
-
-def _overlap_probes(vertices, faces, order, starts, face_count, lo, hi, flip, body, diag, budget,
-                    probes_per_shell: int = 16, nudge: float = 1e-6):
-    """Bodies with material of another body just inside their surface (partial overlaps).
-
-    The centroids of each body's ``probes_per_shell`` largest faces, moved ``nudge · diag`` inward, are
-    tested against every other body whose bounding box holds them (winding number > 1/2 means inside).
-    Catches overlaps whose vertices all lie outside the other body (two crossing bars); an overlap that
-    no probe reaches stays undetected.  Spends at most ``budget`` triangle-point evaluations.
-    """
-    n_shells = len(starts)
-    found = np.zeros(n_shells, dtype=bool)
-    for s in np.flatnonzero(body):
-        others = np.flatnonzero(np.all(lo <= hi[s], axis=1) & np.all(hi >= lo[s], axis=1))
-        others = others[others != s]
-        if not np.any(body[others]):
-            continue
-        f = faces[order[starts[s]:starts[s] + face_count[s]]]
-        a, b, c = vertices[f[:, 0]], vertices[f[:, 1]], vertices[f[:, 2]]
-        normal = np.cross(b - a, c - a)
-        length = np.linalg.norm(normal, axis=1)
-        pick = np.argsort(-length, kind="stable")[:probes_per_shell]
-        pick = pick[length[pick] > 0]
-        outward = normal[pick] / length[pick, None] * (-1.0 if flip[s] else 1.0)
-        points = (a[pick] + b[pick] + c[pick]) / 3.0 - nudge * diag * outward
-        material = np.zeros(len(points))   # signed count of the other shells' material at each probe
-        for t in others:
-            faces_t = faces[order[starts[t]:starts[t] + face_count[t]]]
-            orient = -1.0 if flip[t] else 1.0   # cavities stay inward-wound and count negative
-            for k in np.flatnonzero(np.all((points >= lo[t]) & (points <= hi[t]), axis=1)):
-                budget -= face_count[t]
-                if budget < 0:
-                    return found
-                material[k] += orient * winding_number(points[k], vertices, faces_t)
-        found[s] = bool(np.any(material > 0.5))
-    return found
+    nest = shell_nesting(vertices, faces, labels, n_shells)
+    w = nest.winding * np.where(flip[nest.other], -1, 1)
+    winding = np.bincount(nest.shell, weights=w, minlength=n_shells)
+    # a cavity belongs to the smallest body whose material holds it
+    holds = (sign[nest.shell] < 0) & (sign[nest.other] > 0) & (w > 0)
+    if holds.any():
+        order = np.argsort(-np.abs(vols[nest.other[holds]]), kind="stable")   # smallest last: it wins
+        owner[nest.shell[holds][order]] = nest.other[holds][order]
+    inside_material = winding > 0.5
+    cavity = (sign < 0) & inside_material
+    lonely = (sign < 0) & ~inside_material
+    flip[lonely] = ~flip[lonely]                 # an inside-out body on its own: flip it
+    owner[lonely] = np.flatnonzero(lonely)
+    # a shell every probe of which lies on another surface touches it: an overlap candidate for the boolean
+    overlapped = ((sign > 0) & inside_material) | nest.undecided
+    order = np.argsort(labels, kind="stable")
+    starts = np.searchsorted(labels[order], np.arange(n_shells))
+    p0, p1, p2 = (vertices[faces[order, k]] for k in range(3))
+    lo = np.minimum.reduceat(np.minimum(np.minimum(p0, p1), p2), starts, axis=0)
+    hi = np.maximum.reduceat(np.maximum(np.maximum(p0, p1), p2), starts, axis=0)
+    del p0, p1, p2
+    boxes_meet = np.all(lo[:, None] <= hi[None], axis=2) & np.all(lo[None] <= hi[:, None], axis=2)
+    np.fill_diagonal(boxes_meet, False)
+    if boxes_meet.any() and not check_crossing:
+        overlapped |= boxes_meet.any(axis=1)
+    elif boxes_meet.any():
+        largest = int(np.argmax(np.bincount(labels, minlength=n_shells)))
+        query = labels != largest
+        crossing = crossing_shells(vertices, faces, labels, query,
+                                   max_pairs=max(pairs_per_face * len(faces), 1 << 16))
+        if crossing is None:            # too many candidate pairs to test: let the boolean decide
+            crossing = boxes_meet.any(axis=1)
+        overlapped |= crossing
+    return flip, owner, int(np.count_nonzero(cavity)), int(np.count_nonzero(overlapped))
 
 
 def _check_magnitude(vertices, source: str) -> None:
@@ -218,8 +165,8 @@ def _check_magnitude(vertices, source: str) -> None:
                                "volume integrals can hold without underflow (check the length `units`)")
 
 
-def prepare_mesh(raw: RawMesh, *, repair: bool = False,
-                 merge_tolerance: float = MERGE_TOLERANCE) -> PreparedMesh:
+def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float = MERGE_TOLERANCE,
+                 overlap: str = "union") -> PreparedMesh:
     """Check a raw mesh and classify its shells (see the module docstring for the policy).
 
     Parameters
@@ -227,10 +174,14 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
     raw : RawMesh
         Vertices in metres and faces, from :func:`~inertia_tool.mesh.read.load_mesh`.
     repair : bool
-        Estimate instead of refusing a mesh that does not bound a solid (see
-        :class:`~inertia_tool.mesh.options.LoadOptions`).
+        Give a bounded estimate instead of refusing a mesh that does not bound a solid (holes, cracks, stray
+        pieces; see :mod:`~inertia_tool.mesh.resolve`).
     merge_tolerance : float
-        Tolerance-weld spacing relative to the bounding-box diagonal; 0 disables it.
+        Distance, relative to the bounding-box diagonal, within which vertices are merged when the bit-exact
+        weld leaves the surface unbalanced; 0 disables it.
+    overlap : {"union", "sum"}
+        Overlapping bodies: integrate their union (the physical solid; default) or add their integrals
+        (shared volume counted twice, said in the report).
 
     Returns
     -------
@@ -239,8 +190,10 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
     Raises
     ------
     InvalidMeshError
-        Not a solid (and ``repair`` is off or cannot help), flat, or beyond float64's safe range.
+        Not a solid (and ``repair`` is off), flat, or beyond float64's safe range.
     """
+    if overlap not in OVERLAP_MODES:
+        raise UsageError(f"Expected `overlap` to be one of {', '.join(OVERLAP_MODES)}, got {overlap!r}")
     source = raw.source
     v, f = raw.vertices, raw.faces
     if len(f) == 0:
@@ -260,33 +213,24 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
         raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")
     topo = edge_topology(f, len(v), v)
     watertight = topo.oriented
-    welded = None
-    if not topo.closed and merge_tolerance and merge_tolerance > 0:
-        tol = merge_tolerance * diag
-        f2 = weld_tolerance(v, f, tol)
-        keep = ~((f2[:, 0] == f2[:, 1]) | (f2[:, 1] == f2[:, 2]) | (f2[:, 2] == f2[:, 0]))
-        f2 = f2[keep]
-        topo2 = edge_topology(f2, len(v), v)
-        if topo2.closed and len(f2):  # welding must not collapse the whole surface
-            f, topo, welded = f2, topo2, tol
-            watertight = topo.oriented
-    repaired = False
-    actions: list[str] = []
-    volume_change = None
-    if not topo.oriented:
-        if not repair:
-            raise InvalidMeshError(_describe_edges(topo, source),
-                                   details={"boundary_edges": topo.boundary_edges,
-                                            "nonmanifold_edges": topo.nonmanifold_edges,
-                                            "misoriented_edges": topo.misoriented_edges})
-        before = _signed_volume(v, f)
-        v, f, actions = _repair(v, f, source)
-        after = _signed_volume(v, f)
-        volume_change = (abs(after) - abs(before)) / abs(after) if after else None
-        repaired = bool(actions)
-        if repaired:
-            change = f"; volume changed by {100 * volume_change:+.3g}%" if volume_change is not None else ""
-            warnings.warn(MeshRepairedWarning(f"{source}: repaired: {', '.join(actions)}{change}"), stacklevel=3)
+    found = Resolution(v, f, "exact", (), 0, None, 0)
+    if not topo.oriented:                     # clean meshes skip all of this
+        found = resolve_surface(v, f, diag=diag, source=source, repair=repair, merge_tolerance=merge_tolerance,
+                                moments=volume_moments)
+        v, f = found.vertices, found.faces
+        if found.method != "exact" or found.notes:
+            warning = MeshRepairedWarning if found.estimate is not None else MeshResolvedWarning
+            what = f"repaired ({found.method}, an estimate)" if found.estimate is not None else found.method
+            warnings.warn(warning(f"{source}: {what}: {'; '.join(found.notes)}"), stacklevel=3)
+    common: dict[str, Any] = dict(source=source, units=raw.units, file_faces=raw.file_faces,
+                                  degenerate_faces=n_repeated,
+                  watertight=watertight, welded_tolerance=found.welded_tolerance, flipped_faces=found.flipped_faces,
+                  nonmanifold_edges=found.nonmanifold_edges)
+    patched = found.estimate if found.estimate is not None and found.estimate.method == "patched" else None
+    if found.estimate is not None and patched is None:
+        return _estimated(found, common)
+    # a patched surface is closed: its shells are classified and overlaps united like any other, and the
+    # bounds of the patches carry over to the result
     labels, n_shells = shell_labels(f, len(v))
     if n_shells == 0:
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
@@ -294,8 +238,10 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
     flat = [k for k, s in enumerate(shells) if abs(s.volume) <= FLAT_RTOL * diag ** 3]
     if flat:
         what = "the mesh encloses" if n_shells == 1 else f"{len(flat)} of {n_shells} shells enclose"
-        raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface)")
-    flip, owner, cavities, overlaps = classify_shells(v, f, labels, n_shells, shells, diag)
+        raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
+                               "thin-walled part use the shell model with a wall `thickness`")
+    flip, owner, cavities, overlaps = classify_shells(v, f, labels, n_shells, shells, diag, source=source,
+                                                      check_crossing=not found.nonmanifold_edges)
     if flip.any():
         face_flip = flip[labels]
         f = f.copy()
@@ -306,16 +252,91 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False,
         what = "the mesh is" if n_shells == 1 or n_flipped == n_shells else f"{n_flipped} of {n_shells} shells are"
         warnings.warn(InsideOutWarning(f"{source}: {what} inside out (normals point inward); flipped"),
                       stacklevel=3)
-    if overlaps:
-        warnings.warn(OverlapWarning(f"{source}: {overlaps} bod{'y overlaps' if overlaps == 1 else 'ies overlap'} "
-                                     "another body; the overlapping volume is counted twice"), stacklevel=3)
+    method, notes = found.method, list(found.notes)
+    if overlaps or found.nonmanifold_edges:
+        united = _unite(v, f, labels, owner, source, repair)
+        summed = sum(s.volume for s in shells)
+        if united is not None and abs(united.volume - summed) <= UNION_VOLUME_RTOL * abs(summed):
+            overlaps = 0                      # surfaces touch, no volume is shared
+        elif united is None:
+            found = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
+                                    moments=volume_moments, force_estimate=True)
+            return _estimated(found, {**common, "overlapping_shells": max(overlaps, 1)})
+        elif overlap == "sum":
+            method = "sum"
+            notes.append(f"overlapping bodies: their integrals are added, so {summed - united.volume:.6g} m³ of "
+                         "shared volume is counted twice (`overlap` 'sum')")
+            warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+        else:
+            notes.append(f"overlapping bodies united by a boolean: {summed - united.volume:.6g} m³ shared volume "
+                         "counted once")
+            warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+            method, overlaps = "union", max(overlaps, 1)
+            v, f = united.vertices, united.faces
+            labels, n_shells = shell_labels(f, len(v))
+            shells = body_volume_moments(v, f, labels, n_shells)
+            flip, owner, cavities, _ = classify_shells(v, f, labels, n_shells, shells, diag, source=source)
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
     bbox_min, bbox_max = bounding_box(v)
-    report = MeshReport(source=source, units=raw.units, file_faces=raw.file_faces, vertices=len(v), faces=len(f),
-                        degenerate_faces=n_repeated, zero_area_faces=sum(s.zero_area_faces for s in shells),
-                        bodies=bodies, cavities=cavities,
-                        flipped_shells=int(np.count_nonzero(flip)), overlapping_shells=overlaps,
-                        watertight=watertight, welded_tolerance=welded, repaired=repaired,
-                        repair_actions=tuple(actions), repair_volume_change=volume_change,
-                        bbox_min=bbox_min, bbox_max=bbox_max)
+    uncertainty = None
+    if patched is not None:
+        total = _total(shells)
+        uncertainty = uncertainty_from(total.volume, total.centroid, total.second_moment,
+                                       patched.uncertainty.volume_in_doubt, patched.far)
+        method = "patched"
+    report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
+                        bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),
+                        overlapping_shells=overlaps, repaired=patched is not None,
+                        repair_actions=tuple(notes) if patched is not None else (),
+                        repair_volume_change=None, bbox_min=bbox_min, bbox_max=bbox_max, method=method,
+                        uncertainty=uncertainty, notes=tuple(notes), **common)
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
+
+
+def _total(shells) -> VolumeMoments:
+    """The moments of all shells together (cavities negative): volume, centroid, central second moment."""
+    volume = sum(s.volume for s in shells)
+    centroid = sum(s.volume * s.centroid for s in shells) / volume
+    second = sum(s.second_moment + s.volume * np.outer(s.centroid - centroid, s.centroid - centroid) for s in shells)
+    return VolumeMoments(volume=volume, centroid=centroid, second_moment=second, area=sum(s.area for s in shells))
+
+
+def _unite(vertices, faces, labels, owner, source, repair):
+    """The union of the closed pieces (a :class:`~.union.UnionSurface`), or None when the boolean refuses.
+
+    Each piece belongs to the body that owns its shell, so cavities are cut from their own body only.
+    """
+    groups, n_groups = closed_groups(faces, len(vertices))
+    pieces = body_volume_moments(vertices, faces, groups, n_groups)
+    volume = np.array([p.volume for p in pieces])
+    lo, hi = bounding_box(vertices)
+    solid = np.abs(volume) > FLAT_RTOL * float(np.linalg.norm(hi - lo)) ** 3    # sheets (a face and its reverse)
+    shell_of_group = np.zeros(n_groups, dtype=np.int64)
+    shell_of_group[groups] = labels
+    keep = solid[groups]
+    _, groups = np.unique(groups[keep], return_inverse=True)
+    try:
+        return union_surface(vertices, faces[keep], groups.reshape(-1), int(np.count_nonzero(solid)),
+                             volume[solid] > 0, body=np.asarray(owner)[shell_of_group[solid]])
+    except UnionError as exc:
+        if repair:
+            return None
+        raise InvalidMeshError(f"{source}: overlapping bodies whose union cannot be formed ({exc}); "
+                               "`overlap` 'sum' adds them (shared volume counted twice), `repair=True` gives a "
+                               "bounded estimate") from None
+
+
+def _estimated(found: Resolution, common: dict[str, Any]) -> PreparedMesh:
+    """A PreparedMesh holding one estimated solid (``repair=True``)."""
+    est = found.estimate
+    assert est is not None, "only an estimated Resolution reaches here"
+    moments = VolumeMoments(volume=est.volume, centroid=est.centroid, second_moment=est.second_moment,
+                            area=est.area)
+    lo, hi = bounding_box(found.vertices)
+    common = {"overlapping_shells": 0, **common}
+    report = MeshReport(vertices=len(found.vertices), faces=len(found.faces), zero_area_faces=0, bodies=1,
+                        cavities=0, flipped_shells=0, repaired=True, repair_actions=found.notes,
+                        repair_volume_change=None, bbox_min=lo, bbox_max=hi, method=est.method,
+                        uncertainty=est.uncertainty, notes=found.notes, **common)
+    return PreparedMesh(vertices=found.vertices, faces=found.faces, labels=np.zeros(len(found.faces), dtype=np.intp),
+                        shells=(moments,), owner=np.zeros(1, dtype=np.intp), report=report)

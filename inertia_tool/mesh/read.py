@@ -12,6 +12,7 @@ corners straight from each chunk of file records, in one pass.
 
 from __future__ import annotations
 
+import logging
 import os
 import re
 import stat
@@ -570,6 +571,11 @@ def _check_off_header(path: str, size: int, max_faces: int) -> dict:
         words += line.split(b"#", 1)[0].split()
         if len(words) >= 4:
             break
+    if words and b"OFF" in words[0] and words[0].index(b"OFF") + 3 < len(words[0]) \
+            and words[0][words[0].index(b"OFF") + 3:].isdigit():
+        # "OFF8 6 12": the keyword run into the vertex count, which readers accept
+        cut = words[0].index(b"OFF") + 3
+        words = [words[0][:cut], words[0][cut:]] + words[1:]
     if not words or not words[0].endswith(b"OFF"):
         raise _fail(path, "not an OFF file (no 'OFF' keyword at the start)")
     if len(words) < 3:
@@ -729,9 +735,15 @@ def _read_with_trimesh(path: str, max_faces: int):
         except ImportError:
             raise _fail(path, "reading COLLADA needs pycollada (pip install pycollada)") from None
     try:
+        quiet = logging.getLogger("trimesh")
+        level = quiet.level
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            loaded = trimesh.load(source, file_type=kind, process=False, force=None)
+            quiet.setLevel(logging.CRITICAL)      # e.g. a missing texture image, logged with a traceback
+            try:
+                loaded = trimesh.load(source, file_type=kind, process=False, force=None)
+            finally:
+                quiet.setLevel(level)
             declared = _declared_scale(path, suffix, loaded)
             if isinstance(loaded, trimesh.Scene):   # dump() applies every node's transform
                 geoms = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)] if loaded.geometry else []
@@ -756,8 +768,9 @@ def _read_with_trimesh(path: str, max_faces: int):
         raise _fail(path, f"faces are not triangles (shape {f.shape})")
     if f.min() < 0 or f.max() >= len(v):
         raise _fail(path, f"face indices out of range (0..{len(v) - 1})")
-    if "vertex" in counts and len(v) != counts["vertex"]:
-        raise _fail(path, f"the header announces {counts['vertex']:,} vertices but {len(v):,} were read")
+    if "vertex" in counts and len(v) < counts["vertex"]:
+        # more is fine: the reader splits vertices along texture seams (per-face texture coordinates)
+        raise _fail(path, f"the header announces {counts['vertex']:,} vertices but only {len(v):,} were read")
     if "face" in counts and len(f) < counts["face"]:
         raise _fail(path, f"the header announces {counts['face']:,} faces but only {len(f):,} triangles were read "
                           "(faces dropped or truncated file)")

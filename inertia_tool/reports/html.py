@@ -36,6 +36,7 @@ from ..mass.properties import MassProperties
 from .escape import escape_html
 from .output import check_targets, write_text
 from .serialize import TENSOR_CONVENTION
+from .text import method_line
 
 __all__ = ["HtmlSection", "html_report", "write_html_report", "svg_views", "VIEWS",
            "stability_section", "DEFAULT_MAX_EDGES", "DEFAULT_MAX_FILL_FACES"]
@@ -358,7 +359,8 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
     if density_source:
         summary.append(["density from", _e(density_source), ""])
     summary.append(["centre of mass", "(" + ", ".join(_vec_cells(props.center_of_mass)) + ")", "m"])
-    sections = [HtmlSection("Mass properties", _table(None, summary), "mass")]
+    verdict = f"<p><strong>Result:</strong> {_e(method_line(props.mesh))}</p>"
+    sections = [HtmlSection("Mass properties", verdict + _table(None, summary), "mass")]
     ten = _clean(props.inertia)
     origin = _clean(np.asarray(props.inertia_about(np.zeros(3))))
     tensor_rows = [[_AXIS_LETTERS[i]] + [f"{x:.6e}" for x in ten[i]] for i in range(3)]
@@ -395,7 +397,12 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
                                     "bodies"))
     mesh = props.mesh
     if mesh is not None:
-        rows = [["faces", f"{mesh.faces:,} (file {mesh.file_faces:,})"], ["vertices", f"{mesh.vertices:,}"],
+        u = mesh.uncertainty
+        bounds = ("none: exact for the polyhedron" if u is None else
+                  f"mass ±{100 * u.mass:.3g}%, centre of mass {u.center_of_mass:.3g} m, "
+                  f"inertia ±{100 * u.inertia:.3g}%")
+        rows = [["method", _e(mesh.method)], ["uncertainty", _e(bounds)],
+                ["faces", f"{mesh.faces:,} (file {mesh.file_faces:,})"], ["vertices", f"{mesh.vertices:,}"],
                 ["bodies / cavities", f"{mesh.bodies} / {mesh.cavities}"],
                 ["watertight and consistently wound as read", "yes" if mesh.watertight else "no"],
                 ["degenerate faces ignored / zero-area faces", f"{mesh.degenerate_faces} / {mesh.zero_area_faces}"],
@@ -406,8 +413,11 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
         if mesh.flipped_shells:
             rows.append(["inside-out shells flipped", str(mesh.flipped_shells)])
         if mesh.overlapping_shells:
-            rows.append(["overlapping bodies (volume counted twice)", str(mesh.overlapping_shells)])
-        if mesh.repaired:
+            how = "united, shared volume counted once" if mesh.method == "union" else "volume counted twice"
+            rows.append([f"overlapping bodies ({how})", str(mesh.overlapping_shells)])
+        for note in mesh.notes:
+            rows.append(["note", _e(note)])
+        if mesh.repaired and not mesh.notes:
             rows.append(["repaired", _e(", ".join(mesh.repair_actions))])
         sections.append(HtmlSection(f"Mesh ({mesh.units} coordinates, converted to m)", _table(None, rows),
                                     "mesh"))

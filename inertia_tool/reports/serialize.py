@@ -75,6 +75,8 @@ def mass_properties_dict(props: MassProperties, *, density_source: str | None = 
         },
     }
     if props.mesh is not None:
+        out["method"] = props.mesh.method
+        out["uncertainty"] = props.mesh.uncertainty        # None (null) when exact
         out["mesh"] = mesh_report_dict(props.mesh)
     if props.parts:
         out["bodies"] = [{"name": b.name, "mass": b.mass, "volume": b.volume, "center_of_mass": b.center_of_mass,

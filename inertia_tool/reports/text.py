@@ -37,6 +37,19 @@ def _matrix(m, indent: str) -> list[str]:
     return [indent + "[" + "  ".join(f"{x: .6e}" for x in row) + " ]" for row in m]
 
 
+def method_line(mesh) -> str:
+    """One line: whether the numbers are exact, how the solid was read, and the bounds of an estimate."""
+    if mesh is None:
+        return "exact"
+    u = mesh.uncertainty
+    if u is None:
+        extra = " (shared volume of overlapping bodies counted twice, on request)" if mesh.method == "sum" else ""
+        return f"exact for the polyhedron (method: {mesh.method}){extra}"
+    return (f"ESTIMATE (method: {mesh.method}; the file does not define a closed solid): mass within "
+            f"±{100 * u.mass:.3g}%, centre of mass within {u.center_of_mass:.3g} m, inertia within "
+            f"±{100 * u.inertia:.3g}% (Frobenius)")
+
+
 def format_mass_properties(props: MassProperties, *, density_source: str | None = None) -> str:
     """Multi-line report: units, volume, mass, COM, inertia (about COM and mesh origin), principal axes,
     radii of gyration, physical checks and mesh diagnostics."""
@@ -45,6 +58,7 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
     mesh = props.mesh
     size = float(np.linalg.norm(mesh.bbox_max - mesh.bbox_min)) if mesh is not None else 0.0
     unit_note = f" (mesh coordinates in {mesh.units}, converted)" if mesh is not None else ""
+    lines.append(f"  result: {method_line(mesh)}")
     lines.append(f"  units: SI — m, kg, kg·m²{unit_note}")
     if density_source:
         lines.append(f"  density:          {density_source}")
@@ -90,10 +104,14 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
         if mesh.flipped_shells:
             lines.append(f"    inside-out shells flipped: {mesh.flipped_shells}")
         if mesh.overlapping_shells:
-            lines.append(f"    overlapping bodies (volume counted twice): {mesh.overlapping_shells}")
+            how = "united, shared volume counted once" if mesh.method == "union" else "volume counted twice"
+            lines.append(f"    overlapping bodies ({how}): {mesh.overlapping_shells}")
+        for note in mesh.notes:
+            lines.append(f"    {note}")
         if mesh.repaired:
             change = (f", volume changed by {100 * mesh.repair_volume_change:+.3g}%"
                       if mesh.repair_volume_change is not None else "")
-            lines.append(f"    repaired: {', '.join(mesh.repair_actions)}{change}")
+            if not mesh.notes:
+                lines.append(f"    repaired: {', '.join(mesh.repair_actions)}{change}")
         lines.append(f"    bounding box: {_vec(mesh.bbox_min)} – {_vec(mesh.bbox_max)} m")
     return "\n".join(lines)

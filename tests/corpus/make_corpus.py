@@ -452,7 +452,7 @@ def _(path):
 
 
 @entry("liar-fewer.ply", "PLY whose header claims fewer faces than it holds", 3,
-       r"not a closed, consistently wound solid: .*boundary edges")
+       r"not a closed solid: .*boundary edges")
 def _(path):
     v, f = box()
     write_ply(path, v, f, counts=(8, 10))
@@ -492,18 +492,20 @@ def _(path):
     write_binary_stl(path, v, f)
 
 
-@entry("open-box.stl", "an open box (one face missing)", 3, r"4 boundary edges \(holes\)")
+@entry("open-box.stl", "an open box (one face missing)", 3,
+       r"4 boundary edges \(holes or cracks\).*--repair gives a bounded estimate")
 def _(path):
     v, f = box()
     write_binary_stl(path, v, f[2:])
 
 
-@entry("one-face-flipped.stl", "a box with one face flipped", 3, r"edges with inconsistent winding")
+@entry("one-face-flipped.stl", "a box with one face flipped", 0, r"oriented: 2 faces were wound the wrong way")
 def _(path):
     v, f = box()
-    f = f.copy()
-    f[4:6] = f[4:6, ::-1]
-    write_binary_stl(path, v, f)
+    flipped = f.copy()
+    flipped[4:6] = flipped[4:6, ::-1]
+    write_binary_stl(path, v, flipped)
+    return [(f32(v), f)]
 
 
 @entry("inside-out.stl", "an inside-out box", 0, r"the mesh is inside out .* flipped")
@@ -528,22 +530,34 @@ def _(path):
     return [(f32(v1), f1), (f32(v2), f2)]
 
 
-@entry("overlapping-cubes.stl", "two overlapping cubes (volume counted twice)", 0,
-       r"2 bodies overlap another body; the overlapping volume is counted twice")
+def box_between(lo, hi):
+    """Outward-wound box with the exact corner coordinates ``lo`` and ``hi`` (no arithmetic on them)."""
+    v, f = box((1, 1, 1))
+    return np.where(v > 0, np.asarray(hi, dtype=float), np.asarray(lo, dtype=float)), f
+
+
+@entry("overlapping-cubes.stl", "two overlapping cubes (united: the shared volume counted once)", 0,
+       r"overlapping bodies united by a boolean")
 def _(path):
     v1, f1 = box((1, 1, 1))
     v2, f2 = box((1, 1, 1), center=(0.3, 0.3, 0.3))
     write_binary_stl(path, np.r_[v1, v2], np.r_[f1, f2 + 8])
-    return [(f32(v1), f1), (f32(v2), f2)]
+    a, b = f32(v1), f32(v2)          # the union: cube 1 and three disjoint slabs of cube 2 outside it
+    lo, top, hi = b.min(axis=0), a.max(axis=0), b.max(axis=0)
+    return [(a, f1), box_between([top[0], lo[1], lo[2]], hi),
+            box_between([lo[0], top[1], lo[2]], [top[0], hi[1], hi[2]]),
+            box_between([lo[0], lo[1], top[2]], [top[0], top[1], hi[2]])]
 
 
-@entry("crossed-bars.stl", "two bars crossing like a '+' (no vertex inside the other)", 0,
-       r"counted twice")
+@entry("crossed-bars.stl", "two bars crossing like a '+' (no vertex inside the other; united)", 0,
+       r"overlapping bodies united")
 def _(path):
     v1, f1 = box((3, 1, 1))
     v2, f2 = box((1, 3, 1))
     write_binary_stl(path, np.r_[v1, v2], np.r_[f1, f2 + 8])
-    return [(f32(v1), f1), (f32(v2), f2)]
+    a, b = f32(v1), f32(v2)          # the union: bar 1 and the two arms of bar 2 outside it
+    return [(a, f1), box_between([b[:, 0].min(), a[:, 1].max(), b[:, 2].min()], b.max(axis=0)),
+            box_between(b.min(axis=0), [b[:, 0].max(), a[:, 1].min(), b[:, 2].max()])]
 
 
 @entry("hollow.stl", "a box with an inner cavity", 0, r"^$")

@@ -1,0 +1,214 @@
+"""What solid does a surface that fails the manifold check define?  Exact where it is defined, an estimate on request.
+
+Called by :func:`inertia_tool.mesh.prepare.prepare_mesh` only when the fast edge census finds the surface is not
+a closed, consistently wound 2-manifold (clean meshes never come here).  In order:
+
+1. *Balanced* (every directed edge matched by its reverse; ``orient.py``): bodies touching along an edge or
+   at a vertex, walls meeting at an edge.  The integral is exact as it stands — method ``"exact"``, with a
+   note on the non-manifold edges.
+2. *Oriented*: faces wound the wrong way are turned to agree with their manifold neighbours (the file's
+   majority decides which side is out).  Exact if that balances the surface — method ``"oriented"``.
+3. *Welded*: vertices closer than ``merge_tolerance × diagonal`` are merged (a distance query, ``merge.py``),
+   collapsed faces dropped, orientation redone.  Exact for the welded polyhedron (which moved no vertex by
+   more than the stated distance) — method ``"welded"``.
+4. Otherwise the file does not define a solid.  Without ``repair`` this refuses in one line (edges counted
+   after welding) and says that ``repair=True`` gives a bounded estimate.  With ``repair``: duplicate faces
+   are dropped (exact if that balances the surface — method ``"deduplicated"``), then the estimates of
+   ``estimate.py`` are formed (boundary loops patched by cones; winding number on a grid) and the one with
+   the tighter mass bound is kept — method ``"patched"`` or ``"winding"``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..values import frozen_value
+from ..errors import InvalidMeshError
+from ..tolerances import FLAT_RTOL
+from .estimate import Estimate, patched_estimate, winding_estimate
+from .merge import merge_close_vertices
+from .orient import EdgeBalance, edge_balance, orient_consistently
+
+__all__ = ["Resolution", "resolve_surface", "PATCH_PREFERRED_RTOL"]
+
+#: The patched estimate is kept without trying the grid when its relative mass bound is below this.
+PATCH_PREFERRED_RTOL = 1e-3
+
+
+@frozen_value
+class Resolution:
+    """How a surface that is not a clean 2-manifold was read as a solid.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float
+        m (the estimate's patched vertices when an estimate was made).
+    faces : (m, 3) int
+        Faces to integrate (exact methods); the patched surface for ``"patched"``.
+    method : str
+        ``"exact"``, ``"oriented"``, ``"welded"``, ``"deduplicated"``, ``"patched"`` or ``"winding"``.
+    notes : tuple of str
+        What was found and done, one short sentence each.
+    flipped_faces : int
+        Faces turned to agree with their neighbours.
+    welded_tolerance : float or None
+        Distance (m) within which vertices were merged, when that was needed.
+    nonmanifold_edges : int
+        Edges shared by more than two faces in the surface integrated (bodies or walls touching).
+    estimate : Estimate or None
+        The bounded estimate (``"patched"``, ``"winding"``), else None.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    method: str
+    notes: tuple
+    flipped_faces: int
+    welded_tolerance: float | None
+    nonmanifold_edges: int
+    estimate: Estimate | None = None
+
+
+def _drop_collapsed(faces):
+    return faces[~((faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0]))]
+
+
+def _describe(census: EdgeBalance, welded: float | None, vertices: np.ndarray, faces: np.ndarray) -> str:
+    from .estimate import boundary_edges
+
+    parts = []
+    if census.boundary_edges:
+        parts.append(f"{census.boundary_edges:,} boundary edges (holes or cracks)")
+    if census.nonmanifold_edges:
+        parts.append(f"{census.nonmanifold_edges:,} non-manifold edges (shared by 3+ faces)")
+    other = census.unbalanced_edges - census.boundary_edges
+    if other:
+        parts.append(f"{other:,} edges used more often in one direction than the other")
+    after = f" after welding vertices within {welded:.3g} m" if welded else ""
+    edges = boundary_edges(faces, len(vertices))
+    where = ""
+    if len(edges):
+        a, b = vertices[edges[0, 0]], vertices[edges[0, 1]]
+        where = f", e.g. the edge ({a[0]:.6g}, {a[1]:.6g}, {a[2]:.6g})–({b[0]:.6g}, {b[1]:.6g}, {b[2]:.6g}) m"
+    return "; ".join(parts) + after + where
+
+
+def _touching_note(census: EdgeBalance) -> tuple:
+    if not census.nonmanifold_edges:
+        return ()
+    return (f"{census.nonmanifold_edges:,} non-manifold edges where bodies or walls meet (each edge used equally "
+            "in both directions, so the integral is exact)",)
+
+
+def _dedupe(faces: np.ndarray) -> tuple[np.ndarray, int]:
+    """Drop repeated copies of a face (same corners, same winding); a face and its reverse both stay."""
+    f = np.asarray(faces)
+    roll = np.argmin(f, axis=1)
+    idx = (roll[:, None] + np.arange(3)) % 3
+    canon = np.take_along_axis(f, idx, axis=1)       # rotated to start at the smallest index: keeps winding
+    _, first = np.unique(canon, axis=0, return_index=True)
+    first = np.sort(first)
+    return f[first], len(f) - len(first)
+
+
+def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
+                    merge_tolerance: float, moments, force_estimate: bool = False) -> Resolution:
+    """Read a surface that failed the manifold check as a solid (exact), as an estimate (repair), or refuse.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        m.
+    faces : (m, 3) int
+        Without repeated corners.
+    diag : float
+        Bounding-box diagonal, m.
+    source : str
+        Name for messages.
+    repair : bool
+        Give a bounded estimate instead of refusing.
+    merge_tolerance : float
+        Relative (to ``diag``) distance for merging vertices; 0 disables the weld.
+    moments : callable
+        ``moments(vertices, faces) -> VolumeMoments`` (the exact integrator).
+    force_estimate : bool
+        Go straight to the winding-number estimate (a balanced surface whose overlapping bodies the boolean
+        could not unite).
+
+    Returns
+    -------
+    Resolution
+
+    Raises
+    ------
+    InvalidMeshError
+        Without ``repair`` when no exact reading exists; with it when nothing encloses a volume.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces)
+    n = len(v)
+    census = edge_balance(f, n)
+    if force_estimate:
+        grid = winding_estimate(v, f)
+        if not grid.volume > 0:
+            raise InvalidMeshError(f"{source}: the surface encloses no volume")
+        return Resolution(v, f, grid.method, ("the bodies overlap and their union could not be formed", grid.detail),
+                          0, None, census.nonmanifold_edges, estimate=grid)
+    if census.balanced:
+        return Resolution(v, f, "exact", _touching_note(census), 0, None, census.nonmanifold_edges)
+    oriented = orient_consistently(f, n, v)
+    census = edge_balance(oriented.faces, n)
+    if census.balanced:
+        notes = (f"{oriented.flipped_faces:,} faces were wound the wrong way and were turned",) + _touching_note(census)
+        return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
+                          census.nonmanifold_edges)
+    welded = None
+    current, flipped = oriented.faces, oriented.flipped_faces
+    if merge_tolerance and merge_tolerance > 0:
+        tol = merge_tolerance * diag
+        merged = merge_close_vertices(v, f, tol)
+        if merged.merged_vertices:
+            welded_faces = _drop_collapsed(merged.faces)
+            if len(welded_faces):
+                again = orient_consistently(welded_faces, n, v)
+                census = edge_balance(again.faces, n)
+                current, flipped, welded = again.faces, again.flipped_faces, tol
+                if census.balanced:
+                    notes = (f"{merged.merged_vertices:,} vertices within {tol:.3g} m of another were merged "
+                             f"(largest move {merged.largest_move:.3g} m)",)
+                    if again.flipped_faces:
+                        notes += (f"{again.flipped_faces:,} faces were wound the wrong way and were turned",)
+                    return Resolution(v, again.faces, "welded", notes + _touching_note(census), again.flipped_faces,
+                                      tol, census.nonmanifold_edges)
+    if not repair:
+        raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}; "
+                               "`repair=True` gives a bounded estimate",
+                               details={"boundary_edges": census.boundary_edges,
+                                        "unbalanced_edges": census.unbalanced_edges,
+                                        "nonmanifold_edges": census.nonmanifold_edges})
+    repair_notes = []
+    if welded:
+        repair_notes.append(f"vertices within {welded:.3g} m of another were merged")
+    if flipped:
+        repair_notes.append(f"{flipped:,} faces were turned to agree with their neighbours")
+    unique, dropped = _dedupe(current)
+    if dropped:
+        repair_notes.append(f"{dropped:,} duplicated faces were dropped")
+        census = edge_balance(unique, n)
+        if census.balanced:
+            return Resolution(v, unique, "deduplicated", tuple(repair_notes) + _touching_note(census), flipped, welded,
+                              census.nonmanifold_edges)
+    flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
+    patched = patched_estimate(v, unique, moments)
+    best = patched
+    if not (patched.volume > flat and patched.uncertainty.mass <= PATCH_PREFERRED_RTOL):
+        grid = winding_estimate(v, unique)
+        if grid.volume > flat and not (patched.volume > flat and patched.uncertainty.mass <= grid.uncertainty.mass):
+            best = grid
+    if not best.volume > flat:
+        raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
+                               "thin-walled part use the shell model with a wall `thickness`")
+    repair_notes.append(best.detail)
+    return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
+                      edge_balance(best.faces, len(best.vertices)).nonmanifold_edges if best.method == "patched"
+                      else census.nonmanifold_edges, estimate=best)

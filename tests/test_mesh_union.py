@@ -1,0 +1,110 @@
+"""Shell nesting by ray crossings, the surface-crossing test and the manifold3d union (mesh/nesting.py, union.py)."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from conftest import box_arrays
+from inertia_tool.mesh.nesting import shell_nesting
+from inertia_tool.mesh.union import closed_groups, crossing_shells, triangles_meet, union_surface
+from inertia_tool.mass.volume import volume_moments
+
+
+def _stack(parts):
+    vs, fs, labels, offset = [], [], [], 0
+    for k, (v, f) in enumerate(parts):
+        vs.append(v)
+        fs.append(f + offset)
+        labels.append(np.full(len(f), k))
+        offset += len(v)
+    return np.vstack(vs), np.vstack(fs), np.concatenate(labels)
+
+
+def test_nesting_of_a_box_with_300_voids():
+    rng = np.random.default_rng(7)
+    parts = [box_arrays((10.0, 10.0, 10.0))]
+    centres = rng.uniform(-4.5, 4.5, (300, 3))
+    for c in centres:
+        v, f = box_arrays((0.05, 0.05, 0.05), c)
+        parts.append((v, f[:, ::-1]))                 # voids wound inward
+    v, f, labels = _stack(parts)
+    nest = shell_nesting(v, f, labels, 301)
+    assert not nest.undecided.any()
+    inside_outer = nest.shell[(nest.other == 0) & (nest.winding == 1)]
+    assert np.array_equal(np.sort(inside_outer), np.arange(1, 301))
+    assert not np.any((nest.shell == 0) & (nest.winding != 0))
+
+
+def test_nesting_rays_through_shared_edges_are_counted_once():
+    # the probe of the small box lies on the axis through the big box's vertices and edges
+    big_v, big_f = box_arrays((2.0, 2.0, 2.0))
+    small_v, small_f = box_arrays((0.5, 0.5, 0.5))
+    v, f, labels = _stack([(big_v, big_f), (small_v, small_f)])
+    nest = shell_nesting(v, f, labels, 2)
+    assert not nest.undecided.any()
+    assert list(nest.winding[(nest.shell == 1)]) == [1]
+
+
+def test_two_overlapping_cubes_union_volume_exact():
+    a = box_arrays((2.0, 2.0, 2.0))
+    b = box_arrays((2.0, 2.0, 2.0), (1.0, 1.0, 1.0))
+    v, f, labels = _stack([a, b])
+    crossing = crossing_shells(v, f, labels, np.ones(len(f), dtype=bool))
+    assert crossing.all()
+    groups, n = closed_groups(f, len(v))
+    assert n == 2
+    union = union_surface(v, f, groups, n, np.array([True, True]))
+    moments = volume_moments(union.vertices, union.faces)
+    assert np.isclose(moments.volume, 15.0, rtol=1e-12)
+    # centroid of the union: (8·0 + 8·1 − 1·1.5·… ) by inclusion-exclusion of three boxes
+    com = (8 * np.zeros(3) + 8 * np.ones(3) - 1 * np.full(3, 0.5)) / 15
+    assert np.allclose(moments.centroid, com, atol=1e-12)
+
+
+def test_disjoint_and_nested_shells_do_not_cross():
+    outer = box_arrays((4.0, 4.0, 4.0))
+    inner_v, inner_f = box_arrays((1.0, 1.0, 1.0))
+    far = box_arrays((1.0, 1.0, 1.0), (10.0, 0.0, 0.0))
+    v, f, labels = _stack([outer, (inner_v, inner_f[:, ::-1]), far])
+    assert not crossing_shells(v, f, labels, np.ones(len(f), dtype=bool)).any()
+
+
+def test_union_of_body_minus_overlapping_cavities():
+    outer = box_arrays((4.0, 4.0, 4.0))
+    c1v, c1f = box_arrays((1.0, 1.0, 1.0))
+    c2v, c2f = box_arrays((1.0, 1.0, 1.0), (0.5, 0.0, 0.0))     # two voids overlapping by half a cube
+    v, f, labels = _stack([outer, (c1v, c1f[:, ::-1]), (c2v, c2f[:, ::-1])])
+    union = union_surface(v, f, labels, 3, np.array([True, False, False]))
+    assert np.isclose(volume_moments(union.vertices, union.faces).volume, 64 - 1.5, rtol=1e-12)
+
+
+@pytest.mark.parametrize("shift, meets", [(0.0, True), (0.5, True), (1.0 + 1e-9, False)])
+def test_triangles_meet(shift, meets):
+    t1 = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], dtype=float)
+    t2 = np.array([[[0.2, 0.2, -1], [0.2, 0.2, 1], [0.2 + shift, 1.5, 0]]], dtype=float) + [shift, 0, 0]
+    assert triangles_meet(t1, t2)[0] == meets
+
+
+def test_closed_groups_split_bodies_touching_along_an_edge():
+    a = box_arrays((1.0, 1.0, 1.0))
+    b = box_arrays((1.0, 1.0, 1.0), (1.0, 1.0, 0.0))               # shares the edge x = y = 0.5
+    mesh = trimesh.Trimesh(*_stack([a, b])[:2], process=True)      # merge the shared vertices
+    groups, n = closed_groups(np.asarray(mesh.faces), len(mesh.vertices))
+    assert n == 2
+
+
+def test_crossed_cylinders_union_is_the_steinmetz_closed_form():
+    # two cylinders of radius r and length L crossing at right angles share the Steinmetz bicylinder, 16 r³/3
+    r, length, sections = 1.0, 6.0, 256
+    a = trimesh.creation.cylinder(radius=r, height=length, sections=sections)
+    b = a.copy()
+    b.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0]))
+    v, f, labels = _stack([(np.asarray(a.vertices), np.asarray(a.faces)),
+                           (np.asarray(b.vertices), np.asarray(b.faces))])
+    union = union_surface(v, f, labels, 2, np.array([True, True]))
+    # faceted: the inscribed n-gon has area (n/2) r² sin(2π/n) = k·πr²; the prisms' common part scales as
+    # k^1.5 (it matches to 1e-10 here, while the unscaled circle formulas are off by 9e-5)
+    k = sections / 2 * np.sin(2 * np.pi / sections) / np.pi
+    expected = 2 * np.pi * r * r * length * k - 16 * r ** 3 / 3 * k ** 1.5
+    assert volume_moments(union.vertices, union.faces).volume == pytest.approx(expected, rel=1e-8)
+    assert union.volume == pytest.approx(expected, rel=1e-8)
