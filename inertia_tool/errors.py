@@ -48,6 +48,9 @@ __all__ = [
     "TrailingDataWarning",
     "AsymmetricTopWarning",
     "MalformedTextWarning",
+    "ImplausibleSizeWarning",
+    "ImplausibleDensityWarning",
+    "ImplausibleCorrectionWarning",
 ]
 
 
@@ -174,3 +177,19 @@ class MalformedTextWarning(InertiaToolWarning):
     The geometry lines were still unambiguous (e.g. three ``vertex`` lines per ``facet`` in an ASCII STL),
     so they were read; the warning says what was skipped.
     """
+
+
+class ImplausibleSizeWarning(InertiaToolWarning):
+    """The mesh is implausibly large or small for a part and no length unit was given (metres assumed):
+    most likely the file is in millimetres or inches.  The numbers stay those of the unit assumed; the
+    message names the unit that would make the size plausible (rule: :data:`inertia_tool.units.PLAUSIBLE_EXTENT`)."""
+
+
+class ImplausibleDensityWarning(InertiaToolWarning):
+    """The density implied by a target ``mass`` lies outside every solid material
+    (:data:`inertia_tool.units.PLAUSIBLE_DENSITY`): the mass, the mesh or its length unit is likely wrong."""
+
+
+class ImplausibleCorrectionWarning(InertiaToolWarning):
+    """A balancing correction lies outside the part (radius beyond its extent, plane beyond its ends) or is a
+    sizeable fraction of the part's mass: possible on paper, but check the inputs before drilling."""

@@ -13,7 +13,7 @@ from .errors import MaterialError, UnitsError
 
 __all__ = ["LENGTH_UNITS", "MATERIALS", "length_scale", "material_density", "parse_length",
            "parse_angular_rate", "parse_duration", "parse_mass", "parse_density", "parse_angle", "parse_vector",
-           "parse_fraction"]
+           "parse_fraction", "PLAUSIBLE_EXTENT", "PLAUSIBLE_DENSITY", "implausible_extent", "implausible_density"]
 
 #: Length units accepted for mesh coordinates, as metres per unit.
 LENGTH_UNITS = {
@@ -192,3 +192,68 @@ def parse_fraction(text: str | float) -> float:
     if not 0.0 <= value <= 1.0:
         raise UnitsError(f"Expected a fraction between 0 and 1 (0% to 100%), got {text!r}")
     return value
+
+
+# -- plausibility of what the units make of a part ---------------------------------------------------------
+
+#: Largest bounding-box extent (m) that is plausible for a part, lower and upper bound: 0.1 mm (a watch
+#: screw is ~0.5 mm) to 20 m (a ship's propeller is ~10 m, a wind-turbine blade 80 m but is not balanced
+#: from an STL).  Outside it, when no length unit was given, the file is most likely in mm or inches:
+#: a 150 mm part read as metres is 150 m and, in steel, 1.3e8 kg.
+PLAUSIBLE_EXTENT = (1e-4, 20.0)
+
+#: Densities (kg/m³) of solid materials, lower and upper bound: rigid foams and balsa (~100) to osmium
+#: (22,590, the densest element).  :data:`MATERIALS` lie between 500 and 19,300.  A density implied by a
+#: target mass outside this range means a wrong mass, mesh or length unit.
+PLAUSIBLE_DENSITY = (100.0, 22_600.0)
+
+
+def _length_text(metres: float) -> str:
+    """``0.15`` → ``"0.15 m"``, ``1.5e-5`` → ``"0.015 mm"``: a length in the unit that reads best."""
+    if metres >= 0.1 or metres == 0:
+        return f"{metres:.3g} m"
+    if metres >= 1e-3:
+        return f"{metres * 1e3:.3g} mm"
+    return f"{metres * 1e6:.3g} µm"
+
+
+def implausible_extent(extent: float, *, low: float = PLAUSIBLE_EXTENT[0],
+                       high: float = PLAUSIBLE_EXTENT[1]) -> str | None:
+    """Why a largest bounding-box extent of ``extent`` metres (coordinates read as metres) is implausible for
+    a part, and which unit of the file would make it plausible; ``None`` when it is plausible.
+
+    Parameters
+    ----------
+    extent : float
+        Largest side of the bounding box, m, with the coordinates taken as metres.
+    low, high : float
+        The plausible range, m (default :data:`PLAUSIBLE_EXTENT`).
+
+    Returns
+    -------
+    str or None
+        E.g. ``"largest extent 150 m, above 20 m: if the file is in mm, `units` mm gives 0.15 m"``.
+    """
+    if not (math.isfinite(extent) and extent > 0) or low <= extent <= high:
+        return None
+    side = f"above {high:g} m" if extent > high else f"below {_length_text(low)}"
+    fits = [(name, extent * scale) for name, scale in LENGTH_UNITS.items()
+            if name != "m" and low <= extent * scale <= high]
+    # the usual CAD export units first: mm, then in, cm, um, ft
+    order = {"mm": 0, "in": 1, "cm": 2, "um": 3, "ft": 4}
+    fits.sort(key=lambda item: order.get(item[0], 9))
+    if not fits:
+        return f"largest extent {_length_text(extent)}, {side}: check the mesh and its length `units`"
+    name, size = fits[0]
+    return (f"largest extent {_length_text(extent)}, {side}: if the file is in {name}, `units` {name} "
+            f"gives {_length_text(size)}")
+
+
+def implausible_density(density: float, *, low: float = PLAUSIBLE_DENSITY[0],
+                        high: float = PLAUSIBLE_DENSITY[1]) -> str | None:
+    """Why a density (kg/m³) is implausible for a solid (:data:`PLAUSIBLE_DENSITY`), or ``None``."""
+    if not math.isfinite(density) or low <= density <= high:
+        return None
+    side = "below" if density < low else "above"
+    return (f"{density:.4g} kg/m³, {side} every solid material ({low:g} to {high:,.0f} kg/m³, foams and balsa "
+            "to osmium)")

@@ -251,10 +251,10 @@ def test_cli_batch_summary_exit_codes_and_resume(parts, tmp_path, capsys):
     code = main(["batch", str(d), "--units", "mm", "--density", "1240", "--out", str(out), "--jobs", "1"])
     err = capsys.readouterr().err
     assert code == 3
-    assert "4 ok, 1 failed, 0 skipped" in err and "files/s" in err and "corrupt.stl" in err
+    assert "5 files: 4 ok, 1 failed in this run;" in err and "files/s" in err and "corrupt.stl" in err
     code = main(["batch", str(d / "box*.stl"), "--units", "mm", "--density", "1240", "--out", str(out)])
     err = capsys.readouterr().err
-    assert code == 0 and "0 ok, 0 failed, 4 skipped" in err
+    assert code == 0 and "4 files: nothing new; 4 done before" in err
     assert main(["batch", str(d), "--out", str(tmp_path / "x.txt")]) == 2
     assert main(["batch", str(d), "--out", str(out), "--jobs", "0"]) == 2
 
@@ -300,7 +300,7 @@ def test_killed_run_leaves_a_valid_file_and_resume_completes(tmp_path):
     assert done.returncode == 0, done.stderr
     rows = _rows(out)
     assert sorted(r["path"] for r in rows) == discover_files(d)    # one row per file, none twice
-    assert f"{before} skipped" in done.stderr
+    assert f"; {before} done before;" in done.stderr
 
 
 # -- issue 11: one writer, quoted names, torn tails, workers that die with the batch --------------------------

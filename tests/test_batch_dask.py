@@ -62,7 +62,7 @@ def test_cli_dask_local_resumes_a_process_pool_run(meshes, tmp_path, capsys):
     code = main(["batch", str(meshes), "--out", str(out), "--jobs", "2", "--dask", "local"])
     err = capsys.readouterr().err
     assert code == 3                  # broken.stl failed
-    assert "0 ok, 1 failed, 6 skipped" in err and "Dask (local)" in err
+    assert "0 ok, 1 failed in this run; 6 done before;" in err and "Dask (local)" in err
     with open_results(out) as r:
         rows = r.previous_rows
     assert len(rows) == 7 and np.isfinite([r["mass"] for r in rows if r["status"] == "ok"]).all()

@@ -114,7 +114,7 @@ def test_file_density_text_report_names_the_density(box_stl, capsys):
 
 
 def test_split_part_spec_rules(tmp_path, monkeypatch):
-    from inertia_tool.cli.analyze import split_part_spec
+    from inertia_tool.cli.model_options import split_part_spec
     monkeypatch.chdir(tmp_path)
     (tmp_path / "odd:name.stl").write_bytes(b"")
     assert split_part_spec("odd:name.stl") == ("odd:name.stl", None)            # exists as given

@@ -26,18 +26,19 @@ the torque ``τ = ω × (J ω) = Ω² (−J_yz, J_xz, 0)``.  Both rotate with th
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import NonFiniteResultError, UsageError
+from ..errors import ImplausibleCorrectionWarning, NonFiniteResultError, UsageError
 from ..mass.properties import MassProperties, combine, point_mass
 from ..rotations import perpendicular_basis
 
 __all__ = ["BalanceGrade", "ISO_GRADES", "ShaftFrame", "shaft_frame", "PlaneUnbalance", "Correction",
            "UnbalanceState", "BalanceReport", "balance", "permissible_unbalance", "balance_grade", "unbalance_state",
-           "UNBALANCE_KINDS"]
+           "UNBALANCE_KINDS", "LARGE_CORRECTION_FRACTION"]
 
 #: The kinds of unbalance of ISO 21940-2 (plus ``balanced`` when both parts are within the tolerance).
 UNBALANCE_KINDS = ("balanced", "static", "couple", "quasi-static", "dynamic")
@@ -595,6 +596,57 @@ def _check_shaft_meets_part(props: MassProperties, frame, offset: float, k_max: 
                          "axis through the part")
 
 
+#: A correction whose masses add up to more than this fraction of the part's mass is reported (a sizeable
+#: change of the part: a larger radius needs proportionally less mass).
+LARGE_CORRECTION_FRACTION = 0.10
+
+
+def _bounding_boxes(props: MassProperties) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The bounding boxes (m, mesh axes) of the meshes a body came from: its own, else its parts'."""
+    if props.mesh is not None:
+        return [(np.asarray(props.mesh.bbox_min, float), np.asarray(props.mesh.bbox_max, float))]
+    return [box for part in props.parts for box in _bounding_boxes(part)]
+
+
+def _part_extent(props: MassProperties, frame) -> tuple[float, float, float] | None:
+    """``(largest radius, lowest z, highest z)`` of the part's bounding-box corners in the shaft frame (an
+    outer bound of the part), or ``None`` when the body did not come from a mesh."""
+    boxes = _bounding_boxes(props)
+    if not boxes:
+        return None
+    corners = np.array([[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]]
+                        for lo, hi in boxes for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+    shaft = frame.to_shaft(corners)
+    return float(np.max(np.hypot(shaft[:, 0], shaft[:, 1]))), float(shaft[:, 2].min()), float(shaft[:, 2].max())
+
+
+def _correction_notes(props: MassProperties, frame, radius: float, planes, corrections,
+                      fraction: float = LARGE_CORRECTION_FRACTION) -> list[str]:
+    """Corrections outside the part or heavy compared with it, each also raised as
+    :class:`~inertia_tool.errors.ImplausibleCorrectionWarning` (the report keeps them in its notes)."""
+    notes = []
+    extent = _part_extent(props, frame)
+    if extent is not None:
+        r_max, z_lo, z_hi = extent
+        slack = 1e-9 * max(r_max, z_hi - z_lo)
+        if radius > r_max + slack:
+            notes.append(f"the correction `radius` {radius:.6g} m lies outside the part: no point of its bounding "
+                         f"box is farther than {r_max:.6g} m from the shaft (check the radius and its unit)")
+        outside = [z for z in planes if not z_lo - slack <= z <= z_hi + slack]
+        if outside:
+            notes.append(f"correction `planes` at {', '.join(f'{z:.6g}' for z in outside)} m lie outside the part, "
+                         f"which spans {z_lo:.6g} to {z_hi:.6g} m along the shaft from the axis point (check the "
+                         "planes and their unit)")
+    added = sum(c.mass for c in corrections)
+    if props.mass > 0 and added > fraction * props.mass:
+        notes.append(f"the correction masses add up to {added:.6g} kg, {100 * added / props.mass:.3g} % of the "
+                     f"part's {props.mass:.6g} kg: a sizeable change of the part (a larger `radius` needs "
+                     "proportionally less mass)")
+    for note in notes:
+        warnings.warn(ImplausibleCorrectionWarning(f"{props.name}: {note}"), stacklevel=3)
+    return notes
+
+
 def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | None = None,
             speed: float | None = None, planes=None, radius: float, grade=None, bearings=None,
             single_plane: bool = False, max_axis_offset: float = 10.0, offset_tol: float | None = None,
@@ -718,6 +770,7 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
                                       position=_readonly(pos), removal_angle=rem,
                                       removal_position=_readonly(rpos)))
 
+    notes += _correction_notes(props, frame, r, planes_t, corrections)
     corrected_body = combine([props] + [point_mass(c.mass, c.position, name="correction") for c in corrections],
                              name=props.name)
     corrected = unbalance_state(corrected_body, frame, offset_tol=offset_tol, tilt_tol=tilt_tol)

@@ -99,6 +99,7 @@ class BatchOptions:
         included: it decides whether a file fails).  Computed from the flat field names, so result files
         written before the options were grouped resume unchanged."""
         flat = {**asdict(self.load), "density": self.density, "material": self.material, "mass": self.mass}
+        flat["units"] = flat["units"] or "m"       # not given (metres assumed) gives the numbers of "m"
         text = json.dumps(flat, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -203,7 +204,7 @@ def _finite(x) -> float | None:
 
 def _empty_row(path: str, sha256: str | None, options: BatchOptions) -> dict:
     row = dict.fromkeys(ROW_FIELDS)
-    row.update(schema=SCHEMA, path=path, sha256=sha256, options_key=options.key(), units=options.load.units,
+    row.update(schema=SCHEMA, path=path, sha256=sha256, options_key=options.key(), units=options.load.units or "m",
                worker=f"{platform.node()}:{os.getpid()}")
     return row
 

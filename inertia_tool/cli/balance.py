@@ -14,8 +14,12 @@ from ..errors import UsageError
 from ..reports.output import check_targets, write_files
 from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length
-from .analyze import add_material_options, add_mesh_options, load_from_args, split_part_spec
+from ..reports.serialize import to_jsonable
+from . import speak_options
+from .help import add_command
+from .model_options import add_files_argument, add_model_options, command_parser, length_unit, load_model, with_warnings
 from .options import check_option
+from .report_option import say_written
 
 __all__ = ["register", "run"]
 
@@ -29,18 +33,24 @@ def _lengths(text: str, unit: str, name: str, count) -> list[float]:
 
 def register(subparsers) -> None:
     grades = ", ".join(g.name.replace(" ", "") for g in ISO_GRADES)
-    p = subparsers.add_parser(
-        "balance", help="static/couple unbalance, ISO 21940-11 tolerance and correction masses about a shaft",
-        description="Balancing report of a rigid rotor turning about a given shaft: static and couple unbalance, "
-                    "ISO 21940-2 kind, rotating bearing loads and the torque of Eq. (4.26), the permissible "
-                    "residual unbalance of an ISO 21940-11 grade, and correction masses in one or two planes, "
-                    "verified by re-analysing the part with them. All lengths on this command line (axis point, "
-                    "planes, radius, bearings) are in the mesh unit given by --units unless they carry a unit "
-                    "(e.g. 40mm). Axial positions are measured along the axis direction from the axis point.")
-    p.add_argument("files", nargs="+", metavar="FILE", help="mesh file(s): STL, OBJ, PLY, OFF, 3MF; "
-                                                           "FILE:material or FILE:density for an assembly")
-    add_material_options(p)
-    add_mesh_options(p)
+    p = add_command(
+        subparsers, "balance",
+        help="static/couple unbalance, ISO 21940-11 tolerance and correction masses about a shaft",
+        description="Balancing report of a rigid rotor turning about a given shaft (Chapter 4, §4.3.2): static "
+                    "and couple unbalance, ISO 21940-2 kind, rotating bearing loads and the torque of Eq. (4.26), "
+                    "the permissible residual unbalance of an ISO 21940-11 grade, and correction masses in one or "
+                    "two planes, verified by re-analysing the part with them. All lengths on this command line "
+                    "(axis point, planes, radius, bearings) are in the mesh unit given by --units unless they "
+                    "carry a unit (e.g. 40mm). Axial positions are measured along the axis direction from the "
+                    "axis point. Takes the same model options as analyze.",
+        examples=["inertia-tool balance meshes/unbalanced_wheel.stl --units mm --material steel --rpm 3000 "
+                  "--planes -30,30 --radius 180 --grade G6.3 --bearings -120,120",
+                  "inertia-tool balance meshes/unbalanced_wheel.stl --units mm --material steel --rpm 3000 "
+                  "--single-plane --radius 180mm --json",
+                  "inertia-tool balance meshes/unbalanced_wheel.stl --units mm --material steel --rpm 3000 "
+                  "--planes -30mm,30mm --radius 180mm --report balance.md"])
+    add_files_argument(p)
+    add_model_options(p)
     s = p.add_argument_group("shaft and correction")
     s.add_argument("--axis-point", default="0,0,0", metavar="X,Y,Z",
                    help="a point of the shaft, mesh coordinates in --units (default 0,0,0)")
@@ -82,7 +92,7 @@ def _report_paths(path: str, count: int) -> tuple[str, list[str]]:
 
 
 def run(args) -> int:
-    unit = args.units
+    unit = length_unit(args)
     axis_point = _lengths(args.axis_point, unit, "axis-point", (3,))
     try:
         direction = [float(t) for t in str(args.axis_direction).split(",")]
@@ -108,18 +118,19 @@ def run(args) -> int:
     if args.drill is not None:
         drill = check_option("--radius", parse_length(args.drill, default_unit=unit), typed=args.drill,
                              label="--drill")             # a length in the range of --radius
-    props, _ = load_from_args(args)
+    loaded = load_model(args)
+    props = loaded.props
     part_mesh = None
     if drill is not None:
-        if len(args.files) != 1:
-            raise UsageError("--drill needs a single part (an assembly has no one material to drill)")
-        from ..mesh.read import load_mesh
-        raw = load_mesh(split_part_spec(args.files[0])[0], units=unit, max_faces=args.max_faces)
-        part_mesh = (raw.vertices, raw.faces)
+        if len(loaded.meshes) != 1 or loaded.model["model"] != "solid":
+            raise UsageError("--drill needs a single solid part (an assembly has no one material to drill; a "
+                             "shell or printed part no solid to drill into)")
+        part_mesh = (loaded.meshes[0].vertices, loaded.meshes[0].faces)     # the file as read, not read again
     report = balance(props, axis_point=axis_point, axis_direction=direction, speed=speed, planes=planes,
                      radius=radius, grade=args.grade, bearings=bearings, single_plane=args.single_plane,
                      drill_diameter=drill, part_mesh=part_mesh)
 
+    parser = command_parser(args)
     if args.report is not None:       # written before anything is printed, so a failure prints one line only
         ext, svgs = _report_paths(args.report, len(report.corrections))
         if ext in (".html", ".htm"):
@@ -128,8 +139,16 @@ def run(args) -> int:
             files = {name: polar_svg(report, k) for k, name in enumerate(svgs)}
             files[args.report] = balance_markdown(report, svg_links=[os.path.basename(n) for n in svgs])
         write_files(files, force=args.force, label="--report")
+        say_written(list(files))
     if args.json:
-        print(json.dumps(balance_dict(report), indent=2, ensure_ascii=False))
+        out = balance_dict(report)
+        out["notes"] = [speak_options(n, parser) for n in out.get("notes", [])]
+        out["density_source"] = loaded.density_source
+        out["model"] = loaded.model
+        out["warnings"] = list(loaded.warnings)
+        out["units_assumed"] = loaded.units_assumed
+        print(json.dumps(to_jsonable(out), indent=2, ensure_ascii=False))
     else:
-        print(format_balance_text(report), end="")
+        print(with_warnings(speak_options(format_balance_text(report), parser), loaded.warnings,
+                            loaded.notes()), end="")
     return 0

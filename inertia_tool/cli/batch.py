@@ -16,10 +16,11 @@ import time
 from ..batch.runner import BatchOptions, discover_files, run_batch
 from ..errors import UsageError
 from ..batch.rows import open_results, results_format
+from .help import add_command
+from .model_options import add_model_options, load_options_from_args
 from .options import check_option, density_and_mass
-from .analyze import add_material_options, add_mesh_options, load_options_from_args
 
-__all__ = ["register", "run", "Progress", "dask_executor"]
+__all__ = ["register", "run", "Progress", "dask_executor", "summary_line"]
 
 #: Exit code when at least one file failed.
 EXIT_SOME_FAILED = 3
@@ -105,15 +106,36 @@ def dask_executor(address: str, jobs: int):
     return client.get_executor(), shutdown
 
 
+def summary_line(summary, files: int, args) -> str:
+    """The closing line of a run: what this run computed, what earlier runs had done, the total mass."""
+    where = f"Dask ({args.dask})" if args.dask else f"{args.jobs} process{'es' if args.jobs > 1 else ''}"
+    before = ""
+    if summary.skipped:
+        failed_before = f", {summary.skipped_failed} of them failed" if summary.skipped_failed else ""
+        before = f"; {summary.skipped} done before{failed_before}"
+    if summary.computed == 0:
+        return (f"batch: {files} files: nothing new{before} (same content, same options); total mass of the ok "
+                f"files {summary.total_mass:.6g} kg; rows in {args.out}")
+    return (f"batch: {files} files: {summary.ok} ok, {summary.failed} failed in this run{before}; total mass of "
+            f"the ok files {summary.total_mass:.6g} kg; {summary.seconds:.2f} s, {summary.files_per_second:.1f} "
+            f"files/s on {where}; rows in {args.out}")
+
+
 def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "batch", help="mass properties of many meshes into one JSONL/CSV file (parallel, resumable)",
-        description="Analyse every mesh in a directory (recursively) or matching a glob; one row per file "
-                    "(numbers or the error) appended to --out and flushed per file, so a killed run can be "
-                    "resumed: files already done (same path, same SHA-256 of the content, same options) "
-                    "are skipped.")
-    p.add_argument("source", metavar="DIR_OR_GLOB", help="directory (searched recursively) or glob, e.g. "
-                                                          "'parts/**/*.stl' (quote it)")
+    parser = p = add_command(
+        subparsers, "batch", help="mass properties of many meshes into one JSONL/CSV file (parallel, resumable)",
+        description="Analyse every mesh in a directory (recursively), matching a glob, or named: one row per "
+                    "file (numbers or the error) appended to --out and flushed per file, so a killed run can be "
+                    "resumed: files already done (same path, same SHA-256 of the content, same options) are "
+                    "skipped.",
+        examples=["inertia-tool batch meshes/ --units mm --material steel --out parts.csv",
+                  "inertia-tool batch meshes/*.stl --units mm --density 1240 --out parts.jsonl --jobs 2",
+                  "inertia-tool batch 'meshes/**/*.stl' --units mm --material pla --out printed.csv"])
+    p.add_argument("source", nargs="+", metavar="PATH",
+                   help="directories (searched recursively), mesh files (e.g. parts/*.stl expanded by the "
+                        "shell) or quoted globs ('parts/**/*.stl', expanded here; ** recurses)")
+    add_model_options(p, thin_walls=False)
+    p = p.add_argument_group("run")
     p.add_argument("--out", required=True, metavar="FILE", help="results file: *.jsonl or *.csv (appended to)")
     p.add_argument("--jobs", "-j", type=int, default=1, metavar="N",
                    help="worker processes (default 1: in this process); with --dask, the LocalCluster size")
@@ -121,9 +143,7 @@ def register(subparsers) -> None:
                    help="run on a Dask cluster: 'local' for a LocalCluster of --jobs workers on this machine, or "
                         "a scheduler address tcp://host:8786 (needs the 'dask' extra)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress display")
-    add_material_options(p)
-    add_mesh_options(p)
-    p.set_defaults(func=run)
+    parser.set_defaults(func=run)
 
 
 def run(args) -> int:
@@ -134,7 +154,8 @@ def run(args) -> int:
     options.validate()
     if args.jobs < 1:
         raise UsageError(f"Expected --jobs >= 1, got {args.jobs}")
-    files = discover_files(args.source)
+    sources = args.source if isinstance(args.source, (list, tuple)) else [args.source]
+    files = sorted({f for source in sources for f in discover_files(source)})
     executor, shutdown = (None, None)
     with open_results(args.out) as out:
         if out.torn_bytes:
@@ -144,19 +165,25 @@ def run(args) -> int:
             executor, shutdown = dask_executor(args.dask, args.jobs)
         progress = None if args.quiet else Progress(sys.stderr)
         try:
-            summary = run_batch(files, options, out.write_row, previous_rows=out.previous_rows, jobs=args.jobs,
+            implausible = []
+
+            def write_row(row):
+                if "metres assumed" in str(row.get("warnings") or ""):     # ImplausibleSizeWarning of this file
+                    implausible.append(row["path"])
+                out.write_row(row)
+
+            summary = run_batch(files, options, write_row, previous_rows=out.previous_rows, jobs=args.jobs,
                                 executor=executor, progress=progress)
         finally:
             if progress is not None:
                 progress.close()
             if shutdown is not None:
                 shutdown()
-    where = f"Dask ({args.dask})" if args.dask else f"{args.jobs} process{'es' if args.jobs > 1 else ''}"
-    print(f"batch: {len(files)} files: {summary.ok} ok, {summary.failed} failed, {summary.skipped} skipped "
-          f"(done before{f', {summary.skipped_failed} of them failed' if summary.skipped_failed else ''}); "
-          f"total mass of the ok files {summary.total_mass:.6g} kg; "
-          f"{summary.seconds:.2f} s, {summary.files_per_second:.1f} files/s on {where}; rows in {args.out}",
-          file=sys.stderr)
+    print(summary_line(summary, len(files), args), file=sys.stderr)
+    if implausible:
+        print(f"batch: warning: {len(implausible)} file(s) read without --units are implausibly large or small "
+              f"in metres (first: {implausible[0]}); their rows' warnings column names the unit that fits — "
+              "give --units", file=sys.stderr)
     for path, message in summary.failures[:10]:
         print(f"batch: failed: {path}: {message}", file=sys.stderr)
     if len(summary.failures) > 10:

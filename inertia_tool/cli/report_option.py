@@ -7,13 +7,15 @@ them to :mod:`inertia_tool.reports.html`.
 from __future__ import annotations
 
 import os
+import sys
 
 from ..errors import UsageError
 from ..reports.html import html_report, write_html_report
+from ..reports.models import model_section
 from ..reports.output import atomic_target, check_targets
 
 __all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES",
-           "check_output_file"]
+           "check_output_file", "say_written"]
 
 #: Suffixes of ``--report`` (the only writer here is HTML).
 REPORT_SUFFIXES = (".html", ".htm")
@@ -48,15 +50,25 @@ def check_report_path(args) -> None:
 
 
 def write_report_from_args(args, props, density_source: str | None, warnings=(), *, meshes=(),
-                           stability=None) -> None:
+                           stability=None, model=None) -> None:
     """Write the HTML report asked for by ``args.report`` (no-op without it): ``meshes`` are the
-    ``RawMesh`` objects the command read, ``stability`` its verdict (or the reason it is undefined)."""
+    ``RawMesh`` objects the command read, ``stability`` its verdict (or the reason it is undefined),
+    ``model`` the mass model's summary (:func:`~inertia_tool.reports.models.model_summary`)."""
     if not getattr(args, "report", None):
         return
     check_report_path(args)
+    extra = [model_section(model)] if model else []
     document = html_report(props, meshes=[(m.vertices, m.faces) for m in meshes], density_source=density_source,
-                           warnings=list(warnings), stability=stability)
+                           warnings=list(warnings), stability=stability, extra_sections=extra)
     write_html_report(args.report, document, force=args.force)
+    say_written([args.report])
+
+
+def say_written(paths) -> None:
+    """``wrote a.csv, b.png`` on stderr: every file a command writes is named (stdout stays the report)."""
+    paths = [str(p) for p in paths if p]
+    if paths:
+        print(f"wrote {', '.join(paths)}", file=sys.stderr)
 
 
 def save_figure(fig, path: str, *, dpi: int = 120) -> None:

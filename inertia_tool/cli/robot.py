@@ -15,19 +15,24 @@ from ..robot.geometry import link_inertials
 from ..robot.write import write_corrected
 from ..units import MATERIALS, parse_density
 from . import speak_options
+from .help import add_command
 from .report_option import check_output_file
 
 __all__ = ["register", "run", "parse_packages", "parse_mappings"]
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "robot", help="link mass properties from a URDF/xacro/SDF/MJCF's geometry; audit and correct <inertial>",
+    ur5 = ("tests/data/robots/example-robot-data/robots/ur_description/urdf/ur5_robot.urdf "
+           "--package example-robot-data=tests/data/robots/example-robot-data")
+    p = add_command(
+        subparsers, "robot", help="link mass properties from a URDF/xacro/SDF/MJCF's geometry; audit and correct <inertial>",
         description="Read a robot description (URDF, xacro, SDFormat, MuJoCo MJCF), compute every link's mass, "
                     "centre of mass and inertia tensor from its collision (or visual) geometry in the link frame, "
                     "compare them with the declared <inertial> elements, and optionally write a copy of the "
                     "description with corrected <inertial> elements (origin at the centre of mass, rpy 0, full "
-                    "tensor). See docs/robots.md.")
+                    "tensor). See docs/robots.md.",
+        examples=[f"inertia-tool robot {ur5} --keep-mass",
+                  f"inertia-tool robot {ur5} --material aluminium --json"])
     p.add_argument("robot", metavar="ROBOT", help="*.urdf, *.xacro, *.sdf, or MuJoCo *.xml")
     p.add_argument("--package", action="append", default=[], metavar="NAME=DIR",
                    help="directory of package NAME for package://NAME/... URIs (repeatable; ROS_PACKAGE_PATH is "

@@ -15,24 +15,28 @@ from ..dynamics.experiment import MAX_SAMPLES, spin_experiment
 from ..dynamics.spin_stability import AXIS_NAMES
 from ..units import parse_angular_rate, parse_duration
 from ..mass.principal import DEFAULT_EQUAL_RTOL
-from .analyze import add_material_options, add_mesh_options, load_from_args
 from ..reports.output import atomic_target, check_targets
+from .help import add_command
+from .model_options import add_files_argument, add_model_options, load_model, model_words, with_warnings
 from .options import check_option, require_range
-from .report_option import save_figure
+from .report_option import save_figure, say_written
 
 __all__ = ["register", "run", "MAX_SAMPLES"]
 
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "spin", help="stability of spin about a principal axis: classification, flip or wobble period",
-        description="Classify spin about each principal axis (§4.4.1), then spin the body about one of them with "
-                    "a small perturbation: print the predicted flip (unstable axis) or wobble (stable axis) period "
-                    "and the one measured on a simulation of the torque-free motion.")
-    p.add_argument("files", metavar="FILE", help="mesh file: STL, OBJ, PLY, OFF, 3MF")
-    add_material_options(p)
-    add_mesh_options(p)
+    p = add_command(
+        subparsers, "spin", help="stability of spin about a principal axis: classification, flip or wobble period",
+        description="Classify spin about each principal axis (Chapter 4, §4.4.1), then spin the body about one "
+                    "of them with a small perturbation: print the predicted flip (unstable axis) or wobble "
+                    "(stable axis) period and the one measured on a simulation of the torque-free motion. Takes "
+                    "the same model options as analyze (assemblies, --model shell, --shell/--infill).",
+        examples=["inertia-tool spin meshes/t_handle.stl --units mm --material aluminium --about intermediate",
+                  "inertia-tool spin meshes/box.stl --units mm --about major --rate 2rev/s --json",
+                  "inertia-tool spin meshes/box.stl --units mm --model shell --thickness 1mm --plot spin.png"])
+    add_files_argument(p)
+    add_model_options(p)
     p.add_argument("--about", choices=AXIS_NAMES, default="intermediate",
                    help="principal axis to spin about, by moment (default: intermediate)")
     p.add_argument("--rate", default="5rev/s", metavar="RATE",
@@ -63,23 +67,39 @@ def _write_csv(path: str, traj) -> None:
         np.savetxt(tmp, data, delimiter=",", header=header, comments="", fmt="%.10g")
 
 
-def _plot(path: str, experiment) -> None:
+def _pyplot():
+    """``matplotlib.pyplot`` on the Agg backend, or :class:`UsageError` when matplotlib is missing."""
     try:
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError as exc:
         raise UsageError("--plot needs matplotlib (pip install 'inertia-tool[plots]')") from exc
+    return plt
+
+
+def _plot(path: str, experiment) -> None:
+    """The body angular velocity on the principal axes (top) and, on their own scale, the two components
+    across the spin axis (bottom): a stable axis's small wobble is visible there, an unstable one's flips too."""
+    plt = _pyplot()
     traj = experiment.trajectory
     axes = np.column_stack([e.axis for e in experiment.report.axes])
     w = np.asarray(traj.angular_velocity) @ axes
-    fig, ax = plt.subplots(figsize=(8, 4))
+    spun = experiment.axis.index
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6), sharex=True,
+                                      gridspec_kw={"height_ratios": [1, 1]})
     for k, name in enumerate(AXIS_NAMES):
-        ax.plot(traj.t, w[:, k], lw=0.8, label=f"ω along I{k + 1} ({name})")
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("body angular velocity (rad/s)")
-    ax.set_title(f"spin about the {experiment.axis.name} axis: {experiment.axis.kind}")
-    ax.legend(loc="upper right", fontsize=8)
+        top.plot(traj.t, w[:, k], lw=0.8, color=f"C{k}", label=f"ω along I{k + 1} ({name})")
+        if k != spun:
+            bottom.plot(traj.t, w[:, k], lw=0.8, color=f"C{k}", label=f"ω along I{k + 1} ({name})")
+    top.set_ylabel("ω (rad/s)")
+    top.set_title(f"spin about the {experiment.axis.name} axis: {experiment.axis.kind}")
+    top.legend(loc="best", fontsize=8)
+    kind = "grows and flips the body" if experiment.axis.kind == "unstable" else "stays small (wobble)"
+    bottom.set_ylabel("ω across the spin axis (rad/s)")
+    bottom.set_title(f"the transverse components on their own scale: the perturbation {kind}", fontsize=10)
+    bottom.set_xlabel("t (s)")
+    bottom.legend(loc="best", fontsize=8)
     fig.tight_layout()
     save_figure(fig, path)
 
@@ -92,21 +112,27 @@ def run(args) -> int:
     rate = check_option("--rate", parse_angular_rate(args.rate), typed=args.rate)
     duration = check_option("--duration", parse_duration(args.duration), typed=args.duration)
     check_targets([(args.csv, "--csv"), (args.plot, "--plot")], force=args.force)
-    props, described = load_from_args(args)
+    if args.plot:
+        _pyplot()                      # a missing matplotlib is refused before any work or any file written
+    loaded = load_model(args)
+    props, described = loaded.props, loaded.density_source
     experiment = spin_experiment(props, args.about, rate, perturbation=args.perturbation, duration=duration,
                                  samples=args.samples, rtol=args.rtol, method=args.method, max_samples=MAX_SAMPLES)
     if args.csv:
         _write_csv(args.csv, experiment.trajectory)
     if args.plot:
         _plot(args.plot, experiment)
+    say_written([args.csv, args.plot])
     if args.json:
         out = {"name": props.name, "density_source": described, "mass": props.mass,
+               "model": loaded.model, "warnings": list(loaded.warnings), "units_assumed": loaded.units_assumed,
                "stability": stability_dict(experiment.report, perturbation=args.perturbation),
                "spin": spin_dict(experiment)}
         json.dump(to_jsonable(out), sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     else:
-        print(f"{props.name}: mass {props.mass:.6g} kg ({described})")
+        print(with_warnings(f"{props.name}: mass {props.mass:.6g} kg ({described}{model_words(loaded.model)})",
+                            loaded.warnings, loaded.notes()))
         print("\n".join(format_stability(experiment.report, perturbation=args.perturbation)))
         print(format_spin(experiment, name=props.name))
     return 0

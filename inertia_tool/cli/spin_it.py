@@ -10,7 +10,8 @@ import numpy as np
 
 from ..errors import UsageError
 from ..units import length_scale, parse_density, parse_length, parse_mass, parse_vector
-from .analyze import add_material_options
+from .help import add_command
+from .model_options import add_material_options, length_unit
 from ..reports.output import check_targets
 from .report_option import save_figure
 
@@ -22,14 +23,18 @@ OUTPUT_SUFFIXES = (".stl", ".3mf")
 
 def register(subparsers) -> None:
     from ..design.limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
-    p = subparsers.add_parser(
-        "spin-it", help="hollow a part so that it spins stably as a yo-yo or a top",
+    p = add_command(
+        subparsers, "spin-it", help="hollow a part so that it spins stably as a yo-yo or a top",
         description="Design the inside of a part (Bächer et al., Spin-It, 2014; Hafner et al., Spin-It Faster, "
                     "2024): a cavity bounded by a quadric, keeping a minimum wall, so that the part spins stably "
                     "about the given axis — as a yo-yo (free spin, Chapter 4 §4.4.1: the axis a principal axis of "
                     "largest moment, through the centre of mass) or a top on a pivot (§4.4.3: centre of mass on "
                     "the axis, equal transverse moments, low sleeping-top spin). The hollowed mesh is re-analysed "
-                    "exactly; the report compares before and after.")
+                    "exactly; the report compares before and after.",
+        examples=["inertia-tool spin-it meshes/spinning_top.stl --units mm --material pla --mode top --pivot 0,0,0 "
+                  "--axis 0,0,1 --wall 2mm --resolution 24",
+                  "inertia-tool spin-it meshes/washer.stl --units mm --material pla --axis 0,0,1 --wall 1.5mm "
+                  "--resolution 24 --json"])
     p.add_argument("files", metavar="FILE", help="closed mesh: STL, OBJ, PLY, OFF, 3MF")
     add_material_options(p)
     p.add_argument("--axis", required=True, metavar="X,Y,Z", help="spin axis direction (unitless, normalised)")
@@ -111,19 +116,20 @@ def run(args) -> int:
         raise UsageError("--through is for --mode yoyo; a top's axis passes through its --pivot")
     if args.mode == "yoyo" and args.pivot is not None:
         raise UsageError("--pivot is for --mode top")
-    wall = parse_length(args.wall, args.units)
+    unit = length_unit(args)
+    wall = parse_length(args.wall, unit)
     if not wall > 0:
         raise UsageError(f"--wall must be positive, got {args.wall}")
     result = spin_it(args.files, axis=_direction(args.axis), mode=args.mode, wall=wall,
-                     through=parse_vector(args.through, args.units) if args.through else None,
-                     pivot=parse_vector(args.pivot, args.units) if args.pivot else None, units=args.units,
+                     through=parse_vector(args.through, unit) if args.through else None,
+                     pivot=parse_vector(args.pivot, unit) if args.pivot else None, units=args.units,
                      density=parse_density(args.density) if args.density is not None else None,
                      material=args.material, mass=parse_mass(args.mass) if args.mass is not None else None,
                      resolution=args.resolution, insert_density=insert_density)
     if args.out and result.insert_vertices is not None:
         _write_two_materials(args.out, result, args.material or "part", args.insert)
     elif args.out:
-        _write(args.out, result.vertices, result.faces, args.units)
+        _write(args.out, result.vertices, result.faces, unit)
     if args.plot:
         try:
             from ..reports.spin_it import spin_it_figure

@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import math
 import sys
-import warnings
 
 import numpy as np
 
@@ -15,10 +14,11 @@ from ..dynamics.top import STANDARD_GRAVITY, heavy_top_on_pivot
 from ..reports.stability import format_heavy_top, heavy_top_dict
 from ..reports.serialize import to_jsonable
 from ..units import parse_angle, parse_angular_rate, parse_duration, parse_vector
-from .analyze import add_material_options, add_mesh_options, load_from_args
 from ..reports.output import atomic_target, check_targets
+from .help import add_command
+from .model_options import add_files_argument, add_model_options, length_unit, load_model, model_words, with_warnings
 from .options import check_option, require_range
-from .report_option import save_figure
+from .report_option import save_figure, say_written
 
 __all__ = ["register", "run", "MAX_SAMPLES", "MIN_SAMPLES_PER_PERIOD"]
 
@@ -32,15 +32,20 @@ MIN_SAMPLES_PER_PERIOD = 16
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "top", help="the body spinning on a fixed pivot as a heavy symmetric top: nutation, precession",
-        description="Treat the body as a heavy symmetric top on a fixed pivot (§4.4.3): the symmetry axis runs "
-                    "from the pivot to the centre of mass. Prints the nutation limits and period, the kind of "
-                    "precession (Fig. 4.3), the sleeping-top criterion and the steady precession rates, and "
-                    "checks them on a simulation.")
-    p.add_argument("files", metavar="FILE", help="mesh file: STL, OBJ, PLY, OFF, 3MF")
-    add_material_options(p)
-    add_mesh_options(p)
+    p = add_command(
+        subparsers, "top", help="the body spinning on a fixed pivot as a heavy symmetric top: nutation, precession",
+        description="Treat the body as a heavy symmetric top on a fixed pivot (Chapter 4, §4.4.3): the symmetry "
+                    "axis runs from the pivot to the centre of mass. Prints the nutation limits and period, the "
+                    "kind of precession (Fig. 4.3), the sleeping-top criterion and the steady precession rates, and "
+                    "checks them on a simulation. Takes the same model options as analyze.",
+        examples=["inertia-tool top meshes/spinning_top.stl --units mm --material pla --pivot 0,0,0 --spin 50rev/s "
+                  "--tilt 20deg",
+                  "inertia-tool top meshes/spinning_top.stl --units mm --pivot 0,0,0 --spin 30rev/s --tilt 10deg "
+                  "--no-simulate --json",
+                  "inertia-tool top meshes/spinning_top.stl --units mm --shell 1.2mm --infill 20% --pivot 0,0,0 "
+                  "--spin 50rev/s --tilt 20deg --plot top.png"])
+    add_files_argument(p)
+    add_model_options(p)
     p.add_argument("--pivot", required=True, metavar="X,Y,Z",
                    help="pivot point in mesh coordinates (in --units unless a unit is given, e.g. 0,0,-2mm)")
     p.add_argument("--spin", required=True, metavar="RATE", help="spin about the symmetry axis, e.g. 50rev/s")
@@ -73,25 +78,41 @@ def _write_csv(path: str, traj) -> None:
         np.savetxt(tmp, data, delimiter=",", header=header, comments="", fmt="%.10g")
 
 
-def _plot(path: str, top, traj) -> None:
+def _pyplot():
+    """``matplotlib.pyplot`` on the Agg backend, or :class:`UsageError` when matplotlib is missing."""
     try:
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError as exc:
         raise UsageError("--plot needs matplotlib (pip install 'inertia-tool[plots]')") from exc
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
-    a1.plot(traj.t, np.degrees(traj.theta), lw=0.8)
+    return plt
+
+
+def _plot(path: str, top, traj) -> None:
+    """θ(t) with the predicted limits, and the path of the axis as θ against the precession angle φ (the
+    chapter's Fig. 4.3: waves, loops or cusps between the two limiting circles)."""
+    plt = _pyplot()
+    from matplotlib.ticker import MaxNLocator
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    theta = np.degrees(traj.theta)
+    a1.plot(traj.t, theta, lw=0.8)
     for th in (top.theta_min, top.theta_max):
         a1.axhline(math.degrees(th), color="k", lw=0.5, ls="--")
     a1.set_xlabel("t (s)")
     a1.set_ylabel("tilt θ (deg)")
     a1.set_title("nutation (dashed: predicted limits)")
-    a2.plot(traj.axis[:, 0], traj.axis[:, 1], lw=0.8)
-    a2.set_aspect("equal")
-    a2.set_xlabel("axis x")
-    a2.set_ylabel("axis y")
-    a2.set_title(f"axis seen from above: {top.precession_kind}")
+    a2.plot(np.degrees(traj.phi - traj.phi[0]), theta, lw=0.8)
+    for th in (top.theta_min, top.theta_max):
+        a2.axhline(math.degrees(th), color="k", lw=0.5, ls="--")
+    a2.invert_yaxis()                       # the axis tip seen from outside the sphere: θ grows downwards
+    a2.set_xlabel("precession φ − φ0 (deg)")
+    a2.set_ylabel("tilt θ (deg)")
+    a2.set_title(f"path of the axis (Fig. 4.3): {top.precession_kind}")
+    for ax in (a1, a2):
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=6, steps=[1, 2, 2.5, 5, 10]))
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=6, steps=[1, 2, 2.5, 5, 10]))
+        ax.ticklabel_format(axis="y", useOffset=False)
     fig.tight_layout()
     save_figure(fig, path)
 
@@ -127,11 +148,12 @@ def run(args) -> int:
     if args.no_simulate and (args.csv or args.plot):
         raise UsageError("--csv and --plot need the simulation (drop --no-simulate)")
     check_targets([(args.csv, "--csv"), (args.plot, "--plot")], force=args.force)
-    with warnings.catch_warnings():
-        # a symmetric top has two equal moments by design; heavy_top_on_pivot reports its own asymmetry
-        warnings.simplefilter("ignore", NearlyEqualMomentsWarning)
-        props, described = load_from_args(args)
-    pivot = np.array(check_option("--pivot", list(parse_vector(args.pivot, default_unit=args.units)),
+    if args.plot:
+        _pyplot()                      # a missing matplotlib is refused before any work or any file written
+    # a symmetric top has two equal moments by design; heavy_top_on_pivot reports its own asymmetry
+    loaded = load_model(args, ignore=(NearlyEqualMomentsWarning,))
+    props, described = loaded.props, loaded.density_source
+    pivot = np.array(check_option("--pivot", list(parse_vector(args.pivot, default_unit=length_unit(args))),
                                   typed=args.pivot))
     rates = {name: check_option(f"--{name}", parse_angular_rate(getattr(args, name)), typed=getattr(args, name))
              for name in ("spin", "nutation", "precession")}
@@ -150,11 +172,14 @@ def run(args) -> int:
         _write_csv(args.csv, traj)
     if args.plot:
         _plot(args.plot, top, traj)
+    say_written([args.csv, args.plot])
     if args.json:
-        out = {"name": props.name, "density_source": described, "top": heavy_top_dict(top, traj)}
+        out = {"name": props.name, "density_source": described, "model": loaded.model,
+               "warnings": list(loaded.warnings), "units_assumed": loaded.units_assumed, "top": heavy_top_dict(top, traj)}
         json.dump(to_jsonable(out), sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     else:
-        print(f"{props.name}: mass {props.mass:.6g} kg ({described})")
+        print(with_warnings(f"{props.name}: mass {props.mass:.6g} kg ({described}{model_words(loaded.model)})",
+                            loaded.warnings, loaded.notes()))
         print(format_heavy_top(top, traj))
     return 0

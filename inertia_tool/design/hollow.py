@@ -252,9 +252,13 @@ def _load(source, units: str, density, material, mass):
     from ..mesh.read import load_mesh
 
     rho, _ = resolve_density(density=density, material=material, mass=mass)
+    from ..mesh.plausibility import warn_implausible_size
+
     raw = load_mesh(source, units=units)
+    warn_implausible_size(raw, stacklevel=4)
     prepared = prepare_mesh(raw)
-    props = mass_properties((prepared.vertices, prepared.faces), density=rho, mass=mass, name=raw.source)
+    props = mass_properties((prepared.vertices, prepared.faces), density=rho, mass=mass, name=raw.source,
+                            units="m")           # already converted: metres stated, not assumed
     return prepared.vertices, prepared.faces, props, raw.source
 
 
@@ -273,7 +277,7 @@ def _exact_near_wall(grid, vertices, faces, wall: float):
     return replace(grid, signed_distance=depth)
 
 
-def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivot=None, units: str = "m",
+def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivot=None, units: str | None = None,
             density: float | None = None, material: str | None = None, mass: float | None = None,
             resolution: int = DEFAULT_RESOLUTION, center_weight: float = 1e4, product_weight: float = 1e4,
             gravity: float = 9.80665, insert_density: float | None = None) -> SpinItResult:

@@ -58,7 +58,16 @@ def plot_trajectory(trajectory, path, *, dpi: int = 120):
     ax2.plot_wireframe(radii[0] * np.cos(uu) * np.sin(vv), radii[1] * np.sin(uu) * np.sin(vv),
                        radii[2] * np.cos(vv), color="0.8", linewidth=0.5)
     ax2.plot(omega_p[:, 0], omega_p[:, 1], omega_p[:, 2], color="C3")
-    ax2.set_title("polhode on the inertia ellipsoid ω·I·ω = 2T (principal axes)")
+    # equal scaling on the three axes: the ellipsoid's true shape (a box aspect of its semi-axes and equal
+    # limits), not stretched to a cube
+    reach = 1.05 * float(np.max(radii))
+    for set_lim in (ax2.set_xlim, ax2.set_ylim, ax2.set_zlim):
+        set_lim(-reach, reach)
+    ax2.set_box_aspect((1.0, 1.0, 1.0))
+    ax2.set_xlabel("ω1")
+    ax2.set_ylabel("ω2")
+    ax2.set_zlabel("ω3")
+    ax2.set_title("polhode on the inertia ellipsoid ω·I·ω = 2T\n(principal axes, equal scales)")
     ax3 = fig.add_subplot(2, 2, 3)
     ax3.plot(t, _relative_drift(trajectory.energy))
     ax3.set_xlabel("t [s]")

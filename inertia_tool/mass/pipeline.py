@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import InvalidMeshError, NearlyEqualMomentsWarning, OverlapWarning, PhysicalValidityWarning, UsageError
 from ..mesh.options import LoadOptions
+from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.prepare import PreparedMesh, classify_shells, prepare_mesh
 from ..mesh.read import load_mesh
 from ..tolerances import NEEDLE_RTOL, TRIANGLE_INEQUALITY_RTOL
@@ -172,6 +173,7 @@ def _part(source: MeshSource, rho: float | None, mass: float | None, options: Lo
     prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance,
                             overlap=options.overlap)
     label = name or raw.source
+    warn_implausible_size(raw, stacklevel=4)
     bodies = _bodies(prepared, rho if rho is not None else 1.0, label)
     total = bodies[0] if len(bodies) == 1 else combine(bodies, name=label)
     result = MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
@@ -181,6 +183,7 @@ def _part(source: MeshSource, rho: float | None, mass: float | None, options: Lo
     if rho is None:
         assert mass is not None, "resolve_density leaves the density open only for a target mass"
         result = result.with_mass(mass)
+        warn_implausible_density(label, result.density, mass, result.volume, stacklevel=4)
     _check_finite(result, label)
     _check_physical(result)
     if warn_principal:
@@ -241,7 +244,9 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
     else:
         total = combine(bodies, name="assembly")
         _warn_about_part_overlaps(meshes, [b.name for b in bodies])
-    total = total.with_mass(mass) if mass is not None else total
+    if mass is not None:
+        total = total.with_mass(mass)
+        warn_implausible_density(total.name, total.mass / total.volume, mass, total.volume)
     _warn_about_principal(total, total.name)
     return total
 

@@ -140,6 +140,30 @@ class ReferenceSolid:
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "faces", f)
 
+    def transformed(self, rotation=None, translation=None) -> "ReferenceSolid":
+        """The same solid moved rigidly, ``x ↦ R x + t``: its mesh and both closed forms.
+
+        Parameters
+        ----------
+        rotation : (3, 3) array_like, optional
+            Proper rotation (active), e.g. ``inertia_tool.rotations.rotation_z(angle)``.  Default identity.
+        translation : (3,) array_like, optional
+            m.  Default zero.
+
+        Returns
+        -------
+        ReferenceSolid
+            Vertices ``R v + t`` (winding unchanged: a proper rotation keeps the outward normals outward);
+            ``exact`` and ``mesh_exact`` with ``center_of_mass = R c + t`` and ``inertia = R I Rᵀ``
+            (:meth:`MassProperties.transformed`).
+        """
+        exact = self.exact.transformed(rotation, translation)        # checks the rotation and translation
+        mesh_exact = self.mesh_exact.transformed(rotation, translation)
+        r = np.eye(3) if rotation is None else np.asarray(rotation, dtype=np.float64)
+        t = np.zeros(3) if translation is None else np.asarray(translation, dtype=np.float64).reshape(3)
+        return ReferenceSolid(name=self.name, vertices=self.vertices @ r.T + t, faces=self.faces, exact=exact,
+                              mesh_exact=mesh_exact)
+
 
 # -- input checks -------------------------------------------------------------------------------------
 

@@ -38,6 +38,7 @@ from ..values import frozen_value
 from ..mesh.checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from ..errors import InvalidMeshError, PhysicsError, UsageError
 from ..mesh.options import LoadOptions
+from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.prepare import prepare_mesh
 from ..mesh.read import load_mesh
 from .pipeline import MeshSource, resolve_density
@@ -92,6 +93,7 @@ def shell_mass_properties(source: MeshSource, *, thickness: float, density: floa
     opts = LoadOptions.build(options, **load_options)
     rho, _ = resolve_density(density=density, material=material, mass=mass)
     raw = load_mesh(source, units=opts.units, max_faces=opts.max_faces)
+    warn_implausible_size(raw)
     v, f = raw.vertices, raw.faces
     if len(f) == 0:
         raise InvalidMeshError(f"{raw.source}: the mesh has no triangles")
@@ -117,7 +119,8 @@ def shell_mass_properties(source: MeshSource, *, thickness: float, density: floa
                            name=name or raw.source, mesh=report)
     if rho is None:
         assert mass is not None, "resolve_density leaves the density open only for a target mass"
-        return props.with_mass(mass)
+        props = props.with_mass(mass)
+        warn_implausible_density(props.name, props.density, mass, props.volume)
     return props
 
 
@@ -202,6 +205,7 @@ def printed_part(source: MeshSource, *, skin: float, infill: float, density: flo
     raw = load_mesh(source, units=opts.units, max_faces=opts.max_faces)
     prepared = prepare_mesh(raw, repair=opts.repair, merge_tolerance=opts.merge_tolerance, overlap=opts.overlap)
     v, f = prepared.vertices, prepared.faces
+    warn_implausible_size(raw)
     solid = volume_moments(v, f)
     sm = surface_moments(v, f, origin=solid.centroid)
     skin_volume = sm.area * s

@@ -3,7 +3,8 @@
 Stages: :mod:`.read` (files, trimesh objects and arrays → :class:`~.read.RawMesh` in metres) →
 :mod:`.weld` (shared vertices) → :mod:`.checks` (edge census, shells, :class:`~.checks.MeshReport`) →
 :mod:`.prepare` (what the triangles mean as a solid: refusals, repair, orientation, cavities, overlaps).
-:class:`~.options.LoadOptions` says how, for every entry point.
+:class:`~.options.LoadOptions` says how, for every entry point.  :mod:`.plausibility` warns when a part read
+without a unit is implausibly large or small (a millimetre file read as metres).
 """
 
 from .checks import MeshReport

@@ -36,9 +36,11 @@ class LoadOptions:
 
     Attributes
     ----------
-    units : str
+    units : str or None
         Length unit of the mesh coordinates: ``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft`` (converted to
-        metres on reading; everything after is SI).
+        metres on reading; everything after is SI).  ``None`` (the default): not given, metres assumed; a
+        part whose size is then implausible raises :class:`~inertia_tool.errors.ImplausibleSizeWarning`
+        naming the unit that would fit (STL and OBJ carry no unit).
     repair : bool
         Give a bounded estimate for a mesh that does not bound a solid (holes, cracks, stray pieces) instead
         of refusing it; the mesh report's ``method`` and ``uncertainty`` say what was done and how far off
@@ -54,14 +56,15 @@ class LoadOptions:
         Refuse sources with more triangles than this (a memory guard checked before allocating).
     """
 
-    units: str = "m"
+    units: str | None = None
     repair: bool = False
     overlap: str = "union"
     merge_tolerance: float = MERGE_TOLERANCE
     max_faces: int = DEFAULT_MAX_FACES
 
     def __post_init__(self) -> None:
-        length_scale(self.units)                      # raises UnitsError for an unknown unit
+        if self.units is not None:
+            length_scale(self.units)                  # raises UnitsError for an unknown unit
         if not isinstance(self.repair, (bool, np.bool_)):
             raise UsageError(f"Expected `repair` to be True or False, got {self.repair!r}")
         if self.overlap not in ("union", "sum"):

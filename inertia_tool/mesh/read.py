@@ -66,6 +66,9 @@ class RawMesh:
         Length unit of the file coordinates (the unit the file declares, where its format has one).
     file_faces : int
         Number of triangles the source held (before any cleaning).
+    units_assumed : bool
+        True when no unit was given and metres were assumed (the size check of
+        :func:`inertia_tool.mesh.plausibility.warn_implausible_size` applies only then).
     """
 
     vertices: np.ndarray
@@ -73,6 +76,7 @@ class RawMesh:
     source: str
     units: str = "m"
     file_faces: int = 0
+    units_assumed: bool = False
 
 
 def _display(path) -> str:
@@ -779,7 +783,7 @@ def _read_with_trimesh(path: str, max_faces: int):
     return v, f, declared
 
 
-def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -> RawMesh:
+def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_FACES) -> RawMesh:
     """Read a mesh and convert it to metres.
 
     Parameters
@@ -788,8 +792,9 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
         A file (format from its suffix; STL and OBJ read natively, streaming), a ``trimesh.Trimesh``, a
         pair of arrays ``vertices (n, 3)`` and ``faces (m, 3)``, or a ``RawMesh`` read before (returned as
         it is: it is already in metres, so ``units`` does not apply to it; the face limit still does).
-    units : str
-        Length unit of the coordinates (``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft``).
+    units : str or None
+        Length unit of the coordinates (``m``, ``cm``, ``mm``, ``um``, ``in``, ``ft``); ``None``: not given,
+        metres assumed (``RawMesh.units_assumed`` says so).
     max_faces : int
         Refuse sources with more triangles than this (protects memory).  What a file *announces* (an STL,
         PLY or OFF header, a 3MF's inflated size) is checked against its size and this limit before
@@ -808,6 +813,8 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
     UsageError
         Bad ``units``, ``max_faces`` or malformed arrays.
     """
+    assumed = units is None
+    units = "m" if assumed else units
     scale = length_scale(units)
     if not (isinstance(max_faces, (int, np.integer)) and 0 < max_faces <= MAX_SUPPORTED_FACES):
         raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,} (corner "
@@ -837,11 +844,11 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
                                   max_ratio=MAX_ZIP_RATIO, min_ratio_bytes=_ZIP_RATIO_MIN_BYTES,
                                   suffixes=SUPPORTED_SUFFIXES) as (inner, member):
                     try:
-                        raw = load_mesh(inner, units=units, max_faces=max_faces)
+                        raw = load_mesh(inner, units=None if assumed else units, max_faces=max_faces)
                     except MeshReadError as exc:
                         raise MeshReadError(str(exc).replace(inner, f"{_display(path)}:{member}", 1)) from None
                 return RawMesh(vertices=raw.vertices, faces=raw.faces, source=_display(path), units=raw.units,
-                               file_faces=raw.file_faces)
+                               file_faces=raw.file_faces, units_assumed=raw.units_assumed)
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
                                   f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
@@ -874,15 +881,17 @@ def load_mesh(source, *, units: str = "m", max_faces: int = DEFAULT_MAX_FACES) -
                 raise
             raise _fail(path, f"cannot be read ({os_error_reason(exc, path)})") from None
         name = _display(path)
-        if declared is not None:
+        if declared is not None:           # the file says its unit: nothing is assumed
             scale, units = _declared_units_win(name, declared, units, scale)
+            assumed = False
     else:
         vertices, faces, name = _from_object(source)
         n = len(faces)
         _check_face_budget(name, n, max_faces)
     if scale != 1.0:
         vertices = vertices * scale
-    return RawMesh(vertices=vertices, faces=faces, source=name, units=str(units), file_faces=n)
+    return RawMesh(vertices=vertices, faces=faces, source=name, units=str(units), file_faces=n,
+                   units_assumed=assumed)
 
 
 def _declared_units_win(name: str, declared: tuple[float, str], units: str, scale: float) -> tuple[float, str]:

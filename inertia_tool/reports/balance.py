@@ -143,7 +143,7 @@ def balance_dict(report: BalanceReport) -> dict:
 # ---- shared rows ---------------------------------------------------------------------------------------
 def _summary_rows(report: BalanceReport) -> list[tuple[str, str]]:
     s = report.initial
-    com = s.center_of_mass * 1e3
+    com = s.center_of_mass * 1e3 + 0.0
     rows = [
         ("kind (ISO 21940-2)", _KIND_TEXT[s.kind]),
         ("centre of mass (shaft frame)", f"({com[0]:.4g}, {com[1]:.4g}, {com[2]:.4g}) mm; "
@@ -223,8 +223,8 @@ def _verification_text(report: BalanceReport) -> str:
 
 def _header(report: BalanceReport) -> list[tuple[str, str]]:
     f = report.frame
-    ax = f.axes
-    o = f.origin * 1e3
+    ax = f.axes + 0.0            # + 0.0 turns -0.0 into 0.0, which prints as "0", not "-0"
+    o = f.origin * 1e3 + 0.0
     return [
         ("part", f"{report.name or '(unnamed)'}: {_num(report.mass)} kg"),
         ("speed", f"{report.rpm:.6g} rpm (Ω = {report.speed:.6g} rad/s)"),

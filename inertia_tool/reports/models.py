@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from ..mass.thinwall import PrintedPart
+from .escape import escape_html
 
-__all__ = ["model_summary", "format_model_note"]
+__all__ = ["model_summary", "format_model_note", "model_section"]
 
 
 def model_summary(model: str, *, thickness: float | None = None, printed: PrintedPart | None = None) -> dict:
@@ -44,3 +45,31 @@ def format_model_note(summary: dict) -> str:
                 f"(second-order edge term K·s², K = {summary['offset_coefficient']:.4g} m); "
                 f"inertia error of order {order} (L: part size)")
     return ""
+
+
+def model_section(summary: dict):
+    """The mass model and its assumptions as a section of the HTML report (every model, the solid too)."""
+    from .html import HtmlSection
+    model = summary.get("model", "solid")
+    e = escape_html
+    if model == "solid":
+        rows = [("model", "solid"),
+                ("assumes", "homogeneous material fills the closed surface (exact for the polyhedron: "
+                            "closed-form integration over signed tetrahedra)")]
+    elif model == "shell":
+        rows = [("model", "thin shell (sheet metal, thin-walled part)"),
+                ("wall thickness", f"{summary['thickness'] * 1e3:.6g} mm, the mesh is the wall's mid-surface"),
+                ("assumes", "mass ρ·t·A; exact for flat triangular plates of thickness t (with the t²/12 "
+                            "through-thickness term); walls curved or bent at radius R err by a relative O((t/R)²)")]
+    else:
+        rows = [("model", "3D-printed part (solid skin around a partly filled core)"),
+                ("skin", f"{summary['skin'] * 1e3:.6g} mm"), ("infill", f"{100 * summary['infill']:.4g} %"),
+                ("envelope volume", f"{summary['envelope_volume']:.6g} m³"),
+                ("skin volume A·s", f"{summary['skin_volume_first_order']:.6g} m³"),
+                ("assumes", "first order in the skin thickness s: M = ρ[f·V + (1−f)·A·s], "
+                            "I = ρ[f·I_solid + (1−f)·I_shell(s)]"),
+                ("estimated error", f"mass over-counted by about {100 * summary['mass_error_estimate']:.3g} % "
+                                    f"(edge term K·s², K = {summary['offset_coefficient']:.4g} m); inertia error of "
+                                    f"order {summary['inertia_error_order']}")]
+    body = "<table>" + "".join(f'<tr><th>{e(k)}</th><td class="l">{e(v)}</td></tr>' for k, v in rows) + "</table>"
+    return HtmlSection("Mass model", body, "model")

@@ -45,6 +45,7 @@ def _period(x, none: str, digits: int = 6) -> str:
 def _vec(v) -> str:
     v = np.asarray(v, dtype=float)
     v = np.where(np.abs(v) <= 1e-12 * max(np.max(np.abs(v)), 1e-300), 0.0, v) + 0.0
+    v = np.round(v, 4) + 0.0          # what rounds to zero prints as 0.0000, not -0.0000
     return "(" + ", ".join(f"{x: .4f}" for x in v) + ")"
 
 

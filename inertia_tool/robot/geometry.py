@@ -57,7 +57,9 @@ def mesh_properties(path: str, *, repair: bool = False) -> MassProperties:
     MassProperties
         Unit density: ``mass == volume``.
     """
-    return mass_properties(path, density=1.0, repair=repair)
+    # robot descriptions give mesh coordinates in metres (the element's `scale` is applied afterwards), so the
+    # unit is stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
+    return mass_properties(path, density=1.0, repair=repair, units="m")
 
 
 def _capsule(radius: float, length: float) -> MassProperties:
@@ -256,7 +258,7 @@ def link_inertials(robot: RobotDescription, *, density: float | None = None, mat
 
 def _mesh_vertices_faces(element: GeometryElement):
     from ..mesh.read import load_mesh
-    raw = load_mesh(element.mesh)
+    raw = load_mesh(element.mesh, units="m")
     return raw.vertices * element.scale, raw.faces
 
 

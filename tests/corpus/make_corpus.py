@@ -360,14 +360,14 @@ def _(path):
     return [(v, f)]
 
 
-@entry("micrometre.stl", "a 1 µm part", 0, r"^$")
+@entry("micrometre.stl", "a 1 µm part, no unit given: warned", 0, r"metres assumed; largest extent 3 µm, below 100 µm")
 def _(path):
     v, f = box((1e-6, 2e-6, 3e-6), center=(1e-6, 0, 0))
     write_ascii_stl(path, v, f)
     return [(v, f)]
 
 
-@entry("kilometre.stl", "a 1 km part", 0, r"^$")
+@entry("kilometre.stl", "a 1 km part, no unit given: warned", 0, r"metres assumed; largest extent 1.5e\+03 m, above 20 m")
 def _(path):
     v, f = box((1000.0, 1500.0, 800.0), center=(0, 0, 400.0))
     write_ascii_stl(path, v, f)

@@ -1,0 +1,339 @@
+"""The model options every command that loads a part takes, defined once.
+
+``analyze``, ``spin``, ``top``, ``balance`` and ``batch`` describe the part the same way, in the same order
+in ``--help``:
+
+* ``FILE [FILE ...]`` — one mesh, or an assembly ``a.stl:steel b.stl:1.2g/cm3``;
+* units and material — ``--units``, ``--density`` | ``--material`` | ``--mass``;
+* the mass model — ``--model shell --thickness 2mm`` (sheet metal) or ``--shell 1.2mm --infill 20%``
+  (a printed part);
+* mesh checks — ``--repair``, ``--overlap``, ``--merge-tolerance``, ``--max-faces``.
+
+:func:`load_model` turns them into the engine's :class:`~inertia_tool.mass.properties.MassProperties`, the
+words the reports print about the density (``density_source``), the model's assumptions and the warnings
+the engine raised.  Routing only: numbers come from the engine.
+
+Units: ``--units`` left out means "not given, metres assumed" (``LoadOptions.units=None``), so the engine can
+warn when the part's size is implausible for metres (:class:`~inertia_tool.errors.ImplausibleSizeWarning`).
+Bare lengths elsewhere on the command line are in ``--units`` (metres without it); a number with a unit
+(``2mm``, ``0.5in``) is accepted wherever a length, mass or density is asked for.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from dataclasses import dataclass
+
+from ..errors import InertiaToolWarning, UsageError
+from ..mass.pipeline import DEFAULT_DENSITY, assembly, mass_properties, resolve_density
+from ..mass.thinwall import printed_part, shell_mass_properties
+from ..mesh.options import DEFAULT_MAX_FACES, LoadOptions
+from ..mesh.read import load_mesh
+from ..reports.models import model_summary
+from ..tolerances import MERGE_TOLERANCE
+from ..units import LENGTH_UNITS, MATERIALS, parse_density, parse_fraction, parse_length
+from .options import check_option, density_and_mass
+
+__all__ = ["add_files_argument", "add_model_options", "add_material_options", "add_mesh_options",
+           "split_part_spec", "length_unit", "load_options_from_args", "read_meshes", "load_model",
+           "LoadedModel", "model_words", "with_warnings", "command_parser"]
+
+FILES_HELP = ("mesh file(s): STL, OBJ, PLY, OFF, 3MF; several FILE:material or FILE:density make an "
+              "assembly (e.g. a.stl:steel b.stl:1.2g/cm3)")
+
+
+def add_files_argument(parser, *, help: str = FILES_HELP) -> None:
+    """``FILE [FILE ...]``: one part or an assembly."""
+    parser.add_argument("files", nargs="+", metavar="FILE", help=help)
+
+
+def add_material_options(parser) -> None:
+    """``--units``, then one of ``--density``, ``--material``, ``--mass``."""
+    g = parser.add_argument_group("units and material")
+    g.add_argument("--units", default=None, metavar="UNIT",
+                   help=f"length unit of the mesh coordinates: {', '.join(LENGTH_UNITS)} (default: m, assumed; "
+                        "STL and OBJ carry no unit, so a part implausibly large or small in metres is warned "
+                        "about); bare lengths on this command line are in this unit too")
+    m = g.add_mutually_exclusive_group()
+    m.add_argument("--density", metavar="RHO", help="density, kg/m³ unless a unit is given (e.g. 1.24g/cm3)")
+    m.add_argument("--material", metavar="NAME", help=f"material name: {', '.join(sorted(MATERIALS))}")
+    m.add_argument("--mass", metavar="MASS", help="total mass the part should have, kg unless a unit is given "
+                                                  "(e.g. 412g); the implied density is printed")
+
+
+def add_thin_wall_options(parser) -> None:
+    """``--model``, ``--thickness``, ``--shell``, ``--infill``."""
+    g = parser.add_argument_group("mass model (thin-walled and printed parts)")
+    g.add_argument("--model", choices=("solid", "shell"), default="solid",
+                   help="solid (default): the mesh bounds homogeneous material; shell: the mesh is the "
+                        "mid-surface of a wall of --thickness (sheet metal, thin-walled parts; open meshes allowed)")
+    g.add_argument("--thickness", metavar="LEN", help="wall thickness of --model shell, e.g. 2mm "
+                                                      "(a bare number is in --units)")
+    g.add_argument("--shell", metavar="LEN", help="3D print: solid skin thickness, e.g. 1.2mm (with --infill)")
+    g.add_argument("--infill", metavar="FRACTION", help="3D print: core fill fraction, e.g. 20%% or 0.2 (with --shell)")
+
+
+def add_mesh_options(parser) -> None:
+    """``--repair``, ``--overlap``, ``--merge-tolerance``, ``--max-faces``."""
+    g = parser.add_argument_group("mesh checks")
+    g.add_argument("--repair", action="store_true",
+                   help="give a bounded estimate (method and uncertainty in the report) for a mesh with holes, "
+                        "cracks or stray pieces instead of refusing it")
+    g.add_argument("--overlap", choices=("union", "sum"), default="union",
+                   help="overlapping bodies: integrate their union (default) or add them, counting shared "
+                        "material twice")
+    g.add_argument("--merge-tolerance", type=float, default=MERGE_TOLERANCE, metavar="REL",
+                   help="relative tolerance (of the bounding-box diagonal) for welding nearly coincident "
+                        f"vertices when exact welding leaves the surface open (default {MERGE_TOLERANCE:g}; 0 off)")
+    g.add_argument("--max-faces", type=int, default=DEFAULT_MAX_FACES, metavar="N",
+                   help=f"refuse meshes with more triangles (default {DEFAULT_MAX_FACES:,})")
+
+
+def add_model_options(parser, *, thin_walls: bool = True) -> None:
+    """Every model option, in the order all commands list them: units and material, mass model, mesh checks.
+
+    ``thin_walls=False`` leaves out ``--model``/``--shell`` (``batch``, which analyses solids only)."""
+    add_material_options(parser)
+    if thin_walls:
+        add_thin_wall_options(parser)
+    add_mesh_options(parser)
+
+
+def split_part_spec(spec: str) -> tuple[str, str | None]:
+    """``"lid.stl:abs"`` → ``("lid.stl", "abs")``, ``"lid.stl:1.24g/cm3"`` → ``("lid.stl", "1.24g/cm3")``.
+
+    A path that exists as given is never split.  Otherwise the split is at the last ``:`` whatever follows it
+    (a density unit may contain ``/``), except after a lone drive letter (``C:\\parts\\a.stl``, ``C:/a.stl``):
+    that is a Windows path, reported as missing by the reader.
+    """
+    if ":" not in spec or os.path.exists(spec):
+        return spec, None
+    path, _, what = spec.rpartition(":")
+    if not path or not what.strip():
+        return spec, None
+    if len(path) == 1 and path.isalpha() and what[:1] in ("\\", "/"):
+        return spec, None
+    return path, what
+
+
+def length_unit(args) -> str:
+    """The unit of bare lengths on the command line: ``--units``, metres when it was not given."""
+    return getattr(args, "units", None) or "m"
+
+
+def _files(args) -> list[str]:
+    return list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
+
+
+def _part_density(what: str, source=None) -> dict:
+    try:
+        density = parse_density(what)
+    except UsageError:
+        return {"material": what}
+    name = getattr(source, "source", source)          # a file name, or the RawMesh read from it
+    return {"density": check_option("--density", density, typed=what,
+                                    label=f"the density of {name}" if name else None)}
+
+
+def check_mesh_options(args) -> None:
+    """Refuse a ``--merge-tolerance`` or ``--max-faces`` outside :data:`.options.OPTION_RANGES` (exit 2)."""
+    check_option("--merge-tolerance", getattr(args, "merge_tolerance", 0.0))
+    check_option("--max-faces", getattr(args, "max_faces", 1))
+
+
+def load_options_from_args(args) -> LoadOptions:
+    """The one :class:`LoadOptions` of a command, from ``--units`` and the mesh-check options."""
+    check_mesh_options(args)
+    return LoadOptions(units=getattr(args, "units", None), repair=bool(getattr(args, "repair", False)),
+                       overlap=getattr(args, "overlap", "union"),
+                       merge_tolerance=getattr(args, "merge_tolerance", MERGE_TOLERANCE),
+                       max_faces=getattr(args, "max_faces", DEFAULT_MAX_FACES))
+
+
+def read_meshes(args) -> list:
+    """Read every FILE of ``args`` once, at the edge, into :class:`~inertia_tool.mesh.read.RawMesh` (metres).
+
+    The engine and the report writers then take these objects, so nothing reads a file twice."""
+    options = load_options_from_args(args)
+    return [load_mesh(split_part_spec(f)[0], units=options.units, max_faces=options.max_faces)
+            for f in _files(args)]
+
+
+@dataclass(frozen=True)
+class LoadedModel:
+    """What :func:`load_model` made of the model options.
+
+    Attributes
+    ----------
+    props : MassProperties
+        The part or assembly, SI.
+    density_source : str
+        Where the density came from, for the reports (``"steel (7850 kg/m³)"``, ``"scaled to a total mass
+        of 0.412 kg: implied density 2710 kg/m³"``).
+    model : dict
+        :func:`~inertia_tool.reports.models.model_summary` of the mass model (solid, shell, printed).
+    warnings : tuple of str
+        The engine's warnings while loading, in command-line words (also printed on stderr).
+    meshes : tuple of RawMesh
+        The files as read (for the HTML views).
+
+    Properties
+    ----------
+    units_assumed : bool
+        No ``--units`` was given and no file declares its unit: the coordinates were taken as metres.
+    """
+
+    props: object
+    density_source: str
+    model: dict
+    warnings: tuple
+    meshes: tuple
+
+    @property
+    def units_assumed(self) -> bool:
+        return any(getattr(m, "units_assumed", False) for m in self.meshes)
+
+    def notes(self) -> tuple:
+        """Report lines that are not warnings: the metres taken when no unit was given (a part 0.1 mm to 20 m
+        long raises no warning, but a 15 mm part exported in millimetres reads as 15 m)."""
+        if not self.units_assumed or any("metres assumed" in w for w in self.warnings):
+            return ()
+        from ..mesh.plausibility import largest_extent
+        extent = max(largest_extent(m.vertices) for m in self.meshes if m.units_assumed)
+        return (f"no --units given: coordinates taken as metres (largest extent {extent:.3g} m); "
+                "STL and OBJ carry no unit, give --units if the file is in mm or in",)
+
+
+def command_parser(args):
+    """The parser of the running subcommand (for :func:`~inertia_tool.cli.speak_options`), or None."""
+    return getattr(args, "_subparsers", {}).get(getattr(args, "command", None))
+
+
+def with_warnings(report: str, messages, notes=()) -> str:
+    """A text report with the warnings (and notes) under its first line (title), where they are seen before
+    the numbers."""
+    if not messages and not notes:
+        return report
+    title, _, rest = report.partition("\n")
+    lines = [f"  WARNING: {m}" for m in messages] + [f"  note: {n}" for n in notes]
+    return "\n".join([title, *lines, rest]) if rest else "\n".join([title, *lines])
+
+
+def load_model(args, *, parser=None, ignore=()) -> LoadedModel:
+    """Read the FILEs of ``args`` once and compute their mass properties under the model options.
+
+    ``ignore``: warning classes not to report (``top`` expects two equal moments).  The other engine
+    warnings are recorded (in command-line words, through ``parser``'s options) and handed on, so that the
+    command line prints them on stderr and the command can put them in its report and JSON.
+    """
+    from . import speak_options
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", InertiaToolWarning)
+        for category in ignore:
+            warnings.simplefilter("ignore", category)
+        meshes = read_meshes(args)
+        props, described, model = _load(args, meshes)
+    kept = [w for w in caught if issubclass(w.category, InertiaToolWarning)]
+    for w in kept:          # hand them on so the command line prints them on stderr
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    parser = parser if parser is not None else command_parser(args)
+    messages = tuple(speak_options(str(w.message), parser) for w in kept)
+    return LoadedModel(props=props, density_source=described, model=model, warnings=messages,
+                       meshes=tuple(meshes))
+
+
+def _implied(props, mass) -> str:
+    """``", implied density 2710 kg/m³"`` when a target mass set the density."""
+    if mass is None or not props.volume > 0:
+        return ""
+    return f": implied density {props.mass / props.volume:.4g} kg/m³"
+
+
+def _load(args, meshes):
+    """``(props, density description, model summary)`` of the model options."""
+    model = getattr(args, "model", "solid") or "solid"
+    thickness, skin, infill = (getattr(args, k, None) for k in ("thickness", "shell", "infill"))
+    if model == "solid" and thickness is not None:
+        raise UsageError("--thickness needs --model shell (for a printed part use --shell and --infill)")
+    if (skin is None) != (infill is None):
+        raise UsageError("a printed part needs both --shell (skin thickness) and --infill (core fraction)")
+    if model == "shell" and thickness is None:
+        raise UsageError("--model shell needs --thickness (e.g. --thickness 2mm)")
+    if model == "shell" and skin is not None:
+        raise UsageError("--model shell takes --thickness; --shell/--infill describe a printed solid")
+    if model == "solid" and skin is None:
+        props, described = _load_solid(args, meshes)
+        return props, described, model_summary("solid")
+    files = _files(args)
+    if len(files) != 1 or split_part_spec(files[0])[1] is not None:
+        raise UsageError("the shell and printed-part models take one mesh file with --density, --material or "
+                         "--mass, not an assembly (FILE:material)")
+    options = load_options_from_args(args)
+    density, mass = density_and_mass(args)
+    _, described = resolve_density(density=density, material=args.material, mass=mass)
+    common = dict(density=density, material=args.material, mass=mass)
+    unit = length_unit(args)
+    if model == "shell":
+        t = check_option("--thickness", parse_length(thickness, default_unit=unit), typed=thickness)
+        props = shell_mass_properties(meshes[0], thickness=t, options=options, **common)
+        return props, described + _implied(props, mass), model_summary("shell", thickness=t)
+    skin_m = check_option("--shell", parse_length(skin, default_unit=unit), typed=skin)
+    printed = printed_part(meshes[0], skin=skin_m, infill=parse_fraction(infill), options=options, **common)
+    return printed.properties, described, model_summary("printed", printed=printed)
+
+
+def _load_solid(args, meshes):
+    """Mass properties of one solid part or an assembly, and the density description.
+
+    In an assembly, a global ``--density``/``--material`` is the default of the parts named without their own
+    ``:material`` or ``:density`` (the description says so); when every part has its own, a global one would
+    be ignored and is refused as contradictory (:class:`UsageError`).
+    """
+    options = load_options_from_args(args)
+    density, mass = density_and_mass(args)
+    specs = [(raw, what) for raw, (_, what) in zip(meshes, (split_part_spec(f) for f in _files(args)))]
+    if len(specs) == 1 and specs[0][1] is None:
+        _, described = resolve_density(density=density, material=args.material, mass=mass)
+        props = mass_properties(specs[0][0], density=density, material=args.material, mass=mass, options=options)
+        return props, described + _implied(props, mass)
+    default = None
+    if density is not None or args.material is not None:
+        option = f"--density {args.density}" if density is not None else f"--material {args.material}"
+        if all(what is not None for _, what in specs):
+            raise UsageError(f"{option} would apply to no part: every FILE has its own :material or :density "
+                             "(drop the option, or name a part without its own to give it this default)")
+        default, default_text = resolve_density(density=density, material=args.material)
+    parts, own = [], []
+    for raw, what in specs:
+        if what is not None:
+            parts.append({"source": raw, **_part_density(what, raw)})
+            own.append(what)
+        elif density is not None:
+            parts.append({"source": raw, "density": density})
+        elif args.material is not None:
+            parts.append({"source": raw, "material": args.material})
+        else:
+            parts.append({"source": raw})
+    props = assembly(parts, mass=mass, options=options)
+    if len(specs) == 1:
+        described = resolve_density(**_part_density(own[0]))[1]
+    else:
+        described = "per part"
+        if default is not None:
+            described += f"; {default_text} for the parts without their own"
+        elif len(own) < len(specs):
+            described += f"; {DEFAULT_DENSITY:g} kg/m³ (water) for the parts without their own"
+    if mass is not None:
+        described += f", scaled to a total mass of {mass:g} kg" + _implied(props, mass).replace(":", ";", 1)
+    return props, described
+
+
+def model_words(model: dict) -> str:
+    """``"; thin shell 0.002 m"``: the mass model in a few words, for one-line sources (empty for a solid)."""
+    if model["model"] == "shell":
+        return f"; thin shell {model['thickness']:g} m"
+    if model["model"] == "printed":
+        return (f"; printed: skin {model['skin']:g} m, infill {100 * model['infill']:g}% "
+                f"(first-order model, mass error about {100 * model['mass_error_estimate']:.2g}%)")
+    return ""
