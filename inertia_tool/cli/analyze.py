@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import sys
@@ -110,7 +111,7 @@ def _stability_section(props):
 FORMATS = ("text", "json") + ROBOT_FORMATS + ("cad",)
 
 
-def add_output_options(parser) -> None:
+def add_output_options(parser) -> argparse._ArgumentGroup:
     """``--format``, ``--frame``, ``--cad-units``."""
     g = parser.add_argument_group("output")
     # --json is added by the caller, after --format

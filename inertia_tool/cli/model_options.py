@@ -26,6 +26,7 @@ import warnings
 from dataclasses import dataclass
 
 from ..errors import InertiaToolWarning, UsageError
+from ..mass.properties import MassProperties
 from ..mass.pipeline import DEFAULT_DENSITY, assembly, mass_properties, resolve_density
 from ..mass.thinwall import printed_part, shell_mass_properties
 from ..mesh.options import DEFAULT_MAX_FACES, LoadOptions
@@ -184,7 +185,7 @@ class LoadedModel:
         No ``--units`` was given and no file declares its unit: the coordinates were taken as metres.
     """
 
-    props: object
+    props: MassProperties
     density_source: str
     model: dict
     warnings: tuple

@@ -175,7 +175,8 @@ def run(args) -> int:
     say_written([args.csv, args.plot])
     if args.json:
         out = {"name": props.name, "density_source": described, "model": loaded.model,
-               "warnings": list(loaded.warnings), "units_assumed": loaded.units_assumed, "top": heavy_top_dict(top, traj)}
+               "warnings": list(loaded.warnings), "units_assumed": loaded.units_assumed,
+               "top": heavy_top_dict(top, traj)}
         json.dump(to_jsonable(out), sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     else:

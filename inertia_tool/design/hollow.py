@@ -245,7 +245,7 @@ def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80
                              transverse_asymmetry=top.transverse_asymmetry, height=top.length)
 
 
-def _load(source, units: str, density, material, mass):
+def _load(source, units: str | None, density, material, mass):
     """Checked vertices and faces (m, outward-wound) and the exact mass properties of the solid part."""
     from ..mass.pipeline import mass_properties, resolve_density
     from ..mesh.prepare import prepare_mesh

@@ -140,7 +140,8 @@ class ReferenceSolid:
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "faces", f)
 
-    def transformed(self, rotation=None, translation=None) -> "ReferenceSolid":
+    def transformed(self, rotation: ArrayLike | None = None,
+                    translation: ArrayLike | None = None) -> ReferenceSolid:
         """The same solid moved rigidly, ``x ↦ R x + t``: its mesh and both closed forms.
 
         Parameters

@@ -814,7 +814,7 @@ def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_
         Bad ``units``, ``max_faces`` or malformed arrays.
     """
     assumed = units is None
-    units = "m" if assumed else units
+    units = "m" if units is None else units
     scale = length_scale(units)
     if not (isinstance(max_faces, (int, np.integer)) and 0 < max_faces <= MAX_SUPPORTED_FACES):
         raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,} (corner "

@@ -367,7 +367,8 @@ def _(path):
     return [(v, f)]
 
 
-@entry("kilometre.stl", "a 1 km part, no unit given: warned", 0, r"metres assumed; largest extent 1.5e\+03 m, above 20 m")
+@entry("kilometre.stl", "a 1 km part, no unit given: warned", 0,
+       r"metres assumed; largest extent 1.5e\+03 m, above 20 m")
 def _(path):
     v, f = box((1000.0, 1500.0, 800.0), center=(0, 0, 400.0))
     write_ascii_stl(path, v, f)
