@@ -14,6 +14,8 @@ import math
 from ..balancing.rotor import ISO_GRADES, BalanceReport, PlaneUnbalance
 from .escape import escape_html, escape_markdown
 from .serialize import to_jsonable
+from .html import html_page
+from .numbers import number
 
 __all__ = ["balance_dict", "format_balance_text", "balance_markdown", "balance_html", "polar_svg"]
 
@@ -43,14 +45,7 @@ def _mag(v) -> float:
 
 
 def _num(x: float, digits: int = 4) -> str:
-    if not math.isfinite(x):
-        return "—"
-    if x == 0:
-        return "0"
-    if abs(x) >= 1e6 or abs(x) < 1e-3:
-        return f"{x:.{digits - 1}e}"
-    decimals = max(0, digits - 1 - math.floor(math.log10(abs(x))))
-    return f"{x:.{decimals}f}"
+    return number(x, digits, style="fixed")
 
 
 def _grade_name(g, value) -> str:
@@ -398,17 +393,7 @@ def balance_html(report: BalanceReport) -> str:
                          [[g.name, f"{g.value:g}", g.typical_parts] for g in ISO_GRADES],
                          highlight=None if report.quality_grade is None else report.quality_grade.name)
     notes = "".join(f"<li>{e(n)}</li>" for n in report.notes)
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>{e(title)}</title>
-<style>
-body {{ font-family: sans-serif; max-width: 60em; margin: 2em auto; color: #222; }}
-table {{ border-collapse: collapse; margin: 0.5em 0 1em; }}
-td, th {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }}
-th {{ background: #f2f2f2; }} tr.hl td {{ background: #fff4c2; }}
-figure {{ display: inline-block; margin: 0 1em; }} .small {{ color: #666; font-size: 0.9em; }}
-</style></head><body>
-<h1>{e(title)}</h1>
-{_html_table(["", ""], [list(r) for r in _header(report)])}
+    return html_page(title, f"""{_html_table(["", ""], [list(r) for r in _header(report)])}
 <h2>Unbalance as it is</h2>
 {_html_table(["quantity", "value"], [list(r) for r in _summary_rows(report)])}
 <h2>Loads at {report.rpm:.6g} rpm</h2>
@@ -432,5 +417,4 @@ Angles from the shaft x axis towards y.</p>
 <p class="small">Static unbalance U = M·e; couple unbalance: the moment of unbalance about the plane of the centre
 of mass; U_per = G·M/Ω, shared between the tolerance planes by the lever rule limited to 0.3–0.7.
 Conventions: docs/conventions.md ("Shaft frame").</p>
-</body></html>
-"""
+""")

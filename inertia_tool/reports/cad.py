@@ -13,6 +13,7 @@ import numpy as np
 from ..errors import UsageError
 from ..robot.inertial import positive_tensor_notation
 from ..mass.properties import MassProperties
+from .numbers import number, round_off_zero
 
 __all__ = ["format_cad_report", "CAD_UNITS"]
 
@@ -28,13 +29,11 @@ _SHORT = {"kilograms": "kg", "grams": "g", "meters": "m", "millimeters": "mm", "
 
 
 def _clean(a, rel: float = 1e-12) -> np.ndarray:
-    a = np.asarray(a, dtype=float)
-    scale = np.max(np.abs(a)) if a.size else 0.0
-    return np.where(np.abs(a) <= rel * scale, 0.0, a) + 0.0
+    return round_off_zero(a, rel)
 
 
 def _g(x: float, digits: int) -> str:
-    return f"{float(x) + 0.0:.{digits}g}"
+    return number(x, digits)
 
 
 def _tensor_rows(t, prefix: str, digits: int) -> list[str]:

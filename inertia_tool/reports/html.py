@@ -37,6 +37,7 @@ from .escape import escape_html
 from .output import check_targets, write_text
 from .serialize import TENSOR_CONVENTION
 from .text import method_line
+from .numbers import number, round_off_zero
 
 __all__ = ["HtmlSection", "html_report", "write_html_report", "svg_views", "VIEWS",
            "stability_section", "DEFAULT_MAX_EDGES", "DEFAULT_MAX_FILL_FACES"]
@@ -75,7 +76,18 @@ font-variant-numeric:tabular-nums;white-space:nowrap}td.l{white-space:normal}th{
 font-size:.9em;color:#444}svg{background:#fff;border:1px solid #ddd}.warn{color:#8a4b00}
 .stable{color:#1a7f37}.unstable{color:#b42318;font-weight:600}.marginal{color:#8a4b00}.neutral{color:#555}
 .legend>span{display:inline-block;margin-right:1.2em}.swatch{font-weight:700}
+tr.hl td{background:#fff4c2}figure{display:inline-block;margin:0 1em}.small{color:#666;font-size:.9em}
 """
+
+
+def html_page(title: str, body: str) -> str:
+    """The one HTML skeleton of the reports: a self-contained page (no scripts, fonts or external files) with
+    the shared style sheet, ``<title>`` and ``<h1>`` set to ``title`` (escaped here); ``body`` is an HTML
+    fragment whose text its formatter has escaped."""
+    return "\n".join(["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
+                      '<meta name="viewport" content="width=device-width, initial-scale=1">',
+                      f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>",
+                      f"<h1>{_e(title)}</h1>", body, "</body></html>\n"])
 
 
 @dataclass(frozen=True)
@@ -102,15 +114,12 @@ _e = escape_html
 
 
 def _num(x: float, digits: int = 6) -> str:
-    x = float(x)
-    return f"{x:.{digits}g}" if math.isfinite(x) else "—"
+    return number(x, digits)
 
 
 def _clean(a, rel: float = 1e-12) -> np.ndarray:
     """Display only: entries below ``rel`` of the largest magnitude show as 0 (round-off), as in the text report."""
-    a = np.asarray(a, dtype=float)
-    scale = np.max(np.abs(a)) if a.size else 0.0
-    return np.where(np.abs(a) <= rel * scale, 0.0, a) + 0.0
+    return round_off_zero(a, rel)
 
 
 def _table(header: Sequence[str] | None, rows: Sequence[Sequence[str]], *, left_cols: int = 1,
@@ -469,11 +478,7 @@ def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_
                 "equivalent inertia "
                 "ellipsoid (uniform solid ellipsoid with the same mass and principal moments)</span>"
                 "<span>grey: silhouette and feature edges</span></p>")
-    parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
-             '<meta name="viewport" content="width=device-width, initial-scale=1">',
-             f"<title>Mass properties of {_e(props.name)}</title><style>{_CSS}</style></head><body>",
-             f"<h1>Mass properties of {_e(props.name)}</h1>",
-             f'<p class="muted">inertia-tool {_e(__version__)}, {_e(stamp)}. SI units (m, kg, kg·m²); '
+    parts = [f'<p class="muted">inertia-tool {_e(__version__)}, {_e(stamp)}. SI units (m, kg, kg·m²); '
              "conventions: docs/conventions.md.</p>",
              '<h2 id="views">Views</h2>', legend, f'<div class="views">{figure}</div>']
     if warnings:
@@ -482,8 +487,7 @@ def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_
     for s in sections:
         anchor = "".join(c for c in s.anchor if c.isalnum() or c == "-") or "section"
         parts.append(f'<h2 id="{anchor}">{_e(s.title)}</h2>{s.body}')
-    parts.append("</body></html>\n")
-    return "\n".join(parts)
+    return html_page(f"Mass properties of {props.name}", "\n".join(parts))
 
 
 def write_html_report(path: str | os.PathLike, document: str, *, force: bool = False) -> None:

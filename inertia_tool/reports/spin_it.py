@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .serialize import mass_properties_dict, to_jsonable
+from .numbers import number
 
 __all__ = ["spin_it_dict", "format_spin_it_text", "spin_it_figure"]
 
@@ -51,7 +52,7 @@ def _mm(x) -> str:
 
 
 def _g(x: float) -> str:
-    return f"{x:.5g}"
+    return number(x, 5)
 
 
 def format_spin_it_text(result, *, name: str = "", output: str | None = None) -> str:

@@ -12,6 +12,7 @@ if TYPE_CHECKING:  # pragma: no cover - annotations only; keeps scipy.integrate 
 
 from ..dynamics.spin_stability import StabilityReport
 from .serialize import to_jsonable
+from .numbers import number
 
 __all__ = ["stability_dict", "format_stability", "heavy_top_dict", "format_heavy_top", "spin_dict",
            "format_spin", "DEFAULT_REPORT_PERTURBATION"]
@@ -28,11 +29,7 @@ _KIND_TEXT = {
 
 
 def _g(x, digits: int = 4) -> str:
-    if x is None:
-        return "—"
-    if isinstance(x, float) and math.isinf(x):
-        return "never"
-    return f"{x:.{digits}g}"
+    return number(x, digits, infinite="never")
 
 
 def _period(x, none: str, digits: int = 6) -> str:

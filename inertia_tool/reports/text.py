@@ -6,20 +6,19 @@ import numpy as np
 
 from ..mass.properties import MassProperties
 from .serialize import TENSOR_CONVENTION
+from .numbers import number, round_off_zero
 
 __all__ = ["format_mass_properties"]
 
 
 def _num(x: float) -> str:
-    return f"{x:.6g}"
+    return number(x)
 
 
 def _clean(a, rel: float = 1e-12, scale: float = 0.0) -> np.ndarray:
     """Display only: entries below ``rel`` times the largest magnitude (or ``scale``, if larger) print as 0
     (round-off, not data)."""
-    a = np.asarray(a, dtype=float)
-    scale = max(np.max(np.abs(a)) if a.size else 0.0, scale)
-    return np.where(np.abs(a) <= rel * scale, 0.0, a) + 0.0
+    return round_off_zero(a, rel, scale)
 
 
 def _vec(v, scale: float = 0.0, rel: float = 1e-12) -> str:

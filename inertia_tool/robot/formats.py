@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import UsageError
 from .inertial import InertialFrame
+from ..reports.numbers import number
 
 __all__ = ["format_urdf", "format_sdf", "format_mjcf", "ROBOT_FORMATS", "format_inertial"]
 
@@ -24,7 +25,7 @@ _FRAME_TEXT = {
 
 
 def _num(x: float, digits: int) -> str:
-    return f"{float(x) + 0.0:.{digits}g}"
+    return number(x, digits)
 
 
 def _nums(xs, digits: int) -> str:
