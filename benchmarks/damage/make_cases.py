@@ -24,7 +24,7 @@ overlap         ``overlap_copy`` a copy translated by 30 % (else 15 %) of  the u
 duplicate       ``dup_few`` 5 faces listed twice; ``dup_patch`` a          the clean mesh
                 connected patch of 30 faces listed twice
 touching        ``touch_mirror`` the mirror image across the bounding      both bodies (interiors are
-                box's upper face on a seeded axis; the two share the       disjoint by construction)
+                box face holding most vertices; the two share the          disjoint by construction)
                 part's faces in that plane (exact welding)
 fragments       ``fragments`` 3 stray triangles (2 % of the diagonal)      the clean mesh
                 in the bounding box, sharing no vertex with the part
@@ -258,19 +258,23 @@ def damage_fragments(v, f, rng, diag, count=3, size=0.02):
 
 
 def damage_touch(v, f, rng):
-    axis = int(rng.integers(3))
-    top = v[:, axis].max()
-    mirrored = v.copy()
-    mirrored[:, axis] = 2.0 * top - mirrored[:, axis]   # exact on the plane: 2a - a == a
-    both_v = np.vstack([v, mirrored])
-    both_f = np.vstack([f, f[:, ::-1] + len(v)])       # a reflection reverses the winding
+    """The mirror image across the bounding-box face (of six) holding the most vertices, so that the two
+    bodies share faces there where the part has a flat face (else an edge or a point); the seed breaks ties."""
     from inertia_tool.errors import OverlapWarning
 
+    sides = [(axis, end) for axis in range(3) for end in (v[:, axis].min(), v[:, axis].max())]
+    counts = np.array([np.count_nonzero(v[:, axis] == end) for axis, end in sides])
+    best = np.flatnonzero(counts == counts.max())
+    axis, plane = sides[int(rng.choice(best))]
+    mirrored = v.copy()
+    mirrored[:, axis] = 2.0 * plane - mirrored[:, axis]   # exact on the plane: 2a - a == a
+    both_v = np.vstack([v, mirrored])
+    both_f = np.vstack([f, f[:, ::-1] + len(v)])         # a reflection reverses the winding
     # two separate closed shells (not yet welded): the exact sum of both bodies
     truth = truth_of(both_v, both_f, bodies=2, allowed=(OverlapWarning,))
     welded_v, welded_f = exact_weld(both_v, both_f)
     shared = len(both_v) - len(welded_v)
-    return welded_v, welded_f, {"axis": "xyz"[axis], "shared_vertices": int(shared)}, truth
+    return welded_v, welded_f, {"axis": "xyz"[axis], "plane": float(plane), "shared_vertices": int(shared)}, truth
 
 
 def _manifold(v, f):
