@@ -180,20 +180,32 @@ def _worker(conn, cases_dir):
 
 
 class _Slot:
+    """One worker process and the (tool, case) task it runs, if any."""
+
     def __init__(self, ctx, cases_dir):
-        self.parent, child = ctx.Pipe()
-        self.process = ctx.Process(target=_worker, args=(child, str(cases_dir)), daemon=True)
+        self.ctx, self.cases_dir = ctx, str(cases_dir)
+        self.task = None
+        self.deadline = None
+        self._start()
+
+    def _start(self):
+        self.parent, child = self.ctx.Pipe()
+        self.process = self.ctx.Process(target=_worker, args=(child, self.cases_dir), daemon=True)
         self.process.start()
         child.close()
         if not self.parent.poll(STARTUP_SECONDS) or self.parent.recv() != "ready":
-            self.stop()
+            self.process.kill()
             raise RuntimeError(f"a benchmark worker did not start within {STARTUP_SECONDS} s")
-        self.task = None
-        self.deadline = None
 
-    def stop(self):
-        self.process.kill()    # this worker only, by its own handle
+    def restart(self):
+        """Kill this slot's own worker (stuck or dead) and start a fresh one."""
+        self.process.kill()
         self.process.join()
+        self._start()
+
+    def close(self):
+        self.parent.send(None)
+        self.process.join(timeout=10)
 
 
 def run_all(tasks, cases_dir, timeout, workers=2, progress=None):
@@ -202,6 +214,7 @@ def run_all(tasks, cases_dir, timeout, workers=2, progress=None):
     slots = [_Slot(ctx, cases_dir) for _ in range(workers)]
     pending = list(tasks)
     results = {}
+    late = {"status": "timeout", "seconds": timeout, "error": f"over {timeout:g} s"}
     while pending or any(s.task for s in slots):
         for s in slots:
             if s.task is None and pending:
@@ -214,33 +227,25 @@ def run_all(tasks, cases_dir, timeout, workers=2, progress=None):
         for s in busy:
             if s.parent in ready:
                 try:
-                    results[s.task] = s.parent.recv()
-                    if results[s.task]["seconds"] > timeout:   # finished, but late: the limit decides
-                        results[s.task] = {"status": "timeout", "seconds": timeout, "error": f"over {timeout:g} s"}
-                except EOFError:     # the worker died (e.g. a crash in native code)
-                    results[s.task] = {"status": "error", "seconds": float("nan"),
-                                       "error": f"worker died (exit code {s.process.exitcode})"}
-                    s.stop()
-                    slots[slots.index(s)] = s = _replace(ctx, cases_dir, s)
+                    result = s.parent.recv()
+                    if result["seconds"] > timeout:    # finished, but late: the limit decides
+                        result = late
+                except EOFError:                       # the worker died (e.g. a crash in native code)
+                    result = {"status": "error", "seconds": float("nan"),
+                              "error": f"worker died (exit code {s.process.exitcode})"}
+                    s.restart()
             elif now >= s.deadline:
-                results[s.task] = {"status": "timeout", "seconds": timeout, "error": f"over {timeout:g} s"}
-                s.stop()
-                slots[slots.index(s)] = s = _replace(ctx, cases_dir, s)
+                result = late
+                s.restart()
             else:
                 continue
+            results[s.task] = result
             if progress:
-                progress(s.task, results[s.task])
+                progress(s.task, result)
             s.task = None
     for s in slots:
-        s.parent.send(None)
-        s.process.join(timeout=10)
+        s.close()
     return results
-
-
-def _replace(ctx, cases_dir, old):
-    new = _Slot(ctx, cases_dir)
-    new.task, new.deadline = old.task, old.deadline
-    return new
 
 
 # ------------------------------------------------------------------------------------------------ scoring
