@@ -175,3 +175,17 @@ def test_collada_is_refused_today_in_one_line_naming_the_file(name):
     with pytest.raises(MeshReadError) as info:
         it.mass_properties(DATA / name)
     assert "\n" not in str(info.value) and name in str(info.value)
+
+
+def test_every_data_file_has_its_provenance_in_the_readme():
+    # each file committed under tests/data must name its package, version, original path and licence
+    rows = {}
+    for line in (DATA / "README.md").read_text(encoding="utf-8").splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 5 and cells[0].startswith("`"):
+            rows[cells[0].strip("`")] = cells[1:]
+    files = sorted(p.name for p in DATA.iterdir() if p.name != "README.md")
+    assert files == sorted(rows)
+    for name, (package, original, licence, _) in rows.items():
+        assert package.split()[-1][0].isdigit(), f"{name}: no package version"
+        assert original.startswith("`") and licence, f"{name}: no original path or licence"
