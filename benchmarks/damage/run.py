@@ -57,7 +57,11 @@ BOUND_SLACK = 1e-9      # round-off allowed beyond a stated bound (relative; for
 # ----------------------------------------------------------------------------------------------- adapters
 
 def _bounds_of(report):
-    """(mass, centre-of-mass, inertia) bounds from a report's ``uncertainty``, or None when not stated."""
+    """(mass, centre-of-mass, inertia) bounds from a report's ``uncertainty``, or None when not stated.
+
+    Mass and inertia bounds are relative to the reported mass and ‖inertia‖ (Frobenius), the centre-of-mass
+    bound a distance in m.
+    """
     unc = getattr(report, "uncertainty", None)
     if unc is None:
         return None
@@ -149,8 +153,8 @@ def _warm_up():
             pass
 
 
-def _worker(conn, cases_dir):
-    sys.path.insert(0, str(ROOT))
+def _worker(conn, cases_dir, checkout):
+    sys.path.insert(0, checkout)
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     # the peers' round-off RuntimeWarnings would flood the console; inertia_tool's warnings are recorded
     # inside its adapter (catch_warnings there overrides this)
@@ -182,15 +186,15 @@ def _worker(conn, cases_dir):
 class _Slot:
     """One worker process and the (tool, case) task it runs, if any."""
 
-    def __init__(self, ctx, cases_dir):
-        self.ctx, self.cases_dir = ctx, str(cases_dir)
+    def __init__(self, ctx, cases_dir, checkout):
+        self.ctx, self.cases_dir, self.checkout = ctx, str(cases_dir), str(checkout)
         self.task = None
         self.deadline = None
         self._start()
 
     def _start(self):
         self.parent, child = self.ctx.Pipe()
-        self.process = self.ctx.Process(target=_worker, args=(child, self.cases_dir), daemon=True)
+        self.process = self.ctx.Process(target=_worker, args=(child, self.cases_dir, self.checkout), daemon=True)
         self.process.start()
         child.close()
         if not self.parent.poll(STARTUP_SECONDS) or self.parent.recv() != "ready":
@@ -208,10 +212,13 @@ class _Slot:
         self.process.join(timeout=10)
 
 
-def run_all(tasks, cases_dir, timeout, workers=2, progress=None):
-    """Run (tool, case_id) tasks on ``workers`` processes; a task past ``timeout`` s kills its worker."""
+def run_all(tasks, cases_dir, timeout, workers=2, progress=None, checkout=ROOT):
+    """Run (tool, case_id) tasks on ``workers`` processes; a task past ``timeout`` s kills its worker.
+
+    The workers import ``inertia_tool`` from ``checkout`` (a repository's root).
+    """
     ctx = mp.get_context("spawn")
-    slots = [_Slot(ctx, cases_dir) for _ in range(workers)]
+    slots = [_Slot(ctx, cases_dir, checkout) for _ in range(workers)]
     pending = list(tasks)
     results = {}
     late = {"status": "timeout", "seconds": timeout, "error": f"over {timeout:g} s"}
@@ -267,10 +274,13 @@ def score(case, result):
     stated = bounds is not None and any(b > 0 for b in bounds)
     contains = None
     if bounds is not None:
+        # the bounds are relative to the reported values: |m − m_true| ≤ b_m·m, ‖I − I_true‖ ≤ b_I·‖I‖
         diag = truth["diagonal"]
-        contains = bool(volume_err <= bounds[0] + BOUND_SLACK
+        volume_gap = abs(result["volume"] - truth["volume"])
+        inertia_gap = float(np.linalg.norm(np.asarray(result["inertia"]) - true_inertia))
+        contains = bool(volume_gap <= (bounds[0] + BOUND_SLACK) * abs(result["volume"])
                         and com_err * diag <= bounds[1] + BOUND_SLACK * diag
-                        and inertia_err <= bounds[2] + BOUND_SLACK)
+                        and inertia_gap <= (bounds[2] + BOUND_SLACK) * float(np.linalg.norm(result["inertia"])))
     within = volume_err <= VOLUME_RTOL and com_err <= COM_DTOL and inertia_err <= INERTIA_RTOL
     return {**out, "volume_error": volume_err, "com_error": com_err, "inertia_error": inertia_err,
             "within": {"volume": volume_err <= VOLUME_RTOL, "com": com_err <= COM_DTOL,
@@ -340,9 +350,9 @@ def tables(cases, scored, available, missing):
     return "\n".join(lines), summaries
 
 
-def _git_commit() -> str:
+def _git_commit(checkout) -> str:
     try:
-        return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+        return subprocess.run(["git", "-C", str(checkout), "rev-parse", "--short", "HEAD"], capture_output=True,
                               text=True, check=True).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
@@ -356,8 +366,11 @@ def main(argv=None) -> int:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--tools", default=",".join(TOOLS))
     parser.add_argument("--limit", type=int, help="first N cases only (a quick look)")
+    parser.add_argument("--inertia-tool", type=Path, default=ROOT, metavar="CHECKOUT",
+                        help="root of the checkout whose inertia_tool to measure (default: this one)")
     args = parser.parse_args(argv)
-    sys.path.insert(0, str(ROOT))
+    checkout = args.inertia_tool.resolve()
+    sys.path.insert(0, str(checkout))
     manifest = json.loads(args.cases.read_text())
     cases = manifest["cases"][:args.limit]
     wanted = [t for t in TOOLS if t in args.tools.split(",")]
@@ -372,13 +385,13 @@ def main(argv=None) -> int:
             print(f"  {done[0]}/{len(tasks)}", flush=True)
 
     started = time.time()
-    raw = run_all(tasks, args.cases.parent / "cases", args.timeout, args.workers, progress)
+    raw = run_all(tasks, args.cases.parent / "cases", args.timeout, args.workers, progress, checkout)
     by_id = {c["id"]: c for c in cases}
     scored = {task: score(by_id[task[1]], result) for task, result in raw.items()}
     table, summaries = tables(cases, scored, available, missing)
     import inertia_tool
     versions = {"python": platform.python_version(), "inertia_tool": inertia_tool.__version__,
-                "inertia_tool_commit": _git_commit()}
+                "inertia_tool_file": inertia_tool.__file__, "inertia_tool_commit": _git_commit(checkout)}
     for distribution in ("trimesh", "pymeshfix", "manifold3d", "numpy", "scipy"):
         try:
             versions[distribution] = importlib.metadata.version(distribution)
