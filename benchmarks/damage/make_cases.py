@@ -11,7 +11,8 @@ meshes), deterministically from ``--seed``:
 class           variants                                                   truth
 ==============  =========================================================  ==============================
 hole            ``hole_1`` one face removed; ``hole_patch`` a connected    the clean mesh
-                patch of 20 faces removed
+                patch of 20 faces removed; ``hole_large`` a connected
+                patch of 3 % of the faces (at least 100) removed
 flip            ``flip_few`` 3 faces reversed; ``flip_patch`` a connected  the clean mesh
                 patch of 30 faces reversed
 soup            ``soup_jitter`` every triangle with its own 3 corners,     the clean mesh
@@ -93,7 +94,7 @@ MESHES = [
 
 #: Damage classes and their variants; mesh ``i`` gets variant ``i % len(variants)`` of every class.
 CLASSES = {
-    "hole": ("hole_1", "hole_patch"),
+    "hole": ("hole_1", "hole_patch", "hole_large"),
     "flip": ("flip_few", "flip_patch"),
     "soup": ("soup_jitter",),
     "crack": ("crack",),
@@ -329,6 +330,8 @@ def make_case(kind, v, f, rng, clean_truth):
         return (*damage_hole(v, f, rng, 1), clean_truth)
     if kind == "hole_patch":
         return (*damage_hole(v, f, rng, 20), clean_truth)
+    if kind == "hole_large":
+        return (*damage_hole(v, f, rng, max(100, 3 * len(f) // 100)), clean_truth)
     if kind == "flip_few":
         return (*damage_flip(v, f, rng, 3, patch=False), clean_truth)
     if kind == "flip_patch":
