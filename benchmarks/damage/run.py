@@ -298,7 +298,8 @@ def summarise(cases, scored, tool):
               and not r["said_so"]]
     seconds = np.array([r["seconds"] for r in rows if np.isfinite(r["seconds"])])
     return {"cases": n, "answered": len(answered),
-            "errors": sum(r["status"] == "error" for r in rows), "timeouts": sum(r["status"] == "timeout" for r in rows),
+            "errors": sum(r["status"] == "error" for r in rows),
+            "timeouts": sum(r["status"] == "timeout" for r in rows),
             "within_volume": sum(r["within"]["volume"] for r in answered),
             "within_com": sum(r["within"]["com"] for r in answered),
             "within_inertia": sum(r["within"]["inertia"] for r in answered),
@@ -327,7 +328,8 @@ def tables(cases, scored, available, missing):
             continue
         s = summaries[tool] = summarise(cases, scored, tool)
         n = s["cases"]
-        lines.append(f"| {tool} | {_pct(s['answered'], n)} | {_pct(s['within_volume'], n)} | {_pct(s['within_com'], n)} | "
+        lines.append(f"| {tool} | {_pct(s['answered'], n)} | {_pct(s['within_volume'], n)} | "
+                     f"{_pct(s['within_com'], n)} | "
                      f"{_pct(s['within_inertia'], n)} | **{_pct(s['within_all'], n)}** | {s['bounds_stated']} | "
                      f"{_pct(s['bounds_contain'], s['bounds_stated'])} | {s['silent_over_10pct']} | {s['errors']} | "
                      f"{s['timeouts']} | {s['median_seconds']:.3f} | {s['mean_seconds']:.3f} |")
@@ -342,7 +344,8 @@ def tables(cases, scored, available, missing):
             rows = [scored[(tool, c["id"])] for c in members]
             ok = sum(r["status"] == "answer" and r["within"]["all"] for r in rows)
             silent = sum(r["status"] == "answer" and not r["said_so"]
-                         and max(r["volume_error"], r["com_error"], r["inertia_error"]) > SILENT_THRESHOLD for r in rows)
+                         and max(r["volume_error"], r["com_error"], r["inertia_error"]) > SILENT_THRESHOLD
+                         for r in rows)
             failed = sum(r["status"] != "answer" for r in rows)
             cells.append(f"{ok} / {silent} / {failed}")
         variants = ", ".join(sorted({c["damage"] for c in members}))
