@@ -124,3 +124,21 @@ def test_single_sheet_suggests_the_shell_model():
     f = np.array([[0, 1, 2], [1, 3, 2]])
     with pytest.raises(InvalidMeshError, match="shell model"):
         mass_properties((v, f), repair=True)
+
+
+def test_stray_triangles_beside_a_closed_part_are_left_out_under_repair():
+    """Damage class "stray fragments": loose triangles enclose nothing, so with repair the part is exact and the
+    report says what was left out; without repair the open edges are refused."""
+    import trimesh
+    sphere = trimesh.creation.icosphere(3)
+    v, f = np.asarray(sphere.vertices), np.asarray(sphere.faces)
+    stray = np.random.default_rng(0).uniform(1.5, 2.0, (9, 3))
+    v2, f2 = np.vstack([v, stray]), np.vstack([f, np.arange(9).reshape(3, 3) + len(v)])
+    clean = mass_properties((v, f))
+    with pytest.warns(MeshRepairedWarning, match="3 stray pieces enclosing no volume"):
+        repaired = mass_properties((v2, f2), repair=True)
+    assert repaired.mass == pytest.approx(clean.mass, rel=1e-12)
+    np.testing.assert_allclose(repaired.center_of_mass, clean.center_of_mass, atol=1e-12)
+    assert any("stray" in n for n in repaired.mesh.notes)
+    with pytest.raises(InvalidMeshError, match="boundary edges"):
+        mass_properties((v2, f2))

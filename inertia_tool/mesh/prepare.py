@@ -236,6 +236,19 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
     shells = body_volume_moments(v, f, labels, n_shells)
     flat = [k for k, s in enumerate(shells) if abs(s.volume) <= FLAT_RTOL * diag ** 3]
+    dropped_note = None
+    if flat and patched is not None and len(flat) < n_shells:
+        # with repair, stray pieces that enclose nothing (loose triangles, sheets) carry no material in the solid
+        # model: they are left out and said so, instead of refusing the part they float beside
+        keep_shell = np.ones(n_shells, dtype=bool)
+        keep_shell[flat] = False
+        f = f[keep_shell[labels]]
+        labels, n_shells = shell_labels(f, len(v))
+        shells = body_volume_moments(v, f, labels, n_shells)
+        dropped_note = (f"{len(flat)} stray piece{'s' if len(flat) > 1 else ''} enclosing no volume (loose "
+                        "triangles or sheets) left out")
+        warnings.warn(MeshRepairedWarning(f"{source}: {dropped_note}"), stacklevel=3)
+        flat = []
     if flat:
         what = "the mesh encloses" if n_shells == 1 else f"{len(flat)} of {n_shells} shells enclose"
         raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
@@ -253,6 +266,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         warnings.warn(InsideOutWarning(f"{source}: {what} inside out (normals point inward); flipped"),
                       stacklevel=3)
     method, notes = found.method, list(found.notes)
+    if dropped_note is not None:
+        notes.append(dropped_note)
     if overlaps or found.nonmanifold_edges:
         united = _unite(v, f, labels, owner, source, repair)
         summed = sum(s.volume for s in shells)
