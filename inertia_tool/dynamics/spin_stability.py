@@ -37,6 +37,7 @@ from ..values import frozen_value
 from ..errors import PhysicalValidityWarning, PhysicsError, UsageError
 from ..mass.principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
 from ..mass.properties import MassProperties
+from ..tolerances import TRIANGLE_INEQUALITY_RTOL
 
 __all__ = ["AxisStability", "StabilityReport", "stability", "polhode_period", "KINDS", "AXIS_NAMES"]
 
@@ -252,7 +253,7 @@ def _moments_and_axes(x, rtol: float):
     return m[order], np.eye(3)[:, order], np.zeros(3)
 
 
-def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL, triangle_rtol: float = 1e-9) -> StabilityReport:
+def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL, triangle_rtol: float = TRIANGLE_INEQUALITY_RTOL) -> StabilityReport:
     """Classify steady spin about each principal axis (§4.4.1) and apply the major-axis rule.
 
     Parameters

@@ -33,6 +33,7 @@ import numpy as np
 from ..mass.ellipsoid import equivalent_ellipsoid_semi_axes
 from ..errors import InertiaToolError
 from ..mass.properties import MassProperties
+from ..tolerances import TRIANGLE_INEQUALITY_RTOL
 from .escape import escape_html
 from .output import check_targets, write_text
 from .serialize import TENSOR_CONVENTION
@@ -393,7 +394,7 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
     margin = pa.triangle_inequality_margin
     positive = bool(np.all(pa.moments > 0))
     notes.append(f"Checks: moments positive: {'yes' if positive else 'NO'}; triangle inequality I1 + I2 ≥ I3: "
-                 f"{'yes' if margin >= -1e-9 else 'NO'} (margin {_num(margin, 3)}).")
+                 f"{'yes' if margin >= -TRIANGLE_INEQUALITY_RTOL else 'NO'} (margin {_num(margin, 3)}).")
     body = (_table(["", "moment (kg·m²)", "unit axis (mesh axes)", "radius of gyration (m)",
                     "equivalent-ellipsoid semi-axis (m)"], rows)
             + "".join(f"<p>{_e(n)}</p>" for n in notes))
