@@ -253,7 +253,8 @@ def _moments_and_axes(x, rtol: float):
     return m[order], np.eye(3)[:, order], np.zeros(3)
 
 
-def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL, triangle_rtol: float = TRIANGLE_INEQUALITY_RTOL) -> StabilityReport:
+def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL,
+              triangle_rtol: float = TRIANGLE_INEQUALITY_RTOL) -> StabilityReport:
     """Classify steady spin about each principal axis (§4.4.1) and apply the major-axis rule.
 
     Parameters

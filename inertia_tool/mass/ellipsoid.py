@@ -17,7 +17,8 @@ from ..tolerances import TRIANGLE_INEQUALITY_RTOL
 __all__ = ["equivalent_ellipsoid_semi_axes"]
 
 
-def equivalent_ellipsoid_semi_axes(moments: ArrayLike, mass: float, *, rtol: float = TRIANGLE_INEQUALITY_RTOL) -> np.ndarray:
+def equivalent_ellipsoid_semi_axes(moments: ArrayLike, mass: float, *,
+                                   rtol: float = TRIANGLE_INEQUALITY_RTOL) -> np.ndarray:
     """Semi-axes of the uniform solid ellipsoid with mass ``mass`` and principal moments ``moments``.
 
     A solid ellipsoid of semi-axes ``a_1, a_2, a_3`` and mass ``m`` has ``I_1 = m (a_2² + a_3²)/5`` and
