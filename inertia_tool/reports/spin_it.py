@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
+from .escape import escape_html
+from .html import html_page
 from .serialize import mass_properties_dict, to_jsonable
 from .numbers import number
 
-__all__ = ["spin_it_dict", "format_spin_it_text", "spin_it_figure"]
+__all__ = ["spin_it_dict", "format_spin_it_text", "spin_it_figure", "SpinMotion", "spin_it_html", "motion_svgs"]
 
 
 def _metrics_dict(m) -> dict:
@@ -55,31 +58,9 @@ def _g(x: float) -> str:
     return number(x, 5)
 
 
-def format_spin_it_text(result, *, name: str = "", output: str | None = None) -> str:
-    """A before/after table of a spin design."""
+def _rows(result) -> list[tuple[str, str, str]]:
+    """The before/after rows (label, before, after) of the text and HTML reports."""
     before, after = result.metrics_before, result.metrics_after
-    mode = "yo-yo (free spin, Chapter 4 §4.4.1)" if result.mode == "yoyo" else \
-        "top (heavy symmetric top on a pivot, Chapter 4 §4.4.3)"
-    ax = ", ".join(f"{c:.4g}" for c in result.axis)
-    org = ", ".join(f"{c * 1e3:.4g}" for c in result.origin)
-    where = "pivot" if result.mode == "top" else ("through" if before.axis_offset is not None else
-                                                  "through the centre of mass")
-    lines = [f"spin-it {name}: {mode}",
-             f"  axis ({ax}), {where} ({org}) mm",
-             f"  wall: {_mm(result.wall)} asked, thinnest "
-             f"{_mm(result.measured_wall) if math.isfinite(result.measured_wall) else '— (no cavity)'}"
-             " measured (cavity vertices to the outer surface)",
-             f"  cavity: {result.cavity_volume * 1e6:.4g} cm³ removed, "
-             f"{result.removed_cells} of {result.allowed_cells} cells of {_mm(result.cell_size)}; "
-             f"optimised in {result.optimisation_seconds:.2f} s "
-             f"({result.objective_evaluations} objective evaluations), {result.seconds:.2f} s in all",
-             f"  objective {result.objective_before:.4g} → {result.objective_after:.4g} (exact moments)",
-             "  every 'after' number is the exact re-analysis of the hollowed mesh", ""]
-    if result.insert is not None:
-        lines.insert(5, f"  insert: {result.insert.volume * 1e6:.4g} cm³ of {result.insert_density:g} kg/m³ "
-                        f"({result.insert.mass * 1e3:.4g} g), a second quadric region; 'after' includes it")
-    elif result.insert_density is not None:
-        lines.insert(5, f"  insert of {result.insert_density:g} kg/m³ allowed, but none helps: cavity only")
     if result.mode == "yoyo":
         rows = [("mass", f"{before.mass * 1e3:.4g} g", f"{after.mass * 1e3:.4g} g"),
                 ("I_axis (about the COM) kg·m²", _g(before.axis_moment), _g(after.axis_moment)),
@@ -105,6 +86,35 @@ def format_spin_it_text(result, *, name: str = "", output: str | None = None) ->
                  f"{math.degrees(after.axis_tilt):.3f}°"),
                 ("transverse asymmetry (0 = symmetric top)", f"{before.transverse_asymmetry:.4f}",
                  f"{after.transverse_asymmetry:.4f}")]
+    return rows
+
+
+def format_spin_it_text(result, *, name: str = "", output: str | None = None) -> str:
+    """A before/after table of a spin design."""
+    before = result.metrics_before
+    mode = "yo-yo (free spin, Chapter 4 §4.4.1)" if result.mode == "yoyo" else \
+        "top (heavy symmetric top on a pivot, Chapter 4 §4.4.3)"
+    ax = ", ".join(f"{c:.4g}" for c in result.axis)
+    org = ", ".join(f"{c * 1e3:.4g}" for c in result.origin)
+    where = "pivot" if result.mode == "top" else ("through" if before.axis_offset is not None else
+                                                  "through the centre of mass")
+    lines = [f"spin-it {name}: {mode}",
+             f"  axis ({ax}), {where} ({org}) mm",
+             f"  wall: {_mm(result.wall)} asked, thinnest "
+             f"{_mm(result.measured_wall) if math.isfinite(result.measured_wall) else '— (no cavity)'}"
+             " measured (cavity vertices to the outer surface)",
+             f"  cavity: {result.cavity_volume * 1e6:.4g} cm³ removed, "
+             f"{result.removed_cells} of {result.allowed_cells} cells of {_mm(result.cell_size)}; "
+             f"optimised in {result.optimisation_seconds:.2f} s "
+             f"({result.objective_evaluations} objective evaluations), {result.seconds:.2f} s in all",
+             f"  objective {result.objective_before:.4g} → {result.objective_after:.4g} (exact moments)",
+             "  every 'after' number is the exact re-analysis of the hollowed mesh", ""]
+    if result.insert is not None:
+        lines.insert(5, f"  insert: {result.insert.volume * 1e6:.4g} cm³ of {result.insert_density:g} kg/m³ "
+                        f"({result.insert.mass * 1e3:.4g} g), a second quadric region; 'after' includes it")
+    elif result.insert_density is not None:
+        lines.insert(5, f"  insert of {result.insert_density:g} kg/m³ allowed, but none helps: cavity only")
+    rows = _rows(result)
     width = max(len(r[0]) for r in rows)
     col = max(len(r[1]) for r in rows) + 2
     lines.append(f"  {'':{width}}  {'before':<{col}}after")
@@ -112,6 +122,156 @@ def format_spin_it_text(result, *, name: str = "", output: str | None = None) ->
     if output:
         lines += ["", f"  wrote {output}"]
     return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True)
+class SpinMotion:
+    """A simulated spin of the part before and after, for the picture of :func:`spin_it_html` (the caller
+    simulates; this module only draws).
+
+    Attributes
+    ----------
+    t : (N,) float
+        Sample times, s (the same for both).
+    before, after : (N, k) float
+        The ``k`` plotted quantities at ``t``, in the unit of ``ylabel``.
+    labels : tuple of str
+        Names of the ``k`` quantities (legend).
+    ylabel : str
+        Axis label with its unit.
+    description : str
+        One or two sentences: what was simulated and how it was started (plain text).
+    """
+
+    t: np.ndarray
+    before: np.ndarray
+    after: np.ndarray
+    labels: tuple[str, ...]
+    ylabel: str
+    description: str
+
+
+_COLOURS = ("#1f4e79", "#c55a11", "#548235")
+
+
+def _ticks(lo: float, hi: float, count: int = 5) -> list[float]:
+    """Round tick values covering [lo, hi]."""
+    span = hi - lo if hi > lo else (abs(hi) or 1.0)
+    raw = span / count
+    step = 10 ** math.floor(math.log10(raw))
+    for m in (1, 2, 5, 10):
+        if m * step >= raw:
+            step *= m
+            break
+    first = math.ceil(lo / step - 1e-9) * step
+    return [first + k * step for k in range(int(math.floor((hi - first) / step + 1e-9)) + 1)]
+
+
+def _panel_svg(title: str, t: np.ndarray, ys: np.ndarray, labels, ylabel: str, ylim: tuple[float, float], *,
+               width: int = 470, height: int = 300) -> str:
+    """One line plot as an inline ``<svg>``: ``ys`` (N, k) against ``t`` (s), y range ``ylim``."""
+    e = escape_html
+    left, right, top, bottom = 62, 12, 28, 44
+    pw, ph = width - left - right, height - top - bottom
+    t0, t1 = float(t[0]), float(t[-1]) if t[-1] > t[0] else float(t[0]) + 1.0
+    y0, y1 = ylim
+
+    def x(v):
+        return left + (v - t0) / (t1 - t0) * pw
+
+    def y(v):
+        return top + (y1 - v) / (y1 - y0) * ph
+
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
+           f'viewBox="0 0 {width} {height}" font-family="sans-serif" font-size="11">',
+           f'<text x="{left + pw / 2:.1f}" y="16" text-anchor="middle" font-size="13">{e(title)}</text>',
+           f'<rect x="{left}" y="{top}" width="{pw}" height="{ph}" fill="none" stroke="#888"/>']
+    for v in _ticks(y0, y1):
+        out.append(f'<line x1="{left}" x2="{left + pw}" y1="{y(v):.1f}" y2="{y(v):.1f}" stroke="#e4e4e4"/>'
+                   f'<text x="{left - 4}" y="{y(v) + 4:.1f}" text-anchor="end">{e(number(v, 3))}</text>')
+    for v in _ticks(t0, t1):
+        out.append(f'<line x1="{x(v):.1f}" x2="{x(v):.1f}" y1="{top + ph}" y2="{top + ph + 4}" stroke="#888"/>'
+                   f'<text x="{x(v):.1f}" y="{top + ph + 16}" text-anchor="middle">{e(number(v, 3))}</text>')
+    out.append(f'<text x="{left + pw / 2:.1f}" y="{height - 8}" text-anchor="middle">time (s)</text>'
+               f'<text transform="translate(14 {top + ph / 2:.1f}) rotate(-90)" text-anchor="middle">'
+               f'{e(ylabel)}</text>')
+    for k in range(ys.shape[1]):
+        points = " ".join(f"{x(a):.1f},{y(b):.1f}" for a, b in zip(t, ys[:, k]))
+        colour = _COLOURS[k % len(_COLOURS)]
+        out.append(f'<polyline fill="none" stroke="{colour}" stroke-width="1.4" points="{points}"/>')
+        lx = left + 8 + 120 * k
+        out.append(f'<line x1="{lx}" x2="{lx + 18}" y1="{top + 12}" y2="{top + 12}" stroke="{colour}" '
+                   f'stroke-width="2"/><text x="{lx + 22}" y="{top + 16}">{e(labels[k])}</text>')
+    out.append("</svg>")
+    return "".join(out)
+
+
+def motion_svgs(motion: SpinMotion) -> list[str]:
+    """The before and after panels of ``motion`` on one y scale (two ``<svg>`` elements)."""
+    both = np.concatenate([np.ravel(motion.before), np.ravel(motion.after)])
+    lo, hi = float(np.min(both)), float(np.max(both))
+    pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.1
+    lim = (lo - pad, hi + 2.5 * pad)                                  # room for the legend at the top
+    return [_panel_svg(title, np.asarray(motion.t, float), np.asarray(ys, float).reshape(len(motion.t), -1),
+                       motion.labels, motion.ylabel, lim)
+            for title, ys in (("before (the part as it is)", motion.before), ("after (hollowed)", motion.after))]
+
+
+def _extent_captions(motion: SpinMotion) -> list[str]:
+    """Under each panel: the range the plotted quantities sweep (the size of the wobble or nutation)."""
+    out = []
+    for ys in (motion.before, motion.after):
+        ys = np.asarray(ys, float).reshape(len(motion.t), -1)
+        parts = [f"{label}: {number(float(ys[:, k].min()), 3)} to {number(float(ys[:, k].max()), 3)}"
+                 for k, label in enumerate(motion.labels)]
+        out.append("; ".join(parts))
+    return out
+
+
+def _html_table(head, rows, *, left: int = 1, css: str = "") -> str:
+    """A table of escaped text; the first ``left`` columns left-aligned; no header row when ``head`` is None."""
+    e = escape_html
+    thead = "" if head is None else "<thead><tr>" + "".join(f"<th>{e(h)}</th>" for h in head) + "</tr></thead>"
+    cells = ('<td class="l">', "<td>")
+    body = "".join("<tr>" + "".join(f"{cells[k >= left]}{e(c)}</td>" for k, c in enumerate(r)) + "</tr>"
+                   for r in rows)
+    attribute = f' class="{css}"' if css else ""
+    return f"<table{attribute}>{thead}<tbody>{body}</tbody></table>"
+
+
+def spin_it_html(result, *, name: str = "", motion: SpinMotion | None = None, output: str | None = None) -> str:
+    """A self-contained HTML page of a spin design: the text report's facts, the before/after table of the
+    exact re-analyses, and the simulated spin before and after (``motion``) as inline SVG."""
+    e = escape_html
+    kind = "yo-yo (free spin, Chapter 4 §4.4.1)" if result.mode == "yoyo" else \
+        "top (heavy symmetric top on a pivot, Chapter 4 §4.4.3)"
+    wall = _mm(result.measured_wall) if math.isfinite(result.measured_wall) else "— (no cavity)"
+    facts = [("part", name or "—"), ("design", kind),
+             ("axis", ", ".join(number(c, 4) for c in result.axis)),
+             ("pivot" if result.mode == "top" else "axis point", ", ".join(number(c * 1e3, 4) for c in result.origin)
+              + " mm"),
+             ("wall", f"{_mm(result.wall)} asked, thinnest {wall} measured"),
+             ("cavity", f"{number(result.cavity_volume * 1e6, 4)} cm³ removed ({result.removed_cells} of "
+                        f"{result.allowed_cells} cells of {_mm(result.cell_size)})"),
+             ("objective", f"{number(result.objective_before, 4)} → {number(result.objective_after, 4)} "
+                           "(exact moments)"),
+             ("time", f"{result.seconds:.2f} s ({result.objective_evaluations} objective evaluations)")]
+    if result.insert is not None:
+        facts.append(("insert", f"{number(result.insert.volume * 1e6, 4)} cm³ of {result.insert_density:g} kg/m³ "
+                                f"({number(result.insert.mass * 1e3, 4)} g); 'after' includes it"))
+    if output:
+        facts.append(("hollowed part", output))
+    body = [_html_table(None, facts, left=2),
+            "<h2>Before and after</h2>",
+            "<p>Every “after” number is the exact re-analysis of the hollowed mesh.</p>",
+            _html_table(["quantity", "before", "after"], _rows(result), css="before-after")]
+    if motion is not None:
+        title = "Free spin about the axis" if result.mode == "yoyo" else "Nutation of the top"
+        body += [f"<h2>{e(title)}</h2>", f"<p>{e(motion.description)}</p>",
+                 '<div class="views">' + "".join(
+                     f"<figure>{svg}<figcaption>{e(caption)}</figcaption></figure>"
+                     for svg, caption in zip(motion_svgs(motion), _extent_captions(motion))) + "</div>"]
+    return html_page(f"spin-it: {name or 'part'}", "\n".join(body))
 
 
 def _section_polygons(vertices, faces, origin, frame, plane: str, height: float):
