@@ -81,25 +81,9 @@ def _child(parent, tag: str):
     return child
 
 
-def _inertial_of(link):
-    """The link's ``<inertial>``; a new one, last among its children, when it has none."""
-    from lxml import etree
-    inertial = link.find("inertial")
-    if inertial is not None:
-        return inertial
-    own, step = _layout(link)
-    inertial = etree.SubElement(link, "inertial")
-    if len(link) == 1:
-        link.text = own + step
-    else:
-        link[-2].tail = own + step
-    inertial.tail = own
-    return inertial
-
-
 def _urdf_inertial(link, props) -> None:
     com, t = _clean(props)
-    inertial = _inertial_of(link)
+    inertial = _child(link, "inertial")
     origin = _child(inertial, "origin")
     origin.set("xyz", " ".join(_num(c) for c in com))
     origin.set("rpy", "0 0 0")
@@ -112,7 +96,7 @@ def _urdf_inertial(link, props) -> None:
 
 def _sdf_inertial(link, props) -> None:
     com, t = _clean(props)
-    inertial = _inertial_of(link)
+    inertial = _child(link, "inertial")
     pose = _child(inertial, "pose")
     pose.text = " ".join(_num(c) for c in com) + " 0 0 0"
     pose.attrib.pop("degrees", None)
