@@ -6,6 +6,10 @@ pure-numpy code of ``weld``, ``checks`` and ``volume``, which is the reference a
 modules asks :func:`accel` at call time which one to run.  Set the environment variable
 ``INERTIA_TOOL_NO_ACCEL=1`` to force the numpy path (results are identical, or equal to round-off for the
 integrals, which the C kernel sums with compensation).
+
+The C kernels use :func:`threads` threads on large meshes (the cores this process may run on, at most 16, or
+``INERTIA_TOOL_THREADS``).  Every kernel splits its work so that its result does not depend on the thread
+count: only the speed does.
 """
 
 from __future__ import annotations
@@ -15,10 +19,16 @@ from types import ModuleType
 
 import numpy as np
 
-__all__ = ["accel", "faces_for_c"]
+__all__ = ["accel", "faces_for_c", "threads"]
 
 #: Environment variable that, set to anything but "" or "0", forces the pure-numpy path.
 NO_ACCEL_ENV = "INERTIA_TOOL_NO_ACCEL"
+
+#: Environment variable: the number of threads the C kernels may use (an integer >= 1).
+THREADS_ENV = "INERTIA_TOOL_THREADS"
+
+#: The most threads a kernel uses (MAX_THREADS in _accel.c).
+MAX_THREADS = 16
 
 _MODULE: list[ModuleType | None] = []   # the import result, cached: [module or None]
 
@@ -34,6 +44,19 @@ def accel() -> ModuleType | None:
             _accel = None
         _MODULE.append(_accel)
     return _MODULE[0]
+
+
+def threads() -> int:
+    """Threads for the C kernels: ``INERTIA_TOOL_THREADS`` if set to an integer >= 1, else the CPUs this process
+    may run on; at most 16.  A malformed value counts as unset."""
+    raw = os.environ.get(THREADS_ENV, "").strip()
+    if raw.isdigit() and int(raw) >= 1:
+        return min(int(raw), MAX_THREADS)
+    try:
+        n = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        n = os.cpu_count() or 1
+    return max(1, min(n, MAX_THREADS))
 
 
 def faces_for_c(faces) -> np.ndarray:

@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..values import frozen_value
-from .._native import accel, faces_for_c
+from .._native import accel, faces_for_c, threads
 
 __all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box"]
 
@@ -139,7 +139,7 @@ def _tetra_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, orig
     zero = np.empty(n_labels, dtype=np.int64)
     lib.tetra_sums(np.ascontiguousarray(vertices, dtype=np.float64), faces_for_c(faces),
                    tuple(float(x) for x in origin), float(area_floor),
-                   None if labels is None else np.ascontiguousarray(labels, dtype=np.int64), sums, zero)
+                   None if labels is None else np.ascontiguousarray(labels, dtype=np.int64), sums, zero, threads())
     second = np.empty((n_labels, 3, 3))
     for k, (i, j) in enumerate(_PAIRS):   # columns 4..9 hold xx yy zz xy xz yz
         second[:, i, j] = second[:, j, i] = sums[:, 4 + k]
@@ -167,6 +167,10 @@ def bounding_box(vertices: np.ndarray) -> tuple[NDArray[np.float64], NDArray[np.
     millions of vertices than a reduction over the short axis).
     """
     v = np.asarray(vertices)
+    lib = accel()
+    if lib is not None and len(v) and v.dtype == np.float64 and v.ndim == 2 and v.flags.c_contiguous:
+        lo3, hi3, _ = lib.bounds(v, threads())      # one pass over the rows, NaN propagating like min/max
+        return np.array(lo3), np.array(hi3)
     lo = np.array([v[:, i].min() for i in range(3)], dtype=np.float64)
     hi = np.array([v[:, i].max() for i in range(3)], dtype=np.float64)
     return lo, hi

@@ -14,7 +14,7 @@ from dataclasses import field
 import numpy as np
 
 from ..values import frozen_value
-from .._native import accel, faces_for_c
+from .._native import accel, faces_for_c, threads
 from .estimate import Uncertainty
 
 __all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "winding_number"]
@@ -237,7 +237,8 @@ def edge_topology(faces: np.ndarray, n_vertices: int, vertices: np.ndarray | Non
 
 def _edge_topology_c(lib, faces, n_vertices, vertices) -> EdgeTopology:
     """``edge_topology`` on the C extension (a sorted per-vertex adjacency instead of one global sort)."""
-    edges, boundary, nonmanifold, misoriented, *samples = lib.edge_census(faces_for_c(faces), int(n_vertices))
+    edges, boundary, nonmanifold, misoriented, *samples = lib.edge_census(faces_for_c(faces), int(n_vertices),
+                                                                          threads())
     picks = (samples[0] + samples[1] + samples[2])[:5]    # same order as the numpy path
     sample = np.zeros((0, 2, 3))
     if vertices is not None and picks:
@@ -256,17 +257,17 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
         Shell index of each face, ``0..count-1`` (numbered by the smallest vertex index of the shell).
     count : int
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     m = len(faces)
     if m == 0:
         return np.zeros(0, dtype=np.intp), 0
     lib = accel()
     if lib is not None:      # union-find over vertices, the same numbering
         labels = np.empty(m, dtype=np.intp)
-        count = lib.shell_labels(faces_for_c(faces), int(n_vertices), labels)
+        count = lib.shell_labels(faces_for_c(faces), int(n_vertices), labels, threads())
         return labels, int(count)
+    from scipy.sparse import coo_matrix     # the numpy path only: scipy.sparse costs ~0.2 s to import
+    from scipy.sparse.csgraph import connected_components
+
     # each face links corner 0 to corners 1 and 2: enough to connect all three
     rows = np.repeat(np.asarray(faces[:, 0]), 2)
     cols = np.asarray(faces[:, 1:]).reshape(-1)

@@ -23,6 +23,7 @@ import numpy as np
 
 from ..errors import ImplausibleDensityWarning, ImplausibleSizeWarning
 from ..units import implausible_density, implausible_extent
+from ..mass.volume import bounding_box
 
 __all__ = ["largest_extent", "warn_implausible_size", "warn_implausible_density"]
 
@@ -32,7 +33,8 @@ def largest_extent(vertices: np.ndarray) -> float:
     v = np.asarray(vertices, dtype=np.float64)
     if v.size == 0:
         return 0.0
-    return float(np.max(v.max(axis=0) - v.min(axis=0)))
+    lo, hi = bounding_box(v)
+    return float(np.max(hi - lo))
 
 
 def warn_implausible_size(raw, *, stacklevel: int = 3) -> bool:

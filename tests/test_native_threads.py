@@ -1,0 +1,212 @@
+"""The C kernels' threads: every kernel must give the same result whatever its thread count.
+
+The welder splits points over hash tables and renumbers them in stream order; the edge census splits start
+vertices; the union-find runs concurrently with compare-and-swap links; the tetrahedron sums add a fixed
+number of lanes in lane order.  Each is compared here, on meshes above the kernels' thresholds for using
+threads, with its own one-thread result (bit for bit) and with the numpy reference.
+"""
+
+import numpy as np
+import pytest
+import trimesh
+
+from conftest import HAVE_ACCEL, REQUIRE_ACCEL
+from inertia_tool import _native
+from inertia_tool.mass.volume import bounding_box
+from inertia_tool.mesh.checks import edge_topology, shell_labels
+
+pytestmark = pytest.mark.skipif(not HAVE_ACCEL and not REQUIRE_ACCEL, reason="inertia_tool._accel is not built")
+
+THREADS = (2, 3, 5)
+
+
+@pytest.fixture(scope="module")
+def lib():
+    return _native.accel()
+
+
+@pytest.fixture(scope="module")
+def damaged():
+    """Faces and vertices of 5 shells (icospheres of 81,920 faces, one of them with 40 faces flipped, 30
+    removed and 20 duplicated), 409,550 faces in all: above every kernel's threshold for threads."""
+    sphere = trimesh.creation.icosphere(subdivisions=6, radius=1.0)
+    v0, f0 = np.asarray(sphere.vertices), np.asarray(sphere.faces)
+    rng = np.random.default_rng(7)
+    vs, fs, off = [], [], 0
+    for k in range(5):
+        f = f0.copy()
+        if k == 2:
+            flip = rng.choice(len(f), 40, replace=False)
+            f[flip] = f[flip][:, ::-1]
+            f = np.delete(f, rng.choice(len(f), 30, replace=False), axis=0)
+            f = np.concatenate([f, f[rng.choice(len(f), 20, replace=False)]])
+        vs.append(v0 * (1.0 + 0.1 * k) + [3.0 * k, 0.0, 0.0])
+        fs.append(f + off)
+        off += len(v0)
+    order = rng.permutation(sum(len(f) for f in fs))
+    return np.concatenate(vs), np.concatenate(fs)[order].astype(np.int32)
+
+
+def _weld(lib, corners, threads, chunk):
+    w = lib.Welder("float32", len(corners) // 6, threads)
+    ids = np.empty(len(corners), dtype=np.int32)
+    for s in range(0, len(corners), chunk):
+        w.feed(corners[s:s + chunk], ids[s:s + chunk])
+    v = np.empty((w.count, 3))
+    w.vertices_into(v)
+    return ids, v
+
+
+def test_welder_numbering_is_independent_of_threads(lib, damaged):
+    v, f = damaged
+    corners = v.astype(np.float32)[f].reshape(-1, 3)
+    corners[::97] *= -0.0     # -0.0 and +0.0 are one point (and some corners become the origin)
+    ref_ids, ref_v = _weld(lib, corners, 1, 1 << 20)
+    # first appearance: each id's first occurrence comes before the next id's
+    first = np.full(len(ref_v), -1)
+    first[ref_ids[::-1]] = np.arange(len(ref_ids))[::-1]
+    assert np.all(np.diff(first) > 0)
+    np.testing.assert_array_equal(ref_v[ref_ids], np.where(corners == 0, 0.0, corners))
+    for threads in THREADS:
+        for chunk in (1 << 20, 50_000, 4_000):     # big chunks run threaded, small ones on one thread
+            ids, vv = _weld(lib, corners, threads, chunk)
+            np.testing.assert_array_equal(ids, ref_ids)
+            np.testing.assert_array_equal(vv, ref_v)
+
+
+def test_welder_float64_with_threads(lib, damaged):
+    v, f = damaged
+    corners = v[f].reshape(-1, 3)
+    w1 = lib.Welder("float64", 0, 1)
+    w3 = lib.Welder("float64", 0, 3)
+    a, b = np.empty(len(corners), np.int32), np.empty(len(corners), np.int32)
+    w1.feed(corners, a)
+    w3.feed(corners, b)
+    np.testing.assert_array_equal(a, b)
+    va, vb = np.empty((w1.count, 3)), np.empty((w3.count, 3))
+    w1.vertices_into(va)
+    w3.vertices_into(vb)
+    np.testing.assert_array_equal(va, vb)
+    assert w1.count == len(v)
+
+
+def test_edge_census_is_independent_of_threads(lib, damaged):
+    v, f = damaged
+    ref = lib.edge_census(f, len(v), 1)
+    assert ref[1] > 0 and ref[2] > 0 and ref[3] > 0      # holes, duplicated faces, flips are all seen
+    for threads in THREADS:
+        assert lib.edge_census(f, len(v), threads) == ref
+
+
+def test_edge_census_threads_match_numpy(monkeypatch, damaged):
+    v, f = damaged
+    monkeypatch.setenv(_native.THREADS_ENV, "3")
+    c = edge_topology(f, len(v), v)
+    monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
+    ref = edge_topology(f, len(v), v)
+    assert (c.edges, c.boundary_edges, c.nonmanifold_edges, c.misoriented_edges) == \
+        (ref.edges, ref.boundary_edges, ref.nonmanifold_edges, ref.misoriented_edges)
+    np.testing.assert_array_equal(c.sample, ref.sample)
+
+
+def test_shell_labels_are_independent_of_threads(lib, monkeypatch, damaged):
+    v, f = damaged
+    ref = np.empty(len(f), dtype=np.int64)
+    assert lib.shell_labels(f, len(v), ref, 1) == 5
+    for threads in THREADS:
+        out = np.empty(len(f), dtype=np.int64)
+        assert lib.shell_labels(f, len(v), out, threads) == 5
+        np.testing.assert_array_equal(out, ref)
+    monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
+    labels, count = shell_labels(f, len(v))
+    assert count == 5
+    np.testing.assert_array_equal(labels, ref)
+
+
+def test_shell_labels_many_small_shells_with_threads(lib):
+    """100,000 separate triangles in shuffled order: the concurrent unions must not merge any two."""
+    rng = np.random.default_rng(3)
+    f = rng.permutation(300_000).reshape(-1, 3).astype(np.int32)
+    ref = np.empty(len(f), dtype=np.int64)
+    out = np.empty(len(f), dtype=np.int64)
+    assert lib.shell_labels(f, 300_000, ref, 1) == 100_000
+    assert lib.shell_labels(f, 300_000, out, 4) == 100_000
+    np.testing.assert_array_equal(out, ref)
+    # numbered by the smallest vertex of each triangle
+    np.testing.assert_array_equal(np.argsort(np.argsort(f.min(axis=1))), ref)
+
+
+def _sums(lib, v, f, labels, n_labels, threads):
+    sums = np.empty((n_labels, 11))
+    zero = np.empty(n_labels, dtype=np.int64)
+    lib.tetra_sums(v, f, (0.1, -0.2, 0.3), 1e-30, labels, sums, zero, threads)
+    return sums, zero
+
+
+def test_tetra_sums_are_bitwise_independent_of_threads(lib, damaged):
+    v, f = damaged
+    labels = np.empty(len(f), dtype=np.int64)
+    n = lib.shell_labels(f, len(v), labels, 1)
+    for lab, n_labels in ((None, 1), (labels, n)):
+        ref = _sums(lib, v, f, lab, n_labels, 1)
+        for threads in THREADS:
+            got = _sums(lib, v, f, lab, n_labels, threads)
+            np.testing.assert_array_equal(got[0], ref[0])
+            np.testing.assert_array_equal(got[1], ref[1])
+
+
+def test_tetra_sums_lanes_match_an_exact_sum(lib):
+    """The lane sums against math.fsum of the per-face volume terms (correctly rounded): within 2 ulps."""
+    import math
+    m = trimesh.creation.icosphere(subdivisions=6, radius=1.0)
+    v = np.asarray(m.vertices) + [1e3, -2e3, 5e2]
+    f = np.asarray(m.faces, dtype=np.int64)
+    o = np.array([0.1, -0.2, 0.3])
+    a, b, c = v[f[:, 0]] - o, v[f[:, 1]] - o, v[f[:, 2]] - o
+    v6 = np.einsum("ij,ij->i", a, np.cross(b - a, c - a))
+    exact = math.fsum(v6 / 6.0)
+    sums, _ = _sums(lib, v, f, None, 1, 4)
+    assert abs(sums[0, 0] - exact) <= 2 * np.spacing(abs(exact))
+
+
+def test_tetra_sums_bad_label_reports_the_first(lib, damaged):
+    v, f = damaged
+    labels = np.zeros(len(f), dtype=np.int64)
+    labels[[300_000, 123_456]] = 9
+    with pytest.raises(ValueError, match="position 123456"):
+        _sums(lib, v, f, labels, 2, 3)
+
+
+def test_bounds_kernel(lib, damaged):
+    v, _ = damaged
+    v = np.ascontiguousarray(v)
+    for threads in (1, 3):
+        lo, hi, finite = lib.bounds(v, threads)
+        np.testing.assert_array_equal(lo, v.min(axis=0))
+        np.testing.assert_array_equal(hi, v.max(axis=0))
+        assert finite is True
+    w = v.copy()
+    w[200_000, 1] = np.nan
+    w[5, 2] = np.inf
+    lo, hi, finite = lib.bounds(w, 2)
+    assert np.isnan(lo[1]) and np.isnan(hi[1]) and hi[2] == np.inf and finite is False
+    np.testing.assert_array_equal(np.array(lo)[[0, 2]], w.min(axis=0)[[0, 2]])
+    lo_hi = bounding_box(w)
+    np.testing.assert_array_equal(lo_hi[0], w.min(axis=0))
+    np.testing.assert_array_equal(lo_hi[1], w.max(axis=0))
+    with pytest.raises(ValueError, match="float64"):
+        lib.bounds(v.astype(np.float32))
+    with pytest.raises(ValueError, match="n >= 1"):
+        lib.bounds(np.zeros((0, 3)))
+
+
+@pytest.mark.parametrize("raw, expected", [("3", 3), ("1", 1), ("99", 16), ("0", None), ("abc", None), ("", None),
+                                           ("-2", None)])
+def test_threads_setting(monkeypatch, raw, expected):
+    monkeypatch.setenv(_native.THREADS_ENV, raw)
+    got = _native.threads()
+    if expected is None:
+        monkeypatch.delenv(_native.THREADS_ENV)
+        assert got == _native.threads() and 1 <= got <= 16
+    else:
+        assert got == expected
