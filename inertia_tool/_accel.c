@@ -341,6 +341,9 @@ typedef struct {
     WeldPart part[MAX_THREADS];
     size_t count;          /* vertices so far (global ids) */
     uint64_t points;       /* points fed so far */
+    uint8_t *scratch;      /* parts > 1: the tags and local ids of a feed, kept between feeds (allocating
+                              them per feed costs page faults and, with threads, TLB shootdowns) */
+    size_t scratch_bytes;
 } WelderObject;
 
 static inline uint64_t
@@ -482,8 +485,11 @@ typedef struct {
     WelderObject *w;
     const char *base;
     Py_ssize_t n0, n1, s0, s1, sc;
-    int32_t *ids;          /* out: local ids, then global */
+    int32_t *ids;          /* out: the vertex ids (parts == 1: written by the task; else by welder_number) */
     uint8_t *tag;          /* out: the table of each point (parts > 1) */
+    int32_t *local[MAX_THREADS];  /* parts > 1: thread t's local ids, in stream order of the points it owns
+                                     (private buffers: interleaved writes to `ids` would share cache lines) */
+    uint64_t *hs;          /* threaded feeds: every point's hash, computed first, split by position */
 } FeedTask;
 
 /* Read point (i0, i1) as a key with -0.0 folded onto +0.0. */
@@ -509,6 +515,8 @@ feed_task_##SUFFIX(void *ctx, int t, int nt)                                    
     int pt[WELD_BATCH];                                                                                   \
     Py_ssize_t at[WELD_BATCH];                                                                            \
     int held = 0;                                                                                         \
+    int32_t *dst = ft->local[t] != NULL ? ft->local[t] : ft->ids;                                         \
+    Py_ssize_t pos = 0;                                                                                   \
     Py_ssize_t k = 0, total = ft->n0 * ft->n1;                                                            \
     Py_ssize_t i0 = 0, i1 = 0;                                                                            \
     for (int q = t; q < parts; q += nt) {                                                                 \
@@ -517,24 +525,36 @@ feed_task_##SUFFIX(void *ctx, int t, int nt)                                    
     while (k < total || held > 0) {                                                                       \
         if (k < total && held < WELD_BATCH) {                                                             \
             const char *p = ft->base + i0 * ft->s0 + i1 * ft->s1;                                         \
-            READ_KEY(KEY_T, NEG_ZERO, key[held], p, ft->sc)                                               \
-            uint64_t hh = HASH(key[held]);                                                                \
-            int q = parts > 1 ? part_of(hh, parts) : 0;                                                   \
-            if (t == 0 && ft->tag != NULL) {                                                              \
-                ft->tag[k] = (uint8_t)q;                                                                  \
+            uint64_t hh;                                                                                  \
+            int q;                                                                                        \
+            if (ft->hs != NULL) {                   /* hashed already: read only the points it owns */    \
+                q = ft->tag[k];                                                                           \
+                if (q % nt == t) {                                                                        \
+                    READ_KEY(KEY_T, NEG_ZERO, key[held], p, ft->sc)                                       \
+                }                                                                                         \
+                hh = ft->hs[k];                                                                           \
+            }                                                                                             \
+            else {                                                                                        \
+                READ_KEY(KEY_T, NEG_ZERO, key[held], p, ft->sc)                                           \
+                hh = HASH(key[held]);                                                                     \
+                q = parts > 1 ? part_of(hh, parts) : 0;                                                   \
+                if (t == 0 && ft->tag != NULL) {                                                          \
+                    ft->tag[k] = (uint8_t)q;                                                              \
+                }                                                                                         \
             }                                                                                             \
             if (q % nt == t) {                                                                            \
                 WeldPart *wp = &w->part[q];                                                               \
+                Py_ssize_t d = ft->local[t] != NULL ? pos++ : k;                                          \
                 const SLOT_T *r = (const SLOT_T *)wp->recent + ((hh >> 40) & (WELD_RECENT - 1));          \
                 if (r->id != 0 && r->k[0] == key[held][0] && r->k[1] == key[held][1]                      \
                     && r->k[2] == key[held][2]) {                                                         \
-                    ft->ids[k] = (int32_t)(r->id - 1);                                                    \
+                    dst[d] = (int32_t)(r->id - 1);                                                        \
                 }                                                                                         \
                 else {                                                                                    \
                     PREFETCH(wp->slots + ((size_t)hh & wp->mask));                                        \
                     h[held] = hh;                                                                         \
                     pt[held] = q;                                                                         \
-                    at[held] = k;                                                                         \
+                    at[held] = d;                                                                         \
                     held++;                                                                               \
                 }                                                                                         \
             }                                                                                             \
@@ -550,29 +570,60 @@ feed_task_##SUFFIX(void *ctx, int t, int nt)                                    
             if (wp->status != WELD_OK) {                                                                  \
                 continue;                                                                                 \
             }                                                                                             \
-            wp->status = lookup_##SUFFIX(wp, key[j], h[j], &ft->ids[at[j]]);                              \
+            wp->status = lookup_##SUFFIX(wp, key[j], h[j], &dst[at[j]]);                                  \
             if (wp->status == WELD_OK) {                                                                  \
                 SLOT_T *r = (SLOT_T *)wp->recent + ((h[j] >> 40) & (WELD_RECENT - 1));                    \
                 r->k[0] = key[j][0];                                                                      \
                 r->k[1] = key[j][1];                                                                      \
                 r->k[2] = key[j][2];                                                                      \
-                r->id = (uint32_t)ft->ids[at[j]] + 1;                                                     \
+                r->id = (uint32_t)dst[at[j]] + 1;                                                         \
             }                                                                                             \
         }                                                                                                 \
         held = 0;                                                                                         \
     }                                                                                                     \
 }
 
+/* Thread t of nt, before a threaded feed: hash the t-th contiguous range of the points and tag their tables. */
+#define DEFINE_HASH(SUFFIX, KEY_T, HASH, NEG_ZERO)                                                        \
+static void                                                                                               \
+hash_task_##SUFFIX(void *ctx, int t, int nt)                                                              \
+{                                                                                                         \
+    FeedTask *ft = (FeedTask *)ctx;                                                                       \
+    Py_ssize_t total = ft->n0 * ft->n1;                                                                   \
+    Py_ssize_t lo = (Py_ssize_t)part_start((size_t)total, t, nt);                                         \
+    Py_ssize_t hi = (Py_ssize_t)part_start((size_t)total, t + 1, nt);                                     \
+    Py_ssize_t i0 = lo / ft->n1, i1 = lo % ft->n1;                                                        \
+    int parts = ft->w->parts;                                                                             \
+    for (Py_ssize_t k = lo; k < hi; k++) {                                                                \
+        KEY_T key[3];                                                                                     \
+        const char *p = ft->base + i0 * ft->s0 + i1 * ft->s1;                                             \
+        READ_KEY(KEY_T, NEG_ZERO, key, p, ft->sc)                                                         \
+        uint64_t h = HASH(key);                                                                           \
+        ft->hs[k] = h;                                                                                    \
+        ft->tag[k] = (uint8_t)part_of(h, parts);                                                          \
+        if (++i1 == ft->n1) {                                                                             \
+            i1 = 0;                                                                                       \
+            i0++;                                                                                         \
+        }                                                                                                 \
+    }                                                                                                     \
+}
+
+DEFINE_HASH(32, uint32_t, hash32, 0x80000000U)
+DEFINE_HASH(64, uint64_t, hash64, 0x8000000000000000ULL)
+
 DEFINE_FEED(32, Slot32, uint32_t, hash32, 0x80000000U)
 DEFINE_FEED(64, Slot64, uint64_t, hash64, 0x8000000000000000ULL)
 
 /* Local ids -> global ids in stream order (see the section comment).  Returns a WELD_* status. */
 static int
-welder_number(WelderObject *w, int32_t *ids, const uint8_t *tag, Py_ssize_t total)
+welder_number(WelderObject *w, const FeedTask *ft, Py_ssize_t total, int nt)
 {
+    Py_ssize_t pos[MAX_THREADS] = {0};
+    int32_t *ids = ft->ids;
     for (Py_ssize_t k = 0; k < total; k++) {
-        WeldPart *p = &w->part[tag[k]];
-        size_t local = (size_t)ids[k];
+        int q = ft->tag[k], t = q % nt;
+        WeldPart *p = &w->part[q];
+        size_t local = (size_t)ft->local[t][pos[t]++];
         if (local == p->numbered) {
             if (w->count >= MAX_VERTICES) {
                 return WELD_TOO_MANY;
@@ -643,6 +694,19 @@ Welder_init(WelderObject *w, PyObject *args, PyObject *kwds)
             return -1;
         }
         p->mask = capacity - 1;
+        p->keys_cap = capacity / 2;     /* the load limit: grown (doubled) with the table past the hint */
+        p->keys = malloc(p->keys_cap * (w->wide ? 24 : 12));
+        if (p->keys == NULL) {
+            for (int r = 0; r <= q; r++) {
+                free(w->part[r].slots);
+                free(w->part[r].keys);
+                free(w->part[r].recent);
+                w->part[r].slots = NULL;
+                w->part[r].keys = w->part[r].recent = NULL;
+            }
+            PyErr_NoMemory();
+            return -1;
+        }
     }
     w->parts = parts;
     w->count = 0;
@@ -660,6 +724,7 @@ Welder_dealloc(WelderObject *w)
         free(w->part[q].recent);
         free(w->part[q].global);
     }
+    free(w->scratch);
     Py_TYPE(w)->tp_free((PyObject *)w);
 }
 
@@ -687,7 +752,6 @@ Welder_feed(WelderObject *w, PyObject *args)
         return NULL;
     }
     Py_buffer pts, out;
-    uint8_t *tag = NULL;
     if (PyObject_GetBuffer(points_obj, &pts, PyBUF_STRIDES | PyBUF_FORMAT) < 0) {
         return NULL;
     }
@@ -712,20 +776,45 @@ Welder_feed(WelderObject *w, PyObject *args)
         PyErr_Format(PyExc_ValueError, "Expected `out` as a contiguous int32 array of %zd entries", total);
         goto fail;
     }
+    int nt = thread_count(w->parts, (size_t)total, WELD_PARALLEL_MIN);
+    FeedTask ft = {w, (const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
+                   pts.strides[pts.ndim - 1], (int32_t *)out.buf, NULL, {NULL}, NULL};
     if (w->parts > 1 && total > 0) {
-        tag = (uint8_t *)malloc((size_t)total);
-        if (tag == NULL) {
+        /* one block: the hashes (threaded feeds), each thread's local ids (at most `total` each), the tags */
+        size_t per_point = (nt > 1 ? 8 : 0) + 4 * (size_t)nt + 1;
+        if ((size_t)total > SIZE_MAX / per_point) {
             PyErr_NoMemory();
             goto fail;
         }
+        size_t need = (size_t)total * per_point;
+        if (need > w->scratch_bytes) {
+            free(w->scratch);
+            w->scratch_bytes = 0;
+            w->scratch = (uint8_t *)malloc(need);
+            if (w->scratch == NULL) {
+                PyErr_NoMemory();
+                goto fail;
+            }
+            w->scratch_bytes = need;
+        }
+        uint8_t *at = w->scratch;
+        if (nt > 1) {
+            ft.hs = (uint64_t *)at;
+            at += 8 * (size_t)total;
+        }
+        for (int t = 0; t < nt; t++) {
+            ft.local[t] = (int32_t *)at;
+            at += 4 * (size_t)total;
+        }
+        ft.tag = at;
     }
-    FeedTask ft = {w, (const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
-                   pts.strides[pts.ndim - 1], (int32_t *)out.buf, tag};
-    int nt = thread_count(w->parts, (size_t)total, WELD_PARALLEL_MIN);
     int status = WELD_OK;
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
     if (total > 0) {
+        if (ft.hs != NULL) {
+            run_parallel(nt, w->wide ? hash_task_64 : hash_task_32, &ft);
+        }
         run_parallel(nt, w->wide ? feed_task_64 : feed_task_32, &ft);
         for (int q = 0; q < w->parts; q++) {
             if (w->part[q].status != WELD_OK) {
@@ -734,7 +823,7 @@ Welder_feed(WelderObject *w, PyObject *args)
         }
         if (status == WELD_OK) {
             if (w->parts > 1) {
-                status = welder_number(w, ft.ids, tag, total);
+                status = welder_number(w, &ft, total, nt);
             }
             else {
                 w->count = w->part[0].count;
@@ -743,8 +832,6 @@ Welder_feed(WelderObject *w, PyObject *args)
     }
     Py_END_ALLOW_THREADS
     w->busy = 0;
-    free(tag);
-    tag = NULL;
     if (status == WELD_NOMEM) {
         PyErr_NoMemory();
         goto fail;
@@ -758,7 +845,6 @@ Welder_feed(WelderObject *w, PyObject *args)
     PyBuffer_Release(&out);
     Py_RETURN_NONE;
 fail:
-    free(tag);
     PyBuffer_Release(&pts);
     PyBuffer_Release(&out);
     return NULL;
