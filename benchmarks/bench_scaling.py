@@ -1,0 +1,202 @@
+"""Scaling of ``inertia-tool analyze`` from 1e3 to 1e7 triangles against a bare read of the file and trimesh.
+
+For each size a closed torus is written as binary STL into benchmarks/out/ (not committed); its triangles come
+row by row, as a CAD exporter writes a surface patch by patch.  Each of these then runs in a fresh process, best
+of ``--repeat`` (warm page cache; the file is read once before timing):
+
+* ``cat FILE > /dev/null``: the bare read, the physical floor (the issue's yardstick);
+* ``numpy.fromfile``: the file read into memory by Python (interpreter and numpy start-up included);
+* ``inertia-tool analyze FILE --json``: the whole job, interpreter start-up, imports and full watertight
+  validation included, on the C extension with its threads (``INERTIA_TOOL_THREADS`` to change);
+* trimesh: ``trimesh.load(FILE)`` + ``mass_properties`` (skipped above ``--trimesh-max`` faces).
+
+It prints a table of times, peak resident memory (VmHWM of each child) and the ratios ``analyze / cat``,
+``analyze / fromfile`` and ``trimesh / analyze``, measured in the same run, and draws
+``docs/img/scaling.png`` (time and peak memory against faces, log-log, all four on the same axes).
+
+    python benchmarks/bench_scaling.py [--sizes 1e3 1e4 1e5 1e6 1e7] [--repeat 3] [--plot docs/img/scaling.png]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+OUT = os.path.join(HERE, "out")
+sys.path.insert(0, HERE)
+
+from bench_engine import _PEAK  # noqa: E402
+
+_MIB = 1 << 20
+
+CHILD_READ = _PEAK + r"""
+t = time.perf_counter()
+import numpy as np
+a = np.fromfile(sys.argv[1], dtype=np.uint8)
+dt = time.perf_counter() - t
+print(0, dt, peak())
+"""
+
+CHILD_ANALYZE = _PEAK + r"""
+import io, contextlib
+t = time.perf_counter()
+from inertia_tool.cli import main
+buf = io.StringIO()
+with contextlib.redirect_stdout(buf):
+    rc = main(["analyze", sys.argv[1], "--json", "--units", "mm"])
+dt = time.perf_counter() - t
+print(rc, dt, peak())
+"""
+
+CHILD_TRIMESH = _PEAK + r"""
+t = time.perf_counter()
+import trimesh
+m = trimesh.load(sys.argv[1])
+mp = m.mass_properties
+_ = (mp["volume"], mp["center_mass"], mp["inertia"])
+dt = time.perf_counter() - t
+print(0, dt, peak())
+"""
+
+
+def torus_faces_for(target: int) -> tuple[int, int]:
+    """(nu, nv) with 2·nu·nv close to ``target`` triangles and nu ≈ 4 nv (a ring, like a part's outline)."""
+    nv = max(3, int(round((target / 8) ** 0.5)))
+    nu = max(3, int(round(target / (2 * nv))))
+    return nu, nv
+
+
+def write_torus(target: int) -> tuple[str, int]:
+    """A closed torus (major radius 40 mm, minor 10 mm) of about ``target`` triangles as binary STL."""
+    nu, nv = torus_faces_for(target)
+    m = 2 * nu * nv
+    path = os.path.join(OUT, f"torus_{m}.stl")
+    if os.path.exists(path):
+        return path, m
+    os.makedirs(OUT, exist_ok=True)
+    u = 2 * np.pi * np.arange(nu) / nu
+    v = 2 * np.pi * np.arange(nv) / nv
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    r = 40.0 + 10.0 * np.cos(vv)
+    pts = np.stack([r * np.cos(uu), r * np.sin(uu), 10.0 * np.sin(vv)], axis=-1).astype(np.float32)
+    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
+    a = i * nv + j
+    b = ((i + 1) % nu) * nv + j
+    c = ((i + 1) % nu) * nv + (j + 1) % nv
+    d = i * nv + (j + 1) % nv
+    faces = np.stack([np.stack([a, b, c], -1), np.stack([a, c, d], -1)], axis=2).reshape(-1, 3)
+    flat = pts.reshape(-1, 3)
+    rec = np.zeros(m, dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    step = 1 << 20
+    for s in range(0, m, step):
+        rec["v"][s:s + step] = flat[faces[s:s + step]]
+    with open(path, "wb") as fh:
+        fh.write(b"inertia_tool benchmark torus".ljust(80))
+        fh.write(np.uint32(m).tobytes())
+        rec.tofile(fh)
+    return path, m
+
+
+def run_child(code: str, path: str, repeat: int) -> tuple[float, int]:
+    env = {**os.environ, "PYTHONPATH": ROOT}
+    best = (float("inf"), 0)
+    for _ in range(repeat):
+        r = subprocess.run([sys.executable, "-c", code, path], capture_output=True, text=True, env=env)
+        if r.returncode != 0:
+            raise RuntimeError(f"child failed on {path}: {r.stderr[-2000:]}")
+        rc, dt, rss = r.stdout.split()[-3:]
+        if int(rc) != 0:
+            raise RuntimeError(f"analyze failed on {path}: {r.stderr[-2000:]}")
+        if float(dt) < best[0]:
+            best = (float(dt), int(rss))
+    return best
+
+
+def time_cat(path: str, repeat: int) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        t = time.perf_counter()
+        with open(os.devnull, "wb") as null:
+            subprocess.run(["cat", path], stdout=null, check=True)
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def plot(rows, out: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    faces = [r["faces"] for r in rows]
+    fig, (ax_t, ax_m) = plt.subplots(1, 2, figsize=(11, 4.4))
+    series = (("inertia-tool analyze", "analyze", "C0", "o-"), ("trimesh load + mass_properties", "trimesh", "C3", "s-"),
+              ("Python + numpy.fromfile", "fromfile", "C2", "^--"), ("cat > /dev/null", "cat", "0.4", "v:"))
+    for label, key, colour, style in series:
+        pts = [(r["faces"], r[f"{key}_s"]) for r in rows if r.get(f"{key}_s") is not None]
+        if pts:
+            ax_t.loglog(*zip(*pts), style, color=colour, label=label)
+        mem = [(r["faces"], r[f"{key}_mb"]) for r in rows if r.get(f"{key}_mb") is not None]
+        if mem:
+            ax_m.loglog(*zip(*mem), style, color=colour, label=label)
+    ax_m.loglog(faces, [r["file_mb"] for r in rows], "k-", lw=0.8, label="file size")
+    ax_t.set(xlabel="triangles", ylabel="wall time, s (best of runs, fresh process)", title="Time")
+    ax_m.set(xlabel="triangles", ylabel="peak resident memory, MiB", title="Peak memory")
+    for ax in (ax_t, ax_m):
+        ax.grid(True, which="both", lw=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Binary STL tori, warm page cache, one run: analyze vs a bare read and trimesh", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=float, nargs="+", default=[1e3, 1e4, 1e5, 1e6, 1e7])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--trimesh-max", type=float, default=1.1e7, help="skip trimesh above this many faces")
+    ap.add_argument("--plot", default=os.path.join(ROOT, "docs", "img", "scaling.png"))
+    args = ap.parse_args()
+    rows = []
+    for target in args.sizes:
+        path, m = write_torus(int(target))
+        with open(path, "rb") as fh:      # warm the page cache
+            while fh.read(1 << 24):
+                pass
+        row = dict(faces=m, file_mb=os.path.getsize(path) / _MIB)
+        row["cat_s"] = time_cat(path, args.repeat)
+        row["fromfile_s"], rss = run_child(CHILD_READ, path, args.repeat)
+        row["fromfile_mb"] = rss / _MIB
+        row["analyze_s"], rss = run_child(CHILD_ANALYZE, path, args.repeat)
+        row["analyze_mb"] = rss / _MIB
+        if m <= args.trimesh_max:
+            row["trimesh_s"], rss = run_child(CHILD_TRIMESH, path, 1 if m > 2e6 else args.repeat)
+            row["trimesh_mb"] = rss / _MIB
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+    print()
+    print(f"CPUs: {os.cpu_count()}, load average before the last size: {os.getloadavg()[0]:.2f}")
+    print("| faces | file MB | cat s | fromfile s | analyze s | trimesh s | analyze / cat | analyze / fromfile "
+          "| trimesh / analyze | analyze peak MB | peak / file |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for r in rows:
+        tm = r.get("trimesh_s")
+        tm_s = "—" if tm is None else f"{tm:.2f}"
+        tm_ratio = "—" if tm is None else f"{tm / r['analyze_s']:.1f}"
+        print(f"| {r['faces']:,} | {r['file_mb']:.1f} | {r['cat_s']:.3f} | {r['fromfile_s']:.3f} | "
+              f"{r['analyze_s']:.3f} | {tm_s} | {r['analyze_s'] / r['cat_s']:.1f} | "
+              f"{r['analyze_s'] / r['fromfile_s']:.1f} | {tm_ratio} | "
+              f"{r['analyze_mb']:.0f} | {r['analyze_mb'] / r['file_mb']:.2f} |")
+    if args.plot:
+        plot(rows, args.plot)
+        print(f"wrote {args.plot}")
+
+
+if __name__ == "__main__":
+    main()
