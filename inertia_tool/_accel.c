@@ -155,7 +155,7 @@ check_indices(const void *faces, int size, size_t count, int64_t n)
  * when all are done (the GIL is released by the caller; no task touches a Python object).  If a thread
  * cannot be started, its share runs on the calling thread instead, so the result never depends on how many
  * threads actually ran: every kernel splits its work by `t` and `nt` only, and combines the parts in a
- * fixed order.  cas32 / load32 are the atomics the concurrent union-find needs.
+ * fixed order.  cas32 / load32 / mark_byte are the atomics the concurrent union-find needs.
  * ====================================================================================================== */
 
 #define MAX_THREADS 16
@@ -216,6 +216,12 @@ cas32(int32_t *p, int32_t expected, int32_t desired)
     return InterlockedCompareExchange((volatile LONG *)p, (LONG)desired, (LONG)expected) == (LONG)expected;
 }
 
+static inline void
+mark_byte(unsigned char *p)
+{
+    *(volatile unsigned char *)p = 1;     /* MSVC: volatile stores are atomic for a byte */
+}
+
 #else
 #include <pthread.h>
 
@@ -260,6 +266,13 @@ static inline int
 cas32(int32_t *p, int32_t expected, int32_t desired)
 {
     return __atomic_compare_exchange_n(p, &expected, desired, 0, __ATOMIC_ACQ_REL, __ATOMIC_ACQUIRE);
+}
+
+/* Set a flag byte that other threads may set too (the same value: a relaxed atomic store). */
+static inline void
+mark_byte(unsigned char *p)
+{
+    __atomic_store_n(p, (unsigned char)1, __ATOMIC_RELAXED);
 }
 #endif
 
@@ -1328,7 +1341,7 @@ shell_mark_task(void *ctx, int t, int nt)
     for (size_t i = part_start(s->m, t, nt); i < part_start(s->m, t + 1, nt); i++) {
         int32_t r = nt == 1 ? find_root(s->parent, (int32_t)index_at(s->f, s->size, 3 * i))
                             : find_root_shared(s->parent, (int32_t)index_at(s->f, s->size, 3 * i));
-        s->carries[r] = 1;      /* every writer stores the same value */
+        mark_byte(&s->carries[r]);
     }
 }
 

@@ -323,3 +323,19 @@ def test_sanitizer_build_replays_the_corpus_without_reports():
                           text=True, timeout=600, env={**os.environ, "PYTHON": sys.executable})
     assert done.returncode == 0, done.stderr[-3000:]
     assert "findings 0" in done.stdout and "sanitize: OK" in done.stdout
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform != "linux" or shutil.which("gcc") is None, reason="needs gcc with libtsan (Linux)")
+def test_threaded_kernels_have_no_data_race():
+    """scripts/tsan.sh: the thread tests against a ThreadSanitizer build of the extension.  It found the flag
+    bytes of the shell marking written by several threads without an atomic store (harmless on x86, a data
+    race in C11); they are relaxed atomic stores now."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    tsan = subprocess.run(["gcc", "-print-file-name=libtsan.so"], capture_output=True, text=True).stdout.strip()
+    if not os.path.isabs(tsan):
+        pytest.skip("gcc has no libtsan")
+    done = subprocess.run(["sh", os.path.join(root, "scripts", "tsan.sh")], capture_output=True, text=True,
+                          timeout=900, env={**os.environ, "PYTHON": sys.executable})
+    assert done.returncode == 0, (done.stdout + done.stderr)[-3000:]
+    assert "without reports" in done.stdout

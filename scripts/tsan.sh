@@ -1,0 +1,42 @@
+#!/bin/sh
+# Build the C extension with ThreadSanitizer into a temporary folder and run the thread tests
+# (tests/test_native_threads.py) against it: any data race in the threaded kernels is a failure.
+#
+#     scripts/tsan.sh
+#
+# Needs gcc (or CC) with libtsan and the Python headers; libtsan is preloaded (LD_PRELOAD) ahead of the
+# uninstrumented interpreter.  The log goes to $OUT/tsan.* (OUT: the temporary folder, kept on failure).
+set -eu
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+PYTHON=${PYTHON:-python3}
+CC=${CC:-gcc}
+OUT=$(mktemp -d "${TMPDIR:-/tmp}/inertia-tsan.XXXXXX")
+
+INCLUDE=$("$PYTHON" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')
+SUFFIX=$("$PYTHON" -c 'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))')
+mkdir -p "$OUT/pkg"
+cp -R "$ROOT/inertia_tool" "$OUT/pkg/inertia_tool"
+cp -R "$ROOT/tests" "$OUT/pkg/tests"
+find "$OUT/pkg" -name '_accel*.so' -delete
+find "$OUT/pkg" -name '__pycache__' -prune -exec rm -rf {} +
+"$CC" -shared -fPIC -g -O1 -fsanitize=thread -pthread -Wall -Werror -I"$INCLUDE" \
+    "$ROOT/inertia_tool/_accel.c" -o "$OUT/pkg/inertia_tool/_accel$SUFFIX"
+
+TSAN_LIB=$("$CC" -print-file-name=libtsan.so)
+status=0
+(cd "$OUT/pkg" && env PYTHONPATH="$OUT/pkg" PYTHONDONTWRITEBYTECODE=1 INERTIA_TOOL_NO_ACCEL= \
+    INERTIA_TOOL_REQUIRE_ACCEL=1 LD_PRELOAD="$TSAN_LIB" \
+    TSAN_OPTIONS="report_signal_unsafe=0:halt_on_error=0:log_path=$OUT/tsan" \
+    "$PYTHON" -m pytest -q -p no:cacheprovider tests/test_native_threads.py) || status=$?
+
+if ls "$OUT"/tsan.* >/dev/null 2>&1; then
+    echo "tsan: ThreadSanitizer reports:" >&2
+    cat "$OUT"/tsan.* >&2
+    status=1
+fi
+if [ "$status" -ne 0 ]; then
+    echo "tsan: FAILED (exit $status); build and logs kept in $OUT" >&2
+    exit "$status"
+fi
+rm -rf "$OUT"
+echo "tsan: the threaded kernels ran under ThreadSanitizer without reports"
