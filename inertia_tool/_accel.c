@@ -276,12 +276,6 @@ mark_byte(unsigned char *p)
 }
 #endif
 
-#if defined(__GNUC__) || defined(__clang__)
-#define PREFETCH(p) __builtin_prefetch((p), 1, 1)
-#else
-#define PREFETCH(p) ((void)0)
-#endif
-
 /* Start of part t of n items split into nt contiguous parts. */
 static inline size_t
 part_start(size_t n, int t, int nt)
@@ -309,8 +303,8 @@ thread_count(int requested, size_t items, size_t min_items)
  * live in an array indexed by id and every probe compares the full key, so two different points can
  * never share a vertex whatever the hash does.  A shared corner recurs within a few triangles in the files people have (in a
  * 5M-face sphere, 87 % of repeats within 64 corners, 98 % within 4,096), so each table keeps a small
- * direct-mapped cache of the points it saw last, checked (full key) before the table; table slots of the
- * points that miss it are prefetched a batch of points ahead.
+ * direct-mapped cache of the points it saw last, checked (full key) before the table: 82 % of that sphere's
+ * lookups end there.
  *
  * Threads: the key space is split into `parts` tables by the high bits of the hash; thread t of a feed
  * scans every point of the chunk and inserts those of its own tables, giving each a local id in order of
@@ -321,9 +315,6 @@ thread_count(int requested, size_t items, size_t min_items)
  * ====================================================================================================== */
 
 #define MAX_VERTICES ((size_t)INT32_MAX - 1)
-#ifndef WELD_BATCH
-#define WELD_BATCH 16
-#endif
 #define WELD_RECENT 4096                      /* entries of the recent-point cache of each table */
 #define WELD_INITIAL_MAX ((size_t)1 << 23)    /* slots per table allocated up front, at most */
 #define WELD_PARALLEL_MIN ((size_t)1 << 15)   /* points per feed below which one thread does all tables */
@@ -514,8 +505,9 @@ typedef struct {
         }                                                                                                 \
     }
 
-/* Thread t of nt: weld the points whose table is owned by t (table % nt == t), a batch at a time with the
- * slots prefetched; thread 0 also writes every point's table into `tag`. */
+/* Thread t of nt: weld the points whose table is owned by t (table % nt == t), in stream order, each looked
+ * up in its table's recent-point cache first; when the feed was not hashed beforehand (one thread), thread 0
+ * also writes every point's table into `tag`. */
 #define DEFINE_FEED(SUFFIX, SLOT_T, KEY_T, HASH, NEG_ZERO)                                                \
 static void                                                                                               \
 feed_task_##SUFFIX(void *ctx, int t, int nt)                                                              \
@@ -523,76 +515,56 @@ feed_task_##SUFFIX(void *ctx, int t, int nt)                                    
     FeedTask *ft = (FeedTask *)ctx;                                                                       \
     WelderObject *w = ft->w;                                                                              \
     int parts = w->parts;                                                                                 \
-    KEY_T key[WELD_BATCH][3];                                                                             \
-    uint64_t h[WELD_BATCH];                                                                               \
-    int pt[WELD_BATCH];                                                                                   \
-    Py_ssize_t at[WELD_BATCH];                                                                            \
-    int held = 0;                                                                                         \
     int32_t *dst = ft->local[t] != NULL ? ft->local[t] : ft->ids;                                         \
-    Py_ssize_t pos = 0;                                                                                   \
-    Py_ssize_t k = 0, total = ft->n0 * ft->n1;                                                            \
-    Py_ssize_t i0 = 0, i1 = 0;                                                                            \
+    Py_ssize_t pos = 0, total = ft->n0 * ft->n1, i0 = 0, i1 = 0;                                          \
     for (int q = t; q < parts; q += nt) {                                                                 \
         w->part[q].status = WELD_OK;                                                                      \
     }                                                                                                     \
-    while (k < total || held > 0) {                                                                       \
-        if (k < total && held < WELD_BATCH) {                                                             \
-            const char *p = ft->base + i0 * ft->s0 + i1 * ft->s1;                                         \
-            uint64_t hh;                                                                                  \
-            int q;                                                                                        \
-            if (ft->hs != NULL) {                   /* hashed already: read only the points it owns */    \
-                q = ft->tag[k];                                                                           \
-                if (q % nt == t) {                                                                        \
-                    READ_KEY(KEY_T, NEG_ZERO, key[held], p, ft->sc)                                       \
-                }                                                                                         \
-                hh = ft->hs[k];                                                                           \
-            }                                                                                             \
-            else {                                                                                        \
-                READ_KEY(KEY_T, NEG_ZERO, key[held], p, ft->sc)                                           \
-                hh = HASH(key[held]);                                                                     \
-                q = parts > 1 ? part_of(hh, parts) : 0;                                                   \
-                if (t == 0 && ft->tag != NULL) {                                                          \
-                    ft->tag[k] = (uint8_t)q;                                                              \
-                }                                                                                         \
-            }                                                                                             \
-            if (q % nt == t) {                                                                            \
-                WeldPart *wp = &w->part[q];                                                               \
-                Py_ssize_t d = ft->local[t] != NULL ? pos++ : k;                                          \
-                const SLOT_T *r = (const SLOT_T *)wp->recent + ((hh >> 40) & (WELD_RECENT - 1));          \
-                if (r->id != 0 && r->k[0] == key[held][0] && r->k[1] == key[held][1]                      \
-                    && r->k[2] == key[held][2]) {                                                         \
-                    dst[d] = (int32_t)(r->id - 1);                                                        \
-                }                                                                                         \
-                else {                                                                                    \
-                    PREFETCH(wp->slots + ((size_t)hh & wp->mask));                                        \
-                    h[held] = hh;                                                                         \
-                    pt[held] = q;                                                                         \
-                    at[held] = d;                                                                         \
-                    held++;                                                                               \
-                }                                                                                         \
-            }                                                                                             \
-            k++;                                                                                          \
-            if (++i1 == ft->n1) {                                                                         \
-                i1 = 0;                                                                                   \
-                i0++;                                                                                     \
-            }                                                                                             \
-            continue;                                                                                     \
+    for (Py_ssize_t k = 0; k < total; k++) {                                                              \
+        const char *p = ft->base + i0 * ft->s0 + i1 * ft->s1;                                             \
+        if (++i1 == ft->n1) {                                                                             \
+            i1 = 0;                                                                                       \
+            i0++;                                                                                         \
         }                                                                                                 \
-        for (int j = 0; j < held; j++) {                                                                  \
-            WeldPart *wp = &w->part[pt[j]];                                                               \
-            if (wp->status != WELD_OK) {                                                                  \
+        KEY_T key[3];                                                                                     \
+        uint64_t h;                                                                                       \
+        int q;                                                                                            \
+        if (ft->hs != NULL) {                     /* hashed already: read only the points it owns */      \
+            q = ft->tag[k];                                                                               \
+            if (q % nt != t) {                                                                            \
                 continue;                                                                                 \
             }                                                                                             \
-            wp->status = lookup_##SUFFIX(wp, key[j], h[j], &dst[at[j]]);                                  \
-            if (wp->status == WELD_OK) {                                                                  \
-                SLOT_T *r = (SLOT_T *)wp->recent + ((h[j] >> 40) & (WELD_RECENT - 1));                    \
-                r->k[0] = key[j][0];                                                                      \
-                r->k[1] = key[j][1];                                                                      \
-                r->k[2] = key[j][2];                                                                      \
-                r->id = (uint32_t)dst[at[j]] + 1;                                                         \
+            READ_KEY(KEY_T, NEG_ZERO, key, p, ft->sc)                                                     \
+            h = ft->hs[k];                                                                                \
+        }                                                                                                 \
+        else {                                                                                            \
+            READ_KEY(KEY_T, NEG_ZERO, key, p, ft->sc)                                                     \
+            h = HASH(key);                                                                                \
+            q = parts > 1 ? part_of(h, parts) : 0;                                                        \
+            if (t == 0 && ft->tag != NULL) {                                                              \
+                ft->tag[k] = (uint8_t)q;                                                                  \
+            }                                                                                             \
+            if (q % nt != t) {                                                                            \
+                continue;                                                                                 \
             }                                                                                             \
         }                                                                                                 \
-        held = 0;                                                                                         \
+        WeldPart *wp = &w->part[q];                                                                       \
+        int32_t *out = &dst[ft->local[t] != NULL ? pos++ : k];                                            \
+        SLOT_T *r = (SLOT_T *)wp->recent + ((h >> 40) & (WELD_RECENT - 1));                               \
+        if (r->id != 0 && r->k[0] == key[0] && r->k[1] == key[1] && r->k[2] == key[2]) {                  \
+            *out = (int32_t)(r->id - 1);                                                                  \
+            continue;                                                                                     \
+        }                                                                                                 \
+        if (wp->status != WELD_OK) {                                                                      \
+            continue;                                                                                     \
+        }                                                                                                 \
+        wp->status = lookup_##SUFFIX(wp, key, h, out);                                                    \
+        if (wp->status == WELD_OK) {                                                                      \
+            r->k[0] = key[0];                                                                             \
+            r->k[1] = key[1];                                                                             \
+            r->k[2] = key[2];                                                                             \
+            r->id = (uint32_t)*out + 1;                                                                   \
+        }                                                                                                 \
     }                                                                                                     \
 }
 
