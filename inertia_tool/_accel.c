@@ -155,7 +155,8 @@ check_indices(const void *faces, int size, size_t count, int64_t n)
  * when all are done (the GIL is released by the caller; no task touches a Python object).  If a thread
  * cannot be started, its share runs on the calling thread instead, so the result never depends on how many
  * threads actually ran: every kernel splits its work by `t` and `nt` only, and combines the parts in a
- * fixed order.  cas32 / load32 / mark_byte are the atomics the concurrent union-find needs.
+ * fixed order.  cas32 / load32 / mark_byte are the atomics the concurrent union-find needs; next_ticket
+ * hands out work items to whichever thread is free (so a thread slowed by other processes delays no one).
  * ====================================================================================================== */
 
 #define MAX_THREADS 16
@@ -222,6 +223,12 @@ mark_byte(unsigned char *p)
     *(volatile unsigned char *)p = 1;     /* MSVC: volatile stores are atomic for a byte */
 }
 
+static inline int32_t
+next_ticket(int32_t *counter)
+{
+    return (int32_t)InterlockedIncrement((volatile LONG *)counter) - 1;
+}
+
 #else
 #include <pthread.h>
 
@@ -273,6 +280,13 @@ static inline void
 mark_byte(unsigned char *p)
 {
     __atomic_store_n(p, (unsigned char)1, __ATOMIC_RELAXED);
+}
+
+/* The counter's value before an atomic increment: hands out work items 0, 1, 2, ... to whichever thread asks. */
+static inline int32_t
+next_ticket(int32_t *counter)
+{
+    return __atomic_fetch_add(counter, 1, __ATOMIC_RELAXED);
 }
 #endif
 
@@ -1221,10 +1235,10 @@ accel_edge_census(PyObject *self, PyObject *args)
  * the roots that carry faces: shells are numbered by their smallest vertex index, as checks.shell_labels
  * does.
  *
- * Threads: the faces are split into nt ranges whose unions run concurrently on one parent array, lock-free
- * (a link is a compare-and-swap of a root's parent from itself to the smaller root, retried if the root
- * was linked meanwhile; finds halve paths with compare-and-swaps too, which only ever move a pointer up its
- * own tree).  The final forest has the same roots, so the labels are the serial ones.
+ * Threads: chunks of faces, handed to whichever thread is free, are united concurrently on one parent
+ * array, lock-free (a link is a compare-and-swap of a root's parent from itself to the smaller root, retried
+ * if the root was linked meanwhile; finds halve paths with compare-and-swaps too, which only ever move a
+ * pointer up its own tree).  The final forest has the same roots, so the labels are the serial ones.
  * ====================================================================================================== */
 
 #define SHELL_PARALLEL_MIN ((size_t)1 << 15)
@@ -1255,6 +1269,8 @@ find_root_shared(int32_t *parent, int32_t x)
     }
 }
 
+#define SHELL_CHUNK ((size_t)1 << 16)          /* faces per work item of the threaded phases */
+
 typedef struct {
     const void *f;
     int size;
@@ -1263,16 +1279,30 @@ typedef struct {
     unsigned char *carries;
     void *out;
     int out_size;
+    int32_t next[3];       /* next_ticket counters of the union, mark and label phases */
 } ShellTask;
+
+/* The faces [lo, hi) of the next work item of phase `phase`, or 0 when none is left. */
+static int
+shell_chunk(ShellTask *s, int phase, size_t *lo, size_t *hi)
+{
+    size_t c = (size_t)next_ticket(&s->next[phase]);
+    if (c * SHELL_CHUNK >= s->m) {
+        return 0;
+    }
+    *lo = c * SHELL_CHUNK;
+    *hi = *lo + SHELL_CHUNK < s->m ? *lo + SHELL_CHUNK : s->m;
+    return 1;
+}
 
 static void
 shell_union_task(void *ctx, int t, int nt)
 {
     ShellTask *s = (ShellTask *)ctx;
     int32_t *parent = s->parent;
-    size_t lo = part_start(s->m, t, nt), hi = part_start(s->m, t + 1, nt);
+    size_t lo, hi;
     if (nt == 1) {
-        for (size_t i = lo; i < hi; i++) {
+        for (size_t i = 0; i < s->m; i++) {
             int32_t a = find_root(parent, (int32_t)index_at(s->f, s->size, 3 * i));
             for (int k = 1; k < 3; k++) {
                 int32_t b = find_root(parent, (int32_t)index_at(s->f, s->size, 3 * i + k));
@@ -1287,19 +1317,21 @@ shell_union_task(void *ctx, int t, int nt)
         }
         return;
     }
-    for (size_t i = lo; i < hi; i++) {
-        int32_t a0 = (int32_t)index_at(s->f, s->size, 3 * i);
-        for (int k = 1; k < 3; k++) {
-            int32_t a = a0, b = (int32_t)index_at(s->f, s->size, 3 * i + k);
-            for (;;) {
-                a = find_root_shared(parent, a);
-                b = find_root_shared(parent, b);
-                if (a == b) {
-                    break;
-                }
-                int32_t big = a > b ? a : b, small = a > b ? b : a;
-                if (cas32(&parent[big], big, small)) {
-                    break;
+    while (shell_chunk(s, 0, &lo, &hi)) {
+        for (size_t i = lo; i < hi; i++) {
+            int32_t a0 = (int32_t)index_at(s->f, s->size, 3 * i);
+            for (int k = 1; k < 3; k++) {
+                int32_t a = a0, b = (int32_t)index_at(s->f, s->size, 3 * i + k);
+                for (;;) {
+                    a = find_root_shared(parent, a);
+                    b = find_root_shared(parent, b);
+                    if (a == b) {
+                        break;
+                    }
+                    int32_t big = a > b ? a : b, small = a > b ? b : a;
+                    if (cas32(&parent[big], big, small)) {
+                        break;
+                    }
                 }
             }
         }
@@ -1310,10 +1342,13 @@ static void
 shell_mark_task(void *ctx, int t, int nt)
 {
     ShellTask *s = (ShellTask *)ctx;
-    for (size_t i = part_start(s->m, t, nt); i < part_start(s->m, t + 1, nt); i++) {
-        int32_t r = nt == 1 ? find_root(s->parent, (int32_t)index_at(s->f, s->size, 3 * i))
-                            : find_root_shared(s->parent, (int32_t)index_at(s->f, s->size, 3 * i));
-        mark_byte(&s->carries[r]);
+    size_t lo, hi;
+    while (shell_chunk(s, 1, &lo, &hi)) {
+        for (size_t i = lo; i < hi; i++) {
+            int32_t r = nt == 1 ? find_root(s->parent, (int32_t)index_at(s->f, s->size, 3 * i))
+                                : find_root_shared(s->parent, (int32_t)index_at(s->f, s->size, 3 * i));
+            mark_byte(&s->carries[r]);
+        }
     }
 }
 
@@ -1321,13 +1356,16 @@ static void
 shell_label_task(void *ctx, int t, int nt)
 {
     ShellTask *s = (ShellTask *)ctx;
-    for (size_t i = part_start(s->m, t, nt); i < part_start(s->m, t + 1, nt); i++) {
-        int64_t label = s->parent[index_at(s->f, s->size, 3 * i)];
-        if (s->out_size == 8) {
-            ((int64_t *)s->out)[i] = label;
-        }
-        else {
-            ((int32_t *)s->out)[i] = (int32_t)label;
+    size_t lo, hi;
+    while (shell_chunk(s, 2, &lo, &hi)) {
+        for (size_t i = lo; i < hi; i++) {
+            int64_t label = s->parent[index_at(s->f, s->size, 3 * i)];
+            if (s->out_size == 8) {
+                ((int64_t *)s->out)[i] = label;
+            }
+            else {
+                ((int32_t *)s->out)[i] = (int32_t)label;
+            }
         }
     }
 }
@@ -1370,7 +1408,7 @@ accel_shell_labels(PyObject *self, PyObject *args)
         goto fail;
     }
     int64_t count = 0;
-    ShellTask st = {fv.buf, size, (size_t)m, parent, carries, out.buf, out_size};
+    ShellTask st = {fv.buf, size, (size_t)m, parent, carries, out.buf, out_size, {0, 0, 0}};
     int nt = thread_count(threads, (size_t)m, SHELL_PARALLEL_MIN);
     Py_BEGIN_ALLOW_THREADS
     for (size_t v = 0; v < n; v++) {
@@ -1415,14 +1453,14 @@ fail:
  * per-face terms up to a few ulps whatever the face count.
  *
  * Threads: large meshes are cut into SUM_LANES contiguous ranges of faces (a fixed number, not the thread
- * count), each summed into its own compensated accumulators by whichever thread takes it; the lanes are
- * then added in lane order.  The result depends on the face count only, never on the number of threads.
+ * count), each summed into its own compensated accumulators by whichever thread is free next; the lanes
+ * are then added in lane order.  The result depends on the face count only, never on the threads.
  * ====================================================================================================== */
 
 #define NSUMS 11
-#define SUM_LANES 8
+#define SUM_LANES 32
 #define SUM_LANES_MIN ((size_t)1 << 16)          /* faces below which one lane sums everything */
-#define SUM_LANES_MAX_LABELS ((Py_ssize_t)8192)  /* labels above which one lane (bounded scratch memory) */
+#define SUM_LANES_MAX_LABELS ((Py_ssize_t)1024)  /* labels above which one lane (bounded scratch memory) */
 
 static inline void
 two_sum_add(double *acc, double x)
@@ -1444,6 +1482,7 @@ typedef struct {
     double *acc;           /* lanes x n_labels x 2 NSUMS */
     int64_t *zero;         /* lanes x n_labels */
     Py_ssize_t bad[SUM_LANES];   /* first face with a label out of range in each lane, or -1 */
+    int32_t next_lane;     /* the next lane to sum (next_ticket) */
 } SumTask;
 
 static void
@@ -1502,7 +1541,7 @@ static void
 sum_task(void *ctx, int t, int nt)
 {
     SumTask *st = (SumTask *)ctx;
-    for (int lane = t; lane < st->lanes; lane += nt) {
+    for (int lane = next_ticket(&st->next_lane); lane < st->lanes; lane = next_ticket(&st->next_lane)) {
         sum_lane(st, lane);
     }
 }
@@ -1586,7 +1625,7 @@ accel_tetra_sums(PyObject *self, PyObject *args)
         goto fail;
     }
     SumTask st = {(const double *)vv.buf, fv.buf, have_labels ? lv.buf : NULL, size, label_size, (size_t)m,
-                  lanes, n_labels, ox, oy, oz, 0.5 * area_floor, acc, zero_lanes, {0}};
+                  lanes, n_labels, ox, oy, oz, 0.5 * area_floor, acc, zero_lanes, {0}, 0};
     int nt = thread_count(threads, (size_t)m, SUM_LANES_MIN);
     Py_BEGIN_ALLOW_THREADS
     run_parallel(nt > lanes ? lanes : nt, sum_task, &st);
