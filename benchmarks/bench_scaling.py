@@ -136,8 +136,10 @@ def plot(rows, out: str) -> None:
     import matplotlib.pyplot as plt
     faces = [r["faces"] for r in rows]
     fig, (ax_t, ax_m) = plt.subplots(1, 2, figsize=(11, 4.4))
-    series = (("inertia-tool analyze", "analyze", "C0", "o-"), ("trimesh load + mass_properties", "trimesh", "C3", "s-"),
-              ("Python + numpy.fromfile", "fromfile", "C2", "^--"), ("cat > /dev/null", "cat", "0.4", "v:"))
+    series = (("inertia-tool analyze", "analyze", "C0", "o-"),
+              ("trimesh load + mass_properties", "trimesh", "C3", "s-"),
+              ("Python + numpy.fromfile", "fromfile", "C2", "^--"),
+              ("cat > /dev/null", "cat", "0.4", "v:"))
     for label, key, colour, style in series:
         pts = [(r["faces"], r[f"{key}_s"]) for r in rows if r.get(f"{key}_s") is not None]
         if pts:

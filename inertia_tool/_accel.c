@@ -311,57 +311,41 @@ thread_count(int requested, size_t items, size_t min_items)
 /* ======================================================================================================
  * 2. Welder: streaming exact weld
  *
- * Open-addressing hash tables (linear probing, load factor <= 1/2, doubled when full) map the exact bit
+ * An open-addressing hash table (linear probing, load factor <= 1/2, doubled when full) maps the exact bit
  * pattern of a point -- three float32 or three float64 words, -0.0 folded onto +0.0 -- to a vertex id
- * assigned in order of first appearance.  A table stores only ids; the keys (the full 12 or 24 bytes)
- * live in an array indexed by id and every probe compares the full key, so two different points can
- * never share a vertex whatever the hash does.  A shared corner recurs within a few triangles in the files people have (in a
- * 5M-face sphere, 87 % of repeats within 64 corners, 98 % within 4,096), so each table keeps a small
- * direct-mapped cache of the points it saw last, checked (full key) before the table: 82 % of that sphere's
- * lookups end there.
+ * assigned in order of first appearance.  The table stores only ids; the keys (the full 12 or 24 bytes)
+ * live in an array indexed by id and every probe compares the full key, so two different points can never
+ * share a vertex whatever the hash does.
  *
- * Threads: the key space is split into `parts` tables by the high bits of the hash; thread t of a feed
- * scans every point of the chunk and inserts those of its own tables, giving each a local id in order of
- * first appearance within its table.  One serial pass then turns local ids into global ones: walking the
- * chunk in order, a point whose local id is the next unnumbered one of its table is that table's next new
- * vertex and takes the next global id.  The numbering is therefore exactly the single-table one (first
- * appearance in the whole stream), whatever the number of parts or threads.
+ * A shared corner recurs within a few triangles in the files people have (in a 5M-face sphere, 87 % of
+ * repeats within 64 corners, 98 % within 4,096), so a small direct-mapped cache of the points seen last is
+ * checked (full key) before the table: 82 % of that sphere's lookups end there.
+ *
+ * One thread: a version that split the points over per-thread tables (hash-partitioned, renumbered in
+ * stream order afterwards) gave the same ids but took twice the CPU time of this loop on two cores, and no
+ * less wall time; the other kernels are threaded.
  * ====================================================================================================== */
 
 #define MAX_VERTICES ((size_t)INT32_MAX - 1)
-#define WELD_RECENT 4096                      /* entries of the recent-point cache of each table */
-#define WELD_INITIAL_MAX ((size_t)1 << 23)    /* slots per table allocated up front, at most */
-#define WELD_PARALLEL_MIN ((size_t)1 << 15)   /* points per feed below which one thread does all tables */
+#define WELD_RECENT 4096                      /* entries of the recent-point cache */
+#define WELD_INITIAL_MAX ((size_t)1 << 24)    /* slots allocated up front, at most (the table grows past it) */
 
 enum { WELD_OK = 0, WELD_NOMEM = 1, WELD_TOO_MANY = 2 };
 
-typedef struct { uint32_t k[3]; uint32_t id; } Slot32;   /* recent-cache entry: id = local id + 1; 0 = empty */
-typedef struct { uint64_t k[3]; uint64_t id; } Slot64;
-
-typedef struct {
-    uint32_t *slots;       /* mask + 1 entries: local id + 1, 0 = empty */
-    size_t mask;
-    void *keys;            /* keys_cap keys (3 x uint32 or 3 x uint64), in local-id order */
-    size_t keys_cap;
-    void *recent;          /* WELD_RECENT Slot32 or Slot64: a direct-mapped cache of recently seen points */
-    size_t count;          /* local ids so far */
-    int32_t *global;       /* local id -> global id (parts > 1); global_cap entries */
-    size_t global_cap;
-    size_t numbered;       /* local ids that have a global id */
-    int status;            /* WELD_* of the last feed */
-} WeldPart;
+typedef struct { uint32_t k[3]; uint32_t id; } Recent32;   /* id = vertex id + 1; 0 = empty */
+typedef struct { uint64_t k[3]; uint64_t id; } Recent64;
 
 typedef struct {
     PyObject_HEAD
     int wide;              /* 0: float32 keys (3 x 32 bits); 1: float64 keys (3 x 64 bits) */
     int busy;              /* a feed is running with the GIL released */
-    int parts;             /* tables (= threads asked for at construction) */
-    WeldPart part[MAX_THREADS];
-    size_t count;          /* vertices so far (global ids) */
+    uint32_t *slots;       /* vertex id + 1, 0 = empty; mask + 1 entries */
+    size_t mask;
+    void *keys;            /* keys_cap keys of 3 words each, in vertex-id order */
+    size_t keys_cap;
+    void *recent;          /* WELD_RECENT Recent32 or Recent64 */
+    size_t count;          /* vertices so far */
     uint64_t points;       /* points fed so far */
-    uint8_t *scratch;      /* parts > 1: the tags and local ids of a feed, kept between feeds (allocating
-                              them per feed costs page faults and, with threads, TLB shootdowns) */
-    size_t scratch_bytes;
 } WelderObject;
 
 static inline uint64_t
@@ -394,45 +378,31 @@ hash64(const uint64_t *k)
     return fmix64(h);
 }
 
-/* The table of a hash: its high 32 bits scaled to [0, parts) (the slot index uses the low bits). */
-static inline int
-part_of(uint64_t h, int parts)
-{
-    return (int)(((h >> 32) * (uint64_t)parts) >> 32);
-}
-
-static size_t
-slot_bytes(int wide)
-{
-    return wide ? sizeof(Slot64) : sizeof(Slot32);
-}
-
-/* Append room for one more key to a table's key array (doubling). */
 static int
-grow_keys(WeldPart *p, size_t key_bytes)
+welder_grow_keys(WelderObject *w)
 {
-    size_t cap = p->keys_cap ? 2 * p->keys_cap : 1024;
+    size_t cap = w->keys_cap ? 2 * w->keys_cap : 1024, kb = w->wide ? 24 : 12;
     if (cap > MAX_VERTICES + 1) {
         cap = MAX_VERTICES + 1;
     }
-    if (cap > SIZE_MAX / key_bytes) {
+    if (cap > SIZE_MAX / kb) {
         return WELD_NOMEM;
     }
-    void *keys = realloc(p->keys, cap * key_bytes);
+    void *keys = realloc(w->keys, cap * kb);
     if (keys == NULL) {
         return WELD_NOMEM;
     }
-    p->keys = keys;
-    p->keys_cap = cap;
+    w->keys = keys;
+    w->keys_cap = cap;
     return WELD_OK;
 }
 
-/* Lookup-or-insert and table growth for one key type.  `h` is HASH(key). */
-#define DEFINE_TABLE(SUFFIX, KEY_T, HASH)                                                                 \
+/* Table growth, lookup-or-insert and the feed loop for one key type. */
+#define DEFINE_WELD(SUFFIX, KEY_T, RECENT_T, HASH, NEG_ZERO)                                              \
 static int                                                                                                \
-grow_##SUFFIX(WeldPart *p)                                                                                \
+grow_##SUFFIX(WelderObject *w)                                                                            \
 {                                                                                                         \
-    size_t capacity = p->mask + 1;                                                                        \
+    size_t capacity = w->mask + 1;                                                                        \
     if (capacity > SIZE_MAX / 2 / sizeof(uint32_t)) {                                                     \
         return WELD_NOMEM;                                                                                \
     }                                                                                                     \
@@ -441,219 +411,107 @@ grow_##SUFFIX(WeldPart *p)                                                      
         return WELD_NOMEM;                                                                                \
     }                                                                                                     \
     size_t mask = 2 * capacity - 1;                                                                       \
-    const KEY_T *keys = (const KEY_T *)p->keys;                                                           \
-    for (size_t id = 0; id < p->count; id++) {                                                            \
+    const KEY_T *keys = (const KEY_T *)w->keys;                                                           \
+    for (size_t id = 0; id < w->count; id++) {                                                            \
         size_t i = (size_t)HASH(keys + 3 * id) & mask;                                                    \
         while (slots[i] != 0) {                                                                           \
             i = (i + 1) & mask;                                                                           \
         }                                                                                                 \
         slots[i] = (uint32_t)(id + 1);                                                                    \
     }                                                                                                     \
-    free(p->slots);                                                                                       \
-    p->slots = slots;                                                                                     \
-    p->mask = mask;                                                                                       \
+    free(w->slots);                                                                                       \
+    w->slots = slots;                                                                                     \
+    w->mask = mask;                                                                                       \
     return WELD_OK;                                                                                       \
 }                                                                                                         \
                                                                                                           \
 static inline int                                                                                         \
-lookup_##SUFFIX(WeldPart *p, const KEY_T *key, uint64_t h, int32_t *id_out)                               \
+lookup_##SUFFIX(WelderObject *w, const KEY_T *key, uint64_t h, int32_t *id_out)                           \
 {                                                                                                         \
-    const uint32_t *slots = p->slots;                                                                     \
-    const KEY_T *keys = (const KEY_T *)p->keys;                                                           \
-    size_t i = (size_t)h & p->mask;                                                                       \
-    while (slots[i] != 0) {             /* the load factor stays <= 1/2: an empty slot exists */          \
-        const KEY_T *o = keys + 3 * (size_t)(slots[i] - 1);                                               \
+    const KEY_T *keys = (const KEY_T *)w->keys;                                                           \
+    size_t i = (size_t)h & w->mask;                                                                       \
+    while (w->slots[i] != 0) {          /* the load factor stays <= 1/2: an empty slot exists */          \
+        const KEY_T *o = keys + 3 * (size_t)(w->slots[i] - 1);                                            \
         if (o[0] == key[0] && o[1] == key[1] && o[2] == key[2]) {                                         \
-            *id_out = (int32_t)(slots[i] - 1);                                                            \
+            *id_out = (int32_t)(w->slots[i] - 1);                                                         \
             return WELD_OK;                                                                               \
         }                                                                                                 \
-        i = (i + 1) & p->mask;                                                                            \
+        i = (i + 1) & w->mask;                                                                            \
     }                                                                                                     \
-    if (p->count >= MAX_VERTICES) {                                                                       \
+    if (w->count >= MAX_VERTICES) {                                                                       \
         return WELD_TOO_MANY;                                                                             \
     }                                                                                                     \
-    if (p->count == p->keys_cap) {                                                                        \
-        int st = grow_keys(p, 3 * sizeof(KEY_T));                                                         \
+    if (w->count == w->keys_cap) {                                                                        \
+        int st = welder_grow_keys(w);                                                                     \
         if (st != WELD_OK) {                                                                              \
             return st;                                                                                    \
         }                                                                                                 \
     }                                                                                                     \
-    if (2 * (p->count + 1) > p->mask + 1) {                                                               \
-        int st = grow_##SUFFIX(p);                                                                        \
+    if (2 * (w->count + 1) > w->mask + 1) {                                                               \
+        int st = grow_##SUFFIX(w);                                                                        \
         if (st != WELD_OK) {                                                                              \
             return st;                                                                                    \
         }                                                                                                 \
-        slots = p->slots;                                                                                 \
-        i = (size_t)h & p->mask;                                                                          \
-        while (slots[i] != 0) {                                                                           \
-            i = (i + 1) & p->mask;                                                                        \
+        i = (size_t)h & w->mask;                                                                          \
+        while (w->slots[i] != 0) {                                                                        \
+            i = (i + 1) & w->mask;                                                                        \
         }                                                                                                 \
     }                                                                                                     \
-    memcpy((KEY_T *)p->keys + 3 * p->count, key, 3 * sizeof(KEY_T));                                     \
-    p->slots[i] = (uint32_t)(p->count + 1);                                                               \
-    *id_out = (int32_t)p->count;                                                                          \
-    p->count++;                                                                                           \
+    memcpy((KEY_T *)w->keys + 3 * w->count, key, 3 * sizeof(KEY_T));                                     \
+    w->slots[i] = (uint32_t)(w->count + 1);                                                               \
+    *id_out = (int32_t)w->count;                                                                          \
+    w->count++;                                                                                           \
     return WELD_OK;                                                                                       \
-}
-
-DEFINE_TABLE(32, uint32_t, hash32)
-DEFINE_TABLE(64, uint64_t, hash64)
-
-typedef struct {
-    WelderObject *w;
-    const char *base;
-    Py_ssize_t n0, n1, s0, s1, sc;
-    int32_t *ids;          /* out: the vertex ids (parts == 1: written by the task; else by welder_number) */
-    uint8_t *tag;          /* out: the table of each point (parts > 1) */
-    int32_t *local[MAX_THREADS];  /* parts > 1: thread t's local ids, in stream order of the points it owns
-                                     (private buffers: interleaved writes to `ids` would share cache lines) */
-    uint64_t *hs;          /* threaded feeds: every point's hash, computed first, split by position */
-} FeedTask;
-
-/* Read point (i0, i1) as a key with -0.0 folded onto +0.0. */
-#define READ_KEY(KEY_T, NEG_ZERO, key, p, sc)                                                             \
-    for (int c_ = 0; c_ < 3; c_++) {                                                                      \
-        memcpy(&(key)[c_], (p) + c_ * (sc), sizeof(KEY_T));                                               \
-        if ((key)[c_] == (NEG_ZERO)) {                                                                    \
-            (key)[c_] = 0;                                                                                \
-        }                                                                                                 \
-    }
-
-/* Thread t of nt: weld the points whose table is owned by t (table % nt == t), in stream order, each looked
- * up in its table's recent-point cache first; when the feed was not hashed beforehand (one thread), thread 0
- * also writes every point's table into `tag`. */
-#define DEFINE_FEED(SUFFIX, SLOT_T, KEY_T, HASH, NEG_ZERO)                                                \
-static void                                                                                               \
-feed_task_##SUFFIX(void *ctx, int t, int nt)                                                              \
+}                                                                                                         \
+                                                                                                          \
+/* Weld point (i0, i1) of a (n0, n1, 3) strided array for every i0, i1 in C order into ids[]. */          \
+static int                                                                                                \
+feed_##SUFFIX(WelderObject *w, const char *base, Py_ssize_t n0, Py_ssize_t n1, Py_ssize_t s0,             \
+              Py_ssize_t s1, Py_ssize_t sc, int32_t *ids)                                                 \
 {                                                                                                         \
-    FeedTask *ft = (FeedTask *)ctx;                                                                       \
-    WelderObject *w = ft->w;                                                                              \
-    int parts = w->parts;                                                                                 \
-    int32_t *dst = ft->local[t] != NULL ? ft->local[t] : ft->ids;                                         \
-    Py_ssize_t pos = 0, total = ft->n0 * ft->n1, i0 = 0, i1 = 0;                                          \
-    for (int q = t; q < parts; q += nt) {                                                                 \
-        w->part[q].status = WELD_OK;                                                                      \
-    }                                                                                                     \
-    for (Py_ssize_t k = 0; k < total; k++) {                                                              \
-        const char *p = ft->base + i0 * ft->s0 + i1 * ft->s1;                                             \
-        if (++i1 == ft->n1) {                                                                             \
-            i1 = 0;                                                                                       \
-            i0++;                                                                                         \
-        }                                                                                                 \
-        KEY_T key[3];                                                                                     \
-        uint64_t h;                                                                                       \
-        int q;                                                                                            \
-        if (ft->hs != NULL) {                     /* hashed already: read only the points it owns */      \
-            q = ft->tag[k];                                                                               \
-            if (q % nt != t) {                                                                            \
+    Py_ssize_t k = 0;                                                                                     \
+    for (Py_ssize_t i0 = 0; i0 < n0; i0++) {                                                              \
+        for (Py_ssize_t i1 = 0; i1 < n1; i1++, k++) {                                                     \
+            const char *p = base + i0 * s0 + i1 * s1;                                                     \
+            KEY_T key[3];                                                                                 \
+            for (int c = 0; c < 3; c++) {                                                                 \
+                memcpy(&key[c], p + c * sc, sizeof(KEY_T));                                               \
+                if (key[c] == (NEG_ZERO)) {                                                               \
+                    key[c] = 0;                                                                           \
+                }                                                                                         \
+            }                                                                                             \
+            uint64_t h = HASH(key);                                                                       \
+            RECENT_T *r = (RECENT_T *)w->recent + ((h >> 40) & (WELD_RECENT - 1));                        \
+            if (r->id != 0 && r->k[0] == key[0] && r->k[1] == key[1] && r->k[2] == key[2]) {              \
+                ids[k] = (int32_t)(r->id - 1);                                                            \
                 continue;                                                                                 \
             }                                                                                             \
-            READ_KEY(KEY_T, NEG_ZERO, key, p, ft->sc)                                                     \
-            h = ft->hs[k];                                                                                \
-        }                                                                                                 \
-        else {                                                                                            \
-            READ_KEY(KEY_T, NEG_ZERO, key, p, ft->sc)                                                     \
-            h = HASH(key);                                                                                \
-            q = parts > 1 ? part_of(h, parts) : 0;                                                        \
-            if (t == 0 && ft->tag != NULL) {                                                              \
-                ft->tag[k] = (uint8_t)q;                                                                  \
+            int status = lookup_##SUFFIX(w, key, h, &ids[k]);                                             \
+            if (status != WELD_OK) {                                                                      \
+                return status;                                                                            \
             }                                                                                             \
-            if (q % nt != t) {                                                                            \
-                continue;                                                                                 \
-            }                                                                                             \
-        }                                                                                                 \
-        WeldPart *wp = &w->part[q];                                                                       \
-        int32_t *out = &dst[ft->local[t] != NULL ? pos++ : k];                                            \
-        SLOT_T *r = (SLOT_T *)wp->recent + ((h >> 40) & (WELD_RECENT - 1));                               \
-        if (r->id != 0 && r->k[0] == key[0] && r->k[1] == key[1] && r->k[2] == key[2]) {                  \
-            *out = (int32_t)(r->id - 1);                                                                  \
-            continue;                                                                                     \
-        }                                                                                                 \
-        if (wp->status != WELD_OK) {                                                                      \
-            continue;                                                                                     \
-        }                                                                                                 \
-        wp->status = lookup_##SUFFIX(wp, key, h, out);                                                    \
-        if (wp->status == WELD_OK) {                                                                      \
             r->k[0] = key[0];                                                                             \
             r->k[1] = key[1];                                                                             \
             r->k[2] = key[2];                                                                             \
-            r->id = (uint32_t)*out + 1;                                                                   \
+            r->id = (uint32_t)ids[k] + 1;                                                                 \
         }                                                                                                 \
     }                                                                                                     \
+    return WELD_OK;                                                                                       \
 }
 
-/* Thread t of nt, before a threaded feed: hash the t-th contiguous range of the points and tag their tables. */
-#define DEFINE_HASH(SUFFIX, KEY_T, HASH, NEG_ZERO)                                                        \
-static void                                                                                               \
-hash_task_##SUFFIX(void *ctx, int t, int nt)                                                              \
-{                                                                                                         \
-    FeedTask *ft = (FeedTask *)ctx;                                                                       \
-    Py_ssize_t total = ft->n0 * ft->n1;                                                                   \
-    Py_ssize_t lo = (Py_ssize_t)part_start((size_t)total, t, nt);                                         \
-    Py_ssize_t hi = (Py_ssize_t)part_start((size_t)total, t + 1, nt);                                     \
-    Py_ssize_t i0 = lo / ft->n1, i1 = lo % ft->n1;                                                        \
-    int parts = ft->w->parts;                                                                             \
-    for (Py_ssize_t k = lo; k < hi; k++) {                                                                \
-        KEY_T key[3];                                                                                     \
-        const char *p = ft->base + i0 * ft->s0 + i1 * ft->s1;                                             \
-        READ_KEY(KEY_T, NEG_ZERO, key, p, ft->sc)                                                         \
-        uint64_t h = HASH(key);                                                                           \
-        ft->hs[k] = h;                                                                                    \
-        ft->tag[k] = (uint8_t)part_of(h, parts);                                                          \
-        if (++i1 == ft->n1) {                                                                             \
-            i1 = 0;                                                                                       \
-            i0++;                                                                                         \
-        }                                                                                                 \
-    }                                                                                                     \
-}
-
-DEFINE_HASH(32, uint32_t, hash32, 0x80000000U)
-DEFINE_HASH(64, uint64_t, hash64, 0x8000000000000000ULL)
-
-DEFINE_FEED(32, Slot32, uint32_t, hash32, 0x80000000U)
-DEFINE_FEED(64, Slot64, uint64_t, hash64, 0x8000000000000000ULL)
-
-/* Local ids -> global ids in stream order (see the section comment).  Returns a WELD_* status. */
-static int
-welder_number(WelderObject *w, const FeedTask *ft, Py_ssize_t total, int nt)
-{
-    Py_ssize_t pos[MAX_THREADS] = {0};
-    int32_t *ids = ft->ids;
-    for (Py_ssize_t k = 0; k < total; k++) {
-        int q = ft->tag[k], t = q % nt;
-        WeldPart *p = &w->part[q];
-        size_t local = (size_t)ft->local[t][pos[t]++];
-        if (local == p->numbered) {
-            if (w->count >= MAX_VERTICES) {
-                return WELD_TOO_MANY;
-            }
-            if (p->numbered == p->global_cap) {
-                size_t cap = p->global_cap ? 2 * p->global_cap : 1024;
-                int32_t *g = (int32_t *)realloc(p->global, cap * sizeof(int32_t));
-                if (g == NULL) {
-                    return WELD_NOMEM;
-                }
-                p->global = g;
-                p->global_cap = cap;
-            }
-            p->global[p->numbered++] = (int32_t)w->count++;
-        }
-        ids[k] = p->global[local];
-    }
-    return WELD_OK;
-}
+DEFINE_WELD(32, uint32_t, Recent32, hash32, 0x80000000U)
+DEFINE_WELD(64, uint64_t, Recent64, hash64, 0x8000000000000000ULL)
 
 static int
 Welder_init(WelderObject *w, PyObject *args, PyObject *kwds)
 {
-    static char *kwlist[] = {"dtype", "expected_vertices", "threads", NULL};
+    static char *kwlist[] = {"dtype", "expected_vertices", NULL};
     const char *dtype = NULL;
     Py_ssize_t expected = 0;
-    int threads = 1;
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "s|ni", kwlist, &dtype, &expected, &threads)) {
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "s|n", kwlist, &dtype, &expected)) {
         return -1;
     }
-    if (w->parts != 0) {
+    if (w->slots != NULL) {
         PyErr_SetString(PyExc_RuntimeError, "Welder is already initialised");
         return -1;
     }
@@ -673,41 +531,24 @@ Welder_init(WelderObject *w, PyObject *args, PyObject *kwds)
     if ((size_t)expected > MAX_VERTICES) {
         expected = (Py_ssize_t)MAX_VERTICES;
     }
-    int parts = threads < 1 ? 1 : (threads > MAX_THREADS ? MAX_THREADS : threads);
-    size_t capacity = 1024;      /* expected_vertices is a hint: the tables grow past WELD_INITIAL_MAX */
-    while (capacity < 2 * ((size_t)expected / (size_t)parts + 1) && capacity < WELD_INITIAL_MAX) {
+    size_t capacity = 1024;     /* expected_vertices is a hint: the table grows past WELD_INITIAL_MAX */
+    while (capacity < 2 * (size_t)expected + 2 && capacity < WELD_INITIAL_MAX) {
         capacity *= 2;
     }
-    for (int q = 0; q < parts; q++) {
-        WeldPart *p = &w->part[q];
-        memset(p, 0, sizeof(*p));
-        p->slots = (uint32_t *)calloc(capacity, sizeof(uint32_t));
-        p->recent = calloc(WELD_RECENT, slot_bytes(w->wide));
-        if (p->slots == NULL || p->recent == NULL) {
-            for (int r = 0; r <= q; r++) {
-                free(w->part[r].slots);
-                free(w->part[r].recent);
-                w->part[r].slots = w->part[r].recent = NULL;
-            }
-            PyErr_NoMemory();
-            return -1;
-        }
-        p->mask = capacity - 1;
-        p->keys_cap = capacity / 2;     /* the load limit: grown (doubled) with the table past the hint */
-        p->keys = malloc(p->keys_cap * (w->wide ? 24 : 12));
-        if (p->keys == NULL) {
-            for (int r = 0; r <= q; r++) {
-                free(w->part[r].slots);
-                free(w->part[r].keys);
-                free(w->part[r].recent);
-                w->part[r].slots = NULL;
-                w->part[r].keys = w->part[r].recent = NULL;
-            }
-            PyErr_NoMemory();
-            return -1;
-        }
+    w->slots = (uint32_t *)calloc(capacity, sizeof(uint32_t));
+    w->recent = calloc(WELD_RECENT, w->wide ? sizeof(Recent64) : sizeof(Recent32));
+    w->keys_cap = capacity / 2;
+    w->keys = malloc(w->keys_cap * (w->wide ? 24 : 12));
+    if (w->slots == NULL || w->recent == NULL || w->keys == NULL) {
+        free(w->slots);
+        free(w->recent);
+        free(w->keys);
+        w->slots = NULL;
+        w->recent = w->keys = NULL;
+        PyErr_NoMemory();
+        return -1;
     }
-    w->parts = parts;
+    w->mask = capacity - 1;
     w->count = 0;
     w->points = 0;
     w->busy = 0;
@@ -717,20 +558,16 @@ Welder_init(WelderObject *w, PyObject *args, PyObject *kwds)
 static void
 Welder_dealloc(WelderObject *w)
 {
-    for (int q = 0; q < w->parts; q++) {
-        free(w->part[q].slots);
-        free(w->part[q].keys);
-        free(w->part[q].recent);
-        free(w->part[q].global);
-    }
-    free(w->scratch);
+    free(w->slots);
+    free(w->keys);
+    free(w->recent);
     Py_TYPE(w)->tp_free((PyObject *)w);
 }
 
 static int
 welder_ready(WelderObject *w)
 {
-    if (w->parts == 0) {
+    if (w->slots == NULL) {
         PyErr_SetString(PyExc_RuntimeError, "Welder was not initialised");
         return -1;
     }
@@ -766,6 +603,7 @@ Welder_feed(WelderObject *w, PyObject *args)
         goto fail;
     }
     Py_ssize_t n0 = pts.shape[0], n1 = pts.ndim == 3 ? pts.shape[1] : 1;
+    Py_ssize_t s0 = pts.strides[0], s1 = pts.ndim == 3 ? pts.strides[1] : 0, sc = pts.strides[pts.ndim - 1];
     if (n1 != 0 && n0 > PY_SSIZE_T_MAX / n1) {
         PyErr_SetString(PyExc_OverflowError, "too many points");
         goto fail;
@@ -775,60 +613,11 @@ Welder_feed(WelderObject *w, PyObject *args)
         PyErr_Format(PyExc_ValueError, "Expected `out` as a contiguous int32 array of %zd entries", total);
         goto fail;
     }
-    int nt = thread_count(w->parts, (size_t)total, WELD_PARALLEL_MIN);
-    FeedTask ft = {w, (const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
-                   pts.strides[pts.ndim - 1], (int32_t *)out.buf, NULL, {NULL}, NULL};
-    if (w->parts > 1 && total > 0) {
-        /* one block: the hashes (threaded feeds), each thread's local ids (at most `total` each), the tags */
-        size_t per_point = (nt > 1 ? 8 : 0) + 4 * (size_t)nt + 1;
-        if ((size_t)total > SIZE_MAX / per_point) {
-            PyErr_NoMemory();
-            goto fail;
-        }
-        size_t need = (size_t)total * per_point;
-        if (need > w->scratch_bytes) {
-            free(w->scratch);
-            w->scratch_bytes = 0;
-            w->scratch = (uint8_t *)malloc(need);
-            if (w->scratch == NULL) {
-                PyErr_NoMemory();
-                goto fail;
-            }
-            w->scratch_bytes = need;
-        }
-        uint8_t *at = w->scratch;
-        if (nt > 1) {
-            ft.hs = (uint64_t *)at;
-            at += 8 * (size_t)total;
-        }
-        for (int t = 0; t < nt; t++) {
-            ft.local[t] = (int32_t *)at;
-            at += 4 * (size_t)total;
-        }
-        ft.tag = at;
-    }
-    int status = WELD_OK;
+    int status;
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
-    if (total > 0) {
-        if (ft.hs != NULL) {
-            run_parallel(nt, w->wide ? hash_task_64 : hash_task_32, &ft);
-        }
-        run_parallel(nt, w->wide ? feed_task_64 : feed_task_32, &ft);
-        for (int q = 0; q < w->parts; q++) {
-            if (w->part[q].status != WELD_OK) {
-                status = w->part[q].status;
-            }
-        }
-        if (status == WELD_OK) {
-            if (w->parts > 1) {
-                status = welder_number(w, &ft, total, nt);
-            }
-            else {
-                w->count = w->part[0].count;
-            }
-        }
-    }
+    status = w->wide ? feed_64(w, (const char *)pts.buf, n0, n1, s0, s1, sc, (int32_t *)out.buf)
+                     : feed_32(w, (const char *)pts.buf, n0, n1, s0, s1, sc, (int32_t *)out.buf);
     Py_END_ALLOW_THREADS
     w->busy = 0;
     if (status == WELD_NOMEM) {
@@ -849,34 +638,6 @@ fail:
     return NULL;
 }
 
-typedef struct {
-    WelderObject *w;
-    double *v;
-} VerticesTask;
-
-/* Thread t: write the keys of the tables it owns (table % nt == t) at their global ids. */
-static void
-vertices_task(void *ctx, int t, int nt)
-{
-    VerticesTask *vt = (VerticesTask *)ctx;
-    WelderObject *w = vt->w;
-    for (int q = t; q < w->parts; q += nt) {
-        const WeldPart *p = &w->part[q];
-        for (size_t local = 0; local < p->count; local++) {
-            size_t gid = w->parts > 1 ? (size_t)p->global[local] : local;
-            if (w->wide) {
-                memcpy(vt->v + 3 * gid, (const uint64_t *)p->keys + 3 * local, 24);
-            }
-            else {
-                const float *f = (const float *)p->keys + 3 * local;
-                vt->v[3 * gid] = (double)f[0];
-                vt->v[3 * gid + 1] = (double)f[1];
-                vt->v[3 * gid + 2] = (double)f[2];
-            }
-        }
-    }
-}
-
 /* Welder.vertices_into(out): the distinct points as float64, (count, 3) contiguous, in id order. */
 static PyObject *
 Welder_vertices_into(WelderObject *w, PyObject *out_obj)
@@ -893,15 +654,18 @@ Welder_vertices_into(WelderObject *w, PyObject *out_obj)
         PyBuffer_Release(&out);
         return NULL;
     }
-    VerticesTask vt = {w, (double *)out.buf};
-    int nt = thread_count(w->parts, w->count, WELD_PARALLEL_MIN);
-    w->busy = 1;
+    double *v = (double *)out.buf;
     Py_BEGIN_ALLOW_THREADS
-    if (w->count > 0) {
-        run_parallel(nt, vertices_task, &vt);
+    if (w->wide && w->count > 0) {      /* no memcpy of 0 bytes: out may be NULL then */
+        memcpy(v, w->keys, w->count * 24);
+    }
+    else {
+        const float *f = (const float *)w->keys;
+        for (size_t i = 0; i < 3 * w->count; i++) {
+            v[i] = (double)f[i];
+        }
     }
     Py_END_ALLOW_THREADS
-    w->busy = 0;
     PyBuffer_Release(&out);
     Py_RETURN_NONE;
 }
@@ -936,7 +700,7 @@ static PyGetSetDef Welder_getset[] = {
 static PyTypeObject WelderType = {
     PyVarObject_HEAD_INIT(NULL, 0)
     .tp_name = "inertia_tool._accel.Welder",
-    .tp_doc = "Welder(dtype, expected_vertices=0, threads=1)\n\nStreaming exact weld: hash tables on the exact bit "
+    .tp_doc = "Welder(dtype, expected_vertices=0)\n\nStreaming exact weld: a hash table on the exact bit "
               "pattern of (x, y, z) ('float32' or 'float64'), persisting across feed() calls.",
     .tp_basicsize = sizeof(WelderObject),
     .tp_itemsize = 0,

@@ -21,12 +21,11 @@ from typing import Callable, Iterable
 
 import numpy as np
 
-from .._native import accel, threads
+from .._native import accel
 
 __all__ = ["weld_exact", "weld_exact_stream", "weld_tolerance"]
 
 _CHUNK = 1 << 21
-_PARALLEL_POINTS = 1 << 18     # corners below which the C welder keeps one table (threads would not pay)
 _MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xC2B2AE3D27D4EB4F), np.uint64(0x165667B19E3779F9))
 
 
@@ -94,8 +93,7 @@ def _weld_stream_c(lib, chunks: Callable[[], Iterable[np.ndarray]], n_points: in
             c = c[:, :3]                       # the padded (x, y, z, 0) layout of the numpy path
         if welder is None:
             wide = c.dtype != np.float32
-            welder = lib.Welder("float64" if wide else "float32", n_points // 6,
-                                threads() if n_points >= _PARALLEL_POINTS else 1)
+            welder = lib.Welder("float64" if wide else "float32", n_points // 6)
         if c.dtype != (np.float64 if wide else np.float32) or not c.dtype.isnative:
             if not wide and c.dtype != np.float32:
                 raise ValueError(f"Expected every chunk as float32 like the first one, got {c.dtype}")
