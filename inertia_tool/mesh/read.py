@@ -12,7 +12,6 @@ corners straight from each chunk of file records, in one pass.
 
 from __future__ import annotations
 
-import logging
 import os
 import re
 import stat
@@ -738,6 +737,7 @@ def _read_with_trimesh(path: str, max_faces: int):
             import collada  # noqa: F401 - trimesh reads COLLADA through pycollada
         except ImportError:
             raise _fail(path, "reading COLLADA needs pycollada (pip install pycollada)") from None
+    import logging      # imported on use, like trimesh: only the formats trimesh reads need it
     try:
         quiet = logging.getLogger("trimesh")
         level = quiet.level
