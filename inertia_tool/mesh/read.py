@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 import re
 import stat
+import sys
 import warnings
 
 
@@ -905,12 +906,9 @@ def _declared_units_win(name: str, declared: tuple[float, str], units: str, scal
 
 
 def _from_object(source):
-    try:
-        import trimesh
-        if isinstance(source, trimesh.Trimesh):
-            return np.asarray(source.vertices, dtype=np.float64), np.asarray(source.faces), "<trimesh.Trimesh>"
-    except ImportError:  # pragma: no cover
-        pass
+    trimesh = sys.modules.get("trimesh")     # a Trimesh exists only once trimesh is imported: arrays never import it
+    if trimesh is not None and isinstance(source, trimesh.Trimesh):
+        return np.asarray(source.vertices, dtype=np.float64), np.asarray(source.faces), "<trimesh.Trimesh>"
     if isinstance(source, tuple) and len(source) == 2:
         v = np.asarray(source[0], dtype=np.float64)
         f = np.asarray(source[1])
