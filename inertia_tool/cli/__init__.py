@@ -18,6 +18,7 @@ import os
 import re
 import sys
 import warnings
+from collections.abc import Collection
 
 from ..errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
                       RobotDescriptionError, UsageError)
@@ -102,7 +103,7 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser(commands=None) -> argparse.ArgumentParser:
+def build_parser(commands: Collection[str] | None = None) -> argparse.ArgumentParser:
     """The ``inertia-tool`` parser.
 
     ``commands``: the subcommands whose parsers are built in full (their modules imported, and with them the
