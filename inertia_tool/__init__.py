@@ -22,16 +22,22 @@ Layers (each a subpackage): :mod:`inertia_tool.mesh` (reading, welding, checks, 
 :mod:`inertia_tool.tolerances`; units and materials: :mod:`inertia_tool.units`.
 """
 
+import importlib
+from typing import TYPE_CHECKING
+
 from . import errors
-from .balancing.rotor import BalanceReport, balance
-from .dynamics.spin_stability import StabilityReport, stability
-from .dynamics.top import HeavyTopReport, heavy_top
-from .dynamics.trajectory import Trajectory
 from .errors import InertiaToolError
-from .mass.pipeline import assembly, mass_properties
-from .mass.principal import PrincipalAxes
-from .mass.properties import MassProperties
-from .mesh.options import LoadOptions
+
+if TYPE_CHECKING:   # what the names below are, for type checkers and the API docs; loaded on first use
+    from .balancing.rotor import BalanceReport, balance
+    from .dynamics.simulation import simulate
+    from .dynamics.spin_stability import StabilityReport, stability
+    from .dynamics.top import HeavyTopReport, heavy_top
+    from .dynamics.trajectory import Trajectory
+    from .mass.pipeline import assembly, mass_properties
+    from .mass.principal import PrincipalAxes
+    from .mass.properties import MassProperties
+    from .mesh.options import LoadOptions
 
 __version__ = "0.1.0"
 
@@ -54,16 +60,30 @@ __all__ = [
     "errors",
 ]
 
+#: The module of each name that loads on first use (PEP 562).  ``import inertia_tool`` (and so every run of
+#: the command line) then costs no more than :mod:`.errors`: each command imports only the layers it uses
+#: (``inertia-tool analyze`` on a closed STL never imports balancing, the simulation stages, scipy or
+#: trimesh; ``tests/test_startup.py`` pins it).
+_LAZY = {
+    "mass_properties": ".mass.pipeline", "assembly": ".mass.pipeline",
+    "LoadOptions": ".mesh.options",
+    "MassProperties": ".mass.properties",
+    "PrincipalAxes": ".mass.principal",
+    "stability": ".dynamics.spin_stability", "StabilityReport": ".dynamics.spin_stability",
+    "simulate": ".dynamics.simulation",
+    "Trajectory": ".dynamics.trajectory",
+    "heavy_top": ".dynamics.top", "HeavyTopReport": ".dynamics.top",
+    "balance": ".balancing.rotor", "BalanceReport": ".balancing.rotor",
+}
+
 
 def __getattr__(name):
-    # `simulate` loads on first use: its stages import scipy.special and scipy.integrate (about 0.2 s), which
-    # `inertia-tool analyze` never needs (measured with `python -X importtime -c "import inertia_tool"`).
-    if name == "simulate":
-        from .dynamics.simulation import simulate
-        globals()["simulate"] = simulate
-        return simulate
-    raise AttributeError(f"module 'inertia_tool' has no attribute {name!r}")
+    if name not in _LAZY:
+        raise AttributeError(f"module 'inertia_tool' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+    globals()[name] = value
+    return value
 
 
 def __dir__():
-    return sorted(set(globals()) | {"simulate"})
+    return sorted(set(globals()) | set(_LAZY))

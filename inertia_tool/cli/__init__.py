@@ -18,9 +18,11 @@ import os
 import re
 import sys
 import warnings
+from collections.abc import Collection
 
 from ..errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
                       RobotDescriptionError, UsageError)
+from .help import SUMMARIES
 
 __all__ = ["main", "build_parser", "exit_code", "speak_options", "EXIT_CODES", "EXIT_OK", "EXIT_INTERNAL",
            "EXIT_USAGE", "EXIT_MESH", "EXIT_PHYSICS"]
@@ -80,8 +82,8 @@ def speak_options(message: str, parser=None) -> str:
         return options.get(name, name)
     return _PARAMETER.sub(option, message)
 
-#: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ["analyze", "balance", "spin", "top", "spin_it", "batch", "robot"]
+#: Subcommands, in the order ``--help`` lists them; ``spin-it`` lives in the module ``spin_it``.
+SUBCOMMANDS = list(SUMMARIES)
 
 
 # Values such as "-40,40", "-5,0,0", "-20deg", "-2mm,0,0" or "-40mm,40mm" start with "-" but are numbers
@@ -101,7 +103,13 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(commands: Collection[str] | None = None) -> argparse.ArgumentParser:
+    """The ``inertia-tool`` parser.
+
+    ``commands``: the subcommands whose parsers are built in full (their modules imported, and with them the
+    engine layers they use); all when None.  The others get a placeholder with their one-line summary
+    (:data:`~.help.SUMMARIES`), which is all ``inertia-tool --help`` and the choice of a command read.
+    """
     parser = _Parser(prog="inertia-tool",
                      description="Exact mass properties, principal axes, spin stability, dynamics and balancing "
                                  "of triangle meshes (STL, OBJ, PLY, OFF, 3MF).")
@@ -110,9 +118,21 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name in SUBCOMMANDS:
-        importlib.import_module(f"{__name__}.{name}").register(sub)
+        if commands is None or name in commands:
+            importlib.import_module(f"{__name__}.{name.replace('-', '_')}").register(sub)
+        else:
+            sub.add_parser(name, help=SUMMARIES[name])
     parser.set_defaults(_subparsers=sub.choices)
     return parser
+
+
+def _command_in(argv) -> tuple[str, ...]:
+    """The subcommand ``argv`` names, as a 1-tuple (``()`` when it names none): its first word that is not an
+    option, since the options before the command (``--help``, ``--version``) take no value."""
+    for word in sys.argv[1:] if argv is None else argv:
+        if not word.startswith("-"):
+            return (word,) if word in SUMMARIES else ()
+    return ()
 
 
 def _format_warning(w: warnings.WarningMessage) -> str:
@@ -121,7 +141,7 @@ def _format_warning(w: warnings.WarningMessage) -> str:
 
 def main(argv=None) -> int:
     """Entry point of the ``inertia-tool`` console script; returns the exit code."""
-    parser = build_parser()
+    parser = build_parser(_command_in(argv))      # only the running command's module is imported
     try:
         args, extra = parser.parse_known_args(argv)
         if extra:   # reported by the subcommand's parser, so that the line names the command and its --help

@@ -15,8 +15,6 @@ from ..reports.text import format_mass_properties
 from ..dynamics.spin_stability import stability
 from ..robot.inertial import FRAMES, inertial_frame
 from ..mesh.cad import BREP_SUFFIXES, has_ocp
-from ..mass.brep import compare as brep_compare
-from ..reports.brep import brep_comparison_dict, format_brep_comparison
 from ..reports.cad import CAD_UNITS, format_cad_report
 from ..reports.models import format_model_note
 from ..robot.formats import ROBOT_FORMATS, format_inertial
@@ -30,7 +28,7 @@ __all__ = ["register", "run", "add_output_options", "output_format", "FORMATS"]
 
 def register(subparsers) -> None:
     p = add_command(
-        subparsers, "analyze", help="mass, centre of mass, inertia tensor and principal axes of a mesh",
+        subparsers, "analyze",
         description="Mass properties of the solid bounded by a closed triangle mesh, exact for the polyhedron. "
                     "Several files (FILE:material or FILE:density) are combined into one rigid assembly; "
                     "--model shell and --shell/--infill model sheet-metal and 3D-printed parts.",
@@ -58,6 +56,7 @@ def run(args) -> int:
     if fmt == "json":
         out = mass_properties_dict(props, density_source=described)
         if cad is not None:
+            from ..reports.brep import brep_comparison_dict
             out["brep"] = brep_comparison_dict(cad, props.density)
         out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
         if model["model"] != "solid":
@@ -78,6 +77,7 @@ def run(args) -> int:
         print(with_warnings(format_mass_properties(props, density_source=described), messages,
                                 loaded.notes()))
         if cad is not None:
+            from ..reports.brep import format_brep_comparison
             print(format_brep_comparison(cad, props.density))
         print("\n".join(format_stability(stab)) if stab is not None else f"  spin stability: {stab_error}")
         note = format_model_note(model)
@@ -94,7 +94,8 @@ def _brep_section(args):
     path = split_part_spec(files[0])[0]
     if os.path.splitext(path)[1].lower() not in BREP_SUFFIXES or not has_ocp():
         return None
-    return brep_compare(path)
+    from ..mass.brep import compare      # imported on use: only STEP/IGES files need it
+    return compare(path)
 
 
 def _stability_section(props):

@@ -35,7 +35,6 @@ def register(subparsers) -> None:
     grades = ", ".join(g.name.replace(" ", "") for g in ISO_GRADES)
     p = add_command(
         subparsers, "balance",
-        help="static/couple unbalance, ISO 21940-11 tolerance and correction masses about a shaft",
         description="Balancing report of a rigid rotor turning about a given shaft (Chapter 4, §4.3.2): static "
                     "and couple unbalance, ISO 21940-2 kind, rotating bearing loads and the torque of Eq. (4.26), "
                     "the permissible residual unbalance of an ISO 21940-11 grade, and correction masses in one or "

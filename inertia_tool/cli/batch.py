@@ -123,7 +123,7 @@ def summary_line(summary, files: int, args) -> str:
 
 def register(subparsers) -> None:
     parser = p = add_command(
-        subparsers, "batch", help="mass properties of many meshes into one JSONL/CSV file (parallel, resumable)",
+        subparsers, "batch",
         description="Analyse every mesh in a directory (recursively), matching a glob, or named: one row per "
                     "file (numbers or the error) appended to --out and flushed per file, so a killed run can be "
                     "resumed: files already done (same path, same SHA-256 of the content, same options) are "

@@ -28,7 +28,6 @@ from dataclasses import dataclass
 from ..errors import InertiaToolWarning, UsageError
 from ..mass.properties import MassProperties
 from ..mass.pipeline import DEFAULT_DENSITY, assembly, mass_properties, resolve_density
-from ..mass.thinwall import printed_part, shell_mass_properties
 from ..mesh.options import DEFAULT_MAX_FACES, LoadOptions
 from ..mesh.read import load_mesh
 from ..reports.models import model_summary
@@ -266,6 +265,7 @@ def _load(args, meshes):
     if model == "solid" and skin is None:
         props, described = _load_solid(args, meshes)
         return props, described, model_summary("solid")
+    from ..mass.thinwall import printed_part, shell_mass_properties    # imported on use: solids do without
     files = _files(args)
     if len(files) != 1 or split_part_spec(files[0])[1] is not None:
         raise UsageError("the shell and printed-part models take one mesh file with --density, --material or "

@@ -10,8 +10,6 @@ import os
 import sys
 
 from ..errors import UsageError
-from ..reports.html import html_report, write_html_report
-from ..reports.models import model_section
 from ..reports.output import atomic_target, check_targets
 
 __all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES",
@@ -57,6 +55,8 @@ def write_report_from_args(args, props, density_source: str | None, warnings=(),
     if not getattr(args, "report", None):
         return
     check_report_path(args)
+    from ..reports.html import html_report, write_html_report     # imported on use: most runs write no report
+    from ..reports.models import model_section
     extra = [model_section(model)] if model else []
     document = html_report(props, meshes=[(m.vertices, m.faces) for m in meshes], density_source=density_source,
                            warnings=list(warnings), stability=stability, extra_sections=extra)

@@ -26,7 +26,6 @@ def register(subparsers) -> None:
            "--package example-robot-data=tests/data/robots/example-robot-data")
     p = add_command(
         subparsers, "robot",
-        help="link mass properties from a URDF/xacro/SDF/MJCF's geometry; audit and correct <inertial>",
         description="Read a robot description (URDF, xacro, SDFormat, MuJoCo MJCF), compute every link's mass, "
                     "centre of mass and inertia tensor from its collision (or visual) geometry in the link frame, "
                     "compare them with the declared <inertial> elements, and optionally write a copy of the "

@@ -27,7 +27,7 @@ __all__ = ["register", "run", "MAX_SAMPLES"]
 
 def register(subparsers) -> None:
     p = add_command(
-        subparsers, "spin", help="stability of spin about a principal axis: classification, flip or wobble period",
+        subparsers, "spin",
         description="Classify spin about each principal axis (Chapter 4, §4.4.1), then spin the body about one "
                     "of them with a small perturbation: print the predicted flip (unstable axis) or wobble "
                     "(stable axis) period and the one measured on a simulation of the torque-free motion. Takes "

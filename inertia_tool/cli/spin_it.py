@@ -25,7 +25,7 @@ OUTPUT_SUFFIXES = (".stl", ".3mf")
 def register(subparsers) -> None:
     from ..design.limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
     p = add_command(
-        subparsers, "spin-it", help="hollow a part so that it spins stably as a yo-yo or a top",
+        subparsers, "spin-it",
         description="Design the inside of a part (Bächer et al., Spin-It, 2014; Hafner et al., Spin-It Faster, "
                     "2024): a cavity bounded by a quadric, keeping a minimum wall, so that the part spins stably "
                     "about the given axis — as a yo-yo (free spin, Chapter 4 §4.4.1: the axis a principal axis of "

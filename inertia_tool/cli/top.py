@@ -33,7 +33,7 @@ MIN_SAMPLES_PER_PERIOD = 16
 
 def register(subparsers) -> None:
     p = add_command(
-        subparsers, "top", help="the body spinning on a fixed pivot as a heavy symmetric top: nutation, precession",
+        subparsers, "top",
         description="Treat the body as a heavy symmetric top on a fixed pivot (Chapter 4, §4.4.3): the symmetry "
                     "axis runs from the pivot to the centre of mass. Prints the nutation limits and period, the "
                     "kind of precession (Fig. 4.3), the sleeping-top criterion and the steady precession rates, and "

@@ -24,10 +24,8 @@ from ..mass.volume import VolumeMoments, body_volume_moments, bounding_box, volu
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
-from .nesting import shell_nesting
 from .estimate import uncertainty_from
 from .resolve import Resolution, resolve_surface
-from .union import UnionError, closed_groups, crossing_shells, union_surface
 
 __all__ = ["PreparedMesh", "prepare_mesh", "classify_shells", "MAX_COORDINATE", "MIN_EXTENT"]
 
@@ -113,6 +111,8 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
         # the whole mesh is inside out: flip every shell first
         sign = -sign
         flip[:] = True
+    from .nesting import shell_nesting    # imported on use (as crossing_shells and the union): one shell needs none
+    from .union import crossing_shells
     nest = shell_nesting(vertices, faces, labels, n_shells)
     w = nest.winding * np.where(flip[nest.other], -1, 1)
     winding = np.bincount(nest.shell, weights=w, minlength=n_shells)
@@ -321,6 +321,7 @@ def _unite(vertices, faces, labels, owner, source, repair):
 
     Each piece belongs to the body that owns its shell, so cavities are cut from their own body only.
     """
+    from .union import UnionError, closed_groups, union_surface      # imported on use: overlaps are rare
     groups, n_groups = closed_groups(faces, len(vertices))
     pieces = body_volume_moments(vertices, faces, groups, n_groups)
     volume = np.array([p.volume for p in pieces])

@@ -12,10 +12,10 @@ corners straight from each chunk of file records, in one pass.
 
 from __future__ import annotations
 
-import logging
 import os
 import re
 import stat
+import sys
 import warnings
 
 
@@ -738,6 +738,7 @@ def _read_with_trimesh(path: str, max_faces: int):
             import collada  # noqa: F401 - trimesh reads COLLADA through pycollada
         except ImportError:
             raise _fail(path, "reading COLLADA needs pycollada (pip install pycollada)") from None
+    import logging      # imported on use, like trimesh: only the formats trimesh reads need it
     try:
         quiet = logging.getLogger("trimesh")
         level = quiet.level
@@ -905,12 +906,9 @@ def _declared_units_win(name: str, declared: tuple[float, str], units: str, scal
 
 
 def _from_object(source):
-    try:
-        import trimesh
-        if isinstance(source, trimesh.Trimesh):
-            return np.asarray(source.vertices, dtype=np.float64), np.asarray(source.faces), "<trimesh.Trimesh>"
-    except ImportError:  # pragma: no cover
-        pass
+    trimesh = sys.modules.get("trimesh")     # a Trimesh exists only once trimesh is imported: arrays never import it
+    if trimesh is not None and isinstance(source, trimesh.Trimesh):
+        return np.asarray(source.vertices, dtype=np.float64), np.asarray(source.faces), "<trimesh.Trimesh>"
     if isinstance(source, tuple) and len(source) == 2:
         v = np.asarray(source[0], dtype=np.float64)
         f = np.asarray(source[1])

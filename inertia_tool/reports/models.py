@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
-from ..mass.thinwall import PrintedPart
+from typing import TYPE_CHECKING
+
 from .escape import escape_html
+
+if TYPE_CHECKING:  # pragma: no cover - annotations only; the thin-wall models load when a command uses them
+    from ..mass.thinwall import PrintedPart
 
 __all__ = ["model_summary", "format_model_note", "model_section"]
 

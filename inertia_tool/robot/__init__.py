@@ -8,14 +8,43 @@
   elements (:func:`write_corrected`).  See ``docs/robots.md``.
 """
 
-from .formats import ROBOT_FORMATS, format_inertial
-from .inertial import FRAMES, InertialFrame, MomentCheck, check_moments, inertial_frame, principal_frame_nearest
-from .audit import LinkAudit, audit_links
-from .description import DeclaredInertial, GeometryElement, LinkGeometry, RobotDescription, read_robot
-from .geometry import LinkInertial, link_inertials
-from .write import write_corrected
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:   # what the names below are, for type checkers and the API docs; loaded on first use
+    from .formats import ROBOT_FORMATS, format_inertial
+    from .inertial import FRAMES, InertialFrame, MomentCheck, check_moments, inertial_frame, principal_frame_nearest
+    from .audit import LinkAudit, audit_links
+    from .description import DeclaredInertial, GeometryElement, LinkGeometry, RobotDescription, read_robot
+    from .geometry import LinkInertial, link_inertials
+    from .write import write_corrected
 
 __all__ = ["inertial_frame", "InertialFrame", "check_moments", "MomentCheck", "FRAMES", "format_inertial",
            "ROBOT_FORMATS", "principal_frame_nearest", "read_robot", "RobotDescription", "LinkGeometry",
            "GeometryElement", "DeclaredInertial", "link_inertials", "LinkInertial", "audit_links", "LinkAudit",
            "write_corrected"]
+
+#: The module of each name above; they load on first use (PEP 562), so that ``inertia-tool analyze
+#: --format urdf`` imports the inertial frame and its formats without the description readers and writers.
+_PUBLIC = {
+    "ROBOT_FORMATS": ".formats", "format_inertial": ".formats",
+    "FRAMES": ".inertial", "InertialFrame": ".inertial", "MomentCheck": ".inertial", "check_moments": ".inertial",
+    "inertial_frame": ".inertial", "principal_frame_nearest": ".inertial",
+    "LinkAudit": ".audit", "audit_links": ".audit",
+    "DeclaredInertial": ".description", "GeometryElement": ".description", "LinkGeometry": ".description",
+    "RobotDescription": ".description", "read_robot": ".description",
+    "LinkInertial": ".geometry", "link_inertials": ".geometry",
+    "write_corrected": ".write",
+}
+
+
+def __getattr__(name):
+    if name not in _PUBLIC:
+        raise AttributeError(f"module 'inertia_tool.robot' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_PUBLIC[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_PUBLIC))

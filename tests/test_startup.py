@@ -1,0 +1,170 @@
+"""What a run imports (issue #15, "small files: instant small runs").
+
+``inertia-tool analyze`` on a closed STL imports only the layers it uses: no scipy, trimesh, matplotlib or
+manifold3d, and none of the other subcommands, the balancing, design, batch, simulation, thin-wall or HTML
+modules; each of those loads when the input or an option needs it.  These tests are behavioural (which
+modules are in ``sys.modules`` after a run in a fresh interpreter), not timed: ``benchmarks/bench_startup.py``
+measures the time.  The lazily loaded names of the packages are checked against what type checkers and the
+API docs read (their ``if TYPE_CHECKING:`` imports).
+"""
+
+import ast
+import importlib
+import inspect
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import HAVE_ACCEL, write_binary_stl
+
+ROOT = Path(__file__).resolve().parents[1]
+BOX = "meshes/box.stl"
+
+#: A fresh interpreter runs the console script's entry point and lists its exit code and every module loaded.
+_PROBE = """
+import contextlib, io, sys
+from inertia_tool.cli import main
+with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+    code = main(sys.argv[1:])
+print(code)
+print("\\n".join(sorted(sys.modules)))
+"""
+
+#: Never imported by ``analyze`` of a closed single-shell STL (scipy: when the C extension is built).
+NOT_FOR_A_CLOSED_STL = [
+    "scipy", "trimesh", "matplotlib", "manifold3d", "networkx", "lxml",
+    "inertia_tool.balancing", "inertia_tool.batch", "inertia_tool.design", "inertia_tool.dynamics.simulation",
+    "inertia_tool.dynamics.top", "inertia_tool.mass.shapes", "inertia_tool.mass.thinwall",
+    "inertia_tool.mass.surface", "inertia_tool.mass.brep", "inertia_tool.reports.html",
+    "inertia_tool.robot.description", "inertia_tool.robot.write", "inertia_tool.mesh.union",
+    "inertia_tool.mesh.nesting", "inertia_tool.cli.balance", "inertia_tool.cli.spin", "inertia_tool.cli.top",
+    "inertia_tool.cli.spin_it", "inertia_tool.cli.batch", "inertia_tool.cli.robot",
+]
+
+
+def imported_by(*argv, cwd=ROOT, no_accel=False) -> tuple[int, set]:
+    """Exit code of ``inertia-tool ARGV`` run in a fresh interpreter, and the modules it imported."""
+    env = {k: v for k, v in os.environ.items() if k != "INERTIA_TOOL_NO_ACCEL"}
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])   # this checkout's package
+    if no_accel:
+        env["INERTIA_TOOL_NO_ACCEL"] = "1"
+    done = subprocess.run([sys.executable, "-c", _PROBE, *map(str, argv)], cwd=cwd, env=env, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    code, *modules = done.stdout.split()
+    return int(code), set(modules)
+
+
+def loaded(modules: set, name: str) -> bool:
+    """``name`` or any of its submodules was imported."""
+    return any(m == name or m.startswith(name + ".") for m in modules)
+
+
+@pytest.mark.parametrize("options", [["--json"], [], ["--units", "mm"]], ids=["json", "text", "units-mm"])
+def test_analyze_of_a_closed_stl_imports_only_what_it_uses(options):
+    code, modules = imported_by("analyze", BOX, *options)
+    assert code == 0
+    expected_absent = [n for n in NOT_FOR_A_CLOSED_STL if HAVE_ACCEL or n != "scipy"]
+    assert [n for n in expected_absent if loaded(modules, n)] == []
+    # what it does use is there: the run went through the engine, not around it
+    assert {"numpy", "inertia_tool.mass.pipeline", "inertia_tool.mesh.read",
+            "inertia_tool.dynamics.spin_stability"} <= modules
+
+
+def test_the_numpy_path_imports_scipy_sparse_for_the_shells():
+    code, modules = imported_by("analyze", BOX, "--json", no_accel=True)
+    assert code == 0
+    assert "scipy.sparse.csgraph" in modules
+
+
+def test_formats_trimesh_reads_import_it_and_obj_does_not(tmp_path, box_mesh):
+    ply, obj = tmp_path / "box.ply", tmp_path / "box.obj"
+    box_mesh.export(ply, encoding="ascii")
+    obj.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in box_mesh.vertices.tolist())
+                   + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in box_mesh.faces.tolist()))
+    code, modules = imported_by("analyze", ply, "--json")
+    assert code == 0 and "trimesh" in modules
+    code, modules = imported_by("analyze", obj, "--json")      # OBJ has its own reader (mesh/read.py)
+    assert code == 0 and not loaded(modules, "trimesh")
+
+
+def test_options_that_need_a_layer_import_it(tmp_path):
+    code, modules = imported_by("analyze", BOX, "--units", "mm", "--report", tmp_path / "box.html")
+    assert code == 0 and "inertia_tool.reports.html" in modules
+    code, modules = imported_by("analyze", BOX, "--units", "mm", "--model", "shell", "--thickness", "1mm")
+    assert code == 0 and "inertia_tool.mass.thinwall" in modules
+    code, modules = imported_by("analyze", BOX, "--units", "mm", "--format", "urdf")
+    assert code == 0 and {"inertia_tool.robot.formats", "inertia_tool.robot.inertial"} <= modules
+
+
+def test_a_mesh_of_two_shells_imports_the_nesting_test(tmp_path):
+    from conftest import box_arrays
+    v1, f1 = box_arrays((1.0, 1.0, 1.0))
+    v2, f2 = box_arrays((1.0, 1.0, 1.0), center=(3.0, 0.0, 0.0))
+    path = tmp_path / "two.stl"
+    write_binary_stl(path, list(v1) + list(v2), list(f1) + list(f2 + len(v1)))
+    code, modules = imported_by("analyze", path, "--json")
+    assert code == 0 and "inertia_tool.mesh.nesting" in modules
+
+
+def test_each_command_imports_its_own_module_only():
+    code, modules = imported_by("balance", "meshes/unbalanced_wheel.stl", "--units", "mm", "--rpm", "3000",
+                                "--single-plane", "--radius", "180mm", "--json")
+    assert code == 0
+    assert "inertia_tool.cli.balance" in modules and "inertia_tool.balancing.rotor" in modules
+    assert not loaded(modules, "inertia_tool.cli.analyze")
+    code, modules = imported_by("--help")
+    assert code == 0
+    assert [m for m in modules if m.startswith("inertia_tool.cli.") and m != "inertia_tool.cli.help"] == []
+    assert not loaded(modules, "numpy")
+
+
+def test_importing_the_package_imports_only_its_errors():
+    done = subprocess.run([sys.executable, "-c", "import sys, inertia_tool; print(' '.join(sys.modules))"],
+                          cwd=ROOT, capture_output=True, text=True, timeout=60, check=True)
+    assert sorted(m for m in done.stdout.split() if m.startswith("inertia_tool")) == ["inertia_tool",
+                                                                                     "inertia_tool.errors"]
+
+
+# -- the lazily loaded names (PEP 562) are what type checkers and the docs see ----------------------------------
+
+#: Packages whose public names load on first use, and the name of their ``name → module`` table.
+LAZY_PACKAGES = [("inertia_tool", "_LAZY"), ("inertia_tool.mass", "_PUBLIC"), ("inertia_tool.robot", "_PUBLIC")]
+
+
+def type_checking_imports(module) -> dict:
+    """``name → relative module`` of the ``from .x import name`` statements under ``if TYPE_CHECKING:``."""
+    tree = ast.parse(inspect.getsource(module))
+    found = {}
+    for node in tree.body:
+        if isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING":
+            for stmt in node.body:
+                assert isinstance(stmt, ast.ImportFrom) and stmt.level == 1, ast.dump(stmt)
+                for alias in stmt.names:
+                    found[alias.asname or alias.name] = "." + (stmt.module or alias.name)
+    return found
+
+
+@pytest.mark.parametrize("package, table", LAZY_PACKAGES, ids=[p for p, _ in LAZY_PACKAGES])
+def test_lazy_names_match_the_type_checking_imports(package, table):
+    module = importlib.import_module(package)
+    lazy = getattr(module, table)
+    assert type_checking_imports(module) == lazy
+    assert set(lazy) <= set(module.__all__) and set(module.__all__) <= set(dir(module))
+    for name, where in lazy.items():
+        value = getattr(module, name)
+        source = importlib.import_module(where, package)
+        assert value is (source if inspect.ismodule(value) else getattr(source, name)), name
+
+
+def test_placeholder_subcommands_give_the_same_help():
+    from inertia_tool.cli import SUBCOMMANDS, build_parser
+    full = build_parser()
+    assert build_parser(()).format_help() == full.format_help()
+    for name in SUBCOMMANDS:
+        alone = build_parser((name,))
+        assert (alone._defaults["_subparsers"][name].format_help()
+                == full._defaults["_subparsers"][name].format_help()), name
