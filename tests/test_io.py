@@ -257,3 +257,12 @@ def test_3mf_without_a_model_part_is_refused(tmp_path):
         zf.writestr("Metadata/thumbnail.png", b"png")
     with pytest.raises(MeshReadError, match="without a 3D/3dmodel.model part"):
         load_mesh(p)
+
+
+def test_units_never_scale_the_callers_arrays(box_mesh, tmp_path):
+    """A file's vertices are scaled in place (no second copy of a large mesh); arrays a caller passed are not."""
+    v = np.array(box_mesh.vertices, dtype=np.float64)
+    before = v.copy()
+    raw = load_mesh((v, np.asarray(box_mesh.faces)), units="mm")
+    np.testing.assert_array_equal(v, before)
+    np.testing.assert_allclose(raw.vertices, before * 1e-3, rtol=0, atol=0)

@@ -885,12 +885,17 @@ def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_
         if declared is not None:           # the file says its unit: nothing is assumed
             scale, units = _declared_units_win(name, declared, units, scale)
             assumed = False
+        owned = True                       # arrays this function made: scaled in place (no 2nd copy)
     else:
         vertices, faces, name = _from_object(source)
         n = len(faces)
         _check_face_budget(name, n, max_faces)
+        owned = False                      # may be the caller's own array: never modified
     if scale != 1.0:
-        vertices = vertices * scale
+        if owned and vertices.dtype == np.float64 and vertices.flags.writeable:
+            vertices *= scale
+        else:
+            vertices = vertices * scale
     return RawMesh(vertices=vertices, faces=faces, source=name, units=str(units), file_faces=n,
                    units_assumed=assumed)
 
