@@ -192,3 +192,29 @@ def test_zipped_collada_zae(tmp_path):
     zipped, plain = load_mesh(zae), load_mesh(DAE)
     assert zipped.units == "m" and len(zipped.faces) == len(plain.faces)
     np.testing.assert_array_equal(np.sort(zipped.vertices, axis=0), np.sort(plain.vertices, axis=0))
+
+
+def test_glb_textures_are_not_decoded(tmp_path, monkeypatch):
+    """A textured GLB is read for its geometry only: its images are never decoded (they took most of the time
+    of a textured asset), and the mass properties equal those of the untextured mesh."""
+    from PIL import Image
+
+    m = trimesh.creation.icosphere(subdivisions=3, radius=0.05)
+    uv = np.c_[0.5 + 0.5 * m.vertices[:, 0] / 0.05, 0.5 + 0.5 * m.vertices[:, 1] / 0.05]
+    m.visual = trimesh.visual.TextureVisuals(uv=uv, image=Image.new("RGB", (256, 256), (200, 30, 30)))
+    glb = tmp_path / "textured.glb"
+    m.export(glb)
+    assert b"image/png" in glb.read_bytes()      # the texture is in the file
+
+    opened = []
+    real_open = Image.open
+
+    def spy(*args, **kwargs):        # trimesh catches a reader's errors, so the calls are counted instead
+        opened.append(args)
+        return real_open(*args, **kwargs)
+    monkeypatch.setattr(Image, "open", spy)
+    props = it.mass_properties(glb, density=1000, units="m")
+    assert opened == []
+    ref = it.mass_properties((np.asarray(m.vertices), np.asarray(m.faces)), density=1000, units="m")
+    assert props.mass == pytest.approx(ref.mass, rel=1e-6)       # float32 in the GLB
+    np.testing.assert_allclose(props.inertia, ref.inertia, rtol=1e-5, atol=1e-12)
