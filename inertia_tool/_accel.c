@@ -1526,6 +1526,8 @@ accel_bounds(PyObject *self, PyObject *args)
  * module
  * ====================================================================================================== */
 
+static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 6, below */
+
 static PyMethodDef accel_methods[] = {
     {"edge_census", accel_edge_census, METH_VARARGS,
      "edge_census(faces, n_vertices, threads=1) -> (edges, boundary, nonmanifold, misoriented, sample_boundary, "
@@ -1542,6 +1544,10 @@ static PyMethodDef accel_methods[] = {
     {"bounds", accel_bounds, METH_VARARGS,
      "bounds(vertices, threads=1) -> ((lo x, y, z), (hi x, y, z), all_finite)\n\nColumn minima and maxima of "
      "an (n >= 1, 3) C-contiguous float64 array (NaN propagates) and whether every entry is finite."},
+    {"split_steps", accel_split_steps, METH_VARARGS,
+     "split_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, negligible, separatrix_m1, "
+     "fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition (dynamics/splitting.py), "
+     "principal frame; see section 6."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -1570,4 +1576,517 @@ PyInit__accel(void)
         return NULL;
     }
     return mod;
+}
+
+/* ======================================================================================================
+ * 6. split_steps -- steps of the splitting integrator (dynamics/splitting.py): exact free flow + kicks
+ *
+ * The twin of splitting._python_steps and free_flow.free_flow_step on C doubles: the same branches
+ * (spherical, symmetric, steady spin, time reversal, asymmetric closed form) and formulas, with the special
+ * functions written out here instead of scipy's: K(m) and sn, cn, dn by the arithmetic-geometric mean (the
+ * descending Gauss transformation of elliptic.jacobi_sn_cn_dn), Carlson's R_F and R_J by duplication
+ * (B. C. Carlson, "Numerical computation of real or complex elliptic integrals", Numer. Algorithms 10 (1995)
+ * 13-26, Algorithms 1 and 4; DLMF 19.36.i).  Results equal the Python path to round-off.  The torque is the
+ * Python callable torque(t, q, w) -> 3 numbers (q, w tuples, principal frame); a state within
+ * `separatrix_m1` of the separatrix calls the Python fallback(moments, w, q, h) -> (w, q), as free_flow does.
+ * ====================================================================================================== */
+
+#define SPLIT_MAX_ITER 64           /* bound on AGM / duplication iterations (each converges in < 30) */
+#define SPLIT_MAX_STAGES 64         /* longest composition accepted (the package's has 11 drifts) */
+
+static void
+split_quat_mul(const double p[4], const double q[4], double out[4])
+{
+    double r0 = p[0] * q[0] - p[1] * q[1] - p[2] * q[2] - p[3] * q[3];
+    double r1 = p[0] * q[1] + p[1] * q[0] + p[2] * q[3] - p[3] * q[2];
+    double r2 = p[0] * q[2] - p[1] * q[3] + p[2] * q[0] + p[3] * q[1];
+    double r3 = p[0] * q[3] + p[1] * q[2] - p[2] * q[1] + p[3] * q[0];
+    out[0] = r0;
+    out[1] = r1;
+    out[2] = r2;
+    out[3] = r3;
+}
+
+/* q <- q (x) Rot(x, y, z): the active rotation by the rotation vector (x, y, z), angle = its norm */
+static void
+split_rotate_by(double q[4], double x, double y, double z)
+{
+    double angle = sqrt(x * x + y * y + z * z);
+    if (angle == 0.0) {
+        return;
+    }
+    double s = sin(0.5 * angle) / angle;
+    double r[4] = {cos(0.5 * angle), s * x, s * y, s * z};
+    split_quat_mul(q, r, q);
+}
+
+/* K(m) from m1 = 1 - m > 0: pi / (2 AGM(1, sqrt(m1))) (DLMF 19.8.5) */
+static double
+split_complete_k(double m1)
+{
+    double a = 1.0, b = sqrt(m1);
+    for (int i = 0; i < SPLIT_MAX_ITER && fabs(a - b) > 1e-16 * a; i++) {
+        double next = 0.5 * (a + b);
+        b = sqrt(a * b);
+        a = next;
+    }
+    return M_PI / (a + b);
+}
+
+/* sn, cn, dn of u by the AGM (DLMF 22.20.ii), u reduced by 2K first; m1 = 1 - m kept exact */
+static void
+split_jacobi(double u, double m, double m1, double kk, double *sn, double *cn, double *dn)
+{
+    double turns = nearbyint(u / (2.0 * kk));
+    double r = u - 2.0 * kk * turns;
+    double sign = fmod(turns, 2.0) != 0.0 ? -1.0 : 1.0;     /* sn(u + 2K) = -sn u, cn(u + 2K) = -cn u */
+    if (m <= 0.0) {
+        *sn = sign * sin(r);
+        *cn = sign * cos(r);
+        *dn = 1.0;
+        return;
+    }
+    double a[SPLIT_MAX_ITER + 1], b[SPLIT_MAX_ITER + 1], c[SPLIT_MAX_ITER + 1];
+    a[0] = 1.0;
+    b[0] = sqrt(m1);
+    c[0] = sqrt(m);
+    int n = 0;
+    while (n < SPLIT_MAX_ITER && fabs(c[n]) > 1e-17 * a[n]) {
+        a[n + 1] = 0.5 * (a[n] + b[n]);
+        b[n + 1] = sqrt(a[n] * b[n]);
+        c[n + 1] = 0.5 * (a[n] - b[n]);
+        n++;
+    }
+    double phi = ldexp(a[n] * r, n);
+    for (int i = n; i > 0; i--) {
+        /* asin(c sin(phi) / a) written as atan2 with a^2 - c^2 = b^2 (accurate near m -> 1) */
+        double sp = sin(phi), cp = cos(phi);
+        phi = 0.5 * (phi + atan2(c[i] * sp, sqrt((a[i] * cp) * (a[i] * cp) + (b[i] * sp) * (b[i] * sp))));
+    }
+    double s = sin(phi), co = cos(phi);
+    *sn = sign * s;
+    *cn = sign * co;
+    *dn = sqrt(co * co + m1 * s * s);
+}
+
+/* Carlson's R_F(x, y, z), x, y, z >= 0, at most one zero (Carlson 1995, Algorithm 1, r = 1e-16) */
+static double
+split_carlson_rf(double x, double y, double z)
+{
+    double x0 = x, y0 = y;
+    double a0 = (x + y + z) / 3.0;
+    double bound = pow(3.0e-16, -1.0 / 6.0) * fmax(fabs(a0 - x), fmax(fabs(a0 - y), fabs(a0 - z)));
+    double a = a0, scale = 1.0;                     /* scale = 4^-n */
+    for (int i = 0; i < SPLIT_MAX_ITER && scale * bound >= fabs(a); i++) {
+        double sx = sqrt(x), sy = sqrt(y), sz = sqrt(z);
+        double lam = sx * sy + sx * sz + sy * sz;
+        x = 0.25 * (x + lam);
+        y = 0.25 * (y + lam);
+        z = 0.25 * (z + lam);
+        a = 0.25 * (a + lam);
+        scale *= 0.25;
+    }
+    double dx = (a0 - x0) * scale / a, dy = (a0 - y0) * scale / a;
+    double dz = -dx - dy;
+    double e2 = dx * dy - dz * dz, e3 = dx * dy * dz;
+    return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / sqrt(a);
+}
+
+/* R_C(1, 1 + e), e > -1, in closed form (DLMF 19.2.19-20) */
+static double
+split_carlson_rc1(double e)
+{
+    if (e > 0.0) {
+        double s = sqrt(e);
+        return atan(s) / s;
+    }
+    if (e < 0.0) {
+        double s = sqrt(-e);
+        return atanh(s) / s;
+    }
+    return 1.0;
+}
+
+/* Carlson's R_J(x, y, z, p), x, y, z >= 0 (at most one zero), p > 0 (Carlson 1995, Algorithm 4, r = 1e-16) */
+static double
+split_carlson_rj(double x, double y, double z, double p)
+{
+    double x0 = x, y0 = y, z0 = z;
+    double a0 = (x + y + z + 2.0 * p) / 5.0;
+    double delta = (p - x) * (p - y) * (p - z);
+    double bound = pow(0.25e-16, -1.0 / 6.0)
+                   * fmax(fmax(fabs(a0 - x), fabs(a0 - y)), fmax(fabs(a0 - z), fabs(a0 - p)));
+    double a = a0, scale = 1.0, sum = 0.0;        /* scale = 4^-m */
+    for (int i = 0; i < SPLIT_MAX_ITER && scale * bound >= fabs(a); i++) {
+        double sx = sqrt(x), sy = sqrt(y), sz = sqrt(z), sp = sqrt(p);
+        double lam = sx * sy + sx * sz + sy * sz;
+        double d = (sp + sx) * (sp + sy) * (sp + sz);
+        double e = scale * scale * scale * delta / (d * d);
+        sum += scale / d * split_carlson_rc1(e);
+        x = 0.25 * (x + lam);
+        y = 0.25 * (y + lam);
+        z = 0.25 * (z + lam);
+        p = 0.25 * (p + lam);
+        a = 0.25 * (a + lam);
+        scale *= 0.25;
+    }
+    double dx = (a0 - x0) * scale / a, dy = (a0 - y0) * scale / a, dz = (a0 - z0) * scale / a;
+    double dp = -0.5 * (dx + dy + dz);
+    double e2 = dx * dy + dx * dz + dy * dz - 3.0 * dp * dp;
+    double e3 = dx * dy * dz + 2.0 * e2 * dp + 4.0 * dp * dp * dp;
+    double e4 = (2.0 * dx * dy * dz + e2 * dp + 3.0 * dp * dp * dp) * dp;
+    double e5 = dx * dy * dz * dp * dp;
+    double series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
+                    - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0;
+    return scale * series / (a * sqrt(a)) + 6.0 * sum;
+}
+
+/* Pi(n; phi | m) for |phi| <= pi/2 from s = sin(phi), c = cos(phi) >= 0 (DLMF 19.25.14) */
+static double
+split_pi_reduced(double s, double c, double n, double m1)
+{
+    double c2 = c * c, s2 = s * s;
+    double delta2 = c2 + m1 * s2;
+    return s * split_carlson_rf(c2, delta2, 1.0) + (n / 3.0) * s * s2 * split_carlson_rj(c2, delta2, 1.0, 1.0 - n * s2);
+}
+
+/* rows of the nodal frame of L: (L x d)/|L x d|, L^ x row1, L^ (free_flow._nodal_rows) */
+static void
+split_nodal_rows(double lx, double ly, double lz, const double d[3], double mom, double r[3][3])
+{
+    double ax = ly * d[2] - lz * d[1], ay = lz * d[0] - lx * d[2], az = lx * d[1] - ly * d[0];
+    double p = sqrt(ax * ax + ay * ay + az * az);
+    ax /= p;
+    ay /= p;
+    az /= p;
+    double ux = lx / mom, uy = ly / mom, uz = lz / mom;
+    r[0][0] = ax; r[0][1] = ay; r[0][2] = az;
+    r[1][0] = uy * az - uz * ay; r[1][1] = uz * ax - ux * az; r[1][2] = ux * ay - uy * ax;
+    r[2][0] = ux; r[2][1] = uy; r[2][2] = uz;
+}
+
+/* scalar-first quaternion of a row-major rotation matrix (Shepperd's method, free_flow._matrix_quat) */
+static void
+split_matrix_quat(const double r[9], double out[4])
+{
+    double trace = r[0] + r[4] + r[8];
+    double s;
+    if (trace >= fmax(r[0], fmax(r[4], r[8]))) {
+        s = 2.0 * sqrt(1.0 + trace);
+        out[0] = 0.25 * s; out[1] = (r[7] - r[5]) / s; out[2] = (r[2] - r[6]) / s; out[3] = (r[3] - r[1]) / s;
+    } else if (r[0] >= r[4] && r[0] >= r[8]) {
+        s = 2.0 * sqrt(1.0 + r[0] - r[4] - r[8]);
+        out[0] = (r[7] - r[5]) / s; out[1] = 0.25 * s; out[2] = (r[1] + r[3]) / s; out[3] = (r[2] + r[6]) / s;
+    } else if (r[4] >= r[8]) {
+        s = 2.0 * sqrt(1.0 - r[0] + r[4] - r[8]);
+        out[0] = (r[2] - r[6]) / s; out[1] = (r[1] + r[3]) / s; out[2] = 0.25 * s; out[3] = (r[5] + r[7]) / s;
+    } else {
+        s = 2.0 * sqrt(1.0 - r[0] - r[4] + r[8]);
+        out[0] = (r[3] - r[1]) / s; out[1] = (r[2] + r[6]) / s; out[2] = (r[5] + r[7]) / s; out[3] = 0.25 * s;
+    }
+}
+
+typedef struct {
+    double moments[3];
+    double negligible;          /* torque_free.NEGLIGIBLE_COMPONENT */
+    double separatrix_m1;       /* free_flow.NEAR_SEPARATRIX_M1 */
+    PyObject *fallback;         /* free_flow.free_flow_step */
+} SplitFlow;
+
+/* the Python fallback near the separatrix; 0 on success, -1 with a Python error set */
+static int
+split_fallback(const SplitFlow *flow, double w[3], double q[4], double h)
+{
+    PyObject *res = PyObject_CallFunction(flow->fallback, "(ddd)(ddd)(dddd)d", flow->moments[0],
+                                          flow->moments[1], flow->moments[2], w[0], w[1], w[2], q[0], q[1],
+                                          q[2], q[3], h);
+    if (res == NULL) {
+        return -1;
+    }
+    double wn[3], qn[4];
+    int ok = PyArg_ParseTuple(res, "(ddd)(dddd)", &wn[0], &wn[1], &wn[2], &qn[0], &qn[1], &qn[2], &qn[3]);
+    Py_DECREF(res);
+    if (!ok) {
+        return -1;
+    }
+    memcpy(w, wn, sizeof wn);
+    memcpy(q, qn, sizeof qn);
+    return 0;
+}
+
+/* Q(h) = Q0 Rot(L^, M h / I_perp) Rot(e_k, beta h), w(h) = Rot(e_k, -beta h) w0 (free_flow._symmetric_step) */
+static void
+split_symmetric(const double mo[3], double w[3], double q[4], double h, int k, double i_perp)
+{
+    double big_l[3] = {mo[0] * w[0], mo[1] * w[1], mo[2] * w[2]};
+    double beta = (1.0 / mo[k] - 1.0 / i_perp) * big_l[k];
+    double scale = h / i_perp;
+    split_rotate_by(q, big_l[0] * scale, big_l[1] * scale, big_l[2] * scale);
+    double spin[3] = {0.0, 0.0, 0.0};
+    spin[k] = beta * h;
+    split_rotate_by(q, spin[0], spin[1], spin[2]);
+    double cb = cos(beta * h), sb = sin(beta * h);
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    double wi = w[i], wj = w[j];
+    w[i] = cb * wi + sb * wj;
+    w[j] = -sb * wi + cb * wj;
+}
+
+/* exact torque-free motion over h, principal frame (free_flow.free_flow_step); -1 with a Python error set */
+static int
+split_free_flow(const SplitFlow *flow, double w[3], double q[4], double h)
+{
+    double i1 = flow->moments[0], i2 = flow->moments[1], i3 = flow->moments[2];
+    double w1 = w[0], w2 = w[1], w3 = w[2];
+    double big = fmax(fabs(w1), fmax(fabs(w2), fabs(w3)));
+    if (big == 0.0 || h == 0.0) {
+        return 0;
+    }
+    if (i1 == i3) {
+        split_rotate_by(q, w1 * h, w2 * h, w3 * h);
+        return 0;
+    }
+    if (i1 == i2) {
+        split_symmetric(flow->moments, w, q, h, 2, i1);
+        return 0;
+    }
+    if (i2 == i3) {
+        split_symmetric(flow->moments, w, q, h, 0, i3);
+        return 0;
+    }
+    double tiny = flow->negligible * big;
+    if ((fabs(w1) > tiny) + (fabs(w2) > tiny) + (fabs(w3) > tiny) <= 1) {   /* steady spin */
+        split_rotate_by(q, w1 * h, w2 * h, w3 * h);
+        return 0;
+    }
+    if (h < 0.0) {          /* time reversal: w(-h; w0) = -w(h; -w0), Q(-h; w0, Q0) = Q(h; -w0, Q0) */
+        w[0] = -w1;
+        w[1] = -w2;
+        w[2] = -w3;
+        if (split_free_flow(flow, w, q, -h) < 0) {
+            return -1;
+        }
+        w[0] = -w[0];
+        w[1] = -w[1];
+        w[2] = -w[2];
+        return 0;
+    }
+    double j1, j2, j3, v1, v2, v3;
+    int d_axis;
+    if (i3 * (i3 - i2) * w3 * w3 - i1 * (i2 - i1) * w1 * w1 >= 0.0) {
+        j1 = i1; j2 = i2; j3 = i3; v1 = w1; v2 = w2; v3 = w3;
+        d_axis = 2;
+    } else {
+        j1 = i3; j2 = i2; j3 = i1; v1 = w3; v2 = -w2; v3 = w1;
+        d_axis = 0;
+    }
+    double d_sign = 1.0;
+    if (v3 < 0.0) {
+        v1 = -v1;
+        v3 = -v3;
+        d_sign = -1.0;
+    }
+    double k0 = j1 * (j3 - j1) * v1 * v1 + j2 * (j3 - j2) * v2 * v2;
+    double k1 = j2 * (j2 - j1) * v2 * v2 + j3 * (j3 - j1) * v3 * v3;
+    double gap = j3 * (j3 - j2) * v3 * v3 - j1 * (j2 - j1) * v1 * v1;
+    double m1 = fmax((j3 - j1) * gap / ((j3 - j2) * k1), 0.0);
+    double m = (j2 - j1) * k0 / ((j3 - j2) * k1);
+    if (m1 < 0.5) {
+        m = 1.0 - m1;
+    } else {
+        m1 = 1.0 - m;
+    }
+    if (m1 < flow->separatrix_m1) {
+        return split_fallback(flow, w, q, h);
+    }
+    double a = sqrt(k0 / (j1 * (j3 - j1)));
+    double b = sqrt(k0 / (j2 * (j3 - j2)));
+    double c = sqrt(k1 / (j3 * (j3 - j1)));
+    double lam = sqrt((j3 - j2) * k1 / (j1 * j2 * j3));
+    double sigma = j3 > j2 ? 1.0 : -1.0;
+    double s0 = sigma * v2 / b, c0 = v1 / a;
+    double norm = hypot(s0, c0);
+    s0 /= norm;
+    c0 /= norm;
+    double d0 = sqrt(c0 * c0 + m1 * s0 * s0);
+    double kk = split_complete_k(m1);
+    double v = lam * h;
+    double turns = floor(v / (2.0 * kk));       /* whole half-periods of sn: am advances by pi each */
+    double vr = v - 2.0 * kk * turns;
+    double sv, cv, dv;
+    split_jacobi(vr, m, m1, kk, &sv, &cv, &dv);
+    if (fmod(turns, 2.0) != 0.0) {
+        sv = -sv;
+        cv = -cv;
+    }
+    double den = 1.0 - m * s0 * s0 * sv * sv;
+    double s1 = (s0 * cv * dv + sv * c0 * d0) / den;
+    double c1 = (c0 * cv - s0 * d0 * sv * dv) / den;
+    double d1 = (d0 * dv - m * s0 * c0 * sv * cv) / den;
+    double n = -j3 * (j2 - j1) / (j1 * (j3 - j2));
+    double phi0 = atan2(s0, c0);
+    double delta = fmod(atan2(s1, c1) - phi0 - M_PI * turns, 2.0 * M_PI);
+    if (delta < 0.0) {
+        delta += 2.0 * M_PI;                    /* Python's % is non-negative for a positive modulus */
+    }
+    if (delta > 1.5 * M_PI) {
+        delta -= 2.0 * M_PI;
+    }
+    double phi1 = phi0 + M_PI * turns + delta;
+    double half0 = nearbyint(phi0 / M_PI), half1 = nearbyint(phi1 / M_PI);   /* round half to even */
+    double sign0 = fmod(half0, 2.0) != 0.0 ? -1.0 : 1.0;
+    double sign1 = fmod(half1, 2.0) != 0.0 ? -1.0 : 1.0;
+    double big_pi = split_pi_reduced(sign1 * s1, fabs(c1), n, m1) - split_pi_reduced(sign0 * s0, fabs(c0), n, m1);
+    if (half1 != half0) {
+        double complete = split_carlson_rf(0.0, m1, 1.0) + (n / 3.0) * split_carlson_rj(0.0, m1, 1.0, 1.0 - n);
+        big_pi += 2.0 * (half1 - half0) * complete;
+    }
+    double mom = sqrt((j1 * v1) * (j1 * v1) + (j2 * v2) * (j2 * v2) + (j3 * v3) * (j3 * v3));
+    double psi = mom * h / j3 + mom * (j3 - j1) / (j1 * j3 * lam) * big_pi;
+    double u1 = a * c1, u2 = sigma * b * s1, u3 = c * d1;
+    if (d_sign < 0.0) {
+        u1 = -u1;
+        u3 = -u3;
+    }
+    double out[3];
+    if (d_axis == 2) {
+        out[0] = u1; out[1] = u2; out[2] = u3;
+    } else {
+        out[0] = u3; out[1] = -u2; out[2] = u1;
+    }
+    double d[3] = {0.0, 0.0, 0.0};
+    d[d_axis] = d_sign;
+    double r[3][3], t[3][3];
+    split_nodal_rows(i1 * w1, i2 * w2, i3 * w3, d, mom, r);
+    split_nodal_rows(i1 * out[0], i2 * out[1], i3 * out[2], d, mom, t);
+    double cz = cos(psi), sz = sin(psi);
+    double col1[3], col2[3], rot[9], dq[4];
+    for (int i = 0; i < 3; i++) {
+        col1[i] = cz * r[0][i] + sz * r[1][i];
+        col2[i] = -sz * r[0][i] + cz * r[1][i];
+    }
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            rot[3 * i + j] = col1[i] * t[0][j] + col2[i] * t[1][j] + r[2][i] * t[2][j];
+        }
+    }
+    split_matrix_quat(rot, dq);
+    split_quat_mul(q, dq, q);
+    w[0] = out[0];
+    w[1] = out[1];
+    w[2] = out[2];
+    return 0;
+}
+
+/* tau <- torque(time, q, w) (principal frame); zero without torque; -1 with a Python error set */
+static int
+split_torque(PyObject *torque, double time, const double q[4], const double w[3], double tau[3])
+{
+    if (torque == Py_None) {
+        tau[0] = tau[1] = tau[2] = 0.0;
+        return 0;
+    }
+    PyObject *res = PyObject_CallFunction(torque, "d(dddd)(ddd)", time, q[0], q[1], q[2], q[3], w[0], w[1], w[2]);
+    if (res == NULL) {
+        return -1;
+    }
+    PyObject *seq = PySequence_Fast(res, "the torque must return 3 numbers");
+    Py_DECREF(res);
+    if (seq == NULL) {
+        return -1;
+    }
+    if (PySequence_Fast_GET_SIZE(seq) != 3) {
+        PyErr_Format(PyExc_ValueError, "Expected the torque to return 3 numbers, got %zd",
+                     PySequence_Fast_GET_SIZE(seq));
+        Py_DECREF(seq);
+        return -1;
+    }
+    for (int i = 0; i < 3; i++) {
+        tau[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
+    }
+    Py_DECREF(seq);
+    return PyErr_Occurred() ? -1 : 0;
+}
+
+static int
+split_read_coefficients(PyObject *obj, double *out, Py_ssize_t *count, const char *name)
+{
+    PyObject *seq = PySequence_Fast(obj, "coefficients must be a sequence");
+    if (seq == NULL) {
+        return -1;
+    }
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    if (n < 1 || n > SPLIT_MAX_STAGES + 1) {
+        PyErr_Format(PyExc_ValueError, "Expected 1 to %d %s, got %zd", SPLIT_MAX_STAGES + 1, name, n);
+        Py_DECREF(seq);
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        out[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
+    }
+    Py_DECREF(seq);
+    *count = n;
+    return PyErr_Occurred() ? -1 : 0;
+}
+
+static PyObject *
+accel_split_steps(PyObject *self, PyObject *args)
+{
+    (void)self;
+    SplitFlow flow;
+    PyObject *drift_obj, *kick_obj, *torque;
+    double w[3], q[4], tau[3], t0, h;
+    Py_ssize_t count;
+    double drifts[SPLIT_MAX_STAGES + 1], kicks[SPLIT_MAX_STAGES + 1];
+    Py_ssize_t n_drifts, n_kicks;
+    if (!PyArg_ParseTuple(args, "(ddd)OO(ddd)(dddd)(ddd)ddnOddO", &flow.moments[0], &flow.moments[1],
+                          &flow.moments[2], &drift_obj, &kick_obj, &w[0], &w[1], &w[2], &q[0], &q[1], &q[2],
+                          &q[3], &tau[0], &tau[1], &tau[2], &t0, &h, &count, &torque, &flow.negligible,
+                          &flow.separatrix_m1, &flow.fallback)) {
+        return NULL;
+    }
+    if (split_read_coefficients(drift_obj, drifts, &n_drifts, "drifts") < 0
+        || split_read_coefficients(kick_obj, kicks, &n_kicks, "kicks") < 0) {
+        return NULL;
+    }
+    if (n_kicks != n_drifts + 1) {
+        PyErr_Format(PyExc_ValueError, "Expected len(kicks) == len(drifts) + 1, got %zd and %zd", n_kicks,
+                     n_drifts);
+        return NULL;
+    }
+    if (torque != Py_None && !PyCallable_Check(torque)) {
+        PyErr_SetString(PyExc_TypeError, "Expected `torque` to be callable or None");
+        return NULL;
+    }
+    if (!PyCallable_Check(flow.fallback)) {
+        PyErr_SetString(PyExc_TypeError, "Expected `fallback` to be callable");
+        return NULL;
+    }
+    const double *mo = flow.moments;
+    for (Py_ssize_t step = 0; step < count; step++) {
+        double time = t0 + (double)step * h;
+        for (Py_ssize_t i = 0; i < n_drifts; i++) {
+            double hb = kicks[i] * h;
+            w[0] += hb * tau[0] / mo[0];
+            w[1] += hb * tau[1] / mo[1];
+            w[2] += hb * tau[2] / mo[2];
+            if (split_free_flow(&flow, w, q, drifts[i] * h) < 0) {
+                return NULL;
+            }
+            time += drifts[i] * h;
+            if (split_torque(torque, time, q, w, tau) < 0) {
+                return NULL;
+            }
+        }
+        double hb = kicks[n_drifts] * h;
+        w[0] += hb * tau[0] / mo[0];
+        w[1] += hb * tau[1] / mo[1];
+        w[2] += hb * tau[2] / mo[2];
+        double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);    /* round-off only */
+        q[0] /= norm;
+        q[1] /= norm;
+        q[2] /= norm;
+        q[3] /= norm;
+    }
+    return Py_BuildValue("(ddd)(dddd)(ddd)", w[0], w[1], w[2], q[0], q[1], q[2], q[3], tau[0], tau[1], tau[2]);
 }

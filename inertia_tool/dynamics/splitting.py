@@ -55,7 +55,9 @@ import numpy as np
 from ..values import frozen_value
 from ..errors import PhysicsError, UsageError
 from ..rotations import matrix_to_quaternion
-from .free_flow import free_flow_step
+from .._native import accel
+from .free_flow import NEAR_SEPARATRIX_M1, free_flow_step
+from .torque_free import NEGLIGIBLE_COMPONENT
 
 __all__ = ["SplittingScheme", "SCHEMES", "DEFAULT_SCHEME", "integrate_splitting"]
 
@@ -198,6 +200,33 @@ def _composition_step(scheme, moments, torque_p, t, w, q, tau, h):
     return (w0, w1, w2), (q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm), tau
 
 
+def _python_steps(scheme, moments, torque_p, t, w, q, tau, h, count):
+    """``count`` composition steps of length ``h`` from time ``t`` (step ``k`` starts at ``t + k h``).
+
+    The pure-Python twin of the C kernel ``_accel.split_steps`` (same arithmetic; the special functions
+    are scipy's there and the C file's own here, so results agree to round-off)."""
+    for k in range(count):
+        w, q, tau = _composition_step(scheme, moments, torque_p, t + k * h, w, q, tau, h)
+    return w, q, tau
+
+
+def _steps_function(scheme, moments, torque_p):
+    """``steps(t, w, q, tau, h, count) -> (w, q, tau)``: the C kernel when ``_native.accel()`` has it, else
+    :func:`_python_steps`."""
+    kernel = accel()
+    if kernel is None or not hasattr(kernel, "split_steps"):
+        def python_steps(t, w, q, tau, h, count):
+            return _python_steps(scheme, moments, torque_p, t, w, q, tau, h, count)
+        return python_steps
+    c_steps = kernel.split_steps
+    drifts, kicks = tuple(scheme.drifts), tuple(scheme.kicks)
+
+    def compiled_steps(t, w, q, tau, h, count):
+        return c_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque_p, NEGLIGIBLE_COMPONENT,
+                       NEAR_SEPARATRIX_M1, free_flow_step)
+    return compiled_steps
+
+
 def _error_norm(w_big, q_big, w_fine, q_fine, w_old, q_old, rtol, atol):
     total = 0.0
     for big, fine, old in zip(w_big + q_big, w_fine + q_fine, w_old + q_old):
@@ -264,6 +293,7 @@ def integrate_splitting(moments, axes, angular_velocity, orientation, t, torque,
     moments_t = tuple(float(x) for x in moments)
     times = np.asarray(t, dtype=np.float64)
     torque_p = _make_torque(torque, axes) if torque is not None else None
+    advance = _steps_function(plan, moments_t, torque_p)
     w = tuple((axes.T @ np.asarray(angular_velocity, dtype=np.float64)).tolist())
     qa = matrix_to_quaternion(axes).tolist()
     q_mesh = np.asarray(orientation, dtype=np.float64)
@@ -292,15 +322,15 @@ def integrate_splitting(moments, axes, angular_velocity, orientation, t, torque,
                 raise PhysicsError(f"Splitting integration needed more than max_steps={max_steps} steps "
                                    f"by t={t_now:g} s")
             if step is not None or since_probe < probe_every:
-                w, q, tau = _composition_step(plan, moments_t, torque_p, t_now, w, q, tau, h)
-                steps += 1
-                since_probe += 1
-                t_now = target if count == 1 else t_now + h
+                batch = count if step is not None else min(count, probe_every - since_probe)
+                batch = min(batch, max_steps - steps)
+                w, q, tau = advance(t_now, w, q, tau, h, batch)
+                steps += batch
+                since_probe += batch
+                t_now = target if batch == count else t_now + batch * h
                 continue
-            w_big, q_big, tau_big = _composition_step(plan, moments_t, torque_p, t_now, w, q, tau, h)
-            w_mid, q_mid, tau_mid = _composition_step(plan, moments_t, torque_p, t_now, w, q, tau, 0.5 * h)
-            w_fine, q_fine, _ = _composition_step(plan, moments_t, torque_p, t_now + 0.5 * h, w_mid, q_mid,
-                                                  tau_mid, 0.5 * h)
+            w_big, q_big, tau_big = advance(t_now, w, q, tau, h, 1)
+            w_fine, q_fine, _ = advance(t_now, w, q, tau, 0.5 * h, 2)
             steps += 3
             if q_big[0] * q_fine[0] + q_big[1] * q_fine[1] + q_big[2] * q_fine[2] + q_big[3] * q_fine[3] < 0:
                 q_fine = tuple(-x for x in q_fine)
