@@ -1545,8 +1545,8 @@ static PyMethodDef accel_methods[] = {
      "bounds(vertices, threads=1) -> ((lo x, y, z), (hi x, y, z), all_finite)\n\nColumn minima and maxima of "
      "an (n >= 1, 3) C-contiguous float64 array (NaN propagates) and whether every entry is finite."},
     {"split_steps", accel_split_steps, METH_VARARGS,
-     "split_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, negligible, separatrix_m1, "
-     "fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition (dynamics/splitting.py), "
+     "split_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, frame, q_proto, w_proto, "
+     "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition (dynamics/splitting.py), "
      "principal frame; see section 6."},
     {NULL, NULL, 0, NULL}
 };
@@ -1587,12 +1587,16 @@ PyInit__accel(void)
  * descending Gauss transformation of elliptic.jacobi_sn_cn_dn), Carlson's R_F and R_J by duplication
  * (B. C. Carlson, "Numerical computation of real or complex elliptic integrals", Numer. Algorithms 10 (1995)
  * 13-26, Algorithms 1 and 4; DLMF 19.36.i).  Results equal the Python path to round-off.  The torque is the
- * Python callable torque(t, q, w) -> 3 numbers (q, w tuples, principal frame); a state within
- * `separatrix_m1` of the separatrix calls the Python fallback(moments, w, q, h) -> (w, q), as free_flow does.
+ * caller's torque(t, q, w) -> 3 numbers in mesh axes, called with fresh float64 arrays and rotated to and
+ * from the principal frame here (`frame` = (axes, qa_inv), or None when they coincide) as
+ * splitting._make_torque does; a state within `separatrix_m1` of the separatrix calls the Python
+ * fallback(moments, w, q, h) -> (w, q), as free_flow does.
  * ====================================================================================================== */
 
 #define SPLIT_MAX_ITER 64           /* bound on AGM / duplication iterations (each converges in < 30) */
 #define SPLIT_MAX_STAGES 64         /* longest composition accepted (the package's has 11 drifts) */
+#define SPLIT_RF_BOUND 403.7494618015396    /* (3 r)^(-1/6), r = 1e-16: Carlson 1995, Algorithm 1 */
+#define SPLIT_RJ_BOUND 1847.1570019330606   /* (r / 4)^(-1/6), r = 1e-16: Carlson 1995, Algorithm 4 */
 
 static void
 split_quat_mul(const double p[4], const double q[4], double out[4])
@@ -1675,7 +1679,7 @@ split_carlson_rf(double x, double y, double z)
 {
     double x0 = x, y0 = y;
     double a0 = (x + y + z) / 3.0;
-    double bound = pow(3.0e-16, -1.0 / 6.0) * fmax(fabs(a0 - x), fmax(fabs(a0 - y), fabs(a0 - z)));
+    double bound = SPLIT_RF_BOUND * fmax(fabs(a0 - x), fmax(fabs(a0 - y), fabs(a0 - z)));
     double a = a0, scale = 1.0;                     /* scale = 4^-n */
     for (int i = 0; i < SPLIT_MAX_ITER && scale * bound >= fabs(a); i++) {
         double sx = sqrt(x), sy = sqrt(y), sz = sqrt(z);
@@ -1714,8 +1718,7 @@ split_carlson_rj(double x, double y, double z, double p)
     double x0 = x, y0 = y, z0 = z;
     double a0 = (x + y + z + 2.0 * p) / 5.0;
     double delta = (p - x) * (p - y) * (p - z);
-    double bound = pow(0.25e-16, -1.0 / 6.0)
-                   * fmax(fmax(fabs(a0 - x), fabs(a0 - y)), fmax(fabs(a0 - z), fabs(a0 - p)));
+    double bound = SPLIT_RJ_BOUND * fmax(fmax(fabs(a0 - x), fabs(a0 - y)), fmax(fabs(a0 - z), fabs(a0 - p)));
     double a = a0, scale = 1.0, sum = 0.0;        /* scale = 4^-m */
     for (int i = 0; i < SPLIT_MAX_ITER && scale * bound >= fabs(a); i++) {
         double sx = sqrt(x), sy = sqrt(y), sz = sqrt(z), sp = sqrt(p);
@@ -1978,20 +1981,69 @@ split_free_flow(const SplitFlow *flow, double w[3], double q[4], double h)
     return 0;
 }
 
-/* tau <- torque(time, q, w) (principal frame); zero without torque; -1 with a Python error set */
+/* The caller's torque, in mesh axes: torque(t, q_mesh (4,) ndarray, w_mesh (3,) ndarray) -> 3 numbers.
+ * q_mesh = q (x) qa_inv, w_mesh = axes w, tau_principal = axes^T tau_mesh (splitting._make_torque), skipped
+ * when the principal axes are the mesh axes.  Fresh arrays per call (copies of the prototypes). */
+typedef struct {
+    PyObject *torque;           /* callable or Py_None */
+    int rotated;
+    double axes[9];             /* principal -> mesh, row-major */
+    double qa_inv[4];
+    PyObject *q_proto, *w_proto;
+    PyObject *q_arr, *w_arr;    /* owned; reused only while nobody else holds a reference (see split_array) */
+} SplitTorque;
+
+/* *slot <- an array holding `values`: the previous one when this function holds its only reference (the
+ * torque kept neither it nor a view of it, so no one can see it change), else a fresh copy of proto */
 static int
-split_torque(PyObject *torque, double time, const double q[4], const double w[3], double tau[3])
+split_array(PyObject **slot, PyObject *proto, const double *values, Py_ssize_t n)
 {
-    if (torque == Py_None) {
-        tau[0] = tau[1] = tau[2] = 0.0;
-        return 0;
+    if (*slot != NULL && Py_REFCNT(*slot) != 1) {
+        Py_CLEAR(*slot);
     }
-    PyObject *res = PyObject_CallFunction(torque, "d(dddd)(ddd)", time, q[0], q[1], q[2], q[3], w[0], w[1], w[2]);
-    if (res == NULL) {
+    if (*slot == NULL) {
+        *slot = PyObject_CallMethod(proto, "copy", NULL);
+        if (*slot == NULL) {
+            return -1;
+        }
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(*slot, &view, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) {
+        Py_CLEAR(*slot);
         return -1;
     }
-    PyObject *seq = PySequence_Fast(res, "the torque must return 3 numbers");
-    Py_DECREF(res);
+    if (view.len != n * (Py_ssize_t)sizeof(double) || view.format == NULL || strcmp(view.format, "d") != 0) {
+        PyBuffer_Release(&view);
+        Py_CLEAR(*slot);
+        PyErr_SetString(PyExc_ValueError, "Expected float64 prototype arrays of shapes (4,) and (3,)");
+        return -1;
+    }
+    memcpy(view.buf, values, (size_t)n * sizeof(double));
+    PyBuffer_Release(&view);
+    return 0;
+}
+
+/* three floats from the torque's result: a float64 C-contiguous buffer of 3, else any sequence of 3 numbers */
+static int
+split_read_torque(PyObject *res, double out[3])
+{
+    if (PyObject_CheckBuffer(res)) {
+        Py_buffer view;
+        if (PyObject_GetBuffer(res, &view, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) == 0) {
+            int ok = view.len == 3 * (Py_ssize_t)sizeof(double) && view.format != NULL
+                     && strcmp(view.format, "d") == 0;
+            if (ok) {
+                memcpy(out, view.buf, 3 * sizeof(double));
+            }
+            PyBuffer_Release(&view);
+            if (ok) {
+                return 0;
+            }
+        } else {
+            PyErr_Clear();
+        }
+    }
+    PyObject *seq = PySequence_Fast(res, "Expected the torque to return 3 numbers");
     if (seq == NULL) {
         return -1;
     }
@@ -2002,10 +2054,56 @@ split_torque(PyObject *torque, double time, const double q[4], const double w[3]
         return -1;
     }
     for (int i = 0; i < 3; i++) {
-        tau[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
+        out[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
     }
     Py_DECREF(seq);
     return PyErr_Occurred() ? -1 : 0;
+}
+
+/* tau <- torque at (time, q, w), principal frame; zero without torque; -1 with a Python error set */
+static int
+split_torque(SplitTorque *st, double time, const double q[4], const double w[3], double tau[3])
+{
+    if (st->torque == Py_None) {
+        tau[0] = tau[1] = tau[2] = 0.0;
+        return 0;
+    }
+    double qm[4], wm[3], tm[3];
+    const double *a = st->axes;
+    if (st->rotated) {
+        split_quat_mul(q, st->qa_inv, qm);
+        wm[0] = a[0] * w[0] + a[1] * w[1] + a[2] * w[2];
+        wm[1] = a[3] * w[0] + a[4] * w[1] + a[5] * w[2];
+        wm[2] = a[6] * w[0] + a[7] * w[1] + a[8] * w[2];
+    } else {
+        memcpy(qm, q, sizeof qm);
+        memcpy(wm, w, sizeof wm);
+    }
+    if (split_array(&st->q_arr, st->q_proto, qm, 4) < 0 || split_array(&st->w_arr, st->w_proto, wm, 3) < 0) {
+        return -1;
+    }
+    PyObject *time_obj = PyFloat_FromDouble(time);
+    if (time_obj == NULL) {
+        return -1;
+    }
+    PyObject *res = PyObject_CallFunctionObjArgs(st->torque, time_obj, st->q_arr, st->w_arr, NULL);
+    Py_DECREF(time_obj);
+    if (res == NULL) {
+        return -1;
+    }
+    int status = split_read_torque(res, tm);
+    Py_DECREF(res);
+    if (status < 0) {
+        return -1;
+    }
+    if (st->rotated) {
+        tau[0] = a[0] * tm[0] + a[3] * tm[1] + a[6] * tm[2];
+        tau[1] = a[1] * tm[0] + a[4] * tm[1] + a[7] * tm[2];
+        tau[2] = a[2] * tm[0] + a[5] * tm[1] + a[8] * tm[2];
+    } else {
+        memcpy(tau, tm, sizeof tm);
+    }
+    return 0;
 }
 
 static int
@@ -2034,15 +2132,16 @@ accel_split_steps(PyObject *self, PyObject *args)
 {
     (void)self;
     SplitFlow flow;
-    PyObject *drift_obj, *kick_obj, *torque;
+    SplitTorque st;
+    PyObject *drift_obj, *kick_obj, *frame;
     double w[3], q[4], tau[3], t0, h;
     Py_ssize_t count;
     double drifts[SPLIT_MAX_STAGES + 1], kicks[SPLIT_MAX_STAGES + 1];
     Py_ssize_t n_drifts, n_kicks;
-    if (!PyArg_ParseTuple(args, "(ddd)OO(ddd)(dddd)(ddd)ddnOddO", &flow.moments[0], &flow.moments[1],
+    if (!PyArg_ParseTuple(args, "(ddd)OO(ddd)(dddd)(ddd)ddnOOOOddO", &flow.moments[0], &flow.moments[1],
                           &flow.moments[2], &drift_obj, &kick_obj, &w[0], &w[1], &w[2], &q[0], &q[1], &q[2],
-                          &q[3], &tau[0], &tau[1], &tau[2], &t0, &h, &count, &torque, &flow.negligible,
-                          &flow.separatrix_m1, &flow.fallback)) {
+                          &q[3], &tau[0], &tau[1], &tau[2], &t0, &h, &count, &st.torque, &frame, &st.q_proto,
+                          &st.w_proto, &flow.negligible, &flow.separatrix_m1, &flow.fallback)) {
         return NULL;
     }
     if (split_read_coefficients(drift_obj, drifts, &n_drifts, "drifts") < 0
@@ -2054,7 +2153,7 @@ accel_split_steps(PyObject *self, PyObject *args)
                      n_drifts);
         return NULL;
     }
-    if (torque != Py_None && !PyCallable_Check(torque)) {
+    if (st.torque != Py_None && !PyCallable_Check(st.torque)) {
         PyErr_SetString(PyExc_TypeError, "Expected `torque` to be callable or None");
         return NULL;
     }
@@ -2062,7 +2161,16 @@ accel_split_steps(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_TypeError, "Expected `fallback` to be callable");
         return NULL;
     }
+    st.rotated = frame != Py_None;
+    if (st.rotated && !PyArg_ParseTuple(frame, "(ddddddddd)(dddd)", &st.axes[0], &st.axes[1], &st.axes[2],
+                                        &st.axes[3], &st.axes[4], &st.axes[5], &st.axes[6], &st.axes[7],
+                                        &st.axes[8], &st.qa_inv[0], &st.qa_inv[1], &st.qa_inv[2],
+                                        &st.qa_inv[3])) {
+        return NULL;
+    }
     const double *mo = flow.moments;
+    st.q_arr = st.w_arr = NULL;
+    PyObject *result = NULL;
     for (Py_ssize_t step = 0; step < count; step++) {
         double time = t0 + (double)step * h;
         for (Py_ssize_t i = 0; i < n_drifts; i++) {
@@ -2071,11 +2179,11 @@ accel_split_steps(PyObject *self, PyObject *args)
             w[1] += hb * tau[1] / mo[1];
             w[2] += hb * tau[2] / mo[2];
             if (split_free_flow(&flow, w, q, drifts[i] * h) < 0) {
-                return NULL;
+                goto done;
             }
             time += drifts[i] * h;
-            if (split_torque(torque, time, q, w, tau) < 0) {
-                return NULL;
+            if (split_torque(&st, time, q, w, tau) < 0) {
+                goto done;
             }
         }
         double hb = kicks[n_drifts] * h;
@@ -2088,5 +2196,9 @@ accel_split_steps(PyObject *self, PyObject *args)
         q[2] /= norm;
         q[3] /= norm;
     }
-    return Py_BuildValue("(ddd)(dddd)(ddd)", w[0], w[1], w[2], q[0], q[1], q[2], q[3], tau[0], tau[1], tau[2]);
+    result = Py_BuildValue("(ddd)(dddd)(ddd)", w[0], w[1], w[2], q[0], q[1], q[2], q[3], tau[0], tau[1], tau[2]);
+done:
+    Py_XDECREF(st.q_arr);
+    Py_XDECREF(st.w_arr);
+    return result;
 }

@@ -210,9 +210,10 @@ def _python_steps(scheme, moments, torque_p, t, w, q, tau, h, count):
     return w, q, tau
 
 
-def _steps_function(scheme, moments, torque_p):
-    """``steps(t, w, q, tau, h, count) -> (w, q, tau)``: the C kernel when ``_native.accel()`` has it, else
-    :func:`_python_steps`."""
+def _steps_function(scheme, moments, torque, axes, torque_p):
+    """``steps(t, w, q, tau, h, count) -> (w, q, tau)``: the C kernel ``_accel.split_steps`` when
+    :func:`~inertia_tool._native.accel` has it (it calls the caller's mesh-axes ``torque`` itself, with the
+    frame change of :func:`_make_torque`), else :func:`_python_steps` with the wrapped ``torque_p``."""
     kernel = accel()
     if kernel is None or not hasattr(kernel, "split_steps"):
         def python_steps(t, w, q, tau, h, count):
@@ -220,10 +221,16 @@ def _steps_function(scheme, moments, torque_p):
         return python_steps
     c_steps = kernel.split_steps
     drifts, kicks = tuple(scheme.drifts), tuple(scheme.kicks)
+    if np.array_equal(axes, np.eye(3)):
+        frame = None
+    else:
+        qa = matrix_to_quaternion(axes).tolist()
+        frame = (tuple(axes.ravel().tolist()), (qa[0], -qa[1], -qa[2], -qa[3]))
+    q_proto, w_proto = np.zeros(4), np.zeros(3)
 
     def compiled_steps(t, w, q, tau, h, count):
-        return c_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque_p, NEGLIGIBLE_COMPONENT,
-                       NEAR_SEPARATRIX_M1, free_flow_step)
+        return c_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, frame, q_proto, w_proto,
+                       NEGLIGIBLE_COMPONENT, NEAR_SEPARATRIX_M1, free_flow_step)
     return compiled_steps
 
 
@@ -293,7 +300,7 @@ def integrate_splitting(moments, axes, angular_velocity, orientation, t, torque,
     moments_t = tuple(float(x) for x in moments)
     times = np.asarray(t, dtype=np.float64)
     torque_p = _make_torque(torque, axes) if torque is not None else None
-    advance = _steps_function(plan, moments_t, torque_p)
+    advance = _steps_function(plan, moments_t, torque, axes, torque_p)
     w = tuple((axes.T @ np.asarray(angular_velocity, dtype=np.float64)).tolist())
     qa = matrix_to_quaternion(axes).tolist()
     q_mesh = np.asarray(orientation, dtype=np.float64)
