@@ -1629,7 +1629,8 @@ static double
 split_complete_k(double m1)
 {
     double a = 1.0, b = sqrt(m1);
-    for (int i = 0; i < SPLIT_MAX_ITER && fabs(a - b) > 1e-16 * a; i++) {
+    /* a_{n+1} - b_{n+1} ~ (a_n - b_n)^2 / (8 a): below 1e-9 a the mean (a + b)/2 is the limit to < 2e-19 */
+    for (int i = 0; i < SPLIT_MAX_ITER && fabs(a - b) > 1e-9 * a; i++) {
         double next = 0.5 * (a + b);
         b = sqrt(a * b);
         a = next;
@@ -1655,7 +1656,8 @@ split_jacobi(double u, double m, double m1, double kk, double *sn, double *cn, d
     b[0] = sqrt(m1);
     c[0] = sqrt(m);
     int n = 0;
-    while (n < SPLIT_MAX_ITER && fabs(c[n]) > 1e-17 * a[n]) {
+    /* stop at c <= 2^-53 a (as Cephes' ellpj): a stricter bound can stall at a one-ulp a - b for ever */
+    while (n < SPLIT_MAX_ITER && fabs(c[n]) > 0x1p-53 * a[n]) {
         a[n + 1] = 0.5 * (a[n] + b[n]);
         b[n + 1] = sqrt(a[n] * b[n]);
         c[n + 1] = 0.5 * (a[n] - b[n]);
