@@ -2,9 +2,9 @@
 
     python benchmarks/bench_integrator.py [--plot docs/img/work-precision.png] [--repeat 5]
 
-Error against wall time (best of ``--repeat`` interleaved rounds) for a sweep of fixed steps (splitting) and of tolerances
-(DOP853, rtol = atol; the splitting's own step control, rtol = atol), on three cases, 201 outputs each (the
-splitting's steps divide the output interval: k = 1, 2, 3, ... steps per output):
+Error against wall time (best of ``--repeat`` interleaved rounds) for a sweep of fixed steps (splitting) and
+of tolerances (DOP853, rtol = atol; the splitting's own step control, rtol = atol), on three cases, 201
+outputs each (the splitting's steps divide the output interval: k = 1, 2, 3, ... steps per output):
 
 (a) Heavy symmetric top on a pivot (Chapter 4, "Rigid Body Motion", §4.4.3): I1 = I2 = 0.02, I3 = 0.005 kg·m²
     about the pivot, M = 0.5 kg, l = 0.04 m, g = 9.80665 m/s², released at rest at θ0 = 0.6 rad with spin
@@ -131,7 +131,7 @@ def run_case(name, body, w0, q0, t, torque, error_of, steps, repeat, python_step
     best = [math.inf] * len(jobs)
     outputs = [None] * len(jobs)
     for round_ in range(repeat):
-        for index, (label, run, rounds) in enumerate(jobs):
+        for index, (_label, run, rounds) in enumerate(jobs):
             if round_ >= rounds:
                 continue
             start = time.perf_counter()
@@ -182,11 +182,12 @@ def heavy_top_case(repeat):
         return np.max(np.abs(1.0 - 2.0 * (q[:, 1] ** 2 + q[:, 2] ** 2) - u_exact))
 
     print(f"heavy top: nutation period {period:.4f} s, θ {top.theta_min:.3f}..{top.theta_max:.3f} rad, "
-          f"{top.precession_kind}; tight DOP853 reference: |cos θ − ℘ solution| = {u_error(ref[:, :3], ref[:, 3:]):.1e}")
+          f"{top.precession_kind}; tight DOP853 reference: |cos θ − ℘ solution| = "
+          f"{u_error(ref[:, :3], ref[:, 3:]):.1e}")
     steps = tuple((t[1] - t[0]) / k for k in (1, 2, 3, 4, 6, 8))
     curves = run_case("(a) heavy top, error in cos θ against the Weierstrass ℘ solution", tensor, w0, q0, t,
                       torque, u_error, steps, repeat, python_steps=4)
-    ratio = print_ratios(curves)
+    ratio = (print_ratios(curves), print_ratios(curves, "splitting (Python), fixed step"))
     full = run_case("(a') heavy top, full-state error against DOP853 3e-14", tensor, w0, q0, t, torque,
                     lambda w, q: state_error(w, q, ref[:, :3], ref[:, 3:]), steps[:4], repeat, python_steps=0)
     print_ratios(full)
@@ -209,8 +210,8 @@ def torque_free_case(repeat):
                                                  traj.method)]
     print(f"  closed form, simulate() ({traj.method}): error {curves['closed form (simulate default)'][0][0]:.2e}"
           f"  time {seconds * 1e3:.2f} ms")
-    ratio = print_ratios(curves)
-    print_ratios(curves, "closed form (simulate default)")
+    ratio = (print_ratios(curves), print_ratios(curves, "splitting (Python), fixed step"),
+             print_ratios(curves, "closed form (simulate default)"))
     return curves, ratio
 
 
@@ -228,17 +229,58 @@ def gravity_gradient_case(repeat, rate=0.5):
     ref = solve_ivp(_make_rhs(np.diag(moments), torque), (0.0, 100.0), np.concatenate([w0, q0]),
                     method="DOP853", rtol=3e-14, atol=1e-16, t_eval=t).y.T
     w_chk, q_chk, _ = integrate_splitting(moments, np.eye(3), w0, q0, t, torque, step=1.0 / 64)
+    agreement = state_error(w_chk, q_chk, ref[:, :3], ref[:, 3:])
     print(f"\ngravity gradient n = {rate} rad/s: reference DOP853 3e-14 and splitting h = 1/64 s agree to "
-          f"{state_error(w_chk, q_chk, ref[:, :3], ref[:, 3:]):.1e}")
+          f"{agreement:.1e} (errors below that are not resolved)")
 
     def error_of(w, q):
         return state_error(w, q, ref[:, :3], ref[:, 3:])
 
     steps = tuple(0.5 / k for k in (1, 2, 3, 4, 5, 6, 8))     # k steps per output interval
     curves = run_case(f"(c) gravity gradient n = {rate} rad/s against DOP853 3e-14", moments, w0, q0, t,
-                      torque, error_of, steps, repeat, python_steps=3)
-    ratio = print_ratios(curves)
-    return curves, ratio
+                      torque, error_of, steps, repeat, python_steps=5)
+    ratio = (print_ratios(curves), print_ratios(curves, "splitting (Python), fixed step"))
+    return curves, ratio, agreement
+
+
+def stage_costs(repeat):
+    """Where the time goes: µs per torque call of each integrator, split into its parts (one run)."""
+    moments, w0, q0 = np.array([1.0, 2.0, 3.0]), np.array([0.1, 1.0, 0.05]), np.array([1.0, 0.0, 0.0, 0.0])
+    t = np.linspace(0.0, 20.0, 41)
+    k, (i1, i2, i3) = 0.75, (1.0, 2.0, 3.0)
+
+    def gravity(_t, q, _w):
+        qw, qx, qy, qz = q.tolist()
+        z0, z1, z2 = 2 * (qx * qz - qw * qy), 2 * (qy * qz + qw * qx), 1 - 2 * (qx * qx + qy * qy)
+        return (k * (i3 - i2) * z1 * z2, k * (i1 - i3) * z2 * z0, k * (i2 - i1) * z0 * z1)
+
+    def zero(_t, _q, _w):
+        return (0.0, 0.0, 0.0)
+
+    q_arg, w_arg = np.array([0.9, 0.1, -0.3, 0.2]), np.array([0.1, 1.0, 0.05])
+    torque_alone, _ = best_time(lambda: [gravity(0.0, q_arg, w_arg) for _ in range(2000)], repeat)
+    rows = [("the torque itself (floats, q.tolist())", torque_alone / 2000)]
+    for label, torque in (("DOP853 call, no torque (rhs + scipy)", zero), ("DOP853 call, gravity gradient", gravity)):
+        rhs = _make_rhs(np.diag(moments), torque)
+        seconds, sol = best_time(lambda: solve_ivp(rhs, (0.0, 20.0), np.concatenate([w0, q0]), method="DOP853",
+                                                   rtol=1e-12, atol=1e-12, t_eval=t), repeat)
+        rows.append((label, seconds / sol.nfev))
+    for body, kind in ((moments, "asymmetric"), (np.array([1.0, 1.0, 3.0]), "symmetric")):
+        for path in ("C", "Python"):
+            for label, torque in (("free flow only", None), ("+ call of a zero torque", zero),
+                                  ("+ gravity gradient", gravity)):
+                def run():
+                    return integrate_splitting(body, np.eye(3), w0, q0, t, torque, step=0.1)
+                if path == "Python":
+                    with python_path():
+                        seconds, (_, _, n) = best_time(run, repeat)
+                else:
+                    seconds, (_, _, n) = best_time(run, repeat)
+                rows.append((f"splitting stage ({path}, {kind}): {label}", seconds / (11 * n)))
+    dop = rows[2][1]
+    print("\nwhere the time goes: µs per torque call (splitting: per stage = one exact free flow + one kick)")
+    for label, seconds in rows:
+        print(f"  {label:62s} {seconds * 1e6:7.2f} µs  {seconds / dop:6.2f} × DOP853's")
 
 
 STYLE = {"DOP853": dict(color="black", marker="s"),
@@ -252,18 +294,24 @@ def plot(panels, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.6), constrained_layout=True)
-    for ax, (title, curves, ratio) in zip(axes, panels):
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.0 * len(panels), 4.9), constrained_layout=True)
+    handles = {}
+    for ax, (title, curves, ratio, floor) in zip(axes, panels):
         for label, points in curves.items():
             pts = sorted((p[1], p[0]) for p in points)
-            ax.loglog([p[0] * 1e3 for p in pts], [max(p[1], 1e-17) for p in pts], label=label,
-                      **STYLE.get(label, {}))
-        ax.set_xlabel("wall time [ms] (best of repeats)")
-        ax.set_ylabel("max error over 201 outputs")
-        note = "" if ratio is None else f"\nsplitting/DOP853 time at DOP853 1e-12's error: {ratio:.2f}"
+            (line,) = ax.loglog([p[0] * 1e3 for p in pts], [max(p[1], 1e-17) for p in pts], label=label,
+                                **STYLE.get(label, {}))
+            handles[label] = line
+        if floor is not None:
+            ax.axhline(floor, color="grey", linestyle=":", linewidth=1)
+            ax.annotate("reference resolved to here", (ax.get_xlim()[0], floor), xytext=(4, -11),
+                        textcoords="offset points", fontsize=7, color="grey")
+        ax.set_xlabel("wall time [ms], best of interleaved repeats")
+        ax.set_ylabel("max error over the 201 outputs")
+        note = "" if ratio is None else f"\nsplitting / DOP853 time at DOP853 (tol 1e-12)'s error: {ratio:.2f}"
         ax.set_title(title + note, fontsize=9)
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=8, loc="upper right")
+        ax.grid(True, which="major", alpha=0.3)
+    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncol=len(handles), fontsize=8)
     fig.savefig(path, dpi=110)
     print(f"\nwrote {path}")
 
@@ -275,21 +323,24 @@ def main():
     parser.add_argument("--cases", default="abc", help="which cases to run (letters of a, b, c); the plot needs all")
     args = parser.parse_args()
     print(f"inertia_tool {it.__version__}; C kernel: {'yes' if accel() is not None else 'NO (Python path only)'}")
-    none = ({}, None)
+    stage_costs(args.repeat)
+    none = ({}, (None,))
     top_curves, top_ratio = heavy_top_case(args.repeat) if "a" in args.cases else none
     free_curves, free_ratio = torque_free_case(args.repeat) if "b" in args.cases else none
-    gg_curves, gg_ratio = gravity_gradient_case(args.repeat) if "c" in args.cases else none
-    print("\nsummary: splitting (C, fixed step) / DOP853 wall time at DOP853 rtol = atol = 1e-12's accuracy "
-          "(target <= 0.333)")
-    for letter, name, curves, ratio in (("a", "(a) heavy top (cos θ vs ℘)", top_curves, top_ratio),
-                                        ("b", "(b) torque-free (vs closed form)", free_curves, free_ratio),
-                                        ("c", "(c) gravity gradient n = 0.5 rad/s", gg_curves, gg_ratio)):
+    gg_curves, gg_ratio, gg_floor = gravity_gradient_case(args.repeat) if "c" in args.cases else none + (None,)
+    print("\nsummary: wall time / DOP853's at the error DOP853 reaches with rtol = atol = 1e-12 (target <= 0.333)")
+    print(f"  {'case':38s} {'splitting C':>12s} {'splitting Py':>13s} {'closed form':>12s}")
+    for letter, name, ratios in (("a", "(a) heavy top (cos θ vs ℘)", top_ratio),
+                                 ("b", "(b) torque-free (vs closed form)", free_ratio),
+                                 ("c", "(c) gravity gradient n = 0.5 rad/s", gg_ratio)):
         if letter in args.cases:
-            print(f"  {name:38s} {'not reached' if ratio is None else f'{ratio:.3f}'}")
+            cells = [("not reached" if r is None else f"{r:.3f}") for r in ratios] + [""] * (3 - len(ratios))
+            print(f"  {name:38s} {cells[0]:>12s} {cells[1]:>13s} {cells[2]:>12s}")
     if args.plot and args.cases == "abc":
-        plot([("(a) heavy top, cos θ vs Weierstrass ℘", top_curves, top_ratio),
-              ("(b) torque-free I = (1, 2, 3) vs closed form", free_curves, free_ratio),
-              ("(c) gravity gradient n = 0.5 rad/s vs DOP853 3e-14", gg_curves, gg_ratio)], args.plot)
+        plot([("(a) heavy top: cos θ vs Weierstrass ℘", top_curves, top_ratio[0], None),
+              ("(b) torque-free I = (1, 2, 3): state vs closed form", free_curves, free_ratio[0], None),
+              ("(c) gravity gradient n = 0.5 rad/s: state vs DOP853 3e-14", gg_curves, gg_ratio[0], gg_floor)],
+             args.plot)
 
 
 if __name__ == "__main__":
