@@ -1,8 +1,9 @@
 """The boundary to the optional C extension ``inertia_tool._accel``.
 
-The engine's hot loops (exact welding, the edge census, shell labels, the tetrahedron sums) have two
-implementations: C kernels in ``_accel.c`` (built by ``pip install`` when a C compiler is present) and the
-pure-numpy code of ``weld``, ``checks`` and ``volume``, which is the reference and the fallback.  Each of those
+The engine's hot loops (exact welding, the edge census, shell labels, the tetrahedron sums, the splitting
+integrator's steps) have two implementations: C kernels in ``_accel.c`` (built by ``pip install`` when a C
+compiler is present) and the pure-numpy (or pure-Python) code of ``weld``, ``checks``, ``volume`` and
+``dynamics.splitting``, which is the reference and the fallback.  Each of those
 modules asks :func:`accel` at call time which one to run.  Set the environment variable
 ``INERTIA_TOOL_NO_ACCEL=1`` to force the numpy path (results are identical, or equal to round-off for the
 integrals, which the C kernel sums with compensation).
