@@ -57,6 +57,7 @@ from inertia_tool.rotations import quaternion_to_matrix  # noqa: E402
 
 DOP_TOLERANCES = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13)
 CONTROL_TOLERANCES = (1e-8, 1e-10, 1e-12, 1e-14)
+MIN_SAMPLE = 0.03        # s: shorter runs are repeated within a round and averaged
 
 
 CLOCKS = {"cpu": time.process_time, "wall": time.perf_counter}
@@ -113,8 +114,9 @@ def run_case(name, body, w0, q0, t, torque, error_of, steps, repeat, python_step
     """Sweep DOP853 tolerances and splitting steps; returns {curve label: [(error, time, detail)]}.
 
     Timing: ``repeat`` rounds over all runs (interleaved, so that a burst of load on the shared machine hits
-    every curve alike), the best time of each run kept; the slow pure-Python runs go in the first three rounds
-    only."""
+    every curve alike), the best time of each run kept; after the first round a run shorter than
+    ``MIN_SAMPLE`` is repeated within the round and its mean taken; the slow pure-Python runs go in the first
+    three rounds only."""
     principal = resolve_body(body)
     tensor = principal.axes @ np.diag(principal.moments) @ principal.axes.T
     rhs = _make_rhs(tensor, torque)
@@ -141,13 +143,17 @@ def run_case(name, body, w0, q0, t, torque, error_of, steps, repeat, python_step
     jobs += [("splitting (C), step control", lambda tol=tol: split(tol=tol), repeat) for tol in CONTROL_TOLERANCES]
     best = [math.inf] * len(jobs)
     outputs = [None] * len(jobs)
+    inner = [1] * len(jobs)
     for round_ in range(repeat):
         for index, (_label, run, rounds) in enumerate(jobs):
             if round_ >= rounds:
                 continue
             start = clock()
-            outputs[index] = run()
-            best[index] = min(best[index], clock() - start)
+            for _ in range(inner[index]):
+                outputs[index] = run()
+            seconds = (clock() - start) / inner[index]
+            best[index] = min(best[index], seconds)
+            inner[index] = max(1, min(50, int(MIN_SAMPLE / max(seconds, 1e-6))))   # short runs: average several
     curves = {}
     print(f"\n{name}")
     for (label, _, _), seconds, (w, q, detail) in zip(jobs, best, outputs):
