@@ -1589,8 +1589,9 @@ PyInit__accel(void)
  * 13-26, Algorithms 1 and 4; DLMF 19.36.i).  Results equal the Python path to round-off.  The torque is the
  * caller's torque(t, q, w) -> 3 numbers in mesh axes, called with fresh float64 arrays and rotated to and
  * from the principal frame here (`frame` = (axes, qa_inv), or None when they coincide) as
- * splitting._make_torque does; a state within `separatrix_m1` of the separatrix calls the Python
- * fallback(moments, w, q, h) -> (w, q), as free_flow does.
+ * splitting._make_torque does; a non-finite torque raises FloatingPointError (as the Python path does); a
+ * state within `separatrix_m1` of the separatrix calls the Python fallback(moments, w, q, h) -> (w, q), as
+ * free_flow does.
  * ====================================================================================================== */
 
 #define SPLIT_MAX_ITER 64           /* bound on AGM / duplication iterations (each converges in < 30) */
@@ -2096,6 +2097,13 @@ split_torque(SplitTorque *st, double time, const double q[4], const double w[3],
     int status = split_read_torque(res, tm);
     Py_DECREF(res);
     if (status < 0) {
+        return -1;
+    }
+    if (!isfinite(tm[0]) || !isfinite(tm[1]) || !isfinite(tm[2])) {
+        char message[160];
+        snprintf(message, sizeof message, "the torque is not finite at t = %.17g s: (%g, %g, %g)", time, tm[0],
+                 tm[1], tm[2]);
+        PyErr_SetString(PyExc_FloatingPointError, message);
         return -1;
     }
     if (st->rotated) {

@@ -15,7 +15,7 @@ from inertia_tool.dynamics.splitting import SCHEMES, integrate_splitting
 from inertia_tool.dynamics.top import heavy_top
 from inertia_tool.dynamics.top_motion import top_cos_theta
 from inertia_tool.dynamics.torque_free import NEGLIGIBLE_COMPONENT, torque_free_motion
-from inertia_tool.errors import UsageError
+from inertia_tool.errors import NonFiniteResultError, UsageError
 from inertia_tool.rotations import quaternion_to_matrix
 
 from conftest import HAVE_ACCEL, REQUIRE_ACCEL
@@ -192,6 +192,20 @@ def test_torque_sees_unchanged_arrays_and_errors_propagate(engine_path):
     with pytest.raises(UsageError, match=r"shape \(3,\)"):
         it.simulate([1, 2, 3], [0.1, 1, 0.05], [0.0, 5.0], torque=lambda t, q, w: np.zeros(4),
                     torque_depends_on_angular_velocity=False)
+
+
+@pytest.mark.parametrize("bad_call", [0, 40])
+def test_non_finite_torque_is_refused(engine_path, bad_call):
+    """A torque that returns NaN (at the start or after 40 calls) stops the integration with
+    NonFiniteResultError instead of returning NaN states."""
+    calls = []
+
+    def torque(t, q, w):
+        calls.append(t)
+        return np.array([np.nan if len(calls) > bad_call else 0.01, 0.0, 0.0])
+
+    with pytest.raises(NonFiniteResultError, match="not finite"):
+        integrate_splitting([1, 2, 3], np.eye(3), [0.1, 1.0, 0.05], [1, 0, 0, 0], [0.0, 5.0], torque, step=0.1)
 
 
 def test_every_scheme_runs_on_both_paths(engine_path):

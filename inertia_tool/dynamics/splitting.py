@@ -59,7 +59,7 @@ import math
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import PhysicsError, UsageError
+from ..errors import NonFiniteResultError, PhysicsError, UsageError
 from ..rotations import matrix_to_quaternion
 from .._native import accel
 from .free_flow import NEAR_SEPARATRIX_M1, free_flow_step
@@ -197,7 +197,10 @@ def _composition_step(scheme, moments, torque_p, t, w, q, tau, h):
         w2 += hb * tau[2] / i3
         (w0, w1, w2), q = free_flow_step(moments, (w0, w1, w2), q, a * h)
         time += a * h
-        tau = torque_p(time, q, (w0, w1, w2)) if torque_p is not None else (0.0, 0.0, 0.0)
+        if torque_p is not None:
+            tau = torque_p(time, q, (w0, w1, w2))
+            if not (math.isfinite(tau[0]) and math.isfinite(tau[1]) and math.isfinite(tau[2])):
+                raise FloatingPointError(f"the torque is not finite at t = {time!r} s: {tau}")
     hb = kicks[-1] * h
     w0 += hb * tau[0] / i1
     w1 += hb * tau[1] / i2
@@ -291,6 +294,13 @@ def integrate_splitting(moments, axes, angular_velocity, orientation, t, torque,
         Unit quaternions of body (mesh axes) → space.
     steps : int
         Composition steps taken (probe comparisons included).
+
+    Raises
+    ------
+    NonFiniteResultError
+        The torque returned infinity or NaN.
+    PhysicsError
+        More than ``max_steps`` steps.
     """
     if scheme not in SCHEMES:
         raise UsageError(f"Expected `scheme` in {tuple(SCHEMES)}, got {scheme!r}")
@@ -306,13 +316,20 @@ def integrate_splitting(moments, axes, angular_velocity, orientation, t, torque,
     moments_t = tuple(float(x) for x in moments)
     times = np.asarray(t, dtype=np.float64)
     torque_p = _make_torque(torque, axes) if torque is not None else None
-    advance = _steps_function(plan, moments_t, torque, axes, torque_p)
+    steps_function = _steps_function(plan, moments_t, torque, axes, torque_p)
+
+    def advance(t_start, w_start, q_start, tau_start, h_step, count):
+        try:
+            return steps_function(t_start, w_start, q_start, tau_start, h_step, count)
+        except FloatingPointError as exc:  # raised by either path for a non-finite torque
+            raise NonFiniteResultError(f"{exc}; the splitting integration cannot continue") from None
     w = tuple((axes.T @ np.asarray(angular_velocity, dtype=np.float64)).tolist())
     qa = matrix_to_quaternion(axes).tolist()
     q_mesh = np.asarray(orientation, dtype=np.float64)
     q = _quat_mul(tuple((q_mesh / np.linalg.norm(q_mesh)).tolist()), tuple(qa))  # principal → space
     t_now = float(times[0])
     tau = torque_p(t_now, q, w) if torque_p is not None else (0.0, 0.0, 0.0)
+    NonFiniteResultError.check(f"the torque at t = {t_now!r} s", tau, because="it is not finite")
     span = float(times[-1] - times[0])
     h_nominal = step if step is not None else (max_step if max_step is not None else max(span, 1e-300))
     if max_step is not None:
