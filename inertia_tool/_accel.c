@@ -1526,7 +1526,7 @@ accel_bounds(PyObject *self, PyObject *args)
  * module
  * ====================================================================================================== */
 
-static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 6, below */
+static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 
 static PyMethodDef accel_methods[] = {
     {"edge_census", accel_edge_census, METH_VARARGS,
@@ -1547,7 +1547,7 @@ static PyMethodDef accel_methods[] = {
     {"split_steps", accel_split_steps, METH_VARARGS,
      "split_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, frame, q_proto, w_proto, "
      "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition (dynamics/splitting.py), "
-     "principal frame; see section 6."},
+     "principal frame; see section 7."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -1579,7 +1579,7 @@ PyInit__accel(void)
 }
 
 /* ======================================================================================================
- * 6. split_steps -- steps of the splitting integrator (dynamics/splitting.py): exact free flow + kicks
+ * 7. split_steps -- steps of the splitting integrator (dynamics/splitting.py): exact free flow + kicks
  *
  * The twin of splitting._python_steps and free_flow.free_flow_step on C doubles: the same branches
  * (spherical, symmetric, steady spin, time reversal, asymmetric closed form) and formulas, with the special

@@ -45,7 +45,7 @@ integrator, and as ``rtol``/``atol`` of :mod:`.integrate`).  ``max_step`` bounds
 control).
 
 *Implementation.*  The steps between output times and probes run as one call of the C kernel
-``_accel.split_steps`` (``_accel.c``, section 6: the free flow's closed form with its own AGM and Carlson
+``_accel.split_steps`` (``_accel.c``, section 7: the free flow's closed form with its own AGM and Carlson
 functions, the frame change and the torque calls in one loop, ~1.5 µs per stage plus the torque against
 ~28 µs here) when :func:`~inertia_tool._native.accel` provides it, else as :func:`_python_steps`; the two agree
 to round-off.  ``benchmarks/bench_integrator.py`` measures both against DOP853 (``docs/dynamics.md``).
