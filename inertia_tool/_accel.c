@@ -2182,6 +2182,9 @@ accel_split_steps(PyObject *self, PyObject *args)
     st.q_arr = st.w_arr = NULL;
     PyObject *result = NULL;
     for (Py_ssize_t step = 0; step < count; step++) {
+        if (PyErr_CheckSignals() < 0) {         /* Ctrl-C also without a torque (no Python code runs then) */
+            goto done;
+        }
         double time = t0 + (double)step * h;
         for (Py_ssize_t i = 0; i < n_drifts; i++) {
             double hb = kicks[i] * h;

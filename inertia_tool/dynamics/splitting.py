@@ -212,8 +212,8 @@ def _composition_step(scheme, moments, torque_p, t, w, q, tau, h):
 def _python_steps(scheme, moments, torque_p, t, w, q, tau, h, count):
     """``count`` composition steps of length ``h`` from time ``t`` (step ``k`` starts at ``t + k h``).
 
-    The pure-Python twin of the C kernel ``_accel.split_steps`` (same arithmetic; the special functions
-    are scipy's there and the C file's own here, so results agree to round-off)."""
+    The pure-Python twin of the C kernel ``_accel.split_steps`` (same arithmetic; the special functions are
+    scipy's here and the C file's own there, so results agree to round-off)."""
     for k in range(count):
         w, q, tau = _composition_step(scheme, moments, torque_p, t + k * h, w, q, tau, h)
     return w, q, tau
@@ -323,6 +323,7 @@ def integrate_splitting(moments, axes, angular_velocity, orientation, t, torque,
             return steps_function(t_start, w_start, q_start, tau_start, h_step, count)
         except FloatingPointError as exc:  # raised by either path for a non-finite torque
             raise NonFiniteResultError(f"{exc}; the splitting integration cannot continue") from None
+
     w = tuple((axes.T @ np.asarray(angular_velocity, dtype=np.float64)).tolist())
     qa = matrix_to_quaternion(axes).tolist()
     q_mesh = np.asarray(orientation, dtype=np.float64)
