@@ -1,6 +1,7 @@
 """Work-precision diagrams of the splitting integrator against scipy's DOP853, in one run.
 
-    python benchmarks/bench_integrator.py [--plot docs/img/work-precision.png] [--repeat 5]
+    python benchmarks/bench_integrator.py [--plot docs/img/work-precision.png] [--repeat 5] [--clock cpu|wall]
+                                          [--cases abc]
 
 Error against time (best of ``--repeat`` interleaved rounds) for a sweep of fixed steps (splitting) and
 of tolerances (DOP853, rtol = atol; the splitting's own step control, rtol = atol), on three cases, 201
@@ -23,11 +24,11 @@ outputs each (the splitting's steps divide the output interval: k = 1, 2, 3, ...
 Error (b, c): max over the outputs of max(|ω − ω_ref| / max|ω_ref|, |R − R_ref|) (R the rotation matrix).
 
 Both integrators call the same torque, written on Python floats (``q.tolist()``), and DOP853 gets the
-package's float-level right-hand side (``dynamics.integrate._make_rhs``, the fastest form; a numpy
-right-hand side is ~3× slower).  The ratio "at matched accuracy" is the splitting's time interpolated
-(log-log, along the lower envelope of its curve) at the error DOP853 reaches at each tolerance, divided by
-DOP853's time there.  The splitting is timed on the C kernel (``_accel.split_steps``) and on the pure-Python
-path (``INERTIA_TOOL_NO_ACCEL=1``).  Absolute times drift on a shared machine; ratios come from one run.
+package's float-level right-hand side (``dynamics.integrate._make_rhs``, its fastest form).  The ratio "at
+matched accuracy" is the splitting's time interpolated (log-log, along the lower envelope of its curve) at
+the error DOP853 reaches at each tolerance, divided by DOP853's time there.  The splitting is timed on the C
+kernel (``_accel.split_steps``) and on the pure-Python path (``INERTIA_TOOL_NO_ACCEL=1``).  Absolute times
+drift on a shared machine; ratios come from one run.
 
 Clock: ``--clock cpu`` (default) times the process's CPU time, which equals the wall time of these
 single-threaded runs on an idle machine but, unlike the wall time on a machine shared with other jobs, does not
