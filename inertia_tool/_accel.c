@@ -1546,8 +1546,8 @@ static PyMethodDef accel_methods[] = {
      "an (n >= 1, 3) C-contiguous float64 array (NaN propagates) and whether every entry is finite."},
     {"split_steps", accel_split_steps, METH_VARARGS,
      "split_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, frame, q_proto, w_proto, "
-     "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition (dynamics/splitting.py), "
-     "principal frame; see section 7."},
+     "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition "
+     "(dynamics/splitting.py), principal frame; see section 7."},
     {NULL, NULL, 0, NULL}
 };
 
