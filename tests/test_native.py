@@ -339,3 +339,19 @@ def test_threaded_kernels_have_no_data_race():
                           timeout=900, env={**os.environ, "PYTHON": sys.executable})
     assert done.returncode == 0, (done.stdout + done.stderr)[-3000:]
     assert "without reports" in done.stdout
+
+
+def test_accel_source_has_no_identifier_that_windows_h_redefines():
+    """_accel.c includes <windows.h> on Windows; the Windows SDK defines some plain words as macros there
+    (rpcndr.h: ``#define small char``; minwindef.h: ``far``, ``near``, ``pascal``; combaseapi.h:
+    ``interface``), so a variable of that name does not compile with MSVC -- and setup.py's optional build
+    would then install the package without its C kernels, silently.  Checked on the source text (comments and
+    strings removed) so that it fails on Linux too."""
+    import re
+    path = os.path.join(os.path.dirname(__file__), "..", "inertia_tool", "_accel.c")
+    with open(path, encoding="utf-8") as fh:
+        src = fh.read()
+    code = re.sub(r"/\*.*?\*/|//[^\n]*|\"(?:\\.|[^\"\\])*\"|'(?:\\.|[^'\\])'", " ", src, flags=re.S)
+    words = set(re.findall(r"\b[A-Za-z_]\w*\b", code))
+    assert words.isdisjoint({"small", "hyper", "far", "near", "pascal", "interface"}), \
+        sorted(words & {"small", "hyper", "far", "near", "pascal", "interface"})
