@@ -170,6 +170,9 @@ typedef struct {
 } TaskArg;
 
 #if defined(_WIN32)
+#ifndef WIN32_LEAN_AND_MEAN
+#define WIN32_LEAN_AND_MEAN     /* no rpc.h / ole2.h: fewer plain words (small, interface, ...) become macros */
+#endif
 #include <windows.h>
 
 static DWORD WINAPI
@@ -338,7 +341,7 @@ typedef struct { uint64_t k[3]; uint64_t id; } Recent64;
 typedef struct {
     PyObject_HEAD
     int wide;              /* 0: float32 keys (3 x 32 bits); 1: float64 keys (3 x 64 bits) */
-    int busy;              /* a feed is running with the GIL released */
+    int busy;              /* a feed or vertices_into is running with the GIL released */
     uint32_t *slots;       /* vertex id + 1, 0 = empty; mask + 1 entries */
     size_t mask;
     void *keys;            /* keys_cap keys of 3 words each, in vertex-id order */
@@ -655,6 +658,7 @@ Welder_vertices_into(WelderObject *w, PyObject *out_obj)
         return NULL;
     }
     double *v = (double *)out.buf;
+    w->busy = 1;                        /* the GIL is released: a feed() meanwhile could move the keys */
     Py_BEGIN_ALLOW_THREADS
     if (w->wide && w->count > 0) {      /* no memcpy of 0 bytes: out may be NULL then */
         memcpy(v, w->keys, w->count * 24);
@@ -666,6 +670,7 @@ Welder_vertices_into(WelderObject *w, PyObject *out_obj)
         }
     }
     Py_END_ALLOW_THREADS
+    w->busy = 0;
     PyBuffer_Release(&out);
     Py_RETURN_NONE;
 }
@@ -1092,8 +1097,8 @@ shell_union_task(void *ctx, int t, int nt)
                     if (a == b) {
                         break;
                     }
-                    int32_t big = a > b ? a : b, small = a > b ? b : a;
-                    if (cas32(&parent[big], big, small)) {
+                    int32_t hi = a > b ? a : b, lo = a > b ? b : a;   /* not `small`: a macro of windows.h */
+                    if (cas32(&parent[hi], hi, lo)) {
                         break;
                     }
                 }

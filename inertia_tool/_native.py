@@ -51,7 +51,7 @@ def threads() -> int:
     """Threads for the C kernels: ``INERTIA_TOOL_THREADS`` if set to an integer >= 1, else the CPUs this process
     may run on; at most 16.  A malformed value counts as unset."""
     raw = os.environ.get(THREADS_ENV, "").strip()
-    if raw.isdigit() and int(raw) >= 1:
+    if raw.isascii() and raw.isdigit() and int(raw) >= 1:     # isdigit() alone accepts '²', which int() refuses
         return min(int(raw), MAX_THREADS)
     try:
         n = len(os.sched_getaffinity(0))
