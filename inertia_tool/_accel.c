@@ -3,7 +3,7 @@
  *
  * Written against the CPython C API and the buffer protocol only (no numpy headers), so it builds with a
  * C compiler and the Python headers.  Every function here has a pure-numpy twin that stays the reference
- * (inertia_tool/weld.py, checks.py, volume.py); the Python modules call these only when this module
+ * (inertia_tool/mesh/weld.py, mesh/checks.py, mass/volume.py); the Python modules call these only when this module
  * imports and INERTIA_TOOL_NO_ACCEL is not set.  Results are identical to the numpy path (welding, edge
  * census, shell labels) or equal to round-off (the compensated integration sums).
  *

@@ -28,7 +28,7 @@ def lib():
 @pytest.fixture(scope="module")
 def damaged():
     """Faces and vertices of 5 shells (icospheres of 81,920 faces, one of them with 40 faces flipped, 30
-    removed and 20 duplicated), 409,550 faces in all: above every kernel's threshold for threads."""
+    removed and 20 duplicated), 409,590 faces in all: above every kernel's threshold for threads."""
     sphere = trimesh.creation.icosphere(subdivisions=6, radius=1.0)
     v0, f0 = np.asarray(sphere.vertices), np.asarray(sphere.faces)
     rng = np.random.default_rng(7)
