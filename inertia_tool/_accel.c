@@ -211,7 +211,10 @@ run_parallel(int nt, task_fn fn, void *ctx)
 static inline int32_t
 load32(int32_t *p)
 {
-    return (int32_t)InterlockedCompareExchange((volatile LONG *)p, 0, 0);   /* a full-barrier read */
+    /* An aligned 32-bit volatile read is atomic on every Windows target, and the union-find needs no ordering
+     * from it (only the CAS links).  Not InterlockedCompareExchange(p, 0, 0): a locked write on every read made
+     * the threaded union-find ~6x slower than one thread (emulated on Linux, 1.3M faces, 2 threads). */
+    return (int32_t)*(volatile LONG *)p;
 }
 
 static inline int
