@@ -191,38 +191,48 @@ def test_threads_setting(monkeypatch, raw, expected):
 
 def test_welder_refuses_feed_while_vertices_into_runs(lib):
     """vertices_into releases the GIL while it copies the keys: a feed() from another Python thread meanwhile
-    must be refused (it may grow and move the keys being read).  Thread B waits for the GIL that A drops
-    inside vertices_into and feeds one new point (no growth, so the unfixed kernel does not crash); B's call
-    succeeding entirely within A's call is the race."""
+    must be refused (it may grow and move the keys being read, or raise the count the copy loop reads).
+    Thread B wakes as A enters vertices_into and feeds one new point (no growth, so the unfixed kernel does
+    not crash); B's call succeeding entirely within A's call is the race.  An attempt in which B fed before
+    A started (A then refuses the stale `out`) proves nothing and is repeated."""
     import threading
     import time
     n = 1_000_000
-    w = lib.Welder("float32", n)
-    w.feed(np.arange(3 * n, dtype=np.float32).reshape(-1, 3), np.empty(n, dtype=np.int32))
-    out = np.empty((w.count, 3))
-    state = {"go": False}
+    conclusive = 0
+    for _ in range(5):
+        w = lib.Welder("float32", n)
+        w.feed(np.arange(3 * n, dtype=np.float32).reshape(-1, 3), np.empty(n, dtype=np.int32))
+        out = np.empty((w.count, 3))
+        go = threading.Event()
+        state = {}
 
-    def feed_one():
-        while not state["go"]:
-            pass
+        def feed_one():
+            go.wait()
+            b0 = time.perf_counter()
+            try:
+                w.feed(np.array([[-1.0, -2.0, -3.0]], dtype=np.float32), np.empty(1, dtype=np.int32))
+                state["b"] = "fed"
+            except RuntimeError:
+                state["b"] = "refused"
+            state["b_time"] = (b0, time.perf_counter())
+
+        other = threading.Thread(target=feed_one)
+        other.start()
+        go.set()
         t0 = time.perf_counter()
         try:
-            w.feed(np.array([[-1.0, -2.0, -3.0]], dtype=np.float32), np.empty(1, dtype=np.int32))
-            state["b"] = "fed"
-        except RuntimeError:
-            state["b"] = "refused"
-        state["b_time"] = (t0, time.perf_counter())
-
-    other = threading.Thread(target=feed_one)
-    other.start()
-    state["go"] = True
-    t0 = time.perf_counter()
-    w.vertices_into(out)
-    t1 = time.perf_counter()
-    other.join()
-    b0, b1 = state["b_time"]
-    assert not (state["b"] == "fed" and t0 < b0 and b1 < t1), "feed() ran while vertices_into() was copying"
-    np.testing.assert_array_equal(out[:3], [[0, 1, 2], [3, 4, 5], [6, 7, 8]])
+            w.vertices_into(out)
+        except (RuntimeError, ValueError):      # B's feed came first: the count no longer matches `out`
+            other.join()
+            continue
+        t1 = time.perf_counter()
+        other.join()
+        b0, b1 = state["b_time"]
+        assert not (state["b"] == "fed" and t0 < b0 and b1 < t1), "feed() ran while vertices_into() was copying"
+        np.testing.assert_array_equal(out[:3], [[0, 1, 2], [3, 4, 5], [6, 7, 8]])
+        conclusive += 1
+        break
+    assert conclusive == 1
 
 
 def test_threads_setting_non_ascii_digits(monkeypatch):
