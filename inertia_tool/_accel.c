@@ -9,18 +9,21 @@
  *
  * Sections:
  *   1. buffers     -- format / shape checks shared by the kernels
- *   2. Welder      -- streaming exact weld of float32 or float64 points (weld.py)
- *   3. edge_census -- boundary / non-manifold / misoriented edges (checks.edge_topology)
- *   4. shell_labels-- union-find connected components of faces (checks.shell_labels)
- *   5. tetra_sums  -- signed-tetrahedron volume integrals with compensated sums (volume._tetra_sums)
- *   6. bounds      -- bounding box and finiteness of the vertices in one pass (volume.bounding_box)
+ *   1b. threads    -- run_parallel, the work tickets
+ *   2. Welder      -- streaming exact weld of float32 or float64 points (mesh/weld.py)
+ *   3. edge_census -- boundary / non-manifold / misoriented edges (mesh/checks.edge_topology)
+ *   4. shell_labels-- union-find connected components of faces (mesh/checks.shell_labels)
+ *   5. tetra_sums  -- signed-tetrahedron volume integrals with compensated sums (mass/volume._tetra_sums)
+ *   6. bounds      -- bounding box and finiteness of the vertices in one pass (mass/volume.bounding_box)
+ *   7. split_steps -- the splitting integrator's step loop (dynamics/splitting.py)
  *
  * Safety: every index read from an array is bounds-checked before use, sizes are checked against
  * overflow before allocation, NaN coordinates are hashed by their bit pattern (never compared as floats),
  * and the GIL is released around every loop over faces or points (buffers stay pinned by their views).
  *
- * Threads (section 1b): every kernel takes a `threads` count (default 1) and splits its work so that the
- * result is identical whatever that count is; only the speed changes.
+ * Threads (section 1b): edge_census, tetra_sums and bounds take a `threads` count (default 1) and split
+ * their work so that the result is identical whatever that count is; only the speed changes.  The weld
+ * and the shell labels run on one thread (threaded versions were measured and did not pay on two cores).
  */
 
 #define PY_SSIZE_T_CLEAN
@@ -155,8 +158,8 @@ check_indices(const void *faces, int size, size_t count, int64_t n)
  * when all are done (the GIL is released by the caller; no task touches a Python object).  If a thread
  * cannot be started, its share runs on the calling thread instead, so the result never depends on how many
  * threads actually ran: every kernel splits its work by `t` and `nt` only, and combines the parts in a
- * fixed order.  cas32 / load32 / mark_byte are the atomics the concurrent union-find needs; next_ticket
- * hands out work items to whichever thread is free (so a thread slowed by other processes delays no one).
+ * fixed order.  next_ticket hands out work items to whichever thread is free (so a thread slowed by other
+ * processes delays no one).
  * ====================================================================================================== */
 
 #define MAX_THREADS 16
@@ -209,27 +212,6 @@ run_parallel(int nt, task_fn fn, void *ctx)
 }
 
 static inline int32_t
-load32(int32_t *p)
-{
-    /* An aligned 32-bit volatile read is atomic on every Windows target, and the union-find needs no ordering
-     * from it (only the CAS links).  Not InterlockedCompareExchange(p, 0, 0): a locked write on every read made
-     * the threaded union-find ~6x slower than one thread (emulated on Linux, 1.3M faces, 2 threads). */
-    return (int32_t)*(volatile LONG *)p;
-}
-
-static inline int
-cas32(int32_t *p, int32_t expected, int32_t desired)
-{
-    return InterlockedCompareExchange((volatile LONG *)p, (LONG)desired, (LONG)expected) == (LONG)expected;
-}
-
-static inline void
-mark_byte(unsigned char *p)
-{
-    *(volatile unsigned char *)p = 1;     /* MSVC: volatile stores are atomic for a byte */
-}
-
-static inline int32_t
 next_ticket(int32_t *counter)
 {
     return (int32_t)InterlockedIncrement((volatile LONG *)counter) - 1;
@@ -267,25 +249,6 @@ run_parallel(int nt, task_fn fn, void *ctx)
             fn(ctx, t, nt);
         }
     }
-}
-
-static inline int32_t
-load32(int32_t *p)
-{
-    return __atomic_load_n(p, __ATOMIC_ACQUIRE);
-}
-
-static inline int
-cas32(int32_t *p, int32_t expected, int32_t desired)
-{
-    return __atomic_compare_exchange_n(p, &expected, desired, 0, __ATOMIC_ACQ_REL, __ATOMIC_ACQUIRE);
-}
-
-/* Set a flag byte that other threads may set too (the same value: a relaxed atomic store). */
-static inline void
-mark_byte(unsigned char *p)
-{
-    __atomic_store_n(p, (unsigned char)1, __ATOMIC_RELAXED);
 }
 
 /* The counter's value before an atomic increment: hands out work items 0, 1, 2, ... to whichever thread asks. */
@@ -736,6 +699,7 @@ static PyTypeObject WelderType = {
 
 #define SAMPLE 5
 #define CENSUS_PARALLEL_MIN ((size_t)1 << 15)   /* faces below which one thread does everything */
+#define CENSUS_MAX_THREADS 4    /* each thread scans every face twice: more threads cost more than they save */
 
 typedef struct {
     uint64_t key[SAMPLE];   /* u * n + v, u < v: the numpy path's sort key of the undirected edge */
@@ -956,7 +920,8 @@ accel_edge_census(PyObject *self, PyObject *args)
     c->n = n;
     c->off = off;
     c->tgt = tgt;
-    int nt = thread_count(threads, (size_t)m, CENSUS_PARALLEL_MIN);
+    int nt = thread_count(threads < CENSUS_MAX_THREADS ? threads : CENSUS_MAX_THREADS, (size_t)m,
+                          CENSUS_PARALLEL_MIN);
     if ((size_t)nt > n) {
         nt = n ? (int)n : 1;
     }
@@ -1002,18 +967,13 @@ accel_edge_census(PyObject *self, PyObject *args)
 /* ======================================================================================================
  * 4. shell_labels
  *
- * Union-find over vertices: a root is only ever linked under a smaller root, so each component's root ends
- * as its smallest vertex, whatever the order of the unions.  Faces are labelled by their root's rank among
- * the roots that carry faces: shells are numbered by their smallest vertex index, as checks.shell_labels
- * does.
+ * Union-find over vertices (union by smaller index, path halving), so each root is the smallest vertex of
+ * its component.  Faces are labelled by their root's rank among the roots that carry faces: shells are
+ * numbered by their smallest vertex index, as checks.shell_labels does.
  *
- * Threads: chunks of faces, handed to whichever thread is free, are united concurrently on one parent
- * array, lock-free (a link is a compare-and-swap of a root's parent from itself to the smaller root, retried
- * if the root was linked meanwhile; finds halve paths with compare-and-swaps too, which only ever move a
- * pointer up its own tree).  The final forest has the same roots, so the labels are the serial ones.
+ * One thread: a lock-free concurrent version (compare-and-swap links) gave the same labels but was no
+ * faster on two cores (0.74-1.17x of one thread on 5M-10M faces); the pass is short next to the others.
  * ====================================================================================================== */
-
-#define SHELL_PARALLEL_MIN ((size_t)1 << 15)
 
 static inline int32_t
 find_root(int32_t *parent, int32_t x)
@@ -1025,131 +985,12 @@ find_root(int32_t *parent, int32_t x)
     return x;
 }
 
-static inline int32_t
-find_root_shared(int32_t *parent, int32_t x)
-{
-    for (;;) {
-        int32_t p = load32(&parent[x]);
-        if (p == x) {
-            return x;
-        }
-        int32_t g = load32(&parent[p]);
-        if (g != p) {
-            cas32(&parent[x], p, g);      /* path halving; losing the race is harmless */
-        }
-        x = g;
-    }
-}
-
-#define SHELL_CHUNK ((size_t)1 << 16)          /* faces per work item of the threaded phases */
-
-typedef struct {
-    const void *f;
-    int size;
-    size_t m;
-    int32_t *parent;
-    unsigned char *carries;
-    void *out;
-    int out_size;
-    int32_t next[3];       /* next_ticket counters of the union, mark and label phases */
-} ShellTask;
-
-/* The faces [lo, hi) of the next work item of phase `phase`, or 0 when none is left. */
-static int
-shell_chunk(ShellTask *s, int phase, size_t *lo, size_t *hi)
-{
-    size_t c = (size_t)next_ticket(&s->next[phase]);
-    if (c * SHELL_CHUNK >= s->m) {
-        return 0;
-    }
-    *lo = c * SHELL_CHUNK;
-    *hi = *lo + SHELL_CHUNK < s->m ? *lo + SHELL_CHUNK : s->m;
-    return 1;
-}
-
-static void
-shell_union_task(void *ctx, int t, int nt)
-{
-    ShellTask *s = (ShellTask *)ctx;
-    int32_t *parent = s->parent;
-    size_t lo, hi;
-    if (nt == 1) {
-        for (size_t i = 0; i < s->m; i++) {
-            int32_t a = find_root(parent, (int32_t)index_at(s->f, s->size, 3 * i));
-            for (int k = 1; k < 3; k++) {
-                int32_t b = find_root(parent, (int32_t)index_at(s->f, s->size, 3 * i + k));
-                if (a < b) {
-                    parent[b] = a;
-                }
-                else if (b < a) {
-                    parent[a] = b;
-                    a = b;
-                }
-            }
-        }
-        return;
-    }
-    while (shell_chunk(s, 0, &lo, &hi)) {
-        for (size_t i = lo; i < hi; i++) {
-            int32_t a0 = (int32_t)index_at(s->f, s->size, 3 * i);
-            for (int k = 1; k < 3; k++) {
-                int32_t a = a0, b = (int32_t)index_at(s->f, s->size, 3 * i + k);
-                for (;;) {
-                    a = find_root_shared(parent, a);
-                    b = find_root_shared(parent, b);
-                    if (a == b) {
-                        break;
-                    }
-                    int32_t hi = a > b ? a : b, lo = a > b ? b : a;   /* not `small`: a macro of windows.h */
-                    if (cas32(&parent[hi], hi, lo)) {
-                        break;
-                    }
-                }
-            }
-        }
-    }
-}
-
-static void
-shell_mark_task(void *ctx, int t, int nt)
-{
-    ShellTask *s = (ShellTask *)ctx;
-    size_t lo, hi;
-    while (shell_chunk(s, 1, &lo, &hi)) {
-        for (size_t i = lo; i < hi; i++) {
-            int32_t r = nt == 1 ? find_root(s->parent, (int32_t)index_at(s->f, s->size, 3 * i))
-                                : find_root_shared(s->parent, (int32_t)index_at(s->f, s->size, 3 * i));
-            mark_byte(&s->carries[r]);
-        }
-    }
-}
-
-static void
-shell_label_task(void *ctx, int t, int nt)
-{
-    ShellTask *s = (ShellTask *)ctx;
-    size_t lo, hi;
-    while (shell_chunk(s, 2, &lo, &hi)) {
-        for (size_t i = lo; i < hi; i++) {
-            int64_t label = s->parent[index_at(s->f, s->size, 3 * i)];
-            if (s->out_size == 8) {
-                ((int64_t *)s->out)[i] = label;
-            }
-            else {
-                ((int32_t *)s->out)[i] = (int32_t)label;
-            }
-        }
-    }
-}
-
 static PyObject *
 accel_shell_labels(PyObject *self, PyObject *args)
 {
     PyObject *faces_obj, *out_obj;
     Py_ssize_t n_vertices;
-    int threads = 1;
-    if (!PyArg_ParseTuple(args, "OnO|i", &faces_obj, &n_vertices, &out_obj, &threads)
-        || check_vertex_count(n_vertices) < 0) {
+    if (!PyArg_ParseTuple(args, "OnO", &faces_obj, &n_vertices, &out_obj) || check_vertex_count(n_vertices) < 0) {
         return NULL;
     }
     Py_buffer fv, out;
@@ -1180,24 +1021,45 @@ accel_shell_labels(PyObject *self, PyObject *args)
         goto fail;
     }
     int64_t count = 0;
-    ShellTask st = {fv.buf, size, (size_t)m, parent, carries, out.buf, out_size, {0, 0, 0}};
-    int nt = thread_count(threads, (size_t)m, SHELL_PARALLEL_MIN);
     Py_BEGIN_ALLOW_THREADS
+    const void *f = fv.buf;
     for (size_t v = 0; v < n; v++) {
         parent[v] = (int32_t)v;
     }
-    run_parallel(nt, shell_union_task, &st);
-    run_parallel(nt, shell_mark_task, &st);
+    for (size_t i = 0; i < (size_t)m; i++) {
+        int32_t a = find_root(parent, (int32_t)index_at(f, size, 3 * i));
+        for (int k = 1; k < 3; k++) {
+            int32_t b = find_root(parent, (int32_t)index_at(f, size, 3 * i + k));
+            if (a < b) {
+                parent[b] = a;
+            }
+            else if (b < a) {
+                parent[a] = b;
+                a = b;
+            }
+        }
+    }
+    for (size_t i = 0; i < (size_t)m; i++) {
+        carries[find_root(parent, (int32_t)index_at(f, size, 3 * i))] = 1;
+    }
     /* roots in index order get ranks 0..count-1; every vertex then maps to its root's rank */
     for (size_t v = 0; v < n; v++) {
         if (parent[v] == (int32_t)v) {
             parent[v] = carries[v] ? (int32_t)count++ : -1;
         }
         else {
-            parent[v] = parent[parent[v]];   /* the parent is smaller than v: already its root's rank */
+            parent[v] = parent[parent[v]];   /* the root is smaller than v: already a rank */
         }
     }
-    run_parallel(nt, shell_label_task, &st);
+    for (size_t i = 0; i < (size_t)m; i++) {
+        int64_t label = parent[index_at(f, size, 3 * i)];
+        if (out_size == 8) {
+            ((int64_t *)out.buf)[i] = label;
+        }
+        else {
+            ((int32_t *)out.buf)[i] = (int32_t)label;
+        }
+    }
     Py_END_ALLOW_THREADS
     free(parent);
     free(carries);
@@ -1542,7 +1404,7 @@ static PyMethodDef accel_methods[] = {
      "sample_nonmanifold, sample_misoriented)\n\nEdge census of (m, 3) int32/int64 faces; each sample is a "
      "list of up to 5 (u, v) vertex pairs, u < v, smallest u * n + v first."},
     {"shell_labels", accel_shell_labels, METH_VARARGS,
-     "shell_labels(faces, n_vertices, out, threads=1) -> count\n\nWrite each face's shell (connected by shared "
+     "shell_labels(faces, n_vertices, out) -> count\n\nWrite each face's shell (connected by shared "
      "vertices), numbered by the shell's smallest vertex index, into `out` (m,) int32/int64."},
     {"tetra_sums", accel_tetra_sums, METH_VARARGS,
      "tetra_sums(vertices, faces, origin, area_floor, labels, sums, zero, threads=1)\n\nCompensated signed-tetrahedron "

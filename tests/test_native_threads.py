@@ -1,9 +1,8 @@
 """The C kernels' threads: every kernel must give the same result whatever its thread count.
 
-The edge census splits start vertices; the union-find runs concurrently with compare-and-swap links; the
-tetrahedron sums add a fixed number of lanes in lane order; the bounds split rows.  Each is compared here, on
-meshes above the kernels' thresholds for using threads, with its own one-thread result (bit for bit) and with
-the numpy reference.  The welder runs on one thread; its recent-point cache is checked on the same mesh.
+The edge census splits start vertices; the tetrahedron sums add a fixed number of lanes in lane order; the
+bounds split rows.  Each is compared here, on meshes above the kernels' thresholds for using threads, with its
+own one-thread result (bit for bit) and with the numpy reference.  The welder and the shell labels run on one thread; they are checked on the same mesh.
 """
 
 import numpy as np
@@ -86,30 +85,22 @@ def test_edge_census_threads_match_numpy(monkeypatch, damaged):
     np.testing.assert_array_equal(c.sample, ref.sample)
 
 
-def test_shell_labels_are_independent_of_threads(lib, monkeypatch, damaged):
+def test_shell_labels_match_numpy_on_a_large_mesh(lib, monkeypatch, damaged):
     v, f = damaged
     ref = np.empty(len(f), dtype=np.int64)
-    assert lib.shell_labels(f, len(v), ref, 1) == 5
-    for threads in THREADS:
-        out = np.empty(len(f), dtype=np.int64)
-        assert lib.shell_labels(f, len(v), out, threads) == 5
-        np.testing.assert_array_equal(out, ref)
+    assert lib.shell_labels(f, len(v), ref) == 5
     monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
     labels, count = shell_labels(f, len(v))
     assert count == 5
     np.testing.assert_array_equal(labels, ref)
 
 
-def test_shell_labels_many_small_shells_with_threads(lib):
-    """100,000 separate triangles in shuffled order: the concurrent unions must not merge any two."""
+def test_shell_labels_many_small_shells(lib):
+    """100,000 separate triangles in shuffled order, numbered by the smallest vertex of each."""
     rng = np.random.default_rng(3)
     f = rng.permutation(300_000).reshape(-1, 3).astype(np.int32)
     ref = np.empty(len(f), dtype=np.int64)
-    out = np.empty(len(f), dtype=np.int64)
-    assert lib.shell_labels(f, 300_000, ref, 1) == 100_000
-    assert lib.shell_labels(f, 300_000, out, 4) == 100_000
-    np.testing.assert_array_equal(out, ref)
-    # numbered by the smallest vertex of each triangle
+    assert lib.shell_labels(f, 300_000, ref) == 100_000
     np.testing.assert_array_equal(np.argsort(np.argsort(f.min(axis=1))), ref)
 
 
@@ -123,7 +114,7 @@ def _sums(lib, v, f, labels, n_labels, threads):
 def test_tetra_sums_are_bitwise_independent_of_threads(lib, damaged):
     v, f = damaged
     labels = np.empty(len(f), dtype=np.int64)
-    n = lib.shell_labels(f, len(v), labels, 1)
+    n = lib.shell_labels(f, len(v), labels)
     for lab, n_labels in ((None, 1), (labels, n)):
         ref = _sums(lib, v, f, lab, n_labels, 1)
         for threads in THREADS:

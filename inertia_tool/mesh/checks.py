@@ -263,7 +263,7 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     lib = accel()
     if lib is not None:      # union-find over vertices, the same numbering
         labels = np.empty(m, dtype=np.intp)
-        count = lib.shell_labels(faces_for_c(faces), int(n_vertices), labels, threads())
+        count = lib.shell_labels(faces_for_c(faces), int(n_vertices), labels)
         return labels, int(count)
     from scipy.sparse import coo_matrix     # the numpy path only: scipy.sparse costs ~0.2 s to import
     from scipy.sparse.csgraph import connected_components
