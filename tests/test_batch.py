@@ -331,11 +331,11 @@ def _alive(pid):
 _SLOW_BATCH = """
 import sys, time
 import inertia_tool.batch.runner as b
-real = b.analyze_file
-def slow(path, options, sha256=None):
+real = b._analyze
+def slow(*args):
     time.sleep(float(sys.argv[1]))
-    return real(path, options, sha256)
-b.analyze_file = slow
+    return real(*args)
+b._analyze = slow
 from inertia_tool.cli import main
 sys.exit(main(sys.argv[2:]))
 """

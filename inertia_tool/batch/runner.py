@@ -27,9 +27,10 @@ import platform
 import sys
 import time
 import warnings
+from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, field
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -39,8 +40,9 @@ from ..errors import InertiaToolError, InertiaToolWarning, MeshReadError, UsageE
 from ..mesh.options import LoadOptions
 from ..mesh.read import SUPPORTED_SUFFIXES, os_error_reason
 from ..mass.pipeline import mass_properties, resolve_density
+from .chunks import DASK_CHUNK_SECONDS, POOL_CHUNK_SECONDS, ChunkSizer, DaskTasks, PoolTasks
 
-__all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "analyze_file", "discover_files",
+__all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "analyze_chunk", "analyze_file", "discover_files",
            "file_sha256", "run_batch", "DONE_STATUSES"]
 
 #: Schema identifier written in every row (``schema`` column); bump it when columns change meaning.
@@ -202,10 +204,15 @@ def _finite(x) -> float | None:
     return v if math.isfinite(v) else None
 
 
-def _empty_row(path: str, sha256: str | None, options: BatchOptions) -> dict:
+def _worker_name() -> str:
+    return f"{platform.node()}:{os.getpid()}"
+
+
+def _empty_row(path: str, sha256: str | None, options: BatchOptions, key: str | None = None,
+               worker: str | None = None) -> dict:
     row = dict.fromkeys(ROW_FIELDS)
-    row.update(schema=SCHEMA, path=path, sha256=sha256, options_key=options.key(), units=options.load.units or "m",
-               worker=f"{platform.node()}:{os.getpid()}")
+    row.update(schema=SCHEMA, path=path, sha256=sha256, options_key=key or options.key(),
+               units=options.load.units or "m", worker=worker or _worker_name())
     return row
 
 
@@ -229,8 +236,13 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
         ``" | "``; ``seconds`` is the time
         spent on this file.
     """
+    return _analyze(path, options, sha256, options.key(), _worker_name())
+
+
+def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, worker: str) -> dict:
+    """:func:`analyze_file` with the options key and the worker name computed once by the caller."""
     start = time.perf_counter()
-    row = _empty_row(path, sha256, options)
+    row = _empty_row(path, sha256, options, key, worker)
     try:
         if row["sha256"] is None:
             try:
@@ -267,6 +279,28 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
         row.update(status="internal_error", error_type=type(exc).__name__, error=_one_line(exc))
     row["seconds"] = round(time.perf_counter() - start, 6)
     return row
+
+
+def analyze_chunk(chunk: Sequence[tuple[str, str | None]], options: BatchOptions) -> list[dict]:
+    """The rows of a chunk of files, analysed one after the other in this process; never raises for a file.
+
+    The task a worker runs for :func:`run_batch` (and the one to submit to any other executor): one task per
+    chunk instead of one per file, so the executor's per-task cost is paid once per chunk.
+
+    Parameters
+    ----------
+    chunk : sequence of (str, str or None)
+        ``(path, sha256)`` pairs; a ``None`` hash is computed here, from the file as it is read now.
+    options : BatchOptions
+
+    Returns
+    -------
+    list of dict
+        One row per file (:func:`analyze_file`), in the order of ``chunk``.
+    """
+    key = options.key()
+    worker = _worker_name()
+    return [_analyze(path, options, digest, key, worker) for path, digest in chunk]
 
 
 #: Seconds between the checks of the pool workers' watchdog that their parent (the batch run) is alive.
@@ -346,9 +380,9 @@ def _as_float(x) -> float:
 
 def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[dict], None], *,
               previous_rows: Iterable[dict] = (), jobs: int = 1, executor: cf.Executor | None = None,
-              progress: Callable[[int, int, int, int], None] | None = None,
-              max_in_flight: int | None = None) -> BatchSummary:
-    """Analyse ``files`` and hand each row to ``write_row`` as soon as it is ready (completion order).
+              client: Any = None, progress: Callable[[int, int, int, int], None] | None = None,
+              max_in_flight: int | None = None, chunk_seconds: float | None = None) -> BatchSummary:
+    """Analyse ``files`` and hand each row to ``write_row`` as soon as it is back (order of completion).
 
     Parameters
     ----------
@@ -360,26 +394,45 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
     previous_rows : iterable of dict
         Rows of an earlier run (read back from the output); files done there are skipped.
     jobs : int
-        1 runs in this process; N > 1 uses a pool of N processes (``ProcessPoolExecutor``).
+        1 runs in this process, one file after the other; N > 1 uses a pool of N processes
+        (``ProcessPoolExecutor``) fed with chunks of files (:mod:`inertia_tool.batch.chunks`).
     executor : concurrent.futures.Executor, optional
-        Run on this executor instead (e.g. a Dask ``Client.get_executor()``); ``jobs`` then only sets the
-        number of files in flight.
+        Run the chunks on this executor instead; ``jobs`` is then its number of workers.
+    client : dask.distributed.Client, optional
+        Run the chunks on this Dask cluster (a LocalCluster's client or one connected to a remote scheduler:
+        the same code path); the number of workers is asked of the scheduler.
     progress : callable(done, total, ok, failed), optional
         Called after every file (skipped ones included, at the start).
     max_in_flight : int, optional
-        Files submitted but not finished at most (default ``4 * jobs``), so memory stays bounded for huge
-        batches.
+        Chunks submitted but not finished at most (default two per worker: one running, one queued), so
+        memory stays bounded for huge batches.
+    chunk_seconds : float, optional
+        Analysis time aimed at per chunk, s (default :data:`~inertia_tool.batch.chunks.POOL_CHUNK_SECONDS`
+        for a process pool or executor, :data:`~inertia_tool.batch.chunks.DASK_CHUNK_SECONDS` for Dask).
 
     Returns
     -------
     BatchSummary
+
+    Notes
+    -----
+    Rows of a chunk arrive together, in the chunk's order; chunks arrive in order of completion.  A chunk whose
+    task fails as a whole (its worker process died, the cluster lost it) is split and its files run again one
+    per task; a file that fails alone gets an ``internal_error`` row (retried on resume).  Each file gets
+    exactly one row.
+
+    The SHA-256 that decides skipping is computed here only for files that have a done row of the same path
+    and options in ``previous_rows``; for the others nothing can be skipped and the worker hashes the file.
     """
     if jobs < 1:
         raise UsageError(f"Expected `jobs` >= 1, got {jobs}")
+    if executor is not None and client is not None:
+        raise UsageError("Give at most one of `executor` and `client`")
     options.validate()
     start = time.perf_counter()
     done = _done_keys(previous_rows)
     key = options.key()
+    candidates = {(path, options_key) for path, _, options_key in done}
     todo: list[tuple[str, str | None]] = []
     skipped = skipped_failed = 0
     total_mass = 0.0
@@ -387,10 +440,12 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
     ok = failed = 0
     total = len(files)
     for path in files:
-        try:
-            digest = file_sha256(path)
-        except OSError:
-            digest = None                                      # analyze_file writes the error row
+        digest = None
+        if (path, key) in candidates:                          # a done row exists: is the content the same?
+            try:
+                digest = file_sha256(path)
+            except OSError:
+                digest = None                                  # the worker writes the error row
         prev = done.get((path, digest, key)) if digest is not None else None
         if prev is not None:
             skipped += 1
@@ -415,49 +470,62 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
         if progress:
             progress(skipped + ok + failed, total, ok, failed)
 
-    if executor is None and jobs == 1:
+    if executor is None and client is None and jobs == 1:
+        worker = _worker_name()
         for path, digest in todo:
-            record(analyze_file(path, options, digest))
+            record(_analyze(path, options, digest, key, worker))
     else:
-        own = executor is None
-        pool: cf.Executor = _process_pool(jobs) if executor is None else executor
-        limit = max_in_flight or 4 * jobs
+        tasks: PoolTasks | DaskTasks
+        if client is not None:
+            tasks = DaskTasks(client)
+        elif executor is not None:
+            tasks = PoolTasks(executor=executor, workers=jobs)
+        else:
+            tasks = PoolTasks(make_pool=lambda: _process_pool(jobs), workers=jobs)
+        target = chunk_seconds or (DASK_CHUNK_SECONDS if client is not None else POOL_CHUNK_SECONDS)
         try:
-            pending: dict = {}
-            queue = iter(todo)
-            exhausted = False
-            # bounded: each pass submits or completes at least one of the len(todo) files
-            for _ in range(2 * len(todo) + 2):
-                while not exhausted and len(pending) < limit:
-                    nxt = next(queue, None)
-                    if nxt is None:
-                        exhausted = True
-                        break
-                    try:
-                        fut = pool.submit(analyze_file, nxt[0], options, nxt[1])
-                    except cf.process.BrokenProcessPool:
-                        if not own:
-                            raise
-                        # a worker died hard (e.g. killed for memory): start a fresh pool and go on
-                        pool.shutdown(wait=False, cancel_futures=True)
-                        pool = _process_pool(jobs)
-                        fut = pool.submit(analyze_file, nxt[0], options, nxt[1])
-                    pending[fut] = nxt
-                if not pending:
-                    break
-                finished, _ = cf.wait(list(pending), return_when=cf.FIRST_COMPLETED)
-                for fut in finished:
-                    path, digest = pending.pop(fut)
-                    try:
-                        row = fut.result()
-                    except Exception as exc:  # noqa: BLE001 - a dead worker is a failed file, not a dead batch
-                        row = _empty_row(path, digest, options)
-                        row.update(status="internal_error", error_type=type(exc).__name__,
-                                   error=_one_line(exc) or "worker failed")
-                    record(row)
+            _run_chunks(todo, options, tasks, ChunkSizer(target), record, max_in_flight)
         finally:
-            if own:
-                pool.shutdown(wait=True, cancel_futures=True)
+            tasks.close()
     return BatchSummary(ok=ok, failed=failed, skipped=skipped, skipped_failed=skipped_failed,
                         total_mass=total_mass,
                         seconds=time.perf_counter() - start, failures=tuple(failures))
+
+
+def _run_chunks(todo: list[tuple[str, str | None]], options: BatchOptions, tasks: PoolTasks | DaskTasks,
+                sizer: ChunkSizer, record: Callable[[dict], None], max_in_flight: int | None) -> None:
+    """Feed ``todo`` to ``tasks`` in chunks and ``record`` every row as its chunk comes back.
+
+    A chunk that fails as a whole is split into single files put back at the front of the queue; a single
+    file that fails gets an ``internal_error`` row.  Bounded: every pass hands out or takes back at least one
+    chunk, there are at most ``2 * len(todo)`` chunks (each file is in at most one chunk and one retry).
+    """
+    queue: deque[list[tuple[str, str | None]]] = deque()     # single files to retry, first
+    position = 0
+    for _ in range(4 * len(todo) + 2):
+        workers = tasks.workers
+        limit = max_in_flight or 2 * workers
+        while tasks.in_flight() < limit and (queue or position < len(todo)):
+            if queue:
+                chunk = queue.popleft()
+            else:
+                size = sizer.next_size(len(todo) - position, workers)
+                chunk = todo[position:position + size]
+                position += size
+            tasks.submit(analyze_chunk, chunk, options)
+        if not tasks.in_flight():
+            return
+        for chunk, rows, error in tasks.wait():
+            if error is None:
+                sizer.observe(len(rows), sum(_as_float(r.get("seconds")) for r in rows))
+                for row in rows:
+                    record(row)
+            elif len(chunk) > 1:
+                queue.extend([item] for item in chunk)
+            else:
+                path, digest = chunk[0]
+                row = _empty_row(path, digest, options)
+                row.update(status="internal_error", error_type=type(error).__name__,
+                           error=_one_line(error) or "worker failed")
+                record(row)
+    raise RuntimeError("batch: the chunk loop did not finish within its bound")          # pragma: no cover
