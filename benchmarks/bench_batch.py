@@ -1,14 +1,21 @@
-"""Throughput of ``inertia-tool batch``: files/s with 1 process, 2 processes and a Dask LocalCluster(2).
+"""Throughput of ``inertia-tool batch``: files/s with 1 process, 2 processes and a Dask LocalCluster(2), in one run.
 
-Generates N binary STL files (default 200: icospheres of 5,120-20,480 triangles, boxes, tori of 2k-18k,
-cylinders of 1k-4k; 0.6 kB-1 MB)
-in a temporary directory, then runs the same batch three ways, each into a fresh JSONL file, and prints files/s
-and the speed-up over one process.  The Dask cluster's start-up is timed separately (not in files/s).
+Two catalogues, each written as binary STL files in a temporary directory, each run three ways into fresh JSONL
+files (the real writer: lock, one ``write`` per row, fsync at most once a second):
 
-    python benchmarks/bench_batch.py [--files 200] [--repeat 1]
+- ``small``: 1,000 small parts, the typical parts-catalogue mix: boxes (12 triangles), icospheres of
+  80-1,280, cylinders of 64-4,800 and tori of 256-3,072 triangles (the script prints the range and median);
+- ``mix``: the 200 larger meshes of issue 8 (icospheres of 5,120-20,480 triangles, boxes, tori of 2k-18k,
+  cylinders of 1k-4k; 0.6 kB-1 MB).
 
-Run from the repository root (it puts the repository on sys.path).  The machine it ran on matters: the README
-numbers are from the project's 2-core machine.
+It prints files/s and the ratio to one process for each (best of ``--repeat`` rounds, each round running every
+configuration in turn), with the load average before and after (the machine is shared: other work slows the
+parallel runs).  The Dask LocalCluster is started once, before the rounds; its start-up (worker processes,
+engine imports) is timed separately, not in files/s.
+
+    python benchmarks/bench_batch.py [--set small|mix|both] [--small 1000] [--files 200] [--repeat 3]
+
+Run from the repository root (it puts the repository on sys.path).
 """
 
 from __future__ import annotations
@@ -25,7 +32,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import numpy as np  # noqa: E402
 import trimesh  # noqa: E402
 
-from inertia_tool.mesh import LoadOptions
+from inertia_tool.mesh import LoadOptions  # noqa: E402
 from inertia_tool.batch.runner import BatchOptions, discover_files, run_batch  # noqa: E402
 from inertia_tool.batch.rows import open_results  # noqa: E402
 
@@ -40,10 +47,10 @@ def _write_stl(path, mesh):
         fh.write(rec.tobytes())
 
 
-def make_meshes(directory: str, count: int, seed: int = 0) -> int:
-    """Write ``count`` meshes; return the total number of triangles."""
+def make_meshes(directory: str, count: int, seed: int = 0) -> list[int]:
+    """Write ``count`` meshes of the ``mix`` catalogue; return their numbers of triangles."""
     rng = np.random.default_rng(seed)
-    faces = 0
+    faces = []
     for k in range(count):
         kind = k % 4
         if kind == 0:
@@ -59,7 +66,31 @@ def make_meshes(directory: str, count: int, seed: int = 0) -> int:
                                           sections=int(rng.integers(256, 1024)))
         m.apply_translation(rng.uniform(-100, 100, 3))
         _write_stl(os.path.join(directory, f"part{k:04d}.stl"), m)
-        faces += len(m.faces)
+        faces.append(len(m.faces))
+    return faces
+
+
+def make_small_meshes(directory: str, count: int, seed: int = 1) -> list[int]:
+    """Write ``count`` meshes of the ``small`` catalogue (12-4,800 triangles); return their numbers of
+    triangles."""
+    rng = np.random.default_rng(seed)
+    faces = []
+    for k in range(count):
+        kind = k % 4
+        if kind == 0:
+            m = trimesh.creation.box(rng.uniform(5, 80, 3))
+        elif kind == 1:
+            m = trimesh.creation.icosphere(subdivisions=int(rng.integers(1, 4)), radius=float(rng.uniform(5, 50)))
+        elif kind == 2:
+            m = trimesh.creation.cylinder(radius=float(rng.uniform(3, 30)), height=float(rng.uniform(5, 90)),
+                                          sections=int(rng.integers(16, 1201)))
+        else:
+            m = trimesh.creation.torus(float(rng.uniform(20, 40)), float(rng.uniform(3, 10)),
+                                       major_sections=int(rng.integers(16, 65)),
+                                       minor_sections=int(rng.integers(8, 25)))
+        m.apply_translation(rng.uniform(-100, 100, 3))
+        _write_stl(os.path.join(directory, f"small{k:04d}.stl"), m)
+        faces.append(len(m.faces))
     return faces
 
 
@@ -71,45 +102,64 @@ def _run(files, out, **kw):
     return summary.seconds
 
 
+def _catalogue(tmp, name, make, count):
+    directory = os.path.join(tmp, name)
+    os.mkdir(directory)
+    faces = make(directory, count)
+    files = discover_files(directory)
+    size = sum(os.path.getsize(f) for f in files)
+    print(f"{name}: {len(files)} STL files, {sum(faces):,} triangles ({min(faces):,}-{max(faces):,}, median "
+          f"{int(np.median(faces)):,} per file), {size / 1e6:.1f} MB")
+    return files
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--files", type=int, default=200)
-    ap.add_argument("--repeat", type=int, default=1, help="runs of each configuration (best is reported)")
+    ap.add_argument("--set", choices=["small", "mix", "both"], default="both")
+    ap.add_argument("--small", type=int, default=1000, help="files of the small catalogue")
+    ap.add_argument("--files", type=int, default=200, help="files of the mix catalogue")
+    ap.add_argument("--repeat", type=int, default=3, help="rounds of every configuration (the best is reported)")
     args = ap.parse_args()
+    print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, Python "
+          f"{platform.python_version()}; load average before {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     with tempfile.TemporaryDirectory() as tmp:
-        mesh_dir = os.path.join(tmp, "meshes")
-        os.mkdir(mesh_dir)
-        faces = make_meshes(mesh_dir, args.files)
-        files = discover_files(mesh_dir)
-        size = sum(os.path.getsize(f) for f in files)
-        print(f"{len(files)} STL files, {faces:,} triangles, {size / 1e6:.1f} MB; "
-              f"{platform.processor() or platform.machine()}, "
-              f"{os.cpu_count()} CPUs, Python {platform.python_version()}, load average before "
-              f"{os.getloadavg()[0]:.2f} (other work on the machine slows the parallel runs)")
-        results = {}
-        for label, kw in [("1 process (in-process)", dict(jobs=1)),
-                          ("2 processes (ProcessPoolExecutor)", dict(jobs=2))]:
-            results[label] = min(_run(files, os.path.join(tmp, f"{label[:1]}_{r}.jsonl"), **kw)
-                                 for r in range(args.repeat))
+        catalogues = {}
+        if args.set in ("small", "both"):
+            catalogues["small"] = _catalogue(tmp, "small", make_small_meshes, args.small)
+        if args.set in ("mix", "both"):
+            catalogues["mix"] = _catalogue(tmp, "mix", make_meshes, args.files)
+        cluster, startup = None, None
         try:
-            from inertia_tool.cli.batch import dask_executor
-            t0 = time.perf_counter()
-            executor, shutdown = dask_executor("local", 2)
-            startup = time.perf_counter() - t0
-            try:
-                results["Dask LocalCluster(2 workers)"] = min(
-                    _run(files, os.path.join(tmp, f"d_{r}.jsonl"), jobs=2, executor=executor)
-                    for r in range(args.repeat))
-            finally:
-                shutdown()
+            from inertia_tool.batch.cluster import connect_dask
         except ImportError:
-            startup = None
-        base = results["1 process (in-process)"]
-        print(f"{'configuration':36s} {'seconds':>8s} {'files/s':>8s} {'speed-up':>8s}")
-        for label, sec in results.items():
-            print(f"{label:36s} {sec:8.2f} {len(files) / sec:8.1f} {base / sec:8.2f}")
+            print("(dask.distributed is not installed: no Dask rows)")
+        else:
+            t0 = time.perf_counter()
+            cluster = connect_dask("local", 2)
+            startup = time.perf_counter() - t0
+        configs = [("1 process (in-process)", dict(jobs=1)), ("2 processes (ProcessPoolExecutor)", dict(jobs=2))]
+        if cluster is not None:
+            configs.append(("Dask LocalCluster(2 workers)", dict(client=cluster.client)))
+        results: dict = {}
+        try:
+            # rounds of every configuration in turn, so that a change in the machine's load hits all of them
+            for r in range(args.repeat):
+                for name, files in catalogues.items():
+                    for label, kw in configs:
+                        sec = _run(files, os.path.join(tmp, f"{name}_{label[:1]}_{r}.jsonl"), **kw)
+                        results[name, label] = min(sec, results.get((name, label), sec))
+        finally:
+            if cluster is not None:
+                cluster.close()
+        print(f"{'catalogue':9s} {'configuration':36s} {'seconds':>8s} {'files/s':>8s} {'ratio':>6s}")
+        for name, files in catalogues.items():
+            base = results[name, "1 process (in-process)"]
+            for (n, label), sec in results.items():
+                if n == name:
+                    print(f"{name:9s} {label:36s} {sec:8.2f} {len(files) / sec:8.1f} {base / sec:6.2f}")
         if startup is not None:
-            print(f"(Dask LocalCluster start-up, not included above: {startup:.2f} s)")
+            print(f"(Dask LocalCluster start-up with the workers' warm-up, not included above: {startup:.2f} s)")
+        print(f"load average after {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 
 if __name__ == "__main__":

@@ -1,4 +1,5 @@
-"""``batch --dask local``: the same rows from a Dask LocalCluster of 2 worker processes."""
+"""``batch --dask local``: the same rows from a Dask LocalCluster of 2 worker processes, in chunks streamed back
+as they complete (the code path of a remote scheduler too: only the Client differs)."""
 
 import json
 import os
@@ -31,19 +32,21 @@ def _strip(rows):
     return sorted(json.dumps({k: v for k, v in r.items() if k not in ("seconds", "worker")}) for r in rows)
 
 
-@pytest.mark.slow
-def test_local_cluster_matches_in_process_rows(meshes):
-    from inertia_tool.cli.batch import dask_executor
+@pytest.fixture(scope="module")
+def cluster():
+    from inertia_tool.batch.cluster import connect_dask
 
+    with connect_dask("local", 2) as c:
+        yield c
+
+
+@pytest.mark.slow
+def test_local_cluster_matches_in_process_rows(meshes, cluster):
     files = discover_files(meshes)
     local_rows, dask_rows = [], []
     run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1240.0), local_rows.append)
-    executor, shutdown = dask_executor("local", 2)
-    try:
-        summary = run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1240.0), dask_rows.append, jobs=2,
-                            executor=executor)
-    finally:
-        shutdown()
+    summary = run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1240.0), dask_rows.append,
+                        client=cluster.client)
     assert (summary.ok, summary.failed) == (6, 1)
     assert _strip(dask_rows) == _strip(local_rows)
     workers = {r["worker"] for r in dask_rows}
@@ -66,3 +69,38 @@ def test_cli_dask_local_resumes_a_process_pool_run(meshes, tmp_path, capsys):
     with open_results(out) as r:
         rows = r.previous_rows
     assert len(rows) == 7 and np.isfinite([r["mass"] for r in rows if r["status"] == "ok"]).all()
+
+
+@pytest.mark.slow
+def test_dask_chunks_every_file_once_on_both_workers(tmp_path, cluster, monkeypatch):
+    """60 boxes in chunks (a tiny target so that chunks grow and shrink): every file exactly once, chunks of
+    more than one file, both workers used, the numbers right."""
+    import inertia_tool.batch.chunks as chunks_mod
+
+    d = tmp_path / "boxes"
+    d.mkdir()
+    box = trimesh.creation.box((1.0, 1.0, 1.0))
+    for k in range(60):
+        write_binary_stl(d / f"b{k:02d}.stl", np.asarray(box.vertices) * (1 + k), box.faces)
+    files = discover_files(d)
+    sizes = []
+    real_submit = chunks_mod.DaskTasks.submit
+    monkeypatch.setattr(chunks_mod.DaskTasks, "submit",
+                        lambda self, fn, chunk, *a: (sizes.append(len(chunk)), real_submit(self, fn, chunk, *a)))
+    rows = []
+    summary = run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1000.0), rows.append,
+                        client=cluster.client, chunk_seconds=0.01)
+    assert summary.ok == 60 and sorted(r["path"] for r in rows) == files
+    assert sum(sizes) == 60 and max(sizes) > 1 and sizes[0] == 1
+    assert len({r["worker"] for r in rows}) == 2
+    for r in rows:
+        side = (1 + int(os.path.basename(r["path"])[1:3])) * 1e-3
+        assert r["mass"] == pytest.approx(1000.0 * side ** 3, rel=1e-9)
+
+
+def test_connect_refuses_an_address_without_a_scheduler():
+    from inertia_tool.batch.cluster import connect_dask
+    from inertia_tool.errors import UsageError
+
+    with pytest.raises(UsageError, match="Cannot connect to a Dask scheduler at tcp://127.0.0.1:9"):
+        connect_dask("tcp://127.0.0.1:9", timeout=1.0)

@@ -5,8 +5,9 @@ One task per file makes the per-task cost of the executor the bottleneck on smal
 hands out *chunks*: lists of files analysed one after the other by one worker, which returns their rows
 together.  :class:`ChunkSizer` decides how many files go into the next chunk from the analysis time the workers
 measured (the rows' ``seconds``): the first chunks hold one file each (nothing is measured yet), later ones
-hold ``target_seconds / seconds_per_file`` files, growing at most fourfold per chunk, and never more than a
-share of the files left so that the last chunks spread over every worker.
+hold ``target_seconds / seconds_per_file`` files, growing at most fourfold per chunk, and no more than half a
+fair share of the files left (so that the last chunks spread over every worker) unless that is less than a
+tenth of the target.
 
 :class:`PoolTasks` (any ``concurrent.futures`` executor, by default a process pool of this machine) and
 :class:`DaskTasks` (a ``dask.distributed`` client: a LocalCluster or a remote scheduler, the same code) give the
@@ -31,7 +32,7 @@ DASK_CHUNK_SECONDS = 0.5
 
 #: A finished chunk: ``(chunk, rows, None)`` or ``(chunk, None, exception)`` when the task itself failed (its
 #: worker died, the cluster lost it); a chunk is a list of ``(path, sha256 or None)``.
-Finished = tuple
+Finished = tuple[list, "list[dict] | None", "BaseException | None"]
 
 
 class ChunkSizer:
@@ -78,10 +79,13 @@ class ChunkSizer:
         if self.seconds_per_file is None:
             size = 1
         else:
-            wanted = self.target_seconds / max(self.seconds_per_file, 1e-9)
-            size = int(min(wanted, self.growth * self.largest, self.max_files))
-        # the tail: at most half of a fair share, so that every worker gets some of the last files
-        size = max(1, min(size, remaining // (2 * max(workers, 1)) or 1))
+            per_file = max(self.seconds_per_file, 1e-9)
+            size = int(min(self.target_seconds / per_file, self.growth * self.largest, self.max_files))
+            # the tail: at most half of a fair share of what is left, so that every worker gets some of the
+            # last files, but not below a tenth of the target (each chunk costs a round trip)
+            share = remaining // (2 * max(workers, 1))
+            size = min(size, max(share, int(0.1 * self.target_seconds / per_file)))
+        size = max(1, min(size, remaining))
         self.largest = max(self.largest, size)
         return size
 
@@ -129,7 +133,7 @@ class PoolTasks:
     def wait(self) -> list[Finished]:
         """Block until at least one chunk has finished; the finished ones, in order of completion."""
         done, _ = cf.wait(list(self._pending), return_when=cf.FIRST_COMPLETED)
-        out = []
+        out: list[Finished] = []
         for fut in done:
             chunk = self._pending.pop(fut)
             try:
@@ -187,7 +191,7 @@ class DaskTasks:
 
     def wait(self) -> list[Finished]:
         """Block until at least one chunk has finished; the finished ones, in order of completion."""
-        out = []
+        out: list[Finished] = []
         for fut, result in self._done.next_batch(block=True):
             chunk = self._pending.pop(fut)
             if fut.status == "finished":

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from .runner import ROW_FIELDS, SCHEMA
 from ..errors import UsageError
 
-__all__ = ["ResultsFile", "ResultsFileBusy", "open_results", "results_format", "FORMATS"]
+__all__ = ["ResultsFile", "ResultsFileBusy", "close_inherited", "open_results", "results_format", "FORMATS"]
 
 #: Output formats by file suffix.
 FORMATS = {".jsonl": "jsonl", ".ndjson": "jsonl", ".csv": "csv"}
@@ -216,6 +216,23 @@ def _lock(fd: int, path: str) -> None:
 
 # -- the open file --------------------------------------------------------------------------------------
 
+#: Descriptors of the results files open in this process.  A worker process forked while one is open inherits
+#: it, and with it the lock: a killed run's workers, until they are gone, would refuse the resume.  The pool
+#: workers close their copies at start (:func:`close_inherited`; the lock stays with the parent's).
+_OPEN_FDS: set[int] = set()
+
+
+def close_inherited() -> None:
+    """In a freshly forked worker: close the copies of this process's results files (their lock is the
+    parent's)."""
+    for fd in list(_OPEN_FDS):
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+    _OPEN_FDS.clear()
+
+
 @dataclass
 class ResultsFile:
     """An open, locked, append-only results file.
@@ -270,6 +287,7 @@ class ResultsFile:
             try:
                 self.sync()
             finally:
+                _OPEN_FDS.discard(self._fd)
                 os.close(self._fd)
                 self._fd = None
 
@@ -341,6 +359,7 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30, sync_seco
     except OSError as exc:
         os.close(fd)
         raise UsageError(f"{path}: cannot use the results file ({exc.strerror or exc})") from None
+    _OPEN_FDS.add(fd)
     return ResultsFile(path=path, format=fmt, previous_rows=rows, torn_bytes=torn, sync_seconds=float(sync_seconds),
                        _fd=fd, _synced=time.monotonic())
 

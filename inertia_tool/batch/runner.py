@@ -310,7 +310,8 @@ _PR_SET_PDEATHSIG = 1            # <linux/prctl.h>
 
 
 def _exit_with_parent(parent_pid: int) -> None:
-    """Pool-worker initializer: end this worker when the batch process that started it dies.
+    """Pool-worker initializer: end this worker when the batch process that started it dies, and close the
+    results file it inherited (:func:`inertia_tool.batch.rows.close_inherited`).
 
     A killed parent (``kill -9``, out of memory) cannot shut its pool down, and orphaned workers would go on
     analysing files nobody collects.  On Linux the kernel sends SIGKILL on the parent's death
@@ -320,6 +321,9 @@ def _exit_with_parent(parent_pid: int) -> None:
     import signal
     import threading
 
+    from .rows import close_inherited
+
+    close_inherited()                           # a forked worker must not hold the results file (and its lock)
     if sys.platform.startswith("linux"):
         try:
             import ctypes
@@ -516,8 +520,8 @@ def _run_chunks(todo: list[tuple[str, str | None]], options: BatchOptions, tasks
         if not tasks.in_flight():
             return
         for chunk, rows, error in tasks.wait():
-            if error is None:
-                sizer.observe(len(rows), sum(_as_float(r.get("seconds")) for r in rows))
+            if rows is not None:
+                sizer.observe(len(rows), math.fsum(_as_float(r.get("seconds")) for r in rows))
                 for row in rows:
                     record(row)
             elif len(chunk) > 1:

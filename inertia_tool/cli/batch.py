@@ -20,7 +20,7 @@ from .help import add_command
 from .model_options import add_model_options, load_options_from_args
 from .options import check_option, density_and_mass
 
-__all__ = ["register", "run", "Progress", "dask_executor", "summary_line"]
+__all__ = ["register", "run", "Progress", "connect_dask_cli", "summary_line"]
 
 #: Exit code when at least one file failed.
 EXIT_SOME_FAILED = 3
@@ -76,34 +76,14 @@ class Progress:
             self.stream.flush()
 
 
-def dask_executor(address: str, jobs: int):
-    """A ``concurrent.futures`` executor on a Dask cluster and a function that shuts it down.
+def connect_dask_cli(address: str, jobs: int):
+    """:func:`inertia_tool.batch.cluster.connect_dask`, its messages in terms of the command line's options."""
+    from ..batch.cluster import connect_dask
 
-    ``"local"`` starts a ``LocalCluster`` of ``jobs`` single-threaded worker processes without a
-    dashboard; anything else is a scheduler address (``tcp://host:8786``) for ``Client``.  The files must be
-    readable at the same paths on the workers (a shared file system).
-    """
     try:
-        from dask.distributed import Client, LocalCluster
-    except ImportError:
-        raise UsageError('--dask needs dask.distributed: pip install "inertia-tool[dask]" '
-                         '(or "dask[distributed]")') from None
-    if address == "local":
-        cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None)
-        client = Client(cluster)
-    else:
-        cluster = None
-        try:
-            client = Client(address, timeout="20s")
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise UsageError(f"--dask {address}: cannot connect to a Dask scheduler ({exc})") from None
-
-    def shutdown():
-        client.close()
-        if cluster is not None:
-            cluster.close()
-
-    return client.get_executor(), shutdown
+        return connect_dask(address, jobs)
+    except UsageError as exc:
+        raise UsageError(f"--dask {address}: {exc}") from None
 
 
 def summary_line(summary, files: int, args) -> str:
@@ -156,13 +136,13 @@ def run(args) -> int:
         raise UsageError(f"Expected --jobs >= 1, got {args.jobs}")
     sources = args.source if isinstance(args.source, (list, tuple)) else [args.source]
     files = sorted({f for source in sources for f in discover_files(source)})
-    executor, shutdown = (None, None)
+    cluster = None
     with open_results(args.out) as out:
         if out.torn_bytes:
             print(f"batch: warning: {args.out}: ignored a torn last line ({out.torn_bytes} bytes) — the previous "
                   "run was interrupted", file=sys.stderr)
         if args.dask:
-            executor, shutdown = dask_executor(args.dask, args.jobs)
+            cluster = connect_dask_cli(args.dask, args.jobs)
         progress = None if args.quiet else Progress(sys.stderr)
         try:
             implausible = []
@@ -172,13 +152,14 @@ def run(args) -> int:
                     implausible.append(row["path"])
                 out.write_row(row)
 
-            summary = run_batch(files, options, write_row, previous_rows=out.previous_rows, jobs=args.jobs,
-                                executor=executor, progress=progress)
+            summary = run_batch(files, options, write_row, previous_rows=out.previous_rows,
+                                jobs=1 if cluster else args.jobs, client=cluster.client if cluster else None,
+                                progress=progress)
         finally:
             if progress is not None:
                 progress.close()
-            if shutdown is not None:
-                shutdown()
+            if cluster is not None:
+                cluster.close()
     print(summary_line(summary, len(files), args), file=sys.stderr)
     if implausible:
         print(f"batch: warning: {len(implausible)} file(s) read without --units are implausibly large or small "

@@ -1,0 +1,111 @@
+"""A Dask cluster for :func:`~inertia_tool.batch.runner.run_batch`: a LocalCluster here or a remote scheduler.
+
+Both give a ``dask.distributed.Client`` and the batch then runs the same code on either
+(:class:`~inertia_tool.batch.chunks.DaskTasks`): chunks of files submitted with ``Client.submit``, rows
+streamed back with ``distributed.as_completed``.  Needs the ``dask`` extra (``dask[distributed]``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..errors import UsageError
+
+__all__ = ["DaskCluster", "connect_dask"]
+
+
+def _warm_up() -> int:
+    """Run on every worker when connecting: import the engine and analyse a cube from arrays, so that the
+    first chunk does not pay the imports (the batch's throughput would count them)."""
+    import os
+    import warnings
+
+    import numpy as np
+
+    from ..mass.pipeline import mass_properties
+
+    vertices = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
+    faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                      [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")                     # a cube's equal moments are no news
+        mass_properties((vertices, faces), density=1000.0, units="m")
+    return os.getpid()
+
+
+class DaskCluster:
+    """A connected Dask client, and the LocalCluster behind it when this object started one.
+
+    Attributes
+    ----------
+    client : dask.distributed.Client
+        Pass it to ``run_batch(..., client=...)``.
+    address : str
+        ``"local"`` or the scheduler address connected to.
+    """
+
+    def __init__(self, client: Any, cluster: Any, address: str):
+        self.client = client
+        self._cluster = cluster
+        self.address = address
+
+    @property
+    def workers(self) -> int:
+        """Worker threads the scheduler knows of now."""
+        return sum(self.client.nthreads().values())
+
+    def close(self) -> None:
+        """Close the client, and the LocalCluster if this object started it (a remote cluster stays up)."""
+        self.client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+
+    def __enter__(self) -> "DaskCluster":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> DaskCluster:
+    """Start a LocalCluster (``address="local"``) or connect to a running scheduler, and warm its workers up.
+
+    Parameters
+    ----------
+    address : str
+        ``"local"``: a ``LocalCluster`` of ``workers`` single-threaded worker processes on this machine, without
+        a dashboard.  Anything else is a scheduler address (``"tcp://host:8786"``); the workers must see the
+        mesh files at the same absolute paths (a shared file system) and have inertia_tool installed.
+    workers : int
+        Worker processes of a LocalCluster (ignored for a remote scheduler: its workers are what they are).
+    timeout : float
+        Seconds to wait for a remote scheduler.
+
+    Raises
+    ------
+    UsageError
+        ``dask.distributed`` is not installed, or no scheduler answers at ``address``.
+    """
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise UsageError('Running on Dask needs dask.distributed: pip install "inertia-tool[dask]" '
+                         '(or "dask[distributed]")') from None
+    if workers < 1:
+        raise UsageError(f"Expected `workers` >= 1, got {workers}")
+    if address == "local":
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        client = Client(cluster)
+    else:
+        cluster = None
+        try:
+            client = Client(address, timeout=f"{timeout}s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise UsageError(f"Cannot connect to a Dask scheduler at {address} ({exc})") from None
+    connected = DaskCluster(client, cluster, address)
+    try:
+        client.run(_warm_up)
+    except BaseException:
+        connected.close()
+        raise
+    return connected
