@@ -65,6 +65,14 @@ ROW_FIELDS = (
     "faces", "bodies", "cavities", "watertight", "repaired", "warnings", "seconds", "worker",
 )
 
+#: The numeric columns of an ``ok`` row, in the order :func:`_analyze` fills them from one array.
+_NUMBER_FIELDS = ("density", "mass", "volume", "surface_area", "com_x", "com_y", "com_z",
+                  "ixx", "iyy", "izz", "ixy", "ixz", "iyz", "i1", "i2", "i3",
+                  *(f"axis{k}_{c}" for k in (1, 2, 3) for c in "xyz"))
+
+#: Row and column of ``ixx, iyy, izz, ixy, ixz, iyz`` in the inertia tensor.
+_TENSOR_ENTRIES = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))
+
 #: Bytes read at a time when hashing a file.
 _HASH_CHUNK = 1 << 20
 
@@ -199,11 +207,6 @@ def _one_line(text: object, limit: int = 500) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
-def _finite(x) -> float | None:
-    v = float(x)
-    return v if math.isfinite(v) else None
-
-
 def _worker_name() -> str:
     return f"{platform.node()}:{os.getpid()}"
 
@@ -255,24 +258,18 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
             props = mass_properties(path, density=options.density, material=options.material, mass=options.mass,
                                     options=options.load)
         pa = props.principal
-        inertia = np.asarray(props.inertia)
         mesh = cast(MeshReport, props.mesh)         # MassProperties.mesh is typed `object`
+        numbers = np.concatenate(([props.density, props.mass, props.volume, props.surface_area],
+                                  props.center_of_mass, np.asarray(props.inertia)[_TENSOR_ENTRIES], pa.moments,
+                                  np.asarray(pa.axes).T.ravel()))                 # axis k = column k of `axes`
+        row.update(zip(_NUMBER_FIELDS, [v if math.isfinite(v) else None for v in numbers.tolist()]))
         row.update(
-            status="ok", density=_finite(props.density), density_source=described,
-            mass=_finite(props.mass), volume=_finite(props.volume), surface_area=_finite(props.surface_area),
-            com_x=_finite(props.center_of_mass[0]), com_y=_finite(props.center_of_mass[1]),
-            com_z=_finite(props.center_of_mass[2]),
-            ixx=_finite(inertia[0, 0]), iyy=_finite(inertia[1, 1]), izz=_finite(inertia[2, 2]),
-            ixy=_finite(inertia[0, 1]), ixz=_finite(inertia[0, 2]), iyz=_finite(inertia[1, 2]),
-            i1=_finite(pa.moments[0]), i2=_finite(pa.moments[1]), i3=_finite(pa.moments[2]),
+            status="ok", density_source=described,
             faces=int(mesh.faces), bodies=int(mesh.bodies), cavities=int(mesh.cavities),
             watertight=bool(mesh.watertight), repaired=bool(mesh.repaired),
             warnings=" | ".join(_one_line(w.message) for w in caught
                                 if issubclass(w.category, InertiaToolWarning)) or None,
         )
-        for k in range(3):
-            for c, name in enumerate("xyz"):
-                row[f"axis{k + 1}_{name}"] = _finite(pa.axes[c, k])
     except InertiaToolError as exc:
         row.update(status="error", error_type=type(exc).__name__, error=_one_line(exc))
     except Exception as exc:  # noqa: BLE001 - one bad file must never stop a batch
