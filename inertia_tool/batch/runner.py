@@ -1,8 +1,9 @@
 """Batch analysis of many meshes: the per-file work, the result-row schema and the runner.
 
 One row per file, flat so that JSONL and CSV carry the same columns (:data:`ROW_FIELDS`).  The work for one
-file (:func:`analyze_file`) is pure and picklable so it can run in-process, in a process pool or on a Dask
-cluster; it never raises: an :class:`~inertia_tool.errors.InertiaToolError` becomes a row with
+file (:func:`analyze_file`) and for a chunk of files (:func:`analyze_chunk`, the task the workers run; how
+chunks are sized and fed to a process pool or a Dask cluster is :mod:`inertia_tool.batch.chunks`) is pure and
+picklable; it never raises: an :class:`~inertia_tool.errors.InertiaToolError` becomes a row with
 ``status="error"`` and any other exception a row with ``status="internal_error"`` (the batch goes on).
 
 Resuming: every row carries the SHA-256 of the file's bytes and a key of the options that change the numbers
@@ -10,7 +11,7 @@ Resuming: every row carries the SHA-256 of the file's bytes and a key of the opt
 options key and a status of ``"ok"`` or ``"error"`` (an ``InertiaToolError`` is a property of the file, so it
 is not retried); ``"internal_error"`` rows are retried.  A changed file or a changed density recomputes.
 
-Writing rows (JSONL/CSV, append-only, fsync'd per row) is in :mod:`inertia_tool.batch.rows`; the progress
+Writing rows (JSONL/CSV, append-only, one ``write`` per row) is in :mod:`inertia_tool.batch.rows`; the progress
 bar is the command line's.  All numbers in a row are SI (m, kg, kg·m²), inertia about the centre of mass in
 mesh axes with the tensor sign convention of ``docs/conventions.md``.
 """
