@@ -10,7 +10,10 @@ files (the real writer: lock, one ``write`` per row, fsync at most once a second
 
 It prints files/s and the ratio to one process for each (best of ``--repeat`` rounds, each round running every
 configuration in turn), with the load average before and after (the machine is shared: other work slows the
-parallel runs).  The Dask LocalCluster is started once, before the rounds; its start-up (worker processes,
+parallel runs).  It also prints the CPU time per file of each configuration (this process, the pool's worker
+processes, the Dask workers: what chunking, IPC and the scheduler add) and the "CPU-bound ratio" that CPU time
+allows on two idle cores (one process's CPU time over half the configuration's), which the load of the machine
+changes less.  The Dask LocalCluster is started once, before the rounds; its start-up (worker processes,
 engine imports) is timed separately, not in files/s.
 
     python benchmarks/bench_batch.py [--set small|mix|both] [--small 1000] [--files 200] [--repeat 3]
@@ -94,12 +97,23 @@ def make_small_meshes(directory: str, count: int, seed: int = 1) -> list[int]:
     return faces
 
 
+def _worker_cpu(client) -> float:
+    """CPU seconds used so far by the Dask workers' processes (0 without a client)."""
+    return sum(client.run(time.process_time).values()) if client is not None else 0.0
+
+
 def _run(files, out, **kw):
+    """Wall seconds of one batch and the CPU seconds it used in all (this process, the pool's processes, the
+    Dask workers)."""
+    client = kw.get("client")
+    before, workers_before = os.times(), _worker_cpu(client)
     with open_results(out) as r:
         summary = run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1240.0), r.write_row, **kw)
+    after = os.times()              # the pool's processes are joined by now: their time is in children_*
+    cpu = (sum(after[:4]) - sum(before[:4])) + _worker_cpu(client) - workers_before
     if summary.ok != len(files):
         raise SystemExit(f"benchmark: {summary.failed} files failed")
-    return summary.seconds
+    return summary.seconds, cpu
 
 
 def _catalogue(tmp, name, make, count):
@@ -146,17 +160,21 @@ def main() -> None:
             for r in range(args.repeat):
                 for name, files in catalogues.items():
                     for label, kw in configs:
-                        sec = _run(files, os.path.join(tmp, f"{name}_{label[:1]}_{r}.jsonl"), **kw)
-                        results[name, label] = min(sec, results.get((name, label), sec))
+                        got = _run(files, os.path.join(tmp, f"{name}_{label[:1]}_{r}.jsonl"), **kw)
+                        results[name, label] = min(got, results.get((name, label), got))
         finally:
             if cluster is not None:
                 cluster.close()
-        print(f"{'catalogue':9s} {'configuration':36s} {'seconds':>8s} {'files/s':>8s} {'ratio':>6s}")
+        print(f"{'catalogue':9s} {'configuration':36s} {'seconds':>8s} {'files/s':>8s} {'ratio':>6s} "
+              f"{'CPU ms/file':>11s} {'CPU-bound ratio':>15s}")
         for name, files in catalogues.items():
-            base = results[name, "1 process (in-process)"]
-            for (n, label), sec in results.items():
+            base, base_cpu = results[name, "1 process (in-process)"]
+            for (n, label), (sec, cpu) in results.items():
                 if n == name:
-                    print(f"{name:9s} {label:36s} {sec:8.2f} {len(files) / sec:8.1f} {base / sec:6.2f}")
+                    # the wall ratio the CPU time allows with both cores to ourselves: the same CPU over 2
+                    ideal = base_cpu / (cpu / (1 if label.startswith("1 ") else 2))
+                    print(f"{name:9s} {label:36s} {sec:8.2f} {len(files) / sec:8.1f} {base / sec:6.2f} "
+                          f"{1e3 * cpu / len(files):11.2f} {ideal:15.2f}")
         if startup is not None:
             print(f"(Dask LocalCluster start-up with the workers' warm-up, not included above: {startup:.2f} s)")
         print(f"load average after {', '.join(f'{x:.2f}' for x in os.getloadavg())}")

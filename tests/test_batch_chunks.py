@@ -268,3 +268,30 @@ def test_run_killed_in_the_middle_of_a_chunk_resumes_every_file_once(many, tmp_p
     with open_results(out) as r:
         paths = [x["path"] for x in r.previous_rows]
     assert sorted(paths) == many                                  # every file exactly once
+
+
+# -- the C kernels' threads in the workers ------------------------------------------------------------------
+
+def _environment(name):
+    return os.environ.get(name)
+
+
+@pytest.mark.parametrize("user", [None, "3"])
+def test_pool_workers_share_the_cores_between_their_kernels(monkeypatch, user):
+    """N pool workers give their C kernels the cores divided by N (at least 1), unless the user set
+    INERTIA_TOOL_THREADS, which wins."""
+    from inertia_tool._native import THREADS_ENV, threads
+
+    if user is None:
+        monkeypatch.delenv(THREADS_ENV, raising=False)
+        expected = str(max(1, threads() // 2))
+    else:
+        monkeypatch.setenv(THREADS_ENV, user)
+        expected = user
+    assert batch_mod.kernel_threads_per_worker(2) == int(expected)
+    pool = batch_mod._process_pool(2)
+    try:
+        seen = {pool.submit(_environment, THREADS_ENV).result(timeout=60) for _ in range(4)}
+    finally:
+        pool.shutdown()
+    assert seen == {expected}

@@ -93,6 +93,10 @@ def test_dask_chunks_every_file_once_on_both_workers(tmp_path, cluster, monkeypa
     assert summary.ok == 60 and sorted(r["path"] for r in rows) == files
     assert sum(sizes) == 60 and max(sizes) > 1 and sizes[0] == 1
     assert len({r["worker"] for r in rows}) == 2
+    from inertia_tool._native import THREADS_ENV
+    from inertia_tool.batch.runner import kernel_threads_per_worker
+    seen = cluster.client.run(lambda: os.environ.get(THREADS_ENV))           # evaluated on each worker
+    assert set(seen.values()) == {str(kernel_threads_per_worker(2))}
     for r in rows:
         side = (1 + int(os.path.basename(r["path"])[1:3])) * 1e-3
         assert r["mass"] == pytest.approx(1000.0 * side ** 3, rel=1e-9)

@@ -77,7 +77,8 @@ def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> Da
         a dashboard.  Anything else is a scheduler address (``"tcp://host:8786"``); the workers must see the
         mesh files at the same absolute paths (a shared file system) and have inertia_tool installed.
     workers : int
-        Worker processes of a LocalCluster (ignored for a remote scheduler: its workers are what they are).
+        Worker processes of a LocalCluster (ignored for a remote scheduler: its workers are what they are).  Their
+        C kernels share the cores (``INERTIA_TOOL_THREADS``, unless set, is the cores divided by ``workers``).
     timeout : float
         Seconds to wait for a remote scheduler.
 
@@ -94,7 +95,11 @@ def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> Da
     if workers < 1:
         raise UsageError(f"Expected `workers` >= 1, got {workers}")
     if address == "local":
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        from .._native import THREADS_ENV
+        from .runner import kernel_threads_per_worker
+
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                               env={THREADS_ENV: str(kernel_threads_per_worker(workers))})
         client = Client(cluster)
     else:
         cluster = None

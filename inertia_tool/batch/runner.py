@@ -307,9 +307,28 @@ _WATCHDOG_SECONDS = 0.5
 _PR_SET_PDEATHSIG = 1            # <linux/prctl.h>
 
 
+def kernel_threads_per_worker(workers: int) -> int:
+    """Threads each of ``workers`` worker processes should give the C kernels: the cores shared out (at least
+    1), so that N workers analysing large meshes at once do not run N times the cores in threads.  A
+    ``INERTIA_TOOL_THREADS`` set by the user wins (see :func:`inertia_tool._native.threads`)."""
+    from .._native import THREADS_ENV, threads
+
+    if os.environ.get(THREADS_ENV, "").strip():
+        return threads()
+    return max(1, threads() // max(1, workers))
+
+
+def _init_worker(parent_pid: int, kernel_threads: int) -> None:
+    """Pool-worker initializer: the C kernels' share of the cores, and :func:`_exit_with_parent`."""
+    from .._native import THREADS_ENV
+
+    os.environ[THREADS_ENV] = str(kernel_threads)
+    _exit_with_parent(parent_pid)
+
+
 def _exit_with_parent(parent_pid: int) -> None:
-    """Pool-worker initializer: end this worker when the batch process that started it dies, and close the
-    results file it inherited (:func:`inertia_tool.batch.rows.close_inherited`).
+    """End this worker when the batch process that started it dies, and close the results file it inherited
+    (:func:`inertia_tool.batch.rows.close_inherited`).
 
     A killed parent (``kill -9``, out of memory) cannot shut its pool down, and orphaned workers would go on
     analysing files nobody collects.  On Linux the kernel sends SIGKILL on the parent's death
@@ -359,8 +378,10 @@ def _exit_with_parent(parent_pid: int) -> None:
 
 
 def _process_pool(jobs: int) -> cf.ProcessPoolExecutor:
-    """A pool of ``jobs`` worker processes that exit when this process dies (:func:`_exit_with_parent`)."""
-    return cf.ProcessPoolExecutor(max_workers=jobs, initializer=_exit_with_parent, initargs=(os.getpid(),))
+    """A pool of ``jobs`` worker processes that exit when this process dies (:func:`_exit_with_parent`), their
+    C kernels sharing the cores (:func:`kernel_threads_per_worker`)."""
+    return cf.ProcessPoolExecutor(max_workers=jobs, initializer=_init_worker,
+                                  initargs=(os.getpid(), kernel_threads_per_worker(jobs)))
 
 
 def _done_keys(previous_rows: Iterable[dict]) -> dict:
