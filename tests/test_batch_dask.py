@@ -108,3 +108,12 @@ def test_connect_refuses_an_address_without_a_scheduler():
 
     with pytest.raises(UsageError, match="Cannot connect to a Dask scheduler at tcp://127.0.0.1:9"):
         connect_dask("tcp://127.0.0.1:9", timeout=1.0)
+
+
+@pytest.mark.slow
+def test_local_cluster_workers_run_without_the_profiler(cluster):
+    import dask
+
+    seen = cluster.client.run(lambda: dask.config.get("distributed.worker.profile.enabled"))
+    assert set(seen.values()) == {False}
+    assert dask.config.get("distributed.worker.profile.enabled") is True       # this process's config untouched

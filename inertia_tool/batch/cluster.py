@@ -73,9 +73,10 @@ def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> Da
     Parameters
     ----------
     address : str
-        ``"local"``: a ``LocalCluster`` of ``workers`` single-threaded worker processes on this machine, without
-        a dashboard.  Anything else is a scheduler address (``"tcp://host:8786"``); the workers must see the
-        mesh files at the same absolute paths (a shared file system) and have inertia_tool installed.
+        ``"local"``: a ``LocalCluster`` of ``workers`` single-threaded worker processes on this machine, without a
+        dashboard (and without the workers' profiler, which only feeds it). Anything else is a scheduler address
+        (``"tcp://host:8786"``); the workers must see the mesh files at the same absolute paths (a shared file
+        system) and have inertia_tool installed.
     workers : int
         Worker processes of a LocalCluster (ignored for a remote scheduler: its workers are what they are).  Their
         C kernels share the cores (``INERTIA_TOOL_THREADS``, unless set, is the cores divided by ``workers``).
@@ -98,8 +99,12 @@ def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> Da
         from .._native import THREADS_ENV
         from .runner import kernel_threads_per_worker
 
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                               env={THREADS_ENV: str(kernel_threads_per_worker(workers))})
+        import dask
+
+        # no dashboard, so the workers' statistical profiler (a stack sample every 10 ms) is only overhead
+        with dask.config.set({"distributed.worker.profile.enabled": False}):
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   env={THREADS_ENV: str(kernel_threads_per_worker(workers))})
         client = Client(cluster)
     else:
         cluster = None
