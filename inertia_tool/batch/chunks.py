@@ -4,7 +4,7 @@ One task per file makes the per-task cost of the executor the bottleneck on smal
 ~0.2 ms a task in pickling and pipes, a Dask scheduler a few ms), so :func:`~inertia_tool.batch.runner.run_batch`
 hands out *chunks*: lists of files analysed one after the other by one worker, which returns their rows
 together.  :class:`ChunkSizer` decides how many files go into the next chunk from the analysis time the workers
-measured (the rows' ``seconds``): the first chunks hold one file each (nothing is measured yet), later ones
+measured (the rows' ``seconds``): the first chunks hold 1, 2, 4, then 8 files (nothing is measured yet), later ones
 hold ``target_seconds / seconds_per_file`` files, growing at most fourfold per chunk, and no more than half a
 fair share of the files left (so that the last chunks spread over every worker) unless that is less than a
 tenth of the target.
@@ -64,6 +64,7 @@ class ChunkSizer:
         self.growth = float(growth)
         self.seconds_per_file: float | None = None
         self.largest = 1
+        self._probes = 0
 
     def observe(self, files: int, seconds: float) -> None:
         """Record a finished chunk of ``files`` files that took ``seconds`` of analysis in all."""
@@ -77,7 +78,9 @@ class ChunkSizer:
         if remaining <= 0:
             return 0
         if self.seconds_per_file is None:
-            size = 1
+            # nothing measured yet: 1, 2, 4, 8 files, so that the workers have work during the first round trip
+            size = 2 ** min(self._probes, 3)
+            self._probes += 1
         else:
             per_file = max(self.seconds_per_file, 1e-9)
             size = int(min(self.target_seconds / per_file, self.growth * self.largest, self.max_files))
