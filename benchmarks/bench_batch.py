@@ -13,8 +13,9 @@ configuration in turn), with the load average before and after (the machine is s
 parallel runs).  It also prints the CPU time per file of each configuration (this process, the pool's worker
 processes, the Dask workers: what chunking, IPC and the scheduler add) and the "CPU-bound ratio" that CPU time
 allows on two idle cores (one process's CPU time over half the configuration's), which the load of the machine
-changes less.  The Dask LocalCluster is started once, before the rounds; its start-up (worker processes,
-engine imports) is timed separately, not in files/s.
+changes less.  The Dask LocalCluster is started for its runs in each round and closed after them (its client's
+event loop would slow the other configurations); its start-up (worker processes, engine imports) is timed
+separately, not in files/s.
 
     python benchmarks/bench_batch.py [--set small|mix|both] [--small 1000] [--files 200] [--repeat 3]
 
@@ -142,29 +143,34 @@ def main() -> None:
             catalogues["small"] = _catalogue(tmp, "small", make_small_meshes, args.small)
         if args.set in ("mix", "both"):
             catalogues["mix"] = _catalogue(tmp, "mix", make_meshes, args.files)
-        cluster, startup = None, None
         try:
             from inertia_tool.batch.cluster import connect_dask
         except ImportError:
+            connect_dask = None
             print("(dask.distributed is not installed: no Dask rows)")
-        else:
-            t0 = time.perf_counter()
-            cluster = connect_dask("local", 2)
-            startup = time.perf_counter() - t0
         configs = [("1 process (in-process)", dict(jobs=1)), ("2 processes (ProcessPoolExecutor)", dict(jobs=2))]
-        if cluster is not None:
-            configs.append(("Dask LocalCluster(2 workers)", dict(client=cluster.client)))
+        if connect_dask is not None:
+            configs.append(("Dask LocalCluster(2 workers)", dict(client=None)))
         results: dict = {}
-        try:
-            # rounds of every configuration in turn, so that a change in the machine's load hits all of them
-            for r in range(args.repeat):
-                for name, files in catalogues.items():
-                    for label, kw in configs:
+        startups = []
+        # rounds of every configuration in turn, so that a change in the machine's load hits all of them; the
+        # cluster lives only for its own runs (its client's event loop in this process would slow the others)
+        for r in range(args.repeat):
+            for label, kw in configs:
+                cluster = None
+                if "client" in kw:
+                    t0 = time.perf_counter()
+                    cluster = connect_dask("local", 2)
+                    startups.append(time.perf_counter() - t0)
+                    kw = dict(client=cluster.client)
+                try:
+                    for name, files in catalogues.items():
                         got = _run(files, os.path.join(tmp, f"{name}_{label[:1]}_{r}.jsonl"), **kw)
                         results[name, label] = min(got, results.get((name, label), got))
-        finally:
-            if cluster is not None:
-                cluster.close()
+                finally:
+                    if cluster is not None:
+                        cluster.close()
+        startup = min(startups) if startups else None
         print(f"{'catalogue':9s} {'configuration':36s} {'seconds':>8s} {'files/s':>8s} {'ratio':>6s} "
               f"{'CPU ms/file':>11s} {'CPU-bound ratio':>15s}")
         for name, files in catalogues.items():
@@ -176,7 +182,8 @@ def main() -> None:
                     print(f"{name:9s} {label:36s} {sec:8.2f} {len(files) / sec:8.1f} {base / sec:6.2f} "
                           f"{1e3 * cpu / len(files):11.2f} {ideal:15.2f}")
         if startup is not None:
-            print(f"(Dask LocalCluster start-up with the workers' warm-up, not included above: {startup:.2f} s)")
+            print(f"(Dask LocalCluster start-up with the workers' warm-up, not included above: {startup:.2f} s, "
+                  "the fastest of the rounds)")
         print(f"load average after {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 
