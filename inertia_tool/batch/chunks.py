@@ -109,10 +109,14 @@ class PoolTasks:
 
     def __init__(self, *, make_pool: Callable[[], cf.Executor] | None = None, executor: cf.Executor | None = None,
                  workers: int = 1):
-        if (make_pool is None) == (executor is None):
+        if executor is not None and make_pool is None:
+            pool = executor
+        elif make_pool is not None and executor is None:
+            pool = make_pool()
+        else:
             raise ValueError("Expected exactly one of `make_pool` and `executor`")
         self._make_pool = make_pool
-        self._pool: cf.Executor = executor if executor is not None else make_pool()  # type: ignore[misc]
+        self._pool: cf.Executor = pool
         self._pending: dict[cf.Future, list] = {}
         self.workers = workers
 
