@@ -101,7 +101,8 @@ def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> Da
 
         import dask
 
-        # no dashboard, so the workers' statistical profiler (a stack sample every 10 ms) is only overhead
+        # no dashboard, so the workers' statistical profiler (a stack sample every 10 ms) can only cost; its cost
+        # was within the noise of the project's shared machine
         with dask.config.set({"distributed.worker.profile.enabled": False}):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
                                    env={THREADS_ENV: str(kernel_threads_per_worker(workers))})
