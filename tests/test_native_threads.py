@@ -2,7 +2,8 @@
 
 The edge census splits start vertices; the tetrahedron sums add a fixed number of lanes in lane order; the
 bounds split rows.  Each is compared here, on meshes above the kernels' thresholds for using threads, with its
-own one-thread result (bit for bit) and with the numpy reference.  The welder and the shell labels run on one thread; they are checked on the same mesh.
+own one-thread result (bit for bit) and with the numpy reference.  The welder and the shell labels run on one
+thread; they are checked on the same mesh.
 """
 
 import numpy as np

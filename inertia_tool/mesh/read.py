@@ -17,6 +17,7 @@ import re
 import stat
 import sys
 import warnings
+from typing import Any
 
 
 import numpy as np
@@ -747,7 +748,7 @@ def _read_with_trimesh(path: str, max_faces: int):
             quiet.setLevel(logging.CRITICAL)      # e.g. a missing texture image, logged with a traceback
             try:
                 # glTF: no textures decoded (geometry only; a textured GLB loads up to 50x faster)
-                extra = {"skip_materials": True} if suffix in (".glb", ".gltf") else {}
+                extra: dict[str, Any] = {"skip_materials": True} if suffix in (".glb", ".gltf") else {}
                 loaded = trimesh.load(source, file_type=kind, process=False, force=None, **extra)
             finally:
                 quiet.setLevel(level)
