@@ -8,9 +8,9 @@ modules asks :func:`accel` at call time which one to run.  Set the environment v
 ``INERTIA_TOOL_NO_ACCEL=1`` to force the numpy path (results are identical, or equal to round-off for the
 integrals, which the C kernel sums with compensation).
 
-The C kernels use :func:`threads` threads on large meshes (the cores this process may run on, at most 16, or
-``INERTIA_TOOL_THREADS``).  Every kernel splits its work so that its result does not depend on the thread
-count: only the speed does.
+The edge census, the integrals and the bounding box use :func:`threads` threads on large meshes (the cores
+this process may run on, at most 16, or ``INERTIA_TOOL_THREADS``), split so that their results do not depend
+on the thread count: only the speed does.  The weld and the shell labels run on one thread.
 """
 
 from __future__ import annotations
