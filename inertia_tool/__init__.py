@@ -23,7 +23,7 @@ Layers (each a subpackage): :mod:`inertia_tool.mesh` (reading, welding, checks, 
 """
 
 import importlib
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Callable
 
 from . import errors
 from .errors import InertiaToolError
@@ -77,13 +77,26 @@ _LAZY = {
 }
 
 
-def __getattr__(name):
-    if name not in _LAZY:
-        raise AttributeError(f"module 'inertia_tool' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_LAZY[name], __name__), name)
-    globals()[name] = value
-    return value
+def _lazy_names(package: str, table: dict[str, str], namespace: dict[str, Any]) -> tuple[
+        Callable[[str], Any], Callable[[], list[str]]]:
+    """The module ``__getattr__`` and ``__dir__`` (PEP 562) of a package whose names load on first use.
+
+    ``table`` maps each name to the module (relative to ``package``) that defines it; a name mapped to the
+    module of the same name (``"shapes": ".shapes"``) is that module.  A loaded name is stored in
+    ``namespace`` (the package's globals), so it is looked up only once.  Every layer with lazy names uses this.
+    """
+    def __getattr__(name: str) -> Any:
+        if name not in table:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}")
+        module = importlib.import_module(table[name], package)
+        value = module if table[name] == f".{name}" else getattr(module, name)
+        namespace[name] = value
+        return value
+
+    def __dir__() -> list[str]:
+        return sorted(set(namespace) | set(table))
+
+    return __getattr__, __dir__
 
 
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = _lazy_names(__name__, _LAZY, globals())

@@ -9,7 +9,7 @@ objectives) → :mod:`.optimize` (quadric cavity) and :mod:`.insert` (a dense in
 The names load on first use (PEP 562), so the command line does not import the design stages to start.
 """
 
-import importlib
+from .. import _lazy_names
 
 _PUBLIC = {"spin_it": ".hollow", "SpinItResult": ".hollow", "SpinDesignMetrics": ".hollow",
            "design_metrics": ".hollow"}
@@ -17,13 +17,4 @@ _PUBLIC = {"spin_it": ".hollow", "SpinItResult": ".hollow", "SpinDesignMetrics":
 __all__ = sorted(_PUBLIC)
 
 
-def __getattr__(name):
-    if name not in _PUBLIC:
-        raise AttributeError(f"module 'inertia_tool.design' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_PUBLIC[name], __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_PUBLIC))
+__getattr__, __dir__ = _lazy_names(__name__, _PUBLIC, globals())

@@ -13,7 +13,7 @@ The names below load on first use (PEP 562): the simulation stages import ``scip
 ``scipy.integrate`` (about 0.2 s), which ``inertia-tool analyze`` and the stability analysis never need.
 """
 
-import importlib
+from .. import _lazy_names
 
 _PUBLIC = {
     "stability": ".spin_stability", "StabilityReport": ".spin_stability", "AxisStability": ".spin_stability",
@@ -39,13 +39,4 @@ _PUBLIC = {
 __all__ = sorted(_PUBLIC)
 
 
-def __getattr__(name):
-    if name not in _PUBLIC:
-        raise AttributeError(f"module 'inertia_tool.dynamics' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_PUBLIC[name], __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_PUBLIC))
+__getattr__, __dir__ = _lazy_names(__name__, _PUBLIC, globals())

@@ -7,7 +7,7 @@ entry from a mesh source; :mod:`.thinwall` the shell and printed-part models; :m
 with closed forms; :mod:`.ellipsoid` the equivalent inertia ellipsoid.
 """
 
-import importlib
+from .. import _lazy_names
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:   # what the names below are, for type checkers and the API docs; loaded on first use
@@ -36,14 +36,4 @@ _PUBLIC = {
 }
 
 
-def __getattr__(name: str) -> object:
-    if name not in _PUBLIC:
-        raise AttributeError(f"module 'inertia_tool.mass' has no attribute {name!r}")
-    module = importlib.import_module(_PUBLIC[name], __name__)
-    value = module if _PUBLIC[name] == f".{name}" else getattr(module, name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_PUBLIC))
+__getattr__, __dir__ = _lazy_names(__name__, _PUBLIC, globals())

@@ -8,7 +8,7 @@
   elements (:func:`write_corrected`).  See ``docs/robots.md``.
 """
 
-import importlib
+from .. import _lazy_names
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:   # what the names below are, for type checkers and the API docs; loaded on first use
@@ -38,13 +38,4 @@ _PUBLIC = {
 }
 
 
-def __getattr__(name):
-    if name not in _PUBLIC:
-        raise AttributeError(f"module 'inertia_tool.robot' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_PUBLIC[name], __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_PUBLIC))
+__getattr__, __dir__ = _lazy_names(__name__, _PUBLIC, globals())
