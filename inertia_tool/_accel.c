@@ -172,11 +172,16 @@ typedef struct {
     int t, nt;
 } TaskArg;
 
+/* The platform's threads: thread_start(&handle, arg) runs task_entry(arg) on a new thread and returns
+ * nonzero when it started; thread_join(handle) waits for it.  next_ticket(&counter) is an atomic
+ * fetch-and-increment. */
 #if defined(_WIN32)
 #ifndef WIN32_LEAN_AND_MEAN
 #define WIN32_LEAN_AND_MEAN     /* no rpc.h / ole2.h: fewer plain words (small, interface, ...) become macros */
 #endif
 #include <windows.h>
+
+typedef HANDLE thread_handle;
 
 static DWORD WINAPI
 task_entry(LPVOID arg)
@@ -186,29 +191,18 @@ task_entry(LPVOID arg)
     return 0;
 }
 
-static void
-run_parallel(int nt, task_fn fn, void *ctx)
+static int
+thread_start(thread_handle *handle, TaskArg *arg)
 {
-    HANDLE handle[MAX_THREADS];
-    TaskArg arg[MAX_THREADS];
-    int started[MAX_THREADS] = {0};
-    if (nt > MAX_THREADS) nt = MAX_THREADS;
-    if (nt < 1) nt = 1;
-    for (int t = 1; t < nt; t++) {
-        arg[t].fn = fn; arg[t].ctx = ctx; arg[t].t = t; arg[t].nt = nt;
-        handle[t] = CreateThread(NULL, 0, task_entry, &arg[t], 0, NULL);
-        started[t] = handle[t] != NULL;
-    }
-    fn(ctx, 0, nt);
-    for (int t = 1; t < nt; t++) {
-        if (started[t]) {
-            WaitForSingleObject(handle[t], INFINITE);
-            CloseHandle(handle[t]);
-        }
-        else {
-            fn(ctx, t, nt);
-        }
-    }
+    *handle = CreateThread(NULL, 0, task_entry, arg, 0, NULL);
+    return *handle != NULL;
+}
+
+static void
+thread_join(thread_handle handle)
+{
+    WaitForSingleObject(handle, INFINITE);
+    CloseHandle(handle);
 }
 
 static inline int32_t
@@ -220,6 +214,8 @@ next_ticket(int32_t *counter)
 #else
 #include <pthread.h>
 
+typedef pthread_t thread_handle;
+
 static void *
 task_entry(void *arg)
 {
@@ -228,36 +224,47 @@ task_entry(void *arg)
     return NULL;
 }
 
-static void
-run_parallel(int nt, task_fn fn, void *ctx)
+static int
+thread_start(thread_handle *handle, TaskArg *arg)
 {
-    pthread_t handle[MAX_THREADS];
-    TaskArg arg[MAX_THREADS];
-    int started[MAX_THREADS] = {0};
-    if (nt > MAX_THREADS) nt = MAX_THREADS;
-    if (nt < 1) nt = 1;
-    for (int t = 1; t < nt; t++) {
-        arg[t].fn = fn; arg[t].ctx = ctx; arg[t].t = t; arg[t].nt = nt;
-        started[t] = pthread_create(&handle[t], NULL, task_entry, &arg[t]) == 0;
-    }
-    fn(ctx, 0, nt);
-    for (int t = 1; t < nt; t++) {
-        if (started[t]) {
-            pthread_join(handle[t], NULL);
-        }
-        else {
-            fn(ctx, t, nt);
-        }
-    }
+    return pthread_create(handle, NULL, task_entry, arg) == 0;
 }
 
-/* The counter's value before an atomic increment: hands out work items 0, 1, 2, ... to whichever thread asks. */
+static void
+thread_join(thread_handle handle)
+{
+    pthread_join(handle, NULL);
+}
+
 static inline int32_t
 next_ticket(int32_t *counter)
 {
     return __atomic_fetch_add(counter, 1, __ATOMIC_RELAXED);
 }
 #endif
+
+static void
+run_parallel(int nt, task_fn fn, void *ctx)
+{
+    thread_handle handle[MAX_THREADS];
+    TaskArg arg[MAX_THREADS];
+    int started[MAX_THREADS] = {0};
+    if (nt > MAX_THREADS) nt = MAX_THREADS;
+    if (nt < 1) nt = 1;
+    for (int t = 1; t < nt; t++) {
+        arg[t].fn = fn; arg[t].ctx = ctx; arg[t].t = t; arg[t].nt = nt;
+        started[t] = thread_start(&handle[t], &arg[t]);
+    }
+    fn(ctx, 0, nt);
+    for (int t = 1; t < nt; t++) {
+        if (started[t]) {
+            thread_join(handle[t]);
+        }
+        else {
+            fn(ctx, t, nt);      /* could not start: its share runs here */
+        }
+    }
+}
 
 /* Start of part t of n items split into nt contiguous parts. */
 static inline size_t
