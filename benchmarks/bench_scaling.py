@@ -33,7 +33,7 @@ ROOT = os.path.dirname(HERE)
 OUT = os.path.join(HERE, "out")
 sys.path.insert(0, HERE)
 
-from bench_engine import _PEAK  # noqa: E402
+from bench_engine import _PEAK, CHILD_TRIMESH  # noqa: E402
 
 _MIB = 1 << 20
 
@@ -56,15 +56,6 @@ dt = time.perf_counter() - t
 print(rc, dt, peak())
 """
 
-CHILD_TRIMESH = _PEAK + r"""
-t = time.perf_counter()
-import trimesh
-m = trimesh.load(sys.argv[1])
-mp = m.mass_properties
-_ = (mp["volume"], mp["center_mass"], mp["inertia"])
-dt = time.perf_counter() - t
-print(0, dt, peak())
-"""
 
 
 def torus_faces_for(target: int) -> tuple[int, int]:
