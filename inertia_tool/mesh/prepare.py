@@ -149,11 +149,9 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
     return flip, owner, int(np.count_nonzero(cavity)), int(np.count_nonzero(overlapped))
 
 
-def _check_magnitude(vertices, source: str) -> None:
-    """Refuse coordinates whose volume integrals (∝ L⁵) would overflow or underflow float64."""
-    if not len(vertices):
-        return
-    lo, hi = bounding_box(vertices)
+def _check_magnitude(lo, hi, source: str) -> None:
+    """Refuse coordinates (bounding box ``lo``, ``hi``) whose volume integrals (∝ L⁵) would overflow or underflow
+    float64."""
     top = float(np.max(np.abs(np.r_[lo, hi])))    # = max |coordinate| (NaN propagates)
     if not top <= MAX_COORDINATE:
         raise InvalidMeshError(f"{source}: coordinates reach {top:.3g} m, beyond the ±{MAX_COORDINATE:g} m the "
@@ -198,7 +196,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     v, f = raw.vertices, raw.faces
     if len(f) == 0:
         raise InvalidMeshError(f"{source}: the mesh has no triangles")
-    _check_magnitude(v, source)
+    lo, hi = bounding_box(v)          # of the mesh as read: reused below while the vertices are these
+    _check_magnitude(lo, hi, source)
     repeated = repeated_corner_faces(f)
     n_repeated = int(np.count_nonzero(repeated))
     if n_repeated == len(f):
@@ -207,7 +206,6 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         f = f[~repeated]
         warnings.warn(DegenerateFacesWarning(f"{source}: {n_repeated:,} degenerate triangles (a repeated corner) "
                                              "were ignored"), stacklevel=3)
-    lo, hi = bounding_box(v)
     diag = float(np.linalg.norm(hi - lo))
     if not diag > 0:
         raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")
@@ -292,7 +290,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             shells = body_volume_moments(v, f, labels, n_shells)
             flip, owner, cavities, _ = classify_shells(v, f, labels, n_shells, shells, diag, source=source)
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
-    bbox_min, bbox_max = bounding_box(v)
+    bbox_min, bbox_max = (lo, hi) if v is raw.vertices else bounding_box(v)
     uncertainty = None
     if patched is not None:
         total = _total(shells)
