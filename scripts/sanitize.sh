@@ -17,35 +17,18 @@ PYTHON=${PYTHON:-python3}
 CC=${CC:-gcc}
 OUT=$(mktemp -d "${TMPDIR:-/tmp}/inertia-sanitize.XXXXXX")
 
-INCLUDE=$("$PYTHON" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')
-SUFFIX=$("$PYTHON" -c 'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))')
-mkdir -p "$OUT/pkg"
-cp -R "$ROOT/inertia_tool" "$OUT/pkg/inertia_tool"
-find "$OUT/pkg/inertia_tool" -name '_accel*.so' -delete
-find "$OUT/pkg/inertia_tool" -name '__pycache__' -prune -exec rm -rf {} +
-"$CC" -shared -fPIC -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined \
-    -fno-sanitize-recover=undefined -Wall -Werror -I"$INCLUDE" \
-    "$ROOT/inertia_tool/_accel.c" -o "$OUT/pkg/inertia_tool/_accel$SUFFIX"
+. "$ROOT/scripts/instrumented.sh"
+build_instrumented "$OUT" -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
 
 ASAN_LIB=$("$CC" -print-file-name=libasan.so)
 UBSAN_LIB=$("$CC" -print-file-name=libubsan.so)
 status=0
 env PYTHONPATH="$OUT/pkg" PYTHONDONTWRITEBYTECODE=1 INERTIA_TOOL_NO_ACCEL= \
-    INERTIA_SANITIZE_EXTENSION="$OUT/pkg/inertia_tool/_accel$SUFFIX" \
+    INERTIA_SANITIZE_EXTENSION="$EXT" \
     LD_PRELOAD="$ASAN_LIB $UBSAN_LIB" \
     ASAN_OPTIONS="detect_leaks=0:halt_on_error=1:abort_on_error=1:log_path=$OUT/sanitizer" \
     UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:log_path=$OUT/sanitizer" \
     "$PYTHON" "$ROOT/fuzz/sanitize_replay.py" --mutations "$MUTATIONS" --seed "$SEED" || status=$?
 
 # the replay checks that it ran the sanitizer build; any report in the log is a failure too
-if ls "$OUT"/sanitizer.* >/dev/null 2>&1; then
-    echo "sanitize: sanitizer reports:" >&2
-    cat "$OUT"/sanitizer.* >&2
-    status=1
-fi
-if [ "$status" -ne 0 ]; then
-    echo "sanitize: FAILED (exit $status); build and logs kept in $OUT" >&2
-    exit "$status"
-fi
-rm -rf "$OUT"
-echo "sanitize: OK (AddressSanitizer + UndefinedBehaviorSanitizer, no reports)"
+finish_instrumented sanitize "$OUT" sanitizer "$status" "OK (AddressSanitizer + UndefinedBehaviorSanitizer, no reports)"

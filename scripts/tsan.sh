@@ -12,15 +12,10 @@ PYTHON=${PYTHON:-python3}
 CC=${CC:-gcc}
 OUT=$(mktemp -d "${TMPDIR:-/tmp}/inertia-tsan.XXXXXX")
 
-INCLUDE=$("$PYTHON" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')
-SUFFIX=$("$PYTHON" -c 'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))')
-mkdir -p "$OUT/pkg"
-cp -R "$ROOT/inertia_tool" "$OUT/pkg/inertia_tool"
+. "$ROOT/scripts/instrumented.sh"
+build_instrumented "$OUT" -fsanitize=thread -pthread
 cp -R "$ROOT/tests" "$OUT/pkg/tests"
-find "$OUT/pkg" -name '_accel*.so' -delete
-find "$OUT/pkg" -name '__pycache__' -prune -exec rm -rf {} +
-"$CC" -shared -fPIC -g -O1 -fsanitize=thread -pthread -Wall -Werror -I"$INCLUDE" \
-    "$ROOT/inertia_tool/_accel.c" -o "$OUT/pkg/inertia_tool/_accel$SUFFIX"
+find "$OUT/pkg/tests" -name '__pycache__' -prune -exec rm -rf {} +
 
 TSAN_LIB=$("$CC" -print-file-name=libtsan.so)
 status=0
@@ -29,14 +24,4 @@ status=0
     TSAN_OPTIONS="report_signal_unsafe=0:halt_on_error=0:log_path=$OUT/tsan" \
     "$PYTHON" -m pytest -q -p no:cacheprovider tests/test_native_threads.py) || status=$?
 
-if ls "$OUT"/tsan.* >/dev/null 2>&1; then
-    echo "tsan: ThreadSanitizer reports:" >&2
-    cat "$OUT"/tsan.* >&2
-    status=1
-fi
-if [ "$status" -ne 0 ]; then
-    echo "tsan: FAILED (exit $status); build and logs kept in $OUT" >&2
-    exit "$status"
-fi
-rm -rf "$OUT"
-echo "tsan: the threaded kernels ran under ThreadSanitizer without reports"
+finish_instrumented tsan "$OUT" tsan "$status" "the threaded kernels ran under ThreadSanitizer without reports"
