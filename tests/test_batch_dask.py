@@ -117,3 +117,40 @@ def test_local_cluster_workers_run_without_the_profiler(cluster):
     seen = cluster.client.run(lambda: dask.config.get("distributed.worker.profile.enabled"))
     assert set(seen.values()) == {False}
     assert dask.config.get("distributed.worker.profile.enabled") is True       # this process's config untouched
+
+
+@pytest.mark.slow
+def test_local_cluster_workers_keep_glibc_adaptive_malloc(cluster):
+    """Dask's nanny would set MALLOC_TRIM_THRESHOLD_=65536 in its workers, which freezes glibc's mmap threshold
+    at 128 kB (every larger array a fresh mmap: 28x the page faults on small parts); our LocalCluster unsets it
+    unless the user's own environment has it."""
+    if "MALLOC_TRIM_THRESHOLD_" in os.environ:
+        pytest.skip("MALLOC_TRIM_THRESHOLD_ is set in this environment (the workers inherit it, as they should)")
+    seen = cluster.client.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_"))
+    assert set(seen.values()) == {None}
+    import dask
+
+    assert dask.config.get("distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_") == 65536  # ours untouched
+
+
+@pytest.mark.slow
+def test_dask_chunks_queued_together_reach_the_scheduler_in_one_map(tmp_path, cluster, monkeypatch):
+    """The chunks submitted before a wait go to the scheduler as one Client.map (one decision spreads them over
+    the workers); every chunk's rows come back unpickled from run_packed's bytes."""
+    d = tmp_path / "boxes"
+    d.mkdir()
+    box = trimesh.creation.box((1.0, 1.0, 1.0))
+    for k in range(30):
+        write_binary_stl(d / f"b{k:02d}.stl", np.asarray(box.vertices) * (1 + k), box.faces)
+    files = discover_files(d)
+    calls = []
+    real_map = cluster.client.map
+    monkeypatch.setattr(cluster.client, "map", lambda fn, *cols, **kw: (calls.append([len(c) for c in cols[1]]),
+                                                                        real_map(fn, *cols, **kw))[1])
+    rows = []
+    summary = run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1000.0), rows.append,
+                        client=cluster.client, chunk_seconds=0.01)
+    assert summary.ok == 30 and sorted(r["path"] for r in rows) == files
+    assert calls[0] == [1, 2, 4, 8]               # the first round: four chunks (2 per worker) in one map
+    assert sum(map(sum, calls)) == 30
+    assert all(isinstance(r, dict) and r["status"] == "ok" for r in rows)

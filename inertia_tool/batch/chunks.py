@@ -18,10 +18,12 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import math
+import pickle
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["ChunkSizer", "PoolTasks", "DaskTasks", "Finished", "POOL_CHUNK_SECONDS", "DASK_CHUNK_SECONDS"]
+__all__ = ["ChunkSizer", "PoolTasks", "DaskTasks", "Finished", "POOL_CHUNK_SECONDS", "DASK_CHUNK_SECONDS",
+           "run_packed"]
 
 #: Seconds of work aimed at per chunk on a local process pool (task cost ~0.2 ms: 0.05 s makes it < 1 %,
 #: and a killed run loses at most this much work per worker).
@@ -155,10 +157,24 @@ class PoolTasks:
             self._pool.shutdown(wait=True, cancel_futures=True)
 
 
+def run_packed(fn: Callable, chunk: list, *args: Any) -> bytes:
+    """``fn(chunk, *args)`` pickled into one ``bytes``: the task :class:`DaskTasks` submits.
+
+    A Dask worker measures (``sizeof``) and serialises a returned list of dicts item by item, on the worker and
+    again where the scheduler forwards it; one ``bytes`` object costs it nothing.  On the project's 2-core
+    machine this took 0.1-0.15 s of CPU off a batch of 2,000 small parts (about 5 % of the work), in four of four
+    paired runs.
+    """
+    return pickle.dumps(fn(chunk, *args), protocol=pickle.HIGHEST_PROTOCOL)
+
+
 class DaskTasks:
     """Chunks on a Dask cluster through a ``dask.distributed.Client`` (a LocalCluster's or a remote one's).
 
-    Results come back through ``distributed.as_completed`` in order of completion, fetched in the background.
+    Each chunk runs as :func:`run_packed` (its result comes back as one pickled ``bytes``, unpickled here).
+    Chunks submitted between two :meth:`wait` calls reach the scheduler together (one ``Client.map``), so that
+    it spreads them over the workers in one decision: submitted one by one, the first two chunks of a batch
+    often went to the same worker while the other waited 15-25 ms.  Results come back through ``distributed.as_completed`` in order of completion, fetched in the background.
     The number of workers is asked of the scheduler at most once a second, so that workers joining or leaving
     a running cluster change the chunks in flight.
     """
@@ -169,6 +185,7 @@ class DaskTasks:
         self.client = client
         self._done = as_completed(with_results=True, raise_errors=False)
         self._pending: dict[Any, list] = {}
+        self._queued: list[tuple[Callable, list, tuple]] = []
         self._asked = -math.inf
         self._workers = 1
 
@@ -187,22 +204,34 @@ class DaskTasks:
         return self._workers
 
     def submit(self, fn: Callable, chunk: list, *args: Any) -> None:
-        """Start ``fn(chunk, *args)`` on some worker (``pure=False``: never deduplicated)."""
-        fut = self.client.submit(fn, chunk, *args, pure=False)
-        self._pending[fut] = chunk
-        self._done.add(fut)
+        """Queue ``fn(chunk, *args)`` for some worker; it is sent with the others queued at the next :meth:`wait`
+        (``pure=False``: never deduplicated)."""
+        self._queued.append((fn, chunk, args))
+
+    def _send(self) -> None:
+        """Send the queued chunks to the scheduler in one ``Client.map``."""
+        if not self._queued:
+            return
+        queued, self._queued = self._queued, []
+        columns = [list(c) for c in zip(*((fn, chunk, *args) for fn, chunk, args in queued))]
+        futures = self.client.map(run_packed, *columns, pure=False)
+        for fut, (_, chunk, _) in zip(futures, queued):
+            self._pending[fut] = chunk
+            self._done.add(fut)
 
     def in_flight(self) -> int:
         """Chunks submitted and not yet returned by :meth:`wait`."""
-        return len(self._pending)
+        return len(self._pending) + len(self._queued)
 
     def wait(self) -> list[Finished]:
-        """Block until at least one chunk has finished; the finished ones, in order of completion."""
+        """Send what is queued, block until at least one chunk has finished; the finished ones, in order of
+        completion."""
+        self._send()
         out: list[Finished] = []
         for fut, result in self._done.next_batch(block=True):
             chunk = self._pending.pop(fut)
             if fut.status == "finished":
-                out.append((chunk, result, None))
+                out.append((chunk, pickle.loads(result), None))        # our own task's bytes (run_packed)
             else:                                # "error": (type, exception, traceback); "cancelled": the error
                 exc = result[1] if isinstance(result, tuple) and len(result) == 3 else result
                 out.append((chunk, None, exc if isinstance(exc, BaseException) else RuntimeError(str(exc))))
@@ -210,6 +239,7 @@ class DaskTasks:
 
     def close(self) -> None:
         """Cancel what is still pending (the client and cluster belong to the caller)."""
+        self._queued.clear()
         if self._pending:
             self.client.cancel(list(self._pending))
             self._pending.clear()

@@ -11,7 +11,7 @@ from typing import Any
 
 from ..errors import UsageError
 
-__all__ = ["DaskCluster", "connect_dask"]
+__all__ = ["DaskCluster", "LOCAL_CLUSTER_CONFIG", "connect_dask"]
 
 
 def _warm_up() -> int:
@@ -31,6 +31,23 @@ def _warm_up() -> int:
         warnings.simplefilter("ignore")                     # a cube's equal moments are no news
         mass_properties((vertices, faces), density=1000.0, units="m")
     return os.getpid()
+
+
+#: Dask settings of the LocalCluster :func:`connect_dask` starts (a remote cluster keeps its own; see
+#: ``docs/batch.md``).
+LOCAL_CLUSTER_CONFIG = {
+    # Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers' environment, to give freed memory back to the
+    # system at once.  Any such variable also freezes glibc's mmap threshold at 128 kB, so every array above
+    # 128 kB (a 4,800-triangle part's corners) is a fresh mmap and its pages fault in again: on 2,000 small parts
+    # 28x the page faults and 8-20 % more CPU per file.  Unset, glibc's adaptive thresholds apply (a worker
+    # keeps at most some tens of MB of freed heap).
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+    # no dashboard: the workers' statistical profiler (a stack sample every 10 ms) and a system monitor every
+    # 0.5 s only feed it; the event loop's 20 ms tick only measures how blocked the loop is
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.admin.tick.interval": "1s",
+}
 
 
 class DaskCluster:
@@ -74,7 +91,7 @@ def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> Da
     ----------
     address : str
         ``"local"``: a ``LocalCluster`` of ``workers`` single-threaded worker processes on this machine, without a
-        dashboard (and without the workers' profiler, which only feeds it). Anything else is a scheduler address
+        dashboard, with :data:`LOCAL_CLUSTER_CONFIG`. Anything else is a scheduler address
         (``"tcp://host:8786"``); the workers must see the mesh files at the same absolute paths (a shared file
         system) and have inertia_tool installed.
     workers : int
@@ -101,9 +118,7 @@ def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> Da
 
         import dask
 
-        # no dashboard, so the workers' statistical profiler (a stack sample every 10 ms) can only cost; its cost
-        # was within the noise of the project's shared machine
-        with dask.config.set({"distributed.worker.profile.enabled": False}):
+        with dask.config.set(LOCAL_CLUSTER_CONFIG):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
                                    env={THREADS_ENV: str(kernel_threads_per_worker(workers))})
         client = Client(cluster)
