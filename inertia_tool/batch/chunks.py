@@ -172,9 +172,9 @@ class DaskTasks:
     """Chunks on a Dask cluster through a ``dask.distributed.Client`` (a LocalCluster's or a remote one's).
 
     Each chunk runs as :func:`run_packed` (its result comes back as one pickled ``bytes``, unpickled here).
-    Chunks submitted between two :meth:`wait` calls reach the scheduler together (one ``Client.map``), so that
-    it spreads them over the workers in one decision: submitted one by one, the first two chunks of a batch
-    often went to the same worker while the other waited 15-25 ms.  Results come back through ``distributed.as_completed`` in order of completion, fetched in the background.
+    Chunks submitted between two :meth:`wait` calls reach the scheduler together, in one ``Client.map`` (one
+    graph update instead of one per chunk).  Results come back through ``distributed.as_completed`` in order of
+    completion, fetched in the background.
     The number of workers is asked of the scheduler at most once a second, so that workers joining or leaving
     a running cluster change the chunks in flight.
     """
