@@ -252,7 +252,8 @@ def splitting_section():
                 best = (t_s, label, e)
         if best:
             print(f"{'':20s}best splitting at DOP853's accuracy: {best[1]}, error {best[2]:.2e}, "
-                  f"time ratio {best[0] / t_dop:.3f} (target <= 0.333)")
+                  f"time ratio {best[0] / t_dop:.3f} (a numpy torque of ~10 us a call dominates both here; "
+                  "the 1/3 goal is measured by bench_integrator.py)")
         results[rate] = best
     return results
 

@@ -120,6 +120,8 @@ class NonFiniteResultError(PhysicsError, OverflowError):
     @classmethod
     def check(cls, what: str, value: ArrayLike, *, because: str = "") -> None:
         """Raise unless every entry of ``value`` is finite; the message names ``what`` and ``because``."""
+        if type(value) is float and value - value == 0.0:     # a finite Python float: the common case, no numpy
+            return
         import numpy as np
         a = np.asarray(value, dtype=np.float64)
         if not np.all(np.isfinite(a)):

@@ -1,5 +1,7 @@
 """Result values cannot be corrupted (issue: read-only arrays, equality that works, one way to principal axes)."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -57,3 +59,39 @@ def test_one_way_to_principal_axes_on_a_body(props):
     from inertia_tool.mass.principal import principal_axes
     other = principal_axes(props.inertia, reference_point=props.center_of_mass, mass=props.mass, rtol=1e-3)
     np.testing.assert_array_equal(other.moments, props.principal.moments)
+
+
+@pytest.mark.parametrize("value", [float("inf"), float("-inf"), float("nan"), np.float64("inf"), [1.0, float("nan")],
+                                   np.array([[0.0, np.inf]])])
+def test_non_finite_check_refuses_every_non_finite_form(value):
+    """The float fast path (no numpy) and the array path both refuse inf and NaN, and name the quantity."""
+    from inertia_tool.errors import NonFiniteResultError
+
+    with pytest.raises(NonFiniteResultError, match="the mass is"):
+        NonFiniteResultError.check("the mass", value)
+
+
+@pytest.mark.parametrize("value", [0.0, -1e308, 5e-324, np.float64(2.0), [1.0, 2.0], np.eye(3)])
+def test_non_finite_check_accepts_finite_values(value):
+    from inertia_tool.errors import NonFiniteResultError
+
+    assert NonFiniteResultError.check("the mass", value) is None
+
+
+def test_frozen_value_field_names_are_per_class():
+    """The cached field names are per class: two value classes with different array fields each make their own
+    arrays read-only, and compare by their own compared fields."""
+    @frozen_value
+    class A:
+        x: np.ndarray
+
+    @frozen_value
+    class B:
+        x: np.ndarray
+        y: np.ndarray
+        note: str = dataclasses.field(default="", compare=False)
+
+    a, b = A(np.zeros(2)), B(np.zeros(2), np.ones(2), note="n")
+    assert not a.x.flags.writeable and not b.x.flags.writeable and not b.y.flags.writeable
+    assert b == B(np.zeros(2), np.ones(2), note="other") and hash(b) == hash(B(np.zeros(2), np.ones(2)))
+    assert b != B(np.zeros(2), np.zeros(2))
