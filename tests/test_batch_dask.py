@@ -32,6 +32,15 @@ def _strip(rows):
     return sorted(json.dumps({k: v for k, v in r.items() if k not in ("seconds", "worker")}) for r in rows)
 
 
+def _scaled_boxes(directory, count):
+    """``count`` unit cubes scaled by 1, 2, ... (b00.stl, b01.stl, ...) in ``directory``; their sorted paths."""
+    directory.mkdir()
+    box = trimesh.creation.box((1.0, 1.0, 1.0))
+    for k in range(count):
+        write_binary_stl(directory / f"b{k:02d}.stl", np.asarray(box.vertices) * (1 + k), box.faces)
+    return discover_files(directory)
+
+
 @pytest.fixture(scope="module")
 def cluster():
     from inertia_tool.batch.cluster import connect_dask
@@ -77,12 +86,7 @@ def test_dask_chunks_every_file_once_on_both_workers(tmp_path, cluster, monkeypa
     more than one file, both workers used, the numbers right."""
     import inertia_tool.batch.chunks as chunks_mod
 
-    d = tmp_path / "boxes"
-    d.mkdir()
-    box = trimesh.creation.box((1.0, 1.0, 1.0))
-    for k in range(60):
-        write_binary_stl(d / f"b{k:02d}.stl", np.asarray(box.vertices) * (1 + k), box.faces)
-    files = discover_files(d)
+    files = _scaled_boxes(tmp_path / "boxes", 60)
     sizes = []
     real_submit = chunks_mod.DaskTasks.submit
     monkeypatch.setattr(chunks_mod.DaskTasks, "submit",
@@ -135,14 +139,9 @@ def test_local_cluster_workers_keep_glibc_adaptive_malloc(cluster):
 
 @pytest.mark.slow
 def test_dask_chunks_queued_together_reach_the_scheduler_in_one_map(tmp_path, cluster, monkeypatch):
-    """The chunks submitted before a wait go to the scheduler as one Client.map (one decision spreads them over
-    the workers); every chunk's rows come back unpickled from run_packed's bytes."""
-    d = tmp_path / "boxes"
-    d.mkdir()
-    box = trimesh.creation.box((1.0, 1.0, 1.0))
-    for k in range(30):
-        write_binary_stl(d / f"b{k:02d}.stl", np.asarray(box.vertices) * (1 + k), box.faces)
-    files = discover_files(d)
+    """The chunks submitted before a wait go to the scheduler as one Client.map (one graph update); every chunk's
+    rows come back unpickled from run_packed's bytes."""
+    files = _scaled_boxes(tmp_path / "boxes", 30)
     calls = []
     real_map = cluster.client.map
     monkeypatch.setattr(cluster.client, "map", lambda fn, *cols, **kw: (calls.append([len(c) for c in cols[1]]),
