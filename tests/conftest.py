@@ -1,4 +1,7 @@
 import os
+import signal
+import subprocess
+import time
 
 import numpy as np
 import pytest
@@ -85,3 +88,17 @@ def assert_tensor_close(actual, desired, rtol, err_msg=""):
     desired = np.asarray(desired, dtype=float)
     scale = max(np.linalg.norm(actual), np.linalg.norm(desired))
     np.testing.assert_allclose(actual, desired, rtol=rtol, atol=rtol * scale, err_msg=err_msg)
+
+
+def kill_after_lines(cmd, out, lines, *, env=None, seconds=60.0, poll=0.05):
+    """Start ``cmd``, wait until the file ``out`` holds at least ``lines`` line breaks (or the process ended, or
+    ``seconds`` passed), then SIGKILL it (a crash in the middle of a run) and reap it."""
+    proc = subprocess.Popen(cmd, env=env, stderr=subprocess.DEVNULL)
+    try:
+        for _ in range(int(seconds / poll)):
+            if out.exists() and out.read_bytes().count(b"\n") >= lines or proc.poll() is not None:
+                break
+            time.sleep(poll)
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from conftest import write_binary_stl
+from conftest import kill_after_lines, write_binary_stl
 from inertia_tool.mesh import LoadOptions
 from inertia_tool.batch import runner as batch_mod
 from inertia_tool import mass_properties
@@ -283,15 +283,7 @@ def test_killed_run_leaves_a_valid_file_and_resume_completes(tmp_path):
     out = tmp_path / "r.jsonl"
     env = {**os.environ, "PYTHONPATH": ROOT}
     cmd = [sys.executable, "-m", "inertia_tool.cli", "batch", str(d), "--out", str(out), "-q"]
-    proc = subprocess.Popen(cmd, env=env, stderr=subprocess.DEVNULL)
-    try:
-        for _ in range(600):                       # up to 60 s for the first rows
-            if out.exists() and out.read_bytes().count(b"\n") >= 3 or proc.poll() is not None:
-                break
-            time.sleep(0.1)
-    finally:
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
+    kill_after_lines(cmd, out, 3, env=env, poll=0.1)                  # up to 60 s for the first rows
     with open_results(out) as r:
         before = len(r.previous_rows)
     assert before >= 3

@@ -5,11 +5,9 @@ policy of the results file, and a run killed in the middle of a chunk resumed.""
 import concurrent.futures as cf
 import multiprocessing
 import os
-import signal
 import subprocess
 import sys
 import threading
-import time
 
 import numpy as np
 import pytest
@@ -17,7 +15,7 @@ import trimesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conftest import write_binary_stl
+from conftest import kill_after_lines, write_binary_stl
 from inertia_tool.batch import rows as rows_mod
 from inertia_tool.batch import runner as batch_mod
 from inertia_tool.batch.chunks import ChunkSizer
@@ -249,15 +247,7 @@ def test_run_killed_in_the_middle_of_a_chunk_resumes_every_file_once(many, tmp_p
     env = {**os.environ, "PYTHONPATH": ROOT}
     cmd = [sys.executable, str(script), "batch", *many, "--units", "mm", "--out", str(out), "-j", "2", "-q"]
     header = 1 if suffix == "csv" else 0
-    proc = subprocess.Popen(cmd, env=env, stderr=subprocess.DEVNULL)
-    try:
-        for _ in range(600):                         # up to 60 s for the first chunks (1, 1, 4, ... files)
-            if out.exists() and out.read_bytes().count(b"\n") >= header + 8 or proc.poll() is not None:
-                break
-            time.sleep(0.05)
-    finally:
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
+    kill_after_lines(cmd, out, header + 8, env=env, seconds=30.0)   # the first chunks (1, 2, 4, ... files)
     with open_results(out) as r:
         before = len(r.previous_rows)
     assert 8 <= before < len(many), f"killed after {before} rows: not in the middle of the batch"
