@@ -1,7 +1,10 @@
 """The one number formatter of the reports: how a computed value is shown (never what it is).
 
-Every writer (text, HTML, CAD, balance, stability, spin-it, the simulator snippets) formats numbers here, so a
-rule such as "no −0", "a missing value is —" or "round-off zeros print as 0" is made once.
+The writers (text, HTML, CAD, balance, stability, spin-it, the simulator snippets) format numbers here, so a
+rule such as "no −0", "a missing value is —" or "round-off zeros print as 0" is made once.  Two places do not,
+on purpose or not yet: corrected robot files write ``repr`` (the exact float, not a display), and the robot
+audit's text table still formats with its own fixed-width specs (``reports/robot_audit._fmt``: decimals and
+percentages, which :func:`number` has no style for).
 """
 
 from __future__ import annotations
