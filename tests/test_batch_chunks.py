@@ -148,19 +148,25 @@ def test_a_chunk_that_fails_whole_is_split_and_only_the_bad_file_fails(many):
     assert max(pool.sizes) > 1 and pool.sizes.count(1) >= 2      # chunks were used, the failed one split
 
 
+def _before_analysing(monkeypatch, target, action):
+    """Patch the per-file work so that ``action()`` runs before the file ``target`` is analysed (forked pool
+    workers inherit the patch)."""
+    real = batch_mod._analyze
+
+    def patched(path, *args):
+        if path == target:
+            action()
+        return real(path, *args)
+
+    monkeypatch.setattr(batch_mod, "_analyze", patched)
+
+
 @pytest.mark.skipif(multiprocessing.get_start_method() != "fork", reason="patches the worker through fork")
 def test_a_worker_that_dies_hard_costs_only_its_file(many, monkeypatch):
     """A real dead worker (os._exit in the middle of a chunk) breaks the pool: run_batch restarts it, splits the
     chunks that were lost, and every file ends with exactly one row."""
     poison = many[9]
-    real = batch_mod._analyze
-
-    def die_on_poison(path, *args):
-        if path == poison:
-            os._exit(13)
-        return real(path, *args)
-
-    monkeypatch.setattr(batch_mod, "_analyze", die_on_poison)
+    _before_analysing(monkeypatch, poison, lambda: os._exit(13))
     got = []
     summary = run_batch(many, OPTIONS, got.append, jobs=2, chunk_seconds=100.0)
     assert sorted(r["path"] for r in got) == many
@@ -177,14 +183,7 @@ def test_rows_stream_back_in_order_of_completion(many, monkeypatch):
     """A slow chunk does not hold back the rows of the chunks that finish before it."""
     slow = many[0]
     release = threading.Event()
-    real = batch_mod._analyze
-
-    def held(path, *args):
-        if path == slow:
-            release.wait(30)
-        return real(path, *args)
-
-    monkeypatch.setattr(batch_mod, "_analyze", held)
+    _before_analysing(monkeypatch, slow, lambda: release.wait(30))
     order = []
 
     def write(row):
