@@ -15,6 +15,8 @@ RobotDescriptionError a robot description (URDF, xacro, SDF, MJCF)
 InvalidMeshError      the mesh is read but does not bound a solid
 PhysicsError          valid input, but the request cannot be met
                       (e.g. a singular top)
+OutputCheckError      a file about to be written failed its own
+                      check (nothing was written; a bug to report)
 ====================  ==============================================
 
 Messages name API parameters in backticks (`` `max_faces` ``, `` `repair=True` ``); the command line maps the
@@ -37,6 +39,7 @@ __all__ = [
     "RobotDescriptionError",
     "InvalidMeshError",
     "PhysicsError",
+    "OutputCheckError",
     "InertiaToolWarning",
     "MeshRepairedWarning",
     "InsideOutWarning",
@@ -108,6 +111,13 @@ class InvalidMeshError(InertiaToolError, ValueError):
 class PhysicsError(InertiaToolError, ValueError):
     """The input is well formed but the physical request has no valid answer."""
 
+
+
+class OutputCheckError(InertiaToolError, RuntimeError):
+    """A file the tool was about to write failed the check made before it is written (e.g. a corrected robot
+    description that, read back, differs from its input outside the corrected elements).  Nothing is written;
+    it is a bug of the tool (exit code 1), and the message says which element differed and how.
+    """
 
 
 class NonFiniteResultError(PhysicsError, OverflowError):

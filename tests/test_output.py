@@ -44,9 +44,10 @@ def test_an_os_error_on_rename_is_one_line_and_removes_the_temporary(tmp_path, m
     target = tmp_path / "r.html"
     target.write_text("old")
 
-    def full_disk(src, dst):
+    def full_disk(src, dst, **kw):
         raise OSError(28, "No space left on device")
-    monkeypatch.setattr(output.os, "replace", full_disk)
+    monkeypatch.setattr(output.os, "replace", full_disk)     # the rename that replaces (with --force)
+    monkeypatch.setattr(output.os, "link", full_disk)        # the rename that never replaces
     with pytest.raises(OutputFileError, match=r"r\.html: cannot write it \(No space left on device\)"):
         write_text(target, "new")
     assert target.read_text() == "old" and _names(tmp_path) == ["r.html"]
@@ -96,9 +97,10 @@ def test_balance_markdown_checks_every_file_before_printing_or_writing(tmp_path,
 def test_balance_write_failure_prints_nothing_and_leaves_no_partial_file(tmp_path, monkeypatch, capsys):
     report = tmp_path / "wheel.html"
 
-    def full_disk(src, dst):
+    def full_disk(src, dst, **kw):
         raise OSError(28, "No space left on device")
-    monkeypatch.setattr(output.os, "replace", full_disk)
+    monkeypatch.setattr(output.os, "replace", full_disk)     # the rename that replaces (with --force)
+    monkeypatch.setattr(output.os, "link", full_disk)        # the rename that never replaces
     assert main(BALANCE + ["--report", str(report)]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and "No space left on device" in captured.err

@@ -4,13 +4,16 @@ Every file the tool produces (HTML and Markdown reports, SVG plots, CSV trajecto
 snippets, PNG figures) goes through this module, so there is one overwrite rule and one writer:
 
 * :func:`check_targets` refuses, before any work and before any file is written, a target that exists
-  (unless ``force``), is a directory, or lies in a missing directory.  A command that writes several files
-  checks **all** of them first, so it never stops half-way with some files replaced.
+  (unless ``force``), is a symbolic link (even with ``force``: the tool neither writes through a link nor
+  replaces it), is a directory, or lies in a missing directory.  A command that writes several files checks
+  **all** of them first, so it never stops half-way with some files replaced.
 * :func:`atomic_target` / :func:`write_text` / :func:`write_bytes` write to a temporary file in the target's
-  own directory (same file system), flush and ``fsync`` it, then ``os.replace`` it onto the target: a reader
+  own directory (same file system) with an unpredictable name created ``O_EXCL | O_NOFOLLOW`` (so a
+  planted file or symbolic link is never followed), ``fsync`` it, then rename it onto the target: a reader
   sees the old file or the complete new one, never half a file, and a failure (a full disk, a crash of the
   writer, an exception while producing the content) removes the temporary file and leaves the target as it
-  was.
+  was.  With ``replace=False`` the rename is a hard link that fails if the target appeared meanwhile, so
+  "never overwrite" holds at the moment of writing, not only at the check.
 
 Failures are :class:`~inertia_tool.errors.OutputFileError` (a ``UsageError``, exit code 2) with one line
 naming the file and the operating system's reason.
@@ -19,6 +22,7 @@ naming the file and the operating system's reason.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from collections.abc import Iterator, Mapping, Sequence
@@ -64,6 +68,9 @@ def check_targets(targets: Sequence[str | None | tuple[str | None, str | None]],
         if full in seen:
             raise OutputFileError(f"{where}: named twice among the files to write")
         seen.add(full)
+        if os.path.islink(path):
+            raise OutputFileError(f"{where}: is a symbolic link; refusing to write through it or replace it "
+                                  "(name the file it points to)")
         if os.path.isdir(path):
             raise OutputFileError(f"{where}: is a directory")
         if os.path.lexists(path) and not force:
@@ -89,14 +96,100 @@ def _fsync_directory(directory: str) -> None:
         os.close(fd)
 
 
+_NO_HARD_LINKS = {getattr(errno, name) for name in ("EPERM", "ENOTSUP", "EOPNOTSUPP", "EXDEV", "EMLINK", "ENOSYS")
+                  if hasattr(errno, name)}
+
+
+def _create_temporary(path: str, where: str) -> tuple[int, str, os.stat_result]:
+    """``(fd, name, stat)`` of a new, empty temporary file beside ``path``: an unpredictable name, created
+    with ``O_CREAT | O_EXCL | O_NOFOLLOW`` (``tempfile.mkstemp``), mode 0600 until it is complete."""
+    directory = os.path.dirname(os.path.abspath(path))
+    stem, suffix = os.path.splitext(os.path.basename(path))
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{stem[:80]}.", suffix=f".tmp{suffix}", dir=directory)
+    except OSError as exc:
+        raise OutputFileError(f"{where}: cannot write it ({exc.strerror or exc})") from None
+    return fd, tmp, os.fstat(fd)
+
+
+def _same_file(a: os.stat_result, b: os.stat_result) -> bool:
+    return (a.st_dev, a.st_ino) == (b.st_dev, b.st_ino)
+
+
+def _commit(fd: int, tmp: str, created: os.stat_result, path: str, where: str, replace: bool) -> None:
+    """Make the temporary file (open as ``fd``) durable and give it the name ``path``.
+
+    The name ``tmp`` must still be the file we created (not swapped for another file or a symbolic link
+    while a third-party writer had it).  With ``replace`` false the final step is ``os.link`` (which fails if
+    ``path`` exists, so a file created meanwhile is never overwritten) and the temporary name is removed;
+    where the file system has no hard links, a last ``lexists`` check and ``os.replace``.
+    """
+    try:
+        now = os.lstat(tmp)
+    except FileNotFoundError:
+        now = None
+    if now is None or not _same_file(now, created):
+        raise OutputFileError(f"{where}: its temporary file {tmp} was replaced or removed while it was written; "
+                              "nothing was written")
+    os.fsync(fd)
+    mode = _default_mode()
+    if mode is not None:
+        os.fchmod(fd, mode)                          # mkstemp makes 0600; give the file the usual rights
+    if replace:
+        os.replace(tmp, path)
+        return
+    try:
+        os.link(tmp, path, follow_symlinks=False)
+    except FileExistsError:
+        raise OutputFileError(f"{where}: exists; refusing to overwrite it (`force=True` overwrites it)") from None
+    except OSError as exc:
+        if exc.errno not in _NO_HARD_LINKS:
+            raise
+        if os.path.lexists(path):
+            raise OutputFileError(f"{where}: exists; refusing to overwrite it (`force=True` overwrites it)") \
+                from None
+        os.replace(tmp, path)
+        return
+    os.remove(tmp)
+
+
+def _remove_quietly(tmp: str, created: os.stat_result) -> None:
+    """Remove the temporary name if it is still the file we created."""
+    with contextlib.suppress(OSError):
+        if _same_file(os.lstat(tmp), created):
+            os.remove(tmp)
+
+
 @contextlib.contextmanager
-def atomic_target(path: str | os.PathLike, *, label: str | None = None) -> Iterator[str]:
+def _atomic(path: str | os.PathLike, label: str | None, replace: bool) -> Iterator[tuple[int, str]]:
+    """``(fd, temporary name)``; on a normal exit the file becomes ``path`` (:func:`_commit`), on an
+    exception it is removed and ``path`` is left as it was."""
+    path = os.fspath(path)
+    where = _label(path, label)
+    fd, tmp, created = _create_temporary(path, where)
+    try:
+        yield fd, tmp
+        _commit(fd, tmp, created, path, where, replace)
+    except BaseException as exc:
+        _remove_quietly(tmp, created)
+        if isinstance(exc, OSError) and not isinstance(exc, UsageError):
+            raise OutputFileError(f"{where}: cannot write it ({exc.strerror or exc})") from None
+        raise
+    finally:
+        os.close(fd)
+    _fsync_directory(os.path.dirname(os.path.abspath(path)))
+
+
+@contextlib.contextmanager
+def atomic_target(path: str | os.PathLike, *, label: str | None = None, replace: bool = True) -> Iterator[str]:
     """Context manager yielding a temporary path to write; on success it becomes ``path`` atomically.
 
-    The temporary file is in the directory of ``path`` and keeps its suffix (so ``savefig`` and
-    ``np.savetxt`` pick the format from it).  On leaving the block normally it is fsync'd and renamed onto
-    ``path`` (``os.replace``); on any exception it is removed and ``path`` is left untouched.  The overwrite
-    rule is :func:`check_targets`' (call it first); this only writes.
+    The temporary file is in the directory of ``path``, has an unpredictable name (created with
+    ``O_EXCL | O_NOFOLLOW``) and keeps the suffix of ``path`` (so ``savefig`` and ``np.savetxt`` pick the
+    format from it).  On leaving the block normally it is checked to be still the file created, fsync'd and
+    renamed onto ``path`` (``os.replace``); on any exception it is removed and ``path`` is left untouched.
+    The overwrite rule is :func:`check_targets`' (call it first).  Writers that hold the bytes should use
+    :func:`write_bytes`, which writes through the descriptor and never opens the name again.
 
     Parameters
     ----------
@@ -104,37 +197,17 @@ def atomic_target(path: str | os.PathLike, *, label: str | None = None) -> Itera
         The file to produce.
     label : str, optional
         Prefix of messages (the option that named the file, e.g. ``"--csv"``).
+    replace : bool
+        Replace ``path`` if it exists by then; when false an existing file (even one created after
+        :func:`check_targets`) is refused and left alone.
 
     Raises
     ------
     OutputFileError
         The operating system refused to create, write or rename the file (one line, the reason).
     """
-    path = os.fspath(path)
-    where = _label(path, label)
-    directory = os.path.dirname(os.path.abspath(path))
-    base = os.path.basename(path)
-    stem, suffix = os.path.splitext(base)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{stem[:80]}.", suffix=f".tmp{suffix}", dir=directory)
-        os.close(fd)
-    except OSError as exc:
-        raise OutputFileError(f"{where}: cannot write it ({exc.strerror or exc})") from None
-    try:
+    with _atomic(path, label, replace) as (_fd, tmp):
         yield tmp
-        with open(tmp, "rb+") as fh:                 # whatever wrote the temp file, make its bytes durable
-            os.fsync(fh.fileno())
-        mode = _default_mode()
-        if mode is not None:
-            os.chmod(tmp, mode)                      # mkstemp makes 0600; give the file the usual rights
-        os.replace(tmp, path)
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            os.remove(tmp)
-        if isinstance(exc, OSError) and not isinstance(exc, UsageError):
-            raise OutputFileError(f"{where}: cannot write it ({exc.strerror or exc})") from None
-        raise
-    _fsync_directory(directory)
 
 
 def _default_mode() -> int | None:
@@ -146,25 +219,28 @@ def _default_mode() -> int | None:
     return 0o666 & ~mask
 
 
-def write_bytes(path: str | os.PathLike, data: bytes, *, label: str | None = None) -> None:
-    """Write ``data`` to ``path`` atomically (:func:`atomic_target`).
+def write_bytes(path: str | os.PathLike, data: bytes, *, label: str | None = None, replace: bool = True) -> None:
+    """Write ``data`` to ``path`` atomically: through the descriptor of a new temporary file beside it, then
+    fsync and rename (:func:`atomic_target`).
 
     Parameters
     ----------
     path : str or path
-        The file to produce (replaced if it exists: check it first with :func:`check_targets`).
+        The file to produce (check it first with :func:`check_targets`).
     data : bytes
         Its content.
     label : str, optional
         Prefix of messages.
+    replace : bool
+        Replace ``path`` if it exists by then; when false an existing file is refused and left alone.
     """
-    with atomic_target(path, label=label) as tmp:
-        with open(tmp, "wb") as fh:
-            fh.write(data)
-            fh.flush()
+    with _atomic(path, label, replace) as (fd, _tmp):
+        view = memoryview(data)
+        while view:                                  # os.write may write less than asked
+            view = view[os.write(fd, view):]
 
 
-def write_text(path: str | os.PathLike, text: str, *, label: str | None = None) -> None:
+def write_text(path: str | os.PathLike, text: str, *, label: str | None = None, replace: bool = True) -> None:
     """Write ``text`` as UTF-8 to ``path`` atomically (``\\n`` line ends on every platform).
 
     Parameters
@@ -175,8 +251,10 @@ def write_text(path: str | os.PathLike, text: str, *, label: str | None = None) 
         Its content.
     label : str, optional
         Prefix of messages.
+    replace : bool
+        Replace ``path`` if it exists by then (see :func:`write_bytes`).
     """
-    write_bytes(path, text.encode("utf-8"), label=label)
+    write_bytes(path, text.encode("utf-8"), label=label, replace=replace)
 
 
 def write_files(files: Mapping[str, str | bytes], *, force: bool = False, label: str | None = None) -> None:
@@ -196,4 +274,5 @@ def write_files(files: Mapping[str, str | bytes], *, force: bool = False, label:
     """
     check_targets([(p, label) for p in files], force=force)
     for path, content in files.items():
-        write_bytes(path, content.encode("utf-8") if isinstance(content, str) else content, label=label)
+        write_bytes(path, content.encode("utf-8") if isinstance(content, str) else content, label=label,
+                    replace=force)

@@ -3,26 +3,41 @@
 Only the inertial of each link with a geometry result is touched: its origin moves to the centre of mass, its
 orientation is the link frame (**rpy 0**, MJCF: no ``quat``) and the **full tensor** is written (products of
 inertia in the tensor convention, ``ixy = −∫xy dm``, which URDF, SDFormat and MuJoCo's ``fullinertia`` use).
-The new element is built on the lxml tree of the description and its text is spliced into the input's bytes
-in place of the old element (or inserted where there was none: last in a URDF/SDF link, first in an MJCF
-body), so every other byte — declaration, comments, indentation, attribute order and quoting — is the
-input's.  One comment after the root's start tag says which links were recomputed and from what.  (If the
-elements cannot be matched to the text — a non-UTF-8 encoding, entities — the whole tree is serialised by
-lxml instead, which keeps all of that except the spelling of a few tags and quotes.)
 
-The file is written atomically (a temporary file beside it, then ``os.replace``) and never over an
-existing file (including the input) unless ``force``.  For xacro input the *expanded* URDF is written.
+How, in three steps:
+
+1. **Edit the tree.**  The new elements are built on an lxml tree of the description (the *expected*
+   document): the old ``<inertial>`` edited in place, or a new one inserted where there was none (last in a
+   URDF/SDF link, first in an MJCF body), plus one comment after the root's start tag saying which links were
+   recomputed and from what.
+2. **Splice the text.**  The input is decoded in its own encoding (BOM, declared encoding; XML 1.0
+   Appendix F), :func:`~inertia_tool.robot.xmlspans.element_spans` finds the exact offsets of every element
+   (comments, CDATA, PIs, the DOCTYPE's internal subset, ``>`` inside quoted attributes and ``</inertial >``
+   are followed, not guessed), and only the bytes of each replaced element change: every other byte —
+   BOM, declaration, DOCTYPE, comments, indentation, attribute order and quoting, entity references, line
+   ends — is the input's, in the input's encoding.
+3. **Check before writing.**  The result is parsed again and compared with the input node by node: every
+   element, comment, PI and entity reference outside the corrected ``<inertial>`` elements has the same
+   tag, attributes (in order), text and tail (whitespace-only text may change only inside a link that
+   received a new ``<inertial>``, and where the provenance comment went); each corrected ``<inertial>``
+   equals the one built in step 1; the declaration, encoding and DOCTYPE are unchanged.  Any difference is
+   :class:`~inertia_tool.errors.OutputCheckError` and nothing is written.
+
+The file goes through :mod:`inertia_tool.reports.output` (unpredictable temporary file beside the target,
+fsync, atomic rename; never over an existing file, the input included, unless ``force``; never through a
+symbolic link).  For xacro input the *expanded* URDF is written, indented two spaces per level.
 """
 
 from __future__ import annotations
 
 import os
-import re
 
 import numpy as np
 
-from ..errors import UsageError
+from ..errors import OutputCheckError, UsageError
+from ..reports.output import check_targets, write_bytes
 from .description import RobotDescription, parse_xml
+from .xmlspans import DocumentText, ElementSpan, XMLSpanError, decode_document, element_spans
 
 __all__ = ["write_corrected", "corrected_document"]
 
@@ -138,19 +153,49 @@ def _links(root, fmt: str):
     return bodies
 
 
+def _provenance(robot: RobotDescription, changed: list, note: str) -> str:
+    """The text of the comment naming what was recomputed: ASCII only (it must fit any encoding) and without
+    ``--`` (not allowed in a comment)."""
+    text = (f" inertia-tool robot: <inertial> of {len(changed)} link{'s' if len(changed) != 1 else ''} "
+            f"recomputed from the {robot.geometry} geometry{' (' + note + ')' if note else ''}: origin at the "
+            "centre of mass, axes of the link frame (rpy 0), full tensor about the centre of mass, SI, "
+            "ixy = -(integral of x*y dm) ")
+    text = text.replace("\u00b3", "^3").replace("\u00b2", "^2").replace("\u00b7", "*")
+    text = "".join(c if " " <= c < "\x7f" else "?" for c in text)
+    while "--" in text:
+        text = text.replace("--", "- -")
+    return text
+
+
+def _pretty(data: bytes, source: str) -> bytes:
+    """The expanded xacro document indented two spaces per level (xacro's own output is one line)."""
+    from lxml import etree
+    tree = parse_xml(data, source)
+    etree.indent(tree, space="  ")
+    return etree.tostring(tree, xml_declaration=True, encoding="utf-8") + b"\n"
+
+
+def _elements_in_order(root) -> list:
+    """The elements under and including ``root`` in document order (no comments, PIs or entity references)."""
+    from lxml import etree
+    return list(root.iter(tag=etree.Element))
+
+
+def _local(tag: str) -> str:
+    return tag.rsplit("}", 1)[-1].rsplit(":", 1)[-1]
+
+
 def corrected_document(robot: RobotDescription, inertials, *, note: str = "") -> bytes:
-    """The description's bytes with the inertials of the links in ``inertials`` replaced.
+    """The description's bytes with the inertials of the links in ``inertials`` replaced, checked.
 
     Only the bytes of each replaced ``<inertial>`` element change (a missing one is inserted), plus one
-    provenance comment after the root's start tag; every other byte is the input's.  Where the elements cannot
-    be matched to the text (an encoding other than UTF-8/ASCII, an entity that hides markup), the whole tree is
-    serialised by lxml instead, which keeps comments, whitespace and attribute order but may normalise
-    ``<a />`` to ``<a/>`` and the quotes.
+    provenance comment after the root's start tag; every other byte is the input's, in its encoding.  The
+    result is parsed again and compared with the input before it is returned (see the module docstring).
 
     Parameters
     ----------
     robot : RobotDescription
-        The description (its ``document`` is edited).
+        The description (its ``document``; for xacro the expansion, which is indented first).
     inertials : sequence of LinkInertial
         Links with ``properties`` None are left untouched.
     note : str
@@ -160,158 +205,248 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "") ->
     -------
     bytes
         The corrected document.
+
+    Raises
+    ------
+    OutputCheckError
+        The edit could not be made exactly, or its result differs from the input outside the corrected
+        elements (a bug; nothing should be written).
     """
-    from lxml import etree
-    tree = parse_xml(robot.document, robot.source)
-    root = tree.getroot()
+    base = _pretty(robot.document, robot.source) if robot.format == "xacro" else robot.document
+    original = parse_xml(base, robot.source)
+    expected = parse_xml(base, robot.source)
+    root = expected.getroot()
+    order = {element: k for k, element in enumerate(_elements_in_order(root))}    # before any edit
     elements = _links(root, robot.format)
     writer = {"urdf": _urdf_inertial, "xacro": _urdf_inertial, "sdf": _sdf_inertial,
               "mjcf": _mjcf_inertial}[robot.format]
-    before = list(root.iter("inertial"))
     changed = []
     for result in inertials:
-        if result.properties is None or result.name not in elements:
+        if result.properties is None or result.name not in elements or result.name in changed:
             continue
         writer(elements[result.name], result.properties)
         changed.append(result.name)
-    comment_text = (f" inertia-tool robot: <inertial> of {len(changed)} link{'s' if len(changed) != 1 else ''} "
-                    f"recomputed from the {robot.geometry} "
-                    f"geometry{' (' + note + ')' if note else ''}: origin at the centre of mass, axes of the link "
-                    "frame (rpy 0), full tensor about the centre of mass, SI, ixy = -(integral of x*y dm) "
-                    ).replace("--", "- -")
-    spliced = _splice_text(robot, root, before, [elements[n] for n in changed], comment_text) if changed else None
-    if spliced is not None:
-        return spliced
-    if changed:
-        comment = etree.Comment(comment_text)
-        comment.tail = root.text if root.text and not root.text.strip() else "\n"
-        root.insert(0, comment)
-        if root.text is None or root.text.strip():
-            root.text = "\n"
-    return _splice(robot.document, etree.tostring(root, encoding="utf-8"), root.tag)
-
-
-_MARKUP_TO_HIDE = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>", re.DOTALL)
-
-
-def _tag_spans(masked: str, tag: str) -> list:
-    """``(start, end_of_start_tag, end)`` of every ``<tag>`` element in ``masked`` text (comments blanked);
-    ``end`` is after ``</tag>`` or the self-closing ``/>`` (tags of this kind must not nest)."""
-    spans = []
-    for m in re.finditer(rf"<{tag}(?:\s(?:\"[^\"]*\"|'[^']*'|[^'\">])*)?/?>", masked):
-        if m.group(0).endswith("/>"):
-            spans.append((m.start(), m.end(), m.end()))
-            continue
-        close = masked.find(f"</{tag}>", m.end())
-        if close < 0:
-            return []
-        spans.append((m.start(), m.end(), close + len(tag) + 3))
-    return spans
-
-
-def _line_indent(text: str, position: int) -> str:
-    line_start = text.rfind("\n", 0, position) + 1
-    prefix = text[line_start:position]
-    return prefix if not prefix.strip() else ""
-
-
-def _splice_text(robot: RobotDescription, root, before: list, links: list, comment_text: str) -> bytes | None:
-    """Byte-preserving edit: replace/insert only the changed inertials; None when the text cannot be matched."""
-    from lxml import etree
+    if not changed:
+        return base
+    comment = _provenance(robot, changed, note)
     try:
-        text = robot.document.decode("utf-8")
-    except UnicodeDecodeError:
-        return None
-    if "<!ENTITY" in text:
-        return None
-    masked = _MARKUP_TO_HIDE.sub(lambda m: " " * len(m.group(0)), text)
-    inertial_spans = _tag_spans(masked, "inertial")
-    container = "body" if robot.format == "mjcf" else "link"
-    containers = list(root.iter(container))
-    container_spans = _tag_spans(masked, container) if container == "link" else [
-        (m.start(), m.end(), m.end()) for m in re.finditer(r"<body(?:\s(?:\"[^\"]*\"|'[^']*'|[^'\">])*)?>", masked)]
-    if len(inertial_spans) != len(before) or len(container_spans) != len(containers):
-        return None
+        document = decode_document(base)
+        spans = element_spans(document.text)
+        _check_alignment(spans, order, robot.source)
+        edits = _edits(document.text, spans, order, [elements[name] for name in changed], comment)
+        out = _apply(document, base, edits)
+    except (XMLSpanError, UnicodeError) as exc:
+        raise OutputCheckError(f"{robot.source}: cannot edit its <inertial> elements in place ({exc}); "
+                               "nothing was written") from None
+    _verify(original, expected, out, robot, changed, comment)
+    return out
+
+
+def _check_alignment(spans: list, order: dict, source: str) -> None:
+    """The tokenizer's elements are lxml's, one for one, in the same order with the same names."""
+    elements = sorted(order, key=order.get)
+    if len(spans) != len(elements):
+        raise XMLSpanError(f"found {len(spans)} elements in the text where the parser found {len(elements)}")
+    for span, element in zip(spans, elements):
+        if _local(span.tag) != _local(element.tag):
+            raise XMLSpanError(f"found <{span.tag}> at offset {span.start} where the parser found "
+                               f"<{element.tag}> (line {element.sourceline})")
+
+
+def _newline(text: str) -> str:
+    return "\r\n" if "\r\n" in text and text.count("\r\n") == text.count("\n") else "\n"
+
+
+def _serialized(element, newline: str) -> str:
+    from lxml import etree
+    return etree.tostring(element, encoding="unicode", with_tail=False).replace("\n", newline)
+
+
+def _edits(text: str, spans: list[ElementSpan], order: dict, containers: list, comment: str) -> list:
+    """``(start, end, replacement)`` character ranges of ``text``: each corrected inertial, and the comment."""
+    newline = _newline(text)
     edits = []
-    for element in links:
-        inertial = element.find("inertial")
-        serialized = etree.tostring(inertial, encoding="unicode", with_tail=False)
-        if any(inertial is b for b in before):
-            k = next(i for i, b in enumerate(before) if b is inertial)
-            start, _, end = inertial_spans[k]
-            edits.append((start, end, serialized))
+    for container in containers:
+        inertial = container.find("inertial")
+        serialized = _serialized(inertial, newline)
+        if inertial in order:                               # an edited element of the input: replace its text
+            span = spans[order[inertial]]
+            edits.append((span.start, span.end, serialized))
             continue
-        start, start_end, end = container_spans[next(i for i, c in enumerate(containers) if c is element)]
-        before_it = _whitespace_before(inertial) or ""
-        if container == "body":                 # MJCF: the inertial goes first, after the body's start tag
-            edits.append((start_end, start_end, before_it + serialized))
+        span = spans[order[container]]
+        if span.empty:
+            raise XMLSpanError(f"<{span.tag}> at offset {span.start} is written as an empty-element tag")
+        before = (_whitespace_before(inertial) or "").replace("\n", newline)
+        if container.tag == "body":                         # MJCF: first, right after the body's start tag
+            edits.append((span.start_end, span.start_end, before + serialized))
             continue
-        if start_end == end:                    # a self-closing link holds no geometry: never changed
-            return None
-        close = end - len(container) - 3        # at "</link>"
-        closing_indent = _line_indent(text, close)
-        if closing_indent and before_it.startswith("\n"):   # a line of its own, above "</link>"
-            line_start = close - len(closing_indent)
-            edits.append((line_start, line_start, before_it[1:] + serialized + "\n"))
+        line_start = text.rfind("\n", 0, span.close) + 1
+        if not text[line_start:span.close].strip() and before.startswith(newline):   # "</link>" on its own line
+            edits.append((line_start, line_start, before[len(newline):] + serialized + newline))
         else:
-            edits.append((close, close, serialized))
-    root_start = _START_TAG_TEXT.match(masked, _prolog_end(masked))
-    if root_start is None or root_start.group(0).endswith("/>"):
-        return None
-    edits.append((root_start.end(), root_start.end(),
-                  f"\n{_first_child_indent(text, root_start.end())}<!--{comment_text}-->"))
-    out = text
-    for start, end, replacement in sorted(edits, key=lambda e: e[0], reverse=True):
-        out = out[:start] + replacement + out[end:]
-    return out.encode("utf-8")
+            edits.append((span.close, span.close, serialized))
+    root = spans[0]
+    if root.empty:
+        raise XMLSpanError("the root element is written as an empty-element tag")
+    following = text[root.start_end:root.start_end + 200]
+    indent = following.lstrip("\r\n")
+    indent = indent[:len(indent) - len(indent.lstrip(" \t"))] if following[:1] in "\r\n" and following else ""
+    edits.append((root.start_end, root.start_end, f"{newline}{indent or '  '}<!--{comment}-->"))
+    edits.sort(key=lambda e: (e[0], e[1]))
+    for (_, end, _r), (start, _e, _s) in zip(edits, edits[1:]):
+        if start < end:
+            raise XMLSpanError(f"two edits overlap at offset {start}")
+    return edits
 
 
-def _prolog_end(masked: str) -> int:
-    m = re.match(r"\s*(?:<!DOCTYPE[^>\[]*(?:\[.*?\])?\s*>\s*)?", masked, re.DOTALL)
-    return m.end() if m else 0          # the pattern matches the empty string: m is never None
+def _apply(document: DocumentText, data: bytes, edits: list) -> bytes:
+    """The input's bytes with ``edits`` made: the untouched stretches are the input's own bytes."""
+    body = data[len(document.bom):]
+    if document.encode(document.text) != body:
+        raise XMLSpanError(f"the {document.codec} text does not encode back to the same bytes")
+    pieces, position, offset = [document.bom], 0, 0
+    for start, end, replacement in edits:
+        unchanged = len(document.encode(document.text[position:start]))
+        pieces.append(body[offset:offset + unchanged])
+        offset += unchanged + len(document.encode(document.text[start:end]))
+        pieces.append(document.encode(replacement))
+        position = end
+    pieces.append(body[offset:])
+    return b"".join(pieces)
 
 
-def _first_child_indent(text: str, position: int) -> str:
-    """The indentation of the line after ``position`` (the root's first child), or two spaces."""
-    m = re.match(r"[ \t]*\r?\n([ \t]*)", text[position:])
-    return m.group(1) if m and m.group(1) else "  "
+# -- the check before writing ----------------------------------------------------------------------------
+
+def _describe(node) -> tuple:
+    """What must be equal in two nodes, text and children apart."""
+    from lxml import etree
+    if isinstance(node, etree._Comment):
+        return ("comment", node.text)
+    if isinstance(node, etree._ProcessingInstruction):
+        return ("processing instruction", node.target, node.text)
+    if isinstance(node, etree._Entity):
+        return ("entity reference", node.name)
+    return ("element", node.tag, tuple(node.attrib.items()))
 
 
-_PROLOG = re.compile(rb"(?:\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>\[]*(?:\[.*?\])?\s*>)*", re.DOTALL)
+def _content(element, dropped) -> tuple[list, list]:
+    """``(children, slots)`` of ``element`` with the node ``dropped`` left out: ``slots`` are the text runs
+    between the kept children (``slots[0]`` the element's text); a dropped child's tail joins the run before."""
+    if not isinstance(element.tag, str):
+        return [], []
+    children, slots = [], [element.text or ""]
+    for child in element:
+        if child is dropped:
+            slots[-1] += child.tail or ""
+        else:
+            children.append(child)
+            slots.append(child.tail or "")
+    return children, slots
 
 
-def _splice(original: bytes, element: bytes, tag: str) -> bytes:
-    """``element`` (the serialised root) between the input's own prolog and epilog, byte for byte: the XML
-    declaration, comments before the root, and whatever follows its end tag."""
-    prolog = _PROLOG.match(original)
-    start = prolog.end() if prolog else 0      # the pattern matches the empty string: never None
-    end_tag = f"</{tag}>".encode()
-    close = original.rfind(end_tag)
-    end = close + len(end_tag) if close >= 0 else len(original.rstrip())
-    old_tag, new_tag = _START_TAG.match(original, start), _START_TAG.match(element)
-    if old_tag and new_tag and not old_tag.group(0).endswith(b"/>"):   # the root's attributes are never edited
-        element = old_tag.group(0) + element[new_tag.end():]
-    return original[:start] + element + original[end:]
+def _where(node) -> str:
+    tag = node.tag if isinstance(node.tag, str) else _describe(node)[0]
+    return f"line {node.sourceline}, <{tag}>"
 
 
-_START_TAG_PATTERN = r"<[^\s/>!?]+(?:\s+[^\s=/>]+\s*=\s*(?:\"[^\"]*\"|'[^']*'))*\s*/?>"
-_START_TAG = re.compile(_START_TAG_PATTERN.encode())
-_START_TAG_TEXT = re.compile(_START_TAG_PATTERN)
+def _differ(robot: RobotDescription, where: str, what: str, expected, found) -> OutputCheckError:
+    return OutputCheckError(f"{robot.source}: the corrected copy differs from the input at {where} ({what}: "
+                            f"expected {str(expected)[:80]!r}, found {str(found)[:80]!r}); nothing was written "
+                            "(please report this)")
+
+
+def _same_slots(a: list, b: list, loose: bool) -> int:
+    """Index of the first text run that differs (whitespace-only runs compare equal when ``loose``), or -1."""
+    for k, (x, y) in enumerate(zip(a, b)):
+        if x != y and not (loose and not x.strip() and not y.strip()):
+            return k
+    return -1
+
+
+def _compare(robot, old_root, new_root, *, fixed: dict, skip_first_comment: str | None = None) -> None:
+    """Node-by-node equality of two trees; in ``fixed`` (old element → new element) the children that are
+    the corrected inertials (``old.find("inertial")`` and ``new.find("inertial")``) are left out and runs of
+    whitespace may differ."""
+    stack = [(old_root, new_root)]
+    while stack:                     # bounded: each node of the old tree is visited once
+        old, new = stack.pop()
+        if _describe(old) != _describe(new):
+            raise _differ(robot, _where(old), "the node", _describe(old), _describe(new))
+        if old in fixed and fixed[old] is not new:
+            raise _differ(robot, _where(old), "the corrected link", old.get("name"), new.get("name"))
+        if not isinstance(old.tag, str):
+            continue
+        loose = old in fixed
+        old_children, old_slots = _content(old, old.find("inertial") if loose else None)
+        dropped = new.find("inertial") if loose else None
+        if new is new_root and skip_first_comment is not None:
+            first = new[0] if len(new) else None
+            if first is None or _describe(first) != ("comment", skip_first_comment):
+                raise _differ(robot, _where(new), "the provenance comment", skip_first_comment,
+                              _describe(first) if first is not None else None)
+            dropped, loose = first, True
+        new_children, new_slots = _content(new, dropped)
+        if len(old_children) != len(new_children):
+            raise _differ(robot, _where(old), "the number of children", len(old_children), len(new_children))
+        k = _same_slots(old_slots, new_slots, loose)
+        if k >= 0:
+            raise _differ(robot, _where(old), "the text" if k == 0 else f"the text after child {k}",
+                          old_slots[k], new_slots[k])
+        stack.extend(zip(old_children, new_children))
+
+
+def _document_facts(tree) -> tuple:
+    """What must not change outside the root element: declaration, encoding, DOCTYPE, entity declarations,
+    the comments and PIs around the root."""
+    info = tree.docinfo
+    dtd = info.internalDTD
+    entities = tuple((e.name, e.content, e.system_url) for e in dtd.iterentities()) if dtd is not None else ()
+    root = tree.getroot()
+    around = tuple(_describe(n) for n in root.itersiblings(preceding=True)) + ("root",) + tuple(
+        _describe(n) for n in root.itersiblings())
+    return (info.xml_version, info.encoding, info.standalone, info.doctype, entities, around)
+
+
+def _verify(original, expected, out: bytes, robot: RobotDescription, changed: list, comment: str) -> None:
+    """Parse ``out`` and compare it with the input (``original``) and the edited tree (``expected``)."""
+    from ..errors import RobotDescriptionError
+    try:
+        written = parse_xml(out, robot.source)
+    except RobotDescriptionError as exc:
+        raise OutputCheckError(f"{exc}: the corrected copy is not well-formed XML; nothing was written "
+                               "(please report this)") from None
+    old_facts, new_facts = _document_facts(original), _document_facts(written)
+    if old_facts != new_facts:
+        raise _differ(robot, "the document's declaration, DOCTYPE or top level", "the prolog", old_facts, new_facts)
+    old_links = _links(original.getroot(), robot.format)
+    new_links = _links(written.getroot(), robot.format)
+    want_links = _links(expected.getroot(), robot.format)
+    fixed = {old_links[name]: new_links.get(name) for name in changed}
+    _compare(robot, original.getroot(), written.getroot(), fixed=fixed, skip_first_comment=comment)
+    for name in changed:
+        got, want = new_links[name].find("inertial"), want_links[name].find("inertial")
+        if got is None:
+            raise _differ(robot, _where(new_links[name]), "the corrected <inertial>", "an <inertial>", None)
+        _compare(robot, want, got, fixed={})
+        if (got.getparent().index(got) == 0) != (want.getparent().index(want) == 0):
+            raise _differ(robot, _where(got), "the place of the <inertial>", want.getparent().index(want),
+                          got.getparent().index(got))
 
 
 def write_corrected(robot: RobotDescription, inertials, path, *, force: bool = False, note: str = "") -> tuple:
-    """Write :func:`corrected_document` to ``path`` atomically; returns the names of the corrected links.
+    """Write :func:`corrected_document` to ``path`` through :mod:`inertia_tool.reports.output`; returns the
+    names of the corrected links.
 
     Parameters
     ----------
     robot : RobotDescription
-        The description read by :func:`~inertia_tool.robot.read_robot` (its ``document`` is edited).
+        The description read by :func:`~inertia_tool.robot.read_robot`.
     inertials : sequence of LinkInertial
         From :func:`~inertia_tool.robot.link_inertials`; links without ``properties`` are left untouched.
     path : str or os.PathLike
         The file to write (a temporary file beside it is renamed onto it).
     force : bool
-        Replace an existing file (also the input itself).
+        Replace an existing file (also the input itself).  A symbolic link is never written through.
     note : str
         Appended to the provenance comment (e.g. the density basis).
 
@@ -323,23 +458,18 @@ def write_corrected(robot: RobotDescription, inertials, path, *, force: bool = F
     Raises
     ------
     UsageError
-        ``path`` exists (or is the input) and ``force`` is false; ``path`` is a directory or cannot be written.
+        ``path`` is empty, exists (or is the input) and ``force`` is false, is a directory or a symbolic link,
+        or cannot be written (:class:`~inertia_tool.reports.output.OutputFileError`).
+    OutputCheckError
+        The corrected document failed its check; nothing was written.
     """
     path = os.fspath(path)
-    if os.path.isdir(path):
-        raise UsageError(f"{path}: is a directory")
-    if os.path.exists(path) and not force:
-        same = os.path.exists(robot.source) and os.path.samefile(path, robot.source)
-        raise UsageError(f"{path}: {'is the input description' if same else 'exists'}; refusing to overwrite it")
+    if not path:
+        raise UsageError("Expected a file name to write the corrected description to, got ''")
+    if (not force and os.path.exists(path) and os.path.exists(robot.source)
+            and os.path.samefile(path, robot.source)):
+        raise UsageError(f"{path}: is the input description; refusing to overwrite it (`force=True` does)")
+    check_targets([path], force=force)
     data = corrected_document(robot, inertials, note=note)
-    directory = os.path.dirname(os.path.abspath(path))
-    tmp = os.path.join(directory, f".{os.path.basename(path)}.tmp-{os.getpid()}")
-    try:
-        with open(tmp, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except OSError as exc:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise UsageError(f"{path}: cannot write it ({exc.strerror or exc})") from None
-    return tuple(r.name for r in inertials if r.properties is not None)
+    write_bytes(path, data, replace=force)
+    return tuple(dict.fromkeys(r.name for r in inertials if r.properties is not None))
