@@ -214,3 +214,430 @@ def test_real_mjcf_gets_inertials_inserted_and_reads_back(tmp_path):
         declared = again.link(result.name).declared
         assert declared.mass == result.properties.mass
         assert_tensor_close(declared.inertia, result.properties.inertia, 1e-15)
+
+
+# -- issue 22: the edit never deletes or garbles anything outside the corrected <inertial> elements ------------
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from inertia_tool.cli import main  # noqa: E402
+from inertia_tool.errors import OutputCheckError  # noqa: E402
+from inertia_tool.reports import output  # noqa: E402
+from inertia_tool.robot import audit_links  # noqa: E402
+from inertia_tool.robot import write as write_module  # noqa: E402
+from inertia_tool.robot.xmlspans import XMLSpanError, decode_document, element_spans  # noqa: E402
+
+_PARSER = dict(remove_blank_text=False, remove_comments=False, resolve_entities=False, no_network=True)
+_OLD_INERTIAL = ('<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>'
+                 '</inertial{space}>')
+_BOX_LINK = ('  <link name="{name}">\n    {inertial}\n'
+             '    <collision><geometry><box size="0.1 0.2 0.3"/></geometry></collision>\n  </link>\n')
+
+
+def _tree(data: bytes):
+    return etree.fromstring(data, etree.XMLParser(**_PARSER)).getroottree()
+
+
+def _structure(tree, fmt: str) -> list:
+    """Everything in the document except each link's first <inertial> and the provenance comment, as a list
+    of (depth, kind, name, attributes, stripped text, stripped tail) — computed here, independently of
+    inertia_tool.robot.write.  A removed node's tail joins the text before it."""
+    root = tree.getroot()
+    container = "body" if fmt == "mjcf" else "link"
+    dropped = [c.find("inertial") for c in root.iter(container) if c.find("inertial") is not None]
+    dropped += [c for c in root if isinstance(c, etree._Comment) and "inertia-tool robot:" in (c.text or "")]
+    for node in dropped:
+        parent, previous = node.getparent(), node.getprevious()
+        if previous is not None:
+            previous.tail = (previous.tail or "") + (node.tail or "")
+        else:
+            parent.text = (parent.text or "") + (node.tail or "")
+        parent.remove(node)
+    rows = []
+
+    def visit(node, depth):
+        if isinstance(node, etree._Comment):
+            kind, name = "comment", None
+        elif isinstance(node, etree._ProcessingInstruction):
+            kind, name = "pi", node.target
+        elif isinstance(node, etree._Entity):
+            kind, name = "entity", node.name
+        else:
+            kind, name = "element", node.tag
+        attrs = tuple(node.attrib.items()) if kind == "element" else ()
+        rows.append((depth, kind, name, attrs, (node.text or "").strip(), (node.tail or "").strip()))
+        if kind == "element":
+            for child in node:
+                visit(child, depth + 1)
+    visit(root, 0)
+    return rows
+
+
+def _check_copy(source, out, fmt: str, inertials) -> None:
+    """``out`` parses, holds everything of ``source`` outside the corrected inertials, and declares the
+    computed values exactly."""
+    before, after = _tree(source.read_bytes()), _tree(out.read_bytes())
+    assert _structure(before, fmt) == _structure(after, fmt)
+    assert before.docinfo.doctype == after.docinfo.doctype
+    assert before.docinfo.encoding == after.docinfo.encoding
+    again = read_robot(out)
+    for result in inertials:
+        if result.properties is None:
+            continue
+        declared = again.link(result.name).declared
+        assert declared.mass == result.properties.mass
+        np.testing.assert_array_equal(declared.rotation, np.eye(3))
+        np.testing.assert_allclose(declared.center_of_mass, result.properties.center_of_mass, rtol=0, atol=1e-15)
+        assert_tensor_close(declared.inertia, result.properties.inertia, 1e-15)
+
+
+def test_inertial_end_tag_with_a_space_keeps_the_next_link(tmp_path, capsys):
+    """Before: `</inertial >` was not found, the edit ran to the next link's `</inertial>` and deleted link b's
+    start and its <collision> (exit 0, "corrected")."""
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r">\n' + _BOX_LINK.format(name="a", inertial=_OLD_INERTIAL.format(space=" "))
+                    + _BOX_LINK.format(name="b", inertial=_OLD_INERTIAL.format(space="")) + "</robot>\n")
+    out = tmp_path / "out.urdf"
+    assert main(["robot", str(urdf), "--density", "1000", "--write", str(out)]) == 0
+    capsys.readouterr()
+    written = out.read_text()
+    assert written.count("<collision>") == 2 and written.count("<link ") == 2
+    robot = read_robot(urdf)
+    _check_copy(urdf, out, "urdf", link_inertials(robot, density=1000))
+
+
+def test_two_inertial_end_tags_with_spaces_give_well_formed_xml(tmp_path, capsys):
+    """Before: two such links gave XML that does not parse."""
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r">\n' + "".join(
+        _BOX_LINK.format(name=n, inertial=_OLD_INERTIAL.format(space=" \t\n ")) for n in "abc") + "</robot>\n")
+    out = tmp_path / "out.urdf"
+    assert main(["robot", str(urdf), "--density", "1000", "--write", str(out)]) == 0
+    assert "of 3 links corrected" in capsys.readouterr().err
+    robot = read_robot(urdf)
+    _check_copy(urdf, out, "urdf", link_inertials(robot, density=1000))
+
+
+def test_notation_and_entities_in_the_doctype_are_kept_byte_for_byte(tmp_path, capsys):
+    """Before: a NOTATION (or any '>' inside the internal subset) broke the prolog and the output."""
+    prolog = ('<?xml version="1.0"?>\n<!DOCTYPE robot [\n  <!NOTATION png SYSTEM "image/png">\n'
+              '  <!ENTITY note "a > b ] c">\n  <!ENTITY unused "</inertial>">\n  <!-- ]> <inertial> -->\n]>\n')
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text(prolog + '<robot name="r">&note;\n' + _BOX_LINK.format(name="a", inertial="") + "</robot>\n")
+    out = tmp_path / "out.urdf"
+    assert main(["robot", str(urdf), "--density", "1000", "--write", str(out)]) == 0
+    capsys.readouterr()
+    assert out.read_text().startswith(prolog + '<robot name="r">')
+    assert "&note;" in out.read_text()
+    _check_copy(urdf, out, "urdf", link_inertials(read_robot(urdf), density=1000))
+
+
+def test_latin1_file_stays_latin1(tmp_path, capsys):
+    """Before: a Latin-1 file was serialised as UTF-8 bytes under its Latin-1 declaration: `café` became
+    `cafÃ©`."""
+    urdf = tmp_path / "r.urdf"
+    text = ('<?xml version="1.0" encoding="ISO-8859-1"?>\n<!-- café, señor -->\n<robot name="r">\n'
+            + _BOX_LINK.format(name="café", inertial="") + "</robot>\n")
+    urdf.write_bytes(text.encode("latin-1"))
+    out = tmp_path / "out.urdf"
+    assert main(["robot", str(urdf), "--density", "1000", "--write", str(out)]) == 0
+    capsys.readouterr()
+    data = out.read_bytes()
+    assert b'<link name="caf\xe9">' in data and b"\xc3" not in data
+    assert data.startswith(text.split("<robot")[0].encode("latin-1"))
+    assert read_robot(out).links[0].name == "café"
+    _check_copy(urdf, out, "urdf", link_inertials(read_robot(urdf), density=1000))
+
+
+@pytest.mark.parametrize("bom, codec", [(b"\xef\xbb\xbf", "utf-8"), (b"\xff\xfe", "utf-16-le"),
+                                        (b"\xfe\xff", "utf-16-be"), (b"", "utf-16-le")])
+def test_bom_and_utf16_are_kept(tmp_path, bom, codec):
+    urdf = tmp_path / "r.urdf"
+    declared = ' encoding="UTF-16"' if "16" in codec else ""
+    text = f'<?xml version="1.0"{declared}?>\n<robot name="r">\n' + _BOX_LINK.format(name="ä", inertial="") + \
+        "</robot>\n"
+    urdf.write_bytes(bom + text.encode(codec))
+    robot = read_robot(urdf)
+    inertials = link_inertials(robot, density=1000)
+    out = tmp_path / "out.urdf"
+    write_corrected(robot, inertials, out)
+    data = out.read_bytes()
+    assert data.startswith(bom + text.split("<robot")[0].encode(codec))
+    assert data[len(bom):].decode(codec).count("</inertial>") == 1
+    _check_copy(urdf, out, "urdf", inertials)
+
+
+def test_write_with_an_empty_name_is_a_usage_error(tmp_path, capsys):
+    """Before: `--write ''` was silently ignored (exit 0, nothing written)."""
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r">\n' + _BOX_LINK.format(name="a", inertial="") + "</robot>\n")
+    assert main(["robot", str(urdf), "--density", "1000", "--write", ""]) == 2
+    err = capsys.readouterr().err
+    assert "--write expects the name of the file" in err and len(err.strip().splitlines()) == 1
+    assert sorted(os.listdir(tmp_path)) == ["r.urdf"]
+    with pytest.raises(UsageError, match="file name"):
+        write_corrected(read_robot(urdf), [], "")
+
+
+def test_a_copy_that_fails_its_check_is_not_written(tmp_path, monkeypatch, capsys):
+    """The check before the rename catches a wrong splice (here: offsets forced one element off) and nothing is
+    written; the command exits 1 (an internal error, as docs/usage.md says)."""
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r">\n' + _BOX_LINK.format(name="a", inertial=_OLD_INERTIAL.format(space=""))
+                    + "</robot>\n")
+    real = write_module.element_spans
+
+    def one_off(text):
+        spans = real(text)
+        k = next(i for i, s in enumerate(spans) if s.tag == "inertial")
+        return spans[:k] + [spans[k + 1]] + [spans[k]] + spans[k + 2:]       # <inertial> swapped with <mass>
+    monkeypatch.setattr(write_module, "element_spans", one_off)
+    out = tmp_path / "out.urdf"
+    with pytest.raises(OutputCheckError, match="nothing was written"):
+        corrected_document(read_robot(urdf), link_inertials(read_robot(urdf), density=1000))
+    monkeypatch.setattr(write_module, "_check_alignment", lambda *a: None)   # the check after the splice
+    assert main(["robot", str(urdf), "--density", "1000", "--write", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "differs from the input" in err and "nothing was written" in err
+    assert sorted(os.listdir(tmp_path)) == ["r.urdf"]
+
+
+def test_xacro_output_is_the_indented_expansion(tmp_path, capsys):
+    pytest.importorskip("xacro")
+    source = tmp_path / "r.urdf.xacro"
+    source.write_text('<?xml version="1.0"?>\n<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="r">'
+                      '<xacro:macro name="box_link" params="n"><link name="${n}"><collision><geometry>'
+                      '<box size="0.1 0.2 0.3"/></geometry></collision></link></xacro:macro>'
+                      '<xacro:box_link n="a"/><xacro:box_link n="b"/></robot>')
+    out = tmp_path / "out.urdf"
+    assert main(["robot", str(source), "--density", "1000", "--write", str(out)]) == 0
+    capsys.readouterr()
+    lines = out.read_text().splitlines()
+    assert len(lines) > 10 and max(len(line) for line in lines if "<!--" not in line) < 200
+    assert any(line.startswith("    <collision>") for line in lines)
+    robot = read_robot(out)
+    assert [link.name for link in robot.links] == ["a", "b"]
+    assert all(a.ok for a in audit_links(robot, link_inertials(robot, density=1000)))
+
+
+@pytest.mark.parametrize("name, basis", [("ur5", {"material": "aluminium"}), ("panda", {"density": 2000}),
+                                         ("ur5", {"keep_mass": True})])
+def test_real_robots_written_then_read_back_have_a_clean_audit(name, basis, tmp_path):
+    robot, ours, out = _corrected(name, tmp_path, **basis)
+    again = read_robot(out, packages=PACKAGES)
+    inertials = link_inertials(again, **basis)
+    audits = audit_links(again, inertials, keep_mass=basis.get("keep_mass", False))
+    assert len(audits) >= 7
+    assert [a.issues for a in audits if a.computed is not None and not a.ok] == []
+    before, after = _tree(ROBOTS[name][0].read_bytes()), _tree(out.read_bytes())
+    assert _structure(before, "urdf") == _structure(after, "urdf")
+
+
+# -- the writer: reports/output.py ---------------------------------------------------------------------------
+
+def _simple_robot(tmp_path):
+    urdf = tmp_path / "in" / "r.urdf"
+    urdf.parent.mkdir()
+    urdf.write_text('<robot name="r">\n' + _BOX_LINK.format(name="a", inertial="") + "</robot>\n")
+    robot = read_robot(urdf)
+    return robot, link_inertials(robot, density=1000)
+
+
+def test_write_refuses_a_symlink_target_even_with_force(tmp_path, capsys):
+    """Before: `os.replace` onto the name was preceded by no check, and the old writer's temporary name was
+    predictable; a link planted at the target is now refused and the file it points to is untouched."""
+    robot, inertials = _simple_robot(tmp_path)
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    link = tmp_path / "out.urdf"
+    link.symlink_to(victim)
+    for force in (False, True):
+        with pytest.raises(UsageError, match="symbolic link"):
+            write_corrected(robot, inertials, link, force=force)
+    assert main(["robot", robot.source, "--density", "1000", "--write", str(link), "--force"]) == 2
+    assert "symbolic link" in capsys.readouterr().err
+    assert victim.read_text() == "precious" and link.is_symlink()
+    assert sorted(os.listdir(tmp_path)) == ["in", "out.urdf", "victim.txt"]
+
+
+def test_write_ignores_links_planted_at_the_old_predictable_temporary_names(tmp_path):
+    """Before: the temporary file was `.OUT.tmp-PID`, opened with a plain open(): a symbolic link planted there
+    sent the corrected document into the file it named."""
+    robot, inertials = _simple_robot(tmp_path)
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    out = tmp_path / "out.urdf"
+    for pid in {os.getpid(), *range(os.getpid() - 3, os.getpid() + 4)}:
+        (tmp_path / f".out.urdf.tmp-{pid}").symlink_to(victim)
+    write_corrected(robot, inertials, out)
+    assert victim.read_text() == "precious"
+    assert read_robot(out).links[0].declared.mass == inertials[0].properties.mass
+    leftovers = [p for p in os.listdir(tmp_path) if p.startswith(".") and not os.path.islink(tmp_path / p)]
+    assert leftovers == []
+
+
+def test_temporary_names_are_unpredictable_and_fsynced(tmp_path, monkeypatch):
+    names, synced = [], []
+    real_replace, real_link, real_fsync = os.replace, os.link, os.fsync
+
+    def record_link(src, dst, **kw):
+        names.append(os.path.basename(src))
+        return real_link(src, dst, **kw)
+
+    def record_replace(src, dst):
+        names.append(os.path.basename(src))
+        return real_replace(src, dst)
+
+    def record_fsync(fd):
+        synced.append(os.fstat(fd).st_size)
+        return real_fsync(fd)
+    monkeypatch.setattr(output.os, "link", record_link)
+    monkeypatch.setattr(output.os, "replace", record_replace)
+    monkeypatch.setattr(output.os, "fsync", record_fsync)
+    output.write_bytes(tmp_path / "a.urdf", b"<a/>", replace=False)
+    output.write_bytes(tmp_path / "a.urdf", b"<b/>", replace=True)
+    assert len(names) == 2 and names[0] != names[1]
+    assert all(n.startswith(".a.") and n.endswith(".tmp.urdf") and len(n) > len(".a..tmp.urdf") + 5 for n in names)
+    assert 4 in synced                                         # the file itself, with its bytes, before the rename
+    assert (tmp_path / "a.urdf").read_bytes() == b"<b/>" and os.listdir(tmp_path) == ["a.urdf"]
+
+
+def test_never_clobbers_a_file_that_appears_after_the_check(tmp_path):
+    target = tmp_path / "out.urdf"
+    with pytest.raises(output.OutputFileError, match="exists"):
+        with output.atomic_target(target, replace=False) as tmp:
+            with open(tmp, "wb") as fh:
+                fh.write(b"new")
+            target.write_bytes(b"someone else's")              # created between the check and the rename
+    assert target.read_bytes() == b"someone else's" and os.listdir(tmp_path) == ["out.urdf"]
+
+
+def test_a_temporary_file_swapped_for_a_link_is_refused(tmp_path):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    target = tmp_path / "out.svg"
+    with pytest.raises(output.OutputFileError, match="replaced or removed"):
+        with output.atomic_target(target) as tmp:
+            os.remove(tmp)
+            os.symlink(victim, tmp)
+            with open(tmp, "w") as fh:                         # a third-party writer follows the planted link
+                fh.write("x")
+    assert not target.exists()
+    assert victim.read_text() == "x"          # what the third-party writer did cannot be undone, but...
+    assert sorted(os.listdir(tmp_path)) == sorted(["victim.txt", os.path.basename(tmp)])   # ...nothing renamed
+
+
+# -- the tokenizer -------------------------------------------------------------------------------------------
+
+def test_tokenizer_finds_exact_element_offsets():
+    text = ('<?xml version="1.0"?>\n<!DOCTYPE r [<!ENTITY e "<x>"><!NOTATION n PUBLIC "a>]" "b">]>\n'
+            '<r a=\'x>"y\'><!-- <inertial> --><![CDATA[</r><inertial>]]><i  b="&gt;>" /><j>t</j\n ></r >\n')
+    spans = element_spans(text)
+    assert [(s.tag, s.depth) for s in spans] == [("r", 0), ("i", 1), ("j", 1)]
+    assert text[spans[0].start:spans[0].end].endswith("</r >") and text[spans[0].end:] == "\n"
+    assert text[spans[1].start:spans[1].end] == '<i  b="&gt;>" />' and spans[1].empty
+    assert text[spans[2].start:spans[2].end] == "<j>t</j\n >"
+    assert text[spans[2].start_end:spans[2].close] == "t"
+
+
+@pytest.mark.parametrize("bad", ["<r><a></b></r>", "<r>", "<r a='1></r>", "<!DOCTYPE r [<!ENTITY e 'x'>",
+                                 "<r><!-- open</r>"])
+def test_tokenizer_refuses_what_it_cannot_follow(bad):
+    with pytest.raises(XMLSpanError):
+        element_spans(bad)
+
+
+def test_decode_document_follows_bom_then_declaration():
+    assert decode_document(b'\xef\xbb\xbf<?xml version="1.0" encoding="latin-1"?><a/>').codec == "utf-8"
+    assert decode_document('<?xml version="1.0" encoding="ISO-8859-1"?><a>é</a>'.encode("latin-1")).text.endswith(
+        "é</a>")
+    assert decode_document("<?xml version='1.0'?><a/>".encode("utf-16-be")).codec == "utf-16-be"
+    with pytest.raises(XMLSpanError, match="not one Python"):
+        decode_document(b'<?xml version="1.0" encoding="no-such-codec"?><a/>')
+
+
+# -- property: random formatting, random encodings ----------------------------------------------------------
+
+_WS = st.sampled_from(["", " ", "  ", "\t", "\n", "\n  ", " \r\n "])
+_SIZES = st.tuples(*[st.sampled_from([0.05, 0.1, 0.2, 0.37]) for _ in range(3)])
+_DECOYS = st.sampled_from([
+    "<!-- <inertial><mass value='9'/></inertial> -->",
+    "<![CDATA[ <inertial> </link> ]]>",
+    "<?pi <inertial> ?>",
+    "<!-- </link> -->",
+    "",
+])
+_ENCODINGS = st.sampled_from([("utf-8", b""), ("utf-8", b"\xef\xbb\xbf"), ("latin-1", b""),
+                              ("utf-16-le", b"\xff\xfe"), ("utf-16-be", b"\xfe\xff"), ("utf-16-le", b"")])
+_DOCTYPES = st.sampled_from([
+    "",
+    '<!DOCTYPE {root} [\n  <!NOTATION gif SYSTEM "viewer > gif">\n  <!ENTITY who "a ]> b">\n]>\n',
+    "<!DOCTYPE {root} [ <!-- ]> --> <!ELEMENT link ANY> <!ATTLIST link name CDATA #IMPLIED> ]>\n",
+])
+
+
+@st.composite
+def _documents(draw):
+    fmt = draw(st.sampled_from(["urdf", "sdf", "mjcf"]))
+    links = []
+    for k in range(draw(st.integers(1, 3))):
+        name = draw(st.sampled_from(["l", "é", "a>b", "q\"x"])) + str(k)
+        links.append((name, draw(_SIZES), draw(st.booleans()), draw(_WS), draw(_DECOYS), draw(_WS)))
+    quote = draw(st.sampled_from(['"', "'"]))
+    return fmt, links, quote, draw(_ENCODINGS), draw(_DOCTYPES), draw(_WS)
+
+
+def _attr(value: str, quote: str) -> str:
+    value = value.replace("&", "&amp;").replace("<", "&lt;").replace(quote, "&quot;" if quote == '"' else "&apos;")
+    return f"{quote}{value}{quote}"
+
+
+def _render(fmt, links, quote, ws_tail) -> tuple[str, str]:
+    """(root tag, body text) of a description with one box per link, formatted as drawn."""
+    parts = []
+    for name, (a, b, c), has, ws, decoy, ws2 in links:
+        n = _attr(name, quote)
+        if fmt == "urdf":
+            old = (f"<inertial {' ' if ws else ''}><mass value={quote}2{quote}/><inertia ixx='1' ixy='0' ixz='0' "
+                   f"iyy='1' iyz='0' izz='1'/></inertial{ws}>") if has else ""
+            parts.append(f"<link name={n}{ws}>{decoy}{old}{ws2}<collision note={quote}x > y{quote}><geometry>"
+                         f"<box size='{a} {b} {c}'{ws}/></geometry></collision{ws}>{decoy}</link{ws}>")
+        elif fmt == "sdf":
+            old = (f"<inertial><mass>2</mass><inertia><ixx>1</ixx><iyy>1</iyy><izz>1</izz></inertia>"
+                   f"</inertial{ws}>") if has else ""
+            parts.append(f"<link name={n}>{ws2}{decoy}<collision name='c'><pose>0.1 0 0 0 0 0</pose><geometry><box>"
+                         f"<size>{a} {b} {c}</size></box></geometry></collision{ws}>{old}{decoy}</link{ws}>")
+        else:
+            old = (f"<inertial pos='0 0 0' mass='2' diaginertia='1 1 1'{ws}/>" if ws else
+                   "<inertial pos='0 0 0' mass='2' diaginertia='1 1 1'></inertial >") if has else ""
+            parts.append(f"<body name={n}>{ws2}{old}{decoy}<geom type='box' size='{a / 2} {b / 2} {c / 2}' "
+                         f"pos='0 0.1 0'{ws}/>{decoy}</body{ws}>")
+    sep = "\n  " if ws_tail else ""
+    body = sep + sep.join(parts) + ("\n" if ws_tail else "")
+    if fmt == "urdf":
+        return "robot", f"<robot name='r'>{body}</robot>"
+    if fmt == "sdf":
+        return "sdf", f"<sdf version='1.7'><model name='m'>{body}</model></sdf>"
+    return "mujoco", f"<mujoco model='m'><worldbody>{body}</worldbody></mujoco>"
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(document=_documents())
+def test_random_formatting_and_encodings_round_trip(document, tmp_path_factory):
+    fmt, links, quote, (codec, bom), doctype, ws_tail = document
+    root, body = _render(fmt, links, quote, ws_tail)
+    label = {"utf-8": "UTF-8", "latin-1": "ISO-8859-1"}.get(codec, "UTF-16")
+    prolog = f"<?xml version={quote}1.0{quote} encoding={quote}{label}{quote}?>\n" + doctype.format(root=root)
+    text = prolog + "<!-- before the root: <inertial> -->\n" + body + "\n<!-- after -->\n"
+    directory = tmp_path_factory.mktemp("doc")
+    source = directory / ("r.urdf" if fmt == "urdf" else "r.sdf" if fmt == "sdf" else "r.xml")
+    source.write_bytes(bom + text.encode(codec))
+    robot = read_robot(source)
+    inertials = link_inertials(robot, density=1000)
+    out = directory / ("out" + source.suffix)
+    write_corrected(robot, inertials, out)
+    data = out.read_bytes()
+    assert data.startswith(bom + prolog.encode(codec))                       # declaration, DOCTYPE, BOM kept
+    assert data.endswith("\n<!-- after -->\n".encode(codec))
+    _check_copy(source, out, fmt, inertials)

@@ -82,6 +82,8 @@ def parse_mappings(items) -> dict:
 def run(args) -> int:
     packages = parse_packages(args.package)
     mappings = parse_mappings(args.arg)
+    if args.write is not None and not args.write.strip():
+        raise UsageError(f"--write expects the name of the file to write, got {args.write!r}")
     if args.force and not args.write:
         raise UsageError("--force only applies to --write")
     check_output_file(args.write, "--write", args.force)
@@ -95,7 +97,7 @@ def run(args) -> int:
         note = "declared masses kept" if args.keep_mass else f"density {basis}"
         changed = write_corrected(robot, inertials, args.write, force=args.force, note=note)
         skipped = [r.name for r in inertials if r.properties is None]
-        message = f"wrote {args.write}: <inertial> of {len(changed)} links corrected"
+        message = f"wrote {args.write}: <inertial> of {len(changed)} link{'' if len(changed) == 1 else 's'} corrected"
         if skipped:
             message += f"; left as they were: {', '.join(skipped)}"
         print(message, file=sys.stderr)

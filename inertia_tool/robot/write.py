@@ -130,7 +130,7 @@ def _mjcf_inertial(body, props) -> None:
     if inertial is None:
         own, step = _layout(body)
         inertial = etree.Element("inertial")
-        inertial.tail = body.text if body.text is not None and not body.text.strip() and len(body) else own
+        inertial.tail = body.text if body.text is not None and (len(body) or body.text.strip()) else own
         body.text = own + step
         body.insert(0, inertial)
     for key in _ORIENTATION_KEYS:
@@ -355,10 +355,25 @@ def _differ(robot: RobotDescription, where: str, what: str, expected, found) -> 
                             "(please report this)")
 
 
+def _whitespace_inserted(old: str, new: str, *, max_tries: int = 10_000) -> bool:
+    """``new`` is ``old`` with one run of whitespace inserted somewhere (or equal to it)."""
+    extra = len(new) - len(old)
+    if extra <= 0:
+        return new == old
+    prefix = 0
+    while prefix < len(old) and old[prefix] == new[prefix]:
+        prefix += 1
+    for start in range(prefix, max(-1, prefix - max_tries), -1):
+        if not new[start:start + extra].strip() and new[start + extra:] == old[start:]:
+            return True
+    return False
+
+
 def _same_slots(a: list, b: list, loose: bool) -> int:
-    """Index of the first text run that differs (whitespace-only runs compare equal when ``loose``), or -1."""
+    """Index of the first text run that differs, or -1; when ``loose`` a run may have gained whitespace in
+    one place (where an element was inserted next to it)."""
     for k, (x, y) in enumerate(zip(a, b)):
-        if x != y and not (loose and not x.strip() and not y.strip()):
+        if x != y and not (loose and _whitespace_inserted(x, y)):
             return k
     return -1
 
