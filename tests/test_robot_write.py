@@ -311,7 +311,8 @@ def test_two_inertial_end_tags_with_spaces_give_well_formed_xml(tmp_path, capsys
     """Before: two such links gave XML that does not parse."""
     urdf = tmp_path / "r.urdf"
     urdf.write_text('<robot name="r">\n' + "".join(
-        _BOX_LINK.format(name=n, inertial=_OLD_INERTIAL.format(space=" \t\n ")) for n in "abc") + "</robot>\n")
+        _BOX_LINK.format(name=n, inertial=_OLD_INERTIAL.format(space=space)) for n, space in
+        (("a", " "), ("b", " \t\n "), ("c", ""))) + "</robot>\n")
     out = tmp_path / "out.urdf"
     assert main(["robot", str(urdf), "--density", "1000", "--write", str(out)]) == 0
     assert "of 3 links corrected" in capsys.readouterr().err
