@@ -244,7 +244,7 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "") ->
 
 def _check_alignment(spans: list, order: dict, source: str) -> None:
     """The tokenizer's elements are lxml's, one for one, in the same order with the same names."""
-    elements = sorted(order, key=order.get)
+    elements = sorted(order, key=lambda element: order[element])
     if len(spans) != len(elements):
         raise XMLSpanError(f"found {len(spans)} elements in the text where the parser found {len(elements)}")
     for span, element in zip(spans, elements):

@@ -66,7 +66,7 @@ class ElementSpan:
 
 
 _NAME = re.compile(r"[^\s<>/=\"'!?&;]+")
-_SPACE = re.compile(r"\s*")
+_SUBSET_END = re.compile(r"\]\s*>")
 _ATTRIBUTE = re.compile(r"\s+([^\s<>/=\"']+)\s*=\s*(?:\"[^\"<]*\"|'[^'<]*')")
 _CLOSE_START = re.compile(r"\s*(/?)>")
 _END_TAG = re.compile(r"</([^\s<>/=\"']+)\s*>")
@@ -114,9 +114,10 @@ def _skip_doctype(text: str, pos: int) -> int:
     else:
         raise XMLSpanError(f"the DOCTYPE at offset {pos} is not closed")
     while i < n:                        # the internal subset, up to ']'
-        i = _SPACE.match(text, i).end()
+        while i < n and text[i].isspace():
+            i += 1
         if text.startswith("]", i):
-            m = re.compile(r"\]\s*>").match(text, i)
+            m = _SUBSET_END.match(text, i)
             if m is None:
                 raise XMLSpanError(f"the DOCTYPE's internal subset at offset {i} is not closed by ']>'")
             return m.end()
