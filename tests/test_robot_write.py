@@ -586,7 +586,7 @@ def _documents(draw):
         name = draw(st.sampled_from(["l", "é", "a>b", "q\"x"])) + str(k)
         links.append((name, draw(_SIZES), draw(st.booleans()), draw(_WS), draw(_DECOYS), draw(_WS)))
     quote = draw(st.sampled_from(['"', "'"]))
-    return fmt, links, quote, draw(_ENCODINGS), draw(_DOCTYPES), draw(_WS)
+    return fmt, links, quote, draw(_ENCODINGS), draw(_DOCTYPES), draw(_WS), draw(st.sampled_from(["\n", "\r\n"]))
 
 
 def _attr(value: str, quote: str) -> str:
@@ -626,11 +626,12 @@ def _render(fmt, links, quote, ws_tail) -> tuple[str, str]:
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(document=_documents())
 def test_random_formatting_and_encodings_round_trip(document, tmp_path_factory):
-    fmt, links, quote, (codec, bom), doctype, ws_tail = document
+    fmt, links, quote, (codec, bom), doctype, ws_tail, newline = document
     root, body = _render(fmt, links, quote, ws_tail)
     label = {"utf-8": "UTF-8", "latin-1": "ISO-8859-1"}.get(codec, "UTF-16")
     prolog = f"<?xml version={quote}1.0{quote} encoding={quote}{label}{quote}?>\n" + doctype.format(root=root)
     text = prolog + "<!-- before the root: <inertial> -->\n" + body + "\n<!-- after -->\n"
+    text, prolog = text.replace("\r\n", "\n").replace("\n", newline), prolog.replace("\n", newline)
     directory = tmp_path_factory.mktemp("doc")
     source = directory / ("r.urdf" if fmt == "urdf" else "r.sdf" if fmt == "sdf" else "r.xml")
     source.write_bytes(bom + text.encode(codec))
@@ -640,5 +641,7 @@ def test_random_formatting_and_encodings_round_trip(document, tmp_path_factory):
     write_corrected(robot, inertials, out)
     data = out.read_bytes()
     assert data.startswith(bom + prolog.encode(codec))                       # declaration, DOCTYPE, BOM kept
-    assert data.endswith("\n<!-- after -->\n".encode(codec))
+    assert data.endswith(f"{newline}<!-- after -->{newline}".encode(codec))
+    if newline == "\r\n":                                   # no bare line feed added by the edit
+        assert data.decode(codec).count("\n") == data.decode(codec).count("\r\n")
     _check_copy(source, out, fmt, inertials)
