@@ -645,3 +645,42 @@ def test_random_formatting_and_encodings_round_trip(document, tmp_path_factory):
     if newline == "\r\n":                                   # no bare line feed added by the edit
         assert data.decode(codec).count("\n") == data.decode(codec).count("\r\n")
     _check_copy(source, out, fmt, inertials)
+
+
+@settings(max_examples=80, deadline=None)
+@given(document=_documents())
+def test_tokenizer_agrees_with_lxml_on_every_element(document):
+    """Independent truth: lxml's element order, names and lines (libxml2's ``sourceline`` is the line where the
+    start tag ends) against the spans."""
+    fmt, links, quote, (codec, bom), doctype, ws_tail, newline = document
+    root, body = _render(fmt, links, quote, ws_tail)
+    text = (doctype.format(root=root) + "<!-- <inertial> -->" + body).replace("\r\n", "\n").replace("\n", newline)
+    spans = element_spans(text)
+    elements = list(_tree(text.encode("utf-8")).getroot().iter(tag=etree.Element))
+    assert [s.tag for s in spans] == [e.tag for e in elements]
+    assert [text.count("\n", 0, s.start_end - 1) + 1 for s in spans] == [e.sourceline for e in elements]
+    for span, element in zip(spans, elements):
+        written = text[span.start:span.end]
+        assert written.startswith(f"<{span.tag}") and written.endswith("/>" if span.empty else ">")
+        if not span.empty:
+            assert re.fullmatch(rf"</{re.escape(span.tag)}\s*>", text[span.close:span.end])
+            assert text[span.start_end:span.close].count("<") >= len(element)
+
+
+def test_force_corrects_the_input_in_place_and_a_second_run_changes_only_the_comment(tmp_path, capsys):
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r">\n' + _BOX_LINK.format(name="a", inertial=_OLD_INERTIAL.format(space=" ")) +
+                    "</robot>\n")
+    original = urdf.read_bytes()
+    assert main(["robot", str(urdf), "--density", "1000", "--write", str(urdf)]) == 2
+    assert "is the input description" in capsys.readouterr().err and urdf.read_bytes() == original
+    assert main(["robot", str(urdf), "--density", "1000", "--write", str(urdf), "--force"]) == 0
+    once = urdf.read_bytes()
+    assert once != original and os.listdir(tmp_path) == ["r.urdf"]
+    robot = read_robot(urdf)
+    assert all(a.ok for a in audit_links(robot, link_inertials(robot, density=1000)))
+    assert main(["robot", str(urdf), "--density", "1000", "--write", str(urdf), "--force"]) == 0
+    twice = urdf.read_bytes()
+    assert twice.count(b"<!-- inertia-tool robot:") == 2
+    assert re.sub(rb"[ \t]*<!-- inertia-tool robot:.*?-->\r?\n", b"", twice) == \
+        re.sub(rb"[ \t]*<!-- inertia-tool robot:.*?-->\r?\n", b"", once)       # the same numbers, same bytes

@@ -86,6 +86,10 @@ def run(args) -> int:
         raise UsageError(f"--write expects the name of the file to write, got {args.write!r}")
     if args.force and not args.write:
         raise UsageError("--force only applies to --write")
+    if (args.write and not args.force and os.path.exists(args.write) and os.path.exists(args.robot)
+            and os.path.samefile(args.write, args.robot)):
+        raise UsageError(f"--write {args.write}: is the input description; refusing to overwrite it "
+                         "(--force overwrites it)")
     check_output_file(args.write, "--write", args.force)
     density = parse_density(args.density) if args.density is not None else None
     robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings)

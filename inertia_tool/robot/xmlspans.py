@@ -61,8 +61,8 @@ class ElementSpan:
 
     @property
     def empty(self) -> bool:
-        """Written as one empty-element tag ``<a …/>``."""
-        return self.close == self.start_end
+        """Written as one empty-element tag ``<a …/>`` (not ``<a></a>``)."""
+        return self.end == self.start_end
 
 
 _NAME = re.compile(r"[^\s<>/=\"'!?&;]+")
