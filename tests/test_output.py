@@ -7,7 +7,8 @@ import pytest
 
 from inertia_tool.cli import main
 from inertia_tool.reports import output
-from inertia_tool.reports.output import OutputFileError, atomic_target, check_targets, write_files, write_text
+from inertia_tool.reports.output import (OutputFileError, atomic_target, check_targets, write_bytes, write_files,
+                                         write_text)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WHEEL = os.path.join(ROOT, "meshes", "unbalanced_wheel.stl")
@@ -133,3 +134,73 @@ def test_spin_plot_goes_through_the_atomic_writer(tmp_path, capsys):
     capsys.readouterr()
     assert main(SPIN + ["--plot", str(png), "--csv", str(png), "--force"]) == 2       # one file named twice
     assert "named twice" in capsys.readouterr().err
+
+
+# -- issue 22: temporary files that cannot be predicted, followed or swapped; targets never clobbered ---------
+
+def test_temporary_names_are_unpredictable_and_fsynced(tmp_path, monkeypatch):
+    names, synced = [], []
+    real_replace, real_link, real_fsync = os.replace, os.link, os.fsync
+
+    def record_link(src, dst, **kw):
+        names.append(os.path.basename(src))
+        return real_link(src, dst, **kw)
+
+    def record_replace(src, dst):
+        names.append(os.path.basename(src))
+        return real_replace(src, dst)
+
+    def record_fsync(fd):
+        synced.append(os.fstat(fd).st_size)
+        return real_fsync(fd)
+    monkeypatch.setattr(output.os, "link", record_link)
+    monkeypatch.setattr(output.os, "replace", record_replace)
+    monkeypatch.setattr(output.os, "fsync", record_fsync)
+    write_bytes(tmp_path / "a.urdf", b"<a/>", replace=False)
+    write_bytes(tmp_path / "a.urdf", b"<b/>", replace=True)
+    assert len(names) == 2 and names[0] != names[1]
+    assert all(n.startswith(".a.") and n.endswith(".tmp.urdf") and len(n) > len(".a..tmp.urdf") + 5 for n in names)
+    assert 4 in synced                                         # the file itself, with its bytes, before the rename
+    assert (tmp_path / "a.urdf").read_bytes() == b"<b/>" and os.listdir(tmp_path) == ["a.urdf"]
+
+
+def test_never_clobbers_a_file_that_appears_after_the_check(tmp_path):
+    target = tmp_path / "out.urdf"
+    with pytest.raises(OutputFileError, match="exists"):
+        with atomic_target(target, replace=False) as tmp:
+            with open(tmp, "wb") as fh:
+                fh.write(b"new")
+            target.write_bytes(b"someone else's")              # created between the check and the rename
+    assert target.read_bytes() == b"someone else's" and os.listdir(tmp_path) == ["out.urdf"]
+
+
+def test_a_temporary_file_swapped_for_a_link_is_refused(tmp_path):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    target = tmp_path / "out.svg"
+    with pytest.raises(OutputFileError, match="replaced or removed"):
+        with atomic_target(target) as tmp:
+            os.remove(tmp)
+            os.symlink(victim, tmp)
+            with open(tmp, "w") as fh:                         # a third-party writer follows the planted link
+                fh.write("x")
+    assert not target.exists()
+    assert victim.read_text() == "x"          # what the third-party writer did cannot be undone, but...
+    assert sorted(os.listdir(tmp_path)) == sorted(["victim.txt", os.path.basename(tmp)])   # ...nothing renamed
+
+
+def test_a_symlink_target_is_refused_even_with_force(tmp_path):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    link = tmp_path / "out.md"
+    link.symlink_to(victim)
+    dangling = tmp_path / "dangling.md"
+    dangling.symlink_to(tmp_path / "nowhere")
+    for target in (link, dangling):
+        for force in (False, True):
+            with pytest.raises(OutputFileError, match="symbolic link"):
+                check_targets([str(target)], force=force)
+    with pytest.raises(OutputFileError, match="exists"):       # even without the check, the rename refuses it
+        write_bytes(dangling, b"x", replace=False)
+    assert victim.read_text() == "precious" and not (tmp_path / "nowhere").exists()
+    assert _names(tmp_path) == ["dangling.md", "out.md", "victim.txt"]

@@ -1,15 +1,21 @@
-"""Corrected descriptions (inertia_tool.robot.write), checked by loading them in MuJoCo and Pinocchio."""
+"""Corrected descriptions (inertia_tool.robot.write and its tokenizer inertia_tool.robot.xmlspans), checked by
+loading them in MuJoCo and Pinocchio, by reading them back, and against the input node by node."""
 
 import os
 import re
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from lxml import etree
 
-from inertia_tool.errors import UsageError
-from inertia_tool.robot import link_inertials, read_robot
+from inertia_tool.cli import main
+from inertia_tool.errors import OutputCheckError, UsageError
+from inertia_tool.robot import audit_links, link_inertials, read_robot
+from inertia_tool.robot import write as write_module
 from inertia_tool.robot.write import corrected_document, write_corrected
+from inertia_tool.robot.xmlspans import XMLSpanError, decode_document, element_spans
 
 from conftest import assert_tensor_close
 from robot_data import PACKAGES, PANDA, PANDA_MESHES, UR5, UR5_MESHES
@@ -217,16 +223,6 @@ def test_real_mjcf_gets_inertials_inserted_and_reads_back(tmp_path):
 
 
 # -- issue 22: the edit never deletes or garbles anything outside the corrected <inertial> elements ------------
-
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
-from inertia_tool.cli import main  # noqa: E402
-from inertia_tool.errors import OutputCheckError  # noqa: E402
-from inertia_tool.reports import output  # noqa: E402
-from inertia_tool.robot import audit_links  # noqa: E402
-from inertia_tool.robot import write as write_module  # noqa: E402
-from inertia_tool.robot.xmlspans import XMLSpanError, decode_document, element_spans  # noqa: E402
 
 _PARSER = dict(remove_blank_text=False, remove_comments=False, resolve_entities=False, no_network=True)
 _OLD_INERTIAL = ('<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>'
@@ -476,57 +472,6 @@ def test_write_ignores_links_planted_at_the_old_predictable_temporary_names(tmp_
     assert read_robot(out).links[0].declared.mass == inertials[0].properties.mass
     leftovers = [p for p in os.listdir(tmp_path) if p.startswith(".") and not os.path.islink(tmp_path / p)]
     assert leftovers == []
-
-
-def test_temporary_names_are_unpredictable_and_fsynced(tmp_path, monkeypatch):
-    names, synced = [], []
-    real_replace, real_link, real_fsync = os.replace, os.link, os.fsync
-
-    def record_link(src, dst, **kw):
-        names.append(os.path.basename(src))
-        return real_link(src, dst, **kw)
-
-    def record_replace(src, dst):
-        names.append(os.path.basename(src))
-        return real_replace(src, dst)
-
-    def record_fsync(fd):
-        synced.append(os.fstat(fd).st_size)
-        return real_fsync(fd)
-    monkeypatch.setattr(output.os, "link", record_link)
-    monkeypatch.setattr(output.os, "replace", record_replace)
-    monkeypatch.setattr(output.os, "fsync", record_fsync)
-    output.write_bytes(tmp_path / "a.urdf", b"<a/>", replace=False)
-    output.write_bytes(tmp_path / "a.urdf", b"<b/>", replace=True)
-    assert len(names) == 2 and names[0] != names[1]
-    assert all(n.startswith(".a.") and n.endswith(".tmp.urdf") and len(n) > len(".a..tmp.urdf") + 5 for n in names)
-    assert 4 in synced                                         # the file itself, with its bytes, before the rename
-    assert (tmp_path / "a.urdf").read_bytes() == b"<b/>" and os.listdir(tmp_path) == ["a.urdf"]
-
-
-def test_never_clobbers_a_file_that_appears_after_the_check(tmp_path):
-    target = tmp_path / "out.urdf"
-    with pytest.raises(output.OutputFileError, match="exists"):
-        with output.atomic_target(target, replace=False) as tmp:
-            with open(tmp, "wb") as fh:
-                fh.write(b"new")
-            target.write_bytes(b"someone else's")              # created between the check and the rename
-    assert target.read_bytes() == b"someone else's" and os.listdir(tmp_path) == ["out.urdf"]
-
-
-def test_a_temporary_file_swapped_for_a_link_is_refused(tmp_path):
-    victim = tmp_path / "victim.txt"
-    victim.write_text("precious")
-    target = tmp_path / "out.svg"
-    with pytest.raises(output.OutputFileError, match="replaced or removed"):
-        with output.atomic_target(target) as tmp:
-            os.remove(tmp)
-            os.symlink(victim, tmp)
-            with open(tmp, "w") as fh:                         # a third-party writer follows the planted link
-                fh.write("x")
-    assert not target.exists()
-    assert victim.read_text() == "x"          # what the third-party writer did cannot be undone, but...
-    assert sorted(os.listdir(tmp_path)) == sorted(["victim.txt", os.path.basename(tmp)])   # ...nothing renamed
 
 
 # -- the tokenizer -------------------------------------------------------------------------------------------
