@@ -629,3 +629,22 @@ def test_force_corrects_the_input_in_place_and_a_second_run_changes_only_the_com
     assert twice.count(b"<!-- inertia-tool robot:") == 2
     assert re.sub(rb"[ \t]*<!-- inertia-tool robot:.*?-->\r?\n", b"", twice) == \
         re.sub(rb"[ \t]*<!-- inertia-tool robot:.*?-->\r?\n", b"", once)       # the same numbers, same bytes
+
+
+def test_sdf_values_written_over_entities_and_comments_hold_only_the_new_number(tmp_path):
+    sdf = tmp_path / "m.sdf"
+    sdf.write_text('<?xml version="1.0"?>\n<!DOCTYPE sdf [<!ENTITY kg "">]>\n<sdf version="1.7"><model name="m">'
+                   '<link name="l"><inertial><mass>2<!-- kg -->&kg;</mass><inertia><ixx>1&kg;</ixx><iyy>1</iyy>'
+                   '<izz><![CDATA[1]]></izz></inertia></inertial><collision name="c"><geometry><box>'
+                   '<size>0.1 0.2 0.3</size></box></geometry></collision></link></model></sdf>\n')
+    robot = read_robot(sdf)
+    inertials = link_inertials(robot, density=1000)
+    out = tmp_path / "out.sdf"
+    write_corrected(robot, inertials, out)
+    tree = _tree(out.read_bytes())
+    for tag in ("mass", "ixx", "izz"):
+        element = tree.find(f".//inertial//{tag}")
+        assert len(element) == 0 and float(element.text) == pytest.approx(
+            inertials[0].properties.mass if tag == "mass" else np.diag(inertials[0].properties.inertia)[
+                {"ixx": 0, "izz": 2}[tag]], rel=1e-15)
+    _check_copy(sdf, out, "sdf", inertials)

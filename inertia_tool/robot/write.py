@@ -109,18 +109,26 @@ def _urdf_inertial(link, props) -> None:
         inertia.set(key, _num(t[i, j]))
 
 
+def _set_text(element, text: str) -> None:
+    """``element`` holds ``text`` only: an entity reference, comment or CDATA inside the old value would
+    otherwise stay after (and change) the new number."""
+    for child in list(element):
+        element.remove(child)
+    element.text = text
+
+
 def _sdf_inertial(link, props) -> None:
     com, t = _clean(props)
     inertial = _child(link, "inertial")
     pose = _child(inertial, "pose")
-    pose.text = " ".join(_num(c) for c in com) + " 0 0 0"
+    _set_text(pose, " ".join(_num(c) for c in com) + " 0 0 0")
     pose.attrib.pop("degrees", None)
     pose.attrib.pop("rotation_format", None)
-    _child(inertial, "mass").text = _num(props.mass)
+    _set_text(_child(inertial, "mass"), _num(props.mass))
     inertia = _child(inertial, "inertia")
     for key, (i, j) in (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)), ("iyz", (1, 2)),
                         ("izz", (2, 2))):
-        _child(inertia, key).text = _num(t[i, j])
+        _set_text(_child(inertia, key), _num(t[i, j]))
 
 
 def _mjcf_inertial(body, props) -> None:
