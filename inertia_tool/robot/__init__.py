@@ -5,7 +5,9 @@
 * Robot descriptions: read a URDF, xacro, SDFormat or MJCF file (:func:`read_robot`), compute each link's mass
   properties from its geometry in the link frame (:func:`link_inertials`), audit the declared inertials
   against them (:func:`audit_links`) and write a copy of the description with corrected ``<inertial>``
-  elements (:func:`write_corrected`).  See ``docs/robots.md``.
+  elements (:func:`write_corrected`; the elements are located in the file's own text by the tokenizer of
+  ``inertia_tool.robot.xmlspans`` and the copy is checked against the input before it is written).  See
+  ``docs/robots.md``.
 """
 
 from .. import _lazy_names
