@@ -487,6 +487,13 @@ def test_tokenizer_finds_exact_element_offsets():
     assert text[spans[2].start_end:spans[2].close] == "t"
 
 
+def test_tokenizer_uses_xml_whitespace_not_unicode_whitespace():
+    """U+1680 (Ogham space mark) is a name character in XML 1.0 and whitespace to Python's ``\\s``."""
+    text = '<r><x\u1680y a="1"/><link\u1680 name="a"></link\u1680></r>'
+    assert [s.tag for s in element_spans(text)] == ["r", "x\u1680y", "link\u1680"]
+    assert [e.tag for e in _tree(text.encode()).getroot().iter()] == ["r", "x\u1680y", "link\u1680"]
+
+
 @pytest.mark.parametrize("bad", ["<r><a></b></r>", "<r>", "<r a='1></r>", "<!DOCTYPE r [<!ENTITY e 'x'>",
                                  "<r><!-- open</r>"])
 def test_tokenizer_refuses_what_it_cannot_follow(bad):

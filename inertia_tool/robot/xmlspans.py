@@ -65,11 +65,13 @@ class ElementSpan:
         return self.end == self.start_end
 
 
-_NAME = re.compile(r"[^\s<>/=\"'!?&;]+")
-_SUBSET_END = re.compile(r"\]\s*>")
-_ATTRIBUTE = re.compile(r"\s+([^\s<>/=\"']+)\s*=\s*(?:\"[^\"<]*\"|'[^'<]*')")
-_CLOSE_START = re.compile(r"\s*(/?)>")
-_END_TAG = re.compile(r"</([^\s<>/=\"']+)\s*>")
+#: XML's whitespace (production S): only these four, not Python's Unicode ``\s`` (U+1680 may be in a name).
+_S = "[ \t\r\n]"
+_NAME = re.compile(r"[^ \t\r\n<>/=\"'!?&;]+")
+_SUBSET_END = re.compile(rf"\]{_S}*>")
+_ATTRIBUTE = re.compile(rf"{_S}+([^ \t\r\n<>/=\"']+){_S}*={_S}*(?:\"[^\"<]*\"|'[^'<]*')")
+_CLOSE_START = re.compile(rf"{_S}*(/?)>")
+_END_TAG = re.compile(rf"</([^ \t\r\n<>/=\"']+){_S}*>")
 
 
 def _skip_past(text: str, pos: int, marker: str, what: str) -> int:
@@ -114,7 +116,7 @@ def _skip_doctype(text: str, pos: int) -> int:
     else:
         raise XMLSpanError(f"the DOCTYPE at offset {pos} is not closed")
     while i < n:                        # the internal subset, up to ']'
-        while i < n and text[i].isspace():
+        while i < n and text[i] in " \t\r\n":
             i += 1
         if text.startswith("]", i):
             m = _SUBSET_END.match(text, i)
