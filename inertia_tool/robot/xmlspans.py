@@ -32,7 +32,7 @@ class XMLSpanError(InertiaToolError, ValueError):
     """The text is not XML this tokenizer can follow (expected: a document lxml parsed)."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ElementSpan:
     """Where one element is written in the text (offsets into the ``str``, end offsets exclusive).
 
