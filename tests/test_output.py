@@ -204,3 +204,15 @@ def test_a_symlink_target_is_refused_even_with_force(tmp_path):
         write_bytes(dangling, b"x", replace=False)
     assert victim.read_text() == "precious" and not (tmp_path / "nowhere").exists()
     assert _names(tmp_path) == ["dangling.md", "out.md", "victim.txt"]
+
+
+def test_no_hard_links_falls_back_to_a_checked_replace(tmp_path, monkeypatch):
+    def no_links(src, dst, **kw):
+        raise OSError(1, "Operation not permitted")                 # EPERM: what FAT and some FUSE mounts say
+    monkeypatch.setattr(output.os, "link", no_links)
+    target = tmp_path / "a.md"
+    write_bytes(target, b"one", replace=False)
+    assert target.read_bytes() == b"one" and _names(tmp_path) == ["a.md"]
+    with pytest.raises(OutputFileError, match="exists"):
+        write_bytes(target, b"two", replace=False)
+    assert target.read_bytes() == b"one" and _names(tmp_path) == ["a.md"]

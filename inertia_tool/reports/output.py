@@ -96,7 +96,10 @@ def _fsync_directory(directory: str) -> None:
         os.close(fd)
 
 
-_NO_HARD_LINKS = {getattr(errno, name) for name in ("EPERM", "ENOTSUP", "EOPNOTSUPP", "EXDEV", "EMLINK", "ENOSYS")
+#: Errors of ``os.link`` that mean "this file system has no hard links here" (FAT, some network and FUSE
+#: file systems): the no-clobber rename falls back to a last existence check and ``os.replace``.
+_NO_HARD_LINKS = {getattr(errno, name) for name in ("EPERM", "EACCES", "ENOTSUP", "EOPNOTSUPP", "EXDEV", "EMLINK",
+                                                 "ENOSYS")
                   if hasattr(errno, name)}
 
 
