@@ -9,7 +9,7 @@ How, in three steps:
 1. **Edit the tree.**  The new elements are built on an lxml tree of the description (the *expected*
    document): the old ``<inertial>`` edited in place, or a new one inserted where there was none (last in a
    URDF/SDF link, first in an MJCF body), plus one comment after the root's start tag saying which links were
-   recomputed and from what.
+   recomputed and from what (replacing the comment of an earlier run, so correcting twice adds nothing).
 2. **Splice the text.**  The input is decoded in its own encoding (BOM, declared encoding; XML 1.0
    Appendix F), :func:`~inertia_tool.robot.xmlspans.element_spans` finds the exact offsets of every element
    (comments, CDATA, PIs, the DOCTYPE's internal subset, ``>`` inside quoted attributes and ``</inertial >``
@@ -31,6 +31,7 @@ symbolic link).  For xacro input the *expanded* URDF is written, indented two sp
 from __future__ import annotations
 
 import os
+import re
 
 import numpy as np
 
@@ -161,10 +162,25 @@ def _links(root, fmt: str):
     return bodies
 
 
+#: How the provenance comment starts; one already there (a corrected file corrected again) is replaced.
+_PROVENANCE = " inertia-tool robot:"
+_OLD_PROVENANCE = re.compile(r"[ \t\r\n]*(<!--" + re.escape(_PROVENANCE) + r".*?-->)", re.DOTALL)
+
+
+def _old_provenance(root):
+    """The root's first child node if it is a provenance comment of an earlier run, else None."""
+    from lxml import etree
+    first = root[0] if len(root) else None
+    if (isinstance(first, etree._Comment) and (first.text or "").startswith(_PROVENANCE)
+            and not (root.text or "").strip()):
+        return first
+    return None
+
+
 def _provenance(robot: RobotDescription, changed: list, note: str) -> str:
     """The text of the comment naming what was recomputed: ASCII only (it must fit any encoding) and without
     ``--`` (not allowed in a comment)."""
-    text = (f" inertia-tool robot: <inertial> of {len(changed)} link{'s' if len(changed) != 1 else ''} "
+    text = (f"{_PROVENANCE} <inertial> of {len(changed)} link{'s' if len(changed) != 1 else ''} "
             f"recomputed from the {robot.geometry} geometry{' (' + note + ')' if note else ''}: origin at the "
             "centre of mass, axes of the link frame (rpy 0), full tensor about the centre of mass, SI, "
             "ixy = -(integral of x*y dm) ")
@@ -241,7 +257,8 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "") ->
         document = decode_document(base)
         spans = element_spans(document.text)
         _check_alignment(spans, order, robot.source)
-        edits = _edits(document.text, spans, order, [elements[name] for name in changed], comment)
+        edits = _edits(document.text, spans, order, [elements[name] for name in changed], comment,
+                       _old_provenance(original.getroot()) is not None)
         out = _apply(document, base, edits)
     except (XMLSpanError, UnicodeError) as exc:
         raise OutputCheckError(f"{robot.source}: cannot edit its <inertial> elements in place ({exc}); "
@@ -270,8 +287,10 @@ def _serialized(element, newline: str) -> str:
     return etree.tostring(element, encoding="unicode", with_tail=False).replace("\n", newline)
 
 
-def _edits(text: str, spans: list[ElementSpan], order: dict, containers: list, comment: str) -> list:
-    """``(start, end, replacement)`` character ranges of ``text``: each corrected inertial, and the comment."""
+def _edits(text: str, spans: list[ElementSpan], order: dict, containers: list, comment: str,
+           replace_comment: bool) -> list:
+    """``(start, end, replacement)`` character ranges of ``text``: each corrected inertial, and the comment
+    (in place of the one of an earlier run when ``replace_comment``)."""
     newline = _newline(text)
     edits = []
     for container in containers:
@@ -299,7 +318,14 @@ def _edits(text: str, spans: list[ElementSpan], order: dict, containers: list, c
     following = text[root.start_end:root.start_end + 200]
     indent = following.lstrip("\r\n")
     indent = indent[:len(indent) - len(indent.lstrip(" \t"))] if following[:1] in "\r\n" and following else ""
-    edits.append((root.start_end, root.start_end, f"{newline}{indent or '  '}<!--{comment}-->"))
+    if replace_comment:
+        old = _OLD_PROVENANCE.match(text, root.start_end)
+        if old is None:
+            raise XMLSpanError(f"the provenance comment after the root's start tag (offset {root.start_end}) "
+                               "was not found in the text")
+        edits.append((old.start(1), old.end(1), f"<!--{comment}-->"))
+    else:
+        edits.append((root.start_end, root.start_end, f"{newline}{indent or '  '}<!--{comment}-->"))
     edits.sort(key=lambda e: (e[0], e[1]))
     for (_, end, _r), (start, _e, _s) in zip(edits, edits[1:]):
         if start < end:
@@ -400,7 +426,10 @@ def _compare(robot, old_root, new_root, *, fixed: dict, skip_first_comment: str 
         if not isinstance(old.tag, str):
             continue
         loose = old in fixed
-        old_children, old_slots = _content(old, old.find("inertial") if loose else None)
+        old_dropped = old.find("inertial") if loose else None
+        if old is old_root and skip_first_comment is not None:
+            old_dropped = _old_provenance(old)          # replaced by the new comment, if there was one
+        old_children, old_slots = _content(old, old_dropped)
         dropped = new.find("inertial") if loose else None
         if new is new_root and skip_first_comment is not None:
             first = new[0] if len(new) else None
