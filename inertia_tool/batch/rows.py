@@ -29,6 +29,8 @@ import csv
 import io
 import json
 import os
+import re
+import stat
 import sys
 import time
 from dataclasses import dataclass
@@ -36,7 +38,8 @@ from dataclasses import dataclass
 from .runner import ROW_FIELDS, SCHEMA
 from ..errors import UsageError
 
-__all__ = ["ResultsFile", "ResultsFileBusy", "close_inherited", "open_results", "results_format", "FORMATS"]
+__all__ = ["ResultsFile", "ResultsFileBusy", "ResultsFileDamaged", "ResultsFileWriteError", "read_rows",
+           "close_inherited", "open_results", "results_format", "FORMATS"]
 
 #: Output formats by file suffix.
 FORMATS = {".jsonl": "jsonl", ".ndjson": "jsonl", ".csv": "csv"}
@@ -49,6 +52,11 @@ _TEXT_FIELDS = {"schema", "path", "status", "error_type", "error", "sha256", "op
 
 class ResultsFileBusy(UsageError):
     """Another process holds the lock of the results file (a second batch run on the same results file)."""
+
+
+class ResultsFileWriteError(UsageError):
+    """A row could not be written to the results file (a full disk, a quota, an I/O error).  The file was cut
+    back to its last complete row before this was raised, so the same command resumes once the cause is gone."""
 
 
 def results_format(path: str | os.PathLike) -> str:
@@ -90,88 +98,179 @@ def format_row(row: dict, fmt: str) -> bytes:
         buf = io.StringIO()
         csv.writer(buf, lineterminator="\n").writerow([_csv_cell(row.get(k)) for k in ROW_FIELDS])
         line = buf.getvalue()
-    return line.encode("utf-8")
+    return line.encode("utf-8", "backslashreplace")     # a lone surrogate left in a message: never an error
 
 
 # -- reading back ---------------------------------------------------------------------------------------
 
-def _records(data: bytes, fmt: str) -> list[bytes]:
-    """Split ``data`` into records, each ending in ``\\n`` except possibly a torn last one.
+#: Longest physical line of a results file read back, bytes.  A row is a few KiB (a path of at most 4 KiB, an
+#: error of at most 500 characters, its warnings); a longer line is not one we wrote and is refused (with its
+#: line number) before any parser sees it.
+MAX_LINE_BYTES = 1 << 20
 
-    JSONL: one record per line.  CSV: a line break inside a quoted cell does not end the record; with
-    quotes escaped by doubling, a record ends at the first ``\\n`` after which the count of ``"`` so far
-    is even.
-    """
-    lines = data.splitlines(keepends=True)
-    if fmt == "jsonl":
-        return lines
-    out, pending, quotes = [], b"", 0
-    for line in lines:
-        pending += line
-        quotes += line.count(b'"')
-        if quotes % 2 == 0 and line.endswith(b"\n"):
-            out.append(pending)
-            pending, quotes = b"", 0
-    if pending:
-        out.append(pending)
-    return out
+#: JSON strings of a line (the grammar of RFC 8259 §7), removed before counting brackets: what is left of a
+#: flat row object is one ``{`` and one ``}``.
+_JSON_STRING = re.compile(rb'"(?:[^"\\]|\\.)*"', re.DOTALL)
+
+#: How a row of :data:`SCHEMA` starts in CSV: a record that does not end and runs over lines starting like
+#: this holds more than one row, so it is damage in the middle, not a torn last row.
+_CSV_ROW_START = (SCHEMA + ",").encode()
 
 
-def _parse_record(record: bytes, fmt: str):
-    """A row dict, ``"header"`` for the CSV header, or a string saying why ``record`` is not a row."""
-    text = record.decode("utf-8", errors="replace")
-    if fmt == "jsonl":
-        try:
-            row = json.loads(text)
-        except ValueError:
-            return "is not JSON"
-        if not isinstance(row, dict) or row.get("schema") != SCHEMA:
-            return f"is not a row of schema {SCHEMA}"
-        return row
+@dataclass(frozen=True)
+class _Record:
+    """One record of a results file: physical lines ``first`` to ``end - 1`` (0-based), what it parses to (a row
+    dict, ``"header"``, or a string saying why it is not a row) and whether its last line ends in ``\\n``."""
+
+    first: int
+    end: int
+    parsed: object
+    terminated: bool
+    short: bool = False
+    """True when the record looks cut short (a JSON object without its end, fewer CSV cells than a row)."""
+
+
+def _parse_json_line(line: bytes):
+    """A row dict or a string saying why ``line`` is not one (a flat object: nesting refused before parsing)."""
+    rest = _JSON_STRING.sub(b'""', line).strip()
+    if not (rest.startswith(b"{") and rest.endswith(b"}")):
+        return "is not a JSON object"
+    if rest.count(b"{") != 1 or rest.count(b"}") != 1 or b"[" in rest or b"]" in rest:
+        return "is not a flat JSON object (a row holds no arrays or nested objects)"
     try:
-        cells = next(csv.reader(io.StringIO(text), strict=True), [])
-    except csv.Error as exc:
-        return f"is not CSV ({exc})"
+        row = json.loads(line.decode("utf-8", errors="replace"))
+    except ValueError:
+        return "is not JSON"
+    if not isinstance(row, dict) or row.get("schema") != SCHEMA:
+        return f"is not a row of schema {SCHEMA}"
+    return row
+
+
+def _parse_csv_cells(cells: list[str], text: str):
+    """A row dict, ``"header"``, or a string saying why the cells of ``text`` are not a row."""
     if cells == list(ROW_FIELDS):
         return "header"
-    if len(cells) != len(ROW_FIELDS) or cells[0] != SCHEMA:
+    if len(cells) != len(ROW_FIELDS):
         return f"has {len(cells)} cells, expected {len(ROW_FIELDS)} ({SCHEMA})"
+    if cells[0] != SCHEMA:
+        return f"starts with {cells[0][:40]!r}, expected the schema {SCHEMA}"
+    written = _csv_text(cells)
+    if text != written and text != written[:-1] + "\r\n":
+        # the csv module reads `a"b` as a cell, but the writer quotes any cell holding a quote: a stray quote
+        return "is not quoted as inertia-tool writes it (a stray quote?)"
     try:
         return {k: _csv_value(k, v) for k, v in zip(ROW_FIELDS, cells)}
     except ValueError as exc:
         return f"has a bad cell ({exc})"
 
 
+def _csv_text(cells: list[str]) -> str:
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow(cells)
+    return buf.getvalue()
+
+
+def _jsonl_records(lines: list[bytes], ends_with_newline: bool) -> list[_Record]:
+    last = len(lines) - 1
+    records = []
+    for k, line in enumerate(lines):
+        if line.strip():
+            parsed = _parse_json_line(line)
+            records.append(_Record(k, k + 1, parsed, k < last or ends_with_newline,
+                                   short=parsed in ("is not a JSON object", "is not JSON")))
+    return records
+
+
+def _csv_records(lines: list[bytes], ends_with_newline: bool) -> list[_Record]:
+    """The records of a CSV results file, read with the ``csv`` module (strict: a quote ends a quoted cell
+    only before a delimiter or a line break); a line break inside a quoted cell does not end a record.  A
+    record the module refuses (a stray quote) runs to the end: nothing after it can be trusted to start a
+    record."""
+    texts = [line.decode("utf-8", errors="replace") + "\n" for line in lines]
+    if texts and not ends_with_newline:
+        texts[-1] = texts[-1][:-1]
+    reader = csv.reader(iter(texts), strict=True)
+    records: list[_Record] = []
+    first = 0
+    for _ in range(len(texts) + 1):                      # each pass reads at least one line or stops
+        try:
+            cells = next(reader)
+        except StopIteration:
+            break
+        except csv.Error as exc:
+            at_end = reader.line_num >= len(texts)
+            records.append(_Record(first, len(texts), f"is not CSV ({exc})", ends_with_newline and at_end,
+                                   short=at_end and "unexpected end of data" in str(exc)))
+            break
+        end = reader.line_num
+        if cells:
+            text = "".join(texts[first:end])
+            records.append(_Record(first, end, _parse_csv_cells(cells, text), end < len(texts) or ends_with_newline,
+                                   short=0 < len(cells) < len(ROW_FIELDS)))
+        first = end
+    return records
+
+
+class ResultsFileDamaged(UsageError):
+    """A results file has a damaged record before its last one (a stray quote, a torn line in the middle, a
+    line too long): refused with the line number, never cut (every row after it would be lost)."""
+
+
 def read_rows(data: bytes, fmt: str, path: str) -> tuple[list[dict], int]:
     """The rows of a results file's bytes and the length of the torn tail (0 when there is none).
 
-    The last record is torn when it lacks its final ``\\n`` or does not parse (a run killed while writing
-    it); any other record that is not a row of :data:`SCHEMA`, or a CSV file whose first record is not the
-    header, means the file is not ours: :class:`UsageError`, the file untouched.
+    Only the last record may be torn (a run killed while writing it): one that does not end in ``\\n`` or does
+    not parse, holding at most the start of one row.  It is left out and its length returned, for the caller
+    to cut.  Any other record that is not a row of :data:`SCHEMA` — a stray quote, a torn line in the middle,
+    a line longer than :data:`MAX_LINE_BYTES`, a nested JSON object — is refused with its line number
+    (:class:`ResultsFileDamaged`), as is a file that is not ours (a CSV whose first record is not the header):
+    the file is never cut in the middle, so no complete row is ever dropped.
+
+    Raises
+    ------
+    ResultsFileDamaged
+        A record before the last one is not a row, or a line is too long.
+    UsageError
+        The file is not a results file of this format and schema.
     """
-    records = _records(data, fmt)
+    lines = data.split(b"\n")
+    ends_with_newline = lines[-1] == b""
+    if ends_with_newline:
+        lines.pop()
     refuse = "not a results file of inertia-tool batch (refusing to append to it; choose another results file)"
+    damaged = ("refusing to resume from it: nothing was cut or written (repair or remove that line, or choose "
+               "another results file)")
+    for k, line in enumerate(lines):
+        if len(line) > MAX_LINE_BYTES:
+            raise ResultsFileDamaged(f"{path}: line {k + 1} holds {len(line):,} bytes, more than the "
+                                     f"{MAX_LINE_BYTES:,} of any row; {damaged}")
+    records = _jsonl_records(lines, ends_with_newline) if fmt == "jsonl" else _csv_records(lines, ends_with_newline)
     torn = 0
-    if records:
-        last = records[-1]
-        if not last.endswith(b"\n") or (last.strip() and isinstance(_parse_record(last, fmt), str)):
-            torn = len(last)
-            records = records[:-1]
-            # a file of one torn record has not shown it is ours: it must be the start of what we write
-            start = (",".join(ROW_FIELDS) if fmt == "csv" else json.dumps({"schema": SCHEMA})[:-1]).encode()
-            if not records and not (start.startswith(last.strip()) or last.startswith(start)):
-                raise UsageError(f"{path}: {refuse}")
-    if fmt == "csv" and records and _parse_record(records[0], fmt) != "header":
+    if records and (not records[-1].terminated or records[-1].short):
+        tail = records.pop()
+        more = sum(line.startswith(_CSV_ROW_START) for line in lines[tail.first + 1:tail.end])
+        if more:
+            raise ResultsFileDamaged(
+                f"{path}: line {tail.first + 1} starts a record that never ends (a stray quote?) and runs over "
+                f"{tail.end - tail.first} lines holding {more} more row(s) to the end of the file; {damaged}")
+        torn = sum(len(line) + 1 for line in lines[tail.first:]) - (0 if ends_with_newline else 1)
+        text = data[len(data) - torn:]
+        # a file of one torn record has not shown it is ours: it must be the start of what we write
+        start = (",".join(ROW_FIELDS) if fmt == "csv" else json.dumps({"schema": SCHEMA})[:-1]).encode()
+        if not records and not (start.startswith(text.strip()) or text.startswith(start)):
+            raise UsageError(f"{path}: {refuse}")
+    if fmt == "csv" and records and records[0].parsed != "header":
         raise UsageError(f"{path}: its header is not the inertia-tool batch header ({SCHEMA}); {refuse}")
     rows = []
-    line = 1
     for k, record in enumerate(records):
-        if record.strip() and not (fmt == "csv" and k == 0):
-            got = _parse_record(record, fmt)
-            if isinstance(got, str):
-                raise UsageError(f"{path}: line {line} {got}; {refuse}")
-            rows.append(got)
-        line += record.count(b"\n")
+        if fmt == "csv" and k == 0:
+            continue
+        if not isinstance(record.parsed, dict):
+            problem = "is a second header" if record.parsed == "header" else str(record.parsed)
+            if k == 0:                                   # the first line of a JSON Lines file: not ours
+                raise UsageError(f"{path}: line {record.first + 1} {problem}; {refuse}")
+            raise ResultsFileDamaged(f"{path}: line {record.first + 1} {problem}; {damaged}")
+        rows.append(record.parsed)
     return rows, torn
 
 
@@ -258,6 +357,9 @@ class ResultsFile:
     sync_seconds: float = 1.0
     _fd: int | None = None
     _synced: float = 0.0
+    _size: int = 0               # bytes of complete rows written (what the file is cut back to if a write fails)
+    _synced_size: int = 0        # bytes known to be on the disk (what it is cut back to if an fsync fails)
+    _failed: bool = False
 
     @property
     def repaired_tail(self) -> bool:
@@ -267,22 +369,58 @@ class ResultsFile:
     def write_row(self, row: dict) -> None:
         """Append one row as one record in one ``write`` (``O_APPEND``), so that a killed process loses at most
         the row being written; ``fsync`` when :attr:`sync_seconds` have passed since the last one."""
-        if self._fd is None:
+        if self._fd is None or self._failed:
             raise ValueError(f"{self.path}: the results file is closed")
-        _write_all(self._fd, format_row(row, self.format))
+        record = format_row(row, self.format)
+        try:
+            _write_all(self._fd, record)
+        except OSError as exc:
+            raise self._fail(exc, self._size) from None
+        self._size += len(record)
         now = time.monotonic()
         if now - self._synced >= self.sync_seconds:
-            os.fsync(self._fd)
-            self._synced = now
+            self.sync()
 
     def sync(self) -> None:
-        """``fsync`` the rows written so far to the disk."""
-        if self._fd is not None:
-            os.fsync(self._fd)
+        """``fsync`` the rows written so far to the disk.
+
+        Raises
+        ------
+        ResultsFileWriteError
+            The disk refused them (the file is cut back to the rows synced before).
+        """
+        if self._fd is not None and not self._failed:
+            try:
+                os.fsync(self._fd)
+            except OSError as exc:
+                # after a failed fsync the kernel may have dropped the unsynced pages: keep only what was synced
+                raise self._fail(exc, self._synced_size) from None
             self._synced = time.monotonic()
+            self._synced_size = self._size
+
+    def _fail(self, exc: OSError, keep: int) -> ResultsFileWriteError:
+        """Cut the file back to ``keep`` bytes of complete rows and the error to raise (no more rows are taken)."""
+        self._failed = True
+        cut = ""
+        if self._fd is not None:
+            try:
+                os.ftruncate(self._fd, keep)             # shrinking needs no space
+                os.fsync(self._fd)
+            except OSError as again:
+                cut = f"; cutting it back to its last complete row failed too ({again.strerror or again})"
+        reason = exc.strerror or str(exc) or type(exc).__name__
+        return ResultsFileWriteError(
+            f"{self.path}: cannot write the results file ({reason}); it keeps the complete rows written before"
+            f"{cut} — free space (or fix the cause) and run the same command again to resume")
 
     def close(self) -> None:
-        """Sync and close the file (which releases the lock)."""
+        """Sync and close the file (which releases the lock).
+
+        Raises
+        ------
+        ResultsFileWriteError
+            The final ``fsync`` failed (the file is cut back to the rows synced before).
+        """
         if self._fd is not None:
             try:
                 self.sync()
@@ -342,6 +480,9 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30, sync_seco
     except OSError as exc:
         raise UsageError(f"{path}: cannot write the results file ({exc.strerror or exc})") from None
     try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):                 # replaced between the check above and the open
+            raise UsageError(f"{path}: exists and is not a regular file")
         _lock(fd, path)
         size = os.fstat(fd).st_size
         if size > max_bytes:
@@ -351,8 +492,14 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30, sync_seco
         if torn:
             os.ftruncate(fd, size - torn)
         if fmt == "csv" and size - torn == 0:
-            _write_all(fd, (",".join(ROW_FIELDS) + "\n").encode())
+            try:
+                _write_all(fd, (",".join(ROW_FIELDS) + "\n").encode())
+                os.fsync(fd)
+            except OSError:
+                os.ftruncate(fd, 0)                      # no half header left behind
+                raise
         os.fsync(fd)
+        end = os.fstat(fd).st_size
     except UsageError:
         os.close(fd)
         raise
@@ -361,7 +508,7 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30, sync_seco
         raise UsageError(f"{path}: cannot use the results file ({exc.strerror or exc})") from None
     _OPEN_FDS.add(fd)
     return ResultsFile(path=path, format=fmt, previous_rows=rows, torn_bytes=torn, sync_seconds=float(sync_seconds),
-                       _fd=fd, _synced=time.monotonic())
+                       _fd=fd, _synced=time.monotonic(), _size=end, _synced_size=end)
 
 
 def _read_from_start(fd: int, size: int) -> bytes:                      # pragma: no cover - Windows

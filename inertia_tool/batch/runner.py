@@ -40,11 +40,12 @@ from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, InertiaToolWarning, MeshReadError, UsageError
 from ..mesh.options import LoadOptions
 from ..mesh.read import SUPPORTED_SUFFIXES, os_error_reason
+from ..mesh.regular import open_regular
 from ..mass.pipeline import mass_properties, resolve_density
 from .chunks import DASK_CHUNK_SECONDS, POOL_CHUNK_SECONDS, ChunkSizer, DaskTasks, PoolTasks
 
 __all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "analyze_chunk", "analyze_file", "discover_files",
-           "file_sha256", "run_batch", "DONE_STATUSES"]
+           "file_sha256", "run_batch", "DONE_STATUSES", "counts_as_done", "row_path"]
 
 #: Schema identifier written in every row (``schema`` column); bump it when columns change meaning.
 SCHEMA = "inertia_tool.batch/1"
@@ -182,10 +183,10 @@ def discover_files(spec: str | os.PathLike, *, suffixes: Sequence[str] = SUPPORT
                     found.append(os.path.join(root, n))
                     if len(found) > max_files:
                         raise UsageError(f"{spec}: more than {max_files:,} mesh files; narrow the pattern")
-    elif os.path.isfile(spec):
-        found = [spec]
+    elif os.path.lexists(spec):
+        found = [spec]          # a FIFO or a device too: its row says why it is not read (never opened)
     else:
-        found = [p for p in glob.iglob(spec, recursive=True) if os.path.isfile(p)]
+        found = [p for p in glob.iglob(spec, recursive=True) if not os.path.isdir(p)]
         if len(found) > max_files:
             raise UsageError(f"{spec}: more than {max_files:,} files match; narrow the pattern")
     if not found:
@@ -195,9 +196,18 @@ def discover_files(spec: str | os.PathLike, *, suffixes: Sequence[str] = SUPPORT
 
 
 def file_sha256(path: str | os.PathLike) -> str:
-    """Hex SHA-256 of a file's bytes (read in 1 MiB chunks)."""
+    """Hex SHA-256 of a regular file's bytes (read in 1 MiB chunks).
+
+    Raises
+    ------
+    MeshReadError
+        ``path`` is a FIFO, a device, a socket or a link to one (:func:`inertia_tool.mesh.regular.open_regular`:
+        never opened, so never a hang).
+    OSError
+        It cannot be read.
+    """
     h = hashlib.sha256()
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         while chunk := fh.read(_HASH_CHUNK):
             h.update(chunk)
     return h.hexdigest()
@@ -212,10 +222,28 @@ def _worker_name() -> str:
     return f"{platform.node()}:{os.getpid()}"
 
 
+def row_path(path: str) -> str:
+    """The ``path`` of a file's row: the name itself when it is valid UTF-8; otherwise each byte that is not
+    UTF-8 (held by Python as a surrogate escape) written as ``\\xNN``, e.g. ``b"part\\xff.stl"`` becomes
+    ``part\\xff.stl`` (backslash, x, f, f), so the row is valid UTF-8 in both formats and a resume matches it.
+
+    Not reversible for a name that also holds a literal ``\\xNN``; a resume still skips only a file whose
+    content hash matches its row."""
+    try:
+        path.encode("utf-8")
+        return path
+    except UnicodeEncodeError:
+        pass
+    try:
+        return path.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    except UnicodeEncodeError:                          # a lone surrogate that is no escaped byte
+        return path.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
 def _empty_row(path: str, sha256: str | None, options: BatchOptions, key: str | None = None,
                worker: str | None = None) -> dict:
     row = dict.fromkeys(ROW_FIELDS)
-    row.update(schema=SCHEMA, path=path, sha256=sha256, options_key=key or options.key(),
+    row.update(schema=SCHEMA, path=row_path(path), sha256=sha256, options_key=key or options.key(),
                units=options.load.units or "m", worker=worker or _worker_name())
     return row
 
@@ -251,8 +279,10 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
         if row["sha256"] is None:
             try:
                 row["sha256"] = file_sha256(path)
+            except MeshReadError:       # not a regular file: never opened
+                raise
             except OSError as exc:       # unreadable: a property of the file, reported like the reader does
-                raise MeshReadError(f"{path}: cannot be read ({os_error_reason(exc, path)})") from None
+                raise MeshReadError(f"{row['path']}: cannot be read ({os_error_reason(exc, path)})") from None
         _, described = resolve_density(density=options.density, material=options.material, mass=options.mass)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", InertiaToolWarning)
@@ -272,9 +302,9 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
                                 if issubclass(w.category, InertiaToolWarning)) or None,
         )
     except InertiaToolError as exc:
-        row.update(status="error", error_type=type(exc).__name__, error=_one_line(exc))
+        row.update(status="error", error_type=type(exc).__name__, error=row_path(_one_line(exc)))
     except Exception as exc:  # noqa: BLE001 - one bad file must never stop a batch
-        row.update(status="internal_error", error_type=type(exc).__name__, error=_one_line(exc))
+        row.update(status="internal_error", error_type=type(exc).__name__, error=row_path(_one_line(exc)))
     row["seconds"] = round(time.perf_counter() - start, 6)
     return row
 
@@ -384,11 +414,26 @@ def _process_pool(jobs: int) -> cf.ProcessPoolExecutor:
                                   initargs=(os.getpid(), kernel_threads_per_worker(jobs)))
 
 
+def counts_as_done(row: dict) -> bool:
+    """Whether a previous row means its file need not be analysed again: its status is one of
+    :data:`DONE_STATUSES`, no value in it is NaN or infinite (the writer never writes one: such a row was
+    edited or damaged), and an ``ok`` row has every number of :data:`_NUMBER_FIELDS`."""
+    status = row.get("status")
+    if status not in DONE_STATUSES:
+        return False
+    if any(isinstance(v, float) and not math.isfinite(v) for v in row.values()):
+        return False
+    if status == "ok":
+        return all(isinstance(row.get(k), (int, float)) and not isinstance(row.get(k), bool)
+                   for k in _NUMBER_FIELDS)
+    return True
+
+
 def _done_keys(previous_rows: Iterable[dict]) -> dict:
-    """``{(path, sha256, options_key): row}`` of previous rows that count as done."""
+    """``{(path, sha256, options_key): row}`` of previous rows that count as done (:func:`counts_as_done`)."""
     done = {}
     for r in previous_rows:
-        if r.get("status") in DONE_STATUSES:
+        if counts_as_done(r):
             done[(r.get("path"), r.get("sha256"), r.get("options_key"))] = r
     return done
 
@@ -464,12 +509,12 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
     total = len(files)
     for path in files:
         digest = None
-        if (path, key) in candidates:                          # a done row exists: is the content the same?
+        if (row_path(path), key) in candidates:                 # a done row exists: is the content the same?
             try:
                 digest = file_sha256(path)
             except OSError:
                 digest = None                                  # the worker writes the error row
-        prev = done.get((path, digest, key)) if digest is not None else None
+        prev = done.get((row_path(path), digest, key)) if digest is not None else None
         if prev is not None:
             skipped += 1
             if prev.get("status") == "ok":
@@ -549,6 +594,6 @@ def _run_chunks(todo: list[tuple[str, str | None]], options: BatchOptions, tasks
                 path, digest = chunk[0]
                 row = _empty_row(path, digest, options)
                 row.update(status="internal_error", error_type=type(error).__name__,
-                           error=_one_line(error) or "worker failed")
+                           error=row_path(_one_line(error)) or "worker failed")
                 record(row)
     raise RuntimeError("batch: the chunk loop did not finish within its bound")          # pragma: no cover

@@ -22,6 +22,7 @@ import zipfile
 import zlib
 
 from ..errors import MeshReadError
+from .regular import open_regular
 
 __all__ = ["decompressed", "BLOCK_BYTES"]
 
@@ -73,7 +74,7 @@ def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes
     with tempfile.TemporaryDirectory(prefix="inertia-tool-") as tmp:
         try:
             if outer == ".zip":
-                with zipfile.ZipFile(path) as zf:
+                with open_regular(path) as raw, zipfile.ZipFile(raw) as zf:
                     members = [i for i in zf.infolist() if not i.is_dir()]
                     meshes = [i for i in members if os.path.splitext(i.filename)[1].lower() in suffixes]
                     if len(meshes) != 1 or len(members) != 1:
@@ -94,16 +95,17 @@ def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes
                     raise _fail(path, f"the compressed file {member[:60]!r} is not a mesh with a known suffix "
                                       f"({', '.join(suffixes)})")
                 if outer == ".gz" and compressed >= 18:        # ISIZE trailer: size mod 2³², a cheap first look
-                    with open(path, "rb") as fh:
+                    with open_regular(path) as fh:
                         fh.seek(-4, os.SEEK_END)
                         announced = int.from_bytes(fh.read(4), "little")
                     ratio_limit = max(int(compressed * max_ratio), min_ratio_bytes)
                     if announced > min(max_bytes, ratio_limit):
                         raise _fail(path, f"announces {announced:,} bytes inflated from {compressed:,}: refused as a "
                                           "decompression bomb before inflating")
-                opener = gzip.open if outer == ".gz" else bz2.open
                 target = os.path.join(tmp, member)
-                with opener(path, "rb") as src, open(target, "wb") as dst:
+                with open_regular(path) as raw, \
+                        (gzip.GzipFile(fileobj=raw) if outer == ".gz" else bz2.BZ2File(raw)) as src, \
+                        open(target, "wb") as dst:
                     _copy_bounded(src, dst, path, compressed, max_bytes, max_ratio, min_ratio_bytes)
         except MeshReadError:
             raise

@@ -27,6 +27,7 @@ from ..errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, U
 from .._native import accel
 from ..units import LENGTH_UNITS, length_scale
 from .options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
+from .regular import check_regular, open_regular, regular_file_resolver
 from .weld import weld_exact, weld_exact_stream
 
 __all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "MAX_SUPPORTED_FACES", "SUPPORTED_SUFFIXES",
@@ -137,7 +138,7 @@ def _binary_stl_count(path: str, size: int, max_faces: int) -> int:
     """Validate a binary STL's header against its size (before allocating) and return the triangle count."""
     if size < 84:
         raise _fail(path, f"too short for a binary STL ({size} bytes; the header alone is 84)")
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         fh.seek(80)
         n = int(np.frombuffer(fh.read(4), dtype="<u4")[0])
     available = (size - 84) // 50
@@ -162,7 +163,7 @@ def _binary_stl_chunks(path: str, n: int, *, padded: bool = True):
     memory.
     """
     def views():
-        with open(path, "rb") as fh:
+        with open_regular(path) as fh:
             fh.seek(84)
             done = 0
             while done < n:
@@ -247,7 +248,7 @@ def _read_ascii_stl(path: str, size: int, max_faces: int) -> tuple[np.ndarray, i
     tallies = dict.fromkeys((b"outer", b"endloop", b"endfacet"), 0)
     garbage = 0
     first_garbage = ""
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         for block in _text_blocks(fh, path):
             words = np.char.lower(np.array(_FIRST_WORD_RE.findall(block), dtype="S12"))
             is_facet = words == b"facet"
@@ -333,7 +334,7 @@ def read_stl(path, *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, n
     size = os.path.getsize(path)
     if size == 0:
         raise _fail(path, "empty file (0 bytes)")
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         head = fh.read(4096)
     announced = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else -1
 
@@ -402,7 +403,7 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     line_no = 0
     pending = b""
     max_vertices = 3 * max_faces + 3
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         for block in _text_blocks(fh, path):
             coords: list = []
             tri: list = []
@@ -528,7 +529,7 @@ def _header_count(path: str, word: bytes) -> int:
 
 def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
     """Check what a PLY header announces against the file size before any parser allocates for it."""
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         head = fh.read(1 << 16)
     end = head.find(b"end_header")
     if not head.startswith(b"ply") or end < 0:
@@ -569,7 +570,7 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
 
 def _check_off_header(path: str, size: int, max_faces: int) -> dict:
     """Check the vertex and face counts of an OFF header against the file size."""
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         head = fh.read(1 << 16)
     words = []
     for line in head.replace(b"\r", b"\n").split(b"\n")[:1000]:
@@ -643,7 +644,7 @@ def _check_zip(path: str, max_faces: int) -> dict:
     import zipfile
 
     try:
-        with zipfile.ZipFile(path) as zf:
+        with open_regular(path) as raw, zipfile.ZipFile(raw) as zf:
             infos = zf.infolist()
     except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError) as exc:
         raise _fail(path, f"not a valid zip archive ({str(exc)[:100]})") from None
@@ -670,7 +671,7 @@ def _read_3mf_models(path: str, max_faces: int):
     import zlib
 
     try:
-        with zipfile.ZipFile(path) as zf:
+        with open_regular(path) as raw, zipfile.ZipFile(raw) as zf:
             infos = zf.infolist()
             if len(infos) > MAX_ZIP_MEMBERS:
                 _check_zip_members(path, len(infos), (), "3MF ")
@@ -749,7 +750,12 @@ def _read_with_trimesh(path: str, max_faces: int):
             try:
                 # glTF: no textures decoded (geometry only; a textured GLB loads up to 50x faster)
                 extra: dict[str, Any] = {"skip_materials": True} if suffix in (".glb", ".gltf") else {}
-                loaded = trimesh.load(source, file_type=kind, process=False, force=None, **extra)
+                if kind is None:        # the file itself, opened once (regular files only), its side files too
+                    with open_regular(path) as fh:
+                        loaded = trimesh.load(fh, file_type=suffix[1:], process=False, force=None,
+                                              resolver=regular_file_resolver(path), **extra)
+                else:
+                    loaded = trimesh.load(source, file_type=kind, process=False, force=None, **extra)
             finally:
                 quiet.setLevel(level)
             declared = _declared_scale(path, suffix, loaded)
@@ -837,8 +843,7 @@ def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_
                 raise _fail(path, os_error_reason(exc, path)) from None
             if stat.S_ISDIR(mode):
                 raise _fail(path, "is a directory, not a mesh file")
-            if not stat.S_ISREG(mode):
-                raise _fail(path, "is not a regular file (device, pipe or socket)")
+            check_regular(path)     # a FIFO, a device or a link to one: refused before anything opens it
             suffix = os.path.splitext(path)[1].lower()
             if suffix in COMPRESSED_SUFFIXES:
                 if os.path.getsize(path) == 0:
