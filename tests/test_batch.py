@@ -395,27 +395,59 @@ def test_watchdog_exits_a_worker_whose_parent_is_gone(tmp_path):
     assert not alive, "the watchdog did not end the orphaned worker"
 
 
+_GATED_BATCH = """
+import os, sys, time
+import inertia_tool.batch.runner as b
+real = b._analyze
+gate = sys.argv[1]
+calls = []
+def gated(*args):
+    if calls:                               # every file after the first waits until the test opens the gate
+        for _ in range(6000):               # a bound (10 min), not a timing assumption: the test opens it
+            if os.path.exists(gate):
+                break
+            time.sleep(0.1)
+    calls.append(1)
+    return real(*args)
+b._analyze = gated
+from inertia_tool.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
 @pytest.mark.parametrize("suffix", ["jsonl", "csv"])
 def test_second_batch_on_the_same_results_file_is_refused_and_nothing_is_lost(parts, tmp_path, suffix):
     """Two runs on one results file: the second is refused (exit 2, one line naming the first's pid), the
-    file has no corrupt line, and a resume completes every file once."""
+    file has no corrupt line, and a resume completes every file once.
+
+    Deterministic on a loaded machine: the first run writes its first row and then waits at a gate (a file the
+    test creates only after the second run has ended), so it is certainly running, and holding the lock, while
+    the second run tries."""
     d, boxes, bad = parts
     out = tmp_path / f"r.{suffix}"
-    first = _slow_batch(tmp_path, 0.5, d, "--out", out, "-q")
+    gate = tmp_path / "gate"
+    script = tmp_path / "gated_batch.py"
+    script.write_text(_GATED_BATCH)
+    env = {**os.environ, "PYTHONPATH": ROOT}
+    first = subprocess.Popen([sys.executable, str(script), str(gate), "batch", str(d), "--out", str(out), "-q"],
+                             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        for _ in range(300):
-            if out.exists() and out.stat().st_size > 0:
+        header = 1 if suffix == "csv" else 0
+        for _ in range(6000):                             # until the first row is written (a bound, not a timing)
+            if out.exists() and out.read_bytes().count(b"\n") > header or first.poll() is not None:
                 break
             time.sleep(0.05)
+        assert first.poll() is None, "the first run ended before its gate was opened: " + first.stderr.read()
+        before = out.read_bytes()
         second = subprocess.run([sys.executable, "-m", "inertia_tool.cli", "batch", str(d), "--out", str(out)],
-                                env={**os.environ, "PYTHONPATH": ROOT}, capture_output=True, text=True,
-                                timeout=120)
-        assert first.poll() is None, "the first run ended before the second started; the test proves nothing"
+                                env=env, capture_output=True, text=True, timeout=300)
         assert second.returncode == 2, second.stderr
         lines = second.stderr.strip().splitlines()
         assert len(lines) == 1 and f"is being written by another batch run (pid {first.pid})" in lines[0]
+        assert out.read_bytes() == before                 # the refused run wrote nothing
     finally:
-        first.communicate(timeout=120)
+        gate.write_bytes(b"")
+        first.communicate(timeout=300)
     assert first.returncode == 3                   # the corrupt file
     rows = _rows(out)                              # parses every record: no corrupt line
     assert sorted(r["path"] for r in rows) == discover_files(d)
