@@ -15,7 +15,13 @@ which the next run computes again; ``sync_seconds=0`` syncs every row (0.5-1 ms 
 small mesh).  :func:`open_results`
 reads an existing file back (for resuming) under the lock, cuts a torn last record off (the file then ends
 with a complete row again; :attr:`ResultsFile.torn_bytes` says how much was cut) and refuses a file that is
-not a previous result file of the same kind, so that a run never clobbers unrelated data.
+not a previous result file of the same kind, so that a run never clobbers unrelated data.  Only the last record
+can be torn; damage before it (a stray quote, a torn line followed by rows, an overlong or nested line) is
+refused with its line number (:class:`ResultsFileDamaged`, :func:`read_rows`), never cut.
+
+Write errors (a full disk): a row that cannot be written, or an ``fsync`` that fails, cuts the file back to its
+last complete row (to the last synced one after a failed ``fsync``) and raises :class:`ResultsFileWriteError`;
+the file then resumes like one of a killed run.
 
 Columns are :data:`inertia_tool.batch.runner.ROW_FIELDS`.  In CSV, empty cells are missing values (``None`` in
 JSON); booleans are ``true``/``false``; a cell holding the delimiter, a quote or a line break (a file name

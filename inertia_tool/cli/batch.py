@@ -4,8 +4,9 @@ Routing, the progress bar and the summary only; the per-file work and the runner
 :mod:`inertia_tool.batch.runner`, the result files :mod:`inertia_tool.batch.rows`.
 
 Exit codes: 0 when every file is done without error (this run or an earlier one), 3 when some file failed,
-in this run or in the earlier row it was skipped for (its row says why), 2 for bad arguments or an ``--out`` that
-is not a results file of the same kind.
+in this run or in the earlier row it was skipped for (its row says why), 2 for bad arguments, an ``--out`` that
+is not a results file of the same kind or is damaged before its last line (the line is named), or a results file
+that cannot be written (a full disk: it keeps its complete rows, and the same command resumes).
 """
 
 from __future__ import annotations
