@@ -193,6 +193,7 @@ def test_damaged_results_file_never_drops_an_intact_row(fmt, names, kind, where,
     head = HEADER if fmt == "csv" else b""
     records = [format_row(r, fmt) for r in rows]
     data = head + b"".join(records)
+    assert read_rows(data, fmt, "r") == (rows, 0)             # undamaged: every row back
     at = len(head) + int(where * (len(data) - len(head)))
     if kind == "insert":
         damaged, lo, hi = data[:at] + junk + data[at:], at, at
@@ -309,3 +310,20 @@ def test_json_rows_round_trip_flat_check_accepts_brackets_inside_strings():
     row = _row(7, path='/p/[a]{b}"c"\\d.stl', warnings="x [y] {z}")
     assert read_rows(format_row(row, "jsonl"), "jsonl", "r") == ([row], 0)
     assert json.loads(format_row(row, "jsonl"))["path"] == row["path"]
+
+
+@pytest.mark.parametrize("fmt", ["csv", "jsonl"])
+def test_file_name_with_a_lone_carriage_return_round_trips(tmp_path, fmt):
+    """Found by the fuzzing above: Python 3.11's csv writer left a cell holding a lone CR unquoted, and its
+    reader then refused the record, so a results file with such a file name could not be resumed."""
+    d = tmp_path / "parts"
+    d.mkdir()
+    m = trimesh.creation.box((1, 2, 3))
+    for name in ("a\rb.stl", "c\r.stl", "plain.stl"):
+        write_binary_stl(d / name, m.vertices, m.faces)
+    out = tmp_path / f"r.{fmt}"
+    assert main(["batch", str(d), "--out", str(out), "-q"]) == 0
+    with open_results(out) as r:
+        assert sorted(row["path"] for row in r.previous_rows) == sorted(str(p) for p in d.iterdir())
+    done = _cli("batch", d, "--out", out)
+    assert done.returncode == 0 and "nothing new; 3 done before" in done.stderr

@@ -32,7 +32,6 @@ span several physical lines.
 from __future__ import annotations
 
 import csv
-import io
 import json
 import os
 import re
@@ -95,15 +94,22 @@ def _csv_cell(value) -> str:
     return str(value)
 
 
+def _csv_quoted(cell: str) -> str:
+    """A CSV cell as the ``csv`` module's ``QUOTE_MINIMAL`` writes it, except that a carriage return alone also
+    quotes it (Python 3.11's writer leaves ``a\\rb`` bare with ``lineterminator="\\n"``, and its reader then
+    refuses the record: a file name holding one made the results file unreadable)."""
+    if any(c in cell for c in ',"\n\r'):
+        return '"' + cell.replace('"', '""') + '"'
+    return cell
+
+
 def format_row(row: dict, fmt: str) -> bytes:
     """One row as the bytes of one complete record, ending in ``\\n`` (JSONL: one line; CSV: quoted cells
     may hold line breaks)."""
     if fmt == "jsonl":
         line = json.dumps({k: row.get(k) for k in ROW_FIELDS}, ensure_ascii=False, allow_nan=False) + "\n"
     else:
-        buf = io.StringIO()
-        csv.writer(buf, lineterminator="\n").writerow([_csv_cell(row.get(k)) for k in ROW_FIELDS])
-        line = buf.getvalue()
+        line = ",".join(_csv_quoted(_csv_cell(row.get(k))) for k in ROW_FIELDS) + "\n"
     return line.encode("utf-8", "backslashreplace")     # a lone surrogate left in a message: never an error
 
 
@@ -138,11 +144,14 @@ class _Record:
 
 def _parse_json_line(line: bytes):
     """A row dict or a string saying why ``line`` is not one (a flat object: nesting refused before parsing)."""
-    rest = _JSON_STRING.sub(b'""', line).strip()
-    if not (rest.startswith(b"{") and rest.endswith(b"}")):
+    if line.count(b"{") != 1 or line.count(b"}") != 1 or b"[" in line or b"]" in line:
+        # brackets inside strings are fine: count those outside them (a line of one "{" and one "}" and no
+        # "[" or "]" nests at most one deep however its quotes fall, so the common case skips this)
+        rest = _JSON_STRING.sub(b'""', line)
+        if rest.count(b"{") > 1 or rest.count(b"}") > 1 or b"[" in rest or b"]" in rest:
+            return "is not a flat JSON object (a row holds no arrays or nested objects)"
+    if not line.rstrip().endswith(b"}"):
         return "is not a JSON object"
-    if rest.count(b"{") != 1 or rest.count(b"}") != 1 or b"[" in rest or b"]" in rest:
-        return "is not a flat JSON object (a row holds no arrays or nested objects)"
     try:
         row = json.loads(line.decode("utf-8", errors="replace"))
     except ValueError:
@@ -160,20 +169,14 @@ def _parse_csv_cells(cells: list[str], text: str):
         return f"has {len(cells)} cells, expected {len(ROW_FIELDS)} ({SCHEMA})"
     if cells[0] != SCHEMA:
         return f"starts with {cells[0][:40]!r}, expected the schema {SCHEMA}"
-    written = _csv_text(cells)
-    if text != written and text != written[:-1] + "\r\n":
+    for cell in cells:
         # the csv module reads `a"b` as a cell, but the writer quotes any cell holding a quote: a stray quote
-        return "is not quoted as inertia-tool writes it (a stray quote?)"
+        if '"' in cell and '"' + cell.replace('"', '""') + '"' not in text:
+            return "is not quoted as inertia-tool writes it (a stray quote?)"
     try:
         return {k: _csv_value(k, v) for k, v in zip(ROW_FIELDS, cells)}
     except ValueError as exc:
         return f"has a bad cell ({exc})"
-
-
-def _csv_text(cells: list[str]) -> str:
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerow(cells)
-    return buf.getvalue()
 
 
 def _jsonl_records(lines: list[bytes], ends_with_newline: bool) -> list[_Record]:
@@ -261,10 +264,18 @@ def read_rows(data: bytes, fmt: str, path: str) -> tuple[list[dict], int]:
                 f"{tail.end - tail.first} lines holding {more} more row(s) to the end of the file; {damaged}")
         torn = sum(len(line) + 1 for line in lines[tail.first:]) - (0 if ends_with_newline else 1)
         text = data[len(data) - torn:]
-        # a file of one torn record has not shown it is ours: it must be the start of what we write
-        start = (",".join(ROW_FIELDS) if fmt == "csv" else json.dumps({"schema": SCHEMA})[:-1]).encode()
-        if not records and not (start.startswith(text.strip()) or text.startswith(start)):
-            raise UsageError(f"{path}: {refuse}")
+        # a torn record is the start of one we write (a row; the header in a file of nothing else); anything
+        # else there is damage, or, in a file of nothing else, not ours
+        starts = [_CSV_ROW_START if fmt == "csv" else json.dumps({"schema": SCHEMA})[:-1].encode()]
+        if not records and fmt == "csv":
+            starts.append(",".join(ROW_FIELDS).encode())
+        cut = text.rstrip(b"\r\n")
+        if not any(cut[:len(start)] == start[:len(cut)] for start in starts):
+            if not records:
+                raise UsageError(f"{path}: {refuse}")
+            raise ResultsFileDamaged(f"{path}: line {tail.first + 1} is not a row, nor the start of one cut short "
+                                     f"({tail.parsed if isinstance(tail.parsed, str) else 'no line break'}); "
+                                     f"{damaged}")
     if fmt == "csv" and records and records[0].parsed != "header":
         raise UsageError(f"{path}: its header is not the inertia-tool batch header ({SCHEMA}); {refuse}")
     rows = []
