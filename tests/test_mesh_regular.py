@@ -180,3 +180,22 @@ def test_row_path_escapes_undecodable_bytes_only():
     assert row_path(os.fsdecode(b"/a/caf\xc3\xa9.stl")) == "/a/café.stl"
     assert row_path(os.fsdecode(b"/a/\xff\xfe.stl")) == "/a/\\xff\\xfe.stl"
     assert row_path("lone \ud800 surrogate") == "lone \\ud800 surrogate"
+
+
+# -- robot descriptions: mesh references --------------------------------------------------------------------
+
+@pytest.mark.parametrize("kind", ["fifo", "dev-zero-link"])
+def test_robot_mesh_reference_to_a_fifo_or_device_is_refused(tmp_path, kind):
+    if kind == "fifo":
+        os.mkfifo(tmp_path / "part.stl")
+    else:
+        os.symlink("/dev/zero", tmp_path / "part.stl")
+    geometry = '<geometry><mesh filename="part.stl"/></geometry>'
+    (tmp_path / "r.urdf").write_text(f'<robot name="r"><link name="a"><visual>{geometry}</visual>'
+                                     f'<collision>{geometry}</collision></link></robot>')
+    done = _cli("robot", tmp_path / "r.urdf", "--material", "steel")
+    assert done.returncode == 3, done.stderr
+    what = "a FIFO (named pipe)" if kind == "fifo" else "a symbolic link to a character device"
+    assert done.stderr.strip().splitlines() == [
+        f"inertia-tool: error: {tmp_path / 'r.urdf'}: link 'a': mesh 'part.stl': resolves to "
+        f"{tmp_path / 'part.stl'}, which is {what}, not a regular file"]

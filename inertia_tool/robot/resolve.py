@@ -18,6 +18,7 @@ import os
 from urllib.parse import unquote
 
 from ..errors import RobotDescriptionError
+from ..mesh.regular import not_regular_reason
 
 __all__ = ["resolve_uri", "package_directory", "PACKAGE_PATH_VARIABLES"]
 
@@ -83,5 +84,8 @@ def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) 
                                     "file:// or a path)")
     path = os.path.normpath(path)
     if not os.path.isfile(path):
+        if os.path.exists(path):             # a FIFO, a device or a link to one: never opened (no hang)
+            reason = not_regular_reason(os.stat(path).st_mode, path) or "is not a regular file"
+            raise RobotDescriptionError(f"{where}: resolves to {path}, which {reason}")
         raise RobotDescriptionError(f"{where}: resolves to {path}, which does not exist")
     return path
