@@ -284,7 +284,7 @@ def read_rows(data: bytes, fmt: str, path: str) -> tuple[list[dict], int]:
             continue
         if not isinstance(record.parsed, dict):
             problem = "is a second header" if record.parsed == "header" else str(record.parsed)
-            if k == 0:                                   # the first line of a JSON Lines file: not ours
+            if k == 0 and not any(isinstance(r.parsed, dict) for r in records[1:]):    # no row at all: not ours
                 raise UsageError(f"{path}: line {record.first + 1} {problem}; {refuse}")
             raise ResultsFileDamaged(f"{path}: line {record.first + 1} {problem}; {damaged}")
         rows.append(record.parsed)
