@@ -116,8 +116,20 @@ def test_gltf_buffer_naming_a_fifo_or_device_is_refused_issue22(tmp_path, kind):
     assert done.returncode == 3, done.stderr
     err = done.stderr.strip().splitlines()
     assert len(err) == 1 and str(gltf) in err[0] and "Traceback" not in done.stderr
-    if kind == "fifo":
-        assert err[0].endswith(f"refers to '{buffers[-1]}', which is a FIFO (named pipe), not a regular file")
+    what = "a FIFO (named pipe)" if kind == "fifo" else "a symbolic link to a character device"
+    assert err[0] == f"inertia-tool: error: {gltf}: refers to '{buffers[-1]}', which is {what}, not a regular file"
+
+
+def test_gltf_buffer_outside_the_files_directory_is_refused(tmp_path):
+    gltf, buffers = _gltf(tmp_path / "g")
+    (tmp_path / "outside.bin").write_bytes((gltf.parent / buffers[-1]).read_bytes())
+    data = json.loads(gltf.read_text())
+    data["buffers"][-1]["uri"] = "../outside.bin"
+    gltf.write_text(json.dumps(data))
+    done = _cli("analyze", gltf)
+    assert done.returncode == 3, done.stderr
+    assert done.stderr.strip() == (f"inertia-tool: error: {gltf}: refers to '../outside.bin', which lies outside "
+                                   "the file's directory (refused)")
 
 
 def test_gltf_with_regular_buffers_still_reads_exactly(tmp_path):

@@ -104,17 +104,23 @@ def regular_file_resolver(path: str) -> Any:
         def get(self, name: str) -> bytes:
             stripped = name.strip()
             for candidate in (stripped, stripped.lstrip("/"), os.path.split(name)[-1]):
+                named = os.path.join(self.parent, candidate)          # before links are followed
+                if os.path.lexists(named) and os.path.exists(named):
+                    reason = not_regular_reason(os.stat(named).st_mode, named)
+                    if reason is not None:
+                        raise MeshReadError(f"{_display(path)}: refers to {stripped[:200]!r}, which {reason}")
                 try:
                     target = self.absolute(candidate)
                 except ValueError:
                     continue
                 if os.path.lexists(target):
-                    reason = not_regular_reason(os.stat(target).st_mode, target)
-                    if reason is not None:
-                        raise MeshReadError(f"{_display(path)}: refers to {stripped[:200]!r}, which {reason}")
                     with open_regular(target) as fh:
                         return fh.read()
-            self.absolute(name)                 # a name escaping the directory: trimesh's own ValueError
+            try:
+                self.absolute(name)
+            except ValueError:
+                raise MeshReadError(f"{_display(path)}: refers to {stripped[:200]!r}, which lies outside the "
+                                    "file's directory (refused)") from None
             raise FileNotFoundError(name)
 
         def namespaced(self, namespace: str) -> FilePathResolver:
