@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import InvalidMeshError
 from ..mesh.cad import DEFAULT_ANGULAR_DEFLECTION, chord_tolerance, read_brep, tessellate
 from ..values import frozen_value
 from .properties import MassProperties
@@ -81,7 +82,10 @@ def compare(path: str | os.PathLike[str], *, chord: float | None = None,
     from .pipeline import mass_properties
     path = os.fsdecode(os.fspath(path))
     shape = read_brep(path)
-    tol = chord_tolerance(shape, chord)
+    try:
+        tol = chord_tolerance(shape, chord)
+    except InvalidMeshError as exc:     # a shape without a bounding box: name the file
+        raise InvalidMeshError(f"{os.fsencode(path).decode('utf-8', 'replace')}: {exc}") from None
     exact = exact_mass_properties(shape, name=path)
     vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection)
     mesh = mass_properties((vertices, faces), density=1.0, name=path)

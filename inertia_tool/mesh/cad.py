@@ -28,7 +28,7 @@ import os
 
 import numpy as np
 
-from ..errors import MeshReadError, UsageError
+from ..errors import InvalidMeshError, MeshReadError, UsageError
 
 __all__ = ["BREP_SUFFIXES", "DEFAULT_CHORD_RTOL", "DEFAULT_ANGULAR_DEFLECTION", "read_brep", "tessellate",
            "chord_tolerance", "tessellated_arrays", "has_ocp"]
@@ -110,6 +110,8 @@ def _bounding_diagonal(shape) -> float:
     from OCP.BRepBndLib import BRepBndLib
     box = Bnd_Box()
     BRepBndLib.Add_s(shape, box)
+    if box.IsVoid():        # CornerMin() of a void box raises Standard_ConstructionError
+        raise InvalidMeshError("the shape has no bounding box (it holds no points, curves or faces)")
     return float(box.CornerMin().Distance(box.CornerMax()))
 
 
@@ -189,7 +191,10 @@ def tessellated_arrays(path, *, chord: float | None = None, angular_deflection: 
     path = os.fsdecode(os.fspath(path))
     if has_ocp():
         shape = read_brep(path)
-        tol = chord_tolerance(shape, chord)
+        try:
+            tol = chord_tolerance(shape, chord)
+        except InvalidMeshError as exc:
+            raise _fail(path, str(exc)) from None
         vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection)
         return vertices, faces, tol, "OCP"
     if chord is None:

@@ -82,6 +82,9 @@ def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes
                         raise _fail(path, f"a zip must hold exactly one mesh file; it holds {names}")
                     info = meshes[0]
                     member = os.path.basename(info.filename)
+                    if info.flag_bits & 0x1:
+                        raise _fail(path, f"member {member[:60]!r} is encrypted (password-protected): it cannot be "
+                                          "read")
                     ratio_limit = max(int(info.compress_size * max_ratio), min_ratio_bytes)
                     if info.file_size > min(max_bytes, ratio_limit):
                         raise _fail(path, f"member {member[:60]!r} would inflate to {info.file_size:,} bytes from "
@@ -109,7 +112,8 @@ def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes
                     _copy_bounded(src, dst, path, compressed, max_bytes, max_ratio, min_ratio_bytes)
         except MeshReadError:
             raise
-        except (OSError, EOFError, zipfile.BadZipFile, zlib.error, ValueError) as exc:
+        except (OSError, EOFError, zipfile.BadZipFile, zlib.error, ValueError, RuntimeError,
+                NotImplementedError) as exc:
             raise _fail(path, f"cannot be decompressed ({str(exc)[:120] or type(exc).__name__})") from None
         yield target, member
         shutil.rmtree(tmp, ignore_errors=True)

@@ -631,6 +631,9 @@ def _check_zip_members(path: str, count: int, members, what: str = "") -> None:
         raise _fail(path, f"{what}archive has {count:,} members, more than the {MAX_ZIP_MEMBERS:,} allowed; "
                           "refused before inflating")
     for i in members:
+        if i.flag_bits & 0x1:       # bit 0 of the general purpose flags: the member is encrypted
+            raise _fail(path, f"{what}member {i.filename[:60]!r} is encrypted (password-protected): it cannot be "
+                              "read")
         if i.file_size > _ZIP_RATIO_MIN_BYTES and i.file_size > MAX_ZIP_RATIO * max(i.compress_size, 1):
             raise _fail(path, f"{what}member {i.filename[:60]!r} would inflate "
                               f"{i.file_size / max(i.compress_size, 1):,.0f}:1 ({i.compress_size:,} → "
@@ -691,6 +694,8 @@ def _read_3mf_models(path: str, max_faces: int):
                             if not block:
                                 break
                             dst.write(block)
+    except RuntimeError as exc:     # zipfile: "File ... is encrypted, password required for extraction"
+        raise _fail(path, f"3MF archive member cannot be read ({str(exc)[:100]})") from None
     except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError, NotImplementedError,
             zlib.error) as exc:
         raise _fail(path, f"not a valid 3MF (zip) archive ({str(exc)[:100]})") from None
@@ -698,7 +703,57 @@ def _read_3mf_models(path: str, max_faces: int):
     return buffer
 
 
-_HEADER_CHECKS = {".ply": _check_ply_header, ".off": _check_off_header}
+_FLOAT_ARRAY = re.compile(rb"<(?:\w+:)?float_array\b[^>]*(?<!/)>(.*?)</(?:\w+:)?float_array\s*>", re.DOTALL)
+_NOT_DECIMAL = re.compile(rb"[^0-9eE+\-.\s]")
+
+
+def _check_collada_floats(name: str, data: bytes) -> None:
+    """Refuse a COLLADA document whose ``<float_array>`` text holds anything but decimal numbers.
+
+    pycollada parses each array with ``numpy.fromstring(..., float32)`` and then sets every NaN to 0, so a
+    ``nan`` coordinate would silently become the origin (and ``inf``, ``1e999``, become infinity); the text is
+    checked here, before it is parsed: only digits, signs, ``.``, exponents and white space may appear.
+    """
+    for match in _FLOAT_ARRAY.finditer(data):
+        bad = _NOT_DECIMAL.search(match.group(1))
+        if bad is not None:
+            start = match.group(1).rfind(b" ", 0, bad.start()) + 1
+            token = match.group(1)[start:start + 24].split()[0].decode("utf-8", "replace")
+            raise MeshReadError(f"{name}: a <float_array> holds {token!r}, not a finite decimal number "
+                                "(NaN and infinity are refused: the COLLADA reader would turn NaN into 0)")
+
+
+def _check_collada(path: str, size: int, max_faces: int) -> dict:
+    """A ``.dae`` file: at most :func:`zip_inflate_limit` bytes (the text of ``max_faces`` triangles), and
+    its float arrays decimal numbers (:func:`_check_collada_floats`)."""
+    limit = zip_inflate_limit(max_faces)
+    if size > limit:
+        raise _fail(path, f"{size:,} bytes of COLLADA text, more than the {limit:,} allowed for `max_faces` "
+                          f"({max_faces:,})")
+    with open(path, "rb") as fh:
+        _check_collada_floats(_display(path), fh.read())
+    return {}
+
+
+def _check_zipped_collada(path: str, max_faces: int) -> dict:
+    """A ``.zae`` archive: the inflated-size limits of :func:`_check_zip`, then the float arrays of its
+    ``.dae`` members (:func:`_check_collada_floats`)."""
+    import zipfile
+    counts = _check_zip(path, max_faces)
+    try:
+        with zipfile.ZipFile(path) as zf:
+            for info in zf.infolist():
+                if info.filename.lower().endswith(".dae"):
+                    _check_collada_floats(f"{_display(path)}:{info.filename[:60]}", zf.read(info))
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError, NotImplementedError,
+            RuntimeError, OSError) as exc:
+        if isinstance(exc, MeshReadError):
+            raise
+        raise _fail(path, f"not a valid zip archive ({str(exc)[:100]})") from None
+    return counts
+
+
+_HEADER_CHECKS = {".ply": _check_ply_header, ".off": _check_off_header, ".dae": _check_collada}
 
 
 def _declared_scale(path: str, suffix: str, loaded) -> tuple[float, str] | None:
@@ -727,7 +782,7 @@ def _read_with_trimesh(path: str, max_faces: int):
     if suffix in _HEADER_CHECKS:
         counts = _HEADER_CHECKS[suffix](path, size, max_faces)
     elif suffix == ".zae":
-        counts = _check_zip(path, max_faces)
+        counts = _check_zipped_collada(path, max_faces)
     else:
         counts = {}
     source, kind = (_read_3mf_models(path, max_faces), "3mf") if suffix == ".3mf" else (path, None)
@@ -874,6 +929,8 @@ def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_
                 from .cad import tessellated_arrays
                 vertices, faces, _, _ = tessellated_arrays(path)
                 _check_face_budget(path, len(faces), max_faces)
+                if not np.all(np.isfinite(vertices)):
+                    raise _fail(path, "the tessellation has NaN or infinite coordinates")
                 declared = (1.0, "m")           # the CAD reader converts the file's unit to metres
                 n = len(faces)
             else:

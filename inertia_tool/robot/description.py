@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import re
 from dataclasses import field
 
 import numpy as np
@@ -48,6 +49,21 @@ ROBOT_SUFFIXES = {".urdf": "urdf", ".xacro": "xacro", ".sdf": "sdf", ".world": "
 
 #: Largest description file read (bytes); descriptions are text of a few hundred KB at most.
 MAX_DESCRIPTION_BYTES = 64 << 20
+
+#: Lengths a robot description may state (primitive sizes, |origin| coordinates), m: a nanometre to a million
+#: kilometres.  Inside this range every closed form of ``robot.geometry`` (volumes ~ s³, moments ~ s⁵, times
+#: any density of ``OPTION_RANGES``) is a normal float64; outside it they overflow or underflow to 0.
+ROBOT_LENGTH_RANGE = (1e-9, 1e9)
+
+#: Mesh scale factors a description may state, by magnitude (a negative factor mirrors): the mesh's own
+#: coordinates are bounded by the reader, so a factor in this range keeps the scaled mesh finite.
+ROBOT_SCALE_RANGE = (1e-9, 1e9)
+
+#: The one number grammar of robot files: a decimal as XML Schema's ``xsd:double`` lexical form (optional sign,
+#: ASCII digits with an optional fraction or a fraction alone, optional exponent), without ``INF`` and ``NaN``.
+#: Python's ``float()`` also takes ``1_000``, ``inf``, ``nan`` and non-ASCII digits (``١٢``); none is a number
+#: of URDF, SDFormat or MJCF, so none is accepted.
+_DECIMAL = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
 
 
 def rpy_to_matrix(rpy) -> np.ndarray:
@@ -209,24 +225,61 @@ def _fail(source: str, problem: str) -> RobotDescriptionError:
     return RobotDescriptionError(f"{source}: {problem}")
 
 
-def _numbers(text, count: int, what: str, source: str, default=None) -> np.ndarray:
+def parse_decimal(token: str) -> float:
+    """The value of one number of a robot file, by the grammar :data:`_DECIMAL` (ValueError otherwise).
+
+    A token that matches but overflows (``1e999``) comes back as infinity, for the caller's finiteness check.
+    """
+    if not _DECIMAL.fullmatch(token):
+        raise ValueError(f"not a decimal number: {token[:40]!r}")
+    return float(token)
+
+
+def _numbers(text, count: int | None, what: str, source: str, default=None) -> np.ndarray:
+    """The whitespace-separated numbers of an attribute or element text (``count`` of them; any count when
+    None), each by :func:`parse_decimal` and finite; ``default`` when ``text`` is None."""
     if text is None:
         if default is None:
             raise _fail(source, f"{what}: missing")
         return np.array(default, dtype=np.float64)
+    expected = f"{count} " if count is not None else ""
+    shown = " ".join(str(text).split())[:80]
     try:
-        values = np.array([float(t) for t in str(text).split()], dtype=np.float64)
+        values = np.array([parse_decimal(t) for t in str(text).split()], dtype=np.float64)
     except ValueError:
-        raise _fail(source, f"{what}: expected {count} numbers, got {str(text)[:80]!r}") from None
-    if values.shape != (count,) or not np.all(np.isfinite(values)):
-        raise _fail(source, f"{what}: expected {count} finite numbers, got {str(text)[:80]!r}")
+        raise _fail(source, f"{what}: expected {expected}decimal numbers (like -1.5e-3), got {shown!r}") from None
+    if (count is not None and values.shape != (count,)) or not np.all(np.isfinite(values)):
+        raise _fail(source, f"{what}: expected {expected}finite numbers, got {shown!r}")
     return values
 
 
 def _positive(value: float, what: str, source: str) -> float:
+    """``value`` as a size (m): positive and within :data:`ROBOT_LENGTH_RANGE`."""
+    low, high = ROBOT_LENGTH_RANGE
     if not (math.isfinite(value) and value > 0):
         raise _fail(source, f"{what}: expected a positive size, got {value:g}")
+    if not low <= value <= high:
+        raise _fail(source, f"{what}: expected a size between {low:g} and {high:g} m, got {value:g} (its volume "
+                            "and moments would not be normal float64 numbers)")
     return float(value)
+
+
+def _coordinates(values: np.ndarray, what: str, source: str) -> np.ndarray:
+    """``values`` (m) as position coordinates: each at most ``ROBOT_LENGTH_RANGE[1]`` in magnitude."""
+    high = ROBOT_LENGTH_RANGE[1]
+    if np.any(np.abs(values) > high):
+        raise _fail(source, f"{what}: expected coordinates at most {high:g} m in magnitude, got "
+                            f"{' '.join(f'{v:g}' for v in values)}")
+    return values
+
+
+def _scale(values: np.ndarray, what: str, source: str) -> np.ndarray:
+    """Mesh scale factors: each non-zero with a magnitude within :data:`ROBOT_SCALE_RANGE`."""
+    low, high = ROBOT_SCALE_RANGE
+    if not np.all((np.abs(values) >= low) & (np.abs(values) <= high)):
+        raise _fail(source, f"{what}: expected scale factors between {low:g} and {high:g} in magnitude (negative "
+                            f"mirrors), got {' '.join(f'{v:g}' for v in values)}")
+    return values
 
 
 def parse_xml(data: bytes, source: str):
@@ -294,7 +347,8 @@ def _urdf_origin(element, what: str, source: str) -> tuple[np.ndarray, np.ndarra
     origin = element.find("origin") if element is not None else None
     if origin is None:
         return np.eye(3), np.zeros(3)
-    xyz = _numbers(origin.get("xyz"), 3, f"{what} <origin xyz>", source, default=(0, 0, 0))
+    xyz = _coordinates(_numbers(origin.get("xyz"), 3, f"{what} <origin xyz>", source, default=(0, 0, 0)),
+                       f"{what} <origin xyz>", source)
     rpy = _numbers(origin.get("rpy"), 3, f"{what} <origin rpy>", source, default=(0, 0, 0))
     return rpy_to_matrix(rpy), xyz
 
@@ -347,6 +401,7 @@ def _urdf_geometry(element, link_name: str, label: str, base: str, packages: dic
         h = _numbers(shape.get("length"), 1, f"{what} <{kind} length>", source)[0]
         if not (math.isfinite(h) and (h > 0 or (kind == "capsule" and h == 0))):
             raise _fail(source, f"{what}: <{kind} length> must be positive, got {h:g}")
+        h = _positive(h, f"{what} <{kind} length>", source) if h else h
         return GeometryElement(kind, rotation, translation, size=(r, h), name=name)
     if kind == "sphere":
         r = _positive(_numbers(shape.get("radius"), 1, f"{what} <sphere radius>", source)[0], f"{what} radius", source)
@@ -355,7 +410,8 @@ def _urdf_geometry(element, link_name: str, label: str, base: str, packages: dic
         uri = shape.get("filename")
         if not uri:
             raise _fail(source, f"{what}: <mesh> without a filename")
-        scale = _numbers(shape.get("scale"), 3, f"{what} <mesh scale>", source, default=(1, 1, 1))
+        scale = _scale(_numbers(shape.get("scale"), 3, f"{what} <mesh scale>", source, default=(1, 1, 1)),
+                       f"{what} <mesh scale>", source)
         path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name)
         return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name)
     raise _fail(source, f"{what}: unsupported geometry <{kind}> (expected box, cylinder, sphere, capsule or mesh)")
@@ -397,7 +453,7 @@ def _sdf_pose(element, what: str, source: str) -> tuple[np.ndarray, np.ndarray]:
         rpy = np.radians(rpy)
     if pose.get("rotation_format", "euler_rpy") != "euler_rpy":
         raise _fail(source, f"{what}: <pose rotation_format={pose.get('rotation_format')!r}> is not supported")
-    return rpy_to_matrix(rpy), values[:3]
+    return rpy_to_matrix(rpy), _coordinates(values[:3], f"{what} <pose>", source)
 
 
 def _sdf_number(element, tag: str, what: str, source: str, default=None) -> float:
@@ -450,7 +506,8 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
             raise _fail(source, f"{what}: <mesh> without a <uri>")
         if shape.find("submesh") is not None:
             raise _fail(source, f"{what}: <mesh><submesh> is not supported")
-        scale = _numbers(shape.findtext("scale"), 3, f"{what} <mesh><scale>", source, default=(1, 1, 1))
+        scale = _scale(_numbers(shape.findtext("scale"), 3, f"{what} <mesh><scale>", source, default=(1, 1, 1)),
+                       f"{what} <mesh><scale>", source)
         path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name)
         return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name)
     raise _fail(source, f"{what}: unsupported geometry <{kind}> (expected box, cylinder, sphere, capsule, "

@@ -22,7 +22,7 @@ import os
 import numpy as np
 
 from ..errors import RobotDescriptionError
-from .description import DeclaredInertial, GeometryElement, LinkGeometry, _numbers, _positive
+from .description import DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive, _scale
 from .resolve import resolve_uri
 
 __all__ = ["read_mjcf", "orientation_matrix"]
@@ -60,6 +60,22 @@ def _z_to(direction) -> np.ndarray:
     return _axis_angle(axis, math.atan2(s, c))
 
 
+_ELEMENTARY_AXES = {"x": 0, "y": 1, "z": 2}
+
+
+def _euler_matrix(sequence: str, angles) -> np.ndarray:
+    """Active rotation of the Euler angles ``angles`` (rad) about the axes of ``sequence`` (three of ``xyzXYZ``,
+    checked by :func:`_compiler`), composed as MuJoCo does: a lower-case axis rotates with the frame
+    (``R ← R R_k``, intrinsic), an upper-case one stays fixed (``R ← R_k R``, extrinsic); cases may mix."""
+    rotation = np.eye(3)
+    for letter, angle in zip(sequence, angles):
+        axis = np.zeros(3)
+        axis[_ELEMENTARY_AXES[letter.lower()]] = 1.0
+        step = _axis_angle(axis, float(angle))
+        rotation = rotation @ step if letter.islower() else step @ rotation
+    return rotation
+
+
 def orientation_matrix(attrs: dict, *, degrees: bool, eulerseq: str, what: str, source: str) -> np.ndarray:
     """Active rotation (frame axes as columns, in parent axes) from MJCF orientation attributes.
 
@@ -91,10 +107,8 @@ def orientation_matrix(attrs: dict, *, degrees: bool, eulerseq: str, what: str, 
             raise _fail(source, f"{what}: axisangle with a zero axis")
         return _axis_angle(a[:3], a[3] * unit)
     if key == "euler":
-        from scipy.spatial.transform import Rotation
         angles = _numbers(attrs[key], 3, f"{what} euler", source) * unit
-        seq = eulerseq.swapcase()          # MuJoCo: lower = intrinsic; scipy: upper = intrinsic
-        return Rotation.from_euler(seq, angles).as_matrix()
+        return _euler_matrix(eulerseq, angles)
     if key == "xyaxes":
         a = _numbers(attrs[key], 6, f"{what} xyaxes", source)
         x = a[:3] / np.linalg.norm(a[:3])
@@ -140,11 +154,17 @@ class _Defaults:
         return attrs
 
 
-def _compiler(root) -> tuple[bool, str, str, str]:
+def _compiler(root, source: str) -> tuple[bool, str, str, str]:
     compiler = root.find("compiler")
     get = (compiler.get if compiler is not None else (lambda k, d=None: d))
-    degrees = get("angle", "degree") != "radian"
-    return degrees, get("eulerseq", "xyz"), get("meshdir", None), get("assetdir", None)
+    angle = get("angle", "degree")
+    if angle not in ("degree", "radian"):
+        raise _fail(source, f"<compiler angle={angle[:40]!r}>: expected 'degree' or 'radian'")
+    eulerseq = get("eulerseq", "xyz")
+    if len(eulerseq) != 3 or any(c not in "xyzXYZ" for c in eulerseq):
+        raise _fail(source, f"<compiler eulerseq={eulerseq[:40]!r}>: expected three of the letters xyzXYZ "
+                            "(lower case rotates with the frame, upper case about the fixed axes)")
+    return angle == "degree", eulerseq, get("meshdir", None), get("assetdir", None)
 
 
 def _meshes(root, defaults: _Defaults, base: str, meshdir: str, packages: dict, source: str) -> dict:
@@ -160,7 +180,8 @@ def _meshes(root, defaults: _Defaults, base: str, meshdir: str, packages: dict, 
             if not file:
                 raise _fail(source, f"<mesh name={attrs.get('name')!r}> without a file")
             name = attrs.get("name") or os.path.splitext(os.path.basename(file))[0]
-            scale = _numbers(attrs.get("scale"), 3, f"<mesh name={name!r}> scale", source, default=(1, 1, 1))
+            scale = _scale(_numbers(attrs.get("scale"), 3, f"<mesh name={name!r}> scale", source, default=(1, 1, 1)),
+                           f"<mesh name={name!r}> scale", source)
             meshes[name] = (file, scale)
     return meshes
 
@@ -173,15 +194,17 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, mesh_base: str
     if kind is None:
         raise _fail(source, f"{what}: geom type {attrs.get('type')!r} is not supported")
     rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=what, source=source)
-    position = _numbers(attrs.get("pos"), 3, f"{what} pos", source, default=(0, 0, 0))
-    size = [float(s) for s in (attrs.get("size") or "").split()]
+    position = _coordinates(_numbers(attrs.get("pos"), 3, f"{what} pos", source, default=(0, 0, 0)),
+                            f"{what} pos", source)
+    size = list(_numbers(attrs.get("size") or "", None, f"{what} size", source))
     half_length = None
     if attrs.get("fromto") is not None and kind in ("capsule", "cylinder", "box", "ellipsoid"):
-        ends = _numbers(attrs["fromto"], 6, f"{what} fromto", source)
+        ends = _coordinates(_numbers(attrs["fromto"], 6, f"{what} fromto", source), f"{what} fromto", source)
         axis = ends[3:] - ends[:3]
         if not np.linalg.norm(axis) > 0:
             raise _fail(source, f"{what}: fromto with coincident ends")
-        rotation, position, half_length = _z_to(axis), 0.5 * (ends[:3] + ends[3:]), 0.5 * np.linalg.norm(axis)
+        rotation, position = _z_to(axis), 0.5 * (ends[:3] + ends[3:])
+        half_length = 0.5 * _positive(float(np.linalg.norm(axis)), f"{what} fromto length", source)
     frame_rotation, frame_translation = pose
     rotation, position = frame_rotation @ rotation, frame_rotation @ position + frame_translation
     name = attrs.get("name") or label
@@ -223,7 +246,7 @@ def _inertial(body, name: str, compiler, source: str) -> DeclaredInertial | None
     degrees, eulerseq = compiler
     what = f"body {name!r} <inertial>"
     attrs = dict(inertial.attrib)
-    position = _numbers(attrs.get("pos"), 3, f"{what} pos", source)
+    position = _coordinates(_numbers(attrs.get("pos"), 3, f"{what} pos", source), f"{what} pos", source)
     mass = _numbers(attrs.get("mass"), 1, f"{what} mass", source)[0]
     if attrs.get("fullinertia") is not None:
         if any(attrs.get(k) is not None for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis")):
@@ -238,8 +261,12 @@ def _inertial(body, name: str, compiler, source: str) -> DeclaredInertial | None
                             rotation=rotation, inertia_in_frame=tensor)
 
 
-def _is_collision(attrs: dict) -> bool:
-    return int(float(attrs.get("contype", "1"))) != 0 or int(float(attrs.get("conaffinity", "1"))) != 0
+def _is_collision(attrs: dict, what: str, source: str) -> bool:
+    bits = [_numbers(attrs.get(k, "1"), 1, f"{what} {k}", source)[0] for k in ("contype", "conaffinity")]
+    if any(b != int(b) for b in bits):
+        raise _fail(source, f"{what}: contype and conaffinity are integer bit masks, got "
+                            f"{attrs.get('contype', '1')!r} and {attrs.get('conaffinity', '1')!r}")
+    return any(b != 0 for b in bits)
 
 
 def _child_bodies(element, class_name: str):
@@ -257,7 +284,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
         raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
     if root.find(".//include") is not None:
         raise _fail(source, "<include> is not supported; give a file with the included parts merged")
-    degrees, eulerseq, meshdir, assetdir = _compiler(root)
+    degrees, eulerseq, meshdir, assetdir = _compiler(root, source)
     mesh_base = os.path.join(base, meshdir or assetdir or "")
     defaults = _Defaults(root, source)
     meshes = _meshes(root, defaults, base, mesh_base, packages, source)
@@ -280,14 +307,15 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
         for child in element:
             if child.tag == "geom":
                 attrs = defaults.attributes(child, class_name, source)
-                if _is_collision(attrs) == (geometry == "collision"):
+                if _is_collision(attrs, f"body {link!r} geom {len(elements) + 1}", source) == (geometry == "collision"):
                     label = f"geom {len(elements) + 1}"
                     elements.append(_geom(attrs, pose, label, link, meshes, mesh_base, packages, compiler, source))
             elif child.tag == "frame":
                 attrs = dict(child.attrib)
                 rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=f"body {link!r} frame",
                                               source=source)
-                position = _numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", source, default=(0, 0, 0))
+                position = _coordinates(_numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", source,
+                                                 default=(0, 0, 0)), f"body {link!r} frame pos", source)
                 composed = (pose[0] @ rotation, pose[0] @ position + pose[1])
                 collect(child, link, child.get("childclass", class_name), composed, elements)
 
