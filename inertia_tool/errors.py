@@ -54,6 +54,7 @@ __all__ = [
     "ImplausibleSizeWarning",
     "ImplausibleDensityWarning",
     "ImplausibleCorrectionWarning",
+    "StoragePrecisionWarning",
 ]
 
 
@@ -205,3 +206,10 @@ class ImplausibleDensityWarning(InertiaToolWarning):
 class ImplausibleCorrectionWarning(InertiaToolWarning):
     """A balancing correction lies outside the part (radius beyond its extent, plane beyond its ends) or is a
     sizeable fraction of the part's mass: possible on paper, but check the inputs before drilling."""
+
+
+class StoragePrecisionWarning(InertiaToolWarning):
+    """The file stores coordinates as float32 (binary STL, PLY ``float``, glTF/GLB, COLLADA) and the part lies so
+    far from the origin, or is so thin, that this rounding alone bounds the volume only loosely: the stored mesh
+    is integrated exactly, but it is not the drawn part to the digits reported.  The message gives the bound
+    (:mod:`inertia_tool.mesh.precision`)."""

@@ -34,3 +34,11 @@ ROTATION_ATOL = 1e-9
 #: Display only: tensor products and coordinates below ``DISPLAY_ZERO_RTOL`` of the body's scale print as 0
 #: (round-off, not data).  Never applied to a computed value that is returned.
 DISPLAY_ZERO_RTOL = 1e-12
+
+#: A float32 file (binary STL, PLY ``float``, glTF/GLB, COLLADA) whose storage rounding bounds the volume only to
+#: worse than ``STORAGE_PRECISION_RTOL`` relative gets a :class:`~inertia_tool.errors.StoragePrecisionWarning`
+#: (the bound: :mod:`inertia_tool.mesh.precision`).  float32 rounds each coordinate by up to 2⁻²⁴ of its
+#: magnitude, and the bound is about 60x that over the part's size, so a compact part near its origin is bounded
+#: to ~4e-6 whatever it is: the warning is for a part far from the origin (or a film far thinner than its
+#: coordinates), where the file itself has lost digits the reports would print.
+STORAGE_PRECISION_RTOL = 1e-4

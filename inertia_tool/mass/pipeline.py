@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import InvalidMeshError, NearlyEqualMomentsWarning, OverlapWarning, PhysicalValidityWarning, UsageError
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
+from ..mesh.precision import warn_storage_precision
 from ..mesh.prepare import PreparedMesh, classify_shells, prepare_mesh
 from ..mesh.read import load_mesh
 from ..tolerances import NEEDLE_RTOL, TRIANGLE_INEQUALITY_RTOL
@@ -186,6 +187,7 @@ def _part(source: MeshSource, rho: float | None, mass: float | None, options: Lo
         warn_implausible_density(label, result.density, mass, result.volume, stacklevel=4)
     _check_finite(result, label)
     _check_physical(result)
+    warn_storage_precision(raw, result.volume, stacklevel=4)
     if warn_principal:
         _warn_about_principal(result, label)
     return result, prepared

@@ -71,6 +71,11 @@ class RawMesh:
     units_assumed : bool
         True when no unit was given and metres were assumed (the size check of
         :func:`inertia_tool.mesh.plausibility.warn_implausible_size` applies only then).
+    storage_rounding : float
+        m: how far each stored coordinate may lie from the value the exporter meant, because the file stores
+        float32 (binary STL, PLY ``float``, glTF/GLB, COLLADA): half the float32 spacing at the largest
+        coordinate (:func:`inertia_tool.mesh.precision.float32_rounding`); 0 for text and float64 formats and
+        for arrays.  :func:`inertia_tool.mesh.precision.warn_storage_precision` turns it into a volume bound.
     """
 
     vertices: np.ndarray
@@ -79,6 +84,7 @@ class RawMesh:
     units: str = "m"
     file_faces: int = 0
     units_assumed: bool = False
+    storage_rounding: float = 0.0
 
 
 def _display(path) -> str:
@@ -330,7 +336,12 @@ def read_stl(path, *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, n
     faces : (m, 3) int
     file_faces : int
     """
-    path = os.fsdecode(os.fspath(path))
+    vertices, faces, n, _ = _read_stl(os.fsdecode(os.fspath(path)), max_faces)
+    return vertices, faces, n
+
+
+def _read_stl(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int, bool]:
+    """:func:`read_stl`, and whether the file was binary (float32 coordinates)."""
     size = os.path.getsize(path)
     if size == 0:
         raise _fail(path, "empty file (0 bytes)")
@@ -345,7 +356,7 @@ def read_stl(path, *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, n
         vertices, faces = weld_exact_stream(_binary_stl_chunks(path, n, padded=accel() is None), 3 * n)
         if not np.all(np.isfinite(vertices)):
             raise _fail(path, "triangles have NaN or infinite coordinates")
-        return vertices, faces, n
+        return vertices, faces, n, True
 
     if (announced >= 0 and 84 + 50 * announced == size) or not _looks_ascii_stl(head):
         return binary()
@@ -363,7 +374,7 @@ def read_stl(path, *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, n
         bad = int(np.count_nonzero(~np.isfinite(corners).all(axis=(1, 2))))
         raise _fail(path, f"{bad:,} triangles have NaN or infinite coordinates")
     vertices, faces = weld_exact(corners)
-    return vertices, faces, n
+    return vertices, faces, n, False
 
 
 # -- OBJ ------------------------------------------------------------------------------------------------
@@ -535,6 +546,7 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
     if not head.startswith(b"ply") or end < 0:
         raise _fail(path, "not a PLY file (no 'ply' magic, or no 'end_header' within 64 KiB)")
     fmt = None
+    vertex_float32 = False
     elements: list = []
     for line in head[:end].replace(b"\r", b"\n").split(b"\n")[1:]:
         parts = line.split()
@@ -552,6 +564,8 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
             kind = parts[2] if parts[1:2] == [b"list"] and len(parts) >= 3 else parts[1:2][0] if len(parts) > 1 else b""
             if kind not in _PLY_TYPE_BYTES:
                 raise _fail(path, f"unknown PLY property type {kind[:20].decode('utf-8', 'replace')!r}")
+            if elements[-1][0] == b"vertex" and parts[-1:] == [b"x"] and kind in (b"float", b"float32"):
+                vertex_float32 = True
             elements[-1][2] += 2 if fmt == b"ascii" else _PLY_TYPE_BYTES[kind]
     if fmt not in (b"ascii", b"binary_little_endian", b"binary_big_endian"):
         raise _fail(path, f"unknown PLY format {fmt!r}")
@@ -565,6 +579,7 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
     _check_face_budget(path, counts.get("face", 0), max_faces)
     if counts.get("vertex", 0) > 3 * max_faces + 3:
         raise _fail(path, f"holds {counts['vertex']:,} vertices, more than 3 × `max_faces`")
+    counts["float32"] = int(vertex_float32)
     return counts
 
 
@@ -777,6 +792,34 @@ def _declared_scale(path: str, suffix: str, loaded) -> tuple[float, str] | None:
 
 
 def _read_with_trimesh(path: str, max_faces: int):
+    """``(vertices, faces, declared unit)`` of a file trimesh reads (see :func:`_read_with_trimesh_rounding`)."""
+    vertices, faces, declared, _ = _read_with_trimesh_rounding(path, max_faces)
+    return vertices, faces, declared
+
+
+#: Formats whose coordinates the reader receives as float32 (glTF's POSITION accessor is float32 by the
+#: specification; pycollada parses COLLADA arrays as float32).  PLY: when its vertex x is ``float``.
+_FLOAT32_FORMATS = (".glb", ".gltf", ".dae", ".zae")
+
+
+def _scene_rounding(loaded) -> float:
+    """float32 rounding (file units) of a scene whose geometries are stored as float32 and placed by node
+    transforms: each output coordinate is ``Σ_j M_ij x_j + t_i``, so its error is at most ``‖M‖∞ δ`` with ``δ``
+    the rounding of the largest stored coordinate and ``‖M‖∞`` the largest row sum of any node's matrix."""
+    import trimesh
+    if isinstance(loaded, trimesh.Trimesh):
+        return _float32_rounding(np.asarray(loaded.vertices))
+    stored = [np.asarray(g.vertices) for g in loaded.geometry.values() if hasattr(g, "vertices")]
+    delta = max((_float32_rounding(v) for v in stored), default=0.0)
+    norm = 1.0
+    for node in loaded.graph.nodes_geometry:
+        matrix, _ = loaded.graph[node]
+        norm = max(norm, float(np.abs(np.asarray(matrix)[:3, :3]).sum(axis=1).max()))
+    return delta * norm
+
+
+def _read_with_trimesh_rounding(path: str, max_faces: int):
+    """``(vertices, faces, declared unit, float32 rounding in file units)`` of a file trimesh reads."""
     size = os.path.getsize(path)
     suffix = os.path.splitext(path)[1].lower()
     if suffix in _HEADER_CHECKS:
@@ -814,6 +857,8 @@ def _read_with_trimesh(path: str, max_faces: int):
             finally:
                 quiet.setLevel(level)
             declared = _declared_scale(path, suffix, loaded)
+            float32 = suffix in _FLOAT32_FORMATS or (suffix == ".ply" and counts.get("float32"))
+            rounding = _scene_rounding(loaded) if float32 else 0.0
             if isinstance(loaded, trimesh.Scene):   # dump() applies every node's transform
                 geoms = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)] if loaded.geometry else []
                 if not geoms:
@@ -845,7 +890,7 @@ def _read_with_trimesh(path: str, max_faces: int):
                           "(faces dropped or truncated file)")
     if not np.all(np.isfinite(v)):
         raise _fail(path, "vertices have NaN or infinite coordinates")
-    return v, f, declared
+    return v, f, declared, rounding
 
 
 def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_FACES) -> RawMesh:
@@ -912,15 +957,19 @@ def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_
                     except MeshReadError as exc:
                         raise MeshReadError(str(exc).replace(inner, f"{_display(path)}:{member}", 1)) from None
                 return RawMesh(vertices=raw.vertices, faces=raw.faces, source=_display(path), units=raw.units,
-                               file_faces=raw.file_faces, units_assumed=raw.units_assumed)
+                               file_faces=raw.file_faces, units_assumed=raw.units_assumed,
+                               storage_rounding=raw.storage_rounding)
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
                                   f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
             if os.path.getsize(path) == 0:
                 raise _fail(path, "empty file (0 bytes)")
             declared = None
+            rounding = 0.0                  # file units until scaled below
             if suffix == ".stl":
-                vertices, faces, n = read_stl(path, max_faces=max_faces)
+                vertices, faces, n, binary = _read_stl(path, max_faces)
+                if binary:
+                    rounding = _float32_rounding(vertices)
             elif suffix == ".obj":
                 vertices, faces, n = _read_obj(path, max_faces)
                 if not np.all(np.isfinite(vertices)):
@@ -934,7 +983,7 @@ def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_
                 declared = (1.0, "m")           # the CAD reader converts the file's unit to metres
                 n = len(faces)
             else:
-                vertices, faces, declared = _read_with_trimesh(path, max_faces)
+                vertices, faces, declared, rounding = _read_with_trimesh_rounding(path, max_faces)
                 n = len(faces)
         except PermissionError:
             raise _fail(path, "permission denied") from None
@@ -956,13 +1005,21 @@ def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_
         n = len(faces)
         _check_face_budget(name, n, max_faces)
         owned = False                      # may be the caller's own array: never modified
+        rounding = 0.0
     if scale != 1.0:
         if owned and vertices.dtype == np.float64 and vertices.flags.writeable:
             vertices *= scale
         else:
             vertices = vertices * scale
     return RawMesh(vertices=vertices, faces=faces, source=name, units=str(units), file_faces=n,
-                   units_assumed=assumed)
+                   units_assumed=assumed, storage_rounding=rounding * abs(scale))
+
+
+def _float32_rounding(vertices: np.ndarray) -> float:
+    """Per-coordinate rounding of float32 storage for ``vertices`` (file units): :func:`.precision.float32_rounding`
+    of the largest magnitude."""
+    from .precision import float32_rounding
+    return float32_rounding(float(np.max(np.abs(vertices)))) if vertices.size else 0.0
 
 
 def _declared_units_win(name: str, declared: tuple[float, str], units: str, scale: float) -> tuple[float, str]:
