@@ -720,6 +720,7 @@ def _read_3mf_models(path: str, max_faces: int):
 
 _FLOAT_ARRAY = re.compile(rb"<(?:\w+:)?float_array\b[^>]*(?<!/)>(.*?)</(?:\w+:)?float_array\s*>", re.DOTALL)
 _NOT_DECIMAL = re.compile(rb"[^0-9eE+\-.\s]")
+_BIG_EXPONENT = re.compile(rb"[eE]\+?0*([1-9][0-9]+)")
 
 
 def _check_collada_floats(name: str, data: bytes) -> None:
@@ -730,6 +731,10 @@ def _check_collada_floats(name: str, data: bytes) -> None:
     checked here, before it is parsed: only digits, signs, ``.``, exponents and white space may appear.
     """
     for match in _FLOAT_ARRAY.finditer(data):
+        big = _BIG_EXPONENT.search(match.group(1))
+        if big is not None and int(big.group(1)) >= 38:     # float32 overflows past 3.4e38 (trimesh then drops
+            raise MeshReadError(f"{name}: a <float_array> holds a number with exponent {int(big.group(1))}, "
+                                "beyond float32 (the COLLADA reader would make it infinite)")   # the faces)
         bad = _NOT_DECIMAL.search(match.group(1))
         if bad is not None:
             start = match.group(1).rfind(b" ", 0, bad.start()) + 1

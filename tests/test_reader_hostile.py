@@ -1,0 +1,304 @@
+"""Readers against hostile files: no silent wrong number, no internal error, no unbounded allocation.
+
+Regression tests of issue 22 ("Untrusted files ..."): non-finite coordinates (pycollada turned NaN into 0),
+float32 storage far from the origin (a box 1e6 m out came back 30 % heavy without a word), numbers that only
+Python's ``float()`` accepts in robot files, and the reader inputs that ended in an internal error.
+"""
+
+import io
+import math
+import os
+import struct
+import warnings
+import zipfile
+from contextlib import redirect_stderr, redirect_stdout
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from inertia_tool import mass_properties
+from inertia_tool.cli import main
+from inertia_tool.errors import MeshReadError, RobotDescriptionError, StoragePrecisionWarning
+from inertia_tool.mesh.precision import float32_rounding, volume_rounding_bound
+from inertia_tool.mesh.read import load_mesh
+from inertia_tool.robot.description import parse_decimal, read_robot
+
+from conftest import box_arrays, write_binary_stl
+
+
+def run_cli(*argv):
+    out, err = io.StringIO(), io.StringIO()
+    with redirect_stdout(out), redirect_stderr(err):
+        code = main([str(a) for a in argv])
+    return code, out.getvalue(), err.getvalue()
+
+
+# -- non-finite coordinates ------------------------------------------------------------------------------------
+
+def _box_dae(tmp_path, replace=None):
+    trimesh = pytest.importorskip("trimesh")
+    pytest.importorskip("collada")
+    text = trimesh.exchange.dae.export_collada(trimesh.creation.box(extents=(1.0, 2.0, 4.0))).decode()
+    if replace is not None:
+        start = text.index(">", text.index("<float_array")) + 1
+        first = text[start:].split()[0]
+        text = text[:start] + replace + text[start + len(first):]
+    path = tmp_path / "box.dae"
+    path.write_text(text)
+    return path
+
+
+def test_collada_box_reads_exactly(tmp_path):
+    props = mass_properties(_box_dae(tmp_path), density=1000.0)
+    assert props.mass == pytest.approx(8000.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("token", ["nan", "NaN", "-nan", "inf", "-Infinity", "1e999", "0x1p3", "&#110;an"])
+def test_collada_non_finite_coordinate_is_refused_not_zeroed(tmp_path, token):
+    # pycollada sets NaN to 0: the box would come out at 7,333 kg instead of 8,000 with exit 0
+    path = _box_dae(tmp_path, token)
+    with pytest.raises(MeshReadError, match="box.dae"):
+        load_mesh(path)
+    code, out, err = run_cli("analyze", path, "--density", "1000")
+    assert code == 3 and out == "" and "Traceback" not in err
+
+
+@pytest.mark.parametrize("suffix", ["glb", "ply", "3mf", "off", "obj", "stl"])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_non_finite_vertex_is_refused_in_every_format(tmp_path, suffix, bad):
+    trimesh = pytest.importorskip("trimesh")
+    box = trimesh.creation.box()
+    vertices = box.vertices.copy()
+    vertices[3, 1] = bad
+    path = tmp_path / f"bad.{suffix}"
+    trimesh.Trimesh(vertices, box.faces, process=False).export(path)
+    with pytest.raises(MeshReadError, match="NaN or infinite"):
+        load_mesh(path)
+
+
+def test_collada_nan_hidden_in_cdata_is_refused(tmp_path):
+    path = _box_dae(tmp_path, "<![CDATA[nan]]>")
+    with pytest.raises(MeshReadError, match="float_array"):
+        load_mesh(path)
+
+
+def test_zipped_collada_nan_is_refused(tmp_path):
+    dae = _box_dae(tmp_path, "nan")
+    zae = tmp_path / "box.zae"
+    with zipfile.ZipFile(zae, "w") as zf:
+        zf.write(dae, "box.dae")
+    with pytest.raises(MeshReadError, match="float_array"):
+        load_mesh(zae)
+
+
+def test_step_tessellation_without_bounding_box_is_a_clear_error(tmp_path):
+    pytest.importorskip("OCP")
+    from OCP.BRep import BRep_Builder
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.TopoDS import TopoDS_Compound
+    compound = TopoDS_Compound()
+    BRep_Builder().MakeCompound(compound)
+    writer = STEPControl_Writer()
+    writer.Transfer(compound, STEPControl_AsIs)
+    path = tmp_path / "empty.step"
+    writer.Write(str(path))
+    code, out, err = run_cli("analyze", path)
+    assert code == 3 and "bounding box" in err and "internal error" not in err
+
+
+def _encrypted(path, inner_name, data):
+    """A zip whose one member has the 'encrypted' flag set (zipfile cannot write encryption itself)."""
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as zf:
+        zf.writestr(inner_name, data)
+    raw = bytearray(path.read_bytes())
+    for magic, offset in ((b"PK\x03\x04", 6), (b"PK\x01\x02", 8)):
+        at = raw.find(magic)
+        flags = struct.unpack_from("<H", raw, at + offset)[0]
+        struct.pack_into("<H", raw, at + offset, flags | 1)
+    path.write_bytes(bytes(raw))
+
+
+@pytest.mark.parametrize("name,inner", [("part.zip", "part.stl"), ("part.3mf", "3D/3dmodel.model"),
+                                        ("part.zae", "part.dae")])
+def test_encrypted_zip_member_is_refused(tmp_path, name, inner):
+    path = tmp_path / name
+    _encrypted(path, inner, b"solid x\nendsolid x\n")
+    with pytest.raises(MeshReadError, match="encrypted"):
+        load_mesh(path)
+    code, _, err = run_cli("analyze", path)
+    assert code == 3 and "encrypted" in err and "internal error" not in err
+
+
+# -- float32 storage far from the origin ------------------------------------------------------------------------
+
+def _float32_box(path, center, side):
+    v, f = box_arrays((side, side, side), center)
+    write_binary_stl(path, v, f)
+    return v
+
+
+def test_far_float32_box_warns_with_a_bound_that_holds(tmp_path):
+    # the issue's case: a box a million metres out; its float32 corners are not the drawn ones
+    side = 0.3
+    path = tmp_path / "far.stl"
+    _float32_box(path, (1e6 + 0.01, 1e6 - 0.02, 1e6 + 0.03), side)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        props = mass_properties(path, density=1.0)
+    actual = abs(props.volume - side ** 3)
+    assert actual / side ** 3 > 0.1                     # the file itself lost that much
+    messages = [str(w.message) for w in caught if issubclass(w.category, StoragePrecisionWarning)]
+    assert len(messages) == 1 and "float32" in messages[0]
+    raw = load_mesh(path)
+    assert raw.storage_rounding == float32_rounding(1e6 + 0.03 + side / 2) == 2.0 ** -5
+    assert volume_rounding_bound(raw.vertices, raw.faces, raw.storage_rounding) >= actual
+    code, _, err = run_cli("analyze", path)
+    assert code == 0 and "float32" in err
+
+
+def test_float32_part_near_the_origin_does_not_warn(tmp_path):
+    path = tmp_path / "near.stl"
+    _float32_box(path, (0.01, 0.02, -0.03), 0.1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", StoragePrecisionWarning)
+        props = mass_properties(path, density=1.0)
+    assert props.volume == pytest.approx(1e-3, rel=1e-6)
+
+
+def test_ascii_stl_and_arrays_have_no_storage_rounding(tmp_path):
+    from conftest import write_ascii_stl
+    v, f = box_arrays((0.3, 0.3, 0.3), (1e6, 1e6, 1e6))
+    write_ascii_stl(tmp_path / "far.stl", v, f)
+    assert load_mesh(tmp_path / "far.stl").storage_rounding == 0.0
+    assert load_mesh((v, f)).storage_rounding == 0.0
+
+
+@settings(max_examples=60, deadline=None)
+@given(offset=st.floats(-1e7, 1e7), side=st.floats(1e-3, 10.0), shift=st.floats(0.0, 1.0),
+       exponent=st.integers(-2, 2))
+def test_storage_rounding_bound_contains_the_error_of_rounded_boxes(offset, side, shift, exponent):
+    # the drawn box (float64) against the same box rounded to float32, as an exporter writes it
+    scale = 10.0 ** exponent
+    v, f = box_arrays((side, side * (1 + shift), side * (2 - shift)), (offset, -0.5 * offset, offset * shift))
+    v, side = v * scale, side * scale
+    drawn = side ** 3 * (1 + shift) * (2 - shift)
+    stored = v.astype(np.float32).astype(np.float64)
+    delta = float32_rounding(float(np.max(np.abs(stored))))
+    assert np.max(np.abs(stored - v)) <= delta
+    signed = np.einsum("ij,ij->i", stored[f[:, 0]], np.cross(stored[f[:, 1]], stored[f[:, 2]])).sum() / 6.0
+    assert abs(signed - drawn) <= volume_rounding_bound(stored, f, delta)
+
+
+def test_float32_rounding_is_half_the_spacing():
+    assert float32_rounding(1.0) == 2.0 ** -24
+    assert float32_rounding(1e6) == 2.0 ** -5             # 2^19 ≤ 1e6 < 2^20: spacing 2^-4
+    assert float32_rounding(0.0) > 0
+
+
+def test_far_ply_float_and_glb_warn(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    mesh = trimesh.creation.box(extents=(0.3, 0.3, 0.3))
+    mesh.apply_translation((1e6 + 0.01, 1e6, 1e6))
+    for name in ("far.ply", "far.glb"):
+        mesh.export(tmp_path / name)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            mass_properties(tmp_path / name, density=1.0)
+        assert any(issubclass(w.category, StoragePrecisionWarning) for w in caught), name
+
+
+# -- robot numbers --------------------------------------------------------------------------------------------
+
+_URDF = '<robot name="r"><link name="a"><collision><geometry><box size="{} 1 1"/></geometry></collision></link></robot>'
+
+
+@pytest.mark.parametrize("token", ["1", "2.5", "+.5", "5.", "-0.0e0", "1e-3", "1E+2", "007"])
+def test_decimal_grammar_accepts_xml_schema_decimals(token):
+    assert parse_decimal(token) == float(token)
+
+
+@pytest.mark.parametrize("token", ["1_000", "١٢", "１", "inf", "INF", "nan", "NaN", "Infinity", "0x10", "1e", ".",
+                                   "+-1", "1.0f", "", "1 2", "٣.٥", "1e1_0"])
+def test_decimal_grammar_refuses_what_only_python_float_accepts(token):
+    with pytest.raises(ValueError):
+        parse_decimal(token)
+
+
+@pytest.mark.parametrize("size", ["1_000", "١", "inf", "nan"])
+def test_urdf_number_python_accepts_is_refused(tmp_path, size):
+    path = tmp_path / "r.urdf"
+    path.write_text(_URDF.format(size), encoding="utf-8")
+    with pytest.raises(RobotDescriptionError, match="box size"):
+        read_robot(path)
+    code, out, err = run_cli("robot", path, "--material", "steel")
+    assert code == 3 and out == "" and "Traceback" not in err
+
+
+@pytest.mark.parametrize("shape", ['<sphere radius="1e300"/>', '<cylinder radius="1e-300" length="1"/>',
+                                   '<box size="1e-200 1e-200 1e-200"/>', '<cylinder radius="1" length="1e300"/>',
+                                   '<mesh filename="x.stl" scale="1e-300 1 1"/>'])
+def test_urdf_sizes_outside_float64_range_are_refused(tmp_path, shape):
+    (tmp_path / "x.stl").write_bytes(b"")
+    path = tmp_path / "r.urdf"
+    path.write_text(f'<robot name="r"><link name="a"><collision><origin xyz="0 0 0"/><geometry>{shape}</geometry>'
+                    "</collision></link></robot>")
+    code, out, err = run_cli("robot", path, "--material", "steel")
+    assert code == 3 and "internal error" not in err and "between" in err, err
+
+
+def test_urdf_origin_far_beyond_any_robot_is_refused(tmp_path):
+    path = tmp_path / "r.urdf"
+    path.write_text('<robot name="r"><link name="a"><collision><origin xyz="1e300 0 0"/><geometry>'
+                    '<sphere radius="1"/></geometry></collision></link></robot>')
+    with pytest.raises(RobotDescriptionError, match="origin xyz"):
+        read_robot(path)
+
+
+def _mjcf(tmp_path, compiler, geom='type="box" size="0.1 0.2 0.3" euler="10 20 30"'):
+    path = tmp_path / "m.xml"
+    path.write_text(f'<mujoco><compiler {compiler}/><worldbody><body name="b"><geom {geom}/></body></worldbody>'
+                    "</mujoco>")
+    return path
+
+
+@pytest.mark.parametrize("seq", ["qqq", "xy", "xyzx", "x1z", ""])
+def test_mjcf_bad_eulerseq_is_refused(tmp_path, seq):
+    path = _mjcf(tmp_path, f'eulerseq="{seq}"')
+    with pytest.raises(RobotDescriptionError, match="eulerseq"):
+        read_robot(path)
+    code, _, err = run_cli("robot", path, "--material", "steel")
+    assert code == 3 and "internal error" not in err
+
+
+@pytest.mark.parametrize("seq", ["xyz", "XYZ", "zyx", "xYz", "ZyX", "xyx", "zXz"])
+def test_mjcf_euler_sequences_match_mujoco(tmp_path, seq):
+    mujoco = pytest.importorskip("mujoco")
+    path = _mjcf(tmp_path, f'eulerseq="{seq}"')
+    robot = read_robot(path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    matrix = np.zeros(9)
+    mujoco.mju_quat2Mat(matrix, model.geom_quat[0])
+    np.testing.assert_allclose(robot.links[0].elements[0].rotation, matrix.reshape(3, 3), atol=1e-12)
+
+
+def test_mjcf_non_integer_contype_is_refused(tmp_path):
+    path = _mjcf(tmp_path, 'angle="radian"', 'type="sphere" size="1" contype="1.5"')
+    with pytest.raises(RobotDescriptionError, match="contype"):
+        read_robot(path)
+
+
+def test_mjcf_size_with_python_only_number_is_refused(tmp_path):
+    path = _mjcf(tmp_path, 'angle="radian"', 'type="sphere" size="1_0"')
+    with pytest.raises(RobotDescriptionError, match="size"):
+        read_robot(path)
+
+
+def test_sdf_number_python_accepts_is_refused(tmp_path):
+    path = tmp_path / "r.sdf"
+    path.write_text('<sdf version="1.7"><model name="m"><link name="a"><collision name="c"><geometry><sphere>'
+                    "<radius>1_0</radius></sphere></geometry></collision></link></model></sdf>")
+    with pytest.raises(RobotDescriptionError, match="radius"):
+        read_robot(path)
+    assert math.isfinite(parse_decimal("1e308"))
