@@ -22,6 +22,7 @@ from collections.abc import Collection
 
 from ..errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
                       RobotDescriptionError, UsageError)
+from ..reports.escape import escape_terminal
 from .help import SUMMARIES
 
 __all__ = ["main", "build_parser", "exit_code", "speak_options", "EXIT_CODES", "EXIT_OK", "EXIT_INTERNAL",
@@ -139,6 +140,23 @@ def _format_warning(w: warnings.WarningMessage) -> str:
     return f"warning: {w.message}"
 
 
+class _TerminalSafe:
+    """A text stream that writes through :func:`~inertia_tool.reports.escape.escape_terminal` (lines kept):
+    a file or part name holding terminal escape sequences reaches the terminal as visible ``\\u001b`` text,
+    and JSON on it stays valid (the escape is JSON's own).  Installed as ``sys.stdout`` while a command runs;
+    nothing this tool prints to standard output is a control sequence of its own."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        self._stream.write(escape_terminal(text, lines=True))
+        return len(text)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def main(argv=None) -> int:
     """Entry point of the ``inertia-tool`` console script; returns the exit code."""
     parser = build_parser(_command_in(argv))      # only the running command's module is imported
@@ -153,8 +171,13 @@ def main(argv=None) -> int:
     error_line = None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", InertiaToolWarning)
+        stdout = sys.stdout
         try:
-            code = args.func(args)
+            sys.stdout = _TerminalSafe(stdout)      # type: ignore[assignment]
+            try:
+                code = args.func(args)
+            finally:
+                sys.stdout = stdout
         except InertiaToolError as exc:
             if debug:
                 raise
@@ -177,12 +200,12 @@ def main(argv=None) -> int:
             code = EXIT_INTERNAL
     if error_line is not None:
         # a failed command prints one line: warnings about a result that was never produced are dropped
-        print(error_line.replace("\n", " "), file=sys.stderr)
+        print(escape_terminal(error_line.replace("\n", " ")), file=sys.stderr)
         return int(code)
     for w in caught:
         if issubclass(w.category, InertiaToolWarning):
             owner = args._subparsers.get(getattr(args, "command", None))
-            print(f"inertia-tool: {speak_options(_format_warning(w), owner)}", file=sys.stderr)
+            print(escape_terminal(f"inertia-tool: {speak_options(_format_warning(w), owner)}"), file=sys.stderr)
     return int(code or 0)
 
 

@@ -20,6 +20,7 @@ from ..batch.rows import open_results, results_format
 from .help import add_command
 from .model_options import add_model_options, load_options_from_args
 from .options import check_option, density_and_mass
+from ..reports.escape import escape_terminal
 
 __all__ = ["register", "run", "Progress", "connect_dask_cli", "summary_line"]
 
@@ -161,13 +162,14 @@ def run(args) -> int:
                 progress.close()
             if cluster is not None:
                 cluster.close()
-    print(summary_line(summary, len(files), args), file=sys.stderr)
+    print(escape_terminal(summary_line(summary, len(files), args)), file=sys.stderr)
     if implausible:
         print(f"batch: warning: {len(implausible)} file(s) read without --units are implausibly large or small "
               f"in metres (first: {implausible[0]}); their rows' warnings column names the unit that fits — "
               "give --units", file=sys.stderr)
     for path, message in summary.failures[:10]:
-        print(f"batch: failed: {path}: {message}", file=sys.stderr)
+        print(escape_terminal(f"batch: failed: {path}: {message}"), file=sys.stderr)
     if len(summary.failures) > 10:
-        print(f"batch: ... and {len(summary.failures) - 10} more failures (see {args.out})", file=sys.stderr)
+        print(escape_terminal(f"batch: ... and {len(summary.failures) - 10} more failures (see {args.out})"),
+              file=sys.stderr)
     return EXIT_SOME_FAILED if summary.failed or summary.skipped_failed else 0

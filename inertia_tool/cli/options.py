@@ -83,6 +83,8 @@ OPTION_RANGES: dict[str, OptionRange] = {
     "--planes": _COORDINATE,
     "--bearings": _COORDINATE,
     "--pivot": _COORDINATE,
+    "--through": _COORDINATE,
+    "--wall": _LENGTH,
     "--rpm": _SPEED,
     "--rate": _SPEED,
     "--spin": _SIGNED_RATE,

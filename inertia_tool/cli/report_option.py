@@ -11,6 +11,7 @@ import sys
 
 from ..errors import UsageError
 from ..reports.output import atomic_target, check_targets
+from ..reports.escape import escape_terminal
 
 __all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES",
            "check_output_file", "say_written"]
@@ -68,7 +69,7 @@ def say_written(paths) -> None:
     """``wrote a.csv, b.png`` on stderr: every file a command writes is named (stdout stays the report)."""
     paths = [str(p) for p in paths if p]
     if paths:
-        print(f"wrote {', '.join(paths)}", file=sys.stderr)
+        print(escape_terminal(f"wrote {', '.join(paths)}"), file=sys.stderr)
 
 
 def save_figure(fig, path: str, *, dpi: int = 120) -> None:

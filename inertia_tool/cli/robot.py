@@ -16,6 +16,8 @@ from ..robot.write import write_corrected
 from ..units import MATERIALS, parse_density
 from . import speak_options
 from .help import add_command
+from .options import check_option
+from ..reports.escape import escape_terminal
 from .report_option import check_output_file
 
 __all__ = ["register", "run", "parse_packages", "parse_mappings"]
@@ -91,7 +93,8 @@ def run(args) -> int:
         raise UsageError(f"--write {args.write}: is the input description; refusing to overwrite it "
                          "(--force overwrites it)")
     check_output_file(args.write, "--write", args.force)
-    density = parse_density(args.density) if args.density is not None else None
+    density = check_option("--density", parse_density(args.density), typed=args.density) \
+        if args.density is not None else None
     robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings)
     inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
                                repair=args.repair)
@@ -104,7 +107,7 @@ def run(args) -> int:
         message = f"wrote {args.write}: <inertial> of {len(changed)} link{'' if len(changed) == 1 else 's'} corrected"
         if skipped:
             message += f"; left as they were: {', '.join(skipped)}"
-        print(message, file=sys.stderr)
+        print(escape_terminal(message), file=sys.stderr)
     if args.json:
         print(json.dumps(robot_report_dict(robot, inertials, audits), indent=2, ensure_ascii=False))
     else:

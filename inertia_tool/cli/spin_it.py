@@ -10,9 +10,10 @@ import sys
 import numpy as np
 
 from ..errors import UsageError
-from ..units import length_scale, parse_density, parse_length, parse_mass, parse_vector
+from ..units import length_scale, parse_density, parse_length, parse_vector
 from .help import add_command
 from .model_options import add_material_options, length_unit
+from .options import check_option, density_and_mass
 from ..reports.output import check_targets
 from .report_option import save_figure, say_written
 
@@ -70,17 +71,18 @@ def _direction(text: str) -> np.ndarray:
         v = np.array([float(s) for s in parts])
     except ValueError:
         v = np.zeros(0)
-    if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.linalg.norm(v) > 0:
-        raise UsageError(f"--axis must be three numbers, not all zero, like 0,0,1; got {text!r}")
-    return v
+    if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.max(np.abs(v)) > 0:
+        raise UsageError(f"--axis must be three finite numbers, not all zero, like 0,0,1; got {text!r}")
+    return v / np.max(np.abs(v))         # a direction: scaled so that its norm cannot overflow
 
 
 def _insert_density(text: str) -> float:
     try:
-        return parse_density(text)
+        density = parse_density(text)
     except UsageError:
         from ..units import material_density
-        return material_density(text)
+        density = material_density(text)
+    return check_option("--density", density, typed=text, label="--insert")
 
 
 def _write_two_materials(path: str, result, material: str, insert: str) -> None:
@@ -169,14 +171,17 @@ def run(args) -> int:
     if args.mode == "yoyo" and args.pivot is not None:
         raise UsageError("--pivot is for --mode top")
     unit = length_unit(args)
-    wall = parse_length(args.wall, unit)
-    if not wall > 0:
-        raise UsageError(f"--wall must be positive, got {args.wall}")
-    result = spin_it(args.files, axis=_direction(args.axis), mode=args.mode, wall=wall,
-                     through=parse_vector(args.through, unit) if args.through else None,
-                     pivot=parse_vector(args.pivot, unit) if args.pivot else None, units=args.units,
-                     density=parse_density(args.density) if args.density is not None else None,
-                     material=args.material, mass=parse_mass(args.mass) if args.mass is not None else None,
+    # the same range checks as every other command (cli/options.py OPTION_RANGES)
+    wall = check_option("--wall", parse_length(args.wall, unit), typed=args.wall)
+    through = (check_option("--through", list(parse_vector(args.through, unit)), typed=args.through)
+               if args.through else None)
+    pivot = check_option("--pivot", list(parse_vector(args.pivot, unit)), typed=args.pivot) if args.pivot else None
+    density, mass = density_and_mass(args)
+    axis = _direction(args.axis)
+    result = spin_it(args.files, axis=axis, mode=args.mode, wall=wall,
+                     through=tuple(through) if through is not None else None,
+                     pivot=tuple(pivot) if pivot is not None else None, units=args.units,
+                     density=density, material=args.material, mass=mass,
                      resolution=args.resolution, insert_density=insert_density)
     if args.out and result.insert_vertices is not None:
         _write_two_materials(args.out, result, args.material or "part", args.insert)

@@ -7,8 +7,14 @@ Every writer puts foreign text into its document through these, never raw: a fil
 from __future__ import annotations
 
 import html
+import re
 
-__all__ = ["escape_html", "escape_markdown"]
+__all__ = ["escape_html", "escape_markdown", "escape_terminal"]
+
+# C0 controls but tab and newline, DEL, C1 controls (U+009B is a one-character CSI on some terminals), the
+# Unicode line and paragraph separators and the bidirectional embeddings, overrides and isolates (which reorder
+# what a reader sees)
+_TERMINAL_UNSAFE = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]")
 
 # CommonMark lets any ASCII punctuation be backslash-escaped; these are the ones that mean something in the
 # middle of a line (the writers never put foreign text at the start of one): emphasis, code spans, links and
@@ -37,3 +43,18 @@ def escape_markdown(text: object) -> str:
         else:
             out.append(ch)
     return "".join(out)
+
+
+def escape_terminal(text: object, *, lines: bool = False) -> str:
+    """``text`` safe to print on a terminal: every control character becomes its visible ``\\uXXXX`` escape.
+
+    Escaped: C0 controls (ESC starts the sequences that move the cursor, recolour, retitle the window or
+    rewrite what was printed), DEL, C1 controls, U+2028/U+2029 and the bidirectional controls.  With ``lines``
+    newlines and tabs are kept (a whole report); without, they are escaped too (a file name on one line).
+    The escape is also a valid JSON string escape of the same character, so JSON output stays valid and
+    decodes to the original name.
+    """
+    out = _TERMINAL_UNSAFE.sub(lambda m: f"\\u{ord(m.group(0)):04x}", str(text))
+    if not lines:
+        out = out.replace("\n", "\\u000a").replace("\t", "\\u0009")
+    return out

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import UsageError
 from .inertial import InertialFrame
+from ..reports.escape import escape_terminal
 from ..reports.numbers import number
 
 __all__ = ["format_urdf", "format_sdf", "format_mjcf", "ROBOT_FORMATS", "format_inertial"]
@@ -57,7 +58,9 @@ def _unitless(x) -> np.ndarray:
 
 
 def _comment(frame: InertialFrame, fmt: str, source: str | None, angle_note: str) -> str:
-    parts = [f"inertia-tool: {fmt} <inertial> of {source}" if source else f"inertia-tool: {fmt} <inertial>"]
+    # a name in an XML comment: control characters (not allowed in XML) escaped, "--" broken below
+    parts = [f"inertia-tool: {fmt} <inertial> of {escape_terminal(source)}" if source
+             else f"inertia-tool: {fmt} <inertial>"]
     parts.append("SI units (m, kg, kg*m^2); the link frame is the mesh frame")
     parts.append(f"inertial frame: {_FRAME_TEXT[frame.frame]}")
     if angle_note:
