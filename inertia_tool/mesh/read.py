@@ -675,19 +675,21 @@ def _check_zip(path: str, max_faces: int) -> dict:
     return {}
 
 
-def _read_3mf_models(path: str, max_faces: int):
-    """The model parts of a 3MF as a new in-memory archive (stored, not compressed) for trimesh.
+def _read_3mf(path: str, max_faces: int):
+    """``(vertices, faces, declared unit)`` of a 3MF, read by the streaming reader :mod:`.threemf`.
 
     Refused from the zip's central directory, before anything is inflated: more than
-    :data:`MAX_ZIP_MEMBERS` members, a model member inflating more than :data:`MAX_ZIP_RATIO` : 1, or model
-    parts inflating to more than :func:`zip_inflate_limit` ``(max_faces)`` bytes in all.  Python's zipfile
-    never returns more than a member's declared ``file_size`` (it stops there and checks the CRC), so limits
-    on the declared sizes bound what is inflated.  Members the model does not reference are not read.
+    :data:`MAX_ZIP_MEMBERS` members, an encrypted model part, a model part inflating more than
+    :data:`MAX_ZIP_RATIO` : 1, or model parts inflating to more than :func:`zip_inflate_limit` ``(max_faces)``
+    bytes in all.  Python's zipfile never returns more than a member's declared ``file_size`` (it stops there
+    and checks the CRC), so limits on the declared sizes bound what is inflated.  Members the model does not
+    reference are not read; the parts that are read are streamed (their triangles and vertices counted against
+    ``max_faces`` as they come).
     """
-    import io
     import zipfile
     import zlib
 
+    from .threemf import read_3mf
     try:
         with open_regular(path) as raw, zipfile.ZipFile(raw) as zf:
             infos = zf.infolist()
@@ -700,22 +702,13 @@ def _read_3mf_models(path: str, max_faces: int):
             if total > limit:
                 raise _fail(path, f"3MF model parts would inflate to {total:,} bytes, more than the {limit:,} "
                                   f"allowed for `max_faces` ({max_faces:,}); refused before inflating")
-            buffer = io.BytesIO()
-            with zipfile.ZipFile(buffer, "w", zipfile.ZIP_STORED) as out:
-                for i in models:
-                    with zf.open(i) as src, out.open(i.filename, "w", force_zip64=True) as dst:
-                        for _ in range(i.file_size // (1 << 20) + 2):    # bounded by the declared size
-                            block = src.read(1 << 20)
-                            if not block:
-                                break
-                            dst.write(block)
+            models.sort(key=lambda i: "3d/3dmodel.model" not in i.filename.lower())     # the root model first
+            return read_3mf(path, models, zf, max_faces=max_faces, name=_display(path))
     except RuntimeError as exc:     # zipfile: "File ... is encrypted, password required for extraction"
         raise _fail(path, f"3MF archive member cannot be read ({str(exc)[:100]})") from None
     except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError, NotImplementedError,
             zlib.error) as exc:
         raise _fail(path, f"not a valid 3MF (zip) archive ({str(exc)[:100]})") from None
-    buffer.seek(0)
-    return buffer
 
 
 _FLOAT_ARRAY = re.compile(rb"<(?:\w+:)?float_array\b[^>]*(?<!/)>(.*?)</(?:\w+:)?float_array\s*>", re.DOTALL)
@@ -824,16 +817,23 @@ def _scene_rounding(loaded) -> float:
 
 
 def _read_with_trimesh_rounding(path: str, max_faces: int):
-    """``(vertices, faces, declared unit, float32 rounding in file units)`` of a file trimesh reads."""
+    """``(vertices, faces, declared unit, float32 rounding in file units)`` of a file trimesh reads (3MF: of
+    the streaming reader :func:`_read_3mf`)."""
     size = os.path.getsize(path)
     suffix = os.path.splitext(path)[1].lower()
+    if suffix == ".3mf":
+        v, f, declared = _read_3mf(path, max_faces)
+        _check_face_budget(path, len(f), max_faces)
+        if not np.all(np.isfinite(v)):
+            raise _fail(path, "vertices have NaN or infinite coordinates")
+        return v, f, declared, 0.0
     if suffix in _HEADER_CHECKS:
         counts = _HEADER_CHECKS[suffix](path, size, max_faces)
     elif suffix == ".zae":
         counts = _check_zipped_collada(path, max_faces)
     else:
         counts = {}
-    source, kind = (_read_3mf_models(path, max_faces), "3mf") if suffix == ".3mf" else (path, None)
+    source, kind = path, None
     try:
         import trimesh
     except ImportError as exc:  # pragma: no cover - trimesh is a dependency

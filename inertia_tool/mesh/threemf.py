@@ -1,0 +1,230 @@
+"""A streaming 3MF reader: the model parts' XML read element by element, into flat arrays, within the face limit.
+
+A 3MF is a zip whose model parts (``3D/3dmodel.model`` and any other ``*.model``) hold, per 3MF Core
+Specification (§3–§4): ``<model unit>`` (``micron``, ``millimeter`` (default), ``centimeter``, ``inch``,
+``foot``, ``meter``), ``<resources>`` of ``<object id>`` each holding a ``<mesh>`` (``<vertices>`` of
+``<vertex x y z>`` and ``<triangles>`` of ``<triangle v1 v2 v3>``, 0-based) or ``<components>`` of
+``<component objectid transform>`` (the Production extension's ``path`` attribute names another model part),
+and ``<build>`` of ``<item objectid transform>``.  A transform is twelve numbers ``m00 m01 m02 m10 m11 m12
+m20 m21 m22 m30 m31 m32``: a point ``p`` (row) becomes ``p · M + (m30, m31, m32)``.
+
+Memory: a tree parser (trimesh's, through lxml) holds every element, about 1.6 kB per triangle.  Here each
+element is cleared once read, so the XML costs a constant; vertices (3 doubles) and triangles (3 int64) are
+appended to flat arrays, 24 bytes each, and counted as they come: a part is refused as soon as its triangles
+pass ``max_faces`` or its vertices ``3 · max_faces + 3``, and the build is refused from the triangle count of
+its instances (components multiply) before any instance is placed.
+"""
+
+from __future__ import annotations
+
+import array
+
+import numpy as np
+
+from ..errors import MeshReadError
+
+__all__ = ["read_3mf", "THREEMF_UNITS", "MAX_COMPONENT_DEPTH"]
+
+#: Metres per unit of ``<model unit>`` (3MF Core Specification §3.4.1; millimetre when absent).
+THREEMF_UNITS = {"micron": 1e-6, "millimeter": 1e-3, "centimeter": 1e-2, "inch": 0.0254, "foot": 0.3048,
+                 "meter": 1.0}
+_UNIT_NAMES = {"micron": "um", "millimeter": "mm", "centimeter": "cm", "inch": "in", "foot": "ft", "meter": "m"}
+
+#: Deepest nesting of components followed (a cycle or a pathological file is refused beyond it).
+MAX_COMPONENT_DEPTH = 32
+
+
+def _local(tag) -> str:
+    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
+
+
+def _attribute(element, name: str):
+    """An attribute by local name, whatever its namespace (``path`` of the Production extension)."""
+    value = element.get(name)
+    if value is not None:
+        return value
+    for key, value in element.attrib.items():
+        if _local(key) == name:
+            return value
+    return None
+
+
+def _transform(text, where: str) -> np.ndarray:
+    """A 3MF transform as a 4 × 3 matrix (``p · M[:3] + M[3]``); identity when absent."""
+    if text is None:
+        return np.vstack([np.eye(3), np.zeros(3)])
+    try:
+        values = np.array([float(t) for t in text.split()], dtype=np.float64)
+    except ValueError:
+        values = np.zeros(0)
+    if values.shape != (12,) or not np.all(np.isfinite(values)):
+        raise MeshReadError(f"{where}: transform {text[:80]!r} is not twelve finite numbers")
+    return values.reshape(4, 3)
+
+
+class _Part:
+    """What one model part defines: meshes and component lists by object id, build items, its unit."""
+
+    def __init__(self):
+        self.meshes: dict = {}          # id -> (vertices (n, 3), triangles (m, 3))
+        self.components: dict = {}      # id -> [(part name or None, object id, 4 x 3 transform)]
+        self.items: list = []           # [(object id, 4 x 3 transform)]
+        self.unit = "millimeter"
+
+
+def _read_part(source, where: str, budget: list) -> _Part:
+    """Stream one model part; ``budget = [triangles left, vertices left]`` is shared by all parts."""
+    from lxml import etree
+    part = _Part()
+    coords = array.array("d")
+    corners = array.array("q")
+    components: list = []
+    in_build = False
+    try:
+        for event, element in etree.iterparse(source, events=("start", "end"), resolve_entities=False,
+                                              no_network=True, huge_tree=False, remove_comments=True):
+            tag = _local(element.tag)
+            if event == "start":
+                if tag == "build":
+                    in_build = True
+                elif tag == "model":
+                    part.unit = element.get("unit", "millimeter")
+                continue
+            if tag == "vertex":
+                try:
+                    coords.extend((float(element.get("x")), float(element.get("y")), float(element.get("z"))))
+                except (TypeError, ValueError):
+                    raise MeshReadError(f"{where}: a <vertex> without three numbers x y z") from None
+                budget[1] -= 1
+                if budget[1] < 0:
+                    raise MeshReadError(f"{where}: holds more vertices than 3 × `max_faces` + 3 allows; refused "
+                                        "while reading")
+            elif tag == "triangle":
+                try:
+                    corners.extend((int(element.get("v1")), int(element.get("v2")), int(element.get("v3"))))
+                except (TypeError, ValueError):
+                    raise MeshReadError(f"{where}: a <triangle> without three vertex indices v1 v2 v3") from None
+                budget[0] -= 1
+                if budget[0] < 0:
+                    raise MeshReadError(f"{where}: holds more triangles than `max_faces` allows; refused while "
+                                        "reading")
+            elif tag == "component":
+                components.append((_attribute(element, "path"), element.get("objectid"),
+                                   _transform(element.get("transform"), where)))
+            elif tag == "item" and in_build:
+                part.items.append((element.get("objectid"), _transform(element.get("transform"), where)))
+            elif tag == "object":
+                key = element.get("id")
+                if coords or corners:
+                    v = np.frombuffer(coords, dtype=np.float64).reshape(-1, 3).copy()
+                    f = np.frombuffer(corners, dtype=np.int64).reshape(-1, 3).copy()
+                    if len(f) and (f.min() < 0 or f.max() >= len(v)):
+                        raise MeshReadError(f"{where}: object {str(key)[:20]!r} has a triangle index outside "
+                                            f"0..{len(v) - 1}")
+                    part.meshes[key] = (v, f)
+                if components:
+                    part.components[key] = components
+                coords, corners, components = array.array("d"), array.array("q"), []
+            elif tag == "build":
+                in_build = False
+            if tag in ("vertex", "triangle", "component", "item", "object", "vertices", "triangles", "mesh",
+                       "components"):
+                element.clear()
+                while element.getprevious() is not None:         # drop the siblings already read
+                    del element.getparent()[0]
+    except etree.XMLSyntaxError as exc:
+        raise MeshReadError(f"{where}: not well-formed XML ({str(exc)[:120]})") from None
+    return part
+
+
+def read_3mf(path: str, members, zf, *, max_faces: int, name: str):
+    """Read the model parts ``members`` (``ZipInfo``, the root model first) of the open archive ``zf``.
+
+    Returns
+    -------
+    vertices : (n, 3) float64
+        In the file's unit, every build item placed.
+    faces : (m, 3) int64
+    declared : (float, str)
+        Metres per file unit and the unit's short name.
+
+    Raises
+    ------
+    MeshReadError
+        Malformed XML or attributes, an unknown unit, a reference to an object or part that does not exist, a
+        component cycle, or more triangles (placed instances included) than ``max_faces``.
+    """
+    budget = [int(max_faces), 3 * int(max_faces) + 3]
+    by_name = {"/" + info.filename.lstrip("/"): info for info in members}
+    parts: dict = {}
+
+    def load(part_name: str) -> _Part | None:
+        """A model part, streamed the first time a build item or component needs it (others are never read)."""
+        if part_name not in parts and part_name in by_name:
+            info = by_name[part_name]
+            with zf.open(info) as source:
+                parts[part_name] = _read_part(source, f"{name}:{info.filename[:60]}", budget)
+        return parts.get(part_name)
+
+    root_name = "/" + members[0].filename.lstrip("/")
+    root = load(root_name)
+    assert root is not None, "the root model is among the members"
+    if root.unit not in THREEMF_UNITS:
+        raise MeshReadError(f"{name}: unknown 3MF unit {root.unit[:40]!r}; expected one of "
+                            f"{', '.join(THREEMF_UNITS)}")
+    counts: dict = {}
+
+    def lookup(part_name: str, key):
+        part = load(part_name)
+        if part is None:
+            raise MeshReadError(f"{name}: a component names the model part {part_name[:60]!r}, which the archive "
+                                "does not hold")
+        if key not in part.meshes and key not in part.components:
+            raise MeshReadError(f"{name}: a build item or component names object {str(key)[:20]!r}, which "
+                                f"{part_name[:60]} does not define")
+        return part
+
+    def triangles(part_name: str, key, depth: int) -> int:
+        """Triangles of one instance of an object, components included (memoised; cycles refused)."""
+        if depth > MAX_COMPONENT_DEPTH:
+            raise MeshReadError(f"{name}: components nested deeper than {MAX_COMPONENT_DEPTH} (a cycle?)")
+        if (part_name, key) in counts:
+            return counts[(part_name, key)]
+        part = lookup(part_name, key)
+        total = len(part.meshes[key][1]) if key in part.meshes else 0
+        for sub_part, sub_key, _ in part.components.get(key, ()):
+            total += triangles(sub_part or part_name, sub_key, depth + 1)
+            if total > max_faces:
+                break
+        counts[(part_name, key)] = total
+        return total
+
+    placed = sum(triangles(root_name, key, 0) for key, _ in root.items)
+    if placed > max_faces:
+        raise MeshReadError(f"{name}: the build places at least {placed:,} triangles (components and items "
+                            f"repeated), more than `max_faces` ({max_faces:,}) allows; refused before placing them")
+    out_v: list = []
+    out_f: list = []
+    offset = [0]
+
+    def place(part_name: str, key, matrix: np.ndarray, depth: int) -> None:
+        part = parts[part_name]
+        if key in part.meshes:
+            v, f = part.meshes[key]
+            linear = matrix[:3]
+            out_v.append(v @ linear + matrix[3])
+            out_f.append((f[:, ::-1] if np.linalg.det(linear) < 0 else f) + offset[0])   # a mirror turns winding
+            offset[0] += len(v)
+        for sub_part, sub_key, sub in part.components.get(key, ()):
+            # the component's transform first, then the parent's: p · S · M + (t_S · M + t_M)
+            combined = np.vstack([sub[:3] @ matrix[:3], sub[3] @ matrix[:3] + matrix[3]])
+            place(sub_part or part_name, sub_key, combined, depth + 1)
+
+    with np.errstate(invalid="ignore", over="ignore"):       # non-finite coordinates are refused by the caller
+        for key, matrix in root.items:
+            place(root_name, key, matrix, 0)
+    if not out_f or not sum(len(f) for f in out_f):
+        raise MeshReadError(f"{name}: contains no triangle mesh (no build item places an object with triangles)")
+    vertices = np.concatenate(out_v)
+    faces = np.concatenate(out_f)
+    return vertices, faces, (THREEMF_UNITS[root.unit], _UNIT_NAMES[root.unit])
