@@ -6,8 +6,8 @@ Python's ``float()`` accepts in robot files, and the reader inputs that ended in
 """
 
 import io
+import json
 import math
-import os
 import struct
 import warnings
 import zipfile
@@ -391,8 +391,8 @@ def test_3mf_too_many_vertices_refused_while_streaming(tmp_path):
      '<vertex x="0" y="1" z="0"/></vertices><triangles><triangle v1="0" v2="1" v3="2"/></triangles></mesh>'
      "</object>", '<item objectid="1"/>', "NaN"),
     (f'<object id="1">{_BOX_MESH}</object>', "", "no build item"),
-    (f'<object id="1"><components><component objectid="1" p:path="/3D/missing.model" '
-     f'xmlns:p="http://schemas.microsoft.com/3dmanufacturing/production/2015/06"/></components></object>',
+    ('<object id="1"><components><component objectid="1" p:path="/3D/missing.model" '
+     'xmlns:p="http://schemas.microsoft.com/3dmanufacturing/production/2015/06"/></components></object>',
      '<item objectid="1"/>', "missing.model"),
 ])
 def test_3mf_malformed_models_are_refused(tmp_path, resources, build, match):
@@ -406,3 +406,111 @@ def test_3mf_junk_model_parts_are_never_parsed(tmp_path):
     path = _write_3mf(tmp_path / "junk.3mf", f'<object id="1">{_BOX_MESH}</object>', '<item objectid="1"/>',
                       extra_parts=junk)
     assert len(load_mesh(path).faces) == 12
+
+
+# -- memory: counts checked before anything is allocated -----------------------------------------------------
+
+def _polygon_ply(path, corners, polygons):
+    header = (b"ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\nproperty float y\n"
+              b"property float z\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n"
+              % (corners, polygons))
+    angle = np.linspace(0, 2 * np.pi, corners, endpoint=False)
+    vertices = np.c_[np.cos(angle), np.sin(angle), np.zeros(corners)].astype("<f4").tobytes()
+    face = bytes([corners]) + np.arange(corners, dtype="<i4").tobytes()
+    path.write_bytes(header + vertices + face * polygons)
+
+
+def test_ply_of_255_corner_polygons_is_bounded_by_the_face_limit(tmp_path):
+    # the issue's 204 MB PLY of 255-corner faces took 4.6 GB: 200 faces are 50,600 triangles, counted exactly
+    path = tmp_path / "polygons.ply"
+    _polygon_ply(path, 255, 200)
+    with pytest.raises(MeshReadError, match="up to 50,600 triangles"):
+        load_mesh(path, max_faces=50_599)
+    assert len(load_mesh(path, max_faces=50_600).faces) == 50_600
+
+
+def test_ply_header_claiming_a_billion_faces_is_refused_from_the_header(tmp_path):
+    path = tmp_path / "lying.ply"
+    path.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                     b"property float z\nelement face 1000000000\nproperty list uchar int vertex_indices\n"
+                     b"end_header\n" + bytes(36))
+    with pytest.raises(MeshReadError, match="1,000,000,000"):
+        load_mesh(path)
+
+
+def _instanced_glb(path, instances):
+    """A GLB of one 12-triangle box placed ``instances`` times (one node each): a few bytes per instance."""
+    import json
+    box_v = np.array(box_arrays((1.0, 1.0, 1.0))[0], dtype="<f4")
+    box_f = np.array(box_arrays((1.0, 1.0, 1.0))[1], dtype="<u4")
+    binary = box_v.tobytes() + box_f.tobytes()
+    doc = {"asset": {"version": "2.0"}, "scene": 0,
+           "scenes": [{"nodes": list(range(instances))}],
+           "nodes": [{"mesh": 0, "translation": [2.0 * k, 0.0, 0.0]} for k in range(instances)],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+           "buffers": [{"byteLength": len(binary)}],
+           "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": box_v.nbytes},
+                           {"buffer": 0, "byteOffset": box_v.nbytes, "byteLength": box_f.nbytes}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(box_v), "type": "VEC3",
+                          "min": box_v.min(axis=0).tolist(), "max": box_v.max(axis=0).tolist()},
+                         {"bufferView": 1, "componentType": 5125, "count": box_f.size, "type": "SCALAR"}]}
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    binary += b"\0" * (-len(binary) % 4)
+    body = struct.pack("<I4s", len(text), b"JSON") + text + struct.pack("<I4s", len(binary), b"BIN\0") + binary
+    path.write_bytes(struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body)
+
+
+def test_glb_instances_count_against_the_face_limit(tmp_path):
+    from inertia_tool.mesh.read import GLTF_INSTANCE_FACES
+    path = tmp_path / "few.glb"
+    _instanced_glb(path, 3)
+    props = mass_properties(path, density=1.0)
+    assert props.volume == pytest.approx(3.0, rel=1e-12)
+    per_instance = 12 + GLTF_INSTANCE_FACES
+    assert len(load_mesh(path, max_faces=3 * per_instance).faces) == 36
+    with pytest.raises(MeshReadError, match="places at least"):
+        load_mesh(path, max_faces=3 * per_instance - 1)
+
+
+def test_glb_of_many_instances_is_refused_before_loading(tmp_path):
+    # the issue's 10 MB GLB of 200k instances took 1.7 GB in trimesh; here 20,000 instances and a small limit
+    path = tmp_path / "many.glb"
+    _instanced_glb(path, 20_000)
+    with pytest.raises(MeshReadError, match="places at least"):
+        load_mesh(path, max_faces=100_000)
+
+
+def test_gltf_node_cycle_is_refused(tmp_path):
+    import json
+    path = tmp_path / "cycle.gltf"
+    path.write_text(json.dumps({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}],
+                                "nodes": [{"children": [1]}, {"children": [0]}]}))
+    with pytest.raises(MeshReadError, match="deeper than 64"):
+        load_mesh(path)
+
+
+def test_urdf_with_too_many_links_is_refused(tmp_path):
+    from inertia_tool.robot.description import MAX_ROBOT_LINKS
+    path = tmp_path / "many.urdf"
+    path.write_text('<robot name="r">' + '<link name="l"/>' * (MAX_ROBOT_LINKS + 1) + "</robot>")
+    with pytest.raises(RobotDescriptionError, match="more than 10,000 links"):
+        read_robot(path)
+
+
+def test_robot_max_faces_is_a_total_over_the_meshes(tmp_path):
+    v, f = box_arrays((0.1, 0.1, 0.1))
+    for name in ("a", "b"):
+        write_binary_stl(tmp_path / f"{name}.stl", v, f)
+    links = "".join(f'<link name="{n}"><collision><geometry><mesh filename="{n}.stl"/></geometry></collision>'
+                    "</link>" for n in ("a", "b"))
+    path = tmp_path / "r.urdf"
+    path.write_text(f'<robot name="r">{links}</robot>')
+    code, out, err = run_cli("robot", path, "--density", "1000", "--max-faces", "24", "--json")
+    assert code == 0 and [link["mass"] for link in json.loads(out)["links"]] == pytest.approx([1.0, 1.0])
+    code, out, err = run_cli("robot", path, "--density", "1000", "--max-faces", "20")
+    assert code == 0 and "Traceback" not in err
+    assert "b.stl: holds 12 triangles, more than --max-faces (8) allows: the limit counts all the robot's " \
+           "meshes together (20), and the meshes read before this one left 8" in out
+    code, _, err = run_cli("robot", path, "--density", "1000", "--max-faces", "0")
+    assert code == 2 and "--max-faces" in err

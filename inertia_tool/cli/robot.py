@@ -8,6 +8,7 @@ import os
 import sys
 
 from ..errors import UsageError
+from ..mesh.options import DEFAULT_MAX_FACES
 from ..reports.robot_audit import format_robot_report, robot_report_dict
 from ..robot.audit import audit_links
 from ..robot.description import GEOMETRY_KINDS, read_robot
@@ -49,6 +50,9 @@ def register(subparsers) -> None:
     m.add_argument("--keep-mass", action="store_true",
                    help="keep each link's declared mass and take its distribution from the geometry "
                         "(the implied density is reported)")
+    p.add_argument("--max-faces", type=int, default=DEFAULT_MAX_FACES, metavar="N",
+                   help=f"refuse meshes holding more than N triangles, all the robot's mesh files together (default "
+                        f"{DEFAULT_MAX_FACES:,}; protects memory: each file is checked before it is read in full)")
     p.add_argument("--repair", action="store_true",
                    help="repair open or inconsistently wound link meshes instead of reporting them (warned)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
@@ -93,11 +97,12 @@ def run(args) -> int:
         raise UsageError(f"--write {args.write}: is the input description; refusing to overwrite it "
                          "(--force overwrites it)")
     check_output_file(args.write, "--write", args.force)
+    check_option("--max-faces", args.max_faces)
     density = check_option("--density", parse_density(args.density), typed=args.density) \
         if args.density is not None else None
     robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings)
     inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
-                               repair=args.repair)
+                               repair=args.repair, max_faces=args.max_faces)
     audits = audit_links(robot, inertials, keep_mass=args.keep_mass)
     if args.write:
         basis = next((r.basis for r in inertials if r.properties is not None), "")

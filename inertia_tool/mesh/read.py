@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 import re
 import stat
+import struct
 import sys
 import warnings
 from typing import Any
@@ -548,6 +549,7 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
     fmt = None
     vertex_float32 = False
     elements: list = []
+    layouts: list = []             # per element: (bytes of the property or of a list's count, bytes of a list item)
     for line in head[:end].replace(b"\r", b"\n").split(b"\n")[1:]:
         parts = line.split()
         if not parts:
@@ -558,6 +560,7 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
             if len(parts) != 3:
                 raise _fail(path, f"malformed PLY element line {line[:60].decode('utf-8', 'replace')!r}")
             elements.append([parts[1], _header_count(path, parts[2]), 0])
+            layouts.append([])
         elif parts[0] == b"property":
             if not elements:
                 raise _fail(path, "PLY property before any element")
@@ -567,6 +570,11 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
             if elements[-1][0] == b"vertex" and parts[-1:] == [b"x"] and kind in (b"float", b"float32"):
                 vertex_float32 = True
             elements[-1][2] += 2 if fmt == b"ascii" else _PLY_TYPE_BYTES[kind]
+            is_list = parts[1:2] == [b"list"] and len(parts) >= 4
+            item = parts[3] if is_list else b""
+            if is_list and item not in _PLY_TYPE_BYTES:
+                raise _fail(path, f"unknown PLY property type {item[:20].decode('utf-8', 'replace')!r}")
+            layouts[-1].append((_PLY_TYPE_BYTES[kind], _PLY_TYPE_BYTES[item] if is_list else 0))
     if fmt not in (b"ascii", b"binary_little_endian", b"binary_big_endian"):
         raise _fail(path, f"unknown PLY format {fmt!r}")
     body = size - (end + len(b"end_header") + 1)
@@ -579,8 +587,37 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
     _check_face_budget(path, counts.get("face", 0), max_faces)
     if counts.get("vertex", 0) > 3 * max_faces + 3:
         raise _fail(path, f"holds {counts['vertex']:,} vertices, more than 3 × `max_faces`")
+    if fmt != b"ascii":
+        _check_ply_polygons(path, elements, layouts, body, max_faces)
     counts["float32"] = int(vertex_float32)
     return counts
+
+
+def _check_ply_polygons(path: str, elements: list, layouts: list, body: int, max_faces: int) -> None:
+    """Refuse a binary PLY whose polygons may triangulate into more than ``max_faces`` triangles.
+
+    The header gives the number of faces ``n``, not their corners: a face of ``k`` corners becomes ``k − 2``
+    triangles, and one of 255 corners costs only ``1 + 4 · 255`` bytes.  When every element before ``face``
+    has a fixed record size and ``face`` has the one list property (count of ``c`` bytes, indices of ``s``),
+    the bytes left for the faces, ``F``, hold ``Σ k = (F − n c) / s`` corners, so the triangles number at most
+    ``(F − n c) / s − 2 n`` (exact when nothing follows the faces).  Checked before any parser allocates.
+    """
+    skipped = 0
+    for (name, count, per), layout in zip(elements, layouts):
+        if name == b"face":
+            if len(layout) != 1 or layout[0][1] == 0:
+                return
+            count_bytes, item_bytes = layout[0]
+            corners = (body - skipped - count * count_bytes) // item_bytes
+            triangles = corners - 2 * count
+            if triangles > max_faces:
+                raise _fail(path, f"PLY faces ({count:,} polygons in {body - skipped:,} bytes) may hold up to "
+                                  f"{triangles:,} triangles, more than `max_faces` ({max_faces:,}) allows; refused "
+                                  "before reading")
+            return
+        if any(item for _, item in layout):
+            return                              # a list before the faces: their offset is not known
+        skipped += count * per
 
 
 def _check_off_header(path: str, size: int, max_faces: int) -> dict:
@@ -766,7 +803,119 @@ def _check_zipped_collada(path: str, max_faces: int) -> dict:
     return counts
 
 
-_HEADER_CHECKS = {".ply": _check_ply_header, ".off": _check_off_header, ".dae": _check_collada}
+#: Each mesh instance a glTF scene places counts as at least this many triangles against ``max_faces``:
+#: trimesh spends ~8 kB per placed instance (its own copy of the mesh's arrays and a scene-graph entry), the
+#: memory of ~250 triangles, so 200,000 instances of a 12-triangle box no longer pass as "2.4M triangles".
+GLTF_INSTANCE_FACES = 256
+
+_GLTF_TRIANGLE_MODES = {4: lambda n: n // 3, 5: lambda n: max(n - 2, 0), 6: lambda n: max(n - 2, 0)}
+
+
+def _gltf_document(path: str) -> dict:
+    """The JSON of a ``.gltf`` file or of a ``.glb``'s first chunk (checked against the file size)."""
+    import json
+    with open(path, "rb") as fh:
+        head = fh.read(20)
+        if head[:4] == b"glTF":
+            if len(head) < 20:
+                raise _fail(path, "GLB shorter than its 20-byte header")
+            length, kind = struct.unpack_from("<I4s", head, 12)
+            if kind != b"JSON" or length > os.path.getsize(path) - 20:
+                raise _fail(path, f"GLB JSON chunk of {length:,} bytes does not fit the file (or is not JSON)")
+            text = fh.read(length)
+        else:
+            fh.seek(0)
+            text = fh.read()
+    try:
+        document = json.loads(text)
+    except (ValueError, RecursionError) as exc:
+        raise _fail(path, f"glTF JSON cannot be parsed ({str(exc)[:80] or type(exc).__name__})") from None
+    if not isinstance(document, dict):
+        raise _fail(path, "glTF JSON is not an object")
+    return document
+
+
+def _check_gltf(path: str, size: int, max_faces: int) -> dict:
+    """Refuse a glTF scene that places more triangles than ``max_faces``, from its JSON, before trimesh builds it.
+
+    A primitive's triangles follow from its accessor counts (``indices``, else ``POSITION``; mode 4: count/3,
+    strips and fans: count − 2, points and lines: none).  A node places its mesh once per path to it from the
+    default scene's roots (shared children repeat) and once per ``EXT_mesh_gpu_instancing`` instance; each
+    placement also costs :data:`GLTF_INSTANCE_FACES`.  Node graphs deeper than 64 (a cycle) are refused.
+    """
+    doc = _gltf_document(path)
+
+    def items(key):
+        value = doc.get(key, [])
+        return value if isinstance(value, list) else []
+
+    accessors, meshes, nodes = items("accessors"), items("meshes"), items("nodes")
+
+    def accessor_count(index) -> int:
+        if isinstance(index, int) and 0 <= index < len(accessors) and isinstance(accessors[index], dict):
+            count = accessors[index].get("count", 0)
+            return count if isinstance(count, int) and count > 0 else 0
+        return 0
+
+    def mesh_triangles(index) -> int:
+        if not (isinstance(index, int) and 0 <= index < len(meshes) and isinstance(meshes[index], dict)):
+            return 0
+        total = 0
+        primitives = meshes[index].get("primitives")
+        for primitive in primitives if isinstance(primitives, list) else []:
+            if not isinstance(primitive, dict):
+                continue
+            rule = _GLTF_TRIANGLE_MODES.get(primitive.get("mode", 4))
+            attributes = primitive.get("attributes") if isinstance(primitive.get("attributes"), dict) else {}
+            count = accessor_count(primitive["indices"]) if "indices" in primitive else \
+                accessor_count(attributes.get("POSITION"))
+            total += rule(count) if rule is not None else 0
+        return total
+
+    memo: dict = {}
+
+    def placed(index, depth: int) -> int:
+        if depth > 64:
+            raise _fail(path, "glTF node graph deeper than 64 levels (a cycle?)")
+        if not (isinstance(index, int) and 0 <= index < len(nodes) and isinstance(nodes[index], dict)):
+            return 0
+        if index in memo:
+            return memo[index]
+        node = nodes[index]
+        copies = 1
+        extensions = node.get("extensions")
+        extension = extensions.get("EXT_mesh_gpu_instancing") if isinstance(extensions, dict) else None
+        if isinstance(extension, dict) and isinstance(extension.get("attributes"), dict):
+            copies = max([accessor_count(a) for a in extension["attributes"].values()] + [1])
+        total = copies * (mesh_triangles(node["mesh"]) + GLTF_INSTANCE_FACES) if "mesh" in node else 0
+        children = node.get("children", [])
+        for child in children if isinstance(children, list) else []:
+            total += placed(child, depth + 1)
+            if total > max_faces:
+                break
+        memo[index] = total
+        return total
+
+    scenes = items("scenes")
+    chosen = doc.get("scene", 0)
+    if scenes and isinstance(chosen, int) and 0 <= chosen < len(scenes) and isinstance(scenes[chosen], dict):
+        roots = scenes[chosen].get("nodes", [])
+    else:
+        children = {c for n in nodes if isinstance(n, dict) for c in (n.get("children") or [])
+                    if isinstance(c, int)}
+        roots = [k for k in range(len(nodes)) if k not in children]
+    total = 0
+    for root in roots if isinstance(roots, list) else []:
+        total += placed(root, 0)
+        if total > max_faces:
+            raise _fail(path, f"the glTF scene places at least {total:,} triangles (each mesh instance counted, "
+                              f"and {GLTF_INSTANCE_FACES} more per instance for its copy), more than `max_faces` "
+                              f"({max_faces:,}) allows; refused before loading")
+    return {}
+
+
+_HEADER_CHECKS = {".ply": _check_ply_header, ".off": _check_off_header, ".dae": _check_collada,
+                  ".glb": _check_gltf, ".gltf": _check_gltf}
 
 
 def _declared_scale(path: str, suffix: str, loaded) -> tuple[float, str] | None:

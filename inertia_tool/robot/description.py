@@ -50,6 +50,10 @@ ROBOT_SUFFIXES = {".urdf": "urdf", ".xacro": "xacro", ".sdf": "sdf", ".world": "
 #: Largest description file read (bytes); descriptions are text of a few hundred KB at most.
 MAX_DESCRIPTION_BYTES = 64 << 20
 
+#: Links (MJCF: bodies) a description may hold.  The largest real robots have a few hundred; each link costs a
+#: few kB of parsed geometry and audit, so this bounds a hostile file's memory (300,000 links took 4 GB).
+MAX_ROBOT_LINKS = 10_000
+
 #: Lengths a robot description may state (primitive sizes, |origin| coordinates), m: a nanometre to a million
 #: kilometres.  Inside this range every closed form of ``robot.geometry`` (volumes ~ s³, moments ~ s⁵, times
 #: any density of ``OPTION_RANGES``) is a normal float64; outside it they overflow or underflow to 0.
@@ -536,6 +540,16 @@ def _read_sdf(root, source: str, base: str, packages: dict, geometry: str) -> tu
 
 # -- entry point -------------------------------------------------------------------------------------------
 
+def _check_link_count(root, source: str) -> None:
+    """Refuse more than :data:`MAX_ROBOT_LINKS` links or bodies, counted in the parsed tree before any is read."""
+    count = 0
+    for _ in root.iter("link", "body"):
+        count += 1
+        if count > MAX_ROBOT_LINKS:
+            raise _fail(source, f"holds more than {MAX_ROBOT_LINKS:,} links (or MJCF bodies); real robots have a "
+                                "few hundred: refused")
+
+
 def _detect(path: str) -> str:
     fmt = ROBOT_SUFFIXES.get(os.path.splitext(path)[1].lower())
     if fmt is None:
@@ -584,6 +598,7 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
     if fmt == "xacro":
         data = _expand_xacro(source, mappings or {}, packages)
     root = parse_xml(data, source).getroot()
+    _check_link_count(root, source)
     base = os.path.dirname(os.path.abspath(source))
     if fmt == "mjcf":    # *.xml: the root element says which format it is
         fmt = {"robot": "urdf", "sdf": "sdf"}.get(root.tag, "mjcf")

@@ -32,6 +32,7 @@ from ..errors import InvalidMeshError, MeshReadError, UsageError
 from ..mass import shapes
 from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
+from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
 from ..values import frozen_value
 from .description import GeometryElement, LinkGeometry, RobotDescription
 
@@ -39,7 +40,7 @@ __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", 
            "points_inside_element", "element_bounds"]
 
 
-def mesh_properties(path: str, *, repair: bool = False) -> MassProperties:
+def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = None) -> MassProperties:
     """Unit-density mass properties of the mesh file ``path`` (metres, file axes).
 
     The one place where the robot tools call the mesh engine.
@@ -51,6 +52,8 @@ def mesh_properties(path: str, *, repair: bool = False) -> MassProperties:
     repair : bool
         Let the engine repair an open or inconsistently wound mesh (``LoadOptions.repair``) instead of raising
         :class:`InvalidMeshError` (the caller then reports the link).
+    max_faces : int, optional
+        Refuse a file of more triangles (the reader's limit, ``LoadOptions.max_faces``); its default when None.
 
     Returns
     -------
@@ -59,7 +62,9 @@ def mesh_properties(path: str, *, repair: bool = False) -> MassProperties:
     """
     # robot descriptions give mesh coordinates in metres (the element's `scale` is applied afterwards), so the
     # unit is stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
-    return mass_properties(path, density=1.0, repair=repair, units="m")
+    if max_faces is None:
+        return mass_properties(path, density=1.0, repair=repair, units="m")
+    return mass_properties(path, density=1.0, repair=repair, units="m", max_faces=max_faces)
 
 
 def _capsule(radius: float, length: float) -> MassProperties:
@@ -98,7 +103,7 @@ def _scaled(props: MassProperties, scale) -> MassProperties:
 
 
 def element_mass_properties(element: GeometryElement, *, cache: dict | None = None,
-                            repair: bool = False) -> MassProperties:
+                            repair: bool = False, budget: list | None = None) -> MassProperties:
     """Unit-density mass properties of one geometry element, in the **link frame**.
 
     Parameters
@@ -108,6 +113,10 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
         Mesh path → unit-density properties, shared between the elements of one robot.
     repair : bool
         Passed to :func:`mesh_properties`.
+    budget : list of two int, optional
+        ``[left, total]``: triangles the meshes still to be read may hold together, of ``total``
+        (``robot --max-faces``); each new mesh file is read with ``left`` as its limit and its triangles are
+        taken off.
 
     Returns
     -------
@@ -135,7 +144,19 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
             local = cache[element.mesh]
         else:
             assert element.mesh is not None, "a mesh element carries the path of its file"
-            local = mesh_properties(element.mesh, repair=repair)
+            if budget is not None and budget[0] < 1:
+                raise MeshReadError(f"{element.mesh}: not read: the meshes read before it hold all the triangles "
+                                    "`max_faces` allows (the limit is on all the meshes of the robot together)")
+            try:
+                local = mesh_properties(element.mesh, repair=repair,
+                                        max_faces=None if budget is None else budget[0])
+            except MeshReadError as exc:
+                if budget is None or budget[0] == budget[1] or "`max_faces`" not in str(exc):
+                    raise
+                raise MeshReadError(f"{exc}: the limit counts all the robot's meshes together ({budget[1]:,}), "
+                                    f"and the meshes read before this one left {budget[0]:,}") from None
+            if budget is not None and local.mesh is not None:
+                budget[0] -= local.mesh.file_faces
             if cache is not None:
                 cache[element.mesh] = local
         local = _scaled(local, element.scale)
@@ -145,7 +166,8 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
 
-def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repair: bool = False) -> MassProperties:
+def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repair: bool = False,
+                         budget: list | None = None) -> MassProperties:
     """Unit-density mass properties of all the link's elements together, link frame (parallel-axis sum).
 
     Parameters
@@ -155,6 +177,8 @@ def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repai
         Mesh path → unit-density properties, shared between links.
     repair : bool
         Passed to :func:`mesh_properties`.
+    budget : list of one int, optional
+        Shared triangle budget (:func:`element_mass_properties`).
 
     Returns
     -------
@@ -163,7 +187,7 @@ def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repai
     """
     if not link.elements:
         raise UsageError(f"Expected link {link.name!r} to have geometry, got none")
-    parts = [element_mass_properties(e, cache=cache, repair=repair) for e in link.elements]
+    parts = [element_mass_properties(e, cache=cache, repair=repair, budget=budget) for e in link.elements]
     total = parts[0] if len(parts) == 1 else combine(parts, name=link.name)
     return MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
                           inertia=total.inertia, surface_area=total.surface_area, density=1.0, name=link.name)
@@ -197,7 +221,7 @@ class LinkInertial:
 
 
 def link_inertials(robot: RobotDescription, *, density: float | None = None, material: str | None = None,
-                   keep_mass: bool = False, repair: bool = False) -> tuple:
+                   keep_mass: bool = False, repair: bool = False, max_faces: int = DEFAULT_MAX_FACES) -> tuple:
     """Mass properties of every link from its geometry, in the link frame.
 
     Parameters
@@ -213,6 +237,9 @@ def link_inertials(robot: RobotDescription, *, density: float | None = None, mat
     repair : bool
         Repair open or inconsistently wound meshes (the engine's ``repair``; it warns what it changed) instead
         of reporting the link as needing repair.
+    max_faces : int
+        Triangles all the robot's mesh files together may hold (each file is read once); a mesh past the
+        remaining budget is refused before it is read into memory (its link reports why).
 
     Returns
     -------
@@ -224,14 +251,17 @@ def link_inertials(robot: RobotDescription, *, density: float | None = None, mat
     if chosen != 1:
         raise UsageError("Give exactly one of `density`, `material` and `keep_mass`")
     rho, basis = (None, "") if keep_mass else resolve_density(density=density, material=material)
+    if not (isinstance(max_faces, (int, np.integer)) and 0 < max_faces <= MAX_SUPPORTED_FACES):
+        raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,}, got {max_faces!r}")
     cache: dict = {}
+    budget = [int(max_faces), int(max_faces)]
     out = []
     for link in robot.links:
         if not link.elements:
             out.append(LinkInertial(link.name, None, float("nan"), basis, f"no {robot.geometry} geometry"))
             continue
         try:
-            unit = link_mass_properties(link, cache=cache, repair=repair)
+            unit = link_mass_properties(link, cache=cache, repair=repair, budget=budget)
         except (InvalidMeshError, MeshReadError) as exc:
             out.append(LinkInertial(link.name, None, float("nan"), basis,
                                     f"mesh needs repair or cannot be read: {exc}"))
