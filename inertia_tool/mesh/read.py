@@ -866,9 +866,9 @@ def _check_gltf(path: str, size: int, max_faces: int) -> dict:
             if not isinstance(primitive, dict):
                 continue
             rule = _GLTF_TRIANGLE_MODES.get(primitive.get("mode", 4))
-            attributes = primitive.get("attributes") if isinstance(primitive.get("attributes"), dict) else {}
-            count = accessor_count(primitive["indices"]) if "indices" in primitive else \
-                accessor_count(attributes.get("POSITION"))
+            attributes = primitive.get("attributes")
+            position = attributes.get("POSITION") if isinstance(attributes, dict) else None
+            count = accessor_count(primitive["indices"] if "indices" in primitive else position)
             total += rule(count) if rule is not None else 0
         return total
 
