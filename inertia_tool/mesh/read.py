@@ -956,6 +956,8 @@ def _scene_rounding(loaded) -> float:
     import trimesh
     if isinstance(loaded, trimesh.Trimesh):
         return _float32_rounding(np.asarray(loaded.vertices))
+    if not isinstance(loaded, trimesh.Scene):
+        return 0.0                  # a point cloud or lines: refused below
     stored = [np.asarray(g.vertices) for g in loaded.geometry.values() if hasattr(g, "vertices")]
     delta = max((_float32_rounding(v) for v in stored), default=0.0)
     norm = 1.0
