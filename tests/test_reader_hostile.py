@@ -400,6 +400,18 @@ def test_3mf_malformed_models_are_refused(tmp_path, resources, build, match):
         load_mesh(_write_3mf(tmp_path / "bad.3mf", resources, build))
 
 
+def test_3mf_objects_in_other_model_parts_are_placed(tmp_path):
+    production = "http://schemas.microsoft.com/3dmanufacturing/production/2015/06"
+    other = (f'<model unit="millimeter" xmlns="{_NS}"><resources><object id="5">{_BOX_MESH}</object></resources>'
+             "<build/></model>")
+    resources = (f'<object id="1"><components><component objectid="5" p:path="/3D/other.model" '
+                 f'xmlns:p="{production}"/></components></object>')
+    build = f'<item objectid="1"/><item objectid="5" p:path="/3D/other.model" xmlns:p="{production}" ' \
+            'transform="1 0 0 0 1 0 0 0 1 50 0 0"/>'
+    path = _write_3mf(tmp_path / "production.3mf", resources, build, extra_parts=[("3D/other.model", other)])
+    assert mass_properties(path, density=1.0).volume == pytest.approx(12e-9, rel=1e-12)
+
+
 def test_3mf_junk_model_parts_are_never_parsed(tmp_path):
     # the issue's 5 MB 3MF of 3,000 junk .model parts took 6.3 GB: unreferenced parts are not read now
     junk = [(f"3D/junk{k}.model", "<model>" + "<x/>" * 1000 + "</model>") for k in range(300)]

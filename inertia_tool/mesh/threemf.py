@@ -4,9 +4,10 @@ A 3MF is a zip whose model parts (``3D/3dmodel.model`` and any other ``*.model``
 Specification (§3–§4): ``<model unit>`` (``micron``, ``millimeter`` (default), ``centimeter``, ``inch``,
 ``foot``, ``meter``), ``<resources>`` of ``<object id>`` each holding a ``<mesh>`` (``<vertices>`` of
 ``<vertex x y z>`` and ``<triangles>`` of ``<triangle v1 v2 v3>``, 0-based) or ``<components>`` of
-``<component objectid transform>`` (the Production extension's ``path`` attribute names another model part),
-and ``<build>`` of ``<item objectid transform>``.  A transform is twelve numbers ``m00 m01 m02 m10 m11 m12
-m20 m21 m22 m30 m31 m32``: a point ``p`` (row) becomes ``p · M + (m30, m31, m32)``.
+``<component objectid transform>``, and ``<build>`` of ``<item objectid transform>`` (on both, the Production
+extension's ``path`` attribute names another model part that defines the object).  A transform is twelve
+numbers ``m00 m01 m02 m10 m11 m12 m20 m21 m22 m30 m31 m32``: a point ``p`` (row) becomes
+``p · M + (m30, m31, m32)``.
 
 Memory: a tree parser (trimesh's, through lxml) holds every element, about 1.6 kB per triangle.  Here each
 element is cleared once read, so the XML costs a constant; vertices (3 doubles) and triangles (3 int64) are
@@ -68,7 +69,7 @@ class _Part:
     def __init__(self):
         self.meshes: dict = {}          # id -> (vertices (n, 3), triangles (m, 3))
         self.components: dict = {}      # id -> [(part name or None, object id, 4 x 3 transform)]
-        self.items: list = []           # [(object id, 4 x 3 transform)]
+        self.items: list = []           # [(part name or None, object id, 4 x 3 transform)]
         self.unit = "millimeter"
 
 
@@ -112,7 +113,8 @@ def _read_part(source, where: str, budget: list) -> _Part:
                 components.append((_attribute(element, "path"), element.get("objectid"),
                                    _transform(element.get("transform"), where)))
             elif tag == "item" and in_build:
-                part.items.append((element.get("objectid"), _transform(element.get("transform"), where)))
+                part.items.append((_attribute(element, "path"), element.get("objectid"),
+                                   _transform(element.get("transform"), where)))
             elif tag == "object":
                 key = element.get("id")
                 if coords or corners:
@@ -199,7 +201,7 @@ def read_3mf(path: str, members, zf, *, max_faces: int, name: str):
         counts[(part_name, key)] = total
         return total
 
-    placed = sum(triangles(root_name, key, 0) for key, _ in root.items)
+    placed = sum(triangles(item_part or root_name, key, 0) for item_part, key, _ in root.items)
     if placed > max_faces:
         raise MeshReadError(f"{name}: the build places at least {placed:,} triangles (components and items "
                             f"repeated), more than `max_faces` ({max_faces:,}) allows; refused before placing them")
@@ -221,8 +223,8 @@ def read_3mf(path: str, members, zf, *, max_faces: int, name: str):
             place(sub_part or part_name, sub_key, combined, depth + 1)
 
     with np.errstate(invalid="ignore", over="ignore"):       # non-finite coordinates are refused by the caller
-        for key, matrix in root.items:
-            place(root_name, key, matrix, 0)
+        for item_part, key, matrix in root.items:
+            place(item_part or root_name, key, matrix, 0)
     if not out_f or not sum(len(f) for f in out_f):
         raise MeshReadError(f"{name}: contains no triangle mesh (no build item places an object with triangles)")
     vertices = np.concatenate(out_v)
