@@ -78,6 +78,17 @@ def test_non_finite_vertex_is_refused_in_every_format(tmp_path, suffix, bad):
         load_mesh(path)
 
 
+def test_collada_instances_count_against_the_face_limit(tmp_path):
+    from inertia_tool.mesh.read import GLTF_INSTANCE_FACES
+    path = _box_dae(tmp_path)
+    text = path.read_text()
+    node = text[text.index("<node"):text.index("</node>") + len("</node>")]
+    path.write_text(text.replace(node, node * 50))
+    assert len(load_mesh(path, max_faces=50 * (GLTF_INSTANCE_FACES + 12)).faces) == 50 * 12
+    with pytest.raises(MeshReadError, match="50 geometry and node instances"):
+        load_mesh(path, max_faces=50 * GLTF_INSTANCE_FACES - 1)
+
+
 def test_collada_nan_hidden_in_cdata_is_refused(tmp_path):
     path = _box_dae(tmp_path, "<![CDATA[nan]]>")
     with pytest.raises(MeshReadError, match="float_array"):

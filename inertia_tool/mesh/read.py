@@ -781,8 +781,20 @@ def _check_collada(path: str, size: int, max_faces: int) -> dict:
         raise _fail(path, f"{size:,} bytes of COLLADA text, more than the {limit:,} allowed for `max_faces` "
                           f"({max_faces:,})")
     with open(path, "rb") as fh:
-        _check_collada_floats(_display(path), fh.read())
+        data = fh.read()
+    _check_collada_floats(_display(path), data)
+    _check_collada_instances(_display(path), data, max_faces)
     return {}
+
+
+def _check_collada_instances(name: str, data: bytes, max_faces: int) -> None:
+    """Refuse a COLLADA document whose ``<instance_geometry>`` and ``<instance_node>`` elements alone, at
+    :data:`GLTF_INSTANCE_FACES` triangles each (the scene-graph cost of a placed instance), pass ``max_faces``."""
+    instances = data.count(b"<instance_geometry") + data.count(b"<instance_node")
+    if instances * GLTF_INSTANCE_FACES > max_faces:
+        raise MeshReadError(f"{name}: {instances:,} geometry and node instances, each counted as "
+                            f"{GLTF_INSTANCE_FACES} triangles, pass `max_faces` ({max_faces:,}); refused before "
+                            "loading")
 
 
 def _check_zipped_collada(path: str, max_faces: int) -> dict:
@@ -794,7 +806,9 @@ def _check_zipped_collada(path: str, max_faces: int) -> dict:
         with zipfile.ZipFile(path) as zf:
             for info in zf.infolist():
                 if info.filename.lower().endswith(".dae"):
-                    _check_collada_floats(f"{_display(path)}:{info.filename[:60]}", zf.read(info))
+                    data = zf.read(info)
+                    _check_collada_floats(f"{_display(path)}:{info.filename[:60]}", data)
+                    _check_collada_instances(f"{_display(path)}:{info.filename[:60]}", data, max_faces)
     except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError, NotImplementedError,
             RuntimeError, OSError) as exc:
         if isinstance(exc, MeshReadError):
