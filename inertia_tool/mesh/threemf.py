@@ -73,27 +73,36 @@ class _Part:
         self.unit = "millimeter"
 
 
+#: Elements the reader handles (any namespace); lxml yields only these, and only at their end.
+_TAGS = ("vertex", "triangle", "component", "item", "object", "model")
+#: Elements read between two sweeps of the already-read siblings out of the tree.
+_SWEEP = 4096
+
+
 def _read_part(source, where: str, budget: list) -> _Part:
-    """Stream one model part; ``budget = [triangles left, vertices left]`` is shared by all parts."""
+    """Stream one model part; ``budget = [triangles left, vertices left]`` is shared by all parts.
+
+    Each element is handled at its end event and cleared; every :data:`_SWEEP` elements the siblings already
+    read are removed from their parent, so the tree never holds more than a few thousand empty elements.
+    """
     from lxml import etree
     part = _Part()
     coords = array.array("d")
     corners = array.array("q")
     components: list = []
-    in_build = False
+    kinds: dict = {}          # element tag (with its namespace) -> local name
+    seen = 0
     try:
-        for event, element in etree.iterparse(source, events=("start", "end"), resolve_entities=False,
-                                              no_network=True, huge_tree=False, remove_comments=True):
-            tag = _local(element.tag)
-            if event == "start":
-                if tag == "build":
-                    in_build = True
-                elif tag == "model":
-                    part.unit = element.get("unit", "millimeter")
-                continue
+        for _, element in etree.iterparse(source, events=("end",), tag=[f"{{*}}{t}" for t in _TAGS],
+                                          resolve_entities=False, no_network=True, huge_tree=False,
+                                          remove_comments=True):
+            tag = kinds.get(element.tag)
+            if tag is None:
+                tag = kinds.setdefault(element.tag, _local(element.tag))
+            get = element.get
             if tag == "vertex":
                 try:
-                    coords.extend((float(element.get("x")), float(element.get("y")), float(element.get("z"))))
+                    coords.extend((float(get("x")), float(get("y")), float(get("z"))))
                 except (TypeError, ValueError):
                     raise MeshReadError(f"{where}: a <vertex> without three numbers x y z") from None
                 budget[1] -= 1
@@ -102,7 +111,7 @@ def _read_part(source, where: str, budget: list) -> _Part:
                                         "while reading")
             elif tag == "triangle":
                 try:
-                    corners.extend((int(element.get("v1")), int(element.get("v2")), int(element.get("v3"))))
+                    corners.extend((int(get("v1")), int(get("v2")), int(get("v3"))))
                 except (TypeError, ValueError):
                     raise MeshReadError(f"{where}: a <triangle> without three vertex indices v1 v2 v3") from None
                 budget[0] -= 1
@@ -110,13 +119,12 @@ def _read_part(source, where: str, budget: list) -> _Part:
                     raise MeshReadError(f"{where}: holds more triangles than `max_faces` allows; refused while "
                                         "reading")
             elif tag == "component":
-                components.append((_attribute(element, "path"), element.get("objectid"),
-                                   _transform(element.get("transform"), where)))
-            elif tag == "item" and in_build:
-                part.items.append((_attribute(element, "path"), element.get("objectid"),
-                                   _transform(element.get("transform"), where)))
+                components.append((_attribute(element, "path"), get("objectid"),
+                                   _transform(get("transform"), where)))
+            elif tag == "item":                    # build items (the core specification has no other <item>)
+                part.items.append((_attribute(element, "path"), get("objectid"), _transform(get("transform"), where)))
             elif tag == "object":
-                key = element.get("id")
+                key = get("id")
                 if coords or corners:
                     v = np.frombuffer(coords, dtype=np.float64).reshape(-1, 3).copy()
                     f = np.frombuffer(corners, dtype=np.int64).reshape(-1, 3).copy()
@@ -127,13 +135,15 @@ def _read_part(source, where: str, budget: list) -> _Part:
                 if components:
                     part.components[key] = components
                 coords, corners, components = array.array("d"), array.array("q"), []
-            elif tag == "build":
-                in_build = False
-            if tag in ("vertex", "triangle", "component", "item", "object", "vertices", "triangles", "mesh",
-                       "components"):
-                element.clear()
-                while element.getprevious() is not None:         # drop the siblings already read
-                    del element.getparent()[0]
+            else:                                  # the <model> root, at the very end
+                part.unit = get("unit", "millimeter")
+                break
+            element.clear()
+            seen += 1
+            if seen % _SWEEP == 0 or tag == "object":
+                parent = element.getparent()
+                if parent is not None:
+                    del parent[:parent.index(element)]     # the siblings before this one, all read
     except etree.XMLSyntaxError as exc:
         raise MeshReadError(f"{where}: not well-formed XML ({str(exc)[:120]})") from None
     return part
