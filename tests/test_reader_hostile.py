@@ -85,8 +85,14 @@ def test_collada_instances_count_against_the_face_limit(tmp_path):
     node = text[text.index("<node"):text.index("</node>") + len("</node>")]
     path.write_text(text.replace(node, node * 50))
     assert len(load_mesh(path, max_faces=50 * (GLTF_INSTANCE_FACES + 12)).faces) == 50 * 12
-    with pytest.raises(MeshReadError, match="50 geometry and node instances"):
-        load_mesh(path, max_faces=50 * GLTF_INSTANCE_FACES - 1)
+    trimesh = pytest.importorskip("trimesh")
+    load = trimesh.load
+    trimesh.load = lambda *a, **k: pytest.fail("parsed before the refusal")
+    try:
+        with pytest.raises(MeshReadError, match="50 geometry and node instances"):
+            load_mesh(path, max_faces=50 * GLTF_INSTANCE_FACES - 1)
+    finally:
+        trimesh.load = load
 
 
 def test_collada_nan_hidden_in_cdata_is_refused(tmp_path):
@@ -367,7 +373,7 @@ def test_3mf_reader_agrees_with_trimesh_on_an_exported_scene(tmp_path):
     assert mass_properties(path).volume == pytest.approx(theirs.volume * 1e-9, rel=1e-9)
 
 
-def test_3mf_instance_bomb_is_refused_before_placing(tmp_path):
+def test_3mf_instance_bomb_is_refused_before_placing(tmp_path, no_parser):
     # 12 triangles, 10 copies per level, 6 levels: 12 million placed triangles from a few kB
     resources = f'<object id="1">{_BOX_MESH}</object>'
     for level in range(2, 8):
@@ -443,16 +449,29 @@ def _polygon_ply(path, corners, polygons):
     path.write_bytes(header + vertices + face * polygons)
 
 
-def test_ply_of_255_corner_polygons_is_bounded_by_the_face_limit(tmp_path):
+@pytest.fixture
+def no_parser(monkeypatch):
+    """Make trimesh's loader fail the test if called: a refusal must come before any parser allocates."""
+    trimesh = pytest.importorskip("trimesh")
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the parser ran: the file should have been refused from its counts")
+    monkeypatch.setattr(trimesh, "load", refuse)
+
+
+def test_ply_of_255_corner_polygons_is_bounded_by_the_face_limit(tmp_path, monkeypatch):
     # the issue's 204 MB PLY of 255-corner faces took 4.6 GB: 200 faces are 50,600 triangles, counted exactly
     path = tmp_path / "polygons.ply"
     _polygon_ply(path, 255, 200)
-    with pytest.raises(MeshReadError, match="up to 50,600 triangles"):
-        load_mesh(path, max_faces=50_599)
+    with monkeypatch.context() as patch:
+        trimesh = pytest.importorskip("trimesh")
+        patch.setattr(trimesh, "load", lambda *a, **k: pytest.fail("parsed before the refusal"))
+        with pytest.raises(MeshReadError, match="up to 50,600 triangles"):
+            load_mesh(path, max_faces=50_599)
     assert len(load_mesh(path, max_faces=50_600).faces) == 50_600
 
 
-def test_ply_header_claiming_a_billion_faces_is_refused_from_the_header(tmp_path):
+def test_ply_header_claiming_a_billion_faces_is_refused_from_the_header(tmp_path, no_parser):
     path = tmp_path / "lying.ply"
     path.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                      b"property float z\nelement face 1000000000\nproperty list uchar int vertex_indices\n"
@@ -496,7 +515,7 @@ def test_glb_instances_count_against_the_face_limit(tmp_path):
         load_mesh(path, max_faces=3 * per_instance - 1)
 
 
-def test_glb_of_many_instances_is_refused_before_loading(tmp_path):
+def test_glb_of_many_instances_is_refused_before_loading(tmp_path, no_parser):
     # the issue's 10 MB GLB of 200k instances took 1.7 GB in trimesh; here 20,000 instances and a small limit
     path = tmp_path / "many.glb"
     _instanced_glb(path, 20_000)
@@ -504,7 +523,7 @@ def test_glb_of_many_instances_is_refused_before_loading(tmp_path):
         load_mesh(path, max_faces=100_000)
 
 
-def test_gltf_node_cycle_is_refused(tmp_path):
+def test_gltf_node_cycle_is_refused(tmp_path, no_parser):
     import json
     path = tmp_path / "cycle.gltf"
     path.write_text(json.dumps({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}],
