@@ -780,7 +780,7 @@ def _check_collada(path: str, size: int, max_faces: int) -> dict:
     if size > limit:
         raise _fail(path, f"{size:,} bytes of COLLADA text, more than the {limit:,} allowed for `max_faces` "
                           f"({max_faces:,})")
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         data = fh.read()
     _check_collada_floats(_display(path), data)
     check_collada_instances(_display(path), data, max_faces)
@@ -793,7 +793,7 @@ def _check_zipped_collada(path: str, max_faces: int) -> dict:
     import zipfile
     counts = _check_zip(path, max_faces)
     try:
-        with zipfile.ZipFile(path) as zf:
+        with open_regular(path) as raw, zipfile.ZipFile(raw) as zf:
             for info in zf.infolist():
                 if info.filename.lower().endswith(".dae"):
                     data = zf.read(info)

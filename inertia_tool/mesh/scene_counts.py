@@ -31,7 +31,8 @@ _GLTF_TRIANGLE_MODES = {4: lambda n: n // 3, 5: lambda n: max(n - 2, 0), 6: lamb
 def _document(path: str) -> dict:
     """The JSON of a ``.gltf`` file or of a ``.glb``'s first chunk (checked against the file size)."""
     import json
-    with open(path, "rb") as fh:
+    from .regular import open_regular
+    with open_regular(path) as fh:
         head = fh.read(20)
         if head[:4] == b"glTF":
             if len(head) < 20:
