@@ -877,7 +877,6 @@ def _read_with_trimesh_rounding(path: str, max_faces: int):
         counts = _check_zipped_collada(path, max_faces)
     else:
         counts = {}
-    source, kind = path, None
     try:
         import trimesh
     except ImportError as exc:  # pragma: no cover - trimesh is a dependency
@@ -897,12 +896,10 @@ def _read_with_trimesh_rounding(path: str, max_faces: int):
             try:
                 # glTF: no textures decoded (geometry only; a textured GLB loads up to 50x faster)
                 extra: dict[str, Any] = {"skip_materials": True} if suffix in (".glb", ".gltf") else {}
-                if kind is None:        # the file itself, opened once (regular files only), its side files too
-                    with open_regular(path) as fh:
-                        loaded = trimesh.load(fh, file_type=suffix[1:], process=False, force=None,
-                                              resolver=regular_file_resolver(path), **extra)
-                else:
-                    loaded = trimesh.load(source, file_type=kind, process=False, force=None, **extra)
+                # the file itself, opened once (regular files only), its side files too
+                with open_regular(path) as fh:
+                    loaded = trimesh.load(fh, file_type=suffix[1:], process=False, force=None,
+                                          resolver=regular_file_resolver(path), **extra)
             finally:
                 quiet.setLevel(level)
             declared = _declared_scale(path, suffix, loaded)
