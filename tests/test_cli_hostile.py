@@ -257,3 +257,45 @@ def test_float32_far_box_is_not_silently_exact(hostile):
     assert code == 0 and "float32" in err
     volume = json.loads(out)["volume"]
     assert not np.isclose(volume, 0.1 * 0.2 * 0.3, rtol=1e-3)     # the file's corners really moved
+
+
+# -- hypothesis: any number in a robot file or on the spin-it command line -------------------------------------
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_EXTREMES = st.sampled_from([0.0, -0.0, 5e-324, 1e-300, 1e-200, 1e-10, 1e10, 1e200, 1e300, 1.7976931348623157e308,
+                             float("nan"), float("inf"), -float("inf")])
+_NUMBERS = st.one_of(_EXTREMES, st.floats(allow_nan=True, allow_infinity=True), _EXTREMES.map(lambda x: -x))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(shape=st.sampled_from(["sphere", "cylinder", "box", "capsule"]), size=_NUMBERS, other=_NUMBERS,
+       offset=_NUMBERS, mass=_NUMBERS)
+def test_any_number_in_a_urdf_is_a_result_or_a_clear_error(tmp_path_factory, shape, size, other, offset, mass):
+    tmp = tmp_path_factory.mktemp("urdf")
+    attrs = {"sphere": f'radius="{size!r}"', "cylinder": f'radius="{size!r}" length="{other!r}"',
+             "capsule": f'radius="{size!r}" length="{other!r}"',
+             "box": f'size="{size!r} {other!r} {abs(other)!r}"'}[shape]
+    path = tmp / "r.urdf"
+    path.write_text(f'<robot name="r"><link name="a"><inertial><origin xyz="{offset!r} 0 0"/><mass value="{mass!r}"/>'
+                    f'<inertia ixx="{mass!r}" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial><collision>'
+                    f'<origin xyz="0 {offset!r} 0"/><geometry><{shape} {attrs}/></geometry></collision></link>'
+                    "</robot>")
+    for extra in (["--material", "steel", "--json"], ["--keep-mass", "--json"]):
+        argv = ["robot", path, *extra]
+        code, out, err = run_cli(argv)
+        check_contract(argv, code, out, err)
+        assert code in (0, 3), err
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(option=st.sampled_from(["--through", "--wall", "--density", "--mass", "--insert", "--axis"]), value=_NUMBERS)
+def test_any_number_on_the_spin_it_command_line_is_a_result_or_a_clear_error(hostile, option, value):
+    meshes, _, _ = hostile
+    text = f"{value!r},0,1" if option in ("--through", "--axis") else repr(value)
+    # the option under test comes last: argparse keeps the last value of an option given twice
+    argv = ["spin-it", meshes["good"], "--axis", "0,0,1", "--wall", "1mm", "--resolution", "12", "--json",
+            option, text]
+    code, out, err = run_cli(argv)
+    check_contract(argv, code, out, err)
