@@ -299,3 +299,15 @@ def test_any_number_on_the_spin_it_command_line_is_a_result_or_a_clear_error(hos
             option, text]
     code, out, err = run_cli(argv)
     check_contract(argv, code, out, err)
+
+
+def test_escape_terminal_escapes_every_control_but_keeps_report_lines():
+    from inertia_tool.reports.escape import escape_terminal
+    assert escape_terminal("a\x1b[2Jb") == "a\\u001b[2Jb"
+    assert escape_terminal("x\x9b1m\x7f\x00") == "x\\u009b1m\\u007f\\u0000"
+    assert escape_terminal("abc\u202edcba\u2066") == "abc\\u202edcba\\u2066"        # bidirectional overrides
+    assert escape_terminal("one\ntwo\tthree\r") == "one\\u000atwo\\u0009three\\u000d"
+    assert escape_terminal("one\ntwo\tthree\r", lines=True) == "one\ntwo\tthree\\u000d"
+    assert escape_terminal("café ünïcode ✓") == "café ünïcode ✓"
+    name = "p\x1b]0;t\x07\u2028.stl"
+    assert json.loads(f'"{escape_terminal(name)}"') == name                       # a JSON escape of the same text

@@ -180,7 +180,8 @@ def read_3mf(path: str, members, zf, *, max_faces: int, name: str):
 
     root_name = "/" + members[0].filename.lstrip("/")
     root = load(root_name)
-    assert root is not None, "the root model is among the members"
+    if root is None:
+        raise MeshReadError(f"{name}: the root model part {root_name[:60]!r} cannot be read")
     if root.unit not in THREEMF_UNITS:
         raise MeshReadError(f"{name}: unknown 3MF unit {root.unit[:40]!r}; expected one of "
                             f"{', '.join(THREEMF_UNITS)}")

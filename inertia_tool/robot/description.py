@@ -35,7 +35,8 @@ from ..values import frozen_value
 from .resolve import package_directory, resolve_uri
 
 __all__ = ["GeometryElement", "DeclaredInertial", "LinkGeometry", "RobotDescription", "read_robot",
-           "rpy_to_matrix", "GEOMETRY_KINDS", "ROBOT_SUFFIXES", "PRIMITIVES"]
+           "rpy_to_matrix", "GEOMETRY_KINDS", "ROBOT_SUFFIXES", "PRIMITIVES", "parse_decimal", "MAX_ROBOT_LINKS",
+           "ROBOT_LENGTH_RANGE", "ROBOT_SCALE_RANGE"]
 
 #: Which geometry of a link to take: ``<collision>`` (default; usually simpler, closed meshes) or ``<visual>``.
 GEOMETRY_KINDS = ("collision", "visual")
