@@ -50,7 +50,7 @@ def check_contract(argv, code, out, err):
         assert _finite(json.loads(out)), f"{shown}: non-finite number in JSON"
 
 
-_HOSTILE_NAME = "e\x1b]0;owned\x07\x1b[31m\x9b2J-x-.stl"
+_HOSTILE_NAME = "e\x1b]0;owned\x07\x1b[31m\x9b2J--x-->.stl"
 
 
 def _dae(path, token):

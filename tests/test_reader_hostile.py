@@ -214,11 +214,11 @@ def test_float32_rounding_is_half_the_spacing():
     assert float32_rounding(0.0) > 0
 
 
-def test_far_ply_float_and_glb_warn(tmp_path):
+def test_far_ply_float_glb_and_collada_warn(tmp_path):
     trimesh = pytest.importorskip("trimesh")
     mesh = trimesh.creation.box(extents=(0.3, 0.3, 0.3))
     mesh.apply_translation((1e6 + 0.01, 1e6, 1e6))
-    for name in ("far.ply", "far.glb"):
+    for name in ("far.ply", "far.glb", "far.dae"):
         mesh.export(tmp_path / name)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
