@@ -21,7 +21,8 @@ __all__ = ["LoadOptions", "DEFAULT_MAX_FACES", "MAX_SUPPORTED_FACES"]
 
 #: Default guard on the number of triangles a file may hold.  Peak memory at the limit (``docs/bad-input.md``;
 #: ``benchmarks/bench_memory.py``): binary STL ~63 MiB + 37 B per face with the C extension (1.8 GiB at
-#: 50M), 77 B per face on the numpy path; a 3MF, parsed by trimesh, ~1.6 kB per face.
+#: 50M), 77 B per face on the numpy path; a 3MF (streaming reader, ``mesh.threemf``) ~150 B per face for a whole
+#: ``analyze`` run; other formats per ``benchmarks/bench_memory.py --formats`` (``docs/bad-input.md``).
 DEFAULT_MAX_FACES = 50_000_000
 
 #: Most triangles any reader accepts, whatever ``max_faces`` says: the welders number the 3 corners of every
