@@ -536,8 +536,10 @@ def test_urdf_with_too_many_links_is_refused(tmp_path):
     from inertia_tool.robot.description import MAX_ROBOT_LINKS
     path = tmp_path / "many.urdf"
     path.write_text('<robot name="r">' + '<link name="l"/>' * (MAX_ROBOT_LINKS + 1) + "</robot>")
-    with pytest.raises(RobotDescriptionError, match="more than 10,000 links"):
+    with pytest.raises(RobotDescriptionError, match="10,001 links .*more than the 10,000 allowed"):
         read_robot(path)
+    path.write_text('<robot name="r">' + '<link name="l"/>' * MAX_ROBOT_LINKS + "</robot>")
+    assert len(read_robot(path).links) == MAX_ROBOT_LINKS
 
 
 def test_robot_max_faces_is_a_total_over_the_meshes(tmp_path):
