@@ -34,6 +34,7 @@ __all__ = [
     "InertiaToolError",
     "UsageError",
     "UnitsError",
+    "OutputFileError",
     "MaterialError",
     "MeshReadError",
     "RobotDescriptionError",
@@ -66,6 +67,11 @@ class InertiaToolError(Exception):
 class UsageError(InertiaToolError, ValueError):
     """A parameter is missing, malformed or contradicts another one."""
 
+
+
+class OutputFileError(UsageError):
+    """An output file cannot be written: it exists (without ``force``), is a symbolic link or a directory, its
+    directory is missing, or the operating system refused the write (:mod:`inertia_tool.output`)."""
 
 
 class UnitsError(UsageError):

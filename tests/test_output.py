@@ -1,4 +1,4 @@
-"""The one output writer (inertia_tool.reports.output) and the commands that write files through it."""
+"""The one output writer (inertia_tool.output) and the commands that write files through it."""
 
 import os
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from inertia_tool.cli import main
-from inertia_tool.reports import output
-from inertia_tool.reports.output import (OutputFileError, atomic_target, check_targets, write_bytes, write_files,
+from inertia_tool import output
+from inertia_tool.output import (OutputFileError, atomic_target, check_targets, write_bytes, write_files,
                                          write_text)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

@@ -436,7 +436,7 @@ def test_real_robots_written_then_read_back_have_a_clean_audit(name, basis, tmp_
     assert _structure(before, "urdf") == _structure(after, "urdf")
 
 
-# -- the writer: reports/output.py ---------------------------------------------------------------------------
+# -- the writer: output.py ---------------------------------------------------------------------------
 
 def _simple_robot(tmp_path):
     urdf = tmp_path / "in" / "r.urdf"

@@ -11,7 +11,7 @@ import os
 
 from ..balancing.rotor import ISO_GRADES, balance
 from ..errors import UsageError
-from ..reports.output import check_targets, write_files
+from ..output import check_targets, write_files
 from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length
 from ..reports.serialize import to_jsonable

@@ -10,7 +10,7 @@ import os
 import sys
 
 from ..errors import UsageError
-from ..reports.output import atomic_target, check_targets
+from ..output import atomic_target, check_targets
 from ..reports.escape import escape_terminal
 
 __all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES",
@@ -30,7 +30,7 @@ def add_report_options(parser) -> None:
 
 
 def check_output_file(path: str | None, option: str, force: bool) -> None:
-    """The rule of every file this command line writes (:func:`inertia_tool.reports.output.check_targets`):
+    """The rule of every file this command line writes (:func:`inertia_tool.output.check_targets`):
     refuse (:class:`UsageError`, exit 2), before any work, to replace an existing file without ``--force``,
     to write over a directory, or into a missing directory."""
     check_targets([(path, option)], force=force)
@@ -74,7 +74,7 @@ def say_written(paths) -> None:
 
 def save_figure(fig, path: str, *, dpi: int = 120) -> None:
     """Write a matplotlib figure to ``path`` atomically (the format from its suffix) and close it; an OS error
-    becomes a one-line :class:`~inertia_tool.reports.output.OutputFileError`."""
+    becomes a one-line :class:`~inertia_tool.output.OutputFileError`."""
     import matplotlib.pyplot as plt
     try:
         with atomic_target(path) as tmp:

@@ -15,7 +15,7 @@ from ..dynamics.experiment import MAX_SAMPLES, spin_experiment
 from ..dynamics.spin_stability import AXIS_NAMES
 from ..units import parse_angular_rate, parse_duration
 from ..mass.principal import DEFAULT_EQUAL_RTOL
-from ..reports.output import atomic_target, check_targets
+from ..output import atomic_target, check_targets
 from .help import add_command
 from .model_options import add_files_argument, add_model_options, load_model, model_words, with_warnings
 from .options import check_option, require_range

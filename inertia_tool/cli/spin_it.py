@@ -14,7 +14,7 @@ from ..units import length_scale, parse_density, parse_length, parse_vector
 from .help import add_command
 from .model_options import add_material_options, length_unit
 from .options import check_option, density_and_mass
-from ..reports.output import check_targets
+from ..output import check_targets
 from .report_option import save_figure, say_written
 
 __all__ = ["register", "run", "OUTPUT_SUFFIXES"]
@@ -98,7 +98,7 @@ def _write_two_materials(path: str, result, material: str, insert: str) -> None:
 def _write(path: str, vertices, faces, units: str) -> None:
     import trimesh
 
-    from ..reports.output import atomic_target
+    from ..output import atomic_target
     suffix = os.path.splitext(path)[1].lower()
     scale = length_scale("mm") if suffix == ".3mf" else length_scale(units)
     mesh = trimesh.Trimesh(np.asarray(vertices) / scale, np.asarray(faces), process=False)
@@ -195,7 +195,7 @@ def run(args) -> int:
             raise UsageError("--plot needs matplotlib (pip install 'inertia-tool[plots]')") from exc
         save_figure(figure, args.plot)
     if args.report:
-        from ..reports.output import write_text
+        from ..output import write_text
         from ..reports.spin_it import spin_it_html
         write_text(args.report, spin_it_html(result, name=args.files, motion=_motion(result), output=args.out),
                    label="--report")

@@ -14,7 +14,7 @@ from ..dynamics.top import STANDARD_GRAVITY, heavy_top_on_pivot
 from ..reports.stability import format_heavy_top, heavy_top_dict
 from ..reports.serialize import to_jsonable
 from ..units import parse_angle, parse_angular_rate, parse_duration, parse_vector
-from ..reports.output import atomic_target, check_targets
+from ..output import atomic_target, check_targets
 from .help import add_command
 from .model_options import add_files_argument, add_model_options, length_unit, load_model, model_words, with_warnings
 from .options import check_option, require_range

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
-from ..reports.output import atomic_target
+from ..output import atomic_target
 
 __all__ = ["plot_trajectory"]
 

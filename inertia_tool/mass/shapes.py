@@ -76,7 +76,7 @@ from numpy.typing import ArrayLike
 from ..values import frozen_value
 from ..errors import UsageError
 from .properties import MassProperties
-from ..reports.output import write_bytes
+from ..output import write_bytes
 from ..units import length_scale
 
 __all__ = [
@@ -747,7 +747,7 @@ def octahedron(half_x: float, half_y: float, half_z: float, *, center: ArrayLike
 
 def write_stl(solid: ReferenceSolid, path: str | os.PathLike[str], *, binary: bool = True, units: str = "m") -> Path:
     """Write ``solid``'s mesh as an STL file (atomically, replacing an existing file:
-    :func:`inertia_tool.reports.output.write_bytes`).
+    :func:`inertia_tool.output.write_bytes`).
 
     Parameters
     ----------

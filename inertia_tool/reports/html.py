@@ -35,7 +35,7 @@ from ..errors import InertiaToolError
 from ..mass.properties import MassProperties
 from ..tolerances import TRIANGLE_INEQUALITY_RTOL
 from .escape import escape_html
-from .output import check_targets, write_text
+from ..output import check_targets, write_text
 from .serialize import TENSOR_CONVENTION
 from .text import method_line
 from .numbers import number, round_off_zero
@@ -492,7 +492,7 @@ def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_
 
 
 def write_html_report(path: str | os.PathLike, document: str, *, force: bool = False) -> None:
-    """Write ``document`` to ``path`` through the one output writer (:mod:`inertia_tool.reports.output`):
+    """Write ``document`` to ``path`` through the one output writer (:mod:`inertia_tool.output`):
     refuse to replace an existing file unless ``force``, write atomically (a failure never leaves half a
     report)."""
     check_targets([os.fspath(path)], force=force)

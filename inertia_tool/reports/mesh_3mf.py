@@ -58,7 +58,7 @@ def _model(objects) -> str:
 
 def write_3mf(path, objects, *, label: str | None = None) -> None:
     """Write bodies of different materials as one 3MF package (millimetres), atomically
-    (:func:`inertia_tool.reports.output.atomic_target`; check the target first with ``check_targets``).
+    (:func:`inertia_tool.output.atomic_target`; check the target first with ``check_targets``).
 
     Parameters
     ----------
@@ -70,7 +70,7 @@ def write_3mf(path, objects, *, label: str | None = None) -> None:
     label : str, optional
         The option that named the file, for messages (``"--out"``).
     """
-    from .output import atomic_target
+    from ..output import atomic_target
 
     cleaned = [{**o, "vertices": np.asarray(o["vertices"], dtype=float), "faces": np.asarray(o["faces"], dtype=int)}
                for o in objects]

@@ -23,7 +23,7 @@ How, in three steps:
    equals the one built in step 1; the declaration, encoding and DOCTYPE are unchanged.  Any difference is
    :class:`~inertia_tool.errors.OutputCheckError` and nothing is written.
 
-The file goes through :mod:`inertia_tool.reports.output` (unpredictable temporary file beside the target,
+The file goes through :mod:`inertia_tool.output` (unpredictable temporary file beside the target,
 fsync, atomic rename; never over an existing file, the input included, unless ``force``; never through a
 symbolic link).  For xacro input the *expanded* URDF is written, indented two spaces per level.
 """
@@ -36,7 +36,7 @@ import re
 import numpy as np
 
 from ..errors import OutputCheckError, UsageError
-from ..reports.output import check_targets, write_bytes
+from ..output import check_targets, write_bytes
 from .description import RobotDescription, parse_xml
 from .xmlspans import DocumentText, ElementSpan, XMLSpanError, decode_document, element_spans
 
@@ -486,7 +486,7 @@ def _verify(original, expected, out: bytes, robot: RobotDescription, changed: li
 
 
 def write_corrected(robot: RobotDescription, inertials, path, *, force: bool = False, note: str = "") -> tuple:
-    """Write :func:`corrected_document` to ``path`` through :mod:`inertia_tool.reports.output`; returns the
+    """Write :func:`corrected_document` to ``path`` through :mod:`inertia_tool.output`; returns the
     names of the corrected links.
 
     Parameters
@@ -511,7 +511,7 @@ def write_corrected(robot: RobotDescription, inertials, path, *, force: bool = F
     ------
     UsageError
         ``path`` is empty, exists (or is the input) and ``force`` is false, is a directory or a symbolic link,
-        or cannot be written (:class:`~inertia_tool.reports.output.OutputFileError`).
+        or cannot be written (:class:`~inertia_tool.output.OutputFileError`).
     OutputCheckError
         The corrected document failed its check; nothing was written.
     """

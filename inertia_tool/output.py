@@ -27,14 +27,9 @@ import os
 import tempfile
 from collections.abc import Iterator, Mapping, Sequence
 
-from ..errors import UsageError
+from .errors import OutputFileError, UsageError
 
 __all__ = ["OutputFileError", "check_targets", "atomic_target", "write_text", "write_bytes", "write_files"]
-
-
-class OutputFileError(UsageError):
-    """An output file cannot be written: it exists (without ``force``), is a directory, its directory is
-    missing, or the operating system refused the write."""
 
 
 def _label(path: str, label: str | None) -> str:
