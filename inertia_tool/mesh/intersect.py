@@ -164,6 +164,15 @@ class _Predicates:
 
     def orient3d(self, a, b, c, d) -> np.ndarray:
         """Sign of ``det[a − d; b − d; c − d]`` per row, (k,) int8; ``a..d`` (k, 3) float64."""
+        with np.errstate(all="ignore"):            # out of the filter's range everything is recomputed exactly
+            return self._orient3d(a, b, c, d)
+
+    def orient2d(self, a, b, c) -> np.ndarray:
+        """Sign of ``det[a − c; b − c]`` per row, (k,) int8; ``a, b, c`` (k, 2) float64."""
+        with np.errstate(all="ignore"):
+            return self._orient2d(a, b, c)
+
+    def _orient3d(self, a, b, c, d) -> np.ndarray:
         ad, bd, cd = a - d, b - d, c - d
         m0 = bd[:, 1] * cd[:, 2] - bd[:, 2] * cd[:, 1]
         m1 = bd[:, 2] * cd[:, 0] - bd[:, 0] * cd[:, 2]
@@ -181,8 +190,7 @@ class _Predicates:
         self.exact += len(unsure)
         return sign
 
-    def orient2d(self, a, b, c) -> np.ndarray:
-        """Sign of ``det[a − c; b − c]`` per row, (k,) int8; ``a, b, c`` (k, 2) float64."""
+    def _orient2d(self, a, b, c) -> np.ndarray:
         acx, acy = a[:, 0] - c[:, 0], a[:, 1] - c[:, 1]
         bcx, bcy = b[:, 0] - c[:, 0], b[:, 1] - c[:, 1]
         left, right = acx * bcy, acy * bcx
@@ -327,7 +335,7 @@ def _transversal(t1, t2, d1, d2, same, n_shared, pred: _Predicates) -> np.ndarra
     kind = np.zeros(len(t1), dtype=np.int8)
     touch1, touch2 = _touch_corner(d1), _touch_corner(d2)
     # one triangle meets the other's plane in a single corner: at most a contact there
-    for touch, s, o, dd in ((touch1, t1, t2, d1), (touch2, t2, t1, d2)):
+    for touch, s, o in ((touch1, t1, t2), (touch2, t2, t1)):
         r = np.flatnonzero((touch >= 0) & (n_shared == 0) & (kind == _NONE))
         if len(r):
             i = touch[r]
