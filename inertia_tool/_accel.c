@@ -16,6 +16,7 @@
  *   5. tetra_sums  -- signed-tetrahedron volume integrals with compensated sums (mass/volume._tetra_sums)
  *   6. bounds      -- bounding box and finiteness of the vertices in one pass (mass/volume.bounding_box)
  *   7. split_steps -- the splitting integrator's step loop (dynamics/splitting.py)
+ *   8. contact_kinds -- exact classification of face pairs (mesh/intersect.py)
  *
  * Safety: every index read from an array is bounds-checked before use, sizes are checked against
  * overflow before allocation, NaN coordinates are hashed by their bit pattern (never compared as floats),
@@ -1404,6 +1405,7 @@ accel_bounds(PyObject *self, PyObject *args)
  * ====================================================================================================== */
 
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
+static PyObject *accel_contact_kinds(PyObject *self, PyObject *args);   /* section 8, after the module */
 
 static PyMethodDef accel_methods[] = {
     {"edge_census", accel_edge_census, METH_VARARGS,
@@ -1425,6 +1427,10 @@ static PyMethodDef accel_methods[] = {
      "split_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, frame, q_proto, w_proto, "
      "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition "
      "(dynamics/splitting.py), principal frame; see section 7."},
+    {"contact_kinds", accel_contact_kinds, METH_VARARGS,
+     "contact_kinds(vertices, faces, axis, a, b, out) -> exact evaluations\n\nKind of each face pair (a[i], b[i]) "
+     "into out (k,) int8: 0 none, 1 crossing, 2 coplanar opposite, 3 contact, -1 left to the numpy path "
+     "(mesh/intersect.py); section 8."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -2090,5 +2096,469 @@ accel_split_steps(PyObject *self, PyObject *args)
 done:
     Py_XDECREF(st.q_arr);
     Py_XDECREF(st.w_arr);
+    return result;
+}
+
+/* ======================================================================================================
+ * 8. contact_kinds -- exact classification of face pairs (mesh/intersect.py, the twin of _classify)
+ *
+ * Every decision is the sign of orient3d / orient2d of input coordinates.  Each is evaluated in doubles with
+ * the static error bound of mesh/intersect.py (10 u times the permanent for orient3d, 6 u for orient2d,
+ * u = 2^-53; valid because the caller guarantees every nonzero coordinate magnitude lies in [2^-240, 2^299]);
+ * within the bound the determinant is recomputed exactly with floating-point expansions (Shewchuk 1997:
+ * Two-Sum, Two-Product by fused multiply-add, Grow-Expansion with zero elimination): the nine differences
+ * are exact two-term expansions, each of the six triple products of their parts is an exact sum of four
+ * doubles, and all of them are summed into one nonoverlapping expansion whose largest component gives the
+ * sign.  Exactness of every Two-Product holds in that coordinate range (all quantities are multiples of
+ * 2^-876, representable).  A pair whose expansion would outgrow CONTACT_EXP_MAX components gets kind -1 and
+ * the caller classifies it on the numpy path.
+ * ====================================================================================================== */
+
+#define CONTACT_EXP_MAX 192
+#define CONTACT_O3 (10.0 * 1.1102230246251565e-16)
+#define CONTACT_O2 (6.0 * 1.1102230246251565e-16)
+
+typedef struct {
+    int n;
+    int overflow;
+    double e[CONTACT_EXP_MAX];
+} Expansion;
+
+static inline void
+ct_two_sum(double a, double b, double *x, double *y)
+{
+    volatile double s = a + b;          /* volatile: no reassociation or excess precision */
+    double bv = s - a;
+    double av = s - bv;
+    *x = s;
+    *y = (a - av) + (b - bv);
+}
+
+/* Grow-Expansion with zero elimination: h += b, h nonoverlapping before and after. */
+static void
+ct_grow(Expansion *h, double b)
+{
+    if (b == 0.0) {
+        return;
+    }
+    double q = b;
+    int k = 0;
+    for (int i = 0; i < h->n; i++) {
+        double s, t;
+        ct_two_sum(q, h->e[i], &s, &t);
+        q = s;
+        if (t != 0.0) {
+            h->e[k++] = t;
+        }
+    }
+    if (q != 0.0) {
+        if (k >= CONTACT_EXP_MAX) {
+            h->overflow = 1;
+            return;
+        }
+        h->e[k++] = q;
+    }
+    h->n = k;
+}
+
+/* h += sign * p * q * r exactly (four doubles). */
+static void
+ct_add_product3(Expansion *h, double sign, double p, double q, double r)
+{
+    if (p == 0.0 || q == 0.0 || r == 0.0) {
+        return;
+    }
+    double P = p * q;
+    double e = fma(p, q, -P);
+    double A = P * r;
+    double B = fma(P, r, -A);
+    ct_grow(h, sign * A);
+    ct_grow(h, sign * B);
+    if (e != 0.0) {
+        double C = e * r;
+        double D = fma(e, r, -C);
+        ct_grow(h, sign * C);
+        ct_grow(h, sign * D);
+    }
+}
+
+static void
+ct_add_product2(Expansion *h, double sign, double p, double q)
+{
+    if (p == 0.0 || q == 0.0) {
+        return;
+    }
+    double P = p * q;
+    ct_grow(h, sign * P);
+    ct_grow(h, sign * fma(p, q, -P));
+}
+
+/* Sign of a nonoverlapping expansion (its largest component is last), 2 when it overflowed. */
+static int
+ct_sign(const Expansion *h)
+{
+    if (h->overflow) {
+        return 2;
+    }
+    if (h->n == 0) {
+        return 0;
+    }
+    return h->e[h->n - 1] > 0 ? 1 : -1;
+}
+
+typedef struct {
+    long exact;       /* evaluations decided by the exact stage */
+    int failed;       /* an expansion overflowed: the pair goes back to the numpy path */
+} CtStats;
+
+static int
+ct_orient3d(const double *a, const double *b, const double *c, const double *d, CtStats *st)
+{
+    double ad[3], bd[3], cd[3];
+    for (int k = 0; k < 3; k++) {
+        ad[k] = a[k] - d[k];
+        bd[k] = b[k] - d[k];
+        cd[k] = c[k] - d[k];
+    }
+    double m0 = bd[1] * cd[2] - bd[2] * cd[1];
+    double m1 = bd[2] * cd[0] - bd[0] * cd[2];
+    double m2 = bd[0] * cd[1] - bd[1] * cd[0];
+    double det = ad[0] * m0 + ad[1] * m1 + ad[2] * m2;
+    double perm = fabs(ad[0]) * (fabs(bd[1]) * fabs(cd[2]) + fabs(bd[2]) * fabs(cd[1]))
+                + fabs(ad[1]) * (fabs(bd[2]) * fabs(cd[0]) + fabs(bd[0]) * fabs(cd[2]))
+                + fabs(ad[2]) * (fabs(bd[0]) * fabs(cd[1]) + fabs(bd[1]) * fabs(cd[0]));
+    if (perm == 0.0) {
+        return 0;
+    }
+    if (fabs(det) > CONTACT_O3 * perm) {
+        return det > 0 ? 1 : -1;
+    }
+    /* exact: rows as two-term expansions (hi, lo) */
+    double hi[3][3], lo[3][3];
+    const double *p[3] = {a, b, c};
+    for (int r = 0; r < 3; r++) {
+        for (int k = 0; k < 3; k++) {
+            double x, y;
+            ct_two_sum(p[r][k], -d[k], &x, &y);
+            hi[r][k] = x;
+            lo[r][k] = y;
+        }
+    }
+    static const int terms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 2, 0}, {1, 0, 2}, {2, 0, 1}, {2, 1, 0}};
+    static const double signs[6] = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};
+    Expansion h;
+    h.n = 0;
+    h.overflow = 0;
+    for (int t = 0; t < 6; t++) {
+        for (int mask = 0; mask < 8; mask++) {
+            double x = (mask & 1) ? lo[0][terms[t][0]] : hi[0][terms[t][0]];
+            double y = (mask & 2) ? lo[1][terms[t][1]] : hi[1][terms[t][1]];
+            double z = (mask & 4) ? lo[2][terms[t][2]] : hi[2][terms[t][2]];
+            ct_add_product3(&h, signs[t], x, y, z);
+        }
+    }
+    st->exact++;
+    int s = ct_sign(&h);
+    if (s == 2) {
+        st->failed = 1;
+        return 0;
+    }
+    return s;
+}
+
+static int
+ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
+{
+    double acx = a[0] - c[0], acy = a[1] - c[1], bcx = b[0] - c[0], bcy = b[1] - c[1];
+    double left = acx * bcy, right = acy * bcx;
+    double det = left - right;
+    double perm = fabs(left) + fabs(right);
+    if (perm == 0.0) {
+        return 0;
+    }
+    if (fabs(det) > CONTACT_O2 * perm) {
+        return det > 0 ? 1 : -1;
+    }
+    double xh[2], xl[2], yh[2], yl[2];     /* a - c and b - c as (hi, lo) */
+    ct_two_sum(a[0], -c[0], &xh[0], &xl[0]);
+    ct_two_sum(a[1], -c[1], &xh[1], &xl[1]);
+    ct_two_sum(b[0], -c[0], &yh[0], &yl[0]);
+    ct_two_sum(b[1], -c[1], &yh[1], &yl[1]);
+    Expansion h;
+    h.n = 0;
+    h.overflow = 0;
+    for (int mask = 0; mask < 4; mask++) {
+        double p = (mask & 1) ? xl[0] : xh[0];
+        double q = (mask & 2) ? yl[1] : yh[1];
+        ct_add_product2(&h, 1.0, p, q);
+        p = (mask & 1) ? xl[1] : xh[1];
+        q = (mask & 2) ? yl[0] : yh[0];
+        ct_add_product2(&h, -1.0, p, q);
+    }
+    st->exact++;
+    int s = ct_sign(&h);
+    if (s == 2) {
+        st->failed = 1;
+        return 0;
+    }
+    return s;
+}
+
+enum { CT_NONE = 0, CT_CROSSING = 1, CT_OPPOSITE = 2, CT_CONTACT = 3 };
+
+static int
+ct_touch_corner(const int d[3])
+{
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        if (d[i] == 0 && d[j] != 0 && d[j] == d[k]) {
+            return i;
+        }
+    }
+    return -1;
+}
+
+static int
+ct_alone_corner(const int d[3])
+{
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        if (d[i] != 0 && d[j] * d[i] <= 0 && d[k] * d[i] <= 0) {
+            return i;
+        }
+    }
+    return -1;
+}
+
+/* x, on the plane of tri, lies in the closed tri; apex is off that plane. */
+static int
+ct_point_in_triangle(const double *apex, const double *x, const double *const tri[3], CtStats *st)
+{
+    int s0 = ct_orient3d(apex, x, tri[0], tri[1], st);
+    int s1 = ct_orient3d(apex, x, tri[1], tri[2], st);
+    int s2 = ct_orient3d(apex, x, tri[2], tri[0], st);
+    return (s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0);
+}
+
+static const int ct_plane[3][2] = {{1, 2}, {2, 0}, {0, 1}};
+
+static int
+ct_coplanar(const double *const t1[3], const double *const t2[3], int axis, const int on1[3], const int on2[3],
+            int n_shared, CtStats *st)
+{
+    double A[3][2], B[3][2];
+    for (int i = 0; i < 3; i++) {
+        A[i][0] = t1[i][ct_plane[axis][0]];
+        A[i][1] = t1[i][ct_plane[axis][1]];
+        B[i][0] = t2[i][ct_plane[axis][0]];
+        B[i][1] = t2[i][ct_plane[axis][1]];
+    }
+    int s1 = ct_orient2d(A[0], A[1], A[2], st);
+    int s2 = ct_orient2d(B[0], B[1], B[2], st);
+    int weak = 0, strict = 0;
+    for (int side = 0; side < 2; side++) {
+        double (*P)[2] = side ? B : A;
+        double (*Q)[2] = side ? A : B;
+        int s = side ? s2 : s1;
+        for (int e = 0; e < 3; e++) {
+            int all_le = 1, all_lt = 1;
+            for (int j = 0; j < 3; j++) {
+                int o = ct_orient2d(P[e], P[(e + 1) % 3], Q[j], st) * s;
+                all_le &= o <= 0;
+                all_lt &= o < 0;
+            }
+            weak |= all_le;
+            strict |= all_lt;
+        }
+    }
+    if (!weak) {
+        return s1 == s2 ? CT_CROSSING : CT_OPPOSITE;
+    }
+    if (strict || n_shared >= 2) {
+        return CT_NONE;
+    }
+    if (n_shared == 0) {
+        return CT_CONTACT;
+    }
+    int i1 = on1[0] ? 0 : on1[1] ? 1 : 2;
+    int i2 = on2[0] ? 0 : on2[1] ? 1 : 2;
+    const double *v = t1[i1];
+    for (int x = 1; x <= 2; x++) {
+        for (int y = 1; y <= 2; y++) {
+            const double *px = t1[(i1 + x) % 3], *py = t2[(i2 + y) % 3];
+            if (ct_orient2d(A[i1], A[(i1 + x) % 3], B[(i2 + y) % 3], st) != 0) {
+                continue;
+            }
+            int agree = 1;
+            for (int c = 0; c < 3; c++) {
+                double u = px[c] - v[c], w = py[c] - v[c];
+                agree &= ((u > 0) - (u < 0)) == ((w > 0) - (w < 0));
+            }
+            if (agree) {
+                return CT_CONTACT;
+            }
+        }
+    }
+    return CT_NONE;
+}
+
+static int
+ct_classify(const double *V, const int64_t fa[3], const int64_t fb[3], int axis, CtStats *st)
+{
+    const double *t1[3], *t2[3];
+    int on1[3] = {0, 0, 0}, on2[3] = {0, 0, 0}, n_shared = 0;
+    for (int i = 0; i < 3; i++) {
+        t1[i] = V + 3 * fa[i];
+        t2[i] = V + 3 * fb[i];
+    }
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            if (fa[i] == fb[j]) {
+                on1[i] = on2[j] = 1;
+                n_shared++;
+            }
+        }
+    }
+    int d1[3], d2[3];
+    int any1 = 0;
+    for (int i = 0; i < 3; i++) {
+        d1[i] = on1[i] ? 0 : ct_orient3d(t2[0], t2[1], t2[2], t1[i], st);
+        any1 |= d1[i] != 0;
+    }
+    if (n_shared >= 2 && any1) {
+        return CT_NONE;
+    }
+    for (int j = 0; j < 3; j++) {
+        d2[j] = on2[j] ? 0 : ct_orient3d(t1[0], t1[1], t1[2], t2[j], st);
+    }
+    if ((d1[0] > 0 && d1[1] > 0 && d1[2] > 0) || (d1[0] < 0 && d1[1] < 0 && d1[2] < 0)
+        || (d2[0] > 0 && d2[1] > 0 && d2[2] > 0) || (d2[0] < 0 && d2[1] < 0 && d2[2] < 0)) {
+        return CT_NONE;
+    }
+    if (!any1) {
+        return ct_coplanar(t1, t2, axis, on1, on2, n_shared, st);
+    }
+    if (n_shared >= 2) {
+        return CT_NONE;
+    }
+    int touch1 = ct_touch_corner(d1), touch2 = ct_touch_corner(d2);
+    if (touch1 >= 0 || touch2 >= 0) {
+        if (n_shared > 0) {
+            return CT_NONE;
+        }
+        if (touch1 >= 0 && ct_point_in_triangle(t1[(touch1 + 1) % 3], t1[touch1], t2, st)) {
+            return CT_CONTACT;
+        }
+        if (touch2 >= 0 && ct_point_in_triangle(t2[(touch2 + 1) % 3], t2[touch2], t1, st)) {
+            return CT_CONTACT;
+        }
+        return CT_NONE;
+    }
+    /* Guigue and Devillers' canonical form (see mesh/intersect._transversal) */
+    int i1 = ct_alone_corner(d1);
+    const double *p1 = t1[i1], *q1 = t1[(i1 + 1) % 3], *r1 = t1[(i1 + 2) % 3];
+    int order2[3] = {0, 1, 2};
+    if (d1[i1] < 0) {
+        order2[1] = 2;
+        order2[2] = 1;
+    }
+    const double *t2c[3];
+    int d2c[3];
+    for (int j = 0; j < 3; j++) {
+        t2c[j] = t2[order2[j]];
+        d2c[j] = d2[order2[j]];
+    }
+    int i2 = ct_alone_corner(d2c);
+    const double *p2 = t2c[i2], *q2 = t2c[(i2 + 1) % 3], *r2 = t2c[(i2 + 2) % 3];
+    if (d2c[i2] < 0) {
+        const double *tmp = q1;
+        q1 = r1;
+        r1 = tmp;
+    }
+    int low = ct_orient3d(p1, q1, p2, q2, st);
+    int high = -ct_orient3d(p1, r1, p2, r2, st);
+    int meet = low <= 0 && high <= 0;
+    int positive = low < 0 && high < 0;
+    int zeros1 = (d1[0] == 0) + (d1[1] == 0) + (d1[2] == 0);
+    int zeros2 = (d2[0] == 0) + (d2[1] == 0) + (d2[2] == 0);
+    if (positive && zeros1 < 2 && zeros2 < 2) {
+        return CT_CROSSING;
+    }
+    return (n_shared > 0 ? positive : meet) ? CT_CONTACT : CT_NONE;
+}
+
+static PyObject *
+accel_contact_kinds(PyObject *self, PyObject *args)
+{
+    PyObject *vobj, *fobj, *axobj, *aobj, *bobj, *oobj;
+    if (!PyArg_ParseTuple(args, "OOOOOO", &vobj, &fobj, &axobj, &aobj, &bobj, &oobj)) {
+        return NULL;
+    }
+    Py_buffer vv, fv, xv, av, bv, ov;
+    Py_buffer *views[6] = {&vv, &fv, &xv, &av, &bv, &ov};
+    PyObject *objs[6] = {vobj, fobj, axobj, aobj, bobj, oobj};
+    int got = 0;
+    PyObject *result = NULL;
+    for (; got < 6; got++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (got == 5 ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[got], views[got], flags) < 0) {
+            goto done;
+        }
+    }
+    char vc = native_code(vv.format), fc = native_code(fv.format), xc = native_code(xv.format);
+    char ac = native_code(av.format), bc = native_code(bv.format), oc = native_code(ov.format);
+    int is64f = (fc == 'l' || fc == 'q') && fv.itemsize == 8;
+    int is64x = (xc == 'l' || xc == 'q') && xv.itemsize == 8;
+    int is64a = (ac == 'l' || ac == 'q') && av.itemsize == 8;
+    int is64b = (bc == 'l' || bc == 'q') && bv.itemsize == 8;
+    if (vc != 'd' || vv.itemsize != 8 || vv.ndim != 2 || vv.shape[1] != 3 || !is64f || fv.ndim != 2
+        || fv.shape[1] != 3 || !is64x || xv.ndim != 1 || xv.shape[0] != fv.shape[0] || !is64a || !is64b
+        || av.ndim != 1 || bv.ndim != 1 || av.shape[0] != bv.shape[0] || (oc != 'b' && oc != 'B')
+        || ov.itemsize != 1 || ov.ndim != 1 || ov.shape[0] != av.shape[0]) {
+        PyErr_SetString(PyExc_ValueError, "Expected vertices (n, 3) float64, faces (m, 3) int64, axis (m,) int64, "
+                        "a and b (k,) int64, out (k,) int8, all C-contiguous");
+        goto done;
+    }
+    {
+        const double *V = (const double *)vv.buf;
+        const int64_t *F = (const int64_t *)fv.buf, *X = (const int64_t *)xv.buf;
+        const int64_t *A = (const int64_t *)av.buf, *B = (const int64_t *)bv.buf;
+        int8_t *out = (int8_t *)ov.buf;
+        int64_t n = vv.shape[0], m = fv.shape[0];
+        Py_ssize_t k = av.shape[0];
+        for (Py_ssize_t i = 0; i < m * 3; i++) {
+            if (F[i] < 0 || F[i] >= n) {
+                PyErr_Format(PyExc_ValueError, "Expected face indices in [0, %lld), found %lld",
+                             (long long)n, (long long)F[i]);
+                goto done;
+            }
+        }
+        for (Py_ssize_t i = 0; i < m; i++) {
+            if (X[i] < 0 || X[i] > 2) {
+                PyErr_SetString(PyExc_ValueError, "Expected axis values in 0..2");
+                goto done;
+            }
+        }
+        for (Py_ssize_t i = 0; i < k; i++) {
+            if (A[i] < 0 || A[i] >= m || B[i] < 0 || B[i] >= m) {
+                PyErr_Format(PyExc_ValueError, "Expected pair faces in [0, %lld)", (long long)m);
+                goto done;
+            }
+        }
+        long exact = 0;
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t i = 0; i < k; i++) {
+            CtStats st = {0, 0};
+            int kind = ct_classify(V, F + 3 * A[i], F + 3 * B[i], (int)X[A[i]], &st);
+            out[i] = (int8_t)(st.failed ? -1 : kind);
+            exact += st.exact;
+        }
+        Py_END_ALLOW_THREADS
+        result = PyLong_FromLong(exact);
+    }
+done:
+    for (int i = 0; i < got; i++) {
+        PyBuffer_Release(views[i]);
+    }
     return result;
 }

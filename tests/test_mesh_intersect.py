@@ -15,13 +15,26 @@ import trimesh
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import box_arrays
+from conftest import HAVE_ACCEL, box_arrays
 from intersect_reference import CONTACT, CROSSING, NONE, OPPOSITE, brute_kind
+from inertia_tool import _native
 from inertia_tool.errors import InvalidMeshError
 from inertia_tool.mesh.checks import shell_labels
 from inertia_tool.mesh.intersect import SurfaceContacts, orient2d_sign, orient3d_sign, surface_contacts
 
 MESHES = os.path.join(os.path.dirname(__file__), os.pardir, "meshes")
+
+
+@pytest.fixture(autouse=True, params=["c", "numpy"])
+def kernel(request, monkeypatch):
+    """Every test on both twins: the C kernel (section 8 of _accel.c) and the numpy reference."""
+    if request.param == "c":
+        if not HAVE_ACCEL:
+            pytest.skip("inertia_tool._accel is not built")
+        monkeypatch.delenv(_native.NO_ACCEL_ENV, raising=False)
+    else:
+        monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
+    return request.param
 
 
 def _kinds(result: SurfaceContacts) -> dict:

@@ -59,6 +59,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 import numpy as np
 
+from .._native import accel
 from ..errors import InvalidMeshError
 from ..values import frozen_value
 
@@ -416,6 +417,19 @@ def _coplanar(t1, t2, axis, same, n_shared, pred: _Predicates) -> np.ndarray:
     return kind
 
 
+def _classify_chunk(v, f, axis, axis_c, a, b, pred: _Predicates, lib) -> np.ndarray:
+    """:func:`_classify` on the C extension when it is there (pairs it leaves, kind -1, on numpy)."""
+    if lib is None:
+        return _classify(v, f, axis, a, b, pred)
+    kind = np.empty(len(a), dtype=np.int8)
+    pred.exact += lib.contact_kinds(v, f, axis_c, np.ascontiguousarray(a, dtype=np.int64),
+                                    np.ascontiguousarray(b, dtype=np.int64), kind)
+    left = np.flatnonzero(kind < 0)
+    if len(left):
+        kind[left] = _classify(v, f, axis, a[left], b[left], pred)
+    return kind
+
+
 # -- broad phase ----------------------------------------------------------------------------------------------
 
 def _cells(faces, lo, hi, origin, h, dims):
@@ -536,10 +550,14 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
         raise ValueError(f"Expected chunk >= 1, got {chunk}")
     v, safe = _scaled(v)
     pred = _Predicates(force_exact=not safe)
+    lib = accel() if safe else None
+    axis_c = None
     empty = np.zeros((0, 2), dtype=np.intp)
     if not len(f):
         return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty, complete=True)
     axis, degenerate = _face_axes(v, f, pred)
+    if lib is not None:
+        axis_c = np.ascontiguousarray(axis, dtype=np.int64)
     p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
     lo = np.minimum(np.minimum(p0, p1), p2)
     hi = np.maximum(np.maximum(p0, p1), p2)
@@ -557,7 +575,7 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
         a, b = np.minimum(a[ok], b[ok]), np.maximum(a[ok], b[ok])
         tested += len(a)
         if len(a):
-            kind = _classify(v, f, axis, a, b, pred)
+            kind = _classify_chunk(v, f, axis, axis_c, a, b, pred, lib)
             for key, out in found.items():
                 hit = kind == key
                 if hit.any():
