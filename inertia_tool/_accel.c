@@ -1428,9 +1428,11 @@ static PyMethodDef accel_methods[] = {
      "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition "
      "(dynamics/splitting.py), principal frame; see section 7."},
     {"contact_kinds", accel_contact_kinds, METH_VARARGS,
-     "contact_kinds(vertices, faces, axis, a, b, out) -> exact evaluations\n\nKind of each face pair (a[i], b[i]) "
-     "into out (k,) int8: 0 none, 1 crossing, 2 coplanar opposite, 3 contact, -1 left to the numpy path "
-     "(mesh/intersect.py); section 8."},
+     "contact_kinds(vertices, faces, axis, skip, lo, hi, origin, h, dims, a, b, cell, out) -> exact evaluations"
+     "\n\nFor each raw grid pair (a[i], b[i]) found in cell[i], into out (k,) int8: -2 not a candidate (the same "
+     "face, boxes apart, or not the pair's home cell), -3 a candidate with a skipped (zero-area) face, else its "
+     "kind: 0 none, 1 crossing, 2 coplanar opposite, 3 contact, -1 left to the numpy path (mesh/intersect.py); "
+     "section 8."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -2487,45 +2489,82 @@ ct_classify(const double *V, const int64_t fa[3], const int64_t fb[3], int axis,
     return (n_shared > 0 ? positive : meet) ? CT_CONTACT : CT_NONE;
 }
 
+/* The candidate test of mesh/intersect._keep_mask: distinct faces whose closed boxes meet, kept only in the
+ * cell holding the low corner of the boxes' intersection (the same double operations as numpy's). */
+static int
+ct_is_candidate(int64_t a, int64_t b, int64_t cell, const double *lo, const double *hi, const double origin[3],
+                double h, const int64_t dims[3])
+{
+    if (a == b) {
+        return 0;
+    }
+    int64_t c[3];
+    for (int k = 0; k < 3; k++) {
+        double la = lo[3 * a + k], lb = lo[3 * b + k];
+        if (!(la <= hi[3 * b + k]) || !(lb <= hi[3 * a + k])) {
+            return 0;
+        }
+        c[k] = (int64_t)floor(((la > lb ? la : lb) - origin[k]) / h);
+    }
+    return (c[0] * dims[1] + c[1]) * dims[2] + c[2] == cell;
+}
+
+static int
+ct_int64(const Py_buffer *view)
+{
+    char c = native_code(view->format);
+    return (c == 'l' || c == 'q') && view->itemsize == 8;
+}
+
 static PyObject *
 accel_contact_kinds(PyObject *self, PyObject *args)
 {
-    PyObject *vobj, *fobj, *axobj, *aobj, *bobj, *oobj;
-    if (!PyArg_ParseTuple(args, "OOOOOO", &vobj, &fobj, &axobj, &aobj, &bobj, &oobj)) {
+    PyObject *objs[10];
+    double origin[3], h;
+    long long dl[3];
+    if (!PyArg_ParseTuple(args, "OOOOOO(ddd)d(LLL)OOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4],
+                          &objs[5], &origin[0], &origin[1], &origin[2], &h, &dl[0], &dl[1], &dl[2], &objs[6],
+                          &objs[7], &objs[8], &objs[9])) {
         return NULL;
     }
-    Py_buffer vv, fv, xv, av, bv, ov;
-    Py_buffer *views[6] = {&vv, &fv, &xv, &av, &bv, &ov};
-    PyObject *objs[6] = {vobj, fobj, axobj, aobj, bobj, oobj};
+    const char *names = "vertices (n, 3) float64, faces (m, 3) int64, axis (m,) int64, skip (m,) uint8, lo and hi "
+                        "(m, 3) float64, a, b, cell (k,) int64, out (k,) int8, all C-contiguous";
+    Py_buffer views[10];
     int got = 0;
     PyObject *result = NULL;
-    for (; got < 6; got++) {
-        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (got == 5 ? PyBUF_WRITABLE : 0);
-        if (PyObject_GetBuffer(objs[got], views[got], flags) < 0) {
+    for (; got < 10; got++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (got == 9 ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[got], &views[got], flags) < 0) {
             goto done;
         }
     }
-    char vc = native_code(vv.format), fc = native_code(fv.format), xc = native_code(xv.format);
-    char ac = native_code(av.format), bc = native_code(bv.format), oc = native_code(ov.format);
-    int is64f = (fc == 'l' || fc == 'q') && fv.itemsize == 8;
-    int is64x = (xc == 'l' || xc == 'q') && xv.itemsize == 8;
-    int is64a = (ac == 'l' || ac == 'q') && av.itemsize == 8;
-    int is64b = (bc == 'l' || bc == 'q') && bv.itemsize == 8;
-    if (vc != 'd' || vv.itemsize != 8 || vv.ndim != 2 || vv.shape[1] != 3 || !is64f || fv.ndim != 2
-        || fv.shape[1] != 3 || !is64x || xv.ndim != 1 || xv.shape[0] != fv.shape[0] || !is64a || !is64b
-        || av.ndim != 1 || bv.ndim != 1 || av.shape[0] != bv.shape[0] || (oc != 'b' && oc != 'B')
-        || ov.itemsize != 1 || ov.ndim != 1 || ov.shape[0] != av.shape[0]) {
-        PyErr_SetString(PyExc_ValueError, "Expected vertices (n, 3) float64, faces (m, 3) int64, axis (m,) int64, "
-                        "a and b (k,) int64, out (k,) int8, all C-contiguous");
-        goto done;
-    }
     {
-        const double *V = (const double *)vv.buf;
-        const int64_t *F = (const int64_t *)fv.buf, *X = (const int64_t *)xv.buf;
-        const int64_t *A = (const int64_t *)av.buf, *B = (const int64_t *)bv.buf;
-        int8_t *out = (int8_t *)ov.buf;
-        int64_t n = vv.shape[0], m = fv.shape[0];
-        Py_ssize_t k = av.shape[0];
+        Py_buffer *vv = &views[0], *fv = &views[1], *xv = &views[2], *sv = &views[3], *lv = &views[4];
+        Py_buffer *hv = &views[5], *av = &views[6], *bv = &views[7], *cv = &views[8], *ov = &views[9];
+        char sc = native_code(sv->format), oc = native_code(ov->format);
+        Py_ssize_t m = fv->ndim == 2 ? fv->shape[0] : -1, k = av->ndim == 1 ? av->shape[0] : -1;
+        if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3
+            || !ct_int64(fv) || fv->ndim != 2 || fv->shape[1] != 3
+            || !ct_int64(xv) || xv->ndim != 1 || xv->shape[0] != m
+            || (sc != 'B' && sc != '?') || sv->itemsize != 1 || sv->ndim != 1 || sv->shape[0] != m
+            || native_code(lv->format) != 'd' || lv->itemsize != 8 || lv->ndim != 2 || lv->shape[0] != m
+            || lv->shape[1] != 3
+            || native_code(hv->format) != 'd' || hv->itemsize != 8 || hv->ndim != 2 || hv->shape[0] != m
+            || hv->shape[1] != 3
+            || !ct_int64(av) || !ct_int64(bv) || !ct_int64(cv) || av->ndim != 1 || bv->ndim != 1
+            || cv->ndim != 1 || bv->shape[0] != k || cv->shape[0] != k
+            || (oc != 'b' && oc != 'B') || ov->itemsize != 1 || ov->ndim != 1 || ov->shape[0] != k
+            || !(h > 0)) {
+            PyErr_Format(PyExc_ValueError, "Expected %s, and h > 0", names);
+            goto done;
+        }
+        const double *V = (const double *)vv->buf, *LO = (const double *)lv->buf, *HI = (const double *)hv->buf;
+        const int64_t *F = (const int64_t *)fv->buf, *X = (const int64_t *)xv->buf;
+        const uint8_t *S = (const uint8_t *)sv->buf;
+        const int64_t *A = (const int64_t *)av->buf, *B = (const int64_t *)bv->buf, *C = (const int64_t *)cv->buf;
+        int8_t *out = (int8_t *)ov->buf;
+        int64_t n = vv->shape[0];
+        int64_t dims[3] = {(int64_t)dl[0], (int64_t)dl[1], (int64_t)dl[2]};
         for (Py_ssize_t i = 0; i < m * 3; i++) {
             if (F[i] < 0 || F[i] >= n) {
                 PyErr_Format(PyExc_ValueError, "Expected face indices in [0, %lld), found %lld",
@@ -2548,8 +2587,17 @@ accel_contact_kinds(PyObject *self, PyObject *args)
         long exact = 0;
         Py_BEGIN_ALLOW_THREADS
         for (Py_ssize_t i = 0; i < k; i++) {
+            if (!ct_is_candidate(A[i], B[i], C[i], LO, HI, origin, h, dims)) {
+                out[i] = -2;
+                continue;
+            }
+            if (S[A[i]] || S[B[i]]) {
+                out[i] = -3;
+                continue;
+            }
+            int64_t fa = A[i] < B[i] ? A[i] : B[i], fb = A[i] < B[i] ? B[i] : A[i];
             CtStats st = {0, 0};
-            int kind = ct_classify(V, F + 3 * A[i], F + 3 * B[i], (int)X[A[i]], &st);
+            int kind = ct_classify(V, F + 3 * fa, F + 3 * fb, (int)X[fa], &st);
             out[i] = (int8_t)(st.failed ? -1 : kind);
             exact += st.exact;
         }
@@ -2558,7 +2606,7 @@ accel_contact_kinds(PyObject *self, PyObject *args)
     }
 done:
     for (int i = 0; i < got; i++) {
-        PyBuffer_Release(views[i]);
+        PyBuffer_Release(&views[i]);
     }
     return result;
 }

@@ -417,19 +417,6 @@ def _coplanar(t1, t2, axis, same, n_shared, pred: _Predicates) -> np.ndarray:
     return kind
 
 
-def _classify_chunk(v, f, axis, axis_c, a, b, pred: _Predicates, lib) -> np.ndarray:
-    """:func:`_classify` on the C extension when it is there (pairs it leaves, kind -1, on numpy)."""
-    if lib is None:
-        return _classify(v, f, axis, a, b, pred)
-    kind = np.empty(len(a), dtype=np.int8)
-    pred.exact += lib.contact_kinds(v, f, axis_c, np.ascontiguousarray(a, dtype=np.int64),
-                                    np.ascontiguousarray(b, dtype=np.int64), kind)
-    left = np.flatnonzero(kind < 0)
-    if len(left):
-        kind[left] = _classify(v, f, axis, a[left], b[left], pred)
-    return kind
-
-
 # -- broad phase ----------------------------------------------------------------------------------------------
 
 def _cells(faces, lo, hi, origin, h, dims):
@@ -465,12 +452,16 @@ def _chunks(per_entry: np.ndarray, chunk: int) -> Iterator[tuple[int, int]]:
         start = stop
 
 
-def _candidate_pairs(lo: np.ndarray, hi: np.ndarray, chunk: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-    """Face pairs (a, b), a ≠ b, whose closed bounding boxes meet, each once, in chunks."""
+_Raw = tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray]
+
+
+def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int) -> Iterator[_Raw]:
+    """Chunks ``(a, b, cell, h, dims)`` of face pairs sharing grid cell ``cell`` (side ``h``): a superset of the
+    pairs whose closed boxes meet, each of which appears exactly once with ``cell`` its home (see
+    :func:`_keep_mask`)."""
     m = len(lo)
     if m < 2:
         return
-    origin = lo.min(axis=0)
     size = float(np.max(hi.max(axis=0) - origin))
     d = hi - lo
     extent = np.max(d, axis=1)
@@ -491,7 +482,7 @@ def _candidate_pairs(lo: np.ndarray, hi: np.ndarray, chunk: int) -> Iterator[tup
             n = later[s0:s1]
             first = np.repeat(np.arange(s0, s1), n)
             offset = np.arange(len(first)) - np.repeat(np.cumsum(n) - n, n)
-            yield from _keep((fb[first], fb[first + 1 + offset], kb[first]), lo, hi, origin, h, dims)
+            yield fb[first], fb[first + 1 + offset], kb[first], h, dims
         # the smaller levels' faces through this level's grid
         fa, ka = _cells(np.flatnonzero(level < top), lo, hi, origin, h, dims)
         left = np.searchsorted(kb, ka, side="left")
@@ -499,16 +490,15 @@ def _candidate_pairs(lo: np.ndarray, hi: np.ndarray, chunk: int) -> Iterator[tup
         for s0, s1 in _chunks(count, chunk):
             n = count[s0:s1]
             partner = np.repeat(left[s0:s1], n) + (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n))
-            yield from _keep((np.repeat(fa[s0:s1], n), fb[partner], kb[partner]), lo, hi, origin, h, dims)
+            yield np.repeat(fa[s0:s1], n), fb[partner], kb[partner], h, dims
 
 
-def _keep(group, lo, hi, origin, h, dims) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-    a, b, cell = group
+def _keep_mask(a, b, cell, lo, hi, origin, h, dims) -> np.ndarray:
+    """Raw pairs that are candidates: distinct faces, closed boxes meeting, ``cell`` the pair's home."""
     ok = (a != b) & np.all(lo[a] <= hi[b], axis=1) & np.all(lo[b] <= hi[a], axis=1)
-    a, b, cell = a[ok], b[ok], cell[ok]
-    once = _home(a, b, lo, origin, h, dims) == cell
-    if np.any(once):
-        yield a[once], b[once]
+    r = np.flatnonzero(ok)
+    ok[r] = _home(a[r], b[r], lo, origin, h, dims) == cell[r]
+    return ok
 
 
 # -- entry point ----------------------------------------------------------------------------------------------
@@ -565,17 +555,36 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     found: dict[int, list[np.ndarray]] = {_CROSSING: [], _OPPOSITE: [], _CONTACT: []}
     candidates = tested = 0
     complete = True
-    for a, b in _candidate_pairs(lo, hi, chunk):
+    origin = lo.min(axis=0)
+    skip = degenerate.view(np.uint8)
+    for a, b, cell, h, dims in _raw_pairs(lo, hi, origin, chunk):
+        status = None
+        if lib is not None:             # the candidate test and the classification in one C pass
+            status = np.empty(len(a), dtype=np.int8)
+            pred.exact += lib.contact_kinds(v, f, axis_c, skip, lo, hi, tuple(map(float, origin)), float(h),
+                                            tuple(map(int, dims)), a, b, cell, status)
+            keep = status != -2
+            status = status[keep]
+        else:
+            keep = _keep_mask(a, b, cell, lo, hi, origin, h, dims)
+        a, b = a[keep], b[keep]
         if max_pairs is not None and candidates + len(a) > max_pairs:
             take = max(max_pairs - candidates, 0)
             a, b = a[:take], b[:take]
+            status = status[:take] if status is not None else None
             complete = False
         candidates += len(a)
         ok = ~degenerate[a] & ~degenerate[b]
         a, b = np.minimum(a[ok], b[ok]), np.maximum(a[ok], b[ok])
         tested += len(a)
         if len(a):
-            kind = _classify_chunk(v, f, axis, axis_c, a, b, pred, lib)
+            if status is None:
+                kind = _classify(v, f, axis, a, b, pred)
+            else:
+                kind = status[ok]
+                left = np.flatnonzero(kind < 0)
+                if len(left):           # an expansion too long for the C kernel: numpy decides
+                    kind[left] = _classify(v, f, axis, a[left], b[left], pred)
             for key, out in found.items():
                 hit = kind == key
                 if hit.any():
