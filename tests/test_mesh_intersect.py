@@ -385,3 +385,51 @@ def test_triangle_pair_matches_the_independent_classifier(case, swap, roll):
     assert result.degenerate_faces == 0
     got = _kinds(result).get((0, 1), NONE)
     assert got == want
+
+
+# -- the two twins against each other -----------------------------------------------------------------------
+
+def test_c_and_numpy_twins_agree_on_a_degenerate_soup(kernel, monkeypatch):
+    """400 triangles on a small integer lattice (shared corners, coplanar overlaps, touching edges): the same
+    pairs on both paths."""
+    if kernel != "c":
+        pytest.skip("compares the two paths once")
+    rng = np.random.default_rng(3)
+    v = rng.integers(0, 6, (300, 3)).astype(float)
+    f = rng.integers(0, 300, (400, 3))
+    c = surface_contacts(v, f)
+    monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
+    ref = surface_contacts(v, f)
+    assert c.candidate_pairs == ref.candidate_pairs and c.tested_pairs == ref.tested_pairs
+    for field in ("crossing", "coplanar_opposite", "contact"):
+        assert np.array_equal(getattr(c, field), getattr(ref, field)), field
+    assert len(c.crossing) and len(c.coplanar_opposite) and len(c.contact)
+
+
+@pytest.mark.parametrize("bad", ["faces", "axis", "pair", "dtype", "h"])
+def test_c_kernel_refuses_malformed_arguments(kernel, bad):
+    if kernel != "c":
+        pytest.skip("the C kernel's own argument checks")
+    lib = _native.accel()
+    v, f = _unit_cube()
+    v = np.ascontiguousarray(v)
+    f = np.ascontiguousarray(f, dtype=np.int64)
+    axis = np.zeros(len(f), dtype=np.int64)
+    skip = np.zeros(len(f), dtype=np.uint8)
+    lo, hi = np.ascontiguousarray(v[f].min(axis=1)), np.ascontiguousarray(v[f].max(axis=1))
+    a, b, cell = np.array([0, 1]), np.array([2, 3]), np.array([0, 0])
+    h = 1.0
+    if bad == "faces":
+        f = f.copy()
+        f[3, 1] = 99
+    elif bad == "axis":
+        axis[2] = 5
+    elif bad == "pair":
+        b = np.array([2, 12])
+    elif bad == "dtype":
+        a = a.astype(np.int32)
+    elif bad == "h":
+        h = float("nan")
+    with pytest.raises(ValueError, match="Expected"):
+        lib.contact_kinds(v, f, axis, skip, lo, hi, (0.0, 0.0, 0.0), h, (4, 4, 4), a, b, cell,
+                          np.empty(2, dtype=np.int8))
