@@ -46,12 +46,19 @@ so the determinant is exactly zero.
 Broad phase
 -----------
 A hierarchical uniform grid over the face bounding boxes (closed boxes: touching counts): faces are sorted
-into levels by size (level ``L`` holds boxes at most ``h·2^L`` across, ``h`` the median box size), each level
-has its own grid of cells ``h·2^L``, every face is paired with the faces of its own level that share a cell
+into levels by size (level ``L`` holds boxes at most ``h·2^L`` across, ``h`` twice the median box size),
+each level has its own grid of cells ``h·2^L``, every face is paired with the faces of its own level that share a cell
 and with the faces of larger levels through their grids; a pair is kept only in the cell holding the low
 corner of the intersection of the two boxes, so it is tested once.  Cell indices are ``floor((x − o)/h)``,
 monotone in ``x``, so two closed boxes that meet always share a cell.  Candidate pairs are generated and
 tested in chunks of at most ``chunk`` pairs, so memory stays bounded on any mesh.
+
+C extension
+-----------
+When ``inertia_tool._accel`` is built (and the coordinates are in the filter's range), the candidate test and
+the classification of each chunk run in its section 8 (``contact_kinds``): the same predicates and decisions,
+with the exact stage computed by floating-point expansions instead of Python integers.  This module's numpy
+code stays the reference and the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
 """
 
 from __future__ import annotations
@@ -465,7 +472,7 @@ def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int) -
     size = float(np.max(hi.max(axis=0) - origin))
     d = hi - lo
     extent = np.max(d, axis=1)
-    h0 = max(float(np.median(extent)), size / 4096)
+    h0 = max(2.0 * float(np.median(extent)), size / 4096)
     if not h0 > 0:                                        # every face a point at one place
         h0 = 1.0
     level = np.ceil(np.log2(np.maximum(extent, h0) / h0)).astype(np.int64)
