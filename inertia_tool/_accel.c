@@ -16,7 +16,8 @@
  *   5. tetra_sums  -- signed-tetrahedron volume integrals with compensated sums (mass/volume._tetra_sums)
  *   6. bounds      -- bounding box and finiteness of the vertices in one pass (mass/volume.bounding_box)
  *   7. split_steps -- the splitting integrator's step loop (dynamics/splitting.py)
- *   8. contact_kinds -- exact classification of face pairs (mesh/intersect.py)
+ *   8. contact_scan -- faces meeting beyond what they share: hierarchy of boxes + exact pair classification
+ *                      (mesh/intersect.py)
  *
  * Safety: every index read from an array is bounds-checked before use, sizes are checked against
  * overflow before allocation, NaN coordinates are hashed by their bit pattern (never compared as floats),
@@ -1405,7 +1406,7 @@ accel_bounds(PyObject *self, PyObject *args)
  * ====================================================================================================== */
 
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
-static PyObject *accel_contact_kinds(PyObject *self, PyObject *args);   /* section 8, after the module */
+static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
 
 static PyMethodDef accel_methods[] = {
     {"edge_census", accel_edge_census, METH_VARARGS,
@@ -1427,12 +1428,11 @@ static PyMethodDef accel_methods[] = {
      "split_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, frame, q_proto, w_proto, "
      "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition "
      "(dynamics/splitting.py), principal frame; see section 7."},
-    {"contact_kinds", accel_contact_kinds, METH_VARARGS,
-     "contact_kinds(vertices, faces, axis, skip, lo, hi, origin, h, dims, a, b, cell, out) -> exact evaluations"
-     "\n\nFor each raw grid pair (a[i], b[i]) found in cell[i], into out (k,) int8: -2 not a candidate (the same "
-     "face, boxes apart, or not the pair's home cell), -3 a candidate with a skipped (zero-area) face, else its "
-     "kind: 0 none, 1 crossing, 2 coplanar opposite, 3 contact, -1 left to the numpy path (mesh/intersect.py); "
-     "section 8."},
+    {"contact_scan", accel_contact_scan, METH_VARARGS,
+     "contact_scan(vertices, faces, axis, skip, lo, hi, max_pairs) -> (a, b, kind, candidates, tested, exact, "
+     "complete)\n\nEvery face pair whose closed boxes meet, found by a bounding-volume hierarchy and classified; "
+     "a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
+     "max_pairs < 0: no bound; section 8."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -2102,7 +2102,7 @@ done:
 }
 
 /* ======================================================================================================
- * 8. contact_kinds -- exact classification of face pairs (mesh/intersect.py, the twin of _classify)
+ * 8. contact_scan -- exact classification of face pairs (mesh/intersect.py, the twin of _classify)
  *
  * Every decision is the sign of orient3d / orient2d of input coordinates.  Each is evaluated in doubles with
  * the static error bound of mesh/intersect.py (10 u times the permanent for orient3d, 6 u for orient2d,
@@ -2113,7 +2113,8 @@ done:
  * doubles, and all of them are summed into one nonoverlapping expansion whose largest component gives the
  * sign.  Exactness of every Two-Product holds in that coordinate range (all quantities are multiples of
  * 2^-876, representable).  A pair whose expansion would outgrow CONTACT_EXP_MAX components gets kind -1 and
- * the caller classifies it on the numpy path.
+ * the caller classifies it on the numpy path.  The candidate pairs come from a bounding-volume hierarchy
+ * instead of the numpy path's grid: the same set of pairs (those whose closed boxes meet), in another order.
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
@@ -2404,15 +2405,12 @@ ct_coplanar(const double *const t1[3], const double *const t2[3], int axis, cons
     return CT_NONE;
 }
 
+/* Kind of the face pair with corner indices fa, fb and corner coordinates c1, c2 (3 x 3 doubles each). */
 static int
-ct_classify(const double *V, const int64_t fa[3], const int64_t fb[3], int axis, CtStats *st)
+ct_classify(const double *c1, const double *c2, const int64_t fa[3], const int64_t fb[3], int axis, CtStats *st)
 {
-    const double *t1[3], *t2[3];
+    const double *t1[3] = {c1, c1 + 3, c1 + 6}, *t2[3] = {c2, c2 + 3, c2 + 6};
     int on1[3] = {0, 0, 0}, on2[3] = {0, 0, 0}, n_shared = 0;
-    for (int i = 0; i < 3; i++) {
-        t1[i] = V + 3 * fa[i];
-        t2[i] = V + 3 * fb[i];
-    }
     for (int i = 0; i < 3; i++) {
         for (int j = 0; j < 3; j++) {
             if (fa[i] == fb[j]) {
@@ -2489,26 +2487,6 @@ ct_classify(const double *V, const int64_t fa[3], const int64_t fb[3], int axis,
     return (n_shared > 0 ? positive : meet) ? CT_CONTACT : CT_NONE;
 }
 
-/* The candidate test of mesh/intersect._keep_mask: distinct faces whose closed boxes meet, kept only in the
- * cell holding the low corner of the boxes' intersection (the same double operations as numpy's). */
-static int
-ct_is_candidate(int64_t a, int64_t b, int64_t cell, const double *lo, const double *hi, const double origin[3],
-                double h, const int64_t dims[3])
-{
-    if (a == b) {
-        return 0;
-    }
-    int64_t c[3];
-    for (int k = 0; k < 3; k++) {
-        double la = lo[3 * a + k], lb = lo[3 * b + k];
-        if (!(la <= hi[3 * b + k]) || !(lb <= hi[3 * a + k])) {
-            return 0;
-        }
-        c[k] = (int64_t)floor(((la > lb ? la : lb) - origin[k]) / h);
-    }
-    return (c[0] * dims[1] + c[1]) * dims[2] + c[2] == cell;
-}
-
 static int
 ct_int64(const Py_buffer *view)
 {
@@ -2516,55 +2494,315 @@ ct_int64(const Py_buffer *view)
     return (c == 'l' || c == 'q') && view->itemsize == 8;
 }
 
-static PyObject *
-accel_contact_kinds(PyObject *self, PyObject *args)
+/* ------------------------------------------------------------------------------------------------------
+ * contact_scan -- the whole check in one pass: a bounding-volume hierarchy over the face boxes (median
+ * splits of the box centres along the longest axis, leaves of at most CT_LEAF faces), traversed against
+ * itself so that every unordered pair of faces whose closed boxes meet is visited exactly once (each pair
+ * of leaves once), each such pair classified on the spot; only the pairs that meet are kept.
+ * ------------------------------------------------------------------------------------------------------ */
+
+#define CT_LEAF 4
+
+typedef struct {
+    double lo[3], hi[3];
+    int64_t start, count;       /* leaf: faces order[start .. start+count); inner: count = 0 */
+    int64_t left, right;
+} CtNode;
+
+typedef struct {
+    int64_t *a, *b;
+    int8_t *kind;
+    size_t n, cap;
+} CtFound;
+
+static int
+ct_found_push(CtFound *fd, int64_t a, int64_t b, int kind)
 {
-    PyObject *objs[10];
-    double origin[3], h;
-    long long dl[3];
-    if (!PyArg_ParseTuple(args, "OOOOOO(ddd)d(LLL)OOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4],
-                          &objs[5], &origin[0], &origin[1], &origin[2], &h, &dl[0], &dl[1], &dl[2], &objs[6],
-                          &objs[7], &objs[8], &objs[9])) {
+    if (fd->n == fd->cap) {
+        size_t cap = fd->cap ? 2 * fd->cap : 256;
+        int64_t *na = (int64_t *)realloc(fd->a, cap * sizeof(int64_t));
+        if (na == NULL) return -1;
+        fd->a = na;
+        int64_t *nb = (int64_t *)realloc(fd->b, cap * sizeof(int64_t));
+        if (nb == NULL) return -1;
+        fd->b = nb;
+        int8_t *nk = (int8_t *)realloc(fd->kind, cap);
+        if (nk == NULL) return -1;
+        fd->kind = nk;
+        fd->cap = cap;
+    }
+    fd->a[fd->n] = a;
+    fd->b[fd->n] = b;
+    fd->kind[fd->n] = (int8_t)kind;
+    fd->n++;
+    return 0;
+}
+
+/* Rearrange order[s..e) so that the element of rank k (by key) is at k, smaller before, larger after. */
+static void
+ct_select(int64_t *order, const double *key, int64_t s, int64_t e, int64_t k)
+{
+    while (e - s > 1) {
+        int64_t mid = s + (e - s) / 2;
+        double pivot = key[order[mid]];
+        int64_t i = s, j = e - 1;
+        while (i <= j) {
+            while (key[order[i]] < pivot) i++;
+            while (key[order[j]] > pivot) j--;
+            if (i <= j) {
+                int64_t t = order[i];
+                order[i] = order[j];
+                order[j] = t;
+                i++;
+                j--;
+            }
+        }
+        if (k <= j) e = j + 1;
+        else if (k >= i) s = i;
+        else return;
+    }
+}
+
+/* Builds the hierarchy; returns the node count or -1 when out of memory. */
+static int64_t
+ct_build(CtNode *nodes, int64_t *order, double *key, const double *LO, const double *HI, int64_t m)
+{
+    int64_t n_nodes = 1;
+    int64_t *stack = (int64_t *)malloc(sizeof(int64_t) * 128);
+    if (stack == NULL) return -1;
+    int top = 0;
+    nodes[0].start = 0;
+    nodes[0].count = m;
+    stack[top++] = 0;
+    while (top > 0) {
+        CtNode *nd = &nodes[stack[--top]];
+        int64_t s = nd->start, e = s + nd->count;
+        double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int c = 0; c < 3; c++) {
+            nd->lo[c] = INFINITY;
+            nd->hi[c] = -INFINITY;
+        }
+        for (int64_t i = s; i < e; i++) {
+            int64_t f = order[i];
+            for (int c = 0; c < 3; c++) {
+                double l = LO[3 * f + c], h = HI[3 * f + c], mid = 0.5 * (l + h);
+                if (l < nd->lo[c]) nd->lo[c] = l;
+                if (h > nd->hi[c]) nd->hi[c] = h;
+                if (mid < clo[c]) clo[c] = mid;
+                if (mid > chi[c]) chi[c] = mid;
+            }
+        }
+        if (e - s <= CT_LEAF) {
+            continue;                                   /* a leaf */
+        }
+        int axis = 0;
+        for (int c = 1; c < 3; c++) {
+            if (chi[c] - clo[c] > chi[axis] - clo[axis]) axis = c;
+        }
+        int64_t half = s + (e - s) / 2;
+        if (chi[axis] > clo[axis]) {
+            for (int64_t i = s; i < e; i++) {
+                int64_t f = order[i];
+                key[f] = 0.5 * (LO[3 * f + axis] + HI[3 * f + axis]);
+            }
+            ct_select(order, key, s, e, half);
+        }                                               /* all centres equal: split by position */
+        int64_t l = n_nodes++, r = n_nodes++;
+        nodes[l].start = s;
+        nodes[l].count = half - s;
+        nodes[r].start = half;
+        nodes[r].count = e - half;
+        nd->left = l;
+        nd->right = r;
+        nd->count = 0;
+        nd->start = -1;
+        if (top + 2 > 128) {                            /* depth ~ log2(m / CT_LEAF) < 64: cannot happen */
+            free(stack);
+            return -1;
+        }
+        stack[top++] = l;
+        stack[top++] = r;
+    }
+    free(stack);
+    return n_nodes;
+}
+
+typedef struct {
+    const double *LO, *HI;      /* boxes, in hierarchy order */
+    const double *T;            /* corner coordinates (9 per face), in hierarchy order */
+    const int64_t *FO;          /* corner indices (3 per face), in hierarchy order */
+    const int64_t *X;
+    const uint8_t *S;
+    const CtNode *nodes;
+    const int64_t *order;       /* hierarchy position -> face */
+    long long max_pairs;        /* < 0: no bound */
+    long long candidates, tested;
+    long exact;
+    int complete, oom;
+    CtFound found;
+} CtScan;
+
+static inline int
+ct_boxes_meet(const double *LO, const double *HI, int64_t a, int64_t b)
+{
+    for (int c = 0; c < 3; c++) {
+        if (!(LO[3 * a + c] <= HI[3 * b + c]) || !(LO[3 * b + c] <= HI[3 * a + c])) return 0;
+    }
+    return 1;
+}
+
+/* One candidate pair (hierarchy positions i, j); returns 0 to go on, 1 to stop (bound reached or out of
+ * memory). */
+static int
+ct_visit(CtScan *sc, int64_t i, int64_t j)
+{
+    if (!ct_boxes_meet(sc->LO, sc->HI, i, j)) return 0;
+    if (sc->max_pairs >= 0 && sc->candidates >= sc->max_pairs) {
+        sc->complete = 0;
+        return 1;
+    }
+    sc->candidates++;
+    int64_t a = sc->order[i], b = sc->order[j];
+    if (sc->S[a] || sc->S[b]) return 0;
+    sc->tested++;
+    if (a > b) {
+        int64_t t = a;
+        a = b;
+        b = t;
+        t = i;
+        i = j;
+        j = t;
+    }
+    CtStats st = {0, 0};
+    int kind = ct_classify(sc->T + 9 * i, sc->T + 9 * j, sc->FO + 3 * i, sc->FO + 3 * j, (int)sc->X[a], &st);
+    sc->exact += st.exact;
+    if (st.failed) kind = -1;
+    if (kind != CT_NONE && ct_found_push(&sc->found, a, b, kind) < 0) {
+        sc->oom = 1;
+        return 1;
+    }
+    return 0;
+}
+
+static inline int
+ct_nodes_meet(const CtNode *p, const CtNode *q)
+{
+    for (int c = 0; c < 3; c++) {
+        if (!(p->lo[c] <= q->hi[c]) || !(q->lo[c] <= p->hi[c])) return 0;
+    }
+    return 1;
+}
+
+static void
+ct_traverse(CtScan *sc)
+{
+    size_t cap = 1024, top = 0;
+    int64_t *stack = (int64_t *)malloc(2 * cap * sizeof(int64_t));
+    if (stack == NULL) {
+        sc->oom = 1;
+        return;
+    }
+    stack[0] = 0;
+    stack[1] = 0;
+    top = 1;
+    while (top > 0) {
+        top--;
+        const CtNode *p = &sc->nodes[stack[2 * top]], *q = &sc->nodes[stack[2 * top + 1]];
+        int64_t pi = stack[2 * top], qi = stack[2 * top + 1];
+        if (top + 3 > cap) {
+            int64_t *ns = (int64_t *)realloc(stack, 4 * cap * sizeof(int64_t));
+            if (ns == NULL) {
+                sc->oom = 1;
+                break;
+            }
+            stack = ns;
+            cap *= 2;
+        }
+        if (pi == qi) {
+            if (p->count > 0) {
+                for (int64_t i = p->start; i < p->start + p->count; i++) {
+                    for (int64_t j = i + 1; j < p->start + p->count; j++) {
+                        if (ct_visit(sc, i, j)) goto out;
+                    }
+                }
+            }
+            else {
+                int64_t pushes[3][2] = {{p->left, p->left}, {p->right, p->right}, {p->left, p->right}};
+                for (int k = 0; k < 3; k++) {
+                    stack[2 * top] = pushes[k][0];
+                    stack[2 * top + 1] = pushes[k][1];
+                    top++;
+                }
+            }
+            continue;
+        }
+        if (!ct_nodes_meet(p, q)) continue;
+        if (p->count > 0 && q->count > 0) {
+            for (int64_t i = p->start; i < p->start + p->count; i++) {
+                for (int64_t j = q->start; j < q->start + q->count; j++) {
+                    if (ct_visit(sc, i, j)) goto out;
+                }
+            }
+            continue;
+        }
+        /* descend the inner node (the larger one when both are inner) */
+        int split_p = q->count > 0 || (p->count == 0 && (p->hi[0] - p->lo[0]) + (p->hi[1] - p->lo[1])
+                                        + (p->hi[2] - p->lo[2]) >= (q->hi[0] - q->lo[0])
+                                        + (q->hi[1] - q->lo[1]) + (q->hi[2] - q->lo[2]));
+        if (split_p) {
+            stack[2 * top] = p->left;  stack[2 * top + 1] = qi; top++;
+            stack[2 * top] = p->right; stack[2 * top + 1] = qi; top++;
+        }
+        else {
+            stack[2 * top] = pi; stack[2 * top + 1] = q->left;  top++;
+            stack[2 * top] = pi; stack[2 * top + 1] = q->right; top++;
+        }
+    }
+out:
+    free(stack);
+}
+
+static PyObject *
+accel_contact_scan(PyObject *self, PyObject *args)
+{
+    PyObject *objs[6];
+    long long max_pairs;
+    if (!PyArg_ParseTuple(args, "OOOOOOL", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5],
+                          &max_pairs)) {
         return NULL;
     }
-    const char *names = "vertices (n, 3) float64, faces (m, 3) int64, axis (m,) int64, skip (m,) uint8, lo and hi "
-                        "(m, 3) float64, a, b, cell (k,) int64, out (k,) int8, all C-contiguous";
-    Py_buffer views[10];
+    Py_buffer views[6];
     int got = 0;
     PyObject *result = NULL;
-    for (; got < 10; got++) {
-        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (got == 9 ? PyBUF_WRITABLE : 0);
-        if (PyObject_GetBuffer(objs[got], &views[got], flags) < 0) {
+    CtNode *nodes = NULL;
+    int64_t *order = NULL, *fo = NULL;
+    double *key = NULL, *tri = NULL, *blo = NULL, *bhi = NULL;
+    CtScan sc;
+    memset(&sc, 0, sizeof(sc));
+    for (; got < 6; got++) {
+        if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
             goto done;
         }
     }
     {
         Py_buffer *vv = &views[0], *fv = &views[1], *xv = &views[2], *sv = &views[3], *lv = &views[4];
-        Py_buffer *hv = &views[5], *av = &views[6], *bv = &views[7], *cv = &views[8], *ov = &views[9];
-        char sc = native_code(sv->format), oc = native_code(ov->format);
-        Py_ssize_t m = fv->ndim == 2 ? fv->shape[0] : -1, k = av->ndim == 1 ? av->shape[0] : -1;
+        Py_buffer *hv = &views[5];
+        char sc_code = native_code(sv->format);
+        Py_ssize_t m = fv->ndim == 2 ? fv->shape[0] : -1;
         if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3
             || !ct_int64(fv) || fv->ndim != 2 || fv->shape[1] != 3
             || !ct_int64(xv) || xv->ndim != 1 || xv->shape[0] != m
-            || (sc != 'B' && sc != '?') || sv->itemsize != 1 || sv->ndim != 1 || sv->shape[0] != m
+            || (sc_code != 'B' && sc_code != '?') || sv->itemsize != 1 || sv->ndim != 1 || sv->shape[0] != m
             || native_code(lv->format) != 'd' || lv->itemsize != 8 || lv->ndim != 2 || lv->shape[0] != m
             || lv->shape[1] != 3
             || native_code(hv->format) != 'd' || hv->itemsize != 8 || hv->ndim != 2 || hv->shape[0] != m
-            || hv->shape[1] != 3
-            || !ct_int64(av) || !ct_int64(bv) || !ct_int64(cv) || av->ndim != 1 || bv->ndim != 1
-            || cv->ndim != 1 || bv->shape[0] != k || cv->shape[0] != k
-            || (oc != 'b' && oc != 'B') || ov->itemsize != 1 || ov->ndim != 1 || ov->shape[0] != k
-            || !(h > 0)) {
-            PyErr_Format(PyExc_ValueError, "Expected %s, and h > 0", names);
+            || hv->shape[1] != 3) {
+            PyErr_SetString(PyExc_ValueError, "Expected vertices (n, 3) float64, faces (m, 3) int64, axis (m,) "
+                            "int64, skip (m,) uint8, lo and hi (m, 3) float64, all C-contiguous");
             goto done;
         }
-        const double *V = (const double *)vv->buf, *LO = (const double *)lv->buf, *HI = (const double *)hv->buf;
-        const int64_t *F = (const int64_t *)fv->buf, *X = (const int64_t *)xv->buf;
-        const uint8_t *S = (const uint8_t *)sv->buf;
-        const int64_t *A = (const int64_t *)av->buf, *B = (const int64_t *)bv->buf, *C = (const int64_t *)cv->buf;
-        int8_t *out = (int8_t *)ov->buf;
         int64_t n = vv->shape[0];
-        int64_t dims[3] = {(int64_t)dl[0], (int64_t)dl[1], (int64_t)dl[2]};
+        const int64_t *F = (const int64_t *)fv->buf, *X = (const int64_t *)xv->buf;
         for (Py_ssize_t i = 0; i < m * 3; i++) {
             if (F[i] < 0 || F[i] >= n) {
                 PyErr_Format(PyExc_ValueError, "Expected face indices in [0, %lld), found %lld",
@@ -2578,35 +2816,84 @@ accel_contact_kinds(PyObject *self, PyObject *args)
                 goto done;
             }
         }
-        for (Py_ssize_t i = 0; i < k; i++) {
-            if (A[i] < 0 || A[i] >= m || B[i] < 0 || B[i] >= m) {
-                PyErr_Format(PyExc_ValueError, "Expected pair faces in [0, %lld)", (long long)m);
+        sc.complete = 1;
+        sc.max_pairs = max_pairs;
+        if (m >= 2) {
+            if ((size_t)m > SIZE_MAX / (2 * sizeof(CtNode))) {
+                PyErr_NoMemory();
+                goto done;
+            }
+            nodes = (CtNode *)malloc((size_t)(2 * m) * sizeof(CtNode));
+            order = (int64_t *)malloc((size_t)m * sizeof(int64_t));
+            key = (double *)malloc((size_t)m * sizeof(double));
+            fo = (int64_t *)malloc((size_t)m * 3 * sizeof(int64_t));
+            tri = (double *)malloc((size_t)m * 9 * sizeof(double));
+            blo = (double *)malloc((size_t)m * 3 * sizeof(double));
+            bhi = (double *)malloc((size_t)m * 3 * sizeof(double));
+            if (nodes == NULL || order == NULL || key == NULL || fo == NULL || tri == NULL || blo == NULL
+                || bhi == NULL) {
+                PyErr_NoMemory();
+                goto done;
+            }
+            for (int64_t i = 0; i < m; i++) order[i] = i;
+            const double *V = (const double *)vv->buf, *LO = (const double *)lv->buf;
+            const double *HI = (const double *)hv->buf;
+            sc.X = X;
+            sc.S = (const uint8_t *)sv->buf;
+            sc.order = order;
+            sc.nodes = nodes;
+            sc.LO = blo;
+            sc.HI = bhi;
+            sc.T = tri;
+            sc.FO = fo;
+            int64_t built;
+            Py_BEGIN_ALLOW_THREADS
+            built = ct_build(nodes, order, key, LO, HI, m);
+            if (built > 0) {
+                /* the data the traversal reads, in hierarchy order: neighbours in space are near in memory */
+                for (int64_t i = 0; i < m; i++) {
+                    int64_t face = order[i];
+                    for (int c = 0; c < 3; c++) {
+                        blo[3 * i + c] = LO[3 * face + c];
+                        bhi[3 * i + c] = HI[3 * face + c];
+                        fo[3 * i + c] = F[3 * face + c];
+                        for (int k = 0; k < 3; k++) {
+                            tri[9 * i + 3 * c + k] = V[3 * F[3 * face + c] + k];
+                        }
+                    }
+                }
+                ct_traverse(&sc);
+            }
+            Py_END_ALLOW_THREADS
+            if (built < 0 || sc.oom) {
+                PyErr_NoMemory();
                 goto done;
             }
         }
-        long exact = 0;
-        Py_BEGIN_ALLOW_THREADS
-        for (Py_ssize_t i = 0; i < k; i++) {
-            if (!ct_is_candidate(A[i], B[i], C[i], LO, HI, origin, h, dims)) {
-                out[i] = -2;
-                continue;
-            }
-            if (S[A[i]] || S[B[i]]) {
-                out[i] = -3;
-                continue;
-            }
-            int64_t fa = A[i] < B[i] ? A[i] : B[i], fb = A[i] < B[i] ? B[i] : A[i];
-            CtStats st = {0, 0};
-            int kind = ct_classify(V, F + 3 * fa, F + 3 * fb, (int)X[fa], &st);
-            out[i] = (int8_t)(st.failed ? -1 : kind);
-            exact += st.exact;
+        PyObject *pa = PyBytes_FromStringAndSize((const char *)sc.found.a, (Py_ssize_t)(sc.found.n * 8));
+        PyObject *pb = PyBytes_FromStringAndSize((const char *)sc.found.b, (Py_ssize_t)(sc.found.n * 8));
+        PyObject *pk = PyBytes_FromStringAndSize((const char *)sc.found.kind, (Py_ssize_t)sc.found.n);
+        if (pa && pb && pk) {
+            result = Py_BuildValue("(OOOLLlO)", pa, pb, pk, sc.candidates, sc.tested, sc.exact,
+                                   sc.complete ? Py_True : Py_False);
         }
-        Py_END_ALLOW_THREADS
-        result = PyLong_FromLong(exact);
+        Py_XDECREF(pa);
+        Py_XDECREF(pb);
+        Py_XDECREF(pk);
     }
 done:
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
     }
+    free(nodes);
+    free(order);
+    free(key);
+    free(fo);
+    free(tri);
+    free(blo);
+    free(bhi);
+    free(sc.found.a);
+    free(sc.found.b);
+    free(sc.found.kind);
     return result;
 }

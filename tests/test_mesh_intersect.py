@@ -406,7 +406,7 @@ def test_c_and_numpy_twins_agree_on_a_degenerate_soup(kernel, monkeypatch):
     assert len(c.crossing) and len(c.coplanar_opposite) and len(c.contact)
 
 
-@pytest.mark.parametrize("bad", ["faces", "axis", "pair", "dtype", "h"])
+@pytest.mark.parametrize("bad", ["faces", "axis", "skip", "dtype", "shape"])
 def test_c_kernel_refuses_malformed_arguments(kernel, bad):
     if kernel != "c":
         pytest.skip("the C kernel's own argument checks")
@@ -417,19 +417,16 @@ def test_c_kernel_refuses_malformed_arguments(kernel, bad):
     axis = np.zeros(len(f), dtype=np.int64)
     skip = np.zeros(len(f), dtype=np.uint8)
     lo, hi = np.ascontiguousarray(v[f].min(axis=1)), np.ascontiguousarray(v[f].max(axis=1))
-    a, b, cell = np.array([0, 1]), np.array([2, 3]), np.array([0, 0])
-    h = 1.0
     if bad == "faces":
         f = f.copy()
         f[3, 1] = 99
     elif bad == "axis":
         axis[2] = 5
-    elif bad == "pair":
-        b = np.array([2, 12])
+    elif bad == "skip":
+        skip = np.zeros(len(f) - 1, dtype=np.uint8)
     elif bad == "dtype":
-        a = a.astype(np.int32)
-    elif bad == "h":
-        h = float("nan")
+        f = f.astype(np.int32)
+    elif bad == "shape":
+        lo = np.ascontiguousarray(lo[:, :2])
     with pytest.raises(ValueError, match="Expected"):
-        lib.contact_kinds(v, f, axis, skip, lo, hi, (0.0, 0.0, 0.0), h, (4, 4, 4), a, b, cell,
-                          np.empty(2, dtype=np.int8))
+        lib.contact_scan(v, f, axis, skip, lo, hi, -1)

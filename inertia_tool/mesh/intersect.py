@@ -508,6 +508,55 @@ def _keep_mask(a, b, cell, lo, hi, origin, h, dims) -> np.ndarray:
     return ok
 
 
+_Scan = tuple[np.ndarray, np.ndarray, np.ndarray, int, int, bool]
+
+
+def _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk, pred: _Predicates) -> _Scan:
+    """Pairs that meet (a, b, kind), candidate and tested counts, completeness: the grid and numpy twin."""
+    found_a, found_b, found_k = [], [], []
+    candidates = tested = 0
+    complete = True
+    origin = lo.min(axis=0)
+    for a, b, cell, h, dims in _raw_pairs(lo, hi, origin, chunk):
+        keep = _keep_mask(a, b, cell, lo, hi, origin, h, dims)
+        a, b = a[keep], b[keep]
+        if max_pairs is not None and candidates + len(a) > max_pairs:
+            take = max(max_pairs - candidates, 0)
+            a, b = a[:take], b[:take]
+            complete = False
+        candidates += len(a)
+        ok = ~degenerate[a] & ~degenerate[b]
+        a, b = np.minimum(a[ok], b[ok]), np.maximum(a[ok], b[ok])
+        tested += len(a)
+        if len(a):
+            kind = _classify(v, f, axis, a, b, pred)
+            hit = kind != _NONE
+            found_a.append(a[hit])
+            found_b.append(b[hit])
+            found_k.append(kind[hit])
+        if not complete:
+            break
+    if not found_a:
+        e = np.zeros(0, dtype=np.int64)
+        return e, e, np.zeros(0, dtype=np.int8), candidates, tested, complete
+    return np.concatenate(found_a), np.concatenate(found_b), np.concatenate(found_k), candidates, tested, complete
+
+
+def _scan_c(lib, v, f, axis, degenerate, lo, hi, max_pairs, pred: _Predicates) -> _Scan:
+    """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy)."""
+    raw_a, raw_b, raw_kind, candidates, tested, exact, complete = lib.contact_scan(
+        v, f, np.ascontiguousarray(axis, dtype=np.int64), degenerate.view(np.uint8), lo, hi,
+        -1 if max_pairs is None else int(max_pairs))
+    pred.exact += exact
+    a = np.frombuffer(raw_a, dtype=np.int64)
+    b = np.frombuffer(raw_b, dtype=np.int64)
+    kind = np.frombuffer(raw_kind, dtype=np.int8).copy()
+    left = np.flatnonzero(kind < 0)
+    if len(left):                       # an expansion too long for the C kernel
+        kind[left] = _classify(v, f, axis, a[left], b[left], pred)
+    return a, b, kind, int(candidates), int(tested), bool(complete)
+
+
 # -- entry point ----------------------------------------------------------------------------------------------
 
 def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int | None = None,
@@ -548,61 +597,23 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     v, safe = _scaled(v)
     pred = _Predicates(force_exact=not safe)
     lib = accel() if safe else None
-    axis_c = None
     empty = np.zeros((0, 2), dtype=np.intp)
     if not len(f):
         return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty, complete=True)
     axis, degenerate = _face_axes(v, f, pred)
-    if lib is not None:
-        axis_c = np.ascontiguousarray(axis, dtype=np.int64)
     p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
     lo = np.minimum(np.minimum(p0, p1), p2)
     hi = np.maximum(np.maximum(p0, p1), p2)
     del p0, p1, p2
-    found: dict[int, list[np.ndarray]] = {_CROSSING: [], _OPPOSITE: [], _CONTACT: []}
-    candidates = tested = 0
-    complete = True
-    origin = lo.min(axis=0)
-    skip = degenerate.view(np.uint8)
-    for a, b, cell, h, dims in _raw_pairs(lo, hi, origin, chunk):
-        status = None
-        if lib is not None:             # the candidate test and the classification in one C pass
-            status = np.empty(len(a), dtype=np.int8)
-            pred.exact += lib.contact_kinds(v, f, axis_c, skip, lo, hi, tuple(map(float, origin)), float(h),
-                                            tuple(map(int, dims)), a, b, cell, status)
-            keep = status != -2
-            status = status[keep]
-        else:
-            keep = _keep_mask(a, b, cell, lo, hi, origin, h, dims)
-        a, b = a[keep], b[keep]
-        if max_pairs is not None and candidates + len(a) > max_pairs:
-            take = max(max_pairs - candidates, 0)
-            a, b = a[:take], b[:take]
-            status = status[:take] if status is not None else None
-            complete = False
-        candidates += len(a)
-        ok = ~degenerate[a] & ~degenerate[b]
-        a, b = np.minimum(a[ok], b[ok]), np.maximum(a[ok], b[ok])
-        tested += len(a)
-        if len(a):
-            if status is None:
-                kind = _classify(v, f, axis, a, b, pred)
-            else:
-                kind = status[ok]
-                left = np.flatnonzero(kind < 0)
-                if len(left):           # an expansion too long for the C kernel: numpy decides
-                    kind[left] = _classify(v, f, axis, a[left], b[left], pred)
-            for key, out in found.items():
-                hit = kind == key
-                if hit.any():
-                    out.append(np.stack([a[hit], b[hit]], axis=1))
-        if not complete:
-            break
+    if lib is not None:
+        a, b, kind, candidates, tested, complete = _scan_c(lib, v, f, axis, degenerate, lo, hi, max_pairs, pred)
+    else:
+        a, b, kind, candidates, tested, complete = _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk,
+                                                               pred)
 
     def pairs(key: int) -> np.ndarray:
-        if not found[key]:
-            return empty
-        p = np.concatenate(found[key]).astype(np.intp)
+        hit = kind == key
+        p = np.stack([a[hit], b[hit]], axis=1).astype(np.intp)
         return p[np.lexsort((p[:, 1], p[:, 0]))]
 
     return SurfaceContacts(crossing=pairs(_CROSSING), coplanar_opposite=pairs(_OPPOSITE), contact=pairs(_CONTACT),
