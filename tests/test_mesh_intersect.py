@@ -430,3 +430,29 @@ def test_c_kernel_refuses_malformed_arguments(kernel, bad):
         lo = np.ascontiguousarray(lo[:, :2])
     with pytest.raises(ValueError, match="Expected"):
         lib.contact_scan(v, f, axis, skip, lo, hi, -1)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(2, 300), st.integers(0, 2**32 - 1), st.sampled_from([0.05, 0.3, 3.0]))
+def test_broad_phase_finds_every_pair_of_meeting_boxes(n_faces, seed, spread):
+    """The candidate count equals the brute-force count of face pairs whose closed boxes meet (faces of mixed
+    sizes, some sharing corners, some identical), and every pair of a soup on a small lattice is classified as
+    the all-pairs reference says."""
+    rng = np.random.default_rng(seed)
+    v = np.round(rng.normal(size=(n_faces, 3)) * 4) / 4
+    f = rng.integers(0, n_faces, (n_faces, 3))
+    f[: n_faces // 10] = f[n_faces // 10: 2 * (n_faces // 10)]           # duplicated faces
+    v = v * np.where(rng.random((n_faces, 1)) < 0.1, 1.0, spread)         # a few large faces among small ones
+    result = surface_contacts(v, f)
+    lo, hi = v[f].min(axis=1), v[f].max(axis=1)
+    meet = np.all(lo[:, None] <= hi[None], axis=2) & np.all(lo[None] <= hi[:, None], axis=2)
+    assert result.candidate_pairs == int(np.count_nonzero(np.triu(meet, 1)))
+    if n_faces <= 60:
+        got = _kinds(result)
+        for i in range(n_faces):
+            for j in range(i + 1, n_faces):
+                if not meet[i, j]:
+                    continue
+                shared = [(p, q) for p in range(3) for q in range(3) if f[i, p] == f[j, q]]
+                want = brute_kind(v[f[i]], v[f[j]], shared)
+                assert got.get((i, j), NONE) == (NONE if want is None else want), (i, j)
