@@ -2495,8 +2495,8 @@ ct_int64(const Py_buffer *view)
 }
 
 /* ------------------------------------------------------------------------------------------------------
- * contact_scan -- the whole check in one pass: a bounding-volume hierarchy over the face boxes (median
- * splits of the box centres along the longest axis, leaves of at most CT_LEAF faces), traversed against
+ * contact_scan -- the whole check in one pass: a bounding-volume hierarchy over the face boxes (faces in
+ * Morton order of their box centres, index ranges halved down to leaves of at most CT_LEAF faces), traversed against
  * itself so that every unordered pair of faces whose closed boxes meet is visited exactly once (each pair
  * of leaves once), each such pair classified on the spot; only the pairs that meet are kept.
  * ------------------------------------------------------------------------------------------------------ */
@@ -2538,75 +2538,73 @@ ct_found_push(CtFound *fd, int64_t a, int64_t b, int kind)
     return 0;
 }
 
-/* Rearrange order[s..e) so that the element of rank k (by key) is at k, smaller before, larger after. */
-static void
-ct_select(int64_t *order, const double *key, int64_t s, int64_t e, int64_t k)
+typedef struct {
+    uint64_t code;
+    int64_t face;
+} CtKey;
+
+static int
+ct_key_cmp(const void *x, const void *y)
 {
-    while (e - s > 1) {
-        int64_t mid = s + (e - s) / 2;
-        double pivot = key[order[mid]];
-        int64_t i = s, j = e - 1;
-        while (i <= j) {
-            while (key[order[i]] < pivot) i++;
-            while (key[order[j]] > pivot) j--;
-            if (i <= j) {
-                int64_t t = order[i];
-                order[i] = order[j];
-                order[j] = t;
-                i++;
-                j--;
-            }
-        }
-        if (k <= j) e = j + 1;
-        else if (k >= i) s = i;
-        else return;
-    }
+    const CtKey *p = (const CtKey *)x, *q = (const CtKey *)y;
+    if (p->code != q->code) return p->code < q->code ? -1 : 1;
+    return (p->face > q->face) - (p->face < q->face);
 }
 
-/* Builds the hierarchy; returns the node count or -1 when out of memory. */
-static int64_t
-ct_build(CtNode *nodes, int64_t *order, double *key, const double *LO, const double *HI, int64_t m)
+/* 21 bits of v spread to every third bit. */
+static inline uint64_t
+ct_spread(uint64_t v)
 {
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+}
+
+/* Builds the hierarchy: faces sorted along the Morton (Z-order) curve of their box centres, the tree halving
+ * index ranges (leaves of at most CT_LEAF faces), node boxes from the leaves up.  Fills order (hierarchy
+ * position -> face); returns the node count, or -1 when out of memory. */
+static int64_t
+ct_build(CtNode *nodes, int64_t *order, const double *LO, const double *HI, int64_t m)
+{
+    CtKey *keys = (CtKey *)malloc((size_t)m * sizeof(CtKey));
+    if (keys == NULL) return -1;
+    double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int64_t f = 0; f < m; f++) {
+        for (int c = 0; c < 3; c++) {
+            double mid = 0.5 * (LO[3 * f + c] + HI[3 * f + c]);
+            if (mid < gmin[c]) gmin[c] = mid;
+            if (mid > gmax[c]) gmax[c] = mid;
+        }
+    }
+    for (int64_t f = 0; f < m; f++) {
+        uint64_t code = 0;
+        for (int c = 0; c < 3; c++) {
+            double span = gmax[c] - gmin[c];
+            double t = span > 0 ? (0.5 * (LO[3 * f + c] + HI[3 * f + c]) - gmin[c]) / span : 0.0;
+            uint64_t q = (uint64_t)(t * 2097151.0);
+            if (q > 2097151) q = 2097151;
+            code |= ct_spread(q) << c;
+        }
+        keys[f].code = code;
+        keys[f].face = f;
+    }
+    qsort(keys, (size_t)m, sizeof(CtKey), ct_key_cmp);
+    for (int64_t i = 0; i < m; i++) order[i] = keys[i].face;
+    free(keys);
+    /* topology: a parent always precedes its children */
     int64_t n_nodes = 1;
-    int64_t *stack = (int64_t *)malloc(sizeof(int64_t) * 128);
-    if (stack == NULL) return -1;
-    int top = 0;
     nodes[0].start = 0;
     nodes[0].count = m;
-    stack[top++] = 0;
-    while (top > 0) {
-        CtNode *nd = &nodes[stack[--top]];
-        int64_t s = nd->start, e = s + nd->count;
-        double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (int c = 0; c < 3; c++) {
-            nd->lo[c] = INFINITY;
-            nd->hi[c] = -INFINITY;
+    for (int64_t k = 0; k < n_nodes; k++) {
+        CtNode *nd = &nodes[k];
+        if (nd->count <= CT_LEAF) {
+            continue;
         }
-        for (int64_t i = s; i < e; i++) {
-            int64_t f = order[i];
-            for (int c = 0; c < 3; c++) {
-                double l = LO[3 * f + c], h = HI[3 * f + c], mid = 0.5 * (l + h);
-                if (l < nd->lo[c]) nd->lo[c] = l;
-                if (h > nd->hi[c]) nd->hi[c] = h;
-                if (mid < clo[c]) clo[c] = mid;
-                if (mid > chi[c]) chi[c] = mid;
-            }
-        }
-        if (e - s <= CT_LEAF) {
-            continue;                                   /* a leaf */
-        }
-        int axis = 0;
-        for (int c = 1; c < 3; c++) {
-            if (chi[c] - clo[c] > chi[axis] - clo[axis]) axis = c;
-        }
-        int64_t half = s + (e - s) / 2;
-        if (chi[axis] > clo[axis]) {
-            for (int64_t i = s; i < e; i++) {
-                int64_t f = order[i];
-                key[f] = 0.5 * (LO[3 * f + axis] + HI[3 * f + axis]);
-            }
-            ct_select(order, key, s, e, half);
-        }                                               /* all centres equal: split by position */
+        int64_t s = nd->start, e = s + nd->count, half = s + (e - s) / 2;
         int64_t l = n_nodes++, r = n_nodes++;
         nodes[l].start = s;
         nodes[l].count = half - s;
@@ -2615,15 +2613,31 @@ ct_build(CtNode *nodes, int64_t *order, double *key, const double *LO, const dou
         nd->left = l;
         nd->right = r;
         nd->count = 0;
-        nd->start = -1;
-        if (top + 2 > 128) {                            /* depth ~ log2(m / CT_LEAF) < 64: cannot happen */
-            free(stack);
-            return -1;
-        }
-        stack[top++] = l;
-        stack[top++] = r;
     }
-    free(stack);
+    /* boxes, children before parents */
+    for (int64_t k = n_nodes - 1; k >= 0; k--) {
+        CtNode *nd = &nodes[k];
+        for (int c = 0; c < 3; c++) {
+            nd->lo[c] = INFINITY;
+            nd->hi[c] = -INFINITY;
+        }
+        if (nd->count > 0) {
+            for (int64_t i = nd->start; i < nd->start + nd->count; i++) {
+                int64_t f = order[i];
+                for (int c = 0; c < 3; c++) {
+                    if (LO[3 * f + c] < nd->lo[c]) nd->lo[c] = LO[3 * f + c];
+                    if (HI[3 * f + c] > nd->hi[c]) nd->hi[c] = HI[3 * f + c];
+                }
+            }
+        }
+        else {
+            const CtNode *p = &nodes[nd->left], *q = &nodes[nd->right];
+            for (int c = 0; c < 3; c++) {
+                nd->lo[c] = p->lo[c] < q->lo[c] ? p->lo[c] : q->lo[c];
+                nd->hi[c] = p->hi[c] > q->hi[c] ? p->hi[c] : q->hi[c];
+            }
+        }
+    }
     return n_nodes;
 }
 
@@ -2776,7 +2790,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
     PyObject *result = NULL;
     CtNode *nodes = NULL;
     int64_t *order = NULL, *fo = NULL;
-    double *key = NULL, *tri = NULL, *blo = NULL, *bhi = NULL;
+    double *tri = NULL, *blo = NULL, *bhi = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
     for (; got < 6; got++) {
@@ -2825,12 +2839,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
             nodes = (CtNode *)malloc((size_t)(2 * m) * sizeof(CtNode));
             order = (int64_t *)malloc((size_t)m * sizeof(int64_t));
-            key = (double *)malloc((size_t)m * sizeof(double));
             fo = (int64_t *)malloc((size_t)m * 3 * sizeof(int64_t));
             tri = (double *)malloc((size_t)m * 9 * sizeof(double));
             blo = (double *)malloc((size_t)m * 3 * sizeof(double));
             bhi = (double *)malloc((size_t)m * 3 * sizeof(double));
-            if (nodes == NULL || order == NULL || key == NULL || fo == NULL || tri == NULL || blo == NULL
+            if (nodes == NULL || order == NULL || fo == NULL || tri == NULL || blo == NULL
                 || bhi == NULL) {
                 PyErr_NoMemory();
                 goto done;
@@ -2848,7 +2861,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             sc.FO = fo;
             int64_t built;
             Py_BEGIN_ALLOW_THREADS
-            built = ct_build(nodes, order, key, LO, HI, m);
+            built = ct_build(nodes, order, LO, HI, m);
             if (built > 0) {
                 /* the data the traversal reads, in hierarchy order: neighbours in space are near in memory */
                 for (int64_t i = 0; i < m; i++) {
@@ -2887,7 +2900,6 @@ done:
     }
     free(nodes);
     free(order);
-    free(key);
     free(fo);
     free(tri);
     free(blo);
