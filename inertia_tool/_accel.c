@@ -1429,8 +1429,8 @@ static PyMethodDef accel_methods[] = {
      "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition "
      "(dynamics/splitting.py), principal frame; see section 7."},
     {"contact_scan", accel_contact_scan, METH_VARARGS,
-     "contact_scan(vertices, faces, axis, skip, lo, hi, max_pairs) -> (a, b, kind, candidates, tested, exact, "
-     "complete)\n\nEvery face pair whose closed boxes meet, found by a bounding-volume hierarchy and classified; "
+     "contact_scan(vertices, faces, axis, skip, lo, hi, max_pairs, threads=1) -> (a, b, kind, candidates, tested, "
+     "exact, complete)\n\nEvery face pair whose closed boxes meet, found by a bounding-volume hierarchy and classified; "
      "a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "max_pairs < 0: no bound; section 8."},
     {NULL, NULL, 0, NULL}
@@ -2707,8 +2707,9 @@ ct_nodes_meet(const CtNode *p, const CtNode *q)
     return 1;
 }
 
+/* Every candidate pair below the node pair (p0, q0): p0 == q0 for the pairs within one subtree. */
 static void
-ct_traverse(CtScan *sc)
+ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
 {
     size_t cap = 1024, top = 0;
     int64_t *stack = (int64_t *)malloc(2 * cap * sizeof(int64_t));
@@ -2716,8 +2717,8 @@ ct_traverse(CtScan *sc)
         sc->oom = 1;
         return;
     }
-    stack[0] = 0;
-    stack[1] = 0;
+    stack[0] = p0;
+    stack[1] = q0;
     top = 1;
     while (top > 0) {
         top--;
@@ -2776,13 +2777,76 @@ out:
     free(stack);
 }
 
+/* Threads: the node pairs near the root become tasks (each a traversal on its own), taken by ticket; each
+ * thread keeps its own counters and found pairs, merged afterwards.  The set of pairs found does not depend
+ * on the thread count.  With a work bound (max_pairs >= 0) the scan runs on one thread. */
+#define CT_TASKS 512
+
+typedef struct {
+    CtScan *scans;              /* one per thread, sharing the read-only data of scans[0] */
+    const int64_t *tasks;       /* node pairs */
+    int32_t n_tasks;
+    int32_t next;
+} CtParallel;
+
+static void
+ct_parallel_task(void *ctx, int t, int nt)
+{
+    CtParallel *pp = (CtParallel *)ctx;
+    CtScan *sc = &pp->scans[t];
+    for (;;) {
+        int32_t k = next_ticket(&pp->next);
+        if (k >= pp->n_tasks || sc->oom) break;
+        ct_traverse(sc, pp->tasks[2 * k], pp->tasks[2 * k + 1]);
+    }
+}
+
+/* Node pairs covering every candidate pair, split near the root into up to about CT_TASKS; -1 when out of
+ * memory, else their count. */
+static int32_t
+ct_tasks(const CtNode *nodes, int64_t *tasks)
+{
+    int32_t n = 1;
+    tasks[0] = tasks[1] = 0;
+    for (int round = 0; round < 16 && n < CT_TASKS / 4; round++) {
+        int64_t next[2 * CT_TASKS];
+        int32_t m = 0;
+        for (int32_t k = 0; k < n; k++) {
+            int64_t pi = tasks[2 * k], qi = tasks[2 * k + 1];
+            const CtNode *p = &nodes[pi], *q = &nodes[qi];
+            if (pi == qi && p->count == 0) {
+                int64_t add[3][2] = {{p->left, p->left}, {p->right, p->right}, {p->left, p->right}};
+                for (int j = 0; j < 3; j++) {
+                    next[2 * m] = add[j][0];
+                    next[2 * m + 1] = add[j][1];
+                    m++;
+                }
+            }
+            else if (pi != qi && !ct_nodes_meet(p, q)) {
+                continue;
+            }
+            else if (pi != qi && p->count == 0) {
+                next[2 * m] = p->left; next[2 * m + 1] = qi; m++;
+                next[2 * m] = p->right; next[2 * m + 1] = qi; m++;
+            }
+            else {
+                next[2 * m] = pi; next[2 * m + 1] = qi; m++;
+            }
+        }
+        memcpy(tasks, next, (size_t)m * 2 * sizeof(int64_t));
+        n = m;
+    }
+    return n;
+}
+
 static PyObject *
 accel_contact_scan(PyObject *self, PyObject *args)
 {
     PyObject *objs[6];
     long long max_pairs;
-    if (!PyArg_ParseTuple(args, "OOOOOOL", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5],
-                          &max_pairs)) {
+    int threads = 1;
+    if (!PyArg_ParseTuple(args, "OOOOOOL|i", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5],
+                          &max_pairs, &threads)) {
         return NULL;
     }
     Py_buffer views[6];
@@ -2875,7 +2939,43 @@ accel_contact_scan(PyObject *self, PyObject *args)
                         }
                     }
                 }
-                ct_traverse(&sc);
+                int nt = max_pairs >= 0 ? 1 : thread_count(threads, (size_t)m, 20000);
+                if (nt == 1) {
+                    ct_traverse(&sc, 0, 0);
+                }
+                else {
+                    CtScan scans[MAX_THREADS];
+                    int64_t tasks[2 * CT_TASKS];
+                    CtParallel pp;
+                    for (int t = 0; t < nt; t++) {
+                        scans[t] = sc;
+                    }
+                    pp.scans = scans;
+                    pp.tasks = tasks;
+                    pp.n_tasks = ct_tasks(nodes, tasks);
+                    pp.next = 0;
+                    run_parallel(nt, ct_parallel_task, &pp);
+                    for (int t = 0; t < nt; t++) {          /* merge into sc */
+                        CtScan *u = &scans[t];
+                        if (t > 0) {
+                            sc.candidates += u->candidates;
+                            sc.tested += u->tested;
+                            sc.exact += u->exact;
+                            sc.oom |= u->oom;
+                            for (size_t i = 0; i < u->found.n && !sc.oom; i++) {
+                                if (ct_found_push(&sc.found, u->found.a[i], u->found.b[i], u->found.kind[i]) < 0) {
+                                    sc.oom = 1;
+                                }
+                            }
+                            free(u->found.a);
+                            free(u->found.b);
+                            free(u->found.kind);
+                        }
+                        else {
+                            sc = scans[0];
+                        }
+                    }
+                }
             }
             Py_END_ALLOW_THREADS
             if (built < 0 || sc.oom) {

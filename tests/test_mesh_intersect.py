@@ -456,3 +456,22 @@ def test_broad_phase_finds_every_pair_of_meeting_boxes(n_faces, seed, spread):
                 shared = [(p, q) for p in range(3) for q in range(3) if f[i, p] == f[j, q]]
                 want = brute_kind(v[f[i]], v[f[j]], shared)
                 assert got.get((i, j), NONE) == (NONE if want is None else want), (i, j)
+
+
+def test_c_scan_on_threads_finds_the_same_pairs(kernel, monkeypatch):
+    """Above 20,000 faces the C scan splits its traversal over threads: the same pairs on 1 and 2 threads and
+    on the numpy grid."""
+    if kernel != "c":
+        pytest.skip("compares the C scan's thread counts")
+    v, f = _figure_eight_tube(1000, 12)
+    monkeypatch.setenv(_native.THREADS_ENV, "1")
+    one = surface_contacts(v, f)
+    monkeypatch.setenv(_native.THREADS_ENV, "2")
+    two = surface_contacts(v, f)
+    monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
+    ref = surface_contacts(v, f)
+    assert len(f) > 20_000 and len(one.crossing) > 0
+    for other in (two, ref):
+        assert other.candidate_pairs == one.candidate_pairs
+        for field in ("crossing", "coplanar_opposite", "contact"):
+            assert np.array_equal(getattr(other, field), getattr(one, field)), field

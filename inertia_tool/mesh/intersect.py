@@ -55,10 +55,14 @@ tested in chunks of at most ``chunk`` pairs, so memory stays bounded on any mesh
 
 C extension
 -----------
-When ``inertia_tool._accel`` is built (and the coordinates are in the filter's range), the candidate test and
-the classification of each chunk run in its section 8 (``contact_kinds``): the same predicates and decisions,
-with the exact stage computed by floating-point expansions instead of Python integers.  This module's numpy
-code stays the reference and the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
+When ``inertia_tool._accel`` is built (and the coordinates are in the filter's range) the whole scan runs in
+its section 8 (``contact_scan``): a bounding-volume hierarchy over the face boxes (faces in Morton order of
+their box centres) traversed against itself gives the same candidate pairs as the grid, in another order, and
+each is classified on the spot with the same predicates and decisions, the exact stage computed by
+floating-point expansions instead of Python integers, on :func:`~inertia_tool._native.threads` threads (the
+pairs found do not depend on the count; with ``max_pairs`` it runs on one, and which pairs are tested before
+the bound stops it differs from the grid's order).  This module's numpy code stays the reference and
+the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
 """
 
 from __future__ import annotations
@@ -66,7 +70,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 import numpy as np
 
-from .._native import accel
+from .._native import accel, threads
 from ..errors import InvalidMeshError
 from ..values import frozen_value
 
@@ -546,7 +550,7 @@ def _scan_c(lib, v, f, axis, degenerate, lo, hi, max_pairs, pred: _Predicates) -
     """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy)."""
     raw_a, raw_b, raw_kind, candidates, tested, exact, complete = lib.contact_scan(
         v, f, np.ascontiguousarray(axis, dtype=np.int64), degenerate.view(np.uint8), lo, hi,
-        -1 if max_pairs is None else int(max_pairs))
+        -1 if max_pairs is None else int(max_pairs), threads())
     pred.exact += exact
     a = np.frombuffer(raw_a, dtype=np.int64)
     b = np.frombuffer(raw_b, dtype=np.int64)
