@@ -475,3 +475,22 @@ def test_c_scan_on_threads_finds_the_same_pairs(kernel, monkeypatch):
         assert other.candidate_pairs == one.candidate_pairs
         for field in ("crossing", "coplanar_opposite", "contact"):
             assert np.array_equal(getattr(other, field), getattr(one, field)), field
+
+
+@pytest.mark.parametrize("exponent", [-1000, -900, 900])
+def test_result_does_not_depend_on_scale(exponent):
+    """Scaling by a power of two changes no orientation sign: the same pairs at 2^-1000 (partly subnormal
+    coordinates: every sign exact) and 2^±900 (rescaled into the filter's range first)."""
+    v, f = _t_junction_cube()
+    w, g = _unit_cube()
+    corner = int(np.argmin(np.linalg.norm(w, axis=1)))
+    turned = w @ _rotation(np.ones(3), 30.0).T
+    g2 = g + len(w)
+    g2[g2 == corner + len(w)] = corner
+    verts = np.r_[v, w + 3.0, turned + 3.0]
+    faces = np.r_[f, g + len(v), g2 + len(v)]
+    base = surface_contacts(verts, faces)
+    scaled = surface_contacts(np.ldexp(verts, exponent), faces)
+    assert len(base.crossing) and len(base.contact)
+    for field in ("crossing", "coplanar_opposite", "contact"):
+        assert np.array_equal(getattr(scaled, field), getattr(base, field)), field
