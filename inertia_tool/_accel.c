@@ -16,6 +16,8 @@
  *   5. tetra_sums  -- signed-tetrahedron volume integrals with compensated sums (mass/volume._tetra_sums)
  *   6. bounds      -- bounding box and finiteness of the vertices in one pass (mass/volume.bounding_box)
  *   7. split_steps -- the splitting integrator's step loop (dynamics/splitting.py)
+ *   8. contact_scan -- faces meeting beyond what they share: hierarchy of boxes + exact pair classification
+ *                      (mesh/intersect.py)
  *
  * Safety: every index read from an array is bounds-checked before use, sizes are checked against
  * overflow before allocation, NaN coordinates are hashed by their bit pattern (never compared as floats),
@@ -1404,6 +1406,7 @@ accel_bounds(PyObject *self, PyObject *args)
  * ====================================================================================================== */
 
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
+static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
 
 static PyMethodDef accel_methods[] = {
     {"edge_census", accel_edge_census, METH_VARARGS,
@@ -1425,6 +1428,11 @@ static PyMethodDef accel_methods[] = {
      "split_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, frame, q_proto, w_proto, "
      "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition "
      "(dynamics/splitting.py), principal frame; see section 7."},
+    {"contact_scan", accel_contact_scan, METH_VARARGS,
+     "contact_scan(vertices, faces, axis, skip, lo, hi, max_pairs, threads=1) -> (a, b, kind, candidates, tested, "
+     "exact, complete)\n\nEvery face pair whose closed boxes meet, found by a bounding-volume hierarchy and classified; "
+     "a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
+     "max_pairs < 0: no bound; section 8."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -2090,5 +2098,914 @@ accel_split_steps(PyObject *self, PyObject *args)
 done:
     Py_XDECREF(st.q_arr);
     Py_XDECREF(st.w_arr);
+    return result;
+}
+
+/* ======================================================================================================
+ * 8. contact_scan -- exact classification of face pairs (mesh/intersect.py, the twin of _classify)
+ *
+ * Every decision is the sign of orient3d / orient2d of input coordinates.  Each is evaluated in doubles with
+ * the static error bound of mesh/intersect.py (10 u times the permanent for orient3d, 6 u for orient2d,
+ * u = 2^-53; valid because the caller guarantees every nonzero coordinate magnitude lies in [2^-240, 2^299]);
+ * within the bound the determinant is recomputed exactly with floating-point expansions (Shewchuk 1997:
+ * Two-Sum, Two-Product by fused multiply-add, Grow-Expansion with zero elimination): the nine differences
+ * are exact two-term expansions, each of the six triple products of their parts is an exact sum of four
+ * doubles, and all of them are summed into one nonoverlapping expansion whose largest component gives the
+ * sign.  Exactness of every Two-Product holds in that coordinate range (all quantities are multiples of
+ * 2^-876, representable).  A pair whose expansion would outgrow CONTACT_EXP_MAX components gets kind -1 and
+ * the caller classifies it on the numpy path.  The candidate pairs come from a bounding-volume hierarchy
+ * instead of the numpy path's grid: the same set of pairs (those whose closed boxes meet), in another order.
+ * ====================================================================================================== */
+
+#define CONTACT_EXP_MAX 192
+#define CONTACT_O3 (10.0 * 1.1102230246251565e-16)
+#define CONTACT_O2 (6.0 * 1.1102230246251565e-16)
+
+typedef struct {
+    int n;
+    int overflow;
+    double e[CONTACT_EXP_MAX];
+} Expansion;
+
+static inline void
+ct_two_sum(double a, double b, double *x, double *y)
+{
+    volatile double s = a + b;          /* volatile: no reassociation or excess precision */
+    double bv = s - a;
+    double av = s - bv;
+    *x = s;
+    *y = (a - av) + (b - bv);
+}
+
+/* Grow-Expansion with zero elimination: h += b, h nonoverlapping before and after. */
+static void
+ct_grow(Expansion *h, double b)
+{
+    if (b == 0.0) {
+        return;
+    }
+    double q = b;
+    int k = 0;
+    for (int i = 0; i < h->n; i++) {
+        double s, t;
+        ct_two_sum(q, h->e[i], &s, &t);
+        q = s;
+        if (t != 0.0) {
+            h->e[k++] = t;
+        }
+    }
+    if (q != 0.0) {
+        if (k >= CONTACT_EXP_MAX) {
+            h->overflow = 1;
+            return;
+        }
+        h->e[k++] = q;
+    }
+    h->n = k;
+}
+
+/* h += sign * p * q * r exactly (four doubles). */
+static void
+ct_add_product3(Expansion *h, double sign, double p, double q, double r)
+{
+    if (p == 0.0 || q == 0.0 || r == 0.0) {
+        return;
+    }
+    double P = p * q;
+    double e = fma(p, q, -P);
+    double A = P * r;
+    double B = fma(P, r, -A);
+    ct_grow(h, sign * A);
+    ct_grow(h, sign * B);
+    if (e != 0.0) {
+        double C = e * r;
+        double D = fma(e, r, -C);
+        ct_grow(h, sign * C);
+        ct_grow(h, sign * D);
+    }
+}
+
+static void
+ct_add_product2(Expansion *h, double sign, double p, double q)
+{
+    if (p == 0.0 || q == 0.0) {
+        return;
+    }
+    double P = p * q;
+    ct_grow(h, sign * P);
+    ct_grow(h, sign * fma(p, q, -P));
+}
+
+/* Sign of a nonoverlapping expansion (its largest component is last), 2 when it overflowed. */
+static int
+ct_sign(const Expansion *h)
+{
+    if (h->overflow) {
+        return 2;
+    }
+    if (h->n == 0) {
+        return 0;
+    }
+    return h->e[h->n - 1] > 0 ? 1 : -1;
+}
+
+typedef struct {
+    long exact;       /* evaluations decided by the exact stage */
+    int failed;       /* an expansion overflowed: the pair goes back to the numpy path */
+} CtStats;
+
+static int
+ct_orient3d(const double *a, const double *b, const double *c, const double *d, CtStats *st)
+{
+    double ad[3], bd[3], cd[3];
+    for (int k = 0; k < 3; k++) {
+        ad[k] = a[k] - d[k];
+        bd[k] = b[k] - d[k];
+        cd[k] = c[k] - d[k];
+    }
+    double m0 = bd[1] * cd[2] - bd[2] * cd[1];
+    double m1 = bd[2] * cd[0] - bd[0] * cd[2];
+    double m2 = bd[0] * cd[1] - bd[1] * cd[0];
+    double det = ad[0] * m0 + ad[1] * m1 + ad[2] * m2;
+    double perm = fabs(ad[0]) * (fabs(bd[1]) * fabs(cd[2]) + fabs(bd[2]) * fabs(cd[1]))
+                + fabs(ad[1]) * (fabs(bd[2]) * fabs(cd[0]) + fabs(bd[0]) * fabs(cd[2]))
+                + fabs(ad[2]) * (fabs(bd[0]) * fabs(cd[1]) + fabs(bd[1]) * fabs(cd[0]));
+    if (perm == 0.0) {
+        return 0;
+    }
+    if (fabs(det) > CONTACT_O3 * perm) {
+        return det > 0 ? 1 : -1;
+    }
+    /* exact: rows as two-term expansions (hi, lo) */
+    double hi[3][3], lo[3][3];
+    const double *p[3] = {a, b, c};
+    for (int r = 0; r < 3; r++) {
+        for (int k = 0; k < 3; k++) {
+            double x, y;
+            ct_two_sum(p[r][k], -d[k], &x, &y);
+            hi[r][k] = x;
+            lo[r][k] = y;
+        }
+    }
+    static const int terms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 2, 0}, {1, 0, 2}, {2, 0, 1}, {2, 1, 0}};
+    static const double signs[6] = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};
+    Expansion h;
+    h.n = 0;
+    h.overflow = 0;
+    for (int t = 0; t < 6; t++) {
+        for (int mask = 0; mask < 8; mask++) {
+            double x = (mask & 1) ? lo[0][terms[t][0]] : hi[0][terms[t][0]];
+            double y = (mask & 2) ? lo[1][terms[t][1]] : hi[1][terms[t][1]];
+            double z = (mask & 4) ? lo[2][terms[t][2]] : hi[2][terms[t][2]];
+            ct_add_product3(&h, signs[t], x, y, z);
+        }
+    }
+    st->exact++;
+    int s = ct_sign(&h);
+    if (s == 2) {
+        st->failed = 1;
+        return 0;
+    }
+    return s;
+}
+
+static int
+ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
+{
+    double acx = a[0] - c[0], acy = a[1] - c[1], bcx = b[0] - c[0], bcy = b[1] - c[1];
+    double left = acx * bcy, right = acy * bcx;
+    double det = left - right;
+    double perm = fabs(left) + fabs(right);
+    if (perm == 0.0) {
+        return 0;
+    }
+    if (fabs(det) > CONTACT_O2 * perm) {
+        return det > 0 ? 1 : -1;
+    }
+    double xh[2], xl[2], yh[2], yl[2];     /* a - c and b - c as (hi, lo) */
+    ct_two_sum(a[0], -c[0], &xh[0], &xl[0]);
+    ct_two_sum(a[1], -c[1], &xh[1], &xl[1]);
+    ct_two_sum(b[0], -c[0], &yh[0], &yl[0]);
+    ct_two_sum(b[1], -c[1], &yh[1], &yl[1]);
+    Expansion h;
+    h.n = 0;
+    h.overflow = 0;
+    for (int mask = 0; mask < 4; mask++) {
+        double p = (mask & 1) ? xl[0] : xh[0];
+        double q = (mask & 2) ? yl[1] : yh[1];
+        ct_add_product2(&h, 1.0, p, q);
+        p = (mask & 1) ? xl[1] : xh[1];
+        q = (mask & 2) ? yl[0] : yh[0];
+        ct_add_product2(&h, -1.0, p, q);
+    }
+    st->exact++;
+    int s = ct_sign(&h);
+    if (s == 2) {
+        st->failed = 1;
+        return 0;
+    }
+    return s;
+}
+
+enum { CT_NONE = 0, CT_CROSSING = 1, CT_OPPOSITE = 2, CT_CONTACT = 3 };
+
+static int
+ct_touch_corner(const int d[3])
+{
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        if (d[i] == 0 && d[j] != 0 && d[j] == d[k]) {
+            return i;
+        }
+    }
+    return -1;
+}
+
+static int
+ct_alone_corner(const int d[3])
+{
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        if (d[i] != 0 && d[j] * d[i] <= 0 && d[k] * d[i] <= 0) {
+            return i;
+        }
+    }
+    return -1;
+}
+
+/* x, on the plane of tri, lies in the closed tri; apex is off that plane. */
+static int
+ct_point_in_triangle(const double *apex, const double *x, const double *const tri[3], CtStats *st)
+{
+    int s0 = ct_orient3d(apex, x, tri[0], tri[1], st);
+    int s1 = ct_orient3d(apex, x, tri[1], tri[2], st);
+    int s2 = ct_orient3d(apex, x, tri[2], tri[0], st);
+    return (s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0);
+}
+
+static const int ct_plane[3][2] = {{1, 2}, {2, 0}, {0, 1}};
+
+static int
+ct_coplanar(const double *const t1[3], const double *const t2[3], int axis, const int on1[3], const int on2[3],
+            int n_shared, CtStats *st)
+{
+    double A[3][2], B[3][2];
+    for (int i = 0; i < 3; i++) {
+        A[i][0] = t1[i][ct_plane[axis][0]];
+        A[i][1] = t1[i][ct_plane[axis][1]];
+        B[i][0] = t2[i][ct_plane[axis][0]];
+        B[i][1] = t2[i][ct_plane[axis][1]];
+    }
+    int s1 = ct_orient2d(A[0], A[1], A[2], st);
+    int s2 = ct_orient2d(B[0], B[1], B[2], st);
+    int weak = 0, strict = 0;
+    for (int side = 0; side < 2; side++) {
+        double (*P)[2] = side ? B : A;
+        double (*Q)[2] = side ? A : B;
+        int s = side ? s2 : s1;
+        for (int e = 0; e < 3; e++) {
+            int all_le = 1, all_lt = 1;
+            for (int j = 0; j < 3; j++) {
+                int o = ct_orient2d(P[e], P[(e + 1) % 3], Q[j], st) * s;
+                all_le &= o <= 0;
+                all_lt &= o < 0;
+            }
+            weak |= all_le;
+            strict |= all_lt;
+        }
+    }
+    if (!weak) {
+        return s1 == s2 ? CT_CROSSING : CT_OPPOSITE;
+    }
+    if (strict || n_shared >= 2) {
+        return CT_NONE;
+    }
+    if (n_shared == 0) {
+        return CT_CONTACT;
+    }
+    int i1 = on1[0] ? 0 : on1[1] ? 1 : 2;
+    int i2 = on2[0] ? 0 : on2[1] ? 1 : 2;
+    const double *v = t1[i1];
+    for (int x = 1; x <= 2; x++) {
+        for (int y = 1; y <= 2; y++) {
+            const double *px = t1[(i1 + x) % 3], *py = t2[(i2 + y) % 3];
+            if (ct_orient2d(A[i1], A[(i1 + x) % 3], B[(i2 + y) % 3], st) != 0) {
+                continue;
+            }
+            int agree = 1;
+            for (int c = 0; c < 3; c++) {
+                double u = px[c] - v[c], w = py[c] - v[c];
+                agree &= ((u > 0) - (u < 0)) == ((w > 0) - (w < 0));
+            }
+            if (agree) {
+                return CT_CONTACT;
+            }
+        }
+    }
+    return CT_NONE;
+}
+
+/* Kind of the face pair with corner indices fa, fb and corner coordinates c1, c2 (3 x 3 doubles each). */
+static int
+ct_classify(const double *c1, const double *c2, const int64_t fa[3], const int64_t fb[3], int axis, CtStats *st)
+{
+    const double *t1[3] = {c1, c1 + 3, c1 + 6}, *t2[3] = {c2, c2 + 3, c2 + 6};
+    int on1[3] = {0, 0, 0}, on2[3] = {0, 0, 0}, n_shared = 0;
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            if (fa[i] == fb[j]) {
+                on1[i] = on2[j] = 1;
+                n_shared++;
+            }
+        }
+    }
+    int d1[3], d2[3];
+    int any1 = 0;
+    for (int i = 0; i < 3; i++) {
+        d1[i] = on1[i] ? 0 : ct_orient3d(t2[0], t2[1], t2[2], t1[i], st);
+        any1 |= d1[i] != 0;
+    }
+    if (n_shared >= 2 && any1) {
+        return CT_NONE;
+    }
+    for (int j = 0; j < 3; j++) {
+        d2[j] = on2[j] ? 0 : ct_orient3d(t1[0], t1[1], t1[2], t2[j], st);
+    }
+    if ((d1[0] > 0 && d1[1] > 0 && d1[2] > 0) || (d1[0] < 0 && d1[1] < 0 && d1[2] < 0)
+        || (d2[0] > 0 && d2[1] > 0 && d2[2] > 0) || (d2[0] < 0 && d2[1] < 0 && d2[2] < 0)) {
+        return CT_NONE;
+    }
+    if (!any1) {
+        return ct_coplanar(t1, t2, axis, on1, on2, n_shared, st);
+    }
+    if (n_shared >= 2) {
+        return CT_NONE;
+    }
+    int touch1 = ct_touch_corner(d1), touch2 = ct_touch_corner(d2);
+    if (touch1 >= 0 || touch2 >= 0) {
+        if (n_shared > 0) {
+            return CT_NONE;
+        }
+        if (touch1 >= 0 && ct_point_in_triangle(t1[(touch1 + 1) % 3], t1[touch1], t2, st)) {
+            return CT_CONTACT;
+        }
+        if (touch2 >= 0 && ct_point_in_triangle(t2[(touch2 + 1) % 3], t2[touch2], t1, st)) {
+            return CT_CONTACT;
+        }
+        return CT_NONE;
+    }
+    /* Guigue and Devillers' canonical form (see mesh/intersect._transversal) */
+    int i1 = ct_alone_corner(d1);
+    const double *p1 = t1[i1], *q1 = t1[(i1 + 1) % 3], *r1 = t1[(i1 + 2) % 3];
+    int order2[3] = {0, 1, 2};
+    if (d1[i1] < 0) {
+        order2[1] = 2;
+        order2[2] = 1;
+    }
+    const double *t2c[3];
+    int d2c[3];
+    for (int j = 0; j < 3; j++) {
+        t2c[j] = t2[order2[j]];
+        d2c[j] = d2[order2[j]];
+    }
+    int i2 = ct_alone_corner(d2c);
+    const double *p2 = t2c[i2], *q2 = t2c[(i2 + 1) % 3], *r2 = t2c[(i2 + 2) % 3];
+    if (d2c[i2] < 0) {
+        const double *tmp = q1;
+        q1 = r1;
+        r1 = tmp;
+    }
+    int low = ct_orient3d(p1, q1, p2, q2, st);
+    int high = -ct_orient3d(p1, r1, p2, r2, st);
+    int meet = low <= 0 && high <= 0;
+    int positive = low < 0 && high < 0;
+    int zeros1 = (d1[0] == 0) + (d1[1] == 0) + (d1[2] == 0);
+    int zeros2 = (d2[0] == 0) + (d2[1] == 0) + (d2[2] == 0);
+    if (positive && zeros1 < 2 && zeros2 < 2) {
+        return CT_CROSSING;
+    }
+    return (n_shared > 0 ? positive : meet) ? CT_CONTACT : CT_NONE;
+}
+
+static int
+ct_int64(const Py_buffer *view)
+{
+    char c = native_code(view->format);
+    return (c == 'l' || c == 'q') && view->itemsize == 8;
+}
+
+/* ------------------------------------------------------------------------------------------------------
+ * contact_scan -- the whole check in one pass: a bounding-volume hierarchy over the face boxes (faces in
+ * Morton order of their box centres, index ranges halved down to leaves of at most CT_LEAF faces), traversed against
+ * itself so that every unordered pair of faces whose closed boxes meet is visited exactly once (each pair
+ * of leaves once), each such pair classified on the spot; only the pairs that meet are kept.
+ * ------------------------------------------------------------------------------------------------------ */
+
+#define CT_LEAF 4
+
+typedef struct {
+    double lo[3], hi[3];
+    int64_t start, count;       /* leaf: faces order[start .. start+count); inner: count = 0 */
+    int64_t left, right;
+} CtNode;
+
+typedef struct {
+    int64_t *a, *b;
+    int8_t *kind;
+    size_t n, cap;
+} CtFound;
+
+static int
+ct_found_push(CtFound *fd, int64_t a, int64_t b, int kind)
+{
+    if (fd->n == fd->cap) {
+        size_t cap = fd->cap ? 2 * fd->cap : 256;
+        int64_t *na = (int64_t *)realloc(fd->a, cap * sizeof(int64_t));
+        if (na == NULL) return -1;
+        fd->a = na;
+        int64_t *nb = (int64_t *)realloc(fd->b, cap * sizeof(int64_t));
+        if (nb == NULL) return -1;
+        fd->b = nb;
+        int8_t *nk = (int8_t *)realloc(fd->kind, cap);
+        if (nk == NULL) return -1;
+        fd->kind = nk;
+        fd->cap = cap;
+    }
+    fd->a[fd->n] = a;
+    fd->b[fd->n] = b;
+    fd->kind[fd->n] = (int8_t)kind;
+    fd->n++;
+    return 0;
+}
+
+typedef struct {
+    uint64_t code;
+    int64_t face;
+} CtKey;
+
+static int
+ct_key_cmp(const void *x, const void *y)
+{
+    const CtKey *p = (const CtKey *)x, *q = (const CtKey *)y;
+    if (p->code != q->code) return p->code < q->code ? -1 : 1;
+    return (p->face > q->face) - (p->face < q->face);
+}
+
+/* 21 bits of v spread to every third bit. */
+static inline uint64_t
+ct_spread(uint64_t v)
+{
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+}
+
+/* Builds the hierarchy: faces sorted along the Morton (Z-order) curve of their box centres, the tree halving
+ * index ranges (leaves of at most CT_LEAF faces), node boxes from the leaves up.  Fills order (hierarchy
+ * position -> face); returns the node count, or -1 when out of memory. */
+static int64_t
+ct_build(CtNode *nodes, int64_t *order, const double *LO, const double *HI, int64_t m)
+{
+    CtKey *keys = (CtKey *)malloc((size_t)m * sizeof(CtKey));
+    if (keys == NULL) return -1;
+    double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int64_t f = 0; f < m; f++) {
+        for (int c = 0; c < 3; c++) {
+            double mid = 0.5 * (LO[3 * f + c] + HI[3 * f + c]);
+            if (mid < gmin[c]) gmin[c] = mid;
+            if (mid > gmax[c]) gmax[c] = mid;
+        }
+    }
+    for (int64_t f = 0; f < m; f++) {
+        uint64_t code = 0;
+        for (int c = 0; c < 3; c++) {
+            double span = gmax[c] - gmin[c];
+            double t = span > 0 ? (0.5 * (LO[3 * f + c] + HI[3 * f + c]) - gmin[c]) / span : 0.0;
+            uint64_t q = (uint64_t)(t * 2097151.0);
+            if (q > 2097151) q = 2097151;
+            code |= ct_spread(q) << c;
+        }
+        keys[f].code = code;
+        keys[f].face = f;
+    }
+    qsort(keys, (size_t)m, sizeof(CtKey), ct_key_cmp);
+    for (int64_t i = 0; i < m; i++) order[i] = keys[i].face;
+    free(keys);
+    /* topology: a parent always precedes its children */
+    int64_t n_nodes = 1;
+    nodes[0].start = 0;
+    nodes[0].count = m;
+    for (int64_t k = 0; k < n_nodes; k++) {
+        CtNode *nd = &nodes[k];
+        if (nd->count <= CT_LEAF) {
+            continue;
+        }
+        int64_t s = nd->start, e = s + nd->count, half = s + (e - s) / 2;
+        int64_t l = n_nodes++, r = n_nodes++;
+        nodes[l].start = s;
+        nodes[l].count = half - s;
+        nodes[r].start = half;
+        nodes[r].count = e - half;
+        nd->left = l;
+        nd->right = r;
+        nd->count = 0;
+    }
+    /* boxes, children before parents */
+    for (int64_t k = n_nodes - 1; k >= 0; k--) {
+        CtNode *nd = &nodes[k];
+        for (int c = 0; c < 3; c++) {
+            nd->lo[c] = INFINITY;
+            nd->hi[c] = -INFINITY;
+        }
+        if (nd->count > 0) {
+            for (int64_t i = nd->start; i < nd->start + nd->count; i++) {
+                int64_t f = order[i];
+                for (int c = 0; c < 3; c++) {
+                    if (LO[3 * f + c] < nd->lo[c]) nd->lo[c] = LO[3 * f + c];
+                    if (HI[3 * f + c] > nd->hi[c]) nd->hi[c] = HI[3 * f + c];
+                }
+            }
+        }
+        else {
+            const CtNode *p = &nodes[nd->left], *q = &nodes[nd->right];
+            for (int c = 0; c < 3; c++) {
+                nd->lo[c] = p->lo[c] < q->lo[c] ? p->lo[c] : q->lo[c];
+                nd->hi[c] = p->hi[c] > q->hi[c] ? p->hi[c] : q->hi[c];
+            }
+        }
+    }
+    return n_nodes;
+}
+
+typedef struct {
+    const double *LO, *HI;      /* boxes, in hierarchy order */
+    const double *T;            /* corner coordinates (9 per face), in hierarchy order */
+    const int64_t *FO;          /* corner indices (3 per face), in hierarchy order */
+    const int64_t *X;
+    const uint8_t *S;
+    const CtNode *nodes;
+    const int64_t *order;       /* hierarchy position -> face */
+    long long max_pairs;        /* < 0: no bound */
+    long long candidates, tested;
+    long exact;
+    int complete, oom;
+    CtFound found;
+} CtScan;
+
+static inline int
+ct_boxes_meet(const double *LO, const double *HI, int64_t a, int64_t b)
+{
+    for (int c = 0; c < 3; c++) {
+        if (!(LO[3 * a + c] <= HI[3 * b + c]) || !(LO[3 * b + c] <= HI[3 * a + c])) return 0;
+    }
+    return 1;
+}
+
+/* One candidate pair (hierarchy positions i, j); returns 0 to go on, 1 to stop (bound reached or out of
+ * memory). */
+static int
+ct_visit(CtScan *sc, int64_t i, int64_t j)
+{
+    if (!ct_boxes_meet(sc->LO, sc->HI, i, j)) return 0;
+    if (sc->max_pairs >= 0 && sc->candidates >= sc->max_pairs) {
+        sc->complete = 0;
+        return 1;
+    }
+    sc->candidates++;
+    int64_t a = sc->order[i], b = sc->order[j];
+    if (sc->S[a] || sc->S[b]) return 0;
+    sc->tested++;
+    if (a > b) {
+        int64_t t = a;
+        a = b;
+        b = t;
+        t = i;
+        i = j;
+        j = t;
+    }
+    CtStats st = {0, 0};
+    int kind = ct_classify(sc->T + 9 * i, sc->T + 9 * j, sc->FO + 3 * i, sc->FO + 3 * j, (int)sc->X[a], &st);
+    sc->exact += st.exact;
+    if (st.failed) kind = -1;
+    if (kind != CT_NONE && ct_found_push(&sc->found, a, b, kind) < 0) {
+        sc->oom = 1;
+        return 1;
+    }
+    return 0;
+}
+
+static inline int
+ct_nodes_meet(const CtNode *p, const CtNode *q)
+{
+    for (int c = 0; c < 3; c++) {
+        if (!(p->lo[c] <= q->hi[c]) || !(q->lo[c] <= p->hi[c])) return 0;
+    }
+    return 1;
+}
+
+/* Every candidate pair below the node pair (p0, q0): p0 == q0 for the pairs within one subtree. */
+static void
+ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
+{
+    size_t cap = 1024, top = 0;
+    int64_t *stack = (int64_t *)malloc(2 * cap * sizeof(int64_t));
+    if (stack == NULL) {
+        sc->oom = 1;
+        return;
+    }
+    stack[0] = p0;
+    stack[1] = q0;
+    top = 1;
+    while (top > 0) {
+        top--;
+        const CtNode *p = &sc->nodes[stack[2 * top]], *q = &sc->nodes[stack[2 * top + 1]];
+        int64_t pi = stack[2 * top], qi = stack[2 * top + 1];
+        if (top + 3 > cap) {
+            int64_t *ns = (int64_t *)realloc(stack, 4 * cap * sizeof(int64_t));
+            if (ns == NULL) {
+                sc->oom = 1;
+                break;
+            }
+            stack = ns;
+            cap *= 2;
+        }
+        if (pi == qi) {
+            if (p->count > 0) {
+                for (int64_t i = p->start; i < p->start + p->count; i++) {
+                    for (int64_t j = i + 1; j < p->start + p->count; j++) {
+                        if (ct_visit(sc, i, j)) goto out;
+                    }
+                }
+            }
+            else {
+                int64_t pushes[3][2] = {{p->left, p->left}, {p->right, p->right}, {p->left, p->right}};
+                for (int k = 0; k < 3; k++) {
+                    stack[2 * top] = pushes[k][0];
+                    stack[2 * top + 1] = pushes[k][1];
+                    top++;
+                }
+            }
+            continue;
+        }
+        if (!ct_nodes_meet(p, q)) continue;
+        if (p->count > 0 && q->count > 0) {
+            for (int64_t i = p->start; i < p->start + p->count; i++) {
+                for (int64_t j = q->start; j < q->start + q->count; j++) {
+                    if (ct_visit(sc, i, j)) goto out;
+                }
+            }
+            continue;
+        }
+        /* descend the inner node (the larger one when both are inner) */
+        int split_p = q->count > 0 || (p->count == 0 && (p->hi[0] - p->lo[0]) + (p->hi[1] - p->lo[1])
+                                        + (p->hi[2] - p->lo[2]) >= (q->hi[0] - q->lo[0])
+                                        + (q->hi[1] - q->lo[1]) + (q->hi[2] - q->lo[2]));
+        if (split_p) {
+            stack[2 * top] = p->left;  stack[2 * top + 1] = qi; top++;
+            stack[2 * top] = p->right; stack[2 * top + 1] = qi; top++;
+        }
+        else {
+            stack[2 * top] = pi; stack[2 * top + 1] = q->left;  top++;
+            stack[2 * top] = pi; stack[2 * top + 1] = q->right; top++;
+        }
+    }
+out:
+    free(stack);
+}
+
+/* Threads: the node pairs near the root become tasks (each a traversal on its own), taken by ticket; each
+ * thread keeps its own counters and found pairs, merged afterwards.  The set of pairs found does not depend
+ * on the thread count.  With a work bound (max_pairs >= 0) the scan runs on one thread. */
+#define CT_TASKS 512
+
+typedef struct {
+    CtScan *scans;              /* one per thread, sharing the read-only data of scans[0] */
+    const int64_t *tasks;       /* node pairs */
+    int32_t n_tasks;
+    int32_t next;
+} CtParallel;
+
+static void
+ct_parallel_task(void *ctx, int t, int nt)
+{
+    CtParallel *pp = (CtParallel *)ctx;
+    CtScan *sc = &pp->scans[t];
+    for (;;) {
+        int32_t k = next_ticket(&pp->next);
+        if (k >= pp->n_tasks || sc->oom) break;
+        ct_traverse(sc, pp->tasks[2 * k], pp->tasks[2 * k + 1]);
+    }
+}
+
+/* Node pairs covering every candidate pair, split near the root into up to about CT_TASKS; -1 when out of
+ * memory, else their count. */
+static int32_t
+ct_tasks(const CtNode *nodes, int64_t *tasks)
+{
+    int32_t n = 1;
+    tasks[0] = tasks[1] = 0;
+    for (int round = 0; round < 16 && n < CT_TASKS / 4; round++) {
+        int64_t next[2 * CT_TASKS];
+        int32_t m = 0;
+        for (int32_t k = 0; k < n; k++) {
+            int64_t pi = tasks[2 * k], qi = tasks[2 * k + 1];
+            const CtNode *p = &nodes[pi], *q = &nodes[qi];
+            if (pi == qi && p->count == 0) {
+                int64_t add[3][2] = {{p->left, p->left}, {p->right, p->right}, {p->left, p->right}};
+                for (int j = 0; j < 3; j++) {
+                    next[2 * m] = add[j][0];
+                    next[2 * m + 1] = add[j][1];
+                    m++;
+                }
+            }
+            else if (pi != qi && !ct_nodes_meet(p, q)) {
+                continue;
+            }
+            else if (pi != qi && p->count == 0) {
+                next[2 * m] = p->left; next[2 * m + 1] = qi; m++;
+                next[2 * m] = p->right; next[2 * m + 1] = qi; m++;
+            }
+            else {
+                next[2 * m] = pi; next[2 * m + 1] = qi; m++;
+            }
+        }
+        memcpy(tasks, next, (size_t)m * 2 * sizeof(int64_t));
+        n = m;
+    }
+    return n;
+}
+
+static PyObject *
+accel_contact_scan(PyObject *self, PyObject *args)
+{
+    PyObject *objs[6];
+    long long max_pairs;
+    int threads = 1;
+    if (!PyArg_ParseTuple(args, "OOOOOOL|i", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5],
+                          &max_pairs, &threads)) {
+        return NULL;
+    }
+    Py_buffer views[6];
+    int got = 0;
+    PyObject *result = NULL;
+    CtNode *nodes = NULL;
+    int64_t *order = NULL, *fo = NULL;
+    double *tri = NULL, *blo = NULL, *bhi = NULL;
+    CtScan sc;
+    memset(&sc, 0, sizeof(sc));
+    for (; got < 6; got++) {
+        if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+            goto done;
+        }
+    }
+    {
+        Py_buffer *vv = &views[0], *fv = &views[1], *xv = &views[2], *sv = &views[3], *lv = &views[4];
+        Py_buffer *hv = &views[5];
+        char sc_code = native_code(sv->format);
+        Py_ssize_t m = fv->ndim == 2 ? fv->shape[0] : -1;
+        if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3
+            || !ct_int64(fv) || fv->ndim != 2 || fv->shape[1] != 3
+            || !ct_int64(xv) || xv->ndim != 1 || xv->shape[0] != m
+            || (sc_code != 'B' && sc_code != '?') || sv->itemsize != 1 || sv->ndim != 1 || sv->shape[0] != m
+            || native_code(lv->format) != 'd' || lv->itemsize != 8 || lv->ndim != 2 || lv->shape[0] != m
+            || lv->shape[1] != 3
+            || native_code(hv->format) != 'd' || hv->itemsize != 8 || hv->ndim != 2 || hv->shape[0] != m
+            || hv->shape[1] != 3) {
+            PyErr_SetString(PyExc_ValueError, "Expected vertices (n, 3) float64, faces (m, 3) int64, axis (m,) "
+                            "int64, skip (m,) uint8, lo and hi (m, 3) float64, all C-contiguous");
+            goto done;
+        }
+        int64_t n = vv->shape[0];
+        const int64_t *F = (const int64_t *)fv->buf, *X = (const int64_t *)xv->buf;
+        for (Py_ssize_t i = 0; i < m * 3; i++) {
+            if (F[i] < 0 || F[i] >= n) {
+                PyErr_Format(PyExc_ValueError, "Expected face indices in [0, %lld), found %lld",
+                             (long long)n, (long long)F[i]);
+                goto done;
+            }
+        }
+        for (Py_ssize_t i = 0; i < m; i++) {
+            if (X[i] < 0 || X[i] > 2) {
+                PyErr_SetString(PyExc_ValueError, "Expected axis values in 0..2");
+                goto done;
+            }
+        }
+        sc.complete = 1;
+        sc.max_pairs = max_pairs;
+        if (m >= 2) {
+            if ((size_t)m > SIZE_MAX / (2 * sizeof(CtNode))) {
+                PyErr_NoMemory();
+                goto done;
+            }
+            nodes = (CtNode *)malloc((size_t)(2 * m) * sizeof(CtNode));
+            order = (int64_t *)malloc((size_t)m * sizeof(int64_t));
+            fo = (int64_t *)malloc((size_t)m * 3 * sizeof(int64_t));
+            tri = (double *)malloc((size_t)m * 9 * sizeof(double));
+            blo = (double *)malloc((size_t)m * 3 * sizeof(double));
+            bhi = (double *)malloc((size_t)m * 3 * sizeof(double));
+            if (nodes == NULL || order == NULL || fo == NULL || tri == NULL || blo == NULL
+                || bhi == NULL) {
+                PyErr_NoMemory();
+                goto done;
+            }
+            for (int64_t i = 0; i < m; i++) order[i] = i;
+            const double *V = (const double *)vv->buf, *LO = (const double *)lv->buf;
+            const double *HI = (const double *)hv->buf;
+            sc.X = X;
+            sc.S = (const uint8_t *)sv->buf;
+            sc.order = order;
+            sc.nodes = nodes;
+            sc.LO = blo;
+            sc.HI = bhi;
+            sc.T = tri;
+            sc.FO = fo;
+            int64_t built;
+            Py_BEGIN_ALLOW_THREADS
+            built = ct_build(nodes, order, LO, HI, m);
+            if (built > 0) {
+                /* the data the traversal reads, in hierarchy order: neighbours in space are near in memory */
+                for (int64_t i = 0; i < m; i++) {
+                    int64_t face = order[i];
+                    for (int c = 0; c < 3; c++) {
+                        blo[3 * i + c] = LO[3 * face + c];
+                        bhi[3 * i + c] = HI[3 * face + c];
+                        fo[3 * i + c] = F[3 * face + c];
+                        for (int k = 0; k < 3; k++) {
+                            tri[9 * i + 3 * c + k] = V[3 * F[3 * face + c] + k];
+                        }
+                    }
+                }
+                int nt = max_pairs >= 0 ? 1 : thread_count(threads, (size_t)m, 20000);
+                if (nt == 1) {
+                    ct_traverse(&sc, 0, 0);
+                }
+                else {
+                    CtScan scans[MAX_THREADS];
+                    int64_t tasks[2 * CT_TASKS];
+                    CtParallel pp;
+                    for (int t = 0; t < nt; t++) {
+                        scans[t] = sc;
+                    }
+                    pp.scans = scans;
+                    pp.tasks = tasks;
+                    pp.n_tasks = ct_tasks(nodes, tasks);
+                    pp.next = 0;
+                    run_parallel(nt, ct_parallel_task, &pp);
+                    for (int t = 0; t < nt; t++) {          /* merge into sc */
+                        CtScan *u = &scans[t];
+                        if (t > 0) {
+                            sc.candidates += u->candidates;
+                            sc.tested += u->tested;
+                            sc.exact += u->exact;
+                            sc.oom |= u->oom;
+                            for (size_t i = 0; i < u->found.n && !sc.oom; i++) {
+                                if (ct_found_push(&sc.found, u->found.a[i], u->found.b[i], u->found.kind[i]) < 0) {
+                                    sc.oom = 1;
+                                }
+                            }
+                            free(u->found.a);
+                            free(u->found.b);
+                            free(u->found.kind);
+                        }
+                        else {
+                            sc = scans[0];
+                        }
+                    }
+                }
+            }
+            Py_END_ALLOW_THREADS
+            if (built < 0 || sc.oom) {
+                PyErr_NoMemory();
+                goto done;
+            }
+        }
+        PyObject *pa = PyBytes_FromStringAndSize((const char *)sc.found.a, (Py_ssize_t)(sc.found.n * 8));
+        PyObject *pb = PyBytes_FromStringAndSize((const char *)sc.found.b, (Py_ssize_t)(sc.found.n * 8));
+        PyObject *pk = PyBytes_FromStringAndSize((const char *)sc.found.kind, (Py_ssize_t)sc.found.n);
+        if (pa && pb && pk) {
+            result = Py_BuildValue("(OOOLLlO)", pa, pb, pk, sc.candidates, sc.tested, sc.exact,
+                                   sc.complete ? Py_True : Py_False);
+        }
+        Py_XDECREF(pa);
+        Py_XDECREF(pb);
+        Py_XDECREF(pk);
+    }
+done:
+    for (int i = 0; i < got; i++) {
+        PyBuffer_Release(&views[i]);
+    }
+    free(nodes);
+    free(order);
+    free(fo);
+    free(tri);
+    free(blo);
+    free(bhi);
+    free(sc.found.a);
+    free(sc.found.b);
+    free(sc.found.kind);
     return result;
 }

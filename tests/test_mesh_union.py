@@ -6,7 +6,7 @@ import trimesh
 
 from conftest import box_arrays
 from inertia_tool.mesh.nesting import shell_nesting
-from inertia_tool.mesh.union import closed_groups, crossing_shells, triangles_meet, union_surface
+from inertia_tool.mesh.union import closed_groups, crossing_shells, union_surface
 from inertia_tool.mass.volume import volume_moments
 
 
@@ -78,11 +78,13 @@ def test_union_of_body_minus_overlapping_cavities():
     assert np.isclose(volume_moments(union.vertices, union.faces).volume, 64 - 1.5, rtol=1e-12)
 
 
-@pytest.mark.parametrize("shift, meets", [(0.0, True), (0.5, True), (1.0 + 1e-9, False)])
-def test_triangles_meet(shift, meets):
-    t1 = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], dtype=float)
-    t2 = np.array([[[0.2, 0.2, -1], [0.2, 0.2, 1], [0.2 + shift, 1.5, 0]]], dtype=float) + [shift, 0, 0]
-    assert triangles_meet(t1, t2)[0] == meets
+def test_crossing_shells_tests_the_largest_shell_against_itself():
+    # issue 21: the figure-eight tube is one shell passing through itself; the old test skipped the largest shell
+    from test_mesh_intersect import _figure_eight_tube
+    v, f = _figure_eight_tube(80, 8)
+    labels = np.zeros(len(f), dtype=np.intp)
+    assert crossing_shells(v, f, labels, np.ones(len(f), dtype=bool)).tolist() == [True]
+    assert crossing_shells(v, f, labels, np.ones(len(f), dtype=bool), max_pairs=10) is None
 
 
 def test_closed_groups_split_bodies_touching_along_an_edge():

@@ -4,12 +4,10 @@ When closed shells overlap (two bodies modelled through each other, or one surfa
 at non-manifold edges), the summed divergence-theorem integral counts the shared volume twice: the winding
 number there is 2.  The physical solid is the union ``{w ≥ 1}``.
 
-* :func:`crossing_shells` finds the shells whose surface touches or crosses another shell's surface, by
-  exact-in-spirit triangle–triangle tests (an edge of one triangle passing through the other, with
-  non-strict signs so that touching counts too) on the pairs that a k-d tree of face centres proposes.  It is
-  conservative: it never misses a crossing between faces that share no vertex, and it may report touching
-  surfaces; :func:`union_surface` is the arbiter (the union's volume equals the summed volume when nothing
-  overlaps).
+* :func:`crossing_shells` finds the shells whose surface touches or crosses a surface, by the exact
+  face-pair classification of :func:`~.intersect.surface_contacts` (every pair of faces whose boxes meet,
+  shared vertices included); :func:`union_surface` is the arbiter (the union's volume equals the summed volume
+  when nothing overlaps).
 * :func:`closed_groups` splits a balanced surface into closed, manifold pieces: the patches of faces joined
   through manifold edges, with unclosed patches merged across the edges they share.
 * :func:`union_surface` builds one manifold3d ``Manifold`` per piece (float64 ``Mesh64``), takes the union of
@@ -33,151 +31,13 @@ class UnionError(RuntimeError):
     """The boolean union could not be formed (manifold3d missing, or a piece it rejects)."""
 
 
-# -- sound crossing test -----------------------------------------------------------------------------------
-
-def _orient(a, b, c, d):
-    """6 × signed volume of the tetrahedron (a, b, c, d), rows of (k, 3) arrays."""
-    return np.einsum("ij,ij->i", a - d, np.cross(b - d, c - d))
-
-
-def _segment_meets_triangle(p, q, a, b, c, eps):
-    """Non-strict: the closed segment pq touches or crosses the closed triangle abc (k,) bool."""
-    sp, sq = _orient(a, b, c, p), _orient(a, b, c, q)
-    straddle = ~(((sp > eps) & (sq > eps)) | ((sp < -eps) & (sq < -eps)))
-    u, v, w = _orient(p, q, a, b), _orient(p, q, b, c), _orient(p, q, c, a)
-    same = ~(((u > eps) | (v > eps) | (w > eps)) & ((u < -eps) | (v < -eps) | (w < -eps)))
-    return straddle & same
-
-
-def triangles_meet(t1: np.ndarray, t2: np.ndarray, eps: float = 0.0) -> np.ndarray:
-    """Whether triangle pairs touch or cross (conservative), (k,) bool.
-
-    Two triangles in general position intersect iff an edge of one passes through the other; coplanar or
-    touching configurations make some orientation zero (within ``eps``) and count as meeting.
-
-    Parameters
-    ----------
-    t1, t2 : (k, 3, 3) float
-        Corner coordinates.
-    eps : float
-        Orientation values (6 × tetrahedron volumes) with magnitude at most ``eps`` count as zero.
-    """
-    hit = np.zeros(len(t1), dtype=bool)
-    for s, t in ((t1, t2), (t2, t1)):
-        for i, j in ((0, 1), (1, 2), (2, 0)):
-            hit |= _segment_meets_triangle(s[:, i], s[:, j], t[:, 0], t[:, 1], t[:, 2], eps)
-    return hit
-
-
-def _near_query(lo, hi, query, origin, size, coarse=64):
-    """Indices of the non-query faces whose box may overlap a query face's box.
-
-    A coarse occupancy grid (``coarse`` cells a side) marks the cells the query boxes reach; a face inside one
-    coarse cell is kept when that cell is marked, a face spanning several is kept regardless (conservative).
-    """
-    h = size / coarse if size > 0 else 1.0
-    c0 = np.clip(np.floor((lo - origin) / h).astype(np.int64), 0, coarse - 1)
-    c1 = np.clip(np.floor((hi - origin) / h).astype(np.int64), 0, coarse - 1)
-    marked = np.zeros((coarse, coarse, coarse), dtype=bool)
-    q = np.flatnonzero(query)
-    one = (c0[q, 0] == c1[q, 0]) & (c0[q, 1] == c1[q, 1]) & (c0[q, 2] == c1[q, 2])
-    marked[c0[q[one], 0], c0[q[one], 1], c0[q[one], 2]] = True
-    for f in q[~one]:           # faces spanning several coarse cells: few (cells are 1/64 of the part)
-        marked[c0[f, 0]:c1[f, 0] + 1, c0[f, 1]:c1[f, 1] + 1, c0[f, 2]:c1[f, 2] + 1] = True
-    other = np.flatnonzero(~query)
-    d0, d1 = c0[other], c1[other]
-    single = (d0[:, 0] == d1[:, 0]) & (d0[:, 1] == d1[:, 1]) & (d0[:, 2] == d1[:, 2])
-    keep = ~single
-    cell = c0[other[single]]
-    keep[single] = marked[cell[:, 0], cell[:, 1], cell[:, 2]]
-    return other[keep]
-
-
-def _cells(faces, lo, hi, origin, h, dims):
-    """Grid entries (face, cell key) of ``faces`` on cells of side ``h`` covering their boxes."""
-    i0 = np.floor((lo[faces] - origin) / h).astype(np.int64)
-    i1 = np.floor((hi[faces] - origin) / h).astype(np.int64)
-    span = i1 - i0 + 1
-    count = span[:, 0] * span[:, 1] * span[:, 2]
-    which = np.repeat(np.arange(len(faces)), count)
-    k = np.arange(len(which)) - np.repeat(np.cumsum(count) - count, count)
-    sy, sz = span[which, 1], span[which, 2]
-    key = ((i0[which, 0] + k // (sy * sz)) * dims[1] + i0[which, 1] + (k // sz) % sy) * dims[2] + i0[which, 2] + k % sz
-    return faces[which], key
-
-
-def _home(a, b, lo, origin, h, dims):
-    """Cell key (side ``h``) of the low corner of the intersection of the boxes of faces a and b."""
-    c = np.floor((np.maximum(lo[a], lo[b]) - origin) / h).astype(np.int64)
-    return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
-
-
-def _grid_pairs(lo, hi, query, max_pairs, pad):
-    """Face pairs whose padded bounding boxes overlap, at least one face in ``query``: (a, b) or None.
-
-    A hierarchical grid: faces are sorted into levels by size (level ``L`` holds boxes at most ``h·2^L``
-    across, ``h`` the median), each level has its own grid of cells ``h·2^L`` (a box spans at most 2 cells
-    a side there), and every face is paired with the faces of its own level sharing a cell and with the
-    larger levels' faces through their grids.  A pair is reported only in the cell holding the low corner of
-    the two boxes' intersection, so it comes out once.  Faces far from every query face are dropped first
-    (coarse occupancy grid).  Returns None beyond ``max_pairs`` candidate pairs (the caller then lets the
-    boolean decide).
-    """
-    lo, hi = lo - pad, hi + pad
-    origin = lo.min(axis=0)
-    size = float(np.max(hi.max(axis=0) - origin))
-    d = hi - lo
-    extent = np.maximum(np.maximum(d[:, 0], d[:, 1]), d[:, 2])
-    h0 = max(float(np.median(extent)), size / 4096, pad)
-    level = np.ceil(np.log2(np.maximum(extent, h0) / h0)).astype(np.int64)
-    keep = np.zeros(len(lo), dtype=bool)
-    keep[np.flatnonzero(query)] = True
-    keep[_near_query(lo, hi, query, origin, size)] = True
-    out_a, out_b, total = [], [], 0
-    for top in np.unique(level[keep]):
-        h = h0 * 2.0 ** top
-        dims = np.full(3, int(np.floor(size / h)) + 2, dtype=np.int64)
-        members = np.flatnonzero(keep & (level == top))
-        fb, kb = _cells(members, lo, hi, origin, h, dims)
-        order = np.argsort(kb, kind="stable")
-        fb, kb = fb[order], kb[order]
-        # the same level: pairs within each cell
-        starts = np.flatnonzero(np.r_[True, kb[1:] != kb[:-1]]) if len(kb) else np.zeros(0, dtype=np.int64)
-        size_of = np.diff(np.r_[starts, len(kb)])
-        later = np.repeat(starts + size_of, size_of) - np.arange(len(kb)) - 1
-        n_same = int(later.sum())
-        # smaller levels through this level's grid (only their query faces when this level has none)
-        smaller = keep & (level < top)
-        if not query[members].any():
-            smaller &= query
-        fa, ka = _cells(np.flatnonzero(smaller), lo, hi, origin, h, dims)
-        left = np.searchsorted(kb, ka, side="left")
-        run = np.searchsorted(kb, ka, side="right") - left
-        n_cross = int(run.sum())
-        total += n_same + n_cross
-        if total > max_pairs:
-            return None
-        first = np.repeat(np.arange(len(kb)), later)
-        offset = np.arange(n_same) - np.repeat(np.cumsum(later) - later, later)
-        partner = np.repeat(left, run) + (np.arange(n_cross) - np.repeat(np.cumsum(run) - run, run))
-        a = np.r_[fb[first], np.repeat(fa, run)]
-        b = np.r_[fb[first + 1 + offset], fb[partner]]
-        cell = np.r_[kb[first], kb[partner]]
-        ok = (query[a] | query[b]) & (a != b)
-        ok &= np.all(lo[a] <= hi[b], axis=1) & np.all(lo[b] <= hi[a], axis=1)
-        a, b, cell = a[ok], b[ok], cell[ok]
-        once = _home(a, b, lo, origin, h, dims) == cell
-        out_a.append(a[once])
-        out_b.append(b[once])
-    if not out_a:
-        e = np.zeros(0, dtype=np.int64)
-        return e, e
-    return np.concatenate(out_a), np.concatenate(out_b)
-
+# -- which shells meet another surface -------------------------------------------------------------------
 
 def crossing_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, query: np.ndarray, *,
-                    eps_rtol: float = 1e-12, max_pairs: int = 20_000_000) -> np.ndarray | None:
-    """Shells whose surface touches or crosses another shell's surface or its own (non-adjacent) faces.
+                    max_pairs: int | None = None) -> np.ndarray | None:
+    """Shells having a face that meets another face beyond what the two share by index (crossing, coplanar
+    overlap or boundary contact), for faces in ``query``; a thin caller of
+    :func:`~.intersect.surface_contacts`, which tests every pair of faces (the same shell included).
 
     Parameters
     ----------
@@ -186,48 +46,29 @@ def crossing_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     labels : (m,) int
         Shell of each face.
     query : (m,) bool
-        Faces to test against all faces (e.g. every face of the smaller shells of each overlapping pair).
-    eps_rtol : float
-        Orientation values below ``eps_rtol · L³`` (``L`` the bounding-box diagonal) count as zero.
-    max_pairs : int
+        Only pairs with at least one face in ``query`` count.
+    max_pairs : int, optional
         Work bound on candidate pairs; beyond it the test gives up and returns None (the caller then lets
         the boolean union decide).
 
     Returns
     -------
     (s,) bool or None
-        Per shell (``s = labels.max() + 1``): some face of it meets a face of another shell, or a face of its
-        own shell that shares no vertex with it.
+        Per shell (``s = labels.max() + 1``): some face of it meets another face of the mesh.
     """
-    v = np.asarray(vertices, dtype=np.float64)
-    f = np.asarray(faces, dtype=np.int64)
+    from .intersect import surface_contacts
+
     n_shells = int(labels.max()) + 1 if len(labels) else 0
     found = np.zeros(n_shells, dtype=bool)
+    query = np.asarray(query, dtype=bool)
     if not np.any(query):
         return found
-    centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
-    v = v - centre
-    diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
-    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    lo = np.minimum(np.minimum(p0, p1), p2)
-    hi = np.maximum(np.maximum(p0, p1), p2)
-    del p0, p1, p2
-    pairs = _grid_pairs(lo, hi, np.asarray(query, dtype=bool), max_pairs, 1e-9 * diag)
-    if pairs is None:
+    contacts = surface_contacts(vertices, faces, max_pairs=max_pairs)
+    if not contacts.complete:
         return None
-    a, b = pairs
-    shared = np.zeros(len(a), dtype=bool)
-    for i in range(3):
-        for j in range(3):
-            shared |= f[a, i] == f[b, j]
-    a, b = a[~shared], b[~shared]
-    eps = eps_rtol * diag ** 3
-    step = 1 << 20
-    for s in range(0, len(a), step):
-        aa, bb = a[s:s + step], b[s:s + step]
-        meet = triangles_meet(v[f[aa]], v[f[bb]], eps)
-        found[labels[aa[meet]]] = True
-        found[labels[bb[meet]]] = True
+    pairs = np.concatenate([contacts.crossing, contacts.coplanar_opposite, contacts.contact])
+    pairs = pairs[query[pairs[:, 0]] | query[pairs[:, 1]]]
+    found[labels[pairs.reshape(-1)]] = True
     return found
 
 

@@ -1,0 +1,625 @@
+"""Where the faces of a triangle mesh meet other than along what they share by index: exact detection.
+
+A closed, consistently oriented mesh bounds a simple polyhedron only if no two faces intersect except along
+the vertices and edges they share by index.  :func:`surface_contacts` tests every pair of faces whose
+bounding boxes meet (within one shell and between shells, adjacent faces included) and sorts the pairs that
+meet beyond what they share into three kinds (:class:`SurfaceContacts`):
+
+* ``crossing``: the two triangles cross transversally (a point in the relative interior of both, the planes
+  distinct), or they are coplanar, overlap in a region of positive area and face the same way.  Either the
+  two solids' interiors overlap or the surface passes through itself.
+* ``coplanar_opposite``: coplanar, overlapping in a region of positive area, facing opposite ways (two bodies
+  touching face to face, or a zero-thickness internal wall).
+* ``contact``: the triangles meet, beyond what they share by index, only on the boundary of at least one of
+  them (a vertex on a face, an edge along a face, crossing edges: T-junctions, cubes touching along an edge).
+  Whether that changes the solid is for the caller to decide.
+
+Pairs sharing an edge by index meet beyond it only if they are coplanar with their third vertices on the
+same side of the edge (folded over); they are then ``coplanar_opposite`` when they face opposite ways (which
+is the case for a consistently oriented fold) and ``crossing`` when they face the same way.  Faces of zero
+area (three collinear corners, exactly) are skipped: they bound no volume; the caller counts them.
+
+Exactness
+---------
+Every decision is the sign of an orientation determinant of input coordinates (no tolerance decides
+topology).  ``orient3d(a, b, c, d) = det[a − d; b − d; c − d]`` and ``orient2d(a, b, c) = det[a − c; b − c]``
+are first evaluated in float64 with a static error bound, and recomputed exactly in rational arithmetic
+(Python integers: every float64 is a dyadic rational, so all coordinates of one batch scaled by one power of
+two are integers) when the floating-point
+value is within its bound of zero.
+
+The bound (in the manner of Shewchuk, "Adaptive Precision Floating-Point Arithmetic and Fast Robust
+Geometric Predicates", Discrete Comput. Geom. 18, 1997, section 4.3): with ``u = 2⁻⁵³`` the unit roundoff,
+each of the six triple products of the cofactor expansion of ``orient3d`` passes through at most eight
+roundings (three differences, one product in a 2×2 minor, the minor's subtraction, the product with the
+first row, two additions of the sum), so ``|fl(det) − det| ≤ γ₈·P`` with ``P = Σ|triple products|`` and
+``γₙ = n·u/(1 − n·u)``; ``P`` itself, evaluated in float64 from the absolute values, is at least
+``P/(1 + γ₇)``.  Hence ``|fl(det) − det| ≤ 8.01·u·fl(P)`` and we use ``10·u·fl(P)``.  For ``orient2d`` four
+roundings per product give ``γ₄``; we use ``6·u·fl(P)``.  These relative bounds need every rounding to be
+relative, i.e. no underflow or overflow: we check once that every nonzero coordinate magnitude lies in
+``[2⁻²⁴⁰, 2²⁹⁹]`` (then every nonzero difference lies in ``[2⁻²⁹², 2³⁰⁰]`` and no product of three of
+them leaves the normal range; a subnormal difference of two products is exact); a mesh outside that range is
+first scaled by a power of two (exact, and orientation signs do not change), and if its dynamic range is
+still too wide every sign is computed exactly.  ``fl(P) = 0`` means every triple product has a zero factor,
+so the determinant is exactly zero.
+
+Broad phase
+-----------
+A hierarchical uniform grid over the face bounding boxes (closed boxes: touching counts): faces are sorted
+into levels by size (level ``L`` holds boxes at most ``h·2^L`` across, ``h`` twice the median box size),
+each level has its own grid of cells ``h·2^L``, every face is paired with the faces of its own level that share a cell
+and with the faces of larger levels through their grids; a pair is kept only in the cell holding the low
+corner of the intersection of the two boxes, so it is tested once.  Cell indices are ``floor((x − o)/h)``,
+monotone in ``x``, so two closed boxes that meet always share a cell.  Candidate pairs are generated and
+tested in chunks of at most ``chunk`` pairs, so memory stays bounded on any mesh.
+
+C extension
+-----------
+When ``inertia_tool._accel`` is built (and the coordinates are in the filter's range) the whole scan runs in
+its section 8 (``contact_scan``): a bounding-volume hierarchy over the face boxes (faces in Morton order of
+their box centres) traversed against itself gives the same candidate pairs as the grid, in another order, and
+each is classified on the spot with the same predicates and decisions, the exact stage computed by
+floating-point expansions instead of Python integers, on :func:`~inertia_tool._native.threads` threads (the
+pairs found do not depend on the count; with ``max_pairs`` it runs on one, and which pairs are tested before
+the bound stops it differs from the grid's order).  This module's numpy code stays the reference and
+the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+import numpy as np
+
+from .._native import accel, threads
+from ..errors import InvalidMeshError
+from ..values import frozen_value
+
+__all__ = ["SurfaceContacts", "surface_contacts", "orient3d_sign", "orient2d_sign"]
+
+_U = 2.0 ** -53
+#: Coefficient of the static error bound of orient3d (see the module docstring: 8.01·u suffices).
+O3D_BOUND = 10 * _U
+#: Coefficient of the static error bound of orient2d (γ₄ suffices).
+O2D_BOUND = 6 * _U
+#: Nonzero coordinate magnitudes inside [2⁻²⁴⁰, 2²⁹⁹] keep every rounding of the predicates relative.
+_SMALLEST, _LARGEST = 2.0 ** -240, 2.0 ** 299
+#: Candidate pairs generated and tested at once (memory bound of the narrow phase: ~1 kB per pair).
+CHUNK_PAIRS = 1 << 17
+
+_NONE, _CROSSING, _OPPOSITE, _CONTACT = 0, 1, 2, 3
+
+
+@frozen_value
+class SurfaceContacts:
+    """The face pairs of a mesh that meet beyond the vertices and edges they share by index.
+
+    Attributes
+    ----------
+    crossing : (k, 2) intp
+        Face pairs ``i < j`` (rows sorted) that cross transversally, or are coplanar and overlap in a region of
+        positive area facing the same way: the solids' interiors overlap, or the surface passes through itself.
+    coplanar_opposite : (j, 2) intp
+        Face pairs ``i < j`` that are coplanar and overlap in a region of positive area facing opposite ways
+        (face-to-face contact, or a zero-thickness internal wall).
+    contact : (c, 2) intp
+        Face pairs ``i < j`` that meet, beyond what they share by index, only on the boundary of at least one
+        of them (vertex on a face, edge along a face, edges crossing: T-junctions, bodies touching along an edge).
+    complete : bool
+        True when every candidate pair was tested; False only when ``max_pairs`` stopped the search (the pairs
+        found so far are reported, but the absence of a crossing is then not proven).
+    candidate_pairs : int
+        Face pairs whose bounding boxes meet (the broad phase's output, all of them when ``complete``).
+    tested_pairs : int
+        Candidate pairs tested exactly (both faces of nonzero area).
+    exact_evaluations : int
+        Predicate evaluations the floating-point filter could not decide, recomputed in rational arithmetic.
+    degenerate_faces : int
+        Faces of zero area (skipped).
+    """
+
+    crossing: np.ndarray
+    coplanar_opposite: np.ndarray
+    contact: np.ndarray
+    complete: bool
+    candidate_pairs: int = 0
+    tested_pairs: int = 0
+    exact_evaluations: int = 0
+    degenerate_faces: int = 0
+
+
+# -- exact predicates ----------------------------------------------------------------------------------------
+
+def _integers(*points: np.ndarray) -> list[np.ndarray]:
+    """The rows of float64 arrays as exact Python integers at one common scale (object arrays, same shapes).
+
+    Every float64 is ``M·2^E`` with an integer mantissa ``|M| < 2⁵³``; scaling all of them by the smallest
+    ``2^-E`` makes them integers, and a determinant's sign does not change under a common positive scale.
+    """
+    mant, expo = np.frexp(np.concatenate([p.reshape(-1) for p in points]))
+    m = (mant * 2.0 ** 53).astype(np.int64)
+    e = expo.astype(np.int64) - 53
+    nonzero = m != 0
+    base = int(e[nonzero].min()) if nonzero.any() else 0
+    shift = np.where(nonzero, e - base, 0)
+    ints = np.array([int(x) << int(k) for x, k in zip(m.tolist(), shift.tolist())] if len(m) else [],
+                    dtype=object)
+    out, at = [], 0
+    for p in points:
+        out.append(ints[at:at + p.size].reshape(p.shape))
+        at += p.size
+    return out
+
+
+def _exact_orient3d(a, b, c, d) -> np.ndarray:
+    """Exact sign of orient3d per row (k,) int8, in integer arithmetic."""
+    a, b, c, d = _integers(a, b, c, d)
+    ad, bd, cd = a - d, b - d, c - d
+    det = (ad[:, 0] * (bd[:, 1] * cd[:, 2] - bd[:, 2] * cd[:, 1])
+           + ad[:, 1] * (bd[:, 2] * cd[:, 0] - bd[:, 0] * cd[:, 2])
+           + ad[:, 2] * (bd[:, 0] * cd[:, 1] - bd[:, 1] * cd[:, 0]))
+    return np.array([(x > 0) - (x < 0) for x in det], dtype=np.int8)
+
+
+def _exact_orient2d(a, b, c) -> np.ndarray:
+    """Exact sign of orient2d per row (k,) int8, in integer arithmetic."""
+    a, b, c = _integers(a, b, c)
+    det = (a[:, 0] - c[:, 0]) * (b[:, 1] - c[:, 1]) - (a[:, 1] - c[:, 1]) * (b[:, 0] - c[:, 0])
+    return np.array([(x > 0) - (x < 0) for x in det], dtype=np.int8)
+
+
+class _Predicates:
+    """Filtered exact predicates over rows of points; counts the rows decided exactly."""
+
+    def __init__(self, force_exact: bool = False):
+        self.force_exact = force_exact
+        self.exact = 0
+
+    def orient3d(self, a, b, c, d) -> np.ndarray:
+        """Sign of ``det[a − d; b − d; c − d]`` per row, (k,) int8; ``a..d`` (k, 3) float64."""
+        with np.errstate(all="ignore"):            # out of the filter's range everything is recomputed exactly
+            return self._orient3d(a, b, c, d)
+
+    def orient2d(self, a, b, c) -> np.ndarray:
+        """Sign of ``det[a − c; b − c]`` per row, (k,) int8; ``a, b, c`` (k, 2) float64."""
+        with np.errstate(all="ignore"):
+            return self._orient2d(a, b, c)
+
+    def _orient3d(self, a, b, c, d) -> np.ndarray:
+        ad, bd, cd = a - d, b - d, c - d
+        m0 = bd[:, 1] * cd[:, 2] - bd[:, 2] * cd[:, 1]
+        m1 = bd[:, 2] * cd[:, 0] - bd[:, 0] * cd[:, 2]
+        m2 = bd[:, 0] * cd[:, 1] - bd[:, 1] * cd[:, 0]
+        det = ad[:, 0] * m0 + ad[:, 1] * m1 + ad[:, 2] * m2
+        ab, bb, cb = np.abs(ad), np.abs(bd), np.abs(cd)
+        perm = (ab[:, 0] * (bb[:, 1] * cb[:, 2] + bb[:, 2] * cb[:, 1])
+                + ab[:, 1] * (bb[:, 2] * cb[:, 0] + bb[:, 0] * cb[:, 2])
+                + ab[:, 2] * (bb[:, 0] * cb[:, 1] + bb[:, 1] * cb[:, 0]))
+        sign = np.sign(det).astype(np.int8)
+        unsure = np.flatnonzero((np.abs(det) <= O3D_BOUND * perm) & (perm > 0)) if not self.force_exact \
+            else np.arange(len(det))
+        if len(unsure):
+            sign[unsure] = _exact_orient3d(a[unsure], b[unsure], c[unsure], d[unsure])
+        self.exact += len(unsure)
+        return sign
+
+    def _orient2d(self, a, b, c) -> np.ndarray:
+        acx, acy = a[:, 0] - c[:, 0], a[:, 1] - c[:, 1]
+        bcx, bcy = b[:, 0] - c[:, 0], b[:, 1] - c[:, 1]
+        left, right = acx * bcy, acy * bcx
+        det = left - right
+        perm = np.abs(left) + np.abs(right)
+        sign = np.sign(det).astype(np.int8)
+        unsure = np.flatnonzero((np.abs(det) <= O2D_BOUND * perm) & (perm > 0)) if not self.force_exact \
+            else np.arange(len(det))
+        if len(unsure):
+            sign[unsure] = _exact_orient2d(a[unsure], b[unsure], c[unsure])
+        self.exact += len(unsure)
+        return sign
+
+
+def orient3d_sign(a, b, c, d) -> np.ndarray:
+    """Exact sign of ``det[a − d; b − d; c − d]`` for rows of float64 points, (k,) int8.
+
+    Positive when ``d`` sees ``a, b, c`` clockwise, i.e. ``d`` lies below the plane of the counter-clockwise
+    triangle ``a, b, c`` (its normal ``(b − a)×(c − a)`` points away from ``d``).
+    """
+    pts = [np.atleast_2d(np.asarray(p, dtype=np.float64)) for p in (a, b, c, d)]
+    return _Predicates(not _filter_safe(np.concatenate(pts))).orient3d(*pts)
+
+
+def orient2d_sign(a, b, c) -> np.ndarray:
+    """Exact sign of ``det[a − c; b − c]`` for rows of float64 2-D points, (k,) int8 (+1: ``a, b, c``
+    counter-clockwise)."""
+    pts = [np.atleast_2d(np.asarray(p, dtype=np.float64)) for p in (a, b, c)]
+    return _Predicates(not _filter_safe(np.concatenate(pts))).orient2d(*pts)
+
+
+def _filter_safe(v: np.ndarray) -> bool:
+    """Whether every nonzero coordinate magnitude lies in the range where the static filter's bound holds."""
+    mag = np.abs(v[v != 0])
+    return not len(mag) or (float(mag.min()) >= _SMALLEST and float(mag.max()) <= _LARGEST)
+
+
+def _scaled(v: np.ndarray) -> tuple[np.ndarray, bool]:
+    """``v`` scaled by a power of two (exact) so that the filter holds, and whether it does."""
+    if _filter_safe(v):
+        return v, True
+    mag = np.abs(v[v != 0])
+    _, top = np.frexp(float(mag.max()))
+    w = np.ldexp(v, -int(top))                  # largest magnitude in [0.5, 1): exact unless something underflows
+    if np.array_equal(np.ldexp(w, int(top)), v) and _filter_safe(w):
+        return w, True
+    return v, False
+
+
+# -- per-face data --------------------------------------------------------------------------------------------
+
+_PLANE = np.array([[1, 2], [2, 0], [0, 1]])      # coordinates kept when dropping axis k (orientation-preserving)
+
+
+def _face_axes(v: np.ndarray, f: np.ndarray, pred: _Predicates) -> tuple[np.ndarray, np.ndarray]:
+    """Per face: the axis whose normal component is exactly nonzero and largest in float, and zero-area mask."""
+    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    normal = np.cross(p1 - p0, p2 - p0)
+    axis = np.argmax(np.abs(normal), axis=1)
+    sign = np.zeros(len(f), dtype=np.int8)
+    todo = np.arange(len(f))
+    for _ in range(3):                                   # try the largest component, then the others
+        if not len(todo):
+            break
+        k = axis[todo]
+        keep = _PLANE[k]
+        a = np.take_along_axis(p0[todo], keep, 1)
+        b = np.take_along_axis(p1[todo], keep, 1)
+        c = np.take_along_axis(p2[todo], keep, 1)
+        sign[todo] = pred.orient2d(a, b, c)
+        todo = todo[sign[todo] == 0]
+        axis[todo] = (axis[todo] + 1) % 3
+    degenerate = sign == 0
+    return axis, degenerate
+
+
+# -- narrow phase ---------------------------------------------------------------------------------------------
+
+def _classify(v: np.ndarray, f: np.ndarray, axis: np.ndarray, a: np.ndarray, b: np.ndarray,
+              pred: _Predicates) -> np.ndarray:
+    """Kind of each pair of nondegenerate faces ``(a, b)``: 0 none, 1 crossing, 2 coplanar opposite, 3 contact."""
+    k = len(a)
+    fa, fb = f[a], f[b]
+    same = fa[:, :, None] == fb[:, None, :]              # (k, 3, 3): corner i of a is corner j of b
+    n_shared = same.sum(axis=(1, 2))
+    t1, t2 = v[fa], v[fb]                                  # (k, 3, 3)
+    d1 = np.zeros((k, 3), dtype=np.int8)                   # corners of t1 against the plane of t2
+    d2 = np.zeros((k, 3), dtype=np.int8)
+    on1 = same.any(axis=2)                                 # a shared corner lies on the other plane: sign 0
+    on2 = same.any(axis=1)
+    for i in range(3):
+        r = np.flatnonzero(~on1[:, i])
+        d1[r, i] = pred.orient3d(t2[r, 0], t2[r, 1], t2[r, 2], t1[r, i])
+    # a pair sharing an edge is coplanar iff the third corner of a lies in b's plane; otherwise nothing
+    need2 = (n_shared < 2) | ~(d1 != 0).any(axis=1)
+    for i in range(3):
+        r = np.flatnonzero(~on2[:, i] & need2)
+        d2[r, i] = pred.orient3d(t1[r, 0], t1[r, 1], t1[r, 2], t2[r, i])
+    kind = np.zeros(k, dtype=np.int8)
+    separated = (np.all(d1 > 0, axis=1) | np.all(d1 < 0, axis=1) | np.all(d2 > 0, axis=1)
+                 | np.all(d2 < 0, axis=1))
+    coplanar = np.all(d1 == 0, axis=1)
+    rest = ~separated & ~coplanar & (n_shared < 2)
+    cop = np.flatnonzero(coplanar)
+    if len(cop):
+        kind[cop] = _coplanar(t1[cop], t2[cop], axis[a[cop]], same[cop], n_shared[cop], pred)
+    gen = np.flatnonzero(rest)
+    if len(gen):
+        kind[gen] = _transversal(t1[gen], t2[gen], d1[gen], d2[gen], same[gen], n_shared[gen], pred)
+    return kind
+
+
+def _touch_corner(d: np.ndarray) -> np.ndarray:
+    """Index of the one corner on the other plane when the two others lie strictly on one side, else -1."""
+    out = np.full(len(d), -1)
+    for i in range(3):
+        j, k = (i + 1) % 3, (i + 2) % 3
+        hit = (d[:, i] == 0) & (d[:, j] != 0) & (d[:, j] == d[:, k])
+        out[hit] = i
+    return out
+
+
+def _alone_corner(d: np.ndarray) -> np.ndarray:
+    """Index of a corner strictly on one side with the two others on the other closed side, else -1."""
+    out = np.full(len(d), -1)
+    for i in (2, 1, 0):                                     # the first such corner wins
+        j, k = (i + 1) % 3, (i + 2) % 3
+        hit = (d[:, i] != 0) & (d[:, j] * d[:, i] <= 0) & (d[:, k] * d[:, i] <= 0)
+        out[hit] = i
+    return out
+
+
+def _point_in_triangle(pred: _Predicates, apex, x, tri) -> np.ndarray:
+    """Closed test: ``x``, on the plane of ``tri`` (k, 3, 3), lies in ``tri``; ``apex`` is off that plane."""
+    s = [pred.orient3d(apex, x, tri[:, e], tri[:, (e + 1) % 3]) for e in range(3)]
+    s0, s1, s2 = s
+    return ((s0 >= 0) & (s1 >= 0) & (s2 >= 0)) | ((s0 <= 0) & (s1 <= 0) & (s2 <= 0))
+
+
+def _transversal(t1, t2, d1, d2, same, n_shared, pred: _Predicates) -> np.ndarray:
+    """Pairs in distinct planes, each touching the other's plane, sharing at most one corner."""
+    kind = np.zeros(len(t1), dtype=np.int8)
+    touch1, touch2 = _touch_corner(d1), _touch_corner(d2)
+    # one triangle meets the other's plane in a single corner: at most a contact there
+    for touch, s, o in ((touch1, t1, t2), (touch2, t2, t1)):
+        r = np.flatnonzero((touch >= 0) & (n_shared == 0) & (kind == _NONE))
+        if len(r):
+            i = touch[r]
+            apex = s[r, (i + 1) % 3]
+            inside = _point_in_triangle(pred, apex, s[r, i], o[r])
+            kind[r[inside]] = _CONTACT
+    general = np.flatnonzero((touch1 < 0) & (touch2 < 0))
+    if not len(general):
+        return kind
+    t1, t2, d1, d2 = t1[general], t2[general], d1[general], d2[general]
+    rows = np.arange(len(general))
+    # Guigue and Devillers' canonical form: p1 alone on the positive side of t2's plane (q1, r1 on the closed
+    # negative side), p2 likewise for t1's plane; swapping q and r of one triangle flips the other's signs.
+    i1 = _alone_corner(d1)
+    p1, q1, r1 = t1[rows, i1], t1[rows, (i1 + 1) % 3], t1[rows, (i1 + 2) % 3]
+    flip2 = d1[rows, i1] < 0
+    order2 = np.where(flip2[:, None], [0, 2, 1], [0, 1, 2])
+    t2c = t2[rows[:, None], order2]
+    d2c = d2[rows[:, None], order2]
+    i2 = _alone_corner(d2c)
+    p2, q2, r2 = t2c[rows, i2], t2c[rows, (i2 + 1) % 3], t2c[rows, (i2 + 2) % 3]
+    flip1 = d2c[rows, i2] < 0
+    q1, r1 = np.where(flip1[:, None], r1, q1), np.where(flip1[:, None], q1, r1)
+    # s1 = [i, j] with i on p1q1, j on p1r1; s2 = [k, l] likewise; on the common line they meet iff
+    # k ≤ j and i ≤ l, which are the signs of these two determinants (zero iff the endpoints coincide)
+    low = pred.orient3d(p1, q1, p2, q2)                   # ≤ 0 iff k ≤ j
+    high = -pred.orient3d(p1, r1, p2, r2)                 # ≤ 0 iff i ≤ l  (= orient3d(p1, r1, r2, p2))
+    meet = (low <= 0) & (high <= 0)
+    positive = (low < 0) & (high < 0)                      # both segments have positive length here
+    proper1 = np.count_nonzero(d1 == 0, axis=1) < 2        # not an edge lying in the other plane
+    proper2 = np.count_nonzero(d2 == 0, axis=1) < 2
+    crossing = positive & proper1 & proper2
+    shared = n_shared[general] > 0
+    contact = ~crossing & np.where(shared, positive, meet)
+    sub = np.zeros(len(general), dtype=np.int8)
+    sub[crossing] = _CROSSING
+    sub[contact] = _CONTACT
+    kind[general] = sub
+    return kind
+
+
+def _coplanar(t1, t2, axis, same, n_shared, pred: _Predicates) -> np.ndarray:
+    """Pairs in one plane: positive-area overlap (by facing), boundary contact, or nothing beyond the shared."""
+    k = len(t1)
+    keep = _PLANE[axis]                                    # (k, 2)
+    A = np.stack([np.take_along_axis(t1[:, i], keep, 1) for i in range(3)], axis=1)
+    B = np.stack([np.take_along_axis(t2[:, i], keep, 1) for i in range(3)], axis=1)
+    s1 = pred.orient2d(A[:, 0], A[:, 1], A[:, 2])
+    s2 = pred.orient2d(B[:, 0], B[:, 1], B[:, 2])
+    weak = np.zeros(k, dtype=bool)                         # a line through an edge separates the interiors
+    strict = np.zeros(k, dtype=bool)                       # ... separates the closed triangles
+    for P, Q, s in ((A, B, s1), (B, A, s2)):
+        for e in range(3):
+            o = np.stack([pred.orient2d(P[:, e], P[:, (e + 1) % 3], Q[:, j]) * s for j in range(3)], axis=1)
+            weak |= np.all(o <= 0, axis=1)
+            strict |= np.all(o < 0, axis=1)
+    kind = np.zeros(k, dtype=np.int8)
+    area = ~weak
+    kind[area & (s1 == s2)] = _CROSSING
+    kind[area & (s1 != s2)] = _OPPOSITE
+    touch = weak & ~strict
+    kind[touch & (n_shared == 0)] = _CONTACT
+    one = np.flatnonzero(touch & (n_shared == 1))
+    if len(one):
+        i1 = np.argmax(same[one].any(axis=2), axis=1)       # the shared corner in t1 and in t2
+        i2 = np.argmax(same[one].any(axis=1), axis=1)
+        v = t1[one, i1]
+        vv = A[one, i1]
+        along = np.zeros(len(one), dtype=bool)
+        for x in (1, 2):
+            for y in (1, 2):
+                px, py = t1[one, (i1 + x) % 3], t2[one, (i2 + y) % 3]
+                collinear = pred.orient2d(vv, A[one, (i1 + x) % 3], B[one, (i2 + y) % 3]) == 0
+                # collinear vectors from v point the same way iff their coordinates' signs agree
+                agree = np.all(np.sign(px - v) == np.sign(py - v), axis=1)
+                along |= collinear & agree
+        kind[one[along]] = _CONTACT
+    return kind
+
+
+# -- broad phase ----------------------------------------------------------------------------------------------
+
+def _cells(faces, lo, hi, origin, h, dims):
+    """Grid entries (face, cell key) of ``faces`` on cells of side ``h`` covering their boxes."""
+    i0 = np.floor((lo[faces] - origin) / h).astype(np.int64)
+    i1 = np.floor((hi[faces] - origin) / h).astype(np.int64)
+    span = i1 - i0 + 1
+    count = span[:, 0] * span[:, 1] * span[:, 2]
+    which = np.repeat(np.arange(len(faces)), count)
+    k = np.arange(len(which)) - np.repeat(np.cumsum(count) - count, count)
+    sy, sz = span[which, 1], span[which, 2]
+    key = ((i0[which, 0] + k // (sy * sz)) * dims[1] + i0[which, 1] + (k // sz) % sy) * dims[2] \
+        + i0[which, 2] + k % sz
+    return faces[which], key
+
+
+def _home(a, b, lo, origin, h, dims):
+    """Cell key (side ``h``) of the low corner of the intersection of the boxes of faces a and b."""
+    c = np.floor((np.maximum(lo[a], lo[b]) - origin) / h).astype(np.int64)
+    return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+
+
+def _chunks(per_entry: np.ndarray, chunk: int) -> Iterator[tuple[int, int]]:
+    """Ranges of entries whose pair counts add up to at most ``chunk`` (or one entry when it alone is more)."""
+    total = np.cumsum(per_entry)
+    start = 0
+    n = len(per_entry)
+    while start < n:
+        base = total[start - 1] if start else 0
+        stop = int(np.searchsorted(total, base + chunk, side="right"))
+        stop = max(stop, start + 1)
+        yield start, stop
+        start = stop
+
+
+_Raw = tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray]
+
+
+def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int) -> Iterator[_Raw]:
+    """Chunks ``(a, b, cell, h, dims)`` of face pairs sharing grid cell ``cell`` (side ``h``): a superset of the
+    pairs whose closed boxes meet, each of which appears exactly once with ``cell`` its home (see
+    :func:`_keep_mask`)."""
+    m = len(lo)
+    if m < 2:
+        return
+    size = float(np.max(hi.max(axis=0) - origin))
+    d = hi - lo
+    extent = np.max(d, axis=1)
+    h0 = max(2.0 * float(np.median(extent)), size / 4096)
+    if not h0 > 0:                                        # every face a point at one place
+        h0 = 1.0
+    level = np.ceil(np.log2(np.maximum(extent, h0) / h0)).astype(np.int64)
+    for top in np.unique(level):
+        h = h0 * 2.0 ** top
+        dims = np.full(3, int(np.floor(size / h)) + 2, dtype=np.int64)
+        fb, kb = _cells(np.flatnonzero(level == top), lo, hi, origin, h, dims)
+        order = np.argsort(kb, kind="stable")
+        fb, kb = fb[order], kb[order]
+        starts = np.flatnonzero(np.r_[True, kb[1:] != kb[:-1]])
+        run = np.diff(np.r_[starts, len(kb)])
+        later = np.repeat(starts + run, run) - np.arange(len(kb)) - 1     # same-cell entries after each entry
+        for s0, s1 in _chunks(later, chunk):
+            n = later[s0:s1]
+            first = np.repeat(np.arange(s0, s1), n)
+            offset = np.arange(len(first)) - np.repeat(np.cumsum(n) - n, n)
+            yield fb[first], fb[first + 1 + offset], kb[first], h, dims
+        # the smaller levels' faces through this level's grid
+        fa, ka = _cells(np.flatnonzero(level < top), lo, hi, origin, h, dims)
+        left = np.searchsorted(kb, ka, side="left")
+        count = np.searchsorted(kb, ka, side="right") - left
+        for s0, s1 in _chunks(count, chunk):
+            n = count[s0:s1]
+            partner = np.repeat(left[s0:s1], n) + (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n))
+            yield np.repeat(fa[s0:s1], n), fb[partner], kb[partner], h, dims
+
+
+def _keep_mask(a, b, cell, lo, hi, origin, h, dims) -> np.ndarray:
+    """Raw pairs that are candidates: distinct faces, closed boxes meeting, ``cell`` the pair's home."""
+    ok = (a != b) & np.all(lo[a] <= hi[b], axis=1) & np.all(lo[b] <= hi[a], axis=1)
+    r = np.flatnonzero(ok)
+    ok[r] = _home(a[r], b[r], lo, origin, h, dims) == cell[r]
+    return ok
+
+
+_Scan = tuple[np.ndarray, np.ndarray, np.ndarray, int, int, bool]
+
+
+def _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk, pred: _Predicates) -> _Scan:
+    """Pairs that meet (a, b, kind), candidate and tested counts, completeness: the grid and numpy twin."""
+    found_a, found_b, found_k = [], [], []
+    candidates = tested = 0
+    complete = True
+    origin = lo.min(axis=0)
+    for a, b, cell, h, dims in _raw_pairs(lo, hi, origin, chunk):
+        keep = _keep_mask(a, b, cell, lo, hi, origin, h, dims)
+        a, b = a[keep], b[keep]
+        if max_pairs is not None and candidates + len(a) > max_pairs:
+            take = max(max_pairs - candidates, 0)
+            a, b = a[:take], b[:take]
+            complete = False
+        candidates += len(a)
+        ok = ~degenerate[a] & ~degenerate[b]
+        a, b = np.minimum(a[ok], b[ok]), np.maximum(a[ok], b[ok])
+        tested += len(a)
+        if len(a):
+            kind = _classify(v, f, axis, a, b, pred)
+            hit = kind != _NONE
+            found_a.append(a[hit])
+            found_b.append(b[hit])
+            found_k.append(kind[hit])
+        if not complete:
+            break
+    if not found_a:
+        e = np.zeros(0, dtype=np.int64)
+        return e, e, np.zeros(0, dtype=np.int8), candidates, tested, complete
+    return np.concatenate(found_a), np.concatenate(found_b), np.concatenate(found_k), candidates, tested, complete
+
+
+def _scan_c(lib, v, f, axis, degenerate, lo, hi, max_pairs, pred: _Predicates) -> _Scan:
+    """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy)."""
+    raw_a, raw_b, raw_kind, candidates, tested, exact, complete = lib.contact_scan(
+        v, f, np.ascontiguousarray(axis, dtype=np.int64), degenerate.view(np.uint8), lo, hi,
+        -1 if max_pairs is None else int(max_pairs), threads())
+    pred.exact += exact
+    a = np.frombuffer(raw_a, dtype=np.int64)
+    b = np.frombuffer(raw_b, dtype=np.int64)
+    kind = np.frombuffer(raw_kind, dtype=np.int8).copy()
+    left = np.flatnonzero(kind < 0)
+    if len(left):                       # an expansion too long for the C kernel
+        kind[left] = _classify(v, f, axis, a[left], b[left], pred)
+    return a, b, kind, int(candidates), int(tested), bool(complete)
+
+
+# -- entry point ----------------------------------------------------------------------------------------------
+
+def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int | None = None,
+                     chunk: int = CHUNK_PAIRS) -> SurfaceContacts:
+    """Every pair of faces that meets beyond the vertices and edges it shares by index, classified exactly.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        Coordinates (any unit; the result does not depend on scale).
+    faces : (m, 3) int
+        Corner indices; a face's winding gives its normal (right-hand rule).
+    max_pairs : int, optional
+        Work bound: stop after testing this many candidate pairs (box-overlapping pairs); the result is then
+        ``complete=False``.  Default: no bound.
+    chunk : int
+        Candidate pairs generated and tested at once (memory bound, not a work bound).
+
+    Returns
+    -------
+    SurfaceContacts
+
+    Raises
+    ------
+    InvalidMeshError
+        Non-finite coordinates, or a face index out of range.
+    """
+    v = np.ascontiguousarray(vertices, dtype=np.float64)
+    f = np.ascontiguousarray(faces, dtype=np.int64)
+    if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3:
+        raise InvalidMeshError(f"Expected vertices (n, 3) and faces (m, 3), got {v.shape} and {f.shape}")
+    if not np.all(np.isfinite(v)):
+        raise InvalidMeshError("Expected finite vertex coordinates, found NaN or infinity")
+    if len(f) and (f.min() < 0 or f.max() >= len(v)):
+        raise InvalidMeshError(f"Expected face indices in 0..{len(v) - 1}, found {f.min()}..{f.max()}")
+    if chunk < 1:
+        raise ValueError(f"Expected chunk >= 1, got {chunk}")
+    v, safe = _scaled(v)
+    pred = _Predicates(force_exact=not safe)
+    lib = accel() if safe else None
+    empty = np.zeros((0, 2), dtype=np.intp)
+    if not len(f):
+        return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty, complete=True)
+    axis, degenerate = _face_axes(v, f, pred)
+    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    lo = np.minimum(np.minimum(p0, p1), p2)
+    hi = np.maximum(np.maximum(p0, p1), p2)
+    del p0, p1, p2
+    if lib is not None:
+        a, b, kind, candidates, tested, complete = _scan_c(lib, v, f, axis, degenerate, lo, hi, max_pairs, pred)
+    else:
+        a, b, kind, candidates, tested, complete = _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk,
+                                                               pred)
+
+    def pairs(key: int) -> np.ndarray:
+        hit = kind == key
+        p = np.stack([a[hit], b[hit]], axis=1).astype(np.intp)
+        return p[np.lexsort((p[:, 1], p[:, 0]))]
+
+    return SurfaceContacts(crossing=pairs(_CROSSING), coplanar_opposite=pairs(_OPPOSITE), contact=pairs(_CONTACT),
+                           complete=complete, candidate_pairs=candidates, tested_pairs=tested,
+                           exact_evaluations=pred.exact, degenerate_faces=int(np.count_nonzero(degenerate)))
