@@ -42,3 +42,17 @@ DISPLAY_ZERO_RTOL = 1e-12
 #: to ~4e-6 whatever it is: the warning is for a part far from the origin (or a film far thinner than its
 #: coordinates), where the file itself has lost digits the reports would print.
 STORAGE_PRECISION_RTOL = 1e-4
+
+#: Repair (``repair=True``): boundary vertices closer than ``SEAM_GAP_RTOL · diagonal`` to another boundary
+#: vertex, or to a boundary edge (a T-junction), are taken to be one seam that the export split, and are
+#: sealed.  Openings narrower than this are read as artefacts, not slots; the bound of the sealed estimate
+#: covers the move (see :mod:`inertia_tool.mesh.estimate`).
+SEAM_GAP_RTOL = 1e-4
+
+#: Repair: an estimate whose relative mass bound exceeds this (or whose centre-of-mass or inertia bound is not
+#: finite) is refused instead of printed — a mass "within ±60 %" says nothing the user can build on.
+ESTIMATE_MAX_MASS_RTOL = 0.5
+
+#: Repair: a surface with more than this share of its edges on the boundary is a soup (loose triangles, not a
+#: surface with holes); its solid is read from the winding number, not by patching loops.
+SOUP_BOUNDARY_SHARE = 0.5

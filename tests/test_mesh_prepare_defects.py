@@ -6,6 +6,7 @@ cycloidal.ply) with the same pathology, checked against closed forms.
 
 import numpy as np
 import pytest
+import trimesh
 
 from conftest import assert_tensor_close, box_arrays
 from inertia_tool import mass_properties
@@ -110,13 +111,24 @@ def test_open_box_refused_in_one_line_then_bounded_with_repair():
     with pytest.raises(InvalidMeshError, match="`repair=True` gives a bounded estimate") as e:
         mass_properties((v, f[~gone]))
     assert "\n" not in str(e.value)
+    # half the box is missing: the ball over that rim is larger than the box, so no honest bound exists
+    with pytest.raises(InvalidMeshError, match="cannot be bounded usefully"):
+        mass_properties((v, f[~gone]), repair=True, density=1.0)
+
+
+def test_sphere_with_a_small_hole_is_bounded_with_repair():
+    s = trimesh.creation.icosphere(3)
+    v, f = np.asarray(s.vertices), np.asarray(s.faces)
+    truth = mass_properties((v, f), density=1.0)
+    open_f = f[3:]
     with pytest.warns(MeshRepairedWarning):
-        p = mass_properties((v, f[~gone]), repair=True, density=1.0)
+        p = mass_properties((v, open_f), repair=True, density=1.0)
     u = p.mesh.uncertainty
-    assert p.mesh.method in ("patched", "winding") and u is not None
-    assert abs(p.mass - 6.0) <= u.mass * p.mass
-    assert np.linalg.norm(p.center_of_mass) <= u.center_of_mass
-    assert np.linalg.norm(p.inertia - _box_inertia((1, 2, 3), 6.0)) <= u.inertia * np.linalg.norm(p.inertia)
+    assert p.mesh.method == "patched" and u is not None
+    assert 0 < u.mass < 0.05
+    assert abs(p.mass - truth.mass) <= u.mass * p.mass
+    assert np.linalg.norm(p.center_of_mass - truth.center_of_mass) <= u.center_of_mass
+    assert np.linalg.norm(p.inertia - truth.inertia) <= u.inertia * np.linalg.norm(p.inertia)
 
 
 def test_single_sheet_suggests_the_shell_model():

@@ -5,14 +5,24 @@ answer is an estimate with bounds.  Two estimators, each returning moments and a
 
 * :func:`patched_estimate` — close every boundary loop by a cone (a fan of triangles) to the centroid of the
   loop's vertices and integrate the closed result exactly.  The boundary of a triangle 2-chain is a 1-cycle,
-  so the cones always close it.  Any other reasonable patch lies in the convex hull of the loop, so the
-  volume can be off by at most the hull's volume; the centre of mass and inertia bounds follow from moving
-  that much mass anywhere in the hulls.  A crack pulled 1e-5 of the part apart spans a hull of ~1e-5 of the
-  volume; a planar hole spans none (the flat patch is then the minimal surface and the answer).
-* :func:`winding_estimate` — the generalized winding number ``w`` (``winding.py``) on a regular grid of
-  cells: cells with ``w > 1/2`` are material and integrated exactly as cubes.  Cells that the surface
-  passes through or whose ``w`` is ambiguous (between ``w_low`` and ``w_high``) could go either way; their
-  mass bounds the answer.
+  so the cones always close it.  **Assumption: the missing surface of each hole lies within the ball
+  enclosing the hole's rim** (:func:`enclosing_balls`, close to the smallest such ball; for a round hole in
+  a smooth part this is the ball whose great circle is the rim, which holds any cap up to a hemisphere).
+  The cone lies in the rim's convex hull, inside the same ball, so the closed cycle "cone minus missing
+  surface" lies in the ball and its winding number — the difference between the patched solid and the true
+  one — vanishes outside it: the volume in doubt is the total volume of the balls.  The convex hull of the
+  rim is *not* enough (a planar rim has a hull of volume 0, yet a spherical cap over it is far from flat),
+  and no hole gets a bound of 0.  Seams sealed first (cracks, T-junctions; :mod:`~.seal`) add the volume
+  of the parallel bodies of the faces sealing touched.
+* :func:`winding_estimate` — for soups (no surface with holes to patch): the generalized winding number
+  ``w`` (``winding.py``) on a regular grid of cells.  **Assumption: the solid is the set where ``w > 1/2``**
+  (Jacobson et al.'s definition for soups); cells with ``w > 1/2`` are material and integrated exactly as
+  cubes.  Cells that the surface passes through or whose ``w`` is ambiguous (between ``w_low`` and
+  ``w_high``) could go either way; their volume bounds the discretization error.
+
+An estimate whose bound is not finite, or whose mass bound exceeds ``ESTIMATE_MAX_MASS_RTOL`` (50 %), or
+that encloses no positive volume, is refused (:func:`check_useful`): a printed mass "within ±297 %" helps
+no one.
 
 The mass-property bounds (see :class:`Uncertainty`): ``mass`` relative, ``center_of_mass`` as a distance in m,
 ``inertia`` relative in the Frobenius norm.  With ``δV`` the volume in doubt, ``V`` the estimate, ``D`` the
@@ -23,11 +33,17 @@ largest distance from the centre of mass to a point of the doubtful region and `
 
 from __future__ import annotations
 
+from typing import Any, Callable
+
 import numpy as np
 
+from ..errors import InvalidMeshError
+from ..tolerances import ESTIMATE_MAX_MASS_RTOL
 from ..values import frozen_value
+from .seal import Seal
 
-__all__ = ["Uncertainty", "Estimate", "boundary_edges", "patched_estimate", "winding_estimate", "uncertainty_from"]
+__all__ = ["Uncertainty", "Estimate", "boundary_edges", "patched_estimate", "winding_estimate", "uncertainty_from",
+           "enclosing_balls", "check_useful"]
 
 
 @frozen_value
@@ -138,24 +154,67 @@ def _loops(edges: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     return label.reshape(-1), int(label.max()) + 1 if len(label) else 0
 
 
-def _hull_volume(points: np.ndarray) -> float:
-    """Volume of the convex hull of the points; when Qhull cannot build it, the (larger) volume of their
-    bounding box in the principal frame, so the bound never shrinks on a precision failure."""
-    from scipy.spatial import ConvexHull, QhullError
+def enclosing_balls(points: np.ndarray, group: np.ndarray, n_groups: int, *, iterations: int = 400
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """A ball enclosing each group of points: centres (g, 3) m and radii (g,) m.
 
-    if len(points) < 4:
-        return 0.0
-    centred = points - points.mean(axis=0)
-    try:
-        return float(ConvexHull(points).volume)
-    except (QhullError, ValueError):
-        _, _, axes = np.linalg.svd(centred, full_matrices=False)
-        span = np.ptp(centred @ axes.T, axis=0)
-        return float(np.prod(span))     # exactly 0 for a flat or collinear loop
+    The centre is found by Bădoiu and Clarkson's iteration (step towards the farthest point by ``1/(k+1)``),
+    started at the centre of the group's bounding box and run for ``iterations`` steps on all groups at
+    once; the radius is then the exact largest distance from that centre, so every ball encloses its group
+    whatever the iteration reached (it converges to the smallest enclosing ball: after ``k`` steps the radius
+    is within a factor ``1 + O(1/√k)`` of the smallest).
+    """
+    p = np.asarray(points, dtype=np.float64)
+    g = np.asarray(group, dtype=np.int64)
+    order = np.argsort(g, kind="stable")
+    p, g = p[order], g[order]
+    starts = np.searchsorted(g, np.arange(n_groups))
+    lo = np.minimum.reduceat(p, starts, axis=0)
+    hi = np.maximum.reduceat(p, starts, axis=0)
+    centre = 0.5 * (lo + hi)
+    index = np.arange(len(p))
+    for k in range(1, iterations + 1):
+        d = np.einsum("ij,ij->i", p - centre[g], p - centre[g])
+        top = np.maximum.reduceat(d, starts)
+        far = np.minimum.reduceat(np.where(d >= top[g], index, len(p)), starts)
+        centre = centre + (p[far] - centre) / (k + 1)
+    radius = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", p - centre[g], p - centre[g]), starts))
+    return centre, radius
 
 
-def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments) -> Estimate:
-    """Close each boundary loop by a cone to its centroid and integrate; bound by the loops' convex hulls.
+def check_useful(estimate_volume: float, unc: Uncertainty, *, source: str, what: str,
+                 max_mass_rtol: float = ESTIMATE_MAX_MASS_RTOL) -> None:
+    """Refuse an estimate that encloses no positive volume or whose bounds say nothing.
+
+    Raises
+    ------
+    InvalidMeshError
+        When ``estimate_volume`` is not positive, a bound is not finite, or the relative mass bound exceeds
+        ``max_mass_rtol``; the message says why and what to do.
+    """
+    if not estimate_volume > 0:
+        raise InvalidMeshError(f"{source}: {what} encloses a volume of {estimate_volume:.3g} m³ (expected a "
+                               "positive one): the surface does not bound a solid even after repair; close it "
+                               "in a mesh editor, or for a sheet use the shell model with a wall `thickness`")
+    bounds = (unc.mass, unc.center_of_mass, unc.inertia)
+    if not all(np.isfinite(b) for b in bounds) or unc.mass > max_mass_rtol:
+        mass = f"±{100 * unc.mass:.3g} %" if np.isfinite(unc.mass) else "unbounded"
+        com = f"within {unc.center_of_mass:.3g} m" if np.isfinite(unc.center_of_mass) else "unbounded"
+        raise InvalidMeshError(f"{source}: {what} cannot be bounded usefully (mass {mass}, centre of mass {com}; "
+                               f"an estimate is reported only within ±{100 * max_mass_rtol:g} % mass): the "
+                               "holes are too large to guess what fills them; close them in a mesh editor",
+                               details={"mass_bound": float(unc.mass),
+                                        "center_of_mass_bound": float(unc.center_of_mass)})
+
+
+def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[..., Any], *,
+                     seal: Seal | None = None) -> Estimate:
+    """Close each boundary loop by a cone to its centroid and integrate; bound by the balls over the rims.
+
+    Assumption (stated in the module docstring): the missing surface of each boundary component lies in the
+    ball enclosing its rim (:func:`enclosing_balls`); the cone lies there too, so the patched solid and the
+    true one differ only inside those balls, whose total volume is the volume in doubt.  With ``seal``, the
+    seams it sealed add their own doubt (:mod:`~.seal`).
 
     Parameters
     ----------
@@ -164,6 +223,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments) -> Estima
         Consistently oriented where possible (see ``orient.py``); the sign of the total decides outward.
     moments : callable
         ``moments(vertices, faces) -> VolumeMoments`` (the exact integrator, ``volume.volume_moments``).
+    seal : Seal, optional
+        How ``faces`` were sealed from the input (their slack enters the bound).
 
     Returns
     -------
@@ -181,23 +242,38 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments) -> Estima
     apex = np.zeros((n_loops, 3))
     for i in range(3):
         apex[:, i] = np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) / np.maximum(size, 1)
-    starts = np.r_[0, np.cumsum(size)[:-1]] if n_loops else np.zeros(0, dtype=np.int64)
-    doubt = 0.0
-    for k in np.flatnonzero(size >= 4):        # 3 or fewer points span no volume
-        doubt += _hull_volume(v[vertex_of[starts[k]:starts[k] + size[k]]])
+    if n_loops:
+        centre, radius = enclosing_balls(v[vertex_of], loop_of, n_loops)
+    else:
+        centre, radius = np.zeros((0, 3)), np.zeros(0)
+    doubt = float(np.sum(4.0 / 3.0 * np.pi * radius ** 3))
     cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
     pv = np.vstack([v, apex])
     pf = np.vstack([f, cap])
     closed = moments(pv, pf)
-    sign = 1.0 if closed.volume >= 0 else -1.0
-    if sign < 0:
+    if closed.volume < 0:
         pf = pf[:, ::-1]
         closed = moments(pv, pf)
     area = moments(v, f).area
-    far = float(np.max(np.linalg.norm(v[vertex_of] - closed.centroid, axis=1))) if len(vertex_of) else 0.0
+    far = float(np.max(np.linalg.norm(centre - closed.centroid, axis=1) + radius)) if n_loops else 0.0
+    sealed = ""
+    if seal is not None and (seal.welded or seal.split):
+        doubt += seal.doubt(v)
+        touched = seal.slack > 0
+        if touched.any():
+            corners = v[f[touched]]
+            reach = np.linalg.norm(corners - closed.centroid, axis=2).max(axis=1) + seal.slack[touched]
+            far = max(far, float(reach.max()))
+        sealed = (f"seams sealed ({seal.welded:,} crack vertices welded, {seal.split:,} T-junction vertices "
+                  f"put on their edges, every corner within {float(seal.slack.max(initial=0.0)):.3g} m of where "
+                  "it was); ")
     unc = uncertainty_from(closed.volume, closed.centroid, closed.second_moment, doubt, far)
-    detail = (f"{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) closed by cones to "
-              "their centroids; bounded by the loops' convex hulls")
+    if n_loops:
+        detail = (f"{sealed}{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) closed by "
+                  "cones to their centroids; bounded by the balls enclosing their rims "
+                  f"(largest radius {float(radius.max()):.3g} m)")
+    else:
+        detail = f"{sealed}no hole left" if sealed else "no hole"
     return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,
                     uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far)
 

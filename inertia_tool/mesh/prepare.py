@@ -24,7 +24,7 @@ from ..mass.volume import VolumeMoments, body_volume_moments, bounding_box, volu
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
-from .estimate import uncertainty_from
+from .estimate import check_useful, uncertainty_from
 from .resolve import Resolution, resolve_surface
 
 __all__ = ["PreparedMesh", "prepare_mesh", "classify_shells", "MAX_COORDINATE", "MIN_EXTENT"]
@@ -296,6 +296,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         total = _total(shells)
         uncertainty = uncertainty_from(total.volume, total.centroid, total.second_moment,
                                        patched.uncertainty.volume_in_doubt, patched.far)
+        check_useful(total.volume, uncertainty, source=source, what="the patched surface")
         method = "patched"
     report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
                         bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),

@@ -13,9 +13,10 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
    more than the stated distance) — method ``"welded"``.
 4. Otherwise the file does not define a solid.  Without ``repair`` this refuses in one line (edges counted
    after welding) and says that ``repair=True`` gives a bounded estimate.  With ``repair``: duplicate faces
-   are dropped (exact if that balances the surface — method ``"deduplicated"``), then the estimates of
-   ``estimate.py`` are formed (boundary loops patched by cones; winding number on a grid) and the one with
-   the tighter mass bound is kept — method ``"patched"`` or ``"winding"``.
+   are dropped (exact if that balances the surface — method ``"deduplicated"``), then one estimate of
+   ``estimate.py`` is formed, chosen by :data:`REPAIR_RULE` from what the surface is (a soup → the winding
+   number on a grid, method ``"winding"``; otherwise seams sealed and holes patched, method ``"patched"``),
+   before any of it is computed, so no grid is built only to be thrown away.
 """
 
 from __future__ import annotations
@@ -25,14 +26,25 @@ import numpy as np
 from ..values import frozen_value
 from ..errors import InvalidMeshError
 from ..tolerances import FLAT_RTOL
-from .estimate import Estimate, patched_estimate, winding_estimate
+from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
+from .estimate import Estimate, check_useful, patched_estimate, winding_estimate
+from .seal import Seal, seal_seams
 from .merge import merge_close_vertices
 from .orient import EdgeBalance, edge_balance, orient_consistently
 
-__all__ = ["Resolution", "resolve_surface", "PATCH_PREFERRED_RTOL"]
+__all__ = ["Resolution", "resolve_surface", "REPAIR_RULE"]
 
-#: The patched estimate is kept without trying the grid when its relative mass bound is below this.
-PATCH_PREFERRED_RTOL = 1e-3
+#: Which estimate ``repair=True`` gives, decided from the surface alone, never by which estimate claims the
+#: smaller bound (a method that understates its error would always win that contest):
+REPAIR_RULE = (
+    "a soup (more than SOUP_BOUNDARY_SHARE of the edges on the boundary: loose triangles, no surface with holes "
+    "to follow) -> the winding-number grid, whose solid is by definition where w > 1/2; "
+    "anything else -> seal the seams (crack lips within SEAM_GAP_RTOL of the diagonal welded, T-junctions split; "
+    "bounded by how far sealing moved the surface), then close each remaining hole by a cone, bounded by the "
+    "ball enclosing its rim; "
+    "an estimate whose bound is useless (not finite, or mass beyond ESTIMATE_MAX_MASS_RTOL) or whose volume is "
+    "not positive -> refused with the reason, never replaced by the other method"
+)
 
 
 @frozen_value
@@ -150,8 +162,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     census = edge_balance(f, n)
     if force_estimate:
         grid = winding_estimate(v, f)
-        if not grid.volume > 0:
-            raise InvalidMeshError(f"{source}: the surface encloses no volume")
+        check_useful(grid.volume, grid.uncertainty, source=source, what="the winding-number estimate of the "
+                     "overlapping bodies")
         return Resolution(v, f, grid.method, ("the bodies overlap and their union could not be formed", grid.detail),
                           0, None, census.nonmanifold_edges, estimate=grid)
     if census.balanced:
@@ -198,17 +210,32 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         if census.balanced:
             return Resolution(v, unique, "deduplicated", tuple(repair_notes) + _touching_note(census), flipped, welded,
                               census.nonmanifold_edges)
+    best = _repaired_estimate(v, unique, census, diag=diag, moments=moments)
     flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
-    patched = patched_estimate(v, unique, moments)
-    best = patched
-    if not (patched.volume > flat and patched.uncertainty.mass <= PATCH_PREFERRED_RTOL):
-        grid = winding_estimate(v, unique)
-        if grid.volume > flat and not (patched.volume > flat and patched.uncertainty.mass <= grid.uncertainty.mass):
-            best = grid
     if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
                                "thin-walled part use the shell model with a wall `thickness`")
+    if best.method == "winding":              # a patched estimate is checked on the classified total (prepare)
+        check_useful(best.volume, best.uncertainty, source=source, what="the winding-number estimate")
     repair_notes.append(best.detail)
     return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
                       edge_balance(best.faces, len(best.vertices)).nonmanifold_edges if best.method == "patched"
                       else census.nonmanifold_edges, estimate=best)
+
+
+def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, census: EdgeBalance, *, diag: float,
+                       moments, seam_gap_rtol: float = SEAM_GAP_RTOL,
+                       soup_share: float = SOUP_BOUNDARY_SHARE) -> Estimate:
+    """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed."""
+    total_edges = max(1, 3 * len(faces) // 2)
+    if census.boundary_edges > soup_share * total_edges:
+        return winding_estimate(vertices, faces)
+    sealed = seal_seams(vertices, faces, seam_gap_rtol * diag)
+    kept, _ = _dedupe(sealed.faces) if sealed.welded or sealed.split else (sealed.faces, 0)
+    if len(kept) != len(sealed.faces):
+        # duplicates the weld made: the sealed faces' slack is kept for the faces that remain (a superset bound)
+        seal = Seal(kept, np.full(len(kept), float(sealed.slack.max(initial=0.0))), sealed.dropped_doubt,
+                    sealed.welded, sealed.split)
+    else:
+        seal = sealed
+    return patched_estimate(vertices, seal.faces, moments, seal=seal)
