@@ -79,13 +79,14 @@ def _bounds_of(report):
 
 def run_inertia_tool(vertices, faces):
     import inertia_tool as it
-    from inertia_tool.errors import InertiaToolWarning, NearlyEqualMomentsWarning
+    from inertia_tool.errors import ImplausibleSizeWarning, InertiaToolWarning, NearlyEqualMomentsWarning
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         props = it.mass_properties((vertices, faces), density=1.0, repair=True)
     flags = [f"{w.category.__name__}: {w.message}" for w in caught
-             if issubclass(w.category, InertiaToolWarning) and not issubclass(w.category, NearlyEqualMomentsWarning)]
+             if issubclass(w.category, InertiaToolWarning)
+             and not issubclass(w.category, (NearlyEqualMomentsWarning, ImplausibleSizeWarning))]
     report = getattr(props, "mesh_report", None) or getattr(props, "mesh", None)
     method = getattr(report, "method", None)
     return {"volume": props.volume, "center_of_mass": props.center_of_mass, "inertia": props.inertia,
