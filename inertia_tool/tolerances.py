@@ -53,6 +53,6 @@ SEAM_GAP_RTOL = 1e-4
 #: finite) is refused instead of printed — a mass "within ±60 %" says nothing the user can build on.
 ESTIMATE_MAX_MASS_RTOL = 0.5
 
-#: Repair: a surface with more than this share of its edges on the boundary is a soup (loose triangles, not a
-#: surface with holes); its solid is read from the winding number, not by patching loops.
+#: Repair: a surface more than this share of whose faces share no edge with another face is a soup (loose
+#: triangles, not a surface with holes); its solid is read from the winding number, not by patching loops.
 SOUP_BOUNDARY_SHARE = 0.5

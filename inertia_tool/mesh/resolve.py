@@ -37,11 +37,11 @@ __all__ = ["Resolution", "resolve_surface", "REPAIR_RULE"]
 #: Which estimate ``repair=True`` gives, decided from the surface alone, never by which estimate claims the
 #: smaller bound (a method that understates its error would always win that contest):
 REPAIR_RULE = (
-    "a soup (more than SOUP_BOUNDARY_SHARE of the edges on the boundary: loose triangles, no surface with holes "
-    "to follow) -> the winding-number grid, whose solid is by definition where w > 1/2; "
-    "anything else -> seal the seams (crack lips within SEAM_GAP_RTOL of the diagonal welded, T-junctions split; "
-    "bounded by how far sealing moved the surface), then close each remaining hole by a cone, bounded by the "
-    "ball enclosing its rim; "
+    "first seal the seams (crack lips within SEAM_GAP_RTOL of the diagonal welded, T-junctions split; bounded by "
+    "how far sealing moved the surface: cheap, and it turns a slightly jittered soup into a surface); "
+    "then a soup (more than SOUP_BOUNDARY_SHARE of the faces still share no edge with another: loose triangles, no "
+    "surface with holes to follow) -> the winding-number grid, whose solid is by definition where w > 1/2; "
+    "anything else -> close each remaining hole by a cone, bounded by the ball enclosing its rim; "
     "an estimate whose bound is useless (not finite, or mass beyond ESTIMATE_MAX_MASS_RTOL) or whose volume is "
     "not positive -> refused with the reason, never replaced by the other method"
 )
@@ -163,7 +163,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     if force_estimate:
         grid = winding_estimate(v, f)
         check_useful(grid.volume, grid.uncertainty, source=source, what="the winding-number estimate of the "
-                     "overlapping bodies")
+                     "overlapping bodies", why="`overlap` 'sum' adds the bodies (shared volume counted twice)")
         return Resolution(v, f, grid.method, ("the bodies overlap and their union could not be formed", grid.detail),
                           0, None, census.nonmanifold_edges, estimate=grid)
     if census.balanced:
@@ -210,27 +210,38 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         if census.balanced:
             return Resolution(v, unique, "deduplicated", tuple(repair_notes) + _touching_note(census), flipped, welded,
                               census.nonmanifold_edges)
-    best = _repaired_estimate(v, unique, census, diag=diag, moments=moments)
+    best = _repaired_estimate(v, unique, diag=diag, moments=moments)
     flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
     if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
                                "thin-walled part use the shell model with a wall `thickness`")
     if best.method == "winding":              # a patched estimate is checked on the classified total (prepare)
-        check_useful(best.volume, best.uncertainty, source=source, what="the winding-number estimate")
+        check_useful(best.volume, best.uncertainty, source=source, what="the winding-number estimate",
+                     why="the loose triangles do not enclose a definite volume; mesh the part again as a closed "
+                     "surface")
     repair_notes.append(best.detail)
     return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
                       edge_balance(best.faces, len(best.vertices)).nonmanifold_edges if best.method == "patched"
                       else census.nonmanifold_edges, estimate=best)
 
 
-def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, census: EdgeBalance, *, diag: float,
+def _loose_share(faces: np.ndarray) -> float:
+    """Share of the faces that share no edge with another face (loose triangles of a soup)."""
+    if not len(faces):
+        return 1.0
+    edges = np.sort(np.asarray(faces)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    _, inverse, counts = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
+    alone = (counts[inverse.reshape(-1)] == 1).reshape(-1, 3).all(axis=1)
+    return float(np.count_nonzero(alone)) / len(faces)
+
+
+def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, *, diag: float,
                        moments, seam_gap_rtol: float = SEAM_GAP_RTOL,
                        soup_share: float = SOUP_BOUNDARY_SHARE) -> Estimate:
     """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed."""
-    total_edges = max(1, 3 * len(faces) // 2)
-    if census.boundary_edges > soup_share * total_edges:
-        return winding_estimate(vertices, faces)
     sealed = seal_seams(vertices, faces, seam_gap_rtol * diag)
+    if _loose_share(sealed.faces) > soup_share:
+        return winding_estimate(vertices, faces)
     kept, _ = _dedupe(sealed.faces) if sealed.welded or sealed.split else (sealed.faces, 0)
     if len(kept) != len(sealed.faces):
         # duplicates the weld made: the sealed faces' slack is kept for the faces that remain (a superset bound)

@@ -1,0 +1,398 @@
+"""Do repair's bounds hold?  Randomized damaged meshes with known answers, checked against what ``repair=True`` states.
+
+Sources (each a closed, consistently wound mesh whose exact integral is the truth, cross-checked against
+trimesh's independent ``mass_properties`` to 1e-9):
+
+- ``repo``: the meshes of the repository's ``meshes/`` folder;
+- ``generated``: trimesh's bundled models are not shipped in its wheel, so shapes from ``trimesh.creation``
+  (icosphere, capsule, cylinder, cone, annulus, torus, a subdivided box);
+- ``robots``: the 25 robot parts of ``make_cases.py`` (example-robot-data 6.0.0, SHA-256 checked) when its
+  wheel is in ``benchmarks/out/pkgs`` (``make_cases.py`` downloads it); skipped otherwise.
+
+Damage kinds, each drawn at random from the case's seed:
+
+==================  =========================================================================================
+``hole``            a connected patch of faces removed, its area log-uniform from one face to a fifth of the
+                    surface
+``holes_scattered`` 0.5–5 % of the faces removed one by one
+``t_junction``      a connected patch of 2–30 % of the faces split 1→4 at edge midpoints (T-junctions all
+                    around its border; the polyhedron is unchanged)
+``crack``           a patch of 2–20 % of the faces cut free, its border corners moved by 1e-7…5e-5 of the
+                    diagonal (log-uniform)
+``t_junction_hole`` ``t_junction`` then ``hole``
+``crack_hole``      ``crack`` then ``hole``
+==================  =========================================================================================
+
+In a third of the cases the clean mesh is first quantised (coordinates rounded to 1e-6…1e-4 of the diagonal;
+the truth is then the quantised closed mesh, skipped if rounding broke it).
+
+For each case ``mass_properties((vertices, faces), density=1, repair=True)`` either refuses
+(``InvalidMeshError``: counted as refused, never as wrong) or answers.  An answer's bounds *hold* when
+``|m − m*| ≤ u_m·m``, ``|c − c*| ≤ u_c`` and ``‖I − I*‖_F ≤ u_I·‖I‖_F`` (an answer without bounds claims to be
+exact: round-off of 1e-9 allowed); it is *within tolerance* when the volume is within 1 %, the centre of mass
+within 1 % of the diagonal and the inertia within 2 %.  Any other exception is an error (a bug).
+
+Seeds 0–2 were used while developing; the report uses other seeds (``--seeds``).
+
+Run: ``python benchmarks/damage/coverage.py --seeds 3,4,5,6,7`` (two worker processes); ``--subset`` is the
+fast set of the CI test (``tests/test_repair_coverage.py``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing as mp
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+OUT = ROOT / "benchmarks" / "out"
+KINDS = ("hole", "holes_scattered", "t_junction", "crack", "t_junction_hole", "crack_hole")
+VOLUME_RTOL, COM_DTOL, INERTIA_RTOL = 0.01, 0.01, 0.02
+ROUND_OFF = 1e-9
+MAX_HOLE_SHARE = 0.2          # of the surface area
+QUANTISE_SHARE = 1 / 3
+
+
+# ------------------------------------------------------------------------------------------------ sources
+
+def _weld(v, f):
+    unique, inverse = np.unique(np.asarray(v, dtype=np.float64), axis=0, return_inverse=True)
+    g = inverse.reshape(-1)[np.asarray(f, dtype=np.int64)]
+    keep = (g[:, 0] != g[:, 1]) & (g[:, 1] != g[:, 2]) & (g[:, 2] != g[:, 0])
+    return unique, g[keep]
+
+
+def generated_sources():
+    """(name, vertices, faces) of closed shapes made by trimesh.creation."""
+    import trimesh
+    import trimesh.creation as c
+
+    box = c.box(extents=(1.0, 2.0, 0.5))
+    for _ in range(3):
+        box = box.subdivide()
+    shapes = [("icosphere", c.icosphere(3)), ("capsule", c.capsule(height=2.0, radius=0.5, count=[24, 24])),
+              ("cylinder", c.cylinder(radius=1.0, height=3.0, sections=48)),
+              ("cone", c.cone(radius=1.0, height=2.0, sections=48)),
+              ("annulus", c.annulus(r_min=0.5, r_max=1.0, height=0.4, sections=48)),
+              ("box", box)]
+    if hasattr(c, "torus"):
+        shapes.append(("torus", c.torus(major_radius=1.0, minor_radius=0.3, major_sections=48, minor_sections=24)))
+    out = []
+    for name, mesh in shapes:
+        if not isinstance(mesh, trimesh.Trimesh):
+            continue
+        v, f = _weld(mesh.vertices, mesh.faces)
+        out.append((f"generated/{name}", v, f))
+    return out
+
+
+def repo_sources():
+    import trimesh
+
+    out = []
+    for path in sorted((ROOT / "meshes").glob("*.stl")):
+        mesh = trimesh.load(str(path), process=False, force="mesh")
+        v, f = _weld(mesh.vertices, mesh.faces)
+        out.append((f"repo/{path.name}", v, f))
+    return out
+
+
+def robot_sources():
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import make_cases
+
+    wheel = OUT / "pkgs" / make_cases.WHEEL
+    if not wheel.exists():
+        return []
+    dest = OUT / "damage" / "source"
+    out = []
+    for (rel, _, _), path in zip(make_cases.MESHES, make_cases.extract_meshes(wheel, dest)):
+        v, f = make_cases.load_clean(path)
+        out.append((f"robots/{rel}", v, f))
+    return out
+
+
+def truth_of(v, f):
+    """Exact unit-density properties of a closed mesh, or None when inertia_tool does not call it clean;
+    cross-checked against trimesh's integrals."""
+    import inertia_tool as it
+    import trimesh
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            p = it.mass_properties((v, f), density=1.0, merge_tolerance=0)
+        except it.errors.InertiaToolError:
+            return None
+    notes = (it.errors.NearlyEqualMomentsWarning, it.errors.ImplausibleSizeWarning)
+    if any(not issubclass(w.category, notes) for w in caught) or p.mesh.method != "exact":
+        return None
+    other = trimesh.Trimesh(vertices=v, faces=f, process=False).mass_properties
+    if abs(other.volume - p.volume) > 1e-9 * p.volume:
+        raise ValueError(f"trimesh's volume {other.volume} disagrees with {p.volume}")
+    diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+    return {"volume": float(p.volume), "center_of_mass": p.center_of_mass.tolist(), "inertia": p.inertia.tolist(),
+            "diagonal": diag}
+
+
+# ------------------------------------------------------------------------------------------------- damage
+
+def _adjacency(f):
+    edges = np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    owner = np.repeat(np.arange(len(f)), 3)
+    order = np.lexsort((edges[:, 1], edges[:, 0]))
+    e, o = edges[order], owner[order]
+    same = np.all(e[1:] == e[:-1], axis=1)
+    a, b = o[:-1][same], o[1:][same]
+    nb = [[] for _ in range(len(f))]
+    for x, y in zip(a.tolist(), b.tolist()):
+        nb[x].append(y)
+        nb[y].append(x)
+    return nb
+
+
+def _patch(f, start, keep_going):
+    """Faces grown breadth-first from ``start`` while ``keep_going(count, last_face)`` holds."""
+    nb = _adjacency(f)
+    seen, queue, head = {start}, [start], 0
+    while head < len(queue) and keep_going(len(queue), queue[-1]):
+        for n in nb[queue[head]]:
+            if n not in seen and keep_going(len(queue), queue[-1]):
+                seen.add(n)
+                queue.append(n)
+        head += 1
+    return np.array(sorted(seen), dtype=np.int64)
+
+
+def _areas(v, f):
+    return 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+
+
+def damage_hole(v, f, rng):
+    area = _areas(v, f)
+    one_face = max(float(np.median(area)), float(area.max()) * 1e-6) / area.sum()
+    share = float(np.exp(rng.uniform(np.log(min(one_face, MAX_HOLE_SHARE)), np.log(MAX_HOLE_SHARE))))
+    target = share * area.sum()
+    taken = [0.0]
+
+    def more(count, last):
+        taken[0] = float(area[last]) + (taken[0] if count > 1 else 0.0)
+        return taken[0] < target
+
+    gone = _patch(f, int(rng.integers(len(f))), more)
+    return v, np.delete(f, gone, axis=0), {"hole_area_share": float(area[gone].sum() / area.sum())}
+
+
+def damage_scattered(v, f, rng):
+    k = max(1, int(rng.uniform(0.005, 0.05) * len(f)))
+    gone = rng.choice(len(f), k, replace=False)
+    return v, np.delete(f, gone, axis=0), {"faces_removed": k}
+
+
+def damage_t_junction(v, f, rng):
+    share = rng.uniform(0.02, 0.3)
+    n = max(1, int(share * len(f)))
+    patch = _patch(f, int(rng.integers(len(f))), lambda count, last: count < n)
+    pf = f[patch]
+    edges = np.sort(pf[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    unique, inverse = np.unique(edges, axis=0, return_inverse=True)
+    mid = 0.5 * (v[unique[:, 0]] + v[unique[:, 1]])
+    m = (len(v) + inverse.reshape(-1, 3))
+    a, b, c = pf[:, 0], pf[:, 1], pf[:, 2]
+    ab, bc, ca = m[:, 0], m[:, 1], m[:, 2]
+    fine = np.concatenate([np.c_[a, ab, ca], np.c_[ab, b, bc], np.c_[ca, bc, c], np.c_[ab, bc, ca]])
+    keep = np.ones(len(f), dtype=bool)
+    keep[patch] = False
+    return np.vstack([v, mid]), np.vstack([f[keep], fine]), {"faces_split": int(len(patch))}
+
+
+def damage_crack(v, f, rng, diag):
+    n = max(10, int(rng.uniform(0.02, 0.2) * len(f)))
+    patch = _patch(f, int(rng.integers(len(f))), lambda count, last: count < n)
+    inside = np.zeros(len(f), dtype=bool)
+    inside[patch] = True
+    border = np.intersect1d(np.unique(f[patch]), np.unique(f[~inside]))
+    remap = np.arange(len(v))
+    remap[border] = np.arange(len(v), len(v) + len(border))
+    f = f.copy()
+    f[patch] = remap[f[patch]]
+    width = float(np.exp(rng.uniform(np.log(1e-7), np.log(5e-5))))
+    d = rng.normal(size=3)
+    moved = v[border] + width * diag * d / np.linalg.norm(d)
+    return np.vstack([v, moved]), f, {"faces_cut_free": int(len(patch)), "width": width}
+
+
+def make_case(kind, v, f, rng, diag):
+    meta = {}
+    if kind in ("t_junction", "t_junction_hole"):
+        v, f, m = damage_t_junction(v, f, rng)
+        meta.update(m)
+    if kind in ("crack", "crack_hole"):
+        v, f, m = damage_crack(v, f, rng, diag)
+        meta.update(m)
+    if kind in ("hole", "t_junction_hole", "crack_hole"):
+        v, f, m = damage_hole(v, f, rng)
+        meta.update(m)
+    if kind == "holes_scattered":
+        v, f, m = damage_scattered(v, f, rng)
+        meta.update(m)
+    return v, f, meta
+
+
+# --------------------------------------------------------------------------------------------- evaluation
+
+def evaluate(v, f, truth):
+    """What repair=True says about a damaged mesh, checked against the truth."""
+    import inertia_tool as it
+
+    start = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            p = it.mass_properties((v, f), density=1.0, repair=True)
+    except it.errors.InvalidMeshError as exc:
+        return {"status": "refused", "seconds": time.perf_counter() - start, "reason": str(exc)[:300]}
+    except Exception as exc:       # a bug: reported, never hidden
+        return {"status": "error", "seconds": time.perf_counter() - start, "reason": f"{type(exc).__name__}: {exc}"[:300]}
+    seconds = time.perf_counter() - start
+    diag = truth["diagonal"]
+    inertia, true_inertia = np.asarray(p.inertia), np.asarray(truth["inertia"])
+    err_mass = abs(p.volume - truth["volume"])
+    err_com = float(np.linalg.norm(p.center_of_mass - np.asarray(truth["center_of_mass"])))
+    err_inertia = float(np.linalg.norm(inertia - true_inertia))
+    norm = float(np.linalg.norm(inertia))
+    u = p.mesh.uncertainty
+    bounds = (ROUND_OFF, ROUND_OFF * diag, ROUND_OFF) if u is None else (u.mass, u.center_of_mass, u.inertia)
+    holds = (err_mass <= bounds[0] * p.volume * (1 + ROUND_OFF) + ROUND_OFF * truth["volume"]
+             and err_com <= bounds[1] * (1 + ROUND_OFF) + ROUND_OFF * diag
+             and err_inertia <= bounds[2] * norm * (1 + ROUND_OFF) + ROUND_OFF * norm)
+    within = (err_mass <= VOLUME_RTOL * truth["volume"] and err_com <= COM_DTOL * diag
+              and err_inertia <= INERTIA_RTOL * float(np.linalg.norm(true_inertia)))
+    return {"status": "answer", "seconds": seconds, "method": p.mesh.method, "holds": bool(holds),
+            "within": bool(within), "mass_bound": float(bounds[0]), "com_bound_of_diag": float(bounds[1] / diag),
+            "inertia_bound": float(bounds[2]), "mass_error": err_mass / truth["volume"],
+            "com_error_of_diag": err_com / diag, "inertia_error": err_inertia / float(np.linalg.norm(true_inertia))}
+
+
+def _quantised(v, f, rng, diag):
+    q = diag * 10.0 ** -rng.uniform(4, 6)
+    qv, qf = _weld(np.round(v / q) * q, f)
+    return qv, qf, q
+
+
+def cases(sources, seeds, repeats=1):
+    """(case id, source, kind, seed, rng state) of every case, in a fixed order."""
+    for seed in seeds:
+        for s in range(len(sources)):
+            for k, kind in enumerate(KINDS):
+                for r in range(repeats):
+                    yield f"{seed}-{s:02d}-{kind}-{r}", s, kind, [seed, s, k, r]
+
+
+def run_case(args):
+    case_id, source, kind, entropy, (name, v, f, clean_truth) = args
+    rng = np.random.default_rng(entropy)
+    truth, quantum = clean_truth, None
+    if rng.random() < QUANTISE_SHARE:
+        qv, qf, q = _quantised(v, f, rng, clean_truth["diagonal"])
+        qt = truth_of(qv, qf)
+        if qt is not None:
+            v, f, truth, quantum = qv, qf, qt, q
+    dv, df, meta = make_case(kind, v, f, rng, truth["diagonal"])
+    result = evaluate(dv, df, truth)
+    return {"id": case_id, "source": name, "kind": kind, "faces": int(len(df)), "quantum": quantum, **meta, **result}
+
+
+def summarise(rows):
+    answered = [r for r in rows if r["status"] == "answer"]
+    refused = [r for r in rows if r["status"] == "refused"]
+    errors = [r for r in rows if r["status"] == "error"]
+    held = sum(r["holds"] for r in answered)
+    within = sum(r["within"] for r in answered)
+    bound = [r["mass_bound"] for r in answered]
+    return {"cases": len(rows), "answered": len(answered), "refused": len(refused), "errors": len(errors),
+            "bounds_hold": held, "coverage": held / len(answered) if answered else float("nan"),
+            "within_tolerance": within,
+            "within_share_of_answered": within / len(answered) if answered else float("nan"),
+            "within_share_of_all": within / len(rows) if rows else float("nan"),
+            "median_mass_bound": float(np.median(bound)) if bound else float("nan"),
+            "median_com_bound_of_diag": float(np.median([r["com_bound_of_diag"] for r in answered]))
+            if answered else float("nan"),
+            "slowest_seconds": max((r["seconds"] for r in rows), default=0.0)}
+
+
+def table(rows):
+    lines = ["| kind | cases | answered | bounds hold | within 1 %/1 %/2 % | refused | errors | median mass bound "
+             "| slowest (s) |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for kind in (*KINDS, "all"):
+        sel = rows if kind == "all" else [r for r in rows if r["kind"] == kind]
+        if not sel:
+            continue
+        s = summarise(sel)
+        lines.append(f"| {kind} | {s['cases']} | {s['answered']} | {s['bounds_hold']} ({100 * s['coverage']:.1f} %) "
+                     f"| {s['within_tolerance']} ({100 * s['within_share_of_answered']:.1f} % of answered) "
+                     f"| {s['refused']} | {s['errors']} | {100 * s['median_mass_bound']:.2g} % "
+                     f"| {s['slowest_seconds']:.2f} |")
+    return "\n".join(lines)
+
+
+def load_sources(names):
+    out = []
+    for group in names:
+        out += {"generated": generated_sources, "repo": repo_sources, "robots": robot_sources}[group]()
+    with_truth = []
+    for name, v, f in out:
+        t = truth_of(v, f)
+        if t is not None:
+            with_truth.append((name, v, f, t))
+    return with_truth
+
+
+def subset(seed=11, limit=30):
+    """The fast CI subset: generated and repo sources only, ``limit`` cases of one seed, in a fixed order."""
+    sources = load_sources(("generated", "repo"))
+    tasks = [(cid, s, kind, ent, sources[s]) for cid, s, kind, ent in cases(sources, [seed])]
+    step = max(1, len(tasks) // limit)
+    return [run_case(t) for t in tasks[::step][:limit]]
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--seeds", default="3,4,5,6,7")
+    parser.add_argument("--sources", default="generated,repo,robots")
+    parser.add_argument("--repeats", type=int, default=1)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=OUT / "coverage.json")
+    parser.add_argument("--subset", action="store_true", help="the CI subset only")
+    args = parser.parse_args(argv)
+    sys.path.insert(0, str(ROOT))
+    if args.subset:
+        rows = subset()
+    else:
+        sources = load_sources(args.sources.split(","))
+        seeds = [int(s) for s in args.seeds.split(",")]
+        tasks = [(cid, s, kind, ent, sources[s]) for cid, s, kind, ent in cases(sources, seeds, args.repeats)]
+        print(f"{len(tasks)} cases from {len(sources)} sources, seeds {seeds}", flush=True)
+        with mp.get_context("spawn").Pool(args.workers) as pool:
+            rows = []
+            for i, row in enumerate(pool.imap(run_case, tasks, chunksize=4)):
+                rows.append(row)
+                if row["status"] == "error" or (row["status"] == "answer" and not row["holds"]):
+                    print(f"  {row['id']} {row['source']} {row['kind']}: {row}", flush=True)
+                if (i + 1) % 100 == 0:
+                    print(f"{i + 1}/{len(tasks)}", flush=True)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps({"summary": summarise(rows), "rows": rows}, indent=1))
+    print(table(rows))
+    print(json.dumps(summarise(rows), indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
