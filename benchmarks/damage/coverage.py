@@ -259,7 +259,8 @@ def evaluate(v, f, truth):
     except it.errors.InvalidMeshError as exc:
         return {"status": "refused", "seconds": time.perf_counter() - start, "reason": str(exc)[:300]}
     except Exception as exc:       # a bug: reported, never hidden
-        return {"status": "error", "seconds": time.perf_counter() - start, "reason": f"{type(exc).__name__}: {exc}"[:300]}
+        return {"status": "error", "seconds": time.perf_counter() - start,
+                "reason": f"{type(exc).__name__}: {exc}"[:300]}
     seconds = time.perf_counter() - start
     diag = truth["diagonal"]
     inertia, true_inertia = np.asarray(p.inertia), np.asarray(truth["inertia"])
