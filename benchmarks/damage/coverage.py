@@ -358,9 +358,9 @@ def load_sources(names):
 def subset(seed=11, limit=30):
     """The fast CI subset: generated and repo sources only, ``limit`` cases of one seed, in a fixed order."""
     sources = load_sources(("generated", "repo"))
-    tasks = [(cid, s, kind, ent, sources[s]) for cid, s, kind, ent in cases(sources, [seed])]
-    step = max(1, len(tasks) // limit)
-    return [run_case(t) for t in tasks[::step][:limit]]
+    tasks = {(s, kind): (cid, s, kind, ent, sources[s]) for cid, s, kind, ent in cases(sources, [seed])}
+    # case i: source i mod (sources), kind i mod (kinds): every source and every kind, in varied pairs
+    return [run_case(tasks[(i % len(sources), KINDS[i % len(KINDS)])]) for i in range(limit)]
 
 
 def main(argv=None) -> int:

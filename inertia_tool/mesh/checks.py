@@ -99,6 +99,7 @@ class MeshReport:
         How the solid was obtained from the surface: ``"exact"`` (the surface integral as it stands),
         ``"oriented"`` (faces wound the wrong way turned, then exact), ``"welded"`` (vertices closer than
         ``welded_tolerance`` merged, then exact), ``"deduplicated"`` (repeated faces dropped, then exact),
+        ``"sealed"`` (T-junctions split and crack lips welded without moving any point, then exact),
         ``"union"`` (overlapping bodies united by a boolean, then exact), ``"sum"`` (overlapping bodies'
         integrals added: shared volume counted twice, on request), ``"patched"`` / ``"winding"`` (estimates
         of ``repair=True``, see ``uncertainty``).

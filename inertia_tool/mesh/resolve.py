@@ -58,7 +58,8 @@ class Resolution:
     faces : (m, 3) int
         Faces to integrate (exact methods); the patched surface for ``"patched"``.
     method : str
-        ``"exact"``, ``"oriented"``, ``"welded"``, ``"deduplicated"``, ``"patched"`` or ``"winding"``.
+        ``"exact"``, ``"oriented"``, ``"welded"``, ``"deduplicated"``, ``"sealed"`` (T-junctions split, crack
+        lips welded, nothing moved: exact), ``"patched"`` or ``"winding"``.
     notes : tuple of str
         What was found and done, one short sentence each.
     flipped_faces : int
@@ -220,6 +221,11 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                      why="the loose triangles do not enclose a definite volume; mesh the part again as a closed "
                      "surface")
     repair_notes.append(best.detail)
+    if best.method == "patched" and best.uncertainty.volume_in_doubt == 0:
+        # every seam sealed without moving anything and no hole left: the sealed polyhedron is the solid
+        sealed_faces = best.faces
+        return Resolution(best.vertices, sealed_faces, "sealed", tuple(repair_notes), flipped, welded,
+                          edge_balance(sealed_faces, len(best.vertices)).nonmanifold_edges)
     return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
                       edge_balance(best.faces, len(best.vertices)).nonmanifold_edges if best.method == "patched"
                       else census.nonmanifold_edges, estimate=best)
