@@ -89,8 +89,11 @@ def test_xacro_input_writes_the_expanded_urdf(tmp_path, capsys):
 
 
 def test_an_open_link_mesh_is_reported_with_the_option_that_repairs_it(tmp_path, capsys):
-    from conftest import box_arrays, write_binary_stl
-    v, f = box_arrays((0.1, 0.1, 0.1))
+    import trimesh
+    from conftest import write_binary_stl
+    # a small hole (one of 768 triangles): a bounded estimate exists (a hole as large as a side is refused)
+    box = trimesh.creation.box(extents=(0.1, 0.1, 0.1)).subdivide().subdivide().subdivide()
+    v, f = np.asarray(box.vertices), np.asarray(box.faces)
     write_binary_stl(tmp_path / "open.stl", v, f[:-1])
     urdf = tmp_path / "r.urdf"
     urdf.write_text('<robot name="r"><link name="holed"><collision><geometry><mesh filename="open.stl"/>'

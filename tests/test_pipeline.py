@@ -90,11 +90,21 @@ def test_open_mesh_is_refused_with_counts_and_location():
 
 
 def test_open_mesh_repaired_on_request():
-    v, f = box_arrays()
+    box = trimesh.creation.box(extents=(1.0, 2.0, 3.0)).subdivide().subdivide().subdivide()
+    v, f = np.asarray(box.vertices), np.asarray(box.faces)
     with pytest.warns(MeshRepairedWarning):
         p = mass_properties((v, f[1:]), repair=True)
-    assert p.volume == pytest.approx(6.0, rel=1e-14)
+    assert p.volume == pytest.approx(6.0, rel=1e-14)      # a planar hole: the cone is flat
+    assert 0 < p.mesh.uncertainty.mass < 0.01              # ... but that is not known, so it is bounded
     assert p.mesh.repaired and p.mesh.repair_actions
+
+
+def test_hole_as_large_as_the_part_is_refused_under_repair():
+    """One of the two triangles of a 2 × 3 side missing: the ball over its rim holds four times the box, so
+    no honest bound exists (issue 21: planar rims used to get a bound of exactly 0)."""
+    v, f = box_arrays()
+    with pytest.raises(InvalidMeshError, match="cannot be bounded usefully"):
+        mass_properties((v, f[1:]), repair=True)
 
 
 def test_flipped_face_is_turned_and_exact_without_repair():
