@@ -235,8 +235,9 @@ def _loose_share(faces: np.ndarray) -> float:
     """Share of the faces that share no edge with another face (loose triangles of a soup)."""
     if not len(faces):
         return 1.0
-    edges = np.sort(np.asarray(faces)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    _, inverse, counts = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
+    edges = np.sort(np.asarray(faces, dtype=np.int64)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    key = edges[:, 0] * (int(edges.max()) + 1) + edges[:, 1]
+    _, inverse, counts = np.unique(key, return_inverse=True, return_counts=True)
     alone = (counts[inverse.reshape(-1)] == 1).reshape(-1, 3).all(axis=1)
     return float(np.count_nonzero(alone)) / len(faces)
 
