@@ -194,7 +194,7 @@ def run_isolated(function: Callable[..., Any], *args: Any, limits: Limits = CAD_
         shutil.rmtree(workdir, ignore_errors=True)
 
 
-def _kill_group(process: subprocess.Popen) -> None:
+def _kill_group(process: subprocess.Popen[bytes]) -> None:
     if hasattr(os, "killpg"):
         try:
             os.killpg(process.pid, signal.SIGKILL)
@@ -292,7 +292,7 @@ def _child_main(job_path: str) -> None:
     answer_path = job["answer"]
     _apply_limits(job["cpu"], job["memory"])
     try:
-        outcome: tuple = ("ok", job["function"](*job["args"], **job["kwargs"]))
+        outcome: tuple[Any, ...] = ("ok", job["function"](*job["args"], **job["kwargs"]))
     except MemoryError:
         outcome = ("memory",)
     except Exception as exc:  # noqa: BLE001 - every failure of the job goes back to the parent as its answer

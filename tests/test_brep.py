@@ -2,6 +2,8 @@
 the tessellation and
 the bound on its error, on a part made here with OCP whose closed form is known (a cylinder with a hole)."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -112,3 +114,110 @@ def test_analyze_reports_the_brep_and_the_tessellation_error(washer_files, capsy
     assert out["brep"]["exact"]["mass"] == pytest.approx(7850 * EXACT.volume, rel=1e-12)
     assert out["brep"]["volume_error"] <= out["brep"]["volume_error_bound"]
     assert abs(out["mass"] / out["brep"]["exact"]["mass"] - 1) == pytest.approx(out["brep"]["volume_error"], rel=1e-6)
+
+
+# -- OpenCASCADE runs isolated (issue 22 item 2) -----------------------------------------------------------
+
+def _nested_parentheses_step(path, depth=100_000):
+    """A 200 KB STEP file whose one entity nests ``depth`` parentheses: OpenCASCADE's parser recursed until
+    the stack overflowed (a segmentation fault that took `analyze`, `robot` and `batch` down)."""
+    path.write_text("ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('x'),'2;1');\n"
+                    "FILE_NAME('n','2020-01-01T00:00:00',(''),(''),'','','');\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\n"
+                    "ENDSEC;\nDATA;\n#1=CARTESIAN_POINT(''," + "(" * depth + "0." + ")" * depth
+                    + ");\nENDSEC;\nEND-ISO-10303-21;\n")
+    return path
+
+
+def test_a_step_that_crashes_opencascade_is_an_error_not_a_crash(tmp_path, washer_files, capsys):
+    from inertia_tool.batch.runner import BatchOptions, run_batch
+    from inertia_tool.cli import main
+    from inertia_tool.errors import MeshReadError
+    bad = _nested_parentheses_step(tmp_path / "nested.step")
+    with pytest.raises(MeshReadError, match=r"nested.step: (OpenCASCADE crashed \(SIGSEGV, segmentation fault\)|"
+                                            "holds no shape)") as err:
+        it.mass_properties(bad)
+    if "crashed" not in str(err.value):                          # pragma: no cover - a future OCC may not crash
+        pytest.xfail("this OpenCASCADE no longer crashes on deep nesting (the isolation is tested in test_isolate)")
+    assert main(["analyze", str(bad), "--material", "steel"]) == 3
+    err_text = capsys.readouterr().err
+    assert "OpenCASCADE crashed (SIGSEGV" in err_text and err_text.count("\n") == 1
+    rows = []
+    summary = run_batch([str(bad), str(washer_files["step"])], BatchOptions(), rows.append)
+    assert summary.ok == 1 and summary.failed == 1
+    by_name = {os.path.basename(r["path"]): r for r in rows}
+    assert by_name["nested.step"]["status"] == "error" and "SIGSEGV" in by_name["nested.step"]["error"]
+    assert by_name["washer.step"]["mass"] == pytest.approx(1000 * EXACT.volume, rel=1e-3)
+
+
+def test_opencascade_runs_under_the_limits_of_the_environment(washer_files, monkeypatch, capsys):
+    from inertia_tool.cli import main
+    from inertia_tool.errors import MeshReadError
+    cad._LAST.clear()
+    monkeypatch.setenv("INERTIA_TOOL_MEMORY_LIMIT", "64M")       # less than the interpreter and OCP need
+    with pytest.raises(MeshReadError, match="washer.step: OpenCASCADE (exceeded the memory limit of 64 MiB|"
+                                            "crashed|ended without an answer)"):
+        cad.read_cad(washer_files["step"])
+    assert main(["analyze", str(washer_files["step"]), "--material", "steel"]) == 3
+    assert "OpenCASCADE" in capsys.readouterr().err
+
+
+# -- several solids: the union, not the sum (issue 21 item 6) ------------------------------------------------
+
+def _box_tensor(lo, hi):
+    """Unit-density volume, centre and inertia about the centre of the axis-aligned box [lo, hi] (closed form:
+    ``V/12 (b² + c²)`` on the diagonal, Chapter 4 "Rigid Body Motion", §4.3)."""
+    size = np.subtract(hi, lo, dtype=float)
+    volume = float(np.prod(size))
+    sq = size ** 2
+    return volume, (np.add(lo, hi) / 2), np.diag(volume / 12 * (sq.sum() - sq))
+
+
+def _shifted(volume, centre, tensor, point):
+    d = np.asarray(centre) - point                     # parallel-axis theorem, tensor convention
+    return tensor + volume * (d @ d * np.eye(3) - np.outer(d, d))
+
+
+@pytest.fixture(scope="module")
+def two_boxes_step(tmp_path_factory):
+    """Two 20 mm cubes, the second moved by (10, 10, 10) mm: they share a 10 mm cube (one compound, two solids)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.TopoDS import TopoDS_Compound
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 20, 20, 20).Shape())
+    builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(10, 10, 10), 20, 20, 20).Shape())
+    path = tmp_path_factory.mktemp("cad") / "two_boxes.step"
+    with cad._quiet():
+        writer = STEPControl_Writer()
+        writer.Transfer(compound, STEPControl_AsIs)
+        writer.Write(str(path))
+    return path
+
+
+def _union_of_two_boxes():
+    """Inclusion–exclusion of the closed forms: A + B − (A ∩ B), in metres."""
+    a = _box_tensor([0, 0, 0], [0.02, 0.02, 0.02])
+    b = _box_tensor([0.01, 0.01, 0.01], [0.03, 0.03, 0.03])
+    shared = _box_tensor([0.01, 0.01, 0.01], [0.02, 0.02, 0.02])
+    volume = a[0] + b[0] - shared[0]
+    com = (a[0] * a[1] + b[0] * b[1] - shared[0] * shared[1]) / volume
+    tensor = sum(s * _shifted(*part, com) for s, part in ((1, a), (1, b), (-1, shared)))
+    return volume, com, tensor, shared[0]
+
+
+def test_overlapping_solids_are_fused_into_their_union(two_boxes_step):
+    volume, com, tensor, shared = _union_of_two_boxes()
+    cmp = brep.compare(two_boxes_step)
+    assert cmp.solids == 2 and cmp.fused
+    assert cmp.overlap_volume == pytest.approx(shared, rel=1e-9)
+    assert cmp.exact.volume == pytest.approx(volume, rel=1e-12)                  # 15/16 of the sum, not the sum
+    np.testing.assert_allclose(cmp.exact.center_of_mass, com, atol=1e-15)
+    assert_tensor_close(cmp.exact.inertia, tensor, 1e-12)
+    # the tessellation is of the union too (planar faces: exact), and so is what the mesh reader returns
+    assert cmp.volume_error < 1e-12 and cmp.inertia_error < 1e-12
+    props = it.mass_properties(two_boxes_step, density=1.0)
+    assert props.volume == pytest.approx(volume, rel=1e-12)
+    assert_tensor_close(props.inertia, tensor, 1e-12)
