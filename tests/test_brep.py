@@ -113,7 +113,38 @@ def test_analyze_reports_the_brep_and_the_tessellation_error(washer_files, capsy
     out = json.loads(capsys.readouterr().out)
     assert out["brep"]["exact"]["mass"] == pytest.approx(7850 * EXACT.volume, rel=1e-12)
     assert out["brep"]["volume_error"] <= out["brep"]["volume_error_bound"]
-    assert abs(out["mass"] / out["brep"]["exact"]["mass"] - 1) == pytest.approx(out["brep"]["volume_error"], rel=1e-6)
+    # the headline is the exact B-rep (issue 21 item 6); the tessellation is the second line
+    assert out["mass"] == pytest.approx(7850 * EXACT.volume, rel=1e-12) and out["method"].startswith("brep")
+    assert_tensor_close(np.array(out["inertia"]), 7850 * EXACT.inertia, 1e-12)
+    tess = out["brep"]["tessellation"]["mass"]
+    assert abs(tess / out["mass"] - 1) == pytest.approx(out["brep"]["volume_error"], rel=1e-6)
+    assert tess != pytest.approx(out["mass"], rel=1e-5)             # the two differ: the headline is not the mesh
+
+
+@pytest.mark.parametrize("fmt", ["text", "cad", "urdf"])
+def test_every_format_leads_with_the_exact_brep(washer_files, capsys, fmt):
+    from inertia_tool.cli import main
+    assert main(["analyze", str(washer_files["step"]), "--material", "steel", "--format", fmt]) == 0
+    out = capsys.readouterr().out
+    exact, mesh = 7850 * EXACT.volume, brep.compare(washer_files["step"]).mesh.volume * 7850
+    shown = {"text": f"mass:             {exact:.6g} kg", "cad": f"Mass = {exact:.8g} kilograms",
+             "urdf": f'<mass value="{exact:.12g}"/>'}[fmt]
+    assert shown in out, out
+    assert f"{mesh:.6g}" not in out.split("tessellation")[0]
+    if fmt != "urdf":
+        assert "exact B-rep" in out and "tessellation (" in out and f"mass {mesh:.9g} kg" in out
+    if fmt == "text":
+        assert "result: exact B-rep of the CAD file" in out
+
+
+def test_a_target_mass_scales_the_exact_brep(washer_files, capsys):
+    from inertia_tool.cli import main
+    import json
+    assert main(["analyze", str(washer_files["step"]), "--mass", "2kg", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mass"] == pytest.approx(2.0, rel=1e-14)
+    assert out["density"] == pytest.approx(2.0 / EXACT.volume, rel=1e-12)
+    assert_tensor_close(np.array(out["inertia"]), EXACT.inertia * 2.0 / EXACT.volume, 1e-12)
 
 
 # -- OpenCASCADE runs isolated (issue 22 item 2) -----------------------------------------------------------
@@ -221,3 +252,17 @@ def test_overlapping_solids_are_fused_into_their_union(two_boxes_step):
     props = it.mass_properties(two_boxes_step, density=1.0)
     assert props.volume == pytest.approx(volume, rel=1e-12)
     assert_tensor_close(props.inertia, tensor, 1e-12)
+
+
+def test_analyze_states_the_fusion(two_boxes_step, capsys):
+    from inertia_tool.cli import main
+    import json
+    volume, _, tensor, shared = _union_of_two_boxes()
+    assert main(["analyze", str(two_boxes_step), "--density", "1000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mass"] == pytest.approx(1000 * volume, rel=1e-12)
+    assert out["brep"]["solids"] == 2 and out["brep"]["fused"]
+    assert out["brep"]["overlap_volume"] == pytest.approx(shared, rel=1e-9)
+    assert main(["analyze", str(two_boxes_step), "--density", "1000"]) == 0
+    assert f"2 solids fused into one (OpenCASCADE boolean union); they overlapped by {shared:.6g} m³" in \
+        capsys.readouterr().out
