@@ -266,3 +266,40 @@ def test_analyze_states_the_fusion(two_boxes_step, capsys):
     assert main(["analyze", str(two_boxes_step), "--density", "1000"]) == 0
     assert f"2 solids fused into one (OpenCASCADE boolean union); they overlapped by {shared:.6g} m³" in \
         capsys.readouterr().out
+
+
+def test_solids_apart_are_not_fused_and_sum_exactly(tmp_path):
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+    from OCP.TopoDS import TopoDS_Compound
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 1, 1, 1).Shape())
+    builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(2, 0, 0), 1, 2, 3).Shape())
+    shape, solids, summed, fused = cad.solids_fused(compound)
+    assert solids == 2 and not fused and shape is compound and summed == pytest.approx(7.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_meeting_groups_are_the_components_of_the_box_overlap_graph(seed):
+    """The sweep against brute force: connected components of 'boxes meet' (closed boxes: touching counts)."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 40))
+    lo = rng.integers(0, 12, (n, 3)).astype(float)            # integer corners: many exact touches
+    boxes = np.hstack([lo, lo + rng.integers(0, 4, (n, 3))])
+    meet = np.all(boxes[:, None, :3] <= boxes[None, :, 3:], axis=2) & np.all(boxes[None, :, :3] <= boxes[:, None, 3:],
+                                                                             axis=2)
+    label = np.arange(n)
+    for _ in range(n):                                        # propagate the smallest label along edges
+        label = np.array([label[meet[i]].min() for i in range(n)])
+    expected = sorted(sorted(np.nonzero(label == k)[0].tolist()) for k in np.unique(label))
+    assert sorted(cad._meeting_groups(boxes)) == expected
+
+
+def test_the_face_limit_is_applied_before_the_triangles_are_copied(washer_files):
+    from inertia_tool.errors import MeshReadError
+    cad._LAST.clear()
+    with pytest.raises(MeshReadError, match=r"washer.step: the tessellation .* has 1,152 triangles, more than "
+                                            r"`max_faces` \(100\) allows"):
+        it.mass_properties(washer_files["step"], max_faces=100)

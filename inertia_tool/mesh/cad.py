@@ -136,8 +136,11 @@ def chord_tolerance(shape, chord: float | None = None) -> float:
     return DEFAULT_CHORD_RTOL * _bounding_diagonal(shape)
 
 
-def tessellate(shape, *, chord: float, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION):
+def tessellate(shape, *, chord: float, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
+               max_faces: int | None = None):
     """Triangles of the B-rep (``BRepMesh_IncrementalMesh``): ``(vertices (n, 3) m, faces (m, 3))``, outward.
+
+    ``max_faces``: refuse (:class:`UsageError`) a tessellation of more triangles before copying them out.
 
     Each B-rep face is meshed on its own; reversed faces have their triangles flipped so the normals point
     out of the solid, and each face's location is applied.  Vertices on shared edges coincide (the mesher
@@ -150,6 +153,15 @@ def tessellate(shape, *, chord: float, angular_deflection: float = DEFAULT_ANGUL
     from OCP.TopLoc import TopLoc_Location
     from OCP.TopoDS import TopoDS
     BRepMesh_IncrementalMesh(shape, chord, False, angular_deflection, True)
+    if max_faces is not None:
+        total, explorer = 0, TopExp_Explorer(shape, TopAbs_FACE)
+        while explorer.More():
+            triangulation = BRep_Tool.Triangulation_s(TopoDS.Face(explorer.Current()), TopLoc_Location())
+            total += triangulation.NbTriangles() if triangulation is not None else 0
+            explorer.Next()
+        if total > max_faces:
+            raise UsageError(f"the tessellation at a chord tolerance of {chord:.3g} m has {total:,} triangles, "
+                             f"more than `max_faces` ({max_faces:,}) allows")
     vertices, faces, offset = [], [], 0
     explorer = TopExp_Explorer(shape, TopAbs_FACE)
     while explorer.More():
@@ -195,45 +207,86 @@ def _cascadio_arrays(path: str, chord: float, angular_deflection: float):
 
 
 def solids_fused(shape) -> tuple[object, int, float, bool]:
-    """The union of the solids of ``shape`` (OpenCASCADE's boolean ``BRepAlgoAPI_Fuse``) when it has several.
+    """The union of the solids of ``shape`` (OpenCASCADE's boolean ``BRepAlgoAPI_Fuse``) when some may overlap.
 
     A STEP file of an assembly, or of a part exported as several bodies, holds solids that may overlap; the
     B-rep integrals of such a compound are the *sum* over the solids, counting shared volume twice.  The fused
-    shape is the solid the user means.
+    shape is the solid the user means.  Only solids whose bounding boxes meet are fused (each such group on
+    its own): solids apart from every other one are exact as they are, and a file of thousands of separate
+    bodies is not run through thousands of booleans.
 
     Returns
     -------
     shape : TopoDS_Shape
-        The fused solid, or ``shape`` itself (one solid, or the fuse failed).
+        The solids with each group of possibly overlapping ones fused, or ``shape`` itself (no two solids'
+        boxes meet, or a fuse failed).
     solids : int
         Solids in the file.
     summed_volume : float
         Sum of the solids' volumes, m³ (their overlap is ``summed_volume`` minus the fused volume).
     fused : bool
-        Whether the boolean ran and succeeded (False for a single solid).
+        Whether a boolean ran and succeeded.
     """
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRep import BRep_Builder
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
+    from OCP.BRepBndLib import BRepBndLib
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
     from OCP.TopAbs import TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
-    solids, summed = [], 0.0
+    from OCP.TopoDS import TopoDS_Compound
+    solids, boxes, summed = [], [], 0.0
     explorer = TopExp_Explorer(shape, TopAbs_SOLID)
     while explorer.More():
-        solids.append(explorer.Current())
+        solid = explorer.Current()
+        solids.append(solid)
         props = GProp_GProps()
-        BRepGProp.VolumeProperties_s(explorer.Current(), props)
+        BRepGProp.VolumeProperties_s(solid, props)
         summed += abs(props.Mass())
+        box = Bnd_Box()
+        BRepBndLib.Add_s(solid, box)
+        boxes.append(box.CornerMin().Coord() + box.CornerMax().Coord())
         explorer.Next()
-    if len(solids) < 2:
+    groups = _meeting_groups(np.array(boxes, dtype=np.float64).reshape(-1, 6))
+    if all(len(group) < 2 for group in groups):
         return shape, len(solids), summed, False
-    union = solids[0]
-    for solid in solids[1:]:          # one at a time: the list types of the bindings differ between versions
-        fuse = BRepAlgoAPI_Fuse(union, solid)
-        if not fuse.IsDone() or fuse.Shape().IsNull():
-            return shape, len(solids), summed, False
-        union = fuse.Shape()
-    return union, len(solids), summed, True
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    for group in groups:
+        union = solids[group[0]]
+        for k in group[1:]:           # one at a time: the list types of the bindings differ between versions
+            fuse = BRepAlgoAPI_Fuse(union, solids[k])
+            if not fuse.IsDone() or fuse.Shape().IsNull():
+                return shape, len(solids), summed, False
+            union = fuse.Shape()
+        builder.Add(compound, union)
+    return compound, len(solids), summed, True
+
+
+def _meeting_groups(boxes: np.ndarray) -> list[list[int]]:
+    """Indices of solids grouped by chains of meeting bounding boxes ``(n, 6)`` (min xyz, max xyz)."""
+    n = len(boxes)
+    parent = list(range(n))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    order = np.argsort(boxes[:, 0], kind="stable")     # sweep along x: only boxes whose x-ranges meet are paired
+    sorted_min_x = boxes[order, 0]
+    for a_pos, a in enumerate(order):
+        stop = int(np.searchsorted(sorted_min_x, boxes[a, 3], side="right"))
+        others = order[a_pos + 1:stop]
+        meet = np.all(boxes[others, :3] <= boxes[a, 3:], axis=1) & np.all(boxes[a, :3] <= boxes[others, 3:], axis=1)
+        for b in others[meet]:
+            parent[root(int(a))] = root(int(b))
+    groups: dict[int, list[int]] = {}
+    for i in range(n):
+        groups.setdefault(root(i), []).append(i)
+    return [sorted(g) for g in groups.values()]
 
 
 def brep_integrals(shape) -> tuple[float, np.ndarray, np.ndarray, float]:
@@ -285,13 +338,14 @@ class CadReading:
     fused: bool = False
 
 
-def _read_here(path: str, chord: float | None, angular_deflection: float, use_ocp: bool) -> dict:
+def _read_here(path: str, chord: float | None, angular_deflection: float, use_ocp: bool,
+               max_faces: int | None = None) -> dict:
     """Read, fuse, tessellate and integrate in this process: run only in the isolated child
     (:func:`read_cad`); returns plain values (:func:`inertia_tool.isolate.run_isolated`)."""
     if use_ocp:
         shape, solids, summed, fused = solids_fused(read_brep(path))
         tol = chord_tolerance(shape, chord)
-        vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection)
+        vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection, max_faces=max_faces)
         return {"vertices": vertices, "faces": faces, "chord": tol, "backend": "OCP",
                 "integrals": brep_integrals(shape), "solids": solids, "summed_volume": summed, "fused": fused}
     if chord is None:
@@ -307,17 +361,20 @@ _LAST: list = []
 
 
 def read_cad(path, *, chord: float | None = None, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
-             limits=None) -> CadReading:
+             limits=None, max_faces: int | None = None) -> CadReading:
     """Read, fuse (:func:`solids_fused`), tessellate and integrate a STEP/IGES file in a child process.
 
     OpenCASCADE can crash on a malformed file (a segmentation fault) or spend minutes and gigabytes on a big
     one, so it runs under :func:`inertia_tool.isolate.run_isolated` with ``limits`` (default
     :data:`~inertia_tool.isolate.CAD_LIMITS`; the ``INERTIA_TOOL_*_LIMIT`` environment variables override).
 
+    ``max_faces`` refuses a tessellation of more triangles in the child, before they are copied out.
+
     Raises
     ------
     MeshReadError
-        Unreadable file, or the child crashed or hit a limit (the message says which).
+        Unreadable file, more than ``max_faces`` triangles, or the child crashed or hit a limit (the message
+        says which).
     """
     from ..errors import IsolatedProcessError
     from ..isolate import CAD_LIMITS, run_isolated
@@ -328,10 +385,10 @@ def read_cad(path, *, chord: float | None = None, angular_deflection: float = DE
     use_ocp = has_ocp()
     key = (os.path.realpath(path), stat.st_dev, stat.st_ino, stat.st_size, stat.st_mtime_ns, chord,
            float(angular_deflection), use_ocp)
-    if _LAST and _LAST[0][0] == key:
+    if _LAST and _LAST[0][0] == key and (max_faces is None or len(_LAST[0][1].faces) <= max_faces):
         return _LAST[0][1]
     try:
-        out = run_isolated(_read_here, path, chord, float(angular_deflection), use_ocp,
+        out = run_isolated(_read_here, path, chord, float(angular_deflection), use_ocp, max_faces,
                            limits=limits or CAD_LIMITS, what="OpenCASCADE")
     except IsolatedProcessError as exc:
         raise _fail(path, str(exc)) from None
@@ -346,12 +403,13 @@ def read_cad(path, *, chord: float | None = None, angular_deflection: float = DE
     return reading
 
 
-def tessellated_arrays(path, *, chord: float | None = None, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION):
+def tessellated_arrays(path, *, chord: float | None = None, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
+                       max_faces: int | None = None):
     """``(vertices m, faces, chord m, backend)`` of a STEP/IGES file: OCP if installed, else cascadio.
 
     Read in a child process with limits (:func:`read_cad`); several solids are fused into one.  Without
     ``chord`` and with cascadio, the default tolerance is relative to the file's size as cascadio reports it
     after a first coarse conversion.
     """
-    reading = read_cad(path, chord=chord, angular_deflection=angular_deflection)
+    reading = read_cad(path, chord=chord, angular_deflection=angular_deflection, max_faces=max_faces)
     return reading.vertices, reading.faces, reading.chord, reading.backend
