@@ -242,7 +242,7 @@ def _union_of_two_boxes():
 def test_overlapping_solids_are_fused_into_their_union(two_boxes_step):
     volume, com, tensor, shared = _union_of_two_boxes()
     cmp = brep.compare(two_boxes_step)
-    assert cmp.solids == 2 and cmp.fused
+    assert cmp.solids == 2 and cmp.fusion == "fused"
     assert cmp.overlap_volume == pytest.approx(shared, rel=1e-9)
     assert cmp.exact.volume == pytest.approx(volume, rel=1e-12)                  # 15/16 of the sum, not the sum
     np.testing.assert_allclose(cmp.exact.center_of_mass, com, atol=1e-15)
@@ -261,7 +261,7 @@ def test_analyze_states_the_fusion(two_boxes_step, capsys):
     assert main(["analyze", str(two_boxes_step), "--density", "1000", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["mass"] == pytest.approx(1000 * volume, rel=1e-12)
-    assert out["brep"]["solids"] == 2 and out["brep"]["fused"]
+    assert out["brep"]["solids"] == 2 and out["brep"]["fusion"] == "fused"
     assert out["brep"]["overlap_volume"] == pytest.approx(shared, rel=1e-9)
     assert main(["analyze", str(two_boxes_step), "--density", "1000"]) == 0
     assert f"2 solids fused into one (OpenCASCADE boolean union); they overlapped by {shared:.6g} m³" in \
@@ -277,8 +277,8 @@ def test_solids_apart_are_not_fused_and_sum_exactly(tmp_path):
     builder.MakeCompound(compound)
     builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 1, 1, 1).Shape())
     builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(2, 0, 0), 1, 2, 3).Shape())
-    shape, solids, summed, fused = cad.solids_fused(compound)
-    assert solids == 2 and not fused and shape is compound and summed == pytest.approx(7.0, rel=1e-12)
+    shape, solids, summed, fusion = cad.solids_fused(compound)
+    assert solids == 2 and fusion == "apart" and shape is compound and summed == pytest.approx(7.0, rel=1e-12)
 
 
 @pytest.mark.parametrize("seed", range(20))
@@ -303,3 +303,14 @@ def test_the_face_limit_is_applied_before_the_triangles_are_copied(washer_files)
     with pytest.raises(MeshReadError, match=r"washer.step: the tessellation .* has 1,152 triangles, more than "
                                             r"`max_faces` \(100\) allows"):
         it.mass_properties(washer_files["step"], max_faces=100)
+
+
+@pytest.mark.parametrize("fusion, said", [("apart", "2 solids, no two of which meet: the values are their sum"),
+                                          ("failed", "2 solids that could not be fused: the values are their sum "
+                                                     "(overlaps count twice)")])
+def test_the_report_says_how_several_solids_were_counted(washer_files, fusion, said):
+    from dataclasses import replace
+    from inertia_tool.reports.brep import brep_comparison_dict, format_brep_comparison
+    cmp = replace(brep.compare(washer_files["step"]), solids=2, fusion=fusion)
+    assert said in format_brep_comparison(cmp, 1000.0)
+    assert brep_comparison_dict(cmp, 1000.0)["fusion"] == fusion

@@ -59,7 +59,7 @@ def run(args) -> int:
         props = cad.scaled(props, target_mass=target)
         if target is not None and ": implied density" in described:
             described = described.split(": implied density")[0] + f": implied density {props.density:.4g} kg/m³"
-        if cad.solids > 1 and not cad.fused:
+        if cad.fusion == "failed":
             message = (f"{props.name}: the file holds {cad.solids} solids that could not be fused: the exact "
                        "B-rep values are their sum, so any volume they share is counted twice")
             messages.append(message)

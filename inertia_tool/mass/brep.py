@@ -66,9 +66,11 @@ class BrepComparison:
         ``‖I_mesh − I_exact‖_F / ‖I_exact‖_F`` (about each one's centre of mass).
     solids : int
         Solids in the file.
-    fused : bool
-        Several solids were fused into their union (OpenCASCADE's boolean) before integrating and
-        tessellating: ``exact`` is the union, not the sum.
+    fusion : str
+        :data:`~inertia_tool.mesh.cad.FUSIONS`: ``"fused"`` when several solids were fused into their union
+        (OpenCASCADE's boolean) before integrating and tessellating (``exact`` is the union, not the sum);
+        ``"apart"`` when no two of them meet (the sum is the union); ``"failed"`` when a boolean failed
+        (``exact`` is the sum, shared volume counted twice).
     overlap_volume : float
         m³ the solids shared (their summed volume minus the union's); 0 for one solid.
     """
@@ -83,7 +85,7 @@ class BrepComparison:
     com_error: float
     inertia_error: float
     solids: int = 1
-    fused: bool = False
+    fusion: str = "one solid"
     overlap_volume: float = 0.0
 
     def scaled(self, like: MassProperties, *, target_mass: float | None = None) -> MassProperties:
@@ -121,11 +123,11 @@ def compare(path: str | os.PathLike[str], *, chord: float | None = None,
         warnings.simplefilter("ignore")
         mesh = mass_properties((reading.vertices, reading.faces), density=1.0, name=path)
     tol = reading.chord
-    overlap = max(0.0, reading.summed_volume - exact.volume) if reading.fused else 0.0
+    overlap = max(0.0, reading.summed_volume - exact.volume) if reading.fusion == "fused" else 0.0
     return BrepComparison(
         exact=exact, mesh=mesh, chord=tol, angular_deflection=float(angular_deflection), faces=len(reading.faces),
         volume_error=abs(mesh.volume - exact.volume) / exact.volume,
         volume_bound=exact.surface_area * tol / exact.volume,
         com_error=float(np.linalg.norm(mesh.center_of_mass - exact.center_of_mass)),
         inertia_error=float(np.linalg.norm(mesh.inertia - exact.inertia) / np.linalg.norm(exact.inertia)),
-        solids=max(reading.solids, 1), fused=reading.fused, overlap_volume=overlap)
+        solids=max(reading.solids, 1), fusion=reading.fusion, overlap_volume=overlap)

@@ -38,7 +38,10 @@ from ..values import frozen_value
 
 __all__ = ["BREP_SUFFIXES", "DEFAULT_CHORD_RTOL", "DEFAULT_ANGULAR_DEFLECTION", "read_brep", "tessellate",
            "chord_tolerance", "tessellated_arrays", "has_ocp", "read_cad", "CadReading", "solids_fused",
-           "brep_integrals"]
+           "brep_integrals", "FUSIONS"]
+
+#: How :func:`solids_fused` made one solid of a file's solids.
+FUSIONS = ("one solid", "apart", "fused", "failed")
 
 #: CAD exchange suffixes read as B-reps.
 BREP_SUFFIXES = (".step", ".stp", ".iges", ".igs")
@@ -206,7 +209,7 @@ def _cascadio_arrays(path: str, chord: float, angular_deflection: float):
     return vertices, faces
 
 
-def solids_fused(shape) -> tuple[object, int, float, bool]:
+def solids_fused(shape) -> tuple[object, int, float, str]:
     """The union of the solids of ``shape`` (OpenCASCADE's boolean ``BRepAlgoAPI_Fuse``) when some may overlap.
 
     A STEP file of an assembly, or of a part exported as several bodies, holds solids that may overlap; the
@@ -224,8 +227,10 @@ def solids_fused(shape) -> tuple[object, int, float, bool]:
         Solids in the file.
     summed_volume : float
         Sum of the solids' volumes, m³ (their overlap is ``summed_volume`` minus the fused volume).
-    fused : bool
-        Whether a boolean ran and succeeded.
+    fusion : str
+        :data:`FUSIONS`: ``"one solid"`` (or none), ``"apart"`` (no two bounding boxes meet: nothing to fuse,
+        the sum is the union), ``"fused"`` (the booleans ran and succeeded) or ``"failed"`` (a boolean failed:
+        ``shape`` is returned as it was, and its integrals are the sum).
     """
     from OCP.Bnd import Bnd_Box
     from OCP.BRep import BRep_Builder
@@ -249,8 +254,10 @@ def solids_fused(shape) -> tuple[object, int, float, bool]:
         boxes.append(box.CornerMin().Coord() + box.CornerMax().Coord())
         explorer.Next()
     groups = _meeting_groups(np.array(boxes, dtype=np.float64).reshape(-1, 6))
+    if len(solids) < 2:
+        return shape, len(solids), summed, "one solid"
     if all(len(group) < 2 for group in groups):
-        return shape, len(solids), summed, False
+        return shape, len(solids), summed, "apart"
     compound, builder = TopoDS_Compound(), BRep_Builder()
     builder.MakeCompound(compound)
     for group in groups:
@@ -258,10 +265,10 @@ def solids_fused(shape) -> tuple[object, int, float, bool]:
         for k in group[1:]:           # one at a time: the list types of the bindings differ between versions
             fuse = BRepAlgoAPI_Fuse(union, solids[k])
             if not fuse.IsDone() or fuse.Shape().IsNull():
-                return shape, len(solids), summed, False
+                return shape, len(solids), summed, "failed"
             union = fuse.Shape()
         builder.Add(compound, union)
-    return compound, len(solids), summed, True
+    return compound, len(solids), summed, "fused"
 
 
 def _meeting_groups(boxes: np.ndarray) -> list[list[int]]:
@@ -324,8 +331,9 @@ class CadReading:
         Solids in the file (OCP only; 0 with cascadio).
     summed_volume : float
         Sum of the solids' volumes, m³ (:func:`solids_fused`).
-    fused : bool
-        Several solids were fused into one (the tessellation and ``integrals`` are of the union).
+    fusion : str
+        How several solids became one (:func:`solids_fused`; the tessellation and ``integrals`` are of the
+        result).
     """
 
     vertices: np.ndarray
@@ -335,7 +343,7 @@ class CadReading:
     integrals: tuple | None = None
     solids: int = 0
     summed_volume: float = 0.0
-    fused: bool = False
+    fusion: str = "one solid"
 
 
 def _read_here(path: str, chord: float | None, angular_deflection: float, use_ocp: bool,
@@ -343,11 +351,11 @@ def _read_here(path: str, chord: float | None, angular_deflection: float, use_oc
     """Read, fuse, tessellate and integrate in this process: run only in the isolated child
     (:func:`read_cad`); returns plain values (:func:`inertia_tool.isolate.run_isolated`)."""
     if use_ocp:
-        shape, solids, summed, fused = solids_fused(read_brep(path))
+        shape, solids, summed, fusion = solids_fused(read_brep(path))
         tol = chord_tolerance(shape, chord)
         vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection, max_faces=max_faces)
         return {"vertices": vertices, "faces": faces, "chord": tol, "backend": "OCP",
-                "integrals": brep_integrals(shape), "solids": solids, "summed_volume": summed, "fused": fused}
+                "integrals": brep_integrals(shape), "solids": solids, "summed_volume": summed, "fusion": fusion}
     if chord is None:
         v, _ = _cascadio_arrays(path, 1e-3, 0.5)
         chord = DEFAULT_CHORD_RTOL * float(np.linalg.norm(np.ptp(v, axis=0)))
@@ -398,7 +406,7 @@ def read_cad(path, *, chord: float | None = None, angular_deflection: float = DE
                          faces=np.asarray(out["faces"], dtype=np.int64), chord=float(out["chord"]),
                          backend=str(out["backend"]), integrals=out.get("integrals"),
                          solids=int(out.get("solids", 0)), summed_volume=float(out.get("summed_volume", 0.0)),
-                         fused=bool(out.get("fused", False)))
+                         fusion=str(out.get("fusion", "one solid")))
     _LAST[:] = [(key, reading)]
     return reading
 

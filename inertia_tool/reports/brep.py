@@ -23,7 +23,7 @@ def brep_comparison_dict(cmp: BrepComparison, density: float) -> dict:
         "angular_deflection": cmp.angular_deflection,
         "triangles": cmp.faces,
         "solids": cmp.solids,
-        "fused": cmp.fused,
+        "fusion": cmp.fusion,
         "overlap_volume": cmp.overlap_volume,
         "exact": {"volume": cmp.exact.volume, "mass": cmp.exact.volume * density,
                   "center_of_mass": cmp.exact.center_of_mass, "inertia": cmp.exact.inertia * density},
@@ -41,10 +41,12 @@ def brep_comparison_dict(cmp: BrepComparison, density: float) -> dict:
 def format_brep_comparison(cmp: BrepComparison, density: float) -> str:
     """Two or three lines under the headline: where the numbers come from, and the tessellation's difference."""
     lines = ["  source: exact B-rep of the CAD file (OpenCASCADE BRepGProp, Gauss integration on its faces)"]
-    if cmp.solids > 1 and cmp.fused:
+    if cmp.fusion == "fused":
         lines.append(f"    {cmp.solids} solids fused into one (OpenCASCADE boolean union); they overlapped by "
                      f"{cmp.overlap_volume:.6g} m³, counted once")
-    elif cmp.solids > 1:
+    elif cmp.fusion == "apart":
+        lines.append(f"    {cmp.solids} solids, no two of which meet: the values are their sum")
+    elif cmp.fusion == "failed":
         lines.append(f"    {cmp.solids} solids that could not be fused: the values are their sum (overlaps count "
                      "twice)")
     lines.append(
