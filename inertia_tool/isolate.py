@@ -9,8 +9,9 @@ runs one top-level function in a fresh Python interpreter (``python -I``) and re
   wall-clock limit becomes an :class:`~inertia_tool.errors.IsolatedProcessError` whose ``reason`` says which,
   instead of taking the tool (or a whole batch) down;
 * the child inherits no secrets: its environment is a small allow-list (:data:`ENVIRONMENT_ALLOW_LIST`), its
-  stdin is closed (``/dev/null``), its stdout discarded (OpenCASCADE prints banners there), and it runs in its
-  own session, so the wall-clock limit kills everything it started.
+  stdin is closed (``/dev/null``), its stdout discarded (OpenCASCADE prints banners there), its stderr goes to
+  a file of which the last few KB are kept for a message (any file it writes is capped at the memory limit,
+  ``RLIMIT_FSIZE``), and it runs in its own session, so the wall-clock limit kills everything it started.
 
 This is resource isolation, not a sandbox: the child runs as the same user.  Code that the user has asked to run
 (``--run-xacro``) can still do what that user can do; the limits only stop it from hanging or exhausting the
@@ -29,6 +30,7 @@ suffix) and ``INERTIA_TOOL_WALL_LIMIT`` (seconds) override them for every isolat
 
 from __future__ import annotations
 
+import errno
 import io
 import json
 import os
@@ -175,20 +177,24 @@ def run_isolated(function: Callable[..., Any], *args: Any, limits: Limits = CAD_
             pickle.dump({"function": function, "args": args, "kwargs": kwargs, "answer": answer,
                          "cpu": limits.cpu_seconds, "memory": limits.memory_bytes}, fh)
         command = [sys.executable, "-I", "-c", _CHILD_CODE, json.dumps(sys.path), job]
-        process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                   stderr=subprocess.PIPE, env=_child_environment(), start_new_session=True)
-        try:
-            _, stderr = process.communicate(timeout=limits.wall_seconds)
-        except subprocess.TimeoutExpired:
-            _kill_group(process)
-            process.communicate()
-            raise IsolatedProcessError(f"{what} took longer than {limits.wall_seconds:g} s (wall clock; set "
-                                       f"{_ENV_WALL} to allow more)", kind="wall") from None
-        except BaseException:            # KeyboardInterrupt: leave no child behind
-            _kill_group(process)
-            process.wait()
-            raise
-        _kill_group(process)             # anything the job started and left running
+        # stderr goes to a file (its size capped by RLIMIT_FSIZE in the child), never into this process's memory
+        with open(os.path.join(workdir, "stderr"), "w+b") as stderr_file:
+            process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                       stderr=stderr_file, env=_child_environment(), start_new_session=True)
+            try:
+                process.wait(timeout=limits.wall_seconds)
+            except subprocess.TimeoutExpired:
+                _kill_group(process)
+                process.wait()
+                raise IsolatedProcessError(f"{what} took longer than {limits.wall_seconds:g} s (wall clock; set "
+                                           f"{_ENV_WALL} to allow more)", kind="wall") from None
+            except BaseException:            # KeyboardInterrupt: leave no child behind
+                _kill_group(process)
+                process.wait()
+                raise
+            _kill_group(process)             # anything the job started and left running
+            stderr_file.seek(max(0, os.fstat(stderr_file.fileno()).st_size - _STDERR_KEEP))
+            stderr = stderr_file.read(_STDERR_KEEP)
         return _outcome(process.returncode, answer, stderr, limits, what)
     finally:
         shutil.rmtree(workdir, ignore_errors=True)
@@ -235,6 +241,9 @@ def _outcome(returncode: int, answer: str, stderr: bytes, limits: Limits, what: 
         raise IsolatedProcessError(f"{what} gave an answer that cannot be read", kind="crash")
     if outcome[0] == "ok" and len(outcome) == 2:
         return outcome[1]
+    if outcome[0] == "file":
+        raise IsolatedProcessError(f"{what} wrote more than {_size(limits.memory_bytes)} (the memory limit) to a "
+                                   "file or to its error output", kind="memory")
     if outcome[0] == "memory":
         raise IsolatedProcessError(f"{what} exceeded the memory limit of {_size(limits.memory_bytes)} (set "
                                    f"{_ENV_MEMORY} to allow more)", kind="memory")
@@ -278,7 +287,9 @@ def _apply_limits(cpu: float, memory: int) -> None:
     except ImportError:        # Windows: wall clock only
         return
     whole = max(1, int(cpu + 0.999))
-    for which, soft, hard in ((resource.RLIMIT_CPU, whole, whole + 2), (resource.RLIMIT_AS, memory, memory)):
+    # files the job writes (its stderr included) are capped at the memory limit
+    for which, soft, hard in ((resource.RLIMIT_CPU, whole, whole + 2), (resource.RLIMIT_AS, memory, memory),
+                              (resource.RLIMIT_FSIZE, memory, memory)):
         current_hard = resource.getrlimit(which)[1]
         if current_hard != resource.RLIM_INFINITY:
             soft, hard = min(soft, current_hard), min(hard, current_hard)
@@ -295,6 +306,9 @@ def _child_main(job_path: str) -> None:
         outcome: tuple[Any, ...] = ("ok", job["function"](*job["args"], **job["kwargs"]))
     except MemoryError:
         outcome = ("memory",)
+    except OSError as exc:             # Python ignores SIGXFSZ: a write past RLIMIT_FSIZE fails with EFBIG
+        outcome = (("file",) if exc.errno == errno.EFBIG else
+                   ("error", type(exc).__name__, " ".join(str(exc).split()) or type(exc).__name__))
     except Exception as exc:  # noqa: BLE001 - every failure of the job goes back to the parent as its answer
         outcome = ("error", type(exc).__name__, " ".join(str(exc).split()) or type(exc).__name__)
     try:

@@ -179,3 +179,16 @@ def test_a_xacro_that_hangs_or_explodes_is_stopped(tmp_path, monkeypatch, capsys
     assert main(["robot", str(f), "--material", "steel", "--run-xacro"]) == 3
     err = capsys.readouterr().err
     assert err.startswith(f"inertia-tool: error: {f}: {message}") and err.count("\n") == 1
+
+
+def _shout():
+    chunk = "x" * (1 << 20)
+    for _ in range(10_000):               # 10 GB on stderr if nothing stopped it
+        sys.stderr.write(chunk)
+    return "done"
+
+
+def test_a_child_that_floods_stderr_fills_neither_memory_nor_disk():
+    with pytest.raises(IsolatedProcessError,
+                       match=r"wrote more than 400 MiB \(the memory limit\) to a file or to its error output"):
+        run_isolated(_shout, limits=Limits(cpu_seconds=30, memory_bytes=400 << 20, wall_seconds=120))
