@@ -314,3 +314,13 @@ def test_the_report_says_how_several_solids_were_counted(washer_files, fusion, s
     cmp = replace(brep.compare(washer_files["step"]), solids=2, fusion=fusion)
     assert said in format_brep_comparison(cmp, 1000.0)
     assert brep_comparison_dict(cmp, 1000.0)["fusion"] == fusion
+
+
+def test_the_html_report_leads_with_the_exact_brep(washer_files, tmp_path, capsys):
+    from inertia_tool.cli import main
+    report = tmp_path / "washer.html"
+    assert main(["analyze", str(washer_files["step"]), "--material", "steel", "--report", str(report)]) == 0
+    capsys.readouterr()
+    html = report.read_text()
+    assert "<strong>Result:</strong> exact B-rep of the CAD file" in html
+    assert f"{7850 * EXACT.volume:.6g}" in html and "CAD B-rep and its tessellation" in html

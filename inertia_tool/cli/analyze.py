@@ -66,8 +66,14 @@ def run(args) -> int:
             warnings.warn(OverlapWarning(message), stacklevel=1)
     stab, stab_error = _stability_section(props) if fmt in ("json", "text") or args.report else (None, None)
     # the model in the first table too (its section, with the assumptions, comes after the views and tables)
+    result = f"exact B-rep of the CAD file ({BREP_METHOD}); the mesh below is its tessellation" if cad else None
+    extra = []
+    if cad is not None and getattr(args, "report", None):
+        from ..reports.brep import brep_html_section
+        extra.append(brep_html_section(cad, props.density))
     write_report_from_args(args, props, described + model_words(model), messages, meshes=loaded.meshes,
-                           stability=stab if stab is not None else stab_error, model=model)
+                           stability=stab if stab is not None else stab_error, model=model, extra_sections=extra,
+                           result=result)
     if fmt == "json":
         out = mass_properties_dict(props, density_source=described)
         if cad is not None:
@@ -93,7 +99,6 @@ def run(args) -> int:
         if note:
             print("\n" + note.strip())
     else:
-        result = f"exact B-rep of the CAD file ({BREP_METHOD}); the mesh below is its tessellation" if cad else None
         print(with_warnings(format_mass_properties(props, density_source=described, result=result), messages,
                             loaded.notes()))
         if cad is not None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 from ..mass.brep import BrepComparison
 from .serialize import to_jsonable
 
-__all__ = ["format_brep_comparison", "brep_comparison_dict"]
+__all__ = ["format_brep_comparison", "brep_comparison_dict", "brep_html_section"]
 
 
 def brep_comparison_dict(cmp: BrepComparison, density: float) -> dict:
@@ -55,3 +55,12 @@ def format_brep_comparison(cmp: BrepComparison, density: float) -> str:
         f"{cmp.volume_error:.2e} (at most {cmp.volume_bound:.2e} = area × chord / volume), centre of mass by "
         f"{cmp.com_error:.2e} m, inertia by {cmp.inertia_error:.2e} (relative, Frobenius)")
     return "\n".join(lines)
+
+
+def brep_html_section(cmp: BrepComparison, density: float):
+    """The lines of :func:`format_brep_comparison` as a section of the HTML report."""
+    from .escape import escape_html
+    from .html import HtmlSection
+    lines = format_brep_comparison(cmp, density).splitlines()
+    items = "".join(f"<li>{escape_html(line.strip())}</li>" for line in lines)
+    return HtmlSection("CAD B-rep and its tessellation", f"<ul>{items}</ul>", "brep")
