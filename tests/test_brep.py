@@ -324,3 +324,19 @@ def test_the_html_report_leads_with_the_exact_brep(washer_files, tmp_path, capsy
     html = report.read_text()
     assert "<strong>Result:</strong> exact B-rep of the CAD file" in html
     assert f"{7850 * EXACT.volume:.6g}" in html and "CAD B-rep and its tessellation" in html
+
+
+def test_robot_survives_a_link_mesh_that_crashes_opencascade(tmp_path, capsys):
+    from inertia_tool.cli import main
+    _nested_parentheses_step(tmp_path / "nested.step")
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r">\n'
+                    '  <link name="good"><collision><geometry><box size="1 1 1"/></geometry></collision></link>\n'
+                    '  <link name="bad"><collision><geometry><mesh filename="nested.step"/></geometry></collision>'
+                    "</link>\n</robot>\n")
+    assert main(["robot", str(urdf), "--density", "1000", "--json"]) == 0
+    import json
+    out = json.loads(capsys.readouterr().out)
+    links = {link["name"]: link for link in out["links"]}
+    assert links["good"]["mass"] == pytest.approx(1000.0, rel=1e-12)
+    assert links["bad"]["mass"] is None and "OpenCASCADE" in links["bad"]["problem"]
