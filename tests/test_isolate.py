@@ -192,3 +192,10 @@ def test_a_child_that_floods_stderr_fills_neither_memory_nor_disk():
     with pytest.raises(IsolatedProcessError,
                        match=r"wrote more than 400 MiB \(the memory limit\) to a file or to its error output"):
         run_isolated(_shout, limits=Limits(cpu_seconds=30, memory_bytes=400 << 20, wall_seconds=120))
+
+
+def test_without_the_resource_module_the_limits_are_skipped_not_fatal(monkeypatch):
+    from inertia_tool import isolate
+    monkeypatch.setitem(sys.modules, "resource", None)          # as on Windows: `import resource` fails
+    isolate._apply_limits(1, 1 << 20)                            # would cripple this process if it applied them
+    assert run_isolated(_arrays, 3, limits=SMALL)["range"].tolist() == [0.0, 1.0, 2.0]
