@@ -251,7 +251,9 @@ def solids_fused(shape) -> tuple[object, int, float, str]:
         summed += abs(props.Mass())
         box = Bnd_Box()
         BRepBndLib.Add_s(solid, box)
-        boxes.append(box.CornerMin().Coord() + box.CornerMax().Coord())
+        # a void box (CornerMin() would raise) meets nothing
+        void = (np.inf,) * 3 + (-np.inf,) * 3
+        boxes.append(void if box.IsVoid() else box.CornerMin().Coord() + box.CornerMax().Coord())
         explorer.Next()
     groups = _meeting_groups(np.array(boxes, dtype=np.float64).reshape(-1, 6))
     if len(solids) < 2:
@@ -352,7 +354,10 @@ def _read_here(path: str, chord: float | None, angular_deflection: float, use_oc
     (:func:`read_cad`); returns plain values (:func:`inertia_tool.isolate.run_isolated`)."""
     if use_ocp:
         shape, solids, summed, fusion = solids_fused(read_brep(path))
-        tol = chord_tolerance(shape, chord)
+        try:
+            tol = chord_tolerance(shape, chord)
+        except InvalidMeshError as exc:     # a shape without a bounding box: name the file
+            raise _fail(path, str(exc)) from None
         vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection, max_faces=max_faces)
         return {"vertices": vertices, "faces": faces, "chord": tol, "backend": "OCP",
                 "integrals": brep_integrals(shape), "solids": solids, "summed_volume": summed, "fusion": fusion}
