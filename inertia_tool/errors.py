@@ -12,6 +12,8 @@ MeshReadError         the file cannot be read or parsed as a mesh
 RobotDescriptionError a robot description (URDF, xacro, SDF, MJCF)
                       cannot be read, or names a mesh that cannot
                       be found
+IsolatedProcessError  a parser run in a child process crashed or hit
+                      a CPU-time, memory or wall-clock limit
 InvalidMeshError      the mesh is read but does not bound a solid
 PhysicsError          valid input, but the request cannot be met
                       (e.g. a singular top)
@@ -41,6 +43,7 @@ __all__ = [
     "InvalidMeshError",
     "PhysicsError",
     "OutputCheckError",
+    "IsolatedProcessError",
     "InertiaToolWarning",
     "MeshRepairedWarning",
     "InsideOutWarning",
@@ -113,6 +116,29 @@ class InvalidMeshError(InertiaToolError, ValueError):
     def __init__(self, message: str, details: dict[str, Any] | None = None):
         super().__init__(message)
         self.details = dict(details or {})
+
+
+class IsolatedProcessError(InertiaToolError, OSError):
+    """Work run in a child process (:mod:`inertia_tool.isolate`: xacro expansion, OpenCASCADE) did not finish:
+    it crashed, or it hit its CPU-time, memory or wall-clock limit.
+
+    Parameters
+    ----------
+    message : str
+        One line: what ran and why it stopped ("xacro expansion exceeded 30 s of CPU ...").
+    kind : str
+        ``"cpu"``, ``"memory"``, ``"wall"``, ``"crash"`` (a signal or no answer) or ``"error"`` (an exception
+        that is not one of the package's); kept as the ``kind`` attribute.
+    """
+
+    def __init__(self, message: str, kind: str = "crash"):
+        super().__init__(message)
+        self.kind = kind
+
+    @property
+    def reason(self) -> str:
+        """The message: what ran and why it stopped."""
+        return str(self)
 
 
 class PhysicsError(InertiaToolError, ValueError):

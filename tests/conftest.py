@@ -2,6 +2,7 @@ import os
 import signal
 import subprocess
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -13,6 +14,25 @@ from hypothesis import settings
 settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
+
+
+class MujocoWarning(UserWarning):
+    """A warning MuJoCo issued (it would otherwise append it to MUJOCO_LOG.TXT in the working directory)."""
+
+
+def pytest_collection_finish(session):
+    """MuJoCo writes its warnings to ``MUJOCO_LOG.TXT`` in the current directory (the repository root under
+    pytest): when a selected test module uses MuJoCo, route them to Python warnings instead (imported only then:
+    the import takes most of a second)."""
+    paths = {str(item.fspath) for item in session.items}
+    if not any("mujoco" in open(path, encoding="utf-8", errors="replace").read() for path in paths
+               if path.endswith(".py")):
+        return
+    try:
+        import mujoco
+    except ImportError:
+        return
+    mujoco.set_mju_user_warning(lambda message: warnings.warn(f"MuJoCo: {message}", MujocoWarning, stacklevel=1))
 
 
 @pytest.fixture

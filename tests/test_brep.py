@@ -2,6 +2,8 @@
 the tessellation and
 the bound on its error, on a part made here with OCP whose closed form is known (a cylinder with a hole)."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -111,4 +113,230 @@ def test_analyze_reports_the_brep_and_the_tessellation_error(washer_files, capsy
     out = json.loads(capsys.readouterr().out)
     assert out["brep"]["exact"]["mass"] == pytest.approx(7850 * EXACT.volume, rel=1e-12)
     assert out["brep"]["volume_error"] <= out["brep"]["volume_error_bound"]
-    assert abs(out["mass"] / out["brep"]["exact"]["mass"] - 1) == pytest.approx(out["brep"]["volume_error"], rel=1e-6)
+    # the headline is the exact B-rep (issue 21 item 6); the tessellation is the second line
+    assert out["mass"] == pytest.approx(7850 * EXACT.volume, rel=1e-12) and out["method"].startswith("brep")
+    assert_tensor_close(np.array(out["inertia"]), 7850 * EXACT.inertia, 1e-12)
+    tess = out["brep"]["tessellation"]["mass"]
+    assert abs(tess / out["mass"] - 1) == pytest.approx(out["brep"]["volume_error"], rel=1e-6)
+    assert tess != pytest.approx(out["mass"], rel=1e-5)             # the two differ: the headline is not the mesh
+
+
+@pytest.mark.parametrize("fmt", ["text", "cad", "urdf"])
+def test_every_format_leads_with_the_exact_brep(washer_files, capsys, fmt):
+    from inertia_tool.cli import main
+    assert main(["analyze", str(washer_files["step"]), "--material", "steel", "--format", fmt]) == 0
+    out = capsys.readouterr().out
+    exact, mesh = 7850 * EXACT.volume, brep.compare(washer_files["step"]).mesh.volume * 7850
+    shown = {"text": f"mass:             {exact:.6g} kg", "cad": f"Mass = {exact:.8g} kilograms",
+             "urdf": f'<mass value="{exact:.12g}"/>'}[fmt]
+    assert shown in out, out
+    assert f"{mesh:.6g}" not in out.split("tessellation")[0]
+    if fmt != "urdf":
+        assert "exact B-rep" in out and "tessellation (" in out and f"mass {mesh:.9g} kg" in out
+    if fmt == "text":
+        assert "result: exact B-rep of the CAD file" in out
+
+
+def test_a_target_mass_scales_the_exact_brep(washer_files, capsys):
+    from inertia_tool.cli import main
+    import json
+    assert main(["analyze", str(washer_files["step"]), "--mass", "2kg", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mass"] == pytest.approx(2.0, rel=1e-14)
+    assert out["density"] == pytest.approx(2.0 / EXACT.volume, rel=1e-12)
+    assert_tensor_close(np.array(out["inertia"]), EXACT.inertia * 2.0 / EXACT.volume, 1e-12)
+
+
+# -- OpenCASCADE runs isolated (issue 22 item 2) -----------------------------------------------------------
+
+def _nested_parentheses_step(path, depth=100_000):
+    """A 200 KB STEP file whose one entity nests ``depth`` parentheses: OpenCASCADE's parser recursed until
+    the stack overflowed (a segmentation fault that took `analyze`, `robot` and `batch` down)."""
+    path.write_text("ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('x'),'2;1');\n"
+                    "FILE_NAME('n','2020-01-01T00:00:00',(''),(''),'','','');\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\n"
+                    "ENDSEC;\nDATA;\n#1=CARTESIAN_POINT(''," + "(" * depth + "0." + ")" * depth
+                    + ");\nENDSEC;\nEND-ISO-10303-21;\n")
+    return path
+
+
+def test_a_step_that_crashes_opencascade_is_an_error_not_a_crash(tmp_path, washer_files, capsys):
+    from inertia_tool.batch.runner import BatchOptions, run_batch
+    from inertia_tool.cli import main
+    from inertia_tool.errors import MeshReadError
+    bad = _nested_parentheses_step(tmp_path / "nested.step")
+    with pytest.raises(MeshReadError, match=r"nested.step: (OpenCASCADE crashed \(SIGSEGV, segmentation fault\)|"
+                                            "holds no shape)") as err:
+        it.mass_properties(bad)
+    if "crashed" not in str(err.value):                          # pragma: no cover - a future OCC may not crash
+        pytest.xfail("this OpenCASCADE no longer crashes on deep nesting (the isolation is tested in test_isolate)")
+    assert main(["analyze", str(bad), "--material", "steel"]) == 3
+    err_text = capsys.readouterr().err
+    assert "OpenCASCADE crashed (SIGSEGV" in err_text and err_text.count("\n") == 1
+    rows = []
+    summary = run_batch([str(bad), str(washer_files["step"])], BatchOptions(), rows.append)
+    assert summary.ok == 1 and summary.failed == 1
+    by_name = {os.path.basename(r["path"]): r for r in rows}
+    assert by_name["nested.step"]["status"] == "error" and "SIGSEGV" in by_name["nested.step"]["error"]
+    assert by_name["washer.step"]["mass"] == pytest.approx(1000 * EXACT.volume, rel=1e-3)
+
+
+def test_opencascade_runs_under_the_limits_of_the_environment(washer_files, monkeypatch, capsys):
+    from inertia_tool.cli import main
+    from inertia_tool.errors import MeshReadError
+    cad._LAST.clear()
+    monkeypatch.setenv("INERTIA_TOOL_MEMORY_LIMIT", "64M")       # less than the interpreter and OCP need
+    with pytest.raises(MeshReadError, match="washer.step: OpenCASCADE (exceeded the memory limit of 64 MiB|"
+                                            "crashed|ended without an answer)"):
+        cad.read_cad(washer_files["step"])
+    assert main(["analyze", str(washer_files["step"]), "--material", "steel"]) == 3
+    assert "OpenCASCADE" in capsys.readouterr().err
+
+
+# -- several solids: the union, not the sum (issue 21 item 6) ------------------------------------------------
+
+def _box_tensor(lo, hi):
+    """Unit-density volume, centre and inertia about the centre of the axis-aligned box [lo, hi] (closed form:
+    ``V/12 (b² + c²)`` on the diagonal, Chapter 4 "Rigid Body Motion", §4.3)."""
+    size = np.subtract(hi, lo, dtype=float)
+    volume = float(np.prod(size))
+    sq = size ** 2
+    return volume, (np.add(lo, hi) / 2), np.diag(volume / 12 * (sq.sum() - sq))
+
+
+def _shifted(volume, centre, tensor, point):
+    d = np.asarray(centre) - point                     # parallel-axis theorem, tensor convention
+    return tensor + volume * (d @ d * np.eye(3) - np.outer(d, d))
+
+
+@pytest.fixture(scope="module")
+def two_boxes_step(tmp_path_factory):
+    """Two 20 mm cubes, the second moved by (10, 10, 10) mm: they share a 10 mm cube (one compound, two solids)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.TopoDS import TopoDS_Compound
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 20, 20, 20).Shape())
+    builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(10, 10, 10), 20, 20, 20).Shape())
+    path = tmp_path_factory.mktemp("cad") / "two_boxes.step"
+    with cad._quiet():
+        writer = STEPControl_Writer()
+        writer.Transfer(compound, STEPControl_AsIs)
+        writer.Write(str(path))
+    return path
+
+
+def _union_of_two_boxes():
+    """Inclusion–exclusion of the closed forms: A + B − (A ∩ B), in metres."""
+    a = _box_tensor([0, 0, 0], [0.02, 0.02, 0.02])
+    b = _box_tensor([0.01, 0.01, 0.01], [0.03, 0.03, 0.03])
+    shared = _box_tensor([0.01, 0.01, 0.01], [0.02, 0.02, 0.02])
+    volume = a[0] + b[0] - shared[0]
+    com = (a[0] * a[1] + b[0] * b[1] - shared[0] * shared[1]) / volume
+    tensor = sum(s * _shifted(*part, com) for s, part in ((1, a), (1, b), (-1, shared)))
+    return volume, com, tensor, shared[0]
+
+
+def test_overlapping_solids_are_fused_into_their_union(two_boxes_step):
+    volume, com, tensor, shared = _union_of_two_boxes()
+    cmp = brep.compare(two_boxes_step)
+    assert cmp.solids == 2 and cmp.fusion == "fused"
+    assert cmp.overlap_volume == pytest.approx(shared, rel=1e-9)
+    assert cmp.exact.volume == pytest.approx(volume, rel=1e-12)                  # 15/16 of the sum, not the sum
+    np.testing.assert_allclose(cmp.exact.center_of_mass, com, atol=1e-15)
+    assert_tensor_close(cmp.exact.inertia, tensor, 1e-12)
+    # the tessellation is of the union too (planar faces: exact), and so is what the mesh reader returns
+    assert cmp.volume_error < 1e-12 and cmp.inertia_error < 1e-12
+    props = it.mass_properties(two_boxes_step, density=1.0)
+    assert props.volume == pytest.approx(volume, rel=1e-12)
+    assert_tensor_close(props.inertia, tensor, 1e-12)
+
+
+def test_analyze_states_the_fusion(two_boxes_step, capsys):
+    from inertia_tool.cli import main
+    import json
+    volume, _, tensor, shared = _union_of_two_boxes()
+    assert main(["analyze", str(two_boxes_step), "--density", "1000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mass"] == pytest.approx(1000 * volume, rel=1e-12)
+    assert out["brep"]["solids"] == 2 and out["brep"]["fusion"] == "fused"
+    assert out["brep"]["overlap_volume"] == pytest.approx(shared, rel=1e-9)
+    assert main(["analyze", str(two_boxes_step), "--density", "1000"]) == 0
+    assert f"2 solids fused into one (OpenCASCADE boolean union); they overlapped by {shared:.6g} m³" in \
+        capsys.readouterr().out
+
+
+def test_solids_apart_are_not_fused_and_sum_exactly(tmp_path):
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+    from OCP.TopoDS import TopoDS_Compound
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 1, 1, 1).Shape())
+    builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(2, 0, 0), 1, 2, 3).Shape())
+    shape, solids, summed, fusion = cad.solids_fused(compound)
+    assert solids == 2 and fusion == "apart" and shape is compound and summed == pytest.approx(7.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_meeting_groups_are_the_components_of_the_box_overlap_graph(seed):
+    """The sweep against brute force: connected components of 'boxes meet' (closed boxes: touching counts)."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 40))
+    lo = rng.integers(0, 12, (n, 3)).astype(float)            # integer corners: many exact touches
+    boxes = np.hstack([lo, lo + rng.integers(0, 4, (n, 3))])
+    meet = np.all(boxes[:, None, :3] <= boxes[None, :, 3:], axis=2) & np.all(boxes[None, :, :3] <= boxes[:, None, 3:],
+                                                                             axis=2)
+    label = np.arange(n)
+    for _ in range(n):                                        # propagate the smallest label along edges
+        label = np.array([label[meet[i]].min() for i in range(n)])
+    expected = sorted(sorted(np.nonzero(label == k)[0].tolist()) for k in np.unique(label))
+    assert sorted(cad._meeting_groups(boxes)) == expected
+
+
+def test_the_face_limit_is_applied_before_the_triangles_are_copied(washer_files):
+    from inertia_tool.errors import MeshReadError
+    cad._LAST.clear()
+    with pytest.raises(MeshReadError, match=r"washer.step: the tessellation .* has 1,152 triangles, more than "
+                                            r"`max_faces` \(100\) allows"):
+        it.mass_properties(washer_files["step"], max_faces=100)
+
+
+@pytest.mark.parametrize("fusion, said", [("apart", "2 solids, no two of which meet: the values are their sum"),
+                                          ("failed", "2 solids that could not be fused: the values are their sum "
+                                                     "(overlaps count twice)")])
+def test_the_report_says_how_several_solids_were_counted(washer_files, fusion, said):
+    from dataclasses import replace
+    from inertia_tool.reports.brep import brep_comparison_dict, format_brep_comparison
+    cmp = replace(brep.compare(washer_files["step"]), solids=2, fusion=fusion)
+    assert said in format_brep_comparison(cmp, 1000.0)
+    assert brep_comparison_dict(cmp, 1000.0)["fusion"] == fusion
+
+
+def test_the_html_report_leads_with_the_exact_brep(washer_files, tmp_path, capsys):
+    from inertia_tool.cli import main
+    report = tmp_path / "washer.html"
+    assert main(["analyze", str(washer_files["step"]), "--material", "steel", "--report", str(report)]) == 0
+    capsys.readouterr()
+    html = report.read_text()
+    assert "<strong>Result:</strong> exact B-rep of the CAD file" in html
+    assert f"{7850 * EXACT.volume:.6g}" in html and "CAD B-rep and its tessellation" in html
+
+
+def test_robot_survives_a_link_mesh_that_crashes_opencascade(tmp_path, capsys):
+    from inertia_tool.cli import main
+    _nested_parentheses_step(tmp_path / "nested.step")
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r">\n'
+                    '  <link name="good"><collision><geometry><box size="1 1 1"/></geometry></collision></link>\n'
+                    '  <link name="bad"><collision><geometry><mesh filename="nested.step"/></geometry></collision>'
+                    "</link>\n</robot>\n")
+    assert main(["robot", str(urdf), "--density", "1000", "--json"]) == 0
+    import json
+    out = json.loads(capsys.readouterr().out)
+    links = {link["name"]: link for link in out["links"]}
+    assert links["good"]["mass"] == pytest.approx(1000.0, rel=1e-12)
+    assert links["bad"]["mass"] is None and "OpenCASCADE" in links["bad"]["problem"]

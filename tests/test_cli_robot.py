@@ -73,7 +73,8 @@ def test_xacro_input_writes_the_expanded_urdf(tmp_path, capsys):
                    '      <geometry><cylinder radius="0.02" length="$(arg len)"/></geometry></collision>\n'
                    '  </link>\n</robot>\n')
     out = tmp_path / "rod.urdf"
-    assert main(["robot", str(src), "--arg", "len:=0.3", "--material", "steel", "--write", str(out)]) == 0
+    assert main(["robot", str(src), "--run-xacro", "--arg", "len:=0.3", "--material", "steel", "--write",
+                 str(out)]) == 0
     capsys.readouterr()
     assert "xacro:" not in out.read_text().split("-->", 1)[-1].replace('xmlns:xacro', '')
     text = out.read_text().replace('<robot name="rod"', '<robot name="rod"', 1)

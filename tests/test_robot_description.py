@@ -130,20 +130,20 @@ XACRO = """<?xml version="1.0"?>
 def test_xacro_is_expanded_with_arguments_and_find(tmp_path):
     f = tmp_path / "arm.urdf.xacro"
     f.write_text(XACRO)
-    robot = read_robot(f, packages=PACKAGES, mappings={"radius": "0.02"})
+    robot = read_robot(f, packages=PACKAGES, mappings={"radius": "0.02"}, run_xacro=True)
     assert robot.format == "xacro" and [link.name for link in robot.links] == ["upper", "lower", "tool"]
     lower = robot.link("lower").elements[0]
     assert lower.kind == "cylinder" and lower.size == (0.02, 0.3)
     np.testing.assert_allclose(lower.translation, [0, 0, 0.15])
     assert robot.link("tool").elements[0].mesh.endswith("wrist3.stl")
-    assert read_robot(f, packages=PACKAGES).link("upper").elements[0].size == (0.05, 0.4)   # the default
+    assert read_robot(f, packages=PACKAGES, run_xacro=True).link("upper").elements[0].size == (0.05, 0.4)
 
 
 def test_xacro_errors_are_one_line(tmp_path):
     f = tmp_path / "bad.xacro"
     f.write_text('<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:undefined_macro/></robot>')
     with pytest.raises(RobotDescriptionError, match="xacro expansion failed"):
-        read_robot(f)
+        read_robot(f, run_xacro=True)
     with pytest.raises(UsageError, match="not a xacro file"):
         read_robot(UR5, packages=PACKAGES, mappings={"a": "1"})
 
@@ -203,4 +203,4 @@ def test_billion_laughs_is_refused_not_expanded(tmp_path, suffix):
     f = tmp_path / f"laughs{suffix}"
     f.write_text(LAUGHS)                          # 10⁹ bytes if expanded
     with pytest.raises(RobotDescriptionError, match="amplification"):
-        read_robot(f)
+        read_robot(f, run_xacro=True)

@@ -20,8 +20,8 @@ import sys
 import warnings
 from collections.abc import Collection
 
-from ..errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, MeshReadError, PhysicsError,
-                      RobotDescriptionError, UsageError)
+from ..errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, IsolatedProcessError, MeshReadError,
+                      PhysicsError, RobotDescriptionError, UsageError)
 from ..reports.escape import escape_terminal
 from .help import SUMMARIES
 
@@ -40,6 +40,7 @@ EXIT_CODES = {
     MeshReadError: EXIT_MESH,
     RobotDescriptionError: EXIT_MESH,
     InvalidMeshError: EXIT_MESH,
+    IsolatedProcessError: EXIT_MESH,
     PhysicsError: EXIT_PHYSICS,
     InertiaToolError: EXIT_INTERNAL,
 }

@@ -7,8 +7,9 @@ import argparse
 import json
 import os
 import sys
+import warnings
 
-from ..errors import PhysicsError, UsageError
+from ..errors import OverlapWarning, PhysicsError, UsageError
 from ..reports.serialize import mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
@@ -21,9 +22,13 @@ from ..robot.formats import ROBOT_FORMATS, format_inertial
 from .help import add_command
 from .model_options import (add_files_argument, add_model_options, load_model, model_words, split_part_spec,
                             with_warnings)
+from .options import density_and_mass
 from .report_option import add_report_options, check_report_path, write_report_from_args
 
-__all__ = ["register", "run", "add_output_options", "output_format", "FORMATS"]
+__all__ = ["register", "run", "add_output_options", "output_format", "FORMATS", "BREP_METHOD"]
+
+#: ``method`` of a STEP/IGES result: the exact B-rep, integrated by OpenCASCADE.
+BREP_METHOD = "brep (OpenCASCADE BRepGProp)"
 
 
 def register(subparsers) -> None:
@@ -48,16 +53,33 @@ def run(args) -> int:
     check_report_path(args)
     loaded = load_model(args)
     props, described, model, messages = loaded.props, loaded.density_source, loaded.model, list(loaded.warnings)
+    cad = _brep_section(args)
+    if cad is not None:           # STEP/IGES: the exact B-rep is the headline, the tessellation a second line
+        target = density_and_mass(args)[1]
+        props = cad.scaled(props, target_mass=target)
+        if target is not None and ": implied density" in described:
+            described = described.split(": implied density")[0] + f": implied density {props.density:.4g} kg/m³"
+        if cad.fusion == "failed":
+            message = (f"{props.name}: the file holds {cad.solids} solids that could not be fused: the exact "
+                       "B-rep values are their sum, so any volume they share is counted twice")
+            messages.append(message)
+            warnings.warn(OverlapWarning(message), stacklevel=1)
     stab, stab_error = _stability_section(props) if fmt in ("json", "text") or args.report else (None, None)
     # the model in the first table too (its section, with the assumptions, comes after the views and tables)
+    result = f"exact B-rep of the CAD file ({BREP_METHOD}); the mesh below is its tessellation" if cad else None
+    extra = []
+    if cad is not None and getattr(args, "report", None):
+        from ..reports.brep import brep_html_section
+        extra.append(brep_html_section(cad, props.density))
     write_report_from_args(args, props, described + model_words(model), messages, meshes=loaded.meshes,
-                           stability=stab if stab is not None else stab_error, model=model)
-    cad = _brep_section(args) if fmt in ("json", "text") else None
+                           stability=stab if stab is not None else stab_error, model=model, extra_sections=extra,
+                           result=result)
     if fmt == "json":
         out = mass_properties_dict(props, density_source=described)
         if cad is not None:
             from ..reports.brep import brep_comparison_dict
             out["brep"] = brep_comparison_dict(cad, props.density)
+            out["method"] = BREP_METHOD
         out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
         if model["model"] != "solid":
             out["model"] = to_jsonable(model)
@@ -70,12 +92,15 @@ def run(args) -> int:
         print(format_inertial(frame, fmt, source=f"{props.name}: {described}{model_words(model)}"))
     elif fmt == "cad":
         print(format_cad_report(props, units=args.cad_units or "kg-m", density_source=described))
+        if cad is not None:
+            from ..reports.brep import format_brep_comparison
+            print("\n" + format_brep_comparison(cad, props.density).strip("\n"))
         note = format_model_note(model)
         if note:
             print("\n" + note.strip())
     else:
-        print(with_warnings(format_mass_properties(props, density_source=described), messages,
-                                loaded.notes()))
+        print(with_warnings(format_mass_properties(props, density_source=described, result=result), messages,
+                            loaded.notes()))
         if cad is not None:
             from ..reports.brep import format_brep_comparison
             print(format_brep_comparison(cad, props.density))

@@ -42,6 +42,11 @@ def register(subparsers) -> None:
                         "searched after these)")
     p.add_argument("--arg", action="append", default=[], metavar="NAME:=VALUE",
                    help="xacro argument (repeatable)")
+    p.add_argument("--run-xacro", action="store_true",
+                   help="expand a *.xacro file: this RUNS CODE FROM THE FILE (xacro evaluates Python in ${...}); "
+                        "only for files you trust. It runs in a child process without your environment "
+                        "variables, under CPU, memory and wall-clock limits (INERTIA_TOOL_CPU_LIMIT, "
+                        "INERTIA_TOOL_MEMORY_LIMIT, INERTIA_TOOL_WALL_LIMIT). Without it a xacro file is refused")
     p.add_argument("--geometry", choices=GEOMETRY_KINDS, default="collision",
                    help="which geometry of each link to integrate (default: collision)")
     m = p.add_mutually_exclusive_group(required=True)
@@ -100,7 +105,8 @@ def run(args) -> int:
     check_option("--max-faces", args.max_faces)
     density = check_option("--density", parse_density(args.density), typed=args.density) \
         if args.density is not None else None
-    robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings)
+    robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings,
+                       run_xacro=args.run_xacro)
     inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
                                repair=args.repair, max_faces=args.max_faces)
     audits = audit_links(robot, inertials, keep_mass=args.keep_mass)

@@ -3,6 +3,11 @@
 The exact B-rep mass properties and the comparison with the tessellation are in
 :mod:`inertia_tool.mass.brep`.
 
+OpenCASCADE runs in a child process with CPU-time, memory and wall-clock limits (:func:`read_cad`,
+:mod:`inertia_tool.isolate`): a file that crashes it (a segmentation fault) or makes it run for minutes becomes
+a :class:`~inertia_tool.errors.MeshReadError` naming the reason.  :func:`read_brep`, :func:`tessellate` and
+:func:`solids_fused` run in the calling process, for shapes the caller trusts.
+
 Two back ends, both OpenCASCADE:
 
 * **OCP** (``pip install cadquery-ocp-novtk``, the ``[cad]`` extra): reads STEP/IGES into a B-rep in metres
@@ -29,9 +34,14 @@ import os
 import numpy as np
 
 from ..errors import InvalidMeshError, MeshReadError, UsageError
+from ..values import frozen_value
 
 __all__ = ["BREP_SUFFIXES", "DEFAULT_CHORD_RTOL", "DEFAULT_ANGULAR_DEFLECTION", "read_brep", "tessellate",
-           "chord_tolerance", "tessellated_arrays", "has_ocp"]
+           "chord_tolerance", "tessellated_arrays", "has_ocp", "read_cad", "CadReading", "solids_fused",
+           "brep_integrals", "FUSIONS"]
+
+#: How :func:`solids_fused` made one solid of a file's solids.
+FUSIONS = ("one solid", "apart", "fused", "failed")
 
 #: CAD exchange suffixes read as B-reps.
 BREP_SUFFIXES = (".step", ".stp", ".iges", ".igs")
@@ -44,12 +54,13 @@ DEFAULT_ANGULAR_DEFLECTION = 0.1
 
 
 def has_ocp() -> bool:
-    """Whether OCP (OpenCASCADE's Python bindings) is importable."""
+    """Whether OCP (OpenCASCADE's Python bindings) is installed (looked up, not imported: the import takes
+    most of a second and the reading runs in a child process anyway)."""
+    import importlib.util
     try:
-        import OCP.BRepGProp  # noqa: F401
-    except ImportError:
+        return importlib.util.find_spec("OCP") is not None
+    except (ImportError, ValueError):
         return False
-    return True
 
 
 def _fail(path: str, problem: str) -> MeshReadError:
@@ -79,7 +90,11 @@ def read_brep(path) -> object:
         from OCP.IGESControl import IGESControl_Reader
         from OCP.Interface import Interface_Static
         from OCP.STEPControl import STEPControl_Reader
-    except ImportError:
+    except ImportError as exc:
+        if has_ocp():       # installed but not loadable: under a memory limit, mapping its libraries fails
+            if "map segment" in str(exc) or "allocate memory" in str(exc):
+                raise MemoryError(str(exc)) from None
+            raise _fail(path, f"OCP is installed but cannot be loaded ({exc})") from None
         raise _fail(path, "reading STEP/IGES exactly needs OCP (pip install cadquery-ocp-novtk, or the [cad] "
                           "extra)") from None
     if not os.path.isfile(path):
@@ -124,8 +139,11 @@ def chord_tolerance(shape, chord: float | None = None) -> float:
     return DEFAULT_CHORD_RTOL * _bounding_diagonal(shape)
 
 
-def tessellate(shape, *, chord: float, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION):
+def tessellate(shape, *, chord: float, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
+               max_faces: int | None = None):
     """Triangles of the B-rep (``BRepMesh_IncrementalMesh``): ``(vertices (n, 3) m, faces (m, 3))``, outward.
+
+    ``max_faces``: refuse (:class:`UsageError`) a tessellation of more triangles before copying them out.
 
     Each B-rep face is meshed on its own; reversed faces have their triangles flipped so the normals point
     out of the solid, and each face's location is applied.  Vertices on shared edges coincide (the mesher
@@ -138,6 +156,15 @@ def tessellate(shape, *, chord: float, angular_deflection: float = DEFAULT_ANGUL
     from OCP.TopLoc import TopLoc_Location
     from OCP.TopoDS import TopoDS
     BRepMesh_IncrementalMesh(shape, chord, False, angular_deflection, True)
+    if max_faces is not None:
+        total, explorer = 0, TopExp_Explorer(shape, TopAbs_FACE)
+        while explorer.More():
+            triangulation = BRep_Tool.Triangulation_s(TopoDS.Face(explorer.Current()), TopLoc_Location())
+            total += triangulation.NbTriangles() if triangulation is not None else 0
+            explorer.Next()
+        if total > max_faces:
+            raise UsageError(f"the tessellation at a chord tolerance of {chord:.3g} m has {total:,} triangles, "
+                             f"more than `max_faces` ({max_faces:,}) allows")
     vertices, faces, offset = [], [], 0
     explorer = TopExp_Explorer(shape, TopAbs_FACE)
     while explorer.More():
@@ -182,23 +209,220 @@ def _cascadio_arrays(path: str, chord: float, angular_deflection: float):
     return vertices, faces
 
 
-def tessellated_arrays(path, *, chord: float | None = None, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION):
-    """``(vertices m, faces, chord m, backend)`` of a STEP/IGES file: OCP if installed, else cascadio.
+def solids_fused(shape) -> tuple[object, int, float, str]:
+    """The union of the solids of ``shape`` (OpenCASCADE's boolean ``BRepAlgoAPI_Fuse``) when some may overlap.
 
-    Without ``chord`` and with cascadio, the default tolerance is relative to the file's size as cascadio
-    reports it after a first coarse conversion.
+    A STEP file of an assembly, or of a part exported as several bodies, holds solids that may overlap; the
+    B-rep integrals of such a compound are the *sum* over the solids, counting shared volume twice.  The fused
+    shape is the solid the user means.  Only solids whose bounding boxes meet are fused (each such group on
+    its own): solids apart from every other one are exact as they are, and a file of thousands of separate
+    bodies is not run through thousands of booleans.
+
+    Returns
+    -------
+    shape : TopoDS_Shape
+        The solids with each group of possibly overlapping ones fused, or ``shape`` itself (no two solids'
+        boxes meet, or a fuse failed).
+    solids : int
+        Solids in the file.
+    summed_volume : float
+        Sum of the solids' volumes, m³ (their overlap is ``summed_volume`` minus the fused volume).
+    fusion : str
+        :data:`FUSIONS`: ``"one solid"`` (or none), ``"apart"`` (no two bounding boxes meet: nothing to fuse,
+        the sum is the union), ``"fused"`` (the booleans ran and succeeded) or ``"failed"`` (a boolean failed:
+        ``shape`` is returned as it was, and its integrals are the sum).
     """
-    path = os.fsdecode(os.fspath(path))
-    if has_ocp():
-        shape = read_brep(path)
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
+    from OCP.BRepBndLib import BRepBndLib
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS_Compound
+    solids, boxes, summed = [], [], 0.0
+    explorer = TopExp_Explorer(shape, TopAbs_SOLID)
+    while explorer.More():
+        solid = explorer.Current()
+        solids.append(solid)
+        props = GProp_GProps()
+        BRepGProp.VolumeProperties_s(solid, props)
+        summed += abs(props.Mass())
+        box = Bnd_Box()
+        BRepBndLib.Add_s(solid, box)
+        # a void box (CornerMin() would raise) meets nothing
+        void = (np.inf,) * 3 + (-np.inf,) * 3
+        boxes.append(void if box.IsVoid() else box.CornerMin().Coord() + box.CornerMax().Coord())
+        explorer.Next()
+    groups = _meeting_groups(np.array(boxes, dtype=np.float64).reshape(-1, 6))
+    if len(solids) < 2:
+        return shape, len(solids), summed, "one solid"
+    if all(len(group) < 2 for group in groups):
+        return shape, len(solids), summed, "apart"
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    for group in groups:
+        union = solids[group[0]]
+        for k in group[1:]:           # one at a time: the list types of the bindings differ between versions
+            fuse = BRepAlgoAPI_Fuse(union, solids[k])
+            if not fuse.IsDone() or fuse.Shape().IsNull():
+                return shape, len(solids), summed, "failed"
+            union = fuse.Shape()
+        builder.Add(compound, union)
+    return compound, len(solids), summed, "fused"
+
+
+def _meeting_groups(boxes: np.ndarray) -> list[list[int]]:
+    """Indices of solids grouped by chains of meeting bounding boxes ``(n, 6)`` (min xyz, max xyz)."""
+    n = len(boxes)
+    parent = list(range(n))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    order = np.argsort(boxes[:, 0], kind="stable")     # sweep along x: only boxes whose x-ranges meet are paired
+    sorted_min_x = boxes[order, 0]
+    for a_pos, a in enumerate(order):
+        stop = int(np.searchsorted(sorted_min_x, boxes[a, 3], side="right"))
+        others = order[a_pos + 1:stop]
+        meet = np.all(boxes[others, :3] <= boxes[a, 3:], axis=1) & np.all(boxes[a, :3] <= boxes[others, 3:], axis=1)
+        for b in others[meet]:
+            parent[root(int(a))] = root(int(b))
+    groups: dict[int, list[int]] = {}
+    for i in range(n):
+        groups.setdefault(root(i), []).append(i)
+    return [sorted(g) for g in groups.values()]
+
+
+def brep_integrals(shape) -> tuple[float, np.ndarray, np.ndarray, float]:
+    """Unit-density ``(volume m³, centre of mass (3,) m, inertia (3, 3) m⁵ about it, surface area m²)`` of
+    the B-rep (``BRepGProp``: Gauss integration on its faces; tensor convention, ``Ixy = −∫xy dV``)."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    matrix = props.MatrixOfInertia()
+    tensor = np.array([[matrix.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)])
+    area = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(shape, area)
+    return (float(props.Mass()), np.array(props.CentreOfMass().Coord(), dtype=np.float64), 0.5 * (tensor + tensor.T),
+            float(area.Mass()))
+
+
+@frozen_value
+class CadReading:
+    """What the isolated OpenCASCADE run gives back for one STEP/IGES file.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float
+        Tessellation, m.
+    faces : (m, 3) int
+        Outward triangles.
+    chord : float
+        Chord tolerance used, m.
+    backend : str
+        ``"OCP"`` or ``"cascadio"``.
+    integrals : tuple or None
+        OCP only: :func:`brep_integrals` of the (fused) solid.
+    solids : int
+        Solids in the file (OCP only; 0 with cascadio).
+    summed_volume : float
+        Sum of the solids' volumes, m³ (:func:`solids_fused`).
+    fusion : str
+        How several solids became one (:func:`solids_fused`; the tessellation and ``integrals`` are of the
+        result).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    chord: float
+    backend: str
+    integrals: tuple | None = None
+    solids: int = 0
+    summed_volume: float = 0.0
+    fusion: str = "one solid"
+
+
+def _read_here(path: str, chord: float | None, angular_deflection: float, use_ocp: bool,
+               max_faces: int | None = None) -> dict:
+    """Read, fuse, tessellate and integrate in this process: run only in the isolated child
+    (:func:`read_cad`); returns plain values (:func:`inertia_tool.isolate.run_isolated`)."""
+    if use_ocp:
+        shape, solids, summed, fusion = solids_fused(read_brep(path))
         try:
             tol = chord_tolerance(shape, chord)
-        except InvalidMeshError as exc:
+        except InvalidMeshError as exc:     # a shape without a bounding box: name the file
             raise _fail(path, str(exc)) from None
-        vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection)
-        return vertices, faces, tol, "OCP"
+        vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection, max_faces=max_faces)
+        return {"vertices": vertices, "faces": faces, "chord": tol, "backend": "OCP",
+                "integrals": brep_integrals(shape), "solids": solids, "summed_volume": summed, "fusion": fusion}
     if chord is None:
         v, _ = _cascadio_arrays(path, 1e-3, 0.5)
         chord = DEFAULT_CHORD_RTOL * float(np.linalg.norm(np.ptp(v, axis=0)))
     vertices, faces = _cascadio_arrays(path, chord, angular_deflection)
-    return vertices, faces, float(chord), "cascadio"
+    return {"vertices": vertices, "faces": faces, "chord": float(chord), "backend": "cascadio"}
+
+
+#: The last reading, keyed by the file's identity and the tolerances: ``analyze`` reads a STEP file as a mesh
+#: and then compares it with its B-rep, one child process for both.
+_LAST: list = []
+
+
+def read_cad(path, *, chord: float | None = None, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
+             limits=None, max_faces: int | None = None) -> CadReading:
+    """Read, fuse (:func:`solids_fused`), tessellate and integrate a STEP/IGES file in a child process.
+
+    OpenCASCADE can crash on a malformed file (a segmentation fault) or spend minutes and gigabytes on a big
+    one, so it runs under :func:`inertia_tool.isolate.run_isolated` with ``limits`` (default
+    :data:`~inertia_tool.isolate.CAD_LIMITS`; the ``INERTIA_TOOL_*_LIMIT`` environment variables override).
+
+    ``max_faces`` refuses a tessellation of more triangles in the child, before they are copied out.
+
+    Raises
+    ------
+    MeshReadError
+        Unreadable file, more than ``max_faces`` triangles, or the child crashed or hit a limit (the message
+        says which).
+    """
+    from ..errors import IsolatedProcessError
+    from ..isolate import CAD_LIMITS, run_isolated
+    path = os.fsdecode(os.fspath(path))
+    if not os.path.isfile(path):
+        raise _fail(path, "no such file" if not os.path.exists(path) else "is not a regular file")
+    stat = os.stat(path)
+    use_ocp = has_ocp()
+    key = (os.path.realpath(path), stat.st_dev, stat.st_ino, stat.st_size, stat.st_mtime_ns, chord,
+           float(angular_deflection), use_ocp)
+    if _LAST and _LAST[0][0] == key and (max_faces is None or len(_LAST[0][1].faces) <= max_faces):
+        return _LAST[0][1]
+    try:
+        out = run_isolated(_read_here, path, chord, float(angular_deflection), use_ocp, max_faces,
+                           limits=limits or CAD_LIMITS, what="OpenCASCADE")
+    except IsolatedProcessError as exc:
+        raise _fail(path, str(exc)) from None
+    except UsageError as exc:              # "the shape has no faces": a property of the file
+        raise _fail(path, str(exc)) from None
+    reading = CadReading(vertices=np.asarray(out["vertices"], dtype=np.float64),
+                         faces=np.asarray(out["faces"], dtype=np.int64), chord=float(out["chord"]),
+                         backend=str(out["backend"]), integrals=out.get("integrals"),
+                         solids=int(out.get("solids", 0)), summed_volume=float(out.get("summed_volume", 0.0)),
+                         fusion=str(out.get("fusion", "one solid")))
+    _LAST[:] = [(key, reading)]
+    return reading
+
+
+def tessellated_arrays(path, *, chord: float | None = None, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
+                       max_faces: int | None = None):
+    """``(vertices m, faces, chord m, backend)`` of a STEP/IGES file: OCP if installed, else cascadio.
+
+    Read in a child process with limits (:func:`read_cad`); several solids are fused into one.  Without
+    ``chord`` and with cascadio, the default tolerance is relative to the file's size as cascadio reports it
+    after a first coarse conversion.
+    """
+    reading = read_cad(path, chord=chord, angular_deflection=angular_deflection, max_faces=max_faces)
+    return reading.vertices, reading.faces, reading.chord, reading.backend

@@ -1022,7 +1022,7 @@ def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_
                     raise _fail(path, "vertices have NaN or infinite coordinates")
             elif suffix in (".step", ".stp", ".iges", ".igs"):
                 from .cad import tessellated_arrays
-                vertices, faces, _, _ = tessellated_arrays(path)
+                vertices, faces, _, _ = tessellated_arrays(path, max_faces=max_faces)
                 _check_face_budget(path, len(faces), max_faces)
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "the tessellation has NaN or infinite coordinates")

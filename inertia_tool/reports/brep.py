@@ -1,4 +1,5 @@
-"""The STEP/IGES section of ``analyze``: exact B-rep mass properties against the tessellated mesh.
+"""The STEP/IGES section of ``analyze``: the exact B-rep mass properties are the headline; this section says so and
+gives the tessellated mesh's difference from them.
 
 Formatting only; the numbers come from :func:`inertia_tool.mass.brep.compare` (unit density, scaled here by the
 density the report uses).
@@ -9,37 +10,57 @@ from __future__ import annotations
 from ..mass.brep import BrepComparison
 from .serialize import to_jsonable
 
-__all__ = ["format_brep_comparison", "brep_comparison_dict"]
+__all__ = ["format_brep_comparison", "brep_comparison_dict", "brep_html_section"]
 
 
 def brep_comparison_dict(cmp: BrepComparison, density: float) -> dict:
-    """JSON-ready: exact (B-rep) and tessellated volume, centre of mass, inertia at ``density``, and errors."""
+    """JSON-ready: exact (B-rep, the headline) and tessellated volume, centre of mass, inertia at ``density``,
+    the differences, and how the solid was formed (several solids fused)."""
+    m = cmp.mesh
     return to_jsonable({
+        "headline": "exact",
         "chord_tolerance": cmp.chord,
         "angular_deflection": cmp.angular_deflection,
         "triangles": cmp.faces,
+        "solids": cmp.solids,
+        "fusion": cmp.fusion,
+        "overlap_volume": cmp.overlap_volume,
         "exact": {"volume": cmp.exact.volume, "mass": cmp.exact.volume * density,
                   "center_of_mass": cmp.exact.center_of_mass, "inertia": cmp.exact.inertia * density},
+        "tessellation": {"volume": m.volume, "mass": m.volume * density, "center_of_mass": m.center_of_mass,
+                         "inertia": m.inertia * density},
         "volume_error": cmp.volume_error,
         "volume_error_bound": cmp.volume_bound,
         "center_of_mass_error": cmp.com_error,
         "inertia_error": cmp.inertia_error,
-        "note": "exact: OpenCASCADE BRepGProp on the B-rep; the mesh results above are of the tessellation, "
-                "whose relative volume error is at most surface area x chord tolerance / volume",
+        "note": "the mass properties above are the exact B-rep's (OpenCASCADE BRepGProp); `tessellation` is the "
+                "triangle mesh, whose relative volume error is at most surface area x chord tolerance / volume",
     })
 
 
 def format_brep_comparison(cmp: BrepComparison, density: float) -> str:
-    """A few lines: the exact B-rep values and how far the tessellation is from them, with the bound."""
-    e = cmp.exact
-    i = e.inertia * density
-    return "\n".join([
-        f"  CAD B-rep (exact, OpenCASCADE): volume {e.volume:.9g} m³, mass {e.volume * density:.9g} kg, "
-        f"centre of mass ({e.center_of_mass[0]:.6g}, {e.center_of_mass[1]:.6g}, {e.center_of_mass[2]:.6g}) m",
-        f"    inertia about the centre of mass: Ixx {i[0, 0]:.6g}, Iyy {i[1, 1]:.6g}, Izz {i[2, 2]:.6g}, "
-        f"Ixy {i[0, 1]:.6g}, Ixz {i[0, 2]:.6g}, Iyz {i[1, 2]:.6g} kg·m²",
+    """Two or three lines under the headline: where the numbers come from, and the tessellation's difference."""
+    lines = ["  source: exact B-rep of the CAD file (OpenCASCADE BRepGProp, Gauss integration on its faces)"]
+    if cmp.fusion == "fused":
+        lines.append(f"    {cmp.solids} solids fused into one (OpenCASCADE boolean union); they overlapped by "
+                     f"{cmp.overlap_volume:.6g} m³, counted once")
+    elif cmp.fusion == "apart":
+        lines.append(f"    {cmp.solids} solids, no two of which meet: the values are their sum")
+    elif cmp.fusion == "failed":
+        lines.append(f"    {cmp.solids} solids that could not be fused: the values are their sum (overlaps count "
+                     "twice)")
+    lines.append(
         f"    tessellation ({cmp.faces:,} triangles, chord tolerance {cmp.chord:.3g} m, angular "
-        f"{cmp.angular_deflection:g} rad): volume off by {cmp.volume_error:.2e} (at most {cmp.volume_bound:.2e} = "
-        f"area × chord / volume), centre of mass by {cmp.com_error:.2e} m, inertia by {cmp.inertia_error:.2e} "
-        "(relative, Frobenius)",
-    ])
+        f"{cmp.angular_deflection:g} rad): mass {cmp.mesh.volume * density:.9g} kg, volume off by "
+        f"{cmp.volume_error:.2e} (at most {cmp.volume_bound:.2e} = area × chord / volume), centre of mass by "
+        f"{cmp.com_error:.2e} m, inertia by {cmp.inertia_error:.2e} (relative, Frobenius)")
+    return "\n".join(lines)
+
+
+def brep_html_section(cmp: BrepComparison, density: float):
+    """The lines of :func:`format_brep_comparison` as a section of the HTML report."""
+    from .escape import escape_html
+    from .html import HtmlSection
+    lines = format_brep_comparison(cmp, density).splitlines()
+    items = "".join(f"<li>{escape_html(line.strip())}</li>" for line in lines)
+    return HtmlSection("CAD B-rep and its tessellation", f"<ul>{items}</ul>", "brep")

@@ -362,14 +362,15 @@ def stability_section(report) -> HtmlSection:
     return HtmlSection("Spin stability", body, "stability")
 
 
-def _core_sections(props: MassProperties, density_source: str | None, semi) -> list[HtmlSection]:
+def _core_sections(props: MassProperties, density_source: str | None, semi,
+                   result: str | None = None) -> list[HtmlSection]:
     pa = props.principal
     summary = [["mass", _num(props.mass), "kg"], ["volume", _num(props.volume), "m³"],
                ["surface area", _num(props.surface_area), "m²"], ["density", _num(props.density), "kg/m³"]]
     if density_source:
         summary.append(["density from", _e(density_source), ""])
     summary.append(["centre of mass", "(" + ", ".join(_vec_cells(props.center_of_mass)) + ")", "m"])
-    verdict = f"<p><strong>Result:</strong> {_e(method_line(props.mesh))}</p>"
+    verdict = f"<p><strong>Result:</strong> {_e(result or method_line(props.mesh))}</p>"
     sections = [HtmlSection("Mass properties", verdict + _table(None, summary), "mass")]
     ten = _clean(props.inertia)
     origin = _clean(np.asarray(props.inertia_about(np.zeros(3))))
@@ -436,7 +437,7 @@ def _core_sections(props: MassProperties, density_source: str | None, semi) -> l
 
 def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_source: str | None = None,
                 warnings: Sequence[str] = (), stability=None, extra_sections: Sequence[HtmlSection] = (),
-                max_edges: int = DEFAULT_MAX_EDGES, generated: str | None = None) -> str:
+                max_edges: int = DEFAULT_MAX_EDGES, generated: str | None = None, result: str | None = None) -> str:
     """The complete HTML document (a string).
 
     Parameters
@@ -457,13 +458,15 @@ def html_report(props: MassProperties, *, meshes: Sequence[tuple] = (), density_
         Cap on drawn segments per view.
     generated : str, optional
         Time stamp text; default now (UTC).
+    result : str, optional
+        Where the numbers come from, instead of the mesh's method (a STEP file's exact B-rep says so).
     """
     pa = props.principal
     try:
         semi = equivalent_ellipsoid_semi_axes(pa.moments, props.mass)
     except InertiaToolError:
         semi = None
-    sections = _core_sections(props, density_source, semi)
+    sections = _core_sections(props, density_source, semi, result)
     if stability is not None:
         sections.append(stability_section(stability))
     sections.extend(extra_sections)

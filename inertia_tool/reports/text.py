@@ -49,15 +49,17 @@ def method_line(mesh) -> str:
             f"±{100 * u.inertia:.3g}% (Frobenius)")
 
 
-def format_mass_properties(props: MassProperties, *, density_source: str | None = None) -> str:
+def format_mass_properties(props: MassProperties, *, density_source: str | None = None,
+                           result: str | None = None) -> str:
     """Multi-line report: units, volume, mass, COM, inertia (about COM and mesh origin), principal axes,
-    radii of gyration, physical checks and mesh diagnostics."""
+    radii of gyration, physical checks and mesh diagnostics.  ``result`` replaces the line saying where the
+    numbers come from (:func:`method_line` of the mesh; a STEP file's exact B-rep says so)."""
     pa = props.principal
     lines = [f"Mass properties of {props.name}"]
     mesh = props.mesh
     size = float(np.linalg.norm(mesh.bbox_max - mesh.bbox_min)) if mesh is not None else 0.0
     unit_note = f" (mesh coordinates in {mesh.units}, converted)" if mesh is not None else ""
-    lines.append(f"  result: {method_line(mesh)}")
+    lines.append(f"  result: {result or method_line(mesh)}")
     lines.append(f"  units: SI — m, kg, kg·m²{unit_note}")
     if density_source:
         lines.append(f"  density:          {density_source}")

@@ -16,7 +16,9 @@ Conventions (``docs/conventions.md``):
 * The declared inertia is given in the inertial frame (``I_frame``); in link axes it is ``R I_frame Rᵀ``.
 
 xacro files (``*.xacro``) are expanded with the ``xacro`` package (``mappings`` are its ``name:=value``
-arguments; ``$(find NAME)`` resolves through ``packages`` and ``ROS_PACKAGE_PATH``).  MJCF is read by
+arguments; ``$(find NAME)`` resolves through ``packages`` and ``ROS_PACKAGE_PATH``) only when the caller says
+so (``run_xacro=True``): expansion runs code from the file, so it runs in a child process with limits
+(:mod:`inertia_tool.isolate`).  MJCF is read by
 ``inertia_tool.robot.mjcf``.
 """
 
@@ -330,7 +332,8 @@ def _xacro_find(packages: dict):
         substitution_args._eval_find = original
 
 
-def _expand_xacro(path: str, mappings: dict, packages: dict) -> bytes:
+def _expand_xacro_here(path: str, mappings: dict, packages: dict) -> bytes:
+    """Expand in this process: only ever called in the isolated child (:func:`_expand_xacro`)."""
     try:
         import xacro
     except ImportError:
@@ -340,10 +343,29 @@ def _expand_xacro(path: str, mappings: dict, packages: dict) -> bytes:
             doc = xacro.process_file(path, mappings={str(k): str(v) for k, v in mappings.items()})
     except RobotDescriptionError as exc:
         raise _fail(path, str(exc)) from None
+    except MemoryError:
+        raise
     except Exception as exc:  # noqa: BLE001 - xacro raises many kinds; all mean "cannot expand"
+        if isinstance(exc.__context__, MemoryError) or isinstance(exc.__cause__, MemoryError):
+            raise MemoryError from None     # xacro wraps errors of expressions; a memory limit stays one
         text = " ".join(str(exc).split()) or type(exc).__name__
         raise _fail(path, f"xacro expansion failed ({text[:200]})") from None
     return doc.toxml(encoding="utf-8")
+
+
+def _expand_xacro(path: str, mappings: dict, packages: dict, limits=None) -> bytes:
+    """The expanded URDF of a xacro file, expanded in a child process under ``limits`` (xacro runs the
+    Python expressions of the file: :mod:`inertia_tool.isolate`, :data:`~inertia_tool.isolate.XACRO_LIMITS`)."""
+    from ..errors import IsolatedProcessError
+    from ..isolate import XACRO_LIMITS, run_isolated
+    try:
+        data = run_isolated(_expand_xacro_here, path, dict(mappings), dict(packages),
+                            limits=limits or XACRO_LIMITS, what="xacro expansion")
+    except IsolatedProcessError as exc:
+        raise _fail(path, str(exc)) from None
+    if not isinstance(data, bytes):
+        raise _fail(path, "xacro expansion gave no document")
+    return data
 
 
 # -- URDF --------------------------------------------------------------------------------------------------
@@ -562,7 +584,7 @@ def _detect(path: str) -> str:
 
 
 def read_robot(path, *, packages: dict | None = None, geometry: str = "collision",
-               mappings: dict | None = None) -> RobotDescription:
+               mappings: dict | None = None, run_xacro: bool = False, limits=None) -> RobotDescription:
     """Read a URDF, xacro, SDFormat or MJCF file into a :class:`RobotDescription`.
 
     Parameters
@@ -577,6 +599,15 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         the others).
     mappings : dict, optional
         xacro arguments (``name → value``, the ``name:=value`` of the xacro command line).
+    run_xacro : bool
+        Expanding a xacro file **runs code from the file** (xacro evaluates the Python expressions in
+        ``${...}``; its restrictions can be escaped).  A xacro file is refused unless this is True; then it is
+        expanded in a child process without the caller's environment and under CPU-time, memory and
+        wall-clock limits (:mod:`inertia_tool.isolate`), which stop a file that hangs or explodes but not one
+        that does harm within them.  Give a downloaded file only after reading it, or expand it yourself.
+    limits : inertia_tool.isolate.Limits, optional
+        Limits of the xacro expansion (default :data:`~inertia_tool.isolate.XACRO_LIMITS`; the
+        ``INERTIA_TOOL_*_LIMIT`` environment variables override both).
 
     Returns
     -------
@@ -588,7 +619,7 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         Unreadable or malformed file, unsupported construct, or a mesh that cannot be resolved (the message
         names the link and the URI).
     UsageError
-        Bad ``geometry``, or ``mappings`` for a file that is not xacro.
+        Bad ``geometry``, ``mappings`` for a file that is not xacro, or a xacro file without ``run_xacro``.
     """
     if geometry not in GEOMETRY_KINDS:
         raise UsageError(f"Expected `geometry` to be one of {', '.join(GEOMETRY_KINDS)}, got {geometry!r}")
@@ -599,7 +630,11 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
     if mappings and fmt != "xacro":
         raise UsageError(f"xacro arguments given for {source}, which is not a xacro file")
     if fmt == "xacro":
-        data = _expand_xacro(source, mappings or {}, packages)
+        if not run_xacro:
+            raise UsageError(f"{source}: expanding a xacro file runs code from the file; refused without "
+                             "`run_xacro=True` (only for a file you trust, or expand it yourself with xacro and "
+                             "give the URDF)")
+        data = _expand_xacro(source, mappings or {}, packages, limits)
     _check_link_count(data, source)
     root = parse_xml(data, source).getroot()
     base = os.path.dirname(os.path.abspath(source))
