@@ -124,6 +124,19 @@ class GeometryElement:
         Mesh scale factors per axis (1 for primitives).
     name : str
         Label: the element's ``name`` or ``"collision 1"``, ``"visual 2"`` ...
+    reference_rotation : (3, 3) float
+        Applied to the mesh file's coordinates before ``scale`` (MJCF ``refquat``: its conjugate); identity
+        elsewhere.  A file point ``v`` is ``rotation (scale ⊙ (reference_rotation v + reference_translation))
+        + translation`` in the link frame.
+    reference_translation : (3,) float
+        m, added after ``reference_rotation`` (MJCF: ``−Qᵀ refpos``); zero elsewhere.
+    density : float or None
+        kg/m³ the description gives this element (MJCF geom ``density``, MuJoCo's default 1000); None when the
+        format has no such notion (URDF, SDFormat).
+    mass : float or None
+        kg the description gives this element (MJCF geom ``mass``; overrides ``density``); None if not given.
+    shell : bool
+        The description puts the element's mass on its surface (MJCF ``shellinertia``, ``<mesh inertia="shell">``).
     """
 
     kind: str
@@ -134,11 +147,18 @@ class GeometryElement:
     uri: str | None = None
     scale: np.ndarray = field(default_factory=lambda: np.ones(3))
     name: str = ""
+    reference_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    reference_translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    density: float | None = None
+    mass: float | None = None
+    shell: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))
         object.__setattr__(self, "translation", _frozen(self.translation, (3,)))
         object.__setattr__(self, "scale", _frozen(self.scale, (3,)))
+        object.__setattr__(self, "reference_rotation", _frozen(self.reference_rotation, (3, 3)))
+        object.__setattr__(self, "reference_translation", _frozen(self.reference_translation, (3,)))
         object.__setattr__(self, "size", tuple(float(s) for s in self.size))
 
 

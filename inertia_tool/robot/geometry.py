@@ -28,8 +28,8 @@ import math
 
 import numpy as np
 
-from ..errors import InvalidMeshError, MeshReadError, UsageError
-from ..mass import shapes
+from ..errors import InertiaToolError, MeshReadError, UsageError
+from ..mass import shapes, shell_shapes
 from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
 from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
@@ -37,7 +37,19 @@ from ..values import frozen_value
 from .description import GeometryElement, LinkGeometry, RobotDescription
 
 __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", "LinkInertial", "mesh_properties",
-           "points_inside_element", "element_bounds"]
+           "points_inside_element", "element_bounds", "LinkUncertainty", "METHODS", "MODEL_DENSITY"]
+
+#: What ``LinkInertial.method`` can say: ``"exact"`` (closed forms, and meshes integrated exactly, after
+#: orienting, welding or dropping repeated faces), ``"united"`` (overlapping bodies of a mesh united by a
+#: boolean, then exact), ``"summed"`` (overlapping bodies added, the shared volume counted twice, as asked),
+#: ``"estimate"`` (a repaired open mesh: see ``uncertainty``).
+METHODS = ("exact", "united", "summed", "estimate")
+
+#: The value of ``density`` (and of ``robot --density``) that asks for the description's own densities.
+MODEL_DENSITY = "model"
+
+_MESH_METHOD = {"exact": "exact", "oriented": "exact", "welded": "exact", "deduplicated": "exact",
+                "union": "united", "sum": "summed", "patched": "estimate", "winding": "estimate"}
 
 
 def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = None) -> MassProperties:
@@ -102,6 +114,43 @@ def _scaled(props: MassProperties, scale) -> MassProperties:
                           inertia=np.trace(sigma) * np.eye(3) - sigma, density=1.0, name=props.name)
 
 
+def _referenced(props: MassProperties, element: GeometryElement) -> MassProperties:
+    """The mesh file's body moved by the element's reference transform (MJCF ``refpos``/``refquat``)."""
+    if np.array_equal(element.reference_rotation, np.eye(3)) and not np.any(element.reference_translation):
+        return props
+    return props.transformed(rotation=element.reference_rotation, translation=element.reference_translation)
+
+
+def element_shell_properties(element: GeometryElement) -> MassProperties:
+    """Unit-areal-density properties of the element's surface (mass = area in m²), in the **link frame**.
+
+    Closed forms for spheres, boxes, cylinders and capsules (:mod:`inertia_tool.mass.shell_shapes`); the
+    triangles of a mesh (any winding, open or closed) through :func:`inertia_tool.mass.surface.surface_moments`.
+    An ellipsoid's surface has no closed form (MuJoCo approximates it): :class:`UsageError`.
+    """
+    kind, size = element.kind, element.size
+    if kind == "sphere":
+        local = shell_shapes.sphere_shell(size[0])
+    elif kind == "box":
+        local = shell_shapes.box_shell(size)
+    elif kind == "cylinder":
+        local = shell_shapes.cylinder_shell(*size)
+    elif kind == "capsule":
+        local = shell_shapes.capsule_shell(*size)
+    elif kind == "mesh":
+        from ..mass.surface import surface_moments
+        v, f = _mesh_vertices_faces(element)
+        moments = surface_moments(v, f)
+        c = moments.second_moment
+        local = MassProperties(mass=moments.area, volume=0.0, center_of_mass=moments.centroid,
+                               inertia=np.trace(c) * np.eye(3) - c, surface_area=moments.area,
+                               density=float("nan"), name=element.name)
+    else:
+        raise UsageError(f"Expected a shell of a sphere, box, cylinder, capsule or mesh, got {kind!r} "
+                         f"({element.name}): an ellipsoid's surface has no closed form")
+    return local.transformed(rotation=element.rotation, translation=element.translation)
+
+
 def element_mass_properties(element: GeometryElement, *, cache: dict | None = None,
                             repair: bool = False, budget: list | None = None) -> MassProperties:
     """Unit-density mass properties of one geometry element, in the **link frame**.
@@ -159,15 +208,35 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
                 budget[0] -= local.mesh.file_faces
             if cache is not None:
                 cache[element.mesh] = local
-        local = _scaled(local, element.scale)
+        local = _scaled(_referenced(local, element), element.scale)
     else:
         raise UsageError("Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, mesh, "
                          f"got {kind!r}")
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
 
+def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool,
+                   budget: list | None = None):
+    """Per element of ``link``: ``(element, unit properties, mesh method, mesh uncertainty)``; massless
+    elements (``model`` mode) are left out and named in the second return value."""
+    parts, massless = [], []
+    for element in link.elements:
+        if model and (element.mass == 0 or (element.mass is None and element.density == 0)):
+            massless.append(element)
+            continue
+        if model and element.shell:
+            parts.append((element, element_shell_properties(element), "exact", None))
+            continue
+        props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
+        report = cache[element.mesh].mesh if element.kind == "mesh" and element.mesh in cache else None
+        method = _MESH_METHOD.get(report.method, "estimate") if report is not None else "exact"
+        parts.append((element, props, method, report.uncertainty if report is not None else None))
+    return parts, massless
+
+
 def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repair: bool = False,
                          budget: list | None = None) -> MassProperties:
+
     """Unit-density mass properties of all the link's elements together, link frame (parallel-axis sum).
 
     Parameters
@@ -194,6 +263,29 @@ def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repai
 
 
 @frozen_value
+class LinkUncertainty:
+    """Bounds on a link result that contains estimated meshes (``method == "estimate"``).
+
+    Attributes
+    ----------
+    mass : float
+        Relative: the true mass lies within ``mass · m`` of the reported ``m`` (the elements' absolute bounds
+        added).
+    center_of_mass : float
+        m: ``(Σ m_i e_i + Σ δm_i |c_i − c|) / (M − Σ δm_i)`` with ``e_i`` the elements' centre bounds and
+        ``δm_i`` their absolute mass bounds (the centre ``Σ m_i c_i / M`` perturbed, to first order exact,
+        bounded with the smallest possible total mass).
+    inertia : float or None
+        Relative Frobenius bound on the tensor when the link is a single element; None otherwise (no bound
+        is claimed for a sum of estimated and exact parts).
+    """
+
+    mass: float
+    center_of_mass: float
+    inertia: float | None
+
+
+@frozen_value
 class LinkInertial:
     """The mass properties a link's geometry implies.
 
@@ -206,11 +298,19 @@ class LinkInertial:
         geometry's m³.  None when the link has no geometry or its geometry could not be integrated
         (``problem`` says why).
     density : float
-        kg/m³ used (with ``keep_mass``: the implied density ``declared mass / volume``); nan without result.
+        kg/m³ used (with ``keep_mass``: the implied density ``declared mass / volume``; with the model's own
+        densities: total mass / total volume); nan without result.
     basis : str
-        How the density was chosen (``"7850 kg/m³"``, ``"steel (7850 kg/m³)"``, ``"declared masses kept"``).
+        How the density was chosen (``"7850 kg/m³"``, ``"steel (7850 kg/m³)"``, ``"declared masses kept"``,
+        ``"the model's own densities"``).
     problem : str or None
         Why there is no result: no geometry, no declared mass to keep, a mesh that needs repair.
+    method : str or None
+        One of :data:`METHODS` (the least certain of the link's elements); None without result.
+    uncertainty : LinkUncertainty or None
+        Bounds when ``method == "estimate"``; None when the result is exact for the geometry as described.
+    warnings : tuple of str
+        What the reader should know about a result (massless geoms left out, a repaired mesh).
     """
 
     name: str
@@ -218,17 +318,99 @@ class LinkInertial:
     density: float
     basis: str
     problem: str | None = None
+    method: str | None = None
+    uncertainty: LinkUncertainty | None = None
+    warnings: tuple = ()
 
 
-def link_inertials(robot: RobotDescription, *, density: float | None = None, material: str | None = None,
+def _link_uncertainty(parts: list, total: MassProperties, scale: float) -> LinkUncertainty | None:
+    """Bounds for a link from its elements' (``scale``: mass of each unit part in the link result)."""
+    estimated = [(p, u) for _, p, m, u in parts if m == "estimate" and u is not None]
+    if not estimated:
+        return None
+    dm = [u.mass * p.mass * scale for p, u in estimated]
+    spread = sum(d * float(np.linalg.norm(p.center_of_mass - total.center_of_mass)) for d, (p, _) in zip(dm, estimated))
+    shift = sum(p.mass * scale * u.center_of_mass for p, u in estimated)
+    floor = total.mass - sum(dm)
+    com = (shift + spread) / floor if floor > 0 else float("inf")
+    inertia = estimated[0][1].inertia if len(parts) == 1 else None
+    return LinkUncertainty(mass=sum(dm) / total.mass, center_of_mass=com, inertia=inertia)
+
+
+_RANK = {m: k for k, m in enumerate(METHODS)}
+
+
+def _one_link(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, model: bool, repair: bool, cache: dict,
+              geometry: str, budget: list | None = None) -> LinkInertial:
+    """The result for one link, or the reason there is none (never raises for the link's own problems)."""
+    nan = float("nan")
+    if not link.elements:
+        return LinkInertial(link.name, None, nan, basis, f"no {geometry} geometry")
+    try:
+        parts, massless = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
+    except InertiaToolError as exc:
+        return LinkInertial(link.name, None, nan, basis, f"mesh needs repair or cannot be read: {exc}")
+    warned = [f"{e.kind} {e.name!r} is massless in the description "
+              f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
+    if not parts:
+        return LinkInertial(link.name, None, nan, basis, "every geom is massless in the description",
+                            warnings=tuple(warned))
+    method = max((m for _, _, m, _ in parts), key=_RANK.__getitem__)
+    warned += [f"{e.name or e.kind}: {u.mass:.2g} relative mass bound from the repaired mesh"
+               for e, _, m, u in parts if m == "estimate" and u is not None]
+    try:
+        if model:
+            weighted = []
+            for element, unit, _, _ in parts:
+                if element.mass is not None:
+                    weighted.append(unit.with_mass(element.mass))
+                else:
+                    weighted.append(MassProperties(mass=unit.mass * element.density, volume=unit.volume,
+                                                   center_of_mass=unit.center_of_mass,
+                                                   inertia=unit.inertia * element.density,
+                                                   surface_area=unit.surface_area, density=element.density))
+            total = weighted[0] if len(weighted) == 1 else combine(weighted, name=link.name)
+            volume = sum(u.volume for _, u, _, _ in parts)
+            props = MassProperties(mass=total.mass, volume=volume, center_of_mass=total.center_of_mass,
+                                   inertia=total.inertia, surface_area=total.surface_area,
+                                   density=total.mass / volume if volume > 0 else nan, name=link.name)
+            uncertainty = _link_uncertainty(parts, props, 1.0) if method == "estimate" else None
+            return LinkInertial(link.name, props, props.density, basis, method=method, uncertainty=uncertainty,
+                                warnings=tuple(warned))
+        units = [u for _, u, _, _ in parts]
+        total = units[0] if len(units) == 1 else combine(units, name=link.name)
+        unit = MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
+                              inertia=total.inertia, surface_area=total.surface_area, density=1.0, name=link.name)
+        if keep_mass:
+            if link.declared is None or not link.declared.mass > 0:
+                mass = nan if link.declared is None else link.declared.mass
+                return LinkInertial(link.name, None, nan, "declared masses kept",
+                                    "no declared mass to keep" if link.declared is None
+                                    else f"declared mass {mass:g} kg is not positive", warnings=tuple(warned))
+            props = unit.with_mass(link.declared.mass)
+            scale = props.mass / unit.mass
+            return LinkInertial(link.name, props, props.mass / props.volume, "declared masses kept", method=method,
+                                uncertainty=_link_uncertainty(parts, props, scale), warnings=tuple(warned))
+        props = MassProperties(mass=unit.mass * rho, volume=unit.volume, center_of_mass=unit.center_of_mass,
+                               inertia=unit.inertia * rho, surface_area=unit.surface_area, density=rho,
+                               name=link.name)
+        return LinkInertial(link.name, props, rho, basis, method=method,
+                            uncertainty=_link_uncertainty(parts, props, rho), warnings=tuple(warned))
+    except InertiaToolError as exc:
+        return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}", warnings=tuple(warned))
+
+
+def link_inertials(robot: RobotDescription, *, density: float | str | None = None, material: str | None = None,
                    keep_mass: bool = False, repair: bool = False, max_faces: int = DEFAULT_MAX_FACES) -> tuple:
     """Mass properties of every link from its geometry, in the link frame.
 
     Parameters
     ----------
     robot : RobotDescription
-    density : float, optional
-        kg/m³ for every link.
+    density : float or "model", optional
+        kg/m³ for every link; or :data:`MODEL_DENSITY` (``"model"``) for the description's own densities
+        (MJCF geom ``density``, ``mass``, ``shellinertia``: each geom at its density, a geom with a ``mass``
+        scaled to it, massless geoms left out and named in ``warnings``).
     material : str, optional
         Material name (``inertia_tool.units.MATERIALS``).
     keep_mass : bool
@@ -244,52 +426,40 @@ def link_inertials(robot: RobotDescription, *, density: float | None = None, mat
     Returns
     -------
     tuple of LinkInertial
-        One per link, in the description's order.  A link whose mesh is not a closed solid has
-        ``properties=None`` and ``problem`` naming the mesh and what the engine found.
+        One per link, in the description's order.  A link that cannot be computed (a mesh that is not a
+        closed solid, a degenerate repair, no geometry) has ``properties=None`` and ``problem`` saying why;
+        it never stops the other links.
     """
     chosen = sum([density is not None, material is not None, bool(keep_mass)])
     if chosen != 1:
         raise UsageError("Give exactly one of `density`, `material` and `keep_mass`")
-    rho, basis = (None, "") if keep_mass else resolve_density(density=density, material=material)
+    model = isinstance(density, str)
+    if model and density != MODEL_DENSITY:
+        raise UsageError(f"Expected `density` to be a number or {MODEL_DENSITY!r}, got {density!r}")
+    if model and robot.format != "mjcf":
+        raise UsageError(f"Expected a MuJoCo MJCF description for density={MODEL_DENSITY!r} (only MJCF gives "
+                         f"densities), got {robot.format}")
+    if model or keep_mass:
+        rho, basis = None, ("the model's own densities" if model else "")
+    else:
+        assert not isinstance(density, str), "checked above"
+        rho, basis = resolve_density(density=density, material=material)
     if not (isinstance(max_faces, (int, np.integer)) and 0 < max_faces <= MAX_SUPPORTED_FACES):
         raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,}, got {max_faces!r}")
     cache: dict = {}
     budget = [int(max_faces), int(max_faces)]
-    out = []
-    for link in robot.links:
-        if not link.elements:
-            out.append(LinkInertial(link.name, None, float("nan"), basis, f"no {robot.geometry} geometry"))
-            continue
-        try:
-            unit = link_mass_properties(link, cache=cache, repair=repair, budget=budget)
-        except (InvalidMeshError, MeshReadError) as exc:
-            out.append(LinkInertial(link.name, None, float("nan"), basis,
-                                    f"mesh needs repair or cannot be read: {exc}"))
-            continue
-        if keep_mass:
-            if link.declared is None or not link.declared.mass > 0:
-                mass = float("nan") if link.declared is None else link.declared.mass
-                out.append(LinkInertial(link.name, None, float("nan"), "declared masses kept",
-                                        "no declared mass to keep" if link.declared is None
-                                        else f"declared mass {mass:g} kg is not positive"))
-                continue
-            props = unit.with_mass(link.declared.mass)
-            out.append(LinkInertial(link.name, props, props.mass / props.volume, "declared masses kept"))
-        else:
-            assert rho is not None, "resolve_density gives a density when no target mass is asked"
-            props = MassProperties(mass=unit.mass * rho, volume=unit.volume, center_of_mass=unit.center_of_mass,
-                                   inertia=unit.inertia * rho, surface_area=unit.surface_area, density=rho,
-                                   name=link.name)
-            out.append(LinkInertial(link.name, props, rho, basis))
-    return tuple(out)
+    return tuple(_one_link(link, rho=rho, basis=basis, keep_mass=keep_mass, model=model, repair=repair,
+                           cache=cache, geometry=robot.geometry, budget=budget) for link in robot.links)
 
 
 # -- where the geometry is (for the audit) -----------------------------------------------------------------
 
 def _mesh_vertices_faces(element: GeometryElement):
+    """The mesh's vertices in the element frame (reference transform, then scale) and its faces."""
     from ..mesh.read import load_mesh
     raw = load_mesh(element.mesh, units="m")
-    return raw.vertices * element.scale, raw.faces
+    v = raw.vertices @ element.reference_rotation.T + element.reference_translation
+    return v * element.scale, raw.faces
 
 
 def element_bounds(element: GeometryElement) -> np.ndarray:

@@ -10,8 +10,30 @@ cylinders, boxes and ellipsoids (the axis runs from the first point to the secon
 half-sizes: box half-edges, cylinder and capsule ``radius half-length``, ellipsoid semi-axes.
 
 Collision geoms are those with ``contype`` or ``conaffinity`` non-zero (MuJoCo's default is 1); the others
-are visual.  Geoms directly in ``<worldbody>`` belong to no body and are skipped.  ``<include>``, inline mesh
-vertices and height fields are refused with a message.
+are visual.  Geoms directly in ``<worldbody>`` belong to no body and are skipped.  Inline mesh vertices and
+height fields are refused with a message.
+
+MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
+
+* ``<include file>`` is replaced by the children of the included ``<mujoco>``, recursively; the file is looked
+  up relative to the main model's folder first, then relative to the including file's folder.  At most
+  :data:`MAX_INCLUDE_DEPTH` levels and :data:`MAX_INCLUDED_FILES` files; a file that includes itself
+  (directly or not) is refused.  A mesh is found through the merged ``<compiler meshdir>`` relative to the
+  main model's folder; a mesh declared in an included file that is not found there is looked up through that
+  file's own ``meshdir``, relative to its folder.
+* Defaults: an element's own attribute overrides its class, the class its parent class.  The orientation is
+  one attribute: an element (or class) that gives any of ``quat``, ``axisangle``, ``euler``, ``xyaxes``,
+  ``zaxis`` replaces whatever orientation its class gave.  ``size`` is read number by number: an element's
+  ``size="0.02"`` replaces the first number of its class's ``size`` and keeps the others.  Several top-level
+  ``<default>`` blocks (from included files) all add to the class ``main``.
+* ``fromto`` takes precedence over ``pos`` and the orientation; the radius (and the box or ellipsoid cross
+  section) still come from ``size``.
+* Mesh ``refpos``/``refquat``: file vertices ``v`` become ``scale ⊙ (q̄ (v − refpos) q)`` — the reference
+  position is subtracted, the conjugate of ``refquat`` rotates, the scale applies last.
+* Geom ``density`` (kg/m³, default 1000), ``mass`` (kg; when given, the geom's density is ``mass / volume``)
+  and ``shellinertia`` (mass on the surface; for meshes MuJoCo uses ``<mesh inertia="shell">`` instead) are
+  kept on each :class:`GeometryElement` for the "model's own densities" mode; a geom with ``mass="0"`` or
+  ``density="0"`` is massless there.
 """
 
 from __future__ import annotations
@@ -25,7 +47,16 @@ from ..errors import RobotDescriptionError
 from .description import DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive, _scale
 from .resolve import resolve_uri
 
-__all__ = ["read_mjcf", "orientation_matrix"]
+__all__ = ["read_mjcf", "orientation_matrix", "MAX_INCLUDE_DEPTH", "MAX_INCLUDED_FILES"]
+
+#: Deepest chain of ``<include>`` followed (MuJoCo's own models nest two or three).
+MAX_INCLUDE_DEPTH = 16
+
+#: Most files one model may pull in through ``<include>`` (counting repeats).
+MAX_INCLUDED_FILES = 512
+
+#: The orientation attributes of MJCF: one orientation, whichever of them is given.
+_ORIENTATION = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 
 _GEOM_KINDS = {"box": "box", "sphere": "sphere", "cylinder": "cylinder", "capsule": "capsule",
                "ellipsoid": "ellipsoid", "mesh": "mesh"}
@@ -123,21 +154,34 @@ def orientation_matrix(attrs: dict, *, degrees: bool, eulerseq: str, what: str, 
     return _z_to(z)
 
 
+def _merge_attributes(base: dict, own) -> dict:
+    """``own`` attributes over ``base`` with MuJoCo's rules: one orientation, ``size`` number by number."""
+    out = dict(base)
+    own = dict(own)
+    if any(k in own for k in _ORIENTATION):
+        for key in _ORIENTATION:
+            out.pop(key, None)
+    if "size" in own and "size" in out:
+        mine, theirs = str(own["size"]).split(), str(out["size"]).split()
+        own["size"] = " ".join(mine + theirs[len(mine):])
+    out.update(own)
+    return out
+
+
 class _Defaults:
     """MJCF default classes: class name → {element tag → attributes}, each merged with its parents."""
 
     def __init__(self, root, source: str):
-        self.classes: dict = {}
+        self.classes: dict = {"main": {}}
         for top in root.findall("default"):
-            self._collect(top, {}, source)
-        self.classes.setdefault("main", {})
+            self._collect(top, self.classes["main"] if top.get("class", "main") == "main" else {}, source)
 
     def _collect(self, element, inherited: dict, source: str) -> None:
         name = element.get("class", "main")
         merged = {tag: dict(attrs) for tag, attrs in inherited.items()}
         for child in element:
             if isinstance(child.tag, str) and child.tag != "default":
-                merged.setdefault(child.tag, {}).update(child.attrib)
+                merged[child.tag] = _merge_attributes(merged.get(child.tag, {}), child.attrib)
         self.classes[name] = merged
         for child in element.findall("default"):
             if not child.get("class"):
@@ -148,45 +192,128 @@ class _Defaults:
         name = element.get("class", class_name)
         if name not in self.classes:
             raise _fail(source, f"<{element.tag}> uses the undefined default class {name!r}")
-        attrs = dict(self.classes[name].get(element.tag, {}))
-        attrs.update(element.attrib)
+        attrs = _merge_attributes(self.classes[name].get(element.tag, {}), element.attrib)
         attrs.pop("class", None)
         return attrs
 
 
-def _compiler(root, source: str) -> tuple[bool, str, str, str]:
-    compiler = root.find("compiler")
-    get = (compiler.get if compiler is not None else (lambda k, d=None: d))
-    angle = get("angle", "degree")
+def _compiler(root, source: str) -> tuple[bool, str, str | None]:
+    """``(degrees, eulerseq, mesh folder)`` from every ``<compiler>`` in document order (later ones win)."""
+    merged: dict = {}
+    for compiler in root.iter("compiler"):
+        merged.update(compiler.attrib)
+    angle = merged.get("angle", "degree")
     if angle not in ("degree", "radian"):
         raise _fail(source, f"<compiler angle={angle[:40]!r}>: expected 'degree' or 'radian'")
-    eulerseq = get("eulerseq", "xyz")
+    eulerseq = merged.get("eulerseq", "xyz")
     if len(eulerseq) != 3 or any(c not in "xyzXYZ" for c in eulerseq):
         raise _fail(source, f"<compiler eulerseq={eulerseq[:40]!r}>: expected three of the letters xyzXYZ "
                             "(lower case rotates with the frame, upper case about the fixed axes)")
-    return angle == "degree", eulerseq, get("meshdir", None), get("assetdir", None)
+    return angle == "degree", eulerseq, merged.get("meshdir", merged.get("assetdir"))
 
 
-def _meshes(root, defaults: _Defaults, base: str, meshdir: str, packages: dict, source: str) -> dict:
+def _own_mesh_folder(root, folder: str) -> str:
+    """The folder a file's own ``<compiler meshdir/assetdir>`` names, relative to ``folder`` (the file's)."""
+    merged: dict = {}
+    for compiler in root.iter("compiler"):
+        merged.update(compiler.attrib)
+    return os.path.join(folder, merged.get("meshdir", merged.get("assetdir", "")) or "")
+
+
+def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
+                     max_files: int = MAX_INCLUDED_FILES) -> dict:
+    """Replace every ``<include file>`` under ``root`` by the included ``<mujoco>``'s children, in place.
+
+    Returns ``{<mesh> element: fallback folders}`` for meshes declared in included files: the declaring
+    file's own mesh folder, then those of the files that included it, outwards (used when MuJoCo's
+    main-folder lookup finds nothing).
+    """
+    from .description import _read_bytes, parse_xml
+    main_folder = os.path.dirname(os.path.abspath(source))
+    fallbacks: dict = {}
+    count = [0]
+
+    def expand(element, including: str, stack: tuple, chain: tuple) -> None:
+        for include in list(element.iter("include")):
+            name = include.get("file")
+            if not name:
+                raise _fail(source, f"<include> without a file (in {including})")
+            candidates = [os.path.normpath(os.path.join(main_folder, name)),
+                          os.path.normpath(os.path.join(os.path.dirname(including), name))]
+            path = next((c for c in candidates if os.path.isfile(c)), None)
+            if path is None:
+                raise _fail(source, f"<include file={name!r}> (in {including}): no such file (looked in "
+                                    f"{' and '.join(dict.fromkeys(os.path.dirname(c) for c in candidates))})")
+            key = os.path.realpath(path)
+            if key in stack:
+                raise _fail(source, f"<include file={name!r}> (in {including}) includes itself: "
+                                    f"{' -> '.join(stack + (key,))}")
+            if len(stack) >= max_depth:
+                raise _fail(source, f"<include file={name!r}> (in {including}): includes nested more than "
+                                    f"{max_depth} deep")
+            count[0] += 1
+            if count[0] > max_files:
+                raise _fail(source, f"more than {max_files} included files")
+            included = parse_xml(_read_bytes(path), path).getroot()
+            if included.tag != "mujoco":
+                raise _fail(source, f"<include file={name!r}>: {path} has the root element <{included.tag}>, "
+                                    "expected <mujoco>")
+            folders = (_own_mesh_folder(included, os.path.dirname(path)),) + chain
+            expand(included, path, stack + (key,), folders)
+            for mesh in included.iter("mesh"):
+                fallbacks.setdefault(mesh, folders)
+            parent = include.getparent()
+            index = parent.index(include)
+            tail = include.tail
+            parent.remove(include)
+            children = [c for c in included]
+            for offset, child in enumerate(children):
+                parent.insert(index + offset, child)
+            if children:
+                children[-1].tail = (children[-1].tail or "") + (tail or "")
+
+    expand(root, os.path.abspath(source), (os.path.realpath(source),), ())
+    return fallbacks
+
+
+def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler, source: str) -> dict:
+    """``{name: (file, folders, scale, reference rotation, reference translation, shell)}`` of every mesh asset."""
+    degrees, eulerseq = compiler
     meshes = {}
     for asset in root.findall("asset"):
         for mesh in asset.findall("mesh"):
             attrs = defaults.attributes(mesh, "main", source)
             if attrs.get("vertex") or attrs.get("face"):
                 raise _fail(source, f"<mesh name={attrs.get('name')!r}> with inline vertices is not supported")
-            if attrs.get("refpos") or attrs.get("refquat"):
-                raise _fail(source, f"<mesh name={attrs.get('name')!r}>: refpos/refquat are not supported")
             file = attrs.get("file")
             if not file:
                 raise _fail(source, f"<mesh name={attrs.get('name')!r}> without a file")
             name = attrs.get("name") or os.path.splitext(os.path.basename(file))[0]
-            scale = _scale(_numbers(attrs.get("scale"), 3, f"<mesh name={name!r}> scale", source, default=(1, 1, 1)),
-                           f"<mesh name={name!r}> scale", source)
-            meshes[name] = (file, scale)
+            what = f"<mesh name={name!r}>"
+            scale = _scale(_numbers(attrs.get("scale"), 3, f"{what} scale", source, default=(1, 1, 1)),
+                           f"{what} scale", source)
+            refpos = _numbers(attrs.get("refpos"), 3, f"{what} refpos", source, default=(0, 0, 0))
+            refquat = _numbers(attrs.get("refquat"), 4, f"{what} refquat", source, default=(1, 0, 0, 0))
+            if not np.linalg.norm(refquat) > 0:
+                raise _fail(source, f"{what}: refquat of zero length")
+            # v ↦ q̄ (v − refpos) q: rotation Qᵀ, translation −Qᵀ refpos
+            back = _quaternion_matrix(refquat).T
+            folders = [mesh_base, *fallbacks.get(mesh, ())]
+            shell = attrs.get("inertia") == "shell"
+            meshes[name] = (file, folders, scale, back, -back @ refpos, shell)
     return meshes
 
 
-def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, mesh_base: str, packages: dict, compiler,
+def _optional_number(attrs: dict, key: str, what: str, source: str) -> float | None:
+    if attrs.get(key) is None:
+        return None
+    value = float(_numbers(attrs[key], 1, f"{what} {key}", source)[0])
+    if value < 0:
+        raise _fail(source, f"{what}: {key} must not be negative, got {attrs[key]!r}")
+    return value
+
+
+def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict, compiler,
           source: str) -> GeometryElement:
     degrees, eulerseq = compiler
     what = f"body {link!r} {label}"
@@ -208,6 +335,11 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, mesh_base: str
     frame_rotation, frame_translation = pose
     rotation, position = frame_rotation @ rotation, frame_rotation @ position + frame_translation
     name = attrs.get("name") or label
+    mass_model = {"density": _optional_number(attrs, "density", what, source),
+                  "mass": _optional_number(attrs, "mass", what, source),
+                  "shell": attrs.get("shellinertia", "false") == "true"}
+    if mass_model["density"] is None:
+        mass_model["density"] = 1000.0       # MuJoCo's default geom density, kg/m³
 
     def need(count):
         if len(size) < count:
@@ -218,25 +350,31 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, mesh_base: str
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
-        file, scale = meshes[mesh_name]
-        path = resolve_uri(file, base=mesh_base, packages=packages, source=source, link=link)
-        return GeometryElement("mesh", rotation, position, mesh=path, uri=file, scale=scale, name=name)
+        file, folders, scale, ref_rotation, ref_translation, shell = meshes[mesh_name]
+        mass_model["shell"] = shell          # MuJoCo: a mesh's shell inertia is a property of the asset
+        found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
+        path = resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
+        return GeometryElement("mesh", rotation, position, mesh=path, uri=file, scale=scale, name=name,
+                               reference_rotation=ref_rotation, reference_translation=ref_translation,
+                               **mass_model)
     if kind == "sphere":
-        return GeometryElement("sphere", rotation, position, size=need(1), name=name)
+        return GeometryElement("sphere", rotation, position, size=need(1), name=name, **mass_model)
     if kind in ("capsule", "cylinder"):
         radius = need(1)[0]
         half = half_length if half_length is not None else need(2)[1]
-        return GeometryElement(kind, rotation, position, size=(radius, 2.0 * half), name=name)
+        return GeometryElement(kind, rotation, position, size=(radius, 2.0 * half), name=name, **mass_model)
     if kind == "box":
         if half_length is not None:
             half = need(2)
             return GeometryElement("box", rotation, position, size=(2 * half[0], 2 * half[1], 2 * half_length),
-                                   name=name)
-        return GeometryElement("box", rotation, position, size=tuple(2 * s for s in need(3)), name=name)
+                                   name=name, **mass_model)
+        return GeometryElement("box", rotation, position, size=tuple(2 * s for s in need(3)), name=name,
+                               **mass_model)
     if half_length is not None:
         half = need(2)
-        return GeometryElement("ellipsoid", rotation, position, size=(half[0], half[1], half_length), name=name)
-    return GeometryElement("ellipsoid", rotation, position, size=need(3), name=name)
+        return GeometryElement("ellipsoid", rotation, position, size=(half[0], half[1], half_length), name=name,
+                               **mass_model)
+    return GeometryElement("ellipsoid", rotation, position, size=need(3), name=name, **mass_model)
 
 
 def _inertial(body, name: str, compiler, source: str) -> DeclaredInertial | None:
@@ -282,13 +420,12 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
     """Bodies of an MJCF ``<mujoco>`` tree as links (see the module docstring); returns ``(model, links)``."""
     if root.tag != "mujoco":
         raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
-    if root.find(".//include") is not None:
-        raise _fail(source, "<include> is not supported; give a file with the included parts merged")
-    degrees, eulerseq, meshdir, assetdir = _compiler(root, source)
-    mesh_base = os.path.join(base, meshdir or assetdir or "")
+    fallbacks = _expand_includes(root, source)
+    degrees, eulerseq, meshdir = _compiler(root, source)
+    mesh_base = os.path.join(base, meshdir or "")
     defaults = _Defaults(root, source)
-    meshes = _meshes(root, defaults, base, mesh_base, packages, source)
     compiler = (degrees, eulerseq)
+    meshes = _meshes(root, defaults, mesh_base, fallbacks, compiler, source)
     links = []
     counter = [0]
 
@@ -309,7 +446,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
                 attrs = defaults.attributes(child, class_name, source)
                 if _is_collision(attrs, f"body {link!r} geom {len(elements) + 1}", source) == (geometry == "collision"):
                     label = f"geom {len(elements) + 1}"
-                    elements.append(_geom(attrs, pose, label, link, meshes, mesh_base, packages, compiler, source))
+                    elements.append(_geom(attrs, pose, label, link, meshes, packages, compiler, source))
             elif child.tag == "frame":
                 attrs = dict(child.attrib)
                 rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=f"body {link!r} frame",

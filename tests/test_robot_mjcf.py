@@ -1,0 +1,262 @@
+"""MJCF read as MuJoCo reads it (inertia_tool.robot.mjcf): <include>, default classes and their override rules,
+sizes from classes for `fromto`, mesh refpos/refquat, <frame>, geom density/mass/shellinertia (the model's own
+densities), massless geoms.  The independent reference is MuJoCo's compiler itself (inertiafromgeom)."""
+
+import os
+
+import numpy as np
+import pytest
+
+from inertia_tool.errors import RobotDescriptionError, UsageError
+from inertia_tool.mass import shapes, shell_shapes
+from inertia_tool.mass.surface import surface_moments
+from inertia_tool.robot import link_inertials, read_robot
+
+from conftest import assert_tensor_close
+
+mujoco = pytest.importorskip("mujoco")
+
+
+def _mujoco_bodies(path):
+    """name → (mass, centre, tensor in body axes) from MuJoCo's compiler."""
+    model = mujoco.MjModel.from_xml_path(str(path))
+    out = {}
+    for i in range(1, model.nbody):
+        rot = np.zeros(9)
+        mujoco.mju_quat2Mat(rot, model.body_iquat[i])
+        rot = rot.reshape(3, 3)
+        out[model.body(i).name] = (model.body_mass[i], model.body_ipos[i].copy(),
+                                   rot @ np.diag(model.body_inertia[i]) @ rot.T)
+    return out
+
+
+def _assert_like_mujoco(path, results, *, rtol=1e-9):
+    reference = _mujoco_bodies(path)
+    ours = {r.name: r for r in results}
+    assert set(ours) == set(reference)
+    for name, (mass, com, tensor) in reference.items():
+        props = ours[name].properties
+        assert props is not None, (name, ours[name].problem)
+        assert props.mass == pytest.approx(mass, rel=rtol), name
+        scale = max(np.linalg.norm(com), np.sqrt(np.trace(tensor) / mass))
+        np.testing.assert_allclose(props.center_of_mass, com, atol=rtol * scale, err_msg=name)
+        assert_tensor_close(props.inertia, tensor, rtol)
+
+
+# one model using what the Menagerie files use: an included robot, two top-level <default> blocks, nested
+# classes with childclass, an orientation from a class overridden by the geom's own (anymal_b), a fromto
+# capsule whose radius comes from its class (agilex_piper, arx_l5), a size given in part, a mesh with
+# refpos/refquat and scale (shadow_dexee), frames, and per-geom density and mass
+SCENE = """<mujoco model="scene">
+  <include file="robot.xml"/>
+  <worldbody><light pos="0 0 3"/></worldbody>
+</mujoco>
+"""
+
+ROBOT = """<mujoco model="robot">
+  <compiler angle="radian" meshdir="assets" inertiafromgeom="true"/>
+  <default>
+    <mesh inertia="exact"/>
+    <default class="arm">
+      <geom type="capsule" size="0.02 0.1" quat="0 1 0 0" density="2700"/>
+      <default class="blocky">
+        <geom type="box" size="0.03 0.04 0.05"/>
+      </default>
+    </default>
+  </default>
+  <include file="parts.xml"/>
+  <asset>
+    <mesh name="cone" file="cone.stl" scale="0.001 0.002 0.001" refpos="3 -2 10" refquat="0.9 0.1 -0.3 0.2"/>
+  </asset>
+  <worldbody>
+    <body name="base" pos="0 0 0.1">
+      <freejoint/>
+      <geom class="arm" euler="0.3 0.2 0.1"/>
+      <geom class="arm" fromto="0 0 0 0.1 0.2 0.05"/>
+      <geom class="blocky" size="0.01" pos="0.1 0 0"/>
+      <body name="upper" pos="0 0 0.3" childclass="blocky">
+        <joint type="ball"/>
+        <geom pos="0 0 0.05"/>
+        <geom class="wheel" pos="0.1 0 0"/>
+        <frame pos="0 0.1 0" euler="0 0 1.2" childclass="arm">
+          <geom pos="0.05 0 0" density="7800"/>
+          <body name="tool" pos="0.1 0 0">
+            <joint type="hinge"/>
+            <geom type="mesh" mesh="cone" pos="0 -0.02 0.01" xyaxes="0 1 0 -1 0 0"/>
+            <geom type="sphere" size="0.015" mass="0.25" pos="0 0 0.05"/>
+          </body>
+        </frame>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+PARTS = """<mujoco>
+  <default>
+    <default class="wheel"><geom type="cylinder" size="0.05 0.01" zaxis="1 0 0" density="500"/></default>
+  </default>
+</mujoco>
+"""
+
+
+@pytest.fixture
+def scene(tmp_path):
+    (tmp_path / "assets").mkdir()
+    shapes.write_stl(shapes.cone(20.0, 50.0, segments=40), tmp_path / "assets" / "cone.stl")
+    (tmp_path / "scene.xml").write_text(SCENE)
+    (tmp_path / "robot.xml").write_text(ROBOT)
+    (tmp_path / "parts.xml").write_text(PARTS)
+    return tmp_path / "scene.xml"
+
+
+def test_menagerie_style_scene_matches_mujoco_with_the_models_own_densities(scene):
+    robot = read_robot(scene)
+    assert [link.name for link in robot.links] == ["base", "upper", "tool"]
+    results = link_inertials(robot, density="model")
+    assert all(r.method == "exact" and r.uncertainty is None for r in results)
+    _assert_like_mujoco(scene, results)
+
+
+def test_with_one_density_mujoco_agrees_when_its_geoms_have_that_density(scene, tmp_path):
+    # the same bodies at 1000 kg/m³ everywhere: MuJoCo with every density attribute and mass removed
+    text = (tmp_path / "robot.xml").read_text()
+    for attr in ('density="2700"', 'density="7800"', 'density="500"', 'mass="0.25"'):
+        text = text.replace(attr, "")
+    (tmp_path / "robot.xml").write_text(text)
+    (tmp_path / "parts.xml").write_text(PARTS.replace('density="500"', ""))
+    _assert_like_mujoco(scene, link_inertials(read_robot(scene), density=1000))
+
+
+def test_the_geoms_own_orientation_replaces_its_class_orientation(tmp_path):
+    # anymal_b: a class gives quat, the geom gives euler; MuJoCo takes the geom's (and the other way round)
+    for cls, own in (('quat="0 1 0 0"', 'euler="90 0 0"'), ('euler="90 0 0"', 'quat="0.7 0 0.7 0.1"')):
+        path = tmp_path / "o.xml"
+        path.write_text(f'<mujoco><compiler inertiafromgeom="true"/><default><default class="c"><geom {cls}/>'
+                        f'</default></default><worldbody><body name="b"><freejoint/><geom class="c" type="box" '
+                        f'size="0.1 0.2 0.3" pos="0.1 0 0" {own}/></body></worldbody></mujoco>')
+        _assert_like_mujoco(path, link_inertials(read_robot(path), density=1000))
+
+
+def test_two_orientations_on_one_element_are_still_refused(tmp_path):
+    path = tmp_path / "o.xml"
+    path.write_text('<mujoco><worldbody><body name="b"><geom type="sphere" size="1" quat="1 0 0 0" '
+                    'euler="0 0 1"/></body></worldbody></mujoco>')
+    with pytest.raises(RobotDescriptionError, match="more than one orientation"):
+        read_robot(path)
+
+
+def test_massless_geoms_are_left_out_and_named(tmp_path):
+    # Robotiq 2F-85 pads: mass="0" boxes in a collision class; MuJoCo gives them no mass whatever their group
+    path = tmp_path / "pad.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true"/><default><default class="pad"><geom type="box" '
+                    'mass="0" size="0.011 0.004 0.009" group="3"/></default></default><worldbody>'
+                    '<body name="finger"><freejoint/><geom type="box" size="0.01 0.02 0.03"/>'
+                    '<geom class="pad" name="pad1" pos="0 0.03 0"/><geom type="sphere" size="0.01" density="0" '
+                    'pos="0 0 0.1"/></body><body name="ghost" pos="1 0 0"><freejoint/><inertial mass="1" '
+                    'pos="0 0 0" diaginertia="1 1 1"/><geom class="pad"/></body></worldbody></mujoco>')
+    finger, ghost = link_inertials(read_robot(path), density="model")
+    assert len(finger.warnings) == 2
+    assert "'pad1' is massless in the description (mass=0)" in finger.warnings[0]
+    assert "density=0" in finger.warnings[1]
+    assert finger.properties.mass == pytest.approx(1000 * 0.02 * 0.04 * 0.06, rel=1e-14)
+    assert ghost.properties is None and ghost.problem == "every geom is massless in the description"
+    # with one density for everything the pads count as geometry (the user asked for that density)
+    assert link_inertials(read_robot(path), density=1000)[0].properties.mass > finger.properties.mass
+
+
+@pytest.mark.parametrize("geom", ['type="sphere" size="0.3"', 'type="box" size="0.1 0.2 0.3"',
+                                  'type="cylinder" size="0.1 0.2"', 'type="capsule" size="0.1 0.2"',
+                                  'type="capsule" fromto="0 0 0 0.1 0.2 0.3" size="0.05"'])
+def test_shellinertia_matches_mujoco(tmp_path, geom):
+    path = tmp_path / "s.xml"
+    pose = "" if "fromto" in geom else 'pos="0.1 0.2 0.3" euler="10 20 30"'    # MuJoCo refuses pos with fromto
+    path.write_text(f'<mujoco><compiler inertiafromgeom="true"/><worldbody><body name="b"><freejoint/>'
+                    f'<geom {geom} shellinertia="true" density="3" {pose}/></body></worldbody></mujoco>')
+    _assert_like_mujoco(path, link_inertials(read_robot(path), density="model"), rtol=1e-12)
+
+
+def test_mesh_shell_inertia_matches_mujoco(tmp_path):
+    shapes.write_stl(shapes.cone(0.2, 0.5, segments=32), tmp_path / "cone.stl")
+    path = tmp_path / "s.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true"/><asset><mesh name="m" file="cone.stl" '
+                    'inertia="shell" scale="1 2 1" refpos="0.1 0 0"/></asset><worldbody><body name="b"><freejoint/>'
+                    '<geom type="mesh" mesh="m" density="3" pos="0.1 0.2 0.3"/></body></worldbody></mujoco>')
+    _assert_like_mujoco(path, link_inertials(read_robot(path), density="model"), rtol=1e-9)
+
+
+def test_shell_closed_forms_against_fine_triangulations():
+    # independent: the surface integral of trimesh's fine meshes (exact for the polyhedron) approaches the
+    # closed form as the triangulation refines
+    trimesh = pytest.importorskip("trimesh")
+    cases = [(shell_shapes.sphere_shell(0.3), trimesh.creation.icosphere(subdivisions=6, radius=0.3), 1e-3),
+             (shell_shapes.box_shell((0.2, 0.4, 0.6)), trimesh.creation.box(extents=(0.2, 0.4, 0.6)), 1e-13),
+             (shell_shapes.cylinder_shell(0.1, 0.4), trimesh.creation.cylinder(radius=0.1, height=0.4, sections=2048),
+              1e-5),
+             (shell_shapes.capsule_shell(0.1, 0.4), trimesh.creation.capsule(height=0.4, radius=0.1, count=[256, 256]),
+              1e-3)]
+    for exact, mesh, rtol in cases:
+        moments = surface_moments(mesh.vertices, mesh.faces)
+        assert moments.area == pytest.approx(exact.mass, rel=rtol)
+        c = moments.second_moment
+        assert_tensor_close(np.trace(c) * np.eye(3) - c, exact.inertia, rtol * 3)
+
+
+def test_an_ellipsoid_shell_is_a_reason_not_a_number(tmp_path):
+    path = tmp_path / "e.xml"
+    path.write_text('<mujoco><worldbody><body name="b"><geom type="ellipsoid" size="1 2 3" shellinertia="true"/>'
+                    '</body><body name="c"><geom type="sphere" size="1"/></body></worldbody></mujoco>')
+    b, c = link_inertials(read_robot(path), density="model")
+    assert b.properties is None and "ellipsoid" in b.problem
+    assert c.properties is not None
+
+
+def test_model_densities_need_mjcf():
+    from robot_data import UR5, PACKAGES
+    with pytest.raises(UsageError, match="MJCF"):
+        link_inertials(read_robot(UR5, packages=PACKAGES), density="model")
+
+
+def test_include_cycle_depth_and_missing_file_are_refused(tmp_path):
+    (tmp_path / "a.xml").write_text('<mujoco><include file="b.xml"/></mujoco>')
+    (tmp_path / "b.xml").write_text('<mujoco><include file="a.xml"/></mujoco>')
+    with pytest.raises(RobotDescriptionError, match="includes itself"):
+        read_robot(tmp_path / "a.xml")
+    for k in range(20):
+        (tmp_path / f"d{k}.xml").write_text(f'<mujoco><include file="d{k + 1}.xml"/></mujoco>')
+    (tmp_path / "d20.xml").write_text('<mujoco><worldbody><body name="x"><geom size="1"/></body></worldbody>'
+                                      '</mujoco>')
+    with pytest.raises(RobotDescriptionError, match="nested more than 16 deep"):
+        read_robot(tmp_path / "d0.xml")
+    assert read_robot(tmp_path / "d5.xml").links[0].name == "x"
+    (tmp_path / "m.xml").write_text('<mujoco><include file="nowhere.xml"/></mujoco>')
+    with pytest.raises(RobotDescriptionError, match="nowhere.xml.*no such file"):
+        read_robot(tmp_path / "m.xml")
+    (tmp_path / "u.xml").write_text('<mujoco><include file="r.urdf"/></mujoco>')
+    (tmp_path / "r.urdf").write_text('<robot name="r"/>')
+    with pytest.raises(RobotDescriptionError, match="expected <mujoco>"):
+        read_robot(tmp_path / "u.xml")
+
+
+def test_include_found_beside_the_including_file_and_its_meshdir(tmp_path):
+    # MuJoCo looks in the main model's folder first, then beside the including file; a mesh of an included
+    # file in a sub-folder is found through that file's own meshdir (MuJoCo itself would need it in the main
+    # folder's meshdir: the fallback only applies where MuJoCo finds nothing)
+    sub = tmp_path / "robots" / "arm"
+    (sub / "meshes").mkdir(parents=True)
+    shapes.write_stl(shapes.box(0.1, 0.2, 0.3), sub / "meshes" / "part.stl")
+    (tmp_path / "scene.xml").write_text('<mujoco><include file="robots/arm/arm.xml"/></mujoco>')
+    (sub / "arm.xml").write_text('<mujoco><compiler meshdir="meshes"/><include file="body.xml"/></mujoco>')
+    (sub / "body.xml").write_text('<mujoco><asset><mesh file="part.stl"/></asset><worldbody><body name="b">'
+                                  '<geom type="mesh" mesh="part"/></body></worldbody></mujoco>')
+    (result,) = link_inertials(read_robot(tmp_path / "scene.xml"), density=1000)
+    assert result.properties.mass == pytest.approx(6.0, rel=1e-6)          # float32 STL corners
+    assert read_robot(tmp_path / "scene.xml").links[0].elements[0].mesh == os.path.join(sub, "meshes", "part.stl")
+
+
+def test_partial_size_keeps_the_class_numbers(tmp_path):
+    # size="0.01" on a box whose class says "0.03 0.04 0.05": MuJoCo reads 0.01 0.04 0.05
+    path = tmp_path / "p.xml"
+    path.write_text('<mujoco><default><default class="k"><geom type="box" size="0.03 0.04 0.05"/></default>'
+                    '</default><worldbody><body name="b"><geom class="k" size="0.01"/></body></worldbody></mujoco>')
+    assert read_robot(path).links[0].elements[0].size == pytest.approx((0.02, 0.08, 0.1))
