@@ -6,7 +6,7 @@ import re
 import numpy as np
 import pytest
 
-from inertia_tool.cli import main
+from inertia_tool.cli import EXIT_INCOMPLETE, main
 
 from conftest import assert_tensor_close
 from robot_data import ERD, PANDA, UR5
@@ -99,10 +99,42 @@ def test_an_open_link_mesh_is_reported_with_the_option_that_repairs_it(tmp_path,
     urdf = tmp_path / "r.urdf"
     urdf.write_text('<robot name="r"><link name="holed"><collision><geometry><mesh filename="open.stl"/>'
                     '</geometry></collision></link></robot>')
-    assert main(["robot", str(urdf), "--density", "1000"]) == 0
+    assert main(["robot", str(urdf), "--density", "1000"]) == EXIT_INCOMPLETE    # a link without result
     out = capsys.readouterr().out
     assert "holed: mesh needs repair" in out and "--repair" in out and "`" not in out
+    assert "holed none " in out and out.rstrip().endswith("1 link: 0 computed; 1 without a result: holed")
     assert main(["robot", str(urdf), "--density", "1000", "--repair", "--json"]) == 0
     captured = capsys.readouterr()
-    link = json.loads(captured.out)["links"][0]
+    report = json.loads(captured.out)
+    link = report["links"][0]
     assert link["problem"] is None and link["mass"] > 0 and "repaired" in captured.err
+    assert link["method"] == "estimate" and link["uncertainty"]["mass"] >= 0 and link["warnings"]
+    assert report["links_without_result"] == [] and "1 estimate" in report["summary"]
+
+
+def test_one_bad_link_never_stops_the_others_and_names_stay_whole(tmp_path, capsys):
+    # a zero-volume mesh (a flat sheet, as UR5e's visual wrist1.dae holds) with --repair: that link has no
+    # result and a reason; the long-named link beside it is computed and printed with its full name
+    from conftest import box_arrays, write_binary_stl
+    v, f = box_arrays((0.1, 0.1, 0.1))
+    write_binary_stl(tmp_path / "box.stl", v, f)
+    flat = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], dtype=float)
+    write_binary_stl(tmp_path / "flat.stl", flat, np.array([[0, 1, 2], [1, 3, 2]]))
+    name = "left_shoulder_pitch_link_with_a_long_name"
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text(f'<robot name="r"><link name="sheet"><inertial><mass value="1"/><inertia ixx="1" iyy="1" '
+                    'izz="1" ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><mesh filename="flat.stl"/>'
+                    f'</geometry></collision></link><link name="{name}"><collision><geometry>'
+                    '<mesh filename="box.stl"/></geometry></collision></link><link name="frame"/></robot>')
+    for extra in ([], ["--repair"]):
+        assert main(["robot", str(urdf), "--density", "1000", *extra]) == EXIT_INCOMPLETE
+        out = capsys.readouterr().out
+        assert f"\n{name} exact " in out and re.search(r"\nframe +frame ", out)
+        assert "1 without a result: sheet; 1 without geometry or mass (frames)" in out
+        assert main(["robot", str(urdf), "--density", "1000", "--json", *extra]) == EXIT_INCOMPLETE
+        captured = capsys.readouterr()
+        report = json.loads(captured.out)
+        sheet, long, frame = report["links"]
+        assert sheet["mass"] is None and sheet["method"] is None and sheet["problem"]
+        assert long["method"] == "exact" and long["uncertainty"] is None and long["mass"] == pytest.approx(1.0)
+        assert report["links_without_result"] == ["sheet"] and "without a result: sheet" in captured.err

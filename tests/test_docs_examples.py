@@ -21,6 +21,7 @@ through ``bash`` with ``inertia-tool`` on the PATH as ``python -m inertia_tool``
 install``, a remote Dask scheduler).  ``<!-- slow -->`` marks a block that takes more than a few seconds.
 No example may raise a plausibility warning (a part read in the wrong unit, a correction outside the part):
 an example that does teaches the mistake, unless it is there to show the warning (``<!-- warns -->``).
+``<!-- exits-N -->`` marks a block whose commands exit with the documented code N instead.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ ROOT = Path(__file__).resolve().parent.parent
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), ROOT / "meshes" / "README.md"]
 RUN_LANGUAGES = ("bash", "console", "python")
 _FENCE = re.compile(r"^```(\w*)\s*$")
-_MARK = re.compile(r"<!--\s*(no-test|slow|warns)\s*-->")
+_MARK = re.compile(r"<!--\s*(no-test|slow|warns|exits-\d)\s*-->")
 
 
 def extract_blocks(path: Path) -> list[dict]:
@@ -142,20 +143,24 @@ def _check_plausible(line: str, stderr: str) -> None:
     assert not found, f"`{line}` printed a plausibility warning:\n{stderr[-2000:]}"
 
 
-def _run_command(line: str, env: dict, cwd: Path, capsys, *, warns: bool = False) -> str:
-    """Run one command line; it must exit with 0.  Returns what it printed (stdout, then stderr)."""
+def _expected_code(marks: set) -> int:
+    return next((int(m.split("-")[1]) for m in marks if m.startswith("exits-")), 0)
+
+
+def _run_command(line: str, env: dict, cwd: Path, capsys, *, warns: bool = False, expect: int = 0) -> str:
+    """Run one command line; it must exit with ``expect`` (0).  Returns what it printed (stdout, then stderr)."""
     words = shlex.split(line, comments=True)
     if words and words[0] == "inertia-tool" and not _SHELL.search(line.split("#")[0]):
         from inertia_tool.cli import main
         code = main(words[1:])
         captured = capsys.readouterr()
-        assert code == 0, f"`{line}` exited with {code}:\n{captured.err[-2000:]}"
+        assert code == expect, f"`{line}` exited with {code}:\n{captured.err[-2000:]}"
         if not warns:
             _check_plausible(line, captured.err)
         return captured.out + captured.err
     result = subprocess.run(["bash", "-o", "pipefail", "-c", line], cwd=cwd, env=env, capture_output=True,
                             text=True, timeout=300)
-    assert result.returncode == 0, f"`{line}` exited with {result.returncode}:\n{result.stderr[-2000:]}"
+    assert result.returncode == expect, f"`{line}` exited with {result.returncode}:\n{result.stderr[-2000:]}"
     if not warns:
         _check_plausible(line, result.stderr)
     return result.stdout + result.stderr
@@ -217,11 +222,13 @@ def test_docs_example_runs(page, blocks, sandbox, capsys):
         else:
             if b["language"] == "console":
                 for line, shown in console_pairs(b):
-                    printed = _run_command(line, env, cwd, capsys, warns="warns" in b["marks"])
+                    printed = _run_command(line, env, cwd, capsys, warns="warns" in b["marks"],
+                                           expect=_expected_code(b["marks"]))
                     check_shown_output(line, shown, printed)
             else:
                 for line in commands(b):
-                    printed = _run_command(line, env, cwd, capsys, warns="warns" in b["marks"])
+                    printed = _run_command(line, env, cwd, capsys, warns="warns" in b["marks"],
+                                           expect=_expected_code(b["marks"]))
                     if "shown" in b:
                         check_shown_output(line, b["shown"], printed)
 

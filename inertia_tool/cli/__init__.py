@@ -4,10 +4,10 @@ Routing and formatting only; every number comes from the engine.  Each subcomman
 in this package exposing ``register(subparsers)``, which adds a parser whose ``func(args) -> int`` runs it.
 
 Exit codes (README): 0 success, 2 usage error, 3 unreadable or invalid mesh, 4 a physically impossible
-request, 1 an unexpected internal error (reported in one line, never a traceback; ``INERTIA_TOOL_DEBUG=1``
-shows the traceback).  :data:`EXIT_CODES` maps the engine's exception types to them, and
-:func:`speak_options` turns the API parameter names in engine messages into this command's options: the
-engine knows nothing of either.
+request, 5 ``robot``: a link without a result (the others reported), 1 an unexpected internal error
+(reported in one line, never a traceback; ``INERTIA_TOOL_DEBUG=1`` shows the traceback).
+:data:`EXIT_CODES` maps the engine's exception types to them, and :func:`speak_options` turns the API
+parameter names in engine messages into this command's options: the engine knows nothing of either.
 """
 
 from __future__ import annotations
@@ -26,13 +26,15 @@ from ..reports.escape import escape_terminal
 from .help import SUMMARIES
 
 __all__ = ["main", "build_parser", "exit_code", "speak_options", "EXIT_CODES", "EXIT_OK", "EXIT_INTERNAL",
-           "EXIT_USAGE", "EXIT_MESH", "EXIT_PHYSICS"]
+           "EXIT_USAGE", "EXIT_MESH", "EXIT_PHYSICS", "EXIT_INCOMPLETE"]
 
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_USAGE = 2
 EXIT_MESH = 3
 EXIT_PHYSICS = 4
+#: ``robot``: the report is complete except for links that have no result (each named with its reason).
+EXIT_INCOMPLETE = 5
 
 #: Exit code of each exception type; the most specific class of an exception's MRO that is listed wins.
 EXIT_CODES = {

@@ -9,13 +9,13 @@ import sys
 
 from ..errors import UsageError
 from ..mesh.options import DEFAULT_MAX_FACES
-from ..reports.robot_audit import format_robot_report, robot_report_dict
+from ..reports.robot_audit import format_robot_report, links_without_result, robot_report_dict, summary_line
 from ..robot.audit import audit_links
 from ..robot.description import GEOMETRY_KINDS, read_robot
-from ..robot.geometry import link_inertials
+from ..robot.geometry import MODEL_DENSITY, link_inertials
 from ..robot.write import write_corrected
 from ..units import MATERIALS, parse_density
-from . import speak_options
+from . import EXIT_INCOMPLETE, EXIT_OK, speak_options
 from .help import add_command
 from .options import check_option
 from ..reports.escape import escape_terminal
@@ -50,7 +50,9 @@ def register(subparsers) -> None:
     p.add_argument("--geometry", choices=GEOMETRY_KINDS, default="collision",
                    help="which geometry of each link to integrate (default: collision)")
     m = p.add_mutually_exclusive_group(required=True)
-    m.add_argument("--density", metavar="RHO", help="density of every link, kg/m³ by default (or e.g. 2.7g/cm3)")
+    m.add_argument("--density", metavar="RHO",
+                   help="density of every link, kg/m³ by default (or e.g. 2.7g/cm3); 'model' takes the MJCF "
+                        "file's own geom density, mass and shellinertia (massless geoms are named)")
     m.add_argument("--material", metavar="NAME", help=f"material of every link: {', '.join(sorted(MATERIALS))}")
     m.add_argument("--keep-mass", action="store_true",
                    help="keep each link's declared mass and take its distribution from the geometry "
@@ -103,8 +105,10 @@ def run(args) -> int:
                          "(--force overwrites it)")
     check_output_file(args.write, "--write", args.force)
     check_option("--max-faces", args.max_faces)
-    density = check_option("--density", parse_density(args.density), typed=args.density) \
-        if args.density is not None else None
+    density: float | str | None = None
+    if args.density is not None:
+        density = (MODEL_DENSITY if args.density.strip() == MODEL_DENSITY
+                   else check_option("--density", parse_density(args.density), typed=args.density))
     robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings,
                        run_xacro=args.run_xacro)
     inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
@@ -124,4 +128,8 @@ def run(args) -> int:
     else:
         # engine sentences name API parameters (`repair=True`); here they name this command's options
         print(speak_options(format_robot_report(robot, inertials, audits), getattr(args, "robot_parser", None)))
-    return 0
+    if links_without_result(robot, inertials):
+        if args.json:        # the table ends with the same line
+            print(escape_terminal(f"inertia-tool robot: {summary_line(robot, inertials)}"), file=sys.stderr)
+        return EXIT_INCOMPLETE
+    return EXIT_OK

@@ -13,7 +13,38 @@ from ..robot.description import RobotDescription
 from ..robot.geometry import LinkInertial
 from .serialize import TENSOR_CONVENTION, to_jsonable
 
-__all__ = ["robot_report_dict", "format_robot_report"]
+__all__ = ["robot_report_dict", "format_robot_report", "links_without_result", "summary_line"]
+
+
+def links_without_result(robot: RobotDescription, inertials) -> list:
+    """The results that are missing although the link has geometry or a declared mass (a virtual frame —
+    no geometry, no mass — has nothing to compute and is not counted)."""
+    geometry = {link.name: link for link in robot.links}
+    out = []
+    for result in inertials:
+        link = geometry[result.name]
+        declared_mass = link.declared is not None and link.declared.mass > 0
+        if result.properties is None and (link.elements or declared_mass):
+            out.append(result)
+    return out
+
+
+def summary_line(robot: RobotDescription, inertials) -> str:
+    """One line: how many links were computed, by which method, and which have no result."""
+    computed = [r for r in inertials if r.properties is not None]
+    methods: dict = {}
+    for r in computed:
+        methods[r.method] = methods.get(r.method, 0) + 1
+    by_method = ", ".join(f"{n} {m}" for m, n in sorted(methods.items()))
+    missing = links_without_result(robot, inertials)
+    text = (f"{len(inertials)} link{'' if len(inertials) == 1 else 's'}: {len(computed)} computed"
+            + (f" ({by_method})" if by_method else ""))
+    if missing:
+        text += f"; {len(missing)} without a result: {', '.join(r.name for r in missing)}"
+    frames = len(inertials) - len(computed) - len(missing)
+    if frames:
+        text += f"; {frames} without geometry or mass (frames)"
+    return text
 
 
 def _declared_dict(audit: LinkAudit):
@@ -58,6 +89,11 @@ def robot_report_dict(robot: RobotDescription, inertials, audits) -> dict:
             "inertia": None if props is None else props.inertia,
             "geometry": [{"kind": e.kind, "name": e.name, "mesh": e.uri} for e in geometry.elements],
             "problem": result.problem,
+            "method": result.method,
+            "uncertainty": None if result.uncertainty is None else {
+                "mass": result.uncertainty.mass, "center_of_mass": result.uncertainty.center_of_mass,
+                "inertia": result.uncertainty.inertia},
+            "warnings": list(result.warnings),
             "declared": _declared_dict(audit),
             "audit": _audit_dict(audit),
         })
@@ -71,6 +107,8 @@ def robot_report_dict(robot: RobotDescription, inertials, audits) -> dict:
         "inertia_convention": TENSOR_CONVENTION,
         "density_range": list(DENSITY_RANGE),
         "links": links,
+        "summary": summary_line(robot, inertials),
+        "links_without_result": [r.name for r in links_without_result(robot, inertials)],
     })
 
 
@@ -88,17 +126,20 @@ def format_robot_report(robot: RobotDescription, inertials, audits) -> str:
              "centre of mass in the link frame; ΔCOM = |declared − geometry|; ΔI = relative Frobenius difference "
              "of the tensors at equal mass",
              ""]
-    header = (f"{'link':<22} {'mass kg':>10} {'declared kg':>12} {'ΔCOM mm':>9} {'ΔI':>8} {'implied ρ':>10}  "
-              f"{'COM inside':<10} {'issues':>6}")
+    width = max([4] + [len(r.name) for r in inertials])
+    header = (f"{'link':<{width}} {'method':<8} {'mass kg':>10} {'declared kg':>12} {'ΔCOM mm':>9} {'ΔI':>8} "
+              f"{'implied ρ':>10}  {'COM inside':<10} {'issues':>6}")
     lines += [header, "-" * len(header)]
     inertial: LinkInertial
+    missing = links_without_result(robot, inertials)
     for inertial, audit in zip(inertials, audits):
         props = inertial.properties
         declared = audit.declared
         inside = {True: "yes", False: "no", None: "-"}[audit.com_inside_geometry]
         if audit.com_in_bounding_box is False:
             inside = "no (box)"
-        lines.append(f"{inertial.name[:22]:<22} {_fmt(props.mass if props else None, '10.4g'):>10} "
+        method = inertial.method or ("frame" if inertial not in missing else "none")
+        lines.append(f"{inertial.name:<{width}} {method:<8} {_fmt(props.mass if props else None, '10.4g'):>10} "
                      f"{_fmt(declared.mass if declared else None, '12.4g'):>12} "
                      f"{_fmt(audit.com_distance * 1e3, '9.1f'):>9} {_fmt(audit.inertia_difference, '8.0%'):>8} "
                      f"{_fmt(audit.implied_density, '10.4g'):>10}  {inside:<10} {len(audit.issues):>6}")
@@ -110,4 +151,11 @@ def format_robot_report(robot: RobotDescription, inertials, audits) -> str:
                 lines.append(f"  {result.name}: {issue}")
     else:
         lines += ["", "no issues found"]
+    noted = [(r.name, w) for r in inertials for w in r.warnings]
+    if noted:
+        lines += ["", "warnings:"] + [f"  {name}: {w}" for name, w in noted]
+    without = [r for r in missing if not any(r.problem in i for a in audits if a.name == r.name for i in a.issues)]
+    if without:
+        lines += ["", "no result:"] + [f"  {r.name}: {r.problem}" for r in without]
+    lines += ["", summary_line(robot, inertials)]
     return "\n".join(line for k, line in enumerate(lines) if line or k > 1)
