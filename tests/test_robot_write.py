@@ -661,3 +661,75 @@ def test_sdf_values_written_over_entities_and_comments_hold_only_the_new_number(
             inertials[0].properties.mass if tag == "mass" else np.diag(inertials[0].properties.inertia)[
                 {"ixx": 0, "izz": 2}[tag]], rel=1e-15)
     _check_copy(sdf, out, "sdf", inertials)
+
+
+# -- a copy written to another folder loads there (issue 23 item 3) ---------------------------------------
+
+def test_mjcf_written_to_another_folder_loads_in_mujoco(tmp_path):
+    # go1, 2f85, ur5e, g1: a relative meshdir was copied as it was, so the copy found no meshes
+    mujoco = pytest.importorskip("mujoco")
+    from inertia_tool.mass import shapes
+    src = tmp_path / "robot"
+    (src / "assets").mkdir(parents=True)
+    (src / "textures").mkdir()
+    shapes.write_stl(shapes.cone(0.02, 0.05, segments=24), src / "assets" / "cone.stl")
+    shapes.write_stl(shapes.box(0.01, 0.02, 0.03), src / "plain.stl")
+    (src / "parts.xml").write_text('<mujoco><default><geom density="900"/></default></mujoco>')
+    model = src / "m.xml"
+    model.write_text('<mujoco model="m">\n  <compiler angle="radian" meshdir="assets/"/>\n'
+                     '  <include file="parts.xml"/>\n'
+                     '  <asset>\n    <mesh name="cone" file="cone.stl"/>\n  </asset>\n'
+                     '  <worldbody>\n    <body name="b">\n      <freejoint/>\n'
+                     '      <geom type="mesh" mesh="cone"/>\n    </body>\n  </worldbody>\n</mujoco>\n')
+    out_dir = tmp_path / "elsewhere" / "deeper"
+    out_dir.mkdir(parents=True)
+    out = out_dir / "m_fixed.xml"
+    robot = read_robot(model)
+    results = link_inertials(robot, density=900)
+    write_corrected(robot, results, out)
+    text = out.read_text()
+    assert 'meshdir="../../robot/assets/"' in text and 'file="../../robot/parts.xml"' in text
+    compiled = mujoco.MjModel.from_xml_path(str(out))             # loads where it was written
+    assert compiled.body("b").mass[0] == pytest.approx(results[0].properties.mass, rel=1e-12)
+    # the same folder: no path changes at all
+    same = src / "m_same.xml"
+    write_corrected(robot, link_inertials(robot, density=900), same)
+    assert 'meshdir="assets/"' in same.read_text()
+    # no meshdir: each asset file is re-expressed instead
+    model.write_text(model.read_text().replace(' meshdir="assets/"', "").replace('file="cone.stl"',
+                                                                                'file="assets/cone.stl"'))
+    robot = read_robot(model)
+    out2 = out_dir / "m2.xml"
+    write_corrected(robot, link_inertials(robot, density=900), out2)
+    assert 'file="../../robot/assets/cone.stl"' in out2.read_text()
+    mujoco.MjModel.from_xml_path(str(out2))
+
+
+def test_urdf_and_sdf_written_to_another_folder_read_back_with_their_meshes(tmp_path):
+    from inertia_tool.mass import shapes
+    src = tmp_path / "src"
+    (src / "meshes").mkdir(parents=True)
+    shapes.write_stl(shapes.box(0.1, 0.2, 0.3), src / "meshes" / "b.stl")
+    urdf = src / "r.urdf"
+    urdf.write_text('<robot name="r">\n  <link name="a">\n    <collision><geometry><mesh filename="meshes/b.stl"/>'
+                    '</geometry></collision>\n  </link>\n  <link name="c">\n    <collision><geometry>'
+                    '<mesh filename="file://meshes/b.stl" scale="1 1 1"/></geometry></collision>\n  </link>\n'
+                    '  <link name="p">\n    <collision><geometry><mesh filename="package://pkg/b.stl"/></geometry>'
+                    '</collision>\n  </link>\n</robot>\n')
+    sdf = src / "m.sdf"
+    sdf.write_text('<sdf version="1.7">\n  <model name="m">\n    <link name="a">\n      <collision name="c">\n'
+                   '        <geometry><mesh><uri>meshes/b.stl</uri></mesh></geometry>\n      </collision>\n'
+                   '    </link>\n  </model>\n</sdf>\n')
+    out = tmp_path / "out"
+    out.mkdir()
+    packages = {"pkg": src / "meshes"}
+    for path in (urdf, sdf):
+        robot = read_robot(path, packages=packages)
+        target = out / path.name
+        write_corrected(robot, link_inertials(robot, density=1000), target)
+        again = read_robot(target, packages=packages)
+        assert all(e.mesh == str(src / "meshes" / "b.stl") for link in again.links for e in link.elements)
+    text = (out / "r.urdf").read_text()
+    assert 'filename="../src/meshes/b.stl"' in text and 'filename="file://../src/meshes/b.stl" scale="1 1 1"' in text
+    assert 'filename="package://pkg/b.stl"' in text
+    assert "<uri>../src/meshes/b.stl</uri>" in (out / "m.sdf").read_text()

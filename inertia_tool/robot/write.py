@@ -40,7 +40,7 @@ from ..output import check_targets, write_bytes
 from .description import RobotDescription, parse_xml
 from .xmlspans import DocumentText, ElementSpan, XMLSpanError, decode_document, element_spans
 
-__all__ = ["write_corrected", "corrected_document"]
+__all__ = ["write_corrected", "corrected_document", "rewrite_paths"]
 
 _ORIENTATION_KEYS = ("quat", "axisangle", "euler", "xyaxes", "zaxis", "diaginertia", "fullinertia")
 
@@ -199,6 +199,97 @@ def _pretty(data: bytes, source: str) -> bytes:
     return etree.tostring(tree, xml_declaration=True, encoding="utf-8") + b"\n"
 
 
+# -- paths that must stay right when the file is written to another folder ----------------------------------
+
+#: MJCF asset elements whose ``file`` is relative to a compiler folder, and which folder attributes govern it.
+_MJCF_ASSET_FOLDERS = {"mesh": ("meshdir", "assetdir"), "texture": ("texturedir", "assetdir"),
+                       "hfield": ("assetdir",), "skin": ("assetdir",)}
+
+
+def _moved(value: str, source_dir: str, out_dir: str) -> str | None:
+    """``value`` (a relative path, or ``file://`` + one) re-expressed relative to ``out_dir``; None when it
+    needs no change (absolute, another scheme, empty)."""
+    text = value.strip()
+    prefix = ""
+    if text.startswith("file://"):
+        prefix, text = "file://", text[len("file://"):]
+    elif "://" in text:
+        return None
+    if not text or os.path.isabs(text):
+        return None
+    target = os.path.normpath(os.path.join(source_dir, text))
+    moved = os.path.relpath(target, out_dir).replace(os.sep, "/")
+    if text.endswith(("/", os.sep)) and not moved.endswith("/"):
+        moved += "/"
+    return prefix + moved if moved != text else None
+
+
+def _mjcf_included_folders(robot: RobotDescription) -> set:
+    """Compiler folder attributes that an included file sets (a moved main file cannot fix those)."""
+    from .mjcf import _expand_includes
+    root = parse_xml(robot.document, robot.source).getroot()
+    own = set(id(c) for c in root.iter("compiler"))
+    try:
+        _expand_includes(root, robot.source)
+    except Exception:  # noqa: BLE001 - read_robot already expanded it; this is only a second look
+        return set()
+    return {key for c in root.iter("compiler") if id(c) not in own for key in c.attrib}
+
+
+def rewrite_paths(robot: RobotDescription, root, out_dir: str | None) -> list:
+    """Make the relative file references of the tree ``root`` (the description's document) right for a
+    copy written in ``out_dir``; returns the elements changed (in place).
+
+    URDF: ``<mesh filename>`` (plain relative paths and ``file://`` + a relative path); SDFormat: the text
+    of ``<mesh><uri>``; MJCF: ``<compiler meshdir/assetdir/texturedir>``, ``<include file>`` and the ``file``
+    of ``<mesh>``/``<texture>``/``<hfield>``/``<skin>`` assets that no folder attribute governs.
+    ``package://`` and ``model://`` URIs and absolute paths are left alone.  Nothing changes when
+    ``out_dir`` is the description's own folder (or None).
+    """
+    source_dir = os.path.dirname(os.path.abspath(robot.source))
+    if out_dir is None or os.path.realpath(out_dir) == os.path.realpath(source_dir):
+        return []
+    changed = []
+
+    def move(element, attribute: str | None) -> None:
+        if attribute is None:
+            new = _moved(element.text or "", source_dir, out_dir)
+            if new is not None:
+                element.text = new
+                changed.append(element)
+            return
+        value = element.get(attribute)
+        new = _moved(value, source_dir, out_dir) if value is not None else None
+        if new is not None:
+            element.set(attribute, new)
+            if element not in changed:
+                changed.append(element)
+
+    if robot.format in ("urdf", "xacro"):
+        for mesh in root.iter("mesh"):
+            move(mesh, "filename")
+    elif robot.format == "sdf":
+        for uri in root.iter("uri"):
+            if uri.getparent() is not None and uri.getparent().tag == "mesh":
+                move(uri, None)
+    else:
+        folders: set = set()
+        for compiler in root.iter("compiler"):
+            for key in ("meshdir", "assetdir", "texturedir"):
+                if compiler.get(key) is not None:
+                    folders.add(key)
+                    move(compiler, key)
+        folders |= _mjcf_included_folders(robot)
+        for include in root.iter("include"):
+            move(include, "file")
+        for tag, governing in _MJCF_ASSET_FOLDERS.items():
+            if any(key in folders for key in governing):
+                continue
+            for asset in root.iter(tag):
+                move(asset, "file")
+    return changed
+
+
 def _elements_in_order(root) -> list:
     """The elements under and including ``root`` in document order (no comments, PIs or entity references)."""
     from lxml import etree
@@ -209,7 +300,8 @@ def _local(tag: str) -> str:
     return tag.rsplit("}", 1)[-1].rsplit(":", 1)[-1]
 
 
-def corrected_document(robot: RobotDescription, inertials, *, note: str = "") -> bytes:
+def corrected_document(robot: RobotDescription, inertials, *, note: str = "",
+                       out_dir: str | None = None) -> bytes:
     """The description's bytes with the inertials of the links in ``inertials`` replaced, checked.
 
     Only the bytes of each replaced ``<inertial>`` element change (a missing one is inserted), plus one
@@ -224,6 +316,9 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "") ->
         Links with ``properties`` None are left untouched.
     note : str
         Appended to the provenance comment (e.g. the density basis).
+    out_dir : str, optional
+        The folder the copy will be written to: relative file references are re-expressed from there
+        (:func:`rewrite_paths`), so the copy loads where it is written.
 
     Returns
     -------
@@ -242,6 +337,7 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "") ->
     root = expected.getroot()
     order = {element: k for k, element in enumerate(_elements_in_order(root))}    # before any edit
     elements = _links(root, robot.format)
+    moved = rewrite_paths(robot, root, out_dir)
     writer = {"urdf": _urdf_inertial, "xacro": _urdf_inertial, "sdf": _sdf_inertial,
               "mjcf": _mjcf_inertial}[robot.format]
     changed = []
@@ -250,7 +346,7 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "") ->
             continue
         writer(elements[result.name], result.properties)
         changed.append(result.name)
-    if not changed:
+    if not changed and not moved:
         return base
     comment = _provenance(robot, changed, note)
     try:
@@ -259,12 +355,38 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "") ->
         _check_alignment(spans, order, robot.source)
         edits = _edits(document.text, spans, order, [elements[name] for name in changed], comment,
                        _old_provenance(original.getroot()) is not None)
+        edits = sorted(edits + _path_edits(spans, order, moved), key=lambda e: (e[0], e[1]))
+        for (_, end, _r), (start, _e, _s) in zip(edits, edits[1:]):
+            if start < end:
+                raise XMLSpanError(f"two edits overlap at offset {start}")
         out = _apply(document, base, edits)
     except (XMLSpanError, UnicodeError) as exc:
         raise OutputCheckError(f"{robot.source}: cannot edit its <inertial> elements in place ({exc}); "
                                "nothing was written") from None
+    if moved:             # the input as it should read after the same path rewrites: the reference of the check
+        original = parse_xml(base, robot.source)
+        rewrite_paths(robot, original.getroot(), out_dir)
     _verify(original, expected, out, robot, changed, comment)
     return out
+
+
+def _path_edits(spans: list, order: dict, moved: list) -> list:
+    """Edits replacing the start tag (attributes) or, for a text-only element, the whole element of each
+    element whose path was rewritten."""
+    from lxml import etree
+    edits = []
+    for element in moved:
+        span = spans[order[element]]
+        if len(element) == 0 and element.text is not None and not span.empty:      # SDFormat <uri>text</uri>
+            edits.append((span.start, span.end, _serialized(element, "\n")))
+            continue
+        shallow = etree.Element(element.tag, dict(element.attrib), nsmap=element.nsmap)
+        tag = etree.tostring(shallow, encoding="unicode")
+        if span.empty:
+            edits.append((span.start, span.end, tag))
+        else:
+            edits.append((span.start, span.start_end, tag[:-2] + ">"))
+    return edits
 
 
 def _check_alignment(spans: list, order: dict, source: str) -> None:
@@ -522,6 +644,6 @@ def write_corrected(robot: RobotDescription, inertials, path, *, force: bool = F
             and os.path.samefile(path, robot.source)):
         raise UsageError(f"{path}: is the input description; refusing to overwrite it (`force=True` does)")
     check_targets([path], force=force)
-    data = corrected_document(robot, inertials, note=note)
+    data = corrected_document(robot, inertials, note=note, out_dir=os.path.dirname(os.path.abspath(path)))
     write_bytes(path, data, replace=force)
     return tuple(dict.fromkeys(r.name for r in inertials if r.properties is not None))
