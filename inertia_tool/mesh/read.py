@@ -831,6 +831,27 @@ def _declared_scale(path: str, suffix: str, loaded) -> tuple[float, str] | None:
     return scale, f"{scale:g} m"
 
 
+#: COLLADA elements that say how a surface looks, not where it is: dropped by :func:`_collada_geometry_only`.
+_COLLADA_APPEARANCE = ("library_images", "library_effects", "library_materials", "bind_material")
+
+
+def _collada_geometry_only(path: str):
+    """The COLLADA file ``path`` without images, effects, materials and material bindings (a file object):
+    what is not geometry cannot stop the geometry from being read."""
+    import io
+
+    from lxml import etree
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False)
+    with open_regular(path) as fh:
+        tree = etree.parse(fh, parser)
+    for element in list(tree.iter()):
+        if isinstance(element.tag, str) and element.tag.rsplit("}", 1)[-1] in _COLLADA_APPEARANCE:
+            parent = element.getparent()
+            if parent is not None:
+                parent.remove(element)
+    return io.BytesIO(etree.tostring(tree))
+
+
 def _read_with_trimesh(path: str, max_faces: int):
     """``(vertices, faces, declared unit)`` of a file trimesh reads (see :func:`_read_with_trimesh_rounding`)."""
     vertices, faces, declared, _ = _read_with_trimesh_rounding(path, max_faces)
@@ -900,6 +921,11 @@ def _read_with_trimesh_rounding(path: str, max_faces: int):
                 with open_regular(path) as fh:
                     loaded = trimesh.load(fh, file_type=suffix[1:], process=False, force=None,
                                           resolver=regular_file_resolver(path), **extra)
+                if suffix == ".dae" and isinstance(loaded, trimesh.Scene) and not loaded.geometry:
+                    # pycollada drops every geometry bound to a material it cannot build (an <image> without
+                    # a path: Gazebo's pulley.dae, gear.dae, disk.dae); read the geometry alone
+                    loaded = trimesh.load(_collada_geometry_only(path), file_type="dae", process=False,
+                                          force=None)
             finally:
                 quiet.setLevel(level)
             declared = _declared_scale(path, suffix, loaded)

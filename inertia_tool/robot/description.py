@@ -309,14 +309,31 @@ def _scale(values: np.ndarray, what: str, source: str) -> np.ndarray:
     return values
 
 
+#: An XML declaration after leading comments (osrf gazebo_models ``mpl_right_arm/model.sdf`` puts its licence
+#: first): not well-formed XML, but what Gazebo reads.  Only comments and whitespace may come before it.
+_LATE_DECLARATION = re.compile(rb"\A(\xef\xbb\xbf)?((?:\s*<!--.*?-->)+\s*)(<\?xml\s[^?]*\?>)", re.DOTALL)
+
+
 def parse_xml(data: bytes, source: str):
-    """An lxml tree of ``data`` keeping comments and whitespace; no entity expansion, no network."""
+    """An lxml tree of ``data`` keeping comments and whitespace; no entity expansion, no network.
+
+    A declaration that follows leading comments (not allowed by XML 1.0, read by Gazebo) is read as if it
+    were blank: the same bytes with the declaration replaced by spaces, so offsets stay those of the input.
+    """
     from lxml import etree
     parser = etree.XMLParser(remove_blank_text=False, remove_comments=False, resolve_entities=False,
                              no_network=True, huge_tree=False)
     try:
         return etree.fromstring(data, parser).getroottree()
     except etree.XMLSyntaxError as exc:
+        late = _LATE_DECLARATION.match(data)
+        declared = re.search(rb"encoding\s*=\s*[\"']([^\"']*)", late.group(3)) if late is not None else None
+        if late is not None and (declared is None or declared.group(1).lower() in (b"utf-8", b"utf8")):
+            blanked = data[:late.start(3)] + b" " * len(late.group(3)) + data[late.end(3):]
+            try:
+                return etree.fromstring(blanked, parser).getroottree()
+            except etree.XMLSyntaxError:
+                pass
         raise _fail(source, f"not well-formed XML ({exc})") from None
 
 
@@ -561,24 +578,94 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
                         "ellipsoid or mesh)")
 
 
+#: Deepest chain of SDFormat ``<include>`` and nested ``<model>`` followed.
+MAX_SDF_NESTING = 16
+
+
+def _sdf_include_file(include, base: str, packages: dict, source: str) -> str:
+    """The SDFormat file an ``<include><uri>`` names: a file, or a model folder (its ``model.config``'s
+    ``<sdf>`` file, else ``model.sdf``)."""
+    uri = (include.findtext("uri") or "").strip()
+    if not uri:
+        raise _fail(source, "<include> without a <uri>")
+    scheme, sep, rest = uri.partition("://")
+    if sep and scheme in ("model", "package"):
+        name, _, inner = rest.partition("/")
+        directory = package_directory(name, packages, scheme=scheme, near=base)
+        if directory is None:
+            raise _fail(source, f"<include> {uri!r}: cannot find model {name!r} (not among the packages given, "
+                                "not on GZ_SIM_RESOURCE_PATH/GAZEBO_MODEL_PATH, not beside the model's folder)")
+        path = os.path.join(directory, inner)
+    elif sep and scheme == "file":
+        path = rest if os.path.isabs(rest) else os.path.join(base, rest)
+    elif sep:
+        raise _fail(source, f"<include> {uri!r}: unsupported URI scheme {scheme!r}")
+    else:
+        path = uri if os.path.isabs(uri) else os.path.join(base, uri)
+    path = os.path.normpath(path)
+    if os.path.isdir(path):
+        config = os.path.join(path, "model.config")
+        named = None
+        if os.path.isfile(config):
+            tree = parse_xml(_read_bytes(config), config)
+            named = next(((e.text or "").strip() for e in tree.getroot().iter("sdf") if (e.text or "").strip()),
+                         None)
+        path = os.path.join(path, named or "model.sdf")
+    if not os.path.isfile(path):
+        raise _fail(source, f"<include> {uri!r}: resolves to {path}, which does not exist")
+    return path
+
+
+def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, source: str, stack: tuple) -> list:
+    """The links of ``model`` and of its nested and included models (names prefixed ``model::``)."""
+    if len(stack) > MAX_SDF_NESTING:
+        raise _fail(source, f"models nested or included more than {MAX_SDF_NESTING} deep")
+    links = []
+    for child in model:
+        if not isinstance(child.tag, str):
+            continue
+        if child.tag == "link":
+            name = child.get("name")
+            if not name:
+                raise _fail(source, "a <link> without a name")
+            elements = tuple(_sdf_geometry(el, prefix + name, f"{geometry} {k + 1}", base, packages, source)
+                             for k, el in enumerate(child.findall(geometry)))
+            links.append(LinkGeometry(name=prefix + name, elements=elements, declared=_sdf_inertial(child, source)))
+        elif child.tag == "model":
+            links += _sdf_links(child, f"{prefix}{child.get('name', '')}::", base, packages, geometry, source,
+                                stack + (f"model {child.get('name')}",))
+        elif child.tag == "include":
+            path = _sdf_include_file(child, base, packages, source)
+            key = os.path.realpath(path)
+            if key in stack:
+                raise _fail(source, f"<include> of {path} includes itself")
+            root = parse_xml(_read_bytes(path), path).getroot()
+            inner = root.findall("model")
+            if root.tag != "sdf" or len(inner) > 1:
+                raise _fail(source, f"<include>: {path} is not an SDFormat file with one <model>")
+            if not inner:           # a light, an actor: nothing with mass
+                continue
+            name = (child.findtext("name") or "").strip() or inner[0].get("name", "")
+            links += _sdf_links(inner[0], f"{prefix}{name}::", os.path.dirname(path), packages, geometry, source,
+                                stack + (key,))
+    return links
+
+
 def _read_sdf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
+    """Links of the SDFormat ``<model>`` (or of every model of a ``<world>``), nested and included models
+    read too; their links are named ``model::link`` as SDFormat scopes them."""
     if root.tag != "sdf":
         raise _fail(source, f"not an SDFormat file: the root element is <{root.tag}>, expected <sdf>")
-    models = root.findall("model") + root.findall("world/model")
-    if len(models) != 1:
-        raise _fail(source, f"expected one <model>, found {len(models)}")
-    model = models[0]
-    if model.find("include") is not None or model.find("model") is not None:
-        raise _fail(source, "nested <model> and <include> are not supported; give the included model's file")
-    links = []
-    for link in model.findall("link"):
-        name = link.get("name")
-        if not name:
-            raise _fail(source, "a <link> without a name")
-        elements = tuple(_sdf_geometry(el, name, f"{geometry} {k + 1}", base, packages, source)
-                         for k, el in enumerate(link.findall(geometry)))
-        links.append(LinkGeometry(name=name, elements=elements, declared=_sdf_inertial(link, source)))
-    return model.get("name", ""), tuple(links)
+    models = root.findall("model")
+    worlds = root.findall("world")
+    if models and len(models) == 1 and not worlds:
+        model = models[0]
+        links = _sdf_links(model, "", base, packages, geometry, source, (os.path.realpath(source),))
+        return model.get("name", ""), tuple(links)
+    if len(worlds) == 1 and not models:
+        links = _sdf_links(worlds[0], "", base, packages, geometry, source, (os.path.realpath(source),))
+        return worlds[0].get("name", ""), tuple(links)
+    raise _fail(source, f"expected one <model> or one <world>, found {len(models)} models and {len(worlds)} worlds")
 
 
 # -- entry point -------------------------------------------------------------------------------------------

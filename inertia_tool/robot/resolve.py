@@ -4,7 +4,11 @@ Rules, in order (the first that names an existing directory wins; the file must 
 
 * ``package://NAME/rest`` and ``model://NAME/rest``: the directory given for ``NAME`` in ``packages``; else
   each entry ``D`` of ``ROS_PACKAGE_PATH`` (and, for ``model://``, of ``GZ_SIM_RESOURCE_PATH`` and
-  ``GAZEBO_MODEL_PATH``) holding ``D/NAME``, or ``D`` itself when its last component is ``NAME``.
+  ``GAZEBO_MODEL_PATH``) holding ``D/NAME``, or ``D`` itself when its last component is ``NAME``; else
+  the folders around the description, without any environment variable: walking up from ``base`` (at most
+  :data:`MAX_FOLDERS_UP` levels), a folder ``A`` that is the package (its name is ``NAME`` and, for
+  ``package://``, it holds a ``package.xml``; or its ``package.xml`` names ``NAME``) or holds it as
+  ``A/NAME`` (a sibling model of a Gazebo model folder, a sibling package of a ROS workspace).
 * ``file:///abs/path`` is the absolute path; ``file://rel/path`` and a plain relative path are relative to
   ``base`` (the description's directory, or MuJoCo's ``meshdir``); an absolute path is itself.
 
@@ -20,14 +24,56 @@ from urllib.parse import unquote
 from ..errors import RobotDescriptionError
 from ..mesh.regular import not_regular_reason
 
-__all__ = ["resolve_uri", "package_directory", "PACKAGE_PATH_VARIABLES"]
+__all__ = ["resolve_uri", "package_directory", "nearby_package", "PACKAGE_PATH_VARIABLES", "MAX_FOLDERS_UP"]
+
+#: How many folders above a description are searched for a package or model it names.
+MAX_FOLDERS_UP = 8
 
 #: Environment variables searched for ``package://`` (first) and ``model://`` (all three) URIs.
 PACKAGE_PATH_VARIABLES = ("ROS_PACKAGE_PATH", "GZ_SIM_RESOURCE_PATH", "GAZEBO_MODEL_PATH")
 
 
-def package_directory(name: str, packages: dict, *, scheme: str = "package") -> str | None:
-    """The directory of package ``name``: ``packages[name]`` or a match on the search path; None if none."""
+def _package_xml_name(folder: str) -> str | None:
+    """The ``<name>`` a ROS ``package.xml`` in ``folder`` declares; None without one (or unreadable)."""
+    path = os.path.join(folder, "package.xml")
+    if not os.path.isfile(path) or os.path.getsize(path) > 1 << 20:
+        return None
+    try:
+        with open(path, "rb") as fh:
+            text = fh.read().decode("utf-8", errors="replace")
+    except OSError:
+        return None
+    start, end = text.find("<name>"), text.find("</name>")
+    return text[start + 6:end].strip() if 0 <= start < end else None
+
+
+def _is_package(folder: str, name: str, scheme: str) -> bool:
+    if not os.path.isdir(folder):
+        return False
+    declared = _package_xml_name(folder)
+    if declared is not None:
+        return declared == name
+    return scheme == "model" and os.path.basename(folder.rstrip(os.sep)) == name
+
+
+def nearby_package(name: str, near: str, *, scheme: str = "package", max_up: int = MAX_FOLDERS_UP) -> str | None:
+    """The folder of package (or Gazebo model) ``name`` around the folder ``near``, walking up (see the module
+    docstring); None when none is found."""
+    folder = os.path.abspath(near)
+    for _ in range(max_up + 1):
+        for candidate in (folder, os.path.join(folder, name)):
+            if _is_package(candidate, name, scheme):
+                return candidate
+        parent = os.path.dirname(folder)
+        if parent == folder:
+            break
+        folder = parent
+    return None
+
+
+def package_directory(name: str, packages: dict, *, scheme: str = "package", near: str | None = None) -> str | None:
+    """The directory of package ``name``: ``packages[name]``, a match on the search path, or (given ``near``,
+    a folder) one found around it by :func:`nearby_package`; None if none."""
     if name in packages:
         return os.path.abspath(os.fspath(packages[name]))
     variables = PACKAGE_PATH_VARIABLES if scheme == "model" else PACKAGE_PATH_VARIABLES[:1]
@@ -40,7 +86,7 @@ def package_directory(name: str, packages: dict, *, scheme: str = "package") -> 
                 return entry
             if os.path.isdir(os.path.join(entry, name)):
                 return os.path.join(entry, name)
-    return None
+    return nearby_package(name, near, scheme=scheme) if near is not None else None
 
 
 def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) -> str:
@@ -69,12 +115,13 @@ def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) 
         path = text if os.path.isabs(text) else os.path.join(base, text)
     elif scheme in ("package", "model"):
         name, _, inner = rest.partition("/")
-        directory = package_directory(name, packages, scheme=scheme)
+        directory = package_directory(name, packages, scheme=scheme, near=base)
         if directory is None:
             searched = ("ROS_PACKAGE_PATH" if scheme == "package"
                         else "ROS_PACKAGE_PATH, GZ_SIM_RESOURCE_PATH, GAZEBO_MODEL_PATH")
             raise RobotDescriptionError(f"{where}: cannot resolve package {name!r} (not among the packages given, "
-                                        f"not found on {searched})")
+                                        f"not found on {searched} nor in the {MAX_FOLDERS_UP} folders above "
+                                        "the description)")
         path = os.path.join(directory, unquote(inner))
     elif scheme == "file":
         inner = unquote(rest)

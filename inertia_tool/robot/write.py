@@ -153,9 +153,20 @@ def _links(root, fmt: str):
     """Link (URDF/SDF) or body (MJCF) elements by name, in document order."""
     if fmt in ("urdf", "xacro"):
         return {link.get("name"): link for link in root.findall("link")}
-    if fmt == "sdf":
-        models = root.findall("model") + root.findall("world/model")
-        return {link.get("name"): link for link in models[0].findall("link")}
+    if fmt == "sdf":                # links of inline nested models are scoped "model::link", as read
+        found: dict = {}
+        tops = root.findall("model")
+        stack = [(m, "") for m in tops] if len(tops) == 1 else [(w, "") for w in root.findall("world")]
+        for _ in range(100_000):        # bounded: each element is visited once
+            if not stack:
+                break
+            parent, prefix = stack.pop()
+            for child in parent:
+                if child.tag == "link":
+                    found.setdefault(prefix + (child.get("name") or ""), child)
+                elif child.tag == "model":
+                    stack.append((child, f"{prefix}{child.get('name', '')}::"))
+        return found
     bodies = {}
     for k, body in enumerate(root.iter("body")):
         bodies[body.get("name") or f"body {k + 1}"] = body

@@ -1,0 +1,137 @@
+"""Gazebo model folders and ROS packages as they are shipped (issue 23 item 4): model:// and package:// found
+around the description without environment variables, SDFormat <include> and nested models, a licence comment
+before the XML declaration, COLLADA files whose <image> has no path and whose triangles are in <polylist>."""
+
+import re
+
+import numpy as np
+import pytest
+
+from inertia_tool.errors import RobotDescriptionError
+from inertia_tool.mass import shapes
+from inertia_tool.mesh.read import load_mesh
+from inertia_tool.robot import link_inertials, read_robot
+from inertia_tool.robot.write import write_corrected
+
+LICENCE = b"<!--\n  Copyright (c) a robot maker. Licensed under the Apache License, Version 2.0.\n-->\n"
+
+
+def _box_model(folder, name, link, size, *, extra="", licence=False):
+    (folder / "meshes").mkdir(parents=True)
+    shapes.write_stl(shapes.box(*size), folder / "meshes" / f"{link}.stl")
+    (folder / "model.config").write_text(f"<?xml version='1.0'?>\n<model><name>{name}</name>"
+                                         "<sdf version='1.6'>robot.sdf</sdf></model>\n")
+    text = (f'<?xml version="1.0" encoding="UTF-8"?>\n<sdf version="1.6">\n  <model name="{name}">\n'
+            f'    <link name="{link}">\n      <collision name="c">\n        <geometry><mesh>'
+            f'<uri>model://{name}/meshes/{link}.stl</uri></mesh></geometry>\n      </collision>\n    </link>\n'
+            f'{extra}  </model>\n</sdf>\n').encode()
+    (folder / "robot.sdf").write_bytes((LICENCE if licence else b"") + text)
+    return folder / "robot.sdf"
+
+
+@pytest.fixture
+def gazebo_models(tmp_path, monkeypatch):
+    for var in ("GZ_SIM_RESOURCE_PATH", "GAZEBO_MODEL_PATH", "ROS_PACKAGE_PATH"):
+        monkeypatch.delenv(var, raising=False)
+    models = tmp_path / "models"
+    _box_model(models / "gripper", "gripper", "finger", (0.01, 0.02, 0.03))
+    nested = ('    <model name="inner">\n      <link name="part">\n        <collision name="c"><geometry><box>'
+              '<size>0.1 0.1 0.1</size></box></geometry></collision>\n      </link>\n    </model>\n'
+              '    <include>\n      <uri>model://gripper</uri>\n      <name>hand</name>\n    </include>\n')
+    arm = _box_model(models / "arm", "arm", "base", (0.2, 0.2, 0.1), extra=nested, licence=True)
+    return arm
+
+
+def test_a_gazebo_model_folder_reads_without_environment_variables(gazebo_models):
+    # osrf mpl_right_arm/model.sdf: a licence comment before the declaration; model:// of the model itself and
+    # of a sibling model folder; an <include> of the sibling (model.config names its file) and a nested model
+    robot = read_robot(gazebo_models)
+    assert [link.name for link in robot.links] == ["base", "inner::part", "hand::finger"]
+    masses = {r.name: r.properties.mass for r in link_inertials(robot, density=1000)}
+    assert masses["base"] == pytest.approx(4.0, rel=1e-6)
+    assert masses["inner::part"] == pytest.approx(1.0, rel=1e-14)
+    assert masses["hand::finger"] == pytest.approx(0.006, rel=1e-6)
+
+
+def test_a_corrected_copy_of_a_gazebo_model_keeps_the_licence_and_reads_back(gazebo_models, tmp_path):
+    robot = read_robot(gazebo_models)
+    out = gazebo_models.parent / "robot_fixed.sdf"
+    changed = write_corrected(robot, link_inertials(robot, density=1000), out)
+    assert set(changed) == {"base", "inner::part", "hand::finger"}
+    data = out.read_bytes()
+    assert data.startswith(LICENCE)
+    again = {link.name: link.declared for link in read_robot(out).links}
+    assert again["base"].mass == pytest.approx(4.0, rel=1e-6)
+    assert again["inner::part"].mass == pytest.approx(1.0, rel=1e-14)
+    assert again["hand::finger"] is None                # in the included file: left as it was
+
+
+def test_a_world_with_a_light_include_and_a_missing_model(tmp_path, gazebo_models, monkeypatch):
+    sun = tmp_path / "models" / "sun"
+    sun.mkdir()
+    (sun / "model.sdf").write_text('<sdf version="1.6"><light name="sun" type="directional"/></sdf>')
+    world = tmp_path / "models" / "w.world"
+    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://sun</uri></include>'
+                     '<include><uri>model://gripper</uri></include></world></sdf>')
+    assert [link.name for link in read_robot(world).links] == ["gripper::finger"]
+    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://nowhere</uri></include></world></sdf>')
+    with pytest.raises(RobotDescriptionError, match="cannot find model 'nowhere'"):
+        read_robot(world)
+    (tmp_path / "models" / "loop.sdf").write_text('<sdf version="1.6"><model name="loop"><include><uri>loop.sdf'
+                                                   '</uri></include></model></sdf>')
+    with pytest.raises(RobotDescriptionError, match="includes itself"):
+        read_robot(tmp_path / "models" / "loop.sdf")
+
+
+def test_package_found_through_package_xml_up_the_tree(tmp_path, monkeypatch):
+    # a ROS workspace: src/my_robot_description/urdf/robot.urdf names package://my_robot_description/...
+    # and package://my_meshes/... (a sibling package whose folder has another name)
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    pkg = tmp_path / "src" / "my_robot_description"
+    (pkg / "urdf").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package format='3'><name>my_robot_description</name></package>")
+    meshes = tmp_path / "src" / "my_meshes"
+    meshes.mkdir()
+    (meshes / "package.xml").write_text("<package><name> my_meshes </name></package>")
+    shapes.write_stl(shapes.box(0.1, 0.1, 0.1), meshes / "b.stl")
+    shapes.write_stl(shapes.box(0.1, 0.1, 0.2), pkg / "b2.stl")
+    urdf = pkg / "urdf" / "robot.urdf"
+    urdf.write_text('<robot name="r"><link name="a"><collision><geometry><mesh filename="package://my_meshes/b.stl"/>'
+                    '</geometry></collision></link><link name="b"><collision><geometry>'
+                    '<mesh filename="package://my_robot_description/b2.stl"/></geometry></collision></link></robot>')
+    a, b = read_robot(urdf).links
+    assert a.elements[0].mesh == str(meshes / "b.stl") and b.elements[0].mesh == str(pkg / "b2.stl")
+    # a folder named like the package but declaring another name is not it
+    (meshes / "package.xml").write_text("<package><name>other</name></package>")
+    with pytest.raises(RobotDescriptionError, match="cannot resolve package 'my_meshes'"):
+        read_robot(urdf)
+
+
+def _collada_polylist_with_a_pathless_image(path, extents):
+    trimesh = pytest.importorskip("trimesh")
+    text = trimesh.exchange.dae.export_collada(trimesh.creation.box(extents=extents)).decode()
+    newparams = ('<newparam sid="s-surface"><surface type="2D"><init_from>img1</init_from></surface></newparam>'
+                 '<newparam sid="s-sampler"><sampler2D><source>s-surface</source></sampler2D></newparam>')
+    text = re.sub(r"(<profile_COMMON>)", r"\1" + newparams, text)
+    text = re.sub(r"<diffuse>\s*<color>[^<]*</color>\s*</diffuse>",
+                  '<diffuse><texture texture="s-sampler" texcoord="UVSET0"/></diffuse>', text)
+    text = text.replace("<library_effects>", '<library_images><image id="img1" name="img1"/></library_images>'
+                                             "<library_effects>")
+    count = int(re.search(r'<triangles count="(\d+)"', text).group(1))
+    text = re.sub(r"<triangles (count=\"\d+\"[^>]*)>", r"<polylist \1><vcount>" + " ".join(["3"] * count)
+                  + "</vcount>", text).replace("</triangles>", "</polylist>")
+    # the <p> must follow <vcount> and the inputs: move <vcount> right before <p>
+    text = re.sub(r"(<polylist [^>]*>)(<vcount>[^<]*</vcount>)(.*?)(<p>)", r"\1\3\2\4", text, flags=re.DOTALL)
+    path.write_text(text)
+
+
+def test_collada_with_an_image_without_a_path_reads_its_geometry(tmp_path):
+    # Gazebo's pulley.dae, gear.dae, disk.dae were "no triangle mesh": pycollada dropped the geometry bound to
+    # a material whose image has no path
+    path = tmp_path / "pulley.dae"
+    _collada_polylist_with_a_pathless_image(path, (0.1, 0.2, 0.3))
+    assert "<polylist" in path.read_text() and '<image id="img1" name="img1"/>' in path.read_text()
+    raw = load_mesh(path, units="m")
+    assert len(raw.faces) == 12
+    extent = raw.vertices.max(axis=0) - raw.vertices.min(axis=0)
+    np.testing.assert_allclose(extent, [0.1, 0.2, 0.3], rtol=1e-7)          # float32 in the file
