@@ -27,6 +27,8 @@ __all__ = ["register", "run", "parse_packages", "parse_mappings"]
 def register(subparsers) -> None:
     ur5 = ("tests/data/robots/example-robot-data/robots/ur_description/urdf/ur5_robot.urdf "
            "--package example-robot-data=tests/data/robots/example-robot-data")
+    panda = ("tests/data/robots/example-robot-data/robots/panda_description/urdf/panda.urdf "
+             "--package example-robot-data=tests/data/robots/example-robot-data")
     p = add_command(
         subparsers, "robot",
         description="Read a robot description (URDF, xacro, SDFormat, MuJoCo MJCF), compute every link's mass, "
@@ -34,7 +36,7 @@ def register(subparsers) -> None:
                     "compare them with the declared <inertial> elements, and optionally write a copy of the "
                     "description with corrected <inertial> elements (origin at the centre of mass, rpy 0, full "
                     "tensor). See docs/robots.md.",
-        examples=[f"inertia-tool robot {ur5} --keep-mass",
+        examples=[f"inertia-tool robot {panda} --keep-mass",
                   f"inertia-tool robot {ur5} --material aluminium --json"])
     p.add_argument("robot", metavar="ROBOT", help="*.urdf, *.xacro, *.sdf, or MuJoCo *.xml")
     p.add_argument("--package", action="append", default=[], metavar="NAME=DIR",
