@@ -120,7 +120,7 @@ def run(args) -> int:
         basis = next((r.basis for r in inertials if r.properties is not None), "")
         note = "declared masses kept" if args.keep_mass else f"density {basis}"
         changed = write_corrected(robot, inertials, args.write, force=args.force, note=note)
-        skipped = [r.name for r in inertials if r.properties is None]
+        skipped = [r.name for r in inertials if r.name not in changed]
         message = f"wrote {args.write}: <inertial> of {len(changed)} link{'' if len(changed) == 1 else 's'} corrected"
         if skipped:
             message += f"; left as they were: {', '.join(skipped)}"

@@ -313,6 +313,13 @@ def _local(tag: str) -> str:
 
 def corrected_document(robot: RobotDescription, inertials, *, note: str = "",
                        out_dir: str | None = None) -> bytes:
+    """The description's bytes with the inertials of the links in ``inertials`` replaced, checked (see
+    :func:`_corrected`, which also says which links were written)."""
+    return _corrected(robot, inertials, note=note, out_dir=out_dir)[0]
+
+
+def _corrected(robot: RobotDescription, inertials, *, note: str = "",
+               out_dir: str | None = None) -> tuple[bytes, list]:
     """The description's bytes with the inertials of the links in ``inertials`` replaced, checked.
 
     Only the bytes of each replaced ``<inertial>`` element change (a missing one is inserted), plus one
@@ -358,7 +365,7 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "",
         writer(elements[result.name], result.properties)
         changed.append(result.name)
     if not changed and not moved:
-        return base
+        return base, changed
     comment = _provenance(robot, changed, note)
     try:
         document = decode_document(base)
@@ -378,7 +385,7 @@ def corrected_document(robot: RobotDescription, inertials, *, note: str = "",
         original = parse_xml(base, robot.source)
         rewrite_paths(robot, original.getroot(), out_dir)
     _verify(original, expected, out, robot, changed, comment)
-    return out
+    return out, changed
 
 
 def _path_edits(spans: list, order: dict, moved: list) -> list:
@@ -638,7 +645,8 @@ def write_corrected(robot: RobotDescription, inertials, path, *, force: bool = F
     Returns
     -------
     tuple of str
-        The links whose ``<inertial>`` was written.
+        The links whose ``<inertial>`` was written (a link of an MJCF or SDFormat included file is not: it
+        is not in this document).
 
     Raises
     ------
@@ -655,6 +663,6 @@ def write_corrected(robot: RobotDescription, inertials, path, *, force: bool = F
             and os.path.samefile(path, robot.source)):
         raise UsageError(f"{path}: is the input description; refusing to overwrite it (`force=True` does)")
     check_targets([path], force=force)
-    data = corrected_document(robot, inertials, note=note, out_dir=os.path.dirname(os.path.abspath(path)))
+    data, changed = _corrected(robot, inertials, note=note, out_dir=os.path.dirname(os.path.abspath(path)))
     write_bytes(path, data, replace=force)
-    return tuple(dict.fromkeys(r.name for r in inertials if r.properties is not None))
+    return tuple(changed)
