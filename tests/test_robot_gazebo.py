@@ -135,3 +135,61 @@ def test_collada_with_an_image_without_a_path_reads_its_geometry(tmp_path):
     assert len(raw.faces) == 12
     extent = raw.vertices.max(axis=0) - raw.vertices.min(axis=0)
     np.testing.assert_allclose(extent, [0.1, 0.2, 0.3], rtol=1e-7)          # float32 in the file
+
+
+# -- xacro without --package (issue 23 item 5) -------------------------------------------------------------
+
+def _workspace(tmp_path):
+    pkg = tmp_path / "ws" / "src" / "my_desc"
+    (pkg / "urdf" / "inc").mkdir(parents=True)
+    (pkg / "package.xml").write_text('<package format="3"><name>my_desc</name></package>')
+    (pkg / "urdf" / "inc" / "part.xacro").write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="part"><link name="p"><collision>'
+        '<geometry><box size="0.1 0.2 0.3"/></geometry></collision></link></xacro:macro></robot>')
+    return pkg
+
+
+def test_xacro_find_uses_package_xml_two_folders_up(tmp_path, monkeypatch):
+    pytest.importorskip("xacro")
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    pkg = _workspace(tmp_path)
+    src = pkg / "urdf" / "robot.urdf.xacro"
+    src.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                   '<xacro:include filename="$(find my_desc)/urdf/inc/part.xacro"/><xacro:part/></robot>')
+    (link,) = read_robot(src).links
+    assert link.name == "p" and link.elements[0].size == pytest.approx((0.1, 0.2, 0.3))
+
+
+def test_xacro_failures_are_one_clean_sentence(tmp_path, monkeypatch):
+    pytest.importorskip("xacro")
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    pkg = _workspace(tmp_path)
+    src = pkg / "urdf" / "bad.urdf.xacro"
+    src.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                   '<xacro:include filename="$(find nowhere_pkg)/x.xacro"/></robot>')
+    with pytest.raises(RobotDescriptionError) as info:
+        read_robot(src)
+    message = str(info.value)
+    # was: "xacro expansion failed (<class 'inertia_tool.errors.RobotDescriptionError'>: $(find nowhere_pkg):
+    # package 'nowhere_pkg' is not among ... $(find nowhere_pkg): package 'nowhere_pkg' i)"
+    assert "<class" not in message and "Error" not in message
+    assert message.count("nowhere_pkg") == 2 and message.endswith("in the 8 folders above")
+    long_name = "an_undefined_property_" * 30
+    src.write_text(f'<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="a"><collision>'
+                   f'<geometry><box size="${{{long_name} * 2}} 1 1"/></geometry></collision></link></robot>')
+    with pytest.raises(RobotDescriptionError) as info:
+        read_robot(src)
+    message = str(info.value)
+    assert "<class" not in message and message.endswith(" …")
+    quoted = message.split("xacro expansion failed: ", 1)[1][:-2]
+    assert len(quoted) <= 300 and (long_name + " * 2").startswith(quoted.split("'")[1][:50])
+
+
+def test_xacro_message_drops_class_names_and_repeats():
+    from inertia_tool.robot.description import _xacro_message
+    exc = RuntimeError("<class 'xacro.XacroException'>: missing file. <class 'xacro.XacroException'>: missing file.")
+    assert _xacro_message(exc) == "missing file."
+    assert _xacro_message(ValueError("")) == "unknown failure"
+    words = " ".join(f"word{k}" for k in range(200))
+    cut = _xacro_message(ValueError(words))
+    assert cut.endswith(" …") and cut[:-2] in words and words[len(cut) - 2] == " "
