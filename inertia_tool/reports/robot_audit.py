@@ -69,6 +69,10 @@ def _audit_dict(audit: LinkAudit) -> dict:
         "com_inside_geometry": audit.com_inside_geometry,
         "link_size": audit.size,
         "issues": list(audit.issues),
+        "causes": [{"cause": c.cause, "explanation": c.explanation, "difference_before": c.before,
+                    "difference_after": c.after, "corrected_inertia": c.inertia, "corrected_mass": c.mass}
+                   for c in audit.causes],
+        "nearest_valid_inertia": audit.nearest_valid_inertia,
     }
 
 

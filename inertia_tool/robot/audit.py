@@ -17,6 +17,11 @@ For each link with both a declared inertial and a geometry result (:class:`LinkI
   closed-form inside tests).  A hollow or C-shaped part legitimately has its centre outside its material, so
   this is reported, not judged.
 
+Where the tensors disagree, :func:`inertia_tool.robot.diagnose.diagnose_inertial` names the likely cause
+(a unit or decimal slip, a tensor about the link origin, swapped axes, a placeholder) with its evidence and
+the declared tensor with the cause undone; a declared tensor that the simulators refuse gets the nearest
+valid one (:func:`~inertia_tool.robot.diagnose.nearest_valid_tensor`).
+
 Every threshold is a keyword argument; an issue is a sentence in ``LinkAudit.issues``.
 """
 
@@ -30,6 +35,7 @@ from ..units import MATERIALS
 from ..values import frozen_value
 from .description import DeclaredInertial, RobotDescription
 from .geometry import LinkInertial, element_bounds, points_inside_element
+from .diagnose import diagnose_inertial, nearest_valid_tensor
 from .inertial import MomentCheck, check_moments
 
 __all__ = ["LinkAudit", "audit_links", "DENSITY_RANGE", "DEFAULT_COM_TOLERANCE", "DEFAULT_INERTIA_TOLERANCE",
@@ -80,6 +86,10 @@ class LinkAudit:
         m, bounding-box diagonal of the link geometry; nan without geometry.
     issues : tuple of str
         One sentence per finding beyond the tolerances, or about an invalid declaration.
+    causes : tuple of Diagnosis
+        Likely causes of a tensor disagreement, best first (empty when none explains it).
+    nearest_valid_inertia : (3, 3) float or None
+        kg·m²: for a declared tensor the simulators refuse, the nearest one they accept (same axes).
     """
 
     name: str
@@ -96,6 +106,8 @@ class LinkAudit:
     com_inside_geometry: bool | None
     size: float
     issues: tuple
+    causes: tuple = ()
+    nearest_valid_inertia: np.ndarray | None = None
 
     @property
     def ok(self) -> bool:
@@ -151,6 +163,10 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
                 issues.append(f"declared inertia is not physical: {check.problem()}")
         if result is not None and result.problem and link.elements and result.problem not in issues:
             issues.append(result.problem)
+        causes: tuple = ()
+        nearest = None
+        if check is not None and not check.ok and declared is not None and not massless_frame:
+            nearest = nearest_valid_tensor(declared.inertia)
         nan = float("nan")
         mass_ratio = com_distance = com_rel = inertia_diff = implied = size = nan
         plausible = in_box = inside = None
@@ -181,6 +197,11 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
             if not plausible:
                 issues.append(f"implied density {implied:.4g} kg/m³ is outside every material's "
                               f"({DENSITY_RANGE[0]:g}–{DENSITY_RANGE[1]:g} kg/m³)")
+            if inertia_diff > inertia_tolerance or not plausible:
+                causes = diagnose_inertial(declared.mass, declared.center_of_mass, declared.inertia, computed.mass,
+                                           computed.inertia, tolerance=inertia_tolerance,
+                                           geometry_volume=computed.volume, density_range=DENSITY_RANGE)
+                issues += [f"likely cause: {c.explanation}" for c in causes]
             if not in_box:
                 issues.append("declared centre of mass lies outside the link geometry's bounding box")
             elif not inside:
@@ -188,5 +209,6 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
         out.append(LinkAudit(name=link.name, declared=declared, computed=computed, mass_ratio=mass_ratio,
                              com_distance=com_distance, com_distance_relative=com_rel, inertia_difference=inertia_diff,
                              declared_check=check, implied_density=implied, density_plausible=plausible,
-                             com_in_bounding_box=in_box, com_inside_geometry=inside, size=size, issues=tuple(issues)))
+                             com_in_bounding_box=in_box, com_inside_geometry=inside, size=size, issues=tuple(issues),
+                             causes=causes, nearest_valid_inertia=nearest))
     return tuple(out)

@@ -350,6 +350,8 @@ def _one_link(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, model: bo
         parts, massless = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
     except InertiaToolError as exc:
         return LinkInertial(link.name, None, nan, basis, f"mesh needs repair or cannot be read: {exc}")
+    except (ValueError, ArithmeticError) as exc:     # numerical trouble in one link's geometry: its reason
+        return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}")
     warned = [f"{e.kind} {e.name!r} is massless in the description "
               f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
     if not parts:
@@ -396,7 +398,7 @@ def _one_link(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, model: bo
                                name=link.name)
         return LinkInertial(link.name, props, rho, basis, method=method,
                             uncertainty=_link_uncertainty(parts, props, rho), warnings=tuple(warned))
-    except InertiaToolError as exc:
+    except (InertiaToolError, ValueError, ArithmeticError) as exc:
         return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}", warnings=tuple(warned))
 
 
