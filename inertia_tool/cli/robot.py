@@ -38,7 +38,9 @@ def register(subparsers) -> None:
                     "tensor). See docs/robots.md.",
         examples=[f"inertia-tool robot {panda} --keep-mass",
                   f"inertia-tool robot {ur5} --material aluminium --json"])
-    p.add_argument("robot", metavar="ROBOT", help="*.urdf, *.xacro, *.sdf, or MuJoCo *.xml")
+    p.add_argument("robot", metavar="ROBOT", nargs="+",
+                   help="*.urdf, *.xacro, *.sdf, or MuJoCo *.xml; several files or folders audit every description "
+                        "in them (a corpus) with one summary")
     p.add_argument("--package", action="append", default=[], metavar="NAME=DIR",
                    help="directory of package NAME for package://NAME/... URIs (repeatable; ROS_PACKAGE_PATH is "
                         "searched after these)")
@@ -94,8 +96,35 @@ def parse_mappings(items) -> dict:
     return mappings
 
 
+def _run_corpus(args, packages: dict) -> int:
+    """Several files or folders: every description audited, one summary (no --write, no xacro arguments)."""
+    from ..reports.robot_audit import corpus_report_dict, format_corpus_report
+    from ..robot.corpus import audit_corpus
+    if args.write or args.arg:
+        raise UsageError("--write and --arg apply to one description; a corpus (several files or a folder) is "
+                         "only audited")
+    check_option("--max-faces", args.max_faces)
+    density: float | str | None = None
+    if args.density is not None:
+        density = (MODEL_DENSITY if args.density.strip() == MODEL_DENSITY
+                   else check_option("--density", parse_density(args.density), typed=args.density))
+    models = audit_corpus(args.robot, density=density, material=args.material, keep_mass=args.keep_mass,
+                          repair=args.repair, packages=packages, geometry=args.geometry, max_faces=args.max_faces)
+    if not models:
+        raise UsageError(f"no robot description found in {', '.join(args.robot)}")
+    if args.json:
+        print(json.dumps(corpus_report_dict(models), indent=2, ensure_ascii=False))
+    else:
+        print(speak_options(format_corpus_report(models), getattr(args, "robot_parser", None)))
+    incomplete = any(m.robot is None or links_without_result(m.robot, m.inertials) for m in models)
+    return EXIT_INCOMPLETE if incomplete else EXIT_OK
+
+
 def run(args) -> int:
     packages = parse_packages(args.package)
+    if len(args.robot) > 1 or os.path.isdir(args.robot[0]):
+        return _run_corpus(args, packages)
+    args.robot = args.robot[0]
     mappings = parse_mappings(args.arg)
     if args.write is not None and not args.write.strip():
         raise UsageError(f"--write expects the name of the file to write, got {args.write!r}")

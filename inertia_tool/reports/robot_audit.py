@@ -13,7 +13,8 @@ from ..robot.description import RobotDescription
 from ..robot.geometry import LinkInertial
 from .serialize import TENSOR_CONVENTION, to_jsonable
 
-__all__ = ["robot_report_dict", "format_robot_report", "links_without_result", "summary_line"]
+__all__ = ["robot_report_dict", "format_robot_report", "links_without_result", "summary_line",
+           "corpus_report_dict", "format_corpus_report"]
 
 
 def links_without_result(robot: RobotDescription, inertials) -> list:
@@ -163,3 +164,60 @@ def format_robot_report(robot: RobotDescription, inertials, audits) -> str:
         lines += ["", "no result:"] + [f"  {r.name}: {r.problem}" for r in without]
     lines += ["", summary_line(robot, inertials)]
     return "\n".join(line for k, line in enumerate(lines) if line or k > 1)
+
+
+# -- a corpus: one line per model, the causes, one summary --------------------------------------------------
+
+def _cause_counts(models) -> dict:
+    counts: dict = {}
+    for model in models:
+        for audit in model.audits:
+            if audit.causes:
+                counts[audit.causes[0].cause] = counts.get(audit.causes[0].cause, 0) + 1
+    return counts
+
+
+def _corpus_summary(models) -> str:
+    read = [m for m in models if m.robot is not None]
+    links = sum(len(m.inertials) for m in read)
+    computed = sum(1 for m in read for r in m.inertials if r.properties is not None)
+    missing = sum(len(links_without_result(m.robot, m.inertials)) for m in read)
+    flagged = sum(1 for m in read for a in m.audits if a.issues)
+    causes = _cause_counts(models)
+    text = (f"{len(models)} model{'' if len(models) == 1 else 's'} ({len(models) - len(read)} unreadable): "
+            f"{links} links, {computed} computed, {missing} without a result, {flagged} with issues")
+    if causes:
+        text += "; likely causes: " + ", ".join(f"{k} {n}" for k, n in sorted(causes.items(), key=lambda i: -i[1]))
+    return text
+
+
+def corpus_report_dict(models) -> dict:
+    """The ``robot DIR --json`` object: ``{"models": [per-model report or {"source", "problem"}], "summary"}``."""
+    out = []
+    for model in models:
+        if model.robot is None:
+            out.append(to_jsonable({"source": model.source, "problem": model.problem}))
+        else:
+            out.append(robot_report_dict(model.robot, model.inertials, model.audits))
+    return {"models": out, "summary": _corpus_summary(models), "likely_causes": _cause_counts(models)}
+
+
+def format_corpus_report(models) -> str:
+    """One line per model, then each link's likely cause with its evidence, then the summary line."""
+    width = max([5] + [len(m.source) for m in models])
+    header = f"{'model':<{width}} {'format':<6} {'links':>5} {'computed':>8} {'no result':>9} {'issues':>6}"
+    lines = [header, "-" * len(header)]
+    for m in models:
+        if m.robot is None:
+            lines.append(f"{m.source:<{width}} unreadable: {m.problem}")
+            continue
+        computed = sum(1 for r in m.inertials if r.properties is not None)
+        missing = len(links_without_result(m.robot, m.inertials))
+        flagged = sum(1 for a in m.audits if a.issues)
+        lines.append(f"{m.source:<{width}} {m.robot.format:<6} {len(m.inertials):>5} {computed:>8} {missing:>9} "
+                     f"{flagged:>6}")
+    causes = [(m.source, a.name, c) for m in models for a in m.audits for c in a.causes[:1]]
+    if causes:
+        lines += ["", "likely causes:"] + [f"  {src}: {name}: {c.explanation}" for src, name, c in causes]
+    lines += ["", _corpus_summary(models)]
+    return "\n".join(lines)

@@ -1,0 +1,125 @@
+"""Audit every robot description under some folders (a corpus: a Menagerie checkout, a Gazebo model folder, a
+ROS workspace) and keep one result per model.
+
+Which files are descriptions: ``*.urdf``, ``*.sdf``, ``*.world`` and ``*.xml`` whose root element is
+``<robot>``, ``<sdf>`` or ``<mujoco>`` (read from the first :data:`SNIFF_BYTES` bytes; ``package.xml`` and
+other XML are skipped); ``*.xacro`` only when named directly (in a folder they are mostly fragments).  An MJCF
+file that another MJCF file of the corpus includes is audited through the including file only (Menagerie's
+``scene.xml`` includes the robot).  Folders are walked in sorted order without following symbolic links, at
+most :data:`MAX_CORPUS_FILES` descriptions.  A model that cannot be read is kept with its reason; it never
+stops the others.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+
+from ..errors import InertiaToolError, UsageError
+from ..values import frozen_value
+from .audit import audit_links
+from .description import RobotDescription, read_robot
+from .geometry import link_inertials
+
+__all__ = ["ModelAudit", "find_descriptions", "audit_corpus", "MAX_CORPUS_FILES", "SNIFF_BYTES"]
+
+#: Most descriptions one corpus run reads.
+MAX_CORPUS_FILES = 10_000
+
+#: Bytes read from an ``*.xml`` file to see its root element.
+SNIFF_BYTES = 1 << 16
+
+_ROOT = re.compile(rb"<(mujoco|robot|sdf)[\s>/]")
+_INCLUDE = re.compile(rb"<include\s[^>]*file\s*=\s*[\"']([^\"']+)[\"']")
+
+
+@frozen_value
+class ModelAudit:
+    """One model of a corpus.
+
+    Attributes
+    ----------
+    source : str
+        The description file.
+    robot : RobotDescription or None
+        None when it could not be read (``problem`` says why).
+    inertials : tuple of LinkInertial
+    audits : tuple of LinkAudit
+    problem : str or None
+    """
+
+    source: str
+    robot: RobotDescription | None
+    inertials: tuple = ()
+    audits: tuple = ()
+    problem: str | None = None
+
+
+def _root_kind(path: str) -> str | None:
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(SNIFF_BYTES)
+    except OSError:
+        return None
+    head = re.sub(rb"<!--.*?-->", b"", head, flags=re.DOTALL)
+    match = _ROOT.search(head)
+    return match.group(1).decode() if match else None
+
+
+def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
+    """The description files named by ``paths`` (files, or folders walked; see the module docstring)."""
+    found: list = []
+
+    def add(path: str, explicit: bool) -> None:
+        suffix = os.path.splitext(path)[1].lower()
+        if suffix in (".urdf", ".sdf", ".world") or (suffix == ".xacro" and explicit):
+            found.append(path)
+        elif suffix in (".xml", ".mjcf") and (explicit or _root_kind(path) is not None):
+            found.append(path)
+        if len(found) > max_files:
+            raise UsageError(f"Expected at most {max_files:,} robot descriptions, found more under "
+                             f"{', '.join(map(str, paths))}")
+
+    for entry in paths:
+        entry = os.fspath(entry)
+        if os.path.isdir(entry):
+            for folder, subfolders, files in os.walk(entry):
+                subfolders.sort()
+                for name in sorted(files):
+                    path = os.path.join(folder, name)
+                    if os.path.isfile(path) and not os.path.islink(path):
+                        add(path, False)
+        else:
+            add(entry, True)
+    included = set()
+    for path in found:
+        if os.path.splitext(path)[1].lower() in (".xml", ".mjcf") and _root_kind(path) == "mujoco":
+            with open(path, "rb") as fh:
+                text = fh.read(MAX_CORPUS_FILES * 100)
+            for name in _INCLUDE.findall(text):
+                target = os.path.normpath(os.path.join(os.path.dirname(path), os.fsdecode(name)))
+                if target != os.path.normpath(path):
+                    included.add(target)
+    return [p for p in found if os.path.normpath(p) not in included]
+
+
+def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass: bool = False,
+                 repair: bool = False, packages: dict | None = None, geometry: str = "collision",
+                 **options) -> tuple:
+    """Read, compute and audit every description under ``paths``; one :class:`ModelAudit` each.
+
+    Parameters are those of :func:`~inertia_tool.robot.read_robot`, :func:`~inertia_tool.robot.link_inertials`
+    and :func:`~inertia_tool.robot.audit_links` (``options`` go to ``link_inertials``).
+    """
+    out = []
+    for path in find_descriptions(paths):
+        try:
+            robot = read_robot(path, packages=packages, geometry=geometry)
+            inertials = link_inertials(robot, density=density, material=material, keep_mass=keep_mass,
+                                       repair=repair, **options)
+            audits = audit_links(robot, inertials, keep_mass=keep_mass)
+        except InertiaToolError as exc:
+            out.append(ModelAudit(source=path, robot=None, problem=str(exc)))
+            continue
+        out.append(ModelAudit(source=path, robot=robot, inertials=inertials, audits=audits))
+    return tuple(out)

@@ -1,0 +1,64 @@
+"""`inertia-tool robot` over a folder tree (inertia_tool.robot.corpus): every description audited once, the
+likely cause of each bad inertial named, one summary; a model that cannot be read never stops the others."""
+
+import json
+
+import numpy as np
+
+from inertia_tool.cli import EXIT_INCOMPLETE, EXIT_OK, main
+from inertia_tool.robot.corpus import find_descriptions
+
+
+def _urdf(path, name, ixx, mass=7.8):
+    path.write_text(f'<robot name="{name}"><link name="slab"><inertial><mass value="{mass}"/><inertia ixx="{ixx!r}" '
+                    f'iyy="{ixx!r}" izz="{ixx!r}" ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry>'
+                    '<box size="0.1 0.2 0.3"/></geometry></collision></link></robot>')
+
+
+def _corpus(tmp_path):
+    root = tmp_path / "corpus"
+    (root / "menagerie" / "arm").mkdir(parents=True)
+    (root / "ros" / "pkg").mkdir(parents=True)
+    (root / "ros" / "pkg" / "package.xml").write_text("<package><name>pkg</name></package>")
+    # a box slab, declared as an isotropic placeholder
+    _urdf(root / "ros" / "pkg" / "placeholder.urdf", "p", 0.001)
+    # the right tensor of the 0.1 x 0.2 x 0.3 box entered in kg·mm² (x1e6)
+    moments = 7.8 / 12 * np.array([0.2 ** 2 + 0.3 ** 2, 0.1 ** 2 + 0.3 ** 2, 0.1 ** 2 + 0.2 ** 2])
+    truth = [float(v) * 1e6 for v in moments]
+    (root / "ros" / "pkg" / "mm.urdf").write_text(
+        '<robot name="mm"><link name="slab"><inertial><mass value="7.8"/>'
+        f'<inertia ixx="{truth[0]!r}" iyy="{truth[1]!r}" izz="{truth[2]!r}" ixy="0" ixz="0" iyz="0"/></inertial>'
+        '<collision><geometry><box size="0.1 0.2 0.3"/></geometry></collision></link></robot>')
+    (root / "ros" / "broken.urdf").write_text("<robot name='b'><link name='x'>")
+    arm = root / "menagerie" / "arm"
+    (arm / "arm.xml").write_text('<mujoco model="arm"><worldbody><body name="b"><inertial pos="0 0 0" mass="1" '
+                                 'diaginertia="1 1 1"/><geom type="box" size="0.05 0.1 0.15"/></body></worldbody>'
+                                 '</mujoco>')
+    (arm / "scene.xml").write_text('<mujoco model="scene"><include file="arm.xml"/></mujoco>')
+    return root
+
+
+def test_find_descriptions_skips_included_mjcf_and_other_xml(tmp_path):
+    root = _corpus(tmp_path)
+    found = [p.split("corpus/", 1)[1] for p in find_descriptions([root])]
+    assert found == ["menagerie/arm/scene.xml", "ros/broken.urdf", "ros/pkg/mm.urdf", "ros/pkg/placeholder.urdf"]
+
+
+def test_corpus_audit_names_the_causes_and_sums_up(tmp_path, capsys):
+    root = _corpus(tmp_path)
+    assert main(["robot", str(root), "--keep-mass"]) == EXIT_INCOMPLETE          # broken.urdf is unreadable
+    out = capsys.readouterr().out
+    assert "unreadable:" in out and "broken.urdf" in out
+    assert "mm.urdf: slab: unit slip" in out and "placeholder.urdf: slab: placeholder" in out
+    assert "arm/scene.xml: b: placeholder" in out
+    assert out.rstrip().endswith("4 models (1 unreadable): 3 links, 3 computed, 0 without a result, 3 with issues; "
+                                 "likely causes: placeholder 2, unit 1")
+    assert main(["robot", str(root / "ros" / "pkg"), str(root / "menagerie"), "--keep-mass", "--json"]) == EXIT_OK
+    report = json.loads(capsys.readouterr().out)
+    assert len(report["models"]) == 3 and report["likely_causes"] == {"unit": 1, "placeholder": 2}
+
+
+def test_corpus_refuses_write(tmp_path, capsys):
+    root = _corpus(tmp_path)
+    assert main(["robot", str(root), "--keep-mass", "--write", str(tmp_path / "x.urdf")]) == 2
+    assert "only audited" in capsys.readouterr().err
