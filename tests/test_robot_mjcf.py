@@ -260,3 +260,23 @@ def test_partial_size_keeps_the_class_numbers(tmp_path):
     path.write_text('<mujoco><default><default class="k"><geom type="box" size="0.03 0.04 0.05"/></default>'
                     '</default><worldbody><body name="b"><geom class="k" size="0.01"/></body></worldbody></mujoco>')
     assert read_robot(path).links[0].elements[0].size == pytest.approx((0.02, 0.08, 0.1))
+
+
+def test_replicate_names_and_masses_match_mujoco(tmp_path):
+    path = tmp_path / "r.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true"/><worldbody>'
+                    '<replicate count="2" offset="1 0 0" sep="o"><replicate count="11" offset="0 1 0" sep="i">'
+                    '<body name="b"><freejoint/><geom type="box" size="0.1 0.2 0.3" euler="10 0 0"/>'
+                    '<body name="c"><joint/><geom size="0.05" pos="0 0 0.2"/></body></body></replicate></replicate>'
+                    '</worldbody></mujoco>')
+    results = link_inertials(read_robot(path), density=1000)
+    assert [r.name for r in results][:4] == ["bi00o0", "ci00o0", "bi01o0", "ci01o0"] and len(results) == 44
+    _assert_like_mujoco(path, results)
+
+
+def test_attach_is_refused_not_skipped(tmp_path):
+    path = tmp_path / "a.xml"
+    path.write_text('<mujoco><asset><model name="g" file="g.xml"/></asset><worldbody><body name="b">'
+                    '<attach model="g" body="hand" prefix="g_"/></body></worldbody></mujoco>')
+    with pytest.raises(RobotDescriptionError, match="<attach model='g'> is not supported"):
+        read_robot(path)

@@ -3,7 +3,8 @@
 What is read (MuJoCo XML reference, "MJCF"): ``<compiler angle eulerseq meshdir assetdir>`` (angles in
 **degrees** unless ``angle="radian"``, MuJoCo's default), ``<default>`` classes (nested, ``class`` and
 ``childclass``) for ``<geom>`` and ``<mesh>`` attributes, ``<asset><mesh name file scale>``, and under
-``<worldbody>`` every ``<body>`` (``<frame>`` elements compose their pose into the geoms they hold).  A geom's
+``<worldbody>`` every ``<body>`` (``<frame>`` elements compose their pose into the geoms they hold,
+``<replicate>`` copies its bodies).  A geom's
 frame is ``pos`` and one of ``quat`` (w x y z), ``axisangle``, ``euler`` (sequence ``eulerseq``: lower case
 letters rotate with the frame, upper case stay fixed), ``xyaxes``, ``zaxis``; or ``fromto`` for capsules,
 cylinders, boxes and ellipsoids (the axis runs from the first point to the second).  Sizes are MuJoCo's
@@ -407,13 +408,38 @@ def _is_collision(attrs: dict, what: str, source: str) -> bool:
     return any(b != 0 for b in bits)
 
 
-def _child_bodies(element, class_name: str):
-    """The ``<body>`` children of ``element``, looking through ``<frame>`` elements, with their default class."""
+#: Most copies one ``<replicate>`` may make (and all of them together).
+MAX_REPLICAS = 10_000
+
+
+def _child_bodies(element, class_name: str, suffix: str = "", source: str = "", budget: list | None = None):
+    """The ``<body>`` children of ``element``, looking through ``<frame>`` and ``<replicate>`` elements, with
+    their default class and name suffix.
+
+    ``<replicate count sep>`` repeats its bodies ``count`` times; MuJoCo names copy ``i`` of ``NAME``
+    ``NAME + sep + i`` (``i`` zero-padded to the digits of ``count − 1``), inner replicates' suffixes first.
+    The copies' placement (``offset``, orientation) does not change a body's own mass properties.
+    ``<attach>`` (a body of another model asset) is refused: its bodies would be missing.
+    """
+    budget = [MAX_REPLICAS] if budget is None else budget
     for child in element:
         if child.tag == "body":
-            yield child, class_name
+            yield child, class_name, suffix
         elif child.tag == "frame":
-            yield from _child_bodies(child, child.get("childclass", class_name))
+            yield from _child_bodies(child, child.get("childclass", class_name), suffix, source, budget)
+        elif child.tag == "replicate":
+            count = _numbers(child.get("count"), 1, "<replicate count>", source)[0]
+            if not (count == int(count) and 1 <= count <= budget[0]):
+                raise _fail(source, f"<replicate count={child.get('count')!r}>: expected a whole number from 1 to "
+                                    f"{budget[0]:,} (copies left of {MAX_REPLICAS:,})")
+            budget[0] -= int(count)
+            width = len(str(int(count) - 1))
+            for k in range(int(count)):
+                yield from _child_bodies(child, class_name, f"{child.get('sep', '')}{k:0{width}d}{suffix}", source,
+                                         budget)
+        elif child.tag == "attach":
+            raise _fail(source, f"<attach model={child.get('model')!r}> is not supported: its bodies would be missing "
+                                "(give the model with the attached bodies written out)")
 
 
 def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
@@ -428,17 +454,18 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
     meshes = _meshes(root, defaults, mesh_base, fallbacks, compiler, source)
     links = []
     counter = [0]
+    replicas = [MAX_REPLICAS]
 
-    def walk_body(body, class_name: str) -> None:
+    def walk_body(body, class_name: str, suffix: str) -> None:
         counter[0] += 1
-        name = body.get("name") or f"body {counter[0]}"
+        name = body.get("name") + suffix if body.get("name") else f"body {counter[0]}"
         child_class = body.get("childclass", class_name)
         elements: list[GeometryElement] = []
         collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements)
         links.append(LinkGeometry(name=name, elements=tuple(elements),
                                   declared=_inertial(body, name, compiler, source)))
-        for child, cls in _child_bodies(body, child_class):
-            walk_body(child, cls)
+        for child, cls, more in _child_bodies(body, child_class, suffix, source, replicas):
+            walk_body(child, cls, more)
 
     def collect(element, link: str, class_name: str, pose, elements: list) -> None:
         for child in element:
@@ -457,6 +484,6 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
                 collect(child, link, child.get("childclass", class_name), composed, elements)
 
     for world in root.findall("worldbody"):
-        for body, cls in _child_bodies(world, "main"):
-            walk_body(body, cls)
+        for body, cls, suffix in _child_bodies(world, "main", "", source, replicas):
+            walk_body(body, cls, suffix)
     return root.get("model", ""), tuple(links)
