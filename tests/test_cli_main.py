@@ -119,7 +119,7 @@ WRITERS = [
      "--report", "r.html"),
     (["balance", WHEEL, "--units", "mm", "--rpm", "3000", "--radius", "150", "--planes", "-40,40"],
      "--report", "r.md"),
-    (["robot", str(UR5), "--package", f"example-robot-data={ERD}", "--keep-mass"], "--write", "r.urdf"),
+    (["robot", str(UR5), "--package", f"example-robot-data={ERD}", "--density", "2700"], "--write", "r.urdf"),
 ]
 
 

@@ -553,7 +553,7 @@ def test_robot_max_faces_is_a_total_over_the_meshes(tmp_path):
     code, out, err = run_cli("robot", path, "--density", "1000", "--max-faces", "24", "--json")
     assert code == 0 and [link["mass"] for link in json.loads(out)["links"]] == pytest.approx([1.0, 1.0])
     code, out, err = run_cli("robot", path, "--density", "1000", "--max-faces", "20")
-    assert code == 0 and "Traceback" not in err
+    assert code == 5 and "Traceback" not in err          # link b has no result: exit 5 (issue 23 item 2)
     assert "b.stl: holds 12 triangles, more than --max-faces (8) allows: the limit counts all the robot's " \
            "meshes together (20), and the meshes read before this one left 8" in out
     code, _, err = run_cli("robot", path, "--density", "1000", "--max-faces", "0")
