@@ -138,3 +138,13 @@ def test_one_bad_link_never_stops_the_others_and_names_stay_whole(tmp_path, caps
         assert sheet["mass"] is None and sheet["method"] is None and sheet["problem"]
         assert long["method"] == "exact" and long["uncertainty"] is None and long["mass"] == pytest.approx(1.0)
         assert report["links_without_result"] == ["sheet"] and "without a result: sheet" in captured.err
+
+
+def test_engine_warnings_about_a_links_mesh_are_in_its_json_warnings(capsys):
+    # UR5's wrist3.stl has two overlapping bodies the engine unites: that link says so, the base does not
+    assert main(["robot", str(UR5), "--package", PKG, "--density", "2700", "--json"]) == 0
+    captured = capsys.readouterr()
+    links = {link["name"]: link for link in json.loads(captured.out)["links"]}
+    assert any("wrist3.stl: overlapping bodies united" in w for w in links["wrist_3_link"]["warnings"])
+    assert links["wrist_3_link"]["method"] == "united" and links["base_link"]["warnings"] == []
+    assert "wrist3.stl: overlapping bodies united" in captured.err          # still said on stderr

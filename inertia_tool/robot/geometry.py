@@ -25,6 +25,7 @@ the tensor is ``I = tr(Σ) 1 − Σ`` (Eq. 4.13).  A negative factor (a mirrored
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -340,8 +341,31 @@ def _link_uncertainty(parts: list, total: MassProperties, scale: float) -> LinkU
 _RANK = {m: k for k, m in enumerate(METHODS)}
 
 
-def _one_link(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, model: bool, repair: bool, cache: dict,
-              geometry: str, budget: list | None = None) -> LinkInertial:
+def _with_engine_warnings(result: LinkInertial, caught: list) -> LinkInertial:
+    """``result`` with the engine's warnings about its meshes (the mesh engine's ``InertiaToolWarning``s:
+    faces turned, bodies united, a repair) added to ``warnings``; they are issued again for the caller."""
+    from ..errors import InertiaToolWarning
+    texts = []
+    for item in caught:
+        if issubclass(item.category, InertiaToolWarning):
+            texts.append(str(item.message))
+        warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
+    if not texts:
+        return result
+    return LinkInertial(result.name, result.properties, result.density, result.basis, result.problem,
+                        result.method, result.uncertainty, tuple(result.warnings) + tuple(texts))
+
+
+def _one_link(link: LinkGeometry, **options) -> LinkInertial:
+    """:func:`_one_link_result` with the engine's warnings about the link's meshes in its ``warnings``."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = _one_link_result(link, **options)
+    return _with_engine_warnings(result, caught)
+
+
+def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, model: bool, repair: bool,
+                     cache: dict, geometry: str, budget: list | None = None) -> LinkInertial:
     """The result for one link, or the reason there is none (never raises for the link's own problems)."""
     nan = float("nan")
     if not link.elements:
