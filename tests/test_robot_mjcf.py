@@ -280,3 +280,22 @@ def test_attach_is_refused_not_skipped(tmp_path):
                     '<attach model="g" body="hand" prefix="g_"/></body></worldbody></mujoco>')
     with pytest.raises(RobotDescriptionError, match="<attach model='g'> is not supported"):
         read_robot(path)
+
+
+@pytest.mark.parametrize("kind", ["capsule", "cylinder", "box", "sphere", "ellipsoid"])
+def test_a_primitive_fitted_to_a_mesh_matches_mujoco(tmp_path, kind):
+    # arx_l5: <geom mesh="link1" class="collision"/> where the class says type="capsule" and nothing gives a size
+    # ("capsule needs 1 size values, got None"): MuJoCo fits the primitive to the mesh's equivalent inertia box
+    trimesh = pytest.importorskip("trimesh")
+    block = trimesh.creation.box(extents=[0.1, 0.2, 0.4])
+    block.apply_transform(trimesh.transformations.euler_matrix(0.3, 0.5, 0.7))
+    block.apply_translation([0.3, 0.1, 0.2])
+    block.export(tmp_path / "block.stl")
+    path = tmp_path / "fit.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true"/><default><default class="collision">'
+                    f'<geom type="{kind}" group="3"/></default></default><asset><mesh name="m" file="block.stl" '
+                    'scale="1 1.5 1"/></asset><worldbody><body name="b"><freejoint/><geom class="collision" mesh="m" '
+                    'pos="0.01 0 0.02" euler="0.1 0.2 0.3" fitscale="1.2"/></body></worldbody></mujoco>')
+    robot = read_robot(path)
+    assert robot.links[0].elements[0].fit_scale == 1.2
+    _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-6)     # float32 STL corners

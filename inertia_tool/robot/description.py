@@ -137,6 +137,10 @@ class GeometryElement:
         kg the description gives this element (MJCF geom ``mass``; overrides ``density``); None if not given.
     shell : bool
         The description puts the element's mass on its surface (MJCF ``shellinertia``, ``<mesh inertia="shell">``).
+    fit_scale : float or None
+        MJCF: a primitive (``kind`` box, sphere, ...) with a ``mesh`` and no size takes its size from the mesh
+        (MuJoCo fits it to the mesh's equivalent inertia box, times ``fitscale``); ``size`` is empty until
+        :func:`inertia_tool.robot.geometry.fitted_element` fits it.  None for every other element.
     """
 
     kind: str
@@ -152,6 +156,7 @@ class GeometryElement:
     density: float | None = None
     mass: float | None = None
     shell: bool = False
+    fit_scale: float | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))

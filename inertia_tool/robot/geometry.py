@@ -38,7 +38,7 @@ from ..values import frozen_value
 from .description import GeometryElement, LinkGeometry, RobotDescription
 
 __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", "LinkInertial", "mesh_properties",
-           "points_inside_element", "element_bounds", "LinkUncertainty", "METHODS", "MODEL_DENSITY"]
+           "points_inside_element", "element_bounds", "LinkUncertainty", "METHODS", "MODEL_DENSITY", "fitted_element"]
 
 #: What ``LinkInertial.method`` can say: ``"exact"`` (closed forms, and meshes integrated exactly, after
 #: orienting, welding or dropping repeated faces), ``"united"`` (overlapping bodies of a mesh united by a
@@ -129,6 +129,7 @@ def element_shell_properties(element: GeometryElement) -> MassProperties:
     triangles of a mesh (any winding, open or closed) through :func:`inertia_tool.mass.surface.surface_moments`.
     An ellipsoid's surface has no closed form (MuJoCo approximates it): :class:`UsageError`.
     """
+    element = fitted_element(element)
     kind, size = element.kind, element.size
     if kind == "sphere":
         local = shell_shapes.sphere_shell(size[0])
@@ -150,6 +151,52 @@ def element_shell_properties(element: GeometryElement) -> MassProperties:
         raise UsageError(f"Expected a shell of a sphere, box, cylinder, capsule or mesh, got {kind!r} "
                          f"({element.name}): an ellipsoid's surface has no closed form")
     return local.transformed(rotation=element.rotation, translation=element.translation)
+
+
+def fitted_element(element: GeometryElement, *, cache: dict | None = None, repair: bool = False,
+                   budget: list | None = None) -> GeometryElement:
+    """The primitive MuJoCo fits to a mesh (``<geom type="capsule" mesh="...">`` without a size).
+
+    MuJoCo's default fit (``<compiler fitaabb="false">``): the mesh's equivalent inertia box — the box of the
+    same volume and principal moments, half-sizes ``h_k = √(3 (I_i + I_j − I_k) / (2 V))`` at unit density
+    (from ``I_k = V (h_i² + h_j²) / 3``) — placed at the mesh's centre of volume along its principal axes,
+    ordered so that the x axis has the largest moment (the smallest ``h``) and z the smallest (the largest
+    ``h``).  Then, times ``fitscale``: a box or an ellipsoid takes ``(h_x, h_y, h_z)``, a sphere the mean of
+    the three, a cylinder radius ``(h_x + h_y)/2`` and half-length ``h_z``, a capsule the same radius ``r`` and
+    half-length ``max(0, h_z − r/2)`` (checked against MuJoCo 4.0).  MuJoCo uses the mesh's own inertia
+    mode for the moments (``legacy`` by default), which equals the solid's only for convex meshes; this fit
+    uses the solid.  Elements that are not fitted are returned as they are.
+    """
+    if element.fit_scale is None:
+        return element
+    props = element_mass_properties(GeometryElement("mesh", np.eye(3), np.zeros(3), mesh=element.mesh,
+                                                    uri=element.uri, scale=element.scale, name=element.name,
+                                                    reference_rotation=element.reference_rotation,
+                                                    reference_translation=element.reference_translation),
+                                    cache=cache, repair=repair, budget=budget)
+    moments, axes = np.linalg.eigh(0.5 * (props.inertia + props.inertia.T))
+    axes = axes[:, ::-1]                                 # x: the largest moment, z: the smallest
+    if np.linalg.det(axes) < 0:
+        axes[:, 2] = -axes[:, 2]
+    m = moments[::-1]
+    volume = props.volume
+    half = np.sqrt(np.maximum(0.0, 3.0 * np.array([m[1] + m[2] - m[0], m[0] + m[2] - m[1],
+                                                     m[0] + m[1] - m[2]]) / (2.0 * volume)))
+    half = half * element.fit_scale
+    kind = element.kind
+    if kind == "sphere":
+        size: tuple = (float(np.mean(half)),)
+    elif kind in ("cylinder", "capsule"):
+        radius = 0.5 * (half[0] + half[1])
+        length = half[2] if kind == "cylinder" else max(0.0, half[2] - 0.5 * radius)
+        size = (radius, 2.0 * length)
+    elif kind == "box":
+        size = tuple(2.0 * half)
+    else:
+        size = tuple(half)
+    return GeometryElement(kind, element.rotation @ axes, element.rotation @ props.center_of_mass + element.translation,
+                           size=size, name=element.name, density=element.density, mass=element.mass,
+                           shell=element.shell)
 
 
 def element_mass_properties(element: GeometryElement, *, cache: dict | None = None,
@@ -178,6 +225,8 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     InvalidMeshError, MeshReadError
         From the mesh engine, for a mesh element.
     """
+    if element.fit_scale is not None:
+        element = fitted_element(element, cache=cache, repair=repair, budget=budget)
     kind, size = element.kind, element.size
     if kind == "box":
         local = shapes.box(*size).exact
@@ -490,6 +539,7 @@ def _mesh_vertices_faces(element: GeometryElement):
 
 def element_bounds(element: GeometryElement) -> np.ndarray:
     """(2, 3) m: the link-frame axis-aligned bounding box of the element (lower, upper corners)."""
+    element = fitted_element(element)
     kind, size = element.kind, element.size
     if kind == "mesh":
         v, _ = _mesh_vertices_faces(element)
@@ -511,6 +561,7 @@ def element_bounds(element: GeometryElement) -> np.ndarray:
 
 def points_inside_element(element: GeometryElement, point) -> bool:
     """Whether ``point`` (m, link frame) lies inside the element (meshes: winding number ≥ ½)."""
+    element = fitted_element(element)
     local = element.rotation.T @ (np.asarray(point, dtype=np.float64) - element.translation)
     kind, size = element.kind, element.size
     if kind == "box":

@@ -279,7 +279,6 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
 
 def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler, source: str) -> dict:
     """``{name: (file, folders, scale, reference rotation, reference translation, shell)}`` of every mesh asset."""
-    degrees, eulerseq = compiler
     meshes = {}
     for asset in root.findall("asset"):
         for mesh in asset.findall("mesh"):
@@ -316,7 +315,7 @@ def _optional_number(attrs: dict, key: str, what: str, source: str) -> float | N
 
 def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict, compiler,
           source: str) -> GeometryElement:
-    degrees, eulerseq = compiler
+    degrees, eulerseq, fitaabb = compiler
     what = f"body {link!r} {label}"
     kind = _GEOM_KINDS.get(attrs.get("type", "sphere"))
     if kind is None:
@@ -347,6 +346,21 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
             raise _fail(source, f"{what}: {kind} needs {count} size values, got {attrs.get('size')!r}")
         return [_positive(s, f"{what} size", source) for s in size[:count]]
 
+    if kind != "mesh" and attrs.get("mesh") is not None and attrs.get("fromto") is None:
+        # a primitive fitted to a mesh (arx_l5: type="capsule" from a class, mesh="link1", no size)
+        mesh_name = attrs.get("mesh")
+        if mesh_name not in meshes:
+            raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
+        if fitaabb:
+            raise _fail(source, f"{what}: a {kind} fitted to mesh {mesh_name!r} with <compiler fitaabb=\"true\"> "
+                                "is not supported (only MuJoCo's default fit to the equivalent inertia box)")
+        file, folders, scale, ref_rotation, ref_translation, _shell = meshes[mesh_name]
+        found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
+        path = resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
+        fit = float(_numbers(attrs.get("fitscale"), 1, f"{what} fitscale", source, default=(1.0,))[0])
+        return GeometryElement(kind, rotation, position, mesh=path, uri=file, scale=scale, name=name,
+                               reference_rotation=ref_rotation, reference_translation=ref_translation,
+                               fit_scale=_positive(fit, f"{what} fitscale", source), **mass_model)
     if kind == "mesh":
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
@@ -382,7 +396,7 @@ def _inertial(body, name: str, compiler, source: str) -> DeclaredInertial | None
     inertial = body.find("inertial")
     if inertial is None:
         return None
-    degrees, eulerseq = compiler
+    degrees, eulerseq, _ = compiler
     what = f"body {name!r} <inertial>"
     attrs = dict(inertial.attrib)
     position = _coordinates(_numbers(attrs.get("pos"), 3, f"{what} pos", source), f"{what} pos", source)
@@ -448,9 +462,10 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
         raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
     fallbacks = _expand_includes(root, source)
     degrees, eulerseq, meshdir = _compiler(root, source)
+    fitaabb = any(c.get("fitaabb") == "true" for c in root.iter("compiler"))
     mesh_base = os.path.join(base, meshdir or "")
     defaults = _Defaults(root, source)
-    compiler = (degrees, eulerseq)
+    compiler = (degrees, eulerseq, fitaabb)
     meshes = _meshes(root, defaults, mesh_base, fallbacks, compiler, source)
     links = []
     counter = [0]
