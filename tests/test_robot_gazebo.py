@@ -156,7 +156,7 @@ def test_xacro_find_uses_package_xml_two_folders_up(tmp_path, monkeypatch):
     src = pkg / "urdf" / "robot.urdf.xacro"
     src.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
                    '<xacro:include filename="$(find my_desc)/urdf/inc/part.xacro"/><xacro:part/></robot>')
-    (link,) = read_robot(src).links
+    (link,) = read_robot(src, run_xacro=True).links
     assert link.name == "p" and link.elements[0].size == pytest.approx((0.1, 0.2, 0.3))
 
 
@@ -168,7 +168,7 @@ def test_xacro_failures_are_one_clean_sentence(tmp_path, monkeypatch):
     src.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
                    '<xacro:include filename="$(find nowhere_pkg)/x.xacro"/></robot>')
     with pytest.raises(RobotDescriptionError) as info:
-        read_robot(src)
+        read_robot(src, run_xacro=True)
     message = str(info.value)
     # was: "xacro expansion failed (<class 'inertia_tool.errors.RobotDescriptionError'>: $(find nowhere_pkg):
     # package 'nowhere_pkg' is not among ... $(find nowhere_pkg): package 'nowhere_pkg' i)"
@@ -178,7 +178,7 @@ def test_xacro_failures_are_one_clean_sentence(tmp_path, monkeypatch):
     src.write_text(f'<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="a"><collision>'
                    f'<geometry><box size="${{{long_name} * 2}} 1 1"/></geometry></collision></link></robot>')
     with pytest.raises(RobotDescriptionError) as info:
-        read_robot(src)
+        read_robot(src, run_xacro=True)
     message = str(info.value)
     assert "<class" not in message and message.endswith(" …")
     quoted = message.split("xacro expansion failed: ", 1)[1][:-2]

@@ -109,7 +109,8 @@ def _run_corpus(args, packages: dict) -> int:
         density = (MODEL_DENSITY if args.density.strip() == MODEL_DENSITY
                    else check_option("--density", parse_density(args.density), typed=args.density))
     models = audit_corpus(args.robot, density=density, material=args.material, keep_mass=args.keep_mass,
-                          repair=args.repair, packages=packages, geometry=args.geometry, max_faces=args.max_faces)
+                          repair=args.repair, packages=packages, geometry=args.geometry, max_faces=args.max_faces,
+                          run_xacro=args.run_xacro)
     if not models:
         raise UsageError(f"no robot description found in {', '.join(args.robot)}")
     if args.json:

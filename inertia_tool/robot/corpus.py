@@ -105,7 +105,7 @@ def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
 
 def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass: bool = False,
                  repair: bool = False, packages: dict | None = None, geometry: str = "collision",
-                 **options) -> tuple:
+                 run_xacro: bool = False, **options) -> tuple:
     """Read, compute and audit every description under ``paths``; one :class:`ModelAudit` each.
 
     Parameters are those of :func:`~inertia_tool.robot.read_robot`, :func:`~inertia_tool.robot.link_inertials`
@@ -114,7 +114,7 @@ def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass:
     out = []
     for path in find_descriptions(paths):
         try:
-            robot = read_robot(path, packages=packages, geometry=geometry)
+            robot = read_robot(path, packages=packages, geometry=geometry, run_xacro=run_xacro)
             inertials = link_inertials(robot, density=density, material=material, keep_mass=keep_mass,
                                        repair=repair, **options)
             audits = audit_links(robot, inertials, keep_mass=keep_mass)

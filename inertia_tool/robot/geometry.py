@@ -41,15 +41,15 @@ __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", 
            "points_inside_element", "element_bounds", "LinkUncertainty", "METHODS", "MODEL_DENSITY", "fitted_element"]
 
 #: What ``LinkInertial.method`` can say: ``"exact"`` (closed forms, and meshes integrated exactly, after
-#: orienting, welding or dropping repeated faces), ``"united"`` (overlapping bodies of a mesh united by a
-#: boolean, then exact), ``"summed"`` (overlapping bodies added, the shared volume counted twice, as asked),
-#: ``"estimate"`` (a repaired open mesh: see ``uncertainty``).
+#: orienting, welding, sealing cracks without moving a point or dropping repeated faces), ``"united"``
+#: (overlapping bodies of a mesh united by a boolean, then exact), ``"summed"`` (overlapping bodies added, the
+#: shared volume counted twice, as asked), ``"estimate"`` (a repaired open mesh: see ``uncertainty``).
 METHODS = ("exact", "united", "summed", "estimate")
 
 #: The value of ``density`` (and of ``robot --density``) that asks for the description's own densities.
 MODEL_DENSITY = "model"
 
-_MESH_METHOD = {"exact": "exact", "oriented": "exact", "welded": "exact", "deduplicated": "exact",
+_MESH_METHOD = {"exact": "exact", "oriented": "exact", "welded": "exact", "deduplicated": "exact", "sealed": "exact",
                 "union": "united", "sum": "summed", "patched": "estimate", "winding": "estimate"}
 
 
@@ -279,7 +279,9 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
             continue
         props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
         report = cache[element.mesh].mesh if element.kind == "mesh" and element.mesh in cache else None
-        method = _MESH_METHOD.get(report.method, "estimate") if report is not None else "exact"
+        method = "exact"
+        if report is not None:          # a result with bounds is an estimate, whatever the repair was called
+            method = "estimate" if report.uncertainty is not None else _MESH_METHOD.get(report.method, "estimate")
         parts.append((element, props, method, report.uncertainty if report is not None else None))
     return parts, massless
 
