@@ -193,3 +193,20 @@ def test_xacro_message_drops_class_names_and_repeats():
     words = " ".join(f"word{k}" for k in range(200))
     cut = _xacro_message(ValueError(words))
     assert cut.endswith(" …") and cut[:-2] in words and words[len(cut) - 2] == " "
+
+
+def test_includes_that_multiply_are_bounded(tmp_path):
+    # each level includes the next twice: 2**12 reads without a bound on the total
+    for k in range(12):
+        (tmp_path / f"m{k}.sdf").write_text(f'<sdf version="1.6"><model name="m{k}">'
+                                            f'<include><uri>m{k + 1}.sdf</uri><name>a</name></include>'
+                                            f'<include><uri>m{k + 1}.sdf</uri><name>b</name></include></model></sdf>')
+    (tmp_path / "m12.sdf").write_text('<sdf version="1.6"><model name="leaf"><link name="l"/></model></sdf>')
+    with pytest.raises(RobotDescriptionError, match="more than 512 files"):
+        read_robot(tmp_path / "m0.sdf")
+    for k in range(12):
+        (tmp_path / f"j{k}.xml").write_text(f'<mujoco><include file="j{k + 1}.xml"/><include file="j{k + 1}.xml"/>'
+                                            '</mujoco>')
+    (tmp_path / "j12.xml").write_text('<mujoco/>')
+    with pytest.raises(RobotDescriptionError, match="more than 512 included files"):
+        read_robot(tmp_path / "j0.xml")

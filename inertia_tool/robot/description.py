@@ -613,6 +613,9 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
 #: Deepest chain of SDFormat ``<include>`` and nested ``<model>`` followed.
 MAX_SDF_NESTING = 16
 
+#: Most files the ``<include>``s of one SDFormat description read (repeats counted).
+MAX_SDF_INCLUDES = 512
+
 
 def _sdf_include_file(include, base: str, packages: dict, source: str) -> str:
     """The SDFormat file an ``<include><uri>`` names: a file, or a model folder (its ``model.config``'s
@@ -648,8 +651,13 @@ def _sdf_include_file(include, base: str, packages: dict, source: str) -> str:
     return path
 
 
-def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, source: str, stack: tuple) -> list:
-    """The links of ``model`` and of its nested and included models (names prefixed ``model::``)."""
+def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, source: str, stack: tuple,
+               budget: list | None = None) -> list:
+    """The links of ``model`` and of its nested and included models (names prefixed ``model::``).
+
+    ``budget``: ``[files, bytes]`` the includes may still read (at most ``MAX_SDF_INCLUDES`` files and
+    :data:`MAX_DESCRIPTION_BYTES` bytes in all, so repeated includes cannot multiply without bound)."""
+    budget = [MAX_SDF_INCLUDES, MAX_DESCRIPTION_BYTES] if budget is None else budget
     if len(stack) > MAX_SDF_NESTING:
         raise _fail(source, f"models nested or included more than {MAX_SDF_NESTING} deep")
     links = []
@@ -665,13 +673,19 @@ def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, sou
             links.append(LinkGeometry(name=prefix + name, elements=elements, declared=_sdf_inertial(child, source)))
         elif child.tag == "model":
             links += _sdf_links(child, f"{prefix}{child.get('name', '')}::", base, packages, geometry, source,
-                                stack + (f"model {child.get('name')}",))
+                                stack + (f"model {child.get('name')}",), budget)
         elif child.tag == "include":
             path = _sdf_include_file(child, base, packages, source)
             key = os.path.realpath(path)
             if key in stack:
                 raise _fail(source, f"<include> of {path} includes itself")
-            root = parse_xml(_read_bytes(path), path).getroot()
+            data = _read_bytes(path)
+            budget[0] -= 1
+            budget[1] -= len(data)
+            if budget[0] < 0 or budget[1] < 0:
+                raise _fail(source, f"<include>s read more than {MAX_SDF_INCLUDES} files or "
+                                    f"{MAX_DESCRIPTION_BYTES:,} bytes in all")
+            root = parse_xml(data, path).getroot()
             inner = root.findall("model")
             if root.tag != "sdf" or len(inner) > 1:
                 raise _fail(source, f"<include>: {path} is not an SDFormat file with one <model>")
@@ -679,7 +693,7 @@ def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, sou
                 continue
             name = (child.findtext("name") or "").strip() or inner[0].get("name", "")
             links += _sdf_links(inner[0], f"{prefix}{name}::", os.path.dirname(path), packages, geometry, source,
-                                stack + (key,))
+                                stack + (key,), budget)
     return links
 
 

@@ -18,7 +18,8 @@ MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
 
 * ``<include file>`` is replaced by the children of the included ``<mujoco>``, recursively; the file is looked
   up relative to the main model's folder first, then relative to the including file's folder.  At most
-  :data:`MAX_INCLUDE_DEPTH` levels and :data:`MAX_INCLUDED_FILES` files; a file that includes itself
+  :data:`MAX_INCLUDE_DEPTH` levels, :data:`MAX_INCLUDED_FILES` files and ``MAX_DESCRIPTION_BYTES`` bytes
+  in all; a file that includes itself
   (directly or not) is refused.  A mesh is found through the merged ``<compiler meshdir>`` relative to the
   main model's folder; a mesh declared in an included file that is not found there is looked up through that
   file's own ``meshdir``, relative to its folder.
@@ -229,10 +230,11 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
     file's own mesh folder, then those of the files that included it, outwards (used when MuJoCo's
     main-folder lookup finds nothing).
     """
-    from .description import _read_bytes, parse_xml
+    from .description import MAX_DESCRIPTION_BYTES, _read_bytes, parse_xml
     main_folder = os.path.dirname(os.path.abspath(source))
     fallbacks: dict = {}
     count = [0]
+    total = [os.path.getsize(source) if os.path.isfile(source) else 0]
 
     def expand(element, including: str, stack: tuple, chain: tuple) -> None:
         for include in list(element.iter("include")):
@@ -255,7 +257,12 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
             count[0] += 1
             if count[0] > max_files:
                 raise _fail(source, f"more than {max_files} included files")
-            included = parse_xml(_read_bytes(path), path).getroot()
+            data = _read_bytes(path)
+            total[0] += len(data)
+            if total[0] > MAX_DESCRIPTION_BYTES:
+                raise _fail(source, f"the included files hold more than the {MAX_DESCRIPTION_BYTES:,} bytes a robot "
+                                    "description may have, all files together")
+            included = parse_xml(data, path).getroot()
             if included.tag != "mujoco":
                 raise _fail(source, f"<include file={name!r}>: {path} has the root element <{included.tag}>, "
                                     "expected <mujoco>")
