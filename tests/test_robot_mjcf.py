@@ -299,3 +299,19 @@ def test_a_primitive_fitted_to_a_mesh_matches_mujoco(tmp_path, kind):
     robot = read_robot(path)
     assert robot.links[0].elements[0].fit_scale == 1.2
     _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-6)     # float32 STL corners
+
+
+def test_all_geoms_with_the_models_densities_is_mujocos_inertia_from_geometry(tmp_path):
+    # Menagerie style: visual geoms (contype 0) with their default density count in MuJoCo's inertia from
+    # geometry, a geom outside inertiagrouprange does not; --geometry all --density model reproduces it
+    path = tmp_path / "g.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true" inertiagrouprange="0 3"/><default>'
+                    '<default class="visual"><geom contype="0" conaffinity="0" group="2"/></default></default>'
+                    '<worldbody><body name="b"><freejoint/><geom type="box" size="0.1 0.2 0.3" group="3"/>'
+                    '<geom class="visual" type="sphere" size="0.1" pos="0.3 0 0" density="500"/>'
+                    '<geom type="sphere" size="0.2" pos="0 0.5 0" group="4"/></body></worldbody></mujoco>')
+    results = link_inertials(read_robot(path, geometry="all"), density="model")
+    _assert_like_mujoco(path, results, rtol=1e-12)
+    with pytest.raises(UsageError, match="MJCF only"):
+        from robot_data import UR5, PACKAGES
+        read_robot(UR5, packages=PACKAGES, geometry="all")

@@ -52,7 +52,8 @@ def register(subparsers) -> None:
                         "variables, under CPU, memory and wall-clock limits (INERTIA_TOOL_CPU_LIMIT, "
                         "INERTIA_TOOL_MEMORY_LIMIT, INERTIA_TOOL_WALL_LIMIT). Without it a xacro file is refused")
     p.add_argument("--geometry", choices=GEOMETRY_KINDS, default="collision",
-                   help="which geometry of each link to integrate (default: collision)")
+                   help="which geometry of each link to integrate (default: collision; MJCF also 'all': every geom "
+                        "in <compiler inertiagrouprange>, as MuJoCo's inertia from geometry)")
     m = p.add_mutually_exclusive_group(required=True)
     m.add_argument("--density", metavar="RHO",
                    help="density of every link, kg/m³ by default (or e.g. 2.7g/cm3); 'model' takes the MJCF "

@@ -40,8 +40,9 @@ __all__ = ["GeometryElement", "DeclaredInertial", "LinkGeometry", "RobotDescript
            "rpy_to_matrix", "GEOMETRY_KINDS", "ROBOT_SUFFIXES", "PRIMITIVES", "parse_decimal", "MAX_ROBOT_LINKS",
            "ROBOT_LENGTH_RANGE", "ROBOT_SCALE_RANGE"]
 
-#: Which geometry of a link to take: ``<collision>`` (default; usually simpler, closed meshes) or ``<visual>``.
-GEOMETRY_KINDS = ("collision", "visual")
+#: Which geometry of a link to take: ``<collision>`` (default; usually simpler, closed meshes) or ``<visual>``;
+#: for MJCF also ``"all"``: every geom in ``<compiler inertiagrouprange>``, as MuJoCo's inertia from geometry.
+GEOMETRY_KINDS = ("collision", "visual", "all")
 
 #: Primitive shapes with closed-form mass properties.
 PRIMITIVES = ("box", "cylinder", "sphere", "capsule", "ellipsoid")
@@ -796,6 +797,9 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
     if fmt == "mjcf":
         from .mjcf import read_mjcf
         name, links = read_mjcf(root, source, base, packages, geometry)
+    elif geometry == "all":
+        raise UsageError(f"Expected `geometry` collision or visual for {source} (a {fmt.upper()} link's visual "
+                         "and collision elements describe the same part), got 'all' (MJCF only)")
     elif fmt in ("urdf", "xacro"):
         name, links = _read_urdf(root, source, base, packages, geometry)
     else:

@@ -429,6 +429,16 @@ def _is_collision(attrs: dict, what: str, source: str) -> bool:
     return any(b != 0 for b in bits)
 
 
+def _selected(attrs: dict, geometry: str, groups: tuple, what: str, source: str) -> bool:
+    """Whether a geom belongs to the chosen geometry: collision (``contype``/``conaffinity`` not both 0),
+    visual (both 0), or ``"all"``: every geom whose ``group`` lies in ``<compiler inertiagrouprange>``
+    (MuJoCo's default 0–5), the geoms MuJoCo's inertia from geometry counts."""
+    if geometry == "all":
+        group = _numbers(attrs.get("group", "0"), 1, f"{what} group", source)[0]
+        return groups[0] <= group <= groups[1]
+    return _is_collision(attrs, what, source) == (geometry == "collision")
+
+
 #: Most copies one ``<replicate>`` may make (and all of them together).
 MAX_REPLICAS = 10_000
 
@@ -470,6 +480,9 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
     fallbacks = _expand_includes(root, source)
     degrees, eulerseq, meshdir = _compiler(root, source)
     fitaabb = any(c.get("fitaabb") == "true" for c in root.iter("compiler"))
+    group_range = next((c.get("inertiagrouprange") for c in reversed(list(root.iter("compiler")))
+                        if c.get("inertiagrouprange") is not None), "0 5")
+    groups = tuple(_numbers(group_range, 2, "<compiler inertiagrouprange>", source))
     mesh_base = os.path.join(base, meshdir or "")
     defaults = _Defaults(root, source)
     compiler = (degrees, eulerseq, fitaabb)
@@ -493,7 +506,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
         for child in element:
             if child.tag == "geom":
                 attrs = defaults.attributes(child, class_name, source)
-                if _is_collision(attrs, f"body {link!r} geom {len(elements) + 1}", source) == (geometry == "collision"):
+                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", source):
                     label = f"geom {len(elements) + 1}"
                     elements.append(_geom(attrs, pose, label, link, meshes, packages, compiler, source))
             elif child.tag == "frame":
