@@ -315,3 +315,29 @@ def test_all_geoms_with_the_models_densities_is_mujocos_inertia_from_geometry(tm
     with pytest.raises(UsageError, match="MJCF only"):
         from robot_data import UR5, PACKAGES
         read_robot(UR5, packages=PACKAGES, geometry="all")
+
+
+def test_menagerie_2f85_finger_matches_mujoco_body_by_body():
+    # real MJCF (MuJoCo Menagerie robotiq_2f85, the right linkage; tests/data/README.md): classes, mesh classes
+    # with a scale, massless pad boxes (mass="0" in a class), visual geoms of the default density; every geom
+    # in inertiagrouprange with the file's densities against MuJoCo's compiler with exact mesh inertia
+    from pathlib import Path
+    path = Path(__file__).parent / "data" / "robots" / "menagerie_2f85" / "2f85_right_finger.xml"
+    spec = mujoco.MjSpec.from_file(str(path))
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_TRUE
+    for mesh in spec.meshes:
+        mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
+    model = spec.compile()
+    results = {r.name: r for r in link_inertials(read_robot(path, geometry="all"), density="model")}
+    assert len(results) == model.nbody - 1
+    for i in range(1, model.nbody):
+        rot = np.zeros(9)
+        mujoco.mju_quat2Mat(rot, model.body_iquat[i])
+        rot = rot.reshape(3, 3)
+        props = results[model.body(i).name].properties
+        assert props.mass == pytest.approx(model.body_mass[i], rel=1e-6)         # float32 STL corners
+        np.testing.assert_allclose(props.center_of_mass, model.body_ipos[i], atol=1e-8)
+        assert_tensor_close(props.inertia, rot @ np.diag(model.body_inertia[i]) @ rot.T, 1e-6)
+    pad = {r.name: r for r in link_inertials(read_robot(path), density="model")}["right_pad"]
+    assert pad.properties is None and pad.problem == "every geom is massless in the description"
+    assert [w.split(" is massless")[0] for w in pad.warnings] == ["box 'right_pad1'", "box 'right_pad2'"]
