@@ -341,3 +341,23 @@ def test_menagerie_2f85_finger_matches_mujoco_body_by_body():
     pad = {r.name: r for r in link_inertials(read_robot(path), density="model")}["right_pad"]
     assert pad.properties is None and pad.problem == "every geom is massless in the description"
     assert [w.split(" is massless")[0] for w in pad.warnings] == ["box 'right_pad1'", "box 'right_pad2'"]
+
+
+def test_a_capsule_fitted_to_an_open_mesh_with_repair_is_audited_without_stopping(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    from conftest import write_binary_stl
+    from inertia_tool.robot import audit_links
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=0.1)
+    ball.apply_scale([1.0, 1.5, 3.0])
+    write_binary_stl(tmp_path / "open.stl", ball.vertices, ball.faces[:-1])     # one small triangle missing
+    path = tmp_path / "o.xml"
+    path.write_text('<mujoco><asset><mesh name="m" file="open.stl"/></asset><worldbody><body name="b">'
+                    '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/><geom type="capsule" mesh="m"/></body>'
+                    '<body name="c"><geom type="sphere" size="0.1"/></body></worldbody></mujoco>')
+    robot = read_robot(path)
+    results = link_inertials(robot, density=1000, repair=True)
+    assert results[0].properties is not None and results[1].properties is not None
+    audits = audit_links(robot, results)
+    assert audits[0].com_inside_geometry is None and audits[0].issues        # no box without repair: unknown
+    unrepaired = link_inertials(robot, density=1000)
+    assert unrepaired[0].properties is None and "mesh needs repair" in unrepaired[0].problem

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InertiaToolError
 from ..mass.properties import MassProperties
 from ..units import MATERIALS
 from ..values import frozen_value
@@ -170,11 +171,16 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
         nan = float("nan")
         mass_ratio = com_distance = com_rel = inertia_diff = implied = size = nan
         plausible = in_box = inside = None
+        lo = hi = None
         if link.elements and computed is not None:
-            bounds = [element_bounds(e) for e in link.elements]
-            lo = np.min([b[0] for b in bounds], axis=0)
-            hi = np.max([b[1] for b in bounds], axis=0)
-            size = float(np.linalg.norm(hi - lo))
+            try:
+                bounds = [element_bounds(e) for e in link.elements]
+            except (InertiaToolError, ValueError):      # a mesh the engine only read with repair: no box
+                bounds = []
+            if bounds:
+                lo = np.min([b[0] for b in bounds], axis=0)
+                hi = np.max([b[1] for b in bounds], axis=0)
+                size = float(np.linalg.norm(hi - lo))
         if computed is not None and declared is not None and declared.mass > 0:
             mass_ratio = declared.mass / computed.mass
             com_distance = float(np.linalg.norm(declared.center_of_mass - computed.center_of_mass))
@@ -184,8 +190,12 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
             implied = declared.mass / computed.volume
             plausible = bool(DENSITY_RANGE[0] <= implied <= DENSITY_RANGE[1])
             c = declared.center_of_mass
-            in_box = bool(np.all(c >= lo - 1e-12 * size) and np.all(c <= hi + 1e-12 * size))
-            inside = bool(in_box and any(points_inside_element(e, c) for e in link.elements))
+            if lo is not None and hi is not None:
+                in_box = bool(np.all(c >= lo - 1e-12 * size) and np.all(c <= hi + 1e-12 * size))
+                try:
+                    inside = bool(in_box and any(points_inside_element(e, c) for e in link.elements))
+                except (InertiaToolError, ValueError):
+                    inside = None
             if not keep_mass and abs(mass_ratio - 1.0) > mass_tolerance:
                 issues.append(f"declared mass {declared.mass:.4g} kg is {mass_ratio:.3g}× the geometry's "
                               f"{computed.mass:.4g} kg")
@@ -202,9 +212,9 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
                                            computed.inertia, tolerance=inertia_tolerance,
                                            geometry_volume=computed.volume, density_range=DENSITY_RANGE)
                 issues += [f"likely cause: {c.explanation}" for c in causes]
-            if not in_box:
+            if in_box is False:
                 issues.append("declared centre of mass lies outside the link geometry's bounding box")
-            elif not inside:
+            elif inside is False:
                 issues.append("declared centre of mass lies outside the link geometry (in its bounding box)")
         out.append(LinkAudit(name=link.name, declared=declared, computed=computed, mass_ratio=mass_ratio,
                              com_distance=com_distance, com_distance_relative=com_rel, inertia_difference=inertia_diff,
