@@ -46,7 +46,7 @@ def check_contract(argv, code, out, err):
     assert code != 1, f"{shown}: exit 1\n{err}"
     assert "Traceback" not in err and "internal error" not in err, f"{shown}\n{err}"
     assert not _CONTROL.search(err) and not _CONTROL.search(out), f"{shown}: control character printed"
-    if code == 0 and "--json" in argv:
+    if code in (0, 5) and "--json" in argv:      # 5: robot, a link without a result (the report is complete)
         assert _finite(json.loads(out)), f"{shown}: non-finite number in JSON"
 
 
@@ -286,7 +286,7 @@ def test_any_number_in_a_urdf_is_a_result_or_a_clear_error(tmp_path_factory, sha
         argv = ["robot", path, *extra]
         code, out, err = run_cli(argv)
         check_contract(argv, code, out, err)
-        assert code in (0, 3), err
+        assert code in (0, 3, 5), err              # 5: e.g. --keep-mass with a declared mass of 0
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
