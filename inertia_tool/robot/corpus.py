@@ -18,7 +18,7 @@ import re
 from ..errors import InertiaToolError, UsageError
 from ..values import frozen_value
 from .audit import audit_links
-from .description import RobotDescription, read_robot
+from .description import MAX_DESCRIPTION_BYTES, RobotDescription, read_robot
 from .geometry import link_inertials
 
 __all__ = ["ModelAudit", "find_descriptions", "audit_corpus", "MAX_CORPUS_FILES", "SNIFF_BYTES"]
@@ -95,7 +95,7 @@ def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
     for path in found:
         if os.path.splitext(path)[1].lower() in (".xml", ".mjcf") and _root_kind(path) == "mujoco":
             with open(path, "rb") as fh:
-                text = fh.read(MAX_CORPUS_FILES * 100)
+                text = fh.read(MAX_DESCRIPTION_BYTES)
             for name in _INCLUDE.findall(text):
                 target = os.path.normpath(os.path.join(os.path.dirname(path), os.fsdecode(name)))
                 if target != os.path.normpath(path):
