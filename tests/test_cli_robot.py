@@ -148,3 +148,11 @@ def test_engine_warnings_about_a_links_mesh_are_in_its_json_warnings(capsys):
     assert any("wrist3.stl: overlapping bodies united" in w for w in links["wrist_3_link"]["warnings"])
     assert links["wrist_3_link"]["method"] == "united" and links["base_link"]["warnings"] == []
     assert "wrist3.stl: overlapping bodies united" in captured.err          # still said on stderr
+
+
+def test_writing_an_mjcf_that_ignores_inertials_says_so(tmp_path, capsys):
+    src = tmp_path / "m.xml"
+    src.write_text("<mujoco><compiler inertiafromgeom='true'/><worldbody><body name='b'><freejoint/>"
+                   "<geom type='box' size='0.1 0.2 0.3'/></body></worldbody></mujoco>")
+    assert main(["robot", str(src), "--density", "1000", "--write", str(tmp_path / "out.xml")]) == 0
+    assert 'inertiafromgeom="true"> makes MuJoCo compute the inertias from the geoms' in capsys.readouterr().err

@@ -155,6 +155,9 @@ def run(args) -> int:
         message = f"wrote {args.write}: <inertial> of {len(changed)} link{'' if len(changed) == 1 else 's'} corrected"
         if skipped:
             message += f"; left as they were: {', '.join(skipped)}"
+        if robot.format == "mjcf" and b'inertiafromgeom="true"' in robot.document.replace(b"'", b'"'):
+            message += ('; note: <compiler inertiafromgeom="true"> makes MuJoCo compute the inertias from the geoms '
+                        "and ignore every <inertial>, these included")
         print(escape_terminal(message), file=sys.stderr)
     if args.json:
         print(json.dumps(robot_report_dict(robot, inertials, audits), indent=2, ensure_ascii=False))
