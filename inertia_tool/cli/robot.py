@@ -10,6 +10,7 @@ import sys
 from ..errors import UsageError
 from ..mesh.options import DEFAULT_MAX_FACES
 from ..reports.robot_audit import format_robot_report, robot_report_dict
+from ..reports.serialize import command_output
 from ..robot.audit import audit_links
 from ..robot.description import GEOMETRY_KINDS, read_robot
 from ..robot.geometry import link_inertials
@@ -19,6 +20,7 @@ from . import speak_options
 from .help import add_command
 from .options import check_option
 from ..reports.escape import escape_terminal
+from .model_options import recorded_warnings
 from .report_option import check_output_file
 
 __all__ = ["register", "run", "parse_packages", "parse_mappings"]
@@ -105,11 +107,12 @@ def run(args) -> int:
     check_option("--max-faces", args.max_faces)
     density = check_option("--density", parse_density(args.density), typed=args.density) \
         if args.density is not None else None
-    robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings,
-                       run_xacro=args.run_xacro)
-    inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
-                               repair=args.repair, max_faces=args.max_faces)
-    audits = audit_links(robot, inertials, keep_mass=args.keep_mass)
+    with recorded_warnings(args, parser=getattr(args, "robot_parser", None)) as messages:
+        robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings,
+                           run_xacro=args.run_xacro)
+        inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
+                                   repair=args.repair, max_faces=args.max_faces)
+        audits = audit_links(robot, inertials, keep_mass=args.keep_mass)
     if args.write:
         basis = next((r.basis for r in inertials if r.properties is not None), "")
         note = "declared masses kept" if args.keep_mass else f"density {basis}"
@@ -120,7 +123,8 @@ def run(args) -> int:
             message += f"; left as they were: {', '.join(skipped)}"
         print(escape_terminal(message), file=sys.stderr)
     if args.json:
-        print(json.dumps(robot_report_dict(robot, inertials, audits), indent=2, ensure_ascii=False))
+        out = command_output("robot", robot_report_dict(robot, inertials, audits), warnings=messages)
+        print(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False))
     else:
         # engine sentences name API parameters (`repair=True`); here they name this command's options
         print(speak_options(format_robot_report(robot, inertials, audits), getattr(args, "robot_parser", None)))

@@ -11,7 +11,7 @@ import math
 from ..robot.audit import DENSITY_RANGE, LinkAudit
 from ..robot.description import RobotDescription
 from ..robot.geometry import LinkInertial
-from .serialize import TENSOR_CONVENTION, to_jsonable
+from .serialize import TENSOR_CONVENTION, method_and_uncertainty, to_jsonable
 
 __all__ = ["robot_report_dict", "format_robot_report"]
 
@@ -48,6 +48,7 @@ def robot_report_dict(robot: RobotDescription, inertials, audits) -> dict:
     for result, audit in zip(inertials, audits):
         props = result.properties
         geometry = link_geometry[result.name]
+        method, uncertainty = (None, None) if props is None else method_and_uncertainty(props)
         links.append({
             "name": result.name,
             "mass": None if props is None else props.mass,
@@ -56,6 +57,8 @@ def robot_report_dict(robot: RobotDescription, inertials, audits) -> dict:
             "density_basis": result.basis,
             "center_of_mass": None if props is None else props.center_of_mass,
             "inertia": None if props is None else props.inertia,
+            "method": method,
+            "uncertainty": uncertainty,
             "geometry": [{"kind": e.kind, "name": e.name, "mesh": e.uri} for e in geometry.elements],
             "problem": result.problem,
             "declared": _declared_dict(audit),
