@@ -223,7 +223,8 @@ def test_batch_rows_validate_in_both_formats(fmt, batch_dir, tmp_path, validator
         rows = [json.loads(line) for line in out.read_text().splitlines()]
     else:
         table = list(csv.reader(io.StringIO(out.read_text())))
-        documented = [k for k in schema["$defs"]["batch_row"]["properties"] if k != "certificate"]
+        documented = [k for k in schema["$defs"]["batch_row"]["properties"]
+                      if k != "certificate" or k in ROW_FIELDS]     # the optional column, where it is written
         assert table[0] == list(ROW_FIELDS) == documented        # the schema lists the CSV columns in order
         rows = _rows(out)                             # the cells read back as the reader does on resume
     assert len(rows) == 5
@@ -419,3 +420,11 @@ def test_the_committed_schema_is_what_its_generator_writes():
     script = os.path.join(ROOT, "scripts", "make_output_schema.py")
     assert subprocess.run([sys.executable, script, "--check"]).returncode == 0, \
         "inertia_tool/schema/output-v1.json is out of date: run python scripts/make_output_schema.py"
+
+
+def test_the_old_row_layout_is_frozen():
+    """inertia_tool.batch/1 files have exactly these columns, whatever columns this version adds."""
+    old = ("schema,path,status,error_type,error,sha256,options_key,units,density,density_source,mass,volume,"
+           "surface_area,com_x,com_y,com_z,ixx,iyy,izz,ixy,ixz,iyz,i1,i2,i3,axis1_x,axis1_y,axis1_z,axis2_x,"
+           "axis2_y,axis2_z,axis3_x,axis3_y,axis3_z,faces,bodies,cavities,watertight,repaired,warnings,seconds,worker")
+    assert ",".join(ROW_FIELDS_V1) == old

@@ -84,10 +84,14 @@ ROW_FIELDS = (
     "faces", "bodies", "cavities", "watertight", "repaired", "warnings", "seconds", "worker",
 )
 
-#: The columns of a :data:`SCHEMA_V1` row: ``units`` (the mesh's length unit) where ``mesh_length_unit`` is now,
-#: no ``method`` and ``uncertainty_*``.
-ROW_FIELDS_V1 = tuple("units" if k == "mesh_length_unit" else k for k in ROW_FIELDS
-                      if k != "method" and not k.startswith("uncertainty_"))
+#: The columns of a :data:`SCHEMA_V1` row, frozen (files of that version have exactly these): ``units`` (the
+#: mesh's length unit) where ``mesh_length_unit`` is now, no ``method`` and ``uncertainty_*``.
+ROW_FIELDS_V1 = (
+    "schema", "path", "status", "error_type", "error", "sha256", "options_key", "units", "density", "density_source",
+    "mass", "volume", "surface_area", "com_x", "com_y", "com_z", "ixx", "iyy", "izz", "ixy", "ixz", "iyz",
+    "i1", "i2", "i3", *(f"axis{k}_{c}" for k in (1, 2, 3) for c in "xyz"),
+    "faces", "bodies", "cavities", "watertight", "repaired", "warnings", "seconds", "worker",
+)
 
 #: The numeric columns of an ``ok`` row, in the order :func:`_analyze` fills them from one array.
 _NUMBER_FIELDS = ("density", "mass", "volume", "surface_area", "com_x", "com_y", "com_z",
