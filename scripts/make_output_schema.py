@@ -81,7 +81,8 @@ defs["uncertainty"] = d("null when the result is exact for the polyhedron; for a
                         "(relative, also volume), center_of_mass (m), inertia (relative, Frobenius), volume_in_doubt "
                         "(m^3). A null bound inside the object means no combined bound (see the parts).",
                         {"type": ["object", "null"], "required": ["mass", "center_of_mass", "inertia"],
-                         "properties": {"mass": NN, "center_of_mass": NN, "inertia": NN, "volume_in_doubt": NN}})
+                         "properties": {"mass": NN, "center_of_mass": NN, "inertia": NN, "volume_in_doubt": NN,
+                                        "note": S}})
 CERT_KINDS = ["exact", "united", "summed", "unverified", "estimate"]
 defs["certificate"] = d("Optional: how far the numbers can be trusted. kind exact (the checks that make the integral "
                         "exact ran and passed), united (overlapping bodies united by a boolean, then exact), summed "

@@ -428,3 +428,20 @@ def test_the_old_row_layout_is_frozen():
            "surface_area,com_x,com_y,com_z,ixx,iyy,izz,ixy,ixz,iyz,i1,i2,i3,axis1_x,axis1_y,axis1_z,axis2_x,"
            "axis2_y,axis2_z,axis3_x,axis3_y,axis3_z,faces,bodies,cavities,watertight,repaired,warnings,seconds,worker")
     assert ",".join(ROW_FIELDS_V1) == old
+
+
+def test_an_assembly_with_an_estimated_part_carries_the_bound_that_follows(tmp_path, capsys, validator):
+    """An exact box and an estimated (open) box: method "mixed"; the mass bound of the sum is the largest
+    relative bound of the parts (|sum of errors| <= sum r_k m_k <= max r_k * total), and it holds against the
+    closed-form truth (20 x 10 x 5 mm of water each, the exact box 30 x 20 x 10 mm)."""
+    path = _open_box(tmp_path / "open.stl")
+    data = _run(["analyze", path, _mesh("box.stl"), "--units", "mm", "--repair", "--json"], capsys)
+    assert _errors(validator, data) == []
+    assert _undeclared(validator.schema, validator.schema["$defs"]["analyze"], data) == []
+    methods = [b["method"] for b in data["bodies"]]
+    assert methods[1] == "exact" and methods[0] in ("patched", "winding") and data["method"] == "mixed"
+    part = data["bodies"][0]["uncertainty"]
+    assert data["uncertainty"]["mass"] == part["mass"]
+    assert data["uncertainty"]["center_of_mass"] is None and data["uncertainty"]["inertia"] is None
+    truth = 1e-3 + 6e-3
+    assert abs(data["mass"] - truth) <= data["uncertainty"]["mass"] * data["mass"] + 1e-12 * truth

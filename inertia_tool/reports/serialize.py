@@ -93,9 +93,12 @@ def method_and_uncertainty(props: MassProperties) -> tuple[str, Any]:
     bounds = [u for _, u in pairs if u is not None]
     if not bounds:
         return method, None
-    return method, {"mass": max(float(u.mass) for u in bounds),
+
+    def bound(u, name: str) -> float:
+        return float(u[name] if isinstance(u, dict) else getattr(u, name))
+    return method, {"mass": max(bound(u, "mass") for u in bounds),
                     "center_of_mass": None, "inertia": None,
-                    "volume_in_doubt": sum(float(u.volume_in_doubt) for u in bounds),
+                    "volume_in_doubt": sum(bound(u, "volume_in_doubt") for u in bounds),
                     "note": "centre-of-mass and inertia bounds are per part (bodies[k].uncertainty)"}
 
 
