@@ -50,11 +50,12 @@ def _mesh(name):
     return os.path.join(MESHES, name)
 
 
-def _open_box(path):
-    """A 20 x 10 x 5 mm box with one of its 12 triangles missing (an estimate under --repair)."""
-    m = trimesh.creation.box((20.0, 10.0, 5.0))
+def _open_sphere(path):
+    """A 10 mm icosphere (320 triangles) with one triangle missing (an estimate under --repair); returns the path
+    and the mass in kg of water of the closed polyhedron (trimesh's volume: the truth the bound must hold on)."""
+    m = trimesh.creation.icosphere(subdivisions=2, radius=10.0)
     write_binary_stl(path, np.asarray(m.vertices), np.asarray(m.faces)[1:])
-    return str(path)
+    return str(path), float(m.volume) * 1e-9 * 1000.0
 
 
 #: (id, argv) of one run of each command, on bundled meshes and robot files.
@@ -192,14 +193,13 @@ def test_spin_it_warnings_are_the_ones_printed(outputs):
 
 
 def test_an_estimate_carries_its_method_and_bounds(tmp_path, capsys, validator):
-    path = _open_box(tmp_path / "open.stl")
+    path, truth = _open_sphere(tmp_path / "open.stl")
     data = _run(["analyze", path, "--units", "mm", "--repair", "--json"], capsys)
     assert _errors(validator, data) == []
     assert data["method"] in ("patched", "winding") and data["method"] == data["mesh"]["method"]
     u = data["uncertainty"]
-    assert u is not None and u["mass"] >= 0 and u["center_of_mass"] >= 0 and u["inertia"] >= 0
-    # the bound holds on this case: the true box is 20 x 10 x 5 mm of water
-    assert abs(data["mass"] - 1e-3) <= u["mass"] * data["mass"] + 1e-12 * data["mass"]     # + rounding
+    assert u is not None and u["mass"] > 0 and u["center_of_mass"] > 0 and u["inertia"] > 0
+    assert abs(data["mass"] - truth) <= u["mass"] * data["mass"]          # the bound holds on this case
 
 
 # -- batch rows ---------------------------------------------------------------------------------------------------
@@ -209,7 +209,7 @@ def batch_dir(tmp_path_factory):
     d = tmp_path_factory.mktemp("batch")
     for name in ("box.stl", "cone.stl", "washer.stl"):
         os.symlink(_mesh(name), d / name)
-    _open_box(d / "open.stl")
+    _open_sphere(d / "open.stl")
     (d / "bad.stl").write_bytes(b"solid x\nfacet normal 0 0 1\nendsolid\n")
     return d
 
@@ -237,7 +237,7 @@ def test_batch_rows_validate_in_both_formats(fmt, batch_dir, tmp_path, validator
     assert by_name["box.stl"]["method"] == "exact" and by_name["box.stl"]["uncertainty_mass"] is None
     open_row = by_name["open.stl"]
     assert open_row["method"] in ("patched", "winding")
-    assert all(open_row[f"uncertainty_{k}"] >= 0 for k in ("mass", "center_of_mass", "inertia", "volume_in_doubt"))
+    assert all(open_row[f"uncertainty_{k}"] > 0 for k in ("mass", "center_of_mass", "inertia", "volume_in_doubt"))
     assert "equal within" in by_name["cone.stl"]["warnings"]
 
 
@@ -431,10 +431,10 @@ def test_the_old_row_layout_is_frozen():
 
 
 def test_an_assembly_with_an_estimated_part_carries_the_bound_that_follows(tmp_path, capsys, validator):
-    """An exact box and an estimated (open) box: method "mixed"; the mass bound of the sum is the largest
+    """An exact box and an estimated (open) sphere: method "mixed"; the mass bound of the sum is the largest
     relative bound of the parts (|sum of errors| <= sum r_k m_k <= max r_k * total), and it holds against the
-    closed-form truth (20 x 10 x 5 mm of water each, the exact box 30 x 20 x 10 mm)."""
-    path = _open_box(tmp_path / "open.stl")
+    truth (the closed sphere's polyhedron and the exact 30 x 20 x 10 mm box, water)."""
+    path, sphere = _open_sphere(tmp_path / "open.stl")
     data = _run(["analyze", path, _mesh("box.stl"), "--units", "mm", "--repair", "--json"], capsys)
     assert _errors(validator, data) == []
     assert _undeclared(validator.schema, validator.schema["$defs"]["analyze"], data) == []
@@ -443,5 +443,23 @@ def test_an_assembly_with_an_estimated_part_carries_the_bound_that_follows(tmp_p
     part = data["bodies"][0]["uncertainty"]
     assert data["uncertainty"]["mass"] == part["mass"]
     assert data["uncertainty"]["center_of_mass"] is None and data["uncertainty"]["inertia"] is None
-    truth = 1e-3 + 6e-3
-    assert abs(data["mass"] - truth) <= data["uncertainty"]["mass"] * data["mass"] + 1e-12 * truth
+    truth = sphere + 6e-3
+    assert abs(data["mass"] - truth) <= data["uncertainty"]["mass"] * data["mass"]
+
+
+def test_a_step_file_analysed_from_its_exact_brep_validates(tmp_path, capsys, validator, schema):
+    """STEP: the headline is the exact B-rep (its own method) and the JSON carries the brep comparison."""
+    pytest.importorskip("OCP")
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from inertia_tool.mesh import cad
+    path = tmp_path / "box.step"
+    with cad._quiet():
+        writer = STEPControl_Writer()
+        writer.Transfer(BRepPrimAPI_MakeBox(20.0, 10.0, 5.0).Shape(), STEPControl_AsIs)
+        writer.Write(str(path))
+    data = _run(["analyze", str(path), "--json"], capsys)
+    assert _errors(validator, data) == []
+    assert _undeclared(schema, schema["$defs"]["analyze"], data) == []
+    assert data["method"].startswith("brep") and isinstance(data["brep"], dict)
+    assert math.isclose(data["volume"], 1e-6, rel_tol=1e-9)           # 20 x 10 x 5 mm
