@@ -33,7 +33,7 @@ HEADER = (",".join(ROW_FIELDS) + "\n").encode()
 def _row(k, path=None, **extra):
     row = dict.fromkeys(ROW_FIELDS)
     row.update(schema=SCHEMA, path=path if path is not None else f"/parts/p{k}.stl", status="ok",
-               sha256=f"{k:064x}", options_key="0123456789abcdef", units="m", density=1000.0,
+               sha256=f"{k:064x}", options_key="0123456789abcdef", mesh_length_unit="m", density=1000.0,
                density_source="1000 kg/m³ (default: water, give a density)", mass=1.5 + k, faces=12, bodies=1,
                cavities=0, watertight=True, repaired=False, seconds=0.001, worker="host:1")
     for name in ("volume", "surface_area", "com_x", "com_y", "com_z", "ixx", "iyy", "izz", "ixy", "ixz", "iyz",

@@ -27,6 +27,10 @@ Columns are :data:`inertia_tool.batch.runner.ROW_FIELDS`.  In CSV, empty cells a
 JSON); booleans are ``true``/``false``; a cell holding the delimiter, a quote or a line break (a file name
 may hold any of them) is quoted as the ``csv`` module does by default (``QUOTE_MINIMAL``), so a record can
 span several physical lines.
+
+Rows of an older layout (:data:`~inertia_tool.batch.runner.SCHEMA_V1`) are read back with the current columns
+(:func:`~inertia_tool.batch.runner.upgrade_row`), so an old results file resumes without re-running its files;
+a CSV file with the old header goes on receiving rows of its own layout (its header is never rewritten).
 """
 
 from __future__ import annotations
@@ -40,7 +44,7 @@ import sys
 import time
 from dataclasses import dataclass
 
-from .runner import ROW_FIELDS, SCHEMA
+from .runner import ROW_FIELDS, ROW_FIELDS_V1, SCHEMA, SCHEMA_V1, downgrade_row, upgrade_row
 from ..errors import UsageError
 
 __all__ = ["ResultsFile", "ResultsFileBusy", "ResultsFileDamaged", "ResultsFileWriteError", "read_rows",
@@ -52,7 +56,10 @@ FORMATS = {".jsonl": "jsonl", ".ndjson": "jsonl", ".csv": "csv"}
 _INT_FIELDS = {"faces", "bodies", "cavities"}
 _BOOL_FIELDS = {"watertight", "repaired"}
 _TEXT_FIELDS = {"schema", "path", "status", "error_type", "error", "sha256", "options_key", "units",
+                "mesh_length_unit", "method",
                 "density_source", "warnings", "worker"}
+#: The columns of each row layout, by the ``schema`` value that starts its rows.
+_LAYOUTS = {SCHEMA: ROW_FIELDS, SCHEMA_V1: ROW_FIELDS_V1}
 
 
 class ResultsFileBusy(UsageError):
@@ -103,13 +110,16 @@ def _csv_quoted(cell: str) -> str:
     return cell
 
 
-def format_row(row: dict, fmt: str) -> bytes:
+def format_row(row: dict, fmt: str, layout: str = SCHEMA) -> bytes:
     """One row as the bytes of one complete record, ending in ``\\n`` (JSONL: one line; CSV: quoted cells
-    may hold line breaks)."""
+    may hold line breaks).  ``layout``: :data:`SCHEMA`, or ``SCHEMA_V1`` for an old CSV file's own layout."""
+    if layout == SCHEMA_V1:
+        row = downgrade_row(row)
+    fields = _LAYOUTS[layout]
     if fmt == "jsonl":
-        line = json.dumps({k: row.get(k) for k in ROW_FIELDS}, ensure_ascii=False, allow_nan=False) + "\n"
+        line = json.dumps({k: row.get(k) for k in fields}, ensure_ascii=False, allow_nan=False) + "\n"
     else:
-        line = ",".join(_csv_quoted(_csv_cell(row.get(k))) for k in ROW_FIELDS) + "\n"
+        line = ",".join(_csv_quoted(_csv_cell(row.get(k))) for k in fields) + "\n"
     return line.encode("utf-8", "backslashreplace")     # a lone surrogate left in a message: never an error
 
 
@@ -126,7 +136,7 @@ _JSON_STRING = re.compile(rb'"(?:[^"\\]|\\.)*"', re.DOTALL)
 
 #: How a row of :data:`SCHEMA` starts in CSV: a record that does not end and runs over lines starting like
 #: this holds more than one row, so it is damage in the middle, not a torn last row.
-_CSV_ROW_START = (SCHEMA + ",").encode()
+_CSV_ROW_START = tuple((schema + ",").encode() for schema in _LAYOUTS)
 
 
 @dataclass(frozen=True)
@@ -156,25 +166,26 @@ def _parse_json_line(line: bytes):
         row = json.loads(line.decode("utf-8", errors="replace"))
     except ValueError:
         return "is not JSON"
-    if not isinstance(row, dict) or row.get("schema") != SCHEMA:
+    if not isinstance(row, dict) or row.get("schema") not in _LAYOUTS:
         return f"is not a row of schema {SCHEMA}"
-    return row
+    return upgrade_row(row)
 
 
 def _parse_csv_cells(cells: list[str], text: str):
     """A row dict, ``"header"``, or a string saying why the cells of ``text`` are not a row."""
-    if cells == list(ROW_FIELDS):
+    if any(cells == list(fields) for fields in _LAYOUTS.values()):
         return "header"
-    if len(cells) != len(ROW_FIELDS):
-        return f"has {len(cells)} cells, expected {len(ROW_FIELDS)} ({SCHEMA})"
-    if cells[0] != SCHEMA:
+    fields = _LAYOUTS.get(cells[0], ROW_FIELDS)
+    if len(cells) != len(fields):
+        return f"has {len(cells)} cells, expected {len(fields)} ({cells[0] if cells[0] in _LAYOUTS else SCHEMA})"
+    if cells[0] not in _LAYOUTS:
         return f"starts with {cells[0][:40]!r}, expected the schema {SCHEMA}"
     for cell in cells:
         # the csv module reads `a"b` as a cell, but the writer quotes any cell holding a quote: a stray quote
         if '"' in cell and '"' + cell.replace('"', '""') + '"' not in text:
             return "is not quoted as inertia-tool writes it (a stray quote?)"
     try:
-        return {k: _csv_value(k, v) for k, v in zip(ROW_FIELDS, cells)}
+        return upgrade_row({k: _csv_value(k, v) for k, v in zip(fields, cells)})
     except ValueError as exc:
         return f"has a bad cell ({exc})"
 
@@ -215,7 +226,7 @@ def _csv_records(lines: list[bytes], ends_with_newline: bool) -> list[_Record]:
         if cells:
             text = "".join(texts[first:end])
             records.append(_Record(first, end, _parse_csv_cells(cells, text), end < len(texts) or ends_with_newline,
-                                   short=0 < len(cells) < len(ROW_FIELDS)))
+                                   short=0 < len(cells) < len(_LAYOUTS.get(cells[0], ROW_FIELDS))))
         first = end
     return records
 
@@ -266,7 +277,8 @@ def read_rows(data: bytes, fmt: str, path: str) -> tuple[list[dict], int]:
         text = data[len(data) - torn:]
         # a torn record is the start of one we write (a row; the header in a file of nothing else); anything
         # else there is damage, or, in a file of nothing else, not ours
-        starts = [_CSV_ROW_START if fmt == "csv" else json.dumps({"schema": SCHEMA})[:-1].encode()]
+        starts = list(_CSV_ROW_START) if fmt == "csv" else \
+            [json.dumps({"schema": schema})[:-1].encode() for schema in _LAYOUTS]
         if not records and fmt == "csv":
             starts.append(",".join(ROW_FIELDS).encode())
         cut = text.rstrip(b"\r\n")
@@ -362,6 +374,8 @@ class ResultsFile:
         Rows already in the file when it was opened (for resuming).
     torn_bytes : int
         Length of the torn last record (a killed run) cut off on opening; 0 when there was none.
+    layout : str
+        The ``schema`` of the rows written: :data:`SCHEMA`, or ``SCHEMA_V1`` for a CSV file with the old header.
     sync_seconds : float
         ``fsync`` after a row when at least this many seconds have passed since the last one (0: every row);
         always on :meth:`close`.
@@ -372,6 +386,7 @@ class ResultsFile:
     previous_rows: list
     torn_bytes: int = 0
     sync_seconds: float = 1.0
+    layout: str = SCHEMA
     _fd: int | None = None
     _synced: float = 0.0
     _size: int = 0               # bytes of complete rows written (what the file is cut back to if a write fails)
@@ -388,7 +403,7 @@ class ResultsFile:
         the row being written; ``fsync`` when :attr:`sync_seconds` have passed since the last one."""
         if self._fd is None or self._failed:
             raise ValueError(f"{self.path}: the results file is closed")
-        record = format_row(row, self.format)
+        record = format_row(row, self.format, self.layout)
         try:
             _write_all(self._fd, record)
         except OSError as exc:
@@ -517,6 +532,8 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30, sync_seco
                 raise
         os.fsync(fd)
         end = os.fstat(fd).st_size
+        old_header = (",".join(ROW_FIELDS_V1) + "\n").encode()
+        layout = SCHEMA_V1 if fmt == "csv" and data[:len(old_header)] == old_header else SCHEMA
     except UsageError:
         os.close(fd)
         raise
@@ -525,7 +542,7 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30, sync_seco
         raise UsageError(f"{path}: cannot use the results file ({exc.strerror or exc})") from None
     _OPEN_FDS.add(fd)
     return ResultsFile(path=path, format=fmt, previous_rows=rows, torn_bytes=torn, sync_seconds=float(sync_seconds),
-                       _fd=fd, _synced=time.monotonic(), _size=end, _synced_size=end)
+                       layout=layout, _fd=fd, _synced=time.monotonic(), _size=end, _synced_size=end)
 
 
 def _read_from_start(fd: int, size: int) -> bytes:                      # pragma: no cover - Windows

@@ -1,6 +1,7 @@
 """Batch analysis of many meshes: the per-file work, the result-row schema and the runner.
 
-One row per file, flat so that JSONL and CSV carry the same columns (:data:`ROW_FIELDS`).  The work for one
+One row per file, flat so that JSONL and CSV carry the same columns (:data:`ROW_FIELDS`, each in a fixed SI
+unit; their JSON Schema is the ``batch_row`` of ``inertia_tool/schema/output-v1.json``).  The work for one
 file (:func:`analyze_file`) and for a chunk of files (:func:`analyze_chunk`, the task the workers run; how
 chunks are sized and fed to a process pool or a Dask cluster is :mod:`inertia_tool.batch.chunks`) is pure and
 picklable; it never raises: an :class:`~inertia_tool.errors.InertiaToolError` becomes a row with
@@ -44,19 +45,35 @@ from ..mesh.regular import open_regular
 from ..mass.pipeline import mass_properties, resolve_density
 from .chunks import DASK_CHUNK_SECONDS, POOL_CHUNK_SECONDS, ChunkSizer, DaskTasks, PoolTasks
 
-__all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "analyze_chunk", "analyze_file", "discover_files",
-           "file_sha256", "run_batch", "DONE_STATUSES", "counts_as_done", "row_path"]
+__all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "SCHEMA_V1", "ROW_FIELDS_V1", "analyze_chunk",
+           "analyze_file", "discover_files", "file_sha256", "run_batch", "upgrade_row", "downgrade_row",
+           "DONE_STATUSES", "counts_as_done", "row_path"]
 
-#: Schema identifier written in every row (``schema`` column); bump it when columns change meaning.
-SCHEMA = "inertia_tool.batch/1"
+#: Schema identifier written in every row (``schema`` column); bump it when columns change meaning.  The JSON
+#: Schema of the rows is the ``batch_row`` of ``inertia_tool/schema/output-v1.json`` (docs/json.md).
+SCHEMA = "inertia_tool.batch/2"
+
+#: The rows of results files written before ``units`` was renamed ``mesh_length_unit`` and ``method`` and the
+#: ``uncertainty_*`` columns were added.  They are read back on resume (:func:`upgrade_row`), and a CSV file
+#: with their header goes on receiving rows of its own layout (:func:`downgrade_row`), so an old results file
+#: resumes without re-running its files.
+SCHEMA_V1 = "inertia_tool.batch/1"
+
+#: The bounds of an estimate (``MeshReport.uncertainty``), one column each: ``uncertainty_mass`` (relative),
+#: ``uncertainty_center_of_mass`` (m), ``uncertainty_inertia`` (relative, Frobenius),
+#: ``uncertainty_volume_in_doubt`` (m³); empty (``None``) when the result is exact.
+_UNCERTAINTY = ("mass", "center_of_mass", "inertia", "volume_in_doubt")
 
 #: Row statuses that count as done when resuming (``internal_error`` is retried).
 DONE_STATUSES = ("ok", "error")
 
-#: The columns of a result row, in order.  Units: m, m², m³, kg, kg/m³, kg·m², s.
+#: The columns of a result row, in order.  Units: m, m², m³, kg, kg/m³, kg·m², s; ``mesh_length_unit`` is the
+#: unit the file's coordinates were read in.
 ROW_FIELDS = (
     "schema", "path", "status", "error_type", "error", "sha256", "options_key",
-    "units", "density", "density_source",
+    "mesh_length_unit", "density", "density_source",
+    # how the solid was obtained (MeshReport.method) and an estimate's bounds (empty when exact)
+    "method", *(f"uncertainty_{k}" for k in _UNCERTAINTY),
     "mass", "volume", "surface_area",
     "com_x", "com_y", "com_z",
     # inertia about the centre of mass, mesh axes, tensor convention (off-diagonals are -∫xy dm)
@@ -64,6 +81,15 @@ ROW_FIELDS = (
     # principal moments (ascending) and their unit axes (mesh axes, right-handed)
     "i1", "i2", "i3",
     "axis1_x", "axis1_y", "axis1_z", "axis2_x", "axis2_y", "axis2_z", "axis3_x", "axis3_y", "axis3_z",
+    "faces", "bodies", "cavities", "watertight", "repaired", "warnings", "seconds", "worker",
+)
+
+#: The columns of a :data:`SCHEMA_V1` row, frozen (files of that version have exactly these): ``units`` (the
+#: mesh's length unit) where ``mesh_length_unit`` is now, no ``method`` and ``uncertainty_*``.
+ROW_FIELDS_V1 = (
+    "schema", "path", "status", "error_type", "error", "sha256", "options_key", "units", "density", "density_source",
+    "mass", "volume", "surface_area", "com_x", "com_y", "com_z", "ixx", "iyy", "izz", "ixy", "ixz", "iyz",
+    "i1", "i2", "i3", *(f"axis{k}_{c}" for k in (1, 2, 3) for c in "xyz"),
     "faces", "bodies", "cavities", "watertight", "repaired", "warnings", "seconds", "worker",
 )
 
@@ -77,6 +103,25 @@ _TENSOR_ENTRIES = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))
 
 #: Bytes read at a time when hashing a file.
 _HASH_CHUNK = 1 << 20
+
+
+def upgrade_row(row: dict) -> dict:
+    """A :data:`SCHEMA_V1` row (of an older results file) with this version's columns: ``mesh_length_unit``
+    from ``units``, ``method`` and ``uncertainty_*`` unknown (``None``); its ``schema`` stays what the file says.
+    Other rows are returned unchanged."""
+    if row.get("schema") != SCHEMA_V1:
+        return row
+    new = {k: row.get(k) for k in ROW_FIELDS}
+    new.update(schema=SCHEMA_V1, mesh_length_unit=row.get("units"))
+    return new
+
+
+def downgrade_row(row: dict) -> dict:
+    """A row in the :data:`SCHEMA_V1` layout, for appending to an old CSV results file (whose header is never
+    rewritten): ``units`` from ``mesh_length_unit``; ``method`` and ``uncertainty_*`` are dropped."""
+    old = {k: row.get(k) for k in ROW_FIELDS_V1}
+    old.update(schema=SCHEMA_V1, units=row.get("mesh_length_unit"))
+    return old
 
 
 @frozen_value
@@ -244,7 +289,7 @@ def _empty_row(path: str, sha256: str | None, options: BatchOptions, key: str | 
                worker: str | None = None) -> dict:
     row = dict.fromkeys(ROW_FIELDS)
     row.update(schema=SCHEMA, path=row_path(path), sha256=sha256, options_key=key or options.key(),
-               units=options.load.units or "m", worker=worker or _worker_name())
+               mesh_length_unit=options.load.units or "m", worker=worker or _worker_name())
     return row
 
 
@@ -295,7 +340,7 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
                                   np.asarray(pa.axes).T.ravel()))                 # axis k = column k of `axes`
         row.update(zip(_NUMBER_FIELDS, [v if math.isfinite(v) else None for v in numbers.tolist()]))
         row.update(
-            status="ok", density_source=described,
+            status="ok", density_source=described, method=mesh.method, **_bounds(mesh.uncertainty),
             faces=int(mesh.faces), bodies=int(mesh.bodies), cavities=int(mesh.cavities),
             watertight=bool(mesh.watertight), repaired=bool(mesh.repaired),
             warnings=" | ".join(_one_line(w.message) for w in caught
@@ -307,6 +352,15 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
         row.update(status="internal_error", error_type=type(exc).__name__, error=row_path(_one_line(exc)))
     row["seconds"] = round(time.perf_counter() - start, 6)
     return row
+
+
+def _bounds(uncertainty) -> dict:
+    """The ``uncertainty_*`` columns of an estimate's bounds (``None`` each when exact or not finite)."""
+    out: dict = {}
+    for k in _UNCERTAINTY:
+        v = getattr(uncertainty, k, None)
+        out[f"uncertainty_{k}"] = float(v) if v is not None and math.isfinite(v) else None
+    return out
 
 
 def analyze_chunk(chunk: Sequence[tuple[str, str | None]], options: BatchOptions) -> list[dict]:

@@ -10,7 +10,7 @@ import sys
 import warnings
 
 from ..errors import OverlapWarning, PhysicsError, UsageError
-from ..reports.serialize import mass_properties_dict, to_jsonable
+from ..reports.serialize import command_output, mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
 from ..dynamics.spin_stability import stability
@@ -83,8 +83,8 @@ def run(args) -> int:
         out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
         if model["model"] != "solid":
             out["model"] = to_jsonable(model)
-        out["warnings"] = messages
         out["units_assumed"] = loaded.units_assumed          # no --units and no unit in the file: metres taken
+        out = command_output("analyze", out, warnings=messages)
         json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     elif fmt in ROBOT_FORMATS:

@@ -14,7 +14,7 @@ from ..errors import UsageError
 from ..output import check_targets, write_files
 from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length
-from ..reports.serialize import to_jsonable
+from ..reports.serialize import command_output, method_and_uncertainty
 from . import speak_options
 from .help import add_command
 from .model_options import add_files_argument, add_model_options, command_parser, length_unit, load_model, with_warnings
@@ -144,9 +144,10 @@ def run(args) -> int:
         out["notes"] = [speak_options(n, parser) for n in out.get("notes", [])]
         out["density_source"] = loaded.density_source
         out["model"] = loaded.model
-        out["warnings"] = list(loaded.warnings)
+        out["method"], out["uncertainty"] = method_and_uncertainty(loaded.props)
         out["units_assumed"] = loaded.units_assumed
-        print(json.dumps(to_jsonable(out), indent=2, ensure_ascii=False))
+        out = command_output("balance", out, warnings=loaded.warnings)
+        print(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False))
     else:
         print(with_warnings(speak_options(format_balance_text(report), parser), loaded.warnings,
                             loaded.notes()), end="")

@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import os
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from ..errors import InertiaToolWarning, UsageError
@@ -37,7 +39,7 @@ from .options import check_option, density_and_mass
 
 __all__ = ["add_files_argument", "add_model_options", "add_material_options", "add_mesh_options",
            "split_part_spec", "length_unit", "load_options_from_args", "read_meshes", "load_model",
-           "LoadedModel", "model_words", "with_warnings", "command_parser"]
+           "LoadedModel", "model_words", "with_warnings", "command_parser", "recorded_warnings"]
 
 FILES_HELP = ("mesh file(s): STL, OBJ, PLY, OFF, 3MF; several FILE:material or FILE:density make an "
               "assembly (e.g. a.stl:steel b.stl:1.2g/cm3)")
@@ -227,20 +229,30 @@ def load_model(args, *, parser=None, ignore=()) -> LoadedModel:
     warnings are recorded (in command-line words, through ``parser``'s options) and handed on, so that the
     command line prints them on stderr and the command can put them in its report and JSON.
     """
+    with recorded_warnings(args, parser=parser, ignore=ignore) as messages:
+        meshes = read_meshes(args)
+        props, described, model = _load(args, meshes)
+    return LoadedModel(props=props, density_source=described, model=model, warnings=tuple(messages),
+                       meshes=tuple(meshes))
+
+
+@contextmanager
+def recorded_warnings(args, *, parser=None, ignore=()) -> Iterator[list[str]]:
+    """Record the engine's warnings raised in the ``with`` block into the yielded list (in command-line words,
+    through ``parser``'s options), for the command's report and JSON ``warnings``; on leaving the block they
+    are handed on, so that the command line still prints them on stderr.  ``ignore``: classes not reported."""
     from . import speak_options
+    messages: list[str] = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", InertiaToolWarning)
         for category in ignore:
             warnings.simplefilter("ignore", category)
-        meshes = read_meshes(args)
-        props, described, model = _load(args, meshes)
+        yield messages
     kept = [w for w in caught if issubclass(w.category, InertiaToolWarning)]
     for w in kept:          # hand them on so the command line prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     parser = parser if parser is not None else command_parser(args)
-    messages = tuple(speak_options(str(w.message), parser) for w in kept)
-    return LoadedModel(props=props, density_source=described, model=model, warnings=messages,
-                       meshes=tuple(meshes))
+    messages.extend(speak_options(str(w.message), parser) for w in kept)
 
 
 def _implied(props, mass) -> str:

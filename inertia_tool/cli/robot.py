@@ -10,6 +10,7 @@ import sys
 from ..errors import UsageError
 from ..mesh.options import DEFAULT_MAX_FACES
 from ..reports.robot_audit import format_robot_report, links_without_result, robot_report_dict, summary_line
+from ..reports.serialize import command_output
 from ..robot.audit import audit_links
 from ..robot.description import GEOMETRY_KINDS, read_robot
 from ..robot.geometry import MODEL_DENSITY, link_inertials
@@ -19,6 +20,7 @@ from . import EXIT_INCOMPLETE, EXIT_OK, speak_options
 from .help import add_command
 from .options import check_option
 from ..reports.escape import escape_terminal
+from .model_options import recorded_warnings
 from .report_option import check_output_file
 
 __all__ = ["register", "run", "parse_packages", "parse_mappings"]
@@ -97,6 +99,15 @@ def parse_mappings(items) -> dict:
     return mappings
 
 
+def _density(args) -> float | str | None:
+    """``--density``: kg/m³, ``model`` (the description's own densities), or None when not given."""
+    if args.density is None:
+        return None
+    if args.density.strip() == MODEL_DENSITY:
+        return MODEL_DENSITY
+    return check_option("--density", parse_density(args.density), typed=args.density)
+
+
 def _run_corpus(args, packages: dict) -> int:
     """Several files or folders: every description audited, one summary (no --write, no xacro arguments)."""
     from ..reports.robot_audit import corpus_report_dict, format_corpus_report
@@ -105,17 +116,16 @@ def _run_corpus(args, packages: dict) -> int:
         raise UsageError("--write and --arg apply to one description; a corpus (several files or a folder) is "
                          "only audited")
     check_option("--max-faces", args.max_faces)
-    density: float | str | None = None
-    if args.density is not None:
-        density = (MODEL_DENSITY if args.density.strip() == MODEL_DENSITY
-                   else check_option("--density", parse_density(args.density), typed=args.density))
-    models = audit_corpus(args.robot, density=density, material=args.material, keep_mass=args.keep_mass,
-                          repair=args.repair, packages=packages, geometry=args.geometry, max_faces=args.max_faces,
-                          run_xacro=args.run_xacro)
+    density = _density(args)
+    with recorded_warnings(args, parser=getattr(args, "robot_parser", None)) as messages:
+        models = audit_corpus(args.robot, density=density, material=args.material, keep_mass=args.keep_mass,
+                              repair=args.repair, packages=packages, geometry=args.geometry,
+                              max_faces=args.max_faces, run_xacro=args.run_xacro)
     if not models:
         raise UsageError(f"no robot description found in {', '.join(args.robot)}")
     if args.json:
-        print(json.dumps(corpus_report_dict(models), indent=2, ensure_ascii=False))
+        out = command_output("robot-corpus", corpus_report_dict(models), warnings=messages)
+        print(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False))
     else:
         print(speak_options(format_corpus_report(models), getattr(args, "robot_parser", None)))
     incomplete = any(m.robot is None or links_without_result(m.robot, m.inertials) for m in models)
@@ -138,15 +148,13 @@ def run(args) -> int:
                          "(--force overwrites it)")
     check_output_file(args.write, "--write", args.force)
     check_option("--max-faces", args.max_faces)
-    density: float | str | None = None
-    if args.density is not None:
-        density = (MODEL_DENSITY if args.density.strip() == MODEL_DENSITY
-                   else check_option("--density", parse_density(args.density), typed=args.density))
-    robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings,
-                       run_xacro=args.run_xacro)
-    inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
-                               repair=args.repair, max_faces=args.max_faces)
-    audits = audit_links(robot, inertials, keep_mass=args.keep_mass)
+    density = _density(args)
+    with recorded_warnings(args, parser=getattr(args, "robot_parser", None)) as messages:
+        robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings,
+                           run_xacro=args.run_xacro)
+        inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
+                                   repair=args.repair, max_faces=args.max_faces)
+        audits = audit_links(robot, inertials, keep_mass=args.keep_mass)
     if args.write:
         basis = next((r.basis for r in inertials if r.properties is not None), "")
         note = "declared masses kept" if args.keep_mass else f"density {basis}"
@@ -160,7 +168,8 @@ def run(args) -> int:
                         "and ignore every <inertial>, these included")
         print(escape_terminal(message), file=sys.stderr)
     if args.json:
-        print(json.dumps(robot_report_dict(robot, inertials, audits), indent=2, ensure_ascii=False))
+        out = command_output("robot", robot_report_dict(robot, inertials, audits), warnings=messages)
+        print(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False))
     else:
         # engine sentences name API parameters (`repair=True`); here they name this command's options
         print(speak_options(format_robot_report(robot, inertials, audits), getattr(args, "robot_parser", None)))

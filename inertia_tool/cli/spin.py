@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..reports.stability import format_spin, format_stability, spin_dict, stability_dict
-from ..reports.serialize import to_jsonable
+from ..reports.serialize import command_output, method_and_uncertainty
 from ..dynamics.experiment import MAX_SAMPLES, spin_experiment
 from ..dynamics.spin_stability import AXIS_NAMES
 from ..units import parse_angular_rate, parse_duration
@@ -124,11 +124,13 @@ def run(args) -> int:
         _plot(args.plot, experiment)
     say_written([args.csv, args.plot])
     if args.json:
-        out = {"name": props.name, "density_source": described, "mass": props.mass,
-               "model": loaded.model, "warnings": list(loaded.warnings), "units_assumed": loaded.units_assumed,
-               "stability": stability_dict(experiment.report, perturbation=args.perturbation),
-               "spin": spin_dict(experiment)}
-        json.dump(to_jsonable(out), sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
+        method, uncertainty = method_and_uncertainty(props)
+        out = command_output("spin", {
+            "name": props.name, "density_source": described, "mass": props.mass, "method": method,
+            "uncertainty": uncertainty, "model": loaded.model, "units_assumed": loaded.units_assumed,
+            "stability": stability_dict(experiment.report, perturbation=args.perturbation),
+            "spin": spin_dict(experiment)}, warnings=loaded.warnings)
+        json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     else:
         print(with_warnings(f"{props.name}: mass {props.mass:.6g} kg ({described}{model_words(loaded.model)})",

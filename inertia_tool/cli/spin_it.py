@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import UsageError
 from ..units import length_scale, parse_density, parse_length, parse_vector
 from .help import add_command
-from .model_options import add_material_options, length_unit
+from .model_options import add_material_options, length_unit, recorded_warnings
 from .options import check_option, density_and_mass
 from ..output import check_targets
 from .report_option import save_figure, say_written
@@ -178,11 +178,12 @@ def run(args) -> int:
     pivot = check_option("--pivot", list(parse_vector(args.pivot, unit)), typed=args.pivot) if args.pivot else None
     density, mass = density_and_mass(args)
     axis = _direction(args.axis)
-    result = spin_it(args.files, axis=axis, mode=args.mode, wall=wall,
-                     through=tuple(through) if through is not None else None,
-                     pivot=tuple(pivot) if pivot is not None else None, units=args.units,
-                     density=density, material=args.material, mass=mass,
-                     resolution=args.resolution, insert_density=insert_density)
+    with recorded_warnings(args) as messages:
+        result = spin_it(args.files, axis=axis, mode=args.mode, wall=wall,
+                         through=tuple(through) if through is not None else None,
+                         pivot=tuple(pivot) if pivot is not None else None, units=args.units,
+                         density=density, material=args.material, mass=mass,
+                         resolution=args.resolution, insert_density=insert_density)
     if args.out and result.insert_vertices is not None:
         _write_two_materials(args.out, result, args.material or "part", args.insert)
     elif args.out:
@@ -201,7 +202,11 @@ def run(args) -> int:
                    label="--report")
         say_written([args.report])
     if args.json:
-        json.dump(spin_it_dict(result, output=args.out), sys.stdout, indent=2, ensure_ascii=False)
+        from ..reports.serialize import command_output, method_and_uncertainty
+        body = spin_it_dict(result, output=args.out)
+        body["method"], body["uncertainty"] = method_and_uncertainty(result.after)   # the hollowed part's
+        json.dump(command_output("spin-it", body, warnings=messages), sys.stdout, indent=2, ensure_ascii=False,
+                  allow_nan=False)
         sys.stdout.write("\n")
     else:
         sys.stdout.write(format_spin_it_text(result, name=args.files, output=args.out))

@@ -12,7 +12,7 @@ from ..errors import NearlyEqualMomentsWarning, UsageError
 from ..dynamics.top import MAX_TOP_SAMPLES as MAX_SAMPLES
 from ..dynamics.top import STANDARD_GRAVITY, heavy_top_on_pivot
 from ..reports.stability import format_heavy_top, heavy_top_dict
-from ..reports.serialize import to_jsonable
+from ..reports.serialize import command_output, method_and_uncertainty
 from ..units import parse_angle, parse_angular_rate, parse_duration, parse_vector
 from ..output import atomic_target, check_targets
 from .help import add_command
@@ -174,10 +174,12 @@ def run(args) -> int:
         _plot(args.plot, top, traj)
     say_written([args.csv, args.plot])
     if args.json:
-        out = {"name": props.name, "density_source": described, "model": loaded.model,
-               "warnings": list(loaded.warnings), "units_assumed": loaded.units_assumed,
-               "top": heavy_top_dict(top, traj)}
-        json.dump(to_jsonable(out), sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
+        method, uncertainty = method_and_uncertainty(props)
+        out = command_output("top", {
+            "name": props.name, "density_source": described, "mass": props.mass, "method": method,
+            "uncertainty": uncertainty, "model": loaded.model, "units_assumed": loaded.units_assumed,
+            "top": heavy_top_dict(top, traj)}, warnings=loaded.warnings)
+        json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     else:
         print(with_warnings(f"{props.name}: mass {props.mass:.6g} kg ({described}{model_words(loaded.model)})",

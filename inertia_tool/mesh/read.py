@@ -952,6 +952,8 @@ def _read_with_trimesh_rounding(path: str, max_faces: int):
     _check_face_budget(path, len(f), max_faces)
     if f.ndim != 2 or f.shape[1] != 3:
         raise _fail(path, f"faces are not triangles (shape {f.shape})")
+    if v.ndim != 2 or v.shape[1] != 3:      # e.g. a glTF POSITION naming a SCALAR accessor
+        raise _fail(path, f"vertices are not points in 3-D (expected shape (n, 3), got {v.shape})")
     if f.min() < 0 or f.max() >= len(v):
         raise _fail(path, f"face indices out of range (0..{len(v) - 1})")
     if "vertex" in counts and len(v) < counts["vertex"]:
