@@ -16,6 +16,7 @@ import numpy as np
 from ..values import frozen_value
 from .._native import accel, faces_for_c, threads
 from .estimate import Uncertainty
+from .policy import Certificate
 
 __all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "winding_number"]
 
@@ -112,6 +113,10 @@ class MeshReport:
         Faces turned to agree with their neighbours.
     nonmanifold_edges : int
         Edges shared by more than two faces in the integrated surface (bodies or walls touching).
+    certificate : Certificate
+        How far the result can be trusted and the checks that ran and passed (``kind`` one of ``exact``,
+        ``united``, ``summed``, ``unverified``, ``estimate``; see :mod:`~.policy`).  The default, for reports
+        built outside :func:`~.prepare.prepare_mesh`, is ``unverified``.
     """
 
     source: str
@@ -137,11 +142,13 @@ class MeshReport:
     notes: tuple = ()
     flipped_faces: int = 0
     nonmanifold_edges: int = 0
+    certificate: Certificate = Certificate("unverified")
 
     @property
     def exact(self) -> bool:
-        """The mass properties are exact for the polyhedron integrated (no estimate)."""
-        return self.uncertainty is None
+        """The mass properties are exact for the polyhedron integrated, proven by the checks of the certificate
+        (``exact``, ``united``, or ``summed`` on request); False for estimates and unverified integrals."""
+        return self.uncertainty is None and self.certificate.kind in ("exact", "united", "summed")
 
 
 def repeated_corner_faces(faces: np.ndarray) -> np.ndarray:
@@ -250,14 +257,52 @@ def _edge_topology_c(lib, faces, n_vertices, vertices) -> EdgeTopology:
 
 
 def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
-    """Connected components of the surface (shells), by shared vertices.
+    """Connected components of the surface (shells), joined through shared edges.
+
+    Two faces are in one shell when a chain of faces, each sharing an edge with the next, joins them.  Faces
+    that meet only at a vertex are in different shells: a non-manifold vertex is split into its fans
+    (rule R1 of :mod:`~.policy`), so two bodies sharing a corner are two shells, tested against each other.
 
     Returns
     -------
     labels : (m,) int
-        Shell index of each face, ``0..count-1`` (numbered by the smallest vertex index of the shell).
+        Shell index of each face, ``0..count-1`` (numbered by the smallest vertex index of the shell when no
+        vertex is shared between shells, else in order of each shell's first face).
     count : int
     """
+    labels, count = _vertex_shell_labels(faces, n_vertices)
+    if len(faces) < 2:
+        return labels, count
+    edge_labels, edge_count = _edge_shell_labels(faces, n_vertices)
+    if edge_count == count:
+        return labels, count
+    return edge_labels, edge_count
+
+
+def _edge_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
+    """Components of faces joined through shared (undirected) edges, numbered by first face."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    f = np.asarray(faces, dtype=np.int64)
+    m = len(f)
+    n = np.int64(max(int(n_vertices), 1))
+    a = f[:, [0, 1, 2]].reshape(-1)
+    b = f[:, [1, 2, 0]].reshape(-1)
+    key = np.minimum(a, b) * n + np.maximum(a, b)
+    order = np.argsort(key, kind="stable")
+    same = key[order[1:]] == key[order[:-1]]
+    rows, cols = order[:-1][same] // 3, order[1:][same] // 3
+    graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(m, m))
+    count, label = connected_components(graph, directed=False)
+    _, first = np.unique(label, return_index=True)
+    rank = np.empty(count, dtype=np.intp)
+    rank[np.argsort(first, kind="stable")] = np.arange(count)
+    return rank[label].astype(np.intp), int(count)
+
+
+def _vertex_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
+    """Connected components of the surface by shared vertices (the C extension when built)."""
     m = len(faces)
     if m == 0:
         return np.zeros(0, dtype=np.intp), 0

@@ -25,7 +25,14 @@ from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .estimate import check_useful, uncertainty_from
+from .policy import (TOUCH_VOLUME_RTOL, Certificate, orient_by_depth, self_crossing_message,
+                     shell_contacts)
 from .resolve import Resolution, resolve_surface
+
+try:        # the robust face-intersection module; a float64 stand-in until it lands
+    from .intersect import surface_contacts
+except ImportError:     # pragma: no cover - replaced when mesh/intersect.py is merged
+    from ._contacts_standin import surface_contacts  # type: ignore[assignment]
 
 __all__ = ["PreparedMesh", "prepare_mesh", "classify_shells", "MAX_COORDINATE", "MIN_EXTENT"]
 
@@ -77,17 +84,10 @@ class PreparedMesh:
 
 def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: str = "mesh",
                     check_crossing: bool = True, pairs_per_face: int = CROSSING_PAIRS_PER_FACE):
-    """Flip inside-out shells, attach cavities to their bodies, find overlapping bodies.
+    """Orient shells by nesting depth (R4), attach cavities to their bodies, count overlap candidates (R5, R6).
 
-    Every shell is classified, always: the winding number of every other shell at a point of each shell
-    comes from exact ray crossings against a sorted index of the faces (:func:`~.nesting.shell_nesting`),
-    about one pass over the faces however many shells there are.  A shell all of whose probe points lie on
-    other shells' surfaces counts as an overlap candidate (the boolean union then decides).  Bodies whose surfaces
-    touch or cross
-    another shell's surface are found by triangle–triangle tests (:func:`~.union.crossing_shells`) on the
-    faces of all but the largest shell, within a work bound of ``pairs_per_face`` candidate pairs per face;
-    beyond it (CAD fans of long triangles) every shell whose box meets another's is a candidate and the
-    boolean union decides (``check_crossing=False`` goes there directly).
+    The same rules :func:`prepare_mesh` applies (:mod:`~.policy`), for callers that hold several prepared
+    meshes side by side (an assembly's parts).
 
     Returns
     -------
@@ -97,56 +97,24 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
         Body each shell belongs to.
     cavities : int
     overlaps : int
-        Shells inside another body's material or whose surface meets another shell's (a candidate overlap,
-        for the boolean union to confirm).
+        Shells whose surface crosses another's, touches it, or whose probes all lie on another surface, or
+        (when the intersection check cannot finish, or ``check_crossing`` is False) whose box meets
+        another's: candidates for the boolean union to confirm.
     """
     vols = np.array([s.volume for s in shells])
-    flip = np.zeros(n_shells, dtype=bool)
-    owner = np.arange(n_shells)
     if n_shells == 1:
-        flip[0] = vols[0] < 0
-        return flip, owner, 0, 0
-    sign = np.sign(vols)
-    if vols.sum() < 0:
-        # the whole mesh is inside out: flip every shell first
-        sign = -sign
-        flip[:] = True
-    from .nesting import shell_nesting    # imported on use (as crossing_shells and the union): one shell needs none
-    from .union import crossing_shells
-    nest = shell_nesting(vertices, faces, labels, n_shells)
-    w = nest.winding * np.where(flip[nest.other], -1, 1)
-    winding = np.bincount(nest.shell, weights=w, minlength=n_shells)
-    # a cavity belongs to the smallest body whose material holds it
-    holds = (sign[nest.shell] < 0) & (sign[nest.other] > 0) & (w > 0)
-    if holds.any():
-        order = np.argsort(-np.abs(vols[nest.other[holds]]), kind="stable")   # smallest last: it wins
-        owner[nest.shell[holds][order]] = nest.other[holds][order]
-    inside_material = winding > 0.5
-    cavity = (sign < 0) & inside_material
-    lonely = (sign < 0) & ~inside_material
-    flip[lonely] = ~flip[lonely]                 # an inside-out body on its own: flip it
-    owner[lonely] = np.flatnonzero(lonely)
-    # a shell every probe of which lies on another surface touches it: an overlap candidate for the boolean
-    overlapped = ((sign > 0) & inside_material) | nest.undecided
-    order = np.argsort(labels, kind="stable")
-    starts = np.searchsorted(labels[order], np.arange(n_shells))
-    p0, p1, p2 = (vertices[faces[order, k]] for k in range(3))
-    lo = np.minimum.reduceat(np.minimum(np.minimum(p0, p1), p2), starts, axis=0)
-    hi = np.maximum.reduceat(np.maximum(np.maximum(p0, p1), p2), starts, axis=0)
-    del p0, p1, p2
-    boxes_meet = np.all(lo[:, None] <= hi[None], axis=2) & np.all(lo[None] <= hi[:, None], axis=2)
-    np.fill_diagonal(boxes_meet, False)
-    if boxes_meet.any() and not check_crossing:
-        overlapped |= boxes_meet.any(axis=1)
-    elif boxes_meet.any():
-        largest = int(np.argmax(np.bincount(labels, minlength=n_shells)))
-        query = labels != largest
-        crossing = crossing_shells(vertices, faces, labels, query,
-                                   max_pairs=max(pairs_per_face * len(faces), 1 << 16))
-        if crossing is None:            # too many candidate pairs to test: let the boolean decide
-            crossing = boxes_meet.any(axis=1)
-        overlapped |= crossing
-    return flip, owner, int(np.count_nonzero(cavity)), int(np.count_nonzero(overlapped))
+        return vols < 0, np.zeros(1, dtype=np.intp), 0, 0
+    contacts = surface_contacts(vertices, faces, max_pairs=max(pairs_per_face * len(faces), 1 << 16)) \
+        if check_crossing else None
+    touch = shell_contacts(contacts, labels, n_shells) if contacts is not None else None
+    nest = _nesting(vertices, faces, labels, n_shells)
+    crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
+    flip, owner, depth = orient_by_depth(vols, nest, crossing_with)
+    if touch is not None and touch.complete:
+        candidates = touch.crossing | touch.touching | nest.undecided
+    else:
+        candidates = _boxes_meet(vertices, faces, labels, n_shells) | nest.undecided
+    return flip, owner, int(np.count_nonzero(depth % 2 == 1)), int(np.count_nonzero(candidates))
 
 
 def _check_magnitude(lo, hi, source: str) -> None:
@@ -228,67 +196,79 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if found.estimate is not None and patched is None:
         return _estimated(found, common)
     # a patched surface is closed: its shells are classified and overlaps united like any other, and the
-    # bounds of the patches carry over to the result
-    labels, n_shells = shell_labels(f, len(v))
+    # bounds of the patches carry over to the result.  Every rule applied below is stated in mesh/policy.py.
+    labels, n_shells = shell_labels(f, len(v))                                   # R1
     if n_shells == 0:
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
     shells = body_volume_moments(v, f, labels, n_shells)
-    flat = [k for k, s in enumerate(shells) if abs(s.volume) <= FLAT_RTOL * diag ** 3]
-    dropped_note = None
-    if flat and patched is not None and len(flat) < n_shells:
-        # with repair, stray pieces that enclose nothing (loose triangles, sheets) carry no material in the solid
-        # model: they are left out and said so, instead of refusing the part they float beside
-        keep_shell = np.ones(n_shells, dtype=bool)
-        keep_shell[flat] = False
-        f = f[keep_shell[labels]]
-        labels, n_shells = shell_labels(f, len(v))
-        shells = body_volume_moments(v, f, labels, n_shells)
-        dropped_note = (f"{len(flat)} stray piece{'s' if len(flat) > 1 else ''} enclosing no volume (loose "
-                        "triangles or sheets) left out")
-        warnings.warn(MeshRepairedWarning(f"{source}: {dropped_note}"), stacklevel=3)
-        flat = []
-    if flat:
-        what = "the mesh encloses" if n_shells == 1 else f"{len(flat)} of {n_shells} shells enclose"
-        raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
-                               "thin-walled part use the shell model with a wall `thickness`")
-    flip, owner, cavities, overlaps = classify_shells(v, f, labels, n_shells, shells, diag, source=source,
-                                                      check_crossing=not found.nonmanifold_edges)
-    if flip.any():
-        face_flip = flip[labels]
-        f = f.copy()
-        f[face_flip] = f[face_flip][:, ::-1]
-        shells = [VolumeMoments(-s.volume, s.centroid, -s.second_moment, s.area, s.zero_area_faces) if flip[k] else s
-                  for k, s in enumerate(shells)]
-        n_flipped = int(np.count_nonzero(flip))
-        what = "the mesh is" if n_shells == 1 or n_flipped == n_shells else f"{n_flipped} of {n_shells} shells are"
-        warnings.warn(InsideOutWarning(f"{source}: {what} inside out (normals point inward); flipped"),
-                      stacklevel=3)
+    f, labels, n_shells, shells, dropped_note = _drop_flat(v, f, labels, shells, diag, source)    # R2
+    contacts = surface_contacts(v, f, max_pairs=max(CROSSING_PAIRS_PER_FACE * len(f), 1 << 16))
+    touch = shell_contacts(contacts, labels, n_shells)
+    if touch.self_crossing.any():                                                # R3
+        message = self_crossing_message(source, touch, v, f, contacts.crossing, labels)
+        if not repair:
+            raise InvalidMeshError(message, details={"self_crossing_face_pairs": touch.self_crossing_pairs})
+        forced = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
+                                 moments=volume_moments, force_estimate=True,
+                                 reason=f"the surface passes through itself at {touch.self_crossing_pairs:,} "
+                                        "face pairs")
+        warnings.warn(MeshRepairedWarning(f"{source}: repaired ({forced.method}, an estimate): "
+                                          f"{'; '.join(forced.notes)}"), stacklevel=3)
+        return _estimated(forced, common)
+    nest = _nesting(v, f, labels, n_shells)
+    flip, owner, depth = orient_by_depth(np.array([s.volume for s in shells]), nest, touch.crossing_with)   # R4
+    f, shells = _apply_flips(f, labels, shells, flip, n_shells, source)
+    cavities = int(np.count_nonzero(depth % 2 == 1))
     method, notes = found.method, list(found.notes)
     if dropped_note is not None:
         notes.append(dropped_note)
-    if overlaps or found.nonmanifold_edges:
+    checks = ["edge-balanced", "consistently-oriented"]
+    undecided = nest.undecided if nest is not None else np.zeros(n_shells, dtype=bool)
+    if touch.complete:
+        candidates = touch.crossing | touch.touching | undecided
+    else:       # the check gave up: every shell whose box meets another's goes to the boolean
+        candidates = _boxes_meet(v, f, labels, n_shells) | undecided
+    overlaps = int(np.count_nonzero(touch.crossing))
+    kind = "exact" if touch.complete else "unverified"
+    if touch.complete and not touch.crossing.any():
+        checks.append("no-crossing-faces")
+    if candidates.any() or found.nonmanifold_edges:                             # R5, R6
         united = _unite(v, f, labels, owner, source, repair)
         summed = sum(s.volume for s in shells)
-        if united is not None and abs(united.volume - summed) <= UNION_VOLUME_RTOL * abs(summed):
-            overlaps = 0                      # surfaces touch, no volume is shared
+        if united is not None and not touch.crossing.any() and \
+                abs(united.volume - summed) <= TOUCH_VOLUME_RTOL * abs(summed):
+            overlaps = 0                      # surfaces touch, no volume is shared: the sum is the solid
+            checks.append("touching-confirmed")
+            if int(np.count_nonzero(candidates)):
+                notes.append(f"{int(np.count_nonzero(candidates))} shells touch another (the boolean union's "
+                             "volume equals their sum: no volume is shared)")
         elif united is None:
             found = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
                                     moments=volume_moments, force_estimate=True)
             return _estimated(found, {**common, "overlapping_shells": max(overlaps, 1)})
-        elif overlap == "sum":
-            method = "sum"
-            notes.append(f"overlapping bodies: their integrals are added, so {summed - united.volume:.6g} m³ of "
-                         "shared volume is counted twice (`overlap` 'sum')")
-            warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
         else:
-            notes.append(f"overlapping bodies united by a boolean: {summed - united.volume:.6g} m³ shared volume "
-                         "counted once")
-            warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
-            method, overlaps = "union", max(overlaps, 1)
-            v, f = united.vertices, united.faces
-            labels, n_shells = shell_labels(f, len(v))
-            shells = body_volume_moments(v, f, labels, n_shells)
-            flip, owner, cavities, _ = classify_shells(v, f, labels, n_shells, shells, diag, source=source)
+            overlaps = max(overlaps, 1)
+            shared = _shared_text(summed, united.volume)
+            if overlap == "sum":
+                method, kind = "sum", "summed"
+                notes.append(f"overlapping bodies: their integrals are added, so {shared} is counted twice "
+                             "(`overlap` 'sum')")
+                warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+            else:
+                notes.append(f"overlapping bodies united by a boolean: {shared} counted once")
+                warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+                method = "union"
+                kind = "united" if touch.complete else "unverified"
+                checks = ["edge-balanced", "consistently-oriented", "boolean-union"]
+                v, f = united.vertices, united.faces
+                labels, n_shells = shell_labels(f, len(v))
+                shells = body_volume_moments(v, f, labels, n_shells)
+                f, labels, n_shells, shells, left = _drop_flat(v, f, labels, shells, diag, source, warn=False)
+                nest = _nesting(v, f, labels, n_shells)
+                flip2, owner, depth = orient_by_depth(np.array([s.volume for s in shells]), nest,
+                                                      np.zeros((0, 2), dtype=np.int64))
+                f, shells = _apply_flips(f, labels, shells, flip2, n_shells, source, warn=False)
+                cavities = int(np.count_nonzero(depth % 2 == 1))
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
     bbox_min, bbox_max = (lo, hi) if v is raw.vertices else bounding_box(v)
     uncertainty = None
@@ -297,14 +277,83 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         uncertainty = uncertainty_from(total.volume, total.centroid, total.second_moment,
                                        patched.uncertainty.volume_in_doubt, patched.far)
         check_useful(total.volume, uncertainty, source=source, what="the patched surface")
-        method = "patched"
+        method, kind = "patched", "estimate"
+    certificate = Certificate(kind, tuple(checks) if kind != "estimate" else ())
     report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
                         bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),
                         overlapping_shells=overlaps, repaired=patched is not None,
                         repair_actions=tuple(notes) if patched is not None else (),
                         repair_volume_change=None, bbox_min=bbox_min, bbox_max=bbox_max, method=method,
-                        uncertainty=uncertainty, notes=tuple(notes), **common)
+                        uncertainty=uncertainty, notes=tuple(notes), certificate=certificate, **common)
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
+
+
+def _shared_text(summed: float, united: float) -> str:
+    """The shared volume of overlapping bodies in words, m³ (never negative)."""
+    shared = summed - united
+    if shared >= 0:
+        return f"{shared:.6g} m³ of shared volume"
+    return f"no shared volume (the union is {-shared:.3g} m³ larger than the sum, within rounding)"
+
+
+def _nesting(v, f, labels, n_shells):
+    """The shells' winding numbers at each other's probe points (None for one shell)."""
+    if n_shells < 2:
+        return None
+    from .nesting import shell_nesting      # imported on use: one shell needs none
+    return shell_nesting(v, f, labels, n_shells)
+
+
+def _boxes_meet(v, f, labels, n_shells) -> np.ndarray:
+    """(s,) bool: shells whose bounding box meets another shell's."""
+    order = np.argsort(labels, kind="stable")
+    starts = np.searchsorted(labels[order], np.arange(n_shells))
+    tri = v[f[order]]
+    lo = np.minimum.reduceat(tri.min(axis=1), starts, axis=0)
+    hi = np.maximum.reduceat(tri.max(axis=1), starts, axis=0)
+    meet = np.all(lo[:, None] <= hi[None], axis=2) & np.all(lo[None] <= hi[:, None], axis=2)
+    np.fill_diagonal(meet, False)
+    return np.asarray(meet.any(axis=1))
+
+
+def _drop_flat(v, f, labels, shells, diag, source, *, warn=True):
+    """R2: leave out closed shells that enclose no volume; refuse when nothing else is left."""
+    n_shells = len(shells)
+    flat = np.array([abs(s.volume) <= FLAT_RTOL * diag ** 3 for s in shells], dtype=bool)
+    if not flat.any():
+        return f, labels, n_shells, shells, None
+    if flat.all():
+        what = "the mesh encloses" if n_shells == 1 else f"all {n_shells} shells enclose"
+        raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
+                               "thin-walled part use the shell model with a wall `thickness`")
+    dropped_faces = int(np.count_nonzero(flat[labels]))
+    f = f[~flat[labels]]
+    labels, n_shells = shell_labels(f, len(v))
+    shells = body_volume_moments(v, f, labels, n_shells)
+    n_flat = int(np.count_nonzero(flat))
+    note = (f"{n_flat} closed piece{'s' if n_flat > 1 else ''} enclosing no volume ({dropped_faces:,} faces: "
+            "zero-thickness walls, coincident opposite faces or flat slivers) left out; they contribute nothing "
+            "to the integrals")
+    if warn:
+        warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
+    return f, labels, n_shells, shells, note
+
+
+def _apply_flips(f, labels, shells, flip, n_shells, source, *, warn=True):
+    """Turn the shells marked by R4, with an :class:`InsideOutWarning` naming how many."""
+    if not flip.any():
+        return f, shells
+    face_flip = flip[labels]
+    f = f.copy()
+    f[face_flip] = f[face_flip][:, ::-1]
+    shells = [VolumeMoments(-s.volume, s.centroid, -s.second_moment, s.area, s.zero_area_faces) if flip[k] else s
+              for k, s in enumerate(shells)]
+    if warn:
+        n_flipped = int(np.count_nonzero(flip))
+        what = "the mesh is" if n_shells == 1 or n_flipped == n_shells else f"{n_flipped} of {n_shells} shells are"
+        warnings.warn(InsideOutWarning(f"{source}: {what} wound against its nesting (a body inward or a cavity "
+                                       "outward); flipped"), stacklevel=4)
+    return f, shells
 
 
 def _total(shells) -> VolumeMoments:
@@ -349,7 +398,7 @@ def _estimated(found: Resolution, common: dict[str, Any]) -> PreparedMesh:
                             area=est.area)
     lo, hi = bounding_box(found.vertices)
     common = {"overlapping_shells": 0, **common}
-    report = MeshReport(vertices=len(found.vertices), faces=len(found.faces), zero_area_faces=0, bodies=1,
+    report = MeshReport(certificate=Certificate("estimate"), vertices=len(found.vertices), faces=len(found.faces), zero_area_faces=0, bodies=1,
                         cavities=0, flipped_shells=0, repaired=True, repair_actions=found.notes,
                         repair_volume_change=None, bbox_min=lo, bbox_max=hi, method=est.method,
                         uncertainty=est.uncertainty, notes=found.notes, **common)

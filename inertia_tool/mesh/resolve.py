@@ -125,7 +125,7 @@ def _dedupe(faces: np.ndarray) -> tuple[np.ndarray, int]:
 
 
 def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
-                    merge_tolerance: float, moments, force_estimate: bool = False) -> Resolution:
+                    merge_tolerance: float, moments, force_estimate: bool = False, reason: str | None = None) -> Resolution:
     """Read a surface that failed the manifold check as a solid (exact), as an estimate (repair), or refuse.
 
     Parameters
@@ -146,7 +146,9 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         ``moments(vertices, faces) -> VolumeMoments`` (the exact integrator).
     force_estimate : bool
         Go straight to the winding-number estimate (a balanced surface whose overlapping bodies the boolean
-        could not unite).
+        could not unite, or that passes through itself).
+    reason : str, optional
+        Why the estimate is forced, for the notes (default: the union could not be formed).
 
     Returns
     -------
@@ -163,9 +165,12 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     census = edge_balance(f, n)
     if force_estimate:
         grid = winding_estimate(v, f)
-        check_useful(grid.volume, grid.uncertainty, source=source, what="the winding-number estimate of the "
-                     "overlapping bodies", why="`overlap` 'sum' adds the bodies (shared volume counted twice)")
-        return Resolution(v, f, grid.method, ("the bodies overlap and their union could not be formed", grid.detail),
+        why = reason or "the bodies overlap and their union could not be formed"
+        hint = ("`overlap` 'sum' adds the bodies (shared volume counted twice)" if reason is None else
+                "repair the surface so that it does not pass through itself")
+        check_useful(grid.volume, grid.uncertainty, source=source,
+                     what=f"the winding-number estimate ({why})", why=hint)
+        return Resolution(v, f, grid.method, (why, grid.detail),
                           0, None, census.nonmanifold_edges, estimate=grid)
     if census.balanced:
         return Resolution(v, f, "exact", _touching_note(census), 0, None, census.nonmanifold_edges)

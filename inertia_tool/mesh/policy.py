@@ -1,0 +1,244 @@
+"""Every rule that turns a closed surface into a solid, each stated once with its reason, and the certificate.
+
+:func:`~inertia_tool.mesh.prepare.prepare_mesh` applies these rules in order; nothing else in the pipeline
+decides when to flip, unite, drop or refuse.  The solid of a surface is the set where its winding number is
+at least one (Rigid Body Motion, Ch. 4, the divergence-theorem volume integrals hold for that set only when
+the surface bounds it exactly once).
+
+Rules
+-----
+R1 *Bodies are edge-connected* (:func:`~.checks.shell_labels`).  Faces that meet only at a vertex belong to
+   different shells: a non-manifold vertex is split into its fans of edge-connected faces before anything
+   decides what is one body.  Reason: two bodies that share a corner (or are welded there) are two bodies,
+   and must be tested against each other for overlap.
+R2 *Flat pieces carry no volume* (:data:`FLAT_RTOL`).  A closed shell whose |volume| is at most
+   ``FLAT_RTOL · diagonal³`` (a face and its reverse, a zero-thickness wall, a collapsed sliver) contributes
+   nothing to the integrals, so it is left out with a note and the answer stays exact.  Only a mesh that is
+   flat everywhere is refused.  Reason: such faces cancel pairwise in every surface integral.
+R3 *A surface that passes through itself is not a solid as it stands* (:func:`self_crossing_message`).  A
+   crossing between two faces of one shell makes the winding number 2 (or −1) somewhere, and the summed
+   integral counts that region twice.  manifold3d does not resolve a self-intersection inside one mesh
+   (its booleans assume valid input; the volume of such a mesh is the signed sum), so without ``repair``
+   this is refused; with ``repair`` the winding-number estimate with its bound is given.
+R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is the number of other shells
+   that contain it (whose winding number at a point of it is nonzero and that it does not cross); even depth
+   is a body, wound outward, odd depth a cavity, wound inward.  A shell wound the other way is flipped, with
+   a warning.  Never decided by the sign of the total volume: one inside-out shell must not turn the others.
+R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
+   transversally (or overlap coplanar with the same orientation) mean shared volume: the union is integrated
+   and the certificate is ``united``.
+R6 *Touching shells are decided by the boolean* (:data:`TOUCH_VOLUME_RTOL`).  Shells that meet only at edges,
+   vertices or face to face with opposite normals (touching copies), or whose probe points all lie on
+   another surface, or that share non-manifold edges, are united by the boolean; when the union's volume
+   equals the summed volume within ``TOUCH_VOLUME_RTOL`` the interiors are disjoint and the sum, exact as
+   it stands, is the answer (certificate ``exact``).
+R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only after the edge census found the
+   surface balanced, every shell is oriented by R4, and the face-intersection check ran over every candidate
+   pair and found no crossing.  When the check could not finish within its work bound the integral is still
+   computed but certified ``unverified``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..tolerances import FLAT_RTOL
+
+__all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
+           "self_crossing_message", "shell_contacts", "ShellContacts"]
+
+#: R6: the union's volume may differ from the summed volume by this much (relative) and still count as
+#: "no shared volume".  manifold3d keeps the input vertices and adds only new intersection vertices, so for
+#: touching shells the union's integral differs from the sum by float64 rounding of the two integrals
+#: (about ``faces · 2⁻⁵³`` relative, < 1e-10 up to millions of faces); a genuine overlap smaller than this
+#: changes the mass by less than 1e-9 of itself, far below any stated precision of the inputs.
+TOUCH_VOLUME_RTOL = 1e-9
+
+#: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
+#: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
+#: overlapping bodies' integrals added, on request; the shared volume counts twice), ``unverified`` (the
+#: integral as it stands, but the intersection check did not finish), ``estimate`` (bounds in
+#: ``MeshReport.uncertainty``).
+CERTIFICATE_KINDS = ("exact", "united", "summed", "unverified", "estimate")
+
+#: The checks a certificate can list, with what each proves.
+CHECKS = {
+    "edge-balanced": "every edge is used equally often in both directions (the surface is closed)",
+    "consistently-oriented": "every shell is wound outward as a body or inward as a cavity by its nesting depth",
+    "no-crossing-faces": "no two faces cross or overlap except along shared edges and vertices (checked over "
+                         "every candidate pair)",
+    "boolean-union": "manifold3d formed the union of the bodies (float64)",
+    "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
+}
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """How far a result can be trusted, and the checks that say so.
+
+    Attributes
+    ----------
+    kind : str
+        One of :data:`CERTIFICATE_KINDS`.
+    checks : tuple of str
+        The checks that ran and passed (keys of :data:`CHECKS`).
+    """
+
+    kind: str
+    checks: tuple = ()
+
+    def __post_init__(self) -> None:
+        if self.kind not in CERTIFICATE_KINDS:
+            raise ValueError(f"Expected a certificate kind in {CERTIFICATE_KINDS}, got {self.kind!r}")
+        unknown = [c for c in self.checks if c not in CHECKS]
+        if unknown:
+            raise ValueError(f"Expected checks among {tuple(CHECKS)}, got {unknown}")
+
+    @property
+    def proven(self) -> bool:
+        """The numbers are exact for the solid meant (``exact`` or ``united``)."""
+        return self.kind in ("exact", "united")
+
+    def describe(self) -> str:
+        """One line: the kind and the checks, for text and HTML reports."""
+        if not self.checks:
+            return self.kind
+        return f"{self.kind} ({', '.join(self.checks)})"
+
+
+@dataclass(frozen=True)
+class ShellContacts:
+    """Which shells cross or touch which, from the face-pair contacts of the whole surface.
+
+    Attributes
+    ----------
+    self_crossing : (s,) bool
+        Shells with two faces that cross each other (R3).
+    self_crossing_pairs : int
+        Face pairs of one shell that cross.
+    crossing : (s,) bool
+        Shells with a face crossing a face of another shell (R5).
+    crossing_with : (k, 2) int
+        The pairs of distinct shells that cross.
+    touching : (s,) bool
+        Shells meeting another shell only at boundaries or face to face with opposite normals (R6).
+    complete : bool
+        Every candidate pair was tested.
+    """
+
+    self_crossing: np.ndarray
+    self_crossing_pairs: int
+    crossing: np.ndarray
+    crossing_with: np.ndarray
+    touching: np.ndarray
+    complete: bool
+
+
+def shell_contacts(contacts, labels: np.ndarray, n_shells: int) -> ShellContacts:
+    """Summarise face-pair contacts (a ``SurfaceContacts``) by shell.
+
+    Parameters
+    ----------
+    contacts : SurfaceContacts
+        ``crossing``, ``coplanar_opposite``, ``contact`` face pairs and ``complete``.
+    labels : (m,) int
+        Shell of each face.
+    n_shells : int
+    """
+    labels = np.asarray(labels)
+    cross = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
+    la, lb = labels[cross[:, 0]], labels[cross[:, 1]]
+    same = la == lb
+    self_crossing = np.zeros(n_shells, dtype=bool)
+    self_crossing[la[same]] = True
+    crossing = np.zeros(n_shells, dtype=bool)
+    crossing[la[~same]] = True
+    crossing[lb[~same]] = True
+    pairs = np.unique(np.sort(np.c_[la[~same], lb[~same]], axis=1), axis=0) if np.any(~same) \
+        else np.zeros((0, 2), dtype=np.int64)
+    touching = np.zeros(n_shells, dtype=bool)
+    for group in (contacts.coplanar_opposite, contacts.contact):
+        g = np.asarray(group, dtype=np.int64).reshape(-1, 2)
+        ga, gb = labels[g[:, 0]], labels[g[:, 1]]
+        other = ga != gb
+        touching[ga[other]] = True
+        touching[gb[other]] = True
+    return ShellContacts(self_crossing=self_crossing, self_crossing_pairs=int(np.count_nonzero(same)),
+                         crossing=crossing, crossing_with=pairs, touching=touching,
+                         complete=bool(contacts.complete))
+
+
+def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarray, faces: np.ndarray,
+                          crossing: np.ndarray, labels: np.ndarray) -> str:
+    """R3's refusal: how many face pairs cross within a shell, and where the first one is (m)."""
+    pairs = np.asarray(crossing, dtype=np.int64).reshape(-1, 2)
+    pairs = pairs[labels[pairs[:, 0]] == labels[pairs[:, 1]]]
+    where = ""
+    if len(pairs):
+        p = vertices[faces[pairs[0]]].reshape(-1, 3).mean(axis=0)
+        where = f", e.g. near ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}) m"
+    n_shells = int(np.count_nonzero(found.self_crossing))
+    shells = "one shell" if n_shells == 1 else f"{n_shells} shells"
+    return (f"{source}: the surface passes through itself at {found.self_crossing_pairs:,} face pairs "
+            f"({shells}){where}; the solid there is ambiguous (the summed integral would count the crossed "
+            "region twice); `repair=True` gives a bounded estimate of the solid {winding number ≥ 1}")
+
+
+def orient_by_depth(volumes: np.ndarray, nest, crossing_with: np.ndarray) -> tuple[np.ndarray, np.ndarray,
+                                                                                    np.ndarray]:
+    """R4: which shells to flip, the body each shell belongs to, and its nesting depth.
+
+    Parameters
+    ----------
+    volumes : (s,) float
+        Signed volume of each shell as wound in the file.
+    nest : Nesting or None
+        Winding numbers of each shell at a probe point of every other (:func:`~.nesting.shell_nesting`);
+        None for a single shell.
+    crossing_with : (k, 2) int
+        Pairs of shells whose surfaces cross: neither contains the other.
+
+    Returns
+    -------
+    flip : (s,) bool
+        Shells wound against their depth (even → outward, positive volume; odd → inward, negative).
+    owner : (s,) int
+        The body each shell belongs to: a cavity (odd depth) belongs to its innermost container; a body to
+        itself.
+    depth : (s,) int
+        Number of shells containing each shell.
+
+    Notes
+    -----
+    A shell whose probes all lay on other surfaces (``nest.undecided``) is contained in nothing it could
+    see; its own sign decides (it is passed to the boolean by R6, which then decides what it shares).
+    """
+    vols = np.asarray(volumes, dtype=np.float64)
+    n = len(vols)
+    owner = np.arange(n)
+    depth = np.zeros(n, dtype=np.int64)
+    if nest is None or n == 1:
+        return vols < 0, owner, depth
+    cross = np.zeros((n, n), dtype=bool)
+    if len(crossing_with):
+        cw = np.asarray(crossing_with, dtype=np.int64)
+        cross[cw[:, 0], cw[:, 1]] = True
+        cross[cw[:, 1], cw[:, 0]] = True
+    inside = nest.winding != 0
+    contained = inside & ~cross[nest.shell, nest.other]
+    # the containers of each shell, sorted from the outermost (largest |volume|) inward
+    depth_of = np.bincount(nest.shell[contained], minlength=n)
+    depth[:] = depth_of
+    undecided = np.asarray(nest.undecided, dtype=bool)
+    depth[undecided] = 0
+    want_positive = depth % 2 == 0
+    flip = (vols > 0) != want_positive
+    flip[undecided] = vols[undecided] < 0
+    cavity = ~want_positive & ~undecided
+    if cavity.any():
+        s, o = nest.shell[contained], nest.other[contained]
+        keep = cavity[s] & (depth[o] == depth[s] - 1)        # the innermost container of a cavity
+        owner[s[keep]] = o[keep]
+    return flip, owner, depth
