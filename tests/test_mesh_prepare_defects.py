@@ -147,10 +147,10 @@ def test_stray_triangles_beside_a_closed_part_are_left_out_under_repair():
     stray = np.random.default_rng(0).uniform(1.5, 2.0, (9, 3))
     v2, f2 = np.vstack([v, stray]), np.vstack([f, np.arange(9).reshape(3, 3) + len(v)])
     clean = mass_properties((v, f))
-    with pytest.warns(MeshRepairedWarning, match="3 stray pieces enclosing no volume"):
+    with pytest.warns(MeshResolvedWarning, match="3 closed pieces enclosing no volume"):
         repaired = mass_properties((v2, f2), repair=True)
     assert repaired.mass == pytest.approx(clean.mass, rel=1e-12)
     np.testing.assert_allclose(repaired.center_of_mass, clean.center_of_mass, atol=1e-12)
-    assert any("stray" in n for n in repaired.mesh.notes)
+    assert any("enclosing no volume" in n for n in repaired.mesh.notes)
     with pytest.raises(InvalidMeshError, match="boundary edges"):
         mass_properties((v2, f2))

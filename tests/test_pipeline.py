@@ -60,13 +60,23 @@ def test_one_inside_out_body_among_two():
 
 
 def test_overlapping_bodies_warn_and_are_united():
+    crossing = box_arrays((1.0, 1.0, 1.0), (0.75, 0.75, 0.75))     # shares a 0.75-cube corner with the big box
     with pytest.warns(OverlapWarning, match="united"):
-        p = mass_properties(_concat(box_arrays((2.0, 2.0, 2.0)), box_arrays((1.0, 1.0, 1.0))))
-    assert p.mesh.overlapping_shells == 1 and p.mesh.method == "union"
-    assert p.volume == pytest.approx(8.0, rel=1e-14)            # the inner box adds nothing to the union
+        p = mass_properties(_concat(box_arrays((2.0, 2.0, 2.0)), crossing))
+    assert p.mesh.overlapping_shells == 2 and p.mesh.method == "union"
+    assert p.mesh.certificate.kind == "united"
+    assert p.volume == pytest.approx(9.0 - 0.75 ** 3, rel=1e-14)
     with pytest.warns(OverlapWarning, match="counted twice"):
-        p = mass_properties(_concat(box_arrays((2.0, 2.0, 2.0)), box_arrays((1.0, 1.0, 1.0))), overlap="sum")
+        p = mass_properties(_concat(box_arrays((2.0, 2.0, 2.0)), crossing), overlap="sum")
     assert p.mesh.method == "sum" and p.volume == pytest.approx(9.0, rel=1e-14)
+    assert p.mesh.certificate.kind == "summed"
+
+
+def test_outward_shell_inside_a_body_is_a_cavity_by_its_depth():
+    """Rule R4: a shell at depth 1 is a cavity whatever its winding (flipped, with a warning)."""
+    with pytest.warns(InsideOutWarning, match="1 of 2 shells are inside out"):
+        p = mass_properties(_concat(box_arrays((2.0, 2.0, 2.0)), box_arrays((1.0, 1.0, 1.0))))
+    assert p.volume == pytest.approx(7.0, rel=1e-14) and p.mesh.cavities == 1
 
 
 def test_ball_inside_a_hollow_is_not_an_overlap():

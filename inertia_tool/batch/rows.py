@@ -57,7 +57,7 @@ _INT_FIELDS = {"faces", "bodies", "cavities"}
 _BOOL_FIELDS = {"watertight", "repaired"}
 _TEXT_FIELDS = {"schema", "path", "status", "error_type", "error", "sha256", "options_key", "units",
                 "mesh_length_unit", "method",
-                "density_source", "warnings", "worker"}
+                "density_source", "warnings", "worker", "certificate"}
 #: The columns of each row layout, by the ``schema`` value that starts its rows.
 _LAYOUTS = {SCHEMA: ROW_FIELDS, SCHEMA_V1: ROW_FIELDS_V1}
 

@@ -81,7 +81,7 @@ ROW_FIELDS = (
     # principal moments (ascending) and their unit axes (mesh axes, right-handed)
     "i1", "i2", "i3",
     "axis1_x", "axis1_y", "axis1_z", "axis2_x", "axis2_y", "axis2_z", "axis3_x", "axis3_y", "axis3_z",
-    "faces", "bodies", "cavities", "watertight", "repaired", "warnings", "seconds", "worker",
+    "faces", "bodies", "cavities", "watertight", "repaired", "certificate", "warnings", "seconds", "worker",
 )
 
 #: The columns of a :data:`SCHEMA_V1` row, frozen (files of that version have exactly these): ``units`` (the
@@ -342,7 +342,7 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
         row.update(
             status="ok", density_source=described, method=mesh.method, **_bounds(mesh.uncertainty),
             faces=int(mesh.faces), bodies=int(mesh.bodies), cavities=int(mesh.cavities),
-            watertight=bool(mesh.watertight), repaired=bool(mesh.repaired),
+            watertight=bool(mesh.watertight), repaired=bool(mesh.repaired), certificate=mesh.certificate.kind,
             warnings=" | ".join(_one_line(w.message) for w in caught
                                 if issubclass(w.category, InertiaToolWarning)) or None,
         )

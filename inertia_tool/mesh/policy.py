@@ -47,7 +47,7 @@ import numpy as np
 from ..tolerances import FLAT_RTOL
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
-           "self_crossing_message", "shell_contacts", "ShellContacts"]
+           "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
 
 #: R6: the union's volume may differ from the summed volume by this much (relative) and still count as
 #: "no shared volume".  manifold3d keeps the input vertices and adds only new intersection vertices, so for
@@ -71,6 +71,7 @@ CHECKS = {
                          "every candidate pair)",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
     "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
+    "closed-form": "a primitive (box, cylinder, sphere, capsule, ellipsoid) integrated by its closed form",
 }
 
 
@@ -242,3 +243,12 @@ def orient_by_depth(volumes: np.ndarray, nest, crossing_with: np.ndarray) -> tup
         keep = cavity[s] & (depth[o] == depth[s] - 1)        # the innermost container of a cavity
         owner[s[keep]] = o[keep]
     return flip, owner, depth
+
+
+def weakest(certificates) -> Certificate:
+    """The certificate of a result combined from several (a robot link's elements): the weakest kind, with the
+    checks of the element that has it (the first such, in order)."""
+    certs = list(certificates)
+    if not certs:
+        raise ValueError("Expected at least one certificate to combine, got none")
+    return max(certs, key=lambda c: CERTIFICATE_KINDS.index(c.kind))

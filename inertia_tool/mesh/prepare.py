@@ -11,6 +11,7 @@ sign of each shell), so that the faces are integrated once.
 from __future__ import annotations
 
 import warnings
+from types import SimpleNamespace
 
 
 from typing import Any
@@ -180,6 +181,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     topo = edge_topology(f, len(v), v)
     watertight = topo.oriented
     found = Resolution(v, f, "exact", (), 0, None, 0)
+    n_read = len(v)                           # vertices beyond these are the apexes of repair patches
     if not topo.oriented:                     # clean meshes skip all of this
         found = resolve_surface(v, f, diag=diag, source=source, repair=repair, merge_tolerance=merge_tolerance,
                                 moments=volume_moments)
@@ -203,6 +205,10 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     shells = body_volume_moments(v, f, labels, n_shells)
     f, labels, n_shells, shells, dropped_note = _drop_flat(v, f, labels, shells, diag, source)    # R2
     contacts = surface_contacts(v, f, max_pairs=max(CROSSING_PAIRS_PER_FACE * len(f), 1 << 16))
+    if patched is not None:
+        contacts, patch_notes = _outside_patches(contacts, f, n_read)
+        found = Resolution(found.vertices, found.faces, found.method, found.notes + patch_notes,
+                           found.flipped_faces, found.welded_tolerance, found.nonmanifold_edges, found.estimate)
     touch = shell_contacts(contacts, labels, n_shells)
     if touch.self_crossing.any():                                                # R3
         message = self_crossing_message(source, touch, v, f, contacts.crossing, labels)
@@ -296,6 +302,19 @@ def _shared_text(summed: float, united: float) -> str:
     return f"no shared volume (the union is {-shared:.3g} m³ larger than the sum, within rounding)"
 
 
+def _outside_patches(contacts, faces, n_read):
+    """Contacts with the crossings that involve a repair patch taken out (those lie within the patches' doubt,
+    which the estimate's bound carries), and a note saying how many there were."""
+    crossing = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
+    patch = np.any(faces[crossing[:, 0]] >= n_read, axis=1) | np.any(faces[crossing[:, 1]] >= n_read, axis=1)
+    if not patch.any():
+        return contacts, ()
+    kept = SimpleNamespace(crossing=crossing[~patch], coplanar_opposite=contacts.coplanar_opposite,
+                           contact=contacts.contact, complete=contacts.complete)
+    return kept, (f"{int(np.count_nonzero(patch)):,} face pairs where a patch crosses the surface (within the "
+                  "patches' volume in doubt)",)
+
+
 def _nesting(v, f, labels, n_shells):
     """The shells' winding numbers at each other's probe points (None for one shell)."""
     if n_shells < 2:
@@ -351,8 +370,8 @@ def _apply_flips(f, labels, shells, flip, n_shells, source, *, warn=True):
     if warn:
         n_flipped = int(np.count_nonzero(flip))
         what = "the mesh is" if n_shells == 1 or n_flipped == n_shells else f"{n_flipped} of {n_shells} shells are"
-        warnings.warn(InsideOutWarning(f"{source}: {what} wound against its nesting (a body inward or a cavity "
-                                       "outward); flipped"), stacklevel=4)
+        warnings.warn(InsideOutWarning(f"{source}: {what} inside out for its nesting depth (a body wound inward "
+                                       "or a cavity outward); flipped"), stacklevel=4)
     return f, shells
 
 

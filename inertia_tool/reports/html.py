@@ -412,7 +412,8 @@ def _core_sections(props: MassProperties, density_source: str | None, semi,
         bounds = ("none: exact for the polyhedron" if u is None else
                   f"mass ±{100 * u.mass:.3g}%, centre of mass {u.center_of_mass:.3g} m, "
                   f"inertia ±{100 * u.inertia:.3g}%")
-        rows = [["method", _e(mesh.method)], ["uncertainty", _e(bounds)],
+        rows = [["method", _e(mesh.method)], ["certificate", _e(mesh.certificate.describe())],
+                ["uncertainty", _e(bounds)],
                 ["faces", f"{mesh.faces:,} (file {mesh.file_faces:,})"], ["vertices", f"{mesh.vertices:,}"],
                 ["bodies / cavities", f"{mesh.bodies} / {mesh.cavities}"],
                 ["watertight and consistently wound as read", "yes" if mesh.watertight else "no"],

@@ -141,6 +141,7 @@ def mass_properties_dict(props: MassProperties, *, density_source: str | None = 
     whole = method_and_uncertainty(props)                   # uncertainty None (null) when exact
     out["method"], out["uncertainty"] = whole
     if props.mesh is not None:
+        out["certificate"] = props.mesh.certificate       # {"kind": ..., "checks": [...]}
         out["mesh"] = mesh_report_dict(props.mesh)
     if props.parts:
         # the shells of one mesh share its report (and its method); the parts of an assembly carry their own

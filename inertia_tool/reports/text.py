@@ -41,6 +41,9 @@ def method_line(mesh) -> str:
     if mesh is None:
         return "exact"
     u = mesh.uncertainty
+    if u is None and mesh.certificate.kind == "unverified":
+        return (f"NOT VERIFIED (method: {mesh.method}): the integral of the surface as it stands; the check for "
+                "faces crossing each other did not finish, so the surface may pass through itself")
     if u is None:
         extra = " (shared volume of overlapping bodies counted twice, on request)" if mesh.method == "sum" else ""
         return f"exact for the polyhedron (method: {mesh.method}){extra}"
@@ -60,6 +63,8 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
     size = float(np.linalg.norm(mesh.bbox_max - mesh.bbox_min)) if mesh is not None else 0.0
     unit_note = f" (mesh coordinates in {mesh.units}, converted)" if mesh is not None else ""
     lines.append(f"  result: {result or method_line(mesh)}")
+    if mesh is not None:
+        lines.append(f"  certificate: {mesh.certificate.describe()}")
     lines.append(f"  units: SI — m, kg, kg·m²{unit_note}")
     if density_source:
         lines.append(f"  density:          {density_source}")

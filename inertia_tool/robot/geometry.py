@@ -43,14 +43,13 @@ __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", 
 #: What ``LinkInertial.method`` can say: ``"exact"`` (closed forms, and meshes integrated exactly, after
 #: orienting, welding, sealing cracks without moving a point or dropping repeated faces), ``"united"``
 #: (overlapping bodies of a mesh united by a boolean, then exact), ``"summed"`` (overlapping bodies added, the
-#: shared volume counted twice, as asked), ``"estimate"`` (a repaired open mesh: see ``uncertainty``).
-METHODS = ("exact", "united", "summed", "estimate")
+#: shared volume counted twice, as asked), ``"unverified"`` (a mesh whose face-intersection check did not prove
+#: it; see ``MeshReport.certificate``), ``"estimate"`` (a repaired open mesh: see ``uncertainty``).  For a mesh it
+#: is the kind of the engine's certificate, from the strongest to the weakest.
+METHODS = ("exact", "united", "summed", "unverified", "estimate")
 
 #: The value of ``density`` (and of ``robot --density``) that asks for the description's own densities.
 MODEL_DENSITY = "model"
-
-_MESH_METHOD = {"exact": "exact", "oriented": "exact", "welded": "exact", "deduplicated": "exact", "sealed": "exact",
-                "union": "united", "sum": "summed", "patched": "estimate", "winding": "estimate"}
 
 
 def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = None) -> MassProperties:
@@ -280,8 +279,8 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
         props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
         report = cache[element.mesh].mesh if element.kind == "mesh" and element.mesh in cache else None
         method = "exact"
-        if report is not None:          # a result with bounds is an estimate, whatever the repair was called
-            method = "estimate" if report.uncertainty is not None else _MESH_METHOD.get(report.method, "estimate")
+        if report is not None:          # the engine's certificate (a result with bounds is an estimate)
+            method = "estimate" if report.uncertainty is not None else report.certificate.kind
         parts.append((element, props, method, report.uncertainty if report is not None else None))
     return parts, massless
 

@@ -1,0 +1,336 @@
+"""The certificate and the shell-classification policy (mesh/policy.py, mesh/prepare.py).
+
+Every case named in issue 21 (items 1–5, 7) is a regression test here, checked against independent truths:
+manifold3d booleans in float64 (``tests/solids.py``) and signed-tetrahedron sums of each closed shell on its
+own.  The hypothesis test at the end composes solids and asserts the rule "zero silent wrong answers": every
+result is within tolerance of the truth, or not certified, or refused.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from solids import box, figure_eight, rotation, stack, torus, tube, union_volume, uv_sphere
+from inertia_tool import mass_properties
+from inertia_tool.errors import InsideOutWarning, InvalidMeshError, MeshResolvedWarning
+from inertia_tool.mesh.checks import shell_labels
+from inertia_tool.mesh.policy import CERTIFICATE_KINDS, CHECKS, Certificate
+
+
+def _volume(v, f):
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6)
+
+
+def _quiet(v, f, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return mass_properties((v, f), **kw)
+
+
+# -- item 1: bodies sharing a vertex index ------------------------------------------------------------------
+
+def _cubes_sharing_diagonal():
+    v, f = box((2.0, 2.0, 2.0))
+    v2 = v @ rotation([1, 1, 1], np.pi / 6).T          # corners 0 and 7 lie on the axis: they stay put
+    f2 = f + 8
+    f2[f2 == 8] = 0
+    f2[f2 == 15] = 7
+    return np.vstack([v, v2]), np.vstack([f, f2]), (v, f), (v2, f)
+
+
+def test_shell_labels_split_a_shared_vertex_into_its_fans():
+    v, f, _, _ = _cubes_sharing_diagonal()
+    labels, n = shell_labels(f, len(v))
+    assert n == 2
+    assert set(labels[:12]) == {labels[0]} and set(labels[12:]) == {labels[12]} and labels[0] != labels[12]
+
+
+def test_cube_and_turned_cube_sharing_diagonal_corners_are_united():
+    v, f, a, b = _cubes_sharing_diagonal()
+    truth = union_volume(a, b)
+    assert truth == pytest.approx(9.569219, rel=1e-6)            # the number in the issue
+    props = _quiet(v, f)
+    assert props.volume == pytest.approx(truth, rel=1e-9)
+    assert props.mesh.certificate.kind == "united"
+    assert "boolean-union" in props.mesh.certificate.checks
+
+
+# -- item 2: a surface passing through itself ---------------------------------------------------------------
+
+def _figure_eight_truth(steps=64, radius=0.2, sections=12):
+    """{w ≥ 1} of the figure-eight tube: the union of its two halves (each passes the crossing once), capped."""
+    v, f = figure_eight(steps, radius, sections)
+    t = 2 * np.pi * np.arange(steps) / steps + np.pi / steps
+    centre = np.c_[np.sin(2 * t), 2 * np.sin(t), np.zeros(steps)]
+    halves = []
+    for first, last in ((16, 48), (48, 16 + steps)):
+        rings = [i % steps for i in range(first, last + 1)]
+        pts = np.vstack([v[r * sections:(r + 1) * sections] for r in rings] + [centre[rings[0]], centre[rings[-1]]])
+        faces = []
+        k = len(rings)
+        for i in range(k - 1):
+            for j in range(sections):
+                a, b = i * sections + j, i * sections + (j + 1) % sections
+                c, d = a + sections - j + j, (i + 1) * sections + (j + 1) % sections
+                c = (i + 1) * sections + j
+                faces += [[a, c, d], [a, d, b]]
+        c0, c1 = k * sections, k * sections + 1
+        for j in range(sections):
+            faces.append([c0, (j + 1) % sections, j])
+            faces.append([c1, (k - 1) * sections + j, (k - 1) * sections + (j + 1) % sections])
+        fa = np.asarray(faces, dtype=np.int64)
+        if _volume(pts, fa) < 0:
+            fa = fa[:, ::-1]
+        halves.append((pts, fa))
+    return union_volume(*halves), _volume(v, f)
+
+
+def test_figure_eight_tube_is_refused_without_repair():
+    v, f = figure_eight()
+    truth, summed = _figure_eight_truth()
+    assert summed > truth * 1.005                   # the crossing counted twice would be a wrong "exact"
+    with pytest.raises(InvalidMeshError, match=r"passes through itself at [\d,]+ face pairs"):
+        _quiet(v, f)
+
+
+def test_figure_eight_tube_with_repair_is_an_estimate_whose_bound_holds():
+    v, f = figure_eight()
+    truth, _ = _figure_eight_truth()
+    try:
+        props = _quiet(v, f, repair=True)
+    except InvalidMeshError:
+        return                                      # a refusal is an honest answer
+    assert props.mesh.certificate.kind == "estimate" and not props.mesh.exact
+    u = props.mesh.uncertainty
+    assert abs(props.volume - truth) <= u.mass * props.volume
+
+
+def test_manifold3d_does_not_resolve_a_self_crossing_mesh():
+    """Why R3 refuses: manifold3d accepts the figure-eight and returns the signed sum, not {w ≥ 1}."""
+    import manifold3d as m3
+    v, f = figure_eight()
+    solid = m3.Manifold(m3.Mesh64(vert_properties=v, tri_verts=f.astype(np.uint64)))
+    truth, summed = _figure_eight_truth()
+    assert solid.volume() == pytest.approx(summed, rel=1e-12)
+    assert abs(solid.volume() - truth) > 1e-3 * truth
+
+
+# -- item 3: orientation by nesting depth -------------------------------------------------------------------
+
+@pytest.mark.parametrize("outer_sign, inner_sign", [(1, -1), (-1, -1), (-1, 1), (1, 1)])
+def test_hollow_sphere_in_every_winding_is_the_shell(outer_sign, inner_sign):
+    vo, fo = uv_sphere(1.0)
+    vi, fi = uv_sphere(0.6, (0.1, 0.0, -0.05))
+    truth = _volume(vo, fo) - _volume(vi, fi)
+    v, f = stack((vo, fo if outer_sign > 0 else fo[:, ::-1]), (vi, fi[:, ::-1] if inner_sign < 0 else fi))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        props = mass_properties((v, f))
+    assert props.volume == pytest.approx(truth, rel=1e-12)
+    assert props.mesh.certificate.kind == "exact"
+    assert props.mesh.cavities == 1 and props.mesh.overlapping_shells == 0
+    wrong = (outer_sign < 0) + (inner_sign > 0)
+    assert props.mesh.flipped_shells == wrong
+    assert any(issubclass(w.category, InsideOutWarning) for w in caught) == bool(wrong)
+
+
+def test_body_inside_a_cavity_keeps_its_material():
+    outer, cavity, core = uv_sphere(1.0), uv_sphere(0.7), uv_sphere(0.3)
+    truth = _volume(*outer) - _volume(*cavity) + _volume(*core)
+    for signs in ((1, -1, 1), (-1, 1, -1), (-1, -1, -1)):
+        parts = [(p[0], p[1] if s > 0 else p[1][:, ::-1]) for p, s in zip((outer, cavity, core), signs)]
+        props = _quiet(*stack(*parts))
+        assert props.volume == pytest.approx(truth, rel=1e-12), signs
+        assert props.mesh.certificate.kind == "exact"
+
+
+# -- item 4: touching copies --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("offset", [(1.0, 0.0, 0.0), (1.0, 0.3, 0.2), (0.0, 0.0, 1.0)])
+def test_two_copies_touching_face_to_face_are_the_sum(offset):
+    a, b = box((1.0, 1.0, 1.0)), box((1.0, 1.0, 1.0), offset)
+    props = _quiet(*stack(a, b))
+    assert props.volume == pytest.approx(2.0, rel=1e-12)
+    assert np.all(np.isfinite(props.center_of_mass))
+    np.testing.assert_allclose(props.center_of_mass, np.asarray(offset) / 2, atol=1e-12)
+    assert props.mesh.certificate.kind == "exact"
+    assert "touching-confirmed" in props.mesh.certificate.checks
+    assert props.mesh.overlapping_shells == 0
+    assert all(np.all(np.isfinite(p.center_of_mass)) for p in props.parts)
+
+
+def test_two_copies_of_a_turned_sphere_touching_at_a_pole():
+    v, f = uv_sphere(0.5)
+    r = rotation([0.3, -0.2, 1.0], 0.7)
+    props = _quiet(*stack((v @ r.T, f), ((v + [0, 0, 1.0]) @ r.T, f)))
+    assert props.volume == pytest.approx(2 * _volume(v, f), rel=1e-12)
+    assert props.mesh.certificate.kind == "exact"
+
+
+# -- item 5: zero-thickness walls and flat slivers ----------------------------------------------------------
+
+def test_internal_wall_of_coincident_opposite_faces_is_exact():
+    v, f = box((2.0, 1.0, 1.0))
+    wall = np.array([[0.2, -0.5, -0.5], [0.2, 0.5, -0.5], [0.2, 0.5, 0.5], [0.2, -0.5, 0.5]])
+    quad = np.array([[0, 1, 2], [0, 2, 3]])
+    v2, f2 = stack((v, f), (wall, np.vstack([quad, quad[:, ::-1]])), (wall - [0.5, 0, 0], np.vstack([quad, quad[:, ::-1]])))
+    with pytest.warns(MeshResolvedWarning, match="2 closed pieces enclosing no volume"):
+        props = mass_properties((v2, f2), repair=True)
+    assert props.volume == pytest.approx(2.0, rel=1e-12)
+    props = _quiet(v2, f2)                          # no repair needed: the answer is exact
+    assert props.volume == pytest.approx(2.0, rel=1e-12)
+    assert props.mesh.certificate.kind == "exact"
+    assert any("enclosing no volume" in n for n in props.mesh.notes)
+
+
+def test_internal_wall_sharing_the_parts_vertices_is_exact():
+    """A diagonal wall through four of the box's corners: non-manifold edges, one edge-connected shell."""
+    v, f = box((1.0, 1.0, 1.0))
+    quad = np.array([[0, 3, 7], [0, 7, 4]])           # the plane x = y through corners 0, 3, 7, 4
+    props = _quiet(v, np.vstack([f, quad, quad[:, ::-1]]))
+    assert props.volume == pytest.approx(1.0, rel=1e-12)
+    assert props.mesh.certificate.proven
+
+
+def test_flat_sliver_beside_a_body_is_left_out_and_only_all_flat_is_refused():
+    v, f = uv_sphere(1.0)
+    sliver = np.array([[2.0, 0, 0], [2.1, 0, 0], [2.0, 0.1, 0], [2.05, 0.03, 0]])
+    tet = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])   # four coplanar corners: a flat closed piece
+    props = _quiet(*stack((v, f), (sliver, tet)))
+    assert props.volume == pytest.approx(_volume(v, f), rel=1e-12)
+    assert props.mesh.certificate.kind == "exact"
+    with pytest.raises(InvalidMeshError, match="no volume"):
+        _quiet(sliver, tet)
+
+
+# -- item 6: the certificate itself and where it is shown ---------------------------------------------------
+
+def test_certificate_rejects_unknown_kinds_and_checks():
+    with pytest.raises(ValueError, match="certificate kind"):
+        Certificate("probably")
+    with pytest.raises(ValueError, match="checks among"):
+        Certificate("exact", ("looked fine",))
+    assert set(CERTIFICATE_KINDS) >= {"exact", "united", "estimate"}
+    assert "no-crossing-faces" in CHECKS
+
+
+def test_clean_box_is_exact_only_with_every_check():
+    props = _quiet(*box((1.0, 2.0, 3.0)))
+    cert = props.mesh.certificate
+    assert cert.kind == "exact" and props.mesh.exact
+    assert set(cert.checks) >= {"edge-balanced", "consistently-oriented", "no-crossing-faces"}
+
+
+def test_intersection_check_that_gives_up_is_not_exact(monkeypatch):
+    from inertia_tool.mesh import prepare
+    real = prepare.surface_contacts
+
+    def gives_up(vertices, faces, *, max_pairs=None):
+        found = real(vertices, faces, max_pairs=max_pairs)
+        return type(found)(found.crossing, found.coplanar_opposite, found.contact, False)
+
+    monkeypatch.setattr(prepare, "surface_contacts", gives_up)
+    props = _quiet(*box())
+    assert props.mesh.certificate.kind == "unverified" and not props.mesh.exact
+
+
+def test_certificate_in_json_and_text(tmp_path, capsys):
+    from conftest import write_binary_stl
+    from inertia_tool.cli import main
+    v, f, _, _ = _cubes_sharing_diagonal()
+    path = tmp_path / "cubes.stl"
+    write_binary_stl(path, v, f)
+    main(["analyze", str(path), "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert out["certificate"]["kind"] == "united"
+    assert "boolean-union" in out["certificate"]["checks"]
+    main(["analyze", str(path)])
+    text = capsys.readouterr().out
+    assert "certificate: united" in text
+
+
+# -- hypothesis: zero silent wrong answers ------------------------------------------------------------------
+
+def _rigid(draw):
+    axis = draw(st.tuples(*[st.floats(-1, 1, allow_nan=False)] * 3).filter(lambda a: np.linalg.norm(a) > 0.1))
+    angle = draw(st.floats(0, 2 * np.pi))
+    shift = draw(st.tuples(*[st.floats(-3, 3, allow_nan=False)] * 3))
+    return rotation(axis, angle), np.asarray(shift)
+
+
+def _primitive(draw):
+    kind = draw(st.sampled_from(["box", "sphere", "torus"]))
+    if kind == "box":
+        return box(draw(st.tuples(*[st.floats(0.2, 2.0)] * 3)))
+    if kind == "sphere":
+        return uv_sphere(draw(st.floats(0.2, 1.2)), segments=12, rings=6)
+    return torus(draw(st.floats(0.6, 1.2)), draw(st.floats(0.1, 0.3)), steps=16, sections=8)
+
+
+@st.composite
+def scenes(draw):
+    """(vertices, faces, truth volume, description): solids composed under random rigid motions."""
+    mode = draw(st.sampled_from(["apart", "overlap", "touch", "nested", "shared-vertex"]))
+    flip = draw(st.lists(st.booleans(), min_size=3, max_size=3))
+    r, t = _rigid(draw)
+    if mode == "apart":
+        a, b = _primitive(draw), _primitive(draw)
+        b = (b[0] + [6.0, 0, 0], b[1])
+        truth = _volume(*a) + _volume(*b)
+        parts = [a, b]
+    elif mode == "overlap":
+        a, b = _primitive(draw), _primitive(draw)
+        r2, t2 = _rigid(draw)
+        b = (b[0] @ r2.T + 0.3 * t2, b[1])
+        truth = union_volume(a, b)
+        parts = [a, b]
+    elif mode == "touch":
+        ext = draw(st.tuples(*[st.floats(0.2, 2.0)] * 3))
+        side = draw(st.tuples(st.floats(0.2, 2.0), st.floats(0.2, 2.0)))
+        slide = draw(st.tuples(st.floats(-0.4, 0.4), st.floats(-0.4, 0.4)))
+        a = box(ext)
+        b = box((ext[0], side[0], side[1]), (ext[0], slide[0] * ext[1], slide[1] * ext[2]))
+        truth = _volume(*a) + _volume(*b)
+        parts = [a, b]
+    elif mode == "nested":
+        outer = uv_sphere(1.5, segments=16, rings=8)
+        inner = _primitive(draw)
+        inner = (inner[0] * 0.5, inner[1])           # fits in the sphere's inscribed polyhedron
+        truth = _volume(*outer) - _volume(*inner)
+        parts = [outer, (inner[0], inner[1][:, ::-1])]
+    else:
+        a = box(draw(st.tuples(*[st.floats(0.5, 2.0)] * 3)))
+        r2, _ = _rigid(draw)
+        corner = a[0][0]
+        b = ((a[0] - corner) @ r2.T + corner, a[1])
+        truth = union_volume(a, b)
+        v, f = stack(a, b)
+        f = np.where(f == 8, 0, f)                    # corner 0 of both: one vertex index
+        parts = [(v, f)]
+    v, f = stack(*[(p[0], p[1][:, ::-1] if flip[k] and mode != "shared-vertex" else p[1])
+                   for k, p in enumerate(parts)])
+    if mode == "shared-vertex" and flip[0]:
+        f = f[:, ::-1]
+    return v @ r.T + t, f, truth, mode
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(scenes())
+def test_no_silent_wrong_answer(scene):
+    v, f, truth, mode = scene
+    try:
+        props = _quiet(v, f)
+    except InvalidMeshError:
+        return                                      # refused: honest
+    assert np.all(np.isfinite(props.center_of_mass))
+    if props.mesh.exact:
+        assert props.volume == pytest.approx(truth, rel=1e-8), (mode, props.mesh.certificate, props.mesh.notes)
+    else:
+        assert props.mesh.certificate.kind in ("unverified", "estimate")
