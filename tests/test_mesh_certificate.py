@@ -241,6 +241,26 @@ def test_intersection_check_that_gives_up_is_not_exact(monkeypatch):
     assert props.mesh.certificate.kind == "unverified" and not props.mesh.exact
 
 
+def test_unfinished_check_does_not_turn_an_overlapping_body_into_a_cavity(monkeypatch):
+    """Without the crossing pairs, a shell inside another may overlap it: the depth rule is not applied (R4)."""
+    from inertia_tool.mesh import prepare
+    real = prepare.surface_contacts
+
+    def gives_up(vertices, faces, *, max_pairs=None):
+        found = real(vertices, faces, max_pairs=max_pairs)
+        return type(found)(found.crossing[:0], found.coplanar_opposite[:0], found.contact[:0], False)
+
+    monkeypatch.setattr(prepare, "surface_contacts", gives_up)
+    a, b = box((2.0, 2.0, 2.0)), box((1.0, 1.0, 1.0), (0.75, 0.75, 0.75))
+    props = _quiet(*stack(a, b))
+    assert props.volume == pytest.approx(union_volume(a, b), rel=1e-12)
+    assert props.mesh.certificate.kind == "unverified" and not props.mesh.exact
+    vo, fo = uv_sphere(1.0)
+    vi, fi = uv_sphere(0.5)
+    props = _quiet(*stack((vo, fo), (vi, fi[:, ::-1])))
+    assert props.volume == pytest.approx(_volume(vo, fo) - _volume(vi, fi), rel=1e-12)
+
+
 def test_certificate_in_json_and_text(tmp_path, capsys):
     from conftest import write_binary_stl
     from inertia_tool.cli import main

@@ -20,6 +20,9 @@ from .union import _grid_pairs, triangles_meet
 
 __all__ = ["SurfaceContacts", "surface_contacts"]
 
+#: Beyond this many faces the stand-in does not try (it is slow there) and reports an incomplete check.
+_MAX_FACES = 200_000
+
 
 @dataclass(frozen=True)
 class SurfaceContacts:
@@ -89,12 +92,14 @@ def surface_contacts(vertices, faces, *, max_pairs=None) -> SurfaceContacts:
     empty = np.zeros((0, 2), dtype=np.int64)
     if len(f) < 2:
         return SurfaceContacts(empty, empty, empty, True)
+    if len(f) > _MAX_FACES:
+        return SurfaceContacts(empty, empty, empty, False)
     centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
     v = v - centre
     diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
     tri = v[f]
     lo, hi = tri.min(axis=1), tri.max(axis=1)
-    limit = int(max_pairs) if max_pairs is not None else max(16 * len(f), 1 << 16)
+    limit = int(max_pairs) if max_pairs is not None else max(64 * len(f), 1 << 20)
     pairs = _grid_pairs(lo, hi, np.ones(len(f), dtype=bool), limit, 1e-9 * diag)
     if pairs is None:
         return SurfaceContacts(empty, empty, empty, False)

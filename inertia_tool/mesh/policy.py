@@ -187,8 +187,8 @@ def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarra
             "region twice); `repair=True` gives a bounded estimate of the solid {winding number ≥ 1}")
 
 
-def orient_by_depth(volumes: np.ndarray, nest, crossing_with: np.ndarray) -> tuple[np.ndarray, np.ndarray,
-                                                                                    np.ndarray]:
+def orient_by_depth(volumes: np.ndarray, nest, crossing_with: np.ndarray, *,
+                    crossing_known: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """R4: which shells to flip, the body each shell belongs to, and its nesting depth.
 
     Parameters
@@ -200,6 +200,11 @@ def orient_by_depth(volumes: np.ndarray, nest, crossing_with: np.ndarray) -> tup
         None for a single shell.
     crossing_with : (k, 2) int
         Pairs of shells whose surfaces cross: neither contains the other.
+    crossing_known : bool
+        False when the intersection check did not finish: then a shell inside another may be an overlapping
+        body rather than a cavity, so only what each shell says about itself is used (a negative shell inside
+        a positive one is its cavity, a negative shell inside nothing is flipped, a positive shell stays a
+        body and goes to the boolean); the certificate is ``unverified`` anyway.
 
     Returns
     -------
@@ -228,6 +233,15 @@ def orient_by_depth(volumes: np.ndarray, nest, crossing_with: np.ndarray) -> tup
         cross[cw[:, 0], cw[:, 1]] = True
         cross[cw[:, 1], cw[:, 0]] = True
     inside = nest.winding != 0
+    if not crossing_known:
+        signed = nest.winding * np.sign(vols[nest.other])          # +1 inside the material of ``other``
+        held = (signed > 0) & (vols[nest.shell] < 0) & (vols[nest.other] > 0)
+        in_material = np.bincount(nest.shell[signed > 0], minlength=n) > 0
+        flip = (vols < 0) & ~in_material & ~np.asarray(nest.undecided, dtype=bool)
+        order = np.argsort(-np.abs(vols[nest.other[held]]), kind="stable")     # the smallest container wins
+        owner[nest.shell[held][order]] = nest.other[held][order]
+        depth[np.unique(nest.shell[held])] = 1
+        return flip, owner, depth
     contained = inside & ~cross[nest.shell, nest.other]
     # the containers of each shell, sorted from the outermost (largest |volume|) inward
     depth_of = np.bincount(nest.shell[contained], minlength=n)

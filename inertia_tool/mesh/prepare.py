@@ -49,12 +49,6 @@ MIN_EXTENT = 1e-30
 #: Ways to count overlapping bodies: their union (the physical solid) or the sum of their integrals.
 OVERLAP_MODES = ("union", "sum")
 
-#: Work bound of the surface-crossing test: candidate face pairs per face (beyond it the boolean decides).
-CROSSING_PAIRS_PER_FACE = 16
-
-#: Overlap confirmed when the union's volume falls short of the summed volume by more than this (relative).
-UNION_VOLUME_RTOL = 1e-9
-
 
 @frozen_value
 class PreparedMesh:
@@ -84,7 +78,7 @@ class PreparedMesh:
 
 
 def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: str = "mesh",
-                    check_crossing: bool = True, pairs_per_face: int = CROSSING_PAIRS_PER_FACE):
+                    check_crossing: bool = True):
     """Orient shells by nesting depth (R4), attach cavities to their bodies, count overlap candidates (R5, R6).
 
     The same rules :func:`prepare_mesh` applies (:mod:`~.policy`), for callers that hold several prepared
@@ -105,12 +99,12 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
     vols = np.array([s.volume for s in shells])
     if n_shells == 1:
         return vols < 0, np.zeros(1, dtype=np.intp), 0, 0
-    contacts = surface_contacts(vertices, faces, max_pairs=max(pairs_per_face * len(faces), 1 << 16)) \
-        if check_crossing else None
+    contacts = surface_contacts(vertices, faces) if check_crossing else None
     touch = shell_contacts(contacts, labels, n_shells) if contacts is not None else None
     nest = _nesting(vertices, faces, labels, n_shells)
     crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
-    flip, owner, depth = orient_by_depth(vols, nest, crossing_with)
+    flip, owner, depth = orient_by_depth(vols, nest, crossing_with,
+                                         crossing_known=touch is not None and touch.complete)
     if touch is not None and touch.complete:
         candidates = touch.crossing | touch.touching | nest.undecided
     else:
@@ -204,7 +198,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
     shells = body_volume_moments(v, f, labels, n_shells)
     f, labels, n_shells, shells, dropped_note = _drop_flat(v, f, labels, shells, diag, source)    # R2
-    contacts = surface_contacts(v, f, max_pairs=max(CROSSING_PAIRS_PER_FACE * len(f), 1 << 16))
+    contacts = surface_contacts(v, f)
     if patched is not None:
         contacts, patch_notes = _outside_patches(contacts, f, n_read)
         found = Resolution(found.vertices, found.faces, found.method, found.notes + patch_notes,
@@ -222,7 +216,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                           f"{'; '.join(forced.notes)}"), stacklevel=3)
         return _estimated(forced, common)
     nest = _nesting(v, f, labels, n_shells)
-    flip, owner, depth = orient_by_depth(np.array([s.volume for s in shells]), nest, touch.crossing_with)   # R4
+    flip, owner, depth = orient_by_depth(np.array([s.volume for s in shells]), nest, touch.crossing_with,
+                                         crossing_known=touch.complete)                                  # R4
     f, shells = _apply_flips(f, labels, shells, flip, n_shells, source)
     cavities = int(np.count_nonzero(depth % 2 == 1))
     method, notes = found.method, list(found.notes)
