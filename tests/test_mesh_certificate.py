@@ -16,7 +16,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from solids import box, figure_eight, rotation, stack, torus, tube, union_volume, uv_sphere
+from solids import box, figure_eight, rotation, stack, torus, union_volume, uv_sphere
 from inertia_tool import mass_properties
 from inertia_tool.errors import InsideOutWarning, InvalidMeshError, MeshResolvedWarning
 from inertia_tool.mesh.checks import shell_labels
@@ -180,7 +180,8 @@ def test_internal_wall_of_coincident_opposite_faces_is_exact():
     v, f = box((2.0, 1.0, 1.0))
     wall = np.array([[0.2, -0.5, -0.5], [0.2, 0.5, -0.5], [0.2, 0.5, 0.5], [0.2, -0.5, 0.5]])
     quad = np.array([[0, 1, 2], [0, 2, 3]])
-    v2, f2 = stack((v, f), (wall, np.vstack([quad, quad[:, ::-1]])), (wall - [0.5, 0, 0], np.vstack([quad, quad[:, ::-1]])))
+    sheet = np.vstack([quad, quad[:, ::-1]])
+    v2, f2 = stack((v, f), (wall, sheet), (wall - [0.5, 0, 0], sheet))
     with pytest.warns(MeshResolvedWarning, match="2 closed pieces enclosing no volume"):
         props = mass_properties((v2, f2), repair=True)
     assert props.volume == pytest.approx(2.0, rel=1e-12)

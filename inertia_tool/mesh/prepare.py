@@ -31,7 +31,7 @@ from .policy import (TOUCH_VOLUME_RTOL, Certificate, orient_by_depth, self_cross
 from .resolve import Resolution, resolve_surface
 
 try:        # the robust face-intersection module; a float64 stand-in until it lands
-    from .intersect import surface_contacts
+    from .intersect import surface_contacts  # type: ignore[import-not-found]
 except ImportError:     # pragma: no cover - replaced when mesh/intersect.py is merged
     from ._contacts_standin import surface_contacts  # type: ignore[assignment]
 
@@ -412,7 +412,8 @@ def _estimated(found: Resolution, common: dict[str, Any]) -> PreparedMesh:
                             area=est.area)
     lo, hi = bounding_box(found.vertices)
     common = {"overlapping_shells": 0, **common}
-    report = MeshReport(certificate=Certificate("estimate"), vertices=len(found.vertices), faces=len(found.faces), zero_area_faces=0, bodies=1,
+    report = MeshReport(certificate=Certificate("estimate"), vertices=len(found.vertices), faces=len(found.faces),
+                        zero_area_faces=0, bodies=1,
                         cavities=0, flipped_shells=0, repaired=True, repair_actions=found.notes,
                         repair_volume_change=None, bbox_min=lo, bbox_max=hi, method=est.method,
                         uncertainty=est.uncertainty, notes=found.notes, **common)

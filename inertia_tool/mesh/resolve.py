@@ -125,7 +125,8 @@ def _dedupe(faces: np.ndarray) -> tuple[np.ndarray, int]:
 
 
 def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
-                    merge_tolerance: float, moments, force_estimate: bool = False, reason: str | None = None) -> Resolution:
+                    merge_tolerance: float, moments, force_estimate: bool = False,
+                    reason: str | None = None) -> Resolution:
     """Read a surface that failed the manifold check as a solid (exact), as an estimate (repair), or refuse.
 
     Parameters
