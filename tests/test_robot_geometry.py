@@ -215,3 +215,4 @@ def test_gymnasium_mjcf_models_match_mujocos_inertia_from_geometry(model):
         assert props.mass == pytest.approx(compiled.body_mass[i], rel=1e-13)
         np.testing.assert_allclose(props.center_of_mass, compiled.body_ipos[i], atol=1e-14)
         assert_tensor_close(props.inertia, rot @ np.diag(compiled.body_inertia[i]) @ rot.T, 1e-12)
+
