@@ -355,3 +355,25 @@ def test_no_silent_wrong_answer(scene):
         assert props.volume == pytest.approx(truth, rel=1e-8), (mode, props.mesh.certificate, props.mesh.notes)
     else:
         assert props.mesh.certificate.kind in ("unverified", "estimate")
+
+
+def test_zero_volume_shell_left_by_the_union_gives_no_nan(monkeypatch):
+    """Issue 21 item 4: a flat piece in the boolean's output had a NaN centre of mass (exit 4); rule R2 leaves
+    it out after the union as before it."""
+    from inertia_tool.mesh import union
+    real = union.union_surface
+
+    def with_a_sheet(*args, **kwargs):
+        out = real(*args, **kwargs)
+        sheet = np.array([[5.0, 5, 5], [5.1, 5, 5], [5.1, 5.1, 5]])
+        v = np.vstack([out.vertices, sheet])
+        n = len(out.vertices)
+        f = np.vstack([out.faces, [[n, n + 1, n + 2], [n, n + 2, n + 1]]])
+        return union.UnionSurface(vertices=v, faces=f, volume=out.volume)
+
+    monkeypatch.setattr(union, "union_surface", with_a_sheet)
+    a, b = box((2.0, 2.0, 2.0)), box((1.0, 1.0, 1.0), (0.75, 0.75, 0.75))
+    props = _quiet(*stack(a, b))
+    assert props.volume == pytest.approx(union_volume(a, b), rel=1e-12)
+    assert np.all(np.isfinite(props.center_of_mass)) and np.all(np.isfinite(props.inertia))
+    assert all(np.all(np.isfinite(p.center_of_mass)) for p in props.parts)
