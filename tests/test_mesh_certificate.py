@@ -277,6 +277,32 @@ def test_certificate_in_json_and_text(tmp_path, capsys):
     assert "certificate: united" in text
 
 
+def test_certificate_in_batch_rows_html_and_robot_links(tmp_path):
+    from conftest import write_binary_stl
+    from inertia_tool.batch.runner import BatchOptions, analyze_file
+    from inertia_tool.reports.html import html_report
+    from inertia_tool.robot.description import GeometryElement, LinkGeometry, rpy_to_matrix
+    from inertia_tool.robot.geometry import link_certificate, link_mass_properties
+    v, f, _, _ = _cubes_sharing_diagonal()
+    united = tmp_path / "cubes.stl"
+    write_binary_stl(united, v, f)
+    clean = tmp_path / "box.stl"
+    write_binary_stl(clean, *box())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert analyze_file(str(united), BatchOptions())["certificate"] == "united"
+        assert analyze_file(str(clean), BatchOptions())["certificate"] == "exact"
+        props = mass_properties(str(united))
+        assert "united (edge-balanced, consistently-oriented, boolean-union)" in html_report(props, generated="fixed")
+        elements = (GeometryElement("box", rpy_to_matrix((0, 0, 0)), (0, 0, 0), size=(1, 1, 1)),
+                    GeometryElement("mesh", rpy_to_matrix((0, 0, 0)), (3, 0, 0), mesh=str(united)))
+        link = LinkGeometry("l", elements, None)
+        cache: dict = {}
+        link_mass_properties(link, cache=cache)
+    assert link_certificate(link, cache).kind == "united"
+    assert link_certificate(LinkGeometry("p", elements[:1], None), {}).checks == ("closed-form",)
+
+
 # -- hypothesis: zero silent wrong answers ------------------------------------------------------------------
 
 def _rigid(draw):
@@ -297,48 +323,68 @@ def _primitive(draw):
 
 @st.composite
 def scenes(draw):
-    """(vertices, faces, truth volume, description): solids composed under random rigid motions."""
-    mode = draw(st.sampled_from(["apart", "overlap", "touch", "nested", "shared-vertex"]))
+    """(vertices, faces, truth volume, description): solids composed under random rigid motions.
+
+    Each shell is wound outward or inward at random (a body's truth does not depend on it: rule R4 orients
+    by nesting depth).  Truths: the manifold3d float64 union of the outward shells, or outer − cavity (+ core)
+    by signed-tetrahedron sums of each closed shell alone.
+    """
+    mode = draw(st.sampled_from(["apart", "overlap", "touch", "nested", "shared-vertex", "linked",
+                                 "pole-to-pole", "body-in-cavity"]))
     flip = draw(st.lists(st.booleans(), min_size=3, max_size=3))
     r, t = _rigid(draw)
+    shared = None                                   # (index in part 1, index in part 0) to make one vertex
     if mode == "apart":
         a, b = _primitive(draw), _primitive(draw)
-        b = (b[0] + [6.0, 0, 0], b[1])
-        truth = _volume(*a) + _volume(*b)
-        parts = [a, b]
+        parts = [a, (b[0] + [6.0, 0, 0], b[1])]
+        truth = _volume(*parts[0]) + _volume(*parts[1])
     elif mode == "overlap":
         a, b = _primitive(draw), _primitive(draw)
         r2, t2 = _rigid(draw)
-        b = (b[0] @ r2.T + 0.3 * t2, b[1])
-        truth = union_volume(a, b)
-        parts = [a, b]
+        parts = [a, (b[0] @ r2.T + 0.3 * t2, b[1])]
+        truth = union_volume(*parts)
+        sizes = sorted(_volume(*p) for p in parts)
+        if abs(truth - sizes[1]) <= 1e-9 * truth:     # one lies inside the other: a cavity by its depth (R4)
+            truth = sizes[1] - sizes[0]
     elif mode == "touch":
         ext = draw(st.tuples(*[st.floats(0.2, 2.0)] * 3))
         side = draw(st.tuples(st.floats(0.2, 2.0), st.floats(0.2, 2.0)))
         slide = draw(st.tuples(st.floats(-0.4, 0.4), st.floats(-0.4, 0.4)))
-        a = box(ext)
-        b = box((ext[0], side[0], side[1]), (ext[0], slide[0] * ext[1], slide[1] * ext[2]))
-        truth = _volume(*a) + _volume(*b)
-        parts = [a, b]
+        parts = [box(ext), box((ext[0], side[0], side[1]), (ext[0], slide[0] * ext[1], slide[1] * ext[2]))]
+        truth = _volume(*parts[0]) + _volume(*parts[1])
     elif mode == "nested":
         outer = uv_sphere(1.5, segments=16, rings=8)
         inner = _primitive(draw)
-        inner = (inner[0] * 0.5, inner[1])           # fits in the sphere's inscribed polyhedron
-        truth = _volume(*outer) - _volume(*inner)
-        parts = [outer, (inner[0], inner[1][:, ::-1])]
+        parts = [outer, (inner[0] * 0.5, inner[1][:, ::-1])]    # fits in the sphere's inscribed polyhedron
+        truth = _volume(*outer) - _volume(parts[1][0], inner[1])
+    elif mode == "body-in-cavity":
+        outer, cavity, core = uv_sphere(1.5, segments=16, rings=8), uv_sphere(1.0, segments=16, rings=8), \
+            uv_sphere(draw(st.floats(0.2, 0.8)), segments=12, rings=6)
+        parts = [outer, (cavity[0], cavity[1][:, ::-1]), core]
+        truth = _volume(*outer) - _volume(*cavity) + _volume(*core)
+    elif mode == "linked":
+        minor = draw(st.floats(0.1, 0.45))
+        a = torus(1.0, minor, steps=24, sections=8)
+        turn = rotation([1, 0, 0], np.pi / 2)
+        parts = [a, (a[0] @ turn.T + [1.0, 0, 0], a[1])]        # two links of a chain: cross when minor is big
+        truth = union_volume(*parts)
+    elif mode == "pole-to-pole":
+        v, f = uv_sphere(draw(st.floats(0.3, 1.0)), segments=12, rings=6)
+        r2, _ = _rigid(draw)
+        north = v[0]
+        parts = [(v, f), ((v - north) @ r2.T + north, f)]        # turned about the shared north pole
+        truth = union_volume(*parts)
+        shared = (0, 0)
     else:
         a = box(draw(st.tuples(*[st.floats(0.5, 2.0)] * 3)))
         r2, _ = _rigid(draw)
         corner = a[0][0]
-        b = ((a[0] - corner) @ r2.T + corner, a[1])
-        truth = union_volume(a, b)
-        v, f = stack(a, b)
-        f = np.where(f == 8, 0, f)                    # corner 0 of both: one vertex index
-        parts = [(v, f)]
-    v, f = stack(*[(p[0], p[1][:, ::-1] if flip[k] and mode != "shared-vertex" else p[1])
-                   for k, p in enumerate(parts)])
-    if mode == "shared-vertex" and flip[0]:
-        f = f[:, ::-1]
+        parts = [a, ((a[0] - corner) @ r2.T + corner, a[1])]
+        truth = union_volume(*parts)
+        shared = (0, 0)
+    v, f = stack(*[(p[0], p[1][:, ::-1] if flip[k] else p[1]) for k, p in enumerate(parts)])
+    if shared is not None:                          # the two shells meet at one vertex index
+        f = np.where(f == len(parts[0][0]) + shared[0], shared[1], f)
     return v @ r.T + t, f, truth, mode
 
 

@@ -259,7 +259,12 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                 notes.append(f"overlapping bodies united by a boolean: {shared} counted once")
                 warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
                 method = "union"
-                kind = "united" if touch.complete else "unverified"
+                # R6/R7: the boolean found shared volume; "united" is proven only when crossing faces were found
+                # too (else the two checks disagree: manifold3d's tolerance or a crossing the check cannot see)
+                kind = "united" if touch.complete and touch.crossing.any() else "unverified"
+                if touch.complete and not touch.crossing.any():
+                    notes.append("no faces were found crossing, yet the union is smaller than the sum: the "
+                                 "result is the union, not verified")
                 checks = ["edge-balanced", "consistently-oriented", "boolean-union"]
                 v, f = united.vertices, united.faces
                 labels, n_shells = shell_labels(f, len(v))
