@@ -423,3 +423,11 @@ def test_zero_volume_shell_left_by_the_union_gives_no_nan(monkeypatch):
     assert props.volume == pytest.approx(union_volume(a, b), rel=1e-12)
     assert np.all(np.isfinite(props.center_of_mass)) and np.all(np.isfinite(props.inertia))
     assert all(np.all(np.isfinite(p.center_of_mass)) for p in props.parts)
+
+
+def test_shared_volume_in_messages_is_never_negative():
+    """Issue 21 item 7: a union a rounding larger than the sum was printed as a negative shared volume."""
+    from inertia_tool.mesh.prepare import shared_text
+    assert shared_text(2.0, 1.5) == "0.5 m³ of shared volume"
+    text = shared_text(1.0, 1.0 + 5e-12)
+    assert "-5e-12" not in text and "no shared volume" in text

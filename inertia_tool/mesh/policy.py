@@ -40,11 +40,10 @@ R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only aft
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..tolerances import FLAT_RTOL
+from ..values import frozen_value
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
@@ -75,7 +74,7 @@ CHECKS = {
 }
 
 
-@dataclass(frozen=True)
+@frozen_value
 class Certificate:
     """How far a result can be trusted, and the checks that say so.
 
@@ -109,7 +108,7 @@ class Certificate:
         return f"{self.kind} ({', '.join(self.checks)})"
 
 
-@dataclass(frozen=True)
+@frozen_value
 class ShellContacts:
     """Which shells cross or touch which, from the face-pair contacts of the whole surface.
 

@@ -249,7 +249,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             return _estimated(found, {**common, "overlapping_shells": max(overlaps, 1)})
         else:
             overlaps = max(overlaps, 1)
-            shared = _shared_text(summed, united.volume)
+            shared = shared_text(summed, united.volume)
             if overlap == "sum":
                 method, kind = "sum", "summed"
                 notes.append(f"overlapping bodies: their integrals are added, so {shared} is counted twice "
@@ -294,7 +294,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
 
 
-def _shared_text(summed: float, united: float) -> str:
+def shared_text(summed: float, united: float) -> str:
     """The shared volume of overlapping bodies in words, m³ (never negative)."""
     shared = summed - united
     if shared >= 0:
