@@ -11,7 +11,7 @@ R1 *Bodies are edge-connected* (:func:`~.checks.shell_labels`).  Faces that meet
    different shells: a non-manifold vertex is split into its fans of edge-connected faces before anything
    decides what is one body.  Reason: two bodies that share a corner (or are welded there) are two bodies,
    and must be tested against each other for overlap.
-R2 *Flat pieces carry no volume* (:data:`FLAT_RTOL`).  A closed shell whose |volume| is at most
+R2 *Flat pieces carry no volume* (``tolerances.FLAT_RTOL``).  A closed shell whose |volume| is at most
    ``FLAT_RTOL · diagonal³`` (a face and its reverse, a zero-thickness wall, a collapsed sliver) contributes
    nothing to the integrals, so it is left out with a note and the answer stays exact.  Only a mesh that is
    flat everywhere is refused.  Reason: such faces cancel pairwise in every surface integral.
@@ -24,14 +24,19 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    that contain it (whose winding number at a point of it is nonzero and that it does not cross); even depth
    is a body, wound outward, odd depth a cavity, wound inward.  A shell wound the other way is flipped, with
    a warning.  Never decided by the sign of the total volume: one inside-out shell must not turn the others.
+   So an outward-wound shell inside a body is read as a cavity written with the wrong winding, not as a
+   second body buried in the first.  When the intersection check did not finish (crossings unknown, so
+   "inside" may mean "overlapping"), each shell keeps what its own sign says instead.
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
    transversally (or overlap coplanar with the same orientation) mean shared volume: the union is integrated
    and the certificate is ``united``.
-R6 *Touching shells are decided by the boolean* (:data:`TOUCH_VOLUME_RTOL`).  Shells that meet only at edges,
-   vertices or face to face with opposite normals (touching copies), or whose probe points all lie on
-   another surface, or that share non-manifold edges, are united by the boolean; when the union's volume
-   equals the summed volume within ``TOUCH_VOLUME_RTOL`` the interiors are disjoint and the sum, exact as
-   it stands, is the answer (certificate ``exact``).
+R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL``).  Shells that meet only
+   at edges, vertices or face to face with opposite normals (touching copies), or whose probe points all lie
+   on another surface, or that share non-manifold edges, go to the boolean; when the union's volume equals
+   the summed volume within ``TOUCH_VOLUME_RTOL`` the interiors are disjoint and the sum, exact as it
+   stands, is the answer (certificate ``exact``).  When the union is smaller although no crossing was found,
+   the two checks disagree (manifold3d's tolerance, or a crossing the check cannot see): the union is the
+   answer, certified ``unverified``.
 R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only after the edge census found the
    surface balanced, every shell is oriented by R4, and the face-intersection check ran over every candidate
    pair and found no crossing.  When the check could not finish within its work bound the integral is still
@@ -42,18 +47,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..tolerances import FLAT_RTOL
+from ..tolerances import FLAT_RTOL, TOUCH_VOLUME_RTOL
 from ..values import frozen_value
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
-
-#: R6: the union's volume may differ from the summed volume by this much (relative) and still count as
-#: "no shared volume".  manifold3d keeps the input vertices and adds only new intersection vertices, so for
-#: touching shells the union's integral differs from the sum by float64 rounding of the two integrals
-#: (about ``faces · 2⁻⁵³`` relative, < 1e-10 up to millions of faces); a genuine overlap smaller than this
-#: changes the mass by less than 1e-9 of itself, far below any stated precision of the inputs.
-TOUCH_VOLUME_RTOL = 1e-9
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
