@@ -227,3 +227,8 @@ def test_assembly_warns_when_parts_overlap_and_not_otherwise(tmp_path):
     with pytest.warns(OverlapWarning, match="parts overlap"):
         asm = assembly([{"source": str(a), "density": 1.0}, {"source": str(c), "density": 2.0}])
     assert asm.mass == pytest.approx(3.0)      # the numbers stay those of the parts as given
+    d = tmp_path / "d.stl"
+    write_binary_stl(d, *box_arrays((1.0, 1.0, 1.0), center=(1.0, 0.2, 0)))   # touches a face to face
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", OverlapWarning)
+        assembly([{"source": str(a), "density": 1.0}, {"source": str(d), "density": 2.0}])

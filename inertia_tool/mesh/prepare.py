@@ -92,9 +92,10 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
         Body each shell belongs to.
     cavities : int
     overlaps : int
-        Shells whose surface crosses another's, touches it, or whose probes all lie on another surface, or
-        (when the intersection check cannot finish, or ``check_crossing`` is False) whose box meets
-        another's: candidates for the boolean union to confirm.
+        Shells whose surface crosses another's, that R4 had to turn (inside another shell against their own
+        winding), or whose probes all lie on another surface; or (when the intersection check cannot finish,
+        or ``check_crossing`` is False) whose box meets another's: candidates for the boolean to confirm.
+        Shells that only touch are not counted.
     """
     vols = np.array([s.volume for s in shells])
     if n_shells == 1:
@@ -106,7 +107,9 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
     flip, owner, depth = orient_by_depth(vols, nest, crossing_with,
                                          crossing_known=touch is not None and touch.complete)
     if touch is not None and touch.complete:
-        candidates = touch.crossing | touch.touching | nest.undecided
+        # touching shells share no volume (their interiors are disjoint when no face crosses); a shell that
+        # R4 had to turn lies in another's material or void against its own winding: counted as a candidate
+        candidates = touch.crossing | flip | nest.undecided
     else:
         candidates = _boxes_meet(vertices, faces, labels, n_shells) | nest.undecided
     return flip, owner, int(np.count_nonzero(depth % 2 == 1)), int(np.count_nonzero(candidates))
