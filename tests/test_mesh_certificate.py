@@ -78,18 +78,19 @@ def _figure_eight_truth(steps=64, radius=0.2, sections=12):
         for i in range(k - 1):
             for j in range(sections):
                 a, b = i * sections + j, i * sections + (j + 1) % sections
-                c, d = a + sections - j + j, (i + 1) * sections + (j + 1) % sections
-                c = (i + 1) * sections + j
+                c, d = (i + 1) * sections + j, (i + 1) * sections + (j + 1) % sections
                 faces += [[a, c, d], [a, d, b]]
-        c0, c1 = k * sections, k * sections + 1
+        c0, c1 = k * sections, k * sections + 1           # caps: fans from the curve points, wound to match
         for j in range(sections):
-            faces.append([c0, (j + 1) % sections, j])
-            faces.append([c1, (k - 1) * sections + j, (k - 1) * sections + (j + 1) % sections])
+            faces.append([c0, j, (j + 1) % sections])
+            faces.append([c1, (k - 1) * sections + (j + 1) % sections, (k - 1) * sections + j])
         fa = np.asarray(faces, dtype=np.int64)
         if _volume(pts, fa) < 0:
             fa = fa[:, ::-1]
         halves.append((pts, fa))
-    return union_volume(*halves), _volume(v, f)
+    truth = union_volume(*halves)
+    assert truth > 0.9 * sum(_volume(*h) for h in halves) / 2, "the halves must be valid closed solids"
+    return truth, _volume(v, f)
 
 
 def test_figure_eight_tube_is_refused_without_repair():
