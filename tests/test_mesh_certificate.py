@@ -45,6 +45,7 @@ def _cubes_sharing_diagonal():
     return np.vstack([v, v2]), np.vstack([f, f2]), (v, f), (v2, f)
 
 
+@pytest.mark.usefixtures("engine_path")
 def test_shell_labels_split_a_shared_vertex_into_its_fans():
     v, f, _, _ = _cubes_sharing_diagonal()
     labels, n = shell_labels(f, len(v))
