@@ -433,3 +433,10 @@ def test_shared_volume_in_messages_is_never_negative():
     assert shared_text(2.0, 1.5) == "0.5 m³ of shared volume"
     text = shared_text(1.0, 1.0 + 5e-12)
     assert "-5e-12" not in text and "no shared volume" in text
+
+
+def test_shell_model_is_certified_exact_for_its_model_only():
+    from inertia_tool.mass.thinwall import shell_mass_properties
+    props = shell_mass_properties(box((1.0, 1.0, 1.0)), thickness=0.001, density=1.0)
+    assert props.mesh.certificate == Certificate("exact", ("thin-wall-model",))
+    assert props.mass == pytest.approx(6 * 0.001, rel=1e-12)

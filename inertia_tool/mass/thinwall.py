@@ -36,6 +36,7 @@ import numpy as np
 
 from ..values import frozen_value
 from ..mesh.checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
+from ..mesh.policy import Certificate
 from ..errors import InvalidMeshError, PhysicsError, UsageError
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
@@ -112,7 +113,8 @@ def shell_mass_properties(source: MeshSource, *, thickness: float, density: floa
                         faces=len(f), degenerate_faces=int(np.count_nonzero(repeated)), zero_area_faces=zero_area,
                         bodies=n_shells, cavities=0, flipped_shells=0, overlapping_shells=0,
                         watertight=topo.oriented, welded_tolerance=None, repaired=False, repair_actions=(),
-                        repair_volume_change=None, bbox_min=used.min(axis=0), bbox_max=used.max(axis=0))
+                        repair_volume_change=None, bbox_min=used.min(axis=0), bbox_max=used.max(axis=0),
+                        certificate=Certificate("exact", ("thin-wall-model",)))
     rho_used = rho if rho is not None else 1.0
     props = MassProperties(mass=rho_used * t * sm.area, volume=t * sm.area, center_of_mass=sm.centroid,
                            inertia=shell_inertia(sm, t, rho_used), surface_area=sm.area, density=rho_used,
