@@ -71,7 +71,8 @@ def _figure_eight_truth(steps=64, radius=0.2, sections=12):
     t = 2 * np.pi * np.arange(steps) / steps + np.pi / steps
     centre = np.c_[np.sin(2 * t), 2 * np.sin(t), np.zeros(steps)]
     halves = []
-    for first, last in ((16, 48), (48, 16 + steps)):
+    quarter = steps // 4
+    for first, last in ((quarter, 3 * quarter), (3 * quarter, quarter + steps)):
         rings = [i % steps for i in range(first, last + 1)]
         pts = np.vstack([v[r * sections:(r + 1) * sections] for r in rings] + [centre[rings[0]], centre[rings[-1]]])
         faces = []
@@ -332,7 +333,7 @@ def scenes(draw):
     by signed-tetrahedron sums of each closed shell alone.
     """
     mode = draw(st.sampled_from(["apart", "overlap", "touch", "nested", "shared-vertex", "linked",
-                                 "pole-to-pole", "body-in-cavity"]))
+                                 "pole-to-pole", "body-in-cavity", "self-crossing"]))
     flip = draw(st.lists(st.booleans(), min_size=3, max_size=3))
     r, t = _rigid(draw)
     shared = None                                   # (index in part 1, index in part 0) to make one vertex
@@ -370,6 +371,10 @@ def scenes(draw):
         turn = rotation([1, 0, 0], np.pi / 2)
         parts = [a, (a[0] @ turn.T + [1.0, 0, 0], a[1])]        # two links of a chain: cross when minor is big
         truth = union_volume(*parts)
+    elif mode == "self-crossing":                 # a swept tube through itself: {w ≥ 1} by its capped halves
+        steps, radius = draw(st.sampled_from([32, 48, 64])), draw(st.floats(0.1, 0.3))
+        parts = [figure_eight(steps, radius, 8)]
+        truth, _ = _figure_eight_truth(steps, radius, 8)
     elif mode == "pole-to-pole":
         v, f = uv_sphere(draw(st.floats(0.3, 1.0)), segments=12, rings=6)
         r2, _ = _rigid(draw)
