@@ -25,10 +25,12 @@ MERGE_TOLERANCE = 1e-6
 FLAT_RTOL = 1e-12
 
 #: Touching shells share no volume when the boolean union's volume equals their summed volume within this
-#: (relative; rule R6 of ``mesh/policy.py``).  manifold3d keeps the input vertices and adds only intersection
-#: vertices, so for touching shells the two integrals differ by float64 rounding (about faces · 2⁻⁵³, below
-#: 1e-10 up to millions of faces); a genuine overlap smaller than this changes the mass by less than 1e-9 of
-#: itself, below any stated precision of the inputs.
+#: (relative; rule R6 of ``mesh/policy.py``).  For touching shells of well-shaped triangles manifold3d keeps
+#: the input vertices and adds only intersection vertices, so the two integrals differ by float64 rounding
+#: (about faces · 2⁻⁵³, below 1e-10 up to millions of faces); a genuine overlap smaller than this changes the
+#: mass by less than 1e-9 of itself, below any stated precision of the inputs.  manifold3d also collapses
+#: degenerate slivers, which can move the volume by more (3e-8 on a patched 1.6k-face part): such a result
+#: is certified ``unverified``, never silently exact.
 TOUCH_VOLUME_RTOL = 1e-9
 
 #: A body whose smallest principal moment is at most ``NEEDLE_RTOL`` of the largest is a needle to round-off:
