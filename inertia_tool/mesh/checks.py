@@ -280,25 +280,41 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
 
 
 def _edge_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
-    """Components of faces joined through shared (undirected) edges, numbered by first face."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+    """Components of faces joined through shared (undirected) edges, numbered by first face.
 
+    Faces sharing an edge key are linked; the components come from the C union-find of
+    :func:`_vertex_shell_labels` run on the face graph (each link a row ``(a, b, b)``, each face a row
+    ``(i, i, i)``), or from scipy's ``connected_components`` on the numpy path.
+    """
     f = np.asarray(faces, dtype=np.int64)
     m = len(f)
     n = np.int64(max(int(n_vertices), 1))
-    a = f[:, [0, 1, 2]].reshape(-1)
-    b = f[:, [1, 2, 0]].reshape(-1)
+    a = f.reshape(-1)
+    b = np.roll(f, -1, axis=1).reshape(-1)
     key = np.minimum(a, b) * n + np.maximum(a, b)
-    order = np.argsort(key, kind="stable")
-    same = key[order[1:]] == key[order[:-1]]
+    del a, b
+    order = np.argsort(key)
+    skey = key[order]
+    same = skey[1:] == skey[:-1]
+    del key, skey
     rows, cols = order[:-1][same] // 3, order[1:][same] // 3
+    del order, same
+    lib = accel()
+    if lib is not None:
+        node = np.arange(m, dtype=np.int64)
+        graph = np.concatenate([np.stack([rows, cols, cols], axis=1), np.stack([node, node, node], axis=1)])
+        out = np.empty(len(graph), dtype=np.intp)
+        count = lib.shell_labels(faces_for_c(graph), m, out)
+        return out[len(rows):].astype(np.intp), int(count)
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
     graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(m, m))
-    count, label = connected_components(graph, directed=False)
+    n_components, label = connected_components(graph, directed=False)
     _, first = np.unique(label, return_index=True)
-    rank = np.empty(count, dtype=np.intp)
-    rank[np.argsort(first, kind="stable")] = np.arange(count)
-    return rank[label].astype(np.intp), int(count)
+    rank = np.empty(n_components, dtype=np.intp)
+    rank[np.argsort(first, kind="stable")] = np.arange(n_components)
+    return rank[label].astype(np.intp), int(n_components)
 
 
 def _vertex_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
