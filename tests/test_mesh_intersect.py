@@ -70,7 +70,7 @@ def test_issue21_cube_and_turned_cube_sharing_the_corner_index_cross():
     f2 = f + len(v)
     f2[f2 == corner + len(v)] = corner                             # the same vertex INDEX at the shared corner
     verts, faces = np.r_[v, turned], np.r_[f, f2]
-    assert shell_labels(faces, len(verts))[1] == 1                # one shell to the shell finder
+    assert shell_labels(faces, len(verts))[1] == 2                # the shared vertex split into its fans (R1)
     result = surface_contacts(verts, faces)
     assert result.complete
     assert len(result.crossing) > 0

@@ -30,10 +30,7 @@ from .policy import (TOUCH_VOLUME_RTOL, Certificate, orient_by_depth, self_cross
                      shell_contacts)
 from .resolve import Resolution, resolve_surface
 
-try:        # the robust face-intersection module; a float64 stand-in until it lands
-    from .intersect import surface_contacts  # type: ignore[import-not-found]
-except ImportError:     # pragma: no cover - replaced when mesh/intersect.py is merged
-    from ._contacts_standin import surface_contacts  # type: ignore[assignment]
+from .intersect import surface_contacts
 
 __all__ = ["PreparedMesh", "prepare_mesh", "classify_shells", "MAX_COORDINATE", "MIN_EXTENT"]
 
