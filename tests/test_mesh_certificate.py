@@ -445,3 +445,17 @@ def test_shell_model_is_certified_exact_for_its_model_only():
     props = shell_mass_properties(box((1.0, 1.0, 1.0)), thickness=0.001, density=1.0)
     assert props.mesh.certificate == Certificate("exact", ("thin-wall-model",))
     assert props.mass == pytest.approx(6 * 0.001, rel=1e-12)
+
+
+def test_analyze_of_two_touching_copies_exits_0_with_an_exact_sum(tmp_path, capsys):
+    """Issue 21 item 4: `analyze` exited 4 ("physically impossible") on a NaN centre of mass."""
+    from conftest import write_binary_stl
+    from inertia_tool.cli import main
+    v, f = stack(box((1.0, 2.0, 3.0)), box((1.0, 2.0, 3.0), (1.0, 0.0, 0.0)))
+    path = tmp_path / "pair.stl"
+    write_binary_stl(path, v, f)
+    assert main(["analyze", str(path), "--units", "m", "--density", "1000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mass"] == pytest.approx(12000.0, rel=1e-6)
+    assert out["center_of_mass"] == pytest.approx([0.5, 0.0, 0.0], abs=1e-6)
+    assert out["certificate"]["kind"] == "exact"
