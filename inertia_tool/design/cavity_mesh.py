@@ -103,21 +103,33 @@ def _separate_pinches(vertices, faces, distance: float):
 
     Marching tetrahedra can leave two sheets of the cavity touching at one point, as two distinct vertices at
     the same position: a valid manifold, but a mesh file welds them into a non-manifold vertex.  Moving each
-    copy outward (into the cavity it bounds) separates the sheets by ``2 distance``.
+    copy along its normal (into the cavity it bounds), or against it where that would push one tip of
+    material into another (checked by :func:`~inertia_tool.mesh.intersect.surface_contacts`), separates the
+    sheets by ``2 distance``; when neither way leaves the surface free of crossings it is left touching.
     """
     v = np.array(vertices, dtype=np.float64)
     _, inverse, counts = np.unique(v.astype(np.float32), axis=0, return_inverse=True, return_counts=True)
     shared = counts[inverse.ravel()] > 1
     if not np.any(shared):
         return v, faces
+    from ..mesh.intersect import surface_contacts
+
     tri = v[faces]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     vertex_normal = np.zeros_like(v)
     for k in range(3):
         np.add.at(vertex_normal, faces[:, k], normal)
     length = np.linalg.norm(vertex_normal[shared], axis=1)
-    v[shared] += distance * vertex_normal[shared] / np.where(length > 0, length, 1.0)[:, None]
-    return v, faces
+    step = distance * vertex_normal[shared] / np.where(length > 0, length, 1.0)[:, None]
+    # two void lobes touching at a point separate when each copy moves into its own void (along the normal);
+    # two tips of material touching separate the other way: moving them into the void pushes each tip into
+    # the other's material and the surface passes through itself.  Keep the way that leaves no crossing.
+    for sign in (1.0, -1.0):
+        moved = v.copy()
+        moved[shared] += sign * step
+        if not len(surface_contacts(moved, faces).crossing):
+            return moved, faces
+    return v, faces          # the sheets only touch at the shared positions: a valid solid as it stands
 
 
 def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wall: float):

@@ -168,11 +168,14 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
 
 
 def _part(source: MeshSource, rho: float | None, mass: float | None, options: LoadOptions, *, name: str | None,
-          warn_principal: bool = True) -> tuple[MassProperties, PreparedMesh]:
-    """Mass properties of one mesh and its checked mesh (for cross-part checks of an assembly)."""
+          warn_principal: bool = True, self_crossing: str = "refuse") -> tuple[MassProperties, PreparedMesh]:
+    """Mass properties of one mesh and its checked mesh (for cross-part checks of an assembly).
+
+    ``self_crossing`` is passed to :func:`~inertia_tool.mesh.prepare.prepare_mesh` (``"unverified"`` only for
+    meshes the package made itself by a boolean: spin-it's hollowed parts)."""
     raw = load_mesh(source, units=options.units, max_faces=options.max_faces)
     prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance,
-                            overlap=options.overlap)
+                            overlap=options.overlap, self_crossing=self_crossing)
     label = name or raw.source
     warn_implausible_size(raw, stacklevel=4)
     bodies = _bodies(prepared, rho if rho is not None else 1.0, label)

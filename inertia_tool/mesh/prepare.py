@@ -127,7 +127,7 @@ def _check_magnitude(lo, hi, source: str) -> None:
 
 
 def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float = MERGE_TOLERANCE,
-                 overlap: str = "union") -> PreparedMesh:
+                 overlap: str = "union", self_crossing: str = "refuse") -> PreparedMesh:
     """Check a raw mesh and classify its shells (see the module docstring for the policy).
 
     Parameters
@@ -143,6 +143,10 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     overlap : {"union", "sum"}
         Overlapping bodies: integrate their union (the physical solid; default) or add their integrals
         (shared volume counted twice, said in the report).
+    self_crossing : {"refuse", "unverified"}
+        A shell that passes through itself (rule R3): refused (default; with ``repair`` estimated), or, for
+        meshes made by a boolean whose output crosses itself by rounding (spin-it's hollowed parts),
+        integrated as it stands and certified ``unverified`` with a note counting the crossing face pairs.
 
     Returns
     -------
@@ -155,6 +159,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     """
     if overlap not in OVERLAP_MODES:
         raise UsageError(f"Expected `overlap` to be one of {', '.join(OVERLAP_MODES)}, got {overlap!r}")
+    if self_crossing not in ("refuse", "unverified"):
+        raise UsageError(f"Expected `self_crossing` to be 'refuse' or 'unverified', got {self_crossing!r}")
     source = raw.source
     v, f = raw.vertices, raw.faces
     if len(f) == 0:
@@ -204,7 +210,12 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         found = Resolution(found.vertices, found.faces, found.method, found.notes + patch_notes,
                            found.flipped_faces, found.welded_tolerance, found.nonmanifold_edges, found.estimate)
     touch = shell_contacts(contacts, labels, n_shells)
-    if touch.self_crossing.any():                                                # R3
+    crossing_note = None
+    if touch.self_crossing.any() and self_crossing == "unverified" and not repair:
+        crossing_note = (f"the surface passes through itself at {touch.self_crossing_pairs:,} face pairs: "
+                         "integrated as it stands (a crossed region counts twice), not verified")
+        warnings.warn(MeshResolvedWarning(f"{source}: {crossing_note}"), stacklevel=3)
+    elif touch.self_crossing.any():                                              # R3
         message = self_crossing_message(source, touch, v, f, contacts.crossing, labels)
         if not repair:
             raise InvalidMeshError(message, details={"self_crossing_face_pairs": touch.self_crossing_pairs})
@@ -223,6 +234,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     method, notes = found.method, list(found.notes)
     if dropped_note is not None:
         notes.append(dropped_note)
+    if crossing_note is not None:
+        notes.append(crossing_note)
     checks = ["edge-balanced", "consistently-oriented"]
     undecided = nest.undecided if nest is not None else np.zeros(n_shells, dtype=bool)
     if touch.complete:
@@ -230,8 +243,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     else:       # the check gave up: every shell whose box meets another's goes to the boolean
         candidates = _boxes_meet(v, f, labels, n_shells) | undecided
     overlaps = int(np.count_nonzero(touch.crossing))
-    kind = "exact" if touch.complete else "unverified"
-    if touch.complete and not touch.crossing.any():
+    kind = "exact" if touch.complete and crossing_note is None else "unverified"
+    if touch.complete and not touch.crossing.any() and crossing_note is None:
         checks.append("no-crossing-faces")
     if candidates.any() or found.nonmanifold_edges:                             # R5, R6
         united = _unite(v, f, labels, owner, source, repair)
