@@ -29,7 +29,8 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    "inside" may mean "overlapping"), each shell keeps what its own sign says instead.
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
    transversally (or overlap coplanar with the same orientation) mean shared volume: the union is integrated
-   and the certificate is ``united``.
+   and the certificate is ``united`` once the face-intersection check finds no crossing in the union itself
+   (manifold3d's output is manifold but can pass through itself by rounding; then ``unverified``).
 R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL``).  Shells that meet only
    at edges, vertices or face to face with opposite normals (touching copies), or whose probe points all lie
    on another surface, or that share non-manifold edges, go to the boolean; when the union's volume equals

@@ -281,6 +281,11 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                  "through each other at shared edges): the result is the union, not verified")
                 checks = ["edge-balanced", "consistently-oriented", "boolean-union"]
                 v, f = united.vertices, united.faces
+                after = surface_contacts(v, f)           # manifold3d's output can pass through itself by rounding
+                if len(after.crossing) or not after.complete:
+                    kind = "unverified"
+                    notes.append(f"the union formed by the boolean passes through itself at {len(after.crossing):,} "
+                                 "face pairs (rounding in manifold3d): not verified")
                 labels, n_shells = shell_labels(f, len(v))
                 shells = body_volume_moments(v, f, labels, n_shells)
                 f, labels, n_shells, shells, left = _drop_flat(v, f, labels, shells, diag, source, warn=False)
