@@ -184,7 +184,7 @@ def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarra
     shells = "one shell" if n_shells == 1 else f"{n_shells} shells"
     return (f"{source}: the surface passes through itself at {found.self_crossing_pairs:,} face pairs "
             f"({shells}){where}; the solid there is ambiguous (the summed integral would count the crossed "
-            "region twice); `repair=True` gives a bounded estimate of the solid {winding number ≥ 1}")
+            "region twice); `repair=True` tries a bounded estimate of the solid {winding number ≥ 1}")
 
 
 def orient_by_depth(volumes: np.ndarray, nest, crossing_with: np.ndarray, *,
