@@ -285,7 +285,7 @@ def test_certificate_in_batch_rows_html_and_robot_links(tmp_path):
     from inertia_tool.batch.runner import BatchOptions, analyze_file
     from inertia_tool.reports.html import html_report
     from inertia_tool.robot.description import GeometryElement, LinkGeometry, rpy_to_matrix
-    from inertia_tool.robot.geometry import link_certificate, link_mass_properties
+    from inertia_tool.robot.geometry import _element_parts
     v, f, _, _ = _cubes_sharing_diagonal()
     united = tmp_path / "cubes.stl"
     write_binary_stl(united, v, f)
@@ -299,11 +299,8 @@ def test_certificate_in_batch_rows_html_and_robot_links(tmp_path):
         assert "united (edge-balanced, consistently-oriented, boolean-union)" in html_report(props, generated="fixed")
         elements = (GeometryElement("box", rpy_to_matrix((0, 0, 0)), (0, 0, 0), size=(1, 1, 1)),
                     GeometryElement("mesh", rpy_to_matrix((0, 0, 0)), (3, 0, 0), mesh=str(united)))
-        link = LinkGeometry("l", elements, None)
-        cache: dict = {}
-        link_mass_properties(link, cache=cache)
-    assert link_certificate(link, cache).kind == "united"
-    assert link_certificate(LinkGeometry("p", elements[:1], None), {}).checks == ("closed-form",)
+        parts, _ = _element_parts(LinkGeometry("l", elements, None), cache={}, repair=False, model=False)
+    assert [m for _, _, m, _ in parts] == ["exact", "united"]     # a robot link's method: its meshes' certificate
 
 
 # -- hypothesis: zero silent wrong answers ------------------------------------------------------------------

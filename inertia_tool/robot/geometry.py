@@ -52,13 +52,10 @@ METHODS = ("exact", "united", "summed", "unverified", "estimate")
 MODEL_DENSITY = "model"
 
 
-def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = None,
-                    scale=(1.0, 1.0, 1.0)) -> MassProperties:
-    """Unit-density mass properties of the mesh file ``path`` scaled by ``scale`` (metres, file axes).
+def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = None) -> MassProperties:
+    """Unit-density mass properties of the mesh file ``path`` (metres, file axes).
 
-    The one place where the robot tools call the mesh engine.  The element's ``scale`` is applied to the
-    vertices *before* the engine checks the mesh, so every number in its messages (shared volumes, welding
-    distances, locations) is in metres of the robot, not in the file's units.
+    The one place where the robot tools call the mesh engine.
 
     Parameters
     ----------
@@ -69,33 +66,17 @@ def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = 
         :class:`InvalidMeshError` (the caller then reports the link).
     max_faces : int, optional
         Refuse a file of more triangles (the reader's limit, ``LoadOptions.max_faces``); its default when None.
-    scale : (3,) float
-        Per-axis factors of the description's ``scale`` (a negative determinant mirrors: the faces are turned
-        so that the mesh stays outward-wound).
 
     Returns
     -------
     MassProperties
         Unit density: ``mass == volume``.
     """
-    from ..mesh.read import RawMesh, load_mesh
-
-    s = np.asarray(scale, dtype=np.float64).reshape(3)
-    if not np.all(np.isfinite(s)) or np.any(s == 0):
-        raise UsageError(f"Expected finite, non-zero mesh scale factors, got {s.tolist()}")
-    limit = DEFAULT_MAX_FACES if max_faces is None else max_faces
-    # robot descriptions give mesh coordinates in metres before their `scale`, so the unit is stated, not
-    # assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
-    raw = load_mesh(path, units="m", max_faces=limit)
-    if not np.all(s == 1.0):
-        faces = raw.faces if np.prod(s) > 0 else raw.faces[:, ::-1]
-        raw = RawMesh(vertices=raw.vertices * s, faces=faces, source=f"{raw.source} (scale {_scale_text(s)})",
-                      units=raw.units, file_faces=raw.file_faces)
-    return mass_properties(raw, density=1.0, repair=repair, max_faces=limit)
-
-
-def _scale_text(s: np.ndarray) -> str:
-    return f"{s[0]:g}" if s[0] == s[1] == s[2] else " ".join(f"{x:g}" for x in s)
+    # robot descriptions give mesh coordinates in metres (the element's `scale` is applied afterwards), so the
+    # unit is stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
+    if max_faces is None:
+        return mass_properties(path, density=1.0, repair=repair, units="m")
+    return mass_properties(path, density=1.0, repair=repair, units="m", max_faces=max_faces)
 
 
 def _capsule(radius: float, length: float) -> MassProperties:
@@ -225,7 +206,7 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     ----------
     element : GeometryElement
     cache : dict, optional
-        (mesh path, scale) → unit-density properties, shared between the elements of one robot.
+        Mesh path → unit-density properties, shared between the elements of one robot.
     repair : bool
         Passed to :func:`mesh_properties`.
     budget : list of two int, optional
@@ -257,16 +238,15 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     elif kind == "ellipsoid":
         local = _ellipsoid(*size)
     elif kind == "mesh":
-        key = _cache_key(element)
-        if cache is not None and key in cache:
-            local = cache[key]
+        if cache is not None and element.mesh in cache:
+            local = cache[element.mesh]
         else:
             assert element.mesh is not None, "a mesh element carries the path of its file"
             if budget is not None and budget[0] < 1:
                 raise MeshReadError(f"{element.mesh}: not read: the meshes read before it hold all the triangles "
                                     "`max_faces` allows (the limit is on all the meshes of the robot together)")
             try:
-                local = mesh_properties(element.mesh, repair=repair, scale=element.scale,
+                local = mesh_properties(element.mesh, repair=repair,
                                         max_faces=None if budget is None else budget[0])
             except MeshReadError as exc:
                 if budget is None or budget[0] == budget[1] or "`max_faces`" not in str(exc):
@@ -314,7 +294,7 @@ def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repai
     ----------
     link : LinkGeometry
     cache : dict, optional
-        (mesh path, scale) → unit-density properties, shared between links.
+        Mesh path → unit-density properties, shared between links.
     repair : bool
         Passed to :func:`mesh_properties`.
     budget : list of one int, optional
