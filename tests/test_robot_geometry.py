@@ -12,7 +12,7 @@ from inertia_tool.mesh.read import load_mesh
 from inertia_tool.robot import link_inertials, read_robot
 from inertia_tool.robot.description import GeometryElement, LinkGeometry, rpy_to_matrix
 from inertia_tool.robot.geometry import (element_mass_properties, link_mass_properties, points_inside_element,
-                                         _capsule, _ellipsoid, _scaled)
+                                         _capsule, _ellipsoid)
 
 from conftest import assert_tensor_close
 from robot_data import PACKAGES, UR5
@@ -37,13 +37,53 @@ def test_capsule_closed_form_against_fine_meshes():
     assert_tensor_close((4 * props[1].inertia - props[0].inertia) / 3, exact.inertia, 2e-5)
 
 
-def test_ellipsoid_is_a_scaled_sphere():
-    # the mesh-scale rule (|det S| S Σ S) applied to a sphere must give the ellipsoid's closed form
-    sphere = shapes.sphere(1.0, segments=3, rings=2).exact
-    scaled = _scaled(sphere, [0.3, 0.4, 0.5])
+def _scaled_rule(props, scale):
+    """The mesh-scale rule written out independently: volume |det S| V, centre S c, central second moments
+    Σ = ∫ x xᵀ dV become |det S| S Σ S, and I = tr(Σ) 1 − Σ (Eq. 4.13)."""
+    s = np.asarray(scale, dtype=float)
+    det = abs(float(np.prod(s)))
+    sigma = 0.5 * np.trace(props.inertia) * np.eye(3) - props.inertia
+    sigma = det * (s[:, None] * sigma * s[None, :])
+    return det * props.volume, s * props.center_of_mass, np.trace(sigma) * np.eye(3) - sigma
+
+
+@pytest.mark.parametrize("scale", [(0.3, 0.4, 0.5), (0.3, -0.4, 0.5), (-1e-3, -1e-3, -1e-3)])
+def test_a_scaled_mesh_follows_the_scale_rule(tmp_path, scale):
+    # the scale is applied to the vertices before the engine integrates them; the integrals must be the
+    # analytic transformation of the unscaled mesh's (a mirror reverses the faces, so the volume stays positive)
+    solid = shapes.sphere(1.0, segments=3, rings=2)
+    path = str(tmp_path / "s.stl")
+    shapes.write_stl(solid, path)
+    unscaled = element_mass_properties(_element("mesh", mesh=path))
+    props = element_mass_properties(_element("mesh", mesh=path, scale=scale))
+    volume, com, inertia = _scaled_rule(unscaled, scale)
+    assert props.volume == pytest.approx(volume, rel=1e-12)
+    np.testing.assert_allclose(props.center_of_mass, com, atol=1e-15)
+    assert_tensor_close(props.inertia, inertia, 1e-12)
+
+
+def test_scaled_sphere_approaches_the_ellipsoid():
+    # the rule on a fine sphere mesh: the ellipsoid's closed form, to the mesh's own discretisation error
+    sphere = it.mass_properties(trimesh.creation.icosphere(5), density=1.0)
+    volume, _, inertia = _scaled_rule(sphere, [0.3, 0.4, 0.5])
     exact = _ellipsoid(0.3, 0.4, 0.5)
-    assert scaled.volume == pytest.approx(exact.volume, rel=1e-14)
-    assert_tensor_close(scaled.inertia, exact.inertia, 1e-14)
+    assert volume == pytest.approx(exact.volume, rel=2e-3)
+    assert_tensor_close(inertia, exact.inertia, 5e-3)
+
+
+def test_engine_messages_speak_of_the_scaled_body(tmp_path):
+    # two overlapping millimetre boxes scaled by 0.001 in the description: the overlap warning gives the shared
+    # volume of the body as placed, in m³ (it gave the file's mm³ labelled m³: 224.416 m³ for a Robotiq base)
+    a = trimesh.creation.box(extents=(10.0, 10.0, 10.0))
+    b = a.copy()
+    b.apply_translation((5.0, 0.0, 0.0))
+    path = str(tmp_path / "two.stl")
+    trimesh.util.concatenate([a, b]).export(path)
+    with pytest.warns(it.errors.OverlapWarning) as record:
+        props = element_mass_properties(_element("mesh", mesh=path, scale=(1e-3, 1e-3, 1e-3)))
+    assert props.volume == pytest.approx(1.5e-6, rel=1e-9)
+    message = str(record[0].message)
+    assert "5e-07 m³" in message, message
 
 
 def test_two_boxes_side_by_side_are_one_box():

@@ -1,6 +1,7 @@
 """Mass properties of a link from its geometry: primitives in closed form, meshes through the engine.
 
-Every element is first taken at unit density in its own frame, then scaled (meshes), then moved into the
+Every element is first taken at unit density in its own frame (a mesh with its reference transform and
+``scale`` applied to its vertices before the engine integrates it: :func:`mesh_properties`), then moved into the
 link frame (``x ↦ R x + t``: centre ``R c + t``, tensor ``R I Rᵀ``), and the elements of a link are summed
 with the parallel-axis theorem (Eq. 4.16, :func:`inertia_tool.mass.properties.combine`).  Overlapping elements
 are counted twice (as a simulator's inertia-from-geometry does).
@@ -17,15 +18,16 @@ Closed forms (unit density, about the element's centre, element axes; M = V):
   centre, ``I_xx = 2 m_h R²/5 − m_h (3R/8)² = 83 m_h R²/320``; the parallel-axis theorem moves it to the
   capsule centre, ``I_xx += m_h (L/2 + 3R/8)²``.
 
-Mesh scale ``S = diag(s)``: ``∫_{S(V)} f(y) dy = |det S| ∫_V f(S x) dx``, so the volume becomes
-``|det S| V``, the centre ``S c``, and the central second moments ``Σ = ∫ x xᵀ dV`` become ``|det S| S Σ S``;
-the tensor is ``I = tr(Σ) 1 − Σ`` (Eq. 4.13).  A negative factor (a mirrored mesh) is handled by ``|det S|``.
+Mesh scale ``S = diag(s)`` is applied to the coordinates, not to the integrals, so that the engine's checks,
+warnings and bounds speak of the body as placed, in metres; a negative factor (a mirrored mesh) reverses the
+faces with it, so the surface keeps its outward winding.
 """
 
 from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import replace
 
 import numpy as np
 
@@ -52,10 +54,15 @@ METHODS = ("exact", "united", "summed", "unverified", "estimate")
 MODEL_DENSITY = "model"
 
 
-def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = None) -> MassProperties:
-    """Unit-density mass properties of the mesh file ``path`` (metres, file axes).
+def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = None,
+                    element: GeometryElement | None = None) -> MassProperties:
+    """Unit-density mass properties of the mesh file ``path`` (metres), placed as ``element`` places it.
 
-    The one place where the robot tools call the mesh engine.
+    The one place where the robot tools call the mesh engine.  The element's reference transform (MJCF
+    ``refpos``/``refquat``) and ``scale`` are applied to the vertices *before* the engine checks and integrates
+    them, so that everything the engine says — volumes in its warnings, the bounds of an estimate (a centre of
+    mass bound in m) — is about the body as the description places it, in SI.  A mirroring scale (negative
+    determinant) reverses the faces with the coordinates, so the surface keeps its winding.
 
     Parameters
     ----------
@@ -66,17 +73,32 @@ def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = 
         :class:`InvalidMeshError` (the caller then reports the link).
     max_faces : int, optional
         Refuse a file of more triangles (the reader's limit, ``LoadOptions.max_faces``); its default when None.
+    element : GeometryElement, optional
+        The mesh element: its reference transform and scale (none when not given).
 
     Returns
     -------
     MassProperties
-        Unit density: ``mass == volume``.
+        Unit density: ``mass == volume``; in the element's mesh frame after its scale (before its pose).
     """
-    # robot descriptions give mesh coordinates in metres (the element's `scale` is applied afterwards), so the
-    # unit is stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
-    if max_faces is None:
-        return mass_properties(path, density=1.0, repair=repair, units="m")
-    return mass_properties(path, density=1.0, repair=repair, units="m", max_faces=max_faces)
+    from ..mesh.read import load_mesh
+    # robot descriptions give mesh coordinates in metres (the element's `scale` is applied here), so the unit is
+    # stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
+    raw = load_mesh(path, units="m") if max_faces is None else load_mesh(path, units="m", max_faces=max_faces)
+    if element is not None:
+        scale = np.asarray(element.scale, dtype=np.float64)
+        if not np.all(np.isfinite(scale)) or np.any(scale == 0):
+            raise UsageError(f"Expected finite non-zero mesh scale factors, got {scale.tolist()}")
+        moved = not (np.array_equal(element.reference_rotation, np.eye(3))
+                     and not np.any(element.reference_translation))
+        if moved or not np.all(scale == 1.0):
+            v = raw.vertices
+            if moved:
+                v = v @ element.reference_rotation.T + element.reference_translation
+            f = raw.faces if float(np.prod(np.sign(scale))) > 0 else raw.faces[:, ::-1]
+            raw = replace(raw, vertices=v * scale, faces=np.ascontiguousarray(f),
+                          storage_rounding=raw.storage_rounding * float(np.max(np.abs(scale))))
+    return mass_properties(raw, density=1.0, repair=repair)
 
 
 def _capsule(radius: float, length: float) -> MassProperties:
@@ -100,25 +122,10 @@ def _ellipsoid(a: float, b: float, c: float) -> MassProperties:
                           density=1.0)
 
 
-def _scaled(props: MassProperties, scale) -> MassProperties:
-    s = np.asarray(scale, dtype=np.float64)
-    if np.all(s == 1.0):
-        return props
-    det = abs(float(np.prod(s)))
-    if det == 0:
-        raise UsageError(f"Expected non-zero mesh scale factors, got {s.tolist()}")
-    sigma = 0.5 * np.trace(props.inertia) * np.eye(3) - props.inertia
-    sigma = det * (s[:, None] * sigma * s[None, :])
-    volume = det * props.volume
-    return MassProperties(mass=volume, volume=volume, center_of_mass=s * props.center_of_mass,
-                          inertia=np.trace(sigma) * np.eye(3) - sigma, density=1.0, name=props.name)
-
-
-def _referenced(props: MassProperties, element: GeometryElement) -> MassProperties:
-    """The mesh file's body moved by the element's reference transform (MJCF ``refpos``/``refquat``)."""
-    if np.array_equal(element.reference_rotation, np.eye(3)) and not np.any(element.reference_translation):
-        return props
-    return props.transformed(rotation=element.reference_rotation, translation=element.reference_translation)
+def _mesh_key(element: GeometryElement) -> tuple:
+    """Cache key of a mesh element's unit-density body: the file and how the element scales and moves it."""
+    return (element.mesh, tuple(np.asarray(element.scale, dtype=np.float64).tolist()),
+            element.reference_rotation.tobytes(), np.asarray(element.reference_translation).tobytes())
 
 
 def element_shell_properties(element: GeometryElement) -> MassProperties:
@@ -238,15 +245,16 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     elif kind == "ellipsoid":
         local = _ellipsoid(*size)
     elif kind == "mesh":
-        if cache is not None and element.mesh in cache:
-            local = cache[element.mesh]
+        key = _mesh_key(element)
+        if cache is not None and key in cache:
+            local = cache[key]
         else:
             assert element.mesh is not None, "a mesh element carries the path of its file"
             if budget is not None and budget[0] < 1:
                 raise MeshReadError(f"{element.mesh}: not read: the meshes read before it hold all the triangles "
                                     "`max_faces` allows (the limit is on all the meshes of the robot together)")
             try:
-                local = mesh_properties(element.mesh, repair=repair,
+                local = mesh_properties(element.mesh, repair=repair, element=element,
                                         max_faces=None if budget is None else budget[0])
             except MeshReadError as exc:
                 if budget is None or budget[0] == budget[1] or "`max_faces`" not in str(exc):
@@ -256,8 +264,7 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
             if budget is not None and local.mesh is not None:
                 budget[0] -= local.mesh.file_faces
             if cache is not None:
-                cache[element.mesh] = local
-        local = _scaled(_referenced(local, element), element.scale)
+                cache[key] = local
     else:
         raise UsageError("Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, mesh, "
                          f"got {kind!r}")
@@ -277,7 +284,8 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
             parts.append((element, element_shell_properties(element), "exact", None))
             continue
         props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
-        report = cache[element.mesh].mesh if element.kind == "mesh" and element.mesh in cache else None
+        key = _mesh_key(element) if element.kind == "mesh" else None
+        report = cache[key].mesh if key is not None and key in cache else None
         method = "exact"
         if report is not None:          # the engine's certificate (a result with bounds is an estimate)
             method = "estimate" if report.uncertainty is not None else report.certificate.kind
