@@ -132,7 +132,7 @@ def format_robot_report(robot: RobotDescription, inertials, audits) -> str:
              "of the tensors at equal mass",
              ""]
     width = max([4] + [len(r.name) for r in inertials])
-    header = (f"{'link':<{width}} {'method':<8} {'mass kg':>10} {'declared kg':>12} {'ΔCOM mm':>9} {'ΔI':>8} "
+    header = (f"{'link':<{width}} {'method':<10} {'mass kg':>10} {'declared kg':>12} {'ΔCOM mm':>9} {'ΔI':>8} "
               f"{'implied ρ':>10}  {'COM inside':<10} {'issues':>6}")
     lines += [header, "-" * len(header)]
     inertial: LinkInertial
@@ -144,7 +144,7 @@ def format_robot_report(robot: RobotDescription, inertials, audits) -> str:
         if audit.com_in_bounding_box is False:
             inside = "no (box)"
         method = inertial.method or ("frame" if inertial not in missing else "none")
-        lines.append(f"{inertial.name:<{width}} {method:<8} {_fmt(props.mass if props else None, '10.4g'):>10} "
+        lines.append(f"{inertial.name:<{width}} {method:<10} {_fmt(props.mass if props else None, '10.4g'):>10} "
                      f"{_fmt(declared.mass if declared else None, '12.4g'):>12} "
                      f"{_fmt(audit.com_distance * 1e3, '9.1f'):>9} {_fmt(audit.inertia_difference, '8.0%'):>8} "
                      f"{_fmt(audit.implied_density, '10.4g'):>10}  {inside:<10} {len(audit.issues):>6}")
