@@ -15,6 +15,7 @@ import numpy as np
 
 from ..values import frozen_value
 from .._native import accel, faces_for_c, threads
+from .edges import edge_keys
 from .estimate import Uncertainty
 from .policy import Certificate
 
@@ -163,21 +164,16 @@ def repeated_corner_faces(faces: np.ndarray) -> np.ndarray:
 
 
 def _edge_keys(faces: np.ndarray, n_vertices: int) -> np.ndarray:
-    """Directed-edge keys ``(min·n + max)·2 + [a > b]``, (3m,) int64, sorted."""
-    n = np.int64(max(int(n_vertices), 1))
+    """Directed-edge keys ``2·key + [a > b]`` (:func:`~.edges.edge_keys`), (3m,) int64, sorted; built in chunks of
+    faces, so the temporaries stay small on large meshes."""
     m = len(faces)
     key = np.empty(3 * m, dtype=np.int64)
     step = 1 << 18
-    for k, (i, j) in enumerate(((0, 1), (1, 2), (2, 0))):
-        for s in range(0, m, step):
-            a = faces[s:s + step, i].astype(np.int64)
-            b = faces[s:s + step, j].astype(np.int64)
-            out = key[k * m + s:k * m + min(s + step, m)]
-            np.minimum(a, b, out=out)
-            out *= n
-            out += np.maximum(a, b)
-            out *= 2
-            out += a > b
+    for s in range(0, m, step):
+        undirected, forward = edge_keys(faces[s:s + step], n_vertices)
+        out = key[3 * s:3 * s + len(undirected)]
+        np.multiply(undirected, 2, out=out)
+        out += forward
     key.sort()
     return key
 
@@ -286,13 +282,8 @@ def _edge_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, 
     :func:`_vertex_shell_labels` run on the face graph (each link a row ``(a, b, b)``, each face a row
     ``(i, i, i)``), or from scipy's ``connected_components`` on the numpy path.
     """
-    f = np.asarray(faces, dtype=np.int64)
-    m = len(f)
-    n = np.int64(max(int(n_vertices), 1))
-    a = f.reshape(-1)
-    b = np.roll(f, -1, axis=1).reshape(-1)
-    key = np.minimum(a, b) * n + np.maximum(a, b)
-    del a, b
+    m = len(faces)
+    key = edge_keys(faces, n_vertices)[0]
     order = np.argsort(key)
     skey = key[order]
     same = skey[1:] == skey[:-1]

@@ -42,6 +42,7 @@ import numpy as np
 from ..errors import InvalidMeshError
 from ..tolerances import ESTIMATE_MAX_MASS_RTOL
 from ..values import frozen_value
+from .edges import edge_keys
 from .seal import Seal
 
 __all__ = ["Uncertainty", "Estimate", "boundary_edges", "patched_estimate", "winding_estimate", "uncertainty_from",
@@ -128,12 +129,9 @@ def boundary_edges(faces: np.ndarray, n_vertices: int) -> np.ndarray:
     Each undirected edge contributes ``|#(a→b) − #(b→a)|`` copies in its net direction: the boundary 1-chain,
     which is balanced at every vertex (a union of closed loops).
     """
-    f = np.asarray(faces, dtype=np.int64)
-    a = f.reshape(-1)
-    b = f[:, [1, 2, 0]].reshape(-1)
     n = np.int64(max(int(n_vertices), 1))
-    key = np.minimum(a, b) * n + np.maximum(a, b)
-    sign = np.where(a < b, 1, -1)
+    key, forward = edge_keys(faces, n_vertices)
+    sign = np.where(forward, -1, 1)
     unique, inverse = np.unique(key, return_inverse=True)
     net = np.bincount(inverse.reshape(-1), weights=sign, minlength=len(unique)).astype(np.int64)
     pick = net != 0

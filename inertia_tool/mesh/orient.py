@@ -18,20 +18,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..values import frozen_value
+from .edges import edge_keys
 
 __all__ = ["EdgeBalance", "edge_balance", "Orientation", "orient_consistently"]
-
-
-def _directed_keys(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
-    """Keys ``min·n + max`` of the 3m directed edges, and their direction bit ``[a > b]`` (face-major order).
-
-    Edge ``k`` of face ``i`` (``k = 0, 1, 2`` for ``(0,1), (1,2), (2,0)``) is entry ``3 i + k``.
-    """
-    f = np.asarray(faces, dtype=np.int64)
-    a = f.reshape(-1)
-    b = f[:, [1, 2, 0]].reshape(-1)
-    n = np.int64(max(int(n_vertices), 1))
-    return np.minimum(a, b) * n + np.maximum(a, b), a > b
 
 
 @frozen_value
@@ -77,7 +66,7 @@ def edge_balance(faces: np.ndarray, n_vertices: int) -> EdgeBalance:
     """
     if len(faces) == 0:
         return EdgeBalance(0, 0, 0, 0)
-    key, forward = _directed_keys(faces, n_vertices)
+    key, forward = edge_keys(faces, n_vertices)
     order = np.argsort(key, kind="stable")
     key = key[order]
     sign = np.where(forward[order], 1, -1).astype(np.int64)
@@ -140,7 +129,7 @@ def orient_consistently(faces: np.ndarray, n_vertices: int, vertices: np.ndarray
     m = len(faces)
     if m == 0:
         return Orientation(faces, 0, 0, True)
-    key, forward = _directed_keys(faces, n_vertices)
+    key, forward = edge_keys(faces, n_vertices)
     order = np.argsort(key, kind="stable")
     skey = key[order]
     starts = np.flatnonzero(np.r_[True, skey[1:] != skey[:-1]])

@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..values import frozen_value
+from .edges import edge_keys
 
 __all__ = ["Seal", "seal_seams", "parallel_body_volume"]
 
@@ -146,10 +147,11 @@ def _split_t_junctions(v, f, slack, gap):
     if not len(e):
         return f, slack, 0
     # the face holding each directed edge a→b, and which of its edges it is
-    n = np.int64(len(v))
-    key = (f * n + np.roll(f, -1, axis=1)).reshape(-1)      # edge slot j of face i: f[i, j] → f[i, j+1]
+    undirected, forward = edge_keys(f, len(v))            # edge slot j of face i: f[i, j] → f[i, j+1]
+    key = 2 * undirected + forward
     order = np.argsort(key, kind="stable")
-    want = edges[e, 0] * n + edges[e, 1]
+    start, end = edges[e, 0].astype(np.int64), edges[e, 1].astype(np.int64)
+    want = 2 * edge_keys(np.stack([start, end, end], axis=1), len(v))[0][0::3] + (start > end)
     pos = np.searchsorted(key[order], want)
     found = (pos < len(key)) & (key[order][np.minimum(pos, len(key) - 1)] == want)
     e, m, t, dist, pos = e[found], m[found], t[found], dist[found], pos[found]

@@ -90,11 +90,11 @@ def closed_groups(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from .orient import _directed_keys
+    from .edges import edge_keys
 
     f = np.asarray(faces)
     m = len(f)
-    key, forward = _directed_keys(f, n_vertices)
+    key, forward = edge_keys(f, n_vertices)
     order = np.argsort(key, kind="stable")
     skey = key[order]
     starts = np.flatnonzero(np.r_[True, skey[1:] != skey[:-1]])
