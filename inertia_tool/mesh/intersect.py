@@ -546,19 +546,21 @@ def _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk, pred: _Predica
     return np.concatenate(found_a), np.concatenate(found_b), np.concatenate(found_k), candidates, tested, complete
 
 
-def _scan_c(lib, v, f, axis, degenerate, lo, hi, max_pairs, pred: _Predicates) -> _Scan:
-    """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy)."""
-    raw_a, raw_b, raw_kind, candidates, tested, exact, complete = lib.contact_scan(
-        v, f, np.ascontiguousarray(axis, dtype=np.int64), degenerate.view(np.uint8), lo, hi,
-        -1 if max_pairs is None else int(max_pairs), threads())
+def _scan_c(lib, v, f, max_pairs, pred: _Predicates) -> tuple[_Scan, np.ndarray, np.ndarray]:
+    """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy), with the
+    per-face projection axes and zero-area flags it computed."""
+    raw_a, raw_b, raw_kind, candidates, tested, exact, complete, raw_axis, raw_skip = lib.contact_scan(
+        v, f, -1 if max_pairs is None else int(max_pairs), threads())
     pred.exact += exact
+    axis = np.frombuffer(raw_axis, dtype=np.int8).astype(np.intp)
+    degenerate = np.frombuffer(raw_skip, dtype=np.uint8).astype(bool)
     a = np.frombuffer(raw_a, dtype=np.int64)
     b = np.frombuffer(raw_b, dtype=np.int64)
     kind = np.frombuffer(raw_kind, dtype=np.int8).copy()
     left = np.flatnonzero(kind < 0)
     if len(left):                       # an expansion too long for the C kernel
         kind[left] = _classify(v, f, axis, a[left], b[left], pred)
-    return a, b, kind, int(candidates), int(tested), bool(complete)
+    return (a, b, kind, int(candidates), int(tested), bool(complete)), axis, degenerate
 
 
 # -- entry point ----------------------------------------------------------------------------------------------
@@ -604,14 +606,14 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     empty = np.zeros((0, 2), dtype=np.intp)
     if not len(f):
         return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty, complete=True)
-    axis, degenerate = _face_axes(v, f, pred)
-    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    lo = np.minimum(np.minimum(p0, p1), p2)
-    hi = np.maximum(np.maximum(p0, p1), p2)
-    del p0, p1, p2
     if lib is not None:
-        a, b, kind, candidates, tested, complete = _scan_c(lib, v, f, axis, degenerate, lo, hi, max_pairs, pred)
+        (a, b, kind, candidates, tested, complete), axis, degenerate = _scan_c(lib, v, f, max_pairs, pred)
     else:
+        axis, degenerate = _face_axes(v, f, pred)
+        p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+        lo = np.minimum(np.minimum(p0, p1), p2)
+        hi = np.maximum(np.maximum(p0, p1), p2)
+        del p0, p1, p2
         a, b, kind, candidates, tested, complete = _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk,
                                                                pred)
 
