@@ -2443,9 +2443,10 @@ typedef struct {
     int32_t skip;               /* zero area: skipped */
 } CtFace;
 
-/* Sign of orient3d(t0, t1, t2, x) for the corners t of face F (the side of x on F's plane). */
+/* Sign of orient3d(t0, t1, t2, x) for the corners t of face F (the side of x on F's plane) when the float
+ * filter decides it, else 2. */
 static inline int
-ct_side(const CtFace *F, const double *x, CtStats *st)
+ct_side_filter(const CtFace *F, const double *x)
 {
     double w0 = x[0] - F->t[0], w1 = x[1] - F->t[1], w2 = x[2] - F->t[2];
     double det = w0 * F->n[0] + w1 * F->n[1] + w2 * F->n[2];
@@ -2456,7 +2457,80 @@ ct_side(const CtFace *F, const double *x, CtStats *st)
     if (fabs(det) > CONTACT_O3 * perm) {
         return det > 0 ? -1 : 1;
     }
-    return ct_orient3d_exact(F->t, F->t + 3, F->t + 6, x, st);
+    return 2;
+}
+
+/* The same, always decided (exact stage when the filter cannot). */
+static inline int
+ct_side(const CtFace *F, const double *x, CtStats *st)
+{
+    int s = ct_side_filter(F, x);
+    return s != 2 ? s : ct_orient3d_exact(F->t, F->t + 3, F->t + 6, x, st);
+}
+
+/* Sign of orient2d of the projections of a, b, c along axis k (the coordinates ct_plane[k] kept). */
+static inline int
+ct_orient2d_axis(const double *a, const double *b, const double *c, int k, CtStats *st)
+{
+    double a2[2] = {a[ct_plane[k][0]], a[ct_plane[k][1]]};
+    double b2[2] = {b[ct_plane[k][0]], b[ct_plane[k][1]]};
+    double c2[2] = {c[ct_plane[k][0]], c[ct_plane[k][1]]};
+    return ct_orient2d(a2, b2, c2, st);
+}
+
+/* Faces A, B sharing no, one or two corners by index: 1 when a line (through the shared corner or edge, if
+ * any) separates their projections along A's axis, meeting them only in the projection of what they share.
+ * A's projection is one to one, so A and B then meet only in what they share: a point of both projects into
+ * both projections, i.e. onto the shared corner or edge, whose only preimage in A is itself (and with nothing
+ * shared they do not meet).  Exact (orient2d signs); 0 when no such line is found (not a proof of anything). */
+static int
+ct_projections_separate(const double *const t1[3], const double *const t2[3], const int on1[3],
+                        const int on2[3], int n_shared, int k, CtStats *st)
+{
+    if (n_shared == 2) {
+        int r = !on1[0] ? 0 : !on1[1] ? 1 : 2, s = !on2[0] ? 0 : !on2[1] ? 1 : 2;
+        const double *p = t1[(r + 1) % 3], *q = t1[(r + 2) % 3];
+        int sr = ct_orient2d_axis(p, q, t1[r], k, st);
+        int ss = ct_orient2d_axis(p, q, t2[s], k, st);
+        return sr * ss < 0;
+    }
+    if (n_shared == 0) {
+        /* disjoint projections: an edge line of one with the other's three corners strictly outside */
+        for (int side = 0; side < 2; side++) {
+            const double *const *own = side ? t2 : t1, *const *other = side ? t1 : t2;
+            for (int e = 0; e < 3; e++) {
+                const double *p = own[e], *q = own[(e + 1) % 3];
+                int so = ct_orient2d_axis(p, q, own[(e + 2) % 3], k, st);
+                if (so == 0) break;               /* B's projection degenerate: no line of it */
+                if (ct_orient2d_axis(p, q, other[0], k, st) * so < 0
+                    && ct_orient2d_axis(p, q, other[1], k, st) * so < 0
+                    && ct_orient2d_axis(p, q, other[2], k, st) * so < 0) {
+                    return 1;
+                }
+            }
+        }
+        return 0;
+    }
+    if (n_shared != 1) {
+        return 0;
+    }
+    int i = on1[0] ? 0 : on1[1] ? 1 : 2, j = on2[0] ? 0 : on2[1] ? 1 : 2;
+    const double *v = t1[i];
+    const double *a[2] = {t1[(i + 1) % 3], t1[(i + 2) % 3]}, *b[2] = {t2[(j + 1) % 3], t2[(j + 2) % 3]};
+    for (int side = 0; side < 2; side++) {
+        const double *const *own = side ? b : a, *const *other = side ? a : b;
+        for (int e = 0; e < 2; e++) {
+            /* the line through v and own[e]: own[1 - e] strictly on one side, both of other strictly on the
+             * other */
+            int so = ct_orient2d_axis(v, own[e], own[1 - e], k, st);
+            if (so == 0) continue;
+            if (ct_orient2d_axis(v, own[e], other[0], k, st) * so < 0
+                && ct_orient2d_axis(v, own[e], other[1], k, st) * so < 0) {
+                return 1;
+            }
+        }
+    }
+    return 0;
 }
 
 /* Fills F from corners p0, p1, p2 (the normal, its permanent, the projection axis, the zero-area flag). */
@@ -2511,9 +2585,21 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
         }
     }
     int d1[3], d2[3];
-    int any1 = 0;
+    int any1 = 0, unsure = 0, separate_tried = 0;
     for (int i = 0; i < 3; i++) {
-        d1[i] = on1[i] ? 0 : ct_side(B, t1[i], st);
+        d1[i] = on1[i] ? 0 : ct_side_filter(B, t1[i]);
+        unsure |= d1[i] == 2;
+    }
+    /* a sign the filter cannot decide (e.g. adjacent faces in one plane): first try to show without it that
+     * the faces meet only in what they share */
+    if (unsure && n_shared < 3) {
+        separate_tried = 1;
+        if (ct_projections_separate(t1, t2, on1, on2, n_shared, A->axis, st)) {
+            return CT_NONE;
+        }
+    }
+    for (int i = 0; i < 3; i++) {
+        if (d1[i] == 2) d1[i] = ct_orient3d_exact(B->t, B->t + 3, B->t + 6, t1[i], st);
         any1 |= d1[i] != 0;
     }
     /* sharing an edge: they meet beyond it only when coplanar (the third corner of A on B's plane) */
@@ -2529,8 +2615,17 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
     if (n_shared == 1 && touch1 >= 0) {
         return CT_NONE;
     }
+    unsure = 0;
     for (int j = 0; j < 3; j++) {
-        d2[j] = on2[j] ? 0 : ct_side(A, t2[j], st);
+        d2[j] = on2[j] ? 0 : ct_side_filter(A, t2[j]);
+        unsure |= d2[j] == 2;
+    }
+    if (unsure && n_shared < 3 && !separate_tried
+        && ct_projections_separate(t1, t2, on1, on2, n_shared, A->axis, st)) {
+        return CT_NONE;
+    }
+    for (int j = 0; j < 3; j++) {
+        if (d2[j] == 2) d2[j] = ct_orient3d_exact(A->t, A->t + 3, A->t + 6, t2[j], st);
     }
     if ((d2[0] > 0 && d2[1] > 0 && d2[2] > 0) || (d2[0] < 0 && d2[1] < 0 && d2[2] < 0)) {
         return CT_NONE;
@@ -2945,6 +3040,20 @@ ct_tasks(const CtNode *nodes, int64_t *tasks)
     return n;
 }
 
+static inline double
+ct_min3(double a, double b, double c)
+{
+    double m = a < b ? a : b;
+    return m < c ? m : c;
+}
+
+static inline double
+ct_max3(double a, double b, double c)
+{
+    double m = a > b ? a : b;
+    return m > c ? m : c;
+}
+
 /* Per-face preparation, split over threads by position: Morton codes (pass 0), then the faces and boxes in
  * hierarchy order (pass 1). */
 typedef struct {
@@ -2972,7 +3081,7 @@ ct_prep_task(void *ctx, int t, int nt)
             const double *p2 = pr->V + 3 * pr->F[3 * f + 2];
             uint64_t code = 0;
             for (int c = 0; c < 3; c++) {
-                double lo = fmin(fmin(p0[c], p1[c]), p2[c]), hi = fmax(fmax(p0[c], p1[c]), p2[c]);
+                double lo = ct_min3(p0[c], p1[c], p2[c]), hi = ct_max3(p0[c], p1[c], p2[c]);
                 double q = (0.5 * (lo + hi) - pr->gmin[c]) * pr->scale[c];
                 uint64_t k = q > 0 ? (uint64_t)q : 0;
                 if (k > (1u << CT_MORTON_BITS) - 1) k = (1u << CT_MORTON_BITS) - 1;
@@ -2993,8 +3102,8 @@ ct_prep_task(void *ctx, int t, int nt)
         F->fo[2] = fi[2];
         F->face = f;
         for (int c = 0; c < 3; c++) {
-            pr->box[6 * i + c] = fmin(fmin(F->t[c], F->t[3 + c]), F->t[6 + c]);
-            pr->box[6 * i + 3 + c] = fmax(fmax(F->t[c], F->t[3 + c]), F->t[6 + c]);
+            pr->box[6 * i + c] = ct_min3(F->t[c], F->t[3 + c], F->t[6 + c]);
+            pr->box[6 * i + 3 + c] = ct_max3(F->t[c], F->t[3 + c], F->t[6 + c]);
         }
     }
     pr->exact[t] += st.exact;
