@@ -2698,7 +2698,7 @@ ct_int64(const Py_buffer *view)
  * ------------------------------------------------------------------------------------------------------ */
 
 #ifndef CT_LEAF
-#define CT_LEAF 4
+#define CT_LEAF 8
 #endif
 #define CT_MORTON_BITS 16       /* per axis: a 48-bit code, sorted in four passes of 12 bits */
 
@@ -2944,6 +2944,11 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         }
         if (p->count > 0 && q->count > 0) {
             for (int64_t i = p->start; i < p->start + p->count; i++) {
+                const double *bi = sc->BOX + 6 * i;     /* face i against q's box first */
+                if (!(bi[0] <= q->hi[0] && q->lo[0] <= bi[3] && bi[1] <= q->hi[1] && q->lo[1] <= bi[4]
+                      && bi[2] <= q->hi[2] && q->lo[2] <= bi[5])) {
+                    continue;
+                }
                 for (int64_t j = q->start; j < q->start + q->count; j++) {
                     if (ct_visit(sc, i, j)) goto out;
                 }
