@@ -2857,7 +2857,8 @@ typedef struct {
 static inline int
 ct_boxes_meet(const double *p, const double *q)
 {
-    return p[0] <= q[3] && q[0] <= p[3] && p[1] <= q[4] && q[1] <= p[4] && p[2] <= q[5] && q[2] <= p[5];
+    /* bitwise: no branch per comparison (their outcomes are hard to predict) */
+    return (p[0] <= q[3]) & (q[0] <= p[3]) & (p[1] <= q[4]) & (q[1] <= p[4]) & (p[2] <= q[5]) & (q[2] <= p[5]);
 }
 
 /* One candidate pair (hierarchy positions i, j); returns 0 to go on, 1 to stop (bound reached or out of
@@ -2893,8 +2894,8 @@ ct_visit(CtScan *sc, int64_t i, int64_t j)
 static inline int
 ct_nodes_meet(const CtNode *p, const CtNode *q)
 {
-    return p->lo[0] <= q->hi[0] && q->lo[0] <= p->hi[0] && p->lo[1] <= q->hi[1] && q->lo[1] <= p->hi[1]
-           && p->lo[2] <= q->hi[2] && q->lo[2] <= p->hi[2];
+    return (p->lo[0] <= q->hi[0]) & (q->lo[0] <= p->hi[0]) & (p->lo[1] <= q->hi[1]) & (q->lo[1] <= p->hi[1])
+           & (p->lo[2] <= q->hi[2]) & (q->lo[2] <= p->hi[2]);
 }
 
 /* Every candidate pair below the node pair (p0, q0): p0 == q0 for the pairs within one subtree; for
@@ -2945,8 +2946,8 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         if (p->count > 0 && q->count > 0) {
             for (int64_t i = p->start; i < p->start + p->count; i++) {
                 const double *bi = sc->BOX + 6 * i;     /* face i against q's box first */
-                if (!(bi[0] <= q->hi[0] && q->lo[0] <= bi[3] && bi[1] <= q->hi[1] && q->lo[1] <= bi[4]
-                      && bi[2] <= q->hi[2] && q->lo[2] <= bi[5])) {
+                if (!((bi[0] <= q->hi[0]) & (q->lo[0] <= bi[3]) & (bi[1] <= q->hi[1]) & (q->lo[1] <= bi[4])
+                      & (bi[2] <= q->hi[2]) & (q->lo[2] <= bi[5]))) {
                     continue;
                 }
                 for (int64_t j = q->start; j < q->start + q->count; j++) {
