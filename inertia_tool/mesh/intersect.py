@@ -56,13 +56,17 @@ tested in chunks of at most ``chunk`` pairs, so memory stays bounded on any mesh
 C extension
 -----------
 When ``inertia_tool._accel`` is built (and the coordinates are in the filter's range) the whole scan runs in
-its section 8 (``contact_scan``): a bounding-volume hierarchy over the face boxes (faces in Morton order of
-their box centres) traversed against itself gives the same candidate pairs as the grid, in another order, and
-each is classified on the spot with the same predicates and decisions, the exact stage computed by
-floating-point expansions instead of Python integers, on :func:`~inertia_tool._native.threads` threads (the
-pairs found do not depend on the count; with ``max_pairs`` it runs on one, and which pairs are tested before
-the bound stops it differs from the grid's order).  This module's numpy code stays the reference and
-the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
+its section 8 (``contact_scan``): the per-face axes and boxes, then a bounding-volume hierarchy over the face
+boxes (faces in Morton order of their box centres, radix-sorted) traversed against itself gives the same
+candidate pairs as the grid, in another order, and each is classified on the spot with the same predicates
+and decisions, the exact stage computed by floating-point expansions instead of Python integers, on
+:func:`~inertia_tool._native.threads` threads (the pairs found do not depend on the count; with ``max_pairs``
+it runs on one, and which pairs are tested before the bound stops it differs from the grid's order).  Each
+face keeps its float normal and its permanent, so a side test against its plane is three products with the
+very float value and error bound of ``orient3d``; pairs the filter cannot decide are first tried for a line
+separating their projections through what they share (:func:`_projections_separate`, also used here) before
+any exact evaluation.  This module's numpy code stays the reference and the fallback
+(``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
 """
 
 from __future__ import annotations
