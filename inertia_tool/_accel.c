@@ -1429,10 +1429,10 @@ static PyMethodDef accel_methods[] = {
      "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition "
      "(dynamics/splitting.py), principal frame; see section 7."},
     {"contact_scan", accel_contact_scan, METH_VARARGS,
-     "contact_scan(vertices, faces, axis, skip, lo, hi, max_pairs, threads=1) -> (a, b, kind, candidates, tested, "
-     "exact, complete)\n\nEvery face pair whose closed boxes meet, found by a bounding-volume hierarchy and classified; "
-     "a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
-     "max_pairs < 0: no bound; section 8."},
+     "contact_scan(vertices, faces, max_pairs, threads=1) -> (a, b, kind, candidates, tested, exact, complete, "
+     "axis, degenerate)\n\nEvery face pair whose closed boxes meet, found by a bounding-volume hierarchy and "
+     "classified; a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
+     "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -2214,29 +2214,20 @@ typedef struct {
     int failed;       /* an expansion overflowed: the pair goes back to the numpy path */
 } CtStats;
 
+/* Exact sign of orient3d(a, b, c, d) by expansions (called when the float filter cannot decide). */
 static int
-ct_orient3d(const double *a, const double *b, const double *c, const double *d, CtStats *st)
+ct_orient3d_exact(const double *a, const double *b, const double *c, const double *d, CtStats *st)
 {
-    double ad[3], bd[3], cd[3];
-    for (int k = 0; k < 3; k++) {
-        ad[k] = a[k] - d[k];
-        bd[k] = b[k] - d[k];
-        cd[k] = c[k] - d[k];
+    /* two equal points (e.g. a corner shared by coordinates): two equal rows, the determinant is zero */
+    const double *p4[4] = {a, b, c, d};
+    for (int r = 0; r < 4; r++) {
+        for (int s = r + 1; s < 4; s++) {
+            if (p4[r][0] == p4[s][0] && p4[r][1] == p4[s][1] && p4[r][2] == p4[s][2]) {
+                return 0;
+            }
+        }
     }
-    double m0 = bd[1] * cd[2] - bd[2] * cd[1];
-    double m1 = bd[2] * cd[0] - bd[0] * cd[2];
-    double m2 = bd[0] * cd[1] - bd[1] * cd[0];
-    double det = ad[0] * m0 + ad[1] * m1 + ad[2] * m2;
-    double perm = fabs(ad[0]) * (fabs(bd[1]) * fabs(cd[2]) + fabs(bd[2]) * fabs(cd[1]))
-                + fabs(ad[1]) * (fabs(bd[2]) * fabs(cd[0]) + fabs(bd[0]) * fabs(cd[2]))
-                + fabs(ad[2]) * (fabs(bd[0]) * fabs(cd[1]) + fabs(bd[1]) * fabs(cd[0]));
-    if (perm == 0.0) {
-        return 0;
-    }
-    if (fabs(det) > CONTACT_O3 * perm) {
-        return det > 0 ? 1 : -1;
-    }
-    /* exact: rows as two-term expansions (hi, lo) */
+    /* rows as two-term expansions (hi, lo) */
     double hi[3][3], lo[3][3];
     const double *p[3] = {a, b, c};
     for (int r = 0; r < 3; r++) {
@@ -2270,6 +2261,31 @@ ct_orient3d(const double *a, const double *b, const double *c, const double *d, 
 }
 
 static int
+ct_orient3d(const double *a, const double *b, const double *c, const double *d, CtStats *st)
+{
+    double ad[3], bd[3], cd[3];
+    for (int k = 0; k < 3; k++) {
+        ad[k] = a[k] - d[k];
+        bd[k] = b[k] - d[k];
+        cd[k] = c[k] - d[k];
+    }
+    double m0 = bd[1] * cd[2] - bd[2] * cd[1];
+    double m1 = bd[2] * cd[0] - bd[0] * cd[2];
+    double m2 = bd[0] * cd[1] - bd[1] * cd[0];
+    double det = ad[0] * m0 + ad[1] * m1 + ad[2] * m2;
+    double perm = fabs(ad[0]) * (fabs(bd[1]) * fabs(cd[2]) + fabs(bd[2]) * fabs(cd[1]))
+                + fabs(ad[1]) * (fabs(bd[2]) * fabs(cd[0]) + fabs(bd[0]) * fabs(cd[2]))
+                + fabs(ad[2]) * (fabs(bd[0]) * fabs(cd[1]) + fabs(bd[1]) * fabs(cd[0]));
+    if (perm == 0.0) {
+        return 0;
+    }
+    if (fabs(det) > CONTACT_O3 * perm) {
+        return det > 0 ? 1 : -1;
+    }
+    return ct_orient3d_exact(a, b, c, d, st);
+}
+
+static int
 ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
 {
     double acx = a[0] - c[0], acy = a[1] - c[1], bcx = b[0] - c[0], bcy = b[1] - c[1];
@@ -2281,6 +2297,9 @@ ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
     }
     if (fabs(det) > CONTACT_O2 * perm) {
         return det > 0 ? 1 : -1;
+    }
+    if ((a[0] == b[0] && a[1] == b[1]) || (a[0] == c[0] && a[1] == c[1]) || (b[0] == c[0] && b[1] == c[1])) {
+        return 0;                       /* two equal points */
     }
     double xh[2], xl[2], yh[2], yl[2];     /* a - c and b - c as (hi, lo) */
     ct_two_sum(a[0], -c[0], &xh[0], &xl[0]);
@@ -2405,43 +2424,219 @@ ct_coplanar(const double *const t1[3], const double *const t2[3], int axis, cons
     return CT_NONE;
 }
 
-/* Kind of the face pair with corner indices fa, fb and corner coordinates c1, c2 (3 x 3 doubles each). */
-static int
-ct_classify(const double *c1, const double *c2, const int64_t fa[3], const int64_t fb[3], int axis, CtStats *st)
+/* ------------------------------------------------------------------------------------------------------
+ * One face as the scan reads it, in hierarchy order (neighbours in space are near in memory): its corners,
+ * corner indices, and the float normal n = (t1 - t0) x (t2 - t0) with its permanent na (per component,
+ * |e1_j||e2_k| + |e1_k||e2_j|).  The side of a point x on the face's plane is then three products:
+ * orient3d(t0, t1, t2, x) = -(x - t0) . n, and (x - t0) . n in floats is exactly the float evaluation of
+ * ct_orient3d(x, t1, t2, t0) (the same differences, minors, products and sums in the same order), so the
+ * same static bound (10 u times the permanent (|x - t0|) . na) decides it, and the exact stage runs when it
+ * cannot.
+ * ------------------------------------------------------------------------------------------------------ */
+
+typedef struct {
+    double t[9];
+    double n[3], na[3];
+    int64_t fo[3];              /* corner indices */
+    int64_t face;               /* index in the caller's faces */
+    int32_t axis;               /* projection axis of the coplanar tests (mesh/intersect._face_axes) */
+    int32_t skip;               /* zero area: skipped */
+} CtFace;
+
+/* Sign of orient3d(t0, t1, t2, x) for the corners t of face F (the side of x on F's plane) when the float
+ * filter decides it, else 2. */
+static inline int
+ct_side_filter(const CtFace *F, const double *x)
 {
-    const double *t1[3] = {c1, c1 + 3, c1 + 6}, *t2[3] = {c2, c2 + 3, c2 + 6};
+    double w0 = x[0] - F->t[0], w1 = x[1] - F->t[1], w2 = x[2] - F->t[2];
+    double det = w0 * F->n[0] + w1 * F->n[1] + w2 * F->n[2];
+    double perm = fabs(w0) * F->na[0] + fabs(w1) * F->na[1] + fabs(w2) * F->na[2];
+    if (perm == 0.0) {
+        return 0;
+    }
+    if (fabs(det) > CONTACT_O3 * perm) {
+        return det > 0 ? -1 : 1;
+    }
+    return 2;
+}
+
+/* The same, always decided (exact stage when the filter cannot). */
+static inline int
+ct_side(const CtFace *F, const double *x, CtStats *st)
+{
+    int s = ct_side_filter(F, x);
+    return s != 2 ? s : ct_orient3d_exact(F->t, F->t + 3, F->t + 6, x, st);
+}
+
+/* Sign of orient2d of the projections of a, b, c along axis k (the coordinates ct_plane[k] kept). */
+static inline int
+ct_orient2d_axis(const double *a, const double *b, const double *c, int k, CtStats *st)
+{
+    double a2[2] = {a[ct_plane[k][0]], a[ct_plane[k][1]]};
+    double b2[2] = {b[ct_plane[k][0]], b[ct_plane[k][1]]};
+    double c2[2] = {c[ct_plane[k][0]], c[ct_plane[k][1]]};
+    return ct_orient2d(a2, b2, c2, st);
+}
+
+/* Faces A, B sharing no, one or two corners by index: 1 when a line (through the shared corner or edge, if
+ * any) separates their projections along A's axis, meeting them only in the projection of what they share.
+ * A's projection is one to one, so A and B then meet only in what they share: a point of both projects into
+ * both projections, i.e. onto the shared corner or edge, whose only preimage in A is itself (and with nothing
+ * shared they do not meet).  Exact (orient2d signs); 0 when no such line is found (not a proof of anything). */
+static int
+ct_projections_separate(const double *const t1[3], const double *const t2[3], const int on1[3],
+                        const int on2[3], int n_shared, int k, CtStats *st)
+{
+    if (n_shared == 2) {
+        int r = !on1[0] ? 0 : !on1[1] ? 1 : 2, s = !on2[0] ? 0 : !on2[1] ? 1 : 2;
+        const double *p = t1[(r + 1) % 3], *q = t1[(r + 2) % 3];
+        int sr = ct_orient2d_axis(p, q, t1[r], k, st);
+        int ss = ct_orient2d_axis(p, q, t2[s], k, st);
+        return sr * ss < 0;
+    }
+    if (n_shared == 0) {
+        /* disjoint projections: an edge line of one with the other's three corners strictly outside */
+        for (int side = 0; side < 2; side++) {
+            const double *const *own = side ? t2 : t1, *const *other = side ? t1 : t2;
+            for (int e = 0; e < 3; e++) {
+                const double *p = own[e], *q = own[(e + 1) % 3];
+                int so = ct_orient2d_axis(p, q, own[(e + 2) % 3], k, st);
+                if (so == 0) break;               /* B's projection degenerate: no line of it */
+                if (ct_orient2d_axis(p, q, other[0], k, st) * so < 0
+                    && ct_orient2d_axis(p, q, other[1], k, st) * so < 0
+                    && ct_orient2d_axis(p, q, other[2], k, st) * so < 0) {
+                    return 1;
+                }
+            }
+        }
+        return 0;
+    }
+    if (n_shared != 1) {
+        return 0;
+    }
+    int i = on1[0] ? 0 : on1[1] ? 1 : 2, j = on2[0] ? 0 : on2[1] ? 1 : 2;
+    const double *v = t1[i];
+    const double *a[2] = {t1[(i + 1) % 3], t1[(i + 2) % 3]}, *b[2] = {t2[(j + 1) % 3], t2[(j + 2) % 3]};
+    for (int side = 0; side < 2; side++) {
+        const double *const *own = side ? b : a, *const *other = side ? a : b;
+        for (int e = 0; e < 2; e++) {
+            /* the line through v and own[e]: own[1 - e] strictly on one side, both of other strictly on the
+             * other */
+            int so = ct_orient2d_axis(v, own[e], own[1 - e], k, st);
+            if (so == 0) continue;
+            if (ct_orient2d_axis(v, own[e], other[0], k, st) * so < 0
+                && ct_orient2d_axis(v, own[e], other[1], k, st) * so < 0) {
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* Fills F from corners p0, p1, p2 (the normal, its permanent, the projection axis, the zero-area flag). */
+static void
+ct_face_init(CtFace *F, const double *p0, const double *p1, const double *p2, CtStats *st)
+{
+    double e1[3], e2[3];
+    for (int c = 0; c < 3; c++) {
+        F->t[c] = p0[c];
+        F->t[3 + c] = p1[c];
+        F->t[6 + c] = p2[c];
+        e1[c] = p1[c] - p0[c];
+        e2[c] = p2[c] - p0[c];
+    }
+    F->n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    F->n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    F->n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    F->na[0] = fabs(e1[1]) * fabs(e2[2]) + fabs(e1[2]) * fabs(e2[1]);
+    F->na[1] = fabs(e1[2]) * fabs(e2[0]) + fabs(e1[0]) * fabs(e2[2]);
+    F->na[2] = fabs(e1[0]) * fabs(e2[1]) + fabs(e1[1]) * fabs(e2[0]);
+    /* the axis of the largest |normal component| (first of equals), then the next ones until the projected
+     * triangle has an exactly nonzero orientation (as mesh/intersect._face_axes) */
+    int k = 0;
+    for (int c = 1; c < 3; c++) {
+        if (fabs(F->n[c]) > fabs(F->n[k])) k = c;
+    }
+    F->skip = 1;
+    for (int tries = 0; tries < 3; tries++, k = (k + 1) % 3) {
+        double a[2] = {p0[ct_plane[k][0]], p0[ct_plane[k][1]]};
+        double b[2] = {p1[ct_plane[k][0]], p1[ct_plane[k][1]]};
+        double c[2] = {p2[ct_plane[k][0]], p2[ct_plane[k][1]]};
+        if (ct_orient2d(a, b, c, st) != 0) {
+            F->skip = 0;
+            break;
+        }
+    }
+    F->axis = k % 3;
+}
+
+/* Kind of the pair of faces A, B (A the lower face index). */
+static int
+ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
+{
+    const double *t1[3] = {A->t, A->t + 3, A->t + 6}, *t2[3] = {B->t, B->t + 3, B->t + 6};
     int on1[3] = {0, 0, 0}, on2[3] = {0, 0, 0}, n_shared = 0;
     for (int i = 0; i < 3; i++) {
         for (int j = 0; j < 3; j++) {
-            if (fa[i] == fb[j]) {
+            if (A->fo[i] == B->fo[j]) {
                 on1[i] = on2[j] = 1;
                 n_shared++;
             }
         }
     }
     int d1[3], d2[3];
-    int any1 = 0;
+    int any1 = 0, unsure = 0, separate_tried = 0;
     for (int i = 0; i < 3; i++) {
-        d1[i] = on1[i] ? 0 : ct_orient3d(t2[0], t2[1], t2[2], t1[i], st);
+        d1[i] = on1[i] ? 0 : ct_side_filter(B, t1[i]);
+        unsure |= d1[i] == 2;
+    }
+    /* a sign the filter cannot decide (e.g. adjacent faces in one plane): first try to show without it that
+     * the faces meet only in what they share */
+    if (unsure && n_shared < 3) {
+        separate_tried = 1;
+        if (ct_projections_separate(t1, t2, on1, on2, n_shared, A->axis, st)) {
+            return CT_NONE;
+        }
+    }
+    for (int i = 0; i < 3; i++) {
+        if (d1[i] == 2) d1[i] = ct_orient3d_exact(B->t, B->t + 3, B->t + 6, t1[i], st);
         any1 |= d1[i] != 0;
     }
+    /* sharing an edge: they meet beyond it only when coplanar (the third corner of A on B's plane) */
     if (n_shared >= 2 && any1) {
         return CT_NONE;
     }
-    for (int j = 0; j < 3; j++) {
-        d2[j] = on2[j] ? 0 : ct_orient3d(t1[0], t1[1], t1[2], t2[j], st);
+    /* A strictly on one side of B's plane */
+    if ((d1[0] > 0 && d1[1] > 0 && d1[2] > 0) || (d1[0] < 0 && d1[1] < 0 && d1[2] < 0)) {
+        return CT_NONE;
     }
-    if ((d1[0] > 0 && d1[1] > 0 && d1[2] > 0) || (d1[0] < 0 && d1[1] < 0 && d1[2] < 0)
-        || (d2[0] > 0 && d2[1] > 0 && d2[2] > 0) || (d2[0] < 0 && d2[1] < 0 && d2[2] < 0)) {
+    int touch1 = ct_touch_corner(d1);
+    /* sharing one corner, the two others strictly on one side of B's plane: A meets that plane only there */
+    if (n_shared == 1 && touch1 >= 0) {
+        return CT_NONE;
+    }
+    unsure = 0;
+    for (int j = 0; j < 3; j++) {
+        d2[j] = on2[j] ? 0 : ct_side_filter(A, t2[j]);
+        unsure |= d2[j] == 2;
+    }
+    if (unsure && n_shared < 3 && !separate_tried
+        && ct_projections_separate(t1, t2, on1, on2, n_shared, A->axis, st)) {
+        return CT_NONE;
+    }
+    for (int j = 0; j < 3; j++) {
+        if (d2[j] == 2) d2[j] = ct_orient3d_exact(A->t, A->t + 3, A->t + 6, t2[j], st);
+    }
+    if ((d2[0] > 0 && d2[1] > 0 && d2[2] > 0) || (d2[0] < 0 && d2[1] < 0 && d2[2] < 0)) {
         return CT_NONE;
     }
     if (!any1) {
-        return ct_coplanar(t1, t2, axis, on1, on2, n_shared, st);
+        return ct_coplanar(t1, t2, A->axis, on1, on2, n_shared, st);
     }
     if (n_shared >= 2) {
         return CT_NONE;
     }
-    int touch1 = ct_touch_corner(d1), touch2 = ct_touch_corner(d2);
+    int touch2 = ct_touch_corner(d2);
     if (touch1 >= 0 || touch2 >= 0) {
         if (n_shared > 0) {
             return CT_NONE;
@@ -2496,16 +2691,20 @@ ct_int64(const Py_buffer *view)
 
 /* ------------------------------------------------------------------------------------------------------
  * contact_scan -- the whole check in one pass: a bounding-volume hierarchy over the face boxes (faces in
- * Morton order of their box centres, index ranges halved down to leaves of at most CT_LEAF faces), traversed against
- * itself so that every unordered pair of faces whose closed boxes meet is visited exactly once (each pair
- * of leaves once), each such pair classified on the spot; only the pairs that meet are kept.
+ * Morton order of their box centres, sorted by an LSD radix sort; index ranges halved down to leaves of at
+ * most CT_LEAF faces), traversed against itself so that every unordered pair of faces whose closed boxes
+ * meet is visited exactly once (each pair of leaves once; a child pair is pushed only when its boxes meet),
+ * each such pair classified on the spot; only the pairs that meet are kept.
  * ------------------------------------------------------------------------------------------------------ */
 
-#define CT_LEAF 4
+#ifndef CT_LEAF
+#define CT_LEAF 8
+#endif
+#define CT_MORTON_BITS 16       /* per axis: a 48-bit code, sorted in four passes of 12 bits */
 
 typedef struct {
     double lo[3], hi[3];
-    int64_t start, count;       /* leaf: faces order[start .. start+count); inner: count = 0 */
+    int64_t start, count;       /* leaf: positions start .. start+count; inner: count = 0 */
     int64_t left, right;
 } CtNode;
 
@@ -2538,19 +2737,6 @@ ct_found_push(CtFound *fd, int64_t a, int64_t b, int kind)
     return 0;
 }
 
-typedef struct {
-    uint64_t code;
-    int64_t face;
-} CtKey;
-
-static int
-ct_key_cmp(const void *x, const void *y)
-{
-    const CtKey *p = (const CtKey *)x, *q = (const CtKey *)y;
-    if (p->code != q->code) return p->code < q->code ? -1 : 1;
-    return (p->face > q->face) - (p->face < q->face);
-}
-
 /* 21 bits of v spread to every third bit. */
 static inline uint64_t
 ct_spread(uint64_t v)
@@ -2564,38 +2750,55 @@ ct_spread(uint64_t v)
     return v;
 }
 
-/* Builds the hierarchy: faces sorted along the Morton (Z-order) curve of their box centres, the tree halving
- * index ranges (leaves of at most CT_LEAF faces), node boxes from the leaves up.  Fills order (hierarchy
- * position -> face); returns the node count, or -1 when out of memory. */
-static int64_t
-ct_build(CtNode *nodes, int64_t *order, const double *LO, const double *HI, int64_t m)
+/* order <- 0..m-1 sorted by code (stable LSD radix sort, four passes of 12 bits over the 48-bit codes);
+ * code and the scratch arrays are overwritten.  -1 when out of memory. */
+static int
+ct_radix_sort(uint64_t *code, int64_t *order, int64_t m)
 {
-    CtKey *keys = (CtKey *)malloc((size_t)m * sizeof(CtKey));
-    if (keys == NULL) return -1;
-    double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int64_t f = 0; f < m; f++) {
-        for (int c = 0; c < 3; c++) {
-            double mid = 0.5 * (LO[3 * f + c] + HI[3 * f + c]);
-            if (mid < gmin[c]) gmin[c] = mid;
-            if (mid > gmax[c]) gmax[c] = mid;
-        }
+    size_t mm = m > 0 ? (size_t)m : 1;
+    uint64_t *code2 = (uint64_t *)malloc(mm * sizeof(uint64_t));
+    int64_t *order2 = (int64_t *)malloc(mm * sizeof(int64_t));
+    size_t (*count)[4096] = (size_t (*)[4096])calloc(4, sizeof(*count));
+    if (code2 == NULL || order2 == NULL || count == NULL) {
+        free(code2);
+        free(order2);
+        free(count);
+        return -1;
     }
-    for (int64_t f = 0; f < m; f++) {
-        uint64_t code = 0;
-        for (int c = 0; c < 3; c++) {
-            double span = gmax[c] - gmin[c];
-            double t = span > 0 ? (0.5 * (LO[3 * f + c] + HI[3 * f + c]) - gmin[c]) / span : 0.0;
-            uint64_t q = (uint64_t)(t * 2097151.0);
-            if (q > 2097151) q = 2097151;
-            code |= ct_spread(q) << c;
-        }
-        keys[f].code = code;
-        keys[f].face = f;
+    for (int64_t i = 0; i < m; i++) {
+        order[i] = i;
+        for (int p = 0; p < 4; p++) count[p][(code[i] >> (12 * p)) & 4095]++;
     }
-    qsort(keys, (size_t)m, sizeof(CtKey), ct_key_cmp);
-    for (int64_t i = 0; i < m; i++) order[i] = keys[i].face;
-    free(keys);
-    /* topology: a parent always precedes its children */
+    uint64_t *src_c = code, *dst_c = code2;
+    int64_t *src_o = order, *dst_o = order2;
+    for (int p = 0; p < 4; p++) {
+        size_t sum = 0;
+        for (int k = 0; k < 4096; k++) {
+            size_t c = count[p][k];
+            count[p][k] = sum;
+            sum += c;
+        }
+        for (int64_t i = 0; i < m; i++) {
+            size_t at = count[p][(src_c[i] >> (12 * p)) & 4095]++;
+            dst_c[at] = src_c[i];
+            dst_o[at] = src_o[i];
+        }
+        uint64_t *tc = src_c; src_c = dst_c; dst_c = tc;
+        int64_t *to = src_o; src_o = dst_o; dst_o = to;
+    }
+    /* four passes: the result is back in code / order */
+    free(code2);
+    free(order2);
+    free(count);
+    return 0;
+}
+
+/* Builds the hierarchy over the boxes BOX (lo, hi: 6 doubles per position, already in hierarchy order):
+ * the tree halving index ranges (leaves of at most CT_LEAF faces), node boxes from the leaves up.  Returns
+ * the node count. */
+static int64_t
+ct_build(CtNode *nodes, const double *BOX, int64_t m)
+{
     int64_t n_nodes = 1;
     nodes[0].start = 0;
     nodes[0].count = m;
@@ -2614,19 +2817,18 @@ ct_build(CtNode *nodes, int64_t *order, const double *LO, const double *HI, int6
         nd->right = r;
         nd->count = 0;
     }
-    /* boxes, children before parents */
+    /* boxes, children before parents (a parent always precedes its children) */
     for (int64_t k = n_nodes - 1; k >= 0; k--) {
         CtNode *nd = &nodes[k];
-        for (int c = 0; c < 3; c++) {
-            nd->lo[c] = INFINITY;
-            nd->hi[c] = -INFINITY;
-        }
         if (nd->count > 0) {
+            for (int c = 0; c < 3; c++) {
+                nd->lo[c] = INFINITY;
+                nd->hi[c] = -INFINITY;
+            }
             for (int64_t i = nd->start; i < nd->start + nd->count; i++) {
-                int64_t f = order[i];
                 for (int c = 0; c < 3; c++) {
-                    if (LO[3 * f + c] < nd->lo[c]) nd->lo[c] = LO[3 * f + c];
-                    if (HI[3 * f + c] > nd->hi[c]) nd->hi[c] = HI[3 * f + c];
+                    if (BOX[6 * i + c] < nd->lo[c]) nd->lo[c] = BOX[6 * i + c];
+                    if (BOX[6 * i + 3 + c] > nd->hi[c]) nd->hi[c] = BOX[6 * i + 3 + c];
                 }
             }
         }
@@ -2642,13 +2844,9 @@ ct_build(CtNode *nodes, int64_t *order, const double *LO, const double *HI, int6
 }
 
 typedef struct {
-    const double *LO, *HI;      /* boxes, in hierarchy order */
-    const double *T;            /* corner coordinates (9 per face), in hierarchy order */
-    const int64_t *FO;          /* corner indices (3 per face), in hierarchy order */
-    const int64_t *X;
-    const uint8_t *S;
+    const double *BOX;          /* face boxes (lo, hi), in hierarchy order */
+    const CtFace *FACE;         /* faces, in hierarchy order */
     const CtNode *nodes;
-    const int64_t *order;       /* hierarchy position -> face */
     long long max_pairs;        /* < 0: no bound */
     long long candidates, tested;
     long exact;
@@ -2657,12 +2855,10 @@ typedef struct {
 } CtScan;
 
 static inline int
-ct_boxes_meet(const double *LO, const double *HI, int64_t a, int64_t b)
+ct_boxes_meet(const double *p, const double *q)
 {
-    for (int c = 0; c < 3; c++) {
-        if (!(LO[3 * a + c] <= HI[3 * b + c]) || !(LO[3 * b + c] <= HI[3 * a + c])) return 0;
-    }
-    return 1;
+    /* bitwise: no branch per comparison (their outcomes are hard to predict) */
+    return (p[0] <= q[3]) & (q[0] <= p[3]) & (p[1] <= q[4]) & (q[1] <= p[4]) & (p[2] <= q[5]) & (q[2] <= p[5]);
 }
 
 /* One candidate pair (hierarchy positions i, j); returns 0 to go on, 1 to stop (bound reached or out of
@@ -2670,28 +2866,25 @@ ct_boxes_meet(const double *LO, const double *HI, int64_t a, int64_t b)
 static int
 ct_visit(CtScan *sc, int64_t i, int64_t j)
 {
-    if (!ct_boxes_meet(sc->LO, sc->HI, i, j)) return 0;
+    if (!ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)) return 0;
     if (sc->max_pairs >= 0 && sc->candidates >= sc->max_pairs) {
         sc->complete = 0;
         return 1;
     }
     sc->candidates++;
-    int64_t a = sc->order[i], b = sc->order[j];
-    if (sc->S[a] || sc->S[b]) return 0;
+    const CtFace *A = &sc->FACE[i], *B = &sc->FACE[j];
+    if (A->skip || B->skip) return 0;
     sc->tested++;
-    if (a > b) {
-        int64_t t = a;
-        a = b;
-        b = t;
-        t = i;
-        i = j;
-        j = t;
+    if (A->face > B->face) {
+        const CtFace *T = A;
+        A = B;
+        B = T;
     }
     CtStats st = {0, 0};
-    int kind = ct_classify(sc->T + 9 * i, sc->T + 9 * j, sc->FO + 3 * i, sc->FO + 3 * j, (int)sc->X[a], &st);
+    int kind = ct_classify(A, B, &st);
     sc->exact += st.exact;
     if (st.failed) kind = -1;
-    if (kind != CT_NONE && ct_found_push(&sc->found, a, b, kind) < 0) {
+    if (kind != CT_NONE && ct_found_push(&sc->found, A->face, B->face, kind) < 0) {
         sc->oom = 1;
         return 1;
     }
@@ -2701,13 +2894,12 @@ ct_visit(CtScan *sc, int64_t i, int64_t j)
 static inline int
 ct_nodes_meet(const CtNode *p, const CtNode *q)
 {
-    for (int c = 0; c < 3; c++) {
-        if (!(p->lo[c] <= q->hi[c]) || !(q->lo[c] <= p->hi[c])) return 0;
-    }
-    return 1;
+    return (p->lo[0] <= q->hi[0]) & (q->lo[0] <= p->hi[0]) & (p->lo[1] <= q->hi[1]) & (q->lo[1] <= p->hi[1])
+           & (p->lo[2] <= q->hi[2]) & (q->lo[2] <= p->hi[2]);
 }
 
-/* Every candidate pair below the node pair (p0, q0): p0 == q0 for the pairs within one subtree. */
+/* Every candidate pair below the node pair (p0, q0): p0 == q0 for the pairs within one subtree; for
+ * p0 != q0 the caller has checked that their boxes meet. */
 static void
 ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
 {
@@ -2717,13 +2909,14 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         sc->oom = 1;
         return;
     }
+    const CtNode *nodes = sc->nodes;
     stack[0] = p0;
     stack[1] = q0;
     top = 1;
     while (top > 0) {
         top--;
-        const CtNode *p = &sc->nodes[stack[2 * top]], *q = &sc->nodes[stack[2 * top + 1]];
         int64_t pi = stack[2 * top], qi = stack[2 * top + 1];
+        const CtNode *p = &nodes[pi], *q = &nodes[qi];
         if (top + 3 > cap) {
             int64_t *ns = (int64_t *)realloc(stack, 4 * cap * sizeof(int64_t));
             if (ns == NULL) {
@@ -2742,35 +2935,46 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 }
             }
             else {
-                int64_t pushes[3][2] = {{p->left, p->left}, {p->right, p->right}, {p->left, p->right}};
-                for (int k = 0; k < 3; k++) {
-                    stack[2 * top] = pushes[k][0];
-                    stack[2 * top + 1] = pushes[k][1];
-                    top++;
+                stack[2 * top] = p->left; stack[2 * top + 1] = p->left; top++;
+                stack[2 * top] = p->right; stack[2 * top + 1] = p->right; top++;
+                if (ct_nodes_meet(&nodes[p->left], &nodes[p->right])) {
+                    stack[2 * top] = p->left; stack[2 * top + 1] = p->right; top++;
                 }
             }
             continue;
         }
-        if (!ct_nodes_meet(p, q)) continue;
         if (p->count > 0 && q->count > 0) {
             for (int64_t i = p->start; i < p->start + p->count; i++) {
+                const double *bi = sc->BOX + 6 * i;     /* face i against q's box first */
+                if (!((bi[0] <= q->hi[0]) & (q->lo[0] <= bi[3]) & (bi[1] <= q->hi[1]) & (q->lo[1] <= bi[4])
+                      & (bi[2] <= q->hi[2]) & (q->lo[2] <= bi[5]))) {
+                    continue;
+                }
                 for (int64_t j = q->start; j < q->start + q->count; j++) {
                     if (ct_visit(sc, i, j)) goto out;
                 }
             }
             continue;
         }
-        /* descend the inner node (the larger one when both are inner) */
+        /* descend the inner node (the larger one when both are inner); push only children that meet */
         int split_p = q->count > 0 || (p->count == 0 && (p->hi[0] - p->lo[0]) + (p->hi[1] - p->lo[1])
                                         + (p->hi[2] - p->lo[2]) >= (q->hi[0] - q->lo[0])
                                         + (q->hi[1] - q->lo[1]) + (q->hi[2] - q->lo[2]));
         if (split_p) {
-            stack[2 * top] = p->left;  stack[2 * top + 1] = qi; top++;
-            stack[2 * top] = p->right; stack[2 * top + 1] = qi; top++;
+            if (ct_nodes_meet(&nodes[p->right], q)) {
+                stack[2 * top] = p->right; stack[2 * top + 1] = qi; top++;
+            }
+            if (ct_nodes_meet(&nodes[p->left], q)) {
+                stack[2 * top] = p->left; stack[2 * top + 1] = qi; top++;
+            }
         }
         else {
-            stack[2 * top] = pi; stack[2 * top + 1] = q->left;  top++;
-            stack[2 * top] = pi; stack[2 * top + 1] = q->right; top++;
+            if (ct_nodes_meet(p, &nodes[q->right])) {
+                stack[2 * top] = pi; stack[2 * top + 1] = q->right; top++;
+            }
+            if (ct_nodes_meet(p, &nodes[q->left])) {
+                stack[2 * top] = pi; stack[2 * top + 1] = q->left; top++;
+            }
         }
     }
 out:
@@ -2794,6 +2998,7 @@ ct_parallel_task(void *ctx, int t, int nt)
 {
     CtParallel *pp = (CtParallel *)ctx;
     CtScan *sc = &pp->scans[t];
+    (void)nt;
     for (;;) {
         int32_t k = next_ticket(&pp->next);
         if (k >= pp->n_tasks || sc->oom) break;
@@ -2801,8 +3006,8 @@ ct_parallel_task(void *ctx, int t, int nt)
     }
 }
 
-/* Node pairs covering every candidate pair, split near the root into up to about CT_TASKS; -1 when out of
- * memory, else their count. */
+/* Node pairs covering every candidate pair (the distinct ones with meeting boxes), split near the root into
+ * up to about CT_TASKS; their count. */
 static int32_t
 ct_tasks(const CtNode *nodes, int64_t *tasks)
 {
@@ -2817,17 +3022,19 @@ ct_tasks(const CtNode *nodes, int64_t *tasks)
             if (pi == qi && p->count == 0) {
                 int64_t add[3][2] = {{p->left, p->left}, {p->right, p->right}, {p->left, p->right}};
                 for (int j = 0; j < 3; j++) {
+                    if (j == 2 && !ct_nodes_meet(&nodes[p->left], &nodes[p->right])) continue;
                     next[2 * m] = add[j][0];
                     next[2 * m + 1] = add[j][1];
                     m++;
                 }
             }
-            else if (pi != qi && !ct_nodes_meet(p, q)) {
-                continue;
-            }
             else if (pi != qi && p->count == 0) {
-                next[2 * m] = p->left; next[2 * m + 1] = qi; m++;
-                next[2 * m] = p->right; next[2 * m + 1] = qi; m++;
+                if (ct_nodes_meet(&nodes[p->left], q)) {
+                    next[2 * m] = p->left; next[2 * m + 1] = qi; m++;
+                }
+                if (ct_nodes_meet(&nodes[p->right], q)) {
+                    next[2 * m] = p->right; next[2 * m + 1] = qi; m++;
+                }
             }
             else {
                 next[2 * m] = pi; next[2 * m + 1] = qi; m++;
@@ -2839,160 +3046,257 @@ ct_tasks(const CtNode *nodes, int64_t *tasks)
     return n;
 }
 
+static inline double
+ct_min3(double a, double b, double c)
+{
+    double m = a < b ? a : b;
+    return m < c ? m : c;
+}
+
+static inline double
+ct_max3(double a, double b, double c)
+{
+    double m = a > b ? a : b;
+    return m > c ? m : c;
+}
+
+/* Per-face preparation, split over threads by position: Morton codes (pass 0), then the faces and boxes in
+ * hierarchy order (pass 1). */
+typedef struct {
+    int pass;
+    int64_t m;
+    const double *V;
+    const int64_t *F;
+    const int64_t *order;
+    uint64_t *code;
+    double gmin[3], scale[3];
+    CtFace *face;
+    double *box;
+    long exact[MAX_THREADS];
+    int failed[MAX_THREADS];
+} CtPrep;
+
+static void
+ct_prep_task(void *ctx, int t, int nt)
+{
+    CtPrep *pr = (CtPrep *)ctx;
+    int64_t s = (int64_t)part_start((size_t)pr->m, t, nt), e = (int64_t)part_start((size_t)pr->m, t + 1, nt);
+    if (pr->pass == 0) {
+        for (int64_t f = s; f < e; f++) {
+            const double *p0 = pr->V + 3 * pr->F[3 * f], *p1 = pr->V + 3 * pr->F[3 * f + 1];
+            const double *p2 = pr->V + 3 * pr->F[3 * f + 2];
+            uint64_t code = 0;
+            for (int c = 0; c < 3; c++) {
+                double lo = ct_min3(p0[c], p1[c], p2[c]), hi = ct_max3(p0[c], p1[c], p2[c]);
+                double q = (0.5 * (lo + hi) - pr->gmin[c]) * pr->scale[c];
+                uint64_t k = q > 0 ? (uint64_t)q : 0;
+                if (k > (1u << CT_MORTON_BITS) - 1) k = (1u << CT_MORTON_BITS) - 1;
+                code |= ct_spread(k) << c;
+            }
+            pr->code[f] = code;
+        }
+        return;
+    }
+    CtStats st = {0, 0};
+    for (int64_t i = s; i < e; i++) {
+        int64_t f = pr->order[i];
+        CtFace *F = &pr->face[i];
+        const int64_t *fi = pr->F + 3 * f;
+        ct_face_init(F, pr->V + 3 * fi[0], pr->V + 3 * fi[1], pr->V + 3 * fi[2], &st);
+        F->fo[0] = fi[0];
+        F->fo[1] = fi[1];
+        F->fo[2] = fi[2];
+        F->face = f;
+        for (int c = 0; c < 3; c++) {
+            pr->box[6 * i + c] = ct_min3(F->t[c], F->t[3 + c], F->t[6 + c]);
+            pr->box[6 * i + 3 + c] = ct_max3(F->t[c], F->t[3 + c], F->t[6 + c]);
+        }
+    }
+    pr->exact[t] += st.exact;
+    pr->failed[t] |= st.failed;
+}
+
+/* contact_scan(vertices, faces, max_pairs[, threads]) -> (a, b, kind, candidates, tested, exact, complete,
+ * axis, degenerate): found pairs as int64 / int8 bytes, per-face projection axis (int8 bytes) and zero-area
+ * flags (uint8 bytes) in the caller's face order. */
 static PyObject *
 accel_contact_scan(PyObject *self, PyObject *args)
 {
-    PyObject *objs[6];
+    PyObject *objs[2];
     long long max_pairs;
     int threads = 1;
-    if (!PyArg_ParseTuple(args, "OOOOOOL|i", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5],
-                          &max_pairs, &threads)) {
+    if (!PyArg_ParseTuple(args, "OOL|i", &objs[0], &objs[1], &max_pairs, &threads)) {
         return NULL;
     }
-    Py_buffer views[6];
+    Py_buffer views[2];
     int got = 0;
     PyObject *result = NULL;
     CtNode *nodes = NULL;
-    int64_t *order = NULL, *fo = NULL;
-    double *tri = NULL, *blo = NULL, *bhi = NULL;
+    int64_t *order = NULL;
+    uint64_t *code = NULL;
+    CtFace *face = NULL;
+    double *box = NULL;
+    int8_t *axis_out = NULL;
+    uint8_t *skip_out = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
-    for (; got < 6; got++) {
+    for (; got < 2; got++) {
         if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
             goto done;
         }
     }
     {
-        Py_buffer *vv = &views[0], *fv = &views[1], *xv = &views[2], *sv = &views[3], *lv = &views[4];
-        Py_buffer *hv = &views[5];
-        char sc_code = native_code(sv->format);
-        Py_ssize_t m = fv->ndim == 2 ? fv->shape[0] : -1;
+        Py_buffer *vv = &views[0], *fv = &views[1];
         if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3
-            || !ct_int64(fv) || fv->ndim != 2 || fv->shape[1] != 3
-            || !ct_int64(xv) || xv->ndim != 1 || xv->shape[0] != m
-            || (sc_code != 'B' && sc_code != '?') || sv->itemsize != 1 || sv->ndim != 1 || sv->shape[0] != m
-            || native_code(lv->format) != 'd' || lv->itemsize != 8 || lv->ndim != 2 || lv->shape[0] != m
-            || lv->shape[1] != 3
-            || native_code(hv->format) != 'd' || hv->itemsize != 8 || hv->ndim != 2 || hv->shape[0] != m
-            || hv->shape[1] != 3) {
-            PyErr_SetString(PyExc_ValueError, "Expected vertices (n, 3) float64, faces (m, 3) int64, axis (m,) "
-                            "int64, skip (m,) uint8, lo and hi (m, 3) float64, all C-contiguous");
+            || !ct_int64(fv) || fv->ndim != 2 || fv->shape[1] != 3) {
+            PyErr_SetString(PyExc_ValueError, "Expected vertices (n, 3) float64 and faces (m, 3) int64, both "
+                            "C-contiguous");
             goto done;
         }
-        int64_t n = vv->shape[0];
-        const int64_t *F = (const int64_t *)fv->buf, *X = (const int64_t *)xv->buf;
-        for (Py_ssize_t i = 0; i < m * 3; i++) {
+        int64_t n = vv->shape[0], m = fv->shape[0];
+        const int64_t *F = (const int64_t *)fv->buf;
+        const double *V = (const double *)vv->buf;
+        for (int64_t i = 0; i < m * 3; i++) {
             if (F[i] < 0 || F[i] >= n) {
                 PyErr_Format(PyExc_ValueError, "Expected face indices in [0, %lld), found %lld",
                              (long long)n, (long long)F[i]);
                 goto done;
             }
         }
-        for (Py_ssize_t i = 0; i < m; i++) {
-            if (X[i] < 0 || X[i] > 2) {
-                PyErr_SetString(PyExc_ValueError, "Expected axis values in 0..2");
-                goto done;
-            }
-        }
         sc.complete = 1;
         sc.max_pairs = max_pairs;
-        if (m >= 2) {
-            if ((size_t)m > SIZE_MAX / (2 * sizeof(CtNode))) {
-                PyErr_NoMemory();
-                goto done;
+        if ((size_t)m > SIZE_MAX / (2 * sizeof(CtFace))) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        size_t mm = m > 0 ? (size_t)m : 1;
+        /* leaves hold at least (CT_LEAF + 1) / 2 faces (but the root may be a smaller leaf) */
+        nodes = (CtNode *)malloc((2 * mm / ((CT_LEAF + 1) / 2) + 2) * sizeof(CtNode));
+        order = (int64_t *)malloc(mm * sizeof(int64_t));
+        code = (uint64_t *)malloc(mm * sizeof(uint64_t));
+        face = (CtFace *)malloc(mm * sizeof(CtFace));
+        box = (double *)malloc(mm * 6 * sizeof(double));
+        axis_out = (int8_t *)malloc(mm);
+        skip_out = (uint8_t *)malloc(mm);
+        if (nodes == NULL || order == NULL || code == NULL || face == NULL || box == NULL || axis_out == NULL
+            || skip_out == NULL) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        int oom = 0, failed = 0;
+        Py_BEGIN_ALLOW_THREADS
+        int nt = thread_count(threads, (size_t)m, 20000);
+        CtPrep pr;
+        memset(&pr, 0, sizeof(pr));
+        pr.m = m;
+        pr.V = V;
+        pr.F = F;
+        pr.code = code;
+        pr.order = order;
+        pr.face = face;
+        pr.box = box;
+        /* the Morton grid: box centres of the faces, 2^16 cells per axis over their range */
+        double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int64_t i = 0; i < n; i++) {       /* every vertex: a bound of the box centres */
+            const double *p = V + 3 * i;
+            for (int c = 0; c < 3; c++) {
+                if (p[c] < gmin[c]) gmin[c] = p[c];
+                if (p[c] > gmax[c]) gmax[c] = p[c];
             }
-            nodes = (CtNode *)malloc((size_t)(2 * m) * sizeof(CtNode));
-            order = (int64_t *)malloc((size_t)m * sizeof(int64_t));
-            fo = (int64_t *)malloc((size_t)m * 3 * sizeof(int64_t));
-            tri = (double *)malloc((size_t)m * 9 * sizeof(double));
-            blo = (double *)malloc((size_t)m * 3 * sizeof(double));
-            bhi = (double *)malloc((size_t)m * 3 * sizeof(double));
-            if (nodes == NULL || order == NULL || fo == NULL || tri == NULL || blo == NULL
-                || bhi == NULL) {
-                PyErr_NoMemory();
-                goto done;
+        }
+        for (int c = 0; c < 3; c++) {
+            double span = gmax[c] - gmin[c];
+            pr.gmin[c] = gmin[c];
+            pr.scale[c] = span > 0 ? (double)((1u << CT_MORTON_BITS) - 1) / span : 0.0;
+        }
+        pr.pass = 0;
+        run_parallel(nt, ct_prep_task, &pr);
+        if (ct_radix_sort(code, order, m) < 0) {
+            oom = 1;
+        }
+        else {
+            pr.pass = 1;
+            run_parallel(nt, ct_prep_task, &pr);
+            for (int t = 0; t < MAX_THREADS; t++) {
+                sc.exact += pr.exact[t];
+                failed |= pr.failed[t];
             }
-            for (int64_t i = 0; i < m; i++) order[i] = i;
-            const double *V = (const double *)vv->buf, *LO = (const double *)lv->buf;
-            const double *HI = (const double *)hv->buf;
-            sc.X = X;
-            sc.S = (const uint8_t *)sv->buf;
-            sc.order = order;
+            for (int64_t i = 0; i < m; i++) {
+                axis_out[face[i].face] = (int8_t)face[i].axis;
+                skip_out[face[i].face] = (uint8_t)face[i].skip;
+            }
+        }
+        if (!oom && !failed && m >= 2) {
+            ct_build(nodes, box, m);
+            sc.BOX = box;
+            sc.FACE = face;
             sc.nodes = nodes;
-            sc.LO = blo;
-            sc.HI = bhi;
-            sc.T = tri;
-            sc.FO = fo;
-            int64_t built;
-            Py_BEGIN_ALLOW_THREADS
-            built = ct_build(nodes, order, LO, HI, m);
-            if (built > 0) {
-                /* the data the traversal reads, in hierarchy order: neighbours in space are near in memory */
-                for (int64_t i = 0; i < m; i++) {
-                    int64_t face = order[i];
-                    for (int c = 0; c < 3; c++) {
-                        blo[3 * i + c] = LO[3 * face + c];
-                        bhi[3 * i + c] = HI[3 * face + c];
-                        fo[3 * i + c] = F[3 * face + c];
-                        for (int k = 0; k < 3; k++) {
-                            tri[9 * i + 3 * c + k] = V[3 * F[3 * face + c] + k];
-                        }
-                    }
+            if (max_pairs >= 0) nt = 1;
+            if (nt == 1) {
+                ct_traverse(&sc, 0, 0);
+            }
+            else {
+                CtScan scans[MAX_THREADS];
+                int64_t tasks[2 * CT_TASKS];
+                CtParallel pp;
+                for (int t = 0; t < nt; t++) {
+                    scans[t] = sc;
+                    scans[t].exact = 0;
                 }
-                int nt = max_pairs >= 0 ? 1 : thread_count(threads, (size_t)m, 20000);
-                if (nt == 1) {
-                    ct_traverse(&sc, 0, 0);
-                }
-                else {
-                    CtScan scans[MAX_THREADS];
-                    int64_t tasks[2 * CT_TASKS];
-                    CtParallel pp;
-                    for (int t = 0; t < nt; t++) {
-                        scans[t] = sc;
-                    }
-                    pp.scans = scans;
-                    pp.tasks = tasks;
-                    pp.n_tasks = ct_tasks(nodes, tasks);
-                    pp.next = 0;
-                    run_parallel(nt, ct_parallel_task, &pp);
-                    for (int t = 0; t < nt; t++) {          /* merge into sc */
-                        CtScan *u = &scans[t];
-                        if (t > 0) {
-                            sc.candidates += u->candidates;
-                            sc.tested += u->tested;
-                            sc.exact += u->exact;
-                            sc.oom |= u->oom;
-                            for (size_t i = 0; i < u->found.n && !sc.oom; i++) {
-                                if (ct_found_push(&sc.found, u->found.a[i], u->found.b[i], u->found.kind[i]) < 0) {
-                                    sc.oom = 1;
-                                }
+                pp.scans = scans;
+                pp.tasks = tasks;
+                pp.n_tasks = ct_tasks(nodes, tasks);
+                pp.next = 0;
+                run_parallel(nt, ct_parallel_task, &pp);
+                long exact0 = sc.exact;
+                for (int t = 0; t < nt; t++) {          /* merge into sc */
+                    CtScan *u = &scans[t];
+                    if (t > 0) {
+                        sc.candidates += u->candidates;
+                        sc.tested += u->tested;
+                        sc.exact += u->exact;
+                        sc.oom |= u->oom;
+                        for (size_t i = 0; i < u->found.n && !sc.oom; i++) {
+                            if (ct_found_push(&sc.found, u->found.a[i], u->found.b[i], u->found.kind[i]) < 0) {
+                                sc.oom = 1;
                             }
-                            free(u->found.a);
-                            free(u->found.b);
-                            free(u->found.kind);
                         }
-                        else {
-                            sc = scans[0];
-                        }
+                        free(u->found.a);
+                        free(u->found.b);
+                        free(u->found.kind);
+                    }
+                    else {
+                        sc = scans[0];
+                        sc.exact += exact0;
                     }
                 }
             }
-            Py_END_ALLOW_THREADS
-            if (built < 0 || sc.oom) {
-                PyErr_NoMemory();
-                goto done;
-            }
+        }
+        oom |= sc.oom;
+        Py_END_ALLOW_THREADS
+        if (oom) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        if (failed) {
+            PyErr_SetString(PyExc_OverflowError, "contact_scan: an exact orientation of a face outgrew its "
+                            "expansion");
+            goto done;
         }
         PyObject *pa = PyBytes_FromStringAndSize((const char *)sc.found.a, (Py_ssize_t)(sc.found.n * 8));
         PyObject *pb = PyBytes_FromStringAndSize((const char *)sc.found.b, (Py_ssize_t)(sc.found.n * 8));
         PyObject *pk = PyBytes_FromStringAndSize((const char *)sc.found.kind, (Py_ssize_t)sc.found.n);
-        if (pa && pb && pk) {
-            result = Py_BuildValue("(OOOLLlO)", pa, pb, pk, sc.candidates, sc.tested, sc.exact,
-                                   sc.complete ? Py_True : Py_False);
+        PyObject *px = PyBytes_FromStringAndSize((const char *)axis_out, (Py_ssize_t)m);
+        PyObject *ps = PyBytes_FromStringAndSize((const char *)skip_out, (Py_ssize_t)m);
+        if (pa && pb && pk && px && ps) {
+            result = Py_BuildValue("(OOOLLlOOO)", pa, pb, pk, sc.candidates, sc.tested, sc.exact,
+                                   sc.complete ? Py_True : Py_False, px, ps);
         }
         Py_XDECREF(pa);
         Py_XDECREF(pb);
         Py_XDECREF(pk);
+        Py_XDECREF(px);
+        Py_XDECREF(ps);
     }
 done:
     for (int i = 0; i < got; i++) {
@@ -3000,10 +3304,11 @@ done:
     }
     free(nodes);
     free(order);
-    free(fo);
-    free(tri);
-    free(blo);
-    free(bhi);
+    free(code);
+    free(face);
+    free(box);
+    free(axis_out);
+    free(skip_out);
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);

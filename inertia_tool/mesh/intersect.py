@@ -56,13 +56,17 @@ tested in chunks of at most ``chunk`` pairs, so memory stays bounded on any mesh
 C extension
 -----------
 When ``inertia_tool._accel`` is built (and the coordinates are in the filter's range) the whole scan runs in
-its section 8 (``contact_scan``): a bounding-volume hierarchy over the face boxes (faces in Morton order of
-their box centres) traversed against itself gives the same candidate pairs as the grid, in another order, and
-each is classified on the spot with the same predicates and decisions, the exact stage computed by
-floating-point expansions instead of Python integers, on :func:`~inertia_tool._native.threads` threads (the
-pairs found do not depend on the count; with ``max_pairs`` it runs on one, and which pairs are tested before
-the bound stops it differs from the grid's order).  This module's numpy code stays the reference and
-the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
+its section 8 (``contact_scan``): the per-face axes and boxes, then a bounding-volume hierarchy over the face
+boxes (faces in Morton order of their box centres, radix-sorted) traversed against itself gives the same
+candidate pairs as the grid, in another order, and each is classified on the spot with the same predicates
+and decisions, the exact stage computed by floating-point expansions instead of Python integers, on
+:func:`~inertia_tool._native.threads` threads (the pairs found do not depend on the count; with ``max_pairs``
+it runs on one, and which pairs are tested before the bound stops it differs from the grid's order).  Each
+face keeps its float normal and its permanent, so a side test against its plane is three products with the
+very float value and error bound of ``orient3d``; pairs the filter cannot decide are first tried for a line
+separating their projections through what they share (:func:`_projections_separate`, also used here) before
+any exact evaluation.  This module's numpy code stays the reference and the fallback
+(``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
 """
 
 from __future__ import annotations
@@ -185,6 +189,15 @@ class _Predicates:
             return self._orient2d(a, b, c)
 
     def _orient3d(self, a, b, c, d) -> np.ndarray:
+        sign, unsure = self._orient3d_filter(a, b, c, d)
+        return self._orient3d_resolve(sign, unsure, a, b, c, d)
+
+    def orient3d_filter(self, a, b, c, d) -> tuple[np.ndarray, np.ndarray]:
+        """Float signs of orient3d per row and the rows the static filter cannot decide (left 0)."""
+        with np.errstate(all="ignore"):
+            return self._orient3d_filter(a, b, c, d)
+
+    def _orient3d_filter(self, a, b, c, d) -> tuple[np.ndarray, np.ndarray]:
         ad, bd, cd = a - d, b - d, c - d
         m0 = bd[:, 1] * cd[:, 2] - bd[:, 2] * cd[:, 1]
         m1 = bd[:, 2] * cd[:, 0] - bd[:, 0] * cd[:, 2]
@@ -197,8 +210,25 @@ class _Predicates:
         sign = np.sign(det).astype(np.int8)
         unsure = np.flatnonzero((np.abs(det) <= O3D_BOUND * perm) & (perm > 0)) if not self.force_exact \
             else np.arange(len(det))
+        sign[unsure] = 0
+        return sign, unsure
+
+    def orient3d_resolve(self, sign, unsure, a, b, c, d) -> np.ndarray:
+        """``sign`` with the rows ``unsure`` recomputed exactly."""
+        return self._orient3d_resolve(sign, unsure, a, b, c, d)
+
+    def _orient3d_resolve(self, sign, unsure, a, b, c, d) -> np.ndarray:
         if len(unsure):
-            sign[unsure] = _exact_orient3d(a[unsure], b[unsure], c[unsure], d[unsure])
+            pa, pb, pc, pd = a[unsure], b[unsure], c[unsure], d[unsure]
+            # two equal points: two equal rows (or a zero row), the determinant is zero
+            equal = np.zeros(len(unsure), dtype=bool)
+            for p, q in ((pa, pb), (pa, pc), (pa, pd), (pb, pc), (pb, pd), (pc, pd)):
+                equal |= np.all(p == q, axis=1)
+            sign[unsure[equal]] = 0
+            keep = ~equal
+            unsure = unsure[keep]
+            if len(unsure):
+                sign[unsure] = _exact_orient3d(pa[keep], pb[keep], pc[keep], pd[keep])
         self.exact += len(unsure)
         return sign
 
@@ -293,17 +323,38 @@ def _classify(v: np.ndarray, f: np.ndarray, axis: np.ndarray, a: np.ndarray, b: 
     d2 = np.zeros((k, 3), dtype=np.int8)
     on1 = same.any(axis=2)                                 # a shared corner lies on the other plane: sign 0
     on2 = same.any(axis=1)
+    # signs the float filter cannot decide (e.g. adjacent faces in one plane): first try to show without them
+    # that the faces meet only in what they share (_projections_separate), as the C scan does
+    done = np.zeros(k, dtype=bool)                         # shown to meet only in what they share
+    tried = n_shared > 2
+    unsure1: list[np.ndarray] = []
     for i in range(3):
         r = np.flatnonzero(~on1[:, i])
-        d1[r, i] = pred.orient3d(t2[r, 0], t2[r, 1], t2[r, 2], t1[r, i])
+        d1[r, i], u = pred.orient3d_filter(t2[r, 0], t2[r, 1], t2[r, 2], t1[r, i])
+        unsure1.append(r[u])
+    try_rows = np.setdiff1d(np.unique(np.concatenate(unsure1)), np.flatnonzero(tried))
+    done[try_rows] = _projections_separate(t1[try_rows], t2[try_rows], same[try_rows], n_shared[try_rows],
+                                           axis[a[try_rows]], pred)
+    tried[try_rows] = True
+    for i in range(3):
+        r = unsure1[i][~done[unsure1[i]]]
+        d1[r, i] = pred.orient3d_resolve(d1[r, i], np.arange(len(r)), t2[r, 0], t2[r, 1], t2[r, 2], t1[r, i])
     # a pair sharing an edge is coplanar iff the third corner of a lies in b's plane; otherwise nothing
-    need2 = (n_shared < 2) | ~(d1 != 0).any(axis=1)
+    need2 = ((n_shared < 2) | ~(d1 != 0).any(axis=1)) & ~done
+    unsure2: list[np.ndarray] = []
     for i in range(3):
         r = np.flatnonzero(~on2[:, i] & need2)
-        d2[r, i] = pred.orient3d(t1[r, 0], t1[r, 1], t1[r, 2], t2[r, i])
+        d2[r, i], u = pred.orient3d_filter(t1[r, 0], t1[r, 1], t1[r, 2], t2[r, i])
+        unsure2.append(r[u])
+    try_rows = np.setdiff1d(np.unique(np.concatenate(unsure2)), np.flatnonzero(tried))
+    done[try_rows] = _projections_separate(t1[try_rows], t2[try_rows], same[try_rows], n_shared[try_rows],
+                                           axis[a[try_rows]], pred)
+    for i in range(3):
+        r = unsure2[i][~done[unsure2[i]]]
+        d2[r, i] = pred.orient3d_resolve(d2[r, i], np.arange(len(r)), t1[r, 0], t1[r, 1], t1[r, 2], t2[r, i])
     kind = np.zeros(k, dtype=np.int8)
     separated = (np.all(d1 > 0, axis=1) | np.all(d1 < 0, axis=1) | np.all(d2 > 0, axis=1)
-                 | np.all(d2 < 0, axis=1))
+                 | np.all(d2 < 0, axis=1) | done)
     coplanar = np.all(d1 == 0, axis=1)
     rest = ~separated & ~coplanar & (n_shared < 2)
     cop = np.flatnonzero(coplanar)
@@ -313,6 +364,55 @@ def _classify(v: np.ndarray, f: np.ndarray, axis: np.ndarray, a: np.ndarray, b: 
     if len(gen):
         kind[gen] = _transversal(t1[gen], t2[gen], d1[gen], d2[gen], same[gen], n_shared[gen], pred)
     return kind
+
+
+def _o2(pred: _Predicates, p, q, x, axis) -> np.ndarray:
+    """orient2d signs of the projections of rows p, q, x (k, 3) along ``axis`` (k,)."""
+    keep = _PLANE[axis]
+    return pred.orient2d(np.take_along_axis(p, keep, 1), np.take_along_axis(q, keep, 1),
+                         np.take_along_axis(x, keep, 1))
+
+
+def _projections_separate(t1, t2, same, n_shared, axis, pred: _Predicates) -> np.ndarray:
+    """Pairs (sharing at most an edge) whose projections along ``axis`` (one to one for t1) are separated by a
+    line through what they share (an edge line of either face when nothing is shared): they then meet only in
+    what they share (a point of both projects onto the shared element, whose only preimage in t1 is itself).
+    Exact; False proves nothing.  The twin of ``ct_projections_separate`` in the C extension."""
+    out = np.zeros(len(t1), dtype=bool)
+    on1, on2 = same.any(axis=2), same.any(axis=1)
+    r = np.flatnonzero(n_shared == 2)
+    if len(r):
+        i1 = np.argmin(on1[r], axis=1)                       # the corner of t1 not shared
+        i2 = np.argmin(on2[r], axis=1)
+        p, q = t1[r, (i1 + 1) % 3], t1[r, (i1 + 2) % 3]
+        out[r] = _o2(pred, p, q, t1[r, i1], axis[r]) * _o2(pred, p, q, t2[r, i2], axis[r]) < 0
+    r = np.flatnonzero(n_shared == 1)
+    if len(r):
+        i1 = np.argmax(on1[r], axis=1)                       # the shared corner
+        i2 = np.argmax(on2[r], axis=1)
+        v = t1[r, i1]
+        mine = [t1[r, (i1 + 1) % 3], t1[r, (i1 + 2) % 3]]
+        theirs = [t2[r, (i2 + 1) % 3], t2[r, (i2 + 2) % 3]]
+        hit = np.zeros(len(r), dtype=bool)
+        for own, other in ((mine, theirs), (theirs, mine)):
+            for e in range(2):
+                so = _o2(pred, v, own[e], own[1 - e], axis[r])
+                hit |= ((so != 0) & (_o2(pred, v, own[e], other[0], axis[r]) * so < 0)
+                        & (_o2(pred, v, own[e], other[1], axis[r]) * so < 0))
+        out[r] = hit
+    r = np.flatnonzero(n_shared == 0)
+    if len(r):
+        hit = np.zeros(len(r), dtype=bool)
+        for own, other in ((t1[r], t2[r]), (t2[r], t1[r])):
+            for e in range(3):
+                p, q = own[:, e], own[:, (e + 1) % 3]
+                so = _o2(pred, p, q, own[:, (e + 2) % 3], axis[r])
+                ok = so != 0
+                for j in range(3):
+                    ok &= _o2(pred, p, q, other[:, j], axis[r]) * so < 0
+                hit |= ok
+        out[r] = hit
+    return out
 
 
 def _touch_corner(d: np.ndarray) -> np.ndarray:
@@ -546,19 +646,21 @@ def _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk, pred: _Predica
     return np.concatenate(found_a), np.concatenate(found_b), np.concatenate(found_k), candidates, tested, complete
 
 
-def _scan_c(lib, v, f, axis, degenerate, lo, hi, max_pairs, pred: _Predicates) -> _Scan:
-    """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy)."""
-    raw_a, raw_b, raw_kind, candidates, tested, exact, complete = lib.contact_scan(
-        v, f, np.ascontiguousarray(axis, dtype=np.int64), degenerate.view(np.uint8), lo, hi,
-        -1 if max_pairs is None else int(max_pairs), threads())
+def _scan_c(lib, v, f, max_pairs, pred: _Predicates) -> tuple[_Scan, np.ndarray, np.ndarray]:
+    """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy), with the
+    per-face projection axes and zero-area flags it computed."""
+    raw_a, raw_b, raw_kind, candidates, tested, exact, complete, raw_axis, raw_skip = lib.contact_scan(
+        v, f, -1 if max_pairs is None else int(max_pairs), threads())
     pred.exact += exact
+    axis = np.frombuffer(raw_axis, dtype=np.int8).astype(np.intp)
+    degenerate = np.frombuffer(raw_skip, dtype=np.uint8).astype(bool)
     a = np.frombuffer(raw_a, dtype=np.int64)
     b = np.frombuffer(raw_b, dtype=np.int64)
     kind = np.frombuffer(raw_kind, dtype=np.int8).copy()
     left = np.flatnonzero(kind < 0)
     if len(left):                       # an expansion too long for the C kernel
         kind[left] = _classify(v, f, axis, a[left], b[left], pred)
-    return a, b, kind, int(candidates), int(tested), bool(complete)
+    return (a, b, kind, int(candidates), int(tested), bool(complete)), axis, degenerate
 
 
 # -- entry point ----------------------------------------------------------------------------------------------
@@ -604,14 +706,14 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     empty = np.zeros((0, 2), dtype=np.intp)
     if not len(f):
         return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty, complete=True)
-    axis, degenerate = _face_axes(v, f, pred)
-    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    lo = np.minimum(np.minimum(p0, p1), p2)
-    hi = np.maximum(np.maximum(p0, p1), p2)
-    del p0, p1, p2
     if lib is not None:
-        a, b, kind, candidates, tested, complete = _scan_c(lib, v, f, axis, degenerate, lo, hi, max_pairs, pred)
+        (a, b, kind, candidates, tested, complete), axis, degenerate = _scan_c(lib, v, f, max_pairs, pred)
     else:
+        axis, degenerate = _face_axes(v, f, pred)
+        p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+        lo = np.minimum(np.minimum(p0, p1), p2)
+        hi = np.maximum(np.maximum(p0, p1), p2)
+        del p0, p1, p2
         a, b, kind, candidates, tested, complete = _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk,
                                                                pred)
 
