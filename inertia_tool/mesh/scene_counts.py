@@ -56,7 +56,7 @@ def _document(path: str) -> dict[str, Any]:
     return document
 
 
-def check_gltf(path: str, size: int, max_faces: int) -> dict[str, Any]:
+def check_gltf(path: str, size: int, max_faces: int) -> dict[str, int]:
     """Refuse a glTF scene that places more triangles than ``max_faces``, from its JSON, before trimesh builds it.
 
     A primitive's triangles follow from its accessor counts (``indices``, else ``POSITION``; mode 4: count/3,
