@@ -159,7 +159,7 @@ def _remove_quietly(tmp: str, created: os.stat_result) -> None:
 
 
 @contextlib.contextmanager
-def _atomic(path: str | os.PathLike, label: str | None, replace: bool) -> Iterator[tuple[int, str]]:
+def _atomic(path: str | os.PathLike[str], label: str | None, replace: bool) -> Iterator[tuple[int, str]]:
     """``(fd, temporary name)``; on a normal exit the file becomes ``path`` (:func:`_commit`), on an
     exception it is removed and ``path`` is left as it was."""
     path = os.fspath(path)
@@ -179,7 +179,7 @@ def _atomic(path: str | os.PathLike, label: str | None, replace: bool) -> Iterat
 
 
 @contextlib.contextmanager
-def atomic_target(path: str | os.PathLike, *, label: str | None = None, replace: bool = True) -> Iterator[str]:
+def atomic_target(path: str | os.PathLike[str], *, label: str | None = None, replace: bool = True) -> Iterator[str]:
     """Context manager yielding a temporary path to write; on success it becomes ``path`` atomically.
 
     The temporary file is in the directory of ``path``, has an unpredictable name (created with
@@ -217,7 +217,7 @@ def _default_mode() -> int | None:
     return 0o666 & ~mask
 
 
-def write_bytes(path: str | os.PathLike, data: bytes, *, label: str | None = None, replace: bool = True) -> None:
+def write_bytes(path: str | os.PathLike[str], data: bytes, *, label: str | None = None, replace: bool = True) -> None:
     """Write ``data`` to ``path`` atomically: through the descriptor of a new temporary file beside it, then
     fsync and rename (:func:`atomic_target`).
 
@@ -238,7 +238,7 @@ def write_bytes(path: str | os.PathLike, data: bytes, *, label: str | None = Non
             view = view[os.write(fd, view):]
 
 
-def write_text(path: str | os.PathLike, text: str, *, label: str | None = None, replace: bool = True) -> None:
+def write_text(path: str | os.PathLike[str], text: str, *, label: str | None = None, replace: bool = True) -> None:
     """Write ``text`` as UTF-8 to ``path`` atomically (``\\n`` line ends on every platform).
 
     Parameters

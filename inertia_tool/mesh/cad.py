@@ -30,11 +30,16 @@ from __future__ import annotations
 
 import contextlib
 import os
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import InvalidMeshError, MeshReadError, UsageError
 from ..values import frozen_value
+
+if TYPE_CHECKING:
+    from ..isolate import Limits
 
 __all__ = ["BREP_SUFFIXES", "DEFAULT_CHORD_RTOL", "DEFAULT_ANGULAR_DEFLECTION", "read_brep", "tessellate",
            "chord_tolerance", "tessellated_arrays", "has_ocp", "read_cad", "CadReading", "solids_fused",
@@ -68,7 +73,7 @@ def _fail(path: str, problem: str) -> MeshReadError:
 
 
 @contextlib.contextmanager
-def _quiet():
+def _quiet() -> Iterator[None]:
     """OpenCASCADE prints progress banners on stdout (fd 1); keep them off our output."""
     import sys
     sys.stdout.flush()
@@ -82,7 +87,7 @@ def _quiet():
         os.close(saved)
 
 
-def read_brep(path) -> object:
+def read_brep(path: str | os.PathLike[str]) -> object:
     """The B-rep (``TopoDS_Shape``, metres) of a STEP or IGES file; needs OCP."""
     path = os.fsdecode(os.fspath(path))
     try:
@@ -120,7 +125,7 @@ def read_brep(path) -> object:
     return shape
 
 
-def _bounding_diagonal(shape) -> float:
+def _bounding_diagonal(shape: Any) -> float:
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
     box = Bnd_Box()
@@ -130,7 +135,7 @@ def _bounding_diagonal(shape) -> float:
     return float(box.CornerMin().Distance(box.CornerMax()))
 
 
-def chord_tolerance(shape, chord: float | None = None) -> float:
+def chord_tolerance(shape: Any, chord: float | None = None) -> float:
     """The chord tolerance in m: ``chord`` if given, else :data:`DEFAULT_CHORD_RTOL` × bounding-box diagonal."""
     if chord is not None:
         if not (np.isfinite(chord) and chord > 0):
@@ -139,8 +144,8 @@ def chord_tolerance(shape, chord: float | None = None) -> float:
     return DEFAULT_CHORD_RTOL * _bounding_diagonal(shape)
 
 
-def tessellate(shape, *, chord: float, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
-               max_faces: int | None = None):
+def tessellate(shape: Any, *, chord: float, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
+               max_faces: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Triangles of the B-rep (``BRepMesh_IncrementalMesh``): ``(vertices (n, 3) m, faces (m, 3))``, outward.
 
     ``max_faces``: refuse (:class:`UsageError`) a tessellation of more triangles before copying them out.
@@ -189,7 +194,7 @@ def tessellate(shape, *, chord: float, angular_deflection: float = DEFAULT_ANGUL
     return np.vstack(vertices), np.vstack(faces)
 
 
-def _cascadio_arrays(path: str, chord: float, angular_deflection: float):
+def _cascadio_arrays(path: str, chord: float, angular_deflection: float) -> tuple[np.ndarray, np.ndarray]:
     import tempfile
     try:
         import cascadio
@@ -209,7 +214,7 @@ def _cascadio_arrays(path: str, chord: float, angular_deflection: float):
     return vertices, faces
 
 
-def solids_fused(shape) -> tuple[object, int, float, str]:
+def solids_fused(shape: Any) -> tuple[object, int, float, str]:
     """The union of the solids of ``shape`` (OpenCASCADE's boolean ``BRepAlgoAPI_Fuse``) when some may overlap.
 
     A STEP file of an assembly, or of a part exported as several bodies, holds solids that may overlap; the
@@ -298,7 +303,7 @@ def _meeting_groups(boxes: np.ndarray) -> list[list[int]]:
     return [sorted(g) for g in groups.values()]
 
 
-def brep_integrals(shape) -> tuple[float, np.ndarray, np.ndarray, float]:
+def brep_integrals(shape: Any) -> tuple[float, np.ndarray, np.ndarray, float]:
     """Unit-density ``(volume m³, centre of mass (3,) m, inertia (3, 3) m⁵ about it, surface area m²)`` of
     the B-rep (``BRepGProp``: Gauss integration on its faces; tensor convention, ``Ixy = −∫xy dV``)."""
     from OCP.BRepGProp import BRepGProp
@@ -342,14 +347,14 @@ class CadReading:
     faces: np.ndarray
     chord: float
     backend: str
-    integrals: tuple | None = None
+    integrals: tuple[float, np.ndarray, np.ndarray, float] | None = None
     solids: int = 0
     summed_volume: float = 0.0
     fusion: str = "one solid"
 
 
 def _read_here(path: str, chord: float | None, angular_deflection: float, use_ocp: bool,
-               max_faces: int | None = None) -> dict:
+               max_faces: int | None = None) -> dict[str, Any]:
     """Read, fuse, tessellate and integrate in this process: run only in the isolated child
     (:func:`read_cad`); returns plain values (:func:`inertia_tool.isolate.run_isolated`)."""
     if use_ocp:
@@ -370,11 +375,12 @@ def _read_here(path: str, chord: float | None, angular_deflection: float, use_oc
 
 #: The last reading, keyed by the file's identity and the tolerances: ``analyze`` reads a STEP file as a mesh
 #: and then compares it with its B-rep, one child process for both.
-_LAST: list = []
+_LAST: list[tuple[tuple[object, ...], CadReading]] = []
 
 
-def read_cad(path, *, chord: float | None = None, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
-             limits=None, max_faces: int | None = None) -> CadReading:
+def read_cad(path: str | os.PathLike[str], *, chord: float | None = None,
+             angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION, limits: Limits | None = None,
+             max_faces: int | None = None) -> CadReading:
     """Read, fuse (:func:`solids_fused`), tessellate and integrate a STEP/IGES file in a child process.
 
     OpenCASCADE can crash on a malformed file (a segmentation fault) or spend minutes and gigabytes on a big
@@ -416,8 +422,9 @@ def read_cad(path, *, chord: float | None = None, angular_deflection: float = DE
     return reading
 
 
-def tessellated_arrays(path, *, chord: float | None = None, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
-                       max_faces: int | None = None):
+def tessellated_arrays(path: str | os.PathLike[str], *, chord: float | None = None,
+                       angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
+                       max_faces: int | None = None) -> tuple[np.ndarray, np.ndarray, float, str]:
     """``(vertices m, faces, chord m, backend)`` of a STEP/IGES file: OCP if installed, else cascadio.
 
     Read in a child process with limits (:func:`read_cad`); several solids are fused into one.  Without

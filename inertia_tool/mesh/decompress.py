@@ -20,6 +20,8 @@ import shutil
 import tempfile
 import zipfile
 import zlib
+from collections.abc import Iterator, Sequence
+from typing import IO, Protocol
 
 from ..errors import MeshReadError
 from .regular import open_regular
@@ -30,11 +32,16 @@ __all__ = ["decompressed", "BLOCK_BYTES"]
 BLOCK_BYTES = 16 << 20
 
 
+class _Readable(Protocol):
+    def read(self, size: int, /) -> bytes: ...
+
+
 def _fail(path: str, problem: str) -> MeshReadError:
     return MeshReadError(f"{os.fsencode(path).decode('utf-8', 'replace')}: {problem}")
 
 
-def _copy_bounded(src, dst, path: str, compressed: int, max_bytes: int, max_ratio: float, min_ratio_bytes: int) -> None:
+def _copy_bounded(src: _Readable, dst: IO[bytes], path: str, compressed: int, max_bytes: int, max_ratio: float,
+                  min_ratio_bytes: int) -> None:
     total = 0
     limit = min(max_bytes, max(int(compressed * max_ratio), min_ratio_bytes))
     while True:
@@ -50,7 +57,8 @@ def _copy_bounded(src, dst, path: str, compressed: int, max_bytes: int, max_rati
 
 
 @contextlib.contextmanager
-def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes: int, suffixes):
+def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes: int,
+                 suffixes: Sequence[str]) -> Iterator[tuple[str, str]]:
     """Context manager yielding ``(inflated_path, member_name)`` in a temporary directory removed afterwards.
 
     Parameters

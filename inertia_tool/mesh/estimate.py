@@ -284,7 +284,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
 TREECODE_RESOLUTION = 24
 
 
-def _cube_moments(centres: np.ndarray, h: float, weight: np.ndarray | None = None):
+def _cube_moments(centres: np.ndarray, h: float,
+                  weight: np.ndarray | None = None) -> tuple[float, np.ndarray, np.ndarray]:
     """Volume, centroid and central second moment of disjoint cubes of side h, each counted ``weight`` times
     (1 when omitted; a cube counted half is half its material)."""
     wt = np.ones(len(centres)) if weight is None else np.asarray(weight, dtype=np.float64)
@@ -295,7 +296,8 @@ def _cube_moments(centres: np.ndarray, h: float, weight: np.ndarray | None = Non
     return vol, c, second
 
 
-def _surface_cells(vertices, faces, lo, h, dims, spacing=0.5):
+def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: float, dims: tuple[int, ...],
+                   spacing: float = 0.5) -> np.ndarray:
     """(cells,) bool: every cell the surface passes through (and a thin margin around it).
 
     Each triangle is sampled on a barycentric grid whose sub-triangles have edges of at most

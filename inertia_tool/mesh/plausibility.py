@@ -18,12 +18,16 @@ Rules (the bounds are in :mod:`inertia_tool.units`):
 from __future__ import annotations
 
 import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import ImplausibleDensityWarning, ImplausibleSizeWarning
 from ..units import implausible_density, implausible_extent
 from ..mass.volume import bounding_box
+
+if TYPE_CHECKING:
+    from .read import RawMesh
 
 __all__ = ["largest_extent", "warn_implausible_size", "warn_implausible_density"]
 
@@ -37,7 +41,7 @@ def largest_extent(vertices: np.ndarray) -> float:
     return float(np.max(hi - lo))
 
 
-def warn_implausible_size(raw, *, stacklevel: int = 3) -> bool:
+def warn_implausible_size(raw: RawMesh, *, stacklevel: int = 3) -> bool:
     """Warn (:class:`~inertia_tool.errors.ImplausibleSizeWarning`) when ``raw`` (a
     :class:`~inertia_tool.mesh.read.RawMesh`) was read without a length unit and its size is implausible for
     a part.  Returns whether it warned."""

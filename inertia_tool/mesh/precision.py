@@ -31,11 +31,15 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import StoragePrecisionWarning
 from ..tolerances import STORAGE_PRECISION_RTOL
+
+if TYPE_CHECKING:
+    from .read import RawMesh
 
 __all__ = ["float32_rounding", "volume_rounding_bound", "warn_storage_precision"]
 
@@ -78,7 +82,7 @@ def volume_rounding_bound(vertices: np.ndarray, faces: np.ndarray, rounding: flo
                   + 4.0 / 3.0 * math.pi * eps ** 3 * len(faces))
 
 
-def warn_storage_precision(raw, volume: float, *, rtol: float = STORAGE_PRECISION_RTOL,
+def warn_storage_precision(raw: RawMesh, volume: float, *, rtol: float = STORAGE_PRECISION_RTOL,
                            stacklevel: int = 3) -> float | None:
     """Warn (:class:`~inertia_tool.errors.StoragePrecisionWarning`) when the file's float32 storage limits the
     volume of ``raw`` (a :class:`~inertia_tool.mesh.read.RawMesh`) to worse than ``rtol`` relative.

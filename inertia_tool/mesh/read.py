@@ -17,7 +17,8 @@ import re
 import stat
 import sys
 import warnings
-from typing import Any
+from collections.abc import Callable, Iterator, Sequence
+from typing import IO, TYPE_CHECKING, Any, TypeAlias
 
 
 import numpy as np
@@ -30,6 +31,15 @@ from .options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
 from .regular import check_regular, open_regular, regular_file_resolver
 from .scene_counts import GLTF_INSTANCE_FACES, check_collada_instances, check_gltf
 from .weld import weld_exact, weld_exact_stream
+
+if TYPE_CHECKING:
+    import zipfile
+
+#: What a header check found: element counts by name (``"vertex"``, ``"face"``) and, for PLY, ``"float32"``
+#: (1 when the vertex coordinates are stored as float32).
+_Counts: TypeAlias = "dict[str, int]"
+#: ``(vertices (n, 3), faces (m, 3), declared (metres per file unit, unit name) or None)`` of a reader.
+_Arrays: TypeAlias = "tuple[np.ndarray, np.ndarray, tuple[float, str] | None]"
 
 __all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "MAX_SUPPORTED_FACES", "SUPPORTED_SUFFIXES",
            "os_error_reason", "GLTF_INSTANCE_FACES"]
@@ -88,16 +98,16 @@ class RawMesh:
     storage_rounding: float = 0.0
 
 
-def _display(path) -> str:
+def _display(path: str | bytes | os.PathLike[str] | os.PathLike[bytes]) -> str:
     """A printable form of a file name (undecodable bytes of a non-UTF-8 name become U+FFFD)."""
     return os.fsencode(path).decode("utf-8", "replace")
 
 
-def _fail(path, problem: str) -> MeshReadError:
+def _fail(path: str | bytes | os.PathLike[str] | os.PathLike[bytes], problem: str) -> MeshReadError:
     return MeshReadError(f"{_display(path)}: {problem}")
 
 
-def os_error_reason(exc: OSError, path=None) -> str:
+def os_error_reason(exc: OSError, path: str | os.PathLike[str] | None = None) -> str:
     """The operating system's reason for ``exc`` in words, for a one-line message about ``path``.
 
     ``ENOENT`` of a path that is itself a symbolic link says the link is broken; ``ELOOP`` says "symbolic
@@ -160,7 +170,7 @@ def _binary_stl_count(path: str, size: int, max_faces: int) -> int:
     return n
 
 
-def _binary_stl_chunks(path: str, n: int, *, padded: bool = True):
+def _binary_stl_chunks(path: str, n: int, *, padded: bool = True) -> Callable[[], Iterator[np.ndarray]]:
     """A factory of iterators over the corners of a binary STL, in file order.
 
     ``padded``: ``(k, 4)`` float32 copies ``(x, y, z, 0)`` checked for NaN and infinity (the layout lets the
@@ -169,7 +179,7 @@ def _binary_stl_chunks(path: str, n: int, *, padded: bool = True):
     bounded chunks (a second read comes from the page cache), so the whole triangle soup is never held in
     memory.
     """
-    def views():
+    def views() -> Iterator[np.ndarray]:
         with open_regular(path) as fh:
             fh.seek(84)
             done = 0
@@ -181,7 +191,7 @@ def _binary_stl_chunks(path: str, n: int, *, padded: bool = True):
                 done += k
                 yield rec["v"]
 
-    def chunks():
+    def chunks() -> Iterator[np.ndarray]:
         for v in views():
             corners = np.zeros((3 * len(v), 4), dtype=np.float32)   # (x, y, z, 0): see weld._hash_rows
             corners[:, :3] = v.reshape(-1, 3)
@@ -201,7 +211,8 @@ _BLOCK_BYTES = 1 << 24
 MAX_LINE_BYTES = 1 << 20
 
 
-def _text_blocks(fh, path: str, *, block_bytes: int = _BLOCK_BYTES, max_line: int = MAX_LINE_BYTES):
+def _text_blocks(fh: IO[bytes], path: str, *, block_bytes: int = _BLOCK_BYTES,
+                 max_line: int = MAX_LINE_BYTES) -> Iterator[bytes]:
     """Yield the bytes of a text file in blocks of whole lines, every line ending normalised to ``\n``.
 
     Reads fixed-size byte blocks and splits on any of ``\r\n``, ``\r`` (old Mac) and ``\n`` itself, carrying
@@ -328,7 +339,7 @@ def _read_ascii_stl(path: str, size: int, max_faces: int) -> tuple[np.ndarray, i
     return corners, len(corners)
 
 
-def read_stl(path, *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, np.ndarray, int]:
+def read_stl(path: str | os.PathLike[str], *, max_faces: int = DEFAULT_MAX_FACES) -> tuple[np.ndarray, np.ndarray, int]:
     """Read an STL file (binary or ASCII) into an exactly welded indexed mesh in file units.
 
     Returns
@@ -350,7 +361,7 @@ def _read_stl(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int, b
         head = fh.read(4096)
     announced = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else -1
 
-    def binary():
+    def binary() -> tuple[np.ndarray, np.ndarray, int, bool]:
         n = _binary_stl_count(path, size, max_faces)
         if n == 0:
             raise _fail(path, "STL holds no triangles (empty mesh)")
@@ -387,7 +398,7 @@ _OBJ_SKIPPED = frozenset(b"vt vn vp o g s usemtl mtllib cstype deg bmat step cur
                          b"ctech stech call csh".split())
 
 
-def _obj_vertex_block(path: str, tokens: list, first_line: int) -> np.ndarray:
+def _obj_vertex_block(path: str, tokens: list[bytes], first_line: int) -> np.ndarray:
     try:
         return np.array(tokens, dtype=np.float64).reshape(-1, 3)
     except ValueError:
@@ -409,7 +420,8 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
 
     Returns ``vertices (n, 3)``, ``faces (m, 3)`` and the number of polygons in the file.
     """
-    vertex_blocks, face_blocks = [], []
+    vertex_blocks: list[np.ndarray] = []
+    face_blocks: list[np.ndarray] = []
     nv = n_tri = n_poly = loose = garbage = 0
     first_garbage = ""
     line_no = 0
@@ -417,8 +429,8 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     max_vertices = 3 * max_faces + 3
     with open_regular(path) as fh:
         for block in _text_blocks(fh, path):
-            coords: list = []
-            tri: list = []
+            coords: list[bytes] = []
+            tri: list[int] = []
             block_start = line_no + 1
             lines = block.split(b"\n")
             lines.pop()  # every block ends with a newline
@@ -539,7 +551,7 @@ def _header_count(path: str, word: bytes) -> int:
     return n
 
 
-def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
+def _check_ply_header(path: str, size: int, max_faces: int) -> _Counts:
     """Check what a PLY header announces against the file size before any parser allocates for it."""
     with open_regular(path) as fh:
         head = fh.read(1 << 16)
@@ -548,8 +560,9 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
         raise _fail(path, "not a PLY file (no 'ply' magic, or no 'end_header' within 64 KiB)")
     fmt = None
     vertex_float32 = False
-    elements: list = []
-    layouts: list = []             # per element: (bytes of the property or of a list's count, bytes of a list item)
+    elements: list[list[Any]] = []          # per element: [name, count, bytes per item]
+    # per element and property: (bytes of the property or of a list's count, bytes of a list item)
+    layouts: list[list[tuple[int, int]]] = []
     for line in head[:end].replace(b"\r", b"\n").split(b"\n")[1:]:
         parts = line.split()
         if not parts:
@@ -593,7 +606,8 @@ def _check_ply_header(path: str, size: int, max_faces: int) -> dict:
     return counts
 
 
-def _check_ply_polygons(path: str, elements: list, layouts: list, body: int, max_faces: int) -> None:
+def _check_ply_polygons(path: str, elements: list[list[Any]], layouts: list[list[tuple[int, int]]], body: int,
+                        max_faces: int) -> None:
     """Refuse a binary PLY whose polygons may triangulate into more than ``max_faces`` triangles.
 
     The header gives the number of faces ``n``, not their corners: a face of ``k`` corners becomes ``k − 2``
@@ -620,7 +634,7 @@ def _check_ply_polygons(path: str, elements: list, layouts: list, body: int, max
         skipped += count * per
 
 
-def _check_off_header(path: str, size: int, max_faces: int) -> dict:
+def _check_off_header(path: str, size: int, max_faces: int) -> _Counts:
     """Check the vertex and face counts of an OFF header against the file size."""
     with open_regular(path) as fh:
         head = fh.read(1 << 16)
@@ -657,7 +671,8 @@ def _relationship_targets(data: bytes) -> list[str]:
             and "Target" in r.attrib]
 
 
-def _model_members(path: str, zf, infos) -> list:
+def _model_members(path: str, zf: zipfile.ZipFile,
+                   infos: Sequence[zipfile.ZipInfo]) -> list[zipfile.ZipInfo]:
     """The members of a 3MF that hold geometry, the only ones read: the root model (the first
     ``3D/3dmodel.model``, as trimesh takes it), the parts its relationships point at, and any other
     ``*.model`` part (a component's ``path`` may name one).  Thumbnails, textures, metadata and anything
@@ -676,7 +691,7 @@ def _model_members(path: str, zf, infos) -> list:
     return [i for i in infos if i.filename in wanted]
 
 
-def _check_zip_members(path: str, count: int, members, what: str = "") -> None:
+def _check_zip_members(path: str, count: int, members: Sequence[zipfile.ZipInfo], what: str = "") -> None:
     """Refuse, from the central directory, an archive of more than :data:`MAX_ZIP_MEMBERS` members (``count``)
     or one of ``members`` inflating more than :data:`MAX_ZIP_RATIO` : 1; ``what`` prefixes the messages."""
     if count > MAX_ZIP_MEMBERS:
@@ -693,7 +708,7 @@ def _check_zip_members(path: str, count: int, members, what: str = "") -> None:
                               "before inflating")
 
 
-def _check_zip(path: str, max_faces: int) -> dict:
+def _check_zip(path: str, max_faces: int) -> _Counts:
     """Refuse a zipped mesh (``.zae``) whose members would inflate beyond the limits, from the central
     directory only: :func:`_check_zip_members` and all members together within :func:`zip_inflate_limit`."""
     import zipfile
@@ -712,7 +727,7 @@ def _check_zip(path: str, max_faces: int) -> dict:
     return {}
 
 
-def _read_3mf(path: str, max_faces: int):
+def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str]]:
     """``(vertices, faces, declared unit)`` of a 3MF, read by the streaming reader :mod:`.threemf`.
 
     Refused from the zip's central directory, before anything is inflated: more than
@@ -773,7 +788,7 @@ def _check_collada_floats(name: str, data: bytes) -> None:
                                 "(NaN and infinity are refused: the COLLADA reader would turn NaN into 0)")
 
 
-def _check_collada(path: str, size: int, max_faces: int) -> dict:
+def _check_collada(path: str, size: int, max_faces: int) -> _Counts:
     """A ``.dae`` file: at most :func:`zip_inflate_limit` bytes (the text of ``max_faces`` triangles), and
     its float arrays decimal numbers (:func:`_check_collada_floats`)."""
     limit = zip_inflate_limit(max_faces)
@@ -787,7 +802,7 @@ def _check_collada(path: str, size: int, max_faces: int) -> dict:
     return {}
 
 
-def _check_zipped_collada(path: str, max_faces: int) -> dict:
+def _check_zipped_collada(path: str, max_faces: int) -> _Counts:
     """A ``.zae`` archive: the inflated-size limits of :func:`_check_zip`, then the float arrays of its
     ``.dae`` members (:func:`_check_collada_floats`)."""
     import zipfile
@@ -811,7 +826,7 @@ _HEADER_CHECKS = {".ply": _check_ply_header, ".off": _check_off_header, ".dae": 
                   ".glb": check_gltf, ".gltf": check_gltf}
 
 
-def _declared_scale(path: str, suffix: str, loaded) -> tuple[float, str] | None:
+def _declared_scale(path: str, suffix: str, loaded: object) -> tuple[float, str] | None:
     """Metres per file unit and the unit's name, for formats that declare one (:data:`DECLARES_UNITS`)."""
     if suffix in (".glb", ".gltf"):
         return 1.0, "m"
@@ -835,7 +850,7 @@ def _declared_scale(path: str, suffix: str, loaded) -> tuple[float, str] | None:
 _COLLADA_APPEARANCE = ("library_images", "library_effects", "library_materials", "bind_material")
 
 
-def _collada_geometry_only(path: str):
+def _collada_geometry_only(path: str) -> IO[bytes]:
     """The COLLADA file ``path`` without images, effects, materials and material bindings (a file object):
     what is not geometry cannot stop the geometry from being read."""
     import io
@@ -852,7 +867,7 @@ def _collada_geometry_only(path: str):
     return io.BytesIO(etree.tostring(tree))
 
 
-def _read_with_trimesh(path: str, max_faces: int):
+def _read_with_trimesh(path: str, max_faces: int) -> _Arrays:
     """``(vertices, faces, declared unit)`` of a file trimesh reads (see :func:`_read_with_trimesh_rounding`)."""
     vertices, faces, declared, _ = _read_with_trimesh_rounding(path, max_faces)
     return vertices, faces, declared
@@ -863,7 +878,7 @@ def _read_with_trimesh(path: str, max_faces: int):
 _FLOAT32_FORMATS = (".glb", ".gltf", ".dae", ".zae")
 
 
-def _scene_rounding(loaded) -> float:
+def _scene_rounding(loaded: object) -> float:
     """float32 rounding (file units) of a scene whose geometries are stored as float32 and placed by node
     transforms: each output coordinate is ``Σ_j M_ij x_j + t_i``, so its error is at most ``‖M‖∞ δ`` with ``δ``
     the rounding of the largest stored coordinate and ``‖M‖∞`` the largest row sum of any node's matrix."""
@@ -881,11 +896,13 @@ def _scene_rounding(loaded) -> float:
     return delta * norm
 
 
-def _read_with_trimesh_rounding(path: str, max_faces: int):
+def _read_with_trimesh_rounding(path: str,
+                                max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str] | None, float]:
     """``(vertices, faces, declared unit, float32 rounding in file units)`` of a file trimesh reads (3MF: of
     the streaming reader :func:`_read_3mf`)."""
     size = os.path.getsize(path)
     suffix = os.path.splitext(path)[1].lower()
+    declared: tuple[float, str] | None
     if suffix == ".3mf":
         v, f, declared = _read_3mf(path, max_faces)
         _check_face_budget(path, len(f), max_faces)
@@ -967,7 +984,7 @@ def _read_with_trimesh_rounding(path: str, max_faces: int):
     return v, f, declared, rounding
 
 
-def load_mesh(source, *, units: str | None = None, max_faces: int = DEFAULT_MAX_FACES) -> RawMesh:
+def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFAULT_MAX_FACES) -> RawMesh:
     """Read a mesh and convert it to metres.
 
     Parameters
@@ -1106,7 +1123,7 @@ def _declared_units_win(name: str, declared: tuple[float, str], units: str, scal
     return file_scale, file_unit
 
 
-def _from_object(source):
+def _from_object(source: object) -> tuple[np.ndarray, np.ndarray, str]:
     trimesh = sys.modules.get("trimesh")     # a Trimesh exists only once trimesh is imported: arrays never import it
     if trimesh is not None and isinstance(source, trimesh.Trimesh):
         return np.asarray(source.vertices, dtype=np.float64), np.asarray(source.faces), "<trimesh.Trimesh>"

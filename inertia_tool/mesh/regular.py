@@ -17,22 +17,25 @@ from __future__ import annotations
 
 import os
 import stat
-from typing import Any, BinaryIO
+from typing import Any, BinaryIO, TypeAlias
 
 from ..errors import MeshReadError
 
 __all__ = ["open_regular", "check_regular", "not_regular_reason", "regular_file_resolver"]
 
+#: A file name as :func:`os.open` takes it (a ``bytes`` name keeps undecodable bytes).
+PathName: TypeAlias = "str | bytes | os.PathLike[str] | os.PathLike[bytes]"
+
 _KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
           (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
 
 
-def _display(path: str | os.PathLike) -> str:
+def _display(path: PathName) -> str:
     """A printable form of a file name (undecodable bytes of a non-UTF-8 name become U+FFFD)."""
     return os.fsencode(path).decode("utf-8", "replace")
 
 
-def not_regular_reason(mode: int, path: str | os.PathLike | None = None) -> str | None:
+def not_regular_reason(mode: int, path: PathName | None = None) -> str | None:
     """Why a file of ``mode`` (``st_mode`` of ``os.stat``) is not opened: ``"is a FIFO (named pipe), not a regular
     file"`` (``"is a symbolic link to ..."`` when ``path`` is one), or None for a regular file."""
     if stat.S_ISREG(mode):
@@ -42,7 +45,7 @@ def not_regular_reason(mode: int, path: str | os.PathLike | None = None) -> str 
     return f"is {'a symbolic link to ' if link else ''}{kind}, not a regular file"
 
 
-def check_regular(path: str | os.PathLike) -> os.stat_result:
+def check_regular(path: PathName) -> os.stat_result:
     """``os.stat(path)`` of a regular file; :class:`MeshReadError` naming the file and what it is otherwise.
 
     Raises
@@ -59,7 +62,7 @@ def check_regular(path: str | os.PathLike) -> os.stat_result:
     return st
 
 
-def open_regular(path: str | os.PathLike) -> BinaryIO:
+def open_regular(path: PathName) -> BinaryIO:
     """Open a regular file for reading in binary mode, never blocking on what is not one.
 
     Parameters

@@ -21,6 +21,9 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
 from ..values import frozen_value
@@ -75,15 +78,17 @@ class Resolution:
     vertices: np.ndarray
     faces: np.ndarray
     method: str
-    notes: tuple
+    notes: tuple[str, ...]
     flipped_faces: int
     welded_tolerance: float | None
     nonmanifold_edges: int
     estimate: Estimate | None = None
 
 
-def _drop_collapsed(faces):
-    return faces[~((faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0]))]
+def _drop_collapsed(faces: np.ndarray) -> np.ndarray:
+    collapsed = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0])
+    kept: np.ndarray = faces[~collapsed]
+    return kept
 
 
 def _describe(census: EdgeBalance, welded: float | None, vertices: np.ndarray, faces: np.ndarray) -> str:
@@ -106,7 +111,7 @@ def _describe(census: EdgeBalance, welded: float | None, vertices: np.ndarray, f
     return "; ".join(parts) + after + where
 
 
-def _touching_note(census: EdgeBalance) -> tuple:
+def _touching_note(census: EdgeBalance) -> tuple[str, ...]:
     if not census.nonmanifold_edges:
         return ()
     return (f"{census.nonmanifold_edges:,} non-manifold edges where bodies or walls meet (each edge used equally "
@@ -125,7 +130,7 @@ def _dedupe(faces: np.ndarray) -> tuple[np.ndarray, int]:
 
 
 def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
-                    merge_tolerance: float, moments, force_estimate: bool = False,
+                    merge_tolerance: float, moments: Callable[..., Any], force_estimate: bool = False,
                     reason: str | None = None) -> Resolution:
     """Read a surface that failed the manifold check as a solid (exact), as an estimate (repair), or refuse.
 
@@ -249,7 +254,7 @@ def _loose_share(faces: np.ndarray) -> float:
 
 
 def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, *, diag: float,
-                       moments, seam_gap_rtol: float = SEAM_GAP_RTOL,
+                       moments: Callable[..., Any], seam_gap_rtol: float = SEAM_GAP_RTOL,
                        soup_share: float = SOUP_BOUNDARY_SHARE) -> Estimate:
     """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed."""
     sealed = seal_seams(vertices, faces, seam_gap_rtol * diag)

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import os
 import struct
+from collections.abc import Callable
+from typing import Any
 
 from ..errors import MeshReadError
 
@@ -25,10 +27,11 @@ def _fail(path: str, problem: str) -> MeshReadError:
 #: memory of ~250 triangles, so 200,000 instances of a 12-triangle box no longer pass as "2.4M triangles".
 GLTF_INSTANCE_FACES = 256
 
-_GLTF_TRIANGLE_MODES = {4: lambda n: n // 3, 5: lambda n: max(n - 2, 0), 6: lambda n: max(n - 2, 0)}
+_GLTF_TRIANGLE_MODES: dict[int, Callable[[int], int]] = {4: lambda n: n // 3, 5: lambda n: max(n - 2, 0),
+                                                         6: lambda n: max(n - 2, 0)}
 
 
-def _document(path: str) -> dict:
+def _document(path: str) -> dict[str, Any]:
     """The JSON of a ``.gltf`` file or of a ``.glb``'s first chunk (checked against the file size)."""
     import json
     from .regular import open_regular
@@ -53,7 +56,7 @@ def _document(path: str) -> dict:
     return document
 
 
-def check_gltf(path: str, size: int, max_faces: int) -> dict:
+def check_gltf(path: str, size: int, max_faces: int) -> dict[str, int]:
     """Refuse a glTF scene that places more triangles than ``max_faces``, from its JSON, before trimesh builds it.
 
     A primitive's triangles follow from its accessor counts (``indices``, else ``POSITION``; mode 4: count/3,
@@ -63,19 +66,19 @@ def check_gltf(path: str, size: int, max_faces: int) -> dict:
     """
     doc = _document(path)
 
-    def items(key):
+    def items(key: str) -> list[Any]:
         value = doc.get(key, [])
         return value if isinstance(value, list) else []
 
     accessors, meshes, nodes = items("accessors"), items("meshes"), items("nodes")
 
-    def accessor_count(index) -> int:
+    def accessor_count(index: object) -> int:
         if isinstance(index, int) and 0 <= index < len(accessors) and isinstance(accessors[index], dict):
             count = accessors[index].get("count", 0)
             return count if isinstance(count, int) and count > 0 else 0
         return 0
 
-    def mesh_triangles(index) -> int:
+    def mesh_triangles(index: object) -> int:
         if not (isinstance(index, int) and 0 <= index < len(meshes) and isinstance(meshes[index], dict)):
             return 0
         total = 0
@@ -90,9 +93,9 @@ def check_gltf(path: str, size: int, max_faces: int) -> dict:
             total += rule(count) if rule is not None else 0
         return total
 
-    memo: dict = {}
+    memo: dict[int, int] = {}
 
-    def placed(index, depth: int) -> int:
+    def placed(index: object, depth: int) -> int:
         if depth > 64:
             raise _fail(path, "glTF node graph deeper than 64 levels (a cycle?)")
         if not (isinstance(index, int) and 0 <= index < len(nodes) and isinstance(nodes[index], dict)):

@@ -76,7 +76,8 @@ def parallel_body_volume(vertices: np.ndarray, faces: np.ndarray, radius: np.nda
     area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
     perimeter = (np.linalg.norm(b - a, axis=1) + np.linalg.norm(c - b, axis=1) + np.linalg.norm(a - c, axis=1))
     d = np.asarray(radius, dtype=np.float64)
-    return 2.0 * area * d + 0.5 * np.pi * perimeter * d ** 2 + 4.0 / 3.0 * np.pi * d ** 3
+    volume: np.ndarray = 2.0 * area * d + 0.5 * np.pi * perimeter * d ** 2 + 4.0 / 3.0 * np.pi * d ** 3
+    return volume
 
 
 def _boundary_vertices(faces: np.ndarray, n: int) -> np.ndarray:
@@ -86,7 +87,8 @@ def _boundary_vertices(faces: np.ndarray, n: int) -> np.ndarray:
     return np.unique(edges) if len(edges) else np.zeros(0, dtype=np.int64)
 
 
-def _weld_lips(v, f, slack, vertex_slack, gap):
+def _weld_lips(v: np.ndarray, f: np.ndarray, slack: np.ndarray, vertex_slack: np.ndarray,
+               gap: float) -> tuple[np.ndarray, np.ndarray, float, int]:
     """Step 1: merge boundary vertices within ``gap``; returns faces, face slack, dropped doubt, merged count."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -116,7 +118,8 @@ def _weld_lips(v, f, slack, vertex_slack, gap):
     return g[~collapsed], d[~collapsed], dropped, merged
 
 
-def _split_t_junctions(v, f, slack, gap):
+def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
+                       gap: float) -> tuple[np.ndarray, np.ndarray, int]:
     """Step 2: split faces at boundary vertices lying on the interior of a boundary edge; returns faces,
     slack and the number of vertices inserted."""
     from scipy.spatial import cKDTree
@@ -167,7 +170,8 @@ def _split_t_junctions(v, f, slack, gap):
     by = np.lexsort((t, face))
     face, corner, m, dist = face[by], corner[by], m[by], dist[by]
     split_faces = np.unique(face)
-    new_faces, new_slack = [], []
+    new_faces: list[np.ndarray] = []
+    new_slack: list[np.ndarray] = []
     starts = np.searchsorted(face, split_faces)
     ends = np.r_[starts[1:], len(face)]
     for s, stop in zip(starts.tolist(), ends.tolist()):    # one short fan per split face (bounded by the faces)

@@ -19,6 +19,9 @@ its instances (components multiply) before any instance is placed.
 from __future__ import annotations
 
 import array
+import zipfile
+from collections.abc import Sequence
+from typing import IO, Any, TypeAlias
 
 import numpy as np
 
@@ -34,23 +37,26 @@ _UNIT_NAMES = {"micron": "um", "millimeter": "mm", "centimeter": "cm", "inch": "
 #: Deepest nesting of components followed (a cycle or a pathological file is refused beyond it).
 MAX_COMPONENT_DEPTH = 32
 
+#: A build item or component: (model part name or None for the same part, object id, 4 × 3 transform).
+_Reference: TypeAlias = "tuple[str | None, str | None, np.ndarray]"
 
-def _local(tag) -> str:
+
+def _local(tag: object) -> str:
     return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
 
 
-def _attribute(element, name: str):
+def _attribute(element: Any, name: str) -> str | None:
     """An attribute by local name, whatever its namespace (``path`` of the Production extension)."""
     value = element.get(name)
     if value is not None:
-        return value
+        return str(value)
     for key, value in element.attrib.items():
         if _local(key) == name:
-            return value
+            return str(value)
     return None
 
 
-def _transform(text, where: str) -> np.ndarray:
+def _transform(text: str | None, where: str) -> np.ndarray:
     """A 3MF transform as a 4 × 3 matrix (``p · M[:3] + M[3]``); identity when absent."""
     if text is None:
         return np.vstack([np.eye(3), np.zeros(3)])
@@ -66,10 +72,10 @@ def _transform(text, where: str) -> np.ndarray:
 class _Part:
     """What one model part defines: meshes and component lists by object id, build items, its unit."""
 
-    def __init__(self):
-        self.meshes: dict = {}          # id -> (vertices (n, 3), triangles (m, 3))
-        self.components: dict = {}      # id -> [(part name or None, object id, 4 x 3 transform)]
-        self.items: list = []           # [(part name or None, object id, 4 x 3 transform)]
+    def __init__(self) -> None:
+        self.meshes: dict[str | None, tuple[np.ndarray, np.ndarray]] = {}   # id -> (vertices (n, 3), triangles (m, 3))
+        self.components: dict[str | None, list[_Reference]] = {}             # id -> its components
+        self.items: list[_Reference] = []                                    # the build items
         self.unit = "millimeter"
 
 
@@ -79,7 +85,7 @@ _TAGS = ("vertex", "triangle", "component", "item", "object", "model")
 _SWEEP = 4096
 
 
-def _read_part(source, where: str, budget: list) -> _Part:
+def _read_part(source: IO[bytes], where: str, budget: list[int]) -> _Part:
     """Stream one model part; ``budget = [triangles left, vertices left]`` is shared by all parts.
 
     Each element is handled at its end event and cleared; every :data:`_SWEEP` elements the siblings already
@@ -89,8 +95,8 @@ def _read_part(source, where: str, budget: list) -> _Part:
     part = _Part()
     coords = array.array("d")
     corners = array.array("q")
-    components: list = []
-    kinds: dict = {}          # element tag (with its namespace) -> local name
+    components: list[_Reference] = []
+    kinds: dict[str, str] = {}          # element tag (with its namespace) -> local name
     seen = 0
     try:
         for _, element in etree.iterparse(source, events=("end",), tag=[f"{{*}}{t}" for t in _TAGS],
@@ -149,7 +155,8 @@ def _read_part(source, where: str, budget: list) -> _Part:
     return part
 
 
-def read_3mf(path: str, members, zf, *, max_faces: int, name: str):
+def read_3mf(path: str, members: Sequence[zipfile.ZipInfo], zf: zipfile.ZipFile, *, max_faces: int,
+             name: str) -> tuple[np.ndarray, np.ndarray, tuple[float, str]]:
     """Read the model parts ``members`` (``ZipInfo``, the root model first) of the open archive ``zf``.
 
     Returns
@@ -168,7 +175,7 @@ def read_3mf(path: str, members, zf, *, max_faces: int, name: str):
     """
     budget = [int(max_faces), 3 * int(max_faces) + 3]
     by_name = {"/" + info.filename.lstrip("/"): info for info in members}
-    parts: dict = {}
+    parts: dict[str, _Part] = {}
 
     def load(part_name: str) -> _Part | None:
         """A model part, streamed the first time a build item or component needs it (others are never read)."""
@@ -185,9 +192,9 @@ def read_3mf(path: str, members, zf, *, max_faces: int, name: str):
     if root.unit not in THREEMF_UNITS:
         raise MeshReadError(f"{name}: unknown 3MF unit {root.unit[:40]!r}; expected one of "
                             f"{', '.join(THREEMF_UNITS)}")
-    counts: dict = {}
+    counts: dict[tuple[str, str | None], int] = {}
 
-    def lookup(part_name: str, key):
+    def lookup(part_name: str, key: str | None) -> _Part:
         part = load(part_name)
         if part is None:
             raise MeshReadError(f"{name}: a component names the model part {part_name[:60]!r}, which the archive "
@@ -197,7 +204,7 @@ def read_3mf(path: str, members, zf, *, max_faces: int, name: str):
                                 f"{part_name[:60]} does not define")
         return part
 
-    def triangles(part_name: str, key, depth: int) -> int:
+    def triangles(part_name: str, key: str | None, depth: int) -> int:
         """Triangles of one instance of an object, components included (memoised; cycles refused)."""
         if depth > MAX_COMPONENT_DEPTH:
             raise MeshReadError(f"{name}: components nested deeper than {MAX_COMPONENT_DEPTH} (a cycle?)")
@@ -216,11 +223,11 @@ def read_3mf(path: str, members, zf, *, max_faces: int, name: str):
     if placed > max_faces:
         raise MeshReadError(f"{name}: the build places at least {placed:,} triangles (components and items "
                             f"repeated), more than `max_faces` ({max_faces:,}) allows; refused before placing them")
-    out_v: list = []
-    out_f: list = []
+    out_v: list[np.ndarray] = []
+    out_f: list[np.ndarray] = []
     offset = [0]
 
-    def place(part_name: str, key, matrix: np.ndarray, depth: int) -> None:
+    def place(part_name: str, key: str | None, matrix: np.ndarray, depth: int) -> None:
         part = parts[part_name]
         if key in part.meshes:
             v, f = part.meshes[key]

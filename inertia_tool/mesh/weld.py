@@ -17,7 +17,8 @@ Either way a 5M-face binary STL never exists as a float64 soup.
 
 from __future__ import annotations
 
-from typing import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from types import ModuleType
 
 import numpy as np
 
@@ -41,27 +42,27 @@ def _hash_rows(rows: np.ndarray) -> np.ndarray:
         bits[bits == 0x80000000] = 0     # -0.0 -> +0.0 in place (the chunk is the caller's scratch buffer)
         words = bits.view(np.uint64)
         with np.errstate(over="ignore"):
-            h = words[:, 1] * _MIX[0]
+            h: np.ndarray = words[:, 1] * _MIX[0]
         h ^= words[:, 0]
         return h
     rows = rows + rows.dtype.type(0)  # -0.0 -> +0.0 so that equal values hash equally
     with np.errstate(over="ignore"):
         if rows.dtype == np.float32:
             bits = rows.view(np.uint32)
-            h = (bits[:, 0].astype(np.uint64) << np.uint64(32)) | bits[:, 1]
-            h ^= bits[:, 2].astype(np.uint64) * _MIX[0]
-            return h
+            h32: np.ndarray = (bits[:, 0].astype(np.uint64) << np.uint64(32)) | bits[:, 1]
+            h32 ^= bits[:, 2].astype(np.uint64) * _MIX[0]
+            return h32
         bits = rows.astype(np.float64, copy=False).view(np.uint64)
-        h = bits[:, 0] * _MIX[0]
-        h ^= h >> np.uint64(29)
-        h += bits[:, 1] * _MIX[1]
-        h ^= h >> np.uint64(31)
-        h += bits[:, 2] * _MIX[2]
-        h ^= h >> np.uint64(32)
-        return h
+        h64: np.ndarray = bits[:, 0] * _MIX[0]
+        h64 ^= h64 >> np.uint64(29)
+        h64 += bits[:, 1] * _MIX[1]
+        h64 ^= h64 >> np.uint64(31)
+        h64 += bits[:, 2] * _MIX[2]
+        h64 ^= h64 >> np.uint64(32)
+        return h64
 
 
-def _index_dtype(n: int):
+def _index_dtype(n: int) -> type[np.int32] | type[np.int64]:
     return np.int32 if n < 2**31 - 1 else np.int64
 
 
@@ -81,7 +82,8 @@ def _renumber_by_first_appearance(inverse: np.ndarray, first: np.ndarray) -> Non
         inverse[s:s + _CHUNK] = new_id[inverse[s:s + _CHUNK]]
 
 
-def _weld_stream_c(lib, chunks: Callable[[], Iterable[np.ndarray]], n_points: int):
+def _weld_stream_c(lib: ModuleType, chunks: Callable[[], Iterable[np.ndarray]],
+                   n_points: int) -> tuple[np.ndarray, np.ndarray]:
     """``weld_exact_stream`` on the C extension's hash table: one pass, no keys array, no sort."""
     index = np.empty(n_points, dtype=np.int32)
     welder = None
@@ -197,7 +199,7 @@ def weld_exact(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     flat = np.asarray(corners).reshape(-1, 3)
 
-    def chunks():
+    def chunks() -> Iterator[np.ndarray]:
         for s in range(0, len(flat), _CHUNK):
             yield flat[s:s + _CHUNK]
     return weld_exact_stream(chunks, len(flat))
@@ -232,4 +234,5 @@ def weld_tolerance(vertices: np.ndarray, faces: np.ndarray, tolerance: float) ->
     else:
         _, first, inverse = np.unique(cells, axis=0, return_index=True, return_inverse=True)
     representative = first[inverse.reshape(-1)]
-    return representative[faces].astype(faces.dtype)
+    welded: np.ndarray = representative[faces].astype(faces.dtype)
+    return welded

@@ -40,7 +40,8 @@ def _solid_angles(q: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) ->
     num = np.einsum("...i,...i", a, np.cross(b, c))
     den = (la * lb * lc + np.einsum("...i,...i", a, b) * lc + np.einsum("...i,...i", a, c) * lb
            + np.einsum("...i,...i", b, c) * la)
-    return 2.0 * np.arctan2(num, den)
+    angle: np.ndarray = 2.0 * np.arctan2(num, den)
+    return angle
 
 
 def _direct(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
