@@ -96,7 +96,7 @@ def run_child(code: str, path: str):
 def kernel_times(path: str, repeat: int):
     import trimesh
     from inertia_tool.mesh.read import load_mesh
-    from inertia_tool.mass.volume import volume_moments
+    from inertia_tool.integrals import volume_moments
     raw = load_mesh(path)
     best_ours = min(_timed(lambda: volume_moments(raw.vertices, raw.faces)) for _ in range(repeat))
     tm = trimesh.Trimesh(raw.vertices, raw.faces, process=False)

@@ -13,7 +13,7 @@ from inertia_tool.balancing.rotor import (ISO_GRADES, balance, balance_grade, pe
                                   unbalance_state)
 from inertia_tool.errors import UsageError
 from inertia_tool.mass.properties import MassProperties, combine, point_mass
-from inertia_tool.mass.volume import second_moment_to_inertia, volume_moments
+from inertia_tool.integrals import second_moment_to_inertia, volume_moments
 
 STEEL = 7850.0
 Z = [0.0, 0.0, 1.0]

@@ -3,7 +3,7 @@ import pytest
 
 from conftest import box_arrays
 from inertia_tool.mesh.checks import edge_topology, repeated_corner_faces, shell_labels, winding_number
-from inertia_tool.mass.volume import volume_moments
+from inertia_tool.integrals import volume_moments
 
 
 # every test runs on the C extension (when built) and on the pure-numpy path

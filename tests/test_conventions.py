@@ -7,7 +7,7 @@ from conftest import box_arrays
 from inertia_tool import mass_properties
 from inertia_tool.errors import UsageError
 from inertia_tool.mass import point_mass
-from inertia_tool.mass.volume import volume_moments
+from inertia_tool.integrals import volume_moments
 from conftest import assert_tensor_close
 
 

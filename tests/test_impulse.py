@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 from inertia_tool.errors import PhysicsError, UsageError
 from inertia_tool.dynamics.impulse import apply_impulse
 from inertia_tool.mass.properties import MassProperties, point_mass
-from inertia_tool.mass.volume import second_moment_to_inertia, volume_moments
+from inertia_tool.integrals import second_moment_to_inertia, volume_moments
 
 RADIUS, HEIGHT, DENSITY = 0.03, 0.08, 2700.0
 

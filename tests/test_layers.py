@@ -44,6 +44,13 @@ def test_engine_never_imports_reports_or_cli(package):
     assert offenders == {}
 
 
+def test_the_mesh_layer_never_imports_the_mass_layer():
+    """mesh/ sits below mass/ (the volume integrals both need live in the base module inertia_tool.integrals)."""
+    offenders = [str(p.relative_to(PACKAGE)) for p in sorted((PACKAGE / "mesh").rglob("*.py"))
+                 if "mass" in _imported_packages(p)]
+    assert offenders == []
+
+
 def test_the_checker_sees_an_upward_import(tmp_path, monkeypatch):
     """The AST walk finds ``from ..reports.x import y`` in a module one folder down (so the test above can fail)."""
     module = PACKAGE / "mass" / "_probe_for_layers_test.py"

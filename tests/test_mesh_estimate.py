@@ -10,7 +10,7 @@ from inertia_tool.errors import InvalidMeshError, MeshRepairedWarning
 from inertia_tool.mesh.estimate import boundary_edges, enclosing_balls, patched_estimate, winding_estimate
 from inertia_tool.mesh.seal import parallel_body_volume
 from inertia_tool.mesh.winding import winding_numbers
-from inertia_tool.mass.volume import volume_moments
+from inertia_tool.integrals import volume_moments
 
 
 def test_winding_numbers_of_a_sphere_direct_sum():

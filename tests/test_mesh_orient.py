@@ -6,7 +6,7 @@ import trimesh
 from conftest import box_arrays
 from inertia_tool.mesh.merge import merge_close_vertices
 from inertia_tool.mesh.orient import edge_balance, orient_consistently
-from inertia_tool.mass.volume import volume_moments
+from inertia_tool.integrals import volume_moments
 
 
 def _two_tetrahedra_sharing_an_edge():

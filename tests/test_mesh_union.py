@@ -7,7 +7,7 @@ import trimesh
 from conftest import box_arrays
 from inertia_tool.mesh.nesting import shell_nesting
 from inertia_tool.mesh.union import closed_groups, crossing_shells, union_surface
-from inertia_tool.mass.volume import volume_moments
+from inertia_tool.integrals import volume_moments
 
 
 def _stack(parts):

@@ -21,7 +21,7 @@ from conftest import HAVE_ACCEL, REQUIRE_ACCEL, box_arrays, write_binary_stl
 from inertia_tool import _native
 from inertia_tool.mesh.checks import edge_topology, shell_labels
 from inertia_tool.mesh.read import load_mesh
-from inertia_tool.mass.volume import body_volume_moments, volume_moments
+from inertia_tool.integrals import body_volume_moments, volume_moments
 from inertia_tool.mesh.weld import weld_exact
 
 needs_accel = pytest.mark.skipif(not HAVE_ACCEL and not REQUIRE_ACCEL, reason="inertia_tool._accel is not built")
@@ -212,7 +212,7 @@ def test_tetra_sums_per_label_agree(monkeypatch):
     """Per-shell sums in one labelled pass about one origin, against the numpy labelled pass and the numpy
     single-shell pass.  Shells away from the origin lose digits when the sums are moved to their centroid
     (C − V d dᵀ), so the second moments are compared relative to the raw sum's size ``|C| + V |d|²``."""
-    from inertia_tool.mass.volume import reference_point
+    from inertia_tool.integrals import reference_point
     shells = [trimesh.creation.icosphere(subdivisions=4, radius=r) for r in (1.0, 0.5, 2.0)]
     v = np.concatenate([np.asarray(s.vertices) + 5.0 * k for k, s in enumerate(shells)])
     offs = np.cumsum([0] + [len(s.vertices) for s in shells])

@@ -12,7 +12,7 @@ import trimesh
 
 from conftest import HAVE_ACCEL, REQUIRE_ACCEL
 from inertia_tool import _native
-from inertia_tool.mass.volume import bounding_box
+from inertia_tool.integrals import bounding_box
 from inertia_tool.mesh.checks import edge_topology, shell_labels
 
 pytestmark = pytest.mark.skipif(not HAVE_ACCEL and not REQUIRE_ACCEL, reason="inertia_tool._accel is not built")

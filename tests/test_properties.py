@@ -27,7 +27,7 @@ def test_parallel_axis_theorem_against_direct_integration():
     p = mass_properties((v, f))
     point = np.array([1.0, 2.0, -3.0])
     about = np.asarray(p.inertia_about(point))
-    from inertia_tool.mass.volume import volume_moments
+    from inertia_tool.integrals import volume_moments
     vm = volume_moments(v - point, f)
     d = vm.centroid
     second_about_point = vm.second_moment + vm.volume * np.outer(d, d)

@@ -14,7 +14,7 @@ from scipy import integrate
 from inertia_tool import mass_properties
 from inertia_tool.mass import shapes
 from inertia_tool.errors import UsageError
-from inertia_tool.mass.volume import body_volume_moments, second_moment_to_inertia, volume_moments
+from inertia_tool.integrals import body_volume_moments, second_moment_to_inertia, volume_moments
 
 # Small resolutions keep the suite fast; every constructor appears once.
 SOLIDS = {

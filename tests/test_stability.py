@@ -14,7 +14,7 @@ from inertia_tool.errors import PhysicalValidityWarning, PhysicsError, UsageErro
 from inertia_tool.mass.principal import principal_axes
 from inertia_tool.mass.properties import MassProperties
 from inertia_tool.dynamics.spin_stability import polhode_period, stability
-from inertia_tool.mass.volume import second_moment_to_inertia, volume_moments
+from inertia_tool.integrals import second_moment_to_inertia, volume_moments
 
 
 def _octahedron(a, b, c):

@@ -1,4 +1,4 @@
-"""Reference tests of the signed-tetrahedron engine (inertia_tool.mass.volume) against closed forms (the chapter's
+"""Reference tests of the signed-tetrahedron engine (inertia_tool.integrals) against closed forms (the chapter's
 exercises 4.6 and 4.9 and §4.3.2), Tonon (2004)'s published tetrahedron, trimesh, an independent
 surface-quadrature integrator, and hypothesis property tests (rotation, translation, scaling)."""
 
@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from inertia_tool.mass import shapes
 from inertia_tool.mass.properties import MassProperties
-from inertia_tool.mass.volume import body_volume_moments, second_moment_to_inertia, volume_moments
+from inertia_tool.integrals import body_volume_moments, second_moment_to_inertia, volume_moments
 from conftest import assert_tensor_close
 
 

@@ -1,6 +1,7 @@
 """The mass layer: volume and surface integrals, mass properties and their algebra, principal axes.
 
-Stages: :mod:`.volume` (signed tetrahedra, Tonon 2004) and :mod:`.surface` (thin walls) →
+Stages: the volume integrals (signed tetrahedra, Tonon 2004) live below both this layer and the mesh layer, in
+:mod:`inertia_tool.integrals`, since shell classification reads them too; :mod:`.surface` (thin walls) →
 :mod:`.properties` (:class:`~.properties.MassProperties`: parallel-axis theorem, rotations, sums) →
 :mod:`.principal` (principal moments and right-handed axes, Eq. 4.25 of Chapter 4).  :mod:`.pipeline` is the
 entry from a mesh source; :mod:`.thinwall` the shell and printed-part models; :mod:`.shapes` reference solids

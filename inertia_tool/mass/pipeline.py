@@ -23,7 +23,7 @@ from ..mesh.read import load_mesh
 from ..tolerances import NEEDLE_RTOL, TRIANGLE_INEQUALITY_RTOL
 from ..units import material_density
 from .properties import MassProperties, combine
-from .volume import VolumeMoments, second_moment_to_inertia
+from ..integrals import VolumeMoments, second_moment_to_inertia
 
 if TYPE_CHECKING:  # pragma: no cover
     import os

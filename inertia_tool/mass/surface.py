@@ -38,7 +38,7 @@ from numpy.typing import ArrayLike
 
 from ..values import frozen_value
 from ..errors import UsageError
-from .volume import reference_point, second_moment_to_inertia
+from ..integrals import reference_point, second_moment_to_inertia
 
 __all__ = ["SurfaceMoments", "CurveMoments", "surface_moments", "curve_moments", "shell_second_moment",
            "shell_inertia", "wire_inertia", "inward_offset_coefficient"]

@@ -45,7 +45,7 @@ from ..mesh.read import load_mesh
 from .pipeline import MeshSource, resolve_density
 from .properties import MassProperties
 from .surface import inward_offset_coefficient, shell_inertia, surface_moments
-from .volume import second_moment_to_inertia, volume_moments
+from ..integrals import second_moment_to_inertia, volume_moments
 
 __all__ = ["shell_mass_properties", "printed_part", "PrintedPart"]
 

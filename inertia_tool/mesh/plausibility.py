@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import ImplausibleDensityWarning, ImplausibleSizeWarning
 from ..units import implausible_density, implausible_extent
-from ..mass.volume import bounding_box
+from ..integrals import bounding_box
 
 if TYPE_CHECKING:
     from .read import RawMesh

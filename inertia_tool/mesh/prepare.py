@@ -4,7 +4,7 @@ overlapping bodies found).
 
 This stage decides what the triangles mean as a solid; it refuses what it cannot interpret (open,
 non-manifold or inconsistently wound surfaces without ``repair``, flat shells, coordinates beyond float64's
-safe range).  It hands the per-shell volume moments on (:mod:`inertia_tool.mass.volume`, used here to read the
+safe range).  It hands the per-shell volume moments on (:mod:`inertia_tool.integrals`, used here to read the
 sign of each shell), so that the faces are integrated once.
 """
 
@@ -21,7 +21,7 @@ import numpy as np
 from ..values import frozen_value
 from ..errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
                       MeshResolvedWarning, OverlapWarning, UsageError)
-from ..mass.volume import VolumeMoments, body_volume_moments, bounding_box, volume_moments
+from ..integrals import VolumeMoments, body_volume_moments, bounding_box, volume_moments
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh

@@ -86,7 +86,7 @@ def exact_reference(bodies, density=1000.0):
     ``inertia`` (kg·m² about the centre of mass) at ``density`` kg/m³."""
     from types import SimpleNamespace
 
-    from inertia_tool.mass.volume import second_moment_to_inertia, volume_moments
+    from inertia_tool.integrals import second_moment_to_inertia, volume_moments
     vertices, faces, offset = [], [], 0
     for v, f in bodies:
         vertices.append(np.asarray(v, dtype=float))

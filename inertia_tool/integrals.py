@@ -34,8 +34,8 @@ from types import ModuleType
 import numpy as np
 from numpy.typing import NDArray
 
-from ..values import frozen_value
-from .._native import accel, faces_for_c, threads
+from .values import frozen_value
+from ._native import accel, faces_for_c, threads
 
 __all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box"]
 
