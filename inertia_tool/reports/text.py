@@ -47,7 +47,9 @@ def method_line(mesh) -> str:
     if u is None:
         extra = " (shared volume of overlapping bodies counted twice, on request)" if mesh.method == "sum" else ""
         return f"exact for the polyhedron (method: {mesh.method}){extra}"
-    return (f"ESTIMATE (method: {mesh.method}; the file does not define a closed solid): mass within "
+    why = ("the printed part's core is integrated numerically" if mesh.method.endswith("inward offset")
+           else "the file does not define a closed solid")
+    return (f"ESTIMATE (method: {mesh.method}; {why}): mass within "
             f"±{100 * u.mass:.3g}%, centre of mass within {u.center_of_mass:.3g} m, inertia within "
             f"±{100 * u.inertia:.3g}% (Frobenius)")
 
