@@ -273,10 +273,10 @@ def core_moments(vertices: ArrayLike, faces: ArrayLike, depth: float, *, origin:
         closest = np.concatenate([qc[:, None, :], qk[back]], axis=1)
         cell = h ** 3
         sub = cell / _SUB ** 3
-        core, empty = _certain_parts(c, h, t, points, margins, closest)
-        unknown = ~(core | empty)
+        core, outside = _certain_parts(c, h, t, points, margins, closest)
+        unknown = ~(core | outside)
         lower = sub * np.count_nonzero(core, axis=1)
-        upper = cell - sub * np.count_nonzero(empty, axis=1)
+        upper = cell - sub * np.count_nonzero(outside, axis=1)
         est = np.clip(_cube_cut_fraction(-g, m / h) * cell, lower, upper)
         # the estimate's volume spread evenly over the undecided sub-cells (weight w): its moments are then
         # wrong by at most max(w, 1 − w) of each undecided sub-cell's
