@@ -62,6 +62,7 @@ __all__ = [
     "ImplausibleSizeWarning",
     "ImplausibleDensityWarning",
     "ImplausibleCorrectionWarning",
+    "ImplausiblePointWarning",
     "StoragePrecisionWarning",
 ]
 
@@ -254,6 +255,12 @@ class ImplausibleSizeWarning(InertiaToolWarning):
 class ImplausibleDensityWarning(InertiaToolWarning):
     """The density implied by a target ``mass`` lies outside every solid material
     (:data:`inertia_tool.units.PLAUSIBLE_DENSITY`): the mass, the mesh or its length unit is likely wrong."""
+
+
+class ImplausiblePointWarning(InertiaToolWarning):
+    """A reference point (``inertia_about``, ``--about``) lies implausibly far from the part for its size
+    (:data:`inertia_tool.tolerances.FAR_POINT_RATIO` sizes): most likely a units slip, e.g. millimetre
+    coordinates passed to an API that takes metres.  The result is computed as asked."""
 
 
 class ImplausibleCorrectionWarning(InertiaToolWarning):

@@ -52,6 +52,11 @@ DISPLAY_ZERO_RTOL = 1e-12
 #: coordinates), where the file itself has lost digits the reports would print.
 STORAGE_PRECISION_RTOL = 1e-4
 
+#: A reference point farther than ``FAR_POINT_RATIO`` part sizes (bounding-box diagonal, or twice the radius
+#: of gyration without a mesh) from the centre of mass is warned about (``ImplausiblePointWarning``): a
+#: millimetre point read as metres lands 1000 sizes away from a 1-m part, and a point 100 sizes away changes
+#: the tensor by 10⁴ times the central one — rarely what anyone meant.
+FAR_POINT_RATIO = 100.0
 #: Repair (``repair=True``): boundary vertices closer than ``SEAM_GAP_RTOL · diagonal`` to another boundary
 #: vertex, or to a boundary edge (a T-junction), are taken to be one seam that the export split, and are
 #: sealed.  Openings narrower than this are read as artefacts, not slots; the bound of the sealed estimate

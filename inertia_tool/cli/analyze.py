@@ -9,6 +9,9 @@ import os
 import sys
 import warnings
 
+import numpy as np
+
+from ..errors import ImplausiblePointWarning, PhysicsError, UsageError
 from ..errors import OverlapWarning, PhysicsError, UsageError
 from ..reports.serialize import command_output, mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
@@ -17,9 +20,11 @@ from ..dynamics.spin_stability import stability
 from ..robot.inertial import FRAMES, inertial_frame
 from ..mesh.cad import BREP_SUFFIXES, has_ocp
 from ..reports.cad import CAD_UNITS, format_cad_report
+from ..reports.frame import format_frame_inertia, frame_inertia_dict, frame_inertia_section
 from ..reports.models import format_model_note
 from ..robot.formats import ROBOT_FORMATS, format_inertial
 from .help import add_command
+from .options import check_option
 from .model_options import (add_files_argument, add_model_options, load_model, model_words, split_part_spec,
                             with_warnings)
 from .options import density_and_mass
@@ -65,6 +70,14 @@ def run(args) -> int:
             messages.append(message)
             warnings.warn(OverlapWarning(message), stacklevel=1)
     stab, stab_error = _stability_section(props) if fmt in ("json", "text") or args.report else (None, None)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ImplausiblePointWarning)
+        frame = chosen_frame(args, props)
+    messages += [str(w.message) for w in caught if issubclass(w.category, ImplausiblePointWarning)]
+    if frame is not None and fmt in ROBOT_FORMATS:
+        raise UsageError(f"--about applies to text, json and cad output (and --report), not to --format {fmt}: "
+                         "an <inertial> block is about the centre of mass")
+    sections = [frame_inertia_section(frame)] if frame is not None else []
     # the model in the first table too (its section, with the assumptions, comes after the views and tables)
     result = f"exact B-rep of the CAD file ({BREP_METHOD}); the mesh below is its tessellation" if cad else None
     extra = []
@@ -72,6 +85,8 @@ def run(args) -> int:
         from ..reports.brep import brep_html_section
         extra.append(brep_html_section(cad, props.density))
     write_report_from_args(args, props, described + model_words(model), messages, meshes=loaded.meshes,
+                           stability=stab if stab is not None else stab_error, model=model, sections=sections)
+    cad = _brep_section(args) if fmt in ("json", "text") else None
                            stability=stab if stab is not None else stab_error, model=model, extra_sections=extra,
                            result=result)
     if fmt == "json":
@@ -83,6 +98,8 @@ def run(args) -> int:
         out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
         if model["model"] != "solid":
             out["model"] = to_jsonable(model)
+        if frame is not None:
+            out["coordinate_system"] = frame_inertia_dict(frame)
         out["units_assumed"] = loaded.units_assumed          # no --units and no unit in the file: metres taken
         out = command_output("analyze", out, warnings=messages)
         json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
@@ -91,6 +108,7 @@ def run(args) -> int:
         frame = inertial_frame(props, args.frame or "principal")
         print(format_inertial(frame, fmt, source=f"{props.name}: {described}{model_words(model)}"))
     elif fmt == "cad":
+        print(format_cad_report(props, units=args.cad_units or "kg-m", density_source=described, frame=frame))
         print(format_cad_report(props, units=args.cad_units or "kg-m", density_source=described))
         if cad is not None:
             from ..reports.brep import format_brep_comparison
@@ -105,6 +123,8 @@ def run(args) -> int:
             from ..reports.brep import format_brep_comparison
             print(format_brep_comparison(cad, props.density))
         print("\n".join(format_stability(stab)) if stab is not None else f"  spin stability: {stab_error}")
+        if frame is not None:
+            print(format_frame_inertia(frame))
         note = format_model_note(model)
         if note:
             print(note)
@@ -149,7 +169,53 @@ def add_output_options(parser) -> argparse._ArgumentGroup:
                         "mesh-aligned axes with the full tensor")
     g.add_argument("--cad-units", choices=tuple(CAD_UNITS), default=None,
                    help="display units of --format cad (default kg-m; g-mm is SolidWorks' default)")
+    g.add_argument("--about", metavar="X,Y,Z",
+                   help="also give the inertia about this point and the centre of mass relative to it (the "
+                        "output coordinate system's origin), e.g. 101.6mm,152.4mm,0 (bare numbers in --units); "
+                        "text, json, cad and --report")
+    g.add_argument("--axes", metavar="SPEC",
+                   help="axes of that coordinate system (with --about): axis-angle:AX,AY,AZ,ANGLE (e.g. "
+                        "axis-angle:0,0,1,90deg, the system turned from the mesh axes) or matrix:R11,...,R33 "
+                        "(nine numbers, rows; the columns are the system's x, y, z in mesh coordinates)")
     return g
+
+
+def parse_axes(text: str) -> np.ndarray:
+    """``--axes``: ``axis-angle:AX,AY,AZ,ANGLE`` or ``matrix:R11,...,R33`` → (3, 3) rotation (columns: axes)."""
+    from ..rotations import axis_angle_to_matrix
+    from ..units import parse_angle
+    kind, _, rest = str(text).partition(":")
+    parts = [p.strip() for p in rest.split(",")]
+    try:
+        if kind == "axis-angle" and len(parts) == 4:
+            axis = np.array([float(p) for p in parts[:3]])
+            if not np.all(np.isfinite(axis)) or not np.linalg.norm(axis) > 0:
+                raise ValueError
+            # axis_angle_to_matrix is passive (exercise 4.5): its transpose is the active rotation, whose
+            # columns are the mesh axes turned counter-clockwise by the angle: the system's axes
+            passive = axis_angle_to_matrix(axis / np.linalg.norm(axis), parse_angle(parts[3], "deg"))
+            return np.asarray(passive).T
+        if kind == "matrix" and len(parts) == 9:
+            return np.array([float(p) for p in parts]).reshape(3, 3)
+    except (ValueError, UsageError):
+        pass
+    raise UsageError(f"--axes takes axis-angle:AX,AY,AZ,ANGLE (e.g. axis-angle:0,0,1,90deg) or matrix: and nine "
+                     f"numbers, got {text!r}")
+
+
+def chosen_frame(args, props):
+    """The :class:`~inertia_tool.mass.frame.FrameInertia` of ``--about``/``--axes``, or None."""
+    about, axes = getattr(args, "about", None), getattr(args, "axes", None)
+    if about is None and axes is None:
+        return None
+    if about is None:
+        raise UsageError("--axes needs --about (the origin of the coordinate system; --about 0,0,0 for the "
+                         "mesh origin)")
+    from ..mass.frame import inertia_in_frame
+    from ..units import parse_vector
+    from .model_options import length_unit
+    point = check_option("--about", list(parse_vector(about, length_unit(args))), typed=about)
+    return inertia_in_frame(props, point, None if axes is None else parse_axes(axes))
 
 
 def output_format(args) -> str:
