@@ -12,6 +12,7 @@ import warnings
 import numpy as np
 
 from ..errors import ImplausiblePointWarning, PhysicsError, UsageError
+from ..tolerances import PRINTED_MOMENT_TOLERANCE
 from ..errors import OverlapWarning, PhysicsError, UsageError
 from ..reports.serialize import command_output, mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
@@ -49,6 +50,10 @@ def register(subparsers) -> None:
     add_model_options(p)
     o = add_output_options(p)
     o.add_argument("--json", action="store_true", help="print one JSON object (SI); same as --format json")
+    o.add_argument("--moment-tolerance", metavar="FRACTION",
+                   help="manufacturing tolerance on the principal moments, e.g. 1%% or 0.01 of the largest: axes "
+                        "whose moments lie closer are 'indifferent within tolerance' instead of stable or "
+                        f"UNSTABLE (default {100 * PRINTED_MOMENT_TOLERANCE:g}%% with --shell/--infill, else none)")
     add_report_options(p)
     p.set_defaults(func=run)
 
@@ -58,6 +63,9 @@ def run(args) -> int:
     check_report_path(args)
     loaded = load_model(args)
     props, described, model, messages = loaded.props, loaded.density_source, loaded.model, list(loaded.warnings)
+    tolerance = _moment_tolerance(args)
+    stab, stab_error = (_stability_section(props, tolerance) if fmt in ("json", "text") or args.report
+                        else (None, None))
     cad = _brep_section(args)
     if cad is not None:           # STEP/IGES: the exact B-rep is the headline, the tessellation a second line
         target = density_and_mass(args)[1]
@@ -143,10 +151,25 @@ def _brep_section(args):
     return compare(path)
 
 
-def _stability_section(props):
+def _moment_tolerance(args) -> float | None:
+    """``--moment-tolerance`` as a fraction; the printed-part default with ``--shell``; else None."""
+    text = getattr(args, "moment_tolerance", None)
+    if text is None:
+        return PRINTED_MOMENT_TOLERANCE if getattr(args, "shell", None) is not None else None
+    from ..units import parse_fraction
+    try:
+        value = parse_fraction(text)
+    except UsageError:
+        value = -1.0
+    if not 0 <= value < 1:
+        raise UsageError(f"--moment-tolerance must be a fraction in [0, 1) (e.g. 1% or 0.01), got {text!r}")
+    return value
+
+
+def _stability_section(props, tolerance: float | None = None):
     """Spin stability of the principal axes for the report, or ``(None, reason)`` when undefined."""
     try:
-        return stability(props), None
+        return stability(props, moment_tolerance=tolerance), None
     except PhysicsError as exc:
         return None, f"undefined ({exc})"
 
