@@ -131,8 +131,8 @@ def test_part_thinner_than_the_wall_says_no_resolution_helps(capsys, tmp_path):
 def test_cli_spin_it_repair_reads_a_cracked_part(tmp_path, capsys):
     """Its refusal recommended --repair, which spin-it did not have: now it does."""
     import trimesh
-    box = trimesh.creation.box([40, 30, 20])
-    cracked = trimesh.Trimesh(box.vertices, box.faces[1:], process=False)     # one triangle missing
+    box = trimesh.creation.box([40, 30, 20]).subdivide().subdivide().subdivide().subdivide()
+    cracked = trimesh.Trimesh(box.vertices, box.faces[1:], process=False)     # one small triangle missing
     path = tmp_path / "cracked.stl"
     cracked.export(path)
     args = ["spin-it", str(path), "--units", "mm", "--material", "pla", "--axis", "0,0,1", "--wall", "3mm",

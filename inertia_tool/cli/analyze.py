@@ -11,9 +11,8 @@ import warnings
 
 import numpy as np
 
-from ..errors import ImplausiblePointWarning, PhysicsError, UsageError
+from ..errors import ImplausiblePointWarning, OverlapWarning, PhysicsError, UsageError
 from ..tolerances import PRINTED_MOMENT_TOLERANCE
-from ..errors import OverlapWarning, PhysicsError, UsageError
 from ..reports.serialize import command_output, mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
@@ -25,10 +24,9 @@ from ..reports.frame import format_frame_inertia, frame_inertia_dict, frame_iner
 from ..reports.models import format_model_note
 from ..robot.formats import ROBOT_FORMATS, format_inertial
 from .help import add_command
-from .options import check_option
 from .model_options import (add_files_argument, add_model_options, load_model, model_words, split_part_spec,
                             with_warnings)
-from .options import density_and_mass
+from .options import check_option, density_and_mass
 from .report_option import add_report_options, check_report_path, write_report_from_args
 
 __all__ = ["register", "run", "add_output_options", "output_format", "FORMATS", "BREP_METHOD"]
@@ -63,9 +61,6 @@ def run(args) -> int:
     check_report_path(args)
     loaded = load_model(args)
     props, described, model, messages = loaded.props, loaded.density_source, loaded.model, list(loaded.warnings)
-    tolerance = _moment_tolerance(args)
-    stab, stab_error = (_stability_section(props, tolerance) if fmt in ("json", "text") or args.report
-                        else (None, None))
     cad = _brep_section(args)
     if cad is not None:           # STEP/IGES: the exact B-rep is the headline, the tessellation a second line
         target = density_and_mass(args)[1]
@@ -77,24 +72,25 @@ def run(args) -> int:
                        "B-rep values are their sum, so any volume they share is counted twice")
             messages.append(message)
             warnings.warn(OverlapWarning(message), stacklevel=1)
-    stab, stab_error = _stability_section(props) if fmt in ("json", "text") or args.report else (None, None)
+    tolerance = _moment_tolerance(args)
+    stab, stab_error = (_stability_section(props, tolerance) if fmt in ("json", "text") or args.report
+                        else (None, None))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ImplausiblePointWarning)
-        frame = chosen_frame(args, props)
+        system = chosen_frame(args, props)
     messages += [str(w.message) for w in caught if issubclass(w.category, ImplausiblePointWarning)]
-    if frame is not None and fmt in ROBOT_FORMATS:
+    if system is not None and fmt in ROBOT_FORMATS:
         raise UsageError(f"--about applies to text, json and cad output (and --report), not to --format {fmt}: "
                          "an <inertial> block is about the centre of mass")
-    sections = [frame_inertia_section(frame)] if frame is not None else []
     # the model in the first table too (its section, with the assumptions, comes after the views and tables)
     result = f"exact B-rep of the CAD file ({BREP_METHOD}); the mesh below is its tessellation" if cad else None
     extra = []
     if cad is not None and getattr(args, "report", None):
         from ..reports.brep import brep_html_section
         extra.append(brep_html_section(cad, props.density))
+    if system is not None:
+        extra.append(frame_inertia_section(system))
     write_report_from_args(args, props, described + model_words(model), messages, meshes=loaded.meshes,
-                           stability=stab if stab is not None else stab_error, model=model, sections=sections)
-    cad = _brep_section(args) if fmt in ("json", "text") else None
                            stability=stab if stab is not None else stab_error, model=model, extra_sections=extra,
                            result=result)
     if fmt == "json":
@@ -106,8 +102,8 @@ def run(args) -> int:
         out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
         if model["model"] != "solid":
             out["model"] = to_jsonable(model)
-        if frame is not None:
-            out["coordinate_system"] = frame_inertia_dict(frame)
+        if system is not None:
+            out["coordinate_system"] = frame_inertia_dict(system)
         out["units_assumed"] = loaded.units_assumed          # no --units and no unit in the file: metres taken
         out = command_output("analyze", out, warnings=messages)
         json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
@@ -116,8 +112,7 @@ def run(args) -> int:
         frame = inertial_frame(props, args.frame or "principal")
         print(format_inertial(frame, fmt, source=f"{props.name}: {described}{model_words(model)}"))
     elif fmt == "cad":
-        print(format_cad_report(props, units=args.cad_units or "kg-m", density_source=described, frame=frame))
-        print(format_cad_report(props, units=args.cad_units or "kg-m", density_source=described))
+        print(format_cad_report(props, units=args.cad_units or "kg-m", density_source=described, frame=system))
         if cad is not None:
             from ..reports.brep import format_brep_comparison
             print("\n" + format_brep_comparison(cad, props.density).strip("\n"))
@@ -131,8 +126,8 @@ def run(args) -> int:
             from ..reports.brep import format_brep_comparison
             print(format_brep_comparison(cad, props.density))
         print("\n".join(format_stability(stab)) if stab is not None else f"  spin stability: {stab_error}")
-        if frame is not None:
-            print(format_frame_inertia(frame))
+        if system is not None:
+            print(format_frame_inertia(system))
         note = format_model_note(model)
         if note:
             print(note)

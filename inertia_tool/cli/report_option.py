@@ -49,11 +49,6 @@ def check_report_path(args) -> None:
 
 
 def write_report_from_args(args, props, density_source: str | None, warnings=(), *, meshes=(),
-                           stability=None, model=None, sections=()) -> None:
-    """Write the HTML report asked for by ``args.report`` (no-op without it): ``meshes`` are the
-    ``RawMesh`` objects the command read, ``stability`` its verdict (or the reason it is undefined),
-    ``model`` the mass model's summary (:func:`~inertia_tool.reports.models.model_summary`), ``sections``
-    further :class:`~inertia_tool.reports.html.HtmlSection` objects (the chosen coordinate system)."""
                            stability=None, model=None, extra_sections=(), result=None) -> None:
     """Write the HTML report asked for by ``args.report`` (no-op without it): ``meshes`` are the
     ``RawMesh`` objects the command read, ``stability`` its verdict (or the reason it is undefined),
@@ -64,7 +59,6 @@ def write_report_from_args(args, props, density_source: str | None, warnings=(),
     check_report_path(args)
     from ..reports.html import html_report, write_html_report     # imported on use: most runs write no report
     from ..reports.models import model_section
-    extra = ([model_section(model)] if model else []) + list(sections)
     extra = list(extra_sections) + ([model_section(model)] if model else [])
     document = html_report(props, meshes=[(m.vertices, m.faces) for m in meshes], density_source=density_source,
                            warnings=list(warnings), stability=stability, extra_sections=extra, result=result)
