@@ -205,7 +205,8 @@ def run(args) -> int:
         from ..reports.spin_it import spin_it_html
         write_text(args.report, spin_it_html(result, name=args.files, motion=_motion(result), output=args.out),
                    label="--report")
-        say_written([args.report])
+    # status lines go to stderr, every file named once (stdout is the report; docs/usage.md)
+    say_written([args.out, args.plot, args.report])
     if args.json:
         from ..reports.serialize import command_output, method_and_uncertainty
         body = spin_it_dict(result, output=args.out)

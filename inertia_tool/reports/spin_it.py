@@ -155,8 +155,6 @@ def format_spin_it_text(result, *, name: str = "", output: str | None = None) ->
     col = max(len(r[1]) for r in rows) + 2
     lines.append(f"  {'':{width}}  {'before':<{col}}after")
     lines += [f"  {a:{width}}  {b:<{col}}{c}" for a, b, c in rows]
-    if output:
-        lines += ["", f"  wrote {output}"]
     return "\n".join(lines) + "\n"
 
 
