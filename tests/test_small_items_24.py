@@ -75,3 +75,22 @@ def test_spin_it_status_lines_go_to_stderr(tmp_path, capsys):
     assert "wrote" not in captured.out
     assert f"wrote {out}" in captured.err
     assert out.exists()
+
+
+def test_batch_units_are_for_files_without_one(tmp_path, box_bytes):
+    """Issue 24: `batch --units mm` refused every file that declares its own unit (3MF, glTF) instead of
+    honouring it; `analyze` still refuses the contradiction."""
+    trimesh = pytest.importorskip("trimesh")
+    d = tmp_path / "mixed"
+    d.mkdir()
+    (d / "plain.stl").write_bytes(box_bytes)                                   # millimetres, no unit in the file
+    box = trimesh.creation.box([20.0, 30.0, 40.0])
+    box.export(str(d / "declared.3mf"))                                       # 3MF: millimetres declared
+    out = tmp_path / "rows.jsonl"
+    assert main(["batch", str(d), "--units", "cm", "--density", "1000", "--out", str(out), "--jobs", "1"]) == 0
+    rows = {json.loads(line)["path"].rsplit("/", 1)[1]: json.loads(line)
+            for line in out.read_text().splitlines() if line.strip()}
+    assert rows["declared.3mf"]["status"] == "ok"
+    assert rows["declared.3mf"]["volume"] == pytest.approx(24e-6, rel=1e-9)   # its own millimetres
+    assert rows["plain.stl"]["volume"] == pytest.approx(24e-6 * 1000, rel=1e-9)  # --units cm on mm numbers
+    assert main(["analyze", str(d / "declared.3mf"), "--units", "cm"]) == 2

@@ -157,6 +157,9 @@ class BatchOptions:
         written before the options were grouped resume unchanged."""
         flat = {**asdict(self.load), "density": self.density, "material": self.material, "mass": self.mass}
         flat["units"] = flat["units"] or "m"       # not given (metres assumed) gives the numbers of "m"
+        # it changes only files that were refused before: keys stay those of result files written before it
+        # existed (their error rows for such files are kept on resume; a new results file reads them again)
+        flat.pop("declared_units_win", None)
         text = json.dumps(flat, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
