@@ -94,3 +94,27 @@ def test_batch_units_are_for_files_without_one(tmp_path, box_bytes):
     assert rows["declared.3mf"]["volume"] == pytest.approx(24e-6, rel=1e-9)   # its own millimetres
     assert rows["plain.stl"]["volume"] == pytest.approx(24e-6 * 1000, rel=1e-9)  # --units cm on mm numbers
     assert main(["analyze", str(d / "declared.3mf"), "--units", "cm"]) == 2
+
+
+@pytest.mark.parametrize("command", [["analyze"], ["spin"], ["spin-it", "--axis", "0,0,1", "--wall", "2mm",
+                                                              "--resolution", "16"]])
+def test_step_weld_warning_is_said_once_with_the_file_name(tmp_path, capsys, command):
+    """Issue 24: a STEP printed each weld warning twice, once as `<arrays>`."""
+    pytest.importorskip("OCP")
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    shape = BRepAlgoAPI_Fuse(BRepPrimAPI_MakeBox(20, 30, 40).Shape(), BRepPrimAPI_MakeCylinder(5, 60).Shape()).Shape()
+    writer = STEPControl_Writer()
+    writer.Transfer(shape, STEPControl_AsIs)
+    path = str(tmp_path / "part.step")
+    writer.Write(path)
+    capsys.readouterr()
+    args = [command[0], path, "--material", "steel"] + command[1:]
+    if command[0] == "spin-it":
+        pytest.importorskip("manifold3d")
+    main(args)
+    err = capsys.readouterr().err
+    assert "<arrays>" not in err
+    welds = [line for line in err.splitlines() if "welded" in line]
+    assert len(welds) <= 1 and all(path in line for line in welds)
