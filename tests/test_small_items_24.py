@@ -118,3 +118,17 @@ def test_step_weld_warning_is_said_once_with_the_file_name(tmp_path, capsys, com
     assert "<arrays>" not in err
     welds = [line for line in err.splitlines() if "welded" in line]
     assert len(welds) <= 1 and all(path in line for line in welds)
+
+
+def test_balance_html_text_cells_wrap_and_numbers_stay_whole():
+    """Issue 24: the balance HTML report cut its value columns off at 1280 px (long right-aligned text cells
+    that could not wrap, e.g. the grades' "typical rotors").  Text cells are now left-aligned and wrap."""
+    import re
+
+    from inertia_tool.reports.balance import _html_table
+    html = _html_table(["grade", "e·Ω [mm/s]", "typical rotors"],
+                       [["G 6.3", "6.3", "general machinery: pump impellers, fans, flywheels, electric motor rotors"]])
+    cells = re.findall(r"<td([^>]*)>([^<]*)</td>", html)
+    assert cells[0] == (' class="l" style="white-space:nowrap"', "G 6.3")
+    assert cells[1] == ("", "6.3")                                   # numbers: right-aligned, one line
+    assert cells[2][0] == ' class="l"' and cells[2][1].startswith("general machinery")
