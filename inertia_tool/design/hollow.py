@@ -291,8 +291,11 @@ def _too_thin(name: str, grid, wall: float, extent: float, resolution: int, *, c
     head = (f"{name}: no room for a cavity at resolution {resolution} (cells of {h * 1e3:.3g} mm): "
             + why.replace("{w}", f"{wall * 1e3:.3g}") + f"; the part is about {deepest * 1e3:.3g} mm deep at "
             "its thickest")
-    if deepest <= wall:
+    if deepest + h <= wall:      # the grid's depth is within a cell of the true one (design.grid)
         return NoRoomError(head + " — nowhere deeper than the wall: a thinner `wall` is the only way")
+    if deepest <= wall:
+        return NoRoomError(head + f" — a resolution of about {MAX_RESOLUTION} (the largest) may find room; else "
+                           "use a thinner `wall`", suggested=MAX_RESOLUTION)
     needed = int(math.ceil(extent * _CELLS_ACROSS / (2.0 * (deepest - wall))))
     if needed > MAX_RESOLUTION:
         return NoRoomError(head + f" — a resolution of about {needed} would be needed, above the largest "
