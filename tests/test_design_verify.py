@@ -119,10 +119,10 @@ def test_thin_part_says_so_and_a_finer_resolution_is_found():
 def test_part_thinner_than_the_wall_says_no_resolution_helps(capsys, tmp_path):
     v, f = _box(0.04, 0.04, 0.002)
     with pytest.raises(NoRoomError, match="nowhere deeper than the wall"):
-        spin_it((v, f), axis=[0, 0, 1], wall=0.0012, material="PLA", resolution=48)
+        spin_it((v, f), axis=[0, 0, 1], wall=0.002, material="PLA", resolution=48)
     path = tmp_path / "plate.stl"
     shapes.write_stl(shapes.box(0.04, 0.04, 0.002), str(path), units="mm")
-    code = main(["spin-it", str(path), "--units", "mm", "--material", "pla", "--axis", "0,0,1", "--wall", "1.2mm"])
+    code = main(["spin-it", str(path), "--units", "mm", "--material", "pla", "--axis", "0,0,1", "--wall", "2mm"])
     assert code == EXIT_PHYSICS
     err = capsys.readouterr().err
     assert "a thinner --wall is the only way" in err and "Traceback" not in err
