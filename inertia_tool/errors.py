@@ -17,6 +17,8 @@ IsolatedProcessError  a parser run in a child process crashed or hit
 InvalidMeshError      the mesh is read but does not bound a solid
 PhysicsError          valid input, but the request cannot be met
                       (e.g. a singular top)
+DesignRejectedError   a design (spin-it) is worse than its input by
+                      its own verification, on every attempt
 OutputCheckError      a file about to be written failed its own
                       check (nothing was written; a bug to report)
 ====================  ==============================================
@@ -41,6 +43,8 @@ __all__ = [
     "MeshReadError",
     "RobotDescriptionError",
     "InvalidMeshError",
+    "DesignRejectedError",
+    "NoRoomError",
     "PhysicsError",
     "OutputCheckError",
     "IsolatedProcessError",
@@ -58,6 +62,7 @@ __all__ = [
     "ImplausibleSizeWarning",
     "ImplausibleDensityWarning",
     "ImplausibleCorrectionWarning",
+    "ImplausiblePointWarning",
     "StoragePrecisionWarning",
 ]
 
@@ -143,6 +148,23 @@ class IsolatedProcessError(InertiaToolError, OSError):
 
 class PhysicsError(InertiaToolError, ValueError):
     """The input is well formed but the physical request has no valid answer."""
+
+
+class NoRoomError(PhysicsError):
+    """``spin-it``: the part is too thin at the chosen resolution for a cavity inside its wall.
+
+    ``suggested`` is the resolution the part's depth suggests (None when none up to the largest would do).
+    """
+
+    def __init__(self, message: str, suggested: int | None = None):
+        super().__init__(message)
+        self.suggested = suggested
+
+
+class DesignRejectedError(PhysicsError):
+    """A design (``spin-it``) made the part worse by its own verification — the spin axis off a principal
+    axis, a worse objective or a larger simulated wobble — on every attempt; nothing is written (exit code 6).
+    """
 
 
 
@@ -233,6 +255,12 @@ class ImplausibleSizeWarning(InertiaToolWarning):
 class ImplausibleDensityWarning(InertiaToolWarning):
     """The density implied by a target ``mass`` lies outside every solid material
     (:data:`inertia_tool.units.PLAUSIBLE_DENSITY`): the mass, the mesh or its length unit is likely wrong."""
+
+
+class ImplausiblePointWarning(InertiaToolWarning):
+    """A reference point (``inertia_about``, ``--about``) lies implausibly far from the part for its size
+    (:data:`inertia_tool.tolerances.FAR_POINT_RATIO` sizes): most likely a units slip, e.g. millimetre
+    coordinates passed to an API that takes metres.  The result is computed as asked."""
 
 
 class ImplausibleCorrectionWarning(InertiaToolWarning):

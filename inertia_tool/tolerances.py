@@ -52,6 +52,17 @@ DISPLAY_ZERO_RTOL = 1e-12
 #: coordinates), where the file itself has lost digits the reports would print.
 STORAGE_PRECISION_RTOL = 1e-4
 
+#: A reference point farther than ``FAR_POINT_RATIO`` part sizes (bounding-box diagonal, or twice the radius
+#: of gyration without a mesh) from the centre of mass is warned about (``ImplausiblePointWarning``): a
+#: millimetre point read as metres lands 1000 sizes away from a 1-m part, and a point 100 sizes away changes
+#: the tensor by 10⁴ times the central one — rarely what anyone meant.
+FAR_POINT_RATIO = 100.0
+
+#: Default manufacturing tolerance on the principal moments of a printed part (``--shell``/``--infill``),
+#: relative to the largest: an FDM print holds its dimensions to about ±0.1–0.2 mm on a few centimetres
+#: (≈ 0.5 % of a length, so ≈ 1 % of a moment ∝ m L²), and its infill pattern is neither uniform nor isotropic.
+#: Two moments closer than this are "indifferent within tolerance" (``stability(moment_tolerance=...)``).
+PRINTED_MOMENT_TOLERANCE = 0.01
 #: Repair (``repair=True``): boundary vertices closer than ``SEAM_GAP_RTOL · diagonal`` to another boundary
 #: vertex, or to a boundary edge (a T-junction), are taken to be one seam that the export split, and are
 #: sealed.  Openings narrower than this are read as artefacts, not slots; the bound of the sealed estimate

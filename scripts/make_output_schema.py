@@ -139,14 +139,27 @@ defs["model"] = d("The mass model: solid, shell (with its thickness) or printed 
                   {"type": "object", "required": ["model"], "properties": {
                       "model": {"enum": ["solid", "shell", "printed"]}, "thickness": d("m", NN), "skin": d("m", NN),
                       "infill": d("fraction of the core, 0 to 1", NN), "envelope_volume": d("m^3", NN),
-                      "skin_volume_first_order": d("m^3", NN), "offset_coefficient": NN,
-                      "mass_error_estimate": d("relative", NN),
-                      "inertia_error_order": {"type": ["number", "string", "null"]},
+                      "core_volume": d("m^3: the inward offset by the skin (printed; estimate)", NN),
+                      "skin_volume": d("m^3: the part less its inward offset (printed)", NN),
+                      "mass_error_bound": d("relative; a bound that holds (printed)", NN),
+                      "center_of_mass_error_bound": d("m; a bound that holds (printed)", NN),
+                      "inertia_error_bound": d("spectral norm of the error over the largest principal moment; a "
+                                               "bound that holds (printed)", NN),
+                      "cell_size": d("m: finest cells of the core's integration (printed)", NN),
                       "approximation": S}})
 
 defs["analyze"] = command("analyze", {**{k: v for k, v in MP.items() if k != "units"},
                                       "stability": {"anyOf": [arr(ref("stability_axis")), {"type": "null"}]},
-                                      "model": ref("model"), "brep": {"type": "object"}, "units_assumed": B},
+                                      "model": ref("model"), "brep": {"type": "object"}, "units_assumed": B,
+                                      "coordinate_system": obj(
+                                          {"origin": V3, "axes": ref("matrix3"), "center_of_mass": V3,
+                                           "inertia_about_origin": ref("matrix3"),
+                                           "inertia_about_center_of_mass": ref("matrix3"), "convention": S},
+                                          ["origin", "axes", "center_of_mass", "inertia_about_origin",
+                                           "inertia_about_center_of_mass"],
+                                          "analyze --about/--axes: the chosen coordinate system (SI, tensor "
+                                          "convention, the system's axes; axes are its x, y, z in mesh "
+                                          "coordinates)")},
                           MP_REQUIRED + ["stability", "units_assumed"],
                           "inertia-tool analyze --json (also --format json).")
 defs["spin"] = command("spin", {
@@ -274,7 +287,12 @@ defs["spin-it"] = command("spin-it", {
     "after": obj({"metrics": METRICS, "mass_properties": ref("mass_properties")}),
     "insert": {"type": ["object", "null"], "properties": {"density_kg_m3": N, "volume_m3": N, "mass_kg": N,
                                                           "mass_properties": ref("mass_properties")}},
-    "output": SN, "verified": S, "method": ref("method"), "uncertainty": ref("uncertainty")},
+    "output": SN, "verified": S, "method": ref("method"), "uncertainty": ref("uncertainty"),
+    "verification": obj({"passed": B, "attempts": arr(obj({
+        "resolution": COUNT, "ok": B, "reasons": arr(S), "notes": arr(S),
+        "axis_tilt_before": d("rad", N), "axis_tilt_after": d("rad", N), "objective_before": N,
+        "objective_after": N, "wobble_before": NN, "wobble_after": NN}, []))}, ["passed", "attempts"],
+        "the design compared with its input (design/verify.py): every attempt, the last one accepted")},
     ["mode", "axis", "origin_m", "wall_m", "before", "after", "method", "uncertainty"],
     "inertia-tool spin-it --json: the hollowed design, before and after (after = exact re-analysis of the "
     "hollowed mesh; method/uncertainty are the hollowed part's).")

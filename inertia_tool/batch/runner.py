@@ -40,7 +40,7 @@ from ..values import frozen_value
 from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, InertiaToolWarning, MeshReadError, UsageError
 from ..mesh.options import LoadOptions
-from ..mesh.read import SUPPORTED_SUFFIXES, os_error_reason
+from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, os_error_reason
 from ..mesh.regular import open_regular
 from ..mass.pipeline import mass_properties, resolve_density
 from .chunks import DASK_CHUNK_SECONDS, POOL_CHUNK_SECONDS, ChunkSizer, DaskTasks, PoolTasks
@@ -157,6 +157,9 @@ class BatchOptions:
         written before the options were grouped resume unchanged."""
         flat = {**asdict(self.load), "density": self.density, "material": self.material, "mass": self.mass}
         flat["units"] = flat["units"] or "m"       # not given (metres assumed) gives the numbers of "m"
+        # it changes only files that were refused before: keys stay those of result files written before it
+        # existed (their error rows for such files are kept on resume; a new results file reads them again)
+        flat.pop("declared_units_win", None)
         text = json.dumps(flat, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -199,6 +202,15 @@ class BatchSummary:
         return self.computed / self.seconds if self.seconds > 0 and self.computed else 0.0
 
 
+def _mesh_name(name: str, suffixes: tuple[str, ...]) -> bool:
+    """A directory entry ``batch`` reads: a mesh suffix, a compressed mesh (``part.stl.gz``, ``part.obj.bz2``)
+    or a ``.zip`` (which must hold one mesh; its row says so otherwise)."""
+    if name.endswith(suffixes) or name.endswith(".zip"):
+        return True
+    stem, outer = os.path.splitext(name)
+    return outer in COMPRESSED_SUFFIXES and stem.endswith(suffixes)
+
+
 def discover_files(spec: str | os.PathLike, *, suffixes: Sequence[str] = SUPPORTED_SUFFIXES,
                    max_files: int = 10_000_000) -> list[str]:
     """The mesh files named by a directory (searched recursively) or a glob pattern, sorted, absolute.
@@ -208,7 +220,8 @@ def discover_files(spec: str | os.PathLike, *, suffixes: Sequence[str] = SUPPORT
     spec : str or path
         A directory, a glob (``"parts/**/*.stl"``; ``**`` recurses) or a single file.
     suffixes : sequence of str
-        File suffixes taken from a directory (case-insensitive).  A glob or a file is taken as given.
+        File suffixes taken from a directory (case-insensitive), also compressed (``.gz``, ``.bz2``) and
+        ``.zip`` files (issue 24: they were skipped without a word).  A glob or a file is taken as given.
     max_files : int
         Refuse to list more (guards against pointing at ``/``).
 
@@ -224,7 +237,7 @@ def discover_files(spec: str | os.PathLike, *, suffixes: Sequence[str] = SUPPORT
         for root, dirs, names in os.walk(spec):
             dirs.sort()
             for n in sorted(names):
-                if n.lower().endswith(suffixes):
+                if _mesh_name(n.lower(), suffixes):
                     found.append(os.path.join(root, n))
                     if len(found) > max_files:
                         raise UsageError(f"{spec}: more than {max_files:,} mesh files; narrow the pattern")

@@ -20,13 +20,13 @@ import sys
 import warnings
 from collections.abc import Collection
 
-from ..errors import (InertiaToolError, InertiaToolWarning, InvalidMeshError, IsolatedProcessError, MeshReadError,
-                      PhysicsError, RobotDescriptionError, UsageError)
+from ..errors import (DesignRejectedError, InertiaToolError, InertiaToolWarning, InvalidMeshError,
+                      IsolatedProcessError, MeshReadError, PhysicsError, RobotDescriptionError, UsageError)
 from ..reports.escape import escape_terminal
 from .help import SUMMARIES
 
 __all__ = ["main", "build_parser", "exit_code", "speak_options", "EXIT_CODES", "EXIT_OK", "EXIT_INTERNAL",
-           "EXIT_USAGE", "EXIT_MESH", "EXIT_PHYSICS", "EXIT_INCOMPLETE"]
+           "EXIT_USAGE", "EXIT_MESH", "EXIT_PHYSICS", "EXIT_INCOMPLETE", "EXIT_DESIGN"]
 
 EXIT_OK = 0
 EXIT_INTERNAL = 1
@@ -35,6 +35,8 @@ EXIT_MESH = 3
 EXIT_PHYSICS = 4
 #: ``robot``: the report is complete except for links that have no result (each named with its reason).
 EXIT_INCOMPLETE = 5
+#: ``spin-it``: every design it tried was worse than the part (DesignRejectedError); nothing is written.
+EXIT_DESIGN = 6
 
 #: Exit code of each exception type; the most specific class of an exception's MRO that is listed wins.
 EXIT_CODES = {
@@ -44,6 +46,7 @@ EXIT_CODES = {
     InvalidMeshError: EXIT_MESH,
     IsolatedProcessError: EXIT_MESH,
     PhysicsError: EXIT_PHYSICS,
+    DesignRejectedError: EXIT_DESIGN,
     InertiaToolError: EXIT_INTERNAL,
 }
 

@@ -9,7 +9,10 @@ import os
 import sys
 import warnings
 
-from ..errors import OverlapWarning, PhysicsError, UsageError
+import numpy as np
+
+from ..errors import ImplausiblePointWarning, OverlapWarning, PhysicsError, UsageError
+from ..tolerances import PRINTED_MOMENT_TOLERANCE
 from ..reports.serialize import command_output, mass_properties_dict, to_jsonable
 from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
@@ -17,12 +20,13 @@ from ..dynamics.spin_stability import stability
 from ..robot.inertial import FRAMES, inertial_frame
 from ..mesh.cad import BREP_SUFFIXES, has_ocp
 from ..reports.cad import CAD_UNITS, format_cad_report
+from ..reports.frame import format_frame_inertia, frame_inertia_dict, frame_inertia_section
 from ..reports.models import format_model_note
 from ..robot.formats import ROBOT_FORMATS, format_inertial
 from .help import add_command
 from .model_options import (add_files_argument, add_model_options, load_model, model_words, split_part_spec,
                             with_warnings)
-from .options import density_and_mass
+from .options import check_option, density_and_mass
 from .report_option import add_report_options, check_report_path, write_report_from_args
 
 __all__ = ["register", "run", "add_output_options", "output_format", "FORMATS", "BREP_METHOD"]
@@ -44,6 +48,10 @@ def register(subparsers) -> None:
     add_model_options(p)
     o = add_output_options(p)
     o.add_argument("--json", action="store_true", help="print one JSON object (SI); same as --format json")
+    o.add_argument("--moment-tolerance", metavar="FRACTION",
+                   help="manufacturing tolerance on the principal moments, e.g. 1%% or 0.01 of the largest: axes "
+                        "whose moments lie closer are 'indifferent within tolerance' instead of stable or "
+                        f"UNSTABLE (default {100 * PRINTED_MOMENT_TOLERANCE:g}%% with --shell/--infill, else none)")
     add_report_options(p)
     p.set_defaults(func=run)
 
@@ -64,13 +72,24 @@ def run(args) -> int:
                        "B-rep values are their sum, so any volume they share is counted twice")
             messages.append(message)
             warnings.warn(OverlapWarning(message), stacklevel=1)
-    stab, stab_error = _stability_section(props) if fmt in ("json", "text") or args.report else (None, None)
+    tolerance = _moment_tolerance(args)
+    stab, stab_error = (_stability_section(props, tolerance) if fmt in ("json", "text") or args.report
+                        else (None, None))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ImplausiblePointWarning)
+        system = chosen_frame(args, props)
+    messages += [str(w.message) for w in caught if issubclass(w.category, ImplausiblePointWarning)]
+    if system is not None and fmt in ROBOT_FORMATS:
+        raise UsageError(f"--about applies to text, json and cad output (and --report), not to --format {fmt}: "
+                         "an <inertial> block is about the centre of mass")
     # the model in the first table too (its section, with the assumptions, comes after the views and tables)
     result = f"exact B-rep of the CAD file ({BREP_METHOD}); the mesh below is its tessellation" if cad else None
     extra = []
     if cad is not None and getattr(args, "report", None):
         from ..reports.brep import brep_html_section
         extra.append(brep_html_section(cad, props.density))
+    if system is not None:
+        extra.append(frame_inertia_section(system))
     write_report_from_args(args, props, described + model_words(model), messages, meshes=loaded.meshes,
                            stability=stab if stab is not None else stab_error, model=model, extra_sections=extra,
                            result=result)
@@ -83,6 +102,8 @@ def run(args) -> int:
         out["stability"] = stability_dict(stab) if stab is not None else None   # spin stability (§4.4.1)
         if model["model"] != "solid":
             out["model"] = to_jsonable(model)
+        if system is not None:
+            out["coordinate_system"] = frame_inertia_dict(system)
         out["units_assumed"] = loaded.units_assumed          # no --units and no unit in the file: metres taken
         out = command_output("analyze", out, warnings=messages)
         json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
@@ -91,7 +112,7 @@ def run(args) -> int:
         frame = inertial_frame(props, args.frame or "principal")
         print(format_inertial(frame, fmt, source=f"{props.name}: {described}{model_words(model)}"))
     elif fmt == "cad":
-        print(format_cad_report(props, units=args.cad_units or "kg-m", density_source=described))
+        print(format_cad_report(props, units=args.cad_units or "kg-m", density_source=described, frame=system))
         if cad is not None:
             from ..reports.brep import format_brep_comparison
             print("\n" + format_brep_comparison(cad, props.density).strip("\n"))
@@ -105,6 +126,8 @@ def run(args) -> int:
             from ..reports.brep import format_brep_comparison
             print(format_brep_comparison(cad, props.density))
         print("\n".join(format_stability(stab)) if stab is not None else f"  spin stability: {stab_error}")
+        if system is not None:
+            print(format_frame_inertia(system))
         note = format_model_note(model)
         if note:
             print(note)
@@ -123,10 +146,25 @@ def _brep_section(args):
     return compare(path)
 
 
-def _stability_section(props):
+def _moment_tolerance(args) -> float | None:
+    """``--moment-tolerance`` as a fraction; the printed-part default with ``--shell``; else None."""
+    text = getattr(args, "moment_tolerance", None)
+    if text is None:
+        return PRINTED_MOMENT_TOLERANCE if getattr(args, "shell", None) is not None else None
+    from ..units import parse_fraction
+    try:
+        value = parse_fraction(text)
+    except UsageError:
+        value = -1.0
+    if not 0 <= value < 1:
+        raise UsageError(f"--moment-tolerance must be a fraction in [0, 1) (e.g. 1% or 0.01), got {text!r}")
+    return value
+
+
+def _stability_section(props, tolerance: float | None = None):
     """Spin stability of the principal axes for the report, or ``(None, reason)`` when undefined."""
     try:
-        return stability(props), None
+        return stability(props, moment_tolerance=tolerance), None
     except PhysicsError as exc:
         return None, f"undefined ({exc})"
 
@@ -149,7 +187,53 @@ def add_output_options(parser) -> argparse._ArgumentGroup:
                         "mesh-aligned axes with the full tensor")
     g.add_argument("--cad-units", choices=tuple(CAD_UNITS), default=None,
                    help="display units of --format cad (default kg-m; g-mm is SolidWorks' default)")
+    g.add_argument("--about", metavar="X,Y,Z",
+                   help="also give the inertia about this point and the centre of mass relative to it (the "
+                        "output coordinate system's origin), e.g. 101.6mm,152.4mm,0 (bare numbers in --units); "
+                        "text, json, cad and --report")
+    g.add_argument("--axes", metavar="SPEC",
+                   help="axes of that coordinate system (with --about): axis-angle:AX,AY,AZ,ANGLE (e.g. "
+                        "axis-angle:0,0,1,90deg, the system turned from the mesh axes) or matrix:R11,...,R33 "
+                        "(nine numbers, rows; the columns are the system's x, y, z in mesh coordinates)")
     return g
+
+
+def parse_axes(text: str) -> np.ndarray:
+    """``--axes``: ``axis-angle:AX,AY,AZ,ANGLE`` or ``matrix:R11,...,R33`` → (3, 3) rotation (columns: axes)."""
+    from ..rotations import axis_angle_to_matrix
+    from ..units import parse_angle
+    kind, _, rest = str(text).partition(":")
+    parts = [p.strip() for p in rest.split(",")]
+    try:
+        if kind == "axis-angle" and len(parts) == 4:
+            axis = np.array([float(p) for p in parts[:3]])
+            if not np.all(np.isfinite(axis)) or not np.linalg.norm(axis) > 0:
+                raise ValueError
+            # axis_angle_to_matrix is passive (exercise 4.5): its transpose is the active rotation, whose
+            # columns are the mesh axes turned counter-clockwise by the angle: the system's axes
+            passive = axis_angle_to_matrix(axis / np.linalg.norm(axis), parse_angle(parts[3], "deg"))
+            return np.asarray(passive).T
+        if kind == "matrix" and len(parts) == 9:
+            return np.array([float(p) for p in parts]).reshape(3, 3)
+    except (ValueError, UsageError):
+        pass
+    raise UsageError(f"--axes takes axis-angle:AX,AY,AZ,ANGLE (e.g. axis-angle:0,0,1,90deg) or matrix: and nine "
+                     f"numbers, got {text!r}")
+
+
+def chosen_frame(args, props):
+    """The :class:`~inertia_tool.mass.frame.FrameInertia` of ``--about``/``--axes``, or None."""
+    about, axes = getattr(args, "about", None), getattr(args, "axes", None)
+    if about is None and axes is None:
+        return None
+    if about is None:
+        raise UsageError("--axes needs --about (the origin of the coordinate system; --about 0,0,0 for the "
+                         "mesh origin)")
+    from ..mass.frame import inertia_in_frame
+    from ..units import parse_vector
+    from .model_options import length_unit
+    point = check_option("--about", list(parse_vector(about, length_unit(args))), typed=about)
+    return inertia_in_frame(props, point, None if axes is None else parse_axes(axes))
 
 
 def output_format(args) -> str:

@@ -132,7 +132,9 @@ def run(args) -> int:
     results_format(args.out)                      # a bad suffix is a usage error before any work
     density, mass = density_and_mass(args)
     check_option("--jobs", args.jobs)
-    options = BatchOptions(load=load_options_from_args(args), density=density, material=args.material, mass=mass)
+    # --units is for the files without a unit; a file that declares its own (3MF, glTF, STEP) keeps it
+    load = load_options_from_args(args).replace(declared_units_win=True)
+    options = BatchOptions(load=load, density=density, material=args.material, mass=mass)
     options.validate()
     if args.jobs < 1:
         raise UsageError(f"Expected --jobs >= 1, got {args.jobs}")

@@ -348,5 +348,5 @@ def model_words(model: dict) -> str:
         return f"; thin shell {model['thickness']:g} m"
     if model["model"] == "printed":
         return (f"; printed: skin {model['skin']:g} m, infill {100 * model['infill']:g}% "
-                f"(first-order model, mass error about {100 * model['mass_error_estimate']:.2g}%)")
+                f"(inward-offset model, mass within {100 * model['mass_error_bound']:.2g}%)")
     return ""

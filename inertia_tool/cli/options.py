@@ -84,6 +84,7 @@ OPTION_RANGES: dict[str, OptionRange] = {
     "--bearings": _COORDINATE,
     "--pivot": _COORDINATE,
     "--through": _COORDINATE,
+    "--about": _COORDINATE,
     "--wall": _LENGTH,
     "--rpm": _SPEED,
     "--rate": _SPEED,

@@ -60,6 +60,9 @@ def register(subparsers) -> None:
     p.add_argument("--report", metavar="OUT.html",
                    help="write a self-contained HTML report: before/after table and the simulated spin before and "
                         "after (yo-yo: body angular velocity of a free spin; top: nutation angle θ(t))")
+    p.add_argument("--repair", action="store_true",
+                   help="accept a mesh with holes or cracks: design on the repaired surface (every 'after' number "
+                        "is still the exact re-analysis of the hollowed mesh)")
     p.add_argument("--force", action="store_true", help="let --out, --plot and --report replace existing files")
     p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of text")
     p.set_defaults(func=run)
@@ -155,8 +158,8 @@ def _motion(result):
 
 
 def run(args) -> int:
-    from ..design import spin_it
-    from ..reports.spin_it import format_spin_it_text, spin_it_dict
+    from ..design.verify import spin_it_verified
+    from ..reports.spin_it import format_spin_it_text, format_verification, spin_it_dict, verification_dict
 
     if args.out and os.path.splitext(args.out)[1].lower() not in OUTPUT_SUFFIXES:
         raise UsageError(f"--out writes {' or '.join(OUTPUT_SUFFIXES)}, got {args.out!r}")
@@ -178,12 +181,14 @@ def run(args) -> int:
     pivot = check_option("--pivot", list(parse_vector(args.pivot, unit)), typed=args.pivot) if args.pivot else None
     density, mass = density_and_mass(args)
     axis = _direction(args.axis)
+    # verified by re-analysis and simulation, retried on a finer grid; DesignRejectedError (exit 6) otherwise
     with recorded_warnings(args) as messages:
-        result = spin_it(args.files, axis=axis, mode=args.mode, wall=wall,
-                         through=tuple(through) if through is not None else None,
-                         pivot=tuple(pivot) if pivot is not None else None, units=args.units,
-                         density=density, material=args.material, mass=mass,
-                         resolution=args.resolution, insert_density=insert_density)
+        result, verdicts = spin_it_verified(args.files, axis=axis, mode=args.mode, wall=wall,
+                                            through=tuple(through) if through is not None else None,
+                                            pivot=tuple(pivot) if pivot is not None else None, units=args.units,
+                                            density=density, material=args.material, mass=mass,
+                                            resolution=args.resolution, insert_density=insert_density,
+                                            repair=bool(getattr(args, "repair", False)))
     if args.out and result.insert_vertices is not None:
         _write_two_materials(args.out, result, args.material or "part", args.insert)
     elif args.out:
@@ -200,14 +205,17 @@ def run(args) -> int:
         from ..reports.spin_it import spin_it_html
         write_text(args.report, spin_it_html(result, name=args.files, motion=_motion(result), output=args.out),
                    label="--report")
-        say_written([args.report])
+    # status lines go to stderr, every file named once (stdout is the report; docs/usage.md)
+    say_written([args.out, args.plot, args.report])
     if args.json:
         from ..reports.serialize import command_output, method_and_uncertainty
         body = spin_it_dict(result, output=args.out)
         body["method"], body["uncertainty"] = method_and_uncertainty(result.after)   # the hollowed part's
+        body["verification"] = verification_dict(verdicts)
         json.dump(command_output("spin-it", body, warnings=messages), sys.stdout, indent=2, ensure_ascii=False,
                   allow_nan=False)
         sys.stdout.write("\n")
     else:
         sys.stdout.write(format_spin_it_text(result, name=args.files, output=args.out))
+        sys.stdout.write(format_verification(verdicts))
     return 0

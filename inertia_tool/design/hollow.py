@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import AsymmetricTopWarning, PhysicsError, UsageError
+from ..errors import AsymmetricTopWarning, NoRoomError, PhysicsError, UsageError
 from .cavity_mesh import DEPTH_MARGIN, cut_pocket  # noqa: F401  (DEPTH_MARGIN: used by the benchmark too)
 from .grid import interior_grid, surface_distance
 from .limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
@@ -245,7 +245,7 @@ def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80
                              transverse_asymmetry=top.transverse_asymmetry, height=top.length)
 
 
-def _load(source, units: str | None, density, material, mass):
+def _load(source, units: str | None, density, material, mass, repair: bool = False):
     """Checked vertices and faces (m, outward-wound) and the exact mass properties of the solid part."""
     from ..mass.pipeline import mass_properties, resolve_density
     from ..mesh.prepare import prepare_mesh
@@ -256,7 +256,7 @@ def _load(source, units: str | None, density, material, mass):
 
     raw = load_mesh(source, units=units)
     warn_implausible_size(raw, stacklevel=4)
-    prepared = prepare_mesh(raw)
+    prepared = prepare_mesh(raw, repair=repair)
     props = mass_properties((prepared.vertices, prepared.faces), density=rho, mass=mass, name=raw.source,
                             units="m")           # already converted: metres stated, not assumed
     return prepared.vertices, prepared.faces, props, raw.source
@@ -277,10 +277,37 @@ def _exact_near_wall(grid, vertices, faces, wall: float):
     return replace(grid, signed_distance=depth)
 
 
+#: A cavity is meshed when the region deeper than the wall spans about this many cells across.
+_CELLS_ACROSS = 3.0
+
+
+def _too_thin(name: str, grid, wall: float, extent: float, resolution: int, *, chosen: int = 0) -> NoRoomError:
+    """Why no cavity could be made, and the resolution that would leave room: the region deeper than the wall
+    is ``2 (D − wall)`` thick at the deepest point ``D``; it must span ``_CELLS_ACROSS`` cells."""
+    h = grid.spacing
+    deepest = float(np.max(grid.signed_distance[grid.inside])) if np.any(grid.inside) else 0.0
+    why = ("no cell lies deeper than the {w} mm wall plus half a cell" if not chosen else
+           f"the {chosen} cells the optimiser chose are too thin a layer to make a cavity of")
+    head = (f"{name}: no room for a cavity at resolution {resolution} (cells of {h * 1e3:.3g} mm): "
+            + why.replace("{w}", f"{wall * 1e3:.3g}") + f"; the part is about {deepest * 1e3:.3g} mm deep at "
+            "its thickest")
+    if deepest + h <= wall:      # the grid's depth is within a cell of the true one (design.grid)
+        return NoRoomError(head + " — nowhere deeper than the wall: a thinner `wall` is the only way")
+    if deepest <= wall:
+        return NoRoomError(head + f" — a resolution of about {MAX_RESOLUTION} (the largest) may find room; else "
+                           "use a thinner `wall`", suggested=MAX_RESOLUTION)
+    needed = int(math.ceil(extent * _CELLS_ACROSS / (2.0 * (deepest - wall))))
+    if needed > MAX_RESOLUTION:
+        return NoRoomError(head + f" — a resolution of about {needed} would be needed, above the largest "
+                           f"({MAX_RESOLUTION}): use a thinner `wall`", suggested=MAX_RESOLUTION)
+    return NoRoomError(head + f" — try `resolution` {max(needed, resolution + 1)}",
+                       suggested=max(needed, resolution + 1))
+
+
 def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivot=None, units: str | None = None,
             density: float | None = None, material: str | None = None, mass: float | None = None,
             resolution: int = DEFAULT_RESOLUTION, center_weight: float = 1e4, product_weight: float = 1e4,
-            gravity: float = 9.80665, insert_density: float | None = None) -> SpinItResult:
+            gravity: float = 9.80665, insert_density: float | None = None, repair: bool = False) -> SpinItResult:
     """Hollow a part so that it spins stably about ``axis`` (Bächer et al. 2014; Hafner et al. 2024).
 
     Parameters
@@ -313,6 +340,9 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     insert_density : float, optional
         kg/m³ of a denser material that may fill part of the interior (a second quadric region,
         ``design.insert``); it must exceed the part's density.
+    repair : bool
+        Read a damaged mesh (holes, cracks) as ``mass_properties(repair=True)`` does, and design on the
+        repaired surface; every 'after' number is still the exact re-analysis of the hollowed mesh.
 
     Returns
     -------
@@ -338,7 +368,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         pivot = _point(pivot, "pivot")
     elif pivot is not None:
         raise UsageError("`pivot` is for mode 'top'")
-    vertices, faces, before, name = _load(source, units, density, material, mass)
+    vertices, faces, before, name = _load(source, units, density, material, mass, repair)
     if insert_density is not None and not (isinstance(insert_density, (int, float)) and math.isfinite(insert_density)
                                            and insert_density > before.density):
         raise UsageError(f"Expected `insert_density` above the part's {before.density:g} kg/m³, got {insert_density!r}")
@@ -355,6 +385,8 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     grid = _exact_near_wall(interior_grid(vertices, faces, spacing=h), vertices, faces, wall)
     deep = grid.inside & (grid.signed_distance >= wall + DEPTH_MARGIN * h)
     index = np.nonzero(deep)
+    if len(index[0]) == 0:
+        raise (_too_thin(name, grid, wall, extent, resolution))
     centres = grid.centers(index)
     points = (centres - origin) @ frame
     mu_part = moment_vector(before, origin, frame) / rho
@@ -382,6 +414,8 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     out_v, out_f, ins_v, ins_f, measured = cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall)
     after = before
     insert_props = None
+    if out_v is vertices and ins_v is None and int(cavity.removed.sum()) > 0:
+        raise (_too_thin(name, grid, wall, extent, resolution, chosen=int(cavity.removed.sum())))
     if out_v is not vertices:
         after = _reanalysed((out_v, out_f), rho, f"{name} (hollowed)")
     if ins_v is not None:

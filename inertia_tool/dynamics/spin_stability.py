@@ -14,6 +14,11 @@ for ``(i, j, k)`` a cyclic permutation of the principal axes, hence ``ε̈ = c �
 * two moments equal within ``rtol`` and spin about one of them — **marginal**: ``c = 0`` but one of
   ``p, q`` is not, so ε grows *linearly* (the chapter's "slightly unstable").
 * all three equal — **neutral**: every axis is a steady spin.
+* two moments equal within a stated manufacturing tolerance ``moment_tolerance`` (larger than ``rtol``;
+  equal moments included) and spin about one of them — **indifferent** (within tolerance): ``c`` is the
+  product of two moment *differences*, and one of them is smaller than the tolerance, so its sign —
+  stable wobble or tumble — is not fixed by the design; a real part (a print, a casting) may land on
+  either side.
 
 Labels come from a tolerance, but the user-facing numbers do not jump at its edge: ``turns_to_grow``
 solves the linearised motion exactly for any ``p, q`` (exponential, linear or bounded), so a nearly
@@ -42,7 +47,7 @@ from ..tolerances import TRIANGLE_INEQUALITY_RTOL
 __all__ = ["AxisStability", "StabilityReport", "stability", "polhode_period", "KINDS", "AXIS_NAMES"]
 
 #: The stability classes, see ``docs/conventions.md`` ("Spin stability classes").
-KINDS = ("stable", "unstable", "marginal", "neutral")
+KINDS = ("stable", "unstable", "marginal", "neutral", "indifferent")
 
 #: Names of the principal axes in ascending order of moment.
 AXIS_NAMES = ("minor", "intermediate", "major")
@@ -202,11 +207,15 @@ class StabilityReport:
         bare moments.
     rtol : float
         Relative tolerance (of the largest moment) under which two moments count as equal.
+    moment_tolerance : float or None
+        Relative manufacturing tolerance (of the largest moment) under which two moments are indistinguishable
+        in the made part ("indifferent" axes); None when not stated.
     """
 
     axes: tuple
     reference_point: np.ndarray
     rtol: float
+    moment_tolerance: float | None = None
 
     @property
     def moments(self) -> np.ndarray:
@@ -253,8 +262,8 @@ def _moments_and_axes(x, rtol: float):
     return m[order], np.eye(3)[:, order], np.zeros(3)
 
 
-def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL,
-              triangle_rtol: float = TRIANGLE_INEQUALITY_RTOL) -> StabilityReport:
+def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL, triangle_rtol: float = TRIANGLE_INEQUALITY_RTOL,
+              moment_tolerance: float | None = None) -> StabilityReport:
     """Classify steady spin about each principal axis (§4.4.1) and apply the major-axis rule.
 
     Parameters
@@ -269,6 +278,11 @@ def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL,
     triangle_rtol : float
         Relative slack for the triangle inequality ``I1 + I2 ≥ I3`` before a ``PhysicalValidityWarning``
         (bare moments and ``PrincipalAxes`` only; ``mass_properties`` already checks bodies it loads).
+    moment_tolerance : float, optional
+        A manufacturing tolerance on the moments, relative to the largest (e.g. 0.01 for a print).  An axis
+        whose moment lies within it of another's (equal ones included) is labelled ``"indifferent"``:
+        the sign of ``c`` depends on that difference (§4.4.1), which the made part does not keep.  The
+        numbers (``c``, ``turns_to_grow``) stay those of the moments as given.
 
     Returns
     -------
@@ -281,6 +295,8 @@ def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL,
     """
     if not (rtol >= 0 and math.isfinite(rtol)):
         raise UsageError(f"Expected a finite `rtol` >= 0, got {rtol!r}")
+    if moment_tolerance is not None and not (0 <= moment_tolerance < 1):
+        raise UsageError(f"Expected `moment_tolerance` in [0, 1), got {moment_tolerance!r}")
     moments, axes, ref = _moments_and_axes(x, rtol)
     if not np.all(np.isfinite(moments)):
         raise UsageError(f"Expected finite moments, got {moments.tolist()}")
@@ -294,12 +310,18 @@ def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL,
     tol = rtol * moments[2]
     eq = [abs(moments[1] - moments[0]) <= tol, abs(moments[2] - moments[1]) <= tol]
     all_equal = abs(moments[2] - moments[0]) <= tol
+    stated = moment_tolerance is not None and moment_tolerance > rtol
+    made = (moment_tolerance or 0.0) * moments[2]
+    near = [stated and abs(moments[1] - moments[0]) <= made, stated and abs(moments[2] - moments[1]) <= made]
     entries = []
     for k in range(3):
         p, q = _cross_coefficients(moments, k)
         c = p * q
         in_pair = (k <= 1 and eq[0]) or (k >= 1 and eq[1])
-        if all_equal:
+        in_tolerance = (k <= 1 and near[0]) or (k >= 1 and near[1])
+        if in_tolerance:          # the made part need not keep the design's order (or equality) of these moments
+            kind = "indifferent"
+        elif all_equal:
             kind = "neutral"
         elif in_pair:
             kind = "marginal"
@@ -314,7 +336,8 @@ def stability(x, *, rtol: float = DEFAULT_EQUAL_RTOL,
         e.axis.flags.writeable = False
     ref = np.array(ref, dtype=float)
     ref.flags.writeable = False
-    return StabilityReport(axes=tuple(entries), reference_point=ref, rtol=float(rtol))
+    return StabilityReport(axes=tuple(entries), reference_point=ref, rtol=float(rtol),
+                           moment_tolerance=None if moment_tolerance is None else float(moment_tolerance))
 
 
 def polhode_period(moments, angular_velocity) -> float:

@@ -173,7 +173,8 @@ def _part(source: MeshSource, rho: float | None, mass: float | None, options: Lo
 
     ``self_crossing`` is passed to :func:`~inertia_tool.mesh.prepare.prepare_mesh` (``"unverified"`` only for
     meshes the package made itself by a boolean: spin-it's hollowed parts)."""
-    raw = load_mesh(source, units=options.units, max_faces=options.max_faces)
+    raw = load_mesh(source, units=options.units, max_faces=options.max_faces,
+                    declared_units_win=options.declared_units_win)
     prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance,
                             overlap=options.overlap, self_crossing=self_crossing)
     label = name or raw.source

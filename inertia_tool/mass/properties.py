@@ -18,13 +18,29 @@ from numpy.typing import ArrayLike, DTypeLike, NDArray
 
 from ..values import frozen_value
 from ..errors import NonFiniteResultError, UsageError
-from ..tolerances import ROTATION_ATOL
+from ..tolerances import FAR_POINT_RATIO, ROTATION_ATOL
 from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..mesh.checks import MeshReport
 
 __all__ = ["MassProperties", "InertiaTensor", "point_mass", "combine", "parallel_axis_shift"]
+
+
+def warn_far_point(props: "MassProperties", point: NDArray[np.float64], ratio: float, *, stacklevel: int = 2,
+                   what: str = "the point") -> None:
+    """:class:`ImplausiblePointWarning` when ``point`` lies more than ``ratio`` × ``props.size`` from the centre
+    of mass (see :meth:`MassProperties.inertia_about`)."""
+    size = props.size
+    distance = float(np.linalg.norm(point - props.center_of_mass))
+    if size > 0 and distance > ratio * size:
+        import warnings
+
+        from ..errors import ImplausiblePointWarning
+        warnings.warn(f"{props.name or 'body'}: {what} ({', '.join(f'{x:.6g}' for x in point)}) m is "
+                      f"{distance / size:.3g} part sizes ({distance:.4g} m) from the centre of mass of a "
+                      f"{size:.4g} m part: were its coordinates meant in another unit (millimetres read as "
+                      "metres)?", ImplausiblePointWarning, stacklevel=stacklevel + 1)
 
 
 def as_vector3(x: ArrayLike, name: str) -> NDArray[np.float64]:
@@ -152,13 +168,29 @@ class MassProperties:
         """The inertia tensor about the centre of mass, with its reference point."""
         return InertiaTensor(self.inertia, self.center_of_mass)
 
-    def inertia_about(self, point: ArrayLike) -> InertiaTensor:
+    @property
+    def size(self) -> float:
+        """A length scale of the body, m: the mesh's bounding-box diagonal, else twice the radius of gyration
+        ``√(tr I / 2M)`` (0 for a point mass)."""
+        if self.mesh is not None:
+            return float(np.linalg.norm(np.asarray(self.mesh.bbox_max) - np.asarray(self.mesh.bbox_min)))
+        if not self.mass > 0:
+            return 0.0
+        return float(2.0 * np.sqrt(max(np.trace(self.inertia), 0.0) / (2.0 * self.mass)))
+
+    def inertia_about(self, point: ArrayLike, *, far_point_ratio: float | None = FAR_POINT_RATIO) -> InertiaTensor:
         """Inertia tensor about ``point`` (m, mesh axes) by the parallel-axis theorem, Eq. (4.16).
 
         ``I^(p) = I^(cm) + M [(p−R)² δ_ij − (p−R)_i (p−R)_j]``.  The result converts to a (3, 3) array with
         ``np.asarray`` and carries ``reference_point``.
+
+        A point farther than ``far_point_ratio`` sizes (:attr:`size`) from the centre of mass is most likely a
+        units slip (millimetres given as metres): :class:`~inertia_tool.errors.ImplausiblePointWarning` says
+        so, and the result is computed as asked.  ``None`` skips the check.
         """
         p = as_vector3(point, "point")
+        if far_point_ratio is not None:
+            warn_far_point(self, p, far_point_ratio, stacklevel=2)
         return InertiaTensor(self.inertia + parallel_axis_shift(self.mass, p - self.center_of_mass), p)
 
     def moment_about_axis(self, direction: ArrayLike, point: ArrayLike | None = None) -> float:

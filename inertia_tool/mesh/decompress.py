@@ -4,10 +4,11 @@ with bounds into a temporary file for the readers.
 The hostile-input rules of the readers (README, "Bad input") apply: the output is counted while it is
 produced, and inflating stops — and the file is refused as a decompression bomb — as soon as it exceeds
 ``max_bytes`` or, above ``min_ratio_bytes``, ``max_ratio`` times the compressed size.  Nothing larger than
-the limit is ever written or held in memory (16 MiB blocks).  A zip must hold exactly one member with a mesh
-suffix (other members are refused, not guessed among); its sizes are checked from the central directory
-before inflating (for gzip, the size its trailer announces), and again while inflating (a lying directory
-or trailer cannot get past the count).
+the limit is ever written or held in memory (16 MiB blocks).  A zip must hold exactly one member with a
+mesh suffix (other members are refused, not guessed among; macOS ``__MACOSX/`` forks, folder metadata and an
+OBJ's material library and textures are passed over, :data:`IGNORED_ZIP_MEMBERS`); its sizes are checked
+from the central directory before inflating (for gzip, the size its trailer announces), and again while
+inflating (a lying directory or trailer cannot get past the count).
 """
 
 from __future__ import annotations
@@ -26,10 +27,25 @@ from typing import IO, Protocol
 from ..errors import MeshReadError
 from .regular import open_regular
 
-__all__ = ["decompressed", "BLOCK_BYTES"]
+__all__ = ["decompressed", "BLOCK_BYTES", "IGNORED_ZIP_MEMBERS"]
 
 #: Bytes inflated per step.
 BLOCK_BYTES = 16 << 20
+
+#: Zip members that are no part of the geometry and are passed over (not inflated): macOS resource forks
+#: (``__MACOSX/``, ``._name``) and folder metadata that archivers add, and an OBJ's side files (its material
+#: library and textures: colours, not mass).
+IGNORED_ZIP_MEMBERS = ((".mtl", ".png", ".jpg", ".jpeg", ".tga", ".bmp"), (".ds_store", "thumbs.db", "desktop.ini"))
+
+
+def _ignored(name: str) -> bool:
+    """A zip member that carries no geometry (see :data:`IGNORED_ZIP_MEMBERS`)."""
+    parts = name.replace("\\", "/").split("/")
+    base = parts[-1].lower()
+    if "__MACOSX" in parts[:-1] or base.startswith("._"):
+        return True
+    side, metadata = IGNORED_ZIP_MEMBERS
+    return base in metadata or os.path.splitext(base)[1] in side
 
 
 class _Readable(Protocol):
@@ -83,7 +99,7 @@ def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes
         try:
             if outer == ".zip":
                 with open_regular(path) as raw, zipfile.ZipFile(raw) as zf:
-                    members = [i for i in zf.infolist() if not i.is_dir()]
+                    members = [i for i in zf.infolist() if not i.is_dir() and not _ignored(i.filename)]
                     meshes = [i for i in members if os.path.splitext(i.filename)[1].lower() in suffixes]
                     if len(meshes) != 1 or len(members) != 1:
                         names = ", ".join(i.filename[:60] for i in members[:5]) or "nothing"

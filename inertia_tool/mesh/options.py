@@ -53,6 +53,10 @@ class LoadOptions:
     merge_tolerance : float
         Spacing of the tolerance weld, relative to the bounding-box diagonal, used when the bit-exact weld
         leaves the surface open; 0 disables it (default :data:`inertia_tool.tolerances.MERGE_TOLERANCE`).
+    declared_units_win : bool
+        ``units`` is for the files that carry no unit (STL, OBJ, PLY): a file that declares its own (3MF,
+        glTF, COLLADA, STEP) is read in its unit instead of being refused as contradicting ``units``
+        (``batch`` over a mixed folder; issue 24).  Default False: a contradiction is refused.
     max_faces : int
         Refuse sources with more triangles than this (a memory guard checked before allocating).
     """
@@ -62,6 +66,7 @@ class LoadOptions:
     overlap: str = "union"
     merge_tolerance: float = MERGE_TOLERANCE
     max_faces: int = DEFAULT_MAX_FACES
+    declared_units_win: bool = False
 
     def __post_init__(self) -> None:
         if self.units is not None:

@@ -70,6 +70,8 @@ CHECKS = {
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
     "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
     "closed-form": "a primitive (box, cylinder, sphere, capsule, ellipsoid) integrated by its closed form",
+    "inward-offset-bound": "a printed part's core (the inward offset by the skin) integrated on cells of the exact "
+                           "signed distance, with a bracket that holds for any closed mesh (mass/offset.py)",
     "thin-wall-model": "the shell model (mid-surface area × wall thickness, exact surface integrals of the "
                        "polyhedral mid-surface); exact for that model, not a solid integral",
 }

@@ -984,7 +984,8 @@ def _read_with_trimesh_rounding(path: str,
     return v, f, declared, rounding
 
 
-def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFAULT_MAX_FACES) -> RawMesh:
+def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFAULT_MAX_FACES,
+              declared_units_win: bool = False) -> RawMesh:
     """Read a mesh and convert it to metres.
 
     Parameters
@@ -1000,6 +1001,9 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
         Refuse sources with more triangles than this (protects memory).  What a file *announces* (an STL,
         PLY or OFF header, a 3MF's inflated size) is checked against its size and this limit before
         anything is allocated for it.
+    declared_units_win : bool
+        A file that declares its length unit is read in it even when ``units`` says otherwise (``units`` is
+        then for the files without one); default False: the contradiction is refused (:class:`UsageError`).
 
     Returns
     -------
@@ -1044,7 +1048,8 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                                   max_ratio=MAX_ZIP_RATIO, min_ratio_bytes=_ZIP_RATIO_MIN_BYTES,
                                   suffixes=SUPPORTED_SUFFIXES) as (inner, member):
                     try:
-                        raw = load_mesh(inner, units=None if assumed else units, max_faces=max_faces)
+                        raw = load_mesh(inner, units=None if assumed else units, max_faces=max_faces,
+                                        declared_units_win=declared_units_win)
                     except MeshReadError as exc:
                         raise MeshReadError(str(exc).replace(inner, f"{_display(path)}:{member}", 1)) from None
                 return RawMesh(vertices=raw.vertices, faces=raw.faces, source=_display(path), units=raw.units,
@@ -1088,7 +1093,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
             raise _fail(path, f"cannot be read ({os_error_reason(exc, path)})") from None
         name = _display(path)
         if declared is not None:           # the file says its unit: nothing is assumed
-            scale, units = _declared_units_win(name, declared, units, scale)
+            scale, units = _declared_units_win(name, declared, units, 1.0 if declared_units_win else scale)
             assumed = False
         owned = True                       # arrays this function made: scaled in place (no 2nd copy)
     else:

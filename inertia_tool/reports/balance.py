@@ -374,13 +374,31 @@ def _link(name: str) -> str:
 
 
 # ---- HTML ----------------------------------------------------------------------------------------------
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _html_cell(text: str) -> str:
+    if _is_number(text):
+        return f"<td>{escape_html(text)}</td>"
+    keep = ' style="white-space:nowrap"' if len(text) <= 16 else ""       # a label ("G 1600") stays whole
+    return f'<td class="l"{keep}>{escape_html(text)}</td>'
+
+
 def _html_table(head, rows, highlight: str | None = None) -> str:
+    """Numbers right-aligned and kept on one line; text cells (descriptions, values with words) left-aligned
+    and wrapping (``td.l``), so that a long one cannot push the table past the page (issue 24: the grades
+    table was cut off at 1280 px)."""
     e = escape_html
     th = "".join(f"<th>{e(h)}</th>" for h in head)
     body = []
     for r in rows:
         cls = ' class="hl"' if highlight is not None and r[0] == highlight else ""
-        body.append(f"<tr{cls}>" + "".join(f"<td>{e(c)}</td>" for c in r) + "</tr>")
+        body.append(f"<tr{cls}>" + "".join(_html_cell(str(c)) for c in r) + "</tr>")
     return f"<table><thead><tr>{th}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 

@@ -3,7 +3,7 @@
 Formatting and display units only.  Products of inertia are printed in **positive tensor notation**
 (``Lxy = +∫xy dm``), as SolidWorks does, and the report says so; the conversion from the tensor convention
 is :func:`inertia_tool.robot.inertial.positive_tensor_notation`.  The "output coordinate system" is the mesh axes
-with the mesh origin.
+with the mesh origin, or the one given (``analyze --about``/``--axes``).
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ def _tensor_rows(t, prefix: str, digits: int) -> list[str]:
 
 
 def format_cad_report(props: MassProperties, *, units: str = "kg-m", density_source: str | None = None,
-                      digits: int = 8) -> str:
+                      digits: int = 8, frame=None) -> str:
     """The SolidWorks-style "Mass properties" text of ``props``.
 
     Parameters
@@ -57,6 +57,8 @@ def format_cad_report(props: MassProperties, *, units: str = "kg-m", density_sou
         How the density was chosen (printed as a note).
     digits : int
         Significant digits.
+    frame : FrameInertia, optional
+        The output coordinate system (``inertia_tool.mass.frame``); default the mesh axes and origin.
 
     Returns
     -------
@@ -69,8 +71,19 @@ def format_cad_report(props: MassProperties, *, units: str = "kg-m", density_sou
     inertia_unit = f"{mass_name} * square {len_name}"
     ki = km * lm * lm
     pa = props.principal
+    if frame is None:
+        system = "-- mesh axes and origin --"
+        to_frame, origin = np.eye(3), np.zeros(3)
+        central_tensor = props.inertia
+        about_tensor = np.asarray(props.inertia_about(np.zeros(3), far_point_ratio=None))
+    else:
+        to_frame, origin = np.asarray(frame.rotation).T, np.asarray(frame.origin)
+        system = ("-- origin (" + ", ".join(f"{x:.6g}" for x in origin) + ") m, axes "
+                  + "; ".join("(" + ", ".join(f"{x:.6g}" for x in frame.rotation[:, k]) + ")" for k in range(3))
+                  + " in mesh coordinates --")
+        central_tensor, about_tensor = frame.central_inertia, frame.inertia
     lines = [f"Mass properties of {props.name}",
-             "\tCoordinate system: -- mesh axes and origin -- (output coordinate system)",
+             f"\tCoordinate system: {system} (output coordinate system)",
              f"\tUnits: {units} ({mu}, {lu}); SI source values from inertia-tool", ""]
     if np.isfinite(props.density):
         lines.append(f"Density = {_g(props.density * km / lm ** 3, digits)} {mass_name} per cubic {len_name[:-1]}"
@@ -82,24 +95,24 @@ def format_cad_report(props: MassProperties, *, units: str = "kg-m", density_sou
     lines.append("")
     lines.append(f"Surface area = {_g(props.surface_area * lm ** 2, digits)} square {len_name}")
     lines.append("")
-    com = _clean(props.center_of_mass * lm)
+    com = _clean(to_frame @ (props.center_of_mass - origin) * lm)
     lines.append(f"Center of mass: ( {len_name} )")
     lines += [f"\t{c} = {_g(x, digits)}" for c, x in zip("XYZ", com)]
     lines.append("")
     lines.append(f"Principal axes of inertia and principal moments of inertia: ( {inertia_unit} )")
     lines.append("Taken at the center of mass.")
     for k, (ax, p) in enumerate(zip("xyz", "xyz")):
-        a = _clean(pa.axes[:, k])
+        a = _clean(to_frame @ pa.axes[:, k])
         lines.append(f"\t I{ax} = ({', '.join(f'{c:.6f}' for c in a)})   \tP{p} = {_g(pa.moments[k] * ki, digits)}")
     lines.append("")
     notation = ("(Using positive tensor notation: Lxy = +∫xy dm; the inertia tensor element, as in URDF, "
                 "is −Lxy.)")
-    central = _clean(positive_tensor_notation(props.inertia) * ki)
+    central = _clean(positive_tensor_notation(central_tensor) * ki)
     lines.append(f"Moments of inertia: ( {inertia_unit} )")
     lines.append("Taken at the center of mass and aligned with the output coordinate system. " + notation)
     lines += _tensor_rows(central, "L", digits)
     lines.append("")
-    about = _clean(positive_tensor_notation(np.asarray(props.inertia_about(np.zeros(3)))) * ki)
+    about = _clean(positive_tensor_notation(about_tensor) * ki)
     lines.append(f"Moments of inertia: ( {inertia_unit} )")
     lines.append("Taken at the output coordinate system. " + notation.replace("Lxy", "Ixy"))
     lines += _tensor_rows(about, "I", digits)

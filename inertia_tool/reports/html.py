@@ -373,7 +373,7 @@ def _core_sections(props: MassProperties, density_source: str | None, semi,
     verdict = f"<p><strong>Result:</strong> {_e(result or method_line(props.mesh))}</p>"
     sections = [HtmlSection("Mass properties", verdict + _table(None, summary), "mass")]
     ten = _clean(props.inertia)
-    origin = _clean(np.asarray(props.inertia_about(np.zeros(3))))
+    origin = _clean(np.asarray(props.inertia_about(np.zeros(3), far_point_ratio=None)))
     tensor_rows = [[_AXIS_LETTERS[i]] + [f"{x:.6e}" for x in ten[i]] for i in range(3)]
     origin_rows = [[_AXIS_LETTERS[i]] + [f"{x:.6e}" for x in origin[i]] for i in range(3)]
     body = (f"<p>kg·m², mesh axes; {_e(TENSOR_CONVENTION)}. Entries below 1e-12 of the largest show as 0.</p>"

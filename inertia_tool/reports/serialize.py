@@ -110,7 +110,7 @@ def mesh_report_dict(report: MeshReport) -> dict:
 def mass_properties_dict(props: MassProperties, *, density_source: str | None = None) -> dict:
     """The ``analyze --json`` object for one body or assembly (SI throughout)."""
     pa = props.principal
-    origin = np.asarray(props.inertia_about(np.zeros(3)))
+    origin = np.asarray(props.inertia_about(np.zeros(3), far_point_ratio=None))
     out = {
         "name": props.name,
         "units": {"length": "m", "mass": "kg", "inertia": "kg*m^2", "density": "kg/m^3",

@@ -12,7 +12,34 @@ from .html import html_page
 from .serialize import mass_properties_dict, to_jsonable
 from .numbers import number
 
-__all__ = ["spin_it_dict", "format_spin_it_text", "spin_it_figure", "SpinMotion", "spin_it_html", "motion_svgs"]
+__all__ = ["spin_it_dict", "format_spin_it_text", "spin_it_figure", "SpinMotion", "spin_it_html", "motion_svgs",
+           "verification_dict", "format_verification"]
+
+
+def verification_dict(verdicts) -> dict:
+    """JSON-ready record of ``design.verify`` verdicts: the one accepted (last) and every attempt, SI (rad)."""
+    def one(v) -> dict:
+        return {"resolution": v.resolution, "ok": v.ok, "reasons": list(v.reasons),
+                "axis_tilt_before": v.axis_tilt_before, "axis_tilt_after": v.axis_tilt_after,
+                "objective_before": v.objective_before, "objective_after": v.objective_after,
+                "wobble_before": v.wobble_before, "wobble_after": v.wobble_after, "notes": list(v.notes)}
+    return {"passed": bool(verdicts and verdicts[-1].ok), "attempts": [one(v) for v in verdicts]}
+
+
+def format_verification(verdicts) -> str:
+    """Lines saying what the design was checked against and, when it took retries, why."""
+    import math
+    v = verdicts[-1]
+    lines = [f"  verified against the input: spin axis {math.degrees(v.axis_tilt_after):.3g}° from principal "
+             f"(at most 1°, or no worse than the input's {math.degrees(v.axis_tilt_before):.3g}°), objective "
+             f"not worse"]
+    if v.wobble_after is not None:
+        lines[-1] += (f", simulated wobble |ω⊥|/|ω| {v.wobble_before:.3g} → {v.wobble_after:.3g} "
+                      "(free spin knocked 0.1° off the axis)")
+    lines += [f"  NOTE: {note}" for note in v.notes]
+    for earlier in verdicts[:-1]:
+        lines.append(f"  resolution {earlier.resolution} was rejected: " + "; ".join(earlier.reasons))
+    return "\n".join(lines) + "\n"
 
 
 def _metrics_dict(m) -> dict:
@@ -128,8 +155,6 @@ def format_spin_it_text(result, *, name: str = "", output: str | None = None) ->
     col = max(len(r[1]) for r in rows) + 2
     lines.append(f"  {'':{width}}  {'before':<{col}}after")
     lines += [f"  {a:{width}}  {b:<{col}}{c}" for a, b, c in rows]
-    if output:
-        lines += ["", f"  wrote {output}"]
     return "\n".join(lines) + "\n"
 
 

@@ -25,6 +25,7 @@ _KIND_TEXT = {
     "unstable": "UNSTABLE (tumbles: ε grows exponentially)",
     "marginal": "marginal (two equal moments: ε grows linearly)",
     "neutral": "neutral (all moments equal: any axis is steady)",
+    "indifferent": "indifferent within tolerance",
 }
 
 
@@ -70,8 +71,11 @@ def stability_dict(report: StabilityReport, *, perturbation: float = DEFAULT_REP
 
 def format_stability(report: StabilityReport, *, perturbation: float = DEFAULT_REPORT_PERTURBATION) -> list[str]:
     """Lines of the "spin stability" section (§4.4.1)."""
+    tolerance = getattr(report, "moment_tolerance", None)
     lines = ["  spin stability about the principal axes (§4.4.1; ε̈ = c ω² ε; "
-             f"equal moments within {report.rtol:g}):"]
+             f"equal moments within {report.rtol:g}"
+             + (f"; manufacturing tolerance {100 * tolerance:.3g}% of the largest moment" if tolerance else "")
+             + "):"]
     for e in report.axes:
         detail = f"c = {e.coefficient:+.4g}"
         if e.kind == "stable":
@@ -81,6 +85,11 @@ def format_stability(report: StabilityReport, *, perturbation: float = DEFAULT_R
         elif e.kind in ("unstable", "marginal"):
             detail += (f", a {perturbation:g} wobble reaches order one in "
                        f"{_g(e.turns_to_grow(perturbation, 1.0))} turns")
+        elif e.kind == "indifferent":
+            gap = min(abs(e.moment - o.moment) for o in report.axes if o is not e) / report.moments[2]
+            detail += (f" as designed; its moment differs from the next by {gap:.2g} of the largest, less than "
+                       f"the {100 * (tolerance or 0.0):.3g}% tolerance: c is a product of moment differences (§4.4.1), "
+                       "so the made part may wobble or tumble")
         lines.append(f"    I{e.index + 1} {e.name:<12} {e.moment:.6e} kg·m²  axis {_vec(e.axis)}  "
                      f"{_KIND_TEXT[e.kind]}; {detail}")
     stable = [e for e in report.axes if e.dissipation_stable]

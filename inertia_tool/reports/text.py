@@ -47,7 +47,9 @@ def method_line(mesh) -> str:
     if u is None:
         extra = " (shared volume of overlapping bodies counted twice, on request)" if mesh.method == "sum" else ""
         return f"exact for the polyhedron (method: {mesh.method}){extra}"
-    return (f"ESTIMATE (method: {mesh.method}; the file does not define a closed solid): mass within "
+    why = ("the printed part's core is integrated numerically" if mesh.method.endswith("inward offset")
+           else "the file does not define a closed solid")
+    return (f"ESTIMATE (method: {mesh.method}; {why}): mass within "
             f"±{100 * u.mass:.3g}%, centre of mass within {u.center_of_mass:.3g} m, inertia within "
             f"±{100 * u.inertia:.3g}% (Frobenius)")
 
@@ -75,7 +77,7 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
     lines.append(f"  inertia about the centre of mass, mesh axes (kg·m²; {TENSOR_CONVENTION}):")
     lines += _matrix(props.inertia, "    ")
     lines.append("  inertia about the mesh origin (0, 0, 0), mesh axes (kg·m²):")
-    lines += _matrix(np.asarray(props.inertia_about(np.zeros(3))), "    ")
+    lines += _matrix(np.asarray(props.inertia_about(np.zeros(3), far_point_ratio=None)), "    ")
     lines.append("  (shown as 0: matrix and axis entries below 1e-12 of the largest, coordinates below 1e-10 of "
                  "the part size)")
     lines.append("  principal moments (ascending) and axes (unit vectors, mesh axes, right-handed):")
