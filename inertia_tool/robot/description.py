@@ -737,6 +737,17 @@ def _detect(path: str) -> str:
     return fmt
 
 
+def _check_unique_names(links, source: str) -> None:
+    """Refuse two links of one name, as urdfdom, SDFormat and MuJoCo's compiler do: every result, declared
+    inertial and ``--write`` correction is matched to its link by name, so a repeated name would pair one link's
+    numbers with the other's element."""
+    seen: set[str] = set()
+    for link in links:
+        if link.name in seen:
+            raise _fail(source, f"two links are named {link.name[:80]!r}; expected every link name to be unique")
+        seen.add(link.name)
+
+
 def read_robot(path, *, packages: dict | None = None, geometry: str = "collision",
                mappings: dict | None = None, run_xacro: bool = False, limits=None) -> RobotDescription:
     """Read a URDF, xacro, SDFormat or MJCF file into a :class:`RobotDescription`.
@@ -806,4 +817,5 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         name, links = _read_sdf(root, source, base, packages, geometry)
     if not links:
         raise _fail(source, "no links found")
+    _check_unique_names(links, source)
     return RobotDescription(name=name, source=source, format=fmt, geometry=geometry, links=links, document=data)
