@@ -6,7 +6,8 @@ snippets, PNG figures) goes through this module, so there is one overwrite rule 
 * :func:`check_targets` refuses, before any work and before any file is written, a target that exists
   (unless ``force``), is a symbolic link (even with ``force``: the tool neither writes through a link nor
   replaces it), is a directory, is a device, named pipe or socket (even with ``force``), or lies in a
-  missing directory.  A command that writes several files checks **all** of them first, so it never stops half-way with some files replaced.
+  missing directory.  A command that writes several files checks **all** of them first, so it never stops
+  half-way with some files replaced.
 * :func:`atomic_target` / :func:`write_text` / :func:`write_bytes` write to a temporary file in the target's
   own directory (same file system) with an unpredictable name created ``O_EXCL | O_NOFOLLOW`` (so a
   planted file or symbolic link is never followed), ``fsync`` it, then rename it onto the target: a reader
