@@ -32,7 +32,8 @@ from dataclasses import field
 
 import numpy as np
 
-from ..errors import RobotDescriptionError, UsageError
+from ..errors import MeshReadError, RobotDescriptionError, UsageError
+from ..mesh.regular import open_regular
 from ..values import frozen_value
 from .resolve import MAX_FOLDERS_UP, package_directory, resolve_uri
 
@@ -343,14 +344,24 @@ def parse_xml(data: bytes, source: str):
         raise _fail(source, f"not well-formed XML ({exc})") from None
 
 
-def _read_bytes(path: str) -> bytes:
-    if not os.path.isfile(path):
-        raise _fail(path, "no such file" if not os.path.exists(path) else "is not a regular file")
-    size = os.path.getsize(path)
-    if size > MAX_DESCRIPTION_BYTES:
-        raise _fail(path, f"{size:,} bytes, more than the {MAX_DESCRIPTION_BYTES:,} a robot description may have")
-    with open(path, "rb") as fh:
-        return fh.read()
+def _read_bytes(path: str, *, head: int | None = None) -> bytes:
+    """The bytes of the description file ``path`` (only its first ``head`` bytes when given).
+
+    Opened only as a regular file (:func:`~inertia_tool.mesh.regular.open_regular`: a named pipe or a device
+    is refused, never waited on), and never more than :data:`MAX_DESCRIPTION_BYTES` read."""
+    try:
+        fh = open_regular(path)
+    except FileNotFoundError:
+        raise _fail(path, "no such file") from None
+    except MeshReadError as exc:                 # "PATH: is a FIFO (named pipe), not a regular file"
+        raise RobotDescriptionError(str(exc)) from None
+    except OSError as exc:
+        raise _fail(path, f"cannot be read ({exc.strerror or exc})") from None
+    with fh:
+        data = fh.read(MAX_DESCRIPTION_BYTES + 1 if head is None else head)
+    if head is None and len(data) > MAX_DESCRIPTION_BYTES:
+        raise _fail(path, f"more than the {MAX_DESCRIPTION_BYTES:,} bytes a robot description may have")
+    return data
 
 
 # -- xacro -------------------------------------------------------------------------------------------------
