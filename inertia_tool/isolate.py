@@ -35,7 +35,6 @@ import io
 import json
 import os
 import pickle
-import re
 import shutil
 import signal
 import subprocess
@@ -46,6 +45,7 @@ from collections.abc import Mapping
 from typing import Any, Callable
 
 from .errors import IsolatedProcessError, UsageError
+from .units import DECIMAL
 from .values import frozen_value
 
 __all__ = ["Limits", "run_isolated", "limits_from_environment", "XACRO_LIMITS", "CAD_LIMITS",
@@ -98,13 +98,11 @@ _MEMORY_SUFFIXES = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30}
 _MOST_SECONDS = 1e9
 _MOST_BYTES = 1 << 62
 
-#: A limit in seconds: a plain decimal number (no ``1_0``, ``inf`` or ``nan``, which ``float`` would take).
-_SECONDS = re.compile(r"[0-9]+(?:\.[0-9]*)?(?:[eE][+-]?[0-9]+)?|\.[0-9]+(?:[eE][+-]?[0-9]+)?", re.ASCII)
 
 
 def _positive(name: str, text: str) -> float:
     text = text.strip()
-    value = float(text) if _SECONDS.fullmatch(text) else float("nan")
+    value = float(text) if DECIMAL.fullmatch(text) else float("nan")     # no 1_0, inf, nan
     if not 0 < value <= _MOST_SECONDS:
         raise UsageError(f"Expected {name} to be a number of seconds above 0 and at most {_MOST_SECONDS:g}, "
                          f"got {text!r}")

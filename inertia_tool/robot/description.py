@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import MeshReadError, RobotDescriptionError, UsageError
 from ..mesh.regular import open_regular
+from ..units import DECIMAL
 from ..values import frozen_value
 from .resolve import MAX_FOLDERS_UP, package_directory, resolve_uri
 
@@ -68,11 +69,9 @@ ROBOT_LENGTH_RANGE = (1e-9, 1e9)
 #: coordinates are bounded by the reader, so a factor in this range keeps the scaled mesh finite.
 ROBOT_SCALE_RANGE = (1e-9, 1e9)
 
-#: The one number grammar of robot files: a decimal as XML Schema's ``xsd:double`` lexical form (optional sign,
-#: ASCII digits with an optional fraction or a fraction alone, optional exponent), without ``INF`` and ``NaN``.
-#: Python's ``float()`` also takes ``1_000``, ``inf``, ``nan`` and non-ASCII digits (``١٢``); none is a number
-#: of URDF, SDFormat or MJCF, so none is accepted.
-_DECIMAL = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
+#: The one number grammar of robot files (:data:`inertia_tool.units.DECIMAL`: ``xsd:double`` without ``INF``
+#: and ``NaN``; no ``1_000``, ``inf``, ``nan`` or non-ASCII digits, which Python's ``float()`` would take).
+_DECIMAL = DECIMAL
 
 
 def rpy_to_matrix(rpy) -> np.ndarray:
