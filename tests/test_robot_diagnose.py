@@ -148,7 +148,7 @@ def test_audit_gives_the_nearest_valid_tensor_for_an_impossible_one(tmp_path):
 
 
 @settings(max_examples=50, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.sampled_from([1.0, -1.0]), st.sampled_from([1.0, -1.0]))
+@given(st.integers(0, 2**32 - 2), st.sampled_from([1.0, -1.0]), st.sampled_from([1.0, -1.0]))
 def test_the_angle_between_principal_frames_ignores_their_handedness(seed, sign_a, sign_b):
     # eigh returns a left-handed frame about half the time; with one frame of each hand every sign choice was
     # skipped and the evidence read "axes turned by 180°" for axes that were not turned at all
