@@ -45,6 +45,7 @@ from collections.abc import Mapping
 from typing import Any, Callable
 
 from .errors import IsolatedProcessError, UsageError
+from .units import DECIMAL
 from .values import frozen_value
 
 __all__ = ["Limits", "run_isolated", "limits_from_environment", "XACRO_LIMITS", "CAD_LIMITS",
@@ -92,13 +93,19 @@ _ENV_CPU, _ENV_MEMORY, _ENV_WALL = "INERTIA_TOOL_CPU_LIMIT", "INERTIA_TOOL_MEMOR
 _MEMORY_SUFFIXES = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30}
 
 
+#: Largest limits accepted: seconds (about 30 years) and bytes (``setrlimit`` takes a C long; a larger value
+#: made the child fail before running the job).
+_MOST_SECONDS = 1e9
+_MOST_BYTES = 1 << 62
+
+
+
 def _positive(name: str, text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not (value > 0 and value != float("inf")):
-        raise UsageError(f"Expected {name} to be a positive number, got {text!r}")
+    text = text.strip()
+    value = float(text) if DECIMAL.fullmatch(text) else float("nan")     # no 1_0, inf, nan
+    if not 0 < value <= _MOST_SECONDS:
+        raise UsageError(f"Expected {name} to be a number of seconds above 0 and at most {_MOST_SECONDS:g}, "
+                         f"got {text!r}")
     return value
 
 
@@ -122,10 +129,11 @@ def limits_from_environment(default: Limits, environ: Mapping[str, str] | None =
         text = environ[_ENV_MEMORY].strip().upper().removesuffix("B")
         suffix = text[-1:] if text[-1:] in _MEMORY_SUFFIXES else ""
         number = text[:-1] if suffix else text
-        if not number.isdigit():
-            raise UsageError(f"Expected {_ENV_MEMORY} to be a number of bytes (e.g. 2G, 512M), "
-                             f"got {environ[_ENV_MEMORY]!r}")
-        limits = replace(limits, memory_bytes=int(number) * _MEMORY_SUFFIXES[suffix])
+        memory = int(number) * _MEMORY_SUFFIXES[suffix] if number.isascii() and number.isdigit() else 0
+        if not 0 < memory <= _MOST_BYTES:
+            raise UsageError(f"Expected {_ENV_MEMORY} to be a number of bytes above 0 and at most 2^62 (e.g. 2G, "
+                             f"512M), got {environ[_ENV_MEMORY]!r}")
+        limits = replace(limits, memory_bytes=memory)
     return limits
 
 

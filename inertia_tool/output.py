@@ -5,8 +5,9 @@ snippets, PNG figures) goes through this module, so there is one overwrite rule 
 
 * :func:`check_targets` refuses, before any work and before any file is written, a target that exists
   (unless ``force``), is a symbolic link (even with ``force``: the tool neither writes through a link nor
-  replaces it), is a directory, or lies in a missing directory.  A command that writes several files checks
-  **all** of them first, so it never stops half-way with some files replaced.
+  replaces it), is a directory, is a device, named pipe or socket (even with ``force``), or lies in a
+  missing directory.  A command that writes several files checks **all** of them first, so it never stops
+  half-way with some files replaced.
 * :func:`atomic_target` / :func:`write_text` / :func:`write_bytes` write to a temporary file in the target's
   own directory (same file system) with an unpredictable name created ``O_EXCL | O_NOFOLLOW`` (so a
   planted file or symbolic link is never followed), ``fsync`` it, then rename it onto the target: a reader
@@ -24,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import stat
 import tempfile
 from collections.abc import Iterator, Mapping, Sequence
 
@@ -68,11 +70,29 @@ def check_targets(targets: Sequence[str | None | tuple[str | None, str | None]],
                                   "(name the file it points to)")
         if os.path.isdir(path):
             raise OutputFileError(f"{where}: is a directory")
+        _refuse_special(path, where)
         if os.path.lexists(path) and not force:
             raise OutputFileError(f"{where}: exists; refusing to overwrite it (`force=True` overwrites it)")
         parent = os.path.dirname(full)
         if not os.path.isdir(parent):
             raise OutputFileError(f"{where}: cannot write it (no such directory: {parent})")
+
+
+_SPECIAL_KINDS = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                  (stat.S_ISFIFO, "a named pipe"), (stat.S_ISSOCK, "a socket"))
+
+
+def _refuse_special(path: str, where: str) -> None:
+    """Refuse a target that exists and is not a regular file, even with ``force``: the rename would put a
+    regular file where ``/dev/null``, a named pipe or a socket was (as root, ``/dev/null`` itself)."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return
+    for test, kind in _SPECIAL_KINDS:
+        if test(mode):
+            raise OutputFileError(f"{where}: is {kind}, not a regular file; refusing to replace it (name a "
+                                  "file to write)")
 
 
 def _fsync_directory(directory: str) -> None:
@@ -134,6 +154,7 @@ def _commit(fd: int, tmp: str, created: os.stat_result, path: str, where: str, r
     if mode is not None:
         os.fchmod(fd, mode)                          # mkstemp makes 0600; give the file the usual rights
     if replace:
+        _refuse_special(path, where)                 # a pipe or device made since check_targets
         os.replace(tmp, path)
         return
     try:

@@ -11,7 +11,7 @@ import re
 
 from .errors import MaterialError, UnitsError
 
-__all__ = ["LENGTH_UNITS", "MATERIALS", "length_scale", "material_density", "parse_length",
+__all__ = ["DECIMAL", "LENGTH_UNITS", "MATERIALS", "length_scale", "material_density", "parse_length",
            "parse_angular_rate", "parse_duration", "parse_mass", "parse_density", "parse_angle", "parse_vector",
            "parse_fraction", "PLAUSIBLE_EXTENT", "PLAUSIBLE_DENSITY", "implausible_extent", "implausible_density"]
 
@@ -86,7 +86,13 @@ def material_density(name: str) -> float:
     return MATERIALS[key]
 
 
-_NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+#: The one grammar of a written number (command-line values, robot files, limits in the environment): a decimal
+#: as XML Schema's ``xsd:double`` lexical form (optional sign, ASCII digits with an optional fraction or a
+#: fraction alone, optional exponent), without ``INF`` and ``NaN``.  Python's ``float()`` also takes
+#: ``1_000``, ``inf``, ``nan`` and non-ASCII digits (``١٢``); none of them is accepted.
+DECIMAL = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
+
+_NUM = f"({DECIMAL.pattern})"
 
 
 def _split(text: str, what: str) -> tuple[float, str]:

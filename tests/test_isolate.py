@@ -117,7 +117,12 @@ def test_limits_from_the_environment():
     assert limits_from_environment(XACRO_LIMITS, {}) == XACRO_LIMITS
     assert limits_from_environment(XACRO_LIMITS, {"INERTIA_TOOL_MEMORY_LIMIT": "3G"}).memory_bytes == 3 << 30
     for name, value in (("INERTIA_TOOL_CPU_LIMIT", "-1"), ("INERTIA_TOOL_CPU_LIMIT", "inf"),
-                        ("INERTIA_TOOL_WALL_LIMIT", "nan"), ("INERTIA_TOOL_MEMORY_LIMIT", "lots")):
+                        ("INERTIA_TOOL_WALL_LIMIT", "nan"), ("INERTIA_TOOL_MEMORY_LIMIT", "lots"),
+                        # review: 0 bytes, and limits setrlimit cannot take, made the child fail before the job
+                        # ("ended without an answer"); 1_0 was read as 10 by float
+                        ("INERTIA_TOOL_MEMORY_LIMIT", "0"), ("INERTIA_TOOL_MEMORY_LIMIT", "99999999999999999999G"),
+                        ("INERTIA_TOOL_CPU_LIMIT", "1e308"), ("INERTIA_TOOL_WALL_LIMIT", "1_0"),
+                        ("INERTIA_TOOL_MEMORY_LIMIT", "\u0663M")):
         with pytest.raises(UsageError, match=name):
             limits_from_environment(CAD_LIMITS, {name: value})
 

@@ -1,6 +1,7 @@
 """The one output writer (inertia_tool.output) and the commands that write files through it."""
 
 import os
+import stat
 
 import numpy as np
 import pytest
@@ -204,6 +205,27 @@ def test_a_symlink_target_is_refused_even_with_force(tmp_path):
         write_bytes(dangling, b"x", replace=False)
     assert victim.read_text() == "precious" and not (tmp_path / "nowhere").exists()
     assert _names(tmp_path) == ["dangling.md", "out.md", "victim.txt"]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX")
+def test_a_named_pipe_is_not_replaced_even_with_force(tmp_path, capsys):
+    # `robot --write /dev/null --force` (as root) renamed a regular file over /dev/null; a named pipe stands in
+    # for the device here.  Refused at the check and again at the rename (a pipe made after the check)
+    pipe = tmp_path / "out.urdf"
+    os.mkfifo(pipe)
+    for force in (False, True):
+        with pytest.raises(OutputFileError, match="named pipe, not a regular file"):
+            check_targets([str(pipe)], force=force)
+    with pytest.raises(OutputFileError, match="named pipe"):
+        write_bytes(pipe, b"x", replace=True)
+    robot = tmp_path / "r.urdf"
+    robot.write_text('<robot name="r"><link name="l"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" '
+                     'iyy="1" iyz="0" izz="1"/></inertial><collision><geometry><box size="0.1 0.2 0.3"/>'
+                     '</geometry></collision></link></robot>')
+    assert main(["robot", str(robot), "--keep-mass", "--write", str(pipe), "--force"]) == 2
+    assert "named pipe" in capsys.readouterr().err
+    assert stat.S_ISFIFO(os.lstat(pipe).st_mode)
+    assert _names(tmp_path) == ["out.urdf", "r.urdf"]
 
 
 def test_no_hard_links_falls_back_to_a_checked_replace(tmp_path, monkeypatch):

@@ -538,7 +538,9 @@ def test_urdf_with_too_many_links_is_refused(tmp_path):
     path.write_text('<robot name="r">' + '<link name="l"/>' * (MAX_ROBOT_LINKS + 1) + "</robot>")
     with pytest.raises(RobotDescriptionError, match="10,001 links .*more than the 10,000 allowed"):
         read_robot(path)
-    path.write_text('<robot name="r">' + '<link name="l"/>' * MAX_ROBOT_LINKS + "</robot>")
+    # at the limit, links of distinct names (two links of one name are refused on their own)
+    path.write_text('<robot name="r">' + "".join(f'<link name="l{i}"/>' for i in range(MAX_ROBOT_LINKS))
+                    + "</robot>")
     assert len(read_robot(path).links) == MAX_ROBOT_LINKS
 
 

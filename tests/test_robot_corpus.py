@@ -2,8 +2,10 @@
 likely cause of each bad inertial named, one summary; a model that cannot be read never stops the others."""
 
 import json
+import os
 
 import numpy as np
+import pytest
 
 from inertia_tool.cli import EXIT_INCOMPLETE, EXIT_OK, main
 from inertia_tool.robot.corpus import find_descriptions
@@ -62,3 +64,15 @@ def test_corpus_refuses_write(tmp_path, capsys):
     root = _corpus(tmp_path)
     assert main(["robot", str(root), "--keep-mass", "--write", str(tmp_path / "x.urdf")]) == 2
     assert "only audited" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX")
+def test_a_named_pipe_among_the_models_is_unreadable_not_waited_on(tmp_path, capsys):
+    # `robot pipe.xml a.urdf` sniffed pipe.xml with open(): it waited for a writer for ever
+    _urdf(tmp_path / "a.urdf", "a", 0.001)
+    pipe = tmp_path / "pipe.xml"
+    os.mkfifo(pipe)
+    assert main(["robot", str(pipe), str(tmp_path / "a.urdf"), "--keep-mass"]) == EXIT_INCOMPLETE
+    out = capsys.readouterr().out
+    assert "pipe.xml: is a FIFO (named pipe), not a regular file" in out
+    assert "2 models (1 unreadable)" in out

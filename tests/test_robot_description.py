@@ -204,3 +204,22 @@ def test_billion_laughs_is_refused_not_expanded(tmp_path, suffix):
     f.write_text(LAUGHS)                          # 10⁹ bytes if expanded
     with pytest.raises(RobotDescriptionError, match="amplification"):
         read_robot(f, run_xacro=True)
+
+
+@pytest.mark.parametrize("suffix, text", [
+    (".urdf", '<robot name="r"><link name="l"><inertial><mass value="2"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" '
+              'iyz="0" izz="1"/></inertial><collision><geometry><box size="1 1 1"/></geometry></collision></link>'
+              '<link name="l"><collision><geometry><box size="1 2 1"/></geometry></collision></link></robot>'),
+    (".sdf", '<sdf version="1.9"><model name="m"><link name="l"><collision name="c"><geometry><box><size>1 1 1'
+             '</size></box></geometry></collision></link><link name="l"><collision name="c"><geometry><box><size>'
+             '1 2 1</size></box></geometry></collision></link></model></sdf>'),
+    (".xml", '<mujoco><worldbody><body name="l"><geom type="box" size="1 1 1"/></body><body name="l">'
+             '<geom type="box" size="1 2 1"/></body></worldbody></mujoco>')])
+def test_two_links_of_one_name_are_refused(tmp_path, suffix, text):
+    # results, declared inertials and --write corrections are matched by link name: with two links named 'l',
+    # --keep-mass paired the first link's declared mass with the second and --write put the first box's tensor
+    # into the second link's new <inertial>
+    path = tmp_path / f"dup{suffix}"
+    path.write_text(text)
+    with pytest.raises(RobotDescriptionError, match="two links are named 'l'"):
+        read_robot(path)

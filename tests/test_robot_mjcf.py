@@ -138,6 +138,39 @@ def test_the_geoms_own_orientation_replaces_its_class_orientation(tmp_path):
         _assert_like_mujoco(path, link_inertials(read_robot(path), density=1000))
 
 
+def _box_tensor(tmp_path, orientation):
+    path = tmp_path / "o.xml"
+    path.write_text('<mujoco><worldbody><body name="b"><geom type="box" size="0.1 0.2 0.3" pos="0 0.5 0" '
+                    f'{orientation}/></body></worldbody></mujoco>')
+    return link_inertials(read_robot(path), density=1000)[0].properties.inertia
+
+
+@pytest.mark.parametrize("attribute, numbers", [
+    ("quat", (1.0, 1.0, 0.0, 0.0)), ("quat", (0.7, 0.0, 0.7, 0.1)), ("axisangle", (1.0, 2.0, 3.0, 40.0)),
+    ("zaxis", (1.0, 1.0, 0.0)), ("xyaxes", (1.0, 1.0, 0.0, -1.0, 2.0, 0.5))])
+@pytest.mark.parametrize("factor", [1e300, 1e-300])
+def test_an_orientation_scaled_near_the_float_limits_is_the_same_rotation(tmp_path, attribute, numbers, factor):
+    # a quaternion or axis stands for its direction: ×1e300 once overflowed the norm to inf and silently gave
+    # the identity rotation (an unrotated tensor labelled exact), ×1e-300 underflowed it to a refusal; xyaxes
+    # shorter than 1e-6 are refused, as MuJoCo refuses them (next test)
+    if attribute == "xyaxes" and factor < 1:
+        factor = 1e-5
+    scaled = [x * factor for x in numbers[:3]] + list(numbers[3:]) if attribute == "axisangle" \
+        else [x * factor for x in numbers]
+    reference = _box_tensor(tmp_path, f'{attribute}="{" ".join(map(repr, numbers))}"')
+    assert_tensor_close(_box_tensor(tmp_path, f'{attribute}="{" ".join(map(repr, scaled))}"'), reference, 1e-12)
+
+
+@pytest.mark.parametrize("xyaxes", ["1 1 0 1 1.0000001 0", "1 0 0 1e-5 1e-7 0", "1e-300 0 0 0 1 0"])
+def test_nearly_parallel_xyaxes_are_refused_as_mujoco_refuses_them(tmp_path, xyaxes):
+    # the part of y across x was a rounding residue of 1e-17 and set the rotation's second column
+    with pytest.raises(ValueError, match="too small"):
+        mujoco.MjModel.from_xml_string(f'<mujoco><worldbody><body><geom type="box" size="1 1 1" xyaxes="{xyaxes}"/>'
+                                       '</body></worldbody></mujoco>')
+    with pytest.raises(RobotDescriptionError, match="xyaxes are zero or parallel"):
+        _box_tensor(tmp_path, f'xyaxes="{xyaxes}"')
+
+
 def test_two_orientations_on_one_element_are_still_refused(tmp_path):
     path = tmp_path / "o.xml"
     path.write_text('<mujoco><worldbody><body name="b"><geom type="sphere" size="1" quat="1 0 0 0" '

@@ -30,3 +30,11 @@ def test_non_finite_message_wording(parse, text, message):
     with pytest.raises(UnitsError) as info:
         parse(text)
     assert str(info.value).startswith(message) and "a finite a" not in str(info.value)
+
+
+@pytest.mark.parametrize("text", ["\u0663", "\u0661\u0662 kg/m3", "1_000", "inf", "nan"])
+def test_one_number_grammar_refuses_what_only_float_reads(text):
+    # units.DECIMAL is the grammar of robot files and environment limits too; '٣' (an Arabic-Indic 3) was
+    # read here as 3 kg/m³ while robot files refused it
+    with pytest.raises(UnitsError):
+        parse_density(text)

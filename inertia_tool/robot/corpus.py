@@ -15,10 +15,10 @@ from __future__ import annotations
 import os
 import re
 
-from ..errors import InertiaToolError, UsageError
+from ..errors import InertiaToolError, RobotDescriptionError, UsageError
 from ..values import frozen_value
 from .audit import audit_links
-from .description import MAX_DESCRIPTION_BYTES, RobotDescription, read_robot
+from .description import MAX_DESCRIPTION_BYTES, RobotDescription, _read_bytes, read_robot
 from .geometry import link_inertials
 
 __all__ = ["ModelAudit", "find_descriptions", "audit_corpus", "MAX_CORPUS_FILES", "SNIFF_BYTES"]
@@ -57,9 +57,8 @@ class ModelAudit:
 
 def _root_kind(path: str) -> str | None:
     try:
-        with open(path, "rb") as fh:
-            head = fh.read(SNIFF_BYTES)
-    except OSError:
+        head = _read_bytes(path, head=SNIFF_BYTES)
+    except RobotDescriptionError:          # missing, unreadable, a named pipe or device: read_robot says why
         return None
     head = re.sub(rb"<!--.*?-->", b"", head, flags=re.DOTALL)
     match = _ROOT.search(head)
@@ -94,8 +93,7 @@ def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
     included = set()
     for path in found:
         if os.path.splitext(path)[1].lower() in (".xml", ".mjcf") and _root_kind(path) == "mujoco":
-            with open(path, "rb") as fh:
-                text = fh.read(MAX_DESCRIPTION_BYTES)
+            text = _read_bytes(path, head=MAX_DESCRIPTION_BYTES)
             for name in _INCLUDE.findall(text):
                 target = os.path.normpath(os.path.join(os.path.dirname(path), os.fsdecode(name)))
                 if target != os.path.normpath(path):

@@ -32,7 +32,9 @@ from dataclasses import field
 
 import numpy as np
 
-from ..errors import RobotDescriptionError, UsageError
+from ..errors import MeshReadError, RobotDescriptionError, UsageError
+from ..mesh.regular import open_regular
+from ..units import DECIMAL
 from ..values import frozen_value
 from .resolve import MAX_FOLDERS_UP, package_directory, resolve_uri
 
@@ -67,11 +69,9 @@ ROBOT_LENGTH_RANGE = (1e-9, 1e9)
 #: coordinates are bounded by the reader, so a factor in this range keeps the scaled mesh finite.
 ROBOT_SCALE_RANGE = (1e-9, 1e9)
 
-#: The one number grammar of robot files: a decimal as XML Schema's ``xsd:double`` lexical form (optional sign,
-#: ASCII digits with an optional fraction or a fraction alone, optional exponent), without ``INF`` and ``NaN``.
-#: Python's ``float()`` also takes ``1_000``, ``inf``, ``nan`` and non-ASCII digits (``١٢``); none is a number
-#: of URDF, SDFormat or MJCF, so none is accepted.
-_DECIMAL = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
+#: The one number grammar of robot files (:data:`inertia_tool.units.DECIMAL`: ``xsd:double`` without ``INF``
+#: and ``NaN``; no ``1_000``, ``inf``, ``nan`` or non-ASCII digits, which Python's ``float()`` would take).
+_DECIMAL = DECIMAL
 
 
 def rpy_to_matrix(rpy) -> np.ndarray:
@@ -343,14 +343,24 @@ def parse_xml(data: bytes, source: str):
         raise _fail(source, f"not well-formed XML ({exc})") from None
 
 
-def _read_bytes(path: str) -> bytes:
-    if not os.path.isfile(path):
-        raise _fail(path, "no such file" if not os.path.exists(path) else "is not a regular file")
-    size = os.path.getsize(path)
-    if size > MAX_DESCRIPTION_BYTES:
-        raise _fail(path, f"{size:,} bytes, more than the {MAX_DESCRIPTION_BYTES:,} a robot description may have")
-    with open(path, "rb") as fh:
-        return fh.read()
+def _read_bytes(path: str, *, head: int | None = None) -> bytes:
+    """The bytes of the description file ``path`` (only its first ``head`` bytes when given).
+
+    Opened only as a regular file (:func:`~inertia_tool.mesh.regular.open_regular`: a named pipe or a device
+    is refused, never waited on), and never more than :data:`MAX_DESCRIPTION_BYTES` read."""
+    try:
+        fh = open_regular(path)
+    except FileNotFoundError:
+        raise _fail(path, "no such file") from None
+    except MeshReadError as exc:                 # "PATH: is a FIFO (named pipe), not a regular file"
+        raise RobotDescriptionError(str(exc)) from None
+    except OSError as exc:
+        raise _fail(path, f"cannot be read ({exc.strerror or exc})") from None
+    with fh:
+        data = fh.read(MAX_DESCRIPTION_BYTES + 1 if head is None else head)
+    if head is None and len(data) > MAX_DESCRIPTION_BYTES:
+        raise _fail(path, f"more than the {MAX_DESCRIPTION_BYTES:,} bytes a robot description may have")
+    return data
 
 
 # -- xacro -------------------------------------------------------------------------------------------------
@@ -737,6 +747,17 @@ def _detect(path: str) -> str:
     return fmt
 
 
+def _check_unique_names(links, source: str) -> None:
+    """Refuse two links of one name, as urdfdom, SDFormat and MuJoCo's compiler do: every result, declared
+    inertial and ``--write`` correction is matched to its link by name, so a repeated name would pair one link's
+    numbers with the other's element."""
+    seen: set[str] = set()
+    for link in links:
+        if link.name in seen:
+            raise _fail(source, f"two links are named {link.name[:80]!r}; expected every link name to be unique")
+        seen.add(link.name)
+
+
 def read_robot(path, *, packages: dict | None = None, geometry: str = "collision",
                mappings: dict | None = None, run_xacro: bool = False, limits=None) -> RobotDescription:
     """Read a URDF, xacro, SDFormat or MJCF file into a :class:`RobotDescription`.
@@ -806,4 +827,5 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         name, links = _read_sdf(root, source, base, packages, geometry)
     if not links:
         raise _fail(source, "no links found")
+    _check_unique_names(links, source)
     return RobotDescription(name=name, source=source, format=fmt, geometry=geometry, links=links, document=data)

@@ -27,6 +27,7 @@ moment, ``I1 + I2 < I3``), the tensor with the same axes whose moments are proje
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -90,9 +91,12 @@ def _power_of_ten(ratio: float, factors, *, slack: float = 0.3) -> float | None:
 
 
 def _frame_angle(a: np.ndarray, b: np.ndarray) -> float:
-    """Degrees of the smallest rotation between two principal frames (columns), axis signs free."""
+    """Degrees of the smallest rotation between two principal frames (columns), axis signs free.
+
+    Either frame may be left-handed (``numpy.linalg.eigh`` fixes no sign): all eight sign choices are tried
+    and those that make ``a bᵀ`` a rotation (determinant +1) kept."""
     best = 180.0
-    for signs in ((1, 1, 1), (1, -1, -1), (-1, 1, -1), (-1, -1, 1)):
+    for signs in itertools.product((1, -1), repeat=3):
         r = (a * np.array(signs)) @ b.T
         if np.linalg.det(r) < 0:
             continue

@@ -60,6 +60,10 @@ MAX_INCLUDED_FILES = 512
 #: The orientation attributes of MJCF: one orientation, whichever of them is given.
 _ORIENTATION = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 
+#: Shortest x axis, and part of the y axis across it, that ``xyaxes`` may give: MuJoCo's compiler refuses
+#: shorter ones ("xaxis too small", "yaxis too small"; checked against ``mujoco`` 4.0).
+_AXIS_TOO_SHORT = 1e-6
+
 _GEOM_KINDS = {"box": "box", "sphere": "sphere", "cylinder": "cylinder", "capsule": "capsule",
                "ellipsoid": "ellipsoid", "mesh": "mesh"}
 
@@ -68,24 +72,44 @@ def _fail(source: str, problem: str) -> RobotDescriptionError:
     return RobotDescriptionError(f"{source}: {problem}")
 
 
+def _unit(vector) -> np.ndarray | None:
+    """``vector`` scaled to length 1, or None when it is zero.
+
+    Divided by its largest component first, so that components near the float64 limits (``1e308``, ``1e-320``)
+    neither overflow nor underflow the norm: a direction is refused only when it is zero, never turned into a
+    wrong one (an overflowed norm would make every component 0 and the rotation the identity)."""
+    v = np.asarray(vector, dtype=np.float64)
+    largest = float(np.max(np.abs(v)))
+    if not largest > 0:
+        return None
+    v = v / largest
+    return v / np.linalg.norm(v)
+
+
 def _quaternion_matrix(q) -> np.ndarray:
-    w, x, y, z = np.asarray(q, dtype=np.float64) / np.linalg.norm(q)
+    """Rotation of the quaternion ``q`` (w x y z, any non-zero length)."""
+    unit = _unit(q)
+    if unit is None:
+        raise ValueError("a quaternion of zero length has no rotation")
+    w, x, y, z = unit
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 def _axis_angle(axis, angle: float) -> np.ndarray:
-    n = np.asarray(axis, dtype=np.float64)
-    n = n / np.linalg.norm(n)
+    n = _unit(axis)
+    if n is None:
+        raise ValueError("a zero axis has no rotation")
     k = np.array([[0, -n[2], n[1]], [n[2], 0, -n[0]], [-n[1], n[0], 0]])
     return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * (k @ k)
 
 
 def _z_to(direction) -> np.ndarray:
     """The minimal rotation taking +z onto ``direction`` (MuJoCo's ``zaxis`` and ``fromto`` frames)."""
-    d = np.asarray(direction, dtype=np.float64)
-    d = d / np.linalg.norm(d)
+    d = _unit(direction)
+    if d is None:
+        raise ValueError("a zero direction has no rotation")
     axis = np.cross([0.0, 0.0, 1.0], d)
     s, c = np.linalg.norm(axis), float(d[2])
     if s < 1e-14:
@@ -131,12 +155,12 @@ def orientation_matrix(attrs: dict, *, degrees: bool, eulerseq: str, what: str, 
     unit = math.pi / 180.0 if degrees else 1.0
     if key == "quat":
         q = _numbers(attrs[key], 4, f"{what} quat", source)
-        if not np.linalg.norm(q) > 0:
+        if _unit(q) is None:
             raise _fail(source, f"{what}: quat of zero length")
         return _quaternion_matrix(q)
     if key == "axisangle":
         a = _numbers(attrs[key], 4, f"{what} axisangle", source)
-        if not np.linalg.norm(a[:3]) > 0:
+        if _unit(a[:3]) is None:
             raise _fail(source, f"{what}: axisangle with a zero axis")
         return _axis_angle(a[:3], a[3] * unit)
     if key == "euler":
@@ -144,14 +168,22 @@ def orientation_matrix(attrs: dict, *, degrees: bool, eulerseq: str, what: str, 
         return _euler_matrix(eulerseq, angles)
     if key == "xyaxes":
         a = _numbers(attrs[key], 6, f"{what} xyaxes", source)
-        x = a[:3] / np.linalg.norm(a[:3])
-        y = a[3:] - (a[3:] @ x) * x
-        if not (np.linalg.norm(a[:3]) > 0 and np.linalg.norm(y) > 0):
-            raise _fail(source, f"{what}: xyaxes are zero or parallel")
-        y = y / np.linalg.norm(y)
-        return np.column_stack([x, y, np.cross(x, y)])
+        # MuJoCo refuses an x axis, or the part of y across x, shorter than 1e-6 ("xaxis/yaxis too small");
+        # both lengths are computed on the numbers scaled by their largest, so no length overflows to inf
+        x, y = _unit(a[:3]), a[3:]
+        y_scale = float(np.max(np.abs(y)))
+        across = None
+        if x is not None and y_scale > 0:
+            across = y / y_scale - ((y / y_scale) @ x) * x
+        x_scale = float(np.max(np.abs(a[:3])))
+        if (x is None or across is None or x_scale * float(np.linalg.norm(a[:3] / x_scale)) < _AXIS_TOO_SHORT
+                or y_scale * float(np.linalg.norm(across)) < _AXIS_TOO_SHORT):
+            raise _fail(source, f"{what}: xyaxes are zero or parallel (expected an x axis and a y axis across it "
+                                f"at least {_AXIS_TOO_SHORT:g} long, got {attrs[key]!r})")
+        y_axis = across / np.linalg.norm(across)
+        return np.column_stack([x, y_axis, np.cross(x, y_axis)])
     z = _numbers(attrs[key], 3, f"{what} zaxis", source)
-    if not np.linalg.norm(z) > 0:
+    if _unit(z) is None:
         raise _fail(source, f"{what}: zaxis of zero length")
     return _z_to(z)
 
@@ -301,7 +333,7 @@ def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler
                            f"{what} scale", source)
             refpos = _numbers(attrs.get("refpos"), 3, f"{what} refpos", source, default=(0, 0, 0))
             refquat = _numbers(attrs.get("refquat"), 4, f"{what} refquat", source, default=(1, 0, 0, 0))
-            if not np.linalg.norm(refquat) > 0:
+            if _unit(refquat) is None:
                 raise _fail(source, f"{what}: refquat of zero length")
             # v ↦ q̄ (v − refpos) q: rotation Qᵀ, translation −Qᵀ refpos
             back = _quaternion_matrix(refquat).T
@@ -335,7 +367,7 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
     if attrs.get("fromto") is not None and kind in ("capsule", "cylinder", "box", "ellipsoid"):
         ends = _coordinates(_numbers(attrs["fromto"], 6, f"{what} fromto", source), f"{what} fromto", source)
         axis = ends[3:] - ends[:3]
-        if not np.linalg.norm(axis) > 0:
+        if _unit(axis) is None:
             raise _fail(source, f"{what}: fromto with coincident ends")
         rotation, position = _z_to(axis), 0.5 * (ends[:3] + ends[3:])
         half_length = 0.5 * _positive(float(np.linalg.norm(axis)), f"{what} fromto length", source)
