@@ -46,10 +46,17 @@ R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only aft
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..tolerances import FLAT_RTOL, TOUCH_VOLUME_RTOL
 from ..values import frozen_value
+
+if TYPE_CHECKING:
+    from .intersect import SurfaceContacts
+    from .nesting import Nesting
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
@@ -90,7 +97,7 @@ class Certificate:
     """
 
     kind: str
-    checks: tuple = ()
+    checks: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.kind not in CERTIFICATE_KINDS:
@@ -139,7 +146,7 @@ class ShellContacts:
     complete: bool
 
 
-def shell_contacts(contacts, labels: np.ndarray, n_shells: int) -> ShellContacts:
+def shell_contacts(contacts: SurfaceContacts, labels: np.ndarray, n_shells: int) -> ShellContacts:
     """Summarise face-pair contacts (a ``SurfaceContacts``) by shell.
 
     Parameters
@@ -189,7 +196,7 @@ def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarra
             "region twice); `repair=True` tries a bounded estimate of the solid {winding number ≥ 1}")
 
 
-def orient_by_depth(volumes: np.ndarray, nest, crossing_with: np.ndarray, *,
+def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np.ndarray, *,
                     crossing_known: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """R4: which shells to flip, the body each shell belongs to, and its nesting depth.
 
@@ -261,7 +268,7 @@ def orient_by_depth(volumes: np.ndarray, nest, crossing_with: np.ndarray, *,
     return flip, owner, depth
 
 
-def weakest(certificates) -> Certificate:
+def weakest(certificates: Iterable[Certificate]) -> Certificate:
     """The certificate of a result combined from several (a robot link's elements): the weakest kind, with the
     checks of the element that has it (the first such, in order)."""
     certs = list(certificates)
