@@ -10,8 +10,10 @@ with identical results; the numpy code here is the reference and the fallback.
 from __future__ import annotations
 
 from dataclasses import field
+from types import ModuleType
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..values import frozen_value
 from .._native import accel, faces_for_c, threads
@@ -134,13 +136,13 @@ class MeshReport:
     watertight: bool
     welded_tolerance: float | None
     repaired: bool
-    repair_actions: tuple
+    repair_actions: tuple[str, ...]
     repair_volume_change: float | None
     bbox_min: np.ndarray
     bbox_max: np.ndarray
     method: str = "exact"
     uncertainty: Uncertainty | None = None
-    notes: tuple = ()
+    notes: tuple[str, ...] = ()
     flipped_faces: int = 0
     nonmanifold_edges: int = 0
     certificate: Certificate = Certificate("unverified")
@@ -160,7 +162,8 @@ def repeated_corner_faces(faces: np.ndarray) -> np.ndarray:
     counted by the integration pass (``VolumeMoments.zero_area_faces``).
     """
     f = faces
-    return (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])
+    repeated: np.ndarray = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])
+    return repeated
 
 
 def _edge_keys(faces: np.ndarray, n_vertices: int) -> np.ndarray:
@@ -239,7 +242,8 @@ def edge_topology(faces: np.ndarray, n_vertices: int, vertices: np.ndarray | Non
                         misoriented_edges=len(misoriented), sample=sample)
 
 
-def _edge_topology_c(lib, faces, n_vertices, vertices) -> EdgeTopology:
+def _edge_topology_c(lib: ModuleType, faces: np.ndarray, n_vertices: int,
+                     vertices: np.ndarray | None) -> EdgeTopology:
     """``edge_topology`` on the C extension (a sorted per-vertex adjacency instead of one global sort)."""
     edges, boundary, nonmanifold, misoriented, *samples = lib.edge_census(faces_for_c(faces), int(n_vertices),
                                                                           threads())
@@ -336,7 +340,7 @@ def _vertex_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray
     return remap[face_label].astype(np.intp), int(present.sum())
 
 
-def winding_number(point, vertices: np.ndarray, faces: np.ndarray) -> float:
+def winding_number(point: ArrayLike, vertices: np.ndarray, faces: np.ndarray) -> float:
     """Generalised winding number of a closed oriented surface about ``point``.
 
     Sum of the signed solid angles of the triangles (Van Oosterom & Strackee, IEEE Trans. Biomed. Eng.
