@@ -20,6 +20,9 @@ manifold output for manifold inputs, with symbolic perturbation for coplanar and
 
 from __future__ import annotations
 
+from types import ModuleType
+from typing import Any
+
 import numpy as np
 
 from ..values import frozen_value
@@ -149,7 +152,11 @@ class UnionSurface:
     volume: float
 
 
-def _manifold(m3, vertices, faces):
+#: A ``manifold3d.Manifold``: the package ships no type information, so to mypy it is ``Any``.
+_Manifold = Any
+
+
+def _manifold(m3: ModuleType, vertices: np.ndarray, faces: np.ndarray) -> _Manifold:
     used, inverse = np.unique(faces, return_inverse=True)
     mesh = m3.Mesh64(vert_properties=np.ascontiguousarray(vertices[used], dtype=np.float64),
                      tri_verts=np.ascontiguousarray(inverse.reshape(-1, 3), dtype=np.uint64))
@@ -198,8 +205,8 @@ def union_surface(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
     starts = np.searchsorted(groups[order], np.arange(n_groups + 1))
     solids = []
     for b in np.unique(body):
-        material: list = []
-        voids: list = []
+        material: list[_Manifold] = []
+        voids: list[_Manifold] = []
         for g in np.flatnonzero(body == b):
             piece = f[order[starts[g]:starts[g + 1]]]
             if len(piece):
