@@ -31,24 +31,27 @@ _FRAMES = ((1.0, 0.0, 0.0, 0.0), (0.8660254, 0.2886751, 0.2886751, 0.2886751),
 _PAIR_STEP = 1 << 21
 
 
-def _rotation(q) -> np.ndarray:
+def _rotation(q: tuple[float, float, float, float]) -> np.ndarray:
     w, x, y, z = np.asarray(q, dtype=np.float64) / np.linalg.norm(q)
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
-def _edge_test(pi, pj, i, j, py, pz):
+def _edge_test(pi: np.ndarray, pj: np.ndarray, i: np.ndarray, j: np.ndarray, py: np.ndarray,
+               pz: np.ndarray) -> np.ndarray:
     """orient2d of (p_i, p_j, p) in the (y, z) plane with the end points in canonical (index) order."""
     swap = i > j
     lo = np.where(swap[:, None], pj, pi)
     hi = np.where(swap[:, None], pi, pj)
     d = (hi[:, 1] - lo[:, 1]) * (pz - lo[:, 2]) - (hi[:, 2] - lo[:, 2]) * (py - lo[:, 1])
-    return np.where(swap, -d, d)
+    signed: np.ndarray = np.where(swap, -d, d)
+    return signed
 
 
 def ray_winding(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray,
-                n_groups: int, *, exclude: np.ndarray | None = None, on_surface: float = 0.0):
+                n_groups: int, *, exclude: np.ndarray | None = None,
+                on_surface: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Signed ray-crossing count of every group of faces at every point, along +x.
 
     Parameters
@@ -89,7 +92,8 @@ def ray_winding(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, gro
     del y0, y1, y2
     counts = hi - lo
     candidates = np.flatnonzero(counts)
-    keys, signs = [], []
+    keys: list[np.ndarray] = []
+    signs: list[np.ndarray] = []
     cum = np.cumsum(counts[candidates])
     start = 0
     while start < len(candidates):
@@ -158,7 +162,8 @@ class Nesting:
     undecided: np.ndarray
 
 
-def _probe_faces(faces, vertices, labels, n_shells, rank):
+def _probe_faces(faces: np.ndarray, vertices: np.ndarray, labels: np.ndarray, n_shells: int,
+                 rank: int) -> np.ndarray:
     """Index of the face of each shell with the ``rank``-th largest area (the last one when fewer), (s,)."""
     v = vertices
     e1 = v[faces[:, 1]] - v[faces[:, 0]]
@@ -172,11 +177,13 @@ def _probe_faces(faces, vertices, labels, n_shells, rank):
         best = np.maximum.reduceat(area[order], starts)
         is_best = area[order] == np.repeat(best, np.diff(np.r_[starts, len(order)]))
         first = np.flatnonzero(is_best)
-        return order[first[np.searchsorted(first, starts)]]
+        picked: np.ndarray = order[first[np.searchsorted(first, starts)]]
+        return picked
     order = np.lexsort((-area, labels))
     starts = np.searchsorted(labels[order], np.arange(n_shells))
     ends = np.r_[starts[1:], len(faces)]
-    return order[np.minimum(starts + rank, ends - 1)]
+    picked = order[np.minimum(starts + rank, ends - 1)]
+    return picked
 
 
 def shell_nesting(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n_shells: int, *,
@@ -207,7 +214,9 @@ def shell_nesting(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n
     centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
     diag = float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
     local = vertices - centre
-    result_shell, result_other, result_w = [], [], []
+    result_shell: list[np.ndarray] = []
+    result_other: list[np.ndarray] = []
+    result_w: list[np.ndarray] = []
     probes = np.zeros((n_shells, 3))
     pending = np.arange(n_shells)
     for attempt in range(max(1, int(tries))):
@@ -225,7 +234,7 @@ def shell_nesting(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n
         result_other.append(other[keep])
         result_w.append(w[keep])
         pending = pending[bad]
-    def cat(xs):
+    def cat(xs: list[np.ndarray]) -> np.ndarray:
         return np.concatenate(xs) if xs else np.zeros(0, dtype=np.int64)
     undecided = np.zeros(n_shells, dtype=bool)
     undecided[pending] = True
