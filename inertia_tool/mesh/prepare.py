@@ -10,11 +10,10 @@ sign of each shell), so that the faces are integrated once.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
-from types import SimpleNamespace
-
-
-from typing import Any
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -29,8 +28,11 @@ from .estimate import check_useful, uncertainty_from
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, orient_by_depth, self_crossing_message,
                      shell_contacts)
 from .resolve import Resolution, resolve_surface
+from .intersect import SurfaceContacts, surface_contacts
 
-from .intersect import surface_contacts
+if TYPE_CHECKING:       # imported on use at run time (below)
+    from .nesting import Nesting
+    from .union import UnionSurface
 
 __all__ = ["PreparedMesh", "prepare_mesh", "classify_shells", "MAX_COORDINATE", "MIN_EXTENT"]
 
@@ -69,13 +71,14 @@ class PreparedMesh:
     vertices: np.ndarray
     faces: np.ndarray
     labels: np.ndarray
-    shells: tuple
+    shells: tuple[VolumeMoments, ...]
     owner: np.ndarray
     report: MeshReport
 
 
-def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: str = "mesh",
-                    check_crossing: bool = True):
+def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n_shells: int,
+                    shells: Sequence[VolumeMoments], diag: float, *, source: str = "mesh",
+                    check_crossing: bool = True) -> tuple[np.ndarray, np.ndarray, int, int]:
     """Orient shells by nesting depth (R4), attach cavities to their bodies, count overlap candidates (R5, R6).
 
     The same rules :func:`prepare_mesh` applies (:mod:`~.policy`), for callers that hold several prepared
@@ -103,16 +106,17 @@ def classify_shells(vertices, faces, labels, n_shells, shells, diag, *, source: 
     crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
     flip, owner, depth = orient_by_depth(vols, nest, crossing_with,
                                          crossing_known=touch is not None and touch.complete)
+    undecided = nest.undecided if nest is not None else np.zeros(n_shells, dtype=bool)
     if touch is not None and touch.complete:
         # touching shells share no volume (their interiors are disjoint when no face crosses); a shell that
         # R4 had to turn lies in another's material or void against its own winding: counted as a candidate
-        candidates = touch.crossing | flip | nest.undecided
+        candidates = touch.crossing | flip | undecided
     else:
-        candidates = _boxes_meet(vertices, faces, labels, n_shells) | nest.undecided
+        candidates = _boxes_meet(vertices, faces, labels, n_shells) | undecided
     return flip, owner, int(np.count_nonzero(depth % 2 == 1)), int(np.count_nonzero(candidates))
 
 
-def _check_magnitude(lo, hi, source: str) -> None:
+def _check_magnitude(lo: np.ndarray, hi: np.ndarray, source: str) -> None:
     """Refuse coordinates (bounding box ``lo``, ``hi``) whose volume integrals (∝ L⁵) would overflow or underflow
     float64."""
     top = float(np.max(np.abs(np.r_[lo, hi])))    # = max |coordinate| (NaN propagates)
@@ -321,20 +325,20 @@ def shared_text(summed: float, united: float) -> str:
     return f"no shared volume (the union is {-shared:.3g} m³ larger than the sum, within rounding)"
 
 
-def _outside_patches(contacts, faces, n_read):
+def _outside_patches(contacts: SurfaceContacts, faces: np.ndarray,
+                     n_read: int) -> tuple[SurfaceContacts, tuple[str, ...]]:
     """Contacts with the crossings that involve a repair patch taken out (those lie within the patches' doubt,
     which the estimate's bound carries), and a note saying how many there were."""
     crossing = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
     patch = np.any(faces[crossing[:, 0]] >= n_read, axis=1) | np.any(faces[crossing[:, 1]] >= n_read, axis=1)
     if not patch.any():
         return contacts, ()
-    kept = SimpleNamespace(crossing=crossing[~patch], coplanar_opposite=contacts.coplanar_opposite,
-                           contact=contacts.contact, complete=contacts.complete)
+    kept = dataclasses.replace(contacts, crossing=crossing[~patch])
     return kept, (f"{int(np.count_nonzero(patch)):,} face pairs where a patch crosses the surface (within the "
                   "patches' volume in doubt)",)
 
 
-def _nesting(v, f, labels, n_shells):
+def _nesting(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) -> Nesting | None:
     """The shells' winding numbers at each other's probe points (None for one shell)."""
     if n_shells < 2:
         return None
@@ -342,7 +346,7 @@ def _nesting(v, f, labels, n_shells):
     return shell_nesting(v, f, labels, n_shells)
 
 
-def _boxes_meet(v, f, labels, n_shells) -> np.ndarray:
+def _boxes_meet(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) -> np.ndarray:
     """(s,) bool: shells whose bounding box meets another shell's."""
     order = np.argsort(labels, kind="stable")
     starts = np.searchsorted(labels[order], np.arange(n_shells))
@@ -354,7 +358,9 @@ def _boxes_meet(v, f, labels, n_shells) -> np.ndarray:
     return np.asarray(meet.any(axis=1))
 
 
-def _drop_flat(v, f, labels, shells, diag, source, *, warn=True):
+def _drop_flat(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments], diag: float,
+               source: str, *,
+               warn: bool = True) -> tuple[np.ndarray, np.ndarray, int, list[VolumeMoments], str | None]:
     """R2: leave out closed shells that enclose no volume; refuse when nothing else is left."""
     n_shells = len(shells)
     flat = np.array([abs(s.volume) <= FLAT_RTOL * diag ** 3 for s in shells], dtype=bool)
@@ -377,7 +383,8 @@ def _drop_flat(v, f, labels, shells, diag, source, *, warn=True):
     return f, labels, n_shells, shells, note
 
 
-def _apply_flips(f, labels, shells, flip, n_shells, source, *, warn=True):
+def _apply_flips(f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments], flip: np.ndarray, n_shells: int,
+                 source: str, *, warn: bool = True) -> tuple[np.ndarray, list[VolumeMoments]]:
     """Turn the shells marked by R4, with an :class:`InsideOutWarning` naming how many."""
     if not flip.any():
         return f, shells
@@ -394,15 +401,17 @@ def _apply_flips(f, labels, shells, flip, n_shells, source, *, warn=True):
     return f, shells
 
 
-def _total(shells) -> VolumeMoments:
+def _total(shells: Sequence[VolumeMoments]) -> VolumeMoments:
     """The moments of all shells together (cavities negative): volume, centroid, central second moment."""
     volume = sum(s.volume for s in shells)
-    centroid = sum(s.volume * s.centroid for s in shells) / volume
-    second = sum(s.second_moment + s.volume * np.outer(s.centroid - centroid, s.centroid - centroid) for s in shells)
+    centroid = np.asarray(sum(s.volume * s.centroid for s in shells), dtype=np.float64) / volume
+    second = np.asarray(sum(s.second_moment + s.volume * np.outer(s.centroid - centroid, s.centroid - centroid)
+                            for s in shells), dtype=np.float64)
     return VolumeMoments(volume=volume, centroid=centroid, second_moment=second, area=sum(s.area for s in shells))
 
 
-def _unite(vertices, faces, labels, owner, source, repair):
+def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: np.ndarray, source: str,
+           repair: bool) -> UnionSurface | None:
     """The union of the closed pieces (a :class:`~.union.UnionSurface`), or None when the boolean refuses.
 
     Each piece belongs to the body that owns its shell, so cavities are cut from their own body only.
