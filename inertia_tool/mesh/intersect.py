@@ -72,7 +72,10 @@ any exact evaluation.  This module's numpy code stays the reference and the fall
 from __future__ import annotations
 
 from collections.abc import Iterator
+from types import ModuleType
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._native import accel, threads
 from ..errors import InvalidMeshError
@@ -154,7 +157,7 @@ def _integers(*points: np.ndarray) -> list[np.ndarray]:
     return out
 
 
-def _exact_orient3d(a, b, c, d) -> np.ndarray:
+def _exact_orient3d(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Exact sign of orient3d per row (k,) int8, in integer arithmetic."""
     a, b, c, d = _integers(a, b, c, d)
     ad, bd, cd = a - d, b - d, c - d
@@ -164,7 +167,7 @@ def _exact_orient3d(a, b, c, d) -> np.ndarray:
     return np.array([(x > 0) - (x < 0) for x in det], dtype=np.int8)
 
 
-def _exact_orient2d(a, b, c) -> np.ndarray:
+def _exact_orient2d(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """Exact sign of orient2d per row (k,) int8, in integer arithmetic."""
     a, b, c = _integers(a, b, c)
     det = (a[:, 0] - c[:, 0]) * (b[:, 1] - c[:, 1]) - (a[:, 1] - c[:, 1]) * (b[:, 0] - c[:, 0])
@@ -174,30 +177,32 @@ def _exact_orient2d(a, b, c) -> np.ndarray:
 class _Predicates:
     """Filtered exact predicates over rows of points; counts the rows decided exactly."""
 
-    def __init__(self, force_exact: bool = False):
+    def __init__(self, force_exact: bool = False) -> None:
         self.force_exact = force_exact
         self.exact = 0
 
-    def orient3d(self, a, b, c, d) -> np.ndarray:
+    def orient3d(self, a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> np.ndarray:
         """Sign of ``det[a − d; b − d; c − d]`` per row, (k,) int8; ``a..d`` (k, 3) float64."""
         with np.errstate(all="ignore"):            # out of the filter's range everything is recomputed exactly
             return self._orient3d(a, b, c, d)
 
-    def orient2d(self, a, b, c) -> np.ndarray:
+    def orient2d(self, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
         """Sign of ``det[a − c; b − c]`` per row, (k,) int8; ``a, b, c`` (k, 2) float64."""
         with np.errstate(all="ignore"):
             return self._orient2d(a, b, c)
 
-    def _orient3d(self, a, b, c, d) -> np.ndarray:
+    def _orient3d(self, a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> np.ndarray:
         sign, unsure = self._orient3d_filter(a, b, c, d)
         return self._orient3d_resolve(sign, unsure, a, b, c, d)
 
-    def orient3d_filter(self, a, b, c, d) -> tuple[np.ndarray, np.ndarray]:
+    def orient3d_filter(self, a: np.ndarray, b: np.ndarray, c: np.ndarray,
+                        d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Float signs of orient3d per row and the rows the static filter cannot decide (left 0)."""
         with np.errstate(all="ignore"):
             return self._orient3d_filter(a, b, c, d)
 
-    def _orient3d_filter(self, a, b, c, d) -> tuple[np.ndarray, np.ndarray]:
+    def _orient3d_filter(self, a: np.ndarray, b: np.ndarray, c: np.ndarray,
+                         d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ad, bd, cd = a - d, b - d, c - d
         m0 = bd[:, 1] * cd[:, 2] - bd[:, 2] * cd[:, 1]
         m1 = bd[:, 2] * cd[:, 0] - bd[:, 0] * cd[:, 2]
@@ -213,11 +218,13 @@ class _Predicates:
         sign[unsure] = 0
         return sign, unsure
 
-    def orient3d_resolve(self, sign, unsure, a, b, c, d) -> np.ndarray:
+    def orient3d_resolve(self, sign: np.ndarray, unsure: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray,
+                         d: np.ndarray) -> np.ndarray:
         """``sign`` with the rows ``unsure`` recomputed exactly."""
         return self._orient3d_resolve(sign, unsure, a, b, c, d)
 
-    def _orient3d_resolve(self, sign, unsure, a, b, c, d) -> np.ndarray:
+    def _orient3d_resolve(self, sign: np.ndarray, unsure: np.ndarray, a: np.ndarray, b: np.ndarray,
+                          c: np.ndarray, d: np.ndarray) -> np.ndarray:
         if len(unsure):
             pa, pb, pc, pd = a[unsure], b[unsure], c[unsure], d[unsure]
             # two equal points: two equal rows (or a zero row), the determinant is zero
@@ -232,7 +239,7 @@ class _Predicates:
         self.exact += len(unsure)
         return sign
 
-    def _orient2d(self, a, b, c) -> np.ndarray:
+    def _orient2d(self, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
         acx, acy = a[:, 0] - c[:, 0], a[:, 1] - c[:, 1]
         bcx, bcy = b[:, 0] - c[:, 0], b[:, 1] - c[:, 1]
         left, right = acx * bcy, acy * bcx
@@ -244,10 +251,11 @@ class _Predicates:
         if len(unsure):
             sign[unsure] = _exact_orient2d(a[unsure], b[unsure], c[unsure])
         self.exact += len(unsure)
-        return sign
+        signs: np.ndarray = sign
+        return signs
 
 
-def orient3d_sign(a, b, c, d) -> np.ndarray:
+def orient3d_sign(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike) -> np.ndarray:
     """Exact sign of ``det[a − d; b − d; c − d]`` for rows of float64 points, (k,) int8.
 
     Positive when ``d`` sees ``a, b, c`` clockwise, i.e. ``d`` lies below the plane of the counter-clockwise
@@ -257,7 +265,7 @@ def orient3d_sign(a, b, c, d) -> np.ndarray:
     return _Predicates(not _filter_safe(np.concatenate(pts))).orient3d(*pts)
 
 
-def orient2d_sign(a, b, c) -> np.ndarray:
+def orient2d_sign(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> np.ndarray:
     """Exact sign of ``det[a − c; b − c]`` for rows of float64 2-D points, (k,) int8 (+1: ``a, b, c``
     counter-clockwise)."""
     pts = [np.atleast_2d(np.asarray(p, dtype=np.float64)) for p in (a, b, c)]
@@ -366,20 +374,22 @@ def _classify(v: np.ndarray, f: np.ndarray, axis: np.ndarray, a: np.ndarray, b: 
     return kind
 
 
-def _o2(pred: _Predicates, p, q, x, axis) -> np.ndarray:
+def _o2(pred: _Predicates, p: np.ndarray, q: np.ndarray, x: np.ndarray, axis: np.ndarray) -> np.ndarray:
     """orient2d signs of the projections of rows p, q, x (k, 3) along ``axis`` (k,)."""
     keep = _PLANE[axis]
     return pred.orient2d(np.take_along_axis(p, keep, 1), np.take_along_axis(q, keep, 1),
                          np.take_along_axis(x, keep, 1))
 
 
-def _projections_separate(t1, t2, same, n_shared, axis, pred: _Predicates) -> np.ndarray:
+def _projections_separate(t1: np.ndarray, t2: np.ndarray, same: np.ndarray, n_shared: np.ndarray, axis: np.ndarray,
+                          pred: _Predicates) -> np.ndarray:
     """Pairs (sharing at most an edge) whose projections along ``axis`` (one to one for t1) are separated by a
     line through what they share (an edge line of either face when nothing is shared): they then meet only in
     what they share (a point of both projects onto the shared element, whose only preimage in t1 is itself).
     Exact; False proves nothing.  The twin of ``ct_projections_separate`` in the C extension."""
     out = np.zeros(len(t1), dtype=bool)
-    on1, on2 = same.any(axis=2), same.any(axis=1)
+    on1 = np.asarray(same.any(axis=2))
+    on2 = np.asarray(same.any(axis=1))
     r = np.flatnonzero(n_shared == 2)
     if len(r):
         i1 = np.argmin(on1[r], axis=1)                       # the corner of t1 not shared
@@ -394,11 +404,11 @@ def _projections_separate(t1, t2, same, n_shared, axis, pred: _Predicates) -> np
         mine = [t1[r, (i1 + 1) % 3], t1[r, (i1 + 2) % 3]]
         theirs = [t2[r, (i2 + 1) % 3], t2[r, (i2 + 2) % 3]]
         hit = np.zeros(len(r), dtype=bool)
-        for own, other in ((mine, theirs), (theirs, mine)):
+        for ends, other_ends in ((mine, theirs), (theirs, mine)):
             for e in range(2):
-                so = _o2(pred, v, own[e], own[1 - e], axis[r])
-                hit |= ((so != 0) & (_o2(pred, v, own[e], other[0], axis[r]) * so < 0)
-                        & (_o2(pred, v, own[e], other[1], axis[r]) * so < 0))
+                so = _o2(pred, v, ends[e], ends[1 - e], axis[r])
+                hit |= ((so != 0) & (_o2(pred, v, ends[e], other_ends[0], axis[r]) * so < 0)
+                        & (_o2(pred, v, ends[e], other_ends[1], axis[r]) * so < 0))
         out[r] = hit
     r = np.flatnonzero(n_shared == 0)
     if len(r):
@@ -435,14 +445,15 @@ def _alone_corner(d: np.ndarray) -> np.ndarray:
     return out
 
 
-def _point_in_triangle(pred: _Predicates, apex, x, tri) -> np.ndarray:
+def _point_in_triangle(pred: _Predicates, apex: np.ndarray, x: np.ndarray, tri: np.ndarray) -> np.ndarray:
     """Closed test: ``x``, on the plane of ``tri`` (k, 3, 3), lies in ``tri``; ``apex`` is off that plane."""
     s = [pred.orient3d(apex, x, tri[:, e], tri[:, (e + 1) % 3]) for e in range(3)]
     s0, s1, s2 = s
     return ((s0 >= 0) & (s1 >= 0) & (s2 >= 0)) | ((s0 <= 0) & (s1 <= 0) & (s2 <= 0))
 
 
-def _transversal(t1, t2, d1, d2, same, n_shared, pred: _Predicates) -> np.ndarray:
+def _transversal(t1: np.ndarray, t2: np.ndarray, d1: np.ndarray, d2: np.ndarray, same: np.ndarray,
+                 n_shared: np.ndarray, pred: _Predicates) -> np.ndarray:
     """Pairs in distinct planes, each touching the other's plane, sharing at most one corner."""
     kind = np.zeros(len(t1), dtype=np.int8)
     touch1, touch2 = _touch_corner(d1), _touch_corner(d2)
@@ -489,7 +500,8 @@ def _transversal(t1, t2, d1, d2, same, n_shared, pred: _Predicates) -> np.ndarra
     return kind
 
 
-def _coplanar(t1, t2, axis, same, n_shared, pred: _Predicates) -> np.ndarray:
+def _coplanar(t1: np.ndarray, t2: np.ndarray, axis: np.ndarray, same: np.ndarray, n_shared: np.ndarray,
+              pred: _Predicates) -> np.ndarray:
     """Pairs in one plane: positive-area overlap (by facing), boundary contact, or nothing beyond the shared."""
     k = len(t1)
     keep = _PLANE[axis]                                    # (k, 2)
@@ -530,7 +542,8 @@ def _coplanar(t1, t2, axis, same, n_shared, pred: _Predicates) -> np.ndarray:
 
 # -- broad phase ----------------------------------------------------------------------------------------------
 
-def _cells(faces, lo, hi, origin, h, dims):
+def _cells(faces: np.ndarray, lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, h: float,
+           dims: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Grid entries (face, cell key) of ``faces`` on cells of side ``h`` covering their boxes."""
     i0 = np.floor((lo[faces] - origin) / h).astype(np.int64)
     i1 = np.floor((hi[faces] - origin) / h).astype(np.int64)
@@ -544,10 +557,12 @@ def _cells(faces, lo, hi, origin, h, dims):
     return faces[which], key
 
 
-def _home(a, b, lo, origin, h, dims):
+def _home(a: np.ndarray, b: np.ndarray, lo: np.ndarray, origin: np.ndarray, h: float,
+          dims: np.ndarray) -> np.ndarray:
     """Cell key (side ``h``) of the low corner of the intersection of the boxes of faces a and b."""
     c = np.floor((np.maximum(lo[a], lo[b]) - origin) / h).astype(np.int64)
-    return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+    key: np.ndarray = (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+    return key
 
 
 def _chunks(per_entry: np.ndarray, chunk: int) -> Iterator[tuple[int, int]]:
@@ -604,9 +619,10 @@ def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int) -
             yield np.repeat(fa[s0:s1], n), fb[partner], kb[partner], h, dims
 
 
-def _keep_mask(a, b, cell, lo, hi, origin, h, dims) -> np.ndarray:
+def _keep_mask(a: np.ndarray, b: np.ndarray, cell: np.ndarray, lo: np.ndarray, hi: np.ndarray, origin: np.ndarray,
+               h: float, dims: np.ndarray) -> np.ndarray:
     """Raw pairs that are candidates: distinct faces, closed boxes meeting, ``cell`` the pair's home."""
-    ok = (a != b) & np.all(lo[a] <= hi[b], axis=1) & np.all(lo[b] <= hi[a], axis=1)
+    ok: np.ndarray = (a != b) & np.all(lo[a] <= hi[b], axis=1) & np.all(lo[b] <= hi[a], axis=1)
     r = np.flatnonzero(ok)
     ok[r] = _home(a[r], b[r], lo, origin, h, dims) == cell[r]
     return ok
@@ -615,7 +631,8 @@ def _keep_mask(a, b, cell, lo, hi, origin, h, dims) -> np.ndarray:
 _Scan = tuple[np.ndarray, np.ndarray, np.ndarray, int, int, bool]
 
 
-def _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk, pred: _Predicates) -> _Scan:
+def _scan_numpy(v: np.ndarray, f: np.ndarray, axis: np.ndarray, degenerate: np.ndarray, lo: np.ndarray,
+                hi: np.ndarray, max_pairs: int | None, chunk: int, pred: _Predicates) -> _Scan:
     """Pairs that meet (a, b, kind), candidate and tested counts, completeness: the grid and numpy twin."""
     found_a, found_b, found_k = [], [], []
     candidates = tested = 0
@@ -646,7 +663,8 @@ def _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk, pred: _Predica
     return np.concatenate(found_a), np.concatenate(found_b), np.concatenate(found_k), candidates, tested, complete
 
 
-def _scan_c(lib, v, f, max_pairs, pred: _Predicates) -> tuple[_Scan, np.ndarray, np.ndarray]:
+def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None,
+            pred: _Predicates) -> tuple[_Scan, np.ndarray, np.ndarray]:
     """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy), with the
     per-face projection axes and zero-area flags it computed."""
     raw_a, raw_b, raw_kind, candidates, tested, exact, complete, raw_axis, raw_skip = lib.contact_scan(
