@@ -560,3 +560,45 @@ def test_robot_max_faces_is_a_total_over_the_meshes(tmp_path):
            "meshes together (20), and the meshes read before this one left 8" in out
     code, _, err = run_cli("robot", path, "--density", "1000", "--max-faces", "0")
     assert code == 2 and "--max-faces" in err
+
+
+def test_3mf_nested_empty_objects_are_refused_by_instance_count(tmp_path):
+    # each level holds two copies of the next and no triangle: 2^13 instances from a few hundred bytes
+    resources = '<object id="1"><mesh><vertices><vertex x="0" y="0" z="0"/></vertices><triangles/></mesh></object>'
+    for level in range(2, 14):
+        twice = f'<component objectid="{level - 1}"/>' * 2
+        resources += f'<object id="{level}"><components>{twice}</components></object>'
+    resources += f'<object id="99">{_BOX_MESH}</object>'
+    path = _write_3mf(tmp_path / "empty.3mf", resources, '<item objectid="13"/><item objectid="99"/>')
+    with pytest.raises(MeshReadError, match=r"empty\.3mf.*places at least 2,001 object instances"):
+        load_mesh(path, max_faces=2000)
+    # within the limit the empty tree adds nothing and is not walked when placing
+    mesh = load_mesh(path, max_faces=10_000)
+    assert len(mesh.faces) == 12 and len(mesh.vertices) == 8
+
+
+def test_3mf_vertices_placed_by_many_items_are_refused(tmp_path):
+    # 4 vertices and no triangle, placed by 5,000 build items: 20,000 vertices past max_faces = 10
+    four = "".join(f'<vertex x="{k}" y="0" z="0"/>' for k in range(4))
+    resources = (f'<object id="1"><mesh><vertices>{four}</vertices><triangles/></mesh></object>'
+                 f'<object id="2">{_BOX_MESH.replace("<triangle v1", "<x v1", 11)}</object>')
+    build = '<item objectid="1"/>' * 5000 + '<item objectid="2"/>'
+    with pytest.raises(MeshReadError, match=r"places at least 3[0-9,]+ vertices"):
+        load_mesh(_write_3mf(tmp_path / "v.3mf", resources, build), max_faces=10)
+
+
+@pytest.mark.parametrize("attribute", ['x="1_0"', 'x="\u0661\u0660"', 'x="1\u00a0"'])
+def test_3mf_vertex_numbers_outside_the_grammar_are_refused(tmp_path, attribute):
+    mesh = _BOX_MESH.replace('x="1"', attribute, 1)
+    with pytest.raises(MeshReadError, match=r"bad\.3mf.*<vertex> without three numbers"):
+        load_mesh(_write_3mf(tmp_path / "bad.3mf", f'<object id="1">{mesh}</object>', '<item objectid="1"/>'))
+
+
+@pytest.mark.parametrize("text", ["1_0", "\u0661\u0660"])
+def test_3mf_triangle_indices_and_transforms_outside_the_grammar_are_refused(tmp_path, text):
+    mesh = _BOX_MESH.replace('v3="3"', f'v3="{text}"', 1)
+    with pytest.raises(MeshReadError, match="<triangle> without three numbers"):
+        load_mesh(_write_3mf(tmp_path / "t.3mf", f'<object id="1">{mesh}</object>', '<item objectid="1"/>'))
+    build = f'<item objectid="1" transform="1 0 0 0 1 0 0 0 1 {text} 0 0"/>'
+    with pytest.raises(MeshReadError, match="twelve finite"):
+        load_mesh(_write_3mf(tmp_path / "m.3mf", f'<object id="1">{_BOX_MESH}</object>', build))

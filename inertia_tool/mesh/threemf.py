@@ -12,8 +12,10 @@ numbers ``m00 m01 m02 m10 m11 m12 m20 m21 m22 m30 m31 m32``: a point ``p`` (row)
 Memory: a tree parser (trimesh's, through lxml) holds every element, about 1.6 kB per triangle.  Here each
 element is cleared once read, so the XML costs a constant; vertices (3 doubles) and triangles (3 int64) are
 appended to flat arrays, 24 bytes each, and counted as they come: a part is refused as soon as its triangles
-pass ``max_faces`` or its vertices ``3 · max_faces + 3``, and the build is refused from the triangle count of
-its instances (components multiply) before any instance is placed.
+pass ``max_faces`` or its vertices ``3 · max_faces + 3``, and the build is refused from the triangle, vertex
+and instance counts of what it places (components multiply; an instance of an empty object counts too: more
+than ``max_faces`` instances are refused) before any instance is placed.  Only instances with a triangle
+below them are placed, so a deep tree of empty objects costs nothing.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from typing import IO, Any, TypeAlias
 import numpy as np
 
 from ..errors import MeshReadError
+from ..units import DECIMAL
 
 __all__ = ["read_3mf", "THREEMF_UNITS", "MAX_COMPONENT_DEPTH"]
 
@@ -56,13 +59,33 @@ def _attribute(element: Any, name: str) -> str | None:
     return None
 
 
+def _plain(text: str) -> str:
+    """``text`` unchanged, or ValueError when it holds ``_`` or a non-ASCII character: Python's ``float`` and
+    ``int`` read ``1_0`` as 10 and ``١٢`` as 12, which no 3MF number (``xsd:double``/``xsd:int``) means."""
+    if "_" in text or not text.isascii():
+        raise ValueError(text)
+    return text
+
+
+def _three(get: Any, names: tuple[str, str, str], convert: Any, where: str, tag: str) -> tuple[Any, Any, Any]:
+    """The three numbers ``names`` of a ``<vertex>`` (``float``) or ``<triangle>`` (``int``) element."""
+    texts = (get(names[0]), get(names[1]), get(names[2]))
+    try:
+        return convert(_plain(texts[0])), convert(_plain(texts[1])), convert(_plain(texts[2]))
+    except (TypeError, ValueError):
+        found = " ".join(repr(t)[:24] for t in texts)
+        raise MeshReadError(f"{where}: a <{tag}> without three numbers {' '.join(names)} (found {found})") from None
+
+
 def _transform(text: str | None, where: str) -> np.ndarray:
-    """A 3MF transform as a 4 × 3 matrix (``p · M[:3] + M[3]``); identity when absent."""
+    """A 3MF transform as a 4 × 3 matrix (``p · M[:3] + M[3]``); identity when absent.  Each number by the
+    one grammar :data:`inertia_tool.units.DECIMAL`."""
     if text is None:
         return np.vstack([np.eye(3), np.zeros(3)])
-    try:
-        values = np.array([float(t) for t in text.split()], dtype=np.float64)
-    except ValueError:
+    tokens = text.split()
+    if all(DECIMAL.fullmatch(t) for t in tokens):
+        values = np.array([float(t) for t in tokens], dtype=np.float64)
+    else:
         values = np.zeros(0)
     if values.shape != (12,) or not np.all(np.isfinite(values)):
         raise MeshReadError(f"{where}: transform {text[:80]!r} is not twelve finite numbers")
@@ -106,24 +129,16 @@ def _read_part(source: IO[bytes], where: str, budget: list[int]) -> _Part:
             if tag is None:
                 tag = kinds.setdefault(element.tag, _local(element.tag))
             get = element.get
-            if tag == "vertex":
-                try:
-                    coords.extend((float(get("x")), float(get("y")), float(get("z"))))
-                except (TypeError, ValueError):
-                    raise MeshReadError(f"{where}: a <vertex> without three numbers x y z") from None
-                budget[1] -= 1
-                if budget[1] < 0:
-                    raise MeshReadError(f"{where}: holds more vertices than 3 × `max_faces` + 3 allows; refused "
-                                        "while reading")
-            elif tag == "triangle":
-                try:
-                    corners.extend((int(get("v1")), int(get("v2")), int(get("v3"))))
-                except (TypeError, ValueError):
-                    raise MeshReadError(f"{where}: a <triangle> without three vertex indices v1 v2 v3") from None
-                budget[0] -= 1
-                if budget[0] < 0:
-                    raise MeshReadError(f"{where}: holds more triangles than `max_faces` allows; refused while "
-                                        "reading")
+            if tag == "vertex" or tag == "triangle":
+                vertex = tag == "vertex"
+                (coords if vertex else corners).extend(
+                    _three(get, ("x", "y", "z") if vertex else ("v1", "v2", "v3"), float if vertex else int,
+                           where, tag))
+                slot = 1 if vertex else 0
+                budget[slot] -= 1
+                if budget[slot] < 0:
+                    what = "vertices than 3 × `max_faces` + 3" if vertex else "triangles than `max_faces`"
+                    raise MeshReadError(f"{where}: holds more {what} allows; refused while reading")
             elif tag == "component":
                 components.append((_attribute(element, "path"), get("objectid"),
                                    _transform(get("transform"), where)))
@@ -171,7 +186,8 @@ def read_3mf(path: str, members: Sequence[zipfile.ZipInfo], zf: zipfile.ZipFile,
     ------
     MeshReadError
         Malformed XML or attributes, an unknown unit, a reference to an object or part that does not exist, a
-        component cycle, or more triangles (placed instances included) than ``max_faces``.
+        component cycle, or a build placing more triangles or object instances than ``max_faces`` or more
+        vertices than ``3 · max_faces + 3`` (components and items repeated).
     """
     budget = [int(max_faces), 3 * int(max_faces) + 3]
     by_name = {"/" + info.filename.lstrip("/"): info for info in members}
@@ -192,7 +208,6 @@ def read_3mf(path: str, members: Sequence[zipfile.ZipInfo], zf: zipfile.ZipFile,
     if root.unit not in THREEMF_UNITS:
         raise MeshReadError(f"{name}: unknown 3MF unit {root.unit[:40]!r}; expected one of "
                             f"{', '.join(THREEMF_UNITS)}")
-    counts: dict[tuple[str, str | None], int] = {}
 
     def lookup(part_name: str, key: str | None) -> _Part:
         part = load(part_name)
@@ -204,30 +219,39 @@ def read_3mf(path: str, members: Sequence[zipfile.ZipInfo], zf: zipfile.ZipFile,
                                 f"{part_name[:60]} does not define")
         return part
 
-    def triangles(part_name: str, key: str | None, depth: int) -> int:
-        """Triangles of one instance of an object, components included (memoised; cycles refused)."""
+    # what one instance of an object brings, components included: (triangles, vertices, placements), each
+    # capped just above its limit so that a deep, wide tree stays cheap to count (memoised; cycles refused)
+    limits = (int(max_faces), 3 * int(max_faces) + 3, max(int(max_faces), 1))
+    counts: dict[tuple[str, str | None], tuple[int, int, int]] = {}
+
+    def tally(part_name: str, key: str | None, depth: int) -> tuple[int, int, int]:
         if depth > MAX_COMPONENT_DEPTH:
             raise MeshReadError(f"{name}: components nested deeper than {MAX_COMPONENT_DEPTH} (a cycle?)")
         if (part_name, key) in counts:
             return counts[(part_name, key)]
         part = lookup(part_name, key)
-        total = len(part.meshes[key][1]) if key in part.meshes else 0
+        v, f = part.meshes.get(key, (np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)))
+        total = [len(f), len(v), 1]
         for sub_part, sub_key, _ in part.components.get(key, ()):
-            total += triangles(sub_part or part_name, sub_key, depth + 1)
-            if total > max_faces:
-                break
-        counts[(part_name, key)] = total
-        return total
+            sub = tally(sub_part or part_name, sub_key, depth + 1)
+            total = [min(t + s, limit + 1) for t, s, limit in zip(total, sub, limits)]
+        counts[(part_name, key)] = (total[0], total[1], total[2])
+        return counts[(part_name, key)]
 
-    placed = sum(triangles(item_part or root_name, key, 0) for item_part, key, _ in root.items)
-    if placed > max_faces:
-        raise MeshReadError(f"{name}: the build places at least {placed:,} triangles (components and items "
-                            f"repeated), more than `max_faces` ({max_faces:,}) allows; refused before placing them")
+    placed = [0, 0, 0]
+    for item_part, key, _ in root.items:
+        sub = tally(item_part or root_name, key, 0)
+        placed = [min(t + s, limit + 1) for t, s, limit in zip(placed, sub, limits)]
+    for count, limit, what in zip(placed, limits, ("triangles", "vertices", "object instances")):
+        if count > limit:
+            raise MeshReadError(f"{name}: the build places at least {count:,} {what} (components and items "
+                                f"repeated), more than `max_faces` ({max_faces:,}) allows; refused before placing "
+                                "them")
     out_v: list[np.ndarray] = []
     out_f: list[np.ndarray] = []
     offset = [0]
 
-    def place(part_name: str, key: str | None, matrix: np.ndarray, depth: int) -> None:
+    def place(part_name: str, key: str | None, matrix: np.ndarray) -> None:
         part = parts[part_name]
         if key in part.meshes:
             v, f = part.meshes[key]
@@ -236,13 +260,16 @@ def read_3mf(path: str, members: Sequence[zipfile.ZipInfo], zf: zipfile.ZipFile,
             out_f.append((f[:, ::-1] if np.linalg.det(linear) < 0 else f) + offset[0])   # a mirror turns winding
             offset[0] += len(v)
         for sub_part, sub_key, sub in part.components.get(key, ()):
+            if not counts[(sub_part or part_name, sub_key)][0]:
+                continue                                  # no triangle below: nothing to place
             # the component's transform first, then the parent's: p · S · M + (t_S · M + t_M)
             combined = np.vstack([sub[:3] @ matrix[:3], sub[3] @ matrix[:3] + matrix[3]])
-            place(sub_part or part_name, sub_key, combined, depth + 1)
+            place(sub_part or part_name, sub_key, combined)
 
     with np.errstate(invalid="ignore", over="ignore"):       # non-finite coordinates are refused by the caller
         for item_part, key, matrix in root.items:
-            place(item_part or root_name, key, matrix, 0)
+            if counts[(item_part or root_name, key)][0]:
+                place(item_part or root_name, key, matrix)
     if not out_f or not sum(len(f) for f in out_f):
         raise MeshReadError(f"{name}: contains no triangle mesh (no build item places an object with triangles)")
     vertices = np.concatenate(out_v)
