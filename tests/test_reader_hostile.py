@@ -602,3 +602,50 @@ def test_3mf_triangle_indices_and_transforms_outside_the_grammar_are_refused(tmp
     build = f'<item objectid="1" transform="1 0 0 0 1 0 0 0 1 {text} 0 0"/>'
     with pytest.raises(MeshReadError, match="twelve finite"):
         load_mesh(_write_3mf(tmp_path / "m.3mf", f'<object id="1">{_BOX_MESH}</object>', build))
+
+
+# -- numbers outside the one grammar (Python's float() reads 1_0 as 10) ---------------------------------------
+
+_ODD_NUMBERS = ["1_0", "\u0661\u0660", "\uff11"]          # underscore, Arabic-Indic digits, a full-width digit
+
+
+def _stl_text(x):
+    return ("solid my_part\nfacet normal 0 0 1\nouter loop\n"
+            f"vertex 0 0 0\nvertex {x} 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid my_part\n")
+
+
+@pytest.mark.parametrize("text", _ODD_NUMBERS)
+def test_ascii_stl_coordinate_outside_the_grammar_is_refused(tmp_path, text):
+    path = tmp_path / "odd.stl"
+    path.write_bytes(_stl_text(text).encode())
+    with pytest.raises(MeshReadError, match=r"odd\.stl.*line 5: vertex coordinate is not a decimal number"):
+        load_mesh(path)
+
+
+def test_ascii_stl_names_with_underscores_still_read(tmp_path):
+    path = tmp_path / "named_part.stl"
+    path.write_bytes(_stl_text("1").encode())
+    mesh = load_mesh(path, units="m")
+    assert sorted(mesh.vertices[:, 0]) == [0.0, 0.0, 1.0]
+
+
+def _obj_text(x, index="3"):
+    return f"# my_part\no my_part\nusemtl steel_1\nv 0 0 0\nv {x} 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 {index}\n"
+
+
+@pytest.mark.parametrize("text", _ODD_NUMBERS)
+def test_obj_coordinate_and_index_outside_the_grammar_are_refused(tmp_path, text):
+    path = tmp_path / "odd.obj"
+    path.write_bytes(_obj_text(text).encode())
+    with pytest.raises(MeshReadError, match=r"odd\.obj.*line 5: vertex coordinate .* is not a decimal number"):
+        load_mesh(path)
+    index = "0_3" if "_" in text else text                 # "0_3" was read as index 3: a wrong face, silently
+    path.write_bytes(_obj_text("1", index=index).encode())
+    with pytest.raises(MeshReadError, match=r"odd\.obj.*line 8: face index .* is not an integer"):
+        load_mesh(path)
+
+
+def test_obj_names_with_underscores_still_read(tmp_path):
+    path = tmp_path / "odd.obj"
+    path.write_bytes(_obj_text("1").encode())
+    assert len(load_mesh(path).faces) == 1

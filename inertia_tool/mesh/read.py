@@ -242,6 +242,22 @@ def _text_blocks(fh: IO[bytes], path: str, *, block_bytes: int = _BLOCK_BYTES,
         yield carry if carry.endswith(b"\n") else carry + b"\n"
 
 
+def _odd_number(tokens: Sequence[bytes]) -> bytes | None:
+    """The first token holding ``_`` or a non-ASCII byte, else None.
+
+    Python's ``float``/``int`` (and numpy's bulk conversion) read ``1_0`` as 10; no mesh format's number
+    grammar (:data:`inertia_tool.units.DECIMAL` and its integers) has ``_`` or a non-ASCII digit.  Callers
+    look only in blocks where ``_has_odd_bytes`` found one, so the common case costs one scan per block."""
+    for tok in tokens:
+        if b"_" in tok or not tok.isascii():
+            return tok
+    return None
+
+
+def _has_odd_bytes(block: bytes) -> bool:
+    return b"_" in block or not block.isascii()
+
+
 def _bad_line(path: str, block: bytes, first_line: int, pos: int, problem: str) -> MeshReadError:
     """Error naming the line that holds byte ``pos`` of ``block`` (``first_line`` is the block's first line)."""
     start = block.rfind(b"\n", 0, pos) + 1
@@ -305,6 +321,11 @@ def _read_ascii_stl(path: str, size: int, max_faces: int) -> tuple[np.ndarray, i
                     raise _fail(path, f"line {line_no + len(words) - 1}: a facet has more than 3 vertices")
             facets += int(np.count_nonzero(is_facet))
             found = _VERTEX_RE.findall(block)
+            if _has_odd_bytes(block):                    # a name may hold them, a coordinate may not
+                for m_pos in _VERTEX_RE.finditer(block):
+                    if _odd_number(m_pos.groups()) is not None:
+                        raise _bad_line(path, block, line_no, m_pos.start(),
+                                        "vertex coordinate is not a decimal number (no '_', ASCII digits only)")
             if len(found) != int(np.count_nonzero(is_vertex)):
                 for m_pos in re.finditer(rb"(?im)^[ \t]*vertex\b[^\n]*", block):
                     if not _VERTEX_RE.fullmatch(m_pos.group(0)):
@@ -432,6 +453,7 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
             coords: list[bytes] = []
             tri: list[int] = []
             block_start = line_no + 1
+            odd = _has_odd_bytes(block)                  # names and comments may hold '_'; numbers may not
             lines = block.split(b"\n")
             lines.pop()  # every block ends with a newline
             for raw in lines:
@@ -450,6 +472,10 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
                 if key == b"v":
                     if len(parts) < 4:
                         raise _fail(path, f"line {line_no}: a vertex needs 3 coordinates, found {len(parts) - 1}")
+                    if odd and (bad := _odd_number(parts[1:4])) is not None:
+                        raise _fail(path, f"line {line_no}: vertex coordinate "
+                                          f"{bad[:40].decode('utf-8', 'replace')!r} is not a decimal number "
+                                          "(no '_', ASCII digits only)")
                     coords.extend(parts[1:4])
                     nv += 1
                     if nv > max_vertices:
@@ -458,6 +484,9 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
                     k = len(parts) - 1
                     if k < 3:
                         raise _fail(path, f"line {line_no}: a face needs at least 3 vertices, found {k}")
+                    if odd and (bad := _odd_number([t.split(b"/", 1)[0] for t in parts[1:]])) is not None:
+                        raise _fail(path, f"line {line_no}: face index {bad[:40].decode('utf-8', 'replace')!r} "
+                                          "is not an integer (no '_', ASCII digits only)")
                     idx = []
                     for tok in parts[1:]:
                         try:
