@@ -327,3 +327,22 @@ def test_file_name_with_a_lone_carriage_return_round_trips(tmp_path, fmt):
         assert sorted(row["path"] for row in r.previous_rows) == sorted(str(p) for p in d.iterdir())
     done = _cli("batch", d, "--out", out)
     assert done.returncode == 0 and "nothing new; 3 done before" in done.stderr
+
+
+@pytest.mark.parametrize("dangling", [True, False])
+def test_results_path_that_is_a_symbolic_link_is_refused_exit_2(tmp_path, dangling):
+    # review of issue 22: `res.jsonl -> elsewhere.jsonl` created (or appended to) the link's target
+    target = tmp_path / "elsewhere.jsonl"
+    if not dangling:
+        target.write_bytes(b"")
+    link = tmp_path / "res.jsonl"
+    link.symlink_to(target)
+    with pytest.raises(UsageError, match="res.jsonl: is a symbolic link"):
+        open_results(link)
+    d = _boxes(tmp_path / "parts", 1)
+    done = _cli("batch", d, "--out", link, "-q")
+    assert done.returncode == 2, done.stderr
+    err = done.stderr.strip().splitlines()
+    assert len(err) == 1 and "symbolic link" in err[0] and "Traceback" not in done.stderr
+    assert target.exists() != dangling and (dangling or target.read_bytes() == b"")
+    assert link.is_symlink()

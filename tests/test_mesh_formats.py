@@ -2,7 +2,9 @@
 OBJ groups, compressed single-mesh files with bounded decompression."""
 
 import bz2
+import contextlib
 import gzip
+import os
 import zipfile
 
 import numpy as np
@@ -218,3 +220,20 @@ def test_glb_textures_are_not_decoded(tmp_path, monkeypatch):
     ref = it.mass_properties((np.asarray(m.vertices), np.asarray(m.faces)), density=1000, units="m")
     assert props.mass == pytest.approx(ref.mass, rel=1e-6)       # float32 in the GLB
     np.testing.assert_allclose(props.inertia, ref.inertia, rtol=1e-5, atol=1e-12)
+
+
+@pytest.mark.parametrize("fail", [False, True])
+def test_decompressed_temporary_directory_is_removed_once_after_use(tmp_path, fail):
+    # the review found a second rmtree inside the TemporaryDirectory: one cleanup, after success and failure
+    from inertia_tool.mesh.decompress import decompressed
+    path = tmp_path / "t.stl.gz"
+    path.write_bytes(gzip.compress(b"solid t\nendsolid t\n"))
+    seen = []
+    with pytest.raises(RuntimeError) if fail else contextlib.nullcontext():
+        with decompressed(str(path), max_bytes=1 << 20, max_ratio=100, min_ratio_bytes=1 << 20,
+                          suffixes=(".stl",)) as (inner, member):
+            seen.append(inner)
+            assert member == "t.stl" and os.path.isfile(inner)
+            if fail:
+                raise RuntimeError("the caller failed")
+    assert seen and not os.path.exists(os.path.dirname(seen[0]))

@@ -498,18 +498,25 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30, sync_seco
     ResultsFileBusy
         Another process (a second batch run) is writing the file.
     UsageError
-        Not a results file of this kind, not a regular file, too large, or not readable/writable.
+        Not a results file of this kind, not a regular file, a symbolic link, too large, or not
+        readable/writable.
     """
     path = os.fspath(path)
     fmt = results_format(path)
     if not sync_seconds >= 0:
         raise UsageError(f"Expected `sync_seconds` >= 0, got {sync_seconds}")
+    if os.path.islink(path):                             # even a dangling one: it would create its target
+        raise UsageError(f"{path}: is a symbolic link; refusing to write results through it (name the file it "
+                         "points to)")
     if os.path.exists(path) and not os.path.isfile(path):
         raise UsageError(f"{path}: exists and is not a regular file")
-    flags = os.O_RDWR | os.O_CREAT | os.O_APPEND | getattr(os, "O_BINARY", 0) | getattr(os, "O_CLOEXEC", 0)
+    flags = (os.O_RDWR | os.O_CREAT | os.O_APPEND | getattr(os, "O_BINARY", 0) | getattr(os, "O_CLOEXEC", 0)
+             | getattr(os, "O_NOFOLLOW", 0))
     try:
         fd = os.open(path, flags, 0o666)
     except OSError as exc:
+        if os.path.islink(path):                         # made a link between the check above and the open
+            raise UsageError(f"{path}: is a symbolic link; refusing to write results through it") from None
         raise UsageError(f"{path}: cannot write the results file ({exc.strerror or exc})") from None
     try:
         st = os.fstat(fd)

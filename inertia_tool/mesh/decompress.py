@@ -17,7 +17,6 @@ import bz2
 import contextlib
 import gzip
 import os
-import shutil
 import tempfile
 import zipfile
 import zlib
@@ -140,4 +139,3 @@ def decompressed(path: str, *, max_bytes: int, max_ratio: float, min_ratio_bytes
                 NotImplementedError) as exc:
             raise _fail(path, f"cannot be decompressed ({str(exc)[:120] or type(exc).__name__})") from None
         yield target, member
-        shutil.rmtree(tmp, ignore_errors=True)
