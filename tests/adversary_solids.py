@@ -1,0 +1,786 @@
+"""Generated solids for the adversarial tests of the mesh-to-solid path, with truths from independent code.
+
+Every case is a triangle mesh (``vertices`` float64 m, ``faces`` int64) built by composing closed pieces
+(boxes, icospheres, cylinders, tori, the repository's ``meshes/*.stl``, swept tubes) under rigid motions, and
+the *solid people mean* by it: the union of the bodies less their cavities, a shell's role (body or cavity)
+given by its nesting depth, never by its winding; a surface that passes through itself means the set where
+its winding number is at least one.  The truth of each case comes from code independent of the engine:
+
+* ``fraction``: exact rational integrals (:class:`fractions.Fraction`) over the signed tetrahedra of the
+  pieces of the intended solid, each wound outward, cavities subtracted: exact for the float64 input as given
+  (interiors disjoint by construction);
+* ``manifold``: the intended solid built as manifold3d ``Manifold`` objects from float64 ``Mesh64`` pieces and
+  combined by booleans (union of bodies, difference of cavities), then integrated in float64 about a point
+  near the solid;
+* ``montecarlo`` (a cross-check, :func:`monte_carlo`): uniform points in the bounding box, inside where
+  libigl's generalized winding number is at least 0.5, with a standard error for each quantity.
+
+:func:`make_case` draws one case of a named composition kind from a :class:`numpy.random.Generator`; the
+hypothesis strategy :func:`cases` and ``benchmarks/bench_adversarial.py`` both use it, so a failure anywhere
+is reproduced by ``make_case(kind, np.random.default_rng(seed))``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+
+MESH_DIR = Path(__file__).resolve().parent.parent / "meshes"
+
+#: Composition kinds, in the order of the benchmark table.
+KINDS = ("single", "disjoint", "shared_vertex_overlap", "shared_vertex_touch", "touching_faces",
+         "overlapping", "nested", "internal_wall", "sliver", "figure_eight", "inside_out", "duplicated")
+
+#: Largest mesh integrated with rational arithmetic (faces); larger truths are float64 about a nearby point.
+FRACTION_MAX_FACES = 600
+
+
+# --------------------------------------------------------------------------------------------------- pieces
+def box(extents=(1.0, 1.0, 1.0), center=(0.0, 0.0, 0.0), subdivide=0):
+    """Axis-aligned box, outward; ``subdivide`` times every triangle split into four (a different triangulation
+    of the same faces)."""
+    e = np.asarray(extents, dtype=np.float64) / 2
+    v = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64) * e
+    f = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]], dtype=np.int64)
+    for _ in range(subdivide):
+        v, f = _subdivide(v, f)
+    return v + np.asarray(center, dtype=np.float64), f
+
+
+def _subdivide(v, f):
+    """Split each triangle into four at the edge midpoints (midpoints shared between neighbours)."""
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    uniq, inv = np.unique(edges, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    mid = (v[uniq[:, 0]] + v[uniq[:, 1]]) / 2
+    n, m = len(v), len(f)
+    a, b, c = f[:, 0], f[:, 1], f[:, 2]
+    ab, bc, ca = inv[:m] + n, inv[m:2 * m] + n, inv[2 * m:] + n
+    nf = np.concatenate([np.stack([a, ab, ca], 1), np.stack([ab, b, bc], 1), np.stack([ca, bc, c], 1),
+                         np.stack([ab, bc, ca], 1)])
+    return np.vstack([v, mid]), nf
+
+
+def icosphere(radius=1.0, subdivisions=1):
+    """Icosphere (vertices pushed to the sphere after each split), outward."""
+    t = (1 + 5 ** 0.5) / 2
+    v = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t], [0, 1, -t],
+                  [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], dtype=np.float64)
+    f = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
+                  [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
+                  [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]], dtype=np.int64)
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    for _ in range(subdivisions):
+        v, f = _subdivide(v, f)
+        v /= np.linalg.norm(v, axis=1, keepdims=True)
+    return v * radius, f
+
+
+def cylinder(radius=0.5, height=1.0, sections=16):
+    """Prism over a regular polygon, axis z, centred, outward."""
+    k = np.arange(sections)
+    ang = 2 * np.pi * k / sections
+    ring = np.stack([radius * np.cos(ang), radius * np.sin(ang)], 1)
+    v = np.vstack([np.c_[ring, np.full(sections, -height / 2)], np.c_[ring, np.full(sections, height / 2)],
+                   [[0, 0, -height / 2], [0, 0, height / 2]]])
+    nxt = (k + 1) % sections
+    bot, top = 2 * sections, 2 * sections + 1
+    f = np.concatenate([np.stack([k, nxt, nxt + sections], 1), np.stack([k, nxt + sections, k + sections], 1),
+                        np.stack([np.full(sections, bot), nxt, k], 1),
+                        np.stack([np.full(sections, top), k + sections, nxt + sections], 1)])
+    return v, f.astype(np.int64)
+
+
+def torus(major=1.0, minor=0.3, major_sections=16, minor_sections=8):
+    """Torus about z, outward."""
+    i, j = np.meshgrid(np.arange(major_sections), np.arange(minor_sections), indexing="ij")
+    u = 2 * np.pi * i / major_sections
+    w = 2 * np.pi * j / minor_sections
+    r = major + minor * np.cos(w)
+    v = np.stack([r * np.cos(u), r * np.sin(u), minor * np.sin(w)], -1).reshape(-1, 3)
+    idx = lambda a, b: (a % major_sections) * minor_sections + b % minor_sections
+    a, b, c, d = idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)
+    f = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    return v, f.astype(np.int64)
+
+
+_PART_CACHE: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+#: Repository parts small enough to compose quickly (faces).
+PARTS = ("box.stl", "octahedron.stl", "t_handle.stl", "cone.stl", "spinning_top.stl", "washer.stl")
+
+
+def part(name):
+    """A repository part, welded (by trimesh), scaled to a unit bounding-box diagonal and centred."""
+    if name not in _PART_CACHE:
+        import trimesh
+        m = trimesh.load(MESH_DIR / name, force="mesh")
+        v = np.asarray(m.vertices, dtype=np.float64)
+        v = (v - (v.min(0) + v.max(0)) / 2) / np.linalg.norm(v.max(0) - v.min(0))
+        f = np.asarray(m.faces, dtype=np.int64)
+        if _signed_volume(v, f) < 0:
+            f = f[:, ::-1]
+        _PART_CACHE[name] = (v, f)
+    v, f = _PART_CACHE[name]
+    return v.copy(), f.copy()
+
+
+def tube_slabs(height, radius=0.25, rings=48, sections=8, scale=1.0):
+    """A tube swept along a figure-eight (lemniscate of Gerono lifted by ``height·cos t``): the tube's surface and
+    the closed slabs between consecutive rings (each a prism with polygon caps).
+
+    At t = 0 and t = π the centre line passes (0, 0, ±height): the tube crosses itself when
+    ``2·height < 2·radius``.  The union of the slabs is the set where the tube's winding number is ≥ 1.
+    """
+    t = 2 * np.pi * np.arange(rings) / rings
+    c = np.stack([np.sin(t), np.sin(t) * np.cos(t), height * np.cos(t)], 1) * scale
+    dc = np.stack([np.cos(t), np.cos(2 * t), -height * np.sin(t)], 1)
+    tang = dc / np.linalg.norm(dc, axis=1, keepdims=True)
+    nrm = np.cross(tang, [0.0, 0.0, 1.0])
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    bin_ = np.cross(tang, nrm)
+    ang = 2 * np.pi * np.arange(sections) / sections
+    ringpts = (c[:, None] + radius * scale * (np.cos(ang)[None, :, None] * nrm[:, None]
+                                              + np.sin(ang)[None, :, None] * bin_[:, None]))
+    v = ringpts.reshape(-1, 3)
+    k = np.arange(sections)
+    faces = []
+    for i in range(rings):
+        a, b = i * sections, ((i + 1) % rings) * sections
+        faces += [np.stack([a + k, b + (k + 1) % sections, a + (k + 1) % sections], 1),
+                  np.stack([a + k, b + k, b + (k + 1) % sections], 1)]
+    f = np.concatenate(faces).astype(np.int64)
+    if _signed_volume(v, f) < 0:
+        f = f[:, ::-1]
+        sign = -1
+    else:
+        sign = 1
+    slabs = []
+    for i in range(rings):
+        r0, r1 = ringpts[i], ringpts[(i + 1) % rings]
+        sv = np.vstack([r0, r1])
+        side = [np.stack([k, sections + (k + 1) % sections, (k + 1) % sections], 1),
+                np.stack([k, sections + k, sections + (k + 1) % sections], 1)]
+        fan = np.arange(1, sections - 1)
+        caps = [np.stack([np.zeros_like(fan), fan, fan + 1], 1), np.stack([np.full_like(fan, sections),
+                                                                            sections + fan + 1, sections + fan], 1)]
+        sf = np.concatenate(side + caps).astype(np.int64)
+        if sign < 0:
+            sf = sf[:, ::-1]
+        if _signed_volume(sv, sf) < 0:
+            sf = sf[:, ::-1]
+        slabs.append((sv, sf))
+    return v, f, slabs
+
+
+# ------------------------------------------------------------------------------------------------- motions
+def random_rotation(rng):
+    """A uniformly random proper rotation (from a normalised Gaussian quaternion)."""
+    q = rng.normal(size=4)
+    w, x, y, z = q / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def right_angle_rotation(rng):
+    """One of the 24 proper rotations by multiples of 90° (a signed permutation matrix, det +1): exact."""
+    while True:
+        m = np.eye(3)[rng.permutation(3)] * rng.choice([-1.0, 1.0], size=3)[:, None]
+        if np.linalg.det(m) > 0:
+            return m
+
+
+def rigid_motion(rng, scale=1.0):
+    """(R, t): a right-angle rotation with dyadic translation (coordinates stay exact) or a random one."""
+    if rng.random() < 0.4:
+        return right_angle_rotation(rng), rng.integers(-8, 9, size=3) * 0.125 * scale
+    offset = rng.normal(size=3) * scale * (1000.0 if rng.random() < 0.1 else 2.0)
+    return random_rotation(rng), offset
+
+
+def moved(piece, rot, shift):
+    v, f = piece
+    return v @ rot.T + shift, f
+
+
+# -------------------------------------------------------------------------------------------------- truths
+@dataclass
+class Truth:
+    """Unit-density moments of the intended solid: volume m³, centroid (3,) m, inertia (3, 3) m⁵ about the
+    centroid (tensor convention), and how they were found.  ``sigma_*`` are standard errors (Monte Carlo only)."""
+
+    volume: float
+    centroid: np.ndarray
+    inertia: np.ndarray
+    source: str
+    sigma_volume: float = 0.0
+    sigma_centroid: float = 0.0
+    sigma_inertia: float = 0.0
+
+
+def _signed_volume(v, f):
+    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    ref = v.mean(0)
+    return float(np.einsum("ij,ij->i", p0 - ref, np.cross(p1 - ref, p2 - ref)).sum() / 6)
+
+
+def fraction_moments(v, f):
+    """Exact (volume, ∫x dV (3,), ∫x_i x_j dV (3, 3)) of a closed surface, as Fractions over signed
+    tetrahedra with apex at the origin: det/6, det/24·(a+b+c), det/120·(Σ pᵢpⱼ + sᵢsⱼ), s = a+b+c."""
+    cache: dict[int, list[Fraction]] = {}
+
+    def pt(i):
+        if i not in cache:
+            cache[i] = [Fraction(float(x)) for x in v[i]]
+        return cache[i]
+
+    vol = Fraction(0)
+    first = [Fraction(0)] * 3
+    second = [[Fraction(0)] * 3 for _ in range(3)]
+    for i0, i1, i2 in f:
+        a, b, c = pt(int(i0)), pt(int(i1)), pt(int(i2))
+        det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+               + a[2] * (b[0] * c[1] - b[1] * c[0]))
+        if det == 0:
+            continue
+        s = [a[k] + b[k] + c[k] for k in range(3)]
+        vol += det / 6
+        for k in range(3):
+            first[k] += det * s[k] / 24
+        for r in range(3):
+            for q in range(r, 3):
+                second[r][q] += det * (a[r] * a[q] + b[r] * b[q] + c[r] * c[q] + s[r] * s[q]) / 120
+    for r in range(3):
+        for q in range(r):
+            second[r][q] = second[q][r]
+    return vol, first, second
+
+
+def float_moments(v, f):
+    """(volume, centroid, central second moment) in float64 about the vertex mean (same tetrahedra)."""
+    ref = v.mean(0)
+    p0, p1, p2 = v[f[:, 0]] - ref, v[f[:, 1]] - ref, v[f[:, 2]] - ref
+    det = np.einsum("ij,ij->i", p0, np.cross(p1, p2))
+    s = p0 + p1 + p2
+    vol = det.sum() / 6
+    first = (det[:, None] * s).sum(0) / 24
+    sec = np.einsum("n,ni,nj->ij", det, p0, p0) + np.einsum("n,ni,nj->ij", det, p1, p1) \
+        + np.einsum("n,ni,nj->ij", det, p2, p2) + np.einsum("n,ni,nj->ij", det, s, s)
+    sec /= 120
+    cen = first / vol
+    central = sec - vol * np.outer(cen, cen)
+    return vol, cen + ref, central
+
+
+def _inertia(central):
+    return np.trace(central) * np.eye(3) - central
+
+
+def truth_from_pieces(pieces):
+    """Truth of a solid given as disjoint signed pieces ``[(sign, (v, f)), ...]`` (each outward-wound; sign −1
+    for a cavity), exact in rationals when small."""
+    if sum(len(p[1][1]) for p in pieces) <= FRACTION_MAX_FACES:
+        vol, first, second = Fraction(0), [Fraction(0)] * 3, [[Fraction(0)] * 3 for _ in range(3)]
+        for sign, (v, f) in pieces:
+            pv, pf, ps = fraction_moments(v, f)
+            vol += sign * pv
+            first = [first[k] + sign * pf[k] for k in range(3)]
+            second = [[second[r][q] + sign * ps[r][q] for q in range(3)] for r in range(3)]
+        cen = [first[k] / vol for k in range(3)]
+        central = [[second[r][q] - vol * cen[r] * cen[q] for q in range(3)] for r in range(3)]
+        c = np.array([[float(x) for x in row] for row in central])
+        return Truth(float(vol), np.array([float(x) for x in cen]), _inertia(c), "fraction")
+    vol, mom, sec = 0.0, np.zeros(3), np.zeros((3, 3))
+    for sign, (v, f) in pieces:
+        pv, pc, pcen = float_moments(v, f)
+        vol += sign * pv
+        mom += sign * pv * pc
+        sec += sign * (pcen + pv * np.outer(pc, pc))
+    cen = mom / vol
+    return Truth(vol, cen, _inertia(sec - vol * np.outer(cen, cen)), "float")
+
+
+def to_manifold(piece):
+    import manifold3d as m3
+    v, f = piece
+    mesh = m3.Mesh64(vert_properties=np.ascontiguousarray(v, dtype=np.float64),
+                     tri_verts=np.ascontiguousarray(f, dtype=np.uint64))
+    man = m3.Manifold(mesh)
+    if man.status() != m3.Error.NoError:
+        raise ValueError(f"manifold3d refused a generated piece: {man.status()}")
+    return man
+
+
+def truth_from_manifold(bodies, cavities=()):
+    """Truth of (∪ bodies) − (∪ cavities), formed by manifold3d in float64."""
+    import manifold3d as m3
+    solid = m3.Manifold.batch_boolean([to_manifold(b) for b in bodies], m3.OpType.Add) if len(bodies) > 1 \
+        else to_manifold(bodies[0])
+    if cavities:
+        solid = solid - m3.Manifold.batch_boolean([to_manifold(c) for c in cavities], m3.OpType.Add)
+    out = solid.to_mesh64()
+    v = np.asarray(out.vert_properties, dtype=np.float64)[:, :3]
+    f = np.asarray(out.tri_verts, dtype=np.int64)
+    vol, cen, central = float_moments(v, f)
+    return Truth(vol, cen, _inertia(central), "manifold")
+
+
+def monte_carlo(v, f, rng, n=200_000):
+    """Moments of {winding number ≥ 1} by uniform sampling of the bounding box (libigl fast winding numbers),
+    with standard errors (volume m³; centroid m, the largest coordinate's; inertia, Frobenius m⁵)."""
+    import igl
+    lo, hi = v.min(0), v.max(0)
+    q = lo + rng.random((n, 3)) * (hi - lo)
+    w = igl.fast_winding_number(np.ascontiguousarray(v), np.ascontiguousarray(f), q)
+    inside = q[np.abs(w) >= 0.5]
+    box_vol = float(np.prod(hi - lo))
+    p = len(inside) / n
+    vol = box_vol * p
+    se_vol = box_vol * np.sqrt(p * (1 - p) / n)
+    cen = inside.mean(0)
+    se_cen = float(np.max(inside.std(0)) / np.sqrt(len(inside)))
+    d = inside - cen
+    r2 = np.einsum("ij,ij->i", d, d)
+    per = r2[:, None, None] * np.eye(3) - d[:, :, None] * d[:, None, :]      # (k, 3, 3) per-sample inertia
+    inertia = per.sum(0) * box_vol / n
+    # each sample contributes box_vol/n · (inside · per): variance of the sum over all n samples
+    allper = np.zeros((n, 3, 3))
+    allper[np.abs(w) >= 0.5] = per
+    se_in = float(np.linalg.norm(allper.std(0)) * box_vol / np.sqrt(n))
+    return Truth(vol, cen, inertia, "montecarlo", se_vol, se_cen, se_in)
+
+
+# ---------------------------------------------------------------------------------------------------- cases
+@dataclass
+class Case:
+    """A generated mesh and the solid it means.  ``recipe`` says how it was built (for reproducers)."""
+
+    kind: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    truth: Truth
+    recipe: str
+    check: Truth | None = field(default=None)   # a second, independent truth (Monte Carlo) when one was made
+
+
+def concat(*pieces):
+    """Pieces as one mesh (vertex indices offset; nothing merged)."""
+    vs, fs, off = [], [], 0
+    for v, f in pieces:
+        vs.append(v)
+        fs.append(f + off)
+        off += len(v)
+    return np.vstack(vs), np.concatenate(fs)
+
+
+def flipped(piece):
+    v, f = piece
+    return v, f[:, ::-1].copy()
+
+
+def random_piece(rng, convex=False, small=False):
+    """(name, (v, f)) a random primitive or part, outward, roughly unit size."""
+    choices = ["box", "box_sub", "icosphere", "cylinder"] + ([] if convex else ["torus", "part"])
+    kind = choices[rng.integers(len(choices))]
+    if kind == "box":
+        ext = rng.integers(2, 9, size=3) * 0.125
+        return f"box{tuple(ext)}", box(ext)
+    if kind == "box_sub":
+        ext = rng.integers(2, 9, size=3) * 0.125
+        return f"box{tuple(ext)}/sub1", box(ext, subdivide=1)
+    if kind == "icosphere":
+        r = float(rng.uniform(0.3, 0.7))
+        sub = 0 if small else int(rng.integers(0, 2))
+        return f"icosphere(r={r:.3g},sub={sub})", icosphere(r, sub)
+    if kind == "cylinder":
+        r, h = float(rng.uniform(0.2, 0.5)), float(rng.uniform(0.4, 1.0))
+        n = int(rng.integers(5, 17))
+        return f"cylinder(r={r:.3g},h={h:.3g},n={n})", cylinder(r, h, n)
+    if kind == "torus":
+        big = float(rng.uniform(0.4, 0.6))
+        return f"torus(R={big:.3g})", torus(big, big * float(rng.uniform(0.2, 0.45)), 12, 6)
+    name = PARTS[rng.integers(len(PARTS))]
+    return f"part({name})", part(name)
+
+
+def _motion_all(rng, v, scale=1.0):
+    rot, shift = rigid_motion(rng, scale)
+    return v @ rot.T + shift, rot, shift
+
+
+def _finish(kind, rng, pieces_signed, mesh, recipe, union=None):
+    """Move the whole assembly rigidly; the truth is computed on the moved pieces (so it is the truth of the
+    float64 input as given)."""
+    v, f = mesh
+    rot, shift = rigid_motion(rng)
+    v2 = v @ rot.T + shift
+    if union is not None:
+        bodies, cavities = union
+        truth = truth_from_manifold([moved(b, rot, shift) for b in bodies],
+                                    [moved(c, rot, shift) for c in cavities])
+    else:
+        truth = truth_from_pieces([(s, moved(p, rot, shift)) for s, p in pieces_signed])
+    return Case(kind, v2, f, truth, recipe + f"; whole mesh moved by R={np.round(rot, 3).tolist()}, "
+                                               f"t={np.round(shift, 3).tolist()}")
+
+
+def make_case(kind, rng):
+    """One case of composition ``kind`` drawn from ``rng``."""
+    build = _BUILDERS[kind]
+    return build(rng)
+
+
+def _single(rng):
+    name, p = random_piece(rng)
+    p = moved(p, *rigid_motion(rng))
+    return _finish("single", rng, [(1, p)], p, name)
+
+
+def _disjoint(rng):
+    k = int(rng.integers(2, 4))
+    pieces, names = [], []
+    cursor, last = 0.0, 0.0
+    for _ in range(k):
+        name, p = random_piece(rng)
+        rot = random_rotation(rng) if rng.random() < 0.5 else right_angle_rotation(rng)
+        centre = (p[0].min(0) + p[0].max(0)) / 2
+        radius = float(np.linalg.norm(p[0] - centre, axis=1).max())     # a ball around the piece, any rotation
+        cursor += last + radius + 0.05 * (pieces != [])
+        p = moved((p[0] - centre, p[1]), rot, np.array([cursor, 0.0, 0.0]))
+        last = radius
+        pieces.append(p)
+        names.append(name)
+    return _finish("disjoint", rng, [(1, p) for p in pieces], concat(*pieces), " + ".join(names) + " side by side")
+
+
+def _axis_rotation(axis, angle):
+    axis = np.asarray(axis, dtype=np.float64)
+    axis /= np.linalg.norm(axis)
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+
+
+def _share(a, b, ia, ib):
+    """Concatenate a and b with b's vertex ``ib`` replaced by a's vertex ``ia`` (same index)."""
+    va, fa = a
+    vb, fb = b
+    keep = np.ones(len(vb), dtype=bool)
+    keep[ib] = False
+    remap = np.full(len(vb), -1, dtype=np.int64)
+    remap[keep] = len(va) + np.arange(int(keep.sum()))
+    remap[ib] = ia
+    return np.vstack([va, vb[keep]]), np.concatenate([fa, remap[fb]])
+
+
+def _shared_vertex_overlap(rng):
+    name, a = random_piece(rng, convex=True, small=True)
+    va = a[0]
+    ia = int(rng.integers(len(va)))
+    p = va[ia]
+    diagonal = rng.random() < 0.5
+    axis = (p - va.mean(0)) if diagonal else rng.normal(size=3)
+    angle = float(rng.uniform(0.1, np.pi - 0.1))
+    rot = _axis_rotation(axis, angle)
+    b = ((va - p) @ rot.T + p, a[1].copy())
+    b[0][ia] = p
+    mesh = _share(a, b, ia, ia)
+    return _finish("shared_vertex_overlap", rng, None, mesh,
+                   f"{name} and a copy turned {angle:.3f} rad about "
+                   f"{'its diagonal' if diagonal else 'a random axis'} through vertex {ia}, that vertex shared",
+                   union=([a, b], []))
+
+
+def _shared_vertex_touch(rng):
+    name, a = random_piece(rng, convex=True, small=True)
+    va, fa = a
+    # a vertex that is extreme along a random direction (exposed): the point reflection through it touches there
+    ia = int(np.argmax(va @ rng.normal(size=3)))
+    p = va[ia]
+    b = (2 * p - va, fa[:, ::-1].copy())
+    b[0][ia] = p
+    mesh = _share(a, b, ia, ia)
+    return _finish("shared_vertex_touch", rng, [(1, a), (1, b)], mesh,
+                   f"{name} and its point reflection through vertex {ia}, touching there only, vertex shared")
+
+
+def _touching_faces(rng):
+    if rng.random() < 0.3:     # two copies of a real part, side by side along x: touching where both reach
+        name = PARTS[rng.integers(len(PARTS))]
+        a = part(name)
+        w = a[0][:, 0].max() - a[0][:, 0].min()
+        b = (a[0] + [w, 0, 0], a[1].copy())
+        return _finish("touching_faces", rng, [(1, a), (1, b)], concat(a, b),
+                       f"two copies of {name} touching at x = max (width {w:.6g})")
+    ea = rng.integers(2, 9, size=3) * 0.125
+    eb = rng.integers(2, 9, size=3) * 0.125
+    sa, sb = int(rng.integers(0, 2)), int(rng.integers(0, 2))
+    # b sits on a's +x face, offset in y and z by dyadic amounts (partial contact, different triangulations)
+    off = np.r_[(ea[0] + eb[0]) / 2, rng.integers(-3, 4, size=2) * 0.125]
+    a = box(ea, subdivide=sa)
+    b = box(eb, off, subdivide=sb)
+    if rng.random() < 0.5:   # b's faces turned a quarter about x: the other diagonal on its contact face
+        rot = _axis_rotation([1, 0, 0], np.pi / 2).round()
+        b = ((b[0] - off) @ rot.T + off, b[1])
+    return _finish("touching_faces", rng, [(1, a), (1, b)], concat(a, b),
+                   f"box{tuple(ea)}/sub{sa} and box{tuple(eb)}/sub{sb} face to face at x={off[0]}, "
+                   f"offset {off[1:].tolist()}")
+
+
+def _overlapping(rng):
+    k = int(rng.integers(2, 4))
+    pieces, names = [], []
+    for _ in range(k):
+        name, p = random_piece(rng, small=True)
+        p = moved(p, random_rotation(rng) if rng.random() < 0.5 else right_angle_rotation(rng),
+                  rng.normal(size=3) * 0.25)
+        pieces.append(p)
+        names.append(name)
+    return _finish("overlapping", rng, None, concat(*pieces), " ∪ ".join(names) + " overlapping",
+                   union=(pieces, []))
+
+
+def _inner_of(rng, outer_name, outer, scale):
+    """A convex piece strictly inside ``outer`` (the box or sphere inscribed, shrunk by ``scale``)."""
+    v = outer[0]
+    c = (v.min(0) + v.max(0)) / 2
+    inr = float(np.min(np.abs(v - c).max(0)))      # inscribed for boxes; safe upper bound shrunk below
+    if outer_name.startswith("icosphere") or outer_name.startswith("cylinder"):
+        inr *= 0.75                                # inscribed radius of a coarse icosphere / polygon prism
+    inr *= scale
+    if rng.random() < 0.5:
+        e = inr * 2 / np.sqrt(3)
+        return "box", box([e, e, e], c)
+    return "icosphere", (icosphere(inr, 0)[0] + c, icosphere(inr, 0)[1])
+
+
+def _nested(rng):
+    choices = ["box", "icosphere", "cylinder"]
+    oname = choices[rng.integers(3)]
+    if oname == "box":
+        outer = box(rng.integers(4, 9, size=3) * 0.125, subdivide=int(rng.integers(0, 2)))
+    elif oname == "icosphere":
+        outer = icosphere(float(rng.uniform(0.4, 0.7)), int(rng.integers(0, 2)))
+    else:
+        outer = cylinder(0.5, 0.8, int(rng.integers(8, 17)))
+    iname, inner = _inner_of(rng, oname, outer, float(rng.uniform(0.3, 0.9)))
+    levels = [(1, outer), (-1, inner)]
+    names = [oname, iname]
+    if rng.random() < 0.3:            # a body inside the cavity (depth 2)
+        cname, core = _inner_of(rng, iname, inner, float(rng.uniform(0.3, 0.8)))
+        levels.append((1, core))
+        names.append(cname)
+    wound = []
+    mesh_pieces = []
+    for sign, p in levels:
+        right = rng.random() < 0.5
+        # right: wound as its depth says (outward for a body, inward for a cavity)
+        outward = (sign > 0) == right
+        mesh_pieces.append(p if outward else flipped(p))
+        wound.append(f"{'outward' if outward else 'inward'}")
+    recipe = " ⊃ ".join(f"{n} ({w})" for n, w in zip(names, wound)) + " nested (depth 0 body, 1 cavity, 2 body)"
+    return _finish("nested", rng, levels, concat(*mesh_pieces), recipe)
+
+
+def _internal_wall(rng):
+    ext = rng.integers(2, 9, size=3) * 0.125
+    cut = int(rng.integers(1, int(ext[0] / 0.125)))   # x position of the wall, in eighths from the left face
+    left = np.r_[cut * 0.125, ext[1:]]
+    right = np.r_[ext[0] - cut * 0.125, ext[1:]]
+    x0 = -ext[0] / 2
+    a = box(left, [x0 + left[0] / 2, 0, 0])
+    b = box(right, [x0 + left[0] + right[0] / 2, 0, 0])
+    merge = rng.random() < 0.5
+    if merge:       # the wall's vertices shared by index (as a CAD export that welds)
+        va, fa = a
+        vb, fb = b
+        allv = np.vstack([va, vb])
+        uniq, inv = np.unique(allv, axis=0, return_inverse=True)
+        inv = inv.reshape(-1)
+        mesh = (uniq, np.concatenate([inv[fa], inv[fb + len(va)]]))
+    else:
+        mesh = concat(a, b)
+    return _finish("internal_wall", rng, [(1, a), (1, b)], mesh,
+                   f"box{tuple(ext)} split at x = {x0 + left[0]} into two boxes with a zero-thickness wall "
+                   f"({'welded' if merge else 'separate vertices'})")
+
+
+def _sliver(rng):
+    name, body = random_piece(rng)
+    v = body[0]
+    hi = v.max(0)
+    size = float(rng.uniform(0.05, 0.5))
+    gap = float(rng.choice([0.0, 1e-3, 0.1]))
+    # a flat quad beside the body along +x (both sides: 4 faces, no volume)
+    quad = np.array([[0, 0, 0], [0, size, 0], [0, size, size], [0, 0, size]], dtype=np.float64)
+    quad += [hi[0] + gap + 0.01, 0, 0]
+    quad[:, 0] += rng.uniform(0, 1e-9, size=4) * (rng.random() < 0.3)   # sometimes not quite flat
+    qf = np.array([[0, 1, 2], [0, 2, 3], [0, 2, 1], [0, 3, 2]], dtype=np.int64)
+    if rng.random() < 0.5:
+        sliver = (quad, qf)
+        return _finish("sliver", rng, [(1, body)], concat(body, sliver),
+                       f"{name} with a 4-face flat sliver ({size:.3g} m, gap {gap:g}) beside it")
+    # a 4-face tetrahedron flattened to a thickness of 1e-9 … 1e-5 of its size: a real, very thin solid
+    thick = size * 10 ** float(rng.uniform(-9, -5))
+    tet = np.array([[0, 0, 0], [0, size, 0], [0, 0, size], [thick, size / 3, size / 3]], dtype=np.float64)
+    tet += [hi[0] + gap + 0.01, 0, 0]
+    tf = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]], dtype=np.int64)
+    if _signed_volume(tet, tf) < 0:
+        tf = tf[:, ::-1].copy()
+    return _finish("sliver", rng, [(1, body), (1, (tet, tf))], concat(body, (tet, tf)),
+                   f"{name} with a 4-face tetrahedron {thick:.3g} m thin ({size:.3g} m across, gap {gap:g}) beside it")
+
+
+def _figure_eight(rng, n_mc=0):
+    height = float(rng.uniform(0.0, 0.4))
+    radius = float(rng.uniform(0.1, 0.3))
+    v, f, slabs = tube_slabs(height, radius, rings=int(rng.integers(24, 49)), sections=int(rng.integers(5, 9)))
+    case = _finish("figure_eight", rng, None, (v, f),
+                   f"figure-eight tube, lift {height:.3f}, radius {radius:.3f} "
+                   f"({'crosses itself' if height < radius else 'passes clear'})", union=(slabs, []))
+    if n_mc:
+        case.check = monte_carlo(case.vertices, case.faces, rng, n_mc)
+    return case
+
+
+def _inside_out(rng):
+    base = ("single", "disjoint", "nested", "overlapping", "touching_faces")[rng.integers(5)]
+    case = _BUILDERS[base](rng)
+    return Case("inside_out", case.vertices, case.faces[:, ::-1].copy(), case.truth,
+                f"[{base}] {case.recipe}; every face reversed")
+
+
+def _duplicated(rng):
+    base = ("single", "disjoint", "nested")[rng.integers(3)]
+    case = _BUILDERS[base](rng)
+    v, f = case.vertices, case.faces
+    if base == "nested":
+        # duplicate the whole nest: each shell's copy has the same depth role, the solid is unchanged
+        pick = np.ones(len(f), dtype=bool)
+    else:
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+        e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+        g = coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(len(v), len(v)))
+        _, lab = connected_components(g, directed=False)
+        shell = lab[f[:, 0]]
+        pick = shell == shell[rng.integers(len(f))]
+    shared = rng.random() < 0.5
+    if shared:      # the copy uses the same vertex indices
+        nf = np.concatenate([f, f[pick]])
+        nv = v
+    else:
+        nv = np.vstack([v, v])
+        nf = np.concatenate([f, f[pick] + len(v)])
+    what = "the whole nest" if base == "nested" else "one shell"
+    return Case("duplicated", nv, nf, case.truth,
+                f"[{base}] {case.recipe}; {what} duplicated ({'same' if shared else 'new'} vertex indices)")
+
+
+_BUILDERS = {
+    "single": _single, "disjoint": _disjoint, "shared_vertex_overlap": _shared_vertex_overlap,
+    "shared_vertex_touch": _shared_vertex_touch, "touching_faces": _touching_faces, "overlapping": _overlapping,
+    "nested": _nested, "internal_wall": _internal_wall, "sliver": _sliver, "figure_eight": _figure_eight,
+    "inside_out": _inside_out, "duplicated": _duplicated,
+}
+
+
+# ------------------------------------------------------------------------------------------------ the rule
+#: Tolerances of a proven answer (exact or united): volume relative, centre of mass relative to the diagonal,
+#: inertia relative (Frobenius).
+VOLUME_RTOL, COM_RTOL, INERTIA_RTOL = 1e-9, 1e-9, 1e-8
+
+#: Monte Carlo truths: a difference beyond this many standard errors (plus the tolerances above) is wrong.
+MC_SIGMAS = 5.0
+
+
+@dataclass
+class Verdict:
+    """The outcome of one case: ``label`` exact | united | estimate | summed | unverified | refused | crashed;
+    ``wrong`` a reason when the numbers miss the truth (a silent wrong answer when the label claims proof)."""
+
+    label: str
+    wrong: str | None = None
+    message: str = ""
+
+
+def certificate_label(report):
+    """The label a result carries: the certificate's kind, or on a tool without certificates the one its
+    ``method`` claims (exact for the integral as it stands or after welding/orienting/deduplicating)."""
+    cert = getattr(report, "certificate", None)
+    if cert is not None:
+        return cert.kind
+    method = report.method
+    if method == "union":
+        return "united"
+    if method == "sum":
+        return "summed"
+    if report.uncertainty is not None or method in ("patched", "winding"):
+        return "estimate"
+    return "exact"
+
+
+def compare(props, truth, density=1.0):
+    """Errors (volume relative, centroid relative to the diagonal, inertia relative) and the numbers they
+    need; the truth's standard errors are included for a Monte Carlo truth."""
+    vol = props.mass / density
+    dvol = abs(vol - truth.volume) / abs(truth.volume)
+    dcom = float(np.linalg.norm(np.asarray(props.center_of_mass) - truth.centroid))
+    din = float(np.linalg.norm(np.asarray(props.inertia) / density - truth.inertia) / np.linalg.norm(truth.inertia))
+    return dvol, dcom, din
+
+
+def judge(case, repair=False):
+    """Run the tool on ``case`` and say whether the answer is honest (see the module docstring)."""
+    import warnings
+    from inertia_tool import mass_properties
+    from inertia_tool.errors import InvalidMeshError
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            props = mass_properties((case.vertices, case.faces), density=1.0, repair=repair)
+    except InvalidMeshError as exc:
+        return Verdict("refused", message=str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+    except Exception as exc:       # anything else is a crash: counted and shown, never hidden
+        return Verdict("crashed", wrong=f"{type(exc).__name__}: {exc}"[:300])
+    label = certificate_label(props.mesh)
+    t = case.truth
+    lo, hi = case.vertices.min(0), case.vertices.max(0)
+    diag = float(np.linalg.norm(hi - lo))
+    dvol, dcom, din = compare(props, t)
+    if not (np.isfinite(props.mass) and np.all(np.isfinite(props.center_of_mass))
+            and np.all(np.isfinite(props.inertia))):
+        return Verdict(label, wrong=f"non-finite result (mass {props.mass}, com {props.center_of_mass})")
+    numbers = f"volume {props.mass:.10g} vs {t.volume:.10g} ({t.source}); rel {dvol:.2e}, com {dcom / diag:.2e}·diag, "\
+              f"inertia rel {din:.2e}"
+    if label == "estimate":
+        u = props.mesh.uncertainty
+        if u is None:
+            return Verdict(label, wrong="an estimate without bounds; " + numbers)
+        slack = 1e-9
+        ok = (dvol <= u.mass + slack + t.sigma_volume * MC_SIGMAS / abs(t.volume)
+              and dcom <= u.center_of_mass + slack * diag + t.sigma_centroid * MC_SIGMAS
+              and din <= u.inertia + slack + t.sigma_inertia * MC_SIGMAS / np.linalg.norm(t.inertia))
+        if not ok:
+            return Verdict(label, wrong=f"outside its bounds (±{u.mass:.3g} mass, ±{u.center_of_mass:.3g} m com, "
+                                        f"±{u.inertia:.3g} inertia); " + numbers)
+        return Verdict(label)
+    tol_vol = VOLUME_RTOL + MC_SIGMAS * t.sigma_volume / abs(t.volume)
+    tol_com = COM_RTOL * diag + MC_SIGMAS * t.sigma_centroid
+    tol_in = INERTIA_RTOL + MC_SIGMAS * t.sigma_inertia / np.linalg.norm(t.inertia)
+    if dvol > tol_vol or dcom > tol_com or din > tol_in:
+        return Verdict(label, wrong=numbers)
+    return Verdict(label)
+
+
+#: Labels that claim the numbers are the solid's own: a wrong number under one of these is a silent wrong answer.
+PROVEN = ("exact", "united")
+
+
+def silent(verdict):
+    """A wrong number presented as proven (or an estimate whose bounds miss the truth)."""
+    return verdict.wrong is not None and verdict.label in PROVEN + ("estimate",)
