@@ -32,7 +32,8 @@ MESH_DIR = Path(__file__).resolve().parent.parent / "meshes"
 
 #: Composition kinds, in the order of the benchmark table.
 KINDS = ("single", "disjoint", "shared_vertex_overlap", "shared_vertex_touch", "touching_faces",
-         "overlapping", "nested", "internal_wall", "sliver", "figure_eight", "inside_out", "duplicated")
+         "overlapping", "nested", "internal_wall", "sliver", "figure_eight", "inside_out", "duplicated",
+         "coplanar_overlap", "edge_touch", "flush_cavity")
 
 #: Largest mesh integrated with rational arithmetic (faces); larger truths are float64 about a nearby point.
 FRACTION_MAX_FACES = 600
@@ -681,11 +682,59 @@ def _duplicated(rng):
                 f"[{base}] {case.recipe}; {what} duplicated ({'same' if shared else 'new'} vertex indices)")
 
 
+def _coplanar_overlap(rng):
+    """Two boxes standing on the same plane z = 0 (their bottom faces coplanar, same orientation) whose
+    interiors overlap: the union is one solid with one bottom."""
+    ea = rng.integers(2, 9, size=3) * 0.125
+    eb = rng.integers(2, 9, size=3) * 0.125
+    off = np.r_[rng.integers(-3, 4, size=2) * 0.125, 0.0]
+    a = box(ea, [0, 0, ea[2] / 2], subdivide=int(rng.integers(0, 2)))
+    b = box(eb, off + [0, 0, eb[2] / 2], subdivide=int(rng.integers(0, 2)))
+    return _finish("coplanar_overlap", rng, None, concat(a, b),
+                   f"box{tuple(ea)} and box{tuple(eb)} both on z = 0, offset {off[:2].tolist()}", union=([a, b], []))
+
+
+def _edge_touch(rng):
+    """Two boxes meeting along (part of) an edge only, sharing the edge's vertices by index or not."""
+    ea = rng.integers(2, 9, size=3) * 0.125
+    a = box(ea)
+    eb = np.r_[rng.integers(2, 9, size=2) * 0.125, ea[2]]
+    b = box(eb, [(ea[0] + eb[0]) / 2, (ea[1] + eb[1]) / 2, 0.0])     # diagonal neighbour in xy: common z-edge
+    if rng.random() < 0.5:
+        mesh = _weld_exact(*concat(a, b))
+        how = "edge vertices shared"
+    else:
+        mesh = concat(a, b)
+        how = "separate vertices"
+    return _finish("edge_touch", rng, [(1, a), (1, b)], mesh,
+                   f"box{tuple(ea)} and box{tuple(eb)} meeting along a z edge ({how})")
+
+
+def _flush_cavity(rng):
+    """A box with a box-shaped cavity flush with one of its faces (the cavity's face lies in the outer face,
+    opposite normals): the solid is the box with a notch open to the outside."""
+    ea = rng.integers(4, 9, size=3) * 0.125
+    ec = np.minimum(rng.integers(1, 4, size=3) * 0.125, ea - 0.25)
+    c = np.r_[(ea[0] - ec[0]) / 2, 0.0, 0.0]          # the cavity's +x face in the box's +x face
+    outer = box(ea, subdivide=int(rng.integers(0, 2)))
+    cav = box(ec, c)
+    mesh = concat(outer, flipped(cav) if rng.random() < 0.8 else cav)
+    return _finish("flush_cavity", rng, None, mesh, f"box{tuple(ea)} with a cavity box{tuple(ec)} flush with "
+                   "its +x face", union=([outer], [cav]))
+
+
+def _weld_exact(v, f):
+    """Merge bit-identical vertices."""
+    uniq, inv = np.unique(v, axis=0, return_inverse=True)
+    return uniq, inv.reshape(-1)[f]
+
+
 _BUILDERS = {
     "single": _single, "disjoint": _disjoint, "shared_vertex_overlap": _shared_vertex_overlap,
     "shared_vertex_touch": _shared_vertex_touch, "touching_faces": _touching_faces, "overlapping": _overlapping,
     "nested": _nested, "internal_wall": _internal_wall, "sliver": _sliver, "figure_eight": _figure_eight,
-    "inside_out": _inside_out, "duplicated": _duplicated,
+    "inside_out": _inside_out, "duplicated": _duplicated, "coplanar_overlap": _coplanar_overlap,
+    "edge_touch": _edge_touch, "flush_cavity": _flush_cavity,
 }
 
 

@@ -139,7 +139,25 @@ def _internal_wall():
                   "a unit box as two halves with a zero-thickness wall")
 
 
+def _duplicated_hollow_box():
+    outer = S.box([1.0, 1.0, 1.0])
+    inner = S.box([0.5, 0.5, 0.5])
+    truth = S.truth_from_pieces([(1, outer), (-1, inner)])
+    one = S.concat(outer, S.flipped(inner))
+    return S.Case("duplicated", *S.concat(one, one), truth,
+                  "a hollow box (outward) with its cavity (inward), the whole twice (new vertex indices)")
+
+
+def _flush_cavity():
+    outer = S.box([1.0, 1.0, 1.0])
+    cavity = S.box([0.5, 0.5, 0.5], [0.25, 0.0, 0.0])      # its +x face lies in the outer +x face
+    return S.Case("flush_cavity", *S.concat(outer, S.flipped(cavity)), S.truth_from_manifold([outer], [cavity]),
+                  "a unit box with a cavity (inward) flush with its +x face: a notch")
+
+
 REPRODUCERS = {
+    "flush_cavity_notch": _flush_cavity,
+    "duplicated_hollow_box": _duplicated_hollow_box,
     "cube_turned_about_diagonal_shares_corner": _cube_and_turned_cube,
     "figure_eight_tube": _figure_eight,
     "hollow_sphere_outer_inward": lambda: _hollow_sphere(False, True),
