@@ -621,6 +621,21 @@ def _sliver(rng):
     quad += [hi[0] + gap + 0.01, 0, 0]
     quad[:, 0] += rng.uniform(0, 1e-9, size=4) * (rng.random() < 0.3)   # sometimes not quite flat
     qf = np.array([[0, 1, 2], [0, 2, 3], [0, 2, 1], [0, 3, 2]], dtype=np.int64)
+    if rng.random() < 0.2:
+        # a long thin tetrahedron 10 … 100 body sizes away: a real solid whose volume (1e-10 … 1e-6 of the body's)
+        # may fall under a flatness threshold scaled by the diagonal³
+        span = float(np.linalg.norm(hi - v.min(0)))
+        length = span * 10 ** float(rng.uniform(1, 2))
+        vb = abs(_signed_volume(*body))
+        thick = 6 * vb * 10 ** float(rng.uniform(-10, -6)) / (length * length / 2)
+        tet = np.array([[0, 0, 0], [0, length, 0], [0, 0, length], [thick, length / 3, length / 3]])
+        tet += [hi[0] + length, 0, 0]
+        tf = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]], dtype=np.int64)
+        if _signed_volume(tet, tf) < 0:
+            tf = tf[:, ::-1].copy()
+        return _finish("sliver", rng, [(1, body), (1, (tet, tf))], concat(body, (tet, tf)),
+                       f"{name} with a long thin tetrahedron ({length:.3g} m, {thick:.3g} m thin) "
+                       f"{length:.3g} m away")
     if rng.random() < 0.5:
         sliver = (quad, qf)
         return _finish("sliver", rng, [(1, body)], concat(body, sliver),
@@ -717,6 +732,15 @@ def _flush_cavity(rng):
     ec = np.minimum(rng.integers(1, 4, size=3) * 0.125, ea - 0.25)
     c = np.r_[(ea[0] - ec[0]) / 2, 0.0, 0.0]          # the cavity's +x face in the box's +x face
     outer = box(ea, subdivide=int(rng.integers(0, 2)))
+    if rng.random() < 0.3:
+        # instead a cavity inside, with a box resting on its floor (face to face, opposite normals)
+        ec = ea / 2
+        cav = box(ec)
+        ek = np.r_[ec[:2] / 2, ec[2] / 4]
+        core = box(ek, [0, 0, -ec[2] / 2 + ek[2] / 2])
+        mesh = concat(outer, flipped(cav), core)
+        return _finish("flush_cavity", rng, [(1, outer), (-1, cav), (1, core)], mesh,
+                       f"box{tuple(ea)} with a cavity box{tuple(ec)}, a box{tuple(ek)} resting on its floor")
     cav = box(ec, c)
     mesh = concat(outer, flipped(cav) if rng.random() < 0.8 else cav)
     return _finish("flush_cavity", rng, None, mesh, f"box{tuple(ea)} with a cavity box{tuple(ec)} flush with "

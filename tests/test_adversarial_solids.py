@@ -155,7 +155,41 @@ def _flush_cavity():
                   "a unit box with a cavity (inward) flush with its +x face: a notch")
 
 
+def _cavity_through_face(shift):
+    outer = S.box([1.0, 1.0, 1.0])
+    cavity = S.box([0.5, 0.5, 0.5], [shift, 0.0, 0.0])
+    return S.Case("flush_cavity", *S.concat(outer, S.flipped(cavity)), S.truth_from_manifold([outer], [cavity]),
+                  f"a unit box with a cavity (inward) centred at x = {shift}, poking through its +x face")
+
+
+def _resting_core():
+    outer = S.box([1.0, 1.0, 1.0])
+    cavity = S.box([0.5, 0.5, 0.5])
+    core = S.box([0.25, 0.25, 0.125], [0.0, 0.0, -0.1875])      # its bottom face on the cavity's floor
+    rot = S._axis_rotation([1.0, 2.0, 3.0], 0.7)                  # turned: the contact is coplanar only to rounding
+    outer, cavity, core = (S.moved(p, rot, np.zeros(3)) for p in (outer, cavity, core))
+    return S.Case("flush_cavity", *S.concat(outer, S.flipped(cavity), core),
+                  S.truth_from_pieces([(1, outer), (-1, cavity), (1, core)]),
+                  "a unit box with a cube cavity, a small box resting on the cavity's floor, all turned 0.7 rad "
+                  "about (1, 2, 3)")
+
+
+def _far_thin_tetrahedron():
+    body = S.box([1.0, 1.0, 1.0])
+    length, thick = 50.0, 1e-9
+    tet = np.array([[0, 0, 0], [0, length, 0], [0, 0, length], [thick, length / 3, length / 3]]) + [length, 0, 0]
+    tf = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]])
+    if S._signed_volume(tet, tf) < 0:
+        tf = tf[:, ::-1].copy()
+    return S.Case("sliver", *S.concat(body, (tet, tf)), S.truth_from_pieces([(1, body), (1, (tet, tf))]),
+                  "a unit box and a closed tetrahedron 50 m across and 1e-9 m thin, 50 m away (volume 4e-7 m³)")
+
+
 REPRODUCERS = {
+    "cavity_floor_resting_core": _resting_core,
+    "far_thin_tetrahedron": _far_thin_tetrahedron,
+    "cavity_pokes_through_face": lambda: _cavity_through_face(0.3),
+    "cavity_flush_but_rounded_out": lambda: _cavity_through_face(0.25 + 1e-12),
     "flush_cavity_notch": _flush_cavity,
     "duplicated_hollow_box": _duplicated_hollow_box,
     "cube_turned_about_diagonal_shares_corner": _cube_and_turned_cube,
