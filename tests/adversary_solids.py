@@ -178,6 +178,56 @@ def tube_slabs(height, radius=0.25, rings=48, sections=8, scale=1.0):
     return v, f, slabs
 
 
+def tube_halves(height, radius=0.25, rings=48, sections=8):
+    """The figure-eight tube of :func:`tube_slabs` and its two closed halves: the branch through t = 0 and the
+    branch through t = π, each a tube from the ring nearest t = −π/2 (resp. π/2) to the ring nearest π/2
+    (resp. 3π/2) with polygon caps.  Each half passes clear of itself; only the two halves can overlap, near
+    the origin."""
+    v, f, slabs = tube_slabs(height, radius, rings, sections)
+    qa, qb = int(round(rings / 4)), int(round(3 * rings / 4))
+    halves = []
+    for start, stop in ((qb, qa + rings), (qa, qb)):
+        idx = [i % rings for i in range(start, stop)]
+        vs, fs, off = [], [], 0
+        for i in idx:                       # each slab's side faces, vertices of its two rings
+            sv, sf = slabs[i]
+            side = sf[: 2 * sections]
+            vs.append(sv)
+            fs.append(side + off)
+            off += len(sv)
+        hv, hf = _weld_exact(np.vstack(vs), np.concatenate(fs))
+        first, last = slabs[idx[0]], slabs[idx[-1]]
+        caps = []
+        for (sv, sf), which in ((first, slice(2 * sections, 2 * sections + sections - 2)),
+                                (last, slice(2 * sections + sections - 2, None))):
+            cap = sf[which]
+            # the cap's vertices are the slab's own: find them in the welded half
+            lookup = {tuple(p): k for k, p in enumerate(hv)}
+            caps.append(np.array([[lookup[tuple(sv[c])] for c in tri] for tri in cap], dtype=np.int64))
+        halves.append((hv, np.concatenate([hf] + caps)))
+    return v, f, halves
+
+
+def truth_of_tube(v, f, halves, reach=0.6):
+    """Moments of {winding ≥ 1} of the figure-eight tube: the surface integral (which counts the halves'
+    overlap twice) less the overlap, formed by manifold3d as (A ∩ box) ∩ (B ∩ box) with the box
+    |x| ≤ ``reach`` around the crossing (its planes cut the tube transversally, away from the halves' caps)."""
+    vol, cen, central = float_moments(v, f)
+    lo, hi = v.min(0) - 1.0, v.max(0) + 1.0
+    cut = to_manifold(box([2 * reach, hi[1] - lo[1], hi[2] - lo[2]], [0.0, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2]))
+    a, b = (to_manifold(h) ^ cut for h in halves)
+    overlap = (a ^ b).to_mesh64()
+    ov = np.asarray(overlap.vert_properties, dtype=np.float64)[:, :3]
+    of = np.asarray(overlap.tri_verts, dtype=np.int64)
+    if len(of) == 0:
+        return Truth(vol, cen, _inertia(central), "manifold")
+    ovol, ocen, ocentral = float_moments(ov, of)
+    total = vol - ovol
+    c = (vol * cen - ovol * ocen) / total
+    second = (central + vol * np.outer(cen - c, cen - c)) - (ocentral + ovol * np.outer(ocen - c, ocen - c))
+    return Truth(total, c, _inertia(second), "manifold")
+
+
 # ------------------------------------------------------------------------------------------------- motions
 def random_rotation(rng):
     """A uniformly random proper rotation (from a normalised Gaussian quaternion)."""
@@ -654,10 +704,14 @@ def _sliver(rng):
 def _figure_eight(rng, n_mc=0):
     height = float(rng.uniform(0.0, 0.4))
     radius = float(rng.uniform(0.1, 0.3))
-    v, f, slabs = tube_slabs(height, radius, rings=int(rng.integers(24, 49)), sections=int(rng.integers(5, 9)))
-    case = _finish("figure_eight", rng, None, (v, f),
-                   f"figure-eight tube, lift {height:.3f}, radius {radius:.3f} "
-                   f"({'crosses itself' if height < radius else 'passes clear'})", union=(slabs, []))
+    v, f, halves = tube_halves(height, radius, rings=int(rng.integers(24, 49)), sections=int(rng.integers(5, 9)))
+    local = truth_of_tube(v, f, halves)
+    rot, shift = rigid_motion(rng)
+    truth = Truth(local.volume, rot @ local.centroid + shift, rot @ local.inertia @ rot.T, local.source)
+    case = Case("figure_eight", v @ rot.T + shift, f, truth,
+                f"figure-eight tube, lift {height:.3f}, radius {radius:.3f} "
+                f"({'crosses itself' if height < radius else 'passes clear'}); whole mesh moved by "
+                f"R={np.round(rot, 3).tolist()}, t={np.round(shift, 3).tolist()}")
     if n_mc:
         case.check = monte_carlo(case.vertices, case.faces, rng, n_mc)
     return case
@@ -705,8 +759,13 @@ def _coplanar_overlap(rng):
     off = np.r_[rng.integers(-3, 4, size=2) * 0.125, 0.0]
     a = box(ea, [0, 0, ea[2] / 2], subdivide=int(rng.integers(0, 2)))
     b = box(eb, off + [0, 0, eb[2] / 2], subdivide=int(rng.integers(0, 2)))
-    return _finish("coplanar_overlap", rng, None, concat(a, b),
-                   f"box{tuple(ea)} and box{tuple(eb)} both on z = 0, offset {off[:2].tolist()}", union=([a, b], []))
+    lo = np.maximum(-ea / 2 + [0, 0, ea[2] / 2], off - eb / 2 + [0, 0, eb[2] / 2])
+    hi = np.minimum(ea / 2 + [0, 0, ea[2] / 2], off + eb / 2 + [0, 0, eb[2] / 2])
+    pieces = [(1, a), (1, b)]
+    if np.all(hi > lo):           # inclusion–exclusion: the common box counted once
+        pieces.append((-1, box(hi - lo, (lo + hi) / 2)))
+    return _finish("coplanar_overlap", rng, pieces, concat(a, b),
+                   f"box{tuple(ea)} and box{tuple(eb)} both on z = 0, offset {off[:2].tolist()}")
 
 
 def _edge_touch(rng):
@@ -743,8 +802,8 @@ def _flush_cavity(rng):
                        f"box{tuple(ea)} with a cavity box{tuple(ec)}, a box{tuple(ek)} resting on its floor")
     cav = box(ec, c)
     mesh = concat(outer, flipped(cav) if rng.random() < 0.8 else cav)
-    return _finish("flush_cavity", rng, None, mesh, f"box{tuple(ea)} with a cavity box{tuple(ec)} flush with "
-                   "its +x face", union=([outer], [cav]))
+    return _finish("flush_cavity", rng, [(1, outer), (-1, cav)], mesh, f"box{tuple(ea)} with a cavity "
+                   f"box{tuple(ec)} flush with its +x face")
 
 
 def _weld_exact(v, f):
