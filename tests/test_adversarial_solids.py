@@ -85,12 +85,29 @@ def _assert_honest(case, repair=False):
     return verdict
 
 
+#: Failure classes found by the generator and not fixed yet (each routed to the mesh-to-solid stage, each with
+#: a strict-xfail reproducer below, which fails the suite as soon as the class is fixed so that it is removed
+#: from here): name → (what of the recipe identifies a case of the class, what goes wrong).
+OPEN_CLASSES: dict[str, tuple[str, str]] = {}
+
+
+def _open_class(case):
+    return next((name for name, (mark, _) in OPEN_CLASSES.items() if mark in case.recipe), None)
+
+
 @settings(max_examples=200, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(kind=st.sampled_from(S.KINDS), seed=st.integers(0, 2 ** 32 - 1))
 def test_no_silent_wrong_answer(kind, seed):
     """200 generated compositions (fixed sequence): each answer is proven and right, an estimate whose bounds
-    hold, or a refusal."""
-    _assert_honest(S.make_case(kind, np.random.default_rng(seed)))
+    hold, or a refusal.  A case of an open class (:data:`OPEN_CLASSES`) is held to the rule only when it is not
+    wrong in the known way: its reproducer carries the failure."""
+    case = S.make_case(kind, np.random.default_rng(seed))
+    verdict = S.judge(case)
+    assert verdict.label != "crashed", f"{case.kind}: {case.recipe}\n  {verdict.wrong}"
+    if S.silent(verdict) and _open_class(case) is not None:
+        return
+    assert not S.silent(verdict), (f"silent wrong answer ({verdict.label}) on {case.kind}: {case.recipe}\n"
+                                   f"  {verdict.wrong}")
 
 
 # ------------------------------------------------------------------------ minimal reproducers (issue 21)
@@ -213,7 +230,13 @@ REPRODUCERS = {
 }
 
 
-@pytest.mark.parametrize("name", sorted(REPRODUCERS))
+#: Reproducers of the open classes: name → class of OPEN_CLASSES.
+OPEN_REPRODUCERS: dict[str, str] = {}
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(
+    strict=True, reason=f"open: {OPEN_CLASSES[OPEN_REPRODUCERS[n]][1]}")) if n in OPEN_REPRODUCERS else n
+    for n in sorted(REPRODUCERS)])
 def test_reproducer(name):
     """The minimal cases of each failure class the generator found (and the issue's own)."""
     _assert_honest(REPRODUCERS[name]())
