@@ -417,6 +417,9 @@ class Case:
     truth: Truth
     recipe: str
     check: Truth | None = field(default=None)   # a second, independent truth (Monte Carlo) when one was made
+    #: other readings of the same mesh that the issue's rules also allow (an answer matching one is right)
+    alternatives: list = field(default_factory=list)
+    motion: tuple | None = None
 
 
 def concat(*pieces):
@@ -470,14 +473,17 @@ def _finish(kind, rng, pieces_signed, mesh, recipe, union=None):
     v, f = mesh
     rot, shift = rigid_motion(rng)
     v2 = v @ rot.T + shift
+    motion = (rot, shift)
     if union is not None:
         bodies, cavities = union
         truth = truth_from_manifold([moved(b, rot, shift) for b in bodies],
                                     [moved(c, rot, shift) for c in cavities])
     else:
         truth = truth_from_pieces([(s, moved(p, rot, shift)) for s, p in pieces_signed])
-    return Case(kind, v2, f, truth, recipe + f"; whole mesh moved by R={np.round(rot, 3).tolist()}, "
+    case = Case(kind, v2, f, truth, recipe + f"; whole mesh moved by R={np.round(rot, 3).tolist()}, "
                                                f"t={np.round(shift, 3).tolist()}")
+    case.motion = motion
+    return case
 
 
 def make_case(kind, rng):
@@ -591,8 +597,30 @@ def _overlapping(rng):
                   rng.normal(size=3) * 0.25)
         pieces.append(p)
         names.append(name)
-    return _finish("overlapping", rng, None, concat(*pieces), " ∪ ".join(names) + " overlapping",
+    case = _finish("overlapping", rng, None, concat(*pieces), " ∪ ".join(names) + " overlapping",
                    union=(pieces, []))
+    # a piece wholly inside another is, by nesting depth (issue 21: "orient per shell by nesting depth"), a
+    # cavity wound the wrong way, and by the winding number (≥ 1) a body: both readings are accepted
+    inside = _contained(pieces)
+    if inside.any():
+        rot, shift = case.motion
+        bodies = [moved(p, rot, shift) for p, k in zip(pieces, inside) if not k]
+        cavities = [moved(p, rot, shift) for p, k in zip(pieces, inside) if k]
+        case.alternatives = [truth_from_manifold(bodies, cavities)]
+        case.recipe += f"; piece {int(np.flatnonzero(inside)[0])} lies wholly inside another (depth 1)"
+    return case
+
+
+def _contained(pieces):
+    """(k,) bool: pieces every vertex of which is strictly inside another piece (libigl winding number > 0.5)."""
+    import igl
+    out = np.zeros(len(pieces), dtype=bool)
+    for j, (vj, _) in enumerate(pieces):
+        for i, (vi, fi) in enumerate(pieces):
+            if i != j and np.all(igl.fast_winding_number(np.ascontiguousarray(vi), np.ascontiguousarray(fi),
+                                                         np.ascontiguousarray(vj)) > 0.5):
+                out[j] = True
+    return out
 
 
 def _inner_of(rng, outer_name, outer, scale):
@@ -867,6 +895,17 @@ def compare(props, truth, density=1.0):
 
 
 def judge(case, repair=False):
+    """:func:`judge_truth` against the case's truth, or against an allowed alternative reading when that one
+    holds."""
+    verdict = judge_truth(case, case.truth, repair)
+    for alt in case.alternatives if verdict.wrong is not None and verdict.label != "crashed" else ():
+        other = judge_truth(case, alt, repair)
+        if other.wrong is None:
+            return other
+    return verdict
+
+
+def judge_truth(case, truth, repair=False):
     """Run the tool on ``case`` and say whether the answer is honest (see the module docstring)."""
     import warnings
     from inertia_tool import mass_properties
@@ -880,7 +919,7 @@ def judge(case, repair=False):
     except Exception as exc:       # anything else is a crash: counted and shown, never hidden
         return Verdict("crashed", wrong=f"{type(exc).__name__}: {exc}"[:300])
     label = certificate_label(props.mesh)
-    t = case.truth
+    t = truth
     lo, hi = case.vertices.min(0), case.vertices.max(0)
     diag = float(np.linalg.norm(hi - lo))
     dvol, dcom, din = compare(props, t)

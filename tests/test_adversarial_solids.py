@@ -98,9 +98,9 @@ OPEN_CLASSES: dict[str, tuple[str, str]] = {
                         "cavity filled (certificate united)"),
     "far_thin_solid": ("long thin tetrahedron", "a closed, thin but real solid whose volume is under FLAT_RTOL · "
                        "diagonal³ is left out as flat while the result is certified exact (inertia off by 1e-3)"),
-    "three_body_union": ("part(washer.stl) overlapping", "a subdivided box, an icosphere and the washer overlapping: "
-                         "the union is 0.8 % below manifold3d's union of the pieces (Monte Carlo agrees with the "
-                         "latter within 1.4 standard errors, the tool's answer is 3.8 off), certificate united"),
+    "three_body_union": ("part(washer.stl) overlapping", "a subdivided box, an icosphere and the washer (wholly "
+                         "inside the box) overlapping: united 1.2836, neither the union (1.2939; Monte Carlo "
+                         "1.2911 ± 0.0020) nor the washer read as a cavity by its depth (1.2784)"),
     "duplicated_shell_union": ("one shell duplicated (new vertex indices)", "a torus listed twice with its own "
                                "vertices: united 0.3 % high"),
 }
