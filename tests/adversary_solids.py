@@ -202,7 +202,7 @@ def tube_halves(height, radius=0.25, rings=48, sections=8):
                                 (last, slice(2 * sections + sections - 2, None))):
             cap = sf[which]
             # the cap's vertices are the slab's own: find them in the welded half
-            lookup = {tuple(p): k for k, p in enumerate(hv)}
+            lookup = {_t(p): k for k, p in enumerate(hv)}
             caps.append(np.array([[lookup[tuple(sv[c])] for c in tri] for tri in cap], dtype=np.int64))
         halves.append((hv, np.concatenate([hf] + caps)))
     return v, f, halves
@@ -422,6 +422,11 @@ class Case:
     motion: tuple | None = None
 
 
+def _t(values):
+    """A tuple of plain floats, for recipes."""
+    return tuple(float(x) for x in values)
+
+
 def concat(*pieces):
     """Pieces as one mesh (vertex indices offset; nothing merged)."""
     vs, fs, off = [], [], 0
@@ -443,10 +448,10 @@ def random_piece(rng, convex=False, small=False):
     kind = choices[rng.integers(len(choices))]
     if kind == "box":
         ext = rng.integers(2, 9, size=3) * 0.125
-        return f"box{tuple(ext)}", box(ext)
+        return f"box{_t(ext)}", box(ext)
     if kind == "box_sub":
         ext = rng.integers(2, 9, size=3) * 0.125
-        return f"box{tuple(ext)}/sub1", box(ext, subdivide=1)
+        return f"box{_t(ext)}/sub1", box(ext, subdivide=1)
     if kind == "icosphere":
         r = float(rng.uniform(0.3, 0.7))
         sub = 0 if small else int(rng.integers(0, 2))
@@ -584,7 +589,7 @@ def _touching_faces(rng):
         rot = _axis_rotation([1, 0, 0], np.pi / 2).round()
         b = ((b[0] - off) @ rot.T + off, b[1])
     return _finish("touching_faces", rng, [(1, a), (1, b)], concat(a, b),
-                   f"box{tuple(ea)}/sub{sa} and box{tuple(eb)}/sub{sb} face to face at x={off[0]}, "
+                   f"box{_t(ea)}/sub{sa} and box{_t(eb)}/sub{sb} face to face at x={off[0]}, "
                    f"offset {off[1:].tolist()}")
 
 
@@ -684,7 +689,7 @@ def _internal_wall(rng):
     else:
         mesh = concat(a, b)
     return _finish("internal_wall", rng, [(1, a), (1, b)], mesh,
-                   f"box{tuple(ext)} split at x = {x0 + left[0]} into two boxes with a zero-thickness wall "
+                   f"box{_t(ext)} split at x = {x0 + left[0]} into two boxes with a zero-thickness wall "
                    f"({'welded' if merge else 'separate vertices'})")
 
 
@@ -793,7 +798,7 @@ def _coplanar_overlap(rng):
     if np.all(hi > lo):           # inclusion–exclusion: the common box counted once
         pieces.append((-1, box(hi - lo, (lo + hi) / 2)))
     return _finish("coplanar_overlap", rng, pieces, concat(a, b),
-                   f"box{tuple(ea)} and box{tuple(eb)} both on z = 0, offset {off[:2].tolist()}")
+                   f"box{_t(ea)} and box{_t(eb)} both on z = 0, offset {off[:2].tolist()}")
 
 
 def _edge_touch(rng):
@@ -809,7 +814,7 @@ def _edge_touch(rng):
         mesh = concat(a, b)
         how = "separate vertices"
     return _finish("edge_touch", rng, [(1, a), (1, b)], mesh,
-                   f"box{tuple(ea)} and box{tuple(eb)} meeting along a z edge ({how})")
+                   f"box{_t(ea)} and box{_t(eb)} meeting along a z edge ({how})")
 
 
 def _flush_cavity(rng):
@@ -827,11 +832,11 @@ def _flush_cavity(rng):
         core = box(ek, [0, 0, -ec[2] / 2 + ek[2] / 2])
         mesh = concat(outer, flipped(cav), core)
         return _finish("flush_cavity", rng, [(1, outer), (-1, cav), (1, core)], mesh,
-                       f"box{tuple(ea)} with a cavity box{tuple(ec)}, a box{tuple(ek)} resting on its floor")
+                       f"box{_t(ea)} with a cavity box{_t(ec)}, a box{_t(ek)} resting on its floor")
     cav = box(ec, c)
     mesh = concat(outer, flipped(cav) if rng.random() < 0.8 else cav)
-    return _finish("flush_cavity", rng, [(1, outer), (-1, cav)], mesh, f"box{tuple(ea)} with a cavity "
-                   f"box{tuple(ec)} flush with its +x face")
+    return _finish("flush_cavity", rng, [(1, outer), (-1, cav)], mesh, f"box{_t(ea)} with a cavity "
+                   f"box{_t(ec)} flush with its +x face")
 
 
 def _weld_exact(v, f):
