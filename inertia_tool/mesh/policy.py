@@ -25,8 +25,11 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    is a body, wound outward, odd depth a cavity, wound inward.  A shell wound the other way is flipped, with
    a warning.  Never decided by the sign of the total volume: one inside-out shell must not turn the others.
    So an outward-wound shell inside a body is read as a cavity written with the wrong winding, not as a
-   second body buried in the first.  When the intersection check did not finish (crossings unknown, so
-   "inside" may mean "overlapping"), each shell keeps what its own sign says instead.
+   second body buried in the first.  A shell whose surface crosses another's has no depth of its own: it keeps
+   the file's winding (an inward shell is cut from the outward shell it crosses) and the boolean decides; a
+   group of crossing shells all wound inward and lying in no body is turned as a whole.  When the intersection
+   check did not finish (crossings unknown, so "inside" may mean "overlapping"), each shell keeps what its own
+   sign says instead.
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
    transversally (or overlap coplanar with the same orientation) mean shared volume: the union is integrated
    and the certificate is ``united`` once the face-intersection check finds no crossing in the union itself
@@ -265,7 +268,44 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
         s, o = nest.shell[contained], nest.other[contained]
         keep = cavity[s] & (depth[o] == depth[s] - 1)        # the innermost container of a cavity
         owner[s[keep]] = o[keep]
+    crosses = cross.any(axis=1) & ~undecided
+    if crosses.any():
+        _orient_crossing(vols, cross, crosses, depth, flip, owner)
     return flip, owner, depth
+
+
+def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, depth: np.ndarray,
+                     flip: np.ndarray, owner: np.ndarray) -> None:
+    """R4 for shells whose surfaces cross another's (in place): they have no nesting depth of their own.
+
+    The file's winding says which of them is material and which a hole (a cavity that pokes through its body's
+    wall, a part resting turned on a cavity's floor), and the boolean decides the solid; an inward shell is cut
+    from the outward shell it crosses (the smallest, if several).  A group of crossing shells that are all wound
+    inward and lie in no body (even depth) is a group of bodies written inside out, and is turned as a whole.
+    """
+    n = len(vols)
+    component = np.full(n, -1, dtype=np.int64)
+    for start in np.flatnonzero(crosses):                 # connected groups of crossing shells (bounded by n)
+        if component[start] >= 0:
+            continue
+        component[start] = start
+        stack = [int(start)]
+        while stack:
+            k = stack.pop()
+            for j in np.flatnonzero(cross[k] & (component < 0)):
+                component[j] = start
+                stack.append(int(j))
+    for root in np.unique(component[crosses]):
+        members = np.flatnonzero(component == root)
+        inside_out = bool(np.all(vols[members] < 0)) and int(depth[members].min()) % 2 == 0
+        flip[members] = inside_out
+        owner[members] = members
+        if inside_out:
+            continue
+        for k in members[vols[members] < 0]:
+            bodies = np.flatnonzero(cross[k] & (vols > 0))
+            if len(bodies):
+                owner[k] = bodies[np.argmin(np.abs(vols[bodies]))]
 
 
 def weakest(certificates: Iterable[Certificate]) -> Certificate:

@@ -233,9 +233,17 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     nest = _nesting(v, f, labels, n_shells)
     flip, owner, depth = orient_by_depth(np.array([s.volume for s in shells]), nest, touch.crossing_with,
                                          crossing_known=touch.complete)                                  # R4
+    file_volumes = np.array([s.volume for s in shells])
     f, shells = _apply_flips(f, labels, shells, flip, n_shells, source)
     cavities = int(np.count_nonzero(depth % 2 == 1))
     method, notes = found.method, list(found.notes)
+    ambiguous = _inward_crossing_outward(file_volumes, flip, touch.crossing_with)
+    if ambiguous:
+        plural = ambiguous > 1
+        notes.append(f"{ambiguous} inward-wound shell{'s' if plural else ''} cross{'' if plural else 'es'} "
+                     "an outward one: read as a cavity cut from it (the solid where the winding number is at least "
+                     "one); if it is a body written inside out, fix its winding. Not verified")
+        warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=3)
     if dropped_note is not None:
         notes.append(dropped_note)
     if crossing_note is not None:
@@ -307,6 +315,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                        patched.uncertainty.volume_in_doubt, patched.far)
         check_useful(total.volume, uncertainty, source=source, what="the patched surface")
         method, kind = "patched", "estimate"
+    if ambiguous and kind in ("exact", "united"):
+        kind = "unverified"                   # R4: a reading of the file's winding, not a proven solid
     certificate = Certificate(kind, tuple(checks) if kind != "estimate" else ())
     report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
                         bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),
@@ -399,6 +409,20 @@ def _apply_flips(f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments],
         warnings.warn(InsideOutWarning(f"{source}: {what} inside out for its nesting depth (a body wound inward "
                                        "or a cavity outward); flipped"), stacklevel=4)
     return f, shells
+
+
+def _inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with: np.ndarray) -> int:
+    """How many shells kept their inward winding although they cross an outward shell (R4 for crossing shells):
+    a cavity poking through its body's wall, or a body written inside out: the file cannot say which."""
+    if not len(crossing_with):
+        return 0
+    wound = np.where(flip, -np.sign(volumes), np.sign(volumes))
+    pairs = np.asarray(crossing_with, dtype=np.int64)
+    inward = np.zeros(len(volumes), dtype=bool)
+    for a, b in ((0, 1), (1, 0)):
+        hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
+        inward[pairs[hit, a]] = True
+    return int(np.count_nonzero(inward))
 
 
 def _total(shells: Sequence[VolumeMoments]) -> VolumeMoments:
