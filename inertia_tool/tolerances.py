@@ -24,6 +24,12 @@ MERGE_TOLERANCE = 1e-6
 #: surface).
 FLAT_RTOL = 1e-12
 
+#: A flat piece (|volume| ≤ FLAT_RTOL · diagonal³) is left out only when leaving it out changes the answer by no
+#: more than round-off: its volume at most this fraction of the rest's, and its second moment about the rest's
+#: centroid at most this fraction of the rest's.  A thin but real solid far from the rest (a 27 m long sliver
+#: 27 m away moves the inertia by 5e-5) stays and is integrated as it stands.
+FLAT_MOMENT_RTOL = 1e-12
+
 #: Touching shells share no volume when the boolean union's volume equals their summed volume within this
 #: (relative; rule R6 of ``mesh/policy.py``).  For touching shells of well-shaped triangles manifold3d keeps
 #: the input vertices and adds only intersection vertices, so the two integrals differ by float64 rounding

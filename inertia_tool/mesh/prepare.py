@@ -21,7 +21,7 @@ from ..values import frozen_value
 from ..errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
                       MeshResolvedWarning, OverlapWarning, UsageError)
 from ..integrals import VolumeMoments, body_volume_moments, bounding_box, volume_moments
-from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
+from ..tolerances import FLAT_MOMENT_RTOL, FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .estimate import check_useful, uncertainty_from
@@ -380,6 +380,9 @@ def _drop_flat(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[Vo
         what = "the mesh encloses" if n_shells == 1 else f"all {n_shells} shells enclose"
         raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
                                "thin-walled part use the shell model with a wall `thickness`")
+    flat &= _negligible(shells, flat)        # a thin but real solid whose moments count stays
+    if not flat.any():
+        return f, labels, n_shells, shells, None
     dropped_faces = int(np.count_nonzero(flat[labels]))
     f = f[~flat[labels]]
     labels, n_shells = shell_labels(f, len(v))
@@ -391,6 +394,24 @@ def _drop_flat(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[Vo
     if warn:
         warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
     return f, labels, n_shells, shells, note
+
+
+def _negligible(shells: list[VolumeMoments], flat: np.ndarray) -> np.ndarray:
+    """Which flat shells change neither the volume nor the second moment of the others beyond round-off
+    (``tolerances.FLAT_MOMENT_RTOL``), so that leaving them out keeps the answer exact."""
+    rest = [s for s, k in zip(shells, flat) if not k]
+    volume = sum(abs(s.volume) for s in rest)
+    centre = sum(abs(s.volume) * s.centroid for s in rest) / volume
+    spread = sum(abs(np.trace(s.second_moment)) + abs(s.volume) * float(np.sum((s.centroid - centre) ** 2))
+                 for s in rest)
+    out = np.zeros(len(shells), dtype=bool)
+    for k in np.flatnonzero(flat):
+        s = shells[k]
+        moment = abs(np.trace(s.second_moment)) + abs(s.volume) * float(np.sum((s.centroid - centre) ** 2))
+        if not np.isfinite(moment):           # no volume at all (a face and its reverse): no centroid either
+            moment = 0.0
+        out[k] = abs(s.volume) <= FLAT_MOMENT_RTOL * volume and moment <= FLAT_MOMENT_RTOL * spread
+    return out
 
 
 def _apply_flips(f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments], flip: np.ndarray, n_shells: int,
