@@ -13,8 +13,10 @@ R1 *Bodies are edge-connected* (:func:`~.checks.shell_labels`).  Faces that meet
    and must be tested against each other for overlap.
 R2 *Flat pieces carry no volume* (``tolerances.FLAT_RTOL``).  A closed shell whose |volume| is at most
    ``FLAT_RTOL · diagonal³`` (a face and its reverse, a zero-thickness wall, a collapsed sliver) contributes
-   nothing to the integrals, so it is left out with a note and the answer stays exact.  Only a mesh that is
-   flat everywhere is refused.  Reason: such faces cancel pairwise in every surface integral.
+   nothing to the integrals, so it is left out with a note and the answer stays exact (:func:`negligible_flat`:
+   only when its volume and its second moment about the rest's centroid are below ``FLAT_MOMENT_RTOL`` of the
+   rest's; a thin but real solid far away stays and is integrated).  Only a mesh that is flat everywhere is
+   refused.  Reason: such faces cancel pairwise in every surface integral.
 R3 *A surface that passes through itself is not a solid as it stands* (:func:`self_crossing_message`).  A
    crossing between two faces of one shell makes the winding number 2 (or −1) somewhere, and the summed
    integral counts that region twice.  manifold3d does not resolve a self-intersection inside one mesh
@@ -49,19 +51,21 @@ R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only aft
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..tolerances import FLAT_RTOL, TOUCH_VOLUME_RTOL
+from ..tolerances import FLAT_MOMENT_RTOL, FLAT_RTOL, TOUCH_VOLUME_RTOL
 from ..values import frozen_value
 
 if TYPE_CHECKING:
+    from ..integrals import VolumeMoments
     from .intersect import SurfaceContacts
     from .nesting import Nesting
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
+           "negligible_flat", "inward_crossing_outward",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
@@ -315,3 +319,35 @@ def weakest(certificates: Iterable[Certificate]) -> Certificate:
     if not certs:
         raise ValueError("Expected at least one certificate to combine, got none")
     return max(certs, key=lambda c: CERTIFICATE_KINDS.index(c.kind))
+
+
+def negligible_flat(shells: Sequence[VolumeMoments], flat: np.ndarray) -> np.ndarray:
+    """R2: which flat shells change neither the volume nor the second moment of the others beyond round-off
+    (``tolerances.FLAT_MOMENT_RTOL``), so that leaving them out keeps the answer exact."""
+    rest = [s for s, k in zip(shells, flat) if not k]
+    volume = sum(abs(s.volume) for s in rest)
+    centre = sum(abs(s.volume) * s.centroid for s in rest) / volume
+    spread = sum(abs(np.trace(s.second_moment)) + abs(s.volume) * float(np.sum((s.centroid - centre) ** 2))
+                 for s in rest)
+    out = np.zeros(len(shells), dtype=bool)
+    for k in np.flatnonzero(flat).tolist():
+        s = shells[k]
+        moment = abs(np.trace(s.second_moment)) + abs(s.volume) * float(np.sum((s.centroid - centre) ** 2))
+        if not np.isfinite(moment):           # no volume at all (a face and its reverse): no centroid either
+            moment = 0.0
+        out[k] = abs(s.volume) <= FLAT_MOMENT_RTOL * volume and moment <= FLAT_MOMENT_RTOL * spread
+    return out
+
+
+def inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with: np.ndarray) -> int:
+    """R4: how many shells kept their inward winding although they cross an outward shell (R4 for crossing shells):
+    a cavity poking through its body's wall, or a body written inside out: the file cannot say which."""
+    if not len(crossing_with):
+        return 0
+    wound = np.where(flip, -np.sign(volumes), np.sign(volumes))
+    pairs = np.asarray(crossing_with, dtype=np.int64)
+    inward = np.zeros(len(volumes), dtype=bool)
+    for a, b in ((0, 1), (1, 0)):
+        hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
+        inward[pairs[hit, a]] = True
+    return int(np.count_nonzero(inward))

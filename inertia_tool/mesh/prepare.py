@@ -21,12 +21,12 @@ from ..values import frozen_value
 from ..errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
                       MeshResolvedWarning, OverlapWarning, UsageError)
 from ..integrals import VolumeMoments, body_volume_moments, bounding_box, volume_moments
-from ..tolerances import FLAT_MOMENT_RTOL, FLAT_RTOL, MERGE_TOLERANCE
+from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .estimate import check_useful, uncertainty_from
-from .policy import (TOUCH_VOLUME_RTOL, Certificate, orient_by_depth, self_crossing_message,
-                     shell_contacts)
+from .policy import (TOUCH_VOLUME_RTOL, Certificate, inward_crossing_outward, negligible_flat, orient_by_depth,
+                     self_crossing_message, shell_contacts)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
 
@@ -237,7 +237,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     f, shells = _apply_flips(f, labels, shells, flip, n_shells, source)
     cavities = int(np.count_nonzero(depth % 2 == 1))
     method, notes = found.method, list(found.notes)
-    ambiguous = _inward_crossing_outward(file_volumes, flip, touch.crossing_with)
+    ambiguous = inward_crossing_outward(file_volumes, flip, touch.crossing_with)
     if ambiguous:
         plural = ambiguous > 1
         notes.append(f"{ambiguous} inward-wound shell{'s' if plural else ''} cross{'' if plural else 'es'} "
@@ -380,7 +380,7 @@ def _drop_flat(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[Vo
         what = "the mesh encloses" if n_shells == 1 else f"all {n_shells} shells enclose"
         raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
                                "thin-walled part use the shell model with a wall `thickness`")
-    flat &= _negligible(shells, flat)        # a thin but real solid whose moments count stays
+    flat &= negligible_flat(shells, flat)        # a thin but real solid whose moments count stays
     if not flat.any():
         return f, labels, n_shells, shells, None
     dropped_faces = int(np.count_nonzero(flat[labels]))
@@ -394,24 +394,6 @@ def _drop_flat(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[Vo
     if warn:
         warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
     return f, labels, n_shells, shells, note
-
-
-def _negligible(shells: list[VolumeMoments], flat: np.ndarray) -> np.ndarray:
-    """Which flat shells change neither the volume nor the second moment of the others beyond round-off
-    (``tolerances.FLAT_MOMENT_RTOL``), so that leaving them out keeps the answer exact."""
-    rest = [s for s, k in zip(shells, flat) if not k]
-    volume = sum(abs(s.volume) for s in rest)
-    centre = sum(abs(s.volume) * s.centroid for s in rest) / volume
-    spread = sum(abs(np.trace(s.second_moment)) + abs(s.volume) * float(np.sum((s.centroid - centre) ** 2))
-                 for s in rest)
-    out = np.zeros(len(shells), dtype=bool)
-    for k in np.flatnonzero(flat):
-        s = shells[k]
-        moment = abs(np.trace(s.second_moment)) + abs(s.volume) * float(np.sum((s.centroid - centre) ** 2))
-        if not np.isfinite(moment):           # no volume at all (a face and its reverse): no centroid either
-            moment = 0.0
-        out[k] = abs(s.volume) <= FLAT_MOMENT_RTOL * volume and moment <= FLAT_MOMENT_RTOL * spread
-    return out
 
 
 def _apply_flips(f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments], flip: np.ndarray, n_shells: int,
@@ -430,20 +412,6 @@ def _apply_flips(f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments],
         warnings.warn(InsideOutWarning(f"{source}: {what} inside out for its nesting depth (a body wound inward "
                                        "or a cavity outward); flipped"), stacklevel=4)
     return f, shells
-
-
-def _inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with: np.ndarray) -> int:
-    """How many shells kept their inward winding although they cross an outward shell (R4 for crossing shells):
-    a cavity poking through its body's wall, or a body written inside out: the file cannot say which."""
-    if not len(crossing_with):
-        return 0
-    wound = np.where(flip, -np.sign(volumes), np.sign(volumes))
-    pairs = np.asarray(crossing_with, dtype=np.int64)
-    inward = np.zeros(len(volumes), dtype=bool)
-    for a, b in ((0, 1), (1, 0)):
-        hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
-        inward[pairs[hit, a]] = True
-    return int(np.count_nonzero(inward))
 
 
 def _total(shells: Sequence[VolumeMoments]) -> VolumeMoments:
