@@ -37,6 +37,7 @@ from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
 from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
 from ..values import frozen_value
+from ..mesh.read import RawMesh
 from .description import GeometryElement, LinkGeometry, RobotDescription
 
 __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", "LinkInertial", "mesh_properties",
@@ -86,19 +87,26 @@ def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = 
     # stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
     raw = load_mesh(path, units="m") if max_faces is None else load_mesh(path, units="m", max_faces=max_faces)
     if element is not None:
-        scale = np.asarray(element.scale, dtype=np.float64)
-        if not np.all(np.isfinite(scale)) or np.any(scale == 0):
-            raise UsageError(f"Expected finite non-zero mesh scale factors, got {scale.tolist()}")
-        moved = not (np.array_equal(element.reference_rotation, np.eye(3))
-                     and not np.any(element.reference_translation))
-        if moved or not np.all(scale == 1.0):
-            v = raw.vertices
-            if moved:
-                v = v @ element.reference_rotation.T + element.reference_translation
-            f = raw.faces if float(np.prod(np.sign(scale))) > 0 else raw.faces[:, ::-1]
-            raw = replace(raw, vertices=v * scale, faces=np.ascontiguousarray(f),
-                          storage_rounding=raw.storage_rounding * float(np.max(np.abs(scale))))
+        raw = _placed(raw, element)
     return mass_properties(raw, density=1.0, repair=repair)
+
+
+def _placed(raw: RawMesh, element: GeometryElement) -> RawMesh:
+    """``raw`` with the element's reference transform, then its ``scale``, applied to the vertices (a mirroring
+    scale reverses the faces, so the surface keeps its winding); the one placement of a mesh file in its
+    element, for the integrals and for the audit's bounds and inside tests."""
+    scale = np.asarray(element.scale, dtype=np.float64)
+    if not np.all(np.isfinite(scale)) or np.any(scale == 0):
+        raise UsageError(f"Expected finite non-zero mesh scale factors, got {scale.tolist()}")
+    moved = not (np.array_equal(element.reference_rotation, np.eye(3)) and not np.any(element.reference_translation))
+    if not moved and np.all(scale == 1.0):
+        return raw
+    v = raw.vertices
+    if moved:
+        v = v @ element.reference_rotation.T + element.reference_translation
+    f = raw.faces if float(np.prod(np.sign(scale))) > 0 else raw.faces[:, ::-1]
+    return replace(raw, vertices=v * scale, faces=np.ascontiguousarray(f),
+                   storage_rounding=raw.storage_rounding * float(np.max(np.abs(scale))))
 
 
 def _capsule(radius: float, length: float) -> MassProperties:
@@ -539,11 +547,11 @@ def link_inertials(robot: RobotDescription, *, density: float | str | None = Non
 # -- where the geometry is (for the audit) -----------------------------------------------------------------
 
 def _mesh_vertices_faces(element: GeometryElement):
-    """The mesh's vertices in the element frame (reference transform, then scale) and its faces."""
+    """The mesh's vertices in the element frame (reference transform, then scale: :func:`_placed`) and its
+    faces."""
     from ..mesh.read import load_mesh
-    raw = load_mesh(element.mesh, units="m")
-    v = raw.vertices @ element.reference_rotation.T + element.reference_translation
-    return v * element.scale, raw.faces
+    raw = _placed(load_mesh(element.mesh, units="m"), element)
+    return raw.vertices, raw.faces
 
 
 def element_bounds(element: GeometryElement) -> np.ndarray:
