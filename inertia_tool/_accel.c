@@ -2214,6 +2214,19 @@ typedef struct {
     int failed;       /* an expansion overflowed: the pair goes back to the numpy path */
 } CtStats;
 
+/* The sign of an exact-stage expansion, counted in ``st``; an overflow marks the pair failed (sign 0). */
+static int
+ct_exact_sign(const Expansion *h, CtStats *st)
+{
+    st->exact++;
+    int s = ct_sign(h);
+    if (s == 2) {
+        st->failed = 1;
+        return 0;
+    }
+    return s;
+}
+
 /* Exact sign of orient3d(a, b, c, d) by expansions (called when the float filter cannot decide). */
 static int
 ct_orient3d_exact(const double *a, const double *b, const double *c, const double *d, CtStats *st)
@@ -2251,13 +2264,7 @@ ct_orient3d_exact(const double *a, const double *b, const double *c, const doubl
             ct_add_product3(&h, signs[t], x, y, z);
         }
     }
-    st->exact++;
-    int s = ct_sign(&h);
-    if (s == 2) {
-        st->failed = 1;
-        return 0;
-    }
-    return s;
+    return ct_exact_sign(&h, st);
 }
 
 static int
@@ -2317,13 +2324,7 @@ ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
         q = (mask & 2) ? yl[0] : yh[0];
         ct_add_product2(&h, -1.0, p, q);
     }
-    st->exact++;
-    int s = ct_sign(&h);
-    if (s == 2) {
-        st->failed = 1;
-        return 0;
-    }
-    return s;
+    return ct_exact_sign(&h, st);
 }
 
 enum { CT_NONE = 0, CT_CROSSING = 1, CT_OPPOSITE = 2, CT_CONTACT = 3 };
