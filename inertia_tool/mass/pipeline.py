@@ -9,6 +9,7 @@ that are a choice (equal moments) or at round-off (needles).
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, TypeAlias
 
@@ -18,9 +19,10 @@ from ..errors import InvalidMeshError, NearlyEqualMomentsWarning, OverlapWarning
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.precision import warn_storage_precision
+from ..mesh.overlap import shared_volumes
 from ..mesh.prepare import PreparedMesh, classify_shells, prepare_mesh
 from ..mesh.read import load_mesh
-from ..tolerances import NEEDLE_RTOL, TRIANGLE_INEQUALITY_RTOL
+from ..tolerances import NEEDLE_RTOL, PART_OVERLAP_RTOL, TRIANGLE_INEQUALITY_RTOL
 from ..units import material_density
 from .properties import MassProperties, combine
 from ..integrals import VolumeMoments, second_moment_to_inertia
@@ -219,7 +221,8 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
     parts : iterable of dict
         Each ``{"source": path_or_mesh, "density": kg/m³}``, ``{"source": ..., "material": name}`` or
         ``{"source": ..., "mass": kg}``
-        (optionally ``"units"`` and ``"name"``; a part's ``"units"`` overrides the options' units).
+        (optionally ``"units"``, ``"name"`` and ``"material_label"``, the material's name for reports when the
+        density is given as a number; a part's ``"units"`` overrides the options' units).
     mass : float, optional
         Scale the whole assembly to this total mass (kg), keeping the density ratios.
     options : LoadOptions, optional
@@ -234,13 +237,16 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
         spec = dict(spec)
         src = spec.pop("source")
         part_mass = spec.pop("mass", None)
-        rho, _ = resolve_density(density=spec.pop("density", None), material=spec.pop("material", None),
-                                 mass=part_mass)
+        material = spec.pop("material", None)
+        label = spec.pop("material_label", None) or material or ""
+        rho, _ = resolve_density(density=spec.pop("density", None), material=material, mass=part_mass)
         part_options = opts.replace(units=spec.pop("units")) if "units" in spec else opts
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             # equal moments of one part say nothing about the assembly: checked once on the whole below
             props, prepared = _part(src, rho, part_mass, part_options, name=spec.pop("name", None),
                                     warn_principal=False)
+        if label:
+            props = dataclasses.replace(props, material=str(label))
         bodies.append(props)
         meshes.append(prepared)
     if not bodies:
@@ -249,7 +255,7 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
         total = bodies[0]
     else:
         total = combine(bodies, name="assembly")
-        _warn_about_part_overlaps(meshes, [b.name for b in bodies])
+        _warn_about_part_overlaps(meshes, [b.name for b in bodies], [b.material for b in bodies])
     if mass is not None:
         total = total.with_mass(mass)
         warn_implausible_density(total.name, total.mass / total.volume, mass, total.volume)
@@ -257,12 +263,15 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
     return total
 
 
-def _warn_about_part_overlaps(meshes: list[PreparedMesh], names: list[str]) -> None:
+def _warn_about_part_overlaps(meshes: list[PreparedMesh], names: list[str], materials: list[str] | None = None,
+                              rtol: float = PART_OVERLAP_RTOL) -> None:
     """Warn when the parts of an assembly overlap each other (their shared volume counts twice).
 
     The parts' checked meshes are put side by side and the shell classification of :func:`prepare_mesh` is
-    run on the whole: bodies found inside another body beyond those already inside their own part overlap
-    across parts.
+    run on the whole: bodies found inside another body beyond those already inside their own part may overlap
+    across parts.  Then the volume each pair shares is measured (:func:`~inertia_tool.mesh.overlap.shared_volumes`);
+    pairs sharing at most ``rtol`` of the smaller part only touch (coincident faces, written coordinates
+    rounded) and are not reported.  When the measure is not available, the classification's word stands.
     """
     offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
     label_offsets = np.cumsum([0] + [len(m.shells) for m in meshes[:-1]])
@@ -273,6 +282,23 @@ def _warn_about_part_overlaps(meshes: list[PreparedMesh], names: list[str]) -> N
     diag = float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
     _, _, _, overlaps = classify_shells(vertices, faces, labels, len(shells), shells, diag)
     within = sum(m.report.overlapping_shells for m in meshes)
-    if overlaps > within:
+    if overlaps <= within:
+        return
+    shared = shared_volumes([(m.vertices, m.faces) for m in meshes]) if all(
+        m.report.watertight for m in meshes) else None
+    if shared is None:
         warnings.warn(OverlapWarning(f"assembly of {', '.join(names)}: parts overlap each other; the shared "
                                      "volume is counted once per part"), stacklevel=3)
+        return
+    volumes = [abs(sum(s.volume for s in m.shells)) for m in meshes]
+    found = [(i, j, v) for (i, j), v in shared.items() if v > rtol * max(min(volumes[i], volumes[j]), 0.0)]
+    if not found:
+        return
+    materials = materials or [""] * len(names)
+
+    def who(k: int) -> str:
+        return f"{names[k]} ({materials[k]})" if materials[k] else names[k]
+    pairs = "; ".join(f"{who(i)} and {who(j)} share {v:.4g} m³ ({100 * v / min(volumes[i], volumes[j]):.3g}% of the "
+                      "smaller)" for i, j, v in found)
+    warnings.warn(OverlapWarning(f"assembly of {', '.join(names)}: parts overlap: {pairs}; the shared volume is "
+                                 "counted once per part (its mass with each part's density)"), stacklevel=3)

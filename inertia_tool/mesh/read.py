@@ -87,6 +87,10 @@ class RawMesh:
         float32 (binary STL, PLY ``float``, glTF/GLB, COLLADA): half the float32 spacing at the largest
         coordinate (:func:`inertia_tool.mesh.precision.float32_rounding`); 0 for text and float64 formats and
         for arrays.  :func:`inertia_tool.mesh.precision.warn_storage_precision` turns it into a volume bound.
+    parts : tuple of PartTag
+        The parts of a file that names materials per part (:mod:`inertia_tool.mesh.parts`: a 3MF with base
+        materials or a slicer's filament assignments, a STEP assembly), each a range of ``faces``; empty for a
+        file of one material.
     """
 
     vertices: np.ndarray
@@ -96,6 +100,7 @@ class RawMesh:
     file_faces: int = 0
     units_assumed: bool = False
     storage_rounding: float = 0.0
+    parts: tuple = ()
 
 
 def _display(path: str | bytes | os.PathLike[str] | os.PathLike[bytes]) -> str:
@@ -756,8 +761,10 @@ def _check_zip(path: str, max_faces: int) -> _Counts:
     return {}
 
 
-def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str]]:
-    """``(vertices, faces, declared unit)`` of a 3MF, read by the streaming reader :mod:`.threemf`.
+def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str], tuple]:
+    """``(vertices, faces, declared unit, parts)`` of a 3MF, read by the streaming reader :mod:`.threemf`;
+    ``parts``: :func:`.parts.threemf_parts` of its materials and slicer volumes (PrusaSlicer's and Bambu Studio's
+    ``Metadata/`` configs, :mod:`.slicers`, each read whole, at most :data:`.slicers.MAX_CONFIG_BYTES`).
 
     Refused from the zip's central directory, before anything is inflated: more than
     :data:`MAX_ZIP_MEMBERS` members, an encrypted model part, a model part inflating more than
@@ -770,6 +777,8 @@ def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[
     import zipfile
     import zlib
 
+    from .parts import threemf_parts
+    from .slicers import CONFIG_MEMBERS, MAX_CONFIG_BYTES, read_slicer_config
     from .threemf import read_3mf
     try:
         with open_regular(path) as raw, zipfile.ZipFile(raw) as zf:
@@ -778,13 +787,21 @@ def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[
                 _check_zip_members(path, len(infos), (), "3MF ")
             models = _model_members(path, zf, infos)
             _check_zip_members(path, len(infos), models, "3MF ")
+            configs = [i for i in infos if i.filename.lower().lstrip("/") in CONFIG_MEMBERS]
+            _check_zip_members(path, len(infos), configs, "3MF ")
+            for info in configs:
+                if info.file_size > MAX_CONFIG_BYTES:
+                    raise _fail(path, f"3MF member {info.filename[:60]!r} inflates to {info.file_size:,} bytes, "
+                                      f"more than the {MAX_CONFIG_BYTES:,} read for a slicer's settings")
             total = sum(i.file_size for i in models)
             limit = zip_inflate_limit(max_faces)
             if total > limit:
                 raise _fail(path, f"3MF model parts would inflate to {total:,} bytes, more than the {limit:,} "
                                   f"allowed for `max_faces` ({max_faces:,}); refused before inflating")
             models.sort(key=lambda i: "3d/3dmodel.model" not in i.filename.lower())     # the root model first
-            return read_3mf(path, models, zf, max_faces=max_faces, name=_display(path))
+            vertices, faces, declared, placed = read_3mf(path, models, zf, max_faces=max_faces, name=_display(path))
+            slicer = read_slicer_config({i.filename.lower().lstrip("/"): zf.read(i) for i in configs}, _display(path))
+            return vertices, faces, declared, threemf_parts(placed, slicer, _display(path))
     except RuntimeError as exc:     # zipfile: "File ... is encrypted, password required for extraction"
         raise _fail(path, f"3MF archive member cannot be read ({str(exc)[:100]})") from None
     except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError, NotImplementedError,
@@ -933,7 +950,7 @@ def _read_with_trimesh_rounding(path: str,
     suffix = os.path.splitext(path)[1].lower()
     declared: tuple[float, str] | None
     if suffix == ".3mf":
-        v, f, declared = _read_3mf(path, max_faces)
+        v, f, declared, _ = _read_3mf(path, max_faces)
         _check_face_budget(path, len(f), max_faces)
         if not np.all(np.isfinite(v)):
             raise _fail(path, "vertices have NaN or infinite coordinates")
@@ -1083,7 +1100,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                         raise MeshReadError(str(exc).replace(inner, f"{_display(path)}:{member}", 1)) from None
                 return RawMesh(vertices=raw.vertices, faces=raw.faces, source=_display(path), units=raw.units,
                                file_faces=raw.file_faces, units_assumed=raw.units_assumed,
-                               storage_rounding=raw.storage_rounding)
+                               storage_rounding=raw.storage_rounding, parts=raw.parts)
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
                                   f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
@@ -1091,6 +1108,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                 raise _fail(path, "empty file (0 bytes)")
             declared = None
             rounding = 0.0                  # file units until scaled below
+            parts: tuple = ()
             if suffix == ".stl":
                 vertices, faces, n, binary = _read_stl(path, max_faces)
                 if binary:
@@ -1106,6 +1124,12 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "the tessellation has NaN or infinite coordinates")
                 declared = (1.0, "m")           # the CAD reader converts the file's unit to metres
+                n = len(faces)
+            elif suffix == ".3mf":
+                vertices, faces, declared, parts = _read_3mf(path, max_faces)
+                _check_face_budget(path, len(faces), max_faces)
+                if not np.all(np.isfinite(vertices)):
+                    raise _fail(path, "vertices have NaN or infinite coordinates")
                 n = len(faces)
             else:
                 vertices, faces, declared, rounding = _read_with_trimesh_rounding(path, max_faces)
@@ -1131,13 +1155,14 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
         _check_face_budget(name, n, max_faces)
         owned = False                      # may be the caller's own array: never modified
         rounding = 0.0
+        parts = ()
     if scale != 1.0:
         if owned and vertices.dtype == np.float64 and vertices.flags.writeable:
             vertices *= scale
         else:
             vertices = vertices * scale
     return RawMesh(vertices=vertices, faces=faces, source=name, units=str(units), file_faces=n,
-                   units_assumed=assumed, storage_rounding=rounding * abs(scale))
+                   units_assumed=assumed, storage_rounding=rounding * abs(scale), parts=parts)
 
 
 def _float32_rounding(vertices: np.ndarray) -> float:
