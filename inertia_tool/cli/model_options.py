@@ -38,7 +38,8 @@ from ..units import LENGTH_UNITS, MATERIALS, parse_density, parse_fraction, pars
 from .options import check_option, density_and_mass
 
 __all__ = ["add_files_argument", "add_model_options", "add_material_options", "add_mesh_options",
-           "add_material_map_option", "parse_material_map", "split_part_spec", "length_unit", "load_options_from_args", "read_meshes", "load_model",
+           "add_material_map_option", "parse_material_map", "split_part_spec",
+           "length_unit", "load_options_from_args", "read_meshes", "load_model",
            "LoadedModel", "model_words", "with_warnings", "command_parser", "recorded_warnings"]
 
 FILES_HELP = ("mesh file(s): STL, OBJ, PLY, OFF, 3MF; several FILE:material or FILE:density make an "

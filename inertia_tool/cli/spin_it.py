@@ -192,7 +192,7 @@ def run(args) -> int:
                                             resolution=args.resolution, insert_density=insert_density,
                                             repair=bool(getattr(args, "repair", False)))
     if args.out and result.insert_vertices is not None:
-        _write_two_materials(args.out, result, args.material or "part", args.insert, float(insert_density))
+        _write_two_materials(args.out, result, args.material or "part", args.insert, float(insert_density or 0.0))
     elif args.out:
         _write(args.out, result.vertices, result.faces, unit)
     if args.plot:

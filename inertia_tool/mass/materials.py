@@ -21,13 +21,16 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Iterable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import InvalidMeshError, MaterialError, NonMaterialVolumeWarning, UsageError
 from ..mesh.parts import PartTag, split_parts
 from ..units import MATERIALS, material_density
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..mesh.read import RawMesh
 
 __all__ = ["material_parts", "unused_map_keys", "normalise_name"]
 
@@ -53,11 +56,11 @@ def _mapped(value: float | str, key: str, where: str) -> tuple[float, str]:
             raise MaterialError(f"{where}: `material_map` gives {key!r} the material {value!r}, which is not in "
                                 f"the material table ({', '.join(sorted(MATERIALS))}); give a density instead "
                                 f"(e.g. {key}=1.24g/cm3)") from None
-    density = float(value)
-    if not (np.isfinite(density) and density > 0):
+    number = float(value)
+    if not (np.isfinite(number) and number > 0):
         raise UsageError(f"{where}: `material_map` gives {key!r} the density {value!r}; expected a positive "
                          "finite number of kg/m³")
-    return density, ""
+    return number, ""
 
 
 def _decide(tag: PartTag, where: str, mapping: dict[str, tuple[str, float | str]], used: set[str],
@@ -77,9 +80,9 @@ def _decide(tag: PartTag, where: str, mapping: dict[str, tuple[str, float | str]
             return rho, label or tag.material, f"material_map {hit[0]}"
         if tag.density is not None:
             return tag.density, tag.material, f"the file ({tag.origin})"
-        rho = _in_table(tag.material)
-        if rho is not None:
-            return rho, tag.material, f"material table ({tag.origin})"
+        known = _in_table(tag.material)
+        if known is not None:
+            return known, tag.material, f"material table ({tag.origin})"
         raise MaterialError(f"{where}: part {tag.name!r} is of material {tag.material!r} ({tag.origin}), which is "
                             "not in the material table, and the file gives no density for it; give one with "
                             f"`material_map` ({tag.material}=1.24g/cm3 or {tag.material}=pla)")
@@ -92,7 +95,7 @@ def _decide(tag: PartTag, where: str, mapping: dict[str, tuple[str, float | str]
                         "file (FILE:material, `density`, `material`)")
 
 
-def material_parts(raw, *, material_map: Mapping[str, float | str] | None = None, density: float | None = None,
+def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | None = None, density: float | None = None,
                    material: str | None = None, used: set[str] | None = None) -> list[dict[str, Any]]:
     """The parts of a multi-material ``RawMesh`` as :func:`~inertia_tool.mass.pipeline.assembly` specs.
 

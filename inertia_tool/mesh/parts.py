@@ -14,11 +14,14 @@ every name ``--material-map`` may use for it (see docs/usage.md).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from ..errors import MeshReadError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .read import RawMesh
 
 __all__ = ["PartTag", "part_mesh", "split_parts", "threemf_parts", "unique_names"]
 
@@ -129,8 +132,9 @@ def threemf_parts(placed: Sequence, slicer: tuple, name: str) -> tuple[PartTag, 
             raise MeshReadError(f"{name}: object {p.key} ({label}) names several materials on its triangles "
                                 f"({listed}) and none for its volume (pid/pindex on the <object>); which fills it "
                                 "is not said")
-        material, density = p.materials[0] if p.materials else (None, None)
-        rows.append((label, address, material, density, "3MF basematerials" if material else "", (start, stop),
+        own: str | None = p.materials[0][0] if p.materials else None
+        density = p.materials[0][1] if p.materials else None
+        rows.append((label, address, own, density, "3MF basematerials" if own else "", (start, stop),
                      "part"))
     if not any(r[2] is not None or r[6] != "part" for r in rows):
         return ()
@@ -139,11 +143,11 @@ def threemf_parts(placed: Sequence, slicer: tuple, name: str) -> tuple[PartTag, 
                  for n, r in zip(names, rows))
 
 
-def split_parts(raw):
+def split_parts(raw: RawMesh) -> list[tuple[PartTag, RawMesh]]:
     """One :class:`~inertia_tool.mesh.read.RawMesh` per part of ``raw`` (in its order, with its tag), each
     named ``"FILE [part]"`` for messages; every field but the geometry is ``raw``'s."""
     from .read import RawMesh
-    out = []
+    out: list[tuple[PartTag, RawMesh]] = []
     for tag in raw.parts:
         vertices, faces = part_mesh(raw.vertices, raw.faces, tag)
         out.append((tag, RawMesh(vertices=vertices, faces=faces, source=f"{raw.source} [{tag.name}]", units=raw.units,

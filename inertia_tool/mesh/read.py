@@ -33,6 +33,7 @@ from .scene_counts import GLTF_INSTANCE_FACES, check_collada_instances, check_gl
 from .weld import weld_exact, weld_exact_stream
 
 if TYPE_CHECKING:
+    from .parts import PartTag
     import zipfile
 
 #: What a header check found: element counts by name (``"vertex"``, ``"face"``) and, for PLY, ``"float32"``
@@ -100,7 +101,7 @@ class RawMesh:
     file_faces: int = 0
     units_assumed: bool = False
     storage_rounding: float = 0.0
-    parts: tuple = ()
+    parts: tuple[PartTag, ...] = ()
 
 
 def _display(path: str | bytes | os.PathLike[str] | os.PathLike[bytes]) -> str:
@@ -761,7 +762,7 @@ def _check_zip(path: str, max_faces: int) -> _Counts:
     return {}
 
 
-def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str], tuple]:
+def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str], tuple[PartTag, ...]]:
     """``(vertices, faces, declared unit, parts)`` of a 3MF, read by the streaming reader :mod:`.threemf`;
     ``parts``: :func:`.parts.threemf_parts` of its materials and slicer volumes (PrusaSlicer's and Bambu Studio's
     ``Metadata/`` configs, :mod:`.slicers`, each read whole, at most :data:`.slicers.MAX_CONFIG_BYTES`).
@@ -1108,7 +1109,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                 raise _fail(path, "empty file (0 bytes)")
             declared = None
             rounding = 0.0                  # file units until scaled below
-            parts: tuple = ()
+            parts: tuple[PartTag, ...] = ()
             if suffix == ".stl":
                 vertices, faces, n, binary = _read_stl(path, max_faces)
                 if binary:

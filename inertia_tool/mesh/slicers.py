@@ -178,8 +178,8 @@ def _prusa_filaments(data: bytes, where: str) -> tuple[list[str], list[float | N
         key, sep, value = line.lstrip("; ").partition(" = ")
         if sep and key in ("filament_type", "filament_density"):
             values[key] = value.strip()
-    types = [t.strip().strip('"') for t in values.get("filament_type", "").split(";")] if "filament_type" in values else []
-    densities = _densities(values.get("filament_density", "").split(";"), where) if "filament_density" in values else []
+    types = [t.strip().strip('"') for t in values["filament_type"].split(";")] if "filament_type" in values else []
+    densities = _densities(values["filament_density"].split(";"), where) if "filament_density" in values else []
     return types, densities
 
 

@@ -135,7 +135,7 @@ class PlacedObject(NamedTuple):
     key: str | None
     name: str | None
     item_name: str | None
-    materials: tuple
+    materials: tuple[Material, ...]
     faces: tuple[int, int]
 
 
@@ -151,7 +151,7 @@ class _Part:
         self.references: dict[str | None, list[tuple[str | None, str | None]]] = {}   # id -> [(pid, index)]
         self.basematerials: dict[str | None, list[Material]] = {}           # basematerials id -> its bases
 
-    def materials(self, key: str | None) -> tuple:
+    def materials(self, key: str | None) -> tuple[Material, ...]:
         """The base materials object ``key`` names (see :class:`PlacedObject`); references that are not
         base materials (colour groups, textures) or out of range are left out."""
         found: list[Material] = []
@@ -334,11 +334,11 @@ def read_3mf(path: str, members: Sequence[zipfile.ZipInfo], zf: zipfile.ZipFile,
         counts[(part_name, key)] = (total[0], total[1], total[2])
         return counts[(part_name, key)]
 
-    placed = [0, 0, 0]
+    placing = [0, 0, 0]
     for item_part, key, _ in root.items:
         sub = tally(item_part or root_name, key, 0)
-        placed = [min(t + s, limit + 1) for t, s, limit in zip(placed, sub, limits)]
-    for count, limit, what in zip(placed, limits, ("triangles", "vertices", "object instances")):
+        placing = [min(t + s, limit + 1) for t, s, limit in zip(placing, sub, limits)]
+    for count, limit, what in zip(placing, limits, ("triangles", "vertices", "object instances")):
         if count > limit:
             raise MeshReadError(f"{name}: the build places at least {count:,} {what} (components and items "
                                 f"repeated), more than `max_faces` ({max_faces:,}) allows; refused before placing "

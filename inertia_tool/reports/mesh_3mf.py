@@ -1,6 +1,7 @@
 """A minimal 3MF writer for several objects of different materials (3MF Core Specification 1.3, §4 and the
 ``basematerials`` resource of §5): one ``<object>`` per body, each pointing at its base material, all in the
-build, each material with its density when known.  Used by ``spin-it --out part.3mf`` for a hollowed part with a dense insert."""
+build, each material with its density when known.  Used by ``spin-it --out part.3mf`` for a hollowed part with a
+dense insert."""
 
 from __future__ import annotations
 
