@@ -10,6 +10,7 @@ that are a choice (equal moments) or at round-off (needles).
 from __future__ import annotations
 
 import dataclasses
+import os
 import warnings
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, TypeAlias
 
@@ -21,19 +22,16 @@ from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.precision import warn_storage_precision
 from ..mesh.overlap import shared_volumes
 from ..mesh.prepare import PreparedMesh, classify_shells, prepare_mesh
-from ..mesh.read import load_mesh
+from ..mesh.read import RawMesh, load_mesh
 from ..tolerances import NEEDLE_RTOL, PART_OVERLAP_RTOL, TRIANGLE_INEQUALITY_RTOL
 from ..units import material_density
 from .properties import MassProperties, combine
 from ..integrals import VolumeMoments, second_moment_to_inertia
 
 if TYPE_CHECKING:  # pragma: no cover
-    import os
-
     import trimesh
     from numpy.typing import ArrayLike
 
-    from ..mesh.read import RawMesh
 
 __all__ = ["mass_properties", "assembly", "resolve_density", "DEFAULT_DENSITY"]
 
@@ -131,7 +129,7 @@ def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassPrope
 
 def mass_properties(source: MeshSource, *, density: float | None = None, material: str | None = None,
                     mass: float | None = None, name: str | None = None, options: LoadOptions | None = None,
-                    **load_options: Any) -> MassProperties:
+                    material_map: Mapping[str, float | str] | None = None, **load_options: Any) -> MassProperties:
     """Mass properties of the solid bounded by a triangle mesh, exact for the polyhedron.
 
     Parameters
@@ -149,6 +147,12 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
         Label for reports; defaults to the source.
     options : LoadOptions, optional
         How to read and check the mesh (units, repair, merge tolerance, face limit).
+    material_map : mapping of str to float or str, optional
+        For a file that names materials per part (a 3MF with base materials or slicer filaments, a STEP
+        assembly): part name, ``object ID`` or material name → density (kg/m³) or material name.  Such a file
+        is integrated part by part (:mod:`inertia_tool.mass.materials` gives the rule that decides each
+        density; ``density``/``material`` are then the default of the parts the file names no material for)
+        and the result's ``parts`` are the parts.
     **load_options
         Fields of :class:`~inertia_tool.mesh.options.LoadOptions` (``units="mm"``, ``repair=True``, ...),
         a shortcut that overrides those of ``options``.
@@ -165,6 +169,18 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
     """
     opts = LoadOptions.build(options, **load_options)
     rho, _ = resolve_density(density=density, material=material, mass=mass)
+    if isinstance(source, (str, bytes, os.PathLike, RawMesh)):
+        raw = load_mesh(source, units=opts.units, max_faces=opts.max_faces,
+                        declared_units_win=opts.declared_units_win)
+        if raw.parts or material_map:       # a multi-material file: its parts, each with its own density
+            from .materials import material_parts, unused_map_keys
+            used: set[str] = set()
+            specs = material_parts(raw, material_map=material_map, density=density, material=material, used=used)
+            unused_map_keys(material_map, used, [raw])
+            for spec in specs:
+                spec.pop("decided_by", None)
+            return assembly(specs, mass=mass, options=opts, name=name or raw.source)
+        source = raw
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):   # non-finite results refused below
         return _part(source, rho, mass, opts, name=name)[0]
 
@@ -213,7 +229,7 @@ def _check_physical(props: MassProperties, rtol: float = TRIANGLE_INEQUALITY_RTO
 
 
 def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, options: LoadOptions | None = None,
-             **load_options: Any) -> MassProperties:
+             name: str = "assembly", **load_options: Any) -> MassProperties:
     """Combine several meshes, each with its own material, into one rigid body.
 
     Parameters
@@ -227,6 +243,8 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
         Scale the whole assembly to this total mass (kg), keeping the density ratios.
     options : LoadOptions, optional
         How to read and check every part.
+    name : str
+        Label of the whole for reports.
     **load_options
         Fields of :class:`~inertia_tool.mesh.options.LoadOptions`, overriding those of ``options``.
     """
@@ -254,7 +272,7 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
     if len(bodies) == 1:
         total = bodies[0]
     else:
-        total = combine(bodies, name="assembly")
+        total = combine(bodies, name=name)
         _warn_about_part_overlaps(meshes, [b.name for b in bodies], [b.material for b in bodies])
     if mass is not None:
         total = total.with_mass(mass)
