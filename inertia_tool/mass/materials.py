@@ -114,7 +114,7 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
     -------
     list of dict
         ``{"source": RawMesh of the part, "density": kg/m³, "name": part name, "material_label": material,
-        "decided_by": how}``.  Slicer volumes that are not material are left out
+        "decided_by": how, "file_part": True}`` (pop ``decided_by`` before passing them on).  Slicer volumes that are not material are left out
         (:class:`~inertia_tool.errors.NonMaterialVolumeWarning`).
 
     Raises
@@ -141,7 +141,7 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
             continue
         rho, label, how = _decide(tag, where, mapping, used, density, material)
         specs.append({"source": part, "density": rho, "name": tag.name, "material_label": label,
-                      "decided_by": how})
+                      "decided_by": how, "file_part": True})
     if skipped:
         warnings.warn(NonMaterialVolumeWarning(f"{where}: slicer volumes that are not material left out: "
                                                f"{', '.join(skipped)}"), stacklevel=2)

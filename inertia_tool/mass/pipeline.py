@@ -238,7 +238,8 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
         Each ``{"source": path_or_mesh, "density": kg/m³}``, ``{"source": ..., "material": name}`` or
         ``{"source": ..., "mass": kg}``
         (optionally ``"units"``, ``"name"`` and ``"material_label"``, the material's name for reports when the
-        density is given as a number; a part's ``"units"`` overrides the options' units).
+        density is given as a number; a part's ``"units"`` overrides the options' units; ``"file_part": True``
+        for a part of a multi-material file, which keeps even a single part listed in ``parts``).
     mass : float, optional
         Scale the whole assembly to this total mass (kg), keeping the density ratios.
     options : LoadOptions, optional
@@ -251,8 +252,10 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
     opts = LoadOptions.build(options, **load_options)
     bodies: list[MassProperties] = []
     meshes: list[PreparedMesh] = []
+    file_parts = False
     for spec in parts:
         spec = dict(spec)
+        file_parts |= bool(spec.pop("file_part", False))
         src = spec.pop("source")
         part_mass = spec.pop("mass", None)
         material = spec.pop("material", None)
@@ -269,8 +272,10 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
         meshes.append(prepared)
     if not bodies:
         raise UsageError("Expected at least one part in the assembly")
-    if len(bodies) == 1:
+    if len(bodies) == 1 and not file_parts:
         total = bodies[0]
+    elif len(bodies) == 1:                 # one part of a multi-material file: the parts table still shows it
+        total = combine(bodies, name=name)
     else:
         total = combine(bodies, name=name)
         _warn_about_part_overlaps(meshes, [b.name for b in bodies], [b.material for b in bodies])
