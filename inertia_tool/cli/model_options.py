@@ -377,8 +377,7 @@ def _load_solid(args, meshes):
         else:
             parts.append({"source": raw})
     unused_map_keys(material_map, used, meshes)
-    for spec in parts:
-        spec.pop("decided_by", None)
+    defaulted = [spec["name"] for spec in parts if spec.pop("decided_by", None) == "default (water)"]
     props = assembly(parts, mass=mass, options=options)
     if len(specs) == 1 and not specs[0][0].parts:
         described = resolve_density(**_part_density(own[0]))[1]
@@ -386,8 +385,10 @@ def _load_solid(args, meshes):
         described = "per part" + (" (the file's materials; see the parts)" if any(r.parts for r in meshes) else "")
         if default is not None:
             described += f"; {default_text} for the parts without their own"
-        elif len(own) < len(specs):
-            described += f"; {DEFAULT_DENSITY:g} kg/m³ (water) for the parts without their own"
+        elif len(own) < len(specs) or defaulted:
+            described += (f"; {DEFAULT_DENSITY:g} kg/m³ (default: water) for the parts without their own"
+                          + (f" ({', '.join(defaulted)}): give --material, --density or --material-map"
+                             if defaulted else ""))
     if mass is not None:
         described += f", scaled to a total mass of {mass:g} kg" + _implied(props, mass).replace(":", ";", 1)
     return props, described

@@ -10,7 +10,9 @@ Motion", Eq. (4.16)).  The density of a part is decided by one rule, first match
 3. the file gives a density for that material (a slicer's ``filament_density``, the ``it:density`` spin-it
    writes on a 3MF base material);
 4. the material's name is in :data:`inertia_tool.units.MATERIALS` (or one of its aliases);
-5. a part the file names no material for takes ``density``/``material``, the default for the file.
+5. a part the file names no material for takes ``density``/``material``, the default for the file; when no
+   part of the file names a material (a STEP assembly of named parts only), without a default they all take
+   :data:`~inertia_tool.mass.pipeline.DEFAULT_DENSITY` (water), as a file of one part does, and say so.
 
 Anything else is refused (:class:`~inertia_tool.errors.MaterialError`) with the name to map: a density is
 never guessed.  A ``material_map`` entry that matches nothing is refused too (a typo would otherwise be
@@ -28,6 +30,7 @@ import numpy as np
 from ..errors import InvalidMeshError, MaterialError, NonMaterialVolumeWarning, UsageError
 from ..mesh.parts import PartTag, split_parts
 from ..units import MATERIALS, material_density
+from .pipeline import DEFAULT_DENSITY
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..mesh.read import RawMesh
@@ -64,7 +67,7 @@ def _mapped(value: float | str, key: str, where: str) -> tuple[float, str]:
 
 
 def _decide(tag: PartTag, where: str, mapping: dict[str, tuple[str, float | str]], used: set[str],
-            density: float | None, material: str | None) -> tuple[float, str, str]:
+            density: float | None, material: str | None, any_material: bool) -> tuple[float, str, str]:
     """``(density kg/m³, material label, how it was decided)`` of one part, by the rule of the module."""
     for address in tag.addresses:
         hit = mapping.get(normalise_name(address))
@@ -90,6 +93,8 @@ def _decide(tag: PartTag, where: str, mapping: dict[str, tuple[str, float | str]
         return density, "", "the file's default"
     if material is not None:
         return material_density(material), material, "the file's default"
+    if not any_material:
+        return DEFAULT_DENSITY, "", "default (water)"
     raise MaterialError(f"{where}: part {tag.name!r} has no material in the file while other parts have; give it "
                         f"one with `material_map` ({tag.name}=MATERIAL or {tag.name}=DENSITY) or a default for the "
                         "file (FILE:material, `density`, `material`)")
@@ -114,8 +119,8 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
     -------
     list of dict
         ``{"source": RawMesh of the part, "density": kg/m³, "name": part name, "material_label": material,
-        "decided_by": how, "file_part": True}`` (pop ``decided_by`` before passing them on).  Slicer volumes that are not material are left out
-        (:class:`~inertia_tool.errors.NonMaterialVolumeWarning`).
+        "decided_by": how, "file_part": True}`` (pop ``decided_by`` before passing them on).  Slicer volumes
+        that are not material are left out (:class:`~inertia_tool.errors.NonMaterialVolumeWarning`).
 
     Raises
     ------
@@ -131,6 +136,7 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
     used = used if used is not None else set()
     specs: list[dict[str, Any]] = []
     skipped = []
+    any_material = any(t.material is not None for t in raw.parts)
     for tag, part in split_parts(raw):
         if tag.role == "negative":
             raise InvalidMeshError(f"{where}: part {tag.name!r} is a negative volume (material the slicer "
@@ -139,7 +145,7 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
         if tag.role != "part":
             skipped.append(f"{tag.name!r} ({tag.role})")
             continue
-        rho, label, how = _decide(tag, where, mapping, used, density, material)
+        rho, label, how = _decide(tag, where, mapping, used, density, material, any_material)
         specs.append({"source": part, "density": rho, "name": tag.name, "material_label": label,
                       "decided_by": how, "file_part": True})
     if skipped:

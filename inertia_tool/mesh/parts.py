@@ -23,7 +23,7 @@ from ..errors import MeshReadError
 if TYPE_CHECKING:  # pragma: no cover
     from .read import RawMesh
 
-__all__ = ["PartTag", "part_mesh", "split_parts", "threemf_parts", "unique_names"]
+__all__ = ["PartTag", "part_mesh", "split_parts", "threemf_parts", "cad_parts", "unique_names"]
 
 
 class PartTag(NamedTuple):
@@ -141,6 +141,14 @@ def threemf_parts(placed: Sequence, slicer: tuple, name: str) -> tuple[PartTag, 
     names = unique_names([r[0] for r in rows])
     return tuple(PartTag(n, tuple(dict.fromkeys((n, r[0], *r[1]))), r[2], r[3], r[4], r[5], r[6])
                  for n, r in zip(names, rows))
+
+
+def cad_parts(found: Sequence[tuple[str, str | None, float | None, int, int]]) -> tuple[PartTag, ...]:
+    """The parts of a STEP assembly (:attr:`~inertia_tool.mesh.cad.CadReading.parts`): names made unique,
+    the material and density of its XCAF document."""
+    names = unique_names([f[0] for f in found])
+    return tuple(PartTag(n, tuple(dict.fromkeys((n, f[0]))), f[1], f[2], "STEP material" if f[1] else "",
+                         (f[3], f[4])) for n, f in zip(names, found))
 
 
 def split_parts(raw: RawMesh) -> list[tuple[PartTag, RawMesh]]:

@@ -1119,8 +1119,11 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "vertices have NaN or infinite coordinates")
             elif suffix in (".step", ".stp", ".iges", ".igs"):
-                from .cad import tessellated_arrays
-                vertices, faces, _, _ = tessellated_arrays(path, max_faces=max_faces)
+                from .cad import read_cad
+                from .parts import cad_parts
+                reading = read_cad(path, max_faces=max_faces)
+                vertices, faces = reading.vertices, reading.faces
+                parts = cad_parts(reading.parts)
                 _check_face_budget(path, len(faces), max_faces)
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "the tessellation has NaN or infinite coordinates")
