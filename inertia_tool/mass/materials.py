@@ -10,7 +10,7 @@ Motion", Eq. (4.16)).  The density of a part is decided by one rule, first match
 3. the file gives a density for that material (a slicer's ``filament_density``, the ``it:density`` spin-it
    writes on a 3MF base material);
 4. the material's name is in :data:`inertia_tool.units.MATERIALS` (or one of its aliases);
-5. a part the file names no material for takes ``density``/``material``, the default for the file; when no
+5. a glTF part whose material (an appearance) is unknown, and a part the file names no material for, take ``density``/``material``, the default for the file; when no
    part of the file names a material (a STEP assembly of named parts only), without a default they all take
    :data:`~inertia_tool.mass.pipeline.DEFAULT_DENSITY` (water), as a file of one part does, and say so.
 
@@ -35,7 +35,12 @@ from .pipeline import DEFAULT_DENSITY
 if TYPE_CHECKING:  # pragma: no cover
     from ..mesh.read import RawMesh
 
-__all__ = ["material_parts", "unused_map_keys", "normalise_name"]
+__all__ = ["material_parts", "unused_map_keys", "normalise_name", "APPEARANCE_ORIGINS"]
+
+#: Origins of material names that name an appearance rather than a physical material (glTF materials are
+#: render settings: "Material.001", "Brushed metal"): a name the rule cannot map takes the file's default when
+#: one is given, instead of being refused.
+APPEARANCE_ORIGINS = ("glTF material",)
 
 
 def normalise_name(name: str) -> str:
@@ -86,6 +91,10 @@ def _decide(tag: PartTag, where: str, mapping: dict[str, tuple[str, float | str]
         known = _in_table(tag.material)
         if known is not None:
             return known, tag.material, f"material table ({tag.origin})"
+        if tag.origin in APPEARANCE_ORIGINS and (density is not None or material is not None):
+            # an appearance's name ("Material.001") says nothing of the density: the given default does
+            return (density if density is not None else material_density(str(material)), material or "",
+                    "the file's default")
         raise MaterialError(f"{where}: part {tag.name!r} is of material {tag.material!r} ({tag.origin}), which is "
                             "not in the material table, and the file gives no density for it; give one with "
                             f"`material_map` ({tag.material}=1.24g/cm3 or {tag.material}=pla)")

@@ -23,7 +23,8 @@ from ..errors import MeshReadError
 if TYPE_CHECKING:  # pragma: no cover
     from .read import RawMesh
 
-__all__ = ["PartTag", "part_mesh", "split_parts", "threemf_parts", "cad_parts", "unique_names"]
+__all__ = ["PartTag", "part_mesh", "split_parts", "threemf_parts", "cad_parts", "scene_parts",
+           "unique_names"]
 
 
 class PartTag(NamedTuple):
@@ -149,6 +150,23 @@ def cad_parts(found: Sequence[tuple[str, str | None, float | None, int, int]]) -
     names = unique_names([f[0] for f in found])
     return tuple(PartTag(n, tuple(dict.fromkeys((n, f[0]))), f[1], f[2], "STEP material" if f[1] else "",
                          (f[3], f[4])) for n, f in zip(names, found))
+
+
+def scene_parts(geometries: Sequence) -> tuple[PartTag, ...]:
+    """The parts of a glTF scene, one per mesh node (``trimesh.Scene.dump`` order, the order the reader
+    concatenates them in): the node's name, the name of its primitive's material (trimesh's
+    ``visual.material.name``).  Empty for a single node or when no node's mesh has a named material."""
+    rows, start = [], 0
+    for geometry in geometries:
+        material = getattr(getattr(geometry.visual, "material", None), "name", None)
+        node = geometry.metadata.get("node") or geometry.metadata.get("name") or f"node {len(rows) + 1}"
+        rows.append((str(node), str(material) if material else None, (start, start + len(geometry.faces))))
+        start += len(geometry.faces)
+    if len(rows) < 2 or not any(r[1] for r in rows):
+        return ()
+    names = unique_names([r[0] for r in rows])
+    return tuple(PartTag(n, tuple(dict.fromkeys((n, r[0]))), r[1], None, "glTF material" if r[1] else "", r[2])
+                 for n, r in zip(names, rows))
 
 
 def split_parts(raw: RawMesh) -> list[tuple[PartTag, RawMesh]]:

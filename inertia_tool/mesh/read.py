@@ -943,10 +943,13 @@ def _scene_rounding(loaded: object) -> float:
     return delta * norm
 
 
-def _read_with_trimesh_rounding(path: str,
-                                max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str] | None, float]:
+def _read_with_trimesh_rounding(path: str, max_faces: int,
+                                parts_out: list[Any] | None = None) -> tuple[np.ndarray, np.ndarray,
+                                                                             tuple[float, str] | None, float]:
     """``(vertices, faces, declared unit, float32 rounding in file units)`` of a file trimesh reads (3MF: of
-    the streaming reader :func:`_read_3mf`)."""
+    the streaming reader :func:`_read_3mf`); a glTF scene whose primitives use named materials appends its
+    per-node parts (:func:`.parts.scene_parts`) to ``parts_out``."""
+    parts: tuple[PartTag, ...] = ()
     size = os.path.getsize(path)
     suffix = os.path.splitext(path)[1].lower()
     declared: tuple[float, str] | None
@@ -980,7 +983,9 @@ def _read_with_trimesh_rounding(path: str,
             quiet.setLevel(logging.CRITICAL)      # e.g. a missing texture image, logged with a traceback
             try:
                 # glTF: no textures decoded (geometry only; a textured GLB loads up to 50x faster)
-                extra: dict[str, Any] = {"skip_materials": True} if suffix in (".glb", ".gltf") else {}
+                # (unless primitives use named materials: then each node is a part with its material)
+                extra: dict[str, Any] = ({"skip_materials": not counts.get("named_materials")}
+                                         if suffix in (".glb", ".gltf") else {})
                 # the file itself, opened once (regular files only), its side files too
                 with open_regular(path) as fh:
                     loaded = trimesh.load(fh, file_type=suffix[1:], process=False, force=None,
@@ -999,6 +1004,9 @@ def _read_with_trimesh_rounding(path: str,
                 geoms = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)] if loaded.geometry else []
                 if not geoms:
                     raise _fail(path, "contains no triangle mesh (empty scene or only points/lines)")
+                if suffix in (".glb", ".gltf") and counts.get("named_materials"):
+                    from .parts import scene_parts
+                    parts = scene_parts(geoms)
                 loaded = trimesh.util.concatenate(geoms) if len(geoms) > 1 else geoms[0]
     except MeshReadError:
         raise
@@ -1028,6 +1036,8 @@ def _read_with_trimesh_rounding(path: str,
                           "(faces dropped or truncated file)")
     if not np.all(np.isfinite(v)):
         raise _fail(path, "vertices have NaN or infinite coordinates")
+    if parts_out is not None:
+        parts_out.extend(parts)
     return v, f, declared, rounding
 
 
@@ -1136,7 +1146,9 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                     raise _fail(path, "vertices have NaN or infinite coordinates")
                 n = len(faces)
             else:
-                vertices, faces, declared, rounding = _read_with_trimesh_rounding(path, max_faces)
+                found: list[PartTag] = []
+                vertices, faces, declared, rounding = _read_with_trimesh_rounding(path, max_faces, found)
+                parts = tuple(found)
                 n = len(faces)
         except PermissionError:
             raise _fail(path, "permission denied") from None
