@@ -328,3 +328,21 @@ def test_random_parts_total_is_the_independent_sum(tmp_path, boxes):
     truth = box_truth([(np.multiply(lo, mm), np.multiply(hi, mm), rho) for lo, hi, rho, _ in specs])
     _check(props, truth, rtol=1e-10)
     assert len(props.parts) == len(specs)
+
+
+def test_parts_json_validates_and_declares_every_field(tmp_path, capsys):
+    """The parts of a multi-material file in --json: material, density and certificate per body, in the schema."""
+    import jsonschema
+    from test_json_schema import _errors, _undeclared
+
+    import inertia_tool
+    with open(f"{inertia_tool.__path__[0]}/schema/output-v1.json", encoding="utf-8") as fh:
+        schema = json.load(fh)
+    path = basematerials_3mf(tmp_path / "s.3mf", [((0, 0, 0), (10, 10, 10), None, "PLA"),
+                                                  ((20, 0, 0), (30, 10, 10), 7850.0, "steel")], names=["a", "b"])
+    assert main(["analyze", str(path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert _errors(jsonschema.Draft202012Validator(schema), data) == []
+    assert _undeclared(schema, schema["$defs"]["analyze"], data) == []
+    assert [(b["name"], b["material"], b["density"], b["certificate"]["kind"]) for b in data["bodies"]] == [
+        ("a", "PLA", 1240.0, "exact"), ("b", "steel", 7850.0, "exact")]
