@@ -346,3 +346,31 @@ def test_parts_json_validates_and_declares_every_field(tmp_path, capsys):
     assert _undeclared(schema, schema["$defs"]["analyze"], data) == []
     assert [(b["name"], b["material"], b["density"], b["certificate"]["kind"]) for b in data["bodies"]] == [
         ("a", "PLA", 1240.0, "exact"), ("b", "steel", 7850.0, "exact")]
+
+
+def test_prusaslicer_volumes_that_leave_triangles_out_are_refused(tmp_path):
+    """Triangles no volume claims would be dropped silently: the file is refused instead."""
+    parts = [box((0, 0, 0), (10, 10, 10)), box((20, 0, 0), (30, 10, 10))]
+    v = np.vstack([p[0] for p in parts])
+    f = np.vstack([p[1] + 8 * k for k, p in enumerate(parts)])
+    model = (f'<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="{CORE}"><resources>'
+             f'<object id="1" type="model">{_mesh_xml(v, f)}</object></resources>'
+             '<build><item objectid="1"/></build></model>')
+    config = ('<?xml version="1.0" encoding="UTF-8"?>\n<config>\n <object id="1" instances_count="1">\n'
+              '  <volume firstid="0" lastid="11">\n   <metadata type="volume" key="extruder" value="1"/>\n'
+              '  </volume>\n </object>\n</config>\n')
+    path = write_package(tmp_path / "gap.3mf", model, [("Metadata/Slic3r_PE_model.config", config)])
+    with pytest.raises(Exception, match="do not cover its 24 triangles exactly once"):
+        mass_properties(path)
+
+
+def test_a_flood_of_base_materials_is_refused_while_reading(tmp_path):
+    bases = '<base name="m" displaycolor="#000"/>' * 200
+    v, f = box((0, 0, 0), (10, 10, 10))
+    model = (f'<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="{CORE}"><resources>'
+             f'<basematerials id="1">{bases}</basematerials><object id="2" type="model" pid="1" pindex="0">'
+             f'{_mesh_xml(v, f)}</object></resources><build><item objectid="2"/></build></model>')
+    path = write_package(tmp_path / "flood.3mf", model)
+    with pytest.raises(Exception, match="base materials"):
+        mass_properties(path, max_faces=40)
+    assert mass_properties(path, max_faces=100, material_map={"m": 1000.0}).mass == pytest.approx(1e-3)

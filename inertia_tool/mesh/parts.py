@@ -108,11 +108,14 @@ def threemf_parts(placed: Sequence, slicer: tuple, name: str) -> tuple[PartTag, 
         address = (f"object {p.key}",) if p.key == p.item else (f"object {p.key}", f"object {p.item}")
         config = objects.get(str(p.item)) if p.item is not None else None
         if config is not None and config.slicer == "PrusaSlicer" and config.volumes:
+            ranges = sorted(v.faces or (0, 0) for v in config.volumes)
+            covered = [0] + [r[1] for r in ranges]
+            if any(r[0] != c for r, c in zip(ranges, covered)) or covered[-1] != stop - start:
+                raise MeshReadError(f"{name}: the PrusaSlicer volumes of object {p.key} do not cover its "
+                                    f"{stop - start} triangles exactly once (ranges "
+                                    f"{', '.join(f'{a}..{b - 1}' for a, b in ranges[:6])})")
             for volume in config.volumes:
                 first, last = volume.faces or (0, 0)
-                if last > stop - start:
-                    raise MeshReadError(f"{name}: PrusaSlicer volume {volume.name or ''!r} names triangles "
-                                        f"{first}..{last - 1}, beyond the {stop - start} of object {p.key}")
                 material, density = _slot_material(volume.extruder, types, densities)
                 label = volume.name or config.name or p.name or f"object {p.key}"
                 rows.append((label, address, material, density, f"PrusaSlicer extruder {volume.extruder}",
@@ -121,7 +124,7 @@ def threemf_parts(placed: Sequence, slicer: tuple, name: str) -> tuple[PartTag, 
         if config is not None and config.slicer == "Bambu Studio":
             volume = next((v for v in config.volumes if v.component == str(p.key)), None)
             if volume is not None or not config.volumes:
-                extruder = volume.extruder if volume is not None else 1
+                extruder = volume.extruder if volume is not None else config.extruder
                 material, density = _slot_material(extruder, types, densities)
                 label = (volume.name if volume is not None else None) or p.name or config.name or f"object {p.key}"
                 rows.append((label, address, material, density, f"Bambu Studio extruder {extruder}", (start, stop),
@@ -156,7 +159,8 @@ def scene_parts(geometries: Sequence) -> tuple[PartTag, ...]:
     """The parts of a glTF scene, one per mesh node (``trimesh.Scene.dump`` order, the order the reader
     concatenates them in): the node's name, the name of its primitive's material (trimesh's
     ``visual.material.name``).  Empty for a single node or when no node's mesh has a named material."""
-    rows, start = [], 0
+    rows: list[tuple[str, str | None, tuple[int, int]]] = []
+    start = 0
     for geometry in geometries:
         material = getattr(getattr(geometry.visual, "material", None), "name", None)
         node = geometry.metadata.get("node") or geometry.metadata.get("name") or f"node {len(rows) + 1}"

@@ -89,11 +89,13 @@ class SlicerVolume(NamedTuple):
 
 
 class SlicerObject(NamedTuple):
-    """A slicer object: its name and volumes (``slicer`` is ``"PrusaSlicer"`` or ``"Bambu Studio"``)."""
+    """A slicer object: its name, volumes, ``slicer`` (``"PrusaSlicer"`` or ``"Bambu Studio"``) and its own
+    extruder (1-based; its volumes' default)."""
 
     name: str | None
     volumes: tuple[SlicerVolume, ...]
     slicer: str
+    extruder: int = 1
 
 
 def _metadata(element, kind: str | None = None) -> dict[str, str]:
@@ -143,7 +145,7 @@ def _prusa_objects(data: bytes, where: str) -> dict[str, SlicerObject]:
             role = "negative" if kind in _NEGATIVE else _NOT_MATERIAL.get(kind, "part")
             volumes.append(SlicerVolume(vmeta.get("name"), role, _slot(vmeta.get("extruder"), own, where),
                                         (first, last + 1), None))
-        objects[str(obj.get("id"))] = SlicerObject(meta.get("name"), tuple(volumes), "PrusaSlicer")
+        objects[str(obj.get("id"))] = SlicerObject(meta.get("name"), tuple(volumes), "PrusaSlicer", own)
     return objects
 
 
@@ -159,7 +161,7 @@ def _bambu_objects(data: bytes, where: str) -> dict[str, SlicerObject]:
             role = "negative" if kind in _NEGATIVE else _NOT_MATERIAL.get(kind, "part")
             volumes.append(SlicerVolume(pmeta.get("name"), role, _slot(pmeta.get("extruder"), own, where), None,
                                         str(part.get("id"))))
-        objects[str(obj.get("id"))] = SlicerObject(meta.get("name"), tuple(volumes), "Bambu Studio")
+        objects[str(obj.get("id"))] = SlicerObject(meta.get("name"), tuple(volumes), "Bambu Studio", own)
     return objects
 
 

@@ -228,7 +228,11 @@ def _read_part(source: IO[bytes], where: str, budget: list[int]) -> _Part:
             elif tag == "item":                    # build items (the core specification has no other <item>)
                 part.items.append((_attribute(element, "path"), get("objectid"), _transform(get("transform"), where)))
             elif tag == "base":
-                bases.append((str(get("name") or f"material {len(bases) + 1}"), _density(element)))
+                bases.append((str(get("name") or f"material {len(bases) + 1}")[:200], _density(element)))
+                budget[1] -= 1                 # counted as a vertex: a file of millions of them is refused
+                if budget[1] < 0:
+                    raise MeshReadError(f"{where}: holds more vertices and base materials than 3 × `max_faces` + "
+                                        "3 allows; refused while reading")
             elif tag == "basematerials":
                 part.basematerials[get("id")] = bases
                 bases = []
