@@ -374,3 +374,22 @@ def test_a_flood_of_base_materials_is_refused_while_reading(tmp_path):
     with pytest.raises(Exception, match="base materials"):
         mass_properties(path, max_faces=40)
     assert mass_properties(path, max_faces=100, material_map={"m": 1000.0}).mass == pytest.approx(1e-3)
+
+
+def test_html_report_lists_the_parts(tmp_path, capsys):
+    path = basematerials_3mf(tmp_path / "h.3mf", [((0, 0, 0), (10, 10, 10), None, "PLA"),
+                                                  ((20, 0, 0), (30, 10, 10), None, "steel")], names=["a", "b"])
+    report = tmp_path / "r.html"
+    assert main(["analyze", str(path), "--report", str(report)]) == 0
+    html = report.read_text(encoding="utf-8")
+    assert "Parts (2)" in html and "<td>steel</td>" in html and "<td>PLA</td>" in html
+
+
+def test_a_raw_mesh_is_one_solid_of_the_given_density(tmp_path):
+    """Robot geometry passes meshes read before at unit density: their parts do not decide."""
+    from inertia_tool.mesh.read import load_mesh
+    path = basematerials_3mf(tmp_path / "r.3mf", [((0, 0, 0), (10, 10, 10), None, "steel")])
+    raw = load_mesh(path)
+    assert raw.parts and mass_properties(raw, density=1.0).mass == pytest.approx(1e-6, rel=1e-12)
+    with pytest.raises(UsageError, match="material_map"):
+        mass_properties(raw, material_map={"steel": 1.0})

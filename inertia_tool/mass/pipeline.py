@@ -148,7 +148,7 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
     options : LoadOptions, optional
         How to read and check the mesh (units, repair, merge tolerance, face limit).
     material_map : mapping of str to float or str, optional
-        For a file that names materials per part (a 3MF with base materials or slicer filaments, a STEP
+        For a file (a path) that names materials per part (a 3MF with base materials or slicer filaments, a STEP
         assembly): part name, ``object ID`` or material name → density (kg/m³) or material name.  Such a file
         is integrated part by part (:mod:`inertia_tool.mass.materials` gives the rule that decides each
         density; ``density``/``material`` are then the default of the parts the file names no material for)
@@ -169,7 +169,9 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
     """
     opts = LoadOptions.build(options, **load_options)
     rho, _ = resolve_density(density=density, material=material, mass=mass)
-    if isinstance(source, (str, bytes, os.PathLike, RawMesh)):
+    if isinstance(source, (str, bytes, os.PathLike)):
+        # a file is read here once: when it names materials per part, they decide (a RawMesh passed in is
+        # integrated as one solid of the given density, whatever parts it lists: robot geometry at unit density)
         raw = load_mesh(source, units=opts.units, max_faces=opts.max_faces,
                         declared_units_win=opts.declared_units_win)
         if raw.parts or material_map:       # a multi-material file: its parts, each with its own density
@@ -181,6 +183,9 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
                 spec.pop("decided_by", None)
             return assembly(specs, mass=mass, options=opts, name=name or raw.source)
         source = raw
+    elif material_map:
+        raise UsageError("`material_map` applies to a file that names parts or materials (give its path), not to "
+                         f"{type(source).__name__}")
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):   # non-finite results refused below
         return _part(source, rho, mass, opts, name=name)[0]
 
