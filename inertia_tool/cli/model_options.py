@@ -378,7 +378,8 @@ def _load_solid(args, meshes):
             parts.append({"source": raw})
     unused_map_keys(material_map, used, meshes)
     defaulted = [spec["name"] for spec in parts if spec.pop("decided_by", None) == "default (water)"]
-    props = assembly(parts, mass=mass, options=options)
+    props = assembly(parts, mass=mass, options=options,
+                     name=meshes[0].source if len(meshes) == 1 and meshes[0].parts else "assembly")
     if len(specs) == 1 and not specs[0][0].parts:
         described = resolve_density(**_part_density(own[0]))[1]
     else:
