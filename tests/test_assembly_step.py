@@ -83,13 +83,19 @@ def test_two_named_boxes_of_two_materials_against_closed_form(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_parts_without_materials_take_the_default_or_the_map(tmp_path, capsys):
-    path = write_step_assembly(tmp_path / "plain.step", [("left", (0, 0, 0), (10, 10, 10), None, None),
-                                                         ("right", (20, 0, 0), (30, 10, 10), None, None)])
-    assert main(["analyze", str(path), "--json", "--material", "pla", "--material-map", "right=steel"]) == 0
+def test_parts_with_and_without_materials(tmp_path, capsys):
+    """One part without a material takes the default; with none anywhere the solids are one part (fused, the
+    exact B-rep), and --material-map has nothing to address."""
+    path = write_step_assembly(tmp_path / "half.step", [("left", (0, 0, 0), (10, 10, 10), None, None),
+                                                        ("right", (20, 0, 0), (30, 10, 10), "steel", 7.85)])
+    assert main(["analyze", str(path)]) == 2
+    assert "'left' has no material" in capsys.readouterr().err
+    assert main(["analyze", str(path), "--json", "--material", "pla"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert [(b["name"], b["density"]) for b in data["bodies"]] == [("left", 1240.0), ("right", 7850.0)]
-    assert main(["analyze", str(path), "--json"]) == 0          # no material anywhere: water, and said so
+    assert [(b["name"], b["density"]) for b in data["bodies"]] == [("left", 1240.0), ("right", pytest.approx(7850.0))]
+    plain = write_step_assembly(tmp_path / "plain.step", [("left", (0, 0, 0), (10, 10, 10), None, None),
+                                                          ("right", (20, 0, 0), (30, 10, 10), None, None)])
+    assert main(["analyze", str(plain), "--json", "--material", "pla"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert "water" in data["density_source"] and "left" in data["density_source"]
-    assert data["mass"] == pytest.approx(2e-3, rel=1e-9)
+    assert data["mass"] == pytest.approx(2 * 1.24e-3, rel=1e-9) and "brep" in data
+    assert main(["analyze", str(plain), "--material-map", "left=steel"]) == 2

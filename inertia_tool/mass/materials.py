@@ -11,8 +11,8 @@ Motion", Eq. (4.16)).  The density of a part is decided by one rule, first match
    writes on a 3MF base material);
 4. the material's name is in :data:`inertia_tool.units.MATERIALS` (or one of its aliases);
 5. a glTF part whose material (an appearance) is unknown, and a part the file names no material for, take
-   ``density``/``material``, the default for the file; when no part of the file names a material (a STEP
-   assembly of named parts only), without a default they all take
+   ``density``/``material``, the default for the file; when no part of the file names a material (a slicer
+   project whose volumes name no filament), without a default they all take
    :data:`~inertia_tool.mass.pipeline.DEFAULT_DENSITY` (water), as a file of one part does, and say so.
 
 Anything else is refused (:class:`~inertia_tool.errors.MaterialError`) with the name to map: a density is

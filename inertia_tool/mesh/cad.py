@@ -186,16 +186,22 @@ def step_parts(path: str) -> list[tuple[str, str | None, float | None, Any]]:
     """The parts of a STEP assembly through OpenCASCADE's XCAF document: ``(name, material, density kg/m³ or
     None, located shape in metres)`` for every leaf shape instance, assemblies followed down with their
     placements composed.  One entry (or none) for a file that is not an assembly.  Needs OCP; run in the
-    isolated child only."""
-    from OCP.IFSelect import IFSelect_ReturnStatus
-    from OCP.Interface import Interface_Static
-    from OCP.OCP.collections import Sequence_TDF_Label
-    from OCP.STEPCAFControl import STEPCAFControl_Reader
-    from OCP.TCollection import TCollection_ExtendedString
-    from OCP.TDF import TDF_Label
-    from OCP.TDocStd import TDocStd_Document
-    from OCP.TopLoc import TopLoc_Location
-    from OCP.XCAFDoc import XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
+    isolated child only.  :func:`_read_here` integrates the parts apart only when some part has a material:
+    otherwise the solids are fused as before (the exact B-rep of their union)."""
+    try:
+        from OCP.IFSelect import IFSelect_ReturnStatus
+        from OCP.Interface import Interface_Static
+        from OCP.OCP.collections import Sequence_TDF_Label
+        from OCP.STEPCAFControl import STEPCAFControl_Reader
+        from OCP.TCollection import TCollection_ExtendedString
+        from OCP.TDF import TDF_Label
+        from OCP.TDocStd import TDocStd_Document
+        from OCP.TopLoc import TopLoc_Location
+        from OCP.XCAFDoc import XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
+    except ImportError as exc:      # as read_brep: under a memory limit, mapping the libraries fails
+        if "map segment" in str(exc) or "allocate memory" in str(exc):
+            raise MemoryError(str(exc)) from None
+        raise _fail(path, f"OCP is installed but cannot be loaded ({exc})") from None
     reader = STEPCAFControl_Reader()
     reader.SetNameMode(True)
     reader.SetMatMode(True)
@@ -460,8 +466,9 @@ class CadReading:
         How several solids became one (:func:`solids_fused`; the tessellation and ``integrals`` are of the
         result).
     parts : tuple of (name, material or None, density kg/m³ or None, first face, stop face)
-        A STEP assembly of several parts (:func:`step_parts`): each part tessellated on its own, its face range
-        of ``faces``; the solids are then not fused and ``integrals`` is None (each part has its own material).
+        A STEP assembly of several parts, some with a material (:func:`step_parts`): each part tessellated on its
+        own, its face range of ``faces``; the solids are then not fused and ``integrals`` is None (each part has
+        its own material).
     """
 
     vertices: np.ndarray
@@ -480,8 +487,10 @@ def _read_here(path: str, chord: float | None, angular_deflection: float, use_oc
     """Read, fuse, tessellate and integrate in this process: run only in the isolated child
     (:func:`read_cad`); returns plain values (:func:`inertia_tool.isolate.run_isolated`)."""
     if use_ocp and os.path.splitext(path)[1].lower() in (".step", ".stp"):
+        # parts of different materials are integrated apart; without materials the solids are fused and the
+        # exact B-rep of their union is the answer, as for any STEP file
         found = step_parts(path)
-        if len(found) > 1:
+        if len(found) > 1 and any(material is not None for _, material, _, _ in found):
             return _assembly_here(path, found, chord, angular_deflection, max_faces)
     if use_ocp:
         shape, solids, summed, fusion = solids_fused(read_brep(path))
