@@ -393,3 +393,19 @@ def test_a_raw_mesh_is_one_solid_of_the_given_density(tmp_path):
     assert raw.parts and mass_properties(raw, density=1.0).mass == pytest.approx(1e-6, rel=1e-12)
     with pytest.raises(UsageError, match="material_map"):
         mass_properties(raw, material_map={"steel": 1.0})
+
+
+def test_batch_row_of_a_multi_material_file(tmp_path, capsys):
+    """A batch row of a file integrated part by part: its total, counts added, the parts' certificate."""
+    import csv
+    folder = tmp_path / "in"
+    folder.mkdir()
+    basematerials_3mf(folder / "two.3mf", [((0, 0, 0), (10, 10, 10), None, "PLA"),
+                                           ((20, 0, 0), (30, 10, 10), None, "steel")])
+    out = tmp_path / "rows.csv"
+    assert main(["batch", str(folder), "--out", str(out)]) == 0
+    with open(out, newline="", encoding="utf-8") as fh:
+        (row,) = list(csv.DictReader(fh))
+    assert row["status"] == "ok" and float(row["mass"]) == pytest.approx((1.24 + 7.85) * 1e-3, rel=1e-12)
+    assert row["certificate"] == "exact" and row["faces"] == "24" and row["bodies"] == "2"
+    assert row["density_source"] == "per part (the file's materials)"
