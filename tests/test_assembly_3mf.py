@@ -409,3 +409,17 @@ def test_batch_row_of_a_multi_material_file(tmp_path, capsys):
     assert row["status"] == "ok" and float(row["mass"]) == pytest.approx((1.24 + 7.85) * 1e-3, rel=1e-12)
     assert row["certificate"] == "exact" and row["faces"] == "24" and row["bodies"] == "2"
     assert row["density_source"] == "per part (the file's materials)"
+
+
+def test_overlapping_parts_of_one_material_are_united(tmp_path, recwarn):
+    """Two overlapping PLA cubes: their union (15 × 10 × 10 mm), as when the file was read as one solid; a third
+    part of another material stays apart."""
+    path = basematerials_3mf(tmp_path / "u.3mf", [((0, 0, 0), (10, 10, 10), None, "PLA"),
+                                                  ((5, 0, 0), (15, 10, 10), None, "PLA"),
+                                                  ((30, 0, 0), (40, 10, 10), None, "steel")], names=["a", "b", "c"])
+    props = mass_properties(path)
+    mm = 1e-3
+    _check(props, box_truth([((0, 0, 0), (15 * mm, 10 * mm, 10 * mm), 1240.0),
+                             ((30 * mm, 0, 0), (40 * mm, 10 * mm, 10 * mm), 7850.0)]), rtol=1e-9)
+    assert [b.name for b in props.parts] == ["a + b", "c"]
+    assert not [w for w in recwarn if issubclass(w.category, OverlapWarning) and "parts overlap" in str(w.message)]

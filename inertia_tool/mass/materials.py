@@ -30,6 +30,7 @@ import numpy as np
 
 from ..errors import InvalidMeshError, MaterialError, NonMaterialVolumeWarning, UsageError
 from ..mesh.parts import PartTag, split_parts
+from ..tolerances import PART_OVERLAP_RTOL
 from ..units import MATERIALS, material_density
 from .pipeline import DEFAULT_DENSITY
 
@@ -130,7 +131,8 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
     list of dict
         ``{"source": RawMesh of the part, "density": kg/m³, "name": part name, "material_label": material,
         "decided_by": how, "file_part": True}`` (pop ``decided_by`` before passing them on).  Slicer volumes
-        that are not material are left out (:class:`~inertia_tool.errors.NonMaterialVolumeWarning`).
+        that are not material are left out (:class:`~inertia_tool.errors.NonMaterialVolumeWarning`); parts of
+        one material that overlap are joined into one, ``"a + b"``, whose union is integrated.
 
     Raises
     ------
@@ -163,12 +165,70 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
                                                f"{', '.join(skipped)}"), stacklevel=2)
     if not specs:
         raise InvalidMeshError(f"{where}: no part of the file is material (only slicer modifiers)")
+    specs = _unite_same_material(specs)
     if (density is not None or material is not None) and all(s["decided_by"] != "the file's default"
                                                             for s in specs):
         option = "`density`" if density is not None else "`material`"
         raise UsageError(f"{where}: {option} would apply to no part: every part has a material of its own in "
                          "the file (override one with `material_map`)")
     return specs
+
+
+def _signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """Σ v0 · (v1 × v2) / 6 of a closed outward-wound mesh (the divergence theorem), m³."""
+    v = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
+    return float(np.einsum("ij,ij->i", v[:, 0], np.cross(v[:, 1], v[:, 2])).sum() / 6.0)
+
+
+def _unite_same_material(specs: list[dict[str, Any]], rtol: float = PART_OVERLAP_RTOL) -> list[dict[str, Any]]:
+    """Parts of one material and density that overlap (share more than ``rtol`` of the smaller one's volume,
+    :func:`~inertia_tool.mesh.overlap.shared_volumes`) become one part, ``"a + b"``, whose mesh holds both:
+    the mesh layer then integrates their union, as it did when the file was read as one solid.  Parts of
+    different materials are left apart (which material fills the shared volume is not said; the assembly
+    warns)."""
+    from ..mesh.overlap import shared_volumes
+    from ..mesh.read import RawMesh
+    groups: dict[tuple[float, str], list[int]] = {}
+    for k, spec in enumerate(specs):
+        groups.setdefault((float(spec["density"]), str(spec["material_label"])), []).append(k)
+    parent = list(range(len(specs)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            i = parent[i]
+        return i
+
+    for members in groups.values():
+        if len(members) < 2:
+            continue
+        meshes = [(specs[k]["source"].vertices, specs[k]["source"].faces) for k in members]
+        shared = shared_volumes(meshes)
+        if not shared:
+            continue
+        volumes = [abs(_signed_volume(v, f)) for v, f in meshes]
+        for (i, j), volume in shared.items():
+            if volume > rtol * min(volumes[i], volumes[j]):
+                parent[root(members[i])] = root(members[j])
+    joined: dict[int, list[int]] = {}
+    for k in range(len(specs)):
+        joined.setdefault(root(k), []).append(k)
+    if all(len(ks) == 1 for ks in joined.values()):
+        return specs
+    out = []
+    for ks in sorted(joined.values()):
+        if len(ks) == 1:
+            out.append(specs[ks[0]])
+            continue
+        first = specs[ks[0]]["source"]
+        offsets = np.cumsum([0] + [len(specs[k]["source"].vertices) for k in ks[:-1]])
+        name = " + ".join(specs[k]["name"] for k in ks)
+        mesh = RawMesh(vertices=np.vstack([specs[k]["source"].vertices for k in ks]),
+                       faces=np.vstack([np.asarray(specs[k]["source"].faces) + o for k, o in zip(ks, offsets)]),
+                       source=f"{first.source.rsplit(' [', 1)[0]} [{name}]", units=first.units,
+                       file_faces=sum(len(specs[k]["source"].faces) for k in ks), units_assumed=first.units_assumed,
+                       storage_rounding=first.storage_rounding)
+        out.append({**specs[ks[0]], "source": mesh, "name": name})
+    return out
 
 
 def unused_map_keys(material_map: Mapping[str, Any] | None, used: Iterable[str], sources: Iterable[Any]) -> None:
