@@ -194,9 +194,22 @@ def test_material_map_entry_matching_nothing_is_refused(tmp_path, capsys):
 
 
 def test_a_default_that_applies_to_no_part_is_refused(tmp_path, capsys):
-    path = basematerials_3mf(tmp_path / "m.3mf", [((0, 0, 0), (10, 10, 10), None, "PLA")])
+    path = basematerials_3mf(tmp_path / "m.3mf", [((0, 0, 0), (10, 10, 10), None, "PLA"),
+                                                  ((20, 0, 0), (30, 10, 10), None, "steel")])
     assert main(["analyze", str(path), "--material", "steel"]) == 2
     assert "--material" in capsys.readouterr().err
+
+
+def test_a_file_of_one_material_takes_the_given_one(tmp_path, capsys):
+    """A slicer project in one filament: --material and --density apply to all of it, as to any file."""
+    path = basematerials_3mf(tmp_path / "one.3mf", [((0, 0, 0), (10, 10, 10), 1240.0, "PLA"),
+                                                    ((20, 0, 0), (30, 10, 10), 1240.0, "PLA")])
+    assert mass_properties(path).mass == pytest.approx(2 * 1.24e-3, rel=1e-12)
+    assert mass_properties(path, material="steel").mass == pytest.approx(2 * 7.85e-3, rel=1e-12)
+    assert main(["analyze", str(path), "--density", "1.1g/cm3", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["mass"] == pytest.approx(2 * 1.1e-3, rel=1e-12)
+    unknown = basematerials_3mf(tmp_path / "unknown.3mf", [((0, 0, 0), (10, 10, 10), None, "Generic Filament")])
+    assert mass_properties(unknown, material="petg").mass == pytest.approx(1.27e-3, rel=1e-12)
 
 
 def test_overlapping_parts_of_different_materials_are_warned_with_the_shared_volume(tmp_path):

@@ -3,7 +3,9 @@
 A file that names materials per part (:mod:`inertia_tool.mesh.parts`) is integrated part by part, each with
 its own density, and the parts are joined by :func:`~inertia_tool.mass.properties.combine` (masses add; each
 central tensor is moved to the common centre of mass by the parallel-axis theorem, Chapter 4 "Rigid Body
-Motion", Eq. (4.16)).  The density of a part is decided by one rule, first match wins:
+Motion", Eq. (4.16)).  A file whose parts are all of one material (or none), given ``density`` or ``material``
+and no ``material_map``, takes that for all of them, as any file of one material does.  Otherwise the density
+of a part is decided by one rule, first match wins:
 
 1. ``material_map`` names the part (by any of its ``addresses``: its name, ``object ID``);
 2. ``material_map`` names the part's material (case and spacing ignored);
@@ -141,7 +143,10 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
     InvalidMeshError
         A slicer's negative volume (subtracted material): not supported.
     UsageError
-        A default that would apply to no part (every part has a material of its own).
+        A default that would apply to no part (every part has a material of its own, of several materials).
+
+    A file whose parts are all of one material (or none) takes a given ``density``/``material`` for all of
+    them, as a file of one material does (without ``material_map``).
     """
     where = raw.source
     mapping = {normalise_name(k): (k, v) for k, v in (material_map or {}).items()}
@@ -149,6 +154,10 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
     specs: list[dict[str, Any]] = []
     skipped = []
     any_material = any(t.material is not None for t in raw.parts)
+    # a file of one material (a slicer project printed in one filament): a given density or material is the
+    # user's word for all of it, as for any file of one material; several materials need `material_map`
+    kinds = {None if t.material is None else normalise_name(t.material) for t in raw.parts if t.role == "part"}
+    override = (density is not None or material is not None) and not mapping and len(kinds) == 1
     for tag, part in split_parts(raw):
         if tag.role == "negative":
             raise InvalidMeshError(f"{where}: part {tag.name!r} is a negative volume (material the slicer "
@@ -157,7 +166,11 @@ def material_parts(raw: RawMesh, *, material_map: Mapping[str, float | str] | No
         if tag.role != "part":
             skipped.append(f"{tag.name!r} ({tag.role})")
             continue
-        rho, label, how = _decide(tag, where, mapping, used, density, material, any_material)
+        if override:
+            rho = density if density is not None else material_density(str(material))
+            label, how = material or "", "the file's default"
+        else:
+            rho, label, how = _decide(tag, where, mapping, used, density, material, any_material)
         specs.append({"source": part, "density": rho, "name": tag.name, "material_label": label,
                       "decided_by": how, "file_part": True})
     if skipped:
