@@ -436,3 +436,11 @@ def test_overlapping_parts_of_one_material_are_united(tmp_path, recwarn):
                              ((30 * mm, 0, 0), (40 * mm, 10 * mm, 10 * mm), 7850.0)]), rtol=1e-9)
     assert [b.name for b in props.parts] == ["a + b", "c"]
     assert not [w for w in recwarn if issubclass(w.category, OverlapWarning) and "parts overlap" in str(w.message)]
+
+
+def test_spin_it_refuses_a_file_of_several_materials(tmp_path, capsys):
+    """spin-it hollows one material: a multi-material input would be designed as one density, silently."""
+    path = basematerials_3mf(tmp_path / "two.3mf", [((0, 0, 0), (10, 10, 10), None, "PLA"),
+                                                    ((20, 0, 0), (30, 10, 10), None, "steel")])
+    assert main(["spin-it", str(path), "--material", "pla", "--axis", "0,0,1", "--wall", "1mm"]) == 2
+    assert "several" in capsys.readouterr().err
