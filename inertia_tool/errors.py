@@ -64,6 +64,7 @@ __all__ = [
     "ImplausibleCorrectionWarning",
     "ImplausiblePointWarning",
     "StoragePrecisionWarning",
+    "NonMaterialVolumeWarning",
 ]
 
 
@@ -273,3 +274,9 @@ class StoragePrecisionWarning(InertiaToolWarning):
     far from the origin, or is so thin, that this rounding alone bounds the volume only loosely: the stored mesh
     is integrated exactly, but it is not the drawn part to the digits reported.  The message gives the bound
     (:mod:`inertia_tool.mesh.precision`)."""
+
+
+class NonMaterialVolumeWarning(InertiaToolWarning):
+    """A slicer project holds volumes that are not material (PrusaSlicer's modifiers, support blockers and
+    enforcers; Bambu Studio's modifier parts): they change how the slicer prints, not what is printed, and
+    are left out of the mass properties."""

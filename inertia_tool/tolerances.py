@@ -82,3 +82,11 @@ ESTIMATE_MAX_MASS_RTOL = 0.5
 #: Repair: a surface more than this share of whose faces share no edge with another face is a soup (loose
 #: triangles, not a surface with holes); its solid is read from the winding number, not by patching loops.
 SOUP_BOUNDARY_SHARE = 0.5
+
+#: Two parts of an assembly (a multi-material file, FILE:material files) overlap when the volume they share is
+#: more than this fraction of the smaller one's: then the shared volume is counted once per part, and an
+#: :class:`~inertia_tool.errors.OverlapWarning` names the parts, their materials and the shared volume.  Parts
+#: that only touch (an insert in its pocket) share a sliver from the rounding of their written coordinates: a
+#: text file with 6 to 9 significant digits moves a face by 1e-9 to 1e-6 of the part's size, and spin-it's own
+#: insert shares 1.6e-10 of its volume with the part as written before coordinates were written in full.
+PART_OVERLAP_RTOL = 1e-7

@@ -101,10 +101,14 @@ defs["mesh_report"] = obj({
     ["source", "units", "faces", "bodies", "cavities", "watertight", "repaired", "bbox_min", "bbox_max", "method",
      "uncertainty"], "Mesh diagnostics: what the checks found and what was done (lengths m).")
 defs["body"] = obj({"name": SN, "mass": N, "volume": NN, "center_of_mass": V3, "inertia": M3,
+                    "material": d("the part's material name (a 3MF base material, a slicer's filament type, "
+                                  "FILE:material); null when its density was given as a number", SN),
+                    "density": d("kg/m^3 of this body", NN),
                     "method": ref("method"), "uncertainty": ref("uncertainty"), "certificate": ref("certificate")},
                    ["name", "mass", "center_of_mass", "inertia"],
-                   "One body of a mesh or one part of an assembly: kg, m^3, m; inertia kg*m^2 about its own centre "
-                   "of mass, mesh axes.")
+                   "One body of a mesh or one part of an assembly (a multi-material file's parts, FILE:material "
+                   "files): kg, m^3, m; inertia kg*m^2 about its own centre of mass, mesh axes. The whole's values "
+                   "are the parts' sum about the common centre of mass (parallel-axis theorem).")
 MP = {
     "name": SN,
     "units": ref("units"),

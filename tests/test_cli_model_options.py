@@ -30,13 +30,14 @@ def _option_order(command):
 
 
 def test_model_options_in_the_same_order_everywhere():
-    model = ["--units", "--density", "--material", "--mass", "--model", "--thickness", "--shell", "--infill",
-             "--repair", "--overlap", "--merge-tolerance", "--max-faces"]
+    model = ["--units", "--density", "--material", "--mass", "--material-map", "--model", "--thickness", "--shell",
+             "--infill", "--repair", "--overlap", "--merge-tolerance", "--max-faces"]
     for command in MODEL_COMMANDS:
         order = _option_order(command)
         assert order[:len(model)] == model, command
     batch = _option_order("batch")
-    assert batch[:8] == [o for o in model if o not in ("--model", "--thickness", "--shell", "--infill")]
+    assert batch[:8] == [o for o in model if o not in ("--material-map", "--model", "--thickness", "--shell",
+                                                       "--infill")]
 
 
 @pytest.mark.parametrize("model", [["--model", "shell", "--thickness", "1mm"], ["--shell", "1mm", "--infill", "20%"]])

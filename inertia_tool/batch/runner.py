@@ -347,15 +347,20 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
             props = mass_properties(path, density=options.density, material=options.material, mass=options.mass,
                                     options=options.load)
         pa = props.principal
-        mesh = cast(MeshReport, props.mesh)         # MassProperties.mesh is typed `object`
         numbers = np.concatenate(([props.density, props.mass, props.volume, props.surface_area],
                                   props.center_of_mass, np.asarray(props.inertia)[_TENSOR_ENTRIES], pa.moments,
                                   np.asarray(pa.axes).T.ravel()))                 # axis k = column k of `axes`
         row.update(zip(_NUMBER_FIELDS, [v if math.isfinite(v) else None for v in numbers.tolist()]))
+        if props.mesh is None:           # a multi-material file: its parts, each with its own mesh report
+            row.update(_parts_fields(props))
+            described = "per part (the file's materials)"
+        else:
+            mesh = props.mesh
+            row.update(method=mesh.method, **_bounds(mesh.uncertainty), faces=int(mesh.faces),
+                       bodies=int(mesh.bodies), cavities=int(mesh.cavities), watertight=bool(mesh.watertight),
+                       repaired=bool(mesh.repaired), certificate=mesh.certificate.kind)
         row.update(
-            status="ok", density_source=described, method=mesh.method, **_bounds(mesh.uncertainty),
-            faces=int(mesh.faces), bodies=int(mesh.bodies), cavities=int(mesh.cavities),
-            watertight=bool(mesh.watertight), repaired=bool(mesh.repaired), certificate=mesh.certificate.kind,
+            status="ok", density_source=described,
             warnings=" | ".join(_one_line(w.message) for w in caught
                                 if issubclass(w.category, InertiaToolWarning)) or None,
         )
@@ -365,6 +370,24 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
         row.update(status="internal_error", error_type=type(exc).__name__, error=row_path(_one_line(exc)))
     row["seconds"] = round(time.perf_counter() - start, 6)
     return row
+
+
+def _parts_fields(props) -> dict:
+    """The mesh columns of a file integrated part by part (:mod:`inertia_tool.mass.materials`): counts added,
+    ``method`` the parts' common one (``mixed`` when they differ), the weakest part's certificate, and the
+    mass bound the parts' give (the largest relative one; the others are per part only)."""
+    from ..mesh.policy import CERTIFICATE_KINDS
+    reports = [cast(MeshReport, p.mesh) for p in props.parts]
+    methods = {r.method for r in reports}
+    masses = [getattr(r.uncertainty, "mass", None) for r in reports if r.uncertainty is not None]
+    bounds: dict[str, float | None] = {f"uncertainty_{k}": None for k in _UNCERTAINTY}
+    finite = [float(m) for m in masses if m is not None and math.isfinite(m)]
+    bounds["uncertainty_mass"] = max(finite) if finite else None
+    return dict(method=methods.pop() if len(methods) == 1 else "mixed", **bounds,
+                faces=sum(int(r.faces) for r in reports), bodies=sum(int(r.bodies) for r in reports),
+                cavities=sum(int(r.cavities) for r in reports), watertight=all(r.watertight for r in reports),
+                repaired=any(r.repaired for r in reports),
+                certificate=max((r.certificate.kind for r in reports), key=CERTIFICATE_KINDS.index))
 
 
 def _bounds(uncertainty) -> dict:

@@ -61,7 +61,8 @@ def run(args) -> int:
     check_report_path(args)
     loaded = load_model(args)
     props, described, model, messages = loaded.props, loaded.density_source, loaded.model, list(loaded.warnings)
-    cad = _brep_section(args)
+    # a STEP assembly of several parts is integrated part by part (each its material): no single B-rep to compare
+    cad = _brep_section(args) if not any(m.parts for m in loaded.meshes) else None
     if cad is not None:           # STEP/IGES: the exact B-rep is the headline, the tessellation a second line
         target = density_and_mass(args)[1]
         props = cad.scaled(props, target_mass=target)

@@ -38,7 +38,8 @@ from ..units import LENGTH_UNITS, MATERIALS, parse_density, parse_fraction, pars
 from .options import check_option, density_and_mass
 
 __all__ = ["add_files_argument", "add_model_options", "add_material_options", "add_mesh_options",
-           "split_part_spec", "length_unit", "load_options_from_args", "read_meshes", "load_model",
+           "add_material_map_option", "parse_material_map", "split_part_spec",
+           "length_unit", "load_options_from_args", "read_meshes", "load_model",
            "LoadedModel", "model_words", "with_warnings", "command_parser", "recorded_warnings"]
 
 FILES_HELP = ("mesh file(s): STL, OBJ, PLY, OFF, 3MF; several FILE:material or FILE:density make an "
@@ -62,6 +63,37 @@ def add_material_options(parser) -> None:
     m.add_argument("--material", metavar="NAME", help=f"material name: {', '.join(sorted(MATERIALS))}")
     m.add_argument("--mass", metavar="MASS", help="total mass the part should have, kg unless a unit is given "
                                                   "(e.g. 412g); the implied density is printed")
+
+
+def add_material_map_option(parser) -> None:
+    """``--material-map NAME=MATERIAL|DENSITY``: materials of the parts inside one file (repeatable)."""
+    parser.add_argument("--material-map", action="append", default=None, metavar="NAME=MATERIAL",
+                        help="density of the parts of a multi-material file (3MF base materials, PrusaSlicer or "
+                             "Bambu Studio filaments, STEP assembly parts): NAME is a part name, 'object ID' "
+                             "(3MF) or a material name the file uses; the value a material (steel) or a "
+                             "density (1.24g/cm3); repeat for several. A material the tool cannot map is an "
+                             "error naming it")
+
+
+def parse_material_map(args) -> dict[str, float | str]:
+    """``--material-map`` entries → ``{name: density kg/m³ or material name}`` (a repeated name is refused)."""
+    out: dict[str, float | str] = {}
+    for entry in getattr(args, "material_map", None) or ():
+        name, sep, value = str(entry).partition("=")
+        name, value = name.strip(), value.strip()
+        if not sep or not name or not value:
+            raise UsageError(f"--material-map takes NAME=MATERIAL or NAME=DENSITY (e.g. insert=steel or "
+                             f"PLA=1.24g/cm3), got {entry!r}")
+        if name in out:
+            raise UsageError(f"--material-map names {name!r} twice")
+        try:
+            out[name] = check_option("--density", parse_density(value), typed=value,
+                                     label=f"the density of {name} (--material-map)")
+        except UsageError as exc:
+            if any(c.isdigit() for c in value[:1]):
+                raise exc from None
+            out[name] = value                   # a material name, checked against the table where it is used
+    return out
 
 
 def add_thin_wall_options(parser) -> None:
@@ -95,9 +127,11 @@ def add_mesh_options(parser) -> None:
 def add_model_options(parser, *, thin_walls: bool = True) -> None:
     """Every model option, in the order all commands list them: units and material, mass model, mesh checks.
 
-    ``thin_walls=False`` leaves out ``--model``/``--shell`` (``batch``, which analyses solids only)."""
+    ``thin_walls=False`` leaves out ``--model``/``--shell`` and ``--material-map`` (``batch``, which analyses
+    solids only, one material per file)."""
     add_material_options(parser)
     if thin_walls:
+        add_material_map_option(parser.add_argument_group("multi-material files"))
         add_thin_wall_options(parser)
     add_mesh_options(parser)
 
@@ -279,9 +313,10 @@ def _load(args, meshes):
         return props, described, model_summary("solid")
     from ..mass.thinwall import printed_part, shell_mass_properties    # imported on use: solids do without
     files = _files(args)
-    if len(files) != 1 or split_part_spec(files[0])[1] is not None:
-        raise UsageError("the shell and printed-part models take one mesh file with --density, --material or "
-                         "--mass, not an assembly (FILE:material)")
+    if len(files) != 1 or split_part_spec(files[0])[1] is not None or meshes[0].parts:
+        raise UsageError("the shell and printed-part models take one mesh file of one material with --density, "
+                         "--material or --mass, not an assembly (FILE:material, or a file that names several "
+                         "parts or materials)")
     options = load_options_from_args(args)
     density, mass = density_and_mass(args)
     _, described = resolve_density(density=density, material=args.material, mass=mass)
@@ -301,12 +336,18 @@ def _load_solid(args, meshes):
 
     In an assembly, a global ``--density``/``--material`` is the default of the parts named without their own
     ``:material`` or ``:density`` (the description says so); when every part has its own, a global one would
-    be ignored and is refused as contradictory (:class:`UsageError`).
+    be ignored and is refused as contradictory (:class:`UsageError`).  A file that names materials per part
+    (:mod:`inertia_tool.mesh.parts`) is split into its parts, each with the density of the rule of
+    :mod:`inertia_tool.mass.materials` (``--material-map``, the file's densities, the material table); its
+    ``FILE:material`` or the global option is the default of its parts without a material.
     """
+    from ..mass.materials import material_parts, unused_map_keys
     options = load_options_from_args(args)
     density, mass = density_and_mass(args)
+    material_map = parse_material_map(args)
     specs = [(raw, what) for raw, (_, what) in zip(meshes, (split_part_spec(f) for f in _files(args)))]
-    if len(specs) == 1 and specs[0][1] is None:
+    if len(specs) == 1 and specs[0][1] is None and not specs[0][0].parts:
+        unused_map_keys(material_map, (), meshes)
         _, described = resolve_density(density=density, material=args.material, mass=mass)
         props = mass_properties(specs[0][0], density=density, material=args.material, mass=mass, options=options)
         return props, described + _implied(props, mass)
@@ -318,8 +359,15 @@ def _load_solid(args, meshes):
                              "(drop the option, or name a part without its own to give it this default)")
         default, default_text = resolve_density(density=density, material=args.material)
     parts, own = [], []
+    used: set[str] = set()
     for raw, what in specs:
-        if what is not None:
+        if raw.parts:                   # a multi-material file: its parts, FILE:material their default
+            given = _part_density(what, raw) if what is not None else (
+                {"density": density} if density is not None else
+                {"material": args.material} if args.material is not None else {})
+            parts += material_parts(raw, material_map=material_map, used=used, **given)
+            own.append(what or "per part")
+        elif what is not None:
             parts.append({"source": raw, **_part_density(what, raw)})
             own.append(what)
         elif density is not None:
@@ -328,15 +376,20 @@ def _load_solid(args, meshes):
             parts.append({"source": raw, "material": args.material})
         else:
             parts.append({"source": raw})
-    props = assembly(parts, mass=mass, options=options)
-    if len(specs) == 1:
+    unused_map_keys(material_map, used, meshes)
+    defaulted = [spec["name"] for spec in parts if spec.pop("decided_by", None) == "default (water)"]
+    props = assembly(parts, mass=mass, options=options,
+                     name=meshes[0].source if len(meshes) == 1 and meshes[0].parts else "assembly")
+    if len(specs) == 1 and not specs[0][0].parts:
         described = resolve_density(**_part_density(own[0]))[1]
     else:
-        described = "per part"
+        described = "per part" + (" (the file's materials; see the parts)" if any(r.parts for r in meshes) else "")
         if default is not None:
             described += f"; {default_text} for the parts without their own"
-        elif len(own) < len(specs):
-            described += f"; {DEFAULT_DENSITY:g} kg/m³ (water) for the parts without their own"
+        elif len(own) < len(specs) or defaulted:
+            described += (f"; {DEFAULT_DENSITY:g} kg/m³ (default: water) for the parts without their own"
+                          + (f" ({', '.join(defaulted)}): give --material, --density or --material-map"
+                             if defaulted else ""))
     if mass is not None:
         described += f", scaled to a total mass of {mass:g} kg" + _implied(props, mass).replace(":", ";", 1)
     return props, described

@@ -88,14 +88,16 @@ def _insert_density(text: str) -> float:
     return check_option("--density", density, typed=text, label="--insert")
 
 
-def _write_two_materials(path: str, result, material: str, insert: str) -> None:
+def _write_two_materials(path: str, result, material: str, insert: str, insert_density: float) -> None:
+    """The hollowed part and its insert as a two-material 3MF, each material with the density used (kg/m³),
+    so that ``analyze`` of the file gives back the same mass properties."""
     from ..reports.mesh_3mf import write_3mf
     mm = length_scale("mm")
     write_3mf(path, [
         {"name": "part", "material": material, "color": "#9CC3E6FF", "vertices": result.vertices / mm,
-         "faces": result.faces},
+         "faces": result.faces, "density": float(result.before.density)},
         {"name": "insert", "material": insert, "color": "#595959FF", "vertices": result.insert_vertices / mm,
-         "faces": result.insert_faces}], label="--out")
+         "faces": result.insert_faces, "density": float(insert_density)}], label="--out")
 
 
 def _write(path: str, vertices, faces, units: str) -> None:
@@ -190,7 +192,7 @@ def run(args) -> int:
                                             resolution=args.resolution, insert_density=insert_density,
                                             repair=bool(getattr(args, "repair", False)))
     if args.out and result.insert_vertices is not None:
-        _write_two_materials(args.out, result, args.material or "part", args.insert)
+        _write_two_materials(args.out, result, args.material or "part", args.insert, float(insert_density or 0.0))
     elif args.out:
         _write(args.out, result.vertices, result.faces, unit)
     if args.plot:

@@ -255,6 +255,12 @@ def _load(source, units: str | None, density, material, mass, repair: bool = Fal
     from ..mesh.plausibility import warn_implausible_size
 
     raw = load_mesh(source, units=units)
+    kinds = {(t.material, t.density) for t in raw.parts if t.role == "part"}
+    if len(kinds) > 1:          # a multi-material file (mesh/parts.py) would be hollowed as one density
+        from ..errors import UsageError
+        listed = ", ".join(sorted(f"{t.name} ({t.material})" for t in raw.parts if t.role == "part"))[:300]
+        raise UsageError(f"{raw.source}: spin-it designs a part of one material, and the file holds parts of "
+                         f"several ({listed}); export the part alone")
     warn_implausible_size(raw, stacklevel=4)
     prepared = prepare_mesh(raw, repair=repair)
     props = mass_properties((prepared.vertices, prepared.faces), density=rho, mass=mass, name=raw.source,

@@ -9,6 +9,8 @@ that are a choice (equal moments) or at round-off (needles).
 
 from __future__ import annotations
 
+import dataclasses
+import os
 import warnings
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, TypeAlias
 
@@ -18,20 +20,18 @@ from ..errors import InvalidMeshError, NearlyEqualMomentsWarning, OverlapWarning
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.precision import warn_storage_precision
+from ..mesh.overlap import shared_volumes
 from ..mesh.prepare import PreparedMesh, classify_shells, prepare_mesh
-from ..mesh.read import load_mesh
-from ..tolerances import NEEDLE_RTOL, TRIANGLE_INEQUALITY_RTOL
+from ..mesh.read import RawMesh, load_mesh
+from ..tolerances import NEEDLE_RTOL, PART_OVERLAP_RTOL, TRIANGLE_INEQUALITY_RTOL
 from ..units import material_density
 from .properties import MassProperties, combine
 from ..integrals import VolumeMoments, second_moment_to_inertia
 
 if TYPE_CHECKING:  # pragma: no cover
-    import os
-
     import trimesh
     from numpy.typing import ArrayLike
 
-    from ..mesh.read import RawMesh
 
 __all__ = ["mass_properties", "assembly", "resolve_density", "DEFAULT_DENSITY"]
 
@@ -129,7 +129,7 @@ def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassPrope
 
 def mass_properties(source: MeshSource, *, density: float | None = None, material: str | None = None,
                     mass: float | None = None, name: str | None = None, options: LoadOptions | None = None,
-                    **load_options: Any) -> MassProperties:
+                    material_map: Mapping[str, float | str] | None = None, **load_options: Any) -> MassProperties:
     """Mass properties of the solid bounded by a triangle mesh, exact for the polyhedron.
 
     Parameters
@@ -147,6 +147,12 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
         Label for reports; defaults to the source.
     options : LoadOptions, optional
         How to read and check the mesh (units, repair, merge tolerance, face limit).
+    material_map : mapping of str to float or str, optional
+        For a file (a path) that names materials per part (a 3MF with base materials or slicer filaments, a STEP
+        assembly): part name, ``object ID`` or material name → density (kg/m³) or material name.  Such a file
+        is integrated part by part (:mod:`inertia_tool.mass.materials` gives the rule that decides each
+        density; ``density``/``material`` are then the default of the parts the file names no material for)
+        and the result's ``parts`` are the parts.
     **load_options
         Fields of :class:`~inertia_tool.mesh.options.LoadOptions` (``units="mm"``, ``repair=True``, ...),
         a shortcut that overrides those of ``options``.
@@ -163,6 +169,23 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
     """
     opts = LoadOptions.build(options, **load_options)
     rho, _ = resolve_density(density=density, material=material, mass=mass)
+    if isinstance(source, (str, bytes, os.PathLike)):
+        # a file is read here once: when it names materials per part, they decide (a RawMesh passed in is
+        # integrated as one solid of the given density, whatever parts it lists: robot geometry at unit density)
+        raw = load_mesh(source, units=opts.units, max_faces=opts.max_faces,
+                        declared_units_win=opts.declared_units_win)
+        if raw.parts or material_map:       # a multi-material file: its parts, each with its own density
+            from .materials import material_parts, unused_map_keys
+            used: set[str] = set()
+            specs = material_parts(raw, material_map=material_map, density=density, material=material, used=used)
+            unused_map_keys(material_map, used, [raw])
+            for spec in specs:
+                spec.pop("decided_by", None)
+            return assembly(specs, mass=mass, options=opts, name=name or raw.source)
+        source = raw
+    elif material_map:
+        raise UsageError("`material_map` applies to a file that names parts or materials (give its path), not to "
+                         f"{type(source).__name__}")
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):   # non-finite results refused below
         return _part(source, rho, mass, opts, name=name)[0]
 
@@ -211,7 +234,7 @@ def _check_physical(props: MassProperties, rtol: float = TRIANGLE_INEQUALITY_RTO
 
 
 def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, options: LoadOptions | None = None,
-             **load_options: Any) -> MassProperties:
+             name: str = "assembly", **load_options: Any) -> MassProperties:
     """Combine several meshes, each with its own material, into one rigid body.
 
     Parameters
@@ -219,37 +242,48 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
     parts : iterable of dict
         Each ``{"source": path_or_mesh, "density": kg/m³}``, ``{"source": ..., "material": name}`` or
         ``{"source": ..., "mass": kg}``
-        (optionally ``"units"`` and ``"name"``; a part's ``"units"`` overrides the options' units).
+        (optionally ``"units"``, ``"name"`` and ``"material_label"``, the material's name for reports when the
+        density is given as a number; a part's ``"units"`` overrides the options' units; ``"file_part": True``
+        for a part of a multi-material file, which keeps even a single part listed in ``parts``).
     mass : float, optional
         Scale the whole assembly to this total mass (kg), keeping the density ratios.
     options : LoadOptions, optional
         How to read and check every part.
+    name : str
+        Label of the whole for reports.
     **load_options
         Fields of :class:`~inertia_tool.mesh.options.LoadOptions`, overriding those of ``options``.
     """
     opts = LoadOptions.build(options, **load_options)
     bodies: list[MassProperties] = []
     meshes: list[PreparedMesh] = []
+    file_parts = False
     for spec in parts:
         spec = dict(spec)
+        file_parts |= bool(spec.pop("file_part", False))
         src = spec.pop("source")
         part_mass = spec.pop("mass", None)
-        rho, _ = resolve_density(density=spec.pop("density", None), material=spec.pop("material", None),
-                                 mass=part_mass)
+        material = spec.pop("material", None)
+        label = spec.pop("material_label", None) or material or ""
+        rho, _ = resolve_density(density=spec.pop("density", None), material=material, mass=part_mass)
         part_options = opts.replace(units=spec.pop("units")) if "units" in spec else opts
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             # equal moments of one part say nothing about the assembly: checked once on the whole below
             props, prepared = _part(src, rho, part_mass, part_options, name=spec.pop("name", None),
                                     warn_principal=False)
+        if label:
+            props = dataclasses.replace(props, material=str(label))
         bodies.append(props)
         meshes.append(prepared)
     if not bodies:
         raise UsageError("Expected at least one part in the assembly")
-    if len(bodies) == 1:
+    if len(bodies) == 1 and not file_parts:
         total = bodies[0]
+    elif len(bodies) == 1:                 # one part of a multi-material file: the parts table still shows it
+        total = combine(bodies, name=name)
     else:
-        total = combine(bodies, name="assembly")
-        _warn_about_part_overlaps(meshes, [b.name for b in bodies])
+        total = combine(bodies, name=name)
+        _warn_about_part_overlaps(meshes, [b.name for b in bodies], [b.material for b in bodies])
     if mass is not None:
         total = total.with_mass(mass)
         warn_implausible_density(total.name, total.mass / total.volume, mass, total.volume)
@@ -257,12 +291,15 @@ def assembly(parts: Iterable[Mapping[str, Any]], *, mass: float | None = None, o
     return total
 
 
-def _warn_about_part_overlaps(meshes: list[PreparedMesh], names: list[str]) -> None:
+def _warn_about_part_overlaps(meshes: list[PreparedMesh], names: list[str], materials: list[str] | None = None,
+                              rtol: float = PART_OVERLAP_RTOL) -> None:
     """Warn when the parts of an assembly overlap each other (their shared volume counts twice).
 
     The parts' checked meshes are put side by side and the shell classification of :func:`prepare_mesh` is
-    run on the whole: bodies found inside another body beyond those already inside their own part overlap
-    across parts.
+    run on the whole: bodies found inside another body beyond those already inside their own part may overlap
+    across parts.  Then the volume each pair shares is measured (:func:`~inertia_tool.mesh.overlap.shared_volumes`);
+    pairs sharing at most ``rtol`` of the smaller part only touch (coincident faces, written coordinates
+    rounded) and are not reported.  When the measure is not available, the classification's word stands.
     """
     offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
     label_offsets = np.cumsum([0] + [len(m.shells) for m in meshes[:-1]])
@@ -273,6 +310,23 @@ def _warn_about_part_overlaps(meshes: list[PreparedMesh], names: list[str]) -> N
     diag = float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
     _, _, _, overlaps = classify_shells(vertices, faces, labels, len(shells), shells, diag)
     within = sum(m.report.overlapping_shells for m in meshes)
-    if overlaps > within:
+    if overlaps <= within:
+        return
+    shared = shared_volumes([(m.vertices, m.faces) for m in meshes]) if all(
+        m.report.watertight for m in meshes) else None
+    if shared is None:
         warnings.warn(OverlapWarning(f"assembly of {', '.join(names)}: parts overlap each other; the shared "
                                      "volume is counted once per part"), stacklevel=3)
+        return
+    volumes = [abs(sum(s.volume for s in m.shells)) for m in meshes]
+    found = [(i, j, v) for (i, j), v in shared.items() if v > rtol * max(min(volumes[i], volumes[j]), 0.0)]
+    if not found:
+        return
+    materials = materials or [""] * len(names)
+
+    def who(k: int) -> str:
+        return f"{names[k]} ({materials[k]})" if materials[k] else names[k]
+    pairs = "; ".join(f"{who(i)} and {who(j)} share {v:.4g} m³ ({100 * v / min(volumes[i], volumes[j]):.3g}% of the "
+                      "smaller)" for i, j, v in found)
+    warnings.warn(OverlapWarning(f"assembly of {', '.join(names)}: parts overlap: {pairs}; the shared volume is "
+                                 "counted once per part (its mass with each part's density)"), stacklevel=3)

@@ -122,6 +122,9 @@ class MassProperties:
         Mesh diagnostics (``inertia_tool.mesh.checks.MeshReport``) when the body came from a mesh.
     parts : tuple of MassProperties
         The bodies this one was combined from (disconnected shells of a mesh, parts of an assembly).
+    material : str
+        The material's name, for reports: ``"steel"``, a 3MF base material, a slicer's filament type; empty
+        when the density was given as a number or for a combination.
     """
 
     mass: float
@@ -133,6 +136,7 @@ class MassProperties:
     name: str = ""
     mesh: Optional["MeshReport"] = field(default=None, repr=False, compare=False)
     parts: tuple[MassProperties, ...] = field(default=(), repr=False, compare=False)
+    material: str = field(default="", repr=False, compare=False)
 
     def __post_init__(self) -> None:
         com = np.array(self.center_of_mass, dtype=np.float64).reshape(3)
@@ -242,7 +246,8 @@ class MassProperties:
         return MassProperties(mass=mass, volume=self.volume, center_of_mass=self.center_of_mass,
                               inertia=self.inertia * k, surface_area=self.surface_area,
                               density=self.density * k, name=self.name, mesh=self.mesh,
-                              parts=tuple(p.with_mass(p.mass * k) for p in self.parts if p.mass > 0))
+                              parts=tuple(p.with_mass(p.mass * k) for p in self.parts if p.mass > 0),
+                              material=self.material)
 
     def __add__(self, other: "MassProperties") -> "MassProperties":
         if not isinstance(other, MassProperties):

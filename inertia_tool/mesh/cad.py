@@ -43,7 +43,7 @@ if TYPE_CHECKING:
 
 __all__ = ["BREP_SUFFIXES", "DEFAULT_CHORD_RTOL", "DEFAULT_ANGULAR_DEFLECTION", "read_brep", "tessellate",
            "chord_tolerance", "tessellated_arrays", "has_ocp", "read_cad", "CadReading", "solids_fused",
-           "brep_integrals", "FUSIONS"]
+           "brep_integrals", "FUSIONS", "step_parts", "MAX_ASSEMBLY_DEPTH", "MAX_ASSEMBLY_PARTS"]
 
 #: How :func:`solids_fused` made one solid of a file's solids.
 FUSIONS = ("one solid", "apart", "fused", "failed")
@@ -123,6 +123,130 @@ def read_brep(path: str | os.PathLike[str]) -> object:
     if shape is None or shape.IsNull():
         raise _fail(path, "holds no shape")
     return shape
+
+
+#: Deepest assembly nesting followed in a STEP file's XCAF document (a cycle or a pathological file stops there).
+MAX_ASSEMBLY_DEPTH = 32
+#: Most parts (leaf shape instances) read from one STEP assembly.
+MAX_ASSEMBLY_PARTS = 10_000
+
+
+def _label_name(label: Any) -> str | None:
+    from OCP.TDataStd import TDataStd_Name
+    attribute = TDataStd_Name()
+    if label.FindAttribute(TDataStd_Name.GetID_s(), attribute):
+        text = attribute.Get().ToExtString()
+        return str(text) if text else None
+    return None
+
+
+def _label_entry(label: Any) -> str:
+    from OCP.TCollection import TCollection_AsciiString
+    from OCP.TDF import TDF_Tool
+    entry = TCollection_AsciiString()
+    TDF_Tool.Entry_s(label, entry)
+    return str(entry.ToCString())
+
+
+def _materials_by_shape(doc: Any) -> dict[str, tuple[str, float | None]]:
+    """Shape label entry → (material name, density kg/m³ or None) of the XCAF document's materials.
+
+    OpenCASCADE keeps a material's density as written in the STEP ``material property`` (its own writer puts
+    g/cm³ there, and ``XCAFDoc_MaterialTool::GetDensityForShape`` reads it so); taken as g/cm³, a value that
+    gives no plausible solid density (:data:`inertia_tool.units.PLAUSIBLE_DENSITY`) is dropped and the part is
+    then mapped by its material's name.  Each material's tree node lists the shapes that use it."""
+    from OCP.OCP.collections import Sequence_TDF_Label
+    from OCP.TDataStd import TDataStd_TreeNode
+    from OCP.XCAFDoc import XCAFDoc, XCAFDoc_DocumentTool, XCAFDoc_Material
+    from ..units import PLAUSIBLE_DENSITY
+    out: dict[str, tuple[str, float | None]] = {}
+    materials = Sequence_TDF_Label()
+    XCAFDoc_DocumentTool.MaterialTool_s(doc.Main()).GetMaterialLabels(materials)
+    for i in range(1, min(materials.Length(), MAX_ASSEMBLY_PARTS) + 1):
+        label = materials.Value(i)
+        material = XCAFDoc_Material()
+        node = TDataStd_TreeNode()
+        if not (label.FindAttribute(XCAFDoc_Material.GetID_s(), material)
+                and label.FindAttribute(XCAFDoc.MaterialRefGUID_s(), node)):
+            continue
+        name = material.GetName().ToCString() if material.GetName() is not None else ""
+        density: float | None = float(material.GetDensity()) * 1000.0
+        if not (density is not None and PLAUSIBLE_DENSITY[0] <= density <= PLAUSIBLE_DENSITY[1]):
+            density = None
+        child = node.First() if node.HasFirst() else None
+        for _ in range(MAX_ASSEMBLY_PARTS):
+            if child is None:
+                break
+            out[_label_entry(child.Label())] = (str(name) or f"material {i}", density)
+            child = child.Next() if child.HasNext() else None
+    return out
+
+
+def step_parts(path: str) -> list[tuple[str, str | None, float | None, Any]]:
+    """The parts of a STEP assembly through OpenCASCADE's XCAF document: ``(name, material, density kg/m³ or
+    None, located shape in metres)`` for every leaf shape instance, assemblies followed down with their
+    placements composed.  One entry (or none) for a file that is not an assembly.  Needs OCP; run in the
+    isolated child only.  :func:`_read_here` integrates the parts apart only when some part has a material:
+    otherwise the solids are fused as before (the exact B-rep of their union)."""
+    try:
+        from OCP.IFSelect import IFSelect_ReturnStatus
+        from OCP.Interface import Interface_Static
+        from OCP.OCP.collections import Sequence_TDF_Label
+        from OCP.STEPCAFControl import STEPCAFControl_Reader
+        from OCP.TCollection import TCollection_ExtendedString
+        from OCP.TDF import TDF_Label
+        from OCP.TDocStd import TDocStd_Document
+        from OCP.TopLoc import TopLoc_Location
+        from OCP.XCAFDoc import XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
+    except ImportError as exc:      # as read_brep: under a memory limit, mapping the libraries fails
+        if "map segment" in str(exc) or "allocate memory" in str(exc):
+            raise MemoryError(str(exc)) from None
+        raise _fail(path, f"OCP is installed but cannot be loaded ({exc})") from None
+    reader = STEPCAFControl_Reader()
+    reader.SetNameMode(True)
+    reader.SetMatMode(True)
+    previous = Interface_Static.CVal_s("xstep.cascade.unit")
+    Interface_Static.SetCVal_s("xstep.cascade.unit", "M")
+    doc = TDocStd_Document(TCollection_ExtendedString("inertia-tool"))
+    try:
+        with _quiet():
+            if reader.ReadFile(path) != IFSelect_ReturnStatus.IFSelect_RetDone or not reader.Transfer(doc):
+                return []
+    finally:
+        Interface_Static.SetCVal_s("xstep.cascade.unit", previous or "MM")
+    materials = _materials_by_shape(doc)
+    shapes = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
+    free = Sequence_TDF_Label()
+    shapes.GetFreeShapes(free)
+    parts: list[tuple[str, str | None, float | None, Any]] = []
+
+    def walk(label: Any, location: Any, name: str | None, material: tuple[str, float | None] | None,
+             depth: int) -> None:
+        if depth > MAX_ASSEMBLY_DEPTH or len(parts) >= MAX_ASSEMBLY_PARTS:
+            raise _fail(path, f"the assembly nests deeper than {MAX_ASSEMBLY_DEPTH} or holds more than "
+                              f"{MAX_ASSEMBLY_PARTS:,} parts")
+        name = _label_name(label) or name
+        material = materials.get(_label_entry(label), material)
+        if XCAFDoc_ShapeTool.IsAssembly_s(label):
+            components = Sequence_TDF_Label()
+            XCAFDoc_ShapeTool.GetComponents_s(label, components, False)
+            for i in range(1, components.Length() + 1):
+                component = components.Value(i)
+                referred = TDF_Label()
+                if not XCAFDoc_ShapeTool.GetReferredShape_s(component, referred):
+                    continue
+                placed = location.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(component))
+                walk(referred, placed, _label_name(component) if not _label_name(referred) else None,
+                     materials.get(_label_entry(component), material), depth + 1)
+            return
+        shape = XCAFDoc_ShapeTool.GetShape_s(label)
+        if shape is not None and not shape.IsNull():
+            parts.append((name or f"part {len(parts) + 1}", material[0] if material else None,
+                          material[1] if material else None, shape.Moved(location)))
+
+    for i in range(1, free.Length() + 1):
+        walk(free.Value(i), TopLoc_Location(), None, None, 0)
+    return parts
 
 
 def _bounding_diagonal(shape: Any) -> float:
@@ -341,6 +465,10 @@ class CadReading:
     fusion : str
         How several solids became one (:func:`solids_fused`; the tessellation and ``integrals`` are of the
         result).
+    parts : tuple of (name, material or None, density kg/m³ or None, first face, stop face)
+        A STEP assembly of several parts, some with a material (:func:`step_parts`): each part tessellated on its
+        own, its face range of ``faces``; the solids are then not fused and ``integrals`` is None (each part has
+        its own material).
     """
 
     vertices: np.ndarray
@@ -351,12 +479,19 @@ class CadReading:
     solids: int = 0
     summed_volume: float = 0.0
     fusion: str = "one solid"
+    parts: tuple[tuple[str, str | None, float | None, int, int], ...] = ()
 
 
 def _read_here(path: str, chord: float | None, angular_deflection: float, use_ocp: bool,
                max_faces: int | None = None) -> dict[str, Any]:
     """Read, fuse, tessellate and integrate in this process: run only in the isolated child
     (:func:`read_cad`); returns plain values (:func:`inertia_tool.isolate.run_isolated`)."""
+    if use_ocp and os.path.splitext(path)[1].lower() in (".step", ".stp"):
+        # parts of different materials are integrated apart; without materials the solids are fused and the
+        # exact B-rep of their union is the answer, as for any STEP file
+        found = step_parts(path)
+        if len(found) > 1 and any(material is not None for _, material, _, _ in found):
+            return _assembly_here(path, found, chord, angular_deflection, max_faces)
     if use_ocp:
         shape, solids, summed, fusion = solids_fused(read_brep(path))
         try:
@@ -371,6 +506,35 @@ def _read_here(path: str, chord: float | None, angular_deflection: float, use_oc
         chord = DEFAULT_CHORD_RTOL * float(np.linalg.norm(np.ptp(v, axis=0)))
     vertices, faces = _cascadio_arrays(path, chord, angular_deflection)
     return {"vertices": vertices, "faces": faces, "chord": float(chord), "backend": "cascadio"}
+
+
+def _assembly_here(path: str, found: list[tuple[str, str | None, float | None, Any]], chord: float | None,
+                   angular_deflection: float, max_faces: int | None) -> dict[str, Any]:
+    """Tessellate each part of a STEP assembly on its own (one chord tolerance for all, from the whole)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS_Compound
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    for *_, shape in found:
+        builder.Add(compound, shape)
+    try:
+        tol = chord_tolerance(compound, chord)
+    except InvalidMeshError as exc:
+        raise _fail(path, str(exc)) from None
+    vertices, faces, parts, offset, start = [], [], [], 0, 0
+    for name, material, density, shape in found:
+        try:
+            v, f = tessellate(shape, chord=tol, angular_deflection=angular_deflection,
+                              max_faces=None if max_faces is None else max_faces - start)
+        except UsageError as exc:
+            raise _fail(path, f"part {name!r}: {exc}") from None
+        vertices.append(v)
+        faces.append(f + offset)
+        parts.append((name, material, density, start, start + len(f)))
+        offset += len(v)
+        start += len(f)
+    return {"vertices": np.vstack(vertices), "faces": np.vstack(faces), "chord": tol, "backend": "OCP",
+            "integrals": None, "solids": len(found), "summed_volume": 0.0, "fusion": "apart", "parts": parts}
 
 
 #: The last reading, keyed by the file's identity and the tolerances: ``analyze`` reads a STEP file as a mesh
@@ -417,7 +581,9 @@ def read_cad(path: str | os.PathLike[str], *, chord: float | None = None,
                          faces=np.asarray(out["faces"], dtype=np.int64), chord=float(out["chord"]),
                          backend=str(out["backend"]), integrals=out.get("integrals"),
                          solids=int(out.get("solids", 0)), summed_volume=float(out.get("summed_volume", 0.0)),
-                         fusion=str(out.get("fusion", "one solid")))
+                         fusion=str(out.get("fusion", "one solid")),
+                         parts=tuple((str(n), None if m is None else str(m), None if d is None else float(d), int(a),
+                                      int(b)) for n, m, d, a, b in out.get("parts", ())))
     _LAST[:] = [(key, reading)]
     return reading
 

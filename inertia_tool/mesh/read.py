@@ -33,6 +33,7 @@ from .scene_counts import GLTF_INSTANCE_FACES, check_collada_instances, check_gl
 from .weld import weld_exact, weld_exact_stream
 
 if TYPE_CHECKING:
+    from .parts import PartTag
     import zipfile
 
 #: What a header check found: element counts by name (``"vertex"``, ``"face"``) and, for PLY, ``"float32"``
@@ -87,6 +88,10 @@ class RawMesh:
         float32 (binary STL, PLY ``float``, glTF/GLB, COLLADA): half the float32 spacing at the largest
         coordinate (:func:`inertia_tool.mesh.precision.float32_rounding`); 0 for text and float64 formats and
         for arrays.  :func:`inertia_tool.mesh.precision.warn_storage_precision` turns it into a volume bound.
+    parts : tuple of PartTag
+        The parts of a file that names materials per part (:mod:`inertia_tool.mesh.parts`: a 3MF with base
+        materials or a slicer's filament assignments, a STEP assembly), each a range of ``faces``; empty for a
+        file of one material.
     """
 
     vertices: np.ndarray
@@ -96,6 +101,7 @@ class RawMesh:
     file_faces: int = 0
     units_assumed: bool = False
     storage_rounding: float = 0.0
+    parts: tuple[PartTag, ...] = ()
 
 
 def _display(path: str | bytes | os.PathLike[str] | os.PathLike[bytes]) -> str:
@@ -756,8 +762,10 @@ def _check_zip(path: str, max_faces: int) -> _Counts:
     return {}
 
 
-def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str]]:
-    """``(vertices, faces, declared unit)`` of a 3MF, read by the streaming reader :mod:`.threemf`.
+def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str], tuple[PartTag, ...]]:
+    """``(vertices, faces, declared unit, parts)`` of a 3MF, read by the streaming reader :mod:`.threemf`;
+    ``parts``: :func:`.parts.threemf_parts` of its materials and slicer volumes (PrusaSlicer's and Bambu Studio's
+    ``Metadata/`` configs, :mod:`.slicers`, each read whole, at most :data:`.slicers.MAX_CONFIG_BYTES`).
 
     Refused from the zip's central directory, before anything is inflated: more than
     :data:`MAX_ZIP_MEMBERS` members, an encrypted model part, a model part inflating more than
@@ -770,6 +778,8 @@ def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[
     import zipfile
     import zlib
 
+    from .parts import threemf_parts
+    from .slicers import CONFIG_MEMBERS, MAX_CONFIG_BYTES, read_slicer_config
     from .threemf import read_3mf
     try:
         with open_regular(path) as raw, zipfile.ZipFile(raw) as zf:
@@ -778,13 +788,21 @@ def _read_3mf(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[
                 _check_zip_members(path, len(infos), (), "3MF ")
             models = _model_members(path, zf, infos)
             _check_zip_members(path, len(infos), models, "3MF ")
+            configs = [i for i in infos if i.filename.lower().lstrip("/") in CONFIG_MEMBERS]
+            _check_zip_members(path, len(infos), configs, "3MF ")
+            for info in configs:
+                if info.file_size > MAX_CONFIG_BYTES:
+                    raise _fail(path, f"3MF member {info.filename[:60]!r} inflates to {info.file_size:,} bytes, "
+                                      f"more than the {MAX_CONFIG_BYTES:,} read for a slicer's settings")
             total = sum(i.file_size for i in models)
             limit = zip_inflate_limit(max_faces)
             if total > limit:
                 raise _fail(path, f"3MF model parts would inflate to {total:,} bytes, more than the {limit:,} "
                                   f"allowed for `max_faces` ({max_faces:,}); refused before inflating")
             models.sort(key=lambda i: "3d/3dmodel.model" not in i.filename.lower())     # the root model first
-            return read_3mf(path, models, zf, max_faces=max_faces, name=_display(path))
+            vertices, faces, declared, placed = read_3mf(path, models, zf, max_faces=max_faces, name=_display(path))
+            slicer = read_slicer_config({i.filename.lower().lstrip("/"): zf.read(i) for i in configs}, _display(path))
+            return vertices, faces, declared, threemf_parts(placed, slicer, _display(path))
     except RuntimeError as exc:     # zipfile: "File ... is encrypted, password required for extraction"
         raise _fail(path, f"3MF archive member cannot be read ({str(exc)[:100]})") from None
     except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError, NotImplementedError,
@@ -925,15 +943,18 @@ def _scene_rounding(loaded: object) -> float:
     return delta * norm
 
 
-def _read_with_trimesh_rounding(path: str,
-                                max_faces: int) -> tuple[np.ndarray, np.ndarray, tuple[float, str] | None, float]:
+def _read_with_trimesh_rounding(path: str, max_faces: int,
+                                parts_out: list[Any] | None = None) -> tuple[np.ndarray, np.ndarray,
+                                                                             tuple[float, str] | None, float]:
     """``(vertices, faces, declared unit, float32 rounding in file units)`` of a file trimesh reads (3MF: of
-    the streaming reader :func:`_read_3mf`)."""
+    the streaming reader :func:`_read_3mf`); a glTF scene whose primitives use named materials appends its
+    per-node parts (:func:`.parts.scene_parts`) to ``parts_out``."""
+    parts: tuple[PartTag, ...] = ()
     size = os.path.getsize(path)
     suffix = os.path.splitext(path)[1].lower()
     declared: tuple[float, str] | None
     if suffix == ".3mf":
-        v, f, declared = _read_3mf(path, max_faces)
+        v, f, declared, _ = _read_3mf(path, max_faces)
         _check_face_budget(path, len(f), max_faces)
         if not np.all(np.isfinite(v)):
             raise _fail(path, "vertices have NaN or infinite coordinates")
@@ -962,7 +983,9 @@ def _read_with_trimesh_rounding(path: str,
             quiet.setLevel(logging.CRITICAL)      # e.g. a missing texture image, logged with a traceback
             try:
                 # glTF: no textures decoded (geometry only; a textured GLB loads up to 50x faster)
-                extra: dict[str, Any] = {"skip_materials": True} if suffix in (".glb", ".gltf") else {}
+                # (unless primitives use named materials: then each node is a part with its material)
+                extra: dict[str, Any] = ({"skip_materials": not counts.get("named_materials")}
+                                         if suffix in (".glb", ".gltf") else {})
                 # the file itself, opened once (regular files only), its side files too
                 with open_regular(path) as fh:
                     loaded = trimesh.load(fh, file_type=suffix[1:], process=False, force=None,
@@ -981,6 +1004,9 @@ def _read_with_trimesh_rounding(path: str,
                 geoms = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)] if loaded.geometry else []
                 if not geoms:
                     raise _fail(path, "contains no triangle mesh (empty scene or only points/lines)")
+                if suffix in (".glb", ".gltf") and counts.get("named_materials"):
+                    from .parts import scene_parts
+                    parts = scene_parts(geoms)
                 loaded = trimesh.util.concatenate(geoms) if len(geoms) > 1 else geoms[0]
     except MeshReadError:
         raise
@@ -1010,6 +1036,8 @@ def _read_with_trimesh_rounding(path: str,
                           "(faces dropped or truncated file)")
     if not np.all(np.isfinite(v)):
         raise _fail(path, "vertices have NaN or infinite coordinates")
+    if parts_out is not None:
+        parts_out.extend(parts)
     return v, f, declared, rounding
 
 
@@ -1083,7 +1111,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                         raise MeshReadError(str(exc).replace(inner, f"{_display(path)}:{member}", 1)) from None
                 return RawMesh(vertices=raw.vertices, faces=raw.faces, source=_display(path), units=raw.units,
                                file_faces=raw.file_faces, units_assumed=raw.units_assumed,
-                               storage_rounding=raw.storage_rounding)
+                               storage_rounding=raw.storage_rounding, parts=raw.parts)
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
                                   f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
@@ -1091,6 +1119,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                 raise _fail(path, "empty file (0 bytes)")
             declared = None
             rounding = 0.0                  # file units until scaled below
+            parts: tuple[PartTag, ...] = ()
             if suffix == ".stl":
                 vertices, faces, n, binary = _read_stl(path, max_faces)
                 if binary:
@@ -1100,15 +1129,26 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "vertices have NaN or infinite coordinates")
             elif suffix in (".step", ".stp", ".iges", ".igs"):
-                from .cad import tessellated_arrays
-                vertices, faces, _, _ = tessellated_arrays(path, max_faces=max_faces)
+                from .cad import read_cad
+                from .parts import cad_parts
+                reading = read_cad(path, max_faces=max_faces)
+                vertices, faces = reading.vertices, reading.faces
+                parts = cad_parts(reading.parts)
                 _check_face_budget(path, len(faces), max_faces)
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "the tessellation has NaN or infinite coordinates")
                 declared = (1.0, "m")           # the CAD reader converts the file's unit to metres
                 n = len(faces)
+            elif suffix == ".3mf":
+                vertices, faces, declared, parts = _read_3mf(path, max_faces)
+                _check_face_budget(path, len(faces), max_faces)
+                if not np.all(np.isfinite(vertices)):
+                    raise _fail(path, "vertices have NaN or infinite coordinates")
+                n = len(faces)
             else:
-                vertices, faces, declared, rounding = _read_with_trimesh_rounding(path, max_faces)
+                found: list[PartTag] = []
+                vertices, faces, declared, rounding = _read_with_trimesh_rounding(path, max_faces, found)
+                parts = tuple(found)
                 n = len(faces)
         except PermissionError:
             raise _fail(path, "permission denied") from None
@@ -1131,13 +1171,14 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
         _check_face_budget(name, n, max_faces)
         owned = False                      # may be the caller's own array: never modified
         rounding = 0.0
+        parts = ()
     if scale != 1.0:
         if owned and vertices.dtype == np.float64 and vertices.flags.writeable:
             vertices *= scale
         else:
             vertices = vertices * scale
     return RawMesh(vertices=vertices, faces=faces, source=name, units=str(units), file_faces=n,
-                   units_assumed=assumed, storage_rounding=rounding * abs(scale))
+                   units_assumed=assumed, storage_rounding=rounding * abs(scale), parts=parts)
 
 
 def _float32_rounding(vertices: np.ndarray) -> float:

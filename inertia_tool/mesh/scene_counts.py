@@ -57,7 +57,8 @@ def _document(path: str) -> dict[str, Any]:
 
 
 def check_gltf(path: str, size: int, max_faces: int) -> dict[str, int]:
-    """Refuse a glTF scene that places more triangles than ``max_faces``, from its JSON, before trimesh builds it.
+    """Refuse a glTF scene that places more triangles than ``max_faces``, from its JSON, before trimesh builds it;
+    return ``{"named_materials": n}``, the named materials its primitives use.
 
     A primitive's triangles follow from its accessor counts (``indices``, else ``POSITION``; mode 4: count/3,
     strips and fans: count − 2, points and lines: none).  A node places its mesh once per path to it from the
@@ -132,7 +133,13 @@ def check_gltf(path: str, size: int, max_faces: int) -> dict[str, int]:
             raise _fail(path, f"the glTF scene places at least {total:,} triangles (each mesh instance counted, "
                               f"and {GLTF_INSTANCE_FACES} more per instance for its copy), more than `max_faces` "
                               f"({max_faces:,}) allows; refused before loading")
-    return {}
+    # named materials that primitives use: then the reader keeps them (per-node parts, mesh/parts.py)
+    materials = items("materials")
+    used = {p.get("material") for m in meshes if isinstance(m, dict) for p in (m.get("primitives") or [])
+            if isinstance(p, dict)}
+    named = sum(1 for k in used if isinstance(k, int) and 0 <= k < len(materials)
+                and isinstance(materials[k], dict) and materials[k].get("name"))
+    return {"named_materials": named}
 
 
 def check_collada_instances(name: str, data: bytes, max_faces: int) -> None:

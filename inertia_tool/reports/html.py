@@ -400,7 +400,17 @@ def _core_sections(props: MassProperties, density_source: str | None, semi,
                     "equivalent-ellipsoid semi-axis (m)"], rows)
             + "".join(f"<p>{_e(n)}</p>" for n in notes))
     sections.append(HtmlSection("Principal axes (ascending moments, right-handed)", body, "principal"))
-    if props.parts:
+    if props.parts and any(b.mesh is not None for b in props.parts):
+        rows = [[_e(b.name), _e(b.material or "-"), _num(b.density), _num(b.mass), _num(b.volume),
+                 "(" + ", ".join(_vec_cells(b.center_of_mass)) + ")",
+                 _e(b.mesh.certificate.kind if b.mesh is not None else "-")] for b in props.parts]
+        sections.append(HtmlSection(
+            f"Parts ({len(props.parts)})",
+            _table(["part", "material", "density (kg/m³)", "mass (kg)", "volume (m³)", "centre of mass (m)",
+                    "certificate"], rows)
+            + "<p>Each part is integrated alone; the totals are their sum about the common centre of mass "
+              "(parallel-axis theorem, Chapter 4 “Rigid Body Motion”, Eq. (4.16)).</p>", "bodies"))
+    elif props.parts:
         rows = [[_e(b.name), _num(b.mass), _num(b.volume), "(" + ", ".join(_vec_cells(b.center_of_mass)) + ")"]
                 for b in props.parts]
         sections.append(HtmlSection(f"Bodies ({len(props.parts)})",

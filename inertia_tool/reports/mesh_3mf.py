@@ -1,12 +1,15 @@
 """A minimal 3MF writer for several objects of different materials (3MF Core Specification 1.3, §4 and the
 ``basematerials`` resource of §5): one ``<object>`` per body, each pointing at its base material, all in the
-build.  Used by ``spin-it --out part.3mf`` for a hollowed part with a dense insert."""
+build, each material with its density when known.  Used by ``spin-it --out part.3mf`` for a hollowed part with a
+dense insert."""
 
 from __future__ import annotations
 
 import zipfile
 
 import numpy as np
+
+from ..mesh.threemf import DENSITY_NAMESPACE
 
 __all__ = ["write_3mf"]
 
@@ -32,16 +35,19 @@ def _escape(text: str) -> str:
 def _model(objects) -> str:
     lines = ['<?xml version="1.0" encoding="UTF-8"?>',
              '<model unit="millimeter" xml:lang="en-US" '
-             'xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02">', " <resources>",
+             'xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02" '
+             f'xmlns:it="{DENSITY_NAMESPACE}">', " <resources>",
              '  <basematerials id="1">']
     for obj in objects:
-        lines.append(f'   <base name="{_escape(obj["material"])}" displaycolor="{obj["color"]}"/>')
+        density = f' it:density="{float(obj["density"])!r}"' if obj.get("density") is not None else ""
+        lines.append(f'   <base name="{_escape(obj["material"])}" displaycolor="{obj["color"]}"{density}/>')
     lines.append("  </basematerials>")
     for k, obj in enumerate(objects):
         lines.append(f'  <object id="{k + 2}" type="model" name="{_escape(obj["name"])}" pid="1" pindex="{k}">')
         lines.append("   <mesh>")
         lines.append("    <vertices>")
-        lines += [f'     <vertex x="{x:.9g}" y="{y:.9g}" z="{z:.9g}"/>' for x, y, z in obj["vertices"]]
+        # 17 significant digits: the file reads back to the same doubles (analyze of it gives spin-it's numbers)
+        lines += [f'     <vertex x="{x:.17g}" y="{y:.17g}" z="{z:.17g}"/>' for x, y, z in obj["vertices"]]
         lines.append("    </vertices>")
         lines.append("    <triangles>")
         lines += [f'     <triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in obj["faces"]]
@@ -66,7 +72,9 @@ def write_3mf(path, objects, *, label: str | None = None) -> None:
         Output file.
     objects : sequence of dict
         ``{"name", "material", "color" ("#RRGGBBAA"), "vertices" ((n, 3) float, **millimetres**),
-        "faces" ((m, 3) int, outward-wound)}``.
+        "faces" ((m, 3) int, outward-wound)}`` and optionally ``"density"`` (kg/m³), written on the material
+        as ``it:density`` in :data:`~inertia_tool.mesh.threemf.DENSITY_NAMESPACE` (a namespace 3MF consumers
+        that do not know it ignore; ``analyze`` reads it back).
     label : str, optional
         The option that named the file, for messages (``"--out"``).
     """

@@ -146,7 +146,8 @@ def mass_properties_dict(props: MassProperties, *, density_source: str | None = 
     if props.parts:
         # the shells of one mesh share its report (and its method); the parts of an assembly carry their own
         out["bodies"] = [{"name": b.name, "mass": b.mass, "volume": b.volume, "center_of_mass": b.center_of_mass,
-                          "inertia": b.inertia,
+                          "inertia": b.inertia, "material": b.material or None, "density": b.density,
+                          **({"certificate": b.mesh.certificate} if b.mesh is not None else {}),
                           **dict(zip(("method", "uncertainty"),
                                      method_and_uncertainty(b) if b.mesh is not None or b.parts else whole))}
                          for b in props.parts]

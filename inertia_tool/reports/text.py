@@ -31,6 +31,22 @@ def _position(v, size: float) -> str:
     return _vec(v, size, rel=1e-10)
 
 
+def _parts_table(props: MassProperties, size: float) -> list[str]:
+    """The parts of an assembly, one row each (like a CAD assembly's mass properties report): name, material,
+    density, mass, volume, centre of mass and the certificate of its own integral; the totals above are their
+    sum about the common centre of mass (parallel-axis theorem, Chapter 4 "Rigid Body Motion", Eq. (4.16))."""
+    header = ["part", "material", "density (kg/m³)", "mass (kg)", "volume (m³)", "centre of mass (m)", "certificate"]
+    rows = [[b.name, b.material or "-", f"{b.density:.6g}", _num(b.mass), _num(b.volume),
+             _position(b.center_of_mass, size),
+             b.mesh.certificate.kind if b.mesh is not None else "-"] for b in props.parts]
+    widths = [max(len(r[k]) for r in [header, *rows]) for k in range(len(header))]
+    lines = [f"  parts ({len(props.parts)}), each integrated alone; the totals above are their sum about the common "
+             "centre of mass (parallel-axis theorem, Eq. 4.16):"]
+    for r in [header, *rows]:
+        lines.append("    " + "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip())
+    return lines
+
+
 def _matrix(m, indent: str) -> list[str]:
     m = _clean(m)
     return [indent + "[" + "  ".join(f"{x: .6e}" for x in row) + " ]" for row in m]
@@ -96,7 +112,9 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
     lines.append(f"  checks: moments positive: {'yes' if np.all(pa.moments > 0) else 'NO'}; "
                  f"triangle inequality I1 + I2 ≥ I3: {'yes' if margin >= -1e-9 else 'NO'} "
                  f"(margin {margin:.3g}){'' if ok else '  <- not a physical body'}")
-    if props.parts:
+    if props.parts and any(b.mesh is not None for b in props.parts):
+        lines += _parts_table(props, size)
+    elif props.parts:
         lines.append(f"  bodies ({len(props.parts)}):")
         for b in props.parts:
             lines.append(f"    {b.name}: mass {_num(b.mass)} kg, volume {_num(b.volume)} m³, "

@@ -1,0 +1,49 @@
+"""glTF scenes read per node (mesh/parts.py ``scene_parts``): node names, their materials' names mapped to
+densities, against the closed form of boxes (tests/test_assembly_3mf.py ``box_truth``)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import trimesh
+
+from inertia_tool import mass_properties
+from inertia_tool.cli import main
+from inertia_tool.errors import MaterialError
+from test_assembly_3mf import _check, box_truth
+
+
+def scene(path, boxes):
+    """``boxes``: (node name, lo m, hi m, material name), each a node placing a box mesh by a translation."""
+    s = trimesh.Scene()
+    for name, lo, hi, material in boxes:
+        size = [h - lo_ for h, lo_ in zip(hi, lo)]
+        mesh = trimesh.creation.box(size)
+        mesh.visual = trimesh.visual.TextureVisuals(material=trimesh.visual.material.PBRMaterial(name=material))
+        centre = [(h + lo_) / 2 for h, lo_ in zip(hi, lo)]
+        s.add_geometry(mesh, node_name=name, geom_name=f"{name}-mesh",
+                       transform=trimesh.transformations.translation_matrix(centre))
+    s.export(path)
+    return path
+
+
+def test_nodes_with_named_materials_against_closed_form(tmp_path):
+    path = scene(tmp_path / "s.glb", [("bolt", (0.03, 0, 0), (0.04, 0.01, 0.01), "steel"),
+                                       ("body", (0, 0, 0), (0.01, 0.02, 0.01), "PLA")])
+    props = mass_properties(path)
+    _check(props, box_truth([((0.03, 0, 0), (0.04, 0.01, 0.01), 7850.0), ((0, 0, 0), (0.01, 0.02, 0.01), 1240.0)]),
+           rtol=1e-6)     # glTF stores float32 coordinates
+    assert sorted((b.name, b.material) for b in props.parts) == [("body", "PLA"), ("bolt", "steel")]
+
+
+def test_an_appearance_name_needs_a_default_or_a_map(tmp_path, capsys):
+    path = scene(tmp_path / "a.glb", [("a", (0, 0, 0), (0.01, 0.01, 0.01), "Material.001"),
+                                       ("b", (0.02, 0, 0), (0.03, 0.01, 0.01), "steel")])
+    with pytest.raises(MaterialError, match="Material.001"):
+        mass_properties(path)
+    assert main(["analyze", str(path)]) == 2
+    assert "--material-map" in capsys.readouterr().err
+    assert main(["analyze", str(path), "--material", "abs", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert sorted(b["density"] for b in data["bodies"]) == [1040.0, 7850.0]
