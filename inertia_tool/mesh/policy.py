@@ -82,6 +82,9 @@ CHECKS = {
     "no-crossing-faces": "no two faces cross or overlap except along shared edges and vertices (checked over "
                          "every candidate pair)",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
+    "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves and the "
+                           "faces bounding {winding number ≥ 1} kept (mesh/arrange.py); the result was checked "
+                           "closed and free of crossing faces",
     "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
     "closed-form": "a primitive (box, cylinder, sphere, capsule, ellipsoid) integrated by its closed form",
     "inward-offset-bound": "a printed part's core (the inward offset by the skin) integrated on cells of the exact "
