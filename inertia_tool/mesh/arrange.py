@@ -381,7 +381,9 @@ def _winding_except(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
     ``den = |A||B||C| + (A·B)|C| + (A·C)|B| + (B·C)|A|`` for ``A = a − p`` etc.  In float64 ``|Δdet| ≤ 12u·P``
     (``P`` the permanent of the absolute values, as in the orient3d filter) and ``|Δden| ≤ 100u·|A||B||C|``;
     the angle of ``(den, det)`` then moves by at most ``asin(h/r) ≤ (π/2)·h/r`` with ``h`` the perturbation and
-    ``r`` its length (when ``h < r``), and atan2 adds a few ulps.
+    ``r`` its length (when ``h < r``), and atan2 adds a few ulps; where the perturbation reaches atan2's cut
+    (``den < 0``, ``det = 0``: the point lies in a face's plane over it) the angle may jump by 2π, and the bound
+    is infinite.
     """
     keep = np.ones(len(faces), dtype=bool)
     keep[skip] = False
@@ -399,6 +401,8 @@ def _winding_except(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
     r = np.hypot(det, den) - h
     with np.errstate(divide="ignore", invalid="ignore"):
         angle_error = np.where(r > h, (np.pi / 2) * h / np.maximum(r, 1e-300), np.inf)
+    # atan2 jumps by 2π across den < 0, det = 0 (a point in the plane of a face, over it): unbounded there
+    angle_error[(np.abs(det) <= h) & (den <= h)] = np.inf
     theta = np.arctan2(det, den)
     total = float(np.sum(theta)) / (2 * np.pi)
     bound = float(np.sum(angle_error + 4 * _U * np.abs(theta))) / (2 * np.pi) + len(f) * 4 * _U
