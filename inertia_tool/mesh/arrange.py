@@ -385,18 +385,19 @@ def _winding_except(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
     (``den < 0``, ``det = 0``: the point lies in a face's plane over it) the angle may jump by 2π, and the bound
     is infinite.
     """
-    keep = np.ones(len(faces), dtype=bool)
-    keep[skip] = False
-    f = faces[keep]
-    A, B, C = vertices[f[:, 0]] - point, vertices[f[:, 1]] - point, vertices[f[:, 2]] - point
-    la, lb, lc = (np.sqrt(np.einsum("ij,ij->i", X, X)) for X in (A, B, C))
-    det = np.einsum("ij,ij->i", A, np.cross(B, C))
-    den = la * lb * lc + np.einsum("ij,ij->i", A, B) * lc + np.einsum("ij,ij->i", A, C) * lb \
-        + np.einsum("ij,ij->i", B, C) * la
-    aA, aB, aC = np.abs(A), np.abs(B), np.abs(C)
-    perm = (aA[:, 0] * (aB[:, 1] * aC[:, 2] + aB[:, 2] * aC[:, 1])
-            + aA[:, 1] * (aB[:, 2] * aC[:, 0] + aB[:, 0] * aC[:, 2])
-            + aA[:, 2] * (aB[:, 0] * aC[:, 1] + aB[:, 1] * aC[:, 0]))
+    f = faces
+    ax, ay, az = (vertices[f[:, 0], k] - point[k] for k in range(3))
+    bx, by, bz = (vertices[f[:, 1], k] - point[k] for k in range(3))
+    cx, cy, cz = (vertices[f[:, 2], k] - point[k] for k in range(3))
+    la = np.sqrt(ax * ax + ay * ay + az * az)
+    lb = np.sqrt(bx * bx + by * by + bz * bz)
+    lc = np.sqrt(cx * cx + cy * cy + cz * cz)
+    det = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)
+    den = la * lb * lc + (ax * bx + ay * by + az * bz) * lc + (ax * cx + ay * cy + az * cz) * lb \
+        + (bx * cx + by * cy + bz * cz) * la
+    aax, aay, aaz, abx, aby, abz = np.abs(ax), np.abs(ay), np.abs(az), np.abs(bx), np.abs(by), np.abs(bz)
+    acx, acy, acz = np.abs(cx), np.abs(cy), np.abs(cz)
+    perm = (aax * (aby * acz + abz * acy) + aay * (abz * acx + abx * acz) + aaz * (abx * acy + aby * acx))
     h = 12 * _U * perm + 100 * _U * la * lb * lc
     r = np.hypot(det, den) - h
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -404,6 +405,7 @@ def _winding_except(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
     # atan2 jumps by 2π across den < 0, det = 0 (a point in the plane of a face, over it): unbounded there
     angle_error[(np.abs(det) <= h) & (den <= h)] = np.inf
     theta = np.arctan2(det, den)
+    theta[skip] = angle_error[skip] = 0.0
     total = float(np.sum(theta)) / (2 * np.pi)
     bound = float(np.sum(angle_error + 4 * _U * np.abs(theta))) / (2 * np.pi) + len(f) * 4 * _U
     return total, bound
@@ -480,9 +482,7 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
         out_v[len(v):] = (out_v[len(v):] - centre) @ rot + centre
         out_v[:len(v)] = v
         turned = True
-    used, inverse = np.unique(kept, return_inverse=True)
-    result_v = out_v[used]
-    result_f = inverse.reshape(-1, 3).astype(np.int64)
+    result_v, result_f = _compact(out_v, kept)
     topo = edge_topology(result_f, len(result_v))
     if not topo.oriented:
         raise ArrangementError(f"the surface of winding number ≥ 1 is not closed ({topo.boundary_edges} open, "
@@ -639,7 +639,9 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
         raise ArrangementError("an edge crossed by a face belongs to a face that crosses nothing (internal)")
 
     # 3. labels
-    whole = np.setdiff1d(np.arange(len(f)), split)
+    is_split = np.zeros(len(f), dtype=bool)
+    is_split[split] = True
+    whole = np.flatnonzero(~is_split)
     out_faces = np.vstack([f[whole], np.asarray(pieces, dtype=np.int64).reshape(-1, 3)])
     out_source = np.r_[whole, np.asarray(source, dtype=np.int64)]
     out_v = np.vstack([v, np.asarray(new_xyz, dtype=np.float64).reshape(-1, 3)])
@@ -648,7 +650,8 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
     patch, n_patches = _patches(out_faces, n_all, cut)
     front = _label_patches(out_v, out_faces, out_source, patch, n_patches, v, f)
     w_front = front[patch]
-    _check_curves(out_faces, n_all, cut, out_source, w_front)
+    first_piece = len(whole)                  # cut edges border pieces only
+    _check_curves(out_faces[first_piece:], n_all, cut, out_source[first_piece:], w_front[first_piece:])
 
     # 4. the faces bounding {w ≥ 1}, compacted
     kept = out_faces[w_front == 0]
@@ -656,6 +659,14 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
         raise ArrangementError("no face bounds the region of winding number ≥ 1 (the surface is wound inward)")
     return out_v, kept, dict(crossing_pairs=len(pairs), split_faces=len(split), new_vertices=len(new_xyz),
                              patches=n_patches, max_winding=int(front.max()) + 1)
+
+
+def _compact(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The used vertices (in order) and the faces renumbered onto them (linear time)."""
+    used = np.zeros(len(vertices), dtype=bool)
+    used[faces.reshape(-1)] = True
+    remap = np.cumsum(used) - 1
+    return vertices[used], remap[faces].astype(np.int64)
 
 
 def _common_line(exact: _Exact, faces: np.ndarray, trio: tuple[int, ...]) -> bool:
@@ -675,16 +686,18 @@ def _common_line(exact: _Exact, faces: np.ndarray, trio: tuple[int, ...]) -> boo
 def _label_patches(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndarray, patch: np.ndarray,
                    n_patches: int, v: np.ndarray, f: np.ndarray) -> np.ndarray:
     """(p,) int: the winding number in front of each patch, from one certified evaluation at a face of it."""
-    tri = out_v[out_faces]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    centre = tri.mean(axis=1)
-    order = np.lexsort((-area, patch))
+    p0, p1, p2 = out_v[out_faces[:, 0]], out_v[out_faces[:, 1]], out_v[out_faces[:, 2]]
+    u, w = p1 - p0, p2 - p0
+    area2 = ((u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1]) ** 2 + (u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2]) ** 2
+             + (u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]) ** 2)
+    del p0, p1, p2, u, w
+    order = np.lexsort((-area2, patch))
     starts = np.searchsorted(patch[order], np.arange(n_patches + 1))
     front = np.zeros(n_patches, dtype=np.int64)
     for p in range(n_patches):
         members = order[starts[p]:starts[p + 1]]
         for k in members[:_TRIES].tolist():
-            total, bound = _winding_except(centre[k], v, f, int(out_source[k]))
+            total, bound = _winding_except(out_v[out_faces[k]].mean(axis=0), v, f, int(out_source[k]))
             nearest = np.floor(total) + 0.5
             if bound + abs(total - nearest) < WINDING_MARGIN:
                 front[p] = int(np.floor(total))
@@ -787,7 +800,5 @@ def arrange_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
         parts_v.append(arranged.vertices)
         parts_f.append(arranged.faces + offset)
         offset += len(arranged.vertices)
-    out_f = np.vstack(parts_f)
-    used, inverse = np.unique(out_f, return_inverse=True)
-    return ArrangedShells(vertices=np.vstack(parts_v)[used], faces=inverse.reshape(-1, 3).astype(np.int64),
-                          arrangements=tuple(done), inside_out=inside_out)
+    out_v, out_f = _compact(np.vstack(parts_v), np.vstack(parts_f))
+    return ArrangedShells(vertices=out_v, faces=out_f, arrangements=tuple(done), inside_out=inside_out)
