@@ -313,3 +313,17 @@ def test_winding_bound_is_infinite_on_the_branch_cut_of_atan2():
     assert not bound < 0.5
     total, bound = _winding_except(np.array([0.2, 0.2, -1e-3]), v, f, skip=1)     # just below: nearly +½ turn
     assert bound < 1e-9 and 0.45 < total < 0.5
+
+
+def test_self_crossing_tube_and_a_body_crossing_it_are_arranged_then_united():
+    """R3 then R5: the tube's own crossing is arranged, then the sphere crossing the tube is united with it by
+    manifold3d; the truth is manifold3d's union of the tube's two halves and the sphere."""
+    v, f, halves = S.tube_halves(0.1, 0.2, rings=48, sections=8)
+    ball = S.icosphere(0.3, 2)
+    ball = (ball[0] + [0.75, 0.3, 0.05], ball[1])
+    truth = S.truth_from_manifold([*halves, ball])
+    props = _quiet(*S.concat((v, f), ball))
+    assert props.mesh.certificate.kind == "united"
+    assert props.mesh.certificate.checks == ("edge-balanced", "consistently-oriented", "winding-arrangement",
+                                             "boolean-union")
+    assert props.volume == pytest.approx(truth.volume, rel=1e-9)
