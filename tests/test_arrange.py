@@ -327,3 +327,17 @@ def test_self_crossing_tube_and_a_body_crossing_it_are_arranged_then_united():
     assert props.mesh.certificate.checks == ("edge-balanced", "consistently-oriented", "winding-arrangement",
                                              "boolean-union")
     assert props.volume == pytest.approx(truth.volume, rel=1e-9)
+
+
+@pytest.mark.parametrize("steps, radius, sections", [(64, 0.2, 12), (48, 0.25, 8)])
+def test_symmetric_figure_eight_is_certified_after_merging_split_points(steps, radius, sections):
+    """The planar figure-eight of tests/solids.py crosses edge through edge exactly: arranged on the turned mesh,
+    the points that rounding split apart are merged (ARRANGE_MERGE_RTOL) and the result passes every check."""
+    from solids import figure_eight
+    from test_mesh_certificate import _figure_eight_truth
+    v, f = figure_eight(steps, radius, sections)
+    truth, _ = _figure_eight_truth(steps, radius, sections)
+    a = arrange_crossings(v, f)
+    assert a.turned and a.merged_points > 0 and a.crossings_left == 0
+    _certified(a)
+    assert volume_moments(a.vertices, a.faces).volume == pytest.approx(truth, rel=1e-12)

@@ -98,14 +98,14 @@ def _figure_eight_truth(steps=64, radius=0.2, sections=12):
 def test_figure_eight_tube_is_its_winding_solid_not_the_summed_integral():
     """Issue 21: the tube passing through itself is {w ≥ 1} (mesh/arrange.py), not the crossing counted twice.
     This planar figure-eight is symmetric (edges cross edges exactly), so it is arranged on the mesh turned by
-    a generic rotation; rounding the new points can leave a few crossing slivers: then ``unverified``."""
+    a generic rotation, and the intersection points that rounding split apart are merged again."""
     v, f = figure_eight()
     truth, summed = _figure_eight_truth()
     assert summed > truth * 1.005                   # the crossing counted twice would be a wrong "exact"
     for repair in (False, True):
         props = _quiet(v, f, repair=repair)
         assert props.volume == pytest.approx(truth, rel=1e-12)
-        assert props.mesh.certificate.kind in ("united", "unverified")
+        assert props.mesh.certificate.kind == "united"
         assert "winding-arrangement" in props.mesh.certificate.checks
         assert any("winding number ≥ 1" in n for n in props.mesh.notes)
 

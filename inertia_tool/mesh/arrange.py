@@ -41,6 +41,7 @@ from itertools import combinations
 import numpy as np
 
 from ..errors import ArrangementError
+from ..tolerances import ARRANGE_MERGE_RTOL
 from ..values import frozen_value
 from .checks import edge_topology
 from .edges import edge_keys
@@ -94,6 +95,9 @@ class Arrangement:
     turned : bool
         The crossing was degenerate and was arranged on the mesh turned by a generic rotation (the input's
         vertices keep their coordinates; the new points moved back carry the rotation's rounding).
+    merged_points : int
+        Intersection points merged into a neighbour within ``tolerances.ARRANGE_MERGE_RTOL`` of the diagonal
+        because, rounded, they left faces crossing (see :func:`_merge_close_points`).
     """
 
     vertices: np.ndarray
@@ -105,6 +109,7 @@ class Arrangement:
     max_winding: int
     crossings_left: int = 0
     turned: bool = False
+    merged_points: int = 0
 
 
 # -- exact helpers ---------------------------------------------------------------------------------------------
@@ -490,8 +495,64 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
     after = surface_contacts(result_v, result_f)
     if not after.complete:
         raise ArrangementError("the face-intersection check of the surface of winding number ≥ 1 did not finish")
+    merged = 0
+    if len(after.crossing):
+        merged_v, merged_f, merged = _merge_close_points(out_v, kept, len(v))
+        if merged and edge_topology(merged_f, len(merged_v)).oriented:
+            rechecked = surface_contacts(merged_v, merged_f)
+            if rechecked.complete and len(rechecked.crossing) < len(after.crossing):
+                result_v, result_f, after = merged_v, merged_f, rechecked
+            else:
+                merged = 0
+        else:
+            merged = 0
     return Arrangement(vertices=result_v, faces=result_f, crossings_left=len(after.crossing), turned=turned,
-                       **stats)
+                       merged_points=merged, **stats)
+
+
+def _merge_close_points(vertices: np.ndarray, faces: np.ndarray, n_input: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """Merge intersection points (ids ≥ ``n_input``) lying within ``ARRANGE_MERGE_RTOL`` of the diagonal of a
+    point they share an edge with (into the input's vertex when there is one), drop the faces that collapse and
+    pairs of faces left as one face and its reverse; return the compacted surface and the count merged."""
+    lo, hi = vertices[faces.reshape(-1)].min(axis=0), vertices[faces.reshape(-1)].max(axis=0)
+    limit = ARRANGE_MERGE_RTOL * float(np.linalg.norm(hi - lo))
+    a = faces.reshape(-1)
+    b = faces[:, [1, 2, 0]].reshape(-1)
+    short = (np.linalg.norm(vertices[a] - vertices[b], axis=1) <= limit) & (np.maximum(a, b) >= n_input)
+    target = np.arange(len(vertices))
+
+    def root(i: int) -> int:
+        while target[i] != i:
+            target[i] = target[target[i]]
+            i = int(target[i])
+        return i
+
+    merged = 0
+    for x, y in zip(a[short].tolist(), b[short].tolist()):
+        rx, ry = root(x), root(y)
+        if rx != ry:
+            keep, drop = (rx, ry) if rx < ry else (ry, rx)      # input vertices have the smaller ids
+            target[drop] = keep
+            merged += 1
+    if not merged:
+        return vertices, faces, 0
+    final = np.array([root(i) for i in range(len(vertices))])
+    f = final[faces]
+    f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 2] != f[:, 0])]
+    canon = np.sort(f, axis=1)
+    parity = _cyclic_parity(f)
+    key = np.unique(canon, axis=0, return_inverse=True)[1].reshape(-1)
+    net = np.bincount(key, weights=np.where(parity, 1, -1))
+    count = np.bincount(key)
+    f = f[~((count[key] == 2) & (net[key] == 0))]          # a face and its reverse: a sheet of no volume
+    out_v, out_f = _compact(vertices, f)
+    return out_v, out_f, merged
+
+
+def _cyclic_parity(faces: np.ndarray) -> np.ndarray:
+    """(m,) bool: each face's corners are an even (cyclic) permutation of their sorted order."""
+    order = np.argsort(faces, axis=1)
+    return np.asarray([(o[0], o[1], o[2]) in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) for o in order.tolist()])
 
 
 def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple[np.ndarray, np.ndarray,
