@@ -365,6 +365,46 @@ class _FaceTriangulation:
                 queue.append((z, w))
         raise ArrangementError("an intersection segment could not be made an edge of its face within the flip bound")
 
+    def _in_circle(self, a: int, b: int, c: int, d: int) -> bool:
+        """d lies inside the circle through the counter-clockwise a, b, c, in float64: only the quality of the
+        triangulation depends on it, never its validity (each flip is checked exactly)."""
+        def xy(i: int) -> tuple[float, float]:
+            p = self.xy[i]
+            return p[0] / p[2], p[1] / p[2]
+        dx, dy = xy(d)
+        rows = []
+        for i in (a, b, c):
+            x, y = xy(i)
+            rows.append((x - dx, y - dy, (x - dx) ** 2 + (y - dy) ** 2))
+        (ax, ay, az), (bx, by, bz), (cx, cy, cz) = rows
+        return ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx) > 0
+
+    def improve(self, fixed: set[tuple[int, int]]) -> None:
+        """Lawson flips of the edges not in ``fixed`` (constraints and the face's boundary) towards the
+        constrained Delaunay triangulation: no thin slivers where a better diagonal exists, so that rounding the
+        new points cannot turn a sliver over (bounded by a fixed number of passes)."""
+        for _ in range(2 * len(self.tris) + 8):
+            where = {(t[e], t[(e + 1) % 3]): (k, e) for k, t in enumerate(self.tris) for e in range(3)}
+            touched: set[int] = set()
+            for (x, y), (t1, e1) in where.items():
+                if x > y or (x, y) in fixed or t1 in touched:
+                    continue
+                other = where.get((y, x))
+                if other is None or other[0] in touched:
+                    continue
+                t2, e2 = other
+                z = self.tris[t1][(e1 + 2) % 3]
+                w = self.tris[t2][(e2 + 2) % 3]
+                if not self._in_circle(x, y, z, w):
+                    continue
+                if self.orient(x, w, z) <= 0 or self.orient(w, y, z) <= 0:
+                    continue
+                self.tris[t1] = [x, w, z]
+                self.tris[t2] = [w, y, z]
+                touched |= {t1, t2}
+            if not touched:
+                return
+
     def _between(self, u: int, v: int, x: int) -> bool:
         """x (collinear with u, v) lies strictly between them."""
         pu, pv, px = (self.xy[i] for i in (u, v, x))
@@ -511,14 +551,20 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
 
 
 def _merge_close_points(vertices: np.ndarray, faces: np.ndarray, n_input: int) -> tuple[np.ndarray, np.ndarray, int]:
-    """Merge intersection points (ids ≥ ``n_input``) lying within ``ARRANGE_MERGE_RTOL`` of the diagonal of a
-    point they share an edge with (into the input's vertex when there is one), drop the faces that collapse and
+    """Merge intersection points (ids ≥ ``n_input``) lying within ``ARRANGE_MERGE_RTOL`` of the diagonal of
+    another point of the surface (into the input's vertex when there is one), drop the faces that collapse and
     pairs of faces left as one face and its reverse; return the compacted surface and the count merged."""
     lo, hi = vertices[faces.reshape(-1)].min(axis=0), vertices[faces.reshape(-1)].max(axis=0)
     limit = ARRANGE_MERGE_RTOL * float(np.linalg.norm(hi - lo))
-    a = faces.reshape(-1)
-    b = faces[:, [1, 2, 0]].reshape(-1)
-    short = (np.linalg.norm(vertices[a] - vertices[b], axis=1) <= limit) & (np.maximum(a, b) >= n_input)
+    from scipy.spatial import cKDTree
+    used = np.unique(faces)
+    new = used[used >= n_input]
+    if not len(new):
+        return vertices, faces, 0
+    near = cKDTree(vertices[used]).query_ball_point(vertices[new], r=limit)
+    a = np.repeat(new, [len(n) for n in near])
+    b = used[np.concatenate([np.asarray(n, dtype=np.int64) for n in near])] if len(a) else a
+    short = a != b
     target = np.arange(len(vertices))
 
     def root(i: int) -> int:
@@ -694,6 +740,12 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
             tri.insert(q)
         for a, b in constraints.get(face, []):
             tri.constrain(a, b)
+        fixed = {(min(a, b), max(a, b)) for a, b in constraints.get(face, [])}
+        for e in range(3):                    # the face's boundary, split at its points
+            a, b = corners[e], corners[(e + 1) % 3]
+            chain = [a, *[vid for _, vid in on_edge.get((min(a, b), max(a, b)), [])][::(1 if a < b else -1)], b]
+            fixed |= {(min(p, q), max(p, q)) for p, q in zip(chain[:-1], chain[1:])}
+        tri.improve(fixed)
         pieces += tri.tris
         source += [face] * len(tri.tris)
     if edges_with_points:
