@@ -16,7 +16,8 @@ builds it:
    points, projected on the two axes of the largest normal component): the face is split at the points on its
    edges, the interior points are inserted, and every intersection segment (cut at its triple points) is made
    an edge by flips (Sloan, "A fast algorithm for generating constrained Delaunay triangulations", Computers &
-   Structures 47, 1993, without the Delaunay step).
+   Structures 47, 1993), then the other edges flipped towards the constrained Delaunay triangulation (Lawson's
+   flips), so that no cap sliver is left for the rounding of the new points to turn over.
 3. *Labels.*  The split surface is grouped into patches (pieces joined through edges that are not on an
    intersection curve); the winding number is constant on each side of a patch.  At a point ``c`` of a patch
    lying on its face ``f``, the generalized winding number of every face but ``f`` is ``w_front + ½``
