@@ -54,6 +54,10 @@ __all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells
 #: the sum from the nearest half-integer stays below this (half a turn would make the rounding ambiguous).
 WINDING_MARGIN = 0.25
 
+#: Work bound: intersection points in one face (each face is triangulated on its own, in time growing with
+#: the square of its points); a face crossed more often is refused with the count.
+MAX_POINTS_PER_FACE = 1000
+
 #: Patch points tried (largest faces first) before a patch is refused as too close to other surfaces.
 _TRIES = 12
 
@@ -725,6 +729,9 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
         for e in range(3):
             a, b = corners[e], corners[(e + 1) % 3]
             verts |= {vid for _, vid in on_edge.get((min(a, b), max(a, b)), [])}
+        if len(verts) > MAX_POINTS_PER_FACE:
+            raise ArrangementError(f"a face is crossed at {len(verts) - 3:,} points, more than the arrangement's "
+                                   f"work bound of {MAX_POINTS_PER_FACE:,} per face")
         xy = {vid: (hom[vid][i], hom[vid][j], hom[vid][3]) for vid in verts}
         tri = _FaceTriangulation(corners, xy)
         for e in range(3):
