@@ -43,6 +43,7 @@ __all__ = [
     "MeshReadError",
     "RobotDescriptionError",
     "InvalidMeshError",
+    "ArrangementError",
     "DesignRejectedError",
     "NoRoomError",
     "PhysicsError",
@@ -122,6 +123,12 @@ class InvalidMeshError(InertiaToolError, ValueError):
     def __init__(self, message: str, details: dict[str, Any] | None = None):
         super().__init__(message)
         self.details = dict(details or {})
+
+
+class ArrangementError(InvalidMeshError):
+    """The solid {winding number ≥ 1} of a surface passing through itself could not be built by the mesh
+    arrangement (:mod:`inertia_tool.mesh.arrange`): a degenerate crossing, or an output that failed its checks.
+    The message says which."""
 
 
 class IsolatedProcessError(InertiaToolError, OSError):

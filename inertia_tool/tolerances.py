@@ -90,3 +90,9 @@ SOUP_BOUNDARY_SHARE = 0.5
 #: text file with 6 to 9 significant digits moves a face by 1e-9 to 1e-6 of the part's size, and spin-it's own
 #: insert shares 1.6e-10 of its volume with the part as written before coordinates were written in full.
 PART_OVERLAP_RTOL = 1e-7
+
+#: Intersection points of a self-crossing shell's arrangement (mesh/arrange.py) closer than this times the
+#: bounding-box diagonal are merged when, rounded to float64, they leave faces crossing: a crossing in special
+#: position (an edge exactly through an edge, common in symmetric meshes) splits one true point into several
+#: within rounding of each other; merging them moves the surface by at most this relative distance.
+ARRANGE_MERGE_RTOL = 1e-12

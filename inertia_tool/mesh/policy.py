@@ -20,8 +20,11 @@ R2 *Flat pieces carry no volume* (``tolerances.FLAT_RTOL``).  A closed shell who
 R3 *A surface that passes through itself is not a solid as it stands* (:func:`self_crossing_message`).  A
    crossing between two faces of one shell makes the winding number 2 (or −1) somewhere, and the summed
    integral counts that region twice.  manifold3d does not resolve a self-intersection inside one mesh
-   (its booleans assume valid input; the volume of such a mesh is the signed sum), so without ``repair``
-   this is refused; with ``repair`` the winding-number estimate with its bound is given.
+   (its booleans assume valid input; the volume of such a mesh is the signed sum), so the shell is replaced by
+   the boundary of its {winding number ≥ 1} by a mesh arrangement (:mod:`~.arrange`; under ``overlap`` 'union',
+   as overlapping bodies are united by R5), certified ``united`` once the result is closed and has no crossing
+   faces.  When the arrangement fails its own checks the mesh is refused with the reason; with ``repair`` the
+   winding-number estimate with its bound is given.
 R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is the number of other shells
    that contain it (whose winding number at a point of it is nonzero and that it does not cross); even depth
    is a body, wound outward, odd depth a cavity, wound inward.  A shell wound the other way is flipped, with
@@ -82,6 +85,9 @@ CHECKS = {
     "no-crossing-faces": "no two faces cross or overlap except along shared edges and vertices (checked over "
                          "every candidate pair)",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
+    "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves and the "
+                           "faces bounding {winding number ≥ 1} kept (mesh/arrange.py); the result was checked "
+                           "closed and free of crossing faces",
     "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
     "closed-form": "a primitive (box, cylinder, sphere, capsule, ellipsoid) integrated by its closed form",
     "inward-offset-bound": "a printed part's core (the inward offset by the skin) integrated on cells of the exact "

@@ -18,15 +18,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import (DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
+from ..errors import (ArrangementError, DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
                       MeshResolvedWarning, OverlapWarning, UsageError)
 from ..integrals import VolumeMoments, body_volume_moments, bounding_box, volume_moments
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .estimate import check_useful, uncertainty_from
-from .policy import (TOUCH_VOLUME_RTOL, Certificate, inward_crossing_outward, negligible_flat, orient_by_depth,
-                     self_crossing_message, shell_contacts)
+from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, inward_crossing_outward, negligible_flat,
+                     orient_by_depth, self_crossing_message, shell_contacts)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
 
@@ -214,13 +214,20 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         found = Resolution(found.vertices, found.faces, found.method, found.notes + patch_notes,
                            found.flipped_faces, found.welded_tolerance, found.nonmanifold_edges, found.estimate)
     touch = shell_contacts(contacts, labels, n_shells)
-    crossing_note = None
+    crossing_note = arranged = None
+    arrange_failed, arranged_verified = "", False
+    if touch.self_crossing.any() and self_crossing == "refuse" and overlap == "union" and patched is None:   # R3
+        try:
+            v, f, labels, n_shells, shells, contacts, touch, arranged, arranged_verified = _arrange_self_crossing(
+                v, f, labels, contacts, touch, diag, source)
+        except ArrangementError as exc:
+            arrange_failed = f"; its solid {{winding number ≥ 1}} could not be built: {exc}"
     if touch.self_crossing.any() and self_crossing == "unverified" and not repair:
         crossing_note = (f"the surface passes through itself at {touch.self_crossing_pairs:,} face pairs: "
                          "integrated as it stands (a crossed region counts twice), not verified")
         warnings.warn(MeshResolvedWarning(f"{source}: {crossing_note}"), stacklevel=3)
     elif touch.self_crossing.any():                                              # R3
-        message = self_crossing_message(source, touch, v, f, contacts.crossing, labels)
+        message = self_crossing_message(source, touch, v, f, contacts.crossing, labels) + arrange_failed
         if not repair:
             raise InvalidMeshError(message, details={"self_crossing_face_pairs": touch.self_crossing_pairs})
         forced = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
@@ -246,6 +253,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=3)
     if dropped_note is not None:
         notes.append(dropped_note)
+    if arranged is not None:
+        notes.append(arranged)
     if crossing_note is not None:
         notes.append(crossing_note)
     checks = ["edge-balanced", "consistently-oriented"]
@@ -315,6 +324,13 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                        patched.uncertainty.volume_in_doubt, patched.far)
         check_useful(total.volume, uncertainty, source=source, what="the patched surface")
         method, kind = "patched", "estimate"
+    if arranged is not None:                  # R3: the arrangement's surface, checked like any other
+        method = "union" if method == "exact" else method
+        kind = {"exact": "united"}.get(kind, kind)
+        checks.insert(2, "winding-arrangement")
+        if not arranged_verified:             # crossings left by rounding: not proven
+            kind = "unverified" if kind == "united" else kind
+            checks = [c for c in checks if c != "no-crossing-faces"]
     if ambiguous and kind in ("exact", "united"):
         kind = "unverified"                   # R4: a reading of the file's winding, not a proven solid
     certificate = Certificate(kind, tuple(checks) if kind != "estimate" else ())
@@ -325,6 +341,38 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                         repair_volume_change=None, bbox_min=bbox_min, bbox_max=bbox_max, method=method,
                         uncertainty=uncertainty, notes=tuple(notes), certificate=certificate, **common)
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
+
+
+def _arrange_self_crossing(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: SurfaceContacts,
+                           touch: ShellContacts, diag: float, source: str) -> tuple[Any, ...]:
+    """R3: every shell passing through itself replaced by the boundary of its {winding number ≥ 1}
+    (:mod:`~.arrange`), then the stages after R1 run again on the new surface.
+
+    Returns ``(v, f, labels, n_shells, shells, contacts, touch, note, verified)``; raises ArrangementError.
+    Crossings left by rounding the new points (``verified`` False) are taken out of ``touch`` (the result is
+    then certified ``unverified``)."""
+    from .arrange import arrange_shells      # imported on use: self-crossing shells are rare
+    done = arrange_shells(v, f, labels, contacts.crossing)
+    v, f = done.vertices, done.faces
+    labels, n_shells = shell_labels(f, len(v))
+    shells = body_volume_moments(v, f, labels, n_shells)
+    f, labels, n_shells, shells, _ = _drop_flat(v, f, labels, shells, diag, source, warn=False)
+    contacts = surface_contacts(v, f)
+    touch = shell_contacts(contacts, labels, n_shells)
+    if touch.self_crossing.any():
+        if not done.crossings_left:
+            raise ArrangementError("the arranged surface still passes through itself")
+        touch = dataclasses.replace(touch, self_crossing=np.zeros_like(touch.self_crossing), self_crossing_pairs=0)
+    pairs = sum(a.crossing_pairs for a in done.arrangements)
+    note = (f"the surface passes through itself at {pairs:,} face pairs: cut along the intersection curves and "
+            "the faces bounding the region of winding number ≥ 1 kept (a region enclosed twice counts once)")
+    if done.inside_out:
+        note += f"; {done.inside_out} self-crossing shell(s) wound inward were turned first"
+    if done.crossings_left:
+        note += (f"; {done.crossings_left:,} face pairs of the result still cross after rounding the intersection "
+                 "points to float64 (a crossing in special position): not verified")
+    warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
+    return v, f, labels, n_shells, shells, contacts, touch, note, not done.crossings_left
 
 
 def shared_text(summed: float, united: float) -> str:

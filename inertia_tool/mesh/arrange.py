@@ -1,0 +1,925 @@
+"""A closed surface that passes through itself: the solid {winding number ≥ 1} by a mesh arrangement.
+
+A shell that crosses itself (a tube swept along a figure-eight, two boxes written as one shell) bounds a region
+where its winding number is 2: the summed divergence-theorem integral (Rigid Body Motion, Ch. 4, the volume
+integrals as surface sums) counts that region twice.  The solid meant is ``{w ≥ 1}``; its boundary is made of
+pieces of the input faces, cut along the curves where the surface meets itself.  :func:`arrange_crossings`
+builds it:
+
+1. *Intersection points.*  For every crossing face pair (from :func:`~.intersect.surface_contacts`), each edge
+   of one face that pierces the interior of the other gives a point, keyed by (edge, face) so that the faces
+   sharing that edge share the point.  Every decision (which side of a plane a corner lies on, whether an
+   edge passes through a triangle) is an exact orientation sign (:func:`~.intersect.orient3d_sign`).  Three
+   faces that meet at one point (a triple point) give a point keyed by the three faces.  The coordinates are
+   computed exactly (rational, from integer coordinates at one power-of-two scale) and rounded once to float64.
+2. *Splitting.*  Each crossed face is triangulated in its own plane (exact orientation tests on the rational
+   points, projected on the two axes of the largest normal component): the face is split at the points on its
+   edges, the interior points are inserted, and every intersection segment (cut at its triple points) is made
+   an edge by flips (Sloan, "A fast algorithm for generating constrained Delaunay triangulations", Computers &
+   Structures 47, 1993), then the other edges flipped towards the constrained Delaunay triangulation (Lawson's
+   flips), so that no cap sliver is left for the rounding of the new points to turn over.
+3. *Labels.*  The split surface is grouped into patches (pieces joined through edges that are not on an
+   intersection curve); the winding number is constant on each side of a patch.  At a point ``c`` of a patch
+   lying on its face ``f``, the generalized winding number of every face but ``f`` is ``w_front + ½``
+   (``w_back = w_front + 1`` for a face wound outward), evaluated by the solid-angle sum (Van Oosterom and
+   Strackee, IEEE Trans. Biomed. Eng. 30, 1983) with a rounding bound: accepted only when the bound keeps the
+   nearest half-integer unique.
+4. *Kept faces.*  The faces with ``w_back ≥ 1`` and ``w_front ≤ 0`` (``w_front = 0``) bound ``{w ≥ 1}`` and are
+   wound outward.  Checks: the winding numbers change by exactly one across every intersection curve, the kept
+   surface is closed and consistently wound, and no two of its faces cross (:func:`~.intersect.surface_contacts`
+   again, exact).
+
+Degenerate crossings (a corner in the plane of a face it crosses, an edge through another edge or a corner,
+coplanar overlapping faces, two crossing curves meeting on an edge) are refused with the reason
+(:class:`~inertia_tool.errors.ArrangementError`), never guessed.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from itertools import combinations
+
+import numpy as np
+
+from ..errors import ArrangementError
+from ..tolerances import ARRANGE_MERGE_RTOL
+from ..values import frozen_value
+from .checks import edge_topology
+from .edges import edge_keys
+from .intersect import _integers, orient3d_sign, surface_contacts
+
+__all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells", "WINDING_MARGIN"]
+
+#: A patch's winding number is accepted when the rounding bound of its solid-angle sum plus the distance of
+#: the sum from the nearest half-integer stays below this (half a turn would make the rounding ambiguous).
+WINDING_MARGIN = 0.25
+
+#: Work bound: intersection points in one face (each face is triangulated on its own, in time growing with
+#: the square of its points); a face crossed more often is refused with the count.
+MAX_POINTS_PER_FACE = 1000
+
+#: Patch points tried (largest faces first) before a patch is refused as too close to other surfaces.
+_TRIES = 12
+
+_U = 2.0 ** -53
+
+_Hom = tuple[int, int, int, int]        # homogeneous exact point (X, Y, Z, W), W > 0
+
+#: The generic rotation (unit quaternion, scalar first) under which a degenerate crossing is arranged again.
+_TURN = (0.9689124217106447, 0.1530182, 0.0990312, 0.1620987)
+
+
+class _Degenerate(ArrangementError):
+    """A crossing in special position (a corner in a plane, an edge through an edge, coplanar faces)."""
+
+
+@frozen_value
+class Arrangement:
+    """The boundary of ``{w ≥ 1}`` of a surface that passes through itself.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float64
+        The input's vertices that are used, then the new intersection points (each rounded once from its
+        exact rational value), m.
+    faces : (k, 3) int64
+        Closed, consistently wound outward, no two crossing.
+    crossing_pairs : int
+        Face pairs of the input that cross.
+    split_faces : int
+        Input faces cut along intersection curves.
+    new_vertices : int
+        Intersection points added (edge-face points and triple points).
+    patches : int
+        Patches of constant winding (each labelled by one certified winding-number evaluation).
+    max_winding : int
+        Largest winding number met (2 where a region was counted twice).
+    crossings_left : int
+        Face pairs of the output that still cross: new points rounded to float64 within an ulp of an edge
+        (near-degenerate input); 0 is what certifies the output.
+    turned : bool
+        The crossing was degenerate and was arranged on the mesh turned by a generic rotation (the input's
+        vertices keep their coordinates; the new points moved back carry the rotation's rounding).
+    merged_points : int
+        Intersection points merged into a neighbour within ``tolerances.ARRANGE_MERGE_RTOL`` of the diagonal
+        because, rounded, they left faces crossing (see :func:`_merge_close_points`).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    crossing_pairs: int
+    split_faces: int
+    new_vertices: int
+    patches: int
+    max_winding: int
+    crossings_left: int = 0
+    turned: bool = False
+    merged_points: int = 0
+
+
+# -- exact helpers ---------------------------------------------------------------------------------------------
+
+def _cross(a: tuple[int, ...], b: tuple[int, ...]) -> tuple[int, int, int]:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _sub(a: tuple[int, ...], b: tuple[int, ...]) -> tuple[int, int, int]:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _dot(a: tuple[int, ...], b: tuple[int, ...]) -> int:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _sign(x: int) -> int:
+    return (x > 0) - (x < 0)
+
+
+class _Exact:
+    """Exact integer coordinates (one power-of-two scale) of the vertices involved, and the face planes."""
+
+    def __init__(self, vertices: np.ndarray, used: np.ndarray) -> None:
+        (ints,) = _integers(vertices[used])
+        self.point = {int(k): (int(x), int(y), int(z)) for k, (x, y, z) in zip(used.tolist(), ints.tolist())}
+        self.planes: dict[int, tuple[tuple[int, int, int], int]] = {}
+        flat = vertices[used].reshape(-1)
+        nonzero = np.flatnonzero(flat)
+        #: integer coordinate = float coordinate × scale (a power of two)
+        self.scale = Fraction(int(ints.reshape(-1)[nonzero[0]])) / Fraction(float(flat[nonzero[0]])) \
+            if len(nonzero) else Fraction(1)
+
+    def to_float(self, p: _Hom) -> tuple[float, float, float]:
+        """The float64 nearest to each coordinate of an exact point (rounded once)."""
+        den = self.scale * p[3]
+        return (float(p[0] / den), float(p[1] / den), float(p[2] / den))
+
+    def plane(self, faces: np.ndarray, f: int) -> tuple[tuple[int, int, int], int]:
+        """Normal ``n = (b − a)×(c − a)`` and offset ``n·a`` of face ``f``."""
+        got = self.planes.get(f)
+        if got is None:
+            a, b, c = (self.point[int(i)] for i in faces[f])
+            n = _cross(_sub(b, a), _sub(c, a))
+            got = (n, _dot(n, a))
+            self.planes[f] = got
+        return got
+
+    def edge_point(self, faces: np.ndarray, a: int, b: int, g: int) -> _Hom:
+        """Where the segment from vertex ``a`` to ``b`` meets the plane of face ``g`` (they are on opposite sides)."""
+        n, d = self.plane(faces, g)
+        pa, pb = self.point[a], self.point[b]
+        oa, ob = _dot(n, pa) - d, _dot(n, pb) - d
+        w = oa - ob
+        x = tuple(oa * pb[i] - ob * pa[i] for i in range(3))
+        if w < 0:
+            return (-x[0], -x[1], -x[2], -w)
+        return (x[0], x[1], x[2], w)
+
+    def edge_parameter(self, faces: np.ndarray, a: int, b: int, g: int) -> Fraction:
+        """Position ``t ∈ (0, 1)`` of that point along ``a → b``."""
+        n, d = self.plane(faces, g)
+        oa, ob = _dot(n, self.point[a]) - d, _dot(n, self.point[b]) - d
+        return Fraction(oa, oa - ob)
+
+    def triple_point(self, faces: np.ndarray, f: int, g: int, h: int) -> _Hom | None:
+        """The common point of the planes of three faces (Cramer's rule), or None when they share no single point."""
+        (nf, df), (ng, dg), (nh, dh) = (self.plane(faces, k) for k in (f, g, h))
+        gh, hf, fg = _cross(ng, nh), _cross(nh, nf), _cross(nf, ng)
+        det = _dot(nf, gh)
+        if det == 0:
+            return None
+        x = tuple(df * gh[i] + dg * hf[i] + dh * fg[i] for i in range(3))
+        if det < 0:
+            return (-x[0], -x[1], -x[2], -det)
+        return (x[0], x[1], x[2], det)
+
+
+def _projection(normal: tuple[int, int, int]) -> tuple[int, int]:
+    """Two axes on which a face of this normal projects counter-clockwise (drop the largest normal component)."""
+    k = max(range(3), key=lambda i: abs(normal[i]))
+    i, j = (k + 1) % 3, (k + 2) % 3
+    return (i, j) if normal[k] > 0 else (j, i)
+
+
+def _orient2d(p: tuple[int, int, int], q: tuple[int, int, int], r: tuple[int, int, int]) -> int:
+    """Sign of orient2d of three homogeneous 2-D points (x, y, w), w > 0: +1 counter-clockwise."""
+    return _sign(p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0])
+                 + p[2] * (q[0] * r[1] - q[1] * r[0]))
+
+
+def _inside_face(exact: _Exact, faces: np.ndarray, f: int, p: _Hom) -> int:
+    """+1 when ``p`` (in the plane of ``f``) lies strictly inside face ``f``, 0 on its boundary, −1 outside."""
+    n, _ = exact.plane(faces, f)
+    i, j = _projection(n)
+    q = (p[i], p[j], p[3])
+    corners = [exact.point[int(k)] for k in faces[f]]
+    c2 = [(c[i], c[j], 1) for c in corners]
+    s = [_orient2d(c2[e], c2[(e + 1) % 3], q) for e in range(3)]
+    if min(s) < 0:
+        return -1
+    return 1 if min(s) > 0 else 0
+
+
+# -- step 1: intersection points and segments ----------------------------------------------------------------
+
+def _crossing_points(v: np.ndarray, faces: np.ndarray, pairs: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For each crossing pair, the two ends of its intersection segment: (edge, face) piercings, or the corner
+    the two faces share.
+
+    Returns ``edge_a, edge_b`` (k, 2) vertex ids of the piercing edges and ``face`` (k, 2) the pierced faces;
+    an end at a shared corner ``s`` is ``(s, -1, -1)``.  Raises ArrangementError on a degenerate contact.
+    """
+    F, G = faces[pairs[:, 0]], faces[pairs[:, 1]]
+    k = len(pairs)
+    side_f = np.stack([orient3d_sign(v[G[:, 0]], v[G[:, 1]], v[G[:, 2]], v[F[:, j]]) for j in range(3)], axis=1)
+    side_g = np.stack([orient3d_sign(v[F[:, 0]], v[F[:, 1]], v[F[:, 2]], v[G[:, j]]) for j in range(3)], axis=1)
+    coplanar = np.all(side_g == 0, axis=1)
+    if np.any(coplanar):
+        raise _Degenerate(f"{int(np.count_nonzero(coplanar))} face pairs overlap in one plane facing the same "
+                          "way (a coplanar crossing)")
+    shared_f = np.any(F[:, :, None] == G[:, None, :], axis=2)          # corner j of F is a corner of G
+    shared_g = np.any(G[:, :, None] == F[:, None, :], axis=2)
+    n_shared = shared_f.sum(axis=1)
+    if np.any(n_shared > 1) or np.any((side_f == 0) & ~shared_f) or np.any((side_g == 0) & ~shared_g):
+        raise _Degenerate("a corner of a face lies exactly in the plane of a face it crosses (a degenerate "
+                          "crossing)")
+    rows, ea, eb, pierced = [], [], [], []
+    for own, other, side, target in ((F, G, side_f, pairs[:, 1]), (G, F, side_g, pairs[:, 0])):
+        for j in range(3):
+            r = np.flatnonzero(side[:, j] * side[:, (j + 1) % 3] < 0)
+            if not len(r):
+                continue
+            p, q = own[r, j], own[r, (j + 1) % 3]
+            s = np.stack([orient3d_sign(v[p], v[q], v[other[r, e]], v[other[r, (e + 1) % 3]]) for e in range(3)],
+                         axis=1)
+            inside = np.all(s > 0, axis=1) | np.all(s < 0, axis=1)
+            outside = np.any(s > 0, axis=1) & np.any(s < 0, axis=1)
+            if np.any(~inside & ~outside):
+                raise _Degenerate("an edge passes exactly through an edge or corner of a face it crosses (a "
+                                  "degenerate crossing)")
+            hit = r[inside]
+            rows.append(hit)
+            ea.append(p[inside])
+            eb.append(q[inside])
+            pierced.append(target[hit])
+    one = np.flatnonzero(n_shared == 1)                 # the shared corner ends the segment
+    rows.append(one)
+    ea.append(F[one, np.argmax(shared_f[one], axis=1)])
+    eb.append(np.full(len(one), -1, dtype=np.int64))
+    pierced.append(np.full(len(one), -1, dtype=np.int64))
+    row = np.concatenate(rows)
+    count = np.bincount(row, minlength=k)
+    if np.any(count != 2):
+        raise _Degenerate(f"{int(np.count_nonzero(count != 2))} crossing face pairs do not meet in a segment "
+                          "between two edge crossings (a degenerate crossing)")
+    order = np.argsort(row, kind="stable")
+    edge_a = np.concatenate(ea)[order].reshape(k, 2)
+    edge_b = np.concatenate(eb)[order].reshape(k, 2)
+    face = np.concatenate(pierced)[order].reshape(k, 2)
+    return edge_a, edge_b, face
+
+
+# -- step 2: the triangulation of one face ---------------------------------------------------------------------
+
+class _FaceTriangulation:
+    """A triangulation of one face in its own plane, on exact homogeneous 2-D points."""
+
+    def __init__(self, corners: list[int], xy: dict[int, tuple[int, int, int]]) -> None:
+        self.xy = xy
+        self.tris: list[list[int]] = [list(corners)]
+
+    def orient(self, a: int, b: int, c: int) -> int:
+        return _orient2d(self.xy[a], self.xy[b], self.xy[c])
+
+    def _find_edge(self, a: int, b: int) -> tuple[int, int]:
+        """Triangle holding the directed edge a→b and the index of a in it; (-1, -1) if none."""
+        for t, tri in enumerate(self.tris):
+            for e in range(3):
+                if tri[e] == a and tri[(e + 1) % 3] == b:
+                    return t, e
+        return -1, -1
+
+    def split_boundary(self, a: int, b: int, p: int) -> None:
+        """Insert ``p`` on the boundary edge a→b (p lies on it exactly, by construction)."""
+        t, e = self._find_edge(a, b)
+        if t < 0:
+            raise ArrangementError("internal: a boundary edge was lost while splitting a face")
+        c = self.tris[t][(e + 2) % 3]
+        self.tris[t] = [a, p, c]
+        self.tris.append([p, b, c])
+
+    def insert(self, p: int) -> None:
+        """Insert an interior point: split the triangle holding it (or the two sharing the edge it lies on)."""
+        for t, tri in enumerate(self.tris):
+            s = [self.orient(tri[e], tri[(e + 1) % 3], p) for e in range(3)]
+            if min(s) < 0:
+                continue
+            zeros = s.count(0)
+            if zeros == 0:
+                a, b, c = tri
+                self.tris[t] = [a, b, p]
+                self.tris += [[b, c, p], [c, a, p]]
+                return
+            if zeros > 1:
+                raise _Degenerate("two intersection points coincide in a face (a degenerate crossing)")
+            e = s.index(0)
+            a, b, c = tri[e], tri[(e + 1) % 3], tri[(e + 2) % 3]
+            u, k = self._find_edge(b, a)
+            if u < 0:
+                raise _Degenerate("an intersection point lies exactly on the edge of a face "
+                                       "(a degenerate crossing)")
+            d = self.tris[u][(k + 2) % 3]
+            self.tris[t] = [a, p, c]
+            self.tris.append([p, b, c])
+            self.tris[u] = [b, p, d]
+            self.tris.append([p, a, d])
+            return
+        raise ArrangementError("an intersection point lies outside the face it was computed in (internal)")
+
+    def _crosses(self, u: int, v: int, x: int, y: int) -> bool:
+        """Segment x–y crosses segment u–v at a point interior to both."""
+        return (self.orient(u, v, x) * self.orient(u, v, y) < 0) and (self.orient(x, y, u) * self.orient(x, y, v) < 0)
+
+    def constrain(self, u: int, v: int) -> None:
+        """Make u–v an edge by flipping the edges that cross it (Sloan 1993)."""
+        edges = {(min(t[e], t[(e + 1) % 3]), max(t[e], t[(e + 1) % 3])) for t in self.tris for e in range(3)}
+        if (min(u, v), max(u, v)) in edges:
+            return
+        for x in {i for t in self.tris for i in t} - {u, v}:
+            if self.orient(u, v, x) == 0 and self._between(u, v, x):
+                raise _Degenerate("an intersection segment passes exactly through another point of its face "
+                                       "(a degenerate crossing)")
+        queue = [e for e in edges if u not in e and v not in e and self._crosses(u, v, *e)]
+        limit = 20 * (len(queue) + 2) ** 2 + 100
+        for _ in range(limit):
+            if not queue:
+                return
+            x, y = queue.pop(0)
+            t1, e1 = self._find_edge(x, y)
+            t2, e2 = self._find_edge(y, x)
+            if t1 < 0 or t2 < 0:
+                raise ArrangementError("internal: a crossing edge has no two triangles")
+            z = self.tris[t1][(e1 + 2) % 3]
+            w = self.tris[t2][(e2 + 2) % 3]
+            if self.orient(x, w, z) <= 0 or self.orient(w, y, z) <= 0:
+                queue.append((x, y))           # not convex: come back to it once others have moved
+                continue
+            self.tris[t1] = [x, w, z]
+            self.tris[t2] = [w, y, z]
+            if z not in (u, v) and w not in (u, v) and self._crosses(u, v, z, w):
+                queue.append((z, w))
+        raise ArrangementError("an intersection segment could not be made an edge of its face within the flip bound")
+
+    def _in_circle(self, a: int, b: int, c: int, d: int) -> bool:
+        """d lies inside the circle through the counter-clockwise a, b, c, in float64: only the quality of the
+        triangulation depends on it, never its validity (each flip is checked exactly)."""
+        def xy(i: int) -> tuple[float, float]:
+            p = self.xy[i]
+            return p[0] / p[2], p[1] / p[2]
+        dx, dy = xy(d)
+        rows = []
+        for i in (a, b, c):
+            x, y = xy(i)
+            rows.append((x - dx, y - dy, (x - dx) ** 2 + (y - dy) ** 2))
+        (ax, ay, az), (bx, by, bz), (cx, cy, cz) = rows
+        return ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx) > 0
+
+    def improve(self, fixed: set[tuple[int, int]]) -> None:
+        """Lawson flips of the edges not in ``fixed`` (constraints and the face's boundary) towards the
+        constrained Delaunay triangulation: no thin slivers where a better diagonal exists, so that rounding the
+        new points cannot turn a sliver over (bounded by a fixed number of passes)."""
+        for _ in range(2 * len(self.tris) + 8):
+            where = {(t[e], t[(e + 1) % 3]): (k, e) for k, t in enumerate(self.tris) for e in range(3)}
+            touched: set[int] = set()
+            for (x, y), (t1, e1) in where.items():
+                if x > y or (x, y) in fixed or t1 in touched:
+                    continue
+                other = where.get((y, x))
+                if other is None or other[0] in touched:
+                    continue
+                t2, e2 = other
+                z = self.tris[t1][(e1 + 2) % 3]
+                w = self.tris[t2][(e2 + 2) % 3]
+                if not self._in_circle(x, y, z, w):
+                    continue
+                if self.orient(x, w, z) <= 0 or self.orient(w, y, z) <= 0:
+                    continue
+                self.tris[t1] = [x, w, z]
+                self.tris[t2] = [w, y, z]
+                touched |= {t1, t2}
+            if not touched:
+                return
+
+    def _between(self, u: int, v: int, x: int) -> bool:
+        """x (collinear with u, v) lies strictly between them."""
+        pu, pv, px = (self.xy[i] for i in (u, v, x))
+        du = [Fraction(pu[i], pu[2]) for i in range(2)]
+        dv = [Fraction(pv[i], pv[2]) for i in range(2)]
+        dx = [Fraction(px[i], px[2]) for i in range(2)]
+        s = sum((dx[i] - du[i]) * (dv[i] - du[i]) for i in range(2))
+        length = sum((dv[i] - du[i]) ** 2 for i in range(2))
+        return bool(0 < s < length)
+
+
+# -- step 3: winding numbers of patches ------------------------------------------------------------------------
+
+def _winding_except(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
+                    skip: int) -> tuple[float, float]:
+    """Generalized winding number at ``point`` of every face but ``skip``, and a bound on its rounding error.
+
+    Each face contributes ``Ω/4π`` with ``tan(Ω/2) = det/den`` (Van Oosterom and Strackee 1983), ``det = A·(B×C)``,
+    ``den = |A||B||C| + (A·B)|C| + (A·C)|B| + (B·C)|A|`` for ``A = a − p`` etc.  In float64 ``|Δdet| ≤ 12u·P``
+    (``P`` the permanent of the absolute values, as in the orient3d filter) and ``|Δden| ≤ 100u·|A||B||C|``;
+    the angle of ``(den, det)`` then moves by at most ``asin(h/r) ≤ (π/2)·h/r`` with ``h`` the perturbation and
+    ``r`` its length (when ``h < r``), and atan2 adds a few ulps; where the perturbation reaches atan2's cut
+    (``den < 0``, ``det = 0``: the point lies in a face's plane over it) the angle may jump by 2π, and the bound
+    is infinite.
+    """
+    f = faces
+    ax, ay, az = (vertices[f[:, 0], k] - point[k] for k in range(3))
+    bx, by, bz = (vertices[f[:, 1], k] - point[k] for k in range(3))
+    cx, cy, cz = (vertices[f[:, 2], k] - point[k] for k in range(3))
+    la = np.sqrt(ax * ax + ay * ay + az * az)
+    lb = np.sqrt(bx * bx + by * by + bz * bz)
+    lc = np.sqrt(cx * cx + cy * cy + cz * cz)
+    det = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)
+    den = la * lb * lc + (ax * bx + ay * by + az * bz) * lc + (ax * cx + ay * cy + az * cz) * lb \
+        + (bx * cx + by * cy + bz * cz) * la
+    aax, aay, aaz, abx, aby, abz = np.abs(ax), np.abs(ay), np.abs(az), np.abs(bx), np.abs(by), np.abs(bz)
+    acx, acy, acz = np.abs(cx), np.abs(cy), np.abs(cz)
+    perm = (aax * (aby * acz + abz * acy) + aay * (abz * acx + abx * acz) + aaz * (abx * acy + aby * acx))
+    h = 12 * _U * perm + 100 * _U * la * lb * lc
+    r = np.hypot(det, den) - h
+    with np.errstate(divide="ignore", invalid="ignore"):
+        angle_error = np.where(r > h, (np.pi / 2) * h / np.maximum(r, 1e-300), np.inf)
+    # atan2 jumps by 2π across den < 0, det = 0 (a point in the plane of a face, over it): unbounded there
+    angle_error[(np.abs(det) <= h) & (den <= h)] = np.inf
+    theta = np.arctan2(det, den)
+    theta[skip] = angle_error[skip] = 0.0
+    total = float(np.sum(theta)) / (2 * np.pi)
+    bound = float(np.sum(angle_error + 4 * _U * np.abs(theta))) / (2 * np.pi) + len(f) * 4 * _U
+    return total, bound
+
+
+def _patches(faces: np.ndarray, n_vertices: int, cut: set[int]) -> tuple[np.ndarray, int]:
+    """Patches: faces joined through edges used by exactly two faces in opposite directions and not in ``cut``
+    (the undirected keys of intersection edges)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    key, forward = edge_keys(faces, n_vertices)
+    order = np.argsort(key, kind="stable")
+    sk = key[order]
+    starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
+    count = np.diff(np.r_[starts, len(sk)])
+    pair = starts[count == 2]
+    ok = forward[order[pair]] != forward[order[pair + 1]]
+    if cut:
+        ok &= ~np.isin(sk[pair], np.fromiter(cut, dtype=np.int64, count=len(cut)))
+    pair = pair[ok]
+    a, b = order[pair] // 3, order[pair + 1] // 3
+    m = len(faces)
+    n, labels = connected_components(coo_matrix((np.ones(len(a), dtype=np.int8), (a, b)), shape=(m, m)),
+                                     directed=False)
+    return labels, int(n)
+
+
+# -- entry point -----------------------------------------------------------------------------------------------
+
+def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndarray | None = None, *,
+                      turn: bool = True) -> Arrangement:
+    """The boundary of ``{w ≥ 1}`` of a closed surface that passes through itself (see the module docstring).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        m (any unit).
+    faces : (m, 3) int
+        A closed, consistently oriented surface (one or several shells), wound so that its inside has a
+        positive winding number.
+    crossing : (k, 2) int, optional
+        The face pairs that cross (``surface_contacts(vertices, faces).crossing``); computed when not given.
+    turn : bool
+        When the crossing is degenerate (symmetric meshes: a corner exactly in the plane of a face it crosses),
+        arrange the surface again turned by a fixed generic rotation about its centre; the input's vertices keep
+        their coordinates, the new points are turned back (rounded), and ``turned`` says so.
+
+    Returns
+    -------
+    Arrangement
+
+    Raises
+    ------
+    ArrangementError
+        A degenerate crossing (coplanar overlapping faces, an edge through an edge or a corner), a patch whose
+        winding number cannot be certified, or an output that fails its checks; the message says which.
+    """
+    v = np.ascontiguousarray(vertices, dtype=np.float64)
+    f = np.ascontiguousarray(faces, dtype=np.int64)
+    try:
+        out_v, kept, stats = _arrange(v, f, crossing)
+        turned = False
+    except _Degenerate as exc:
+        if not turn:
+            raise
+        from .nesting import _rotation
+        rot = _rotation(_TURN)
+        centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
+        try:
+            out_v, kept, stats = _arrange((v - centre) @ rot.T + centre, f, None)
+        except _Degenerate as again:
+            raise _Degenerate(f"{exc} (and again on the mesh turned: {again})") from None
+        out_v[len(v):] = (out_v[len(v):] - centre) @ rot + centre
+        out_v[:len(v)] = v
+        turned = True
+    result_v, result_f = _compact(out_v, kept)
+    topo = edge_topology(result_f, len(result_v))
+    if not topo.oriented:
+        raise ArrangementError(f"the surface of winding number ≥ 1 is not closed ({topo.boundary_edges} open, "
+                               f"{topo.nonmanifold_edges} non-manifold, {topo.misoriented_edges} misoriented edges)")
+    after = surface_contacts(result_v, result_f)
+    if not after.complete:
+        raise ArrangementError("the face-intersection check of the surface of winding number ≥ 1 did not finish")
+    merged = 0
+    if len(after.crossing):
+        merged_v, merged_f, merged = _merge_close_points(out_v, kept, len(v))
+        if merged and edge_topology(merged_f, len(merged_v)).oriented:
+            rechecked = surface_contacts(merged_v, merged_f)
+            if rechecked.complete and len(rechecked.crossing) < len(after.crossing):
+                result_v, result_f, after = merged_v, merged_f, rechecked
+            else:
+                merged = 0
+        else:
+            merged = 0
+    return Arrangement(vertices=result_v, faces=result_f, crossings_left=len(after.crossing), turned=turned,
+                       merged_points=merged, **stats)
+
+
+def _merge_close_points(vertices: np.ndarray, faces: np.ndarray, n_input: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """Merge intersection points (ids ≥ ``n_input``) lying within ``ARRANGE_MERGE_RTOL`` of the diagonal of
+    another point of the surface (into the input's vertex when there is one), drop the faces that collapse and
+    pairs of faces left as one face and its reverse; return the compacted surface and the count merged."""
+    lo, hi = vertices[faces.reshape(-1)].min(axis=0), vertices[faces.reshape(-1)].max(axis=0)
+    limit = ARRANGE_MERGE_RTOL * float(np.linalg.norm(hi - lo))
+    from scipy.spatial import cKDTree
+    used = np.unique(faces)
+    new = used[used >= n_input]
+    if not len(new):
+        return vertices, faces, 0
+    near = cKDTree(vertices[used]).query_ball_point(vertices[new], r=limit)
+    a = np.repeat(new, [len(n) for n in near])
+    b = used[np.concatenate([np.asarray(n, dtype=np.int64) for n in near])] if len(a) else a
+    short = a != b
+    target = np.arange(len(vertices))
+
+    def root(i: int) -> int:
+        while target[i] != i:
+            target[i] = target[target[i]]
+            i = int(target[i])
+        return i
+
+    merged = 0
+    for x, y in zip(a[short].tolist(), b[short].tolist()):
+        rx, ry = root(x), root(y)
+        if rx != ry:
+            keep, drop = (rx, ry) if rx < ry else (ry, rx)      # input vertices have the smaller ids
+            target[drop] = keep
+            merged += 1
+    if not merged:
+        return vertices, faces, 0
+    final = np.array([root(i) for i in range(len(vertices))])
+    f = final[faces]
+    f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 2] != f[:, 0])]
+    canon = np.sort(f, axis=1)
+    parity = _cyclic_parity(f)
+    key = np.unique(canon, axis=0, return_inverse=True)[1].reshape(-1)
+    net = np.bincount(key, weights=np.where(parity, 1, -1))
+    count = np.bincount(key)
+    f = f[~((count[key] == 2) & (net[key] == 0))]          # a face and its reverse: a sheet of no volume
+    out_v, out_f = _compact(vertices, f)
+    return out_v, out_f, merged
+
+
+def _cyclic_parity(faces: np.ndarray) -> np.ndarray:
+    """(m,) bool: each face's corners are an even (cyclic) permutation of their sorted order."""
+    order = np.argsort(faces, axis=1)
+    return np.asarray([(o[0], o[1], o[2]) in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) for o in order.tolist()])
+
+
+def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple[np.ndarray, np.ndarray,
+                                                                                dict[str, int]]:
+    """The split surface's vertices, the kept faces (w_front = 0) and the counts for :class:`Arrangement`."""
+    n = len(v)
+    if crossing is None:
+        found = surface_contacts(v, f)
+        if not found.complete:
+            raise ArrangementError("the face-intersection check did not finish")
+        crossing = found.crossing
+    pairs = np.unique(np.sort(np.asarray(crossing, dtype=np.int64).reshape(-1, 2), axis=1), axis=0)
+    if not len(pairs):
+        raise ArrangementError("no crossing face pairs to arrange")
+    edge_a, edge_b, pierced = _crossing_points(v, f, pairs)
+    split = np.unique(pairs)
+    exact = _Exact(v, np.unique(f[split]))
+
+    # 1. points: (edge, face) piercings, then triple points
+    point_id: dict[tuple[int, int], int] = {}
+    hom: dict[int, _Hom] = {}
+    for vid, p in exact.point.items():
+        hom[vid] = (p[0], p[1], p[2], 1)
+    new_xyz: list[tuple[float, float, float]] = []
+    on_edge: dict[tuple[int, int], list[tuple[Fraction, int]]] = {}
+
+    def add_point(h: _Hom) -> int:
+        vid = n + len(new_xyz)
+        hom[vid] = h
+        new_xyz.append(exact.to_float(h))
+        return vid
+
+    segment_ends = np.zeros((len(pairs), 2), dtype=np.int64)
+    for r in range(len(pairs)):
+        for s in range(2):
+            a, b, g = int(edge_a[r, s]), int(edge_b[r, s]), int(pierced[r, s])
+            if g < 0:                       # the corner both faces share
+                segment_ends[r, s] = a
+                continue
+            lo, hi = min(a, b), max(a, b)
+            key = (lo * n + hi, g)
+            got = point_id.get(key)
+            if got is None:
+                got = add_point(exact.edge_point(f, lo, hi, g))
+                point_id[key] = got
+                on_edge.setdefault((lo, hi), []).append((exact.edge_parameter(f, lo, hi, g), got))
+            segment_ends[r, s] = got
+    pair_row = {(int(a), int(b)): r for r, (a, b) in enumerate(pairs.tolist())}
+    partners: dict[int, list[int]] = {}
+    for a, b in pairs.tolist():
+        partners.setdefault(a, []).append(b)
+        partners.setdefault(b, []).append(a)
+    on_segment: dict[int, list[int]] = {}
+    interior: dict[int, list[int]] = {}
+    seen: set[tuple[int, int, int]] = set()
+    for a in sorted(partners):
+        for g, h in combinations(sorted(partners[a]), 2):
+            trio = tuple(sorted((a, g, h)))
+            if (g, h) not in pair_row or trio in seen:
+                continue
+            seen.add(trio)  # type: ignore[arg-type]
+            if set(f[trio[0]].tolist()) & set(f[trio[1]].tolist()) & set(f[trio[2]].tolist()):
+                continue                    # three faces around one corner meet there, not at a new point
+            meet = exact.triple_point(f, *trio)
+            inside = [_inside_face(exact, f, k, meet) for k in trio] if meet is not None else [-1]
+            if meet is None and _common_line(exact, f, trio):
+                raise _Degenerate("three faces cross along one common line (a degenerate crossing)")
+            if min(inside) < 0:
+                continue
+            if min(inside) == 0:
+                raise _Degenerate("two intersection curves meet exactly on an edge (a degenerate crossing)")
+            if meet is None:
+                continue
+            triple = add_point(meet)
+            for x, y in ((trio[0], trio[1]), (trio[0], trio[2]), (trio[1], trio[2])):
+                on_segment.setdefault(pair_row[(x, y)], []).append(triple)
+            for k in trio:
+                interior.setdefault(k, []).append(triple)
+    # points of each crossed edge in order, shared by the faces around it
+    for pts in on_edge.values():
+        pts.sort()
+        if any(pts[i][0] == pts[i + 1][0] for i in range(len(pts) - 1)):
+            raise _Degenerate("two faces cross one edge at the same point (a degenerate crossing)")
+    # pieces of each intersection segment, cut at its triple points
+    cut_edges: list[tuple[int, int, int]] = []          # (pair row, u, v)
+    for r in range(len(pairs)):
+        e0, e1 = int(segment_ends[r, 0]), int(segment_ends[r, 1])
+        chain = [e0, e1]
+        mids = on_segment.get(r, [])
+        if mids:
+            p0, p1 = hom[e0], hom[e1]
+            d = [Fraction(p1[i], p1[3]) - Fraction(p0[i], p0[3]) for i in range(3)]
+
+            def along(vid: int, p0: _Hom = p0, d: list[Fraction] = d) -> Fraction:
+                q = hom[vid]
+                return sum((Fraction(q[i], q[3]) - Fraction(p0[i], p0[3])) * d[i] for i in range(3)) or Fraction(0)
+
+            ordered = sorted(mids, key=along)
+            keys = [along(x) for x in ordered]
+            if any(keys[i] == keys[i + 1] for i in range(len(keys) - 1)):
+                raise _Degenerate("two triple points coincide (four faces through one point)")
+            chain = [e0, *ordered, e1]
+        cut_edges += [(r, chain[i], chain[i + 1]) for i in range(len(chain) - 1)]
+    # interior piercing points of each face: an edge of another face through it
+    for r in range(len(pairs)):
+        for s in range(2):
+            if pierced[r, s] >= 0:
+                interior.setdefault(int(pierced[r, s]), []).append(int(segment_ends[r, s]))
+    constraints: dict[int, list[tuple[int, int]]] = {}
+    for r, a, b in cut_edges:
+        for k in pairs[r]:
+            constraints.setdefault(int(k), []).append((a, b))
+
+    # 2. every crossed face triangulated in its plane
+    edges_with_points = set(on_edge)
+    pieces: list[list[int]] = []
+    source: list[int] = []
+    for face in split.tolist():
+        corners = [int(x) for x in f[face]]
+        normal, _ = exact.plane(f, face)
+        i, j = _projection(normal)
+        verts = set(corners) | set(interior.get(face, []))
+        for e in range(3):
+            a, b = corners[e], corners[(e + 1) % 3]
+            verts |= {vid for _, vid in on_edge.get((min(a, b), max(a, b)), [])}
+        if len(verts) > MAX_POINTS_PER_FACE:
+            raise ArrangementError(f"a face is crossed at {len(verts) - 3:,} points, more than the arrangement's "
+                                   f"work bound of {MAX_POINTS_PER_FACE:,} per face")
+        xy = {vid: (hom[vid][i], hom[vid][j], hom[vid][3]) for vid in verts}
+        tri = _FaceTriangulation(corners, xy)
+        for e in range(3):
+            a, b = corners[e], corners[(e + 1) % 3]
+            along_edge = [vid for _, vid in on_edge.get((min(a, b), max(a, b)), [])]
+            if a > b:
+                along_edge = along_edge[::-1]
+            prev = a
+            for q in along_edge:
+                tri.split_boundary(prev, b, q)
+                prev = q
+            edges_with_points.discard((min(a, b), max(a, b)))
+        for q in sorted(set(interior.get(face, []))):
+            tri.insert(q)
+        for a, b in constraints.get(face, []):
+            tri.constrain(a, b)
+        fixed = {(min(a, b), max(a, b)) for a, b in constraints.get(face, [])}
+        for e in range(3):                    # the face's boundary, split at its points
+            a, b = corners[e], corners[(e + 1) % 3]
+            chain = [a, *[vid for _, vid in on_edge.get((min(a, b), max(a, b)), [])][::(1 if a < b else -1)], b]
+            fixed |= {(min(p, q), max(p, q)) for p, q in zip(chain[:-1], chain[1:])}
+        tri.improve(fixed)
+        pieces += tri.tris
+        source += [face] * len(tri.tris)
+    if edges_with_points:
+        raise ArrangementError("an edge crossed by a face belongs to a face that crosses nothing (internal)")
+
+    # 3. labels
+    is_split = np.zeros(len(f), dtype=bool)
+    is_split[split] = True
+    whole = np.flatnonzero(~is_split)
+    out_faces = np.vstack([f[whole], np.asarray(pieces, dtype=np.int64).reshape(-1, 3)])
+    out_source = np.r_[whole, np.asarray(source, dtype=np.int64)]
+    out_v = np.vstack([v, np.asarray(new_xyz, dtype=np.float64).reshape(-1, 3)])
+    n_all = len(out_v)
+    cut = {min(a, b) * n_all + max(a, b) for _, a, b in cut_edges}
+    patch, n_patches = _patches(out_faces, n_all, cut)
+    front = _label_patches(out_v, out_faces, out_source, patch, n_patches, v, f)
+    w_front = front[patch]
+    first_piece = len(whole)                  # cut edges border pieces only
+    _check_curves(out_faces[first_piece:], n_all, cut, out_source[first_piece:], w_front[first_piece:])
+
+    # 4. the faces bounding {w ≥ 1}, compacted
+    kept = out_faces[w_front == 0]
+    if not len(kept):
+        raise ArrangementError("no face bounds the region of winding number ≥ 1 (the surface is wound inward)")
+    return out_v, kept, dict(crossing_pairs=len(pairs), split_faces=len(split), new_vertices=len(new_xyz),
+                             patches=n_patches, max_winding=int(front.max()) + 1)
+
+
+def _compact(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The used vertices (in order) and the faces renumbered onto them (linear time)."""
+    used = np.zeros(len(vertices), dtype=bool)
+    used[faces.reshape(-1)] = True
+    remap = np.cumsum(used) - 1
+    return vertices[used], remap[faces].astype(np.int64)
+
+
+def _common_line(exact: _Exact, faces: np.ndarray, trio: tuple[int, ...]) -> bool:
+    """Whether the three faces' planes share a common line (their normals are coplanar and the planes meet)."""
+    (n1, d1), (n2, d2), (n3, d3) = (exact.plane(faces, k) for k in trio)
+    # planes through one line: the 3x4 matrix [n | d] has rank 2
+    m = [list(n1) + [d1], list(n2) + [d2], list(n3) + [d3]]
+    minors = []
+    for cols in combinations(range(4), 3):
+        a = [[m[r][c] for c in cols] for r in range(3)]
+        minors.append(a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+                      - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+                      + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]))
+    return all(x == 0 for x in minors)
+
+
+def _label_patches(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndarray, patch: np.ndarray,
+                   n_patches: int, v: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """(p,) int: the winding number in front of each patch, from one certified evaluation at a face of it."""
+    p0, p1, p2 = out_v[out_faces[:, 0]], out_v[out_faces[:, 1]], out_v[out_faces[:, 2]]
+    u, w = p1 - p0, p2 - p0
+    area2 = ((u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1]) ** 2 + (u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2]) ** 2
+             + (u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]) ** 2)
+    del p0, p1, p2, u, w
+    order = np.lexsort((-area2, patch))
+    starts = np.searchsorted(patch[order], np.arange(n_patches + 1))
+    front = np.zeros(n_patches, dtype=np.int64)
+    for p in range(n_patches):
+        members = order[starts[p]:starts[p + 1]]
+        for k in members[:_TRIES].tolist():
+            total, bound = _winding_except(out_v[out_faces[k]].mean(axis=0), v, f, int(out_source[k]))
+            nearest = np.floor(total) + 0.5
+            if bound + abs(total - nearest) < WINDING_MARGIN:
+                front[p] = int(np.floor(total))
+                break
+        else:
+            raise ArrangementError(f"the winding number of a patch of {len(members):,} faces could not be certified "
+                                   "(every point tried is too close to another surface for float64)")
+    return front
+
+
+def _check_curves(faces: np.ndarray, n_vertices: int, cut: set[int], source: np.ndarray, w_front: np.ndarray) -> None:
+    """Across every intersection edge, the two pieces of one input face differ by exactly one turn (the other
+    face's sheet lies between them); raise ArrangementError otherwise."""
+    if not cut:
+        return
+    key, _ = edge_keys(faces, n_vertices)
+    on_cut = np.isin(key, np.fromiter(cut, dtype=np.int64, count=len(cut)))
+    idx = np.flatnonzero(on_cut)
+    face = idx // 3
+    group = key[idx]
+    order = np.lexsort((source[face], group))
+    g, s, w = group[order], source[face][order], w_front[face][order]
+    starts = np.flatnonzero(np.r_[True, (g[1:] != g[:-1]) | (s[1:] != s[:-1])])
+    lengths = np.diff(np.r_[starts, len(g)])
+    if np.any(lengths != 2):
+        raise ArrangementError("an intersection edge is not bordered by two pieces of each face (internal)")
+    if np.any(np.abs(w[starts] - w[starts + 1]) != 1):
+        raise ArrangementError("the winding numbers of the patches do not change by one across an intersection "
+                               "curve (inconsistent labels)")
+
+
+@frozen_value
+class ArrangedShells:
+    """A surface whose self-crossing shells were each replaced by the boundary of their ``{w ≥ 1}``.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float64
+        m; the used vertices of the input, then the new intersection points.
+    faces : (k, 3) int64
+        The shells that did not cross themselves, as given, then the arranged ones (wound outward).
+    arrangements : tuple of Arrangement
+        One per self-crossing shell, in shell order.
+    inside_out : int
+        Self-crossing shells wound inward as a whole (negative signed volume), turned before arranging.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    arrangements: tuple[Arrangement, ...]
+    inside_out: int
+
+    @property
+    def crossings_left(self) -> int:
+        """Face pairs of the arranged shells still crossing by rounding (0 certifies them)."""
+        return sum(a.crossings_left for a in self.arrangements)
+
+
+def arrange_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
+                   crossing: np.ndarray) -> ArrangedShells:
+    """Replace each shell that passes through itself by the boundary of its own ``{w ≥ 1}`` (rule R3).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+        A closed, consistently oriented surface.
+    labels : (m,) int
+        Shell of each face.
+    crossing : (k, 2) int
+        Crossing face pairs of the whole surface (those within one shell are arranged).
+
+    Raises
+    ------
+    ArrangementError
+        When a shell's arrangement fails (see :func:`arrange_crossings`).
+    """
+    from ..integrals import volume_moments
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    labels = np.asarray(labels)
+    pairs = np.asarray(crossing, dtype=np.int64).reshape(-1, 2)
+    pairs = pairs[labels[pairs[:, 0]] == labels[pairs[:, 1]]]
+    shells = np.unique(labels[pairs[:, 0]])
+    position = np.full(len(f), -1, dtype=np.int64)
+    parts_v, parts_f, done = [v], [f[~np.isin(labels, shells)]], []
+    offset, inside_out = len(v), 0
+    for s in shells.tolist():
+        idx = np.flatnonzero(labels == s)
+        position[idx] = np.arange(len(idx))
+        used, inverse = np.unique(f[idx], return_inverse=True)
+        sv, sf = v[used], inverse.reshape(-1, 3).astype(np.int64)
+        if volume_moments(sv, sf).volume < 0:        # wound inward as a whole: {w ≥ 1} of the turned shell
+            sf = sf[:, ::-1].copy()
+            inside_out += 1
+        mine = pairs[labels[pairs[:, 0]] == s]
+        arranged = arrange_crossings(sv, sf, position[mine])
+        done.append(arranged)
+        parts_v.append(arranged.vertices)
+        parts_f.append(arranged.faces + offset)
+        offset += len(arranged.vertices)
+    out_v, out_f = _compact(np.vstack(parts_v), np.vstack(parts_f))
+    return ArrangedShells(vertices=out_v, faces=out_f, arrangements=tuple(done), inside_out=inside_out)
