@@ -18,9 +18,7 @@ from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
 from ..dynamics.spin_stability import stability
 from ..robot.inertial import FRAMES, inertial_frame
-from ..mesh.cad import BREP_SUFFIXES, has_ocp
 from ..reports.cad import CAD_UNITS, format_cad_report
-from ..reports.frame import format_frame_inertia, frame_inertia_dict, frame_inertia_section
 from ..reports.models import format_model_note
 from ..robot.formats import ROBOT_FORMATS, format_inertial
 from .help import add_command
@@ -90,6 +88,7 @@ def run(args) -> int:
         from ..reports.brep import brep_html_section
         extra.append(brep_html_section(cad, props.density))
     if system is not None:
+        from ..reports.frame import format_frame_inertia, frame_inertia_dict, frame_inertia_section
         extra.append(frame_inertia_section(system))
     write_report_from_args(args, props, described + model_words(model), messages, meshes=loaded.meshes,
                            stability=stab if stab is not None else stab_error, model=model, extra_sections=extra,
@@ -140,6 +139,7 @@ def _brep_section(args):
     files = list(args.files) if isinstance(args.files, (list, tuple)) else [args.files]
     if len(files) != 1 or getattr(args, "model", "solid") != "solid" or getattr(args, "shell", None):
         return None
+    from ..mesh.cad import BREP_SUFFIXES, has_ocp      # imported on use, like the B-rep comparison below
     path = split_part_spec(files[0])[0]
     if os.path.splitext(path)[1].lower() not in BREP_SUFFIXES or not has_ocp():
         return None

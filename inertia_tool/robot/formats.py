@@ -7,12 +7,16 @@ what the three formats define.  The mesh axes are the link (body) frame.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..errors import UsageError
-from .inertial import InertialFrame
 from ..reports.escape import escape_terminal
 from ..reports.numbers import number
+
+if TYPE_CHECKING:
+    from .inertial import InertialFrame
 
 __all__ = ["format_urdf", "format_sdf", "format_mjcf", "ROBOT_FORMATS", "format_inertial"]
 
