@@ -49,7 +49,7 @@ __all__ = ["BREP_SUFFIXES", "DEFAULT_CHORD_RTOL", "DEFAULT_ANGULAR_DEFLECTION", 
 FUSIONS = ("one solid", "apart", "fused", "failed")
 
 #: CAD exchange suffixes read as B-reps.
-BREP_SUFFIXES = (".step", ".stp", ".iges", ".igs")
+from .read import BREP_SUFFIXES   # noqa: E402 - defined with the other suffixes, where the reader needs it
 
 #: Default chord tolerance as a fraction of the bounding-box diagonal.
 DEFAULT_CHORD_RTOL = 1e-4

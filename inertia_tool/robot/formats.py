@@ -23,6 +23,10 @@ __all__ = ["format_urdf", "format_sdf", "format_mjcf", "ROBOT_FORMATS", "format_
 #: Format names accepted by :func:`format_inertial`.
 ROBOT_FORMATS = ("urdf", "sdf", "mjcf")
 
+#: Inertial frame orientations (:func:`inertia_tool.robot.inertial.inertial_frame`): the principal frame
+#: (diagonal tensor) or the link/mesh axes (full tensor).
+FRAMES = ("principal", "mesh")
+
 _FRAME_TEXT = {
     "principal": "principal axes at the centre of mass, the rotation nearest the link frame (diagonal tensor)",
     "mesh": "centre of mass, axes parallel to the mesh (link) axes (full tensor)",
