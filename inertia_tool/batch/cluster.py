@@ -11,7 +11,7 @@ from typing import Any
 
 from ..errors import UsageError
 
-__all__ = ["DaskCluster", "LOCAL_CLUSTER_CONFIG", "connect_dask"]
+__all__ = ["DaskCluster", "LOCAL_CLUSTER_CONFIG", "connect_dask", "check_workers_read"]
 
 
 def _warm_up() -> int:
@@ -135,3 +135,38 @@ def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> Da
         connected.close()
         raise
     return connected
+
+
+def _unreadable(paths: list[str]) -> list[str]:
+    """Run on a worker: the ones of ``paths`` it cannot open for reading."""
+    import os
+
+    return [p for p in paths if not os.access(p, os.R_OK)]
+
+
+def check_workers_read(client: Any, paths: list[str]) -> None:
+    """Refuse to start a batch that some worker of ``client``'s cluster would read differently from this process.
+
+    The workers of a cluster of several machines must see the mesh files at the same absolute paths (a shared
+    file system mounted alike).  A worker that cannot would write an ``error`` row for each file it is given,
+    and ``error`` rows count as done on resume (a bad file stays bad), so the mistake would outlive the run.
+    Each worker is asked whether it can read ``paths`` (a sample: the first and last file of the batch).
+
+    Raises
+    ------
+    UsageError
+        A worker cannot read one of ``paths`` (the message names the worker and the file), or the workers
+        cannot be asked.
+    """
+    if not paths:
+        return
+    try:
+        answers = client.run(_unreadable, list(paths))
+    except (OSError, TimeoutError) as exc:
+        raise UsageError(f"the Dask workers did not answer whether they can read the files ({exc})") from None
+    for worker, missing in sorted(answers.items()):
+        if missing:
+            raise UsageError(f"the Dask worker {worker} cannot read {missing[0]} (expected every worker to see the "
+                             "files at the same absolute paths as this machine: a shared file system mounted "
+                             "alike; see docs/batch.md, 'Running on several machines')")
+
