@@ -56,7 +56,8 @@ def scheduler_and_two_workers(tmp_path_factory):
     where = tmp_path_factory.mktemp("cluster")
     scheduler_file = where / "scheduler.json"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
-           "INERTIA_TOOL_THREADS": "1", "DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED": "False"}
+           "INERTIA_TOOL_THREADS": "1", "DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED": "False",
+           "DASK_DISTRIBUTED__WORKER__MEMORY__MONITOR_INTERVAL": "1s"}
     started: list[subprocess.Popen] = []
 
     def start(*args: str, log: str) -> None:

@@ -47,6 +47,11 @@ LOCAL_CLUSTER_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.system-monitor.interval": "5s",
     "distributed.admin.tick.interval": "1s",
+    # each worker and each nanny (the nannies run in the batch's process) read the worker's memory every 100 ms
+    # by default, for the spill, pause and terminate thresholds: about half of an idle cluster's CPU (idle, 12 ms
+    # of CPU per second in the two workers and 12-17 in the batch's process; 6 and 7 with 1 s).  A batch holds
+    # one part at a time per worker, bounded by --max-faces; a second is soon enough to see it grow.
+    "distributed.worker.memory.monitor-interval": "1s",
 }
 
 
