@@ -42,6 +42,7 @@ NOT_FOR_A_CLOSED_STL = [
     "OCP", "mujoco", "tempfile", "shutil", "html", "inertia_tool.mesh.estimate", "inertia_tool.mesh.seal",
     "inertia_tool.mesh.merge", "inertia_tool.mesh.orient", "inertia_tool.mesh.winding", "inertia_tool.mesh.cad",
     "inertia_tool.robot.inertial", "inertia_tool.output", "inertia_tool.isolate", "inertia_tool.reports.frame",
+    "inertia_tool.mass.materials", "inertia_tool.mesh.parts", "inertia_tool.mesh.overlap",
     "inertia_tool.balancing", "inertia_tool.batch", "inertia_tool.design", "inertia_tool.dynamics.simulation",
     "inertia_tool.dynamics.top", "inertia_tool.mass.shapes", "inertia_tool.mass.thinwall",
     "inertia_tool.mass.surface", "inertia_tool.mass.brep", "inertia_tool.reports.html",
