@@ -70,16 +70,17 @@ def _key(value: Any) -> object:
     return value
 
 
-_FIELD_NAMES: dict[type, tuple[tuple[str, ...], tuple[str, ...]]] = {}
+_FIELD_NAMES: dict[type, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]] = {}
 
 
-def _field_names(cls: type) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """``(all field names, compared field names)`` of a dataclass, computed once per class (``dataclasses.fields``
-    was a tenth of the engine's Python time on a small part)."""
+def _field_names(cls: type) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
+    """``(all field names, compared field names, shown field names)`` of a dataclass, computed once per class
+    (``dataclasses.fields`` was a tenth of the engine's Python time on a small part)."""
     names = _FIELD_NAMES.get(cls)
     if names is None:
         fields = dataclasses.fields(cls)
-        names = _FIELD_NAMES[cls] = (tuple(f.name for f in fields), tuple(f.name for f in fields if f.compare))
+        names = _FIELD_NAMES[cls] = (tuple(f.name for f in fields), tuple(f.name for f in fields if f.compare),
+                                     tuple(f.name for f in fields if f.repr))
     return names
 
 
@@ -93,6 +94,12 @@ def _eq(self: Any, other: Any) -> bool:
 def _hash(self: Any) -> int:
     return hash((self.__class__.__name__,) + tuple(_key(getattr(self, name))
                                                    for name in _field_names(self.__class__)[1]))
+
+
+def _repr(self: Any) -> str:
+    """``Name(field=value, ...)`` over the fields declared ``repr=True``, as a dataclass writes it."""
+    shown = ", ".join(f"{name}={getattr(self, name)!r}" for name in _field_names(self.__class__)[2])
+    return f"{self.__class__.__qualname__}({shown})"
 
 
 @dataclass_transform(frozen_default=True, eq_default=False)
@@ -112,7 +119,12 @@ def frozen_value(cls: type[_T]) -> type[_T]:
     built: Any = cls
     # set before the dataclass is made: its generated __init__ calls __post_init__ only if it exists then
     built.__post_init__ = __post_init__
-    built = dataclasses.dataclass(frozen=True, eq=False)(built)
+    # one __repr__ for every class instead of one compiled per class (dataclass compiles each method it writes:
+    # a fifth of the time of making the class, and every command line run makes some twenty at import)
+    own_repr = "__repr__" in cls.__dict__
+    built = dataclasses.dataclass(frozen=True, eq=False, repr=False)(built)
+    if not own_repr:
+        built.__repr__ = _repr
     built.__eq__ = _eq
     built.__hash__ = _hash
     result: type[_T] = built

@@ -120,6 +120,8 @@ def test_local_cluster_workers_run_without_the_profiler(cluster):
 
     seen = cluster.client.run(lambda: dask.config.get("distributed.worker.profile.enabled"))
     assert set(seen.values()) == {False}
+    seen = cluster.client.run(lambda: dask.config.get("distributed.worker.memory.monitor-interval"))
+    assert set(seen.values()) == {"1s"}                                      # not every 100 ms
     assert dask.config.get("distributed.worker.profile.enabled") is True       # this process's config untouched
 
 

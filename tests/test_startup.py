@@ -1,4 +1,4 @@
-"""What a run imports (issue #15, "small files: instant small runs").
+"""What a run imports (issue #15, "small files: instant small runs"; issue 25 item 4, within 1.3x ``import numpy``).
 
 ``inertia-tool analyze`` on a closed STL imports only the layers it uses: no scipy, trimesh, matplotlib or
 manifold3d, and none of the other subcommands, the balancing, design, batch, simulation, thin-wall or HTML
@@ -33,9 +33,16 @@ print(code)
 print("\\n".join(sorted(sys.modules)))
 """
 
-#: Never imported by ``analyze`` of a closed single-shell STL (scipy: when the C extension is built).
+#: Never imported by ``analyze`` of a closed single-shell STL (scipy: when the C extension is built).  Besides
+#: the heavy third-party packages: the repair stages (a closed surface never reaches them), the CAD reader, the
+#: robot inertial frames, the file writers (tempfile, shutil: argparse's help width is read without shutil)
+#: and HTML escaping; issue 25 item 4 found most of them imported on every run.
 NOT_FOR_A_CLOSED_STL = [
-    "scipy", "trimesh", "matplotlib", "manifold3d", "networkx", "lxml",
+    "scipy", "trimesh", "matplotlib", "manifold3d", "networkx", "lxml", "jsonschema", "dask", "distributed",
+    "OCP", "mujoco", "tempfile", "shutil", "html", "inertia_tool.mesh.estimate", "inertia_tool.mesh.seal",
+    "inertia_tool.mesh.merge", "inertia_tool.mesh.orient", "inertia_tool.mesh.winding", "inertia_tool.mesh.cad",
+    "inertia_tool.robot.inertial", "inertia_tool.output", "inertia_tool.isolate", "inertia_tool.reports.frame",
+    "inertia_tool.mass.materials", "inertia_tool.mesh.parts", "inertia_tool.mesh.overlap",
     "inertia_tool.balancing", "inertia_tool.batch", "inertia_tool.design", "inertia_tool.dynamics.simulation",
     "inertia_tool.dynamics.top", "inertia_tool.mass.shapes", "inertia_tool.mass.thinwall",
     "inertia_tool.mass.surface", "inertia_tool.mass.brep", "inertia_tool.reports.html",
@@ -70,8 +77,27 @@ def test_analyze_of_a_closed_stl_imports_only_what_it_uses(options):
     expected_absent = [n for n in NOT_FOR_A_CLOSED_STL if HAVE_ACCEL or n != "scipy"]
     assert [n for n in expected_absent if loaded(modules, n)] == []
     # what it does use is there: the run went through the engine, not around it
-    assert {"numpy", "inertia_tool.mass.pipeline", "inertia_tool.mesh.read",
+    assert {"numpy", "inertia_tool.mass.pipeline", "inertia_tool.mesh.read", "inertia_tool.mesh.intersect",
             "inertia_tool.dynamics.spin_stability"} <= modules
+    assert ("json" in modules) == ("--json" in options)          # the text report needs no JSON encoder
+
+
+def test_the_face_pair_check_ran_on_the_lean_path():
+    """The imports were cut, not the checks: the report of the same run certifies the box exact."""
+    import json
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    done = subprocess.run([sys.executable, "-m", "inertia_tool", "analyze", BOX, "--json"], cwd=ROOT,
+                          capture_output=True, text=True, timeout=120, env=env)
+    assert done.returncode == 0, done.stderr
+    mesh = json.loads(done.stdout)["mesh"]
+    assert mesh["certificate"]["kind"] == "exact" and "no-crossing-faces" in mesh["certificate"]["checks"]
+
+
+@pytest.mark.parametrize("suffix", [".step", ".STP", ".iges", ".igs"])
+def test_brep_suffixes_are_those_the_reader_routes_to_opencascade(suffix):
+    from inertia_tool.mesh import cad, read
+    assert cad.BREP_SUFFIXES is read.BREP_SUFFIXES
+    assert suffix.lower() in read.BREP_SUFFIXES and suffix.lower() in read.SUPPORTED_SUFFIXES
 
 
 def test_the_numpy_path_imports_scipy_sparse_for_the_shells():

@@ -6,8 +6,8 @@ hands out *chunks*: lists of files analysed one after the other by one worker, w
 together.  :class:`ChunkSizer` decides how many files go into the next chunk from the analysis time the workers
 measured (the rows' ``seconds``): the first chunks hold 1, 2, 4, then 8 files (nothing is measured yet), later ones
 hold ``target_seconds / seconds_per_file`` files, growing at most fourfold per chunk, and no more than half a
-fair share of the files left (so that the last chunks spread over every worker) unless that is less than a
-tenth of the target.
+fair share of the files left (so that the last chunks spread over every worker) unless that is less than the
+tail floor (:data:`POOL_TAIL_SECONDS`, :data:`DASK_TAIL_SECONDS`: a few of the executor's round trips).
 
 :class:`PoolTasks` (any ``concurrent.futures`` executor, by default a process pool of this machine) and
 :class:`DaskTasks` (a ``dask.distributed`` client: a LocalCluster or a remote scheduler, the same code) give the
@@ -23,7 +23,7 @@ from collections.abc import Callable
 from typing import Any
 
 __all__ = ["ChunkSizer", "PoolTasks", "DaskTasks", "Finished", "POOL_CHUNK_SECONDS", "DASK_CHUNK_SECONDS",
-           "run_packed"]
+           "POOL_TAIL_SECONDS", "DASK_TAIL_SECONDS", "run_packed"]
 
 #: Seconds of work aimed at per chunk on a local process pool (task cost ~0.2 ms: 0.05 s makes it < 1 %,
 #: and a killed run loses at most this much work per worker).
@@ -31,6 +31,16 @@ POOL_CHUNK_SECONDS = 0.05
 
 #: Seconds of work aimed at per chunk on Dask (the scheduler and its round trip cost a few ms a task).
 DASK_CHUNK_SECONDS = 0.5
+
+#: Least work of a chunk near the end of a batch on a process pool, s (a tenth of the target; a task's round
+#: trip is ~0.2-0.6 ms).
+POOL_TAIL_SECONDS = 0.005
+
+#: Least work of a chunk near the end of a batch on Dask, s: above the ~8 ms from ``Client.map`` to a task
+#: starting, so that with two chunks in flight per worker the round trip stays hidden behind the running chunk.
+#: The last chunks bound how long one worker may wait for the other at the end: by a tenth of the target (0.05 s)
+#: before, a third of a 200-part batch's 0.15 s of work per worker; now by this.
+DASK_TAIL_SECONDS = 0.02
 
 #: A finished chunk: ``(chunk, rows, None)`` or ``(chunk, None, exception)`` when the task itself failed (its
 #: worker died, the cluster lost it); a chunk is a list of ``(path, sha256 or None)``.
@@ -49,6 +59,9 @@ class ChunkSizer:
     growth : float
         A chunk holds at most this many times the files of the largest one so far (a few fast first files
         must not make the next chunk huge).
+    tail_seconds : float, optional
+        Least work of a chunk when the tail rule (half a fair share of what is left) would make it smaller, s
+        (default a tenth of ``target_seconds``): each chunk costs a round trip of the executor.
 
     Notes
     -----
@@ -56,14 +69,20 @@ class ChunkSizer:
     file, so a catalogue sorted from small to large parts adapts within a few chunks.
     """
 
-    def __init__(self, target_seconds: float, *, max_files: int = 1000, growth: float = 4.0):
+    def __init__(self, target_seconds: float, *, max_files: int = 1000, growth: float = 4.0,
+                 tail_seconds: float | None = None):
         if not (target_seconds > 0 and math.isfinite(target_seconds)):
             raise ValueError(f"Expected `target_seconds` > 0, got {target_seconds}")
+        if tail_seconds is None:
+            tail_seconds = 0.1 * target_seconds
+        if not (0 < tail_seconds <= target_seconds):
+            raise ValueError(f"Expected 0 < `tail_seconds` <= `target_seconds` ({target_seconds}), got {tail_seconds}")
         if max_files < 1:
             raise ValueError(f"Expected `max_files` >= 1, got {max_files}")
         self.target_seconds = float(target_seconds)
         self.max_files = int(max_files)
         self.growth = float(growth)
+        self.tail_seconds = float(tail_seconds)
         self.seconds_per_file: float | None = None
         self.largest = 1
         self._probes = 0
@@ -87,9 +106,9 @@ class ChunkSizer:
             per_file = max(self.seconds_per_file, 1e-9)
             size = int(min(self.target_seconds / per_file, self.growth * self.largest, self.max_files))
             # the tail: at most half of a fair share of what is left, so that every worker gets some of the
-            # last files, but not below a tenth of the target (each chunk costs a round trip)
+            # last files, but not below the tail floor (each chunk costs a round trip)
             share = remaining // (2 * max(workers, 1))
-            size = min(size, max(share, int(0.1 * self.target_seconds / per_file)))
+            size = min(size, max(share, int(self.tail_seconds / per_file)))
         size = max(1, min(size, remaining))
         self.largest = max(self.largest, size)
         return size

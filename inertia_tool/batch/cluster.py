@@ -11,7 +11,7 @@ from typing import Any
 
 from ..errors import UsageError
 
-__all__ = ["DaskCluster", "LOCAL_CLUSTER_CONFIG", "connect_dask"]
+__all__ = ["DaskCluster", "LOCAL_CLUSTER_CONFIG", "connect_dask", "check_workers_read"]
 
 
 def _warm_up() -> int:
@@ -47,6 +47,11 @@ LOCAL_CLUSTER_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.admin.system-monitor.interval": "5s",
     "distributed.admin.tick.interval": "1s",
+    # each worker and each nanny (the nannies run in the batch's process) read the worker's memory every 100 ms
+    # by default, for the spill, pause and terminate thresholds: about half of an idle cluster's CPU (idle, 12 ms
+    # of CPU per second in the two workers and 12-17 in the batch's process; 6 and 7 with 1 s).  A batch holds
+    # one part at a time per worker, bounded by --max-faces; a second is soon enough to see it grow.
+    "distributed.worker.memory.monitor-interval": "1s",
 }
 
 
@@ -135,3 +140,38 @@ def connect_dask(address: str, workers: int = 2, *, timeout: float = 20.0) -> Da
         connected.close()
         raise
     return connected
+
+
+def _unreadable(paths: list[str]) -> list[str]:
+    """Run on a worker: the ones of ``paths`` it cannot open for reading."""
+    import os
+
+    return [p for p in paths if not os.access(p, os.R_OK)]
+
+
+def check_workers_read(client: Any, paths: list[str]) -> None:
+    """Refuse to start a batch that some worker of ``client``'s cluster would read differently from this process.
+
+    The workers of a cluster of several machines must see the mesh files at the same absolute paths (a shared
+    file system mounted alike).  A worker that cannot would write an ``error`` row for each file it is given,
+    and ``error`` rows count as done on resume (a bad file stays bad), so the mistake would outlive the run.
+    Each worker is asked whether it can read ``paths`` (a sample: the first and last file of the batch).
+
+    Raises
+    ------
+    UsageError
+        A worker cannot read one of ``paths`` (the message names the worker and the file), or the workers
+        cannot be asked.
+    """
+    if not paths:
+        return
+    try:
+        answers = client.run(_unreadable, list(paths))
+    except (OSError, TimeoutError) as exc:
+        raise UsageError(f"the Dask workers did not answer whether they can read the files ({exc})") from None
+    for worker, missing in sorted(answers.items()):
+        if missing:
+            raise UsageError(f"the Dask worker {worker} cannot read {missing[0]} (expected every worker to see the "
+                             "files at the same absolute paths as this machine: a shared file system mounted "
+                             "alike; see docs/batch.md, 'Running on several machines')")
+

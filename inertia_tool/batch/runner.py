@@ -43,7 +43,8 @@ from ..mesh.options import LoadOptions
 from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, os_error_reason
 from ..mesh.regular import open_regular
 from ..mass.pipeline import mass_properties, resolve_density
-from .chunks import DASK_CHUNK_SECONDS, POOL_CHUNK_SECONDS, ChunkSizer, DaskTasks, PoolTasks
+from .chunks import (DASK_CHUNK_SECONDS, DASK_TAIL_SECONDS, POOL_CHUNK_SECONDS, POOL_TAIL_SECONDS, ChunkSizer,
+                     DaskTasks, PoolTasks)
 
 __all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "SCHEMA_V1", "ROW_FIELDS_V1", "analyze_chunk",
            "analyze_file", "discover_files", "file_sha256", "run_batch", "upgrade_row", "downgrade_row",
@@ -641,8 +642,9 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
         else:
             tasks = PoolTasks(make_pool=lambda: _process_pool(jobs), workers=jobs)
         target = chunk_seconds or (DASK_CHUNK_SECONDS if client is not None else POOL_CHUNK_SECONDS)
+        tail = min(target, DASK_TAIL_SECONDS if client is not None else POOL_TAIL_SECONDS)
         try:
-            _run_chunks(todo, options, tasks, ChunkSizer(target), record, max_in_flight)
+            _run_chunks(todo, options, tasks, ChunkSizer(target, tail_seconds=tail), record, max_in_flight)
         finally:
             tasks.close()
     return BatchSummary(ok=ok, failed=failed, skipped=skipped, skipped_failed=skipped_failed,

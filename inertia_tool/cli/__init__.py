@@ -99,11 +99,31 @@ SUBCOMMANDS = list(SUMMARIES)
 _NEGATIVE_VALUE = re.compile(r"^-\.?\d[^\s,]*(,[-+]?\.?\d[^\s,]*)*$")
 
 
+def _terminal_columns(fallback: int = 80) -> int:
+    """The width help is wrapped to, as :func:`shutil.get_terminal_size` gives it: ``COLUMNS`` if a positive
+    integer, else the terminal of standard output, else ``fallback``."""
+    try:
+        columns = int(os.environ["COLUMNS"])
+    except (KeyError, ValueError):
+        columns = 0
+    if columns <= 0:
+        try:
+            columns = os.get_terminal_size(sys.__stdout__.fileno()).columns    # type: ignore[union-attr]
+        except (AttributeError, ValueError, OSError):
+            columns = 0
+    return columns if columns > 0 else fallback
+
+
 class _Parser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         # argparse treats "-40,40" as an option unless it matches this private pattern
         self._negative_number_matcher = _NEGATIVE_VALUE
+
+    def _get_formatter(self):
+        # argparse's formatter takes its default width from shutil.get_terminal_size(); importing shutil (with
+        # bz2 and lzma) costs a few ms of every run, since add_argument builds a formatter for each option
+        return self.formatter_class(prog=self.prog, width=_terminal_columns() - 2)
 
     def error(self, message):  # one line, exit code 2, as documented (no usage block)
         message = " ".join(str(message).split())

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import warnings
@@ -17,12 +16,10 @@ from ..reports.serialize import command_output, mass_properties_dict, to_jsonabl
 from ..reports.stability import format_stability, stability_dict
 from ..reports.text import format_mass_properties
 from ..dynamics.spin_stability import stability
-from ..robot.inertial import FRAMES, inertial_frame
-from ..mesh.cad import BREP_SUFFIXES, has_ocp
+from ..mesh.read import BREP_SUFFIXES
 from ..reports.cad import CAD_UNITS, format_cad_report
-from ..reports.frame import format_frame_inertia, frame_inertia_dict, frame_inertia_section
 from ..reports.models import format_model_note
-from ..robot.formats import ROBOT_FORMATS, format_inertial
+from ..robot.formats import FRAMES, ROBOT_FORMATS, format_inertial
 from .help import add_command
 from .model_options import (add_files_argument, add_model_options, load_model, model_words, split_part_spec,
                             with_warnings)
@@ -90,11 +87,13 @@ def run(args) -> int:
         from ..reports.brep import brep_html_section
         extra.append(brep_html_section(cad, props.density))
     if system is not None:
+        from ..reports.frame import format_frame_inertia, frame_inertia_dict, frame_inertia_section
         extra.append(frame_inertia_section(system))
     write_report_from_args(args, props, described + model_words(model), messages, meshes=loaded.meshes,
                            stability=stab if stab is not None else stab_error, model=model, extra_sections=extra,
                            result=result)
     if fmt == "json":
+        import json         # imported on use: the text report does without
         out = mass_properties_dict(props, density_source=described)
         if cad is not None:
             from ..reports.brep import brep_comparison_dict
@@ -110,6 +109,7 @@ def run(args) -> int:
         json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     elif fmt in ROBOT_FORMATS:
+        from ..robot.inertial import inertial_frame
         frame = inertial_frame(props, args.frame or "principal")
         print(format_inertial(frame, fmt, source=f"{props.name}: {described}{model_words(model)}"))
     elif fmt == "cad":
@@ -141,7 +141,10 @@ def _brep_section(args):
     if len(files) != 1 or getattr(args, "model", "solid") != "solid" or getattr(args, "shell", None):
         return None
     path = split_part_spec(files[0])[0]
-    if os.path.splitext(path)[1].lower() not in BREP_SUFFIXES or not has_ocp():
+    if os.path.splitext(path)[1].lower() not in BREP_SUFFIXES:
+        return None
+    from ..mesh.cad import has_ocp      # imported on use, like the B-rep comparison below
+    if not has_ocp():
         return None
     from ..mass.brep import compare      # imported on use: only STEP/IGES files need it
     return compare(path)

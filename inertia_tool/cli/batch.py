@@ -88,6 +88,16 @@ def connect_dask_cli(address: str, jobs: int):
         raise UsageError(f"--dask {address}: {exc}") from None
 
 
+def check_workers_read_cli(cluster, address: str, files: list[str]) -> None:
+    """:func:`inertia_tool.batch.cluster.check_workers_read` on the first and last file, in the command's terms."""
+    from ..batch.cluster import check_workers_read
+
+    try:
+        check_workers_read(cluster.client, sorted({files[0], files[-1]}) if files else [])
+    except UsageError as exc:
+        raise UsageError(f"--dask {address}: {exc}") from None
+
+
 def summary_line(summary, files: int, args) -> str:
     """The closing line of a run: what this run computed, what earlier runs had done, the total mass."""
     where = f"Dask ({args.dask})" if args.dask else f"{args.jobs} process{'es' if args.jobs > 1 else ''}"
@@ -147,6 +157,11 @@ def run(args) -> int:
                   "run was interrupted", file=sys.stderr)
         if args.dask:
             cluster = connect_dask_cli(args.dask, args.jobs)
+            try:
+                check_workers_read_cli(cluster, args.dask, files)
+            except BaseException:
+                cluster.close()
+                raise
         progress = None if args.quiet else Progress(sys.stderr)
         try:
             implausible = []

@@ -341,16 +341,18 @@ def _load_solid(args, meshes):
     :mod:`inertia_tool.mass.materials` (``--material-map``, the file's densities, the material table); its
     ``FILE:material`` or the global option is the default of its parts without a material.
     """
-    from ..mass.materials import material_parts, unused_map_keys
     options = load_options_from_args(args)
     density, mass = density_and_mass(args)
     material_map = parse_material_map(args)
     specs = [(raw, what) for raw, (_, what) in zip(meshes, (split_part_spec(f) for f in _files(args)))]
     if len(specs) == 1 and specs[0][1] is None and not specs[0][0].parts:
-        unused_map_keys(material_map, (), meshes)
+        if material_map:            # imported on use: one file without parts and no --material-map needs no rule
+            from ..mass.materials import unused_map_keys
+            unused_map_keys(material_map, (), meshes)
         _, described = resolve_density(density=density, material=args.material, mass=mass)
         props = mass_properties(specs[0][0], density=density, material=args.material, mass=mass, options=options)
         return props, described + _implied(props, mass)
+    from ..mass.materials import material_parts, unused_map_keys
     default = None
     if density is not None or args.material is not None:
         option = f"--density {args.density}" if density is not None else f"--material {args.material}"

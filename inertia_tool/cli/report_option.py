@@ -10,7 +10,6 @@ import os
 import sys
 
 from ..errors import UsageError
-from ..output import atomic_target, check_targets
 from ..reports.escape import escape_terminal
 
 __all__ = ["add_report_options", "check_report_path", "write_report_from_args", "REPORT_SUFFIXES",
@@ -33,6 +32,7 @@ def check_output_file(path: str | None, option: str, force: bool) -> None:
     """The rule of every file this command line writes (:func:`inertia_tool.output.check_targets`):
     refuse (:class:`UsageError`, exit 2), before any work, to replace an existing file without ``--force``,
     to write over a directory, or into a missing directory."""
+    from ..output import check_targets      # imported on use (tempfile, shutil): most runs write no file
     check_targets([(path, option)], force=force)
 
 
@@ -77,6 +77,8 @@ def save_figure(fig, path: str, *, dpi: int = 120) -> None:
     """Write a matplotlib figure to ``path`` atomically (the format from its suffix) and close it; an OS error
     becomes a one-line :class:`~inertia_tool.output.OutputFileError`."""
     import matplotlib.pyplot as plt
+
+    from ..output import atomic_target
     try:
         with atomic_target(path) as tmp:
             fig.savefig(tmp, dpi=dpi)

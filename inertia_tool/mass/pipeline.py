@@ -20,7 +20,6 @@ from ..errors import InvalidMeshError, NearlyEqualMomentsWarning, OverlapWarning
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.precision import warn_storage_precision
-from ..mesh.overlap import shared_volumes
 from ..mesh.prepare import PreparedMesh, classify_shells, prepare_mesh
 from ..mesh.read import RawMesh, load_mesh
 from ..tolerances import NEEDLE_RTOL, PART_OVERLAP_RTOL, TRIANGLE_INEQUALITY_RTOL
@@ -312,6 +311,7 @@ def _warn_about_part_overlaps(meshes: list[PreparedMesh], names: list[str], mate
     within = sum(m.report.overlapping_shells for m in meshes)
     if overlaps <= within:
         return
+    from ..mesh.overlap import shared_volumes      # imported on use: assemblies whose parts may overlap only
     shared = shared_volumes([(m.vertices, m.faces) for m in meshes]) if all(
         m.report.watertight for m in meshes) else None
     if shared is None:

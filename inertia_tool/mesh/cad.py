@@ -37,6 +37,7 @@ import numpy as np
 
 from ..errors import InvalidMeshError, MeshReadError, UsageError
 from ..values import frozen_value
+from .read import BREP_SUFFIXES      # CAD exchange suffixes read as B-reps, defined with the reader's suffixes
 
 if TYPE_CHECKING:
     from ..isolate import Limits
@@ -47,9 +48,6 @@ __all__ = ["BREP_SUFFIXES", "DEFAULT_CHORD_RTOL", "DEFAULT_ANGULAR_DEFLECTION", 
 
 #: How :func:`solids_fused` made one solid of a file's solids.
 FUSIONS = ("one solid", "apart", "fused", "failed")
-
-#: CAD exchange suffixes read as B-reps.
-BREP_SUFFIXES = (".step", ".stp", ".iges", ".igs")
 
 #: Default chord tolerance as a fraction of the bounding-box diagonal.
 DEFAULT_CHORD_RTOL = 1e-4

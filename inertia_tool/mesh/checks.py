@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import field
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -18,8 +19,10 @@ from numpy.typing import ArrayLike
 from ..values import frozen_value
 from .._native import accel, faces_for_c, threads
 from .edges import edge_keys
-from .estimate import Uncertainty
 from .policy import Certificate
+
+if TYPE_CHECKING:
+    from .estimate import Uncertainty
 
 __all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "winding_number"]
 

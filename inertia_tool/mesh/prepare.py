@@ -24,7 +24,6 @@ from ..integrals import VolumeMoments, body_volume_moments, bounding_box, volume
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
-from .estimate import check_useful, uncertainty_from
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, inward_crossing_outward, negligible_flat,
                      orient_by_depth, self_crossing_message, shell_contacts)
 from .resolve import Resolution, resolve_surface
@@ -319,6 +318,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     bbox_min, bbox_max = (lo, hi) if v is raw.vertices else bounding_box(v)
     uncertainty = None
     if patched is not None:
+        from .estimate import check_useful, uncertainty_from      # imported on use: repair only
         total = _total(shells)
         uncertainty = uncertainty_from(total.volume, total.centroid, total.second_moment,
                                        patched.uncertainty.volume_in_doubt, patched.far)

@@ -47,10 +47,12 @@ __all__ = ["RawMesh", "load_mesh", "read_stl", "DEFAULT_MAX_FACES", "MAX_SUPPORT
 
 
 
+#: CAD files with an exact B-rep (STEP, IGES), read through OpenCASCADE (:mod:`inertia_tool.mesh.cad`).
+BREP_SUFFIXES = (".step", ".stp", ".iges", ".igs")
+
 #: File suffixes handled (STL natively, the rest through trimesh; COLLADA needs pycollada; STEP/IGES are
 #: tessellated through OpenCASCADE, ``inertia_tool.mesh.cad``).
-SUPPORTED_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".3mf", ".glb", ".gltf", ".dae", ".zae",
-                      ".step", ".stp", ".iges", ".igs")
+SUPPORTED_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".3mf", ".glb", ".gltf", ".dae", ".zae") + BREP_SUFFIXES
 
 #: Compressed single-mesh files: ``part.stl.gz``, ``part.obj.bz2``, or a ``.zip`` holding exactly one mesh.
 COMPRESSED_SUFFIXES = (".gz", ".bz2", ".zip")
@@ -1128,7 +1130,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                 vertices, faces, n = _read_obj(path, max_faces)
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "vertices have NaN or infinite coordinates")
-            elif suffix in (".step", ".stp", ".iges", ".igs"):
+            elif suffix in BREP_SUFFIXES:
                 from .cad import read_cad
                 from .parts import cad_parts
                 reading = read_cad(path, max_faces=max_faces)

@@ -22,7 +22,7 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,10 +30,10 @@ from ..values import frozen_value
 from ..errors import InvalidMeshError
 from ..tolerances import FLAT_RTOL
 from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
-from .estimate import Estimate, check_useful, patched_estimate, winding_estimate
-from .seal import Seal, seal_seams
-from .merge import merge_close_vertices
-from .orient import EdgeBalance, edge_balance, orient_consistently
+
+if TYPE_CHECKING:
+    from .estimate import Estimate
+    from .orient import EdgeBalance
 
 __all__ = ["Resolution", "resolve_surface", "REPAIR_RULE"]
 
@@ -165,6 +165,10 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     InvalidMeshError
         Without ``repair`` when no exact reading exists; with it when nothing encloses a volume.
     """
+    # imported on use: a surface that passes the manifold check (nearly every file) never comes here
+    from .estimate import check_useful, winding_estimate
+    from .merge import merge_close_vertices
+    from .orient import edge_balance, orient_consistently
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     n = len(v)
@@ -257,6 +261,8 @@ def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, *, diag: float,
                        moments: Callable[..., Any], seam_gap_rtol: float = SEAM_GAP_RTOL,
                        soup_share: float = SOUP_BOUNDARY_SHARE) -> Estimate:
     """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed."""
+    from .estimate import patched_estimate, winding_estimate
+    from .seal import Seal, seal_seams
     sealed = seal_seams(vertices, faces, seam_gap_rtol * diag)
     if _loose_share(sealed.faces) > soup_share:
         return winding_estimate(vertices, faces)

@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
-from ..robot.inertial import positive_tensor_notation
 from ..mass.properties import MassProperties
 from .numbers import number, round_off_zero
 
@@ -64,6 +63,7 @@ def format_cad_report(props: MassProperties, *, units: str = "kg-m", density_sou
     -------
     str
     """
+    from ..robot.inertial import positive_tensor_notation      # imported on use: analyze's parser needs CAD_UNITS
     if units not in CAD_UNITS:
         raise UsageError(f"Expected CAD units among {', '.join(CAD_UNITS)}, got {units!r}")
     mass_name, km, len_name, lm = CAD_UNITS[units]

@@ -6,7 +6,6 @@ Every writer puts foreign text into its document through these, never raw: a fil
 
 from __future__ import annotations
 
-import html
 import re
 
 __all__ = ["escape_html", "escape_markdown", "escape_terminal"]
@@ -24,6 +23,7 @@ _MARKDOWN_SPECIAL = frozenset("\\`*_[]|~#")
 
 def escape_html(text: object) -> str:
     """``text`` as HTML/XML character data or a quoted attribute value (``& < > " '`` escaped)."""
+    import html         # imported on use: the command line escapes for the terminal only, unless it writes HTML
     return html.escape(str(text), quote=True)
 
 

@@ -7,17 +7,25 @@ what the three formats define.  The mesh axes are the link (body) frame.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..errors import UsageError
-from .inertial import InertialFrame
 from ..reports.escape import escape_terminal
 from ..reports.numbers import number
+
+if TYPE_CHECKING:
+    from .inertial import InertialFrame
 
 __all__ = ["format_urdf", "format_sdf", "format_mjcf", "ROBOT_FORMATS", "format_inertial"]
 
 #: Format names accepted by :func:`format_inertial`.
 ROBOT_FORMATS = ("urdf", "sdf", "mjcf")
+
+#: Inertial frame orientations (:func:`inertia_tool.robot.inertial.inertial_frame`): the principal frame
+#: (diagonal tensor) or the link/mesh axes (full tensor).
+FRAMES = ("principal", "mesh")
 
 _FRAME_TEXT = {
     "principal": "principal axes at the centre of mass, the rotation nearest the link frame (diagonal tensor)",

@@ -37,6 +37,7 @@ from ..values import frozen_value
 from ..errors import PhysicsError, UsageError
 from ..mass.properties import MassProperties
 from ..rotations import matrix_to_quaternion
+from .formats import FRAMES     # the frames an <inertial> block is written in, defined beside its formats
 
 __all__ = ["InertialFrame", "MomentCheck", "inertial_frame", "check_moments", "rpy_from_matrix",
            "quaternion_from_matrix", "positive_tensor_notation", "principal_frame_nearest", "GAZEBO_TOLERANCE",
@@ -48,8 +49,6 @@ GAZEBO_TOLERANCE = 10.0
 #: MuJoCo's ``mjMINVAL``: masses and principal moments of moving bodies must exceed it (kg, kg·m²).
 MUJOCO_MINVAL = 1e-15
 
-#: Inertial frame orientations: the principal frame (diagonal tensor) or the link/mesh axes (full tensor).
-FRAMES = ("principal", "mesh")
 
 
 @frozen_value
