@@ -394,3 +394,33 @@ def test_a_capsule_fitted_to_an_open_mesh_with_repair_is_audited_without_stoppin
     assert audits[0].com_inside_geometry is None and audits[0].issues        # no box without repair: unknown
     unrepaired = link_inertials(robot, density=1000)
     assert unrepaired[0].properties is None and "mesh needs repair" in unrepaired[0].problem
+
+
+def test_geoms_of_an_explicit_contact_pair_are_collision_geometry(tmp_path):
+    # Menagerie's MJX models switch every geom's contype/conaffinity off and list their contacts as
+    # <contact><pair>: MuJoCo collides those geoms all the same (a contact appears), so they are collision geometry
+    path = tmp_path / "pairs.xml"
+    path.write_text('<mujoco><default><geom contype="0" conaffinity="0"/></default><worldbody>'
+                    '<body name="foot"><freejoint/><geom name="sole" type="sphere" size="0.1"/>'
+                    '<geom name="shin" type="box" size="0.1 0.1 0.1" pos="0 0 0.5"/></body>'
+                    '<body name="floor" pos="0 0 -0.15"><geom name="plate" type="box" size="1 1 0.1"/></body>'
+                    '</worldbody><contact><pair geom1="sole" geom2="plate"/></contact></mujoco>')
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert data.ncon == 1 and {model.geom(data.contact.geom1[0]).name, model.geom(data.contact.geom2[0]).name} == {
+        "sole", "plate"}
+    links = {link.name: link for link in read_robot(path).links}
+    assert [e.name for e in links["foot"].elements] == ["sole"]
+    assert [e.name for e in links["floor"].elements] == ["plate"]
+    visual = {link.name: link for link in read_robot(path, geometry="visual").links}
+    assert [e.name for e in visual["foot"].elements] == ["shin"] and visual["floor"].elements == ()
+
+
+def test_a_body_without_a_geom_in_the_group_range_says_so(tmp_path):
+    path = tmp_path / "g.xml"
+    path.write_text('<mujoco><compiler inertiagrouprange="0 2"/><worldbody><body name="b">'
+                    '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/><geom type="sphere" size="0.1" group="3"/>'
+                    '</body></worldbody></mujoco>')
+    result = link_inertials(read_robot(path, geometry="all"), density="model")[0]
+    assert result.properties is None and result.problem == "no geom in <compiler inertiagrouprange>"

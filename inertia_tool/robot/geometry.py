@@ -435,7 +435,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     """The result for one link, or the reason there is none (never raises for the link's own problems)."""
     nan = float("nan")
     if not link.elements:
-        return LinkInertial(link.name, None, nan, basis, f"no {geometry} geometry")
+        return LinkInertial(link.name, None, nan, basis, "no geom in <compiler inertiagrouprange>" if geometry == "all"
+                            else f"no {geometry} geometry")
     try:
         parts, massless = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
     except InertiaToolError as exc:

@@ -10,9 +10,10 @@ letters rotate with the frame, upper case stay fixed), ``xyaxes``, ``zaxis``; or
 cylinders, boxes and ellipsoids (the axis runs from the first point to the second).  Sizes are MuJoCo's
 half-sizes: box half-edges, cylinder and capsule ``radius half-length``, ellipsoid semi-axes.
 
-Collision geoms are those with ``contype`` or ``conaffinity`` non-zero (MuJoCo's default is 1); the others
-are visual.  Geoms directly in ``<worldbody>`` belong to no body and are skipped.  Inline mesh vertices and
-height fields are refused with a message.
+Collision geoms are those with ``contype`` or ``conaffinity`` non-zero (MuJoCo's default is 1) and those
+named in a ``<contact><pair>`` (MuJoCo collides them whatever their bit masks); the others are visual.  Geoms
+directly in ``<worldbody>`` belong to no body and are skipped.  Inline mesh vertices and height fields are
+refused with a message.
 
 MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
 
@@ -461,14 +462,27 @@ def _is_collision(attrs: dict, what: str, source: str) -> bool:
     return any(b != 0 for b in bits)
 
 
-def _selected(attrs: dict, geometry: str, groups: tuple, what: str, source: str) -> bool:
-    """Whether a geom belongs to the chosen geometry: collision (``contype``/``conaffinity`` not both 0),
-    visual (both 0), or ``"all"``: every geom whose ``group`` lies in ``<compiler inertiagrouprange>``
-    (MuJoCo's default 0–5), the geoms MuJoCo's inertia from geometry counts."""
+def _selected(attrs: dict, geometry: str, groups: tuple, what: str, source: str,
+              paired: frozenset = frozenset()) -> bool:
+    """Whether a geom belongs to the chosen geometry: collision (``contype``/``conaffinity`` not both 0, or
+    named in a ``<contact><pair>``: MuJoCo collides a pair's geoms whatever their bit masks, which is how the MJX
+    models of Menagerie give their contacts), visual (the others), or ``"all"``: every geom whose ``group``
+    lies in ``<compiler inertiagrouprange>`` (MuJoCo's default 0–5), the geoms MuJoCo's inertia from geometry
+    counts."""
     if geometry == "all":
         group = _numbers(attrs.get("group", "0"), 1, f"{what} group", source)[0]
         return groups[0] <= group <= groups[1]
-    return _is_collision(attrs, what, source) == (geometry == "collision")
+    collides = attrs.get("name") in paired or _is_collision(attrs, what, source)
+    return collides == (geometry == "collision")
+
+
+def _paired_geoms(root) -> frozenset:
+    """Names of the geoms in ``<contact><pair geom1 geom2>`` elements (explicit contact pairs)."""
+    names = set()
+    for contact in root.findall("contact"):
+        for pair in contact.findall("pair"):
+            names.update(n for n in (pair.get("geom1"), pair.get("geom2")) if n)
+    return frozenset(names)
 
 
 #: Most copies one ``<replicate>`` may make (and all of them together).
@@ -519,6 +533,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
     defaults = _Defaults(root, source)
     compiler = (degrees, eulerseq, fitaabb)
     meshes = _meshes(root, defaults, mesh_base, fallbacks, compiler, source)
+    paired = _paired_geoms(root)
     links = []
     counter = [0]
     replicas = [MAX_REPLICAS]
@@ -538,7 +553,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
         for child in element:
             if child.tag == "geom":
                 attrs = defaults.attributes(child, class_name, source)
-                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", source):
+                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", source, paired):
                     label = f"geom {len(elements) + 1}"
                     elements.append(_geom(attrs, pose, label, link, meshes, packages, compiler, source))
             elif child.tag == "frame":
