@@ -20,7 +20,7 @@ from ..errors import InertiaToolError, RobotDescriptionError, UsageError
 from ..values import frozen_value
 from .audit import audit_links
 from .description import MAX_DESCRIPTION_BYTES, RobotDescription, _read_bytes, read_robot
-from .geometry import link_inertials
+from .geometry import MeshCache, link_inertials
 
 __all__ = ["ModelAudit", "find_descriptions", "audit_corpus", "MAX_CORPUS_FILES", "SNIFF_BYTES"]
 
@@ -118,11 +118,12 @@ def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass:
     and :func:`~inertia_tool.robot.audit_links` (``options`` go to ``link_inertials``).
     """
     out = []
+    meshes = MeshCache()                 # scene variants and sibling models share mesh files: each integrated once
     for path in find_descriptions(paths):
         try:
             robot = read_robot(path, packages=packages, geometry=geometry, run_xacro=run_xacro)
             inertials = link_inertials(robot, density=density, material=material, keep_mass=keep_mass,
-                                       repair=repair, **options)
+                                       repair=repair, mesh_cache=meshes, **options)
             audits = audit_links(robot, inertials, keep_mass=keep_mass)
         except InertiaToolError as exc:
             out.append(ModelAudit(source=path, robot=None, problem=str(exc)))
