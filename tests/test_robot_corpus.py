@@ -124,7 +124,8 @@ def test_a_mesh_shared_by_links_and_models_is_read_once_with_its_warnings_for_ea
             assert left.properties is None and left.problem == right.problem and "not a closed" in left.problem
             continue
         volume = 0.1 * 0.2 * 0.3
-        assert left.properties.mass == pytest.approx(1000 * volume, rel=1e-6) and left.properties.mass == right.properties.mass  # float32 corners
+        assert left.properties.mass == pytest.approx(1000 * volume, rel=1e-6)          # float32 corners
+        assert left.properties.mass == right.properties.mass
         # the engine's word on the mesh, with the first link that uses it, in each model as if read there
         assert any("inside out" in w and "flipped" in w for w in left.warnings), left.warnings
 
