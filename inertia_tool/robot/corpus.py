@@ -7,8 +7,8 @@ other XML are skipped); ``*.xacro`` only when named directly (in a folder they a
 file that another MJCF file of the corpus includes is audited through the including file only (Menagerie's
 ``scene.xml`` includes the robot); one found in a folder with neither a ``<worldbody>`` nor an ``<include>``
 is a fragment meant to be included (Menagerie's actuator and keyframe files) and is skipped.  Folders are
-walked in sorted order without following symbolic links, at most :data:`MAX_CORPUS_FILES` descriptions.  A model that cannot be read is kept with its reason; it never
-stops the others.
+walked in sorted order without following symbolic links, at most :data:`MAX_CORPUS_FILES` descriptions.  A
+model that cannot be read is kept with its reason; it never stops the others.
 """
 
 from __future__ import annotations
