@@ -50,7 +50,7 @@ from ..errors import RobotDescriptionError
 from .description import DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive, _scale
 from .resolve import resolve_uri
 
-__all__ = ["read_mjcf", "orientation_matrix", "MAX_INCLUDE_DEPTH", "MAX_INCLUDED_FILES"]
+__all__ = ["read_mjcf", "orientation_matrix", "inertia_from_geometry", "MAX_INCLUDE_DEPTH", "MAX_INCLUDED_FILES"]
 
 #: Deepest chain of ``<include>`` followed (MuJoCo's own models nest two or three).
 MAX_INCLUDE_DEPTH = 16
@@ -245,6 +245,42 @@ def _compiler(root, source: str) -> tuple[bool, str, str | None]:
         raise _fail(source, f"<compiler eulerseq={eulerseq[:40]!r}>: expected three of the letters xyzXYZ "
                             "(lower case rotates with the frame, upper case about the fixed axes)")
     return angle == "degree", eulerseq, merged.get("meshdir", merged.get("assetdir"))
+
+
+#: The values of ``<compiler inertiafromgeom>`` (MuJoCo's default: ``auto``).
+INERTIA_FROM_GEOMETRY = ("false", "true", "auto")
+
+
+def inertia_from_geometry(source: str, document: bytes | None = None) -> str:
+    """MuJoCo's ``<compiler inertiafromgeom>`` for the model ``source``: ``"true"`` (every body's inertia is
+    computed from its geoms and every ``<inertial>`` is ignored), ``"false"`` or ``"auto"`` (the default: only
+    bodies without an ``<inertial>``).  Read as MuJoCo reads it: from every ``<compiler>`` of the file and of
+    the files it includes, in document order, the last one that sets it winning; comments and other elements
+    do not count.
+
+    Parameters
+    ----------
+    source : str
+        The main MJCF file (included files are found relative to it).
+    document : bytes, optional
+        Its content, when already read.
+
+    Raises
+    ------
+    RobotDescriptionError
+        Unreadable file or include, or a value MuJoCo refuses.
+    """
+    from .description import _read_bytes, parse_xml
+    data = _read_bytes(source) if document is None else document
+    root = parse_xml(data, source).getroot()
+    _expand_includes(root, source)
+    value = "auto"
+    for compiler in root.iter("compiler"):
+        value = compiler.get("inertiafromgeom", value)
+    if value not in INERTIA_FROM_GEOMETRY:
+        raise _fail(source, f"<compiler inertiafromgeom={value[:40]!r}>: expected one of "
+                            f"{', '.join(INERTIA_FROM_GEOMETRY)}")
+    return value
 
 
 def _own_mesh_folder(root, folder: str) -> str:
