@@ -12,17 +12,19 @@ half-sizes: box half-edges, cylinder and capsule ``radius half-length``, ellipso
 
 Collision geoms are those with ``contype`` or ``conaffinity`` non-zero (MuJoCo's default is 1) and those
 named in a ``<contact><pair>`` (MuJoCo collides them whatever their bit masks); the others are visual.  Geoms
-directly in ``<worldbody>`` belong to no body and are skipped.  Inline mesh vertices and height fields are
-refused with a message.
+directly in ``<worldbody>`` belong to no body and are skipped, and so are planes in a body (MuJoCo gives them
+no mass or inertia).  Inline mesh vertices and height fields are refused with a message.
 
 MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
 
 * ``<include file>`` is replaced by the children of the included ``<mujoco>``, recursively; the file is looked
-  up relative to the main model's folder first, then relative to the including file's folder.  At most
-  :data:`MAX_INCLUDE_DEPTH` levels, :data:`MAX_INCLUDED_FILES` files and ``MAX_DESCRIPTION_BYTES`` bytes
-  in all; a file that includes itself
-  (directly or not) is refused.  A mesh is found through the merged ``<compiler meshdir>`` relative to the
-  main model's folder; a mesh declared in an included file that is not found there is looked up through that
+  up relative to the main model's folder first, then relative to the including file's folder; its root is
+  ``<mujoco>`` or ``<mujocoinclude>``.  At most :data:`MAX_INCLUDE_DEPTH` levels, :data:`MAX_INCLUDED_FILES`
+  files and ``MAX_DESCRIPTION_BYTES`` bytes in all; a file that includes itself (directly or not) is refused.
+  A mesh is found through the merged ``<compiler meshdir>`` relative to the main model's folder; a mesh
+  declared in an included file that is not found there is looked up, as MuJoCo 4.0 does, beside that file
+  (its folder joined with the mesh's ``file``, without any ``meshdir``: Menagerie's MJX scenes in MuJoCo
+  Playground give ``file="assets/link0.stl"`` for this lookup); then, beyond what MuJoCo does, through that
   file's own ``meshdir``, relative to its folder.
 * Defaults: an element's own attribute overrides its class, the class its parent class.  The orientation is
   one attribute: an element (or class) that gives any of ``quat``, ``axisangle``, ``euler``, ``xyaxes``,
@@ -57,6 +59,11 @@ MAX_INCLUDE_DEPTH = 16
 
 #: Most files one model may pull in through ``<include>`` (counting repeats).
 MAX_INCLUDED_FILES = 512
+
+#: Root elements of an included file: MuJoCo takes the children of whatever root it has; ``<mujocoinclude>`` is
+#: the name older models use (MyoSuite, Meta-World, Gymnasium-Robotics); other roots (a URDF's ``<robot>``) are
+#: refused rather than read as nothing.
+_INCLUDED_ROOTS = ("mujoco", "mujocoinclude")
 
 #: The orientation attributes of MJCF: one orientation, whichever of them is given.
 _ORIENTATION = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
@@ -332,13 +339,13 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
                 raise _fail(source, f"the included files hold more than the {MAX_DESCRIPTION_BYTES:,} bytes a robot "
                                     "description may have, all files together")
             included = parse_xml(data, path).getroot()
-            if included.tag != "mujoco":
+            if included.tag not in _INCLUDED_ROOTS:
                 raise _fail(source, f"<include file={name!r}>: {path} has the root element <{included.tag}>, "
-                                    "expected <mujoco>")
+                                    "expected <mujoco> or <mujocoinclude>")
             folders = (_own_mesh_folder(included, os.path.dirname(path)),) + chain
             expand(included, path, stack + (key,), folders)
-            for mesh in included.iter("mesh"):
-                fallbacks.setdefault(mesh, folders)
+            for mesh in included.iter("mesh"):        # MuJoCo's own fallback first: beside the declaring file
+                fallbacks.setdefault(mesh, (os.path.dirname(path),) + folders)
             parent = include.getparent()
             index = parent.index(include)
             tail = include.tail
@@ -589,6 +596,8 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
         for child in element:
             if child.tag == "geom":
                 attrs = defaults.attributes(child, class_name, source)
+                if attrs.get("type") == "plane":      # MuJoCo gives a plane no mass and no inertia
+                    continue
                 if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", source, paired):
                     label = f"geom {len(elements) + 1}"
                     elements.append(_geom(attrs, pose, label, link, meshes, packages, compiler, source))
