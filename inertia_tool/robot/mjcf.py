@@ -521,7 +521,7 @@ def _selected(attrs: dict, geometry: str, groups: tuple, what: str, source: str,
 
 def _paired_geoms(root) -> frozenset:
     """Names of the geoms in ``<contact><pair geom1 geom2>`` elements (explicit contact pairs)."""
-    names = set()
+    names: set = set()
     for contact in root.findall("contact"):
         for pair in contact.findall("pair"):
             names.update(n for n in (pair.get("geom1"), pair.get("geom2")) if n)
