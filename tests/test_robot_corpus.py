@@ -79,15 +79,17 @@ def test_a_named_pipe_among_the_models_is_unreadable_not_waited_on(tmp_path, cap
 
 
 def test_mjcf_fragments_in_a_folder_are_not_models_but_a_fragment_named_is_read(tmp_path):
-    # Menagerie's aloha folder holds actuator and keyframe files meant to be included (no <worldbody>, no
-    # <include>); walked in a folder they are skipped, named on the command line they are read (and refused)
+    # Menagerie's aloha folder holds actuator and keyframe files meant to be included (no <body>, no
+    # <include>; sites in a <worldbody> at most); walked in a folder they are skipped, named on the command
+    # line they are read (and refused)
     root = tmp_path / "aloha"
     root.mkdir()
     (root / "robot.xml").write_text('<mujoco><worldbody><body name="b"><geom type="sphere" size="0.1"/></body>'
                                     '</worldbody></mujoco>')
     (root / "keyframe_no_act.xml").write_text('<mujoco><!-- <worldbody> --><keyframe><key name="home" qpos=""/>'
                                               '</keyframe></mujoco>')
-    (root / "actuators.xml").write_text('<mujoco><actuator><position joint="j"/></actuator></mujoco>')
+    (root / "actuators.xml").write_text('<mujoco><worldbody><site name="centre"/></worldbody><actuator>'
+                                        '<position joint="j"/></actuator></mujoco>')
     assert [os.path.basename(p) for p in find_descriptions([root])] == ["robot.xml"]
     assert find_descriptions([root / "actuators.xml"]) == [str(root / "actuators.xml")]
 

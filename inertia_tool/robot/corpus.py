@@ -5,8 +5,9 @@ Which files are descriptions: ``*.urdf``, ``*.sdf``, ``*.world`` and ``*.xml`` w
 ``<robot>``, ``<sdf>`` or ``<mujoco>`` (read from the first :data:`SNIFF_BYTES` bytes; ``package.xml`` and
 other XML are skipped); ``*.xacro`` only when named directly (in a folder they are mostly fragments).  An MJCF
 file that another MJCF file of the corpus includes is audited through the including file only (Menagerie's
-``scene.xml`` includes the robot); one found in a folder with neither a ``<worldbody>`` nor an ``<include>``
-is a fragment meant to be included (Menagerie's actuator and keyframe files) and is skipped.  Folders are
+``scene.xml`` includes the robot); one found in a folder with neither a ``<body>`` nor an ``<include>`` is a
+fragment meant to be included (Menagerie's actuator and keyframe files, sites in a ``<worldbody>``) and is
+skipped: it has no link to audit.  Folders are
 walked in sorted order without following symbolic links, at most :data:`MAX_CORPUS_FILES` descriptions.  A
 model that cannot be read is kept with its reason; it never stops the others.
 """
@@ -31,7 +32,7 @@ MAX_CORPUS_FILES = 10_000
 SNIFF_BYTES = 1 << 16
 
 _ROOT = re.compile(rb"<(mujoco|robot|sdf)[\s>/]")
-_MODEL_PART = re.compile(rb"<(worldbody|include)[\s>/]")
+_MODEL_PART = re.compile(rb"<(body|include)[\s>/]")
 _INCLUDE = re.compile(rb"<include\s[^>]*file\s*=\s*[\"']([^\"']+)[\"']")
 
 
@@ -100,7 +101,7 @@ def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
         if os.path.splitext(path)[1].lower() in (".xml", ".mjcf") and _root_kind(path) == "mujoco":
             text = _read_bytes(path, head=MAX_DESCRIPTION_BYTES)
             if path not in explicit and not _MODEL_PART.search(re.sub(rb"<!--.*?-->", b"", text, flags=re.DOTALL)):
-                left_out.add(os.path.normpath(path))      # a fragment: actuators, keyframes, assets only
+                left_out.add(os.path.normpath(path))      # a fragment: actuators, keyframes, sites
                 continue
             for name in _INCLUDE.findall(text):
                 target = os.path.normpath(os.path.join(os.path.dirname(path), os.fsdecode(name)))
