@@ -19,6 +19,7 @@ whatever it is given, or refuses the mesh); the tool's certificate says which bo
 therefore splits the agreement by the tool's method.
 
     python benchmarks/bench_robot_corpus.py DIR [DIR ...] [--repair] [--geometry collision] [--no-mujoco]
+        [--package NAME=DIR]
 """
 
 from __future__ import annotations
@@ -143,9 +144,11 @@ def main(argv=None) -> int:
     parser.add_argument("--repair", action="store_true")
     parser.add_argument("--no-mujoco", action="store_true")
     parser.add_argument("--rtol", type=float, default=1e-6)
+    parser.add_argument("--package", action="append", default=[], metavar="NAME=DIR")
     parser.add_argument("--verbose", action="store_true", help="print every link without a result")
     args = parser.parse_args(argv)
     density = args.density if args.density == "model" else float(args.density)
+    packages = dict(item.split("=", 1) for item in args.package)
     models = find_descriptions(args.folders)
     answered: collections.Counter = collections.Counter()
     causes: collections.Counter = collections.Counter()
@@ -160,7 +163,7 @@ def main(argv=None) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
-                robot = read_robot(path, geometry=args.geometry)
+                robot = read_robot(path, geometry=args.geometry, packages=packages)
                 results = link_inertials(robot, density=density, repair=args.repair)
             except InertiaToolError as exc:
                 unreadable.append(f"{path}: {exc}")
