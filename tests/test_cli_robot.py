@@ -156,3 +156,40 @@ def test_writing_an_mjcf_that_ignores_inertials_says_so(tmp_path, capsys):
                    "<geom type='box' size='0.1 0.2 0.3'/></body></worldbody></mujoco>")
     assert main(["robot", str(src), "--density", "1000", "--write", str(tmp_path / "out.xml")]) == 0
     assert 'inertiafromgeom="true"> makes MuJoCo compute the inertias from the geoms' in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("main_text, part_text, expected", [
+    # set in an included file, with spaces around '=': MuJoCo ignores the inertials
+    ("<include file='part.xml'/>", "<compiler inertiafromgeom = 'true'/>", "true"),
+    # only in a comment, and overridden later in document order: MuJoCo keeps them
+    ("<!-- <compiler inertiafromgeom=\"true\"/> --><compiler inertiafromgeom='true'/><include file='part.xml'/>",
+     "<compiler inertiafromgeom='auto'/>", "auto"),
+    ("<!-- inertiafromgeom=\"true\" -->", "", "auto"),
+])
+def test_inertiafromgeom_is_read_as_mujoco_reads_it(tmp_path, capsys, main_text, part_text, expected):
+    mujoco = pytest.importorskip("mujoco")
+    from inertia_tool.robot.mjcf import inertia_from_geometry
+    (tmp_path / "part.xml").write_text(f"<mujoco>{part_text}</mujoco>")
+    src = tmp_path / "m.xml"
+    src.write_text(f"<mujoco>{main_text}<worldbody><body name='b'><freejoint/><inertial pos='0 0 0' mass='5' "
+                   "diaginertia='1 1 1'/><geom type='box' size='0.1 0.2 0.3'/></body></worldbody></mujoco>")
+    assert inertia_from_geometry(str(src)) == expected
+    spec = mujoco.MjSpec.from_file(str(src))                                  # MuJoCo's own reading
+    assert spec.compiler.inertiafromgeom == {"true": mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_TRUE,
+                                             "auto": mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_AUTO}[expected]
+    model = spec.compile()
+    assert (model.body("b").mass[0] == pytest.approx(5.0)) == (expected != "true")
+    assert main(["robot", str(src), "--density", "1000", "--write", str(tmp_path / "out.xml")]) == 0
+    said = "makes MuJoCo compute the inertias from the geoms" in capsys.readouterr().err
+    assert said == (expected == "true")
+
+
+def test_links_left_as_they_were_are_named_with_their_reason(tmp_path, capsys):
+    src = tmp_path / "m.xml"
+    src.write_text("<mujoco><worldbody><body name='solid'><geom type='box' size='0.1 0.2 0.3'/></body>"
+                   "<body name='ghost'><geom type='box' size='0.1 0.1 0.1' contype='0' conaffinity='0'/></body>"
+                   "<body name='pad'><geom type='box' size='0.1 0.1 0.1' mass='0'/></body></worldbody></mujoco>")
+    assert main(["robot", str(src), "--density", "model", "--write", str(tmp_path / "out.xml")]) == EXIT_INCOMPLETE
+    err = capsys.readouterr().err
+    assert ("<inertial> of 1 link corrected; left as they were: ghost (no collision geometry), "
+            "pad (every geom is massless in the description)") in err

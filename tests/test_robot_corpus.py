@@ -76,3 +76,69 @@ def test_a_named_pipe_among_the_models_is_unreadable_not_waited_on(tmp_path, cap
     out = capsys.readouterr().out
     assert "pipe.xml: is a FIFO (named pipe), not a regular file" in out
     assert "2 models (1 unreadable)" in out
+
+
+def test_mjcf_fragments_in_a_folder_are_not_models_but_a_fragment_named_is_read(tmp_path):
+    # Menagerie's aloha folder holds actuator and keyframe files meant to be included (no <body>, no
+    # <include>; sites in a <worldbody> at most); walked in a folder they are skipped, named on the command
+    # line they are read (and refused)
+    root = tmp_path / "aloha"
+    root.mkdir()
+    (root / "robot.xml").write_text('<mujoco><worldbody><body name="b"><geom type="sphere" size="0.1"/></body>'
+                                    '</worldbody></mujoco>')
+    (root / "keyframe_no_act.xml").write_text('<mujoco><!-- <worldbody> --><keyframe><key name="home" qpos=""/>'
+                                              '</keyframe></mujoco>')
+    (root / "actuators.xml").write_text('<mujoco><worldbody><site name="centre"/></worldbody><actuator>'
+                                        '<position joint="j"/></actuator></mujoco>')
+    assert [os.path.basename(p) for p in find_descriptions([root])] == ["robot.xml"]
+    assert find_descriptions([root / "actuators.xml"]) == [str(root / "actuators.xml")]
+
+
+def _box_stl(path, *, inside_out=False, open_=False):
+    from conftest import box_arrays, write_binary_stl
+    v, f = box_arrays((0.1, 0.2, 0.3))
+    f = f[:, ::-1] if inside_out else f
+    write_binary_stl(path, v, f[:-1] if open_ else f)
+
+
+def _mjcf_using(path, mesh, bodies=("left", "right")):
+    body = "".join(f'<body name="{b}"><geom type="mesh" mesh="m"/></body>' for b in bodies)
+    path.write_text(f'<mujoco><asset><mesh name="m" file="{mesh}"/></asset><worldbody>{body}</worldbody></mujoco>')
+
+
+def test_a_mesh_shared_by_links_and_models_is_read_once_with_its_warnings_for_each(tmp_path, monkeypatch):
+    import inertia_tool.robot.geometry as geometry
+    from inertia_tool.robot.corpus import audit_corpus
+    calls = []
+    real = geometry.mesh_properties
+    monkeypatch.setattr(geometry, "mesh_properties", lambda path, **kw: calls.append(path) or real(path, **kw))
+    _box_stl(tmp_path / "flipped.stl", inside_out=True)
+    _box_stl(tmp_path / "open.stl", open_=True)
+    for name in ("scene", "scene_mjx"):                   # two scene variants of one robot
+        _mjcf_using(tmp_path / f"{name}.xml", "flipped.stl")
+    _mjcf_using(tmp_path / "other.xml", "open.stl")
+    with pytest.warns(Warning):
+        models = audit_corpus([tmp_path], density=1000)
+    assert sorted(os.path.basename(p) for p in calls) == ["flipped.stl", "open.stl"]    # one read each, in all
+    for model in models:
+        left, right = model.inertials
+        if os.path.basename(model.source) == "other.xml":          # refused once, the reason on both links
+            assert left.properties is None and left.problem == right.problem and "not a closed" in left.problem
+            continue
+        volume = 0.1 * 0.2 * 0.3
+        assert left.properties.mass == pytest.approx(1000 * volume, rel=1e-6)          # float32 corners
+        assert left.properties.mass == right.properties.mass
+        # the engine's word on the mesh, with the first link that uses it, in each model as if read there
+        assert any("inside out" in w and "flipped" in w for w in left.warnings), left.warnings
+
+
+def test_the_shared_cache_still_counts_each_robots_face_budget(tmp_path):
+    from inertia_tool.robot import link_inertials, read_robot
+    from inertia_tool.robot.geometry import MeshCache
+    _box_stl(tmp_path / "box.stl")
+    _mjcf_using(tmp_path / "a.xml", "box.stl", bodies=("only",))
+    shared = MeshCache()
+    assert link_inertials(read_robot(tmp_path / "a.xml"), density=1000, mesh_cache=shared)[0].properties is not None
+    assert len(shared) == 1
+    small = link_inertials(read_robot(tmp_path / "a.xml"), density=1000, mesh_cache=shared, max_faces=5)[0]
+    assert small.properties is None and "max_faces" in small.problem and "12 triangles" in small.problem

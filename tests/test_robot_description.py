@@ -223,3 +223,15 @@ def test_two_links_of_one_name_are_refused(tmp_path, suffix, text):
     path.write_text(text)
     with pytest.raises(RobotDescriptionError, match="two links are named 'l'"):
         read_robot(path)
+
+
+def test_a_package_uri_with_three_slashes_names_the_package_in_its_path(tmp_path):
+    # example-robot-data 6.0.0, talos_full_v2.urdf: package:///example-robot-data/robots/talos_data/meshes/...
+    from inertia_tool.mass import shapes
+    from inertia_tool.robot.resolve import resolve_uri
+    (tmp_path / "pkg" / "meshes").mkdir(parents=True)
+    shapes.write_stl(shapes.box(0.1, 0.2, 0.3), tmp_path / "pkg" / "meshes" / "b.stl")
+    expected = str(tmp_path / "pkg" / "meshes" / "b.stl")
+    for uri in ("package:///pkg/meshes/b.stl", "package://pkg/meshes/b.stl"):
+        assert resolve_uri(uri, base=str(tmp_path), packages={"pkg": tmp_path / "pkg"}, source="r.urdf",
+                           link="l") == expected

@@ -163,3 +163,49 @@ def test_the_angle_between_principal_frames_ignores_their_handedness(seed, sign_
     # acos near 1 resolves angles to about 1e-6 degrees
     assert _frame_angle(a, b) == pytest.approx(min(truths), abs=1e-4)
     assert _frame_angle(b, b) == pytest.approx(0.0, abs=1e-4)
+
+
+# -- placeholder box and mass from another link (issue 23) -----------------------------------------------
+
+def test_a_placeholder_box_of_the_bounding_box_is_named_with_both_boxes():
+    # a cone link (r 0.05, h 0.4) whose declared tensor is that of its 0.1 x 0.1 x 0.4 bounding box
+    from inertia_tool.mass import shapes
+    mass = 3.0
+    cone = shapes.cone(0.05, 0.4, segments=3).exact
+    geometry = cone.inertia * (mass / cone.mass)
+    box = shapes.box(0.1, 0.1, 0.4).exact
+    declared = box.inertia * (mass / box.mass)
+    causes = diagnose_inertial(mass, np.zeros(3), declared, mass, geometry, tolerance=0.1,
+                               geometry_extents=np.array([0.1, 0.1, 0.4]))
+    assert [c.cause for c in causes] == ["placeholder"]
+    assert ("placeholder box: the declared tensor is that of a solid 0.1 × 0.1 × 0.4 m box of 3 kg"
+            in causes[0].explanation)
+    np.testing.assert_allclose(causes[0].inertia, geometry, rtol=1e-12)
+    # the same tensor against a bounding box 10 % off, or turned off the link axes: not a placeholder box
+    assert diagnose_inertial(mass, np.zeros(3), declared, mass, geometry, tolerance=0.1,
+                             geometry_extents=np.array([0.11, 0.1, 0.4])) == ()
+    turn = np.array([[np.cos(0.3), -np.sin(0.3), 0], [np.sin(0.3), np.cos(0.3), 0], [0, 0, 1]])
+    turned = np.array([[1, 0, 0], [0, np.cos(0.3), -np.sin(0.3)], [0, np.sin(0.3), np.cos(0.3)]]) @ turn
+    assert all(c.cause != "placeholder" for c in diagnose_inertial(
+        mass, np.zeros(3), turned @ declared @ turned.T, mass, geometry, tolerance=0.1,
+        geometry_extents=np.array([0.1, 0.1, 0.4])))
+
+
+def test_a_mass_copied_from_another_link_is_named(tmp_path):
+    from inertia_tool.robot import audit_links, link_inertials, read_robot
+    # 'upper' is right (a 0.1 x 0.1 x 0.4 aluminium bar: 10.8 kg); 'small' (a 0.1 m aluminium cube, 2.7 kg)
+    # declares the same 10.8 kg, copied
+    box = '<collision><geometry><box size="{}"/></geometry></collision>'
+    inertial = '<inertial><mass value="10.8"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>'
+    path = tmp_path / "r.urdf"
+    path.write_text(f'<robot name="r"><link name="upper">{inertial}{box.format("0.1 0.1 0.4")}</link>'
+                    f'<link name="small">{inertial}{box.format("0.1 0.1 0.1")}</link></robot>')
+    robot = read_robot(path)
+    audits = {a.name: a for a in audit_links(robot, link_inertials(robot, material="aluminium"))}
+    (cause,) = [c for c in audits["small"].causes if c.cause == "other_link"]
+    assert "10.8 kg is exactly the declared mass of 'upper', whose geometry it fits (1×)" in cause.explanation
+    assert cause.mass == pytest.approx(2.7, rel=1e-12)
+    assert all(c.cause != "other_link" for c in audits["upper"].causes)
+    # with the declared masses kept there is no disagreement about masses to explain
+    kept = audit_links(robot, link_inertials(robot, keep_mass=True), keep_mass=True)
+    assert all(c.cause != "other_link" for a in kept for c in a.causes)

@@ -267,7 +267,7 @@ def test_include_cycle_depth_and_missing_file_are_refused(tmp_path):
         read_robot(tmp_path / "m.xml")
     (tmp_path / "u.xml").write_text('<mujoco><include file="r.urdf"/></mujoco>')
     (tmp_path / "r.urdf").write_text('<robot name="r"/>')
-    with pytest.raises(RobotDescriptionError, match="expected <mujoco>"):
+    with pytest.raises(RobotDescriptionError, match="expected <mujoco> or <mujocoinclude>"):
         read_robot(tmp_path / "u.xml")
 
 
@@ -394,3 +394,70 @@ def test_a_capsule_fitted_to_an_open_mesh_with_repair_is_audited_without_stoppin
     assert audits[0].com_inside_geometry is None and audits[0].issues        # no box without repair: unknown
     unrepaired = link_inertials(robot, density=1000)
     assert unrepaired[0].properties is None and "mesh needs repair" in unrepaired[0].problem
+
+
+def test_geoms_of_an_explicit_contact_pair_are_collision_geometry(tmp_path):
+    # Menagerie's MJX models switch every geom's contype/conaffinity off and list their contacts as
+    # <contact><pair>: MuJoCo collides those geoms all the same (a contact appears), so they are collision geometry
+    path = tmp_path / "pairs.xml"
+    path.write_text('<mujoco><default><geom contype="0" conaffinity="0"/></default><worldbody>'
+                    '<body name="foot"><freejoint/><geom name="sole" type="sphere" size="0.1"/>'
+                    '<geom name="shin" type="box" size="0.1 0.1 0.1" pos="0 0 0.5"/></body>'
+                    '<body name="floor" pos="0 0 -0.15"><geom name="plate" type="box" size="1 1 0.1"/></body>'
+                    '</worldbody><contact><pair geom1="sole" geom2="plate"/></contact></mujoco>')
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert data.ncon == 1 and {model.geom(data.contact.geom1[0]).name, model.geom(data.contact.geom2[0]).name} == {
+        "sole", "plate"}
+    links = {link.name: link for link in read_robot(path).links}
+    assert [e.name for e in links["foot"].elements] == ["sole"]
+    assert [e.name for e in links["floor"].elements] == ["plate"]
+    visual = {link.name: link for link in read_robot(path, geometry="visual").links}
+    assert [e.name for e in visual["foot"].elements] == ["shin"] and visual["floor"].elements == ()
+
+
+def test_a_body_without_a_geom_in_the_group_range_says_so(tmp_path):
+    path = tmp_path / "g.xml"
+    path.write_text('<mujoco><compiler inertiagrouprange="0 2"/><worldbody><body name="b">'
+                    '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/><geom type="sphere" size="0.1" group="3"/>'
+                    '</body></worldbody></mujoco>')
+    result = link_inertials(read_robot(path, geometry="all"), density="model")[0]
+    assert result.properties is None and result.problem == "no geom in <compiler inertiagrouprange>"
+
+
+def test_included_files_as_mujoco_reads_them_mujocoinclude_root_and_meshes_beside_the_included_file(tmp_path):
+    # MyoSuite and Meta-World include <mujocoinclude> files; MuJoCo Playground's mjx_scene.xml includes
+    # Menagerie's mjx_panda.xml (meshdir="assets", mesh file="assets/link0.stl") from another folder, which
+    # MuJoCo finds beside the included file when <main folder>/<meshdir>/<file> does not exist
+    robot = tmp_path / "menagerie" / "panda"
+    (robot / "assets").mkdir(parents=True)
+    shapes.write_stl(shapes.box(0.1, 0.2, 0.3), robot / "assets" / "link0.stl")
+    (robot / "panda.xml").write_text('<mujoco><compiler meshdir="assets"/><include file="defaults.xml"/>'
+                                     '<asset><mesh name="l0" file="assets/link0.stl"/></asset><worldbody>'
+                                     '<body name="link0"><geom class="k" type="mesh" mesh="l0"/></body>'
+                                     '</worldbody></mujoco>')
+    (robot / "defaults.xml").write_text('<mujocoinclude><default><default class="k"><geom density="500"/>'
+                                        '</default></default></mujocoinclude>')
+    scene = tmp_path / "playground" / "xmls" / "mjx_scene.xml"
+    scene.parent.mkdir(parents=True)
+    scene.write_text('<mujoco><include file="../../menagerie/panda/panda.xml"/></mujoco>')
+    spec = mujoco.MjSpec.from_file(str(scene))
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_TRUE
+    for mesh in spec.meshes:
+        mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
+    model = spec.compile()
+    description = read_robot(scene)
+    assert description.links[0].elements[0].mesh == str(robot / "assets" / "link0.stl")
+    (result,) = link_inertials(description, density="model")
+    assert result.properties.mass == pytest.approx(model.body("link0").mass[0], rel=1e-12)
+    assert result.properties.mass == pytest.approx(500 * 0.006, rel=1e-6)               # float32 corners
+
+
+def test_a_plane_in_a_body_has_no_mass_as_in_mujoco(tmp_path):
+    # MuJoCo Playground's mjx_cabinet.xml: a plane geom in body 'barrier' (MuJoCo gives a plane no inertia)
+    path = tmp_path / "p.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true"/><worldbody><body name="barrier" pos="0 0 1">'
+                    '<geom type="plane" size="1 1 0.1"/><geom type="sphere" size="0.1" pos="0 0.2 0"/></body>'
+                    '</worldbody></mujoco>')
+    _assert_like_mujoco(path, link_inertials(read_robot(path), density=1000), rtol=1e-12)

@@ -733,3 +733,37 @@ def test_urdf_and_sdf_written_to_another_folder_read_back_with_their_meshes(tmp_
     assert 'filename="../src/meshes/b.stl"' in text and 'filename="file://../src/meshes/b.stl" scale="1 1 1"' in text
     assert 'filename="package://pkg/b.stl"' in text
     assert "<uri>../src/meshes/b.stl</uri>" in (out / "m.sdf").read_text()
+
+
+def test_mjcf_scene_written_elsewhere_restates_the_meshdir_of_the_included_robot(tmp_path):
+    # Menagerie: scene.xml includes robot.xml, whose <compiler meshdir="assets"/> MuJoCo takes relative to the
+    # *main* file's folder; a scene written to another folder must say where the meshes are
+    mujoco = pytest.importorskip("mujoco")
+    from inertia_tool.mass import shapes
+    src = tmp_path / "robot"
+    (src / "assets").mkdir(parents=True)
+    shapes.write_stl(shapes.cone(0.02, 0.05, segments=24), src / "assets" / "cone.stl")
+    (src / "robot.xml").write_text('<mujoco model="r">\n  <compiler angle="radian" meshdir="assets"/>\n'
+                                   '  <asset>\n    <mesh name="cone" file="cone.stl"/>\n  </asset>\n'
+                                   '  <worldbody>\n    <body name="b">\n      <freejoint/>\n'
+                                   '      <geom type="mesh" mesh="cone"/>\n    </body>\n  </worldbody>\n</mujoco>\n')
+    scene = src / "scene.xml"
+    scene.write_text('<mujoco model="scene">\n  <include file="robot.xml"/>\n  <worldbody>\n'
+                     '    <geom name="floor" type="plane" size="1 1 0.1"/>\n  </worldbody>\n</mujoco>\n')
+    out = tmp_path / "elsewhere" / "scene_fixed.xml"
+    out.parent.mkdir()
+    robot = read_robot(scene)
+    results = link_inertials(robot, density=1000)
+    write_corrected(robot, results, out)
+    text = out.read_text()
+    assert '<include file="../robot/robot.xml"/>\n  <compiler meshdir="../robot/assets"/>\n  <worldbody>' in text
+    compiled = mujoco.MjModel.from_xml_path(str(out))                        # loads where it was written
+    assert compiled.body("b").mass[0] == pytest.approx(results[0].properties.mass, rel=1e-12)
+    again = read_robot(out)
+    assert again.links[0].elements[0].mesh == str(src / "assets" / "cone.stl")
+    # a compiler of the main file after the include still has the last word (left as it was, moved)
+    scene.write_text(scene.read_text().replace('  <worldbody>', '  <compiler meshdir="assets/"/>\n  <worldbody>'))
+    robot = read_robot(scene)
+    write_corrected(robot, link_inertials(robot, density=1000), out, force=True)
+    assert text.count("<compiler") + 1 == out.read_text().count("<compiler")
+    mujoco.MjModel.from_xml_path(str(out))

@@ -9,11 +9,13 @@ import sys
 
 from ..errors import UsageError
 from ..mesh.options import DEFAULT_MAX_FACES
-from ..reports.robot_audit import format_robot_report, links_without_result, robot_report_dict, summary_line
+from ..reports.robot_audit import (format_robot_report, left_unchanged, links_without_result, robot_report_dict,
+                                   summary_line)
 from ..reports.serialize import command_output
 from ..robot.audit import audit_links
 from ..robot.description import GEOMETRY_KINDS, read_robot
 from ..robot.geometry import MODEL_DENSITY, link_inertials
+from ..robot.mjcf import inertia_from_geometry
 from ..robot.write import write_corrected
 from ..units import MATERIALS, parse_density
 from . import EXIT_INCOMPLETE, EXIT_OK, speak_options
@@ -159,11 +161,11 @@ def run(args) -> int:
         basis = next((r.basis for r in inertials if r.properties is not None), "")
         note = "declared masses kept" if args.keep_mass else f"density {basis}"
         changed = write_corrected(robot, inertials, args.write, force=args.force, note=note)
-        skipped = [r.name for r in inertials if r.name not in changed]
         message = f"wrote {args.write}: <inertial> of {len(changed)} link{'' if len(changed) == 1 else 's'} corrected"
-        if skipped:
-            message += f"; left as they were: {', '.join(skipped)}"
-        if robot.format == "mjcf" and b'inertiafromgeom="true"' in robot.document.replace(b"'", b'"'):
+        unchanged = left_unchanged(inertials, changed)
+        if unchanged:
+            message += f"; left as they were: {unchanged}"
+        if robot.format == "mjcf" and inertia_from_geometry(robot.source, robot.document) == "true":
             message += ('; note: <compiler inertiafromgeom="true"> makes MuJoCo compute the inertias from the geoms '
                         "and ignore every <inertial>, these included")
         print(escape_terminal(message), file=sys.stderr)

@@ -13,7 +13,7 @@ from ..robot.description import RobotDescription
 from ..robot.geometry import LinkInertial
 from .serialize import TENSOR_CONVENTION, to_jsonable
 
-__all__ = ["robot_report_dict", "format_robot_report", "links_without_result", "summary_line",
+__all__ = ["robot_report_dict", "format_robot_report", "links_without_result", "summary_line", "left_unchanged",
            "corpus_report_dict", "format_corpus_report"]
 
 
@@ -28,6 +28,27 @@ def links_without_result(robot: RobotDescription, inertials) -> list:
         if result.properties is None and (link.elements or declared_mass):
             out.append(result)
     return out
+
+
+#: The start of a link's problem that stands for all of it in :func:`left_unchanged` (the rest names files and
+#: is in the table).
+_SHORT_PROBLEMS = ("mesh needs repair or cannot be read", "cannot be computed")
+
+
+def left_unchanged(inertials, changed) -> str:
+    """``"a (no collision geometry), b (mesh needs repair or cannot be read)"``: the links a written copy left
+    as they were, each with the reason; "" when every link was corrected."""
+    parts = []
+    for result in inertials:
+        if result.name in changed:
+            continue
+        if result.properties is not None:
+            reason = "no element of its own in the file"          # e.g. a copy made by MJCF <replicate>
+        else:
+            reason = next((short for short in _SHORT_PROBLEMS if (result.problem or "").startswith(short)),
+                          result.problem or "no result")
+        parts.append(f"{result.name} ({reason})")
+    return ", ".join(parts)
 
 
 def summary_line(robot: RobotDescription, inertials) -> str:

@@ -28,6 +28,8 @@ Every threshold is a keyword argument; an issue is a sentence in ``LinkAudit.iss
 from __future__ import annotations
 
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..errors import InertiaToolError
@@ -36,7 +38,7 @@ from ..units import MATERIALS
 from ..values import frozen_value
 from .description import DeclaredInertial, RobotDescription
 from .geometry import LinkInertial, element_bounds, points_inside_element
-from .diagnose import diagnose_inertial, nearest_valid_tensor
+from .diagnose import copied_masses, diagnose_inertial, nearest_valid_tensor
 from .inertial import MomentCheck, check_moments
 
 __all__ = ["LinkAudit", "audit_links", "DENSITY_RANGE", "DEFAULT_COM_TOLERANCE", "DEFAULT_INERTIA_TOLERANCE",
@@ -210,7 +212,8 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
             if inertia_diff > inertia_tolerance or not plausible:
                 causes = diagnose_inertial(declared.mass, declared.center_of_mass, declared.inertia, computed.mass,
                                            computed.inertia, tolerance=inertia_tolerance,
-                                           geometry_volume=computed.volume, density_range=DENSITY_RANGE)
+                                           geometry_volume=computed.volume, density_range=DENSITY_RANGE,
+                                           geometry_extents=None if lo is None or hi is None else hi - lo)
                 issues += [f"likely cause: {c.explanation}" for c in causes]
             if in_box is False:
                 issues.append("declared centre of mass lies outside the link geometry's bounding box")
@@ -221,4 +224,13 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
                              declared_check=check, implied_density=implied, density_plausible=plausible,
                              com_in_bounding_box=in_box, com_inside_geometry=inside, size=size, issues=tuple(issues),
                              causes=causes, nearest_valid_inertia=nearest))
-    return tuple(out)
+    if keep_mass:                    # the geometry was scaled to the declared masses: no mass disagrees
+        return tuple(out)
+    missing = float("nan")
+    copied = copied_masses([a.name for a in out],
+                           [a.declared.mass if a.declared is not None else missing for a in out],
+                           [a.computed.mass if a.computed is not None else missing for a in out],
+                           mass_tolerance=mass_tolerance)
+    return tuple(replace(a, causes=a.causes + (copied[a.name],),
+                         issues=a.issues + (f"likely cause: {copied[a.name].explanation}",))
+                 if a.name in copied else a for a in out)

@@ -5,9 +5,11 @@ Which files are descriptions: ``*.urdf``, ``*.sdf``, ``*.world`` and ``*.xml`` w
 ``<robot>``, ``<sdf>`` or ``<mujoco>`` (read from the first :data:`SNIFF_BYTES` bytes; ``package.xml`` and
 other XML are skipped); ``*.xacro`` only when named directly (in a folder they are mostly fragments).  An MJCF
 file that another MJCF file of the corpus includes is audited through the including file only (Menagerie's
-``scene.xml`` includes the robot).  Folders are walked in sorted order without following symbolic links, at
-most :data:`MAX_CORPUS_FILES` descriptions.  A model that cannot be read is kept with its reason; it never
-stops the others.
+``scene.xml`` includes the robot); one found in a folder with neither a ``<body>`` nor an ``<include>`` is a
+fragment meant to be included (Menagerie's actuator and keyframe files, sites in a ``<worldbody>``) and is
+skipped: it has no link to audit.  Folders are
+walked in sorted order without following symbolic links, at most :data:`MAX_CORPUS_FILES` descriptions.  A
+model that cannot be read is kept with its reason; it never stops the others.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from ..errors import InertiaToolError, RobotDescriptionError, UsageError
 from ..values import frozen_value
 from .audit import audit_links
 from .description import MAX_DESCRIPTION_BYTES, RobotDescription, _read_bytes, read_robot
-from .geometry import link_inertials
+from .geometry import MeshCache, link_inertials
 
 __all__ = ["ModelAudit", "find_descriptions", "audit_corpus", "MAX_CORPUS_FILES", "SNIFF_BYTES"]
 
@@ -30,6 +32,7 @@ MAX_CORPUS_FILES = 10_000
 SNIFF_BYTES = 1 << 16
 
 _ROOT = re.compile(rb"<(mujoco|robot|sdf)[\s>/]")
+_MODEL_PART = re.compile(rb"<(body|include)[\s>/]")
 _INCLUDE = re.compile(rb"<include\s[^>]*file\s*=\s*[\"']([^\"']+)[\"']")
 
 
@@ -68,12 +71,15 @@ def _root_kind(path: str) -> str | None:
 def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
     """The description files named by ``paths`` (files, or folders walked; see the module docstring)."""
     found: list = []
+    explicit: set = set()
 
-    def add(path: str, explicit: bool) -> None:
+    def add(path: str, named: bool) -> None:
         suffix = os.path.splitext(path)[1].lower()
-        if suffix in (".urdf", ".sdf", ".world") or (suffix == ".xacro" and explicit):
+        if named:
+            explicit.add(path)
+        if suffix in (".urdf", ".sdf", ".world") or (suffix == ".xacro" and named):
             found.append(path)
-        elif suffix in (".xml", ".mjcf") and (explicit or _root_kind(path) is not None):
+        elif suffix in (".xml", ".mjcf") and (named or _root_kind(path) is not None):
             found.append(path)
         if len(found) > max_files:
             raise UsageError(f"Expected at most {max_files:,} robot descriptions, found more under "
@@ -90,15 +96,18 @@ def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
                         add(path, False)
         else:
             add(entry, True)
-    included = set()
-    for path in found:
+    left_out = set()           # included by another file of the corpus, or a fragment
+    for path in list(found):
         if os.path.splitext(path)[1].lower() in (".xml", ".mjcf") and _root_kind(path) == "mujoco":
             text = _read_bytes(path, head=MAX_DESCRIPTION_BYTES)
+            if path not in explicit and not _MODEL_PART.search(re.sub(rb"<!--.*?-->", b"", text, flags=re.DOTALL)):
+                left_out.add(os.path.normpath(path))      # a fragment: actuators, keyframes, sites
+                continue
             for name in _INCLUDE.findall(text):
                 target = os.path.normpath(os.path.join(os.path.dirname(path), os.fsdecode(name)))
                 if target != os.path.normpath(path):
-                    included.add(target)
-    return [p for p in found if os.path.normpath(p) not in included]
+                    left_out.add(target)
+    return [p for p in found if os.path.normpath(p) not in left_out]
 
 
 def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass: bool = False,
@@ -110,11 +119,12 @@ def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass:
     and :func:`~inertia_tool.robot.audit_links` (``options`` go to ``link_inertials``).
     """
     out = []
+    meshes = MeshCache()                 # scene variants and sibling models share mesh files: each integrated once
     for path in find_descriptions(paths):
         try:
             robot = read_robot(path, packages=packages, geometry=geometry, run_xacro=run_xacro)
             inertials = link_inertials(robot, density=density, material=material, keep_mass=keep_mass,
-                                       repair=repair, **options)
+                                       repair=repair, mesh_cache=meshes, **options)
             audits = audit_links(robot, inertials, keep_mass=keep_mass)
         except InertiaToolError as exc:
             out.append(ModelAudit(source=path, robot=None, problem=str(exc)))

@@ -20,6 +20,13 @@ named place, checked in this order, all reported that pass):
   principal frames and the correction is ``R``'s axes with the declared moments.
 * ``placeholder``: an isotropic tensor ``k 1`` (``diaginertia="0.001 0.001 0.001"``) for geometry whose
   principal moments differ by more than ``anisotropy``: a placeholder; the geometry's tensor replaces it.
+  Or a *box*: a tensor diagonal in the link axes that is the tensor of the solid box of the declared mass
+  whose edges are the geometry's bounding box (each within ``box_rtol``), while the geometry's own tensor differs:
+  the box's edges follow from the moments, ``a_x² = 6 (I_yy + I_zz − I_xx) / m`` (cyclic; from
+  ``I_xx = m (a_y² + a_z²) / 12``), so the evidence is the two boxes side by side.
+* ``other_link`` (:func:`copied_masses`, across links): the declared mass is exactly another link's, whose
+  geometry it fits, while this link's geometry gives a mass ``mass_tolerance`` or more away — a value copied
+  from the other link; the geometry's mass replaces it.
 
 :func:`nearest_valid_tensor` gives, for a declared tensor that fails the simulators' checks (a negative
 moment, ``I1 + I2 < I3``), the tensor with the same axes whose moments are projected onto the valid set.
@@ -34,10 +41,11 @@ import numpy as np
 
 from ..values import frozen_value
 
-__all__ = ["Diagnosis", "diagnose_inertial", "nearest_valid_tensor", "CAUSES", "UNIT_FACTORS", "DECIMAL_FACTORS"]
+__all__ = ["Diagnosis", "diagnose_inertial", "copied_masses", "nearest_valid_tensor", "CAUSES", "UNIT_FACTORS",
+           "DECIMAL_FACTORS"]
 
 #: Cause keys, in the order the rules are tried.
-CAUSES = ("unit", "decimal", "origin", "axes", "placeholder")
+CAUSES = ("unit", "decimal", "origin", "axes", "placeholder", "other_link")
 
 #: Factors a unit slip multiplies by (kg·m² read as g·m², kg·mm², g·mm²; and the inverses).
 UNIT_FACTORS = (1e3, 1e6, 1e9)
@@ -107,7 +115,8 @@ def _frame_angle(a: np.ndarray, b: np.ndarray) -> float:
 
 def diagnose_inertial(declared_mass: float, declared_com, declared_inertia, geometry_mass: float,
                       geometry_inertia, *, tolerance: float = 0.25, anisotropy: float = 0.1,
-                      density_range: tuple = (500.0, 19300.0), geometry_volume: float | None = None) -> tuple:
+                      density_range: tuple = (500.0, 19300.0), geometry_volume: float | None = None,
+                      geometry_extents=None, box_rtol: float = 0.05) -> tuple:
     """Likely causes of a declared inertial's disagreement with the geometry (see the module docstring).
 
     Parameters
@@ -131,6 +140,11 @@ def diagnose_inertial(declared_mass: float, declared_com, declared_inertia, geom
         kg/m³ of plausible materials (for unit slips of the mass).
     geometry_volume : float, optional
         m³ (for unit slips of the mass).
+    geometry_extents : (3,) float, optional
+        m, the edges of the geometry's bounding box in link axes (for a placeholder box).
+    box_rtol : float
+        Largest difference of each edge of the box the declared tensor describes from the bounding box's,
+        relative to that edge, for a placeholder box.
 
     Returns
     -------
@@ -192,7 +206,67 @@ def diagnose_inertial(declared_mass: float, declared_com, declared_inertia, geom
                                f"{tensor[0, 0]:g}·1 (isotropic) while the geometry's principal moments span "
                                f"{moments_r[0]:.3g}–{moments_r[-1]:.3g} kg·m²", before=before, after=after,
                                inertia=reference))
+    if not iso and geometry_extents is not None:
+        box = _box_placeholder(tensor, declared_mass, np.asarray(geometry_extents, dtype=np.float64), box_rtol)
+        if box is not None:
+            found.append(Diagnosis(cause="placeholder", explanation=f"placeholder box: the declared tensor is that "
+                                   f"of a solid {box} box of {declared_mass:g} kg, the link's bounding box, while "
+                                   f"the geometry's tensor differs from it by {before:.0%}", before=before,
+                                   after=0.0, inertia=reference))
     return tuple(sorted(found, key=lambda d: d.after))
+
+
+def _box_placeholder(tensor: np.ndarray, mass: float, extents: np.ndarray, rtol: float) -> str | None:
+    """``"0.1 × 0.2 × 0.3 m"`` when ``tensor`` (link axes) is diagonal and is the solid box of ``mass`` whose
+    edges are ``extents``, each within ``rtol`` of its own length; else None."""
+    moments = np.diag(tensor)
+    if not (np.all(np.isfinite(extents)) and extents.max() > 0 and mass > 0):
+        return None
+    if np.abs(tensor - np.diag(moments)).max() > 1e-6 * np.abs(moments).max():
+        return None
+    squares = 6.0 * (moments.sum() - 2.0 * moments) / mass           # a_i² = 6 (I_j + I_k − I_i) / m
+    if np.any(squares < 0):
+        return None
+    edges = np.sqrt(squares)
+    if np.any(np.abs(edges - extents) > rtol * extents):
+        return None
+    return " × ".join(f"{e:.3g}" for e in edges) + " m"
+
+
+def copied_masses(names, declared_masses, geometry_masses, *, mass_tolerance: float = 0.25) -> dict:
+    """Links whose declared mass is exactly another link's, copied from it (the ``other_link`` rule of the
+    module docstring).
+
+    Parameters
+    ----------
+    names : sequence of str
+    declared_masses, geometry_masses : sequence of float
+        kg per link (nan where missing), geometry at the density used.
+    mass_tolerance : float
+        Relative mass difference that counts as a disagreement (the audit's).
+
+    Returns
+    -------
+    dict
+        Link name → :class:`Diagnosis` (``mass`` the geometry's) for each link found.
+    """
+    fits: dict = {}
+    for name, declared, geometry in zip(names, declared_masses, geometry_masses):
+        if declared > 0 and geometry > 0 and abs(declared / geometry - 1.0) <= mass_tolerance:
+            fits.setdefault(float(declared), (name, declared / geometry))
+    out = {}
+    for name, declared, geometry in zip(names, declared_masses, geometry_masses):
+        if not (declared > 0 and geometry > 0) or abs(declared / geometry - 1.0) <= mass_tolerance:
+            continue
+        source = fits.get(float(declared))
+        if source is None or source[0] == name:
+            continue
+        ratio = declared / geometry
+        out[name] = Diagnosis(cause="other_link", explanation=f"mass from another link: {declared:g} kg is exactly "
+                              f"the declared mass of {source[0]!r}, whose geometry it fits ({source[1]:.3g}×), "
+                              f"while this link's geometry gives {geometry:.4g} kg ({ratio:.3g}×)",
+                              before=abs(ratio - 1.0), after=0.0, mass=float(geometry))
+    return out
 
 
 def nearest_valid_tensor(tensor, *, max_iterations: int = 10_000, rtol: float = 1e-14) -> np.ndarray:

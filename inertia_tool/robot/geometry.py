@@ -41,7 +41,8 @@ from ..mesh.read import RawMesh
 from .description import GeometryElement, LinkGeometry, RobotDescription
 
 __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", "LinkInertial", "mesh_properties",
-           "points_inside_element", "element_bounds", "LinkUncertainty", "METHODS", "MODEL_DENSITY", "fitted_element"]
+           "points_inside_element", "element_bounds", "LinkUncertainty", "METHODS", "MODEL_DENSITY", "fitted_element",
+           "MeshCache"]
 
 #: What ``LinkInertial.method`` can say: ``"exact"`` (closed forms, and meshes integrated exactly, after
 #: orienting, welding, sealing cracks without moving a point or dropping repeated faces), ``"united"``
@@ -213,6 +214,95 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
                            shell=element.shell)
 
 
+class MeshCache:
+    """Unit-density mesh bodies kept across the robots of one run (a corpus: Menagerie's scene variants, the
+    left and right links of a robot, share mesh files), failures included.
+
+    Each entry is keyed by the file, how the element scales and moves it, and ``repair``; it holds the result
+    (or the exception that refused the mesh), the engine's warnings about it (issued again on every robot that
+    uses it, so that each link still names what was done to its meshes) and the file's triangle count (taken
+    off each robot's ``max_faces`` budget as if it had been read).  Entries are never changed once stored.
+    """
+
+    def __init__(self) -> None:
+        self._entries: dict = {}
+
+    def __len__(self) -> int:
+        return len(self._entries)
+
+    def get(self, key):
+        """``(result or exception, warnings, faces)`` for ``key``, or None."""
+        return self._entries.get(key)
+
+    def put(self, key, outcome, caught: tuple, faces: int) -> None:
+        self._entries.setdefault(key, (outcome, caught, faces))
+
+
+def _reissue(caught) -> None:
+    for item in caught:
+        warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
+
+
+def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, budget: list | None):
+    """The unit-density body of a mesh element, through the robot's ``cache`` (mesh key → result or the
+    exception that refused it, so that a mesh shared by links is read, and refused, once) and the run's shared
+    :class:`MeshCache` (``cache["shared"]``, when given)."""
+    key = _mesh_key(element)
+    if cache is not None and key in cache:
+        found = cache[key]
+        if isinstance(found, BaseException):
+            raise found.with_traceback(None)
+        return found
+    shared = cache.get(_SHARED) if cache is not None else None
+    entry = shared.get((key, repair)) if shared is not None else None
+    if entry is not None:
+        outcome, caught, faces = entry
+        if budget is not None and faces > budget[0] and not isinstance(outcome, BaseException):
+            outcome = MeshReadError(f"{element.mesh}: {faces:,} triangles, more than the {budget[0]:,} that "
+                                    f"`max_faces` leaves (the limit counts all the robot's meshes together, "
+                                    f"{budget[1]:,})")
+        elif budget is not None:
+            budget[0] -= faces
+        _reissue(caught)
+    else:
+        assert element.mesh is not None, "a mesh element carries the path of its file"
+        if budget is not None and budget[0] < 1:
+            raise MeshReadError(f"{element.mesh}: not read: the meshes read before it hold all the triangles "
+                                "`max_faces` allows (the limit is on all the meshes of the robot together)")
+        faces = 0
+        with warnings.catch_warnings(record=True) as recorded:
+            warnings.simplefilter("always")
+            try:
+                outcome = mesh_properties(element.mesh, repair=repair, element=element,
+                                          max_faces=None if budget is None else budget[0])
+            except MeshReadError as exc:
+                if budget is None or budget[0] == budget[1] or "`max_faces`" not in str(exc):
+                    outcome = exc
+                else:
+                    outcome = MeshReadError(f"{exc}: the limit counts all the robot's meshes together "
+                                            f"({budget[1]:,}), and the meshes read before this one left "
+                                            f"{budget[0]:,}")
+            except InertiaToolError as exc:
+                outcome = exc
+        caught = tuple(recorded)
+        _reissue(caught)
+        if not isinstance(outcome, BaseException) and outcome.mesh is not None:
+            faces = int(outcome.mesh.file_faces)
+            if budget is not None:
+                budget[0] -= faces
+        if shared is not None and not (isinstance(outcome, MeshReadError) and "`max_faces`" in str(outcome)):
+            shared.put((key, repair), outcome, caught, faces)     # a budget refusal is this robot's, not the file's
+    if cache is not None:
+        cache[key] = outcome
+    if isinstance(outcome, BaseException):
+        raise outcome.with_traceback(None)
+    return outcome
+
+
+#: Key of the run's shared :class:`MeshCache` inside a robot's cache dict.
+_SHARED = "shared"
+
+
 def element_mass_properties(element: GeometryElement, *, cache: dict | None = None,
                             repair: bool = False, budget: list | None = None) -> MassProperties:
     """Unit-density mass properties of one geometry element, in the **link frame**.
@@ -253,26 +343,7 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     elif kind == "ellipsoid":
         local = _ellipsoid(*size)
     elif kind == "mesh":
-        key = _mesh_key(element)
-        if cache is not None and key in cache:
-            local = cache[key]
-        else:
-            assert element.mesh is not None, "a mesh element carries the path of its file"
-            if budget is not None and budget[0] < 1:
-                raise MeshReadError(f"{element.mesh}: not read: the meshes read before it hold all the triangles "
-                                    "`max_faces` allows (the limit is on all the meshes of the robot together)")
-            try:
-                local = mesh_properties(element.mesh, repair=repair, element=element,
-                                        max_faces=None if budget is None else budget[0])
-            except MeshReadError as exc:
-                if budget is None or budget[0] == budget[1] or "`max_faces`" not in str(exc):
-                    raise
-                raise MeshReadError(f"{exc}: the limit counts all the robot's meshes together ({budget[1]:,}), "
-                                    f"and the meshes read before this one left {budget[0]:,}") from None
-            if budget is not None and local.mesh is not None:
-                budget[0] -= local.mesh.file_faces
-            if cache is not None:
-                cache[key] = local
+        local = _cached_mesh(element, cache=cache, repair=repair, budget=budget)
     else:
         raise UsageError("Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, mesh, "
                          f"got {kind!r}")
@@ -435,7 +506,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     """The result for one link, or the reason there is none (never raises for the link's own problems)."""
     nan = float("nan")
     if not link.elements:
-        return LinkInertial(link.name, None, nan, basis, f"no {geometry} geometry")
+        return LinkInertial(link.name, None, nan, basis, "no geom in <compiler inertiagrouprange>" if geometry == "all"
+                            else f"no {geometry} geometry")
     try:
         parts, massless = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
     except InertiaToolError as exc:
@@ -493,7 +565,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
 
 
 def link_inertials(robot: RobotDescription, *, density: float | str | None = None, material: str | None = None,
-                   keep_mass: bool = False, repair: bool = False, max_faces: int = DEFAULT_MAX_FACES) -> tuple:
+                   keep_mass: bool = False, repair: bool = False, max_faces: int = DEFAULT_MAX_FACES,
+                   mesh_cache: MeshCache | None = None) -> tuple:
     """Mass properties of every link from its geometry, in the link frame.
 
     Parameters
@@ -514,6 +587,9 @@ def link_inertials(robot: RobotDescription, *, density: float | str | None = Non
     max_faces : int
         Triangles all the robot's mesh files together may hold (each file is read once); a mesh past the
         remaining budget is refused before it is read into memory (its link reports why).
+    mesh_cache : MeshCache, optional
+        Mesh bodies shared with other robots of the same run (a corpus); each mesh file placed the same way is
+        then integrated (or refused) once for all of them.  Without it, once per robot.
 
     Returns
     -------
@@ -538,7 +614,7 @@ def link_inertials(robot: RobotDescription, *, density: float | str | None = Non
         rho, basis = resolve_density(density=density, material=material)
     if not (isinstance(max_faces, (int, np.integer)) and 0 < max_faces <= MAX_SUPPORTED_FACES):
         raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,}, got {max_faces!r}")
-    cache: dict = {}
+    cache: dict = {} if mesh_cache is None else {_SHARED: mesh_cache}
     budget = [int(max_faces), int(max_faces)]
     return tuple(_one_link(link, rho=rho, basis=basis, keep_mass=keep_mass, model=model, repair=repair,
                            cache=cache, geometry=robot.geometry, budget=budget) for link in robot.links)

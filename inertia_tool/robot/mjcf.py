@@ -10,18 +10,21 @@ letters rotate with the frame, upper case stay fixed), ``xyaxes``, ``zaxis``; or
 cylinders, boxes and ellipsoids (the axis runs from the first point to the second).  Sizes are MuJoCo's
 half-sizes: box half-edges, cylinder and capsule ``radius half-length``, ellipsoid semi-axes.
 
-Collision geoms are those with ``contype`` or ``conaffinity`` non-zero (MuJoCo's default is 1); the others
-are visual.  Geoms directly in ``<worldbody>`` belong to no body and are skipped.  Inline mesh vertices and
-height fields are refused with a message.
+Collision geoms are those with ``contype`` or ``conaffinity`` non-zero (MuJoCo's default is 1) and those
+named in a ``<contact><pair>`` (MuJoCo collides them whatever their bit masks); the others are visual.  Geoms
+directly in ``<worldbody>`` belong to no body and are skipped, and so are planes in a body (MuJoCo gives them
+no mass or inertia).  Inline mesh vertices and height fields are refused with a message.
 
 MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
 
 * ``<include file>`` is replaced by the children of the included ``<mujoco>``, recursively; the file is looked
-  up relative to the main model's folder first, then relative to the including file's folder.  At most
-  :data:`MAX_INCLUDE_DEPTH` levels, :data:`MAX_INCLUDED_FILES` files and ``MAX_DESCRIPTION_BYTES`` bytes
-  in all; a file that includes itself
-  (directly or not) is refused.  A mesh is found through the merged ``<compiler meshdir>`` relative to the
-  main model's folder; a mesh declared in an included file that is not found there is looked up through that
+  up relative to the main model's folder first, then relative to the including file's folder; its root is
+  ``<mujoco>`` or ``<mujocoinclude>``.  At most :data:`MAX_INCLUDE_DEPTH` levels, :data:`MAX_INCLUDED_FILES`
+  files and ``MAX_DESCRIPTION_BYTES`` bytes in all; a file that includes itself (directly or not) is refused.
+  A mesh is found through the merged ``<compiler meshdir>`` relative to the main model's folder; a mesh
+  declared in an included file that is not found there is looked up, as MuJoCo 4.0 does, beside that file
+  (its folder joined with the mesh's ``file``, without any ``meshdir``: Menagerie's MJX scenes in MuJoCo
+  Playground give ``file="assets/link0.stl"`` for this lookup); then, beyond what MuJoCo does, through that
   file's own ``meshdir``, relative to its folder.
 * Defaults: an element's own attribute overrides its class, the class its parent class.  The orientation is
   one attribute: an element (or class) that gives any of ``quat``, ``axisangle``, ``euler``, ``xyaxes``,
@@ -49,13 +52,18 @@ from ..errors import RobotDescriptionError
 from .description import DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive, _scale
 from .resolve import resolve_uri
 
-__all__ = ["read_mjcf", "orientation_matrix", "MAX_INCLUDE_DEPTH", "MAX_INCLUDED_FILES"]
+__all__ = ["read_mjcf", "orientation_matrix", "inertia_from_geometry", "MAX_INCLUDE_DEPTH", "MAX_INCLUDED_FILES"]
 
 #: Deepest chain of ``<include>`` followed (MuJoCo's own models nest two or three).
 MAX_INCLUDE_DEPTH = 16
 
 #: Most files one model may pull in through ``<include>`` (counting repeats).
 MAX_INCLUDED_FILES = 512
+
+#: Root elements of an included file: MuJoCo takes the children of whatever root it has; ``<mujocoinclude>`` is
+#: the name older models use (MyoSuite, Meta-World, Gymnasium-Robotics); other roots (a URDF's ``<robot>``) are
+#: refused rather than read as nothing.
+_INCLUDED_ROOTS = ("mujoco", "mujocoinclude")
 
 #: The orientation attributes of MJCF: one orientation, whichever of them is given.
 _ORIENTATION = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
@@ -246,6 +254,42 @@ def _compiler(root, source: str) -> tuple[bool, str, str | None]:
     return angle == "degree", eulerseq, merged.get("meshdir", merged.get("assetdir"))
 
 
+#: The values of ``<compiler inertiafromgeom>`` (MuJoCo's default: ``auto``).
+INERTIA_FROM_GEOMETRY = ("false", "true", "auto")
+
+
+def inertia_from_geometry(source: str, document: bytes | None = None) -> str:
+    """MuJoCo's ``<compiler inertiafromgeom>`` for the model ``source``: ``"true"`` (every body's inertia is
+    computed from its geoms and every ``<inertial>`` is ignored), ``"false"`` or ``"auto"`` (the default: only
+    bodies without an ``<inertial>``).  Read as MuJoCo reads it: from every ``<compiler>`` of the file and of
+    the files it includes, in document order, the last one that sets it winning; comments and other elements
+    do not count.
+
+    Parameters
+    ----------
+    source : str
+        The main MJCF file (included files are found relative to it).
+    document : bytes, optional
+        Its content, when already read.
+
+    Raises
+    ------
+    RobotDescriptionError
+        Unreadable file or include, or a value MuJoCo refuses.
+    """
+    from .description import _read_bytes, parse_xml
+    data = _read_bytes(source) if document is None else document
+    root = parse_xml(data, source).getroot()
+    _expand_includes(root, source)
+    value = "auto"
+    for compiler in root.iter("compiler"):
+        value = compiler.get("inertiafromgeom", value)
+    if value not in INERTIA_FROM_GEOMETRY:
+        raise _fail(source, f"<compiler inertiafromgeom={value[:40]!r}>: expected one of "
+                            f"{', '.join(INERTIA_FROM_GEOMETRY)}")
+    return value
+
+
 def _own_mesh_folder(root, folder: str) -> str:
     """The folder a file's own ``<compiler meshdir/assetdir>`` names, relative to ``folder`` (the file's)."""
     merged: dict = {}
@@ -295,13 +339,13 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
                 raise _fail(source, f"the included files hold more than the {MAX_DESCRIPTION_BYTES:,} bytes a robot "
                                     "description may have, all files together")
             included = parse_xml(data, path).getroot()
-            if included.tag != "mujoco":
+            if included.tag not in _INCLUDED_ROOTS:
                 raise _fail(source, f"<include file={name!r}>: {path} has the root element <{included.tag}>, "
-                                    "expected <mujoco>")
+                                    "expected <mujoco> or <mujocoinclude>")
             folders = (_own_mesh_folder(included, os.path.dirname(path)),) + chain
             expand(included, path, stack + (key,), folders)
-            for mesh in included.iter("mesh"):
-                fallbacks.setdefault(mesh, folders)
+            for mesh in included.iter("mesh"):        # MuJoCo's own fallback first: beside the declaring file
+                fallbacks.setdefault(mesh, (os.path.dirname(path),) + folders)
             parent = include.getparent()
             index = parent.index(include)
             tail = include.tail
@@ -461,14 +505,27 @@ def _is_collision(attrs: dict, what: str, source: str) -> bool:
     return any(b != 0 for b in bits)
 
 
-def _selected(attrs: dict, geometry: str, groups: tuple, what: str, source: str) -> bool:
-    """Whether a geom belongs to the chosen geometry: collision (``contype``/``conaffinity`` not both 0),
-    visual (both 0), or ``"all"``: every geom whose ``group`` lies in ``<compiler inertiagrouprange>``
-    (MuJoCo's default 0–5), the geoms MuJoCo's inertia from geometry counts."""
+def _selected(attrs: dict, geometry: str, groups: tuple, what: str, source: str,
+              paired: frozenset = frozenset()) -> bool:
+    """Whether a geom belongs to the chosen geometry: collision (``contype``/``conaffinity`` not both 0, or
+    named in a ``<contact><pair>``: MuJoCo collides a pair's geoms whatever their bit masks, which is how the MJX
+    models of Menagerie give their contacts), visual (the others), or ``"all"``: every geom whose ``group``
+    lies in ``<compiler inertiagrouprange>`` (MuJoCo's default 0–5), the geoms MuJoCo's inertia from geometry
+    counts."""
     if geometry == "all":
         group = _numbers(attrs.get("group", "0"), 1, f"{what} group", source)[0]
         return groups[0] <= group <= groups[1]
-    return _is_collision(attrs, what, source) == (geometry == "collision")
+    collides = attrs.get("name") in paired or _is_collision(attrs, what, source)
+    return collides == (geometry == "collision")
+
+
+def _paired_geoms(root) -> frozenset:
+    """Names of the geoms in ``<contact><pair geom1 geom2>`` elements (explicit contact pairs)."""
+    names: set = set()
+    for contact in root.findall("contact"):
+        for pair in contact.findall("pair"):
+            names.update(n for n in (pair.get("geom1"), pair.get("geom2")) if n)
+    return frozenset(names)
 
 
 #: Most copies one ``<replicate>`` may make (and all of them together).
@@ -519,6 +576,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
     defaults = _Defaults(root, source)
     compiler = (degrees, eulerseq, fitaabb)
     meshes = _meshes(root, defaults, mesh_base, fallbacks, compiler, source)
+    paired = _paired_geoms(root)
     links = []
     counter = [0]
     replicas = [MAX_REPLICAS]
@@ -538,7 +596,9 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
         for child in element:
             if child.tag == "geom":
                 attrs = defaults.attributes(child, class_name, source)
-                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", source):
+                if attrs.get("type") == "plane":      # MuJoCo gives a plane no mass and no inertia
+                    continue
+                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", source, paired):
                     label = f"geom {len(elements) + 1}"
                     elements.append(_geom(attrs, pose, label, link, meshes, packages, compiler, source))
             elif child.tag == "frame":

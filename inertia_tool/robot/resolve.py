@@ -9,6 +9,7 @@ Rules, in order (the first that names an existing directory wins; the file must 
   :data:`MAX_FOLDERS_UP` levels), a folder ``A`` that is the package (its name is ``NAME`` and, for
   ``package://``, it holds a ``package.xml``; or its ``package.xml`` names ``NAME``) or holds it as
   ``A/NAME`` (a sibling model of a Gazebo model folder, a sibling package of a ROS workspace).
+* ``package:///NAME/rest`` (three slashes) is read as ``package://NAME/rest``.
 * ``file:///abs/path`` is the absolute path; ``file://rel/path`` and a plain relative path are relative to
   ``base`` (the description's directory, or MuJoCo's ``meshdir``); an absolute path is itself.
 
@@ -114,7 +115,9 @@ def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) 
     if not sep:
         path = text if os.path.isabs(text) else os.path.join(base, text)
     elif scheme in ("package", "model"):
-        name, _, inner = rest.partition("/")
+        # ``package:///NAME/rest`` (an empty authority: example-robot-data's talos_full_v2.urdf): the package
+        # is the first path component all the same
+        name, _, inner = rest.lstrip("/").partition("/")
         directory = package_directory(name, packages, scheme=scheme, near=base)
         if directory is None:
             searched = ("ROS_PACKAGE_PATH" if scheme == "package"

@@ -247,13 +247,58 @@ def _mjcf_included_folders(robot: RobotDescription) -> set:
     return {key for c in root.iter("compiler") if id(c) not in own for key in c.attrib}
 
 
+#: Compiler attributes naming folders, which MuJoCo takes relative to the main model file's folder.
+_MJCF_FOLDER_KEYS = ("meshdir", "assetdir", "texturedir")
+
+
+def _folders_set_by(include, robot: RobotDescription) -> dict:
+    """The compiler folder attributes that the file of ``include`` (an ``<include>`` of the main file) sets,
+    with the files it includes in turn, as MuJoCo merges them (later ones win); {} when it sets none."""
+    from .mjcf import _expand_includes
+    from lxml import etree
+    probe = etree.Element("mujoco")
+    probe.append(etree.Element("include", file=include.get("file") or ""))
+    try:
+        _expand_includes(probe, robot.source)
+    except Exception:  # noqa: BLE001 - read_robot already expanded it; this is only a second look
+        return {}
+    merged: dict = {}
+    for compiler in probe.iter("compiler"):
+        merged.update({k: v for k, v in compiler.attrib.items() if k in _MJCF_FOLDER_KEYS})
+    return merged
+
+
+def _restate_included_folders(robot: RobotDescription, root, source_dir: str, out_dir: str) -> list:
+    """After each ``<include>`` of the main file whose file sets ``meshdir``/``assetdir``/``texturedir``, a new
+    ``<compiler>`` giving the same folders relative to ``out_dir``.  MuJoCo takes those folders relative to the
+    *main* file's folder, wherever the included file sits, so a main file written elsewhere needs them restated
+    (the included file is not written).  The new element comes right after the include, so that it holds
+    where the included one held (a later ``<compiler>`` of the main file still overrides it).  Returns the new
+    elements (in ``root``)."""
+    from lxml import etree
+    added = []
+    for include in root.findall("include"):        # a <compiler> may only stand at the top level
+        folders = _folders_set_by(include, robot)
+        moved = {k: _moved(v, source_dir, out_dir) for k, v in folders.items()}
+        moved = {k: v for k, v in moved.items() if v is not None}
+        if not moved:
+            continue
+        compiler = etree.Element("compiler", moved)
+        compiler.tail = include.tail
+        include.tail = _whitespace_before(include) or " "
+        include.addnext(compiler)
+        added.append(compiler)
+    return added
+
+
 def rewrite_paths(robot: RobotDescription, root, out_dir: str | None) -> list:
     """Make the relative file references of the tree ``root`` (the description's document) right for a
     copy written in ``out_dir``; returns the elements changed (in place).
 
     URDF: ``<mesh filename>`` (plain relative paths and ``file://`` + a relative path); SDFormat: the text
     of ``<mesh><uri>``; MJCF: ``<compiler meshdir/assetdir/texturedir>``, ``<include file>`` and the ``file``
-    of ``<mesh>``/``<texture>``/``<hfield>``/``<skin>`` assets that no folder attribute governs.
+    of ``<mesh>``/``<texture>``/``<hfield>``/``<skin>`` assets that no folder attribute governs; the folders an
+    included file sets are restated after its ``<include>`` (:func:`_restate_included_folders`).
     ``package://`` and ``model://`` URIs and absolute paths are left alone.  Nothing changes when
     ``out_dir`` is the description's own folder (or None).
     """
@@ -291,6 +336,7 @@ def rewrite_paths(robot: RobotDescription, root, out_dir: str | None) -> list:
                     folders.add(key)
                     move(compiler, key)
         folders |= _mjcf_included_folders(robot)
+        changed.extend(_restate_included_folders(robot, root, source_dir, out_dir))
         for include in root.iter("include"):
             move(include, "file")
         for tag, governing in _MJCF_ASSET_FOLDERS.items():
@@ -394,6 +440,11 @@ def _path_edits(spans: list, order: dict, moved: list) -> list:
     from lxml import etree
     edits = []
     for element in moved:
+        if element not in order:      # a <compiler> restating an included file's folders: after that <include>
+            before = spans[order[element.getprevious()]]
+            edits.append((before.end, before.end, (element.getprevious().tail or "")
+                          + etree.tostring(element, encoding="unicode", with_tail=False)))
+            continue
         span = spans[order[element]]
         if len(element) == 0 and element.text is not None and not span.empty:      # SDFormat <uri>text</uri>
             edits.append((span.start, span.end, _serialized(element, "\n")))
