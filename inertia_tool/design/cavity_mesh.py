@@ -1,8 +1,8 @@
 """The cavity (and insert) as closed meshes, subtracted from the part with a robust boolean (manifold3d).
 
-* :func:`_cavity_field` — the region ``depth ≥ wall + margin`` and ``s_k q_k < 0`` as a scalar field (trilinear
-  depth from the grid, quadrics analytic, creases rounded by a smooth minimum) for ``Manifold.level_set``
-  (marching tetrahedra);
+* :func:`_cavity_values` — the region ``depth ≥ wall + margin`` and ``s_k q_k < 0`` as a scalar field on the
+  grid's cell centres (depth from the grid, quadrics analytic, creases rounded by a smooth minimum), meshed by
+  marching tetrahedra (:mod:`.tetra`);
 * :func:`_region` — its mesh, slivers dropped, the wall measured exactly from every vertex
   (``design.grid.surface_distance``) and the mesh remade deeper when it is too thin;
 * :func:`cut_pocket` — pocket = cavity ∪ insert, ``part − pocket``, pinched vertices separated.
@@ -36,53 +36,39 @@ MIN_VOID_CELLS = 8
 MAX_MESH_ATTEMPTS = 4
 
 
-def _cavity_field(grid, terms, centre, half: float, origin, frame, threshold: float):
-    """The scalar field ``min(depth − threshold, −s_k q_k · half_extent …)`` (m, positive inside the region), for
-    the quadric ``terms`` ``[(coefficients, s_k)]`` (``s = +1``: inside where ``q < 0``; ``−1``: outside it),
-    creases rounded over a quarter cell, as a Python callable of mesh coordinates for ``Manifold.level_set``;
-    the depth is trilinear between the grid's cell centres."""
-    sd = grid.signed_distance
-    nx, ny, nz = sd.shape
-    flat = sd.ravel().tolist()
-    ox, oy, oz = (float(c) for c in grid.origin)
-    inv = 1.0 / grid.spacing
-    r = frame
-    c = centre
-    quadrics = [((np.asarray(t) / np.linalg.norm(t)).tolist(), float(sign)) for t, sign in terms]
-    # frame coordinates, normalised: x̂ = (Rᵀ (x − o) − centre)/half = A x + b
-    a = (r.T / half).tolist()
-    b = ((-(r.T @ np.asarray(origin)) - c) / half).tolist()
-    stride_x, stride_y = ny * nz, nz
-    smooth = 0.25 * grid.spacing
+def _cavity_values(grid, terms, centre, half: float, origin, frame, threshold: float, lo, hi):
+    """The scalar field ``min(depth − threshold, −s_k q_k · half_extent …)`` (m, positive inside the region) at
+    the grid's cell centres from ``lo`` to ``hi`` (index triples, inclusive, within the grid), with one layer
+    of −h around them (so that the surface closes), for the quadric ``terms`` ``[(coefficients, s_k)]``
+    (``s = +1``: inside where ``q < 0``; ``−1``: outside it), creases rounded over a quarter cell.
 
-    def field(x, y, z):
-        gx, gy, gz = (x - ox) * inv, (y - oy) * inv, (z - oz) * inv
-        i = min(max(int(math.floor(gx)), 0), nx - 2)
-        j = min(max(int(math.floor(gy)), 0), ny - 2)
-        k = min(max(int(math.floor(gz)), 0), nz - 2)
-        fx = min(max(gx - i, 0.0), 1.0)
-        fy = min(max(gy - j, 0.0), 1.0)
-        fz = min(max(gz - k, 0.0), 1.0)
-        base = i * stride_x + j * stride_y + k
-        c00 = flat[base] * (1 - fz) + flat[base + 1] * fz
-        c01 = flat[base + stride_y] * (1 - fz) + flat[base + stride_y + 1] * fz
-        c10 = flat[base + stride_x] * (1 - fz) + flat[base + stride_x + 1] * fz
-        c11 = flat[base + stride_x + stride_y] * (1 - fz) + flat[base + stride_x + stride_y + 1] * fz
-        depth = (c00 * (1 - fy) + c01 * fy) * (1 - fx) + (c10 * (1 - fy) + c11 * fy) * fx
-        u = a[0][0] * x + a[0][1] * y + a[0][2] * z + b[0]
-        v = a[1][0] * x + a[1][1] * y + a[1][2] * z + b[1]
-        w = a[2][0] * x + a[2][1] * y + a[2][2] * z + b[2]
-        value = depth - threshold
-        for t, sign in quadrics:
-            q = (t[0] + t[1] * u + t[2] * v + t[3] * w + t[4] * u * u + t[5] * v * v + t[6] * w * w
-                 + t[7] * u * v + t[8] * u * w + t[9] * v * w)
-            inner = -sign * q * half
-            # smooth minimum (rounds the crease where the wall meets the quadric, so the two sheets of the
-            # marching tetrahedra do not pinch at a shared point): min(d, e) − k log(1 + exp(−|d − e|/k))
-            value = min(value, inner) - smooth * math.log1p(math.exp(-abs(value - inner) / smooth))
-        return value
-
-    return field
+    Returns (values (nx + 2, ny + 2, nz + 2), position of the first sample (3,) m)."""
+    h = grid.spacing
+    depth = grid.signed_distance[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1, lo[2]:hi[2] + 1]
+    shape = depth.shape
+    first = grid.origin + h * (np.asarray(lo, dtype=np.float64) - 1.0)
+    axes = [grid.origin[d] + h * np.arange(lo[d], hi[d] + 1, dtype=np.float64) for d in range(3)]
+    # frame coordinates, normalised: x̂ = (Rᵀ (x − o) − centre)/half, one axis at a time (no (n, 3) temporaries)
+    r = np.asarray(frame, dtype=np.float64)
+    shift = (-(r.T @ np.asarray(origin, dtype=np.float64)) - np.asarray(centre)) / half
+    normalised = []
+    for row in range(3):
+        parts = [(r[d, row] / half) * axes[d] for d in range(3)]
+        normalised.append(parts[0][:, None, None] + parts[1][None, :, None] + parts[2][None, None, :] + shift[row])
+    u, v, w = normalised
+    value = depth - threshold
+    smooth = 0.25 * h
+    for t, sign in terms:
+        c = np.asarray(t, dtype=np.float64) / np.linalg.norm(t)
+        q = (c[0] + c[1] * u + c[2] * v + c[3] * w + c[4] * u * u + c[5] * v * v + c[6] * w * w
+             + c[7] * u * v + c[8] * u * w + c[9] * v * w)
+        inner = -sign * q * half
+        # smooth minimum (rounds the crease where the wall meets the quadric, so the two sheets of the
+        # marching tetrahedra do not pinch at a shared point): min(d, e) − k log(1 + exp(−|d − e|/k))
+        value = np.minimum(value, inner) - smooth * np.log1p(np.exp(-np.abs(value - inner) / smooth))
+    padded = np.full((shape[0] + 2, shape[1] + 2, shape[2] + 2), -h)
+    padded[1:-1, 1:-1, 1:-1] = value
+    return padded, first
 
 
 def _manifold_of(vertices, faces):
@@ -132,20 +118,30 @@ def _separate_pinches(vertices, faces, distance: float):
     return v, faces          # the sheets only touch at the shared positions: a valid solid as it stands
 
 
-def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wall: float):
-    """A closed mesh (manifold) of the region of ``terms`` deeper than the wall, from ``Manifold.level_set``,
-    with its wall measured exactly; remeshed deeper (up to ``MAX_MESH_ATTEMPTS``) if thinner than ``wall``.
-    Returns (manifold or None when empty, measured wall)."""
+def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wall: float, tree=None):
+    """A closed mesh (manifold) of the region of ``terms`` deeper than the wall, by marching tetrahedra on the
+    grid's cell centres (``design.tetra``), with its wall measured exactly; remeshed deeper (up to
+    ``MAX_MESH_ATTEMPTS``) if thinner than ``wall``.  Returns (manifold or None when empty, measured wall)."""
     import manifold3d
 
+    from .tetra import marching_tetrahedra
+
     h = grid.spacing
-    lo = cells.min(axis=0) - 2 * h
-    hi = cells.max(axis=0) + 2 * h
+    index = np.rint((cells - grid.origin) / h).astype(np.int64)
+    lo = np.maximum(index.min(axis=0) - 2, 0)
+    hi = np.minimum(index.max(axis=0) + 2, np.array(grid.shape) - 1)
     margin = DEPTH_MARGIN * h
     for _ in range(MAX_MESH_ATTEMPTS):
-        field = _cavity_field(grid, terms, centre, half, origin, frame, wall + margin)
+        values, first = _cavity_values(grid, terms, centre, half, origin, frame, wall + margin, lo, hi)
+        region_v, region_f = marching_tetrahedra(values, first, h)
+        del values
+        if not len(region_f):
+            return None, math.inf
+        region = _manifold_of(region_v, region_f)
+        if region.status() != manifold3d.Error.NoError:
+            raise PhysicsError(f"the cavity surface is not a manifold ({region.status()})")
         # marching tetrahedra can leave vertices closer than a float32 STL can tell apart: merge them
-        region = manifold3d.Manifold.level_set(field, [*lo, *hi], h).simplify(SNAP * h)
+        region = region.simplify(SNAP * h)
         # slivers the marching tetrahedra leave where the field grazes zero: voids smaller than (2h)³ change
         # the moments by nothing measurable and no print could be emptied of them
         pieces = [piece for piece in region.decompose() if piece.volume() >= MIN_VOID_CELLS * h ** 3]
@@ -153,7 +149,7 @@ def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wa
             return None, math.inf
         region = manifold3d.Manifold.batch_boolean(pieces, manifold3d.OpType.Add)
         region_v, _ = _arrays_of(region)
-        measured = float(surface_distance(region_v, vertices, faces, cutoff=wall + h).min())
+        measured = float(surface_distance(region_v, vertices, faces, cutoff=wall + h, tree=tree).min())
         if measured >= wall + SNAP * h:          # pinches are separated by SNAP·h below
             return region, measured - SNAP * h
         margin += 0.5 * h
@@ -161,7 +157,7 @@ def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wa
                        f"{measured:g} m after {MAX_MESH_ATTEMPTS} attempts")
 
 
-def cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall: float):
+def cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall: float, *, tree=None):
     """Mesh the cavity (and the insert), check the wall exactly, subtract, separate pinches.
 
     ``design`` is a :class:`QuadricCavity` or a :class:`~.insert.QuadricInsert`.  Returns (vertices, faces,
@@ -177,13 +173,13 @@ def cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall: floa
     insert = hole = None
     if inserted is not None and np.any(inserted):
         insert, measured = _region(grid, [(design.insert_coefficients, 1.0)], cavity.centre, cavity.half_extent,
-                                   centres[inserted], vertices, faces, origin, frame, wall)
+                                   centres[inserted], vertices, faces, origin, frame, wall, tree)
         walls.append(measured)
     in_q1 = cavity.removed if inserted is None else cavity.removed | (inserted & (cavity.values(
         (centres - origin) @ frame) < 0))
     if np.any(in_q1):
         hole, measured = _region(grid, [(cavity.coefficients, 1.0)], cavity.centre, cavity.half_extent,
-                                 centres[in_q1], vertices, faces, origin, frame, wall)
+                                 centres[in_q1], vertices, faces, origin, frame, wall, tree)
         walls.append(measured)
     if hole is None and insert is None:
         return vertices, faces, None, None, math.inf

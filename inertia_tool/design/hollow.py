@@ -8,7 +8,7 @@ Pipeline (one function per stage):
 3. the quadric cavity that minimises the mode's objective of the mass moments (``design.optimize``,
    ``design.moments``);
 4. the cavity as a closed mesh — the zero level set of ``min(depth − wall, −q)`` by marching tetrahedra
-   (``manifold3d.Manifold.level_set``) — subtracted from the part with manifold3d's robust boolean;
+   (``design.tetra``) — subtracted from the part with manifold3d's robust boolean;
 5. the wall measured exactly (distance from every cavity vertex to the outer surface, ``design.grid``), and
    the hollowed mesh re-analysed by the exact engine: every number reported comes from that re-analysis.
 
@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import AsymmetricTopWarning, NoRoomError, PhysicsError, UsageError
 from .cavity_mesh import DEPTH_MARGIN, cut_pocket  # noqa: F401  (DEPTH_MARGIN: used by the benchmark too)
-from .grid import interior_grid, surface_distance
+from .grid import SurfaceTree, interior_grid, surface_distance
 from .limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
 from .moments import OBJECTIVES, frame_quantities, moment_vector, top_threshold_measure
 from .optimize import QuadricCavity, optimize_quadric_cavity
@@ -268,7 +268,7 @@ def _load(source, units: str | None, density, material, mass, repair: bool = Fal
     return prepared.vertices, prepared.faces, props, raw.source
 
 
-def _exact_near_wall(grid, vertices, faces, wall: float):
+def _exact_near_wall(grid, vertices, faces, wall: float, tree=None):
     """The grid with exact depths (``design.grid.surface_distance``, capped at ``wall + 2h``) at the inside cells
     whose approximate depth lies in ``[wall − h, wall + 2h]``, where the allowed region is decided."""
     from dataclasses import replace
@@ -279,7 +279,7 @@ def _exact_near_wall(grid, vertices, faces, wall: float):
     if len(index[0]) == 0:
         return grid
     depth = grid.signed_distance.copy()
-    depth[index] = surface_distance(grid.centers(index), vertices, faces, cutoff=wall + 2 * h)
+    depth[index] = surface_distance(grid.centers(index), vertices, faces, cutoff=wall + 2 * h, tree=tree)
     return replace(grid, signed_distance=depth)
 
 
@@ -388,7 +388,8 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     rho = before.density
 
     h = extent / resolution
-    grid = _exact_near_wall(interior_grid(vertices, faces, spacing=h), vertices, faces, wall)
+    tree = SurfaceTree(vertices, faces)
+    grid = _exact_near_wall(interior_grid(vertices, faces, spacing=h), vertices, faces, wall, tree)
     deep = grid.inside & (grid.signed_distance >= wall + DEPTH_MARGIN * h)
     index = np.nonzero(deep)
     if len(index[0]) == 0:
@@ -417,7 +418,8 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         design = optimize_cavity_and_insert(objective, mu_part, points, h, cavity, size=size,
                                             density_ratio=insert_density / rho)
         cavity = design.cavity
-    out_v, out_f, ins_v, ins_f, measured = cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall)
+    out_v, out_f, ins_v, ins_f, measured = cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall,
+                                                             tree=tree)
     after = before
     insert_props = None
     if out_v is vertices and ins_v is None and int(cavity.removed.sum()) > 0:
