@@ -8,7 +8,7 @@ Pipeline (one function per stage):
 3. the quadric cavity that minimises the mode's objective of the mass moments (``design.optimize``,
    ``design.moments``);
 4. the cavity as a closed mesh — the zero level set of ``min(depth − wall, −q)`` by marching tetrahedra
-   (``design.tetra``) — subtracted from the part with manifold3d's robust boolean;
+   (``design.tetra``), kept ``wall`` from the part's surface and added to it turned inward (no boolean);
 5. the wall measured exactly (distance from every cavity vertex to the outer surface, ``design.grid``), and
    the hollowed mesh re-analysed by the exact engine: every number reported comes from that re-analysis.
 
@@ -283,6 +283,10 @@ def _exact_near_wall(grid, vertices, faces, wall: float, tree=None):
     return replace(grid, signed_distance=depth)
 
 
+#: Cells beyond the wall up to which the grid's depths are computed (``interior_grid(depth_cap=…)``): the cavity
+#: field asks for ``wall`` + up to 2 cells of margin (``cavity_mesh``), and its smooth minimum reaches 2 more.
+DEPTH_CAP_CELLS = 6
+
 #: A cavity is meshed when the region deeper than the wall spans about this many cells across.
 _CELLS_ACROSS = 3.0
 
@@ -295,8 +299,8 @@ def _too_thin(name: str, grid, wall: float, extent: float, resolution: int, *, c
     why = ("no cell lies deeper than the {w} mm wall plus half a cell" if not chosen else
            f"the {chosen} cells the optimiser chose are too thin a layer to make a cavity of")
     head = (f"{name}: no room for a cavity at resolution {resolution} (cells of {h * 1e3:.3g} mm): "
-            + why.replace("{w}", f"{wall * 1e3:.3g}") + f"; the part is about {deepest * 1e3:.3g} mm deep at "
-            "its thickest")
+            + why.replace("{w}", f"{wall * 1e3:.3g}") + "; the part is "
+            + ("at least" if deepest >= grid.depth_cap else "about") + f" {deepest * 1e3:.3g} mm deep at its thickest")
     if deepest + h <= wall:      # the grid's depth is within a cell of the true one (design.grid)
         return NoRoomError(head + " — nowhere deeper than the wall: a thinner `wall` is the only way")
     if deepest <= wall:
@@ -313,7 +317,8 @@ def _too_thin(name: str, grid, wall: float, extent: float, resolution: int, *, c
 def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivot=None, units: str | None = None,
             density: float | None = None, material: str | None = None, mass: float | None = None,
             resolution: int = DEFAULT_RESOLUTION, center_weight: float = 1e4, product_weight: float = 1e4,
-            gravity: float = 9.80665, insert_density: float | None = None, repair: bool = False) -> SpinItResult:
+            gravity: float = 9.80665, insert_density: float | None = None, repair: bool = False,
+            storage_scale: float | None = None) -> SpinItResult:
     """Hollow a part so that it spins stably about ``axis`` (Bächer et al. 2014; Hafner et al. 2024).
 
     Parameters
@@ -349,6 +354,10 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     repair : bool
         Read a damaged mesh (holes, cracks) as ``mass_properties(repair=True)`` does, and design on the
         repaired surface; every 'after' number is still the exact re-analysis of the hollowed mesh.
+    storage_scale : float, optional
+        m per unit of the file the result will be written to as float32 (an STL in ``units``): the hollowed
+        mesh is rounded as that file holds it before it is re-analysed, so that the file analyses to the
+        numbers reported.  ``None``: kept in float64.
 
     Returns
     -------
@@ -389,7 +398,9 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
 
     h = extent / resolution
     tree = SurfaceTree(vertices, faces)
-    grid = _exact_near_wall(interior_grid(vertices, faces, spacing=h), vertices, faces, wall, tree)
+    # depths matter up to the deepest cavity threshold (wall + margins) plus the smooth minimum's reach
+    grid = interior_grid(vertices, faces, spacing=h, depth_cap=wall + DEPTH_CAP_CELLS * h)
+    grid = _exact_near_wall(grid, vertices, faces, wall, tree)
     deep = grid.inside & (grid.signed_distance >= wall + DEPTH_MARGIN * h)
     index = np.nonzero(deep)
     if len(index[0]) == 0:
@@ -418,14 +429,17 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         design = optimize_cavity_and_insert(objective, mu_part, points, h, cavity, size=size,
                                             density_ratio=insert_density / rho)
         cavity = design.cavity
-    out_v, out_f, ins_v, ins_f, measured = cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall,
-                                                             tree=tree)
+    pockets = cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall, tree=tree,
+                         storage_scale=storage_scale)
     after = before
     insert_props = None
-    if out_v is vertices and ins_v is None and int(cavity.removed.sum()) > 0:
+    out_v, out_f, ins_v, ins_f, measured = vertices, faces, None, None, math.inf
+    if not pockets and int(cavity.removed.sum()) > 0:
         raise (_too_thin(name, grid, wall, extent, resolution, chosen=int(cavity.removed.sum())))
-    if out_v is not vertices:
-        after = _reanalysed((out_v, out_f), rho, f"{name} (hollowed)")
+    if pockets:
+        pocket, after = _first_certified(pockets, rho, f"{name} (hollowed)")
+        out_v, out_f, ins_v, ins_f, measured = (pocket.vertices, pocket.faces, pocket.insert_vertices,
+                                                pocket.insert_faces, pocket.measured_wall)
     if ins_v is not None:
         assert insert_density is not None, "an insert is made only when its density is given"
         from ..mass.properties import combine
@@ -447,13 +461,29 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
 
 
 def _reanalysed(mesh, density: float, name: str):
-    """Mass properties of a mesh made here by manifold3d's boolean, by the engine.
-
-    manifold3d's output is manifold but can pass through itself by rounding at a few face pairs; the engine
-    then integrates it as it stands with the certificate ``unverified`` and says so in its notes, instead of
-    refusing the design (rule R3 of :mod:`inertia_tool.mesh.policy`).
-    """
+    """Mass properties of a mesh made here, by the engine with every check of ``analyze`` (a surface that
+    passes through itself is refused, as ``analyze`` would refuse the file)."""
     from ..mass.pipeline import _part
     from ..mesh.options import LoadOptions
 
-    return _part(mesh, density, None, LoadOptions(), name=name, self_crossing="unverified")[0]
+    return _part(mesh, density, None, LoadOptions(), name=name)[0]
+
+
+def _first_certified(pockets, density: float, name: str):
+    """The first candidate pocket whose hollowed part the engine certifies ``exact`` (as ``analyze`` will the
+    file), and its mass properties.  A cavity added to the part's surface keeps the wall from it and is an
+    embedded surface (``design.tetra``), so the first normally passes; the manifold3d simplification is the
+    one that may fold, and the marching tetrahedra's own mesh is tried next."""
+    from ..errors import InvalidMeshError
+
+    failures = []
+    for pocket in pockets:
+        try:
+            props = _reanalysed((pocket.vertices, pocket.faces), density, name)
+        except InvalidMeshError as exc:
+            failures.append(str(exc))
+            continue
+        if props.mesh is None or props.mesh.certificate.kind == "exact":
+            return pocket, props
+        failures.append(f"certificate {props.mesh.certificate.kind}")
+    raise PhysicsError(f"{name}: no mesh of the cavity could be certified exact ({'; '.join(failures)})")

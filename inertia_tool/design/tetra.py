@@ -28,7 +28,7 @@ _UNIT = np.eye(3, dtype=np.int64)
 def _tetrahedra() -> list[tuple[np.ndarray, int]]:
     """The six Freudenthal tetrahedra of the unit cube: (corner offsets (4, 3), orientation ±1)."""
     out = []
-    for a, b, c in permutations(range(3)):
+    for a, b, _ in permutations(range(3)):
         corners = np.array([[0, 0, 0], _UNIT[a], _UNIT[a] + _UNIT[b], [1, 1, 1]], dtype=np.int64)
         out.append((corners, int(round(np.linalg.det(corners[1:] - corners[0])))))
     return out
@@ -52,7 +52,7 @@ def _case_table() -> dict[int, list[list[tuple[int, int]]]]:
         towards_out = ref[outs].mean(axis=0) - ref[ins].mean(axis=0)
         triangles = []
         for cycle in cycles:
-            edges = [tuple(sorted(e)) for e in cycle]
+            edges = [(min(e), max(e)) for e in cycle]
             p = np.array([0.5 * (ref[i] + ref[j]) for i, j in edges])
             if np.cross(p[1] - p[0], p[2] - p[0]) @ towards_out < 0:
                 edges = [edges[0], edges[2], edges[1]]
@@ -65,7 +65,7 @@ _TETRAHEDRA = _tetrahedra()
 _CASES = _case_table()
 
 
-def marching_tetrahedra(values, origin, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+def marching_tetrahedra(values, origin, spacing: float, *, edge_margin: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """The surface ``{f = 0}`` around ``{f > 0}`` of lattice samples.
 
     Parameters
@@ -76,6 +76,12 @@ def marching_tetrahedra(values, origin, spacing: float) -> tuple[np.ndarray, np.
         Position of sample (0, 0, 0), m.
     spacing : float
         Lattice step, m.
+    edge_margin : float
+        Fraction of a lattice edge (0 to 0.25) kept between a surface vertex and the edge's ends: the crossing
+        is moved inside ``[margin, 1 − margin]``.  The surface stays an embedded manifold wherever its
+        vertices lie in the open edges; with a margin, distinct vertices stay at least about
+        ``0.5 margin · spacing`` apart, so that rounding them (a float32 file) cannot fold a triangle over
+        another.
 
     Returns
     -------
@@ -101,7 +107,7 @@ def marching_tetrahedra(values, origin, spacing: float) -> tuple[np.ndarray, np.
     base = (cube[0] * ny + cube[1]) * nz + cube[2]
     strides = np.array([ny * nz, nz, 1], dtype=np.int64)
     flat_inside = inside.ravel()
-    keys, faces_of = [], []
+    keys = []
     for corners, orientation in _TETRAHEDRA:
         lin = base[:, None] + corners @ strides                      # (m, 4) lattice indices of the corners
         code = (flat_inside[lin] * np.array([1, 2, 4, 8])).sum(axis=1)
@@ -122,13 +128,15 @@ def marching_tetrahedra(values, origin, spacing: float) -> tuple[np.ndarray, np.
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
     all_keys = np.concatenate(keys)
     unique, inverse = np.unique(all_keys.ravel(), return_inverse=True)
-    lower, direction = np.divmod(unique, 7)
-    code = direction + 1
+    lower, edge_direction = np.divmod(unique, 7)
+    code = edge_direction + 1
     step = np.column_stack([(code >> 2) & 1, (code >> 1) & 1, code & 1])
     upper = lower + step @ strides
     flat = f.ravel()
     f0, f1 = flat[lower], flat[upper]
     t = f0 / (f0 - f1)                                               # one end > 0, the other ≤ 0: t in (0, 1]
+    if edge_margin > 0:
+        np.clip(t, edge_margin, 1.0 - edge_margin, out=t)
     index = np.column_stack(np.unravel_index(lower, f.shape)).astype(np.float64)
     vertices = np.asarray(origin, dtype=np.float64) + spacing * (index + t[:, None] * step)
     return vertices, inverse.reshape(-1, 3).astype(np.int64)
