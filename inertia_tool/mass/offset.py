@@ -28,6 +28,7 @@ flat or smooth).
 from __future__ import annotations
 
 import itertools
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -338,7 +339,7 @@ def _column_fraction(column: np.ndarray, j_lo: int, h: float, depth: float, top:
     return fraction / _COLUMN_SAMPLES
 
 
-def _crosses_surface(tree, v: np.ndarray, f: np.ndarray, centres: np.ndarray, size: float, top: float,
+def _crosses_surface(tree: Any, v: np.ndarray, f: np.ndarray, centres: np.ndarray, size: float, top: float,
                      bottom: float) -> np.ndarray:
     """Whether every vertical segment ``[q − bottom, q + top]`` from every point ``q`` of each cell certainly leaves
     the solid: the face first hit by the vertical ray from the cell's centre (up, then down) covers the cell's
@@ -372,7 +373,8 @@ def _crosses_surface(tree, v: np.ndarray, f: np.ndarray, centres: np.ndarray, si
     return out
 
 
-def _add_weighted(c: np.ndarray, size: float, weight: np.ndarray, origin: np.ndarray):
+def _add_weighted(c: np.ndarray, size: float, weight: np.ndarray,
+                  origin: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
     """Volume, first and second moments (about ``origin``) of cubes at ``c`` filled to ``weight``."""
     x = c - origin
     w = size ** 3 * weight

@@ -42,7 +42,7 @@ from ..mesh.prepare import prepare_mesh
 from ..mesh.read import load_mesh
 from .pipeline import MeshSource, resolve_density
 from .properties import MassProperties
-from .offset import DEFAULT_BAND_CELLS, core_moments, vertical_skin_moments
+from .offset import DEFAULT_BAND_CELLS, CoreMoments, core_moments, vertical_skin_moments
 from .surface import shell_inertia, surface_moments
 from ..integrals import second_moment_to_inertia, volume_moments
 
@@ -293,14 +293,14 @@ def printed_part(source: MeshSource, *, skin: float, infill: float, density: flo
                        cell_size=cell, top=top_m, bottom=bottom_m)
 
 
-def _non_negative_length(value, name: str) -> float:
+def _non_negative_length(value: Any, name: str) -> float:
     length = float(value)
     if not (np.isfinite(length) and length >= 0):
         raise UsageError(f"Expected `{name}` to be a finite length ≥ 0 in m, got {value!r}")
     return length
 
 
-def _less_layers(core, layers):
+def _less_layers(core: CoreMoments, layers: CoreMoments) -> CoreMoments:
     """The core's moments less those of the part the top/bottom layers make solid; brackets add (the two
     integrations' errors are independent bounds)."""
     low = core.volume_bounds[0] - layers.volume_bounds[1]
