@@ -342,3 +342,35 @@ def test_written_generated_parts_analyse_exact(tmp_path_factory, blobs, tilt, re
     analysed = json.loads(buffer.getvalue())
     assert analysed["certificate"]["kind"] == "exact"
     assert analysed["mass"] == pytest.approx(reported["after"]["mass_properties"]["mass"], rel=1e-9, abs=0)
+
+
+# -- ring insert -------------------------------------------------------------------------------------------
+@settings(max_examples=30, deadline=None)
+@given(st.floats(0.001, 0.05), st.floats(-0.01, 0.01), st.floats(-0.01, 0.01), st.floats(0.005, 0.05))
+def test_ring_quadric_is_negative_exactly_beyond_its_radius(radius, cx, cy, half):
+    """``ring_coefficients``: q(x̂) < 0 ⇔ x² + y² > ρ² for frame points x = centre + half x̂ (independent: the
+    radius computed from the points)."""
+    from inertia_tool.design.insert import ring_coefficients
+    from inertia_tool.design.optimize import quadric_values
+    centre = np.array([cx, cy, 0.003])
+    rng = np.random.default_rng(int(radius * 1e6))
+    points = rng.uniform(-0.06, 0.06, size=(500, 3))
+    q = quadric_values(ring_coefficients(radius, centre, half), (points - centre) / half)
+    r2 = points[:, 0] ** 2 + points[:, 1] ** 2
+    clear = np.abs(r2 - radius ** 2) > 1e-9 * max(radius ** 2, 1e-6)
+    np.testing.assert_array_equal((q < 0)[clear], (r2 > radius ** 2)[clear])
+
+
+@pytest.mark.slow
+def test_insert_is_the_best_exact_objective_of_its_shapes():
+    """With an insert allowed, spin-it meshes the quadric insert, the ring (a rim about the axis) and the cavity
+    alone and keeps the best exact objective: never worse than the cavity-only design at the same grid."""
+    from pathlib import Path
+    top = Path(__file__).parents[1] / "meshes" / "spinning_top.stl"
+    spec = dict(units="mm", material="PLA", mode="top", pivot=[0, 0, 0], axis=[0, 0, 1], wall=0.002,
+                resolution=32)
+    alone = spin_it(str(top), **spec)
+    with_insert = spin_it(str(top), insert_density=7850.0, **spec)
+    assert with_insert.objective_after <= alone.objective_after * (1 + 1e-9)
+    assert with_insert.insert_shape in ("quadric", "ring", None)
+    assert (with_insert.insert is None) == (with_insert.insert_shape is None)

@@ -141,6 +141,8 @@ class SpinItResult:
         The insert alone, re-analysed at ``insert_density`` (``after`` includes it).
     insert_density : float or None
         kg/m³ of the insert material.
+    insert_shape : str or None
+        ``"quadric"`` or ``"ring"`` (a rim about the spin axis; ``design.insert``), None without an insert.
     """
 
     mode: str
@@ -168,6 +170,7 @@ class SpinItResult:
     insert_faces: np.ndarray | None = None
     insert: object = None
     insert_density: float | None = None
+    insert_shape: str | None = None
 
 
 def _unit(vector, name: str) -> np.ndarray:
@@ -429,22 +432,28 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         design = optimize_cavity_and_insert(objective, mu_part, points, h, cavity, size=size,
                                             density_ratio=insert_density / rho)
         cavity = design.cavity
-    pockets = cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall, tree=tree,
-                         storage_scale=storage_scale)
-    after = before
-    insert_props = None
-    out_v, out_f, ins_v, ins_f, measured = vertices, faces, None, None, math.inf
-    if not pockets and int(cavity.removed.sum()) > 0:
-        raise (_too_thin(name, grid, wall, extent, resolution, chosen=int(cavity.removed.sum())))
-    if pockets:
-        pocket, after = _first_certified(pockets, rho, f"{name} (hollowed)")
-        out_v, out_f, ins_v, ins_f, measured = (pocket.vertices, pocket.faces, pocket.insert_vertices,
-                                                pocket.insert_faces, pocket.measured_wall)
-    if ins_v is not None:
-        assert insert_density is not None, "an insert is made only when its density is given"
-        from ..mass.properties import combine
-        insert_props = _reanalysed((ins_v, ins_f), float(insert_density), f"{name} (insert)")
-        after = combine([after, insert_props], name=f"{name} (hollowed, with insert)")
+    # an insert may come with alternatives (another shape, worse on the cells): each is meshed and re-analysed,
+    # and the best exact objective kept
+    made = None
+    for candidate in (design, *getattr(design, "alternatives", ())):
+        attempt = _made(candidate, vertices, faces, grid, centres, origin, frame, wall, tree, storage_scale, rho,
+                        insert_density, name, before)
+        if attempt is None:
+            continue
+        value = float(objective(moment_vector(attempt[0], origin, frame) / rho))
+        if made is None or value < made[-1]:
+            made = (*attempt, candidate, value)
+    if made is None:
+        if int(cavity.removed.sum()) > 0:
+            raise (_too_thin(name, grid, wall, extent, resolution, chosen=int(cavity.removed.sum())))
+        after, pocket, insert_props, chosen = before, None, None, design
+    else:
+        after, pocket, insert_props, chosen, _ = made
+    cavity = chosen.cavity if hasattr(chosen, "cavity") else chosen
+    out_v, out_f, ins_v, ins_f, measured = ((vertices, faces, None, None, math.inf) if pocket is None else
+                                            (pocket.vertices, pocket.faces, pocket.insert_vertices,
+                                             pocket.insert_faces, pocket.measured_wall))
+    insert_shape = getattr(chosen, "shape", None) if ins_v is not None else None
     metric_origin = origin if (mode == "top" or through is not None) else None
     return SpinItResult(mode=mode, axis=axis, origin=origin, wall=float(wall), vertices=out_v, faces=out_f,
                         before=before, after=after,
@@ -457,7 +466,27 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
                         objective_after=float(objective(moment_vector(after, origin, frame) / rho)),
                         optimisation_seconds=cavity.seconds, objective_evaluations=cavity.evaluations,
                         seconds=time.perf_counter() - started, insert_vertices=ins_v, insert_faces=ins_f,
-                        insert=insert_props, insert_density=None if insert_density is None else float(insert_density))
+                        insert=insert_props, insert_density=None if insert_density is None else float(insert_density),
+                        insert_shape=insert_shape)
+
+
+def _made(design, vertices, faces, grid, centres, origin, frame, wall: float, tree, storage_scale, rho: float,
+          insert_density, name: str, before):
+    """One design meshed and re-analysed: (after, pocket, insert properties), or None when no cavity came out
+    of the meshing (the chosen cells too thin a layer)."""
+    pockets = cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall, tree=tree,
+                         storage_scale=storage_scale)
+    if not pockets:
+        return None
+    pocket, after = _first_certified(pockets, rho, f"{name} (hollowed)")
+    insert_props = None
+    if pocket.insert_vertices is not None:
+        assert insert_density is not None, "an insert is made only when its density is given"
+        from ..mass.properties import combine
+        insert_props = _reanalysed((pocket.insert_vertices, pocket.insert_faces), float(insert_density),
+                                   f"{name} (insert)")
+        after = combine([after, insert_props], name=f"{name} (hollowed, with insert)")
+    return after, pocket, insert_props
 
 
 def _reanalysed(mesh, density: float, name: str):
