@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -143,6 +143,8 @@ class SpinItResult:
         kg/m³ of the insert material.
     insert_shape : str or None
         ``"quadric"`` or ``"ring"`` (a rim about the spin axis; ``design.insert``), None without an insert.
+    loaded : tuple or None
+        The checked input ``(vertices, faces, before, name)``, for another attempt (``spin_it(loaded=…)``).
     """
 
     mode: str
@@ -171,6 +173,7 @@ class SpinItResult:
     insert: object = None
     insert_density: float | None = None
     insert_shape: str | None = None
+    loaded: tuple | None = field(default=None, repr=False, compare=False)
 
 
 def _unit(vector, name: str) -> np.ndarray:
@@ -321,7 +324,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
             density: float | None = None, material: str | None = None, mass: float | None = None,
             resolution: int = DEFAULT_RESOLUTION, center_weight: float = 1e4, product_weight: float = 1e4,
             gravity: float = 9.80665, insert_density: float | None = None, repair: bool = False,
-            storage_scale: float | None = None) -> SpinItResult:
+            storage_scale: float | None = None, loaded: tuple | None = None) -> SpinItResult:
     """Hollow a part so that it spins stably about ``axis`` (Bächer et al. 2014; Hafner et al. 2024).
 
     Parameters
@@ -361,6 +364,9 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         m per unit of the file the result will be written to as float32 (an STL in ``units``): the hollowed
         mesh is rounded as that file holds it before it is re-analysed, so that the file analyses to the
         numbers reported.  ``None``: kept in float64.
+    loaded : tuple, optional
+        ``(vertices, faces, MassProperties, name)`` of this ``source`` already read and checked (``_load``):
+        ``spin_it_verified`` reads the part once for all its attempts.
 
     Returns
     -------
@@ -386,7 +392,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         pivot = _point(pivot, "pivot")
     elif pivot is not None:
         raise UsageError("`pivot` is for mode 'top'")
-    vertices, faces, before, name = _load(source, units, density, material, mass, repair)
+    vertices, faces, before, name = loaded or _load(source, units, density, material, mass, repair)
     if insert_density is not None and not (isinstance(insert_density, (int, float)) and math.isfinite(insert_density)
                                            and insert_density > before.density):
         raise UsageError(f"Expected `insert_density` above the part's {before.density:g} kg/m³, got {insert_density!r}")
@@ -467,7 +473,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
                         optimisation_seconds=cavity.seconds, objective_evaluations=cavity.evaluations,
                         seconds=time.perf_counter() - started, insert_vertices=ins_v, insert_faces=ins_f,
                         insert=insert_props, insert_density=None if insert_density is None else float(insert_density),
-                        insert_shape=insert_shape)
+                        insert_shape=insert_shape, loaded=(vertices, faces, before, name))
 
 
 def _made(design, vertices, faces, grid, centres, origin, frame, wall: float, tree, storage_scale, rho: float,
