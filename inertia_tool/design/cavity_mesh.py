@@ -150,24 +150,31 @@ def _simplified(vertices, faces, tolerance: float):
     return _arrays_of(solid.simplify(tolerance))
 
 
+def _box(grid, cells):
+    """Grid index range (lo, hi, inclusive) of the lattice around ``cells`` (centres, m), two cells wider."""
+    index = np.rint((cells - grid.origin) / grid.spacing).astype(np.int64)
+    return (np.maximum(index.min(axis=0) - 2, 0), np.minimum(index.max(axis=0) + 2, np.array(grid.shape) - 1))
+
+
 def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wall: float, tree=None,
-            storage_scale: float | None = None):
+            storage_scale: float | None = None, *, box=None, margins=None, simplify: bool = True):
     """Closed meshes of the region of ``terms`` deeper than the wall, by marching tetrahedra on the grid's cell
     centres (``design.tetra``), rounded as the file will hold them, each with its wall measured exactly;
     remeshed deeper (up to ``MAX_MESH_ATTEMPTS``) if thinner than ``wall``.
 
     Returns a list of candidates ``(vertices, faces, measured wall)``, preferred first: the mesh simplified by
     manifold3d within ``SIMPLIFY`` cells (when it has at most ``SIMPLIFY_MAX_TRIANGLES`` triangles), then the
-    marching tetrahedra's own; empty when the region is."""
+    marching tetrahedra's own; empty when the region is.  ``box`` (lattice range), ``margins`` (the depth
+    margins tried, m) and ``simplify=False`` let two regions be meshed on the same lattice and field values, so
+    that where their fields agree their surfaces are the same triangles."""
     from .tetra import marching_tetrahedra
 
     h = grid.spacing
-    index = np.rint((cells - grid.origin) / h).astype(np.int64)
-    lo = np.maximum(index.min(axis=0) - 2, 0)
-    hi = np.minimum(index.max(axis=0) + 2, np.array(grid.shape) - 1)
-    margin = DEPTH_MARGIN * h
+    lo, hi = _box(grid, cells) if box is None else box
+    if margins is None:
+        margins = [DEPTH_MARGIN * h + 0.5 * h * k for k in range(MAX_MESH_ATTEMPTS)]
     thinnest = math.inf
-    for _ in range(MAX_MESH_ATTEMPTS):
+    for margin in margins:
         values, first = _cavity_values(grid, terms, centre, half, origin, frame, wall + margin, lo, hi)
         region_v, region_f = marching_tetrahedra(values, first, h, edge_margin=EDGE_MARGIN)
         del values
@@ -178,7 +185,7 @@ def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wa
         if not len(region_f):
             return []
         meshes = []
-        if len(region_f) <= SIMPLIFY_MAX_TRIANGLES:
+        if simplify and len(region_f) <= SIMPLIFY_MAX_TRIANGLES:
             simplified = _simplified(region_v, region_f, SIMPLIFY * h)
             if simplified is not None and len(simplified[1]):
                 meshes.append(simplified)
@@ -192,9 +199,8 @@ def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wa
                 kept.append((mesh_v, mesh_f, measured))
         if kept:
             return kept
-        margin += 0.5 * h
     raise PhysicsError(f"could not mesh a cavity keeping a wall of {wall:g} m: the thinnest came out "
-                       f"{thinnest:g} m after {MAX_MESH_ATTEMPTS} attempts")
+                       f"{thinnest:g} m after {len(margins)} attempts")
 
 
 @dataclass(frozen=True)
@@ -227,8 +233,8 @@ def cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall: floa
     The cavity keeps at least ``wall`` from the part's surface (measured), so the hollowed part is the part's
     surface plus the cavity's, turned inward: no boolean, and nothing of the cavity comes within rounding of
     the outer surface.  With an insert the pocket is the union of the cavity and the insert regions (the larger
-    of their fields, one surface) and the insert its own region: the two surfaces agree to the marching
-    tetrahedra's edge margin and the simplification (a few hundredths of a cell), not exactly.
+    of their fields, one surface) and the insert its own region, both on one lattice with the same margin and
+    not simplified: where the insert bounds the pocket, both surfaces are the same triangles.
 
     ``design`` is a :class:`QuadricCavity` or a :class:`~.insert.QuadricInsert`; ``storage_scale`` (m per unit)
     rounds the new vertices as a float32 file in that unit holds them.  Returns the candidates, preferred
@@ -238,29 +244,43 @@ def cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall: floa
     inserted = getattr(design, "inserted", None)
     part_v = _storage_rounded(vertices, storage_scale)
     part_f = np.asarray(faces, dtype=np.int64)
-    inserts: list = []
     holes: list = []
-    if inserted is not None and np.any(inserted):
-        inserts = _region(grid, [(design.insert_coefficients, 1.0)], cavity.centre, cavity.half_extent,
-                          centres[inserted], vertices, faces, origin, frame, wall, tree, storage_scale)
     in_q1 = cavity.removed if inserted is None else cavity.removed | (inserted & (cavity.values(
         (centres - origin) @ frame) < 0))
-    if np.any(in_q1) and not inserts:
+    if np.any(in_q1) and not (inserted is not None and np.any(inserted)):
         holes = _region(grid, [(cavity.coefficients, 1.0)], cavity.centre, cavity.half_extent,
                         centres[in_q1], vertices, faces, origin, frame, wall, tree, storage_scale)
-    pockets = []
-    if not inserts:
+    pockets: list[Pocket] = []
+    if inserted is None or not np.any(inserted):
         for hole_v, hole_f, measured in holes:
             pockets.append(Pocket(np.vstack([part_v, hole_v]), np.vstack([part_f, hole_f[:, ::-1] + len(part_v)]),
                                   None, None, measured))
         return pockets
-    # the pocket is the union of both regions (the larger of their fields), meshed as one surface: no boolean
+    # the pocket is the union of both regions (the larger of their fields), meshed as one surface: no boolean.
+    # Pocket and insert are meshed on one lattice with the same margin and not simplified, so that where the
+    # insert bounds the pocket both surfaces are the same triangles (the insert sits in its pocket, no overlap)
     pocket_cells = centres[inserted | in_q1]
     pocket_terms = [[(design.insert_coefficients, 1.0)]] + ([[(cavity.coefficients, 1.0)]] if np.any(in_q1) else [])
-    pocket_meshes = _region(grid, pocket_terms, cavity.centre, cavity.half_extent, pocket_cells, vertices, faces,
-                            origin, frame, wall, tree, storage_scale)
-    for k, (pocket_v, pocket_f, measured) in enumerate(pocket_meshes):
-        ins_v, ins_f, ins_wall = inserts[min(k, len(inserts) - 1)]
+    box = _box(grid, pocket_cells)
+    h = grid.spacing
+    failure = None
+    for k in range(MAX_MESH_ATTEMPTS):
+        margin = [DEPTH_MARGIN * h + 0.5 * h * k]
+        try:
+            inserts = _region(grid, [(design.insert_coefficients, 1.0)], cavity.centre, cavity.half_extent,
+                              pocket_cells, vertices, faces, origin, frame, wall, tree, storage_scale, box=box,
+                              margins=margin, simplify=False)
+            pocket_meshes = _region(grid, pocket_terms, cavity.centre, cavity.half_extent, pocket_cells, vertices,
+                                    faces, origin, frame, wall, tree, storage_scale, box=box, margins=margin,
+                                    simplify=False)
+        except PhysicsError as exc:
+            failure = exc
+            continue
+        if not inserts:          # no insert region after all: the pocket is the cavity alone
+            return [Pocket(np.vstack([part_v, pv]), np.vstack([part_f, pf[:, ::-1] + len(part_v)]), None, None, w)
+                    for pv, pf, w in pocket_meshes]
+        (ins_v, ins_f, ins_wall), (pocket_v, pocket_f, measured) = inserts[0], pocket_meshes[0]
         pockets.append(Pocket(np.vstack([part_v, pocket_v]), np.vstack([part_f, pocket_f[:, ::-1] + len(part_v)]),
                               ins_v, ins_f, min(measured, ins_wall)))
-    return pockets
+        return pockets
+    raise failure or PhysicsError("could not mesh the pocket and the insert")
