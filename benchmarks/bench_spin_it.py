@@ -18,6 +18,12 @@ Peer, side by side on the same cells and the same objective: the Spin-It (2014) 
 fraction per cell in [0, 1], L-BFGS-B with the exact gradient through the moments, then thresholded at 1/2 —
 against the quadric cavity (Hafner et al. 2024, 10 unknowns).  Reported: the objective of each sharp cavity on
 the cells, and the optimisation times with their ratio.
+
+    python benchmarks/bench_spin_it.py --parts 48,128
+
+Per part (the bundled ``meshes/`` parts, the two shapes above and a thin finely tessellated top like trimesh's
+``fixed_top.ply``), each in a fresh process: ``spin_it_verified`` (what the command runs) at each resolution,
+its CPU time and peak resident memory (``ru_maxrss``, interpreter and imports included), and the load average.
 """
 
 import argparse
@@ -119,10 +125,78 @@ def _row(name, m, mode):
             f"l {m.height * 1e3:.2f} mm, mass {m.mass * 1e3:.2f} g")
 
 
+PARTS = [
+    ("washer", "meshes/washer.stl", dict(mode="yoyo", axis=[0, 0, 1], wall=1.5e-3)),
+    ("torus", "meshes/torus.stl", dict(mode="yoyo", axis=[0, 0, 1], wall=2e-3)),
+    ("spinning_top", "meshes/spinning_top.stl", dict(mode="top", axis=[0, 0, 1], pivot=[0, 0, 0], wall=2e-3)),
+    ("t_handle", "meshes/t_handle.stl", dict(mode="yoyo", axis=[0, 0, 1], wall=2e-3)),
+    ("cone", "meshes/cone.stl", dict(mode="yoyo", axis=[0, 0, 1], wall=2e-3)),
+    ("box", "meshes/box.stl", dict(mode="yoyo", axis=[0, 0, 1], wall=2e-3)),
+    ("octahedron", "meshes/octahedron.stl", dict(mode="yoyo", axis=[0, 0, 1], wall=2e-3)),
+    ("hollow_sphere", "meshes/hollow_sphere.stl", dict(mode="yoyo", axis=[0, 0, 1], wall=1e-3)),
+    ("unbalanced_wheel", "meshes/unbalanced_wheel.stl", dict(mode="yoyo", axis=[0, 0, 1], wall=3e-3)),
+    ("lopsided_yoyo", "@lopsided_yoyo", dict(mode="yoyo", axis=[0, 0, 1], through=[0, 0, 0], wall=2e-3)),
+    ("asymmetric_top", "@asymmetric_top", dict(mode="top", axis=[0, 0, 1], pivot=[0, 0, 0], wall=1.5e-3)),
+    ("thin_top", "@thin_top", dict(mode="top", axis=[0, 0, 1], pivot=[0, 0, 0], wall=1e-3)),
+]
+
+
+def thin_top():
+    """Like trimesh's fixed_top.ply: a thin disc (r 30 mm, 4 mm) on a cone tip with a stem, 3,580 triangles."""
+    disc = manifold3d.Manifold.cylinder(0.004, 0.030, 0.030, 512).translate([0, 0, 0.008])
+    tip = manifold3d.Manifold.cylinder(0.008, 0.0004, 0.010, 256)
+    stem = manifold3d.Manifold.cylinder(0.020, 0.003, 0.003, 128).translate([0, 0, 0.010])
+    return _arrays(disc + tip + stem)
+
+
+def _one_part(name, resolution):
+    """Child process: run one part, print one JSON line."""
+    import json
+    import resource
+    import warnings
+
+    from inertia_tool.design.verify import spin_it_verified
+    warnings.simplefilter("ignore")
+    _, path, spec = next(p for p in PARTS if p[0] == name)
+    root = Path(__file__).resolve().parents[1]
+    source, units = (globals()[path[1:]](), None) if path.startswith("@") else (str(root / path), "mm")
+    cpu = time.process_time()
+    try:
+        result, verdicts = spin_it_verified(source, units=units, material="PLA", resolution=resolution, **spec)
+        out = dict(ok=True, resolution=verdicts[-1].resolution, removed=result.removed_cells)
+    except Exception as exc:                  # a rejected design is a result here, not a failure
+        out = dict(ok=False, error=type(exc).__name__)
+    out.update(cpu=time.process_time() - cpu, peak_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+    print(json.dumps(out))
+
+
+def parts(resolutions):
+    import json
+    import os
+    import subprocess
+    for resolution in resolutions:
+        print(f"== resolution {resolution}; load average {os.getloadavg()[0]:.1f}")
+        cpus = []
+        for name, _, _ in PARTS:
+            run = subprocess.run([sys.executable, __file__, "--one", name, str(resolution)], capture_output=True,
+                                 text=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+            row = json.loads(run.stdout.strip().splitlines()[-1])
+            cpus.append(row["cpu"])
+            what = f"resolution {row['resolution']}" if row["ok"] else row["error"]
+            print(f"  {name:18s} CPU {row['cpu']:6.2f} s  peak {row['peak_mb']:6.0f} MB  ({what})")
+        print(f"  median CPU {float(np.median(cpus)):.2f} s; load average {os.getloadavg()[0]:.1f}")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--resolutions", default="32,48,64")
+    parser.add_argument("--parts", help="resolutions for the per-part CPU time and memory table, e.g. 48,128")
+    parser.add_argument("--one", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.one:
+        return _one_part(args.one[0], int(args.one[1]))
+    if args.parts:
+        return parts([int(r) for r in args.parts.split(",")])
     resolutions = [int(r) for r in args.resolutions.split(",")]
     for name, build, spec in CASES:
         vertices, faces = build()

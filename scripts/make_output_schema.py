@@ -290,7 +290,7 @@ defs["spin-it"] = command("spin-it", {
     "before": obj({"metrics": METRICS, "mass_properties": ref("mass_properties")}),
     "after": obj({"metrics": METRICS, "mass_properties": ref("mass_properties")}),
     "insert": {"type": ["object", "null"], "properties": {"density_kg_m3": N, "volume_m3": N, "mass_kg": N,
-                                                          "mass_properties": ref("mass_properties")}},
+                                                          "shape": SN, "mass_properties": ref("mass_properties")}},
     "output": SN, "verified": S, "method": ref("method"), "uncertainty": ref("uncertainty"),
     "verification": obj({"passed": B, "attempts": arr(obj({
         "resolution": COUNT, "ok": B, "reasons": arr(S), "notes": arr(S),

@@ -31,13 +31,15 @@ def _option_order(command):
 
 def test_model_options_in_the_same_order_everywhere():
     model = ["--units", "--density", "--material", "--mass", "--material-map", "--model", "--thickness", "--shell",
-             "--infill", "--repair", "--overlap", "--merge-tolerance", "--max-faces"]
+             "--infill", "--top-bottom", "--top-layers", "--bottom-layers", "--layer-height",
+             "--repair", "--overlap", "--merge-tolerance", "--max-faces"]
     for command in MODEL_COMMANDS:
         order = _option_order(command)
         assert order[:len(model)] == model, command
     batch = _option_order("batch")
-    assert batch[:8] == [o for o in model if o not in ("--material-map", "--model", "--thickness", "--shell",
-                                                       "--infill")]
+    printed = ("--material-map", "--model", "--thickness", "--shell", "--infill", "--top-bottom", "--top-layers",
+               "--bottom-layers", "--layer-height")
+    assert batch[:8] == [o for o in model if o not in printed]
 
 
 @pytest.mark.parametrize("model", [["--model", "shell", "--thickness", "1mm"], ["--shell", "1mm", "--infill", "20%"]])

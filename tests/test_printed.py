@@ -188,3 +188,67 @@ def test_cli_contradictory_model_options_exit_2(block_stl, args, capsys):
     from inertia_tool.cli import main
     assert main(["analyze", block_stl, "--units", "mm", *args]) == 2
     assert "error" in capsys.readouterr().err
+
+
+# -- top and bottom layers as a slicer makes them --------------------------------------------------------------
+def _slab_box_inertia(mass, a, b, c):
+    return _box_inertia(mass, a, b, c)
+
+
+@pytest.mark.parametrize("layers, height", [(6, 0.0002), (8, 0.00025)])
+def test_printed_cube_with_top_and_bottom_layers_closed_form(layers, height):
+    """20 mm cube, walls 0.8 mm (two 0.4 mm perimeters), N top and bottom layers of height H, 20 % infill: the
+    infill is the core [t, a − t]² × [T, a − T] with T = N H > t (closed form: walls + slabs + infilled core);
+    the mass and inertia within 1 %, and inside the stated bounds."""
+    a, s, f = 0.02, 0.0008, 0.2
+    thickness = layers * height
+    part = printed_part(trimesh.creation.box([a, a, a]), skin=s, infill=f, density=RHO, top=thickness,
+                        bottom=thickness, band_cells=30_000)
+    ci, hi = a - 2 * s, a - 2 * thickness
+    mass = RHO * (a ** 3 - (1 - f) * ci * ci * hi)
+    inertia = _box_inertia(RHO * a ** 3, a, a, a) - (1 - f) * _box_inertia(RHO * ci * ci * hi, ci, ci, hi)
+    assert part.properties.mass == pytest.approx(mass, rel=0.01)
+    assert_tensor_close(part.properties.inertia, inertia, rtol=0.01)
+    without = RHO * (a ** 3 - (1 - f) * ci ** 3)
+    assert abs(part.properties.mass - mass) < 0.1 * abs(without - mass)      # the layers are really counted
+    _assert_within_bounds(part, mass, np.zeros(3), inertia)
+    assert part.top == part.bottom == thickness
+
+
+def test_printed_cylinder_with_top_and_bottom_layers_closed_form():
+    """A 128-gon prism (apothem a, height h), walls s, top/bottom T: the infill is the prism of apothem a − s
+    over [T, h − T] (closed form from the polygon's area n a² tan(π/n)), within 1 %."""
+    n, radius, h, s, thickness, f = 128, 0.01, 0.02, 0.0008, 0.0016, 0.15
+    from inertia_tool.mass import shapes
+    solid = shapes.cylinder(radius, h, segments=n)
+    apothem = radius * np.cos(np.pi / n)
+    area = n * (apothem - s) ** 2 * np.tan(np.pi / n)
+    volume = solid.mesh_exact.volume
+    mass = RHO * (volume - (1 - f) * area * (h - 2 * thickness))
+    part = printed_part(_vf(solid), skin=s, infill=f, density=RHO, top=thickness, bottom=thickness,
+                        band_cells=30_000)
+    assert part.properties.mass == pytest.approx(mass, rel=0.01)
+    assert part.mass_error_bound >= abs(part.properties.mass / mass - 1)
+
+
+def test_layers_thinner_than_the_wall_change_nothing(block):
+    plain = printed_part(block, skin=0.002, infill=0.2, density=RHO, band_cells=5_000)
+    thin = printed_part(block, skin=0.002, infill=0.2, density=RHO, top=0.0015, bottom=0.001, band_cells=5_000)
+    assert thin.properties.mass == plain.properties.mass
+
+
+@pytest.mark.slow
+def test_cli_top_bottom_layers(block_stl, capsys):
+    from inertia_tool.cli import main
+    import json
+    base = ["analyze", str(block_stl), "--units", "mm", "--material", "pla", "--shell", "0.8mm", "--infill", "20%",
+            "--json"]
+    assert main(base) == 0
+    plain = json.loads(capsys.readouterr().out)["mass"]
+    assert main(base + ["--top-layers", "6", "--bottom-layers", "6", "--layer-height", "0.3mm"]) == 0
+    layered = json.loads(capsys.readouterr().out)["mass"]
+    assert main(base + ["--top-bottom", "1.8mm"]) == 0
+    same = json.loads(capsys.readouterr().out)["mass"]
+    assert layered > plain and same == pytest.approx(layered, rel=1e-12)
+    assert main(base + ["--top-layers", "6"]) == 2                      # needs --layer-height
+    assert main(base + ["--top-bottom", "1mm", "--top-layers", "3", "--layer-height", "0.2mm"]) == 2

@@ -106,6 +106,13 @@ def add_thin_wall_options(parser) -> None:
                                                       "(a bare number is in --units)")
     g.add_argument("--shell", metavar="LEN", help="3D print: solid skin thickness, e.g. 1.2mm (with --infill)")
     g.add_argument("--infill", metavar="FRACTION", help="3D print: core fill fraction, e.g. 20%% or 0.2 (with --shell)")
+    g.add_argument("--top-bottom", metavar="LEN",
+                   help="3D print: vertical thickness of the solid top and bottom layers, e.g. 1.2mm (with --shell)")
+    g.add_argument("--top-layers", type=int, metavar="N", help="3D print: solid top layers (with --layer-height)")
+    g.add_argument("--bottom-layers", type=int, metavar="N",
+                   help="3D print: solid bottom layers (with --layer-height)")
+    g.add_argument("--layer-height", metavar="LEN", help="3D print: layer height, e.g. 0.2mm (with --top-layers "
+                                                         "and/or --bottom-layers)")
 
 
 def add_mesh_options(parser) -> None:
@@ -304,6 +311,10 @@ def _load(args, meshes):
         raise UsageError("--thickness needs --model shell (for a printed part use --shell and --infill)")
     if (skin is None) != (infill is None):
         raise UsageError("a printed part needs both --shell (skin thickness) and --infill (core fraction)")
+    if skin is None and any(getattr(args, k, None) is not None
+                            for k in ("top_bottom", "top_layers", "bottom_layers", "layer_height")):
+        raise UsageError("top and bottom layers (--top-bottom, --top-layers, --bottom-layers, --layer-height) "
+                         "describe a printed part: give --shell and --infill too")
     if model == "shell" and thickness is None:
         raise UsageError("--model shell needs --thickness (e.g. --thickness 2mm)")
     if model == "shell" and skin is not None:
@@ -327,8 +338,33 @@ def _load(args, meshes):
         props = shell_mass_properties(meshes[0], thickness=t, options=options, **common)
         return props, described + _implied(props, mass), model_summary("shell", thickness=t)
     skin_m = check_option("--shell", parse_length(skin, default_unit=unit), typed=skin)
-    printed = printed_part(meshes[0], skin=skin_m, infill=parse_fraction(infill), options=options, **common)
+    top, bottom = _top_bottom(args, unit)
+    printed = printed_part(meshes[0], skin=skin_m, infill=parse_fraction(infill), options=options, top=top,
+                           bottom=bottom, **common)
     return printed.properties, described, model_summary("printed", printed=printed)
+
+
+def _top_bottom(args, unit):
+    """The top and bottom layer thicknesses (m, or None) of ``--top-bottom`` or ``--top-layers``/
+    ``--bottom-layers`` × ``--layer-height``."""
+    both = getattr(args, "top_bottom", None)
+    top_n, bottom_n, height = (getattr(args, k, None) for k in ("top_layers", "bottom_layers", "layer_height"))
+    if both is not None and (top_n is not None or bottom_n is not None):
+        raise UsageError("give --top-bottom or --top-layers/--bottom-layers with --layer-height, not both")
+    if both is not None:
+        thickness = check_option("--shell", parse_length(both, default_unit=unit), typed=both, label="--top-bottom")
+        return thickness, thickness
+    if top_n is None and bottom_n is None:
+        if height is not None:
+            raise UsageError("--layer-height needs --top-layers and/or --bottom-layers")
+        return None, None
+    if height is None:
+        raise UsageError("--top-layers and --bottom-layers need --layer-height (e.g. 0.2mm)")
+    for option, n in (("--top-layers", top_n), ("--bottom-layers", bottom_n)):
+        if n is not None and not 0 <= n <= 10_000:
+            raise UsageError(f"{option} must be a whole number of layers from 0 to 10000, got {n}")
+    h = check_option("--shell", parse_length(height, default_unit=unit), typed=height, label="--layer-height")
+    return (None if top_n is None else top_n * h), (None if bottom_n is None else bottom_n * h)
 
 
 def _load_solid(args, meshes):

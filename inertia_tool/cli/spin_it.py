@@ -183,6 +183,9 @@ def run(args) -> int:
     pivot = check_option("--pivot", list(parse_vector(args.pivot, unit)), typed=args.pivot) if args.pivot else None
     density, mass = density_and_mass(args)
     axis = _direction(args.axis)
+    # the hollowed mesh is rounded as the file will hold it (float32 STL in --units, 3MF in millimetres) before
+    # it is re-analysed, so that `analyze` of the file gives the numbers printed here
+    storage = length_scale("mm") if args.out and args.out.lower().endswith(".3mf") else length_scale(unit)
     # verified by re-analysis and simulation, retried on a finer grid; DesignRejectedError (exit 6) otherwise
     with recorded_warnings(args) as messages:
         result, verdicts = spin_it_verified(args.files, axis=axis, mode=args.mode, wall=wall,
@@ -190,7 +193,7 @@ def run(args) -> int:
                                             pivot=tuple(pivot) if pivot is not None else None, units=args.units,
                                             density=density, material=args.material, mass=mass,
                                             resolution=args.resolution, insert_density=insert_density,
-                                            repair=bool(getattr(args, "repair", False)))
+                                            repair=bool(getattr(args, "repair", False)), storage_scale=storage)
     if args.out and result.insert_vertices is not None:
         _write_two_materials(args.out, result, args.material or "part", args.insert, float(insert_density or 0.0))
     elif args.out:

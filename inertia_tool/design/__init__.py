@@ -4,7 +4,7 @@ Every mass moment is linear in the density field, so a cavity can be placed to m
 user wants: :func:`spin_it` hollows a part into a yo-yo (stable free spin about a chosen axis) or a top
 (a heavy symmetric top on a pivot).  Stages: :mod:`.grid` (voxels, depth) → :mod:`.moments` (moment vector,
 objectives) → :mod:`.optimize` (quadric cavity) and :mod:`.insert` (a dense insert, a second quadric) →
-:mod:`.hollow` (mesh, boolean, verification).
+:mod:`.tetra` and :mod:`.cavity_mesh` (the cavity's surface) → :mod:`.hollow` (re-analysis) → :mod:`.verify`.
 
 The names load on first use (PEP 562), so the command line does not import the design stages to start.
 """

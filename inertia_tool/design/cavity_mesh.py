@@ -1,33 +1,45 @@
-"""The cavity (and insert) as closed meshes, subtracted from the part with a robust boolean (manifold3d).
+"""The cavity (and insert) as closed meshes inside the part, keeping the wall from its surface.
 
-* :func:`_cavity_field` — the region ``depth ≥ wall + margin`` and ``s_k q_k < 0`` as a scalar field (trilinear
-  depth from the grid, quadrics analytic, creases rounded by a smooth minimum) for ``Manifold.level_set``
-  (marching tetrahedra);
+* :func:`_cavity_values` — the region ``depth ≥ wall + margin`` and ``s_k q_k < 0`` as a scalar field on the
+  grid's cell centres (depth from the grid, quadrics analytic, creases rounded by a smooth minimum), meshed by
+  marching tetrahedra (:mod:`.tetra`);
 * :func:`_region` — its mesh, slivers dropped, the wall measured exactly from every vertex
   (``design.grid.surface_distance``) and the mesh remade deeper when it is too thin;
-* :func:`cut_pocket` — pocket = cavity ∪ insert, ``part − pocket``, pinched vertices separated.
+* :func:`cut_pocket` — the part's surface plus the cavity's turned inward (no boolean: the cavity keeps the
+  wall from the surface); with an insert, the pocket (cavity ∪ insert region) is meshed the same way as one
+  region, and the insert as another.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..errors import PhysicsError, UsageError
+from ..errors import PhysicsError
 from .grid import surface_distance
 from .optimize import QuadricCavity
 
-__all__ = ["cut_pocket", "DEPTH_MARGIN", "SNAP", "MIN_VOID_CELLS", "MAX_MESH_ATTEMPTS"]
+__all__ = ["cut_pocket", "Pocket", "DEPTH_MARGIN", "SIMPLIFY", "EDGE_MARGIN", "MIN_VOID_CELLS", "MAX_MESH_ATTEMPTS"]
 
 #: Cells of extra depth asked of the cavity beyond the wall (the depths near the wall are exact at the cell
 #: centres; the margin covers the linear interpolation of the level set between them).
 DEPTH_MARGIN = 0.5
 
-#: Edges of the cavity mesh shorter than this fraction of a cell are collapsed (``Manifold.simplify``), so
-#: that a float32 STL of the result keeps every vertex distinct.
-SNAP = 1e-3
+#: The cavity mesh is simplified (``Manifold.simplify``) within this fraction of a cell: marching tetrahedra
+#: make about four times the triangles a surface of that detail needs (memory and time of the re-analysis, size
+#: of the file); the surface moves by at most this much, and the wall is measured after.
+SIMPLIFY = 0.02
+
+#: Largest cavity mesh (triangles) simplified through manifold3d, whose structures hold about 200 bytes a
+#: triangle (bounds the memory at resolution 128); larger ones are kept as marching tetrahedra made them.
+SIMPLIFY_MAX_TRIANGLES = 250_000
+
+#: Fraction of a lattice edge kept between a cavity vertex and the lattice points (``design.tetra``): distinct
+#: vertices stay about 0.03 cells apart, far beyond the rounding of a float32 file.
+EDGE_MARGIN = 0.05
 
 #: Smallest separate void kept, in cell volumes.
 MIN_VOID_CELLS = 8
@@ -36,53 +48,53 @@ MIN_VOID_CELLS = 8
 MAX_MESH_ATTEMPTS = 4
 
 
-def _cavity_field(grid, terms, centre, half: float, origin, frame, threshold: float):
-    """The scalar field ``min(depth − threshold, −s_k q_k · half_extent …)`` (m, positive inside the region), for
-    the quadric ``terms`` ``[(coefficients, s_k)]`` (``s = +1``: inside where ``q < 0``; ``−1``: outside it),
-    creases rounded over a quarter cell, as a Python callable of mesh coordinates for ``Manifold.level_set``;
-    the depth is trilinear between the grid's cell centres."""
-    sd = grid.signed_distance
-    nx, ny, nz = sd.shape
-    flat = sd.ravel().tolist()
-    ox, oy, oz = (float(c) for c in grid.origin)
-    inv = 1.0 / grid.spacing
-    r = frame
-    c = centre
-    quadrics = [((np.asarray(t) / np.linalg.norm(t)).tolist(), float(sign)) for t, sign in terms]
-    # frame coordinates, normalised: x̂ = (Rᵀ (x − o) − centre)/half = A x + b
-    a = (r.T / half).tolist()
-    b = ((-(r.T @ np.asarray(origin)) - c) / half).tolist()
-    stride_x, stride_y = ny * nz, nz
-    smooth = 0.25 * grid.spacing
+def _cavity_values(grid, terms, centre, half: float, origin, frame, threshold: float, lo, hi):
+    """The scalar field ``min(depth − threshold, −s_k q_k · half_extent …)`` (m, positive inside the region) at
+    the grid's cell centres from ``lo`` to ``hi`` (index triples, inclusive, within the grid), with one layer
+    of −h around them (so that the surface closes), for the quadric ``terms`` ``[(coefficients, s_k)]``
+    (``s = +1``: inside where ``q < 0``; ``−1``: outside it), creases rounded over a quarter cell.
 
-    def field(x, y, z):
-        gx, gy, gz = (x - ox) * inv, (y - oy) * inv, (z - oz) * inv
-        i = min(max(int(math.floor(gx)), 0), nx - 2)
-        j = min(max(int(math.floor(gy)), 0), ny - 2)
-        k = min(max(int(math.floor(gz)), 0), nz - 2)
-        fx = min(max(gx - i, 0.0), 1.0)
-        fy = min(max(gy - j, 0.0), 1.0)
-        fz = min(max(gz - k, 0.0), 1.0)
-        base = i * stride_x + j * stride_y + k
-        c00 = flat[base] * (1 - fz) + flat[base + 1] * fz
-        c01 = flat[base + stride_y] * (1 - fz) + flat[base + stride_y + 1] * fz
-        c10 = flat[base + stride_x] * (1 - fz) + flat[base + stride_x + 1] * fz
-        c11 = flat[base + stride_x + stride_y] * (1 - fz) + flat[base + stride_x + stride_y + 1] * fz
-        depth = (c00 * (1 - fy) + c01 * fy) * (1 - fx) + (c10 * (1 - fy) + c11 * fy) * fx
-        u = a[0][0] * x + a[0][1] * y + a[0][2] * z + b[0]
-        v = a[1][0] * x + a[1][1] * y + a[1][2] * z + b[1]
-        w = a[2][0] * x + a[2][1] * y + a[2][2] * z + b[2]
-        value = depth - threshold
-        for t, sign in quadrics:
-            q = (t[0] + t[1] * u + t[2] * v + t[3] * w + t[4] * u * u + t[5] * v * v + t[6] * w * w
-                 + t[7] * u * v + t[8] * u * w + t[9] * v * w)
-            inner = -sign * q * half
-            # smooth minimum (rounds the crease where the wall meets the quadric, so the two sheets of the
-            # marching tetrahedra do not pinch at a shared point): min(d, e) − k log(1 + exp(−|d − e|/k))
-            value = min(value, inner) - smooth * math.log1p(math.exp(-abs(value - inner) / smooth))
-        return value
+    Returns (values (nx + 2, ny + 2, nz + 2), position of the first sample (3,) m)."""
+    h = grid.spacing
+    shape = tuple(int(hi[d] - lo[d] + 1) for d in range(3))
+    first = grid.origin + h * (np.asarray(lo, dtype=np.float64) - 1.0)
+    axes = [grid.origin[d] + h * np.arange(lo[d], hi[d] + 1, dtype=np.float64) for d in range(3)]
+    # frame coordinates, normalised: x̂ = (Rᵀ (x − o) − centre)/half, one axis at a time
+    r = np.asarray(frame, dtype=np.float64)
+    shift = (-(r.T @ np.asarray(origin, dtype=np.float64)) - np.asarray(centre)) / half
+    # ``terms`` is one list of quadrics (their intersection) or a list of such lists (the union of the regions)
+    alternatives = terms if isinstance(terms[0], list) else [terms]
+    smooth = 0.25 * h
+    padded = np.full((shape[0] + 2, shape[1] + 2, shape[2] + 2), -h)
+    for start in range(0, shape[0], _SLAB):              # a slab at a time: its temporaries, not the box's
+        stop = min(start + _SLAB, shape[0])
+        x_axis = axes[0][start:stop]
+        normalised = []
+        for row in range(3):
+            normalised.append((r[0, row] / half) * x_axis[:, None, None]
+                              + ((r[1, row] / half) * axes[1])[None, :, None]
+                              + ((r[2, row] / half) * axes[2])[None, None, :] + shift[row])
+        u, v, w = normalised
+        deep = grid.signed_distance[lo[0] + start:lo[0] + stop, lo[1]:hi[1] + 1,
+                                    lo[2]:hi[2] + 1].astype(np.float64) - threshold
+        union = None
+        for alternative in alternatives:
+            value = deep
+            for t, sign in alternative:
+                c = np.asarray(t, dtype=np.float64) / np.linalg.norm(t)
+                q = (c[0] + c[1] * u + c[2] * v + c[3] * w + c[4] * u * u + c[5] * v * v + c[6] * w * w
+                     + c[7] * u * v + c[8] * u * w + c[9] * v * w)
+                inner = -sign * q * half
+                # smooth minimum (rounds the crease where the wall meets the quadric, so the two sheets of the
+                # marching tetrahedra do not pinch at a shared point): min(d, e) − k log(1 + exp(−|d − e|/k))
+                value = np.minimum(value, inner) - smooth * np.log1p(np.exp(-np.abs(value - inner) / smooth))
+            union = value if union is None else np.maximum(union, value)
+        padded[1 + start:1 + stop, 1:-1, 1:-1] = union
+    return padded, first
 
-    return field
+
+#: Lattice planes evaluated at once by :func:`_cavity_values` (bounds its temporaries).
+_SLAB = 8
 
 
 def _manifold_of(vertices, faces):
@@ -98,105 +110,177 @@ def _arrays_of(manifold: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3], np.asarray(mesh.tri_verts, dtype=np.int64)
 
 
-def _separate_pinches(vertices, faces, distance: float):
-    """Move apart vertices that share a position (float32), each by ``distance`` along its outward normal.
-
-    Marching tetrahedra can leave two sheets of the cavity touching at one point, as two distinct vertices at
-    the same position: a valid manifold, but a mesh file welds them into a non-manifold vertex.  Moving each
-    copy along its normal (into the cavity it bounds), or against it where that would push one tip of
-    material into another (checked by :func:`~inertia_tool.mesh.intersect.surface_contacts`), separates the
-    sheets by ``2 distance``; when neither way leaves the surface free of crossings it is left touching.
-    """
-    v = np.array(vertices, dtype=np.float64)
-    _, inverse, counts = np.unique(v.astype(np.float32), axis=0, return_inverse=True, return_counts=True)
-    shared = counts[inverse.ravel()] > 1
-    if not np.any(shared):
-        return v, faces
-    from ..mesh.intersect import surface_contacts
-
-    tri = v[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    vertex_normal = np.zeros_like(v)
-    for k in range(3):
-        np.add.at(vertex_normal, faces[:, k], normal)
-    length = np.linalg.norm(vertex_normal[shared], axis=1)
-    step = distance * vertex_normal[shared] / np.where(length > 0, length, 1.0)[:, None]
-    # two void lobes touching at a point separate when each copy moves into its own void (along the normal);
-    # two tips of material touching separate the other way: moving them into the void pushes each tip into
-    # the other's material and the surface passes through itself.  Keep the way that leaves no crossing.
-    for sign in (1.0, -1.0):
-        moved = v.copy()
-        moved[shared] += sign * step
-        if not len(surface_contacts(moved, faces).crossing):
-            return moved, faces
-    return v, faces          # the sheets only touch at the shared positions: a valid solid as it stands
+def _storage_rounded(vertices, storage_scale: float | None) -> np.ndarray:
+    """The vertices as a float32 file in the unit ``storage_scale`` (m per unit) holds them (None: as they are)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    if storage_scale is None:
+        return v
+    return (v / storage_scale).astype(np.float32).astype(np.float64) * storage_scale
 
 
-def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wall: float):
-    """A closed mesh (manifold) of the region of ``terms`` deeper than the wall, from ``Manifold.level_set``,
-    with its wall measured exactly; remeshed deeper (up to ``MAX_MESH_ATTEMPTS``) if thinner than ``wall``.
-    Returns (manifold or None when empty, measured wall)."""
+def _without_specks(vertices, faces, min_volume: float):
+    """The mesh without its connected pieces of volume below ``min_volume`` (m³)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = len(vertices)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]]])
+    graph = coo_matrix((np.ones(len(edges), dtype=np.int8), (edges[:, 0], edges[:, 1])), shape=(n, n))
+    count, label = connected_components(graph, directed=False)
+    face_label = label[faces[:, 0]]
+    tri = vertices[faces]
+    six_volume = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))
+    volume = np.bincount(face_label, weights=six_volume, minlength=count) / 6.0
+    keep = np.abs(volume[face_label]) >= min_volume
+    if np.all(keep):
+        return vertices, faces
+    kept = faces[keep]
+    used, new_index = np.unique(kept.ravel(), return_inverse=True)
+    return vertices[used], new_index.reshape(-1, 3)
+
+
+def _simplified(vertices, faces, tolerance: float):
+    """manifold3d's ``simplify`` of a closed mesh (edges collapsed within ``tolerance``, m), or None if manifold3d
+    does not take it as a manifold."""
     import manifold3d
 
+    solid = _manifold_of(vertices, faces)
+    if solid.status() != manifold3d.Error.NoError:
+        return None
+    return _arrays_of(solid.simplify(tolerance))
+
+
+def _box(grid, cells):
+    """Grid index range (lo, hi, inclusive) of the lattice around ``cells`` (centres, m), two cells wider."""
+    index = np.rint((cells - grid.origin) / grid.spacing).astype(np.int64)
+    return (np.maximum(index.min(axis=0) - 2, 0), np.minimum(index.max(axis=0) + 2, np.array(grid.shape) - 1))
+
+
+def _region(grid, terms, centre, half, cells, vertices, faces, origin, frame, wall: float, tree=None,
+            storage_scale: float | None = None, *, box=None, margins=None, simplify: bool = True):
+    """Closed meshes of the region of ``terms`` deeper than the wall, by marching tetrahedra on the grid's cell
+    centres (``design.tetra``), rounded as the file will hold them, each with its wall measured exactly;
+    remeshed deeper (up to ``MAX_MESH_ATTEMPTS``) if thinner than ``wall``.
+
+    Returns a list of candidates ``(vertices, faces, measured wall)``, preferred first: the mesh simplified by
+    manifold3d within ``SIMPLIFY`` cells (when it has at most ``SIMPLIFY_MAX_TRIANGLES`` triangles), then the
+    marching tetrahedra's own; empty when the region is.  ``box`` (lattice range), ``margins`` (the depth
+    margins tried, m) and ``simplify=False`` let two regions be meshed on the same lattice and field values, so
+    that where their fields agree their surfaces are the same triangles."""
+    from .tetra import marching_tetrahedra
+
     h = grid.spacing
-    lo = cells.min(axis=0) - 2 * h
-    hi = cells.max(axis=0) + 2 * h
-    margin = DEPTH_MARGIN * h
-    for _ in range(MAX_MESH_ATTEMPTS):
-        field = _cavity_field(grid, terms, centre, half, origin, frame, wall + margin)
-        # marching tetrahedra can leave vertices closer than a float32 STL can tell apart: merge them
-        region = manifold3d.Manifold.level_set(field, [*lo, *hi], h).simplify(SNAP * h)
+    lo, hi = _box(grid, cells) if box is None else box
+    if margins is None:
+        margins = [DEPTH_MARGIN * h + 0.5 * h * k for k in range(MAX_MESH_ATTEMPTS)]
+    thinnest = math.inf
+    for margin in margins:
+        values, first = _cavity_values(grid, terms, centre, half, origin, frame, wall + margin, lo, hi)
+        region_v, region_f = marching_tetrahedra(values, first, h, edge_margin=EDGE_MARGIN)
+        del values
         # slivers the marching tetrahedra leave where the field grazes zero: voids smaller than (2h)³ change
         # the moments by nothing measurable and no print could be emptied of them
-        pieces = [piece for piece in region.decompose() if piece.volume() >= MIN_VOID_CELLS * h ** 3]
-        if not pieces:
-            return None, math.inf
-        region = manifold3d.Manifold.batch_boolean(pieces, manifold3d.OpType.Add)
-        region_v, _ = _arrays_of(region)
-        measured = float(surface_distance(region_v, vertices, faces, cutoff=wall + h).min())
-        if measured >= wall + SNAP * h:          # pinches are separated by SNAP·h below
-            return region, measured - SNAP * h
-        margin += 0.5 * h
+        if len(region_f):
+            region_v, region_f = _without_specks(region_v, region_f, MIN_VOID_CELLS * h ** 3)
+        if not len(region_f):
+            return []
+        meshes = []
+        if simplify and len(region_f) <= SIMPLIFY_MAX_TRIANGLES:
+            simplified = _simplified(region_v, region_f, SIMPLIFY * h)
+            if simplified is not None and len(simplified[1]):
+                meshes.append(simplified)
+        meshes.append((region_v, region_f))
+        kept = []
+        for mesh_v, mesh_f in meshes:
+            mesh_v = _storage_rounded(mesh_v, storage_scale)
+            measured = float(surface_distance(mesh_v, vertices, faces, cutoff=wall + h, tree=tree).min())
+            thinnest = min(thinnest, measured)
+            if measured >= wall:
+                kept.append((mesh_v, mesh_f, measured))
+        if kept:
+            return kept
     raise PhysicsError(f"could not mesh a cavity keeping a wall of {wall:g} m: the thinnest came out "
-                       f"{measured:g} m after {MAX_MESH_ATTEMPTS} attempts")
+                       f"{thinnest:g} m after {len(margins)} attempts")
 
 
-def cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall: float):
-    """Mesh the cavity (and the insert), check the wall exactly, subtract, separate pinches.
+@dataclass(frozen=True)
+class Pocket:
+    """One way of meshing the design: the hollowed part and the insert (None without), as the file will hold
+    them.
 
-    ``design`` is a :class:`QuadricCavity` or a :class:`~.insert.QuadricInsert`.  Returns (vertices, faces,
-    insert vertices or None, insert faces or None, measured wall)."""
-    try:
-        import manifold3d
-    except ImportError as exc:                # pragma: no cover - a dependency of the package
-        raise UsageError("spin_it needs manifold3d (pip install manifold3d)") from exc
+    Attributes
+    ----------
+    vertices : (n, 3) float
+        The hollowed part, m: the part's surface and the cavity's, wound inward (outward of the material).
+    faces : (m, 3) int
+    insert_vertices, insert_faces : arrays or None
+        The insert, m.
+    measured_wall : float
+        Smallest distance from a vertex of the cavity (or insert) surface to the part's surface, m.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    insert_vertices: np.ndarray | None
+    insert_faces: np.ndarray | None
+    measured_wall: float
+
+
+def cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall: float, *, tree=None,
+               storage_scale: float | None = None) -> list[Pocket]:
+    """Mesh the cavity (and the insert), check the wall exactly, and hollow the part.
+
+    The cavity keeps at least ``wall`` from the part's surface (measured), so the hollowed part is the part's
+    surface plus the cavity's, turned inward: no boolean, and nothing of the cavity comes within rounding of
+    the outer surface.  With an insert the pocket is the union of the cavity and the insert regions (the larger
+    of their fields, one surface) and the insert its own region, both on one lattice with the same margin and
+    not simplified: where the insert bounds the pocket, both surfaces are the same triangles.
+
+    ``design`` is a :class:`QuadricCavity` or a :class:`~.insert.QuadricInsert`; ``storage_scale`` (m per unit)
+    rounds the new vertices as a float32 file in that unit holds them.  Returns the candidates, preferred
+    first (empty: no cavity).
+    """
     cavity = design if isinstance(design, QuadricCavity) else design.cavity
     inserted = getattr(design, "inserted", None)
-    h = grid.spacing
-    walls = [math.inf]
-    insert = hole = None
-    if inserted is not None and np.any(inserted):
-        insert, measured = _region(grid, [(design.insert_coefficients, 1.0)], cavity.centre, cavity.half_extent,
-                                   centres[inserted], vertices, faces, origin, frame, wall)
-        walls.append(measured)
+    part_v = _storage_rounded(vertices, storage_scale)
+    part_f = np.asarray(faces, dtype=np.int64)
+    holes: list = []
     in_q1 = cavity.removed if inserted is None else cavity.removed | (inserted & (cavity.values(
         (centres - origin) @ frame) < 0))
-    if np.any(in_q1):
-        hole, measured = _region(grid, [(cavity.coefficients, 1.0)], cavity.centre, cavity.half_extent,
-                                 centres[in_q1], vertices, faces, origin, frame, wall)
-        walls.append(measured)
-    if hole is None and insert is None:
-        return vertices, faces, None, None, math.inf
-    # the pocket is the union of both regions: the part keeps none of it, the insert fills its own share
-    pocket = hole if insert is None else (insert if hole is None else hole + insert)
-    part = _manifold_of(vertices, faces)
-    if part.status() != manifold3d.Error.NoError:
-        raise PhysicsError(f"the part is not a manifold solid for the boolean ({part.status()})")
-    result = part - pocket
-    if result.status() != manifold3d.Error.NoError:
-        raise PhysicsError(f"the boolean subtraction failed ({result.status()})")
-    out_v, out_f = _separate_pinches(*_arrays_of(result), SNAP * h)
-    ins_v = ins_f = None
-    if insert is not None:
-        ins_v, ins_f = _separate_pinches(*_arrays_of(insert), SNAP * h)
-    return out_v, out_f, ins_v, ins_f, min(walls)
+    if np.any(in_q1) and not (inserted is not None and np.any(inserted)):
+        holes = _region(grid, [(cavity.coefficients, 1.0)], cavity.centre, cavity.half_extent,
+                        centres[in_q1], vertices, faces, origin, frame, wall, tree, storage_scale)
+    pockets: list[Pocket] = []
+    if inserted is None or not np.any(inserted):
+        for hole_v, hole_f, measured in holes:
+            pockets.append(Pocket(np.vstack([part_v, hole_v]), np.vstack([part_f, hole_f[:, ::-1] + len(part_v)]),
+                                  None, None, measured))
+        return pockets
+    # the pocket is the union of both regions (the larger of their fields), meshed as one surface: no boolean.
+    # Pocket and insert are meshed on one lattice with the same margin and not simplified, so that where the
+    # insert bounds the pocket both surfaces are the same triangles (the insert sits in its pocket, no overlap)
+    pocket_cells = centres[inserted | in_q1]
+    pocket_terms = [[(design.insert_coefficients, 1.0)]] + ([[(cavity.coefficients, 1.0)]] if np.any(in_q1) else [])
+    box = _box(grid, pocket_cells)
+    h = grid.spacing
+    failure = None
+    for k in range(MAX_MESH_ATTEMPTS):
+        margin = [DEPTH_MARGIN * h + 0.5 * h * k]
+        try:
+            inserts = _region(grid, [(design.insert_coefficients, 1.0)], cavity.centre, cavity.half_extent,
+                              pocket_cells, vertices, faces, origin, frame, wall, tree, storage_scale, box=box,
+                              margins=margin, simplify=False)
+            pocket_meshes = _region(grid, pocket_terms, cavity.centre, cavity.half_extent, pocket_cells, vertices,
+                                    faces, origin, frame, wall, tree, storage_scale, box=box, margins=margin,
+                                    simplify=False)
+        except PhysicsError as exc:
+            failure = exc
+            continue
+        if not inserts:          # no insert region after all: the pocket is the cavity alone
+            return [Pocket(np.vstack([part_v, pv]), np.vstack([part_f, pf[:, ::-1] + len(part_v)]), None, None, w)
+                    for pv, pf, w in pocket_meshes]
+        (ins_v, ins_f, ins_wall), (pocket_v, pocket_f, measured) = inserts[0], pocket_meshes[0]
+        pockets.append(Pocket(np.vstack([part_v, pocket_v]), np.vstack([part_f, pocket_f[:, ::-1] + len(part_v)]),
+                              ins_v, ins_f, min(measured, ins_wall)))
+        return pockets
+    raise failure or PhysicsError("could not mesh the pocket and the insert")

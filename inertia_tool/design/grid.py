@@ -14,19 +14,20 @@ part is then measured exactly (:func:`surface_distance`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import UsageError
 
-__all__ = ["InteriorGrid", "interior_grid", "surface_distance"]
+__all__ = ["InteriorGrid", "SurfaceTree", "interior_grid", "surface_distance"]
 
 #: Fraction of a cell by which the grid is shifted off the mesh's round coordinates (irrational ratios).
 _SHIFT = np.array([0.1234567 * np.sqrt(2.0), 0.0765432 * np.sqrt(3.0), 0.0])
 
 #: Most (column, triangle) pairs examined at once while casting rays (bounds the memory of one batch).
-_PAIR_BATCH = 2_000_000
+_PAIR_BATCH = 200_000
 
 
 @dataclass(frozen=True)
@@ -41,14 +42,17 @@ class InteriorGrid:
         Cell edge ``h``, m.
     inside : (nx, ny, nz) bool
         Cell centre inside the solid (winding number ≥ 1).
-    signed_distance : (nx, ny, nz) float
+    signed_distance : (nx, ny, nz) float32
         Approximate distance from the cell centre to the surface, m, positive inside (distance transform).
+    depth_cap : float
+        m: distances beyond it read as ``±depth_cap`` (``inf``: none; see :func:`interior_grid`).
     """
 
     origin: np.ndarray
     spacing: float
     inside: np.ndarray
     signed_distance: np.ndarray
+    depth_cap: float = math.inf
 
     @property
     def shape(self) -> tuple:
@@ -102,12 +106,47 @@ def _winding_columns(vertices, faces, origin, spacing, shape) -> np.ndarray:
         # cells strictly below the crossing: k < k_cross
         k_cross = np.clip(np.ceil((z_cross - origin[2]) / spacing).astype(np.int64), 0, nz)
         np.add.at(delta, (ci[hit], cj[hit], k_cross), sign)
-    # winding(k) = Σ of crossings with k_cross > k
-    winding = np.cumsum(delta[:, :, ::-1], axis=2)[:, :, ::-1]
-    return winding[:, :, 1:]
+    # winding(k) = Σ of crossings with k_cross > k (in place: int32, no second grid)
+    np.cumsum(delta[:, :, ::-1], axis=2, out=delta[:, :, ::-1])
+    return delta[:, :, 1:]
 
 
-def interior_grid(vertices, faces, *, spacing: float, padding: int = 2) -> InteriorGrid:
+def _capped_squared_distance(target: np.ndarray, reach: int) -> np.ndarray:
+    """Squared distance, in cells, from every cell centre to the nearest ``target`` cell centre: exact up to
+    ``reach`` cells, and above ``reach²`` (not necessarily exact) beyond.  float32, (nx, ny, nz).
+
+    Separable (Saito and Toriwaki's decomposition): the distance along x by two scans, then
+    ``d²(x, y, z) = min over |dy|, |dz| ≤ reach of g_x(x, y + dy, z + dz)² + dy² + dz²``, one axis at a time.  A
+    nearest target within ``reach`` lies within ``reach`` along every axis, so it is among the candidates.
+    Memory: three float32 grids (the distance, a scratch grid, the 1-D pass), whatever ``reach``.
+    """
+    far = np.float32(4.0 * (reach + 1) ** 2)
+    g = np.where(target, np.float32(0.0), far).astype(np.float32)
+    for i in range(1, g.shape[0]):                               # distance along x: forward, then backward
+        np.minimum(g[i], g[i - 1] + 1.0, out=g[i])
+    for i in range(g.shape[0] - 2, -1, -1):
+        np.minimum(g[i], g[i + 1] + 1.0, out=g[i])
+    np.minimum(g, far, out=g)
+    np.multiply(g, g, out=g)
+    scratch = np.empty_like(g)
+    for axis in (1, 2):
+        out = g.copy()
+        n = g.shape[axis]
+        for step in range(1, min(reach, n - 1) + 1):
+            lo = [slice(None)] * 3
+            hi = [slice(None)] * 3
+            lo[axis], hi[axis] = slice(0, n - step), slice(step, n)
+            lo_t, hi_t = tuple(lo), tuple(hi)
+            np.add(g[lo_t], np.float32(step * step), out=scratch[lo_t])
+            np.minimum(out[hi_t], scratch[lo_t], out=out[hi_t])          # a target `step` cells below
+            np.add(g[hi_t], np.float32(step * step), out=scratch[hi_t])
+            np.minimum(out[lo_t], scratch[hi_t], out=out[lo_t])          # … and above
+        g = out
+    return g
+
+
+def interior_grid(vertices, faces, *, spacing: float, padding: int = 2,
+                  depth_cap: float | None = None) -> InteriorGrid:
     """Voxelise a closed, outward-wound mesh on cubic cells of edge ``spacing``.
 
     Parameters
@@ -120,13 +159,15 @@ def interior_grid(vertices, faces, *, spacing: float, padding: int = 2) -> Inter
         Cell edge, m, > 0.
     padding : int
         Cells of outside margin around the bounding box.
+    depth_cap : float, optional
+        m: distances are needed only up to here; deeper cells read as ``depth_cap`` (or more).  The capped
+        transform holds three float32 grids instead of scipy's exact transform's ~70 bytes a cell.  ``None``:
+        the exact transform everywhere.
 
     Returns
     -------
     InteriorGrid
     """
-    from scipy.ndimage import distance_transform_edt
-
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     if not (np.isfinite(spacing) and spacing > 0):
@@ -135,58 +176,70 @@ def interior_grid(vertices, faces, *, spacing: float, padding: int = 2) -> Inter
     shape = tuple(int(n) for n in np.ceil((hi - lo) / spacing).astype(int) + 2 * padding)
     origin = lo - (padding - 0.5) * spacing + _SHIFT * spacing
     inside = _winding_columns(v, f, origin, spacing, shape) >= 1
-    signed = (distance_transform_edt(inside, sampling=spacing)
-              - distance_transform_edt(~inside, sampling=spacing))
-    return InteriorGrid(origin=origin, spacing=float(spacing), inside=inside, signed_distance=signed)
+    # float32 (a cell's depth to 1e-7 relative: the wall is measured exactly afterwards), one grid at a time
+    if depth_cap is not None and depth_cap / spacing <= _MAX_REACH:
+        reach = int(np.ceil(depth_cap / spacing))
+        signed = _capped_squared_distance(~inside, reach)
+        np.sqrt(signed, out=signed)
+        outside = _capped_squared_distance(inside, reach)
+        np.sqrt(outside, out=outside)
+        signed -= outside
+        del outside
+        signed *= np.float32(spacing)
+        cap = float(depth_cap)
+        np.clip(signed, -cap, cap, out=signed)
+    else:
+        from scipy.ndimage import distance_transform_edt
+        signed = distance_transform_edt(inside, sampling=spacing).astype(np.float32)
+        signed -= distance_transform_edt(~inside, sampling=spacing).astype(np.float32)
+        cap = math.inf
+    return InteriorGrid(origin=origin, spacing=float(spacing), inside=inside, signed_distance=signed,
+                        depth_cap=cap)
 
 
-def _closest_on_triangles(p, a, b, c):
-    """Squared distance from points ``p`` to triangles ``abc`` (all (k, 3)), Ericson's region tests."""
-    ab, ac, ap = b - a, c - a, p - a
-    d1, d2 = np.einsum("ij,ij->i", ab, ap), np.einsum("ij,ij->i", ac, ap)
-    bp = p - b
-    d3, d4 = np.einsum("ij,ij->i", ab, bp), np.einsum("ij,ij->i", ac, bp)
-    cp = p - c
-    d5, d6 = np.einsum("ij,ij->i", ab, cp), np.einsum("ij,ij->i", ac, cp)
-    va = d3 * d6 - d5 * d4
-    vb = d5 * d2 - d1 * d6
-    vc = d1 * d4 - d3 * d2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        denom = va + vb + vc
-        v = np.where(denom != 0, vb / denom, 0.0)
-        w = np.where(denom != 0, vc / denom, 0.0)
-        closest = a + ab * v[:, None] + ac * w[:, None]                    # interior of the face
-        # edges
-        t_ab = np.where(d1 - d3 != 0, d1 / (d1 - d3), 0.0)
-        t_ac = np.where(d2 - d6 != 0, d2 / (d2 - d6), 0.0)
-        t_bc = np.where((d4 - d3) + (d5 - d6) != 0, (d4 - d3) / ((d4 - d3) + (d5 - d6)), 0.0)
-    on_ab = (vc <= 0) & (d1 >= 0) & (d3 <= 0)
-    on_ac = (vb <= 0) & (d2 >= 0) & (d6 <= 0)
-    on_bc = (va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0)
-    closest = np.where(on_bc[:, None], b + (c - b) * t_bc[:, None], closest)
-    closest = np.where(on_ac[:, None], a + ac * t_ac[:, None], closest)
-    closest = np.where(on_ab[:, None], a + ab * t_ab[:, None], closest)
-    closest = np.where(((d6 >= 0) & (d5 <= d6))[:, None], c, closest)
-    closest = np.where(((d3 >= 0) & (d4 <= d3))[:, None], b, closest)
-    closest = np.where(((d1 <= 0) & (d2 <= 0))[:, None], a, closest)
-    diff = p - closest
-    return np.einsum("ij,ij->i", diff, diff)
+#: Cells of reach above which ``interior_grid`` uses scipy's exact transform (the capped one costs a pass of the
+#: grid per cell of reach and axis).
+_MAX_REACH = 40
 
 
-def _expand_ranges(begin: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """For ranges ``[begin, begin + count)``: (range number, position) of every element, concatenated."""
-    owner = np.repeat(np.arange(len(count)), count)
-    offset = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
-    return owner, np.repeat(begin, count) + offset
+class SurfaceTree:
+    """The outer surface in libigl's AABB tree, built once and queried for exact point-surface distances.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        m.
+    faces : (m, 3) int
+    """
+
+    def __init__(self, vertices, faces):
+        import igl
+
+        self.vertices = np.ascontiguousarray(vertices, dtype=np.float64)
+        self.faces = np.ascontiguousarray(faces, dtype=np.int64)
+        self._tree = igl.AABB()
+        self._tree.init(self.vertices, self.faces)
+
+    def squared_distance(self, points) -> np.ndarray:
+        """Squared distance from each point (k, 3) m to the nearest triangle, m², (k,)."""
+        pts = np.asarray(points, dtype=np.float64)
+        out = np.empty(len(pts))
+        for start in range(0, len(pts), _QUERY_BATCH):          # bounds the (k, 3) closest points libigl returns
+            chunk = np.ascontiguousarray(pts[start:start + _QUERY_BATCH])
+            out[start:start + len(chunk)] = self._tree.squared_distance(self.vertices, self.faces, chunk)[0]
+        return out
 
 
-def surface_distance(points, vertices, faces, *, cutoff: float, max_pairs: int = 2_000_000) -> np.ndarray:
-    """Exact distance from each point to the nearest triangle, clipped at ``cutoff`` (m).
+#: Points per libigl query (its closest-point output is 24 bytes a point).
+_QUERY_BATCH = 1 << 18
 
-    Points are binned on cubic cells of edge ``cutoff``; each triangle is paired with the points of the cells
-    its bounding box, grown by ``cutoff``, touches (every point closer than ``cutoff`` is among them, and each
-    pair occurs once).  Pairs are then culled by the distance to the triangle's bounding box and plane before
-    the exact point-triangle distance (Ericson, *Real-Time Collision Detection*, §5.1.5).
+
+def surface_distance(points, vertices, faces, *, cutoff: float, tree: SurfaceTree | None = None) -> np.ndarray:
+    """Distance from each point to the nearest triangle, clipped at ``cutoff`` (m).
+
+    The nearest triangle is found in libigl's AABB tree and the point-triangle distance evaluated in floating
+    point (the closest point by the region tests of Ericson, *Real-Time Collision Detection*, §5.1.5): exact up
+    to the rounding of a few dozen operations on the coordinates.
 
     Parameters
     ----------
@@ -196,67 +249,19 @@ def surface_distance(points, vertices, faces, *, cutoff: float, max_pairs: int =
         The surface.
     cutoff : float
         Distances at or beyond it are returned as ``cutoff`` (m), > 0.
-    max_pairs : int
-        Most (cell, triangle) or (point, triangle) pairs held at once (memory bound).
+    tree : SurfaceTree, optional
+        The same surface already in a tree (reused across calls).
 
     Returns
     -------
     (k,) float
     """
     pts = np.asarray(points, dtype=np.float64)
-    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
     result = np.full(len(pts), float(cutoff))
-    if len(pts) == 0 or len(tri) == 0:
+    if len(pts) == 0 or len(faces) == 0:
         return result
     if not (np.isfinite(cutoff) and cutoff > 0):
         raise UsageError(f"Expected a positive `cutoff`, got {cutoff!r}")
-    base = pts.min(axis=0)
-    n_cells = np.floor((pts.max(axis=0) - base) / cutoff).astype(np.int64) + 1
-    stride = np.array([n_cells[1] * n_cells[2], n_cells[2], 1], dtype=np.int64)
-    pcell = np.floor((pts - base) / cutoff).astype(np.int64) @ stride
-    order = np.argsort(pcell, kind="stable")
-    sorted_cells = pcell[order]
-    box_lo, box_hi = tri.min(axis=1), tri.max(axis=1)
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    length = np.linalg.norm(normal, axis=1)
-    unit_normal = normal / np.where(length > 0, length, 1.0)[:, None]   # degenerate: 0, no plane bound
-    tlo = np.clip(np.floor((box_lo - cutoff - base) / cutoff).astype(np.int64), 0, n_cells - 1)
-    thi = np.floor((box_hi + cutoff - base) / cutoff).astype(np.int64)
-    outside = np.any(thi < 0, axis=1) | np.any(tlo > n_cells - 1, axis=1) | np.any(
-        (box_lo - cutoff - base) > (n_cells * cutoff), axis=1)
-    thi = np.clip(thi, 0, n_cells - 1)
-    span = np.where(outside[:, None], 0, thi - tlo + 1)
-    count = span.prod(axis=1)
-    best = np.full(len(pts), float(cutoff) ** 2)
-    tri_ids = np.nonzero(count)[0]
-    cum = np.cumsum(count[tri_ids])
-    first = 0
-    while first < len(tri_ids):
-        done = cum[first - 1] if first else 0
-        last = max(first + 1, int(np.searchsorted(cum, done + max_pairs, side="right")))
-        ids = tri_ids[first:last]
-        first = last
-        owner, local = _expand_ranges(np.zeros(len(ids), dtype=np.int64), count[ids])
-        sy, sz = span[ids[owner], 1], span[ids[owner], 2]
-        cells = (tlo[ids[owner]] + np.column_stack([local // (sy * sz), (local // sz) % sy, local % sz])) @ stride
-        begin = np.searchsorted(sorted_cells, cells, side="left")
-        end = np.searchsorted(sorted_cells, cells, side="right")
-        has = end > begin
-        cell_tri = ids[owner[has]]
-        begin, n = begin[has], (end - begin)[has]
-        for s in range(0, len(n), max(1, max_pairs // max(1, int(n.max(initial=1))))):
-            which, pos = _expand_ranges(begin[s:s + max_pairs], n[s:s + max_pairs])
-            pair_point = order[pos]
-            pair_tri = cell_tri[s:s + max_pairs][which]
-            p = pts[pair_point]
-            gap = np.maximum(np.maximum(box_lo[pair_tri] - p, p - box_hi[pair_tri]), 0.0)
-            keep = np.einsum("ij,ij->i", gap, gap) < best[pair_point]
-            plane = np.einsum("ij,ij->i", p - tri[pair_tri, 0], unit_normal[pair_tri])
-            keep &= plane * plane < best[pair_point]
-            if not np.any(keep):
-                continue
-            pair_point, pair_tri = pair_point[keep], pair_tri[keep]
-            t = tri[pair_tri]
-            d2 = _closest_on_triangles(pts[pair_point], t[:, 0], t[:, 1], t[:, 2])
-            np.minimum.at(best, pair_point, d2)
-    return np.sqrt(best)
+    if tree is None:
+        tree = SurfaceTree(vertices, faces)
+    return np.minimum(np.sqrt(tree.squared_distance(pts)), float(cutoff))

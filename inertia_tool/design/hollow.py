@@ -8,7 +8,7 @@ Pipeline (one function per stage):
 3. the quadric cavity that minimises the mode's objective of the mass moments (``design.optimize``,
    ``design.moments``);
 4. the cavity as a closed mesh — the zero level set of ``min(depth − wall, −q)`` by marching tetrahedra
-   (``manifold3d.Manifold.level_set``) — subtracted from the part with manifold3d's robust boolean;
+   (``design.tetra``), kept ``wall`` from the part's surface and added to it turned inward (no boolean);
 5. the wall measured exactly (distance from every cavity vertex to the outer surface, ``design.grid``), and
    the hollowed mesh re-analysed by the exact engine: every number reported comes from that re-analysis.
 
@@ -22,14 +22,14 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import AsymmetricTopWarning, NoRoomError, PhysicsError, UsageError
 from .cavity_mesh import DEPTH_MARGIN, cut_pocket  # noqa: F401  (DEPTH_MARGIN: used by the benchmark too)
-from .grid import interior_grid, surface_distance
+from .grid import SurfaceTree, interior_grid, surface_distance
 from .limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
 from .moments import OBJECTIVES, frame_quantities, moment_vector, top_threshold_measure
 from .optimize import QuadricCavity, optimize_quadric_cavity
@@ -141,6 +141,10 @@ class SpinItResult:
         The insert alone, re-analysed at ``insert_density`` (``after`` includes it).
     insert_density : float or None
         kg/m³ of the insert material.
+    insert_shape : str or None
+        ``"quadric"`` or ``"ring"`` (a rim about the spin axis; ``design.insert``), None without an insert.
+    loaded : tuple or None
+        The checked input ``(vertices, faces, before, name)``, for another attempt (``spin_it(loaded=…)``).
     """
 
     mode: str
@@ -168,6 +172,8 @@ class SpinItResult:
     insert_faces: np.ndarray | None = None
     insert: object = None
     insert_density: float | None = None
+    insert_shape: str | None = None
+    loaded: tuple | None = field(default=None, repr=False, compare=False)
 
 
 def _unit(vector, name: str) -> np.ndarray:
@@ -268,7 +274,7 @@ def _load(source, units: str | None, density, material, mass, repair: bool = Fal
     return prepared.vertices, prepared.faces, props, raw.source
 
 
-def _exact_near_wall(grid, vertices, faces, wall: float):
+def _exact_near_wall(grid, vertices, faces, wall: float, tree=None):
     """The grid with exact depths (``design.grid.surface_distance``, capped at ``wall + 2h``) at the inside cells
     whose approximate depth lies in ``[wall − h, wall + 2h]``, where the allowed region is decided."""
     from dataclasses import replace
@@ -279,9 +285,13 @@ def _exact_near_wall(grid, vertices, faces, wall: float):
     if len(index[0]) == 0:
         return grid
     depth = grid.signed_distance.copy()
-    depth[index] = surface_distance(grid.centers(index), vertices, faces, cutoff=wall + 2 * h)
+    depth[index] = surface_distance(grid.centers(index), vertices, faces, cutoff=wall + 2 * h, tree=tree)
     return replace(grid, signed_distance=depth)
 
+
+#: Cells beyond the wall up to which the grid's depths are computed (``interior_grid(depth_cap=…)``): the cavity
+#: field asks for ``wall`` + up to 2 cells of margin (``cavity_mesh``), and its smooth minimum reaches 2 more.
+DEPTH_CAP_CELLS = 6
 
 #: A cavity is meshed when the region deeper than the wall spans about this many cells across.
 _CELLS_ACROSS = 3.0
@@ -295,8 +305,8 @@ def _too_thin(name: str, grid, wall: float, extent: float, resolution: int, *, c
     why = ("no cell lies deeper than the {w} mm wall plus half a cell" if not chosen else
            f"the {chosen} cells the optimiser chose are too thin a layer to make a cavity of")
     head = (f"{name}: no room for a cavity at resolution {resolution} (cells of {h * 1e3:.3g} mm): "
-            + why.replace("{w}", f"{wall * 1e3:.3g}") + f"; the part is about {deepest * 1e3:.3g} mm deep at "
-            "its thickest")
+            + why.replace("{w}", f"{wall * 1e3:.3g}") + "; the part is "
+            + ("at least" if deepest >= grid.depth_cap else "about") + f" {deepest * 1e3:.3g} mm deep at its thickest")
     if deepest + h <= wall:      # the grid's depth is within a cell of the true one (design.grid)
         return NoRoomError(head + " — nowhere deeper than the wall: a thinner `wall` is the only way")
     if deepest <= wall:
@@ -313,7 +323,8 @@ def _too_thin(name: str, grid, wall: float, extent: float, resolution: int, *, c
 def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivot=None, units: str | None = None,
             density: float | None = None, material: str | None = None, mass: float | None = None,
             resolution: int = DEFAULT_RESOLUTION, center_weight: float = 1e4, product_weight: float = 1e4,
-            gravity: float = 9.80665, insert_density: float | None = None, repair: bool = False) -> SpinItResult:
+            gravity: float = 9.80665, insert_density: float | None = None, repair: bool = False,
+            storage_scale: float | None = None, loaded: tuple | None = None) -> SpinItResult:
     """Hollow a part so that it spins stably about ``axis`` (Bächer et al. 2014; Hafner et al. 2024).
 
     Parameters
@@ -349,6 +360,13 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     repair : bool
         Read a damaged mesh (holes, cracks) as ``mass_properties(repair=True)`` does, and design on the
         repaired surface; every 'after' number is still the exact re-analysis of the hollowed mesh.
+    storage_scale : float, optional
+        m per unit of the file the result will be written to as float32 (an STL in ``units``): the hollowed
+        mesh is rounded as that file holds it before it is re-analysed, so that the file analyses to the
+        numbers reported.  ``None``: kept in float64.
+    loaded : tuple, optional
+        ``(vertices, faces, MassProperties, name)`` of this ``source`` already read and checked (``_load``):
+        ``spin_it_verified`` reads the part once for all its attempts.
 
     Returns
     -------
@@ -374,7 +392,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         pivot = _point(pivot, "pivot")
     elif pivot is not None:
         raise UsageError("`pivot` is for mode 'top'")
-    vertices, faces, before, name = _load(source, units, density, material, mass, repair)
+    vertices, faces, before, name = loaded or _load(source, units, density, material, mass, repair)
     if insert_density is not None and not (isinstance(insert_density, (int, float)) and math.isfinite(insert_density)
                                            and insert_density > before.density):
         raise UsageError(f"Expected `insert_density` above the part's {before.density:g} kg/m³, got {insert_density!r}")
@@ -388,7 +406,10 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     rho = before.density
 
     h = extent / resolution
-    grid = _exact_near_wall(interior_grid(vertices, faces, spacing=h), vertices, faces, wall)
+    tree = SurfaceTree(vertices, faces)
+    # depths matter up to the deepest cavity threshold (wall + margins) plus the smooth minimum's reach
+    grid = interior_grid(vertices, faces, spacing=h, depth_cap=wall + DEPTH_CAP_CELLS * h)
+    grid = _exact_near_wall(grid, vertices, faces, wall, tree)
     deep = grid.inside & (grid.signed_distance >= wall + DEPTH_MARGIN * h)
     index = np.nonzero(deep)
     if len(index[0]) == 0:
@@ -417,18 +438,28 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         design = optimize_cavity_and_insert(objective, mu_part, points, h, cavity, size=size,
                                             density_ratio=insert_density / rho)
         cavity = design.cavity
-    out_v, out_f, ins_v, ins_f, measured = cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall)
-    after = before
-    insert_props = None
-    if out_v is vertices and ins_v is None and int(cavity.removed.sum()) > 0:
-        raise (_too_thin(name, grid, wall, extent, resolution, chosen=int(cavity.removed.sum())))
-    if out_v is not vertices:
-        after = _reanalysed((out_v, out_f), rho, f"{name} (hollowed)")
-    if ins_v is not None:
-        assert insert_density is not None, "an insert is made only when its density is given"
-        from ..mass.properties import combine
-        insert_props = _reanalysed((ins_v, ins_f), float(insert_density), f"{name} (insert)")
-        after = combine([after, insert_props], name=f"{name} (hollowed, with insert)")
+    # an insert may come with alternatives (another shape, worse on the cells): each is meshed and re-analysed,
+    # and the best exact objective kept
+    made = None
+    for candidate in (design, *getattr(design, "alternatives", ())):
+        attempt = _made(candidate, vertices, faces, grid, centres, origin, frame, wall, tree, storage_scale, rho,
+                        insert_density, name, before)
+        if attempt is None:
+            continue
+        value = float(objective(moment_vector(attempt[0], origin, frame) / rho))
+        if made is None or value < made[-1]:
+            made = (*attempt, candidate, value)
+    if made is None:
+        if int(cavity.removed.sum()) > 0:
+            raise (_too_thin(name, grid, wall, extent, resolution, chosen=int(cavity.removed.sum())))
+        after, pocket, insert_props, chosen = before, None, None, design
+    else:
+        after, pocket, insert_props, chosen, _ = made
+    cavity = chosen.cavity if hasattr(chosen, "cavity") else chosen
+    out_v, out_f, ins_v, ins_f, measured = ((vertices, faces, None, None, math.inf) if pocket is None else
+                                            (pocket.vertices, pocket.faces, pocket.insert_vertices,
+                                             pocket.insert_faces, pocket.measured_wall))
+    insert_shape = getattr(chosen, "shape", None) if ins_v is not None else None
     metric_origin = origin if (mode == "top" or through is not None) else None
     return SpinItResult(mode=mode, axis=axis, origin=origin, wall=float(wall), vertices=out_v, faces=out_f,
                         before=before, after=after,
@@ -441,17 +472,53 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
                         objective_after=float(objective(moment_vector(after, origin, frame) / rho)),
                         optimisation_seconds=cavity.seconds, objective_evaluations=cavity.evaluations,
                         seconds=time.perf_counter() - started, insert_vertices=ins_v, insert_faces=ins_f,
-                        insert=insert_props, insert_density=None if insert_density is None else float(insert_density))
+                        insert=insert_props, insert_density=None if insert_density is None else float(insert_density),
+                        insert_shape=insert_shape, loaded=(vertices, faces, before, name))
+
+
+def _made(design, vertices, faces, grid, centres, origin, frame, wall: float, tree, storage_scale, rho: float,
+          insert_density, name: str, before):
+    """One design meshed and re-analysed: (after, pocket, insert properties), or None when no cavity came out
+    of the meshing (the chosen cells too thin a layer)."""
+    pockets = cut_pocket(vertices, faces, grid, design, centres, origin, frame, wall, tree=tree,
+                         storage_scale=storage_scale)
+    if not pockets:
+        return None
+    pocket, after = _first_certified(pockets, rho, f"{name} (hollowed)")
+    insert_props = None
+    if pocket.insert_vertices is not None:
+        assert insert_density is not None, "an insert is made only when its density is given"
+        from ..mass.properties import combine
+        insert_props = _reanalysed((pocket.insert_vertices, pocket.insert_faces), float(insert_density),
+                                   f"{name} (insert)")
+        after = combine([after, insert_props], name=f"{name} (hollowed, with insert)")
+    return after, pocket, insert_props
 
 
 def _reanalysed(mesh, density: float, name: str):
-    """Mass properties of a mesh made here by manifold3d's boolean, by the engine.
-
-    manifold3d's output is manifold but can pass through itself by rounding at a few face pairs; the engine
-    then integrates it as it stands with the certificate ``unverified`` and says so in its notes, instead of
-    refusing the design (rule R3 of :mod:`inertia_tool.mesh.policy`).
-    """
+    """Mass properties of a mesh made here, by the engine with every check of ``analyze`` (a surface that
+    passes through itself is refused, as ``analyze`` would refuse the file)."""
     from ..mass.pipeline import _part
     from ..mesh.options import LoadOptions
 
-    return _part(mesh, density, None, LoadOptions(), name=name, self_crossing="unverified")[0]
+    return _part(mesh, density, None, LoadOptions(), name=name)[0]
+
+
+def _first_certified(pockets, density: float, name: str):
+    """The first candidate pocket whose hollowed part the engine certifies ``exact`` (as ``analyze`` will the
+    file), and its mass properties.  A cavity added to the part's surface keeps the wall from it and is an
+    embedded surface (``design.tetra``), so the first normally passes; the manifold3d simplification is the
+    one that may fold, and the marching tetrahedra's own mesh is tried next."""
+    from ..errors import InvalidMeshError
+
+    failures = []
+    for pocket in pockets:
+        try:
+            props = _reanalysed((pocket.vertices, pocket.faces), density, name)
+        except InvalidMeshError as exc:
+            failures.append(str(exc))
+            continue
+        if props.mesh is None or props.mesh.certificate.kind == "exact":
+            return pocket, props
+        failures.append(f"certificate {props.mesh.certificate.kind}")
+    raise PhysicsError(f"{name}: no mesh of the cavity could be certified exact ({'; '.join(failures)})")

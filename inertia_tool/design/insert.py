@@ -9,6 +9,11 @@ indicators ``σ(−q_k/τ)``.  The objective of the moments is still linear in t
 quadrics (the first-order change of adding insert material at ``x`` is ``(r − 1) ∇f · ψ(x)``).  Optimisation:
 from the cavity-only optimum and the first-order insert quadric there, BFGS on the 20 coefficients through the
 same annealing schedule as :mod:`.optimize`; the sharp design is kept only if it beats the cavity alone.
+
+A **ring insert** is tried beside it (a heavy rim about the spin axis: the obvious fix of a top): the allowed
+cells beyond a radius ``ρ``, itself a quadric ``ρ² − x² − y² < 0``, for the outermost 5 % to 50 % of them
+(``RING_FRACTIONS``), with the cavity-only optimum.  Both shapes that beat the cavity alone are handed to
+``spin_it``, which meshes and re-analyses each and keeps the better exact objective.
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ import numpy as np
 from .optimize import ANNEALING, MAX_ITERATIONS_PER_STAGE, QuadricCavity, _gradient_in_moments, _moment_scales, \
     _monomials
 
-__all__ = ["QuadricInsert", "optimize_cavity_and_insert"]
+__all__ = ["QuadricInsert", "optimize_cavity_and_insert", "ring_coefficients", "RING_FRACTIONS"]
 
 
 @dataclass(frozen=True)
@@ -40,6 +45,12 @@ class QuadricInsert:
         ``ρ2/ρ``.
     objective_cavity_only, objective : float
         The objective with the best cavity alone and with cavity and insert (on the cells).
+    shape : str
+        ``"quadric"`` (the optimised second quadric), ``"ring"`` (a rim about the spin axis) or ``"none"``.
+    alternatives : tuple of QuadricInsert
+        The other shapes that also beat the cavity alone on the cells, and last the cavity alone: the cells
+        and the meshed part differ by up to a cell at the wall (where a rim lies), so ``spin_it`` meshes and
+        re-analyses each and keeps the best exact objective.
     """
 
     cavity: QuadricCavity
@@ -48,11 +59,38 @@ class QuadricInsert:
     density_ratio: float
     objective_cavity_only: float
     objective: float
+    shape: str = "quadric"
+    alternatives: tuple["QuadricInsert", ...] = ()
 
     def insert_values(self, points) -> np.ndarray:
         """``q2`` at frame points (n, 3) m (negative inside the insert)."""
         x = (np.asarray(points) - self.cavity.centre) / self.cavity.half_extent
         return _monomials(x) @ (self.insert_coefficients / np.linalg.norm(self.insert_coefficients))
+
+
+#: Fractions of the allowed cells (the outermost about the axis) a ring insert may take.
+RING_FRACTIONS = (0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5)
+
+
+def ring_coefficients(radius: float, centre, half: float) -> np.ndarray:
+    """Unit ``θ̂`` of the quadric ``q = ρ² − (x² + y²)`` (frame coordinates, m: the spin axis is ``e3`` through the
+    frame origin) in the normalised monomials of ``x = centre + half · x̂``: ``q < 0`` outside the cylinder of
+    radius ``ρ`` about the axis, so that the insert is the ring (annulus) of the allowed region beyond ``ρ``."""
+    c0, c1 = float(centre[0]), float(centre[1])
+    theta = np.array([radius ** 2 - c0 * c0 - c1 * c1, -2.0 * c0 * half, -2.0 * c1 * half, 0.0, -half * half,
+                      -half * half, 0.0, 0.0, 0.0, 0.0])
+    return theta / np.linalg.norm(theta)
+
+
+def _best_ring(objective_of_insert, points, centre, half: float):
+    """The ring insert (the outermost ``RING_FRACTIONS`` of the allowed cells about the axis) of lowest objective:
+    its unit ``θ̂``, or None without cells."""
+    radius = np.hypot(points[:, 0], points[:, 1])
+    if not len(radius):
+        return None
+    rings = [ring_coefficients(float(np.quantile(radius, 1.0 - fraction)), centre, half)
+             for fraction in RING_FRACTIONS]
+    return min(rings, key=objective_of_insert)
 
 
 def optimize_cavity_and_insert(objective, mu_part, points, spacing: float, cavity: QuadricCavity, *,
@@ -133,13 +171,24 @@ def optimize_cavity_and_insert(objective, mu_part, points, spacing: float, cavit
                           options={"maxiter": MAX_ITERATIONS_PER_STAGE, "gtol": 1e-9})
         theta = np.concatenate([result.x[:10] / np.linalg.norm(result.x[:10]),
                                 result.x[10:] / np.linalg.norm(result.x[10:])])
-    value, void, insert = sharp(theta[:10], theta[10:])
-    if not value < cavity.objective:
-        no_insert = np.r_[1.0, np.zeros(9)]
-        return QuadricInsert(cavity=cavity, insert_coefficients=no_insert, inserted=np.zeros(len(pts), bool),
-                             density_ratio=r, objective_cavity_only=cavity.objective, objective=cavity.objective)
     from dataclasses import replace
-    new_cavity = replace(cavity, coefficients=theta[:10], removed=void, objective=float(value),
-                         seconds=cavity.seconds + time.perf_counter() - started)
-    return QuadricInsert(cavity=new_cavity, insert_coefficients=theta[10:], inserted=insert, density_ratio=r,
-                         objective_cavity_only=cavity.objective, objective=float(value))
+
+    def made(theta1, theta2, shape: str) -> QuadricInsert:
+        value, void, insert = sharp(theta1, theta2)
+        new_cavity = replace(cavity, coefficients=theta1, removed=void, objective=float(value),
+                             seconds=cavity.seconds + time.perf_counter() - started)
+        return QuadricInsert(cavity=new_cavity, insert_coefficients=theta2, inserted=insert, density_ratio=r,
+                             objective_cavity_only=cavity.objective, objective=float(value), shape=shape)
+
+    # the optimised insert quadric, and a ring (a heavy rim about the axis) with the cavity-only optimum
+    designs = [made(theta[:10], theta[10:], "quadric")]
+    ring = _best_ring(lambda t2: sharp(cavity.coefficients, t2)[0], pts, centre, half)
+    if ring is not None:
+        designs.append(made(cavity.coefficients, ring, "ring"))
+    better = sorted((d for d in designs if d.objective < cavity.objective), key=lambda d: d.objective)
+    no_insert = QuadricInsert(cavity=cavity, insert_coefficients=np.r_[1.0, np.zeros(9)],
+                              inserted=np.zeros(len(pts), bool), density_ratio=r,
+                              objective_cavity_only=cavity.objective, objective=cavity.objective, shape="none")
+    if not better:
+        return no_insert
+    return replace(better[0], alternatives=(*better[1:], no_insert))

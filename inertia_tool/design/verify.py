@@ -166,6 +166,7 @@ def spin_it_verified(source, *, resolution: int, retries: int = MAX_RETRIES, **o
     from . import hollow
     verdicts: list[SpinVerdict] = []
     current = int(resolution)
+
     name = str(source) if isinstance(source, (str, bytes)) or hasattr(source, "__fspath__") else "the part"
     thin_note: tuple[str, ...] = ()
     for _attempt in range(max(int(retries), 0) + 1):
@@ -177,6 +178,9 @@ def spin_it_verified(source, *, resolution: int, retries: int = MAX_RETRIES, **o
             result, current = _finer_room(source, current, exc, options)
             thin_note = (f"resolution {resolution} left no room for a cavity (the part is thin there); "
                          f"resolution {current} did, and was used",)
+        # the part is read and checked once: later attempts reuse the first's (the check of a large mesh costs)
+        if getattr(result, "loaded", None) is not None:
+            options = {**options, "loaded": result.loaded}
         verdict = verify_spin_design(result, current)
         if thin_note:
             verdict = replace(verdict, notes=thin_note + verdict.notes)

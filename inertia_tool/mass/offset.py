@@ -28,6 +28,7 @@ flat or smooth).
 from __future__ import annotations
 
 import itertools
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -35,7 +36,7 @@ from numpy.typing import ArrayLike
 from ..errors import UsageError
 from ..values import frozen_value
 
-__all__ = ["CoreMoments", "core_moments", "DEFAULT_BAND_CELLS"]
+__all__ = ["CoreMoments", "core_moments", "vertical_skin_moments", "DEFAULT_BAND_CELLS"]
 
 #: Finest band cells (distance queries) ``core_moments`` aims at by default: about 1–3 s on one core.
 DEFAULT_BAND_CELLS = 100_000
@@ -302,5 +303,227 @@ def core_moments(vertices: ArrayLike, faces: ArrayLike, depth: float, *, origin:
         high = volume + float((upper - est).sum())
         break
     return CoreMoments(depth=t, origin=o, volume=volume, volume_bounds=np.array([max(low, 0.0), high]),
+                       first_moment=first, first_moment_bound=first_bound, second_moment=0.5 * (second + second.T),
+                       second_moment_bound=second_bound, cell_size=h, band_cells=n_band)
+
+
+#: Points per cell at which ``_column_fraction`` samples the cell's height.
+_COLUMN_SAMPLES = 16
+
+
+def _column_fraction(column: np.ndarray, j_lo: int, h: float, depth: float, top: float, bottom: float) -> np.ndarray:
+    """Estimated fraction of each cell in ``D`` (see ``vertical_skin_moments``), along its centre's vertical line.
+
+    ``column[:, k]`` is the signed distance at ``c + (j_lo + k) h e_z``; between samples it is taken linear.  At
+    ``_COLUMN_SAMPLES`` heights ``z`` in the cell: in the core when ``d(z) ≥ t``; the surface crossings of the
+    line are where the linear ``d`` changes sign; ``z`` is in ``D`` when the nearest crossing above is closer than
+    ``top`` or the nearest below closer than ``bottom``.  Exact where the distance is linear along the line
+    (below horizontal faces), an estimate elsewhere; the bracket does not depend on it."""
+    n, m = column.shape
+    z = (np.arange(m) + j_lo) * h                                              # sample heights, cell centre 0
+    d0, d1 = column[:, :-1], column[:, 1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        crossing = z[:-1] + h * d0 / (d0 - d1)                                 # where the linear d is 0
+    exits = np.where((d0 > 0) & (d1 <= 0), crossing, np.inf)                   # leaving X going up
+    enters = np.where((d0 <= 0) & (d1 > 0), crossing, -np.inf)                 # entering X going up
+    samples = ((np.arange(_COLUMN_SAMPLES) + 0.5) / _COLUMN_SAMPLES - 0.5) * h
+    k0 = -j_lo
+    fraction = np.zeros(n)
+    for zs in samples:
+        below = k0 - 1 if zs < 0 else k0
+        w = (zs - z[below]) / h
+        d = column[:, below] * (1.0 - w) + column[:, below + 1] * w
+        up = np.where(exits > zs, exits, np.inf).min(axis=1)
+        down = np.where(enters < zs, enters, -np.inf).max(axis=1)
+        fraction += (d >= depth) & ((up - zs < top) | (zs - down < bottom))
+    return fraction / _COLUMN_SAMPLES
+
+
+def _crosses_surface(tree: Any, v: np.ndarray, f: np.ndarray, centres: np.ndarray, size: float, top: float,
+                     bottom: float) -> np.ndarray:
+    """Whether every vertical segment ``[q − bottom, q + top]`` from every point ``q`` of each cell certainly leaves
+    the solid: the face first hit by the vertical ray from the cell's centre (up, then down) covers the cell's
+    whole footprint in projection, faces the way of travel (its outward normal's z has the ray's sign, so the
+    line passes from inside to outside there), and lies over the footprint above the cell's top and within
+    ``top`` of its bottom (below: within ``bottom``).  Exact predicates are not needed: the margins are a cell."""
+    out = np.zeros(len(centres), dtype=bool)
+    half = 0.5 * size
+    corners = np.array([[-1.0, -1.0], [1.0, -1.0], [-1.0, 1.0], [1.0, 1.0]]) * half
+    for sign, reach in ((1.0, top), (-1.0, bottom)):
+        direction = np.tile([0.0, 0.0, sign], (len(centres), 1))
+        face, _, _ = tree.intersect_ray_first(v, f, np.ascontiguousarray(centres), direction)
+        hit = face >= 0
+        tri = v[f[np.where(hit, face, 0)]]                                          # (k, 3, 3)
+        normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        facing = hit & (sign * normal[:, 2] > 0)
+        ok = facing.copy()
+        a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+        area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+        for dx, dy in corners:
+            px, py = centres[:, 0] + dx, centres[:, 1] + dy
+            w0 = (b[:, 0] - px) * (c[:, 1] - py) - (b[:, 1] - py) * (c[:, 0] - px)
+            w1 = (c[:, 0] - px) * (a[:, 1] - py) - (c[:, 1] - py) * (a[:, 0] - px)
+            w2 = area - w0 - w1
+            inside = np.where(area > 0, (w0 >= 0) & (w1 >= 0) & (w2 >= 0), (w0 <= 0) & (w1 <= 0) & (w2 <= 0))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                z = (w0 * a[:, 2] + w1 * b[:, 2] + w2 * c[:, 2]) / area                # the face over the corner
+            rise = sign * (z - centres[:, 2])                                          # along the travel
+            ok &= inside & (area != 0) & (rise > half) & (rise <= reach - half)
+        out |= ok
+    return out
+
+
+def _add_weighted(c: np.ndarray, size: float, weight: np.ndarray,
+                  origin: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """Volume, first and second moments (about ``origin``) of cubes at ``c`` filled to ``weight``."""
+    x = c - origin
+    w = size ** 3 * weight
+    return (float(w.sum()), w @ x, (x * w[:, None]).T @ x + float(w.sum()) * size * size / 12.0 * np.eye(3))
+
+
+#: Distance queries per refinement level of ``vertical_skin_moments`` at most (its loop's memory bound).
+_VERTICAL_QUERY_BATCH = 1 << 18
+
+
+def vertical_skin_moments(vertices: ArrayLike, faces: ArrayLike, depth: float, *, top: float, bottom: float,
+                          origin: ArrayLike, band_cells: int = DEFAULT_BAND_CELLS) -> CoreMoments:
+    """Volume moments of the part of the core that a slicer's top and bottom layers make solid, with bounds.
+
+    A slicer fills solid every point within ``top`` (measured vertically) below an up-facing surface and within
+    ``bottom`` above a down-facing one.  With ``S = [−bottom, top] e_z``, the point ``p`` stays infill only when
+    the vertical segment ``p + S`` lies in the solid ``X`` (the erosion ``X ⊖ S``).  This function integrates
+    ``D = X_t \\ (X ⊖ S)``: the points of the core ``X_t`` (``core_moments``) the top/bottom layers take.  The
+    infill is then ``X_t − D``.
+
+    Method: an octree over the box of the core.  With the exact signed distance ``d`` (1-Lipschitz) and a cell
+    ``Q`` of centre ``c``, half-diagonal ``r`` and edge ``h``:
+
+    * ``Q ⊂ X_t`` when ``d(c) − t ≥ r``; ``Q ∩ X_t = ∅`` when ``d(c) − t ≤ −r``;
+    * ``Q ∩ D = ∅`` when the cubes ``Q + j h e_z`` that cover ``Q + S`` all lie in ``X`` (``d ≥ r`` at their
+      centres): every segment from ``Q`` stays in the solid;
+    * ``Q ⊂ D`` (given ``Q ⊂ X_t``) when one cube ``Q + j h e_z`` lying within ``q + S`` for every ``q ∈ Q``
+      lies wholly outside ``X`` (``d ≤ −r``): every vertical segment from ``Q`` passes through it.
+
+    Undecided cells are split into eight, down to the size that leaves about ``band_cells`` of them; at the
+    finest level each undecided cell counts by its centre (in ``X_t`` and its segment, sampled every cell and
+    at its two ends, leaving ``X``).  The bracket ``[certain, certain + undecided]`` holds for any closed,
+    consistently oriented mesh (the assumption of the signed distance's sign), as in ``core_moments``.
+
+    Parameters
+    ----------
+    vertices, faces
+        The closed, outward-wound surface, m.
+    depth : float
+        ``t > 0``, m: the wall (the core is the inward offset by ``t``).
+    top, bottom : float
+        m, ≥ 0: the vertical thickness of the top and bottom skins.
+    origin : (3,) float
+        Reference point of the moments, m.
+    band_cells : int
+        About how many finest cells may stay undecided (each costs a column of distance queries).
+
+    Returns
+    -------
+    CoreMoments
+        Of ``D``; its ``volume_bounds`` and moment bounds bracket the truth.
+    """
+    t = float(depth)
+    top, bottom = float(top), float(bottom)
+    if not (np.isfinite(t) and t > 0):
+        raise UsageError(f"Expected `depth` to be a positive finite length in m, got {depth}")
+    if not (np.isfinite(top) and np.isfinite(bottom) and top >= 0 and bottom >= 0):
+        raise UsageError(f"Expected `top` and `bottom` to be finite lengths ≥ 0 in m, got {top}, {bottom}")
+    if int(band_cells) < 1000:
+        raise UsageError(f"Expected `band_cells` of at least 1000, got {band_cells}")
+    v = np.ascontiguousarray(vertices, dtype=np.float64)
+    f = np.ascontiguousarray(faces, dtype=np.int64)
+    o = np.asarray(origin, dtype=np.float64)
+    lo, hi = v.min(axis=0) + t, v.max(axis=0) - t
+    empty = CoreMoments(depth=t, origin=o, volume=0.0, volume_bounds=np.zeros(2), first_moment=np.zeros(3),
+                        first_moment_bound=0.0, second_moment=np.zeros((3, 3)), second_moment_bound=0.0,
+                        cell_size=0.0, band_cells=0)
+    if np.any(hi <= lo) or max(top, bottom) <= t:       # a ball of radius t in X holds the segment: D is empty
+        return empty
+    extent = hi - lo
+    h = float(np.prod(extent) / _FIRST_GRID_CELLS) ** (1.0 / 3.0)
+    h = max(h, float(extent.max()) / 256.0)
+    counts = np.maximum(np.ceil(extent / h).astype(np.int64), 1)
+    start = lo + 0.5 * (extent - counts * h)
+    axes = [start[k] + h * (np.arange(counts[k]) + 0.5) for k in range(3)]
+    centres = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    # refined while the next level's undecided cells stay within the budget (the zone is often a thin slab,
+    # far smaller than the surface's area suggests)
+    finest = 0.0
+
+    import igl
+    tree = igl.AABB()
+    tree.init(v, f)
+
+    def distance(points: np.ndarray) -> np.ndarray:
+        out = np.empty(len(points))
+        for a in range(0, len(points), _VERTICAL_QUERY_BATCH):
+            out[a:a + _VERTICAL_QUERY_BATCH] = _signed_distance(points[a:a + _VERTICAL_QUERY_BATCH], v, f,
+                                                                np.inf)[0]
+        return out
+
+    volume, first, second = 0.0, np.zeros(3), np.zeros((3, 3))
+    undecided_volume = first_bound = second_bound = 0.0
+    n_band = 0
+
+    def add(c: np.ndarray, size: float) -> tuple[float, np.ndarray, np.ndarray]:
+        x = c - o
+        cell = size ** 3
+        return (cell * len(c), cell * x.sum(axis=0),
+                cell * (x.T @ x) + cell * len(c) * size * size / 12.0 * np.eye(3))
+
+    for level in range(_MAX_LEVELS + 1):
+        r = 0.5 * np.sqrt(3.0) * h
+        d_c = distance(centres)
+        in_core = d_c - t >= r
+        maybe = d_c - t > -r
+        centres, d_c, in_core = centres[maybe], d_c[maybe], in_core[maybe]
+        j_lo, j_hi = -int(np.ceil(bottom / h)) - 1, int(np.ceil(top / h)) + 1
+        # the cubes Q + j h e_z cover Q + S (one more each way, for the column estimate below); those with
+        # (1 − bottom/h) ≤ j ≤ (top/h − 1) lie in q + S for every q in Q
+        column = np.empty((len(centres), j_hi - j_lo + 1))
+        stays = np.ones(len(centres), dtype=bool)
+        leaves = np.zeros(len(centres), dtype=bool)
+        for j in range(j_lo, j_hi + 1):
+            d_j = d_c if j == 0 else distance(centres + [0.0, 0.0, j * h])
+            column[:, j - j_lo] = d_j
+            if -bottom / h - 1.0 <= j <= top / h + 1.0 and j_lo < j < j_hi:
+                stays &= d_j >= r
+            if 1.0 - bottom / h <= j <= top / h - 1.0:
+                leaves |= d_j <= -r
+        candidates = np.nonzero(in_core & ~leaves & ~stays)[0]
+        if len(candidates):
+            leaves[candidates] = _crosses_surface(tree, v, f, centres[candidates], h, top, bottom)
+        certain = in_core & leaves
+        undecided = ~certain & ~stays
+        dv, ds, dj = add(centres[certain], h)
+        volume, first, second = volume + dv, first + ds, second + dj
+        n_undecided = int(np.count_nonzero(undecided))
+        last = h <= finest or level == _MAX_LEVELS or 8 * n_undecided > int(band_cells)
+        if not last:
+            kids = np.array(list(itertools.product((-0.25, 0.25), repeat=3))) * h
+            centres = (centres[undecided][:, None, :] + kids[None, :, :]).reshape(-1, 3)
+            h *= 0.5
+            continue
+        c = centres[undecided]
+        n_band = len(c)
+        certain_volume = volume
+        fraction = _column_fraction(column[undecided], j_lo, h, t, top, bottom)
+        dv, ds, dj = _add_weighted(c, h, fraction, o)
+        volume, first, second = volume + dv, first + ds, second + dj
+        cell = h ** 3
+        reach_o = np.linalg.norm(c - o, axis=1) + r
+        undecided_volume = cell * n_band
+        first_bound = float(cell * reach_o.sum())
+        second_bound = float(cell * (reach_o * reach_o).sum())
+        break
+    else:                                        # pragma: no cover - the loop always ends at its last level
+        certain_volume = volume
+    return CoreMoments(depth=t, origin=o, volume=volume,
+                       volume_bounds=np.array([certain_volume, certain_volume + undecided_volume]),
                        first_moment=first, first_moment_bound=first_bound, second_moment=0.5 * (second + second.T),
                        second_moment_bound=second_bound, cell_size=h, band_cells=n_band)

@@ -42,7 +42,7 @@ from ..mesh.prepare import prepare_mesh
 from ..mesh.read import load_mesh
 from .pipeline import MeshSource, resolve_density
 from .properties import MassProperties
-from .offset import DEFAULT_BAND_CELLS, core_moments
+from .offset import DEFAULT_BAND_CELLS, CoreMoments, core_moments, vertical_skin_moments
 from .surface import shell_inertia, surface_moments
 from ..integrals import second_moment_to_inertia, volume_moments
 
@@ -153,6 +153,8 @@ class PrintedPart:
         moment.
     cell_size : float
         Edge of the finest cells of the core's integration, m (0 when none was needed).
+    top, bottom : float
+        Vertical thickness of the solid top and bottom layers, m (0: the skin alone; see ``printed_part``).
     """
 
     properties: MassProperties
@@ -165,12 +167,14 @@ class PrintedPart:
     center_of_mass_error_bound: float
     inertia_error_bound: float
     cell_size: float
+    top: float = 0.0
+    bottom: float = 0.0
 
 
 def printed_part(source: MeshSource, *, skin: float, infill: float, density: float | None = None,
                  material: str | None = None, mass: float | None = None, name: str | None = None,
                  band_cells: int = DEFAULT_BAND_CELLS, options: LoadOptions | None = None,
-                 **load_options: Any) -> PrintedPart:
+                 top: float | None = None, bottom: float | None = None, **load_options: Any) -> PrintedPart:
     """Mass properties of a 3D-printed part: solid skin of thickness ``skin``, core filled to ``infill``.
 
     The skin is the part less its inward offset by ``skin`` (every point within ``skin`` of the surface); the
@@ -200,6 +204,12 @@ def printed_part(source: MeshSource, *, skin: float, infill: float, density: flo
         Resolution of the core's integration (see ``offset.core_moments``): more is slower and tighter.
     options : LoadOptions, optional
         How to read and check the mesh.
+    top, bottom : float, optional
+        Vertical thickness (m) of the solid top and bottom layers as a slicer makes them (layers × layer
+        height): every point of the core within ``top`` below an up-facing surface, or within ``bottom`` above a
+        down-facing one, measured vertically, is solid too (``offset.vertical_skin_moments``).  A thickness up
+        to ``skin`` adds nothing (the skin already holds it).  The bracket of that integration joins the
+        bounds; it assumes only a closed, consistently oriented mesh.
     **load_options
         Fields of :class:`~inertia_tool.mesh.options.LoadOptions`, overriding those of ``options``.
 
@@ -226,6 +236,11 @@ def printed_part(source: MeshSource, *, skin: float, infill: float, density: flo
     o = solid.centroid
     rho_used = rho if rho is not None else 1.0
     core = core_moments(v, f, s, origin=o, band_cells=band_cells) if f_in < 1.0 else None
+    top_m = 0.0 if top is None else _non_negative_length(top, "top")
+    bottom_m = 0.0 if bottom is None else _non_negative_length(bottom, "bottom")
+    if core is not None and max(top_m, bottom_m) > s:
+        core = _less_layers(core, vertical_skin_moments(v, f, s, top=top_m, bottom=bottom_m, origin=o,
+                                                        band_cells=band_cells))
     void = 1.0 - f_in
     if core is None or core.volume_bounds[1] == 0.0:            # solid throughout: exact
         vc, sc, jc, b_v, b_s, b_j, cell = 0.0, np.zeros(3), np.zeros((3, 3)), 0.0, 0.0, 0.0, 0.0
@@ -275,4 +290,24 @@ def printed_part(source: MeshSource, *, skin: float, infill: float, density: flo
     return PrintedPart(properties=props, skin=s, infill=f_in, envelope_volume=solid.volume, core_volume=vc,
                        skin_volume=solid.volume - vc, mass_error_bound=bound_m / total,
                        center_of_mass_error_bound=float(com_bound), inertia_error_bound=float(inertia_bound),
-                       cell_size=cell)
+                       cell_size=cell, top=top_m, bottom=bottom_m)
+
+
+def _non_negative_length(value: Any, name: str) -> float:
+    length = float(value)
+    if not (np.isfinite(length) and length >= 0):
+        raise UsageError(f"Expected `{name}` to be a finite length ≥ 0 in m, got {value!r}")
+    return length
+
+
+def _less_layers(core: CoreMoments, layers: CoreMoments) -> CoreMoments:
+    """The core's moments less those of the part the top/bottom layers make solid; brackets add (the two
+    integrations' errors are independent bounds)."""
+    low = core.volume_bounds[0] - layers.volume_bounds[1]
+    high = core.volume_bounds[1] - layers.volume_bounds[0]
+    return dataclasses.replace(core, volume=core.volume - layers.volume,
+                               volume_bounds=np.array([max(low, 0.0), max(high, 0.0)]),
+                               first_moment=core.first_moment - layers.first_moment,
+                               first_moment_bound=core.first_moment_bound + layers.first_moment_bound,
+                               second_moment=core.second_moment - layers.second_moment,
+                               second_moment_bound=core.second_moment_bound + layers.second_moment_bound)

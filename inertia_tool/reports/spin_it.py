@@ -71,6 +71,7 @@ def spin_it_dict(result, *, output: str | None = None) -> dict:
                   mass_properties_dict(result.after)},
         "insert": None if result.insert is None else {
             "density_kg_m3": result.insert_density, "volume_m3": result.insert.volume, "mass_kg": result.insert.mass,
+            "shape": getattr(result, "insert_shape", None),
             "mass_properties": mass_properties_dict(result.insert)},
         "output": output,
         "verified": _verified(result.after),
@@ -147,9 +148,12 @@ def format_spin_it_text(result, *, name: str = "", output: str | None = None) ->
              "  every 'after' number is the exact re-analysis of the hollowed mesh", ""]
     if result.insert is not None:
         lines.insert(5, f"  insert: {result.insert.volume * 1e6:.4g} cm³ of {result.insert_density:g} kg/m³ "
-                        f"({result.insert.mass * 1e3:.4g} g), a second quadric region; 'after' includes it")
+                        f"({result.insert.mass * 1e3:.4g} g), "
+                        + ("a ring about the spin axis" if getattr(result, "insert_shape", None) == "ring" else
+                           "a second quadric region") + "; 'after' includes it")
     elif result.insert_density is not None:
-        lines.insert(5, f"  insert of {result.insert_density:g} kg/m³ allowed, but none helps: cavity only")
+        lines.insert(5, f"  insert of {result.insert_density:g} kg/m³ allowed (a quadric region and a ring about the "
+                        "axis tried, meshed and re-analysed), but none helps: cavity only")
     rows = _rows(result)
     width = max(len(r[0]) for r in rows)
     col = max(len(r[1]) for r in rows) + 2
