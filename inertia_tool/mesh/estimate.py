@@ -232,7 +232,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
-    edges = boundary_edges(f, len(v))
+    edges = seal.boundary if seal is not None else boundary_edges(f, len(v))
     label, n_loops = _loops(edges, len(v)) if len(edges) else (np.zeros(0, dtype=np.int64), 0)
     # the distinct vertices of each loop, grouped: (loop, vertex) pairs sorted by loop
     pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0) if n_loops \

@@ -22,7 +22,7 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -30,10 +30,11 @@ from ..values import frozen_value
 from ..errors import InvalidMeshError
 from ..tolerances import FLAT_RTOL
 from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
-
-if TYPE_CHECKING:
-    from .estimate import Estimate
-    from .orient import EdgeBalance
+from .estimate import Estimate, check_useful, patched_estimate, winding_estimate
+from .seal import drop_duplicate_faces, seal_seams
+from .merge import merge_close_vertices
+from .edges import edge_keys
+from .orient import EdgeBalance, edge_balance, orient_consistently
 
 __all__ = ["Resolution", "resolve_surface", "REPAIR_RULE"]
 
@@ -85,6 +86,35 @@ class Resolution:
     estimate: Estimate | None = None
 
 
+@frozen_value
+class _Census:
+    """One sort of the directed edges: the balance, the manifold edges whose two faces disagree, and the
+    vertices of unbalanced edges."""
+
+    balance: EdgeBalance
+    misoriented_pairs: int
+    unbalanced_vertices: np.ndarray
+
+
+def _census(faces: np.ndarray, n_vertices: int) -> _Census:
+    if len(faces) == 0:
+        return _Census(EdgeBalance(0, 0, 0, 0), 0, np.zeros(0, dtype=np.int64))
+    key, forward = edge_keys(faces, n_vertices)
+    order = np.argsort(key, kind="stable")
+    key = key[order]
+    fwd = forward[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    count = np.diff(np.r_[starts, len(key)])
+    net = np.add.reduceat(np.where(fwd, 1, -1).astype(np.int64), starts)
+    pair = starts[count == 2]
+    misoriented = int(np.count_nonzero(fwd[pair] == fwd[pair + 1]))
+    bad = key[starts[net != 0]]
+    nv = np.int64(max(int(n_vertices), 1))
+    balance = EdgeBalance(edges=len(starts), boundary_edges=int(np.count_nonzero(count == 1)),
+                          nonmanifold_edges=int(np.count_nonzero(count > 2)), unbalanced_edges=len(bad))
+    return _Census(balance, misoriented, np.r_[bad // nv, bad % nv])
+
+
 def _drop_collapsed(faces: np.ndarray) -> np.ndarray:
     collapsed = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0])
     kept: np.ndarray = faces[~collapsed]
@@ -116,17 +146,6 @@ def _touching_note(census: EdgeBalance) -> tuple[str, ...]:
         return ()
     return (f"{census.nonmanifold_edges:,} non-manifold edges where bodies or walls meet (each edge used equally "
             "in both directions, so the integral is exact)",)
-
-
-def _dedupe(faces: np.ndarray) -> tuple[np.ndarray, int]:
-    """Drop repeated copies of a face (same corners, same winding); a face and its reverse both stay."""
-    f = np.asarray(faces)
-    roll = np.argmin(f, axis=1)
-    idx = (roll[:, None] + np.arange(3)) % 3
-    canon = np.take_along_axis(f, idx, axis=1)       # rotated to start at the smallest index: keeps winding
-    _, first = np.unique(canon, axis=0, return_index=True)
-    first = np.sort(first)
-    return f[first], len(f) - len(first)
 
 
 def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
@@ -165,15 +184,11 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     InvalidMeshError
         Without ``repair`` when no exact reading exists; with it when nothing encloses a volume.
     """
-    # imported on use: a surface that passes the manifold check (nearly every file) never comes here
-    from .estimate import check_useful, winding_estimate
-    from .merge import merge_close_vertices
-    from .orient import edge_balance, orient_consistently
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     n = len(v)
-    census = edge_balance(f, n)
     if force_estimate:
+        census = edge_balance(f, n)
         grid = winding_estimate(v, f)
         why = reason or "the bodies overlap and their union could not be formed"
         hint = ("`overlap` 'sum' adds the bodies (shared volume counted twice)" if reason is None else
@@ -182,31 +197,43 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                      what=f"the winding-number estimate ({why})", why=hint)
         return Resolution(v, f, grid.method, (why, grid.detail),
                           0, None, census.nonmanifold_edges, estimate=grid)
+    found = _census(f, n)
+    census = found.balance
     if census.balanced:
         return Resolution(v, f, "exact", _touching_note(census), 0, None, census.nonmanifold_edges)
-    oriented = orient_consistently(f, n, v)
-    census = edge_balance(oriented.faces, n)
-    if census.balanced:
-        notes = (f"{oriented.flipped_faces:,} faces were wound the wrong way and were turned",) + _touching_note(census)
-        return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
-                          census.nonmanifold_edges)
+    current, flipped = f, 0
+    if found.misoriented_pairs:     # else orienting would turn nothing (each patch already agrees with itself)
+        oriented = orient_consistently(f, n, v)
+        found = _census(oriented.faces, n)
+        census = found.balance
+        if census.balanced:
+            notes = (f"{oriented.flipped_faces:,} faces were wound the wrong way and were turned",) + \
+                _touching_note(census)
+            return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
+                              census.nonmanifold_edges)
+        current, flipped = oriented.faces, oriented.flipped_faces
     welded = None
-    current, flipped = oriented.faces, oriented.flipped_faces
     if merge_tolerance and merge_tolerance > 0:
         tol = merge_tolerance * diag
-        merged = merge_close_vertices(v, f, tol)
+        # only vertices of unbalanced edges: merging vertices whose edges all balance cannot balance anything
+        merged = merge_close_vertices(v, f, tol, among=found.unbalanced_vertices)
         if merged.merged_vertices:
             welded_faces = _drop_collapsed(merged.faces)
             if len(welded_faces):
-                again = orient_consistently(welded_faces, n, v)
-                census = edge_balance(again.faces, n)
-                current, flipped, welded = again.faces, again.flipped_faces, tol
+                again = _census(welded_faces, n)
+                turned = orient_consistently(welded_faces, n, v) if again.misoriented_pairs else None
+                if turned is not None:
+                    again = _census(turned.faces, n)
+                census, found = again.balance, again
+                current = turned.faces if turned is not None else welded_faces
+                flipped = turned.flipped_faces if turned is not None else 0
+                welded = tol
                 if census.balanced:
                     notes = (f"{merged.merged_vertices:,} vertices within {tol:.3g} m of another were merged "
                              f"(largest move {merged.largest_move:.3g} m)",)
-                    if again.flipped_faces:
-                        notes += (f"{again.flipped_faces:,} faces were wound the wrong way and were turned",)
-                    return Resolution(v, again.faces, "welded", notes + _touching_note(census), again.flipped_faces,
+                    if flipped:
+                        notes += (f"{flipped:,} faces were wound the wrong way and were turned",)
+                    return Resolution(v, current, "welded", notes + _touching_note(census), flipped,
                                       tol, census.nonmanifold_edges)
     if not repair:
         raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}; "
@@ -219,7 +246,9 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         repair_notes.append(f"vertices within {welded:.3g} m of another were merged")
     if flipped:
         repair_notes.append(f"{flipped:,} faces were turned to agree with their neighbours")
-    unique, dropped = _dedupe(current)
+    # a repeated face uses each of its edges twice in one direction: a misoriented pair or a non-manifold edge
+    maybe_repeated = found.misoriented_pairs or census.nonmanifold_edges
+    unique, dropped = drop_duplicate_faces(current) if maybe_repeated else (current, 0)
     if dropped:
         repair_notes.append(f"{dropped:,} duplicated faces were dropped")
         census = edge_balance(unique, n)
@@ -246,31 +275,11 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                       else census.nonmanifold_edges, estimate=best)
 
 
-def _loose_share(faces: np.ndarray) -> float:
-    """Share of the faces that share no edge with another face (loose triangles of a soup)."""
-    if not len(faces):
-        return 1.0
-    edges = np.sort(np.asarray(faces, dtype=np.int64)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    key = edges[:, 0] * (int(edges.max()) + 1) + edges[:, 1]
-    _, inverse, counts = np.unique(key, return_inverse=True, return_counts=True)
-    alone = (counts[inverse.reshape(-1)] == 1).reshape(-1, 3).all(axis=1)
-    return float(np.count_nonzero(alone)) / len(faces)
-
-
 def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, *, diag: float,
                        moments: Callable[..., Any], seam_gap_rtol: float = SEAM_GAP_RTOL,
                        soup_share: float = SOUP_BOUNDARY_SHARE) -> Estimate:
     """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed."""
-    from .estimate import patched_estimate, winding_estimate
-    from .seal import Seal, seal_seams
-    sealed = seal_seams(vertices, faces, seam_gap_rtol * diag)
-    if _loose_share(sealed.faces) > soup_share:
+    seal = seal_seams(vertices, faces, seam_gap_rtol * diag)
+    if not len(seal.faces) or seal.loose_faces > soup_share * len(seal.faces):
         return winding_estimate(vertices, faces)
-    kept, _ = _dedupe(sealed.faces) if sealed.welded or sealed.split else (sealed.faces, 0)
-    if len(kept) != len(sealed.faces):
-        # duplicates the weld made: the sealed faces' slack is kept for the faces that remain (a superset bound)
-        seal = Seal(kept, np.full(len(kept), float(sealed.slack.max(initial=0.0))), sealed.dropped_doubt,
-                    sealed.welded, sealed.split)
-    else:
-        seal = sealed
     return patched_estimate(vertices, seal.faces, moments, seal=seal)
