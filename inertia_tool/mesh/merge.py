@@ -109,7 +109,8 @@ def _groups(points: np.ndarray, tolerance: float) -> np.ndarray | None:
         if not len(pairs):
             return None
         graph = coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(k, k))
-        return connected_components(graph, directed=False)[1]
+        labels: np.ndarray = connected_components(graph, directed=False)[1]
+        return labels
     c = cells.astype(np.int64)
     key = (c[:, 0] << 42) | (c[:, 1] << 21) | c[:, 2]
     order = np.argsort(key, kind="stable")
