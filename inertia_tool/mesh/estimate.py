@@ -169,17 +169,57 @@ def enclosing_balls(points: np.ndarray, group: np.ndarray, n_groups: int, *, ite
     order = np.argsort(g, kind="stable")
     p, g = p[order], g[order]
     starts = np.searchsorted(g, np.arange(n_groups))
+    size = np.diff(np.r_[starts, len(p)])
     lo = np.minimum.reduceat(p, starts, axis=0)
     hi = np.maximum.reduceat(p, starts, axis=0)
     centre = 0.5 * (lo + hi)
-    index = np.arange(len(p))
-    for k in range(1, iterations + 1):
-        d = np.einsum("ij,ij->i", p - centre[g], p - centre[g])
-        top = np.maximum.reduceat(d, starts)
-        far = np.minimum.reduceat(np.where(d >= top[g], index, len(p)), starts)
-        centre = centre + (p[far] - centre) / (k + 1)
+    small = size <= 3
+    if small.any():           # one, two or three points: the smallest ball in closed form
+        centre[small] = _small_ball_centres(p, starts[small], size[small])
+    big = np.flatnonzero(~small)
+    if len(big):              # Bădoiu–Clarkson on the larger groups only
+        pick = np.repeat(starts[big], size[big]) + (np.arange(int(size[big].sum()))
+                                                    - np.repeat(np.cumsum(size[big]) - size[big], size[big]))
+        q, local = p[pick], np.repeat(np.arange(len(big)), size[big])
+        local_starts = np.r_[0, np.cumsum(size[big])[:-1]]
+        c = centre[big]
+        index = np.arange(len(q))
+        for k in range(1, iterations + 1):
+            d = np.einsum("ij,ij->i", q - c[local], q - c[local])
+            top = np.maximum.reduceat(d, local_starts)
+            far = np.minimum.reduceat(np.where(d >= top[local], index, len(q)), local_starts)
+            c = c + (q[far] - c) / (k + 1)
+        centre[big] = c
     radius = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", p - centre[g], p - centre[g]), starts))
     return centre, radius
+
+
+def _small_ball_centres(p: np.ndarray, starts: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Centres of the smallest balls around groups of 1–3 consecutive points of ``p`` (the radius is taken
+    afterwards as the largest distance, so round-off here cannot make a ball miss a point)."""
+    a = p[starts]
+    b = p[starts + np.minimum(size - 1, 1)]
+    c = p[starts + np.minimum(size - 1, 2)]
+    centre = 0.5 * (a + b)                         # one or two points: the midpoint
+    tri = size == 3
+    if tri.any():
+        a3, b3, c3 = a[tri], b[tri], c[tri]
+        sides = np.stack([np.linalg.norm(b3 - c3, axis=1), np.linalg.norm(c3 - a3, axis=1),
+                          np.linalg.norm(a3 - b3, axis=1)], axis=1)
+        longest = np.argmax(sides, axis=1)
+        ends = np.stack([0.5 * (b3 + c3), 0.5 * (c3 + a3), 0.5 * (a3 + b3)], axis=1)
+        mid = ends[np.arange(len(a3)), longest]
+        # circumcentre (a + (|u|²(v × w)... ) with u = b − a, v = c − a, w = u × v)
+        u, v = b3 - a3, c3 - a3
+        w = np.cross(u, v)
+        ww = np.einsum("ij,ij->i", w, w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            circ = a3 + (np.einsum("ij,ij->i", u, u)[:, None] * np.cross(v, w)
+                         + np.einsum("ij,ij->i", v, v)[:, None] * np.cross(w, u)) / (2 * ww[:, None])
+        la, lb, lc = sides[:, 0] ** 2, sides[:, 1] ** 2, sides[:, 2] ** 2
+        obtuse = (la >= lb + lc) | (lb >= la + lc) | (lc >= la + lb) | ~(ww > 0)
+        centre[tri] = np.where(obtuse[:, None], mid, circ)
+    return centre
 
 
 def check_useful(estimate_volume: float, unc: Uncertainty, *, source: str, what: str,
