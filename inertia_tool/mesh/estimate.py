@@ -200,7 +200,7 @@ def _small_ball_centres(p: np.ndarray, starts: np.ndarray, size: np.ndarray) -> 
     a = p[starts]
     b = p[starts + np.minimum(size - 1, 1)]
     c = p[starts + np.minimum(size - 1, 2)]
-    centre = 0.5 * (a + b)                         # one or two points: the midpoint
+    centre: np.ndarray = 0.5 * (a + b)             # one or two points: the midpoint
     tri = size == 3
     if tri.any():
         a3, b3, c3 = a[tri], b[tri], c[tri]
