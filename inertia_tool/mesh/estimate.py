@@ -142,15 +142,16 @@ def boundary_edges(faces: np.ndarray, n_vertices: int) -> np.ndarray:
     return np.stack([np.repeat(start, reps), np.repeat(end, reps)], axis=1)
 
 
-def _loops(edges: np.ndarray, n_vertices: int, faces: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+def _loops(edges: np.ndarray, n_vertices: int, faces: np.ndarray | None = None,
+           vertices: np.ndarray | None = None) -> tuple[np.ndarray, int]:
     """Loop of each boundary edge: the cycles of the boundary, separated at pinch vertices where ``faces`` tell
     how (else the components of edges connected through shared vertices).
 
     At a vertex where two holes meet (in-degree 2 or more), the fans of faces around it tell which in-edge
     continues into which out-edge: a fan starts with an out-edge and ends with an in-edge, each next to a
-    different hole, so a hole's rim runs from the in-edge of one fan into the out-edge of *another*.  With two
-    fans that pairing is determined; with more (several holes at one corner, rare) the fans are paired in turn,
-    which still makes closed cycles.  Each cycle then gets its own cone, and two cones never share an edge
+    different hole, so a hole's rim runs from the in-edge of one fan into the out-edge of the next fan around
+    the vertex (with two fans, the other one; with more, the next by the angle of their out-edges about the
+    vertex normal).  Each cycle then gets its own cone, and two cones never share an edge
     (a shared apex edge would be non-manifold, and send the patched surface to the boolean union).
     """
     from scipy.sparse import coo_matrix
@@ -163,8 +164,8 @@ def _loops(edges: np.ndarray, n_vertices: int, faces: np.ndarray | None = None) 
     in_deg = np.bincount(edges[:, 1], minlength=n)
     pinch = in_deg > 1
     nxt = _successors(edges, n)
-    if faces is not None and pinch.any():
-        paired = _pinch_successors(edges, faces, n, pinch)
+    if faces is not None and vertices is not None and pinch.any():
+        paired = _pinch_successors(edges, faces, n, pinch, vertices)
         if paired is not None:
             nxt = np.where(paired >= 0, paired, nxt)
     if (nxt < 0).any():       # no consistent pairing: components through shared vertices
@@ -185,7 +186,8 @@ def _successors(edges: np.ndarray, n: int) -> np.ndarray:
     return np.where(ok, order[np.minimum(first, len(edges) - 1)], -1)
 
 
-def _pinch_successors(edges: np.ndarray, faces: np.ndarray, n: int, pinch: np.ndarray) -> np.ndarray | None:
+def _pinch_successors(edges: np.ndarray, faces: np.ndarray, n: int, pinch: np.ndarray,
+                      vertices: np.ndarray) -> np.ndarray | None:
     """Successor of each in-edge at a pinch vertex (-1 for the others), from the fans around the vertex; None
     when the fans do not give one in- and one out-edge each (then the caller keeps whole components)."""
     from scipy.sparse import coo_matrix
@@ -214,9 +216,21 @@ def _pinch_successors(edges: np.ndarray, faces: np.ndarray, n: int, pinch: np.nd
     fan_in = _lookup(in_key, fan, edges[e_in, 1] * n + edges[e_in, 0])
     if fan_out is None or fan_in is None:
         return None
-    # per pinch vertex: in-edges and out-edges sorted by fan; in-edge of fan i → out-edge of the next fan
-    oi = np.lexsort((fan_in, edges[e_in, 1]))
-    oo = np.lexsort((fan_out, edges[e_out, 0]))
+    # fans in turn around the vertex (angle of their out-edge about the vertex normal, the faces' winding
+    # sense): a fan runs from its out-edge to its in-edge, then comes a hole, then the next fan's out-edge
+    normal = np.zeros((n, 3))
+    area = np.cross(vertices[nxt_v] - vertices[p], vertices[prv_v] - vertices[p])
+    np.add.at(normal, p, area)
+    nrm = normal[edges[e_out, 0]]
+    trial = np.where(np.abs(nrm[:, :1]) < 0.9 * np.linalg.norm(nrm, axis=1, keepdims=True), [[1.0, 0, 0]],
+                     [[0, 1.0, 0]])
+    u = np.cross(nrm, trial)
+    w = np.cross(nrm, u)
+    d = vertices[edges[e_out, 1]] - vertices[edges[e_out, 0]]
+    angle_by_fan = np.zeros(len(fi))
+    angle_by_fan[fan_out] = np.arctan2(np.einsum("ij,ij->i", d, w), np.einsum("ij,ij->i", d, u))
+    oi = np.lexsort((angle_by_fan[fan_in], edges[e_in, 1]))
+    oo = np.lexsort((angle_by_fan[fan_out], edges[e_out, 0]))
     vin, vout = edges[e_in[oi], 1], edges[e_out[oo], 0]
     if len(vin) != len(vout) or (vin != vout).any() or (fan_in[oi] != fan_out[oo]).any():
         return None           # not one in- and one out-edge per fan
@@ -364,7 +378,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     edges = seal.boundary if seal is not None else boundary_edges(f, len(v))
-    label, n_loops = _loops(edges, len(v), f) if len(edges) else (np.zeros(0, dtype=np.int64), 0)
+    label, n_loops = _loops(edges, len(v), f, v) if len(edges) else (np.zeros(0, dtype=np.int64), 0)
     # the distinct vertices of each loop, grouped: (loop, vertex) pairs sorted by loop
     pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0) if n_loops \
         else np.zeros((0, 2), dtype=np.int64)
