@@ -45,8 +45,11 @@ sys.path.insert(0, HERE)
 from bench_scaling import write_torus  # noqa: E402
 
 _COMMON = r"""
-import json, sys, time
+import json, resource, sys, time
 t0 = time.perf_counter()
+def cpu():
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
 def peak():
     with open("/proc/self/status") as fh:
         for line in fh:
@@ -56,7 +59,8 @@ def peak():
 def report(t1, volume, com, inertia):
     import numpy as np
     t2 = time.perf_counter()
-    print(json.dumps({"total": t2 - t0, "compute": t2 - t1, "peak": peak(), "volume": float(volume),
+    print(json.dumps({"total": t2 - t0, "compute": t2 - t1, "cpu": cpu(), "cpu_compute": cpu() - c1,
+                      "peak": peak(), "volume": float(volume),
                       "com": [float(x) for x in np.asarray(com).reshape(3)],
                       "inertia": [float(x) for x in np.asarray(inertia).reshape(9)]}))
 """
@@ -67,6 +71,7 @@ PEERS = {
 import warnings
 from inertia_tool import mass_properties
 t1 = time.perf_counter()
+c1 = cpu()
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     mp = mass_properties(sys.argv[1], density=1.0, units="mm")
@@ -75,6 +80,7 @@ report(t1, mp.mass * 1e9, mp.center_of_mass * 1e3, mp.inertia * 1e15)
     "trimesh": _COMMON + r"""
 import trimesh
 t1 = time.perf_counter()
+c1 = cpu()
 m = trimesh.load(sys.argv[1])
 p = m.mass_properties
 report(t1, p["volume"], p["center_mass"], p["inertia"])
@@ -82,6 +88,7 @@ report(t1, p["volume"], p["center_mass"], p["inertia"])
     "trimesh process=False": _COMMON + r"""
 import trimesh
 t1 = time.perf_counter()
+c1 = cpu()
 m = trimesh.load(sys.argv[1], process=False)
 p = m.mass_properties
 report(t1, p["volume"], p["center_mass"], p["inertia"])
@@ -89,6 +96,7 @@ report(t1, p["volume"], p["center_mass"], p["inertia"])
     "numpy-stl": _COMMON + r"""
 from stl import mesh
 t1 = time.perf_counter()
+c1 = cpu()
 m = mesh.Mesh.from_file(sys.argv[1], calculate_normals=False)
 volume, cog, inertia = m.get_mass_properties()
 report(t1, volume, cog, inertia)
@@ -97,6 +105,7 @@ report(t1, volume, cog, inertia)
 import mujoco
 import numpy as np
 t1 = time.perf_counter()
+c1 = cpu()
 spec = mujoco.MjSpec()
 part = spec.add_mesh()
 part.name = "part"
@@ -158,11 +167,11 @@ def plot(rows: list[dict], out: str) -> None:
         pts = [(r["faces"], r["peers"][peer]["total"]) for r in rows if "total" in r["peers"].get(peer, {})]
         if pts:
             ax_t.loglog(*zip(*pts), style, color=colour, label=peer)
-        pts = [(r["faces"], r["peers"][peer]["compute"]) for r in rows if "total" in r["peers"].get(peer, {})]
+        pts = [(r["faces"], r["peers"][peer]["cpu"]) for r in rows if "cpu" in r["peers"].get(peer, {})]
         if pts:
             ax_c.loglog(*zip(*pts), style, color=colour, label=peer)
-    ax_t.set(xlabel="triangles", ylabel="wall time, s (fresh process, imports included)", title="Whole run")
-    ax_c.set(xlabel="triangles", ylabel="wall time after imports, s", title="Read + mass properties")
+    ax_t.set(xlabel="triangles", ylabel="wall time, s (fresh process, imports included)", title="Wall time")
+    ax_c.set(xlabel="triangles", ylabel="CPU time, s (user + system, all threads)", title="CPU time")
     for ax in (ax_t, ax_c):
         ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=8)
@@ -172,7 +181,8 @@ def plot(rows: list[dict], out: str) -> None:
 
 
 def table(rows: list[dict], load: tuple[float, float], key: str = "total") -> str:
-    """The README table: each peer's time (``key``: "total" or "compute") and its ratio to ours."""
+    """The README table: each peer's time (``key``: "total" or "compute" wall time, "cpu" or "cpu_compute" CPU
+    time of the process) and its ratio to ours."""
     peers = [p for p in PEERS if p != "inertia_tool"]
     head = "| faces | STL | inertia_tool | " + " | ".join(peers) + " |"
     lines = [head, "|---:|---:|---:|" + "---:|" * len(peers)]
@@ -190,7 +200,9 @@ def table(rows: list[dict], load: tuple[float, float], key: str = "total") -> st
                 cells.append(f"{got[key]:.2f} s")
         lines.append("| " + " | ".join(cells) + " |")
     lines.append("")
-    what = "imports included" if key == "total" else "after the imports (read + mass properties)"
+    what = {"total": "wall time, imports included", "compute": "wall time after the imports (read + mass properties)",
+            "cpu": "CPU time of the whole process (user + system, all threads), imports included",
+            "cpu_compute": "CPU time after the imports"}[key]
     lines.append(f"Fresh process per run, {what}, best of the repeats; (n×) = the peer's time / "
                  f"inertia_tool's, from this one run. Load average {load[0]:.2f} before, {load[1]:.2f} after, "
                  f"{os.cpu_count()} CPUs.")
@@ -222,8 +234,8 @@ def main() -> None:
             t = time.perf_counter()
             got = run(peer, path, repeat, args.timeout) or {"error": "no output"}
             row["peers"][peer] = got
-            print(json.dumps({"faces": m, "peer": peer, "elapsed": round(time.perf_counter() - t, 2),
-                              **{k: got[k] for k in ("total", "compute", "peak", "error") if k in got}}),
+            shown = {k: got[k] for k in ("total", "compute", "cpu", "cpu_compute", "peak", "error") if k in got}
+            print(json.dumps({"faces": m, "peer": peer, "elapsed": round(time.perf_counter() - t, 2), **shown}),
                   flush=True)
         ours = row["peers"]["inertia_tool"]
         for peer, got in row["peers"].items():
@@ -253,8 +265,9 @@ def main() -> None:
                       f"{'agrees' if got['agrees'] else 'DISAGREES'}")
     print()
     print(table(rows, (load_before, load_after)))
-    print()
-    print(table(rows, (load_before, load_after), key="compute"))
+    for key in ("cpu", "compute", "cpu_compute"):
+        print()
+        print(table(rows, (load_before, load_after), key=key))
     if args.json:
         with open(args.json, "w") as fh:
             json.dump({"rows": rows, "load": [load_before, load_after]}, fh, indent=1)
