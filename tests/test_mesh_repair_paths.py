@@ -161,3 +161,25 @@ def test_scattered_holes_patch_without_nonmanifold_edges(seed):
     assert np.count_nonzero(np.bincount(rim[:, 1], minlength=len(v)) >= 2) > 5      # pinches are there
     assert census.nonmanifold_edges == 0
     assert abs(est.volume - volume_moments(v, f).volume) <= est.uncertainty.volume_in_doubt
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_resolution_counts_nonmanifold_edges_of_the_whole_patched_surface(seed):
+    from inertia_tool.integrals import volume_moments
+    from inertia_tool.mesh.orient import edge_balance
+    from inertia_tool.mesh.resolve import resolve_surface
+
+    rng = np.random.default_rng(seed)
+    v, f = _torus(30, 12)
+    # a second torus sharing one edge with the first far from the holes: a non-manifold edge away from the frontier
+    v2 = v + np.array([0.0, 0.0, 0.0])
+    f2 = f + len(v)
+    f2 = np.where(f2 == f[0, 0] + len(v), f[0, 0], f2)
+    f2 = np.where(f2 == f[0, 1] + len(v), f[0, 1], f2)
+    vv, ff = np.vstack([v, v2]), np.vstack([f, f2])
+    drop = rng.choice(np.arange(200, len(f)), int(rng.integers(1, 30)), replace=False)
+    ff = np.delete(ff, drop, axis=0)
+    diag = float(np.linalg.norm(vv.max(0) - vv.min(0)))
+    res = resolve_surface(vv, ff, diag=diag, source="t", repair=True, merge_tolerance=1e-6, moments=volume_moments)
+    assert res.method in ("patched", "sealed")
+    assert res.nonmanifold_edges == edge_balance(res.faces, len(res.vertices)).nonmanifold_edges

@@ -94,11 +94,14 @@ class _Census:
     balance: EdgeBalance
     misoriented_pairs: int
     unbalanced_vertices: np.ndarray
+    boundary: np.ndarray
+    nonmanifold_keys: np.ndarray
 
 
 def _census(faces: np.ndarray, n_vertices: int) -> _Census:
     if len(faces) == 0:
-        return _Census(EdgeBalance(0, 0, 0, 0), 0, np.zeros(0, dtype=np.int64))
+        none = np.zeros(0, dtype=np.int64)
+        return _Census(EdgeBalance(0, 0, 0, 0), 0, none, np.zeros((0, 2), dtype=np.int64), none)
     key, forward = edge_keys(faces, n_vertices)
     order = np.argsort(key, kind="stable")
     key = key[order]
@@ -108,11 +111,17 @@ def _census(faces: np.ndarray, n_vertices: int) -> _Census:
     net = np.add.reduceat(np.where(fwd, 1, -1).astype(np.int64), starts)
     pair = starts[count == 2]
     misoriented = int(np.count_nonzero(fwd[pair] == fwd[pair + 1]))
-    bad = key[starts[net != 0]]
+    unbalanced = net != 0
+    bad = key[starts[unbalanced]]
     nv = np.int64(max(int(n_vertices), 1))
     balance = EdgeBalance(edges=len(starts), boundary_edges=int(np.count_nonzero(count == 1)),
                           nonmanifold_edges=int(np.count_nonzero(count > 2)), unbalanced_edges=len(bad))
-    return _Census(balance, misoriented, np.r_[bad // nv, bad % nv])
+    # the boundary 1-chain as estimate.boundary_edges gives it: |net| copies of each edge in its net direction
+    lo, hi, k = bad // nv, bad % nv, net[unbalanced]
+    reps = np.abs(k)
+    boundary = np.stack([np.repeat(np.where(k > 0, hi, lo), reps), np.repeat(np.where(k > 0, lo, hi), reps)],
+                        axis=1)
+    return _Census(balance, misoriented, np.r_[lo, hi], boundary, key[starts[count > 2]])
 
 
 def _drop_collapsed(faces: np.ndarray) -> np.ndarray:
@@ -251,11 +260,12 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     unique, dropped = drop_duplicate_faces(current) if maybe_repeated else (current, 0)
     if dropped:
         repair_notes.append(f"{dropped:,} duplicated faces were dropped")
-        census = edge_balance(unique, n)
+        found = _census(unique, n)
+        census = found.balance
         if census.balanced:
             return Resolution(v, unique, "deduplicated", tuple(repair_notes) + _touching_note(census), flipped, welded,
                               census.nonmanifold_edges)
-    best = _repaired_estimate(v, unique, diag=diag, moments=moments)
+    best, front_nonmanifold = _repaired_estimate(v, unique, found, diag=diag, moments=moments)
     flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
     if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
@@ -267,19 +277,37 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     repair_notes.append(best.detail)
     if best.method == "patched" and best.uncertainty.volume_in_doubt == 0:
         # every seam sealed without moving anything and no hole left: the sealed polyhedron is the solid
-        sealed_faces = best.faces
-        return Resolution(best.vertices, sealed_faces, "sealed", tuple(repair_notes), flipped, welded,
-                          edge_balance(sealed_faces, len(best.vertices)).nonmanifold_edges)
+        return Resolution(best.vertices, best.faces, "sealed", tuple(repair_notes), flipped, welded,
+                          front_nonmanifold)
     return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
-                      edge_balance(best.faces, len(best.vertices)).nonmanifold_edges if best.method == "patched"
-                      else census.nonmanifold_edges, estimate=best)
+                      front_nonmanifold if best.method == "patched" else census.nonmanifold_edges, estimate=best)
 
 
-def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, *, diag: float,
+def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, *, diag: float,
                        moments: Callable[..., Any], seam_gap_rtol: float = SEAM_GAP_RTOL,
-                       soup_share: float = SOUP_BOUNDARY_SHARE) -> Estimate:
-    """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed."""
-    seal = seal_seams(vertices, faces, seam_gap_rtol * diag)
+                       soup_share: float = SOUP_BOUNDARY_SHARE) -> tuple[Estimate, int]:
+    """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed, and
+    the non-manifold edges of the surface it integrates (``found`` is the census of ``faces``)."""
+    seal = seal_seams(vertices, faces, seam_gap_rtol * diag, boundary=found.boundary)
     if not len(seal.faces) or seal.loose_faces > soup_share * len(seal.faces):
-        return winding_estimate(vertices, faces)
-    return patched_estimate(vertices, seal.faces, moments, seal=seal)
+        return winding_estimate(vertices, faces), found.balance.nonmanifold_edges
+    best = patched_estimate(vertices, seal.faces, moments, seal=seal)
+    # edges away from the frontier keep their count; the frontier's and the cones' are counted here
+    n = len(vertices)
+    region = np.zeros(n, dtype=bool)
+    region[found.boundary.reshape(-1)] = True
+    nv = np.int64(max(n, 1))
+    keys = found.nonmanifold_keys
+    away = int(np.count_nonzero(~(region[keys // nv] | region[keys % nv])))
+    near = np.vstack([seal.faces[seal.front_start:], best.faces[len(seal.faces):]])
+    key, _ = edge_keys(near, len(best.vertices))
+    key = np.sort(key)
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    count = np.diff(np.r_[starts, len(key)])
+    nb = np.int64(max(len(best.vertices), 1))
+    lo, hi = key[starts] // nb, key[starts] % nb
+    touching = np.zeros(len(best.vertices), dtype=bool)
+    touching[:n] = region
+    touching[n:] = True                       # the cones' apexes
+    counted = int(np.count_nonzero((count > 2) & (touching[lo] | touching[hi])))
+    return best, away + counted

@@ -61,6 +61,9 @@ class Seal:
         :func:`~.estimate.boundary_edges` gives it), found on the frontier.
     loose_faces : int
         Faces of ``faces`` sharing no edge with another face (loose triangles of a soup).
+    front_start : int
+        ``faces[front_start:]`` are the frontier (every face with a corner on an unbalanced edge), sealed; the
+        faces before it are untouched.
     duplicates : int
         Repeated copies of a face (same corners, same winding) that sealing made and that were dropped.
     """
@@ -73,6 +76,7 @@ class Seal:
     boundary: np.ndarray
     loose_faces: int = 0
     duplicates: int = 0
+    front_start: int = 0
 
     def doubt(self, vertices: np.ndarray) -> float:
         """Volume (m³) within which the sealed solid may differ from the true one (module docstring)."""
@@ -250,7 +254,8 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
             int(len(m)))
 
 
-def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_duplicates: bool = True) -> Seal:
+def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_duplicates: bool = True,
+               boundary: np.ndarray | None = None) -> Seal:
     """Weld crack lips and split T-junctions within ``gap`` m (module docstring: steps and bound).
 
     Parameters
@@ -263,6 +268,8 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
     drop_duplicates : bool
         Drop the repeated faces a weld or split made (same corners, same winding); the faces kept then all
         take the largest slack (a superset of what each could have been).
+    boundary : (k, 2) int, optional
+        The net boundary of ``faces`` when the caller has it (as :func:`~.estimate.boundary_edges` gives it).
 
     Returns
     -------
@@ -274,9 +281,9 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     n = len(v)
-    edges = boundary_edges(f, n)
+    edges = boundary_edges(f, n) if boundary is None else np.asarray(boundary, dtype=np.int64).reshape(-1, 2)
     if not len(edges):
-        return Seal(f, np.zeros(len(f)), 0.0, 0, 0, edges, 0, 0)
+        return Seal(f, np.zeros(len(f)), 0.0, 0, 0, edges, 0, 0, len(f))
     region = np.zeros(n, dtype=bool)
     region[edges.reshape(-1)] = True
     at_front = region[f].any(axis=1)
@@ -305,4 +312,5 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
     else:
         all_slack = np.concatenate([np.zeros(len(rest)), slack])
     boundary = _frontier_boundary(front, n, region) if (welded or split or duplicates) else edges
-    return Seal(out, all_slack, dropped, welded, split, boundary, _loose_faces(front, n, region), duplicates)
+    return Seal(out, all_slack, dropped, welded, split, boundary, _loose_faces(front, n, region), duplicates,
+                len(rest))
