@@ -27,8 +27,10 @@ diagonal and the inertia tensors by less than 1e-6 (relative, Frobenius norm); e
 
     python benchmarks/bench_peers.py [--sizes 1e4 1e5 1e6 1e7] [--repeat 3] [--plot docs/img/peers.png]
 
-prints a JSON line per run, then the Markdown table of the README (time of each peer and its ratio to ours, from
-this one run, with the load average), and draws the scaling plot.  ``--json FILE`` keeps the rows.
+prints a JSON line per run, the answers' checks, then the Markdown table of the README (CPU time of each peer and its
+ratio to ours, from this one run) and the tables of the docs (wall and CPU time, whole process and after the
+imports, with the load average), and draws the scaling plot.  ``--json FILE`` keeps the rows; ``--from-json FILE``
+prints the tables and redraws the plot from them without running anything.
 """
 
 from __future__ import annotations
@@ -188,7 +190,8 @@ def plot(rows: list[dict], out: str) -> None:
     for ax in (ax_t, ax_c):
         ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=8)
-    fig.suptitle("Binary STL tori, one run; inertia_tool validates (certificate), the peers do not", fontsize=10)
+    fig.suptitle("Binary STL tori, one run, load average ~10-20 on 2 CPUs; inertia_tool runs every check of its "
+                 "certificate, numpy-stl a closedness check, trimesh and MuJoCo none", fontsize=9)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
 
@@ -222,6 +225,27 @@ def table(rows: list[dict], load: tuple[float, float], key: str = "total") -> st
     return "\n".join(lines)
 
 
+def readme_table(rows: list[dict]) -> str:
+    """The README's table: CPU time of the whole process (imports included) and each peer's ratio to ours."""
+    peers = [p for p in PEERS if p != "inertia_tool"]
+    names = {"trimesh process=False": "trimesh `process=False`", "MuJoCo MjSpec": "MuJoCo `MjSpec` (exact inertia)"}
+    lines = ["| faces | inertia_tool | " + " | ".join(names.get(p, p) for p in peers) + " |",
+             "|---:|---:|" + "---:|" * len(peers)]
+    for r in rows:
+        ours = r["peers"]["inertia_tool"]
+        cells = [f"{r['faces']:,}", f"{ours['cpu']:.2f} s" if "cpu" in ours else "—"]
+        for p in peers:
+            got = r["peers"].get(p, {})
+            if "cpu" not in got:
+                cells.append("not run" if "not run" in got.get("error", "") else got.get("error", "—"))
+            else:
+                flag = "" if got.get("agrees", True) else " (disagrees)"
+                ratio = f" ({got['cpu'] / ours['cpu']:.1f}×)" if "cpu" in ours else ""
+                cells.append(f"{got['cpu']:.2f} s{ratio}{flag}")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", type=float, nargs="+", default=[1e4, 1e5, 1e6, 1e7])
@@ -230,11 +254,21 @@ def main() -> None:
     ap.add_argument("--peers", nargs="+", default=list(PEERS), choices=list(PEERS))
     ap.add_argument("--plot", default=os.path.join(ROOT, "docs", "img", "peers.png"))
     ap.add_argument("--json", help="write the rows here (after every size)")
+    ap.add_argument("--from-json", help="print the tables and draw the plot from rows written by --json (no runs)")
     ap.add_argument("--limit", nargs="*", default=["numpy-stl=1.1e6"],
                     help="PEER=FACES: do not run PEER above FACES faces (default: numpy-stl=1.1e6)")
     args = ap.parse_args()
     if "inertia_tool" not in args.peers:
         args.peers.insert(0, "inertia_tool")
+    if args.from_json:
+        with open(args.from_json) as fh:
+            saved = json.load(fh)
+        print(readme_table(saved["rows"]), end="\n\n")
+        for key in ("total", "cpu", "compute", "cpu_compute"):
+            print(table(saved["rows"], tuple(saved["load"]), key=key), end="\n\n")
+        if args.plot:
+            plot(saved["rows"], args.plot)
+        return
     limits = {k: float(v) for k, v in (item.rsplit("=", 1) for item in args.limit)}
     load_before = os.getloadavg()[0]
     rows = []
@@ -285,6 +319,8 @@ def main() -> None:
                 dv, dc, di = got["difference"]
                 print(f"check {r['faces']:>10,} {peer:<22} volume {dv:.1e}  centre {dc:.1e}  inertia {di:.1e}  "
                       f"{'agrees' if got['agrees'] else 'DISAGREES'}")
+    print("\nREADME table (CPU time, imports included):\n")
+    print(readme_table(rows))
     print()
     print(table(rows, (load_before, load_after)))
     for key in ("cpu", "compute", "cpu_compute"):
