@@ -120,6 +120,7 @@ def test_jittered_soup_is_welded_then_exact_like_the_clean_part():
         got = mass_properties((soup_v, soup_f), density=1.0, repair=True)
     assert got.mesh.method == "welded"
     assert got.mesh.certificate.kind == "exact"
+    assert got.mesh.vertices == len(v)          # one copy of each welded vertex is kept, not the soup's three
     assert got.mass == pytest.approx(clean.mass, rel=1e-7)
     np.testing.assert_allclose(got.inertia, clean.inertia, rtol=1e-6, atol=1e-9 * np.abs(clean.inertia).max())
 

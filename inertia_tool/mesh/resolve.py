@@ -124,6 +124,15 @@ def _census(faces: np.ndarray, n_vertices: int) -> _Census:
     return _Census(balance, misoriented, np.r_[lo, hi], boundary, key[starts[count > 2]])
 
 
+def _compact(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Only the vertices the faces use, renumbered in their order (a welded soup keeps one copy in six)."""
+    used = np.bincount(faces.reshape(-1), minlength=len(vertices)) > 0
+    if used.all():
+        return vertices, faces
+    new_index = np.cumsum(used) - 1
+    return vertices[used], new_index[faces].astype(faces.dtype)
+
+
 def _drop_collapsed(faces: np.ndarray) -> np.ndarray:
     collapsed = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0])
     kept: np.ndarray = faces[~collapsed]
@@ -242,7 +251,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                              f"(largest move {merged.largest_move:.3g} m)",)
                     if flipped:
                         notes += (f"{flipped:,} faces were wound the wrong way and were turned",)
-                    return Resolution(v, current, "welded", notes + _touching_note(census), flipped,
+                    kept_v, kept_f = _compact(v, current)
+                    return Resolution(kept_v, kept_f, "welded", notes + _touching_note(census), flipped,
                                       tol, census.nonmanifold_edges)
     if not repair:
         raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}; "
