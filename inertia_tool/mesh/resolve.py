@@ -22,7 +22,7 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,11 +30,10 @@ from ..values import frozen_value
 from ..errors import InvalidMeshError
 from ..tolerances import FLAT_RTOL
 from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
-from .estimate import Estimate, check_useful, patched_estimate, winding_estimate
-from .seal import drop_duplicate_faces, seal_seams
-from .merge import merge_close_vertices
-from .edges import edge_keys
-from .orient import EdgeBalance, edge_balance, orient_consistently
+
+if TYPE_CHECKING:
+    from .estimate import Estimate
+    from .orient import EdgeBalance
 
 __all__ = ["Resolution", "resolve_surface", "REPAIR_RULE"]
 
@@ -99,6 +98,8 @@ class _Census:
 
 
 def _census(faces: np.ndarray, n_vertices: int) -> _Census:
+    from .edges import edge_keys
+    from .orient import EdgeBalance
     if len(faces) == 0:
         none = np.zeros(0, dtype=np.int64)
         return _Census(EdgeBalance(0, 0, 0, 0), 0, none, np.zeros((0, 2), dtype=np.int64), none)
@@ -202,6 +203,11 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     InvalidMeshError
         Without ``repair`` when no exact reading exists; with it when nothing encloses a volume.
     """
+    # imported on use: a surface that passes the manifold check (nearly every file) never comes here
+    from .estimate import check_useful, winding_estimate
+    from .merge import merge_close_vertices
+    from .orient import edge_balance, orient_consistently
+    from .seal import drop_duplicate_faces
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     n = len(v)
@@ -298,6 +304,9 @@ def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, 
                        soup_share: float = SOUP_BOUNDARY_SHARE) -> tuple[Estimate, int]:
     """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed, and
     the non-manifold edges of the surface it integrates (``found`` is the census of ``faces``)."""
+    from .edges import edge_keys
+    from .estimate import patched_estimate, winding_estimate
+    from .seal import seal_seams
     seal = seal_seams(vertices, faces, seam_gap_rtol * diag, boundary=found.boundary)
     if not len(seal.faces) or seal.loose_faces > soup_share * len(seal.faces):
         return winding_estimate(vertices, faces), found.balance.nonmanifold_edges
