@@ -37,7 +37,8 @@ class Merge:
     largest_move: float
 
 
-def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: float) -> Merge:
+def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: float, *,
+                         among: np.ndarray | None = None) -> Merge:
     """Merge the vertices that lie within ``tolerance`` of each other (transitively).
 
     Parameters
@@ -46,26 +47,26 @@ def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: flo
     faces : (m, 3) int
     tolerance : float
         Distance, in the units of ``vertices``; must be positive.
+    among : (k,) int, optional
+        Only these vertices may merge (default: every vertex a face uses).  The repair passes the vertices of
+        unbalanced edges: merging two vertices whose edges are all balanced cannot balance anything.
 
     Returns
     -------
     Merge
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-    from scipy.spatial import cKDTree
-
     if not tolerance > 0:
         raise ValueError(f"Expected a positive tolerance, got {tolerance}")
     v = np.asarray(vertices, dtype=np.float64)
     faces = np.asarray(faces)
-    used = np.unique(faces)                     # only vertices that faces use can matter
-    pairs = cKDTree(v[used]).query_pairs(tolerance, output_type="ndarray")
-    if len(pairs) == 0:
-        return Merge(faces=faces, merged_vertices=0, largest_move=0.0)
+    if among is None:                           # only vertices that faces use can matter
+        used = np.flatnonzero(np.bincount(faces.reshape(-1), minlength=len(v)))
+    else:
+        used = np.flatnonzero(np.bincount(np.asarray(among, dtype=np.int64).reshape(-1), minlength=len(v)))
     k = len(used)
-    graph = coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(k, k))
-    _, group = connected_components(graph, directed=False)
+    group = _groups(v[used], tolerance)
+    if group is None:
+        return Merge(faces=faces, merged_vertices=0, largest_move=0.0)
     first = np.full(group.max() + 1, k, dtype=np.int64)
     np.minimum.at(first, group, np.arange(k))
     representative = np.arange(len(v), dtype=np.int64)
@@ -74,3 +75,79 @@ def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: flo
     largest = float(np.max(np.linalg.norm(v[moved] - v[representative[moved]], axis=1))) if moved.any() else 0.0
     return Merge(faces=representative[faces].astype(faces.dtype), merged_vertices=int(np.count_nonzero(moved)),
                  largest_move=largest)
+
+
+#: Cells per axis up to which the grid of :func:`_groups` packs a cell into one 63-bit key.
+_GRID_AXIS_LIMIT = 1 << 21
+
+#: Point pairs checked per block when two neighbouring cells are compared.
+_PAIR_BLOCK = 1 << 20
+
+
+def _groups(points: np.ndarray, tolerance: float) -> np.ndarray | None:
+    """Connected components of the graph "closer than ``tolerance``", (k,) int, or None when no pair is close.
+
+    Points sharing a cell of side ``tolerance/√3`` are within ``tolerance`` of each other, so a cell is one
+    group at once; only cells whose boxes come within ``tolerance`` of each other (a k-d tree over the cell
+    centres with radius ``tolerance + cell diagonal``) have their points compared, pair by pair, exactly.  For a
+    soup (every vertex copied per triangle, the copies a hair apart) this handles a few points per cell
+    instead of every close pair.  Falls back to a k-d tree over the points when the grid would not fit 63-bit
+    keys (a tolerance below 2⁻²¹ of the extent).
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    k = len(points)
+    if k < 2:
+        return None
+    side = tolerance / np.sqrt(3.0) * (1.0 - 1e-9)      # two points in one cell: |Δ| < side·√3 < tolerance
+    lo = points.min(axis=0)
+    cells = np.floor((points - lo) / side)
+    if not float(cells.max()) < _GRID_AXIS_LIMIT:
+        pairs = cKDTree(points, balanced_tree=False, compact_nodes=False).query_pairs(tolerance, output_type="ndarray")
+        if not len(pairs):
+            return None
+        graph = coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(k, k))
+        labels: np.ndarray = connected_components(graph, directed=False)[1]
+        return labels
+    c = cells.astype(np.int64)
+    key = (c[:, 0] << 42) | (c[:, 1] << 21) | c[:, 2]
+    order = np.argsort(key, kind="stable")
+    sk = key[order]
+    new = np.r_[True, sk[1:] != sk[:-1]]
+    cell_of = np.empty(k, dtype=np.int64)
+    cell_of[order] = np.cumsum(new) - 1                  # cell index of each point, cells in key order
+    starts = np.flatnonzero(new)
+    n_cells = len(starts)
+    counts = np.diff(np.r_[starts, k])
+    corner = c[order[starts]]
+    centre = (corner + 0.5) * side
+    reach = tolerance + side * np.sqrt(3.0)              # two points' distance ≥ centres' distance − diagonal
+    near = cKDTree(centre, balanced_tree=False, compact_nodes=False).query_pairs(reach, output_type="ndarray")
+    links = [np.zeros((0, 2), dtype=np.int64)]
+    if len(near):
+        # every point of cell a against every point of cell b, in blocks of bounded size
+        cum = np.cumsum(counts[near[:, 0]] * counts[near[:, 1]])
+        begin = 0
+        while begin < len(near):                         # each block advances by at least one cell pair
+            done = int(cum[begin - 1]) if begin else 0
+            end = max(begin + 1, int(np.searchsorted(cum, done + _PAIR_BLOCK, side="right")))
+            block = near[begin:end]
+            begin = end
+            na, nb = counts[block[:, 0]], counts[block[:, 1]]
+            m = na * nb
+            pair = np.repeat(np.arange(len(block)), m)
+            within = np.arange(int(m.sum())) - np.repeat(np.cumsum(m) - m, m)
+            ia = order[starts[block[:, 0]][pair] + within // nb[pair]]
+            ib = order[starts[block[:, 1]][pair] + within % nb[pair]]
+            d = points[ia] - points[ib]
+            close = np.einsum("ij,ij->i", d, d) <= tolerance * tolerance
+            links.append(block[np.bincount(pair[close], minlength=len(block)) > 0])
+    link = np.concatenate(links)
+    if not len(link) and n_cells == k:
+        return None
+    graph = coo_matrix((np.ones(len(link), dtype=np.int8), (link[:, 0], link[:, 1])), shape=(n_cells, n_cells))
+    _, cell_group = connected_components(graph, directed=False)
+    group: np.ndarray = cell_group[cell_of]
+    return group

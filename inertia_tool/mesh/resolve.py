@@ -85,6 +85,55 @@ class Resolution:
     estimate: Estimate | None = None
 
 
+@frozen_value
+class _Census:
+    """One sort of the directed edges: the balance, the manifold edges whose two faces disagree, and the
+    vertices of unbalanced edges."""
+
+    balance: EdgeBalance
+    misoriented_pairs: int
+    unbalanced_vertices: np.ndarray
+    boundary: np.ndarray
+    nonmanifold_keys: np.ndarray
+
+
+def _census(faces: np.ndarray, n_vertices: int) -> _Census:
+    from .edges import edge_keys
+    from .orient import EdgeBalance
+    if len(faces) == 0:
+        none = np.zeros(0, dtype=np.int64)
+        return _Census(EdgeBalance(0, 0, 0, 0), 0, none, np.zeros((0, 2), dtype=np.int64), none)
+    key, forward = edge_keys(faces, n_vertices)
+    order = np.argsort(key, kind="stable")
+    key = key[order]
+    fwd = forward[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    count = np.diff(np.r_[starts, len(key)])
+    net = np.add.reduceat(np.where(fwd, 1, -1).astype(np.int64), starts)
+    pair = starts[count == 2]
+    misoriented = int(np.count_nonzero(fwd[pair] == fwd[pair + 1]))
+    unbalanced = net != 0
+    bad = key[starts[unbalanced]]
+    nv = np.int64(max(int(n_vertices), 1))
+    balance = EdgeBalance(edges=len(starts), boundary_edges=int(np.count_nonzero(count == 1)),
+                          nonmanifold_edges=int(np.count_nonzero(count > 2)), unbalanced_edges=len(bad))
+    # the boundary 1-chain as estimate.boundary_edges gives it: |net| copies of each edge in its net direction
+    lo, hi, k = bad // nv, bad % nv, net[unbalanced]
+    reps = np.abs(k)
+    boundary = np.stack([np.repeat(np.where(k > 0, hi, lo), reps), np.repeat(np.where(k > 0, lo, hi), reps)],
+                        axis=1)
+    return _Census(balance, misoriented, np.r_[lo, hi], boundary, key[starts[count > 2]])
+
+
+def _compact(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Only the vertices the faces use, renumbered in their order (a welded soup keeps one copy in six)."""
+    used = np.bincount(faces.reshape(-1), minlength=len(vertices)) > 0
+    if used.all():
+        return vertices, faces
+    new_index = np.cumsum(used) - 1
+    return vertices[used], new_index[faces].astype(faces.dtype)
+
+
 def _drop_collapsed(faces: np.ndarray) -> np.ndarray:
     collapsed = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0])
     kept: np.ndarray = faces[~collapsed]
@@ -116,17 +165,6 @@ def _touching_note(census: EdgeBalance) -> tuple[str, ...]:
         return ()
     return (f"{census.nonmanifold_edges:,} non-manifold edges where bodies or walls meet (each edge used equally "
             "in both directions, so the integral is exact)",)
-
-
-def _dedupe(faces: np.ndarray) -> tuple[np.ndarray, int]:
-    """Drop repeated copies of a face (same corners, same winding); a face and its reverse both stay."""
-    f = np.asarray(faces)
-    roll = np.argmin(f, axis=1)
-    idx = (roll[:, None] + np.arange(3)) % 3
-    canon = np.take_along_axis(f, idx, axis=1)       # rotated to start at the smallest index: keeps winding
-    _, first = np.unique(canon, axis=0, return_index=True)
-    first = np.sort(first)
-    return f[first], len(f) - len(first)
 
 
 def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
@@ -169,11 +207,12 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     from .estimate import check_useful, winding_estimate
     from .merge import merge_close_vertices
     from .orient import edge_balance, orient_consistently
+    from .seal import drop_duplicate_faces
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     n = len(v)
-    census = edge_balance(f, n)
     if force_estimate:
+        census = edge_balance(f, n)
         grid = winding_estimate(v, f)
         why = reason or "the bodies overlap and their union could not be formed"
         hint = ("`overlap` 'sum' adds the bodies (shared volume counted twice)" if reason is None else
@@ -182,31 +221,44 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                      what=f"the winding-number estimate ({why})", why=hint)
         return Resolution(v, f, grid.method, (why, grid.detail),
                           0, None, census.nonmanifold_edges, estimate=grid)
+    found = _census(f, n)
+    census = found.balance
     if census.balanced:
         return Resolution(v, f, "exact", _touching_note(census), 0, None, census.nonmanifold_edges)
-    oriented = orient_consistently(f, n, v)
-    census = edge_balance(oriented.faces, n)
-    if census.balanced:
-        notes = (f"{oriented.flipped_faces:,} faces were wound the wrong way and were turned",) + _touching_note(census)
-        return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
-                          census.nonmanifold_edges)
+    current, flipped = f, 0
+    if found.misoriented_pairs:     # else orienting would turn nothing (each patch already agrees with itself)
+        oriented = orient_consistently(f, n, v)
+        found = _census(oriented.faces, n)
+        census = found.balance
+        if census.balanced:
+            notes = (f"{oriented.flipped_faces:,} faces were wound the wrong way and were turned",) + \
+                _touching_note(census)
+            return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
+                              census.nonmanifold_edges)
+        current, flipped = oriented.faces, oriented.flipped_faces
     welded = None
-    current, flipped = oriented.faces, oriented.flipped_faces
     if merge_tolerance and merge_tolerance > 0:
         tol = merge_tolerance * diag
-        merged = merge_close_vertices(v, f, tol)
+        # only vertices of unbalanced edges: merging vertices whose edges all balance cannot balance anything
+        merged = merge_close_vertices(v, f, tol, among=found.unbalanced_vertices)
         if merged.merged_vertices:
             welded_faces = _drop_collapsed(merged.faces)
             if len(welded_faces):
-                again = orient_consistently(welded_faces, n, v)
-                census = edge_balance(again.faces, n)
-                current, flipped, welded = again.faces, again.flipped_faces, tol
+                again = _census(welded_faces, n)
+                turned = orient_consistently(welded_faces, n, v) if again.misoriented_pairs else None
+                if turned is not None:
+                    again = _census(turned.faces, n)
+                census, found = again.balance, again
+                current = turned.faces if turned is not None else welded_faces
+                flipped = turned.flipped_faces if turned is not None else 0
+                welded = tol
                 if census.balanced:
                     notes = (f"{merged.merged_vertices:,} vertices within {tol:.3g} m of another were merged "
                              f"(largest move {merged.largest_move:.3g} m)",)
-                    if again.flipped_faces:
-                        notes += (f"{again.flipped_faces:,} faces were wound the wrong way and were turned",)
-                    return Resolution(v, again.faces, "welded", notes + _touching_note(census), again.flipped_faces,
+                    if flipped:
+                        notes += (f"{flipped:,} faces were wound the wrong way and were turned",)
+                    kept_v, kept_f = _compact(v, current)
+                    return Resolution(kept_v, kept_f, "welded", notes + _touching_note(census), flipped,
                                       tol, census.nonmanifold_edges)
     if not repair:
         raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}; "
@@ -219,14 +271,17 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         repair_notes.append(f"vertices within {welded:.3g} m of another were merged")
     if flipped:
         repair_notes.append(f"{flipped:,} faces were turned to agree with their neighbours")
-    unique, dropped = _dedupe(current)
+    # a repeated face uses each of its edges twice in one direction: a misoriented pair or a non-manifold edge
+    maybe_repeated = found.misoriented_pairs or census.nonmanifold_edges
+    unique, dropped = drop_duplicate_faces(current) if maybe_repeated else (current, 0)
     if dropped:
         repair_notes.append(f"{dropped:,} duplicated faces were dropped")
-        census = edge_balance(unique, n)
+        found = _census(unique, n)
+        census = found.balance
         if census.balanced:
             return Resolution(v, unique, "deduplicated", tuple(repair_notes) + _touching_note(census), flipped, welded,
                               census.nonmanifold_edges)
-    best = _repaired_estimate(v, unique, diag=diag, moments=moments)
+    best, front_nonmanifold = _repaired_estimate(v, unique, found, diag=diag, moments=moments)
     flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
     if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
@@ -238,39 +293,40 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     repair_notes.append(best.detail)
     if best.method == "patched" and best.uncertainty.volume_in_doubt == 0:
         # every seam sealed without moving anything and no hole left: the sealed polyhedron is the solid
-        sealed_faces = best.faces
-        return Resolution(best.vertices, sealed_faces, "sealed", tuple(repair_notes), flipped, welded,
-                          edge_balance(sealed_faces, len(best.vertices)).nonmanifold_edges)
+        return Resolution(best.vertices, best.faces, "sealed", tuple(repair_notes), flipped, welded,
+                          front_nonmanifold)
     return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
-                      edge_balance(best.faces, len(best.vertices)).nonmanifold_edges if best.method == "patched"
-                      else census.nonmanifold_edges, estimate=best)
+                      front_nonmanifold if best.method == "patched" else census.nonmanifold_edges, estimate=best)
 
 
-def _loose_share(faces: np.ndarray) -> float:
-    """Share of the faces that share no edge with another face (loose triangles of a soup)."""
-    if not len(faces):
-        return 1.0
-    edges = np.sort(np.asarray(faces, dtype=np.int64)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    key = edges[:, 0] * (int(edges.max()) + 1) + edges[:, 1]
-    _, inverse, counts = np.unique(key, return_inverse=True, return_counts=True)
-    alone = (counts[inverse.reshape(-1)] == 1).reshape(-1, 3).all(axis=1)
-    return float(np.count_nonzero(alone)) / len(faces)
-
-
-def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, *, diag: float,
+def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, *, diag: float,
                        moments: Callable[..., Any], seam_gap_rtol: float = SEAM_GAP_RTOL,
-                       soup_share: float = SOUP_BOUNDARY_SHARE) -> Estimate:
-    """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed."""
+                       soup_share: float = SOUP_BOUNDARY_SHARE) -> tuple[Estimate, int]:
+    """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed, and
+    the non-manifold edges of the surface it integrates (``found`` is the census of ``faces``)."""
+    from .edges import edge_keys
     from .estimate import patched_estimate, winding_estimate
-    from .seal import Seal, seal_seams
-    sealed = seal_seams(vertices, faces, seam_gap_rtol * diag)
-    if _loose_share(sealed.faces) > soup_share:
-        return winding_estimate(vertices, faces)
-    kept, _ = _dedupe(sealed.faces) if sealed.welded or sealed.split else (sealed.faces, 0)
-    if len(kept) != len(sealed.faces):
-        # duplicates the weld made: the sealed faces' slack is kept for the faces that remain (a superset bound)
-        seal = Seal(kept, np.full(len(kept), float(sealed.slack.max(initial=0.0))), sealed.dropped_doubt,
-                    sealed.welded, sealed.split)
-    else:
-        seal = sealed
-    return patched_estimate(vertices, seal.faces, moments, seal=seal)
+    from .seal import seal_seams
+    seal = seal_seams(vertices, faces, seam_gap_rtol * diag, boundary=found.boundary)
+    if not len(seal.faces) or seal.loose_faces > soup_share * len(seal.faces):
+        return winding_estimate(vertices, faces), found.balance.nonmanifold_edges
+    best = patched_estimate(vertices, seal.faces, moments, seal=seal)
+    # edges away from the frontier keep their count; the frontier's and the cones' are counted here
+    n = len(vertices)
+    region = np.zeros(n, dtype=bool)
+    region[found.boundary.reshape(-1)] = True
+    nv = np.int64(max(n, 1))
+    keys = found.nonmanifold_keys
+    away = int(np.count_nonzero(~(region[keys // nv] | region[keys % nv])))
+    near = np.vstack([seal.faces[seal.front_start:], best.faces[len(seal.faces):]])
+    key, _ = edge_keys(near, len(best.vertices))
+    key = np.sort(key)
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    count = np.diff(np.r_[starts, len(key)])
+    nb = np.int64(max(len(best.vertices), 1))
+    lo, hi = key[starts] // nb, key[starts] % nb
+    touching = np.zeros(len(best.vertices), dtype=bool)
+    touching[:n] = region
+    touching[n:] = True                       # the cones' apexes
+    counted = int(np.count_nonzero((count > 2) & (touching[lo] | touching[hi])))
+    return best, away + counted

@@ -19,6 +19,12 @@ of radius ``d`` around the touched faces, whose volume for a triangle of area ``
 Steiner's ``2Ad + (π/2)Pd² + (4/3)πd³`` (a dropped, collapsed face counts as a segment, ``A = 0``).  The
 sum over touched faces is the volume in doubt.  When nothing moved (a T-vertex exactly on its edge, lips
 bit-identical) every slack is zero and the sealed surface is exact.
+
+Only the *frontier* is looked at: the faces with a corner on an unbalanced edge.  Every unbalanced edge has
+both ends there, and every face using such an edge is a frontier face, so the frontier alone tells which edges
+are unbalanced (those of its edges that touch a frontier vertex); welds merge frontier vertices into frontier
+vertices and splits insert them, so that stays true round after round.  The rest of the surface is passed
+through untouched, and a big part with a small hole costs what the hole costs.
 """
 
 from __future__ import annotations
@@ -28,7 +34,7 @@ import numpy as np
 from ..values import frozen_value
 from .edges import edge_keys
 
-__all__ = ["Seal", "seal_seams", "parallel_body_volume"]
+__all__ = ["Seal", "seal_seams", "parallel_body_volume", "drop_duplicate_faces"]
 
 #: Rounds of (weld, split): a T-vertex revealed by a weld, or a weld revealed by a split, is found next round.
 MAX_SEAL_ROUNDS = 4
@@ -50,6 +56,16 @@ class Seal:
         Boundary vertices merged into another.
     split : int
         T-junction vertices inserted into an edge.
+    boundary : (k, 2) int
+        The net boundary of ``faces`` as directed edges with multiplicity (as
+        :func:`~.estimate.boundary_edges` gives it), found on the frontier.
+    loose_faces : int
+        Faces of ``faces`` sharing no edge with another face (loose triangles of a soup).
+    front_start : int
+        ``faces[front_start:]`` are the frontier (every face with a corner on an unbalanced edge), sealed; the
+        faces before it are untouched.
+    duplicates : int
+        Repeated copies of a face (same corners, same winding) that sealing made and that were dropped.
     """
 
     faces: np.ndarray
@@ -57,6 +73,10 @@ class Seal:
     dropped_doubt: float
     welded: int
     split: int
+    boundary: np.ndarray
+    loose_faces: int = 0
+    duplicates: int = 0
+    front_start: int = 0
 
     def doubt(self, vertices: np.ndarray) -> float:
         """Volume (m³) within which the sealed solid may differ from the true one (module docstring)."""
@@ -80,24 +100,72 @@ def parallel_body_volume(vertices: np.ndarray, faces: np.ndarray, radius: np.nda
     return volume
 
 
-def _boundary_vertices(faces: np.ndarray, n: int) -> np.ndarray:
+def _frontier_boundary(faces: np.ndarray, n: int, region: np.ndarray | None) -> np.ndarray:
+    """Boundary edges of the frontier ``faces`` that are boundary edges of the whole surface: those with an end
+    in ``region`` (the frontier vertices; None: ``faces`` is the whole surface)."""
     from .estimate import boundary_edges
 
     edges = boundary_edges(faces, n)
-    return np.unique(edges) if len(edges) else np.zeros(0, dtype=np.int64)
+    if region is not None and len(edges):
+        edges = edges[region[edges[:, 0]] | region[edges[:, 1]]]
+    return edges
+
+
+def _boundary_vertices(faces: np.ndarray, n: int, region: np.ndarray | None = None) -> np.ndarray:
+    edges = _frontier_boundary(faces, n, region)
+    return np.flatnonzero(np.bincount(edges.reshape(-1), minlength=n)) if len(edges) else np.zeros(0, np.int64)
+
+
+def drop_duplicate_faces(faces: np.ndarray) -> tuple[np.ndarray, int]:
+    """Drop repeated copies of a face (same corners, same winding); a face and its reverse both stay.
+
+    Returns the faces kept (first copies, in their order) and the number dropped.
+    """
+    f = np.asarray(faces)
+    if len(f) < 2:
+        return f, 0
+    roll = np.argmin(f, axis=1)
+    idx = (roll[:, None] + np.arange(3)) % 3
+    canon = np.take_along_axis(f, idx, axis=1)       # rotated to start at the smallest index: keeps winding
+    order = np.lexsort((canon[:, 2], canon[:, 1], canon[:, 0]))
+    sc = canon[order]
+    repeat = np.zeros(len(f), dtype=bool)
+    repeat[order[1:]] = (sc[1:] == sc[:-1]).all(axis=1)
+    if not repeat.any():
+        return f, 0
+    # keep the first copy in file order: within a run of equal rows lexsort is stable, so order[start] is it
+    return f[~repeat], int(np.count_nonzero(repeat))
+
+
+def _loose_faces(faces: np.ndarray, n: int, region: np.ndarray) -> int:
+    """Frontier faces none of whose edges is used by another face (an edge without an end in ``region`` is
+    balanced in the whole surface, so it is shared even if its other face is not in the frontier)."""
+    if not len(faces):
+        return 0
+    key, _ = edge_keys(faces, n)
+    order = np.argsort(key, kind="stable")
+    sk = key[order]
+    nn = np.int64(max(n, 1))
+    single = region[sk // nn] | region[sk % nn]
+    same = sk[1:] == sk[:-1]
+    single[1:] &= ~same
+    single[:-1] &= ~same
+    alone = np.empty(len(sk), dtype=bool)
+    alone[order] = single
+    return int(np.count_nonzero(alone.reshape(-1, 3).all(axis=1)))
 
 
 def _weld_lips(v: np.ndarray, f: np.ndarray, slack: np.ndarray, vertex_slack: np.ndarray,
-               gap: float) -> tuple[np.ndarray, np.ndarray, float, int]:
+               gap: float, region: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, float, int]:
     """Step 1: merge boundary vertices within ``gap``; returns faces, face slack, dropped doubt, merged count."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
 
-    bv = _boundary_vertices(f, len(v))
+    bv = _boundary_vertices(f, len(v), region)
     if len(bv) < 2:
         return f, slack, 0.0, 0
-    pairs = cKDTree(v[bv]).query_pairs(gap, output_type="ndarray")
+    pairs = cKDTree(v[bv], balanced_tree=False, compact_nodes=False).query_pairs(gap, output_type="ndarray")
     if not len(pairs):
         return f, slack, 0.0, 0
     k = len(bv)
@@ -119,21 +187,20 @@ def _weld_lips(v: np.ndarray, f: np.ndarray, slack: np.ndarray, vertex_slack: np
 
 
 def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
-                       gap: float) -> tuple[np.ndarray, np.ndarray, int]:
+                       gap: float, region: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, int]:
     """Step 2: split faces at boundary vertices lying on the interior of a boundary edge; returns faces,
     slack and the number of vertices inserted."""
     from scipy.spatial import cKDTree
-    from .estimate import boundary_edges
 
-    edges = boundary_edges(f, len(v))
+    edges = _frontier_boundary(f, len(v), region)
     if not len(edges):
         return f, slack, 0
     edges = np.unique(edges, axis=0)
-    bv = np.unique(edges)
+    bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v)))
     a, b = v[edges[:, 0]], v[edges[:, 1]]
     ab = b - a
     length = np.linalg.norm(ab, axis=1)
-    near = cKDTree(v[bv]).query_ball_point(0.5 * (a + b), 0.5 * length + gap)
+    near = cKDTree(v[bv], balanced_tree=False, compact_nodes=False).query_ball_point(0.5 * (a + b), 0.5 * length + gap)
     counts = np.fromiter((len(x) for x in near), dtype=np.int64, count=len(near))
     if not counts.sum():
         return f, slack, 0
@@ -169,7 +236,7 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     face, corner, m, t, dist = face[unique_m], corner[unique_m], m[unique_m], t[unique_m], dist[unique_m]
     by = np.lexsort((t, face))
     face, corner, m, dist = face[by], corner[by], m[by], dist[by]
-    split_faces = np.unique(face)
+    split_faces = np.flatnonzero(np.bincount(face, minlength=len(f)))
     new_faces: list[np.ndarray] = []
     new_slack: list[np.ndarray] = []
     starts = np.searchsorted(face, split_faces)
@@ -187,7 +254,8 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
             int(len(m)))
 
 
-def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float) -> Seal:
+def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_duplicates: bool = True,
+               boundary: np.ndarray | None = None) -> Seal:
     """Weld crack lips and split T-junctions within ``gap`` m (module docstring: steps and bound).
 
     Parameters
@@ -197,25 +265,52 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float) -> Seal:
     faces : (m, 3) int
     gap : float
         m; 0 leaves the surface as it is.
+    drop_duplicates : bool
+        Drop the repeated faces a weld or split made (same corners, same winding); the faces kept then all
+        take the largest slack (a superset of what each could have been).
+    boundary : (k, 2) int, optional
+        The net boundary of ``faces`` when the caller has it (as :func:`~.estimate.boundary_edges` gives it).
 
     Returns
     -------
     Seal
+        Its faces are the untouched faces followed by the frontier's, sealed.
     """
+    from .estimate import boundary_edges
+
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
-    slack = np.zeros(len(f))
-    vertex_slack = np.zeros(len(v))
+    n = len(v)
+    edges = boundary_edges(f, n) if boundary is None else np.asarray(boundary, dtype=np.int64).reshape(-1, 2)
+    if not len(edges):
+        return Seal(f, np.zeros(len(f)), 0.0, 0, 0, edges, 0, 0, len(f))
+    region = np.zeros(n, dtype=bool)
+    region[edges.reshape(-1)] = True
+    at_front = region[f].any(axis=1)
+    rest, front = f[~at_front], f[at_front]
+    slack = np.zeros(len(front))
+    vertex_slack = np.zeros(n)
     dropped, welded, split = 0.0, 0, 0
-    if not gap > 0:
-        return Seal(f, slack, 0.0, 0, 0)
-    for _ in range(MAX_SEAL_ROUNDS):
-        f, slack, lost, merged = _weld_lips(v, f, slack, vertex_slack, gap)
-        f, slack, inserted = _split_t_junctions(v, f, slack, gap)
-        dropped += lost
-        welded += merged
-        split += inserted
-        if not (merged or inserted):
-            break
-    slack = np.maximum(slack, vertex_slack[f].max(axis=1)) if len(f) else slack
-    return Seal(f, slack, dropped, welded, split)
+    if gap > 0:
+        for _ in range(MAX_SEAL_ROUNDS):
+            front, slack, lost, merged = _weld_lips(v, front, slack, vertex_slack, gap, region)
+            front, slack, inserted = _split_t_junctions(v, front, slack, gap, region)
+            dropped += lost
+            welded += merged
+            split += inserted
+            if not (merged or inserted):
+                break
+        slack = np.maximum(slack, vertex_slack[front].max(axis=1)) if len(front) else slack
+    duplicates = 0
+    if drop_duplicates and (welded or split):
+        kept, duplicates = drop_duplicate_faces(front)
+        if duplicates:
+            front = kept
+    out = np.vstack([rest, front]) if len(rest) else front
+    if duplicates:    # the duplicates' slack is kept for every face that remains (a superset bound)
+        all_slack = np.full(len(out), float(slack.max(initial=0.0)))
+    else:
+        all_slack = np.concatenate([np.zeros(len(rest)), slack])
+    boundary = _frontier_boundary(front, n, region) if (welded or split or duplicates) else edges
+    return Seal(out, all_slack, dropped, welded, split, boundary, _loose_faces(front, n, region), duplicates,
+                len(rest))
