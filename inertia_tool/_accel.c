@@ -1081,6 +1081,156 @@ fail:
     return NULL;
 }
 
+/* ------------------------------------------------------------------------------------------------------
+ * 4b. edge_shell_labels -- faces joined through shared undirected edges (checks._edge_shell_labels)
+ *
+ * Each face edge {a, b} is bucketed by its smaller end u = min(a, b) as the packed word (v << 32) | face,
+ * v = max(a, b) (a CSR over vertices: 3m words plus n + 1 offsets); each bucket is sorted, so the faces
+ * using one edge form a run, and consecutive faces of a run are united (union-find over faces, union by
+ * smaller index, path halving: each root is its component's first face).  Faces are then labelled by
+ * their root's rank in face order, i.e. components are numbered by their first face, as the numpy path.
+ * ------------------------------------------------------------------------------------------------------ */
+
+static void
+sort_words(uint64_t *t, size_t len)
+{
+    for (size_t i = 1; i < len; i++) {
+        uint64_t x = t[i];
+        size_t j = i;
+        while (j > 0 && t[j - 1] > x) {
+            t[j] = t[j - 1];
+            j--;
+        }
+        t[j] = x;
+    }
+}
+
+static int
+cmp_uint64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static inline void
+unite_faces(int32_t *parent, int32_t a, int32_t b)
+{
+    a = find_root(parent, a);
+    b = find_root(parent, b);
+    if (a < b) {
+        parent[b] = a;
+    }
+    else if (b < a) {
+        parent[a] = b;
+    }
+}
+
+static PyObject *
+accel_edge_shell_labels(PyObject *self, PyObject *args)
+{
+    PyObject *faces_obj, *out_obj;
+    Py_ssize_t n_vertices;
+    if (!PyArg_ParseTuple(args, "OnO", &faces_obj, &n_vertices, &out_obj) || check_vertex_count(n_vertices) < 0) {
+        return NULL;
+    }
+    Py_buffer fv, out;
+    Py_ssize_t m;
+    int size;
+    if (get_faces(faces_obj, &fv, &m, &size) < 0) {
+        return NULL;
+    }
+    if (PyObject_GetBuffer(out_obj, &out, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        PyBuffer_Release(&fv);
+        return NULL;
+    }
+    int out_size = signed_int_size(&out);
+    if (out_size == 0 || out.ndim != 1 || out.shape[0] != m) {
+        PyErr_Format(PyExc_ValueError, "Expected `out` as a contiguous int32 or int64 array of %zd entries", m);
+        goto fail;
+    }
+    if ((size_t)m > (size_t)INT32_MAX - 1) {
+        PyErr_Format(PyExc_ValueError, "Expected fewer than 2**31 - 1 faces, got %zd", m);
+        goto fail;
+    }
+    if (check_indices(fv.buf, size, 3 * (size_t)m, n_vertices) < 0) {
+        goto fail;
+    }
+    size_t n = (size_t)n_vertices, mm = (size_t)m;
+    int64_t *off = (int64_t *)calloc(n + 1, sizeof(int64_t));
+    uint64_t *word = (uint64_t *)malloc((mm ? 3 * mm : 1) * sizeof(uint64_t));
+    int32_t *parent = (int32_t *)malloc((mm ? mm : 1) * sizeof(int32_t));
+    if (off == NULL || word == NULL || parent == NULL) {
+        free(off);
+        free(word);
+        free(parent);
+        PyErr_NoMemory();
+        goto fail;
+    }
+    int64_t count = 0;
+    Py_BEGIN_ALLOW_THREADS
+    const void *f = fv.buf;
+    for (size_t i = 0; i < 3 * mm; i++) {
+        size_t face = i / 3, k = i - 3 * face;
+        int64_t a = index_at(f, size, i), b = index_at(f, size, 3 * face + (k + 1) % 3);
+        off[(a < b ? a : b) + 1]++;
+    }
+    for (size_t u = 0; u < n; u++) {
+        off[u + 1] += off[u];
+    }
+    for (size_t face = 0; face < mm; face++) {          /* off[u] runs from u's bucket start to its end */
+        for (int k = 0; k < 3; k++) {
+            int64_t a = index_at(f, size, 3 * face + k), b = index_at(f, size, 3 * face + (k + 1) % 3);
+            int64_t u = a < b ? a : b, v = a < b ? b : a;
+            word[off[u]++] = ((uint64_t)v << 32) | (uint64_t)face;
+        }
+    }
+    for (size_t face = 0; face < mm; face++) {
+        parent[face] = (int32_t)face;
+    }
+    for (size_t u = 0; u < n; u++) {                     /* off[u] is now the end of u's bucket */
+        size_t lo = u ? (size_t)off[u - 1] : 0, hi = (size_t)off[u];
+        if (hi - lo > 32) {
+            qsort(word + lo, hi - lo, sizeof(uint64_t), cmp_uint64);
+        }
+        else {
+            sort_words(word + lo, hi - lo);
+        }
+        for (size_t p = lo + 1; p < hi; p++) {
+            if ((word[p] >> 32) == (word[p - 1] >> 32)) {
+                unite_faces(parent, (int32_t)(word[p - 1] & 0xffffffffu), (int32_t)(word[p] & 0xffffffffu));
+            }
+        }
+    }
+    /* a root precedes every face of its component: it gets its rank first */
+    for (size_t face = 0; face < mm; face++) {
+        int32_t r = find_root(parent, (int32_t)face);
+        int64_t label;
+        if (r == (int32_t)face) {
+            label = count++;
+        }
+        else {
+            label = out_size == 8 ? ((int64_t *)out.buf)[r] : ((int32_t *)out.buf)[r];
+        }
+        if (out_size == 8) {
+            ((int64_t *)out.buf)[face] = label;
+        }
+        else {
+            ((int32_t *)out.buf)[face] = (int32_t)label;
+        }
+    }
+    Py_END_ALLOW_THREADS
+    free(off);
+    free(word);
+    free(parent);
+    PyBuffer_Release(&fv);
+    PyBuffer_Release(&out);
+    return PyLong_FromLongLong((long long)count);
+fail:
+    PyBuffer_Release(&fv);
+    PyBuffer_Release(&out);
+    return NULL;
+}
+
 /* ======================================================================================================
  * 5. tetra_sums
  *
@@ -1416,6 +1566,9 @@ static PyMethodDef accel_methods[] = {
     {"shell_labels", accel_shell_labels, METH_VARARGS,
      "shell_labels(faces, n_vertices, out) -> count\n\nWrite each face's shell (connected by shared "
      "vertices), numbered by the shell's smallest vertex index, into `out` (m,) int32/int64."},
+    {"edge_shell_labels", accel_edge_shell_labels, METH_VARARGS,
+     "edge_shell_labels(faces, n_vertices, out) -> count\n\nWrite each face's shell (faces connected through "
+     "shared undirected edges), numbered by the shell's first face, into `out` (m,) int32/int64."},
     {"tetra_sums", accel_tetra_sums, METH_VARARGS,
      "tetra_sums(vertices, faces, origin, area_floor, labels, sums, zero, threads=1)\n\nCompensated signed-tetrahedron "
      "sums per label into sums (L, 11) float64 [vol, first xyz, second xx yy zz xy xz yz, area] and zero "

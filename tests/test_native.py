@@ -188,6 +188,81 @@ def test_shell_labels_identical_with_shuffled_shells_and_loose_vertices(monkeypa
     np.testing.assert_array_equal(lc, ln)
 
 
+def _edge_components_brute(faces: np.ndarray) -> np.ndarray:
+    """Faces joined through shared undirected edges by a plain fixed-point iteration (independent of both
+    paths), numbered by first face."""
+    m = len(faces)
+    edges = [{frozenset((int(f[k]), int(f[(k + 1) % 3]))) for k in range(3)} for f in faces]
+    label = list(range(m))
+    changed = True
+    while changed:                      # at most m rounds: each round lowers some label
+        changed = False
+        for i in range(m):
+            for j in range(i + 1, m):
+                if edges[i] & edges[j] and label[i] != label[j]:
+                    label[i] = label[j] = min(label[i], label[j])
+                    changed = True
+    rank = {r: k for k, r in enumerate(sorted(set(label)))}
+    return np.array([rank[x] for x in label])
+
+
+@needs_accel
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(case=_faces)
+def test_edge_shell_labels_match_numpy_and_brute_force(monkeypatch, case):
+    """Random faces over a few vertices (shared corners without a shared edge, fins, duplicated faces,
+    repeated corners): the C kernel, the numpy path and a brute-force fixed point give the same numbering."""
+    from inertia_tool.mesh.checks import _edge_shell_labels
+    n, faces = case
+    f = np.array(faces, dtype=np.int64)
+    (lc, kc), (ln, kn) = both(monkeypatch, lambda: _edge_shell_labels(f, n))
+    brute = _edge_components_brute(f)
+    assert kc == kn == len(set(brute.tolist()))
+    np.testing.assert_array_equal(lc, ln)
+    np.testing.assert_array_equal(lc, brute)
+    lib = _native.accel()
+    out32 = np.empty(len(f), np.int32)
+    assert lib.edge_shell_labels(f.astype(np.int32), n, out32) == kc      # int32 faces and labels
+    np.testing.assert_array_equal(out32, lc)
+
+
+@needs_accel
+def test_edge_shell_labels_on_a_high_degree_fan_and_bowtie(monkeypatch):
+    """A 40,000-sided cone (one vertex in every face: a bucket sorted by qsort) and two cones sharing only
+    their apex (one vertex-connected piece, two edge-connected shells)."""
+    from inertia_tool.mesh.checks import _edge_shell_labels
+    k = 40_000
+    t = np.linspace(0, 2 * np.pi, k, endpoint=False)
+    v = np.vstack([[0, 0, 1.0], [0, 0, 0.0], np.c_[np.cos(t), np.sin(t), np.zeros(k)]])
+    ring = 2 + np.arange(k)
+    nxt = 2 + (np.arange(k) + 1) % k
+    cone = np.vstack([np.c_[np.zeros(k, int), ring, nxt], np.c_[np.ones(k, int), nxt, ring]])
+    second = np.where(cone == 0, 0, cone + len(v))        # a copy sharing the apex (vertex 0) only
+    faces = np.vstack([second, cone])
+    (lc, kc), (ln, kn) = both(monkeypatch, lambda: _edge_shell_labels(faces, 2 * len(v)))
+    assert kc == kn == 2
+    np.testing.assert_array_equal(lc, ln)
+    assert (lc[:len(cone)] == 0).all() and (lc[len(cone):] == 1).all()
+    labels, count = shell_labels(faces, 2 * len(v))
+    assert count == 2
+
+
+def test_edge_shell_labels_refuses_malformed_arguments():
+    lib = _native.accel()
+    if lib is None:
+        pytest.skip("inertia_tool._accel is not built")
+    v, f = box_arrays()
+    f = np.ascontiguousarray(f, dtype=np.int64)
+    bad = f.copy()
+    bad[5, 1] = len(v)
+    with pytest.raises(ValueError, match="face indices"):
+        lib.edge_shell_labels(bad, len(v), np.empty(len(f), np.int64))
+    with pytest.raises(ValueError):
+        lib.edge_shell_labels(f, len(v), np.empty(len(f) - 1, np.int64))
+    with pytest.raises(ValueError):
+        lib.edge_shell_labels(f.astype(np.float64), len(v), np.empty(len(f), np.int64))
+
+
 def _rel(a, b):
     return float(np.max(np.abs(np.asarray(a) - np.asarray(b))) / max(np.max(np.abs(b)), 1e-300))
 
