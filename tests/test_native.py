@@ -263,6 +263,33 @@ def test_edge_shell_labels_refuses_malformed_arguments():
         lib.edge_shell_labels(f.astype(np.float64), len(v), np.empty(len(f), np.int64))
 
 
+@needs_accel
+@pytest.mark.parametrize("m", [5, 70_000])       # one lane, and 32 lanes over two threads
+def test_face_measures_agree_with_numpy_to_round_off(monkeypatch, m):
+    """The float32 storage bound's area and perimeter sums: C (lanes) against numpy (chunks) and against
+    a direct float64 evaluation, on random triangles with repeated corners and int32 or int64 faces."""
+    from inertia_tool.mesh.precision import volume_rounding_bound
+    rng = np.random.default_rng(m)
+    v = rng.normal(size=(m + 3, 3)) * 10.0 + 100.0
+    f = rng.integers(0, len(v), size=(m, 3))
+    f[0, 1] = f[0, 0]                              # a zero-area face
+    lib = _native.accel()
+    for faces in (f, f.astype(np.int32)):
+        area, perimeter = lib.face_measures(v, np.ascontiguousarray(faces), 2)
+        tri = v[f]
+        e = np.roll(tri, -1, axis=1) - tri
+        ref_perimeter = np.linalg.norm(e, axis=2).sum()
+        ref_area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+        assert area == pytest.approx(ref_area, rel=1e-12)
+        assert perimeter == pytest.approx(ref_perimeter, rel=1e-12)
+    c, ref = both(monkeypatch, lambda: volume_rounding_bound(v, f, 1e-6))
+    assert c == pytest.approx(ref, rel=1e-12) and c > 0
+    with pytest.raises(ValueError, match="face indices"):
+        lib.face_measures(v, np.full((1, 3), len(v)))
+    with pytest.raises(ValueError):
+        lib.face_measures(v.astype(np.float32), f)
+
+
 def _rel(a, b):
     return float(np.max(np.abs(np.asarray(a) - np.asarray(b))) / max(np.max(np.abs(b)), 1e-300))
 
