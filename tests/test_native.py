@@ -136,6 +136,43 @@ def test_welder_table_grows_from_a_small_hint():
     np.testing.assert_array_equal(out[ids], pts)
 
 
+def _first_appearance_ids(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex ids in order of first appearance by a Python dict on the exact values (-0.0 equal to +0.0)."""
+    seen: dict = {}
+    ids = np.array([seen.setdefault(tuple(float(x) + 0.0 for x in p), len(seen)) for p in points], np.int32)
+    return ids, np.array(list(seen), dtype=np.float64).reshape(-1, 3)
+
+
+@needs_accel
+@settings(max_examples=150, deadline=None)
+@given(n=st.integers(1, 400), alphabet=st.integers(1, 6), seed=st.integers(0, 2**32 - 1),
+       wide=st.booleans(), records=st.booleans(), feeds=st.integers(1, 4))
+def test_welder_pipeline_matches_a_dict_on_any_feed_size(n, alphabet, seed, wide, records, feeds):
+    """The feed loop's prefetch pipeline (64 points ahead) on feeds shorter and longer than its distance, on
+    strided record views and plain (k, 3) arrays, with -0.0 and +0.0, many duplicates and table growth from
+    a tiny hint: the same ids as a dict in stream order."""
+    lib = _native.accel()
+    rng = np.random.default_rng(seed)
+    values = np.array([0.0, -0.0, 1.0, -1.5, 2.0 ** -149, 3e38][:max(alphabet, 2)])
+    pts = rng.choice(values, size=(3 * n, 3)).astype(np.float64 if wide else np.float32)
+    ids, ref_vertices = _first_appearance_ids(pts)
+    out = np.empty(3 * n, np.int32)
+    w = lib.Welder("float64" if wide else "float32", 1)
+    cuts = np.unique(np.r_[0, rng.integers(0, n + 1, size=feeds - 1), n])
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        if records:      # (k, 3, 3) views into 50-byte-like records, as the binary STL reader feeds them
+            rec = np.zeros(b - a, dtype=[("n", pts.dtype, (3,)), ("v", pts.dtype, (3, 3)), ("a", "<u2")])
+            rec["v"] = pts[3 * a:3 * b].reshape(-1, 3, 3)
+            w.feed(rec["v"], out[3 * a:3 * b])
+        else:
+            w.feed(pts[3 * a:3 * b], out[3 * a:3 * b])
+    np.testing.assert_array_equal(out, ids)
+    vertices = np.empty((w.count, 3))
+    w.vertices_into(vertices)
+    np.testing.assert_array_equal(vertices, ref_vertices)
+    assert not np.signbit(vertices[vertices == 0]).any()
+
+
 _faces = st.integers(2, 12).flatmap(lambda n: st.tuples(
     st.just(n), st.lists(st.tuples(*[st.integers(0, n - 1)] * 3), min_size=1, max_size=40)))
 
