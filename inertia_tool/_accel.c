@@ -3206,18 +3206,20 @@ ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
 /* One candidate pair (hierarchy positions i, j); returns 0 to go on, 1 to stop (bound reached or out of
  * memory). */
 static int
-ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, int *have_i)
+ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
     if (!ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)) return 0;
-    if (!*have_i) {                         /* face i is loaded once for all its partners in a leaf */
+    if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
         ct_face_load(FI, sc, i);
         *have_i = 1;
     }
-    CtFace FJ;
-    ct_face_load(&FJ, sc, j);
+    if (!*have_j) {
+        ct_face_load(FJ, sc, j);
+        *have_j = 1;
+    }
     for (int c = 0; c < 3; c++) {           /* the exact (float64) boxes */
-        if (ct_max3(FI->t[c], FI->t[3 + c], FI->t[6 + c]) < ct_min3(FJ.t[c], FJ.t[3 + c], FJ.t[6 + c])
-            || ct_max3(FJ.t[c], FJ.t[3 + c], FJ.t[6 + c]) < ct_min3(FI->t[c], FI->t[3 + c], FI->t[6 + c])) {
+        if (ct_max3(FI->t[c], FI->t[3 + c], FI->t[6 + c]) < ct_min3(FJ->t[c], FJ->t[3 + c], FJ->t[6 + c])
+            || ct_max3(FJ->t[c], FJ->t[3 + c], FJ->t[6 + c]) < ct_min3(FI->t[c], FI->t[3 + c], FI->t[6 + c])) {
             return 0;
         }
     }
@@ -3226,9 +3228,9 @@ ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, int *have_i)
         return 1;
     }
     sc->candidates++;
-    if (FI->skip || FJ.skip) return 0;
+    if (FI->skip || FJ->skip) return 0;
     sc->tested++;
-    const CtFace *A = FI, *B = &FJ;
+    const CtFace *A = FI, *B = FJ;
     if (A->face > B->face) {
         const CtFace *T = A;
         A = B;
@@ -3282,11 +3284,12 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         }
         if (pi == qi) {
             if (p->count > 0) {
+                CtFace leaf[CT_LEAF];
+                uint8_t have[CT_LEAF] = {0};
                 for (int64_t i = p->start; i < p->start + p->count; i++) {
-                    CtFace FI;
-                    int have_i = 0;
                     for (int64_t j = i + 1; j < p->start + p->count; j++) {
-                        if (ct_visit(sc, i, j, &FI, &have_i)) goto out;
+                        int64_t a = i - p->start, b = j - p->start;
+                        if (ct_visit(sc, i, j, &leaf[a], &have[a], &leaf[b], &have[b])) goto out;
                     }
                 }
             }
@@ -3300,6 +3303,8 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             continue;
         }
         if (p->count > 0 && q->count > 0) {
+            CtFace leaf[CT_LEAF];
+            uint8_t have[CT_LEAF] = {0};
             for (int64_t i = p->start; i < p->start + p->count; i++) {
                 const float *bi = sc->BOX + 6 * i;      /* face i against q's box first */
                 if (!((bi[0] <= q->hi[0]) & (q->lo[0] <= bi[3]) & (bi[1] <= q->hi[1]) & (q->lo[1] <= bi[4])
@@ -3307,9 +3312,10 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                     continue;
                 }
                 CtFace FI;
-                int have_i = 0;
+                uint8_t have_i = 0;
                 for (int64_t j = q->start; j < q->start + q->count; j++) {
-                    if (ct_visit(sc, i, j, &FI, &have_i)) goto out;
+                    int64_t b = j - q->start;
+                    if (ct_visit(sc, i, j, &FI, &have_i, &leaf[b], &have[b])) goto out;
                 }
             }
             continue;

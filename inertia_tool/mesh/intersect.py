@@ -274,8 +274,11 @@ def orient2d_sign(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> np.ndarray:
 
 def _filter_safe(v: np.ndarray) -> bool:
     """Whether every nonzero coordinate magnitude lies in the range where the static filter's bound holds."""
-    mag = np.abs(v[v != 0])
-    return not len(mag) or (float(mag.min()) >= _SMALLEST and float(mag.max()) <= _LARGEST)
+    mag = np.abs(v)                      # one temporary, no compaction of the nonzero entries
+    if not mag.size or not float(mag.max()) <= _LARGEST:
+        return not mag.size
+    mag[mag == 0] = np.inf               # zeros are exact: only nonzero magnitudes count
+    return float(mag.min()) >= _SMALLEST
 
 
 def _scaled(v: np.ndarray) -> tuple[np.ndarray, bool]:

@@ -74,8 +74,8 @@ def volume_rounding_bound(vertices: np.ndarray, faces: np.ndarray, rounding: flo
     eps = math.sqrt(3.0) * float(rounding)
     lib = accel()
     if lib is not None:     # the same sums in one pass over the faces, in another order (equal to round-off)
-        area, perimeter = lib.face_measures(np.ascontiguousarray(vertices, dtype=np.float64), faces_for_c(faces),
-                                            threads())
+        sums = lib.face_measures(np.ascontiguousarray(vertices, dtype=np.float64), faces_for_c(faces), threads())
+        area, perimeter = float(sums[0]), float(sums[1])
     else:
         area = perimeter = 0.0
         for start in range(0, len(faces), _CHUNK):
