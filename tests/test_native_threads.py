@@ -1,9 +1,10 @@
 """The C kernels' threads: every kernel must give the same result whatever its thread count.
 
 The edge census splits start vertices; the tetrahedron sums and the face measures add a fixed number of lanes
-in lane order; the bounds split rows; the face-pair check takes node pairs by ticket (same set of pairs).  Each is compared here, on meshes above the kernels' thresholds for using threads, with its
-own one-thread result (bit for bit) and with the numpy reference.  The welder and the shell labels run on one
-thread; they are checked on the same mesh.
+in lane order; the bounds split rows; the face-pair check takes node pairs by ticket (same set of pairs).
+Each is compared here, on meshes above the kernels' thresholds for using threads, with its own one-thread
+result (bit for bit) and with the numpy reference.  The welder and the shell labels run on one thread; they
+are checked on the same mesh.
 """
 
 import numpy as np
