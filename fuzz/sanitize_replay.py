@@ -116,7 +116,9 @@ def c_api_calls() -> int:
         lib.shell_labels(none, 0, np.empty(0, dtype=itype))
         sums, zero = np.zeros((1, 11)), np.zeros(1, dtype=np.int64)
         lib.tetra_sums(np.empty((0, 3)), none, (0.0, 0.0, 0.0), 0.0, None, sums, zero)
-        calls += 3
+        lib.edge_shell_labels(none, 0, np.empty(0, dtype=itype))
+        lib.face_measures(np.empty((0, 3)), none)
+        calls += 5
         tri = np.array([[0, 1, 2]], dtype=itype)
         bad = np.array([[0, 1, 3]], dtype=itype)
         neg = np.array([[0, -1, 2]], dtype=itype)
@@ -124,14 +126,21 @@ def c_api_calls() -> int:
         lib.edge_census(tri, 3)
         lib.shell_labels(tri, 3, np.empty(1, dtype=itype))
         lib.tetra_sums(v, tri, (0.0, 0.0, 0.0), 0.0, None, sums, zero)
-        calls += 3
+        lib.edge_shell_labels(tri, 3, np.empty(1, dtype=itype))
+        lib.face_measures(v, tri, 2)
+        lib.contact_scan(v, np.tile(tri, (3, 1)), -1, 2)
+        calls += 6
         for faces in (bad, neg):
+            expect_error(lib.edge_shell_labels, faces, 3, np.empty(1, dtype=itype))
+            expect_error(lib.face_measures, v, faces)
+            expect_error(lib.contact_scan, v, faces, -1)
             expect_error(lib.edge_census, faces, 3)
             expect_error(lib.shell_labels, faces, 3, np.empty(1, dtype=itype))
             expect_error(lib.tetra_sums, v, faces, (0.0, 0.0, 0.0), 0.0, None, sums, zero)
         expect_error(lib.edge_census, tri, -1)
         expect_error(lib.edge_census, np.asfortranarray(np.tile(tri, (2, 1))), 3)
         expect_error(lib.shell_labels, tri, 3, np.empty(2, dtype=itype))
+        expect_error(lib.edge_shell_labels, tri, 3, np.empty(2, dtype=itype))
         expect_error(lib.tetra_sums, v, tri, (0.0, 0.0, 0.0), 0.0, np.array([5], dtype=itype), sums, zero)
     return calls
 

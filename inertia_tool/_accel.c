@@ -307,6 +307,8 @@ thread_count(int requested, size_t items, size_t min_items)
 #define MAX_VERTICES ((size_t)INT32_MAX - 1)
 #define WELD_RECENT 4096                      /* entries of the recent-point cache */
 #define WELD_INITIAL_MAX ((size_t)1 << 24)    /* slots allocated up front, at most (the table grows past it) */
+#define WELD_AHEAD 64                         /* prefetch distance (points) of the feed loop */
+#define WELD_RING 128                         /* hashes kept for it: a power of two > WELD_AHEAD */
 
 enum { WELD_OK = 0, WELD_NOMEM = 1, WELD_TOO_MANY = 2 };
 
@@ -442,37 +444,70 @@ lookup_##SUFFIX(WelderObject *w, const KEY_T *key, uint64_t h, int32_t *id_out) 
     return WELD_OK;                                                                                       \
 }                                                                                                         \
                                                                                                           \
-/* Weld point (i0, i1) of a (n0, n1, 3) strided array for every i0, i1 in C order into ids[]. */          \
+/* Weld point (i0, i1) of a (n0, n1, 3) strided array for every i0, i1 in C order into ids[].              \
+ * Software pipelined: the point WELD_AHEAD places ahead is hashed and, when the recent-point cache does    \
+ * not hold it, its table slot is prefetched; half as far ahead the slot is read and the key it points to  \
+ * prefetched; so the two dependent cache misses of a table lookup overlap with the work on other points.  \
+ * Prefetches are only hints: the ids are those of the plain loop. */                                     \
+static inline void                                                                                        \
+load_key_##SUFFIX(const char *p, Py_ssize_t sc, KEY_T *key)                                               \
+{                                                                                                         \
+    for (int c = 0; c < 3; c++) {                                                                         \
+        memcpy(&key[c], p + c * sc, sizeof(KEY_T));                                                       \
+        if (key[c] == (NEG_ZERO)) {                                                                       \
+            key[c] = 0;                                                                                   \
+        }                                                                                                 \
+    }                                                                                                     \
+}                                                                                                         \
+                                                                                                          \
 static int                                                                                                \
 feed_##SUFFIX(WelderObject *w, const char *base, Py_ssize_t n0, Py_ssize_t n1, Py_ssize_t s0,             \
               Py_ssize_t s1, Py_ssize_t sc, int32_t *ids)                                                 \
 {                                                                                                         \
-    Py_ssize_t k = 0;                                                                                     \
-    for (Py_ssize_t i0 = 0; i0 < n0; i0++) {                                                              \
-        for (Py_ssize_t i1 = 0; i1 < n1; i1++, k++) {                                                     \
-            const char *p = base + i0 * s0 + i1 * s1;                                                     \
-            KEY_T key[3];                                                                                 \
-            for (int c = 0; c < 3; c++) {                                                                 \
-                memcpy(&key[c], p + c * sc, sizeof(KEY_T));                                               \
-                if (key[c] == (NEG_ZERO)) {                                                               \
-                    key[c] = 0;                                                                           \
-                }                                                                                         \
+    uint64_t ring[WELD_RING];                                                                             \
+    Py_ssize_t total = n0 * n1, a0 = 0, a1 = 0, i0 = 0, i1 = 0;                                           \
+    /* hashes of the first WELD_AHEAD points; (a0, a1) then walks WELD_AHEAD points ahead of (i0, i1) */  \
+    for (Py_ssize_t k = 0; k < total && k < WELD_AHEAD; k++) {                                            \
+        KEY_T key[3];                                                                                     \
+        load_key_##SUFFIX(base + a0 * s0 + a1 * s1, sc, key);                                             \
+        ring[k & (WELD_RING - 1)] = HASH(key);                                                            \
+        if (++a1 == n1) { a1 = 0; a0++; }                                                                 \
+    }                                                                                                     \
+    for (Py_ssize_t k = 0; k < total; k++) {                                                              \
+        if (k + WELD_AHEAD < total) {                                                                     \
+            KEY_T ka[3];                                                                                  \
+            load_key_##SUFFIX(base + a0 * s0 + a1 * s1, sc, ka);                                          \
+            if (++a1 == n1) { a1 = 0; a0++; }                                                             \
+            uint64_t ha = HASH(ka);                                                                       \
+            ring[(k + WELD_AHEAD) & (WELD_RING - 1)] = ha;                                                \
+            const RECENT_T *ra = (const RECENT_T *)w->recent + ((ha >> 40) & (WELD_RECENT - 1));          \
+            if (!(ra->id != 0 && ra->k[0] == ka[0] && ra->k[1] == ka[1] && ra->k[2] == ka[2])) {          \
+                __builtin_prefetch(&w->slots[(size_t)ha & w->mask]);                                      \
             }                                                                                             \
-            uint64_t h = HASH(key);                                                                       \
-            RECENT_T *r = (RECENT_T *)w->recent + ((h >> 40) & (WELD_RECENT - 1));                        \
-            if (r->id != 0 && r->k[0] == key[0] && r->k[1] == key[1] && r->k[2] == key[2]) {              \
-                ids[k] = (int32_t)(r->id - 1);                                                            \
-                continue;                                                                                 \
-            }                                                                                             \
-            int status = lookup_##SUFFIX(w, key, h, &ids[k]);                                             \
-            if (status != WELD_OK) {                                                                      \
-                return status;                                                                            \
-            }                                                                                             \
-            r->k[0] = key[0];                                                                             \
-            r->k[1] = key[1];                                                                             \
-            r->k[2] = key[2];                                                                             \
-            r->id = (uint32_t)ids[k] + 1;                                                                 \
         }                                                                                                 \
+        if (k + WELD_AHEAD / 2 < total) {                                                                 \
+            uint32_t sid = w->slots[(size_t)ring[(k + WELD_AHEAD / 2) & (WELD_RING - 1)] & w->mask];      \
+            if (sid != 0) {                                                                               \
+                __builtin_prefetch((const KEY_T *)w->keys + 3 * (size_t)(sid - 1));                       \
+            }                                                                                             \
+        }                                                                                                 \
+        KEY_T key[3];                                                                                     \
+        load_key_##SUFFIX(base + i0 * s0 + i1 * s1, sc, key);                                             \
+        if (++i1 == n1) { i1 = 0; i0++; }                                                                 \
+        uint64_t h = ring[k & (WELD_RING - 1)];                                                           \
+        RECENT_T *r = (RECENT_T *)w->recent + ((h >> 40) & (WELD_RECENT - 1));                            \
+        if (r->id != 0 && r->k[0] == key[0] && r->k[1] == key[1] && r->k[2] == key[2]) {                  \
+            ids[k] = (int32_t)(r->id - 1);                                                                \
+            continue;                                                                                     \
+        }                                                                                                 \
+        int status = lookup_##SUFFIX(w, key, h, &ids[k]);                                                 \
+        if (status != WELD_OK) {                                                                          \
+            return status;                                                                                \
+        }                                                                                                 \
+        r->k[0] = key[0];                                                                                 \
+        r->k[1] = key[1];                                                                                 \
+        r->k[2] = key[2];                                                                                 \
+        r->id = (uint32_t)ids[k] + 1;                                                                     \
     }                                                                                                     \
     return WELD_OK;                                                                                       \
 }
@@ -1081,6 +1116,156 @@ fail:
     return NULL;
 }
 
+/* ------------------------------------------------------------------------------------------------------
+ * 4b. edge_shell_labels -- faces joined through shared undirected edges (checks._edge_shell_labels)
+ *
+ * Each face edge {a, b} is bucketed by its smaller end u = min(a, b) as the packed word (v << 32) | face,
+ * v = max(a, b) (a CSR over vertices: 3m words plus n + 1 offsets); each bucket is sorted, so the faces
+ * using one edge form a run, and consecutive faces of a run are united (union-find over faces, union by
+ * smaller index, path halving: each root is its component's first face).  Faces are then labelled by
+ * their root's rank in face order, i.e. components are numbered by their first face, as the numpy path.
+ * ------------------------------------------------------------------------------------------------------ */
+
+static void
+sort_words(uint64_t *t, size_t len)
+{
+    for (size_t i = 1; i < len; i++) {
+        uint64_t x = t[i];
+        size_t j = i;
+        while (j > 0 && t[j - 1] > x) {
+            t[j] = t[j - 1];
+            j--;
+        }
+        t[j] = x;
+    }
+}
+
+static int
+cmp_uint64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static inline void
+unite_faces(int32_t *parent, int32_t a, int32_t b)
+{
+    a = find_root(parent, a);
+    b = find_root(parent, b);
+    if (a < b) {
+        parent[b] = a;
+    }
+    else if (b < a) {
+        parent[a] = b;
+    }
+}
+
+static PyObject *
+accel_edge_shell_labels(PyObject *self, PyObject *args)
+{
+    PyObject *faces_obj, *out_obj;
+    Py_ssize_t n_vertices;
+    if (!PyArg_ParseTuple(args, "OnO", &faces_obj, &n_vertices, &out_obj) || check_vertex_count(n_vertices) < 0) {
+        return NULL;
+    }
+    Py_buffer fv, out;
+    Py_ssize_t m;
+    int size;
+    if (get_faces(faces_obj, &fv, &m, &size) < 0) {
+        return NULL;
+    }
+    if (PyObject_GetBuffer(out_obj, &out, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        PyBuffer_Release(&fv);
+        return NULL;
+    }
+    int out_size = signed_int_size(&out);
+    if (out_size == 0 || out.ndim != 1 || out.shape[0] != m) {
+        PyErr_Format(PyExc_ValueError, "Expected `out` as a contiguous int32 or int64 array of %zd entries", m);
+        goto fail;
+    }
+    if ((size_t)m > (size_t)INT32_MAX - 1) {
+        PyErr_Format(PyExc_ValueError, "Expected fewer than 2**31 - 1 faces, got %zd", m);
+        goto fail;
+    }
+    if (check_indices(fv.buf, size, 3 * (size_t)m, n_vertices) < 0) {
+        goto fail;
+    }
+    size_t n = (size_t)n_vertices, mm = (size_t)m;
+    int64_t *off = (int64_t *)calloc(n + 1, sizeof(int64_t));
+    uint64_t *word = (uint64_t *)malloc((mm ? 3 * mm : 1) * sizeof(uint64_t));
+    int32_t *parent = (int32_t *)malloc((mm ? mm : 1) * sizeof(int32_t));
+    if (off == NULL || word == NULL || parent == NULL) {
+        free(off);
+        free(word);
+        free(parent);
+        PyErr_NoMemory();
+        goto fail;
+    }
+    int64_t count = 0;
+    Py_BEGIN_ALLOW_THREADS
+    const void *f = fv.buf;
+    for (size_t i = 0; i < 3 * mm; i++) {
+        size_t face = i / 3, k = i - 3 * face;
+        int64_t a = index_at(f, size, i), b = index_at(f, size, 3 * face + (k + 1) % 3);
+        off[(a < b ? a : b) + 1]++;
+    }
+    for (size_t u = 0; u < n; u++) {
+        off[u + 1] += off[u];
+    }
+    for (size_t face = 0; face < mm; face++) {          /* off[u] runs from u's bucket start to its end */
+        for (int k = 0; k < 3; k++) {
+            int64_t a = index_at(f, size, 3 * face + k), b = index_at(f, size, 3 * face + (k + 1) % 3);
+            int64_t u = a < b ? a : b, v = a < b ? b : a;
+            word[off[u]++] = ((uint64_t)v << 32) | (uint64_t)face;
+        }
+    }
+    for (size_t face = 0; face < mm; face++) {
+        parent[face] = (int32_t)face;
+    }
+    for (size_t u = 0; u < n; u++) {                     /* off[u] is now the end of u's bucket */
+        size_t lo = u ? (size_t)off[u - 1] : 0, hi = (size_t)off[u];
+        if (hi - lo > 32) {
+            qsort(word + lo, hi - lo, sizeof(uint64_t), cmp_uint64);
+        }
+        else {
+            sort_words(word + lo, hi - lo);
+        }
+        for (size_t p = lo + 1; p < hi; p++) {
+            if ((word[p] >> 32) == (word[p - 1] >> 32)) {
+                unite_faces(parent, (int32_t)(word[p - 1] & 0xffffffffu), (int32_t)(word[p] & 0xffffffffu));
+            }
+        }
+    }
+    /* a root precedes every face of its component: it gets its rank first */
+    for (size_t face = 0; face < mm; face++) {
+        int32_t r = find_root(parent, (int32_t)face);
+        int64_t label;
+        if (r == (int32_t)face) {
+            label = count++;
+        }
+        else {
+            label = out_size == 8 ? ((int64_t *)out.buf)[r] : ((int32_t *)out.buf)[r];
+        }
+        if (out_size == 8) {
+            ((int64_t *)out.buf)[face] = label;
+        }
+        else {
+            ((int32_t *)out.buf)[face] = (int32_t)label;
+        }
+    }
+    Py_END_ALLOW_THREADS
+    free(off);
+    free(word);
+    free(parent);
+    PyBuffer_Release(&fv);
+    PyBuffer_Release(&out);
+    return PyLong_FromLongLong((long long)count);
+fail:
+    PyBuffer_Release(&fv);
+    PyBuffer_Release(&out);
+    return NULL;
+}
+
 /* ======================================================================================================
  * 5. tetra_sums
  *
@@ -1401,6 +1586,100 @@ accel_bounds(PyObject *self, PyObject *args)
     return Py_BuildValue("((ddd)(ddd)O)", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], finite ? Py_True : Py_False);
 }
 
+/* ------------------------------------------------------------------------------------------------------
+ * 6b. face_measures -- sums of the face areas and perimeters (mesh/precision.volume_rounding_bound)
+ *
+ * Faces are split into SUM_LANES fixed contiguous lanes, summed lane by lane (threads take lanes t, t + nt,
+ * ...) and the lane sums added in lane order, so the result does not depend on the thread count.
+ * ------------------------------------------------------------------------------------------------------ */
+
+typedef struct {
+    const double *v;
+    const void *f;
+    int size;
+    size_t m;
+    int lanes;
+    double area[SUM_LANES], perimeter[SUM_LANES];
+} MeasureTask;
+
+static void
+measure_task(void *ctx, int t, int nt)
+{
+    MeasureTask *c = (MeasureTask *)ctx;
+    for (int lane = t; lane < c->lanes; lane += nt) {
+        double area = 0.0, perimeter = 0.0;
+        for (size_t i = part_start(c->m, lane, c->lanes); i < part_start(c->m, lane + 1, c->lanes); i++) {
+            const double *a = c->v + 3 * index_at(c->f, c->size, 3 * i);
+            const double *b = c->v + 3 * index_at(c->f, c->size, 3 * i + 1);
+            const double *d = c->v + 3 * index_at(c->f, c->size, 3 * i + 2);
+            double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            double ad[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+            double bd[3] = {d[0] - b[0], d[1] - b[1], d[2] - b[2]};
+            double nx = ab[1] * ad[2] - ab[2] * ad[1], ny = ab[2] * ad[0] - ab[0] * ad[2];
+            double nz = ab[0] * ad[1] - ab[1] * ad[0];
+            area += 0.5 * sqrt(nx * nx + ny * ny + nz * nz);
+            perimeter += sqrt(ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2])
+                         + sqrt(ad[0] * ad[0] + ad[1] * ad[1] + ad[2] * ad[2])
+                         + sqrt(bd[0] * bd[0] + bd[1] * bd[1] + bd[2] * bd[2]);
+        }
+        c->area[lane] = area;
+        c->perimeter[lane] = perimeter;
+    }
+}
+
+static PyObject *
+accel_face_measures(PyObject *self, PyObject *args)
+{
+    PyObject *vert_obj, *faces_obj;
+    int threads = 1;
+    if (!PyArg_ParseTuple(args, "OO|i", &vert_obj, &faces_obj, &threads)) {
+        return NULL;
+    }
+    Py_buffer vv, fv;
+    Py_ssize_t m;
+    int size;
+    if (PyObject_GetBuffer(vert_obj, &vv, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    if (native_code(vv.format) != 'd' || vv.itemsize != 8 || vv.ndim != 2 || vv.shape[1] != 3) {
+        PyErr_SetString(PyExc_ValueError, "Expected `vertices` as a C-contiguous (n, 3) float64 array");
+        PyBuffer_Release(&vv);
+        return NULL;
+    }
+    if (get_faces(faces_obj, &fv, &m, &size) < 0) {
+        PyBuffer_Release(&vv);
+        return NULL;
+    }
+    PyObject *result = NULL;
+    if (check_indices(fv.buf, size, 3 * (size_t)m, (int64_t)vv.shape[0]) == 0) {
+        MeasureTask *c = (MeasureTask *)calloc(1, sizeof(MeasureTask));
+        if (c == NULL) {
+            PyErr_NoMemory();
+        }
+        else {
+            c->v = (const double *)vv.buf;
+            c->f = fv.buf;
+            c->size = size;
+            c->m = (size_t)m;
+            c->lanes = (size_t)m < SUM_LANES_MIN ? 1 : SUM_LANES;
+            int nt = thread_count(threads, (size_t)m, SUM_LANES_MIN);
+            Py_BEGIN_ALLOW_THREADS
+            run_parallel(nt, measure_task, c);
+            Py_END_ALLOW_THREADS
+            double area = 0.0, perimeter = 0.0;
+            for (int lane = 0; lane < c->lanes; lane++) {
+                area += c->area[lane];
+                perimeter += c->perimeter[lane];
+            }
+            free(c);
+            result = Py_BuildValue("(dd)", area, perimeter);
+        }
+    }
+    PyBuffer_Release(&vv);
+    PyBuffer_Release(&fv);
+    return result;
+}
+
 /* ======================================================================================================
  * module
  * ====================================================================================================== */
@@ -1416,6 +1695,9 @@ static PyMethodDef accel_methods[] = {
     {"shell_labels", accel_shell_labels, METH_VARARGS,
      "shell_labels(faces, n_vertices, out) -> count\n\nWrite each face's shell (connected by shared "
      "vertices), numbered by the shell's smallest vertex index, into `out` (m,) int32/int64."},
+    {"edge_shell_labels", accel_edge_shell_labels, METH_VARARGS,
+     "edge_shell_labels(faces, n_vertices, out) -> count\n\nWrite each face's shell (faces connected through "
+     "shared undirected edges), numbered by the shell's first face, into `out` (m,) int32/int64."},
     {"tetra_sums", accel_tetra_sums, METH_VARARGS,
      "tetra_sums(vertices, faces, origin, area_floor, labels, sums, zero, threads=1)\n\nCompensated signed-tetrahedron "
      "sums per label into sums (L, 11) float64 [vol, first xyz, second xx yy zz xy xz yz, area] and zero "
@@ -1424,6 +1706,9 @@ static PyMethodDef accel_methods[] = {
     {"bounds", accel_bounds, METH_VARARGS,
      "bounds(vertices, threads=1) -> ((lo x, y, z), (hi x, y, z), all_finite)\n\nColumn minima and maxima of "
      "an (n >= 1, 3) C-contiguous float64 array (NaN propagates) and whether every entry is finite."},
+    {"face_measures", accel_face_measures, METH_VARARGS,
+     "face_measures(vertices, faces, threads=1) -> (area, perimeter)\n\nSums of the face areas and of the face "
+     "perimeters of (n, 3) float64 vertices and (m, 3) int32/int64 faces; threads only change the speed."},
     {"split_steps", accel_split_steps, METH_VARARGS,
      "split_steps(moments, drifts, kicks, w, q, tau, t, h, count, torque, frame, q_proto, w_proto, "
      "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition "
@@ -2535,8 +2820,8 @@ ct_projections_separate(const double *const t1[3], const double *const t2[3], co
 }
 
 /* Fills F from corners p0, p1, p2 (the normal, its permanent, the projection axis, the zero-area flag). */
-static void
-ct_face_init(CtFace *F, const double *p0, const double *p1, const double *p2, CtStats *st)
+static inline void
+ct_face_geometry(CtFace *F, const double *p0, const double *p1, const double *p2)
 {
     double e1[3], e2[3];
     for (int c = 0; c < 3; c++) {
@@ -2552,6 +2837,12 @@ ct_face_init(CtFace *F, const double *p0, const double *p1, const double *p2, Ct
     F->na[0] = fabs(e1[1]) * fabs(e2[2]) + fabs(e1[2]) * fabs(e2[1]);
     F->na[1] = fabs(e1[2]) * fabs(e2[0]) + fabs(e1[0]) * fabs(e2[2]);
     F->na[2] = fabs(e1[0]) * fabs(e2[1]) + fabs(e1[1]) * fabs(e2[0]);
+}
+
+static void
+ct_face_init(CtFace *F, const double *p0, const double *p1, const double *p2, CtStats *st)
+{
+    ct_face_geometry(F, p0, p1, p2);
     /* the axis of the largest |normal component| (first of equals), then the next ones until the projected
      * triangle has an exactly nonzero orientation (as mesh/intersect._face_axes) */
     int k = 0;
@@ -2683,13 +2974,6 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
     return (n_shared > 0 ? positive : meet) ? CT_CONTACT : CT_NONE;
 }
 
-static int
-ct_int64(const Py_buffer *view)
-{
-    char c = native_code(view->format);
-    return (c == 'l' || c == 'q') && view->itemsize == 8;
-}
-
 /* ------------------------------------------------------------------------------------------------------
  * contact_scan -- the whole check in one pass: a bounding-volume hierarchy over the face boxes (faces in
  * Morton order of their box centres, sorted by an LSD radix sort; index ranges halved down to leaves of at
@@ -2703,8 +2987,46 @@ ct_int64(const Py_buffer *view)
 #endif
 #define CT_MORTON_BITS 16       /* per axis: a 48-bit code, sorted in four passes of 12 bits */
 
+static inline double
+ct_min3(double a, double b, double c)
+{
+    double m = a < b ? a : b;
+    return m < c ? m : c;
+}
+
+static inline double
+ct_max3(double a, double b, double c)
+{
+    double m = a > b ? a : b;
+    return m > c ? m : c;
+}
+
+/* A face at a hierarchy position: its corner indices and its index in the caller's faces (16 bytes). */
 typedef struct {
-    double lo[3], hi[3];
+    int32_t fo[3];
+    int32_t face;
+} CtRec;
+
+/* Boxes in the hierarchy are float32, rounded outward (ct_f32_down / ct_f32_up), so they contain the exact
+ * boxes: a pair whose float boxes meet may not be a candidate, and ct_visit decides that from the faces'
+ * float64 corners; a pair whose exact boxes meet always has meeting float boxes.  Half the memory of double
+ * boxes (24 bytes per face), and half the traffic of the walk. */
+static inline float
+ct_f32_down(double x)
+{
+    float f = (float)x;
+    return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+
+static inline float
+ct_f32_up(double x)
+{
+    float f = (float)x;
+    return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
+typedef struct {
+    float lo[3], hi[3];
     int64_t start, count;       /* leaf: positions start .. start+count; inner: count = 0 */
     int64_t left, right;
 } CtNode;
@@ -2794,11 +3116,11 @@ ct_radix_sort(uint64_t *code, int64_t *order, int64_t m)
     return 0;
 }
 
-/* Builds the hierarchy over the boxes BOX (lo, hi: 6 doubles per position, already in hierarchy order):
+/* Builds the hierarchy over the boxes BOX (lo, hi: 6 floats per position, already in hierarchy order):
  * the tree halving index ranges (leaves of at most CT_LEAF faces), node boxes from the leaves up.  Returns
  * the node count. */
 static int64_t
-ct_build(CtNode *nodes, const double *BOX, int64_t m)
+ct_build(CtNode *nodes, const float *BOX, int64_t m)
 {
     int64_t n_nodes = 1;
     nodes[0].start = 0;
@@ -2845,8 +3167,10 @@ ct_build(CtNode *nodes, const double *BOX, int64_t m)
 }
 
 typedef struct {
-    const double *BOX;          /* face boxes (lo, hi), in hierarchy order */
-    const CtFace *FACE;         /* faces, in hierarchy order */
+    const float *BOX;           /* face boxes (lo, hi) rounded outward to float32, in hierarchy order */
+    const CtRec *rec;           /* corner indices and face index, in hierarchy order */
+    const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
+    const double *V;            /* vertices (n, 3) */
     const CtNode *nodes;
     long long max_pairs;        /* < 0: no bound */
     long long candidates, tested;
@@ -2856,26 +3180,57 @@ typedef struct {
 } CtScan;
 
 static inline int
-ct_boxes_meet(const double *p, const double *q)
+ct_boxes_meet(const float *p, const float *q)
 {
     /* bitwise: no branch per comparison (their outcomes are hard to predict) */
     return (p[0] <= q[3]) & (q[0] <= p[3]) & (p[1] <= q[4]) & (q[1] <= p[4]) & (p[2] <= q[5]) & (q[2] <= p[5]);
 }
 
+/* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
+ * (the same arithmetic as ct_face_init), its corner indices, and the axis and zero-area flag ct_face_init
+ * gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
+ * when a box meets its (16 + 1 bytes per face instead). */
+static inline void
+ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
+{
+    const CtRec *r = &sc->rec[i];
+    for (int k = 0; k < 3; k++) {
+        F->fo[k] = r->fo[k];
+    }
+    ct_face_geometry(F, sc->V + 3 * (size_t)r->fo[0], sc->V + 3 * (size_t)r->fo[1], sc->V + 3 * (size_t)r->fo[2]);
+    F->face = r->face;
+    F->axis = sc->flags[i] & 3;
+    F->skip = sc->flags[i] >> 2;
+}
+
 /* One candidate pair (hierarchy positions i, j); returns 0 to go on, 1 to stop (bound reached or out of
  * memory). */
 static int
-ct_visit(CtScan *sc, int64_t i, int64_t j)
+ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
     if (!ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)) return 0;
+    if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
+        ct_face_load(FI, sc, i);
+        *have_i = 1;
+    }
+    if (!*have_j) {
+        ct_face_load(FJ, sc, j);
+        *have_j = 1;
+    }
+    for (int c = 0; c < 3; c++) {           /* the exact (float64) boxes */
+        if (ct_max3(FI->t[c], FI->t[3 + c], FI->t[6 + c]) < ct_min3(FJ->t[c], FJ->t[3 + c], FJ->t[6 + c])
+            || ct_max3(FJ->t[c], FJ->t[3 + c], FJ->t[6 + c]) < ct_min3(FI->t[c], FI->t[3 + c], FI->t[6 + c])) {
+            return 0;
+        }
+    }
     if (sc->max_pairs >= 0 && sc->candidates >= sc->max_pairs) {
         sc->complete = 0;
         return 1;
     }
     sc->candidates++;
-    const CtFace *A = &sc->FACE[i], *B = &sc->FACE[j];
-    if (A->skip || B->skip) return 0;
+    if (FI->skip || FJ->skip) return 0;
     sc->tested++;
+    const CtFace *A = FI, *B = FJ;
     if (A->face > B->face) {
         const CtFace *T = A;
         A = B;
@@ -2929,9 +3284,12 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         }
         if (pi == qi) {
             if (p->count > 0) {
+                CtFace leaf[CT_LEAF];
+                uint8_t have[CT_LEAF] = {0};
                 for (int64_t i = p->start; i < p->start + p->count; i++) {
                     for (int64_t j = i + 1; j < p->start + p->count; j++) {
-                        if (ct_visit(sc, i, j)) goto out;
+                        int64_t a = i - p->start, b = j - p->start;
+                        if (ct_visit(sc, i, j, &leaf[a], &have[a], &leaf[b], &have[b])) goto out;
                     }
                 }
             }
@@ -2945,14 +3303,19 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             continue;
         }
         if (p->count > 0 && q->count > 0) {
+            CtFace leaf[CT_LEAF];
+            uint8_t have[CT_LEAF] = {0};
             for (int64_t i = p->start; i < p->start + p->count; i++) {
-                const double *bi = sc->BOX + 6 * i;     /* face i against q's box first */
+                const float *bi = sc->BOX + 6 * i;      /* face i against q's box first */
                 if (!((bi[0] <= q->hi[0]) & (q->lo[0] <= bi[3]) & (bi[1] <= q->hi[1]) & (q->lo[1] <= bi[4])
                       & (bi[2] <= q->hi[2]) & (q->lo[2] <= bi[5]))) {
                     continue;
                 }
+                CtFace FI;
+                uint8_t have_i = 0;
                 for (int64_t j = q->start; j < q->start + q->count; j++) {
-                    if (ct_visit(sc, i, j)) goto out;
+                    int64_t b = j - q->start;
+                    if (ct_visit(sc, i, j, &FI, &have_i, &leaf[b], &have[b])) goto out;
                 }
             }
             continue;
@@ -3047,32 +3410,22 @@ ct_tasks(const CtNode *nodes, int64_t *tasks)
     return n;
 }
 
-static inline double
-ct_min3(double a, double b, double c)
-{
-    double m = a < b ? a : b;
-    return m < c ? m : c;
-}
-
-static inline double
-ct_max3(double a, double b, double c)
-{
-    double m = a > b ? a : b;
-    return m > c ? m : c;
-}
-
 /* Per-face preparation, split over threads by position: Morton codes (pass 0), then the faces and boxes in
  * hierarchy order (pass 1). */
 typedef struct {
     int pass;
     int64_t m;
     const double *V;
-    const int64_t *F;
+    const void *F;
+    int size;
     const int64_t *order;
     uint64_t *code;
     double gmin[3], scale[3];
-    CtFace *face;
-    double *box;
+    int8_t *axis;
+    uint8_t *skip;
+    float *box;
+    CtRec *rec;
+    uint8_t *flags;
     long exact[MAX_THREADS];
     int failed[MAX_THREADS];
 } CtPrep;
@@ -3084,8 +3437,9 @@ ct_prep_task(void *ctx, int t, int nt)
     int64_t s = (int64_t)part_start((size_t)pr->m, t, nt), e = (int64_t)part_start((size_t)pr->m, t + 1, nt);
     if (pr->pass == 0) {
         for (int64_t f = s; f < e; f++) {
-            const double *p0 = pr->V + 3 * pr->F[3 * f], *p1 = pr->V + 3 * pr->F[3 * f + 1];
-            const double *p2 = pr->V + 3 * pr->F[3 * f + 2];
+            const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
+            const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
+            const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
             uint64_t code = 0;
             for (int c = 0; c < 3; c++) {
                 double lo = ct_min3(p0[c], p1[c], p2[c]), hi = ct_max3(p0[c], p1[c], p2[c]);
@@ -3101,16 +3455,21 @@ ct_prep_task(void *ctx, int t, int nt)
     CtStats st = {0, 0};
     for (int64_t i = s; i < e; i++) {
         int64_t f = pr->order[i];
-        CtFace *F = &pr->face[i];
-        const int64_t *fi = pr->F + 3 * f;
-        ct_face_init(F, pr->V + 3 * fi[0], pr->V + 3 * fi[1], pr->V + 3 * fi[2], &st);
-        F->fo[0] = fi[0];
-        F->fo[1] = fi[1];
-        F->fo[2] = fi[2];
-        F->face = f;
+        CtFace F;
+        const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
+        const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
+        const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
+        ct_face_init(&F, p0, p1, p2, &st);
+        pr->axis[f] = (int8_t)F.axis;
+        pr->skip[f] = (uint8_t)F.skip;
+        pr->flags[i] = (uint8_t)(F.axis | F.skip << 2);
+        for (int k = 0; k < 3; k++) {
+            pr->rec[i].fo[k] = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
+        }
+        pr->rec[i].face = (int32_t)f;
         for (int c = 0; c < 3; c++) {
-            pr->box[6 * i + c] = ct_min3(F->t[c], F->t[3 + c], F->t[6 + c]);
-            pr->box[6 * i + 3 + c] = ct_max3(F->t[c], F->t[3 + c], F->t[6 + c]);
+            pr->box[6 * i + c] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
+            pr->box[6 * i + 3 + c] = ct_f32_up(ct_max3(p0[c], p1[c], p2[c]));
         }
     }
     pr->exact[t] += st.exact;
@@ -3135,8 +3494,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
     CtNode *nodes = NULL;
     int64_t *order = NULL;
     uint64_t *code = NULL;
-    CtFace *face = NULL;
-    double *box = NULL;
+    float *box = NULL;
+    CtRec *rec = NULL;
+    uint8_t *flags = NULL;
     int8_t *axis_out = NULL;
     uint8_t *skip_out = NULL;
     CtScan sc;
@@ -3148,21 +3508,29 @@ accel_contact_scan(PyObject *self, PyObject *args)
     }
     {
         Py_buffer *vv = &views[0], *fv = &views[1];
+        int fsize = signed_int_size(fv);
         if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3
-            || !ct_int64(fv) || fv->ndim != 2 || fv->shape[1] != 3) {
-            PyErr_SetString(PyExc_ValueError, "Expected vertices (n, 3) float64 and faces (m, 3) int64, both "
-                            "C-contiguous");
+            || fsize == 0 || fv->ndim != 2 || fv->shape[1] != 3) {
+            PyErr_SetString(PyExc_ValueError, "Expected vertices (n, 3) float64 and faces (m, 3) int32 or int64, "
+                            "both C-contiguous");
             goto done;
         }
         int64_t n = vv->shape[0], m = fv->shape[0];
-        const int64_t *F = (const int64_t *)fv->buf;
+        const void *F = fv->buf;
         const double *V = (const double *)vv->buf;
-        for (int64_t i = 0; i < m * 3; i++) {
-            if (F[i] < 0 || F[i] >= n) {
-                PyErr_Format(PyExc_ValueError, "Expected face indices in [0, %lld), found %lld",
-                             (long long)n, (long long)F[i]);
-                goto done;
-            }
+        Py_ssize_t bad;
+        Py_BEGIN_ALLOW_THREADS
+        bad = first_bad_index(F, fsize, 3 * (size_t)m, n);
+        Py_END_ALLOW_THREADS
+        if (bad >= 0) {
+            PyErr_Format(PyExc_ValueError, "Expected face indices in [0, %lld), found %lld",
+                         (long long)n, (long long)index_at(F, fsize, (size_t)bad));
+            goto done;
+        }
+        if (n > (int64_t)INT32_MAX || m > (int64_t)INT32_MAX - 1) {
+            PyErr_Format(PyExc_ValueError, "Expected fewer than 2**31 vertices and faces, got %lld and %lld",
+                         (long long)n, (long long)m);
+            goto done;
         }
         sc.complete = 1;
         sc.max_pairs = max_pairs;
@@ -3175,12 +3543,13 @@ accel_contact_scan(PyObject *self, PyObject *args)
         nodes = (CtNode *)malloc((2 * mm / ((CT_LEAF + 1) / 2) + 2) * sizeof(CtNode));
         order = (int64_t *)malloc(mm * sizeof(int64_t));
         code = (uint64_t *)malloc(mm * sizeof(uint64_t));
-        face = (CtFace *)malloc(mm * sizeof(CtFace));
-        box = (double *)malloc(mm * 6 * sizeof(double));
+        box = (float *)malloc(mm * 6 * sizeof(float));
+        rec = (CtRec *)malloc(mm * sizeof(CtRec));
+        flags = (uint8_t *)malloc(mm);
         axis_out = (int8_t *)malloc(mm);
         skip_out = (uint8_t *)malloc(mm);
-        if (nodes == NULL || order == NULL || code == NULL || face == NULL || box == NULL || axis_out == NULL
-            || skip_out == NULL) {
+        if (nodes == NULL || order == NULL || code == NULL || box == NULL || rec == NULL || flags == NULL
+            || axis_out == NULL || skip_out == NULL) {
             PyErr_NoMemory();
             goto done;
         }
@@ -3192,10 +3561,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.m = m;
         pr.V = V;
         pr.F = F;
+        pr.size = fsize;
         pr.code = code;
         pr.order = order;
-        pr.face = face;
+        pr.axis = axis_out;
+        pr.skip = skip_out;
         pr.box = box;
+        pr.rec = rec;
+        pr.flags = flags;
         /* the Morton grid: box centres of the faces, 2^16 cells per axis over their range */
         double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int64_t i = 0; i < n; i++) {       /* every vertex: a bound of the box centres */
@@ -3216,21 +3589,23 @@ accel_contact_scan(PyObject *self, PyObject *args)
             oom = 1;
         }
         else {
+            free(code);                     /* the sorted codes are not needed */
+            code = NULL;
             pr.pass = 1;
             run_parallel(nt, ct_prep_task, &pr);
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
                 failed |= pr.failed[t];
             }
-            for (int64_t i = 0; i < m; i++) {
-                axis_out[face[i].face] = (int8_t)face[i].axis;
-                skip_out[face[i].face] = (uint8_t)face[i].skip;
-            }
+            free(order);                    /* rec holds the face indices in hierarchy order */
+            order = NULL;
         }
         if (!oom && !failed && m >= 2) {
             ct_build(nodes, box, m);
             sc.BOX = box;
-            sc.FACE = face;
+            sc.rec = rec;
+            sc.flags = flags;
+            sc.V = V;
             sc.nodes = nodes;
             if (max_pairs >= 0) nt = 1;
             if (nt == 1) {
@@ -3306,8 +3681,9 @@ done:
     free(nodes);
     free(order);
     free(code);
-    free(face);
     free(box);
+    free(rec);
+    free(flags);
     free(axis_out);
     free(skip_out);
     free(sc.found.a);

@@ -1,9 +1,10 @@
 """The boundary to the optional C extension ``inertia_tool._accel``.
 
-The engine's hot loops (exact welding, the edge census, shell labels, the tetrahedron sums, the splitting
-integrator's steps) have two implementations: C kernels in ``_accel.c`` (built by ``pip install`` when a C
-compiler is present) and the pure-numpy (or pure-Python) code of ``weld``, ``checks``, ``volume`` and
-``dynamics.splitting``, which is the reference and the fallback.  Each of those
+The engine's hot loops (exact welding, the edge census, shell labels, the tetrahedron sums, the face-pair
+check, the float32 storage bound, the splitting integrator's steps) have two implementations: C kernels in
+``_accel.c`` (built by ``pip install`` when a C compiler is present) and the pure-numpy (or pure-Python) code
+of ``weld``, ``checks``, ``volume``, ``intersect``, ``precision`` and ``dynamics.splitting``, which is the
+reference and the fallback.  Each of those
 modules asks :func:`accel` at call time which one to run.  Set the environment variable
 ``INERTIA_TOOL_NO_ACCEL=1`` to force the numpy path (results are identical, or equal to round-off for the
 integrals, which the C kernel sums with compensation).

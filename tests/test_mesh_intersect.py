@@ -512,13 +512,28 @@ def test_c_kernel_refuses_malformed_arguments(kernel, bad):
         f = f.copy()
         f[3, 1] = 99
     elif bad == "dtype":
-        f = f.astype(np.int32)
+        f = f.astype(np.int16)          # int32 and int64 are read (see the next test)
     elif bad == "shape":
         v = np.ascontiguousarray(v[:, :2])
     elif bad == "vertex dtype":
         v = v.astype(np.float32)
     with pytest.raises(ValueError, match="Expected"):
         lib.contact_scan(v, f, -1)
+
+
+def test_c_kernel_reads_int32_faces_as_int64(kernel):
+    """The C scan reads int32 faces in place (no 24-byte-per-face int64 copy): same pairs, counts and flags."""
+    if kernel != "c":
+        pytest.skip("the C kernel's face types")
+    lib = _native.accel()
+    rng = np.random.default_rng(5)
+    v = rng.random((40, 3))
+    f = rng.integers(0, 40, size=(120, 3))
+    wide = lib.contact_scan(v, np.ascontiguousarray(f, dtype=np.int64), -1, 1)
+    narrow = lib.contact_scan(v, np.ascontiguousarray(f, dtype=np.int32), -1, 1)
+    assert wide[3] > 0 and wide[3:7] == narrow[3:7]
+    for w, n in zip(wide[:3] + wide[7:], narrow[:3] + narrow[7:]):
+        assert w == n
 
 
 @settings(max_examples=25, deadline=None)

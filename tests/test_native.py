@@ -136,6 +136,43 @@ def test_welder_table_grows_from_a_small_hint():
     np.testing.assert_array_equal(out[ids], pts)
 
 
+def _first_appearance_ids(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex ids in order of first appearance by a Python dict on the exact values (-0.0 equal to +0.0)."""
+    seen: dict = {}
+    ids = np.array([seen.setdefault(tuple(float(x) + 0.0 for x in p), len(seen)) for p in points], np.int32)
+    return ids, np.array(list(seen), dtype=np.float64).reshape(-1, 3)
+
+
+@needs_accel
+@settings(max_examples=150, deadline=None)
+@given(n=st.integers(1, 400), alphabet=st.integers(1, 6), seed=st.integers(0, 2**32 - 1),
+       wide=st.booleans(), records=st.booleans(), feeds=st.integers(1, 4))
+def test_welder_pipeline_matches_a_dict_on_any_feed_size(n, alphabet, seed, wide, records, feeds):
+    """The feed loop's prefetch pipeline (64 points ahead) on feeds shorter and longer than its distance, on
+    strided record views and plain (k, 3) arrays, with -0.0 and +0.0, many duplicates and table growth from
+    a tiny hint: the same ids as a dict in stream order."""
+    lib = _native.accel()
+    rng = np.random.default_rng(seed)
+    values = np.array([0.0, -0.0, 1.0, -1.5, 2.0 ** -149, 3e38][:max(alphabet, 2)])
+    pts = rng.choice(values, size=(3 * n, 3)).astype(np.float64 if wide else np.float32)
+    ids, ref_vertices = _first_appearance_ids(pts)
+    out = np.empty(3 * n, np.int32)
+    w = lib.Welder("float64" if wide else "float32", 1)
+    cuts = np.unique(np.r_[0, rng.integers(0, n + 1, size=feeds - 1), n])
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        if records:      # (k, 3, 3) views into 50-byte-like records, as the binary STL reader feeds them
+            rec = np.zeros(b - a, dtype=[("n", pts.dtype, (3,)), ("v", pts.dtype, (3, 3)), ("a", "<u2")])
+            rec["v"] = pts[3 * a:3 * b].reshape(-1, 3, 3)
+            w.feed(rec["v"], out[3 * a:3 * b])
+        else:
+            w.feed(pts[3 * a:3 * b], out[3 * a:3 * b])
+    np.testing.assert_array_equal(out, ids)
+    vertices = np.empty((w.count, 3))
+    w.vertices_into(vertices)
+    np.testing.assert_array_equal(vertices, ref_vertices)
+    assert not np.signbit(vertices[vertices == 0]).any()
+
+
 _faces = st.integers(2, 12).flatmap(lambda n: st.tuples(
     st.just(n), st.lists(st.tuples(*[st.integers(0, n - 1)] * 3), min_size=1, max_size=40)))
 
@@ -186,6 +223,108 @@ def test_shell_labels_identical_with_shuffled_shells_and_loose_vertices(monkeypa
     (lc, kc), (ln, kn) = both(monkeypatch, lambda: shell_labels(faces, n))
     assert kc == kn == 6
     np.testing.assert_array_equal(lc, ln)
+
+
+def _edge_components_brute(faces: np.ndarray) -> np.ndarray:
+    """Faces joined through shared undirected edges by a plain fixed-point iteration (independent of both
+    paths), numbered by first face."""
+    m = len(faces)
+    edges = [{frozenset((int(f[k]), int(f[(k + 1) % 3]))) for k in range(3)} for f in faces]
+    label = list(range(m))
+    changed = True
+    while changed:                      # at most m rounds: each round lowers some label
+        changed = False
+        for i in range(m):
+            for j in range(i + 1, m):
+                if edges[i] & edges[j] and label[i] != label[j]:
+                    label[i] = label[j] = min(label[i], label[j])
+                    changed = True
+    rank = {r: k for k, r in enumerate(sorted(set(label)))}
+    return np.array([rank[x] for x in label])
+
+
+@needs_accel
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(case=_faces)
+def test_edge_shell_labels_match_numpy_and_brute_force(monkeypatch, case):
+    """Random faces over a few vertices (shared corners without a shared edge, fins, duplicated faces,
+    repeated corners): the C kernel, the numpy path and a brute-force fixed point give the same numbering."""
+    from inertia_tool.mesh.checks import _edge_shell_labels
+    n, faces = case
+    f = np.array(faces, dtype=np.int64)
+    (lc, kc), (ln, kn) = both(monkeypatch, lambda: _edge_shell_labels(f, n))
+    brute = _edge_components_brute(f)
+    assert kc == kn == len(set(brute.tolist()))
+    np.testing.assert_array_equal(lc, ln)
+    np.testing.assert_array_equal(lc, brute)
+    lib = _native.accel()
+    out32 = np.empty(len(f), np.int32)
+    assert lib.edge_shell_labels(f.astype(np.int32), n, out32) == kc      # int32 faces and labels
+    np.testing.assert_array_equal(out32, lc)
+
+
+@needs_accel
+def test_edge_shell_labels_on_a_high_degree_fan_and_bowtie(monkeypatch):
+    """A 40,000-sided cone (one vertex in every face: a bucket sorted by qsort) and two cones sharing only
+    their apex (one vertex-connected piece, two edge-connected shells)."""
+    from inertia_tool.mesh.checks import _edge_shell_labels
+    k = 40_000
+    t = np.linspace(0, 2 * np.pi, k, endpoint=False)
+    v = np.vstack([[0, 0, 1.0], [0, 0, 0.0], np.c_[np.cos(t), np.sin(t), np.zeros(k)]])
+    ring = 2 + np.arange(k)
+    nxt = 2 + (np.arange(k) + 1) % k
+    cone = np.vstack([np.c_[np.zeros(k, int), ring, nxt], np.c_[np.ones(k, int), nxt, ring]])
+    second = np.where(cone == 0, 0, cone + len(v))        # a copy sharing the apex (vertex 0) only
+    faces = np.vstack([second, cone])
+    (lc, kc), (ln, kn) = both(monkeypatch, lambda: _edge_shell_labels(faces, 2 * len(v)))
+    assert kc == kn == 2
+    np.testing.assert_array_equal(lc, ln)
+    assert (lc[:len(cone)] == 0).all() and (lc[len(cone):] == 1).all()
+    labels, count = shell_labels(faces, 2 * len(v))
+    assert count == 2
+
+
+def test_edge_shell_labels_refuses_malformed_arguments():
+    lib = _native.accel()
+    if lib is None:
+        pytest.skip("inertia_tool._accel is not built")
+    v, f = box_arrays()
+    f = np.ascontiguousarray(f, dtype=np.int64)
+    bad = f.copy()
+    bad[5, 1] = len(v)
+    with pytest.raises(ValueError, match="face indices"):
+        lib.edge_shell_labels(bad, len(v), np.empty(len(f), np.int64))
+    with pytest.raises(ValueError):
+        lib.edge_shell_labels(f, len(v), np.empty(len(f) - 1, np.int64))
+    with pytest.raises(ValueError):
+        lib.edge_shell_labels(f.astype(np.float64), len(v), np.empty(len(f), np.int64))
+
+
+@needs_accel
+@pytest.mark.parametrize("m", [5, 70_000])       # one lane, and 32 lanes over two threads
+def test_face_measures_agree_with_numpy_to_round_off(monkeypatch, m):
+    """The float32 storage bound's area and perimeter sums: C (lanes) against numpy (chunks) and against
+    a direct float64 evaluation, on random triangles with repeated corners and int32 or int64 faces."""
+    from inertia_tool.mesh.precision import volume_rounding_bound
+    rng = np.random.default_rng(m)
+    v = rng.normal(size=(m + 3, 3)) * 10.0 + 100.0
+    f = rng.integers(0, len(v), size=(m, 3))
+    f[0, 1] = f[0, 0]                              # a zero-area face
+    lib = _native.accel()
+    for faces in (f, f.astype(np.int32)):
+        area, perimeter = lib.face_measures(v, np.ascontiguousarray(faces), 2)
+        tri = v[f]
+        e = np.roll(tri, -1, axis=1) - tri
+        ref_perimeter = np.linalg.norm(e, axis=2).sum()
+        ref_area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+        assert area == pytest.approx(ref_area, rel=1e-12)
+        assert perimeter == pytest.approx(ref_perimeter, rel=1e-12)
+    c, ref = both(monkeypatch, lambda: volume_rounding_bound(v, f, 1e-6))
+    assert c == pytest.approx(ref, rel=1e-12) and c > 0
+    with pytest.raises(ValueError, match="face indices"):
+        lib.face_measures(v, np.full((1, 3), len(v)))
+    with pytest.raises(ValueError):
+        lib.face_measures(v.astype(np.float32), f)
 
 
 def _rel(a, b):

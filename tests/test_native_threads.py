@@ -1,9 +1,10 @@
 """The C kernels' threads: every kernel must give the same result whatever its thread count.
 
-The edge census splits start vertices; the tetrahedron sums add a fixed number of lanes in lane order; the
-bounds split rows.  Each is compared here, on meshes above the kernels' thresholds for using threads, with its
-own one-thread result (bit for bit) and with the numpy reference.  The welder and the shell labels run on one
-thread; they are checked on the same mesh.
+The edge census splits start vertices; the tetrahedron sums and the face measures add a fixed number of lanes
+in lane order; the bounds split rows; the face-pair check takes node pairs by ticket (same set of pairs).
+Each is compared here, on meshes above the kernels' thresholds for using threads, with its own one-thread
+result (bit for bit) and with the numpy reference.  The welder and the shell labels run on one thread; they
+are checked on the same mesh.
 """
 
 import numpy as np
@@ -122,6 +123,26 @@ def test_tetra_sums_are_bitwise_independent_of_threads(lib, damaged):
             got = _sums(lib, v, f, lab, n_labels, threads)
             np.testing.assert_array_equal(got[0], ref[0])
             np.testing.assert_array_equal(got[1], ref[1])
+
+
+def test_face_measures_are_bitwise_independent_of_threads(lib, damaged):
+    v, f = damaged
+    ref = lib.face_measures(v, f, 1)
+    for threads in THREADS:
+        assert lib.face_measures(v, f, threads) == ref
+
+
+def test_contact_scan_pairs_are_independent_of_threads(lib, damaged):
+    """The face-pair check's tasks are taken by ticket, so the pairs come in another order: the same set,
+    counts and per-face outputs (the damaged shell's duplicated faces are found on every thread count)."""
+    v, f = damaged
+    ref = lib.contact_scan(v, f, -1, 1)
+    ref_pairs = set(zip(np.frombuffer(ref[0], np.int64), np.frombuffer(ref[1], np.int64), ref[2]))
+    assert ref_pairs and ref[3] > len(f)
+    for threads in (2, 3):
+        got = lib.contact_scan(v, f, -1, threads)
+        assert set(zip(np.frombuffer(got[0], np.int64), np.frombuffer(got[1], np.int64), got[2])) == ref_pairs
+        assert got[3:7] == ref[3:7] and got[7:] == ref[7:]
 
 
 def test_tetra_sums_lanes_match_an_exact_sum(lib):

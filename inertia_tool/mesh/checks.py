@@ -285,11 +285,16 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
 def _edge_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     """Components of faces joined through shared (undirected) edges, numbered by first face.
 
-    Faces sharing an edge key are linked; the components come from the C union-find of
-    :func:`_vertex_shell_labels` run on the face graph (each link a row ``(a, b, b)``, each face a row
-    ``(i, i, i)``), or from scipy's ``connected_components`` on the numpy path.
+    The C extension buckets the edges by their smaller end and unites the faces of each edge
+    (``edge_shell_labels``); the numpy path sorts the edge keys, links the faces sharing a key and takes
+    scipy's ``connected_components``.
     """
     m = len(faces)
+    lib = accel()
+    if lib is not None and m < 2**31 - 1:
+        out = np.empty(m, dtype=np.intp)
+        count = lib.edge_shell_labels(faces_for_c(faces), int(n_vertices), out)
+        return out, int(count)
     key = edge_keys(faces, n_vertices)[0]
     order = np.argsort(key)
     skey = key[order]
@@ -297,13 +302,6 @@ def _edge_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, 
     del key, skey
     rows, cols = order[:-1][same] // 3, order[1:][same] // 3
     del order, same
-    lib = accel()
-    if lib is not None:
-        node = np.arange(m, dtype=np.int64)
-        graph = np.concatenate([np.stack([rows, cols, cols], axis=1), np.stack([node, node, node], axis=1)])
-        out = np.empty(len(graph), dtype=np.intp)
-        count = lib.shell_labels(faces_for_c(graph), m, out)
-        return out[len(rows):].astype(np.intp), int(count)
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 

@@ -77,7 +77,7 @@ from types import ModuleType
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._native import accel, threads
+from .._native import accel, faces_for_c, threads
 from ..errors import InvalidMeshError
 from ..values import frozen_value
 
@@ -274,8 +274,11 @@ def orient2d_sign(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> np.ndarray:
 
 def _filter_safe(v: np.ndarray) -> bool:
     """Whether every nonzero coordinate magnitude lies in the range where the static filter's bound holds."""
-    mag = np.abs(v[v != 0])
-    return not len(mag) or (float(mag.min()) >= _SMALLEST and float(mag.max()) <= _LARGEST)
+    mag = np.abs(v)                      # one temporary, no compaction of the nonzero entries
+    if not mag.size or not float(mag.max()) <= _LARGEST:
+        return not mag.size
+    mag[mag == 0] = np.inf               # zeros are exact: only nonzero magnitudes count
+    return float(mag.min()) >= _SMALLEST
 
 
 def _scaled(v: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -709,7 +712,7 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
         Non-finite coordinates, or a face index out of range.
     """
     v = np.ascontiguousarray(vertices, dtype=np.float64)
-    f = np.ascontiguousarray(faces, dtype=np.int64)
+    f = faces_for_c(faces)          # int32 stays int32 (the C scan reads either; no 24-byte-per-face copy)
     if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3:
         raise InvalidMeshError(f"Expected vertices (n, 3) and faces (m, 3), got {v.shape} and {f.shape}")
     if not np.all(np.isfinite(v)):
@@ -727,6 +730,7 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     if lib is not None:
         (a, b, kind, candidates, tested, complete), axis, degenerate = _scan_c(lib, v, f, max_pairs, pred)
     else:
+        f = f.astype(np.int64, copy=False)
         axis, degenerate = _face_axes(v, f, pred)
         p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
         lo = np.minimum(np.minimum(p0, p1), p2)

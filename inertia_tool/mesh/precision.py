@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._native import accel, faces_for_c, threads
 from ..errors import StoragePrecisionWarning
 from ..tolerances import STORAGE_PRECISION_RTOL
 
@@ -71,13 +72,18 @@ def volume_rounding_bound(vertices: np.ndarray, faces: np.ndarray, rounding: flo
         m³.
     """
     eps = math.sqrt(3.0) * float(rounding)
-    area = perimeter = 0.0
-    for start in range(0, len(faces), _CHUNK):
-        tri = vertices[faces[start:start + _CHUNK]]
-        ab, ac, bc = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], tri[:, 2] - tri[:, 1]
-        area += 0.5 * float(np.linalg.norm(np.cross(ab, ac), axis=1).sum())
-        perimeter += float((np.linalg.norm(ab, axis=1) + np.linalg.norm(ac, axis=1)
-                            + np.linalg.norm(bc, axis=1)).sum())
+    lib = accel()
+    if lib is not None:     # the same sums in one pass over the faces, in another order (equal to round-off)
+        sums = lib.face_measures(np.ascontiguousarray(vertices, dtype=np.float64), faces_for_c(faces), threads())
+        area, perimeter = float(sums[0]), float(sums[1])
+    else:
+        area = perimeter = 0.0
+        for start in range(0, len(faces), _CHUNK):
+            tri = vertices[faces[start:start + _CHUNK]]
+            ab, ac, bc = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], tri[:, 2] - tri[:, 1]
+            area += 0.5 * float(np.linalg.norm(np.cross(ab, ac), axis=1).sum())
+            perimeter += float((np.linalg.norm(ab, axis=1) + np.linalg.norm(ac, axis=1)
+                                + np.linalg.norm(bc, axis=1)).sum())
     return 3.0 * (2.0 * eps * area + 0.5 * math.pi * eps * eps * perimeter
                   + 4.0 / 3.0 * math.pi * eps ** 3 * len(faces))
 
