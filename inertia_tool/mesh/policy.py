@@ -68,7 +68,7 @@ if TYPE_CHECKING:
     from .nesting import Nesting
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
-           "negligible_flat", "inward_crossing_outward",
+           "negligible_flat", "inward_crossing_outward", "Coincident", "coincident_surfaces", "coincident_message",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
@@ -357,3 +357,144 @@ def inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with
         hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
         inward[pairs[hit, a]] = True
     return int(np.count_nonzero(inward))
+
+
+@frozen_value
+class Coincident:
+    """R0: closed surfaces listed twice, and closed surfaces listed with their exact inverted copy.
+
+    Attributes
+    ----------
+    drop : (m,) bool
+        Faces to leave out: the later copy of each surface listed twice, and both members of each cancelling pair.
+    repeated : int
+        Closed surfaces that repeat another face for face (same corners, same winding): counted once.
+    repeated_faces : int
+    cancelled : int
+        Pairs of closed surfaces each the other's exact inverse (same corners, opposite winding).
+    cancelled_faces : int
+        Faces of the cancelling pairs (both members).
+    where : (3,) float
+        A corner of the first surface left out, m (NaN when none).
+    """
+
+    drop: np.ndarray
+    repeated: int
+    repeated_faces: int
+    cancelled: int
+    cancelled_faces: int
+    where: np.ndarray
+
+
+def _closed_components(faces: np.ndarray, members: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
+    """Edge-connected components of the faces ``members`` (indices into ``faces``) and which of them are closed and
+    balanced on their own (every directed edge matched by its reverse within the component)."""
+    from .checks import shell_labels
+    from .edges import edge_keys
+
+    sub = faces[members]
+    comp, n_comp = shell_labels(sub, n_vertices)
+    key, forward = edge_keys(sub, n_vertices)
+    owner = np.repeat(comp, 3).astype(np.int64)          # edge_keys lists each face's three edges in turn
+    _, inverse = np.unique(np.stack([owner, key.astype(np.int64)], axis=1), axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
+    unbalanced = np.zeros(n_comp, dtype=bool)
+    first = np.zeros(len(net), dtype=np.int64)
+    first[inverse] = owner
+    unbalanced[first[net != 0]] = True
+    return comp, ~unbalanced
+
+
+def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarray | None = None,
+                        labels: np.ndarray | None = None) -> Coincident:
+    """R0: find closed surfaces listed twice (same winding) or with their exact inverted copy (opposite winding).
+
+    Faces are compared by the exact coordinates of their corners (bit for bit; a copy may use its own vertex
+    indices or the same ones), each face taken from its smallest corner on in its own cyclic order.  A set of
+    repeated faces is left out only when it is closed and balanced on its own (a whole shell, not a face that two
+    overlapping bodies happen to share); a cancelling pair only when each member is closed and balanced and the
+    other's faces are exactly its reverses, so what stays is as closed as before.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    among : (m,) bool, optional
+        Only these faces are compared (the shells that could be copies); default all.
+    labels : (m,) int, optional
+        Shell of each face: of the copies of a face, the one in the lowest-numbered shell is kept, so that a
+        copy with its own vertices is left out whole however the faces are ordered.
+    """
+    m = len(faces)
+    drop = np.zeros(m, dtype=bool)
+    none = Coincident(drop=drop, repeated=0, repeated_faces=0, cancelled=0, cancelled_faces=0,
+                      where=np.full(3, np.nan))
+    idx = np.flatnonzero(np.ones(m, dtype=bool) if among is None else np.asarray(among, dtype=bool))
+    if len(idx) < 8:                       # a closed surface has at least 4 faces, two of them at least 8
+        return none
+    f = np.asarray(faces, dtype=np.int64)[idx]
+    used, local = np.unique(f, return_inverse=True)
+    _, point = np.unique(np.asarray(vertices, dtype=np.float64)[used], axis=0, return_inverse=True)
+    g = point.reshape(-1)[local.reshape(-1)].reshape(-1, 3)         # corners as ids of distinct points
+    rows = np.arange(len(g))[:, None]
+    start = np.argmin(g, axis=1)[:, None]
+    key = g[rows, (start + np.arange(3)) % 3]                       # from the smallest corner, same cycle
+    rev = key[:, [0, 2, 1]]                                         # the same face wound the other way
+    _, code = np.unique(np.concatenate([key, rev]), axis=0, return_inverse=True)
+    code = code.reshape(-1)
+    fwd, back = code[:len(g)], code[len(g):]
+    shell = np.zeros(len(g), dtype=np.int64) if labels is None else np.asarray(labels, dtype=np.int64)[idx]
+    order = np.lexsort((shell, fwd))
+    later = np.zeros(len(g), dtype=bool)
+    later[order[1:]] = fwd[order[1:]] == fwd[order[:-1]]            # a repeat of an earlier face
+    n_v = len(vertices)
+    repeated = repeated_faces = 0
+    if later.any():
+        members = np.flatnonzero(later)
+        comp, closed = _closed_components(f, members, n_v)
+        gone = members[closed[comp]]
+        drop[idx[gone]] = True
+        repeated, repeated_faces = int(np.count_nonzero(closed)), len(gone)
+    cancelled = cancelled_faces = 0
+    first_of = np.full(int(code.max()) + 1, -1, dtype=np.int64)
+    alive = np.flatnonzero(~later)
+    first_of[fwd[alive]] = alive
+    partner = first_of[back]                                         # a face of the reverse, or -1
+    paired = np.flatnonzero((partner >= 0) & ~later)
+    if len(paired):
+        comp, closed = _closed_components(f, paired, n_v)
+        comp_of = np.full(len(g), -1, dtype=np.int64)
+        comp_of[paired] = comp
+        size = np.bincount(comp)
+        other = comp_of[partner[paired]]
+        ok = closed.copy()
+        for c in range(len(closed)):                                 # bounded by the number of components
+            mine = other[comp == c]
+            if not ok[c] or np.any(mine < 0) or np.any(mine != mine[0]) or size[mine[0]] != size[c] \
+                    or not closed[mine[0]]:
+                ok[c] = False
+        gone = paired[ok[comp]]
+        drop[idx[gone]] = True
+        cancelled, cancelled_faces = (int(np.count_nonzero(ok)) + 1) // 2, len(gone)
+    where = np.asarray(vertices, dtype=np.float64)[faces[np.flatnonzero(drop)[0], 0]] if drop.any() \
+        else np.full(3, np.nan)
+    return Coincident(drop=drop, repeated=repeated, repeated_faces=repeated_faces, cancelled=cancelled,
+                      cancelled_faces=cancelled_faces, where=where)
+
+
+def coincident_message(found: Coincident) -> str:
+    """R0's note: what was left out and why, faces counted so that they add up."""
+    parts = []
+    p = found.where
+    near = f" (one near ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}) m)" if np.all(np.isfinite(p)) else ""
+    if found.repeated:
+        n = found.repeated
+        parts.append(f"{n} closed surface{'s' if n > 1 else ''} listed twice ({found.repeated_faces:,} faces "
+                     "repeating others corner for corner) counted once")
+    if found.cancelled:
+        n = found.cancelled
+        parts.append(f"{n} closed surface{'s' if n > 1 else ''} listed together with {'their' if n > 1 else 'its'} "
+                     f"exact inverted cop{'ies' if n > 1 else 'y'} ({found.cancelled_faces:,} faces in all): each "
+                     "pair cancels (winding number 0 everywhere, no volume) and is left out")
+    return "; ".join(parts) + near

@@ -24,8 +24,8 @@ from ..integrals import VolumeMoments, body_volume_moments, bounding_box, volume
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
-from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, inward_crossing_outward, negligible_flat,
-                     orient_by_depth, self_crossing_message, shell_contacts)
+from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
+                     inward_crossing_outward, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
 
@@ -182,6 +182,12 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if not diag > 0:
         raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")
     topo = edge_topology(f, len(v), v)
+    coincident_notes: list[str] = []
+    if topo.nonmanifold_edges:                # R0: a shell listed twice with the same vertex indices
+        f, note = _leave_out_coincident(v, f, None, source)
+        if note is not None:
+            coincident_notes.append(note)
+            topo = edge_topology(f, len(v), v)
     watertight = topo.oriented
     found = Resolution(v, f, "exact", (), 0, None, 0)
     n_read = len(v)                           # vertices beyond these are the apexes of repair patches
@@ -206,6 +212,13 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if n_shells == 0:
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
     shells = body_volume_moments(v, f, labels, n_shells)
+    twins = _twin_candidates(shells, labels)
+    if twins is not None:                     # R0: a shell listed twice with its own vertices
+        f, note = _leave_out_coincident(v, f, twins, source, labels)
+        if note is not None:
+            coincident_notes.append(note)
+            labels, n_shells = shell_labels(f, len(v))
+            shells = body_volume_moments(v, f, labels, n_shells)
     f, labels, n_shells, shells, dropped_note = _drop_flat(v, f, labels, shells, diag, source)    # R2
     contacts = surface_contacts(v, f)
     if patched is not None:
@@ -242,7 +255,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     file_volumes = np.array([s.volume for s in shells])
     f, shells = _apply_flips(f, labels, shells, flip, n_shells, source)
     cavities = int(np.count_nonzero(depth % 2 == 1))
-    method, notes = found.method, list(found.notes)
+    method, notes = found.method, list(found.notes) + coincident_notes
     ambiguous = inward_crossing_outward(file_volumes, flip, touch.crossing_with)
     if ambiguous:
         plural = ambiguous > 1
@@ -402,6 +415,41 @@ def _nesting(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) ->
         return None
     from .nesting import shell_nesting      # imported on use: one shell needs none
     return shell_nesting(v, f, labels, n_shells)
+
+
+def _twin_candidates(shells: Sequence[VolumeMoments], labels: np.ndarray) -> np.ndarray | None:
+    """(m,) bool: faces of shells that could be copies of another (R0: same face count, |volume| and area equal
+    to 1e-9), or None when no two shells could be."""
+    n = len(shells)
+    if n < 2:
+        return None
+    count = np.bincount(labels, minlength=n)
+    size = np.array([[abs(s.volume), s.area] for s in shells])
+    order = np.lexsort((size[:, 0], count))
+    a, b = order[:-1], order[1:]
+    close = (count[a] == count[b]) & np.all(np.abs(size[a] - size[b]) <= 1e-9 * np.maximum(size[a], size[b]), axis=1)
+    if not close.any():
+        return None
+    shell = np.zeros(n, dtype=bool)
+    shell[a[close]] = shell[b[close]] = True
+    return np.asarray(shell[labels])
+
+
+def _leave_out_coincident(v: np.ndarray, f: np.ndarray, among: np.ndarray | None, source: str,
+                          labels: np.ndarray | None = None) -> tuple[np.ndarray, str | None]:
+    """R0: the faces without the later copy of each shell listed twice and without shells cancelled by their exact
+    inverted copy, with the note (warned); refused when nothing is left."""
+    found = coincident_surfaces(v, f, among, labels)
+    if not found.drop.any():
+        return f, None
+    if found.drop.all():
+        raise InvalidMeshError(f"{source}: the mesh is a closed surface listed together with its exact inverted copy "
+                               f"({len(f) // 2:,} faces each, same corners, opposite winding): they cancel to "
+                               "nothing (winding number 0 everywhere, no volume); remove one copy, or reverse it "
+                               "if the surface was meant twice")
+    note = coincident_message(found)
+    warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
+    return f[~found.drop], note
 
 
 def _boxes_meet(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) -> np.ndarray:
