@@ -809,8 +809,20 @@ def _coplanar_overlap(rng):
     pieces = [(1, a), (1, b)]
     if np.all(hi > lo):           # inclusion–exclusion: the common box counted once
         pieces.append((-1, box(hi - lo, (lo + hi) / 2)))
-    return _finish("coplanar_overlap", rng, pieces, concat(a, b),
+    case = _finish("coplanar_overlap", rng, pieces, concat(a, b),
                    f"box{_t(ea)} and box{_t(eb)} both on z = 0, offset {off[:2].tolist()}")
+    # one box wholly within the other (standing on its floor from inside): by nesting depth (R4 of mesh/policy.py,
+    # one rule for a shell strictly inside another and one touching its boundary from inside) a cavity written
+    # outward, by the winding number a body; as for `overlapping`, both readings are accepted
+    box_a = (-ea / 2 + [0, 0, ea[2] / 2], ea / 2 + [0, 0, ea[2] / 2])
+    box_b = (off - eb / 2 + [0, 0, eb[2] / 2], off + eb / 2 + [0, 0, eb[2] / 2])
+    for (inner, ib), (outer, ob) in (((a, box_a), (b, box_b)), ((b, box_b), (a, box_a))):
+        if np.all(ib[0] >= ob[0]) and np.all(ib[1] <= ob[1]) and not np.array_equal(ea, eb):
+            rot, shift = case.motion
+            case.alternatives = [truth_from_manifold([moved(outer, rot, shift)], [moved(inner, rot, shift)])]
+            case.recipe += "; one box lies within the other (depth 1)"
+            break
+    return case
 
 
 def _edge_touch(rng):

@@ -89,9 +89,6 @@ def _assert_honest(case, repair=False):
 #: a strict-xfail reproducer below, which fails the suite as soon as the class is fixed so that it is removed
 #: from here): name → (what of the recipe identifies a case of the class, what goes wrong).
 OPEN_CLASSES: dict[str, tuple[str, str]] = {
-    "flush_cavity_turned": ("flush with its +x face", "a cavity flush with its body's face (coplanar contact only, "
-                            "no crossing) under a random rotation is not cut from its body (certificate united); "
-                            "the axis-aligned and poking-through cases are fixed (their reproducers pass)"),
     "far_thin_solid": ("long thin tetrahedron", "a closed, thin but real solid whose volume is under FLAT_RTOL · "
                        "diagonal³: R2 now keeps it (its moments count, tolerances.FLAT_MOMENT_RTOL) and integrates "
                        "it, but 50 diagonals out float64 round-off leaves the inertia 1.7e-8 off, past this "
@@ -317,3 +314,38 @@ def test_core_filling_its_cavity_exactly_cancels():
     hole = S.box([1.0, 1.0, 1.0])
     p, said = _props(*S.concat(outer, S.flipped(hole), hole))
     assert p.mesh.certificate.kind == "exact" and abs(p.mass - 8.0) <= 1e-12
+
+
+# -------------------------------------------------- R4: a shell within another up to its boundary (issue 21)
+@settings(max_examples=30, derandomize=True, deadline=None)
+@given(seed=st.integers(0, 2 ** 32 - 1), cavity_inward=st.booleans(), turned=st.booleans())
+def test_flush_cavity_is_a_cavity_however_turned(seed, cavity_inward, turned):
+    """A cavity flush with its body's face, wound either way, axis-aligned or under a random rotation (so the
+    contact is coplanar exactly, or only to rounding): one rule, the depth of the closed solid, makes it a
+    cavity; the answer is the notched box (rational truth) or a label that says it is not proven."""
+    rng = np.random.default_rng(seed)
+    ea = rng.integers(4, 9, size=3) * 0.125
+    ec = np.minimum(rng.integers(1, 4, size=3) * 0.125, ea - 0.25)
+    outer = S.box(ea)
+    cavity = S.box(ec, [(ea[0] - ec[0]) / 2, 0.0, 0.0])
+    rot = S.random_rotation(rng) if turned else S.right_angle_rotation(rng)
+    shift = rng.normal(size=3)
+    outer, cavity = S.moved(outer, rot, shift), S.moved(cavity, rot, shift)
+    mesh = S.concat(outer, S.flipped(cavity) if cavity_inward else cavity)
+    case = S.Case("flush_cavity", *mesh, S.truth_from_pieces([(1, outer), (-1, cavity)]), "flush cavity")
+    verdict = _assert_honest(case)
+    assert verdict.label in ("exact", "united", "unverified")
+    if not turned:
+        assert verdict.wrong is None and verdict.label in ("exact", "united")
+
+
+def test_box_standing_inside_another_reads_like_a_flush_cavity():
+    """The same geometry two ways: a small box (outward) standing on the floor inside a big one, and a cavity
+    (outward) flush with a big box's face.  Both are a shell within another touching its boundary, so both read
+    as a cavity (R4), with the same volume as the cavity wound inward."""
+    big = S.box([1.0, 1.0, 1.0])
+    small = S.box([0.25, 0.25, 0.25], [0.0, 0.0, -0.375])            # on the floor z = -0.5, from inside
+    for inner in (small, S.flipped(small)):
+        p, said = _props(*S.concat(big, inner))
+        assert p.mesh.certificate.kind in ("exact", "united")
+        assert abs(p.mass - (1.0 - 0.25 ** 3)) <= 1e-12

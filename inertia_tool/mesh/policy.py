@@ -32,7 +32,13 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    So an outward-wound shell inside a body is read as a cavity written with the wrong winding, not as a
    second body buried in the first.  A shell whose surface crosses another's has no depth of its own: it keeps
    the file's winding (an inward shell is cut from the outward shell it crosses) and the boolean decides; a
-   group of crossing shells all wound inward and lying in no body is turned as a whole.  When the intersection
+   group of crossing shells all wound inward and lying in no body is turned as a whole.  A shell whose surface
+   meets another's only where its solid reaches the other's boundary (all but ``TOUCH_VOLUME_RTOL`` of its
+   solid shared with the other's, by the boolean: :func:`within_up_to_rounding`) lies *within* it and takes its
+   depth from it like any nested shell, whether the contact is exactly coplanar or coplanar only to rounding
+   after a rotation: a cavity flush with its body's face is a cavity (cut from the body by the boolean, certified
+   ``united``), an outward-wound one included.  One rule covers a shell strictly inside another and one
+   touching the other's boundary from inside: *the role is the depth of the closed solid*.  When the intersection
    check did not finish (crossings unknown, so "inside" may mean "overlapping"), each shell keeps what its own
    sign says instead.
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
@@ -68,7 +74,8 @@ if TYPE_CHECKING:
     from .nesting import Nesting
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
-           "negligible_flat", "inward_crossing_outward", "Coincident", "coincident_surfaces", "coincident_message",
+           "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
+           "coincident_surfaces", "coincident_message",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
@@ -210,7 +217,8 @@ def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarra
 
 
 def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np.ndarray, *,
-                    crossing_known: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    crossing_known: bool = True,
+                    within: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """R4: which shells to flip, the body each shell belongs to, and its nesting depth.
 
     Parameters
@@ -255,6 +263,7 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
         cross[cw[:, 0], cw[:, 1]] = True
         cross[cw[:, 1], cw[:, 0]] = True
     inside = nest.winding != 0
+    extra = np.zeros((0, 2), dtype=np.int64) if within is None else np.asarray(within, dtype=np.int64).reshape(-1, 2)
     if not crossing_known:
         signed = nest.winding * np.sign(vols[nest.other])          # +1 inside the material of ``other``
         held = (signed > 0) & (vols[nest.shell] < 0) & (vols[nest.other] > 0)
@@ -264,24 +273,61 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
         owner[nest.shell[held][order]] = nest.other[held][order]
         depth[np.unique(nest.shell[held])] = 1
         return flip, owner, depth
-    contained = inside & ~cross[nest.shell, nest.other]
-    # the containers of each shell, sorted from the outermost (largest |volume|) inward
-    depth_of = np.bincount(nest.shell[contained], minlength=n)
-    depth[:] = depth_of
-    undecided = np.asarray(nest.undecided, dtype=bool)
+    held = inside & ~cross[nest.shell, nest.other]
+    pairs = np.unique(np.concatenate([np.c_[nest.shell[held], nest.other[held]], extra]), axis=0)
+    s_in, o_in = pairs[:, 0], pairs[:, 1]
+    depth[:] = np.bincount(s_in, minlength=n)
+    undecided = np.asarray(nest.undecided, dtype=bool).copy()
+    undecided[extra[:, 0]] = False
     depth[undecided] = 0
     want_positive = depth % 2 == 0
     flip = (vols > 0) != want_positive
     flip[undecided] = vols[undecided] < 0
     cavity = ~want_positive & ~undecided
     if cavity.any():
-        s, o = nest.shell[contained], nest.other[contained]
-        keep = cavity[s] & (depth[o] == depth[s] - 1)        # the innermost container of a cavity
-        owner[s[keep]] = o[keep]
+        keep = cavity[s_in] & (depth[o_in] == depth[s_in] - 1)        # the innermost container of a cavity
+        owner[s_in[keep]] = o_in[keep]
     crosses = cross.any(axis=1) & ~undecided
     if crosses.any():
         _orient_crossing(vols, cross, crosses, depth, flip, owner)
     return flip, owner, depth
+
+
+def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.ndarray, *,
+                          rtol: float = TOUCH_VOLUME_RTOL) -> tuple[np.ndarray, np.ndarray]:
+    """R4: which pairs of crossing shells are one inside the other up to rounding.
+
+    Shell ``a`` lies within ``b`` when all but ``rtol`` of its solid (wound outward) is shared with ``b``'s:
+    ``vol(A ∩ B) ≥ (1 − rtol)·|vol A|`` while ``b`` is not likewise within ``a`` (two copies of one solid are
+    not nested).  The surfaces then meet only where ``a`` reaches ``b``'s boundary (a cavity flush with its body's
+    face, a core resting on its cavity's floor), and the faces "cross" only because coplanar faces were rounded
+    differently (a random rotation) or because an outward-wound cavity shares a face with its body.
+
+    Parameters
+    ----------
+    volumes : (s,) float
+        Signed shell volumes.
+    pairs : (k, 2) int
+        Crossing pairs.
+    common : (k,) float
+        ``vol(A ∩ B)`` of each pair (:func:`~.union.common_volumes`; NaN when unknown: the pair stays crossing).
+
+    Returns
+    -------
+    within : (j, 2) int
+        ``(shell, container)``.
+    crossing : (k − j, 2) int
+        The pairs that cross for real.
+    """
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    size = np.abs(np.asarray(volumes, dtype=np.float64))
+    c = np.asarray(common, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        a_in_b = c >= (1 - rtol) * size[p[:, 0]]
+        b_in_a = c >= (1 - rtol) * size[p[:, 1]]
+    one = a_in_b ^ b_in_a
+    within = np.where(a_in_b[one, None], p[one], p[one][:, ::-1])
+    return within.reshape(-1, 2), p[~one]
 
 
 def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, depth: np.ndarray,
@@ -406,6 +452,15 @@ def _closed_components(faces: np.ndarray, members: np.ndarray, n_vertices: int) 
     return comp, ~unbalanced
 
 
+def _doubled_closed(faces: np.ndarray, n_vertices: int) -> bool:
+    """Every edge of ``faces`` is used at least four times (a closed surface and its reverse on the same vertices;
+    a flat sheet's rim edges are used twice)."""
+    from .edges import edge_keys
+
+    _, count = np.unique(edge_keys(faces, n_vertices)[0], return_counts=True)
+    return bool(np.all(count >= 4))
+
+
 def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarray | None = None,
                         labels: np.ndarray | None = None) -> Coincident:
     """R0: find closed surfaces listed twice (same winding) or with their exact inverted copy (opposite winding).
@@ -474,9 +529,13 @@ def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarr
             if not ok[c] or np.any(mine < 0) or np.any(mine != mine[0]) or size[mine[0]] != size[c] \
                     or not closed[mine[0]]:
                 ok[c] = False
+            elif mine[0] == c:       # both members in one piece: a doubled closed surface, not a flat sheet (R2)
+                ok[c] = _doubled_closed(f[paired[comp == c]], n_v)
         gone = paired[ok[comp]]
         drop[idx[gone]] = True
-        cancelled, cancelled_faces = (int(np.count_nonzero(ok)) + 1) // 2, len(gone)
+        twin = np.array([other[comp == c][0] for c in range(len(closed))], dtype=np.int64)
+        cancelled = int(np.count_nonzero(ok & (twin >= np.arange(len(closed)))))   # each pair once
+        cancelled_faces = len(gone)
     where = np.asarray(vertices, dtype=np.float64)[faces[np.flatnonzero(drop)[0], 0]] if drop.any() \
         else np.full(3, np.nan)
     return Coincident(drop=drop, repeated=repeated, repeated_faces=repeated_faces, cancelled=cancelled,

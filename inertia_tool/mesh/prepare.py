@@ -25,7 +25,8 @@ from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
-                     inward_crossing_outward, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts)
+                     inward_crossing_outward, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts,
+                     within_up_to_rounding)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
 
@@ -103,8 +104,11 @@ def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     touch = shell_contacts(contacts, labels, n_shells) if contacts is not None else None
     nest = _nesting(vertices, faces, labels, n_shells)
     crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
+    within = None
+    if touch is not None and touch.complete:
+        within, crossing_with = _within(vertices, faces, labels, vols, crossing_with)
     flip, owner, depth = orient_by_depth(vols, nest, crossing_with,
-                                         crossing_known=touch is not None and touch.complete)
+                                         crossing_known=touch is not None and touch.complete, within=within)
     undecided = nest.undecided if nest is not None else np.zeros(n_shells, dtype=bool)
     if touch is not None and touch.complete:
         # touching shells share no volume (their interiors are disjoint when no face crosses); a shell that
@@ -250,19 +254,28 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                           f"{'; '.join(forced.notes)}"), stacklevel=3)
         return _estimated(forced, common)
     nest = _nesting(v, f, labels, n_shells)
-    flip, owner, depth = orient_by_depth(np.array([s.volume for s in shells]), nest, touch.crossing_with,
-                                         crossing_known=touch.complete)                                  # R4
     file_volumes = np.array([s.volume for s in shells])
+    within, crossing_with = None, touch.crossing_with
+    if touch.complete:
+        within, crossing_with = _within(v, f, labels, file_volumes, crossing_with)
+    flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
+                                         within=within)                                                 # R4
     f, shells = _apply_flips(f, labels, shells, flip, n_shells, source)
     cavities = int(np.count_nonzero(depth % 2 == 1))
     method, notes = found.method, list(found.notes) + coincident_notes
-    ambiguous = inward_crossing_outward(file_volumes, flip, touch.crossing_with)
+    ambiguous = inward_crossing_outward(file_volumes, flip, crossing_with)
     if ambiguous:
         plural = ambiguous > 1
         notes.append(f"{ambiguous} inward-wound shell{'s' if plural else ''} cross{'' if plural else 'es'} "
                      "an outward one: read as a cavity cut from it (the solid where the winding number is at least "
                      "one); if it is a body written inside out, fix its winding. Not verified")
         warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+    if within is not None and len(within):
+        n_within = len(np.unique(within[:, 0]))
+        notes.append(f"{n_within} shell{'s' if n_within > 1 else ''} meet{'' if n_within > 1 else 's'} the "
+                     "shell around it only on its boundary (a cavity flush with its body's face, a part resting on "
+                     "a cavity's floor; the faces there coincide or cross by rounding): read by nesting depth and "
+                     "formed by the boolean")
     if dropped_note is not None:
         notes.append(dropped_note)
     if arranged is not None:
@@ -275,7 +288,9 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         candidates = touch.crossing | touch.touching | undecided
     else:       # the check gave up: every shell whose box meets another's goes to the boolean
         candidates = _boxes_meet(v, f, labels, n_shells) | undecided
-    overlaps = int(np.count_nonzero(touch.crossing))
+    really = np.zeros(n_shells, dtype=bool)
+    really[crossing_with.reshape(-1)] = True
+    overlaps = int(np.count_nonzero(really))
     kind = "exact" if touch.complete and crossing_note is None else "unverified"
     if touch.complete and not touch.crossing.any() and crossing_note is None:
         checks.append("no-crossing-faces")
@@ -294,16 +309,17 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                     moments=volume_moments, force_estimate=True)
             return _estimated(found, {**common, "overlapping_shells": max(overlaps, 1)})
         else:
-            overlaps = max(overlaps, 1)
+            overlaps = max(overlaps, 1) if really.any() or not touch.crossing.any() else 0
             shared = shared_text(summed, united.volume)
-            if overlap == "sum":
+            if overlap == "sum" and overlaps:
                 method, kind = "sum", "summed"
                 notes.append(f"overlapping bodies: their integrals are added, so {shared} is counted twice "
                              "(`overlap` 'sum')")
                 warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
             else:
-                notes.append(f"overlapping bodies united by a boolean: {shared} counted once")
-                warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+                if overlaps:          # else only shells within others (R4): their cavities are cut, nothing shared
+                    notes.append(f"overlapping bodies united by a boolean: {shared} counted once")
+                    warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
                 method = "union"
                 # R6/R7: the boolean found shared volume; "united" is proven only when crossing faces were found
                 # too (else the two checks disagree: manifold3d's tolerance or a crossing the check cannot see)
@@ -415,6 +431,23 @@ def _nesting(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) ->
         return None
     from .nesting import shell_nesting      # imported on use: one shell needs none
     return shell_nesting(v, f, labels, n_shells)
+
+
+#: Crossing shell pairs tested for lying one within the other (R4), at most; beyond, a pair stays crossing.
+MAX_WITHIN_PAIRS = 256
+
+
+def _within(v: np.ndarray, f: np.ndarray, labels: np.ndarray, volumes: np.ndarray,
+            crossing_with: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """R4: the crossing pairs whose one shell lies within the other up to rounding (``(shell, container)``), and the
+    pairs that cross for real (:func:`~.policy.within_up_to_rounding`, volumes shared by manifold3d)."""
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    if not len(pairs):
+        return np.zeros((0, 2), dtype=np.int64), pairs
+    from .union import common_volumes            # imported on use: crossings are rare
+    tested = pairs[:MAX_WITHIN_PAIRS]
+    within, really = within_up_to_rounding(volumes, tested, common_volumes(v, f, labels, volumes, tested))
+    return within, np.concatenate([really, pairs[MAX_WITHIN_PAIRS:]])
 
 
 def _twin_candidates(shells: Sequence[VolumeMoments], labels: np.ndarray) -> np.ndarray | None:
