@@ -334,26 +334,27 @@ def _inertia(central):
 
 def truth_from_pieces(pieces):
     """Truth of a solid given as disjoint signed pieces ``[(sign, (v, f)), ...]`` (each outward-wound; sign −1
-    for a cavity), exact in rationals when small."""
-    if sum(len(p[1][1]) for p in pieces) <= FRACTION_MAX_FACES:
-        vol, first, second = Fraction(0), [Fraction(0)] * 3, [[Fraction(0)] * 3 for _ in range(3)]
-        for sign, (v, f) in pieces:
-            pv, pf, ps = fraction_moments(v, f)
-            vol += sign * pv
-            first = [first[k] + sign * pf[k] for k in range(3)]
-            second = [[second[r][q] + sign * ps[r][q] for q in range(3)] for r in range(3)]
-        cen = [first[k] / vol for k in range(3)]
-        central = [[second[r][q] - vol * cen[r] * cen[q] for q in range(3)] for r in range(3)]
-        c = np.array([[float(x) for x in row] for row in central])
-        return Truth(float(vol), np.array([float(x) for x in cen]), _inertia(c), "fraction")
-    vol, mom, sec = 0.0, np.zeros(3), np.zeros((3, 3))
+    for a cavity): each piece of at most ``FRACTION_MAX_FACES`` faces integrated exactly in rationals, a larger
+    one in float64 about its own vertex mean (well conditioned for the repository's parts), the sum formed in
+    rationals (so a thin piece far from a large one keeps its exact moments)."""
+    vol, first, second = Fraction(0), [Fraction(0)] * 3, [[Fraction(0)] * 3 for _ in range(3)]
+    exact = True
     for sign, (v, f) in pieces:
-        pv, pc, pcen = float_moments(v, f)
+        if len(f) <= FRACTION_MAX_FACES:
+            pv, pf, ps = fraction_moments(v, f)
+        else:
+            exact = False
+            fv, fc, fcen = float_moments(v, f)
+            pv = Fraction(fv)
+            pf = [pv * Fraction(x) for x in fc]
+            ps = [[Fraction(fcen[r, q]) + pv * Fraction(fc[r]) * Fraction(fc[q]) for q in range(3)] for r in range(3)]
         vol += sign * pv
-        mom += sign * pv * pc
-        sec += sign * (pcen + pv * np.outer(pc, pc))
-    cen = mom / vol
-    return Truth(vol, cen, _inertia(sec - vol * np.outer(cen, cen)), "float")
+        first = [first[k] + sign * pf[k] for k in range(3)]
+        second = [[second[r][q] + sign * ps[r][q] for q in range(3)] for r in range(3)]
+    cen = [first[k] / vol for k in range(3)]
+    central = [[second[r][q] - vol * cen[r] * cen[q] for q in range(3)] for r in range(3)]
+    c = np.array([[float(x) for x in row] for row in central])
+    return Truth(float(vol), np.array([float(x) for x in cen]), _inertia(c), "fraction" if exact else "float")
 
 
 def to_manifold(piece):

@@ -20,8 +20,9 @@ import numpy as np
 from ..values import frozen_value
 from ..errors import (ArrangementError, DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
                       MeshResolvedWarning, OverlapWarning, UsageError)
-from ..integrals import VolumeMoments, body_volume_moments, bounding_box, volume_moments
-from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
+from ..integrals import (RoundoffBound, VolumeMoments, accurate_shells, body_volume_moments, bounding_box,
+                         total_roundoff, volume_moments)
+from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE, ROUNDOFF_RTOL
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
@@ -223,7 +224,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             coincident_notes.append(note)
             labels, n_shells = shell_labels(f, len(v))
             shells = body_volume_moments(v, f, labels, n_shells)
-    f, labels, n_shells, shells, dropped_note = _drop_flat(v, f, labels, shells, diag, source)    # R2
+    shells, bound = _accurate(v, f, labels, shells)          # R7: signs and moments within the round-off bound
+    f, labels, n_shells, shells, dropped_note, bound = _drop_flat(v, f, labels, shells, diag, source, bound)  # R2
     contacts = surface_contacts(v, f)
     if patched is not None:
         contacts, patch_notes = _outside_patches(contacts, f, n_read)
@@ -336,13 +338,21 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                     notes.append(f"the union formed by the boolean passes through itself at {len(after.crossing):,} "
                                  "face pairs (rounding in manifold3d): not verified")
                 labels, n_shells = shell_labels(f, len(v))
-                shells = body_volume_moments(v, f, labels, n_shells)
-                f, labels, n_shells, shells, left = _drop_flat(v, f, labels, shells, diag, source, warn=False)
+                shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+                f, labels, n_shells, shells, left, bound = _drop_flat(v, f, labels, shells, diag, source, bound,
+                                                                      warn=False)
                 nest = _nesting(v, f, labels, n_shells)
                 flip2, owner, depth = orient_by_depth(np.array([s.volume for s in shells]), nest,
                                                       np.zeros((0, 2), dtype=np.int64))
                 f, shells = _apply_flips(f, labels, shells, flip2, n_shells, source, warn=False)
                 cavities = int(np.count_nonzero(depth % 2 == 1))
+    roundoff = total_roundoff(shells, bound)
+    if patched is None:                                                          # R7: exact up to round-off
+        if roundoff > ROUNDOFF_RTOL and kind in ("exact", "united"):
+            kind = "unverified"
+            notes.append(f"the float64 round-off of the integrals is bounded only by {roundoff:.2g} of the result "
+                         f"(above {ROUNDOFF_RTOL:g}: a sliver thinner than its coordinates' rounding, too large for "
+                         "exact arithmetic): not verified")
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
     bbox_min, bbox_max = (lo, hi) if v is raw.vertices else bounding_box(v)
     uncertainty = None
@@ -450,6 +460,15 @@ def _within(v: np.ndarray, f: np.ndarray, labels: np.ndarray, volumes: np.ndarra
     return within, np.concatenate([really, pairs[MAX_WITHIN_PAIRS:]])
 
 
+def _accurate(v: np.ndarray, f: np.ndarray, labels: np.ndarray,
+              shells: list[VolumeMoments]) -> tuple[list[VolumeMoments], RoundoffBound]:
+    """R7: the shells with their round-off bounded (:func:`~inertia_tool.integrals.accurate_shells`: a sliver
+    thinner than its coordinates' rounding integrated exactly, so that even its sign is right), and each shell's
+    round-off bound."""
+    better, _, bound = accurate_shells(v, f, labels, list(shells))
+    return better, bound
+
+
 def _twin_candidates(shells: Sequence[VolumeMoments], labels: np.ndarray) -> np.ndarray | None:
     """(m,) bool: faces of shells that could be copies of another (R0: same face count, |volume| and area equal
     to 1e-9), or None when no two shells could be."""
@@ -498,31 +517,33 @@ def _boxes_meet(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int)
 
 
 def _drop_flat(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments], diag: float,
-               source: str, *,
-               warn: bool = True) -> tuple[np.ndarray, np.ndarray, int, list[VolumeMoments], str | None]:
-    """R2: leave out closed shells that enclose no volume; refuse when nothing else is left."""
+               source: str, bound: RoundoffBound, *,
+               warn: bool = True) -> tuple[np.ndarray, np.ndarray, int, list[VolumeMoments], str | None,
+                                           RoundoffBound]:
+    """R2: leave out closed shells that enclose no volume; refuse when nothing else is left.  ``bound`` is the
+    round-off bound of ``shells`` (R7), returned anew when they are recomputed."""
     n_shells = len(shells)
     flat = np.array([abs(s.volume) <= FLAT_RTOL * diag ** 3 for s in shells], dtype=bool)
     if not flat.any():
-        return f, labels, n_shells, shells, None
+        return f, labels, n_shells, shells, None, bound
     if flat.all():
         what = "the mesh encloses" if n_shells == 1 else f"all {n_shells} shells enclose"
         raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
                                "thin-walled part use the shell model with a wall `thickness`")
     flat &= negligible_flat(shells, flat)        # a thin but real solid whose moments count stays
     if not flat.any():
-        return f, labels, n_shells, shells, None
+        return f, labels, n_shells, shells, None, bound
     dropped_faces = int(np.count_nonzero(flat[labels]))
     f = f[~flat[labels]]
     labels, n_shells = shell_labels(f, len(v))
-    shells = body_volume_moments(v, f, labels, n_shells)
+    shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
     n_flat = int(np.count_nonzero(flat))
     note = (f"{n_flat} closed piece{'s' if n_flat > 1 else ''} enclosing no volume ({dropped_faces:,} faces: "
             "zero-thickness walls, coincident opposite faces or flat slivers) left out; they contribute nothing "
             "to the integrals")
     if warn:
         warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
-    return f, labels, n_shells, shells, note
+    return f, labels, n_shells, shells, note, bound
 
 
 def _apply_flips(f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments], flip: np.ndarray, n_shells: int,
