@@ -415,11 +415,16 @@ def _arrange_self_crossing(v: np.ndarray, f: np.ndarray, labels: np.ndarray, con
 
 
 def shared_text(summed: float, united: float) -> str:
-    """The shared volume of overlapping bodies in words, m³ (never negative)."""
+    """The shared volume of overlapping bodies in words, m³ (never negative).  A union larger than the summed
+    integral beyond rounding (``TOUCH_VOLUME_RTOL``) is a cavity reaching out of its body: the boolean cuts it
+    only where it lies in the body, the summed integral all of it."""
     shared = summed - united
     if shared >= 0:
         return f"{shared:.6g} m³ of shared volume"
-    return f"no shared volume (the union is {-shared:.3g} m³ larger than the sum, within rounding)"
+    if -shared <= TOUCH_VOLUME_RTOL * abs(summed):
+        return f"no shared volume (the union is {-shared:.3g} m³ larger than the sum, within rounding)"
+    return (f"no shared volume; the union is {-shared:.3g} m³ larger than the summed integral (a cavity reaching "
+            "out of its body is cut only where it lies in the body)")
 
 
 def _outside_patches(contacts: SurfaceContacts, faces: np.ndarray,
