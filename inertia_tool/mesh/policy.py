@@ -7,6 +7,12 @@ the surface bounds it exactly once).
 
 Rules
 -----
+R0 *A shell listed twice is one solid* (:func:`coincident_surfaces`).  A closed surface that repeats another
+   corner for corner (the same float64 coordinates, bit for bit, in the same cyclic order; with the same
+   vertex indices or its own) is counted once, with a note naming how many faces were left out.  A closed
+   surface listed together with its exact inverted copy has winding number 0 everywhere: the pair is left out
+   (a mesh that is nothing else is refused with that reason).  Reason: a shell exported twice means the part
+   once; summed, its volume counts twice, and united it only shows as a false overlap.
 R1 *Bodies are edge-connected* (:func:`~.checks.shell_labels`).  Faces that meet only at a vertex belong to
    different shells: a non-manifold vertex is split into its fans of edge-connected faces before anything
    decides what is one body.  Reason: two bodies that share a corner (or are welded there) are two bodies,
@@ -55,7 +61,11 @@ R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL`
 R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only after the edge census found the
    surface balanced, every shell is oriented by R4, and the face-intersection check ran over every candidate
    pair and found no crossing.  When the check could not finish within its work bound the integral is still
-   computed but certified ``unverified``.
+   computed but certified ``unverified``.  "Exact" is exact for the polyhedron up to a derived float64
+   round-off bound (:func:`~inertia_tool.integrals.roundoff_bounds`) of at most ``tolerances.ROUNDOFF_RTOL``
+   of the result: shells whose bound is wider are integrated again about their own centre or in exact integer
+   arithmetic (:func:`~inertia_tool.integrals.accurate_shells`), before any sign is read (R2, R4); a result
+   whose bound stays wider is certified ``unverified``.
 """
 
 from __future__ import annotations
