@@ -263,7 +263,7 @@ def _props(v, f):
     return p, [str(w.message) for w in caught]
 
 
-@settings(max_examples=25, derandomize=True, deadline=None)
+@settings(max_examples=15, derandomize=True, deadline=None)
 @given(seed=st.integers(0, 2 ** 32 - 1), same_indices=st.booleans(), copy_first=st.booleans(),
        shuffle=st.booleans())
 def test_shell_listed_twice_is_counted_once(seed, same_indices, copy_first, shuffle):
@@ -358,7 +358,7 @@ def _thin_far_tetrahedron(rng):
     return tet, tf
 
 
-@settings(max_examples=40, derandomize=True, deadline=None)
+@settings(max_examples=25, derandomize=True, deadline=None)
 @given(seed=st.integers(0, 2 ** 32 - 1))
 def test_exact_integer_moments_match_rationals(seed):
     """exact_volume_moments (integers over a power of two) against the rational integral of the harness, on
