@@ -280,6 +280,12 @@ def _signed_volume(v, f):
     return float(np.einsum("ij,ij->i", p0 - ref, np.cross(p1 - ref, p2 - ref)).sum() / 6)
 
 
+def _outward_exactly(v, f):
+    """``f`` wound outward by the sign of its exact rational volume (a float64 sign is wrong for a tetrahedron
+    thinner than its coordinates' rounding)."""
+    return f if fraction_moments(v, f)[0] > 0 else f[:, ::-1].copy()
+
+
 def fraction_moments(v, f):
     """Exact (volume, ∫x dV (3,), ∫x_i x_j dV (3, 3)) of a closed surface, as Fractions over signed
     tetrahedra with apex at the origin: det/6, det/24·(a+b+c), det/120·(Σ pᵢpⱼ + sᵢsⱼ), s = a+b+c."""
@@ -715,8 +721,7 @@ def _sliver(rng):
         tet = np.array([[0, 0, 0], [0, length, 0], [0, 0, length], [thick, length / 3, length / 3]])
         tet += [hi[0] + length, 0, 0]
         tf = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]], dtype=np.int64)
-        if _signed_volume(tet, tf) < 0:
-            tf = tf[:, ::-1].copy()
+        tf = _outward_exactly(tet, tf)
         return _finish("sliver", rng, [(1, body), (1, (tet, tf))], concat(body, (tet, tf)),
                        f"{name} with a long thin tetrahedron ({length:.3g} m, {thick:.3g} m thin) "
                        f"{length:.3g} m away")
@@ -729,8 +734,7 @@ def _sliver(rng):
     tet = np.array([[0, 0, 0], [0, size, 0], [0, 0, size], [thick, size / 3, size / 3]], dtype=np.float64)
     tet += [hi[0] + gap + 0.01, 0, 0]
     tf = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]], dtype=np.int64)
-    if _signed_volume(tet, tf) < 0:
-        tf = tf[:, ::-1].copy()
+    tf = _outward_exactly(tet, tf)
     return _finish("sliver", rng, [(1, body), (1, (tet, tf))], concat(body, (tet, tf)),
                    f"{name} with a 4-face tetrahedron {thick:.3g} m thin ({size:.3g} m across, gap {gap:g}) beside it")
 

@@ -206,9 +206,7 @@ def _far_thin_tetrahedron():
     body = S.box([1.0, 1.0, 1.0])
     length, thick = 50.0, 1e-9
     tet = np.array([[0, 0, 0], [0, length, 0], [0, 0, length], [thick, length / 3, length / 3]]) + [length, 0, 0]
-    tf = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]])
-    if S._signed_volume(tet, tf) < 0:
-        tf = tf[:, ::-1].copy()
+    tf = S._outward_exactly(tet, np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]))
     return S.Case("sliver", *S.concat(body, (tet, tf)), S.truth_from_pieces([(1, body), (1, (tet, tf))]),
                   "a unit box and a closed tetrahedron 50 m across and 1e-9 m thin, 50 m away (volume 4e-7 m³)")
 
@@ -352,10 +350,7 @@ def _thin_far_tetrahedron(rng):
     thick = length * float(10 ** rng.uniform(-16, -6))
     tet = np.array([[0, 0, 0], [0, length, 0], [0, 0, length], [thick, length / 3, length / 3]])
     tet = tet @ S.random_rotation(rng).T + rng.normal(size=3) * length * float(10 ** rng.uniform(0, 2))
-    tf = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]])
-    if S._signed_volume(tet, tf) < 0:
-        tf = tf[:, ::-1].copy()
-    return tet, tf
+    return tet, S._outward_exactly(tet, np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]))
 
 
 @settings(max_examples=25, derandomize=True, deadline=None)
