@@ -236,8 +236,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     arrange_failed, arranged_verified = "", False
     if touch.self_crossing.any() and self_crossing == "refuse" and overlap == "union" and patched is None:   # R3
         try:
-            v, f, labels, n_shells, shells, contacts, touch, arranged, arranged_verified = _arrange_self_crossing(
-                v, f, labels, contacts, touch, diag, source)
+            v, f, labels, n_shells, shells, contacts, touch, arranged, arranged_verified, bound = \
+                _arrange_self_crossing(v, f, labels, contacts, touch, diag, source)
         except ArrangementError as exc:
             arrange_failed = f"; its solid {{winding number ≥ 1}} could not be built: {exc}"
     if touch.self_crossing.any() and self_crossing == "unverified" and not repair:
@@ -387,15 +387,16 @@ def _arrange_self_crossing(v: np.ndarray, f: np.ndarray, labels: np.ndarray, con
     """R3: every shell passing through itself replaced by the boundary of its {winding number ≥ 1}
     (:mod:`~.arrange`), then the stages after R1 run again on the new surface.
 
-    Returns ``(v, f, labels, n_shells, shells, contacts, touch, note, verified)``; raises ArrangementError.
+    Returns ``(v, f, labels, n_shells, shells, contacts, touch, note, verified, bound)`` (``bound`` the shells'
+    round-off bounds, R7); raises ArrangementError.
     Crossings left by rounding the new points (``verified`` False) are taken out of ``touch`` (the result is
     then certified ``unverified``)."""
     from .arrange import arrange_shells      # imported on use: self-crossing shells are rare
     done = arrange_shells(v, f, labels, contacts.crossing)
     v, f = done.vertices, done.faces
     labels, n_shells = shell_labels(f, len(v))
-    shells = body_volume_moments(v, f, labels, n_shells)
-    f, labels, n_shells, shells, _ = _drop_flat(v, f, labels, shells, diag, source, warn=False)
+    shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+    f, labels, n_shells, shells, _, bound = _drop_flat(v, f, labels, shells, diag, source, bound, warn=False)
     contacts = surface_contacts(v, f)
     touch = shell_contacts(contacts, labels, n_shells)
     if touch.self_crossing.any():
@@ -411,7 +412,7 @@ def _arrange_self_crossing(v: np.ndarray, f: np.ndarray, labels: np.ndarray, con
         note += (f"; {done.crossings_left:,} face pairs of the result still cross after rounding the intersection "
                  "points to float64 (a crossing in special position): not verified")
     warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
-    return v, f, labels, n_shells, shells, contacts, touch, note, not done.crossings_left
+    return v, f, labels, n_shells, shells, contacts, touch, note, not done.crossings_left, bound
 
 
 def shared_text(summed: float, united: float) -> str:
