@@ -36,10 +36,15 @@ from numpy.typing import NDArray
 
 from .values import frozen_value
 from ._native import accel, faces_for_c, threads
+from .tolerances import ROUNDOFF_RTOL
 
-__all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box"]
+__all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box",
+           "roundoff_bounds", "exact_volume_moments", "RoundoffBound", "accurate_shells", "total_roundoff"]
 
 _DEFAULT_CHUNK = 1 << 15
+
+#: Largest shell (faces) :func:`accurate_shells` integrates in exact integer arithmetic (about 10 µs a face).
+EXACT_MAX_FACES = 4096
 
 
 @frozen_value
@@ -258,3 +263,276 @@ def second_moment_to_inertia(second_moment: np.ndarray, density: float = 1.0) ->
     c = np.asarray(second_moment, dtype=np.float64)
     inertia: NDArray[np.float64] = density * (np.trace(c) * np.eye(3) - c)
     return inertia
+
+
+# -- round-off: a derived bound, and exact integer arithmetic where the bound is too wide ----------------------
+
+#: Unit round-off of float64 (2⁻⁵³).
+_U = float(np.finfo(np.float64).eps) / 2
+
+
+@frozen_value
+class RoundoffBound:
+    """Bounds on the float64 round-off of each shell's moments as :func:`body_volume_moments` computes them.
+
+    Attributes
+    ----------
+    volume : (s,) float
+        m³, on the volume.
+    centroid : (s,) float
+        m, on the centroid (Euclidean).
+    second_moment : (s,) float
+        m⁵, on the central second moment (Frobenius).
+    """
+
+    volume: np.ndarray
+    centroid: np.ndarray
+    second_moment: np.ndarray
+
+
+def _dot_abs_cross(a: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``Σᵢ aᵢ (x ⊠ y)ᵢ`` for non-negative (3, k) arrays, ``⊠`` the cross product with both products added."""
+    return np.asarray(a[0] * (x[1] * y[2] + x[2] * y[1]) + a[1] * (x[2] * y[0] + x[0] * y[2])
+                      + a[2] * (x[0] * y[1] + x[1] * y[0]))
+
+
+def roundoff_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments],
+                    origin: np.ndarray, *, chunk_size: int = _DEFAULT_CHUNK) -> RoundoffBound:
+    """A bound on the float64 round-off of every shell's moments about ``origin`` (first order in u = 2⁻⁵³).
+
+    By the standard model ``fl(x ∘ y) = (x ∘ y)(1 + δ)``, ``|δ| ≤ u`` (Higham, *Accuracy and Stability of
+    Numerical Algorithms*, §2.2, §3.1), each face's ``6v = a·(e₁ × e₂)``, ``e₁ = b − a``, ``e₂ = c − a`` (``a, b,
+    c`` the corners less ``origin``) errs by at most ``u·P`` with
+
+    ``P = 8·|a|·(|e₁| ⊠ |e₂|) + 2·|a|·((|a| + |b|) ⊠ |e₂| + |e₁| ⊠ (|a| + |c|))``
+
+    (``⊠`` the cross product with both products of a component added, all entries non-negative): the rounding
+    of ``a`` (1), of each difference (1) and of the cross (2) and dot (3) products give the 8; the roundings of
+    the corners inside the differences the second term (1, doubled for slack and the u² terms), so a part far
+    from ``origin`` is charged for its distance once.  The first-moment term ``6v·s/24`` adds the roundings of
+    ``s = a + b + c`` and of two products (bound ``2u·P·‖s‖``), the second-moment term
+    ``6v·(Σ pₖpₖᵀ + ssᵀ)/120`` those of ``Q`` (``3u·P·tr|Q|``).  Sums over a shell's m faces add
+    ``(2 + m²u)·u·Σ P`` when compensated (the C path; Ogita, Rump and Oishi 2005, Sum2) or ``m·u·Σ P`` when not
+    (numpy's sequential ``bincount``).  The central moment ``C − f fᵀ/V`` carries the errors of its parts to
+    first order plus ``4u·(‖C‖ + ‖f‖²/|V|)`` of its own.  Terms of order u² are left out.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    labels : (m,) int
+        Shell of each face.
+    shells : list of VolumeMoments
+        As computed about ``origin``.
+    origin : (3,) float
+        The reference point the moments were computed about.
+    """
+    n = len(shells)
+    coords = np.ascontiguousarray((np.asarray(vertices, dtype=np.float64) - origin).T)
+    sp, sps, spq, sv1, sv2 = (np.zeros(n) for _ in range(5))
+    counts = np.bincount(labels, minlength=n).astype(np.float64)
+    for start in range(0, len(faces), chunk_size):
+        f = faces[start:start + chunk_size]
+        lab = labels[start:start + chunk_size]
+        a, b, c = (coords[:, f[:, k]] for k in range(3))
+        e1, e2 = np.abs(b - a), np.abs(c - a)
+        a, b, c = np.abs(a), np.abs(b), np.abs(c)
+        # |a|·(|e1| ⊠ |e2|) carries the roundings of the cross and dot products and of a itself; the terms with
+        # |a| + |b| (|a| + |c|) carry the roundings of the corners and of the differences b − a (c − a)
+        p = 8 * _dot_abs_cross(a, e1, e2) + 2 * (_dot_abs_cross(a, a + b, e2) + _dot_abs_cross(a, e1, a + c))
+        n2 = np.einsum("ij,ij->j", a, a) + np.einsum("ij,ij->j", b, b) + np.einsum("ij,ij->j", c, c)
+        s_norm = np.sqrt(3 * n2)                      # ‖|a| + |b| + |c|‖ ≤ √(3 Σ‖pₖ‖²)
+        q = 4 * n2                                    # tr|Q| = Σ‖pₖ‖² + ‖|a| + |b| + |c|‖² ≤ 4 Σ‖pₖ‖²
+        sp += np.bincount(lab, weights=p, minlength=n)
+        sps += np.bincount(lab, weights=p * s_norm, minlength=n)
+        spq += np.bincount(lab, weights=p * q, minlength=n)
+    summing = (2 + counts * counts * _U) * _U if accel() is not None else counts * _U
+    e_volume = (_U + summing) * sp / 6
+    e_first = (2 * _U + summing) * sps / 24
+    e_second = (3 * _U + summing) * spq / 120
+    vol = np.array([abs(sh.volume) for sh in shells])
+    d = np.array([np.linalg.norm(sh.centroid - origin) if sh.volume != 0 else 0.0 for sh in shells])
+    first = vol * d
+    about_origin = np.array([np.linalg.norm(sh.second_moment) for sh in shells]) + vol * d * d
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e_centroid = np.where(vol > 0, (e_first + d * e_volume) / vol, np.inf)
+        e_central = e_second + np.where(vol > 0, (2 * first * e_first + d * d * vol * e_volume) / vol, np.inf) \
+            + 4 * _U * (about_origin + first * d)
+    return RoundoffBound(volume=e_volume, centroid=e_centroid, second_moment=e_central)
+
+
+def exact_volume_moments(vertices: np.ndarray, faces: np.ndarray, *, area: float = 0.0,
+                         zero_area_faces: int = 0) -> VolumeMoments:
+    """The moments of one closed surface in exact integer arithmetic, rounded to float64 once at the end.
+
+    Every float64 coordinate is an integer multiple of a common power of two ``2⁻ᵏ``, so the signed-tetrahedron
+    sums (volume ``det/6``, first moment ``det·s/24``, second moment ``det·(Σ pₖpₖᵀ + ssᵀ)/120``: Tonon 2004, as
+    in :func:`volume_moments`) are integers times known powers of two; the centroid and the central moment are
+    formed as fractions and rounded.  The answer is the polyhedron's to the last bit (one rounding each), at
+    about 10 µs a face: for small shells whose float64 bound (:func:`roundoff_bounds`) is too wide.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    area, zero_area_faces
+        Carried over to the result (not recomputed).
+    """
+    from fractions import Fraction
+
+    f = np.asarray(faces, dtype=np.int64)
+    used, local = np.unique(f, return_inverse=True)
+    pts = np.asarray(vertices, dtype=np.float64)[used]
+    ref = pts[0].copy()
+    # the differences to one corner (exact as fractions: pts - ref in float64 would round)
+    exact = [[Fraction(x) - Fraction(r) for x, r in zip(row, ref.tolist())] for row in pts.tolist()]
+    scale = max((q.denominator for row in exact for q in row), default=1)
+    ints = [[int(q * scale) for q in row] for row in exact]
+    tri = local.reshape(-1, 3)
+    vol6 = 0
+    first24 = [0, 0, 0]
+    second120 = [[0] * 3 for _ in range(3)]
+    for i0, i1, i2 in tri.tolist():
+        a, b, c = ints[i0], ints[i1], ints[i2]
+        det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+               + a[2] * (b[0] * c[1] - b[1] * c[0]))
+        if det == 0:
+            continue
+        s = [a[k] + b[k] + c[k] for k in range(3)]
+        vol6 += det
+        for k in range(3):
+            first24[k] += det * s[k]
+        for r in range(3):
+            for q in range(r, 3):
+                second120[r][q] += det * (a[r] * a[q] + b[r] * b[q] + c[r] * c[q] + s[r] * s[q])
+    if vol6 == 0:
+        return VolumeMoments(volume=0.0, centroid=np.full(3, np.nan), second_moment=np.zeros((3, 3)), area=area,
+                             zero_area_faces=zero_area_faces)
+    volume = Fraction(vol6, 6 * scale ** 3)
+    first = [Fraction(x, 24 * scale ** 4) for x in first24]
+    centre = [x / volume for x in first]
+    central = np.zeros((3, 3))
+    for r in range(3):
+        for q in range(r, 3):
+            central[r, q] = central[q, r] = float(Fraction(second120[r][q], 120 * scale ** 5)
+                                                  - volume * centre[r] * centre[q])
+    centroid = np.array([float(Fraction(x) + cx) for x, cx in zip(ref.tolist(), centre)])
+    return VolumeMoments(volume=float(volume), centroid=centroid, second_moment=central, area=area,
+                         zero_area_faces=zero_area_faces)
+
+
+def accurate_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments],
+                    origin: np.ndarray | None = None, *, rtol: float = ROUNDOFF_RTOL,
+                    exact_max_faces: int = EXACT_MAX_FACES,
+                    integrated: np.ndarray | None = None) -> tuple[list[VolumeMoments], int, RoundoffBound]:
+    """Shell moments whose combined round-off is provably within ``rtol`` where that can be reached.
+
+    The bound of :func:`roundoff_bounds` is turned into each shell's share of the error of the total volume
+    and of the total inertia about the total centroid (``3·(E_C + d²·E_V + 2|V|·d·E_c)`` for a shell at
+    distance ``d`` from it; ``‖ΔI‖ ≤ 3‖ΔC‖`` since ``I = tr(C)𝟙 − C``).  Shells are taken from the largest share
+    down until what is left sums to at most half of ``rtol``; each of those is integrated again about its own
+    bounding-box centre (a part far from the rest keeps its digits), and, when its bound is still above its
+    part of the other half and it has at most ``exact_max_faces`` faces, in exact integer arithmetic
+    (:func:`exact_volume_moments`).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    labels : (m,) int
+        Shell of each face, ``0..len(shells)-1``.
+    shells : list of VolumeMoments
+        As computed about ``origin`` (default: the vertices' bounding-box centre, as :func:`body_volume_moments`).
+    rtol : float
+        Target relative bound (``tolerances.ROUNDOFF_RTOL``).
+    exact_max_faces : int
+        Largest shell integrated in exact arithmetic (about 10 µs a face).
+    integrated : (m, 3) int, optional
+        The faces as they were wound when ``shells`` were integrated (a shell turned inside out afterwards has
+        its moments negated, not recomputed): the bound is of that computation.  Default ``faces``.
+
+    Returns
+    -------
+    shells : list of VolumeMoments
+    refined : int
+        Shells integrated again.
+    bounds : RoundoffBound
+        Each shell's bound after refinement (:func:`total_roundoff` turns them into the total's).
+
+    Notes
+    -----
+    Which shells to refine is decided against the magnitudes ``Σ|V|`` and ``Σ (‖C‖ + |V| d²)``, which do not
+    depend on how the shells are wound (this runs before they are oriented); the bound of the final answer is
+    :func:`total_roundoff` of the oriented shells.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces)
+    lab = np.asarray(labels, dtype=np.intp)
+    o = reference_point(v) if origin is None else np.asarray(origin, dtype=np.float64)
+    shells = list(shells)
+    b = roundoff_bounds(v, f if integrated is None else np.asarray(integrated), lab, shells, o)
+    e_vol, e_cen, e_sec = b.volume.copy(), b.centroid.copy(), b.second_moment.copy()
+    share_v, share_i, total_v, total_i = _shares(shells, e_vol, e_cen, e_sec, magnitude=True)
+    if not np.isfinite(total_v) or total_v == 0 or total_i == 0:
+        return shells, 0, RoundoffBound(volume=e_vol, centroid=e_cen, second_moment=e_sec)
+    budget = 0.5 * rtol
+    worst = np.argsort(-np.maximum(share_v / (rtol * total_v), share_i / (rtol * total_i)), kind="stable")
+    rest_v, rest_i = np.cumsum(share_v[worst][::-1])[::-1], np.cumsum(share_i[worst][::-1])[::-1]
+    over = (rest_v > budget * total_v) | (rest_i > budget * total_i) | ~np.isfinite(rest_v) | ~np.isfinite(rest_i)
+    redo = worst[over]
+    refined = 0
+    for k in redo.tolist():                    # the shells carrying the error, largest first (bounded by s)
+        mine = lab == k
+        fk = f[mine]
+        own = reference_point(v[np.unique(fk)])
+        s = shells[k]
+        again = volume_moments(v, fk, origin=own)
+        shells[k] = VolumeMoments(again.volume, again.centroid, again.second_moment, s.area, s.zero_area_faces)
+        bk = roundoff_bounds(v, fk, np.zeros(len(fk), dtype=np.intp), [shells[k]], own)
+        e_vol[k], e_cen[k], e_sec[k] = bk.volume[0], bk.centroid[0], bk.second_moment[0]
+        refined += 1
+        sv, si, _, _ = _shares(shells, e_vol, e_cen, e_sec, only=k, magnitude=True)
+        if (sv > budget * total_v / len(redo) or si > budget * total_i / len(redo)) and len(fk) <= exact_max_faces:
+            shells[k] = exact_volume_moments(v, fk, area=s.area, zero_area_faces=s.zero_area_faces)
+            e_vol[k], e_cen[k], e_sec[k] = _exact_rounding(shells[k])
+    return shells, refined, RoundoffBound(volume=e_vol, centroid=e_cen, second_moment=e_sec)
+
+
+def total_roundoff(shells: list[VolumeMoments], bounds: RoundoffBound) -> float:
+    """The bound on the relative round-off of the total of oriented ``shells`` (cavities negative): the larger
+    of the volume's (relative to ``|Σ V|``) and the inertia's about the total centroid (relative to its Frobenius
+    norm), from each shell's bounds (:func:`accurate_shells`); inf when the total is zero."""
+    share_v, share_i, total_v, total_i = _shares(shells, bounds.volume, bounds.centroid, bounds.second_moment)
+    if not (total_v > 0 and total_i > 0):
+        return float("inf")
+    return float(max(share_v.sum() / total_v, share_i.sum() / total_i))
+
+
+def _exact_rounding(s: VolumeMoments) -> tuple[float, float, float]:
+    """The bounds of an exactly integrated shell: one rounding of each rounded value."""
+    return (_U * abs(s.volume), _U * float(np.linalg.norm(s.centroid)) if s.volume else 0.0,
+            2 * _U * float(np.linalg.norm(s.second_moment)))
+
+
+def _shares(shells: list[VolumeMoments], e_vol: np.ndarray, e_cen: np.ndarray, e_sec: np.ndarray,
+            only: int | None = None, magnitude: bool = False) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """Each shell's bound on the total volume and on the total central inertia (Frobenius), and the totals'
+    sizes ``|V|`` and ``‖I‖`` (with ``magnitude``, ``Σ|V|`` and ``Σ ‖I‖`` of the shells taken positive; with
+    ``only``, that shell's two shares)."""
+    vol = np.array([s.volume for s in shells])
+    weight = np.abs(vol) if magnitude else vol
+    total = float(np.sum(weight))
+    cen = np.array([s.centroid if s.volume else np.zeros(3) for s in shells])
+    c = (weight @ cen) / total if total else np.zeros(3)
+    d = np.linalg.norm(cen - c, axis=1)
+    if magnitude:
+        inertia = float(sum(np.linalg.norm(s.second_moment) + abs(s.volume) * dd * dd
+                            for s, dd in zip(shells, d) if s.volume))
+    else:
+        second = sum((s.second_moment + s.volume * np.outer(cc - c, cc - c) for s, cc in zip(shells, cen)),
+                     np.zeros((3, 3)))
+        inertia = float(np.linalg.norm(np.trace(second) * np.eye(3) - second))
+    share_i = 3 * (e_sec + d * d * e_vol + 2 * np.abs(vol) * d * e_cen)
+    if only is not None:
+        return np.array(e_vol[only]), np.array(share_i[only]), abs(total), inertia
+    return e_vol, share_i, abs(total), inertia

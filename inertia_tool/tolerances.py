@@ -96,3 +96,10 @@ PART_OVERLAP_RTOL = 1e-7
 #: position (an edge exactly through an edge, common in symmetric meshes) splits one true point into several
 #: within rounding of each other; merging them moves the surface by at most this relative distance.
 ARRANGE_MERGE_RTOL = 1e-12
+
+#: "Exact" for a float64 integral means: the volume within ``ROUNDOFF_RTOL`` of the polyhedron's (relative to the
+#: total volume) and the inertia within ``ROUNDOFF_RTOL`` of the total's (Frobenius), by the derived floating-point
+#: bound of :func:`inertia_tool.integrals.roundoff_bounds`.  A shell whose bound is larger (a sliver thinner than
+#: its coordinates' rounding can carry, a part far from the rest) is integrated again in exact integer arithmetic
+#: (:func:`inertia_tool.integrals.exact_volume_moments`); one too large for that is certified ``unverified``.
+ROUNDOFF_RTOL = 1e-10

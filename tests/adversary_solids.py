@@ -280,6 +280,12 @@ def _signed_volume(v, f):
     return float(np.einsum("ij,ij->i", p0 - ref, np.cross(p1 - ref, p2 - ref)).sum() / 6)
 
 
+def _outward_exactly(v, f):
+    """``f`` wound outward by the sign of its exact rational volume (a float64 sign is wrong for a tetrahedron
+    thinner than its coordinates' rounding)."""
+    return f if fraction_moments(v, f)[0] > 0 else f[:, ::-1].copy()
+
+
 def fraction_moments(v, f):
     """Exact (volume, ∫x dV (3,), ∫x_i x_j dV (3, 3)) of a closed surface, as Fractions over signed
     tetrahedra with apex at the origin: det/6, det/24·(a+b+c), det/120·(Σ pᵢpⱼ + sᵢsⱼ), s = a+b+c."""
@@ -334,26 +340,27 @@ def _inertia(central):
 
 def truth_from_pieces(pieces):
     """Truth of a solid given as disjoint signed pieces ``[(sign, (v, f)), ...]`` (each outward-wound; sign −1
-    for a cavity), exact in rationals when small."""
-    if sum(len(p[1][1]) for p in pieces) <= FRACTION_MAX_FACES:
-        vol, first, second = Fraction(0), [Fraction(0)] * 3, [[Fraction(0)] * 3 for _ in range(3)]
-        for sign, (v, f) in pieces:
-            pv, pf, ps = fraction_moments(v, f)
-            vol += sign * pv
-            first = [first[k] + sign * pf[k] for k in range(3)]
-            second = [[second[r][q] + sign * ps[r][q] for q in range(3)] for r in range(3)]
-        cen = [first[k] / vol for k in range(3)]
-        central = [[second[r][q] - vol * cen[r] * cen[q] for q in range(3)] for r in range(3)]
-        c = np.array([[float(x) for x in row] for row in central])
-        return Truth(float(vol), np.array([float(x) for x in cen]), _inertia(c), "fraction")
-    vol, mom, sec = 0.0, np.zeros(3), np.zeros((3, 3))
+    for a cavity): each piece of at most ``FRACTION_MAX_FACES`` faces integrated exactly in rationals, a larger
+    one in float64 about its own vertex mean (well conditioned for the repository's parts), the sum formed in
+    rationals (so a thin piece far from a large one keeps its exact moments)."""
+    vol, first, second = Fraction(0), [Fraction(0)] * 3, [[Fraction(0)] * 3 for _ in range(3)]
+    exact = True
     for sign, (v, f) in pieces:
-        pv, pc, pcen = float_moments(v, f)
+        if len(f) <= FRACTION_MAX_FACES:
+            pv, pf, ps = fraction_moments(v, f)
+        else:
+            exact = False
+            fv, fc, fcen = float_moments(v, f)
+            pv = Fraction(fv)
+            pf = [pv * Fraction(x) for x in fc]
+            ps = [[Fraction(fcen[r, q]) + pv * Fraction(fc[r]) * Fraction(fc[q]) for q in range(3)] for r in range(3)]
         vol += sign * pv
-        mom += sign * pv * pc
-        sec += sign * (pcen + pv * np.outer(pc, pc))
-    cen = mom / vol
-    return Truth(vol, cen, _inertia(sec - vol * np.outer(cen, cen)), "float")
+        first = [first[k] + sign * pf[k] for k in range(3)]
+        second = [[second[r][q] + sign * ps[r][q] for q in range(3)] for r in range(3)]
+    cen = [first[k] / vol for k in range(3)]
+    central = [[second[r][q] - vol * cen[r] * cen[q] for q in range(3)] for r in range(3)]
+    c = np.array([[float(x) for x in row] for row in central])
+    return Truth(float(vol), np.array([float(x) for x in cen]), _inertia(c), "fraction" if exact else "float")
 
 
 def to_manifold(piece):
@@ -714,8 +721,7 @@ def _sliver(rng):
         tet = np.array([[0, 0, 0], [0, length, 0], [0, 0, length], [thick, length / 3, length / 3]])
         tet += [hi[0] + length, 0, 0]
         tf = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]], dtype=np.int64)
-        if _signed_volume(tet, tf) < 0:
-            tf = tf[:, ::-1].copy()
+        tf = _outward_exactly(tet, tf)
         return _finish("sliver", rng, [(1, body), (1, (tet, tf))], concat(body, (tet, tf)),
                        f"{name} with a long thin tetrahedron ({length:.3g} m, {thick:.3g} m thin) "
                        f"{length:.3g} m away")
@@ -728,8 +734,7 @@ def _sliver(rng):
     tet = np.array([[0, 0, 0], [0, size, 0], [0, 0, size], [thick, size / 3, size / 3]], dtype=np.float64)
     tet += [hi[0] + gap + 0.01, 0, 0]
     tf = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]], dtype=np.int64)
-    if _signed_volume(tet, tf) < 0:
-        tf = tf[:, ::-1].copy()
+    tf = _outward_exactly(tet, tf)
     return _finish("sliver", rng, [(1, body), (1, (tet, tf))], concat(body, (tet, tf)),
                    f"{name} with a 4-face tetrahedron {thick:.3g} m thin ({size:.3g} m across, gap {gap:g}) beside it")
 
@@ -809,8 +814,20 @@ def _coplanar_overlap(rng):
     pieces = [(1, a), (1, b)]
     if np.all(hi > lo):           # inclusion–exclusion: the common box counted once
         pieces.append((-1, box(hi - lo, (lo + hi) / 2)))
-    return _finish("coplanar_overlap", rng, pieces, concat(a, b),
+    case = _finish("coplanar_overlap", rng, pieces, concat(a, b),
                    f"box{_t(ea)} and box{_t(eb)} both on z = 0, offset {off[:2].tolist()}")
+    # one box wholly within the other (standing on its floor from inside): by nesting depth (R4 of mesh/policy.py,
+    # one rule for a shell strictly inside another and one touching its boundary from inside) a cavity written
+    # outward, by the winding number a body; as for `overlapping`, both readings are accepted
+    box_a = (-ea / 2 + [0, 0, ea[2] / 2], ea / 2 + [0, 0, ea[2] / 2])
+    box_b = (off - eb / 2 + [0, 0, eb[2] / 2], off + eb / 2 + [0, 0, eb[2] / 2])
+    for (inner, ib), (outer, ob) in (((a, box_a), (b, box_b)), ((b, box_b), (a, box_a))):
+        if np.all(ib[0] >= ob[0]) and np.all(ib[1] <= ob[1]) and not np.array_equal(ea, eb):
+            rot, shift = case.motion
+            case.alternatives = [truth_from_manifold([moved(outer, rot, shift)], [moved(inner, rot, shift)])]
+            case.recipe += "; one box lies within the other (depth 1)"
+            break
+    return case
 
 
 def _edge_touch(rng):

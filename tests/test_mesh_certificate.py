@@ -451,3 +451,32 @@ def test_analyze_of_two_touching_copies_exits_0_with_an_exact_sum(tmp_path, caps
     assert out["mass"] == pytest.approx(12000.0, rel=1e-6)
     assert out["center_of_mass"] == pytest.approx([0.5, 0.0, 0.0], abs=1e-6)
     assert out["certificate"]["kind"] == "exact"
+
+
+def test_union_larger_than_sum_is_not_called_rounding():
+    """A cavity poking out of its body: the union exceeds the summed integral by far more than rounding; the
+    message says why instead of "within rounding"."""
+    from inertia_tool.mesh.prepare import shared_text
+    text = shared_text(0.875, 0.8875)
+    assert "within rounding" not in text and "cavity reaching out of its body" in text
+    assert "within rounding" in shared_text(1.0, 1.0 + 5e-12)
+
+
+def test_face_counts_in_the_report_add_up():
+    """Issue 21 item 7: "faces 36 (file 24)" after a union, "faces 12 (file 24)" after a copy was left out: the
+    text now says where the difference went, and its numbers add up."""
+    import re
+    from inertia_tool import mass_properties
+    from inertia_tool.reports.text import face_count_text
+    cube = box((1.0, 1.0, 1.0))
+    twice = stack(cube, cube)
+    with pytest.warns(Warning):
+        left = mass_properties(twice, density=1.0).mesh
+    text = face_count_text(left)
+    kept, file_, gone = (int(x.replace(",", "")) for x in re.findall(r"[\d,]+", text)[:3])
+    assert kept + gone == file_ == 24 and "left out" in text
+    moved = (cube[0] + [0.5, 0.2, 0.1], cube[1])
+    with pytest.warns(Warning):
+        united = mass_properties(stack(cube, moved), density=1.0).mesh
+    assert "union's surface" in face_count_text(united)
+    assert face_count_text(mass_properties(cube, density=1.0).mesh) == "12 (as in the file)"

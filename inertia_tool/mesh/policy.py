@@ -7,6 +7,12 @@ the surface bounds it exactly once).
 
 Rules
 -----
+R0 *A shell listed twice is one solid* (:func:`coincident_surfaces`).  A closed surface that repeats another
+   corner for corner (the same float64 coordinates, bit for bit, in the same cyclic order; with the same
+   vertex indices or its own) is counted once, with a note naming how many faces were left out.  A closed
+   surface listed together with its exact inverted copy has winding number 0 everywhere: the pair is left out
+   (a mesh that is nothing else is refused with that reason).  Reason: a shell exported twice means the part
+   once; summed, its volume counts twice, and united it only shows as a false overlap.
 R1 *Bodies are edge-connected* (:func:`~.checks.shell_labels`).  Faces that meet only at a vertex belong to
    different shells: a non-manifold vertex is split into its fans of edge-connected faces before anything
    decides what is one body.  Reason: two bodies that share a corner (or are welded there) are two bodies,
@@ -32,7 +38,13 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    So an outward-wound shell inside a body is read as a cavity written with the wrong winding, not as a
    second body buried in the first.  A shell whose surface crosses another's has no depth of its own: it keeps
    the file's winding (an inward shell is cut from the outward shell it crosses) and the boolean decides; a
-   group of crossing shells all wound inward and lying in no body is turned as a whole.  When the intersection
+   group of crossing shells all wound inward and lying in no body is turned as a whole.  A shell whose surface
+   meets another's only where its solid reaches the other's boundary (all but ``TOUCH_VOLUME_RTOL`` of its
+   solid shared with the other's, by the boolean: :func:`within_up_to_rounding`) lies *within* it and takes its
+   depth from it like any nested shell, whether the contact is exactly coplanar or coplanar only to rounding
+   after a rotation: a cavity flush with its body's face is a cavity (cut from the body by the boolean, certified
+   ``united``), an outward-wound one included.  One rule covers a shell strictly inside another and one
+   touching the other's boundary from inside: *the role is the depth of the closed solid*.  When the intersection
    check did not finish (crossings unknown, so "inside" may mean "overlapping"), each shell keeps what its own
    sign says instead.
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
@@ -49,7 +61,11 @@ R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL`
 R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only after the edge census found the
    surface balanced, every shell is oriented by R4, and the face-intersection check ran over every candidate
    pair and found no crossing.  When the check could not finish within its work bound the integral is still
-   computed but certified ``unverified``.
+   computed but certified ``unverified``.  "Exact" is exact for the polyhedron up to a derived float64
+   round-off bound (:func:`~inertia_tool.integrals.roundoff_bounds`) of at most ``tolerances.ROUNDOFF_RTOL``
+   of the result: shells whose bound is wider are integrated again about their own centre or in exact integer
+   arithmetic (:func:`~inertia_tool.integrals.accurate_shells`), before any sign is read (R2, R4); a result
+   whose bound stays wider is certified ``unverified``.
 """
 
 from __future__ import annotations
@@ -68,7 +84,8 @@ if TYPE_CHECKING:
     from .nesting import Nesting
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
-           "negligible_flat", "inward_crossing_outward",
+           "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
+           "coincident_surfaces", "coincident_message",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
@@ -210,7 +227,8 @@ def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarra
 
 
 def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np.ndarray, *,
-                    crossing_known: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    crossing_known: bool = True,
+                    within: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """R4: which shells to flip, the body each shell belongs to, and its nesting depth.
 
     Parameters
@@ -255,6 +273,7 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
         cross[cw[:, 0], cw[:, 1]] = True
         cross[cw[:, 1], cw[:, 0]] = True
     inside = nest.winding != 0
+    extra = np.zeros((0, 2), dtype=np.int64) if within is None else np.asarray(within, dtype=np.int64).reshape(-1, 2)
     if not crossing_known:
         signed = nest.winding * np.sign(vols[nest.other])          # +1 inside the material of ``other``
         held = (signed > 0) & (vols[nest.shell] < 0) & (vols[nest.other] > 0)
@@ -264,24 +283,61 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
         owner[nest.shell[held][order]] = nest.other[held][order]
         depth[np.unique(nest.shell[held])] = 1
         return flip, owner, depth
-    contained = inside & ~cross[nest.shell, nest.other]
-    # the containers of each shell, sorted from the outermost (largest |volume|) inward
-    depth_of = np.bincount(nest.shell[contained], minlength=n)
-    depth[:] = depth_of
-    undecided = np.asarray(nest.undecided, dtype=bool)
+    held = inside & ~cross[nest.shell, nest.other]
+    pairs = np.unique(np.concatenate([np.c_[nest.shell[held], nest.other[held]], extra]), axis=0)
+    s_in, o_in = pairs[:, 0], pairs[:, 1]
+    depth[:] = np.bincount(s_in, minlength=n)
+    undecided = np.asarray(nest.undecided, dtype=bool).copy()
+    undecided[extra[:, 0]] = False
     depth[undecided] = 0
     want_positive = depth % 2 == 0
     flip = (vols > 0) != want_positive
     flip[undecided] = vols[undecided] < 0
     cavity = ~want_positive & ~undecided
     if cavity.any():
-        s, o = nest.shell[contained], nest.other[contained]
-        keep = cavity[s] & (depth[o] == depth[s] - 1)        # the innermost container of a cavity
-        owner[s[keep]] = o[keep]
+        keep = cavity[s_in] & (depth[o_in] == depth[s_in] - 1)        # the innermost container of a cavity
+        owner[s_in[keep]] = o_in[keep]
     crosses = cross.any(axis=1) & ~undecided
     if crosses.any():
         _orient_crossing(vols, cross, crosses, depth, flip, owner)
     return flip, owner, depth
+
+
+def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.ndarray, *,
+                          rtol: float = TOUCH_VOLUME_RTOL) -> tuple[np.ndarray, np.ndarray]:
+    """R4: which pairs of crossing shells are one inside the other up to rounding.
+
+    Shell ``a`` lies within ``b`` when all but ``rtol`` of its solid (wound outward) is shared with ``b``'s:
+    ``vol(A ∩ B) ≥ (1 − rtol)·|vol A|`` while ``b`` is not likewise within ``a`` (two copies of one solid are
+    not nested).  The surfaces then meet only where ``a`` reaches ``b``'s boundary (a cavity flush with its body's
+    face, a core resting on its cavity's floor), and the faces "cross" only because coplanar faces were rounded
+    differently (a random rotation) or because an outward-wound cavity shares a face with its body.
+
+    Parameters
+    ----------
+    volumes : (s,) float
+        Signed shell volumes.
+    pairs : (k, 2) int
+        Crossing pairs.
+    common : (k,) float
+        ``vol(A ∩ B)`` of each pair (:func:`~.union.common_volumes`; NaN when unknown: the pair stays crossing).
+
+    Returns
+    -------
+    within : (j, 2) int
+        ``(shell, container)``.
+    crossing : (k − j, 2) int
+        The pairs that cross for real.
+    """
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    size = np.abs(np.asarray(volumes, dtype=np.float64))
+    c = np.asarray(common, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        a_in_b = c >= (1 - rtol) * size[p[:, 0]]
+        b_in_a = c >= (1 - rtol) * size[p[:, 1]]
+    one = a_in_b ^ b_in_a
+    within = np.where(a_in_b[one, None], p[one], p[one][:, ::-1])
+    return within.reshape(-1, 2), p[~one]
 
 
 def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, depth: np.ndarray,
@@ -357,3 +413,157 @@ def inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with
         hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
         inward[pairs[hit, a]] = True
     return int(np.count_nonzero(inward))
+
+
+@frozen_value
+class Coincident:
+    """R0: closed surfaces listed twice, and closed surfaces listed with their exact inverted copy.
+
+    Attributes
+    ----------
+    drop : (m,) bool
+        Faces to leave out: the later copy of each surface listed twice, and both members of each cancelling pair.
+    repeated : int
+        Closed surfaces that repeat another face for face (same corners, same winding): counted once.
+    repeated_faces : int
+    cancelled : int
+        Pairs of closed surfaces each the other's exact inverse (same corners, opposite winding).
+    cancelled_faces : int
+        Faces of the cancelling pairs (both members).
+    where : (3,) float
+        A corner of the first surface left out, m (NaN when none).
+    """
+
+    drop: np.ndarray
+    repeated: int
+    repeated_faces: int
+    cancelled: int
+    cancelled_faces: int
+    where: np.ndarray
+
+
+def _closed_components(faces: np.ndarray, members: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
+    """Edge-connected components of the faces ``members`` (indices into ``faces``) and which of them are closed and
+    balanced on their own (every directed edge matched by its reverse within the component)."""
+    from .checks import shell_labels
+    from .edges import edge_keys
+
+    sub = faces[members]
+    comp, n_comp = shell_labels(sub, n_vertices)
+    key, forward = edge_keys(sub, n_vertices)
+    owner = np.repeat(comp, 3).astype(np.int64)          # edge_keys lists each face's three edges in turn
+    _, inverse = np.unique(np.stack([owner, key.astype(np.int64)], axis=1), axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
+    unbalanced = np.zeros(n_comp, dtype=bool)
+    first = np.zeros(len(net), dtype=np.int64)
+    first[inverse] = owner
+    unbalanced[first[net != 0]] = True
+    return comp, ~unbalanced
+
+
+def _doubled_closed(faces: np.ndarray, n_vertices: int) -> bool:
+    """Every edge of ``faces`` is used at least four times (a closed surface and its reverse on the same vertices;
+    a flat sheet's rim edges are used twice)."""
+    from .edges import edge_keys
+
+    _, count = np.unique(edge_keys(faces, n_vertices)[0], return_counts=True)
+    return bool(np.all(count >= 4))
+
+
+def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarray | None = None,
+                        labels: np.ndarray | None = None) -> Coincident:
+    """R0: find closed surfaces listed twice (same winding) or with their exact inverted copy (opposite winding).
+
+    Faces are compared by the exact coordinates of their corners (bit for bit; a copy may use its own vertex
+    indices or the same ones), each face taken from its smallest corner on in its own cyclic order.  A set of
+    repeated faces is left out only when it is closed and balanced on its own (a whole shell, not a face that two
+    overlapping bodies happen to share); a cancelling pair only when each member is closed and balanced and the
+    other's faces are exactly its reverses, so what stays is as closed as before.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    among : (m,) bool, optional
+        Only these faces are compared (the shells that could be copies); default all.
+    labels : (m,) int, optional
+        Shell of each face: of the copies of a face, the one in the lowest-numbered shell is kept, so that a
+        copy with its own vertices is left out whole however the faces are ordered.
+    """
+    m = len(faces)
+    drop = np.zeros(m, dtype=bool)
+    none = Coincident(drop=drop, repeated=0, repeated_faces=0, cancelled=0, cancelled_faces=0,
+                      where=np.full(3, np.nan))
+    idx = np.flatnonzero(np.ones(m, dtype=bool) if among is None else np.asarray(among, dtype=bool))
+    if len(idx) < 8:                       # a closed surface has at least 4 faces, two of them at least 8
+        return none
+    f = np.asarray(faces, dtype=np.int64)[idx]
+    used, local = np.unique(f, return_inverse=True)
+    _, point = np.unique(np.asarray(vertices, dtype=np.float64)[used], axis=0, return_inverse=True)
+    g = point.reshape(-1)[local.reshape(-1)].reshape(-1, 3)         # corners as ids of distinct points
+    rows = np.arange(len(g))[:, None]
+    start = np.argmin(g, axis=1)[:, None]
+    key = g[rows, (start + np.arange(3)) % 3]                       # from the smallest corner, same cycle
+    rev = key[:, [0, 2, 1]]                                         # the same face wound the other way
+    _, code = np.unique(np.concatenate([key, rev]), axis=0, return_inverse=True)
+    code = code.reshape(-1)
+    fwd, back = code[:len(g)], code[len(g):]
+    shell = np.zeros(len(g), dtype=np.int64) if labels is None else np.asarray(labels, dtype=np.int64)[idx]
+    order = np.lexsort((shell, fwd))
+    later = np.zeros(len(g), dtype=bool)
+    later[order[1:]] = fwd[order[1:]] == fwd[order[:-1]]            # a repeat of an earlier face
+    n_v = len(vertices)
+    repeated = repeated_faces = 0
+    if later.any():
+        members = np.flatnonzero(later)
+        comp, closed = _closed_components(f, members, n_v)
+        gone = members[closed[comp]]
+        drop[idx[gone]] = True
+        repeated, repeated_faces = int(np.count_nonzero(closed)), len(gone)
+    cancelled = cancelled_faces = 0
+    first_of = np.full(int(code.max()) + 1, -1, dtype=np.int64)
+    alive = np.flatnonzero(~later)
+    first_of[fwd[alive]] = alive
+    partner = first_of[back]                                         # a face of the reverse, or -1
+    paired = np.flatnonzero((partner >= 0) & ~later)
+    if len(paired):
+        comp, closed = _closed_components(f, paired, n_v)
+        comp_of = np.full(len(g), -1, dtype=np.int64)
+        comp_of[paired] = comp
+        size = np.bincount(comp)
+        other = comp_of[partner[paired]]
+        ok = closed.copy()
+        for c in range(len(closed)):                                 # bounded by the number of components
+            mine = other[comp == c]
+            if not ok[c] or np.any(mine < 0) or np.any(mine != mine[0]) or size[mine[0]] != size[c] \
+                    or not closed[mine[0]]:
+                ok[c] = False
+            elif mine[0] == c:       # both members in one piece: a doubled closed surface, not a flat sheet (R2)
+                ok[c] = _doubled_closed(f[paired[comp == c]], n_v)
+        gone = paired[ok[comp]]
+        drop[idx[gone]] = True
+        twin = np.array([other[comp == c][0] for c in range(len(closed))], dtype=np.int64)
+        cancelled = int(np.count_nonzero(ok & (twin >= np.arange(len(closed)))))   # each pair once
+        cancelled_faces = len(gone)
+    where = np.asarray(vertices, dtype=np.float64)[faces[np.flatnonzero(drop)[0], 0]] if drop.any() \
+        else np.full(3, np.nan)
+    return Coincident(drop=drop, repeated=repeated, repeated_faces=repeated_faces, cancelled=cancelled,
+                      cancelled_faces=cancelled_faces, where=where)
+
+
+def coincident_message(found: Coincident) -> str:
+    """R0's note: what was left out and why, faces counted so that they add up."""
+    parts = []
+    p = found.where
+    near = f" (one near ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}) m)" if np.all(np.isfinite(p)) else ""
+    if found.repeated:
+        n = found.repeated
+        parts.append(f"{n} closed surface{'s' if n > 1 else ''} listed twice ({found.repeated_faces:,} faces "
+                     "repeating others corner for corner) counted once")
+    if found.cancelled:
+        n = found.cancelled
+        parts.append(f"{n} closed surface{'s' if n > 1 else ''} listed together with {'their' if n > 1 else 'its'} "
+                     f"exact inverted cop{'ies' if n > 1 else 'y'} ({found.cancelled_faces:,} faces in all): each "
+                     "pair cancels (winding number 0 everywhere, no volume) and is left out")
+    return "; ".join(parts) + near

@@ -20,12 +20,14 @@ import numpy as np
 from ..values import frozen_value
 from ..errors import (ArrangementError, DegenerateFacesWarning, InsideOutWarning, InvalidMeshError, MeshRepairedWarning,
                       MeshResolvedWarning, OverlapWarning, UsageError)
-from ..integrals import VolumeMoments, body_volume_moments, bounding_box, volume_moments
-from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE
+from ..integrals import (RoundoffBound, VolumeMoments, accurate_shells, body_volume_moments, bounding_box,
+                         total_roundoff, volume_moments)
+from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE, ROUNDOFF_RTOL
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
-from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, inward_crossing_outward, negligible_flat,
-                     orient_by_depth, self_crossing_message, shell_contacts)
+from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
+                     inward_crossing_outward, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts,
+                     within_up_to_rounding)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
 
@@ -103,8 +105,11 @@ def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     touch = shell_contacts(contacts, labels, n_shells) if contacts is not None else None
     nest = _nesting(vertices, faces, labels, n_shells)
     crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
+    within = None
+    if touch is not None and touch.complete:
+        within, crossing_with = _within(vertices, faces, labels, vols, crossing_with)
     flip, owner, depth = orient_by_depth(vols, nest, crossing_with,
-                                         crossing_known=touch is not None and touch.complete)
+                                         crossing_known=touch is not None and touch.complete, within=within)
     undecided = nest.undecided if nest is not None else np.zeros(n_shells, dtype=bool)
     if touch is not None and touch.complete:
         # touching shells share no volume (their interiors are disjoint when no face crosses); a shell that
@@ -182,6 +187,12 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if not diag > 0:
         raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")
     topo = edge_topology(f, len(v), v)
+    coincident_notes: list[str] = []
+    if topo.nonmanifold_edges:                # R0: a shell listed twice with the same vertex indices
+        f, note = _leave_out_coincident(v, f, None, source)
+        if note is not None:
+            coincident_notes.append(note)
+            topo = edge_topology(f, len(v), v)
     watertight = topo.oriented
     found = Resolution(v, f, "exact", (), 0, None, 0)
     n_read = len(v)                           # vertices beyond these are the apexes of repair patches
@@ -206,7 +217,15 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if n_shells == 0:
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
     shells = body_volume_moments(v, f, labels, n_shells)
-    f, labels, n_shells, shells, dropped_note = _drop_flat(v, f, labels, shells, diag, source)    # R2
+    twins = _twin_candidates(shells, labels)
+    if twins is not None:                     # R0: a shell listed twice with its own vertices
+        f, note = _leave_out_coincident(v, f, twins, source, labels)
+        if note is not None:
+            coincident_notes.append(note)
+            labels, n_shells = shell_labels(f, len(v))
+            shells = body_volume_moments(v, f, labels, n_shells)
+    shells, bound = _accurate(v, f, labels, shells)          # R7: signs and moments within the round-off bound
+    f, labels, n_shells, shells, dropped_note, bound = _drop_flat(v, f, labels, shells, diag, source, bound)  # R2
     contacts = surface_contacts(v, f)
     if patched is not None:
         contacts, patch_notes = _outside_patches(contacts, f, n_read)
@@ -217,8 +236,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     arrange_failed, arranged_verified = "", False
     if touch.self_crossing.any() and self_crossing == "refuse" and overlap == "union" and patched is None:   # R3
         try:
-            v, f, labels, n_shells, shells, contacts, touch, arranged, arranged_verified = _arrange_self_crossing(
-                v, f, labels, contacts, touch, diag, source)
+            v, f, labels, n_shells, shells, contacts, touch, arranged, arranged_verified, bound = \
+                _arrange_self_crossing(v, f, labels, contacts, touch, diag, source)
         except ArrangementError as exc:
             arrange_failed = f"; its solid {{winding number ≥ 1}} could not be built: {exc}"
     if touch.self_crossing.any() and self_crossing == "unverified" and not repair:
@@ -237,19 +256,28 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                           f"{'; '.join(forced.notes)}"), stacklevel=3)
         return _estimated(forced, common)
     nest = _nesting(v, f, labels, n_shells)
-    flip, owner, depth = orient_by_depth(np.array([s.volume for s in shells]), nest, touch.crossing_with,
-                                         crossing_known=touch.complete)                                  # R4
     file_volumes = np.array([s.volume for s in shells])
+    within, crossing_with = None, touch.crossing_with
+    if touch.complete:
+        within, crossing_with = _within(v, f, labels, file_volumes, crossing_with)
+    flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
+                                         within=within)                                                 # R4
     f, shells = _apply_flips(f, labels, shells, flip, n_shells, source)
     cavities = int(np.count_nonzero(depth % 2 == 1))
-    method, notes = found.method, list(found.notes)
-    ambiguous = inward_crossing_outward(file_volumes, flip, touch.crossing_with)
+    method, notes = found.method, list(found.notes) + coincident_notes
+    ambiguous = inward_crossing_outward(file_volumes, flip, crossing_with)
     if ambiguous:
         plural = ambiguous > 1
         notes.append(f"{ambiguous} inward-wound shell{'s' if plural else ''} cross{'' if plural else 'es'} "
                      "an outward one: read as a cavity cut from it (the solid where the winding number is at least "
                      "one); if it is a body written inside out, fix its winding. Not verified")
         warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+    if within is not None and len(within):
+        n_within = len(np.unique(within[:, 0]))
+        notes.append(f"{n_within} shell{'s' if n_within > 1 else ''} meet{'' if n_within > 1 else 's'} the "
+                     "shell around it only on its boundary (a cavity flush with its body's face, a part resting on "
+                     "a cavity's floor; the faces there coincide or cross by rounding): read by nesting depth and "
+                     "formed by the boolean")
     if dropped_note is not None:
         notes.append(dropped_note)
     if arranged is not None:
@@ -262,7 +290,9 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         candidates = touch.crossing | touch.touching | undecided
     else:       # the check gave up: every shell whose box meets another's goes to the boolean
         candidates = _boxes_meet(v, f, labels, n_shells) | undecided
-    overlaps = int(np.count_nonzero(touch.crossing))
+    really = np.zeros(n_shells, dtype=bool)
+    really[crossing_with.reshape(-1)] = True
+    overlaps = int(np.count_nonzero(really))
     kind = "exact" if touch.complete and crossing_note is None else "unverified"
     if touch.complete and not touch.crossing.any() and crossing_note is None:
         checks.append("no-crossing-faces")
@@ -281,16 +311,17 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                     moments=volume_moments, force_estimate=True)
             return _estimated(found, {**common, "overlapping_shells": max(overlaps, 1)})
         else:
-            overlaps = max(overlaps, 1)
+            overlaps = max(overlaps, 1) if really.any() or not touch.crossing.any() else 0
             shared = shared_text(summed, united.volume)
-            if overlap == "sum":
+            if overlap == "sum" and overlaps:
                 method, kind = "sum", "summed"
                 notes.append(f"overlapping bodies: their integrals are added, so {shared} is counted twice "
                              "(`overlap` 'sum')")
                 warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
             else:
-                notes.append(f"overlapping bodies united by a boolean: {shared} counted once")
-                warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+                if overlaps:          # else only shells within others (R4): their cavities are cut, nothing shared
+                    notes.append(f"overlapping bodies united by a boolean: {shared} counted once")
+                    warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
                 method = "union"
                 # R6/R7: the boolean found shared volume; "united" is proven only when crossing faces were found
                 # too (else the two checks disagree: manifold3d's tolerance or a crossing the check cannot see)
@@ -307,13 +338,21 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                     notes.append(f"the union formed by the boolean passes through itself at {len(after.crossing):,} "
                                  "face pairs (rounding in manifold3d): not verified")
                 labels, n_shells = shell_labels(f, len(v))
-                shells = body_volume_moments(v, f, labels, n_shells)
-                f, labels, n_shells, shells, left = _drop_flat(v, f, labels, shells, diag, source, warn=False)
+                shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+                f, labels, n_shells, shells, left, bound = _drop_flat(v, f, labels, shells, diag, source, bound,
+                                                                      warn=False)
                 nest = _nesting(v, f, labels, n_shells)
                 flip2, owner, depth = orient_by_depth(np.array([s.volume for s in shells]), nest,
                                                       np.zeros((0, 2), dtype=np.int64))
                 f, shells = _apply_flips(f, labels, shells, flip2, n_shells, source, warn=False)
                 cavities = int(np.count_nonzero(depth % 2 == 1))
+    roundoff = total_roundoff(shells, bound)
+    if patched is None:                                                          # R7: exact up to round-off
+        if roundoff > ROUNDOFF_RTOL and kind in ("exact", "united"):
+            kind = "unverified"
+            notes.append(f"the float64 round-off of the integrals is bounded only by {roundoff:.2g} of the result "
+                         f"(above {ROUNDOFF_RTOL:g}: a sliver thinner than its coordinates' rounding, too large for "
+                         "exact arithmetic): not verified")
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))
     bbox_min, bbox_max = (lo, hi) if v is raw.vertices else bounding_box(v)
     uncertainty = None
@@ -348,15 +387,16 @@ def _arrange_self_crossing(v: np.ndarray, f: np.ndarray, labels: np.ndarray, con
     """R3: every shell passing through itself replaced by the boundary of its {winding number ≥ 1}
     (:mod:`~.arrange`), then the stages after R1 run again on the new surface.
 
-    Returns ``(v, f, labels, n_shells, shells, contacts, touch, note, verified)``; raises ArrangementError.
+    Returns ``(v, f, labels, n_shells, shells, contacts, touch, note, verified, bound)`` (``bound`` the shells'
+    round-off bounds, R7); raises ArrangementError.
     Crossings left by rounding the new points (``verified`` False) are taken out of ``touch`` (the result is
     then certified ``unverified``)."""
     from .arrange import arrange_shells      # imported on use: self-crossing shells are rare
     done = arrange_shells(v, f, labels, contacts.crossing)
     v, f = done.vertices, done.faces
     labels, n_shells = shell_labels(f, len(v))
-    shells = body_volume_moments(v, f, labels, n_shells)
-    f, labels, n_shells, shells, _ = _drop_flat(v, f, labels, shells, diag, source, warn=False)
+    shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+    f, labels, n_shells, shells, _, bound = _drop_flat(v, f, labels, shells, diag, source, bound, warn=False)
     contacts = surface_contacts(v, f)
     touch = shell_contacts(contacts, labels, n_shells)
     if touch.self_crossing.any():
@@ -372,15 +412,20 @@ def _arrange_self_crossing(v: np.ndarray, f: np.ndarray, labels: np.ndarray, con
         note += (f"; {done.crossings_left:,} face pairs of the result still cross after rounding the intersection "
                  "points to float64 (a crossing in special position): not verified")
     warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
-    return v, f, labels, n_shells, shells, contacts, touch, note, not done.crossings_left
+    return v, f, labels, n_shells, shells, contacts, touch, note, not done.crossings_left, bound
 
 
 def shared_text(summed: float, united: float) -> str:
-    """The shared volume of overlapping bodies in words, m³ (never negative)."""
+    """The shared volume of overlapping bodies in words, m³ (never negative).  A union larger than the summed
+    integral beyond rounding (``TOUCH_VOLUME_RTOL``) is a cavity reaching out of its body: the boolean cuts it
+    only where it lies in the body, the summed integral all of it."""
     shared = summed - united
     if shared >= 0:
         return f"{shared:.6g} m³ of shared volume"
-    return f"no shared volume (the union is {-shared:.3g} m³ larger than the sum, within rounding)"
+    if -shared <= TOUCH_VOLUME_RTOL * abs(summed):
+        return f"no shared volume (the union is {-shared:.3g} m³ larger than the sum, within rounding)"
+    return (f"no shared volume; the union is {-shared:.3g} m³ larger than the summed integral (a cavity reaching "
+            "out of its body is cut only where it lies in the body)")
 
 
 def _outside_patches(contacts: SurfaceContacts, faces: np.ndarray,
@@ -404,6 +449,67 @@ def _nesting(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) ->
     return shell_nesting(v, f, labels, n_shells)
 
 
+#: Crossing shell pairs tested for lying one within the other (R4), at most; beyond, a pair stays crossing.
+MAX_WITHIN_PAIRS = 256
+
+
+def _within(v: np.ndarray, f: np.ndarray, labels: np.ndarray, volumes: np.ndarray,
+            crossing_with: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """R4: the crossing pairs whose one shell lies within the other up to rounding (``(shell, container)``), and the
+    pairs that cross for real (:func:`~.policy.within_up_to_rounding`, volumes shared by manifold3d)."""
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    if not len(pairs):
+        return np.zeros((0, 2), dtype=np.int64), pairs
+    from .union import common_volumes            # imported on use: crossings are rare
+    tested = pairs[:MAX_WITHIN_PAIRS]
+    within, really = within_up_to_rounding(volumes, tested, common_volumes(v, f, labels, volumes, tested))
+    return within, np.concatenate([really, pairs[MAX_WITHIN_PAIRS:]])
+
+
+def _accurate(v: np.ndarray, f: np.ndarray, labels: np.ndarray,
+              shells: list[VolumeMoments]) -> tuple[list[VolumeMoments], RoundoffBound]:
+    """R7: the shells with their round-off bounded (:func:`~inertia_tool.integrals.accurate_shells`: a sliver
+    thinner than its coordinates' rounding integrated exactly, so that even its sign is right), and each shell's
+    round-off bound."""
+    better, _, bound = accurate_shells(v, f, labels, list(shells))
+    return better, bound
+
+
+def _twin_candidates(shells: Sequence[VolumeMoments], labels: np.ndarray) -> np.ndarray | None:
+    """(m,) bool: faces of shells that could be copies of another (R0: same face count, |volume| and area equal
+    to 1e-9), or None when no two shells could be."""
+    n = len(shells)
+    if n < 2:
+        return None
+    count = np.bincount(labels, minlength=n)
+    size = np.array([[abs(s.volume), s.area] for s in shells])
+    order = np.lexsort((size[:, 0], count))
+    a, b = order[:-1], order[1:]
+    close = (count[a] == count[b]) & np.all(np.abs(size[a] - size[b]) <= 1e-9 * np.maximum(size[a], size[b]), axis=1)
+    if not close.any():
+        return None
+    shell = np.zeros(n, dtype=bool)
+    shell[a[close]] = shell[b[close]] = True
+    return np.asarray(shell[labels])
+
+
+def _leave_out_coincident(v: np.ndarray, f: np.ndarray, among: np.ndarray | None, source: str,
+                          labels: np.ndarray | None = None) -> tuple[np.ndarray, str | None]:
+    """R0: the faces without the later copy of each shell listed twice and without shells cancelled by their exact
+    inverted copy, with the note (warned); refused when nothing is left."""
+    found = coincident_surfaces(v, f, among, labels)
+    if not found.drop.any():
+        return f, None
+    if found.drop.all():
+        raise InvalidMeshError(f"{source}: the mesh is a closed surface listed together with its exact inverted copy "
+                               f"({len(f) // 2:,} faces each, same corners, opposite winding): they cancel to "
+                               "nothing (winding number 0 everywhere, no volume); remove one copy, or reverse it "
+                               "if the surface was meant twice")
+    note = coincident_message(found)
+    warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
+    return f[~found.drop], note
+
+
 def _boxes_meet(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) -> np.ndarray:
     """(s,) bool: shells whose bounding box meets another shell's."""
     order = np.argsort(labels, kind="stable")
@@ -417,31 +523,33 @@ def _boxes_meet(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int)
 
 
 def _drop_flat(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments], diag: float,
-               source: str, *,
-               warn: bool = True) -> tuple[np.ndarray, np.ndarray, int, list[VolumeMoments], str | None]:
-    """R2: leave out closed shells that enclose no volume; refuse when nothing else is left."""
+               source: str, bound: RoundoffBound, *,
+               warn: bool = True) -> tuple[np.ndarray, np.ndarray, int, list[VolumeMoments], str | None,
+                                           RoundoffBound]:
+    """R2: leave out closed shells that enclose no volume; refuse when nothing else is left.  ``bound`` is the
+    round-off bound of ``shells`` (R7), returned anew when they are recomputed."""
     n_shells = len(shells)
     flat = np.array([abs(s.volume) <= FLAT_RTOL * diag ** 3 for s in shells], dtype=bool)
     if not flat.any():
-        return f, labels, n_shells, shells, None
+        return f, labels, n_shells, shells, None, bound
     if flat.all():
         what = "the mesh encloses" if n_shells == 1 else f"all {n_shells} shells enclose"
         raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
                                "thin-walled part use the shell model with a wall `thickness`")
     flat &= negligible_flat(shells, flat)        # a thin but real solid whose moments count stays
     if not flat.any():
-        return f, labels, n_shells, shells, None
+        return f, labels, n_shells, shells, None, bound
     dropped_faces = int(np.count_nonzero(flat[labels]))
     f = f[~flat[labels]]
     labels, n_shells = shell_labels(f, len(v))
-    shells = body_volume_moments(v, f, labels, n_shells)
+    shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
     n_flat = int(np.count_nonzero(flat))
     note = (f"{n_flat} closed piece{'s' if n_flat > 1 else ''} enclosing no volume ({dropped_faces:,} faces: "
             "zero-thickness walls, coincident opposite faces or flat slivers) left out; they contribute nothing "
             "to the integrals")
     if warn:
         warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
-    return f, labels, n_shells, shells, note
+    return f, labels, n_shells, shells, note, bound
 
 
 def _apply_flips(f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments], flip: np.ndarray, n_shells: int,

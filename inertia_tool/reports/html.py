@@ -33,6 +33,7 @@ import numpy as np
 from ..mass.ellipsoid import equivalent_ellipsoid_semi_axes
 from ..errors import InertiaToolError
 from ..mass.properties import MassProperties
+from .text import face_count_text
 from ..tolerances import TRIANGLE_INEQUALITY_RTOL
 from .escape import escape_html
 from ..output import check_targets, write_text
@@ -424,7 +425,7 @@ def _core_sections(props: MassProperties, density_source: str | None, semi,
                   f"inertia ±{100 * u.inertia:.3g}%")
         rows = [["method", _e(mesh.method)], ["certificate", _e(mesh.certificate.describe())],
                 ["uncertainty", _e(bounds)],
-                ["faces", f"{mesh.faces:,} (file {mesh.file_faces:,})"], ["vertices", f"{mesh.vertices:,}"],
+                ["faces", _e(face_count_text(mesh))], ["vertices", f"{mesh.vertices:,}"],
                 ["bodies / cavities", f"{mesh.bodies} / {mesh.cavities}"],
                 ["watertight and consistently wound as read", "yes" if mesh.watertight else "no"],
                 ["degenerate faces ignored / zero-area faces", f"{mesh.degenerate_faces} / {mesh.zero_area_faces}"],

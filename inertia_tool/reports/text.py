@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..mass.properties import MassProperties
 from .serialize import TENSOR_CONVENTION
 from .numbers import number, round_off_zero
+
+if TYPE_CHECKING:
+    from ..mesh.checks import MeshReport
 
 __all__ = ["format_mass_properties"]
 
@@ -121,7 +126,7 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
                          f"centre of mass {_position(b.center_of_mass, size)} m")
     if mesh is not None:
         lines.append("  mesh:")
-        lines.append(f"    faces {mesh.faces:,} (file {mesh.file_faces:,}), vertices {mesh.vertices:,}, "
+        lines.append(f"    faces {face_count_text(mesh)}, vertices {mesh.vertices:,}, "
                      f"bodies {mesh.bodies}, cavities {mesh.cavities}")
         lines.append(f"    watertight and consistently wound as read: {'yes' if mesh.watertight else 'no'}"
                      f"; degenerate faces ignored: {mesh.degenerate_faces}; zero-area faces: {mesh.zero_area_faces}")
@@ -141,3 +146,19 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
                 lines.append(f"    repaired: {', '.join(mesh.repair_actions)}{change}")
         lines.append(f"    bounding box: {_vec(mesh.bbox_min)} – {_vec(mesh.bbox_max)} m")
     return "\n".join(lines)
+
+
+def face_count_text(mesh: MeshReport) -> str:
+    """The faces integrated and how they relate to the file's, so that the counts add up: the file's less the
+    degenerate ones and those left out (flat pieces, copies: see the notes), or a surface the tool formed (the
+    boolean union, repair patches)."""
+    kept = mesh.file_faces - mesh.degenerate_faces
+    if mesh.faces == mesh.file_faces:
+        return f"{mesh.faces:,} (as in the file)"
+    if mesh.method in ("union", "patched") or mesh.faces > kept:
+        made = "the boolean union's surface" if mesh.method == "union" else "after repair"
+        return f"{mesh.faces:,} ({made}; the file has {mesh.file_faces:,})"
+    parts = [f"{mesh.degenerate_faces:,} degenerate"] if mesh.degenerate_faces else []
+    if mesh.faces < kept:
+        parts.append(f"{kept - mesh.faces:,} left out: see the notes")
+    return f"{mesh.faces:,} (the file's {mesh.file_faces:,} less {' and '.join(parts)})"
