@@ -85,7 +85,7 @@ if TYPE_CHECKING:
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
            "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
-           "coincident_surfaces", "coincident_message",
+           "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
@@ -301,6 +301,57 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
     if crosses.any():
         _orient_crossing(vols, cross, crosses, depth, flip, owner)
     return flip, owner, depth
+
+
+@frozen_value
+class TouchRelations:
+    """R4 for shells that touch (no face pair crosses): what their vertices say, pair by pair.
+
+    Attributes
+    ----------
+    crossing : (k, 2) int
+        Pairs whose surfaces cross along edges and vertices of the meshes: one shell has vertices strictly inside
+        the other and vertices strictly outside it (or each lies inside the other).
+    within : (j, 2) int
+        ``(shell, container)``: every tested vertex of ``shell`` off the container's surface is inside it, and
+        every one of the container's is outside ``shell``.
+    apart : (i, 2) int
+        Pairs whose tested vertices all lie outside the other shell: interiors disjoint, they only touch.
+    unknown : (u, 2) int
+        Pairs the vertices cannot decide (one shell has every tested vertex on the other's surface): sent to the
+        boolean like crossing pairs, which decides (``within_up_to_rounding``, R5, R6).
+    """
+
+    crossing: np.ndarray
+    within: np.ndarray
+    apart: np.ndarray
+    unknown: np.ndarray
+
+
+def touching_relations(pairs: np.ndarray, inside: np.ndarray, outside: np.ndarray) -> TouchRelations:
+    """R4: decide each pair of touching shells from the sides of their vertices, never from one probe point.
+
+    Parameters
+    ----------
+    pairs : (2k, 2) int
+        ``(a, b)`` rows for the k pairs, then the same pairs reversed (:func:`~.nesting.touching_sides`).
+    inside, outside : (2k,) int
+        Vertices of the row's first shell strictly inside / outside its second shell (winding number ≠ 0 / = 0).
+    """
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    k = len(p) // 2
+    fwd = p[:k]
+    i_ab, o_ab = np.asarray(inside[:k]), np.asarray(outside[:k])
+    i_ba, o_ba = np.asarray(inside[k:]), np.asarray(outside[k:])
+    all_in_ab, all_out_ab = (i_ab > 0) & (o_ab == 0), (o_ab > 0) & (i_ab == 0)
+    all_in_ba, all_out_ba = (i_ba > 0) & (o_ba == 0), (o_ba > 0) & (i_ba == 0)
+    crossing = ((i_ab > 0) & (o_ab > 0)) | ((i_ba > 0) & (o_ba > 0)) | (all_in_ab & all_in_ba)
+    a_in_b = all_in_ab & all_out_ba & ~crossing
+    b_in_a = all_in_ba & all_out_ab & ~crossing
+    apart = all_out_ab & all_out_ba & ~crossing
+    unknown = ~(crossing | a_in_b | b_in_a | apart)
+    within = np.concatenate([fwd[a_in_b], fwd[b_in_a][:, ::-1]]).reshape(-1, 2)
+    return TouchRelations(crossing=fwd[crossing], within=within, apart=fwd[apart], unknown=fwd[unknown])
 
 
 def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.ndarray, *,
