@@ -325,13 +325,25 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                              "(`overlap` 'sum')")
                 warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
             else:
-                if overlaps:          # else only shells within others (R4): their cavities are cut, nothing shared
+                excess = united.volume - summed
+                if excess > TOUCH_VOLUME_RTOL * abs(summed):
+                    # the union of the bodies, each with its own cavities cut, cannot exceed the summed integral
+                    # unless a shell read as a cavity reaches out of its body: the boolean cuts it only where it
+                    # lies in the body.  Unless the file's winding said so (``ambiguous``: an inward shell crossing
+                    # an outward one), R4 misread a nesting: not a proven solid.
+                    notes.append(f"the boolean union is {excess:.3g} m³ larger than the summed integral: a shell "
+                                 "read as a cavity reaches out of the body around it and is cut only where it lies "
+                                 "in the body" + ("" if ambiguous else "; the nesting read by R4 disagrees with "
+                                                  "the boolean: not verified"))
+                    warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+                elif overlaps:        # else only shells within others (R4): their cavities are cut, nothing shared
                     notes.append(f"overlapping bodies united by a boolean: {shared} counted once")
                     warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
                 method = "union"
                 # R6/R7: the boolean found shared volume; "united" is proven only when crossing faces were found
                 # too (else the two checks disagree: manifold3d's tolerance or a crossing the check cannot see)
-                kind = "united" if touch.complete and touch.crossing.any() else "unverified"
+                kind = "united" if touch.complete and touch.crossing.any() and \
+                    not excess > TOUCH_VOLUME_RTOL * abs(summed) else "unverified"
                 if touch.complete and not touch.crossing.any():
                     notes.append(f"no faces were found crossing, yet the union's volume differs from the sum by "
                                  f"{abs(summed - united.volume):.3g} m³ (manifold3d's tolerance, or bodies passing "
