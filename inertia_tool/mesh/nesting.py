@@ -245,19 +245,30 @@ def shell_nesting(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n
 #: Vertices of a shell tested against a shell it touches, at most, besides those of the faces in contact.
 TOUCH_SAMPLE = 4096
 
+#: Frames for the points of touching shells: no ray along a mesh axis, so a point on a face parallel to an axis
+#: (rounded off it by 1e-16) meets that face at a generic angle, within the on-surface margin, and stays undecided
+#: instead of being counted by its rounding.
+_GENERIC_FRAMES = ((0.8660254, 0.2886751, 0.2886751, 0.2886751), (0.7071068, 0.1, 0.6928203, 0.0707107),
+                   (0.3, 0.4, -0.5, 0.7), (0.6, -0.2, 0.3, 0.71))
+
+#: Barycentric weights of the points tested inside each face in contact: its centroid and the midpoints between
+#: the centroid and each corner (two bodies crossing like beams have every vertex of both on the other surface).
+_INNER_WEIGHTS = np.array([[1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+
 
 @frozen_value
 class PointSides:
-    """Where the vertices of one shell lie relative to another shell that it touches (R4).
+    """Where the points of one shell lie relative to another shell that it touches (R4).
 
     Attributes
     ----------
     pairs : (k, 2) int
         ``(shell, other)``: the vertices of ``shell`` were tested against the surface of ``other``.
     inside, outside : (k,) int
-        Tested vertices where ``other``'s winding number is nonzero / zero (exact ray counts).
+        Tested points (vertices, and points inside the faces in contact) where ``other``'s winding number is
+        nonzero / zero (exact ray counts).
     on_surface : (k,) int
-        Tested vertices left undecided: on ``other``'s surface (within ``on_surface_rtol`` of the diagonal along
+        Tested points left undecided: on ``other``'s surface (within ``on_surface_rtol`` of the diagonal along
         every ray tried) or with every ray through an edge.
     """
 
@@ -287,8 +298,12 @@ def touching_sides(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, 
 
     Two surfaces can cross exactly along edges and vertices of both meshes (CAD tessellations sharing their
     intersection curve): then no face pair crosses transversally, every pair there is only a contact, and one
-    probe point cannot tell nesting from overlap.  The vertices decide instead: those of shell A that are not
-    on B's surface lie inside B (winding number ≠ 0), outside it, or both (the surfaces cross).
+    probe point cannot tell nesting from overlap.  Points of A decide instead: those not on B's surface lie
+    inside B (winding number ≠ 0), outside it, or both (the surfaces cross).  Tested are every corner of A's
+    faces in contact with B and four points inside each of those faces (a face whose corners all lie on B's
+    surface can still lie inside B: two boxes crossing like beams), and a strided sample of A's other vertices.
+    Without a transversal crossing, the faces of A next to where the surfaces cross are in contact with B and
+    lie on both sides of it, so these points see the crossing.
 
     Parameters
     ----------
@@ -300,7 +315,7 @@ def touching_sides(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, 
     pairs : (k, 2) int
         Shell pairs that touch (a contact or coplanar-opposite face pair between them).
     contact_pairs : (c, 2) int
-        The touching face pairs (faces of different shells): their corners are always tested.
+        The touching face pairs (faces of different shells): their corners and inner points are always tested.
     on_surface_rtol : float
         A vertex within this fraction of the bounding-box diagonal of the other surface (along its ray) lies on it.
     sample : int
@@ -330,14 +345,17 @@ def touching_sides(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, 
         own = order[starts[a]:starts[a + 1]]
         other = order[starts[b]:starts[b + 1]]
         touching = np.concatenate([contact_pairs[(ca == a) & (cb == b), 0], contact_pairs[(ca == b) & (cb == a), 1]])
-        points = _touch_points(faces, own, touching, np.unique(faces[other]), sample)
+        corners = local[_touch_points(faces, own, touching, np.unique(faces[other]), sample)]
+        tri = local[faces[np.unique(touching)]]                  # (t, 3, 3)
+        inner = np.einsum("pk,tkd->tpd", _INNER_WEIGHTS, tri).reshape(-1, 3)
+        points = np.concatenate([corners, inner])
         pending = np.arange(len(points))
         winding = np.zeros(len(points), dtype=np.int64)
-        for frame_q in _FRAMES:                                   # recast rays through an edge; bounded
+        for frame_q in _GENERIC_FRAMES:                           # recast rays through an edge; bounded
             if not len(pending):
                 break
             frame = _rotation(frame_q)
-            point, _, w, bad = ray_winding(local[points[pending]] @ frame, local @ frame, faces[other],
+            point, _, w, bad = ray_winding(points[pending] @ frame, local @ frame, faces[other],
                                            np.zeros(len(other), dtype=np.int64), 1, on_surface=margin)
             winding[pending] = 0
             winding[pending[point]] = w
