@@ -207,3 +207,20 @@ def test_go1_thigh_is_the_union_of_its_three_shells():
     assert props.volume == pytest.approx(truth, rel=1e-6)
     assert props.mesh.certificate.kind == "united"
     assert props.mesh.flipped_shells == 0 and props.mesh.cavities == 0
+
+
+def test_cavity_reaching_out_of_its_body_is_not_called_shared_volume():
+    """An inward box poking through its body's +x face: the union (body minus cavity) exceeds the summed integral
+    (the cavity counted whole).  Before: "overlapping bodies united by a boolean: no shared volume; the union is …
+    larger than the summed integral … counted once".  Truth: 1 − 0.5·0.5·0.3 by hand (the part of the cavity inside
+    the body, x from 0.2 to 0.5)."""
+    from solids import box
+    body = box((1.0, 1.0, 1.0))
+    cv, cf = box((0.6, 0.5, 0.5), (0.5, 0.0, 0.0))
+    with pytest.warns(Warning) as caught:
+        props = mass_properties(stack(body, (cv, cf[:, ::-1])), density=1.0)
+    texts = " ".join(str(w.message) for w in caught)
+    assert "counted once" not in texts and "shared volume" not in texts
+    assert "reaches out of the body around it" in texts
+    assert props.volume == pytest.approx(1.0 - 0.3 * 0.25, rel=1e-12)
+    assert props.mesh.certificate.kind == "unverified"      # the file cannot say cavity or inside-out body (R4)
