@@ -44,7 +44,12 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    depth from it like any nested shell, whether the contact is exactly coplanar or coplanar only to rounding
    after a rotation: a cavity flush with its body's face is a cavity (cut from the body by the boolean, certified
    ``united``), an outward-wound one included.  One rule covers a shell strictly inside another and one
-   touching the other's boundary from inside: *the role is the depth of the closed solid*.  When the intersection
+   touching the other's boundary from inside: *the role is the depth of the closed solid*.  Shells that touch
+   without a crossing face pair are never placed by one probe point: their surfaces can still cross exactly along
+   edges and vertices of both meshes (CAD tessellations sharing the intersection curve), so the points of each
+   near the contact and a sample of its vertices decide (:func:`touching_relations`): points strictly inside and
+   strictly outside the other make the pair crossing, all inside make it contained, all outside apart; a pair the
+   points cannot decide goes to the boolean like a crossing one.  When the intersection
    check did not finish (crossings unknown, so "inside" may mean "overlapping"), each shell keeps what its own
    sign says instead.
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
@@ -57,7 +62,10 @@ R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL`
    the summed volume within ``TOUCH_VOLUME_RTOL`` the interiors are disjoint and the sum, exact as it
    stands, is the answer (certificate ``exact``).  When the union is smaller although no crossing was found,
    the two checks disagree (manifold3d's tolerance, or a crossing the check cannot see): the union is the
-   answer, certified ``unverified``.
+   answer, certified ``unverified``.  A union *larger* than the summed integral beyond ``TOUCH_VOLUME_RTOL``
+   shares nothing: a shell read as a cavity reaches out of its body and the boolean cuts it only inside the body;
+   said so, never as shared volume, and ``unverified`` unless the file's winding made it so (an inward shell
+   crossing an outward one), since R4 places a cavity within its body.
 R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only after the edge census found the
    surface balanced, every shell is oriented by R4, and the face-intersection check ran over every candidate
    pair and found no crossing.  When the check could not finish within its work bound the integral is still
