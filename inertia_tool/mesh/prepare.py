@@ -116,10 +116,11 @@ def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
                                          within=_both(within, touch_within))
     undecided = nest.undecided if nest is not None else np.zeros(n_shells, dtype=bool)
     if touch is not None and touch.complete:
-        # touching shells share no volume (their interiors are disjoint when no face crosses); a shell that
-        # R4 had to turn lies in another's material or void against its own winding: counted as a candidate
+        # touching shells that their points found apart or nested share no volume (R4: those crossing along shared
+        # edges are in ``touch.crossing`` now, those the points could not decide in ``crossing_with``); a shell
+        # that R4 had to turn lies in another's material or void against its own winding: counted as a candidate
         candidates = touch.crossing | flip | undecided
-        candidates[np.asarray(touch.crossing_with, dtype=np.int64).reshape(-1)] = True   # vertices undecided (R4)
+        candidates[np.asarray(touch.crossing_with, dtype=np.int64).reshape(-1)] = True
     else:
         candidates = _boxes_meet(vertices, faces, labels, n_shells) | undecided
     return flip, owner, int(np.count_nonzero(depth % 2 == 1)), int(np.count_nonzero(candidates))
