@@ -21,7 +21,7 @@ import numpy as np
 
 from ..values import frozen_value
 
-__all__ = ["Nesting", "shell_nesting", "ray_winding"]
+__all__ = ["Nesting", "shell_nesting", "ray_winding", "PointSides", "touching_sides", "TOUCH_SAMPLE"]
 
 #: Fixed generic rotations (unit quaternions, scalar first) for recasting rays that hit an edge exactly.
 _FRAMES = ((1.0, 0.0, 0.0, 0.0), (0.8660254, 0.2886751, 0.2886751, 0.2886751),
@@ -240,3 +240,129 @@ def shell_nesting(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n
     undecided[pending] = True
     return Nesting(shell=cat(result_shell), other=cat(result_other), winding=cat(result_w), probes=probes,
                    undecided=undecided)
+
+
+#: Vertices of a shell tested against a shell it touches, at most, besides those of the faces in contact.
+TOUCH_SAMPLE = 4096
+
+#: Frames for the points of touching shells: no ray along a mesh axis, so a point on a face parallel to an axis
+#: (rounded off it by 1e-16) meets that face at a generic angle, within the on-surface margin, and stays undecided
+#: instead of being counted by its rounding.
+_GENERIC_FRAMES = ((0.8660254, 0.2886751, 0.2886751, 0.2886751), (0.7071068, 0.1, 0.6928203, 0.0707107),
+                   (0.3, 0.4, -0.5, 0.7), (0.6, -0.2, 0.3, 0.71))
+
+#: Barycentric weights of the points tested inside each face in contact: its centroid and the midpoints between
+#: the centroid and each corner (two bodies crossing like beams have every vertex of both on the other surface).
+_INNER_WEIGHTS = np.array([[1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+
+
+@frozen_value
+class PointSides:
+    """Where the points of one shell lie relative to another shell that it touches (R4).
+
+    Attributes
+    ----------
+    pairs : (k, 2) int
+        ``(shell, other)``: the vertices of ``shell`` were tested against the surface of ``other``.
+    inside, outside : (k,) int
+        Tested points (vertices, and points inside the faces in contact) where ``other``'s winding number is
+        nonzero / zero (exact ray counts).
+    on_surface : (k,) int
+        Tested points left undecided: on ``other``'s surface (within ``on_surface_rtol`` of the diagonal along
+        every ray tried) or with every ray through an edge.
+    """
+
+    pairs: np.ndarray
+    inside: np.ndarray
+    outside: np.ndarray
+    on_surface: np.ndarray
+
+
+def _touch_points(faces: np.ndarray, shell_faces: np.ndarray, contact_faces: np.ndarray, shared: np.ndarray,
+                  sample: int) -> np.ndarray:
+    """Vertex indices of one shell to test: every corner of its faces in contact with the other shell, and a
+    strided sample of at most ``sample`` of the others; corners shared by index with the other shell left out."""
+    everyone = np.unique(faces[shell_faces])
+    near = np.unique(faces[contact_faces])
+    rest = np.setdiff1d(everyone, near, assume_unique=True)
+    if len(rest) > sample:
+        rest = rest[np.linspace(0, len(rest) - 1, sample).astype(np.int64)]
+    points = np.union1d(near, rest)
+    return np.setdiff1d(points, shared, assume_unique=True)
+
+
+def touching_sides(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, pairs: np.ndarray,
+                   contact_pairs: np.ndarray, *, on_surface_rtol: float = 1e-9,
+                   sample: int = TOUCH_SAMPLE) -> PointSides:
+    """For each pair of shells that touch, the sides of each shell's vertices relative to the other shell.
+
+    Two surfaces can cross exactly along edges and vertices of both meshes (CAD tessellations sharing their
+    intersection curve): then no face pair crosses transversally, every pair there is only a contact, and one
+    probe point cannot tell nesting from overlap.  Points of A decide instead: those not on B's surface lie
+    inside B (winding number ≠ 0), outside it, or both (the surfaces cross).  Tested are every corner of A's
+    faces in contact with B and four points inside each of those faces (a face whose corners all lie on B's
+    surface can still lie inside B: two boxes crossing like beams), and a strided sample of A's other vertices.
+    Without a transversal crossing, the faces of A next to where the surfaces cross are in contact with B and
+    lie on both sides of it, so these points see the crossing.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+        Closed, balanced shells.
+    labels : (m,) int
+        Shell of each face.
+    pairs : (k, 2) int
+        Shell pairs that touch (a contact or coplanar-opposite face pair between them).
+    contact_pairs : (c, 2) int
+        The touching face pairs (faces of different shells): their corners and inner points are always tested.
+    on_surface_rtol : float
+        A vertex within this fraction of the bounding-box diagonal of the other surface (along its ray) lies on it.
+    sample : int
+        Other vertices of each shell tested, at most (evenly strided over the vertex indices).
+
+    Returns
+    -------
+    PointSides
+        Both directions of every pair, ``(a, b)`` then ``(b, a)``.
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    labels = np.asarray(labels, dtype=np.int64)
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    contact_pairs = np.asarray(contact_pairs, dtype=np.int64).reshape(-1, 2)
+    centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
+    margin = on_surface_rtol * float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
+    local = vertices - centre
+    order = np.argsort(labels, kind="stable")
+    starts = np.searchsorted(labels[order], np.arange(int(labels.max()) + 2))
+    directed = np.concatenate([pairs, pairs[:, ::-1]]) if len(pairs) else pairs
+    inside = np.zeros(len(directed), dtype=np.int64)
+    outside = np.zeros(len(directed), dtype=np.int64)
+    undecided = np.zeros(len(directed), dtype=np.int64)
+    ca, cb = labels[contact_pairs[:, 0]], labels[contact_pairs[:, 1]]
+    for k, (a, b) in enumerate(directed.tolist()):                # bounded by the pairs given
+        own = order[starts[a]:starts[a + 1]]
+        other = order[starts[b]:starts[b + 1]]
+        touching = np.concatenate([contact_pairs[(ca == a) & (cb == b), 0], contact_pairs[(ca == b) & (cb == a), 1]])
+        corners = local[_touch_points(faces, own, touching, np.unique(faces[other]), sample)]
+        tri = local[faces[np.unique(touching)]]                  # (t, 3, 3)
+        inner = np.einsum("pk,tkd->tpd", _INNER_WEIGHTS, tri).reshape(-1, 3)
+        points = np.concatenate([corners, inner])
+        pending = np.arange(len(points))
+        winding = np.zeros(len(points), dtype=np.int64)
+        for frame_q in _GENERIC_FRAMES:                           # recast rays through an edge; bounded
+            if not len(pending):
+                break
+            frame = _rotation(frame_q)
+            point, _, w, bad = ray_winding(points[pending] @ frame, local @ frame, faces[other],
+                                           np.zeros(len(other), dtype=np.int64), 1, on_surface=margin)
+            winding[pending] = 0
+            winding[pending[point]] = w
+            pending = pending[bad]
+        decided = np.ones(len(points), dtype=bool)
+        decided[pending] = False
+        inside[k] = int(np.count_nonzero(decided & (winding != 0)))
+        outside[k] = int(np.count_nonzero(decided & (winding == 0)))
+        undecided[k] = len(pending)
+    return PointSides(pairs=directed, inside=inside, outside=outside, on_surface=undecided)

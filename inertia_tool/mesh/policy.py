@@ -44,7 +44,12 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    depth from it like any nested shell, whether the contact is exactly coplanar or coplanar only to rounding
    after a rotation: a cavity flush with its body's face is a cavity (cut from the body by the boolean, certified
    ``united``), an outward-wound one included.  One rule covers a shell strictly inside another and one
-   touching the other's boundary from inside: *the role is the depth of the closed solid*.  When the intersection
+   touching the other's boundary from inside: *the role is the depth of the closed solid*.  Shells that touch
+   without a crossing face pair are never placed by one probe point: their surfaces can still cross exactly along
+   edges and vertices of both meshes (CAD tessellations sharing the intersection curve), so the points of each
+   near the contact and a sample of its vertices decide (:func:`touching_relations`): points strictly inside and
+   strictly outside the other make the pair crossing, all inside make it contained, all outside apart; a pair the
+   points cannot decide goes to the boolean like a crossing one.  When the intersection
    check did not finish (crossings unknown, so "inside" may mean "overlapping"), each shell keeps what its own
    sign says instead.
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
@@ -57,7 +62,10 @@ R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL`
    the summed volume within ``TOUCH_VOLUME_RTOL`` the interiors are disjoint and the sum, exact as it
    stands, is the answer (certificate ``exact``).  When the union is smaller although no crossing was found,
    the two checks disagree (manifold3d's tolerance, or a crossing the check cannot see): the union is the
-   answer, certified ``unverified``.
+   answer, certified ``unverified``.  A union *larger* than the summed integral beyond ``TOUCH_VOLUME_RTOL``
+   shares nothing: a shell read as a cavity reaches out of its body and the boolean cuts it only inside the body;
+   said so, never as shared volume, and ``unverified`` unless the file's winding made it so (an inward shell
+   crossing an outward one), since R4 places a cavity within its body.
 R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only after the edge census found the
    surface balanced, every shell is oriented by R4, and the face-intersection check ran over every candidate
    pair and found no crossing.  When the check could not finish within its work bound the integral is still
@@ -85,7 +93,7 @@ if TYPE_CHECKING:
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
            "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
-           "coincident_surfaces", "coincident_message",
+           "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
@@ -301,6 +309,57 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
     if crosses.any():
         _orient_crossing(vols, cross, crosses, depth, flip, owner)
     return flip, owner, depth
+
+
+@frozen_value
+class TouchRelations:
+    """R4 for shells that touch (no face pair crosses): what their vertices say, pair by pair.
+
+    Attributes
+    ----------
+    crossing : (k, 2) int
+        Pairs whose surfaces cross along edges and vertices of the meshes: one shell has vertices strictly inside
+        the other and vertices strictly outside it (or each lies inside the other).
+    within : (j, 2) int
+        ``(shell, container)``: every tested vertex of ``shell`` off the container's surface is inside it, and
+        every one of the container's is outside ``shell``.
+    apart : (i, 2) int
+        Pairs whose tested vertices all lie outside the other shell: interiors disjoint, they only touch.
+    unknown : (u, 2) int
+        Pairs the vertices cannot decide (one shell has every tested vertex on the other's surface): sent to the
+        boolean like crossing pairs, which decides (``within_up_to_rounding``, R5, R6).
+    """
+
+    crossing: np.ndarray
+    within: np.ndarray
+    apart: np.ndarray
+    unknown: np.ndarray
+
+
+def touching_relations(pairs: np.ndarray, inside: np.ndarray, outside: np.ndarray) -> TouchRelations:
+    """R4: decide each pair of touching shells from the sides of their vertices, never from one probe point.
+
+    Parameters
+    ----------
+    pairs : (2k, 2) int
+        ``(a, b)`` rows for the k pairs, then the same pairs reversed (:func:`~.nesting.touching_sides`).
+    inside, outside : (2k,) int
+        Vertices of the row's first shell strictly inside / outside its second shell (winding number ≠ 0 / = 0).
+    """
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    k = len(p) // 2
+    fwd = p[:k]
+    i_ab, o_ab = np.asarray(inside[:k]), np.asarray(outside[:k])
+    i_ba, o_ba = np.asarray(inside[k:]), np.asarray(outside[k:])
+    all_in_ab, all_out_ab = (i_ab > 0) & (o_ab == 0), (o_ab > 0) & (i_ab == 0)
+    all_in_ba, all_out_ba = (i_ba > 0) & (o_ba == 0), (o_ba > 0) & (i_ba == 0)
+    crossing = ((i_ab > 0) & (o_ab > 0)) | ((i_ba > 0) & (o_ba > 0)) | (all_in_ab & all_in_ba)
+    a_in_b = all_in_ab & all_out_ba & ~crossing
+    b_in_a = all_in_ba & all_out_ab & ~crossing
+    apart = all_out_ab & all_out_ba & ~crossing
+    unknown = ~(crossing | a_in_b | b_in_a | apart)
+    within = np.concatenate([fwd[a_in_b], fwd[b_in_a][:, ::-1]]).reshape(-1, 2)
+    return TouchRelations(crossing=fwd[crossing], within=within, apart=fwd[apart], unknown=fwd[unknown])
 
 
 def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.ndarray, *,

@@ -27,7 +27,7 @@ from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labe
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
                      inward_crossing_outward, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts,
-                     within_up_to_rounding)
+                     touching_relations, within_up_to_rounding)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
 
@@ -104,17 +104,23 @@ def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     contacts = surface_contacts(vertices, faces) if check_crossing else None
     touch = shell_contacts(contacts, labels, n_shells) if contacts is not None else None
     nest = _nesting(vertices, faces, labels, n_shells)
+    touch_within = np.zeros((0, 2), dtype=np.int64)
+    if touch is not None and contacts is not None:
+        touch, nest, touch_within = _settle_touching(vertices, faces, labels, contacts, touch, nest)
     crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
     within = None
     if touch is not None and touch.complete:
         within, crossing_with = _within(vertices, faces, labels, vols, crossing_with)
     flip, owner, depth = orient_by_depth(vols, nest, crossing_with,
-                                         crossing_known=touch is not None and touch.complete, within=within)
+                                         crossing_known=touch is not None and touch.complete,
+                                         within=_both(within, touch_within))
     undecided = nest.undecided if nest is not None else np.zeros(n_shells, dtype=bool)
     if touch is not None and touch.complete:
-        # touching shells share no volume (their interiors are disjoint when no face crosses); a shell that
-        # R4 had to turn lies in another's material or void against its own winding: counted as a candidate
+        # touching shells that their points found apart or nested share no volume (R4: those crossing along shared
+        # edges are in ``touch.crossing`` now, those the points could not decide in ``crossing_with``); a shell
+        # that R4 had to turn lies in another's material or void against its own winding: counted as a candidate
         candidates = touch.crossing | flip | undecided
+        candidates[np.asarray(touch.crossing_with, dtype=np.int64).reshape(-1)] = True
     else:
         candidates = _boxes_meet(vertices, faces, labels, n_shells) | undecided
     return flip, owner, int(np.count_nonzero(depth % 2 == 1)), int(np.count_nonzero(candidates))
@@ -257,11 +263,12 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         return _estimated(forced, common)
     nest = _nesting(v, f, labels, n_shells)
     file_volumes = np.array([s.volume for s in shells])
+    touch, nest, touch_within = _settle_touching(v, f, labels, contacts, touch, nest)                   # R4
     within, crossing_with = None, touch.crossing_with
     if touch.complete:
         within, crossing_with = _within(v, f, labels, file_volumes, crossing_with)
     flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
-                                         within=within)                                                 # R4
+                                         within=_both(within, touch_within))                            # R4
     f, shells = _apply_flips(f, labels, shells, flip, n_shells, source)
     cavities = int(np.count_nonzero(depth % 2 == 1))
     method, notes = found.method, list(found.notes) + coincident_notes
@@ -319,13 +326,25 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                              "(`overlap` 'sum')")
                 warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
             else:
-                if overlaps:          # else only shells within others (R4): their cavities are cut, nothing shared
+                excess = united.volume - summed
+                if excess > TOUCH_VOLUME_RTOL * abs(summed):
+                    # the union of the bodies, each with its own cavities cut, cannot exceed the summed integral
+                    # unless a shell read as a cavity reaches out of its body: the boolean cuts it only where it
+                    # lies in the body.  Unless the file's winding said so (``ambiguous``: an inward shell crossing
+                    # an outward one), R4 misread a nesting: not a proven solid.
+                    notes.append(f"the boolean union is {excess:.3g} m³ larger than the summed integral: a shell "
+                                 "read as a cavity reaches out of the body around it and is cut only where it lies "
+                                 "in the body" + ("" if ambiguous else "; the nesting read by R4 disagrees with "
+                                                  "the boolean: not verified"))
+                    warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+                elif overlaps:        # else only shells within others (R4): their cavities are cut, nothing shared
                     notes.append(f"overlapping bodies united by a boolean: {shared} counted once")
                     warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
                 method = "union"
                 # R6/R7: the boolean found shared volume; "united" is proven only when crossing faces were found
                 # too (else the two checks disagree: manifold3d's tolerance or a crossing the check cannot see)
-                kind = "united" if touch.complete and touch.crossing.any() else "unverified"
+                kind = "united" if touch.complete and touch.crossing.any() and \
+                    not excess > TOUCH_VOLUME_RTOL * abs(summed) else "unverified"
                 if touch.complete and not touch.crossing.any():
                     notes.append(f"no faces were found crossing, yet the union's volume differs from the sum by "
                                  f"{abs(summed - united.volume):.3g} m³ (manifold3d's tolerance, or bodies passing "
@@ -447,6 +466,70 @@ def _nesting(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) ->
         return None
     from .nesting import shell_nesting      # imported on use: one shell needs none
     return shell_nesting(v, f, labels, n_shells)
+
+
+#: Touching shell pairs whose vertices are tested against each other (R4), at most; beyond, the pairs go to the
+#: boolean like crossing ones.
+MAX_TOUCHING_PAIRS = 512
+
+
+def _settle_touching(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: SurfaceContacts,
+                     touch: ShellContacts, nest: Nesting | None) -> tuple[ShellContacts, Nesting | None, np.ndarray]:
+    """R4 for shells that touch without a crossing face pair: their vertices decide (:func:`~.nesting.touching_sides`,
+    :func:`~.policy.touching_relations`), not one probe point.
+
+    Surfaces that cross exactly along edges and vertices of both meshes are crossing shells (added to ``touch``'s
+    crossing pairs, so R5 unites them); a pair the vertices cannot decide (or beyond ``MAX_TOUCHING_PAIRS``) joins
+    the crossing pairs for the boolean to decide (R4's ``within_up_to_rounding``, R5, R6).  The probes' winding
+    numbers between every decided pair are dropped from ``nest``.
+
+    Returns
+    -------
+    touch : ShellContacts
+    nest : Nesting or None
+    within : (j, 2) int
+        ``(shell, container)`` pairs found by the vertices.
+    """
+    none = np.zeros((0, 2), dtype=np.int64)
+    if nest is None or not touch.complete:
+        return touch, nest, none
+    faces_touching = np.concatenate([np.asarray(contacts.coplanar_opposite, dtype=np.int64).reshape(-1, 2),
+                                     np.asarray(contacts.contact, dtype=np.int64).reshape(-1, 2)])
+    faces_touching = faces_touching[labels[faces_touching[:, 0]] != labels[faces_touching[:, 1]]]
+    if not len(faces_touching):
+        return touch, nest, none
+    pairs = np.unique(np.sort(labels[faces_touching], axis=1), axis=0)
+    n = len(touch.crossing)
+    crossed = np.zeros((n, n), dtype=bool)
+    cw = np.asarray(touch.crossing_with, dtype=np.int64).reshape(-1, 2)
+    crossed[cw[:, 0], cw[:, 1]] = True
+    pairs = pairs[~crossed[pairs[:, 0], pairs[:, 1]]]
+    if not len(pairs):
+        return touch, nest, none
+    from .nesting import touching_sides      # imported on use: touching shells are rare
+    tested, beyond = pairs[:MAX_TOUCHING_PAIRS], pairs[MAX_TOUCHING_PAIRS:]
+    sides = touching_sides(v, f, labels, tested, faces_touching)
+    found = touching_relations(sides.pairs, sides.inside, sides.outside)
+    if len(found.crossing):
+        crossing = touch.crossing.copy()
+        crossing[found.crossing.reshape(-1)] = True
+        touch = dataclasses.replace(touch, crossing=crossing)
+    more = np.concatenate([cw, found.crossing, found.unknown, beyond]).reshape(-1, 2)
+    touch = dataclasses.replace(touch, crossing_with=np.unique(np.sort(more, axis=1), axis=0))
+    decided = np.concatenate([found.within, found.apart]).reshape(-1, 2)
+    if len(decided):
+        drop = np.zeros((n, n), dtype=bool)
+        drop[decided[:, 0], decided[:, 1]] = drop[decided[:, 1], decided[:, 0]] = True
+        keep = ~drop[nest.shell, nest.other]
+        nest = dataclasses.replace(nest, shell=nest.shell[keep], other=nest.other[keep], winding=nest.winding[keep])
+    return touch, nest, found.within
+
+
+def _both(within: np.ndarray | None, more: np.ndarray) -> np.ndarray | None:
+    """``(shell, container)`` pairs from the boolean (R4's ``within_up_to_rounding``) and from the vertices."""
+    if within is None:
+        return more if len(more) else None
+    return np.concatenate([np.asarray(within, dtype=np.int64).reshape(-1, 2), more]).reshape(-1, 2)
 
 
 #: Crossing shell pairs tested for lying one within the other (R4), at most; beyond, a pair stays crossing.
