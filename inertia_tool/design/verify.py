@@ -126,6 +126,8 @@ def verify_spin_design(result, resolution: int, *, max_axis_tilt: float = MAX_AX
     if tilt_a > max_axis_tilt and tilt_a > tilt_b:
         reasons.append(f"the spin axis ends {math.degrees(tilt_a):.3g}° from {what} (the input's was "
                        f"{math.degrees(tilt_b):.3g}°; at most {math.degrees(max_axis_tilt):.3g}° is accepted)")
+    if getattr(result, "cavity_volume", None) == 0 and getattr(result, "insert_vertices", None) is None:
+        notes.append("no cavity inside the wall improves the objective: the part is handed back as it was")
     ob, oa = result.objective_before, result.objective_after
     if oa > ob + OBJECTIVE_RTOL * max(abs(ob), 1e-300):
         reasons.append(f"the objective is worse after ({ob:.6g} → {oa:.6g})")
@@ -232,7 +234,7 @@ def _rejection(name: str, verdicts: list[SpinVerdict], result) -> str:
         direction = ",".join(f"{c:.4g}" for c in np.where(np.abs(signed) < 1e-9, 0.0, signed))
         hint = (f"the axis is the part's {before.nearest_principal} principal axis (I_axis/I_next "
                 f"{before.moment_ratio:.3g}, best design {result.metrics_after.moment_ratio:.3g}) and a yo-yo "
-                f"needs the largest moment, which no cavity inside this wall gives; nothing was written — spin it "
+                f"needs the largest moment, which no design inside this wall reached; nothing was written — spin it "
                 f"about its major axis (--axis {direction})")
     elif last.resolution >= MAX_RESOLUTION:
         hint = "nothing was written — try another --through or --wall (the resolution is at its maximum)"
