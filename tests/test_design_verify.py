@@ -219,6 +219,7 @@ def test_cylinder_mesh_spun_across_its_axis_is_on_principal():
 
 # --- the two bundled-mesh rejections of issue 24 --------------------------------------------------------------
 
+@pytest.mark.slow
 def test_t_handle_yoyo_about_its_minor_axis_is_refused_with_the_axis_to_use(tmp_path, capsys):
     """meshes/t_handle.stl about z: z is its minor principal axis (I_axis/I_next 0.489); a cavity lowers the
     transverse moment towards it and the spin tumbles (a real failure, rightly refused).  The refusal is one
@@ -230,6 +231,10 @@ def test_t_handle_yoyo_about_its_minor_axis_is_refused_with_the_axis_to_use(tmp_
     assert code == EXIT_DESIGN and not out.exists() and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1
     assert "minor principal axis" in err and "--axis 0,1,0" in err and "wobbles more after" in err
+    # the axis the refusal names is one spin-it can design for
+    assert main(["spin-it", "meshes/t_handle.stl", "--units", "mm", "--material", "pla", "--axis", "0,1,0",
+                 "--wall", "2mm"]) == 0
+    assert "major" in capsys.readouterr().out
 
 
 @pytest.mark.slow
