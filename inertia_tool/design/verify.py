@@ -224,7 +224,8 @@ def _rejection(name: str, verdicts: list[SpinVerdict], result) -> str:
     """One line: what failed (the last, finest attempt's reasons), what was tried, and what the user can do."""
     last = verdicts[-1]
     tried = ", ".join(dict.fromkeys(str(v.resolution) for v in verdicts))
-    head = (f"{name}: spin-it rejected every design it made (resolution {tried}, {len(verdicts)} attempts): "
+    count = f"{len(verdicts)} attempt" + ("s" if len(verdicts) != 1 else "")
+    head = (f"{name}: spin-it rejected every design it made (resolution {tried}, {count}): "
             + "; ".join(last.reasons))
     before = result.metrics_before
     if result.mode == "yoyo" and before.nearest_principal != "major" and result.metrics_after.moment_ratio < 1:
