@@ -87,7 +87,7 @@ def main() -> int:
                 broken.append(f"{label}: exit 0 with a worse part ({ob} → {oa})")
         else:
             lines = [line for line in err.splitlines() if "error:" in line]
-            outcome += ": " + (lines[-1].split("error:", 1)[1].strip() if lines else err[-200:])
+            outcome += ": " + (lines[-1].split("error:", 1)[1].strip() if lines else err[-200:]).replace("|", "\\|")
         print(f"| {label} | {outcome} | {objective} | {tilt} | {attempts} | {cpu:.2f} | {peak:.0f} |", flush=True)
     for line in broken:
         print("BROKEN:", line, file=sys.stderr)

@@ -233,7 +233,8 @@ def _rejection(name: str, verdicts: list[SpinVerdict], result) -> str:
         major = stability(result.before).major_axis
         signed = major.axis if major.axis @ result.axis >= 0 else -major.axis
         direction = ",".join(f"{c:.4g}" for c in np.where(np.abs(signed) < 1e-9, 0.0, signed))
-        hint = (f"the axis is the part's {before.nearest_principal} principal axis (I_axis/I_next "
+        which = ("the part's" if before.axis_tilt <= MAX_AXIS_TILT else "nearest the part's")
+        hint = (f"the axis is {which} {before.nearest_principal} principal axis (I_axis/I_next "
                 f"{before.moment_ratio:.3g}, best design {result.metrics_after.moment_ratio:.3g}) and a yo-yo "
                 f"needs the largest moment, which no design inside this wall reached; nothing was written — spin it "
                 f"about its major axis (--axis {direction})")
