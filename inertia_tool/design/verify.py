@@ -128,6 +128,10 @@ def verify_spin_design(result, resolution: int, *, max_axis_tilt: float = MAX_AX
                        f"{math.degrees(tilt_b):.3g}°; at most {math.degrees(max_axis_tilt):.3g}° is accepted)")
     if getattr(result, "cavity_volume", None) == 0 and getattr(result, "insert_vertices", None) is None:
         notes.append("no cavity inside the wall improves the objective: the part is handed back as it was")
+    rise_b, rise_a = getattr(before, "sleeping_threshold", None), getattr(after, "sleeping_threshold", None)
+    if result.mode == "top" and rise_b is not None and rise_a is not None and rise_a > rise_b:
+        notes.append(f"the sleeping-top spin rises ({rise_b:.4g} → {rise_a:.4g} rad/s): the objective improved "
+                     "through the symmetry terms, so the top must be spun faster to sleep")
     ob, oa = result.objective_before, result.objective_after
     if oa > ob + OBJECTIVE_RTOL * max(abs(ob), 1e-300):
         reasons.append(f"the objective is worse after ({ob:.6g} → {oa:.6g})")
