@@ -7,8 +7,9 @@ when the design fails, so that a part is never handed back worse without saying 
 A design **fails** when
 
 * the spin axis ends more than ``max_axis_tilt`` (default 1°) from a principal axis (yo-yo: the nearest
-  principal axis of the central tensor; top: the pivot → centre-of-mass line) and farther than the input's
-  was (a design that brings it closer but not within 1° passes with a note saying so);
+  principal eigenspace of the central tensor, ``hollow.principal_tilt``, so that the arbitrary axes of equal
+  moments do not count; top: the pivot → centre-of-mass line) and farther than the input's was (a design that
+  brings it closer but not within 1° passes with a note saying so);
 * the mode's objective (``design.moments``) of the re-analysed part is worse than the input's;
 * yo-yo only: the simulated free spin (Chapter 4, "Rigid Body Motion", §4.4.1, the exact torque-free
   solution) started about the axis, knocked by 0.1°, wobbles more than the input's: the largest angular
@@ -165,7 +166,9 @@ def _finer_room(source, resolution: int, error: NoRoomError, options: dict):
 
 
 def spin_it_verified(source, *, resolution: int, retries: int = MAX_RETRIES, **options):
-    """``spin_it``, verified; on failure tried again on a grid ``RETRY_FACTOR`` finer (at most ``retries`` times).
+    """``spin_it``, verified; on failure tried again: a design off principal first on the same grid with the
+    product penalty ``STIFFER_FACTOR`` stiffer (at most ``MAX_STIFFER`` times), then on a grid ``RETRY_FACTOR``
+    finer (at most ``retries`` times).
 
     Returns
     -------
