@@ -295,7 +295,9 @@ defs["spin-it"] = command("spin-it", {
     "verification": obj({"passed": B, "attempts": arr(obj({
         "resolution": COUNT, "ok": B, "reasons": arr(S), "notes": arr(S),
         "axis_tilt_before": d("rad", N), "axis_tilt_after": d("rad", N), "objective_before": N,
-        "objective_after": N, "wobble_before": NN, "wobble_after": NN}, []))}, ["passed", "attempts"],
+        "objective_after": N, "wobble_before": NN, "wobble_after": NN,
+        "product_weight": d("the product-of-inertia penalty weight the attempt was optimised with", N)}, []))},
+        ["passed", "attempts"],
         "the design compared with its input (design/verify.py): every attempt, the last one accepted")},
     ["mode", "axis", "origin_m", "wall_m", "before", "after", "method", "uncertainty"],
     "inertia-tool spin-it --json: the hollowed design, before and after (after = exact re-analysis of the "

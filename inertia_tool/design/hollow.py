@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import AsymmetricTopWarning, NoRoomError, PhysicsError, UsageError
+from ..tolerances import EQUAL_MOMENTS_RTOL
 from .cavity_mesh import DEPTH_MARGIN, cut_pocket  # noqa: F401  (DEPTH_MARGIN: used by the benchmark too)
 from .grid import SurfaceTree, interior_grid, surface_distance
 from .limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
@@ -37,7 +38,8 @@ from .optimize import QuadricCavity, optimize_quadric_cavity
 if TYPE_CHECKING:  # pragma: no cover
     from .insert import QuadricInsert
 
-__all__ = ["SpinDesignMetrics", "SpinItResult", "spin_it", "design_metrics", "MODES", "DEFAULT_RESOLUTION"]
+__all__ = ["SpinDesignMetrics", "SpinItResult", "spin_it", "design_metrics", "principal_tilt", "MODES",
+           "DEFAULT_RESOLUTION"]
 
 #: ``"yoyo"`` (free spin, §4.4.1) and ``"top"`` (heavy symmetric top on a pivot, §4.4.3).
 MODES = ("yoyo", "top")
@@ -62,8 +64,9 @@ class SpinDesignMetrics:
     moment_ratio : float
         ``axis_moment / next_moment`` (> 1: the axis carries the largest moment).
     axis_tilt : float
-        rad: yo-yo, angle between the requested axis and the nearest principal axis; top, angle between the
-        requested axis and the pivot → centre-of-mass line.
+        rad: yo-yo, angle between the requested axis and the nearest principal eigenspace of the central
+        tensor (``principal_tilt``: equal moments form one, in which every direction is principal); top,
+        angle between the requested axis and the pivot → centre-of-mass line.
     axis_offset : float or None
         Distance of the centre of mass from the requested axis line, m; ``None`` for a yo-yo without a
         ``through`` point.
@@ -197,6 +200,50 @@ def design_frame(axis) -> np.ndarray:
     return np.column_stack([e1, e2, axis])
 
 
+def principal_tilt(inertia, axis, *, equal_rtol: float = EQUAL_MOMENTS_RTOL) -> tuple[float, int]:
+    """Angle between a direction and the nearest principal **eigenspace** of a tensor, and that eigenspace.
+
+    Moments equal within ``equal_rtol`` of the largest (the tolerance under which ``principal_axes`` calls two
+    moments equal and the axes in their plane an arbitrary choice) form one eigenspace, and the angle is
+    measured to that space, not to the arbitrary basis vectors chosen in it: for a body of revolution the
+    symmetry axis is an eigenspace of its own and every transverse direction lies in the other, at angle 0.
+    Moments farther apart than that are distinct, and their axes are judged one by one (the rule is never
+    looser for a tensor without equal moments).
+
+    Parameters
+    ----------
+    inertia : (3, 3) array_like
+        Symmetric inertia tensor (kg·m², any reference point; spin-it passes the central one).
+    axis : (3,) array_like
+        Unit direction, same axes.
+    equal_rtol : float
+        Relative tolerance of equal moments (default ``tolerances.EQUAL_MOMENTS_RTOL``).
+
+    Returns
+    -------
+    (float, int)
+        The angle (rad, in [0, π/2]) and the index, in ascending moment order, of the principal axis of that
+        eigenspace nearest the direction.
+    """
+    moments, vectors = np.linalg.eigh(np.asarray(inertia, dtype=np.float64))
+    direction = np.asarray(axis, dtype=np.float64)
+    cosines = np.abs(vectors.T @ direction)
+    tol = equal_rtol * float(np.max(np.abs(moments)))
+    groups, start = [], 0
+    for k in range(1, 4):
+        if k == 3 or moments[k] - moments[k - 1] > tol:
+            groups.append(list(range(start, k)))
+            start = k
+    best_angle, best_index = math.pi / 2, int(np.argmax(cosines))
+    for group in groups:
+        basis = vectors[:, group]
+        inside = basis @ (basis.T @ direction)          # the direction's projection on the eigenspace
+        angle = float(math.atan2(np.linalg.norm(direction - inside), np.linalg.norm(inside)))   # no acos rounding
+        if angle < best_angle or (angle == best_angle and best_index not in group):
+            best_angle, best_index = angle, max(group, key=lambda k: cosines[k])
+    return best_angle, int(best_index)
+
+
 def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80665) -> SpinDesignMetrics:
     """:class:`SpinDesignMetrics` of a body spinning about an axis.
 
@@ -221,9 +268,7 @@ def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80
 
     axis = _unit(axis, "axis")
     report = stability(props)
-    axes = np.column_stack([e.axis for e in report.axes])
-    cosines = np.abs(axes.T @ axis)
-    nearest = int(np.argmax(cosines))
+    tilt, nearest = principal_tilt(props.inertia, axis)
     entry = report.axes[nearest]
     offset = None
     if origin is not None:
@@ -236,7 +281,7 @@ def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80
         return SpinDesignMetrics(mass=props.mass, axis_moment=float(central[2, 2]),
                                  next_moment=float(transverse[1]),
                                  moment_ratio=float(central[2, 2] / transverse[1]),
-                                 axis_tilt=float(math.acos(min(1.0, cosines[nearest]))), axis_offset=offset,
+                                 axis_tilt=tilt, axis_offset=offset,
                                  nearest_principal=entry.name, epsilon_coefficient=float(entry.coefficient))
     from ..dynamics.top import heavy_top_on_pivot
     with warnings.catch_warnings():

@@ -22,7 +22,8 @@ def verification_dict(verdicts) -> dict:
         return {"resolution": v.resolution, "ok": v.ok, "reasons": list(v.reasons),
                 "axis_tilt_before": v.axis_tilt_before, "axis_tilt_after": v.axis_tilt_after,
                 "objective_before": v.objective_before, "objective_after": v.objective_after,
-                "wobble_before": v.wobble_before, "wobble_after": v.wobble_after, "notes": list(v.notes)}
+                "wobble_before": v.wobble_before, "wobble_after": v.wobble_after, "notes": list(v.notes),
+                "product_weight": v.product_weight}
     return {"passed": bool(verdicts and verdicts[-1].ok), "attempts": [one(v) for v in verdicts]}
 
 
@@ -38,7 +39,8 @@ def format_verification(verdicts) -> str:
                       "(free spin knocked 0.1° off the axis)")
     lines += [f"  NOTE: {note}" for note in v.notes]
     for earlier in verdicts[:-1]:
-        lines.append(f"  resolution {earlier.resolution} was rejected: " + "; ".join(earlier.reasons))
+        lines.append(f"  resolution {earlier.resolution} (product weight {earlier.product_weight:.0e}) was "
+                     "rejected: " + "; ".join(earlier.reasons))
     return "\n".join(lines) + "\n"
 
 
