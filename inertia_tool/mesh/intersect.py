@@ -90,6 +90,9 @@ O3D_BOUND = 10 * _U
 O2D_BOUND = 6 * _U
 #: Nonzero coordinate magnitudes inside [2⁻²⁴⁰, 2²⁹⁹] keep every rounding of the predicates relative.
 _SMALLEST, _LARGEST = 2.0 ** -240, 2.0 ** 299
+#: Stars of at least this many faces are tried for certification (module docstring, "Stars"); smaller ones cost
+#: too few pairs to be worth it.  0 turns the pruning off (the unpruned scan, kept for the tests).
+STAR_MIN_FACES = 8
 #: Candidate pairs generated and tested at once (memory bound of the narrow phase: ~1 kB per pair).
 CHUNK_PAIRS = 1 << 17
 
@@ -543,6 +546,85 @@ def _coplanar(t1: np.ndarray, t2: np.ndarray, axis: np.ndarray, same: np.ndarray
     return kind
 
 
+# -- certified stars ------------------------------------------------------------------------------------------
+
+def _star_ring(v: int, link: np.ndarray) -> tuple[np.ndarray, bool] | None:
+    """The ring ``r_0 .. r_k`` of the star of ``v`` from its link edges (k, 2), and whether it is closed
+    (``r_k = r_0``); None unless the faces form one edge-connected fan of distinct corners."""
+    k = len(link)
+    if np.any(link == v) or np.any(link[:, 0] == link[:, 1]):
+        return None
+    ids, count = np.unique(link, return_counts=True)
+    if np.any(count > 2):
+        return None
+    ends = ids[count == 1]
+    if len(ends) not in (0, 2):
+        return None
+    faces_of: dict[int, list[int]] = {}
+    for i, (x, y) in enumerate(link.tolist()):
+        faces_of.setdefault(x, []).append(i)
+        faces_of.setdefault(y, []).append(i)
+    closed = len(ends) == 0
+    at = int(link[0, 0]) if closed else int(ends[0])
+    face = faces_of[at][0]
+    ring = [at]
+    used = np.zeros(k, dtype=bool)
+    for _ in range(k):
+        used[face] = True
+        x, y = int(link[face, 0]), int(link[face, 1])
+        at = y if x == at else x
+        ring.append(at)
+        nxt = [g for g in faces_of[at] if not used[g]]
+        if not nxt:
+            break
+        face = nxt[0]
+    if not used.all() or len(ring) != k + 1 or (closed and ring[-1] != ring[0]):
+        return None
+    return np.array(ring, dtype=np.int64), closed
+
+
+def _certified_stars(v: np.ndarray, f: np.ndarray, min_faces: int, pred: _Predicates) -> np.ndarray:
+    """(n,) bool: the vertices whose star (at least ``min_faces`` faces) is certified (module docstring,
+    "Stars"): one fan whose projection along some coordinate axis turns round the vertex once without overlap
+    (a closed fan) or less than once (an open one), every projected triangle strictly of one orientation."""
+    cert = np.zeros(len(v), dtype=bool)
+    if min_faces <= 0 or not len(f):
+        return cert
+    valence = np.bincount(f.reshape(-1), minlength=len(v))
+    for c in np.flatnonzero(valence >= min_faces).tolist():
+        rows, corner = np.nonzero(f == c)
+        link = np.stack([f[rows, (corner + 1) % 3], f[rows, (corner + 2) % 3]], axis=1)
+        found = _star_ring(c, link)
+        if found is None:
+            continue
+        ring, closed = found
+        k = len(ring) - 1
+        for axis in range(3):
+            keep = _PLANE[axis]
+            centre = np.repeat(v[c, keep][None, :], k, axis=0)
+            p, q = v[ring[:-1]][:, keep], v[ring[1:]][:, keep]
+            r0 = np.repeat(v[ring[0], keep][None, :], k, axis=0)
+            turn = pred.orient2d(centre, p, q)
+            if turn[0] == 0 or np.any(turn != turn[0]):
+                continue
+            s = int(turn[0])
+            passes = (s * pred.orient2d(centre, p, r0) > 0) & (s * pred.orient2d(centre, r0, q) >= 0)
+            if int(np.count_nonzero(passes)) == (1 if closed else 0):
+                cert[c] = True
+                break
+    return cert
+
+
+def _star_pairs(f: np.ndarray, a: np.ndarray, b: np.ndarray, cert: np.ndarray) -> np.ndarray:
+    """(k,) bool: the pairs of faces ``a, b`` sharing a certified vertex (both in its star)."""
+    fa, fb = f[a], f[b]
+    shared = np.zeros(len(a), dtype=bool)
+    for i in range(3):
+        hit = cert[fa[:, i]]
+        shared |= hit & ((fa[:, i] == fb[:, 0]) | (fa[:, i] == fb[:, 1]) | (fa[:, i] == fb[:, 2]))
+    return shared
+
+
 # -- broad phase ----------------------------------------------------------------------------------------------
 
 def _cells(faces: np.ndarray, lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, h: float,
@@ -635,8 +717,9 @@ _Scan = tuple[np.ndarray, np.ndarray, np.ndarray, int, int, bool]
 
 
 def _scan_numpy(v: np.ndarray, f: np.ndarray, axis: np.ndarray, degenerate: np.ndarray, lo: np.ndarray,
-                hi: np.ndarray, max_pairs: int | None, chunk: int, pred: _Predicates) -> _Scan:
-    """Pairs that meet (a, b, kind), candidate and tested counts, completeness: the grid and numpy twin."""
+                hi: np.ndarray, max_pairs: int | None, chunk: int, pred: _Predicates, cert: np.ndarray) -> _Scan:
+    """Pairs that meet (a, b, kind), candidate and tested counts, completeness: the grid and numpy twin
+    (pairs within the star of a vertex ``cert`` marks are left out)."""
     found_a, found_b, found_k = [], [], []
     candidates = tested = 0
     complete = True
@@ -644,6 +727,9 @@ def _scan_numpy(v: np.ndarray, f: np.ndarray, axis: np.ndarray, degenerate: np.n
     for a, b, cell, h, dims in _raw_pairs(lo, hi, origin, chunk):
         keep = _keep_mask(a, b, cell, lo, hi, origin, h, dims)
         a, b = a[keep], b[keep]
+        if cert.any():
+            star = _star_pairs(f, a, b, cert)
+            a, b = a[~star], b[~star]
         if max_pairs is not None and candidates + len(a) > max_pairs:
             take = max(max_pairs - candidates, 0)
             a, b = a[:take], b[:take]
@@ -666,12 +752,12 @@ def _scan_numpy(v: np.ndarray, f: np.ndarray, axis: np.ndarray, degenerate: np.n
     return np.concatenate(found_a), np.concatenate(found_b), np.concatenate(found_k), candidates, tested, complete
 
 
-def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None,
-            pred: _Predicates) -> tuple[_Scan, np.ndarray, np.ndarray]:
+def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None, pred: _Predicates,
+            star_faces: int) -> tuple[_Scan, np.ndarray, np.ndarray]:
     """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy), with the
     per-face projection axes and zero-area flags it computed."""
     raw_a, raw_b, raw_kind, candidates, tested, exact, complete, raw_axis, raw_skip = lib.contact_scan(
-        v, f, -1 if max_pairs is None else int(max_pairs), threads())
+        v, f, -1 if max_pairs is None else int(max_pairs), threads(), star_faces)
     pred.exact += exact
     axis = np.frombuffer(raw_axis, dtype=np.int8).astype(np.intp)
     degenerate = np.frombuffer(raw_skip, dtype=np.uint8).astype(bool)
@@ -687,7 +773,7 @@ def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None
 # -- entry point ----------------------------------------------------------------------------------------------
 
 def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int | None = None,
-                     chunk: int = CHUNK_PAIRS) -> SurfaceContacts:
+                     chunk: int = CHUNK_PAIRS, _star_faces: int = STAR_MIN_FACES) -> SurfaceContacts:
     """Every pair of faces that meets beyond the vertices and edges it shares by index, classified exactly.
 
     Parameters
@@ -701,6 +787,9 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
         ``complete=False``.  Default: no bound.
     chunk : int
         Candidate pairs generated and tested at once (memory bound, not a work bound).
+    _star_faces : int
+        Private, for the tests: stars of at least this many faces are certified and their pairs left out
+        (module docstring, "Stars"); 0 runs the unpruned scan.  The pairs found do not depend on it.
 
     Returns
     -------
@@ -728,7 +817,8 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     if not len(f):
         return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty, complete=True)
     if lib is not None:
-        (a, b, kind, candidates, tested, complete), axis, degenerate = _scan_c(lib, v, f, max_pairs, pred)
+        (a, b, kind, candidates, tested, complete), axis, degenerate = _scan_c(lib, v, f, max_pairs, pred,
+                                                                               _star_faces)
     else:
         f = f.astype(np.int64, copy=False)
         axis, degenerate = _face_axes(v, f, pred)
@@ -736,8 +826,9 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
         lo = np.minimum(np.minimum(p0, p1), p2)
         hi = np.maximum(np.maximum(p0, p1), p2)
         del p0, p1, p2
+        cert = _certified_stars(v, f, _star_faces, pred)
         a, b, kind, candidates, tested, complete = _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk,
-                                                               pred)
+                                                               pred, cert)
 
     def pairs(key: int) -> np.ndarray:
         hit = kind == key
