@@ -2401,6 +2401,9 @@ done:
  * 2^-876, representable).  A pair whose expansion would outgrow CONTACT_EXP_MAX components gets kind -1 and
  * the caller classifies it on the numpy path.  The candidate pairs come from a bounding-volume hierarchy
  * instead of the numpy path's grid: the same set of pairs (those whose closed boxes meet), in another order.
+ * With star_faces > 0 the pairs within one certified star (ct_stars; mesh/intersect.py, "Stars", proves they
+ * meet only in what they share) are left out on both paths, here also whole node pairs whose faces all hold
+ * one certified vertex (CtNode.apex), so a fan cap of k faces costs O(k) instead of k(k - 1)/2 pairs.
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192

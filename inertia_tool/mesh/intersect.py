@@ -2,7 +2,8 @@
 
 A closed, consistently oriented mesh bounds a simple polyhedron only if no two faces intersect except along
 the vertices and edges they share by index.  :func:`surface_contacts` tests every pair of faces whose
-bounding boxes meet (within one shell and between shells, adjacent faces included) and sorts the pairs that
+bounding boxes meet (within one shell and between shells, adjacent faces included), but the pairs within a
+fan it proves apart without testing (see "Stars" below), and sorts the pairs that
 meet beyond what they share into three kinds (:class:`SurfaceContacts`):
 
 * ``crossing``: the two triangles cross transversally (a point in the relative interior of both, the planes
@@ -52,6 +53,36 @@ and with the faces of larger levels through their grids; a pair is kept only in 
 corner of the intersection of the two boxes, so it is tested once.  Cell indices are ``floor((x − o)/h)``,
 monotone in ``x``, so two closed boxes that meet always share a cell.  Candidate pairs are generated and
 tested in chunks of at most ``chunk`` pairs, so memory stays bounded on any mesh.
+
+Stars
+-----
+Every face of a fan-triangulated cap (cylinders, holes, bosses in CAD exports) contains the centre vertex, so
+all their boxes meet there and a cap of ``k`` faces alone gives ``k(k − 1)/2`` candidate pairs.  Those pairs
+are left out, without changing the result, for the stars this rule certifies.  A vertex ``v`` of at least
+:data:`STAR_MIN_FACES` faces is *certified* when (1) its faces ``(v, x, y)``, with ``v, x, y`` distinct
+indices, form one edge-connected fan: the link edges ``x–y`` make one path or one cycle, every link vertex in
+at most two of them, giving the ring ``r₀ … r_k`` (``r_k = r₀`` for a cycle); and (2) along some coordinate
+axis (dropping that coordinate: an exact projection) every triangle ``(v′, r′ᵢ, r′ᵢ₊₁)`` has the same strict
+orientation ``s`` (exact ``orient2d``), and the number of steps ``i`` whose half-open wedge ``(r′ᵢ, r′ᵢ₊₁]``
+about ``v′`` holds the direction of ``r′₀`` — ``s·orient2d(v′, r′ᵢ, r′₀) > 0`` and
+``s·orient2d(v′, r′₀, r′ᵢ₊₁) ≥ 0`` — is 1 for a cycle and 0 for a path.
+
+Proof that two faces of a certified star meet only in what they share by index (so the check would find
+nothing there).  Each step turns by an angle in ``(0, π)`` in the sense ``s``, so the cumulative angle
+increases strictly; a wedge narrower than π holds a direction iff the two signs above hold, and holds at most
+one multiple of 2π of the cumulative angle, so the count is the number of whole turns: the total is exactly
+2π for a cycle and below 2π for a path.  The projected wedges ``Wᵢ`` are then non-overlapping closed sectors
+with distinct bounding rays; two non-adjacent ones meet only in ``v′`` and adjacent ones along the ray through
+``r′ᵢ₊₁``, which meets ``Tᵢ′`` and ``Tᵢ₊₁′`` (the projected faces, ``Tᵢ′ ⊂ Wᵢ``) only in the projected edge
+``[v′, r′ᵢ₊₁]``.  Each face projects one to one (its projection has nonzero area), so a common point of two
+faces is the only preimage in each of a point of ``{v′}`` or of the projected shared edge: it is ``v`` or on
+the shared edge ``[v, rᵢ₊₁]``.  Distinct ring vertices make non-adjacent faces share only ``v`` by index and
+adjacent ones exactly the edge.  Both twins leave out every pair of faces sharing a certified vertex before
+counting candidates (the C scan also whole node pairs of its hierarchy whose faces all contain one certified
+vertex), so ``candidate_pairs`` counts the box-meeting pairs not within one certified star on both paths.
+A fan that folds over itself, winds twice or overlaps after less than a turn fails (2) and is tested pair by
+pair as before; faces outside the star are always tested against it.  ``surface_contacts(...,
+_star_faces=0)`` runs the unpruned scan (for the tests).
 
 C extension
 -----------
@@ -118,7 +149,8 @@ class SurfaceContacts:
         True when every candidate pair was tested; False only when ``max_pairs`` stopped the search (the pairs
         found so far are reported, but the absence of a crossing is then not proven).
     candidate_pairs : int
-        Face pairs whose bounding boxes meet (the broad phase's output, all of them when ``complete``).
+        Face pairs whose bounding boxes meet, but those within one certified star (module docstring, "Stars":
+        they provably meet only in what they share); the broad phase's output, all of them when ``complete``.
     tested_pairs : int
         Candidate pairs tested exactly (both faces of nonzero area).
     exact_evaluations : int
@@ -783,7 +815,8 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     faces : (m, 3) int
         Corner indices; a face's winding gives its normal (right-hand rule).
     max_pairs : int, optional
-        Work bound: stop after testing this many candidate pairs (box-overlapping pairs); the result is then
+        Work bound: stop after testing this many candidate pairs (box-overlapping pairs not within one
+        certified star); the result is then
         ``complete=False``.  Default: no bound.
     chunk : int
         Candidate pairs generated and tested at once (memory bound, not a work bound).
