@@ -698,10 +698,12 @@ def _chunks(per_entry: np.ndarray, chunk: int) -> Iterator[tuple[int, int]]:
 _Raw = tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray]
 
 
-def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int) -> Iterator[_Raw]:
+def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int,
+               group: np.ndarray | None = None) -> Iterator[_Raw]:
     """Chunks ``(a, b, cell, h, dims)`` of face pairs sharing grid cell ``cell`` (side ``h``): a superset of the
     pairs whose closed boxes meet, each of which appears exactly once with ``cell`` its home (see
-    :func:`_keep_mask`)."""
+    :func:`_keep_mask`), but pairs of faces of one nonnegative ``group`` (m,) int64, which are not generated
+    (faces holding one certified vertex: their pairs are within its star; negative groups are one face each)."""
     m = len(lo)
     if m < 2:
         return
@@ -712,27 +714,47 @@ def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int) -
     if not h0 > 0:                                        # every face a point at one place
         h0 = 1.0
     level = np.ceil(np.log2(np.maximum(extent, h0) / h0)).astype(np.int64)
+    if group is None:
+        group = -1 - np.arange(m, dtype=np.int64)         # every face its own group: nothing left out
+    shift = m + 1                                          # group + shift >= 1
     for top in np.unique(level):
         h = h0 * 2.0 ** top
         dims = np.full(3, int(np.floor(size / h)) + 2, dtype=np.int64)
         fb, kb = _cells(np.flatnonzero(level == top), lo, hi, origin, h, dims)
-        order = np.argsort(kb, kind="stable")
+        order = np.lexsort((group[fb], kb))               # by cell, then by group within a cell
         fb, kb = fb[order], kb[order]
+        gb = group[fb]
         starts = np.flatnonzero(np.r_[True, kb[1:] != kb[:-1]])
         run = np.diff(np.r_[starts, len(kb)])
-        later = np.repeat(starts + run, run) - np.arange(len(kb)) - 1     # same-cell entries after each entry
+        cell_end = np.repeat(starts + run, run)
+        gstarts = np.flatnonzero(np.r_[True, (kb[1:] != kb[:-1]) | (gb[1:] != gb[:-1])])
+        grun = np.diff(np.r_[gstarts, len(kb)])
+        after = np.repeat(gstarts + grun, grun)           # first entry of the cell past the entry's own group
+        later = cell_end - after
         for s0, s1 in _chunks(later, chunk):
             n = later[s0:s1]
             first = np.repeat(np.arange(s0, s1), n)
             offset = np.arange(len(first)) - np.repeat(np.cumsum(n) - n, n)
-            yield fb[first], fb[first + 1 + offset], kb[first], h, dims
-        # the smaller levels' faces through this level's grid
+            yield fb[first], fb[after[first] + offset], kb[first], h, dims
+        # the smaller levels' faces through this level's grid (partners in the cell but those of their group)
         fa, ka = _cells(np.flatnonzero(level < top), lo, hi, origin, h, dims)
         left = np.searchsorted(kb, ka, side="left")
-        count = np.searchsorted(kb, ka, side="right") - left
+        right = np.searchsorted(kb, ka, side="right")
+        rank = np.cumsum(np.r_[True, kb[1:] != kb[:-1]]) - 1          # cell rank of each entry
+        combined = rank * (2 * shift) + gb + shift                     # nondecreasing along the entries
+        ga = group[fa] + shift
+        inside = right > left
+        query = np.where(inside, rank[np.minimum(left, len(kb) - 1)], 0) * (2 * shift) + ga
+        g_lo = np.where(inside, np.searchsorted(combined, query, side="left"), left)
+        g_hi = np.where(inside, np.searchsorted(combined, query, side="right"), left)
+        before = g_lo - left
+        count = before + (right - g_hi)
         for s0, s1 in _chunks(count, chunk):
             n = count[s0:s1]
-            partner = np.repeat(left[s0:s1], n) + (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n))
+            offset = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+            lo_part = np.repeat(left[s0:s1], n) + offset
+            b4 = np.repeat(before[s0:s1], n)
+            partner = np.where(offset < b4, lo_part, np.repeat(g_hi[s0:s1], n) + (offset - b4))
             yield np.repeat(fa[s0:s1], n), fb[partner], kb[partner], h, dims
 
 
@@ -756,7 +778,12 @@ def _scan_numpy(v: np.ndarray, f: np.ndarray, axis: np.ndarray, degenerate: np.n
     candidates = tested = 0
     complete = True
     origin = lo.min(axis=0)
-    for a, b, cell, h, dims in _raw_pairs(lo, hi, origin, chunk):
+    group = None
+    if cert.any():                          # faces holding a certified vertex, grouped by their first such vertex
+        held = cert[f]
+        first = np.argmax(held, axis=1)
+        group = np.where(held.any(axis=1), f[np.arange(len(f)), first], -1 - np.arange(len(f)))
+    for a, b, cell, h, dims in _raw_pairs(lo, hi, origin, chunk, group):
         keep = _keep_mask(a, b, cell, lo, hi, origin, h, dims)
         a, b = a[keep], b[keep]
         if cert.any():
