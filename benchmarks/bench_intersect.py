@@ -16,7 +16,12 @@ the check, the candidate pairs per face and the predicate evaluations the float 
 arithmetic.  ``INERTIA_TOOL_NO_ACCEL=1`` runs both on their numpy paths; ``INERTIA_TOOL_THREADS`` sets the
 C kernels' threads.
 
-    python benchmarks/bench_intersect.py [--sizes 1e4 1e5 1e6] [--repeat 5]
+``--shape cylinder`` builds instead a closed cylinder of about ``size`` triangles (``size/4`` sections) with
+fan-triangulated caps around a centre vertex, as CAD exports them: every cap face shares the centre, so the
+unpruned scan has about ``size²/16`` candidate pairs; ``--unpruned`` runs the check without the certified-star
+pruning (``_star_faces=0``, module docstring of ``mesh/intersect.py``, "Stars"), the scan as it was before.
+
+    python benchmarks/bench_intersect.py [--sizes 1e4 1e5 1e6] [--repeat 5] [--shape cylinder] [--unpruned]
 """
 
 from __future__ import annotations
@@ -47,6 +52,20 @@ def torus(n_faces: float, major: float = 1.0, minor: float = 0.35) -> tuple[np.n
     return v, f
 
 
+def cylinder(n_faces: float, radius: float = 1.0, height: float = 2.0) -> tuple[np.ndarray, np.ndarray]:
+    """A closed cylinder of about ``n_faces`` triangles (``n_faces/4`` sections), fan caps round a centre."""
+    n = max(8, int(round(n_faces / 4)))
+    t = 2 * np.pi * np.arange(n) / n
+    ring = np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
+    v = np.concatenate([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, height)], [[0, 0, 0], [0, 0, height]]])
+    i = np.arange(n)
+    j = (i + 1) % n
+    bottom, top = np.full(n, 2 * n), np.full(n, 2 * n + 1)
+    f = np.concatenate([np.stack([bottom, j, i], 1), np.stack([top, n + i, n + j], 1),
+                        np.stack([i, j, n + j], 1), np.stack([i, n + j, n + i], 1)])
+    return v, f
+
+
 def medians(fn, repeat: int) -> tuple[float, float, object]:
     """Median CPU time (all threads of this process) and median wall-clock time of ``repeat`` calls, and the
     result."""
@@ -63,10 +82,17 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", nargs="+", type=float, default=[1e4, 1e5, 1e6])
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--shape", choices=["torus", "cylinder"], default="torus")
+    parser.add_argument("--unpruned", action="store_true", help="no certified-star pruning (the scan before it)")
     args = parser.parse_args(argv)
+    import functools
+
     import inertia_tool
     from inertia_tool.mesh import prepare
     from inertia_tool.mesh.intersect import surface_contacts
+
+    if args.unpruned:
+        surface_contacts = functools.partial(surface_contacts, _star_faces=0)
 
     inside = [0.0, 0.0]                                  # CPU and wall time spent in the check by the analysis
 
@@ -81,7 +107,7 @@ def main(argv=None) -> None:
     def analysis():
         inside[0] = inside[1] = 0.0
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")              # the torus has two equal principal moments
+            warnings.simplefilter("ignore")              # two equal principal moments
             inertia_tool.mass_properties((v, f))
         return tuple(inside)
 
@@ -89,7 +115,7 @@ def main(argv=None) -> None:
     print(f"{'faces':>10} | {'check cpu':>9} {'wall':>6} | {'analysis cpu':>12} {'wall':>6} | {'rest cpu':>8} "
           f"{'wall':>6} | {'ratio cpu':>9} {'wall':>5} | {'ns/face':>7} {'pairs/face':>10} {'exact':>6} found")
     for size in args.sizes:
-        v, f = torus(size)
+        v, f = (torus if args.shape == "torus" else cylinder)(size)
         c_check, t_check, res = medians(lambda: surface_contacts(v, f), args.repeat)
         cpus, walls, rest_c, rest_t = [], [], [], []
         for _ in range(args.repeat):

@@ -1714,8 +1714,9 @@ static PyMethodDef accel_methods[] = {
      "negligible, separatrix_m1, fallback) -> (w, q, tau)\n\n`count` steps h of the splitting composition "
      "(dynamics/splitting.py), principal frame; see section 7."},
     {"contact_scan", accel_contact_scan, METH_VARARGS,
-     "contact_scan(vertices, faces, max_pairs, threads=1) -> (a, b, kind, candidates, tested, exact, complete, "
-     "axis, degenerate)\n\nEvery face pair whose closed boxes meet, found by a bounding-volume hierarchy and "
+     "contact_scan(vertices, faces, max_pairs, threads=1, star_faces=0) -> (a, b, kind, candidates, tested, exact, "
+     "complete, axis, degenerate)\n\nEvery face pair whose closed boxes meet (but those within one certified star "
+     "of at least star_faces faces, when star_faces > 0), found by a bounding-volume hierarchy and "
      "classified; a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
     {NULL, NULL, 0, NULL}
@@ -2400,6 +2401,9 @@ done:
  * 2^-876, representable).  A pair whose expansion would outgrow CONTACT_EXP_MAX components gets kind -1 and
  * the caller classifies it on the numpy path.  The candidate pairs come from a bounding-volume hierarchy
  * instead of the numpy path's grid: the same set of pairs (those whose closed boxes meet), in another order.
+ * With star_faces > 0 the pairs within one certified star (ct_stars; mesh/intersect.py, "Stars", proves they
+ * meet only in what they share) are left out on both paths, here also whole node pairs whose faces all hold
+ * one certified vertex (CtNode.apex), so a fan cap of k faces costs O(k) instead of k(k - 1)/2 pairs.
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
@@ -3029,6 +3033,7 @@ typedef struct {
     float lo[3], hi[3];
     int64_t start, count;       /* leaf: positions start .. start+count; inner: count = 0 */
     int64_t left, right;
+    int64_t apex;               /* a certified star vertex (ct_stars) of every face below, else -1 */
 } CtNode;
 
 typedef struct {
@@ -3116,11 +3121,177 @@ ct_radix_sort(uint64_t *code, int64_t *order, int64_t m)
     return 0;
 }
 
+/* ------------------------------------------------------------------------------------------------------
+ * Certified stars (the fan pruning of mesh/intersect.py, see its docstring "Stars").  A vertex v of at least
+ * min_faces faces is certified when its faces (v, x, y), with x, y and v distinct, form one edge-connected
+ * fan: the link edges x-y make a single path or cycle (every link vertex in at most two of them), with ring
+ * r_0 .. r_k (r_k = r_0 for a cycle); and along some coordinate axis every projected triangle (v, r_i,
+ * r_{i+1}) has the same strict orientation s (exact orient2d), while the number of steps whose half-open wedge
+ * (r_i, r_{i+1}] about v holds the direction of r_0 (s * orient2d(v, r_i, r_0) > 0 and s * orient2d(v, r_0,
+ * r_{i+1}) >= 0) is 1 for a cycle and 0 for a path: the projected wedges then turn once round v (cycle) or
+ * less than once (path) without overlapping, so two faces of the star meet only in what they share by index,
+ * and every pair within the star is of kind "none" without being tested.
+ * ------------------------------------------------------------------------------------------------------ */
+
+typedef struct {
+    int32_t vid, slot;
+} CtEnd;
+
+static int
+ct_end_cmp(const void *x, const void *y)
+{
+    const CtEnd *a = (const CtEnd *)x, *b = (const CtEnd *)y;
+    return a->vid != b->vid ? (a->vid < b->vid ? -1 : 1) : (a->slot < b->slot ? -1 : a->slot > b->slot);
+}
+
+/* 1 when the star of v (link edges link[0 .. k-1], pairs of vertex ids) is certified, 0 when not, -1 when out
+ * of memory. */
+static int
+ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
+{
+    CtEnd *ends = (CtEnd *)malloc((size_t)(2 * k) * sizeof(CtEnd));
+    int32_t *partner = (int32_t *)malloc((size_t)(2 * k) * sizeof(int32_t));
+    int32_t *ring = (int32_t *)malloc((size_t)(k + 1) * sizeof(int32_t));
+    int ok = 0;
+    if (ends == NULL || partner == NULL || ring == NULL) {
+        ok = -1;
+        goto done;
+    }
+    for (int64_t s = 0; s < 2 * k; s++) {
+        ends[s].vid = link[s];
+        ends[s].slot = (int32_t)s;
+        partner[s] = -1;
+        if (link[s] == v) goto done;                       /* a repeated corner */
+    }
+    for (int64_t f = 0; f < k; f++) {
+        if (link[2 * f] == link[2 * f + 1]) goto done;
+    }
+    qsort(ends, (size_t)(2 * k), sizeof(CtEnd), ct_end_cmp);
+    int64_t free_slot = -1, n_free = 0;
+    for (int64_t s = 0; s < 2 * k;) {
+        int64_t e = s + 1;
+        while (e < 2 * k && ends[e].vid == ends[s].vid) e++;
+        if (e - s > 2) goto done;                          /* a link vertex in three faces or more */
+        if (e - s == 2) {
+            partner[ends[s].slot] = ends[s + 1].slot;
+            partner[ends[s + 1].slot] = ends[s].slot;
+        }
+        else {
+            n_free++;
+            if (free_slot < 0) free_slot = ends[s].slot;
+        }
+        s = e;
+    }
+    if (n_free != 0 && n_free != 2) goto done;
+    int closed = n_free == 0;
+    int64_t start = closed ? 0 : free_slot, len = 0, slot = start;
+    ring[len++] = link[start];
+    for (int64_t steps = 0; steps < k; steps++) {          /* walk face to face through shared link vertices */
+        int64_t out = slot ^ 1;                            /* the face's other end */
+        ring[len++] = link[out];
+        int32_t nx = partner[out];
+        if (nx < 0 || nx == start) break;
+        slot = nx;
+    }
+    if (len != k + 1) goto done;                           /* not one fan (several components) */
+    if (closed && ring[k] != ring[0]) goto done;
+    for (int axis = 0; axis < 3 && !ok; axis++) {
+        int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
+        CtStats st = {0, 0};
+        double c[2] = {V[3 * (size_t)v + kx], V[3 * (size_t)v + ky]};
+        double r0[2] = {V[3 * (size_t)ring[0] + kx], V[3 * (size_t)ring[0] + ky]};
+        int sign = 0, count = 0, good = 1;
+        for (int64_t i = 0; i < k && good; i++) {
+            double p[2] = {V[3 * (size_t)ring[i] + kx], V[3 * (size_t)ring[i] + ky]};
+            double q[2] = {V[3 * (size_t)ring[i + 1] + kx], V[3 * (size_t)ring[i + 1] + ky]};
+            int o = ct_orient2d(c, p, q, &st);
+            if (o == 0 || (sign != 0 && o != sign)) {
+                good = 0;
+                break;
+            }
+            sign = o;
+            if (sign * ct_orient2d(c, p, r0, &st) > 0 && sign * ct_orient2d(c, r0, q, &st) >= 0) count++;
+        }
+        ok = good && !st.failed && count == (closed ? 1 : 0);
+    }
+done:
+    free(ends);
+    free(partner);
+    free(ring);
+    return ok;
+}
+
+/* cert[v] <- 1 for every certified vertex (faces F, m of them, n vertices); 0 or -1 when out of memory. */
+static int
+ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, uint8_t *cert)
+{
+    memset(cert, 0, (size_t)n);
+    int64_t *off = (int64_t *)calloc((size_t)(n > 0 ? n : 1), sizeof(int64_t));
+    if (off == NULL) return -1;
+    for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
+    int64_t total = 0;
+    for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
+        if (off[v] >= min_faces) {
+            total += off[v];
+            off[v] = total;
+        }
+        else {
+            off[v] = -1;
+        }
+    }
+    int32_t *link = (int32_t *)malloc((size_t)(total > 0 ? 2 * total : 1) * sizeof(int32_t));
+    if (link == NULL) {
+        free(off);
+        return -1;
+    }
+    for (int64_t f = 0; f < m; f++) {
+        for (int c = 0; c < 3; c++) {
+            int64_t v = index_at(F, fsize, 3 * (size_t)f + (size_t)c);
+            if (off[v] < 0) continue;
+            int64_t at = --off[v];
+            link[2 * at] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 1) % 3));
+            link[2 * at + 1] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 2) % 3));
+        }
+    }
+    int rc = 0;
+    for (int64_t v = 0; v < n && rc == 0; v++) {           /* off[v] is now the start of v's range */
+        if (off[v] < 0) continue;
+        int64_t s = off[v], e;
+        /* the range ends where the next kept vertex's starts: ranges were laid out in vertex order */
+        int64_t w = v + 1;
+        while (w < n && off[w] < 0) w++;
+        e = w < n ? off[w] : total;
+        int r = ct_star_certify(V, (int32_t)v, link + 2 * s, e - s);
+        if (r < 0) rc = -1;
+        else cert[v] = (uint8_t)r;
+    }
+    free(link);
+    free(off);
+    return rc;
+}
+
+/* The certified vertex shared by every face at hierarchy positions s .. s+count-1, or -1. */
+static int64_t
+ct_leaf_apex(const CtRec *rec, const uint8_t *cert, int64_t s, int64_t count)
+{
+    if (cert == NULL) return -1;
+    for (int c = 0; c < 3; c++) {
+        int32_t x = rec[s].fo[c];
+        if (!cert[x]) continue;
+        int all = 1;
+        for (int64_t i = s + 1; i < s + count && all; i++) {
+            all = rec[i].fo[0] == x || rec[i].fo[1] == x || rec[i].fo[2] == x;
+        }
+        if (all) return x;
+    }
+    return -1;
+}
+
 /* Builds the hierarchy over the boxes BOX (lo, hi: 6 floats per position, already in hierarchy order):
  * the tree halving index ranges (leaves of at most CT_LEAF faces), node boxes from the leaves up.  Returns
  * the node count. */
 static int64_t
-ct_build(CtNode *nodes, const float *BOX, int64_t m)
+ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert, int64_t m)
 {
     int64_t n_nodes = 1;
     nodes[0].start = 0;
@@ -3144,6 +3315,7 @@ ct_build(CtNode *nodes, const float *BOX, int64_t m)
     for (int64_t k = n_nodes - 1; k >= 0; k--) {
         CtNode *nd = &nodes[k];
         if (nd->count > 0) {
+            nd->apex = ct_leaf_apex(rec, cert, nd->start, nd->count);
             for (int c = 0; c < 3; c++) {
                 nd->lo[c] = INFINITY;
                 nd->hi[c] = -INFINITY;
@@ -3157,6 +3329,7 @@ ct_build(CtNode *nodes, const float *BOX, int64_t m)
         }
         else {
             const CtNode *p = &nodes[nd->left], *q = &nodes[nd->right];
+            nd->apex = p->apex == q->apex ? p->apex : -1;
             for (int c = 0; c < 3; c++) {
                 nd->lo[c] = p->lo[c] < q->lo[c] ? p->lo[c] : q->lo[c];
                 nd->hi[c] = p->hi[c] > q->hi[c] ? p->hi[c] : q->hi[c];
@@ -3172,6 +3345,7 @@ typedef struct {
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
     const double *V;            /* vertices (n, 3) */
     const CtNode *nodes;
+    const uint8_t *cert;        /* certified star vertices (ct_stars), NULL without pruning */
     long long max_pairs;        /* < 0: no bound */
     long long candidates, tested;
     long exact;
@@ -3209,6 +3383,12 @@ static int
 ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
     if (!ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)) return 0;
+    if (sc->cert != NULL) {                 /* both in one certified star: they meet only in what they share */
+        const int32_t *x = sc->rec[i].fo, *y = sc->rec[j].fo;
+        for (int c = 0; c < 3; c++) {
+            if (sc->cert[x[c]] && (x[c] == y[0] || x[c] == y[1] || x[c] == y[2])) return 0;
+        }
+    }
     if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
         ct_face_load(FI, sc, i);
         *have_i = 1;
@@ -3273,6 +3453,9 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         top--;
         int64_t pi = stack[2 * top], qi = stack[2 * top + 1];
         const CtNode *p = &nodes[pi], *q = &nodes[qi];
+        if (p->apex >= 0 && p->apex == q->apex) {
+            continue;                       /* every pair below is within one certified star */
+        }
         if (top + 3 > cap) {
             int64_t *ns = (int64_t *)realloc(stack, 4 * cap * sizeof(int64_t));
             if (ns == NULL) {
@@ -3476,7 +3659,7 @@ ct_prep_task(void *ctx, int t, int nt)
     pr->failed[t] |= st.failed;
 }
 
-/* contact_scan(vertices, faces, max_pairs[, threads]) -> (a, b, kind, candidates, tested, exact, complete,
+/* contact_scan(vertices, faces, max_pairs[, threads[, star_faces]]) -> (a, b, kind, candidates, tested, exact, complete,
  * axis, degenerate): found pairs as int64 / int8 bytes, per-face projection axis (int8 bytes) and zero-area
  * flags (uint8 bytes) in the caller's face order. */
 static PyObject *
@@ -3485,7 +3668,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
     PyObject *objs[2];
     long long max_pairs;
     int threads = 1;
-    if (!PyArg_ParseTuple(args, "OOL|i", &objs[0], &objs[1], &max_pairs, &threads)) {
+    long long star_faces = 0;
+    if (!PyArg_ParseTuple(args, "OOL|iL", &objs[0], &objs[1], &max_pairs, &threads, &star_faces)) {
         return NULL;
     }
     Py_buffer views[2];
@@ -3499,6 +3683,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
     uint8_t *flags = NULL;
     int8_t *axis_out = NULL;
     uint8_t *skip_out = NULL;
+    uint8_t *cert = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
     for (; got < 2; got++) {
@@ -3600,8 +3785,15 @@ accel_contact_scan(PyObject *self, PyObject *args)
             free(order);                    /* rec holds the face indices in hierarchy order */
             order = NULL;
         }
+        if (!oom && !failed && m >= 2 && star_faces > 0) {
+            cert = (uint8_t *)malloc((size_t)n);
+            if (cert == NULL || ct_stars(V, n, F, fsize, m, star_faces, cert) < 0) {
+                oom = 1;
+            }
+        }
         if (!oom && !failed && m >= 2) {
-            ct_build(nodes, box, m);
+            ct_build(nodes, box, rec, cert, m);
+            sc.cert = cert;
             sc.BOX = box;
             sc.rec = rec;
             sc.flags = flags;
@@ -3686,6 +3878,7 @@ done:
     free(flags);
     free(axis_out);
     free(skip_out);
+    free(cert);
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);

@@ -2,7 +2,8 @@
 
 A closed, consistently oriented mesh bounds a simple polyhedron only if no two faces intersect except along
 the vertices and edges they share by index.  :func:`surface_contacts` tests every pair of faces whose
-bounding boxes meet (within one shell and between shells, adjacent faces included) and sorts the pairs that
+bounding boxes meet (within one shell and between shells, adjacent faces included), but the pairs within a
+fan it proves apart without testing (see "Stars" below), and sorts the pairs that
 meet beyond what they share into three kinds (:class:`SurfaceContacts`):
 
 * ``crossing``: the two triangles cross transversally (a point in the relative interior of both, the planes
@@ -53,6 +54,36 @@ corner of the intersection of the two boxes, so it is tested once.  Cell indices
 monotone in ``x``, so two closed boxes that meet always share a cell.  Candidate pairs are generated and
 tested in chunks of at most ``chunk`` pairs, so memory stays bounded on any mesh.
 
+Stars
+-----
+Every face of a fan-triangulated cap (cylinders, holes, bosses in CAD exports) contains the centre vertex, so
+all their boxes meet there and a cap of ``k`` faces alone gives ``k(k − 1)/2`` candidate pairs.  Those pairs
+are left out, without changing the result, for the stars this rule certifies.  A vertex ``v`` of at least
+:data:`STAR_MIN_FACES` faces is *certified* when (1) its faces ``(v, x, y)``, with ``v, x, y`` distinct
+indices, form one edge-connected fan: the link edges ``x–y`` make one path or one cycle, every link vertex in
+at most two of them, giving the ring ``r₀ … r_k`` (``r_k = r₀`` for a cycle); and (2) along some coordinate
+axis (dropping that coordinate: an exact projection) every triangle ``(v′, r′ᵢ, r′ᵢ₊₁)`` has the same strict
+orientation ``s`` (exact ``orient2d``), and the number of steps ``i`` whose half-open wedge ``(r′ᵢ, r′ᵢ₊₁]``
+about ``v′`` holds the direction of ``r′₀`` — ``s·orient2d(v′, r′ᵢ, r′₀) > 0`` and
+``s·orient2d(v′, r′₀, r′ᵢ₊₁) ≥ 0`` — is 1 for a cycle and 0 for a path.
+
+Proof that two faces of a certified star meet only in what they share by index (so the check would find
+nothing there).  Each step turns by an angle in ``(0, π)`` in the sense ``s``, so the cumulative angle
+increases strictly; a wedge narrower than π holds a direction iff the two signs above hold, and holds at most
+one multiple of 2π of the cumulative angle, so the count is the number of whole turns: the total is exactly
+2π for a cycle and below 2π for a path.  The projected wedges ``Wᵢ`` are then non-overlapping closed sectors
+with distinct bounding rays; two non-adjacent ones meet only in ``v′`` and adjacent ones along the ray through
+``r′ᵢ₊₁``, which meets ``Tᵢ′`` and ``Tᵢ₊₁′`` (the projected faces, ``Tᵢ′ ⊂ Wᵢ``) only in the projected edge
+``[v′, r′ᵢ₊₁]``.  Each face projects one to one (its projection has nonzero area), so a common point of two
+faces is the only preimage in each of a point of ``{v′}`` or of the projected shared edge: it is ``v`` or on
+the shared edge ``[v, rᵢ₊₁]``.  Distinct ring vertices make non-adjacent faces share only ``v`` by index and
+adjacent ones exactly the edge.  Both twins leave out every pair of faces sharing a certified vertex before
+counting candidates (the C scan also whole node pairs of its hierarchy whose faces all contain one certified
+vertex), so ``candidate_pairs`` counts the box-meeting pairs not within one certified star on both paths.
+A fan that folds over itself, winds twice or overlaps after less than a turn fails (2) and is tested pair by
+pair as before; faces outside the star are always tested against it.  ``surface_contacts(...,
+_star_faces=0)`` runs the unpruned scan (for the tests).
+
 C extension
 -----------
 When ``inertia_tool._accel`` is built (and the coordinates are in the filter's range) the whole scan runs in
@@ -90,6 +121,9 @@ O3D_BOUND = 10 * _U
 O2D_BOUND = 6 * _U
 #: Nonzero coordinate magnitudes inside [2⁻²⁴⁰, 2²⁹⁹] keep every rounding of the predicates relative.
 _SMALLEST, _LARGEST = 2.0 ** -240, 2.0 ** 299
+#: Stars of at least this many faces are tried for certification (module docstring, "Stars"); smaller ones cost
+#: too few pairs to be worth it.  0 turns the pruning off (the unpruned scan, kept for the tests).
+STAR_MIN_FACES = 8
 #: Candidate pairs generated and tested at once (memory bound of the narrow phase: ~1 kB per pair).
 CHUNK_PAIRS = 1 << 17
 
@@ -115,7 +149,8 @@ class SurfaceContacts:
         True when every candidate pair was tested; False only when ``max_pairs`` stopped the search (the pairs
         found so far are reported, but the absence of a crossing is then not proven).
     candidate_pairs : int
-        Face pairs whose bounding boxes meet (the broad phase's output, all of them when ``complete``).
+        Face pairs whose bounding boxes meet, but those within one certified star (module docstring, "Stars":
+        they provably meet only in what they share); the broad phase's output, all of them when ``complete``.
     tested_pairs : int
         Candidate pairs tested exactly (both faces of nonzero area).
     exact_evaluations : int
@@ -543,6 +578,85 @@ def _coplanar(t1: np.ndarray, t2: np.ndarray, axis: np.ndarray, same: np.ndarray
     return kind
 
 
+# -- certified stars ------------------------------------------------------------------------------------------
+
+def _star_ring(v: int, link: np.ndarray) -> tuple[np.ndarray, bool] | None:
+    """The ring ``r_0 .. r_k`` of the star of ``v`` from its link edges (k, 2), and whether it is closed
+    (``r_k = r_0``); None unless the faces form one edge-connected fan of distinct corners."""
+    k = len(link)
+    if np.any(link == v) or np.any(link[:, 0] == link[:, 1]):
+        return None
+    ids, count = np.unique(link, return_counts=True)
+    if np.any(count > 2):
+        return None
+    ends = ids[count == 1]
+    if len(ends) not in (0, 2):
+        return None
+    faces_of: dict[int, list[int]] = {}
+    for i, (x, y) in enumerate(link.tolist()):
+        faces_of.setdefault(x, []).append(i)
+        faces_of.setdefault(y, []).append(i)
+    closed = len(ends) == 0
+    at = int(link[0, 0]) if closed else int(ends[0])
+    face = faces_of[at][0]
+    ring = [at]
+    used = np.zeros(k, dtype=bool)
+    for _ in range(k):
+        used[face] = True
+        x, y = int(link[face, 0]), int(link[face, 1])
+        at = y if x == at else x
+        ring.append(at)
+        nxt = [g for g in faces_of[at] if not used[g]]
+        if not nxt:
+            break
+        face = nxt[0]
+    if not used.all() or len(ring) != k + 1 or (closed and ring[-1] != ring[0]):
+        return None
+    return np.array(ring, dtype=np.int64), closed
+
+
+def _certified_stars(v: np.ndarray, f: np.ndarray, min_faces: int, pred: _Predicates) -> np.ndarray:
+    """(n,) bool: the vertices whose star (at least ``min_faces`` faces) is certified (module docstring,
+    "Stars"): one fan whose projection along some coordinate axis turns round the vertex once without overlap
+    (a closed fan) or less than once (an open one), every projected triangle strictly of one orientation."""
+    cert = np.zeros(len(v), dtype=bool)
+    if min_faces <= 0 or not len(f):
+        return cert
+    valence = np.bincount(f.reshape(-1), minlength=len(v))
+    for c in np.flatnonzero(valence >= min_faces).tolist():
+        rows, corner = np.nonzero(f == c)
+        link = np.stack([f[rows, (corner + 1) % 3], f[rows, (corner + 2) % 3]], axis=1)
+        found = _star_ring(c, link)
+        if found is None:
+            continue
+        ring, closed = found
+        k = len(ring) - 1
+        for axis in range(3):
+            keep = _PLANE[axis]
+            centre = np.repeat(v[c, keep][None, :], k, axis=0)
+            p, q = v[ring[:-1]][:, keep], v[ring[1:]][:, keep]
+            r0 = np.repeat(v[ring[0], keep][None, :], k, axis=0)
+            turn = pred.orient2d(centre, p, q)
+            if turn[0] == 0 or np.any(turn != turn[0]):
+                continue
+            s = int(turn[0])
+            passes = (s * pred.orient2d(centre, p, r0) > 0) & (s * pred.orient2d(centre, r0, q) >= 0)
+            if int(np.count_nonzero(passes)) == (1 if closed else 0):
+                cert[c] = True
+                break
+    return cert
+
+
+def _star_pairs(f: np.ndarray, a: np.ndarray, b: np.ndarray, cert: np.ndarray) -> np.ndarray:
+    """(k,) bool: the pairs of faces ``a, b`` sharing a certified vertex (both in its star)."""
+    fa, fb = f[a], f[b]
+    shared = np.zeros(len(a), dtype=bool)
+    for i in range(3):
+        hit = cert[fa[:, i]]
+        shared |= hit & ((fa[:, i] == fb[:, 0]) | (fa[:, i] == fb[:, 1]) | (fa[:, i] == fb[:, 2]))
+    return shared
+
+
 # -- broad phase ----------------------------------------------------------------------------------------------
 
 def _cells(faces: np.ndarray, lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, h: float,
@@ -584,10 +698,12 @@ def _chunks(per_entry: np.ndarray, chunk: int) -> Iterator[tuple[int, int]]:
 _Raw = tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray]
 
 
-def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int) -> Iterator[_Raw]:
+def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int,
+               group: np.ndarray | None = None) -> Iterator[_Raw]:
     """Chunks ``(a, b, cell, h, dims)`` of face pairs sharing grid cell ``cell`` (side ``h``): a superset of the
     pairs whose closed boxes meet, each of which appears exactly once with ``cell`` its home (see
-    :func:`_keep_mask`)."""
+    :func:`_keep_mask`), but pairs of faces of one nonnegative ``group`` (m,) int64, which are not generated
+    (faces holding one certified vertex: their pairs are within its star; negative groups are one face each)."""
     m = len(lo)
     if m < 2:
         return
@@ -598,27 +714,47 @@ def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int) -
     if not h0 > 0:                                        # every face a point at one place
         h0 = 1.0
     level = np.ceil(np.log2(np.maximum(extent, h0) / h0)).astype(np.int64)
+    if group is None:
+        group = -1 - np.arange(m, dtype=np.int64)         # every face its own group: nothing left out
+    shift = m + 1                                          # group + shift >= 1
     for top in np.unique(level):
         h = h0 * 2.0 ** top
         dims = np.full(3, int(np.floor(size / h)) + 2, dtype=np.int64)
         fb, kb = _cells(np.flatnonzero(level == top), lo, hi, origin, h, dims)
-        order = np.argsort(kb, kind="stable")
+        order = np.lexsort((group[fb], kb))               # by cell, then by group within a cell
         fb, kb = fb[order], kb[order]
+        gb = group[fb]
         starts = np.flatnonzero(np.r_[True, kb[1:] != kb[:-1]])
         run = np.diff(np.r_[starts, len(kb)])
-        later = np.repeat(starts + run, run) - np.arange(len(kb)) - 1     # same-cell entries after each entry
+        cell_end = np.repeat(starts + run, run)
+        gstarts = np.flatnonzero(np.r_[True, (kb[1:] != kb[:-1]) | (gb[1:] != gb[:-1])])
+        grun = np.diff(np.r_[gstarts, len(kb)])
+        after = np.repeat(gstarts + grun, grun)           # first entry of the cell past the entry's own group
+        later = cell_end - after
         for s0, s1 in _chunks(later, chunk):
             n = later[s0:s1]
             first = np.repeat(np.arange(s0, s1), n)
             offset = np.arange(len(first)) - np.repeat(np.cumsum(n) - n, n)
-            yield fb[first], fb[first + 1 + offset], kb[first], h, dims
-        # the smaller levels' faces through this level's grid
+            yield fb[first], fb[after[first] + offset], kb[first], h, dims
+        # the smaller levels' faces through this level's grid (partners in the cell but those of their group)
         fa, ka = _cells(np.flatnonzero(level < top), lo, hi, origin, h, dims)
         left = np.searchsorted(kb, ka, side="left")
-        count = np.searchsorted(kb, ka, side="right") - left
+        right = np.searchsorted(kb, ka, side="right")
+        rank = np.cumsum(np.r_[True, kb[1:] != kb[:-1]]) - 1          # cell rank of each entry
+        combined = rank * (2 * shift) + gb + shift                     # nondecreasing along the entries
+        ga = group[fa] + shift
+        inside = right > left
+        query = np.where(inside, rank[np.minimum(left, len(kb) - 1)], 0) * (2 * shift) + ga
+        g_lo = np.where(inside, np.searchsorted(combined, query, side="left"), left)
+        g_hi = np.where(inside, np.searchsorted(combined, query, side="right"), left)
+        before = g_lo - left
+        count = before + (right - g_hi)
         for s0, s1 in _chunks(count, chunk):
             n = count[s0:s1]
-            partner = np.repeat(left[s0:s1], n) + (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n))
+            offset = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+            lo_part = np.repeat(left[s0:s1], n) + offset
+            b4 = np.repeat(before[s0:s1], n)
+            partner = np.where(offset < b4, lo_part, np.repeat(g_hi[s0:s1], n) + (offset - b4))
             yield np.repeat(fa[s0:s1], n), fb[partner], kb[partner], h, dims
 
 
@@ -635,15 +771,24 @@ _Scan = tuple[np.ndarray, np.ndarray, np.ndarray, int, int, bool]
 
 
 def _scan_numpy(v: np.ndarray, f: np.ndarray, axis: np.ndarray, degenerate: np.ndarray, lo: np.ndarray,
-                hi: np.ndarray, max_pairs: int | None, chunk: int, pred: _Predicates) -> _Scan:
-    """Pairs that meet (a, b, kind), candidate and tested counts, completeness: the grid and numpy twin."""
+                hi: np.ndarray, max_pairs: int | None, chunk: int, pred: _Predicates, cert: np.ndarray) -> _Scan:
+    """Pairs that meet (a, b, kind), candidate and tested counts, completeness: the grid and numpy twin
+    (pairs within the star of a vertex ``cert`` marks are left out)."""
     found_a, found_b, found_k = [], [], []
     candidates = tested = 0
     complete = True
     origin = lo.min(axis=0)
-    for a, b, cell, h, dims in _raw_pairs(lo, hi, origin, chunk):
+    group = None
+    if cert.any():                          # faces holding a certified vertex, grouped by their first such vertex
+        held = cert[f]
+        first = np.argmax(held, axis=1)
+        group = np.where(held.any(axis=1), f[np.arange(len(f)), first], -1 - np.arange(len(f)))
+    for a, b, cell, h, dims in _raw_pairs(lo, hi, origin, chunk, group):
         keep = _keep_mask(a, b, cell, lo, hi, origin, h, dims)
         a, b = a[keep], b[keep]
+        if cert.any():
+            star = _star_pairs(f, a, b, cert)
+            a, b = a[~star], b[~star]
         if max_pairs is not None and candidates + len(a) > max_pairs:
             take = max(max_pairs - candidates, 0)
             a, b = a[:take], b[:take]
@@ -666,12 +811,12 @@ def _scan_numpy(v: np.ndarray, f: np.ndarray, axis: np.ndarray, degenerate: np.n
     return np.concatenate(found_a), np.concatenate(found_b), np.concatenate(found_k), candidates, tested, complete
 
 
-def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None,
-            pred: _Predicates) -> tuple[_Scan, np.ndarray, np.ndarray]:
+def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None, pred: _Predicates,
+            star_faces: int) -> tuple[_Scan, np.ndarray, np.ndarray]:
     """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy), with the
     per-face projection axes and zero-area flags it computed."""
     raw_a, raw_b, raw_kind, candidates, tested, exact, complete, raw_axis, raw_skip = lib.contact_scan(
-        v, f, -1 if max_pairs is None else int(max_pairs), threads())
+        v, f, -1 if max_pairs is None else int(max_pairs), threads(), star_faces)
     pred.exact += exact
     axis = np.frombuffer(raw_axis, dtype=np.int8).astype(np.intp)
     degenerate = np.frombuffer(raw_skip, dtype=np.uint8).astype(bool)
@@ -687,7 +832,7 @@ def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None
 # -- entry point ----------------------------------------------------------------------------------------------
 
 def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int | None = None,
-                     chunk: int = CHUNK_PAIRS) -> SurfaceContacts:
+                     chunk: int = CHUNK_PAIRS, _star_faces: int = STAR_MIN_FACES) -> SurfaceContacts:
     """Every pair of faces that meets beyond the vertices and edges it shares by index, classified exactly.
 
     Parameters
@@ -697,10 +842,14 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     faces : (m, 3) int
         Corner indices; a face's winding gives its normal (right-hand rule).
     max_pairs : int, optional
-        Work bound: stop after testing this many candidate pairs (box-overlapping pairs); the result is then
+        Work bound: stop after testing this many candidate pairs (box-overlapping pairs not within one
+        certified star); the result is then
         ``complete=False``.  Default: no bound.
     chunk : int
         Candidate pairs generated and tested at once (memory bound, not a work bound).
+    _star_faces : int
+        Private, for the tests: stars of at least this many faces are certified and their pairs left out
+        (module docstring, "Stars"); 0 runs the unpruned scan.  The pairs found do not depend on it.
 
     Returns
     -------
@@ -728,7 +877,8 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     if not len(f):
         return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty, complete=True)
     if lib is not None:
-        (a, b, kind, candidates, tested, complete), axis, degenerate = _scan_c(lib, v, f, max_pairs, pred)
+        (a, b, kind, candidates, tested, complete), axis, degenerate = _scan_c(lib, v, f, max_pairs, pred,
+                                                                               _star_faces)
     else:
         f = f.astype(np.int64, copy=False)
         axis, degenerate = _face_axes(v, f, pred)
@@ -736,8 +886,9 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
         lo = np.minimum(np.minimum(p0, p1), p2)
         hi = np.maximum(np.maximum(p0, p1), p2)
         del p0, p1, p2
+        cert = _certified_stars(v, f, _star_faces, pred)
         a, b, kind, candidates, tested, complete = _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk,
-                                                               pred)
+                                                               pred, cert)
 
     def pairs(key: int) -> np.ndarray:
         hit = kind == key
