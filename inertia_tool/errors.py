@@ -64,6 +64,7 @@ __all__ = [
     "ImplausibleDensityWarning",
     "ImplausibleCorrectionWarning",
     "ImplausiblePointWarning",
+    "PivotOffPartWarning",
     "StoragePrecisionWarning",
     "NonMaterialVolumeWarning",
 ]
@@ -269,6 +270,13 @@ class ImplausiblePointWarning(InertiaToolWarning):
     """A reference point (``inertia_about``, ``--about``) lies implausibly far from the part for its size
     (:data:`inertia_tool.tolerances.FAR_POINT_RATIO` sizes): most likely a units slip, e.g. millimetre
     coordinates passed to an API that takes metres.  The result is computed as asked."""
+
+
+class PivotOffPartWarning(InertiaToolWarning):
+    """spin-it's top pivot lies in empty space, away from the part (farther than
+    :data:`inertia_tool.tolerances.PIVOT_GAP_RTOL` of its largest extent from its surface, outside it): a top
+    stands on a point of its own surface, so the design is for a part held on a pin it does not have; most likely a
+    wrong ``--pivot`` or a units slip.  The design is computed as asked."""
 
 
 class ImplausibleCorrectionWarning(InertiaToolWarning):

@@ -64,6 +64,11 @@ STORAGE_PRECISION_RTOL = 1e-4
 #: the tensor by 10⁴ times the central one — rarely what anyone meant.
 FAR_POINT_RATIO = 100.0
 
+#: spin-it (top): a pivot outside the part and farther than this fraction of the part's largest extent from its
+#: surface is warned about (``PivotOffPartWarning``).  A top's pivot is a point of its surface (its tip); 2 % of
+#: the extent leaves room for a tip rounded by the mesh's facets or a pivot given to a rounded coordinate.
+PIVOT_GAP_RTOL = 0.02
+
 #: Default manufacturing tolerance on the principal moments of a printed part (``--shell``/``--infill``),
 #: relative to the largest: an FDM print holds its dimensions to about ±0.1–0.2 mm on a few centimetres
 #: (≈ 0.5 % of a length, so ≈ 1 % of a moment ∝ m L²), and its infill pattern is neither uniform nor isotropic.

@@ -374,3 +374,44 @@ def test_insert_is_the_best_exact_objective_of_its_shapes():
     assert with_insert.objective_after <= alone.objective_after * (1 + 1e-9)
     assert with_insert.insert_shape in ("quadric", "ring", None)
     assert (with_insert.insert is None) == (with_insert.insert_shape is None)
+
+
+# -- a top's pivot in empty space (issue 24 item 3) ----------------------------------------------------------
+@pytest.mark.parametrize("pivot, warned", [
+    ((0.0, 0.0, 0.0), False),             # the centre: inside the material
+    ((0.0, 0.0, -0.5), False),            # on the bottom face
+    ((0.5, 0.5, -0.5), False),            # a corner
+    ((0.0, 0.0, -0.515), False),          # 1.5 % of the extent below: within PIVOT_GAP_RTOL
+    ((0.0, 0.0, -0.53), True),            # 3 % below the bottom face
+    ((0.0, 0.0, -30.0), True),            # a millimetre pivot read as metres
+    ((0.7, 0.7, 0.0), True),              # beside the part
+])
+def test_a_pivot_outside_the_part_is_warned_about(pivot, warned):
+    from inertia_tool.design.grid import SurfaceTree
+    from inertia_tool.design.hollow import _warn_pivot_off_part
+    from inertia_tool.errors import PivotOffPartWarning
+    from inertia_tool.tolerances import PIVOT_GAP_RTOL
+
+    cube = shapes.box(1.0, 1.0, 1.0)                 # unit cube about the origin, extent 1 m
+    v, f = cube.vertices, cube.faces
+    assert PIVOT_GAP_RTOL == pytest.approx(0.02)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _warn_pivot_off_part("cube", np.array(pivot), v, f, SurfaceTree(v, f), 1.0)
+    found = [w for w in caught if issubclass(w.category, PivotOffPartWarning)]
+    assert bool(found) is warned
+    if warned:
+        assert "empty space" in str(found[0].message) and "--pivot" in str(found[0].message)
+
+
+def test_spin_it_top_warns_about_a_pivot_below_its_tip_and_not_at_it():
+    from inertia_tool.errors import PivotOffPartWarning
+
+    v, f = asymmetric_top()
+    for pivot, warned in (([0, 0, 0], False), ([0, 0, -0.01], True)):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = spin_it((v, f), axis=[0, 0, 1], pivot=pivot, mode="top", wall=0.0015, material="PLA",
+                             resolution=16)
+        assert np.allclose(result.origin, pivot)             # designed as asked
+        assert any(issubclass(w.category, PivotOffPartWarning) for w in caught) is warned

@@ -27,8 +27,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import AsymmetricTopWarning, NoRoomError, PhysicsError, UsageError
-from ..tolerances import EQUAL_MOMENTS_RTOL
+from ..errors import AsymmetricTopWarning, NoRoomError, PhysicsError, PivotOffPartWarning, UsageError
+from ..tolerances import EQUAL_MOMENTS_RTOL, PIVOT_GAP_RTOL
 from .cavity_mesh import DEPTH_MARGIN, cut_pocket  # noqa: F401  (DEPTH_MARGIN: used by the benchmark too)
 from .grid import SurfaceTree, interior_grid, surface_distance
 from .limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
@@ -365,6 +365,25 @@ def _too_thin(name: str, grid, wall: float, extent: float, resolution: int, *, c
                        suggested=max(needed, resolution + 1))
 
 
+def _warn_pivot_off_part(name: str, pivot: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
+                         tree: SurfaceTree, extent: float) -> None:
+    """``PivotOffPartWarning`` when a top's pivot lies outside the part, farther than ``PIVOT_GAP_RTOL`` of its
+    largest extent from the surface (inside: the generalized winding number above one half)."""
+    import igl
+
+    gap = float(np.sqrt(tree.squared_distance(np.asarray(pivot, dtype=np.float64)[None, :])[0]))
+    if gap <= PIVOT_GAP_RTOL * extent:
+        return
+    winding = igl.fast_winding_number(tree.vertices, tree.faces, np.asarray(pivot, dtype=np.float64)[None, :])
+    if float(np.asarray(winding).reshape(-1)[0]) > 0.5:
+        return
+    p = ", ".join(f"{c:.6g}" for c in pivot)
+    warnings.warn(PivotOffPartWarning(
+        f"{name}: the pivot ({p}) m lies in empty space, {gap:.3g} m from the part's surface ({gap / extent:.1%} "
+        f"of its {extent:.3g} m extent): a top stands on a point of its own surface; check --pivot and --units "
+        "(designed as asked)"), stacklevel=3)
+
+
 def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivot=None, units: str | None = None,
             density: float | None = None, material: str | None = None, mass: float | None = None,
             resolution: int = DEFAULT_RESOLUTION, center_weight: float = 1e4, product_weight: float = 1e4,
@@ -452,6 +471,8 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
 
     h = extent / resolution
     tree = SurfaceTree(vertices, faces)
+    if mode == "top":
+        _warn_pivot_off_part(name, pivot, vertices, faces, tree, extent)
     # depths matter up to the deepest cavity threshold (wall + margins) plus the smooth minimum's reach
     grid = interior_grid(vertices, faces, spacing=h, depth_cap=wall + DEPTH_CAP_CELLS * h)
     grid = _exact_near_wall(grid, vertices, faces, wall, tree)
