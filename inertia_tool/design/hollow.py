@@ -570,6 +570,21 @@ def _reanalysed(mesh, density: float, name: str):
     return _part(mesh, density, None, LoadOptions(), name=name)[0]
 
 
+def replay_warnings(caught, name: str, *, seen: set | None = None) -> None:
+    """Warn again the recorded ``caught`` (``warnings.WarningMessage``), a mesh made here named ``name`` instead
+    of ``"<arrays>"`` (the name of an in-memory mesh); one whose category and text are in ``seen`` is skipped
+    (and each warned one added), so that a retry does not repeat what the first attempt said."""
+    for w in caught:
+        text = str(w.message).replace("<arrays>", name)
+        if seen is not None:
+            if (w.category, text) in seen:
+                continue
+            seen.add((w.category, text))
+        message = w.category(text)
+        message.about_made_mesh = True     # type: ignore[attr-defined]  # verify drops these of a rejected design
+        warnings.warn_explicit(message, w.category, w.filename, w.lineno)
+
+
 def _first_certified(pockets, density: float, name: str):
     """The first candidate pocket whose hollowed part the engine certifies ``exact`` (as ``analyze`` will the
     file), and its mass properties.  A cavity added to the part's surface keeps the wall from it and is an
@@ -579,12 +594,17 @@ def _first_certified(pockets, density: float, name: str):
 
     failures = []
     for pocket in pockets:
-        try:
-            props = _reanalysed((pocket.vertices, pocket.faces), density, name)
-        except InvalidMeshError as exc:
-            failures.append(str(exc))
-            continue
+        # a candidate that is not kept says nothing: its warnings (a fold it had, "<arrays>" for its name) are
+        # about a mesh the user never gets
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                props = _reanalysed((pocket.vertices, pocket.faces), density, name)
+            except InvalidMeshError as exc:
+                failures.append(str(exc))
+                continue
         if props.mesh is None or props.mesh.certificate.kind == "exact":
+            replay_warnings(caught, name)
             return pocket, props
         failures.append(f"certificate {props.mesh.certificate.kind}")
     raise PhysicsError(f"{name}: no mesh of the cavity could be certified exact ({'; '.join(failures)})")

@@ -20,6 +20,7 @@ A design **fails** when
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -192,15 +193,23 @@ def spin_it_verified(source, *, resolution: int, retries: int = MAX_RETRIES, **o
 
     name = str(source) if isinstance(source, (str, bytes)) or hasattr(source, "__fspath__") else "the part"
     thin_note: tuple[str, ...] = ()
+    # each attempt's warnings are recorded and said once at the end: those about the input (read once, the pivot
+    # checked by every attempt) once, those about a hollowed mesh only for the design handed back
+    about_input: list = []
+    seen: set = set()
     for _attempt in range(max(int(retries), 0) + 1 + MAX_STIFFER):
-        try:
-            result = hollow.spin_it(source, resolution=current, **options)
-        except NoRoomError as exc:
-            if verdicts:          # a finer retry of a rejected design: the earlier rejection stands
-                break
-            result, current = _finer_room(source, current, exc, options)
-            thin_note = (f"resolution {resolution} left no room for a cavity (the part is thin there); "
-                         f"resolution {current} did, and was used",)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                result = hollow.spin_it(source, resolution=current, **options)
+            except NoRoomError as exc:
+                if verdicts:          # a finer retry of a rejected design: the earlier rejection stands
+                    break
+                result, current = _finer_room(source, current, exc, options)
+                thin_note = (f"resolution {resolution} left no room for a cavity (the part is thin there); "
+                             f"resolution {current} did, and was used",)
+        made = [w for w in caught if getattr(w.message, "about_made_mesh", False)]
+        about_input.extend(w for w in caught if not getattr(w.message, "about_made_mesh", False))
         # the part is read and checked once: later attempts reuse the first's (the check of a large mesh costs)
         if getattr(result, "loaded", None) is not None:
             options = {**options, "loaded": result.loaded}
@@ -210,6 +219,8 @@ def spin_it_verified(source, *, resolution: int, retries: int = MAX_RETRIES, **o
             verdict = replace(verdict, notes=thin_note + verdict.notes)
         verdicts.append(verdict)
         if verdict.ok:
+            hollow.replay_warnings(about_input, name, seen=seen)
+            hollow.replay_warnings(made, name, seen=seen)
             return result, tuple(verdicts)
         if _tilted(verdict, MAX_AXIS_TILT) and stiffer < MAX_STIFFER:
             stiffer += 1          # the same grid, the products of inertia weighed more
@@ -220,6 +231,7 @@ def spin_it_verified(source, *, resolution: int, retries: int = MAX_RETRIES, **o
         if finer == current:
             break
         current = finer
+    hollow.replay_warnings(about_input, name, seen=seen)
     raise DesignRejectedError(_rejection(name, verdicts, result))
 
 

@@ -442,8 +442,8 @@ def _core_sections(props: MassProperties, density_source: str | None, semi,
             rows.append(["note", _e(note)])
         if mesh.repaired and not mesh.notes:
             rows.append(["repaired", _e(", ".join(mesh.repair_actions))])
-        sections.append(HtmlSection(f"Mesh ({mesh.units} coordinates, converted to m)", _table(None, rows),
-                                    "mesh"))
+        sections.append(HtmlSection(f"Mesh ({mesh.units} coordinates, converted to m)",
+                                    _table(None, rows, text_cols=(1,)), "mesh"))   # values are text: wrap
     return sections
 
 

@@ -155,9 +155,13 @@ def face_count_text(mesh: MeshReport) -> str:
     kept = mesh.file_faces - mesh.degenerate_faces
     if mesh.faces == mesh.file_faces:
         return f"{mesh.faces:,} (as in the file)"
-    if mesh.method in ("union", "patched") or mesh.faces > kept:
-        made = "the boolean union's surface" if mesh.method == "union" else "after repair"
+    base_method = mesh.method.split(",", 1)[0]  # "union, inward offset" (a printed part) is still a union
+    if base_method in ("union", "patched") or (mesh.faces > kept and mesh.repaired):
+        made = "the boolean union's surface" if base_method == "union" else "after repair"
         return f"{mesh.faces:,} ({made}; the file has {mesh.file_faces:,})"
+    if mesh.faces > kept:
+        # nothing was repaired, so the extra triangles come from the file's polygons (OBJ/PLY/OFF quads, n-gons)
+        return f"{mesh.faces:,} triangles (the file's {mesh.file_faces:,} polygons split into triangles)"
     parts = [f"{mesh.degenerate_faces:,} degenerate"] if mesh.degenerate_faces else []
     if mesh.faces < kept:
         parts.append(f"{kept - mesh.faces:,} left out: see the notes")
