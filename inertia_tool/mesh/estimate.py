@@ -477,6 +477,100 @@ def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: f
     return marked
 
 
+#: Largest cone cap (triangles) for which :func:`_closed_part_numbers` is tried; beyond it (a soup whose
+#: boundary is most of its edges) every free cell is evaluated.
+CAP_FACES_LIMIT = 20000
+#: Most boundary components for which the cells' distances to every cap are bounded one cap at a time.
+CAP_LOOPS_LIMIT = 512
+
+
+def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, centres: np.ndarray, crossed: np.ndarray,
+                         lo: np.ndarray, h: float, dims: tuple[int, ...], *, fast: bool, margin: float
+                         ) -> tuple[np.ndarray, np.ndarray] | None:
+    """Winding numbers of the cells far from the surface's holes without evaluating them one by one.
+
+    Close the surface ``S`` by a cone ``C`` over each component of its boundary (apex at the centroid of the
+    component's vertices; a component of the net boundary is balanced at every vertex, so the cone over it
+    has exactly that boundary, reversed).  ``S + C`` is a cycle, so its winding number is an integer,
+    constant on each connected region of space it does not meet, and ``w_S = w_{S+C} − w_C``.  Cells that
+    neither ``S`` nor ``C`` crosses are grouped into face-connected regions (two such neighbouring cubes
+    form a box that meets neither surface); ``w_{S+C}`` is found once per region, at one cell, from
+    ``w_S + w_C`` rounded (refused, returning None, when that is more than 1/4 from an integer).  A triangle
+    of area ``a`` at distance at least ``s`` subtends a solid angle of at most ``a/s²``; each cone lies in the
+    ball enclosing its rim (:func:`enclosing_balls`: the apex is in the rim's convex hull), so at a cell at
+    distance ``s`` from the ball ``|w_C| ≤ A_C / (4π s²)``.  Where the sum of these bounds over the cones is
+    below ``margin`` (= ``min(w_low, 1 − w_high)``), the cell's ``w`` lies within ``margin`` of the region's
+    integer and every threshold of :func:`winding_estimate` decides it as the exact value would: it is
+    *settled* with that integer.  Every other free cell is left to the caller to evaluate.
+
+    Returns
+    -------
+    settled : (cells,) bool
+        Cells given a value here.
+    value : (cells,) float
+        The integer of each settled cell's region (0 elsewhere).
+    None
+        When the caps are too large to help or a region's integer is uncertain.
+    """
+    from scipy import ndimage
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from .winding import winding_numbers
+
+    v, f = vertices, faces
+    edges = boundary_edges(f, len(v))
+    if len(edges) > CAP_FACES_LIMIT:
+        return None
+    if len(edges):
+        n = len(v)
+        graph = coo_matrix((np.ones(len(edges), dtype=np.int8), (edges[:, 0], edges[:, 1])), shape=(n, n))
+        _, vertex_label = connected_components(graph, directed=False)
+        _, label = np.unique(vertex_label[edges[:, 0]], return_inverse=True)
+        label = label.reshape(-1)
+        n_loops = int(label.max()) + 1
+        if n_loops > CAP_LOOPS_LIMIT:
+            return None
+        pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
+        size = np.bincount(pairs[:, 0], minlength=n_loops)
+        apex = np.stack([np.bincount(pairs[:, 0], weights=v[pairs[:, 1], i], minlength=n_loops)
+                         for i in range(3)], axis=1) / size[:, None]
+        ball_centre, ball_radius = enclosing_balls(v[pairs[:, 1]], pairs[:, 0], n_loops)
+        cap_v = np.vstack([v, apex])
+        cap_f = np.stack([edges[:, 1], edges[:, 0], n + label], axis=1)
+        ca, cb, cc = cap_v[cap_f[:, 0]], cap_v[cap_f[:, 1]], cap_v[cap_f[:, 2]]
+        cap_area = np.bincount(label, weights=0.5 * np.linalg.norm(np.cross(cb - ca, cc - ca), axis=1),
+                               minlength=n_loops)
+        on_cap = _surface_cells(cap_v, cap_f, lo, h, dims)
+    else:
+        n_loops, on_cap = 0, np.zeros(len(centres), dtype=bool)
+    open_cells = ~crossed & ~on_cap
+    region, n_regions = ndimage.label(open_cells.reshape(dims))
+    region = region.reshape(-1)
+    value = np.zeros(len(centres))
+    settled = np.zeros(len(centres), dtype=bool)
+    if n_regions == 0:
+        return settled, value
+    _, first = np.unique(region, return_index=True)
+    first = first[1:] if region[first[0]] == 0 else first           # one cell of each region (0 = none)
+    w_s = winding_numbers(centres[first], v, f, fast=fast)
+    w_c = winding_numbers(centres[first], cap_v, cap_f, fast=False) if n_loops else np.zeros(len(first))
+    total = w_s + w_c
+    whole = np.round(total)
+    if np.any(np.abs(total - whole) > 0.25):
+        return None
+    cells = np.flatnonzero(open_cells)
+    bound = np.zeros(len(cells))
+    for i in range(n_loops):
+        gap = np.linalg.norm(centres[cells] - ball_centre[i], axis=1) - ball_radius[i]
+        with np.errstate(divide="ignore"):
+            bound += np.where(gap > 0, cap_area[i] / (4 * np.pi * np.maximum(gap, 0.0) ** 2), np.inf)
+    ok = cells[bound < margin]
+    value[ok] = whole[region[ok] - 1]
+    settled[ok] = True
+    return settled, value
+
+
 def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64, w_low: float = 0.1,
                      w_high: float = 0.9, fast: bool | None = None, tolerance: float = 2e-3) -> Estimate:
     """Material where the generalized winding number exceeds 1/2, on a grid, with the doubtful cells as bounds.
@@ -517,7 +611,15 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
     w = np.full(len(centres), 0.5)                  # cells the surface crosses: half material, half in doubt
     err = np.zeros(len(centres))
     free = np.flatnonzero(~crossed)
-    if use_igl:
+    known = _closed_part_numbers(v, f, centres, crossed, lo, h, dims, fast=use_igl,
+                                 margin=min(w_low, 1.0 - w_high)) if use_igl else None
+    if known is not None:
+        # cells far from every cap take the integer of their component; the others are evaluated
+        settled, value = known
+        w[free] = value[free]
+        ask = free[~settled[free]]
+        w[ask] = winding_numbers(centres[ask], v, f, fast=True)
+    elif use_igl:
         w[free] = winding_numbers(centres[free], v, f, fast=True)
     else:
         w[free], err[free] = winding_numbers_bounded(centres[free], v, f, tolerance=tolerance)
