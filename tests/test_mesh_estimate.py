@@ -240,3 +240,61 @@ def test_random_triangle_soup_is_refused_with_its_reason():
     f = np.arange(90).reshape(-1, 3)
     with pytest.raises(InvalidMeshError, match="(cannot be bounded usefully|encloses)"):
         mass_properties((v, f), repair=True)
+
+
+def _open_and_self_crossing_cases():
+    s = trimesh.creation.icosphere(3)
+    v, f = np.asarray(s.vertices), np.asarray(s.faces)
+    keep = v[f].mean(axis=1)[:, 2] < 0.93                      # a cap cut away: one hole
+    a = trimesh.creation.box((1.0, 1.0, 1.0))
+    b = trimesh.creation.box((1.0, 1.0, 1.0))
+    b.apply_translation((0.4, 0.3, 0.2))                         # two closed boxes passing through each other
+    both_v = np.vstack([a.vertices, b.vertices])
+    both_f = np.vstack([a.faces, b.faces + len(a.vertices)])
+    torn = trimesh.creation.torus(1.0, 0.4)
+    tv, tf = np.asarray(torn.vertices), np.asarray(torn.faces)
+    cut = tv[tf].mean(axis=1)
+    holes = (np.linalg.norm(cut - (1.4, 0, 0), axis=1) < 0.15) | (np.linalg.norm(cut - (0, -1.0, 0.4), axis=1) < 0.15)
+    return [(v, f[keep]), (both_v, both_f), (tv, tf[~holes])]
+
+
+@pytest.mark.parametrize("case", range(3))
+def test_cells_settled_by_their_region_classify_as_the_exact_winding_number(case):
+    """Regression (issue 23 item 6, UR5e speed): cells far from every hole take the integer winding number of
+    their region instead of an evaluation; each must fall on the same side of 0.1, 0.5 and 0.9 as the exact
+    direct sum (an independent evaluation) there."""
+    from inertia_tool.mesh.estimate import _closed_part_numbers, _surface_cells
+    v, f = _open_and_self_crossing_cases()[case]
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    h = float(np.max(hi - lo)) / 20
+    lo = lo - h
+    dims = tuple(int(x) for x in np.ceil((hi + h - lo) / h).astype(np.int64))
+    axes = [lo[i] + h * (np.arange(dims[i]) + 0.5) for i in range(3)]
+    centres = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    crossed = _surface_cells(v, f, lo, h, dims)
+    found = _closed_part_numbers(v, f, centres, crossed, lo, h, dims, fast=False, margin=0.1)
+    assert found is not None
+    settled, value = found
+    assert settled.sum() > 0.3 * (~crossed).sum()              # the shortcut does its job
+    exact = winding_numbers(centres[settled], v, f, fast=False)
+    got = value[settled]
+    for t in (0.1, 0.5, 0.9):
+        assert np.array_equal(exact > t, got > t)
+    assert np.all(np.abs(exact - got) < 0.1)
+
+
+def test_winding_estimate_with_and_without_the_region_shortcut_agree(monkeypatch):
+    import inertia_tool.mesh.estimate as est
+    if not est.TREECODE_RESOLUTION:
+        pytest.skip("no grid")
+    from inertia_tool.mesh.winding import fast_available
+    if not fast_available():
+        pytest.skip("libigl not installed: the shortcut is used only with it")
+    for v, f in _open_and_self_crossing_cases():
+        fast = winding_estimate(v, f, resolution=24)
+        monkeypatch.setattr(est, "_closed_part_numbers", lambda *a, **k: None)
+        slow = winding_estimate(v, f, resolution=24)
+        monkeypatch.undo()
+        assert fast.volume == pytest.approx(slow.volume, rel=1e-12)
+        assert fast.uncertainty.mass == pytest.approx(slow.uncertainty.mass, rel=1e-12)
+        assert np.allclose(fast.centroid, slow.centroid, atol=1e-12)
