@@ -455,12 +455,16 @@ def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: f
     v = vertices
     a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
     delta = spacing * h
+    if 2 * delta > h:
+        raise ValueError(f"expected a sample spacing of at most half a cell, got {spacing}")
     longest = np.max(np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
                                np.linalg.norm(a - c, axis=1)]), axis=0)
     steps = np.maximum(1, np.ceil(longest / delta).astype(np.int64))
     limit = np.array(dims) - 1
-    marked = np.zeros(int(np.prod(dims)), dtype=bool)
-    offsets = delta * np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
+    # the cell of each cube's lowest corner; the cube (side 2δ ≤ h) reaches at most one cell further along
+    # each axis, so marking those cells and then each marked cell's 7 upper neighbours covers every cell
+    # the cube touches (a superset only where a cube ends exactly on a cell face)
+    low = np.zeros(int(np.prod(dims)), dtype=bool)
     for n in np.unique(steps):
         sel = np.flatnonzero(steps == n)
         i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
@@ -471,9 +475,15 @@ def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: f
             ids = sel[k:k + per]
             pts = (a[ids, None] * (1 - s - t)[None, :, None] + b[ids, None] * s[None, :, None]
                    + c[ids, None] * t[None, :, None]).reshape(-1, 3)
-            for off in offsets:
-                idx = np.clip(np.floor((pts + off - lo) / h).astype(np.int64), 0, limit)
-                marked[np.ravel_multi_index(idx.T, dims)] = True
+            idx = np.minimum(np.maximum(np.floor((pts - (lo + delta)) / h).astype(np.int64), 0), limit)
+            low[(idx[:, 0] * dims[1] + idx[:, 1]) * dims[2] + idx[:, 2]] = True
+    grid = low.reshape(dims)
+    for axis in range(3):
+        ahead = [slice(None)] * 3
+        behind = [slice(None)] * 3
+        ahead[axis], behind[axis] = slice(1, None), slice(None, -1)
+        grid[tuple(ahead)] |= grid[tuple(behind)]
+    marked: np.ndarray = grid.reshape(-1)
     return marked
 
 
