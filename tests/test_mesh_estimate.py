@@ -298,3 +298,26 @@ def test_winding_estimate_with_and_without_the_region_shortcut_agree(monkeypatch
         assert fast.volume == pytest.approx(slow.volume, rel=1e-12)
         assert fast.uncertainty.mass == pytest.approx(slow.uncertainty.mass, rel=1e-12)
         assert np.allclose(fast.centroid, slow.centroid, atol=1e-12)
+
+
+@pytest.mark.parametrize("resolution", [7, 20])
+def test_surface_cells_hold_every_surface_point(resolution):
+    """Every cell holding a point of the surface is marked (brute force: 200,000 random points of the faces)."""
+    from inertia_tool.mesh.estimate import _surface_cells
+    rng = np.random.default_rng(resolution)
+    m = trimesh.creation.torus(1.0, 0.35)
+    v, f = np.asarray(m.vertices) @ trimesh.transformations.random_rotation_matrix(rng.random(3))[:3, :3].T, \
+        np.asarray(m.faces)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    h = float(np.max(hi - lo)) / resolution
+    lo = lo - h
+    dims = tuple(int(x) for x in np.ceil((hi + h - lo) / h).astype(np.int64))
+    marked = _surface_cells(v, f, lo, h, dims)
+    r = rng.random((200_000, 2))
+    r = np.where(r.sum(axis=1, keepdims=True) > 1, 1 - r, r)
+    face = rng.integers(0, len(f), len(r))
+    a, b, c = v[f[face, 0]], v[f[face, 1]], v[f[face, 2]]
+    pts = a + r[:, :1] * (b - a) + r[:, 1:] * (c - a)
+    idx = np.floor((pts - lo) / h).astype(np.int64)
+    assert marked[np.ravel_multi_index(idx.T, dims)].all()
+    assert marked.sum() < 0.6 * marked.size                   # and not everything
