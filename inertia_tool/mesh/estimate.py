@@ -20,7 +20,10 @@ answer is an estimate with bounds.  Two estimators, each returning moments and a
   cubes.  Cells that the surface passes through count as half material, half of their volume in doubt
   (their true share lies between 0 and 1; ``w`` is not evaluated there); cells whose ``w`` is ambiguous
   (between ``w_low`` and ``w_high``, or whose evaluation error bound could cross 1/2) could go either way;
-  their volume bounds the discretization error.
+  their volume bounds the discretization error.  With libigl, ``w`` is evaluated only at cells near a hole:
+  elsewhere it is the integer winding number of the surface closed by cones over its holes, constant on each
+  region of cells no surface crosses, less the cones' share, which a distance bound keeps below the margin
+  of every threshold (:func:`_closed_part_numbers`), so those cells are decided as the exact ``w`` would be.
 
 An estimate whose bound is not finite, or whose mass bound exceeds ``ESTIMATE_MAX_MASS_RTOL`` (50 %), or
 that encloses no positive volume, is refused (:func:`check_useful`): a printed mass "within ±297 %" helps
