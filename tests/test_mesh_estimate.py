@@ -290,7 +290,10 @@ def test_winding_estimate_with_and_without_the_region_shortcut_agree(monkeypatch
     from inertia_tool.mesh.winding import fast_available
     if not fast_available():
         pytest.skip("libigl not installed: the shortcut is used only with it")
-    for v, f in _open_and_self_crossing_cases():
+    s = trimesh.creation.icosphere(4)
+    scattered = np.random.default_rng(5).choice(len(s.faces), 200, replace=False)   # 200 one-face holes
+    cases = _open_and_self_crossing_cases() + [(np.asarray(s.vertices), np.delete(np.asarray(s.faces), scattered, 0))]
+    for v, f in cases:
         fast = winding_estimate(v, f, resolution=24)
         monkeypatch.setattr(est, "_closed_part_numbers", lambda *a, **k: None)
         slow = winding_estimate(v, f, resolution=24)

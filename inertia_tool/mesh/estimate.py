@@ -493,8 +493,26 @@ def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: f
 #: Largest cone cap (triangles) for which :func:`_closed_part_numbers` is tried; beyond it (a soup whose
 #: boundary is most of its edges) every free cell is evaluated.
 CAP_FACES_LIMIT = 20000
-#: Most boundary components for which the cells' distances to every cap are bounded one cap at a time.
+#: Most boundary components for which the cells' distances to every cap are bounded.
 CAP_LOOPS_LIMIT = 512
+#: Most (cell, cap) pairs bounded one by one; cells beyond it are evaluated instead.
+CAP_BOUND_WORK = 20_000_000
+
+
+def _cap_bound(points: np.ndarray, reach: float, ball_centre: np.ndarray, ball_radius: np.ndarray,
+               cap_area: np.ndarray) -> np.ndarray:
+    """(p,) bound on ``|w_C|`` at every point within ``reach`` m of each of ``points``: Σ over the cones of
+    ``A / (4π s²)``, ``s`` the distance from the point to the cone's ball less ``reach`` (∞ where s ≤ 0)."""
+    bound = np.zeros(len(points))
+    per = max(1, (1 << 22) // max(len(points), 1))
+    for k in range(0, len(ball_radius), per):
+        delta = points[:, None, :] - ball_centre[None, k:k + per, :]
+        gap = np.sqrt(np.einsum("pki,pki->pk", delta, delta)) - ball_radius[None, k:k + per] - reach
+        with np.errstate(divide="ignore"):
+            share = np.where(gap > 0, cap_area[None, k:k + per] / (4 * np.pi * np.maximum(gap, 1e-300) ** 2),
+                             np.inf)
+        bound += share.sum(axis=1)
+    return bound
 
 
 def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, centres: np.ndarray, crossed: np.ndarray,
@@ -573,12 +591,21 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, centres: np.nd
     if np.any(np.abs(total - whole) > 0.25):
         return None
     cells = np.flatnonzero(open_cells)
-    bound = np.zeros(len(cells))
-    for i in range(n_loops):
-        gap = np.linalg.norm(centres[cells] - ball_centre[i], axis=1) - ball_radius[i]
-        with np.errstate(divide="ignore"):
-            bound += np.where(gap > 0, cap_area[i] / (4 * np.pi * np.maximum(gap, 0.0) ** 2), np.inf)
-    ok = cells[bound < margin]
+    if n_loops:
+        # first per block of 4×4×4 cells (every centre within 1.5·√3·h of the block's), then cell by cell
+        # where the block's bound is not enough and the work stays within CAP_BOUND_WORK
+        nb = tuple(-(-d // 4) for d in dims)
+        blocks = np.stack(np.meshgrid(*[np.arange(m) for m in nb], indexing="ij"), axis=-1).reshape(-1, 3)
+        block_bound = _cap_bound(lo + h * (4 * blocks + 2), 1.5 * np.sqrt(3) * h, ball_centre, ball_radius,
+                                 cap_area)
+        i, j, k = np.unravel_index(cells, dims)
+        fine = block_bound[((i // 4) * nb[1] + j // 4) * nb[2] + k // 4] < margin
+        rest = np.flatnonzero(~fine)
+        if len(rest) * n_loops <= CAP_BOUND_WORK:
+            fine[rest] = _cap_bound(centres[cells[rest]], 0.0, ball_centre, ball_radius, cap_area) < margin
+        ok = cells[fine]
+    else:
+        ok = cells
     value[ok] = whole[region[ok] - 1]
     settled[ok] = True
     return settled, value
