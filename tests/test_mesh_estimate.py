@@ -240,3 +240,121 @@ def test_random_triangle_soup_is_refused_with_its_reason():
     f = np.arange(90).reshape(-1, 3)
     with pytest.raises(InvalidMeshError, match="(cannot be bounded usefully|encloses)"):
         mass_properties((v, f), repair=True)
+
+
+def _open_and_self_crossing_cases():
+    s = trimesh.creation.icosphere(3)
+    v, f = np.asarray(s.vertices), np.asarray(s.faces)
+    keep = v[f].mean(axis=1)[:, 2] < 0.93                      # a cap cut away: one hole
+    a = trimesh.creation.box((1.0, 1.0, 1.0))
+    b = trimesh.creation.box((1.0, 1.0, 1.0))
+    b.apply_translation((0.4, 0.3, 0.2))                         # two closed boxes passing through each other
+    both_v = np.vstack([a.vertices, b.vertices])
+    both_f = np.vstack([a.faces, b.faces + len(a.vertices)])
+    torn = trimesh.creation.torus(1.0, 0.4)
+    tv, tf = np.asarray(torn.vertices), np.asarray(torn.faces)
+    cut = tv[tf].mean(axis=1)
+    holes = (np.linalg.norm(cut - (1.4, 0, 0), axis=1) < 0.15) | (np.linalg.norm(cut - (0, -1.0, 0.4), axis=1) < 0.15)
+    return [(v, f[keep]), (both_v, both_f), (tv, tf[~holes])]
+
+
+@pytest.mark.parametrize("case", range(3))
+def test_cells_settled_by_their_region_classify_as_the_exact_winding_number(case):
+    """Regression (issue 23 item 6, UR5e speed): cells far from every hole take the integer winding number of
+    their region instead of an evaluation; each must fall on the same side of 0.1, 0.5 and 0.9 as the exact
+    direct sum (an independent evaluation) there."""
+    from inertia_tool.mesh.estimate import _closed_part_numbers, _surface_cells
+    v, f = _open_and_self_crossing_cases()[case]
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    h = float(np.max(hi - lo)) / 20
+    lo = lo - h
+    dims = tuple(int(x) for x in np.ceil((hi + h - lo) / h).astype(np.int64))
+    axes = [lo[i] + h * (np.arange(dims[i]) + 0.5) for i in range(3)]
+    centres = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    crossed = _surface_cells(v, f, lo, h, dims)
+    found = _closed_part_numbers(v, f, centres, crossed, lo, h, dims, fast=False, margin=0.1)
+    assert found is not None
+    settled, value = found
+    assert settled.sum() > 0.3 * (~crossed).sum()              # the shortcut does its job
+    exact = winding_numbers(centres[settled], v, f, fast=False)
+    got = value[settled]
+    for t in (0.1, 0.5, 0.9):
+        assert np.array_equal(exact > t, got > t)
+    assert np.all(np.abs(exact - got) < 0.1)
+
+
+def test_winding_estimate_with_and_without_the_region_shortcut_agree(monkeypatch):
+    import inertia_tool.mesh.estimate as est
+    if not est.TREECODE_RESOLUTION:
+        pytest.skip("no grid")
+    from inertia_tool.mesh.winding import fast_available
+    if not fast_available():
+        pytest.skip("libigl not installed: the shortcut is used only with it")
+    s = trimesh.creation.icosphere(4)
+    scattered = np.random.default_rng(5).choice(len(s.faces), 200, replace=False)   # 200 one-face holes
+    cases = _open_and_self_crossing_cases() + [(np.asarray(s.vertices), np.delete(np.asarray(s.faces), scattered, 0))]
+    for v, f in cases:
+        fast = winding_estimate(v, f, resolution=24)
+        monkeypatch.setattr(est, "_closed_part_numbers", lambda *a, **k: None)
+        slow = winding_estimate(v, f, resolution=24)
+        monkeypatch.undo()
+        assert fast.volume == pytest.approx(slow.volume, rel=1e-12)
+        assert fast.uncertainty.mass == pytest.approx(slow.uncertainty.mass, rel=1e-12)
+        assert np.allclose(fast.centroid, slow.centroid, atol=1e-12)
+
+
+@pytest.mark.parametrize("resolution", [7, 20])
+def test_surface_cells_hold_every_surface_point(resolution):
+    """Every cell holding a point of the surface is marked (brute force: 200,000 random points of the faces)."""
+    from inertia_tool.mesh.estimate import _surface_cells
+    rng = np.random.default_rng(resolution)
+    m = trimesh.creation.torus(1.0, 0.35)
+    v, f = np.asarray(m.vertices) @ trimesh.transformations.random_rotation_matrix(rng.random(3))[:3, :3].T, \
+        np.asarray(m.faces)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    h = float(np.max(hi - lo)) / resolution
+    lo = lo - h
+    dims = tuple(int(x) for x in np.ceil((hi + h - lo) / h).astype(np.int64))
+    marked = _surface_cells(v, f, lo, h, dims)
+    r = rng.random((200_000, 2))
+    r = np.where(r.sum(axis=1, keepdims=True) > 1, 1 - r, r)
+    face = rng.integers(0, len(f), len(r))
+    a, b, c = v[f[face, 0]], v[f[face, 1]], v[f[face, 2]]
+    pts = a + r[:, :1] * (b - a) + r[:, 1:] * (c - a)
+    idx = np.floor((pts - lo) / h).astype(np.int64)
+    assert marked[np.ravel_multi_index(idx.T, dims)].all()
+    assert marked.sum() < 0.6 * marked.size                   # and not everything
+
+
+def _union_volume_of_boxes(lows, highs):
+    """Exact volume of a union of axis-aligned boxes by coordinate compression (independent of any mesh code)."""
+    axes = [np.unique(np.r_[lows[:, i], highs[:, i]]) for i in range(3)]
+    mids = np.meshgrid(*[0.5 * (a[1:] + a[:-1]) for a in axes], indexing="ij")
+    sizes = np.einsum("i,j,k->ijk", *[np.diff(a) for a in axes])
+    inside = np.zeros(sizes.shape, dtype=bool)
+    for lo_, hi_ in zip(lows, highs):
+        inside |= np.all([(m > lo_[i]) & (m < hi_[i]) for i, m in enumerate(mids)], axis=0)
+    return float(sizes[inside].sum())
+
+
+@pytest.mark.parametrize("seed", [11, 12, 13])
+def test_winding_estimate_of_boxes_passing_through_each_other_brackets_their_union(seed):
+    """Closed boxes that pass through each other (the forced-estimate path of self-crossing surfaces, as on
+    the UR5e's visual meshes): the solid w > 1/2 is their union, whose volume must lie within the stated bound."""
+    rng = np.random.default_rng(seed)
+    vs, fs, lows, highs, count = [], [], [], [], 0
+    for _ in range(3):
+        size = rng.uniform(0.4, 1.0, 3)
+        centre = rng.uniform(-0.3, 0.3, 3)
+        b = trimesh.creation.box(size)
+        b.apply_translation(centre)
+        vs.append(np.asarray(b.vertices))
+        fs.append(np.asarray(b.faces) + count)
+        count += len(b.vertices)
+        lows.append(centre - size / 2)
+        highs.append(centre + size / 2)
+    v, f = np.vstack(vs), np.vstack(fs)
+    truth = _union_volume_of_boxes(np.array(lows), np.array(highs))
+    est = winding_estimate(v, f, resolution=32)
+    assert abs(est.volume - truth) <= est.uncertainty.mass * est.volume
+    assert est.uncertainty.mass < 0.5

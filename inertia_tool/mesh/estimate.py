@@ -20,7 +20,10 @@ answer is an estimate with bounds.  Two estimators, each returning moments and a
   cubes.  Cells that the surface passes through count as half material, half of their volume in doubt
   (their true share lies between 0 and 1; ``w`` is not evaluated there); cells whose ``w`` is ambiguous
   (between ``w_low`` and ``w_high``, or whose evaluation error bound could cross 1/2) could go either way;
-  their volume bounds the discretization error.
+  their volume bounds the discretization error.  With libigl, ``w`` is evaluated only at cells near a hole:
+  elsewhere it is the integer winding number of the surface closed by cones over its holes, constant on each
+  region of cells no surface crosses, less the cones' share, which a distance bound keeps below the margin
+  of every threshold (:func:`_closed_part_numbers`), so those cells are decided as the exact ``w`` would be.
 
 An estimate whose bound is not finite, or whose mass bound exceeds ``ESTIMATE_MAX_MASS_RTOL`` (50 %), or
 that encloses no positive volume, is refused (:func:`check_useful`): a printed mass "within ±297 %" helps
@@ -455,12 +458,16 @@ def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: f
     v = vertices
     a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
     delta = spacing * h
+    if 2 * delta > h:
+        raise ValueError(f"expected a sample spacing of at most half a cell, got {spacing}")
     longest = np.max(np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
                                np.linalg.norm(a - c, axis=1)]), axis=0)
     steps = np.maximum(1, np.ceil(longest / delta).astype(np.int64))
     limit = np.array(dims) - 1
-    marked = np.zeros(int(np.prod(dims)), dtype=bool)
-    offsets = delta * np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
+    # the cell of each cube's lowest corner; the cube (side 2δ ≤ h) reaches at most one cell further along
+    # each axis, so marking those cells and then each marked cell's 7 upper neighbours covers every cell
+    # the cube touches (a superset only where a cube ends exactly on a cell face)
+    low = np.zeros(int(np.prod(dims)), dtype=bool)
     for n in np.unique(steps):
         sel = np.flatnonzero(steps == n)
         i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
@@ -471,10 +478,137 @@ def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: f
             ids = sel[k:k + per]
             pts = (a[ids, None] * (1 - s - t)[None, :, None] + b[ids, None] * s[None, :, None]
                    + c[ids, None] * t[None, :, None]).reshape(-1, 3)
-            for off in offsets:
-                idx = np.clip(np.floor((pts + off - lo) / h).astype(np.int64), 0, limit)
-                marked[np.ravel_multi_index(idx.T, dims)] = True
+            idx = np.minimum(np.maximum(np.floor((pts - (lo + delta)) / h).astype(np.int64), 0), limit)
+            low[(idx[:, 0] * dims[1] + idx[:, 1]) * dims[2] + idx[:, 2]] = True
+    grid = low.reshape(dims)
+    for axis in range(3):
+        ahead = [slice(None)] * 3
+        behind = [slice(None)] * 3
+        ahead[axis], behind[axis] = slice(1, None), slice(None, -1)
+        grid[tuple(ahead)] |= grid[tuple(behind)]
+    marked: np.ndarray = grid.reshape(-1)
     return marked
+
+
+#: Largest cone cap (triangles) for which :func:`_closed_part_numbers` is tried; beyond it (a soup whose
+#: boundary is most of its edges) every free cell is evaluated.
+CAP_FACES_LIMIT = 20000
+#: Most boundary components for which the cells' distances to every cap are bounded.
+CAP_LOOPS_LIMIT = 512
+#: Most (cell, cap) pairs bounded one by one; cells beyond it are evaluated instead.
+CAP_BOUND_WORK = 20_000_000
+
+
+def _cap_bound(points: np.ndarray, reach: float, ball_centre: np.ndarray, ball_radius: np.ndarray,
+               cap_area: np.ndarray) -> np.ndarray:
+    """(p,) bound on ``|w_C|`` at every point within ``reach`` m of each of ``points``: Σ over the cones of
+    ``A / (4π s²)``, ``s`` the distance from the point to the cone's ball less ``reach`` (∞ where s ≤ 0)."""
+    bound = np.zeros(len(points))
+    per = max(1, (1 << 22) // max(len(points), 1))
+    for k in range(0, len(ball_radius), per):
+        delta = points[:, None, :] - ball_centre[None, k:k + per, :]
+        gap = np.sqrt(np.einsum("pki,pki->pk", delta, delta)) - ball_radius[None, k:k + per] - reach
+        with np.errstate(divide="ignore"):
+            share = np.where(gap > 0, cap_area[None, k:k + per] / (4 * np.pi * np.maximum(gap, 1e-300) ** 2),
+                             np.inf)
+        bound += share.sum(axis=1)
+    return bound
+
+
+def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, centres: np.ndarray, crossed: np.ndarray,
+                         lo: np.ndarray, h: float, dims: tuple[int, ...], *, fast: bool, margin: float
+                         ) -> tuple[np.ndarray, np.ndarray] | None:
+    """Winding numbers of the cells far from the surface's holes without evaluating them one by one.
+
+    Close the surface ``S`` by a cone ``C`` over each component of its boundary (apex at the centroid of the
+    component's vertices; a component of the net boundary is balanced at every vertex, so the cone over it
+    has exactly that boundary, reversed).  ``S + C`` is a cycle, so its winding number is an integer,
+    constant on each connected region of space it does not meet, and ``w_S = w_{S+C} − w_C``.  Cells that
+    neither ``S`` nor ``C`` crosses are grouped into face-connected regions (two such neighbouring cubes
+    form a box that meets neither surface); ``w_{S+C}`` is found once per region, at one cell, from
+    ``w_S + w_C`` rounded (refused, returning None, when that is more than 1/4 from an integer).  A triangle
+    of area ``a`` at distance at least ``s`` subtends a solid angle of at most ``a/s²``; each cone lies in the
+    ball enclosing its rim (:func:`enclosing_balls`: the apex is in the rim's convex hull), so at a cell at
+    distance ``s`` from the ball ``|w_C| ≤ A_C / (4π s²)``.  Where the sum of these bounds over the cones is
+    below ``margin`` (= ``min(w_low, 1 − w_high)``), the cell's ``w`` lies within ``margin`` of the region's
+    integer and every threshold of :func:`winding_estimate` decides it as the exact value would: it is
+    *settled* with that integer.  Every other free cell is left to the caller to evaluate.
+
+    Returns
+    -------
+    settled : (cells,) bool
+        Cells given a value here.
+    value : (cells,) float
+        The integer of each settled cell's region (0 elsewhere).
+    None
+        When the caps are too large to help or a region's integer is uncertain.
+    """
+    from scipy import ndimage
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from .winding import winding_numbers
+
+    v, f = vertices, faces
+    edges = boundary_edges(f, len(v))
+    if len(edges) > CAP_FACES_LIMIT:
+        return None
+    if len(edges):
+        n = len(v)
+        graph = coo_matrix((np.ones(len(edges), dtype=np.int8), (edges[:, 0], edges[:, 1])), shape=(n, n))
+        _, vertex_label = connected_components(graph, directed=False)
+        _, label = np.unique(vertex_label[edges[:, 0]], return_inverse=True)
+        label = label.reshape(-1)
+        n_loops = int(label.max()) + 1
+        if n_loops > CAP_LOOPS_LIMIT:
+            return None
+        pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
+        size = np.bincount(pairs[:, 0], minlength=n_loops)
+        apex = np.stack([np.bincount(pairs[:, 0], weights=v[pairs[:, 1], i], minlength=n_loops)
+                         for i in range(3)], axis=1) / size[:, None]
+        ball_centre, ball_radius = enclosing_balls(v[pairs[:, 1]], pairs[:, 0], n_loops)
+        cap_v = np.vstack([v, apex])
+        cap_f = np.stack([edges[:, 1], edges[:, 0], n + label], axis=1)
+        ca, cb, cc = cap_v[cap_f[:, 0]], cap_v[cap_f[:, 1]], cap_v[cap_f[:, 2]]
+        cap_area = np.bincount(label, weights=0.5 * np.linalg.norm(np.cross(cb - ca, cc - ca), axis=1),
+                               minlength=n_loops)
+        on_cap = _surface_cells(cap_v, cap_f, lo, h, dims)
+    else:
+        n_loops, on_cap = 0, np.zeros(len(centres), dtype=bool)
+    open_cells = ~crossed & ~on_cap
+    region, n_regions = ndimage.label(open_cells.reshape(dims))
+    region = region.reshape(-1)
+    value = np.zeros(len(centres))
+    settled = np.zeros(len(centres), dtype=bool)
+    if n_regions == 0:
+        return settled, value
+    _, first = np.unique(region, return_index=True)
+    first = first[1:] if region[first[0]] == 0 else first           # one cell of each region (0 = none)
+    w_s = winding_numbers(centres[first], v, f, fast=fast)
+    w_c = winding_numbers(centres[first], cap_v, cap_f, fast=False) if n_loops else np.zeros(len(first))
+    total = w_s + w_c
+    whole = np.round(total)
+    if np.any(np.abs(total - whole) > 0.25):
+        return None
+    cells = np.flatnonzero(open_cells)
+    if n_loops:
+        # first per block of 4×4×4 cells (every centre within 1.5·√3·h of the block's), then cell by cell
+        # where the block's bound is not enough and the work stays within CAP_BOUND_WORK
+        nb = tuple(-(-d // 4) for d in dims)
+        blocks = np.stack(np.meshgrid(*[np.arange(m) for m in nb], indexing="ij"), axis=-1).reshape(-1, 3)
+        block_bound = _cap_bound(lo + h * (4 * blocks + 2), 1.5 * np.sqrt(3) * h, ball_centre, ball_radius,
+                                 cap_area)
+        i, j, k = np.unravel_index(cells, dims)
+        fine = block_bound[((i // 4) * nb[1] + j // 4) * nb[2] + k // 4] < margin
+        rest = np.flatnonzero(~fine)
+        if len(rest) * n_loops <= CAP_BOUND_WORK:
+            fine[rest] = _cap_bound(centres[cells[rest]], 0.0, ball_centre, ball_radius, cap_area) < margin
+        ok = cells[fine]
+    else:
+        ok = cells
+    value[ok] = whole[region[ok] - 1]
+    settled[ok] = True
+    return settled, value
 
 
 def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64, w_low: float = 0.1,
@@ -517,7 +651,15 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
     w = np.full(len(centres), 0.5)                  # cells the surface crosses: half material, half in doubt
     err = np.zeros(len(centres))
     free = np.flatnonzero(~crossed)
-    if use_igl:
+    known = _closed_part_numbers(v, f, centres, crossed, lo, h, dims, fast=use_igl,
+                                 margin=min(w_low, 1.0 - w_high)) if use_igl else None
+    if known is not None:
+        # cells far from every cap take the integer of their component; the others are evaluated
+        settled, value = known
+        w[free] = value[free]
+        ask = free[~settled[free]]
+        w[ask] = winding_numbers(centres[ask], v, f, fast=True)
+    elif use_igl:
         w[free] = winding_numbers(centres[free], v, f, fast=True)
     else:
         w[free], err[free] = winding_numbers_bounded(centres[free], v, f, tolerance=tolerance)
