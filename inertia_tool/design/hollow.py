@@ -366,10 +366,13 @@ def _too_thin(name: str, grid, wall: float, extent: float, resolution: int, *, c
 
 
 def _warn_pivot_off_part(name: str, pivot: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
-                         tree: SurfaceTree, extent: float) -> None:
+                         tree: SurfaceTree, extent: float, units: str | None = None) -> None:
     """``PivotOffPartWarning`` when a top's pivot lies outside the part, farther than ``PIVOT_GAP_RTOL`` of its
-    largest extent from the surface (inside: the generalized winding number above one half)."""
+    largest extent from the surface (inside: the generalized winding number above one half).  Lengths in the
+    message are in ``units`` (the user's, as the pivot was given), metres without."""
     import igl
+
+    from ..units import length_scale
 
     gap = float(np.sqrt(tree.squared_distance(np.asarray(pivot, dtype=np.float64)[None, :])[0]))
     if gap <= PIVOT_GAP_RTOL * extent:
@@ -377,11 +380,17 @@ def _warn_pivot_off_part(name: str, pivot: np.ndarray, vertices: np.ndarray, fac
     winding = igl.fast_winding_number(tree.vertices, tree.faces, np.asarray(pivot, dtype=np.float64)[None, :])
     if float(np.asarray(winding).reshape(-1)[0]) > 0.5:
         return
-    p = ", ".join(f"{c:.6g}" for c in pivot)
+    unit, scale = "m", 1.0
+    if units:
+        try:
+            unit, scale = str(units), length_scale(units)
+        except ValueError:          # an unknown unit was refused where it was given; metres here
+            pass
+    p = ", ".join(f"{c / scale:.6g}" for c in pivot)
     warnings.warn(PivotOffPartWarning(
-        f"{name}: the pivot ({p}) m lies in empty space, {gap:.3g} m from the part's surface ({gap / extent:.1%} "
-        f"of its {extent:.3g} m extent): a top stands on a point of its own surface; check --pivot and --units "
-        "(designed as asked)"), stacklevel=3)
+        f"{name}: the pivot ({p}) {unit} lies in empty space, {gap / scale:.3g} {unit} from the part's surface "
+        f"({gap / extent:.1%} of its {extent / scale:.3g} {unit} extent): a top stands on a point of its own "
+        "surface; check --pivot and --units (designed as asked)"), stacklevel=3)
 
 
 def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivot=None, units: str | None = None,
@@ -472,7 +481,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     h = extent / resolution
     tree = SurfaceTree(vertices, faces)
     if mode == "top":
-        _warn_pivot_off_part(name, pivot, vertices, faces, tree, extent)
+        _warn_pivot_off_part(name, pivot, vertices, faces, tree, extent, units)
     # depths matter up to the deepest cavity threshold (wall + margins) plus the smooth minimum's reach
     grid = interior_grid(vertices, faces, spacing=h, depth_cap=wall + DEPTH_CAP_CELLS * h)
     grid = _exact_near_wall(grid, vertices, faces, wall, tree)
