@@ -171,7 +171,7 @@ def disagreement(ours: dict, theirs: dict, diag: float) -> tuple[float, float, f
             float(np.linalg.norm(ti - ii) / np.linalg.norm(ii)))
 
 
-def plot(rows: list[dict], out: str) -> None:
+def plot(rows: list[dict], out: str, load: tuple[float, float]) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -190,7 +190,8 @@ def plot(rows: list[dict], out: str) -> None:
     for ax in (ax_t, ax_c):
         ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=8)
-    fig.suptitle("Binary STL tori, one run, load average ~10-20 on 2 CPUs; inertia_tool runs every check of its "
+    fig.suptitle(f"Binary STL tori, one run, load average {load[0]:.1f} before, {load[1]:.1f} after on "
+                 f"{os.cpu_count()} CPUs\ninertia_tool runs every check of its "
                  "certificate, numpy-stl a closedness check, trimesh and MuJoCo none", fontsize=9)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
@@ -267,7 +268,7 @@ def main() -> None:
         for key in ("total", "cpu", "compute", "cpu_compute"):
             print(table(saved["rows"], tuple(saved["load"]), key=key), end="\n\n")
         if args.plot:
-            plot(saved["rows"], args.plot)
+            plot(saved["rows"], args.plot, tuple(saved["load"]))
         return
     limits = {k: float(v) for k, v in (item.rsplit("=", 1) for item in args.limit)}
     load_before = os.getloadavg()[0]
@@ -330,7 +331,7 @@ def main() -> None:
         with open(args.json, "w") as fh:
             json.dump({"rows": rows, "load": [load_before, load_after]}, fh, indent=1)
     if args.plot:
-        plot(rows, args.plot)
+        plot(rows, args.plot, (load_before, load_after))
         print(f"\nwrote {args.plot}")
 
 
