@@ -1746,6 +1746,16 @@ PyInit__accel(void)
         Py_DECREF(mod);
         return NULL;
     }
+#ifdef ACCEL_SOURCE_CRC
+    /* CRC-32 of this file as it was compiled (setup.py passes it): _native.accel() compares it with the
+     * _accel.c beside the package, so a stale build in a source checkout is set aside, not called */
+    PyObject *crc = PyLong_FromUnsignedLong((unsigned long)(ACCEL_SOURCE_CRC));
+    if (crc == NULL || PyModule_AddObject(mod, "SOURCE_CRC", crc) < 0) {
+        Py_XDECREF(crc);
+        Py_DECREF(mod);
+        return NULL;
+    }
+#endif
     return mod;
 }
 

@@ -17,6 +17,8 @@ on the thread count: only the speed does.  The weld and the shell labels run on 
 from __future__ import annotations
 
 import os
+import warnings
+import zlib
 from types import ModuleType
 
 import numpy as np
@@ -44,8 +46,32 @@ def accel() -> ModuleType | None:
             from . import _accel
         except ImportError:
             _accel = None
+        if _accel is not None and not _matches_source(_accel):
+            warnings.warn("inertia_tool._accel was built from another _accel.c than the one beside it (a source "
+                          "checkout updated without a rebuild; rebuild with `pip install -e .`): the C kernels are "
+                          "set aside and the pure-numpy path is used (the same results, slower)", RuntimeWarning,
+                          stacklevel=2)
+            _accel = None
         _MODULE.append(_accel)
     return _MODULE[0]
+
+
+def _source_crc() -> int | None:
+    """CRC-32 of the ``_accel.c`` beside this package (a source checkout), None where it is not installed."""
+    try:
+        with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "_accel.c"), "rb") as f:
+            return zlib.crc32(f.read())
+    except OSError:
+        return None
+
+
+def _matches_source(module: ModuleType) -> bool:
+    """False only when both the build's ``SOURCE_CRC`` and the source beside it are known and differ."""
+    built = getattr(module, "SOURCE_CRC", None)
+    if built is None:
+        return True
+    source = _source_crc()
+    return source is None or int(built) == source
 
 
 def threads() -> int:

@@ -51,6 +51,38 @@ def test_ci_builds_the_extension():
     assert _native.accel() is not None
 
 
+def test_ci_build_carries_the_crc_of_its_source():
+    """setup.py compiles the CRC-32 of _accel.c in; under CI it must equal the source's, so the check below runs."""
+    if not REQUIRE_ACCEL:
+        pytest.skip("INERTIA_TOOL_REQUIRE_ACCEL is not set")
+    module = _native.accel()
+    assert module is not None and int(module.SOURCE_CRC) == _native._source_crc()
+
+
+def test_a_build_of_another_source_is_set_aside_with_a_warning(monkeypatch):
+    """A source checkout updated without a rebuild: the stale extension is not called (its kernels' arguments may
+    have changed: every file failed with a TypeError), the numpy path answers, and a warning says to rebuild."""
+    class Stale:
+        SOURCE_CRC = 12345
+
+    monkeypatch.setattr(_native, "_source_crc", lambda: 54321)
+    assert not _native._matches_source(Stale())
+    monkeypatch.setattr(_native, "_source_crc", lambda: 12345)
+    assert _native._matches_source(Stale())
+    monkeypatch.setattr(_native, "_source_crc", lambda: None)      # installed without its source: no check
+    assert _native._matches_source(Stale())
+    assert _native._matches_source(object())                       # built without the CRC: no check
+    if not HAVE_ACCEL:
+        return
+    monkeypatch.setattr(_native, "_source_crc", lambda: -1)
+    monkeypatch.setattr(_native, "_MODULE", [])
+    with pytest.warns(RuntimeWarning, match="rebuild"):
+        assert _native.accel() is None
+    v, f = box_arrays()
+    before = volume_moments(v, f)                                  # answered on the numpy path
+    assert before.volume == pytest.approx(np.prod(np.ptp(v, axis=0)), rel=1e-12)
+
+
 def _soup(seed=0):
     """Corners of an icosphere with shuffled faces, -0.0 at some zero coordinates, and a detached tetrahedron."""
     m = trimesh.creation.icosphere(subdivisions=4, radius=2.0)
