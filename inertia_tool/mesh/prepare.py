@@ -129,7 +129,7 @@ def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
 def _check_magnitude(lo: np.ndarray, hi: np.ndarray, source: str) -> None:
     """Refuse coordinates (bounding box ``lo``, ``hi``) whose volume integrals (∝ L⁵) would overflow or underflow
     float64."""
-    top = float(np.max(np.abs(np.r_[lo, hi])))    # = max |coordinate| (NaN propagates)
+    top = float(np.max(np.abs(np.concatenate((lo, hi)))))    # = max |coordinate| (NaN propagates)
     if not top <= MAX_COORDINATE:
         raise InvalidMeshError(f"{source}: coordinates reach {top:.3g} m, beyond the ±{MAX_COORDINATE:g} m the "
                                "volume integrals can hold without overflow (check the length `units`)")
