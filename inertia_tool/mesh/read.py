@@ -28,7 +28,7 @@ from ..errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, U
 from .._native import accel
 from ..units import LENGTH_UNITS, length_scale
 from .options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
-from .regular import check_regular, open_regular, regular_file_resolver
+from .regular import not_regular_reason, open_regular, regular_file_resolver
 from .scene_counts import GLTF_INSTANCE_FACES, check_collada_instances, check_gltf
 from .weld import weld_exact, weld_exact_stream
 
@@ -1103,12 +1103,15 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
         path = os.fsdecode(os.fspath(source))
         try:
             try:
-                mode = os.stat(path).st_mode
+                st = os.stat(path)
             except OSError as exc:
                 raise _fail(path, os_error_reason(exc, path)) from None
+            mode = st.st_mode
             if stat.S_ISDIR(mode):
                 raise _fail(path, "is a directory, not a mesh file")
-            check_regular(path)     # a FIFO, a device or a link to one: refused before anything opens it
+            reason = not_regular_reason(mode, path)   # a FIFO, a device or a link to one: refused before opening
+            if reason is not None:
+                raise _fail(path, reason)
             suffix = os.path.splitext(path)[1].lower()
             if suffix in COMPRESSED_SUFFIXES:
                 if os.path.getsize(path) == 0:
@@ -1128,7 +1131,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
                                   f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
-            if os.path.getsize(path) == 0:
+            if st.st_size == 0:
                 raise _fail(path, "empty file (0 bytes)")
             declared = None
             rounding = 0.0                  # file units until scaled below
