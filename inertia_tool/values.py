@@ -110,10 +110,13 @@ def frozen_value(cls: type[_T]) -> type[_T]:
     def __post_init__(self: Any) -> None:
         if own_post_init is not None:
             own_post_init(self)
+        # the instance dictionary holds exactly the fields here (a frozen dataclass without slots; derived
+        # values cached later are not set yet): reading it skips a getattr per field
+        stored = self.__dict__
         for name in _field_names(self.__class__)[0]:
-            value = getattr(self, name)
+            value = stored[name]
             if isinstance(value, np.ndarray) and value.flags.writeable:
-                object.__setattr__(self, name, readonly(value))
+                stored[name] = readonly(value)
 
     # the class is being built: methods are added to it dynamically, which a type checker cannot follow
     built: Any = cls

@@ -5,6 +5,7 @@ import bz2
 import contextlib
 import gzip
 import os
+import warnings
 import zipfile
 
 import numpy as np
@@ -237,3 +238,27 @@ def test_decompressed_temporary_directory_is_removed_once_after_use(tmp_path, fa
             if fail:
                 raise RuntimeError("the caller failed")
     assert seen and not os.path.exists(os.path.dirname(seen[0]))
+
+
+@pytest.mark.parametrize("n_faces", [1, 80, 81, 200])
+def test_small_binary_stl_read_once_equals_chunked_read(tmp_path, n_faces):
+    """A binary STL that fits in the first read (at most 80 triangles: 84 + 50·80 ≤ 4096 bytes) is welded from
+    those bytes instead of being opened again: the vertices and faces are the ones the chunked file read gives,
+    and a trailing byte after the triangles changes nothing."""
+    from inertia_tool.mesh.read import _binary_stl_chunks, load_mesh
+    from inertia_tool.mesh.weld import weld_exact_stream
+
+    rng = np.random.default_rng(n_faces)
+    tri = rng.integers(-4, 5, size=(n_faces, 3, 3)).astype(np.float32) / 4    # shared corners, exact in float32
+    rec = np.zeros(n_faces, dtype=[("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    rec["v"] = tri
+    for extra in (b"", b"\x00"):
+        path = tmp_path / f"t{len(extra)}.stl"
+        path.write_bytes(b"\x00" * 80 + np.uint32(n_faces).tobytes() + rec.tobytes() + extra)
+        chunked = weld_exact_stream(_binary_stl_chunks(str(path), n_faces, padded=False), 3 * n_faces)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            raw = load_mesh(str(path), units="m")
+        np.testing.assert_array_equal(raw.faces, chunked[1])
+        np.testing.assert_array_equal(raw.vertices, chunked[0])
+        np.testing.assert_array_equal(raw.vertices[raw.faces], tri.astype(np.float64))

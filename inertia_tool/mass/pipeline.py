@@ -10,6 +10,7 @@ that are a choice (equal moments) or at round-off (needles).
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import warnings
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, TypeAlias
@@ -81,8 +82,9 @@ def resolve_density(*, density: float | None = None, material: str | None = None
 
 def _check_finite(props: MassProperties, source: str) -> None:
     """Refuse a result with a non-finite number (never print inf or NaN as a mass property)."""
-    values = np.r_[props.mass, props.volume, props.center_of_mass, props.inertia.ravel(), props.surface_area]
-    if not np.all(np.isfinite(values)):
+    scalars = (props.mass, props.volume, props.surface_area)
+    if not (all(map(math.isfinite, scalars)) and np.isfinite(props.center_of_mass).all()
+            and np.isfinite(props.inertia).all()):
         raise InvalidMeshError(f"{source}: the mass properties overflow or are undefined (non-finite values); "
                                "check the coordinates' size and the length unit")
 
@@ -119,6 +121,9 @@ def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassPrope
     for b in owners:
         members = [prepared.shells[k] for k in np.flatnonzero(prepared.owner == b)]
         props = [_shell_properties(s, density, name) for s in members]
+        if len(props) == 1 and len(owners) == 1:     # one shell: the copy below would equal it field for field
+            bodies.append(props[0])
+            continue
         body = props[0] if len(props) == 1 else combine(props, name=name)
         bodies.append(MassProperties(mass=body.mass, volume=body.volume, center_of_mass=body.center_of_mass,
                                      inertia=body.inertia, surface_area=body.surface_area, density=density,

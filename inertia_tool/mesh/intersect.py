@@ -890,6 +890,11 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
         a, b, kind, candidates, tested, complete = _scan_numpy(v, f, axis, degenerate, lo, hi, max_pairs, chunk,
                                                                pred, cert)
 
+    if not len(kind):                   # nothing meets (every clean mesh): no masks, stacks or sorts to make
+        return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty,
+                               complete=complete, candidate_pairs=candidates, tested_pairs=tested,
+                               exact_evaluations=pred.exact, degenerate_faces=int(np.count_nonzero(degenerate)))
+
     def pairs(key: int) -> np.ndarray:
         hit = kind == key
         p = np.stack([a[hit], b[hit]], axis=1).astype(np.intp)

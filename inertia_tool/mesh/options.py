@@ -92,11 +92,16 @@ class LoadOptions:
     @classmethod
     def build(cls, options: LoadOptions | None = None, **overrides: Any) -> LoadOptions:
         """``options`` (or the defaults) with keyword overrides; unknown names raise :class:`UsageError`."""
-        names = {f.name for f in fields(cls)}
+        names = _LOAD_OPTION_NAMES
         unknown = sorted(set(overrides) - names)
         if unknown:
             raise UsageError(f"Expected load options among {', '.join(sorted(names))}, got {', '.join(unknown)}")
         if options is not None and not isinstance(options, LoadOptions):
             raise UsageError(f"Expected `options` to be a LoadOptions, got {type(options).__name__}")
-        base = options if options is not None else cls()
-        return replace(base, **overrides) if overrides else base
+        if options is None:                      # the defaults with the overrides: one construction, not two
+            return cls(**overrides)
+        return replace(options, **overrides) if overrides else options
+
+
+#: The field names of :class:`LoadOptions` (every one an ``__init__`` argument), for :meth:`LoadOptions.build`.
+_LOAD_OPTION_NAMES = frozenset(f.name for f in fields(LoadOptions))

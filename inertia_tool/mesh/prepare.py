@@ -129,7 +129,7 @@ def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
 def _check_magnitude(lo: np.ndarray, hi: np.ndarray, source: str) -> None:
     """Refuse coordinates (bounding box ``lo``, ``hi``) whose volume integrals (∝ L⁵) would overflow or underflow
     float64."""
-    top = float(np.max(np.abs(np.r_[lo, hi])))    # = max |coordinate| (NaN propagates)
+    top = float(np.max(np.abs(np.concatenate((lo, hi)))))    # = max |coordinate| (NaN propagates)
     if not top <= MAX_COORDINATE:
         raise InvalidMeshError(f"{source}: coordinates reach {top:.3g} m, beyond the ±{MAX_COORDINATE:g} m the "
                                "volume integrals can hold without overflow (check the length `units`)")
@@ -222,15 +222,18 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     labels, n_shells = shell_labels(f, len(v))                                   # R1
     if n_shells == 0:
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
-    shells = body_volume_moments(v, f, labels, n_shells)
+    # the reference point body_volume_moments and accurate_shells would take (the bounding-box centre), from the
+    # box computed above while the vertices are the ones read
+    centre = 0.5 * (lo + hi) if v is raw.vertices else None
+    shells = body_volume_moments(v, f, labels, n_shells, origin=centre)
     twins = _twin_candidates(shells, labels)
     if twins is not None:                     # R0: a shell listed twice with its own vertices
         f, note = _leave_out_coincident(v, f, twins, source, labels)
         if note is not None:
             coincident_notes.append(note)
             labels, n_shells = shell_labels(f, len(v))
-            shells = body_volume_moments(v, f, labels, n_shells)
-    shells, bound = _accurate(v, f, labels, shells)          # R7: signs and moments within the round-off bound
+            shells = body_volume_moments(v, f, labels, n_shells, origin=centre)
+    shells, bound = _accurate(v, f, labels, shells, centre)  # R7: signs and moments within the round-off bound
     f, labels, n_shells, shells, dropped_note, bound = _drop_flat(v, f, labels, shells, diag, source, bound)  # R2
     contacts = surface_contacts(v, f)
     if patched is not None:
@@ -549,12 +552,13 @@ def _within(v: np.ndarray, f: np.ndarray, labels: np.ndarray, volumes: np.ndarra
     return within, np.concatenate([really, pairs[MAX_WITHIN_PAIRS:]])
 
 
-def _accurate(v: np.ndarray, f: np.ndarray, labels: np.ndarray,
-              shells: list[VolumeMoments]) -> tuple[list[VolumeMoments], RoundoffBound]:
+def _accurate(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[VolumeMoments],
+              origin: np.ndarray | None = None) -> tuple[list[VolumeMoments], RoundoffBound]:
     """R7: the shells with their round-off bounded (:func:`~inertia_tool.integrals.accurate_shells`: a sliver
     thinner than its coordinates' rounding integrated exactly, so that even its sign is right), and each shell's
-    round-off bound."""
-    better, _, bound = accurate_shells(v, f, labels, list(shells))
+    round-off bound.  ``origin``: the point ``shells`` were integrated about (default the vertices' bounding-box
+    centre, computed again)."""
+    better, _, bound = accurate_shells(v, f, labels, list(shells), origin)
     return better, bound
 
 

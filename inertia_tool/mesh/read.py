@@ -28,7 +28,7 @@ from ..errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, U
 from .._native import accel
 from ..units import LENGTH_UNITS, length_scale
 from .options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
-from .regular import check_regular, open_regular, regular_file_resolver
+from .regular import not_regular_reason, open_regular, regular_file_resolver
 from .scene_counts import GLTF_INSTANCE_FACES, check_collada_instances, check_gltf
 from .weld import weld_exact, weld_exact_stream
 
@@ -159,13 +159,17 @@ def _looks_ascii_stl(head: bytes) -> bool:
                                       or len(head) < 84)
 
 
-def _binary_stl_count(path: str, size: int, max_faces: int) -> int:
-    """Validate a binary STL's header against its size (before allocating) and return the triangle count."""
+def _binary_stl_count(path: str, size: int, max_faces: int, announced: int = -1) -> int:
+    """Validate a binary STL's header against its size (before allocating) and return the triangle count
+    (``announced``: the header's count when the caller has read it already, else -1 to read it here)."""
     if size < 84:
         raise _fail(path, f"too short for a binary STL ({size} bytes; the header alone is 84)")
-    with open_regular(path) as fh:
-        fh.seek(80)
-        n = int(np.frombuffer(fh.read(4), dtype="<u4")[0])
+    if announced >= 0:
+        n = announced
+    else:
+        with open_regular(path) as fh:
+            fh.seek(80)
+            n = int(np.frombuffer(fh.read(4), dtype="<u4")[0])
     available = (size - 84) // 50
     if n > available:
         raise _fail(path, f"binary STL header announces {n:,} triangles but the file holds at most "
@@ -178,16 +182,21 @@ def _binary_stl_count(path: str, size: int, max_faces: int) -> int:
     return n
 
 
-def _binary_stl_chunks(path: str, n: int, *, padded: bool = True) -> Callable[[], Iterator[np.ndarray]]:
+def _binary_stl_chunks(path: str, n: int, *, padded: bool = True,
+                       whole: bytes | None = None) -> Callable[[], Iterator[np.ndarray]]:
     """A factory of iterators over the corners of a binary STL, in file order.
 
     ``padded``: ``(k, 4)`` float32 copies ``(x, y, z, 0)`` checked for NaN and infinity (the layout lets the
     numpy welder hash a corner as two 64-bit words); otherwise ``(k, 3, 3)`` float32 views into the chunk's
     50-byte records, unchecked (the caller checks the welded vertices).  Each call re-reads the file in
     bounded chunks (a second read comes from the page cache), so the whole triangle soup is never held in
-    memory.
+    memory.  ``whole``: the file's bytes when the caller has read all of them already (a small file), read
+    from there instead of opening the file again.
     """
     def views() -> Iterator[np.ndarray]:
+        if whole is not None and 84 + 50 * n <= len(whole):
+            yield np.frombuffer(whole, dtype=_STL_RECORD, count=n, offset=84)["v"]
+            return
         with open_regular(path) as fh:
             fh.seek(84)
             done = 0
@@ -391,10 +400,12 @@ def _read_stl(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int, b
     announced = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else -1
 
     def binary() -> tuple[np.ndarray, np.ndarray, int, bool]:
-        n = _binary_stl_count(path, size, max_faces)
+        n = _binary_stl_count(path, size, max_faces, announced)
         if n == 0:
             raise _fail(path, "STL holds no triangles (empty mesh)")
-        vertices, faces = weld_exact_stream(_binary_stl_chunks(path, n, padded=accel() is None), 3 * n)
+        whole = head if len(head) == size else None          # a small file is read once
+        vertices, faces = weld_exact_stream(_binary_stl_chunks(path, n, padded=accel() is None, whole=whole),
+                                            3 * n)
         if not np.all(np.isfinite(vertices)):
             raise _fail(path, "triangles have NaN or infinite coordinates")
         return vertices, faces, n, True
@@ -1092,12 +1103,15 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
         path = os.fsdecode(os.fspath(source))
         try:
             try:
-                mode = os.stat(path).st_mode
+                st = os.stat(path)
             except OSError as exc:
                 raise _fail(path, os_error_reason(exc, path)) from None
+            mode = st.st_mode
             if stat.S_ISDIR(mode):
                 raise _fail(path, "is a directory, not a mesh file")
-            check_regular(path)     # a FIFO, a device or a link to one: refused before anything opens it
+            reason = not_regular_reason(mode, path)   # a FIFO, a device or a link to one: refused before opening
+            if reason is not None:
+                raise _fail(path, reason)
             suffix = os.path.splitext(path)[1].lower()
             if suffix in COMPRESSED_SUFFIXES:
                 if os.path.getsize(path) == 0:
@@ -1117,7 +1131,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
                                   f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
-            if os.path.getsize(path) == 0:
+            if st.st_size == 0:
                 raise _fail(path, "empty file (0 bytes)")
             declared = None
             rounding = 0.0                  # file units until scaled below
