@@ -324,6 +324,25 @@ def test_spin_it_two_material_3mf_reads_back_with_its_mass(tmp_path, capsys):
     assert data["warnings"] == []            # the insert touches its pocket: no overlap
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("insert", [False, True])
+def test_spin_it_one_material_3mf_reads_back_with_its_mass(tmp_path, capsys, insert):
+    """A 3MF of one material (no --insert, or an insert that did not help: spin-it then keeps the cavity alone)
+    carries the material and its density: analyze gave the mass at water's density (21.8 g for 27.0 g of PLA)."""
+    out = tmp_path / "top.3mf"
+    extra = ["--insert", "steel"] if insert else []
+    assert main(["spin-it", "meshes/spinning_top.stl", "--units", "mm", "--material", "PLA", "--axis", "0,0,1",
+                 "--mode", "top", "--pivot", "0,0,0", "--wall", "2mm", "--resolution", "24", "--out", str(out),
+                 "--json", *extra]) == 0
+    body = json.loads(capsys.readouterr().out)
+    after = body["after"]["mass_properties"]
+    assert main(["analyze", str(out), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["mass"] == pytest.approx(after["mass"], rel=1e-9)
+    expected = [("PLA", 1240.0)] + ([] if body["insert"] is None else [("steel", 7850.0)])
+    assert [(b["material"], b["density"]) for b in data["bodies"]] == expected
+
+
 # -- property: totals of random parts against an independent sum ------------------------------------------------
 
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

@@ -100,6 +100,15 @@ def _write_two_materials(path: str, result, material: str, insert: str, insert_d
          "faces": result.insert_faces, "density": float(insert_density)}], label="--out")
 
 
+def _write_one_material(path: str, result, material: str) -> None:
+    """The hollowed part as a 3MF that carries its material and the density used (kg/m³): ``analyze`` of the
+    file gives the mass spin-it printed (a plain mesh export read back at the default density)."""
+    from ..reports.mesh_3mf import write_3mf
+    mm = length_scale("mm")
+    write_3mf(path, [{"name": "part", "material": material, "color": "#9CC3E6FF", "vertices": result.vertices / mm,
+                      "faces": result.faces, "density": float(result.before.density)}], label="--out")
+
+
 def _write(path: str, vertices, faces, units: str) -> None:
     import trimesh
 
@@ -196,6 +205,8 @@ def run(args) -> int:
                                             repair=bool(getattr(args, "repair", False)), storage_scale=storage)
     if args.out and result.insert_vertices is not None:
         _write_two_materials(args.out, result, args.material or "part", args.insert, float(insert_density or 0.0))
+    elif args.out and args.out.lower().endswith(".3mf"):
+        _write_one_material(args.out, result, args.material or "part")
     elif args.out:
         _write(args.out, result.vertices, result.faces, unit)
     if args.plot:
