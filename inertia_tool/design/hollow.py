@@ -370,15 +370,15 @@ def _warn_pivot_off_part(name: str, pivot: np.ndarray, vertices: np.ndarray, fac
     """``PivotOffPartWarning`` when a top's pivot lies outside the part, farther than ``PIVOT_GAP_RTOL`` of its
     largest extent from the surface (inside: the generalized winding number above one half).  Lengths in the
     message are in ``units`` (the user's, as the pivot was given), metres without."""
-    import igl
-
+    from ..mesh.winding import winding_numbers
     from ..units import length_scale
 
     gap = float(np.sqrt(tree.squared_distance(np.asarray(pivot, dtype=np.float64)[None, :])[0]))
     if gap <= PIVOT_GAP_RTOL * extent:
         return
-    winding = igl.fast_winding_number(tree.vertices, tree.faces, np.asarray(pivot, dtype=np.float64)[None, :])
-    if float(np.asarray(winding).reshape(-1)[0]) > 0.5:
+    # one point: the exact solid-angle sum (the project's winding numbers), not libigl's approximation
+    if float(winding_numbers(np.asarray(pivot, dtype=np.float64)[None, :], tree.vertices, tree.faces,
+                             fast=False)[0]) > 0.5:
         return
     unit, scale = "m", 1.0
     if units:
