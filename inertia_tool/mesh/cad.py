@@ -38,6 +38,7 @@ import numpy as np
 from ..errors import InvalidMeshError, MeshReadError, UsageError
 from ..values import frozen_value
 from .read import BREP_SUFFIXES      # CAD exchange suffixes read as B-reps, defined with the reader's suffixes
+from .weld import weld_exact
 
 if TYPE_CHECKING:
     from ..isolate import Limits
@@ -274,7 +275,7 @@ def tessellate(shape: Any, *, chord: float, angular_deflection: float = DEFAULT_
 
     Each B-rep face is meshed on its own; reversed faces have their triangles flipped so the normals point
     out of the solid, and each face's location is applied.  Vertices on shared edges coincide (the mesher
-    shares edge discretisations), so the mesh reader welds them into a closed surface.
+    shares edge discretisations); they are joined here (bit-exact), so the surface is closed.
     """
     from OCP.BRep import BRep_Tool
     from OCP.BRepMesh import BRepMesh_IncrementalMesh
@@ -313,7 +314,10 @@ def tessellate(shape: Any, *, chord: float, angular_deflection: float = DEFAULT_
         offset += len(nodes)
     if not faces:
         raise UsageError("the shape has no faces to tessellate")
-    return np.vstack(vertices), np.vstack(faces)
+    # each B-rep face carries its own copy of the nodes on its edges, bit-identical to its neighbours': join
+    # them here, so the surface arrives closed and no tolerance merge is reported for a clean B-rep
+    welded_vertices, welded_faces = weld_exact(np.vstack(vertices)[np.vstack(faces)])
+    return welded_vertices, welded_faces.astype(np.int64, copy=False)
 
 
 def _cascadio_arrays(path: str, chord: float, angular_deflection: float) -> tuple[np.ndarray, np.ndarray]:

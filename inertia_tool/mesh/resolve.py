@@ -253,8 +253,11 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                 flipped = turned.flipped_faces if turned is not None else 0
                 welded = tol
                 if census.balanced:
-                    notes = (f"{merged.merged_vertices:,} vertices within {tol:.3g} m of another were merged "
-                             f"(largest move {merged.largest_move:.3g} m)",)
+                    if merged.largest_move > 0:
+                        notes = (f"{merged.merged_vertices:,} vertices within {tol:.3g} m of another were merged "
+                                 f"(largest move {merged.largest_move:.3g} m)",)
+                    else:   # repeated records of one point (e.g. CAD faces tessellated one by one): nothing moved
+                        notes = (f"{merged.merged_vertices:,} repeated vertices (identical coordinates) were joined",)
                     if flipped:
                         notes += (f"{flipped:,} faces were wound the wrong way and were turned",)
                     kept_v, kept_f = _compact(v, current)
