@@ -415,3 +415,18 @@ def test_spin_it_top_warns_about_a_pivot_below_its_tip_and_not_at_it():
                              resolution=16)
         assert np.allclose(result.origin, pivot)             # designed as asked
         assert any(issubclass(w.category, PivotOffPartWarning) for w in caught) is warned
+
+
+@pytest.mark.parametrize("named, expected", [("z", (0, 0, 1)), ("X", (1, 0, 0)), ("-y", (0, -1, 0)),
+                                             ("+z", (0, 0, 1)), ("0,0,2", (0, 0, 1))])
+def test_the_spin_axis_can_be_named(named, expected):
+    from inertia_tool.cli.spin_it import _direction
+    np.testing.assert_array_equal(_direction(named), expected)
+
+
+@pytest.mark.parametrize("bad", ["w", "zz", "0,0,0", "1,2", "nan,0,1", "--z"])
+def test_a_bad_spin_axis_is_a_usage_error(bad):
+    from inertia_tool.cli.spin_it import _direction
+    from inertia_tool.errors import UsageError
+    with pytest.raises(UsageError, match="--axis must be"):
+        _direction(bad)

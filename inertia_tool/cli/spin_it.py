@@ -39,7 +39,8 @@ def register(subparsers) -> None:
                   "--resolution 24 --json"])
     p.add_argument("files", metavar="FILE", help="closed mesh: STL, OBJ, PLY, OFF, 3MF")
     add_material_options(p)
-    p.add_argument("--axis", required=True, metavar="X,Y,Z", help="spin axis direction (unitless, normalised)")
+    p.add_argument("--axis", required=True, metavar="X,Y,Z",
+                   help="spin axis direction (unitless, normalised), or one of x, y, z, -x, -y, -z")
     p.add_argument("--mode", choices=("yoyo", "top"), default="yoyo", help="yoyo (free spin) or top (on a pivot)")
     p.add_argument("--through", metavar="X,Y,Z",
                    help="yo-yo: a point of the axis (in --units unless a unit is given); the centre of mass is "
@@ -68,14 +69,21 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
 
+_NAMED_AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
 def _direction(text: str) -> np.ndarray:
+    named = str(text).strip().lower()
+    sign, bare = (-1.0, named[1:]) if named[:1] == "-" else (1.0, named[1:] if named[:1] == "+" else named)
+    if bare in _NAMED_AXES:
+        return sign * np.array(_NAMED_AXES[bare])
     parts = [s.strip() for s in str(text).split(",")]
     try:
         v = np.array([float(s) for s in parts])
     except ValueError:
         v = np.zeros(0)
     if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.max(np.abs(v)) > 0:
-        raise UsageError(f"--axis must be three finite numbers, not all zero, like 0,0,1; got {text!r}")
+        raise UsageError(f"--axis must be three finite numbers, not all zero, like 0,0,1, or x, y, z; got {text!r}")
     return v / np.max(np.abs(v))         # a direction: scaled so that its norm cannot overflow
 
 
