@@ -142,6 +142,15 @@ class GeometryElement:
         MJCF: a primitive (``kind`` box, sphere, ...) with a ``mesh`` and no size takes its size from the mesh
         (MuJoCo fits it to the mesh's equivalent inertia box, times ``fitscale``); ``size`` is empty until
         :func:`inertia_tool.robot.geometry.fitted_element` fits it.  None for every other element.
+    note : str
+        What the reader should know about how the element stands for the description's geometry (an MJCF
+        height field taken as MuJoCo's inertia box); empty for an element read as written.  It is carried into
+        the link result's ``warnings``.
+    vertices : (n, 3) float or None
+        An inline mesh (MJCF ``<mesh vertex=...>``): its vertices in the file's frame, m, before the reference
+        transform and ``scale``; ``mesh`` is then None.  None for a mesh read from a file and for primitives.
+    faces : (m, 3) int or None
+        The inline mesh's triangles (indices into ``vertices``, wound outwards).
     """
 
     kind: str
@@ -158,6 +167,9 @@ class GeometryElement:
     mass: float | None = None
     shell: bool = False
     fit_scale: float | None = None
+    note: str = ""
+    vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))

@@ -514,8 +514,9 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
         return LinkInertial(link.name, None, nan, basis, f"mesh needs repair or cannot be read: {exc}")
     except (ValueError, ArithmeticError) as exc:     # numerical trouble in one link's geometry: its reason
         return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}")
-    warned = [f"{e.kind} {e.name!r} is massless in the description "
-              f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
+    warned = [e.note for e in link.elements if e.note]
+    warned += [f"{e.kind} {e.name!r} is massless in the description "
+               f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
     if not parts:
         return LinkInertial(link.name, None, nan, basis, "every geom is massless in the description",
                             warnings=tuple(warned))

@@ -43,6 +43,7 @@ MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 
@@ -387,6 +388,39 @@ def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler
     return meshes
 
 
+def _hfields(root, source: str) -> dict:
+    """``{name: (radius_x, radius_y, elevation_z, base_z)}`` (m) of every ``<asset><hfield>``.
+
+    Only ``size`` is read (MuJoCo requires it: four positive numbers); the elevation data (``file`` or
+    ``elevation``) is not, because MuJoCo's inertia of a height field depends on its size alone."""
+    found = {}
+    for asset in root.findall("asset"):
+        for hfield in asset.findall("hfield"):
+            name = hfield.get("name") or os.path.splitext(os.path.basename(hfield.get("file") or ""))[0]
+            what = f"<hfield name={name!r}>"
+            size = _numbers(hfield.get("size"), 4, f"{what} size", source)
+            found[name] = tuple(_positive(float(s), f"{what} size", source) for s in size)
+    return found
+
+
+def _hfield_geom(attrs: dict, pose, label: str, link: str, hfields: dict, compiler, source: str) -> GeometryElement:
+    """A ``type="hfield"`` geom in a body as MuJoCo's compiler takes it for the body's inertia: the box centred
+    on the geom's frame with half-sizes ``(radius_x, radius_y, elevation_z/4 + base_z/2)`` of its
+    ``<hfield size>`` (checked against ``mujoco`` 4.0: ``geom_size`` and the body's mass, centre and inertia
+    are those of this box, whatever the elevation data), noted on the element as a stand-in."""
+    name = attrs.get("hfield")
+    if name not in hfields:
+        raise _fail(source, f"body {link!r} {label}: height field {name!r} is not defined in <asset>")
+    rx, ry, elevation, base = hfields[name]
+    boxed = {k: v for k, v in attrs.items() if k not in ("fromto", "mesh", "hfield", "size")}
+    boxed.update(type="box", size=f"{rx!r} {ry!r} {0.25 * elevation + 0.5 * base!r}")
+    element = _geom(boxed, pose, label, link, {}, {}, compiler, source)
+    note = (f"height field {name!r} ({element.name}) taken as MuJoCo's inertia box "
+            f"{2 * rx:g} x {2 * ry:g} x {0.5 * elevation + base:g} m, as MuJoCo's compiler does (not the shape "
+            "of its surface)")
+    return dataclasses.replace(element, note=note)
+
+
 def _optional_number(attrs: dict, key: str, what: str, source: str) -> float | None:
     if attrs.get(key) is None:
         return None
@@ -576,6 +610,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
     defaults = _Defaults(root, source)
     compiler = (degrees, eulerseq, fitaabb)
     meshes = _meshes(root, defaults, mesh_base, fallbacks, compiler, source)
+    hfields = _hfields(root, source)
     paired = _paired_geoms(root)
     links = []
     counter = [0]
@@ -600,6 +635,9 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
                     continue
                 if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", source, paired):
                     label = f"geom {len(elements) + 1}"
+                    if attrs.get("type") == "hfield":
+                        elements.append(_hfield_geom(attrs, pose, label, link, hfields, compiler, source))
+                        continue
                     elements.append(_geom(attrs, pose, label, link, meshes, packages, compiler, source))
             elif child.tag == "frame":
                 attrs = dict(child.attrib)

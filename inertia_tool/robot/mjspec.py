@@ -116,7 +116,8 @@ def compare_with_mujoco(robot: RobotDescription, *, rtol: float = AGREEMENT_RTOL
     mesh_kind = mujoco.mjtGeom.mjGEOM_MESH
     kinds = {mujoco.mjtGeom.mjGEOM_BOX: "box", mujoco.mjtGeom.mjGEOM_SPHERE: "sphere",
              mujoco.mjtGeom.mjGEOM_CAPSULE: "capsule", mujoco.mjtGeom.mjGEOM_CYLINDER: "cylinder",
-             mujoco.mjtGeom.mjGEOM_ELLIPSOID: "ellipsoid", mesh_kind: "mesh"}
+             mujoco.mjtGeom.mjGEOM_ELLIPSOID: "ellipsoid", mesh_kind: "mesh",
+             mujoco.mjtGeom.mjGEOM_HFIELD: "box"}       # MuJoCo's size of a height field is its inertia box
     for index, link in enumerate(robot.links, start=1):
         name = model.body(index).name
         if (name or f"body {index}") != link.name:
