@@ -28,11 +28,12 @@ import contextlib
 import math
 import os
 import re
+import warnings
 from dataclasses import field
 
 import numpy as np
 
-from ..errors import MeshReadError, RobotDescriptionError, UsageError
+from ..errors import MeshReadError, RobotDescriptionError, SkippedModelWarning, UsageError
 from ..mesh.regular import open_regular
 from ..units import DECIMAL
 from ..values import frozen_value
@@ -633,6 +634,18 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
                         "ellipsoid or mesh)")
 
 
+#: SDFormat shapes that bound no volume: a ground ``<plane>``, a terrain ``<heightmap>``, ``<empty>``.  Like
+#: MuJoCo's planes they give a link no mass: the elements are skipped (a link with nothing else is then a frame).
+_SDF_SHAPES_WITHOUT_VOLUME = ("plane", "heightmap", "empty")
+
+
+def _sdf_without_volume(element) -> bool:
+    """Whether a ``<collision>``/``<visual>`` holds one of :data:`_SDF_SHAPES_WITHOUT_VOLUME`."""
+    geometry = element.find("geometry")
+    shapes = [c for c in geometry if isinstance(c.tag, str)] if geometry is not None else []
+    return len(shapes) == 1 and shapes[0].tag in _SDF_SHAPES_WITHOUT_VOLUME
+
+
 #: Deepest chain of SDFormat ``<include>`` and nested ``<model>`` followed.
 MAX_SDF_NESTING = 16
 
@@ -640,9 +653,30 @@ MAX_SDF_NESTING = 16
 MAX_SDF_INCLUDES = 512
 
 
-def _sdf_include_file(include, base: str, packages: dict, source: str) -> str:
+#: Gazebo's stock models that nearly every world file includes and that hold no link with mass: when one is not
+#: on disk, the include is skipped with a note (:class:`~inertia_tool.errors.SkippedModelWarning`) instead of
+#: refusing the world.  What each one is, for the note.
+STOCK_MODELS_WITHOUT_MASS = {"sun": "a directional light", "ground_plane": "a static plane"}
+
+
+def _searched_folders(scheme: str, packages: dict, base: str) -> str:
+    """The folders :func:`~inertia_tool.robot.resolve.package_directory` looked in, for a message."""
+    from .resolve import PACKAGE_PATH_VARIABLES
+    variables = PACKAGE_PATH_VARIABLES if scheme == "model" else PACKAGE_PATH_VARIABLES[:1]
+    parts = [f"{var}={os.environ[var]!r}" if os.environ.get(var) else f"{var} (unset)" for var in variables]
+    if packages:
+        parts.insert(0, f"the packages given ({', '.join(sorted(packages))})")
+    top = os.path.abspath(base)
+    for _ in range(MAX_FOLDERS_UP):
+        top = os.path.dirname(top)
+    parts.append(f"{os.path.abspath(base)} and the folders above it up to {top}")
+    return "; ".join(parts)
+
+
+def _sdf_include_file(include, base: str, packages: dict, source: str) -> str | None:
     """The SDFormat file an ``<include><uri>`` names: a file, or a model folder (its ``model.config``'s
-    ``<sdf>`` file, else ``model.sdf``)."""
+    ``<sdf>`` file, else ``model.sdf``); None for a stock model of :data:`STOCK_MODELS_WITHOUT_MASS` that is not
+    on disk (skipped, with a :class:`~inertia_tool.errors.SkippedModelWarning` naming it)."""
     uri = (include.findtext("uri") or "").strip()
     if not uri:
         raise _fail(source, "<include> without a <uri>")
@@ -650,9 +684,14 @@ def _sdf_include_file(include, base: str, packages: dict, source: str) -> str:
     if sep and scheme in ("model", "package"):
         name, _, inner = rest.partition("/")
         directory = package_directory(name, packages, scheme=scheme, near=base)
+        if directory is None and scheme == "model" and name in STOCK_MODELS_WITHOUT_MASS:
+            warnings.warn(SkippedModelWarning(f"{source}: <include> {uri!r} skipped: Gazebo's stock model {name!r} "
+                                              f"({STOCK_MODELS_WITHOUT_MASS[name]}, no link with mass) is not on "
+                                              "disk"), stacklevel=2)
+            return None
         if directory is None:
-            raise _fail(source, f"<include> {uri!r}: cannot find model {name!r} (not among the packages given, "
-                                "not on GZ_SIM_RESOURCE_PATH/GAZEBO_MODEL_PATH, not beside the model's folder)")
+            raise _fail(source, f"<include> {uri!r}: cannot find model {name!r}; searched "
+                                f"{_searched_folders(scheme, packages, base)}")
         path = os.path.join(directory, inner)
     elif sep and scheme == "file":
         path = rest if os.path.isabs(rest) else os.path.join(base, rest)
@@ -692,13 +731,15 @@ def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, sou
             if not name:
                 raise _fail(source, "a <link> without a name")
             elements = tuple(_sdf_geometry(el, prefix + name, f"{geometry} {k + 1}", base, packages, source)
-                             for k, el in enumerate(child.findall(geometry)))
+                             for k, el in enumerate(child.findall(geometry)) if not _sdf_without_volume(el))
             links.append(LinkGeometry(name=prefix + name, elements=elements, declared=_sdf_inertial(child, source)))
         elif child.tag == "model":
             links += _sdf_links(child, f"{prefix}{child.get('name', '')}::", base, packages, geometry, source,
                                 stack + (f"model {child.get('name')}",), budget)
         elif child.tag == "include":
             path = _sdf_include_file(child, base, packages, source)
+            if path is None:        # a stock light or ground plane that is not on disk: nothing with mass
+                continue
             key = os.path.realpath(path)
             if key in stack:
                 raise _fail(source, f"<include> of {path} includes itself")
