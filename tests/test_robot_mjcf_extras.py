@@ -81,3 +81,81 @@ def test_an_undefined_height_field_is_named(tmp_path):
                     '</worldbody></mujoco>')
     with pytest.raises(RobotDescriptionError, match="height field 'nowhere' is not defined"):
         read_robot(path)
+
+
+# -- inline meshes ------------------------------------------------------------------------------------------
+
+def _octahedron(a=0.1, b=0.2, c=0.3):
+    vertices = [(a, 0, 0), (-a, 0, 0), (0, b, 0), (0, -b, 0), (0, 0, c), (0, 0, -c)]
+    faces = [(0, 2, 4), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)]
+    return (" ".join(f"{x:g} {y:g} {z:g}" for x, y, z in vertices), " ".join(f"{i} {j} {k}" for i, j, k in faces))
+
+
+def test_inline_vertex_and_face_match_mujoco_with_scale_and_reference_frame(tmp_path):
+    vertex, face = _octahedron()
+    path = tmp_path / "inline.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true" angle="radian"/><asset>'
+                    f'<mesh name="octa" vertex="{vertex}" face="{face}" scale="1 2 0.5" refpos="0.01 0.02 0.03" '
+                    'refquat="0.9 0.1 0.2 0.3"/></asset><worldbody>'
+                    '<body name="a"><freejoint/><geom type="mesh" mesh="octa" pos="0.1 0.2 0.3" euler="0.1 0.2 0.3" '
+                    'density="500"/><geom type="box" size="0.01 0.02 0.03" pos="0.3 0 0"/></body>'
+                    '<body name="b"><freejoint/><geom type="mesh" mesh="octa"/></body></worldbody></mujoco>')
+    robot = read_robot(path)
+    assert robot.links[0].elements[0].mesh is None and robot.links[0].elements[0].vertices.shape == (6, 3)
+    # MuJoCo keeps mesh vertices in float32 (0.1 is not one): agreement to its rounding, not to 1e-9
+    _assert_like_mujoco(path, link_inertials(robot, density="model"), rtol=1e-6)
+    assert compare_with_mujoco(robot) == ()
+
+
+def test_inline_octahedron_is_the_closed_form(tmp_path):
+    # independent of MuJoCo: the octahedron of semi-axes a, b, c has V = 4abc/3 and I_xx = V (b² + c²)/10
+    vertex, face = _octahedron(0.1, 0.2, 0.3)
+    path = tmp_path / "octa.xml"
+    path.write_text(f'<mujoco><asset><mesh name="o" vertex="{vertex}" face="{face}"/></asset><worldbody>'
+                    '<body name="b"><geom type="mesh" mesh="o"/></body></worldbody></mujoco>')
+    props = link_inertials(read_robot(path), density=1.0)[0].properties
+    volume = 4 * 0.1 * 0.2 * 0.3 / 3
+    assert props.volume == pytest.approx(volume, rel=1e-13)
+    expected = volume / 10 * np.array([0.2 ** 2 + 0.3 ** 2, 0.1 ** 2 + 0.3 ** 2, 0.1 ** 2 + 0.2 ** 2])
+    np.testing.assert_allclose(np.diag(props.inertia), expected, rtol=1e-12)
+
+
+def test_vertex_without_face_is_mujocos_convex_hull(tmp_path):
+    # the corners of a 1 x 2 x 3 box, points inside it and on its faces: the hull is the box
+    rng = np.random.default_rng(23)
+    corners = [(x, y, z) for x in (0, 1) for y in (0, 2) for z in (0, 3)]
+    inside = rng.uniform(0.1, 0.9, (20, 3)) * (1, 2, 3)
+    on_faces = np.column_stack([np.zeros(5), rng.uniform(0, 2, 5), rng.uniform(0, 3, 5)])
+    points = np.vstack([inside[:10], corners, on_faces, inside[10:]])
+    vertex = " ".join(f"{v!r}" for v in points.ravel().tolist())
+    path = tmp_path / "hull.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true"/><asset>'
+                    f'<mesh name="h" vertex="{vertex}" scale="1 1 2" refpos="0.5 0 0"/></asset><worldbody>'
+                    '<body name="b"><freejoint/><geom type="mesh" mesh="h" pos="0 0 1"/></body></worldbody></mujoco>')
+    robot = read_robot(path)
+    results = link_inertials(robot, density=1000)
+    _assert_like_mujoco(path, results, rtol=1e-9)
+    props = results[0].properties
+    assert props.mass == pytest.approx(1000 * 1 * 2 * 6, rel=1e-12)
+    np.testing.assert_allclose(props.center_of_mass, [0, 1, 4], atol=1e-12)
+    assert results[0].method == "exact"
+
+
+@pytest.mark.parametrize("mesh, message", [
+    ('vertex="0 0 0 1 0 0 0 1 0"', "4 to"),
+    ('vertex="0 0 0 1 0 0 0 1 0 0 0"', "x y z"),
+    ('vertex="0 0 0 1 0 0 0 1 0 2 2 0"', "span no volume"),
+    ('vertex="0 0 0 1 0 0 0 1 0 0 0 1" face="0 1 4"', "whole vertex indices from 0 to 3"),
+    ('vertex="0 0 0 1 0 0 0 1 0 0 0 1" face="0 1 2.5"', "whole vertex indices"),
+    ('vertex="0 0 0 1 0 0 0 1 0 0 0 1" face="0 1"', "triples"),
+    ('face="0 1 2"', "face without vertex"),
+    ('vertex="0 0 0 1 0 0 0 1 0 0 0 1" file="x.stl"', "both a file and inline vertices"),
+    ('builtin="sphere" params="1"', "builtin='sphere' meshes are not supported"),
+])
+def test_bad_inline_meshes_are_one_sentence(tmp_path, mesh, message):
+    path = tmp_path / "bad.xml"
+    path.write_text(f'<mujoco><asset><mesh name="m" {mesh}/></asset><worldbody><body name="b">'
+                    '<geom type="mesh" mesh="m"/></body></worldbody></mujoco>')
+    with pytest.raises(RobotDescriptionError, match=message) as caught:
+        read_robot(path)
+    assert "\n" not in str(caught.value)

@@ -361,18 +361,91 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
     return fallbacks
 
 
+#: Most vertices and triangles an inline ``<mesh vertex face>`` may hold (MuJoCo models write a few hundred;
+#: larger meshes are files).  The text is bounded by ``MAX_DESCRIPTION_BYTES`` already; this bounds the hull.
+MAX_INLINE_VERTICES = 1_000_000
+
+
+@dataclasses.dataclass(frozen=True)
+class _InlineMesh:
+    """The vertices (n, 3), m, and outward triangles (m, 3) of an inline ``<mesh>``."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    hull: bool
+
+
+def _convex_hull(vertices: np.ndarray, what: str, source: str) -> np.ndarray:
+    """Outward-wound triangles of the convex hull of ``vertices`` (MuJoCo's mesh from ``vertex`` alone).
+
+    Qhull's facets (``scipy.spatial.ConvexHull``, triangulated) come in no consistent order; each is turned so
+    that its normal ``(b − a) × (c − a)`` points along the facet's outward plane normal."""
+    from scipy.spatial import ConvexHull, QhullError
+    try:
+        hull = ConvexHull(vertices)
+    except (QhullError, ValueError):
+        raise _fail(source, f"{what}: its vertices span no volume (expected at least 4 points not in one plane, "
+                            "whose convex hull MuJoCo takes)") from None
+    faces = np.array(hull.simplices, dtype=np.int64)
+    a, b, c = (vertices[faces[:, k]] for k in range(3))
+    inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), hull.equations[:, :3]) < 0
+    faces[inward] = faces[inward][:, ::-1]
+    return np.ascontiguousarray(faces)
+
+
+def _inline_mesh(attrs: dict, source: str) -> _InlineMesh | None:
+    """The mesh an MJCF ``<mesh vertex="x y z ..." face="i j k ...">`` spells out, or None without ``vertex``.
+
+    ``vertex`` without ``face`` is MuJoCo's convex hull of the points.  Checked as MuJoCo checks it: at least
+    4 vertices, whole face indices within range; together with a ``file`` it is refused (two meshes in one)."""
+    if attrs.get("vertex") is None:
+        if attrs.get("face") is not None:
+            raise _fail(source, f"<mesh name={attrs.get('name')!r}>: face without vertex")
+        return None
+    what = f"<mesh name={attrs.get('name')!r}>"
+    if attrs.get("file"):
+        raise _fail(source, f"{what}: both a file and inline vertices (expected one of them)")
+    if not attrs.get("name"):
+        raise _fail(source, "an inline <mesh vertex> without a name (expected a name, as it has no file to name it)")
+    flat = _numbers(attrs["vertex"], None, f"{what} vertex", source)
+    if flat.size % 3 or not 12 <= flat.size <= 3 * MAX_INLINE_VERTICES:
+        raise _fail(source, f"{what}: expected vertex to hold x y z of 4 to {MAX_INLINE_VERTICES:,} points, got "
+                            f"{flat.size} numbers")
+    vertices = _coordinates(flat.reshape(-1, 3), f"{what} vertex", source)
+    if attrs.get("face") is None:
+        return _InlineMesh(vertices, _convex_hull(vertices, what, source), hull=True)
+    indices = _numbers(attrs["face"], None, f"{what} face", source)
+    if (indices.size % 3 or indices.size == 0 or indices.size > 6 * MAX_INLINE_VERTICES
+            or np.any(indices != np.round(indices)) or np.any(indices < 0) or np.any(indices >= len(vertices))):
+        raise _fail(source, f"{what}: expected face to hold triples of whole vertex indices from 0 to "
+                            f"{len(vertices) - 1}, got {' '.join(str(attrs['face']).split())[:80]!r}")
+    return _InlineMesh(vertices, indices.astype(np.int64).reshape(-1, 3), hull=False)
+
+
+def _mesh_source(file, folders, packages: dict, source: str, link: str) -> dict:
+    """The ``GeometryElement`` fields that say where a mesh asset's triangles are: ``mesh`` (the file found
+    through ``folders``, the first holding it) and ``uri``; or, for an inline mesh, ``vertices`` and ``faces``."""
+    if isinstance(file, _InlineMesh):
+        return {"mesh": None, "uri": None, "vertices": file.vertices, "faces": file.faces}
+    found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
+    path = resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
+    return {"mesh": path, "uri": file}
+
+
 def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler, source: str) -> dict:
     """``{name: (file, folders, scale, reference rotation, reference translation, shell)}`` of every mesh asset."""
     meshes = {}
     for asset in root.findall("asset"):
         for mesh in asset.findall("mesh"):
             attrs = defaults.attributes(mesh, "main", source)
-            if attrs.get("vertex") or attrs.get("face"):
-                raise _fail(source, f"<mesh name={attrs.get('name')!r}> with inline vertices is not supported")
+            inline = _inline_mesh(attrs, source)
             file = attrs.get("file")
-            if not file:
-                raise _fail(source, f"<mesh name={attrs.get('name')!r}> without a file")
-            name = attrs.get("name") or os.path.splitext(os.path.basename(file))[0]
+            if not file and inline is None:
+                if attrs.get("builtin") is not None:
+                    raise _fail(source, f"<mesh name={attrs.get('name')!r}>: builtin={attrs.get('builtin')!r} "
+                                        "meshes are not supported (expected a file, or vertex and face)")
+                raise _fail(source, f"<mesh name={attrs.get('name')!r}> without a file or vertex")
+            name = attrs.get("name") or os.path.splitext(os.path.basename(file or ""))[0]
             what = f"<mesh name={name!r}>"
             scale = _scale(_numbers(attrs.get("scale"), 3, f"{what} scale", source, default=(1, 1, 1)),
                            f"{what} scale", source)
@@ -384,7 +457,7 @@ def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler
             back = _quaternion_matrix(refquat).T
             folders = [mesh_base, *fallbacks.get(mesh, ())]
             shell = attrs.get("inertia") == "shell"
-            meshes[name] = (file, folders, scale, back, -back @ refpos, shell)
+            meshes[name] = (inline if inline is not None else file, folders, scale, back, -back @ refpos, shell)
     return meshes
 
 
@@ -472,10 +545,9 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
             raise _fail(source, f"{what}: a {kind} fitted to mesh {mesh_name!r} with <compiler fitaabb=\"true\"> "
                                 "is not supported (only MuJoCo's default fit to the equivalent inertia box)")
         file, folders, scale, ref_rotation, ref_translation, _shell = meshes[mesh_name]
-        found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
-        path = resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
         fit = float(_numbers(attrs.get("fitscale"), 1, f"{what} fitscale", source, default=(1.0,))[0])
-        return GeometryElement(kind, rotation, position, mesh=path, uri=file, scale=scale, name=name,
+        return GeometryElement(kind, rotation, position, **_mesh_source(file, folders, packages, source, link),
+                               scale=scale, name=name,
                                reference_rotation=ref_rotation, reference_translation=ref_translation,
                                fit_scale=_positive(fit, f"{what} fitscale", source), **mass_model)
     if kind == "mesh":
@@ -484,9 +556,8 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
         file, folders, scale, ref_rotation, ref_translation, shell = meshes[mesh_name]
         mass_model["shell"] = shell          # MuJoCo: a mesh's shell inertia is a property of the asset
-        found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
-        path = resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
-        return GeometryElement("mesh", rotation, position, mesh=path, uri=file, scale=scale, name=name,
+        return GeometryElement("mesh", rotation, position, **_mesh_source(file, folders, packages, source, link),
+                               scale=scale, name=name,
                                reference_rotation=ref_rotation, reference_translation=ref_translation,
                                **mass_model)
     if kind == "sphere":
