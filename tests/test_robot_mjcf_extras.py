@@ -16,14 +16,15 @@ mujoco = pytest.importorskip("mujoco")
 
 
 def _mujoco_bodies(path):
-    """name → (mass, centre, tensor in body axes) of every body but the world, from MuJoCo's compiler."""
+    """name → (mass, centre, tensor in body axes) of every body but the world, from MuJoCo's compiler (an
+    unnamed body is ``body N``, as the reader names it)."""
     model = mujoco.MjModel.from_xml_path(str(path))
     out = {}
     for i in range(1, model.nbody):
         rot = np.zeros(9)
         mujoco.mju_quat2Mat(rot, model.body_iquat[i])
         rot = rot.reshape(3, 3)
-        out[model.body(i).name] = (model.body_mass[i], model.body_ipos[i].copy(),
+        out[model.body(i).name or f"body {i}"] = (model.body_mass[i], model.body_ipos[i].copy(),
                                    rot @ np.diag(model.body_inertia[i]) @ rot.T)
     return out
 
@@ -158,4 +159,80 @@ def test_bad_inline_meshes_are_one_sentence(tmp_path, mesh, message):
                     '<geom type="mesh" mesh="m"/></body></worldbody></mujoco>')
     with pytest.raises(RobotDescriptionError, match=message) as caught:
         read_robot(path)
+    assert "\n" not in str(caught.value)
+
+
+# -- <attach> -----------------------------------------------------------------------------------------------
+
+CHILD = """<mujoco model="child"><compiler angle="radian" meshdir="meshes"/>
+<default><geom density="2000"/><default class="k"><geom type="box" size="0.1 0.1 0.1"/></default></default>
+<asset><mesh name="part" file="part.stl" refpos="0.01 0 0"/><model name="gm" file="grand.xml"/></asset>
+<worldbody><body name="root" pos="1 0 0"><geom type="mesh" mesh="part"/>
+<body name="hand" pos="0 0 1" euler="0.5 0 0" childclass="k"><geom euler="0.3 0 0" pos="0.1 0 0" size="0.1 0.2 0.3"/>
+<geom type="mesh" mesh="part" pos="0 0 0.5"/>
+<body><geom type="sphere" size="0.05"/></body>
+<body name="finger"><geom size="0.02"/><attach model="gm" body="tip" prefix="g_"/></body></body></body>
+</worldbody></mujoco>"""
+
+GRAND = """<mujoco model="grand"><compiler meshdir="g"/>
+<asset><mesh name="part" file="part.stl" scale="2 1 1"/></asset>
+<worldbody><geom type="box" size="0.1 0.2 0.3" pos="1 0 0" euler="0 30 0"/>
+<body name="tip"><geom type="mesh" mesh="part"/></body><body name="other"><geom size="0.3"/></body></worldbody>
+</mujoco>"""
+
+MAIN = """<mujoco model="main"><compiler meshdir="meshes"/>
+<asset><model name="c" file="sub/child.xml"/><model name="w" file="sub/grand.xml"/>
+<mesh name="part" file="part.stl"/></asset>
+<worldbody><body name="base"><geom type="mesh" mesh="part"/>
+<body name="first"><geom size="0.1"/></body>
+<attach model="c" body="hand" prefix="c_"/>
+<body name="last"><geom size="0.1 0.2 0.3" euler="30 0 0" type="box"/>
+<frame pos="0 1 0" euler="0 0 45"><attach model="w" prefix="w_"/></frame></body>
+</body></worldbody></mujoco>"""
+
+
+@pytest.fixture
+def attached(tmp_path):
+    """A model attaching a body of a child model (own angle unit, meshdir, defaults, childclass), which attaches
+    a body of a grandchild (own meshdir and mesh scale); and the grandchild's whole worldbody in a frame (its
+    world geom joins the enclosing body)."""
+    from inertia_tool.mass import shapes
+    for folder, size in (("meshes", (0.3, 0.2, 0.1)), ("sub/meshes", (0.1, 0.2, 0.3)), ("sub/g", (0.1, 0.1, 0.2))):
+        (tmp_path / folder).mkdir(parents=True)
+        shapes.write_stl(shapes.box(*size), tmp_path / folder / "part.stl")
+    (tmp_path / "sub" / "child.xml").write_text(CHILD)
+    (tmp_path / "sub" / "grand.xml").write_text(GRAND)
+    (tmp_path / "main.xml").write_text(MAIN)
+    return tmp_path / "main.xml"
+
+
+def test_attached_bodies_are_read_as_mujoco_reads_them(attached):
+    robot = read_robot(attached)
+    assert [link.name for link in robot.links] == ["base", "first", "c_hand", "body 4", "c_finger", "c_g_tip",
+                                                   "last", "w_tip", "w_other"]
+    _assert_like_mujoco(attached, link_inertials(robot, density="model"), rtol=1e-9)
+    assert compare_with_mujoco(robot) == ()
+
+
+def test_attached_with_one_density_matches_mujoco_at_that_density(attached, tmp_path):
+    # the child's default density is 2000: with MuJoCo told 2000 in the other two models, density=2000 agrees
+    default = '<default><geom density="2000"/></default>'
+    attached.write_text(MAIN.replace('<mujoco model="main">', f'<mujoco model="main">{default}'))
+    (tmp_path / "sub" / "grand.xml").write_text(GRAND.replace("<compiler", f"{default}<compiler"))
+    _assert_like_mujoco(attached, link_inertials(read_robot(attached), density=2000), rtol=1e-9)
+
+
+@pytest.mark.parametrize("attach, message", [
+    ('<attach model="c" body="hand"/>', "expected a prefix"),
+    ('<attach model="nowhere" body="hand" prefix="x_"/>', "no <asset><model name='nowhere'>"),
+    ('<attach model="c" body="nobody" prefix="x_"/>', "has no body 'nobody'"),
+    ('<attach model="self" body="base" prefix="x_"/>', "attaches itself"),
+    ('<attach model="missing" body="b" prefix="x_"/>', "does not exist"),
+])
+def test_attach_problems_are_one_sentence(attached, attach, message):
+    text = MAIN.replace('<attach model="c" body="hand" prefix="c_"/>', attach).replace(
+        "<asset>", '<asset><model name="self" file="main.xml"/><model name="missing" file="no.xml"/>')
+    attached.write_text(text)
+    with pytest.raises(RobotDescriptionError, match=message) as caught:
+        read_robot(attached)
     assert "\n" not in str(caught.value)

@@ -644,7 +644,7 @@ def _child_bodies(element, class_name: str, suffix: str = "", source: str = "", 
     ``<replicate count sep>`` repeats its bodies ``count`` times; MuJoCo names copy ``i`` of ``NAME``
     ``NAME + sep + i`` (``i`` zero-padded to the digits of ``count − 1``), inner replicates' suffixes first.
     The copies' placement (``offset``, orientation) does not change a body's own mass properties.
-    ``<attach>`` (a body of another model asset) is refused: its bodies would be missing.
+    An ``<attach>`` element is yielded as it is, with ``None`` for its class: its bodies are another model's.
     """
     budget = [MAX_REPLICAS] if budget is None else budget
     for child in element:
@@ -663,63 +663,174 @@ def _child_bodies(element, class_name: str, suffix: str = "", source: str = "", 
                 yield from _child_bodies(child, class_name, f"{child.get('sep', '')}{k:0{width}d}{suffix}", source,
                                          budget)
         elif child.tag == "attach":
-            raise _fail(source, f"<attach model={child.get('model')!r}> is not supported: its bodies would be missing "
-                                "(give the model with the attached bodies written out)")
+            yield child, None, suffix          # the caller reads the attached model (:func:`read_mjcf`)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Model:
+    """One MJCF file as its own elements are read: the main model, or a model asset an ``<attach>`` takes bodies
+    from (each keeps its own compiler angles, mesh folder, default classes, assets and contact pairs)."""
+
+    source: str
+    root: object
+    defaults: _Defaults
+    compiler: tuple
+    meshes: dict
+    hfields: dict
+    paired: frozenset
+    models: dict
+
+
+def _model(root, source: str, folder: str, packages: dict, fitaabb: bool | None = None) -> _Model:
+    """The :class:`_Model` of the ``<mujoco>`` ``root`` read from ``source`` in ``folder`` (its includes
+    expanded here, in place); ``fitaabb`` is the main model's (a compile-time setting), its own when None."""
+    fallbacks = _expand_includes(root, source)
+    if fitaabb is None:
+        fitaabb = any(c.get("fitaabb") == "true" for c in root.iter("compiler"))
+    degrees, eulerseq, meshdir = _compiler(root, source)
+    defaults = _Defaults(root, source)
+    compiler = (degrees, eulerseq, fitaabb)
+    meshes = _meshes(root, defaults, os.path.join(folder, meshdir or ""), fallbacks, compiler, source)
+    models = {}
+    for asset in root.findall("asset"):
+        for model in asset.findall("model"):
+            if not model.get("name") or not model.get("file"):
+                raise _fail(source, f"<asset><model name={model.get('name')!r} file={model.get('file')!r}>: "
+                                    "expected both a name and a file")
+            models[model.get("name")] = os.path.normpath(os.path.join(folder, model.get("file")))
+    return _Model(source, root, defaults, compiler, meshes, _hfields(root, source), _paired_geoms(root), models)
+
+
+class _Attachments:
+    """The model assets ``<attach>`` elements take bodies from, each read once, with MuJoCo's rules:
+    ``<asset><model name file>`` names a file relative to the declaring model's folder; ``<attach model body
+    prefix>`` puts the body ``body`` of that model, with its subtree, where the ``<attach>`` stands, every
+    name prefixed with ``prefix`` (required); without ``body`` the model's whole ``<worldbody>`` is attached
+    as a ``<frame>`` (its geoms join the enclosing body).  At most :data:`MAX_INCLUDE_DEPTH` models deep and
+    :data:`MAX_INCLUDED_FILES` files; a model that attaches itself is refused."""
+
+    def __init__(self, packages: dict, fitaabb: bool):
+        self.packages, self.fitaabb = packages, fitaabb
+        self.read: dict = {}
+        self.total = 0
+
+    def model(self, attach, host: _Model, stack: tuple) -> tuple[_Model, tuple]:
+        """The model asset ``attach`` names (declared in ``host``) and the attach chain extended by it."""
+        from .description import MAX_DESCRIPTION_BYTES, _read_bytes, parse_xml
+        name = attach.get("model")
+        what = f"<attach model={name!r}>"
+        if attach.get("prefix") is None:
+            raise _fail(host.source, f"{what}: expected a prefix (MuJoCo requires one)")
+        if name not in host.models:
+            raise _fail(host.source, f"{what}: no <asset><model name={name!r}> declares it")
+        path = host.models[name]
+        key = os.path.realpath(path)
+        if key in stack:
+            raise _fail(host.source, f"{what}: {path} attaches itself: {' -> '.join(stack + (key,))}")
+        if len(stack) > MAX_INCLUDE_DEPTH:
+            raise _fail(host.source, f"{what}: models attached more than {MAX_INCLUDE_DEPTH} deep")
+        if key not in self.read:
+            if not os.path.isfile(path):
+                raise _fail(host.source, f"{what}: the model file {path} does not exist")
+            if len(self.read) >= MAX_INCLUDED_FILES:
+                raise _fail(host.source, f"more than {MAX_INCLUDED_FILES} attached model files")
+            data = _read_bytes(path)
+            self.total += len(data)
+            if self.total > MAX_DESCRIPTION_BYTES:
+                raise _fail(host.source, f"the attached model files hold more than the {MAX_DESCRIPTION_BYTES:,} "
+                                         "bytes a robot description may have, all files together")
+            root = parse_xml(data, path).getroot()
+            if root.tag != "mujoco":
+                raise _fail(host.source, f"{what}: {path} has the root element <{root.tag}>, expected <mujoco>")
+            self.read[key] = _model(root, path, os.path.dirname(os.path.abspath(path)), self.packages, self.fitaabb)
+        return self.read[key], stack + (key,)
+
+
+def _attached_body(attach, model: _Model):
+    """``(body element, its default class)`` of the body an ``<attach body>`` names in ``model``; the class is
+    the ``childclass`` in force where the body stands in its own model."""
+    wanted = attach.get("body")
+    for world in model.root.findall("worldbody"):
+        for body in world.iter("body"):
+            if body.get("name") == wanted:
+                class_name = next((a.get("childclass") for a in body.iterancestors()
+                                   if a.get("childclass") is not None), "main")
+                return body, class_name
+    raise _fail(model.source, f"<attach model=... body={wanted!r}>: the model has no body {wanted!r}")
 
 
 def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
     """Bodies of an MJCF ``<mujoco>`` tree as links (see the module docstring); returns ``(model, links)``."""
+    from .description import MAX_ROBOT_LINKS
     if root.tag != "mujoco":
         raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
-    fallbacks = _expand_includes(root, source)
-    degrees, eulerseq, meshdir = _compiler(root, source)
-    fitaabb = any(c.get("fitaabb") == "true" for c in root.iter("compiler"))
+    main = _model(root, source, base, packages)
+    # compile-time settings are the main model's (MuJoCo applies them to the attached bodies too)
     group_range = next((c.get("inertiagrouprange") for c in reversed(list(root.iter("compiler")))
                         if c.get("inertiagrouprange") is not None), "0 5")
     groups = tuple(_numbers(group_range, 2, "<compiler inertiagrouprange>", source))
-    mesh_base = os.path.join(base, meshdir or "")
-    defaults = _Defaults(root, source)
-    compiler = (degrees, eulerseq, fitaabb)
-    meshes = _meshes(root, defaults, mesh_base, fallbacks, compiler, source)
-    hfields = _hfields(root, source)
-    paired = _paired_geoms(root)
+    attachments = _Attachments(packages, main.compiler[2])
     links = []
     counter = [0]
     replicas = [MAX_REPLICAS]
 
-    def walk_body(body, class_name: str, suffix: str) -> None:
+    def walk_body(body, class_name: str, suffix: str, model: _Model, prefix: str, stack: tuple) -> None:
         counter[0] += 1
-        name = body.get("name") + suffix if body.get("name") else f"body {counter[0]}"
+        if counter[0] > MAX_ROBOT_LINKS:
+            raise _fail(source, f"holds more than the {MAX_ROBOT_LINKS:,} bodies allowed (attached models "
+                                "included)")
+        name = prefix + body.get("name") + suffix if body.get("name") else f"body {counter[0]}"
         child_class = body.get("childclass", class_name)
         elements: list[GeometryElement] = []
-        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements)
+        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements, model, stack)
         links.append(LinkGeometry(name=name, elements=tuple(elements),
-                                  declared=_inertial(body, name, compiler, source)))
-        for child, cls, more in _child_bodies(body, child_class, suffix, source, replicas):
-            walk_body(child, cls, more)
+                                  declared=_inertial(body, name, model.compiler, model.source)))
+        walk_children(body, child_class, suffix, model, prefix, stack)
 
-    def collect(element, link: str, class_name: str, pose, elements: list) -> None:
+    def walk_children(element, class_name: str, suffix: str, model: _Model, prefix: str, stack: tuple) -> None:
+        for child, cls, more in _child_bodies(element, class_name, suffix, model.source, replicas):
+            if cls is not None:
+                walk_body(child, cls, more, model, prefix, stack)
+                continue
+            attached, deeper = attachments.model(child, model, stack)
+            inner = prefix + child.get("prefix")
+            if child.get("body") is None:           # the whole worldbody, as a frame
+                for world in attached.root.findall("worldbody"):
+                    walk_children(world, "main", more, attached, inner, deeper)
+            else:
+                body, body_class = _attached_body(child, attached)
+                walk_body(body, body_class, more, attached, inner, deeper)
+
+    def collect(element, link: str, class_name: str, pose, elements: list, model: _Model, stack: tuple) -> None:
+        degrees, eulerseq, _ = model.compiler
         for child in element:
             if child.tag == "geom":
-                attrs = defaults.attributes(child, class_name, source)
+                attrs = model.defaults.attributes(child, class_name, model.source)
                 if attrs.get("type") == "plane":      # MuJoCo gives a plane no mass and no inertia
                     continue
-                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", source, paired):
+                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", model.source,
+                             model.paired):
                     label = f"geom {len(elements) + 1}"
                     if attrs.get("type") == "hfield":
-                        elements.append(_hfield_geom(attrs, pose, label, link, hfields, compiler, source))
+                        elements.append(_hfield_geom(attrs, pose, label, link, model.hfields, model.compiler,
+                                                     model.source))
                         continue
-                    elements.append(_geom(attrs, pose, label, link, meshes, packages, compiler, source))
+                    elements.append(_geom(attrs, pose, label, link, model.meshes, packages, model.compiler,
+                                          model.source))
             elif child.tag == "frame":
                 attrs = dict(child.attrib)
                 rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=f"body {link!r} frame",
-                                              source=source)
-                position = _coordinates(_numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", source,
-                                                 default=(0, 0, 0)), f"body {link!r} frame pos", source)
+                                              source=model.source)
+                position = _coordinates(_numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", model.source,
+                                                 default=(0, 0, 0)), f"body {link!r} frame pos", model.source)
                 composed = (pose[0] @ rotation, pose[0] @ position + pose[1])
-                collect(child, link, child.get("childclass", class_name), composed, elements)
+                collect(child, link, child.get("childclass", class_name), composed, elements, model, stack)
+            elif child.tag == "attach" and child.get("body") is None:
+                # a whole worldbody attached as a frame: its geoms are this body's, in its own model's terms
+                attached, deeper = attachments.model(child, model, stack)
+                for world in attached.root.findall("worldbody"):
+                    collect(world, link, "main", pose, elements, attached, deeper)
 
     for world in root.findall("worldbody"):
-        for body, cls, suffix in _child_bodies(world, "main", "", source, replicas):
-            walk_body(body, cls, suffix)
+        walk_children(world, "main", "", main, "", (os.path.realpath(source),))
     return root.get("model", ""), tuple(links)
