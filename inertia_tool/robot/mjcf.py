@@ -46,6 +46,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+from typing import Any
 
 import numpy as np
 
@@ -672,7 +673,7 @@ class _Model:
     from (each keeps its own compiler angles, mesh folder, default classes, assets and contact pairs)."""
 
     source: str
-    root: object
+    root: Any               # the lxml <mujoco> element, includes expanded
     defaults: _Defaults
     compiler: tuple
     meshes: dict
