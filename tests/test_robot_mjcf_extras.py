@@ -151,7 +151,8 @@ def test_vertex_without_face_is_mujocos_convex_hull(tmp_path):
     ('vertex="0 0 0 1 0 0 0 1 0 0 0 1" face="0 1"', "triples"),
     ('face="0 1 2"', "face without vertex"),
     ('vertex="0 0 0 1 0 0 0 1 0 0 0 1" file="x.stl"', "both a file and inline vertices"),
-    ('builtin="sphere" params="1"', "builtin='sphere' meshes are not supported"),
+    ('builtin="sphere"  params="1 2 3 4 5 6 7 8 9"', "MuJoCo refuses builtin='sphere'"),
+    ('builtin="sphere" params="1" file="x.stl"', "also a file or vertices"),
 ])
 def test_bad_inline_meshes_are_one_sentence(tmp_path, mesh, message):
     path = tmp_path / "bad.xml"
@@ -236,3 +237,20 @@ def test_attach_problems_are_one_sentence(attached, attach, message):
     with pytest.raises(RobotDescriptionError, match=message) as caught:
         read_robot(attached)
     assert "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize("builtin, params", [
+    ("sphere", "1"), ("hemisphere", "2"), ("supersphere", "10 0.5 0.5"),
+    ("cone", "8 0.5"), ("wedge", "8 8 60 30 1"),                 # MuJoCo gives points only: their convex hull
+    ("supertorus", "16 0.3 0.5 0.5"),                            # not convex: MuJoCo's exact inertia
+])
+def test_builtin_meshes_are_mujocos_triangles(tmp_path, builtin, params):
+    path = tmp_path / "builtin.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true"/><asset>'
+                    f'<mesh name="m" builtin="{builtin}" params="{params}" scale="0.1 0.2 0.15" refpos="0.01 0 0.02" '
+                    'refquat="1 0.2 0 0.1" inertia="exact"/></asset><worldbody><body name="b"><freejoint/>'
+                    '<geom type="mesh" mesh="m" pos="0.1 0 0" euler="10 20 30"/></body></worldbody></mujoco>')
+    robot = read_robot(path)
+    results = link_inertials(robot, density=1000)
+    assert results[0].method == "exact", results[0].problem
+    _assert_like_mujoco(path, results, rtol=1e-6)      # MuJoCo keeps mesh vertices in float32

@@ -395,10 +395,23 @@ def _convex_hull(vertices: np.ndarray, what: str, source: str) -> np.ndarray:
 
 
 def _inline_mesh(attrs: dict, source: str) -> _InlineMesh | None:
-    """The mesh an MJCF ``<mesh vertex="x y z ..." face="i j k ...">`` spells out, or None without ``vertex``.
+    """The mesh an MJCF ``<mesh vertex="x y z ..." face="i j k ...">`` spells out, or MuJoCo generates
+    (``<mesh builtin params>``: :func:`~inertia_tool.robot.mjspec.builtin_mesh`); None for a mesh file.
 
     ``vertex`` without ``face`` is MuJoCo's convex hull of the points.  Checked as MuJoCo checks it: at least
     4 vertices, whole face indices within range; together with a ``file`` it is refused (two meshes in one)."""
+    if attrs.get("builtin") is not None and attrs.get("builtin") != "none":
+        what = f"<mesh name={attrs.get('name')!r} builtin={attrs.get('builtin')!r}>"
+        if attrs.get("file") or attrs.get("vertex") is not None:
+            raise _fail(source, f"{what}: also a file or vertices (expected one source of triangles)")
+        if not attrs.get("name"):
+            raise _fail(source, f"{what}: without a name (expected one, as it has no file to name it)")
+        from .mjspec import builtin_mesh
+        vertices, faces = builtin_mesh(attrs["builtin"], attrs.get("params"), what=what, source=source)
+        vertices = _coordinates(vertices, f"{what} vertices", source)
+        if faces is None:
+            return _InlineMesh(vertices, _convex_hull(vertices, what, source), hull=True)
+        return _InlineMesh(vertices, faces, hull=False)
     if attrs.get("vertex") is None:
         if attrs.get("face") is not None:
             raise _fail(source, f"<mesh name={attrs.get('name')!r}>: face without vertex")
@@ -442,9 +455,6 @@ def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler
             inline = _inline_mesh(attrs, source)
             file = attrs.get("file")
             if not file and inline is None:
-                if attrs.get("builtin") is not None:
-                    raise _fail(source, f"<mesh name={attrs.get('name')!r}>: builtin={attrs.get('builtin')!r} "
-                                        "meshes are not supported (expected a file, or vertex and face)")
                 raise _fail(source, f"<mesh name={attrs.get('name')!r}> without a file or vertex")
             name = attrs.get("name") or os.path.splitext(os.path.basename(file or ""))[0]
             what = f"<mesh name={name!r}>"
