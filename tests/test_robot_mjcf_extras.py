@@ -254,3 +254,22 @@ def test_builtin_meshes_are_mujocos_triangles(tmp_path, builtin, params):
     results = link_inertials(robot, density=1000)
     assert results[0].method == "exact", results[0].problem
     _assert_like_mujoco(path, results, rtol=1e-6)      # MuJoCo keeps mesh vertices in float32
+
+
+# -- <replicate> of geoms in a body ------------------------------------------------------------------------
+
+@pytest.mark.parametrize("angle, turn", [("degree", "0 10 30"), ("radian", "0.1 0.2 0.5")])
+def test_geoms_replicated_in_a_body_are_all_counted_where_mujoco_puts_them(tmp_path, angle, turn):
+    # the reader once skipped geoms inside a <replicate> in a body: the body's mass lacked every copy
+    path = tmp_path / "rep.xml"
+    path.write_text(f'<mujoco><compiler inertiafromgeom="true" angle="{angle}" eulerseq="zyx"/><worldbody>'
+                    '<body name="wheel"><freejoint/><geom type="cylinder" size="0.05 0.02"/>'
+                    f'<replicate count="5" offset="0.2 0 0.01" euler="{turn}">'
+                    '<geom type="box" size="0.05 0.01 0.02" pos="0.2 0.1 0" euler="0.3 0 0"/>'
+                    '<frame pos="0 0 0.05"><replicate count="2" offset="0 0.1 0">'
+                    '<geom type="capsule" size="0.01 0.03" pos="0 0 0.1"/></replicate></frame>'
+                    '</replicate></body></worldbody></mujoco>')
+    robot = read_robot(path)
+    assert len(robot.links[0].elements) == 1 + 5 * (1 + 2)
+    _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-9)
+    assert compare_with_mujoco(robot) == ()
