@@ -2,9 +2,10 @@
 
 What is read (MuJoCo XML reference, "MJCF"): ``<compiler angle eulerseq meshdir assetdir>`` (angles in
 **degrees** unless ``angle="radian"``, MuJoCo's default), ``<default>`` classes (nested, ``class`` and
-``childclass``) for ``<geom>`` and ``<mesh>`` attributes, ``<asset><mesh name file scale>``, and under
-``<worldbody>`` every ``<body>`` (``<frame>`` elements compose their pose into the geoms they hold,
-``<replicate>`` copies its bodies).  A geom's
+``childclass``) for ``<geom>`` and ``<mesh>`` attributes, ``<asset><mesh name file scale>`` (or inline
+``vertex``/``face``, or ``builtin``), ``<asset><hfield size>``, and under ``<worldbody>`` every ``<body>``
+(``<frame>`` elements compose their pose into the geoms they hold, ``<replicate>`` copies its bodies and
+geoms, ``<attach>`` brings in the bodies of an ``<asset><model>``).  A geom's
 frame is ``pos`` and one of ``quat`` (w x y z), ``axisangle``, ``euler`` (sequence ``eulerseq``: lower case
 letters rotate with the frame, upper case stay fixed), ``xyaxes``, ``zaxis``; or ``fromto`` for capsules,
 cylinders, boxes and ellipsoids (the axis runs from the first point to the second).  Sizes are MuJoCo's
@@ -13,7 +14,8 @@ half-sizes: box half-edges, cylinder and capsule ``radius half-length``, ellipso
 Collision geoms are those with ``contype`` or ``conaffinity`` non-zero (MuJoCo's default is 1) and those
 named in a ``<contact><pair>`` (MuJoCo collides them whatever their bit masks); the others are visual.  Geoms
 directly in ``<worldbody>`` belong to no body and are skipped, and so are planes in a body (MuJoCo gives them
-no mass or inertia).  Inline mesh vertices and height fields are refused with a message.
+no mass or inertia).  A height field in a body is MuJoCo's inertia box (:func:`_hfield_geom`), noted on the
+element.
 
 MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
 
@@ -35,6 +37,8 @@ MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
   section) still come from ``size``.
 * Mesh ``refpos``/``refquat``: file vertices ``v`` become ``scale ⊙ (q̄ (v − refpos) q)`` — the reference
   position is subtracted, the conjugate of ``refquat`` rotates, the scale applies last.
+* ``<attach model body prefix>``: :class:`_Attachments`; ``<mesh vertex face>`` and ``builtin``:
+  :func:`_inline_mesh`; copies of geoms in a ``<replicate>``: :func:`_replica_poses`.
 * Geom ``density`` (kg/m³, default 1000), ``mass`` (kg; when given, the geom's density is ``mass / volume``)
   and ``shellinertia`` (mass on the surface; for meshes MuJoCo uses ``<mesh inertia="shell">`` instead) are
   kept on each :class:`GeometryElement` for the "model's own densities" mode; a geom with ``mass="0"`` or
