@@ -273,3 +273,17 @@ def test_geoms_replicated_in_a_body_are_all_counted_where_mujoco_puts_them(tmp_p
     assert len(robot.links[0].elements) == 1 + 5 * (1 + 2)
     _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-9)
     assert compare_with_mujoco(robot) == ()
+
+
+def test_a_copy_written_elsewhere_still_attaches_its_model(attached, tmp_path):
+    # the attached bodies live in the model files, which are not written: they are named as left as they were,
+    # and the copy's <model file> is re-expressed from its own folder, so MuJoCo still finds the child
+    from inertia_tool.robot.write import write_corrected
+    robot = read_robot(attached)
+    out = tmp_path / "elsewhere" / "deeper" / "main.xml"
+    out.parent.mkdir(parents=True)
+    changed = write_corrected(robot, link_inertials(robot, density="model"), out)
+    assert set(changed) == {"base", "first", "last"}
+    theirs = _mujoco_bodies(out)
+    assert set(theirs) == set(_mujoco_bodies(attached))
+    assert theirs["c_g_tip"][0] == pytest.approx(_mujoco_bodies(attached)["c_g_tip"][0], rel=1e-12)
