@@ -287,3 +287,50 @@ def test_a_copy_written_elsewhere_still_attaches_its_model(attached, tmp_path):
     theirs = _mujoco_bodies(out)
     assert set(theirs) == set(_mujoco_bodies(attached))
     assert theirs["c_g_tip"][0] == pytest.approx(_mujoco_bodies(attached)["c_g_tip"][0], rel=1e-12)
+
+
+# -- adversarial: generated replicates and point clouds against MuJoCo ---------------------------------------
+
+from hypothesis import given, settings, strategies as st  # noqa: E402
+
+_angles = st.lists(st.floats(-180, 180, allow_nan=False).map(lambda a: round(a, 3)), min_size=3, max_size=3)
+_offset = st.lists(st.floats(-0.5, 0.5, allow_nan=False).map(lambda a: round(a, 4)), min_size=3, max_size=3)
+
+
+@settings(max_examples=25, deadline=None)
+@given(count=st.integers(1, 6), angles=_angles, offset=_offset, sequence=st.sampled_from(["xyz", "zyx", "XYZ", "xYz"]),
+       inner=st.integers(1, 3))
+def test_generated_replicates_of_geoms_match_mujoco(tmp_path_factory, count, angles, offset, sequence, inner):
+    path = tmp_path_factory.mktemp("rep") / "r.xml"
+    turn, step = " ".join(map(str, angles)), " ".join(map(str, offset))
+    path.write_text(f'<mujoco><compiler inertiafromgeom="true" eulerseq="{sequence}"/><worldbody><body name="b">'
+                    f'<geom type="sphere" size="0.05"/><replicate count="{count}" offset="{step}" euler="{turn}">'
+                    '<geom type="box" size="0.05 0.01 0.02" pos="0.2 0.1 0" euler="30 0 10"/>'
+                    f'<replicate count="{inner}" offset="{step}" euler="{turn}"><geom type="capsule" size="0.01 0.03" '
+                    'pos="0 0.05 0.1"/></replicate></replicate></body></worldbody></mujoco>')
+    robot = read_robot(path)
+    _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-9)
+    assert compare_with_mujoco(robot) == ()
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2 ** 32 - 1), count=st.integers(4, 40), flat=st.booleans())
+def test_generated_point_clouds_are_mujocos_hull(tmp_path_factory, seed, count, flat):
+    # random points (some on a grid of one plane when `flat`, so that hull facets have coplanar points)
+    rng = np.random.default_rng(seed)
+    points = np.round(rng.uniform(-1, 1, (count, 3)), 2)
+    if flat:
+        points[: count // 2, 2] = -1.0
+    path = tmp_path_factory.mktemp("hull") / "h.xml"
+    vertex = " ".join(f"{v:g}" for v in points.ravel())
+    path.write_text(f'<mujoco><compiler inertiafromgeom="true"/><asset><mesh name="m" vertex="{vertex}"/></asset>'
+                    '<worldbody><body name="b"><geom type="mesh" mesh="m"/></body></worldbody></mujoco>')
+    try:
+        mujoco.MjModel.from_xml_path(str(path))
+    except ValueError:              # MuJoCo refuses it (coplanar points): so must the reader
+        with pytest.raises(RobotDescriptionError):
+            link_inertials(read_robot(path), density=1000)
+        return
+    results = link_inertials(read_robot(path), density=1000)
+    assert results[0].method == "exact"
+    _assert_like_mujoco(path, results, rtol=1e-6)      # float32 vertices in MuJoCo
