@@ -334,3 +334,14 @@ def test_generated_point_clouds_are_mujocos_hull(tmp_path_factory, seed, count, 
     results = link_inertials(read_robot(path), density=1000)
     assert results[0].method == "exact"
     _assert_like_mujoco(path, results, rtol=1e-6)      # float32 vertices in MuJoCo
+
+
+def test_attaches_that_multiply_are_bounded(tmp_path):
+    # each level attaches the next ten times: 10^5 bodies from five small files, refused at the body limit
+    for level in range(5):
+        attaches = "".join(f'<attach model="n" body="b" prefix="p{k}_"/>' for k in range(10))
+        nxt = f'<asset><model name="n" file="l{level + 1}.xml"/></asset>' if level < 4 else ""
+        (tmp_path / f"l{level}.xml").write_text(f'<mujoco>{nxt}<worldbody><body name="b"><geom size="0.1"/>'
+                                                f'{attaches if level < 4 else ""}</body></worldbody></mujoco>')
+    with pytest.raises(RobotDescriptionError, match="more than the 10,000 bodies allowed"):
+        read_robot(tmp_path / "l0.xml")

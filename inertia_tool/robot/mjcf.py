@@ -305,8 +305,11 @@ def _own_mesh_folder(root, folder: str) -> str:
 
 
 def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
-                     max_files: int = MAX_INCLUDED_FILES) -> dict:
+                     max_files: int = MAX_INCLUDED_FILES, budget: list | None = None) -> dict:
     """Replace every ``<include file>`` under ``root`` by the included ``<mujoco>``'s children, in place.
+
+    ``budget``: ``[files, bytes]`` already read by other files of the same model (the models ``<attach>``
+    brings in share one budget with the main model's includes); updated in place.
 
     Returns ``{<mesh> element: fallback folders}`` for meshes declared in included files: the declaring
     file's own mesh folder, then those of the files that included it, outwards (used when MuJoCo's
@@ -315,8 +318,8 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
     from .description import MAX_DESCRIPTION_BYTES, _read_bytes, parse_xml
     main_folder = os.path.dirname(os.path.abspath(source))
     fallbacks: dict = {}
-    count = [0]
-    total = [os.path.getsize(source) if os.path.isfile(source) else 0]
+    if budget is None:
+        budget = [0, os.path.getsize(source) if os.path.isfile(source) else 0]
 
     def expand(element, including: str, stack: tuple, chain: tuple) -> None:
         for include in list(element.iter("include")):
@@ -336,12 +339,12 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
             if len(stack) >= max_depth:
                 raise _fail(source, f"<include file={name!r}> (in {including}): includes nested more than "
                                     f"{max_depth} deep")
-            count[0] += 1
-            if count[0] > max_files:
+            budget[0] += 1
+            if budget[0] > max_files:
                 raise _fail(source, f"more than {max_files} included files")
             data = _read_bytes(path)
-            total[0] += len(data)
-            if total[0] > MAX_DESCRIPTION_BYTES:
+            budget[1] += len(data)
+            if budget[1] > MAX_DESCRIPTION_BYTES:
                 raise _fail(source, f"the included files hold more than the {MAX_DESCRIPTION_BYTES:,} bytes a robot "
                                     "description may have, all files together")
             included = parse_xml(data, path).getroot()
@@ -723,10 +726,11 @@ class _Model:
     models: dict
 
 
-def _model(root, source: str, folder: str, packages: dict, fitaabb: bool | None = None) -> _Model:
+def _model(root, source: str, folder: str, packages: dict, budget: list, fitaabb: bool | None = None) -> _Model:
     """The :class:`_Model` of the ``<mujoco>`` ``root`` read from ``source`` in ``folder`` (its includes
-    expanded here, in place); ``fitaabb`` is the main model's (a compile-time setting), its own when None."""
-    fallbacks = _expand_includes(root, source)
+    expanded here, in place, counted in ``budget``: ``[files, bytes]`` of the whole model); ``fitaabb`` is the
+    main model's (a compile-time setting), its own when None."""
+    fallbacks = _expand_includes(root, source, budget=budget)
     if fitaabb is None:
         fitaabb = any(c.get("fitaabb") == "true" for c in root.iter("compiler"))
     degrees, eulerseq, meshdir = _compiler(root, source)
@@ -751,10 +755,9 @@ class _Attachments:
     as a ``<frame>`` (its geoms join the enclosing body).  At most :data:`MAX_INCLUDE_DEPTH` models deep and
     :data:`MAX_INCLUDED_FILES` files; a model that attaches itself is refused."""
 
-    def __init__(self, packages: dict, fitaabb: bool):
-        self.packages, self.fitaabb = packages, fitaabb
+    def __init__(self, packages: dict, fitaabb: bool, budget: list):
+        self.packages, self.fitaabb, self.budget = packages, fitaabb, budget
         self.read: dict = {}
-        self.total = 0
 
     def model(self, attach, host: _Model, stack: tuple) -> tuple[_Model, tuple]:
         """The model asset ``attach`` names (declared in ``host``) and the attach chain extended by it."""
@@ -774,17 +777,20 @@ class _Attachments:
         if key not in self.read:
             if not os.path.isfile(path):
                 raise _fail(host.source, f"{what}: the model file {path} does not exist")
-            if len(self.read) >= MAX_INCLUDED_FILES:
-                raise _fail(host.source, f"more than {MAX_INCLUDED_FILES} attached model files")
+            self.budget[0] += 1
+            if self.budget[0] > MAX_INCLUDED_FILES:
+                raise _fail(host.source, f"more than {MAX_INCLUDED_FILES} included and attached files")
             data = _read_bytes(path)
-            self.total += len(data)
-            if self.total > MAX_DESCRIPTION_BYTES:
-                raise _fail(host.source, f"the attached model files hold more than the {MAX_DESCRIPTION_BYTES:,} "
-                                         "bytes a robot description may have, all files together")
+            self.budget[1] += len(data)
+            if self.budget[1] > MAX_DESCRIPTION_BYTES:
+                raise _fail(host.source, f"the included and attached files hold more than the "
+                                         f"{MAX_DESCRIPTION_BYTES:,} bytes a robot description may have, all "
+                                         "files together")
             root = parse_xml(data, path).getroot()
             if root.tag != "mujoco":
                 raise _fail(host.source, f"{what}: {path} has the root element <{root.tag}>, expected <mujoco>")
-            self.read[key] = _model(root, path, os.path.dirname(os.path.abspath(path)), self.packages, self.fitaabb)
+            self.read[key] = _model(root, path, os.path.dirname(os.path.abspath(path)), self.packages, self.budget,
+                                    self.fitaabb)
         return self.read[key], stack + (key,)
 
 
@@ -806,12 +812,13 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
     from .description import MAX_ROBOT_LINKS
     if root.tag != "mujoco":
         raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
-    main = _model(root, source, base, packages)
+    budget = [0, os.path.getsize(source) if os.path.isfile(source) else 0]     # [files, bytes] read in all
+    main = _model(root, source, base, packages, budget)
     # compile-time settings are the main model's (MuJoCo applies them to the attached bodies too)
     group_range = next((c.get("inertiagrouprange") for c in reversed(list(root.iter("compiler")))
                         if c.get("inertiagrouprange") is not None), "0 5")
     groups = tuple(_numbers(group_range, 2, "<compiler inertiagrouprange>", source))
-    attachments = _Attachments(packages, main.compiler[2])
+    attachments = _Attachments(packages, main.compiler[2], budget)
     links = []
     counter = [0]
     replicas = [MAX_REPLICAS]
