@@ -2,6 +2,7 @@
 around the description without environment variables, SDFormat <include> and nested models, a licence comment
 before the XML declaration, COLLADA files whose <image> has no path and whose triangles are in <polylist>."""
 
+import json
 import re
 
 import numpy as np
@@ -264,3 +265,16 @@ def test_a_missing_model_names_the_folders_searched(tmp_path, gazebo_models, mon
     assert "cannot find model 'sunflower'" in message and "\n" not in message
     assert f"GZ_SIM_RESOURCE_PATH={str(tmp_path / 'elsewhere')!r}" in message
     assert "GAZEBO_MODEL_PATH (unset)" in message and str(tmp_path / "models") in message
+
+
+def test_cli_reads_a_world_with_stock_models_and_says_what_it_skipped(tmp_path, gazebo_models, capsys):
+    from inertia_tool.cli import main
+    world = tmp_path / "models" / "w.world"
+    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://sun</uri></include>'
+                     '<include><uri>model://ground_plane</uri></include>'
+                     '<include><uri>model://gripper</uri></include></world></sdf>')
+    assert main(["robot", str(world), "--density", "1000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [link["name"] for link in out["links"]] == ["gripper::finger"]
+    skipped = [w for w in out["warnings"] if "skipped" in w]
+    assert len(skipped) == 2 and "'sun'" in skipped[0] and "'ground_plane'" in skipped[1]

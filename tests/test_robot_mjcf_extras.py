@@ -345,3 +345,11 @@ def test_attaches_that_multiply_are_bounded(tmp_path):
                                                 f'{attaches if level < 4 else ""}</body></worldbody></mujoco>')
     with pytest.raises(RobotDescriptionError, match="more than the 10,000 bodies allowed"):
         read_robot(tmp_path / "l0.xml")
+
+
+def test_a_scene_of_world_geoms_only_says_so(tmp_path):
+    path = tmp_path / "scene.xml"
+    path.write_text('<mujoco><asset><hfield name="t" nrow="2" ncol="2" size="1 1 0.1 0.1"/></asset><worldbody>'
+                    '<geom type="hfield" hfield="t"/><geom type="box" size="1 1 0.1"/></worldbody></mujoco>')
+    with pytest.raises(RobotDescriptionError, match="no bodies: every geom is in <worldbody>"):
+        read_robot(path)

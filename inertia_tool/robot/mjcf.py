@@ -885,4 +885,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
 
     for world in root.findall("worldbody"):
         walk_children(world, "main", "", main, "", (os.path.realpath(source),))
+    if not links and any(world.find("geom") is not None for world in root.findall("worldbody")):
+        raise _fail(source, "no bodies: every geom is in <worldbody> (a scene: terrain, floor, walls), which MuJoCo "
+                            "fixes to the world with no mass; expected a model with at least one <body>")
     return root.get("model", ""), tuple(links)
