@@ -380,7 +380,6 @@ class _InlineMesh:
 
     vertices: np.ndarray
     faces: np.ndarray
-    hull: bool
 
 
 def _convex_hull(vertices: np.ndarray, what: str, source: str) -> np.ndarray:
@@ -417,8 +416,8 @@ def _inline_mesh(attrs: dict, source: str) -> _InlineMesh | None:
         vertices, faces = builtin_mesh(attrs["builtin"], attrs.get("params"), what=what, source=source)
         vertices = _coordinates(vertices, f"{what} vertices", source)
         if faces is None:
-            return _InlineMesh(vertices, _convex_hull(vertices, what, source), hull=True)
-        return _InlineMesh(vertices, faces, hull=False)
+            return _InlineMesh(vertices, _convex_hull(vertices, what, source))
+        return _InlineMesh(vertices, faces)
     if attrs.get("vertex") is None:
         if attrs.get("face") is not None:
             raise _fail(source, f"<mesh name={attrs.get('name')!r}>: face without vertex")
@@ -434,13 +433,13 @@ def _inline_mesh(attrs: dict, source: str) -> _InlineMesh | None:
                             f"{flat.size} numbers")
     vertices = _coordinates(flat.reshape(-1, 3), f"{what} vertex", source)
     if attrs.get("face") is None:
-        return _InlineMesh(vertices, _convex_hull(vertices, what, source), hull=True)
+        return _InlineMesh(vertices, _convex_hull(vertices, what, source))
     indices = _numbers(attrs["face"], None, f"{what} face", source)
     if (indices.size % 3 or indices.size == 0 or indices.size > 6 * MAX_INLINE_VERTICES
             or np.any(indices != np.round(indices)) or np.any(indices < 0) or np.any(indices >= len(vertices))):
         raise _fail(source, f"{what}: expected face to hold triples of whole vertex indices from 0 to "
                             f"{len(vertices) - 1}, got {' '.join(str(attrs['face']).split())[:80]!r}")
-    return _InlineMesh(vertices, indices.astype(np.int64).reshape(-1, 3), hull=False)
+    return _InlineMesh(vertices, indices.astype(np.int64).reshape(-1, 3))
 
 
 def _mesh_source(file, folders, packages: dict, source: str, link: str) -> dict:
