@@ -278,3 +278,20 @@ def test_cli_reads_a_world_with_stock_models_and_says_what_it_skipped(tmp_path, 
     assert [link["name"] for link in out["links"]] == ["gripper::finger"]
     skipped = [w for w in out["warnings"] if "skipped" in w]
     assert len(skipped) == 2 and "'sun'" in skipped[0] and "'ground_plane'" in skipped[1]
+
+
+def test_fuel_urls_of_stock_models_are_skipped_and_others_named(tmp_path, gazebo_models):
+    # gz-sim worlds include the sun and the ground plane from Gazebo Fuel; nothing is downloaded
+    world = tmp_path / "models" / "w.world"
+    world.write_text('<sdf version="1.9"><world name="w">'
+                     '<include><uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/Sun</uri></include>'
+                     '<include><uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/Ground%20Plane/2</uri>'
+                     '</include><include><uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/gripper</uri>'
+                     '</include></world></sdf>')
+    with pytest.warns(SkippedModelWarning):
+        robot = read_robot(world)
+    assert [link.name for link in robot.links] == ["gripper::finger"]       # found on disk by its name
+    world.write_text('<sdf version="1.9"><world name="w"><include><uri>https://fuel.gazebosim.org/1.0/'
+                     'OpenRobotics/models/Fancy Table</uri></include></world></sdf>')
+    with pytest.raises(RobotDescriptionError, match="a Gazebo Fuel model \\('Fancy Table'\\).*'fancy_table'"):
+        read_robot(world)

@@ -673,21 +673,54 @@ def _searched_folders(scheme: str, packages: dict, base: str) -> str:
     return "; ".join(parts)
 
 
+def _skip_stock_model(uri: str, name: str, source: str) -> None:
+    """Warn that the include ``uri`` of the stock model ``name`` (:data:`STOCK_MODELS_WITHOUT_MASS`) is skipped."""
+    warnings.warn(SkippedModelWarning(f"{source}: <include> {uri!r} skipped: Gazebo's stock model {name!r} "
+                                      f"({STOCK_MODELS_WITHOUT_MASS[name]}, no link with mass) is not on disk"),
+                  stacklevel=3)
+
+
+def _fuel_model(scheme: str, rest: str) -> str | None:
+    """The model name of a Gazebo Fuel URL (``https://fuel.gazebosim.org/1.0/OpenRobotics/models/Ground
+    Plane/2``: ``"Ground Plane"``), None for any other URL."""
+    from urllib.parse import unquote
+    if scheme not in ("http", "https") or "/models/" not in rest:
+        return None
+    host = rest.split("/", 1)[0].lower()
+    if not host.startswith(("fuel.", "app.")):
+        return None
+    return unquote(rest.split("/models/", 1)[1].split("/", 1)[0]).strip() or None
+
+
 def _sdf_include_file(include, base: str, packages: dict, source: str) -> str | None:
     """The SDFormat file an ``<include><uri>`` names: a file, or a model folder (its ``model.config``'s
     ``<sdf>`` file, else ``model.sdf``); None for a stock model of :data:`STOCK_MODELS_WITHOUT_MASS` that is not
-    on disk (skipped, with a :class:`~inertia_tool.errors.SkippedModelWarning` naming it)."""
+    on disk (skipped, with a :class:`~inertia_tool.errors.SkippedModelWarning` naming it).
+
+    A Gazebo Fuel URL (``https://fuel.gazebosim.org/.../models/Sun``, which Gazebo downloads) is never fetched:
+    its model is looked up on disk as ``model://`` would be, under its name in lower case with ``_`` for
+    spaces (``Ground Plane``: ``ground_plane``); a stock model is skipped, any other is refused naming it."""
     uri = (include.findtext("uri") or "").strip()
     if not uri:
         raise _fail(source, "<include> without a <uri>")
     scheme, sep, rest = uri.partition("://")
-    if sep and scheme in ("model", "package"):
+    fuel = _fuel_model(scheme, rest) if sep else None
+    if fuel is not None:
+        name = fuel.lower().replace(" ", "_")
+        directory = package_directory(name, packages, scheme="model", near=base)
+        if directory is None and name in STOCK_MODELS_WITHOUT_MASS:
+            _skip_stock_model(uri, name, source)
+            return None
+        if directory is None:
+            raise _fail(source, f"<include> {uri!r}: a Gazebo Fuel model ({fuel!r}), which Gazebo downloads and "
+                                f"this tool does not; expected a folder {name!r} on disk, searched "
+                                f"{_searched_folders('model', packages, base)}")
+        path = directory
+    elif sep and scheme in ("model", "package"):
         name, _, inner = rest.partition("/")
         directory = package_directory(name, packages, scheme=scheme, near=base)
         if directory is None and scheme == "model" and name in STOCK_MODELS_WITHOUT_MASS:
-            warnings.warn(SkippedModelWarning(f"{source}: <include> {uri!r} skipped: Gazebo's stock model {name!r} "
-                                              f"({STOCK_MODELS_WITHOUT_MASS[name]}, no link with mass) is not on "
-                                              "disk"), stacklevel=2)
+            _skip_stock_model(uri, name, source)
             return None
         if directory is None:
             raise _fail(source, f"<include> {uri!r}: cannot find model {name!r}; searched "
