@@ -90,7 +90,7 @@ def mesh_properties(path: str | None, *, repair: bool = False, max_faces: int | 
     return mass_properties(raw, density=1.0, repair=repair)
 
 
-def mesh_label(element: GeometryElement) -> str:
+def _mesh_label(element: GeometryElement) -> str:
     """The mesh of ``element`` for messages: its file, or ``inline mesh of geom NAME``."""
     return element.mesh if element.mesh is not None else f"inline mesh of {element.name!r}"
 
@@ -103,10 +103,10 @@ def _raw_mesh(path: str | None, element: GeometryElement | None, max_faces: int 
             raise UsageError("Expected a mesh file or an element with inline vertices and faces, got neither")
         faces = np.asarray(element.faces)
         if max_faces is not None and len(faces) > max_faces:
-            raise MeshReadError(f"{mesh_label(element)}: {len(faces):,} triangles, more than `max_faces` "
+            raise MeshReadError(f"{_mesh_label(element)}: {len(faces):,} triangles, more than `max_faces` "
                                 f"({max_faces:,})")
         return RawMesh(vertices=np.array(element.vertices, dtype=np.float64), faces=faces.copy(),
-                       source=mesh_label(element), units="m", file_faces=len(faces))
+                       source=_mesh_label(element), units="m", file_faces=len(faces))
     from ..mesh.read import load_mesh
     # robot descriptions give mesh coordinates in metres (the element's `scale` is applied here), so the unit is
     # stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
@@ -285,7 +285,7 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
     if entry is not None:
         outcome, caught, faces = entry
         if budget is not None and faces > budget[0] and not isinstance(outcome, BaseException):
-            outcome = MeshReadError(f"{mesh_label(element)}: {faces:,} triangles, more than the {budget[0]:,} that "
+            outcome = MeshReadError(f"{_mesh_label(element)}: {faces:,} triangles, more than the {budget[0]:,} that "
                                     f"`max_faces` leaves (the limit counts all the robot's meshes together, "
                                     f"{budget[1]:,})")
         elif budget is not None:
@@ -293,7 +293,7 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
         _reissue(caught)
     else:
         if budget is not None and budget[0] < 1:
-            raise MeshReadError(f"{mesh_label(element)}: not read: the meshes read before it hold all the triangles "
+            raise MeshReadError(f"{_mesh_label(element)}: not read: the meshes read before it hold all the triangles "
                                 "`max_faces` allows (the limit is on all the meshes of the robot together)")
         faces = 0
         with warnings.catch_warnings(record=True) as recorded:
