@@ -82,6 +82,9 @@ def test_an_undefined_height_field_is_named(tmp_path):
                     '</worldbody></mujoco>')
     with pytest.raises(RobotDescriptionError, match="height field 'nowhere' is not defined"):
         read_robot(path)
+    path.write_text('<mujoco><worldbody><body name="b"><geom type="hfield"/></body></worldbody></mujoco>')
+    with pytest.raises(RobotDescriptionError, match="a height field geom without hfield"):
+        read_robot(path)
 
 
 # -- inline meshes ------------------------------------------------------------------------------------------

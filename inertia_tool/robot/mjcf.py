@@ -499,6 +499,9 @@ def _hfield_geom(attrs: dict, pose, label: str, link: str, hfields: dict, compil
     ``<hfield size>`` (checked against ``mujoco`` 4.0: ``geom_size`` and the body's mass, centre and inertia
     are those of this box, whatever the elevation data), noted on the element as a stand-in."""
     name = attrs.get("hfield")
+    if name is None:
+        raise _fail(source, f"body {link!r} {label}: a height field geom without hfield (expected the name of an "
+                            "<asset><hfield>)")
     if name not in hfields:
         raise _fail(source, f"body {link!r} {label}: height field {name!r} is not defined in <asset>")
     rx, ry, elevation, base = hfields[name]
