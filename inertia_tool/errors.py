@@ -67,6 +67,7 @@ __all__ = [
     "PivotOffPartWarning",
     "StoragePrecisionWarning",
     "NonMaterialVolumeWarning",
+    "SkippedModelWarning",
 ]
 
 
@@ -295,3 +296,9 @@ class NonMaterialVolumeWarning(InertiaToolWarning):
     """A slicer project holds volumes that are not material (PrusaSlicer's modifiers, support blockers and
     enforcers; Bambu Studio's modifier parts): they change how the slicer prints, not what is printed, and
     are left out of the mass properties."""
+
+
+class SkippedModelWarning(InertiaToolWarning):
+    """A robot description (a Gazebo world) includes a stock model that is not on disk and has no link with
+    mass (``model://sun``, a light; ``model://ground_plane``, a static plane): it is skipped, and the message
+    names it."""

@@ -2,16 +2,18 @@
 around the description without environment variables, SDFormat <include> and nested models, a licence comment
 before the XML declaration, COLLADA files whose <image> has no path and whose triangles are in <polylist>."""
 
+import json
 import re
 
 import numpy as np
 import pytest
 
-from inertia_tool.errors import RobotDescriptionError
+from inertia_tool.errors import RobotDescriptionError, SkippedModelWarning
 from inertia_tool.mass import shapes
 from inertia_tool.mesh.read import load_mesh
 from inertia_tool.robot import link_inertials, read_robot
 from inertia_tool.robot.write import write_corrected
+from inertia_tool.reports.robot_audit import links_without_result
 
 LICENCE = b"<!--\n  Copyright (c) a robot maker. Licensed under the Apache License, Version 2.0.\n-->\n"
 
@@ -210,3 +212,86 @@ def test_includes_that_multiply_are_bounded(tmp_path):
     (tmp_path / "j12.xml").write_text('<mujoco/>')
     with pytest.raises(RobotDescriptionError, match="more than 512 included files"):
         read_robot(tmp_path / "j0.xml")
+
+
+GROUND_PLANE = ('<model name="ground_plane"><static>true</static><link name="link"><collision name="c"><geometry>'
+                '<plane><normal>0 0 1</normal><size>100 100</size></plane></geometry></collision><visual name="v">'
+                '<geometry><plane><normal>0 0 1</normal><size>100 100</size></plane></geometry></visual></link>'
+                '</model>')
+
+
+def test_stock_sun_and_ground_plane_not_on_disk_are_skipped_with_a_note(tmp_path, gazebo_models):
+    # issue 23 item 4: nearly every Gazebo world includes model://sun and model://ground_plane, which are not
+    # shipped with the robot; they hold no link with mass, so the world is read without them and each is named
+    world = tmp_path / "models" / "w.world"
+    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://sun</uri></include>'
+                     '<include><uri>model://ground_plane</uri></include>'
+                     '<include><uri>model://gripper</uri></include></world></sdf>')
+    with pytest.warns(SkippedModelWarning) as caught:
+        robot = read_robot(world)
+    assert [link.name for link in robot.links] == ["gripper::finger"]
+    messages = [str(w.message) for w in caught if issubclass(w.category, SkippedModelWarning)]
+    assert len(messages) == 2 and "'sun'" in messages[0] and "'ground_plane'" in messages[1]
+    assert all("\n" not in m for m in messages)
+
+
+def test_a_ground_plane_on_disk_or_inline_is_a_link_without_geometry(tmp_path, gazebo_models):
+    plane = tmp_path / "models" / "ground_plane"
+    plane.mkdir()
+    (plane / "model.sdf").write_text(f'<sdf version="1.6">{GROUND_PLANE}</sdf>')
+    world = tmp_path / "models" / "w.world"
+    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://ground_plane</uri></include>'
+                     f'{GROUND_PLANE.replace("ground_plane", "floor")}<model name="t"><static>true</static>'
+                     '<link name="terrain"><collision name="h"><geometry><heightmap><uri>h.png</uri>'
+                     '<size>10 10 1</size></heightmap></geometry></collision></link></model>'
+                     '<include><uri>model://gripper</uri></include></world></sdf>')
+    robot = read_robot(world)
+    names = {link.name: link for link in robot.links}
+    assert set(names) == {"ground_plane::link", "floor::link", "t::terrain", "gripper::finger"}
+    assert names["ground_plane::link"].elements == () and names["t::terrain"].elements == ()
+    results = {r.name: r for r in link_inertials(robot, density=1000)}
+    assert results["gripper::finger"].properties.mass == pytest.approx(1000 * 0.01 * 0.02 * 0.03, rel=1e-6)
+    assert links_without_result(robot, results.values()) == []
+
+
+def test_a_missing_model_names_the_folders_searched(tmp_path, gazebo_models, monkeypatch):
+    monkeypatch.setenv("GZ_SIM_RESOURCE_PATH", str(tmp_path / "elsewhere"))
+    world = tmp_path / "models" / "w.world"
+    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://sunflower</uri></include></world>'
+                     '</sdf>')
+    with pytest.raises(RobotDescriptionError) as caught:
+        read_robot(world)
+    message = str(caught.value)
+    assert "cannot find model 'sunflower'" in message and "\n" not in message
+    assert f"GZ_SIM_RESOURCE_PATH={str(tmp_path / 'elsewhere')!r}" in message
+    assert "GAZEBO_MODEL_PATH (unset)" in message and str(tmp_path / "models") in message
+
+
+def test_cli_reads_a_world_with_stock_models_and_says_what_it_skipped(tmp_path, gazebo_models, capsys):
+    from inertia_tool.cli import main
+    world = tmp_path / "models" / "w.world"
+    world.write_text('<sdf version="1.6"><world name="w"><include><uri>model://sun</uri></include>'
+                     '<include><uri>model://ground_plane</uri></include>'
+                     '<include><uri>model://gripper</uri></include></world></sdf>')
+    assert main(["robot", str(world), "--density", "1000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [link["name"] for link in out["links"]] == ["gripper::finger"]
+    skipped = [w for w in out["warnings"] if "skipped" in w]
+    assert len(skipped) == 2 and "'sun'" in skipped[0] and "'ground_plane'" in skipped[1]
+
+
+def test_fuel_urls_of_stock_models_are_skipped_and_others_named(tmp_path, gazebo_models):
+    # gz-sim worlds include the sun and the ground plane from Gazebo Fuel; nothing is downloaded
+    world = tmp_path / "models" / "w.world"
+    world.write_text('<sdf version="1.9"><world name="w">'
+                     '<include><uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/Sun</uri></include>'
+                     '<include><uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/Ground%20Plane/2</uri>'
+                     '</include><include><uri>https://fuel.gazebosim.org/1.0/OpenRobotics/models/gripper</uri>'
+                     '</include></world></sdf>')
+    with pytest.warns(SkippedModelWarning):
+        robot = read_robot(world)
+    assert [link.name for link in robot.links] == ["gripper::finger"]       # found on disk by its name
+    world.write_text('<sdf version="1.9"><world name="w"><include><uri>https://fuel.gazebosim.org/1.0/'
+                     'OpenRobotics/models/Fancy Table</uri></include></world></sdf>')
+    with pytest.raises(RobotDescriptionError, match="a Gazebo Fuel model \\('Fancy Table'\\).*'fancy_table'"):
+        read_robot(world)

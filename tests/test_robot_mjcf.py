@@ -307,11 +307,12 @@ def test_replicate_names_and_masses_match_mujoco(tmp_path):
     _assert_like_mujoco(path, results)
 
 
-def test_attach_is_refused_not_skipped(tmp_path):
+def test_attach_of_a_missing_model_is_refused_not_skipped(tmp_path):
+    # <attach> is read (tests/test_robot_mjcf_extras.py); a model file that is not there is named, never skipped
     path = tmp_path / "a.xml"
     path.write_text('<mujoco><asset><model name="g" file="g.xml"/></asset><worldbody><body name="b">'
                     '<attach model="g" body="hand" prefix="g_"/></body></worldbody></mujoco>')
-    with pytest.raises(RobotDescriptionError, match="<attach model='g'> is not supported"):
+    with pytest.raises(RobotDescriptionError, match="<attach model='g'>: the model file .*g.xml does not exist"):
         read_robot(path)
 
 

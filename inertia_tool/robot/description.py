@@ -28,11 +28,12 @@ import contextlib
 import math
 import os
 import re
+import warnings
 from dataclasses import field
 
 import numpy as np
 
-from ..errors import MeshReadError, RobotDescriptionError, UsageError
+from ..errors import MeshReadError, RobotDescriptionError, SkippedModelWarning, UsageError
 from ..mesh.regular import open_regular
 from ..units import DECIMAL
 from ..values import frozen_value
@@ -142,6 +143,15 @@ class GeometryElement:
         MJCF: a primitive (``kind`` box, sphere, ...) with a ``mesh`` and no size takes its size from the mesh
         (MuJoCo fits it to the mesh's equivalent inertia box, times ``fitscale``); ``size`` is empty until
         :func:`inertia_tool.robot.geometry.fitted_element` fits it.  None for every other element.
+    note : str
+        What the reader should know about how the element stands for the description's geometry (an MJCF
+        height field taken as MuJoCo's inertia box); empty for an element read as written.  It is carried into
+        the link result's ``warnings``.
+    vertices : (n, 3) float or None
+        An inline mesh (MJCF ``<mesh vertex=...>``): its vertices in the file's frame, m, before the reference
+        transform and ``scale``; ``mesh`` is then None.  None for a mesh read from a file and for primitives.
+    faces : (m, 3) int or None
+        The inline mesh's triangles (indices into ``vertices``, wound outwards).
     """
 
     kind: str
@@ -158,6 +168,9 @@ class GeometryElement:
     mass: float | None = None
     shell: bool = False
     fit_scale: float | None = None
+    note: str = ""
+    vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))
@@ -621,6 +634,18 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
                         "ellipsoid or mesh)")
 
 
+#: SDFormat shapes that bound no volume: a ground ``<plane>``, a terrain ``<heightmap>``, ``<empty>``.  Like
+#: MuJoCo's planes they give a link no mass: the elements are skipped (a link with nothing else is then a frame).
+_SDF_SHAPES_WITHOUT_VOLUME = ("plane", "heightmap", "empty")
+
+
+def _sdf_without_volume(element) -> bool:
+    """Whether a ``<collision>``/``<visual>`` holds one of :data:`_SDF_SHAPES_WITHOUT_VOLUME`."""
+    geometry = element.find("geometry")
+    shapes = [c for c in geometry if isinstance(c.tag, str)] if geometry is not None else []
+    return len(shapes) == 1 and shapes[0].tag in _SDF_SHAPES_WITHOUT_VOLUME
+
+
 #: Deepest chain of SDFormat ``<include>`` and nested ``<model>`` followed.
 MAX_SDF_NESTING = 16
 
@@ -628,19 +653,78 @@ MAX_SDF_NESTING = 16
 MAX_SDF_INCLUDES = 512
 
 
-def _sdf_include_file(include, base: str, packages: dict, source: str) -> str:
+#: Gazebo's stock models that nearly every world file includes and that hold no link with mass: when one is not
+#: on disk, the include is skipped with a note (:class:`~inertia_tool.errors.SkippedModelWarning`) instead of
+#: refusing the world.  What each one is, for the note.
+STOCK_MODELS_WITHOUT_MASS = {"sun": "a directional light", "ground_plane": "a static plane"}
+
+
+def _searched_folders(scheme: str, packages: dict, base: str) -> str:
+    """The folders :func:`~inertia_tool.robot.resolve.package_directory` looked in, for a message."""
+    from .resolve import PACKAGE_PATH_VARIABLES
+    variables = PACKAGE_PATH_VARIABLES if scheme == "model" else PACKAGE_PATH_VARIABLES[:1]
+    parts = [f"{var}={os.environ[var]!r}" if os.environ.get(var) else f"{var} (unset)" for var in variables]
+    if packages:
+        parts.insert(0, f"the packages given ({', '.join(sorted(packages))})")
+    top = os.path.abspath(base)
+    for _ in range(MAX_FOLDERS_UP):
+        top = os.path.dirname(top)
+    parts.append(f"{os.path.abspath(base)} and the folders above it up to {top}")
+    return "; ".join(parts)
+
+
+def _skip_stock_model(uri: str, name: str, source: str) -> None:
+    """Warn that the include ``uri`` of the stock model ``name`` (:data:`STOCK_MODELS_WITHOUT_MASS`) is skipped."""
+    warnings.warn(SkippedModelWarning(f"{source}: <include> {uri!r} skipped: Gazebo's stock model {name!r} "
+                                      f"({STOCK_MODELS_WITHOUT_MASS[name]}, no link with mass) is not on disk"),
+                  stacklevel=3)
+
+
+def _fuel_model(scheme: str, rest: str) -> str | None:
+    """The model name of a Gazebo Fuel URL (``https://fuel.gazebosim.org/1.0/OpenRobotics/models/Ground
+    Plane/2``: ``"Ground Plane"``), None for any other URL."""
+    from urllib.parse import unquote
+    if scheme not in ("http", "https") or "/models/" not in rest:
+        return None
+    host = rest.split("/", 1)[0].lower()
+    if not host.startswith(("fuel.", "app.")):
+        return None
+    return unquote(rest.split("/models/", 1)[1].split("/", 1)[0]).strip() or None
+
+
+def _sdf_include_file(include, base: str, packages: dict, source: str) -> str | None:
     """The SDFormat file an ``<include><uri>`` names: a file, or a model folder (its ``model.config``'s
-    ``<sdf>`` file, else ``model.sdf``)."""
+    ``<sdf>`` file, else ``model.sdf``); None for a stock model of :data:`STOCK_MODELS_WITHOUT_MASS` that is not
+    on disk (skipped, with a :class:`~inertia_tool.errors.SkippedModelWarning` naming it).
+
+    A Gazebo Fuel URL (``https://fuel.gazebosim.org/.../models/Sun``, which Gazebo downloads) is never fetched:
+    its model is looked up on disk as ``model://`` would be, under its name in lower case with ``_`` for
+    spaces (``Ground Plane``: ``ground_plane``); a stock model is skipped, any other is refused naming it."""
     uri = (include.findtext("uri") or "").strip()
     if not uri:
         raise _fail(source, "<include> without a <uri>")
     scheme, sep, rest = uri.partition("://")
-    if sep and scheme in ("model", "package"):
+    fuel = _fuel_model(scheme, rest) if sep else None
+    if fuel is not None:
+        name = fuel.lower().replace(" ", "_")
+        directory = package_directory(name, packages, scheme="model", near=base)
+        if directory is None and name in STOCK_MODELS_WITHOUT_MASS:
+            _skip_stock_model(uri, name, source)
+            return None
+        if directory is None:
+            raise _fail(source, f"<include> {uri!r}: a Gazebo Fuel model ({fuel!r}), which Gazebo downloads and "
+                                f"this tool does not; expected a folder {name!r} on disk, searched "
+                                f"{_searched_folders('model', packages, base)}")
+        path = directory
+    elif sep and scheme in ("model", "package"):
         name, _, inner = rest.partition("/")
         directory = package_directory(name, packages, scheme=scheme, near=base)
+        if directory is None and scheme == "model" and name in STOCK_MODELS_WITHOUT_MASS:
+            _skip_stock_model(uri, name, source)
+            return None
         if directory is None:
-            raise _fail(source, f"<include> {uri!r}: cannot find model {name!r} (not among the packages given, "
-                                "not on GZ_SIM_RESOURCE_PATH/GAZEBO_MODEL_PATH, not beside the model's folder)")
+            raise _fail(source, f"<include> {uri!r}: cannot find model {name!r}; searched "
+                                f"{_searched_folders(scheme, packages, base)}")
         path = os.path.join(directory, inner)
     elif sep and scheme == "file":
         path = rest if os.path.isabs(rest) else os.path.join(base, rest)
@@ -680,13 +764,15 @@ def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, sou
             if not name:
                 raise _fail(source, "a <link> without a name")
             elements = tuple(_sdf_geometry(el, prefix + name, f"{geometry} {k + 1}", base, packages, source)
-                             for k, el in enumerate(child.findall(geometry)))
+                             for k, el in enumerate(child.findall(geometry)) if not _sdf_without_volume(el))
             links.append(LinkGeometry(name=prefix + name, elements=elements, declared=_sdf_inertial(child, source)))
         elif child.tag == "model":
             links += _sdf_links(child, f"{prefix}{child.get('name', '')}::", base, packages, geometry, source,
                                 stack + (f"model {child.get('name')}",), budget)
         elif child.tag == "include":
             path = _sdf_include_file(child, base, packages, source)
+            if path is None:        # a stock light or ground plane that is not on disk: nothing with mass
+                continue
             key = os.path.realpath(path)
             if key in stack:
                 raise _fail(source, f"<include> of {path} includes itself")

@@ -25,6 +25,7 @@ faces with it, so the surface keeps its outward winding.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import warnings
 from dataclasses import replace
@@ -56,7 +57,7 @@ METHODS = ("exact", "united", "summed", "unverified", "estimate")
 MODEL_DENSITY = "model"
 
 
-def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = None,
+def mesh_properties(path: str | None, *, repair: bool = False, max_faces: int | None = None,
                     element: GeometryElement | None = None) -> MassProperties:
     """Unit-density mass properties of the mesh file ``path`` (metres), placed as ``element`` places it.
 
@@ -68,8 +69,8 @@ def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = 
 
     Parameters
     ----------
-    path : str
-        The mesh file.
+    path : str or None
+        The mesh file; None for an inline mesh (``element.vertices`` and ``element.faces``).
     repair : bool
         Let the engine repair an open or inconsistently wound mesh (``LoadOptions.repair``) instead of raising
         :class:`InvalidMeshError` (the caller then reports the link).
@@ -83,13 +84,33 @@ def mesh_properties(path: str, *, repair: bool = False, max_faces: int | None = 
     MassProperties
         Unit density: ``mass == volume``; in the element's mesh frame after its scale (before its pose).
     """
-    from ..mesh.read import load_mesh
-    # robot descriptions give mesh coordinates in metres (the element's `scale` is applied here), so the unit is
-    # stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
-    raw = load_mesh(path, units="m") if max_faces is None else load_mesh(path, units="m", max_faces=max_faces)
+    raw = _raw_mesh(path, element, max_faces)
     if element is not None:
         raw = _placed(raw, element)
     return mass_properties(raw, density=1.0, repair=repair)
+
+
+def _mesh_label(element: GeometryElement) -> str:
+    """The mesh of ``element`` for messages: its file, or ``inline mesh of geom NAME``."""
+    return element.mesh if element.mesh is not None else f"inline mesh of {element.name!r}"
+
+
+def _raw_mesh(path: str | None, element: GeometryElement | None, max_faces: int | None = None) -> RawMesh:
+    """The mesh file ``path`` read in metres, or the element's inline vertices and faces (MJCF
+    ``<mesh vertex face>``: float64 text, so no storage rounding), before its placement."""
+    if path is None:
+        if element is None or element.vertices is None or element.faces is None:
+            raise UsageError("Expected a mesh file or an element with inline vertices and faces, got neither")
+        faces = np.asarray(element.faces)
+        if max_faces is not None and len(faces) > max_faces:
+            raise MeshReadError(f"{_mesh_label(element)}: {len(faces):,} triangles, more than `max_faces` "
+                                f"({max_faces:,})")
+        return RawMesh(vertices=np.array(element.vertices, dtype=np.float64), faces=faces.copy(),
+                       source=_mesh_label(element), units="m", file_faces=len(faces))
+    from ..mesh.read import load_mesh
+    # robot descriptions give mesh coordinates in metres (the element's `scale` is applied here), so the unit is
+    # stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
+    return load_mesh(path, units="m") if max_faces is None else load_mesh(path, units="m", max_faces=max_faces)
 
 
 def _placed(raw: RawMesh, element: GeometryElement) -> RawMesh:
@@ -133,7 +154,12 @@ def _ellipsoid(a: float, b: float, c: float) -> MassProperties:
 
 def _mesh_key(element: GeometryElement) -> tuple:
     """Cache key of a mesh element's unit-density body: the file and how the element scales and moves it."""
-    return (element.mesh, tuple(np.asarray(element.scale, dtype=np.float64).tolist()),
+    where = element.mesh
+    if where is None and element.vertices is not None and element.faces is not None:
+        digest = hashlib.sha256(np.ascontiguousarray(element.vertices, dtype=np.float64).tobytes())
+        digest.update(np.ascontiguousarray(element.faces, dtype=np.int64).tobytes())
+        where = f"inline:{digest.hexdigest()}"
+    return (where, tuple(np.asarray(element.scale, dtype=np.float64).tolist()),
             element.reference_rotation.tobytes(), np.asarray(element.reference_translation).tobytes())
 
 
@@ -186,6 +212,7 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
         return element
     props = element_mass_properties(GeometryElement("mesh", np.eye(3), np.zeros(3), mesh=element.mesh,
                                                     uri=element.uri, scale=element.scale, name=element.name,
+                                                    vertices=element.vertices, faces=element.faces,
                                                     reference_rotation=element.reference_rotation,
                                                     reference_translation=element.reference_translation),
                                     cache=cache, repair=repair, budget=budget)
@@ -258,16 +285,15 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
     if entry is not None:
         outcome, caught, faces = entry
         if budget is not None and faces > budget[0] and not isinstance(outcome, BaseException):
-            outcome = MeshReadError(f"{element.mesh}: {faces:,} triangles, more than the {budget[0]:,} that "
+            outcome = MeshReadError(f"{_mesh_label(element)}: {faces:,} triangles, more than the {budget[0]:,} that "
                                     f"`max_faces` leaves (the limit counts all the robot's meshes together, "
                                     f"{budget[1]:,})")
         elif budget is not None:
             budget[0] -= faces
         _reissue(caught)
     else:
-        assert element.mesh is not None, "a mesh element carries the path of its file"
         if budget is not None and budget[0] < 1:
-            raise MeshReadError(f"{element.mesh}: not read: the meshes read before it hold all the triangles "
+            raise MeshReadError(f"{_mesh_label(element)}: not read: the meshes read before it hold all the triangles "
                                 "`max_faces` allows (the limit is on all the meshes of the robot together)")
         faces = 0
         with warnings.catch_warnings(record=True) as recorded:
@@ -514,8 +540,9 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
         return LinkInertial(link.name, None, nan, basis, f"mesh needs repair or cannot be read: {exc}")
     except (ValueError, ArithmeticError) as exc:     # numerical trouble in one link's geometry: its reason
         return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}")
-    warned = [f"{e.kind} {e.name!r} is massless in the description "
-              f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
+    warned = [e.note for e in link.elements if e.note]
+    warned += [f"{e.kind} {e.name!r} is massless in the description "
+               f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
     if not parts:
         return LinkInertial(link.name, None, nan, basis, "every geom is massless in the description",
                             warnings=tuple(warned))
@@ -625,8 +652,7 @@ def link_inertials(robot: RobotDescription, *, density: float | str | None = Non
 def _mesh_vertices_faces(element: GeometryElement):
     """The mesh's vertices in the element frame (reference transform, then scale: :func:`_placed`) and its
     faces."""
-    from ..mesh.read import load_mesh
-    raw = _placed(load_mesh(element.mesh, units="m"), element)
+    raw = _placed(_raw_mesh(element.mesh, element), element)
     return raw.vertices, raw.faces
 
 

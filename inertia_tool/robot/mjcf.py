@@ -2,9 +2,10 @@
 
 What is read (MuJoCo XML reference, "MJCF"): ``<compiler angle eulerseq meshdir assetdir>`` (angles in
 **degrees** unless ``angle="radian"``, MuJoCo's default), ``<default>`` classes (nested, ``class`` and
-``childclass``) for ``<geom>`` and ``<mesh>`` attributes, ``<asset><mesh name file scale>``, and under
-``<worldbody>`` every ``<body>`` (``<frame>`` elements compose their pose into the geoms they hold,
-``<replicate>`` copies its bodies).  A geom's
+``childclass``) for ``<geom>`` and ``<mesh>`` attributes, ``<asset><mesh name file scale>`` (or inline
+``vertex``/``face``, or ``builtin``), ``<asset><hfield size>``, and under ``<worldbody>`` every ``<body>``
+(``<frame>`` elements compose their pose into the geoms they hold, ``<replicate>`` copies its bodies and
+geoms, ``<attach>`` brings in the bodies of an ``<asset><model>``).  A geom's
 frame is ``pos`` and one of ``quat`` (w x y z), ``axisangle``, ``euler`` (sequence ``eulerseq``: lower case
 letters rotate with the frame, upper case stay fixed), ``xyaxes``, ``zaxis``; or ``fromto`` for capsules,
 cylinders, boxes and ellipsoids (the axis runs from the first point to the second).  Sizes are MuJoCo's
@@ -13,7 +14,8 @@ half-sizes: box half-edges, cylinder and capsule ``radius half-length``, ellipso
 Collision geoms are those with ``contype`` or ``conaffinity`` non-zero (MuJoCo's default is 1) and those
 named in a ``<contact><pair>`` (MuJoCo collides them whatever their bit masks); the others are visual.  Geoms
 directly in ``<worldbody>`` belong to no body and are skipped, and so are planes in a body (MuJoCo gives them
-no mass or inertia).  Inline mesh vertices and height fields are refused with a message.
+no mass or inertia).  A height field in a body is MuJoCo's inertia box (:func:`_hfield_geom`), noted on the
+element.
 
 MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
 
@@ -35,6 +37,8 @@ MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
   section) still come from ``size``.
 * Mesh ``refpos``/``refquat``: file vertices ``v`` become ``scale ⊙ (q̄ (v − refpos) q)`` — the reference
   position is subtracted, the conjugate of ``refquat`` rotates, the scale applies last.
+* ``<attach model body prefix>``: :class:`_Attachments`; ``<mesh vertex face>`` and ``builtin``:
+  :func:`_inline_mesh`; copies of geoms in a ``<replicate>``: :func:`_replica_poses`.
 * Geom ``density`` (kg/m³, default 1000), ``mass`` (kg; when given, the geom's density is ``mass / volume``)
   and ``shellinertia`` (mass on the surface; for meshes MuJoCo uses ``<mesh inertia="shell">`` instead) are
   kept on each :class:`GeometryElement` for the "model's own densities" mode; a geom with ``mass="0"`` or
@@ -43,8 +47,10 @@ MuJoCo's rules, as its compiler applies them (checked against ``mujoco`` 4.0):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
+from typing import Any
 
 import numpy as np
 
@@ -299,8 +305,11 @@ def _own_mesh_folder(root, folder: str) -> str:
 
 
 def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
-                     max_files: int = MAX_INCLUDED_FILES) -> dict:
+                     max_files: int = MAX_INCLUDED_FILES, budget: list | None = None) -> dict:
     """Replace every ``<include file>`` under ``root`` by the included ``<mujoco>``'s children, in place.
+
+    ``budget``: ``[files, bytes]`` already read by other files of the same model (the models ``<attach>``
+    brings in share one budget with the main model's includes); updated in place.
 
     Returns ``{<mesh> element: fallback folders}`` for meshes declared in included files: the declaring
     file's own mesh folder, then those of the files that included it, outwards (used when MuJoCo's
@@ -309,8 +318,8 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
     from .description import MAX_DESCRIPTION_BYTES, _read_bytes, parse_xml
     main_folder = os.path.dirname(os.path.abspath(source))
     fallbacks: dict = {}
-    count = [0]
-    total = [os.path.getsize(source) if os.path.isfile(source) else 0]
+    if budget is None:
+        budget = [0, os.path.getsize(source) if os.path.isfile(source) else 0]
 
     def expand(element, including: str, stack: tuple, chain: tuple) -> None:
         for include in list(element.iter("include")):
@@ -330,12 +339,12 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
             if len(stack) >= max_depth:
                 raise _fail(source, f"<include file={name!r}> (in {including}): includes nested more than "
                                     f"{max_depth} deep")
-            count[0] += 1
-            if count[0] > max_files:
+            budget[0] += 1
+            if budget[0] > max_files:
                 raise _fail(source, f"more than {max_files} included files")
             data = _read_bytes(path)
-            total[0] += len(data)
-            if total[0] > MAX_DESCRIPTION_BYTES:
+            budget[1] += len(data)
+            if budget[1] > MAX_DESCRIPTION_BYTES:
                 raise _fail(source, f"the included files hold more than the {MAX_DESCRIPTION_BYTES:,} bytes a robot "
                                     "description may have, all files together")
             included = parse_xml(data, path).getroot()
@@ -360,18 +369,100 @@ def _expand_includes(root, source: str, *, max_depth: int = MAX_INCLUDE_DEPTH,
     return fallbacks
 
 
+#: Most vertices and triangles an inline ``<mesh vertex face>`` may hold (MuJoCo models write a few hundred;
+#: larger meshes are files).  The text is bounded by ``MAX_DESCRIPTION_BYTES`` already; this bounds the hull.
+MAX_INLINE_VERTICES = 1_000_000
+
+
+@dataclasses.dataclass(frozen=True)
+class _InlineMesh:
+    """The vertices (n, 3), m, and outward triangles (m, 3) of an inline ``<mesh>``."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+
+
+def _convex_hull(vertices: np.ndarray, what: str, source: str) -> np.ndarray:
+    """Outward-wound triangles of the convex hull of ``vertices`` (MuJoCo's mesh from ``vertex`` alone).
+
+    Qhull's facets (``scipy.spatial.ConvexHull``, triangulated) come in no consistent order; each is turned so
+    that its normal ``(b − a) × (c − a)`` points along the facet's outward plane normal."""
+    from scipy.spatial import ConvexHull, QhullError
+    try:
+        hull = ConvexHull(vertices)
+    except (QhullError, ValueError):
+        raise _fail(source, f"{what}: its vertices span no volume (expected at least 4 points not in one plane, "
+                            "whose convex hull MuJoCo takes)") from None
+    faces = np.array(hull.simplices, dtype=np.int64)
+    a, b, c = (vertices[faces[:, k]] for k in range(3))
+    inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), hull.equations[:, :3]) < 0
+    faces[inward] = faces[inward][:, ::-1]
+    return np.ascontiguousarray(faces)
+
+
+def _inline_mesh(attrs: dict, source: str) -> _InlineMesh | None:
+    """The mesh an MJCF ``<mesh vertex="x y z ..." face="i j k ...">`` spells out, or MuJoCo generates
+    (``<mesh builtin params>``: :func:`~inertia_tool.robot.mjspec.builtin_mesh`); None for a mesh file.
+
+    ``vertex`` without ``face`` is MuJoCo's convex hull of the points.  Checked as MuJoCo checks it: at least
+    4 vertices, whole face indices within range; together with a ``file`` it is refused (two meshes in one)."""
+    if attrs.get("builtin") is not None and attrs.get("builtin") != "none":
+        what = f"<mesh name={attrs.get('name')!r} builtin={attrs.get('builtin')!r}>"
+        if attrs.get("file") or attrs.get("vertex") is not None:
+            raise _fail(source, f"{what}: also a file or vertices (expected one source of triangles)")
+        if not attrs.get("name"):
+            raise _fail(source, f"{what}: without a name (expected one, as it has no file to name it)")
+        from .mjspec import builtin_mesh
+        vertices, faces = builtin_mesh(attrs["builtin"], attrs.get("params"), what=what, source=source)
+        vertices = _coordinates(vertices, f"{what} vertices", source)
+        if faces is None:
+            return _InlineMesh(vertices, _convex_hull(vertices, what, source))
+        return _InlineMesh(vertices, faces)
+    if attrs.get("vertex") is None:
+        if attrs.get("face") is not None:
+            raise _fail(source, f"<mesh name={attrs.get('name')!r}>: face without vertex")
+        return None
+    what = f"<mesh name={attrs.get('name')!r}>"
+    if attrs.get("file"):
+        raise _fail(source, f"{what}: both a file and inline vertices (expected one of them)")
+    if not attrs.get("name"):
+        raise _fail(source, "an inline <mesh vertex> without a name (expected a name, as it has no file to name it)")
+    flat = _numbers(attrs["vertex"], None, f"{what} vertex", source)
+    if flat.size % 3 or not 12 <= flat.size <= 3 * MAX_INLINE_VERTICES:
+        raise _fail(source, f"{what}: expected vertex to hold x y z of 4 to {MAX_INLINE_VERTICES:,} points, got "
+                            f"{flat.size} numbers")
+    vertices = _coordinates(flat.reshape(-1, 3), f"{what} vertex", source)
+    if attrs.get("face") is None:
+        return _InlineMesh(vertices, _convex_hull(vertices, what, source))
+    indices = _numbers(attrs["face"], None, f"{what} face", source)
+    if (indices.size % 3 or indices.size == 0 or indices.size > 6 * MAX_INLINE_VERTICES
+            or np.any(indices != np.round(indices)) or np.any(indices < 0) or np.any(indices >= len(vertices))):
+        raise _fail(source, f"{what}: expected face to hold triples of whole vertex indices from 0 to "
+                            f"{len(vertices) - 1}, got {' '.join(str(attrs['face']).split())[:80]!r}")
+    return _InlineMesh(vertices, indices.astype(np.int64).reshape(-1, 3))
+
+
+def _mesh_source(file, folders, packages: dict, source: str, link: str) -> dict:
+    """The ``GeometryElement`` fields that say where a mesh asset's triangles are: ``mesh`` (the file found
+    through ``folders``, the first holding it) and ``uri``; or, for an inline mesh, ``vertices`` and ``faces``."""
+    if isinstance(file, _InlineMesh):
+        return {"mesh": None, "uri": None, "vertices": file.vertices, "faces": file.faces}
+    found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
+    path = resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
+    return {"mesh": path, "uri": file}
+
+
 def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler, source: str) -> dict:
     """``{name: (file, folders, scale, reference rotation, reference translation, shell)}`` of every mesh asset."""
     meshes = {}
     for asset in root.findall("asset"):
         for mesh in asset.findall("mesh"):
             attrs = defaults.attributes(mesh, "main", source)
-            if attrs.get("vertex") or attrs.get("face"):
-                raise _fail(source, f"<mesh name={attrs.get('name')!r}> with inline vertices is not supported")
+            inline = _inline_mesh(attrs, source)
             file = attrs.get("file")
-            if not file:
-                raise _fail(source, f"<mesh name={attrs.get('name')!r}> without a file")
-            name = attrs.get("name") or os.path.splitext(os.path.basename(file))[0]
+            if not file and inline is None:
+                raise _fail(source, f"<mesh name={attrs.get('name')!r}> without a file or vertex")
+            name = attrs.get("name") or os.path.splitext(os.path.basename(file or ""))[0]
             what = f"<mesh name={name!r}>"
             scale = _scale(_numbers(attrs.get("scale"), 3, f"{what} scale", source, default=(1, 1, 1)),
                            f"{what} scale", source)
@@ -383,8 +474,44 @@ def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler
             back = _quaternion_matrix(refquat).T
             folders = [mesh_base, *fallbacks.get(mesh, ())]
             shell = attrs.get("inertia") == "shell"
-            meshes[name] = (file, folders, scale, back, -back @ refpos, shell)
+            meshes[name] = (inline if inline is not None else file, folders, scale, back, -back @ refpos, shell)
     return meshes
+
+
+def _hfields(root, source: str) -> dict:
+    """``{name: (radius_x, radius_y, elevation_z, base_z)}`` (m) of every ``<asset><hfield>``.
+
+    Only ``size`` is read (MuJoCo requires it: four positive numbers); the elevation data (``file`` or
+    ``elevation``) is not, because MuJoCo's inertia of a height field depends on its size alone."""
+    found = {}
+    for asset in root.findall("asset"):
+        for hfield in asset.findall("hfield"):
+            name = hfield.get("name") or os.path.splitext(os.path.basename(hfield.get("file") or ""))[0]
+            what = f"<hfield name={name!r}>"
+            size = _numbers(hfield.get("size"), 4, f"{what} size", source)
+            found[name] = tuple(_positive(float(s), f"{what} size", source) for s in size)
+    return found
+
+
+def _hfield_geom(attrs: dict, pose, label: str, link: str, hfields: dict, compiler, source: str) -> GeometryElement:
+    """A ``type="hfield"`` geom in a body as MuJoCo's compiler takes it for the body's inertia: the box centred
+    on the geom's frame with half-sizes ``(radius_x, radius_y, elevation_z/4 + base_z/2)`` of its
+    ``<hfield size>`` (checked against ``mujoco`` 4.0: ``geom_size`` and the body's mass, centre and inertia
+    are those of this box, whatever the elevation data), noted on the element as a stand-in."""
+    name = attrs.get("hfield")
+    if name is None:
+        raise _fail(source, f"body {link!r} {label}: a height field geom without hfield (expected the name of an "
+                            "<asset><hfield>)")
+    if name not in hfields:
+        raise _fail(source, f"body {link!r} {label}: height field {name!r} is not defined in <asset>")
+    rx, ry, elevation, base = hfields[name]
+    boxed = {k: v for k, v in attrs.items() if k not in ("fromto", "mesh", "hfield", "size")}
+    boxed.update(type="box", size=f"{rx!r} {ry!r} {0.25 * elevation + 0.5 * base!r}")
+    element = _geom(boxed, pose, label, link, {}, {}, compiler, source)
+    note = (f"height field {name!r} ({element.name}) taken as MuJoCo's inertia box "
+            f"{2 * rx:g} x {2 * ry:g} x {0.5 * elevation + base:g} m, as MuJoCo's compiler does (not the shape "
+            "of its surface)")
+    return dataclasses.replace(element, note=note)
 
 
 def _optional_number(attrs: dict, key: str, what: str, source: str) -> float | None:
@@ -438,10 +565,9 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
             raise _fail(source, f"{what}: a {kind} fitted to mesh {mesh_name!r} with <compiler fitaabb=\"true\"> "
                                 "is not supported (only MuJoCo's default fit to the equivalent inertia box)")
         file, folders, scale, ref_rotation, ref_translation, _shell = meshes[mesh_name]
-        found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
-        path = resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
         fit = float(_numbers(attrs.get("fitscale"), 1, f"{what} fitscale", source, default=(1.0,))[0])
-        return GeometryElement(kind, rotation, position, mesh=path, uri=file, scale=scale, name=name,
+        return GeometryElement(kind, rotation, position, **_mesh_source(file, folders, packages, source, link),
+                               scale=scale, name=name,
                                reference_rotation=ref_rotation, reference_translation=ref_translation,
                                fit_scale=_positive(fit, f"{what} fitscale", source), **mass_model)
     if kind == "mesh":
@@ -450,9 +576,8 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
         file, folders, scale, ref_rotation, ref_translation, shell = meshes[mesh_name]
         mass_model["shell"] = shell          # MuJoCo: a mesh's shell inertia is a property of the asset
-        found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
-        path = resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
-        return GeometryElement("mesh", rotation, position, mesh=path, uri=file, scale=scale, name=name,
+        return GeometryElement("mesh", rotation, position, **_mesh_source(file, folders, packages, source, link),
+                               scale=scale, name=name,
                                reference_rotation=ref_rotation, reference_translation=ref_translation,
                                **mass_model)
     if kind == "sphere":
@@ -539,7 +664,7 @@ def _child_bodies(element, class_name: str, suffix: str = "", source: str = "", 
     ``<replicate count sep>`` repeats its bodies ``count`` times; MuJoCo names copy ``i`` of ``NAME``
     ``NAME + sep + i`` (``i`` zero-padded to the digits of ``count − 1``), inner replicates' suffixes first.
     The copies' placement (``offset``, orientation) does not change a body's own mass properties.
-    ``<attach>`` (a body of another model asset) is refused: its bodies would be missing.
+    An ``<attach>`` element is yielded as it is, with ``None`` for its class: its bodies are another model's.
     """
     budget = [MAX_REPLICAS] if budget is None else budget
     for child in element:
@@ -558,59 +683,211 @@ def _child_bodies(element, class_name: str, suffix: str = "", source: str = "", 
                 yield from _child_bodies(child, class_name, f"{child.get('sep', '')}{k:0{width}d}{suffix}", source,
                                          budget)
         elif child.tag == "attach":
-            raise _fail(source, f"<attach model={child.get('model')!r}> is not supported: its bodies would be missing "
-                                "(give the model with the attached bodies written out)")
+            yield child, None, suffix          # the caller reads the attached model (:func:`read_mjcf`)
+
+
+def _replica_poses(replicate, pose, model, budget: list) -> list:
+    """The poses of the copies a ``<replicate count offset euler>`` makes of the geoms (and frames) it holds
+    in a body, composed onto ``pose``: copy ``k`` is turned by the Euler angles ``k · euler`` (the model's angle
+    unit and ``eulerseq``) and moved by ``Σ_{j<k} R(j · euler) offset`` — each step's offset taken in the
+    previous copy's axes (checked against ``mujoco`` 4.0's ``geom_pos`` and ``geom_quat``; for angles about
+    one axis this is the step ``x ↦ R x + offset`` applied ``k`` times).  ``budget`` is the copies left of
+    :data:`MAX_REPLICAS`."""
+    degrees, eulerseq, _ = model.compiler
+    count = _numbers(replicate.get("count"), 1, "<replicate count>", model.source)[0]
+    if not (count == int(count) and 1 <= count <= budget[0]):
+        raise _fail(model.source, f"<replicate count={replicate.get('count')!r}>: expected a whole number from 1 to "
+                                  f"{budget[0]:,} (copies left of {MAX_REPLICAS:,})")
+    budget[0] -= int(count)
+    angles = _numbers(replicate.get("euler"), 3, "<replicate euler>", model.source, default=(0, 0, 0))
+    angles = angles * (math.pi / 180.0 if degrees else 1.0)
+    step = _coordinates(_numbers(replicate.get("offset"), 3, "<replicate offset>", model.source, default=(0, 0, 0)),
+                        "<replicate offset>", model.source)
+    poses = []
+    rotation, translation = pose
+    moved = np.zeros(3)
+    for k in range(int(count)):
+        turn = _euler_matrix(eulerseq, k * angles)
+        poses.append((rotation @ turn, rotation @ moved + translation))
+        moved = moved + turn @ step
+    return poses
+
+
+@dataclasses.dataclass(frozen=True)
+class _Model:
+    """One MJCF file as its own elements are read: the main model, or a model asset an ``<attach>`` takes bodies
+    from (each keeps its own compiler angles, mesh folder, default classes, assets and contact pairs)."""
+
+    source: str
+    root: Any               # the lxml <mujoco> element, includes expanded
+    defaults: _Defaults
+    compiler: tuple
+    meshes: dict
+    hfields: dict
+    paired: frozenset
+    models: dict
+
+
+def _model(root, source: str, folder: str, packages: dict, budget: list, fitaabb: bool | None = None) -> _Model:
+    """The :class:`_Model` of the ``<mujoco>`` ``root`` read from ``source`` in ``folder`` (its includes
+    expanded here, in place, counted in ``budget``: ``[files, bytes]`` of the whole model); ``fitaabb`` is the
+    main model's (a compile-time setting), its own when None."""
+    fallbacks = _expand_includes(root, source, budget=budget)
+    if fitaabb is None:
+        fitaabb = any(c.get("fitaabb") == "true" for c in root.iter("compiler"))
+    degrees, eulerseq, meshdir = _compiler(root, source)
+    defaults = _Defaults(root, source)
+    compiler = (degrees, eulerseq, fitaabb)
+    meshes = _meshes(root, defaults, os.path.join(folder, meshdir or ""), fallbacks, compiler, source)
+    models = {}
+    for asset in root.findall("asset"):
+        for model in asset.findall("model"):
+            if not model.get("name") or not model.get("file"):
+                raise _fail(source, f"<asset><model name={model.get('name')!r} file={model.get('file')!r}>: "
+                                    "expected both a name and a file")
+            models[model.get("name")] = os.path.normpath(os.path.join(folder, model.get("file")))
+    return _Model(source, root, defaults, compiler, meshes, _hfields(root, source), _paired_geoms(root), models)
+
+
+class _Attachments:
+    """The model assets ``<attach>`` elements take bodies from, each read once, with MuJoCo's rules:
+    ``<asset><model name file>`` names a file relative to the declaring model's folder; ``<attach model body
+    prefix>`` puts the body ``body`` of that model, with its subtree, where the ``<attach>`` stands, every
+    name prefixed with ``prefix`` (required); without ``body`` the model's whole ``<worldbody>`` is attached
+    as a ``<frame>`` (its geoms join the enclosing body).  At most :data:`MAX_INCLUDE_DEPTH` models deep and
+    :data:`MAX_INCLUDED_FILES` files; a model that attaches itself is refused."""
+
+    def __init__(self, packages: dict, fitaabb: bool, budget: list):
+        self.packages, self.fitaabb, self.budget = packages, fitaabb, budget
+        self.read: dict = {}
+
+    def model(self, attach, host: _Model, stack: tuple) -> tuple[_Model, tuple]:
+        """The model asset ``attach`` names (declared in ``host``) and the attach chain extended by it."""
+        from .description import MAX_DESCRIPTION_BYTES, _read_bytes, parse_xml
+        name = attach.get("model")
+        what = f"<attach model={name!r}>"
+        if attach.get("prefix") is None:
+            raise _fail(host.source, f"{what}: expected a prefix (MuJoCo requires one)")
+        if name not in host.models:
+            raise _fail(host.source, f"{what}: no <asset><model name={name!r}> declares it")
+        path = host.models[name]
+        key = os.path.realpath(path)
+        if key in stack:
+            raise _fail(host.source, f"{what}: {path} attaches itself: {' -> '.join(stack + (key,))}")
+        if len(stack) > MAX_INCLUDE_DEPTH:
+            raise _fail(host.source, f"{what}: models attached more than {MAX_INCLUDE_DEPTH} deep")
+        if key not in self.read:
+            if not os.path.isfile(path):
+                raise _fail(host.source, f"{what}: the model file {path} does not exist")
+            self.budget[0] += 1
+            if self.budget[0] > MAX_INCLUDED_FILES:
+                raise _fail(host.source, f"more than {MAX_INCLUDED_FILES} included and attached files")
+            data = _read_bytes(path)
+            self.budget[1] += len(data)
+            if self.budget[1] > MAX_DESCRIPTION_BYTES:
+                raise _fail(host.source, f"the included and attached files hold more than the "
+                                         f"{MAX_DESCRIPTION_BYTES:,} bytes a robot description may have, all "
+                                         "files together")
+            root = parse_xml(data, path).getroot()
+            if root.tag != "mujoco":
+                raise _fail(host.source, f"{what}: {path} has the root element <{root.tag}>, expected <mujoco>")
+            self.read[key] = _model(root, path, os.path.dirname(os.path.abspath(path)), self.packages, self.budget,
+                                    self.fitaabb)
+        return self.read[key], stack + (key,)
+
+
+def _attached_body(attach, model: _Model):
+    """``(body element, its default class)`` of the body an ``<attach body>`` names in ``model``; the class is
+    the ``childclass`` in force where the body stands in its own model."""
+    wanted = attach.get("body")
+    for world in model.root.findall("worldbody"):
+        for body in world.iter("body"):
+            if body.get("name") == wanted:
+                class_name = next((a.get("childclass") for a in body.iterancestors()
+                                   if a.get("childclass") is not None), "main")
+                return body, class_name
+    raise _fail(model.source, f"<attach model=... body={wanted!r}>: the model has no body {wanted!r}")
 
 
 def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
     """Bodies of an MJCF ``<mujoco>`` tree as links (see the module docstring); returns ``(model, links)``."""
+    from .description import MAX_ROBOT_LINKS
     if root.tag != "mujoco":
         raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
-    fallbacks = _expand_includes(root, source)
-    degrees, eulerseq, meshdir = _compiler(root, source)
-    fitaabb = any(c.get("fitaabb") == "true" for c in root.iter("compiler"))
+    budget = [0, os.path.getsize(source) if os.path.isfile(source) else 0]     # [files, bytes] read in all
+    main = _model(root, source, base, packages, budget)
+    # compile-time settings are the main model's (MuJoCo applies them to the attached bodies too)
     group_range = next((c.get("inertiagrouprange") for c in reversed(list(root.iter("compiler")))
                         if c.get("inertiagrouprange") is not None), "0 5")
     groups = tuple(_numbers(group_range, 2, "<compiler inertiagrouprange>", source))
-    mesh_base = os.path.join(base, meshdir or "")
-    defaults = _Defaults(root, source)
-    compiler = (degrees, eulerseq, fitaabb)
-    meshes = _meshes(root, defaults, mesh_base, fallbacks, compiler, source)
-    paired = _paired_geoms(root)
+    attachments = _Attachments(packages, main.compiler[2], budget)
     links = []
     counter = [0]
     replicas = [MAX_REPLICAS]
 
-    def walk_body(body, class_name: str, suffix: str) -> None:
+    def walk_body(body, class_name: str, suffix: str, model: _Model, prefix: str, stack: tuple) -> None:
         counter[0] += 1
-        name = body.get("name") + suffix if body.get("name") else f"body {counter[0]}"
+        if counter[0] > MAX_ROBOT_LINKS:
+            raise _fail(source, f"holds more than the {MAX_ROBOT_LINKS:,} bodies allowed (attached models "
+                                "included)")
+        name = prefix + body.get("name") + suffix if body.get("name") else f"body {counter[0]}"
         child_class = body.get("childclass", class_name)
         elements: list[GeometryElement] = []
-        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements)
+        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements, model, stack)
         links.append(LinkGeometry(name=name, elements=tuple(elements),
-                                  declared=_inertial(body, name, compiler, source)))
-        for child, cls, more in _child_bodies(body, child_class, suffix, source, replicas):
-            walk_body(child, cls, more)
+                                  declared=_inertial(body, name, model.compiler, model.source)))
+        walk_children(body, child_class, suffix, model, prefix, stack)
 
-    def collect(element, link: str, class_name: str, pose, elements: list) -> None:
+    def walk_children(element, class_name: str, suffix: str, model: _Model, prefix: str, stack: tuple) -> None:
+        for child, cls, more in _child_bodies(element, class_name, suffix, model.source, replicas):
+            if cls is not None:
+                walk_body(child, cls, more, model, prefix, stack)
+                continue
+            attached, deeper = attachments.model(child, model, stack)
+            inner = prefix + child.get("prefix")
+            if child.get("body") is None:           # the whole worldbody, as a frame
+                for world in attached.root.findall("worldbody"):
+                    walk_children(world, "main", more, attached, inner, deeper)
+            else:
+                body, body_class = _attached_body(child, attached)
+                walk_body(body, body_class, more, attached, inner, deeper)
+
+    def collect(element, link: str, class_name: str, pose, elements: list, model: _Model, stack: tuple) -> None:
+        degrees, eulerseq, _ = model.compiler
         for child in element:
             if child.tag == "geom":
-                attrs = defaults.attributes(child, class_name, source)
+                attrs = model.defaults.attributes(child, class_name, model.source)
                 if attrs.get("type") == "plane":      # MuJoCo gives a plane no mass and no inertia
                     continue
-                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", source, paired):
+                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", model.source,
+                             model.paired):
                     label = f"geom {len(elements) + 1}"
-                    elements.append(_geom(attrs, pose, label, link, meshes, packages, compiler, source))
+                    if attrs.get("type") == "hfield":
+                        elements.append(_hfield_geom(attrs, pose, label, link, model.hfields, model.compiler,
+                                                     model.source))
+                        continue
+                    elements.append(_geom(attrs, pose, label, link, model.meshes, packages, model.compiler,
+                                          model.source))
             elif child.tag == "frame":
                 attrs = dict(child.attrib)
                 rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=f"body {link!r} frame",
-                                              source=source)
-                position = _coordinates(_numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", source,
-                                                 default=(0, 0, 0)), f"body {link!r} frame pos", source)
+                                              source=model.source)
+                position = _coordinates(_numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", model.source,
+                                                 default=(0, 0, 0)), f"body {link!r} frame pos", model.source)
                 composed = (pose[0] @ rotation, pose[0] @ position + pose[1])
-                collect(child, link, child.get("childclass", class_name), composed, elements)
+                collect(child, link, child.get("childclass", class_name), composed, elements, model, stack)
+            elif child.tag == "replicate":
+                for copy in _replica_poses(child, pose, model, replicas):
+                    collect(child, link, class_name, copy, elements, model, stack)
+            elif child.tag == "attach" and child.get("body") is None:
+                # a whole worldbody attached as a frame: its geoms are this body's, in its own model's terms
+                attached, deeper = attachments.model(child, model, stack)
+                for world in attached.root.findall("worldbody"):
+                    collect(world, link, "main", pose, elements, attached, deeper)
 
     for world in root.findall("worldbody"):
-        for body, cls, suffix in _child_bodies(world, "main", "", source, replicas):
-            walk_body(body, cls, suffix)
+        walk_children(world, "main", "", main, "", (os.path.realpath(source),))
+    if not links and any(world.find("geom") is not None for world in root.findall("worldbody")):
+        raise _fail(source, "no bodies: every geom is in <worldbody> (a scene: terrain, floor, walls), which MuJoCo "
+                            "fixes to the world with no mass; expected a model with at least one <body>")
     return root.get("model", ""), tuple(links)

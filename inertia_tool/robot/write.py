@@ -214,7 +214,8 @@ def _pretty(data: bytes, source: str) -> bytes:
 
 #: MJCF asset elements whose ``file`` is relative to a compiler folder, and which folder attributes govern it.
 _MJCF_ASSET_FOLDERS = {"mesh": ("meshdir", "assetdir"), "texture": ("texturedir", "assetdir"),
-                       "hfield": ("assetdir",), "skin": ("assetdir",)}
+                       "hfield": ("assetdir",), "skin": ("assetdir",),
+                       "model": ()}         # <asset><model file> (for <attach>): relative to the model's folder
 
 
 def _moved(value: str, source_dir: str, out_dir: str) -> str | None:
