@@ -1,9 +1,13 @@
 """Result values cannot be corrupted (issue: read-only arrays, equality that works, one way to principal axes)."""
 
+import copy
 import dataclasses
+import inspect
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import inertia_tool as it
 from inertia_tool.mass import point_mass, shapes
@@ -95,3 +99,90 @@ def test_frozen_value_field_names_are_per_class():
     assert not a.x.flags.writeable and not b.x.flags.writeable and not b.y.flags.writeable
     assert b == B(np.zeros(2), np.ones(2), note="other") and hash(b) == hash(B(np.zeros(2), np.ones(2)))
     assert b != B(np.zeros(2), np.zeros(2))
+
+
+# --- frozen_value writes one __init__ and shares __setattr__/__delattr__ (issue 25 item 4, start-up) --------------
+
+_KINDS = st.sampled_from(["required", "default", "field_default", "factory"])
+
+
+def _declare(decorator, kinds, flags):
+    """A class with one field per kind (in order), decorated by ``decorator``; required fields first, as a
+    dataclass demands."""
+    kinds = sorted(kinds, key=lambda k: k != "required")
+    namespace: dict = {"__annotations__": {}, "__module__": __name__, "__doc__": "a value"}
+    for i, (kind, (shown, compared)) in enumerate(zip(kinds, flags)):
+        name = f"f{i}"
+        namespace["__annotations__"][name] = "float"
+        if kind == "default":
+            namespace[name] = float(i)
+        elif kind == "field_default":
+            namespace[name] = dataclasses.field(default=float(i), repr=shown, compare=compared)
+        elif kind == "factory":
+            namespace[name] = dataclasses.field(default_factory=lambda i=i: np.full(2, float(i)), repr=shown,
+                                                compare=compared)
+        elif not (shown and compared):
+            namespace[name] = dataclasses.field(repr=shown, compare=compared)
+    return decorator(type("Value", (), namespace)), kinds
+
+
+def _reference(cls):
+    """What frozen_value promises to behave as: a dataclass made by dataclasses itself (frozen), with the same
+    equality, hash and repr."""
+    from inertia_tool import values
+    built = dataclasses.dataclass(frozen=True, eq=False, repr=False)(cls)
+    built.__repr__, built.__eq__, built.__hash__ = values._repr, values._eq, values._hash
+    return built
+
+
+def _outcome(make):
+    try:
+        value = make()
+    except TypeError as exc:
+        return ("TypeError", str(exc).split(" ", 1)[1])     # the message without the class's qualified name
+    return ("value", repr(value), dataclasses.astuple(value).__repr__(), hash(value))
+
+
+@settings(max_examples=60, deadline=None)
+@given(kinds=st.lists(_KINDS, min_size=0, max_size=5),
+       flags=st.lists(st.tuples(st.booleans(), st.booleans()), min_size=5, max_size=5),
+       positional=st.integers(0, 6), keywords=st.sets(st.integers(0, 6), max_size=4))
+def test_frozen_value_behaves_as_a_frozen_dataclass(kinds, flags, positional, keywords):
+    """Against ``dataclasses.dataclass(frozen=True)`` on the same declaration: the same signature, fields,
+    repr, equality and hash for every call (too few, too many and unknown arguments raise the same TypeError),
+    and assignment and deletion refused with FrozenInstanceError."""
+    ours, kinds = _declare(frozen_value, kinds, flags)
+    theirs, _ = _declare(_reference, kinds, flags)
+    assert str(inspect.signature(ours)) == str(inspect.signature(theirs))
+    assert [(f.name, f.repr, f.compare, f.default) for f in dataclasses.fields(ours)] == \
+        [(f.name, f.repr, f.compare, f.default) for f in dataclasses.fields(theirs)]
+    assert ours.__dataclass_params__.frozen and ours.__match_args__ == theirs.__match_args__
+    args = [10.0 + i for i in range(positional)]
+    kwargs = {f"f{i}": 20.0 + i for i in keywords}
+    assert _outcome(lambda: ours(*args, **kwargs)) == _outcome(lambda: theirs(*args, **kwargs))
+    defaults = {f"f{i}": 1.0 for i, kind in enumerate(kinds) if kind == "required"}
+    value = ours(**defaults)
+    assert value == ours(**defaults) and hash(value) == hash(ours(**defaults))
+    assert dataclasses.replace(value) == value and copy.deepcopy(value) == value
+    for name in ("f0", "other"):
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(value, name, 1.0)
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            delattr(value, name)
+
+
+def test_frozen_value_leaves_the_unusual_cases_to_dataclasses():
+    """Keyword-only and ``init=False`` fields, and a class with its own ``__init__``, are made by dataclasses
+    (frozen): they behave as declared and still refuse assignment."""
+    @frozen_value
+    class KeywordOnly:
+        x: float
+        y: float = dataclasses.field(default=2.0, kw_only=True)
+        z: float = dataclasses.field(default=3.0, init=False)
+
+    value = KeywordOnly(1.0, y=5.0)
+    assert (value.x, value.y, value.z) == (1.0, 5.0, 3.0)
+    with pytest.raises(TypeError):
+        KeywordOnly(1.0, 5.0)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        value.x = 0.0
