@@ -148,6 +148,26 @@ def test_each_command_imports_its_own_module_only():
     assert not loaded(modules, "numpy")
 
 
+def test_analyze_help_loads_neither_numpy_nor_the_engine():
+    """Issue 25 item 4: ``analyze --help`` built the whole engine (0.12 s, numpy included) to list options whose
+    choices and defaults are constants; now only the parser's modules load, and the help is the same."""
+    code, modules = imported_by("analyze", "--help")
+    assert code == 0
+    assert not loaded(modules, "numpy")
+    assert [m for m in modules if m.startswith(("inertia_tool.mesh", "inertia_tool.mass", "inertia_tool.dynamics",
+                                                "inertia_tool.integrals", "inertia_tool.values"))] == []
+
+
+def test_limits_moved_for_the_parser_are_the_same_objects():
+    """The face limits live in ``tolerances`` (so a parser states them without the mesh layer); the mesh layer
+    and its readers use the very same values."""
+    from inertia_tool import tolerances
+    from inertia_tool.mesh import options, read
+    assert options.DEFAULT_MAX_FACES is tolerances.DEFAULT_MAX_FACES == 50_000_000
+    assert read.MAX_SUPPORTED_FACES is options.MAX_SUPPORTED_FACES is tolerances.MAX_SUPPORTED_FACES
+    assert options.LoadOptions().max_faces == tolerances.DEFAULT_MAX_FACES
+
+
 def test_importing_the_package_imports_only_its_errors():
     done = subprocess.run([sys.executable, "-c", "import sys, inertia_tool; print(' '.join(sys.modules))"],
                           cwd=ROOT, capture_output=True, text=True, timeout=60, check=True)
@@ -158,7 +178,8 @@ def test_importing_the_package_imports_only_its_errors():
 # -- the lazily loaded names (PEP 562) are what type checkers and the docs see ----------------------------------
 
 #: Packages whose public names load on first use, and the name of their ``name → module`` table.
-LAZY_PACKAGES = [("inertia_tool", "_LAZY"), ("inertia_tool.mass", "_PUBLIC"), ("inertia_tool.robot", "_PUBLIC")]
+LAZY_PACKAGES = [("inertia_tool", "_LAZY"), ("inertia_tool.mass", "_PUBLIC"), ("inertia_tool.mesh", "_PUBLIC"),
+                 ("inertia_tool.robot", "_PUBLIC")]
 
 
 def type_checking_imports(module) -> dict:
