@@ -168,6 +168,20 @@ def test_limits_moved_for_the_parser_are_the_same_objects():
     assert options.LoadOptions().max_faces == tolerances.DEFAULT_MAX_FACES
 
 
+def test_a_run_leaves_out_the_other_commands_but_top_level_help_lists_them(capsys):
+    """``analyze FILE`` builds no placeholder for the other commands (nothing reads them); an option before the
+    command (``--help analyze``) prints the top-level help, which lists every command."""
+    from inertia_tool.cli import SUBCOMMANDS, build_parser, main
+    lean = build_parser(("analyze",), others=False)
+    assert list(lean._defaults["_subparsers"]) == ["analyze"]
+    full = build_parser(("analyze",))
+    argv = ["analyze", BOX, "--json", "--units", "mm"]
+    assert vars(lean.parse_args(argv)).keys() == vars(full.parse_args(argv)).keys()
+    assert main(["--help", "analyze"]) == 0
+    listed = capsys.readouterr().out
+    assert all(name in listed for name in SUBCOMMANDS)
+
+
 def test_importing_the_package_imports_only_its_errors():
     done = subprocess.run([sys.executable, "-c", "import sys, inertia_tool; print(' '.join(sys.modules))"],
                           cwd=ROOT, capture_output=True, text=True, timeout=60, check=True)

@@ -6,15 +6,19 @@ sign choice, degenerate planes) are on ``docs/conventions.md``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
 
 from ..values import frozen_value
 from ..errors import UsageError
 from ..rotations import perpendicular_basis
 from ..tolerances import EQUAL_MOMENTS_RTOL
+
+if TYPE_CHECKING:     # annotations only: numpy.typing is not loaded at run time
+    from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["PrincipalAxes", "principal_axes", "DEFAULT_EQUAL_RTOL"]
 
