@@ -182,6 +182,42 @@ def test_a_run_leaves_out_the_other_commands_but_top_level_help_lists_them(capsy
     assert all(name in listed for name in SUBCOMMANDS)
 
 
+def _program(code: str, *argv, cwd=ROOT) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    return subprocess.run([sys.executable, "-c", code, *map(str, argv)], cwd=cwd, env=env, capture_output=True,
+                          text=True, timeout=120)
+
+
+@pytest.mark.parametrize("argv, exit_code", [(["analyze", BOX, "--json", "--units", "mm"], 0),
+                                             (["analyze", BOX, "--units", "parsec"], 2),
+                                             (["analyze", "no_such_file.stl"], 3)],
+                         ids=["json", "usage-error", "missing-file"])
+def test_the_program_ends_itself_with_everything_written(argv, exit_code, capsys):
+    """``main()`` as the program ends the process once the command is done (no interpreter teardown): standard
+    output and error are flushed first, so they are exactly what ``main(argv)`` prints in process, with the
+    same exit code; nothing after ``main()`` runs."""
+    from inertia_tool.cli import main
+    assert main(argv) == exit_code
+    expected = capsys.readouterr()
+    done = _program("import sys; from inertia_tool.cli import main; code = main(); print('after main')", *argv)
+    assert done.returncode == exit_code
+    assert done.stdout == expected.out and done.stderr == expected.err
+    assert "after main" not in done.stdout
+
+
+def test_the_program_exits_normally_when_something_waits_for_the_exit():
+    """An ``atexit`` callback (logging, multiprocessing, a temporary directory's cleanup register one) or a
+    running thread means the normal exit: the callback runs and the thread is joined."""
+    done = _program("import atexit, sys; atexit.register(lambda: print('atexit ran'));"
+                    "from inertia_tool.cli import main; sys.exit(main())", "analyze", BOX, "--units", "mm")
+    assert done.returncode == 0 and done.stdout.rstrip().endswith("atexit ran")
+    # the thread prints once the main thread has finished, which only a normal exit lets it see
+    done = _program("import sys, threading; t = threading.Thread(target=lambda: (threading.main_thread().join(), "
+                    "print('thread done'))); t.start(); from inertia_tool.cli import main; sys.exit(main())",
+                    "analyze", BOX, "--units", "mm")
+    assert done.returncode == 0 and done.stdout.rstrip().endswith("thread done")
+
+
 def test_importing_the_package_imports_only_its_errors():
     done = subprocess.run([sys.executable, "-c", "import sys, inertia_tool; print(' '.join(sys.modules))"],
                           cwd=ROOT, capture_output=True, text=True, timeout=60, check=True)

@@ -109,8 +109,8 @@ def run(args) -> int:
             out["coordinate_system"] = frame_inertia_dict(system)
         out["units_assumed"] = loaded.units_assumed          # no --units and no unit in the file: metres taken
         out = command_output("analyze", out, warnings=messages)
-        json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
-        sys.stdout.write("\n")
+        # one string, one write: json.dump writes each of its hundreds of pieces through the terminal-safe stream
+        sys.stdout.write(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False) + "\n")
     elif fmt in ROBOT_FORMATS:
         from ..robot.inertial import inertial_frame
         frame = inertial_frame(props, args.frame or "principal")
