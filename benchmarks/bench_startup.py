@@ -112,7 +112,8 @@ def _importtime_rows(stderr: str) -> list[tuple[int, int, int, str]]:
 def importtime(env: dict, repeat: int, top: int = 12) -> tuple[list[tuple[int, str]], list[tuple[int, str]]]:
     """What ``analyze`` imports beyond ``import numpy``, from ``python -X importtime`` (µs, best of ``repeat``):
     the cumulative time of each import made at the top of the tree (by the CLI or at run time, not inside
-    numpy), and the ``top`` largest self times."""
+    numpy; numpy's own modules taken out of the one that first imports it), and the ``top`` largest self
+    times."""
     numpy_modules = {name for *_, name in _importtime_rows(subprocess.run(
         [sys.executable, "-X", "importtime", "-c", "import numpy"], cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE, text=True, check=True).stderr)}
@@ -122,12 +123,16 @@ def importtime(env: dict, repeat: int, top: int = 12) -> tuple[list[tuple[int, s
         done = subprocess.run([sys.executable, "-X", "importtime", "-m", "inertia_tool", "analyze", BOX, "--json"],
                               cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                               check=True)
+        inside_numpy = 0                         # self µs of numpy's modules since the last top-level import
         for self_us, cum_us, depth, name in _importtime_rows(done.stderr):
             if name in numpy_modules:
+                inside_numpy = 0 if depth == 0 else inside_numpy + self_us
                 continue
             self_time[name] = min(self_time.get(name, 1 << 62), self_us)
             if depth == 0:
-                cumulative[name] = min(cumulative.get(name, 1 << 62), cum_us)
+                # children come before their parent: the first of our modules to import numpy carries it
+                cumulative[name] = min(cumulative.get(name, 1 << 62), cum_us - inside_numpy)
+                inside_numpy = 0
     return (sorted(((us, name) for name, us in cumulative.items()), reverse=True),
             sorted(((us, name) for name, us in self_time.items()), reverse=True)[:top])
 

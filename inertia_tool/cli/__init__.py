@@ -210,9 +210,9 @@ def _end_program(code: int) -> None:
     command returns.  When a flush fails (a closed pipe) the normal exit takes over and reports it as usual.
     """
     import atexit
-    import threading
     callbacks = getattr(atexit, "_ncallbacks", None)            # CPython's count; elsewhere: the normal exit
-    if callbacks is None or callbacks() or threading.active_count() > 1:
+    threading = sys.modules.get("threading")                   # never imported: no thread was started with it
+    if callbacks is None or callbacks() or (threading is not None and threading.active_count() > 1):
         return
     try:
         sys.stdout.flush()
