@@ -186,3 +186,20 @@ def test_frozen_value_leaves_the_unusual_cases_to_dataclasses():
         KeywordOnly(1.0, 5.0)
     with pytest.raises(dataclasses.FrozenInstanceError):
         value.x = 0.0
+
+
+def test_stored_arrays_plain_and_subclass():
+    """The inlined path for plain arrays and readonly() for subclasses store the same thing: a read-only
+    plain ndarray, copied when small, a view when large."""
+    @frozen_value
+    class Holder:
+        data: np.ndarray
+
+    small, big = np.arange(3.0), np.zeros(COPY_LIMIT + 1)
+    sub = np.asmatrix(np.arange(3.0))          # an ndarray subclass
+    for given, shares in ((small, False), (big, True), (sub, None)):
+        held = Holder(given).data
+        assert type(held) is np.ndarray and not held.flags.writeable
+        if shares is not None:
+            assert np.shares_memory(held, given) == shares
+        np.testing.assert_array_equal(held, np.asarray(given))
