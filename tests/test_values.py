@@ -196,10 +196,13 @@ def test_stored_arrays_plain_and_subclass():
         data: np.ndarray
 
     small, big = np.arange(3.0), np.zeros(COPY_LIMIT + 1)
-    sub = np.asmatrix(np.arange(3.0))          # an ndarray subclass
-    for given, shares in ((small, False), (big, True), (sub, None)):
-        held = Holder(given).data
+    class Sub(np.ndarray):
+        pass
+
+    sub = np.arange(3.0).view(Sub)
+    for source, shares in ((small, False), (big, True), (sub, None)):
+        held = Holder(source).data
         assert type(held) is np.ndarray and not held.flags.writeable
         if shares is not None:
-            assert np.shares_memory(held, given) == shares
-        np.testing.assert_array_equal(held, np.asarray(given))
+            assert np.shares_memory(held, source) == shares
+        np.testing.assert_array_equal(held, np.asarray(source))
