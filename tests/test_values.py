@@ -206,3 +206,15 @@ def test_stored_arrays_plain_and_subclass():
         if shares is not None:
             assert np.shares_memory(held, source) == shares
         np.testing.assert_array_equal(held, np.asarray(source))
+
+
+def test_results_survive_pickling_and_replace(props):
+    """Batch workers and Dask move results between processes: unpickling fills the instance dictionary
+    without the refusing ``__setattr__``, and ``dataclasses.replace`` goes through ``__init__``."""
+    import pickle
+    again = pickle.loads(pickle.dumps(props))
+    assert again == props and not again.center_of_mass.flags.writeable
+    renamed = dataclasses.replace(props, name="renamed")
+    assert renamed.name == "renamed" and renamed.mass == props.mass
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        again.mass = 0.0
