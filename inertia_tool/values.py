@@ -102,6 +102,21 @@ def _repr(self: Any) -> str:
     return f"{self.__class__.__qualname__}({shown})"
 
 
+def _setstate(self: Any, state: Any) -> None:
+    """Unpickling: the instance dictionary filled directly (the refusing ``__setattr__`` is not called), and
+    its arrays made read-only again (pickle does not keep the flag; the unpickled arrays are this value's own,
+    so no copy is needed)."""
+    if isinstance(state, tuple):                   # (dict, slots): what object.__reduce_ex__ gives with slots
+        state, slots = state
+        for name, value in (slots or {}).items():
+            object.__setattr__(self, name, value)
+    stored = self.__dict__
+    stored.update(state or {})
+    for value in stored.values():
+        if isinstance(value, np.ndarray) and value.flags.writeable:
+            value.setflags(write=False)
+
+
 def _refuse_assignment(self: Any, name: str, value: Any) -> None:
     raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
 
@@ -220,6 +235,8 @@ def frozen_value(cls: type[_T]) -> type[_T]:
             built.__doc__ = f"{built.__name__}({', '.join(f.name for f in fields)})"
     if not own_repr:
         built.__repr__ = _repr
+    if not any(k in cls.__dict__ for k in ("__setstate__", "__getstate__", "__reduce__", "__reduce_ex__")):
+        built.__setstate__ = _setstate
     built.__eq__ = _eq
     built.__hash__ = _hash
     result: type[_T] = built

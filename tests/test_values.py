@@ -210,10 +210,15 @@ def test_stored_arrays_plain_and_subclass():
 
 def test_results_survive_pickling_and_replace(props):
     """Batch workers and Dask move results between processes: unpickling fills the instance dictionary
-    without the refusing ``__setattr__``, and ``dataclasses.replace`` goes through ``__init__``."""
+    without the refusing ``__setattr__`` and makes the arrays read-only again (pickle does not keep the flag:
+    before, an unpickled result's centre of mass could be written to), and ``dataclasses.replace`` goes
+    through ``__init__``."""
     import pickle
     again = pickle.loads(pickle.dumps(props))
     assert again == props and not again.center_of_mass.flags.writeable
+    assert not again.principal.axes.flags.writeable and not again.mesh.bbox_min.flags.writeable
+    with pytest.raises(ValueError, match="read-only"):
+        again.inertia[0, 0] = 0.0
     renamed = dataclasses.replace(props, name="renamed")
     assert renamed.name == "renamed" and renamed.mass == props.mass
     with pytest.raises(dataclasses.FrozenInstanceError):
