@@ -20,7 +20,10 @@ would compile the package from source.  ``--importtime`` also lists what the ana
 ``import numpy`` (``python -X importtime``, best of the repeats): the cumulative time of each top-level import
 and the largest self times, so a new eager import shows up by name.
 
-    python benchmarks/bench_startup.py [--repeat 7] [--importtime]
+``--baseline DIR`` adds the analyze and help commands run against another checkout (e.g. a copy of ``main``)
+to the same round-robin, so that before and after are measured in one run under the same load.
+
+    python benchmarks/bench_startup.py [--repeat 7] [--importtime] [--baseline DIR]
 """
 
 from __future__ import annotations
@@ -44,9 +47,9 @@ GOAL = 1.3
 TRIMESH = "import sys, trimesh; m = trimesh.load(sys.argv[1]); p = m.mass_properties; p['inertia'], p['center_mass']"
 
 
-def child_env() -> dict:
+def child_env(root: str = ROOT) -> dict:
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "INERTIA_TOOL_NO_ACCEL")}
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (ROOT, os.environ.get("PYTHONPATH", "")) if p)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)
     return env
 
 
@@ -76,11 +79,19 @@ def commands() -> list[tuple[str, list[str]]]:
     return rows
 
 
-def run(argv: list[str], env: dict) -> tuple[float, float]:
+def baseline_commands(baseline: str) -> list[tuple[str, list[str]]]:
+    """The analyze and help commands again, labelled ``[baseline]``: the same interpreter and console script,
+    with ``PYTHONPATH`` (see :func:`main`) pointing at ``baseline``."""
+    keep = ("analyze", "--help")
+    return [(f"[baseline] {label}", argv) for label, argv in commands()
+            if label.startswith(("inertia-tool", "python -m")) and any(k in label for k in keep)]
+
+
+def run(argv: list[str], env: dict, cwd: str = ROOT) -> tuple[float, float]:
     """Wall and CPU (user + system) seconds of one run of ``argv`` in a fresh process."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    subprocess.run(argv, cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
+    subprocess.run(argv, cwd=cwd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -101,7 +112,8 @@ def _importtime_rows(stderr: str) -> list[tuple[int, int, int, str]]:
 def importtime(env: dict, repeat: int, top: int = 12) -> tuple[list[tuple[int, str]], list[tuple[int, str]]]:
     """What ``analyze`` imports beyond ``import numpy``, from ``python -X importtime`` (µs, best of ``repeat``):
     the cumulative time of each import made at the top of the tree (by the CLI or at run time, not inside
-    numpy), and the ``top`` largest self times."""
+    numpy; numpy's own modules taken out of the one that first imports it), and the ``top`` largest self
+    times."""
     numpy_modules = {name for *_, name in _importtime_rows(subprocess.run(
         [sys.executable, "-X", "importtime", "-c", "import numpy"], cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE, text=True, check=True).stderr)}
@@ -111,12 +123,16 @@ def importtime(env: dict, repeat: int, top: int = 12) -> tuple[list[tuple[int, s
         done = subprocess.run([sys.executable, "-X", "importtime", "-m", "inertia_tool", "analyze", BOX, "--json"],
                               cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                               check=True)
+        inside_numpy = 0                         # self µs of numpy's modules since the last top-level import
         for self_us, cum_us, depth, name in _importtime_rows(done.stderr):
             if name in numpy_modules:
+                inside_numpy = 0 if depth == 0 else inside_numpy + self_us
                 continue
             self_time[name] = min(self_time.get(name, 1 << 62), self_us)
             if depth == 0:
-                cumulative[name] = min(cumulative.get(name, 1 << 62), cum_us)
+                # children come before their parent: the first of our modules to import numpy carries it
+                cumulative[name] = min(cumulative.get(name, 1 << 62), cum_us - inside_numpy)
+                inside_numpy = 0
     return (sorted(((us, name) for name, us in cumulative.items()), reverse=True),
             sorted(((us, name) for name, us in self_time.items()), reverse=True)[:top])
 
@@ -125,19 +141,27 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeat", type=int, default=7, help="runs of each command; best and median are kept")
     parser.add_argument("--importtime", action="store_true", help="also list what analyze imports beyond numpy")
+    parser.add_argument("--baseline", metavar="DIR", help="another checkout (e.g. a copy of main) to time in the same "
+                                                         "run: its analyze and help commands are added")
     args = parser.parse_args()
     env = child_env()
     where = subprocess.run([sys.executable, "-c", "import inertia_tool; print(inertia_tool.__file__)"], cwd=ROOT,
                            env=env, capture_output=True, text=True, check=True).stdout.strip()
     rows = commands()
-    for _, argv in rows:                              # warm-up: bytecode caches written, files in the page cache
-        run(argv, env)
+    envs = {label: (env, ROOT) for label, _ in rows}
+    if args.baseline:
+        base = os.path.abspath(args.baseline)
+        extra = baseline_commands(base)
+        rows += extra
+        envs.update({label: (child_env(base), base) for label, _ in extra})
+    for label, argv in rows:                          # warm-up: bytecode caches written, files in the page cache
+        run(argv, *envs[label])
     walls: dict[str, list[float]] = {label: [] for label, _ in rows}
     cpus: dict[str, list[float]] = {label: [] for label, _ in rows}
     load_before = os.getloadavg()
     for _ in range(args.repeat):
         for label, argv in rows:
-            wall, cpu = run(argv, env)
+            wall, cpu = run(argv, *envs[label])
             walls[label].append(wall)
             cpus[label].append(cpu)
     load_after = os.getloadavg()
@@ -163,6 +187,8 @@ def main() -> None:
         verdict = "met" if best <= GOAL else "NOT met"
         print(f"goal (issue 25): {label} within {GOAL:g}x import numpy (best of {args.repeat}): {best:.2f}x, "
               f"{verdict} (median {median:.2f}x, CPU {cpu:.2f}x)")
+    if args.baseline:
+        print(f"baseline: {os.path.abspath(args.baseline)} (same interpreter and console script)")
     peer = f"trimesh.load({BOX}).mass_properties"
     analyze = f"python -m inertia_tool analyze {BOX} --json"
     print(f"trimesh load + mass_properties of the same file / analyze --json: "

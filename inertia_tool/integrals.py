@@ -30,9 +30,9 @@ Everything here is pure: SI numpy arrays in, numpy arrays out.  See ``docs/conve
 from __future__ import annotations
 
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
 
 from .values import frozen_value
 from ._native import accel, faces_for_c, threads
@@ -74,8 +74,15 @@ class VolumeMoments:
 
 _PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
-#: Per-label raw sums: volume (L,), first moment (L, 3), second moment (L, 3, 3), area (L,), zero-area faces (L,).
-_Sums = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]
+if TYPE_CHECKING:     # annotations only: numpy.typing is not loaded at run time
+    from typing import TypeAlias
+
+    from numpy.typing import NDArray
+
+    #: Per-label raw sums: volume (L,), first moment (L, 3), second moment (L, 3, 3), area (L,), zero-area faces
+    #: (L,).
+    _Sums: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                             NDArray[np.int64]]
 
 
 def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chunk_size: int,

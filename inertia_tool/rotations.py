@@ -23,11 +23,11 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
 
 from .errors import UsageError
 
 if TYPE_CHECKING:                       # scipy has no type information: Rotation is Any to the checker
+    from numpy.typing import ArrayLike, NDArray      # annotations only: not loaded at run time
     from scipy.spatial.transform import Rotation
 
 __all__ = [

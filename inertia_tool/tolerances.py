@@ -108,3 +108,17 @@ ARRANGE_MERGE_RTOL = 1e-12
 #: its coordinates' rounding can carry, a part far from the rest) is integrated again in exact integer arithmetic
 #: (:func:`inertia_tool.integrals.exact_volume_moments`); one too large for that is certified ``unverified``.
 ROUNDOFF_RTOL = 1e-10
+
+# -- limits on the input (guards, not tolerances; here so that a command's parser states them without loading
+#    the mesh layer) ---------------------------------------------------------------------------------------------
+
+#: Default guard on the number of triangles a file may hold (``LoadOptions.max_faces``).  Peak memory at the
+#: limit (``docs/bad-input.md``; ``benchmarks/bench_memory.py``): binary STL ~63 MiB + 37 B per face with the C
+#: extension (1.8 GiB at 50M), 77 B per face on the numpy path; a 3MF (streaming reader, ``mesh.threemf``)
+#: ~150 B per face for a whole ``analyze`` run; other formats per ``benchmarks/bench_memory.py --formats``.
+DEFAULT_MAX_FACES = 50_000_000
+
+#: Most triangles any reader accepts, whatever ``max_faces`` says: the welders number the 3 corners of every
+#: triangle with 32-bit integers, so 3 x faces must stay below 2^31 (715,827,882 triangles, ~36 GB of
+#: binary STL).  A file announcing more is refused from its header, before anything is allocated.
+MAX_SUPPORTED_FACES = (2**31 - 1) // 3

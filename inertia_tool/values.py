@@ -102,21 +102,117 @@ def _repr(self: Any) -> str:
     return f"{self.__class__.__qualname__}({shown})"
 
 
+def _setstate(self: Any, state: Any) -> None:
+    """Unpickling: the instance dictionary filled directly (the refusing ``__setattr__`` is not called), and
+    its arrays made read-only again (pickle does not keep the flag; the unpickled arrays are this value's own,
+    so no copy is needed)."""
+    if isinstance(state, tuple):                   # (dict, slots): what object.__reduce_ex__ gives with slots
+        state, slots = state
+        for name, value in (slots or {}).items():
+            object.__setattr__(self, name, value)
+    stored = self.__dict__
+    stored.update(state or {})
+    for value in stored.values():
+        if isinstance(value, np.ndarray) and value.flags.writeable:
+            value.setflags(write=False)
+
+
+def _refuse_assignment(self: Any, name: str, value: Any) -> None:
+    raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
+
+
+def _refuse_deletion(self: Any, name: str) -> None:
+    raise dataclasses.FrozenInstanceError(f"cannot delete field {name!r}")
+
+
+class _Factory:
+    """Default of an ``__init__`` parameter whose field has a ``default_factory`` (as in dataclasses)."""
+
+    def __repr__(self) -> str:
+        return "<factory>"
+
+
+_HAS_FACTORY = _Factory()
+
+
+def _frozen_init(cls: type, fields: tuple[dataclasses.Field[Any], ...]) -> Any:
+    """The ``__init__`` a frozen dataclass writes for ``fields`` (each an ``init`` field, neither keyword-only
+    nor an ``InitVar``): one parameter per field in order, defaults and default factories as declared, each
+    value stored with ``object.__setattr__`` (bypassing the refusal), then ``self.__post_init__()``."""
+    scope: dict[str, Any] = {"__object_setattr": object.__setattr__, "__has_factory": _HAS_FACTORY}
+    params, body = [], []
+    for f in fields:
+        name = f.name
+        if f.default is not dataclasses.MISSING:
+            scope[f"__default_{name}"] = f.default
+            params.append(f"{name}=__default_{name}")
+        elif f.default_factory is not dataclasses.MISSING:
+            scope[f"__factory_{name}"] = f.default_factory
+            params.append(f"{name}=__has_factory")
+            body.append(f"    if {name} is __has_factory: {name} = __factory_{name}()")
+        else:
+            params.append(name)
+        body.append(f"    __object_setattr(__self, {name!r}, {name})")
+    body.append("    __self.__post_init__()")
+    source = f"def __init__(__self, {', '.join(params)}) -> None:\n" + "\n".join(body) + "\n"
+    exec(source, scope)                            # noqa: S102 - source built above from the field names only
+    init = scope["__init__"]
+    init.__qualname__ = f"{cls.__qualname__}.__init__"
+    init.__module__ = cls.__module__
+    init.__annotations__ = {**{f.name: f.type for f in fields}, "return": None}
+    return init
+
+
+def _is_simple(cls: type) -> bool:
+    """Whether :func:`_frozen_init` can write the ``__init__`` of ``cls`` before it is a dataclass: it defines
+    no ``__init__``, ``__setattr__`` or ``__delattr__`` of its own, has no dataclass base, and no field is
+    keyword-only, ``init=False``, an ``InitVar`` or a ``ClassVar`` (all of which dataclasses handles itself)."""
+    own = cls.__dict__
+    if "__init__" in own or "__setattr__" in own or "__delattr__" in own:
+        return False
+    if any("__dataclass_fields__" in base.__dict__ for base in cls.__mro__[1:]):
+        return False
+    for name, annotation in own.get("__annotations__", {}).items():
+        text = annotation if isinstance(annotation, str) else repr(annotation)
+        if "InitVar" in text or "ClassVar" in text or "KW_ONLY" in text:
+            return False
+        default = own.get(name)
+        if isinstance(default, dataclasses.Field) and (not default.init or default.kw_only is True):
+            return False
+    return True
+
+
 @dataclass_transform(frozen_default=True, eq_default=False)
 def frozen_value(cls: type[_T]) -> type[_T]:
-    """Class decorator: a frozen dataclass whose arrays are read-only, with equality and hash by value."""
+    """Class decorator: a frozen dataclass whose arrays are read-only, with equality and hash by value.
+
+    It behaves as ``dataclasses.dataclass(frozen=True, eq=False)`` plus the equality, hash and repr above,
+    but is cheaper to make: a frozen dataclass compiles three methods per class (``__init__``,
+    ``__setattr__``, ``__delattr__``), and every command-line run makes some twenty of these classes at
+    import.  Here the class is made a dataclass without an ``__init__`` (its fields, ``fields()``,
+    ``replace()`` and ``asdict()`` as usual), then given the ``__init__`` a frozen dataclass would have
+    (:func:`_frozen_init`, the one method compiled) and one shared ``__setattr__``/``__delattr__`` that
+    refuse with :class:`dataclasses.FrozenInstanceError`.  A class with keyword-only, ``init=False`` or
+    ``InitVar`` fields, or a dataclass base, is made by ``dataclasses.dataclass(frozen=True)`` itself.
+    """
     own_post_init = cls.__dict__.get("__post_init__")
 
     def __post_init__(self: Any) -> None:
         if own_post_init is not None:
             own_post_init(self)
         # the instance dictionary holds exactly the fields here (a frozen dataclass without slots; derived
-        # values cached later are not set yet): reading it skips a getattr per field
+        # values cached later are not set yet; an init=False field with a plain default stays on the class):
+        # reading it skips a getattr per field
         stored = self.__dict__
         for name in _field_names(self.__class__)[0]:
-            value = stored[name]
+            value = stored.get(name)
             if isinstance(value, np.ndarray) and value.flags.writeable:
-                stored[name] = readonly(value)
+                if type(value) is np.ndarray:      # readonly() inlined: ~14 values of a small part, ~30 arrays
+                    value = value.copy() if value.size <= COPY_LIMIT else value.view()
+                    value.setflags(write=False)
+                    stored[name] = value
+                else:                              # a subclass: readonly() makes it a plain ndarray
+                    stored[name] = readonly(value)
 
     # the class is being built: methods are added to it dynamically, which a type checker cannot follow
     built: Any = cls
@@ -125,9 +221,22 @@ def frozen_value(cls: type[_T]) -> type[_T]:
     # one __repr__ for every class instead of one compiled per class (dataclass compiles each method it writes:
     # a fifth of the time of making the class, and every command line run makes some twenty at import)
     own_repr = "__repr__" in cls.__dict__
-    built = dataclasses.dataclass(frozen=True, eq=False, repr=False)(built)
+    undocumented = cls.__doc__ is None
+    if not _is_simple(built):                      # the general case, left to dataclasses
+        built = dataclasses.dataclass(frozen=True, eq=False, repr=False)(built)
+    else:
+        built = dataclasses.dataclass(init=False, repr=False, eq=False)(built)
+        fields = dataclasses.fields(built)
+        built.__init__ = _frozen_init(built, fields)
+        built.__setattr__ = _refuse_assignment
+        built.__delattr__ = _refuse_deletion
+        built.__dataclass_params__.frozen = True   # what dataclasses.dataclass(frozen=True) records
+        if undocumented:                           # dataclass's default docstring, from the real __init__
+            built.__doc__ = f"{built.__name__}({', '.join(f.name for f in fields)})"
     if not own_repr:
         built.__repr__ = _repr
+    if not any(k in cls.__dict__ for k in ("__setstate__", "__getstate__", "__reduce__", "__reduce_ex__")):
+        built.__setstate__ = _setstate
     built.__eq__ = _eq
     built.__hash__ = _hash
     result: type[_T] = built

@@ -148,6 +148,76 @@ def test_each_command_imports_its_own_module_only():
     assert not loaded(modules, "numpy")
 
 
+def test_analyze_help_loads_neither_numpy_nor_the_engine():
+    """Issue 25 item 4: ``analyze --help`` built the whole engine (0.12 s, numpy included) to list options whose
+    choices and defaults are constants; now only the parser's modules load, and the help is the same."""
+    code, modules = imported_by("analyze", "--help")
+    assert code == 0
+    assert not loaded(modules, "numpy")
+    assert [m for m in modules if m.startswith(("inertia_tool.mesh", "inertia_tool.mass", "inertia_tool.dynamics",
+                                                "inertia_tool.integrals", "inertia_tool.values"))] == []
+
+
+def test_limits_moved_for_the_parser_are_the_same_objects():
+    """The face limits live in ``tolerances`` (so a parser states them without the mesh layer); the mesh layer
+    and its readers use the very same values."""
+    from inertia_tool import tolerances
+    from inertia_tool.mesh import options, read
+    assert options.DEFAULT_MAX_FACES is tolerances.DEFAULT_MAX_FACES == 50_000_000
+    assert read.MAX_SUPPORTED_FACES is options.MAX_SUPPORTED_FACES is tolerances.MAX_SUPPORTED_FACES
+    assert options.LoadOptions().max_faces == tolerances.DEFAULT_MAX_FACES
+
+
+def test_a_run_leaves_out_the_other_commands_but_top_level_help_lists_them(capsys):
+    """``analyze FILE`` builds no placeholder for the other commands (nothing reads them); an option before the
+    command (``--help analyze``) prints the top-level help, which lists every command."""
+    from inertia_tool.cli import SUBCOMMANDS, build_parser, main
+    lean = build_parser(("analyze",), others=False)
+    assert list(lean._defaults["_subparsers"]) == ["analyze"]
+    full = build_parser(("analyze",))
+    argv = ["analyze", BOX, "--json", "--units", "mm"]
+    assert vars(lean.parse_args(argv)).keys() == vars(full.parse_args(argv)).keys()
+    assert main(["--help", "analyze"]) == 0
+    listed = capsys.readouterr().out
+    assert all(name in listed for name in SUBCOMMANDS)
+
+
+def _program(code: str, *argv, cwd=ROOT) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    return subprocess.run([sys.executable, "-c", code, *map(str, argv)], cwd=cwd, env=env, capture_output=True,
+                          text=True, timeout=120)
+
+
+@pytest.mark.parametrize("argv, exit_code", [(["analyze", BOX, "--json", "--units", "mm"], 0),
+                                             (["analyze", BOX, "--units", "parsec"], 2),
+                                             (["analyze", "no_such_file.stl"], 3)],
+                         ids=["json", "usage-error", "missing-file"])
+def test_the_program_ends_itself_with_everything_written(argv, exit_code, capsys):
+    """``main()`` as the program ends the process once the command is done (no interpreter teardown): standard
+    output and error are flushed first, so they are exactly what ``main(argv)`` prints in process, with the
+    same exit code; nothing after ``main()`` runs."""
+    from inertia_tool.cli import main
+    assert main(argv) == exit_code
+    expected = capsys.readouterr()
+    done = _program("import sys; from inertia_tool.cli import main; code = main(); print('after main')", *argv)
+    assert done.returncode == exit_code
+    assert done.stdout == expected.out and done.stderr == expected.err
+    assert "after main" not in done.stdout
+
+
+def test_the_program_exits_normally_when_something_waits_for_the_exit():
+    """An ``atexit`` callback (logging, multiprocessing, a temporary directory's cleanup register one) or a
+    running thread means the normal exit: the callback runs and the thread is joined."""
+    done = _program("import atexit, sys; atexit.register(lambda: print('atexit ran'));"
+                    "from inertia_tool.cli import main; sys.exit(main())", "analyze", BOX, "--units", "mm")
+    assert done.returncode == 0 and done.stdout.rstrip().endswith("atexit ran")
+    # the thread prints once the main thread has finished, which only a normal exit lets it see
+    done = _program("import sys, threading; t = threading.Thread(target=lambda: (threading.main_thread().join(), "
+                    "print('thread done'))); t.start(); from inertia_tool.cli import main; sys.exit(main())",
+                    "analyze", BOX, "--units", "mm")
+    assert done.returncode == 0 and done.stdout.rstrip().endswith("thread done")
+
+
 def test_importing_the_package_imports_only_its_errors():
     done = subprocess.run([sys.executable, "-c", "import sys, inertia_tool; print(' '.join(sys.modules))"],
                           cwd=ROOT, capture_output=True, text=True, timeout=60, check=True)
@@ -158,7 +228,8 @@ def test_importing_the_package_imports_only_its_errors():
 # -- the lazily loaded names (PEP 562) are what type checkers and the docs see ----------------------------------
 
 #: Packages whose public names load on first use, and the name of their ``name → module`` table.
-LAZY_PACKAGES = [("inertia_tool", "_LAZY"), ("inertia_tool.mass", "_PUBLIC"), ("inertia_tool.robot", "_PUBLIC")]
+LAZY_PACKAGES = [("inertia_tool", "_LAZY"), ("inertia_tool.mass", "_PUBLIC"), ("inertia_tool.mesh", "_PUBLIC"),
+                 ("inertia_tool.robot", "_PUBLIC")]
 
 
 def type_checking_imports(module) -> dict:

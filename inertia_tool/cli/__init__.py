@@ -130,12 +130,14 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser(commands: Collection[str] | None = None) -> argparse.ArgumentParser:
+def build_parser(commands: Collection[str] | None = None, *, others: bool = True) -> argparse.ArgumentParser:
     """The ``inertia-tool`` parser.
 
     ``commands``: the subcommands whose parsers are built in full (their modules imported, and with them the
     engine layers they use); all when None.  The others get a placeholder with their one-line summary
-    (:data:`~.help.SUMMARIES`), which is all ``inertia-tool --help`` and the choice of a command read.
+    (:data:`~.help.SUMMARIES`), which is all ``inertia-tool --help`` and the choice of a command read; with
+    ``others=False`` they are left out (``argv`` starts with the command, so neither is read: each placeholder
+    is a whole ArgumentParser, about a tenth of a millisecond).
     """
     parser = _Parser(prog="inertia-tool",
                      description="Exact mass properties, principal axes, spin stability, dynamics and balancing "
@@ -147,7 +149,7 @@ def build_parser(commands: Collection[str] | None = None) -> argparse.ArgumentPa
     for name in SUBCOMMANDS:
         if commands is None or name in commands:
             importlib.import_module(f"{__name__}.{name.replace('-', '_')}").register(sub)
-        else:
+        elif others:
             sub.add_parser(name, help=SUMMARIES[name])
     parser.set_defaults(_subparsers=sub.choices)
     return parser
@@ -184,8 +186,48 @@ class _TerminalSafe:
 
 
 def main(argv=None) -> int:
-    """Entry point of the ``inertia-tool`` console script; returns the exit code."""
-    parser = build_parser(_command_in(argv))      # only the running command's module is imported
+    """Entry point of the ``inertia-tool`` console script; returns the exit code.
+
+    Called without ``argv`` (as the console script and ``python -m inertia_tool`` call it) it is the program:
+    once the command is done it ends the process itself when nothing is left to run at exit
+    (:func:`_end_program`).
+    """
+    code = _main(argv)
+    if argv is None:
+        _end_program(code)
+    return code
+
+
+def _end_program(code: int) -> None:
+    """End the process with ``code`` now, skipping the interpreter's teardown, when that loses nothing.
+
+    Tearing down an interpreter that has loaded numpy and this package (clearing every module, collecting
+    every object) costs about a tenth of a start-up on a small part; it does nothing a finished command
+    needs.  So, after flushing standard output and error, the process ends with :func:`os._exit` if no
+    ``atexit`` callback is registered (the hooks of ``logging``, ``multiprocessing``, ``weakref.finalize``,
+    temporary directories, ... all register one, and then the normal exit runs them) and no other thread is
+    running.  Files this tool writes are closed by their writer (:mod:`inertia_tool.output`) before the
+    command returns.  When a flush fails (a closed pipe) the normal exit takes over and reports it as usual.
+    """
+    import atexit
+    callbacks = getattr(atexit, "_ncallbacks", None)            # CPython's count; elsewhere: the normal exit
+    threading = sys.modules.get("threading")                   # never imported: no thread was started with it
+    if callbacks is None or callbacks() or (threading is not None and threading.active_count() > 1):
+        return
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        return
+    os._exit(code)
+
+
+def _main(argv) -> int:
+    command = _command_in(argv)
+    words = sys.argv[1:] if argv is None else list(argv)
+    # only the running command's module is imported; the other commands are left out when nothing before the
+    # command could print the top-level help (``inertia-tool --help analyze`` lists them all)
+    parser = build_parser(command, others=not command or words[0] != command[0])
     try:
         args, extra = parser.parse_known_args(argv)
         if extra:   # reported by the subcommand's parser, so that the line names the command and its --help

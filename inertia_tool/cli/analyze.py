@@ -8,23 +8,20 @@ import os
 import sys
 import warnings
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ..errors import ImplausiblePointWarning, OverlapWarning, PhysicsError, UsageError
 from ..tolerances import PRINTED_MOMENT_TOLERANCE
-from ..reports.serialize import command_output, mass_properties_dict, to_jsonable
-from ..reports.stability import format_stability, stability_dict
-from ..reports.text import format_mass_properties
-from ..dynamics.spin_stability import stability
-from ..mesh.read import BREP_SUFFIXES
-from ..reports.cad import CAD_UNITS, format_cad_report
-from ..reports.models import format_model_note
-from ..robot.formats import FRAMES, ROBOT_FORMATS, format_inertial
+from ..reports.cad import CAD_UNITS
+from ..robot.formats import FRAMES, ROBOT_FORMATS
 from .help import add_command
 from .model_options import (add_files_argument, add_model_options, load_model, model_words, split_part_spec,
                             with_warnings)
 from .options import check_option, density_and_mass
 from .report_option import add_report_options, check_report_path, write_report_from_args
+
+if TYPE_CHECKING:     # the engine and the report writers load when the command runs, not for its --help
+    import numpy as np
 
 __all__ = ["register", "run", "add_output_options", "output_format", "FORMATS", "BREP_METHOD"]
 
@@ -54,6 +51,12 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
+    from ..reports.serialize import command_output, mass_properties_dict, to_jsonable
+    from ..reports.stability import format_stability, stability_dict
+    from ..reports.text import format_mass_properties
+    from ..reports.cad import format_cad_report
+    from ..reports.models import format_model_note
+    from ..robot.formats import format_inertial
     fmt = output_format(args)
     check_report_path(args)
     loaded = load_model(args)
@@ -106,8 +109,8 @@ def run(args) -> int:
             out["coordinate_system"] = frame_inertia_dict(system)
         out["units_assumed"] = loaded.units_assumed          # no --units and no unit in the file: metres taken
         out = command_output("analyze", out, warnings=messages)
-        json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
-        sys.stdout.write("\n")
+        # one string, one write: json.dump writes each of its hundreds of pieces through the terminal-safe stream
+        sys.stdout.write(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False) + "\n")
     elif fmt in ROBOT_FORMATS:
         from ..robot.inertial import inertial_frame
         frame = inertial_frame(props, args.frame or "principal")
@@ -141,6 +144,7 @@ def _brep_section(args):
     if len(files) != 1 or getattr(args, "model", "solid") != "solid" or getattr(args, "shell", None):
         return None
     path = split_part_spec(files[0])[0]
+    from ..mesh.read import BREP_SUFFIXES
     if os.path.splitext(path)[1].lower() not in BREP_SUFFIXES:
         return None
     from ..mesh.cad import has_ocp      # imported on use, like the B-rep comparison below
@@ -167,6 +171,7 @@ def _moment_tolerance(args) -> float | None:
 
 def _stability_section(props, tolerance: float | None = None):
     """Spin stability of the principal axes for the report, or ``(None, reason)`` when undefined."""
+    from ..dynamics.spin_stability import stability
     try:
         return stability(props, moment_tolerance=tolerance), None
     except PhysicsError as exc:
@@ -204,6 +209,8 @@ def add_output_options(parser) -> argparse._ArgumentGroup:
 
 def parse_axes(text: str) -> np.ndarray:
     """``--axes``: ``axis-angle:AX,AY,AZ,ANGLE`` or ``matrix:R11,...,R33`` → (3, 3) rotation (columns: axes)."""
+    import numpy as np
+
     from ..rotations import axis_angle_to_matrix
     from ..units import parse_angle
     kind, _, rest = str(text).partition(":")

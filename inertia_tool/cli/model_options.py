@@ -26,16 +26,16 @@ import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..errors import InertiaToolWarning, UsageError
-from ..mass.properties import MassProperties
-from ..mass.pipeline import DEFAULT_DENSITY, assembly, mass_properties, resolve_density
-from ..mesh.options import DEFAULT_MAX_FACES, LoadOptions
-from ..mesh.read import load_mesh
-from ..reports.models import model_summary
-from ..tolerances import MERGE_TOLERANCE
+from ..tolerances import DEFAULT_MAX_FACES, MERGE_TOLERANCE
 from ..units import LENGTH_UNITS, MATERIALS, parse_density, parse_fraction, parse_length
 from .options import check_option, density_and_mass
+
+if TYPE_CHECKING:     # the engine loads when a part is loaded, not to build a parser (``analyze --help``)
+    from ..mass.properties import MassProperties
+    from ..mesh.options import LoadOptions
 
 __all__ = ["add_files_argument", "add_model_options", "add_material_options", "add_mesh_options",
            "add_material_map_option", "parse_material_map", "split_part_spec",
@@ -187,6 +187,7 @@ def check_mesh_options(args) -> None:
 
 def load_options_from_args(args) -> LoadOptions:
     """The one :class:`LoadOptions` of a command, from ``--units`` and the mesh-check options."""
+    from ..mesh.options import LoadOptions
     check_mesh_options(args)
     return LoadOptions(units=getattr(args, "units", None), repair=bool(getattr(args, "repair", False)),
                        overlap=getattr(args, "overlap", "union"),
@@ -198,6 +199,7 @@ def read_meshes(args) -> list:
     """Read every FILE of ``args`` once, at the edge, into :class:`~inertia_tool.mesh.read.RawMesh` (metres).
 
     The engine and the report writers then take these objects, so nothing reads a file twice."""
+    from ..mesh.read import load_mesh
     options = load_options_from_args(args)
     return [load_mesh(split_part_spec(f)[0], units=options.units, max_faces=options.max_faces)
             for f in _files(args)]
@@ -305,6 +307,8 @@ def _implied(props, mass) -> str:
 
 def _load(args, meshes):
     """``(props, density description, model summary)`` of the model options."""
+    from ..reports.models import model_summary
+    from ..mass.pipeline import resolve_density
     model = getattr(args, "model", "solid") or "solid"
     thickness, skin, infill = (getattr(args, k, None) for k in ("thickness", "shell", "infill"))
     if model == "solid" and thickness is not None:
@@ -377,6 +381,7 @@ def _load_solid(args, meshes):
     :mod:`inertia_tool.mass.materials` (``--material-map``, the file's densities, the material table); its
     ``FILE:material`` or the global option is the default of its parts without a material.
     """
+    from ..mass.pipeline import DEFAULT_DENSITY, assembly, mass_properties, resolve_density
     options = load_options_from_args(args)
     density, mass = density_and_mass(args)
     material_map = parse_material_map(args)

@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import UsageError
-from ..mesh.options import MAX_SUPPORTED_FACES
+from ..tolerances import MAX_SUPPORTED_FACES
 
 __all__ = ["require_range", "OptionRange", "OPTION_RANGES", "check_option", "density_and_mass"]
 

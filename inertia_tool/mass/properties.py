@@ -14,12 +14,14 @@ from functools import cached_property
 from typing import TYPE_CHECKING, Iterable, Optional
 
 import numpy as np
-from numpy.typing import ArrayLike, DTypeLike, NDArray
 
 from ..values import frozen_value
 from ..errors import NonFiniteResultError, UsageError
 from ..tolerances import FAR_POINT_RATIO, ROTATION_ATOL
 from .principal import DEFAULT_EQUAL_RTOL, PrincipalAxes, principal_axes
+
+if TYPE_CHECKING:     # annotations only: numpy.typing is not loaded at run time
+    from numpy.typing import ArrayLike, DTypeLike, NDArray
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..mesh.checks import MeshReport

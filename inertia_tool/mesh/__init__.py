@@ -9,10 +9,26 @@ face-to-face contact, edge and vertex contact), which is what lets an answer be 
 without a unit is implausibly large or small (a millimetre file read as metres).
 """
 
-from .checks import MeshReport
-from .options import DEFAULT_MAX_FACES, LoadOptions
-from .prepare import PreparedMesh, prepare_mesh
-from .read import SUPPORTED_SUFFIXES, RawMesh, load_mesh
+from typing import TYPE_CHECKING
+
+from .. import _lazy_names
+
+if TYPE_CHECKING:   # what the names below are, for type checkers and the API docs; loaded on first use
+    from .checks import MeshReport
+    from .options import DEFAULT_MAX_FACES, LoadOptions
+    from .prepare import PreparedMesh, prepare_mesh
+    from .read import SUPPORTED_SUFFIXES, RawMesh, load_mesh
 
 __all__ = ["LoadOptions", "load_mesh", "RawMesh", "prepare_mesh", "PreparedMesh", "MeshReport",
            "SUPPORTED_SUFFIXES", "DEFAULT_MAX_FACES"]
+
+#: The module of each name above; they load on first use (PEP 562), so that a module of this layer can be
+#: imported alone (a command's parser reads ``LoadOptions``' limits without the readers and checks).
+_PUBLIC = {
+    "LoadOptions": ".options", "DEFAULT_MAX_FACES": ".options",
+    "load_mesh": ".read", "RawMesh": ".read", "SUPPORTED_SUFFIXES": ".read",
+    "prepare_mesh": ".prepare", "PreparedMesh": ".prepare",
+    "MeshReport": ".checks",
+}
+
+__getattr__, __dir__ = _lazy_names(__name__, _PUBLIC, globals())

@@ -14,7 +14,6 @@ from types import ModuleType
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from ..values import frozen_value
 from .._native import accel, faces_for_c, threads
@@ -22,6 +21,7 @@ from .edges import edge_keys
 from .policy import Certificate
 
 if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
     from .estimate import Uncertainty
 
 __all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "winding_number"]

@@ -104,13 +104,16 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from .._native import accel, faces_for_c, threads
 from ..errors import InvalidMeshError
 from ..values import frozen_value
+
+if TYPE_CHECKING:     # annotations only: numpy.typing is not loaded at run time
+    from numpy.typing import ArrayLike
 
 __all__ = ["SurfaceContacts", "surface_contacts", "orient3d_sign", "orient2d_sign"]
 

@@ -14,22 +14,10 @@ import numpy as np
 
 from ..values import frozen_value
 from ..errors import UsageError
-from ..tolerances import MERGE_TOLERANCE
+from ..tolerances import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES, MERGE_TOLERANCE
 from ..units import length_scale
 
 __all__ = ["LoadOptions", "DEFAULT_MAX_FACES", "MAX_SUPPORTED_FACES"]
-
-#: Default guard on the number of triangles a file may hold.  Peak memory at the limit (``docs/bad-input.md``;
-#: ``benchmarks/bench_memory.py``): binary STL ~63 MiB + 37 B per face with the C extension (1.8 GiB at
-#: 50M), 77 B per face on the numpy path; a 3MF (streaming reader, ``mesh.threemf``) ~150 B per face for a whole
-#: ``analyze`` run; other formats per ``benchmarks/bench_memory.py --formats`` (``docs/bad-input.md``).
-DEFAULT_MAX_FACES = 50_000_000
-
-#: Most triangles any reader accepts, whatever ``max_faces`` says: the welders number the 3 corners of every
-#: triangle with 32-bit integers, so 3 x faces must stay below 2^31 (715,827,882 triangles, ~36 GB of
-#: binary STL).  A file announcing more is refused from its header, before anything is allocated.
-MAX_SUPPORTED_FACES = (2**31 - 1) // 3
-
 
 @frozen_value
 class LoadOptions:

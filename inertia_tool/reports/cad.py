@@ -8,11 +8,15 @@ with the mesh origin, or the one given (``analyze --about``/``--axes``).
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ..errors import UsageError
-from ..mass.properties import MassProperties
 from .numbers import number, round_off_zero
+
+if TYPE_CHECKING:     # numpy loads when a report is formatted, not when a parser lists CAD_UNITS
+    import numpy as np
+
+    from ..mass.properties import MassProperties
 
 __all__ = ["format_cad_report", "CAD_UNITS"]
 
@@ -63,6 +67,8 @@ def format_cad_report(props: MassProperties, *, units: str = "kg-m", density_sou
     -------
     str
     """
+    import numpy as np
+
     from ..robot.inertial import positive_tensor_notation      # imported on use: analyze's parser needs CAD_UNITS
     if units not in CAD_UNITS:
         raise UsageError(f"Expected CAD units among {', '.join(CAD_UNITS)}, got {units!r}")

@@ -10,11 +10,13 @@ percentages, which :func:`number` has no style for).
 from __future__ import annotations
 
 import math
-
-import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from typing import TYPE_CHECKING
 
 from ..tolerances import DISPLAY_ZERO_RTOL
+
+if TYPE_CHECKING:     # numpy loads when a number is formatted, not when a parser lists the choices
+    import numpy as np
+    from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["number", "round_off_zero"]
 
@@ -69,6 +71,8 @@ def round_off_zero(values: ArrayLike, rel: float = DISPLAY_ZERO_RTOL, scale: flo
     scale : float
         A floor for the reference magnitude (e.g. the part's size for coordinates near zero).
     """
+    import numpy as np
+
     a = np.asarray(values, dtype=float)
     reference = max(float(np.max(np.abs(a))) if a.size else 0.0, scale)
     return np.where(np.abs(a) <= rel * reference, 0.0, a) + 0.0

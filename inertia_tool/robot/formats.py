@@ -9,13 +9,13 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from ..errors import UsageError
 from ..reports.escape import escape_terminal
 from ..reports.numbers import number
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:     # numpy loads when a block is formatted, not when a parser lists the formats
+    import numpy as np
+
     from .inertial import InertialFrame
 
 __all__ = ["format_urdf", "format_sdf", "format_mjcf", "ROBOT_FORMATS", "format_inertial"]
@@ -43,6 +43,8 @@ def _nums(xs, digits: int) -> str:
 
 def _products(frame: InertialFrame) -> np.ndarray:
     """Display only: products below 1e-12 of the largest moment print as 0 (round-off, not data)."""
+    import numpy as np
+
     t = np.array(frame.inertia, dtype=float)
     scale = float(np.max(np.abs(np.diag(t))))
     off = ~np.eye(3, dtype=bool)
@@ -52,6 +54,8 @@ def _products(frame: InertialFrame) -> np.ndarray:
 
 def _position(frame: InertialFrame) -> np.ndarray:
     """Display only: coordinates below 1e-12 of the body's size (|COM| + largest radius of gyration) print as 0."""
+    import numpy as np
+
     p = np.array(frame.position, dtype=float)
     size = float(np.max(np.abs(p))) + float(np.sqrt(max(frame.check.moments[-1], 0.0) / frame.mass))
     p[np.abs(p) <= 1e-12 * size] = 0.0
@@ -60,6 +64,8 @@ def _position(frame: InertialFrame) -> np.ndarray:
 
 def _unitless(x) -> np.ndarray:
     """Display only: angles and quaternion components below 1e-14 (round-off) print as 0."""
+    import numpy as np
+
     a = np.array(x, dtype=float)
     a[np.abs(a) < 1e-14] = 0.0
     return a
@@ -126,6 +132,8 @@ def format_mjcf(frame: InertialFrame, *, source: str | None = None, digits: int 
     """MuJoCo ``<inertial>``: ``pos``, ``mass`` and, in the principal frame, ``quat`` (w x y z) with
     ``diaginertia``; in the mesh frame ``fullinertia`` in MuJoCo's order M11 M22 M33 M12 M13 M23 (MuJoCo
     forbids ``quat`` together with ``fullinertia``)."""
+    import numpy as np
+
     t = _products(frame)
     attrs = [f'pos="{_nums(_position(frame), digits)}"']
     if frame.frame == "principal":
