@@ -341,8 +341,8 @@ def ball_slab_volume(radius: np.ndarray, offset: np.ndarray, half_width: np.ndar
     r = np.asarray(radius, dtype=np.float64)
     lo = np.clip(-np.asarray(half_width) - np.asarray(offset), -r, r)
     hi = np.clip(np.asarray(half_width) - np.asarray(offset), -r, r)
-    volume: np.ndarray = np.pi * ((r ** 2 * hi - hi ** 3 / 3.0) - (r ** 2 * lo - lo ** 3 / 3.0))
-    return np.maximum(volume, 0.0)
+    volume: np.ndarray = np.maximum(np.pi * ((r ** 2 * hi - hi ** 3 / 3.0) - (r ** 2 * lo - lo ** 3 / 3.0)), 0.0)
+    return volume
 
 
 def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
@@ -383,7 +383,7 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
         The distinct (vertex, loop) pairs of the rims.
     """
     v = np.asarray(vertices, dtype=np.float64)
-    ball = 4.0 / 3.0 * np.pi * radius ** 3
+    ball: np.ndarray = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=np.float64) ** 3
     n = len(v)
     nv = np.int64(max(n, 1))
     key, _ = edge_keys(faces, n)
@@ -431,7 +431,7 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     has = choice >= 0
     scale = float(np.max(np.abs(v))) if n else 0.0
     margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
-    doubt = ball.copy()
+    doubt: np.ndarray = ball.copy()
     k = choice[has]
     offset = np.einsum("ij,ij->i", centre[has] - a[k], unit[k])
     doubt[has] = np.minimum(ball[has], ball_slab_volume(radius[has], offset, best[has] + margin))
