@@ -505,12 +505,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         apex[:, i] = np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) / np.maximum(size, 1)
     if n_loops:
         centre, radius = enclosing_balls(v[vertex_of], loop_of, n_loops)
-    else:
-        centre, radius = np.zeros((0, 3)), np.zeros(0)
-    if n_loops:
         hole_doubt = hole_doubt_volumes(v, f, edges, label, n_loops, centre, radius, vertex_of, loop_of)
     else:
-        hole_doubt = np.zeros(0)
+        centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
     doubt = float(np.sum(hole_doubt))
     cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
     pv = np.vstack([v, apex])
@@ -536,9 +533,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                   "it was); ")
     unc = uncertainty_from(closed.volume, closed.centroid, closed.second_moment, doubt, far)
     if n_loops:
-        detail = (f"{sealed}{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) closed by "
-                  "cones to their centroids; bounded by the balls enclosing their rims, each cut to the slab around "
-                  "the plane of the face beside it that the rim strays least from "
+        detail = (f"{sealed}{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) "
+                  "closed by cones to their centroids; bounded by the balls enclosing their rims, each cut to the "
+                  "slab around the plane of the face beside it that the rim strays least from "
                   f"(largest radius {float(radius.max()):.3g} m)")
     else:
         detail = f"{sealed}no hole left" if sealed else "no hole"

@@ -207,7 +207,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     from .estimate import check_useful, winding_estimate
     from .merge import merge_close_vertices
     from .orient import edge_balance, orient_consistently
-    from .seal import drop_duplicate_faces
+    from .seal import drop_duplicate_faces, on_edge_vertices
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     n = len(v)
@@ -239,8 +239,13 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     welded = None
     if merge_tolerance and merge_tolerance > 0:
         tol = merge_tolerance * diag
-        # only vertices of unbalanced edges: merging vertices whose edges all balance cannot balance anything
-        merged = merge_close_vertices(v, f, tol, among=found.unbalanced_vertices)
+        # only vertices of unbalanced edges: merging vertices whose edges all balance cannot balance anything;
+        # under repair, not a T-junction's vertex lying on its edge (the seal puts it there without moving it;
+        # merged with a sliver's apex a hair away it would fold the surface)
+        among = found.unbalanced_vertices
+        if repair:
+            among = np.setdiff1d(among, on_edge_vertices(v, found.boundary))
+        merged = merge_close_vertices(v, f, tol, among=among)
         if merged.merged_vertices:
             welded_faces = _drop_collapsed(merged.faces)
             if len(welded_faces):
