@@ -3,8 +3,9 @@
 A surface whose boundary edges come in near pairs (a crack: the two lips of a seam a hair apart) or end on
 the middle of another boundary edge (a T-junction: a fine side meeting a coarse one) is geometrically
 closed, or nearly: only the bookkeeping of its vertices is broken.  :func:`seal_seams` repairs that
-bookkeeping within a stated gap ``g`` and nothing else, in bounded rounds of two steps (splits first, so a
-T-vertex on a short edge is put on it rather than welded to its end):
+bookkeeping within a stated gap ``g`` and nothing else: first every T-vertex lying on its edge to round-off is
+put on it (step 2 restricted to those: exact, nothing moves, so a T-vertex on a short edge is not welded to its
+end), then bounded rounds of two steps:
 
 1. *Weld the lips*: boundary vertices within ``g`` of another boundary vertex are merged (a k-d tree,
    exact distances), each cluster into its lowest-numbered vertex; faces that collapse are dropped.
@@ -43,7 +44,7 @@ __all__ = ["Seal", "seal_seams", "parallel_body_volume", "drop_duplicate_faces",
 #: put on the edge even when it is within the gap of an end, where it would otherwise be welded.
 ON_EDGE_RTOL = 1e-9
 
-#: Rounds of (split, weld): a T-vertex revealed by a weld, or a weld revealed by a split, is found next round.
+#: Rounds of (weld, split): a T-vertex revealed by a weld, or a weld revealed by a split, is found next round.
 MAX_SEAL_ROUNDS = 4
 
 
@@ -353,14 +354,13 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
             if not more:
                 break
         for _ in range(MAX_SEAL_ROUNDS):
-            # splits first: a T-vertex on a short edge is put on it (exact) before a weld could move it
+            front, slack, lost, merged = _weld_lips(v, front, slack, vertex_slack, gap, region)
             inserted = 0
             for _ in range(3):          # a face splits one edge per pass and has three
                 front, slack, more = _split_t_junctions(v, front, slack, gap, region)
                 inserted += more
                 if not more:
                     break
-            front, slack, lost, merged = _weld_lips(v, front, slack, vertex_slack, gap, region)
             dropped += lost
             welded += merged
             split += inserted
