@@ -417,12 +417,19 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     per_face = rim_count[ring_loop]
     if int(per_face.sum()) > RING_WORK_LIMIT:
         return ball
-    which = np.repeat(np.arange(len(ring_face)), per_face)
-    offset_in = np.arange(int(per_face.sum())) - np.repeat(np.cumsum(per_face) - per_face, per_face)
-    pts = v[rim_vertex[rim_start[ring_loop[which]] + offset_in]]
-    dist = np.abs(np.einsum("ij,ij->i", pts - a[which], unit[which]))
-    starts = np.r_[0, np.cumsum(per_face)[:-1]]
-    e_face = np.maximum.reduceat(dist, starts) if len(dist) else np.zeros(len(ring_face))
+    e_face = np.zeros(len(ring_face))
+    ends = np.cumsum(per_face)
+    lo = 0
+    while lo < len(ring_face):          # ring faces in chunks of about RING_CHUNK (face, vertex) pairs
+        hi = max(lo + 1, int(np.searchsorted(ends, ends[lo] - per_face[lo] + RING_CHUNK, side="right")))
+        hi = min(hi, len(ring_face))
+        count = per_face[lo:hi]
+        which = lo + np.repeat(np.arange(hi - lo), count)
+        offset_in = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+        pts = v[rim_vertex[rim_start[ring_loop[which]] + offset_in]]
+        dist = np.abs(np.einsum("ij,ij->i", pts - a[which], unit[which]))
+        e_face[lo:hi] = np.maximum.reduceat(dist, np.r_[0, np.cumsum(count)[:-1]])
+        lo = hi
     best = np.full(n_loops, np.inf)
     np.minimum.at(best, ring_loop, e_face)
     choice = np.full(n_loops, -1, dtype=np.int64)
@@ -438,9 +445,11 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     return doubt
 
 
-#: Most (ring face, rim vertex) pairs measured by :func:`hole_doubt_volumes`; beyond it every hole keeps its
-#: whole ball (a bound that needs no ring).
-RING_WORK_LIMIT = 20_000_000
+#: Most (ring face, rim vertex) pairs measured by :func:`hole_doubt_volumes` (a few seconds); beyond it every
+#: hole keeps its whole ball (a bound that needs no ring).
+RING_WORK_LIMIT = 200_000_000
+#: (ring face, rim vertex) pairs measured at once (bounds the memory: ~100 MB).
+RING_CHUNK = 2_000_000
 
 
 def check_useful(estimate_volume: float, unc: Uncertainty, *, source: str, what: str,
