@@ -1,7 +1,8 @@
 """The fast subset of the repair coverage benchmark (``benchmarks/damage/coverage.py``): randomized holes,
 scattered holes, T-junctions, cracks, slivers, internal walls and touching copies on the repository's meshes
-and trimesh-generated shapes, some with quantised coordinates.  Every bound ``repair=True`` states must contain the truth (the clean mesh's exact
-integral, cross-checked against trimesh); refusals are allowed, other exceptions are bugs."""
+and trimesh-generated shapes, some with quantised coordinates.  Every bound ``repair=True`` states must
+contain the truth (the clean mesh's exact integral, cross-checked against trimesh); refusals are allowed, other
+exceptions are bugs."""
 
 import importlib.util
 from pathlib import Path
