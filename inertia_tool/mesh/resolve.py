@@ -40,11 +40,13 @@ __all__ = ["Resolution", "resolve_surface", "REPAIR_RULE"]
 #: Which estimate ``repair=True`` gives, decided from the surface alone, never by which estimate claims the
 #: smaller bound (a method that understates its error would always win that contest):
 REPAIR_RULE = (
-    "first seal the seams (crack lips within SEAM_GAP_RTOL of the diagonal welded, T-junctions split; bounded by "
+    "first seal the seams (T-vertices lying on their edges split first, then crack lips within SEAM_GAP_RTOL of "
+    "the diagonal welded and T-junctions within it split; bounded by "
     "how far sealing moved the surface: cheap, and it turns a slightly jittered soup into a surface); "
     "then a soup (more than SOUP_BOUNDARY_SHARE of the faces still share no edge with another: loose triangles, no "
     "surface with holes to follow) -> the winding-number grid, whose solid is by definition where w > 1/2; "
-    "anything else -> close each remaining hole by a cone, bounded by the ball enclosing its rim; "
+    "anything else -> close each remaining hole by a cone, bounded by the ball enclosing its rim cut to the slab "
+    "around the plane of the face beside it that the rim strays least from; "
     "an estimate whose bound is useless (not finite, or mass beyond ESTIMATE_MAX_MASS_RTOL) or whose volume is "
     "not positive -> refused with the reason, never replaced by the other method"
 )
