@@ -10,7 +10,9 @@ answer is an estimate with bounds.  Two estimators, each returning moments and a
   a smooth part this is the ball whose great circle is the rim, which holds any cap up to a hemisphere).
   The cone lies in the rim's convex hull, inside the same ball, so the closed cycle "cone minus missing
   surface" lies in the ball and its winding number — the difference between the patched solid and the true
-  one — vanishes outside it: the volume in doubt is the total volume of the balls.  The convex hull of the
+  one — vanishes outside it.  **Second assumption: the missing surface strays from the plane of a face
+  beside the hole no farther than the rim does** (:func:`hole_doubt_volumes`); the cone does too, so each
+  ball is cut to that slab, and the volume in doubt is the total volume of the cut balls.  The convex hull of the
   rim is *not* enough (a planar rim has a hull of volume 0, yet a spherical cap over it is far from flat),
   and no hole gets a bound of 0.  Seams sealed first (cracks, T-junctions; :mod:`~.seal`) add the volume
   of the parallel bodies of the faces sealing touched.
@@ -483,8 +485,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
 
     Assumption (stated in the module docstring): the missing surface of each boundary component lies in the
     ball enclosing its rim (:func:`enclosing_balls`); the cone lies there too, so the patched solid and the
-    true one differ only inside those balls, whose total volume is the volume in doubt.  With ``seal``, the
-    seams it sealed add their own doubt (:mod:`~.seal`).
+    true one differ only inside those balls; with the second assumption (the missing surface strays from the
+    plane of a face beside the hole no farther than the rim does) only inside each ball's slab around that
+    plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  With ``seal``, the seams it
+    sealed add their own doubt (:mod:`~.seal`).  Limits: a hole whose missing piece joins two rims (a band
+    round a handle) or reaches far outside its rim's ball (a pocket swallowed whole) is not covered.
 
     Parameters
     ----------
