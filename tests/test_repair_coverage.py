@@ -1,7 +1,8 @@
 """The fast subset of the repair coverage benchmark (``benchmarks/damage/coverage.py``): randomized holes,
-scattered holes, T-junctions and cracks on the repository's meshes and trimesh-generated shapes, some with
-quantised coordinates.  Every bound ``repair=True`` states must contain the truth (the clean mesh's exact
-integral, cross-checked against trimesh); refusals are allowed, other exceptions are bugs."""
+scattered holes, T-junctions, cracks, slivers, internal walls and touching copies on the repository's meshes
+and trimesh-generated shapes, some with quantised coordinates.  Every bound ``repair=True`` states must
+contain the truth (the clean mesh's exact integral, cross-checked against trimesh); refusals are allowed, other
+exceptions are bugs."""
 
 import importlib.util
 from pathlib import Path
@@ -26,9 +27,41 @@ def test_repair_bounds_hold_on_the_ci_subset():
     assert summary["cases"] >= 30
     assert summary["errors"] == 0, [r for r in rows if r["status"] == "error"]
     assert summary["answered"] >= 15                # most cases get an answer, not a refusal
-    failed = [r for r in rows if r["status"] == "answer" and not r["holds"]]
-    assert summary["bounds_hold"] >= 0.99 * summary["answered"], failed
+    failed = [r for r in rows if r["status"] == "answer" and r["holds"] is False]
+    # every answer but an "unverified" one states a bound (exact: round-off), and it holds
+    assert summary["bounds_hold"] >= 0.99 * summary["certified"], failed
+    assert summary["certified"] >= 15
     # an estimate never claims a bound of 0; only answers labelled exact do
     assert all(r["mass_bound"] > 0 for r in rows if r["status"] == "answer" and r["method"] in ("patched", "winding"))
+    # the refusal causes are named (the table of the benchmark groups them)
+    assert all(not cov.refusal_cause(r["reason"]).startswith("other") for r in rows if r["status"] == "refused")
     assert {r["kind"] for r in rows} == set(cov.KINDS)
     assert np.isfinite(summary["median_mass_bound"])
+
+
+def test_patched_surface_whose_union_is_not_verified_is_certified_unverified():
+    """Benchmark case 10-04-hole (an annulus with a hole of its own): the patched surface goes through the
+    boolean union, which R6 cannot verify.  It was certified "estimate", with the patches' bound, which does not
+    cover what the boolean changed (talos arm_1 with an internal wall: 1.59e-6 off with ±1.56e-6 stated); a
+    patched answer keeps the union's "unverified"."""
+    import warnings
+
+    import inertia_tool as it
+
+    cov = _coverage_module()
+    sources = cov.load_sources(("generated",))
+    case = next(c for c in cov.cases(sources, [10]) if c[0] == "10-04-hole-0")
+    cid, s, kind, entropy = case
+    name, v, f, truth = sources[s]
+    assert name == "generated/annulus"
+    rng = np.random.default_rng(entropy)
+    if rng.random() < cov.QUANTISE_SHARE:
+        qv, qf, _ = cov._quantised(v, f, rng, truth["diagonal"])
+        if cov.truth_of(qv, qf) is not None:
+            v, f = qv, qf
+    dv, df, _ = cov.make_case(kind, v, f, rng, truth["diagonal"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = it.mass_properties((dv, df), density=1.0, repair=True)
+    assert p.mesh.method == "patched"
+    assert p.mesh.certificate.kind == "unverified"

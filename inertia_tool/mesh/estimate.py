@@ -10,7 +10,9 @@ answer is an estimate with bounds.  Two estimators, each returning moments and a
   a smooth part this is the ball whose great circle is the rim, which holds any cap up to a hemisphere).
   The cone lies in the rim's convex hull, inside the same ball, so the closed cycle "cone minus missing
   surface" lies in the ball and its winding number — the difference between the patched solid and the true
-  one — vanishes outside it: the volume in doubt is the total volume of the balls.  The convex hull of the
+  one — vanishes outside it.  **Second assumption: the missing surface strays from the plane of a face
+  beside the hole no farther than the rim does** (:func:`hole_doubt_volumes`); the cone does too, so each
+  ball is cut to that slab, and the volume in doubt is the total volume of the cut balls.  The convex hull of the
   rim is *not* enough (a planar rim has a hull of volume 0, yet a spherical cap over it is far from flat),
   and no hole gets a bound of 0.  Seams sealed first (cracks, T-junctions; :mod:`~.seal`) add the volume
   of the parallel bodies of the faces sealing touched.
@@ -49,7 +51,7 @@ from .edges import edge_keys
 from .seal import Seal
 
 __all__ = ["Uncertainty", "Estimate", "boundary_edges", "patched_estimate", "winding_estimate", "uncertainty_from",
-           "enclosing_balls", "check_useful"]
+           "enclosing_balls", "check_useful", "hole_doubt_volumes", "ball_slab_volume"]
 
 
 @frozen_value
@@ -330,6 +332,128 @@ def _small_ball_centres(p: np.ndarray, starts: np.ndarray, size: np.ndarray) -> 
     return centre
 
 
+def ball_slab_volume(radius: np.ndarray, offset: np.ndarray, half_width: np.ndarray) -> np.ndarray:
+    """Volume of the part of a ball that lies in a slab, (k,) m³.
+
+    The ball has radius ``r``; the slab is the set of points whose signed distance from a plane lies in
+    ``[−t, t]`` (``t = half_width``), and the ball's centre is at signed distance ``s = offset`` from that plane.
+    In the ball's own axial coordinate ``z`` the slab is ``[−t − s, t − s]``; clipped to ``[−r, r]`` it is
+    ``[a, b]``, and the volume is ``π ∫_a^b (r² − z²) dz = π [r² z − z³/3]_a^b`` (slices of a ball are discs).
+    """
+    r = np.asarray(radius, dtype=np.float64)
+    lo = np.clip(-np.asarray(half_width) - np.asarray(offset), -r, r)
+    hi = np.clip(np.asarray(half_width) - np.asarray(offset), -r, r)
+    volume: np.ndarray = np.maximum(np.pi * ((r ** 2 * hi - hi ** 3 / 3.0) - (r ** 2 * lo - lo ** 3 / 3.0)), 0.0)
+    return volume
+
+
+def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
+                       n_loops: int, centre: np.ndarray, radius: np.ndarray, vertex_of: np.ndarray,
+                       loop_of: np.ndarray) -> np.ndarray:
+    """Volume in doubt of each hole (boundary loop), (n_loops,) m³: the ball over its rim, cut to a slab.
+
+    Two assumptions, both about the missing surface ``M`` of the hole (the surface the file lost):
+
+    1. ``M`` lies in the ball enclosing the rim (module docstring), and
+    2. ``M`` strays from the plane of a face beside the hole no farther than the rim itself does: of the faces
+       sharing an edge with the rim (the *ring*), take the one whose plane the rim is closest to; if every rim
+       vertex is within ``e`` of that plane, so is ``M``.  A hole inside a flat face of a part (a missing
+       triangle of a CAD face) has ``e`` ≈ 0; a hole in a curved surface has ``e`` of the order of its sagitta
+       (for a spherical cap of half-angle α the ring plane is tilted by about α and the rim's far side lies
+       ``2r sin α`` from it, more than the cap's height ``r tan(α/2)`` above the rim's own plane); a hole
+       across a crease has ``e`` up to its width, and the ball decides.  It fails for a hole that swallowed a
+       whole boss or dimple standing on a flat face (the ring is flat, the missing part is not): the stated
+       limit of this bound.
+
+    The cone that patches the hole has its apex at the centroid of the rim vertices, so it lies in the rim's
+    convex hull, inside both the ball and the slab of half-width ``e`` around the plane (a convex set holding
+    every rim vertex).  The patched and the true solid therefore differ only where the cycle "cone minus
+    ``M``" winds, which is inside ball ∩ slab: its volume (:func:`ball_slab_volume`) is the hole's volume in
+    doubt.  ``e`` carries a round-off margin of 16 ulp of the coordinates, so an exactly flat hole still
+    states a (tiny) positive bound.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+        The surface with the holes (sealed where seams were sealed).
+    edges : (k, 2) int
+        Its boundary edges; ``label`` (k,) the loop of each.
+    centre, radius : (n_loops, 3), (n_loops,) float
+        The ball enclosing each loop's rim (:func:`enclosing_balls`).
+    vertex_of, loop_of : (p,) int
+        The distinct (vertex, loop) pairs of the rims.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    ball: np.ndarray = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=np.float64) ** 3
+    n = len(v)
+    nv = np.int64(max(n, 1))
+    key, _ = edge_keys(faces, n)
+    rim_key = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * nv + np.maximum(edges[:, 0], edges[:, 1])
+    order = np.argsort(rim_key, kind="stable")
+    sorted_rim = rim_key[order]
+    pos = np.searchsorted(sorted_rim, key)
+    hit = (pos < len(sorted_rim)) & (sorted_rim[np.minimum(pos, len(sorted_rim) - 1)] == key)
+    slot = np.flatnonzero(hit)
+    if not len(slot):
+        return ball
+    ring_face = slot // 3
+    ring_loop = label[order[pos[slot]]]
+    # one (face, loop) pair per ring face of each loop
+    pair = np.unique(np.stack([ring_face, ring_loop], axis=1), axis=0)
+    ring_face, ring_loop = pair[:, 0], pair[:, 1]
+    a, b, c = (v[faces[ring_face, k]] for k in range(3))
+    normal = np.cross(b - a, c - a)
+    length = np.linalg.norm(normal, axis=1)
+    usable = length > 0
+    ring_face, ring_loop, a, normal = ring_face[usable], ring_loop[usable], a[usable], normal[usable]
+    if not len(ring_face):
+        return ball
+    unit = normal / length[usable, None]
+    # the farthest rim vertex of each loop from each of its ring faces' planes; (ring face, rim vertex)
+    # pairs are formed loop by loop (rims are short next to the surface, so this stays small)
+    rim_order = np.argsort(loop_of, kind="stable")
+    rim_loop, rim_vertex = loop_of[rim_order], vertex_of[rim_order]
+    rim_start = np.searchsorted(rim_loop, np.arange(n_loops))
+    rim_count = np.diff(np.r_[rim_start, len(rim_loop)])
+    per_face = rim_count[ring_loop]
+    if int(per_face.sum()) > RING_WORK_LIMIT:
+        return ball
+    e_face = np.zeros(len(ring_face))
+    ends = np.cumsum(per_face)
+    lo = 0
+    while lo < len(ring_face):          # ring faces in chunks of about RING_CHUNK (face, vertex) pairs
+        hi = max(lo + 1, int(np.searchsorted(ends, ends[lo] - per_face[lo] + RING_CHUNK, side="right")))
+        hi = min(hi, len(ring_face))
+        count = per_face[lo:hi]
+        which = lo + np.repeat(np.arange(hi - lo), count)
+        offset_in = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+        pts = v[rim_vertex[rim_start[ring_loop[which]] + offset_in]]
+        dist = np.abs(np.einsum("ij,ij->i", pts - a[which], unit[which]))
+        e_face[lo:hi] = np.maximum.reduceat(dist, np.r_[0, np.cumsum(count)[:-1]])
+        lo = hi
+    best = np.full(n_loops, np.inf)
+    np.minimum.at(best, ring_loop, e_face)
+    choice = np.full(n_loops, -1, dtype=np.int64)
+    is_best = e_face <= best[ring_loop]
+    choice[ring_loop[is_best]] = np.flatnonzero(is_best)
+    has = choice >= 0
+    scale = float(np.max(np.abs(v))) if n else 0.0
+    margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
+    doubt: np.ndarray = ball.copy()
+    k = choice[has]
+    offset = np.einsum("ij,ij->i", centre[has] - a[k], unit[k])
+    doubt[has] = np.minimum(ball[has], ball_slab_volume(radius[has], offset, best[has] + margin))
+    return doubt
+
+
+#: Most (ring face, rim vertex) pairs measured by :func:`hole_doubt_volumes` (a few seconds); beyond it every
+#: hole keeps its whole ball (a bound that needs no ring).
+RING_WORK_LIMIT = 200_000_000
+#: (ring face, rim vertex) pairs measured at once (bounds the memory: ~100 MB).
+RING_CHUNK = 2_000_000
+
+
 def check_useful(estimate_volume: float, unc: Uncertainty, *, source: str, what: str,
                  why: str = "the holes are too large to guess what fills them; close them in a mesh editor",
                  max_mass_rtol: float = ESTIMATE_MAX_MASS_RTOL) -> None:
@@ -361,8 +485,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
 
     Assumption (stated in the module docstring): the missing surface of each boundary component lies in the
     ball enclosing its rim (:func:`enclosing_balls`); the cone lies there too, so the patched solid and the
-    true one differ only inside those balls, whose total volume is the volume in doubt.  With ``seal``, the
-    seams it sealed add their own doubt (:mod:`~.seal`).
+    true one differ only inside those balls; with the second assumption (the missing surface strays from the
+    plane of a face beside the hole no farther than the rim does) only inside each ball's slab around that
+    plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  With ``seal``, the seams it
+    sealed add their own doubt (:mod:`~.seal`).  Limits: a hole whose missing piece joins two rims (a band
+    round a handle) or reaches far outside its rim's ball (a pocket swallowed whole) is not covered.
 
     Parameters
     ----------
@@ -392,9 +519,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         apex[:, i] = np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) / np.maximum(size, 1)
     if n_loops:
         centre, radius = enclosing_balls(v[vertex_of], loop_of, n_loops)
+        hole_doubt = hole_doubt_volumes(v, f, edges, label, n_loops, centre, radius, vertex_of, loop_of)
     else:
-        centre, radius = np.zeros((0, 3)), np.zeros(0)
-    doubt = float(np.sum(4.0 / 3.0 * np.pi * radius ** 3))
+        centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
+    doubt = float(np.sum(hole_doubt))
     cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
     pv = np.vstack([v, apex])
     pf = np.vstack([f, cap])
@@ -419,8 +547,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                   "it was); ")
     unc = uncertainty_from(closed.volume, closed.centroid, closed.second_moment, doubt, far)
     if n_loops:
-        detail = (f"{sealed}{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) closed by "
-                  "cones to their centroids; bounded by the balls enclosing their rims "
+        detail = (f"{sealed}{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) "
+                  "closed by cones to their centroids; bounded by the balls enclosing their rims, each cut to the "
+                  "slab around the plane of the face beside it that the rim strays least from "
                   f"(largest radius {float(radius.max()):.3g} m)")
     else:
         detail = f"{sealed}no hole left" if sealed else "no hole"

@@ -384,7 +384,9 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         uncertainty = uncertainty_from(total.volume, total.centroid, total.second_moment,
                                        patched.uncertainty.volume_in_doubt, patched.far)
         check_useful(total.volume, uncertainty, source=source, what="the patched surface")
-        method, kind = "patched", "estimate"
+        # a patched surface whose union could not be verified (R6) keeps "unverified": the patches' bound does
+        # not cover what the boolean changed beyond them
+        method, kind = "patched", ("unverified" if kind == "unverified" else "estimate")
     if arranged is not None:                  # R3: the arrangement's surface, checked like any other
         method = "union" if method == "exact" else method
         kind = {"exact": "united"}.get(kind, kind)

@@ -40,11 +40,13 @@ __all__ = ["Resolution", "resolve_surface", "REPAIR_RULE"]
 #: Which estimate ``repair=True`` gives, decided from the surface alone, never by which estimate claims the
 #: smaller bound (a method that understates its error would always win that contest):
 REPAIR_RULE = (
-    "first seal the seams (crack lips within SEAM_GAP_RTOL of the diagonal welded, T-junctions split; bounded by "
+    "first seal the seams (T-vertices lying on their edges split first, then crack lips within SEAM_GAP_RTOL of "
+    "the diagonal welded and T-junctions within it split; bounded by "
     "how far sealing moved the surface: cheap, and it turns a slightly jittered soup into a surface); "
     "then a soup (more than SOUP_BOUNDARY_SHARE of the faces still share no edge with another: loose triangles, no "
     "surface with holes to follow) -> the winding-number grid, whose solid is by definition where w > 1/2; "
-    "anything else -> close each remaining hole by a cone, bounded by the ball enclosing its rim; "
+    "anything else -> close each remaining hole by a cone, bounded by the ball enclosing its rim cut to the slab "
+    "around the plane of the face beside it that the rim strays least from; "
     "an estimate whose bound is useless (not finite, or mass beyond ESTIMATE_MAX_MASS_RTOL) or whose volume is "
     "not positive -> refused with the reason, never replaced by the other method"
 )
@@ -207,7 +209,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     from .estimate import check_useful, winding_estimate
     from .merge import merge_close_vertices
     from .orient import edge_balance, orient_consistently
-    from .seal import drop_duplicate_faces
+    from .seal import drop_duplicate_faces, on_edge_vertices
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     n = len(v)
@@ -239,8 +241,13 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     welded = None
     if merge_tolerance and merge_tolerance > 0:
         tol = merge_tolerance * diag
-        # only vertices of unbalanced edges: merging vertices whose edges all balance cannot balance anything
-        merged = merge_close_vertices(v, f, tol, among=found.unbalanced_vertices)
+        # only vertices of unbalanced edges: merging vertices whose edges all balance cannot balance anything;
+        # under repair, not a T-junction's vertex lying on its edge (the seal puts it there without moving it;
+        # merged with a sliver's apex a hair away it would fold the surface)
+        among = found.unbalanced_vertices
+        if repair:
+            among = np.setdiff1d(among, on_edge_vertices(v, found.boundary))
+        merged = merge_close_vertices(v, f, tol, among=among)
         if merged.merged_vertices:
             welded_faces = _drop_collapsed(merged.faces)
             if len(welded_faces):

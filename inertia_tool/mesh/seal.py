@@ -3,13 +3,16 @@
 A surface whose boundary edges come in near pairs (a crack: the two lips of a seam a hair apart) or end on
 the middle of another boundary edge (a T-junction: a fine side meeting a coarse one) is geometrically
 closed, or nearly: only the bookkeeping of its vertices is broken.  :func:`seal_seams` repairs that
-bookkeeping within a stated gap ``g`` and nothing else, in bounded rounds of two steps:
+bookkeeping within a stated gap ``g`` and nothing else: first every T-vertex lying on its edge to round-off is
+put on it (step 2 restricted to those: exact, nothing moves, so a T-vertex on a short edge is not welded to its
+end), then bounded rounds of two steps:
 
 1. *Weld the lips*: boundary vertices within ``g`` of another boundary vertex are merged (a k-d tree,
    exact distances), each cluster into its lowest-numbered vertex; faces that collapse are dropped.
 2. *Split at T-junctions*: a boundary vertex ``m`` within ``g`` of the interior of a boundary edge
-   ``a→b`` (and farther than ``g`` from both ends) splits the face holding ``a→b`` into a fan through the
-   points on that edge, in order along it.
+   ``a→b`` (and farther than ``g`` from both ends, or on it to round-off: ``ON_EDGE_RTOL``) splits the face
+   holding ``a→b`` into a fan through the points on that edge, in order along it (each vertex onto its nearest
+   edge, never onto its own face; T-vertices on their edges to round-off first, before anything is welded).
 
 The stated assumption: **the true surface is the sealed surface with each corner of a face that sealing
 touched moved by at most that face's slack** ``d`` (the distance a welded corner travelled, or the distance
@@ -34,7 +37,12 @@ import numpy as np
 from ..values import frozen_value
 from .edges import edge_keys
 
-__all__ = ["Seal", "seal_seams", "parallel_body_volume", "drop_duplicate_faces"]
+__all__ = ["Seal", "seal_seams", "parallel_body_volume", "drop_duplicate_faces", "on_edge_vertices"]
+
+#: A boundary vertex whose distance from an edge is at most ``ON_EDGE_RTOL ×`` its distance from the edge's
+#: nearer end lies on it (round-off of a midpoint; a jittered copy of the end is never that well aligned): it is
+#: put on the edge even when it is within the gap of an end, where it would otherwise be welded.
+ON_EDGE_RTOL = 1e-9
 
 #: Rounds of (weld, split): a T-vertex revealed by a weld, or a weld revealed by a split, is found next round.
 MAX_SEAL_ROUNDS = 4
@@ -187,9 +195,10 @@ def _weld_lips(v: np.ndarray, f: np.ndarray, slack: np.ndarray, vertex_slack: np
 
 
 def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
-                       gap: float, region: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+                       gap: float, region: np.ndarray | None = None, *, on_edge_only: bool = False
+                       ) -> tuple[np.ndarray, np.ndarray, int]:
     """Step 2: split faces at boundary vertices lying on the interior of a boundary edge; returns faces,
-    slack and the number of vertices inserted."""
+    slack and the number of vertices inserted (``on_edge_only``: only vertices on the edge to round-off)."""
     from scipy.spatial import cKDTree
 
     edges = _frontier_boundary(f, len(v), region)
@@ -211,11 +220,18 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     t = np.einsum("ij,ij->i", v[m] - a[e], ab[e]) / np.maximum(length[e] ** 2, np.finfo(float).tiny)
     foot = a[e] + t[:, None] * ab[e]
     dist = np.linalg.norm(v[m] - foot, axis=1)
-    ok = ((dist <= gap) & (t > 0) & (t < 1) & (np.linalg.norm(v[m] - a[e], axis=1) > gap)
-          & (np.linalg.norm(v[m] - b[e], axis=1) > gap))
+    to_end = np.minimum(np.linalg.norm(v[m] - a[e], axis=1), np.linalg.norm(v[m] - b[e], axis=1))
+    # a vertex within the gap of an end is a crack lip to weld, unless it lies on the edge itself (to
+    # round-off: a T-junction on a short edge, which welding would move by up to the gap)
+    on_edge = dist <= ON_EDGE_RTOL * to_end
+    ok = (dist <= gap) & (t > 0) & (t < 1) & (to_end > 0) & (on_edge if on_edge_only else (to_end > gap) | on_edge)
     e, m, t, dist = e[ok], m[ok], t[ok], dist[ok]
     if not len(e):
         return f, slack, 0
+    # each vertex onto its nearest edge only (a thin part can hold other boundary edges within the gap)
+    nearest = np.lexsort((dist, m))
+    first = nearest[np.r_[True, m[nearest][1:] != m[nearest][:-1]]]
+    e, m, t, dist = e[first], m[first], t[first], dist[first]
     # the face holding each directed edge a→b, and which of its edges it is
     undirected, forward = edge_keys(f, len(v))            # edge slot j of face i: f[i, j] → f[i, j+1]
     key = 2 * undirected + forward
@@ -227,6 +243,9 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     e, m, t, dist, pos = e[found], m[found], t[found], dist[found], pos[found]
     slot = order[pos]
     face, corner = slot // 3, slot % 3
+    # never a face's own third corner (a sliver whose apex lies on its base edge): the fan would repeat it
+    own = m != f[face, (corner + 2) % 3]
+    face, corner, m, t, dist, slot = face[own], corner[own], m[own], t[own], dist[own], slot[own]
     # one edge per face per round: keep the points of the first edge listed for each face
     first_slot = np.full(len(f), -1, dtype=np.int64)
     np.maximum.at(first_slot, face, slot)
@@ -252,6 +271,40 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     keep_face[split_faces] = False
     return (np.vstack([f[keep_face], *new_faces]), np.concatenate([slack[keep_face], *new_slack]),
             int(len(m)))
+
+
+def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
+    """Boundary vertices that lie on the interior of another boundary edge to round-off (T-junctions whose
+    vertex is on its edge: ``ON_EDGE_RTOL``), sorted (k,) int.
+
+    The weld before repair leaves these alone: merging such a vertex with a near one (a sliver's apex a hair
+    from the edge) would fold the surface, while putting it on its edge (:func:`seal_seams`) changes nothing.
+    """
+    from scipy.spatial import cKDTree
+
+    v = np.asarray(vertices, dtype=np.float64)
+    edges = np.unique(np.asarray(boundary, dtype=np.int64).reshape(-1, 2), axis=0)
+    if not len(edges):
+        return np.zeros(0, dtype=np.int64)
+    bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v)))
+    a, b = v[edges[:, 0]], v[edges[:, 1]]
+    ab = b - a
+    length = np.linalg.norm(ab, axis=1)
+    near = cKDTree(v[bv], balanced_tree=False, compact_nodes=False).query_ball_point(
+        0.5 * (a + b), 0.5 * length * (1 + 1e-9))
+    counts = np.fromiter((len(x) for x in near), dtype=np.int64, count=len(near))
+    if not counts.sum():
+        return np.zeros(0, dtype=np.int64)
+    e = np.repeat(np.arange(len(edges)), counts)
+    m = bv[np.concatenate([np.asarray(x, dtype=np.int64) for x in near if len(x)])]
+    keep = (m != edges[e, 0]) & (m != edges[e, 1])
+    e, m = e[keep], m[keep]
+    t = np.einsum("ij,ij->i", v[m] - a[e], ab[e]) / np.maximum(length[e] ** 2, np.finfo(float).tiny)
+    dist = np.linalg.norm(v[m] - (a[e] + t[:, None] * ab[e]), axis=1)
+    to_end = np.minimum(np.linalg.norm(v[m] - a[e], axis=1), np.linalg.norm(v[m] - b[e], axis=1))
+    on = (t > 0) & (t < 1) & (dist <= ON_EDGE_RTOL * to_end)
+    found: np.ndarray = np.unique(m[on])
+    return found
 
 
 def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_duplicates: bool = True,
@@ -292,9 +345,22 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
     vertex_slack = np.zeros(n)
     dropped, welded, split = 0.0, 0, 0
     if gap > 0:
+        # first the T-junctions exactly on their edges (exact splits, nothing moves), until none is left: a
+        # vertex that only comes near an edge (a sliver's apex) is not put on it while the exact ones still
+        # leave that edge open
+        for _ in range(3 * MAX_SEAL_ROUNDS):
+            front, slack, more = _split_t_junctions(v, front, slack, gap, region, on_edge_only=True)
+            split += more
+            if not more:
+                break
         for _ in range(MAX_SEAL_ROUNDS):
             front, slack, lost, merged = _weld_lips(v, front, slack, vertex_slack, gap, region)
-            front, slack, inserted = _split_t_junctions(v, front, slack, gap, region)
+            inserted = 0
+            for _ in range(3):          # a face splits one edge per pass and has three
+                front, slack, more = _split_t_junctions(v, front, slack, gap, region)
+                inserted += more
+                if not more:
+                    break
             dropped += lost
             welded += merged
             split += inserted

@@ -1,0 +1,207 @@
+"""Each hole's volume in doubt: the ball over its rim cut to the slab around the plane beside it
+(``mesh/estimate.py``: :func:`hole_doubt_volumes`, :func:`ball_slab_volume`)."""
+
+import numpy as np
+import pytest
+import trimesh
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from scipy.integrate import quad
+from scipy.spatial.transform import Rotation
+
+from conftest import box_arrays
+from inertia_tool import mass_properties
+from inertia_tool.errors import InvalidMeshError, MeshRepairedWarning
+from inertia_tool.integrals import volume_moments
+from inertia_tool.mesh.estimate import ball_slab_volume, boundary_edges, patched_estimate
+
+
+def _inertia(m):
+    return np.trace(m.second_moment) * np.eye(3) - m.second_moment
+
+
+def _holds(est, truth):
+    """The truth lies inside every bound the estimate states."""
+    u = est.uncertainty
+    return (abs(est.volume - truth.volume) <= u.mass * est.volume * (1 + 1e-12) + 1e-12 * truth.volume
+            and np.linalg.norm(est.centroid - truth.centroid) <= u.center_of_mass * (1 + 1e-12) + 1e-12
+            and np.linalg.norm(_inertia(est) - _inertia(truth))
+            <= u.inertia * np.linalg.norm(_inertia(est)) * (1 + 1e-12) + 1e-12 * np.linalg.norm(_inertia(truth)))
+
+
+# ------------------------------------------------------------------------------------------ ball ∩ slab
+
+def test_ball_slab_volume_closed_forms():
+    r = 2.0
+    ball = 4 / 3 * np.pi * r ** 3
+    assert ball_slab_volume(np.array([r]), np.array([0.0]), np.array([5.0]))[0] == pytest.approx(ball, rel=1e-14)
+    # a slab from the centre plane outwards past the ball: a hemisphere
+    assert ball_slab_volume(np.array([r]), np.array([-3.0]), np.array([3.0]))[0] == pytest.approx(ball / 2)
+    # a slab that misses the ball
+    assert ball_slab_volume(np.array([r]), np.array([10.0]), np.array([1.0]))[0] == 0.0
+    # a cap of height h: π h² (3r − h) / 3 (slab from r − h above the centre to beyond the ball)
+    h = 0.7
+    cap = np.pi * h ** 2 * (3 * r - h) / 3
+    assert ball_slab_volume(np.array([r]), np.array([-(r - h) - 10.0]), np.array([10.0]))[0] == pytest.approx(cap)
+
+
+@settings(max_examples=60, deadline=None)
+@given(r=st.floats(0.01, 10.0), s=st.floats(-20.0, 20.0), t=st.floats(0.0, 20.0))
+def test_ball_slab_volume_agrees_with_quadrature(r, s, t):
+    """Against scipy's quadrature of the disc areas π(r² − z²) over the slab clipped to the ball."""
+    lo, hi = max(-t - s, -r), min(t - s, r)
+    expected = quad(lambda z: np.pi * (r * r - z * z), lo, hi)[0] if hi > lo else 0.0
+    got = ball_slab_volume(np.array([r]), np.array([s]), np.array([t]))[0]
+    assert got == pytest.approx(expected, rel=1e-9, abs=1e-12 * r ** 3)
+    assert 0.0 <= got <= 4 / 3 * np.pi * r ** 3 * (1 + 1e-12)
+
+
+# ------------------------------------------------------------------------------------ flat holes (CAD)
+
+def test_missing_triangle_of_a_flat_face_is_answered_not_refused_at_400_percent():
+    """Benchmark case 3-07-holes_scattered (``meshes/box.stl`` less one triangle) was refused with "mass
+    ±409 %": the ball over a triangle across a whole side of a 12-triangle box is larger than the box.  The
+    other half of that side lies in the hole's plane, so the slab is as thin as round-off and the (exact)
+    patched answer is given with a tiny bound."""
+    v, f = box_arrays((1.0, 2.0, 3.0))
+    for k in range(len(f)):
+        open_f = np.delete(f, k, axis=0)
+        est = patched_estimate(v, open_f, volume_moments)
+        assert est.volume == pytest.approx(6.0, rel=1e-14)
+        assert 0 < est.uncertainty.mass < 1e-12
+        with pytest.warns(MeshRepairedWarning):
+            p = mass_properties((v, open_f), density=1.0, repair=True)
+        assert p.mesh.method == "patched" and p.mesh.certificate.kind == "estimate"
+        assert 0 < p.mesh.uncertainty.mass < 1e-12
+        assert p.mass == pytest.approx(6.0, rel=1e-12)
+
+
+def test_hole_across_a_crease_keeps_its_ball():
+    """Two triangles of different sides (sharing the box's edge) missing: the rim is bent over the edge, no
+    face beside it holds it, and the slab is as wide as the hole: the bound is the ball's, and holds."""
+    v, f = box_arrays((1.0, 2.0, 3.0))
+    normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    plus_x, plus_y = np.flatnonzero(normals[:, 0] > 0), np.flatnonzero(normals[:, 1] > 0)
+    # one triangle of each side that share an edge
+    pair = next((a, b) for a in plus_x for b in plus_y if len(set(f[a]) & set(f[b])) == 2)
+    open_f = np.delete(f, list(pair), axis=0)
+    est = patched_estimate(v, open_f, volume_moments)
+    assert _holds(est, volume_moments(v, f))
+    assert est.uncertainty.mass > 0.3
+
+
+def test_octahedron_missing_a_face_stays_refused():
+    """Every face beside the hole meets it at 109.5°: nothing says the hole is flat, the ball decides and
+    holds 330 % of the solid; refused with its reason (an honest refusal, not a bound traded away)."""
+    v = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=float)
+    f = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    with pytest.raises(InvalidMeshError, match="cannot be bounded usefully"):
+        mass_properties((v, f[1:]), repair=True)
+
+
+# ---------------------------------------------------------------------------------- curved holes hold
+
+@settings(max_examples=25, deadline=None)
+@given(height=st.floats(0.0, 0.98), quat=st.lists(st.floats(-1, 1), min_size=4, max_size=4)
+       .filter(lambda q: np.linalg.norm(q) > 0.1))
+def test_spherical_cap_holes_in_any_orientation_are_inside_their_bound(height, quat):
+    """A cap above the plane z = height cut from a finely tessellated sphere, turned at random: the ring's
+    planes are tilted by the cap's half-angle, the rim's far side stands off them by more than the cap's
+    height, and the stated bound contains the truth (mass, centre of mass, inertia)."""
+    s = trimesh.creation.icosphere(4)
+    rot = Rotation.from_quat(quat).as_matrix()
+    v0, f = np.asarray(s.vertices), np.asarray(s.faces)
+    open_f = f[~np.all(v0[f][:, :, 2] > height, axis=1)]
+    v = v0 @ rot.T
+    est = patched_estimate(v, open_f, volume_moments)
+    assert est.uncertainty.mass > 0
+    assert _holds(est, volume_moments(v, f))
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 2 ** 31 - 1), share=st.floats(0.001, 0.1))
+def test_patches_cut_from_a_torus_are_inside_their_bound(seed, share):
+    """Saddles: a torus's inner side bends up one way and down the other.  A patch of nearby faces (the
+    faces whose centroids are closest to a random one, up to ``share`` of them) removed: the bound holds.
+
+    Only holes with one rim: a band all round the tube leaves two rims, and the bound assumes each rim closes
+    over its own missing disc (docs/meshes.md, limits), which a band is not."""
+    s = trimesh.creation.torus(major_radius=1.0, minor_radius=0.35, major_sections=40, minor_sections=20)
+    v, f = np.asarray(s.vertices), np.asarray(s.faces)
+    rng = np.random.default_rng(seed)
+    centroids = v[f].mean(axis=1)
+    start = centroids[rng.integers(len(f))]
+    gone = np.argsort(np.linalg.norm(centroids - start, axis=1))[:max(1, int(share * len(f)))]
+    open_f = np.delete(f, gone, axis=0)
+    assume(len(connected_components_of(boundary_edges(open_f, len(v)))) == 1)
+    est = patched_estimate(v, open_f, volume_moments)
+    assert _holds(est, volume_moments(v, f))
+
+
+def connected_components_of(edges):
+    """The vertex sets of the components of an edge list (a few hundred edges: a plain union-find)."""
+    parent = {}
+
+    def root(x):
+        while parent.setdefault(x, x) != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    for a, b in edges.tolist():
+        parent[root(a)] = root(b)
+    groups = {}
+    for x in list(parent):
+        groups.setdefault(root(x), set()).add(x)
+    return list(groups.values())
+
+
+# ------------------------------------------------------------------------------- seams on sliver faces
+
+def _box_with_a_sliver_side(height=1e-7):
+    """A 1×2×3 box whose +x side holds a sliver: E lies ``height`` from the side's diagonal A–C, so the side
+    is (A, B, E), (B, C, E), (A, E, C) (the sliver, apex E over its base A–C) and (A, C, D)."""
+    v, f = box_arrays((1.0, 2.0, 3.0))
+    normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    side = normals[:, 0] > 0
+    corners = np.unique(f[side])
+    # the side's corners in turn about +x (counter-clockwise seen from outside)
+    angle = np.arctan2(v[corners, 2], v[corners, 1])
+    a, b, c, d = corners[np.argsort(angle)]
+    towards_b = v[b] - 0.5 * (v[a] + v[c])
+    e_point = 0.5 * (v[a] + v[c]) + height * towards_b / np.linalg.norm(towards_b)
+    e = len(v)
+    v = np.vstack([v, e_point])
+    faces = np.vstack([f[~side], [[a, b, e], [b, c, e], [a, e, c], [a, c, d]]])
+    return v, faces, (a, e, c)
+
+
+def test_t_junctions_on_a_sliver_are_sealed_exactly_not_welded_into_a_fold():
+    """so101 parts (benchmark 3-14, 3-18 ``t_junction``): the T-junction patch held a sliver whose apex lies
+    within the seam gap of its own base's neighbour edge.  The seal put that apex on the edge beside the
+    exact T-vertex (and welded a midpoint to a near end), folding the surface: "passes through itself at 2
+    face pairs", then refused at ±70 %.  Exact T-junctions are now split first, each vertex onto its
+    nearest edge, never onto its own face: the box comes back exactly."""
+    v, f, (a, e, c) = _box_with_a_sliver_side()
+    sliver = np.flatnonzero((np.sort(f, axis=1) == np.sort([a, e, c])).all(axis=1))[0]
+    mid = {}
+    extra = []
+
+    def midpoint(p, q):
+        key = (min(p, q), max(p, q))
+        if key not in mid:
+            mid[key] = len(v) + len(extra)
+            extra.append(0.5 * (v[p] + v[q]))
+        return mid[key]
+
+    ab, bc, ca = midpoint(a, e), midpoint(e, c), midpoint(c, a)
+    fine = [[a, ab, ca], [ab, e, bc], [ca, bc, c], [ab, bc, ca]]
+    split_v = np.vstack([v, extra])
+    split_f = np.vstack([np.delete(f, sliver, axis=0), fine])
+    truth = volume_moments(v, f)
+    assert truth.volume == pytest.approx(6.0, rel=1e-12)
+    with pytest.warns(MeshRepairedWarning):
+        p = mass_properties((split_v, split_f), density=1.0, repair=True)
+    assert p.mass == pytest.approx(6.0, rel=1e-12)
+    u = p.mesh.uncertainty
+    assert u is None or u.mass < 1e-12
