@@ -3147,6 +3147,16 @@ typedef struct {
     int32_t vid, slot;
 } CtEnd;
 
+/* cert[v]: 0 not certified; CT_STAR_SMALL_CERT certified with fewer than star_faces faces (its pairs are
+ * enumerated, counted as candidates and decided by the certificate, not tested one by one: the counts stay
+ * those of mesh/intersect.py, which certifies only stars of star_faces faces or more); CT_STAR_BIG certified
+ * with star_faces faces or more (its pairs are left out, whole node pairs at a time). */
+#define CT_STAR_SMALL_CERT 1
+#define CT_STAR_BIG 2
+/* Stars of fewer faces are not tried (a pair of faces sharing an edge and nothing else is one "fan" of two
+ * faces; three is the smallest star worth certifying). */
+#define CT_STAR_MIN 3
+
 static int
 ct_end_cmp(const void *x, const void *y)
 {
@@ -3154,11 +3164,92 @@ ct_end_cmp(const void *x, const void *y)
     return a->vid != b->vid ? (a->vid < b->vid ? -1 : 1) : (a->slot < b->slot ? -1 : a->slot > b->slot);
 }
 
+/* The ring r_0 .. r_k of the star of v from its k link edges (link[2f], link[2f+1]), walked face to face
+ * through shared link vertices; partner[s] is the other slot holding the vertex of slot s (-1: an end).  1 and
+ * *closed set when the faces form one edge-connected fan of distinct corners, else 0. */
+static int
+ct_star_ring(int32_t v, const int32_t *link, int64_t k, const int32_t *partner, int64_t free_slot, int64_t n_free,
+             int32_t *ring, int *closed)
+{
+    for (int64_t s = 0; s < 2 * k; s++) {
+        if (link[s] == v) return 0;                        /* a repeated corner */
+    }
+    for (int64_t f = 0; f < k; f++) {
+        if (link[2 * f] == link[2 * f + 1]) return 0;
+    }
+    if (n_free != 0 && n_free != 2) return 0;
+    *closed = n_free == 0;
+    int64_t start = *closed ? 0 : free_slot, len = 0, slot = start;
+    ring[len++] = link[start];
+    for (int64_t steps = 0; steps < k; steps++) {          /* walk face to face through shared link vertices */
+        int64_t out = slot ^ 1;                            /* the face's other end */
+        ring[len++] = link[out];
+        int32_t nx = partner[out];
+        if (nx < 0 || nx == start) break;
+        slot = nx;
+    }
+    if (len != k + 1) return 0;                            /* not one fan (several components) */
+    if (*closed && ring[k] != ring[0]) return 0;
+    return 1;
+}
+
+/* 1 when the fan of v with ring r_0 .. r_k turns once (closed) or less than once (open) round v, without
+ * overlap, in the projection along some coordinate axis (every projected triangle of one strict orientation). */
+static int
+ct_star_turns(const double *V, int32_t v, const int32_t *ring, int64_t k, int closed)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
+        CtStats st = {0, 0};
+        double c[2] = {V[3 * (size_t)v + kx], V[3 * (size_t)v + ky]};
+        double r0[2] = {V[3 * (size_t)ring[0] + kx], V[3 * (size_t)ring[0] + ky]};
+        int sign = 0, count = 0, good = 1;
+        for (int64_t i = 0; i < k && good; i++) {
+            double p[2] = {V[3 * (size_t)ring[i] + kx], V[3 * (size_t)ring[i] + ky]};
+            double q[2] = {V[3 * (size_t)ring[i + 1] + kx], V[3 * (size_t)ring[i + 1] + ky]};
+            int o = ct_orient2d(c, p, q, &st);
+            if (o == 0 || (sign != 0 && o != sign)) {
+                good = 0;
+                break;
+            }
+            sign = o;
+            if (sign * ct_orient2d(c, p, r0, &st) > 0 && sign * ct_orient2d(c, r0, q, &st) >= 0) count++;
+        }
+        if (good && !st.failed && count == (closed ? 1 : 0)) return 1;
+    }
+    return 0;
+}
+
+/* Stars of at most this many faces are matched on the stack by comparing link vertices pairwise (no sort). */
+#define CT_STAR_SMALL 32
+
 /* 1 when the star of v (link edges link[0 .. k-1], pairs of vertex ids) is certified, 0 when not, -1 when out
  * of memory. */
 static int
 ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
 {
+    int closed = 0;
+    if (k <= CT_STAR_SMALL) {                              /* the common case: everything on the stack */
+        int32_t partner[2 * CT_STAR_SMALL], ring[CT_STAR_SMALL + 1];
+        int64_t free_slot = -1, n_free = 0;
+        for (int64_t s = 0; s < 2 * k; s++) partner[s] = -1;
+        for (int64_t s = 0; s < 2 * k; s++) {
+            int64_t hits = 0;
+            for (int64_t t = 0; t < 2 * k; t++) {
+                if (t != s && link[t] == link[s]) {
+                    hits++;
+                    partner[s] = (int32_t)t;
+                }
+            }
+            if (hits > 1) return 0;                        /* a link vertex in three faces or more */
+            if (hits == 0) {
+                n_free++;
+                if (free_slot < 0) free_slot = s;
+            }
+        }
+        if (!ct_star_ring(v, link, k, partner, free_slot, n_free, ring, &closed)) return 0;
+        return ct_star_turns(V, v, ring, k, closed);
+    }
     CtEnd *ends = (CtEnd *)malloc((size_t)(2 * k) * sizeof(CtEnd));
     int32_t *partner = (int32_t *)malloc((size_t)(2 * k) * sizeof(int32_t));
     int32_t *ring = (int32_t *)malloc((size_t)(k + 1) * sizeof(int32_t));
@@ -3171,10 +3262,6 @@ ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
         ends[s].vid = link[s];
         ends[s].slot = (int32_t)s;
         partner[s] = -1;
-        if (link[s] == v) goto done;                       /* a repeated corner */
-    }
-    for (int64_t f = 0; f < k; f++) {
-        if (link[2 * f] == link[2 * f + 1]) goto done;
     }
     qsort(ends, (size_t)(2 * k), sizeof(CtEnd), ct_end_cmp);
     int64_t free_slot = -1, n_free = 0;
@@ -3192,37 +3279,8 @@ ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
         }
         s = e;
     }
-    if (n_free != 0 && n_free != 2) goto done;
-    int closed = n_free == 0;
-    int64_t start = closed ? 0 : free_slot, len = 0, slot = start;
-    ring[len++] = link[start];
-    for (int64_t steps = 0; steps < k; steps++) {          /* walk face to face through shared link vertices */
-        int64_t out = slot ^ 1;                            /* the face's other end */
-        ring[len++] = link[out];
-        int32_t nx = partner[out];
-        if (nx < 0 || nx == start) break;
-        slot = nx;
-    }
-    if (len != k + 1) goto done;                           /* not one fan (several components) */
-    if (closed && ring[k] != ring[0]) goto done;
-    for (int axis = 0; axis < 3 && !ok; axis++) {
-        int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
-        CtStats st = {0, 0};
-        double c[2] = {V[3 * (size_t)v + kx], V[3 * (size_t)v + ky]};
-        double r0[2] = {V[3 * (size_t)ring[0] + kx], V[3 * (size_t)ring[0] + ky]};
-        int sign = 0, count = 0, good = 1;
-        for (int64_t i = 0; i < k && good; i++) {
-            double p[2] = {V[3 * (size_t)ring[i] + kx], V[3 * (size_t)ring[i] + ky]};
-            double q[2] = {V[3 * (size_t)ring[i + 1] + kx], V[3 * (size_t)ring[i + 1] + ky]};
-            int o = ct_orient2d(c, p, q, &st);
-            if (o == 0 || (sign != 0 && o != sign)) {
-                good = 0;
-                break;
-            }
-            sign = o;
-            if (sign * ct_orient2d(c, p, r0, &st) > 0 && sign * ct_orient2d(c, r0, q, &st) >= 0) count++;
-        }
-        ok = good && !st.failed && count == (closed ? 1 : 0);
+    if (ct_star_ring(v, link, k, partner, free_slot, n_free, ring, &closed)) {
+        ok = ct_star_turns(V, v, ring, k, closed);
     }
 done:
     free(ends);
@@ -3231,9 +3289,43 @@ done:
     return ok;
 }
 
-/* cert[v] <- 1 for every certified vertex (faces F, m of them, n vertices); 0 or -1 when out of memory. */
+/* The stars of vertices ranges of ct_stars, certified on threads (each vertex's result is its own). */
+typedef struct {
+    const double *V;
+    const int64_t *off;         /* start of each kept vertex's link range, -1 for the others */
+    const int32_t *link;
+    int64_t n, total, min_faces, big_faces;
+    uint8_t *cert;
+    int oom[MAX_THREADS];
+} CtStarJob;
+
+static void
+ct_star_task(void *ctx, int t, int nt)
+{
+    CtStarJob *jb = (CtStarJob *)ctx;
+    int64_t v0 = (int64_t)part_start((size_t)jb->n, t, nt), v1 = (int64_t)part_start((size_t)jb->n, t + 1, nt);
+    int64_t v = v0;
+    while (v < v1 && jb->off[v] < 0) v++;
+    while (v < v1) {
+        /* the range ends where the next kept vertex's starts: ranges were laid out in vertex order */
+        int64_t w = v + 1;
+        while (w < jb->n && jb->off[w] < 0) w++;
+        int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total;
+        int r = ct_star_certify(jb->V, (int32_t)v, jb->link + 2 * s, e - s);
+        if (r < 0) {
+            jb->oom[t] = 1;
+            return;
+        }
+        jb->cert[v] = r ? (e - s >= jb->big_faces ? CT_STAR_BIG : CT_STAR_SMALL_CERT) : 0;
+        v = w;
+    }
+}
+
+/* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
+ * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory. */
 static int
-ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, uint8_t *cert)
+ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
+         uint8_t *cert, int threads)
 {
     memset(cert, 0, (size_t)n);
     int64_t *off = (int64_t *)calloc((size_t)(n > 0 ? n : 1), sizeof(int64_t));
@@ -3263,17 +3355,20 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
             link[2 * at + 1] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 2) % 3));
         }
     }
+    CtStarJob jb;
+    memset(&jb, 0, sizeof(jb));
+    jb.V = V;
+    jb.off = off;
+    jb.link = link;
+    jb.n = n;
+    jb.total = total;
+    jb.min_faces = min_faces;
+    jb.big_faces = big_faces;
+    jb.cert = cert;
+    run_parallel(thread_count(threads, (size_t)n, 20000), ct_star_task, &jb);
     int rc = 0;
-    for (int64_t v = 0; v < n && rc == 0; v++) {           /* off[v] is now the start of v's range */
-        if (off[v] < 0) continue;
-        int64_t s = off[v], e;
-        /* the range ends where the next kept vertex's starts: ranges were laid out in vertex order */
-        int64_t w = v + 1;
-        while (w < n && off[w] < 0) w++;
-        e = w < n ? off[w] : total;
-        int r = ct_star_certify(V, (int32_t)v, link + 2 * s, e - s);
-        if (r < 0) rc = -1;
-        else cert[v] = (uint8_t)r;
+    for (int t = 0; t < MAX_THREADS; t++) {
+        if (jb.oom[t]) rc = -1;
     }
     free(link);
     free(off);
@@ -3287,7 +3382,7 @@ ct_leaf_apex(const CtRec *rec, const uint8_t *cert, int64_t s, int64_t count)
     if (cert == NULL) return -1;
     for (int c = 0; c < 3; c++) {
         int32_t x = rec[s].fo[c];
-        if (!cert[x]) continue;
+        if (cert[x] != CT_STAR_BIG) continue;
         int all = 1;
         for (int64_t i = s + 1; i < s + count && all; i++) {
             all = rec[i].fo[0] == x || rec[i].fo[1] == x || rec[i].fo[2] == x;
@@ -3387,19 +3482,42 @@ ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
     F->skip = sc->flags[i] >> 2;
 }
 
-/* One candidate pair (hierarchy positions i, j); returns 0 to go on, 1 to stop (bound reached or out of
- * memory). */
+#ifdef CT_PROF
+static long long ctp_visit, ctp_hit, ctp_pop, ctp_leafpair, ctp_load;
+#define CTP(x) (x)++
+#include <time.h>
+static double ctp_now(void) { struct timespec t; clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
+#else
+#define CTP(x)
+#endif
+/* One pair of faces (hierarchy positions i, j) whose float32 boxes meet; returns 0 to go on, 1 to stop (bound
+ * reached or out of memory). */
 static int
 ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
-    if (!ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)) return 0;
+    CTP(ctp_hit);
     if (sc->cert != NULL) {                 /* both in one certified star: they meet only in what they share */
         const int32_t *x = sc->rec[i].fo, *y = sc->rec[j].fo;
+        int star = 0;
         for (int c = 0; c < 3; c++) {
-            if (sc->cert[x[c]] && (x[c] == y[0] || x[c] == y[1] || x[c] == y[2])) return 0;
+            uint8_t k = sc->cert[x[c]];
+            if (k && (x[c] == y[0] || x[c] == y[1] || x[c] == y[2]) && k > star) star = k;
+        }
+        if (star == CT_STAR_BIG) return 0;  /* left out (not a candidate on either twin) */
+        if (star == CT_STAR_SMALL_CERT) {
+            /* a candidate (the closed boxes share the vertex) of two faces of nonzero area (each projects to a
+             * triangle of nonzero area), decided "none" by the certificate: counted as tested */
+            if (sc->max_pairs >= 0 && sc->candidates >= sc->max_pairs) {
+                sc->complete = 0;
+                return 1;
+            }
+            sc->candidates++;
+            sc->tested++;
+            return 0;
         }
     }
     if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
+        CTP(ctp_load);
         ct_face_load(FI, sc, i);
         *have_i = 1;
     }
@@ -3463,6 +3581,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         top--;
         int64_t pi = stack[2 * top], qi = stack[2 * top + 1];
         const CtNode *p = &nodes[pi], *q = &nodes[qi];
+        CTP(ctp_pop);
         if (p->apex >= 0 && p->apex == q->apex) {
             continue;                       /* every pair below is within one certified star */
         }
@@ -3482,7 +3601,9 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 for (int64_t i = p->start; i < p->start + p->count; i++) {
                     for (int64_t j = i + 1; j < p->start + p->count; j++) {
                         int64_t a = i - p->start, b = j - p->start;
-                        if (ct_visit(sc, i, j, &leaf[a], &have[a], &leaf[b], &have[b])) goto out;
+                        CTP(ctp_visit);
+                        if (ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)
+                            && ct_visit(sc, i, j, &leaf[a], &have[a], &leaf[b], &have[b])) goto out;
                     }
                 }
             }
@@ -3496,6 +3617,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             continue;
         }
         if (p->count > 0 && q->count > 0) {
+            CTP(ctp_leafpair);
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
             for (int64_t i = p->start; i < p->start + p->count; i++) {
@@ -3508,7 +3630,9 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 uint8_t have_i = 0;
                 for (int64_t j = q->start; j < q->start + q->count; j++) {
                     int64_t b = j - q->start;
-                    if (ct_visit(sc, i, j, &FI, &have_i, &leaf[b], &have[b])) goto out;
+                    CTP(ctp_visit);
+                    if (ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)
+                        && ct_visit(sc, i, j, &FI, &have_i, &leaf[b], &have[b])) goto out;
                 }
             }
             continue;
@@ -3765,6 +3889,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.rec = rec;
         pr.flags = flags;
         /* the Morton grid: box centres of the faces, 2^16 cells per axis over their range */
+#ifdef CT_PROF
+        double T0 = ctp_now();
+#endif
         double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int64_t i = 0; i < n; i++) {       /* every vertex: a bound of the box centres */
             const double *p = V + 3 * i;
@@ -3778,14 +3905,23 @@ accel_contact_scan(PyObject *self, PyObject *args)
             pr.gmin[c] = gmin[c];
             pr.scale[c] = span > 0 ? (double)((1u << CT_MORTON_BITS) - 1) / span : 0.0;
         }
+#ifdef CT_PROF
+        double T1 = ctp_now();
+#endif
         pr.pass = 0;
         run_parallel(nt, ct_prep_task, &pr);
+#ifdef CT_PROF
+        double T2 = ctp_now();
+#endif
         if (ct_radix_sort(code, order, m) < 0) {
             oom = 1;
         }
         else {
             free(code);                     /* the sorted codes are not needed */
             code = NULL;
+#ifdef CT_PROF
+            T2 = ctp_now() - T2;
+#endif
             pr.pass = 1;
             run_parallel(nt, ct_prep_task, &pr);
             for (int t = 0; t < MAX_THREADS; t++) {
@@ -3795,14 +3931,24 @@ accel_contact_scan(PyObject *self, PyObject *args)
             free(order);                    /* rec holds the face indices in hierarchy order */
             order = NULL;
         }
+#ifdef CT_PROF
+        double T3 = ctp_now();
+#endif
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
-            if (cert == NULL || ct_stars(V, n, F, fsize, m, star_faces, cert) < 0) {
+            if (cert == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
+                                         star_faces, cert, nt) < 0) {
                 oom = 1;
             }
         }
+#ifdef CT_PROF
+        double T4 = ctp_now(), T5 = T4;
+#endif
         if (!oom && !failed && m >= 2) {
             ct_build(nodes, box, rec, cert, m);
+#ifdef CT_PROF
+            T5 = ctp_now();
+#endif
             sc.cert = cert;
             sc.BOX = box;
             sc.rec = rec;
@@ -3850,6 +3996,12 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 }
             }
         }
+#ifdef CT_PROF
+        double T6 = ctp_now();
+        fprintf(stderr, "bbox %.3f prep %.3f (sort %.3f) stars %.3f build %.3f walk %.3f | visit %lld hit %lld pop %lld leafpair %lld load %lld\n",
+                T1 - T0, T3 - T1, T2, T4 - T3, T5 - T4, T6 - T5, ctp_visit, ctp_hit, ctp_pop, ctp_leafpair, ctp_load);
+        ctp_visit = ctp_hit = ctp_pop = ctp_leafpair = ctp_load = 0;
+#endif
         oom |= sc.oom;
         Py_END_ALLOW_THREADS
         if (oom) {
