@@ -35,6 +35,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* ======================================================================================================
  * 1. buffers
@@ -2999,7 +3002,7 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
 #ifndef CT_LEAF
 #define CT_LEAF 8
 #endif
-#define CT_MORTON_BITS 16       /* per axis: a 48-bit code, sorted in four passes of 12 bits */
+#define CT_MORTON_BITS 11       /* per axis: a 33-bit code, sorted in three passes of 11 bits */
 
 static inline double
 ct_min3(double a, double b, double c)
@@ -3021,6 +3024,27 @@ typedef struct {
     int32_t face;
 } CtRec;
 
+/* The next float32 above a finite f (nextafterf(f, +inf) without the library call): from -0 or +0 the
+ * smallest subnormal, else one unit in the last place away from zero for f > 0, toward zero for f < 0;
+ * float32's largest finite value goes to +inf. */
+static inline float
+ct_f32_next_up(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof(u));
+    if ((u & 0x7fffffffu) == 0) {
+        u = 1u;
+    }
+    else if (u >> 31) {
+        u--;
+    }
+    else {
+        u++;
+    }
+    memcpy(&f, &u, sizeof(u));
+    return f;
+}
+
 /* Boxes in the hierarchy are float32, rounded outward (ct_f32_down / ct_f32_up), so they contain the exact
  * boxes: a pair whose float boxes meet may not be a candidate, and ct_visit decides that from the faces'
  * float64 corners; a pair whose exact boxes meet always has meeting float boxes.  Half the memory of double
@@ -3029,14 +3053,14 @@ static inline float
 ct_f32_down(double x)
 {
     float f = (float)x;
-    return (double)f > x ? nextafterf(f, -INFINITY) : f;
+    return (double)f > x ? -ct_f32_next_up(-f) : f;
 }
 
 static inline float
 ct_f32_up(double x)
 {
     float f = (float)x;
-    return (double)f < x ? nextafterf(f, INFINITY) : f;
+    return (double)f < x ? ct_f32_next_up(f) : f;
 }
 
 typedef struct {
@@ -3088,45 +3112,38 @@ ct_spread(uint64_t v)
     return v;
 }
 
-/* order <- 0..m-1 sorted by code (stable LSD radix sort, four passes of 12 bits over the 48-bit codes);
- * code and the scratch arrays are overwritten.  -1 when out of memory. */
+/* key[i] = code << 31 | i (a 33-bit Morton code above a 31-bit face index) sorted by code, stable (LSD radix
+ * sort, three passes of 11 bits over the code): the face indices in hierarchy order are then key & (2^31 - 1).
+ * One 8-byte word per face moves, not a code and an index.  -1 when out of memory. */
 static int
-ct_radix_sort(uint64_t *code, int64_t *order, int64_t m)
+ct_radix_sort(uint64_t *key, int64_t m)
 {
     size_t mm = m > 0 ? (size_t)m : 1;
-    uint64_t *code2 = (uint64_t *)malloc(mm * sizeof(uint64_t));
-    int64_t *order2 = (int64_t *)malloc(mm * sizeof(int64_t));
-    size_t (*count)[4096] = (size_t (*)[4096])calloc(4, sizeof(*count));
-    if (code2 == NULL || order2 == NULL || count == NULL) {
-        free(code2);
-        free(order2);
+    uint64_t *key2 = (uint64_t *)malloc(mm * sizeof(uint64_t));
+    size_t (*count)[2048] = (size_t (*)[2048])calloc(3, sizeof(*count));
+    if (key2 == NULL || count == NULL) {
+        free(key2);
         free(count);
         return -1;
     }
     for (int64_t i = 0; i < m; i++) {
-        order[i] = i;
-        for (int p = 0; p < 4; p++) count[p][(code[i] >> (12 * p)) & 4095]++;
+        for (int p = 0; p < 3; p++) count[p][(key[i] >> (31 + 11 * p)) & 2047]++;
     }
-    uint64_t *src_c = code, *dst_c = code2;
-    int64_t *src_o = order, *dst_o = order2;
-    for (int p = 0; p < 4; p++) {
+    uint64_t *src = key, *dst = key2;
+    for (int p = 0; p < 3; p++) {
         size_t sum = 0;
-        for (int k = 0; k < 4096; k++) {
+        for (int k = 0; k < 2048; k++) {
             size_t c = count[p][k];
             count[p][k] = sum;
             sum += c;
         }
         for (int64_t i = 0; i < m; i++) {
-            size_t at = count[p][(src_c[i] >> (12 * p)) & 4095]++;
-            dst_c[at] = src_c[i];
-            dst_o[at] = src_o[i];
+            dst[count[p][(src[i] >> (31 + 11 * p)) & 2047]++] = src[i];
         }
-        uint64_t *tc = src_c; src_c = dst_c; dst_c = tc;
-        int64_t *to = src_o; src_o = dst_o; dst_o = to;
+        uint64_t *t = src; src = dst; dst = t;
     }
-    /* four passes: the result is back in code / order */
-    free(code2);
-    free(order2);
+    memcpy(key, src, (size_t)m * sizeof(uint64_t));  /* three passes: the result is in key2 */
+    free(key2);
     free(count);
     return 0;
 }
@@ -3392,9 +3409,64 @@ ct_leaf_apex(const CtRec *rec, const uint8_t *cert, int64_t s, int64_t count)
     return -1;
 }
 
-/* Builds the hierarchy over the boxes BOX (lo, hi: 6 floats per position, already in hierarchy order):
- * the tree halving index ranges (leaves of at most CT_LEAF faces), node boxes from the leaves up.  Returns
- * the node count. */
+/* Boxes of the faces in blocks of CT_LEAF hierarchy positions, coordinate by coordinate (structure of arrays):
+ * block b holds lo x, lo y, lo z, hi x, hi y, hi z of positions CT_LEAF b .. CT_LEAF b + CT_LEAF - 1, CT_LEAF
+ * floats each; positions past the last face are empty boxes (lo +inf, hi -inf) that meet nothing.  One leaf
+ * of the hierarchy is one block, so a face is tested against a whole leaf's boxes at once (ct_block_mask). */
+#define CT_BLOCK (6 * CT_LEAF)
+
+static inline float
+ct_box_at(const float *BOX, int64_t i, int c)     /* c 0..2: lo, 3..5: hi */
+{
+    return BOX[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF];
+}
+
+static inline int
+ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_ctz(x);
+#else
+    int k = 0;
+    while (!(x & 1u)) {
+        x >>= 1;
+        k++;
+    }
+    return k;
+#endif
+}
+
+/* Bit j set when box j of the block meets the box (lx, ly, lz)-(hx, hy, hz) (closed boxes). */
+static inline unsigned
+ct_block_mask(const float *blk, float lx, float ly, float lz, float hx, float hy, float hz)
+{
+#if defined(__SSE2__) && CT_LEAF == 8
+    unsigned mask = 0;
+    for (int half = 0; half < 2; half++) {
+        const float *b = blk + 4 * half;
+        __m128 ok = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b), _mm_set1_ps(hx)),
+                               _mm_cmple_ps(_mm_set1_ps(lx), _mm_loadu_ps(b + 3 * CT_LEAF)));
+        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + CT_LEAF), _mm_set1_ps(hy)),
+                                       _mm_cmple_ps(_mm_set1_ps(ly), _mm_loadu_ps(b + 4 * CT_LEAF))));
+        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + 2 * CT_LEAF), _mm_set1_ps(hz)),
+                                       _mm_cmple_ps(_mm_set1_ps(lz), _mm_loadu_ps(b + 5 * CT_LEAF))));
+        mask |= (unsigned)_mm_movemask_ps(ok) << (4 * half);
+    }
+    return mask;
+#else
+    unsigned mask = 0;
+    for (int j = 0; j < CT_LEAF; j++) {
+        mask |= (unsigned)((blk[j] <= hx) & (lx <= blk[3 * CT_LEAF + j]) & (blk[CT_LEAF + j] <= hy)
+                           & (ly <= blk[4 * CT_LEAF + j]) & (blk[2 * CT_LEAF + j] <= hz)
+                           & (lz <= blk[5 * CT_LEAF + j])) << j;
+    }
+    return mask;
+#endif
+}
+
+/* Builds the hierarchy over the boxes BOX (blocks above, already in hierarchy order): the tree halving block
+ * ranges (a leaf is one block of at most CT_LEAF faces), node boxes from the leaves up.  Returns the node
+ * count. */
 static int64_t
 ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert, int64_t m)
 {
@@ -3406,7 +3478,8 @@ ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert,
         if (nd->count <= CT_LEAF) {
             continue;
         }
-        int64_t s = nd->start, e = s + nd->count, half = s + (e - s) / 2;
+        int64_t s = nd->start, e = s + nd->count, blocks = (nd->count + CT_LEAF - 1) / CT_LEAF;
+        int64_t half = s + CT_LEAF * (blocks / 2);     /* starts stay multiples of CT_LEAF */
         int64_t l = n_nodes++, r = n_nodes++;
         nodes[l].start = s;
         nodes[l].count = half - s;
@@ -3427,8 +3500,9 @@ ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert,
             }
             for (int64_t i = nd->start; i < nd->start + nd->count; i++) {
                 for (int c = 0; c < 3; c++) {
-                    if (BOX[6 * i + c] < nd->lo[c]) nd->lo[c] = BOX[6 * i + c];
-                    if (BOX[6 * i + 3 + c] > nd->hi[c]) nd->hi[c] = BOX[6 * i + 3 + c];
+                    float lo = ct_box_at(BOX, i, c), hi = ct_box_at(BOX, i, 3 + c);
+                    if (lo < nd->lo[c]) nd->lo[c] = lo;
+                    if (hi > nd->hi[c]) nd->hi[c] = hi;
                 }
             }
         }
@@ -3445,7 +3519,7 @@ ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert,
 }
 
 typedef struct {
-    const float *BOX;           /* face boxes (lo, hi) rounded outward to float32, in hierarchy order */
+    const float *BOX;           /* face boxes rounded outward to float32, in blocks of CT_LEAF (ct_block_mask) */
     const CtRec *rec;           /* corner indices and face index, in hierarchy order */
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
     const double *V;            /* vertices (n, 3) */
@@ -3598,12 +3672,18 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             if (p->count > 0) {
                 CtFace leaf[CT_LEAF];
                 uint8_t have[CT_LEAF] = {0};
-                for (int64_t i = p->start; i < p->start + p->count; i++) {
-                    for (int64_t j = i + 1; j < p->start + p->count; j++) {
-                        int64_t a = i - p->start, b = j - p->start;
-                        CTP(ctp_visit);
-                        if (ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)
-                            && ct_visit(sc, i, j, &leaf[a], &have[a], &leaf[b], &have[b])) goto out;
+                const float *blk = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
+                for (int a = 0; a + 1 < p->count; a++) {
+                    unsigned mask = ct_block_mask(blk, blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a],
+                                                  blk[3 * CT_LEAF + a], blk[4 * CT_LEAF + a], blk[5 * CT_LEAF + a]);
+                    mask &= ~((2u << a) - 1);               /* the later positions j > i only */
+                    CTP(ctp_visit);
+                    while (mask) {
+                        int b = ct_ctz(mask);
+                        mask &= mask - 1;
+                        if (ct_visit(sc, p->start + a, p->start + b, &leaf[a], &have[a], &leaf[b], &have[b])) {
+                            goto out;
+                        }
                     }
                 }
             }
@@ -3620,19 +3700,22 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             CTP(ctp_leafpair);
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
-            for (int64_t i = p->start; i < p->start + p->count; i++) {
-                const float *bi = sc->BOX + 6 * i;      /* face i against q's box first */
-                if (!((bi[0] <= q->hi[0]) & (q->lo[0] <= bi[3]) & (bi[1] <= q->hi[1]) & (q->lo[1] <= bi[4])
-                      & (bi[2] <= q->hi[2]) & (q->lo[2] <= bi[5]))) {
-                    continue;
-                }
+            const float *pb = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
+            const float *qb = sc->BOX + CT_BLOCK * (q->start / CT_LEAF);
+            /* p's faces against q's box first, then each that meets it against q's faces */
+            unsigned pmask = ct_block_mask(pb, q->lo[0], q->lo[1], q->lo[2], q->hi[0], q->hi[1], q->hi[2]);
+            while (pmask) {
+                int a = ct_ctz(pmask);
+                pmask &= pmask - 1;
+                unsigned mask = ct_block_mask(qb, pb[a], pb[CT_LEAF + a], pb[2 * CT_LEAF + a], pb[3 * CT_LEAF + a],
+                                              pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]);
                 CtFace FI;
                 uint8_t have_i = 0;
-                for (int64_t j = q->start; j < q->start + q->count; j++) {
-                    int64_t b = j - q->start;
-                    CTP(ctp_visit);
-                    if (ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)
-                        && ct_visit(sc, i, j, &FI, &have_i, &leaf[b], &have[b])) goto out;
+                CTP(ctp_visit);
+                while (mask) {
+                    int b = ct_ctz(mask);
+                    mask &= mask - 1;
+                    if (ct_visit(sc, p->start + a, q->start + b, &FI, &have_i, &leaf[b], &have[b])) goto out;
                 }
             }
             continue;
@@ -3735,8 +3818,7 @@ typedef struct {
     const double *V;
     const void *F;
     int size;
-    const int64_t *order;
-    uint64_t *code;
+    uint64_t *code;             /* Morton code << 31 | face index; sorted between the passes */
     double gmin[3], scale[3];
     int8_t *axis;
     uint8_t *skip;
@@ -3765,13 +3847,13 @@ ct_prep_task(void *ctx, int t, int nt)
                 if (k > (1u << CT_MORTON_BITS) - 1) k = (1u << CT_MORTON_BITS) - 1;
                 code |= ct_spread(k) << c;
             }
-            pr->code[f] = code;
+            pr->code[f] = code << 31 | (uint64_t)f;
         }
         return;
     }
     CtStats st = {0, 0};
     for (int64_t i = s; i < e; i++) {
-        int64_t f = pr->order[i];
+        int64_t f = (int64_t)(pr->code[i] & 0x7fffffff);
         CtFace F;
         const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
         const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
@@ -3785,8 +3867,9 @@ ct_prep_task(void *ctx, int t, int nt)
         }
         pr->rec[i].face = (int32_t)f;
         for (int c = 0; c < 3; c++) {
-            pr->box[6 * i + c] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
-            pr->box[6 * i + 3 + c] = ct_f32_up(ct_max3(p0[c], p1[c], p2[c]));
+            float *blk = pr->box + CT_BLOCK * (i / CT_LEAF);
+            blk[c * CT_LEAF + i % CT_LEAF] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
+            blk[(3 + c) * CT_LEAF + i % CT_LEAF] = ct_f32_up(ct_max3(p0[c], p1[c], p2[c]));
         }
     }
     pr->exact[t] += st.exact;
@@ -3810,7 +3893,6 @@ accel_contact_scan(PyObject *self, PyObject *args)
     int got = 0;
     PyObject *result = NULL;
     CtNode *nodes = NULL;
-    int64_t *order = NULL;
     uint64_t *code = NULL;
     float *box = NULL;
     CtRec *rec = NULL;
@@ -3860,17 +3942,23 @@ accel_contact_scan(PyObject *self, PyObject *args)
         size_t mm = m > 0 ? (size_t)m : 1;
         /* leaves hold at least (CT_LEAF + 1) / 2 faces (but the root may be a smaller leaf) */
         nodes = (CtNode *)malloc((2 * mm / ((CT_LEAF + 1) / 2) + 2) * sizeof(CtNode));
-        order = (int64_t *)malloc(mm * sizeof(int64_t));
         code = (uint64_t *)malloc(mm * sizeof(uint64_t));
-        box = (float *)malloc(mm * 6 * sizeof(float));
+        size_t n_blocks = (mm + CT_LEAF - 1) / CT_LEAF;
+        box = (float *)malloc(n_blocks * CT_BLOCK * sizeof(float));
         rec = (CtRec *)malloc(mm * sizeof(CtRec));
         flags = (uint8_t *)malloc(mm);
         axis_out = (int8_t *)malloc(mm);
         skip_out = (uint8_t *)malloc(mm);
-        if (nodes == NULL || order == NULL || code == NULL || box == NULL || rec == NULL || flags == NULL
+        if (nodes == NULL || code == NULL || box == NULL || rec == NULL || flags == NULL
             || axis_out == NULL || skip_out == NULL) {
             PyErr_NoMemory();
             goto done;
+        }
+        for (size_t i = (size_t)m; i < n_blocks * CT_LEAF; i++) {     /* the last block's empty boxes */
+            for (int c = 0; c < 3; c++) {
+                box[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = INFINITY;
+                box[CT_BLOCK * (i / CT_LEAF) + (3 + c) * CT_LEAF + i % CT_LEAF] = -INFINITY;
+            }
         }
         int oom = 0, failed = 0;
         Py_BEGIN_ALLOW_THREADS
@@ -3882,7 +3970,6 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.F = F;
         pr.size = fsize;
         pr.code = code;
-        pr.order = order;
         pr.axis = axis_out;
         pr.skip = skip_out;
         pr.box = box;
@@ -3913,12 +4000,10 @@ accel_contact_scan(PyObject *self, PyObject *args)
 #ifdef CT_PROF
         double T2 = ctp_now();
 #endif
-        if (ct_radix_sort(code, order, m) < 0) {
+        if (ct_radix_sort(code, m) < 0) {
             oom = 1;
         }
         else {
-            free(code);                     /* the sorted codes are not needed */
-            code = NULL;
 #ifdef CT_PROF
             T2 = ctp_now() - T2;
 #endif
@@ -3928,8 +4013,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 sc.exact += pr.exact[t];
                 failed |= pr.failed[t];
             }
-            free(order);                    /* rec holds the face indices in hierarchy order */
-            order = NULL;
+            free(code);                     /* rec holds the face indices in hierarchy order */
+            code = NULL;
         }
 #ifdef CT_PROF
         double T3 = ctp_now();
@@ -4033,7 +4118,6 @@ done:
         PyBuffer_Release(&views[i]);
     }
     free(nodes);
-    free(order);
     free(code);
     free(box);
     free(rec);
