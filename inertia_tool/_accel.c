@@ -2594,19 +2594,10 @@ ct_orient3d(const double *a, const double *b, const double *c, const double *d, 
     return ct_orient3d_exact(a, b, c, d, st);
 }
 
+/* Exact sign of orient2d(a, b, c) by expansions (called when the float filter cannot decide). */
 static int
-ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
+ct_orient2d_exact(const double *a, const double *b, const double *c, CtStats *st)
 {
-    double acx = a[0] - c[0], acy = a[1] - c[1], bcx = b[0] - c[0], bcy = b[1] - c[1];
-    double left = acx * bcy, right = acy * bcx;
-    double det = left - right;
-    double perm = fabs(left) + fabs(right);
-    if (perm == 0.0) {
-        return 0;
-    }
-    if (fabs(det) > CONTACT_O2 * perm) {
-        return det > 0 ? 1 : -1;
-    }
     if ((a[0] == b[0] && a[1] == b[1]) || (a[0] == c[0] && a[1] == c[1]) || (b[0] == c[0] && b[1] == c[1])) {
         return 0;                       /* two equal points */
     }
@@ -2627,6 +2618,22 @@ ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
         ct_add_product2(&h, -1.0, p, q);
     }
     return ct_exact_sign(&h, st);
+}
+
+static inline int
+ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
+{
+    double acx = a[0] - c[0], acy = a[1] - c[1], bcx = b[0] - c[0], bcy = b[1] - c[1];
+    double left = acx * bcy, right = acy * bcx;
+    double det = left - right;
+    double perm = fabs(left) + fabs(right);
+    if (perm == 0.0) {
+        return 0;
+    }
+    if (fabs(det) > CONTACT_O2 * perm) {
+        return det > 0 ? 1 : -1;
+    }
+    return ct_orient2d_exact(a, b, c, st);
 }
 
 enum { CT_NONE = 0, CT_CROSSING = 1, CT_OPPOSITE = 2, CT_CONTACT = 3 };
@@ -3000,7 +3007,7 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
  * ------------------------------------------------------------------------------------------------------ */
 
 #ifndef CT_LEAF
-#define CT_LEAF 8
+#define CT_LEAF 16
 #endif
 #define CT_MORTON_BITS 11       /* per axis: a 33-bit code, sorted in three passes of 11 bits */
 
@@ -3248,21 +3255,33 @@ ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
     int closed = 0;
     if (k <= CT_STAR_SMALL) {                              /* the common case: everything on the stack */
         int32_t partner[2 * CT_STAR_SMALL], ring[CT_STAR_SMALL + 1];
+        uint64_t ends[2 * CT_STAR_SMALL];                  /* vertex id << 32 | slot, insertion-sorted */
         int64_t free_slot = -1, n_free = 0;
-        for (int64_t s = 0; s < 2 * k; s++) partner[s] = -1;
         for (int64_t s = 0; s < 2 * k; s++) {
-            int64_t hits = 0;
-            for (int64_t t = 0; t < 2 * k; t++) {
-                if (t != s && link[t] == link[s]) {
-                    hits++;
-                    partner[s] = (int32_t)t;
+            uint64_t key = (uint64_t)(uint32_t)link[s] << 32 | (uint64_t)s;
+            int64_t t = s;
+            while (t > 0 && ends[t - 1] > key) {
+                ends[t] = ends[t - 1];
+                t--;
+            }
+            ends[t] = key;
+            partner[s] = -1;
+        }
+        for (int64_t s = 0; s < 2 * k;) {
+            int64_t e = s + 1;
+            while (e < 2 * k && ends[e] >> 32 == ends[s] >> 32) e++;
+            if (e - s > 2) return 0;                       /* a link vertex in three faces or more */
+            if (e - s == 2) {
+                partner[ends[s] & 0xffffffffu] = (int32_t)(ends[s + 1] & 0xffffffffu);
+                partner[ends[s + 1] & 0xffffffffu] = (int32_t)(ends[s] & 0xffffffffu);
+            }
+            else {
+                n_free++;
+                if (free_slot < 0 || (int64_t)(ends[s] & 0xffffffffu) < free_slot) {
+                    free_slot = (int64_t)(ends[s] & 0xffffffffu);
                 }
             }
-            if (hits > 1) return 0;                        /* a link vertex in three faces or more */
-            if (hits == 0) {
-                n_free++;
-                if (free_slot < 0) free_slot = s;
-            }
+            s = e;
         }
         if (!ct_star_ring(v, link, k, partner, free_slot, n_free, ring, &closed)) return 0;
         return ct_star_turns(V, v, ring, k, closed);
@@ -3340,10 +3359,18 @@ ct_star_task(void *ctx, int t, int nt)
 
 /* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
  * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory. */
+#ifdef CT_PROF
+#include <time.h>
+static double ctp_t0;
+static double ctp_now(void) { struct timespec t; clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
+#endif
 static int
 ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
          uint8_t *cert, int threads)
 {
+#ifdef CT_PROF
+    ctp_t0 = ctp_now();
+#endif
     memset(cert, 0, (size_t)n);
     int64_t *off = (int64_t *)calloc((size_t)(n > 0 ? n : 1), sizeof(int64_t));
     if (off == NULL) return -1;
@@ -3372,6 +3399,9 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
             link[2 * at + 1] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 2) % 3));
         }
     }
+#ifdef CT_PROF
+    fprintf(stderr, "[csr %.3f] ", ctp_now() - ctp_t0);
+#endif
     CtStarJob jb;
     memset(&jb, 0, sizeof(jb));
     jb.V = V;
@@ -3440,9 +3470,9 @@ ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
 static inline unsigned
 ct_block_mask(const float *blk, float lx, float ly, float lz, float hx, float hy, float hz)
 {
-#if defined(__SSE2__) && CT_LEAF == 8
+#if defined(__SSE2__) && CT_LEAF % 4 == 0
     unsigned mask = 0;
-    for (int half = 0; half < 2; half++) {
+    for (int half = 0; half < CT_LEAF / 4; half++) {
         const float *b = blk + 4 * half;
         __m128 ok = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b), _mm_set1_ps(hx)),
                                _mm_cmple_ps(_mm_set1_ps(lx), _mm_loadu_ps(b + 3 * CT_LEAF)));
@@ -3524,7 +3554,7 @@ typedef struct {
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
     const double *V;            /* vertices (n, 3) */
     const CtNode *nodes;
-    const uint8_t *cert;        /* certified star vertices (ct_stars), NULL without pruning */
+    const uint8_t *stars;       /* certified corners per position (ct_visit), NULL without pruning */
     long long max_pairs;        /* < 0: no bound */
     long long candidates, tested;
     long exact;
@@ -3559,37 +3589,14 @@ ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
 #ifdef CT_PROF
 static long long ctp_visit, ctp_hit, ctp_pop, ctp_leafpair, ctp_load;
 #define CTP(x) (x)++
-#include <time.h>
-static double ctp_now(void) { struct timespec t; clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
 #else
 #define CTP(x)
 #endif
-/* One pair of faces (hierarchy positions i, j) whose float32 boxes meet; returns 0 to go on, 1 to stop (bound
- * reached or out of memory). */
+/* A pair of faces (hierarchy positions i, j) whose float32 boxes meet and that share no certified star vertex:
+ * the float64 boxes, then the test; returns 0 to go on, 1 to stop (bound reached or out of memory). */
 static int
-ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
+ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
-    CTP(ctp_hit);
-    if (sc->cert != NULL) {                 /* both in one certified star: they meet only in what they share */
-        const int32_t *x = sc->rec[i].fo, *y = sc->rec[j].fo;
-        int star = 0;
-        for (int c = 0; c < 3; c++) {
-            uint8_t k = sc->cert[x[c]];
-            if (k && (x[c] == y[0] || x[c] == y[1] || x[c] == y[2]) && k > star) star = k;
-        }
-        if (star == CT_STAR_BIG) return 0;  /* left out (not a candidate on either twin) */
-        if (star == CT_STAR_SMALL_CERT) {
-            /* a candidate (the closed boxes share the vertex) of two faces of nonzero area (each projects to a
-             * triangle of nonzero area), decided "none" by the certificate: counted as tested */
-            if (sc->max_pairs >= 0 && sc->candidates >= sc->max_pairs) {
-                sc->complete = 0;
-                return 1;
-            }
-            sc->candidates++;
-            sc->tested++;
-            return 0;
-        }
-    }
     if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
         CTP(ctp_load);
         ct_face_load(FI, sc, i);
@@ -3627,6 +3634,37 @@ ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *
         return 1;
     }
     return 0;
+}
+
+/* A pair of faces (hierarchy positions i, j) whose float32 boxes meet; returns 0 to go on, 1 to stop (bound
+ * reached or out of memory).  Two faces of one certified star meet only in what they share (ct_stars): a
+ * big star's pair is left out (not a candidate on either twin); a small star's is a candidate (the closed
+ * boxes share the vertex) of two faces of nonzero area (each projects to a triangle of nonzero area), decided
+ * "none" by the certificate and counted as tested, without rebuilding either face.  stars[i] says which
+ * corners of the face at position i are certified (bit c: small star, bit 3 + c: big star). */
+static inline int
+ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
+{
+    CTP(ctp_hit);
+    unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
+    if (bits) {
+        const int32_t *x = sc->rec[i].fo, *y = sc->rec[j].fo;
+        unsigned shared = 0;                /* bit c: corner c of face i is a corner of face j */
+        for (int c = 0; c < 3; c++) {
+            shared |= (unsigned)((x[c] == y[0]) | (x[c] == y[1]) | (x[c] == y[2])) << c;
+        }
+        if ((bits >> 3) & shared) return 0;
+        if (bits & shared) {
+            if (sc->max_pairs >= 0 && sc->candidates >= sc->max_pairs) {
+                sc->complete = 0;
+                return 1;
+            }
+            sc->candidates++;
+            sc->tested++;
+            return 0;
+        }
+    }
+    return ct_test_pair(sc, i, j, FI, have_i, FJ, have_j);
 }
 
 static inline int
@@ -3810,6 +3848,18 @@ ct_tasks(const CtNode *nodes, int64_t *tasks)
     return n;
 }
 
+#define CT_AHEAD 32
+
+static inline void
+ct_prefetch(const void *p)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(p);
+#else
+    (void)p;
+#endif
+}
+
 /* Per-face preparation, split over threads by position: Morton codes (pass 0), then the faces and boxes in
  * hierarchy order (pass 1). */
 typedef struct {
@@ -3853,6 +3903,15 @@ ct_prep_task(void *ctx, int t, int nt)
     }
     CtStats st = {0, 0};
     for (int64_t i = s; i < e; i++) {
+        /* the faces are read in hierarchy order, i.e. at random in the caller's: their rows are fetched
+         * CT_AHEAD positions ahead, their corners CT_AHEAD / 2 ahead (from the rows fetched by then) */
+        if (i + CT_AHEAD < e) {
+            ct_prefetch((const char *)pr->F + (size_t)pr->size * 3 * (size_t)(pr->code[i + CT_AHEAD] & 0x7fffffff));
+        }
+        if (i + CT_AHEAD / 2 < e) {
+            size_t g = 3 * (size_t)(pr->code[i + CT_AHEAD / 2] & 0x7fffffff);
+            for (int k = 0; k < 3; k++) ct_prefetch(pr->V + 3 * index_at(pr->F, pr->size, g + (size_t)k));
+        }
         int64_t f = (int64_t)(pr->code[i] & 0x7fffffff);
         CtFace F;
         const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
@@ -3900,6 +3959,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
     int8_t *axis_out = NULL;
     uint8_t *skip_out = NULL;
     uint8_t *cert = NULL;
+    uint8_t *stars = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
     for (; got < 2; got++) {
@@ -4008,7 +4068,13 @@ accel_contact_scan(PyObject *self, PyObject *args)
             T2 = ctp_now() - T2;
 #endif
             pr.pass = 1;
+#ifdef CT_PROF
+            double T2b = ctp_now();
+#endif
             run_parallel(nt, ct_prep_task, &pr);
+#ifdef CT_PROF
+            fprintf(stderr, "[pass1 %.3f] ", ctp_now() - T2b);
+#endif
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
                 failed |= pr.failed[t];
@@ -4021,7 +4087,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
 #endif
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
-            if (cert == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
+            stars = (uint8_t *)malloc(mm);
+            if (cert == NULL || stars == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
                                          star_faces, cert, nt) < 0) {
                 oom = 1;
             }
@@ -4034,7 +4101,17 @@ accel_contact_scan(PyObject *self, PyObject *args)
 #ifdef CT_PROF
             T5 = ctp_now();
 #endif
-            sc.cert = cert;
+            if (cert != NULL) {
+                for (int64_t i = 0; i < m; i++) {
+                    unsigned b = 0;
+                    for (int c = 0; c < 3; c++) {
+                        uint8_t k = cert[rec[i].fo[c]];
+                        b |= k == CT_STAR_BIG ? 8u << c : k == CT_STAR_SMALL_CERT ? 1u << c : 0u;
+                    }
+                    stars[i] = (uint8_t)b;
+                }
+            }
+            sc.stars = cert != NULL ? stars : NULL;
             sc.BOX = box;
             sc.rec = rec;
             sc.flags = flags;
@@ -4125,6 +4202,7 @@ done:
     free(axis_out);
     free(skip_out);
     free(cert);
+    free(stars);
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);
