@@ -1720,7 +1720,7 @@ static PyMethodDef accel_methods[] = {
      "contact_scan(vertices, faces, max_pairs, threads=1, star_faces=0) -> (a, b, kind, candidates, tested, exact, "
      "complete, axis, degenerate)\n\nEvery face pair whose closed boxes meet (but those within one certified star "
      "of at least star_faces faces, when star_faces > 0), found by a bounding-volume hierarchy and "
-     "classified; a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
+     "classified (those within a smaller certified star by its certificate); a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
     {NULL, NULL, 0, NULL}
 };
@@ -2416,7 +2416,11 @@ done:
  * instead of the numpy path's grid: the same set of pairs (those whose closed boxes meet), in another order.
  * With star_faces > 0 the pairs within one certified star (ct_stars; mesh/intersect.py, "Stars", proves they
  * meet only in what they share) are left out on both paths, here also whole node pairs whose faces all hold
- * one certified vertex (CtNode.apex), so a fan cap of k faces costs O(k) instead of k(k - 1)/2 pairs.
+ * one certified vertex (CtNode.apex), so a fan cap of k faces costs O(k) instead of k(k - 1)/2 pairs.  Here
+ * also the star of every vertex of at least CT_STAR_MIN (3) faces is tried: a pair within a small certified
+ * star (fewer than star_faces faces) is still enumerated and counted as a candidate and as tested, as the numpy
+ * path counts it, but decided "none" by the certificate instead of rebuilding and testing both faces (on a
+ * clean mesh that is nearly every candidate pair: the faces sharing a corner).
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
@@ -3000,10 +3004,11 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
 
 /* ------------------------------------------------------------------------------------------------------
  * contact_scan -- the whole check in one pass: a bounding-volume hierarchy over the face boxes (faces in
- * Morton order of their box centres, sorted by an LSD radix sort; index ranges halved down to leaves of at
- * most CT_LEAF faces), traversed against itself so that every unordered pair of faces whose closed boxes
- * meet is visited exactly once (each pair of leaves once; a child pair is pushed only when its boxes meet),
- * each such pair classified on the spot; only the pairs that meet are kept.
+ * Morton order of their box centres, sorted by an LSD radix sort; ranges of blocks of CT_LEAF positions halved
+ * down to leaves of one block), traversed against itself so that every unordered pair of faces whose closed
+ * boxes meet is visited exactly once (each pair of leaves once; a child pair is pushed only when its boxes
+ * meet; within a leaf pair a face's box is tested against the other leaf's CT_LEAF boxes at once), each such
+ * pair classified on the spot; only the pairs that meet are kept.
  * ------------------------------------------------------------------------------------------------------ */
 
 #ifndef CT_LEAF
@@ -3359,18 +3364,10 @@ ct_star_task(void *ctx, int t, int nt)
 
 /* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
  * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory. */
-#ifdef CT_PROF
-#include <time.h>
-static double ctp_t0;
-static double ctp_now(void) { struct timespec t; clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
-#endif
 static int
 ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
          uint8_t *cert, int threads)
 {
-#ifdef CT_PROF
-    ctp_t0 = ctp_now();
-#endif
     memset(cert, 0, (size_t)n);
     int64_t *off = (int64_t *)calloc((size_t)(n > 0 ? n : 1), sizeof(int64_t));
     if (off == NULL) return -1;
@@ -3399,9 +3396,6 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
             link[2 * at + 1] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 2) % 3));
         }
     }
-#ifdef CT_PROF
-    fprintf(stderr, "[csr %.3f] ", ctp_now() - ctp_t0);
-#endif
     CtStarJob jb;
     memset(&jb, 0, sizeof(jb));
     jb.V = V;
@@ -3562,13 +3556,6 @@ typedef struct {
     CtFound found;
 } CtScan;
 
-static inline int
-ct_boxes_meet(const float *p, const float *q)
-{
-    /* bitwise: no branch per comparison (their outcomes are hard to predict) */
-    return (p[0] <= q[3]) & (q[0] <= p[3]) & (p[1] <= q[4]) & (q[1] <= p[4]) & (p[2] <= q[5]) & (q[2] <= p[5]);
-}
-
 /* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
  * (the same arithmetic as ct_face_init), its corner indices, and the axis and zero-area flag ct_face_init
  * gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
@@ -3586,19 +3573,12 @@ ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
     F->skip = sc->flags[i] >> 2;
 }
 
-#ifdef CT_PROF
-static long long ctp_visit, ctp_hit, ctp_pop, ctp_leafpair, ctp_load;
-#define CTP(x) (x)++
-#else
-#define CTP(x)
-#endif
 /* A pair of faces (hierarchy positions i, j) whose float32 boxes meet and that share no certified star vertex:
  * the float64 boxes, then the test; returns 0 to go on, 1 to stop (bound reached or out of memory). */
 static int
 ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
     if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
-        CTP(ctp_load);
         ct_face_load(FI, sc, i);
         *have_i = 1;
     }
@@ -3645,7 +3625,6 @@ ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFa
 static inline int
 ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
-    CTP(ctp_hit);
     unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
     if (bits) {
         const int32_t *x = sc->rec[i].fo, *y = sc->rec[j].fo;
@@ -3693,7 +3672,6 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         top--;
         int64_t pi = stack[2 * top], qi = stack[2 * top + 1];
         const CtNode *p = &nodes[pi], *q = &nodes[qi];
-        CTP(ctp_pop);
         if (p->apex >= 0 && p->apex == q->apex) {
             continue;                       /* every pair below is within one certified star */
         }
@@ -3715,7 +3693,6 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                     unsigned mask = ct_block_mask(blk, blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a],
                                                   blk[3 * CT_LEAF + a], blk[4 * CT_LEAF + a], blk[5 * CT_LEAF + a]);
                     mask &= ~((2u << a) - 1);               /* the later positions j > i only */
-                    CTP(ctp_visit);
                     while (mask) {
                         int b = ct_ctz(mask);
                         mask &= mask - 1;
@@ -3735,7 +3712,6 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             continue;
         }
         if (p->count > 0 && q->count > 0) {
-            CTP(ctp_leafpair);
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
             const float *pb = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
@@ -3749,7 +3725,6 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                                               pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]);
                 CtFace FI;
                 uint8_t have_i = 0;
-                CTP(ctp_visit);
                 while (mask) {
                     int b = ct_ctz(mask);
                     mask &= mask - 1;
@@ -4036,9 +4011,6 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.rec = rec;
         pr.flags = flags;
         /* the Morton grid: box centres of the faces, 2^16 cells per axis over their range */
-#ifdef CT_PROF
-        double T0 = ctp_now();
-#endif
         double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int64_t i = 0; i < n; i++) {       /* every vertex: a bound of the box centres */
             const double *p = V + 3 * i;
@@ -4052,29 +4024,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
             pr.gmin[c] = gmin[c];
             pr.scale[c] = span > 0 ? (double)((1u << CT_MORTON_BITS) - 1) / span : 0.0;
         }
-#ifdef CT_PROF
-        double T1 = ctp_now();
-#endif
         pr.pass = 0;
         run_parallel(nt, ct_prep_task, &pr);
-#ifdef CT_PROF
-        double T2 = ctp_now();
-#endif
         if (ct_radix_sort(code, m) < 0) {
             oom = 1;
         }
         else {
-#ifdef CT_PROF
-            T2 = ctp_now() - T2;
-#endif
             pr.pass = 1;
-#ifdef CT_PROF
-            double T2b = ctp_now();
-#endif
             run_parallel(nt, ct_prep_task, &pr);
-#ifdef CT_PROF
-            fprintf(stderr, "[pass1 %.3f] ", ctp_now() - T2b);
-#endif
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
                 failed |= pr.failed[t];
@@ -4082,9 +4039,6 @@ accel_contact_scan(PyObject *self, PyObject *args)
             free(code);                     /* rec holds the face indices in hierarchy order */
             code = NULL;
         }
-#ifdef CT_PROF
-        double T3 = ctp_now();
-#endif
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
             stars = (uint8_t *)malloc(mm);
@@ -4093,14 +4047,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 oom = 1;
             }
         }
-#ifdef CT_PROF
-        double T4 = ctp_now(), T5 = T4;
-#endif
         if (!oom && !failed && m >= 2) {
             ct_build(nodes, box, rec, cert, m);
-#ifdef CT_PROF
-            T5 = ctp_now();
-#endif
             if (cert != NULL) {
                 for (int64_t i = 0; i < m; i++) {
                     unsigned b = 0;
@@ -4158,12 +4106,6 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 }
             }
         }
-#ifdef CT_PROF
-        double T6 = ctp_now();
-        fprintf(stderr, "bbox %.3f prep %.3f (sort %.3f) stars %.3f build %.3f walk %.3f | visit %lld hit %lld pop %lld leafpair %lld load %lld\n",
-                T1 - T0, T3 - T1, T2, T4 - T3, T5 - T4, T6 - T5, ctp_visit, ctp_hit, ctp_pop, ctp_leafpair, ctp_load);
-        ctp_visit = ctp_hit = ctp_pop = ctp_leafpair = ctp_load = 0;
-#endif
         oom |= sc.oom;
         Py_END_ALLOW_THREADS
         if (oom) {
