@@ -3675,7 +3675,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         if (p->apex >= 0 && p->apex == q->apex) {
             continue;                       /* every pair below is within one certified star */
         }
-        if (top + 3 > cap) {
+        if (top + 4 > cap) {
             int64_t *ns = (int64_t *)realloc(stack, 4 * cap * sizeof(int64_t));
             if (ns == NULL) {
                 sc->oom = 1;
@@ -3733,7 +3733,19 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             }
             continue;
         }
-        /* descend the inner node (the larger one when both are inner); push only children that meet */
+        if (p->count == 0 && q->count == 0) {
+            /* both inner: descend both at once (the four child pairs that meet) */
+            const int64_t pc[2] = {p->left, p->right}, qc[2] = {q->left, q->right};
+            for (int u = 1; u >= 0; u--) {
+                for (int w = 1; w >= 0; w--) {
+                    if (ct_nodes_meet(&nodes[pc[u]], &nodes[qc[w]])) {
+                        stack[2 * top] = pc[u]; stack[2 * top + 1] = qc[w]; top++;
+                    }
+                }
+            }
+            continue;
+        }
+        /* descend the inner node; push only children that meet */
         int split_p = q->count > 0 || (p->count == 0 && (p->hi[0] - p->lo[0]) + (p->hi[1] - p->lo[1])
                                         + (p->hi[2] - p->lo[2]) >= (q->hi[0] - q->lo[0])
                                         + (q->hi[1] - q->lo[1]) + (q->hi[2] - q->lo[2]));
