@@ -1720,7 +1720,8 @@ static PyMethodDef accel_methods[] = {
      "contact_scan(vertices, faces, max_pairs, threads=1, star_faces=0) -> (a, b, kind, candidates, tested, exact, "
      "complete, axis, degenerate)\n\nEvery face pair whose closed boxes meet (but those within one certified star "
      "of at least star_faces faces, when star_faces > 0), found by a bounding-volume hierarchy and "
-     "classified (those within a smaller certified star by its certificate); a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
+     "classified (those within a smaller certified star by its certificate); a, b (bytes of int64, a < b) and "
+     "kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
     {NULL, NULL, 0, NULL}
 };
