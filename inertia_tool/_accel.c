@@ -35,6 +35,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* ======================================================================================================
  * 1. buffers
@@ -1717,7 +1720,8 @@ static PyMethodDef accel_methods[] = {
      "contact_scan(vertices, faces, max_pairs, threads=1, star_faces=0) -> (a, b, kind, candidates, tested, exact, "
      "complete, axis, degenerate)\n\nEvery face pair whose closed boxes meet (but those within one certified star "
      "of at least star_faces faces, when star_faces > 0), found by a bounding-volume hierarchy and "
-     "classified; a, b (bytes of int64, a < b) and kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
+     "classified (those within a smaller certified star by its certificate); a, b (bytes of int64, a < b) and "
+     "kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
     {NULL, NULL, 0, NULL}
 };
@@ -2413,7 +2417,11 @@ done:
  * instead of the numpy path's grid: the same set of pairs (those whose closed boxes meet), in another order.
  * With star_faces > 0 the pairs within one certified star (ct_stars; mesh/intersect.py, "Stars", proves they
  * meet only in what they share) are left out on both paths, here also whole node pairs whose faces all hold
- * one certified vertex (CtNode.apex), so a fan cap of k faces costs O(k) instead of k(k - 1)/2 pairs.
+ * one certified vertex (CtNode.apex), so a fan cap of k faces costs O(k) instead of k(k - 1)/2 pairs.  Here
+ * also the star of every vertex of at least CT_STAR_MIN (3) faces is tried: a pair within a small certified
+ * star (fewer than star_faces faces) is still enumerated and counted as a candidate and as tested, as the numpy
+ * path counts it, but decided "none" by the certificate instead of rebuilding and testing both faces (on a
+ * clean mesh that is nearly every candidate pair: the faces sharing a corner).
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
@@ -2591,19 +2599,10 @@ ct_orient3d(const double *a, const double *b, const double *c, const double *d, 
     return ct_orient3d_exact(a, b, c, d, st);
 }
 
+/* Exact sign of orient2d(a, b, c) by expansions (called when the float filter cannot decide). */
 static int
-ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
+ct_orient2d_exact(const double *a, const double *b, const double *c, CtStats *st)
 {
-    double acx = a[0] - c[0], acy = a[1] - c[1], bcx = b[0] - c[0], bcy = b[1] - c[1];
-    double left = acx * bcy, right = acy * bcx;
-    double det = left - right;
-    double perm = fabs(left) + fabs(right);
-    if (perm == 0.0) {
-        return 0;
-    }
-    if (fabs(det) > CONTACT_O2 * perm) {
-        return det > 0 ? 1 : -1;
-    }
     if ((a[0] == b[0] && a[1] == b[1]) || (a[0] == c[0] && a[1] == c[1]) || (b[0] == c[0] && b[1] == c[1])) {
         return 0;                       /* two equal points */
     }
@@ -2624,6 +2623,22 @@ ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
         ct_add_product2(&h, -1.0, p, q);
     }
     return ct_exact_sign(&h, st);
+}
+
+static inline int
+ct_orient2d(const double *a, const double *b, const double *c, CtStats *st)
+{
+    double acx = a[0] - c[0], acy = a[1] - c[1], bcx = b[0] - c[0], bcy = b[1] - c[1];
+    double left = acx * bcy, right = acy * bcx;
+    double det = left - right;
+    double perm = fabs(left) + fabs(right);
+    if (perm == 0.0) {
+        return 0;
+    }
+    if (fabs(det) > CONTACT_O2 * perm) {
+        return det > 0 ? 1 : -1;
+    }
+    return ct_orient2d_exact(a, b, c, st);
 }
 
 enum { CT_NONE = 0, CT_CROSSING = 1, CT_OPPOSITE = 2, CT_CONTACT = 3 };
@@ -2990,16 +3005,17 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
 
 /* ------------------------------------------------------------------------------------------------------
  * contact_scan -- the whole check in one pass: a bounding-volume hierarchy over the face boxes (faces in
- * Morton order of their box centres, sorted by an LSD radix sort; index ranges halved down to leaves of at
- * most CT_LEAF faces), traversed against itself so that every unordered pair of faces whose closed boxes
- * meet is visited exactly once (each pair of leaves once; a child pair is pushed only when its boxes meet),
- * each such pair classified on the spot; only the pairs that meet are kept.
+ * Morton order of their box centres, sorted by an LSD radix sort; ranges of blocks of CT_LEAF positions halved
+ * down to leaves of one block), traversed against itself so that every unordered pair of faces whose closed
+ * boxes meet is visited exactly once (each pair of leaves once; a child pair is pushed only when its boxes
+ * meet; within a leaf pair a face's box is tested against the other leaf's CT_LEAF boxes at once), each such
+ * pair classified on the spot; only the pairs that meet are kept.
  * ------------------------------------------------------------------------------------------------------ */
 
 #ifndef CT_LEAF
-#define CT_LEAF 8
+#define CT_LEAF 16
 #endif
-#define CT_MORTON_BITS 16       /* per axis: a 48-bit code, sorted in four passes of 12 bits */
+#define CT_MORTON_BITS 11       /* per axis: a 33-bit code, sorted in three passes of 11 bits */
 
 static inline double
 ct_min3(double a, double b, double c)
@@ -3021,6 +3037,27 @@ typedef struct {
     int32_t face;
 } CtRec;
 
+/* The next float32 above a finite f (nextafterf(f, +inf) without the library call): from -0 or +0 the
+ * smallest subnormal, else one unit in the last place away from zero for f > 0, toward zero for f < 0;
+ * float32's largest finite value goes to +inf. */
+static inline float
+ct_f32_next_up(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof(u));
+    if ((u & 0x7fffffffu) == 0) {
+        u = 1u;
+    }
+    else if (u >> 31) {
+        u--;
+    }
+    else {
+        u++;
+    }
+    memcpy(&f, &u, sizeof(u));
+    return f;
+}
+
 /* Boxes in the hierarchy are float32, rounded outward (ct_f32_down / ct_f32_up), so they contain the exact
  * boxes: a pair whose float boxes meet may not be a candidate, and ct_visit decides that from the faces'
  * float64 corners; a pair whose exact boxes meet always has meeting float boxes.  Half the memory of double
@@ -3029,14 +3066,14 @@ static inline float
 ct_f32_down(double x)
 {
     float f = (float)x;
-    return (double)f > x ? nextafterf(f, -INFINITY) : f;
+    return (double)f > x ? -ct_f32_next_up(-f) : f;
 }
 
 static inline float
 ct_f32_up(double x)
 {
     float f = (float)x;
-    return (double)f < x ? nextafterf(f, INFINITY) : f;
+    return (double)f < x ? ct_f32_next_up(f) : f;
 }
 
 typedef struct {
@@ -3088,45 +3125,38 @@ ct_spread(uint64_t v)
     return v;
 }
 
-/* order <- 0..m-1 sorted by code (stable LSD radix sort, four passes of 12 bits over the 48-bit codes);
- * code and the scratch arrays are overwritten.  -1 when out of memory. */
+/* key[i] = code << 31 | i (a 33-bit Morton code above a 31-bit face index) sorted by code, stable (LSD radix
+ * sort, three passes of 11 bits over the code): the face indices in hierarchy order are then key & (2^31 - 1).
+ * One 8-byte word per face moves, not a code and an index.  -1 when out of memory. */
 static int
-ct_radix_sort(uint64_t *code, int64_t *order, int64_t m)
+ct_radix_sort(uint64_t *key, int64_t m)
 {
     size_t mm = m > 0 ? (size_t)m : 1;
-    uint64_t *code2 = (uint64_t *)malloc(mm * sizeof(uint64_t));
-    int64_t *order2 = (int64_t *)malloc(mm * sizeof(int64_t));
-    size_t (*count)[4096] = (size_t (*)[4096])calloc(4, sizeof(*count));
-    if (code2 == NULL || order2 == NULL || count == NULL) {
-        free(code2);
-        free(order2);
+    uint64_t *key2 = (uint64_t *)malloc(mm * sizeof(uint64_t));
+    size_t (*count)[2048] = (size_t (*)[2048])calloc(3, sizeof(*count));
+    if (key2 == NULL || count == NULL) {
+        free(key2);
         free(count);
         return -1;
     }
     for (int64_t i = 0; i < m; i++) {
-        order[i] = i;
-        for (int p = 0; p < 4; p++) count[p][(code[i] >> (12 * p)) & 4095]++;
+        for (int p = 0; p < 3; p++) count[p][(key[i] >> (31 + 11 * p)) & 2047]++;
     }
-    uint64_t *src_c = code, *dst_c = code2;
-    int64_t *src_o = order, *dst_o = order2;
-    for (int p = 0; p < 4; p++) {
+    uint64_t *src = key, *dst = key2;
+    for (int p = 0; p < 3; p++) {
         size_t sum = 0;
-        for (int k = 0; k < 4096; k++) {
+        for (int k = 0; k < 2048; k++) {
             size_t c = count[p][k];
             count[p][k] = sum;
             sum += c;
         }
         for (int64_t i = 0; i < m; i++) {
-            size_t at = count[p][(src_c[i] >> (12 * p)) & 4095]++;
-            dst_c[at] = src_c[i];
-            dst_o[at] = src_o[i];
+            dst[count[p][(src[i] >> (31 + 11 * p)) & 2047]++] = src[i];
         }
-        uint64_t *tc = src_c; src_c = dst_c; dst_c = tc;
-        int64_t *to = src_o; src_o = dst_o; dst_o = to;
+        uint64_t *t = src; src = dst; dst = t;
     }
-    /* four passes: the result is back in code / order */
-    free(code2);
-    free(order2);
+    memcpy(key, src, (size_t)m * sizeof(uint64_t));  /* three passes: the result is in key2 */
+    free(key2);
     free(count);
     return 0;
 }
@@ -3147,6 +3177,16 @@ typedef struct {
     int32_t vid, slot;
 } CtEnd;
 
+/* cert[v]: 0 not certified; CT_STAR_SMALL_CERT certified with fewer than star_faces faces (its pairs are
+ * enumerated, counted as candidates and decided by the certificate, not tested one by one: the counts stay
+ * those of mesh/intersect.py, which certifies only stars of star_faces faces or more); CT_STAR_BIG certified
+ * with star_faces faces or more (its pairs are left out, whole node pairs at a time). */
+#define CT_STAR_SMALL_CERT 1
+#define CT_STAR_BIG 2
+/* Stars of fewer faces are not tried (a pair of faces sharing an edge and nothing else is one "fan" of two
+ * faces; three is the smallest star worth certifying). */
+#define CT_STAR_MIN 3
+
 static int
 ct_end_cmp(const void *x, const void *y)
 {
@@ -3154,11 +3194,104 @@ ct_end_cmp(const void *x, const void *y)
     return a->vid != b->vid ? (a->vid < b->vid ? -1 : 1) : (a->slot < b->slot ? -1 : a->slot > b->slot);
 }
 
+/* The ring r_0 .. r_k of the star of v from its k link edges (link[2f], link[2f+1]), walked face to face
+ * through shared link vertices; partner[s] is the other slot holding the vertex of slot s (-1: an end).  1 and
+ * *closed set when the faces form one edge-connected fan of distinct corners, else 0. */
+static int
+ct_star_ring(int32_t v, const int32_t *link, int64_t k, const int32_t *partner, int64_t free_slot, int64_t n_free,
+             int32_t *ring, int *closed)
+{
+    for (int64_t s = 0; s < 2 * k; s++) {
+        if (link[s] == v) return 0;                        /* a repeated corner */
+    }
+    for (int64_t f = 0; f < k; f++) {
+        if (link[2 * f] == link[2 * f + 1]) return 0;
+    }
+    if (n_free != 0 && n_free != 2) return 0;
+    *closed = n_free == 0;
+    int64_t start = *closed ? 0 : free_slot, len = 0, slot = start;
+    ring[len++] = link[start];
+    for (int64_t steps = 0; steps < k; steps++) {          /* walk face to face through shared link vertices */
+        int64_t out = slot ^ 1;                            /* the face's other end */
+        ring[len++] = link[out];
+        int32_t nx = partner[out];
+        if (nx < 0 || nx == start) break;
+        slot = nx;
+    }
+    if (len != k + 1) return 0;                            /* not one fan (several components) */
+    if (*closed && ring[k] != ring[0]) return 0;
+    return 1;
+}
+
+/* 1 when the fan of v with ring r_0 .. r_k turns once (closed) or less than once (open) round v, without
+ * overlap, in the projection along some coordinate axis (every projected triangle of one strict orientation). */
+static int
+ct_star_turns(const double *V, int32_t v, const int32_t *ring, int64_t k, int closed)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
+        CtStats st = {0, 0};
+        double c[2] = {V[3 * (size_t)v + kx], V[3 * (size_t)v + ky]};
+        double r0[2] = {V[3 * (size_t)ring[0] + kx], V[3 * (size_t)ring[0] + ky]};
+        int sign = 0, count = 0, good = 1;
+        for (int64_t i = 0; i < k && good; i++) {
+            double p[2] = {V[3 * (size_t)ring[i] + kx], V[3 * (size_t)ring[i] + ky]};
+            double q[2] = {V[3 * (size_t)ring[i + 1] + kx], V[3 * (size_t)ring[i + 1] + ky]};
+            int o = ct_orient2d(c, p, q, &st);
+            if (o == 0 || (sign != 0 && o != sign)) {
+                good = 0;
+                break;
+            }
+            sign = o;
+            if (sign * ct_orient2d(c, p, r0, &st) > 0 && sign * ct_orient2d(c, r0, q, &st) >= 0) count++;
+        }
+        if (good && !st.failed && count == (closed ? 1 : 0)) return 1;
+    }
+    return 0;
+}
+
+/* Stars of at most this many faces are matched on the stack by comparing link vertices pairwise (no sort). */
+#define CT_STAR_SMALL 32
+
 /* 1 when the star of v (link edges link[0 .. k-1], pairs of vertex ids) is certified, 0 when not, -1 when out
  * of memory. */
 static int
 ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
 {
+    int closed = 0;
+    if (k <= CT_STAR_SMALL) {                              /* the common case: everything on the stack */
+        int32_t partner[2 * CT_STAR_SMALL], ring[CT_STAR_SMALL + 1];
+        uint64_t ends[2 * CT_STAR_SMALL];                  /* vertex id << 32 | slot, insertion-sorted */
+        int64_t free_slot = -1, n_free = 0;
+        for (int64_t s = 0; s < 2 * k; s++) {
+            uint64_t key = (uint64_t)(uint32_t)link[s] << 32 | (uint64_t)s;
+            int64_t t = s;
+            while (t > 0 && ends[t - 1] > key) {
+                ends[t] = ends[t - 1];
+                t--;
+            }
+            ends[t] = key;
+            partner[s] = -1;
+        }
+        for (int64_t s = 0; s < 2 * k;) {
+            int64_t e = s + 1;
+            while (e < 2 * k && ends[e] >> 32 == ends[s] >> 32) e++;
+            if (e - s > 2) return 0;                       /* a link vertex in three faces or more */
+            if (e - s == 2) {
+                partner[ends[s] & 0xffffffffu] = (int32_t)(ends[s + 1] & 0xffffffffu);
+                partner[ends[s + 1] & 0xffffffffu] = (int32_t)(ends[s] & 0xffffffffu);
+            }
+            else {
+                n_free++;
+                if (free_slot < 0 || (int64_t)(ends[s] & 0xffffffffu) < free_slot) {
+                    free_slot = (int64_t)(ends[s] & 0xffffffffu);
+                }
+            }
+            s = e;
+        }
+        if (!ct_star_ring(v, link, k, partner, free_slot, n_free, ring, &closed)) return 0;
+        return ct_star_turns(V, v, ring, k, closed);
+    }
     CtEnd *ends = (CtEnd *)malloc((size_t)(2 * k) * sizeof(CtEnd));
     int32_t *partner = (int32_t *)malloc((size_t)(2 * k) * sizeof(int32_t));
     int32_t *ring = (int32_t *)malloc((size_t)(k + 1) * sizeof(int32_t));
@@ -3171,10 +3304,6 @@ ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
         ends[s].vid = link[s];
         ends[s].slot = (int32_t)s;
         partner[s] = -1;
-        if (link[s] == v) goto done;                       /* a repeated corner */
-    }
-    for (int64_t f = 0; f < k; f++) {
-        if (link[2 * f] == link[2 * f + 1]) goto done;
     }
     qsort(ends, (size_t)(2 * k), sizeof(CtEnd), ct_end_cmp);
     int64_t free_slot = -1, n_free = 0;
@@ -3192,37 +3321,8 @@ ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
         }
         s = e;
     }
-    if (n_free != 0 && n_free != 2) goto done;
-    int closed = n_free == 0;
-    int64_t start = closed ? 0 : free_slot, len = 0, slot = start;
-    ring[len++] = link[start];
-    for (int64_t steps = 0; steps < k; steps++) {          /* walk face to face through shared link vertices */
-        int64_t out = slot ^ 1;                            /* the face's other end */
-        ring[len++] = link[out];
-        int32_t nx = partner[out];
-        if (nx < 0 || nx == start) break;
-        slot = nx;
-    }
-    if (len != k + 1) goto done;                           /* not one fan (several components) */
-    if (closed && ring[k] != ring[0]) goto done;
-    for (int axis = 0; axis < 3 && !ok; axis++) {
-        int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
-        CtStats st = {0, 0};
-        double c[2] = {V[3 * (size_t)v + kx], V[3 * (size_t)v + ky]};
-        double r0[2] = {V[3 * (size_t)ring[0] + kx], V[3 * (size_t)ring[0] + ky]};
-        int sign = 0, count = 0, good = 1;
-        for (int64_t i = 0; i < k && good; i++) {
-            double p[2] = {V[3 * (size_t)ring[i] + kx], V[3 * (size_t)ring[i] + ky]};
-            double q[2] = {V[3 * (size_t)ring[i + 1] + kx], V[3 * (size_t)ring[i + 1] + ky]};
-            int o = ct_orient2d(c, p, q, &st);
-            if (o == 0 || (sign != 0 && o != sign)) {
-                good = 0;
-                break;
-            }
-            sign = o;
-            if (sign * ct_orient2d(c, p, r0, &st) > 0 && sign * ct_orient2d(c, r0, q, &st) >= 0) count++;
-        }
-        ok = good && !st.failed && count == (closed ? 1 : 0);
+    if (ct_star_ring(v, link, k, partner, free_slot, n_free, ring, &closed)) {
+        ok = ct_star_turns(V, v, ring, k, closed);
     }
 done:
     free(ends);
@@ -3231,9 +3331,43 @@ done:
     return ok;
 }
 
-/* cert[v] <- 1 for every certified vertex (faces F, m of them, n vertices); 0 or -1 when out of memory. */
+/* The stars of vertices ranges of ct_stars, certified on threads (each vertex's result is its own). */
+typedef struct {
+    const double *V;
+    const int64_t *off;         /* start of each kept vertex's link range, -1 for the others */
+    const int32_t *link;
+    int64_t n, total, min_faces, big_faces;
+    uint8_t *cert;
+    int oom[MAX_THREADS];
+} CtStarJob;
+
+static void
+ct_star_task(void *ctx, int t, int nt)
+{
+    CtStarJob *jb = (CtStarJob *)ctx;
+    int64_t v0 = (int64_t)part_start((size_t)jb->n, t, nt), v1 = (int64_t)part_start((size_t)jb->n, t + 1, nt);
+    int64_t v = v0;
+    while (v < v1 && jb->off[v] < 0) v++;
+    while (v < v1) {
+        /* the range ends where the next kept vertex's starts: ranges were laid out in vertex order */
+        int64_t w = v + 1;
+        while (w < jb->n && jb->off[w] < 0) w++;
+        int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total;
+        int r = ct_star_certify(jb->V, (int32_t)v, jb->link + 2 * s, e - s);
+        if (r < 0) {
+            jb->oom[t] = 1;
+            return;
+        }
+        jb->cert[v] = r ? (e - s >= jb->big_faces ? CT_STAR_BIG : CT_STAR_SMALL_CERT) : 0;
+        v = w;
+    }
+}
+
+/* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
+ * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory. */
 static int
-ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, uint8_t *cert)
+ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
+         uint8_t *cert, int threads)
 {
     memset(cert, 0, (size_t)n);
     int64_t *off = (int64_t *)calloc((size_t)(n > 0 ? n : 1), sizeof(int64_t));
@@ -3263,17 +3397,20 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
             link[2 * at + 1] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 2) % 3));
         }
     }
+    CtStarJob jb;
+    memset(&jb, 0, sizeof(jb));
+    jb.V = V;
+    jb.off = off;
+    jb.link = link;
+    jb.n = n;
+    jb.total = total;
+    jb.min_faces = min_faces;
+    jb.big_faces = big_faces;
+    jb.cert = cert;
+    run_parallel(thread_count(threads, (size_t)n, 20000), ct_star_task, &jb);
     int rc = 0;
-    for (int64_t v = 0; v < n && rc == 0; v++) {           /* off[v] is now the start of v's range */
-        if (off[v] < 0) continue;
-        int64_t s = off[v], e;
-        /* the range ends where the next kept vertex's starts: ranges were laid out in vertex order */
-        int64_t w = v + 1;
-        while (w < n && off[w] < 0) w++;
-        e = w < n ? off[w] : total;
-        int r = ct_star_certify(V, (int32_t)v, link + 2 * s, e - s);
-        if (r < 0) rc = -1;
-        else cert[v] = (uint8_t)r;
+    for (int t = 0; t < MAX_THREADS; t++) {
+        if (jb.oom[t]) rc = -1;
     }
     free(link);
     free(off);
@@ -3287,7 +3424,7 @@ ct_leaf_apex(const CtRec *rec, const uint8_t *cert, int64_t s, int64_t count)
     if (cert == NULL) return -1;
     for (int c = 0; c < 3; c++) {
         int32_t x = rec[s].fo[c];
-        if (!cert[x]) continue;
+        if (cert[x] != CT_STAR_BIG) continue;
         int all = 1;
         for (int64_t i = s + 1; i < s + count && all; i++) {
             all = rec[i].fo[0] == x || rec[i].fo[1] == x || rec[i].fo[2] == x;
@@ -3297,9 +3434,64 @@ ct_leaf_apex(const CtRec *rec, const uint8_t *cert, int64_t s, int64_t count)
     return -1;
 }
 
-/* Builds the hierarchy over the boxes BOX (lo, hi: 6 floats per position, already in hierarchy order):
- * the tree halving index ranges (leaves of at most CT_LEAF faces), node boxes from the leaves up.  Returns
- * the node count. */
+/* Boxes of the faces in blocks of CT_LEAF hierarchy positions, coordinate by coordinate (structure of arrays):
+ * block b holds lo x, lo y, lo z, hi x, hi y, hi z of positions CT_LEAF b .. CT_LEAF b + CT_LEAF - 1, CT_LEAF
+ * floats each; positions past the last face are empty boxes (lo +inf, hi -inf) that meet nothing.  One leaf
+ * of the hierarchy is one block, so a face is tested against a whole leaf's boxes at once (ct_block_mask). */
+#define CT_BLOCK (6 * CT_LEAF)
+
+static inline float
+ct_box_at(const float *BOX, int64_t i, int c)     /* c 0..2: lo, 3..5: hi */
+{
+    return BOX[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF];
+}
+
+static inline int
+ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_ctz(x);
+#else
+    int k = 0;
+    while (!(x & 1u)) {
+        x >>= 1;
+        k++;
+    }
+    return k;
+#endif
+}
+
+/* Bit j set when box j of the block meets the box (lx, ly, lz)-(hx, hy, hz) (closed boxes). */
+static inline unsigned
+ct_block_mask(const float *blk, float lx, float ly, float lz, float hx, float hy, float hz)
+{
+#if defined(__SSE2__) && CT_LEAF % 4 == 0
+    unsigned mask = 0;
+    for (int half = 0; half < CT_LEAF / 4; half++) {
+        const float *b = blk + 4 * half;
+        __m128 ok = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b), _mm_set1_ps(hx)),
+                               _mm_cmple_ps(_mm_set1_ps(lx), _mm_loadu_ps(b + 3 * CT_LEAF)));
+        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + CT_LEAF), _mm_set1_ps(hy)),
+                                       _mm_cmple_ps(_mm_set1_ps(ly), _mm_loadu_ps(b + 4 * CT_LEAF))));
+        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + 2 * CT_LEAF), _mm_set1_ps(hz)),
+                                       _mm_cmple_ps(_mm_set1_ps(lz), _mm_loadu_ps(b + 5 * CT_LEAF))));
+        mask |= (unsigned)_mm_movemask_ps(ok) << (4 * half);
+    }
+    return mask;
+#else
+    unsigned mask = 0;
+    for (int j = 0; j < CT_LEAF; j++) {
+        mask |= (unsigned)((blk[j] <= hx) & (lx <= blk[3 * CT_LEAF + j]) & (blk[CT_LEAF + j] <= hy)
+                           & (ly <= blk[4 * CT_LEAF + j]) & (blk[2 * CT_LEAF + j] <= hz)
+                           & (lz <= blk[5 * CT_LEAF + j])) << j;
+    }
+    return mask;
+#endif
+}
+
+/* Builds the hierarchy over the boxes BOX (blocks above, already in hierarchy order): the tree halving block
+ * ranges (a leaf is one block of at most CT_LEAF faces), node boxes from the leaves up.  Returns the node
+ * count. */
 static int64_t
 ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert, int64_t m)
 {
@@ -3311,7 +3503,8 @@ ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert,
         if (nd->count <= CT_LEAF) {
             continue;
         }
-        int64_t s = nd->start, e = s + nd->count, half = s + (e - s) / 2;
+        int64_t s = nd->start, e = s + nd->count, blocks = (nd->count + CT_LEAF - 1) / CT_LEAF;
+        int64_t half = s + CT_LEAF * (blocks / 2);     /* starts stay multiples of CT_LEAF */
         int64_t l = n_nodes++, r = n_nodes++;
         nodes[l].start = s;
         nodes[l].count = half - s;
@@ -3332,8 +3525,9 @@ ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert,
             }
             for (int64_t i = nd->start; i < nd->start + nd->count; i++) {
                 for (int c = 0; c < 3; c++) {
-                    if (BOX[6 * i + c] < nd->lo[c]) nd->lo[c] = BOX[6 * i + c];
-                    if (BOX[6 * i + 3 + c] > nd->hi[c]) nd->hi[c] = BOX[6 * i + 3 + c];
+                    float lo = ct_box_at(BOX, i, c), hi = ct_box_at(BOX, i, 3 + c);
+                    if (lo < nd->lo[c]) nd->lo[c] = lo;
+                    if (hi > nd->hi[c]) nd->hi[c] = hi;
                 }
             }
         }
@@ -3350,25 +3544,18 @@ ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert,
 }
 
 typedef struct {
-    const float *BOX;           /* face boxes (lo, hi) rounded outward to float32, in hierarchy order */
+    const float *BOX;           /* face boxes rounded outward to float32, in blocks of CT_LEAF (ct_block_mask) */
     const CtRec *rec;           /* corner indices and face index, in hierarchy order */
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
     const double *V;            /* vertices (n, 3) */
     const CtNode *nodes;
-    const uint8_t *cert;        /* certified star vertices (ct_stars), NULL without pruning */
+    const uint8_t *stars;       /* certified corners per position (ct_visit), NULL without pruning */
     long long max_pairs;        /* < 0: no bound */
     long long candidates, tested;
     long exact;
     int complete, oom;
     CtFound found;
 } CtScan;
-
-static inline int
-ct_boxes_meet(const float *p, const float *q)
-{
-    /* bitwise: no branch per comparison (their outcomes are hard to predict) */
-    return (p[0] <= q[3]) & (q[0] <= p[3]) & (p[1] <= q[4]) & (q[1] <= p[4]) & (p[2] <= q[5]) & (q[2] <= p[5]);
-}
 
 /* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
  * (the same arithmetic as ct_face_init), its corner indices, and the axis and zero-area flag ct_face_init
@@ -3387,18 +3574,11 @@ ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
     F->skip = sc->flags[i] >> 2;
 }
 
-/* One candidate pair (hierarchy positions i, j); returns 0 to go on, 1 to stop (bound reached or out of
- * memory). */
+/* A pair of faces (hierarchy positions i, j) whose float32 boxes meet and that share no certified star vertex:
+ * the float64 boxes, then the test; returns 0 to go on, 1 to stop (bound reached or out of memory). */
 static int
-ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
+ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
-    if (!ct_boxes_meet(sc->BOX + 6 * i, sc->BOX + 6 * j)) return 0;
-    if (sc->cert != NULL) {                 /* both in one certified star: they meet only in what they share */
-        const int32_t *x = sc->rec[i].fo, *y = sc->rec[j].fo;
-        for (int c = 0; c < 3; c++) {
-            if (sc->cert[x[c]] && (x[c] == y[0] || x[c] == y[1] || x[c] == y[2])) return 0;
-        }
-    }
     if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
         ct_face_load(FI, sc, i);
         *have_i = 1;
@@ -3437,6 +3617,36 @@ ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *
     return 0;
 }
 
+/* A pair of faces (hierarchy positions i, j) whose float32 boxes meet; returns 0 to go on, 1 to stop (bound
+ * reached or out of memory).  Two faces of one certified star meet only in what they share (ct_stars): a
+ * big star's pair is left out (not a candidate on either twin); a small star's is a candidate (the closed
+ * boxes share the vertex) of two faces of nonzero area (each projects to a triangle of nonzero area), decided
+ * "none" by the certificate and counted as tested, without rebuilding either face.  stars[i] says which
+ * corners of the face at position i are certified (bit c: small star, bit 3 + c: big star). */
+static inline int
+ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
+{
+    unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
+    if (bits) {
+        const int32_t *x = sc->rec[i].fo, *y = sc->rec[j].fo;
+        unsigned shared = 0;                /* bit c: corner c of face i is a corner of face j */
+        for (int c = 0; c < 3; c++) {
+            shared |= (unsigned)((x[c] == y[0]) | (x[c] == y[1]) | (x[c] == y[2])) << c;
+        }
+        if ((bits >> 3) & shared) return 0;
+        if (bits & shared) {
+            if (sc->max_pairs >= 0 && sc->candidates >= sc->max_pairs) {
+                sc->complete = 0;
+                return 1;
+            }
+            sc->candidates++;
+            sc->tested++;
+            return 0;
+        }
+    }
+    return ct_test_pair(sc, i, j, FI, have_i, FJ, have_j);
+}
+
 static inline int
 ct_nodes_meet(const CtNode *p, const CtNode *q)
 {
@@ -3466,7 +3676,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         if (p->apex >= 0 && p->apex == q->apex) {
             continue;                       /* every pair below is within one certified star */
         }
-        if (top + 3 > cap) {
+        if (top + 4 > cap) {
             int64_t *ns = (int64_t *)realloc(stack, 4 * cap * sizeof(int64_t));
             if (ns == NULL) {
                 sc->oom = 1;
@@ -3479,10 +3689,17 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             if (p->count > 0) {
                 CtFace leaf[CT_LEAF];
                 uint8_t have[CT_LEAF] = {0};
-                for (int64_t i = p->start; i < p->start + p->count; i++) {
-                    for (int64_t j = i + 1; j < p->start + p->count; j++) {
-                        int64_t a = i - p->start, b = j - p->start;
-                        if (ct_visit(sc, i, j, &leaf[a], &have[a], &leaf[b], &have[b])) goto out;
+                const float *blk = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
+                for (int a = 0; a + 1 < p->count; a++) {
+                    unsigned mask = ct_block_mask(blk, blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a],
+                                                  blk[3 * CT_LEAF + a], blk[4 * CT_LEAF + a], blk[5 * CT_LEAF + a]);
+                    mask &= ~((2u << a) - 1);               /* the later positions j > i only */
+                    while (mask) {
+                        int b = ct_ctz(mask);
+                        mask &= mask - 1;
+                        if (ct_visit(sc, p->start + a, p->start + b, &leaf[a], &have[a], &leaf[b], &have[b])) {
+                            goto out;
+                        }
                     }
                 }
             }
@@ -3498,22 +3715,38 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         if (p->count > 0 && q->count > 0) {
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
-            for (int64_t i = p->start; i < p->start + p->count; i++) {
-                const float *bi = sc->BOX + 6 * i;      /* face i against q's box first */
-                if (!((bi[0] <= q->hi[0]) & (q->lo[0] <= bi[3]) & (bi[1] <= q->hi[1]) & (q->lo[1] <= bi[4])
-                      & (bi[2] <= q->hi[2]) & (q->lo[2] <= bi[5]))) {
-                    continue;
-                }
+            const float *pb = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
+            const float *qb = sc->BOX + CT_BLOCK * (q->start / CT_LEAF);
+            /* p's faces against q's box first, then each that meets it against q's faces */
+            unsigned pmask = ct_block_mask(pb, q->lo[0], q->lo[1], q->lo[2], q->hi[0], q->hi[1], q->hi[2]);
+            while (pmask) {
+                int a = ct_ctz(pmask);
+                pmask &= pmask - 1;
+                unsigned mask = ct_block_mask(qb, pb[a], pb[CT_LEAF + a], pb[2 * CT_LEAF + a], pb[3 * CT_LEAF + a],
+                                              pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]);
                 CtFace FI;
                 uint8_t have_i = 0;
-                for (int64_t j = q->start; j < q->start + q->count; j++) {
-                    int64_t b = j - q->start;
-                    if (ct_visit(sc, i, j, &FI, &have_i, &leaf[b], &have[b])) goto out;
+                while (mask) {
+                    int b = ct_ctz(mask);
+                    mask &= mask - 1;
+                    if (ct_visit(sc, p->start + a, q->start + b, &FI, &have_i, &leaf[b], &have[b])) goto out;
                 }
             }
             continue;
         }
-        /* descend the inner node (the larger one when both are inner); push only children that meet */
+        if (p->count == 0 && q->count == 0) {
+            /* both inner: descend both at once (the four child pairs that meet) */
+            const int64_t pc[2] = {p->left, p->right}, qc[2] = {q->left, q->right};
+            for (int u = 1; u >= 0; u--) {
+                for (int w = 1; w >= 0; w--) {
+                    if (ct_nodes_meet(&nodes[pc[u]], &nodes[qc[w]])) {
+                        stack[2 * top] = pc[u]; stack[2 * top + 1] = qc[w]; top++;
+                    }
+                }
+            }
+            continue;
+        }
+        /* descend the inner node; push only children that meet */
         int split_p = q->count > 0 || (p->count == 0 && (p->hi[0] - p->lo[0]) + (p->hi[1] - p->lo[1])
                                         + (p->hi[2] - p->lo[2]) >= (q->hi[0] - q->lo[0])
                                         + (q->hi[1] - q->lo[1]) + (q->hi[2] - q->lo[2]));
@@ -3603,6 +3836,18 @@ ct_tasks(const CtNode *nodes, int64_t *tasks)
     return n;
 }
 
+#define CT_AHEAD 32
+
+static inline void
+ct_prefetch(const void *p)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(p);
+#else
+    (void)p;
+#endif
+}
+
 /* Per-face preparation, split over threads by position: Morton codes (pass 0), then the faces and boxes in
  * hierarchy order (pass 1). */
 typedef struct {
@@ -3611,8 +3856,7 @@ typedef struct {
     const double *V;
     const void *F;
     int size;
-    const int64_t *order;
-    uint64_t *code;
+    uint64_t *code;             /* Morton code << 31 | face index; sorted between the passes */
     double gmin[3], scale[3];
     int8_t *axis;
     uint8_t *skip;
@@ -3641,13 +3885,22 @@ ct_prep_task(void *ctx, int t, int nt)
                 if (k > (1u << CT_MORTON_BITS) - 1) k = (1u << CT_MORTON_BITS) - 1;
                 code |= ct_spread(k) << c;
             }
-            pr->code[f] = code;
+            pr->code[f] = code << 31 | (uint64_t)f;
         }
         return;
     }
     CtStats st = {0, 0};
     for (int64_t i = s; i < e; i++) {
-        int64_t f = pr->order[i];
+        /* the faces are read in hierarchy order, i.e. at random in the caller's: their rows are fetched
+         * CT_AHEAD positions ahead, their corners CT_AHEAD / 2 ahead (from the rows fetched by then) */
+        if (i + CT_AHEAD < e) {
+            ct_prefetch((const char *)pr->F + (size_t)pr->size * 3 * (size_t)(pr->code[i + CT_AHEAD] & 0x7fffffff));
+        }
+        if (i + CT_AHEAD / 2 < e) {
+            size_t g = 3 * (size_t)(pr->code[i + CT_AHEAD / 2] & 0x7fffffff);
+            for (int k = 0; k < 3; k++) ct_prefetch(pr->V + 3 * index_at(pr->F, pr->size, g + (size_t)k));
+        }
+        int64_t f = (int64_t)(pr->code[i] & 0x7fffffff);
         CtFace F;
         const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
         const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
@@ -3661,8 +3914,9 @@ ct_prep_task(void *ctx, int t, int nt)
         }
         pr->rec[i].face = (int32_t)f;
         for (int c = 0; c < 3; c++) {
-            pr->box[6 * i + c] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
-            pr->box[6 * i + 3 + c] = ct_f32_up(ct_max3(p0[c], p1[c], p2[c]));
+            float *blk = pr->box + CT_BLOCK * (i / CT_LEAF);
+            blk[c * CT_LEAF + i % CT_LEAF] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
+            blk[(3 + c) * CT_LEAF + i % CT_LEAF] = ct_f32_up(ct_max3(p0[c], p1[c], p2[c]));
         }
     }
     pr->exact[t] += st.exact;
@@ -3686,7 +3940,6 @@ accel_contact_scan(PyObject *self, PyObject *args)
     int got = 0;
     PyObject *result = NULL;
     CtNode *nodes = NULL;
-    int64_t *order = NULL;
     uint64_t *code = NULL;
     float *box = NULL;
     CtRec *rec = NULL;
@@ -3694,6 +3947,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
     int8_t *axis_out = NULL;
     uint8_t *skip_out = NULL;
     uint8_t *cert = NULL;
+    uint8_t *stars = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
     for (; got < 2; got++) {
@@ -3736,17 +3990,23 @@ accel_contact_scan(PyObject *self, PyObject *args)
         size_t mm = m > 0 ? (size_t)m : 1;
         /* leaves hold at least (CT_LEAF + 1) / 2 faces (but the root may be a smaller leaf) */
         nodes = (CtNode *)malloc((2 * mm / ((CT_LEAF + 1) / 2) + 2) * sizeof(CtNode));
-        order = (int64_t *)malloc(mm * sizeof(int64_t));
         code = (uint64_t *)malloc(mm * sizeof(uint64_t));
-        box = (float *)malloc(mm * 6 * sizeof(float));
+        size_t n_blocks = (mm + CT_LEAF - 1) / CT_LEAF;
+        box = (float *)malloc(n_blocks * CT_BLOCK * sizeof(float));
         rec = (CtRec *)malloc(mm * sizeof(CtRec));
         flags = (uint8_t *)malloc(mm);
         axis_out = (int8_t *)malloc(mm);
         skip_out = (uint8_t *)malloc(mm);
-        if (nodes == NULL || order == NULL || code == NULL || box == NULL || rec == NULL || flags == NULL
+        if (nodes == NULL || code == NULL || box == NULL || rec == NULL || flags == NULL
             || axis_out == NULL || skip_out == NULL) {
             PyErr_NoMemory();
             goto done;
+        }
+        for (size_t i = (size_t)m; i < n_blocks * CT_LEAF; i++) {     /* the last block's empty boxes */
+            for (int c = 0; c < 3; c++) {
+                box[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = INFINITY;
+                box[CT_BLOCK * (i / CT_LEAF) + (3 + c) * CT_LEAF + i % CT_LEAF] = -INFINITY;
+            }
         }
         int oom = 0, failed = 0;
         Py_BEGIN_ALLOW_THREADS
@@ -3758,7 +4018,6 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.F = F;
         pr.size = fsize;
         pr.code = code;
-        pr.order = order;
         pr.axis = axis_out;
         pr.skip = skip_out;
         pr.box = box;
@@ -3780,30 +4039,40 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         pr.pass = 0;
         run_parallel(nt, ct_prep_task, &pr);
-        if (ct_radix_sort(code, order, m) < 0) {
+        if (ct_radix_sort(code, m) < 0) {
             oom = 1;
         }
         else {
-            free(code);                     /* the sorted codes are not needed */
-            code = NULL;
             pr.pass = 1;
             run_parallel(nt, ct_prep_task, &pr);
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
                 failed |= pr.failed[t];
             }
-            free(order);                    /* rec holds the face indices in hierarchy order */
-            order = NULL;
+            free(code);                     /* rec holds the face indices in hierarchy order */
+            code = NULL;
         }
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
-            if (cert == NULL || ct_stars(V, n, F, fsize, m, star_faces, cert) < 0) {
+            stars = (uint8_t *)malloc(mm);
+            if (cert == NULL || stars == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
+                                         star_faces, cert, nt) < 0) {
                 oom = 1;
             }
         }
         if (!oom && !failed && m >= 2) {
             ct_build(nodes, box, rec, cert, m);
-            sc.cert = cert;
+            if (cert != NULL) {
+                for (int64_t i = 0; i < m; i++) {
+                    unsigned b = 0;
+                    for (int c = 0; c < 3; c++) {
+                        uint8_t k = cert[rec[i].fo[c]];
+                        b |= k == CT_STAR_BIG ? 8u << c : k == CT_STAR_SMALL_CERT ? 1u << c : 0u;
+                    }
+                    stars[i] = (uint8_t)b;
+                }
+            }
+            sc.stars = cert != NULL ? stars : NULL;
             sc.BOX = box;
             sc.rec = rec;
             sc.flags = flags;
@@ -3881,7 +4150,6 @@ done:
         PyBuffer_Release(&views[i]);
     }
     free(nodes);
-    free(order);
     free(code);
     free(box);
     free(rec);
@@ -3889,6 +4157,7 @@ done:
     free(axis_out);
     free(skip_out);
     free(cert);
+    free(stars);
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);
