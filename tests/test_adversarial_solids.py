@@ -211,10 +211,11 @@ def _far_thin_tetrahedron():
                   "a unit box and a closed tetrahedron 50 m across and 1e-9 m thin, 50 m away (volume 4e-7 m³)")
 
 
-def _generated(kind, index, seed=21):
-    """Case ``index`` of ``benchmarks/bench_adversarial.py --seed`` ``seed`` (its kind must be ``kind``)."""
+def _generated(kind, index, seed=21, n_kinds=15):
+    """Case ``index`` of ``benchmarks/bench_adversarial.py --seed`` ``seed`` when the table had ``n_kinds`` kinds
+    (its kind must be ``kind``; the case itself depends only on the kind, the seed and the index)."""
     case = S.make_case(kind, np.random.default_rng([seed, index]))
-    assert S.KINDS[index % len(S.KINDS)] == kind
+    assert S.KINDS[index % n_kinds] == kind
     return case
 
 

@@ -17,6 +17,15 @@ R1 *Bodies are edge-connected* (:func:`~.checks.shell_labels`).  Faces that meet
    different shells: a non-manifold vertex is split into its fans of edge-connected faces before anything
    decides what is one body.  Reason: two bodies that share a corner (or are welded there) are two bodies,
    and must be tested against each other for overlap.
+R1b *Bodies welded along their crossing are still separate bodies* (:func:`welded_bodies`).  Where closed
+   surfaces cross exactly along edges of both tessellations and the file shares those edges' vertices (an STL
+   is welded bit-exactly on reading), each crossing edge is used by four faces, two of each body, and edge
+   connectivity would make the bodies one shell whose summed integral counts their common volume twice (the
+   edges still balance, so nothing else notices).  A shell with non-manifold edges is split into the pieces
+   joined through its manifold edges (used by exactly two faces) when every piece is closed and balanced on
+   its own; the face pairs of different pieces along a shared non-manifold edge are contacts for R4 (their
+   points decide crossing, nesting or touching; :func:`touching_relations`).  Reason: a body is a closed
+   surface, and the faces meeting at a non-manifold edge say nothing about which of them close together.
 R2 *Flat pieces carry no volume* (``tolerances.FLAT_RTOL``).  A closed shell whose |volume| is at most
    ``FLAT_RTOL · diagonal³`` (a face and its reverse, a zero-thickness wall, a collapsed sliver) contributes
    nothing to the integrals, so it is left out with a note and the answer stays exact (:func:`negligible_flat`:
@@ -78,6 +87,7 @@ R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only aft
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING
 
@@ -94,7 +104,7 @@ if TYPE_CHECKING:
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
            "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
            "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
-           "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
+           "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -626,3 +636,162 @@ def coincident_message(found: Coincident) -> str:
                      f"exact inverted cop{'ies' if n > 1 else 'y'} ({found.cancelled_faces:,} faces in all): each "
                      "pair cancels (winding number 0 everywhere, no volume) and is left out")
     return "; ".join(parts) + near
+
+
+@frozen_value
+class WeldedBodies:
+    """R1b: shells split at their non-manifold edges into the bodies welded there.
+
+    Attributes
+    ----------
+    labels : (m,) int
+        Shell of each face after the split, ``0..n_shells-1``.
+    n_shells : int
+    split : int
+        Shells that were split (0: the labels are the ones given).
+    ambiguous : int
+        Shells with non-manifold edges that could not be split into closed bodies (kept whole).
+    contact : (c, 2) int
+        Face pairs of different shells that share a non-manifold edge by index (R4 tests their points).
+    """
+
+    labels: np.ndarray
+    n_shells: int
+    split: int
+    ambiguous: int
+    contact: np.ndarray
+
+
+def _crossing_pairs_at_edges(vertices: np.ndarray, faces: np.ndarray, at: np.ndarray, edge_faces: np.ndarray,
+                             lo: np.ndarray, hi: np.ndarray, forward: np.ndarray) -> np.ndarray:
+    """R1b: at each non-manifold edge, the faces that continue one body's surface through the others, (p, 2).
+
+    Around the edge ``lo → hi`` the faces are sorted by angle; crossing a face wound along the edge (``forward``)
+    counter-clockwise leaves a solid (the winding number drops by one), crossing one wound against it enters one.
+    Read from a sector of the smallest winding number, the faces form a sequence of entries and exits, and the
+    first solid entered is the first left: entries and exits are paired first in, first out, so that bodies whose
+    surfaces pass through each other stay whole (paired last in, first out they would read as the boundary of the
+    union around the boundary of the common part, a body inside a body).  An edge where two faces lie at the same
+    angle facing the same way (coplanar faces of two bodies overlapping: the order is not defined) gives no pairs;
+    two at the same angle facing opposite ways (bodies face to face) are read leaving one before entering the other.
+    """
+    out = []
+    groups = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
+    for g0, g1 in zip(groups, np.r_[groups[1:], len(at)]):         # bounded by the non-manifold edges
+        fs, fw = edge_faces[g0:g1], forward[g0:g1]
+        a, b = vertices[lo[g0]], vertices[hi[g0]]
+        d = (b - a) / np.linalg.norm(b - a)
+        third = np.array([[c for c in faces[k] if c != lo[g0] and c != hi[g0]][0] for k in fs])
+        w = vertices[third] - a
+        w -= np.outer(w @ d, d)
+        u = w[0] / np.linalg.norm(w[0])
+        angle = np.arctan2(w @ np.cross(d, u), w @ u) % (2 * np.pi)
+        order = np.lexsort((~fw, angle))                   # at one angle, a face leaving a solid first
+        ang = angle[order]
+        tied = np.diff(np.r_[ang, ang[0] + 2 * np.pi]) <= 1e-9
+        if np.any(tied & (fw[order] == np.roll(fw[order], -1))):
+            continue                                        # two faces facing the same way in one plane
+        step = np.where(fw[order], -1, 1)                  # counter-clockwise: leave (−1) or enter (+1) a solid
+        level = np.cumsum(step)
+        start = int(np.argmin(level)) + 1                   # just after the sector of the smallest winding number
+        seq = np.roll(order, -start)
+        sgn = np.roll(step, -start)
+        entered: list[int] = []
+        for k, e in zip(seq.tolist(), sgn.tolist()):
+            if e > 0:
+                entered.append(k)
+            elif entered:
+                out.append((int(fs[entered.pop(0)]), int(fs[k])))
+    return np.array(out, dtype=np.int64).reshape(-1, 2)
+
+
+def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shells: int,
+                  vertices: np.ndarray) -> WeldedBodies:
+    """R1b: split each shell at its non-manifold edges into the bodies welded there.
+
+    The faces joined through manifold edges (used by exactly two faces) form pieces; at each non-manifold edge the
+    pieces are joined as :func:`_crossing_pairs_at_edges` pairs the faces (bodies passing through each other stay
+    whole).  A shell is split when every group of pieces so joined is closed and balanced on its own; otherwise it
+    stays one shell (``ambiguous`` counts it).
+
+    Parameters
+    ----------
+    faces : (m, 3) int
+        A balanced surface (every directed edge matched by its reverse).
+    n_vertices : int
+    labels : (m,) int
+        Edge-connected shells (:func:`~.checks.shell_labels`).
+    n_shells : int
+    vertices : (n, 3) float
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from .edges import edge_keys
+
+    f = np.asarray(faces, dtype=np.int64)
+    labels = np.asarray(labels, dtype=np.int64)
+    m = len(f)
+    none = WeldedBodies(labels=labels, n_shells=n_shells, split=0, ambiguous=0,
+                        contact=np.zeros((0, 2), dtype=np.int64))
+    if m < 8:                                     # two closed surfaces need at least eight faces
+        return none
+    key, forward = edge_keys(f, n_vertices)
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    starts = np.flatnonzero(np.r_[True, skey[1:] != skey[:-1]])
+    count = np.diff(np.r_[starts, len(skey)])
+    many = np.flatnonzero(count > 2)
+    if not len(many):
+        return none
+    two = starts[count == 2]
+    rows, cols = order[two] // 3, order[two + 1] // 3
+    # the faces around each non-manifold edge, paired so that crossing bodies stay whole
+    at = np.repeat(many, count[many])
+    slots = order[np.concatenate([np.arange(starts[k], starts[k] + count[k]) for k in many])]
+    nv = np.int64(max(int(n_vertices), 1))
+    ekey = key[slots]
+    paired = _crossing_pairs_at_edges(np.asarray(vertices, dtype=np.float64), f, at, slots // 3, ekey // nv,
+                                      ekey % nv, forward[slots])
+    rows, cols = np.r_[rows, paired[:, 0]], np.r_[cols, paired[:, 1]]
+    graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(m, m))
+    n_pieces, piece = connected_components(graph, directed=False)
+    # each group balanced on its own: the net direction of every (group, edge) is zero
+    owner = piece[np.arange(3 * m) // 3].astype(np.int64)
+    _, inverse = np.unique(np.stack([owner, key], axis=1), axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
+    first = np.zeros(len(net), dtype=np.int64)
+    first[inverse] = owner
+    unbalanced = np.zeros(n_pieces, dtype=bool)
+    unbalanced[first[net != 0]] = True
+    shell_of_piece = np.zeros(n_pieces, dtype=np.int64)
+    shell_of_piece[piece] = labels
+    bad_shell = np.zeros(n_shells, dtype=bool)
+    bad_shell[shell_of_piece[unbalanced]] = True
+    pieces_per_shell = np.bincount(shell_of_piece, minlength=n_shells)
+    splits = (pieces_per_shell > 1) & ~bad_shell
+    nonmanifold_shell = np.zeros(n_shells, dtype=bool)
+    nonmanifold_shell[labels[slots // 3]] = True
+    ambiguous = int(np.count_nonzero(nonmanifold_shell & bad_shell))
+    if not splits.any():
+        return dataclasses.replace(none, ambiguous=ambiguous)
+    sub = np.where(splits[labels], piece, -1)
+    _, new = np.unique(np.stack([labels, sub], axis=1), axis=0, return_inverse=True)
+    new = new.reshape(-1)
+    _, first_face = np.unique(new, return_index=True)          # numbered in order of each shell's first face
+    rank = np.empty(len(first_face), dtype=np.int64)
+    rank[np.argsort(first_face, kind="stable")] = np.arange(len(first_face))
+    new = rank[new]
+    # face pairs of different new shells around each non-manifold edge: contacts for R4
+    fa = slots // 3
+    groups = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
+    pairs = []
+    for g0, g1 in zip(groups, np.r_[groups[1:], len(at)]):      # bounded by the non-manifold edges
+        fs = fa[g0:g1]
+        i, j = np.triu_indices(len(fs), 1)
+        keep = new[fs[i]] != new[fs[j]]
+        pairs.append(np.stack([fs[i][keep], fs[j][keep]], axis=1))
+    contact = np.unique(np.sort(np.concatenate(pairs), axis=1), axis=0) if pairs else np.zeros((0, 2), np.int64)
+    return WeldedBodies(labels=new.astype(np.intp), n_shells=len(first_face), split=int(np.count_nonzero(splits)),
+                        ambiguous=ambiguous, contact=contact.astype(np.int64))

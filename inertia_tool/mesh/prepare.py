@@ -27,7 +27,7 @@ from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labe
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
                      inward_crossing_outward, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts,
-                     touching_relations, within_up_to_rounding)
+                     touching_relations, welded_bodies, within_up_to_rounding)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
 
@@ -235,7 +235,16 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             shells = body_volume_moments(v, f, labels, n_shells, origin=centre)
     shells, bound = _accurate(v, f, labels, shells, centre)  # R7: signs and moments within the round-off bound
     f, labels, n_shells, shells, dropped_note, bound = _drop_flat(v, f, labels, shells, diag, source, bound)  # R2
+    welded = None
+    if found.nonmanifold_edges and patched is None:                             # R1b
+        welded = welded_bodies(f, len(v), labels, n_shells, v)
+        if welded.split:
+            labels, n_shells = welded.labels, welded.n_shells
+            shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
     contacts = surface_contacts(v, f)
+    if welded is not None and len(welded.contact):      # R1b: bodies welded along an edge meet there (R4 decides)
+        contacts = dataclasses.replace(contacts, contact=np.concatenate(
+            [np.asarray(contacts.contact, dtype=np.int64).reshape(-1, 2), welded.contact]))
     if patched is not None:
         contacts, patch_notes = _outside_patches(contacts, f, n_read)
         found = Resolution(found.vertices, found.faces, found.method, found.notes + patch_notes,
@@ -396,6 +405,12 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             checks = [c for c in checks if c != "no-crossing-faces"]
     if ambiguous and kind in ("exact", "united"):
         kind = "unverified"                   # R4: a reading of the file's winding, not a proven solid
+    if welded is not None and welded.ambiguous and kind in ("exact", "united"):
+        kind = "unverified"                   # R1b: bodies welded at an edge whose faces could not be paired
+        notes.append(f"{welded.ambiguous} shell{'s' if welded.ambiguous > 1 else ''} with non-manifold edges where "
+                     "coplanar faces of two bodies meet could not be split into closed bodies: integrated as "
+                     "written (a region enclosed by two bodies counts twice there), not verified")
+        warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
     certificate = Certificate(kind, tuple(checks) if kind != "estimate" else ())
     report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
                         bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),
@@ -676,6 +691,10 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
     """
     from .union import UnionError, closed_groups, union_surface      # imported on use: overlaps are rare
     groups, n_groups = closed_groups(faces, len(vertices))
+    # within the shells: bodies welded along their crossing (R1b) are closed apart, though one group to closed_groups
+    _, groups = np.unique(np.stack([np.asarray(labels, dtype=np.int64), groups], axis=1), axis=0, return_inverse=True)
+    groups = groups.reshape(-1)
+    n_groups = int(groups.max()) + 1 if len(groups) else 0
     pieces = body_volume_moments(vertices, faces, groups, n_groups)
     volume = np.array([p.volume for p in pieces])
     lo, hi = bounding_box(vertices)
