@@ -790,15 +790,21 @@ def _duplicated(rng):
         shell = lab[f[:, 0]]
         pick = shell == shell[rng.integers(len(f))]
     shared = rng.random() < 0.5
+    apart = ""
     if shared:      # the copy uses the same vertex indices
         nf = np.concatenate([f, f[pick]])
         nv = v
     else:
-        nv = np.vstack([v, v])
+        copy = v
+        if rng.random() < 0.4:     # the copy's coordinates computed apart: (v + c) − c, equal up to rounding
+            c = rng.normal(size=3) * float(np.abs(v).max() + 1.0)
+            copy = (v + c) - c
+            apart = f", coordinates rounded apart (up to {float(np.abs(copy - v).max()):.2g} m)"
+        nv = np.vstack([v, copy])
         nf = np.concatenate([f, f[pick] + len(v)])
     what = "the whole nest" if base == "nested" else "one shell"
     return Case("duplicated", nv, nf, case.truth,
-                f"[{base}] {case.recipe}; {what} duplicated ({'same' if shared else 'new'} vertex indices)")
+                f"[{base}] {case.recipe}; {what} duplicated ({'same' if shared else 'new'} vertex indices{apart})")
 
 
 def _coplanar_overlap(rng):

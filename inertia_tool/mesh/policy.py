@@ -13,6 +13,16 @@ R0 *A shell listed twice is one solid* (:func:`coincident_surfaces`).  A closed 
    surface listed together with its exact inverted copy has winding number 0 everywhere: the pair is left out
    (a mesh that is nothing else is refused with that reason).  Reason: a shell exported twice means the part
    once; summed, its volume counts twice, and united it only shows as a false overlap.
+   *Up to rounding* (:func:`near_copies`): a closed surface whose every corner lies within
+   ``tolerances.COINCIDENT_RTOL`` of the largest |coordinate| of a corner of another, face for face with the same
+   winding (a copy whose coordinates were computed apart), is counted once too, when the bound on what it could
+   add is within ``tolerances.ROUNDOFF_RTOL`` of the result (what "exact" means, R7): the copy differs from the
+   surface kept only inside the δ-neighbourhood of that surface (δ the largest distance between corresponding
+   corners: moving every corner by at most δ moves every point of every face by at most δ, so a point enclosed by
+   one surface and not the other lies within δ of both), whose volume is at most ``Σ 2δ·A + (π/2)δ²·P + (4/3)πδ³``
+   over the faces (Steiner's formula for a triangle of area A and perimeter P); the moments it could carry are at
+   most that volume times the distance (squared) from the centroid.  Beyond that bound the pair goes on to R4–R6
+   like any two shells.
 R1 *Bodies are edge-connected* (:func:`~.checks.shell_labels`).  Faces that meet only at a vertex belong to
    different shells: a non-manifold vertex is split into its fans of edge-connected faces before anything
    decides what is one body.  Reason: two bodies that share a corner (or are welded there) are two bodies,
@@ -75,6 +85,13 @@ R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL`
    shares nothing: a shell read as a cavity reaches out of its body and the boolean cuts it only inside the body;
    said so, never as shared volume, and ``unverified`` unless the file's winding made it so (an inward shell
    crossing an outward one), since R4 places a cavity within its body.
+   *Touching up to rounding*: when faces of two shells do cross (after a rotation, faces that were coplanar are
+   coplanar only to rounding, and cross or gap by ~1e-16 of the coordinates) but the union's volume equals the
+   summed volume within ``TOUCH_VOLUME_RTOL``, the shells share no volume beyond that tolerance: the summed
+   integral of the surface as written is given, certified ``united`` (check ``touching-up-to-rounding``), with a
+   note saying so.  Not ``exact``: the file's surface does enclose slivers twice, thinner than its coordinates'
+   rounding, so the solid it means is ambiguous at that level, and the only witness that they are that thin is
+   the float64 boolean.  Touching copies that only gap by rounding (no face pair crosses) stay ``exact``.
 R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only after the edge census found the
    surface balanced, every shell is oriented by R4, and the face-intersection check ran over every candidate
    pair and found no crossing.  When the check could not finish within its work bound the integral is still
@@ -93,7 +110,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..tolerances import FLAT_MOMENT_RTOL, FLAT_RTOL, TOUCH_VOLUME_RTOL
+from ..tolerances import COINCIDENT_RTOL, FLAT_MOMENT_RTOL, FLAT_RTOL, ROUNDOFF_RTOL, TOUCH_VOLUME_RTOL
 from ..values import frozen_value
 
 if TYPE_CHECKING:
@@ -104,7 +121,8 @@ if TYPE_CHECKING:
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
            "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
            "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
-           "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies"]
+           "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
+           "near_copies", "NearCopies", "near_copies_message"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -124,6 +142,9 @@ CHECKS = {
                            "faces bounding {winding number ≥ 1} kept (mesh/arrange.py); the result was checked "
                            "closed and free of crossing faces",
     "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
+    "touching-up-to-rounding": "faces of touching shells cross only by rounding: the boolean union's volume equals "
+                               "the summed volume within TOUCH_VOLUME_RTOL, so the summed integral is the solid's "
+                               "to that tolerance",
     "closed-form": "a primitive (box, cylinder, sphere, capsule, ellipsoid) integrated by its closed form",
     "inward-offset-bound": "a printed part's core (the inward offset by the skin) integrated on cells of the exact "
                            "signed distance, with a bracket that holds for any closed mesh (mass/offset.py)",
@@ -795,3 +816,117 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
     contact = np.unique(np.sort(np.concatenate(pairs), axis=1), axis=0) if pairs else np.zeros((0, 2), np.int64)
     return WeldedBodies(labels=new.astype(np.intp), n_shells=len(first_face), split=int(np.count_nonzero(splits)),
                         ambiguous=ambiguous, contact=contact.astype(np.int64))
+
+
+@frozen_value
+class NearCopies:
+    """R0 up to rounding: closed surfaces repeating another corner for corner within a rounding distance.
+
+    Attributes
+    ----------
+    drop : (m,) bool
+        Faces of the copies left out.
+    copies : int
+        Closed surfaces left out.
+    distance : float
+        Largest distance between corresponding corners of a copy and the surface kept, m.
+    volume_bound : float
+        Bound on the volume in which the copies differ from the surfaces kept, m³ (Steiner).
+    """
+
+    drop: np.ndarray
+    copies: int
+    distance: float
+    volume_bound: float
+
+
+#: Pairs of candidate shells compared corner for corner (R0 up to rounding), at most.
+MAX_NEAR_COPY_PAIRS = 256
+
+
+def _steiner_bound(vertices: np.ndarray, faces: np.ndarray, delta: float) -> float:
+    """Volume of the ``delta``-neighbourhood of the faces, bounded above: Σ 2δA + (π/2)δ²P + (4/3)πδ³."""
+    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    perimeter = np.linalg.norm(b - a, axis=1) + np.linalg.norm(c - b, axis=1) + np.linalg.norm(a - c, axis=1)
+    per_face = 2 * delta * area + 0.5 * np.pi * delta ** 2 * perimeter + 4 / 3 * np.pi * delta ** 3
+    return float(np.sum(per_face) * (1 + 1e-12))
+
+
+def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, shells: Sequence[VolumeMoments], *,
+                rtol: float = COINCIDENT_RTOL, budget: float = ROUNDOFF_RTOL) -> NearCopies:
+    """R0 up to rounding: the later of two closed surfaces that repeat each other corner for corner, the same
+    winding, every corner within ``rtol × max|coordinate|`` of its match, left out when what it could add to the
+    kept one is within ``budget`` of the kept one's volume and second moment (see R0).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    labels : (m,) int
+        Shell of each face.
+    shells : sequence of VolumeMoments
+        Moments of each shell (candidates need equal face counts, |volume| and area within 1e-9).
+    """
+    from scipy.spatial import cKDTree
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    labels = np.asarray(labels, dtype=np.int64)
+    n = len(shells)
+    drop = np.zeros(len(f), dtype=bool)
+    none = NearCopies(drop=drop, copies=0, distance=0.0, volume_bound=0.0)
+    if n < 2:
+        return none
+    count = np.bincount(labels, minlength=n)
+    size = np.array([[abs(s.volume), s.area] for s in shells])
+    order = np.lexsort((size[:, 0], count))
+    first, second = order[:-1], order[1:]
+    close = (count[first] == count[second]) & \
+        np.all(np.abs(size[first] - size[second]) <= 1e-9 * np.maximum(size[first], size[second]), axis=1)
+    gone = np.zeros(n, dtype=bool)
+    copies, distance, volume_bound = 0, 0.0, 0.0
+    for a, b in zip(first[close][:MAX_NEAR_COPY_PAIRS].tolist(), second[close][:MAX_NEAR_COPY_PAIRS].tolist()):
+        if gone[a] or gone[b]:
+            continue
+        fa, fb = f[labels == a], f[labels == b]
+        ua, ia = np.unique(fa, return_inverse=True)
+        ub, ib = np.unique(fb, return_inverse=True)
+        if len(ua) != len(ub) or np.intersect1d(ua, ub).size:
+            continue                                   # shared corners: not a separate copy
+        reach = rtol * float(max(np.abs(v[ua]).max(), np.abs(v[ub]).max()))
+        dist, match = cKDTree(v[ua]).query(v[ub], distance_upper_bound=reach)
+        if not np.all(np.isfinite(dist)) or len(np.unique(match)) != len(ub):
+            continue
+        ga = ia.reshape(-1, 3)                          # faces of a and of b as indices into ua
+        gb = match[ib.reshape(-1, 3)]
+
+        def cyclic(g: np.ndarray) -> np.ndarray:
+            start = np.argmin(g, axis=1)[:, None]
+            key: np.ndarray = np.take_along_axis(g, (start + np.arange(3)) % 3, axis=1)
+            return key
+
+        ka, kb = np.unique(cyclic(ga), axis=0), np.unique(cyclic(gb), axis=0)
+        if len(ka) != len(ga) or not np.array_equal(ka, kb):
+            continue
+        delta = float(dist.max())
+        bound = _steiner_bound(v, fa, delta)
+        kept = shells[a]
+        reach_sq = (float(np.sqrt(np.max(np.sum((v[ua] - kept.centroid) ** 2, axis=1)))) + delta) ** 2
+        if bound > budget * abs(kept.volume) or \
+                bound * reach_sq > budget * float(np.linalg.norm(kept.second_moment)):
+            continue
+        gone[b] = True
+        drop |= labels == b
+        copies += 1
+        distance, volume_bound = max(distance, delta), volume_bound + bound
+    return NearCopies(drop=drop, copies=copies, distance=distance, volume_bound=volume_bound)
+
+
+def near_copies_message(found: NearCopies) -> str:
+    """R0's note for copies up to rounding."""
+    n = found.copies
+    return (f"{n} closed surface{'s' if n > 1 else ''} repeating another corner for corner within "
+            f"{found.distance:.3g} m (listed twice, the copy's coordinates rounded apart) counted once; the copies "
+            f"differ from the surfaces kept by at most {found.volume_bound:.3g} m³ (the surfaces' neighbourhood of that "
+            "width), within the round-off bound of an exact result")

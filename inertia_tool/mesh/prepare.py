@@ -26,7 +26,7 @@ from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE, ROUNDOFF_RTOL
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
-                     inward_crossing_outward, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts,
+                     inward_crossing_outward, near_copies, near_copies_message, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts,
                      touching_relations, welded_bodies, within_up_to_rounding)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
@@ -233,6 +233,13 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             coincident_notes.append(note)
             labels, n_shells = shell_labels(f, len(v))
             shells = body_volume_moments(v, f, labels, n_shells, origin=centre)
+        near = near_copies(v, f, labels, shells)                                # R0 up to rounding
+        if near.copies:
+            f = f[~near.drop]
+            coincident_notes.append(near_copies_message(near))
+            warnings.warn(MeshResolvedWarning(f"{source}: {coincident_notes[-1]}"), stacklevel=3)
+            labels, n_shells = shell_labels(f, len(v))
+            shells = body_volume_moments(v, f, labels, n_shells, origin=centre)
     shells, bound = _accurate(v, f, labels, shells, centre)  # R7: signs and moments within the round-off bound
     f, labels, n_shells, shells, dropped_note, bound = _drop_flat(v, f, labels, shells, diag, source, bound)  # R2
     welded = None
@@ -325,6 +332,22 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             if int(np.count_nonzero(candidates)):
                 notes.append(f"{int(np.count_nonzero(candidates))} shells touch another (the boolean union's "
                              "volume equals their sum: no volume is shared)")
+        elif united is not None and overlap == "union" and touch.complete and \
+                abs(united.volume - summed) <= TOUCH_VOLUME_RTOL * abs(summed):
+            # R6 up to rounding: faces cross, yet the boolean finds no volume shared beyond TOUCH_VOLUME_RTOL (copies
+            # touching face to face after a rotation, a cavity flush with its body's face): the surface as written
+            # is the solid to that tolerance, not exactly (the crossing slivers are thinner than the rounding)
+            overlaps = 0
+            kind = "united"
+            checks = ["edge-balanced", "consistently-oriented", "boolean-union", "touching-up-to-rounding"]
+            crossed = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
+            n_pairs = int(np.count_nonzero(labels[crossed[:, 0]] != labels[crossed[:, 1]]))
+            notes.append(f"touching up to rounding: {n_pairs:,} face pairs of shells that touch cross by float64 "
+                         f"rounding (faces coplanar only to rounding, e.g. after a rotation); the boolean union's "
+                         f"volume equals the summed volume within {TOUCH_VOLUME_RTOL:g} (difference "
+                         f"{abs(united.volume - summed):.3g} m³), so the summed integral is given, certified united "
+                         "(the solid is ambiguous at the rounding level: not exact)")
+            warnings.warn(MeshResolvedWarning(f"{source}: {notes[-1]}"), stacklevel=3)
         elif united is None:
             found = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
                                     moments=volume_moments, force_estimate=True)
