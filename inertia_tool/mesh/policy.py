@@ -927,6 +927,6 @@ def near_copies_message(found: NearCopies) -> str:
     """R0's note for copies up to rounding."""
     n = found.copies
     return (f"{n} closed surface{'s' if n > 1 else ''} repeating another corner for corner within "
-            f"{found.distance:.3g} m (listed twice, the copy's coordinates rounded apart) counted once; the copies "
-            f"differ from the surfaces kept by at most {found.volume_bound:.3g} m³ (the surfaces' neighbourhood of that "
-            "width), within the round-off bound of an exact result")
+            f"{found.distance:.3g} m (listed twice, the copy's coordinates rounded apart) counted once; the "
+            f"copies differ from the surfaces kept by at most {found.volume_bound:.3g} m³ (the surfaces' "
+            "neighbourhood of that width), within the round-off bound of an exact result")

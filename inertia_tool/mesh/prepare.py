@@ -26,8 +26,9 @@ from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE, ROUNDOFF_RTOL
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
-                     inward_crossing_outward, near_copies, near_copies_message, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts,
-                     touching_relations, welded_bodies, within_up_to_rounding)
+                     inward_crossing_outward, near_copies, near_copies_message, negligible_flat, orient_by_depth,
+                     self_crossing_message, shell_contacts, touching_relations, welded_bodies,
+                     within_up_to_rounding)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
 
