@@ -523,8 +523,8 @@ def test_crossing_bodies_read_from_an_stl(tmp_path):
     tri = case.vertices[case.faces]
     lines = ["solid x"]
     for t in tri:
-        lines += ["facet normal 0 0 0", "outer loop"] + [f"vertex {float(p[0])!r} {float(p[1])!r} {float(p[2])!r}" for p in t] + \
-            ["endloop", "endfacet"]
+        corners = [f"vertex {float(p[0])!r} {float(p[1])!r} {float(p[2])!r}" for p in t]
+        lines += ["facet normal 0 0 0", "outer loop", *corners, "endloop", "endfacet"]
     path = tmp_path / "crossing.stl"
     path.write_text("\n".join(lines + ["endsolid x"]) + "\n")
     from inertia_tool import mass_properties
