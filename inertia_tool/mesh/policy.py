@@ -104,7 +104,6 @@ R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only aft
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING
 
@@ -707,9 +706,13 @@ def _crossing_pairs_at_edges(vertices: np.ndarray, faces: np.ndarray, at: np.nda
         w -= np.outer(w @ d, d)
         u = w[0] / np.linalg.norm(w[0])
         angle = np.arctan2(w @ np.cross(d, u), w @ u) % (2 * np.pi)
+        # each angle's float64 error is a few units of rounding of the coordinates over the face's height from the
+        # edge (a sliver face's angle is uncertain): angles closer than their errors are taken as tied
+        scale = float(np.abs(np.concatenate([a, b, vertices[third].reshape(-1)])).max())
+        error = 64 * 2.0 ** -53 * scale / np.maximum(np.linalg.norm(w, axis=1), 1e-300) + 1e-12
         order = np.lexsort((~fw, angle))                   # at one angle, a face leaving a solid first
         ang = angle[order]
-        tied = np.diff(np.r_[ang, ang[0] + 2 * np.pi]) <= 1e-9
+        tied = np.diff(np.r_[ang, ang[0] + 2 * np.pi]) <= error[order] + np.roll(error[order], -1)
         if np.any(tied & (fw[order] == np.roll(fw[order], -1))):
             continue                                        # two faces facing the same way in one plane
         step = np.where(fw[order], -1, 1)                  # counter-clockwise: leave (−1) or enter (+1) a solid
@@ -795,15 +798,16 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
     nonmanifold_shell = np.zeros(n_shells, dtype=bool)
     nonmanifold_shell[labels[slots // 3]] = True
     ambiguous = int(np.count_nonzero(nonmanifold_shell & bad_shell))
-    if not splits.any():
-        return dataclasses.replace(none, ambiguous=ambiguous)
-    sub = np.where(splits[labels], piece, -1)
-    _, new = np.unique(np.stack([labels, sub], axis=1), axis=0, return_inverse=True)
-    new = new.reshape(-1)
-    _, first_face = np.unique(new, return_index=True)          # numbered in order of each shell's first face
-    rank = np.empty(len(first_face), dtype=np.int64)
-    rank[np.argsort(first_face, kind="stable")] = np.arange(len(first_face))
-    new = rank[new]
+    if splits.any():
+        sub = np.where(splits[labels], piece, -1)
+        _, new = np.unique(np.stack([labels, sub], axis=1), axis=0, return_inverse=True)
+        new = new.reshape(-1)
+        _, first_face = np.unique(new, return_index=True)          # numbered in order of each shell's first face
+        rank = np.empty(len(first_face), dtype=np.int64)
+        rank[np.argsort(first_face, kind="stable")] = np.arange(len(first_face))
+        new, count_new = rank[new], len(first_face)
+    else:                      # already apart (split before): the contacts at their shared edges are still wanted
+        new, count_new = labels, n_shells
     # face pairs of different new shells around each non-manifold edge: contacts for R4
     fa = slots // 3
     groups = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
@@ -814,7 +818,7 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
         keep = new[fs[i]] != new[fs[j]]
         pairs.append(np.stack([fs[i][keep], fs[j][keep]], axis=1))
     contact = np.unique(np.sort(np.concatenate(pairs), axis=1), axis=0) if pairs else np.zeros((0, 2), np.int64)
-    return WeldedBodies(labels=new.astype(np.intp), n_shells=len(first_face), split=int(np.count_nonzero(splits)),
+    return WeldedBodies(labels=new.astype(np.intp), n_shells=count_new, split=int(np.count_nonzero(splits)),
                         ambiguous=ambiguous, contact=contact.astype(np.int64))
 
 
@@ -892,8 +896,8 @@ def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, she
         fa, fb = f[labels == a], f[labels == b]
         ua, ia = np.unique(fa, return_inverse=True)
         ub, ib = np.unique(fb, return_inverse=True)
-        if len(ua) != len(ub) or np.intersect1d(ua, ub).size:
-            continue                                   # shared corners: not a separate copy
+        if len(ua) != len(ub):
+            continue
         reach = rtol * float(max(np.abs(v[ua]).max(), np.abs(v[ub]).max()))
         dist, match = cKDTree(v[ua]).query(v[ub], distance_upper_bound=reach)
         if not np.all(np.isfinite(dist)) or len(np.unique(match)) != len(ub):

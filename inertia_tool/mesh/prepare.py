@@ -220,7 +220,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         return _estimated(found, common)
     # a patched surface is closed: its shells are classified and overlaps united like any other, and the
     # bounds of the patches carry over to the result.  Every rule applied below is stated in mesh/policy.py.
-    labels, n_shells = shell_labels(f, len(v))                                   # R1
+    split_welded = bool(found.nonmanifold_edges) and patched is None
+    labels, n_shells = _bodies(v, f, split_welded)                               # R1, R1b
     if n_shells == 0:
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
     # the reference point body_volume_moments and accurate_shells would take (the bounding-box centre), from the
@@ -232,19 +233,19 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         f, note = _leave_out_coincident(v, f, twins, source, labels)
         if note is not None:
             coincident_notes.append(note)
-            labels, n_shells = shell_labels(f, len(v))
+            labels, n_shells = _bodies(v, f, split_welded)
             shells = body_volume_moments(v, f, labels, n_shells, origin=centre)
         near = near_copies(v, f, labels, shells)                                # R0 up to rounding
         if near.copies:
             f = f[~near.drop]
             coincident_notes.append(near_copies_message(near))
             warnings.warn(MeshResolvedWarning(f"{source}: {coincident_notes[-1]}"), stacklevel=3)
-            labels, n_shells = shell_labels(f, len(v))
+            labels, n_shells = _bodies(v, f, split_welded)
             shells = body_volume_moments(v, f, labels, n_shells, origin=centre)
     shells, bound = _accurate(v, f, labels, shells, centre)  # R7: signs and moments within the round-off bound
     f, labels, n_shells, shells, dropped_note, bound = _drop_flat(v, f, labels, shells, diag, source, bound)  # R2
     welded = None
-    if found.nonmanifold_edges and patched is None:                             # R1b
+    if split_welded:                                                             # R1b (again: R2 relabels)
         welded = welded_bodies(f, len(v), labels, n_shells, v)
         if welded.split:
             labels, n_shells = welded.labels, welded.n_shells
@@ -601,6 +602,17 @@ def _accurate(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[Vol
     centre, computed again)."""
     better, _, bound = accurate_shells(v, f, labels, list(shells), origin)
     return better, bound
+
+
+def _bodies(v: np.ndarray, f: np.ndarray, split_welded: bool) -> tuple[np.ndarray, int]:
+    """R1 (edge-connected shells) and, on a surface with non-manifold edges, R1b (bodies welded along their
+    crossing split apart, :func:`~.policy.welded_bodies`)."""
+    labels, n_shells = shell_labels(f, len(v))
+    if split_welded and n_shells:
+        welded = welded_bodies(f, len(v), labels, n_shells, v)
+        if welded.split:
+            return welded.labels, welded.n_shells
+    return labels, n_shells
 
 
 def _twin_candidates(shells: Sequence[VolumeMoments], labels: np.ndarray) -> np.ndarray | None:
