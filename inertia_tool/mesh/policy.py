@@ -34,8 +34,14 @@ R1b *Bodies welded along their crossing are still separate bodies* (:func:`welde
    edges still balance, so nothing else notices).  A shell with non-manifold edges is split into the pieces
    joined through its manifold edges (used by exactly two faces) when every piece is closed and balanced on
    its own; the face pairs of different pieces along a shared non-manifold edge are contacts for R4 (their
-   points decide crossing, nesting or touching; :func:`touching_relations`).  Reason: a body is a closed
-   surface, and the faces meeting at a non-manifold edge say nothing about which of them close together.
+   points decide crossing, nesting or touching; :func:`touching_relations`).  Around each non-manifold edge the
+   faces are paired first in, first out (:func:`_crossing_pairs_at_edges`): bodies passing through each other stay
+   whole, where pairing last in, first out would give the boundary of their union around the boundary of their
+   common part, which R4 would read as a body with a cavity (both pairings have the same winding number; only
+   this one lets the depth rule agree with it).  Where coplanar faces of two bodies face the same way at such an
+   edge the order is undefined and the bodies overlap there: refused with that reason (``repair``: the
+   winding-number estimate).  Reason: a body is a closed surface, and the faces meeting at a non-manifold edge
+   say nothing about which of them close together.
 R2 *Flat pieces carry no volume* (``tolerances.FLAT_RTOL``).  A closed shell whose |volume| is at most
    ``FLAT_RTOL · diagonal³`` (a face and its reverse, a zero-thickness wall, a collapsed sliver) contributes
    nothing to the integrals, so it is left out with a note and the answer stays exact (:func:`negligible_flat`:

@@ -250,6 +250,20 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         if welded.split:
             labels, n_shells = welded.labels, welded.n_shells
             shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+        if welded.ambiguous:     # R1b: coplanar faces of two bodies facing the same way at a welded edge
+            n_amb = welded.ambiguous
+            reason = (f"{n_amb} shell{'s' if n_amb > 1 else ''} with non-manifold edges where coplanar faces of two "
+                      "bodies facing the same way meet could not be split into closed bodies (which faces close "
+                      "which body is undefined there); the bodies overlap, and the summed integral would count "
+                      "their common volume twice")
+            if not repair:
+                raise InvalidMeshError(f"{source}: {reason}; `repair=True` gives a bounded estimate of the solid "
+                                       "{winding number ≥ 1}")
+            forced = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
+                                     moments=volume_moments, force_estimate=True, reason=reason)
+            warnings.warn(MeshRepairedWarning(f"{source}: repaired ({forced.method}, an estimate): "
+                                              f"{'; '.join(forced.notes)}"), stacklevel=3)
+            return _estimated(forced, common)
     contacts = surface_contacts(v, f)
     if welded is not None and len(welded.contact):      # R1b: bodies welded along an edge meet there (R4 decides)
         contacts = dataclasses.replace(contacts, contact=np.concatenate(
@@ -430,12 +444,6 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             checks = [c for c in checks if c != "no-crossing-faces"]
     if ambiguous and kind in ("exact", "united"):
         kind = "unverified"                   # R4: a reading of the file's winding, not a proven solid
-    if welded is not None and welded.ambiguous and kind in ("exact", "united"):
-        kind = "unverified"                   # R1b: bodies welded at an edge whose faces could not be paired
-        notes.append(f"{welded.ambiguous} shell{'s' if welded.ambiguous > 1 else ''} with non-manifold edges where "
-                     "coplanar faces of two bodies meet could not be split into closed bodies: integrated as "
-                     "written (a region enclosed by two bodies counts twice there), not verified")
-        warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=3)
     certificate = Certificate(kind, tuple(checks) if kind != "estimate" else ())
     report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
                         bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),
