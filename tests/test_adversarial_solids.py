@@ -633,3 +633,19 @@ def test_welded_bodies_with_coplanar_faces_at_a_crossing_edge_are_refused():
         _props(case.vertices, case.faces)
     verdict = _assert_honest(case, repair=True)
     assert verdict.label == "estimate" and verdict.wrong is None
+
+
+def test_welded_grid_of_touching_cubes_is_left_whole_and_exact():
+    """R1b splits only shells where surfaces cross at a welded edge (the winding number around it spans two):
+    4 × 4 × 2 unit cubes welded face to face (zero-thickness walls, edges of up to eight faces) stay one shell
+    whose sum is exact, as before R1b.  Reading the faces' direction along the edge the wrong way made every wall a
+    crossing: 32 shells, united, 10× the CPU time."""
+    from inertia_tool.mesh.checks import shell_labels
+    from inertia_tool.mesh.policy import welded_bodies
+    cubes = [S.box([1, 1, 1], [i, j, k]) for i in range(4) for j in range(4) for k in range(2)]
+    v, f = S._weld_exact(*S.concat(*cubes))
+    labels, n = shell_labels(f, len(v))
+    found = welded_bodies(f, len(v), labels, n, v)
+    assert n == 1 and found.split == 0 and found.ambiguous == 0
+    p, _ = _props(v, f)
+    assert p.mesh.certificate.kind == "exact" and p.mass == pytest.approx(32.0, rel=1e-14)

@@ -689,50 +689,95 @@ class WeldedBodies:
 
 
 def _crossing_pairs_at_edges(vertices: np.ndarray, faces: np.ndarray, at: np.ndarray, edge_faces: np.ndarray,
-                             lo: np.ndarray, hi: np.ndarray, forward: np.ndarray) -> np.ndarray:
-    """R1b: at each non-manifold edge, the faces that continue one body's surface through the others, (p, 2).
+                             lo: np.ndarray, hi: np.ndarray,
+                             forward: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """R1b: at each non-manifold edge, the faces that continue one body's surface through the others.
 
     Around the edge ``lo → hi`` the faces are sorted by angle; crossing a face wound along the edge (``forward``)
     counter-clockwise leaves a solid (the winding number drops by one), crossing one wound against it enters one.
     Read from a sector of the smallest winding number, the faces form a sequence of entries and exits, and the
     first solid entered is the first left: entries and exits are paired first in, first out, so that bodies whose
     surfaces pass through each other stay whole (paired last in, first out they would read as the boundary of the
-    union around the boundary of the common part, a body inside a body).  An edge where two faces lie at the same
-    angle facing the same way (coplanar faces of two bodies overlapping: the order is not defined) gives no pairs;
-    two at the same angle facing opposite ways (bodies face to face) are read leaving one before entering the other.
+    union around the boundary of the common part, a body inside a body).  Where the winding number around the
+    edge never differs by more than one (bodies only touching there) both readings pair each entry with the next
+    exit.  Two faces at the same angle (within their angles' rounding errors) facing opposite ways (bodies face to
+    face) are read leaving one before entering the other; facing the same way (coplanar faces of two bodies
+    overlapping) the order is undefined and the edge gives no pairs.
+
+    Parameters
+    ----------
+    at : (k,) int
+        Edge of each slot (a face at a non-manifold edge), slots grouped by edge.
+    edge_faces, lo, hi, forward : (k,) arrays
+        The slot's face, the edge's end points (``lo < hi``) and whether the face runs ``lo → hi`` (its outward
+        normal then turns counter-clockwise about ``hi − lo`` from the face, so its solid lies clockwise).
+
+    Returns
+    -------
+    pairs : (p, 2) int
+        Faces paired.
+    crossing : (k,) bool
+        Slots at an edge where surfaces cross (the winding number around it spans two or more).
+    undefined : (k,) bool
+        Slots at an edge whose order is undefined.
     """
-    out = []
-    groups = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
-    for g0, g1 in zip(groups, np.r_[groups[1:], len(at)]):         # bounded by the non-manifold edges
-        fs, fw = edge_faces[g0:g1], forward[g0:g1]
-        a, b = vertices[lo[g0]], vertices[hi[g0]]
-        d = (b - a) / np.linalg.norm(b - a)
-        third = np.array([[c for c in faces[k] if c != lo[g0] and c != hi[g0]][0] for k in fs])
-        w = vertices[third] - a
-        w -= np.outer(w @ d, d)
-        u = w[0] / np.linalg.norm(w[0])
-        angle = np.arctan2(w @ np.cross(d, u), w @ u) % (2 * np.pi)
-        # each angle's float64 error is a few units of rounding of the coordinates over the face's height from the
-        # edge (a sliver face's angle is uncertain): angles closer than their errors are taken as tied
-        scale = float(np.abs(np.concatenate([a, b, vertices[third].reshape(-1)])).max())
-        error = 64 * 2.0 ** -53 * scale / np.maximum(np.linalg.norm(w, axis=1), 1e-300) + 1e-12
-        order = np.lexsort((~fw, angle))                   # at one angle, a face leaving a solid first
-        ang = angle[order]
-        tied = np.diff(np.r_[ang, ang[0] + 2 * np.pi]) <= error[order] + np.roll(error[order], -1)
-        if np.any(tied & (fw[order] == np.roll(fw[order], -1))):
-            continue                                        # two faces facing the same way in one plane
-        step = np.where(fw[order], -1, 1)                  # counter-clockwise: leave (−1) or enter (+1) a solid
-        level = np.cumsum(step)
-        start = int(np.argmin(level)) + 1                   # just after the sector of the smallest winding number
-        seq = np.roll(order, -start)
-        sgn = np.roll(step, -start)
+    v = vertices
+    k = len(at)
+    starts = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
+    size = np.diff(np.r_[starts, k])
+    group = np.repeat(np.arange(len(starts)), size)
+    a, b = v[lo], v[hi]
+    d = b - a
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    third = faces[edge_faces].sum(axis=1) - lo - hi
+    w = v[third] - a
+    w -= np.einsum("ij,ij->i", w, d)[:, None] * d
+    height = np.linalg.norm(w, axis=1)
+    u = w[starts] / np.maximum(height[starts], 1e-300)[:, None]
+    u = u[group]
+    angle = np.arctan2(np.einsum("ij,ij->i", w, np.cross(d, u)), np.einsum("ij,ij->i", w, u)) % (2 * np.pi)
+    # each angle's float64 error is a few units of rounding of the coordinates over the face's height from the edge
+    scale = np.max(np.abs(np.concatenate([a, b, v[third]], axis=1)), axis=1)
+    error = 64 * 2.0 ** -53 * scale / np.maximum(height, 1e-300) + 1e-12
+    order = np.lexsort((~forward, angle, at))          # by edge, by angle, at one angle a face leaving first
+    ang, err, fw = angle[order], error[order], forward[order]
+    nxt = np.arange(k) + 1
+    last = starts + size - 1
+    nxt[last] = starts                                  # the next slot around the edge, cyclically
+    gap = np.where(np.isin(np.arange(k), last), ang[nxt] + 2 * np.pi - ang, ang[nxt] - ang)
+    undefined_slot = (gap <= err + err[nxt]) & (fw == fw[nxt]) & (nxt != np.arange(k))
+    undefined_edge = np.bincount(group, weights=undefined_slot, minlength=len(starts)) > 0
+    step = np.where(fw, -1, 1)
+    level = np.cumsum(step)
+    level -= np.repeat(level[starts] - step[starts], size)     # within each edge, from its first slot
+    low = np.minimum.reduceat(level, starts)
+    high = np.maximum.reduceat(level, starts)
+    crossing_edge = (high - low >= 2) & ~undefined_edge
+    # start just after the first sector of the smallest winding number, each edge's sequence rotated there
+    is_low = level == low[group]
+    first_low = np.minimum.reduceat(np.where(is_low, np.arange(k), k), starts)
+    start = first_low + 1 - starts                      # offset within the edge
+    pos = (np.arange(k) - starts[group] - start[group]) % size[group]
+    rotated = np.empty(k, dtype=np.int64)
+    rotated[starts[group] + pos] = np.arange(k)         # rotated[starts + j] = the j-th slot read
+    pairs = []
+    simple = ~crossing_edge & ~undefined_edge
+    if simple.any():                                    # enter, leave, enter, leave: consecutive slots pair
+        first = starts[group] + pos
+        take = simple[group] & (pos % 2 == 0)
+        entry = order[np.arange(k)[take]]
+        exit_ = order[rotated[first[take] + 1]]
+        pairs.append(np.stack([edge_faces[entry], edge_faces[exit_]], axis=1))
+    for e in np.flatnonzero(crossing_edge):             # surfaces crossing: first in, first out (rare; bounded)
+        seq = order[rotated[starts[e]:starts[e] + size[e]]]
         entered: list[int] = []
-        for k, e in zip(seq.tolist(), sgn.tolist()):
-            if e > 0:
-                entered.append(k)
+        for slot in seq.tolist():
+            if not forward[slot]:
+                entered.append(slot)
             elif entered:
-                out.append((int(fs[entered.pop(0)]), int(fs[k])))
-    return np.array(out, dtype=np.int64).reshape(-1, 2)
+                pairs.append(np.array([[edge_faces[entered.pop(0)], edge_faces[slot]]]))
+    out = np.concatenate(pairs).astype(np.int64) if pairs else np.zeros((0, 2), dtype=np.int64)
+    return out, crossing_edge[group], undefined_edge[group]
 
 
 def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shells: int,
@@ -781,8 +826,8 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
     slots = order[np.concatenate([np.arange(starts[k], starts[k] + count[k]) for k in many])]
     nv = np.int64(max(int(n_vertices), 1))
     ekey = key[slots]
-    paired = _crossing_pairs_at_edges(np.asarray(vertices, dtype=np.float64), f, at, slots // 3, ekey // nv,
-                                      ekey % nv, forward[slots])
+    paired, crossing_slot, undefined_slot = _crossing_pairs_at_edges(
+        np.asarray(vertices, dtype=np.float64), f, at, slots // 3, ekey // nv, ekey % nv, ~forward[slots])
     rows, cols = np.r_[rows, paired[:, 0]], np.r_[cols, paired[:, 1]]
     graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(m, m))
     n_pieces, piece = connected_components(graph, directed=False)
@@ -800,10 +845,11 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
     bad_shell = np.zeros(n_shells, dtype=bool)
     bad_shell[shell_of_piece[unbalanced]] = True
     pieces_per_shell = np.bincount(shell_of_piece, minlength=n_shells)
-    splits = (pieces_per_shell > 1) & ~bad_shell
-    nonmanifold_shell = np.zeros(n_shells, dtype=bool)
-    nonmanifold_shell[labels[slots // 3]] = True
-    ambiguous = int(np.count_nonzero(nonmanifold_shell & bad_shell))
+    # only shells where surfaces cross at a welded edge need splitting (bodies that only touch sum exactly)
+    crossed = np.zeros(n_shells, dtype=bool)
+    crossed[labels[(slots // 3)[crossing_slot | undefined_slot]]] = True
+    splits = (pieces_per_shell > 1) & ~bad_shell & crossed
+    ambiguous = int(np.count_nonzero(crossed & bad_shell))
     if splits.any():
         sub = np.where(splits[labels], piece, -1)
         _, new = np.unique(np.stack([labels, sub], axis=1), axis=0, return_inverse=True)
@@ -817,8 +863,9 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
     # face pairs of different new shells around each non-manifold edge: contacts for R4
     fa = slots // 3
     groups = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
+    mixed = np.minimum.reduceat(new[fa], groups) != np.maximum.reduceat(new[fa], groups)
     pairs = []
-    for g0, g1 in zip(groups, np.r_[groups[1:], len(at)]):      # bounded by the non-manifold edges
+    for g0, g1 in zip(groups[mixed], np.r_[groups[1:], len(at)][mixed]):     # edges between shells; bounded
         fs = fa[g0:g1]
         i, j = np.triu_indices(len(fs), 1)
         keep = new[fs[i]] != new[fs[j]]
