@@ -354,6 +354,10 @@ def truth_from_pieces(pieces):
             pv = Fraction(fv)
             pf = [pv * Fraction(x) for x in fc]
             ps = [[Fraction(fcen[r, q]) + pv * Fraction(fc[r]) * Fraction(fc[q]) for q in range(3)] for r in range(3)]
+        if pv < 0:
+            # a piece thinner than its coordinates' rounding can come out of the rigid motion wound inward, exactly:
+            # by nesting depth (R4) it is still the piece it was meant to be, so its moments count turned
+            pv, pf, ps = -pv, [-x for x in pf], [[-x for x in row] for row in ps]
         vol += sign * pv
         first = [first[k] + sign * pf[k] for k in range(3)]
         second = [[second[r][q] + sign * ps[r][q] for q in range(3)] for r in range(3)]
@@ -770,8 +774,9 @@ def _figure_eight(rng, n_mc=0):
 def _inside_out(rng):
     base = ("single", "disjoint", "nested", "overlapping", "touching_faces")[rng.integers(5)]
     case = _BUILDERS[base](rng)
+    # the base's other allowed readings carry over (an overlapping piece wholly inside another: cavity by depth)
     return Case("inside_out", case.vertices, case.faces[:, ::-1].copy(), case.truth,
-                f"[{base}] {case.recipe}; every face reversed")
+                f"[{base}] {case.recipe}; every face reversed", alternatives=case.alternatives)
 
 
 def _duplicated(rng):
