@@ -946,6 +946,8 @@ def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, she
     for a, b in zip(first[close][:MAX_NEAR_COPY_PAIRS].tolist(), second[close][:MAX_NEAR_COPY_PAIRS].tolist()):
         if gone[a] or gone[b]:
             continue
+        if np.linalg.norm(shells[a].centroid - shells[b].centroid) > 1e-6 * np.sqrt(shells[a].area):
+            continue                                   # a copy elsewhere (identical parts of an assembly): cheap out
         fa, fb = f[labels == a], f[labels == b]
         ua, ia = np.unique(fa, return_inverse=True)
         ub, ib = np.unique(fb, return_inverse=True)
