@@ -2,9 +2,9 @@
 
 Uses the generator of ``tests/adversary_solids.py`` (boxes, icospheres, cylinders, tori, the repository's parts
 under rigid motions; disjoint, sharing a vertex, touching face to face, overlapping, nested with cavities wound
-either way, internal walls, slivers, self-crossing tubes, inside-out and duplicated shells) and its rule: a
-result certified exact or united must match the truth (volume 1e-9, centre of mass 1e-9·diagonal, inertia 1e-8),
-an estimate must hold its bounds, anything else must be refused.  Case ``i`` is drawn from
+either way, internal walls, slivers, self-crossing tubes, inside-out and duplicated shells, bodies crossing along
+shared edges) and its rule: a result certified exact or united must match the truth (volume 1e-9, centre of mass
+1e-9·diagonal, inertia 1e-8), an estimate must hold its bounds, anything else must be refused.  Case ``i`` is drawn from
 ``numpy.random.default_rng([seed, i])`` with kind ``KINDS[i % len(KINDS)]``, so every row is reproducible::
 
     python benchmarks/bench_adversarial.py --cases 10000            # the table (Markdown) and the failures

@@ -109,6 +109,14 @@ ARRANGE_MERGE_RTOL = 1e-12
 #: (:func:`inertia_tool.integrals.exact_volume_moments`); one too large for that is certified ``unverified``.
 ROUNDOFF_RTOL = 1e-10
 
+#: Two closed surfaces that repeat each other corner for corner with every corner within ``COINCIDENT_RTOL`` times
+#: the largest |coordinate| of the pair are one surface listed twice up to rounding (R0 of mesh/policy.py): a copy
+#: whose coordinates were computed apart (the same rigid motion applied in another order) differs by a few units
+#: in the last place, 2⁻⁵³ each; 64 of them leave room for a dozen roundings per coordinate.  Counted once only
+#: when the bound on what the copy could add (its corners' δ-neighbourhood of the surface) is within
+#: ``ROUNDOFF_RTOL`` of the result.
+COINCIDENT_RTOL = 64 * 2.0 ** -53
+
 # -- limits on the input (guards, not tolerances; here so that a command's parser states them without loading
 #    the mesh layer) ---------------------------------------------------------------------------------------------
 

@@ -33,7 +33,7 @@ MESH_DIR = Path(__file__).resolve().parent.parent / "meshes"
 #: Composition kinds, in the order of the benchmark table.
 KINDS = ("single", "disjoint", "shared_vertex_overlap", "shared_vertex_touch", "touching_faces",
          "overlapping", "nested", "internal_wall", "sliver", "figure_eight", "inside_out", "duplicated",
-         "coplanar_overlap", "edge_touch", "flush_cavity")
+         "coplanar_overlap", "edge_touch", "flush_cavity", "shared_edge_crossing")
 
 #: Largest mesh integrated with rational arithmetic (faces); larger truths are float64 about a nearby point.
 FRACTION_MAX_FACES = 600
@@ -354,6 +354,10 @@ def truth_from_pieces(pieces):
             pv = Fraction(fv)
             pf = [pv * Fraction(x) for x in fc]
             ps = [[Fraction(fcen[r, q]) + pv * Fraction(fc[r]) * Fraction(fc[q]) for q in range(3)] for r in range(3)]
+        if pv < 0:
+            # a piece thinner than its coordinates' rounding can come out of the rigid motion wound inward, exactly:
+            # by nesting depth (R4) it is still the piece it was meant to be, so its moments count turned
+            pv, pf, ps = -pv, [-x for x in pf], [[-x for x in row] for row in ps]
         vol += sign * pv
         first = [first[k] + sign * pf[k] for k in range(3)]
         second = [[second[r][q] + sign * ps[r][q] for q in range(3)] for r in range(3)]
@@ -770,8 +774,9 @@ def _figure_eight(rng, n_mc=0):
 def _inside_out(rng):
     base = ("single", "disjoint", "nested", "overlapping", "touching_faces")[rng.integers(5)]
     case = _BUILDERS[base](rng)
+    # the base's other allowed readings carry over (an overlapping piece wholly inside another: cavity by depth)
     return Case("inside_out", case.vertices, case.faces[:, ::-1].copy(), case.truth,
-                f"[{base}] {case.recipe}; every face reversed")
+                f"[{base}] {case.recipe}; every face reversed", alternatives=case.alternatives)
 
 
 def _duplicated(rng):
@@ -790,15 +795,21 @@ def _duplicated(rng):
         shell = lab[f[:, 0]]
         pick = shell == shell[rng.integers(len(f))]
     shared = rng.random() < 0.5
+    apart = ""
     if shared:      # the copy uses the same vertex indices
         nf = np.concatenate([f, f[pick]])
         nv = v
     else:
-        nv = np.vstack([v, v])
+        copy = v
+        if rng.random() < 0.4:     # the copy's coordinates computed apart: (v + c) − c, equal up to rounding
+            c = rng.normal(size=3) * float(np.abs(v).max() + 1.0)
+            copy = (v + c) - c
+            apart = f", coordinates rounded apart (up to {float(np.abs(copy - v).max()):.2g} m)"
+        nv = np.vstack([v, copy])
         nf = np.concatenate([f, f[pick] + len(v)])
     what = "the whole nest" if base == "nested" else "one shell"
     return Case("duplicated", nv, nf, case.truth,
-                f"[{base}] {case.recipe}; {what} duplicated ({'same' if shared else 'new'} vertex indices)")
+                f"[{base}] {case.recipe}; {what} duplicated ({'same' if shared else 'new'} vertex indices{apart})")
 
 
 def _coplanar_overlap(rng):
@@ -868,6 +879,202 @@ def _flush_cavity(rng):
                    f"box{_t(ec)} flush with its +x face")
 
 
+# ------------------------------------------------------------- bodies crossing exactly along shared edges
+def _orient_convex(v, f):
+    """``f`` of a convex solid wound outward, triangle by triangle (normal away from the vertex mean)."""
+    centre = v.mean(0)
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    out = np.einsum("ij,ij->i", np.cross(b - a, c - a), (a + b + c) / 3 - centre) > 0
+    return np.where(out[:, None], f, f[:, ::-1])
+
+
+def grid_box(grids, rng):
+    """Closed outward box ``[x₀, x₋₁] × [y₀, y₋₁] × [z₀, z₋₁]`` of ``grids = (xs, ys, zs)`` whose faces are cut
+    along every grid line (each cell two triangles, its diagonal drawn at random): another box cut along the
+    same lines meets it only along edges of both."""
+    g = [np.unique(np.asarray(x, dtype=np.float64)) for x in grids]
+    index: dict = {}
+    faces = []
+    for axis in range(3):
+        u, w = (axis + 1) % 3, (axis + 2) % 3
+        for c in (g[axis][0], g[axis][-1]):
+            for i in range(len(g[u]) - 1):
+                for j in range(len(g[w]) - 1):
+                    ids = []
+                    for du, dw in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                        p = [0.0, 0.0, 0.0]
+                        p[axis], p[u], p[w] = c, g[u][i + du], g[w][j + dw]
+                        ids.append(index.setdefault(tuple(p), len(index)))
+                    a, b, cc, d = ids
+                    faces += [[a, b, cc], [a, cc, d]] if rng.random() < 0.5 else [[a, b, d], [b, cc, d]]
+    v = np.array(sorted(index, key=index.get), dtype=np.float64)
+    f = np.array(faces, dtype=np.int64)
+    return v, _orient_convex(v, f)
+
+
+def _ring_strip(inner, outer):
+    """Triangles (``("i"|"o", index)`` corners into ``inner`` (n, 2) and ``outer`` (k, 2), both convex and
+    counter-clockwise, the inner inside the outer around its centroid) filling the ring between them, the two
+    rings merged by angle; None when a triangle is not clockwise or the areas do not add up (draw again)."""
+    c = inner.mean(0)
+    ai = np.arctan2(inner[:, 1] - c[1], inner[:, 0] - c[0]) % (2 * np.pi)
+    ao = np.arctan2(outer[:, 1] - c[1], outer[:, 0] - c[0]) % (2 * np.pi)
+    i0, o0 = int(np.argmin(ai)), int(np.argmin(ao))
+    n, k = len(inner), len(outer)
+
+    def after(angles, start, j, m):
+        return angles[(start + j + 1) % m] if j + 1 < m else angles[start] + 2 * np.pi
+
+    tris, i, o = [], 0, 0
+    while i < n or o < k:                             # n + k triangles in all
+        ci, co = ("i", (i0 + i) % n), ("o", (o0 + o) % k)
+        if o >= k or (i < n and after(ai, i0, i, n) <= after(ao, o0, o, k)):
+            tris.append((ci, ("i", (i0 + i + 1) % n), co))
+            i += 1
+        else:
+            tris.append((ci, ("o", (o0 + o + 1) % k), co))
+            o += 1
+    pts = {"i": inner, "o": outer}
+
+    def area2(t):
+        p = [pts[s][j] for s, j in t]
+        return (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0])
+
+    def polygon2(q):
+        return float(np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1]))
+
+    areas = np.array([area2(t) for t in tris])
+    if np.any(areas >= 0) or abs(-areas.sum() - (polygon2(outer) - polygon2(inner))) > 1e-12 * polygon2(outer):
+        return None
+    return tris
+
+
+def prism_through_box(rng):
+    """A box and a convex polygon prism along z through its top face (and its bottom one, or ending inside),
+    the polygon drawn in the box's top (bottom) face triangulation and the prism's sides cut where they pass the
+    box's faces: the surfaces cross only along edges of both.  Returns (box, prism, [(sign, piece)] of the union
+    by inclusion–exclusion) or None when the ring could not be triangulated (draw again)."""
+    half = rng.integers(2, 7, size=2) * 0.125
+    zb, zt = -float(rng.integers(2, 7)) * 0.125, float(rng.integers(2, 7)) * 0.125
+    n = int(rng.integers(3, 9))
+    radius = float(rng.uniform(0.2, 0.9)) * float(half.min())
+    centre = rng.uniform(-1, 1, size=2) * (half - radius) * 0.9
+    ang = float(rng.uniform(0, 2 * np.pi)) + 2 * np.pi * np.sort(rng.uniform(0, 1, size=n)) \
+        if rng.random() < 0.5 else float(rng.uniform(0, 2 * np.pi)) + 2 * np.pi * np.arange(n) / n
+    poly = centre + radius * np.c_[np.cos(ang), np.sin(ang)]
+    if n > 3 and np.any(np.diff(np.r_[ang, ang[0] + 2 * np.pi]) >= np.pi):
+        return None                                   # not containing its centre: draw again
+    square = np.array([[-half[0], -half[1]], [half[0], -half[1]], [half[0], half[1]], [-half[0], half[1]]])
+    ring = _ring_strip(poly, square)
+    if ring is None:
+        return None
+    through = rng.random() < 0.5
+    z1 = zt + float(rng.integers(1, 5)) * 0.125
+    z0 = zb - float(rng.integers(1, 5)) * 0.125 if through else float(rng.uniform(zb, zt) * 0.9)
+    # the box: top (and, when the prism passes through, bottom) face with the polygon imprinted
+    verts, faces = [], []
+
+    def vid(p):
+        verts.append(p)
+        return len(verts) - 1
+
+    for z, cut in ((zt, True), (zb, through)):
+        sq = [vid([x, y, z]) for x, y in square]
+        if not cut:
+            faces += [[sq[0], sq[1], sq[2]], [sq[0], sq[2], sq[3]]]
+            continue
+        pl = [vid([x, y, z]) for x, y in poly]
+        ids = {"i": pl, "o": sq}
+        faces += [[ids[s][j] for s, j in t] for t in ring]
+        faces += [[pl[0], pl[j], pl[j + 1]] for j in range(1, n - 1)]
+    top, bot = {}, {}
+    for k, p in enumerate(verts):
+        (top if p[2] == zt else bot)[(p[0], p[1])] = k
+    for j in range(4):                                # the four sides
+        a, b = square[j], square[(j + 1) % 4]
+        q = [bot[tuple(a)], bot[tuple(b)], top[tuple(b)], top[tuple(a)]]
+        faces += [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]
+    bv = np.array(verts, dtype=np.float64)
+    box_piece = (bv, _orient_convex(bv, np.array(faces, dtype=np.int64)))
+    # the prism, its sides cut at every level it passes
+    levels = sorted({z0, z1} | {z for z in (zb, zt) if z0 < z < z1})
+    pv = np.array([[x, y, z] for z in levels for x, y in poly], dtype=np.float64)
+    pf = []
+    for li in range(len(levels) - 1):
+        for j in range(n):
+            a, b = li * n + j, li * n + (j + 1) % n
+            c, d = b + n, a + n
+            pf += [[a, b, c], [a, c, d]] if rng.random() < 0.5 else [[a, b, d], [b, c, d]]
+    last = (len(levels) - 1) * n
+    pf += [[0, j, j + 1] for j in range(1, n - 1)] + [[last, last + j, last + j + 1] for j in range(1, n - 1)]
+    prism = (pv, _orient_convex(pv, np.array(pf, dtype=np.int64)))
+    lo, hi = max(z0, zb), min(z1, zt)
+    cv = np.array([[x, y, z] for z in (lo, hi) for x, y in poly], dtype=np.float64)
+    cf = [[j, (j + 1) % n, n + (j + 1) % n] for j in range(n)] + [[j, n + (j + 1) % n, n + j] for j in range(n)]
+    cf += [[0, j, j + 1] for j in range(1, n - 1)] + [[n, n + j, n + j + 1] for j in range(1, n - 1)]
+    common = (cv, _orient_convex(cv, np.array(cf, dtype=np.int64)))
+    recipe = (f"box{_t(2 * half)}×z[{zb}, {zt}] and a {n}-gon prism (r={radius:.3g}) z[{z0:.4g}, {z1:.4g}] "
+              f"{'through it' if through else 'ending inside it'}, crossing along the polygon drawn in its face")
+    return box_piece, prism, [(1, box_piece), (1, prism), (-1, common)], recipe
+
+
+def boxes_on_shared_grid(rng, k):
+    """``k`` boxes with corners on a half-unit grid, each cut along every coordinate of all of them within its
+    range, each crossing another and none within another.  Returns (pieces, [(sign, box)] by inclusion–exclusion,
+    recipe) or None (draw again)."""
+    from itertools import combinations
+    lo = rng.integers(0, 4, size=(k, 3)) * 0.5
+    hi = lo + rng.integers(1, 5, size=(k, 3)) * 0.5
+    generic = rng.random() < 0.6
+    if generic:                                       # no two boxes share a plane: only edges cross edges
+        shift = np.arange(k)[:, None] * 0.125
+        lo, hi = lo + shift, hi + shift
+    for a, b in combinations(range(k), 2):
+        if np.all(lo[a] <= lo[b]) and np.all(hi[b] <= hi[a]) or np.all(lo[b] <= lo[a]) and np.all(hi[a] <= hi[b]):
+            return None                               # one within the other (a cavity by depth): another kind
+    for a in range(k):
+        if not any(np.all(np.maximum(lo[a], lo[b]) < np.minimum(hi[a], hi[b])) for b in range(k) if b != a):
+            return None                               # crossing none of the others
+    coords = [np.unique(np.r_[lo[:, d], hi[:, d]]) for d in range(3)]
+    pieces = [grid_box([c[(c >= lo[i, d]) & (c <= hi[i, d])] for d, c in enumerate(coords)], rng)
+              for i in range(k)]
+    signed = []
+    for r in range(1, k + 1):
+        for sub in combinations(range(k), r):
+            low, h = lo[list(sub)].max(0), hi[list(sub)].min(0)
+            if np.all(h > low):
+                signed.append(((-1) ** (r + 1), box(h - low, (low + h) / 2)))
+    recipe = (" and ".join(f"box[{_t(lo[i])}, {_t(hi[i])}]" for i in range(k))
+              + " on a shared grid (each cut along all the others' planes), crossing along shared edges"
+              + ("" if generic else " (some planes shared: coplanar faces overlap)"))
+    return pieces, signed, recipe
+
+
+def _shared_edge_crossing(rng):
+    """Closed shells whose surfaces cross only along edges of both tessellations (no face pair crosses
+    transversally: MuJoCo Menagerie's Go1 thigh): 2–3 boxes on a shared grid (L shapes, beams, corners), or a
+    polygon prism through a box's face.  Truth: inclusion–exclusion in rationals."""
+    for _ in range(100):                              # bounded redraws
+        if rng.random() < 0.5:
+            made = prism_through_box(rng)
+            if made is None:
+                continue
+            a, b, signed, recipe = made
+            pieces = [a, b]
+        else:
+            made = boxes_on_shared_grid(rng, int(rng.integers(2, 4)))
+            if made is None:
+                continue
+            pieces, signed, recipe = made
+        order = rng.permutation(len(pieces))
+        mesh = concat(*[pieces[i] for i in order])
+        if rng.random() < 0.5:    # as an STL reads: the crossing edges' vertices shared, each edge used by 4 faces
+            mesh = _weld_exact(*mesh)
+            recipe += "; vertices welded (non-manifold crossing edges)"
+        return _finish("shared_edge_crossing", rng, signed, mesh, recipe)
+    raise RuntimeError("no shared-edge crossing drawn in 100 tries")
+
+
 def _weld_exact(v, f):
     """Merge bit-identical vertices."""
     uniq, inv = np.unique(v, axis=0, return_inverse=True)
@@ -879,7 +1086,7 @@ _BUILDERS = {
     "shared_vertex_touch": _shared_vertex_touch, "touching_faces": _touching_faces, "overlapping": _overlapping,
     "nested": _nested, "internal_wall": _internal_wall, "sliver": _sliver, "figure_eight": _figure_eight,
     "inside_out": _inside_out, "duplicated": _duplicated, "coplanar_overlap": _coplanar_overlap,
-    "edge_touch": _edge_touch, "flush_cavity": _flush_cavity,
+    "edge_touch": _edge_touch, "flush_cavity": _flush_cavity, "shared_edge_crossing": _shared_edge_crossing,
 }
 
 

@@ -13,10 +13,35 @@ R0 *A shell listed twice is one solid* (:func:`coincident_surfaces`).  A closed 
    surface listed together with its exact inverted copy has winding number 0 everywhere: the pair is left out
    (a mesh that is nothing else is refused with that reason).  Reason: a shell exported twice means the part
    once; summed, its volume counts twice, and united it only shows as a false overlap.
+   *Up to rounding* (:func:`near_copies`): a closed surface whose every corner lies within
+   ``tolerances.COINCIDENT_RTOL`` of the largest |coordinate| of a corner of another, face for face with the same
+   winding (a copy whose coordinates were computed apart), is counted once too, when the bound on what it could
+   add is within ``tolerances.ROUNDOFF_RTOL`` of the result (what "exact" means, R7): the copy differs from the
+   surface kept only inside the δ-neighbourhood of that surface (δ the largest distance between corresponding
+   corners: moving every corner by at most δ moves every point of every face by at most δ, so a point enclosed by
+   one surface and not the other lies within δ of both), whose volume is at most ``Σ 2δ·A + (π/2)δ²·P + (4/3)πδ³``
+   over the faces (Steiner's formula for a triangle of area A and perimeter P); the moments it could carry are at
+   most that volume times the distance (squared) from the centroid.  Beyond that bound the pair goes on to R4–R6
+   like any two shells.
 R1 *Bodies are edge-connected* (:func:`~.checks.shell_labels`).  Faces that meet only at a vertex belong to
    different shells: a non-manifold vertex is split into its fans of edge-connected faces before anything
    decides what is one body.  Reason: two bodies that share a corner (or are welded there) are two bodies,
    and must be tested against each other for overlap.
+R1b *Bodies welded along their crossing are still separate bodies* (:func:`welded_bodies`).  Where closed
+   surfaces cross exactly along edges of both tessellations and the file shares those edges' vertices (an STL
+   is welded bit-exactly on reading), each crossing edge is used by four faces, two of each body, and edge
+   connectivity would make the bodies one shell whose summed integral counts their common volume twice (the
+   edges still balance, so nothing else notices).  A shell with non-manifold edges is split into the pieces
+   joined through its manifold edges (used by exactly two faces) when every piece is closed and balanced on
+   its own; the face pairs of different pieces along a shared non-manifold edge are contacts for R4 (their
+   points decide crossing, nesting or touching; :func:`touching_relations`).  Around each non-manifold edge the
+   faces are paired first in, first out (:func:`_crossing_pairs_at_edges`): bodies passing through each other stay
+   whole, where pairing last in, first out would give the boundary of their union around the boundary of their
+   common part, which R4 would read as a body with a cavity (both pairings have the same winding number; only
+   this one lets the depth rule agree with it).  Where coplanar faces of two bodies face the same way at such an
+   edge the order is undefined and the bodies overlap there: refused with that reason (``repair``: the
+   winding-number estimate).  Reason: a body is a closed surface, and the faces meeting at a non-manifold edge
+   say nothing about which of them close together.
 R2 *Flat pieces carry no volume* (``tolerances.FLAT_RTOL``).  A closed shell whose |volume| is at most
    ``FLAT_RTOL · diagonal³`` (a face and its reverse, a zero-thickness wall, a collapsed sliver) contributes
    nothing to the integrals, so it is left out with a note and the answer stays exact (:func:`negligible_flat`:
@@ -66,6 +91,13 @@ R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL`
    shares nothing: a shell read as a cavity reaches out of its body and the boolean cuts it only inside the body;
    said so, never as shared volume, and ``unverified`` unless the file's winding made it so (an inward shell
    crossing an outward one), since R4 places a cavity within its body.
+   *Touching up to rounding*: when faces of two shells do cross (after a rotation, faces that were coplanar are
+   coplanar only to rounding, and cross or gap by ~1e-16 of the coordinates) but the union's volume equals the
+   summed volume within ``TOUCH_VOLUME_RTOL``, the shells share no volume beyond that tolerance: the summed
+   integral of the surface as written is given, certified ``united`` (check ``touching-up-to-rounding``), with a
+   note saying so.  Not ``exact``: the file's surface does enclose slivers twice, thinner than its coordinates'
+   rounding, so the solid it means is ambiguous at that level, and the only witness that they are that thin is
+   the float64 boolean.  Touching copies that only gap by rounding (no face pair crosses) stay ``exact``.
 R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only after the edge census found the
    surface balanced, every shell is oriented by R4, and the face-intersection check ran over every candidate
    pair and found no crossing.  When the check could not finish within its work bound the integral is still
@@ -83,7 +115,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..tolerances import FLAT_MOMENT_RTOL, FLAT_RTOL, TOUCH_VOLUME_RTOL
+from ..tolerances import COINCIDENT_RTOL, FLAT_MOMENT_RTOL, FLAT_RTOL, ROUNDOFF_RTOL, TOUCH_VOLUME_RTOL
 from ..values import frozen_value
 
 if TYPE_CHECKING:
@@ -94,7 +126,8 @@ if TYPE_CHECKING:
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
            "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
            "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
-           "self_crossing_message", "shell_contacts", "ShellContacts", "weakest"]
+           "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
+           "near_copies", "NearCopies", "near_copies_message"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -114,6 +147,9 @@ CHECKS = {
                            "faces bounding {winding number ≥ 1} kept (mesh/arrange.py); the result was checked "
                            "closed and free of crossing faces",
     "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
+    "touching-up-to-rounding": "faces of touching shells cross only by rounding: the boolean union's volume equals "
+                               "the summed volume within TOUCH_VOLUME_RTOL, so the summed integral is the solid's "
+                               "to that tolerance",
     "closed-form": "a primitive (box, cylinder, sphere, capsule, ellipsoid) integrated by its closed form",
     "inward-offset-bound": "a printed part's core (the inward offset by the skin) integrated on cells of the exact "
                            "signed distance, with a bracket that holds for any closed mesh (mass/offset.py)",
@@ -626,3 +662,330 @@ def coincident_message(found: Coincident) -> str:
                      f"exact inverted cop{'ies' if n > 1 else 'y'} ({found.cancelled_faces:,} faces in all): each "
                      "pair cancels (winding number 0 everywhere, no volume) and is left out")
     return "; ".join(parts) + near
+
+
+@frozen_value
+class WeldedBodies:
+    """R1b: shells split at their non-manifold edges into the bodies welded there.
+
+    Attributes
+    ----------
+    labels : (m,) int
+        Shell of each face after the split, ``0..n_shells-1``.
+    n_shells : int
+    split : int
+        Shells that were split (0: the labels are the ones given).
+    ambiguous : int
+        Shells with non-manifold edges that could not be split into closed bodies (kept whole).
+    contact : (c, 2) int
+        Face pairs of different shells that share a non-manifold edge by index (R4 tests their points).
+    """
+
+    labels: np.ndarray
+    n_shells: int
+    split: int
+    ambiguous: int
+    contact: np.ndarray
+
+
+def _crossing_pairs_at_edges(vertices: np.ndarray, faces: np.ndarray, at: np.ndarray, edge_faces: np.ndarray,
+                             lo: np.ndarray, hi: np.ndarray,
+                             forward: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """R1b: at each non-manifold edge, the faces that continue one body's surface through the others.
+
+    Around the edge ``lo → hi`` the faces are sorted by angle; crossing a face wound along the edge (``forward``)
+    counter-clockwise leaves a solid (the winding number drops by one), crossing one wound against it enters one.
+    Read from a sector of the smallest winding number, the faces form a sequence of entries and exits, and the
+    first solid entered is the first left: entries and exits are paired first in, first out, so that bodies whose
+    surfaces pass through each other stay whole (paired last in, first out they would read as the boundary of the
+    union around the boundary of the common part, a body inside a body).  Where the winding number around the
+    edge never differs by more than one (bodies only touching there) both readings pair each entry with the next
+    exit.  Two faces at the same angle (within their angles' rounding errors) facing opposite ways (bodies face to
+    face) are read leaving one before entering the other; facing the same way (coplanar faces of two bodies
+    overlapping) the order is undefined and the edge gives no pairs.
+
+    Parameters
+    ----------
+    at : (k,) int
+        Edge of each slot (a face at a non-manifold edge), slots grouped by edge.
+    edge_faces, lo, hi, forward : (k,) arrays
+        The slot's face, the edge's end points (``lo < hi``) and whether the face runs ``lo → hi`` (its outward
+        normal then turns counter-clockwise about ``hi − lo`` from the face, so its solid lies clockwise).
+
+    Returns
+    -------
+    pairs : (p, 2) int
+        Faces paired.
+    crossing : (k,) bool
+        Slots at an edge where surfaces cross (the winding number around it spans two or more).
+    undefined : (k,) bool
+        Slots at an edge whose order is undefined.
+    """
+    v = vertices
+    k = len(at)
+    starts = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
+    size = np.diff(np.r_[starts, k])
+    group = np.repeat(np.arange(len(starts)), size)
+    a, b = v[lo], v[hi]
+    d = b - a
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    third = faces[edge_faces].sum(axis=1) - lo - hi
+    w = v[third] - a
+    w -= np.einsum("ij,ij->i", w, d)[:, None] * d
+    height = np.linalg.norm(w, axis=1)
+    u = w[starts] / np.maximum(height[starts], 1e-300)[:, None]
+    u = u[group]
+    angle = np.arctan2(np.einsum("ij,ij->i", w, np.cross(d, u)), np.einsum("ij,ij->i", w, u)) % (2 * np.pi)
+    # each angle's float64 error is a few units of rounding of the coordinates over the face's height from the edge
+    scale = np.max(np.abs(np.concatenate([a, b, v[third]], axis=1)), axis=1)
+    error = 64 * 2.0 ** -53 * scale / np.maximum(height, 1e-300) + 1e-12
+    order = np.lexsort((~forward, angle, at))          # by edge, by angle, at one angle a face leaving first
+    ang, err, fw = angle[order], error[order], forward[order]
+    nxt = np.arange(k) + 1
+    last = starts + size - 1
+    nxt[last] = starts                                  # the next slot around the edge, cyclically
+    gap = np.where(np.isin(np.arange(k), last), ang[nxt] + 2 * np.pi - ang, ang[nxt] - ang)
+    undefined_slot = (gap <= err + err[nxt]) & (fw == fw[nxt]) & (nxt != np.arange(k))
+    undefined_edge = np.bincount(group, weights=undefined_slot, minlength=len(starts)) > 0
+    step = np.where(fw, -1, 1)
+    level = np.cumsum(step)
+    level -= np.repeat(level[starts] - step[starts], size)     # within each edge, from its first slot
+    low = np.minimum.reduceat(level, starts)
+    high = np.maximum.reduceat(level, starts)
+    crossing_edge = (high - low >= 2) & ~undefined_edge
+    # start just after the first sector of the smallest winding number, each edge's sequence rotated there
+    is_low = level == low[group]
+    first_low = np.minimum.reduceat(np.where(is_low, np.arange(k), k), starts)
+    start = first_low + 1 - starts                      # offset within the edge
+    pos = (np.arange(k) - starts[group] - start[group]) % size[group]
+    rotated = np.empty(k, dtype=np.int64)
+    rotated[starts[group] + pos] = np.arange(k)         # rotated[starts + j] = the j-th slot read
+    pairs = []
+    simple = ~crossing_edge & ~undefined_edge
+    if simple.any():                                    # enter, leave, enter, leave: consecutive slots pair
+        first = starts[group] + pos
+        take = simple[group] & (pos % 2 == 0)
+        entry = order[np.arange(k)[take]]
+        exit_ = order[rotated[first[take] + 1]]
+        pairs.append(np.stack([edge_faces[entry], edge_faces[exit_]], axis=1))
+    for e in np.flatnonzero(crossing_edge):             # surfaces crossing: first in, first out (rare; bounded)
+        seq = order[rotated[starts[e]:starts[e] + size[e]]]
+        entered: list[int] = []
+        for slot in seq.tolist():
+            if not forward[slot]:
+                entered.append(slot)
+            elif entered:
+                pairs.append(np.array([[edge_faces[entered.pop(0)], edge_faces[slot]]]))
+    out = np.concatenate(pairs).astype(np.int64) if pairs else np.zeros((0, 2), dtype=np.int64)
+    return out, crossing_edge[group], undefined_edge[group]
+
+
+def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shells: int,
+                  vertices: np.ndarray) -> WeldedBodies:
+    """R1b: split each shell at its non-manifold edges into the bodies welded there.
+
+    The faces joined through manifold edges (used by exactly two faces) form pieces; at each non-manifold edge the
+    pieces are joined as :func:`_crossing_pairs_at_edges` pairs the faces (bodies passing through each other stay
+    whole).  A shell is split when every group of pieces so joined is closed and balanced on its own; otherwise it
+    stays one shell (``ambiguous`` counts it).
+
+    Parameters
+    ----------
+    faces : (m, 3) int
+        A balanced surface (every directed edge matched by its reverse).
+    n_vertices : int
+    labels : (m,) int
+        Edge-connected shells (:func:`~.checks.shell_labels`).
+    n_shells : int
+    vertices : (n, 3) float
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from .edges import edge_keys
+
+    f = np.asarray(faces, dtype=np.int64)
+    labels = np.asarray(labels, dtype=np.int64)
+    m = len(f)
+    none = WeldedBodies(labels=labels, n_shells=n_shells, split=0, ambiguous=0,
+                        contact=np.zeros((0, 2), dtype=np.int64))
+    if m < 8:                                     # two closed surfaces need at least eight faces
+        return none
+    key, forward = edge_keys(f, n_vertices)
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    starts = np.flatnonzero(np.r_[True, skey[1:] != skey[:-1]])
+    count = np.diff(np.r_[starts, len(skey)])
+    many = np.flatnonzero(count > 2)
+    if not len(many):
+        return none
+    two = starts[count == 2]
+    rows, cols = order[two] // 3, order[two + 1] // 3
+    # the faces around each non-manifold edge, paired so that crossing bodies stay whole
+    at = np.repeat(many, count[many])
+    slots = order[np.concatenate([np.arange(starts[k], starts[k] + count[k]) for k in many])]
+    nv = np.int64(max(int(n_vertices), 1))
+    ekey = key[slots]
+    paired, crossing_slot, undefined_slot = _crossing_pairs_at_edges(
+        np.asarray(vertices, dtype=np.float64), f, at, slots // 3, ekey // nv, ekey % nv, ~forward[slots])
+    rows, cols = np.r_[rows, paired[:, 0]], np.r_[cols, paired[:, 1]]
+    graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(m, m))
+    n_pieces, piece = connected_components(graph, directed=False)
+    # each group balanced on its own: the net direction of every (group, edge) is zero
+    owner = piece[np.arange(3 * m) // 3].astype(np.int64)
+    _, inverse = np.unique(np.stack([owner, key], axis=1), axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
+    first = np.zeros(len(net), dtype=np.int64)
+    first[inverse] = owner
+    unbalanced = np.zeros(n_pieces, dtype=bool)
+    unbalanced[first[net != 0]] = True
+    shell_of_piece = np.zeros(n_pieces, dtype=np.int64)
+    shell_of_piece[piece] = labels
+    bad_shell = np.zeros(n_shells, dtype=bool)
+    bad_shell[shell_of_piece[unbalanced]] = True
+    pieces_per_shell = np.bincount(shell_of_piece, minlength=n_shells)
+    # only shells where surfaces cross at a welded edge need splitting (bodies that only touch sum exactly)
+    crossed = np.zeros(n_shells, dtype=bool)
+    crossed[labels[(slots // 3)[crossing_slot | undefined_slot]]] = True
+    splits = (pieces_per_shell > 1) & ~bad_shell & crossed
+    ambiguous = int(np.count_nonzero(crossed & bad_shell))
+    if splits.any():
+        sub = np.where(splits[labels], piece, -1)
+        _, new = np.unique(np.stack([labels, sub], axis=1), axis=0, return_inverse=True)
+        new = new.reshape(-1)
+        _, first_face = np.unique(new, return_index=True)          # numbered in order of each shell's first face
+        rank = np.empty(len(first_face), dtype=np.int64)
+        rank[np.argsort(first_face, kind="stable")] = np.arange(len(first_face))
+        new, count_new = rank[new], len(first_face)
+    else:                      # already apart (split before): the contacts at their shared edges are still wanted
+        new, count_new = labels, n_shells
+    # face pairs of different new shells around each non-manifold edge: contacts for R4
+    fa = slots // 3
+    groups = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
+    mixed = np.minimum.reduceat(new[fa], groups) != np.maximum.reduceat(new[fa], groups)
+    pairs = []
+    for g0, g1 in zip(groups[mixed], np.r_[groups[1:], len(at)][mixed]):     # edges between shells; bounded
+        fs = fa[g0:g1]
+        i, j = np.triu_indices(len(fs), 1)
+        keep = new[fs[i]] != new[fs[j]]
+        pairs.append(np.stack([fs[i][keep], fs[j][keep]], axis=1))
+    contact = np.unique(np.sort(np.concatenate(pairs), axis=1), axis=0) if pairs else np.zeros((0, 2), np.int64)
+    return WeldedBodies(labels=new.astype(np.intp), n_shells=count_new, split=int(np.count_nonzero(splits)),
+                        ambiguous=ambiguous, contact=contact.astype(np.int64))
+
+
+@frozen_value
+class NearCopies:
+    """R0 up to rounding: closed surfaces repeating another corner for corner within a rounding distance.
+
+    Attributes
+    ----------
+    drop : (m,) bool
+        Faces of the copies left out.
+    copies : int
+        Closed surfaces left out.
+    distance : float
+        Largest distance between corresponding corners of a copy and the surface kept, m.
+    volume_bound : float
+        Bound on the volume in which the copies differ from the surfaces kept, m³ (Steiner).
+    """
+
+    drop: np.ndarray
+    copies: int
+    distance: float
+    volume_bound: float
+
+
+#: Pairs of candidate shells compared corner for corner (R0 up to rounding), at most.
+MAX_NEAR_COPY_PAIRS = 256
+
+
+def _steiner_bound(vertices: np.ndarray, faces: np.ndarray, delta: float) -> float:
+    """Volume of the ``delta``-neighbourhood of the faces, bounded above: Σ 2δA + (π/2)δ²P + (4/3)πδ³."""
+    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    perimeter = np.linalg.norm(b - a, axis=1) + np.linalg.norm(c - b, axis=1) + np.linalg.norm(a - c, axis=1)
+    per_face = 2 * delta * area + 0.5 * np.pi * delta ** 2 * perimeter + 4 / 3 * np.pi * delta ** 3
+    return float(np.sum(per_face) * (1 + 1e-12))
+
+
+def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, shells: Sequence[VolumeMoments], *,
+                rtol: float = COINCIDENT_RTOL, budget: float = ROUNDOFF_RTOL) -> NearCopies:
+    """R0 up to rounding: the later of two closed surfaces that repeat each other corner for corner, the same
+    winding, every corner within ``rtol × max|coordinate|`` of its match, left out when what it could add to the
+    kept one is within ``budget`` of the kept one's volume and second moment (see R0).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    labels : (m,) int
+        Shell of each face.
+    shells : sequence of VolumeMoments
+        Moments of each shell (candidates need equal face counts, |volume| and area within 1e-9).
+    """
+    from scipy.spatial import cKDTree
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    labels = np.asarray(labels, dtype=np.int64)
+    n = len(shells)
+    drop = np.zeros(len(f), dtype=bool)
+    none = NearCopies(drop=drop, copies=0, distance=0.0, volume_bound=0.0)
+    if n < 2:
+        return none
+    count = np.bincount(labels, minlength=n)
+    size = np.array([[abs(s.volume), s.area] for s in shells])
+    order = np.lexsort((size[:, 0], count))
+    first, second = order[:-1], order[1:]
+    close = (count[first] == count[second]) & \
+        np.all(np.abs(size[first] - size[second]) <= 1e-9 * np.maximum(size[first], size[second]), axis=1)
+    gone = np.zeros(n, dtype=bool)
+    copies, distance, volume_bound = 0, 0.0, 0.0
+    for a, b in zip(first[close][:MAX_NEAR_COPY_PAIRS].tolist(), second[close][:MAX_NEAR_COPY_PAIRS].tolist()):
+        if gone[a] or gone[b]:
+            continue
+        if np.linalg.norm(shells[a].centroid - shells[b].centroid) > 1e-6 * np.sqrt(shells[a].area):
+            continue                                   # a copy elsewhere (identical parts of an assembly): cheap out
+        fa, fb = f[labels == a], f[labels == b]
+        ua, ia = np.unique(fa, return_inverse=True)
+        ub, ib = np.unique(fb, return_inverse=True)
+        if len(ua) != len(ub):
+            continue
+        reach = rtol * float(max(np.abs(v[ua]).max(), np.abs(v[ub]).max()))
+        dist, match = cKDTree(v[ua]).query(v[ub], distance_upper_bound=reach)
+        if not np.all(np.isfinite(dist)) or len(np.unique(match)) != len(ub):
+            continue
+        ga = ia.reshape(-1, 3)                          # faces of a and of b as indices into ua
+        gb = match[ib.reshape(-1, 3)]
+
+        def cyclic(g: np.ndarray) -> np.ndarray:
+            start = np.argmin(g, axis=1)[:, None]
+            key: np.ndarray = np.take_along_axis(g, (start + np.arange(3)) % 3, axis=1)
+            return key
+
+        ka, kb = np.unique(cyclic(ga), axis=0), np.unique(cyclic(gb), axis=0)
+        if len(ka) != len(ga) or not np.array_equal(ka, kb):
+            continue
+        delta = float(dist.max())
+        bound = _steiner_bound(v, fa, delta)
+        kept = shells[a]
+        reach_sq = (float(np.sqrt(np.max(np.sum((v[ua] - kept.centroid) ** 2, axis=1)))) + delta) ** 2
+        if bound > budget * abs(kept.volume) or \
+                bound * reach_sq > budget * float(np.linalg.norm(kept.second_moment)):
+            continue
+        gone[b] = True
+        drop |= labels == b
+        copies += 1
+        distance, volume_bound = max(distance, delta), volume_bound + bound
+    return NearCopies(drop=drop, copies=copies, distance=distance, volume_bound=volume_bound)
+
+
+def near_copies_message(found: NearCopies) -> str:
+    """R0's note for copies up to rounding."""
+    n = found.copies
+    return (f"{n} closed surface{'s' if n > 1 else ''} repeating another corner for corner within "
+            f"{found.distance:.3g} m (listed twice, the copy's coordinates rounded apart) counted once; the "
+            f"copies differ from the surfaces kept by at most {found.volume_bound:.3g} m³ (the surfaces' "
+            "neighbourhood of that width), within the round-off bound of an exact result")

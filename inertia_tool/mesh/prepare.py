@@ -26,8 +26,9 @@ from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE, ROUNDOFF_RTOL
 from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
-                     inward_crossing_outward, negligible_flat, orient_by_depth, self_crossing_message, shell_contacts,
-                     touching_relations, within_up_to_rounding)
+                     inward_crossing_outward, near_copies, near_copies_message, negligible_flat, orient_by_depth,
+                     self_crossing_message, shell_contacts, touching_relations, welded_bodies,
+                     within_up_to_rounding)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
 
@@ -219,7 +220,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         return _estimated(found, common)
     # a patched surface is closed: its shells are classified and overlaps united like any other, and the
     # bounds of the patches carry over to the result.  Every rule applied below is stated in mesh/policy.py.
-    labels, n_shells = shell_labels(f, len(v))                                   # R1
+    split_welded = bool(found.nonmanifold_edges) and patched is None
+    labels, n_shells = _bodies(v, f, split_welded)                               # R1, R1b
     if n_shells == 0:
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
     # the reference point body_volume_moments and accurate_shells would take (the bounding-box centre), from the
@@ -231,11 +233,41 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         f, note = _leave_out_coincident(v, f, twins, source, labels)
         if note is not None:
             coincident_notes.append(note)
-            labels, n_shells = shell_labels(f, len(v))
+            labels, n_shells = _bodies(v, f, split_welded)
+            shells = body_volume_moments(v, f, labels, n_shells, origin=centre)
+        near = near_copies(v, f, labels, shells)                                # R0 up to rounding
+        if near.copies:
+            f = f[~near.drop]
+            coincident_notes.append(near_copies_message(near))
+            warnings.warn(MeshResolvedWarning(f"{source}: {coincident_notes[-1]}"), stacklevel=3)
+            labels, n_shells = _bodies(v, f, split_welded)
             shells = body_volume_moments(v, f, labels, n_shells, origin=centre)
     shells, bound = _accurate(v, f, labels, shells, centre)  # R7: signs and moments within the round-off bound
     f, labels, n_shells, shells, dropped_note, bound = _drop_flat(v, f, labels, shells, diag, source, bound)  # R2
+    welded = None
+    if split_welded:                                                             # R1b (again: R2 relabels)
+        welded = welded_bodies(f, len(v), labels, n_shells, v)
+        if welded.split:
+            labels, n_shells = welded.labels, welded.n_shells
+            shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+        if welded.ambiguous:     # R1b: coplanar faces of two bodies facing the same way at a welded edge
+            n_amb = welded.ambiguous
+            reason = (f"{n_amb} shell{'s' if n_amb > 1 else ''} with non-manifold edges where coplanar faces of two "
+                      "bodies facing the same way meet could not be split into closed bodies (which faces close "
+                      "which body is undefined there); the bodies overlap, and the summed integral would count "
+                      "their common volume twice")
+            if not repair:
+                raise InvalidMeshError(f"{source}: {reason}; `repair=True` gives a bounded estimate of the solid "
+                                       "{winding number ≥ 1}")
+            forced = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
+                                     moments=volume_moments, force_estimate=True, reason=reason)
+            warnings.warn(MeshRepairedWarning(f"{source}: repaired ({forced.method}, an estimate): "
+                                              f"{'; '.join(forced.notes)}"), stacklevel=3)
+            return _estimated(forced, common)
     contacts = surface_contacts(v, f)
+    if welded is not None and len(welded.contact):      # R1b: bodies welded along an edge meet there (R4 decides)
+        contacts = dataclasses.replace(contacts, contact=np.concatenate(
+            [np.asarray(contacts.contact, dtype=np.int64).reshape(-1, 2), welded.contact]))
     if patched is not None:
         contacts, patch_notes = _outside_patches(contacts, f, n_read)
         found = Resolution(found.vertices, found.faces, found.method, found.notes + patch_notes,
@@ -316,6 +348,22 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             if int(np.count_nonzero(candidates)):
                 notes.append(f"{int(np.count_nonzero(candidates))} shells touch another (the boolean union's "
                              "volume equals their sum: no volume is shared)")
+        elif united is not None and overlap == "union" and touch.complete and \
+                abs(united.volume - summed) <= TOUCH_VOLUME_RTOL * abs(summed):
+            # R6 up to rounding: faces cross, yet the boolean finds no volume shared beyond TOUCH_VOLUME_RTOL (copies
+            # touching face to face after a rotation, a cavity flush with its body's face): the surface as written
+            # is the solid to that tolerance, not exactly (the crossing slivers are thinner than the rounding)
+            overlaps = 0
+            kind = "united"
+            checks = ["edge-balanced", "consistently-oriented", "boolean-union", "touching-up-to-rounding"]
+            crossed = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
+            n_pairs = int(np.count_nonzero(labels[crossed[:, 0]] != labels[crossed[:, 1]]))
+            notes.append(f"touching up to rounding: {n_pairs:,} face pairs of shells that touch cross by float64 "
+                         f"rounding (faces coplanar only to rounding, e.g. after a rotation); the boolean union's "
+                         f"volume equals the summed volume within {TOUCH_VOLUME_RTOL:g} (difference "
+                         f"{abs(united.volume - summed):.3g} m³), so the summed integral is given, certified united "
+                         "(the solid is ambiguous at the rounding level: not exact)")
+            warnings.warn(MeshResolvedWarning(f"{source}: {notes[-1]}"), stacklevel=3)
         elif united is None:
             found = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
                                     moments=volume_moments, force_estimate=True)
@@ -564,6 +612,17 @@ def _accurate(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[Vol
     return better, bound
 
 
+def _bodies(v: np.ndarray, f: np.ndarray, split_welded: bool) -> tuple[np.ndarray, int]:
+    """R1 (edge-connected shells) and, on a surface with non-manifold edges, R1b (bodies welded along their
+    crossing split apart, :func:`~.policy.welded_bodies`)."""
+    labels, n_shells = shell_labels(f, len(v))
+    if split_welded and n_shells:
+        welded = welded_bodies(f, len(v), labels, n_shells, v)
+        if welded.split:
+            return welded.labels, welded.n_shells
+    return labels, n_shells
+
+
 def _twin_candidates(shells: Sequence[VolumeMoments], labels: np.ndarray) -> np.ndarray | None:
     """(m,) bool: faces of shells that could be copies of another (R0: same face count, |volume| and area equal
     to 1e-9), or None when no two shells could be."""
@@ -676,6 +735,10 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
     """
     from .union import UnionError, closed_groups, union_surface      # imported on use: overlaps are rare
     groups, n_groups = closed_groups(faces, len(vertices))
+    # within the shells: bodies welded along their crossing (R1b) are closed apart, though one group to closed_groups
+    _, groups = np.unique(np.stack([np.asarray(labels, dtype=np.int64), groups], axis=1), axis=0, return_inverse=True)
+    groups = groups.reshape(-1)
+    n_groups = int(groups.max()) + 1 if len(groups) else 0
     pieces = body_volume_moments(vertices, faces, groups, n_groups)
     volume = np.array([p.volume for p in pieces])
     lo, hi = bounding_box(vertices)
