@@ -166,7 +166,8 @@ def _touching_note(census: EdgeBalance) -> tuple[str, ...]:
     if not census.nonmanifold_edges:
         return ()
     return (f"{census.nonmanifold_edges:,} non-manifold edges where bodies or walls meet (each edge used equally "
-            "in both directions, so the integral is exact)",)
+            "in both directions, so the surface is closed; whether the bodies there touch or cross is checked "
+            "apart)",)
 
 
 def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
