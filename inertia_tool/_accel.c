@@ -776,6 +776,8 @@ typedef struct {
     int threads, bits, busy, state;    /* state: 0 feeding, 1 finished, 2 output written (released) */
     size_t n_points, points;
     PwEntry *entries;                  /* n_points entries: chunk after chunk (a big-page arena) */
+    size_t entries_used;               /* entries of the chunks so far, with the gaps between parts */
+    Recent32 *recent;                  /* per thread: WELD_RECENT points seen last in the part it feeds */
     Py_buffer index;                   /* the caller's int32 output: bucket numbers until output() */
     int has_index;
     size_t arena_bytes;
@@ -855,6 +857,8 @@ pw_release(PartWelderObject *w)
         w->mark[t] = NULL;
         w->vcount[t] = w->vcap[t] = 0;
     }
+    free(w->recent);
+    w->recent = NULL;
     free(w->owner);
     free(w->v0);
     free(w->nv);
@@ -883,9 +887,12 @@ typedef struct {
     Py_ssize_t n0, n1, s0, s1, sc;
     PwChunk *chunk;
     int bits;
+    Recent32 *recent[MAX_THREADS];
 } PwFeedTask;
 
-/* Part t of the chunk: histogram of its points' buckets, then the stable scatter into its range. */
+/* Part t of the chunk.  A point the part's recent-point cache holds (full key compared) refers to that
+ * earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and then, in a
+ * second pass, copied with its corner into the part's range of the chunk's entries (a stable scatter). */
 static void
 pw_feed_task(void *ctx, int t, int nt)
 {
@@ -895,15 +902,27 @@ pw_feed_task(void *ctx, int t, int nt)
     int shift = 64 - f->bits;
     uint32_t *off = c->off + (size_t)t * (nb + 1);
     uint32_t cursor[(size_t)1 << PW_MAX_BITS];
+    Recent32 *recent = f->recent[t];
     memset(off, 0, (nb + 1) * sizeof(uint32_t));
+    memset(recent, 0, WELD_RECENT * sizeof(Recent32));
     Py_ssize_t i0 = (Py_ssize_t)lo / f->n1, i1 = (Py_ssize_t)lo % f->n1;
     for (size_t k = lo; k < hi; k++) {
         uint32_t key[3];
         pw_load(f->base + i0 * f->s0 + i1 * f->s1, f->sc, key);
         if (++i1 == f->n1) { i1 = 0; i0++; }
-        int32_t b = f->bits ? (int32_t)(hash32(key) >> shift) : 0;
+        uint64_t h = hash32(key);
+        Recent32 *r = recent + ((h >> 40) & (WELD_RECENT - 1));
+        if (r->id != 0 && r->k[0] == key[0] && r->k[1] == key[1] && r->k[2] == key[2]) {
+            c->bucket[k] = -(int32_t)r->id;                 /* id = corner + 1 */
+            continue;
+        }
+        int32_t b = f->bits ? (int32_t)(h >> shift) : 0;
         c->bucket[k] = b;
         off[b + 1]++;
+        r->k[0] = key[0];
+        r->k[1] = key[1];
+        r->k[2] = key[2];
+        r->id = c->corner0 + (uint32_t)k + 1;
     }
     off[0] = (uint32_t)lo;
     for (size_t b = 0; b < nb; b++) {
@@ -913,10 +932,13 @@ pw_feed_task(void *ctx, int t, int nt)
     i0 = (Py_ssize_t)lo / f->n1;
     i1 = (Py_ssize_t)lo % f->n1;
     for (size_t k = lo; k < hi; k++) {
-        PwEntry *e = c->entries + cursor[c->bucket[k]]++;
-        pw_load(f->base + i0 * f->s0 + i1 * f->s1, f->sc, e->k);
+        int32_t b = c->bucket[k];
+        if (b >= 0) {
+            PwEntry *e = c->entries + cursor[b]++;
+            pw_load(f->base + i0 * f->s0 + i1 * f->s1, f->sc, e->k);
+            e->corner = c->corner0 + (uint32_t)k;
+        }
         if (++i1 == f->n1) { i1 = 0; i0++; }
-        e->corner = c->corner0 + (uint32_t)k;
     }
 }
 
@@ -1111,8 +1133,9 @@ pw_gather_task(void *ctx, int t, int nt)
             memcpy(cursor, off, nb * sizeof(uint32_t));
             size_t lo = part_start(c->size, p, c->nt), hi = part_start(c->size, p + 1, c->nt);
             for (size_t k = lo; k < hi; k++) {
-                int32_t b = c->bucket[k];
-                out[k] = (int32_t)c->entries[cursor[b]++].k[0];
+                int32_t b = c->bucket[k];        /* the same memory as out[k] */
+                out[k] = b >= 0 ? (int32_t)c->entries[cursor[b]++].k[0]
+                                : o->index[-(int64_t)b - 1];    /* an earlier corner of this part: done */
             }
         }
     }
@@ -1166,7 +1189,8 @@ PartWelder_init(PartWelderObject *w, PyObject *args, PyObject *kwds)
     int fits = (size_t)n_points <= (SIZE_MAX - 64) / sizeof(PwEntry);
     w->arena_bytes = fits ? (size_t)n_points * sizeof(PwEntry) + 64 : 0;
     w->entries = fits ? (PwEntry *)arena_alloc(w->arena_bytes) : NULL;
-    int ok = w->owner && w->v0 && w->nv && w->vbase && w->rank && w->entries;
+    w->recent = (Recent32 *)malloc((size_t)w->threads * WELD_RECENT * sizeof(Recent32));
+    int ok = w->owner && w->v0 && w->nv && w->vbase && w->rank && w->entries && w->recent;
     for (int t = 0; t < w->threads && ok; t++) {
         w->mark[t] = (uint64_t *)calloc(words, sizeof(uint64_t));
         ok = w->mark[t] != NULL;
@@ -1252,7 +1276,7 @@ PartWelder_feed(PartWelderObject *w, PyObject *points_obj)
     int nt = thread_count(w->threads, total, (size_t)1 << 14);
     size_t nb = (size_t)1 << w->bits;
     PwChunk *c = &w->chunks[w->n_chunks];
-    c->entries = w->entries + w->points;
+    c->entries = w->entries + w->entries_used;
     c->bucket = (int32_t *)w->index.buf + w->points;
     c->off = (uint32_t *)malloc((size_t)nt * (nb + 1) * sizeof(uint32_t));
     c->corner0 = (uint32_t)w->points;
@@ -1264,13 +1288,17 @@ PartWelder_feed(PartWelderObject *w, PyObject *points_obj)
     }
     w->n_chunks++;
     PwFeedTask task = {(const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
-                       pts.strides[pts.ndim - 1], c, w->bits};
+                       pts.strides[pts.ndim - 1], c, w->bits, {NULL}};
+    for (int t = 0; t < nt; t++) {
+        task.recent[t] = w->recent + (size_t)t * WELD_RECENT;
+    }
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
     run_parallel(nt, pw_feed_task, &task);
     Py_END_ALLOW_THREADS
     w->busy = 0;
     w->points += total;
+    w->entries_used += c->off[(size_t)(nt - 1) * (nb + 1) + nb];   /* the end of the last part's entries */
     PyBuffer_Release(&pts);
     Py_RETURN_NONE;
 }
