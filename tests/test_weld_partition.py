@@ -57,6 +57,7 @@ def _part_welder(lib, points, threads=2, bits=-1, cuts=None, records=False):
             w.feed(points[a:b])
     assert w.points == len(points)
     out = np.empty((w.finish(), 3))
+    assert w.count <= w.partitioned <= len(points)    # every vertex's first corner reaches a bucket
     w.output(out)
     return out, ids
 
