@@ -31,9 +31,11 @@ __all__ = ["weld_exact", "weld_exact_stream", "weld_tolerance"]
 
 _CHUNK = 1 << 21
 #: Points from which a float32 stream is welded by the C extension's radix partition (``PartWelder``, on
-#: :func:`inertia_tool._native.threads` threads) rather than its one hash table (``Welder``): below it the
-#: table fits in the cache and the partition's extra pass over memory does not pay.
-PARTITION_MIN_POINTS = 1 << 20
+#: :func:`inertia_tool._native.threads` threads) rather than its one hash table (``Welder``): 2**22 corners,
+#: about 1.4M triangles.  At 3M corners (1M-face torus) both took the same CPU time (the table still largely
+#: in the cache) and the partition 2 % more peak memory; at 15.7M and 30M corners the partition took 0.79x
+#: and 0.54x the CPU time (docs/performance.md, "The weld by radix partition").
+PARTITION_MIN_POINTS = 1 << 22
 _MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xC2B2AE3D27D4EB4F), np.uint64(0x165667B19E3779F9))
 
 
