@@ -857,7 +857,7 @@ pw_release(PartWelderObject *w)
     }
     w->n_chunks = w->chunks_cap = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
-        free(w->verts[t]);
+        arena_free(w->verts[t], w->vcap[t] * sizeof(PwVertex));
         free(w->mark[t]);
         w->verts[t] = NULL;
         w->mark[t] = NULL;
@@ -977,15 +977,9 @@ pw_weld_task(void *ctx, int t, int nt)
                 points += off[b + 1] - off[b];
             }
         }
-        if (w->vcount[t] + points > w->vcap[t]) {
-            size_t cap = 2 * w->vcap[t] > w->vcount[t] + points ? 2 * w->vcap[t] : w->vcount[t] + points;
-            PwVertex *v = (PwVertex *)realloc(w->verts[t], (cap ? cap : 1) * sizeof(PwVertex));
-            if (v == NULL) {
-                __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
-                break;
-            }
-            w->verts[t] = v;
-            w->vcap[t] = cap;
+        if (w->vcount[t] + points > w->vcap[t]) {     /* cannot happen: vcap is all the points partitioned */
+            __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
+            break;
         }
         size_t cap = 64;
         while (cap < points / 2) {
@@ -1326,6 +1320,19 @@ PartWelder_finish(PartWelderObject *w, PyObject *unused)
     size_t nb = (size_t)1 << w->bits, words = (w->n_points + 63) / 64 + 1;
     PwTask task = {w, 0, 0};
     int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
+    /* each thread's vertices: reserved for every partitioned point (a thread's buckets hold no more), only
+     * the pages written become resident, and the pages go back to the system when the welder is done
+     * (memory from malloc in a worker thread could stay in that thread's heap) */
+    for (int t = 0; t < nt; t++) {
+        w->vcap[t] = w->partitioned ? w->partitioned : 1;
+        w->verts[t] = (PwVertex *)arena_alloc(w->vcap[t] * sizeof(PwVertex));
+        if (w->verts[t] == NULL) {
+            w->vcap[t] = 0;
+            pw_release(w);
+            w->state = 2;
+            return PyErr_NoMemory();
+        }
+    }
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
     run_parallel(nt, pw_weld_task, &task);
@@ -1378,7 +1385,8 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
                      w->count);
         goto fail;
     }
-    uint32_t *number = (uint32_t *)malloc((w->count ? w->count : 1) * sizeof(uint32_t));
+    size_t number_bytes = (w->count ? w->count : 1) * sizeof(uint32_t);
+    uint32_t *number = (uint32_t *)arena_alloc(number_bytes);
     if (number == NULL) {
         PyErr_NoMemory();
         goto fail;
@@ -1390,9 +1398,9 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
     run_parallel(nt, pw_number_task, &task);
     task.ticket = 0;
     run_parallel(nt, pw_gather_task, &task);
-    free(number);
-    pw_release(w);
+    arena_free(number, number_bytes);
     Py_END_ALLOW_THREADS
+    pw_release(w);                      /* releases the index buffer: with the GIL */
     w->busy = 0;
     w->state = 2;
     PyBuffer_Release(&vert);
