@@ -224,3 +224,16 @@ def test_partwelder_refuses_misuse(lib):
     empty = lib.PartWelder(np.empty(0, np.int32))
     assert empty.finish() == 0
     empty.output(np.empty((0, 3)))
+
+
+def test_partition_reads_any_strides(lib):
+    """Reversed arrays, reversed record views and reversed coordinate order (negative strides) are welded as
+    their contiguous copies are."""
+    pts = np.random.default_rng(3).integers(0, 9, size=(30_000, 3)).astype(np.float32)
+    rec = np.zeros(10_000, dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = pts.reshape(-1, 3, 3)
+    for view in (pts[::-1], rec["v"][::-1], rec["v"][:, ::-1], pts[:, ::-1]):
+        flat = np.ascontiguousarray(view).reshape(-1, 3)
+        got = _part_welder(lib, view.reshape(-1, 3) if view.ndim == 2 else view, 2, 3)
+        _same(got, _welder(lib, flat))
+        _same(got, _dict_weld(flat))
