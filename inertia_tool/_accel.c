@@ -11,6 +11,7 @@
  *   1. buffers     -- format / shape checks shared by the kernels
  *   1b. threads    -- run_parallel, the work tickets
  *   2. Welder      -- streaming exact weld of float32 or float64 points (mesh/weld.py)
+ *   2b. PartWelder -- the same weld of float32 points by radix partition, on several threads
  *   3. edge_census -- boundary / non-manifold / misoriented edges (mesh/checks.edge_topology)
  *   4. shell_labels-- union-find connected components of faces (mesh/checks.shell_labels)
  *   5. tetra_sums  -- signed-tetrahedron volume integrals with compensated sums (mass/volume._tetra_sums)
@@ -25,7 +26,8 @@
  *
  * Threads (section 1b): edge_census, tetra_sums and bounds take a `threads` count (default 1) and split
  * their work so that the result is identical whatever that count is; only the speed changes.  The weld
- * and the shell labels run on one thread (threaded versions were measured and did not pay on two cores).
+ * and the shell labels run on one thread (threaded versions were measured and did not pay on two cores);
+ * PartWelder (section 2b), the weld of large float32 streams, takes a `threads` count too.
  */
 
 #define PY_SSIZE_T_CLEAN
@@ -37,6 +39,9 @@
 #include <string.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if defined(__linux__)
+#include <sys/mman.h>
 #endif
 
 /* ======================================================================================================
@@ -728,6 +733,746 @@ static PyTypeObject WelderType = {
     .tp_dealloc = (destructor)Welder_dealloc,
     .tp_methods = Welder_methods,
     .tp_getset = Welder_getset,
+};
+
+/* ------------------------------------------------------------------------------------------------------
+ * 2b. PartWelder: the same exact weld of float32 points by radix partition, on several threads
+ *
+ * The Welder above probes one table of all the vertices: past a few million vertices that table lives in
+ * memory and every lookup the recent-point cache misses costs one or two cache misses (72 ns per corner on
+ * a 10M-face torus).  PartWelder splits the work so that every table fits in a core's L2 cache:
+ *
+ *   feed     each point is hashed (hash32, -0.0 folded onto +0.0); one that the thread's cache of the
+ *            4,096 points seen last holds (full key compared) refers to that earlier corner; any other is
+ *            copied with its corner number into one of 2**bits buckets chosen by the hash's top bits (a
+ *            radix partition: per thread a histogram of its half of the chunk, then a scatter); the output
+ *            index keeps each point's bucket or reference until output;
+ *   finish   each bucket (threads take the next bucket free) is welded in a small table: equal keys always
+ *            share a bucket, and a bucket holds its points in file order (chunks in order, a chunk's parts in
+ *            order, a part's points in order), so the first point of each distinct key in its bucket is its
+ *            first corner in the whole stream; that corner is marked in a bitmap of all corners;
+ *   output   a vertex's number is the count of marked corners before its first corner (first appearance
+ *            order, exactly the Welder's numbering); the vertices are written at their numbers, and every
+ *            corner's number is gathered in file order through its bucket's cursor (or copied from the
+ *            earlier corner it refers to, which is in the same chunk: done already).
+ *
+ * The result is the Welder's bit for bit (same keys, same equality, same numbering); only the order of the
+ * work differs, and no step depends on which thread did it.  Memory until output returns: 16 bytes (key,
+ * corner) per point the recent-point cache did not hold -- at most 48 per triangle, about the size of the
+ * binary STL (50 per triangle), 18-52 % of that on the benchmark meshes; the arena is reserved for
+ * all points but only the pages written are resident -- plus 20 per vertex and a bit per point per thread.
+ * The Welder's table is about 12 bytes per triangle.
+ * ------------------------------------------------------------------------------------------------------ */
+
+#define PW_MAX_BITS 12
+#define PW_TARGET_POINTS ((size_t)1 << 15)   /* points per bucket aimed at: table and keys stay in L2 */
+
+typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* after finish, k[0] is the local vertex id */
+typedef struct { uint32_t k[3]; uint32_t first; } PwVertex;   /* first corner; after output, its number */
+
+typedef struct {
+    PwEntry *entries;      /* the chunk's points; part t (corners [lo_t, hi_t)) occupies entries[lo_t, hi_t) */
+    int32_t *bucket;       /* bucket of each point of the chunk, in file order (its part of `index`) */
+    uint32_t *off;         /* nt * (B + 1): start of bucket b of part t at off[t * (B + 1) + b] */
+    uint32_t corner0;      /* the chunk's first corner */
+    uint32_t size;         /* its points */
+    int nt;
+} PwChunk;
+
+typedef struct {
+    PyObject_HEAD
+    int threads, bits, busy, state;    /* state: 0 feeding, 1 finished, 2 output written (released) */
+    size_t n_points, points;
+    PwEntry *entries;                  /* n_points entries: chunk after chunk (a big-page arena) */
+    size_t entries_used;               /* entries of the chunks so far, with the gaps between parts */
+    size_t partitioned;                /* points copied into the buckets (not found in a recent cache) */
+    Recent32 *recent;                  /* per thread: WELD_RECENT points seen last in the part it feeds */
+    Py_buffer index;                   /* the caller's int32 output: bucket numbers until output() */
+    int has_index;
+    size_t arena_bytes;
+    PwChunk *chunks;
+    size_t n_chunks, chunks_cap;
+    PwVertex *verts[MAX_THREADS];      /* vertices of the buckets each thread welded, bucket after bucket */
+    size_t vcount[MAX_THREADS], vcap[MAX_THREADS];
+    uint8_t *owner;                    /* per bucket: the thread that welded it */
+    size_t *v0;                        /* per bucket: its first vertex in verts[owner] */
+    uint32_t *nv;                      /* per bucket: its vertices */
+    uint32_t *vbase;                   /* per bucket: its first vertex in bucket order (B + 1) */
+    uint64_t *mark[MAX_THREADS];       /* per thread: bit c set when corner c is a vertex's first */
+    uint32_t *rank;                    /* per mark word: marked corners before it */
+    size_t count;
+} PartWelderObject;
+
+/* A large zeroed-on-demand allocation, backed by 2 MB pages where the kernel offers them: the points of a
+ * 10M-face file are 540 MB, and 4 kB pages would cost one page fault per 227 points. */
+static void *
+arena_alloc(size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    void *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) {
+        return NULL;
+    }
+    madvise(p, bytes, MADV_HUGEPAGE);     /* a hint: without it, ordinary pages */
+    return p;
+#else
+    return malloc(bytes);
+#endif
+}
+
+static void
+arena_free(void *p, size_t bytes)
+{
+    if (p == NULL) {
+        return;
+    }
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    munmap(p, bytes);
+#else
+    (void)bytes;
+    free(p);
+#endif
+}
+
+static inline uint32_t
+popcount64(uint64_t x)
+{
+    x = x - ((x >> 1) & 0x5555555555555555ULL);
+    x = (x & 0x3333333333333333ULL) + ((x >> 2) & 0x3333333333333333ULL);
+    x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0FULL;
+    return (uint32_t)((x * 0x0101010101010101ULL) >> 56);
+}
+
+static void
+pw_release(PartWelderObject *w)
+{
+    for (size_t i = 0; i < w->n_chunks; i++) {
+        free(w->chunks[i].off);
+    }
+    free(w->chunks);
+    w->chunks = NULL;
+    arena_free(w->entries, w->arena_bytes);
+    w->entries = NULL;
+    w->arena_bytes = 0;
+    if (w->has_index) {
+        PyBuffer_Release(&w->index);
+        w->has_index = 0;
+    }
+    w->n_chunks = w->chunks_cap = 0;
+    for (int t = 0; t < MAX_THREADS; t++) {
+        arena_free(w->verts[t], w->vcap[t] * sizeof(PwVertex));
+        free(w->mark[t]);
+        w->verts[t] = NULL;
+        w->mark[t] = NULL;
+        w->vcount[t] = w->vcap[t] = 0;
+    }
+    free(w->recent);
+    w->recent = NULL;
+    free(w->owner);
+    free(w->v0);
+    free(w->nv);
+    free(w->vbase);
+    free(w->rank);
+    w->owner = NULL;
+    w->v0 = NULL;
+    w->nv = NULL;
+    w->vbase = NULL;
+    w->rank = NULL;
+}
+
+static inline void
+pw_load(const char *p, Py_ssize_t sc, uint32_t *key)
+{
+    for (int c = 0; c < 3; c++) {
+        memcpy(&key[c], p + c * sc, 4);
+        if (key[c] == 0x80000000U) {
+            key[c] = 0;
+        }
+    }
+}
+
+typedef struct {
+    const char *base;
+    Py_ssize_t n0, n1, s0, s1, sc;
+    PwChunk *chunk;
+    int bits;
+    Recent32 *recent[MAX_THREADS];
+} PwFeedTask;
+
+/* Part t of the chunk.  A point the part's recent-point cache holds (full key compared) refers to that
+ * earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and then, in a
+ * second pass, copied with its corner into the part's range of the chunk's entries (a stable scatter). */
+static void
+pw_feed_task(void *ctx, int t, int nt)
+{
+    PwFeedTask *f = (PwFeedTask *)ctx;
+    PwChunk *c = f->chunk;
+    size_t nb = (size_t)1 << f->bits, lo = part_start(c->size, t, nt), hi = part_start(c->size, t + 1, nt);
+    int shift = 64 - f->bits;
+    uint32_t *off = c->off + (size_t)t * (nb + 1);
+    uint32_t cursor[(size_t)1 << PW_MAX_BITS];
+    Recent32 *recent = f->recent[t];
+    memset(off, 0, (nb + 1) * sizeof(uint32_t));
+    memset(recent, 0, WELD_RECENT * sizeof(Recent32));
+    Py_ssize_t i0 = (Py_ssize_t)lo / f->n1, i1 = (Py_ssize_t)lo % f->n1;
+    for (size_t k = lo; k < hi; k++) {
+        uint32_t key[3];
+        pw_load(f->base + i0 * f->s0 + i1 * f->s1, f->sc, key);
+        if (++i1 == f->n1) { i1 = 0; i0++; }
+        uint64_t h = hash32(key);
+        Recent32 *r = recent + ((h >> 40) & (WELD_RECENT - 1));
+        if (r->id != 0 && r->k[0] == key[0] && r->k[1] == key[1] && r->k[2] == key[2]) {
+            c->bucket[k] = -(int32_t)r->id;                 /* id = corner + 1 */
+            continue;
+        }
+        int32_t b = f->bits ? (int32_t)(h >> shift) : 0;
+        c->bucket[k] = b;
+        off[b + 1]++;
+        r->k[0] = key[0];
+        r->k[1] = key[1];
+        r->k[2] = key[2];
+        r->id = c->corner0 + (uint32_t)k + 1;
+    }
+    off[0] = (uint32_t)lo;
+    for (size_t b = 0; b < nb; b++) {
+        off[b + 1] += off[b];
+        cursor[b] = off[b];
+    }
+    i0 = (Py_ssize_t)lo / f->n1;
+    i1 = (Py_ssize_t)lo % f->n1;
+    for (size_t k = lo; k < hi; k++) {
+        int32_t b = c->bucket[k];
+        if (b >= 0) {
+            PwEntry *e = c->entries + cursor[b]++;
+            pw_load(f->base + i0 * f->s0 + i1 * f->s1, f->sc, e->k);
+            e->corner = c->corner0 + (uint32_t)k;
+        }
+        if (++i1 == f->n1) { i1 = 0; i0++; }
+    }
+}
+
+typedef struct {
+    PartWelderObject *w;
+    int32_t ticket;
+    int nomem;
+} PwTask;
+
+/* Weld the buckets this thread draws: a table of local ids (load <= 1/2, doubled when full) per bucket. */
+static void
+pw_weld_task(void *ctx, int t, int nt)
+{
+    PwTask *task = (PwTask *)ctx;
+    PartWelderObject *w = task->w;
+    size_t nb = (size_t)1 << w->bits;
+    uint32_t *slots = NULL;
+    size_t slots_cap = 0;
+    uint64_t *mark = w->mark[t];
+    for (;;) {
+        int32_t b = next_ticket(&task->ticket);
+        if (b < 0 || (size_t)b >= nb || __atomic_load_n(&task->nomem, __ATOMIC_RELAXED)) {
+            break;
+        }
+        size_t points = 0;
+        for (size_t i = 0; i < w->n_chunks; i++) {
+            const PwChunk *c = &w->chunks[i];
+            for (int p = 0; p < c->nt; p++) {
+                const uint32_t *off = c->off + (size_t)p * (nb + 1);
+                points += off[b + 1] - off[b];
+            }
+        }
+        if (w->vcount[t] + points > w->vcap[t]) {     /* cannot happen: vcap is all the points partitioned */
+            __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
+            break;
+        }
+        size_t cap = 64;
+        while (cap < points / 2) {
+            cap *= 2;
+        }
+        if (cap > slots_cap) {
+            free(slots);
+            slots = (uint32_t *)malloc(cap * sizeof(uint32_t));
+            slots_cap = slots ? cap : 0;
+            if (slots == NULL) {
+                __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
+                break;
+            }
+        }
+        memset(slots, 0, cap * sizeof(uint32_t));
+        size_t mask = cap - 1, count = 0;
+        PwVertex *vs = w->verts[t] + w->vcount[t];
+        int failed = 0;
+        for (size_t i = 0; i < w->n_chunks && !failed; i++) {
+            const PwChunk *c = &w->chunks[i];
+            for (int p = 0; p < c->nt && !failed; p++) {
+                const uint32_t *off = c->off + (size_t)p * (nb + 1);
+                for (PwEntry *e = c->entries + off[b], *end = c->entries + off[b + 1]; e < end; e++) {
+                    size_t j = (size_t)hash32(e->k) & mask;
+                    uint32_t id;
+                    for (;;) {          /* the load stays <= 1/2: an empty slot exists */
+                        id = slots[j];
+                        if (id == 0) {
+                            break;
+                        }
+                        const PwVertex *o = vs + (id - 1);
+                        if (o->k[0] == e->k[0] && o->k[1] == e->k[1] && o->k[2] == e->k[2]) {
+                            break;
+                        }
+                        j = (j + 1) & mask;
+                    }
+                    if (id == 0) {
+                        PwVertex *nv = vs + count;
+                        nv->k[0] = e->k[0];
+                        nv->k[1] = e->k[1];
+                        nv->k[2] = e->k[2];
+                        nv->first = e->corner;
+                        mark[e->corner >> 6] |= (uint64_t)1 << (e->corner & 63);
+                        id = (uint32_t)++count;
+                        slots[j] = id;
+                        if (2 * count > cap) {       /* double the table and re-insert the ids */
+                            size_t ncap = 2 * cap;
+                            uint32_t *ns = (uint32_t *)calloc(ncap, sizeof(uint32_t));
+                            if (ns == NULL) {
+                                __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
+                                failed = 1;
+                                break;
+                            }
+                            for (size_t v = 0; v < count; v++) {
+                                size_t q = (size_t)hash32(vs[v].k) & (ncap - 1);
+                                while (ns[q] != 0) {
+                                    q = (q + 1) & (ncap - 1);
+                                }
+                                ns[q] = (uint32_t)(v + 1);
+                            }
+                            free(slots);
+                            slots = ns;
+                            cap = slots_cap = ncap;
+                            mask = cap - 1;
+                        }
+                    }
+                    e->k[0] = id - 1;
+                }
+            }
+        }
+        if (failed) {
+            break;
+        }
+        w->owner[b] = (uint8_t)t;
+        w->v0[b] = w->vcount[t];
+        w->nv[b] = (uint32_t)count;
+        w->vcount[t] += count;
+    }
+    free(slots);
+    (void)nt;
+}
+
+typedef struct {
+    PartWelderObject *w;
+    double *vertices;
+    int32_t *index;
+    uint32_t *number;     /* per vertex in bucket order: its number */
+    int32_t ticket;
+} PwOutTask;
+
+/* Number the vertices of the buckets this thread draws, write their coordinates at their numbers, and
+ * replace each of the bucket's points' local id by its vertex's number. */
+static void
+pw_number_task(void *ctx, int t, int nt)
+{
+    PwOutTask *o = (PwOutTask *)ctx;
+    PartWelderObject *w = o->w;
+    size_t nb = (size_t)1 << w->bits;
+    const uint64_t *mark = w->mark[0];
+    for (;;) {
+        int32_t b = next_ticket(&o->ticket);
+        if (b < 0 || (size_t)b >= nb) {
+            break;
+        }
+        const PwVertex *vs = w->verts[w->owner[b]] + w->v0[b];
+        uint32_t *number = o->number + w->vbase[b];
+        for (size_t l = 0; l < w->nv[b]; l++) {
+            uint32_t p = vs[l].first;
+            uint64_t below = mark[p >> 6] & (((uint64_t)1 << (p & 63)) - 1);
+            uint32_t g = w->rank[p >> 6] + popcount64(below);
+            number[l] = g;
+            double *v = o->vertices + 3 * (size_t)g;
+            for (int c = 0; c < 3; c++) {
+                float x;
+                memcpy(&x, &vs[l].k[c], 4);
+                v[c] = (double)x;
+            }
+        }
+        /* the bucket's points: local id -> number, while the bucket's numbers are in this core's cache */
+        for (size_t i = 0; i < w->n_chunks; i++) {
+            const PwChunk *c = &w->chunks[i];
+            for (int p = 0; p < c->nt; p++) {
+                const uint32_t *off = c->off + (size_t)p * (nb + 1);
+                for (PwEntry *e = c->entries + off[b], *end = c->entries + off[b + 1]; e < end; e++) {
+                    e->k[0] = number[e->k[0]];
+                }
+            }
+        }
+    }
+    (void)t;
+    (void)nt;
+}
+
+/* The corners of the chunks this thread draws, in file order, each through its bucket's cursor. */
+static void
+pw_gather_task(void *ctx, int t, int nt)
+{
+    PwOutTask *o = (PwOutTask *)ctx;
+    PartWelderObject *w = o->w;
+    size_t nb = (size_t)1 << w->bits;
+    uint32_t cursor[(size_t)1 << PW_MAX_BITS];
+    for (;;) {
+        int32_t u = next_ticket(&o->ticket);
+        if (u < 0 || (size_t)u >= w->n_chunks) {
+            break;
+        }
+        const PwChunk *c = &w->chunks[u];
+        int32_t *out = o->index + c->corner0;
+        for (int p = 0; p < c->nt; p++) {
+            const uint32_t *off = c->off + (size_t)p * (nb + 1);
+            memcpy(cursor, off, nb * sizeof(uint32_t));
+            size_t lo = part_start(c->size, p, c->nt), hi = part_start(c->size, p + 1, c->nt);
+            for (size_t k = lo; k < hi; k++) {
+                int32_t b = c->bucket[k];        /* the same memory as out[k] */
+                out[k] = b >= 0 ? (int32_t)c->entries[cursor[b]++].k[0]
+                                : o->index[-(int64_t)b - 1];    /* an earlier corner of this part: done */
+            }
+        }
+    }
+    (void)t;
+    (void)nt;
+}
+
+static int
+PartWelder_init(PartWelderObject *w, PyObject *args, PyObject *kwds)
+{
+    static char *kwlist[] = {"index", "threads", "bucket_bits", NULL};
+    PyObject *index_obj;
+    int threads = 1, bits = -1;
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "O|ii", kwlist, &index_obj, &threads, &bits)) {
+        return -1;
+    }
+    if (w->owner != NULL || w->state != 0 || w->points != 0) {
+        PyErr_SetString(PyExc_RuntimeError, "PartWelder is already initialised");
+        return -1;
+    }
+    if (bits > PW_MAX_BITS) {
+        PyErr_Format(PyExc_ValueError, "Expected bucket_bits <= %d, got %d", PW_MAX_BITS, bits);
+        return -1;
+    }
+    if (PyObject_GetBuffer(index_obj, &w->index, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        return -1;
+    }
+    w->has_index = 1;
+    Py_ssize_t n_points = w->index.len / 4;
+    if (signed_int_size(&w->index) != 4 || w->index.ndim != 1 || (size_t)n_points > MAX_VERTICES) {
+        PyErr_SetString(PyExc_ValueError, "Expected `index` as a contiguous int32 array of fewer than 2**31 - 1 "
+                        "entries");
+        pw_release(w);
+        return -1;
+    }
+    if (bits < 0) {
+        bits = 0;
+        while (bits < PW_MAX_BITS && ((size_t)PW_TARGET_POINTS << bits) < (size_t)n_points) {
+            bits++;
+        }
+    }
+    size_t nb = (size_t)1 << bits, words = ((size_t)n_points + 63) / 64 + 1;
+    w->threads = thread_count(threads, (size_t)n_points, 1);
+    w->bits = bits;
+    w->n_points = (size_t)n_points;
+    w->owner = (uint8_t *)calloc(nb, 1);
+    w->v0 = (size_t *)calloc(nb, sizeof(size_t));
+    w->nv = (uint32_t *)calloc(nb, sizeof(uint32_t));
+    w->vbase = (uint32_t *)calloc(nb + 1, sizeof(uint32_t));
+    w->rank = (uint32_t *)malloc(words * sizeof(uint32_t));
+    int fits = (size_t)n_points <= (SIZE_MAX - 64) / sizeof(PwEntry);
+    w->arena_bytes = fits ? (size_t)n_points * sizeof(PwEntry) + 64 : 0;
+    w->entries = fits ? (PwEntry *)arena_alloc(w->arena_bytes) : NULL;
+    w->recent = (Recent32 *)malloc((size_t)w->threads * WELD_RECENT * sizeof(Recent32));
+    int ok = w->owner && w->v0 && w->nv && w->vbase && w->rank && w->entries && w->recent;
+    for (int t = 0; t < w->threads && ok; t++) {
+        w->mark[t] = (uint64_t *)calloc(words, sizeof(uint64_t));
+        ok = w->mark[t] != NULL;
+    }
+    if (!ok) {
+        pw_release(w);
+        PyErr_NoMemory();
+        return -1;
+    }
+    return 0;
+}
+
+static void
+PartWelder_dealloc(PartWelderObject *w)
+{
+    pw_release(w);
+    Py_TYPE(w)->tp_free((PyObject *)w);
+}
+
+static int
+pw_ready(PartWelderObject *w, int state)
+{
+    if (w->owner == NULL && w->state == 0) {
+        PyErr_SetString(PyExc_RuntimeError, "PartWelder was not initialised");
+        return -1;
+    }
+    if (w->busy) {
+        PyErr_SetString(PyExc_RuntimeError, "PartWelder is in use by another thread");
+        return -1;
+    }
+    if (w->state != state) {
+        static const char *what[] = {"feeding", "finished", "written out"};
+        PyErr_Format(PyExc_RuntimeError, "Expected a PartWelder %s, got one %s", what[state], what[w->state]);
+        return -1;
+    }
+    return 0;
+}
+
+/* PartWelder.feed(points): partition (k, 3) or (k, j, 3) float32 points (any strides) into the buckets. */
+static PyObject *
+PartWelder_feed(PartWelderObject *w, PyObject *points_obj)
+{
+    if (pw_ready(w, 0) < 0) {
+        return NULL;
+    }
+    Py_buffer pts;
+    if (PyObject_GetBuffer(points_obj, &pts, PyBUF_STRIDES | PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    if (native_code(pts.format) != 'f' || pts.itemsize != 4 || (pts.ndim != 2 && pts.ndim != 3)
+            || pts.shape[pts.ndim - 1] != 3) {
+        PyErr_Format(PyExc_ValueError, "Expected points as a (k, 3) or (k, j, 3) float32 array, got format %s "
+                     "with %d dimensions", pts.format ? pts.format : "B", pts.ndim);
+        PyBuffer_Release(&pts);
+        return NULL;
+    }
+    Py_ssize_t n0 = pts.shape[0], n1 = pts.ndim == 3 ? pts.shape[1] : 1;
+    if (n1 != 0 && n0 > PY_SSIZE_T_MAX / n1) {
+        PyBuffer_Release(&pts);
+        PyErr_SetString(PyExc_OverflowError, "too many points");
+        return NULL;
+    }
+    size_t total = (size_t)(n0 * n1);
+    if (total > w->n_points - w->points) {
+        PyBuffer_Release(&pts);
+        PyErr_Format(PyExc_ValueError, "Expected %zu points in all, got more", w->n_points);
+        return NULL;
+    }
+    if (total == 0) {
+        PyBuffer_Release(&pts);
+        Py_RETURN_NONE;
+    }
+    if (w->n_chunks == w->chunks_cap) {
+        size_t cap = w->chunks_cap ? 2 * w->chunks_cap : 16;
+        PwChunk *chunks = (PwChunk *)realloc(w->chunks, cap * sizeof(PwChunk));
+        if (chunks == NULL) {
+            PyBuffer_Release(&pts);
+            return PyErr_NoMemory();
+        }
+        w->chunks = chunks;
+        w->chunks_cap = cap;
+    }
+    int nt = thread_count(w->threads, total, (size_t)1 << 14);
+    size_t nb = (size_t)1 << w->bits;
+    PwChunk *c = &w->chunks[w->n_chunks];
+    c->entries = w->entries + w->entries_used;
+    c->bucket = (int32_t *)w->index.buf + w->points;
+    c->off = (uint32_t *)malloc((size_t)nt * (nb + 1) * sizeof(uint32_t));
+    c->corner0 = (uint32_t)w->points;
+    c->size = (uint32_t)total;
+    c->nt = nt;
+    if (c->off == NULL) {
+        PyBuffer_Release(&pts);
+        return PyErr_NoMemory();
+    }
+    w->n_chunks++;
+    PwFeedTask task = {(const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
+                       pts.strides[pts.ndim - 1], c, w->bits, {NULL}};
+    for (int t = 0; t < nt; t++) {
+        task.recent[t] = w->recent + (size_t)t * WELD_RECENT;
+    }
+    w->busy = 1;
+    Py_BEGIN_ALLOW_THREADS
+    run_parallel(nt, pw_feed_task, &task);
+    Py_END_ALLOW_THREADS
+    w->busy = 0;
+    w->points += total;
+    w->entries_used += c->off[(size_t)(nt - 1) * (nb + 1) + nb];   /* the end of the last part's entries */
+    for (int t = 0; t < nt; t++) {
+        w->partitioned += c->off[(size_t)t * (nb + 1) + nb] - c->off[(size_t)t * (nb + 1)];
+    }
+    PyBuffer_Release(&pts);
+    Py_RETURN_NONE;
+}
+
+/* PartWelder.finish() -> count: weld every bucket; the number of distinct points. */
+static PyObject *
+PartWelder_finish(PartWelderObject *w, PyObject *unused)
+{
+    if (pw_ready(w, 0) < 0) {
+        return NULL;
+    }
+    if (w->points != w->n_points) {
+        PyErr_Format(PyExc_ValueError, "Expected %zu points, got %zu", w->n_points, (size_t)w->points);
+        return NULL;
+    }
+    size_t nb = (size_t)1 << w->bits, words = (w->n_points + 63) / 64 + 1;
+    PwTask task = {w, 0, 0};
+    int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
+    /* each thread's vertices: reserved for every partitioned point (a thread's buckets hold no more), only
+     * the pages written become resident, and the pages go back to the system when the welder is done
+     * (memory from malloc in a worker thread could stay in that thread's heap) */
+    for (int t = 0; t < nt; t++) {
+        w->vcap[t] = w->partitioned ? w->partitioned : 1;
+        w->verts[t] = (PwVertex *)arena_alloc(w->vcap[t] * sizeof(PwVertex));
+        if (w->verts[t] == NULL) {
+            w->vcap[t] = 0;
+            pw_release(w);
+            w->state = 2;
+            return PyErr_NoMemory();
+        }
+    }
+    w->busy = 1;
+    Py_BEGIN_ALLOW_THREADS
+    run_parallel(nt, pw_weld_task, &task);
+    if (!task.nomem) {
+        uint64_t *mark = w->mark[0];
+        uint32_t run = 0;
+        for (size_t i = 0; i < words; i++) {
+            uint64_t m = mark[i];
+            for (int t = 1; t < w->threads; t++) {
+                m |= w->mark[t][i];
+            }
+            mark[i] = m;
+            w->rank[i] = run;
+            run += popcount64(m);
+        }
+        for (int t = 1; t < w->threads; t++) {
+            free(w->mark[t]);
+            w->mark[t] = NULL;
+        }
+        w->count = run;
+        for (size_t b = 0; b < nb; b++) {
+            w->vbase[b + 1] = w->vbase[b] + w->nv[b];
+        }
+    }
+    Py_END_ALLOW_THREADS
+    w->busy = 0;
+    if (task.nomem) {
+        pw_release(w);
+        w->state = 2;
+        return PyErr_NoMemory();
+    }
+    w->state = 1;
+    return PyLong_FromSize_t(w->count);
+}
+
+/* PartWelder.output(vertices): each point's vertex id into `index` (the array given to the constructor),
+ * the distinct points into the contiguous float64 `vertices` (count, 3); then the welder's memory is freed. */
+static PyObject *
+PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
+{
+    if (pw_ready(w, 1) < 0) {
+        return NULL;
+    }
+    Py_buffer vert;
+    if (PyObject_GetBuffer(vert_obj, &vert, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        return NULL;
+    }
+    if (native_code(vert.format) != 'd' || vert.itemsize != 8 || vert.len != (Py_ssize_t)(w->count * 3 * 8)) {
+        PyErr_Format(PyExc_ValueError, "Expected `vertices` as a contiguous float64 array of shape (%zu, 3)",
+                     w->count);
+        goto fail;
+    }
+    size_t number_bytes = (w->count ? w->count : 1) * sizeof(uint32_t);
+    uint32_t *number = (uint32_t *)arena_alloc(number_bytes);
+    if (number == NULL) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    PwOutTask task = {w, (double *)vert.buf, (int32_t *)w->index.buf, number, 0};
+    int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
+    w->busy = 1;
+    Py_BEGIN_ALLOW_THREADS
+    run_parallel(nt, pw_number_task, &task);
+    task.ticket = 0;
+    run_parallel(nt, pw_gather_task, &task);
+    arena_free(number, number_bytes);
+    Py_END_ALLOW_THREADS
+    pw_release(w);                      /* releases the index buffer: with the GIL */
+    w->busy = 0;
+    w->state = 2;
+    PyBuffer_Release(&vert);
+    Py_RETURN_NONE;
+fail:
+    PyBuffer_Release(&vert);
+    return NULL;
+}
+
+static PyObject *
+PartWelder_get_count(PartWelderObject *w, void *closure)
+{
+    return PyLong_FromSize_t(w->state >= 1 ? w->count : 0);
+}
+
+static PyObject *
+PartWelder_get_points(PartWelderObject *w, void *closure)
+{
+    return PyLong_FromSize_t(w->points);
+}
+
+static PyObject *
+PartWelder_get_partitioned(PartWelderObject *w, void *closure)
+{
+    return PyLong_FromSize_t(w->partitioned);
+}
+
+static PyObject *
+PartWelder_get_buckets(PartWelderObject *w, void *closure)
+{
+    return PyLong_FromLong(1L << w->bits);
+}
+
+static PyMethodDef PartWelder_methods[] = {
+    {"feed", (PyCFunction)PartWelder_feed, METH_O,
+     "feed(points)\n\nPartition (k, 3) or (k, j, 3) float32 points (any strides; -0.0 equals +0.0), the next "
+     "k[*j] of the stream, into the buckets."},
+    {"finish", (PyCFunction)PartWelder_finish, METH_NOARGS,
+     "finish() -> count\n\nWeld every bucket once all n_points are fed; the number of distinct points."},
+    {"output", (PyCFunction)PartWelder_output, METH_O,
+     "output(vertices)\n\nWrite each point's vertex id (first-appearance order) into the constructor's `index` "
+     "and the distinct points into the (count, 3) float64 array `vertices`; frees the welder's memory."},
+    {NULL, NULL, 0, NULL}
+};
+
+static PyGetSetDef PartWelder_getset[] = {
+    {"count", (getter)PartWelder_get_count, NULL, "Distinct points (after finish).", NULL},
+    {"points", (getter)PartWelder_get_points, NULL, "Points fed so far.", NULL},
+    {"buckets", (getter)PartWelder_get_buckets, NULL, "Buckets of the radix partition.", NULL},
+    {"partitioned", (getter)PartWelder_get_partitioned, NULL,
+     "Points copied into the buckets so far (the others were found in a recent-point cache).", NULL},
+    {NULL, NULL, NULL, NULL, NULL}
+};
+
+static PyTypeObject PartWelderType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "inertia_tool._accel.PartWelder",
+    .tp_doc = "PartWelder(index, threads=1, bucket_bits=-1)\n\nExact weld of a stream of len(index) float32 "
+              "points by radix partition into buckets welded in cache-sized tables on `threads` threads: "
+              "feed() every chunk, finish(), output(vertices); each point's vertex id lands in `index` (a "
+              "contiguous int32 array, which holds bucket numbers until then).  The same result as Welder.",
+    .tp_basicsize = sizeof(PartWelderObject),
+    .tp_itemsize = 0,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)PartWelder_init,
+    .tp_dealloc = (destructor)PartWelder_dealloc,
+    .tp_methods = PartWelder_methods,
+    .tp_getset = PartWelder_getset,
 };
 
 /* ======================================================================================================
@@ -1737,7 +2482,7 @@ static struct PyModuleDef accel_module = {
 PyMODINIT_FUNC
 PyInit__accel(void)
 {
-    if (PyType_Ready(&WelderType) < 0) {
+    if (PyType_Ready(&WelderType) < 0 || PyType_Ready(&PartWelderType) < 0) {
         return NULL;
     }
     PyObject *mod = PyModule_Create(&accel_module);
@@ -1747,6 +2492,12 @@ PyInit__accel(void)
     Py_INCREF(&WelderType);
     if (PyModule_AddObject(mod, "Welder", (PyObject *)&WelderType) < 0) {
         Py_DECREF(&WelderType);
+        Py_DECREF(mod);
+        return NULL;
+    }
+    Py_INCREF(&PartWelderType);
+    if (PyModule_AddObject(mod, "PartWelder", (PyObject *)&PartWelderType) < 0) {
+        Py_DECREF(&PartWelderType);
         Py_DECREF(mod);
         return NULL;
     }

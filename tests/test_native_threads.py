@@ -3,8 +3,9 @@
 The edge census splits start vertices; the tetrahedron sums and the face measures add a fixed number of lanes
 in lane order; the bounds split rows; the face-pair check takes node pairs by ticket (same set of pairs).
 Each is compared here, on meshes above the kernels' thresholds for using threads, with its own one-thread
-result (bit for bit) and with the numpy reference.  The welder and the shell labels run on one thread; they
-are checked on the same mesh.
+result (bit for bit) and with the numpy reference.  The radix-partition welder takes buckets by ticket and
+numbers vertices by first appearance: the one-table Welder's result whatever the thread count.  The one-table
+welder and the shell labels run on one thread; they are checked on the same mesh.
 """
 
 import numpy as np
@@ -66,6 +67,28 @@ def test_welder_on_a_large_stream_matches_first_appearance(lib, damaged):
         assert np.all(np.diff(first) > 0)
         np.testing.assert_array_equal(out[ids], np.where(corners == 0, 0.0, corners))
         assert w.count == len(np.unique(np.where(corners == 0, 0.0, corners), axis=0))
+
+
+def test_partition_welder_is_independent_of_threads(lib, damaged):
+    """PartWelder on 1.2M corners (some -0.0) with 1, 2, 3 and 5 threads, in the reader's chunk size: the
+    one-table Welder's vertices and ids, bit for bit (ThreadSanitizer runs this via scripts/tsan.sh)."""
+    v, f = damaged
+    corners = v.astype(np.float32)[f].reshape(-1, 3)
+    corners[::97] *= -0.0
+    ref_ids = np.empty(len(corners), dtype=np.int32)
+    w = lib.Welder("float32", len(corners) // 6)
+    w.feed(corners, ref_ids)
+    ref = np.empty((w.count, 3))
+    w.vertices_into(ref)
+    for threads in (1,) + THREADS:
+        ids = np.empty(len(corners), dtype=np.int32)
+        p = lib.PartWelder(ids, threads)
+        for s in range(0, len(corners), 3 << 17):
+            p.feed(corners[s:s + (3 << 17)])
+        out = np.empty((p.finish(), 3))
+        p.output(out)
+        np.testing.assert_array_equal(ids, ref_ids)
+        np.testing.assert_array_equal(out.view(np.uint64), ref.view(np.uint64))
 
 
 def test_edge_census_is_independent_of_threads(lib, damaged):

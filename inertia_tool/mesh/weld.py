@@ -8,11 +8,14 @@ exporter rounded shared corners differently.  Welding never moves a coordinate t
 
 Vertices are numbered in order of first appearance in the corner stream, whichever path welds them.
 
-Two implementations give identical results: the C extension's ``Welder`` (an open-addressing hash table on
+Three implementations give identical results: the C extension's ``Welder`` (an open-addressing hash table on
 the exact 12 or 24 bytes of a point, fed chunk by chunk in one pass, about 12 bytes per triangle beyond
-the output; see ``inertia_tool._native``) and the numpy reference below, which reads the corners in
-chunks (twice) and holds only 64-bit keys and 32-bit indices, about 72 bytes per triangle at its peak.
-Either way a 5M-face binary STL never exists as a float64 soup.
+the output; see ``inertia_tool._native``); its ``PartWelder`` for large float32 streams (binary STL), which
+partitions the points by hash into buckets as they stream in and welds each bucket in a table that fits in
+a core's cache, on several threads (48 bytes per triangle until it returns, about the file's size); and
+the numpy reference below, which reads the corners in chunks (twice) and holds only 64-bit keys and 32-bit
+indices, about 72 bytes per triangle at its peak.  Either way a 5M-face binary STL never exists as a
+float64 soup.
 """
 
 from __future__ import annotations
@@ -22,11 +25,17 @@ from types import ModuleType
 
 import numpy as np
 
-from .._native import accel
+from .._native import accel, threads
 
 __all__ = ["weld_exact", "weld_exact_stream", "weld_tolerance"]
 
 _CHUNK = 1 << 21
+#: Points from which a float32 stream is welded by the C extension's radix partition (``PartWelder``, on
+#: :func:`inertia_tool._native.threads` threads) rather than its one hash table (``Welder``): 2**22 corners,
+#: about 1.4M triangles.  At 3M corners (1M-face torus) both took the same CPU time (the table still largely
+#: in the cache) and the partition 2 % more peak memory; at 15.7M and 30M corners the partition took 0.79x
+#: and 0.54x the CPU time (docs/performance.md, "The weld by radix partition").
+PARTITION_MIN_POINTS = 1 << 22
 _MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xC2B2AE3D27D4EB4F), np.uint64(0x165667B19E3779F9))
 
 
@@ -82,9 +91,51 @@ def _renumber_by_first_appearance(inverse: np.ndarray, first: np.ndarray) -> Non
         inverse[s:s + _CHUNK] = new_id[inverse[s:s + _CHUNK]]
 
 
+def _weld_partitioned(lib: ModuleType, stream: Iterable[np.ndarray], n_points: int) -> tuple[np.ndarray, np.ndarray]:
+    """``weld_exact_stream`` of float32 points on the C extension's radix partition (``PartWelder``).
+
+    The points are partitioned by hash into buckets as they stream in, each bucket is welded in a table that
+    fits in a core's cache, and the vertices are numbered by first appearance: the same vertices and faces as
+    the one-table ``Welder``, on :func:`inertia_tool._native.threads` threads.
+    """
+    index = np.empty(n_points, dtype=np.int32)
+    welder = lib.PartWelder(index, threads())
+    s = 0
+    for c in stream:
+        c = np.asarray(c)
+        if c.ndim == 2 and c.shape[1] == 4:
+            c = c[:, :3]                       # the padded (x, y, z, 0) layout of the numpy path
+        if c.dtype != np.float32 or not c.dtype.isnative:
+            if c.dtype.kind != "f" or c.dtype.itemsize != 4:
+                raise ValueError(f"Expected every chunk as float32 like the first one, got {c.dtype}")
+            c = c.astype(np.float32)
+        k = c.size // 3
+        if s + k > n_points:
+            raise ValueError(f"expected {n_points} points from the stream, got more")
+        welder.feed(c)
+        s += k
+    if s != n_points:
+        raise ValueError(f"expected {n_points} points from the stream, got {s}")
+    vertices = np.empty((welder.finish(), 3), dtype=np.float64)
+    welder.output(vertices)
+    return vertices, index.reshape(-1, 3)
+
+
+def _chain(first: np.ndarray, rest: Iterator[np.ndarray]) -> Iterator[np.ndarray]:
+    yield first
+    yield from rest
+
+
 def _weld_stream_c(lib: ModuleType, chunks: Callable[[], Iterable[np.ndarray]],
                    n_points: int) -> tuple[np.ndarray, np.ndarray]:
-    """``weld_exact_stream`` on the C extension's hash table: one pass, no keys array, no sort."""
+    """``weld_exact_stream`` on the C extension: a float32 stream of at least ``PARTITION_MIN_POINTS`` points
+    by radix partition on several threads, any other in one hash table (one pass, no keys array, no sort)."""
+    if n_points >= PARTITION_MIN_POINTS:
+        it = iter(chunks())
+        first = next(it, None)
+        if first is not None and np.asarray(first).dtype == np.float32:
+            return _weld_partitioned(lib, _chain(first, it), n_points)
+        chunks = _restart(first, it)
     index = np.empty(n_points, dtype=np.int32)
     welder = None
     wide = False
@@ -111,6 +162,15 @@ def _weld_stream_c(lib: ModuleType, chunks: Callable[[], Iterable[np.ndarray]],
     if welder is not None:
         welder.vertices_into(vertices)
     return vertices, index.reshape(-1, 3)
+
+
+def _restart(first: np.ndarray | None, rest: Iterator[np.ndarray]) -> Callable[[], Iterator[np.ndarray]]:
+    """A one-shot chunk factory over a stream whose first chunk was already taken."""
+    def chunks() -> Iterator[np.ndarray]:
+        if first is not None:
+            yield first
+        yield from rest
+    return chunks
 
 
 def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int) -> tuple[np.ndarray, np.ndarray]:
