@@ -335,6 +335,41 @@ def test_a_primitive_fitted_to_a_mesh_matches_mujoco(tmp_path, kind):
     _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-6)     # float32 STL corners
 
 
+@pytest.mark.parametrize("kind", ["capsule", "cylinder", "box", "sphere", "ellipsoid"])
+def test_a_primitive_fitted_to_a_meshs_bounding_box_matches_mujoco(tmp_path, kind):
+    # Menagerie's realsense_d435i: <compiler fitaabb="true"> and a capsule fitted to a mesh, refused before; the
+    # mesh is a convex hull of scattered points, so the bounding box's centre is not the centre of volume
+    trimesh = pytest.importorskip("trimesh")
+    points = np.random.default_rng(23).normal(size=(40, 3)) * [0.03, 0.05, 0.12] + [0.2, 0.1, -0.1]
+    trimesh.convex.convex_hull(points).export(tmp_path / "hull.stl")
+    path = tmp_path / "fit.xml"
+    path.write_text('<mujoco><compiler inertiafromgeom="true" fitaabb="true"/><asset><mesh name="m" '
+                    'file="hull.stl" scale="1 1.5 1"/></asset><worldbody><body name="b"><freejoint/>'
+                    f'<geom type="{kind}" mesh="m" pos="0.01 0 0.02" euler="0.1 0.2 0.3" fitscale="1.2"/>'
+                    '</body></worldbody></mujoco>')
+    robot = read_robot(path)
+    assert robot.links[0].elements[0].fit_aabb
+    _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-6)     # float32 STL corners
+
+
+def test_a_primitive_fitted_to_a_mesh_is_as_sure_as_the_mesh(tmp_path):
+    # arx_l5 link2: a capsule fitted to a mesh whose bodies overlap was labelled "exact", and differed from
+    # MuJoCo's fit (which counts the overlap twice) by 1.6e-3; the fit is only as sure as the mesh's integrals
+    trimesh = pytest.importorskip("trimesh")
+    from conftest import write_binary_stl
+    a = trimesh.creation.box(extents=[0.1, 0.1, 0.3])
+    b = trimesh.creation.box(extents=[0.3, 0.1, 0.1])
+    both = trimesh.util.concatenate([a, b])                   # two closed boxes crossing each other
+    write_binary_stl(tmp_path / "cross.stl", both.vertices, both.faces)
+    path = tmp_path / "c.xml"
+    path.write_text('<mujoco><asset><mesh name="m" file="cross.stl"/></asset><worldbody><body name="b">'
+                    '<geom type="capsule" mesh="m"/></body><body name="c"><geom type="mesh" mesh="m"/></body>'
+                    '</worldbody></mujoco>')
+    fit, mesh = link_inertials(read_robot(path), density=1000)
+    assert mesh.method in ("united", "unverified")
+    assert fit.method == mesh.method
+
+
 def test_all_geoms_with_the_models_densities_is_mujocos_inertia_from_geometry(tmp_path):
     # Menagerie style: visual geoms (contype 0) with their default density count in MuJoCo's inertia from
     # geometry, a geom outside inertiagrouprange does not; --geometry all --density model reproduces it
@@ -393,6 +428,7 @@ def test_a_capsule_fitted_to_an_open_mesh_with_repair_is_audited_without_stoppin
     assert results[0].properties is not None and results[1].properties is not None
     audits = audit_links(robot, results)
     assert audits[0].com_inside_geometry is None and audits[0].issues        # no box without repair: unknown
+    assert results[0].method == "unverified"              # no bound follows for a fit to a repaired mesh
     unrepaired = link_inertials(robot, density=1000)
     assert unrepaired[0].properties is None and "mesh needs repair" in unrepaired[0].problem
 

@@ -471,8 +471,9 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     ``|ac| ≤ |bd|``, else ``abd, bcd``), the rule of MuJoCo's OBJ loader (checked against ``mujoco`` 4.0 on
     Menagerie's meshes): for a quad that is not planar the two splits bound different solids, and this one is
     the solid a simulator reading the same file integrates.  Polygons with more than four corners are
-    fan-triangulated from their first corner (exact for planar polygons).  Index 0, a relative index before the first vertex, or an index past the last vertex is
-    refused with the line named, never dropped: a dropped face would silently change the volume.
+    fan-triangulated from their first corner (exact for planar polygons).  Index 0, a relative index before the
+    first vertex, or an index past the last vertex is refused with the line named, never dropped: a dropped face
+    would silently change the volume.
 
     Returns ``vertices (n, 3)``, ``faces (m, 3)`` and the number of polygons in the file.
     """
@@ -576,8 +577,8 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     top = max(int(block.max()) for block in face_blocks)
     if top >= nv:
         raise _fail(path, f"face index {top + 1:,} is past the last vertex ({nv:,} defined)")
-    for block, first in quad_blocks:
-        _split_quads_along_shorter_diagonal(vertices, face_blocks[block], first)
+    for block, rows in quad_blocks:
+        _split_quads_along_shorter_diagonal(vertices, face_blocks[block], rows)
     faces = np.concatenate(face_blocks)
     if garbage:
         warnings.warn(MalformedTextWarning(f"{_display(path)}: {garbage:,} unrecognised lines were ignored"

@@ -152,6 +152,9 @@ class GeometryElement:
         transform and ``scale``; ``mesh`` is then None.  None for a mesh read from a file and for primitives.
     faces : (m, 3) int or None
         The inline mesh's triangles (indices into ``vertices``, wound outwards).
+    fit_aabb : bool
+        With ``fit_scale``: MuJoCo's ``<compiler fitaabb="true">``, the primitive is fitted to the mesh's
+        bounding box in its principal axes instead of its equivalent inertia box.
     """
 
     kind: str
@@ -171,6 +174,7 @@ class GeometryElement:
     note: str = ""
     vertices: np.ndarray | None = None
     faces: np.ndarray | None = None
+    fit_aabb: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))

@@ -561,15 +561,13 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
-        if fitaabb:
-            raise _fail(source, f"{what}: a {kind} fitted to mesh {mesh_name!r} with <compiler fitaabb=\"true\"> "
-                                "is not supported (only MuJoCo's default fit to the equivalent inertia box)")
         file, folders, scale, ref_rotation, ref_translation, _shell = meshes[mesh_name]
         fit = float(_numbers(attrs.get("fitscale"), 1, f"{what} fitscale", source, default=(1.0,))[0])
         return GeometryElement(kind, rotation, position, **_mesh_source(file, folders, packages, source, link),
                                scale=scale, name=name,
                                reference_rotation=ref_rotation, reference_translation=ref_translation,
-                               fit_scale=_positive(fit, f"{what} fitscale", source), **mass_model)
+                               fit_scale=_positive(fit, f"{what} fitscale", source), fit_aabb=fitaabb,
+                               **mass_model)
     if kind == "mesh":
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
