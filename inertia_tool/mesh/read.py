@@ -577,8 +577,8 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     top = max(int(block.max()) for block in face_blocks)
     if top >= nv:
         raise _fail(path, f"face index {top + 1:,} is past the last vertex ({nv:,} defined)")
-    for block, rows in quad_blocks:
-        _split_quads_along_shorter_diagonal(vertices, face_blocks[block], rows)
+    for block_index, rows in quad_blocks:
+        _split_quads_along_shorter_diagonal(vertices, face_blocks[block_index], rows)
     faces = np.concatenate(face_blocks)
     if garbage:
         warnings.warn(MalformedTextWarning(f"{_display(path)}: {garbage:,} unrecognised lines were ignored"
