@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
 import warnings
 from dataclasses import replace
 
@@ -565,6 +566,10 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     if not link.elements:
         return LinkInertial(link.name, None, nan, basis, "no geom in <compiler inertiagrouprange>" if geometry == "all"
                             else f"no {geometry} geometry")
+    missing = [e.mesh for e in link.elements if e.mesh is not None and not os.path.exists(e.mesh)
+               and not (model and (e.mass == 0 or (e.mass is None and e.density == 0)))]
+    if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute
+        return LinkInertial(link.name, None, nan, basis, f"mesh file missing: {', '.join(dict.fromkeys(missing))}")
     try:
         parts, massless = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
     except InertiaToolError as exc:
