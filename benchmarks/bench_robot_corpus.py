@@ -44,8 +44,8 @@ from inertia_tool.robot.corpus import find_descriptions  # noqa: E402
 
 def _cause(problem: str) -> str:
     """A short name for a link's problem (the part before the file name or the first colon)."""
-    for key in ("mesh needs repair", "mesh file missing", "every geom is massless", "no collision geometry", "no visual geometry",
-                "no all geometry", "cannot be computed", "no declared mass"):
+    for key in ("mesh needs repair", "mesh file missing", "every geom is massless", "no collision geometry",
+                "no visual geometry", "no all geometry", "cannot be computed", "no declared mass"):
         if problem.startswith(key):
             if key == "mesh needs repair":
                 for detail in ("not a closed solid", "passes through itself", "not closed", "open",
