@@ -38,18 +38,19 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 
 from inertia_tool.errors import InertiaToolError  # noqa: E402
-from inertia_tool.robot import link_inertials, read_robot  # noqa: E402
+from inertia_tool.robot import audit_links, link_inertials, read_robot  # noqa: E402
 from inertia_tool.robot.corpus import find_descriptions  # noqa: E402
 
 
 def _cause(problem: str) -> str:
     """A short name for a link's problem (the part before the file name or the first colon)."""
-    for key in ("mesh needs repair", "every geom is massless", "no collision geometry", "no visual geometry",
-                "no all geometry", "cannot be computed", "no declared mass"):
+    for key in ("mesh needs repair", "mesh file missing", "every geom is massless", "no collision geometry",
+                "no visual geometry", "no all geometry", "cannot be computed", "no declared mass"):
         if problem.startswith(key):
             if key == "mesh needs repair":
-                for detail in ("not closed", "open", "inconsistently", "self-intersect", "crossing", "zero volume",
-                               "negative volume", "inside out", "no outward", "refused"):
+                for detail in ("not a closed solid", "passes through itself", "not closed", "open",
+                               "inconsistently", "self-intersect", "crossing", "zero volume", "negative volume",
+                               "inside out", "no outward", "refused", "no such file"):
                     if detail in problem:
                         return f"{key} ({detail})"
             return key
@@ -136,9 +137,366 @@ def compare(path: str, rtol: float, repair: bool) -> tuple[list, list, str | Non
     return rows, lines, None
 
 
+# -- the whole MuJoCo Menagerie (--menagerie ROOT) ----------------------------------------------------------------
+
+_ROOT_TAG = re.compile(rb"<(mujoco|robot|sdf)[\s>/]")
+_BODY_OR_INCLUDE = re.compile(rb"<(body|include)[\s>/]")
+_OPENING = re.compile(r"Error opening file '([^']+)'")
+_ELEMENT = re.compile(r"Element name '([^']*)'")
+_TOO_SMALL = re.compile(r"too small: (\S+) \.")
+_SENTINEL_RGBA = (0.123, 0.456, 0.789, 0.321)          # marks a geom whose mesh file is missing
+
+
+def menagerie_files(root: str) -> tuple[list, list]:
+    """(model files, scene files): every ``*.xml`` under ``root`` whose root element is ``<mujoco>`` and that
+    holds a ``<body>`` or an ``<include>`` (actuator, keyframe and asset fragments are not models); a scene is
+    a file named ``scene*.xml``.  Included files are kept: each model file is read on its own too."""
+    models, scenes = [], []
+    for folder, subfolders, files in os.walk(root):
+        subfolders.sort()
+        for name in sorted(files):
+            if not name.endswith(".xml"):
+                continue
+            path = os.path.join(folder, name)
+            with open(path, "rb") as fh:
+                text = re.sub(rb"<!--.*?-->", b"", fh.read(), flags=re.DOTALL)
+            match = _ROOT_TAG.search(text)
+            if not match or match.group(1) != b"mujoco" or not _BODY_OR_INCLUDE.search(text):
+                continue
+            (scenes if name.startswith("scene") else models).append(path)
+    return models, scenes
+
+
+def _refusal(text: str) -> str:
+    """The bucket of a description the tool refuses (the work of another helper is named as pending)."""
+    if "which does not exist" in text:
+        return "mesh file missing"
+    for key, label in (("<attach", "pending <attach>"), ("inline vertices", "pending inline mesh vertices"),
+                       ("hfield", "pending height field"), ("height field", "pending height field")):
+        if key in text:
+            return label
+    return text.split(": ", 2)[-1][:80]
+
+
+def _massless(element) -> bool:
+    return element.mass == 0 or (element.mass is None and element.density == 0)
+
+
+def mujoco_reference(path: str, *, geometry: str = "collision", max_rounds: int = 400):
+    """MuJoCo's inertia from geometry for every body of ``path``, each mesh with exact inertia where MuJoCo
+    accepts it (``inertia="shell"`` kept; a mesh whose exact inertia MuJoCo refuses keeps the file's own mode).
+
+    Returns ``(bodies, refused, missing)``: ``bodies`` [(name, mass, centre, tensor in body axes, faces by mesh
+    file basename)], ``refused`` {mesh file basename: MuJoCo's reason}, ``missing`` {body name: [files]} (a
+    missing file's geoms are compiled as small spheres, so that the rest of the model compiles; their bodies
+    are not compared).  ``geometry="collision"``: the geoms that do not collide (``contype`` and
+    ``conaffinity`` 0, in no ``<contact><pair>``) are made massless first, so that MuJoCo's inertia from
+    geometry is that of the collision geoms (a body left without mass is bounded by ``boundmass`` and
+    ``boundinertia`` 1e-15, which nothing else reaches)."""
+    import mujoco
+    spec = mujoco.MjSpec.from_file(path)
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_TRUE
+    if geometry == "collision":
+        paired = {name for pair in spec.pairs for name in (pair.geomname1, pair.geomname2)}
+        for geom in spec.geoms:
+            if geom.contype == 0 and geom.conaffinity == 0 and geom.name not in paired:
+                geom.mass, geom.density = 0.0, 0.0
+        spec.compiler.boundmass, spec.compiler.boundinertia = 1e-15, 1e-15
+    declared = {}
+    for mesh in spec.meshes:
+        declared[mesh.name] = mesh.inertia
+        if mesh.inertia != mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL:
+            mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
+    refused: dict = {}
+    missing: dict = collections.defaultdict(list)
+    for _ in range(max_rounds):
+        try:
+            model = spec.compile()
+            break
+        except ValueError as exc:
+            text = str(exc)
+            first = text.splitlines()[0]
+            opening = _OPENING.search(first)
+            if opening:
+                base = os.path.basename(opening.group(1))
+                gone = [m for m in spec.meshes if os.path.basename(m.file) == base]
+                if not gone:
+                    raise
+                for mesh in gone:
+                    key = mesh.name or os.path.splitext(os.path.basename(mesh.file))[0]
+                    for geom in spec.geoms:
+                        if geom.meshname == key:
+                            missing[geom.parent.name].append(base)
+                            geom.type, geom.meshname = mujoco.mjtGeom.mjGEOM_SPHERE, ""
+                            geom.size, geom.rgba = [1e-3, 0, 0], list(_SENTINEL_RGBA)
+                    spec.delete(mesh)
+                continue
+            names = [m.group(1) for m in (_ELEMENT.search(text), _TOO_SMALL.search(first), _MESH_NAMED.search(first))
+                     if m and m.group(1)]
+            mesh = next((spec.mesh(n) for n in names if spec.mesh(n) is not None), None)
+            if mesh is None or os.path.basename(mesh.file) in refused:
+                raise
+            refused[os.path.basename(mesh.file)] = first.removeprefix("Error: ")
+            keep = declared.get(mesh.name, mujoco.mjtMeshInertia.mjMESH_INERTIA_LEGACY)
+            mesh.inertia = (keep if keep != mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
+                            else mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX)
+    else:
+        raise ValueError(f"MuJoCo refused more than {max_rounds} meshes")
+    faces = {}
+    for m in range(model.nmesh):
+        file = model.paths[model.mesh_pathadr[m]:].split(b"\0", 1)[0].decode()
+        faces[os.path.basename(file)] = int(model.mesh_facenum[m])
+    bodies = []
+    for i in range(1, model.nbody):
+        rot = np.zeros(9)
+        mujoco.mju_quat2Mat(rot, model.body_iquat[i])
+        rot = rot.reshape(3, 3)
+        bodies.append((model.body(i).name, float(model.body_mass[i]), model.body_ipos[i].copy(),
+                       rot @ np.diag(model.body_inertia[i]) @ rot.T))
+    return bodies, refused, dict(missing), faces
+
+
+def _difference(props, mass: float, com, tensor) -> float:
+    """``max(|Δm|/m, |Δc|/size, ‖ΔI‖/‖I‖)``, ``size`` the body's radius of gyration."""
+    if mass == 0:
+        return 0.0 if props.mass == 0 else float("inf")
+    size = max(np.sqrt(np.trace(tensor) / (2 * mass)), 1e-12)
+    return max(abs(props.mass - mass) / mass, float(np.linalg.norm(props.center_of_mass - com)) / size,
+               float(np.linalg.norm(props.inertia - tensor) / max(np.linalg.norm(tensor), 1e-300)))
+
+
+#: Unit-density mesh bodies of :func:`twin`, by file, overlap rule, rounding and placement (one run).
+_TWIN_MESHES: dict = {}
+
+
+def twin(link, *, overlap: str = "union", float32: bool = False):
+    """The body recomputed from its elements at the model's densities the way MuJoCo's compiler integrates it:
+    ``overlap="sum"`` counts a mesh's overlapping bodies twice (MuJoCo integrates the signed volume of the
+    triangles as given), ``float32`` rounds the file's coordinates to float32 first (MuJoCo stores vertices
+    in float32).  Meshes that need repair raise."""
+    from dataclasses import replace
+
+    from inertia_tool import mass_properties
+    from inertia_tool.mass.properties import MassProperties, combine
+    from inertia_tool.mesh.read import load_mesh
+    from inertia_tool.robot.geometry import _placed, element_mass_properties, element_shell_properties
+    weighted = []
+    for e in link.elements:
+        if _massless(e):
+            continue
+        if e.shell:
+            unit = element_shell_properties(e)
+        elif e.kind == "mesh":
+            key = (e.mesh, overlap, float32, e.scale.tobytes(), e.reference_rotation.tobytes(),
+                   e.reference_translation.tobytes())
+            if key not in _TWIN_MESHES:
+                raw = load_mesh(e.mesh, units="m")
+                if float32:
+                    raw = replace(raw, vertices=raw.vertices.astype(np.float32).astype(np.float64))
+                _TWIN_MESHES[key] = mass_properties(_placed(raw, e), density=1.0, overlap=overlap)
+            unit = _TWIN_MESHES[key].transformed(rotation=e.rotation, translation=e.translation)
+        else:
+            unit = element_mass_properties(e)
+        if e.mass is not None:
+            weighted.append(unit.with_mass(e.mass))
+        else:
+            weighted.append(MassProperties(mass=unit.mass * e.density, volume=unit.volume,
+                                           center_of_mass=unit.center_of_mass, inertia=unit.inertia * e.density,
+                                           density=e.density))
+    return weighted[0] if len(weighted) == 1 else combine(weighted)
+
+
+def _bounds_hold(result, mass: float, com, tensor) -> bool:
+    """Whether MuJoCo's values lie within the estimate's stated bounds (mass relative, centre in m, tensor
+    relative Frobenius where a bound is given)."""
+    u, p = result.uncertainty, result.properties
+    if u is None:
+        return False
+    ok = abs(p.mass - mass) <= u.mass * p.mass and float(np.linalg.norm(p.center_of_mass - com)) <= u.center_of_mass
+    if u.inertia is not None:
+        ok = ok and float(np.linalg.norm(p.inertia - tensor)) <= u.inertia * float(np.linalg.norm(p.inertia))
+    return bool(ok)
+
+
+def compare_menagerie_file(path: str, *, rtol: float, repair: bool, cache, geometry: str = "collision") -> list:
+    """[(body, bucket, difference, detail)] for every body of ``path`` (see :func:`run_menagerie`)."""
+    reference, refused, missing, faces = mujoco_reference(path, geometry=geometry)
+    robot = read_robot(path, geometry=geometry, missing_meshes="per-link")
+    ours = link_inertials(robot, density="model", repair=repair, mesh_cache=cache)
+    if len(ours) != len(reference):
+        return [("*", "bodies differ in number", float("nan"), f"{len(ours)} links, MuJoCo {len(reference)}")]
+    rows = []
+    for result, link, (name, mass, com, tensor) in zip(ours, robot.links, reference):
+        files = {os.path.basename(e.mesh) for e in link.elements if e.mesh and not _massless(e)}
+        if name in missing or (result.problem or "").startswith("mesh file missing"):
+            rows.append((name, "mesh file missing", float("nan"), ", ".join(sorted(set(missing.get(name, ())))
+                                                                                 or [result.problem[19:]])))
+            continue
+        if name and result.name != name:
+            rows.append((name, "named differently", float("nan"), result.name))
+            continue
+        if result.properties is None:
+            rows.append((name, f"no result: {_cause(result.problem or '')}", float("nan"), result.problem))
+            continue
+        diff = _difference(result.properties, mass, com, tensor)
+        said = sorted(files & set(refused))
+        if said:
+            rows.append((name, f"MuJoCo's exact mode refuses a mesh ({result.method})", diff,
+                         f"{said[0]}: {refused[said[0]]}"))
+            continue
+        method = result.method
+        if method == "estimate":
+            rows.append((name, "estimate, bounds hold" if _bounds_hold(result, mass, com, tensor)
+                         else "estimate, bounds fail", diff, ""))
+            continue
+        if diff <= rtol:
+            rows.append((name, f"{method}, agrees", diff, ""))
+            continue
+        try:
+            summed = _difference(twin(link, overlap="sum"), mass, com, tensor)
+            rounded = _difference(twin(link, overlap="sum", float32=True), mass, com, tensor)
+        except Exception as exc:   # noqa: BLE001 -- the diagnosis failing is reported, not fatal
+            summed = rounded = float("nan")
+            detail = f"twin failed: {exc}"
+        else:
+            detail = f"summed {summed:.1e}, float32 {rounded:.1e}"
+        dropped = [f for f in files if f in faces and f.lower().endswith(".obj")
+                   and faces[f] < _file_triangles(link, f)]
+        if method != "exact" and summed <= rtol:
+            bucket = f"{method}: MuJoCo counts overlaps twice (summed integral agrees)"
+        elif rounded <= rtol:
+            bucket = f"{method}: MuJoCo approximate (float32 vertices)"
+        elif dropped:
+            bucket = f"{method}: MuJoCo approximate (its OBJ loader drops polygon triangles)"
+            detail += (f"; {dropped[0]}: MuJoCo {faces[dropped[0]]} triangles, the file "
+                       f"{_file_triangles(link, dropped[0])}")
+        else:
+            bucket = f"{method}, disagrees"
+        rows.append((name, bucket, diff, detail))
+    return rows
+
+
+def _file_triangles(link, basename: str) -> int:
+    from inertia_tool.mesh.read import load_mesh
+    element = next(e for e in link.elements if e.mesh and os.path.basename(e.mesh) == basename)
+    return int(len(load_mesh(element.mesh, units="m").faces))
+
+
+def _cli_corpus(root: str, repair: bool) -> tuple[float, float, int]:
+    """CPU (children) and wall seconds and exit code of ``inertia-tool robot ROOT --density 1000`` (folder mode)."""
+    import resource
+    import subprocess
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-m", "inertia_tool", "robot", root, "--density", "1000"]
+                          + (["--repair"] if repair else []), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                          env=dict(os.environ, PYTHONPATH=os.path.dirname(HERE)), check=False)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime), wall, done.returncode
+
+
+def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_mode: bool, verbose: bool,
+                  geometry: str = "collision") -> int:
+    """Every model file and scene of a Menagerie checkout through the tool, then every body against MuJoCo."""
+    from inertia_tool.robot.geometry import MeshCache
+    models, scenes = menagerie_files(root)
+    folders = sorted({os.path.relpath(p, root).split(os.sep)[0] for p in models + scenes})
+    print(f"Menagerie at {root}: {len(folders)} model folders, {len(models)} model files, {len(scenes)} scenes; "
+          f"load average {os.getloadavg()[0]:.1f} at start", flush=True)
+    refusals: collections.Counter = collections.Counter()
+    refused_files: dict = collections.defaultdict(list)
+    read = {"model": 0, "scene": 0}
+    methods: collections.Counter = collections.Counter()
+    causes: collections.Counter = collections.Counter()
+    cache = MeshCache()
+    cpu0, wall0 = time.process_time(), time.perf_counter()
+    for path in models + scenes:
+        kind = "scene" if path in scenes else "model"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                robot = read_robot(path)
+                results = link_inertials(robot, density=1000.0, repair=repair, mesh_cache=cache)
+                audit_links(robot, results)
+            except InertiaToolError as exc:
+                bucket = _refusal(str(exc))
+                refusals[bucket] += 1
+                refused_files[bucket].append(f"{os.path.relpath(path, root)}: {str(exc).split(': ', 1)[-1][:160]}")
+                continue
+        read[kind] += 1
+        for r in results:
+            if r.properties is not None:
+                methods[r.method] += 1
+            elif r.problem:
+                causes[_cause(r.problem)] += 1
+    cpu, wall = time.process_time() - cpu0, time.perf_counter() - wall0
+    print(f"\ninertia-tool robot FILE --density 1000{' --repair' if repair else ''} (collision geometry), every "
+          f"file in one process, meshes shared:\n  read {read['model']}/{len(models)} model files, "
+          f"{read['scene']}/{len(scenes)} scenes; CPU {cpu:.1f} s, wall {wall:.1f} s")
+    print(f"  links computed: {sum(methods.values())} ({', '.join(f'{k} {v}' for k, v in methods.most_common())}); "
+          f"without a result: {sum(causes.values())}")
+    for cause, n in causes.most_common():
+        print(f"    {n:5d}  {cause}")
+    print("  files refused, by reason:")
+    for bucket, n in refusals.most_common():
+        print(f"    {n:5d}  {bucket}")
+        if verbose or bucket.startswith(("mesh file missing", "pending")):
+            for line in refused_files[bucket]:
+                print(f"             {line}")
+    if folder_mode:
+        ccpu, cwall, code = _cli_corpus(root, repair)
+        print(f"\ninertia-tool robot {root} --density 1000{' --repair' if repair else ''} (folder mode, one "
+              f"command): CPU {ccpu:.1f} s, wall {cwall:.1f} s, exit code {code}", flush=True)
+    if not mujoco:
+        return 0
+    buckets: collections.Counter = collections.Counter()
+    diffs: dict = collections.defaultdict(list)
+    listed: list = []
+    unreadable: list = []
+    cpu0 = time.process_time()
+    for path in models + scenes:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                rows = compare_menagerie_file(path, rtol=rtol, repair=repair, cache=cache, geometry=geometry)
+            except Exception as exc:   # noqa: BLE001 -- a refusal (MuJoCo's or the tool's) is a finding
+                unreadable.append(f"{os.path.relpath(path, root)}: {type(exc).__name__}: "
+                                  f"{str(exc).splitlines()[0][:200]}")
+                continue
+        for body, bucket, diff, detail in rows:
+            buckets[bucket] += 1
+            if np.isfinite(diff):
+                diffs[bucket].append(diff)
+            if "disagree" in bucket or "fail" in bucket or "approximate" in bucket or verbose:
+                listed.append(f"  {os.path.relpath(path, root)}: {body} [{bucket}] {diff:.1e} {detail[:200]}")
+    print(f"\nagainst MuJoCo {_mujoco_version()} (--geometry {geometry} --density model"
+          f"{' --repair' if repair else ''}, "
+          f"every body of every file; MuJoCo with inertiafromgeom, exact mesh inertia where it accepts it"
+          f"{', non-colliding geoms massless' if geometry == 'collision' else ''}), "
+          f"CPU {time.process_time() - cpu0:.1f} s:")
+    for bucket, n in sorted(buckets.items(), key=lambda kv: (-kv[1], kv[0])):
+        d = np.array(diffs.get(bucket, []))
+        print(f"  {n:5d}  {bucket}" + (f"  (median {np.median(d):.1e}, max {d.max():.1e})" if d.size else ""))
+    for line in unreadable:
+        print(f"  not compared: {line}")
+    for line in listed:
+        print(line)
+    return 0
+
+
+def _mujoco_version() -> str:
+    import mujoco
+    return mujoco.__version__
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("folders", nargs="+")
+    parser.add_argument("folders", nargs="*")
+    parser.add_argument("--menagerie", metavar="ROOT", help="every model file and scene*.xml of a MuJoCo Menagerie "
+                        "checkout, then every body against MuJoCo")
+    parser.add_argument("--no-folder-mode", action="store_true", help="with --menagerie: skip timing the "
+                        "folder-mode command")
     parser.add_argument("--geometry", default="collision")
     parser.add_argument("--density", default="1000")
     parser.add_argument("--repair", action="store_true")
@@ -147,6 +505,12 @@ def main(argv=None) -> int:
     parser.add_argument("--package", action="append", default=[], metavar="NAME=DIR")
     parser.add_argument("--verbose", action="store_true", help="print every link without a result")
     args = parser.parse_args(argv)
+    if args.menagerie:
+        return run_menagerie(args.menagerie, repair=args.repair, rtol=args.rtol, mujoco=not args.no_mujoco,
+                             folder_mode=not args.no_folder_mode, verbose=args.verbose,
+                             geometry="all" if args.geometry == "all" else "collision")
+    if not args.folders:
+        parser.error("give folders, or --menagerie ROOT")
     density = args.density if args.density == "model" else float(args.density)
     packages = dict(item.split("=", 1) for item in args.package)
     models = find_descriptions(args.folders)

@@ -266,3 +266,28 @@ def test_units_never_scale_the_callers_arrays(box_mesh, tmp_path):
     raw = load_mesh((v, np.asarray(box_mesh.faces)), units="mm")
     np.testing.assert_array_equal(v, before)
     np.testing.assert_allclose(raw.vertices, before * 1e-3, rtol=0, atol=0)
+
+
+def _cube_with_raised_corner(height: float, order: int) -> str:
+    """OBJ of the unit cube whose top corner (1, 1, 1) is raised by ``height``: the top quad is not planar.
+    ``order`` rotates the top quad's corner list, so that its first corner is any of the four."""
+    vertices = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1 + height), (0, 1, 1)]
+    top = [5, 6, 7, 8][order:] + [5, 6, 7, 8][:order]
+    quads = [[1, 4, 3, 2], top, [1, 2, 6, 5], [2, 3, 7, 6], [3, 4, 8, 7], [4, 1, 5, 8]]
+    return "".join(f"v {x} {y} {z}\n" for x, y, z in vertices) + "".join(
+        "f " + " ".join(map(str, q)) + "\n" for q in quads)
+
+
+@pytest.mark.parametrize("order", range(4))
+def test_a_non_planar_quad_is_split_along_its_shorter_diagonal(tmp_path, order):
+    # top corners a=(0,0,1) b=(1,0,1) c=(1,1,1+h) d=(0,1,1): |bd| = √2 < |ac| = √(2 + h²), so the top is
+    # abd (flat) and bcd (a tetrahedron of volume h/6 above the cube); the other split, abc and acd, would
+    # add h/3 (MuJoCo's OBJ loader splits along the shorter diagonal too: Menagerie's trossen_wxai meshes)
+    from inertia_tool import mass_properties
+    height = 0.5
+    path = tmp_path / "raised.obj"
+    path.write_text(_cube_with_raised_corner(height, order))
+    raw = load_mesh(str(path), units="m")
+    assert len(raw.faces) == 12
+    assert mass_properties(raw, density=1.0).volume == pytest.approx(1 + height / 6, rel=1e-14)
+    assert not any(4 in f and 6 in f for f in raw.faces.tolist())    # no triangle holds the long diagonal a–c

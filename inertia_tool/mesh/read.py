@@ -451,17 +451,35 @@ def _obj_vertex_block(path: str, tokens: list[bytes], first_line: int) -> np.nda
         raise _fail(path, "vertex coordinates are not numbers") from None
 
 
+def _split_quads_along_shorter_diagonal(vertices: np.ndarray, faces: np.ndarray, first: np.ndarray) -> None:
+    """Re-split in place the quads whose two triangles start at rows ``first`` of ``faces`` (read as
+    ``abc, acd``) into ``abd, bcd`` where the diagonal ``bd`` is shorter than ``ac`` (ties keep ``ac``)."""
+    a, b, c = faces[first, 0], faces[first, 1], faces[first, 2]
+    d = faces[first + 1, 2]
+    ac = np.einsum("ij,ij->i", vertices[c] - vertices[a], vertices[c] - vertices[a])
+    bd = np.einsum("ij,ij->i", vertices[d] - vertices[b], vertices[d] - vertices[b])
+    swap = bd < ac
+    rows = first[swap]
+    faces[rows] = np.column_stack([a[swap], b[swap], d[swap]])
+    faces[rows + 1] = np.column_stack([b[swap], c[swap], d[swap]])
+
+
 def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     """Stream a Wavefront OBJ: ``v`` lines and ``f`` polygons (1-based or negative relative indices).
 
-    Polygons with more than three corners are fan-triangulated from their first corner (exact for planar
-    polygons).  Index 0, a relative index before the first vertex, or an index past the last vertex is
-    refused with the line named, never dropped: a dropped face would silently change the volume.
+    A quadrilateral is split along its shorter diagonal (corners ``a b c d``: ``abc, acd`` when
+    ``|ac| ≤ |bd|``, else ``abd, bcd``), the rule of MuJoCo's OBJ loader (checked against ``mujoco`` 4.0 on
+    Menagerie's meshes): for a quad that is not planar the two splits bound different solids, and this one is
+    the solid a simulator reading the same file integrates.  Polygons with more than four corners are
+    fan-triangulated from their first corner (exact for planar polygons).  Index 0, a relative index before the
+    first vertex, or an index past the last vertex is refused with the line named, never dropped: a dropped face
+    would silently change the volume.
 
     Returns ``vertices (n, 3)``, ``faces (m, 3)`` and the number of polygons in the file.
     """
     vertex_blocks: list[np.ndarray] = []
     face_blocks: list[np.ndarray] = []
+    quad_blocks: list[tuple[int, np.ndarray]] = []       # (face block, first of its two triangles) per quad
     nv = n_tri = n_poly = loose = garbage = 0
     first_garbage = ""
     line_no = 0
@@ -471,6 +489,7 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
         for block in _text_blocks(fh, path):
             coords: list[bytes] = []
             tri: list[int] = []
+            quads: list[int] = []
             block_start = line_no + 1
             odd = _has_odd_bytes(block)                  # names and comments may hold '_'; numbers may not
             lines = block.split(b"\n")
@@ -527,6 +546,9 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
                             raise _fail(path, f"line {line_no}: face index 0 (OBJ indices start at 1)")
                     if k == 3:
                         tri.extend(idx)
+                    elif k == 4:
+                        quads.append(len(tri))          # split once the coordinates are known
+                        tri.extend((idx[0], idx[1], idx[2], idx[0], idx[2], idx[3]))
                     else:
                         first = idx[0]
                         for j in range(1, k - 1):
@@ -544,16 +566,20 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
                 vertex_blocks.append(_obj_vertex_block(path, coords, block_start))
             if tri:
                 face_blocks.append(np.array(tri, dtype=np.int64).reshape(-1, 3))
+                if quads:
+                    quad_blocks.append((len(face_blocks) - 1, np.array(quads, dtype=np.int64) // 3))
     if not face_blocks:
         if nv == 0:
             raise _fail(path, "no vertices and no faces (empty mesh)")
         what = "points and lines only" if loose else "vertices only"
         raise _fail(path, f"contains no faces ({nv:,} vertices, {what}: a point cloud, not a solid)")
     vertices = np.concatenate(vertex_blocks) if vertex_blocks else np.zeros((0, 3))
-    faces = np.concatenate(face_blocks)
-    top = int(faces.max())
+    top = max(int(block.max()) for block in face_blocks)
     if top >= nv:
         raise _fail(path, f"face index {top + 1:,} is past the last vertex ({nv:,} defined)")
+    for block_index, rows in quad_blocks:
+        _split_quads_along_shorter_diagonal(vertices, face_blocks[block_index], rows)
+    faces = np.concatenate(face_blocks)
     if garbage:
         warnings.warn(MalformedTextWarning(f"{_display(path)}: {garbage:,} unrecognised lines were ignored"
                                            f"{first_garbage}"), stacklevel=4)

@@ -152,6 +152,9 @@ class GeometryElement:
         transform and ``scale``; ``mesh`` is then None.  None for a mesh read from a file and for primitives.
     faces : (m, 3) int or None
         The inline mesh's triangles (indices into ``vertices``, wound outwards).
+    fit_aabb : bool
+        With ``fit_scale``: MuJoCo's ``<compiler fitaabb="true">``, the primitive is fitted to the mesh's
+        bounding box in its principal axes instead of its equivalent inertia box.
     """
 
     kind: str
@@ -171,6 +174,7 @@ class GeometryElement:
     note: str = ""
     vertices: np.ndarray | None = None
     faces: np.ndarray | None = None
+    fit_aabb: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))
@@ -844,8 +848,13 @@ def _check_unique_names(links, source: str) -> None:
         seen.add(link.name)
 
 
+#: What :func:`read_robot` does with an MJCF mesh file that does not exist (``missing_meshes``).
+MISSING_MESHES = ("refuse", "per-link")
+
+
 def read_robot(path, *, packages: dict | None = None, geometry: str = "collision",
-               mappings: dict | None = None, run_xacro: bool = False, limits=None) -> RobotDescription:
+               mappings: dict | None = None, run_xacro: bool = False, limits=None,
+               missing_meshes: str = "refuse") -> RobotDescription:
     """Read a URDF, xacro, SDFormat or MJCF file into a :class:`RobotDescription`.
 
     Parameters
@@ -869,6 +878,10 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
     limits : inertia_tool.isolate.Limits, optional
         Limits of the xacro expansion (default :data:`~inertia_tool.isolate.XACRO_LIMITS`; the
         ``INERTIA_TOOL_*_LIMIT`` environment variables override both).
+    missing_meshes : {"refuse", "per-link"}
+        MJCF: a mesh file that does not exist refuses the whole description (default, as MuJoCo does), or only
+        its link, whose result then says ``mesh file missing: PATH`` (a corpus with files left out, compared
+        body by body).  URDF and SDFormat always refuse.
 
     Returns
     -------
@@ -884,6 +897,8 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
     """
     if geometry not in GEOMETRY_KINDS:
         raise UsageError(f"Expected `geometry` to be one of {', '.join(GEOMETRY_KINDS)}, got {geometry!r}")
+    if missing_meshes not in MISSING_MESHES:
+        raise UsageError(f"Expected `missing_meshes` to be one of {', '.join(MISSING_MESHES)}, got {missing_meshes!r}")
     source = os.fsdecode(os.fspath(path))
     packages = dict(packages or {})
     data = _read_bytes(source)
@@ -903,7 +918,7 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         fmt = {"robot": "urdf", "sdf": "sdf"}.get(root.tag, "mjcf")
     if fmt == "mjcf":
         from .mjcf import read_mjcf
-        name, links = read_mjcf(root, source, base, packages, geometry)
+        name, links = read_mjcf(root, source, base, packages, geometry, missing_meshes=missing_meshes)
     elif geometry == "all":
         raise UsageError(f"Expected `geometry` collision or visual for {source} (a {fmt.upper()} link's visual "
                          "and collision elements describe the same part), got 'all' (MJCF only)")

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
 import warnings
 from dataclasses import replace
 
@@ -204,9 +205,17 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
     ordered so that the x axis has the largest moment (the smallest ``h``) and z the smallest (the largest
     ``h``).  Then, times ``fitscale``: a box or an ellipsoid takes ``(h_x, h_y, h_z)``, a sphere the mean of
     the three, a cylinder radius ``(h_x + h_y)/2`` and half-length ``h_z``, a capsule the same radius ``r`` and
-    half-length ``max(0, h_z − r/2)`` (checked against MuJoCo 4.0).  MuJoCo uses the mesh's own inertia
-    mode for the moments (``legacy`` by default), which equals the solid's only for convex meshes; this fit
-    uses the solid.  Elements that are not fitted are returned as they are.
+    half-length ``max(0, h_z − r/2)`` (checked against MuJoCo 4.0).
+
+    With ``<compiler fitaabb="true">`` (``element.fit_aabb``): the bounding box of the mesh's vertices in the
+    same principal axes, half-sizes ``h`` and centre the box's (not the centre of volume); then, times
+    ``fitscale``, a box or an ellipsoid takes ``h``, a sphere ``max h``, a cylinder radius ``max(h_x, h_y)``
+    and half-length ``h_z``, a capsule the same radius ``r`` and half-length ``max(0, h_z − r)`` (checked
+    against MuJoCo 4.0: Menagerie's RealSense D435i).
+
+    MuJoCo uses the mesh's own inertia mode for the moments and axes (``legacy`` by default), which equals
+    the solid's only for convex meshes; this fit uses the solid.  Elements that are not fitted are returned as
+    they are.
     """
     if element.fit_scale is None:
         return element
@@ -224,8 +233,25 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
     volume = props.volume
     half = np.sqrt(np.maximum(0.0, 3.0 * np.array([m[1] + m[2] - m[0], m[0] + m[2] - m[1],
                                                      m[0] + m[1] - m[2]]) / (2.0 * volume)))
-    half = half * element.fit_scale
     kind = element.kind
+    centre = props.center_of_mass
+    if element.fit_aabb:
+        vertices, faces = _mesh_vertices_faces(element)
+        used = vertices[np.unique(faces)] @ axes       # the corners in the principal axes
+        low, high = used.min(axis=0), used.max(axis=0)
+        half = 0.5 * (high - low) * element.fit_scale
+        centre = axes @ (0.5 * (high + low))
+        if kind == "sphere":
+            size_aabb: tuple = (float(np.max(half)),)
+        elif kind in ("cylinder", "capsule"):
+            radius = float(max(half[0], half[1]))
+            size_aabb = (radius, 2.0 * (half[2] if kind == "cylinder" else max(0.0, half[2] - radius)))
+        else:
+            size_aabb = tuple(2.0 * half) if kind == "box" else tuple(half)
+        return GeometryElement(kind, element.rotation @ axes, element.rotation @ centre + element.translation,
+                               size=size_aabb, name=element.name, density=element.density, mass=element.mass,
+                               shell=element.shell)
+    half = half * element.fit_scale
     if kind == "sphere":
         size: tuple = (float(np.mean(half)),)
     elif kind in ("cylinder", "capsule"):
@@ -389,12 +415,18 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
             parts.append((element, element_shell_properties(element), "exact", None))
             continue
         props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
-        key = _mesh_key(element) if element.kind == "mesh" else None
+        fitted = element.fit_scale is not None
+        key = _mesh_key(element) if element.kind == "mesh" or fitted else None
         report = cache[key].mesh if key is not None and key in cache else None
-        method = "exact"
-        if report is not None:          # the engine's certificate (a result with bounds is an estimate)
+        method, uncertainty = "exact", None
+        if report is not None and fitted:
+            # a primitive fitted to a mesh is a closed form sized by the mesh's integrals: exactly as sure as
+            # they are (a united mesh gives a united fit); no bound follows for a fit to a repaired mesh
+            method = "unverified" if report.uncertainty is not None else report.certificate.kind
+        elif report is not None:        # the engine's certificate (a result with bounds is an estimate)
             method = "estimate" if report.uncertainty is not None else report.certificate.kind
-        parts.append((element, props, method, report.uncertainty if report is not None else None))
+            uncertainty = report.uncertainty
+        parts.append((element, props, method, uncertainty))
     return parts, massless
 
 
@@ -534,6 +566,10 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     if not link.elements:
         return LinkInertial(link.name, None, nan, basis, "no geom in <compiler inertiagrouprange>" if geometry == "all"
                             else f"no {geometry} geometry")
+    missing = [e.mesh for e in link.elements if e.mesh is not None and not os.path.exists(e.mesh)
+               and not (model and (e.mass == 0 or (e.mass is None and e.density == 0)))]
+    if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute
+        return LinkInertial(link.name, None, nan, basis, f"mesh file missing: {', '.join(dict.fromkeys(missing))}")
     try:
         parts, massless = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
     except InertiaToolError as exc:

@@ -51,6 +51,7 @@ import dataclasses
 import math
 import os
 from typing import Any
+import re
 
 import numpy as np
 
@@ -442,14 +443,13 @@ def _inline_mesh(attrs: dict, source: str) -> _InlineMesh | None:
     return _InlineMesh(vertices, indices.astype(np.int64).reshape(-1, 3))
 
 
-def _mesh_source(file, folders, packages: dict, source: str, link: str) -> dict:
+def _mesh_source(file, folders, packages: dict, source: str, link: str, missing_meshes: str = "refuse") -> dict:
     """The ``GeometryElement`` fields that say where a mesh asset's triangles are: ``mesh`` (the file found
-    through ``folders``, the first holding it) and ``uri``; or, for an inline mesh, ``vertices`` and ``faces``."""
+    through ``folders``, the first holding it; see :func:`_mesh_path`) and ``uri``; or, for an inline mesh,
+    ``vertices`` and ``faces``."""
     if isinstance(file, _InlineMesh):
         return {"mesh": None, "uri": None, "vertices": file.vertices, "faces": file.faces}
-    found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
-    path = resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
-    return {"mesh": path, "uri": file}
+    return {"mesh": _mesh_path(file, folders, packages, source, link, missing_meshes), "uri": file}
 
 
 def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler, source: str) -> dict:
@@ -523,8 +523,24 @@ def _optional_number(attrs: dict, key: str, what: str, source: str) -> float | N
     return value
 
 
+_MISSING = re.compile(r": resolves to (.+), which does not exist$")
+
+
+def _mesh_path(file: str, folders: list, packages: dict, source: str, link: str, missing_meshes: str) -> str:
+    """The mesh file of an asset: the first of ``folders`` holding it (else the first folder), resolved; a file
+    that does not exist is refused, or with ``missing_meshes="per-link"`` returned as the path it would have."""
+    found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
+    try:
+        return resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
+    except RobotDescriptionError as exc:
+        match = _MISSING.search(str(exc))
+        if missing_meshes == "refuse" or match is None:
+            raise
+        return match.group(1)
+
+
 def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict, compiler,
-          source: str) -> GeometryElement:
+          source: str, missing_meshes: str = "refuse") -> GeometryElement:
     degrees, eulerseq, fitaabb = compiler
     what = f"body {link!r} {label}"
     kind = _GEOM_KINDS.get(attrs.get("type", "sphere"))
@@ -561,22 +577,22 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
-        if fitaabb:
-            raise _fail(source, f"{what}: a {kind} fitted to mesh {mesh_name!r} with <compiler fitaabb=\"true\"> "
-                                "is not supported (only MuJoCo's default fit to the equivalent inertia box)")
         file, folders, scale, ref_rotation, ref_translation, _shell = meshes[mesh_name]
         fit = float(_numbers(attrs.get("fitscale"), 1, f"{what} fitscale", source, default=(1.0,))[0])
-        return GeometryElement(kind, rotation, position, **_mesh_source(file, folders, packages, source, link),
+        return GeometryElement(kind, rotation, position, **_mesh_source(file, folders, packages, source, link,
+                                                                           missing_meshes),
                                scale=scale, name=name,
                                reference_rotation=ref_rotation, reference_translation=ref_translation,
-                               fit_scale=_positive(fit, f"{what} fitscale", source), **mass_model)
+                               fit_scale=_positive(fit, f"{what} fitscale", source), fit_aabb=fitaabb,
+                               **mass_model)
     if kind == "mesh":
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
         file, folders, scale, ref_rotation, ref_translation, shell = meshes[mesh_name]
         mass_model["shell"] = shell          # MuJoCo: a mesh's shell inertia is a property of the asset
-        return GeometryElement("mesh", rotation, position, **_mesh_source(file, folders, packages, source, link),
+        return GeometryElement("mesh", rotation, position, **_mesh_source(file, folders, packages, source, link,
+                                                                           missing_meshes),
                                scale=scale, name=name,
                                reference_rotation=ref_rotation, reference_translation=ref_translation,
                                **mass_model)
@@ -809,8 +825,12 @@ def _attached_body(attach, model: _Model):
     raise _fail(model.source, f"<attach model=... body={wanted!r}>: the model has no body {wanted!r}")
 
 
-def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
-    """Bodies of an MJCF ``<mujoco>`` tree as links (see the module docstring); returns ``(model, links)``."""
+def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
+              missing_meshes: str = "refuse") -> tuple[str, tuple]:
+    """Bodies of an MJCF ``<mujoco>`` tree as links (see the module docstring); returns ``(model, links)``.
+
+    ``missing_meshes="per-link"`` keeps a mesh geom whose file does not exist (its link then has no result and
+    says so) instead of refusing the model."""
     from .description import MAX_ROBOT_LINKS
     if root.tag != "mujoco":
         raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
@@ -867,7 +887,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str) -> tu
                                                      model.source))
                         continue
                     elements.append(_geom(attrs, pose, label, link, model.meshes, packages, model.compiler,
-                                          model.source))
+                                          model.source, missing_meshes))
             elif child.tag == "frame":
                 attrs = dict(child.attrib)
                 rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=f"body {link!r} frame",
