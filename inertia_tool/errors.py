@@ -68,6 +68,7 @@ __all__ = [
     "StoragePrecisionWarning",
     "NonMaterialVolumeWarning",
     "SkippedModelWarning",
+    "NonPlanarPolygonWarning",
 ]
 
 
@@ -302,3 +303,10 @@ class SkippedModelWarning(InertiaToolWarning):
     """A robot description (a Gazebo world) includes a stock model that is not on disk and has no link with
     mass (``model://sun``, a light; ``model://ground_plane``, a static plane): it is skipped, and the message
     names it."""
+
+
+class NonPlanarPolygonWarning(InertiaToolWarning):
+    """An OBJ holds quadrilaterals whose corners are not in one plane: such a quad bounds no definite surface,
+    and its two possible splits into triangles enclose different solids.  The reader splits each along its
+    shorter diagonal (MuJoCo's rule; trimesh and most viewers split from the first corner); the message gives
+    how much the other split could change the volume, as a fraction of the enclosed volume."""

@@ -291,3 +291,30 @@ def test_a_non_planar_quad_is_split_along_its_shorter_diagonal(tmp_path, order):
     assert len(raw.faces) == 12
     assert mass_properties(raw, density=1.0).volume == pytest.approx(1 + height / 6, rel=1e-14)
     assert not any(4 in f and 6 in f for f in raw.faces.tolist())    # no triangle holds the long diagonal a–c
+
+
+@pytest.mark.parametrize("height", [0.5, 1e-3])
+def test_non_planar_quads_are_named_with_what_the_other_split_could_change(tmp_path, height):
+    """The warning's fraction bounds the volume the first-corner split (trimesh's) gives instead."""
+    import re
+
+    import trimesh
+
+    from inertia_tool.errors import NonPlanarPolygonWarning
+    path = tmp_path / "raised.obj"
+    path.write_text(_cube_with_raised_corner(height, 0))
+    with pytest.warns(NonPlanarPolygonWarning, match="1 of 6 quadrilaterals are not planar") as caught:
+        raw = load_mesh(str(path), units="m")
+    stated = float(re.search(r"up to ([0-9.e+-]+) %", str(caught[0].message)).group(1)) / 100
+    ours = abs(float(np.linalg.det(raw.vertices[raw.faces]).sum()) / 6)
+    other = trimesh.load(str(path), process=False).volume
+    assert 0 < abs(other - ours) / ours <= stated * (1 + 1e-2)       # printed to two digits
+
+
+def test_planar_quads_split_without_a_word(tmp_path):
+    import warnings as _warnings
+    path = tmp_path / "cube.obj"
+    path.write_text(_cube_with_raised_corner(0.0, 1))
+    with _warnings.catch_warnings():
+        _warnings.simplefilter("error")
+        load_mesh(str(path), units="m")

@@ -13,7 +13,7 @@ import trimesh
 from inertia_tool import mass_properties
 from inertia_tool.cli import main
 from inertia_tool.design.verify import spin_it_verified
-from inertia_tool.errors import PivotOffPartWarning
+from inertia_tool.errors import DesignRejectedError, PivotOffPartWarning
 from inertia_tool.reports.text import face_count_text
 
 DATA = Path(__file__).parent / "data" / "real_parts"
@@ -32,22 +32,32 @@ def _degrees_to_nearest_principal(inertia: np.ndarray, axis: np.ndarray) -> floa
 @pytest.mark.slow
 def test_quadknot_yoyo_does_not_end_off_principal():
     """Issue 24: "on quadknot.obj the yo-yo's spin axis ends 10° off every principal axis" with exit 0.  The
-    input's axis (1, 0, 0) lies in its plane of two equal moments; the design handed back must put it within 1°
-    of a principal axis of the hollowed mesh as trimesh integrates it, and say nothing about "<arrays>"."""
+    input's axis (1, 0, 0) lies in its plane of two equal moments (I1 = I2 < I3), so it is not the major axis
+    a yo-yo needs.  Read as the file's non-planar quads are split now (shorter diagonal, as MuJoCo does), every
+    design's simulated spin wobbles more than the input's: spin-it must refuse, name the major axis, hand
+    nothing back and say nothing about "<arrays>" (with the first-corner split a design passed its checks; a
+    design handed back must in any case put the axis within 1° of a principal axis: the check below)."""
     axis = np.array([1.0, 0.0, 0.0])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result, verdicts = spin_it_verified(str(QUADKNOT), axis=tuple(axis), mode="yoyo", wall=0.002,
-                                            units="mm", material="pla", resolution=48)
-    assert verdicts[-1].ok
-    hollowed = trimesh.Trimesh(result.vertices, result.faces, process=False)
-    assert hollowed.is_watertight and hollowed.volume > 0
-    assert _degrees_to_nearest_principal(hollowed.moment_inertia, axis) < 1.0
-    # the package's own re-analysis agrees with trimesh's integral of the same mesh
-    np.testing.assert_allclose(result.after.inertia / result.after.density, hollowed.moment_inertia,
-                               rtol=1e-6, atol=1e-9 * np.abs(hollowed.moment_inertia).max())
+        try:
+            result, verdicts = spin_it_verified(str(QUADKNOT), axis=tuple(axis), mode="yoyo", wall=0.002,
+                                                units="mm", material="pla", resolution=48)
+        except DesignRejectedError as exc:
+            message = str(exc)
+            assert "major axis" in message and "nothing was written" in message, message
+            assert "intermediate" in message or "minor" in message, message
+            result = None
+    if result is not None:       # a design that passed every check: it must end on a principal axis
+        assert verdicts[-1].ok
+        hollowed = trimesh.Trimesh(result.vertices, result.faces, process=False)
+        assert hollowed.is_watertight and hollowed.volume > 0
+        assert _degrees_to_nearest_principal(hollowed.moment_inertia, axis) < 1.0
+        np.testing.assert_allclose(result.after.inertia / result.after.density, hollowed.moment_inertia,
+                                   rtol=1e-6, atol=1e-9 * np.abs(hollowed.moment_inertia).max())
     texts = [str(w.message) for w in caught]
     assert not any("<arrays>" in t for t in texts), texts
+    assert sum("quadrilaterals are not planar" in t for t in texts) >= 1
 
 
 def test_fixed_top_pivot_warning_said_once_when_a_finer_design_is_rejected():

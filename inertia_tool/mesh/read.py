@@ -24,7 +24,7 @@ from typing import IO, TYPE_CHECKING, Any, TypeAlias
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, UsageError
+from ..errors import MalformedTextWarning, MeshReadError, NonPlanarPolygonWarning, TrailingDataWarning, UsageError
 from .._native import accel
 from ..units import LENGTH_UNITS, length_scale
 from .options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
@@ -451,17 +451,40 @@ def _obj_vertex_block(path: str, tokens: list[bytes], first_line: int) -> np.nda
         raise _fail(path, "vertex coordinates are not numbers") from None
 
 
-def _split_quads_along_shorter_diagonal(vertices: np.ndarray, faces: np.ndarray, first: np.ndarray) -> None:
+def _split_quads_along_shorter_diagonal(vertices: np.ndarray, faces: np.ndarray,
+                                        first: np.ndarray) -> tuple[int, float]:
     """Re-split in place the quads whose two triangles start at rows ``first`` of ``faces`` (read as
-    ``abc, acd``) into ``abd, bcd`` where the diagonal ``bd`` is shorter than ``ac`` (ties keep ``ac``)."""
+    ``abc, acd``) into ``abd, bcd`` where the diagonal ``bd`` is shorter than ``ac`` (ties keep ``ac``).
+
+    Returns the number of quads whose corners are not coplanar and six times the volume between the two
+    splits of all of them (the tetrahedron ``abcd`` of each quad: the other split adds or removes it)."""
     a, b, c = faces[first, 0], faces[first, 1], faces[first, 2]
     d = faces[first + 1, 2]
+    six = np.abs(np.einsum("ij,ij->i", vertices[b] - vertices[a],
+                           np.cross(vertices[c] - vertices[a], vertices[d] - vertices[a])))
+    warped = int(np.count_nonzero(six))
     ac = np.einsum("ij,ij->i", vertices[c] - vertices[a], vertices[c] - vertices[a])
     bd = np.einsum("ij,ij->i", vertices[d] - vertices[b], vertices[d] - vertices[b])
     swap = bd < ac
     rows = first[swap]
     faces[rows] = np.column_stack([a[swap], b[swap], d[swap]])
     faces[rows + 1] = np.column_stack([b[swap], c[swap], d[swap]])
+    return warped, float(six.sum())
+
+
+def _warn_warped_quads(path: str, vertices: np.ndarray, faces: np.ndarray, warped: int, quads: int,
+                       six_between: float) -> None:
+    """Say that non-planar quads were split by rule, with the volume the other split could change, as a
+    fraction of the enclosed volume (unit-free: the reader does not know the file's unit); nothing below
+    1e-9 of it (round-off of a planar export)."""
+    p = vertices[faces]
+    six_volume = abs(float(np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])).sum()))
+    if not six_volume > 0 or six_between <= 1e-9 * six_volume:
+        return
+    warnings.warn(NonPlanarPolygonWarning(
+        f"{_display(path)}: {warped:,} of {quads:,} quadrilaterals are not planar; each was split along its "
+        f"shorter diagonal (as MuJoCo reads OBJ; trimesh splits from the first corner): the other split would "
+        f"change the volume by up to {100 * six_between / six_volume:.2g} % of the whole"), stacklevel=4)
 
 
 def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
@@ -577,9 +600,13 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     top = max(int(block.max()) for block in face_blocks)
     if top >= nv:
         raise _fail(path, f"face index {top + 1:,} is past the last vertex ({nv:,} defined)")
+    warped, between = 0, 0.0
     for block_index, rows in quad_blocks:
-        _split_quads_along_shorter_diagonal(vertices, face_blocks[block_index], rows)
+        w, v6 = _split_quads_along_shorter_diagonal(vertices, face_blocks[block_index], rows)
+        warped, between = warped + w, between + v6
     faces = np.concatenate(face_blocks)
+    if warped:
+        _warn_warped_quads(path, vertices, faces, warped, sum(len(rows) for _, rows in quad_blocks), between)
     if garbage:
         warnings.warn(MalformedTextWarning(f"{_display(path)}: {garbage:,} unrecognised lines were ignored"
                                            f"{first_garbage}"), stacklevel=4)
