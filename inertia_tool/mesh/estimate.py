@@ -51,7 +51,8 @@ from .edges import edge_keys
 from .seal import Seal
 
 __all__ = ["Uncertainty", "Estimate", "boundary_edges", "patched_estimate", "winding_estimate", "uncertainty_from",
-           "enclosing_balls", "check_useful", "hole_doubt_volumes", "ball_slab_volume"]
+           "enclosing_balls", "check_useful", "hole_doubt_volumes", "ball_slab_volume",
+           "closed_surface_estimate"]
 
 
 @frozen_value
@@ -813,3 +814,60 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
               f"{int(np.count_nonzero(doubtful[~crossed])):,} more undecided")
     return Estimate(volume=vol, centroid=c, second_moment=second, area=area, uncertainty=unc, method="winding",
                     detail=detail, vertices=v, faces=f, far=far)
+
+
+#: Closed-surface estimate (:func:`closed_surface_estimate`): the mass bound it refines towards, relative.
+CLOSED_TARGET_MASS_RTOL = 0.05
+#: Finest grid of the closed-surface estimate, cells along the longest side: one refinement pass at most, and
+#: each crossed cell costs its surface samples, so a 7.6k-face part with dense inner detail (qb_move) stays
+#: within ~8 s of CPU at 256.
+CLOSED_MAX_RESOLUTION = 256
+
+
+def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64,
+                            target: float = CLOSED_TARGET_MASS_RTOL,
+                            max_resolution: int = CLOSED_MAX_RESOLUTION) -> Estimate:
+    """The solid ``{w ≥ 1}`` of a closed, edge-balanced surface that passes through itself, on a grid, with an
+    assumption-free bound.
+
+    For a surface whose every directed edge is matched by its reverse (a 2-cycle), the winding number ``w``
+    is an integer at every point off the surface, constant on each connected region of space the surface
+    does not meet.  On a grid of cubes, a cell the surface crosses is *undecided*
+    (:func:`_surface_cells` marks a superset of them); the other cells form face-connected regions, each
+    given the integer of one of its cells (:func:`_closed_part_numbers`: evaluated there and rounded,
+    refused when more than 1/4 from an integer — then every free cell is evaluated and thresholded with
+    the margins of :func:`winding_estimate`).  With ``D`` the decided cells with ``w ≥ 1`` and ``U`` the
+    undecided ones, the true solid ``S`` satisfies ``D ⊆ S ⊆ D ∪ U`` **with no assumption** on the
+    surface.  The estimate is ``D`` plus half of ``U`` (each undecided cell counted half), so its volume is
+    within ``|U|/2`` of the truth, and the mass, centre-of-mass and inertia bounds of
+    :func:`uncertainty_from` follow from ``δV = |U|/2`` lying within ``far`` of the centroid (the
+    difference between truth and estimate is a signed density of at most 1/2 on ``U``).
+
+    The grid has ``resolution`` cells along the longest side; when the mass bound exceeds ``target``, it is
+    built once more at ``resolution · bound / target`` cells (the undecided volume of a surface shrinks as
+    the cell size), at most ``max_resolution``, and that second grid is the answer (chosen by this rule, not
+    by which bound is smaller).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        m.
+    faces : (m, 3) int
+        Edge-balanced (closed) surface; the caller checks.
+    resolution, target, max_resolution
+        As above.
+
+    Returns
+    -------
+    Estimate
+        ``method`` ``"winding"``.
+    """
+    first = winding_estimate(vertices, faces, resolution=resolution)
+    bound = first.uncertainty.mass
+    if not (np.isfinite(bound) and bound > target) or resolution >= max_resolution:
+        return first
+    finer = int(min(max_resolution, np.ceil(resolution * bound / target)))
+    if finer <= resolution:
+        return first
+    second = winding_estimate(vertices, faces, resolution=finer)
+    return second if second.detail != first.detail else first
