@@ -833,10 +833,9 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
 
 #: Closed-surface estimate (:func:`closed_surface_estimate`): the mass bound it refines towards, relative.
 CLOSED_TARGET_MASS_RTOL = 0.05
-#: Finest grid of the closed-surface estimate, cells along the longest side: one refinement pass at most, and
-#: each crossed cell costs its surface samples, so a 7.6k-face part with dense inner detail (qb_move) stays
-#: within ~8 s of CPU at 256.
-CLOSED_MAX_RESOLUTION = 256
+#: Finest grid of the closed-surface estimate, cells along the longest side (one refinement pass at most): the
+#: dense grid's arrays dominate the cost, ~6 s of CPU for a near-cubic part at 224 (qb_move: 9.7 s at 256).
+CLOSED_MAX_RESOLUTION = 224
 
 
 def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64,
