@@ -149,3 +149,24 @@ def test_qb_move_is_estimated_consistently():
     coarse = winding_estimate(np.asarray(mesh.vertices) * 1e-3, np.asarray(mesh.faces))
     lo, hi = coarse.volume * (1 - coarse.uncertainty.mass), coarse.volume * (1 + coarse.uncertainty.mass)
     assert props.volume * (1 - unc.mass) <= hi and props.volume * (1 + unc.mass) >= lo
+
+
+def test_useless_bound_is_still_refused_with_the_arrangement_reason(monkeypatch):
+    """Past the 50 % mass rule the estimate is refused, and the message keeps why the arrangement failed (a
+    grid of 24 cells on a thin figure-eight tube: ±97 %)."""
+    import inertia_tool.mesh.arrange as arrange
+    import inertia_tool.mesh.estimate as estimate
+
+    def fail(*args, **kwargs):
+        raise ArrangementError("a corner of a face lies exactly in the plane of a face it crosses")
+
+    monkeypatch.setattr(arrange, "arrange_crossings", fail)
+    original = estimate.closed_surface_estimate
+    monkeypatch.setattr(estimate, "closed_surface_estimate",
+                        lambda v, f, **kw: original(v, f, resolution=24, max_resolution=24))
+    v, f, _ = S.tube_halves(0.1, 0.2, rings=48, sections=8)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(InvalidMeshError, match=r"could not be built: a corner of a face.*cannot be bounded "
+                                                   r"usefully"):
+            mass_properties((v, f), density=1.0, repair=True)
