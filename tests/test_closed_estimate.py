@@ -77,6 +77,16 @@ def test_refinement_narrows_the_bound_and_keeps_the_truth():
     _truth_within(refined, truth)
 
 
+def test_a_part_thinner_than_the_first_grid_is_refined_to_the_finest():
+    """A thin figure-eight tube: no cell of a 16-cell grid is decided inside (the first estimate has no volume
+    and no bound); the finest grid is built, and the union of the two halves lies within its bounds."""
+    v, f, halves = S.tube_halves(0.1, 0.2, rings=48, sections=8)
+    assert winding_estimate(v, f, resolution=16).volume == 0
+    est = closed_surface_estimate(v, f, resolution=16, max_resolution=64)
+    assert est.volume > 0 and np.isfinite(est.uncertainty.mass)
+    _truth_within(est, S.truth_from_manifold(list(halves)))
+
+
 def test_no_refinement_when_the_first_grid_meets_the_target():
     pieces = _special_boxes([0.4, 0.1, 0.0])
     v, f = S.concat(*pieces)

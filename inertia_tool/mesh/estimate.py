@@ -859,8 +859,8 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
 
     The grid has ``resolution`` cells along the longest side; when the mass bound exceeds ``target``, it is
     built once more at ``resolution · bound / target`` cells (the undecided volume of a surface shrinks as
-    the cell size), at most ``max_resolution``, and that second grid is the answer (chosen by this rule, not
-    by which bound is smaller).
+    the cell size), at most ``max_resolution`` (exactly that when no cell was decided inside, a part thinner
+    than the cells), and that second grid is the answer (chosen by this rule, not by which bound is smaller).
 
     Parameters
     ----------
@@ -878,9 +878,11 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
     """
     first = winding_estimate(vertices, faces, resolution=resolution)
     bound = first.uncertainty.mass
-    if not (np.isfinite(bound) and bound > target) or resolution >= max_resolution:
+    if resolution >= max_resolution or (np.isfinite(bound) and bound <= target):
         return first
-    finer = int(min(max_resolution, np.ceil(resolution * bound / target)))
+    # no cell decided inside (a part thinner than the cells) or no finite bound: the finest grid
+    finer = max_resolution if not (np.isfinite(bound) and first.volume > 0) else \
+        int(min(max_resolution, np.ceil(resolution * bound / target)))
     if finer <= resolution:
         return first
     second = winding_estimate(vertices, faces, resolution=finer)
