@@ -36,6 +36,9 @@ The mass-property bounds (see :class:`Uncertainty`): ``mass`` relative, ``center
 largest distance from the centre of mass to a point of the doubtful region and ``J = ‖I/ρ‖_F``:
 ``δm/m = δV/V``, ``δc = δV·D/(V − δV)`` and ``δI/I = (√2 δV D² + (V + δV) δc² · √6) / J`` (a point mass
 ``δV`` at distance ``D`` has ``‖I‖_F = √2 δV D²``; the shift of the centre adds the parallel-axis term).
+The winding estimate sums over its doubtful cells instead (``δV·D → Σ δV_u r_u``, ``δV·D² → Σ δV_u r_u²``,
+``r_u`` the distance from the centroid to the farthest point of cell ``u``): the same argument cell by cell,
+never wider, and much narrower when most doubt lies near the centre.
 """
 
 from __future__ import annotations
@@ -51,7 +54,8 @@ from .edges import edge_keys
 from .seal import Seal
 
 __all__ = ["Uncertainty", "Estimate", "boundary_edges", "patched_estimate", "winding_estimate", "uncertainty_from",
-           "enclosing_balls", "check_useful", "hole_doubt_volumes", "ball_slab_volume"]
+           "enclosing_balls", "check_useful", "hole_doubt_volumes", "ball_slab_volume",
+           "closed_surface_estimate"]
 
 
 @frozen_value
@@ -114,15 +118,23 @@ class Estimate:
 
 
 def uncertainty_from(volume: float, centroid: np.ndarray, second_moment: np.ndarray, doubt: float,
-                     far: float) -> Uncertainty:
-    """Bounds from ``doubt`` m³ of undecided space lying within ``far`` m of the centroid (formulas above)."""
+                     far: float, *, first_doubt: float | None = None,
+                     second_doubt: float | None = None) -> Uncertainty:
+    """Bounds from ``doubt`` m³ of undecided space lying within ``far`` m of the centroid (formulas above).
+
+    ``first_doubt`` (m⁴) and ``second_doubt`` (m⁵), when given, replace ``doubt · far`` and ``doubt · far²``:
+    bounds on ``∫ |x − c| d|ν|`` and ``∫ |x − c|² d|ν|`` for the difference ``ν`` between the true and the
+    estimated material, summed cell by cell (never larger than the products, often much smaller).
+    """
     if not volume > 0:
         return Uncertainty(np.inf, np.inf, np.inf, float(doubt))
     inertia = np.trace(second_moment) * np.eye(3) - second_moment
     norm = float(np.linalg.norm(inertia))
     rel_mass = doubt / volume
-    shift = doubt * far / (volume - doubt) if doubt < volume else np.inf
-    rel_inertia = (np.sqrt(2) * doubt * far ** 2 + (volume + doubt) * shift ** 2 * np.sqrt(6)) / norm \
+    first = doubt * far if first_doubt is None else min(first_doubt, doubt * far)
+    second = doubt * far ** 2 if second_doubt is None else min(second_doubt, doubt * far ** 2)
+    shift = first / (volume - doubt) if doubt < volume else np.inf
+    rel_inertia = (np.sqrt(2) * second + (volume + doubt) * shift ** 2 * np.sqrt(6)) / norm \
         if norm > 0 else np.inf
     return Uncertainty(mass=float(rel_mass), center_of_mass=float(shift), inertia=float(rel_inertia),
                        volume_in_doubt=float(doubt))
@@ -804,12 +816,74 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
                         "no grid cell has a winding number above 1/2", v, f)
     vol, c, second = _cube_moments(centres[material > 0], h, material[material > 0])
     doubt = float(np.sum(doubtful)) * h ** 3
-    far = float(np.max(np.linalg.norm(centres[doubtful > 0] - c, axis=1))) + h * np.sqrt(3) / 2 \
-        if doubtful.any() else 0.0
-    unc = uncertainty_from(vol, c, second, doubt, far)
+    # each doubtful cell's points lie within its centre's distance + half its diagonal of the centroid; the
+    # difference between true and estimated material there is at most its weight (1/2 crossed, 1 ambiguous)
+    reach = np.linalg.norm(centres[doubtful > 0] - c, axis=1) + h * np.sqrt(3) / 2
+    far = float(np.max(reach)) if doubtful.any() else 0.0
+    cell_doubt = doubtful[doubtful > 0] * h ** 3
+    unc = uncertainty_from(vol, c, second, doubt, far, first_doubt=float(np.sum(cell_doubt * reach)),
+                           second_doubt=float(np.sum(cell_doubt * reach ** 2)))
     how = "libigl fast winding numbers" if use_igl else "winding numbers by a treecode with an error bound"
     detail = (f"winding number > 1/2 on a {dims[0]}×{dims[1]}×{dims[2]} grid of {h:.3g} m cells ({how}); "
               f"{int(np.count_nonzero(crossed)):,} cells crossed by the surface counted half, "
               f"{int(np.count_nonzero(doubtful[~crossed])):,} more undecided")
     return Estimate(volume=vol, centroid=c, second_moment=second, area=area, uncertainty=unc, method="winding",
                     detail=detail, vertices=v, faces=f, far=far)
+
+
+#: Closed-surface estimate (:func:`closed_surface_estimate`): the mass bound it refines towards, relative.
+CLOSED_TARGET_MASS_RTOL = 0.05
+#: Finest grid of the closed-surface estimate, cells along the longest side (one refinement pass at most): the
+#: dense grid's arrays dominate the cost, ~6 s of CPU for a near-cubic part at 224 (qb_move: 9.7 s at 256).
+CLOSED_MAX_RESOLUTION = 224
+
+
+def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64,
+                            target: float = CLOSED_TARGET_MASS_RTOL,
+                            max_resolution: int = CLOSED_MAX_RESOLUTION) -> Estimate:
+    """The solid ``{w ≥ 1}`` of a closed, edge-balanced surface that passes through itself, on a grid, with an
+    assumption-free bound.
+
+    For a surface whose every directed edge is matched by its reverse (a 2-cycle), the winding number ``w``
+    is an integer at every point off the surface, constant on each connected region of space the surface
+    does not meet.  On a grid of cubes, a cell the surface crosses is *undecided*
+    (:func:`_surface_cells` marks a superset of them); the other cells form face-connected regions, each
+    given the integer of one of its cells (:func:`_closed_part_numbers`: evaluated there and rounded,
+    refused when more than 1/4 from an integer — then every free cell is evaluated and thresholded with
+    the margins of :func:`winding_estimate`).  With ``D`` the decided cells with ``w ≥ 1`` and ``U`` the
+    undecided ones, the true solid ``S`` satisfies ``D ⊆ S ⊆ D ∪ U`` **with no assumption** on the
+    surface.  The estimate is ``D`` plus half of ``U`` (each undecided cell counted half), so its volume is
+    within ``|U|/2`` of the truth, and the mass, centre-of-mass and inertia bounds of
+    :func:`uncertainty_from` follow from ``δV = |U|/2`` lying within ``far`` of the centroid (the
+    difference between truth and estimate is a signed density of at most 1/2 on ``U``).
+
+    The grid has ``resolution`` cells along the longest side; when the mass bound exceeds ``target``, it is
+    built once more at ``resolution · bound / target`` cells (the undecided volume of a surface shrinks as
+    the cell size), at most ``max_resolution`` (exactly that when no cell was decided inside, a part thinner
+    than the cells), and that second grid is the answer (chosen by this rule, not by which bound is smaller).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        m.
+    faces : (m, 3) int
+        Edge-balanced (closed) surface; the caller checks.
+    resolution, target, max_resolution
+        As above.
+
+    Returns
+    -------
+    Estimate
+        ``method`` ``"winding"``.
+    """
+    first = winding_estimate(vertices, faces, resolution=resolution)
+    bound = first.uncertainty.mass
+    if resolution >= max_resolution or (np.isfinite(bound) and bound <= target):
+        return first
+    # no cell decided inside (a part thinner than the cells) or no finite bound: the finest grid
+    finer = max_resolution if not (np.isfinite(bound) and first.volume > 0) else \
+        int(min(max_resolution, np.ceil(resolution * bound / target)))
+    if finer <= resolution:
+        return first
+    second = winding_estimate(vertices, faces, resolution=finer)
+    return second if second.detail != first.detail else first

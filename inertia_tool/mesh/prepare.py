@@ -292,7 +292,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         forced = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
                                  moments=volume_moments, force_estimate=True,
                                  reason=f"the surface passes through itself at {touch.self_crossing_pairs:,} "
-                                        "face pairs")
+                                        f"face pairs{arrange_failed}")
         warnings.warn(MeshRepairedWarning(f"{source}: repaired ({forced.method}, an estimate): "
                                           f"{'; '.join(forced.notes)}"), stacklevel=3)
         return _estimated(forced, common)

@@ -207,7 +207,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         Without ``repair`` when no exact reading exists; with it when nothing encloses a volume.
     """
     # imported on use: a surface that passes the manifold check (nearly every file) never comes here
-    from .estimate import check_useful, winding_estimate
+    from .estimate import check_useful, closed_surface_estimate, winding_estimate
     from .merge import merge_close_vertices
     from .orient import edge_balance, orient_consistently
     from .seal import drop_duplicate_faces, on_edge_vertices
@@ -216,7 +216,9 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     n = len(v)
     if force_estimate:
         census = edge_balance(f, n)
-        grid = winding_estimate(v, f)
+        # a closed surface has an integer winding number off it: the decided cells bound the solid with no
+        # assumption, and the grid is refined once towards CLOSED_TARGET_MASS_RTOL
+        grid = closed_surface_estimate(v, f) if census.balanced else winding_estimate(v, f)
         why = reason or "the bodies overlap and their union could not be formed"
         hint = ("`overlap` 'sum' adds the bodies (shared volume counted twice)" if reason is None else
                 "repair the surface so that it does not pass through itself")
