@@ -902,12 +902,10 @@ MAX_NEAR_COPY_PAIRS = 256
 
 
 def _steiner_bound(vertices: np.ndarray, faces: np.ndarray, delta: float) -> float:
-    """Volume of the ``delta``-neighbourhood of the faces, bounded above: Σ 2δA + (π/2)δ²P + (4/3)πδ³."""
-    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
-    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    perimeter = np.linalg.norm(b - a, axis=1) + np.linalg.norm(c - b, axis=1) + np.linalg.norm(a - c, axis=1)
-    per_face = 2 * delta * area + 0.5 * np.pi * delta ** 2 * perimeter + 4 / 3 * np.pi * delta ** 3
-    return float(np.sum(per_face) * (1 + 1e-12))
+    """Volume of the ``delta``-neighbourhood of the faces, bounded above (Steiner's formula per face,
+    :func:`~.seal.parallel_body_volume`, summed, with a relative 1e-12 for the sum's rounding)."""
+    from .seal import parallel_body_volume
+    return float(np.sum(parallel_body_volume(vertices, faces, np.full(len(faces), delta))) * (1 + 1e-12))
 
 
 def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, shells: Sequence[VolumeMoments], *,
