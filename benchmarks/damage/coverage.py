@@ -111,10 +111,17 @@ def repo_sources():
     return out
 
 
-def robot_sources():
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
+def _make_cases():
+    """``make_cases.py`` beside this file (its robot parts and the touching pair are shared)."""
+    here = str(Path(__file__).resolve().parent)
+    if here not in sys.path:
+        sys.path.insert(0, here)
     import make_cases
+    return make_cases
 
+
+def robot_sources():
+    make_cases = _make_cases()
     wheel = OUT / "pkgs" / make_cases.WHEEL
     if not wheel.exists():
         return []
@@ -324,14 +331,7 @@ def damage_touching_copy(v, f, rng):
     """The mirror image across one of the six bounding-box planes, joined to the part by exact vertex weld
     where they meet (shared faces where the part has a flat face on that plane, else an edge or a point).
     Truth: both bodies (the exact integral of the two closed shells before welding)."""
-    sides = [(axis, end) for axis in range(3) for end in (v[:, axis].min(), v[:, axis].max())]
-    counts = np.array([np.count_nonzero(v[:, axis] == end) for axis, end in sides])
-    best = np.flatnonzero(counts == counts.max())
-    axis, plane = sides[int(rng.choice(best))]
-    mirrored = v.copy()
-    mirrored[:, axis] = 2.0 * plane - mirrored[:, axis]   # exact on the plane: 2a - a == a
-    both_v = np.vstack([v, mirrored])
-    both_f = np.vstack([f, f[:, ::-1] + len(v)])         # a reflection reverses the winding
+    both_v, both_f, axis, _ = _make_cases().mirror_pair(v, f, rng)
     truth = _moments_truth(both_v, both_f)
     wv, wf = _weld(both_v, both_f)
     return wv, wf, {"axis": "xyz"[axis], "shared_vertices": int(len(both_v) - len(wv))}, truth

@@ -260,11 +260,10 @@ def damage_fragments(v, f, rng, diag, count=3, size=0.02):
     return np.vstack([v, corners.reshape(-1, 3)]), np.vstack([f, new]), {"stray_triangles": count}
 
 
-def damage_touch(v, f, rng):
-    """The mirror image across the bounding-box face (of six) holding the most vertices, so that the two
-    bodies share faces there where the part has a flat face (else an edge or a point); the seed breaks ties."""
-    from inertia_tool.errors import OverlapWarning
-
+def mirror_pair(v, f, rng):
+    """The part and its mirror image across the bounding-box face (of six) holding the most vertices, so that
+    the two bodies share faces there where the part has a flat face (else an edge or a point); the seed breaks
+    ties.  Returns the two shells unwelded (vertices, faces), the axis and the plane's coordinate."""
     sides = [(axis, end) for axis in range(3) for end in (v[:, axis].min(), v[:, axis].max())]
     counts = np.array([np.count_nonzero(v[:, axis] == end) for axis, end in sides])
     best = np.flatnonzero(counts == counts.max())
@@ -273,11 +272,16 @@ def damage_touch(v, f, rng):
     mirrored[:, axis] = 2.0 * plane - mirrored[:, axis]   # exact on the plane: 2a - a == a
     both_v = np.vstack([v, mirrored])
     both_f = np.vstack([f, f[:, ::-1] + len(v)])         # a reflection reverses the winding
+    return both_v, both_f, axis, plane
+
+
+def damage_touch(v, f, rng):
+    """Two bodies touching: :func:`mirror_pair`, welded bit-exactly where they meet."""
+    both_v, both_f, axis, plane = mirror_pair(v, f, rng)
     # the exact sum of both bodies, from the part's own truth and the reflection (independent of how the engine
     # treats the shared faces: their interiors lie on opposite sides of the plane, so nothing overlaps)
     truth = _mirror_pair_truth(truth_of(v, f), axis, plane)
     truth["diagonal"] = float(np.linalg.norm(both_v.max(axis=0) - both_v.min(axis=0)))
-    del OverlapWarning
     welded_v, welded_f = exact_weld(both_v, both_f)
     shared = len(both_v) - len(welded_v)
     return welded_v, welded_f, {"axis": "xyz"[axis], "plane": float(plane), "shared_vertices": int(shared)}, truth
