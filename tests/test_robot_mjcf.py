@@ -13,34 +13,9 @@ from inertia_tool.mass.surface import surface_moments
 from inertia_tool.robot import audit_links, link_inertials, read_robot
 
 from conftest import assert_tensor_close
+from mujoco_reference import assert_like_mujoco
 
 mujoco = pytest.importorskip("mujoco")
-
-
-def _mujoco_bodies(path):
-    """name → (mass, centre, tensor in body axes) from MuJoCo's compiler."""
-    model = mujoco.MjModel.from_xml_path(str(path))
-    out = {}
-    for i in range(1, model.nbody):
-        rot = np.zeros(9)
-        mujoco.mju_quat2Mat(rot, model.body_iquat[i])
-        rot = rot.reshape(3, 3)
-        out[model.body(i).name] = (model.body_mass[i], model.body_ipos[i].copy(),
-                                   rot @ np.diag(model.body_inertia[i]) @ rot.T)
-    return out
-
-
-def _assert_like_mujoco(path, results, *, rtol=1e-9):
-    reference = _mujoco_bodies(path)
-    ours = {r.name: r for r in results}
-    assert set(ours) == set(reference)
-    for name, (mass, com, tensor) in reference.items():
-        props = ours[name].properties
-        assert props is not None, (name, ours[name].problem)
-        assert props.mass == pytest.approx(mass, rel=rtol), name
-        scale = max(np.linalg.norm(com), np.sqrt(np.trace(tensor) / mass))
-        np.testing.assert_allclose(props.center_of_mass, com, atol=rtol * scale, err_msg=name)
-        assert_tensor_close(props.inertia, tensor, rtol)
 
 
 # one model using what the Menagerie files use: an included robot, two top-level <default> blocks, nested
@@ -115,7 +90,7 @@ def test_menagerie_style_scene_matches_mujoco_with_the_models_own_densities(scen
     assert [link.name for link in robot.links] == ["base", "upper", "tool"]
     results = link_inertials(robot, density="model")
     assert all(r.method == "exact" and r.uncertainty is None for r in results)
-    _assert_like_mujoco(scene, results)
+    assert_like_mujoco(scene, results)
 
 
 def test_with_one_density_mujoco_agrees_when_its_geoms_have_that_density(scene, tmp_path):
@@ -125,7 +100,7 @@ def test_with_one_density_mujoco_agrees_when_its_geoms_have_that_density(scene, 
         text = text.replace(attr, "")
     (tmp_path / "robot.xml").write_text(text)
     (tmp_path / "parts.xml").write_text(PARTS.replace('density="500"', ""))
-    _assert_like_mujoco(scene, link_inertials(read_robot(scene), density=1000))
+    assert_like_mujoco(scene, link_inertials(read_robot(scene), density=1000))
 
 
 def test_the_geoms_own_orientation_replaces_its_class_orientation(tmp_path):
@@ -135,7 +110,7 @@ def test_the_geoms_own_orientation_replaces_its_class_orientation(tmp_path):
         path.write_text(f'<mujoco><compiler inertiafromgeom="true"/><default><default class="c"><geom {cls}/>'
                         f'</default></default><worldbody><body name="b"><freejoint/><geom class="c" type="box" '
                         f'size="0.1 0.2 0.3" pos="0.1 0 0" {own}/></body></worldbody></mujoco>')
-        _assert_like_mujoco(path, link_inertials(read_robot(path), density=1000))
+        assert_like_mujoco(path, link_inertials(read_robot(path), density=1000))
 
 
 def _box_tensor(tmp_path, orientation):
@@ -206,7 +181,7 @@ def test_shellinertia_matches_mujoco(tmp_path, geom):
     pose = "" if "fromto" in geom else 'pos="0.1 0.2 0.3" euler="10 20 30"'    # MuJoCo refuses pos with fromto
     path.write_text(f'<mujoco><compiler inertiafromgeom="true"/><worldbody><body name="b"><freejoint/>'
                     f'<geom {geom} shellinertia="true" density="3" {pose}/></body></worldbody></mujoco>')
-    _assert_like_mujoco(path, link_inertials(read_robot(path), density="model"), rtol=1e-12)
+    assert_like_mujoco(path, link_inertials(read_robot(path), density="model"), rtol=1e-12)
 
 
 def test_mesh_shell_inertia_matches_mujoco(tmp_path):
@@ -215,7 +190,7 @@ def test_mesh_shell_inertia_matches_mujoco(tmp_path):
     path.write_text('<mujoco><compiler inertiafromgeom="true"/><asset><mesh name="m" file="cone.stl" '
                     'inertia="shell" scale="1 2 1" refpos="0.1 0 0"/></asset><worldbody><body name="b"><freejoint/>'
                     '<geom type="mesh" mesh="m" density="3" pos="0.1 0.2 0.3"/></body></worldbody></mujoco>')
-    _assert_like_mujoco(path, link_inertials(read_robot(path), density="model"), rtol=1e-9)
+    assert_like_mujoco(path, link_inertials(read_robot(path), density="model"), rtol=1e-9)
 
 
 def test_shell_closed_forms_against_fine_triangulations():
@@ -304,7 +279,7 @@ def test_replicate_names_and_masses_match_mujoco(tmp_path):
                     '</worldbody></mujoco>')
     results = link_inertials(read_robot(path), density=1000)
     assert [r.name for r in results][:4] == ["bi00o0", "ci00o0", "bi01o0", "ci01o0"] and len(results) == 44
-    _assert_like_mujoco(path, results)
+    assert_like_mujoco(path, results)
 
 
 def test_attach_of_a_missing_model_is_refused_not_skipped(tmp_path):
@@ -332,7 +307,7 @@ def test_a_primitive_fitted_to_a_mesh_matches_mujoco(tmp_path, kind):
                     'pos="0.01 0 0.02" euler="0.1 0.2 0.3" fitscale="1.2"/></body></worldbody></mujoco>')
     robot = read_robot(path)
     assert robot.links[0].elements[0].fit_scale == 1.2
-    _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-6)     # float32 STL corners
+    assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-6)     # float32 STL corners
 
 
 @pytest.mark.parametrize("kind", ["capsule", "cylinder", "box", "sphere", "ellipsoid"])
@@ -349,7 +324,7 @@ def test_a_primitive_fitted_to_a_meshs_bounding_box_matches_mujoco(tmp_path, kin
                     '</body></worldbody></mujoco>')
     robot = read_robot(path)
     assert robot.links[0].elements[0].fit_aabb
-    _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-6)     # float32 STL corners
+    assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-6)     # float32 STL corners
 
 
 def test_a_primitive_fitted_to_a_mesh_is_as_sure_as_the_mesh(tmp_path):
@@ -380,7 +355,7 @@ def test_all_geoms_with_the_models_densities_is_mujocos_inertia_from_geometry(tm
                     '<geom class="visual" type="sphere" size="0.1" pos="0.3 0 0" density="500"/>'
                     '<geom type="sphere" size="0.2" pos="0 0.5 0" group="4"/></body></worldbody></mujoco>')
     results = link_inertials(read_robot(path, geometry="all"), density="model")
-    _assert_like_mujoco(path, results, rtol=1e-12)
+    assert_like_mujoco(path, results, rtol=1e-12)
     with pytest.raises(UsageError, match="MJCF only"):
         from robot_data import UR5, PACKAGES
         read_robot(UR5, packages=PACKAGES, geometry="all")
@@ -497,7 +472,7 @@ def test_a_plane_in_a_body_has_no_mass_as_in_mujoco(tmp_path):
     path.write_text('<mujoco><compiler inertiafromgeom="true"/><worldbody><body name="barrier" pos="0 0 1">'
                     '<geom type="plane" size="1 1 0.1"/><geom type="sphere" size="0.1" pos="0 0.2 0"/></body>'
                     '</worldbody></mujoco>')
-    _assert_like_mujoco(path, link_inertials(read_robot(path), density=1000), rtol=1e-12)
+    assert_like_mujoco(path, link_inertials(read_robot(path), density=1000), rtol=1e-12)
 
 
 def test_a_missing_mesh_file_refuses_the_model_or_only_its_body(tmp_path):

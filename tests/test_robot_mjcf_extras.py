@@ -10,36 +10,9 @@ from inertia_tool.errors import RobotDescriptionError
 from inertia_tool.robot import link_inertials, read_robot
 from inertia_tool.robot.mjspec import compare_with_mujoco
 
-from conftest import assert_tensor_close
+from mujoco_reference import assert_like_mujoco, mujoco_bodies
 
 mujoco = pytest.importorskip("mujoco")
-
-
-def _mujoco_bodies(path):
-    """name → (mass, centre, tensor in body axes) of every body but the world, from MuJoCo's compiler (an
-    unnamed body is ``body N``, as the reader names it)."""
-    model = mujoco.MjModel.from_xml_path(str(path))
-    out = {}
-    for i in range(1, model.nbody):
-        rot = np.zeros(9)
-        mujoco.mju_quat2Mat(rot, model.body_iquat[i])
-        rot = rot.reshape(3, 3)
-        out[model.body(i).name or f"body {i}"] = (model.body_mass[i], model.body_ipos[i].copy(),
-                                   rot @ np.diag(model.body_inertia[i]) @ rot.T)
-    return out
-
-
-def _assert_like_mujoco(path, results, *, rtol=1e-9):
-    reference = _mujoco_bodies(path)
-    ours = {r.name: r for r in results}
-    assert set(ours) == set(reference)
-    for name, (mass, com, tensor) in reference.items():
-        props = ours[name].properties
-        assert props is not None, (name, ours[name].problem)
-        assert props.mass == pytest.approx(mass, rel=rtol), name
-        scale = max(np.linalg.norm(com), np.sqrt(np.trace(tensor) / mass))
-        np.testing.assert_allclose(props.center_of_mass, com, atol=rtol * scale, err_msg=name)
-        assert_tensor_close(props.inertia, tensor, rtol)
 
 
 # -- height fields ------------------------------------------------------------------------------------------
@@ -59,7 +32,7 @@ def test_terrain_in_the_world_is_skipped_and_a_body_height_field_is_mujocos_box(
     path.write_text(HFIELD)
     robot = read_robot(path)
     results = link_inertials(robot, density="model")
-    _assert_like_mujoco(path, results, rtol=1e-12)
+    assert_like_mujoco(path, results, rtol=1e-12)
     (a,) = results
     assert any("height field 'bump'" in w and "0.6 x 0.4 x 0.04 m" in w for w in a.warnings), a.warnings
     assert compare_with_mujoco(robot) == ()
@@ -107,7 +80,7 @@ def test_inline_vertex_and_face_match_mujoco_with_scale_and_reference_frame(tmp_
     robot = read_robot(path)
     assert robot.links[0].elements[0].mesh is None and robot.links[0].elements[0].vertices.shape == (6, 3)
     # MuJoCo keeps mesh vertices in float32 (0.1 is not one): agreement to its rounding, not to 1e-9
-    _assert_like_mujoco(path, link_inertials(robot, density="model"), rtol=1e-6)
+    assert_like_mujoco(path, link_inertials(robot, density="model"), rtol=1e-6)
     assert compare_with_mujoco(robot) == ()
 
 
@@ -138,7 +111,7 @@ def test_vertex_without_face_is_mujocos_convex_hull(tmp_path):
                     '<body name="b"><freejoint/><geom type="mesh" mesh="h" pos="0 0 1"/></body></worldbody></mujoco>')
     robot = read_robot(path)
     results = link_inertials(robot, density=1000)
-    _assert_like_mujoco(path, results, rtol=1e-9)
+    assert_like_mujoco(path, results, rtol=1e-9)
     props = results[0].properties
     assert props.mass == pytest.approx(1000 * 1 * 2 * 6, rel=1e-12)
     np.testing.assert_allclose(props.center_of_mass, [0, 1, 4], atol=1e-12)
@@ -214,7 +187,7 @@ def test_attached_bodies_are_read_as_mujoco_reads_them(attached):
     robot = read_robot(attached)
     assert [link.name for link in robot.links] == ["base", "first", "c_hand", "body 4", "c_finger", "c_g_tip",
                                                    "last", "w_tip", "w_other"]
-    _assert_like_mujoco(attached, link_inertials(robot, density="model"), rtol=1e-9)
+    assert_like_mujoco(attached, link_inertials(robot, density="model"), rtol=1e-9)
     assert compare_with_mujoco(robot) == ()
 
 
@@ -223,7 +196,7 @@ def test_attached_with_one_density_matches_mujoco_at_that_density(attached, tmp_
     default = '<default><geom density="2000"/></default>'
     attached.write_text(MAIN.replace('<mujoco model="main">', f'<mujoco model="main">{default}'))
     (tmp_path / "sub" / "grand.xml").write_text(GRAND.replace("<compiler", f"{default}<compiler"))
-    _assert_like_mujoco(attached, link_inertials(read_robot(attached), density=2000), rtol=1e-9)
+    assert_like_mujoco(attached, link_inertials(read_robot(attached), density=2000), rtol=1e-9)
 
 
 @pytest.mark.parametrize("attach, message", [
@@ -256,7 +229,7 @@ def test_builtin_meshes_are_mujocos_triangles(tmp_path, builtin, params):
     robot = read_robot(path)
     results = link_inertials(robot, density=1000)
     assert results[0].method == "exact", results[0].problem
-    _assert_like_mujoco(path, results, rtol=1e-6)      # MuJoCo keeps mesh vertices in float32
+    assert_like_mujoco(path, results, rtol=1e-6)      # MuJoCo keeps mesh vertices in float32
 
 
 # -- <replicate> of geoms in a body ------------------------------------------------------------------------
@@ -274,7 +247,7 @@ def test_geoms_replicated_in_a_body_are_all_counted_where_mujoco_puts_them(tmp_p
                     '</replicate></body></worldbody></mujoco>')
     robot = read_robot(path)
     assert len(robot.links[0].elements) == 1 + 5 * (1 + 2)
-    _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-9)
+    assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-9)
     assert compare_with_mujoco(robot) == ()
 
 
@@ -287,9 +260,9 @@ def test_a_copy_written_elsewhere_still_attaches_its_model(attached, tmp_path):
     out.parent.mkdir(parents=True)
     changed = write_corrected(robot, link_inertials(robot, density="model"), out)
     assert set(changed) == {"base", "first", "last"}
-    theirs = _mujoco_bodies(out)
-    assert set(theirs) == set(_mujoco_bodies(attached))
-    assert theirs["c_g_tip"][0] == pytest.approx(_mujoco_bodies(attached)["c_g_tip"][0], rel=1e-12)
+    theirs = mujoco_bodies(out)
+    assert set(theirs) == set(mujoco_bodies(attached))
+    assert theirs["c_g_tip"][0] == pytest.approx(mujoco_bodies(attached)["c_g_tip"][0], rel=1e-12)
 
 
 # -- adversarial: generated replicates and point clouds against MuJoCo ---------------------------------------
@@ -312,7 +285,7 @@ def test_generated_replicates_of_geoms_match_mujoco(tmp_path_factory, count, ang
                     f'<replicate count="{inner}" offset="{step}" euler="{turn}"><geom type="capsule" size="0.01 0.03" '
                     'pos="0 0.05 0.1"/></replicate></replicate></body></worldbody></mujoco>')
     robot = read_robot(path)
-    _assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-9)
+    assert_like_mujoco(path, link_inertials(robot, density=1000), rtol=1e-9)
     assert compare_with_mujoco(robot) == ()
 
 
@@ -344,7 +317,7 @@ def test_generated_point_clouds_are_mujocos_hull(tmp_path_factory, seed, count, 
     # MuJoCo rounds the points to float32 (a relative 6e-8): on a thin hull that moves the volume by up to
     # ~ extent³/volume times as much, so the comparison allows what that rounding can do, no more
     extent = float(np.max(np.abs(points)))
-    _assert_like_mujoco(path, results, rtol=1e-6 * max(1.0, extent ** 3 / volume))
+    assert_like_mujoco(path, results, rtol=1e-6 * max(1.0, extent ** 3 / volume))
 
 
 def test_attaches_that_multiply_are_bounded(tmp_path):
