@@ -4,6 +4,16 @@ from fractions import Fraction
 NONE, CROSSING, OPPOSITE, CONTACT = 0, 1, 2, 3
 
 
+def pair_kinds(result):
+    """{(i, j): kind} of every pair a ``SurfaceContacts`` found, in the kinds above."""
+    out = {}
+    for kind, pairs in ((CROSSING, result.crossing), (OPPOSITE, result.coplanar_opposite),
+                        (CONTACT, result.contact)):
+        for i, j in pairs:
+            out[(int(i), int(j))] = kind
+    return out
+
+
 def _sub(p, q):
     return [p[0] - q[0], p[1] - q[1], p[2] - q[2]]
 

@@ -16,11 +16,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL, box_arrays
-from intersect_reference import CONTACT, CROSSING, NONE, OPPOSITE, brute_kind
+from intersect_reference import NONE, OPPOSITE, brute_kind, pair_kinds
 from inertia_tool import _native
 from inertia_tool.errors import InvalidMeshError
 from inertia_tool.mesh.checks import shell_labels
-from inertia_tool.mesh.intersect import SurfaceContacts, orient2d_sign, orient3d_sign, surface_contacts
+from inertia_tool.mesh.intersect import orient2d_sign, orient3d_sign, surface_contacts
 
 MESHES = os.path.join(os.path.dirname(__file__), os.pardir, "meshes")
 
@@ -35,16 +35,6 @@ def kernel(request, monkeypatch):
     else:
         monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
     return request.param
-
-
-def _kinds(result: SurfaceContacts) -> dict:
-    """{(i, j): kind} of every pair found."""
-    out = {}
-    for kind, pairs in ((CROSSING, result.crossing), (OPPOSITE, result.coplanar_opposite),
-                        (CONTACT, result.contact)):
-        for i, j in pairs:
-            out[(int(i), int(j))] = kind
-    return out
 
 
 def _rotation(axis, degrees):
@@ -270,7 +260,7 @@ def test_result_is_invariant_under_vertex_face_and_corner_permutation():
     f2 = f + len(v)
     f2[f2 == corner + len(v)] = corner
     v, f = np.r_[v, turned, _t_junction_cube()[0] + [3.0, 0, 0]], np.r_[f, f2, _t_junction_cube()[1] + 16]
-    base = _kinds(surface_contacts(v, f))
+    base = pair_kinds(surface_contacts(v, f))
     rng = np.random.default_rng(7)
     for _ in range(3):
         vp = rng.permutation(len(v))
@@ -280,7 +270,7 @@ def test_result_is_invariant_under_vertex_face_and_corner_permutation():
         new_index[vp] = np.arange(len(v))
         g = new_index[f][fp]
         g = np.stack([np.roll(row, k) for row, k in zip(g, roll[fp])])
-        got = _kinds(surface_contacts(v[vp], g))
+        got = pair_kinds(surface_contacts(v[vp], g))
         mapped = {tuple(sorted((int(fp[i]), int(fp[j])))): k for (i, j), k in got.items()}
         assert mapped == base
 
@@ -383,7 +373,7 @@ def test_triangle_pair_matches_the_independent_classifier(case, swap, roll):
         assert len(result.crossing) == len(result.coplanar_opposite) == len(result.contact) == 0
         return
     assert result.degenerate_faces == 0
-    got = _kinds(result).get((0, 1), NONE)
+    got = pair_kinds(result).get((0, 1), NONE)
     assert got == want
 
 
@@ -438,7 +428,7 @@ def test_adjacent_pair_near_one_plane_matches_the_independent_classifier(case, s
     if want is None:
         assert result.degenerate_faces >= 1
         return
-    assert _kinds(result).get((0, 1), NONE) == want
+    assert pair_kinds(result).get((0, 1), NONE) == want
 
 
 def test_planar_quad_grid_is_decided_without_exact_arithmetic(kernel):
@@ -473,7 +463,7 @@ def test_coplanar_fan_folded_over_is_found(kernel):
     assert sum(len(getattr(surface_contacts(v, flat), k)) for k in ("crossing", "coplanar_opposite",
                                                                     "contact")) == 0
     folded = np.r_[flat, [[0, 5, 1]]]                       # on top of face 0, reversed: shares edge 0-1
-    got = _kinds(surface_contacts(v, folded))
+    got = pair_kinds(surface_contacts(v, folded))
     assert got[(0, 4)] == OPPOSITE
     for i in range(4):
         want = brute_kind(v[folded[i]], v[folded[4]],
@@ -552,7 +542,7 @@ def test_broad_phase_finds_every_pair_of_meeting_boxes(n_faces, seed, spread):
     meet = np.all(lo[:, None] <= hi[None], axis=2) & np.all(lo[None] <= hi[:, None], axis=2)
     assert result.candidate_pairs == int(np.count_nonzero(np.triu(meet, 1)))
     if n_faces <= 60:
-        got = _kinds(result)
+        got = pair_kinds(result)
         for i in range(n_faces):
             for j in range(i + 1, n_faces):
                 if not meet[i, j]:

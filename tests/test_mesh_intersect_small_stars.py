@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 import adversary_solids as adv
 from conftest import HAVE_ACCEL
-from intersect_reference import CONTACT, CROSSING, NONE, OPPOSITE, brute_kind
+from intersect_reference import NONE, brute_kind, pair_kinds
 from inertia_tool import _native
 from inertia_tool.mesh.intersect import SurfaceContacts, surface_contacts
 
@@ -46,15 +46,6 @@ def _same_pairs(a: SurfaceContacts, b: SurfaceContacts) -> None:
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
 
 
-def _kinds(result: SurfaceContacts) -> dict:
-    out = {}
-    for kind, pairs in ((CROSSING, result.crossing), (OPPOSITE, result.coplanar_opposite),
-                        (CONTACT, result.contact)):
-        for i, j in pairs:
-            out[(int(i), int(j))] = kind
-    return out
-
-
 def _check_all_paths(v, f, brute=False) -> SurfaceContacts:
     """The C scan against its unpruned self and the numpy twin (pairs, candidate and tested counts), and
     optionally every pair against the rational classifier."""
@@ -65,7 +56,7 @@ def _check_all_paths(v, f, brute=False) -> SurfaceContacts:
     assert (fast.candidate_pairs, fast.tested_pairs, fast.degenerate_faces) == \
         (ref.candidate_pairs, ref.tested_pairs, ref.degenerate_faces)
     if brute:
-        got = _kinds(fast)
+        got = pair_kinds(fast)
         for i in range(len(f)):
             for j in range(i + 1, len(f)):
                 shared = [(a, b) for a in range(3) for b in range(3) if f[i][a] == f[j][b]]

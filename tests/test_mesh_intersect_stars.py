@@ -16,7 +16,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL
-from intersect_reference import CONTACT, CROSSING, NONE, OPPOSITE, brute_kind
+from intersect_reference import NONE, brute_kind, pair_kinds
 from inertia_tool import _native
 from inertia_tool.mesh.intersect import STAR_MIN_FACES, SurfaceContacts, surface_contacts
 
@@ -40,15 +40,6 @@ def _same(pruned: SurfaceContacts, full: SurfaceContacts) -> None:
     for field in FIELDS:
         assert np.array_equal(getattr(pruned, field), getattr(full, field)), field
     assert pruned.candidate_pairs <= full.candidate_pairs
-
-
-def _kinds(result: SurfaceContacts) -> dict:
-    out = {}
-    for kind, pairs in ((CROSSING, result.crossing), (OPPOSITE, result.coplanar_opposite),
-                        (CONTACT, result.contact)):
-        for i, j in pairs:
-            out[(int(i), int(j))] = kind
-    return out
 
 
 def _cylinder(n, radius=1.0, height=2.0):
@@ -218,7 +209,7 @@ def test_random_fans_find_the_same_pairs_as_the_unpruned_scan_and_the_rational_c
     pruned = surface_contacts(v, f)
     event("certified" if pruned.candidate_pairs < len(f) * (len(f) - 1) // 2 else "not certified")
     _same(pruned, surface_contacts(v, f, _star_faces=0))
-    got = _kinds(pruned)
+    got = pair_kinds(pruned)
     for i in range(len(f)):
         for j in range(i + 1, len(f)):
             shared = [(p, q) for p in range(3) for q in range(3) if f[i, p] == f[j, q]]
