@@ -557,8 +557,8 @@ def accurate_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
         return shells, 0, RoundoffBound(volume=e_vol, centroid=e_cen, second_moment=e_sec)
     budget = 0.5 * rtol
     if len(shells) == 1:                       # one shell (most parts): the ordering below is that shell alone
-        sv, si = float(share_v[0]), float(share_i[0])
-        if sv <= budget * total_v and si <= budget * total_i and math.isfinite(sv) and math.isfinite(si):
+        one_v, one_i = float(share_v[0]), float(share_i[0])
+        if one_v <= budget * total_v and one_i <= budget * total_i and math.isfinite(one_v) and math.isfinite(one_i):
             return shells, 0, RoundoffBound(volume=e_vol, centroid=e_cen, second_moment=e_sec)
     worst = np.argsort(-np.maximum(share_v / (rtol * total_v), share_i / (rtol * total_i)), kind="stable")
     rest_v, rest_i = np.cumsum(share_v[worst][::-1])[::-1], np.cumsum(share_i[worst][::-1])[::-1]
