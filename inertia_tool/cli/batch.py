@@ -39,12 +39,16 @@ class Progress:
         Seconds between plain lines when ``stream`` is not a terminal (the last state is always printed).
     width : int
         Characters of the bar.
+    redraw : float
+        Seconds between two redraws of the bar on a terminal (the first and the last state are always drawn): a
+        redraw per file cost a write and a flush per part, ~2 % of a small part's time.
     """
 
-    def __init__(self, stream=None, *, interval: float = 5.0, width: int = 30):
+    def __init__(self, stream=None, *, interval: float = 5.0, width: int = 30, redraw: float = 0.1):
         self.stream = stream if stream is not None else sys.stderr
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
         self.interval = interval
+        self.redraw = redraw
         self.width = width
         self.start = time.perf_counter()
         self.first = None
@@ -62,6 +66,9 @@ class Progress:
         self.state = (done, total, ok, failed)
         now = time.perf_counter()
         if self.tty:
+            if now - self.last_line < self.redraw and done != total:
+                return
+            self.last_line = now
             filled = int(self.width * done / total) if total else self.width
             bar = "#" * filled + "." * (self.width - filled)
             self.stream.write(f"\r[{bar}] {self._text(done, total, ok, failed)}\x1b[K")
