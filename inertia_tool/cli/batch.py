@@ -14,13 +14,14 @@ from __future__ import annotations
 import sys
 import time
 
-from ..batch.runner import BatchOptions, discover_files, run_batch
 from ..errors import UsageError
-from ..batch.rows import open_results, results_format
 from .help import add_command
 from .model_options import add_model_options, load_options_from_args
 from .options import check_option, density_and_mass
 from ..reports.escape import escape_terminal
+
+# the runner (numpy and the engine) and the results files load in run(): ``batch --help`` needs neither
+# (issue 25 item 4)
 
 __all__ = ["register", "run", "Progress", "connect_dask_cli", "summary_line"]
 
@@ -146,6 +147,9 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
+    from ..batch.rows import open_results, results_format
+    from ..batch.runner import BatchOptions, discover_files, run_batch
+
     results_format(args.out)                      # a bad suffix is a usage error before any work
     density, mass = density_and_mass(args)
     check_option("--jobs", args.jobs)
