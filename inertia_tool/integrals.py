@@ -75,6 +75,9 @@ class VolumeMoments:
 
 _PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
+#: Columns of the C kernel's sums (4..9: xx yy zz xy xz yz) that fill a second-moment matrix row by row.
+_SECOND_COLUMNS = np.array([4, 7, 8, 7, 5, 9, 8, 9, 6])
+
 if TYPE_CHECKING:     # annotations only: numpy.typing is not loaded at run time
     from typing import TypeAlias
 
@@ -153,9 +156,7 @@ def _tetra_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, orig
     lib.tetra_sums(np.ascontiguousarray(vertices, dtype=np.float64), faces_for_c(faces),
                    tuple(float(x) for x in origin), float(area_floor),
                    None if labels is None else np.ascontiguousarray(labels, dtype=np.int64), sums, zero, threads())
-    second = np.empty((n_labels, 3, 3))
-    for k, (i, j) in enumerate(_PAIRS):   # columns 4..9 hold xx yy zz xy xz yz
-        second[:, i, j] = second[:, j, i] = sums[:, 4 + k]
+    second = sums[:, _SECOND_COLUMNS].reshape(n_labels, 3, 3)     # one gather instead of twelve assignments
     return sums[:, 0].copy(), sums[:, 1:4].copy(), second, sums[:, 10].copy(), zero
 
 
