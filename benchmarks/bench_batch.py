@@ -18,20 +18,35 @@ event loop would slow the other configurations); its start-up (worker processes,
 separately, not in files/s.
 
     python benchmarks/bench_batch.py [--set small|mix|both] [--small 1000] [--files 200] [--repeat 3]
+                                     [--baseline DIR]
 
-Run from the repository root (it puts the repository on sys.path).
+Run from the repository root (it puts the repository on sys.path).  ``--baseline DIR`` (e.g. a copy of ``main``
+with its built extension) runs the same configurations on DIR's ``inertia_tool`` in a child process after each
+round of this checkout's, so that before and after meet the same load; its rows are marked ``[baseline]`` and
+their ratios are to the baseline's own single process.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
+import subprocess
 import sys
 import tempfile
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+def _tree(argv: list[str]) -> str:
+    """The checkout whose ``inertia_tool`` is timed: ``--tree DIR`` (how ``--baseline`` runs the other checkout),
+    else the one holding this script."""
+    if "--tree" in argv[:-1]:
+        return os.path.abspath(argv[argv.index("--tree") + 1])
+    return os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+sys.path.insert(0, _tree(sys.argv))
 
 import numpy as np  # noqa: E402
 import trimesh  # noqa: E402
@@ -133,12 +148,26 @@ def _catalogue(tmp, name, make, count):
     return files
 
 
+def _baseline_round(args) -> list[tuple[str, str, tuple[float, float]]]:
+    """One round of every configuration on the ``--baseline`` checkout, in a child process running this script
+    with ``--tree``: ``(catalogue, configuration, (seconds, CPU seconds))`` of each."""
+    argv = [sys.executable, os.path.abspath(__file__), "--tree", args.baseline, "--repeat", "1", "--json",
+            "--set", args.set, "--small", str(args.small), "--files", str(args.files), "--kinds", args.kinds]
+    done = subprocess.run(argv, capture_output=True, text=True, check=True)
+    rows = [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
+    return [(r["catalogue"], r["configuration"], (r["seconds"], r["cpu"])) for r in rows]
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--set", choices=["small", "mix", "both"], default="both")
     ap.add_argument("--small", type=int, default=1000, help="files of the small catalogue")
     ap.add_argument("--files", type=int, default=200, help="files of the mix catalogue")
     ap.add_argument("--repeat", type=int, default=3, help="rounds of every configuration (the best is reported)")
+    ap.add_argument("--baseline", metavar="DIR", help="another checkout (e.g. a copy of main) timed in a child "
+                    "process after each round of this one's, in the same run")
+    ap.add_argument("--tree", metavar="DIR", help="import inertia_tool from DIR (set by --baseline)")
+    ap.add_argument("--json", action="store_true", help="print the results as JSON lines (read by --baseline)")
     ap.add_argument("--kinds", default=",".join(SMALL_KINDS),
                     help="kinds of part of the small catalogue, comma-separated (default all: "
                          f"{','.join(SMALL_KINDS)}); e.g. without cylinder, whose fan-triangulated caps make the "
@@ -183,16 +212,27 @@ def main() -> None:
                 finally:
                     if cluster is not None:
                         cluster.close()
+            if args.baseline:
+                for name, label, got in _baseline_round(args):
+                    key = (name, f"[baseline] {label}")
+                    results[key] = min(got, results.get(key, got))
+        if args.json:
+            for (name, label), (sec, cpu) in results.items():
+                print(json.dumps({"catalogue": name, "configuration": label, "seconds": sec, "cpu": cpu}))
+            return
         startup = min(startups) if startups else None
-        print(f"{'catalogue':9s} {'configuration':36s} {'seconds':>8s} {'files/s':>8s} {'ratio':>6s} "
+        if args.baseline:
+            print(f"[baseline]: {os.path.abspath(args.baseline)}, one round after each of this checkout's")
+        print(f"{'catalogue':9s} {'configuration':47s} {'seconds':>8s} {'files/s':>8s} {'ratio':>6s} "
               f"{'CPU ms/file':>11s} {'CPU-bound ratio':>15s}")
         for name, files in catalogues.items():
-            base, base_cpu = results[name, "1 process (in-process)"]
             for (n, label), (sec, cpu) in results.items():
                 if n == name:
+                    tree, own = ("[baseline] ", label[11:]) if label.startswith("[baseline] ") else ("", label)
+                    base, base_cpu = results[name, f"{tree}1 process (in-process)"]
                     # the wall ratio the CPU time allows with both cores to ourselves: the same CPU over 2
-                    ideal = base_cpu / (cpu / (1 if label.startswith("1 ") else 2))
-                    print(f"{name:9s} {label:36s} {sec:8.2f} {len(files) / sec:8.1f} {base / sec:6.2f} "
+                    ideal = base_cpu / (cpu / (1 if own.startswith("1 ") else 2))
+                    print(f"{name:9s} {label:47s} {sec:8.2f} {len(files) / sec:8.1f} {base / sec:6.2f} "
                           f"{1e3 * cpu / len(files):11.2f} {ideal:15.2f}")
         if startup is not None:
             print(f"(Dask LocalCluster start-up with the workers' warm-up, not included above: {startup:.2f} s, "

@@ -14,7 +14,8 @@
  *   2b. PartWelder -- the same weld of float32 points by radix partition, on several threads
  *   3. edge_census -- boundary / non-manifold / misoriented edges (mesh/checks.edge_topology)
  *   4. shell_labels-- union-find connected components of faces (mesh/checks.shell_labels)
- *   5. tetra_sums  -- signed-tetrahedron volume integrals with compensated sums (mass/volume._tetra_sums)
+ *   5. tetra_sums  -- signed-tetrahedron volume integrals with compensated sums (mass/volume._tetra_sums);
+ *                     roundoff_sums, the per-face sums of their round-off bound (integrals.roundoff_bounds)
  *   6. bounds      -- bounding box and finiteness of the vertices in one pass (mass/volume.bounding_box)
  *   7. split_steps -- the splitting integrator's step loop (dynamics/splitting.py)
  *   8. contact_scan -- faces meeting beyond what they share: hierarchy of boxes + exact pair classification
@@ -2244,6 +2245,158 @@ fail:
     return result;
 }
 
+/* roundoff_sums: the per-face sums of integrals.roundoff_bounds, bit for bit those of its numpy loop (the
+ * reference): with a, b, c the corners less `origin`, e1 = |b - a|, e2 = |c - a| and |.| taken entry by entry,
+ *   P = 8 |a|.(e1 (x) e2) + 2 (|a|.((|a| + |b|) (x) e2) + |a|.(e1 (x) (|a| + |c|)))
+ *   (x (x) y)_0 = x1 y2 + x2 y1 (and cyclically), n2 = |a|.|a| + |b|.|b| + |c|.|c|
+ * and per label the plain sequential sums of P, P sqrt(3 n2) and P 4 n2 in face order, within chunks of
+ * `chunk` faces whose sums are then added in chunk order (numpy's bincount per chunk, added to the totals).
+ * Every operation is the one numpy performs, in its order, so the rounding is the same; no fused
+ * multiply-add (which would round differently) is allowed here. */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("fp-contract=off")))
+#endif
+static void
+roundoff_loop(const double *v, const void *f, int size, const void *lab, int label_size, size_t m,
+              double ox, double oy, double oz, size_t chunk, double *part, double *out, Py_ssize_t n_labels,
+              Py_ssize_t *bad)
+{
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+    *bad = -1;
+    for (size_t start = 0; start < m; start += chunk) {
+        size_t stop = m - start > chunk ? start + chunk : m;
+        memset(part, 0, (size_t)n_labels * 3 * sizeof(double));
+        for (size_t i = start; i < stop; i++) {
+            int64_t l = 0;
+            if (lab != NULL) {
+                l = index_at(lab, label_size, i);
+                if (l < 0 || l >= n_labels) {
+                    *bad = (Py_ssize_t)i;
+                    return;
+                }
+            }
+            const double *pa = v + 3 * index_at(f, size, 3 * i);
+            const double *pb = v + 3 * index_at(f, size, 3 * i + 1);
+            const double *pc = v + 3 * index_at(f, size, 3 * i + 2);
+            double a0 = pa[0] - ox, a1 = pa[1] - oy, a2 = pa[2] - oz;
+            double b0 = pb[0] - ox, b1 = pb[1] - oy, b2 = pb[2] - oz;
+            double c0 = pc[0] - ox, c1 = pc[1] - oy, c2 = pc[2] - oz;
+            double e10 = fabs(b0 - a0), e11 = fabs(b1 - a1), e12 = fabs(b2 - a2);
+            double e20 = fabs(c0 - a0), e21 = fabs(c1 - a1), e22 = fabs(c2 - a2);
+            a0 = fabs(a0); a1 = fabs(a1); a2 = fabs(a2);
+            b0 = fabs(b0); b1 = fabs(b1); b2 = fabs(b2);
+            c0 = fabs(c0); c1 = fabs(c1); c2 = fabs(c2);
+            double ab0 = a0 + b0, ab1 = a1 + b1, ab2 = a2 + b2;
+            double ac0 = a0 + c0, ac1 = a1 + c1, ac2 = a2 + c2;
+            double x = a0 * (e11 * e22 + e12 * e21) + a1 * (e12 * e20 + e10 * e22) + a2 * (e10 * e21 + e11 * e20);
+            double y = a0 * (ab1 * e22 + ab2 * e21) + a1 * (ab2 * e20 + ab0 * e22) + a2 * (ab0 * e21 + ab1 * e20);
+            double z = a0 * (e11 * ac2 + e12 * ac1) + a1 * (e12 * ac0 + e10 * ac2) + a2 * (e10 * ac1 + e11 * ac0);
+            double p = 8.0 * x + 2.0 * (y + z);
+            double n2 = ((a0 * a0 + a1 * a1) + a2 * a2) + ((b0 * b0 + b1 * b1) + b2 * b2)
+                        + ((c0 * c0 + c1 * c1) + c2 * c2);
+            double s_norm = sqrt(3.0 * n2);
+            double q = 4.0 * n2;
+            double *o = part + 3 * (size_t)l;
+            o[0] += p;
+            o[1] += p * s_norm;
+            o[2] += p * q;
+        }
+        for (size_t k = 0; k < (size_t)n_labels * 3; k++) {
+            out[k] += part[k];
+        }
+    }
+}
+
+static PyObject *
+accel_roundoff_sums(PyObject *self, PyObject *args)
+{
+    PyObject *vert_obj, *faces_obj, *labels_obj, *out_obj;
+    double ox, oy, oz;
+    Py_ssize_t chunk;
+    if (!PyArg_ParseTuple(args, "OO(ddd)OOn", &vert_obj, &faces_obj, &ox, &oy, &oz, &labels_obj, &out_obj,
+                          &chunk)) {
+        return NULL;
+    }
+    Py_buffer vv, fv, lv, ov;
+    double *part = NULL;
+    PyObject *result = NULL;
+    int have_labels = labels_obj != Py_None, label_size = 0, size;
+    Py_ssize_t m;
+    if (chunk < 1) {
+        PyErr_Format(PyExc_ValueError, "Expected `chunk_size` >= 1, got %zd", chunk);
+        return NULL;
+    }
+    if (PyObject_GetBuffer(vert_obj, &vv, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    if (get_faces(faces_obj, &fv, &m, &size) < 0) {
+        PyBuffer_Release(&vv);
+        return NULL;
+    }
+    if (PyObject_GetBuffer(out_obj, &ov, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        PyBuffer_Release(&vv);
+        PyBuffer_Release(&fv);
+        return NULL;
+    }
+    if (have_labels && PyObject_GetBuffer(labels_obj, &lv, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        have_labels = 0;
+        goto fail;
+    }
+    if (native_code(vv.format) != 'd' || vv.itemsize != 8 || vv.ndim != 2 || vv.shape[1] != 3) {
+        PyErr_SetString(PyExc_ValueError, "Expected `vertices` as a C-contiguous (n, 3) float64 array");
+        goto fail;
+    }
+    if (native_code(ov.format) != 'd' || ov.itemsize != 8 || ov.ndim != 2 || ov.shape[1] != 3 || ov.shape[0] < 1) {
+        PyErr_SetString(PyExc_ValueError, "Expected `out` as a C-contiguous (n_labels, 3) float64 array");
+        goto fail;
+    }
+    Py_ssize_t n_labels = ov.shape[0];
+    if (have_labels) {
+        label_size = signed_int_size(&lv);
+        if (label_size == 0 || lv.ndim != 1 || lv.shape[0] != m) {
+            PyErr_SetString(PyExc_ValueError, "Expected `labels` as a contiguous int32 or int64 (m,) array");
+            goto fail;
+        }
+    }
+    else if (n_labels != 1) {
+        PyErr_SetString(PyExc_ValueError, "Expected `labels` when n_labels > 1");
+        goto fail;
+    }
+    if (check_indices(fv.buf, size, 3 * (size_t)m, vv.shape[0]) < 0) {
+        goto fail;
+    }
+    part = (double *)calloc((size_t)n_labels * 3, sizeof(double));
+    if (part == NULL) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    double *out = (double *)ov.buf;
+    memset(out, 0, (size_t)n_labels * 3 * sizeof(double));
+    Py_ssize_t bad;
+    Py_BEGIN_ALLOW_THREADS
+    roundoff_loop((const double *)vv.buf, fv.buf, size, have_labels ? lv.buf : NULL, label_size, (size_t)m,
+                  ox, oy, oz, (size_t)chunk, part, out, n_labels, &bad);
+    Py_END_ALLOW_THREADS
+    if (bad >= 0) {
+        PyErr_Format(PyExc_ValueError, "Expected labels in 0..%zd, got %lld at position %zd", n_labels - 1,
+                     (long long)index_at(lv.buf, label_size, (size_t)bad), bad);
+        goto fail;
+    }
+    result = Py_None;
+    Py_INCREF(result);
+fail:
+    free(part);
+    PyBuffer_Release(&vv);
+    PyBuffer_Release(&fv);
+    PyBuffer_Release(&ov);
+    if (have_labels) {
+        PyBuffer_Release(&lv);
+    }
+    return result;
+}
+
 /* ======================================================================================================
  * 6. bounds
  *
@@ -2451,6 +2604,10 @@ static PyMethodDef accel_methods[] = {
      "sums per label into sums (L, 11) float64 [vol, first xyz, second xx yy zz xy xz yz, area] and zero "
      "(L,) int64 (faces with area <= area_floor / 2); labels (m,) int or None when L == 1; threads (default 1) "
      "only changes the speed."},
+    {"roundoff_sums", accel_roundoff_sums, METH_VARARGS,
+     "roundoff_sums(vertices, faces, origin, labels, out, chunk_size)\n\nThe sums of integrals.roundoff_bounds "
+     "per label into out (L, 3) float64 [sum P, sum P sqrt(3 n2), sum P 4 n2], bit for bit its numpy loop's "
+     "(sequential within chunks of chunk_size faces, chunks added in order); labels (m,) int or None when L == 1."},
     {"bounds", accel_bounds, METH_VARARGS,
      "bounds(vertices, threads=1) -> ((lo x, y, z), (hi x, y, z), all_finite)\n\nColumn minima and maxima of "
      "an (n >= 1, 3) C-contiguous float64 array (NaN propagates) and whether every entry is finite."},

@@ -12,6 +12,11 @@ integrals, which the C kernel sums with compensation).
 The edge census, the integrals and the bounding box use :func:`threads` threads on large meshes (the cores
 this process may run on, at most 16, or ``INERTIA_TOOL_THREADS``), split so that their results do not depend
 on the thread count: only the speed does.  The weld and the shell labels run on one thread.
+
+Both settings are asked for on every call (a test or a pool worker may change them), a dozen times per part of
+a batch: each call looks the variable up in the process environment's own table and derives the answer again
+only when the raw value changed since the last call (``os.environ.get`` cost ~2 µs a call, mostly the
+``KeyError`` of an unset variable; ``os.sched_getaffinity`` ~1.5 µs, read once per process).
 """
 
 from __future__ import annotations
@@ -36,10 +41,46 @@ MAX_THREADS = 16
 
 _MODULE: list[ModuleType | None] = []   # the import result, cached: [module or None]
 
+_UNSET = object()
+
+
+class _Setting:
+    """One environment variable read cheaply on every call: the raw value is looked up in ``os.environ``'s
+    table of encoded names (a dict lookup, no exception when unset) and compared with the last one seen; the
+    decoded text is returned again unless it changed.  Where ``os.environ`` keeps no such table (not CPython),
+    ``os.environ.get`` is asked each time."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        encode = getattr(os.environ, "encodekey", None)
+        self.key = encode(name) if callable(encode) else None
+        self.raw: object = _UNSET
+        self.text = ""
+
+    def get(self) -> str:
+        """The variable's value, ``""`` when unset."""
+        data = getattr(os.environ, "_data", None)
+        if self.key is None or not isinstance(data, dict):
+            return os.environ.get(self.name, "")
+        raw = data.get(self.key)
+        if raw is not self.raw:
+            self.text = os.environ.get(self.name, "")
+            self.raw = raw
+        return self.text
+
+
+_NO_ACCEL = _Setting(NO_ACCEL_ENV)
+_THREADS = _Setting(THREADS_ENV)
+#: ``[INERTIA_TOOL_THREADS as last read, threads()]``: the CPUs are read once per process (a forked child, whose
+#: affinity may differ, starts without it)
+_THREADS_MEMO: list = []
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_THREADS_MEMO.clear)
+
 
 def accel() -> ModuleType | None:
     """The ``inertia_tool._accel`` module, or None when it is not built or ``INERTIA_TOOL_NO_ACCEL`` is set."""
-    if os.environ.get(NO_ACCEL_ENV, "").strip() not in ("", "0"):
+    if _NO_ACCEL.get().strip() not in ("", "0"):
         return None
     if not _MODULE:
         try:
@@ -77,14 +118,20 @@ def _matches_source(module: ModuleType) -> bool:
 def threads() -> int:
     """Threads for the C kernels: ``INERTIA_TOOL_THREADS`` if set to an integer >= 1, else the CPUs this process
     may run on; at most 16.  A malformed value counts as unset."""
-    raw = os.environ.get(THREADS_ENV, "").strip()
-    if raw.isascii() and raw.isdigit() and int(raw) >= 1:     # isdigit() alone accepts '²', which int() refuses
-        return min(int(raw), MAX_THREADS)
-    try:
-        n = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        n = os.cpu_count() or 1
-    return max(1, min(n, MAX_THREADS))
+    raw = _THREADS.get()
+    if _THREADS_MEMO and _THREADS_MEMO[0] is raw:
+        return int(_THREADS_MEMO[1])
+    text = raw.strip()
+    if text.isascii() and text.isdigit() and int(text) >= 1:  # isdigit() alone accepts '²', which int() refuses
+        n = min(int(text), MAX_THREADS)
+    else:
+        try:
+            n = len(os.sched_getaffinity(0))
+        except (AttributeError, OSError):
+            n = os.cpu_count() or 1
+        n = max(1, min(n, MAX_THREADS))
+    _THREADS_MEMO[:] = [raw, n]
+    return n
 
 
 def faces_for_c(faces) -> np.ndarray:

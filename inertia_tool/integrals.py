@@ -29,6 +29,7 @@ Everything here is pure: SI numpy arrays in, numpy arrays out.  See ``docs/conve
 
 from __future__ import annotations
 
+import math
 from types import ModuleType
 from typing import TYPE_CHECKING
 
@@ -73,6 +74,9 @@ class VolumeMoments:
 
 
 _PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+
+#: Columns of the C kernel's sums (4..9: xx yy zz xy xz yz) that fill a second-moment matrix row by row.
+_SECOND_COLUMNS = np.array([4, 7, 8, 7, 5, 9, 8, 9, 6])
 
 if TYPE_CHECKING:     # annotations only: numpy.typing is not loaded at run time
     from typing import TypeAlias
@@ -152,9 +156,7 @@ def _tetra_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, orig
     lib.tetra_sums(np.ascontiguousarray(vertices, dtype=np.float64), faces_for_c(faces),
                    tuple(float(x) for x in origin), float(area_floor),
                    None if labels is None else np.ascontiguousarray(labels, dtype=np.int64), sums, zero, threads())
-    second = np.empty((n_labels, 3, 3))
-    for k, (i, j) in enumerate(_PAIRS):   # columns 4..9 hold xx yy zz xy xz yz
-        second[:, i, j] = second[:, j, i] = sums[:, 4 + k]
+    second = sums[:, _SECOND_COLUMNS].reshape(n_labels, 3, 3)     # one gather instead of twelve assignments
     return sums[:, 0].copy(), sums[:, 1:4].copy(), second, sums[:, 10].copy(), zero
 
 
@@ -335,25 +337,27 @@ def roundoff_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
         The reference point the moments were computed about.
     """
     n = len(shells)
-    coords = np.ascontiguousarray((np.asarray(vertices, dtype=np.float64) - origin).T)
-    sp, sps, spq, sv1, sv2 = (np.zeros(n) for _ in range(5))
-    counts = np.bincount(labels, minlength=n).astype(np.float64)
-    for start in range(0, len(faces), chunk_size):
-        f = faces[start:start + chunk_size]
-        lab = labels[start:start + chunk_size]
-        a, b, c = (coords[:, f[:, k]] for k in range(3))
-        e1, e2 = np.abs(b - a), np.abs(c - a)
-        a, b, c = np.abs(a), np.abs(b), np.abs(c)
-        # |a|·(|e1| ⊠ |e2|) carries the roundings of the cross and dot products and of a itself; the terms with
-        # |a| + |b| (|a| + |c|) carry the roundings of the corners and of the differences b − a (c − a)
-        p = 8 * _dot_abs_cross(a, e1, e2) + 2 * (_dot_abs_cross(a, a + b, e2) + _dot_abs_cross(a, e1, a + c))
-        n2 = np.einsum("ij,ij->j", a, a) + np.einsum("ij,ij->j", b, b) + np.einsum("ij,ij->j", c, c)
-        s_norm = np.sqrt(3 * n2)                      # ‖|a| + |b| + |c|‖ ≤ √(3 Σ‖pₖ‖²)
-        q = 4 * n2                                    # tr|Q| = Σ‖pₖ‖² + ‖|a| + |b| + |c|‖² ≤ 4 Σ‖pₖ‖²
-        sp += np.bincount(lab, weights=p, minlength=n)
-        sps += np.bincount(lab, weights=p * s_norm, minlength=n)
-        spq += np.bincount(lab, weights=p * q, minlength=n)
-    summing = (2 + counts * counts * _U) * _U if accel() is not None else counts * _U
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces)
+    lab = np.asarray(labels)
+    origin = np.asarray(origin, dtype=np.float64)
+    lib = accel()
+    if lib is not None:
+        sums = _roundoff_sums_c(lib, v, f, lab, n, origin, chunk_size)
+    else:
+        sums = _roundoff_sums(v, f, lab, n, origin, chunk_size)
+    if n == 1:
+        return _one_shell_bound(sums[0], len(f), shells[0], origin, compensated=lib is not None)
+    return _shells_bound(sums, np.bincount(lab, minlength=n), shells, origin, compensated=lib is not None)
+
+
+def _shells_bound(sums: np.ndarray, counts: np.ndarray, shells: list[VolumeMoments], origin: np.ndarray, *,
+                  compensated: bool) -> RoundoffBound:
+    """The tail of :func:`roundoff_bounds`: each shell's bounds from its sums (:func:`_roundoff_sums`) and its
+    face count ``counts`` (s,)."""
+    sp, sps, spq = sums.T
+    counts = np.asarray(counts).astype(np.float64)
+    summing = (2 + counts * counts * _U) * _U if compensated else counts * _U
     e_volume = (_U + summing) * sp / 6
     e_first = (2 * _U + summing) * sps / 24
     e_second = (3 * _U + summing) * spq / 120
@@ -366,6 +370,76 @@ def roundoff_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
         e_central = e_second + np.where(vol > 0, (2 * first * e_first + d * d * vol * e_volume) / vol, np.inf) \
             + 4 * _U * (about_origin + first * d)
     return RoundoffBound(volume=e_volume, centroid=e_centroid, second_moment=e_central)
+
+
+def _roundoff_sums(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n: int, origin: np.ndarray,
+                   chunk_size: int) -> np.ndarray:
+    """(n, 3) per-shell sums ``Σ P``, ``Σ P·√(3 Σ‖pₖ‖²)``, ``Σ P·4 Σ‖pₖ‖²`` of :func:`roundoff_bounds` (the
+    numpy reference: sequential sums per chunk of faces, the chunks added in order)."""
+    coords = np.ascontiguousarray((vertices - origin).T)
+    sp, sps, spq = (np.zeros(n) for _ in range(3))
+    for start in range(0, len(faces), chunk_size):
+        f = faces[start:start + chunk_size]
+        lab = labels[start:start + chunk_size]
+        a, b, c = (coords[:, f[:, k]] for k in range(3))
+        e1, e2 = np.abs(b - a), np.abs(c - a)
+        a, b, c = np.abs(a), np.abs(b), np.abs(c)
+        # |a|·(|e1| ⊠ |e2|) carries the roundings of the cross and dot products and of a itself; the terms with
+        # |a| + |b| (|a| + |c|) carry the roundings of the corners and of the differences b − a (c − a)
+        p = 8 * _dot_abs_cross(a, e1, e2) + 2 * (_dot_abs_cross(a, a + b, e2) + _dot_abs_cross(a, e1, a + c))
+        # Σ‖pₖ‖², each square norm summed x, y, z in that order (einsum's order depends on the array's shape; a
+        # fixed one is what the C kernel repeats bit for bit)
+        n2 = (_norm2(a) + _norm2(b)) + _norm2(c)
+        s_norm = np.sqrt(3 * n2)                      # ‖|a| + |b| + |c|‖ ≤ √(3 Σ‖pₖ‖²)
+        q = 4 * n2                                    # tr|Q| = Σ‖pₖ‖² + ‖|a| + |b| + |c|‖² ≤ 4 Σ‖pₖ‖²
+        sp += np.bincount(lab, weights=p, minlength=n)
+        sps += np.bincount(lab, weights=p * s_norm, minlength=n)
+        spq += np.bincount(lab, weights=p * q, minlength=n)
+    return np.stack([sp, sps, spq], axis=1)
+
+
+def _norm2(x: np.ndarray) -> np.ndarray:
+    """``(x₀² + x₁²) + x₂²`` of a (3, k) array, in that order."""
+    return np.asarray((x[0] * x[0] + x[1] * x[1]) + x[2] * x[2])
+
+
+def _roundoff_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n: int,
+                     origin: np.ndarray, chunk_size: int) -> np.ndarray:
+    """:func:`_roundoff_sums` on the C extension, bit for bit the same (the same operations in the same order)."""
+    out = np.empty((n, 3))
+    lib.roundoff_sums(np.ascontiguousarray(vertices), faces_for_c(faces), (float(origin[0]), float(origin[1]),
+                      float(origin[2])), None if n == 1 else np.ascontiguousarray(labels, dtype=np.int64), out,
+                      max(1, int(chunk_size)))
+    return out
+
+
+def _norm(x: np.ndarray) -> float:
+    """``np.linalg.norm(x)`` of a float64 vector or matrix, the same bits: ``√(x·x)`` over the flattened entries."""
+    flat = x.ravel(order="K")
+    return math.sqrt(float(flat.dot(flat)))
+
+
+def _one_shell_bound(sums: np.ndarray, m: int, shell: VolumeMoments, origin: np.ndarray, *,
+                     compensated: bool) -> RoundoffBound:
+    """The tail of :func:`roundoff_bounds` for one shell of ``m`` faces on Python floats: the same operations
+    in the same order as its array form :func:`_shells_bound` (the same bits: ``tests/test_integrals_small.py``),
+    without its dozens of numpy calls on arrays of one element (a small part makes this call once or twice)."""
+    sp, sps, spq = (float(x) for x in sums)
+    count = float(m)
+    summing = (2 + count * count * _U) * _U if compensated else count * _U
+    e_volume = (_U + summing) * sp / 6
+    e_first = (2 * _U + summing) * sps / 24
+    e_second = (3 * _U + summing) * spq / 120
+    vol = abs(shell.volume)
+    d = _norm(shell.centroid - origin) if shell.volume != 0 else 0.0
+    first = vol * d
+    about_origin = _norm(shell.second_moment) + vol * d * d
+    # numpy.where's choice: a shell of no (or NaN) volume has no bounded centroid
+    spread = (2 * first * e_first + d * d * vol * e_volume) / vol if vol > 0 else math.inf
+    e_centroid = (e_first + d * e_volume) / vol if vol > 0 else math.inf
+    e_central = e_second + spread + 4 * _U * (about_origin + first * d)
+    return RoundoffBound(volume=np.array([e_volume]), centroid=np.array([e_centroid]),
+                         second_moment=np.array([e_central]))
 
 
 def exact_volume_moments(vertices: np.ndarray, faces: np.ndarray, *, area: float = 0.0,
@@ -483,6 +557,10 @@ def accurate_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     if not np.isfinite(total_v) or total_v == 0 or total_i == 0:
         return shells, 0, RoundoffBound(volume=e_vol, centroid=e_cen, second_moment=e_sec)
     budget = 0.5 * rtol
+    if len(shells) == 1:                       # one shell (most parts): the ordering below is that shell alone
+        one_v, one_i = float(share_v[0]), float(share_i[0])
+        if one_v <= budget * total_v and one_i <= budget * total_i and math.isfinite(one_v) and math.isfinite(one_i):
+            return shells, 0, RoundoffBound(volume=e_vol, centroid=e_cen, second_moment=e_sec)
     worst = np.argsort(-np.maximum(share_v / (rtol * total_v), share_i / (rtol * total_i)), kind="stable")
     rest_v, rest_i = np.cumsum(share_v[worst][::-1])[::-1], np.cumsum(share_i[worst][::-1])[::-1]
     over = (rest_v > budget * total_v) | (rest_i > budget * total_i) | ~np.isfinite(rest_v) | ~np.isfinite(rest_i)
@@ -526,6 +604,14 @@ def _shares(shells: list[VolumeMoments], e_vol: np.ndarray, e_cen: np.ndarray, e
     """Each shell's bound on the total volume and on the total central inertia (Frobenius), and the totals'
     sizes ``|V|`` and ``‖I‖`` (with ``magnitude``, ``Σ|V|`` and ``Σ ‖I‖`` of the shells taken positive; with
     ``only``, that shell's two shares)."""
+    if len(shells) == 1:
+        return _one_shell_shares(shells[0], e_vol, e_cen, e_sec, only, magnitude)
+    return _many_shares(shells, e_vol, e_cen, e_sec, only, magnitude)
+
+
+def _many_shares(shells: list[VolumeMoments], e_vol: np.ndarray, e_cen: np.ndarray, e_sec: np.ndarray,
+                 only: int | None, magnitude: bool) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """:func:`_shares` on arrays, for any number of shells."""
     vol = np.array([s.volume for s in shells])
     weight = np.abs(vol) if magnitude else vol
     total = float(np.sum(weight))
@@ -543,3 +629,27 @@ def _shares(shells: list[VolumeMoments], e_vol: np.ndarray, e_cen: np.ndarray, e
     if only is not None:
         return np.array(e_vol[only]), np.array(share_i[only]), abs(total), inertia
     return e_vol, share_i, abs(total), inertia
+
+
+def _one_shell_shares(s: VolumeMoments, e_vol: np.ndarray, e_cen: np.ndarray, e_sec: np.ndarray, only: int | None,
+                      magnitude: bool) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """:func:`_shares` of a single shell on Python floats: the same operations in the same order (the same bits;
+    ``tests/test_integrals_small.py`` compares them), a tenth of the time on a small part."""
+    volume = float(s.volume)
+    weight = abs(volume) if magnitude else volume
+    cen = [float(x) for x in s.centroid] if volume else [0.0, 0.0, 0.0]
+    c = [(weight * x) / weight for x in cen] if weight else [0.0, 0.0, 0.0]
+    delta = [x - y for x, y in zip(cen, c)]
+    d = math.sqrt((delta[0] * delta[0] + delta[1] * delta[1]) + delta[2] * delta[2])
+    if magnitude:
+        inertia = _norm(s.second_moment) + abs(volume) * d * d if volume else 0.0
+    else:
+        m = s.second_moment.tolist()
+        second = [[0.0 + (m[i][j] + volume * (delta[i] * delta[j])) for j in range(3)] for i in range(3)]
+        trace = (second[0][0] + second[1][1]) + second[2][2]
+        flat = np.array([trace * (1.0 if i == j else 0.0) - second[i][j] for i in range(3) for j in range(3)])
+        inertia = math.sqrt(float(flat.dot(flat)))
+    share_i = 3 * (e_sec + d * d * e_vol + 2 * abs(volume) * d * e_cen)
+    if only is not None:
+        return np.array(e_vol[only]), np.array(share_i[only]), abs(weight), inertia
+    return e_vol, share_i, abs(weight), inertia

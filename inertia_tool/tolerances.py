@@ -130,3 +130,7 @@ DEFAULT_MAX_FACES = 50_000_000
 #: triangle with 32-bit integers, so 3 x faces must stay below 2^31 (715,827,882 triangles, ~36 GB of
 #: binary STL).  A file announcing more is refused from its header, before anything is allocated.
 MAX_SUPPORTED_FACES = (2**31 - 1) // 3
+
+#: Most output samples of a simulated trajectory (``spin``'s experiment, ``top``'s heavy top): bounds memory
+#: (~100 B a sample) and the integrator's work.
+MAX_TRAJECTORY_SAMPLES = 400_001

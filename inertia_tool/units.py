@@ -11,9 +11,13 @@ import re
 
 from .errors import MaterialError, UnitsError
 
+#: m/s², the conventional standard acceleration of gravity (3rd CGPM, 1901); ``top``'s default gravity.
+STANDARD_GRAVITY = 9.80665
+
 __all__ = ["DECIMAL", "LENGTH_UNITS", "MATERIALS", "length_scale", "material_density", "parse_length",
            "parse_angular_rate", "parse_duration", "parse_mass", "parse_density", "parse_angle", "parse_vector",
-           "parse_fraction", "PLAUSIBLE_EXTENT", "PLAUSIBLE_DENSITY", "implausible_extent", "implausible_density"]
+           "parse_fraction", "PLAUSIBLE_EXTENT", "PLAUSIBLE_DENSITY", "implausible_extent", "implausible_density",
+           "STANDARD_GRAVITY"]
 
 #: Length units accepted for mesh coordinates, as metres per unit.
 LENGTH_UNITS = {

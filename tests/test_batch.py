@@ -514,3 +514,30 @@ def test_csv_record_torn_inside_a_quoted_line_break(tmp_path):
     cut = record[: record.index(b"\n") + 1]                       # ends in the quoted line break
     rows, torn = read_rows(header + record + cut, "csv", "r.csv")
     assert len(rows) == 1 and torn == len(cut)
+
+
+def test_progress_bar_on_a_terminal_is_redrawn_at_most_every_redraw_seconds():
+    """A redraw per file cost a write and a flush per small part: the bar is drawn first, then at most every
+    ``redraw`` seconds, and always in its final state."""
+    import io
+
+    from inertia_tool.cli.batch import Progress
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    buf = Terminal()
+    p = Progress(buf, redraw=3600)
+    for k in range(1, 1001):
+        p(k, 1000, k, 0)
+    p.close()
+    draws = buf.getvalue().split("\r")[1:]
+    assert len(draws) == 2
+    assert draws[0].startswith("[") and "1/1000 files" in draws[0]
+    assert "1000/1000 files (1000 ok, 0 failed)" in draws[1] and buf.getvalue().endswith("\n")
+    every = Terminal()
+    p = Progress(every, redraw=0)
+    for k in range(1, 6):
+        p(k, 5, k, 0)
+    assert every.getvalue().count("\r") == 5

@@ -265,3 +265,37 @@ def test_placeholder_subcommands_give_the_same_help():
         alone = build_parser((name,))
         assert (alone._defaults["_subparsers"][name].format_help()
                 == full._defaults["_subparsers"][name].format_help()), name
+
+
+@pytest.mark.parametrize("command", ["spin", "top", "balance", "batch", "robot", "spin-it"])
+def test_command_help_loads_neither_numpy_nor_the_engine(command):
+    """Issue 25 item 4: ``spin``, ``top``, ``balance``, ``batch``, ``robot`` and ``spin-it --help`` loaded numpy and
+    the engine (0.13-0.26 s of CPU) to state a few constants; now, like ``analyze --help``, only the parser's
+    modules load."""
+    code, modules = imported_by(command, "--help")
+    assert code == 0
+    assert not loaded(modules, "numpy")
+    assert [m for m in modules if m.startswith((
+        "inertia_tool.mesh", "inertia_tool.mass", "inertia_tool.dynamics", "inertia_tool.integrals",
+        "inertia_tool.values", "inertia_tool.balancing", "inertia_tool.robot", "inertia_tool.batch",
+        "inertia_tool.output", "inertia_tool.reports.serialize", "inertia_tool.reports.stability"))] == []
+
+
+def test_the_parsers_constants_are_the_engines():
+    """What the light parsers state (choices, defaults, limits) is what the engine uses: the same objects where
+    they moved to ``tolerances``/``units``, equal copies where the engine keeps its own."""
+    from inertia_tool import tolerances, units
+    from inertia_tool.balancing.rotor import ISO_GRADES
+    from inertia_tool.cli import balance, robot, spin, top
+    from inertia_tool.dynamics import experiment, spin_stability
+    from inertia_tool.dynamics import top as heavy_top
+    from inertia_tool.mass.principal import DEFAULT_EQUAL_RTOL
+    from inertia_tool.robot.description import GEOMETRY_KINDS
+    from inertia_tool.robot.geometry import MODEL_DENSITY
+    assert spin.MAX_SAMPLES is experiment.MAX_SAMPLES is heavy_top.MAX_TOP_SAMPLES is top.MAX_SAMPLES \
+        is tolerances.MAX_TRAJECTORY_SAMPLES
+    assert heavy_top.STANDARD_GRAVITY is units.STANDARD_GRAVITY == 9.80665
+    assert spin.DEFAULT_EQUAL_RTOL is DEFAULT_EQUAL_RTOL
+    assert spin.AXIS_NAMES == spin_stability.AXIS_NAMES
+    assert balance.ISO_GRADE_NAMES == tuple(g.name.replace(" ", "") for g in ISO_GRADES)
+    assert robot.GEOMETRY_KINDS == GEOMETRY_KINDS and robot.MODEL_DENSITY == MODEL_DENSITY

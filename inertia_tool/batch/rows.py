@@ -110,6 +110,25 @@ def _csv_quoted(cell: str) -> str:
     return cell
 
 
+def _csv_field(value) -> str:
+    """``_csv_quoted(_csv_cell(value))``, with the cells that never need quotes (empty, numbers, booleans) not
+    searched for a delimiter: a row has some forty numbers."""
+    if value is None:
+        return ""
+    kind = type(value)
+    if kind is float:
+        return repr(value)                     # digits, '.', 'e', '-', 'inf'/'nan' (never written): no quotes
+    if kind is bool:
+        return "true" if value else "false"
+    if kind is int:
+        return str(value)
+    return _csv_quoted(_csv_cell(value))
+
+
+#: The JSON writer of the rows (one, made once: ``json.dumps`` with options builds a new encoder per call).
+_JSON_ROW = json.JSONEncoder(ensure_ascii=False, allow_nan=False)
+
+
 def format_row(row: dict, fmt: str, layout: str = SCHEMA) -> bytes:
     """One row as the bytes of one complete record, ending in ``\\n`` (JSONL: one line; CSV: quoted cells
     may hold line breaks).  ``layout``: :data:`SCHEMA`, or ``SCHEMA_V1`` for an old CSV file's own layout."""
@@ -117,9 +136,11 @@ def format_row(row: dict, fmt: str, layout: str = SCHEMA) -> bytes:
         row = downgrade_row(row)
     fields = _LAYOUTS[layout]
     if fmt == "jsonl":
-        line = json.dumps({k: row.get(k) for k in fields}, ensure_ascii=False, allow_nan=False) + "\n"
+        # a row made by the runner holds exactly the columns, in order: written as it is
+        ordered = row if tuple(row) == fields else {k: row.get(k) for k in fields}
+        line = _JSON_ROW.encode(ordered) + "\n"
     else:
-        line = ",".join(_csv_quoted(_csv_cell(row.get(k))) for k in fields) + "\n"
+        line = ",".join([_csv_field(row.get(k)) for k in fields]) + "\n"
     return line.encode("utf-8", "backslashreplace")     # a lone surrogate left in a message: never an error
 
 

@@ -9,19 +9,21 @@ from __future__ import annotations
 import json
 import os
 
-from ..balancing.rotor import ISO_GRADES, balance
 from ..errors import UsageError
-from ..output import check_targets, write_files
-from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
 from ..units import parse_angular_rate, parse_length
-from ..reports.serialize import command_output, method_and_uncertainty
 from . import speak_options
 from .help import add_command
 from .model_options import add_files_argument, add_model_options, command_parser, length_unit, load_model, with_warnings
 from .options import check_option
 from .report_option import say_written
 
+# numpy, the engine and the reports load in run(): ``balance --help`` needs none of them (issue 25 item 4)
+
 __all__ = ["register", "run"]
+
+#: The ISO 21940-11 grades ``--grade`` names in its help: the parser's copy of the names of
+#: ``balancing.rotor.ISO_GRADES`` (the same, in order: ``tests/test_startup.py``).
+ISO_GRADE_NAMES = ("G0.4", "G1", "G2.5", "G6.3", "G16", "G40", "G100", "G250", "G630", "G1600", "G4000")
 
 def _lengths(text: str, unit: str, name: str, count) -> list[float]:
     items = [t for t in str(text).replace(";", ",").split(",")]
@@ -32,7 +34,7 @@ def _lengths(text: str, unit: str, name: str, count) -> list[float]:
 
 
 def register(subparsers) -> None:
-    grades = ", ".join(g.name.replace(" ", "") for g in ISO_GRADES)
+    grades = ", ".join(ISO_GRADE_NAMES)
     p = add_command(
         subparsers, "balance",
         description="Balancing report of a rigid rotor turning about a given shaft (Chapter 4, §4.3.2): static "
@@ -91,6 +93,11 @@ def _report_paths(path: str, count: int) -> tuple[str, list[str]]:
 
 
 def run(args) -> int:
+    from ..balancing.rotor import balance
+    from ..output import check_targets, write_files
+    from ..reports.balance import balance_dict, balance_html, balance_markdown, format_balance_text, polar_svg
+    from ..reports.serialize import command_output, method_and_uncertainty
+
     unit = length_unit(args)
     axis_point = _lengths(args.axis_point, unit, "axis-point", (3,))
     try:

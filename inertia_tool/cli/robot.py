@@ -8,15 +8,7 @@ import os
 import sys
 
 from ..errors import UsageError
-from ..mesh.options import DEFAULT_MAX_FACES
-from ..reports.robot_audit import (format_robot_report, left_unchanged, links_without_result, robot_report_dict,
-                                   summary_line)
-from ..reports.serialize import command_output
-from ..robot.audit import audit_links
-from ..robot.description import GEOMETRY_KINDS, read_robot
-from ..robot.geometry import MODEL_DENSITY, link_inertials
-from ..robot.mjcf import inertia_from_geometry
-from ..robot.write import write_corrected
+from ..tolerances import DEFAULT_MAX_FACES
 from ..units import MATERIALS, parse_density
 from . import EXIT_INCOMPLETE, EXIT_OK, speak_options
 from .help import add_command
@@ -25,7 +17,14 @@ from ..reports.escape import escape_terminal
 from .model_options import recorded_warnings
 from .report_option import check_output_file
 
+# the readers, the engine and the reports load in run(): ``robot --help`` needs none of them (issue 25 item 4)
+
 __all__ = ["register", "run", "parse_packages", "parse_mappings"]
+
+#: ``--geometry``'s choices and ``--density``'s word for the description's own densities: the parser's copies
+#: of ``robot.description.GEOMETRY_KINDS`` and ``robot.geometry.MODEL_DENSITY`` (the same: tests/test_startup.py).
+GEOMETRY_KINDS = ("collision", "visual", "all")
+MODEL_DENSITY = "model"
 
 
 def register(subparsers) -> None:
@@ -112,7 +111,8 @@ def _density(args) -> float | str | None:
 
 def _run_corpus(args, packages: dict) -> int:
     """Several files or folders: every description audited, one summary (no --write, no xacro arguments)."""
-    from ..reports.robot_audit import corpus_report_dict, format_corpus_report
+    from ..reports.robot_audit import corpus_report_dict, format_corpus_report, links_without_result
+    from ..reports.serialize import command_output
     from ..robot.corpus import audit_corpus
     if args.write or args.arg:
         raise UsageError("--write and --arg apply to one description; a corpus (several files or a folder) is "
@@ -135,6 +135,15 @@ def _run_corpus(args, packages: dict) -> int:
 
 
 def run(args) -> int:
+    from ..reports.robot_audit import (format_robot_report, left_unchanged, links_without_result, robot_report_dict,
+                                       summary_line)
+    from ..reports.serialize import command_output
+    from ..robot.audit import audit_links
+    from ..robot.description import read_robot
+    from ..robot.geometry import link_inertials
+    from ..robot.mjcf import inertia_from_geometry
+    from ..robot.write import write_corrected
+
     packages = parse_packages(args.package)
     if len(args.robot) > 1 or os.path.isdir(args.robot[0]):
         return _run_corpus(args, packages)

@@ -6,23 +6,22 @@ from __future__ import annotations
 import json
 import sys
 
-import numpy as np
-
 from ..errors import UsageError
-from ..reports.stability import format_spin, format_stability, spin_dict, stability_dict
-from ..reports.serialize import command_output, method_and_uncertainty
-from ..dynamics.experiment import MAX_SAMPLES, spin_experiment
-from ..dynamics.spin_stability import AXIS_NAMES
+from ..tolerances import EQUAL_MOMENTS_RTOL as DEFAULT_EQUAL_RTOL
+from ..tolerances import MAX_TRAJECTORY_SAMPLES as MAX_SAMPLES
 from ..units import parse_angular_rate, parse_duration
-from ..mass.principal import DEFAULT_EQUAL_RTOL
-from ..output import atomic_target, check_targets
 from .help import add_command
 from .model_options import add_files_argument, add_model_options, load_model, model_words, with_warnings
 from .options import check_option, require_range
 from .report_option import save_figure, say_written
 
+# numpy, the engine and the reports load in run(): ``spin --help`` needs none of them (issue 25 item 4)
+
 __all__ = ["register", "run", "MAX_SAMPLES"]
 
+#: The principal axes by moment, as ``--about`` takes them: the parser's copy of
+#: ``dynamics.spin_stability.AXIS_NAMES`` (the same tuple: ``tests/test_startup.py``).
+AXIS_NAMES = ("minor", "intermediate", "major")
 
 
 def register(subparsers) -> None:
@@ -60,6 +59,10 @@ def register(subparsers) -> None:
 
 
 def _write_csv(path: str, traj) -> None:
+    import numpy as np
+
+    from ..output import atomic_target
+
     data = np.column_stack([traj.t, traj.angular_velocity, traj.orientation, traj.angular_momentum, traj.energy])
     header = ("t_s,omega_x_rad_s,omega_y_rad_s,omega_z_rad_s,q_w,q_x,q_y,q_z,"
               "L_x_kg_m2_s,L_y_kg_m2_s,L_z_kg_m2_s,energy_J")
@@ -81,6 +84,8 @@ def _pyplot():
 def _plot(path: str, experiment) -> None:
     """The body angular velocity on the principal axes (top) and, on their own scale, the two components
     across the spin axis (bottom): a stable axis's small wobble is visible there, an unstable one's flips too."""
+    import numpy as np
+
     plt = _pyplot()
     traj = experiment.trajectory
     axes = np.column_stack([e.axis for e in experiment.report.axes])
@@ -105,6 +110,11 @@ def _plot(path: str, experiment) -> None:
 
 
 def run(args) -> int:
+    from ..dynamics.experiment import spin_experiment
+    from ..output import check_targets
+    from ..reports.serialize import command_output, method_and_uncertainty
+    from ..reports.stability import format_spin, format_stability, spin_dict, stability_dict
+
     require_range(args.perturbation, "--perturbation", low=0, high=1, low_open=True, high_open=True)
     require_range(args.rtol, "--rtol", low=0, high=1, high_open=True)
     if args.samples is not None and not 2 <= args.samples <= MAX_SAMPLES:

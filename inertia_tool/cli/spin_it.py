@@ -6,16 +6,17 @@ import json
 import math
 import os
 import sys
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ..errors import UsageError
 from ..units import length_scale, parse_density, parse_length, parse_vector
 from .help import add_command
 from .model_options import add_material_options, length_unit, recorded_warnings
 from .options import check_option, density_and_mass
-from ..output import check_targets
 from .report_option import save_figure, say_written
+
+if TYPE_CHECKING:     # numpy and the design stages load in run(): ``spin-it --help`` needs none of them
+    import numpy as np
 
 __all__ = ["register", "run", "OUTPUT_SUFFIXES"]
 
@@ -74,6 +75,8 @@ _NAMED_AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 
 def _direction(text: str) -> np.ndarray:
     named = str(text).strip().lower()
+    import numpy as np
+
     sign, bare = (-1.0, named[1:]) if named[:1] == "-" else (1.0, named[1:] if named[:1] == "+" else named)
     if bare in _NAMED_AXES:
         return sign * np.array(_NAMED_AXES[bare])
@@ -118,6 +121,7 @@ def _write_one_material(path: str, result, material: str) -> None:
 
 
 def _write(path: str, vertices, faces, units: str) -> None:
+    import numpy as np
     import trimesh
 
     from ..output import atomic_target
@@ -137,6 +141,8 @@ _TOP_TILT, _TOP_SPIN_FACTOR, _TOP_PERIODS = 0.05, 1.1, 3.0
 
 def _motion(result):
     """The simulated spin before and after of the ``--report`` picture (engine calls; the report draws)."""
+    import numpy as np
+
     from ..reports.spin_it import SpinMotion
     from ..rotations import perpendicular_basis
     axis = np.asarray(result.axis, dtype=float)
@@ -178,6 +184,7 @@ def _motion(result):
 
 def run(args) -> int:
     from ..design.verify import spin_it_verified
+    from ..output import check_targets
     from ..reports.spin_it import format_spin_it_text, format_verification, spin_it_dict, verification_dict
 
     if args.out and os.path.splitext(args.out)[1].lower() not in OUTPUT_SUFFIXES:

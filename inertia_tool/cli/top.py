@@ -6,19 +6,15 @@ import json
 import math
 import sys
 
-import numpy as np
-
 from ..errors import NearlyEqualMomentsWarning, UsageError
-from ..dynamics.top import MAX_TOP_SAMPLES as MAX_SAMPLES
-from ..dynamics.top import STANDARD_GRAVITY, heavy_top_on_pivot
-from ..reports.stability import format_heavy_top, heavy_top_dict
-from ..reports.serialize import command_output, method_and_uncertainty
-from ..units import parse_angle, parse_angular_rate, parse_duration, parse_vector
-from ..output import atomic_target, check_targets
+from ..tolerances import MAX_TRAJECTORY_SAMPLES as MAX_SAMPLES
+from ..units import STANDARD_GRAVITY, parse_angle, parse_angular_rate, parse_duration, parse_vector
 from .help import add_command
 from .model_options import add_files_argument, add_model_options, length_unit, load_model, model_words, with_warnings
 from .options import check_option, require_range
 from .report_option import save_figure, say_written
+
+# numpy, the engine and the reports load in run(): ``top --help`` needs none of them (issue 25 item 4)
 
 __all__ = ["register", "run", "MAX_SAMPLES", "MIN_SAMPLES_PER_PERIOD"]
 
@@ -72,6 +68,10 @@ def register(subparsers) -> None:
 
 
 def _write_csv(path: str, traj) -> None:
+    import numpy as np
+
+    from ..output import atomic_target
+
     data = np.column_stack([traj.t, traj.theta, traj.phi, traj.axis, traj.angular_momentum, traj.energy])
     header = "t_s,theta_rad,phi_rad,axis_x,axis_y,axis_z,L_x_kg_m2_s,L_y_kg_m2_s,L_z_kg_m2_s,energy_J"
     with atomic_target(path, label="--csv") as tmp:
@@ -92,6 +92,8 @@ def _pyplot():
 def _plot(path: str, top, traj) -> None:
     """θ(t) with the predicted limits, and the path of the axis as θ against the precession angle φ (the
     chapter's Fig. 4.3: waves, loops or cusps between the two limiting circles)."""
+    import numpy as np
+
     plt = _pyplot()
     from matplotlib.ticker import MaxNLocator
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -134,6 +136,13 @@ def _check_sampling(top, duration: float, samples: int) -> None:
 
 
 def run(args) -> int:
+    import numpy as np
+
+    from ..dynamics.top import heavy_top_on_pivot
+    from ..output import check_targets
+    from ..reports.serialize import command_output, method_and_uncertainty
+    from ..reports.stability import format_heavy_top, heavy_top_dict
+
     tilt = parse_angle(args.tilt, default_unit="deg")
     if not (math.isfinite(tilt) and 0.0 <= tilt <= math.pi):
         raise UsageError(f"--tilt must be between 0 and 180 deg (0 and π rad) from the vertical, got {args.tilt} "

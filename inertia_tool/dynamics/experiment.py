@@ -16,6 +16,7 @@ from ..values import frozen_value
 from ..errors import NonFiniteResultError, UsageError
 from .spin_stability import AxisStability, StabilityReport, polhode_period, stability
 from ..mass.principal import DEFAULT_EQUAL_RTOL
+from ..tolerances import MAX_TRAJECTORY_SAMPLES
 
 __all__ = ["SpinExperiment", "spin_experiment", "SAMPLES_PER_TURN", "MIN_SAMPLES_PER_PERIOD", "MAX_SAMPLES"]
 
@@ -91,8 +92,8 @@ class SpinExperiment:
     energy_drift: float
 
 
-#: Most output samples of a spin experiment (bounds memory and time).
-MAX_SAMPLES = 400_001
+#: Most output samples of a spin experiment (bounds memory and time; ``tolerances``, so the parser states it).
+MAX_SAMPLES = MAX_TRAJECTORY_SAMPLES
 
 def _crossings(t: np.ndarray, y: np.ndarray, *, upward_only: bool) -> np.ndarray:
     """Times where ``y`` changes sign (or only goes − → +), linearly interpolated."""

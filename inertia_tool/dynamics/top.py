@@ -27,12 +27,12 @@ import numpy as np
 from ..values import frozen_value
 from ..errors import AsymmetricTopWarning, NonFiniteResultError, PhysicsError, UsageError
 from ..mass.properties import MassProperties
+from ..tolerances import MAX_TRAJECTORY_SAMPLES
+from ..units import STANDARD_GRAVITY          # m/s² (re-exported: the top's default gravity)
 
 __all__ = ["HeavyTopReport", "TopTrajectory", "heavy_top", "heavy_top_on_pivot", "simulate_top",
            "STANDARD_GRAVITY", "PRECESSION_KINDS"]
 
-#: m/s², the conventional standard acceleration of gravity.
-STANDARD_GRAVITY = 9.80665
 
 #: Labels of ``HeavyTopReport.precession_kind``.
 PRECESSION_KINDS = ("looping", "undulating", "cusp", "steady", "planar")
@@ -340,8 +340,8 @@ def heavy_top(I1: float, I3: float, mass: float, length: float, *, theta0: float
                           precession_rate_slow=slow, precession_rate_fast=fast)
 
 
-#: Most output samples of :func:`simulate_top` (bounds memory and the integrator's work).
-MAX_TOP_SAMPLES = 400_001
+#: Most output samples of :func:`simulate_top` (bounds memory and the integrator's work; ``tolerances``).
+MAX_TOP_SAMPLES = MAX_TRAJECTORY_SAMPLES
 
 
 def simulate_top(top: HeavyTopReport, duration: float, *, samples: int = 2001, rtol: float = 1e-10,
