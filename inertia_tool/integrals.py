@@ -325,6 +325,9 @@ def roundoff_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     (numpy's sequential ``bincount``).  The central moment ``C − f fᵀ/V`` carries the errors of its parts to
     first order plus ``4u·(‖C‖ + ‖f‖²/|V|)`` of its own.  Terms of order u² are left out.
 
+    The per-face terms and their sums run in one C pass when the extension is built (``_accel.roundoff_sums``:
+    the numpy loop's operations in its order, so the same bits), and a single shell's tail on Python floats.
+
     Parameters
     ----------
     vertices : (n, 3) float
