@@ -3333,6 +3333,25 @@ done:
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
+
+/* Stage timing of contact_scan for profiling: with INERTIA_TOOL_CT_PROFILE set in the environment each call
+ * prints the CPU time (all threads) of its stages (preparation, sort, stars, build, traversal) to stderr. */
+#if defined(__linux__) || defined(__APPLE__)
+#include <time.h>
+static double
+ct_clock(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);     /* CPU time: the machine is shared */
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+#else
+static double
+ct_clock(void)
+{
+    return 0.0;
+}
+#endif
 #define CONTACT_O3 (10.0 * 1.1102230246251565e-16)
 #define CONTACT_O2 (6.0 * 1.1102230246251565e-16)
 
@@ -3776,27 +3795,35 @@ ct_face_geometry(CtFace *F, const double *p0, const double *p1, const double *p2
     F->na[2] = fabs(e1[0]) * fabs(e2[1]) + fabs(e1[1]) * fabs(e2[0]);
 }
 
-static void
-ct_face_init(CtFace *F, const double *p0, const double *p1, const double *p2, CtStats *st)
+/* The projection axis of the face p0, p1, p2 and *skip (1: zero area): the axis of the largest |normal
+ * component| of the float normal (the first of equals), then the next ones until the projected triangle has an
+ * exactly nonzero orientation (as mesh/intersect._face_axes). */
+static inline int
+ct_face_axis(const double *p0, const double *p1, const double *p2, int *skip, CtStats *st)
 {
-    ct_face_geometry(F, p0, p1, p2);
-    /* the axis of the largest |normal component| (first of equals), then the next ones until the projected
-     * triangle has an exactly nonzero orientation (as mesh/intersect._face_axes) */
+    double e1[3], e2[3], n[3];
+    for (int c = 0; c < 3; c++) {
+        e1[c] = p1[c] - p0[c];
+        e2[c] = p2[c] - p0[c];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];         /* the arithmetic of ct_face_geometry */
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
     int k = 0;
     for (int c = 1; c < 3; c++) {
-        if (fabs(F->n[c]) > fabs(F->n[k])) k = c;
+        if (fabs(n[c]) > fabs(n[k])) k = c;
     }
-    F->skip = 1;
+    *skip = 1;
     for (int tries = 0; tries < 3; tries++, k = (k + 1) % 3) {
         double a[2] = {p0[ct_plane[k][0]], p0[ct_plane[k][1]]};
         double b[2] = {p1[ct_plane[k][0]], p1[ct_plane[k][1]]};
         double c[2] = {p2[ct_plane[k][0]], p2[ct_plane[k][1]]};
         if (ct_orient2d(a, b, c, st) != 0) {
-            F->skip = 0;
+            *skip = 0;
             break;
         }
     }
-    F->axis = k % 3;
+    return k % 3;
 }
 
 /* Kind of the pair of faces A, B (A the lower face index). */
@@ -3939,11 +3966,30 @@ ct_max3(double a, double b, double c)
     return m > c ? m : c;
 }
 
-/* A face at a hierarchy position: its corner indices and its index in the caller's faces (16 bytes). */
-typedef struct {
-    int32_t fo[3];
-    int32_t face;
-} CtRec;
+/* Corner indices of the faces in blocks of CT_LEAF hierarchy positions, corner by corner: block b holds
+ * corners 0, 1, 2 of positions CT_LEAF b .. CT_LEAF b + CT_LEAF - 1, CT_LEAF int32 each (ct_share_mask tests
+ * one vertex against a whole block); positions past the last face hold -1 (no vertex). */
+#define CT_IDBLOCK (3 * CT_LEAF)
+
+static inline int32_t
+ct_id(const int32_t *ids, int64_t i, int c)      /* corner c of the face at position i */
+{
+    return ids[CT_IDBLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF];
+}
+
+/* The large per-face arrays of contact_scan: zeroed-on-demand mappings backed by 2 MB pages where the kernel
+ * offers them (arena_alloc, section 2b), so that a 1M-face scan does not take one page fault per 4 kB. */
+static inline void *
+ct_alloc(size_t bytes)
+{
+    return arena_alloc(bytes > 0 ? bytes : 1);
+}
+
+static inline void
+ct_free(void *p, size_t bytes)
+{
+    arena_free(p, bytes > 0 ? bytes : 1);
+}
 
 /* The next float32 above a finite f (nextafterf(f, +inf) without the library call): from -0 or +0 the
  * smallest subnormal, else one unit in the last place away from zero for f > 0, toward zero for f < 0;
@@ -4040,10 +4086,10 @@ static int
 ct_radix_sort(uint64_t *key, int64_t m)
 {
     size_t mm = m > 0 ? (size_t)m : 1;
-    uint64_t *key2 = (uint64_t *)malloc(mm * sizeof(uint64_t));
+    uint64_t *key2 = (uint64_t *)ct_alloc(mm * sizeof(uint64_t));
     size_t (*count)[2048] = (size_t (*)[2048])calloc(3, sizeof(*count));
     if (key2 == NULL || count == NULL) {
-        free(key2);
+        ct_free(key2, mm * sizeof(uint64_t));
         free(count);
         return -1;
     }
@@ -4064,7 +4110,7 @@ ct_radix_sort(uint64_t *key, int64_t m)
         uint64_t *t = src; src = dst; dst = t;
     }
     memcpy(key, src, (size_t)m * sizeof(uint64_t));  /* three passes: the result is in key2 */
-    free(key2);
+    ct_free(key2, mm * sizeof(uint64_t));
     free(count);
     return 0;
 }
@@ -4278,8 +4324,10 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
          uint8_t *cert, int threads)
 {
     memset(cert, 0, (size_t)n);
-    int64_t *off = (int64_t *)calloc((size_t)(n > 0 ? n : 1), sizeof(int64_t));
+    size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
+    int64_t *off = (int64_t *)ct_alloc(off_bytes);
     if (off == NULL) return -1;
+    memset(off, 0, off_bytes);                             /* arena_alloc zeroes only on Linux */
     for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
     int64_t total = 0;
     for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
@@ -4291,9 +4339,10 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
             off[v] = -1;
         }
     }
-    int32_t *link = (int32_t *)malloc((size_t)(total > 0 ? 2 * total : 1) * sizeof(int32_t));
+    size_t link_bytes = (size_t)(total > 0 ? 2 * total : 1) * sizeof(int32_t);
+    int32_t *link = (int32_t *)ct_alloc(link_bytes);
     if (link == NULL) {
-        free(off);
+        ct_free(off, off_bytes);
         return -1;
     }
     for (int64_t f = 0; f < m; f++) {
@@ -4320,22 +4369,22 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
     for (int t = 0; t < MAX_THREADS; t++) {
         if (jb.oom[t]) rc = -1;
     }
-    free(link);
-    free(off);
+    ct_free(link, link_bytes);
+    ct_free(off, off_bytes);
     return rc;
 }
 
 /* The certified vertex shared by every face at hierarchy positions s .. s+count-1, or -1. */
 static int64_t
-ct_leaf_apex(const CtRec *rec, const uint8_t *cert, int64_t s, int64_t count)
+ct_leaf_apex(const int32_t *ids, const uint8_t *cert, int64_t s, int64_t count)
 {
     if (cert == NULL) return -1;
     for (int c = 0; c < 3; c++) {
-        int32_t x = rec[s].fo[c];
+        int32_t x = ct_id(ids, s, c);
         if (cert[x] != CT_STAR_BIG) continue;
         int all = 1;
         for (int64_t i = s + 1; i < s + count && all; i++) {
-            all = rec[i].fo[0] == x || rec[i].fo[1] == x || rec[i].fo[2] == x;
+            all = ct_id(ids, i, 0) == x || ct_id(ids, i, 1) == x || ct_id(ids, i, 2) == x;
         }
         if (all) return x;
     }
@@ -4397,11 +4446,45 @@ ct_block_mask(const float *blk, float lx, float ly, float lz, float hx, float hy
 #endif
 }
 
+/* Bit j set when vertex x is a corner of the face at position j of the block ids (one CT_IDBLOCK). */
+static inline unsigned
+ct_share_mask(const int32_t *ids, int32_t x)
+{
+#if defined(__SSE2__) && CT_LEAF % 4 == 0
+    __m128i k = _mm_set1_epi32(x);
+    unsigned mask = 0;
+    for (int q = 0; q < CT_LEAF / 4; q++) {
+        __m128i e = _mm_or_si128(
+            _mm_or_si128(_mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(ids + 4 * q)), k),
+                         _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(ids + CT_LEAF + 4 * q)), k)),
+            _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(ids + 2 * CT_LEAF + 4 * q)), k));
+        mask |= (unsigned)_mm_movemask_ps(_mm_castsi128_ps(e)) << (4 * q);
+    }
+    return mask;
+#else
+    unsigned mask = 0;
+    for (int j = 0; j < CT_LEAF; j++) {
+        mask |= (unsigned)((ids[j] == x) | (ids[CT_LEAF + j] == x) | (ids[2 * CT_LEAF + j] == x)) << j;
+    }
+    return mask;
+#endif
+}
+
+static inline int
+ct_popcount(unsigned x)         /* bits set in x (SWAR: no library call without -mpopcnt) */
+{
+    uint32_t v = (uint32_t)x;
+    v = v - ((v >> 1) & 0x55555555u);
+    v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
+    v = (v + (v >> 4)) & 0x0f0f0f0fu;
+    return (int)((v * 0x01010101u) >> 24);
+}
+
 /* Builds the hierarchy over the boxes BOX (blocks above, already in hierarchy order): the tree halving block
  * ranges (a leaf is one block of at most CT_LEAF faces), node boxes from the leaves up.  Returns the node
  * count. */
 static int64_t
-ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert, int64_t m)
+ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cert, int64_t m)
 {
     int64_t n_nodes = 1;
     nodes[0].start = 0;
@@ -4426,7 +4509,7 @@ ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert,
     for (int64_t k = n_nodes - 1; k >= 0; k--) {
         CtNode *nd = &nodes[k];
         if (nd->count > 0) {
-            nd->apex = ct_leaf_apex(rec, cert, nd->start, nd->count);
+            nd->apex = ct_leaf_apex(ids, cert, nd->start, nd->count);
             for (int c = 0; c < 3; c++) {
                 nd->lo[c] = INFINITY;
                 nd->hi[c] = -INFINITY;
@@ -4453,7 +4536,8 @@ ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert,
 
 typedef struct {
     const float *BOX;           /* face boxes rounded outward to float32, in blocks of CT_LEAF (ct_block_mask) */
-    const CtRec *rec;           /* corner indices and face index, in hierarchy order */
+    const int32_t *order;       /* the caller's face index of each hierarchy position */
+    const int32_t *ids;         /* corner indices in hierarchy order, in blocks of CT_LEAF (ct_id) */
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
     const double *V;            /* vertices (n, 3) */
     const CtNode *nodes;
@@ -4463,21 +4547,21 @@ typedef struct {
     long exact;
     int complete, oom;
     CtFound found;
+    long long node_pairs, leaf_pairs, loads;   /* work counts, printed with INERTIA_TOOL_CT_PROFILE */
 } CtScan;
 
 /* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
- * (the same arithmetic as ct_face_init), its corner indices, and the axis and zero-area flag ct_face_init
+ * (the arithmetic of ct_face_geometry), its corner indices, and the axis and zero-area flag ct_face_axis
  * gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
  * when a box meets its (16 + 1 bytes per face instead). */
 static inline void
 ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
 {
-    const CtRec *r = &sc->rec[i];
     for (int k = 0; k < 3; k++) {
-        F->fo[k] = r->fo[k];
+        F->fo[k] = ct_id(sc->ids, i, k);
     }
-    ct_face_geometry(F, sc->V + 3 * (size_t)r->fo[0], sc->V + 3 * (size_t)r->fo[1], sc->V + 3 * (size_t)r->fo[2]);
-    F->face = r->face;
+    ct_face_geometry(F, sc->V + 3 * (size_t)F->fo[0], sc->V + 3 * (size_t)F->fo[1], sc->V + 3 * (size_t)F->fo[2]);
+    F->face = sc->order[i];
     F->axis = sc->flags[i] & 3;
     F->skip = sc->flags[i] >> 2;
 }
@@ -4487,6 +4571,7 @@ ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
 static int
 ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
+    sc->loads++;
     if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
         ct_face_load(FI, sc, i);
         *have_i = 1;
@@ -4536,10 +4621,11 @@ ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *
 {
     unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
     if (bits) {
-        const int32_t *x = sc->rec[i].fo, *y = sc->rec[j].fo;
+        int32_t y0 = ct_id(sc->ids, j, 0), y1 = ct_id(sc->ids, j, 1), y2 = ct_id(sc->ids, j, 2);
         unsigned shared = 0;                /* bit c: corner c of face i is a corner of face j */
         for (int c = 0; c < 3; c++) {
-            shared |= (unsigned)((x[c] == y[0]) | (x[c] == y[1]) | (x[c] == y[2])) << c;
+            int32_t x = ct_id(sc->ids, i, c);
+            shared |= (unsigned)((x == y0) | (x == y1) | (x == y2)) << c;
         }
         if ((bits >> 3) & shared) return 0;
         if (bits & shared) {
@@ -4553,6 +4639,47 @@ ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *
         }
     }
     return ct_test_pair(sc, i, j, FI, have_i, FJ, have_j);
+}
+
+/* The pairs of the face at position i with the positions base + j of one block, j the bits of mask (their float32
+ * boxes meet); returns 0 to go on, 1 to stop.  The same decisions as ct_visit pair by pair, but the pairs
+ * sharing a certified corner are found for the whole block at once (ct_share_mask on the block's corner
+ * indices): those of a big star dropped, those of a small star counted (candidates and tested, as ct_visit
+ * counts them; both faces hold the shared vertex, so their float64 boxes meet); only the others are visited
+ * one by one.  With a work bound (max_pairs >= 0) every pair goes through ct_visit, in order. */
+static inline int
+ct_visit_block(CtScan *sc, int64_t i, int64_t base, unsigned mask, CtFace *FI, uint8_t *have_i, CtFace *leaf,
+               uint8_t *have)
+{
+    unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
+    if (bits && sc->max_pairs < 0) {
+        const int32_t *ids = sc->ids + CT_IDBLOCK * (base / CT_LEAF);
+        unsigned big = 0, small = 0;
+        for (int c = 0; c < 3; c++) {
+            if (!((bits >> c) & 9u)) continue;
+            unsigned eq = ct_share_mask(ids, ct_id(sc->ids, i, c));
+            if (bits & (8u << c)) big |= eq;
+            else small |= eq;
+        }
+        mask &= ~big;
+        unsigned counted = mask & small;
+        int n = ct_popcount(counted);
+        sc->candidates += n;
+        sc->tested += n;
+        mask &= ~counted;
+        while (mask) {
+            int b = ct_ctz(mask);
+            mask &= mask - 1;
+            if (ct_test_pair(sc, i, base + b, FI, have_i, &leaf[b], &have[b])) return 1;
+        }
+        return 0;
+    }
+    while (mask) {
+        int b = ct_ctz(mask);
+        mask &= mask - 1;
+        if (ct_visit(sc, i, base + b, FI, have_i, &leaf[b], &have[b])) return 1;
+    }
+    return 0;
 }
 
 static inline int
@@ -4579,6 +4706,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
     top = 1;
     while (top > 0) {
         top--;
+        sc->node_pairs++;
         int64_t pi = stack[2 * top], qi = stack[2 * top + 1];
         const CtNode *p = &nodes[pi], *q = &nodes[qi];
         if (p->apex >= 0 && p->apex == q->apex) {
@@ -4595,6 +4723,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         }
         if (pi == qi) {
             if (p->count > 0) {
+                sc->leaf_pairs++;
                 CtFace leaf[CT_LEAF];
                 uint8_t have[CT_LEAF] = {0};
                 const float *blk = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
@@ -4602,12 +4731,8 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                     unsigned mask = ct_block_mask(blk, blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a],
                                                   blk[3 * CT_LEAF + a], blk[4 * CT_LEAF + a], blk[5 * CT_LEAF + a]);
                     mask &= ~((2u << a) - 1);               /* the later positions j > i only */
-                    while (mask) {
-                        int b = ct_ctz(mask);
-                        mask &= mask - 1;
-                        if (ct_visit(sc, p->start + a, p->start + b, &leaf[a], &have[a], &leaf[b], &have[b])) {
-                            goto out;
-                        }
+                    if (mask && ct_visit_block(sc, p->start + a, p->start, mask, &leaf[a], &have[a], leaf, have)) {
+                        goto out;
                     }
                 }
             }
@@ -4621,6 +4746,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             continue;
         }
         if (p->count > 0 && q->count > 0) {
+            sc->leaf_pairs++;
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
             const float *pb = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
@@ -4634,11 +4760,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                                               pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]);
                 CtFace FI;
                 uint8_t have_i = 0;
-                while (mask) {
-                    int b = ct_ctz(mask);
-                    mask &= mask - 1;
-                    if (ct_visit(sc, p->start + a, q->start + b, &FI, &have_i, &leaf[b], &have[b])) goto out;
-                }
+                if (mask && ct_visit_block(sc, p->start + a, q->start, mask, &FI, &have_i, leaf, have)) goto out;
             }
             continue;
         }
@@ -4756,8 +4878,9 @@ ct_prefetch(const void *p)
 #endif
 }
 
-/* Per-face preparation, split over threads by position: Morton codes (pass 0), then the faces and boxes in
- * hierarchy order (pass 1). */
+/* Per-face preparation, split over threads by position: Morton codes and each face's projection axis and
+ * zero-area flag, in the caller's order (pass 0: the rows are read in sequence), then the corner indices, flags
+ * and boxes in hierarchy order (pass 1). */
 typedef struct {
     int pass;
     int64_t m;
@@ -4769,7 +4892,8 @@ typedef struct {
     int8_t *axis;
     uint8_t *skip;
     float *box;
-    CtRec *rec;
+    int32_t *order;
+    int32_t *ids;
     uint8_t *flags;
     long exact[MAX_THREADS];
     int failed[MAX_THREADS];
@@ -4780,11 +4904,15 @@ ct_prep_task(void *ctx, int t, int nt)
 {
     CtPrep *pr = (CtPrep *)ctx;
     int64_t s = (int64_t)part_start((size_t)pr->m, t, nt), e = (int64_t)part_start((size_t)pr->m, t + 1, nt);
+    CtStats st = {0, 0};
     if (pr->pass == 0) {
         for (int64_t f = s; f < e; f++) {
             const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
             const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
             const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
+            int skip;
+            pr->axis[f] = (int8_t)ct_face_axis(p0, p1, p2, &skip, &st);
+            pr->skip[f] = (uint8_t)skip;
             uint64_t code = 0;
             for (int c = 0; c < 3; c++) {
                 double lo = ct_min3(p0[c], p1[c], p2[c]), hi = ct_max3(p0[c], p1[c], p2[c]);
@@ -4795,9 +4923,10 @@ ct_prep_task(void *ctx, int t, int nt)
             }
             pr->code[f] = code << 31 | (uint64_t)f;
         }
+        pr->exact[t] += st.exact;
+        pr->failed[t] |= st.failed;
         return;
     }
-    CtStats st = {0, 0};
     for (int64_t i = s; i < e; i++) {
         /* the faces are read in hierarchy order, i.e. at random in the caller's: their rows are fetched
          * CT_AHEAD positions ahead, their corners CT_AHEAD / 2 ahead (from the rows fetched by then) */
@@ -4809,26 +4938,21 @@ ct_prep_task(void *ctx, int t, int nt)
             for (int k = 0; k < 3; k++) ct_prefetch(pr->V + 3 * index_at(pr->F, pr->size, g + (size_t)k));
         }
         int64_t f = (int64_t)(pr->code[i] & 0x7fffffff);
-        CtFace F;
         const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
         const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
         const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
-        ct_face_init(&F, p0, p1, p2, &st);
-        pr->axis[f] = (int8_t)F.axis;
-        pr->skip[f] = (uint8_t)F.skip;
-        pr->flags[i] = (uint8_t)(F.axis | F.skip << 2);
+        pr->flags[i] = (uint8_t)(pr->axis[f] | pr->skip[f] << 2);
         for (int k = 0; k < 3; k++) {
-            pr->rec[i].fo[k] = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
+            pr->ids[CT_IDBLOCK * (i / CT_LEAF) + k * CT_LEAF + i % CT_LEAF]
+                = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
         }
-        pr->rec[i].face = (int32_t)f;
+        pr->order[i] = (int32_t)f;
         for (int c = 0; c < 3; c++) {
             float *blk = pr->box + CT_BLOCK * (i / CT_LEAF);
             blk[c * CT_LEAF + i % CT_LEAF] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
             blk[(3 + c) * CT_LEAF + i % CT_LEAF] = ct_f32_up(ct_max3(p0[c], p1[c], p2[c]));
         }
     }
-    pr->exact[t] += st.exact;
-    pr->failed[t] |= st.failed;
 }
 
 /* contact_scan(vertices, faces, max_pairs[, threads[, star_faces]]) -> (a, b, kind, candidates, tested, exact, complete,
@@ -4850,7 +4974,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
     CtNode *nodes = NULL;
     uint64_t *code = NULL;
     float *box = NULL;
-    CtRec *rec = NULL;
+    int32_t *order = NULL;
+    int32_t *ids = NULL;
+    size_t nodes_bytes = 0, code_bytes = 0, box_bytes = 0, order_bytes = 0, ids_bytes = 0;
     uint8_t *flags = NULL;
     int8_t *axis_out = NULL;
     uint8_t *skip_out = NULL;
@@ -4897,15 +5023,21 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         size_t mm = m > 0 ? (size_t)m : 1;
         /* leaves hold at least (CT_LEAF + 1) / 2 faces (but the root may be a smaller leaf) */
-        nodes = (CtNode *)malloc((2 * mm / ((CT_LEAF + 1) / 2) + 2) * sizeof(CtNode));
-        code = (uint64_t *)malloc(mm * sizeof(uint64_t));
         size_t n_blocks = (mm + CT_LEAF - 1) / CT_LEAF;
-        box = (float *)malloc(n_blocks * CT_BLOCK * sizeof(float));
-        rec = (CtRec *)malloc(mm * sizeof(CtRec));
+        nodes_bytes = (2 * mm / ((CT_LEAF + 1) / 2) + 2) * sizeof(CtNode);
+        code_bytes = mm * sizeof(uint64_t);
+        box_bytes = n_blocks * CT_BLOCK * sizeof(float);
+        order_bytes = mm * sizeof(int32_t);
+        ids_bytes = n_blocks * CT_IDBLOCK * sizeof(int32_t);
+        nodes = (CtNode *)ct_alloc(nodes_bytes);
+        code = (uint64_t *)ct_alloc(code_bytes);
+        box = (float *)ct_alloc(box_bytes);
+        order = (int32_t *)ct_alloc(order_bytes);
+        ids = (int32_t *)ct_alloc(ids_bytes);
         flags = (uint8_t *)malloc(mm);
         axis_out = (int8_t *)malloc(mm);
         skip_out = (uint8_t *)malloc(mm);
-        if (nodes == NULL || code == NULL || box == NULL || rec == NULL || flags == NULL
+        if (nodes == NULL || code == NULL || box == NULL || order == NULL || ids == NULL || flags == NULL
             || axis_out == NULL || skip_out == NULL) {
             PyErr_NoMemory();
             goto done;
@@ -4914,10 +5046,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
             for (int c = 0; c < 3; c++) {
                 box[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = INFINITY;
                 box[CT_BLOCK * (i / CT_LEAF) + (3 + c) * CT_LEAF + i % CT_LEAF] = -INFINITY;
+                ids[CT_IDBLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = -1;
             }
         }
         int oom = 0, failed = 0;
+        int profile = getenv("INERTIA_TOOL_CT_PROFILE") != NULL;
+        double clk[8] = {0};
         Py_BEGIN_ALLOW_THREADS
+        clk[0] = ct_clock();
         int nt = thread_count(threads, (size_t)m, 20000);
         CtPrep pr;
         memset(&pr, 0, sizeof(pr));
@@ -4929,7 +5065,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.axis = axis_out;
         pr.skip = skip_out;
         pr.box = box;
-        pr.rec = rec;
+        pr.order = order;
+        pr.ids = ids;
         pr.flags = flags;
         /* the Morton grid: box centres of the faces, 2^16 cells per axis over their range */
         double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -4947,17 +5084,20 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         pr.pass = 0;
         run_parallel(nt, ct_prep_task, &pr);
+        clk[1] = ct_clock();
         if (ct_radix_sort(code, m) < 0) {
             oom = 1;
         }
         else {
+            clk[2] = ct_clock();
             pr.pass = 1;
             run_parallel(nt, ct_prep_task, &pr);
+            clk[3] = ct_clock();
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
                 failed |= pr.failed[t];
             }
-            free(code);                     /* rec holds the face indices in hierarchy order */
+            ct_free(code, code_bytes);      /* order holds the face indices in hierarchy order */
             code = NULL;
         }
         if (!oom && !failed && m >= 2 && star_faces > 0) {
@@ -4968,21 +5108,24 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 oom = 1;
             }
         }
+        clk[4] = ct_clock();
         if (!oom && !failed && m >= 2) {
-            ct_build(nodes, box, rec, cert, m);
+            ct_build(nodes, box, ids, cert, m);
             if (cert != NULL) {
                 for (int64_t i = 0; i < m; i++) {
                     unsigned b = 0;
                     for (int c = 0; c < 3; c++) {
-                        uint8_t k = cert[rec[i].fo[c]];
+                        uint8_t k = cert[ct_id(ids, i, c)];
                         b |= k == CT_STAR_BIG ? 8u << c : k == CT_STAR_SMALL_CERT ? 1u << c : 0u;
                     }
                     stars[i] = (uint8_t)b;
                 }
             }
+            clk[5] = ct_clock();
             sc.stars = cert != NULL ? stars : NULL;
             sc.BOX = box;
-            sc.rec = rec;
+            sc.order = order;
+            sc.ids = ids;
             sc.flags = flags;
             sc.V = V;
             sc.nodes = nodes;
@@ -5008,6 +5151,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
                     CtScan *u = &scans[t];
                     if (t > 0) {
                         sc.candidates += u->candidates;
+                        sc.node_pairs += u->node_pairs;
+                        sc.leaf_pairs += u->leaf_pairs;
+                        sc.loads += u->loads;
                         sc.tested += u->tested;
                         sc.exact += u->exact;
                         sc.oom |= u->oom;
@@ -5028,7 +5174,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
         }
         oom |= sc.oom;
+        clk[6] = ct_clock();
         Py_END_ALLOW_THREADS
+        if (profile) {
+            fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars %.4f build %.4f "
+                    "traverse %.4f s; candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld\n",
+                    (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[4] - clk[3], clk[5] - clk[4],
+                    clk[6] - clk[5], sc.candidates, sc.tested, sc.node_pairs, sc.leaf_pairs, sc.loads);
+        }
         if (oom) {
             PyErr_NoMemory();
             goto done;
@@ -5057,10 +5210,11 @@ done:
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
     }
-    free(nodes);
-    free(code);
-    free(box);
-    free(rec);
+    ct_free(nodes, nodes_bytes);
+    ct_free(code, code_bytes);
+    ct_free(box, box_bytes);
+    ct_free(order, order_bytes);
+    ct_free(ids, ids_bytes);
     free(flags);
     free(axis_out);
     free(skip_out);
