@@ -4030,12 +4030,24 @@ ct_f32_up(double x)
     return (double)f < x ? ct_f32_next_up(f) : f;
 }
 
+/* A node of the hierarchy in 32 bytes (two to a cache line): its box, its children or its block, and apex. */
 typedef struct {
     float lo[3], hi[3];
-    int64_t start, count;       /* leaf: positions start .. start+count; inner: count = 0 */
-    int64_t left, right;
-    int64_t apex;               /* a certified star vertex (ct_stars) of every face below, else -1 */
+    int32_t link;               /* inner: the left child (the right one is link + 1); leaf: -1 - its block */
+    int32_t apex;               /* a certified star vertex (ct_stars) of every face below, else -1 */
 } CtNode;
+
+#define CT_IS_LEAF(nd) ((nd)->link < 0)
+#define CT_BLOCK_OF(nd) ((int64_t)(-1 - (int64_t)(nd)->link))      /* a leaf's block: positions CT_LEAF b .. */
+#define CT_LEFT(nd) ((int64_t)(nd)->link)
+#define CT_RIGHT(nd) ((int64_t)(nd)->link + 1)
+
+static inline int
+ct_leaf_count(const CtNode *nd, int64_t m)     /* faces in a leaf: its block's, the last one may be short */
+{
+    int64_t start = CT_LEAF * CT_BLOCK_OF(nd);
+    return (int)(m - start < CT_LEAF ? m - start : CT_LEAF);
+}
 
 typedef struct {
     int64_t *a, *b;
@@ -4080,17 +4092,14 @@ ct_spread(uint64_t v)
 }
 
 /* key[i] = code << 31 | i (a 33-bit Morton code above a 31-bit face index) sorted by code, stable (LSD radix
- * sort, three passes of 11 bits over the code): the face indices in hierarchy order are then key & (2^31 - 1).
- * One 8-byte word per face moves, not a code and an index.  -1 when out of memory. */
+ * sort, three passes of 11 bits over the code, key2 m words of scratch): the face indices in hierarchy order
+ * are then key & (2^31 - 1).  One 8-byte word per face moves, not a code and an index.  -1 when out of
+ * memory. */
 static int
-ct_radix_sort(uint64_t *key, int64_t m)
+ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m)
 {
-    size_t mm = m > 0 ? (size_t)m : 1;
-    uint64_t *key2 = (uint64_t *)ct_alloc(mm * sizeof(uint64_t));
     size_t (*count)[2048] = (size_t (*)[2048])calloc(3, sizeof(*count));
-    if (key2 == NULL || count == NULL) {
-        ct_free(key2, mm * sizeof(uint64_t));
-        free(count);
+    if (count == NULL) {
         return -1;
     }
     for (int64_t i = 0; i < m; i++) {
@@ -4110,7 +4119,6 @@ ct_radix_sort(uint64_t *key, int64_t m)
         uint64_t *t = src; src = dst; dst = t;
     }
     memcpy(key, src, (size_t)m * sizeof(uint64_t));  /* three passes: the result is in key2 */
-    ct_free(key2, mm * sizeof(uint64_t));
     free(count);
     return 0;
 }
@@ -4288,12 +4296,30 @@ done:
 /* The stars of vertices ranges of ct_stars, certified on threads (each vertex's result is its own). */
 typedef struct {
     const double *V;
-    const int64_t *off;         /* start of each kept vertex's link range, -1 for the others */
-    const int32_t *link;
+    const void *F;
+    int fsize;
+    const int64_t *off;         /* start of each kept vertex's range of faces, -1 for the others */
+    const int32_t *faces;       /* the faces holding each kept vertex, vertex after vertex */
     int64_t n, total, min_faces, big_faces;
     uint8_t *cert;
     int oom[MAX_THREADS];
 } CtStarJob;
+
+/* The link edges of v (corners after and before v in each of its k faces) into link (2 k int32). */
+static inline void
+ct_star_link(const CtStarJob *jb, int32_t v, const int32_t *faces, int64_t k, int32_t *link)
+{
+    for (int64_t i = 0; i < k; i++) {
+        size_t g = 3 * (size_t)faces[i];
+        int64_t x0 = index_at(jb->F, jb->fsize, g), x1 = index_at(jb->F, jb->fsize, g + 1);
+        int64_t x2 = index_at(jb->F, jb->fsize, g + 2);
+        /* v's first corner in the face: a face holding v twice gets a link edge holding v (rejected) */
+        int c = x0 == v ? 0 : x1 == v ? 1 : 2;
+        int64_t nx = c == 0 ? x1 : c == 1 ? x2 : x0, pv = c == 0 ? x2 : c == 1 ? x0 : x1;
+        link[2 * i] = (int32_t)nx;
+        link[2 * i + 1] = (int32_t)pv;
+    }
+}
 
 static void
 ct_star_task(void *ctx, int t, int nt)
@@ -4307,7 +4333,14 @@ ct_star_task(void *ctx, int t, int nt)
         int64_t w = v + 1;
         while (w < jb->n && jb->off[w] < 0) w++;
         int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total;
-        int r = ct_star_certify(jb->V, (int32_t)v, jb->link + 2 * s, e - s);
+        int32_t small[2 * CT_STAR_SMALL];
+        int32_t *link = e - s <= CT_STAR_SMALL ? small : (int32_t *)malloc((size_t)(2 * (e - s)) * sizeof(int32_t));
+        int r = -1;
+        if (link != NULL) {
+            ct_star_link(jb, (int32_t)v, jb->faces + s, e - s, link);
+            r = ct_star_certify(jb->V, (int32_t)v, link, e - s);
+            if (link != small) free(link);
+        }
         if (r < 0) {
             jb->oom[t] = 1;
             return;
@@ -4317,17 +4350,25 @@ ct_star_task(void *ctx, int t, int nt)
     }
 }
 
+/* Bytes of scratch ct_stars needs for n vertices and m faces (it takes its arrays from the caller's). */
+static inline size_t
+ct_stars_scratch(int64_t n, int64_t m)
+{
+    return (size_t)(n > 0 ? n : 1) * sizeof(int64_t) + 3 * (size_t)(m > 0 ? m : 1) * sizeof(int32_t);
+}
+
 /* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
- * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory. */
+ * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory.
+ * scratch: ct_stars_scratch(n, m) bytes, any content (the memory of the preparation's sort, reused). */
 static int
 ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
-         uint8_t *cert, int threads)
+         uint8_t *cert, int threads, void *scratch)
 {
     memset(cert, 0, (size_t)n);
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
-    int64_t *off = (int64_t *)ct_alloc(off_bytes);
-    if (off == NULL) return -1;
-    memset(off, 0, off_bytes);                             /* arena_alloc zeroes only on Linux */
+    int64_t *off = (int64_t *)scratch;
+    int32_t *faces = (int32_t *)((char *)scratch + off_bytes);
+    memset(off, 0, off_bytes);
     for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
     int64_t total = 0;
     for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
@@ -4339,26 +4380,20 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
             off[v] = -1;
         }
     }
-    size_t link_bytes = (size_t)(total > 0 ? 2 * total : 1) * sizeof(int32_t);
-    int32_t *link = (int32_t *)ct_alloc(link_bytes);
-    if (link == NULL) {
-        ct_free(off, off_bytes);
-        return -1;
-    }
     for (int64_t f = 0; f < m; f++) {
         for (int c = 0; c < 3; c++) {
             int64_t v = index_at(F, fsize, 3 * (size_t)f + (size_t)c);
             if (off[v] < 0) continue;
-            int64_t at = --off[v];
-            link[2 * at] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 1) % 3));
-            link[2 * at + 1] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 2) % 3));
+            faces[--off[v]] = (int32_t)f;           /* a face holding v twice is listed twice (then rejected) */
         }
     }
     CtStarJob jb;
     memset(&jb, 0, sizeof(jb));
     jb.V = V;
+    jb.F = F;
+    jb.fsize = fsize;
     jb.off = off;
-    jb.link = link;
+    jb.faces = faces;
     jb.n = n;
     jb.total = total;
     jb.min_faces = min_faces;
@@ -4369,8 +4404,6 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
     for (int t = 0; t < MAX_THREADS; t++) {
         if (jb.oom[t]) rc = -1;
     }
-    ct_free(link, link_bytes);
-    ct_free(off, off_bytes);
     return rc;
 }
 
@@ -4486,35 +4519,36 @@ ct_popcount(unsigned x)         /* bits set in x (SWAR: no library call without 
 static int64_t
 ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cert, int64_t m)
 {
+    /* top down, halving block ranges (a parent always precedes its children, which are adjacent); while
+     * building, link holds a node's first block and apex its block count */
     int64_t n_nodes = 1;
-    nodes[0].start = 0;
-    nodes[0].count = m;
+    nodes[0].link = 0;
+    nodes[0].apex = (int32_t)((m + CT_LEAF - 1) / CT_LEAF);
     for (int64_t k = 0; k < n_nodes; k++) {
         CtNode *nd = &nodes[k];
-        if (nd->count <= CT_LEAF) {
+        int64_t b0 = nd->link, blocks = nd->apex;
+        if (blocks <= 1) {
+            nd->link = (int32_t)(-1 - b0);          /* a leaf: one block */
             continue;
         }
-        int64_t s = nd->start, e = s + nd->count, blocks = (nd->count + CT_LEAF - 1) / CT_LEAF;
-        int64_t half = s + CT_LEAF * (blocks / 2);     /* starts stay multiples of CT_LEAF */
         int64_t l = n_nodes++, r = n_nodes++;
-        nodes[l].start = s;
-        nodes[l].count = half - s;
-        nodes[r].start = half;
-        nodes[r].count = e - half;
-        nd->left = l;
-        nd->right = r;
-        nd->count = 0;
+        nodes[l].link = (int32_t)b0;
+        nodes[l].apex = (int32_t)(blocks / 2);
+        nodes[r].link = (int32_t)(b0 + blocks / 2);
+        nodes[r].apex = (int32_t)(blocks - blocks / 2);
+        nd->link = (int32_t)l;
     }
-    /* boxes, children before parents (a parent always precedes its children) */
+    /* boxes and apexes, children before parents */
     for (int64_t k = n_nodes - 1; k >= 0; k--) {
         CtNode *nd = &nodes[k];
-        if (nd->count > 0) {
-            nd->apex = ct_leaf_apex(ids, cert, nd->start, nd->count);
+        if (CT_IS_LEAF(nd)) {
+            int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
+            nd->apex = (int32_t)ct_leaf_apex(ids, cert, start, count);
             for (int c = 0; c < 3; c++) {
                 nd->lo[c] = INFINITY;
                 nd->hi[c] = -INFINITY;
             }
-            for (int64_t i = nd->start; i < nd->start + nd->count; i++) {
+            for (int64_t i = start; i < start + count; i++) {
                 for (int c = 0; c < 3; c++) {
                     float lo = ct_box_at(BOX, i, c), hi = ct_box_at(BOX, i, 3 + c);
                     if (lo < nd->lo[c]) nd->lo[c] = lo;
@@ -4523,7 +4557,7 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
             }
         }
         else {
-            const CtNode *p = &nodes[nd->left], *q = &nodes[nd->right];
+            const CtNode *p = &nodes[CT_LEFT(nd)], *q = &nodes[CT_RIGHT(nd)];
             nd->apex = p->apex == q->apex ? p->apex : -1;
             for (int c = 0; c < 3; c++) {
                 nd->lo[c] = p->lo[c] < q->lo[c] ? p->lo[c] : q->lo[c];
@@ -4541,6 +4575,7 @@ typedef struct {
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
     const double *V;            /* vertices (n, 3) */
     const CtNode *nodes;
+    int64_t m;                  /* faces */
     const uint8_t *stars;       /* certified corners per position (ct_visit), NULL without pruning */
     long long max_pairs;        /* < 0: no bound */
     long long candidates, tested;
@@ -4722,35 +4757,38 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             cap *= 2;
         }
         if (pi == qi) {
-            if (p->count > 0) {
+            if (CT_IS_LEAF(p)) {
                 sc->leaf_pairs++;
+                int64_t pstart = CT_LEAF * CT_BLOCK_OF(p);
+                int pcount = ct_leaf_count(p, sc->m);
                 CtFace leaf[CT_LEAF];
                 uint8_t have[CT_LEAF] = {0};
-                const float *blk = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
-                for (int a = 0; a + 1 < p->count; a++) {
+                const float *blk = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+                for (int a = 0; a + 1 < pcount; a++) {
                     unsigned mask = ct_block_mask(blk, blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a],
                                                   blk[3 * CT_LEAF + a], blk[4 * CT_LEAF + a], blk[5 * CT_LEAF + a]);
                     mask &= ~((2u << a) - 1);               /* the later positions j > i only */
-                    if (mask && ct_visit_block(sc, p->start + a, p->start, mask, &leaf[a], &have[a], leaf, have)) {
+                    if (mask && ct_visit_block(sc, pstart + a, pstart, mask, &leaf[a], &have[a], leaf, have)) {
                         goto out;
                     }
                 }
             }
             else {
-                stack[2 * top] = p->left; stack[2 * top + 1] = p->left; top++;
-                stack[2 * top] = p->right; stack[2 * top + 1] = p->right; top++;
-                if (ct_nodes_meet(&nodes[p->left], &nodes[p->right])) {
-                    stack[2 * top] = p->left; stack[2 * top + 1] = p->right; top++;
+                stack[2 * top] = CT_LEFT(p); stack[2 * top + 1] = CT_LEFT(p); top++;
+                stack[2 * top] = CT_RIGHT(p); stack[2 * top + 1] = CT_RIGHT(p); top++;
+                if (ct_nodes_meet(&nodes[CT_LEFT(p)], &nodes[CT_RIGHT(p)])) {
+                    stack[2 * top] = CT_LEFT(p); stack[2 * top + 1] = CT_RIGHT(p); top++;
                 }
             }
             continue;
         }
-        if (p->count > 0 && q->count > 0) {
+        if (CT_IS_LEAF(p) && CT_IS_LEAF(q)) {
             sc->leaf_pairs++;
+            int64_t pstart = CT_LEAF * CT_BLOCK_OF(p), qstart = CT_LEAF * CT_BLOCK_OF(q);
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
-            const float *pb = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
-            const float *qb = sc->BOX + CT_BLOCK * (q->start / CT_LEAF);
+            const float *pb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+            const float *qb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(q);
             /* p's faces against q's box first, then each that meets it against q's faces */
             unsigned pmask = ct_block_mask(pb, q->lo[0], q->lo[1], q->lo[2], q->hi[0], q->hi[1], q->hi[2]);
             while (pmask) {
@@ -4760,13 +4798,13 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                                               pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]);
                 CtFace FI;
                 uint8_t have_i = 0;
-                if (mask && ct_visit_block(sc, p->start + a, q->start, mask, &FI, &have_i, leaf, have)) goto out;
+                if (mask && ct_visit_block(sc, pstart + a, qstart, mask, &FI, &have_i, leaf, have)) goto out;
             }
             continue;
         }
-        if (p->count == 0 && q->count == 0) {
+        if (!CT_IS_LEAF(p) && !CT_IS_LEAF(q)) {
             /* both inner: descend both at once (the four child pairs that meet) */
-            const int64_t pc[2] = {p->left, p->right}, qc[2] = {q->left, q->right};
+            const int64_t pc[2] = {CT_LEFT(p), CT_RIGHT(p)}, qc[2] = {CT_LEFT(q), CT_RIGHT(q)};
             for (int u = 1; u >= 0; u--) {
                 for (int w = 1; w >= 0; w--) {
                     if (ct_nodes_meet(&nodes[pc[u]], &nodes[qc[w]])) {
@@ -4777,23 +4815,23 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             continue;
         }
         /* descend the inner node; push only children that meet */
-        int split_p = q->count > 0 || (p->count == 0 && (p->hi[0] - p->lo[0]) + (p->hi[1] - p->lo[1])
+        int split_p = CT_IS_LEAF(q) || (!CT_IS_LEAF(p) && (p->hi[0] - p->lo[0]) + (p->hi[1] - p->lo[1])
                                         + (p->hi[2] - p->lo[2]) >= (q->hi[0] - q->lo[0])
                                         + (q->hi[1] - q->lo[1]) + (q->hi[2] - q->lo[2]));
         if (split_p) {
-            if (ct_nodes_meet(&nodes[p->right], q)) {
-                stack[2 * top] = p->right; stack[2 * top + 1] = qi; top++;
+            if (ct_nodes_meet(&nodes[CT_RIGHT(p)], q)) {
+                stack[2 * top] = CT_RIGHT(p); stack[2 * top + 1] = qi; top++;
             }
-            if (ct_nodes_meet(&nodes[p->left], q)) {
-                stack[2 * top] = p->left; stack[2 * top + 1] = qi; top++;
+            if (ct_nodes_meet(&nodes[CT_LEFT(p)], q)) {
+                stack[2 * top] = CT_LEFT(p); stack[2 * top + 1] = qi; top++;
             }
         }
         else {
-            if (ct_nodes_meet(p, &nodes[q->right])) {
-                stack[2 * top] = pi; stack[2 * top + 1] = q->right; top++;
+            if (ct_nodes_meet(p, &nodes[CT_RIGHT(q)])) {
+                stack[2 * top] = pi; stack[2 * top + 1] = CT_RIGHT(q); top++;
             }
-            if (ct_nodes_meet(p, &nodes[q->left])) {
-                stack[2 * top] = pi; stack[2 * top + 1] = q->left; top++;
+            if (ct_nodes_meet(p, &nodes[CT_LEFT(q)])) {
+                stack[2 * top] = pi; stack[2 * top + 1] = CT_LEFT(q); top++;
             }
         }
     }
@@ -4839,21 +4877,21 @@ ct_tasks(const CtNode *nodes, int64_t *tasks)
         for (int32_t k = 0; k < n; k++) {
             int64_t pi = tasks[2 * k], qi = tasks[2 * k + 1];
             const CtNode *p = &nodes[pi], *q = &nodes[qi];
-            if (pi == qi && p->count == 0) {
-                int64_t add[3][2] = {{p->left, p->left}, {p->right, p->right}, {p->left, p->right}};
+            if (pi == qi && !CT_IS_LEAF(p)) {
+                int64_t add[3][2] = {{CT_LEFT(p), CT_LEFT(p)}, {CT_RIGHT(p), CT_RIGHT(p)}, {CT_LEFT(p), CT_RIGHT(p)}};
                 for (int j = 0; j < 3; j++) {
-                    if (j == 2 && !ct_nodes_meet(&nodes[p->left], &nodes[p->right])) continue;
+                    if (j == 2 && !ct_nodes_meet(&nodes[CT_LEFT(p)], &nodes[CT_RIGHT(p)])) continue;
                     next[2 * m] = add[j][0];
                     next[2 * m + 1] = add[j][1];
                     m++;
                 }
             }
-            else if (pi != qi && p->count == 0) {
-                if (ct_nodes_meet(&nodes[p->left], q)) {
-                    next[2 * m] = p->left; next[2 * m + 1] = qi; m++;
+            else if (pi != qi && !CT_IS_LEAF(p)) {
+                if (ct_nodes_meet(&nodes[CT_LEFT(p)], q)) {
+                    next[2 * m] = CT_LEFT(p); next[2 * m + 1] = qi; m++;
                 }
-                if (ct_nodes_meet(&nodes[p->right], q)) {
-                    next[2 * m] = p->right; next[2 * m + 1] = qi; m++;
+                if (ct_nodes_meet(&nodes[CT_RIGHT(p)], q)) {
+                    next[2 * m] = CT_RIGHT(p); next[2 * m + 1] = qi; m++;
                 }
             }
             else {
@@ -5022,10 +5060,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
             goto done;
         }
         size_t mm = m > 0 ? (size_t)m : 1;
-        /* leaves hold at least (CT_LEAF + 1) / 2 faces (but the root may be a smaller leaf) */
         size_t n_blocks = (mm + CT_LEAF - 1) / CT_LEAF;
-        nodes_bytes = (2 * mm / ((CT_LEAF + 1) / 2) + 2) * sizeof(CtNode);
-        code_bytes = mm * sizeof(uint64_t);
+        nodes_bytes = (2 * n_blocks + 1) * sizeof(CtNode);     /* a leaf per block: 2 n_blocks - 1 nodes */
+        /* the sort's keys and scratch (2 m words), then the stars' arrays, in one mapping */
+        code_bytes = 2 * mm * sizeof(uint64_t);
+        if (ct_stars_scratch(n, m) > code_bytes) code_bytes = ct_stars_scratch(n, m);
         box_bytes = n_blocks * CT_BLOCK * sizeof(float);
         order_bytes = mm * sizeof(int32_t);
         ids_bytes = n_blocks * CT_IDBLOCK * sizeof(int32_t);
@@ -5085,7 +5124,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.pass = 0;
         run_parallel(nt, ct_prep_task, &pr);
         clk[1] = ct_clock();
-        if (ct_radix_sort(code, m) < 0) {
+        if (ct_radix_sort(code, code + mm, m) < 0) {
             oom = 1;
         }
         else {
@@ -5097,14 +5136,13 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 sc.exact += pr.exact[t];
                 failed |= pr.failed[t];
             }
-            ct_free(code, code_bytes);      /* order holds the face indices in hierarchy order */
-            code = NULL;
+            /* order holds the face indices in hierarchy order: code's memory is the stars' scratch now */
         }
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
             stars = (uint8_t *)malloc(mm);
             if (cert == NULL || stars == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
-                                         star_faces, cert, nt) < 0) {
+                                         star_faces, cert, nt, code) < 0) {
                 oom = 1;
             }
         }
@@ -5129,6 +5167,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             sc.flags = flags;
             sc.V = V;
             sc.nodes = nodes;
+            sc.m = m;
             if (max_pairs >= 0) nt = 1;
             if (nt == 1) {
                 ct_traverse(&sc, 0, 0);
