@@ -3682,7 +3682,8 @@ typedef struct {
     int64_t fo[3];              /* corner indices */
     int64_t face;               /* index in the caller's faces */
     int32_t axis;               /* projection axis of the coplanar tests (mesh/intersect._face_axes) */
-    int32_t skip;               /* zero area: skipped */
+    int16_t skip;               /* zero area: skipped */
+    int16_t has_n;              /* n and na computed (ct_face_normal: only when a side test needs them) */
 } CtFace;
 
 /* Sign of orient3d(t0, t1, t2, x) for the corners t of face F (the side of x on F's plane) when the float
@@ -3700,14 +3701,6 @@ ct_side_filter(const CtFace *F, const double *x)
         return det > 0 ? -1 : 1;
     }
     return 2;
-}
-
-/* The same, always decided (exact stage when the filter cannot). */
-static inline int
-ct_side(const CtFace *F, const double *x, CtStats *st)
-{
-    int s = ct_side_filter(F, x);
-    return s != 2 ? s : ct_orient3d_exact(F->t, F->t + 3, F->t + 6, x, st);
 }
 
 /* Sign of orient2d of the projections of a, b, c along axis k (the coordinates ct_plane[k] kept). */
@@ -3775,18 +3768,29 @@ ct_projections_separate(const double *const t1[3], const double *const t2[3], co
     return 0;
 }
 
-/* Fills F from corners p0, p1, p2 (the normal, its permanent, the projection axis, the zero-area flag). */
+/* Fills F's corners from p0, p1, p2 (its normal is computed when first needed, ct_face_normal). */
 static inline void
 ct_face_geometry(CtFace *F, const double *p0, const double *p1, const double *p2)
 {
-    double e1[3], e2[3];
     for (int c = 0; c < 3; c++) {
         F->t[c] = p0[c];
         F->t[3 + c] = p1[c];
         F->t[6 + c] = p2[c];
-        e1[c] = p1[c] - p0[c];
-        e2[c] = p2[c] - p0[c];
     }
+    F->has_n = 0;
+}
+
+/* F's float normal n = (t1 - t0) x (t2 - t0) and its permanent na, once. */
+static inline void
+ct_face_normal(CtFace *F)
+{
+    if (F->has_n) return;
+    double e1[3], e2[3];
+    for (int c = 0; c < 3; c++) {
+        e1[c] = F->t[3 + c] - F->t[c];
+        e2[c] = F->t[6 + c] - F->t[c];
+    }
+    F->has_n = 1;
     F->n[0] = e1[1] * e2[2] - e1[2] * e2[1];
     F->n[1] = e1[2] * e2[0] - e1[0] * e2[2];
     F->n[2] = e1[0] * e2[1] - e1[1] * e2[0];
@@ -3806,7 +3810,7 @@ ct_face_axis(const double *p0, const double *p1, const double *p2, int *skip, Ct
         e1[c] = p1[c] - p0[c];
         e2[c] = p2[c] - p0[c];
     }
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];         /* the arithmetic of ct_face_geometry */
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];         /* the arithmetic of ct_face_normal */
     n[1] = e1[2] * e2[0] - e1[0] * e2[2];
     n[2] = e1[0] * e2[1] - e1[1] * e2[0];
     int k = 0;
@@ -3826,9 +3830,9 @@ ct_face_axis(const double *p0, const double *p1, const double *p2, int *skip, Ct
     return k % 3;
 }
 
-/* Kind of the pair of faces A, B (A the lower face index). */
+/* Kind of the pair of faces A, B (A the lower face index); computes their normals when a side test needs them. */
 static int
-ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
+ct_classify(CtFace *A, CtFace *B, CtStats *st)
 {
     const double *t1[3] = {A->t, A->t + 3, A->t + 6}, *t2[3] = {B->t, B->t + 3, B->t + 6};
     int on1[3] = {0, 0, 0}, on2[3] = {0, 0, 0}, n_shared = 0;
@@ -3842,6 +3846,7 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
     }
     int d1[3], d2[3];
     int any1 = 0, unsure = 0, separate_tried = 0;
+    ct_face_normal(B);
     for (int i = 0; i < 3; i++) {
         d1[i] = on1[i] ? 0 : ct_side_filter(B, t1[i]);
         unsure |= d1[i] == 2;
@@ -3872,6 +3877,7 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
         return CT_NONE;
     }
     unsure = 0;
+    ct_face_normal(A);
     for (int j = 0; j < 3; j++) {
         d2[j] = on2[j] ? 0 : ct_side_filter(A, t2[j]);
         unsure |= d2[j] == 2;
@@ -4215,6 +4221,37 @@ ct_star_turns(const double *V, int32_t v, const int32_t *ring, int64_t k, int cl
 /* Stars of at most this many faces are matched on the stack by comparing link vertices pairwise (no sort). */
 #define CT_STAR_SMALL 32
 
+/* The ring of a closed fan whose faces are consistently oriented (each link edge (x, y) followed by the one
+ * starting at y), the common case of a closed manifold's vertex: 1 and ring r_0 .. r_k (r_k = r_0) when
+ * following the link edges from the first one uses each face once, returns to r_0 after the k-th and meets k
+ * distinct ring vertices, none v; else 0 (then ct_star_ring decides).  When it returns 1, ct_star_ring finds
+ * the same cycle (every ring vertex is in exactly two link edges, no link edge is degenerate), so the
+ * certificate (ct_star_turns, invariant under the cycle's starting point and direction) is the same. */
+static int
+ct_star_ring_oriented(int32_t v, const int32_t *link, int64_t k, int32_t *ring)
+{
+    if (k < 1) return 0;
+    uint64_t used = 1;                                     /* k <= CT_STAR_SMALL <= 64 faces */
+    ring[0] = link[0];
+    ring[1] = link[1];
+    for (int64_t len = 2; len <= k; len++) {
+        int32_t at = ring[len - 1];
+        int64_t j = 0;
+        while (j < k && (((used >> j) & 1u) || link[2 * j] != at)) j++;
+        if (j == k) return 0;
+        used |= (uint64_t)1 << j;
+        ring[len] = link[2 * j + 1];
+    }
+    if (ring[k] != ring[0]) return 0;
+    for (int64_t i = 0; i < k; i++) {
+        if (ring[i] == v) return 0;
+        for (int64_t j = i + 1; j < k; j++) {
+            if (ring[i] == ring[j]) return 0;
+        }
+    }
+    return 1;
+}
+
 /* 1 when the star of v (link edges link[0 .. k-1], pairs of vertex ids) is certified, 0 when not, -1 when out
  * of memory. */
 static int
@@ -4223,6 +4260,9 @@ ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
     int closed = 0;
     if (k <= CT_STAR_SMALL) {                              /* the common case: everything on the stack */
         int32_t partner[2 * CT_STAR_SMALL], ring[CT_STAR_SMALL + 1];
+        if (ct_star_ring_oriented(v, link, k, ring)) {
+            return ct_star_turns(V, v, ring, k, 1);
+        }
         uint64_t ends[2 * CT_STAR_SMALL];                  /* vertex id << 32 | slot, insertion-sorted */
         int64_t free_slot = -1, n_free = 0;
         for (int64_t s = 0; s < 2 * k; s++) {
@@ -4586,7 +4626,7 @@ typedef struct {
 } CtScan;
 
 /* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
- * (the arithmetic of ct_face_geometry), its corner indices, and the axis and zero-area flag ct_face_axis
+ * (the arithmetic of ct_face_normal, when first needed), its corner indices, and the axis and zero-area flag ct_face_axis
  * gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
  * when a box meets its (16 + 1 bytes per face instead). */
 static inline void
@@ -4628,9 +4668,9 @@ ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFa
     sc->candidates++;
     if (FI->skip || FJ->skip) return 0;
     sc->tested++;
-    const CtFace *A = FI, *B = FJ;
+    CtFace *A = FI, *B = FJ;
     if (A->face > B->face) {
-        const CtFace *T = A;
+        CtFace *T = A;
         A = B;
         B = T;
     }
