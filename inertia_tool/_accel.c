@@ -4043,6 +4043,9 @@ typedef struct {
     int32_t apex;               /* a certified star vertex (ct_stars) of every face below, else -1 */
 } CtNode;
 
+/* The root is node 1 (node 0 is unused), so that every left child has an even index and shares its 64-byte
+ * line with its sibling (the nodes are page-aligned): a pair of children is one cache line. */
+#define CT_ROOT 1
 #define CT_IS_LEAF(nd) ((nd)->link < 0)
 #define CT_BLOCK_OF(nd) ((int64_t)(-1 - (int64_t)(nd)->link))      /* a leaf's block: positions CT_LEAF b .. */
 #define CT_LEFT(nd) ((int64_t)(nd)->link)
@@ -4470,12 +4473,6 @@ ct_leaf_apex(const int32_t *ids, const uint8_t *cert, int64_t s, int64_t count)
  * of the hierarchy is one block, so a face is tested against a whole leaf's boxes at once (ct_block_mask). */
 #define CT_BLOCK (6 * CT_LEAF)
 
-static inline float
-ct_box_at(const float *BOX, int64_t i, int c)     /* c 0..2: lo, 3..5: hi */
-{
-    return BOX[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF];
-}
-
 static inline int
 ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
 {
@@ -4561,10 +4558,11 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
 {
     /* top down, halving block ranges (a parent always precedes its children, which are adjacent); while
      * building, link holds a node's first block and apex its block count */
-    int64_t n_nodes = 1;
-    nodes[0].link = 0;
-    nodes[0].apex = (int32_t)((m + CT_LEAF - 1) / CT_LEAF);
-    for (int64_t k = 0; k < n_nodes; k++) {
+    int64_t n_nodes = CT_ROOT + 1;
+    memset(&nodes[0], 0, sizeof(CtNode));
+    nodes[CT_ROOT].link = 0;
+    nodes[CT_ROOT].apex = (int32_t)((m + CT_LEAF - 1) / CT_LEAF);
+    for (int64_t k = CT_ROOT; k < n_nodes; k++) {
         CtNode *nd = &nodes[k];
         int64_t b0 = nd->link, blocks = nd->apex;
         if (blocks <= 1) {
@@ -4579,21 +4577,34 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
         nd->link = (int32_t)l;
     }
     /* boxes and apexes, children before parents */
-    for (int64_t k = n_nodes - 1; k >= 0; k--) {
+    for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
         CtNode *nd = &nodes[k];
         if (CT_IS_LEAF(nd)) {
             int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
             nd->apex = (int32_t)ct_leaf_apex(ids, cert, start, count);
+            /* the whole block: its empty positions (lo +inf, hi -inf) change no minimum or maximum */
+            const float *blk = BOX + CT_BLOCK * CT_BLOCK_OF(nd);
             for (int c = 0; c < 3; c++) {
+#if defined(__SSE2__) && CT_LEAF % 4 == 0
+                __m128 lo = _mm_loadu_ps(blk + c * CT_LEAF), hi = _mm_loadu_ps(blk + (3 + c) * CT_LEAF);
+                for (int q = 4; q < CT_LEAF; q += 4) {
+                    lo = _mm_min_ps(lo, _mm_loadu_ps(blk + c * CT_LEAF + q));
+                    hi = _mm_max_ps(hi, _mm_loadu_ps(blk + (3 + c) * CT_LEAF + q));
+                }
+                lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(1, 0, 3, 2)));
+                lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(2, 3, 0, 1)));
+                hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(1, 0, 3, 2)));
+                hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(2, 3, 0, 1)));
+                nd->lo[c] = _mm_cvtss_f32(lo);
+                nd->hi[c] = _mm_cvtss_f32(hi);
+#else
                 nd->lo[c] = INFINITY;
                 nd->hi[c] = -INFINITY;
-            }
-            for (int64_t i = start; i < start + count; i++) {
-                for (int c = 0; c < 3; c++) {
-                    float lo = ct_box_at(BOX, i, c), hi = ct_box_at(BOX, i, 3 + c);
-                    if (lo < nd->lo[c]) nd->lo[c] = lo;
-                    if (hi > nd->hi[c]) nd->hi[c] = hi;
+                for (int j = 0; j < CT_LEAF; j++) {
+                    if (blk[c * CT_LEAF + j] < nd->lo[c]) nd->lo[c] = blk[c * CT_LEAF + j];
+                    if (blk[(3 + c) * CT_LEAF + j] > nd->hi[c]) nd->hi[c] = blk[(3 + c) * CT_LEAF + j];
                 }
+#endif
             }
         }
         else {
@@ -4910,7 +4921,7 @@ static int32_t
 ct_tasks(const CtNode *nodes, int64_t *tasks)
 {
     int32_t n = 1;
-    tasks[0] = tasks[1] = 0;
+    tasks[0] = tasks[1] = CT_ROOT;
     for (int round = 0; round < 16 && n < CT_TASKS / 4; round++) {
         int64_t next[2 * CT_TASKS];
         int32_t m = 0;
@@ -5101,7 +5112,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         size_t mm = m > 0 ? (size_t)m : 1;
         size_t n_blocks = (mm + CT_LEAF - 1) / CT_LEAF;
-        nodes_bytes = (2 * n_blocks + 1) * sizeof(CtNode);     /* a leaf per block: 2 n_blocks - 1 nodes */
+        nodes_bytes = (2 * n_blocks + 1) * sizeof(CtNode);     /* a leaf per block: 2 n_blocks - 1 nodes, from 1 */
         /* the sort's keys and scratch (2 m words), then the stars' arrays, in one mapping */
         code_bytes = 2 * mm * sizeof(uint64_t);
         if (ct_stars_scratch(n, m) > code_bytes) code_bytes = ct_stars_scratch(n, m);
@@ -5210,7 +5221,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             sc.m = m;
             if (max_pairs >= 0) nt = 1;
             if (nt == 1) {
-                ct_traverse(&sc, 0, 0);
+                ct_traverse(&sc, CT_ROOT, CT_ROOT);
             }
             else {
                 CtScan scans[MAX_THREADS];
