@@ -16,54 +16,31 @@ the check, the candidate pairs per face and the predicate evaluations the float 
 arithmetic.  ``INERTIA_TOOL_NO_ACCEL=1`` runs both on their numpy paths; ``INERTIA_TOOL_THREADS`` sets the
 C kernels' threads.
 
-``--shape cylinder`` builds instead a closed cylinder of about ``size`` triangles (``size/4`` sections) with
+``--shape wheel`` analyses instead a real-ish CAD part, ``meshes/unbalanced_wheel.stl`` midpoint-subdivided to
+at least ``size`` faces (4,332 · 4^k: 1.1M for 1e6; flat faces, fan caps, slivers).  ``--shape cylinder`` builds
+instead a closed cylinder of about ``size`` triangles (``size/4`` sections) with
 fan-triangulated caps around a centre vertex, as CAD exports them: every cap face shares the centre, so the
 unpruned scan has about ``size²/16`` candidate pairs; ``--unpruned`` runs the check without the certified-star
 pruning (``_star_faces=0``, module docstring of ``mesh/intersect.py``, "Stars"), the scan as it was before.
 
-    python benchmarks/bench_intersect.py [--sizes 1e4 1e5 1e6] [--repeat 5] [--shape cylinder] [--unpruned]
+The builders are in ``benchmarks/_shapes.py``.  ``INERTIA_TOOL_CT_PROFILE=1`` makes the C scan print the CPU
+time of its stages (Morton codes, sort, preparation, stars, hierarchy, traversal) to stderr.
+
+    python benchmarks/bench_intersect.py [--sizes 1e4 1e5 1e6] [--repeat 5] [--shape cylinder|wheel] [--unpruned]
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
+import sys
 import time
 import warnings
 
-import numpy as np
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-
-def torus(n_faces: float, major: float = 1.0, minor: float = 0.35) -> tuple[np.ndarray, np.ndarray]:
-    """A closed torus grid of about ``n_faces`` triangles (n around the axis, n/2 around the tube)."""
-    n = max(8, int(round(np.sqrt(n_faces))))
-    k = max(4, n // 2)
-    u = 2 * np.pi * np.arange(n) / n
-    w = 2 * np.pi * np.arange(k) / k + 0.1234      # off the coordinate planes: no accidental symmetry
-    uu, ww = np.meshgrid(u, w, indexing="ij")
-    r = major + minor * np.cos(ww)
-    v = np.stack([r * np.cos(uu), r * np.sin(uu), minor * np.sin(ww)], axis=-1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(n), np.arange(k), indexing="ij")
-    a = i * k + j
-    b = ((i + 1) % n) * k + j
-    c = ((i + 1) % n) * k + (j + 1) % k
-    d = i * k + (j + 1) % k
-    f = np.r_[np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)]
-    return v, f
-
-
-def cylinder(n_faces: float, radius: float = 1.0, height: float = 2.0) -> tuple[np.ndarray, np.ndarray]:
-    """A closed cylinder of about ``n_faces`` triangles (``n_faces/4`` sections), fan caps round a centre."""
-    n = max(8, int(round(n_faces / 4)))
-    t = 2 * np.pi * np.arange(n) / n
-    ring = np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
-    v = np.concatenate([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, height)], [[0, 0, 0], [0, 0, height]]])
-    i = np.arange(n)
-    j = (i + 1) % n
-    bottom, top = np.full(n, 2 * n), np.full(n, 2 * n + 1)
-    f = np.concatenate([np.stack([bottom, j, i], 1), np.stack([top, n + i, n + j], 1),
-                        np.stack([i, j, n + j], 1), np.stack([i, n + j, n + i], 1)])
-    return v, f
+from _shapes import SHAPES  # noqa: E402  (benchmarks/ is not a package)
 
 
 def medians(fn, repeat: int) -> tuple[float, float, object]:
@@ -82,7 +59,7 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", nargs="+", type=float, default=[1e4, 1e5, 1e6])
     parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--shape", choices=["torus", "cylinder"], default="torus")
+    parser.add_argument("--shape", choices=sorted(SHAPES), default="torus")
     parser.add_argument("--unpruned", action="store_true", help="no certified-star pruning (the scan before it)")
     args = parser.parse_args(argv)
     import functools
@@ -115,7 +92,7 @@ def main(argv=None) -> None:
     print(f"{'faces':>10} | {'check cpu':>9} {'wall':>6} | {'analysis cpu':>12} {'wall':>6} | {'rest cpu':>8} "
           f"{'wall':>6} | {'ratio cpu':>9} {'wall':>5} | {'ns/face':>7} {'pairs/face':>10} {'exact':>6} found")
     for size in args.sizes:
-        v, f = (torus if args.shape == "torus" else cylinder)(size)
+        v, f = SHAPES[args.shape](size)
         c_check, t_check, res = medians(lambda: surface_contacts(v, f), args.repeat)
         cpus, walls, rest_c, rest_t = [], [], [], []
         for _ in range(args.repeat):

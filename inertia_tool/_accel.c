@@ -3333,6 +3333,25 @@ done:
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
+
+/* Stage timing of contact_scan for profiling: with INERTIA_TOOL_CT_PROFILE set in the environment each call
+ * prints the CPU time (all threads) of its stages (preparation, sort, stars, build, traversal) to stderr. */
+#if defined(__linux__) || defined(__APPLE__)
+#include <time.h>
+static double
+ct_clock(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);     /* CPU time: the machine is shared */
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+#else
+static double
+ct_clock(void)
+{
+    return 0.0;
+}
+#endif
 #define CONTACT_O3 (10.0 * 1.1102230246251565e-16)
 #define CONTACT_O2 (6.0 * 1.1102230246251565e-16)
 
@@ -3663,7 +3682,8 @@ typedef struct {
     int64_t fo[3];              /* corner indices */
     int64_t face;               /* index in the caller's faces */
     int32_t axis;               /* projection axis of the coplanar tests (mesh/intersect._face_axes) */
-    int32_t skip;               /* zero area: skipped */
+    int16_t skip;               /* zero area: skipped */
+    int16_t has_n;              /* n and na computed (ct_face_normal: only when a side test needs them) */
 } CtFace;
 
 /* Sign of orient3d(t0, t1, t2, x) for the corners t of face F (the side of x on F's plane) when the float
@@ -3681,14 +3701,6 @@ ct_side_filter(const CtFace *F, const double *x)
         return det > 0 ? -1 : 1;
     }
     return 2;
-}
-
-/* The same, always decided (exact stage when the filter cannot). */
-static inline int
-ct_side(const CtFace *F, const double *x, CtStats *st)
-{
-    int s = ct_side_filter(F, x);
-    return s != 2 ? s : ct_orient3d_exact(F->t, F->t + 3, F->t + 6, x, st);
 }
 
 /* Sign of orient2d of the projections of a, b, c along axis k (the coordinates ct_plane[k] kept). */
@@ -3756,18 +3768,29 @@ ct_projections_separate(const double *const t1[3], const double *const t2[3], co
     return 0;
 }
 
-/* Fills F from corners p0, p1, p2 (the normal, its permanent, the projection axis, the zero-area flag). */
+/* Fills F's corners from p0, p1, p2 (its normal is computed when first needed, ct_face_normal). */
 static inline void
 ct_face_geometry(CtFace *F, const double *p0, const double *p1, const double *p2)
 {
-    double e1[3], e2[3];
     for (int c = 0; c < 3; c++) {
         F->t[c] = p0[c];
         F->t[3 + c] = p1[c];
         F->t[6 + c] = p2[c];
-        e1[c] = p1[c] - p0[c];
-        e2[c] = p2[c] - p0[c];
     }
+    F->has_n = 0;
+}
+
+/* F's float normal n = (t1 - t0) x (t2 - t0) and its permanent na, once. */
+static inline void
+ct_face_normal(CtFace *F)
+{
+    if (F->has_n) return;
+    double e1[3], e2[3];
+    for (int c = 0; c < 3; c++) {
+        e1[c] = F->t[3 + c] - F->t[c];
+        e2[c] = F->t[6 + c] - F->t[c];
+    }
+    F->has_n = 1;
     F->n[0] = e1[1] * e2[2] - e1[2] * e2[1];
     F->n[1] = e1[2] * e2[0] - e1[0] * e2[2];
     F->n[2] = e1[0] * e2[1] - e1[1] * e2[0];
@@ -3776,32 +3799,40 @@ ct_face_geometry(CtFace *F, const double *p0, const double *p1, const double *p2
     F->na[2] = fabs(e1[0]) * fabs(e2[1]) + fabs(e1[1]) * fabs(e2[0]);
 }
 
-static void
-ct_face_init(CtFace *F, const double *p0, const double *p1, const double *p2, CtStats *st)
+/* The projection axis of the face p0, p1, p2 and *skip (1: zero area): the axis of the largest |normal
+ * component| of the float normal (the first of equals), then the next ones until the projected triangle has an
+ * exactly nonzero orientation (as mesh/intersect._face_axes). */
+static inline int
+ct_face_axis(const double *p0, const double *p1, const double *p2, int *skip, CtStats *st)
 {
-    ct_face_geometry(F, p0, p1, p2);
-    /* the axis of the largest |normal component| (first of equals), then the next ones until the projected
-     * triangle has an exactly nonzero orientation (as mesh/intersect._face_axes) */
+    double e1[3], e2[3], n[3];
+    for (int c = 0; c < 3; c++) {
+        e1[c] = p1[c] - p0[c];
+        e2[c] = p2[c] - p0[c];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];         /* the arithmetic of ct_face_normal */
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
     int k = 0;
     for (int c = 1; c < 3; c++) {
-        if (fabs(F->n[c]) > fabs(F->n[k])) k = c;
+        if (fabs(n[c]) > fabs(n[k])) k = c;
     }
-    F->skip = 1;
+    *skip = 1;
     for (int tries = 0; tries < 3; tries++, k = (k + 1) % 3) {
         double a[2] = {p0[ct_plane[k][0]], p0[ct_plane[k][1]]};
         double b[2] = {p1[ct_plane[k][0]], p1[ct_plane[k][1]]};
         double c[2] = {p2[ct_plane[k][0]], p2[ct_plane[k][1]]};
         if (ct_orient2d(a, b, c, st) != 0) {
-            F->skip = 0;
+            *skip = 0;
             break;
         }
     }
-    F->axis = k % 3;
+    return k % 3;
 }
 
-/* Kind of the pair of faces A, B (A the lower face index). */
+/* Kind of the pair of faces A, B (A the lower face index); computes their normals when a side test needs them. */
 static int
-ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
+ct_classify(CtFace *A, CtFace *B, CtStats *st)
 {
     const double *t1[3] = {A->t, A->t + 3, A->t + 6}, *t2[3] = {B->t, B->t + 3, B->t + 6};
     int on1[3] = {0, 0, 0}, on2[3] = {0, 0, 0}, n_shared = 0;
@@ -3815,6 +3846,7 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
     }
     int d1[3], d2[3];
     int any1 = 0, unsure = 0, separate_tried = 0;
+    ct_face_normal(B);
     for (int i = 0; i < 3; i++) {
         d1[i] = on1[i] ? 0 : ct_side_filter(B, t1[i]);
         unsure |= d1[i] == 2;
@@ -3845,6 +3877,7 @@ ct_classify(const CtFace *A, const CtFace *B, CtStats *st)
         return CT_NONE;
     }
     unsure = 0;
+    ct_face_normal(A);
     for (int j = 0; j < 3; j++) {
         d2[j] = on2[j] ? 0 : ct_side_filter(A, t2[j]);
         unsure |= d2[j] == 2;
@@ -3939,11 +3972,30 @@ ct_max3(double a, double b, double c)
     return m > c ? m : c;
 }
 
-/* A face at a hierarchy position: its corner indices and its index in the caller's faces (16 bytes). */
-typedef struct {
-    int32_t fo[3];
-    int32_t face;
-} CtRec;
+/* Corner indices of the faces in blocks of CT_LEAF hierarchy positions, corner by corner: block b holds
+ * corners 0, 1, 2 of positions CT_LEAF b .. CT_LEAF b + CT_LEAF - 1, CT_LEAF int32 each (ct_share_mask tests
+ * one vertex against a whole block); positions past the last face hold -1 (no vertex). */
+#define CT_IDBLOCK (3 * CT_LEAF)
+
+static inline int32_t
+ct_id(const int32_t *ids, int64_t i, int c)      /* corner c of the face at position i */
+{
+    return ids[CT_IDBLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF];
+}
+
+/* The large per-face arrays of contact_scan: zeroed-on-demand mappings backed by 2 MB pages where the kernel
+ * offers them (arena_alloc, section 2b), so that a 1M-face scan does not take one page fault per 4 kB. */
+static inline void *
+ct_alloc(size_t bytes)
+{
+    return arena_alloc(bytes > 0 ? bytes : 1);
+}
+
+static inline void
+ct_free(void *p, size_t bytes)
+{
+    arena_free(p, bytes > 0 ? bytes : 1);
+}
 
 /* The next float32 above a finite f (nextafterf(f, +inf) without the library call): from -0 or +0 the
  * smallest subnormal, else one unit in the last place away from zero for f > 0, toward zero for f < 0;
@@ -3984,12 +4036,27 @@ ct_f32_up(double x)
     return (double)f < x ? ct_f32_next_up(f) : f;
 }
 
+/* A node of the hierarchy in 32 bytes (two to a cache line): its box, its children or its block, and apex. */
 typedef struct {
     float lo[3], hi[3];
-    int64_t start, count;       /* leaf: positions start .. start+count; inner: count = 0 */
-    int64_t left, right;
-    int64_t apex;               /* a certified star vertex (ct_stars) of every face below, else -1 */
+    int32_t link;               /* inner: the left child (the right one is link + 1); leaf: -1 - its block */
+    int32_t apex;               /* a certified star vertex (ct_stars) of every face below, else -1 */
 } CtNode;
+
+/* The root is node 1 (node 0 is unused), so that every left child has an even index and shares its 64-byte
+ * line with its sibling (the nodes are page-aligned): a pair of children is one cache line. */
+#define CT_ROOT 1
+#define CT_IS_LEAF(nd) ((nd)->link < 0)
+#define CT_BLOCK_OF(nd) ((int64_t)(-1 - (int64_t)(nd)->link))      /* a leaf's block: positions CT_LEAF b .. */
+#define CT_LEFT(nd) ((int64_t)(nd)->link)
+#define CT_RIGHT(nd) ((int64_t)(nd)->link + 1)
+
+static inline int
+ct_leaf_count(const CtNode *nd, int64_t m)     /* faces in a leaf: its block's, the last one may be short */
+{
+    int64_t start = CT_LEAF * CT_BLOCK_OF(nd);
+    return (int)(m - start < CT_LEAF ? m - start : CT_LEAF);
+}
 
 typedef struct {
     int64_t *a, *b;
@@ -4034,17 +4101,14 @@ ct_spread(uint64_t v)
 }
 
 /* key[i] = code << 31 | i (a 33-bit Morton code above a 31-bit face index) sorted by code, stable (LSD radix
- * sort, three passes of 11 bits over the code): the face indices in hierarchy order are then key & (2^31 - 1).
- * One 8-byte word per face moves, not a code and an index.  -1 when out of memory. */
+ * sort, three passes of 11 bits over the code, key2 m words of scratch): the face indices in hierarchy order
+ * are then key & (2^31 - 1).  One 8-byte word per face moves, not a code and an index.  -1 when out of
+ * memory. */
 static int
-ct_radix_sort(uint64_t *key, int64_t m)
+ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m)
 {
-    size_t mm = m > 0 ? (size_t)m : 1;
-    uint64_t *key2 = (uint64_t *)malloc(mm * sizeof(uint64_t));
     size_t (*count)[2048] = (size_t (*)[2048])calloc(3, sizeof(*count));
-    if (key2 == NULL || count == NULL) {
-        free(key2);
-        free(count);
+    if (count == NULL) {
         return -1;
     }
     for (int64_t i = 0; i < m; i++) {
@@ -4064,7 +4128,6 @@ ct_radix_sort(uint64_t *key, int64_t m)
         uint64_t *t = src; src = dst; dst = t;
     }
     memcpy(key, src, (size_t)m * sizeof(uint64_t));  /* three passes: the result is in key2 */
-    free(key2);
     free(count);
     return 0;
 }
@@ -4161,6 +4224,37 @@ ct_star_turns(const double *V, int32_t v, const int32_t *ring, int64_t k, int cl
 /* Stars of at most this many faces are matched on the stack by comparing link vertices pairwise (no sort). */
 #define CT_STAR_SMALL 32
 
+/* The ring of a closed fan whose faces are consistently oriented (each link edge (x, y) followed by the one
+ * starting at y), the common case of a closed manifold's vertex: 1 and ring r_0 .. r_k (r_k = r_0) when
+ * following the link edges from the first one uses each face once, returns to r_0 after the k-th and meets k
+ * distinct ring vertices, none v; else 0 (then ct_star_ring decides).  When it returns 1, ct_star_ring finds
+ * the same cycle (every ring vertex is in exactly two link edges, no link edge is degenerate), so the
+ * certificate (ct_star_turns, invariant under the cycle's starting point and direction) is the same. */
+static int
+ct_star_ring_oriented(int32_t v, const int32_t *link, int64_t k, int32_t *ring)
+{
+    if (k < 1) return 0;
+    uint64_t used = 1;                                     /* k <= CT_STAR_SMALL <= 64 faces */
+    ring[0] = link[0];
+    ring[1] = link[1];
+    for (int64_t len = 2; len <= k; len++) {
+        int32_t at = ring[len - 1];
+        int64_t j = 0;
+        while (j < k && (((used >> j) & 1u) || link[2 * j] != at)) j++;
+        if (j == k) return 0;
+        used |= (uint64_t)1 << j;
+        ring[len] = link[2 * j + 1];
+    }
+    if (ring[k] != ring[0]) return 0;
+    for (int64_t i = 0; i < k; i++) {
+        if (ring[i] == v) return 0;
+        for (int64_t j = i + 1; j < k; j++) {
+            if (ring[i] == ring[j]) return 0;
+        }
+    }
+    return 1;
+}
+
 /* 1 when the star of v (link edges link[0 .. k-1], pairs of vertex ids) is certified, 0 when not, -1 when out
  * of memory. */
 static int
@@ -4169,6 +4263,9 @@ ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
     int closed = 0;
     if (k <= CT_STAR_SMALL) {                              /* the common case: everything on the stack */
         int32_t partner[2 * CT_STAR_SMALL], ring[CT_STAR_SMALL + 1];
+        if (ct_star_ring_oriented(v, link, k, ring)) {
+            return ct_star_turns(V, v, ring, k, 1);
+        }
         uint64_t ends[2 * CT_STAR_SMALL];                  /* vertex id << 32 | slot, insertion-sorted */
         int64_t free_slot = -1, n_free = 0;
         for (int64_t s = 0; s < 2 * k; s++) {
@@ -4242,12 +4339,30 @@ done:
 /* The stars of vertices ranges of ct_stars, certified on threads (each vertex's result is its own). */
 typedef struct {
     const double *V;
-    const int64_t *off;         /* start of each kept vertex's link range, -1 for the others */
-    const int32_t *link;
+    const void *F;
+    int fsize;
+    const int64_t *off;         /* start of each kept vertex's range of faces, -1 for the others */
+    const int32_t *faces;       /* the faces holding each kept vertex, vertex after vertex */
     int64_t n, total, min_faces, big_faces;
     uint8_t *cert;
     int oom[MAX_THREADS];
 } CtStarJob;
+
+/* The link edges of v (corners after and before v in each of its k faces) into link (2 k int32). */
+static inline void
+ct_star_link(const CtStarJob *jb, int32_t v, const int32_t *faces, int64_t k, int32_t *link)
+{
+    for (int64_t i = 0; i < k; i++) {
+        size_t g = 3 * (size_t)faces[i];
+        int64_t x0 = index_at(jb->F, jb->fsize, g), x1 = index_at(jb->F, jb->fsize, g + 1);
+        int64_t x2 = index_at(jb->F, jb->fsize, g + 2);
+        /* v's first corner in the face: a face holding v twice gets a link edge holding v (rejected) */
+        int c = x0 == v ? 0 : x1 == v ? 1 : 2;
+        int64_t nx = c == 0 ? x1 : c == 1 ? x2 : x0, pv = c == 0 ? x2 : c == 1 ? x0 : x1;
+        link[2 * i] = (int32_t)nx;
+        link[2 * i + 1] = (int32_t)pv;
+    }
+}
 
 static void
 ct_star_task(void *ctx, int t, int nt)
@@ -4261,7 +4376,14 @@ ct_star_task(void *ctx, int t, int nt)
         int64_t w = v + 1;
         while (w < jb->n && jb->off[w] < 0) w++;
         int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total;
-        int r = ct_star_certify(jb->V, (int32_t)v, jb->link + 2 * s, e - s);
+        int32_t small[2 * CT_STAR_SMALL];
+        int32_t *link = e - s <= CT_STAR_SMALL ? small : (int32_t *)malloc((size_t)(2 * (e - s)) * sizeof(int32_t));
+        int r = -1;
+        if (link != NULL) {
+            ct_star_link(jb, (int32_t)v, jb->faces + s, e - s, link);
+            r = ct_star_certify(jb->V, (int32_t)v, link, e - s);
+            if (link != small) free(link);
+        }
         if (r < 0) {
             jb->oom[t] = 1;
             return;
@@ -4271,15 +4393,25 @@ ct_star_task(void *ctx, int t, int nt)
     }
 }
 
+/* Bytes of scratch ct_stars needs for n vertices and m faces (it takes its arrays from the caller's). */
+static inline size_t
+ct_stars_scratch(int64_t n, int64_t m)
+{
+    return (size_t)(n > 0 ? n : 1) * sizeof(int64_t) + 3 * (size_t)(m > 0 ? m : 1) * sizeof(int32_t);
+}
+
 /* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
- * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory. */
+ * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory.
+ * scratch: ct_stars_scratch(n, m) bytes, any content (the memory of the preparation's sort, reused). */
 static int
 ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
-         uint8_t *cert, int threads)
+         uint8_t *cert, int threads, void *scratch)
 {
     memset(cert, 0, (size_t)n);
-    int64_t *off = (int64_t *)calloc((size_t)(n > 0 ? n : 1), sizeof(int64_t));
-    if (off == NULL) return -1;
+    size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
+    int64_t *off = (int64_t *)scratch;
+    int32_t *faces = (int32_t *)((char *)scratch + off_bytes);
+    memset(off, 0, off_bytes);
     for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
     int64_t total = 0;
     for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
@@ -4291,25 +4423,20 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
             off[v] = -1;
         }
     }
-    int32_t *link = (int32_t *)malloc((size_t)(total > 0 ? 2 * total : 1) * sizeof(int32_t));
-    if (link == NULL) {
-        free(off);
-        return -1;
-    }
     for (int64_t f = 0; f < m; f++) {
         for (int c = 0; c < 3; c++) {
             int64_t v = index_at(F, fsize, 3 * (size_t)f + (size_t)c);
             if (off[v] < 0) continue;
-            int64_t at = --off[v];
-            link[2 * at] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 1) % 3));
-            link[2 * at + 1] = (int32_t)index_at(F, fsize, 3 * (size_t)f + (size_t)((c + 2) % 3));
+            faces[--off[v]] = (int32_t)f;           /* a face holding v twice is listed twice (then rejected) */
         }
     }
     CtStarJob jb;
     memset(&jb, 0, sizeof(jb));
     jb.V = V;
+    jb.F = F;
+    jb.fsize = fsize;
     jb.off = off;
-    jb.link = link;
+    jb.faces = faces;
     jb.n = n;
     jb.total = total;
     jb.min_faces = min_faces;
@@ -4320,22 +4447,20 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
     for (int t = 0; t < MAX_THREADS; t++) {
         if (jb.oom[t]) rc = -1;
     }
-    free(link);
-    free(off);
     return rc;
 }
 
 /* The certified vertex shared by every face at hierarchy positions s .. s+count-1, or -1. */
 static int64_t
-ct_leaf_apex(const CtRec *rec, const uint8_t *cert, int64_t s, int64_t count)
+ct_leaf_apex(const int32_t *ids, const uint8_t *cert, int64_t s, int64_t count)
 {
     if (cert == NULL) return -1;
     for (int c = 0; c < 3; c++) {
-        int32_t x = rec[s].fo[c];
+        int32_t x = ct_id(ids, s, c);
         if (cert[x] != CT_STAR_BIG) continue;
         int all = 1;
         for (int64_t i = s + 1; i < s + count && all; i++) {
-            all = rec[i].fo[0] == x || rec[i].fo[1] == x || rec[i].fo[2] == x;
+            all = ct_id(ids, i, 0) == x || ct_id(ids, i, 1) == x || ct_id(ids, i, 2) == x;
         }
         if (all) return x;
     }
@@ -4347,12 +4472,6 @@ ct_leaf_apex(const CtRec *rec, const uint8_t *cert, int64_t s, int64_t count)
  * floats each; positions past the last face are empty boxes (lo +inf, hi -inf) that meet nothing.  One leaf
  * of the hierarchy is one block, so a face is tested against a whole leaf's boxes at once (ct_block_mask). */
 #define CT_BLOCK (6 * CT_LEAF)
-
-static inline float
-ct_box_at(const float *BOX, int64_t i, int c)     /* c 0..2: lo, 3..5: hi */
-{
-    return BOX[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF];
-}
 
 static inline int
 ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
@@ -4397,50 +4516,99 @@ ct_block_mask(const float *blk, float lx, float ly, float lz, float hx, float hy
 #endif
 }
 
+/* Bit j set when vertex x is a corner of the face at position j of the block ids (one CT_IDBLOCK). */
+static inline unsigned
+ct_share_mask(const int32_t *ids, int32_t x)
+{
+#if defined(__SSE2__) && CT_LEAF % 4 == 0
+    __m128i k = _mm_set1_epi32(x);
+    unsigned mask = 0;
+    for (int q = 0; q < CT_LEAF / 4; q++) {
+        __m128i e = _mm_or_si128(
+            _mm_or_si128(_mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(ids + 4 * q)), k),
+                         _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(ids + CT_LEAF + 4 * q)), k)),
+            _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(ids + 2 * CT_LEAF + 4 * q)), k));
+        mask |= (unsigned)_mm_movemask_ps(_mm_castsi128_ps(e)) << (4 * q);
+    }
+    return mask;
+#else
+    unsigned mask = 0;
+    for (int j = 0; j < CT_LEAF; j++) {
+        mask |= (unsigned)((ids[j] == x) | (ids[CT_LEAF + j] == x) | (ids[2 * CT_LEAF + j] == x)) << j;
+    }
+    return mask;
+#endif
+}
+
+static inline int
+ct_popcount(unsigned x)         /* bits set in x (SWAR: no library call without -mpopcnt) */
+{
+    uint32_t v = (uint32_t)x;
+    v = v - ((v >> 1) & 0x55555555u);
+    v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
+    v = (v + (v >> 4)) & 0x0f0f0f0fu;
+    return (int)((v * 0x01010101u) >> 24);
+}
+
 /* Builds the hierarchy over the boxes BOX (blocks above, already in hierarchy order): the tree halving block
  * ranges (a leaf is one block of at most CT_LEAF faces), node boxes from the leaves up.  Returns the node
  * count. */
 static int64_t
-ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert, int64_t m)
+ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cert, int64_t m)
 {
-    int64_t n_nodes = 1;
-    nodes[0].start = 0;
-    nodes[0].count = m;
-    for (int64_t k = 0; k < n_nodes; k++) {
+    /* top down, halving block ranges (a parent always precedes its children, which are adjacent); while
+     * building, link holds a node's first block and apex its block count */
+    int64_t n_nodes = CT_ROOT + 1;
+    memset(&nodes[0], 0, sizeof(CtNode));
+    nodes[CT_ROOT].link = 0;
+    nodes[CT_ROOT].apex = (int32_t)((m + CT_LEAF - 1) / CT_LEAF);
+    for (int64_t k = CT_ROOT; k < n_nodes; k++) {
         CtNode *nd = &nodes[k];
-        if (nd->count <= CT_LEAF) {
+        int64_t b0 = nd->link, blocks = nd->apex;
+        if (blocks <= 1) {
+            nd->link = (int32_t)(-1 - b0);          /* a leaf: one block */
             continue;
         }
-        int64_t s = nd->start, e = s + nd->count, blocks = (nd->count + CT_LEAF - 1) / CT_LEAF;
-        int64_t half = s + CT_LEAF * (blocks / 2);     /* starts stay multiples of CT_LEAF */
         int64_t l = n_nodes++, r = n_nodes++;
-        nodes[l].start = s;
-        nodes[l].count = half - s;
-        nodes[r].start = half;
-        nodes[r].count = e - half;
-        nd->left = l;
-        nd->right = r;
-        nd->count = 0;
+        nodes[l].link = (int32_t)b0;
+        nodes[l].apex = (int32_t)(blocks / 2);
+        nodes[r].link = (int32_t)(b0 + blocks / 2);
+        nodes[r].apex = (int32_t)(blocks - blocks / 2);
+        nd->link = (int32_t)l;
     }
-    /* boxes, children before parents (a parent always precedes its children) */
-    for (int64_t k = n_nodes - 1; k >= 0; k--) {
+    /* boxes and apexes, children before parents */
+    for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
         CtNode *nd = &nodes[k];
-        if (nd->count > 0) {
-            nd->apex = ct_leaf_apex(rec, cert, nd->start, nd->count);
+        if (CT_IS_LEAF(nd)) {
+            int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
+            nd->apex = (int32_t)ct_leaf_apex(ids, cert, start, count);
+            /* the whole block: its empty positions (lo +inf, hi -inf) change no minimum or maximum */
+            const float *blk = BOX + CT_BLOCK * CT_BLOCK_OF(nd);
             for (int c = 0; c < 3; c++) {
+#if defined(__SSE2__) && CT_LEAF % 4 == 0
+                __m128 lo = _mm_loadu_ps(blk + c * CT_LEAF), hi = _mm_loadu_ps(blk + (3 + c) * CT_LEAF);
+                for (int q = 4; q < CT_LEAF; q += 4) {
+                    lo = _mm_min_ps(lo, _mm_loadu_ps(blk + c * CT_LEAF + q));
+                    hi = _mm_max_ps(hi, _mm_loadu_ps(blk + (3 + c) * CT_LEAF + q));
+                }
+                lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(1, 0, 3, 2)));
+                lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(2, 3, 0, 1)));
+                hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(1, 0, 3, 2)));
+                hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(2, 3, 0, 1)));
+                nd->lo[c] = _mm_cvtss_f32(lo);
+                nd->hi[c] = _mm_cvtss_f32(hi);
+#else
                 nd->lo[c] = INFINITY;
                 nd->hi[c] = -INFINITY;
-            }
-            for (int64_t i = nd->start; i < nd->start + nd->count; i++) {
-                for (int c = 0; c < 3; c++) {
-                    float lo = ct_box_at(BOX, i, c), hi = ct_box_at(BOX, i, 3 + c);
-                    if (lo < nd->lo[c]) nd->lo[c] = lo;
-                    if (hi > nd->hi[c]) nd->hi[c] = hi;
+                for (int j = 0; j < CT_LEAF; j++) {
+                    if (blk[c * CT_LEAF + j] < nd->lo[c]) nd->lo[c] = blk[c * CT_LEAF + j];
+                    if (blk[(3 + c) * CT_LEAF + j] > nd->hi[c]) nd->hi[c] = blk[(3 + c) * CT_LEAF + j];
                 }
+#endif
             }
         }
         else {
-            const CtNode *p = &nodes[nd->left], *q = &nodes[nd->right];
+            const CtNode *p = &nodes[CT_LEFT(nd)], *q = &nodes[CT_RIGHT(nd)];
             nd->apex = p->apex == q->apex ? p->apex : -1;
             for (int c = 0; c < 3; c++) {
                 nd->lo[c] = p->lo[c] < q->lo[c] ? p->lo[c] : q->lo[c];
@@ -4453,31 +4621,33 @@ ct_build(CtNode *nodes, const float *BOX, const CtRec *rec, const uint8_t *cert,
 
 typedef struct {
     const float *BOX;           /* face boxes rounded outward to float32, in blocks of CT_LEAF (ct_block_mask) */
-    const CtRec *rec;           /* corner indices and face index, in hierarchy order */
+    const int32_t *order;       /* the caller's face index of each hierarchy position */
+    const int32_t *ids;         /* corner indices in hierarchy order, in blocks of CT_LEAF (ct_id) */
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
     const double *V;            /* vertices (n, 3) */
     const CtNode *nodes;
+    int64_t m;                  /* faces */
     const uint8_t *stars;       /* certified corners per position (ct_visit), NULL without pruning */
     long long max_pairs;        /* < 0: no bound */
     long long candidates, tested;
     long exact;
     int complete, oom;
     CtFound found;
+    long long node_pairs, leaf_pairs, loads;   /* work counts, printed with INERTIA_TOOL_CT_PROFILE */
 } CtScan;
 
 /* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
- * (the same arithmetic as ct_face_init), its corner indices, and the axis and zero-area flag ct_face_init
+ * (the arithmetic of ct_face_normal, when first needed), its corner indices, and the axis and zero-area flag ct_face_axis
  * gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
  * when a box meets its (16 + 1 bytes per face instead). */
 static inline void
 ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
 {
-    const CtRec *r = &sc->rec[i];
     for (int k = 0; k < 3; k++) {
-        F->fo[k] = r->fo[k];
+        F->fo[k] = ct_id(sc->ids, i, k);
     }
-    ct_face_geometry(F, sc->V + 3 * (size_t)r->fo[0], sc->V + 3 * (size_t)r->fo[1], sc->V + 3 * (size_t)r->fo[2]);
-    F->face = r->face;
+    ct_face_geometry(F, sc->V + 3 * (size_t)F->fo[0], sc->V + 3 * (size_t)F->fo[1], sc->V + 3 * (size_t)F->fo[2]);
+    F->face = sc->order[i];
     F->axis = sc->flags[i] & 3;
     F->skip = sc->flags[i] >> 2;
 }
@@ -4487,6 +4657,7 @@ ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
 static int
 ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
 {
+    sc->loads++;
     if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
         ct_face_load(FI, sc, i);
         *have_i = 1;
@@ -4508,9 +4679,9 @@ ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFa
     sc->candidates++;
     if (FI->skip || FJ->skip) return 0;
     sc->tested++;
-    const CtFace *A = FI, *B = FJ;
+    CtFace *A = FI, *B = FJ;
     if (A->face > B->face) {
-        const CtFace *T = A;
+        CtFace *T = A;
         A = B;
         B = T;
     }
@@ -4536,10 +4707,11 @@ ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *
 {
     unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
     if (bits) {
-        const int32_t *x = sc->rec[i].fo, *y = sc->rec[j].fo;
+        int32_t y0 = ct_id(sc->ids, j, 0), y1 = ct_id(sc->ids, j, 1), y2 = ct_id(sc->ids, j, 2);
         unsigned shared = 0;                /* bit c: corner c of face i is a corner of face j */
         for (int c = 0; c < 3; c++) {
-            shared |= (unsigned)((x[c] == y[0]) | (x[c] == y[1]) | (x[c] == y[2])) << c;
+            int32_t x = ct_id(sc->ids, i, c);
+            shared |= (unsigned)((x == y0) | (x == y1) | (x == y2)) << c;
         }
         if ((bits >> 3) & shared) return 0;
         if (bits & shared) {
@@ -4553,6 +4725,47 @@ ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *
         }
     }
     return ct_test_pair(sc, i, j, FI, have_i, FJ, have_j);
+}
+
+/* The pairs of the face at position i with the positions base + j of one block, j the bits of mask (their float32
+ * boxes meet); returns 0 to go on, 1 to stop.  The same decisions as ct_visit pair by pair, but the pairs
+ * sharing a certified corner are found for the whole block at once (ct_share_mask on the block's corner
+ * indices): those of a big star dropped, those of a small star counted (candidates and tested, as ct_visit
+ * counts them; both faces hold the shared vertex, so their float64 boxes meet); only the others are visited
+ * one by one.  With a work bound (max_pairs >= 0) every pair goes through ct_visit, in order. */
+static inline int
+ct_visit_block(CtScan *sc, int64_t i, int64_t base, unsigned mask, CtFace *FI, uint8_t *have_i, CtFace *leaf,
+               uint8_t *have)
+{
+    unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
+    if (bits && sc->max_pairs < 0) {
+        const int32_t *ids = sc->ids + CT_IDBLOCK * (base / CT_LEAF);
+        unsigned big = 0, small = 0;
+        for (int c = 0; c < 3; c++) {
+            if (!((bits >> c) & 9u)) continue;
+            unsigned eq = ct_share_mask(ids, ct_id(sc->ids, i, c));
+            if (bits & (8u << c)) big |= eq;
+            else small |= eq;
+        }
+        mask &= ~big;
+        unsigned counted = mask & small;
+        int n = ct_popcount(counted);
+        sc->candidates += n;
+        sc->tested += n;
+        mask &= ~counted;
+        while (mask) {
+            int b = ct_ctz(mask);
+            mask &= mask - 1;
+            if (ct_test_pair(sc, i, base + b, FI, have_i, &leaf[b], &have[b])) return 1;
+        }
+        return 0;
+    }
+    while (mask) {
+        int b = ct_ctz(mask);
+        mask &= mask - 1;
+        if (ct_visit(sc, i, base + b, FI, have_i, &leaf[b], &have[b])) return 1;
+    }
+    return 0;
 }
 
 static inline int
@@ -4579,6 +4792,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
     top = 1;
     while (top > 0) {
         top--;
+        sc->node_pairs++;
         int64_t pi = stack[2 * top], qi = stack[2 * top + 1];
         const CtNode *p = &nodes[pi], *q = &nodes[qi];
         if (p->apex >= 0 && p->apex == q->apex) {
@@ -4594,37 +4808,38 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             cap *= 2;
         }
         if (pi == qi) {
-            if (p->count > 0) {
+            if (CT_IS_LEAF(p)) {
+                sc->leaf_pairs++;
+                int64_t pstart = CT_LEAF * CT_BLOCK_OF(p);
+                int pcount = ct_leaf_count(p, sc->m);
                 CtFace leaf[CT_LEAF];
                 uint8_t have[CT_LEAF] = {0};
-                const float *blk = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
-                for (int a = 0; a + 1 < p->count; a++) {
+                const float *blk = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+                for (int a = 0; a + 1 < pcount; a++) {
                     unsigned mask = ct_block_mask(blk, blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a],
                                                   blk[3 * CT_LEAF + a], blk[4 * CT_LEAF + a], blk[5 * CT_LEAF + a]);
                     mask &= ~((2u << a) - 1);               /* the later positions j > i only */
-                    while (mask) {
-                        int b = ct_ctz(mask);
-                        mask &= mask - 1;
-                        if (ct_visit(sc, p->start + a, p->start + b, &leaf[a], &have[a], &leaf[b], &have[b])) {
-                            goto out;
-                        }
+                    if (mask && ct_visit_block(sc, pstart + a, pstart, mask, &leaf[a], &have[a], leaf, have)) {
+                        goto out;
                     }
                 }
             }
             else {
-                stack[2 * top] = p->left; stack[2 * top + 1] = p->left; top++;
-                stack[2 * top] = p->right; stack[2 * top + 1] = p->right; top++;
-                if (ct_nodes_meet(&nodes[p->left], &nodes[p->right])) {
-                    stack[2 * top] = p->left; stack[2 * top + 1] = p->right; top++;
+                stack[2 * top] = CT_LEFT(p); stack[2 * top + 1] = CT_LEFT(p); top++;
+                stack[2 * top] = CT_RIGHT(p); stack[2 * top + 1] = CT_RIGHT(p); top++;
+                if (ct_nodes_meet(&nodes[CT_LEFT(p)], &nodes[CT_RIGHT(p)])) {
+                    stack[2 * top] = CT_LEFT(p); stack[2 * top + 1] = CT_RIGHT(p); top++;
                 }
             }
             continue;
         }
-        if (p->count > 0 && q->count > 0) {
+        if (CT_IS_LEAF(p) && CT_IS_LEAF(q)) {
+            sc->leaf_pairs++;
+            int64_t pstart = CT_LEAF * CT_BLOCK_OF(p), qstart = CT_LEAF * CT_BLOCK_OF(q);
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
-            const float *pb = sc->BOX + CT_BLOCK * (p->start / CT_LEAF);
-            const float *qb = sc->BOX + CT_BLOCK * (q->start / CT_LEAF);
+            const float *pb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+            const float *qb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(q);
             /* p's faces against q's box first, then each that meets it against q's faces */
             unsigned pmask = ct_block_mask(pb, q->lo[0], q->lo[1], q->lo[2], q->hi[0], q->hi[1], q->hi[2]);
             while (pmask) {
@@ -4634,17 +4849,13 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                                               pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]);
                 CtFace FI;
                 uint8_t have_i = 0;
-                while (mask) {
-                    int b = ct_ctz(mask);
-                    mask &= mask - 1;
-                    if (ct_visit(sc, p->start + a, q->start + b, &FI, &have_i, &leaf[b], &have[b])) goto out;
-                }
+                if (mask && ct_visit_block(sc, pstart + a, qstart, mask, &FI, &have_i, leaf, have)) goto out;
             }
             continue;
         }
-        if (p->count == 0 && q->count == 0) {
+        if (!CT_IS_LEAF(p) && !CT_IS_LEAF(q)) {
             /* both inner: descend both at once (the four child pairs that meet) */
-            const int64_t pc[2] = {p->left, p->right}, qc[2] = {q->left, q->right};
+            const int64_t pc[2] = {CT_LEFT(p), CT_RIGHT(p)}, qc[2] = {CT_LEFT(q), CT_RIGHT(q)};
             for (int u = 1; u >= 0; u--) {
                 for (int w = 1; w >= 0; w--) {
                     if (ct_nodes_meet(&nodes[pc[u]], &nodes[qc[w]])) {
@@ -4655,23 +4866,23 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             continue;
         }
         /* descend the inner node; push only children that meet */
-        int split_p = q->count > 0 || (p->count == 0 && (p->hi[0] - p->lo[0]) + (p->hi[1] - p->lo[1])
+        int split_p = CT_IS_LEAF(q) || (!CT_IS_LEAF(p) && (p->hi[0] - p->lo[0]) + (p->hi[1] - p->lo[1])
                                         + (p->hi[2] - p->lo[2]) >= (q->hi[0] - q->lo[0])
                                         + (q->hi[1] - q->lo[1]) + (q->hi[2] - q->lo[2]));
         if (split_p) {
-            if (ct_nodes_meet(&nodes[p->right], q)) {
-                stack[2 * top] = p->right; stack[2 * top + 1] = qi; top++;
+            if (ct_nodes_meet(&nodes[CT_RIGHT(p)], q)) {
+                stack[2 * top] = CT_RIGHT(p); stack[2 * top + 1] = qi; top++;
             }
-            if (ct_nodes_meet(&nodes[p->left], q)) {
-                stack[2 * top] = p->left; stack[2 * top + 1] = qi; top++;
+            if (ct_nodes_meet(&nodes[CT_LEFT(p)], q)) {
+                stack[2 * top] = CT_LEFT(p); stack[2 * top + 1] = qi; top++;
             }
         }
         else {
-            if (ct_nodes_meet(p, &nodes[q->right])) {
-                stack[2 * top] = pi; stack[2 * top + 1] = q->right; top++;
+            if (ct_nodes_meet(p, &nodes[CT_RIGHT(q)])) {
+                stack[2 * top] = pi; stack[2 * top + 1] = CT_RIGHT(q); top++;
             }
-            if (ct_nodes_meet(p, &nodes[q->left])) {
-                stack[2 * top] = pi; stack[2 * top + 1] = q->left; top++;
+            if (ct_nodes_meet(p, &nodes[CT_LEFT(q)])) {
+                stack[2 * top] = pi; stack[2 * top + 1] = CT_LEFT(q); top++;
             }
         }
     }
@@ -4710,28 +4921,28 @@ static int32_t
 ct_tasks(const CtNode *nodes, int64_t *tasks)
 {
     int32_t n = 1;
-    tasks[0] = tasks[1] = 0;
+    tasks[0] = tasks[1] = CT_ROOT;
     for (int round = 0; round < 16 && n < CT_TASKS / 4; round++) {
         int64_t next[2 * CT_TASKS];
         int32_t m = 0;
         for (int32_t k = 0; k < n; k++) {
             int64_t pi = tasks[2 * k], qi = tasks[2 * k + 1];
             const CtNode *p = &nodes[pi], *q = &nodes[qi];
-            if (pi == qi && p->count == 0) {
-                int64_t add[3][2] = {{p->left, p->left}, {p->right, p->right}, {p->left, p->right}};
+            if (pi == qi && !CT_IS_LEAF(p)) {
+                int64_t add[3][2] = {{CT_LEFT(p), CT_LEFT(p)}, {CT_RIGHT(p), CT_RIGHT(p)}, {CT_LEFT(p), CT_RIGHT(p)}};
                 for (int j = 0; j < 3; j++) {
-                    if (j == 2 && !ct_nodes_meet(&nodes[p->left], &nodes[p->right])) continue;
+                    if (j == 2 && !ct_nodes_meet(&nodes[CT_LEFT(p)], &nodes[CT_RIGHT(p)])) continue;
                     next[2 * m] = add[j][0];
                     next[2 * m + 1] = add[j][1];
                     m++;
                 }
             }
-            else if (pi != qi && p->count == 0) {
-                if (ct_nodes_meet(&nodes[p->left], q)) {
-                    next[2 * m] = p->left; next[2 * m + 1] = qi; m++;
+            else if (pi != qi && !CT_IS_LEAF(p)) {
+                if (ct_nodes_meet(&nodes[CT_LEFT(p)], q)) {
+                    next[2 * m] = CT_LEFT(p); next[2 * m + 1] = qi; m++;
                 }
-                if (ct_nodes_meet(&nodes[p->right], q)) {
-                    next[2 * m] = p->right; next[2 * m + 1] = qi; m++;
+                if (ct_nodes_meet(&nodes[CT_RIGHT(p)], q)) {
+                    next[2 * m] = CT_RIGHT(p); next[2 * m + 1] = qi; m++;
                 }
             }
             else {
@@ -4756,8 +4967,9 @@ ct_prefetch(const void *p)
 #endif
 }
 
-/* Per-face preparation, split over threads by position: Morton codes (pass 0), then the faces and boxes in
- * hierarchy order (pass 1). */
+/* Per-face preparation, split over threads by position: Morton codes and each face's projection axis and
+ * zero-area flag, in the caller's order (pass 0: the rows are read in sequence), then the corner indices, flags
+ * and boxes in hierarchy order (pass 1). */
 typedef struct {
     int pass;
     int64_t m;
@@ -4769,7 +4981,8 @@ typedef struct {
     int8_t *axis;
     uint8_t *skip;
     float *box;
-    CtRec *rec;
+    int32_t *order;
+    int32_t *ids;
     uint8_t *flags;
     long exact[MAX_THREADS];
     int failed[MAX_THREADS];
@@ -4780,11 +4993,15 @@ ct_prep_task(void *ctx, int t, int nt)
 {
     CtPrep *pr = (CtPrep *)ctx;
     int64_t s = (int64_t)part_start((size_t)pr->m, t, nt), e = (int64_t)part_start((size_t)pr->m, t + 1, nt);
+    CtStats st = {0, 0};
     if (pr->pass == 0) {
         for (int64_t f = s; f < e; f++) {
             const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
             const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
             const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
+            int skip;
+            pr->axis[f] = (int8_t)ct_face_axis(p0, p1, p2, &skip, &st);
+            pr->skip[f] = (uint8_t)skip;
             uint64_t code = 0;
             for (int c = 0; c < 3; c++) {
                 double lo = ct_min3(p0[c], p1[c], p2[c]), hi = ct_max3(p0[c], p1[c], p2[c]);
@@ -4795,9 +5012,10 @@ ct_prep_task(void *ctx, int t, int nt)
             }
             pr->code[f] = code << 31 | (uint64_t)f;
         }
+        pr->exact[t] += st.exact;
+        pr->failed[t] |= st.failed;
         return;
     }
-    CtStats st = {0, 0};
     for (int64_t i = s; i < e; i++) {
         /* the faces are read in hierarchy order, i.e. at random in the caller's: their rows are fetched
          * CT_AHEAD positions ahead, their corners CT_AHEAD / 2 ahead (from the rows fetched by then) */
@@ -4809,26 +5027,21 @@ ct_prep_task(void *ctx, int t, int nt)
             for (int k = 0; k < 3; k++) ct_prefetch(pr->V + 3 * index_at(pr->F, pr->size, g + (size_t)k));
         }
         int64_t f = (int64_t)(pr->code[i] & 0x7fffffff);
-        CtFace F;
         const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
         const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
         const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
-        ct_face_init(&F, p0, p1, p2, &st);
-        pr->axis[f] = (int8_t)F.axis;
-        pr->skip[f] = (uint8_t)F.skip;
-        pr->flags[i] = (uint8_t)(F.axis | F.skip << 2);
+        pr->flags[i] = (uint8_t)(pr->axis[f] | pr->skip[f] << 2);
         for (int k = 0; k < 3; k++) {
-            pr->rec[i].fo[k] = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
+            pr->ids[CT_IDBLOCK * (i / CT_LEAF) + k * CT_LEAF + i % CT_LEAF]
+                = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
         }
-        pr->rec[i].face = (int32_t)f;
+        pr->order[i] = (int32_t)f;
         for (int c = 0; c < 3; c++) {
             float *blk = pr->box + CT_BLOCK * (i / CT_LEAF);
             blk[c * CT_LEAF + i % CT_LEAF] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
             blk[(3 + c) * CT_LEAF + i % CT_LEAF] = ct_f32_up(ct_max3(p0[c], p1[c], p2[c]));
         }
     }
-    pr->exact[t] += st.exact;
-    pr->failed[t] |= st.failed;
 }
 
 /* contact_scan(vertices, faces, max_pairs[, threads[, star_faces]]) -> (a, b, kind, candidates, tested, exact, complete,
@@ -4850,7 +5063,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
     CtNode *nodes = NULL;
     uint64_t *code = NULL;
     float *box = NULL;
-    CtRec *rec = NULL;
+    int32_t *order = NULL;
+    int32_t *ids = NULL;
+    size_t nodes_bytes = 0, code_bytes = 0, box_bytes = 0, order_bytes = 0, ids_bytes = 0;
     uint8_t *flags = NULL;
     int8_t *axis_out = NULL;
     uint8_t *skip_out = NULL;
@@ -4896,16 +5111,23 @@ accel_contact_scan(PyObject *self, PyObject *args)
             goto done;
         }
         size_t mm = m > 0 ? (size_t)m : 1;
-        /* leaves hold at least (CT_LEAF + 1) / 2 faces (but the root may be a smaller leaf) */
-        nodes = (CtNode *)malloc((2 * mm / ((CT_LEAF + 1) / 2) + 2) * sizeof(CtNode));
-        code = (uint64_t *)malloc(mm * sizeof(uint64_t));
         size_t n_blocks = (mm + CT_LEAF - 1) / CT_LEAF;
-        box = (float *)malloc(n_blocks * CT_BLOCK * sizeof(float));
-        rec = (CtRec *)malloc(mm * sizeof(CtRec));
+        nodes_bytes = (2 * n_blocks + 1) * sizeof(CtNode);     /* a leaf per block: 2 n_blocks - 1 nodes, from 1 */
+        /* the sort's keys and scratch (2 m words), then the stars' arrays, in one mapping */
+        code_bytes = 2 * mm * sizeof(uint64_t);
+        if (ct_stars_scratch(n, m) > code_bytes) code_bytes = ct_stars_scratch(n, m);
+        box_bytes = n_blocks * CT_BLOCK * sizeof(float);
+        order_bytes = mm * sizeof(int32_t);
+        ids_bytes = n_blocks * CT_IDBLOCK * sizeof(int32_t);
+        nodes = (CtNode *)ct_alloc(nodes_bytes);
+        code = (uint64_t *)ct_alloc(code_bytes);
+        box = (float *)ct_alloc(box_bytes);
+        order = (int32_t *)ct_alloc(order_bytes);
+        ids = (int32_t *)ct_alloc(ids_bytes);
         flags = (uint8_t *)malloc(mm);
         axis_out = (int8_t *)malloc(mm);
         skip_out = (uint8_t *)malloc(mm);
-        if (nodes == NULL || code == NULL || box == NULL || rec == NULL || flags == NULL
+        if (nodes == NULL || code == NULL || box == NULL || order == NULL || ids == NULL || flags == NULL
             || axis_out == NULL || skip_out == NULL) {
             PyErr_NoMemory();
             goto done;
@@ -4914,10 +5136,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
             for (int c = 0; c < 3; c++) {
                 box[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = INFINITY;
                 box[CT_BLOCK * (i / CT_LEAF) + (3 + c) * CT_LEAF + i % CT_LEAF] = -INFINITY;
+                ids[CT_IDBLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = -1;
             }
         }
         int oom = 0, failed = 0;
+        int profile = getenv("INERTIA_TOOL_CT_PROFILE") != NULL;
+        double clk[8] = {0};
         Py_BEGIN_ALLOW_THREADS
+        clk[0] = ct_clock();
         int nt = thread_count(threads, (size_t)m, 20000);
         CtPrep pr;
         memset(&pr, 0, sizeof(pr));
@@ -4929,7 +5155,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.axis = axis_out;
         pr.skip = skip_out;
         pr.box = box;
-        pr.rec = rec;
+        pr.order = order;
+        pr.ids = ids;
         pr.flags = flags;
         /* the Morton grid: box centres of the faces, 2^16 cells per axis over their range */
         double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -4947,48 +5174,54 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         pr.pass = 0;
         run_parallel(nt, ct_prep_task, &pr);
-        if (ct_radix_sort(code, m) < 0) {
+        clk[1] = ct_clock();
+        if (ct_radix_sort(code, code + mm, m) < 0) {
             oom = 1;
         }
         else {
+            clk[2] = ct_clock();
             pr.pass = 1;
             run_parallel(nt, ct_prep_task, &pr);
+            clk[3] = ct_clock();
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
                 failed |= pr.failed[t];
             }
-            free(code);                     /* rec holds the face indices in hierarchy order */
-            code = NULL;
+            /* order holds the face indices in hierarchy order: code's memory is the stars' scratch now */
         }
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
             stars = (uint8_t *)malloc(mm);
             if (cert == NULL || stars == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
-                                         star_faces, cert, nt) < 0) {
+                                         star_faces, cert, nt, code) < 0) {
                 oom = 1;
             }
         }
+        clk[4] = ct_clock();
         if (!oom && !failed && m >= 2) {
-            ct_build(nodes, box, rec, cert, m);
+            ct_build(nodes, box, ids, cert, m);
             if (cert != NULL) {
                 for (int64_t i = 0; i < m; i++) {
                     unsigned b = 0;
                     for (int c = 0; c < 3; c++) {
-                        uint8_t k = cert[rec[i].fo[c]];
+                        uint8_t k = cert[ct_id(ids, i, c)];
                         b |= k == CT_STAR_BIG ? 8u << c : k == CT_STAR_SMALL_CERT ? 1u << c : 0u;
                     }
                     stars[i] = (uint8_t)b;
                 }
             }
+            clk[5] = ct_clock();
             sc.stars = cert != NULL ? stars : NULL;
             sc.BOX = box;
-            sc.rec = rec;
+            sc.order = order;
+            sc.ids = ids;
             sc.flags = flags;
             sc.V = V;
             sc.nodes = nodes;
+            sc.m = m;
             if (max_pairs >= 0) nt = 1;
             if (nt == 1) {
-                ct_traverse(&sc, 0, 0);
+                ct_traverse(&sc, CT_ROOT, CT_ROOT);
             }
             else {
                 CtScan scans[MAX_THREADS];
@@ -5008,6 +5241,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
                     CtScan *u = &scans[t];
                     if (t > 0) {
                         sc.candidates += u->candidates;
+                        sc.node_pairs += u->node_pairs;
+                        sc.leaf_pairs += u->leaf_pairs;
+                        sc.loads += u->loads;
                         sc.tested += u->tested;
                         sc.exact += u->exact;
                         sc.oom |= u->oom;
@@ -5028,7 +5264,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
         }
         oom |= sc.oom;
+        clk[6] = ct_clock();
         Py_END_ALLOW_THREADS
+        if (profile) {
+            fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars %.4f build %.4f "
+                    "traverse %.4f s; candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld\n",
+                    (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[4] - clk[3], clk[5] - clk[4],
+                    clk[6] - clk[5], sc.candidates, sc.tested, sc.node_pairs, sc.leaf_pairs, sc.loads);
+        }
         if (oom) {
             PyErr_NoMemory();
             goto done;
@@ -5057,10 +5300,11 @@ done:
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
     }
-    free(nodes);
-    free(code);
-    free(box);
-    free(rec);
+    ct_free(nodes, nodes_bytes);
+    ct_free(code, code_bytes);
+    ct_free(box, box_bytes);
+    ct_free(order, order_bytes);
+    ct_free(ids, ids_bytes);
     free(flags);
     free(axis_out);
     free(skip_out);

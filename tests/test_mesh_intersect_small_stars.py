@@ -190,3 +190,53 @@ def test_star_certificates_and_pairs_do_not_depend_on_the_thread_count():
         got = lib.contact_scan(v, faces_for_c(f), -1, threads, 8)
         assert set(zip(np.frombuffer(got[0], np.int64), np.frombuffer(got[1], np.int64), got[2])) == pairs
         assert got[3:7] == ref[3:7] and got[7:] == ref[7:]
+
+
+@st.composite
+def closed_fans(draw):
+    """One vertex's fan of k faces, consistently oriented as a closed manifold's (each link edge followed by the
+    next), that winds once or twice round the centre (a double cover with distinct ring vertices: the oriented
+    ring walk accepts it, only the turn count may refuse it), with ring heights from flat (coplanar faces) to
+    steep, optionally a face turned over (the walk then fails and the general matching decides) or a ring
+    vertex repeated (a pinched fan: neither may certify it).  Integer coordinates: every coincidence is exact."""
+    k = draw(st.integers(3, 12))
+    turns = draw(st.sampled_from([1, 1, 2]))
+    radius = draw(st.integers(4, 12))
+    heights = draw(st.lists(st.integers(-2, 2), min_size=k, max_size=k))
+    angles = 2 * np.pi * turns * (np.arange(k) + 0.5 * np.array(draw(
+        st.lists(st.floats(0.0, 0.8), min_size=k, max_size=k)))) / k
+    ring = np.stack([np.round(radius * np.cos(angles)), np.round(radius * np.sin(angles)),
+                     np.array(heights, dtype=float)], axis=1)
+    v = np.vstack([[[0.0, 0.0, draw(st.integers(-1, 1))]], ring])
+    f = np.array([[0, 1 + i, 1 + (i + 1) % k] for i in range(k)], dtype=np.int64)
+    if draw(st.booleans()):                                   # one face turned over
+        g = draw(st.integers(0, k - 1))
+        f[g] = f[g][[0, 2, 1]]
+    if k >= 4 and draw(st.booleans()):                        # a ring vertex repeated (pinched)
+        a = draw(st.integers(1, k))
+        b = 1 + (a - 1 + draw(st.integers(2, k - 2))) % k
+        f[f == b] = a
+    return v, f
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(closed_fans())
+def test_oriented_fans_winding_once_or_twice_match_numpy_and_brute_force(mesh):
+    """The C scan's oriented ring walk (``ct_star_ring_oriented``, the fast path of a closed manifold's star)
+    finds the ring of a consistently oriented fan; a fan winding twice, turned over in one face or pinched must
+    still not be certified: every pair against the numpy twin and the rational classifier."""
+    v, f = mesh
+    keep = np.array([len(set(row.tolist())) == 3 for row in f])
+    _check_all_paths(v, f[keep], brute=True)
+
+
+def test_fan_winding_twice_is_not_certified_regression():
+    """A flat 6-face fan winding twice round its centre, ring vertices distinct and consistently oriented (the
+    oriented ring walk closes it): faces i and i + 3 overlap in the plane and are found as coplanar pairs."""
+    k = 6
+    angles = 4 * np.pi * (np.arange(k) + 0.3 * (np.arange(k) % 2)) / k
+    ring = np.stack([np.round(10 * np.cos(angles)), np.round(10 * np.sin(angles)), np.zeros(k)], axis=1)
+    v = np.vstack([[[0.0, 0.0, 0.0]], ring])
+    f = np.array([[0, 1 + i, 1 + (i + 1) % k] for i in range(k)], dtype=np.int64)
+    result = _check_all_paths(v, f, brute=True)
+    assert len(result.crossing) + len(result.coplanar_opposite) + len(result.contact) > 0

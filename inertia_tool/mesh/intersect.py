@@ -102,9 +102,14 @@ enumerated and counted as a candidate and as tested (exactly as the numpy twin c
 the larger stars and tests such a pair), but decided by the certificate, without rebuilding or testing the two
 faces.  On a clean mesh that is nearly every candidate pair (the faces sharing a corner: six of the 6.4 per
 face of a 1M-face torus); the pairs found are the same, since a certified star's pairs meet only in what they
-share.  Its hierarchy's leaves are blocks of 16 faces whose float32 boxes are stored coordinate by
-coordinate, so that one face's box is tested against a whole leaf at once.  This module's numpy code stays the
-reference and the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
+share.  Its hierarchy's leaves are blocks of 16 faces whose float32 boxes and corner indices are stored
+coordinate by coordinate, so that one face's box is tested against a whole leaf at once, and so are its
+certified corners: the pairs of a leaf sharing a certified corner are counted a block at a time, and only the
+others are tested one by one.  The star of a vertex whose faces are consistently oriented round it (every
+vertex of a closed, oriented manifold) is ringed by following its link edges, ``x → y`` then ``y → z``, with
+no sort; any other star by matching link vertices as before; either way the certificate is the same.  This
+module's numpy code stays the reference and the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on
+both.
 """
 
 from __future__ import annotations
