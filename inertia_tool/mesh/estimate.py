@@ -52,6 +52,7 @@ from ..tolerances import ESTIMATE_MAX_MASS_RTOL
 from ..values import frozen_value
 from .edges import edge_keys
 from .seal import Seal
+from ..rounding import round_up
 
 __all__ = ["Uncertainty", "Estimate", "boundary_edges", "patched_estimate", "winding_estimate", "uncertainty_from",
            "enclosing_balls", "check_useful", "hole_doubt_volumes", "ball_slab_volume",
@@ -483,8 +484,8 @@ def check_useful(estimate_volume: float, unc: Uncertainty, *, source: str, what:
                                "in a mesh editor, or for a sheet use the shell model with a wall `thickness`")
     bounds = (unc.mass, unc.center_of_mass, unc.inertia)
     if not all(np.isfinite(b) for b in bounds) or unc.mass > max_mass_rtol:
-        mass = f"±{100 * unc.mass:.3g} %" if np.isfinite(unc.mass) else "unbounded"
-        com = f"within {unc.center_of_mass:.3g} m" if np.isfinite(unc.center_of_mass) else "unbounded"
+        mass = f"±{round_up(100 * unc.mass):.3g} %" if np.isfinite(unc.mass) else "unbounded"
+        com = f"within {round_up(unc.center_of_mass):.3g} m" if np.isfinite(unc.center_of_mass) else "unbounded"
         raise InvalidMeshError(f"{source}: {what} cannot be bounded usefully (mass {mass}, centre of mass {com}; "
                                f"an estimate is reported only within ±{100 * max_mass_rtol:g} % mass): {why}",
                                details={"mass_bound": float(unc.mass),
@@ -554,9 +555,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             corners = v[f[touched]]
             reach = np.linalg.norm(corners - closed.centroid, axis=2).max(axis=1) + seal.slack[touched]
             far = max(far, float(reach.max()))
+        moved = round_up(float(seal.slack.max(initial=0.0)))
         sealed = (f"seams sealed ({seal.welded:,} crack vertices welded, {seal.split:,} T-junction vertices "
-                  f"put on their edges, every corner within {float(seal.slack.max(initial=0.0)):.3g} m of where "
-                  "it was); ")
+                  f"put on their edges, every corner within {moved:.3g} m of where it was); ")
     unc = uncertainty_from(closed.volume, closed.centroid, closed.second_moment, doubt, far)
     if n_loops:
         detail = (f"{sealed}{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) "
