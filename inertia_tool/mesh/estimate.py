@@ -14,8 +14,11 @@ answer is an estimate with bounds.  Two estimators, each returning moments and a
   beside the hole no farther than the rim does** (:func:`hole_doubt_volumes`); the cone does too, so each
   ball is cut to that slab, and the volume in doubt is the total volume of the cut balls.  The convex hull of the
   rim is *not* enough (a planar rim has a hull of volume 0, yet a spherical cap over it is far from flat),
-  and no hole gets a bound of 0.  Seams sealed first (cracks, T-junctions; :mod:`~.seal`) add the volume
-  of the parallel bodies of the faces sealing touched.
+  and no hole gets a bound of 0.  **Third assumption, for a hole across one crease of a faceted part: the
+  missing surface lies in the two planes that hold its rim** (:func:`crease_fills`): each plane's part of
+  the rim is filled in that plane instead of by the cone, and the ball is cut to both slabs.  Seams sealed
+  first (cracks, T-junctions; :mod:`~.seal`) add the volume of the parallel bodies of the faces sealing
+  touched.
 * :func:`winding_estimate` — for soups (no surface with holes to patch): the generalized winding number
   ``w`` (``winding.py``) on a regular grid of cells.  **Assumption: the solid is the set where ``w > 1/2``**
   (Jacobson et al.'s definition for soups); cells with ``w > 1/2`` are material and integrated exactly as

@@ -47,7 +47,8 @@ REPAIR_RULE = (
     "then a soup (more than SOUP_BOUNDARY_SHARE of the faces still share no edge with another: loose triangles, no "
     "surface with holes to follow) -> the winding-number grid, whose solid is by definition where w > 1/2; "
     "anything else -> close each remaining hole by a cone, bounded by the ball enclosing its rim cut to the slab "
-    "around the plane of the face beside it that the rim strays least from; "
+    "around the plane of the face beside it that the rim strays least from (a hole across one crease, whose rim "
+    "two planes beside it hold, filled in those two planes instead and bounded by both slabs); "
     "an estimate whose bound is useless (not finite, or mass beyond ESTIMATE_MAX_MASS_RTOL) or whose volume is "
     "not positive -> refused with the reason, never replaced by the other method"
 )
