@@ -556,6 +556,8 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         normal = np.cross(v[f[ring, 1]] - a0, v[f[ring, 2]] - a0)
         length = np.linalg.norm(normal, axis=1)
         keep = length > 0
+        if not keep.any():
+            continue
         unit, a0 = normal[keep] / length[keep, None], a0[keep]
         offset = np.einsum("ij,ij->i", unit, a0)
         rim = np.array(list(succ), dtype=np.int64)
