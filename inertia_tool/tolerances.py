@@ -117,6 +117,12 @@ ROUNDOFF_RTOL = 1e-10
 #: ``ROUNDOFF_RTOL`` of the result.
 COINCIDENT_RTOL = 64 * 2.0 ** -53
 
+#: A printed bound is rounded up (``rounding.round_up``) from the stored value raised by this much: the float64
+#: sums and products a bound comes from (``100 * mass``, a ratio of two volume sums) land a few units in the last
+#: place, 2⁻⁵³ each, from the exact value, and the printed number must cover the exact one.  An exact decimal
+#: such as 25 % is therefore printed one step up (26 % at two digits): the price of never printing too little.
+PRINTED_BOUND_RTOL = 1e-12
+
 # -- limits on the input (guards, not tolerances; here so that a command's parser states them without loading
 #    the mesh layer) ---------------------------------------------------------------------------------------------
 

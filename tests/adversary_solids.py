@@ -33,7 +33,7 @@ MESH_DIR = Path(__file__).resolve().parent.parent / "meshes"
 #: Composition kinds, in the order of the benchmark table.
 KINDS = ("single", "disjoint", "shared_vertex_overlap", "shared_vertex_touch", "touching_faces",
          "overlapping", "nested", "internal_wall", "sliver", "figure_eight", "inside_out", "duplicated",
-         "coplanar_overlap", "edge_touch", "flush_cavity", "shared_edge_crossing")
+         "coplanar_overlap", "edge_touch", "flush_cavity", "shared_edge_crossing", "welded_l_shapes")
 
 #: Largest mesh integrated with rational arithmetic (faces); larger truths are float64 about a nearby point.
 FRACTION_MAX_FACES = 600
@@ -1075,6 +1075,65 @@ def _shared_edge_crossing(rng):
     raise RuntimeError("no shared-edge crossing drawn in 100 tries")
 
 
+def cell_body(cells, step, rng):
+    """Closed outward surface of a union of grid cells ``cells`` (a set of integer ``(i, j, k)``; cells meeting
+    only along an edge are not allowed): every cell face with no cell behind it, two triangles each, the
+    diagonal drawn at random.  Two bodies of one grid meet only along grid edges of both."""
+    index: dict = {}
+    faces = []
+    for cell in sorted(cells):
+        for axis in range(3):
+            for side in (0, 1):
+                nb = list(cell)
+                nb[axis] += 1 if side else -1
+                if tuple(nb) in cells:
+                    continue
+                u, w = (axis + 1) % 3, (axis + 2) % 3
+                ids = []
+                for du, dw in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                    p = [0, 0, 0]
+                    p[axis], p[u], p[w] = cell[axis] + side, cell[u] + du, cell[w] + dw
+                    ids.append(index.setdefault(tuple(p), len(index)))
+                a, b, c, d = ids if side else ids[::-1]         # counter-clockwise seen from outside
+                faces += [[a, b, c], [a, c, d]] if rng.random() < 0.5 else [[a, b, d], [b, c, d]]
+    v = np.array(sorted(index, key=index.get), dtype=np.float64) * step
+    return v, np.array(faces, dtype=np.int64)
+
+
+def _l_cells(arm_x, arm_y, width, height, turn, offset):
+    """Cells of an L-shaped prism: arms of ``arm_x`` and ``arm_y`` cells, ``width`` thick, ``height`` tall
+    from z = 0, turned by ``turn`` quarter turns about z, then moved by ``offset`` cells."""
+    flat = {(i, j) for i in range(arm_x) for j in range(width)} | {(i, j) for i in range(width) for j in range(arm_y)}
+    for _ in range(turn % 4):
+        flat = {(-j, i) for i, j in flat}
+    return {(i + offset[0], j + offset[1], k) for i, j in flat for k in range(height)}
+
+
+def _welded_l_shapes(rng):
+    """Two L-shaped prisms standing on one plane (their bottom faces coplanar and facing the same way), crossing
+    each other, tessellated on one grid and welded bit-exactly: at the crossing edges on the shared plane four
+    faces meet, two of them coplanar and facing the same way, so which faces close which body is undefined
+    there (R1b).  Truth: the union's cells, each a box, integrated in rationals."""
+    for _ in range(100):                              # bounded redraws
+        step = 0.5
+        a = _l_cells(*(int(x) for x in rng.integers(2, 5, size=2)), int(rng.integers(1, 3)),
+                     int(rng.integers(1, 4)), 0, (0, 0))
+        b = _l_cells(*(int(x) for x in rng.integers(2, 5, size=2)), int(rng.integers(1, 3)),
+                     int(rng.integers(1, 4)), int(rng.integers(4)), tuple(int(x) for x in rng.integers(-2, 4, size=2)))
+        if not (a & b) or a <= b or b <= a:
+            continue                                  # apart, or one within the other: other kinds
+        pieces = [cell_body(a, step, rng), cell_body(b, step, rng)]
+        order = rng.permutation(2)
+        mesh = _weld_exact(*concat(*[pieces[i] for i in order]))
+        union = a | b
+        signed = [(1, box((step, step, step), (np.asarray(c, dtype=np.float64) + 0.5) * step)) for c in sorted(union)]
+        recipe = (f"two L-shaped prisms of {len(a)} and {len(b)} cells of {step} on one grid, both standing on "
+                  f"z = 0 (coplanar bottoms facing the same way), crossing ({len(a & b)} cells shared); vertices "
+                  "welded (non-manifold crossing edges)")
+        return _finish("welded_l_shapes", rng, signed, mesh, recipe)
+    raise RuntimeError("no crossing L shapes drawn in 100 tries")
+
+
 def _weld_exact(v, f):
     """Merge bit-identical vertices."""
     uniq, inv = np.unique(v, axis=0, return_inverse=True)
@@ -1087,6 +1146,7 @@ _BUILDERS = {
     "nested": _nested, "internal_wall": _internal_wall, "sliver": _sliver, "figure_eight": _figure_eight,
     "inside_out": _inside_out, "duplicated": _duplicated, "coplanar_overlap": _coplanar_overlap,
     "edge_touch": _edge_touch, "flush_cavity": _flush_cavity, "shared_edge_crossing": _shared_edge_crossing,
+    "welded_l_shapes": _welded_l_shapes,
 }
 
 

@@ -76,18 +76,88 @@ def test_missing_triangle_of_a_flat_face_is_answered_not_refused_at_400_percent(
         assert p.mass == pytest.approx(6.0, rel=1e-12)
 
 
-def test_hole_across_a_crease_keeps_its_ball():
-    """Two triangles of different sides (sharing the box's edge) missing: the rim is bent over the edge, no
-    face beside it holds it, and the slab is as wide as the hole: the bound is the ball's, and holds."""
+def test_hole_across_a_crease_is_filled_in_its_two_planes():
+    """Issue 21 item 4: two triangles of different sides (sharing the box's edge) missing.  The rim is bent over
+    the edge; no one plane holds it, and the slab was as wide as the hole (the ball's bound, ±330 %, refused).
+    Each of the two sides holds three rim corners, every rim edge lies in one side, and the rim changes side
+    twice, at the edge's ends: each side's part is filled in its own plane, which is exact for the box, with a
+    bound of round-off.  Every such pair of the 12-triangle box."""
     v, f = box_arrays((1.0, 2.0, 3.0))
     normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    plus_x, plus_y = np.flatnonzero(normals[:, 0] > 0), np.flatnonzero(normals[:, 1] > 0)
-    # one triangle of each side that share an edge
-    pair = next((a, b) for a in plus_x for b in plus_y if len(set(f[a]) & set(f[b])) == 2)
-    open_f = np.delete(f, list(pair), axis=0)
+    truth = volume_moments(v, f)
+    pairs = [(a, b) for a in range(len(f)) for b in range(a + 1, len(f))
+             if len(set(f[a]) & set(f[b])) == 2 and abs(float(normals[a] @ normals[b])) == 0.0]
+    assert len(pairs) == 12
+    for pair in pairs:
+        est = patched_estimate(v, np.delete(f, list(pair), axis=0), volume_moments)
+        assert "across a crease" in est.detail
+        assert est.volume == pytest.approx(6.0, rel=1e-14)
+        assert np.allclose(est.second_moment, truth.second_moment, rtol=1e-13, atol=1e-13)
+        assert 0 < est.uncertainty.mass < 1e-12
+        assert _holds(est, truth)
+
+
+@settings(max_examples=30, deadline=None)
+@given(quat=st.lists(st.floats(-1, 1), min_size=4, max_size=4).filter(lambda q: np.linalg.norm(q) > 0.1),
+       corner=st.integers(0, 7), extents=st.lists(st.floats(0.2, 5.0), min_size=3, max_size=3))
+def test_crease_fill_of_a_turned_subdivided_box_holds_its_bound(quat, corner, extents):
+    """A box whose faces are each split in four, turned at random, less the triangles touching one edge at a
+    corner (parts of two faces, the rim bent over the edge; sometimes a third face's triangle goes too, and
+    then no pair of planes holds the rim and the cone and ball stay): the stated bound contains the truth."""
+    v0, f0 = box_arrays(tuple(extents))
+    mesh = trimesh.Trimesh(v0, f0, process=False).subdivide()
+    v, f = np.asarray(mesh.vertices) @ Rotation.from_quat(quat).as_matrix().T, np.asarray(mesh.faces)
+    truth = volume_moments(v, f)
+    near = np.argsort(np.linalg.norm(v[f].mean(axis=1) - v[corner % len(v)], axis=1))[:2]
+    open_f = np.delete(f, near, axis=0)
+    est = patched_estimate(v, open_f, volume_moments)
+    assert _holds(est, truth)
+
+
+@settings(max_examples=30, deadline=None)
+@given(sections=st.integers(5, 16), seed=st.integers(0, 2 ** 31 - 1), count=st.integers(1, 6))
+def test_holes_near_the_rim_of_a_coarse_cylinder_are_inside_their_bound(sections, seed, count):
+    """A coarse cylinder (a faceted side, fan caps) less ``count`` faces nearest a random point of its top rim:
+    holes across the crease between cap and side (filled in the two planes when they qualify), holes of one
+    plane, holes across several facets (cone and ball): whatever the fill, the stated bound holds."""
+    s = trimesh.creation.cylinder(radius=1.0, height=1.5, sections=sections)
+    v, f = np.asarray(s.vertices), np.asarray(s.faces)
+    rng = np.random.default_rng(seed)
+    angle = rng.uniform(0, 2 * np.pi)
+    point = np.array([np.cos(angle), np.sin(angle), 0.75])
+    gone = np.argsort(np.linalg.norm(v[f].mean(axis=1) - point, axis=1))[:count]
+    open_f = np.delete(f, gone, axis=0)
     est = patched_estimate(v, open_f, volume_moments)
     assert _holds(est, volume_moments(v, f))
-    assert est.uncertainty.mass > 0.3
+
+
+def test_the_octahedron_is_not_a_crease_hole():
+    """Two faces of the octahedron missing: the rim lies on two of the faces beside it, but each holds only an
+    edge of the rim (two corners), and the missing faces lie in two other planes: not filled in the ring's
+    planes (that would be 33 % off with a bound of round-off), the ball decides."""
+    v = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=float)
+    f = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    est = patched_estimate(v, f[2:], volume_moments)
+    assert "across a crease" not in est.detail
+    assert _holds(est, volume_moments(v, f))
+
+
+@pytest.mark.xfail(strict=True, reason="stated limit (docs/meshes.md): a hole that took a whole feature standing "
+                   "on a flat face leaves the ball over its rim; nothing near the rim shows it")
+def test_a_hole_that_took_a_whole_boss_is_inside_its_bound():
+    """The mechanism of the one failing bound of the coverage benchmark (``7-38-crack_hole``: a connector
+    housing of xarm7's ``link_base.stl`` taken whole), made small: a 5 × 5 × 1 slab with a 1 × 1 × 3 boss on
+    top, the boss's walls and top removed.  The rim is the boss's footprint, flat, in the slab's top face;
+    the patch is flat and its bound round-off, the boss (3 of 28 cells) is missing.  Strict xfail: fails the
+    suite as soon as such holes are detected or bounded, so that this is turned into a plain test."""
+    import adversary_solids as S
+    cells = {(i, j, 0) for i in range(5) for j in range(5)} | {(2, 2, k) for k in range(1, 4)}
+    v, f = S.cell_body(cells, 1.0, np.random.default_rng(0))
+    truth = volume_moments(v, f)
+    assert truth.volume == pytest.approx(28.0)
+    boss = np.all(v[f][:, :, 2] >= 1.0, axis=1) & np.all(np.abs(v[f][:, :, :2] - 2.5) <= 0.5, axis=(1, 2))
+    est = patched_estimate(v, f[~boss], volume_moments)
+    assert _holds(est, truth)
 
 
 def test_octahedron_missing_a_face_stays_refused():

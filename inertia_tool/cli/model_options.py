@@ -32,6 +32,7 @@ from ..errors import InertiaToolWarning, UsageError
 from ..tolerances import DEFAULT_MAX_FACES, MERGE_TOLERANCE
 from ..units import LENGTH_UNITS, MATERIALS, parse_density, parse_fraction, parse_length
 from .options import check_option, density_and_mass
+from ..rounding import round_up
 
 if TYPE_CHECKING:     # the engine loads when a part is loaded, not to build a parser (``analyze --help``)
     from ..mass.properties import MassProperties
@@ -444,5 +445,5 @@ def model_words(model: dict) -> str:
         return f"; thin shell {model['thickness']:g} m"
     if model["model"] == "printed":
         return (f"; printed: skin {model['skin']:g} m, infill {100 * model['infill']:g}% "
-                f"(inward-offset model, mass within {100 * model['mass_error_bound']:.2g}%)")
+                f"(inward-offset model, mass within {round_up(100 * model['mass_error_bound'], 2):.2g}%)")
     return ""

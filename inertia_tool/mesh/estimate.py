@@ -14,8 +14,11 @@ answer is an estimate with bounds.  Two estimators, each returning moments and a
   beside the hole no farther than the rim does** (:func:`hole_doubt_volumes`); the cone does too, so each
   ball is cut to that slab, and the volume in doubt is the total volume of the cut balls.  The convex hull of the
   rim is *not* enough (a planar rim has a hull of volume 0, yet a spherical cap over it is far from flat),
-  and no hole gets a bound of 0.  Seams sealed first (cracks, T-junctions; :mod:`~.seal`) add the volume
-  of the parallel bodies of the faces sealing touched.
+  and no hole gets a bound of 0.  **Third assumption, for a hole across one crease of a faceted part: the
+  missing surface lies in the two planes that hold its rim** (:func:`crease_fills`): each plane's part of
+  the rim is filled in that plane instead of by the cone, and the ball is cut to both slabs.  Seams sealed
+  first (cracks, T-junctions; :mod:`~.seal`) add the volume of the parallel bodies of the faces sealing
+  touched.
 * :func:`winding_estimate` — for soups (no surface with holes to patch): the generalized winding number
   ``w`` (``winding.py``) on a regular grid of cells.  **Assumption: the solid is the set where ``w > 1/2``**
   (Jacobson et al.'s definition for soups); cells with ``w > 1/2`` are material and integrated exactly as
@@ -52,9 +55,10 @@ from ..tolerances import ESTIMATE_MAX_MASS_RTOL
 from ..values import frozen_value
 from .edges import edge_keys
 from .seal import Seal
+from ..rounding import round_up
 
 __all__ = ["Uncertainty", "Estimate", "boundary_edges", "patched_estimate", "winding_estimate", "uncertainty_from",
-           "enclosing_balls", "check_useful", "hole_doubt_volumes", "ball_slab_volume",
+           "enclosing_balls", "check_useful", "hole_doubt_volumes", "ball_slab_volume", "crease_fills", "CreaseFill",
            "closed_surface_estimate"]
 
 
@@ -459,6 +463,159 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     return doubt
 
 
+@frozen_value
+class CreaseFill:
+    """A hole across one crease of a faceted part, filled in the two planes that hold its rim.
+
+    Attributes
+    ----------
+    loop : int
+        The boundary loop.
+    apexes : (2, 3) float
+        The centroid of each planar part of the rim (with the two ends of the crease segment), m.
+    caps : (k, 3) int
+        The fill's triangles: each rim edge with the apex of its plane (index ``n_vertices + 0`` or ``+ 1`` of
+        the caller's numbering, shifted by the caller), and the two triangles over the crease segment.
+    doubt : float
+        Volume in doubt, m³: the ball over the rim cut to the slab of each plane, summed.
+    """
+
+    loop: int
+    apexes: np.ndarray
+    caps: np.ndarray
+    doubt: float
+
+
+#: Most distinct planes of the faces beside one rim tried in pairs by :func:`crease_fills`.
+CREASE_MAX_PLANES = 8
+#: Most loops :func:`crease_fills` examines (one at a time, ~0.1 ms each).
+CREASE_MAX_LOOPS = 5000
+
+
+def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                 centre: np.ndarray, radius: np.ndarray) -> list[CreaseFill]:
+    """Holes across one crease, each filled by two planar fans instead of one cone (the third assumption).
+
+    A hole that took triangles from two flat faces of a faceted part meeting at a crease (a box's edge, a
+    cylinder's cap rim) has a rim that no one plane holds, so one slab cannot cut its ball.  It qualifies here
+    when two planes of faces beside it (the ring) hold the rim this way: each holds three rim vertices not on
+    a line (a two-dimensional part of the rim, not an edge: the octahedron's faces hold only an edge each),
+    every rim edge lies in one of them and none in both, and walking the rim the plane changes exactly twice,
+    at two vertices ``a`` and ``b`` lying on both (on the crease).  **Assumption: the missing surface lies in
+    those two planes** (the hole is a piece of the two faces it crosses), as far from each as the rim part it
+    holds (``e₁``, ``e₂``, plus 16 ulp of the coordinates).  Each planar part of the rim, closed by the crease
+    segment ``a–b``, is filled by a fan to the centroid of its vertices; the two fans share ``a–b`` with
+    opposite windings, so the fill has exactly the rim as boundary.  A 2-chain in a plane is fixed by its
+    boundary, so where the assumption holds exactly the fill *is* the missing surface; in general the cycle
+    "fill − missing surface" lies in the ball over the rim (assumption 1; the fans lie in the rim's convex hull)
+    cut to the union of the two slabs, whose complement is connected (each piece of the ball between the slabs
+    reaches its sphere), so the winding number of the cycle vanishes outside it: the volume in doubt is at most
+    the sum of the ball's two slab volumes (:func:`ball_slab_volume`).  Loops of at least four edges are tried,
+    at most ``CREASE_MAX_LOOPS`` of them (beyond, every hole keeps its cone).
+
+    Returns
+    -------
+    list of CreaseFill
+        The loops that qualify (others keep their cone).
+    """
+    from itertools import combinations
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n = len(v)
+    scale = float(np.max(np.abs(v))) if n else 0.0
+    margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
+    on_tol = 4.0 * margin                        # a rim vertex "on" a plane: within round-off of it
+    candidates = np.flatnonzero(np.bincount(label, minlength=n_loops) >= 4).tolist()
+    if not candidates or len(candidates) > CREASE_MAX_LOOPS:
+        return []
+    nv = np.int64(max(n, 1))
+    rim_key = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * nv + np.maximum(edges[:, 0], edges[:, 1])
+    key, _ = edge_keys(f, n)
+    hit = np.isin(key, rim_key[np.isin(label, candidates)])
+    face_loop: dict[int, set[int]] = {}
+    rim_lookup = dict(zip(rim_key.tolist(), label.tolist()))
+    for slot in np.flatnonzero(hit).tolist():
+        face_loop.setdefault(rim_lookup[int(key[slot])], set()).add(slot // 3)
+    out = []
+    for k in candidates:
+        raw = edges[label == k]
+        succ = dict(zip(raw[:, 0].tolist(), raw[:, 1].tolist()))
+        if len(succ) != len(raw) or len(raw) < 4:
+            continue                              # a vertex met twice (a pinch), or too short to cross a crease
+        walk = [int(raw[0, 0])]                   # the rim in its own order (one cycle, else skipped)
+        while len(walk) <= len(raw) and succ.get(walk[-1], walk[0]) != walk[0]:
+            walk.append(succ[walk[-1]])
+        if len(walk) != len(raw):
+            continue
+        loop_edges = np.array([[x, succ[x]] for x in walk], dtype=np.int64)
+        ring = np.array(sorted(face_loop.get(k, ())), dtype=np.int64)
+        if not len(ring):
+            continue
+        a0 = v[f[ring, 0]]
+        normal = np.cross(v[f[ring, 1]] - a0, v[f[ring, 2]] - a0)
+        length = np.linalg.norm(normal, axis=1)
+        keep = length > 0
+        if not keep.any():
+            continue
+        unit, a0 = normal[keep] / length[keep, None], a0[keep]
+        offset = np.einsum("ij,ij->i", unit, a0)
+        rim = np.array(list(succ), dtype=np.int64)
+        dist = np.abs(v[rim] @ unit.T - offset[None, :])          # (rim vertex, ring face)
+        on = dist <= on_tol
+        # distinct planes: ring faces holding the same rim vertices within round-off of one plane
+        _, first = np.unique(on.T, axis=0, return_index=True)
+        planes = [int(p) for p in first if np.count_nonzero(on[:, p]) >= 3]
+        if len(planes) < 2 or len(planes) > CREASE_MAX_PLANES:
+            continue
+        index = {int(x): i for i, x in enumerate(rim.tolist())}
+        found = None
+        for p, q in combinations(planes, 2):
+            if abs(float(unit[p] @ unit[q])) > 1.0 - 1e-9:
+                continue                          # parallel planes meet in no crease
+            in_p, in_q = on[:, p], on[:, q]
+            if not (in_p | in_q).all():
+                continue
+            if any(np.linalg.matrix_rank(v[rim[m]][1:] - v[rim[m]][0], tol=on_tol) < 2 for m in (in_p, in_q)):
+                continue
+            side: list[int] = []
+            for start, end in loop_edges.tolist():
+                ep = in_p[index[start]] and in_p[index[end]]
+                eq = in_q[index[start]] and in_q[index[end]]
+                if ep == eq:
+                    side = []
+                    break                         # an edge in neither plane, or along the crease itself
+                side.append(0 if ep else 1)
+            if side and sum(side[i] != side[i - 1] for i in range(len(side))) == 2:
+                found = (p, q, side)
+                break
+        if found is None:
+            continue
+        p, q, side = found
+        order = loop_edges.tolist()
+        switch = [i for i in range(len(side)) if side[i] != side[i - 1]]
+        # the vertex where plane p's chain ends and q's begins (a), and where q's ends and p's begins (b)
+        a = next(order[i][0] for i in switch if side[i] == 1)
+        b = next(order[i][0] for i in switch if side[i] == 0)
+        parts = []
+        for which in (0, 1):
+            ids = sorted({x for (s0, s1), sd in zip(order, side) if sd == which for x in (s0, s1)})
+            parts.append(v[ids].mean(axis=0))
+        apexes = np.array(parts)
+        caps = [[e1, e0, n + sd] for (e0, e1), sd in zip(order, side)]
+        # p's chain runs b → … → a and closes along a → b; q's runs a → … → b and closes along b → a
+        caps += [[b, a, n + 0], [a, b, n + 1]]
+        doubt = 0.0
+        for which, plane in ((0, p), (1, q)):
+            chain = [index[x] for (s0, s1), sd in zip(order, side) if sd == which for x in (s0, s1)]
+            half = float(dist[chain, plane].max()) + margin
+            centre_offset = float(centre[k] @ unit[plane] - offset[plane])
+            doubt += float(ball_slab_volume(np.array([radius[k]]), np.array([centre_offset]),
+                                            np.array([half]))[0])
+        out.append(CreaseFill(loop=int(k), apexes=apexes, caps=np.array(caps, dtype=np.int64), doubt=doubt))
+    return out
+
+
 #: Most (ring face, rim vertex) pairs measured by :func:`hole_doubt_volumes` (a few seconds); beyond it every
 #: hole keeps its whole ball (a bound that needs no ring).
 RING_WORK_LIMIT = 200_000_000
@@ -483,8 +640,8 @@ def check_useful(estimate_volume: float, unc: Uncertainty, *, source: str, what:
                                "in a mesh editor, or for a sheet use the shell model with a wall `thickness`")
     bounds = (unc.mass, unc.center_of_mass, unc.inertia)
     if not all(np.isfinite(b) for b in bounds) or unc.mass > max_mass_rtol:
-        mass = f"±{100 * unc.mass:.3g} %" if np.isfinite(unc.mass) else "unbounded"
-        com = f"within {unc.center_of_mass:.3g} m" if np.isfinite(unc.center_of_mass) else "unbounded"
+        mass = f"±{round_up(100 * unc.mass):.3g} %" if np.isfinite(unc.mass) else "unbounded"
+        com = f"within {round_up(unc.center_of_mass):.3g} m" if np.isfinite(unc.center_of_mass) else "unbounded"
         raise InvalidMeshError(f"{source}: {what} cannot be bounded usefully (mass {mass}, centre of mass {com}; "
                                f"an estimate is reported only within ±{100 * max_mass_rtol:g} % mass): {why}",
                                details={"mass_bound": float(unc.mass),
@@ -529,14 +686,28 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     apex = np.zeros((n_loops, 3))
     for i in range(3):
         apex[:, i] = np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) / np.maximum(size, 1)
+    creases: list[CreaseFill] = []
     if n_loops:
         centre, radius = enclosing_balls(v[vertex_of], loop_of, n_loops)
         hole_doubt = hole_doubt_volumes(v, f, edges, label, n_loops, centre, radius, vertex_of, loop_of)
+        creases = crease_fills(v, f, edges, label, n_loops, centre, radius)
     else:
         centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
-    doubt = float(np.sum(hole_doubt))
     cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
-    pv = np.vstack([v, apex])
+    extra = np.zeros((0, 3))
+    if creases:               # holes across one crease: two planar fans instead of the cone (third assumption)
+        crossed = np.zeros(n_loops, dtype=bool)
+        fills = []
+        for j, fill in enumerate(creases):
+            crossed[fill.loop] = True
+            hole_doubt[fill.loop] = fill.doubt
+            shifted = fill.caps.copy()
+            shifted[shifted >= len(v)] += n_loops + 2 * j       # apexes after the cones' (kept for numbering)
+            fills.append(shifted)
+        cap = np.vstack([cap[~crossed[label]], *fills])
+        extra = np.vstack([fill.apexes for fill in creases])
+    doubt = float(np.sum(hole_doubt))
+    pv = np.vstack([v, apex, extra])
     pf = np.vstack([f, cap])
     closed = moments(pv, pf)
     if closed.volume < 0:
@@ -554,15 +725,18 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             corners = v[f[touched]]
             reach = np.linalg.norm(corners - closed.centroid, axis=2).max(axis=1) + seal.slack[touched]
             far = max(far, float(reach.max()))
+        moved = round_up(float(seal.slack.max(initial=0.0)))
         sealed = (f"seams sealed ({seal.welded:,} crack vertices welded, {seal.split:,} T-junction vertices "
-                  f"put on their edges, every corner within {float(seal.slack.max(initial=0.0)):.3g} m of where "
-                  "it was); ")
+                  f"put on their edges, every corner within {moved:.3g} m of where it was); ")
     unc = uncertainty_from(closed.volume, closed.centroid, closed.second_moment, doubt, far)
     if n_loops:
         detail = (f"{sealed}{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) "
                   "closed by cones to their centroids; bounded by the balls enclosing their rims, each cut to the "
                   "slab around the plane of the face beside it that the rim strays least from "
                   f"(largest radius {float(radius.max()):.3g} m)")
+        if creases:
+            detail += (f"; {len(creases)} of them across a crease, filled instead in the two planes that hold "
+                       "the rim and bounded by the ball cut to both planes' slabs")
     else:
         detail = f"{sealed}no hole left" if sealed else "no hole"
     return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,

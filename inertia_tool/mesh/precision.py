@@ -38,6 +38,7 @@ import numpy as np
 from .._native import accel, faces_for_c, threads
 from ..errors import StoragePrecisionWarning
 from ..tolerances import STORAGE_PRECISION_RTOL
+from ..rounding import round_up
 
 if TYPE_CHECKING:
     from .read import RawMesh
@@ -117,7 +118,7 @@ def warn_storage_precision(raw: RawMesh, volume: float, *, rtol: float = STORAGE
     extent = float(np.max(np.abs(raw.vertices))) if raw.vertices.size else 0.0
     warnings.warn(StoragePrecisionWarning(
         f"{raw.source}: the file stores coordinates as float32; at coordinates up to {extent:.3g} m each is "
-        f"rounded by up to {rounding:.3g} m, so the volume (and mass) is known only to ±{relative:.2g} relative "
-        f"(±{bound:.3g} m³; the mesh as stored is integrated exactly). Export the part near the origin, or in a "
-        "format that stores more digits"), stacklevel=stacklevel)
+        f"rounded by up to {round_up(rounding):.3g} m, so the volume (and mass) is known only to "
+        f"±{round_up(relative, 2):.2g} relative (±{round_up(bound):.3g} m³; the mesh as stored is integrated "
+        "exactly). Export the part near the origin, or in a format that stores more digits"), stacklevel=stacklevel)
     return relative

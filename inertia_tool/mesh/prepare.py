@@ -31,6 +31,7 @@ from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_m
                      within_up_to_rounding)
 from .resolve import Resolution, resolve_surface
 from .intersect import SurfaceContacts, surface_contacts
+from ..rounding import round_up
 
 if TYPE_CHECKING:       # imported on use at run time (below)
     from .nesting import Nesting
@@ -420,7 +421,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if patched is None:                                                          # R7: exact up to round-off
         if roundoff > ROUNDOFF_RTOL and kind in ("exact", "united"):
             kind = "unverified"
-            notes.append(f"the float64 round-off of the integrals is bounded only by {roundoff:.2g} of the result "
+            notes.append("the float64 round-off of the integrals is bounded only by "
+                         f"{round_up(roundoff, 2):.2g} of the result "
                          f"(above {ROUNDOFF_RTOL:g}: a sliver thinner than its coordinates' rounding, too large for "
                          "exact arithmetic): not verified")
     bodies = int(np.count_nonzero(owner == np.arange(n_shells)))

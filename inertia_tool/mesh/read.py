@@ -12,7 +12,6 @@ corners straight from each chunk of file records, in one pass.
 
 from __future__ import annotations
 
-import math
 import os
 import re
 import stat
@@ -27,6 +26,7 @@ import numpy as np
 from ..values import frozen_value
 from ..errors import MalformedTextWarning, MeshReadError, NonPlanarPolygonWarning, TrailingDataWarning, UsageError
 from .._native import accel
+from ..rounding import round_up
 from ..units import LENGTH_UNITS, length_scale
 from .options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
 from .regular import not_regular_reason, open_regular, regular_file_resolver
@@ -485,16 +485,8 @@ def _warn_warped_quads(path: str, vertices: np.ndarray, faces: np.ndarray, warpe
     warnings.warn(NonPlanarPolygonWarning(
         f"{_display(path)}: {warped:,} of {quads:,} quadrilaterals are not planar; each was split along its "
         f"shorter diagonal (as MuJoCo reads OBJ; trimesh splits from the first corner): the other split would "
-        f"change the volume by up to {_two_digits_up(100 * six_between / six_volume):.2g} % of the whole"),
+        f"change the volume by up to {round_up(100 * six_between / six_volume, 2):.2g} % of the whole"),
         stacklevel=4)
-
-
-def _two_digits_up(x: float) -> float:
-    """``x`` > 0 rounded up to two significant digits, so that a printed bound stays a bound (``x`` is first
-    raised by 1e-12 of itself for the rounding of the sums it came from)."""
-    x *= 1 + 1e-12
-    step = 10.0 ** (math.floor(math.log10(x)) - 1)
-    return math.ceil(x / step) * step
 
 
 def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:

@@ -30,6 +30,7 @@ from ..values import frozen_value
 from ..errors import InvalidMeshError
 from ..tolerances import FLAT_RTOL
 from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
+from ..rounding import round_up
 
 if TYPE_CHECKING:
     from .estimate import Estimate
@@ -46,7 +47,8 @@ REPAIR_RULE = (
     "then a soup (more than SOUP_BOUNDARY_SHARE of the faces still share no edge with another: loose triangles, no "
     "surface with holes to follow) -> the winding-number grid, whose solid is by definition where w > 1/2; "
     "anything else -> close each remaining hole by a cone, bounded by the ball enclosing its rim cut to the slab "
-    "around the plane of the face beside it that the rim strays least from; "
+    "around the plane of the face beside it that the rim strays least from (a hole across one crease, whose rim "
+    "two planes beside it hold, filled in those two planes instead and bounded by both slabs); "
     "an estimate whose bound is useless (not finite, or mass beyond ESTIMATE_MAX_MASS_RTOL) or whose volume is "
     "not positive -> refused with the reason, never replaced by the other method"
 )
@@ -153,7 +155,7 @@ def _describe(census: EdgeBalance, welded: float | None, vertices: np.ndarray, f
     other = census.unbalanced_edges - census.boundary_edges
     if other:
         parts.append(f"{other:,} edges used more often in one direction than the other")
-    after = f" after welding vertices within {welded:.3g} m" if welded else ""
+    after = f" after welding vertices within {round_up(welded):.3g} m" if welded else ""
     edges = boundary_edges(faces, len(vertices))
     where = ""
     if len(edges):
@@ -264,8 +266,9 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                 welded = tol
                 if census.balanced:
                     if merged.largest_move > 0:
-                        notes = (f"{merged.merged_vertices:,} vertices within {tol:.3g} m of another were merged "
-                                 f"(largest move {merged.largest_move:.3g} m)",)
+                        notes = (f"{merged.merged_vertices:,} vertices within {round_up(tol):.3g} m of another were "
+                                 "merged "
+                                 f"(largest move {round_up(merged.largest_move):.3g} m)",)
                     else:   # repeated records of one point (e.g. CAD faces tessellated one by one): nothing moved
                         notes = (f"{merged.merged_vertices:,} repeated vertices (identical coordinates) were joined",)
                     if flipped:
@@ -281,7 +284,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                                         "nonmanifold_edges": census.nonmanifold_edges})
     repair_notes = []
     if welded:
-        repair_notes.append(f"vertices within {welded:.3g} m of another were merged")
+        repair_notes.append(f"vertices within {round_up(welded):.3g} m of another were merged")
     if flipped:
         repair_notes.append(f"{flipped:,} faces were turned to agree with their neighbours")
     # a repeated face uses each of its edges twice in one direction: a misoriented pair or a non-manifold edge

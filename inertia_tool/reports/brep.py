@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from ..mass.brep import BrepComparison
 from .serialize import to_jsonable
+from ..rounding import round_up
 
 __all__ = ["format_brep_comparison", "brep_comparison_dict", "brep_html_section"]
 
@@ -52,7 +53,7 @@ def format_brep_comparison(cmp: BrepComparison, density: float) -> str:
     lines.append(
         f"    tessellation ({cmp.faces:,} triangles, chord tolerance {cmp.chord:.3g} m, angular "
         f"{cmp.angular_deflection:g} rad): mass {cmp.mesh.volume * density:.9g} kg, volume off by "
-        f"{cmp.volume_error:.2e} (at most {cmp.volume_bound:.2e} = area × chord / volume), centre of mass by "
+        f"{cmp.volume_error:.2e} (at most {round_up(cmp.volume_bound):.2e} = area × chord / volume), centre of mass by "
         f"{cmp.com_error:.2e} m, inertia by {cmp.inertia_error:.2e} (relative, Frobenius)")
     return "\n".join(lines)
 

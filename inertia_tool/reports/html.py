@@ -40,6 +40,7 @@ from ..output import check_targets, write_text
 from .serialize import TENSOR_CONVENTION
 from .text import method_line
 from .numbers import number, round_off_zero
+from ..rounding import round_up
 
 __all__ = ["HtmlSection", "html_report", "write_html_report", "svg_views", "VIEWS",
            "stability_section", "DEFAULT_MAX_EDGES", "DEFAULT_MAX_FILL_FACES"]
@@ -421,8 +422,8 @@ def _core_sections(props: MassProperties, density_source: str | None, semi,
     if mesh is not None:
         u = mesh.uncertainty
         bounds = ("none: exact for the polyhedron" if u is None else
-                  f"mass ±{100 * u.mass:.3g}%, centre of mass {u.center_of_mass:.3g} m, "
-                  f"inertia ±{100 * u.inertia:.3g}%")
+                  f"mass ±{round_up(100 * u.mass):.3g}%, centre of mass {round_up(u.center_of_mass):.3g} m, "
+                  f"inertia ±{round_up(100 * u.inertia):.3g}%")
         rows = [["method", _e(mesh.method)], ["certificate", _e(mesh.certificate.describe())],
                 ["uncertainty", _e(bounds)],
                 ["faces", _e(face_count_text(mesh))], ["vertices", f"{mesh.vertices:,}"],
@@ -432,7 +433,7 @@ def _core_sections(props: MassProperties, density_source: str | None, semi,
                 ["bounding box (m)", "(" + ", ".join(_vec_cells(mesh.bbox_min)) + ") – ("
                  + ", ".join(_vec_cells(mesh.bbox_max)) + ")"]]
         if mesh.welded_tolerance is not None:
-            rows.append(["welded within", f"{mesh.welded_tolerance:.3g} m"])
+            rows.append(["welded within", f"{round_up(mesh.welded_tolerance):.3g} m"])
         if mesh.flipped_shells:
             rows.append(["inside-out shells flipped", str(mesh.flipped_shells)])
         if mesh.overlapping_shells:

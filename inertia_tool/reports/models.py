@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from .escape import escape_html
+from ..rounding import round_up
 
 if TYPE_CHECKING:  # pragma: no cover - annotations only; the thin-wall models load when a command uses them
     from ..mass.thinwall import PrintedPart
@@ -17,9 +18,9 @@ def bounds_words(summary: dict) -> str:
     if summary["mass_error_bound"] == 0.0:
         return "exact: the part is solid throughout (no core deeper than the skin, or 100 % infill)"
     return (f"bounds that hold (core integrated on {summary['cell_size'] * 1e3:.3g} mm cells): mass within "
-            f"{100 * summary['mass_error_bound']:.2g} %, centre of mass within "
-            f"{summary['center_of_mass_error_bound'] * 1e3:.2g} mm, inertia within "
-            f"{100 * summary['inertia_error_bound']:.2g} % of the largest moment")
+            f"{round_up(100 * summary['mass_error_bound'], 2):.2g} %, centre of mass within "
+            f"{round_up(summary['center_of_mass_error_bound'] * 1e3, 2):.2g} mm, inertia within "
+            f"{round_up(100 * summary['inertia_error_bound'], 2):.2g} % of the largest moment")
 
 
 def model_summary(model: str, *, thickness: float | None = None, printed: PrintedPart | None = None) -> dict:

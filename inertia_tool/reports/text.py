@@ -9,6 +9,7 @@ import numpy as np
 from ..mass.properties import MassProperties
 from .serialize import TENSOR_CONVENTION
 from .numbers import number, round_off_zero
+from ..rounding import round_up
 
 if TYPE_CHECKING:
     from ..mesh.checks import MeshReport
@@ -71,8 +72,8 @@ def method_line(mesh) -> str:
     why = ("the printed part's core is integrated numerically" if mesh.method.endswith("inward offset")
            else "the file does not define a closed solid")
     return (f"ESTIMATE (method: {mesh.method}; {why}): mass within "
-            f"±{100 * u.mass:.3g}%, centre of mass within {u.center_of_mass:.3g} m, inertia within "
-            f"±{100 * u.inertia:.3g}% (Frobenius)")
+            f"±{round_up(100 * u.mass):.3g}%, centre of mass within {round_up(u.center_of_mass):.3g} m, inertia within "
+            f"±{round_up(100 * u.inertia):.3g}% (Frobenius)")
 
 
 def format_mass_properties(props: MassProperties, *, density_source: str | None = None,
@@ -131,7 +132,7 @@ def format_mass_properties(props: MassProperties, *, density_source: str | None 
         lines.append(f"    watertight and consistently wound as read: {'yes' if mesh.watertight else 'no'}"
                      f"; degenerate faces ignored: {mesh.degenerate_faces}; zero-area faces: {mesh.zero_area_faces}")
         if mesh.welded_tolerance is not None:
-            lines.append(f"    nearly coincident vertices welded within {mesh.welded_tolerance:.3g} m")
+            lines.append(f"    nearly coincident vertices welded within {round_up(mesh.welded_tolerance):.3g} m")
         if mesh.flipped_shells:
             lines.append(f"    inside-out shells flipped: {mesh.flipped_shells}")
         if mesh.overlapping_shells:

@@ -41,6 +41,7 @@ from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
 from ..values import frozen_value
 from ..mesh.read import RawMesh
 from .description import GeometryElement, LinkGeometry, RobotDescription
+from ..rounding import round_up
 
 __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", "LinkInertial", "mesh_properties",
            "points_inside_element", "element_bounds", "LinkUncertainty", "METHODS", "MODEL_DENSITY", "fitted_element",
@@ -583,7 +584,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
         return LinkInertial(link.name, None, nan, basis, "every geom is massless in the description",
                             warnings=tuple(warned))
     method = max((m for _, _, m, _ in parts), key=_RANK.__getitem__)
-    warned += [f"{e.name or e.kind}: {u.mass:.2g} relative mass bound from the repaired mesh"
+    warned += [f"{e.name or e.kind}: {round_up(u.mass, 2):.2g} relative mass bound from the repaired mesh"
                for e, _, m, u in parts if m == "estimate" and u is not None]
     try:
         if model:
