@@ -2587,6 +2587,7 @@ accel_face_measures(PyObject *self, PyObject *args)
 
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
+static PyObject *accel_on_edge_points(PyObject *self, PyObject *args);  /* section 9, after the module */
 
 static PyMethodDef accel_methods[] = {
     {"edge_census", accel_edge_census, METH_VARARGS,
@@ -2625,6 +2626,10 @@ static PyMethodDef accel_methods[] = {
      "classified (those within a smaller certified star by its certificate); a, b (bytes of int64, a < b) and "
      "kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
+    {"on_edge_points", accel_on_edge_points, METH_VARARGS,
+     "on_edge_points(vertices, edges, points, cell, rtol, out) -> count\n\nSet out[m] = 1 (out (n,) uint8) for "
+     "each of `points` ((p,) int64) lying on the interior of one of `edges` ((k, 2) int64) to rtol of its "
+     "distance from the nearer end (seal.on_edge_vertices); `cell` only changes the speed; section 9."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -5313,5 +5318,338 @@ done:
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);
+    return result;
+}
+
+/* ======================================================================================================
+ * 9. on_edge_points -- boundary vertices lying on the interior of a boundary edge (mesh/seal.py)
+ *
+ * The twin of seal._on_edge_numpy: a point m (not an end of the edge a-b) is on the edge when
+ *     t = ((m-a).(b-a)) / max(|b-a|^2, DBL_MIN) lies in (0, 1) and
+ *     |m - (a + t (b-a))| <= rtol * min(|m-a|, |m-b|),
+ * each product sum written in the same order as the numpy twin, so the decisions are the same bit for bit.
+ * Candidates: the points are bucketed in a hash table of cubic cells of side `cell` (the cell of a point is
+ * floor((x - lo) / cell) per axis, monotone in x); each edge is cut into pieces no longer than cell / 2 and
+ * every cell met by a piece's box, widened by r = rtol |b-a| + 1e-12 (scale of its ends + cell), is visited.
+ * A point that passes the test lies within rtol |b-a| / 2 (plus round-off) of the segment, so inside one of
+ * those boxes: the candidates are a superset, and the test alone decides.  Work: the cells along each edge
+ * and the points in them (a soup's jittered copies of an end are tested once per piece at that end).
+ * ====================================================================================================== */
+
+#include <float.h>
+
+#define OE_BITS 21
+#define OE_MAXCELL ((int64_t)1 << OE_BITS)
+#define OE_EMPTY UINT64_MAX
+
+
+static inline uint64_t
+oe_key(int64_t ix, int64_t iy, int64_t iz)
+{
+    return ((uint64_t)ix << (2 * OE_BITS)) | ((uint64_t)iy << OE_BITS) | (uint64_t)iz;
+}
+
+/* The slot of a cell: blocks of 8 x 8 x 8 cells are hashed, the cells of a block keep their order inside it, so
+ * neighbouring cells (and, stored in slot order, their points) lie close in memory. */
+static inline size_t
+oe_hash(uint64_t key, size_t mask)
+{
+    const uint64_t m21 = OE_MAXCELL - 1;
+    const uint64_t ix = key >> (2 * OE_BITS), iy = (key >> OE_BITS) & m21, iz = key & m21;
+    uint64_t block = ((ix >> 3) << (2 * OE_BITS)) | ((iy >> 3) << OE_BITS) | (iz >> 3);
+    const uint64_t inside = (ix & 7) | ((iy & 7) << 3) | ((iz & 7) << 6);
+    block ^= block >> 33;
+    block *= 0xff51afd7ed558ccdULL;
+    block ^= block >> 33;
+    block *= 0xc4ceb9fe1a85ec53ULL;
+    block ^= block >> 33;
+    return (size_t)((block << 9) | inside) & mask;
+}
+
+typedef struct {
+    uint64_t key;
+    uint32_t start;
+    uint32_t count;
+} OeSlot;
+
+/* Insert `key` (or find it) in the open-addressing table; returns its slot. */
+static inline size_t
+oe_slot(OeSlot *table, size_t mask, uint64_t key)
+{
+    size_t s = oe_hash(key, mask);
+    while (table[s].key != OE_EMPTY && table[s].key != key) {
+        s = (s + 1) & mask;
+    }
+    return s;
+}
+
+/* The table at twice the size, every key moved to its new slot (counts kept); NULL when out of memory. */
+static OeSlot *
+oe_grow(OeSlot *table, size_t size)
+{
+    size_t bigger = 2 * size;
+    OeSlot *grown = (OeSlot *)malloc(bigger * sizeof(OeSlot));
+    if (grown == NULL) {
+        return NULL;
+    }
+    for (size_t s = 0; s < bigger; s++) {
+        grown[s].key = OE_EMPTY;
+        grown[s].count = 0;
+    }
+    for (size_t s = 0; s < size; s++) {
+        if (table[s].key != OE_EMPTY) {
+            grown[oe_slot(grown, bigger - 1, table[s].key)] = table[s];
+        }
+    }
+    free(table);
+    return grown;
+}
+
+static inline int64_t
+oe_cell(double x, double lo, double cell)
+{
+    return (int64_t)floor((x - lo) / cell);
+}
+
+static inline double
+oe_norm(double x, double y, double z)
+{
+    return sqrt((x * x + y * y) + z * z);
+}
+
+static PyObject *
+accel_on_edge_points(PyObject *self, PyObject *args)
+{
+    PyObject *vert_obj, *edges_obj, *points_obj, *out_obj;
+    double cell, rtol;
+    if (!PyArg_ParseTuple(args, "OOOddO", &vert_obj, &edges_obj, &points_obj, &cell, &rtol, &out_obj)) {
+        return NULL;
+    }
+    Py_buffer views[4];
+    int got = 0;
+    PyObject *result = NULL;
+    OeSlot *table = NULL;
+    int64_t *fill = NULL, *order = NULL;
+    double *coords = NULL;
+    if (!(cell > 0.0) || !isfinite(cell) || !(rtol >= 0.0) || !isfinite(rtol)) {
+        PyErr_Format(PyExc_ValueError, "Expected a finite cell > 0 and rtol >= 0, got %g and %g", cell, rtol);
+        return NULL;
+    }
+    if (PyObject_GetBuffer(vert_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(edges_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(points_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(out_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        goto done;
+    }
+    got++;
+    Py_buffer *vv = &views[0], *ev = &views[1], *pv = &views[2], *ov = &views[3];
+    if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3) {
+        PyErr_SetString(PyExc_ValueError, "Expected `vertices` as a C-contiguous (n, 3) float64 array");
+        goto done;
+    }
+    if (signed_int_size(ev) != 8 || ev->ndim != 2 || ev->shape[1] != 2) {
+        PyErr_SetString(PyExc_ValueError, "Expected `edges` as a C-contiguous (k, 2) int64 array");
+        goto done;
+    }
+    if (signed_int_size(pv) != 8 || pv->ndim != 1) {
+        PyErr_SetString(PyExc_ValueError, "Expected `points` as a C-contiguous (p,) int64 array");
+        goto done;
+    }
+    if (ov->itemsize != 1 || ov->ndim != 1 || ov->shape[0] != vv->shape[0]) {
+        PyErr_SetString(PyExc_ValueError, "Expected `out` as a writable C-contiguous (n,) uint8 array");
+        goto done;
+    }
+    const double *v = (const double *)vv->buf;
+    const int64_t *e = (const int64_t *)ev->buf;
+    const int64_t *pts = (const int64_t *)pv->buf;
+    uint8_t *out = (uint8_t *)ov->buf;
+    const int64_t n = (int64_t)vv->shape[0];
+    const size_t k = (size_t)ev->shape[0], p = (size_t)pv->shape[0];
+    if (check_indices(e, 8, 2 * k, n) < 0 || check_indices(pts, 8, p, n) < 0) {
+        goto done;
+    }
+    int64_t found = 0;
+    if (p == 0 || k == 0) {
+        result = PyLong_FromLongLong(0);
+        goto done;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY};
+    for (size_t i = 0; i < p; i++) {
+        const double *q = v + 3 * pts[i];
+        for (int c = 0; c < 3; c++) {
+            if (!isfinite(q[c])) {
+                PyErr_SetString(PyExc_ValueError, "Expected finite vertex coordinates");
+                goto done;
+            }
+            lo[c] = q[c] < lo[c] ? q[c] : lo[c];
+        }
+    }
+    if (p >= (size_t)UINT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "Expected fewer than 2**32 points");
+        goto done;
+    }
+    /* the table holds the occupied cells only (grown by doubling at half full): a few per cent of the
+     * points' count on a dense soup, so its lookups stay in cache */
+    size_t size = 1024, used = 0;
+    table = (OeSlot *)malloc(size * sizeof(OeSlot));
+    order = (int64_t *)malloc(p * sizeof(int64_t));
+    coords = (double *)malloc(3 * p * sizeof(double));
+    if (table == NULL || order == NULL || coords == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (size_t s = 0; s < size; s++) {
+        table[s].key = OE_EMPTY;
+        table[s].count = 0;
+    }
+    for (size_t i = 0; i < p; i++) {
+        const double *q = v + 3 * pts[i];
+        int64_t ix = oe_cell(q[0], lo[0], cell), iy = oe_cell(q[1], lo[1], cell), iz = oe_cell(q[2], lo[2], cell);
+        if (ix < 0 || iy < 0 || iz < 0 || ix >= OE_MAXCELL || iy >= OE_MAXCELL || iz >= OE_MAXCELL) {
+            PyErr_Format(PyExc_ValueError, "Expected a cell of at least 2**-%d of the extent, got %g", OE_BITS,
+                         cell);
+            goto done;
+        }
+        uint64_t key = oe_key(ix, iy, iz);
+        size_t s = oe_slot(table, size - 1, key);
+        if (table[s].key == OE_EMPTY) {
+            if (2 * (used + 1) > size) {
+                OeSlot *grown = oe_grow(table, size);
+                if (grown == NULL) {
+                    PyErr_NoMemory();
+                    goto done;
+                }
+                table = grown;
+                size *= 2;
+                s = oe_slot(table, size - 1, key);
+            }
+            table[s].key = key;
+            used++;
+        }
+        table[s].count++;
+    }
+    const size_t mask = size - 1;
+    uint32_t at = 0;
+    for (size_t s = 0; s < size; s++) {
+        table[s].start = at;
+        at += table[s].count;
+    }
+    fill = (int64_t *)calloc(size, sizeof(int64_t));
+    if (fill == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (size_t i = 0; i < p; i++) {
+        const double *q = v + 3 * pts[i];
+        size_t s = oe_slot(table, mask, oe_key(oe_cell(q[0], lo[0], cell), oe_cell(q[1], lo[1], cell),
+                                               oe_cell(q[2], lo[2], cell)));
+        int64_t j = (int64_t)table[s].start + fill[s]++;
+        order[j] = pts[i];
+        memcpy(coords + 3 * j, q, 3 * sizeof(double));
+    }
+    Py_BEGIN_ALLOW_THREADS
+    for (size_t i = 0; i < k; i++) {
+        const int64_t ia = e[2 * i], ib = e[2 * i + 1];
+        const double *A = v + 3 * ia, *B = v + 3 * ib;
+        const double d0 = B[0] - A[0], d1 = B[1] - A[1], d2 = B[2] - A[2];
+        const double len = oe_norm(d0, d1, d2);
+        const double len2 = len * len > DBL_MIN ? len * len : DBL_MIN;
+        double scale = cell;
+        for (int c = 0; c < 3; c++) {
+            scale = fabs(A[c]) > scale ? fabs(A[c]) : scale;
+            scale = fabs(B[c]) > scale ? fabs(B[c]) : scale;
+        }
+        const double r = rtol * len + 1e-12 * scale;
+        const double pieces_d = ceil(2.0 * len / cell);
+        const int64_t pieces = pieces_d < 1.0 ? 1 : (int64_t)pieces_d;
+        for (int64_t s = 0; s < pieces; s++) {
+            double p0[3], p1[3];
+            const double t0 = (double)s / (double)pieces, t1 = (double)(s + 1) / (double)pieces;
+            p0[0] = s == 0 ? A[0] : A[0] + t0 * d0;
+            p0[1] = s == 0 ? A[1] : A[1] + t0 * d1;
+            p0[2] = s == 0 ? A[2] : A[2] + t0 * d2;
+            p1[0] = s + 1 == pieces ? B[0] : A[0] + t1 * d0;
+            p1[1] = s + 1 == pieces ? B[1] : A[1] + t1 * d1;
+            p1[2] = s + 1 == pieces ? B[2] : A[2] + t1 * d2;
+            int64_t c_lo[3], c_hi[3];
+            int empty = 0;
+            for (int c = 0; c < 3; c++) {
+                double mn = p0[c] < p1[c] ? p0[c] : p1[c], mx = p0[c] < p1[c] ? p1[c] : p0[c];
+                c_lo[c] = oe_cell(mn - r, lo[c], cell);
+                c_hi[c] = oe_cell(mx + r, lo[c], cell);
+                c_lo[c] = c_lo[c] < 0 ? 0 : c_lo[c];
+                c_hi[c] = c_hi[c] >= OE_MAXCELL ? OE_MAXCELL - 1 : c_hi[c];
+                empty |= c_lo[c] > c_hi[c];
+            }
+            if (empty) {
+                continue;
+            }
+            for (int64_t ix = c_lo[0]; ix <= c_hi[0]; ix++) {
+                for (int64_t iy = c_lo[1]; iy <= c_hi[1]; iy++) {
+                    for (int64_t iz = c_lo[2]; iz <= c_hi[2]; iz++) {
+                        const size_t h = oe_slot(table, mask, oe_key(ix, iy, iz));
+                        if (table[h].key == OE_EMPTY) {
+                            continue;
+                        }
+                        const int64_t first = table[h].start, stop = first + table[h].count;
+                        for (int64_t j = first; j < stop; j++) {
+                            const int64_t im = order[j];
+                            if (im == ia || im == ib || out[im]) {
+                                continue;
+                            }
+                            const double *M = coords + 3 * j;
+                            const double w0 = M[0] - A[0], w1 = M[1] - A[1], w2 = M[2] - A[2];
+                            const double dot = (w0 * d0 + w1 * d1) + w2 * d2;
+                            /* t = dot / len2 (correctly rounded, len2 > 0) is in (0, 1) only if this holds */
+                            if (!(dot > 0.0 && dot < len2)) {
+                                continue;
+                            }
+                            const double t = dot / len2;
+                            if (!(t > 0.0 && t < 1.0)) {
+                                continue;
+                            }
+                            const double e0 = M[0] - (A[0] + t * d0), e1 = M[1] - (A[1] + t * d1),
+                                         e2 = M[2] - (A[2] + t * d2);
+                            const double dist2 = (e0 * e0 + e1 * e1) + e2 * e2;
+                            const double ta2 = (w0 * w0 + w1 * w1) + w2 * w2;
+                            const double b0 = M[0] - B[0], b1 = M[1] - B[1], b2 = M[2] - B[2];
+                            const double tb2 = (b0 * b0 + b1 * b1) + b2 * b2;
+                            const double near2 = ta2 < tb2 ? ta2 : tb2;
+                            /* the test below on the square roots of these same sums passes only if
+                             * dist2 <= rtol^2 near2 to a few ulps: a factor 4 rejects none it would pass */
+                            if (near2 > 1e-200 && dist2 > 4.0 * rtol * rtol * near2) {
+                                continue;
+                            }
+                            const double dist = sqrt(dist2);
+                            const double ta = sqrt(ta2), tb = sqrt(tb2);
+                            if (dist <= rtol * (ta < tb ? ta : tb)) {
+                                out[im] = 1;
+                                found++;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Py_END_ALLOW_THREADS
+    result = PyLong_FromLongLong((long long)found);
+done:
+    for (int i = 0; i < got; i++) {
+        PyBuffer_Release(&views[i]);
+    }
+    free(table);
+    free(fill);
+    free(order);
+    free(coords);
     return result;
 }
