@@ -2587,7 +2587,7 @@ accel_face_measures(PyObject *self, PyObject *args)
 
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
-static PyObject *accel_on_edge_points(PyObject *self, PyObject *args);  /* section 9, after the module */
+static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
 
 static PyMethodDef accel_methods[] = {
     {"edge_census", accel_edge_census, METH_VARARGS,
@@ -2626,10 +2626,11 @@ static PyMethodDef accel_methods[] = {
      "classified (those within a smaller certified star by its certificate); a, b (bytes of int64, a < b) and "
      "kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
-    {"on_edge_points", accel_on_edge_points, METH_VARARGS,
-     "on_edge_points(vertices, edges, points, cell, rtol, out) -> count\n\nSet out[m] = 1 (out (n,) uint8) for "
-     "each of `points` ((p,) int64) lying on the interior of one of `edges` ((k, 2) int64) to rtol of its "
-     "distance from the nearer end (seal.on_edge_vertices); `cell` only changes the speed; section 9."},
+    {"edge_point_candidates", accel_edge_point_candidates, METH_VARARGS,
+     "edge_point_candidates(vertices, edges, points, cell, rtol, gap) -> (edge, point)\n\nEvery pair of an edge "
+     "of `edges` ((k, 2) int64) and a vertex of `points` ((p,) int64, not an end of it) near its interior: "
+     "within max(gap, 2 rtol * distance from the nearer end) of it, to round-off; bytes of int64 each, by edge; "
+     "`cell` only changes the speed (seal.py); section 9."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -5322,18 +5323,20 @@ done:
 }
 
 /* ======================================================================================================
- * 9. on_edge_points -- boundary vertices lying on the interior of a boundary edge (mesh/seal.py)
+ * 9. edge_point_candidates -- boundary vertices near the interior of a boundary edge (mesh/seal.py)
  *
- * The twin of seal._on_edge_numpy: a point m (not an end of the edge a-b) is on the edge when
- *     t = ((m-a).(b-a)) / max(|b-a|^2, DBL_MIN) lies in (0, 1) and
- *     |m - (a + t (b-a))| <= rtol * min(|m-a|, |m-b|),
- * each product sum written in the same order as the numpy twin, so the decisions are the same bit for bit.
- * Candidates: the points are bucketed in a hash table of cubic cells of side `cell` (the cell of a point is
- * floor((x - lo) / cell) per axis, monotone in x); each edge is cut into pieces no longer than cell / 2 and
- * every cell met by a piece's box, widened by r = rtol |b-a| + 1e-12 (scale of its ends + cell), is visited.
- * A point that passes the test lies within rtol |b-a| / 2 (plus round-off) of the segment, so inside one of
- * those boxes: the candidates are a superset, and the test alone decides.  Work: the cells along each edge
- * and the points in them (a soup's jittered copies of an end are tested once per piece at that end).
+ * The candidates of seal.on_edge_vertices and seal._split_t_junctions, which then apply their own tests: every
+ * (edge, point) pair, the point not an end of the edge a-b, with
+ *     0 < t = ((m-a).(b-a)) / |b-a|^2 < 1 (widened by 1e-12) and
+ *     |m - (a + t (b-a))| <= max(gap, 2 rtol min(|m-a|, |m-b|)) + 64 eps (|b-a| + scale),
+ * tested on squares without roots (a superset of the pairs that pass the callers' tests: those are
+ * dist <= gap or dist <= rtol * to_end, evaluated by numpy in another order, so equal to a few ulps).  Each pair
+ * once, by edge.  The points are bucketed in a hash table of cubic cells of side `cell` (the cell of a point is
+ * floor((x - lo) / cell) per axis, monotone in x; blocks of 8^3 cells hashed, the cells of a block kept
+ * together so that neighbours are near in memory); each edge is cut into pieces no longer than cell / 2 and
+ * every cell met by a piece's box, widened by the distance above, is visited: a pair that passes lies in one of
+ * those boxes, and the test alone decides.  The seconds of a soup's T-vertex search (every vertex on the
+ * boundary) were a k-d tree's Python lists: ~9 points per edge.
  * ====================================================================================================== */
 
 #include <float.h>
@@ -5417,22 +5420,53 @@ oe_norm(double x, double y, double z)
     return sqrt((x * x + y * y) + z * z);
 }
 
-static PyObject *
-accel_on_edge_points(PyObject *self, PyObject *args)
+typedef struct {
+    int64_t *edge, *point;
+    size_t count, capacity;
+} OePairs;
+
+static int
+oe_push(OePairs *pairs, int64_t edge, int64_t point)
 {
-    PyObject *vert_obj, *edges_obj, *points_obj, *out_obj;
-    double cell, rtol;
-    if (!PyArg_ParseTuple(args, "OOOddO", &vert_obj, &edges_obj, &points_obj, &cell, &rtol, &out_obj)) {
+    if (pairs->count == pairs->capacity) {
+        size_t bigger = pairs->capacity ? 2 * pairs->capacity : 1024;
+        int64_t *e = (int64_t *)realloc(pairs->edge, bigger * sizeof(int64_t));
+        if (e == NULL) {
+            return -1;
+        }
+        pairs->edge = e;
+        int64_t *q = (int64_t *)realloc(pairs->point, bigger * sizeof(int64_t));
+        if (q == NULL) {
+            return -1;
+        }
+        pairs->point = q;
+        pairs->capacity = bigger;
+    }
+    pairs->edge[pairs->count] = edge;
+    pairs->point[pairs->count] = point;
+    pairs->count++;
+    return 0;
+}
+
+static PyObject *
+accel_edge_point_candidates(PyObject *self, PyObject *args)
+{
+    PyObject *vert_obj, *edges_obj, *points_obj;
+    double cell, rtol, gap;
+    if (!PyArg_ParseTuple(args, "OOOddd", &vert_obj, &edges_obj, &points_obj, &cell, &rtol, &gap)) {
         return NULL;
     }
-    Py_buffer views[4];
+    Py_buffer views[3];
     int got = 0;
     PyObject *result = NULL;
     OeSlot *table = NULL;
     int64_t *fill = NULL, *order = NULL;
     double *coords = NULL;
-    if (!(cell > 0.0) || !isfinite(cell) || !(rtol >= 0.0) || !isfinite(rtol)) {
-        PyErr_Format(PyExc_ValueError, "Expected a finite cell > 0 and rtol >= 0, got %g and %g", cell, rtol);
+    OePairs pairs = {NULL, NULL, 0, 0};
+    uint32_t *stamp = NULL;
+    if (!(cell > 0.0) || !isfinite(cell) || !(rtol >= 0.0) || !isfinite(rtol) || !(gap >= 0.0) || !isfinite(gap)) {
+        PyErr_Format(PyExc_ValueError, "Expected a finite cell > 0, rtol >= 0 and gap >= 0, got %g, %g and %g",
+                     cell, rtol, gap);
         return NULL;
     }
     if (PyObject_GetBuffer(vert_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
@@ -5447,11 +5481,7 @@ accel_on_edge_points(PyObject *self, PyObject *args)
         goto done;
     }
     got++;
-    if (PyObject_GetBuffer(out_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
-        goto done;
-    }
-    got++;
-    Py_buffer *vv = &views[0], *ev = &views[1], *pv = &views[2], *ov = &views[3];
+    Py_buffer *vv = &views[0], *ev = &views[1], *pv = &views[2];
     if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3) {
         PyErr_SetString(PyExc_ValueError, "Expected `vertices` as a C-contiguous (n, 3) float64 array");
         goto done;
@@ -5464,23 +5494,16 @@ accel_on_edge_points(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "Expected `points` as a C-contiguous (p,) int64 array");
         goto done;
     }
-    if (ov->itemsize != 1 || ov->ndim != 1 || ov->shape[0] != vv->shape[0]) {
-        PyErr_SetString(PyExc_ValueError, "Expected `out` as a writable C-contiguous (n,) uint8 array");
-        goto done;
-    }
     const double *v = (const double *)vv->buf;
     const int64_t *e = (const int64_t *)ev->buf;
     const int64_t *pts = (const int64_t *)pv->buf;
-    uint8_t *out = (uint8_t *)ov->buf;
     const int64_t n = (int64_t)vv->shape[0];
     const size_t k = (size_t)ev->shape[0], p = (size_t)pv->shape[0];
     if (check_indices(e, 8, 2 * k, n) < 0 || check_indices(pts, 8, p, n) < 0) {
         goto done;
     }
-    int64_t found = 0;
     if (p == 0 || k == 0) {
-        result = PyLong_FromLongLong(0);
-        goto done;
+        goto finish;
     }
     double lo[3] = {INFINITY, INFINITY, INFINITY};
     for (size_t i = 0; i < p; i++) {
@@ -5556,8 +5579,19 @@ accel_on_edge_points(PyObject *self, PyObject *args)
         order[j] = pts[i];
         memcpy(coords + 3 * j, q, 3 * sizeof(double));
     }
+    if (k >= (size_t)UINT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "Expected fewer than 2**32 edges");
+        goto done;
+    }
+    stamp = (uint32_t *)malloc(p * sizeof(uint32_t));      /* the last edge (+1) each stored point was tested on */
+    if (stamp == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    memset(stamp, 0, p * sizeof(uint32_t));
+    int failed = 0;
     Py_BEGIN_ALLOW_THREADS
-    for (size_t i = 0; i < k; i++) {
+    for (size_t i = 0; i < k && !failed; i++) {
         const int64_t ia = e[2 * i], ib = e[2 * i + 1];
         const double *A = v + 3 * ia, *B = v + 3 * ib;
         const double d0 = B[0] - A[0], d1 = B[1] - A[1], d2 = B[2] - A[2];
@@ -5568,7 +5602,10 @@ accel_on_edge_points(PyObject *self, PyObject *args)
             scale = fabs(A[c]) > scale ? fabs(A[c]) : scale;
             scale = fabs(B[c]) > scale ? fabs(B[c]) : scale;
         }
-        const double r = rtol * len + 1e-12 * scale;
+        const double slop = 64.0 * DBL_EPSILON * (len + scale);
+        /* every pair passing lies within this distance of the segment */
+        const double r = (gap > rtol * len ? gap : rtol * len) + slop + 1e-12 * scale;
+        const double gap2 = gap * gap, slop2 = slop * slop, rtol2 = 4.0 * rtol * rtol;
         const double pieces_d = ceil(2.0 * len / cell);
         const int64_t pieces = pieces_d < 1.0 ? 1 : (int64_t)pieces_d;
         for (int64_t s = 0; s < pieces; s++) {
@@ -5603,37 +5640,31 @@ accel_on_edge_points(PyObject *self, PyObject *args)
                         const int64_t first = table[h].start, stop = first + table[h].count;
                         for (int64_t j = first; j < stop; j++) {
                             const int64_t im = order[j];
-                            if (im == ia || im == ib || out[im]) {
+                            if (im == ia || im == ib || stamp[j] == (uint32_t)(i + 1)) {
                                 continue;
                             }
+                            stamp[j] = (uint32_t)(i + 1);
                             const double *M = coords + 3 * j;
                             const double w0 = M[0] - A[0], w1 = M[1] - A[1], w2 = M[2] - A[2];
                             const double dot = (w0 * d0 + w1 * d1) + w2 * d2;
-                            /* t = dot / len2 (correctly rounded, len2 > 0) is in (0, 1) only if this holds */
-                            if (!(dot > 0.0 && dot < len2)) {
+                            if (!(dot > -1e-12 * len2 && dot < (1.0 + 1e-12) * len2)) {
                                 continue;
                             }
                             const double t = dot / len2;
-                            if (!(t > 0.0 && t < 1.0)) {
-                                continue;
-                            }
                             const double e0 = M[0] - (A[0] + t * d0), e1 = M[1] - (A[1] + t * d1),
                                          e2 = M[2] - (A[2] + t * d2);
                             const double dist2 = (e0 * e0 + e1 * e1) + e2 * e2;
                             const double ta2 = (w0 * w0 + w1 * w1) + w2 * w2;
                             const double b0 = M[0] - B[0], b1 = M[1] - B[1], b2 = M[2] - B[2];
                             const double tb2 = (b0 * b0 + b1 * b1) + b2 * b2;
-                            const double near2 = ta2 < tb2 ? ta2 : tb2;
-                            /* the test below on the square roots of these same sums passes only if
-                             * dist2 <= rtol^2 near2 to a few ulps: a factor 4 rejects none it would pass */
-                            if (near2 > 1e-200 && dist2 > 4.0 * rtol * rtol * near2) {
+                            const double near2 = rtol2 * (ta2 < tb2 ? ta2 : tb2);
+                            /* (x + y)^2 <= 2 x^2 + 2 y^2: dist <= max(gap, 2 rtol near) + slop implies this */
+                            if (dist2 > 2.0 * (gap2 > near2 ? gap2 : near2) + 2.0 * slop2) {
                                 continue;
                             }
-                            const double dist = sqrt(dist2);
-                            const double ta = sqrt(ta2), tb = sqrt(tb2);
-                            if (dist <= rtol * (ta < tb ? ta : tb)) {
-                                out[im] = 1;
-                                found++;
+                            if (oe_push(&pairs, (int64_t)i, im) < 0) {
+                                failed = 1;
+                                break;
                             }
                         }
                     }
@@ -5642,7 +5673,20 @@ accel_on_edge_points(PyObject *self, PyObject *args)
         }
     }
     Py_END_ALLOW_THREADS
-    result = PyLong_FromLongLong((long long)found);
+    if (failed) {
+        PyErr_NoMemory();
+        goto done;
+    }
+finish:
+    {
+        PyObject *pe = PyBytes_FromStringAndSize((const char *)pairs.edge, (Py_ssize_t)(pairs.count * sizeof(int64_t)));
+        PyObject *pm = PyBytes_FromStringAndSize((const char *)pairs.point, (Py_ssize_t)(pairs.count * sizeof(int64_t)));
+        if (pe && pm) {
+            result = Py_BuildValue("(OO)", pe, pm);
+        }
+        Py_XDECREF(pe);
+        Py_XDECREF(pm);
+    }
 done:
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
@@ -5651,5 +5695,8 @@ done:
     free(fill);
     free(order);
     free(coords);
+    free(stamp);
+    free(pairs.edge);
+    free(pairs.point);
     return result;
 }

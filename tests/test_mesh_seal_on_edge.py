@@ -16,29 +16,25 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from inertia_tool.mesh.seal import ON_EDGE_RTOL, on_edge_vertices
+from conftest import HAVE_ACCEL
 
-pytestmark = pytest.mark.usefixtures("engine_path")
+both_paths = pytest.mark.usefixtures("engine_path")
 
 
 def brute_force(v, edges):
-    """Every boundary vertex against every boundary edge, with the test of the docstring (float64, each sum in
-    the documented order), all pairs at once."""
+    """Every boundary vertex against every boundary edge with the documented test, all pairs at once (no
+    spatial search)."""
     v = np.asarray(v, dtype=np.float64)
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     boundary = np.unique(edges)
     e = np.repeat(np.arange(len(edges)), len(boundary))
     m = np.tile(boundary, len(edges))
     a, b, p = v[edges[e, 0]], v[edges[e, 1]], v[m]
-
-    def dot(x, y):
-        return (x[:, 0] * y[:, 0] + x[:, 1] * y[:, 1]) + x[:, 2] * y[:, 2]
-
-    d, w, u = b - a, p - a, p - b
-    length = np.sqrt(dot(d, d))
-    t = dot(w, d) / np.maximum(length * length, np.finfo(float).tiny)
-    off = p - (a + t[:, None] * d)
-    dist = np.sqrt(dot(off, off))
-    near = np.minimum(np.sqrt(dot(w, w)), np.sqrt(dot(u, u)))
+    d = b - a
+    length = np.linalg.norm(d, axis=1)
+    t = np.einsum("ij,ij->i", p - a, d) / np.maximum(length ** 2, np.finfo(float).tiny)
+    dist = np.linalg.norm(p - (a + t[:, None] * d), axis=1)
+    near = np.minimum(np.linalg.norm(p - a, axis=1), np.linalg.norm(p - b, axis=1))
     on = (m != edges[e, 0]) & (m != edges[e, 1]) & (t > 0) & (t < 1) & (dist <= ON_EDGE_RTOL * near)
     return np.unique(m[on])
 
@@ -80,6 +76,7 @@ def edge_sets(draw):
     return v, e
 
 
+@both_paths
 @settings(max_examples=80, deadline=None)
 @given(edge_sets())
 def test_on_edge_vertices_equal_brute_force(case):
@@ -87,6 +84,7 @@ def test_on_edge_vertices_equal_brute_force(case):
     np.testing.assert_array_equal(on_edge_vertices(v, edges), brute_force(v, edges))
 
 
+@both_paths
 def test_t_vertex_found_and_soup_copies_not():
     """A vertex at the midpoint of an edge is found; copies of the ends moved by 1e-7 of the length are not;
     a vertex exactly at an end (a duplicate point) is not either (t = 0)."""
@@ -98,6 +96,7 @@ def test_t_vertex_found_and_soup_copies_not():
     np.testing.assert_array_equal(on_edge_vertices(v, edges), [2])
 
 
+@both_paths
 def test_soup_of_a_closed_surface_has_no_on_edge_vertex():
     """The regression case of the slow path, small: a jittered soup of an icosphere (every vertex a boundary
     vertex, every edge a boundary edge): no vertex is on an edge, on both paths, as the brute force says."""
@@ -115,10 +114,12 @@ def test_soup_of_a_closed_surface_has_no_on_edge_vertex():
     assert len(found) == 0
 
 
+@both_paths
 def test_no_boundary():
     assert on_edge_vertices(np.zeros((3, 3)), np.zeros((0, 2), dtype=np.int64)).tolist() == []
 
 
+@both_paths
 def test_t_junction_repair_unchanged_on_both_paths():
     """A box whose top face is split at a T-vertex on a shared edge (the vertex is on the neighbour's edge):
     repair seals it exactly (nothing welded onto the T-vertex), as before the kernel."""
@@ -134,3 +135,58 @@ def test_t_junction_repair_unchanged_on_both_paths():
         p = it.mass_properties((v, faces), density=1.0, repair=True)
     assert p.mesh.method == "sealed" and p.mesh.certificate.kind == "exact"
     assert p.volume == pytest.approx(1.0, rel=1e-12)
+
+
+def _damaged_sphere(seed):
+    """An icosphere with a patch split 1→4 at edge midpoints (T-junctions round it) and a crack: a patch cut
+    free, its border corners moved by 1e-7…1e-5 of the size (the lips within the seal's gap)."""
+    import trimesh
+
+    rng = np.random.default_rng(seed)
+    mesh = trimesh.creation.icosphere(3)
+    v, f = np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64)
+    patch = np.flatnonzero(np.linalg.norm(v[f].mean(axis=1) - v[rng.integers(len(v))], axis=1) < 0.5)
+    pf = f[patch]
+    edges = np.sort(pf[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    unique, inverse = np.unique(edges, axis=0, return_inverse=True)
+    mid = 0.5 * (v[unique[:, 0]] + v[unique[:, 1]])
+    mm = len(v) + inverse.reshape(-1, 3)
+    a, b, c = pf[:, 0], pf[:, 1], pf[:, 2]
+    fine = np.concatenate([np.c_[a, mm[:, 0], mm[:, 2]], np.c_[mm[:, 0], b, mm[:, 1]],
+                           np.c_[mm[:, 2], mm[:, 1], c], np.c_[mm[:, 0], mm[:, 1], mm[:, 2]]])
+    keep = np.ones(len(f), dtype=bool)
+    keep[patch] = False
+    v, f = np.vstack([v, mid]), np.vstack([f[keep], fine])
+    cut = np.flatnonzero(np.linalg.norm(v[f].mean(axis=1) - v[rng.integers(len(v))], axis=1) < 0.4)
+    inside = np.zeros(len(f), dtype=bool)
+    inside[cut] = True
+    border = np.intersect1d(np.unique(f[cut]), np.unique(f[~inside]))
+    remap = np.arange(len(v))
+    remap[border] = np.arange(len(v), len(v) + len(border))
+    f = f.copy()
+    f[cut] = remap[f[cut]]
+    step = rng.normal(size=(len(border), 3))
+    moved = v[border] + 10.0 ** rng.uniform(-7, -5) * 2.0 * step / np.linalg.norm(step, axis=1, keepdims=True)
+    return np.vstack([v, moved]), f
+
+
+@pytest.mark.skipif(not HAVE_ACCEL, reason="compares the C kernel's candidates with the k-d tree's")
+@settings(max_examples=8, deadline=None)
+@given(st.integers(0, 2 ** 32 - 1))
+def test_seal_seams_same_on_both_paths(seed):
+    """The seal (T-junction splits exactly on their edges, then lip welds and splits within the gap) finds the
+    same pairs from the C kernel's candidates as from the k-d tree's: the same faces, slack and counts."""
+    from inertia_tool.mesh.seal import seal_seams
+
+    v, f = _damaged_sphere(seed)
+    gap = 1e-4 * 2.0
+    with pytest.MonkeyPatch.context() as patch:
+        patch.delenv("INERTIA_TOOL_NO_ACCEL", raising=False)
+        fast = seal_seams(v, f, gap)
+        patch.setenv("INERTIA_TOOL_NO_ACCEL", "1")
+        slow = seal_seams(v, f, gap)
+    assert fast.split > 0 or fast.welded > 0
+    np.testing.assert_array_equal(fast.faces, slow.faces)
+    np.testing.assert_array_equal(fast.slack, slow.slack)
+    assert (fast.welded, fast.split, fast.duplicates, fast.loose_faces) == \
+        (slow.welded, slow.split, slow.duplicates, slow.loose_faces)
