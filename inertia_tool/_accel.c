@@ -2588,6 +2588,7 @@ accel_face_measures(PyObject *self, PyObject *args)
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
+static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
 
 static PyMethodDef accel_methods[] = {
     {"edge_census", accel_edge_census, METH_VARARGS,
@@ -2631,6 +2632,10 @@ static PyMethodDef accel_methods[] = {
      "of `edges` ((k, 2) int64) and a vertex of `points` ((p,) int64, not an end of it) near its interior: "
      "within max(gap, 2 rtol * distance from the nearer end) of it, to round-off; bytes of int64 each, by edge; "
      "`cell` only changes the speed (seal.py); section 9."},
+    {"sample_cells", accel_sample_cells, METH_VARARGS,
+     "sample_cells(vertices, faces, steps, origin, h, dims, out)\n\nMark in `out` (bytes of the flat grid dims, "
+     "C order) the cell floor((p - origin) / h) of every barycentric sample p of each face on its grid of "
+     "steps[f] (estimate._surface_cells); section 10."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -5698,5 +5703,114 @@ done:
     free(stamp);
     free(pairs.edge);
     free(pairs.point);
+    return result;
+}
+
+/* ======================================================================================================
+ * 10. sample_cells -- the cells a surface passes through, from samples of its triangles (mesh/estimate.py)
+ *
+ * The twin of the sampling loop of estimate._surface_cells, bit for bit: triangle f (corners a, b, c) with
+ * n = steps[f] is sampled at s = i/n, t = j/n for i + j <= n, the point ((a (1-s-t) + b s) + c t) per
+ * coordinate (1-s-t evaluated as (1 - s) - t), and the cell floor((p - origin) / h) per axis, clamped to
+ * 0..dims-1, is marked in `out` (bytes of the flat grid, C order).  numpy evaluated the same expressions on
+ * blocks of (triangles, samples, 3) arrays; a needle of length L and no area costs (L / spacing)^2 / 2 samples
+ * either way, here without the temporary arrays.
+ * ====================================================================================================== */
+
+static PyObject *
+accel_sample_cells(PyObject *self, PyObject *args)
+{
+    PyObject *vert_obj, *faces_obj, *steps_obj, *out_obj;
+    double o0, o1, o2, h;
+    long long n0, n1, n2;
+    if (!PyArg_ParseTuple(args, "OOO(ddd)d(LLL)O", &vert_obj, &faces_obj, &steps_obj, &o0, &o1, &o2, &h,
+                          &n0, &n1, &n2, &out_obj)) {
+        return NULL;
+    }
+    if (!(h > 0.0) || !isfinite(h) || n0 < 1 || n1 < 1 || n2 < 1) {
+        PyErr_Format(PyExc_ValueError, "Expected a cell h > 0 and dims >= 1, got %g and (%lld, %lld, %lld)", h,
+                     n0, n1, n2);
+        return NULL;
+    }
+    Py_buffer views[4];
+    int got = 0;
+    PyObject *result = NULL;
+    Py_ssize_t m;
+    int size;
+    if (PyObject_GetBuffer(vert_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (get_faces(faces_obj, &views[got], &m, &size) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(steps_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(out_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        goto done;
+    }
+    got++;
+    Py_buffer *vv = &views[0], *fv = &views[1], *sv = &views[2], *ov = &views[3];
+    if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3) {
+        PyErr_SetString(PyExc_ValueError, "Expected `vertices` as a C-contiguous (n, 3) float64 array");
+        goto done;
+    }
+    if (signed_int_size(sv) != 8 || sv->ndim != 1 || sv->shape[0] != m) {
+        PyErr_SetString(PyExc_ValueError, "Expected `steps` as a C-contiguous (m,) int64 array, one per face");
+        goto done;
+    }
+    if (ov->itemsize != 1 || ov->ndim != 1 || (long long)ov->shape[0] != n0 * n1 * n2) {
+        PyErr_SetString(PyExc_ValueError, "Expected `out` as a writable C-contiguous byte array of prod(dims)");
+        goto done;
+    }
+    if (check_indices(fv->buf, size, 3 * (size_t)m, (int64_t)vv->shape[0]) < 0) {
+        goto done;
+    }
+    const int64_t *steps = (const int64_t *)sv->buf;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        if (steps[i] < 1 || steps[i] > (1 << 20)) {
+            PyErr_Format(PyExc_ValueError, "Expected 1 <= steps <= 2**20, got %lld at face %zd",
+                         (long long)steps[i], i);
+            goto done;
+        }
+    }
+    {
+        const double *v = (const double *)vv->buf;
+        uint8_t *out = (uint8_t *)ov->buf;
+        const double origin[3] = {o0, o1, o2};
+        const long long dims[3] = {n0, n1, n2};
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t f = 0; f < m; f++) {
+            const double *A = v + 3 * index_at(fv->buf, size, 3 * (size_t)f);
+            const double *B = v + 3 * index_at(fv->buf, size, 3 * (size_t)f + 1);
+            const double *C = v + 3 * index_at(fv->buf, size, 3 * (size_t)f + 2);
+            const int64_t n = steps[f];
+            for (int64_t i = 0; i <= n; i++) {
+                const double s = (double)i / (double)n;
+                for (int64_t j = 0; i + j <= n; j++) {
+                    const double t = (double)j / (double)n;
+                    const double w = (1.0 - s) - t;
+                    long long idx[3];
+                    for (int c = 0; c < 3; c++) {
+                        const double p = (A[c] * w + B[c] * s) + C[c] * t;
+                        const double q = floor((p - origin[c]) / h);
+                        long long k = q < 0.0 ? 0 : (q > (double)(dims[c] - 1) ? dims[c] - 1 : (long long)q);
+                        idx[c] = k;
+                    }
+                    out[(idx[0] * dims[1] + idx[1]) * dims[2] + idx[2]] = 1;
+                }
+            }
+        }
+        Py_END_ALLOW_THREADS
+    }
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    for (int i = 0; i < got; i++) {
+        PyBuffer_Release(&views[i]);
+    }
     return result;
 }
