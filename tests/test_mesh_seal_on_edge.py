@@ -190,3 +190,19 @@ def test_seal_seams_same_on_both_paths(seed):
     np.testing.assert_array_equal(fast.slack, slow.slack)
     assert (fast.welded, fast.split, fast.duplicates, fast.loose_faces) == \
         (slow.welded, slow.split, slow.duplicates, slow.loose_faces)
+
+
+@both_paths
+def test_long_edges_over_a_fine_part():
+    """A few long boundary edges over thousands of tiny ones (the grid is coarsened so that the long edges are
+    not cut into millions of pieces): the same vertices as the brute force, the T-vertex on a long edge too."""
+    rng = np.random.default_rng(3)
+    tiny = rng.normal(size=(3000, 3)) * 1e-6
+    tiny_edges = np.stack([np.arange(0, 3000, 2), np.arange(1, 3000, 2)], axis=1)
+    far = np.array([[-1.0, 0, 0], [1.0, 0, 0], [0, -1.0, 0], [0, 1.0, 0]])
+    t_vertex = np.array([[0.25, 0, 0]])                   # on the first long edge
+    v = np.vstack([tiny, far, t_vertex])
+    edges = np.vstack([tiny_edges, [[3000, 3001], [3002, 3003], [3004, 0]]])
+    found = on_edge_vertices(v, edges)
+    np.testing.assert_array_equal(found, brute_force(v, edges))
+    assert 3004 in found

@@ -315,13 +315,17 @@ def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tupl
     bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v)))
     lib = accel()
     points = v[bv]
+    cell = np.inf
     if lib is not None and np.isfinite(points).all():
         extent = float((points.max(axis=0) - points.min(axis=0)).max())
-        sample = edges[:: max(1, len(edges) // 4096)]
-        typical = float(np.median(np.linalg.norm(v[sample[:, 1]] - v[sample[:, 0]], axis=1)))
+        length = np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1)
+        typical = float(np.median(length[:: max(1, len(edges) // 4096)]))
         # a typical edge's length or the gap (only the speed depends on it), at least 2**-20 of the extent
-        # (the kernel's grid indices have 21 bits)
-        cell = max(typical, gap, extent * 2.0 ** -20, np.finfo(float).tiny)
+        # (the kernel's grid indices have 21 bits), and coarse enough that the edges are cut into at most
+        # 16 pieces each on average plus 2**20 (a few long edges over a finely meshed part)
+        cell = max(typical, gap, extent * 2.0 ** -20, 2.0 * float(length.sum()) / (16 * len(edges) + 2 ** 20),
+                   np.finfo(float).tiny)
+    if lib is not None and np.isfinite(cell):      # else (no C extension, or coordinates overflowing): the tree
         pe, pm = lib.edge_point_candidates(np.ascontiguousarray(v), np.ascontiguousarray(edges, dtype=np.int64),
                                            bv, cell, ON_EDGE_RTOL, float(gap))
         return np.frombuffer(pe, dtype=np.int64), np.frombuffer(pm, dtype=np.int64)
