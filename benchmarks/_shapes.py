@@ -1,7 +1,16 @@
-"""Meshes the benchmarks build in memory: closed tori, fan-capped cylinders, and a real-ish CAD part subdivided.
+"""Meshes the benchmarks build in memory: closed tori, fan-capped cylinders, and a real-ish CAD part subdivided;
+and the binary STL writer the benchmarks share.
 
 Shared by ``bench_intersect.py`` and any benchmark that needs the same surfaces (vertices (n, 3) float64, faces
-(m, 3) int64, outward winding).
+(m, 3) int64, outward winding):
+
+* :func:`torus`, :func:`cylinder`, :func:`wheel` (``bench_intersect.py``);
+* :func:`ring_torus` — a ring of ``2·nu·nv`` triangles, each grid quad's two triangles next to each other in the
+  face list (an exporter's patch-by-patch order), in mm (``bench_repair.py``, ``bench_scaling.py`` and so
+  ``bench_peers.py``);
+* :func:`icosphere` — a subdivided icosahedron on the sphere, ``20·4^s`` triangles (``bench_repair.py``);
+* :func:`write_binary_stl` — float32 corners, zero normals, written to a temporary file and renamed (a run cut
+  short leaves no half-written file for the next run to reuse).
 """
 
 from __future__ import annotations
@@ -76,3 +85,69 @@ def wheel(n_faces: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 SHAPES = {"torus": torus, "cylinder": cylinder, "wheel": wheel}
+
+STL_RECORD = np.dtype([("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+
+
+def ring_torus(nu: int, nv: int, major: float = 40.0, minor: float = 10.0) -> tuple[np.ndarray, np.ndarray]:
+    """A closed outward torus: ((nu·nv, 3) float64 vertices, (2·nu·nv, 3) int64 faces).
+
+    ``nu`` points round the ring (major radius ``major``), ``nv`` round the tube (minor radius ``minor``);
+    grid quad (i, j) becomes the faces (a, b, c) and (a, c, d), written one after the other.
+    """
+    u = 2 * np.pi * np.arange(nu) / nu
+    v = 2 * np.pi * np.arange(nv) / nv
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    r = major + minor * np.cos(vv)
+    pts = np.stack([r * np.cos(uu), r * np.sin(uu), minor * np.sin(vv)], axis=-1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
+    a = i * nv + j
+    b = ((i + 1) % nu) * nv + j
+    c = ((i + 1) % nu) * nv + (j + 1) % nv
+    d = i * nv + (j + 1) % nv
+    faces = np.stack([np.stack([a, b, c], -1), np.stack([a, c, d], -1)], axis=2).reshape(-1, 3)
+    return pts, faces.astype(np.int64)
+
+
+def icosphere(subdivisions: int, radius: float = 50.0) -> tuple[np.ndarray, np.ndarray]:
+    """A subdivided icosahedron projected on the sphere of ``radius``: 20·4^s faces, outward
+    ((n, 3) float64 vertices, (m, 3) int64 faces)."""
+    t = (1 + 5 ** 0.5) / 2
+    v = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t], [0, 1, -t],
+                  [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], dtype=np.float64)
+    f = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
+                  [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
+                  [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]], dtype=np.int64)
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    for _ in range(subdivisions):
+        edges = np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+        unique, inverse = np.unique(edges, axis=0, return_inverse=True)
+        mid = v[unique].mean(axis=1)
+        mid /= np.linalg.norm(mid, axis=1, keepdims=True)
+        m = (len(v) + inverse.reshape(-1)).reshape(-1, 3)         # midpoints of edges (01, 12, 20)
+        v = np.vstack([v, mid])
+        a, b, c = f[:, 0], f[:, 1], f[:, 2]
+        ab, bc, ca = m[:, 0], m[:, 1], m[:, 2]
+        f = np.concatenate([np.stack([a, ab, ca], 1), np.stack([b, bc, ab], 1), np.stack([c, ca, bc], 1),
+                            np.stack([ab, bc, ca], 1)])
+    return v * radius, f
+
+
+def write_binary_stl(path: str, vertices: np.ndarray, faces: np.ndarray | None = None,
+                     header: bytes = b"inertia_tool benchmark", chunk: int = 1 << 20) -> None:
+    """Write triangles as binary STL: ``vertices`` (k, 3, 3) triangles, or (n, 3) vertices with (k, 3) ``faces``
+    (gathered ``chunk`` faces at a time, so a 10M-face part needs no second copy in float64)."""
+    count = len(vertices) if faces is None else len(faces)
+    rec = np.zeros(count, dtype=STL_RECORD)
+    if faces is None:
+        rec["v"] = np.asarray(vertices, dtype=np.float32)
+    else:
+        flat = np.asarray(vertices, dtype=np.float32)
+        for s in range(0, count, chunk):
+            rec["v"][s:s + chunk] = flat[faces[s:s + chunk]]
+    tmp = path + ".tmp"
+    with open(tmp, "wb") as fh:
+        fh.write(header.ljust(80, b" ")[:80])
+        fh.write(np.uint32(count).tobytes())
+        rec.tofile(fh)
+    os.replace(tmp, path)

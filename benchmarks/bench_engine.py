@@ -23,9 +23,11 @@ import subprocess
 import sys
 import time
 
-import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from _shapes import write_binary_stl  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -74,13 +76,7 @@ def write_icosphere(subdivisions: int) -> str:
         return path
     os.makedirs(OUT, exist_ok=True)
     m = trimesh.creation.icosphere(subdivisions=subdivisions, radius=50.0)
-    tri = m.vertices.astype(np.float32)[m.faces]
-    rec = np.zeros(len(tri), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
-    rec["v"] = tri
-    with open(path, "wb") as fh:
-        fh.write(b"inertia_tool benchmark icosphere".ljust(80))
-        fh.write(np.uint32(len(tri)).tobytes())
-        rec.tofile(fh)
+    write_binary_stl(path, m.vertices, m.faces, header=b"inertia_tool benchmark icosphere")
     return path
 
 

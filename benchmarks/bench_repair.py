@@ -41,6 +41,10 @@ import sys
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+from _shapes import icosphere, ring_torus, write_binary_stl  # noqa: E402
+
 ROOT = os.path.dirname(HERE)
 OUT = os.path.join(HERE, "out", "repair")
 
@@ -65,46 +69,7 @@ print(json.dumps({"rc": rc, "wall": dt, "cpu": cpu, "peak": peak, "out": buf.get
 """
 
 
-def torus(nu: int = 760, nv: int = 190) -> tuple[np.ndarray, np.ndarray]:
-    """A closed outward torus, (vertices mm, faces)."""
-    u = 2 * np.pi * np.arange(nu) / nu
-    v = 2 * np.pi * np.arange(nv) / nv
-    uu, vv = np.meshgrid(u, v, indexing="ij")
-    r = 40.0 + 10.0 * np.cos(vv)
-    pts = np.stack([r * np.cos(uu), r * np.sin(uu), 10.0 * np.sin(vv)], axis=-1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
-    a = i * nv + j
-    b = ((i + 1) % nu) * nv + j
-    c = ((i + 1) % nu) * nv + (j + 1) % nv
-    d = i * nv + (j + 1) % nv
-    faces = np.stack([np.stack([a, b, c], -1), np.stack([a, c, d], -1)], axis=2).reshape(-1, 3)
-    return pts, faces.astype(np.int64)
-
-
-def icosphere(subdivisions: int = 8, radius: float = 50.0) -> tuple[np.ndarray, np.ndarray]:
-    """A subdivided icosahedron projected on the sphere, 20·4^s faces, outward (vertices mm, faces)."""
-    t = (1 + 5 ** 0.5) / 2
-    v = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t], [0, 1, -t],
-                  [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], dtype=np.float64)
-    f = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
-                  [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
-                  [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]], dtype=np.int64)
-    v /= np.linalg.norm(v, axis=1, keepdims=True)
-    for _ in range(subdivisions):
-        edges = np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-        unique, inverse = np.unique(edges, axis=0, return_inverse=True)
-        mid = v[unique].mean(axis=1)
-        mid /= np.linalg.norm(mid, axis=1, keepdims=True)
-        m = (len(v) + inverse.reshape(-1)).reshape(-1, 3)         # midpoints of edges (01, 12, 20)
-        v = np.vstack([v, mid])
-        a, b, c = f[:, 0], f[:, 1], f[:, 2]
-        ab, bc, ca = m[:, 0], m[:, 1], m[:, 2]
-        f = np.concatenate([np.stack([a, ab, ca], 1), np.stack([b, bc, ab], 1), np.stack([c, ca, bc], 1),
-                            np.stack([ab, bc, ca], 1)])
-    return v * radius, f
-
-
-BASES = {"torus": torus, "sphere": icosphere}
+BASES = {"torus": lambda: ring_torus(760, 190), "sphere": lambda: icosphere(8, 50.0)}
 KINDS = ("hole", "scattered", "soup", "tjunction")
 
 
@@ -138,15 +103,6 @@ def damage(kind: str, v: np.ndarray, f: np.ndarray, rng: np.random.Generator) ->
     raise ValueError(f"unknown damage kind {kind!r}")
 
 
-def write_stl(path: str, tri: np.ndarray) -> None:
-    rec = np.zeros(len(tri), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
-    rec["v"] = tri.astype(np.float32)
-    with open(path, "wb") as fh:
-        fh.write(b"inertia_tool repair benchmark".ljust(80))
-        fh.write(np.uint32(len(tri)).tobytes())
-        rec.tofile(fh)
-
-
 def clean_volume(v: np.ndarray, f: np.ndarray) -> float:
     """Exact polyhedral volume (mm³) of the clean base as written (float32 corners)."""
     tri = v.astype(np.float32).astype(np.float64)[f]
@@ -164,7 +120,7 @@ def build(bases: list[str], kinds: list[str], seed: int) -> list[dict]:
             rng = np.random.default_rng([seed, k, len(f)])
             tri = damage(kind, v, f, rng)
             if not os.path.exists(path):
-                write_stl(path, tri)
+                write_binary_stl(path, tri, header=b"inertia_tool repair benchmark")
             cases.append({"case": f"{base}_{kind}", "path": path, "faces": len(tri), "truth_mm3": truth})
     return cases
 

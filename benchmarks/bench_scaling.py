@@ -26,13 +26,13 @@ import subprocess
 import sys
 import time
 
-import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 OUT = os.path.join(HERE, "out")
 sys.path.insert(0, HERE)
 
+from _shapes import ring_torus, write_binary_stl  # noqa: E402
 from bench_engine import _PEAK, CHILD_TRIMESH  # noqa: E402
 
 _MIB = 1 << 20
@@ -73,26 +73,8 @@ def write_torus(target: int) -> tuple[str, int]:
     if os.path.exists(path):
         return path, m
     os.makedirs(OUT, exist_ok=True)
-    u = 2 * np.pi * np.arange(nu) / nu
-    v = 2 * np.pi * np.arange(nv) / nv
-    uu, vv = np.meshgrid(u, v, indexing="ij")
-    r = 40.0 + 10.0 * np.cos(vv)
-    pts = np.stack([r * np.cos(uu), r * np.sin(uu), 10.0 * np.sin(vv)], axis=-1).astype(np.float32)
-    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
-    a = i * nv + j
-    b = ((i + 1) % nu) * nv + j
-    c = ((i + 1) % nu) * nv + (j + 1) % nv
-    d = i * nv + (j + 1) % nv
-    faces = np.stack([np.stack([a, b, c], -1), np.stack([a, c, d], -1)], axis=2).reshape(-1, 3)
-    flat = pts.reshape(-1, 3)
-    rec = np.zeros(m, dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
-    step = 1 << 20
-    for s in range(0, m, step):
-        rec["v"][s:s + step] = flat[faces[s:s + step]]
-    with open(path, "wb") as fh:
-        fh.write(b"inertia_tool benchmark torus".ljust(80))
-        fh.write(np.uint32(m).tobytes())
-        rec.tofile(fh)
+    pts, faces = ring_torus(nu, nv)
+    write_binary_stl(path, pts, faces, header=b"inertia_tool benchmark torus")
     return path, m
 
 

@@ -2587,6 +2587,8 @@ accel_face_measures(PyObject *self, PyObject *args)
 
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
+static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
+static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
 
 static PyMethodDef accel_methods[] = {
     {"edge_census", accel_edge_census, METH_VARARGS,
@@ -2625,6 +2627,15 @@ static PyMethodDef accel_methods[] = {
      "classified (those within a smaller certified star by its certificate); a, b (bytes of int64, a < b) and "
      "kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
+    {"edge_point_candidates", accel_edge_point_candidates, METH_VARARGS,
+     "edge_point_candidates(vertices, edges, points, cell, rtol, gap) -> (edge, point)\n\nEvery pair of an edge "
+     "of `edges` ((k, 2) int64) and a vertex of `points` ((p,) int64, not an end of it) near its interior: "
+     "within max(gap, 2 rtol * distance from the nearer end) of it, to round-off; bytes of int64 each, by edge; "
+     "`cell` only changes the speed (seal.py); section 9."},
+    {"sample_cells", accel_sample_cells, METH_VARARGS,
+     "sample_cells(vertices, faces, steps, origin, h, dims, out)\n\nMark in `out` (bytes of the flat grid dims, "
+     "C order) the cell floor((p - origin) / h) of every barycentric sample p of each face on its grid of "
+     "steps[f] (estimate._surface_cells); section 10."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -5313,5 +5324,493 @@ done:
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);
+    return result;
+}
+
+/* ======================================================================================================
+ * 9. edge_point_candidates -- boundary vertices near the interior of a boundary edge (mesh/seal.py)
+ *
+ * The candidates of seal.on_edge_vertices and seal._split_t_junctions, which then apply their own tests: every
+ * (edge, point) pair, the point not an end of the edge a-b, with
+ *     0 < t = ((m-a).(b-a)) / |b-a|^2 < 1 (widened by 1e-12) and
+ *     |m - (a + t (b-a))| <= max(gap, 2 rtol min(|m-a|, |m-b|)) + 64 eps (|b-a| + scale),
+ * tested on squares without roots (a superset of the pairs that pass the callers' tests: those are
+ * dist <= gap or dist <= rtol * to_end, evaluated by numpy in another order, so equal to a few ulps).  Each pair
+ * once, by edge.  The points are bucketed in a hash table of cubic cells of side `cell` (the cell of a point is
+ * floor((x - lo) / cell) per axis, monotone in x; blocks of 8^3 cells hashed, the cells of a block kept
+ * together so that neighbours are near in memory); each edge is cut into pieces no longer than cell / 2 and
+ * every cell met by a piece's box, widened by the distance above, is visited: a pair that passes lies in one of
+ * those boxes, and the test alone decides.  The seconds of a soup's T-vertex search (every vertex on the
+ * boundary) were a k-d tree's Python lists: ~9 points per edge.
+ * ====================================================================================================== */
+
+#include <float.h>
+
+#define OE_BITS 21
+#define OE_MAXCELL ((int64_t)1 << OE_BITS)
+#define OE_EMPTY UINT64_MAX
+
+
+static inline uint64_t
+oe_key(int64_t ix, int64_t iy, int64_t iz)
+{
+    return ((uint64_t)ix << (2 * OE_BITS)) | ((uint64_t)iy << OE_BITS) | (uint64_t)iz;
+}
+
+/* The slot of a cell: blocks of 8 x 8 x 8 cells are hashed, the cells of a block keep their order inside it, so
+ * neighbouring cells (and, stored in slot order, their points) lie close in memory. */
+static inline size_t
+oe_hash(uint64_t key, size_t mask)
+{
+    const uint64_t m21 = OE_MAXCELL - 1;
+    const uint64_t ix = key >> (2 * OE_BITS), iy = (key >> OE_BITS) & m21, iz = key & m21;
+    uint64_t block = ((ix >> 3) << (2 * OE_BITS)) | ((iy >> 3) << OE_BITS) | (iz >> 3);
+    const uint64_t inside = (ix & 7) | ((iy & 7) << 3) | ((iz & 7) << 6);
+    block ^= block >> 33;
+    block *= 0xff51afd7ed558ccdULL;
+    block ^= block >> 33;
+    block *= 0xc4ceb9fe1a85ec53ULL;
+    block ^= block >> 33;
+    return (size_t)((block << 9) | inside) & mask;
+}
+
+typedef struct {
+    uint64_t key;
+    uint32_t start;
+    uint32_t count;
+} OeSlot;
+
+/* Insert `key` (or find it) in the open-addressing table; returns its slot. */
+static inline size_t
+oe_slot(OeSlot *table, size_t mask, uint64_t key)
+{
+    size_t s = oe_hash(key, mask);
+    while (table[s].key != OE_EMPTY && table[s].key != key) {
+        s = (s + 1) & mask;
+    }
+    return s;
+}
+
+/* The table at twice the size, every key moved to its new slot (counts kept); NULL when out of memory. */
+static OeSlot *
+oe_grow(OeSlot *table, size_t size)
+{
+    size_t bigger = 2 * size;
+    OeSlot *grown = (OeSlot *)malloc(bigger * sizeof(OeSlot));
+    if (grown == NULL) {
+        return NULL;
+    }
+    for (size_t s = 0; s < bigger; s++) {
+        grown[s].key = OE_EMPTY;
+        grown[s].count = 0;
+    }
+    for (size_t s = 0; s < size; s++) {
+        if (table[s].key != OE_EMPTY) {
+            grown[oe_slot(grown, bigger - 1, table[s].key)] = table[s];
+        }
+    }
+    free(table);
+    return grown;
+}
+
+static inline int64_t
+oe_cell(double x, double lo, double cell)
+{
+    return (int64_t)floor((x - lo) / cell);
+}
+
+static inline double
+oe_norm(double x, double y, double z)
+{
+    return sqrt((x * x + y * y) + z * z);
+}
+
+typedef struct {
+    int64_t *edge, *point;
+    size_t count, capacity;
+} OePairs;
+
+static int
+oe_push(OePairs *pairs, int64_t edge, int64_t point)
+{
+    if (pairs->count == pairs->capacity) {
+        size_t bigger = pairs->capacity ? 2 * pairs->capacity : 1024;
+        int64_t *e = (int64_t *)realloc(pairs->edge, bigger * sizeof(int64_t));
+        if (e == NULL) {
+            return -1;
+        }
+        pairs->edge = e;
+        int64_t *q = (int64_t *)realloc(pairs->point, bigger * sizeof(int64_t));
+        if (q == NULL) {
+            return -1;
+        }
+        pairs->point = q;
+        pairs->capacity = bigger;
+    }
+    pairs->edge[pairs->count] = edge;
+    pairs->point[pairs->count] = point;
+    pairs->count++;
+    return 0;
+}
+
+static PyObject *
+accel_edge_point_candidates(PyObject *self, PyObject *args)
+{
+    PyObject *vert_obj, *edges_obj, *points_obj;
+    double cell, rtol, gap;
+    if (!PyArg_ParseTuple(args, "OOOddd", &vert_obj, &edges_obj, &points_obj, &cell, &rtol, &gap)) {
+        return NULL;
+    }
+    Py_buffer views[3];
+    int got = 0;
+    PyObject *result = NULL;
+    OeSlot *table = NULL;
+    int64_t *fill = NULL, *order = NULL;
+    double *coords = NULL;
+    OePairs pairs = {NULL, NULL, 0, 0};
+    uint32_t *stamp = NULL;
+    if (!(cell > 0.0) || !isfinite(cell) || !(rtol >= 0.0) || !isfinite(rtol) || !(gap >= 0.0) || !isfinite(gap)) {
+        PyErr_Format(PyExc_ValueError, "Expected a finite cell > 0, rtol >= 0 and gap >= 0, got %g, %g and %g",
+                     cell, rtol, gap);
+        return NULL;
+    }
+    if (PyObject_GetBuffer(vert_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(edges_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(points_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    Py_buffer *vv = &views[0], *ev = &views[1], *pv = &views[2];
+    if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3) {
+        PyErr_SetString(PyExc_ValueError, "Expected `vertices` as a C-contiguous (n, 3) float64 array");
+        goto done;
+    }
+    if (signed_int_size(ev) != 8 || ev->ndim != 2 || ev->shape[1] != 2) {
+        PyErr_SetString(PyExc_ValueError, "Expected `edges` as a C-contiguous (k, 2) int64 array");
+        goto done;
+    }
+    if (signed_int_size(pv) != 8 || pv->ndim != 1) {
+        PyErr_SetString(PyExc_ValueError, "Expected `points` as a C-contiguous (p,) int64 array");
+        goto done;
+    }
+    const double *v = (const double *)vv->buf;
+    const int64_t *e = (const int64_t *)ev->buf;
+    const int64_t *pts = (const int64_t *)pv->buf;
+    const int64_t n = (int64_t)vv->shape[0];
+    const size_t k = (size_t)ev->shape[0], p = (size_t)pv->shape[0];
+    if (check_indices(e, 8, 2 * k, n) < 0 || check_indices(pts, 8, p, n) < 0) {
+        goto done;
+    }
+    if (p == 0 || k == 0) {
+        goto finish;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY};
+    for (size_t i = 0; i < p; i++) {
+        const double *q = v + 3 * pts[i];
+        for (int c = 0; c < 3; c++) {
+            if (!isfinite(q[c])) {
+                PyErr_SetString(PyExc_ValueError, "Expected finite vertex coordinates");
+                goto done;
+            }
+            lo[c] = q[c] < lo[c] ? q[c] : lo[c];
+        }
+    }
+    if (p >= (size_t)UINT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "Expected fewer than 2**32 points");
+        goto done;
+    }
+    /* the table holds the occupied cells only (grown by doubling at half full): a few per cent of the
+     * points' count on a dense soup, so its lookups stay in cache */
+    size_t size = 1024, used = 0;
+    table = (OeSlot *)malloc(size * sizeof(OeSlot));
+    order = (int64_t *)malloc(p * sizeof(int64_t));
+    coords = (double *)malloc(3 * p * sizeof(double));
+    if (table == NULL || order == NULL || coords == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (size_t s = 0; s < size; s++) {
+        table[s].key = OE_EMPTY;
+        table[s].count = 0;
+    }
+    for (size_t i = 0; i < p; i++) {
+        const double *q = v + 3 * pts[i];
+        int64_t ix = oe_cell(q[0], lo[0], cell), iy = oe_cell(q[1], lo[1], cell), iz = oe_cell(q[2], lo[2], cell);
+        if (ix < 0 || iy < 0 || iz < 0 || ix >= OE_MAXCELL || iy >= OE_MAXCELL || iz >= OE_MAXCELL) {
+            PyErr_Format(PyExc_ValueError, "Expected a cell of at least 2**-%d of the extent, got %g", OE_BITS,
+                         cell);
+            goto done;
+        }
+        uint64_t key = oe_key(ix, iy, iz);
+        size_t s = oe_slot(table, size - 1, key);
+        if (table[s].key == OE_EMPTY) {
+            if (2 * (used + 1) > size) {
+                OeSlot *grown = oe_grow(table, size);
+                if (grown == NULL) {
+                    PyErr_NoMemory();
+                    goto done;
+                }
+                table = grown;
+                size *= 2;
+                s = oe_slot(table, size - 1, key);
+            }
+            table[s].key = key;
+            used++;
+        }
+        table[s].count++;
+    }
+    const size_t mask = size - 1;
+    uint32_t at = 0;
+    for (size_t s = 0; s < size; s++) {
+        table[s].start = at;
+        at += table[s].count;
+    }
+    fill = (int64_t *)calloc(size, sizeof(int64_t));
+    if (fill == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (size_t i = 0; i < p; i++) {
+        const double *q = v + 3 * pts[i];
+        size_t s = oe_slot(table, mask, oe_key(oe_cell(q[0], lo[0], cell), oe_cell(q[1], lo[1], cell),
+                                               oe_cell(q[2], lo[2], cell)));
+        int64_t j = (int64_t)table[s].start + fill[s]++;
+        order[j] = pts[i];
+        memcpy(coords + 3 * j, q, 3 * sizeof(double));
+    }
+    if (k >= (size_t)UINT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "Expected fewer than 2**32 edges");
+        goto done;
+    }
+    stamp = (uint32_t *)malloc(p * sizeof(uint32_t));      /* the last edge (+1) each stored point was tested on */
+    if (stamp == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    memset(stamp, 0, p * sizeof(uint32_t));
+    int failed = 0;
+    Py_BEGIN_ALLOW_THREADS
+    for (size_t i = 0; i < k && !failed; i++) {
+        const int64_t ia = e[2 * i], ib = e[2 * i + 1];
+        const double *A = v + 3 * ia, *B = v + 3 * ib;
+        const double d0 = B[0] - A[0], d1 = B[1] - A[1], d2 = B[2] - A[2];
+        const double len = oe_norm(d0, d1, d2);
+        const double len2 = len * len > DBL_MIN ? len * len : DBL_MIN;
+        double scale = cell;
+        for (int c = 0; c < 3; c++) {
+            scale = fabs(A[c]) > scale ? fabs(A[c]) : scale;
+            scale = fabs(B[c]) > scale ? fabs(B[c]) : scale;
+        }
+        const double slop = 64.0 * DBL_EPSILON * (len + scale);
+        /* every pair passing lies within this distance of the segment */
+        const double r = (gap > rtol * len ? gap : rtol * len) + slop + 1e-12 * scale;
+        const double gap2 = gap * gap, slop2 = slop * slop, rtol2 = 4.0 * rtol * rtol;
+        const double pieces_d = ceil(2.0 * len / cell);
+        const int64_t pieces = pieces_d < 1.0 ? 1 : (int64_t)pieces_d;
+        for (int64_t s = 0; s < pieces; s++) {
+            double p0[3], p1[3];
+            const double t0 = (double)s / (double)pieces, t1 = (double)(s + 1) / (double)pieces;
+            p0[0] = s == 0 ? A[0] : A[0] + t0 * d0;
+            p0[1] = s == 0 ? A[1] : A[1] + t0 * d1;
+            p0[2] = s == 0 ? A[2] : A[2] + t0 * d2;
+            p1[0] = s + 1 == pieces ? B[0] : A[0] + t1 * d0;
+            p1[1] = s + 1 == pieces ? B[1] : A[1] + t1 * d1;
+            p1[2] = s + 1 == pieces ? B[2] : A[2] + t1 * d2;
+            int64_t c_lo[3], c_hi[3];
+            int empty = 0;
+            for (int c = 0; c < 3; c++) {
+                double mn = p0[c] < p1[c] ? p0[c] : p1[c], mx = p0[c] < p1[c] ? p1[c] : p0[c];
+                c_lo[c] = oe_cell(mn - r, lo[c], cell);
+                c_hi[c] = oe_cell(mx + r, lo[c], cell);
+                c_lo[c] = c_lo[c] < 0 ? 0 : c_lo[c];
+                c_hi[c] = c_hi[c] >= OE_MAXCELL ? OE_MAXCELL - 1 : c_hi[c];
+                empty |= c_lo[c] > c_hi[c];
+            }
+            if (empty) {
+                continue;
+            }
+            for (int64_t ix = c_lo[0]; ix <= c_hi[0]; ix++) {
+                for (int64_t iy = c_lo[1]; iy <= c_hi[1]; iy++) {
+                    for (int64_t iz = c_lo[2]; iz <= c_hi[2]; iz++) {
+                        const size_t h = oe_slot(table, mask, oe_key(ix, iy, iz));
+                        if (table[h].key == OE_EMPTY) {
+                            continue;
+                        }
+                        const int64_t first = table[h].start, stop = first + table[h].count;
+                        for (int64_t j = first; j < stop; j++) {
+                            const int64_t im = order[j];
+                            if (im == ia || im == ib || stamp[j] == (uint32_t)(i + 1)) {
+                                continue;
+                            }
+                            stamp[j] = (uint32_t)(i + 1);
+                            const double *M = coords + 3 * j;
+                            const double w0 = M[0] - A[0], w1 = M[1] - A[1], w2 = M[2] - A[2];
+                            const double dot = (w0 * d0 + w1 * d1) + w2 * d2;
+                            if (!(dot > -1e-12 * len2 && dot < (1.0 + 1e-12) * len2)) {
+                                continue;
+                            }
+                            const double t = dot / len2;
+                            const double e0 = M[0] - (A[0] + t * d0), e1 = M[1] - (A[1] + t * d1),
+                                         e2 = M[2] - (A[2] + t * d2);
+                            const double dist2 = (e0 * e0 + e1 * e1) + e2 * e2;
+                            const double ta2 = (w0 * w0 + w1 * w1) + w2 * w2;
+                            const double b0 = M[0] - B[0], b1 = M[1] - B[1], b2 = M[2] - B[2];
+                            const double tb2 = (b0 * b0 + b1 * b1) + b2 * b2;
+                            const double near2 = rtol2 * (ta2 < tb2 ? ta2 : tb2);
+                            /* (x + y)^2 <= 2 x^2 + 2 y^2: dist <= max(gap, 2 rtol near) + slop implies this */
+                            if (dist2 > 2.0 * (gap2 > near2 ? gap2 : near2) + 2.0 * slop2) {
+                                continue;
+                            }
+                            if (oe_push(&pairs, (int64_t)i, im) < 0) {
+                                failed = 1;
+                                break;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Py_END_ALLOW_THREADS
+    if (failed) {
+        PyErr_NoMemory();
+        goto done;
+    }
+finish:
+    {
+        PyObject *pe = PyBytes_FromStringAndSize((const char *)pairs.edge, (Py_ssize_t)(pairs.count * sizeof(int64_t)));
+        PyObject *pm = PyBytes_FromStringAndSize((const char *)pairs.point, (Py_ssize_t)(pairs.count * sizeof(int64_t)));
+        if (pe && pm) {
+            result = Py_BuildValue("(OO)", pe, pm);
+        }
+        Py_XDECREF(pe);
+        Py_XDECREF(pm);
+    }
+done:
+    for (int i = 0; i < got; i++) {
+        PyBuffer_Release(&views[i]);
+    }
+    free(table);
+    free(fill);
+    free(order);
+    free(coords);
+    free(stamp);
+    free(pairs.edge);
+    free(pairs.point);
+    return result;
+}
+
+/* ======================================================================================================
+ * 10. sample_cells -- the cells a surface passes through, from samples of its triangles (mesh/estimate.py)
+ *
+ * The twin of the sampling loop of estimate._surface_cells, bit for bit: triangle f (corners a, b, c) with
+ * n = steps[f] is sampled at s = i/n, t = j/n for i + j <= n, the point ((a (1-s-t) + b s) + c t) per
+ * coordinate (1-s-t evaluated as (1 - s) - t), and the cell floor((p - origin) / h) per axis, clamped to
+ * 0..dims-1, is marked in `out` (bytes of the flat grid, C order).  numpy evaluated the same expressions on
+ * blocks of (triangles, samples, 3) arrays; a needle of length L and no area costs (L / spacing)^2 / 2 samples
+ * either way, here without the temporary arrays.
+ * ====================================================================================================== */
+
+static PyObject *
+accel_sample_cells(PyObject *self, PyObject *args)
+{
+    PyObject *vert_obj, *faces_obj, *steps_obj, *out_obj;
+    double o0, o1, o2, h;
+    long long n0, n1, n2;
+    if (!PyArg_ParseTuple(args, "OOO(ddd)d(LLL)O", &vert_obj, &faces_obj, &steps_obj, &o0, &o1, &o2, &h,
+                          &n0, &n1, &n2, &out_obj)) {
+        return NULL;
+    }
+    if (!(h > 0.0) || !isfinite(h) || n0 < 1 || n1 < 1 || n2 < 1) {
+        PyErr_Format(PyExc_ValueError, "Expected a cell h > 0 and dims >= 1, got %g and (%lld, %lld, %lld)", h,
+                     n0, n1, n2);
+        return NULL;
+    }
+    Py_buffer views[4];
+    int got = 0;
+    PyObject *result = NULL;
+    Py_ssize_t m;
+    int size;
+    if (PyObject_GetBuffer(vert_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (get_faces(faces_obj, &views[got], &m, &size) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(steps_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(out_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        goto done;
+    }
+    got++;
+    Py_buffer *vv = &views[0], *fv = &views[1], *sv = &views[2], *ov = &views[3];
+    if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3) {
+        PyErr_SetString(PyExc_ValueError, "Expected `vertices` as a C-contiguous (n, 3) float64 array");
+        goto done;
+    }
+    if (signed_int_size(sv) != 8 || sv->ndim != 1 || sv->shape[0] != m) {
+        PyErr_SetString(PyExc_ValueError, "Expected `steps` as a C-contiguous (m,) int64 array, one per face");
+        goto done;
+    }
+    if (ov->itemsize != 1 || ov->ndim != 1 || (long long)ov->shape[0] != n0 * n1 * n2) {
+        PyErr_SetString(PyExc_ValueError, "Expected `out` as a writable C-contiguous byte array of prod(dims)");
+        goto done;
+    }
+    if (check_indices(fv->buf, size, 3 * (size_t)m, (int64_t)vv->shape[0]) < 0) {
+        goto done;
+    }
+    const int64_t *steps = (const int64_t *)sv->buf;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        if (steps[i] < 1 || steps[i] > (1 << 20)) {
+            PyErr_Format(PyExc_ValueError, "Expected 1 <= steps <= 2**20, got %lld at face %zd",
+                         (long long)steps[i], i);
+            goto done;
+        }
+    }
+    {
+        const double *v = (const double *)vv->buf;
+        uint8_t *out = (uint8_t *)ov->buf;
+        const double origin[3] = {o0, o1, o2};
+        const long long dims[3] = {n0, n1, n2};
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t f = 0; f < m; f++) {
+            const double *A = v + 3 * index_at(fv->buf, size, 3 * (size_t)f);
+            const double *B = v + 3 * index_at(fv->buf, size, 3 * (size_t)f + 1);
+            const double *C = v + 3 * index_at(fv->buf, size, 3 * (size_t)f + 2);
+            const int64_t n = steps[f];
+            for (int64_t i = 0; i <= n; i++) {
+                const double s = (double)i / (double)n;
+                for (int64_t j = 0; i + j <= n; j++) {
+                    const double t = (double)j / (double)n;
+                    const double w = (1.0 - s) - t;
+                    long long idx[3];
+                    for (int c = 0; c < 3; c++) {
+                        const double p = (A[c] * w + B[c] * s) + C[c] * t;
+                        const double q = floor((p - origin[c]) / h);
+                        long long k = q < 0.0 ? 0 : (q > (double)(dims[c] - 1) ? dims[c] - 1 : (long long)q);
+                        idx[c] = k;
+                    }
+                    out[(idx[0] * dims[1] + idx[1]) * dims[2] + idx[2]] = 1;
+                }
+            }
+        }
+        Py_END_ALLOW_THREADS
+    }
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    for (int i = 0; i < got; i++) {
+        PyBuffer_Release(&views[i]);
+    }
     return result;
 }

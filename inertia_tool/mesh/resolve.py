@@ -250,8 +250,11 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         # under repair, not a T-junction's vertex lying on its edge (the seal puts it there without moving it;
         # merged with a sliver's apex a hair away it would fold the surface)
         among = found.unbalanced_vertices
-        if repair:
-            among = np.setdiff1d(among, on_edge_vertices(v, found.boundary))
+        if repair:     # as np.setdiff1d (sorted, each once), by a mask: numpy's hash-based unique is slow here
+            keep = np.zeros(n, dtype=bool)
+            keep[among] = True
+            keep[on_edge_vertices(v, found.boundary)] = False
+            among = np.flatnonzero(keep)
         merged = merge_close_vertices(v, f, tol, among=among)
         if merged.merged_vertices:
             welded_faces = _drop_collapsed(merged.faces)

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._native import accel
 from ..values import frozen_value
 from .edges import edge_keys
 
@@ -199,24 +200,16 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
                        ) -> tuple[np.ndarray, np.ndarray, int]:
     """Step 2: split faces at boundary vertices lying on the interior of a boundary edge; returns faces,
     slack and the number of vertices inserted (``on_edge_only``: only vertices on the edge to round-off)."""
-    from scipy.spatial import cKDTree
-
     edges = _frontier_boundary(f, len(v), region)
     if not len(edges):
         return f, slack, 0
-    edges = np.unique(edges, axis=0)
-    bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v)))
+    edges = _unique_rows(edges, len(v))
     a, b = v[edges[:, 0]], v[edges[:, 1]]
     ab = b - a
     length = np.linalg.norm(ab, axis=1)
-    near = cKDTree(v[bv], balanced_tree=False, compact_nodes=False).query_ball_point(0.5 * (a + b), 0.5 * length + gap)
-    counts = np.fromiter((len(x) for x in near), dtype=np.int64, count=len(near))
-    if not counts.sum():
+    e, m = _edge_point_candidates(v, edges, 0.0 if on_edge_only else gap)
+    if not len(e):
         return f, slack, 0
-    e = np.repeat(np.arange(len(edges)), counts)
-    m = bv[np.concatenate([np.asarray(x, dtype=np.int64) for x in near if len(x)])]
-    keep = (m != edges[e, 0]) & (m != edges[e, 1])
-    e, m = e[keep], m[keep]
     t = np.einsum("ij,ij->i", v[m] - a[e], ab[e]) / np.maximum(length[e] ** 2, np.finfo(float).tiny)
     foot = a[e] + t[:, None] * ab[e]
     dist = np.linalg.norm(v[m] - foot, axis=1)
@@ -280,31 +273,75 @@ def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
     The weld before repair leaves these alone: merging such a vertex with a near one (a sliver's apex a hair
     from the edge) would fold the surface, while putting it on its edge (:func:`seal_seams`) changes nothing.
     """
-    from scipy.spatial import cKDTree
-
     v = np.asarray(vertices, dtype=np.float64)
-    edges = np.unique(np.asarray(boundary, dtype=np.int64).reshape(-1, 2), axis=0)
+    edges = np.asarray(boundary, dtype=np.int64).reshape(-1, 2)
     if not len(edges):
         return np.zeros(0, dtype=np.int64)
-    bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v)))
+    edges = _unique_rows(edges, len(v))
+    e, m = _edge_point_candidates(v, edges, 0.0)
+    if not len(e):
+        return np.zeros(0, dtype=np.int64)
     a, b = v[edges[:, 0]], v[edges[:, 1]]
     ab = b - a
     length = np.linalg.norm(ab, axis=1)
-    near = cKDTree(v[bv], balanced_tree=False, compact_nodes=False).query_ball_point(
-        0.5 * (a + b), 0.5 * length * (1 + 1e-9))
-    counts = np.fromiter((len(x) for x in near), dtype=np.int64, count=len(near))
-    if not counts.sum():
-        return np.zeros(0, dtype=np.int64)
-    e = np.repeat(np.arange(len(edges)), counts)
-    m = bv[np.concatenate([np.asarray(x, dtype=np.int64) for x in near if len(x)])]
-    keep = (m != edges[e, 0]) & (m != edges[e, 1])
-    e, m = e[keep], m[keep]
     t = np.einsum("ij,ij->i", v[m] - a[e], ab[e]) / np.maximum(length[e] ** 2, np.finfo(float).tiny)
     dist = np.linalg.norm(v[m] - (a[e] + t[:, None] * ab[e]), axis=1)
     to_end = np.minimum(np.linalg.norm(v[m] - a[e], axis=1), np.linalg.norm(v[m] - b[e], axis=1))
     on = (t > 0) & (t < 1) & (dist <= ON_EDGE_RTOL * to_end)
-    found: np.ndarray = np.unique(m[on])
+    found: np.ndarray = np.flatnonzero(np.bincount(m[on], minlength=len(v)))    # sorted, each once
     return found
+
+
+def _unique_rows(edges: np.ndarray, n: int) -> np.ndarray:
+    """The distinct rows of (k, 2) int edges in lexicographic order, as ``numpy.unique(axis=0)`` gives them
+    (by a sort of one int64 key per row, several times faster)."""
+    nv = np.int64(max(n, 1))
+    key = np.sort(edges[:, 0].astype(np.int64) * nv + edges[:, 1])
+    key = key[np.r_[True, key[1:] != key[:-1]]]
+    rows: np.ndarray = np.stack([key // nv, key % nv], axis=1)
+    return rows
+
+
+def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tuple[np.ndarray, np.ndarray]:
+    """(edge row, vertex) pairs, by edge, of the edges' own vertices ``m`` (not an end of the edge) that may lie
+    within ``gap`` of the edge's interior or on it to ``ON_EDGE_RTOL``: a superset of the pairs the callers'
+    tests accept, which they then apply.
+
+    The C kernel (``_accel.edge_point_candidates``, section 9) visits a grid of cells along each edge and keeps
+    the pairs within the distance to round-off; without it, a k-d tree lists the vertices in the ball on each
+    edge widened by ``gap`` (every pair the tests accept lies in it).  Before the kernel, a soup (every vertex on
+    the boundary) spent seconds in the k-d tree's Python lists: ~9 vertices per edge.
+    """
+    bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v)))
+    lib = accel()
+    points = v[bv]
+    cell = np.inf
+    if lib is not None and np.isfinite(points).all():
+        extent = float((points.max(axis=0) - points.min(axis=0)).max())
+        length = np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1)
+        typical = float(np.median(length[:: max(1, len(edges) // 4096)]))
+        # a typical edge's length or the gap (only the speed depends on it), at least 2**-20 of the extent
+        # (the kernel's grid indices have 21 bits), and coarse enough that the edges are cut into at most
+        # 16 pieces each on average plus 2**20 (a few long edges over a finely meshed part)
+        cell = max(typical, gap, extent * 2.0 ** -20, 2.0 * float(length.sum()) / (16 * len(edges) + 2 ** 20),
+                   np.finfo(float).tiny)
+    if lib is not None and np.isfinite(cell):      # else (no C extension, or coordinates overflowing): the tree
+        pe, pm = lib.edge_point_candidates(np.ascontiguousarray(v), np.ascontiguousarray(edges, dtype=np.int64),
+                                           bv, cell, ON_EDGE_RTOL, float(gap))
+        return np.frombuffer(pe, dtype=np.int64), np.frombuffer(pm, dtype=np.int64)
+    from scipy.spatial import cKDTree
+
+    a, b = v[edges[:, 0]], v[edges[:, 1]]
+    length = np.linalg.norm(b - a, axis=1)
+    near = cKDTree(points, balanced_tree=False, compact_nodes=False).query_ball_point(
+        0.5 * (a + b), 0.5 * length * (1 + 1e-9) + gap)
+    counts = np.fromiter((len(x) for x in near), dtype=np.int64, count=len(near))
+    if not counts.sum():
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    e = np.repeat(np.arange(len(edges)), counts)
+    m = bv[np.concatenate([np.asarray(x, dtype=np.int64) for x in near if len(x)])]
+    keep = (m != edges[e, 0]) & (m != edges[e, 1])
+    return e[keep], m[keep]
 
 
 def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_duplicates: bool = True,
