@@ -4387,13 +4387,13 @@ ct_star_task(void *ctx, int t, int nt)
         int64_t w = v + 1;
         while (w < jb->n && jb->off[w] < 0) w++;
         int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total;
-        int32_t small[2 * CT_STAR_SMALL];
-        int32_t *link = e - s <= CT_STAR_SMALL ? small : (int32_t *)malloc((size_t)(2 * (e - s)) * sizeof(int32_t));
+        int32_t link_local[2 * CT_STAR_SMALL];
+        int32_t *link = e - s <= CT_STAR_SMALL ? link_local : (int32_t *)malloc((size_t)(2 * (e - s)) * sizeof(int32_t));
         int r = -1;
         if (link != NULL) {
             ct_star_link(jb, (int32_t)v, jb->faces + s, e - s, link);
             r = ct_star_certify(jb->V, (int32_t)v, link, e - s);
-            if (link != small) free(link);
+            if (link != link_local) free(link);
         }
         if (r < 0) {
             jb->oom[t] = 1;
@@ -4751,15 +4751,15 @@ ct_visit_block(CtScan *sc, int64_t i, int64_t base, unsigned mask, CtFace *FI, u
     unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
     if (bits && sc->max_pairs < 0) {
         const int32_t *ids = sc->ids + CT_IDBLOCK * (base / CT_LEAF);
-        unsigned big = 0, small = 0;
+        unsigned big = 0, in_small = 0;
         for (int c = 0; c < 3; c++) {
             if (!((bits >> c) & 9u)) continue;
             unsigned eq = ct_share_mask(ids, ct_id(sc->ids, i, c));
             if (bits & (8u << c)) big |= eq;
-            else small |= eq;
+            else in_small |= eq;
         }
         mask &= ~big;
-        unsigned counted = mask & small;
+        unsigned counted = mask & in_small;
         int n = ct_popcount(counted);
         sc->candidates += n;
         sc->tested += n;
