@@ -2057,6 +2057,7 @@ typedef struct {
     size_t m, n;
     int nt;
     int nomem;
+    int bad;                             /* a face index out of range: nothing is computed */
     int shared;                          /* a vertex carries faces of two components */
     int32_t ticket;
     size_t fpart[MAX_THREADS + 1];       /* part t of the faces: [fpart[t], fpart[t + 1]) */
@@ -2095,9 +2096,14 @@ cs_count_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
     uint32_t *cnt = c->cnt[t];
+    uint64_t n = c->n;
     for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
         int64_t a = index_at(c->f, c->size, 3 * i), b = index_at(c->f, c->size, 3 * i + 1);
         int64_t d = index_at(c->f, c->size, 3 * i + 2);
+        if ((uint64_t)a >= n || (uint64_t)b >= n || (uint64_t)d >= n) {   /* the caller reports where */
+            __atomic_store_n(&c->bad, 1, __ATOMIC_RELAXED);
+            return;
+        }
         cnt[a < b ? a : b]++;
         cnt[b < d ? b : d]++;
         cnt[d < a ? d : a]++;
@@ -2384,13 +2390,16 @@ cs_free(CsTask *c)
     free(c);
 }
 
-/* The census_shells work with the GIL released; -1 when memory ran out, else the number of shells (0 when
- * no labels were asked for). */
+/* The census_shells work with the GIL released; -1 when memory ran out, -2 on an index out of range, else
+ * the number of shells (0 when no labels were asked for). */
 static int64_t
 cs_run(CsTask *c)
 {
     int nt = c->nt;
-    run_parallel(nt, cs_count_task, c);
+    run_parallel(nt, cs_count_task, c);       /* checks the indices too */
+    if (c->bad) {
+        return -2;
+    }
     run_parallel(nt, cs_sum_task, c);
     int64_t run = 0;
     for (int t = 0; t < nt; t++) {
@@ -2491,9 +2500,6 @@ accel_census_shells(PyObject *self, PyObject *args)
         PyErr_Format(PyExc_ValueError, "Expected at most 1,431,655,765 faces, got %zd", m);
         goto done;
     }
-    if (check_indices(fv.buf, size, 3 * (size_t)m, n_vertices) < 0) {
-        goto done;
-    }
     size_t n = (size_t)n_vertices, mm = (size_t)m;
     int nt = thread_count(threads, mm, parallel_min > 0 ? (size_t)parallel_min : 1);
     if ((size_t)nt > mm) {
@@ -2530,6 +2536,10 @@ accel_census_shells(PyObject *self, PyObject *args)
     Py_BEGIN_ALLOW_THREADS
     count = cs_run(c);
     Py_END_ALLOW_THREADS
+    if (count == -2) {
+        check_indices(fv.buf, size, 3 * (size_t)m, n_vertices);    /* sets the error: where, which index */
+        goto done;
+    }
     if (count < 0) {
         PyErr_NoMemory();
         goto done;
