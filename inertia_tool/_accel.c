@@ -989,8 +989,11 @@ pw_weld_task(void *ctx, int t, int nt)
             __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
             break;
         }
-        size_t cap = 64;
-        while (cap < points / 2) {
+        /* a table for every point of the bucket at load <= 1/2 (a bucket holds at most as many vertices as
+         * points: no growth); a bucket of more than 2**20 points (one point recurring past the recent-point
+         * cache) starts at half its points and grows with its vertices */
+        size_t cap = 64, want = points <= ((size_t)1 << 20) ? 2 * points : points / 2;
+        while (cap < want) {
             cap *= 2;
         }
         if (cap > slots_cap) {
