@@ -2047,15 +2047,15 @@ fail:
  * pairs to unite (consecutive faces of the run).
  *
  * Union-find over faces (union by smaller index, path halving, as 4b): first, on thread p, the pairs whose
- * two faces lie in the p-th part of the faces (they touch only that part's parents), then the pairs across
- * parts on one thread.  Whatever the order of the unions, every root ends as its component's first face,
+ * two faces lie in the p-th part of the faces (they touch only that part's parents; every thread reads all
+ * the pairs and keeps its own), then the pairs across parts on one thread.  Whatever the order of the unions, every root ends as its component's first face,
  * and components are numbered by first face, as 4b.  Then, as checks.shell_labels does with sections 4 and
  * 4b: when no vertex is shared by two components (so that the components through shared vertices, section
  * 4, are these same ones), they are renumbered by their smallest vertex, which is section 4's numbering.
  * The result is 3 and 4b (and 4 where it applies) bit for bit whatever the thread count.
  *
- * Memory: 24 bytes per face (the words), 4 per face (parents), 8 per face-pair united (about 12 per face on
- * a closed surface), 4 per vertex per thread (counts, then the vertex owners) and 4 per vertex (offsets).
+ * Memory: 24 bytes per face (the words; the face pairs to unite are written over them, block by block),
+ * 4 per face (parents), 4 per vertex per thread (counts, then the vertex owners) and 4 per vertex (offsets).
  * The adjacency's offsets are 32-bit: 3 * faces must stay below 2**32 (checks.py falls back otherwise).
  * ------------------------------------------------------------------------------------------------------ */
 
@@ -2063,16 +2063,10 @@ fail:
 #define CS_PARALLEL_MIN ((size_t)1 << 15)   /* faces below which one thread does everything */
 
 typedef struct {
-    uint64_t *p;
-    size_t len, cap;
-} PairList;
-
-typedef struct {
     const void *f;
     int size;
     size_t m, n;
     int nt;
-    int nomem;
     int bad;                             /* a face index out of range: nothing is computed */
     int shared;                          /* a vertex carries faces of two components */
     int32_t ticket;
@@ -2086,7 +2080,8 @@ typedef struct {
     int out_size;
     int64_t roots[MAX_THREADS];          /* per part: its roots; then the labels before the part's first */
     int32_t *rank;                       /* per component: its rank by smallest vertex */
-    PairList pairs[MAX_THREADS][MAX_THREADS + 1];    /* [thread that found it][part of both faces, nt: across] */
+    uint32_t *npairs;                    /* per block of CS_BLOCK vertices: face pairs to unite, kept in place
+                                            of the block's words (from its first) */
     CensusTally tally[MAX_THREADS];
 } CsTask;
 
@@ -2174,33 +2169,9 @@ cs_place_task(void *ctx, int t, int nt)
     (void)nt;
 }
 
-static int
-pair_push(PairList *l, uint64_t pair)
-{
-    if (l->len == l->cap) {
-        size_t cap = l->cap ? 2 * l->cap : 4096;
-        uint64_t *p = (uint64_t *)realloc(l->p, cap * sizeof(uint64_t));
-        if (p == NULL) {
-            return -1;
-        }
-        l->p = p;
-        l->cap = cap;
-    }
-    l->p[l->len++] = pair;
-    return 0;
-}
-
-static inline int
-face_part(const CsTask *c, uint32_t face)
-{
-    int p = 0;
-    while ((size_t)face >= c->fpart[p + 1]) {
-        p++;
-    }
-    return p;
-}
-
-/* Sort the buckets of the vertex blocks this thread draws, take their census and list the faces to unite. */
+/* Sort the buckets of the vertex blocks this thread draws, take their census and list the faces to unite:
+ * the pairs (first << 32 | second) overwrite the block's words from its first on, never a word not yet read
+ * (a run of L words gives at most L - 1 pairs). */
 static void
 cs_tally_task(void *ctx, int t, int nt)
 {
@@ -2212,10 +2183,11 @@ cs_tally_task(void *ctx, int t, int nt)
     memset(y, 0, sizeof(*y));
     for (;;) {
         int32_t blk = next_ticket(&c->ticket);
-        if (blk < 0 || (size_t)blk * CS_BLOCK >= c->n || __atomic_load_n(&c->nomem, __ATOMIC_RELAXED)) {
+        if (blk < 0 || (size_t)blk * CS_BLOCK >= c->n) {
             break;
         }
         size_t u0 = (size_t)blk * CS_BLOCK, u1 = u0 + CS_BLOCK < c->n ? u0 + CS_BLOCK : c->n;
+        size_t put = off[u0];
         for (size_t u = u0; u < u1; u++) {
             size_t lo = off[u], hi = off[u + 1];
             if (hi - lo > 32) {
@@ -2248,37 +2220,56 @@ cs_tally_task(void *ctx, int t, int nt)
                     keep_smallest(&y->sm, key);
                 }
                 if (c->parent != NULL) {
-                    for (size_t r = p + 1; r < q; r++) {
-                        uint32_t g = (uint32_t)(word[r - 1] & 0x7fffffffu), h = (uint32_t)(word[r] & 0x7fffffffu);
-                        if (g == h) {
-                            continue;
+                    uint64_t g = word[p] & 0x7fffffffu;
+                    for (size_t r = p + 1; r < q; r++) {      /* put <= r - 1: word[r] is read first */
+                        uint64_t h = word[r] & 0x7fffffffu;
+                        if (g != h) {
+                            word[put++] = (g << 32) | h;
                         }
-                        int pg = face_part(c, g), ph = face_part(c, h);
-                        if (pair_push(&c->pairs[t][pg == ph ? pg : nt], ((uint64_t)g << 32) | h) < 0) {
-                            __atomic_store_n(&c->nomem, 1, __ATOMIC_RELAXED);
-                            return;
-                        }
+                        g = h;
                     }
                 }
                 p = q;
             }
         }
+        c->npairs[blk] = (uint32_t)(put - off[u0]);
     }
+    (void)nt;
 }
 
-/* Part t of the faces: parents reset, then the pairs within the part united. */
+/* Whether faces g and h lie in one part of the faces. */
+static inline int
+cs_same_part(const CsTask *c, uint64_t g, uint64_t h)
+{
+    int p = 0;
+    while (g >= c->fpart[p + 1]) {
+        p++;
+    }
+    return h >= c->fpart[p] && h < c->fpart[p + 1];
+}
+
+/* Part t of the faces (t < nt): parents reset, then the pairs with both faces in the part united; t == nt
+ * (one thread, after the others): the pairs across parts. */
 static void
 cs_unite_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
     int32_t *parent = c->parent;
-    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
-        parent[i] = (int32_t)i;
+    uint64_t lo = t < nt ? c->fpart[t] : 0, hi = t < nt ? c->fpart[t + 1] : 0;
+    if (t < nt) {
+        for (size_t i = lo; i < hi; i++) {
+            parent[i] = (int32_t)i;
+        }
     }
-    for (int s = 0; s < nt; s++) {
-        const PairList *l = &c->pairs[s][t];
-        for (size_t k = 0; k < l->len; k++) {
-            unite_faces(parent, (int32_t)(l->p[k] >> 32), (int32_t)(l->p[k] & 0xffffffffu));
+    size_t blocks = (c->n + CS_BLOCK - 1) / CS_BLOCK;
+    for (size_t b = 0; b < blocks; b++) {
+        const uint64_t *pair = c->word + c->off[b * CS_BLOCK];
+        for (uint32_t k = 0; k < c->npairs[b]; k++) {
+            uint64_t g = pair[k] >> 32, h = pair[k] & 0xffffffffu;
+            int mine = t < nt ? (g >= lo && g < hi && h >= lo && h < hi) : !cs_same_part(c, g, h);
+            if (mine) {
+                unite_faces(parent, (int32_t)g, (int32_t)h);
+            }
         }
     }
 }
@@ -2395,10 +2386,8 @@ cs_free(CsTask *c)
 {
     for (int t = 0; t < MAX_THREADS; t++) {
         free(c->cnt[t]);
-        for (int p = 0; p <= MAX_THREADS; p++) {
-            free(c->pairs[t][p].p);
-        }
     }
+    free(c->npairs);
     free(c->off);
     free(c->word);
     free(c->parent);
@@ -2437,21 +2426,15 @@ cs_run(CsTask *c)
         merge_smallest(&c->tally[0].sn, &y->sn);
         merge_smallest(&c->tally[0].sm, &y->sm);
     }
-    if (c->nomem) {
-        return -1;
-    }
     if (c->parent == NULL) {
         return 0;
     }
-    free(c->word);                       /* the adjacency is done with */
-    c->word = NULL;
     run_parallel(nt, cs_unite_task, c);
-    for (int s = 0; s < nt; s++) {       /* the pairs across parts, in one thread */
-        const PairList *l = &c->pairs[s][nt];
-        for (size_t k = 0; k < l->len; k++) {
-            unite_faces(c->parent, (int32_t)(l->p[k] >> 32), (int32_t)(l->p[k] & 0xffffffffu));
-        }
+    if (nt > 1) {
+        cs_unite_task(c, nt, nt);        /* the pairs across parts, on this thread */
     }
+    free(c->word);                       /* the pairs are done with */
+    c->word = NULL;
     run_parallel(nt, cs_root_task, c);
     int64_t count = 0;
     for (int t = 0; t < nt; t++) {
@@ -2544,7 +2527,8 @@ accel_census_shells(PyObject *self, PyObject *args)
     c->off = (uint32_t *)malloc((n + 1) * sizeof(uint32_t));
     c->word = (uint64_t *)malloc((mm ? 3 * mm : 1) * sizeof(uint64_t));
     c->parent = has_out ? (int32_t *)malloc((mm ? mm : 1) * sizeof(int32_t)) : NULL;
-    if (!ok || c->off == NULL || c->word == NULL || (has_out && c->parent == NULL)) {
+    c->npairs = (uint32_t *)malloc((n / CS_BLOCK + 1) * sizeof(uint32_t));
+    if (!ok || c->off == NULL || c->word == NULL || c->npairs == NULL || (has_out && c->parent == NULL)) {
         PyErr_NoMemory();
         goto done;
     }
