@@ -2068,6 +2068,7 @@ typedef struct {
     size_t m, n;
     int nt;
     int bad;                             /* a face index out of range: nothing is computed */
+    int several;                         /* more than one shell: the labels' numbering must be checked */
     int shared;                          /* a vertex carries faces of two components */
     int32_t ticket;
     size_t fpart[MAX_THREADS + 1];       /* part t of the faces: [fpart[t], fpart[t + 1]) */
@@ -2320,14 +2321,16 @@ cs_label_task(void *ctx, int t, int nt)
     CsTask *c = (CsTask *)ctx;
     int32_t *owner = (int32_t *)c->cnt[t];
     int shared = 0;
-    memset(owner, 0xff, c->n * sizeof(int32_t));
+    if (c->several) {
+        memset(owner, 0xff, c->n * sizeof(int32_t));
+    }
     for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
         int32_t r = c->parent[i];
         int64_t label = label_at(c->out, c->out_size, (size_t)r);
         if (r != (int32_t)i) {
             set_label(c->out, c->out_size, i, label);
         }
-        for (int k = 0; k < 3; k++) {
+        for (int k = 0; k < 3 && c->several; k++) {   /* one shell: no vertex can join two */
             int64_t v = index_at(c->f, c->size, 3 * i + k);
             if (owner[v] < 0) {
                 owner[v] = (int32_t)label;
@@ -2443,11 +2446,12 @@ cs_run(CsTask *c)
         count += r;
     }
     run_parallel(nt, cs_number_task, c);
+    c->several = count > 1;              /* one shell: numbered 0 by first face and by smallest vertex alike */
     run_parallel(nt, cs_label_task, c);
-    if (!c->shared) {
+    if (c->several && !c->shared) {
         run_parallel(nt, cs_owner_task, c);
     }
-    if (!c->shared) {                    /* renumber by smallest vertex: components in order of first owner */
+    if (c->several && !c->shared) {                    /* renumber by smallest vertex: components in order of first owner */
         c->rank = (int32_t *)malloc((count ? (size_t)count : 1) * sizeof(int32_t));
         if (c->rank == NULL) {
             return -1;
