@@ -7,7 +7,8 @@ into ``benchmarks/out/`` when missing, not committed) it reports the median of `
 * ``fromfile``: ``numpy.fromfile`` of the whole file (a fresh allocation each time, as the reader's is);
 * the stages of :func:`inertia_tool.mass_properties`, called one by one as ``prepare_mesh`` calls them:
   ``read`` (the file's records, chunk by chunk), ``weld`` (``load_mesh`` less ``read``), ``census``
-  (``edge_topology``), ``shells`` (``shell_labels``), ``check`` (``surface_contacts``, the face-pair
+  (``edge_topology``), ``shells`` (``shell_labels``), ``census+shells`` (both from one call,
+  ``census_and_shells``, as ``prepare_mesh`` takes them), ``check`` (``surface_contacts``, the face-pair
   self-intersection check), ``integrate`` (``body_volume_moments``), ``precision`` (the float32 storage
   bound of ``warn_storage_precision``), each in ns per corner (3 per face) and in seconds;
 * ``total``: ``mass_properties(path, density=1000)`` in-process, and its ratio to ``fromfile`` (wall, and CPU
@@ -124,7 +125,7 @@ def _median_time(fn: Callable[[], object], repeat: int) -> tuple[float, float]:
 def measure(path: str, repeat: int) -> dict:
     from inertia_tool.integrals import body_volume_moments
     from inertia_tool.mass.pipeline import mass_properties
-    from inertia_tool.mesh.checks import edge_topology, shell_labels
+    from inertia_tool.mesh.checks import census_and_shells, edge_topology, shell_labels
     from inertia_tool.mesh.intersect import surface_contacts
     from inertia_tool.mesh.precision import volume_rounding_bound
     from inertia_tool.mesh.read import _binary_stl_chunks, load_mesh
@@ -149,6 +150,7 @@ def measure(path: str, repeat: int) -> dict:
         "load": lambda: load_mesh(path),
         "census": lambda: edge_topology(f, len(v), v),
         "shells": lambda: shell_labels(f, len(v)),
+        "census+shells": lambda: census_and_shells(f, len(v), v),
         "check": lambda: surface_contacts(v, f),
         "integrate": lambda: body_volume_moments(v, f, labels, n_shells),
         "precision": lambda: volume_rounding_bound(v, f, rounding),
@@ -162,7 +164,7 @@ def measure(path: str, repeat: int) -> dict:
     child = subprocess.run([sys.executable, "-c", _CHILD, path], capture_output=True, text=True, check=True,
                            env={**os.environ, "PYTHONPATH": os.path.dirname(HERE)})
     base, peak = (int(x) for x in child.stdout.split()[-2:])
-    parts = ("read", "weld", "census", "shells", "check", "integrate", "precision")
+    parts = ("read", "weld", "census", "shells", "census+shells", "check", "integrate", "precision")
     return {
         "file": os.path.basename(path), "faces": n, "file_bytes": size, "seconds": seconds, "cpu_seconds": cpu,
         "ns_per_corner": {k: 1e9 * seconds[k] / corners for k in parts + ("total",)},

@@ -14,6 +14,8 @@
  *   2b. PartWelder -- the same weld of float32 points by radix partition, on several threads
  *   3. edge_census -- boundary / non-manifold / misoriented edges (mesh/checks.edge_topology)
  *   4. shell_labels-- union-find connected components of faces (mesh/checks.shell_labels)
+ *   4c. census_shells -- the census and the shell labels from one adjacency, on several threads
+ *                      (mesh/checks.census_and_shells, and the C path of edge_topology and shell_labels)
  *   5. tetra_sums  -- signed-tetrahedron volume integrals with compensated sums (mass/volume._tetra_sums);
  *                     roundoff_sums, the per-face sums of their round-off bound (integrals.roundoff_bounds)
  *   6. bounds      -- bounding box and finiteness of the vertices in one pass (mass/volume.bounding_box)
@@ -25,10 +27,11 @@
  * overflow before allocation, NaN coordinates are hashed by their bit pattern (never compared as floats),
  * and the GIL is released around every loop over faces or points (buffers stay pinned by their views).
  *
- * Threads (section 1b): edge_census, tetra_sums and bounds take a `threads` count (default 1) and split
- * their work so that the result is identical whatever that count is; only the speed changes.  The weld
- * and the shell labels run on one thread (threaded versions were measured and did not pay on two cores);
- * PartWelder (section 2b), the weld of large float32 streams, takes a `threads` count too.
+ * Threads (section 1b): edge_census, census_shells, tetra_sums and bounds take a `threads` count (default 1)
+ * and split their work so that the result is identical whatever that count is; only the speed changes.  The
+ * one-table weld and the separate shell_labels / edge_shell_labels run on one thread; PartWelder (section
+ * 2b), the weld of large float32 streams, and census_shells (4c), which the Python side uses for the shell
+ * labels, take a `threads` count.
  */
 
 #define PY_SSIZE_T_CLEAN
@@ -768,7 +771,8 @@ static PyTypeObject WelderType = {
 #define PW_MAX_BITS 12
 #define PW_TARGET_POINTS ((size_t)1 << 15)   /* points per bucket aimed at: table and keys stay in L2 */
 
-typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* after finish, k[0] is the local vertex id */
+typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* corner: after finish the local vertex id, after
+                                                                 * numbering the vertex's number */
 typedef struct { uint32_t k[3]; uint32_t first; } PwVertex;   /* first corner; after output, its number */
 
 typedef struct {
@@ -985,8 +989,11 @@ pw_weld_task(void *ctx, int t, int nt)
             __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
             break;
         }
-        size_t cap = 64;
-        while (cap < points / 2) {
+        /* a table for every point of the bucket at load <= 1/2 (a bucket holds at most as many vertices as
+         * points: no growth); a bucket of more than 2**20 points (one point recurring past the recent-point
+         * cache) starts at half its points and grows with its vertices */
+        size_t cap = 64, want = points <= ((size_t)1 << 20) ? 2 * points : points / 2;
+        while (cap < want) {
             cap *= 2;
         }
         if (cap > slots_cap) {
@@ -1050,7 +1057,7 @@ pw_weld_task(void *ctx, int t, int nt)
                             mask = cap - 1;
                         }
                     }
-                    e->k[0] = id - 1;
+                    e->corner = id - 1;      /* the key stays: output writes the vertex from it */
                 }
             }
         }
@@ -1074,8 +1081,9 @@ typedef struct {
     int32_t ticket;
 } PwOutTask;
 
-/* Number the vertices of the buckets this thread draws, write their coordinates at their numbers, and
- * replace each of the bucket's points' local id by its vertex's number. */
+/* Number the vertices of the buckets this thread draws and replace each of the bucket's points' local id by
+ * its vertex's number (the coordinates are written in file order by the gather, where each vertex's first
+ * corner comes: sequential writes instead of one cache miss per vertex). */
 static void
 pw_number_task(void *ctx, int t, int nt)
 {
@@ -1095,12 +1103,6 @@ pw_number_task(void *ctx, int t, int nt)
             uint64_t below = mark[p >> 6] & (((uint64_t)1 << (p & 63)) - 1);
             uint32_t g = w->rank[p >> 6] + popcount64(below);
             number[l] = g;
-            double *v = o->vertices + 3 * (size_t)g;
-            for (int c = 0; c < 3; c++) {
-                float x;
-                memcpy(&x, &vs[l].k[c], 4);
-                v[c] = (double)x;
-            }
         }
         /* the bucket's points: local id -> number, while the bucket's numbers are in this core's cache */
         for (size_t i = 0; i < w->n_chunks; i++) {
@@ -1108,7 +1110,7 @@ pw_number_task(void *ctx, int t, int nt)
             for (int p = 0; p < c->nt; p++) {
                 const uint32_t *off = c->off + (size_t)p * (nb + 1);
                 for (PwEntry *e = c->entries + off[b], *end = c->entries + off[b + 1]; e < end; e++) {
-                    e->k[0] = number[e->k[0]];
+                    e->corner = number[e->corner];
                 }
             }
         }
@@ -1136,10 +1138,27 @@ pw_gather_task(void *ctx, int t, int nt)
             const uint32_t *off = c->off + (size_t)p * (nb + 1);
             memcpy(cursor, off, nb * sizeof(uint32_t));
             size_t lo = part_start(c->size, p, c->nt), hi = part_start(c->size, p + 1, c->nt);
+            /* numbers by first appearance: a corner is its vertex's first exactly when its number is the
+             * count of vertices first seen before it, `next` (the marked corners before the part's first) */
+            size_t c0 = c->corner0 + lo;
+            uint32_t next = w->rank[c0 >> 6] + popcount64(w->mark[0][c0 >> 6] & (((uint64_t)1 << (c0 & 63)) - 1));
             for (size_t k = lo; k < hi; k++) {
                 int32_t b = c->bucket[k];        /* the same memory as out[k] */
-                out[k] = b >= 0 ? (int32_t)c->entries[cursor[b]++].k[0]
-                                : o->index[-(int64_t)b - 1];    /* an earlier corner of this part: done */
+                if (b < 0) {
+                    out[k] = o->index[-(int64_t)b - 1];    /* an earlier corner of this part: done */
+                    continue;
+                }
+                const PwEntry *e = c->entries + cursor[b]++;
+                if (e->corner == next) {         /* the vertex's first corner: its coordinates, in order */
+                    double *v = o->vertices + 3 * (size_t)next;
+                    for (int q = 0; q < 3; q++) {
+                        float x;
+                        memcpy(&x, &e->k[q], 4);
+                        v[q] = (double)x;
+                    }
+                    next++;
+                }
+                out[k] = (int32_t)e->corner;
             }
         }
     }
@@ -2015,6 +2034,542 @@ fail:
     return NULL;
 }
 
+/* ------------------------------------------------------------------------------------------------------
+ * 4c. census_shells -- the edge census and the shell labels from one sorted adjacency, on several threads
+ *
+ * Each face edge a->b is bucketed by its smaller end u = min(a, b) as the word (v << 32) | (d << 31) | face,
+ * v = max(a, b), d = [a > b]: a CSR over vertices, built by threads that each count and then place the
+ * edges of their part of the faces (thread t's edges after those of threads < t in every bucket).  Threads
+ * then take blocks of vertices by ticket and sort each bucket, so that the uses of one undirected edge
+ * {u, v} form a run: its length is fwd + bwd and its d bits say the directions.  The run gives the census
+ * (as section 3: boundary = used once, non-manifold = more than twice, misoriented = twice in one
+ * direction; counts added and smallest keys merged over threads) and, when labels are asked for, the face
+ * pairs to unite (consecutive faces of the run).
+ *
+ * Union-find over faces (union by smaller index, path halving, as 4b): first, on thread p, the pairs whose
+ * two faces lie in the p-th part of the faces (they touch only that part's parents; every thread reads all
+ * the pairs and keeps its own), then the pairs across parts on one thread.  Whatever the order of the unions, every root ends as its component's first face,
+ * and components are numbered by first face, as 4b.  Then, as checks.shell_labels does with sections 4 and
+ * 4b: when no vertex is shared by two components (so that the components through shared vertices, section
+ * 4, are these same ones), they are renumbered by their smallest vertex, which is section 4's numbering.
+ * The result is 3 and 4b (and 4 where it applies) bit for bit whatever the thread count.
+ *
+ * Memory: 24 bytes per face (the words; the face pairs to unite are written over them, block by block),
+ * 4 per face (parents), 4 per vertex per thread (counts, then the vertex owners) and 4 per vertex (offsets).
+ * The adjacency's offsets are 32-bit: 3 * faces must stay below 2**32 (checks.py falls back otherwise).
+ * ------------------------------------------------------------------------------------------------------ */
+
+#define CS_BLOCK 2048               /* vertices per ticket when sorting and tallying */
+#define CS_PARALLEL_MIN ((size_t)1 << 15)   /* faces below which one thread does everything */
+
+typedef struct {
+    const void *f;
+    int size;
+    size_t m, n;
+    int nt;
+    int bad;                             /* a face index out of range: nothing is computed */
+    int several;                         /* more than one shell: the labels' numbering must be checked */
+    int shared;                          /* a vertex carries faces of two components */
+    int32_t ticket;
+    size_t fpart[MAX_THREADS + 1];       /* part t of the faces: [fpart[t], fpart[t + 1]) */
+    uint32_t *cnt[MAX_THREADS];          /* per thread and vertex: edges counted, then its cursor; later the
+                                            vertex's component seen by that thread (-1: none) */
+    uint32_t *off;                       /* n + 1: start of each vertex's bucket */
+    uint64_t *word;                      /* 3m */
+    int32_t *parent;                     /* m, or NULL for the census alone */
+    void *out;                           /* labels: m of out_size bytes */
+    int out_size;
+    int64_t roots[MAX_THREADS];          /* per part: its roots; then the labels before the part's first */
+    int32_t *rank;                       /* per component: its rank by smallest vertex */
+    uint32_t *npairs;                    /* per block of CS_BLOCK vertices: face pairs to unite, kept in place
+                                            of the block's words (from its first) */
+    CensusTally tally[MAX_THREADS];
+} CsTask;
+
+static inline int64_t
+label_at(const void *out, int size, size_t i)
+{
+    return size == 8 ? ((const int64_t *)out)[i] : (int64_t)((const int32_t *)out)[i];
+}
+
+static inline void
+set_label(void *out, int size, size_t i, int64_t label)
+{
+    if (size == 8) {
+        ((int64_t *)out)[i] = label;
+    }
+    else {
+        ((int32_t *)out)[i] = (int32_t)label;
+    }
+}
+
+static void
+cs_count_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    uint32_t *cnt = c->cnt[t];
+    uint64_t n = c->n;
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+        int64_t a = index_at(c->f, c->size, 3 * i), b = index_at(c->f, c->size, 3 * i + 1);
+        int64_t d = index_at(c->f, c->size, 3 * i + 2);
+        if ((uint64_t)a >= n || (uint64_t)b >= n || (uint64_t)d >= n) {   /* the caller reports where */
+            __atomic_store_n(&c->bad, 1, __ATOMIC_RELAXED);
+            return;
+        }
+        cnt[a < b ? a : b]++;
+        cnt[b < d ? b : d]++;
+        cnt[d < a ? d : a]++;
+    }
+    (void)nt;
+}
+
+/* Bucket starts for the vertices of part t: first the sums of each part (ticket 0), then the starts. */
+static void
+cs_sum_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    uint64_t sum = 0;
+    for (size_t u = part_start(c->n, t, nt); u < part_start(c->n, t + 1, nt); u++) {
+        for (int s = 0; s < c->nt; s++) {
+            sum += c->cnt[s][u];
+        }
+    }
+    c->roots[t] = (int64_t)sum;
+}
+
+static void
+cs_start_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    uint32_t run = (uint32_t)c->roots[t];      /* the edges of the vertices before the part */
+    for (size_t u = part_start(c->n, t, nt); u < part_start(c->n, t + 1, nt); u++) {
+        c->off[u] = run;
+        for (int s = 0; s < c->nt; s++) {
+            uint32_t k = c->cnt[s][u];
+            c->cnt[s][u] = run;
+            run += k;
+        }
+    }
+}
+
+static void
+cs_place_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    uint32_t *cursor = c->cnt[t];
+    uint64_t *word = c->word;
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+        int64_t x[3] = {index_at(c->f, c->size, 3 * i), index_at(c->f, c->size, 3 * i + 1),
+                        index_at(c->f, c->size, 3 * i + 2)};
+        for (int k = 0; k < 3; k++) {
+            int64_t a = x[k], b = x[k == 2 ? 0 : k + 1];
+            uint64_t u = (uint64_t)(a < b ? a : b), v = (uint64_t)(a < b ? b : a);
+            word[cursor[u]++] = (v << 32) | ((uint64_t)(a > b) << 31) | (uint64_t)i;
+        }
+    }
+    (void)nt;
+}
+
+/* Sort the buckets of the vertex blocks this thread draws, take their census and list the faces to unite:
+ * the pairs (first << 32 | second) overwrite the block's words from its first on, never a word not yet read
+ * (a run of L words gives at most L - 1 pairs). */
+static void
+cs_tally_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    CensusTally *y = &c->tally[t];
+    uint64_t *word = c->word;
+    const uint32_t *off = c->off;
+    uint64_t n = c->n;
+    memset(y, 0, sizeof(*y));
+    for (;;) {
+        int32_t blk = next_ticket(&c->ticket);
+        if (blk < 0 || (size_t)blk * CS_BLOCK >= c->n) {
+            break;
+        }
+        size_t u0 = (size_t)blk * CS_BLOCK, u1 = u0 + CS_BLOCK < c->n ? u0 + CS_BLOCK : c->n;
+        size_t put = off[u0];
+        for (size_t u = u0; u < u1; u++) {
+            size_t lo = off[u], hi = off[u + 1];
+            if (hi - lo > 32) {
+                qsort(word + lo, hi - lo, sizeof(uint64_t), cmp_uint64);
+            }
+            else {
+                sort_words(word + lo, hi - lo);
+            }
+            size_t p = lo;
+            while (p < hi) {
+                uint64_t v = word[p] >> 32;
+                size_t q = p + 1, backward = (word[p] >> 31) & 1;
+                while (q < hi && (word[q] >> 32) == v) {
+                    backward += (word[q] >> 31) & 1;
+                    q++;
+                }
+                size_t total = q - p;
+                uint64_t key = (uint64_t)u * n + v;
+                y->edges++;
+                if (total == 1) {
+                    y->boundary++;
+                    keep_smallest(&y->sb, key);
+                }
+                else if (total > 2) {
+                    y->nonmanifold++;
+                    keep_smallest(&y->sn, key);
+                }
+                else if (backward != 1) {
+                    y->misoriented++;
+                    keep_smallest(&y->sm, key);
+                }
+                if (c->parent != NULL) {
+                    uint64_t g = word[p] & 0x7fffffffu;
+                    for (size_t r = p + 1; r < q; r++) {      /* put <= r - 1: word[r] is read first */
+                        uint64_t h = word[r] & 0x7fffffffu;
+                        if (g != h) {
+                            word[put++] = (g << 32) | h;
+                        }
+                        g = h;
+                    }
+                }
+                p = q;
+            }
+        }
+        c->npairs[blk] = (uint32_t)(put - off[u0]);
+    }
+    (void)nt;
+}
+
+/* Whether faces g and h lie in one part of the faces. */
+static inline int
+cs_same_part(const CsTask *c, uint64_t g, uint64_t h)
+{
+    int p = 0;
+    while (g >= c->fpart[p + 1]) {
+        p++;
+    }
+    return h >= c->fpart[p] && h < c->fpart[p + 1];
+}
+
+/* Part t of the faces (t < nt): parents reset, then the pairs with both faces in the part united; t == nt
+ * (one thread, after the others): the pairs across parts. */
+static void
+cs_unite_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    int32_t *parent = c->parent;
+    uint64_t lo = t < nt ? c->fpart[t] : 0, hi = t < nt ? c->fpart[t + 1] : 0;
+    if (t < nt) {
+        for (size_t i = lo; i < hi; i++) {
+            parent[i] = (int32_t)i;
+        }
+    }
+    size_t blocks = (c->n + CS_BLOCK - 1) / CS_BLOCK;
+    for (size_t b = 0; b < blocks; b++) {
+        const uint64_t *pair = c->word + c->off[b * CS_BLOCK];
+        for (uint32_t k = 0; k < c->npairs[b]; k++) {
+            uint64_t g = pair[k] >> 32, h = pair[k] & 0xffffffffu;
+            int mine = t < nt ? (g >= lo && g < hi && h >= lo && h < hi) : !cs_same_part(c, g, h);
+            if (mine) {
+                unite_faces(parent, (int32_t)g, (int32_t)h);
+            }
+        }
+    }
+}
+
+/* Part t: every face's parent set to its root (the parents of other parts are read meanwhile: relaxed atomic
+ * loads and stores, each value an ancestor of the face), roots counted. */
+static void
+cs_root_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    int32_t *parent = c->parent;
+    int64_t roots = 0;
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+        int32_t r = (int32_t)i, up;
+        while ((up = __atomic_load_n(&parent[r], __ATOMIC_RELAXED)) != r) {
+            r = up;
+        }
+        if (r == (int32_t)i) {
+            roots++;
+        }
+        else {
+            __atomic_store_n(&parent[i], r, __ATOMIC_RELAXED);
+        }
+    }
+    c->roots[t] = roots;
+    (void)nt;
+}
+
+/* Part t: roots numbered in face order from the part's first label. */
+static void
+cs_number_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    int64_t label = c->roots[t];
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+        if (c->parent[i] == (int32_t)i) {
+            set_label(c->out, c->out_size, i, label++);
+        }
+    }
+    (void)nt;
+}
+
+/* Part t: every other face takes its root's label; each vertex of the part's faces notes the component
+ * (cnt[t], -1 when none) and a vertex seen in two components is flagged. */
+static void
+cs_label_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    int32_t *owner = (int32_t *)c->cnt[t];
+    int shared = 0;
+    if (c->several) {
+        memset(owner, 0xff, c->n * sizeof(int32_t));
+    }
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+        int32_t r = c->parent[i];
+        int64_t label = label_at(c->out, c->out_size, (size_t)r);
+        if (r != (int32_t)i) {
+            set_label(c->out, c->out_size, i, label);
+        }
+        for (int k = 0; k < 3 && c->several; k++) {   /* one shell: no vertex can join two */
+            int64_t v = index_at(c->f, c->size, 3 * i + k);
+            if (owner[v] < 0) {
+                owner[v] = (int32_t)label;
+            }
+            else if (owner[v] != (int32_t)label) {
+                shared = 1;
+            }
+        }
+    }
+    if (shared) {
+        __atomic_store_n(&c->shared, 1, __ATOMIC_RELAXED);
+    }
+    (void)nt;
+}
+
+/* Vertices of part t: the components the threads saw at each must agree; the agreed one into cnt[0]. */
+static void
+cs_owner_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    int32_t *merged = (int32_t *)c->cnt[0];
+    int shared = 0;
+    for (size_t v = part_start(c->n, t, nt); v < part_start(c->n, t + 1, nt) && !shared; v++) {
+        int32_t o = merged[v];
+        for (int s = 1; s < c->nt; s++) {
+            int32_t x = ((const int32_t *)c->cnt[s])[v];
+            if (x >= 0) {
+                if (o < 0) {
+                    o = x;
+                }
+                else if (o != x) {
+                    shared = 1;
+                }
+            }
+        }
+        merged[v] = o;
+    }
+    if (shared) {
+        __atomic_store_n(&c->shared, 1, __ATOMIC_RELAXED);
+    }
+}
+
+/* Part t of the faces: labels replaced by their component's rank by smallest vertex. */
+static void
+cs_rank_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+        set_label(c->out, c->out_size, i, c->rank[label_at(c->out, c->out_size, i)]);
+    }
+    (void)nt;
+}
+
+static void
+cs_free(CsTask *c)
+{
+    for (int t = 0; t < MAX_THREADS; t++) {
+        free(c->cnt[t]);
+    }
+    free(c->npairs);
+    free(c->off);
+    free(c->word);
+    free(c->parent);
+    free(c->rank);
+    free(c);
+}
+
+/* The census_shells work with the GIL released; -1 when memory ran out, -2 on an index out of range, else
+ * the number of shells (0 when no labels were asked for). */
+static int64_t
+cs_run(CsTask *c)
+{
+    int nt = c->nt;
+    run_parallel(nt, cs_count_task, c);       /* checks the indices too */
+    if (c->bad) {
+        return -2;
+    }
+    run_parallel(nt, cs_sum_task, c);
+    int64_t run = 0;
+    for (int t = 0; t < nt; t++) {
+        int64_t s = c->roots[t];
+        c->roots[t] = run;
+        run += s;
+    }
+    c->off[c->n] = (uint32_t)run;
+    run_parallel(nt, cs_start_task, c);
+    run_parallel(nt, cs_place_task, c);
+    run_parallel(nt, cs_tally_task, c);
+    for (int t = 1; t < nt; t++) {
+        CensusTally *y = &c->tally[t];
+        c->tally[0].edges += y->edges;
+        c->tally[0].boundary += y->boundary;
+        c->tally[0].nonmanifold += y->nonmanifold;
+        c->tally[0].misoriented += y->misoriented;
+        merge_smallest(&c->tally[0].sb, &y->sb);
+        merge_smallest(&c->tally[0].sn, &y->sn);
+        merge_smallest(&c->tally[0].sm, &y->sm);
+    }
+    if (c->parent == NULL) {
+        return 0;
+    }
+    run_parallel(nt, cs_unite_task, c);
+    if (nt > 1) {
+        cs_unite_task(c, nt, nt);        /* the pairs across parts, on this thread */
+    }
+    free(c->word);                       /* the pairs are done with */
+    c->word = NULL;
+    run_parallel(nt, cs_root_task, c);
+    int64_t count = 0;
+    for (int t = 0; t < nt; t++) {
+        int64_t r = c->roots[t];
+        c->roots[t] = count;
+        count += r;
+    }
+    run_parallel(nt, cs_number_task, c);
+    c->several = count > 1;              /* one shell: numbered 0 by first face and by smallest vertex alike */
+    run_parallel(nt, cs_label_task, c);
+    if (c->several && !c->shared) {
+        run_parallel(nt, cs_owner_task, c);
+    }
+    if (c->several && !c->shared) {                    /* renumber by smallest vertex: components in order of first owner */
+        c->rank = (int32_t *)malloc((count ? (size_t)count : 1) * sizeof(int32_t));
+        if (c->rank == NULL) {
+            return -1;
+        }
+        memset(c->rank, 0xff, (count ? (size_t)count : 1) * sizeof(int32_t));
+        const int32_t *owner = (const int32_t *)c->cnt[0];
+        int32_t next = 0;
+        for (size_t v = 0; v < c->n; v++) {
+            int32_t o = owner[v];
+            if (o >= 0 && c->rank[o] < 0) {
+                c->rank[o] = next++;
+            }
+        }
+        run_parallel(nt, cs_rank_task, c);
+    }
+    return count;
+}
+
+static PyObject *
+accel_census_shells(PyObject *self, PyObject *args)
+{
+    PyObject *faces_obj, *out_obj;
+    Py_ssize_t n_vertices;
+    int threads = 1;
+    Py_ssize_t parallel_min = (Py_ssize_t)CS_PARALLEL_MIN;
+    if (!PyArg_ParseTuple(args, "OnO|in", &faces_obj, &n_vertices, &out_obj, &threads, &parallel_min)
+            || check_vertex_count(n_vertices) < 0) {
+        return NULL;
+    }
+    Py_buffer fv, out;
+    Py_ssize_t m;
+    int size, has_out = out_obj != Py_None;
+    if (get_faces(faces_obj, &fv, &m, &size) < 0) {
+        return NULL;
+    }
+    if (has_out && PyObject_GetBuffer(out_obj, &out, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        PyBuffer_Release(&fv);
+        return NULL;
+    }
+    PyObject *result = NULL;
+    CsTask *c = NULL;
+    int out_size = has_out ? signed_int_size(&out) : 0;
+    if (has_out && (out_size == 0 || out.ndim != 1 || out.shape[0] != m)) {
+        PyErr_Format(PyExc_ValueError, "Expected `out` as a contiguous int32 or int64 array of %zd entries, or "
+                     "None", m);
+        goto done;
+    }
+    if ((size_t)m > (size_t)INT32_MAX - 1 || 3 * (uint64_t)m > (uint64_t)UINT32_MAX) {
+        PyErr_Format(PyExc_ValueError, "Expected at most 1,431,655,765 faces, got %zd", m);
+        goto done;
+    }
+    size_t n = (size_t)n_vertices, mm = (size_t)m;
+    int nt = thread_count(threads, mm, parallel_min > 0 ? (size_t)parallel_min : 1);
+    if ((size_t)nt > mm) {
+        nt = mm ? (int)mm : 1;
+    }
+    c = (CsTask *)calloc(1, sizeof(CsTask));
+    if (c == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    c->f = fv.buf;
+    c->size = size;
+    c->m = mm;
+    c->n = n;
+    c->nt = nt;
+    c->out = has_out ? out.buf : NULL;
+    c->out_size = out_size;
+    for (int t = 0; t <= nt; t++) {
+        c->fpart[t] = part_start(mm, t, nt);
+    }
+    int ok = 1;
+    for (int t = 0; t < nt && ok; t++) {
+        c->cnt[t] = (uint32_t *)calloc(n ? n : 1, sizeof(uint32_t));
+        ok = c->cnt[t] != NULL;
+    }
+    c->off = (uint32_t *)malloc((n + 1) * sizeof(uint32_t));
+    c->word = (uint64_t *)malloc((mm ? 3 * mm : 1) * sizeof(uint64_t));
+    c->parent = has_out ? (int32_t *)malloc((mm ? mm : 1) * sizeof(int32_t)) : NULL;
+    c->npairs = (uint32_t *)malloc((n / CS_BLOCK + 1) * sizeof(uint32_t));
+    if (!ok || c->off == NULL || c->word == NULL || c->npairs == NULL || (has_out && c->parent == NULL)) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    int64_t count;
+    Py_BEGIN_ALLOW_THREADS
+    count = cs_run(c);
+    Py_END_ALLOW_THREADS
+    if (count == -2) {
+        check_indices(fv.buf, size, 3 * (size_t)m, n_vertices);    /* sets the error: where, which index */
+        goto done;
+    }
+    if (count < 0) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    CensusTally *y = &c->tally[0];
+    uint64_t nn = n ? n : 1;
+    PyObject *lb = keys_to_list(&y->sb, nn), *ln = keys_to_list(&y->sn, nn), *lm = keys_to_list(&y->sm, nn);
+    if (lb && ln && lm) {
+        result = Py_BuildValue("(KKKKOOOL)", (unsigned long long)y->edges, (unsigned long long)y->boundary,
+                               (unsigned long long)y->nonmanifold, (unsigned long long)y->misoriented, lb, ln, lm,
+                               (long long)(has_out ? count : -1));
+    }
+    Py_XDECREF(lb);
+    Py_XDECREF(ln);
+    Py_XDECREF(lm);
+done:
+    if (c != NULL) {
+        cs_free(c);
+    }
+    PyBuffer_Release(&fv);
+    if (has_out) {
+        PyBuffer_Release(&out);
+    }
+    return result;
+}
+
 /* ======================================================================================================
  * 5. tetra_sums
  *
@@ -2601,6 +3156,12 @@ static PyMethodDef accel_methods[] = {
     {"edge_shell_labels", accel_edge_shell_labels, METH_VARARGS,
      "edge_shell_labels(faces, n_vertices, out) -> count\n\nWrite each face's shell (faces connected through "
      "shared undirected edges), numbered by the shell's first face, into `out` (m,) int32/int64."},
+    {"census_shells", accel_census_shells, METH_VARARGS,
+     "census_shells(faces, n_vertices, out, threads=1, parallel_min=32768) -> (edges, boundary, nonmanifold, "
+     "misoriented, sample_boundary, sample_nonmanifold, sample_misoriented, count)\n\nThe edge census of "
+     "edge_census and, when `out` ((m,) int32/int64) is not None, each face's shell into `out` as "
+     "checks.shell_labels numbers them (count: the shells; -1 without `out`), from one adjacency on `threads` "
+     "threads (one below `parallel_min` faces; tests lower it); the result does not depend on either."},
     {"tetra_sums", accel_tetra_sums, METH_VARARGS,
      "tetra_sums(vertices, faces, origin, area_floor, labels, sums, zero, threads=1)\n\nCompensated signed-tetrahedron "
      "sums per label into sums (L, 11) float64 [vol, first xyz, second xx yy zz xy xz yz, area] and zero "

@@ -11,7 +11,8 @@ integrals, which the C kernel sums with compensation).
 
 The edge census, the integrals and the bounding box use :func:`threads` threads on large meshes (the cores
 this process may run on, at most 16, or ``INERTIA_TOOL_THREADS``), split so that their results do not depend
-on the thread count: only the speed does.  The weld and the shell labels run on one thread.
+on the thread count: only the speed does.  So do the radix-partition weld of large float32 streams and the
+census with the shell labels (``census_shells``); the one-table weld runs on one thread.
 
 Both settings are asked for on every call (a test or a pool worker may change them), a dozen times per part of
 a batch: each call looks the variable up in the process environment's own table and derives the answer again

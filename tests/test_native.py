@@ -316,6 +316,82 @@ def test_edge_shell_labels_on_a_high_degree_fan_and_bowtie(monkeypatch):
     assert count == 2
 
 
+def _vertex_components_brute(faces: np.ndarray, n: int) -> tuple[np.ndarray, int]:
+    """Faces joined through shared vertices by a plain fixed point over vertex labels, numbered by each
+    component's smallest vertex (independent of every kernel)."""
+    label = list(range(n))
+    changed = True
+    while changed:                      # at most n rounds: each round lowers some label
+        changed = False
+        for f in faces:
+            low = min(label[int(x)] for x in f)
+            for x in f:
+                if label[int(x)] != low:
+                    label[int(x)] = low
+                    changed = True
+    roots = sorted({label[int(f[0])] for f in faces})
+    rank = {r: k for k, r in enumerate(roots)}
+    return np.array([rank[label[int(f[0])]] for f in faces], dtype=np.int64), len(roots)
+
+
+@needs_accel
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(case=_faces, threads=st.integers(1, 5), wide=st.booleans())
+def test_census_shells_match_numpy_brute_force_and_the_separate_kernels(monkeypatch, case, threads, wide):
+    """The one-adjacency census and shell labels (``census_shells``), on 1-5 threads even for a handful of
+    faces (``parallel_min=1``: parts of a face or two, pairs across parts), int32 or int64 faces and labels:
+    the census of the numpy path and of ``edge_census``, and the shells of ``checks.shell_labels`` -- numbered
+    by smallest vertex when no vertex joins two edge-connected shells (brute force over vertices), else by
+    first face (brute force over edges)."""
+    from inertia_tool.mesh.checks import census_and_shells
+    n, faces = case
+    lib = _native.accel()
+    f = np.array(faces, dtype=np.int64 if wide else np.int32)
+    v = np.random.default_rng(n).random((n, 3))
+    by_edge = _edge_components_brute(f)
+    by_vertex, k_vertex = _vertex_components_brute(f, n)
+    expected = by_vertex if k_vertex == len(set(by_edge.tolist())) else by_edge
+    out = np.empty(len(f), np.int64 if wide else np.int32)
+    got = lib.census_shells(f, n, out, threads, 1)
+    assert got[:7] == lib.edge_census(f, n, 1)
+    assert got[7] == len(set(expected.tolist()))
+    np.testing.assert_array_equal(out, expected)
+    assert lib.census_shells(f, n, None, threads, 1) == got[:7] + (-1,)
+    (tc, lc, kc), (tn, ln, kn) = both(monkeypatch, lambda: census_and_shells(f, n, v))
+    assert (tc.edges, tc.boundary_edges, tc.nonmanifold_edges, tc.misoriented_edges) == \
+        (tn.edges, tn.boundary_edges, tn.nonmanifold_edges, tn.misoriented_edges)
+    np.testing.assert_array_equal(tc.sample, tn.sample)
+    assert kc == kn == got[7]
+    np.testing.assert_array_equal(lc, ln)
+    np.testing.assert_array_equal(lc, expected)
+
+
+def test_census_shells_refuses_malformed_arguments():
+    lib = _native.accel()
+    if lib is None:
+        pytest.skip("inertia_tool._accel is not built")
+    v, f = box_arrays()
+    f = np.ascontiguousarray(f, dtype=np.int64)
+    bad = f.copy()
+    bad[5, 1] = len(v)
+    with pytest.raises(ValueError, match="face indices"):
+        lib.census_shells(bad, len(v), np.empty(len(f), np.int64))
+    with pytest.raises(ValueError, match="face indices"):
+        lib.census_shells(-f - 1, len(v), None)
+    with pytest.raises(ValueError, match="entries"):
+        lib.census_shells(f, len(v), np.empty(len(f) - 1, np.int64))
+    with pytest.raises(ValueError, match="entries"):
+        lib.census_shells(f, len(v), np.empty(len(f), np.float64))
+    with pytest.raises(ValueError):
+        lib.census_shells(f.astype(np.float64), len(v), None)
+    with pytest.raises(ValueError):
+        lib.census_shells(f, -1, None)
+    with pytest.raises((ValueError, TypeError)):
+        lib.census_shells(f, len(v), np.empty(len(f), np.int64)[::-1])   # not contiguous / read-only views
+    empty = np.zeros((0, 3), np.int64)
+    assert lib.census_shells(empty, 0, np.empty(0, np.int64)) == (0, 0, 0, 0, [], [], [], 0)
+
+
 def test_edge_shell_labels_refuses_malformed_arguments():
     lib = _native.accel()
     if lib is None:

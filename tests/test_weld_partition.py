@@ -116,6 +116,18 @@ def test_partition_extremes(lib, case, bits):
         assert len(got[0]) == 1 and not np.signbit(got[0]).any()
 
 
+def test_partition_bucket_past_its_preset_table(lib):
+    """One bucket (bucket_bits 0) of 1.2M points, 1.09M of them distinct: past 2**20 points a bucket's table
+    starts at half its points and must grow while welding (the path every smaller bucket skips); one early
+    point recurring 109,091 times keeps its id across the growth."""
+    k = 1_200_000
+    pts = np.arange(3 * k, dtype=np.float32).reshape(-1, 3)
+    pts[::11] = pts[5]                          # 109,091 repeats of one early point, far apart
+    got = _part_welder(lib, pts, 2, 0, [0, 400_000, k])
+    _same(got, _welder(lib, pts))
+    assert len(got[0]) == k - len(pts[::11]) + (0 if 5 % 11 else 1)
+
+
 def _torus_soup(n_major: int, n_minor: int) -> np.ndarray:
     """Corners of a closed torus written as benchmarks/bench_stages.py writes them: every quad's first
     triangle in the first half of the stream and its second in the second half (repeats far apart)."""

@@ -10,8 +10,9 @@ with identical results; the numpy code here is the reference and the fallback.
 from __future__ import annotations
 
 from dataclasses import field
+from collections.abc import Sequence
 from types import ModuleType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -24,7 +25,8 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
     from .estimate import Uncertainty
 
-__all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "winding_number"]
+__all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "census_and_shells",
+           "winding_number"]
 
 
 @frozen_value
@@ -245,11 +247,23 @@ def edge_topology(faces: np.ndarray, n_vertices: int, vertices: np.ndarray | Non
                         misoriented_edges=len(misoriented), sample=sample)
 
 
+#: Faces above which the C extension's one-adjacency census (``census_shells``, 32-bit offsets) is not used.
+_CENSUS_SHELLS_MAX_FACES = (2**32 - 1) // 3
+
+
 def _edge_topology_c(lib: ModuleType, faces: np.ndarray, n_vertices: int,
                      vertices: np.ndarray | None) -> EdgeTopology:
     """``edge_topology`` on the C extension (a sorted per-vertex adjacency instead of one global sort)."""
-    edges, boundary, nonmanifold, misoriented, *samples = lib.edge_census(faces_for_c(faces), int(n_vertices),
-                                                                          threads())
+    if len(faces) <= _CENSUS_SHELLS_MAX_FACES:
+        *counts, _ = lib.census_shells(faces_for_c(faces), int(n_vertices), None, threads())
+    else:
+        counts = lib.edge_census(faces_for_c(faces), int(n_vertices), threads())
+    return _topology_from_census(counts, vertices)
+
+
+def _topology_from_census(counts: Sequence[Any], vertices: np.ndarray | None) -> EdgeTopology:
+    """An EdgeTopology from the C census ``(edges, boundary, nonmanifold, misoriented, *samples)``."""
+    edges, boundary, nonmanifold, misoriented, *samples = counts
     picks = (samples[0] + samples[1] + samples[2])[:5]    # same order as the numpy path
     sample = np.zeros((0, 2, 3))
     if vertices is not None and picks:
@@ -273,6 +287,9 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
         vertex is shared between shells, else in order of each shell's first face).
     count : int
     """
+    lib = accel()
+    if lib is not None and len(faces) <= _CENSUS_SHELLS_MAX_FACES:
+        return census_and_shells(faces, n_vertices)[1:]
     labels, count = _vertex_shell_labels(faces, n_vertices)
     if len(faces) < 2:
         return labels, count
@@ -280,6 +297,32 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     if edge_count == count:
         return labels, count
     return edge_labels, edge_count
+
+
+def census_and_shells(faces: np.ndarray, n_vertices: int,
+                      vertices: np.ndarray | None = None) -> tuple[EdgeTopology, np.ndarray, int]:
+    """:func:`edge_topology` and :func:`shell_labels` of the same faces, with identical results.
+
+    The C extension takes both from one sorted adjacency (each edge bucketed by its smaller end, the buckets
+    sorted on :func:`~inertia_tool._native.threads` threads: ``census_shells``); without it, or beyond its
+    32-bit offsets, the two functions run one after the other.
+
+    Returns
+    -------
+    topology : EdgeTopology
+    labels : (m,) int
+        Shell index of each face, as :func:`shell_labels`.
+    count : int
+    """
+    lib = accel()
+    if lib is None or len(faces) > _CENSUS_SHELLS_MAX_FACES:
+        labels, count = shell_labels(faces, n_vertices)
+        return edge_topology(faces, n_vertices, vertices), labels, count
+    labels = np.empty(len(faces), dtype=np.intp)
+    *counts, count = lib.census_shells(faces_for_c(faces), int(n_vertices), labels, threads())
+    if len(faces) == 0:
+        return EdgeTopology(0, 0, 0, 0, np.zeros((0, 2, 3))), labels, 0
+    return _topology_from_census(counts, vertices), labels, int(count)
 
 
 def _edge_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:

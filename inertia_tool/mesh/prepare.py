@@ -23,7 +23,7 @@ from ..errors import (ArrangementError, DegenerateFacesWarning, InsideOutWarning
 from ..integrals import (RoundoffBound, VolumeMoments, accurate_shells, body_volume_moments, bounding_box,
                          total_roundoff, volume_moments)
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE, ROUNDOFF_RTOL
-from .checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
+from .checks import MeshReport, census_and_shells, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
                      inward_crossing_outward, near_copies, near_copies_message, negligible_flat, orient_by_depth,
@@ -194,13 +194,13 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     diag = float(np.linalg.norm(hi - lo))
     if not diag > 0:
         raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")
-    topo = edge_topology(f, len(v), v)
+    topo, census_labels, census_shells = census_and_shells(f, len(v), v)   # R1's shells from the same adjacency
     coincident_notes: list[str] = []
     if topo.nonmanifold_edges:                # R0: a shell listed twice with the same vertex indices
         f, note = _leave_out_coincident(v, f, None, source)
         if note is not None:
             coincident_notes.append(note)
-            topo = edge_topology(f, len(v), v)
+            topo, census_labels, census_shells = census_and_shells(f, len(v), v)
     watertight = topo.oriented
     found = Resolution(v, f, "exact", (), 0, None, 0)
     n_read = len(v)                           # vertices beyond these are the apexes of repair patches
@@ -222,7 +222,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     # a patched surface is closed: its shells are classified and overlaps united like any other, and the
     # bounds of the patches carry over to the result.  Every rule applied below is stated in mesh/policy.py.
     split_welded = bool(found.nonmanifold_edges) and patched is None
-    labels, n_shells = _bodies(v, f, split_welded)                               # R1, R1b
+    known = (census_labels, census_shells) if topo.oriented else None          # f is the census's: unchanged
+    labels, n_shells = _bodies(v, f, split_welded, known)                        # R1, R1b
     if n_shells == 0:
         raise InvalidMeshError(f"{source}: no triangles are left after removing degenerate ones")
     # the reference point body_volume_moments and accurate_shells would take (the bounding-box centre), from the
@@ -614,10 +615,12 @@ def _accurate(v: np.ndarray, f: np.ndarray, labels: np.ndarray, shells: list[Vol
     return better, bound
 
 
-def _bodies(v: np.ndarray, f: np.ndarray, split_welded: bool) -> tuple[np.ndarray, int]:
+def _bodies(v: np.ndarray, f: np.ndarray, split_welded: bool,
+            known: tuple[np.ndarray, int] | None = None) -> tuple[np.ndarray, int]:
     """R1 (edge-connected shells) and, on a surface with non-manifold edges, R1b (bodies welded along their
-    crossing split apart, :func:`~.policy.welded_bodies`)."""
-    labels, n_shells = shell_labels(f, len(v))
+    crossing split apart, :func:`~.policy.welded_bodies`).  ``known``: the shell labels of ``f`` if already
+    taken (with the edge census)."""
+    labels, n_shells = known if known is not None else shell_labels(f, len(v))
     if split_welded and n_shells:
         welded = welded_bodies(f, len(v), labels, n_shells, v)
         if welded.split:
