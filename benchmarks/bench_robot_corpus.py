@@ -208,6 +208,7 @@ def mujoco_reference(path: str, *, geometry: str = "collision", max_rounds: int 
         if mesh.inertia != mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL:
             mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
     refused: dict = {}
+    retried: set = set()
     missing: dict = collections.defaultdict(list)
     for _ in range(max_rounds):
         try:
@@ -234,8 +235,11 @@ def mujoco_reference(path: str, *, geometry: str = "collision", max_rounds: int 
             names = [m.group(1) for m in (_ELEMENT.search(text), _TOO_SMALL.search(first), _MESH_NAMED.search(first))
                      if m and m.group(1)]
             mesh = next((spec.mesh(n) for n in names if spec.mesh(n) is not None), None)
-            if mesh is None or os.path.basename(mesh.file) in refused:
+            if mesh is None or mesh.name in retried:
                 raise
+            # keyed by file for the report, retried by mesh: several meshes may name one file (Talos, TIAGo,
+            # Lite 6 and Cassie use one file for a left and a right mesh, each refused in turn)
+            retried.add(mesh.name)
             refused[os.path.basename(mesh.file)] = first.removeprefix("Error: ")
             keep = declared.get(mesh.name, mujoco.mjtMeshInertia.mjMESH_INERTIA_LEGACY)
             mesh.inertia = (keep if keep != mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
