@@ -33,7 +33,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..errors import InertiaToolError, MeshReadError, UsageError
+from ..errors import InertiaToolError, InvalidMeshError, MeshReadError, UsageError
 from ..mass import shapes, shell_shapes
 from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
@@ -403,11 +403,89 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
 
+def _piece_group(element: GeometryElement, model: bool) -> tuple:
+    """Elements whose open meshes may be joined: the same placement and scale, and the same density with no
+    mass of their own (``model``; otherwise the robot's one density weighs them all)."""
+    weight = (element.mass is None, element.density) if model else ()
+    return (element.rotation.tobytes(), np.asarray(element.translation, dtype=np.float64).tobytes(),
+            _mesh_key(element)[1:], weight)
+
+
+def _joined_pieces(pieces: list, *, budget: list | None, repair: bool):
+    """``(unit-density body, method, uncertainty)`` of the open meshes ``pieces`` (elements of one link, one
+    placement) integrated as one surface, or None when together they are not a closed solid either (with
+    ``repair``: not even a bounded estimate) or cannot be read.
+
+    Menagerie's Stretch splits a part into one OBJ file per material (``link_arm_l1_0.obj`` carbon fibre,
+    ``link_arm_l1_1.obj`` printed plastic): each file is open where it meets the other, and together they bound
+    the part.  The union of the pieces' triangles is checked and integrated by the engine like any mesh: first
+    without repair; if it still has holes and ``repair`` is asked, repaired as one surface (the seams the
+    pieces share are then not taken for holes, which is what refused most of them one by one)."""
+    first = pieces[0]
+    vertices, faces, offset, count = [], [], 0, 0
+    try:
+        for element in pieces:
+            raw = _placed(_raw_mesh(element.mesh, element), element)
+            vertices.append(raw.vertices)
+            faces.append(raw.faces.astype(np.int64) + offset)
+            offset += len(raw.vertices)
+            count += int(raw.file_faces)
+        if budget is not None and count > budget[0]:
+            return None
+        joined = RawMesh(vertices=np.concatenate(vertices), faces=np.concatenate(faces),
+                         source=" + ".join(_mesh_label(e) for e in pieces), units="m", file_faces=count)
+    except InertiaToolError:
+        return None
+    for fix in (False, True) if repair else (False,):
+        with warnings.catch_warnings(record=True) as recorded:
+            warnings.simplefilter("always")
+            try:
+                local = mass_properties(joined, density=1.0, repair=fix)
+            except InertiaToolError:
+                continue
+        _reissue(recorded)
+        report = local.mesh
+        method = ("exact" if report is None else "estimate" if report.uncertainty is not None
+                  else report.certificate.kind)
+        uncertainty = None if report is None else report.uncertainty
+        return local.transformed(rotation=first.rotation, translation=first.translation), method, uncertainty
+    return None
+
+
+def _join_open_pieces(parts: list, refused: list, *, model: bool, repair: bool,
+                      budget: list | None) -> tuple[list, list, list]:
+    """``parts`` and ``refused`` with each group of at least two open mesh pieces that close together
+    (:func:`_joined_pieces`) replaced by one part; the third value names what was joined, for the link's
+    warnings.  Open pieces are the meshes refused as needing repair and those repaired into estimates."""
+    candidates = [e for e, _ in refused] + [e for e, _, m, _ in parts if m == "estimate" and e.fit_scale is None]
+    groups: dict = {}
+    for element in candidates:
+        if element.kind == "mesh" and not element.shell and (element.mass is None or not model):
+            groups.setdefault(_piece_group(element, model), []).append(element)
+    notes = []
+    for pieces in groups.values():
+        keys = [_mesh_key(e) for e in pieces]
+        if len(pieces) < 2 or len(set(keys)) < len(keys):     # one piece, or a mesh twice: nothing to join
+            continue
+        found = _joined_pieces(pieces, budget=budget, repair=repair)
+        if found is None:
+            continue
+        local, method, uncertainty = found
+        joined = {id(e) for e in pieces}
+        parts = [p for p in parts if id(p[0]) not in joined] + [(pieces[0], local, method, uncertainty)]
+        refused = [r for r in refused if id(r[0]) not in joined]
+        notes.append(f"meshes {', '.join(os.path.basename(_mesh_label(e)) for e in pieces)} are open one by one: "
+                     + ("they close together (pieces of one part) and were integrated as one solid"
+                        if method != "estimate" else "integrated as one surface, repaired together"))
+    return parts, refused, notes
+
+
 def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool,
                    budget: list | None = None):
     """Per element of ``link``: ``(element, unit properties, mesh method, mesh uncertainty)``; massless
-    elements (``model`` mode) are left out and named in the second return value."""
-    parts, massless = [], []
+    elements (``model`` mode) are left out and named in the second return value; the third names open mesh
+    pieces integrated together (:func:`_join_open_pieces`)."""
+    parts, massless, refused = [], [], []
     for element in link.elements:
         if model and (element.mass == 0 or (element.mass is None and element.density == 0)):
             massless.append(element)
@@ -415,7 +493,13 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
         if model and element.shell:
             parts.append((element, element_shell_properties(element), "exact", None))
             continue
-        props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
+        try:
+            props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
+        except InvalidMeshError as exc:      # an open piece may close with the link's other pieces: tried below
+            if element.kind != "mesh" or element.fit_scale is not None:
+                raise
+            refused.append((element, exc))
+            continue
         fitted = element.fit_scale is not None
         key = _mesh_key(element) if element.kind == "mesh" or fitted else None
         report = cache[key].mesh if key is not None and key in cache else None
@@ -428,7 +512,12 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
             method = "estimate" if report.uncertainty is not None else report.certificate.kind
             uncertainty = report.uncertainty
         parts.append((element, props, method, uncertainty))
-    return parts, massless
+    joined: list = []
+    if len(refused) + sum(1 for p in parts if p[2] == "estimate") >= 2:
+        parts, refused, joined = _join_open_pieces(parts, refused, model=model, repair=repair, budget=budget)
+    if refused:
+        raise refused[0][1]
+    return parts, massless, joined
 
 
 def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repair: bool = False,
@@ -572,12 +661,12 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute
         return LinkInertial(link.name, None, nan, basis, f"mesh file missing: {', '.join(dict.fromkeys(missing))}")
     try:
-        parts, massless = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
+        parts, massless, joined = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
     except InertiaToolError as exc:
         return LinkInertial(link.name, None, nan, basis, f"mesh needs repair or cannot be read: {exc}")
     except (ValueError, ArithmeticError) as exc:     # numerical trouble in one link's geometry: its reason
         return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}")
-    warned = [e.note for e in link.elements if e.note]
+    warned = [e.note for e in link.elements if e.note] + joined
     warned += [f"{e.kind} {e.name!r} is massless in the description "
                f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
     if not parts:
