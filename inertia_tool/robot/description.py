@@ -155,6 +155,9 @@ class GeometryElement:
     fit_aabb : bool
         With ``fit_scale``: MuJoCo's ``<compiler fitaabb="true">``, the primitive is fitted to the mesh's
         bounding box in its principal axes instead of its equivalent inertia box.
+    mesh_inertia : str
+        MJCF ``<mesh inertia>`` when it names ``"convex"`` or ``"legacy"`` (taken with the model's own
+        densities: :mod:`inertia_tool.robot.mesh_inertia`); ``"exact"`` otherwise (``shell`` is ``shell``).
     """
 
     kind: str
@@ -175,6 +178,7 @@ class GeometryElement:
     vertices: np.ndarray | None = None
     faces: np.ndarray | None = None
     fit_aabb: bool = False
+    mesh_inertia: str = "exact"
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))

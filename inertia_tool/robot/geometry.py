@@ -403,6 +403,34 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
 
+#: What a link's warnings say of a mesh taken by its MJCF ``<mesh inertia>`` mode (``--density model``).
+_MESH_INERTIA_NOTES = {
+    "convex": "mesh {} has inertia=\"convex\" in the model: its convex hull is integrated, as MuJoCo does",
+    "legacy": ("mesh {} has inertia=\"legacy\" in the model: MuJoCo's legacy formula (absolute volumes of the "
+               "tetrahedra from the surface's centre) is used, as MuJoCo does; for a non-convex mesh it is not "
+               "the solid's integral, hence 'unverified'"),
+}
+
+
+def _mesh_inertia_part(element: GeometryElement, *, cache: dict, budget: list | None) -> tuple:
+    """``(element, unit properties in the link frame, method, None)`` of a mesh taken by its MJCF inertia
+    mode (:mod:`inertia_tool.robot.mesh_inertia`): ``convex`` is the exact integral of the hull, ``legacy``
+    MuJoCo's formula, labelled ``unverified`` (no check makes it the solid's)."""
+    from .mesh_inertia import convex_hull_properties, legacy_properties
+    key = ("mesh inertia", element.mesh_inertia) + _mesh_key(element)
+    found = cache.get(key)
+    if found is None:
+        raw = _placed(_raw_mesh(element.mesh, element, None if budget is None else budget[0]), element)
+        if budget is not None:
+            budget[0] -= int(raw.file_faces)
+        label = _mesh_label(element)
+        found = (convex_hull_properties(raw.vertices, source=label) if element.mesh_inertia == "convex"
+                 else legacy_properties(raw.vertices, raw.faces, source=label))
+        cache[key] = found
+    method = "exact" if element.mesh_inertia == "convex" else "unverified"
+    return element, found.transformed(rotation=element.rotation, translation=element.translation), method, None
+
+
 def _piece_group(element: GeometryElement, model: bool) -> tuple:
     """Elements whose open meshes may be joined: the same placement and scale, and the same density with no
     mass of their own (``model``; otherwise the robot's one density weighs them all)."""
@@ -483,15 +511,20 @@ def _join_open_pieces(parts: list, refused: list, *, model: bool, repair: bool,
 def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool,
                    budget: list | None = None):
     """Per element of ``link``: ``(element, unit properties, mesh method, mesh uncertainty)``; massless
-    elements (``model`` mode) are left out and named in the second return value; the third names open mesh
-    pieces integrated together (:func:`_join_open_pieces`)."""
-    parts, massless, refused = [], [], []
+    elements (``model`` mode) are left out and named in the second return value; the third says what the
+    link's warnings should: meshes taken by their MJCF ``inertia`` mode, open mesh pieces integrated together
+    (:func:`_join_open_pieces`)."""
+    parts, massless, refused, notes = [], [], [], []
     for element in link.elements:
         if model and (element.mass == 0 or (element.mass is None and element.density == 0)):
             massless.append(element)
             continue
         if model and element.shell:
             parts.append((element, element_shell_properties(element), "exact", None))
+            continue
+        if model and element.kind == "mesh" and element.mesh_inertia != "exact" and element.fit_scale is None:
+            parts.append(_mesh_inertia_part(element, cache=cache, budget=budget))
+            notes.append(_MESH_INERTIA_NOTES[element.mesh_inertia].format(os.path.basename(_mesh_label(element))))
             continue
         try:
             props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
@@ -517,7 +550,7 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
         parts, refused, joined = _join_open_pieces(parts, refused, model=model, repair=repair, budget=budget)
     if refused:
         raise refused[0][1]
-    return parts, massless, joined
+    return parts, massless, notes + joined
 
 
 def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repair: bool = False,

@@ -59,6 +59,9 @@ from ..errors import RobotDescriptionError
 from .description import DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive, _scale
 from .resolve import resolve_uri
 
+#: The values of MJCF ``<mesh inertia>`` (MuJoCo 3.x): how the compiler takes a mesh's mass and inertia.
+MESH_INERTIA_MODES = ("convex", "exact", "legacy", "shell")
+
 __all__ = ["read_mjcf", "orientation_matrix", "inertia_from_geometry", "MAX_INCLUDE_DEPTH", "MAX_INCLUDED_FILES"]
 
 #: Deepest chain of ``<include>`` followed (MuJoCo's own models nest two or three).
@@ -453,7 +456,8 @@ def _mesh_source(file, folders, packages: dict, source: str, link: str, missing_
 
 
 def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler, source: str) -> dict:
-    """``{name: (file, folders, scale, reference rotation, reference translation, shell)}`` of every mesh asset."""
+    """``{name: (file, folders, scale, reference rotation, reference translation, inertia mode)}`` of every mesh
+    asset (the mode of ``<mesh inertia>``; ``"exact"`` when not given: this tool integrates the solid)."""
     meshes = {}
     for asset in root.findall("asset"):
         for mesh in asset.findall("mesh"):
@@ -473,8 +477,11 @@ def _meshes(root, defaults: _Defaults, mesh_base: str, fallbacks: dict, compiler
             # v ↦ q̄ (v − refpos) q: rotation Qᵀ, translation −Qᵀ refpos
             back = _quaternion_matrix(refquat).T
             folders = [mesh_base, *fallbacks.get(mesh, ())]
-            shell = attrs.get("inertia") == "shell"
-            meshes[name] = (inline if inline is not None else file, folders, scale, back, -back @ refpos, shell)
+            mode = attrs.get("inertia", "exact")
+            if mode not in MESH_INERTIA_MODES:
+                raise _fail(source, f"{what}: inertia must be one of {', '.join(MESH_INERTIA_MODES)}, "
+                                    f"got {mode!r}")
+            meshes[name] = (inline if inline is not None else file, folders, scale, back, -back @ refpos, mode)
     return meshes
 
 
@@ -577,7 +584,7 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
-        file, folders, scale, ref_rotation, ref_translation, _shell = meshes[mesh_name]
+        file, folders, scale, ref_rotation, ref_translation, _mode = meshes[mesh_name]
         fit = float(_numbers(attrs.get("fitscale"), 1, f"{what} fitscale", source, default=(1.0,))[0])
         return GeometryElement(kind, rotation, position, **_mesh_source(file, folders, packages, source, link,
                                                                            missing_meshes),
@@ -589,13 +596,13 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
-        file, folders, scale, ref_rotation, ref_translation, shell = meshes[mesh_name]
-        mass_model["shell"] = shell          # MuJoCo: a mesh's shell inertia is a property of the asset
+        file, folders, scale, ref_rotation, ref_translation, mode = meshes[mesh_name]
+        mass_model["shell"] = mode == "shell"    # MuJoCo: a mesh's shell inertia is a property of the asset
         return GeometryElement("mesh", rotation, position, **_mesh_source(file, folders, packages, source, link,
                                                                            missing_meshes),
                                scale=scale, name=name,
                                reference_rotation=ref_rotation, reference_translation=ref_translation,
-                               **mass_model)
+                               mesh_inertia=mode if mode in ("convex", "legacy") else "exact", **mass_model)
     if kind == "sphere":
         return GeometryElement("sphere", rotation, position, size=need(1), name=name, **mass_model)
     if kind in ("capsule", "cylinder"):
