@@ -819,16 +819,26 @@ class _Attachments:
         return self.read[key], stack + (key,)
 
 
+def _named_bodies(element, class_name: str, suffix: str, source: str, budget: list):
+    """Every body under ``element`` as MuJoCo names it: ``(body element, default class in force, name suffix of
+    its ``<replicate>`` copies)``, depth first (the bodies of ``<attach>`` elements are another model's)."""
+    for child, cls, more in _child_bodies(element, class_name, suffix, source, budget):
+        if cls is None:
+            continue
+        yield child, cls, more
+        yield from _named_bodies(child, child.get("childclass", cls), more, source, budget)
+
+
 def _attached_body(attach, model: _Model):
-    """``(body element, its default class)`` of the body an ``<attach body>`` names in ``model``; the class is
+    """``(body element, its default class, name suffix)`` of the body an ``<attach body>`` names in ``model``:
+    a body of that name, or a ``<replicate>`` copy of one by MuJoCo's name for it (``leg-1``: checked against
+    ``mujoco`` 4.0, which attaches that copy alone, its subtree named with the copy's suffix).  The class is
     the ``childclass`` in force where the body stands in its own model."""
     wanted = attach.get("body")
     for world in model.root.findall("worldbody"):
-        for body in world.iter("body"):
-            if body.get("name") == wanted:
-                class_name = next((a.get("childclass") for a in body.iterancestors()
-                                   if a.get("childclass") is not None), "main")
-                return body, class_name
+        for body, class_name, suffix in _named_bodies(world, "main", "", model.source, [MAX_REPLICAS]):
+            if body.get("name") is not None and body.get("name") + suffix == wanted:
+                return body, class_name, suffix
     raise _fail(model.source, f"<attach model=... body={wanted!r}>: the model has no body {wanted!r}")
 
 
@@ -876,8 +886,8 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                 for world in attached.root.findall("worldbody"):
                     walk_children(world, "main", more, attached, inner, deeper)
             else:
-                body, body_class = _attached_body(child, attached)
-                walk_body(body, body_class, more, attached, inner, deeper)
+                body, body_class, copy = _attached_body(child, attached)
+                walk_body(body, body_class, copy + more, attached, inner, deeper)
 
     def collect(element, link: str, class_name: str, pose, elements: list, model: _Model, stack: tuple) -> None:
         degrees, eulerseq, _ = model.compiler
