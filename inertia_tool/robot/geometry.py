@@ -687,8 +687,11 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     """The result for one link, or the reason there is none (never raises for the link's own problems)."""
     nan = float("nan")
     if not link.elements:
+        other = {"collision": "visual", "visual": "collision"}.get(geometry)
+        has = (f"; {link.unselected} {other} element{'s' if link.unselected > 1 else ''}, which --geometry "
+               f"{other} reads" if link.unselected and other else "")
         return LinkInertial(link.name, None, nan, basis, "no geom in <compiler inertiagrouprange>" if geometry == "all"
-                            else f"no {geometry} geometry")
+                            else f"no {geometry} geometry{has}")
     missing = [e.mesh for e in link.elements if e.mesh is not None and not os.path.exists(e.mesh)
                and not (model and (e.mass == 0 or (e.mass is None and e.density == 0)))]
     if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute

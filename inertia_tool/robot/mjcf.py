@@ -280,9 +280,11 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
         name = prefix + body.get("name") + suffix if body.get("name") else f"body {counter[0]}"
         child_class = body.get("childclass", class_name)
         elements: list[GeometryElement] = []
-        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements, model, stack)
+        unselected = [0]
+        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements, model, stack, unselected)
         links.append(LinkGeometry(name=name, elements=tuple(elements),
-                                  declared=_inertial(body, name, model.compiler, model.source)))
+                                  declared=_inertial(body, name, model.compiler, model.source),
+                                  unselected=unselected[0]))
         walk_children(body, child_class, suffix, model, prefix, stack)
 
     def walk_children(element, class_name: str, suffix: str, model: _Model, prefix: str, stack: tuple) -> None:
@@ -299,7 +301,8 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                 body, body_class, copy = _attached_body(child, attached)
                 walk_body(body, body_class, copy + more, attached, inner, deeper)
 
-    def collect(element, link: str, class_name: str, pose, elements: list, model: _Model, stack: tuple) -> None:
+    def collect(element, link: str, class_name: str, pose, elements: list, model: _Model, stack: tuple,
+                unselected: list) -> None:
         degrees, eulerseq, _ = model.compiler
         for child in element:
             if child.tag == "geom":
@@ -315,6 +318,8 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                         continue
                     elements.append(_geom(attrs, pose, label, link, model.meshes, packages, model.compiler,
                                           model.source, missing_meshes))
+                else:
+                    unselected[0] += 1
             elif child.tag == "frame":
                 attrs = dict(child.attrib)
                 rotation = orientation_matrix(attrs, degrees=degrees, eulerseq=eulerseq, what=f"body {link!r} frame",
@@ -322,15 +327,15 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                 position = _coordinates(_numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", model.source,
                                                  default=(0, 0, 0)), f"body {link!r} frame pos", model.source)
                 composed = (pose[0] @ rotation, pose[0] @ position + pose[1])
-                collect(child, link, child.get("childclass", class_name), composed, elements, model, stack)
+                collect(child, link, child.get("childclass", class_name), composed, elements, model, stack, unselected)
             elif child.tag == "replicate":
                 for copy in _replica_poses(child, pose, model, replicas):
-                    collect(child, link, class_name, copy, elements, model, stack)
+                    collect(child, link, class_name, copy, elements, model, stack, unselected)
             elif child.tag == "attach" and child.get("body") is None:
                 # a whole worldbody attached as a frame: its geoms are this body's, in its own model's terms
                 attached, deeper = attachments.model(child, model, stack)
                 for world in attached.root.findall("worldbody"):
-                    collect(world, link, "main", pose, elements, attached, deeper)
+                    collect(world, link, "main", pose, elements, attached, deeper, unselected)
 
     for world in root.findall("worldbody"):
         walk_children(world, "main", "", main, "", (os.path.realpath(source),))
