@@ -380,7 +380,8 @@ def compare_menagerie_file(path: str, *, rtol: float, repair: bool, cache, geome
         elif rounded <= rtol:
             bucket = f"{method}: MuJoCo approximate (float32 vertices)"
         elif dropped:
-            bucket = f"{method}: MuJoCo approximate (its OBJ loader drops polygon triangles)"
+            bucket = (f"{method}: MuJoCo approximate (its OBJ loader keeps fewer triangles: polygons it cannot "
+                      "clip, or only the first object of a file)")
             detail += (f"; {dropped[0]}: MuJoCo {faces[dropped[0]]} triangles, the file "
                        f"{_file_triangles(link, dropped[0])}")
         else:
