@@ -51,7 +51,8 @@ __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", 
 #: orienting, welding, sealing cracks without moving a point or dropping repeated faces), ``"united"``
 #: (overlapping bodies of a mesh united by a boolean, then exact), ``"summed"`` (overlapping bodies added, the
 #: shared volume counted twice, as asked), ``"unverified"`` (a mesh whose face-intersection check did not prove
-#: it; see ``MeshReport.certificate``), ``"estimate"`` (a repaired open mesh: see ``uncertainty``).  For a mesh it
+#: it, see ``MeshReport.certificate``; or an MJCF mesh taken by MuJoCo's ``inertia="legacy"`` formula with the
+#: model's densities), ``"estimate"`` (a repaired open mesh: see ``uncertainty``).  For a mesh it
 #: is the kind of the engine's certificate, from the strongest to the weakest.
 METHODS = ("exact", "united", "summed", "unverified", "estimate")
 
