@@ -87,3 +87,25 @@ def test_one_open_mesh_used_twice_is_not_joined_with_itself(tmp_path):
     path = _model(tmp_path, '<geom type="mesh" mesh="sides"/><geom type="mesh" mesh="sides"/>')
     (result,) = link_inertials(read_robot(path), density=1000.0)
     assert result.properties is None and "mesh needs repair" in result.problem
+
+
+def test_open_pieces_without_a_common_seam_are_repaired_apart(tmp_path):
+    # two boxes 1 m apart, each missing one triangle: two separate holes, no seam in common, so each box is
+    # repaired on its own (joined, the two would be one surface repaired together)
+    (tmp_path / "assets").mkdir()
+    for name, shift in (("a", 0.0), ("b", 1.0)):
+        with open(tmp_path / "assets" / f"{name}.obj", "w") as fh:
+            for c in CORNERS:
+                fh.write("v {:.17g} {:.17g} {:.17g}\n".format(*(np.array(c) * SIZE / 2 + [shift, 0, 0])))
+            for t in TRIANGLES[1:]:
+                fh.write("f {} {} {}\n".format(*(i + 1 for i in t)))
+    path = tmp_path / "robot.xml"
+    path.write_text("""<mujoco model="apart"><compiler meshdir="assets"/>
+  <asset><mesh file="a.obj"/><mesh file="b.obj"/></asset>
+  <worldbody><body name="link"><geom type="mesh" mesh="a"/><geom type="mesh" mesh="b"/></body></worldbody>
+</mujoco>""")
+    (result,) = link_inertials(read_robot(str(path)), density=1000.0, repair=True)
+    assert result.method == "estimate"
+    assert not any("together" in w for w in result.warnings)
+    truth = 2 * 1000.0 * float(np.prod(SIZE))
+    assert abs(result.properties.mass - truth) <= result.uncertainty.mass * result.properties.mass

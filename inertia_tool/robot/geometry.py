@@ -440,6 +440,19 @@ def _piece_group(element: GeometryElement, model: bool) -> tuple:
             _mesh_key(element)[1:], weight)
 
 
+def _boundary_edges(vertices: np.ndarray, faces: np.ndarray) -> set:
+    """The edges of ``faces`` used once (a piece's open rim), each as the bytes of its two end points in a fixed
+    order, so that pieces with their own vertex numbering can be compared."""
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    edges.sort(axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    rims = unique[counts == 1]
+    ends = np.ascontiguousarray(vertices[rims], dtype=np.float64)             # (k, 2, 3)
+    swap = [tuple(a) > tuple(b) for a, b in zip(ends[:, 0].tolist(), ends[:, 1].tolist())]
+    ends[swap] = ends[swap][:, ::-1]
+    return {row.tobytes() for row in ends}
+
+
 def _joined_pieces(pieces: list, *, budget: list | None, repair: bool):
     """``(unit-density body, method, uncertainty)`` of the open meshes ``pieces`` (elements of one link, one
     placement) integrated as one surface, or None when together they are not a closed solid either (with
@@ -452,15 +465,24 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool):
     pieces share are then not taken for holes, which is what refused most of them one by one)."""
     first = pieces[0]
     vertices, faces, offset, count = [], [], 0, 0
+    seams: list[set] = []
     try:
         for element in pieces:
             raw = _placed(_raw_mesh(element.mesh, element), element)
+            seams.append(_boundary_edges(raw.vertices, raw.faces))
             vertices.append(raw.vertices)
             faces.append(raw.faces.astype(np.int64) + offset)
             offset += len(raw.vertices)
             count += int(raw.file_faces)
         if budget is not None and count > budget[0]:
             return None
+    except InertiaToolError:
+        return None
+    # pieces of one part meet along seams: a boundary edge of one is a boundary edge of another (the same two
+    # points); pieces with no seam in common are separate holes, no better repaired together than apart
+    if not any(seams[i] & seams[j] for i in range(len(seams)) for j in range(i + 1, len(seams))):
+        return None
+    try:
         joined = RawMesh(vertices=np.concatenate(vertices), faces=np.concatenate(faces),
                          source=" + ".join(_mesh_label(e) for e in pieces), units="m", file_faces=count)
     except InertiaToolError:
