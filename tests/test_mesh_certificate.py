@@ -294,7 +294,7 @@ def test_certificate_in_batch_rows_html_and_robot_links(tmp_path):
         assert "united (edge-balanced, consistently-oriented, boolean-union)" in html_report(props, generated="fixed")
         elements = (GeometryElement("box", rpy_to_matrix((0, 0, 0)), (0, 0, 0), size=(1, 1, 1)),
                     GeometryElement("mesh", rpy_to_matrix((0, 0, 0)), (3, 0, 0), mesh=str(united)))
-        parts, _ = _element_parts(LinkGeometry("l", elements, None), cache={}, repair=False, model=False)
+        parts, _, _ = _element_parts(LinkGeometry("l", elements, None), cache={}, repair=False, model=False)
     assert [m for _, _, m, _ in parts] == ["exact", "united"]     # a robot link's method: its meshes' certificate
 
 

@@ -47,6 +47,9 @@ __all__ = ["GeometryElement", "DeclaredInertial", "LinkGeometry", "RobotDescript
 #: for MJCF also ``"all"``: every geom in ``<compiler inertiagrouprange>``, as MuJoCo's inertia from geometry.
 GEOMETRY_KINDS = ("collision", "visual", "all")
 
+#: The geometry kind a link without geometry of the chosen kind may have instead.
+_OTHER_KIND = {"collision": "visual", "visual": "collision"}
+
 #: Primitive shapes with closed-form mass properties.
 PRIMITIVES = ("box", "cylinder", "sphere", "capsule", "ellipsoid")
 
@@ -155,6 +158,9 @@ class GeometryElement:
     fit_aabb : bool
         With ``fit_scale``: MuJoCo's ``<compiler fitaabb="true">``, the primitive is fitted to the mesh's
         bounding box in its principal axes instead of its equivalent inertia box.
+    mesh_inertia : str
+        MJCF ``<mesh inertia>`` when it names ``"convex"`` or ``"legacy"`` (taken with the model's own
+        densities: :mod:`inertia_tool.robot.mesh_inertia`); ``"exact"`` otherwise (``shell`` is ``shell``).
     """
 
     kind: str
@@ -175,6 +181,7 @@ class GeometryElement:
     vertices: np.ndarray | None = None
     faces: np.ndarray | None = None
     fit_aabb: bool = False
+    mesh_inertia: str = "exact"
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))
@@ -227,11 +234,16 @@ class LinkGeometry:
         Empty for a link without geometry of that kind (a frame, a virtual link).
     declared : DeclaredInertial or None
         None when the description has no ``<inertial>`` for the link.
+    unselected : int
+        Geometry elements of the link the chosen kind leaves out (``<visual>`` when reading collision geometry
+        and the other way round; MJCF: the geoms outside the selection), so that a link without geometry can
+        say which kind it has.
     """
 
     name: str
     elements: tuple
     declared: DeclaredInertial | None
+    unselected: int = 0
 
 
 @frozen_value
@@ -553,7 +565,9 @@ def _read_urdf(root, source: str, base: str, packages: dict, geometry: str) -> t
             raise _fail(source, "a <link> without a name")
         elements = tuple(_urdf_geometry(el, name, f"{geometry} {k + 1}", base, packages, source)
                          for k, el in enumerate(link.findall(geometry)))
-        links.append(LinkGeometry(name=name, elements=elements, declared=_urdf_inertial(link, source)))
+        other = len(link.findall(_OTHER_KIND[geometry])) if geometry in _OTHER_KIND else 0
+        links.append(LinkGeometry(name=name, elements=elements, declared=_urdf_inertial(link, source),
+                                  unselected=other))
     return root.get("name", ""), tuple(links)
 
 
@@ -769,7 +783,10 @@ def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, sou
                 raise _fail(source, "a <link> without a name")
             elements = tuple(_sdf_geometry(el, prefix + name, f"{geometry} {k + 1}", base, packages, source)
                              for k, el in enumerate(child.findall(geometry)) if not _sdf_without_volume(el))
-            links.append(LinkGeometry(name=prefix + name, elements=elements, declared=_sdf_inertial(child, source)))
+            other = (sum(1 for el in child.findall(_OTHER_KIND[geometry]) if not _sdf_without_volume(el))
+                     if geometry in _OTHER_KIND else 0)
+            links.append(LinkGeometry(name=prefix + name, elements=elements, declared=_sdf_inertial(child, source),
+                                      unselected=other))
         elif child.tag == "model":
             links += _sdf_links(child, f"{prefix}{child.get('name', '')}::", base, packages, geometry, source,
                                 stack + (f"model {child.get('name')}",), budget)

@@ -33,7 +33,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..errors import InertiaToolError, MeshReadError, UsageError
+from ..errors import InertiaToolError, InvalidMeshError, MeshReadError, UsageError
 from ..mass import shapes, shell_shapes
 from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
@@ -51,7 +51,8 @@ __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", 
 #: orienting, welding, sealing cracks without moving a point or dropping repeated faces), ``"united"``
 #: (overlapping bodies of a mesh united by a boolean, then exact), ``"summed"`` (overlapping bodies added, the
 #: shared volume counted twice, as asked), ``"unverified"`` (a mesh whose face-intersection check did not prove
-#: it; see ``MeshReport.certificate``), ``"estimate"`` (a repaired open mesh: see ``uncertainty``).  For a mesh it
+#: it, see ``MeshReport.certificate``; or an MJCF mesh taken by MuJoCo's ``inertia="legacy"`` formula with the
+#: model's densities), ``"estimate"`` (a repaired open mesh: see ``uncertainty``).  For a mesh it
 #: is the kind of the engine's certificate, from the strongest to the weakest.
 METHODS = ("exact", "united", "summed", "unverified", "estimate")
 
@@ -403,11 +404,140 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
 
+#: What a link's warnings say of a mesh taken by its MJCF ``<mesh inertia>`` mode (``--density model``).
+_MESH_INERTIA_NOTES = {
+    "convex": "mesh {} has inertia=\"convex\" in the model: its convex hull is integrated, as MuJoCo does",
+    "legacy": ("mesh {} has inertia=\"legacy\" in the model: MuJoCo's legacy formula (absolute volumes of the "
+               "tetrahedra from the surface's centre) is used, as MuJoCo does; for a non-convex mesh it is not "
+               "the solid's integral, hence 'unverified'"),
+}
+
+
+def _mesh_inertia_part(element: GeometryElement, *, cache: dict, budget: list | None) -> tuple:
+    """``(element, unit properties in the link frame, method, None)`` of a mesh taken by its MJCF inertia
+    mode (:mod:`inertia_tool.robot.mesh_inertia`): ``convex`` is the exact integral of the hull, ``legacy``
+    MuJoCo's formula, labelled ``unverified`` (no check makes it the solid's)."""
+    from .mesh_inertia import convex_hull_properties, legacy_properties
+    key = ("mesh inertia", element.mesh_inertia) + _mesh_key(element)
+    found = cache.get(key)
+    if found is None:
+        raw = _placed(_raw_mesh(element.mesh, element, None if budget is None else budget[0]), element)
+        if budget is not None:
+            budget[0] -= int(raw.file_faces)
+        label = _mesh_label(element)
+        found = (convex_hull_properties(raw.vertices, source=label) if element.mesh_inertia == "convex"
+                 else legacy_properties(raw.vertices, raw.faces, source=label))
+        cache[key] = found
+    method = "exact" if element.mesh_inertia == "convex" else "unverified"
+    return element, found.transformed(rotation=element.rotation, translation=element.translation), method, None
+
+
+def _piece_group(element: GeometryElement, model: bool) -> tuple:
+    """Elements whose open meshes may be joined: the same placement and scale, and the same density with no
+    mass of their own (``model``; otherwise the robot's one density weighs them all)."""
+    weight = (element.mass is None, element.density) if model else ()
+    return (element.rotation.tobytes(), np.asarray(element.translation, dtype=np.float64).tobytes(),
+            _mesh_key(element)[1:], weight)
+
+
+def _boundary_edges(vertices: np.ndarray, faces: np.ndarray) -> set:
+    """The edges of ``faces`` used once (a piece's open rim), each as the bytes of its two end points in a fixed
+    order, so that pieces with their own vertex numbering can be compared."""
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    edges.sort(axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    rims = unique[counts == 1]
+    ends = np.ascontiguousarray(vertices[rims], dtype=np.float64)             # (k, 2, 3)
+    swap = [tuple(a) > tuple(b) for a, b in zip(ends[:, 0].tolist(), ends[:, 1].tolist())]
+    ends[swap] = ends[swap][:, ::-1]
+    return {row.tobytes() for row in ends}
+
+
+def _joined_pieces(pieces: list, *, budget: list | None, repair: bool):
+    """``(unit-density body, method, uncertainty)`` of the open meshes ``pieces`` (elements of one link, one
+    placement) integrated as one surface, or None when together they are not a closed solid either (with
+    ``repair``: not even a bounded estimate) or cannot be read.
+
+    Menagerie's Stretch splits a part into one OBJ file per material (``link_arm_l1_0.obj`` carbon fibre,
+    ``link_arm_l1_1.obj`` printed plastic): each file is open where it meets the other, and together they bound
+    the part.  The union of the pieces' triangles is checked and integrated by the engine like any mesh: first
+    without repair; if it still has holes and ``repair`` is asked, repaired as one surface (the seams the
+    pieces share are then not taken for holes, which is what refused most of them one by one)."""
+    first = pieces[0]
+    vertices, faces, offset, count = [], [], 0, 0
+    seams: list[set] = []
+    try:
+        for element in pieces:
+            raw = _placed(_raw_mesh(element.mesh, element), element)
+            seams.append(_boundary_edges(raw.vertices, raw.faces))
+            vertices.append(raw.vertices)
+            faces.append(raw.faces.astype(np.int64) + offset)
+            offset += len(raw.vertices)
+            count += int(raw.file_faces)
+        if budget is not None and count > budget[0]:
+            return None
+    except InertiaToolError:
+        return None
+    # pieces of one part meet along seams: a boundary edge of one is a boundary edge of another (the same two
+    # points); pieces with no seam in common are separate holes, no better repaired together than apart
+    if not any(seams[i] & seams[j] for i in range(len(seams)) for j in range(i + 1, len(seams))):
+        return None
+    try:
+        joined = RawMesh(vertices=np.concatenate(vertices), faces=np.concatenate(faces),
+                         source=" + ".join(_mesh_label(e) for e in pieces), units="m", file_faces=count)
+    except InertiaToolError:
+        return None
+    for fix in (False, True) if repair else (False,):
+        with warnings.catch_warnings(record=True) as recorded:
+            warnings.simplefilter("always")
+            try:
+                local = mass_properties(joined, density=1.0, repair=fix)
+            except InertiaToolError:
+                continue
+        _reissue(recorded)
+        report = local.mesh
+        method = ("exact" if report is None else "estimate" if report.uncertainty is not None
+                  else report.certificate.kind)
+        uncertainty = None if report is None else report.uncertainty
+        return local.transformed(rotation=first.rotation, translation=first.translation), method, uncertainty
+    return None
+
+
+def _join_open_pieces(parts: list, refused: list, *, model: bool, repair: bool,
+                      budget: list | None) -> tuple[list, list, list]:
+    """``parts`` and ``refused`` with each group of at least two open mesh pieces that close together
+    (:func:`_joined_pieces`) replaced by one part; the third value names what was joined, for the link's
+    warnings.  Open pieces are the meshes refused as needing repair and those repaired into estimates."""
+    candidates = [e for e, _ in refused] + [e for e, _, m, _ in parts if m == "estimate" and e.fit_scale is None]
+    groups: dict = {}
+    for element in candidates:
+        if element.kind == "mesh" and not element.shell and (element.mass is None or not model):
+            groups.setdefault(_piece_group(element, model), []).append(element)
+    notes = []
+    for pieces in groups.values():
+        keys = [_mesh_key(e) for e in pieces]
+        if len(pieces) < 2 or len(set(keys)) < len(keys):     # one piece, or a mesh twice: nothing to join
+            continue
+        found = _joined_pieces(pieces, budget=budget, repair=repair)
+        if found is None:
+            continue
+        local, method, uncertainty = found
+        joined = {id(e) for e in pieces}
+        parts = [p for p in parts if id(p[0]) not in joined] + [(pieces[0], local, method, uncertainty)]
+        refused = [r for r in refused if id(r[0]) not in joined]
+        notes.append(f"meshes {', '.join(os.path.basename(_mesh_label(e)) for e in pieces)} are open one by one: "
+                     + ("they close together (pieces of one part) and were integrated as one solid"
+                        if method != "estimate" else "integrated as one surface, repaired together"))
+    return parts, refused, notes
+
+
 def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool,
                    budget: list | None = None):
     """Per element of ``link``: ``(element, unit properties, mesh method, mesh uncertainty)``; massless
-    elements (``model`` mode) are left out and named in the second return value."""
-    parts, massless = [], []
+    elements (``model`` mode) are left out and named in the second return value; the third says what the
+    link's warnings should: meshes taken by their MJCF ``inertia`` mode, open mesh pieces integrated together
+    (:func:`_join_open_pieces`)."""
+    parts, massless, refused, notes = [], [], [], []
     for element in link.elements:
         if model and (element.mass == 0 or (element.mass is None and element.density == 0)):
             massless.append(element)
@@ -415,7 +545,17 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
         if model and element.shell:
             parts.append((element, element_shell_properties(element), "exact", None))
             continue
-        props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
+        if model and element.kind == "mesh" and element.mesh_inertia != "exact" and element.fit_scale is None:
+            parts.append(_mesh_inertia_part(element, cache=cache, budget=budget))
+            notes.append(_MESH_INERTIA_NOTES[element.mesh_inertia].format(os.path.basename(_mesh_label(element))))
+            continue
+        try:
+            props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
+        except InvalidMeshError as exc:      # an open piece may close with the link's other pieces: tried below
+            if element.kind != "mesh" or element.fit_scale is not None:
+                raise
+            refused.append((element, exc))
+            continue
         fitted = element.fit_scale is not None
         key = _mesh_key(element) if element.kind == "mesh" or fitted else None
         report = cache[key].mesh if key is not None and key in cache else None
@@ -428,7 +568,12 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
             method = "estimate" if report.uncertainty is not None else report.certificate.kind
             uncertainty = report.uncertainty
         parts.append((element, props, method, uncertainty))
-    return parts, massless
+    joined: list = []
+    if len(refused) + sum(1 for p in parts if p[2] == "estimate") >= 2:
+        parts, refused, joined = _join_open_pieces(parts, refused, model=model, repair=repair, budget=budget)
+    if refused:
+        raise refused[0][1]
+    return parts, massless, notes + joined
 
 
 def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repair: bool = False,
@@ -565,19 +710,22 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     """The result for one link, or the reason there is none (never raises for the link's own problems)."""
     nan = float("nan")
     if not link.elements:
+        other = {"collision": "visual", "visual": "collision"}.get(geometry)
+        has = (f"; {link.unselected} {other} element{'s' if link.unselected > 1 else ''}, which --geometry "
+               f"{other} reads" if link.unselected and other else "")
         return LinkInertial(link.name, None, nan, basis, "no geom in <compiler inertiagrouprange>" if geometry == "all"
-                            else f"no {geometry} geometry")
+                            else f"no {geometry} geometry{has}")
     missing = [e.mesh for e in link.elements if e.mesh is not None and not os.path.exists(e.mesh)
                and not (model and (e.mass == 0 or (e.mass is None and e.density == 0)))]
     if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute
         return LinkInertial(link.name, None, nan, basis, f"mesh file missing: {', '.join(dict.fromkeys(missing))}")
     try:
-        parts, massless = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
+        parts, massless, joined = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
     except InertiaToolError as exc:
         return LinkInertial(link.name, None, nan, basis, f"mesh needs repair or cannot be read: {exc}")
     except (ValueError, ArithmeticError) as exc:     # numerical trouble in one link's geometry: its reason
         return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}")
-    warned = [e.note for e in link.elements if e.note]
+    warned = [e.note for e in link.elements if e.note] + joined
     warned += [f"{e.kind} {e.name!r} is massless in the description "
                f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
     if not parts:

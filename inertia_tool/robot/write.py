@@ -238,7 +238,7 @@ def _moved(value: str, source_dir: str, out_dir: str) -> str | None:
 
 def _mjcf_included_folders(robot: RobotDescription) -> set:
     """Compiler folder attributes that an included file sets (a moved main file cannot fix those)."""
-    from .mjcf import _expand_includes
+    from .mjcf_model import _expand_includes
     root = parse_xml(robot.document, robot.source).getroot()
     own = set(id(c) for c in root.iter("compiler"))
     try:
@@ -255,7 +255,7 @@ _MJCF_FOLDER_KEYS = ("meshdir", "assetdir", "texturedir")
 def _folders_set_by(include, robot: RobotDescription) -> dict:
     """The compiler folder attributes that the file of ``include`` (an ``<include>`` of the main file) sets,
     with the files it includes in turn, as MuJoCo merges them (later ones win); {} when it sets none."""
-    from .mjcf import _expand_includes
+    from .mjcf_model import _expand_includes
     from lxml import etree
     probe = etree.Element("mujoco")
     probe.append(etree.Element("include", file=include.get("file") or ""))

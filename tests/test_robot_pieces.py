@@ -1,0 +1,111 @@
+"""A part split into one mesh file per material (Menagerie's Stretch: ``link_arm_l1_0.obj`` carbon fibre and
+``link_arm_l1_1.obj`` printed plastic): each file is open where it meets the other and was refused; the link's
+pieces with one placement and one density are integrated as one surface (``inertia_tool.robot.geometry``).
+The truth is the closed form of the solid the pieces bound."""
+
+import numpy as np
+import pytest
+
+from inertia_tool.robot import link_inertials, read_robot
+
+# a box 0.2 × 0.1 × 0.05 m; its 12 triangles split into the 4 of the two ends (x = ±a) and the 8 of the sides
+SIZE = np.array([0.2, 0.1, 0.05])
+CORNERS = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+TRIANGLES = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5),                     # x = -a, x = +a
+             (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+
+
+def _write_piece(path, triangles):
+    with open(path, "w") as fh:
+        for c in CORNERS:
+            fh.write("v {:.17g} {:.17g} {:.17g}\n".format(*(np.array(c) * SIZE / 2)))
+        for t in triangles:
+            fh.write("f {} {} {}\n".format(*(i + 1 for i in t)))
+
+
+def _model(tmp_path, geoms, *, drop_one=False):
+    (tmp_path / "assets").mkdir(exist_ok=True)
+    _write_piece(tmp_path / "assets" / "ends.obj", TRIANGLES[:4][: 3 if drop_one else 4])
+    _write_piece(tmp_path / "assets" / "sides.obj", TRIANGLES[4:])
+    path = tmp_path / "robot.xml"
+    path.write_text(f"""<mujoco model="pieces">
+  <compiler meshdir="assets"/>
+  <asset><mesh file="ends.obj"/><mesh file="sides.obj"/></asset>
+  <worldbody><body name="link" pos="0 0 1">{geoms}</body></worldbody>
+</mujoco>
+""")
+    return str(path)
+
+
+PLACED = 'pos="0.1 0.2 0.3" euler="30 0 45"'
+
+
+def _rotation():
+    from scipy.spatial.transform import Rotation
+    return Rotation.from_euler("XYZ", [30, 0, 45], degrees=True).as_matrix()     # MJCF: intrinsic x, y, z
+
+
+@pytest.mark.parametrize("repair", [False, True])
+def test_two_open_pieces_of_one_box_are_the_box(tmp_path, repair):
+    path = _model(tmp_path, f'<geom type="mesh" mesh="ends" {PLACED}/><geom type="mesh" mesh="sides" {PLACED}/>')
+    (result,) = link_inertials(read_robot(path), density=2000.0, repair=repair)
+    a, b, c = SIZE
+    mass = 2000.0 * a * b * c
+    assert result.method == "exact" and result.uncertainty is None
+    assert result.properties.mass == pytest.approx(mass, rel=1e-14)
+    np.testing.assert_allclose(result.properties.center_of_mass, [0.1, 0.2, 0.3], atol=1e-15)
+    box = mass / 12 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
+    np.testing.assert_allclose(result.properties.inertia, _rotation() @ box @ _rotation().T, rtol=0, atol=1e-15)
+    assert any("close together" in w and "ends.obj, sides.obj" in w for w in result.warnings)
+
+
+def test_pieces_that_do_not_close_stay_refused_without_repair_and_are_bounded_with_it(tmp_path):
+    path = _model(tmp_path, '<geom type="mesh" mesh="ends"/><geom type="mesh" mesh="sides"/>', drop_one=True)
+    (refused,) = link_inertials(read_robot(path), density=1000.0)
+    assert refused.properties is None and "mesh needs repair" in refused.problem
+    (repaired,) = link_inertials(read_robot(path), density=1000.0, repair=True)
+    assert repaired.method == "estimate"
+    truth = 1000.0 * float(np.prod(SIZE))       # the hole is half an end: the box is one filling of it
+    assert abs(repaired.properties.mass - truth) <= repaired.uncertainty.mass * repaired.properties.mass
+    assert any("repaired together" in w for w in repaired.warnings)
+
+
+@pytest.mark.parametrize("geoms", [
+    # differently placed pieces do not bound one solid
+    '<geom type="mesh" mesh="ends"/><geom type="mesh" mesh="sides" pos="0 0 0.01"/>',
+    # with the model's densities, pieces of different materials are not one body
+    '<geom type="mesh" mesh="ends" density="900"/><geom type="mesh" mesh="sides" density="7800"/>',
+    # a piece with a mass of its own: how the mass splits between the pieces is not known
+    '<geom type="mesh" mesh="ends" mass="1"/><geom type="mesh" mesh="sides"/>',
+])
+def test_pieces_that_are_not_one_body_are_not_joined(tmp_path, geoms):
+    (result,) = link_inertials(read_robot(_model(tmp_path, geoms)), density="model")
+    assert result.properties is None and "mesh needs repair" in result.problem
+
+
+def test_one_open_mesh_used_twice_is_not_joined_with_itself(tmp_path):
+    path = _model(tmp_path, '<geom type="mesh" mesh="sides"/><geom type="mesh" mesh="sides"/>')
+    (result,) = link_inertials(read_robot(path), density=1000.0)
+    assert result.properties is None and "mesh needs repair" in result.problem
+
+
+def test_open_pieces_without_a_common_seam_are_repaired_apart(tmp_path):
+    # two boxes 1 m apart, each missing one triangle: two separate holes, no seam in common, so each box is
+    # repaired on its own (joined, the two would be one surface repaired together)
+    (tmp_path / "assets").mkdir()
+    for name, shift in (("a", 0.0), ("b", 1.0)):
+        with open(tmp_path / "assets" / f"{name}.obj", "w") as fh:
+            for c in CORNERS:
+                fh.write("v {:.17g} {:.17g} {:.17g}\n".format(*(np.array(c) * SIZE / 2 + [shift, 0, 0])))
+            for t in TRIANGLES[1:]:
+                fh.write("f {} {} {}\n".format(*(i + 1 for i in t)))
+    path = tmp_path / "robot.xml"
+    path.write_text("""<mujoco model="apart"><compiler meshdir="assets"/>
+  <asset><mesh file="a.obj"/><mesh file="b.obj"/></asset>
+  <worldbody><body name="link"><geom type="mesh" mesh="a"/><geom type="mesh" mesh="b"/></body></worldbody>
+</mujoco>""")
+    (result,) = link_inertials(read_robot(str(path)), density=1000.0, repair=True)
+    assert result.method == "estimate"
+    assert not any("together" in w for w in result.warnings)
+    truth = 2 * 1000.0 * float(np.prod(SIZE))
+    assert abs(result.properties.mass - truth) <= result.uncertainty.mass * result.properties.mass
