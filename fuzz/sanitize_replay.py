@@ -130,10 +130,20 @@ def c_api_calls() -> int:
         lib.face_measures(v, tri, 2)
         lib.contact_scan(v, np.tile(tri, (3, 1)), -1, 2)
         calls += 6
+        # boxes past float32's range (-inf .. +inf) must not meet a leaf's empty padding positions
+        huge = np.array([[-1e300] * 3, [1e300] * 3, [1e300, -1e300, 1e300], [-1e300, 1e300, -1e300]])
+        lib.contact_scan(huge, np.array([[0, 1, 2], [0, 1, 3], [1, 2, 3]], dtype=itype), -1, 1, 3)
+        out = np.zeros((1, 3))
+        lib.roundoff_sums(np.empty((0, 3)), none, (0.0, 0.0, 0.0), None, out, 1)
+        lib.roundoff_sums(v, tri, (0.0, 0.0, 0.0), None, out, 1 << 62)
+        calls += 3
+        expect_error(lib.roundoff_sums, v, tri, (0.0, 0.0, 0.0), np.array([5], dtype=itype), np.zeros((2, 3)), 8)
+        expect_error(lib.roundoff_sums, v, tri, (0.0, 0.0, 0.0), None, np.zeros((0, 3)), 8)
         for faces in (bad, neg):
             expect_error(lib.edge_shell_labels, faces, 3, np.empty(1, dtype=itype))
             expect_error(lib.face_measures, v, faces)
             expect_error(lib.contact_scan, v, faces, -1)
+            expect_error(lib.roundoff_sums, v, faces, (0.0, 0.0, 0.0), None, np.zeros((1, 3)), 8)
             expect_error(lib.edge_census, faces, 3)
             expect_error(lib.shell_labels, faces, 3, np.empty(1, dtype=itype))
             expect_error(lib.tetra_sums, v, faces, (0.0, 0.0, 0.0), 0.0, None, sums, zero)

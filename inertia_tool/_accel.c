@@ -4630,6 +4630,15 @@ ct_leaf_count(const CtNode *nd, int64_t m)     /* faces in a leaf: its block's, 
     return (int)(m - start < CT_LEAF ? m - start : CT_LEAF);
 }
 
+/* Bits 0 .. count - 1: the positions of a leaf's block that hold faces.  A block mask is cut to them: the empty
+ * boxes past the last face (lo +inf, hi -inf) meet nothing finite, but a face whose float32 box overflowed to
+ * -inf .. +inf (a direct call with coordinates beyond float32's range) would meet them too. */
+static inline unsigned
+ct_leaf_bits(int count)
+{
+    return count >= CT_LEAF ? (unsigned)((1ull << CT_LEAF) - 1) : (1u << count) - 1;
+}
+
 typedef struct {
     int64_t *a, *b;
     int8_t *kind;
@@ -5390,7 +5399,7 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 for (int a = 0; a + 1 < pcount; a++) {
                     unsigned mask = ct_block_mask(blk, blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a],
                                                   blk[3 * CT_LEAF + a], blk[4 * CT_LEAF + a], blk[5 * CT_LEAF + a]);
-                    mask &= ~((2u << a) - 1);               /* the later positions j > i only */
+                    mask &= ~((2u << a) - 1) & ct_leaf_bits(pcount);     /* the later faces j > i only */
                     if (mask && ct_visit_block(sc, pstart + a, pstart, mask, &leaf[a], &have[a], leaf, have)) {
                         goto out;
                     }
@@ -5413,12 +5422,14 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             const float *pb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
             const float *qb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(q);
             /* p's faces against q's box first, then each that meets it against q's faces */
-            unsigned pmask = ct_block_mask(pb, q->lo[0], q->lo[1], q->lo[2], q->hi[0], q->hi[1], q->hi[2]);
+            unsigned pmask = ct_block_mask(pb, q->lo[0], q->lo[1], q->lo[2], q->hi[0], q->hi[1], q->hi[2])
+                             & ct_leaf_bits(ct_leaf_count(p, sc->m));
+            unsigned qbits = ct_leaf_bits(ct_leaf_count(q, sc->m));
             while (pmask) {
                 int a = ct_ctz(pmask);
                 pmask &= pmask - 1;
                 unsigned mask = ct_block_mask(qb, pb[a], pb[CT_LEAF + a], pb[2 * CT_LEAF + a], pb[3 * CT_LEAF + a],
-                                              pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]);
+                                              pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]) & qbits;
                 CtFace FI;
                 uint8_t have_i = 0;
                 if (mask && ct_visit_block(sc, pstart + a, qstart, mask, &FI, &have_i, leaf, have)) goto out;

@@ -409,6 +409,8 @@ def _norm2(x: np.ndarray) -> np.ndarray:
 def _roundoff_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n: int,
                      origin: np.ndarray, chunk_size: int) -> np.ndarray:
     """:func:`_roundoff_sums` on the C extension, bit for bit the same (the same operations in the same order)."""
+    if n == 0:                                  # no shells (the kernel wants an output row): no sums, as numpy's
+        return np.zeros((0, 3))
     out = np.empty((n, 3))
     lib.roundoff_sums(np.ascontiguousarray(vertices), faces_for_c(faces), (float(origin[0]), float(origin[1]),
                       float(origin[2])), None if n == 1 else np.ascontiguousarray(labels, dtype=np.int64), out,

@@ -214,3 +214,13 @@ def test_bound_holds_on_random_small_meshes_both_paths(monkeypatch):
         bound = roundoff_bounds(v, f, labels, [shell], o)
         exact = integrals.exact_volume_moments(v, f)
         assert abs(shell.volume - exact.volume) <= bound.volume[0] + 2 * integrals._U * abs(exact.volume)
+
+
+@pytest.mark.usefixtures("engine_path")
+def test_roundoff_bounds_of_no_shells_is_empty_on_both_paths():
+    """Regression (review of batch2): with no shells the C path refused its (0, 3) output ("Expected `out` ...")
+    where the numpy twin returns empty bounds; both return empty bounds now."""
+    v = np.zeros((3, 3))
+    bound = roundoff_bounds(v, np.zeros((0, 3), dtype=np.int64), np.zeros(0, dtype=np.intp), [], np.zeros(3))
+    for name in ("volume", "centroid", "second_moment"):
+        assert getattr(bound, name).shape == (0,)
