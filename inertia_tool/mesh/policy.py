@@ -142,6 +142,10 @@ CHECKS = {
     "consistently-oriented": "every shell is wound outward as a body or inward as a cavity by its nesting depth",
     "no-crossing-faces": "no two faces cross or overlap except along shared edges and vertices (checked over "
                          "every candidate pair)",
+    "zero-volume-folds": "sliver fans (a vertex of three faces splitting the face of its neighbours) and internal "
+                         "walls (faces near one plane whose edges cancel by index) were taken out: the winding "
+                         "number they add is nonzero only in a volume bounded within ROUNDOFF_RTOL of the result, "
+                         "zero when exactly flat (mesh/folds.py)",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
     "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves and the "
                            "faces bounding {winding number ≥ 1} kept (mesh/arrange.py); the result was checked "

@@ -270,6 +270,10 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if welded is not None and len(welded.contact):      # R1b: bodies welded along an edge meet there (R4 decides)
         contacts = dataclasses.replace(contacts, contact=np.concatenate(
             [np.asarray(contacts.contact, dtype=np.int64).reshape(-1, 2), welded.contact]))
+    folds = None
+    if patched is None and (len(contacts.crossing) or len(contacts.coplanar_opposite)):                 # R3a
+        v, f, labels, n_shells, shells, contacts, bound, folds = _settle_folds(v, f, labels, n_shells, shells, contacts,
+                                                                               bound, split_welded, diag, source)
     if patched is not None:
         contacts, patch_notes = _outside_patches(contacts, f, n_read)
         found = Resolution(found.vertices, found.faces, found.method, found.notes + patch_notes,
@@ -326,6 +330,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         notes.append(dropped_note)
     if arranged is not None:
         notes.append(arranged)
+    if folds is not None:
+        notes.append(folds.describe())
     if crossing_note is not None:
         notes.append(crossing_note)
     checks = ["edge-balanced", "consistently-oriented"]
@@ -447,6 +453,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             checks = [c for c in checks if c != "no-crossing-faces"]
     if ambiguous and kind in ("exact", "united"):
         kind = "unverified"                   # R4: a reading of the file's winding, not a proven solid
+    if folds is not None and "no-crossing-faces" in checks:
+        checks.insert(checks.index("no-crossing-faces"), "zero-volume-folds")      # R3a: what makes it exact
     certificate = Certificate(kind, tuple(checks) if kind != "estimate" else ())
     report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
                         bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),
@@ -455,6 +463,32 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                         repair_volume_change=None, bbox_min=bbox_min, bbox_max=bbox_max, method=method,
                         uncertainty=uncertainty, notes=tuple(notes), certificate=certificate, **common)
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
+
+
+def _settle_folds(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int, shells: list[VolumeMoments],
+                  contacts: SurfaceContacts, bound: RoundoffBound, split_welded: bool, diag: float,
+                  source: str) -> tuple[Any, ...]:
+    """R3a: sliver fans and internal walls taken out (:func:`~.folds.settle_folds`) and the stages after R1 run
+    again on what is left; everything unchanged when there are none or they cannot be shown to enclose nothing.
+
+    Returns ``(v, f, labels, n_shells, shells, contacts, bound, folds)`` (``folds`` None when unchanged)."""
+    from .folds import settle_folds        # imported on use: only surfaces with flagged face pairs
+    folds = settle_folds(v, f, contacts, labels)
+    if folds is None:
+        return v, f, labels, n_shells, shells, contacts, bound, None
+    f = folds.faces
+    labels, n_shells = _bodies(v, f, split_welded)
+    shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+    m = len(f)
+    f, labels, n_shells, shells, _, bound = _drop_flat(v, f, labels, shells, diag, source, bound, warn=False)
+    contacts = folds.contacts if len(f) == m else surface_contacts(v, f)
+    if split_welded:                       # R1b: bodies welded along an edge still meet there (R4 decides)
+        welded = welded_bodies(f, len(v), labels, n_shells, v)
+        if len(welded.contact):
+            contacts = dataclasses.replace(contacts, contact=np.concatenate(
+                [np.asarray(contacts.contact, dtype=np.int64).reshape(-1, 2), welded.contact]))
+    warnings.warn(MeshResolvedWarning(f"{source}: {folds.describe()}"), stacklevel=4)
+    return v, f, labels, n_shells, shells, contacts, bound, folds
 
 
 def _arrange_self_crossing(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: SurfaceContacts,

@@ -1,0 +1,429 @@
+"""Folds that enclose (next to) nothing: sliver fans and internal walls taken out of a closed surface (rule R3a).
+
+A closed, edge-balanced triangle surface ``S`` is a 2-chain: its faces with their orientations, a face and its
+reverse cancelling.  Its winding number at a point ``x`` off the faces is the sum of the faces' signed solid angles
+over 4π, and the divergence-theorem integrals (Rigid Body Motion, Ch. 4, the volume integrals written as sums over
+the faces) are ``∫ w_S (1, x, x xᵀ) dV``.  Both are additive: when ``S = S′ + Z`` as chains, with ``Z`` closed
+(every edge of ``Z`` used equally often in both directions, by vertex index), then ``w_S = w_S′ + w_Z`` off the
+faces.  If ``w_Z`` vanishes except on a set ``D`` of bounded volume, the solids ``{w_S ≥ 1}`` and ``{w_S′ ≥ 1}``
+differ only inside ``D``, by at most ``∫|w_Z| dV`` of volume; and when ``S′`` passes the face-pair check with no
+crossing (:mod:`~.intersect`, exact), ``S′`` bounds its solid exactly.  Two kinds of ``Z`` are found here.
+
+Sliver fans
+-----------
+A vertex ``m`` in exactly three faces whose other corners form one cycle ``a → b → c → a`` (the faces
+``(a, b, m), (b, c, m), (c, a, m)``) is the face ``(a, b, c)`` split at ``m``: the fan minus ``(a, b, c)`` is
+closed (the edges at ``m`` cancel, the link edges are those of ``(a, b, c)``) and is the boundary of the
+tetrahedron ``(a, b, c, m)``, so ``w_Z = ±1`` inside it and 0 outside, ``∫|w_Z| = |det(a − m, b − m, c − m)|/6``.
+A point put on an edge makes such a fan: a face split at a point of one of its edges into a zero-area sliver
+``(a, b, m)`` and two triangles, or a T-vertex on a face's edge closed by a sliver.  When ``m`` lies exactly on
+the edge the tetrahedron is flat (``w_Z = 0`` almost everywhere: the replacement is exact).  When ``m`` was rounded
+off the edge the sliver folds by that rounding, the check rightly finds the folds crossing, and the tetrahedron is
+as thin as ``m``'s distance from the edge.  A face of exactly zero area (three collinear corners) subtends no solid
+angle from any point off it, so it cannot change the winding number and cannot make a crossing that matters: the
+face-pair check skips it.  Fans are replaced one at a time (a vertex left with three faces by a replacement is
+tried next, so a chain of points on one edge unwinds), only those touching a face the check flagged.
+
+Internal walls
+--------------
+Faces ``W`` that lie within ``δ`` of one plane ``P`` and are closed by themselves (``∂W = 0`` by index) are two
+sheets of a wall covering one region with opposite orientation: two halves of a part written face to face, each
+half's cut face triangulated on its own, or two bodies touching face to face.  For ``x`` farther than ``δ`` from
+``P`` the ray from ``x`` along the normal away from ``P`` meets no face of ``W``, so ``w_W(x) = 0``; within the
+slab that ray meets at most ``N(x)`` faces, the number of faces of ``W`` whose projection on ``P`` contains that of
+``x``, so ``∫|w_W| ≤ 2δ·Σ area``.  When every corner of ``W`` lies exactly in one plane (exact ``orient3d``) the
+sheets cancel exactly: the density ``Σ ±1_T`` of the projected faces jumps across an edge by that edge's net use
+in ``W``, which is zero, so it is zero everywhere (their signed areas cancel over every region of the plane) and
+``w_W = 0`` off ``P``.  Walls are grown from the faces of crossing or coplanar-opposite pairs (connected through
+those pairs), and, when the faces so found are not closed, through shared edges to faces within ``δ`` of the same
+plane; a group that is still not closed stays on the normal path.
+
+The bound
+---------
+``D = Σ ∫|w_Z|`` over the fans and walls taken out.  The result stands for the file's solid (R7) when ``D`` is
+within ``budget`` (``tolerances.ROUNDOFF_RTOL``) of the remaining surface's volume, and ``D·R²`` (``R`` the largest
+distance of a corner of a removed piece from the remaining surface's centroid) within ``budget`` of its second
+moment's norm: the same test as R0's copies up to rounding.  Otherwise, or when the remaining surface still has a
+crossing face pair, nothing is taken out and the surface goes on to R3 as it stands.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import deque
+
+import numpy as np
+
+from ..integrals import volume_moments
+from ..tolerances import ROUNDOFF_RTOL, WALL_PLANE_RTOL
+from ..values import frozen_value
+from .edges import edge_keys
+from .intersect import O3D_BOUND, SurfaceContacts, orient2d_sign, orient3d_sign, surface_contacts
+
+__all__ = ["Folds", "settle_folds", "sliver_fans", "internal_walls"]
+
+_U = 2.0 ** -53
+_PLANE = np.array([[1, 2], [2, 0], [0, 1]])       # coordinates kept when dropping an axis (orientation-preserving)
+
+
+@frozen_value
+class Folds:
+    """A closed surface with its zero-volume folds taken out (R3a).
+
+    Attributes
+    ----------
+    faces : (k, 3) int64
+        The remaining surface (sliver fans replaced by the face they split, wall faces left out).
+    contacts : SurfaceContacts
+        The face-pair check of ``faces`` (no crossing pair).
+    fans : int
+        Sliver fans replaced.
+    wall_faces : int
+        Faces of internal walls left out.
+    walls : int
+        Internal walls (closed coplanar groups) left out.
+    exact_walls : int
+        Walls whose corners lie exactly in one plane (their sheets cancel exactly).
+    volume_bound : float
+        m³: bound on the volume in which the file's winding number differs from that of ``faces`` (``D`` of the
+        module docstring); 0 when every fan and wall is exactly flat.
+    """
+
+    faces: np.ndarray
+    contacts: SurfaceContacts
+    fans: int
+    wall_faces: int
+    walls: int
+    exact_walls: int
+    volume_bound: float
+
+    def describe(self) -> str:
+        """One line for the report's notes."""
+        parts = []
+        if self.fans:
+            parts.append(f"{self.fans:,} sliver fan{'s' if self.fans > 1 else ''} (a vertex of three faces splitting "
+                         "the face of its neighbours, folded by rounding) replaced by the face they split")
+        if self.walls:
+            exact = f", {self.exact_walls} exactly coplanar" if self.exact_walls else ""
+            parts.append(f"{self.walls:,} internal wall{'s' if self.walls > 1 else ''} ({self.wall_faces:,} faces: two "
+                         f"sheets of opposite orientation whose edges cancel{exact}) left out")
+        return ("zero-volume folds: " + "; ".join(parts) + f"; the winding number they add is nonzero in at most "
+                f"{self.volume_bound:.3g} m³, within the round-off bound of an exact result")
+
+
+# -- sliver fans ----------------------------------------------------------------------------------------------
+
+def sliver_fans(vertices: np.ndarray, faces: np.ndarray, seeds: np.ndarray, *,
+                volume_cap: float) -> tuple[np.ndarray, int, float, np.ndarray]:
+    """Replace the sliver fans (module docstring) at the vertices of faces ``seeds`` by the face they split.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    seeds : (s,) int
+        Faces where the search starts (those of the flagged face pairs).
+    volume_cap : float
+        m³: a fan whose tetrahedron may hold more than this is left alone.
+
+    Returns
+    -------
+    faces : (k, 3) int64
+        The surface with the fans replaced (a face and its fan's three faces: two fewer per fan).
+    fans : int
+    volume : float
+        m³, upper bound on the summed volumes of the fans' tetrahedra.
+    corners : (c,) int
+        The vertices of the fans replaced (for the moment bound).
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n, m = len(v), len(f)
+    valence = np.bincount(f.reshape(-1), minlength=n)
+    order = np.argsort(f.reshape(-1), kind="stable")
+    start = np.r_[0, np.cumsum(valence)]
+    rows = [tuple(r) for r in f.tolist()]
+    alive = [True] * m
+    added: dict[int, list[int]] = {}
+    seed_vertices = np.unique(f[np.asarray(seeds, dtype=np.int64)].reshape(-1)) if len(seeds) else np.zeros(0, int)
+    queue = deque(int(x) for x in seed_vertices[valence[seed_vertices] == 3])
+    fans, volume, corners = 0, 0.0, []
+    for _ in range(m):                                   # each replacement removes two faces: bounded by m
+        if not queue:
+            break
+        c0 = queue.popleft()
+        around = [g for g in (order[start[c0]:start[c0 + 1]] // 3).tolist() + added.get(c0, []) if alive[g]]
+        if len(around) != 3:
+            continue
+        link: dict[int, int] = {}
+        for g in around:
+            tri = rows[g]
+            i = tri.index(c0)
+            link[tri[(i + 1) % 3]] = tri[(i + 2) % 3]
+        if len(link) != 3 or set(link) != set(link.values()) or c0 in link or any(x == y for x, y in link.items()):
+            continue                                     # not one cycle of three distinct corners
+        a = next(iter(link))
+        b = link[a]
+        c = link[b]
+        tet = _tetra_volume_bound(v[a], v[b], v[c], v[c0])
+        if tet > volume_cap:
+            continue
+        for g in around:
+            alive[g] = False
+        rows.append((a, b, c))
+        alive.append(True)
+        new = len(rows) - 1
+        for x in (a, b, c):
+            added.setdefault(x, []).append(new)
+            valence[x] -= 1
+            if valence[x] == 3:
+                queue.append(x)
+        valence[c0] = 0
+        fans += 1
+        volume += tet
+        corners += [a, b, c, c0]
+    if not fans:
+        return f, 0, 0.0, np.zeros(0, dtype=np.int64)
+    keep = np.flatnonzero(np.array(alive))
+    return (np.array([rows[g] for g in keep.tolist()], dtype=np.int64).reshape(-1, 3), fans, volume,
+            np.unique(np.array(corners, dtype=np.int64)))
+
+
+def _tetra_volume_bound(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> float:
+    """m³, an upper bound on ``|det(a − d, b − d, c − d)|/6`` (the float value plus orient3d's static error bound,
+    :data:`~.intersect.O3D_BOUND`, and the rounding of the last steps)."""
+    ad, bd, cd = a - d, b - d, c - d
+    det = float(np.dot(ad, np.cross(bd, cd)))
+    perm = float(np.dot(np.abs(ad), np.abs(bd)[[1, 2, 0]] * np.abs(cd)[[2, 0, 1]]
+                        + np.abs(bd)[[2, 0, 1]] * np.abs(cd)[[1, 2, 0]]))
+    return (abs(det) + O3D_BOUND * perm) / 6 * (1 + 8 * _U)
+
+
+# -- internal walls -------------------------------------------------------------------------------------------
+
+def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *,
+                   plane_rtol: float = WALL_PLANE_RTOL) -> tuple[np.ndarray, list[tuple[float, float, bool, int]]]:
+    """The internal walls (module docstring) among the faces of ``pairs``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    pairs : (k, 2) int
+        Face pairs the check flagged (crossing, or coplanar and facing opposite ways within one shell).
+    plane_rtol : float
+        A wall's corners lie within ``plane_rtol`` times the largest |coordinate| of its plane.
+
+    Returns
+    -------
+    wall : (m,) bool
+        Faces of the walls found.
+    walls : list of (δ, area, exact, faces)
+        Per wall: m, the largest distance of a corner from its plane (an upper bound; 0 when exactly coplanar);
+        m², its faces' summed area (rounded up); whether exactly coplanar; its number of faces.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    m = len(f)
+    wall = np.zeros(m, dtype=bool)
+    found: list[tuple[float, float, bool, int]] = []
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    if not len(p):
+        return wall, found
+    graph = coo_matrix((np.ones(len(p), dtype=np.int8), (p[:, 0], p[:, 1])), shape=(m, m))
+    _, comp = connected_components(graph, directed=False)
+    flagged = np.unique(p.reshape(-1))
+    key, forward = edge_keys(f, len(v))
+    key_order = np.argsort(key, kind="stable")
+    sorted_keys = key[key_order]
+    tolerance = plane_rtol * float(np.abs(v).max())
+    groups = comp[flagged]
+    order = np.argsort(groups, kind="stable")
+    bounds = np.flatnonzero(np.r_[True, groups[order][1:] != groups[order][:-1], True])
+    for s0, s1 in zip(bounds[:-1], bounds[1:]):            # one group per connected set of flagged faces
+        members = np.zeros(m, dtype=bool)
+        members[flagged[order[s0:s1]]] = True
+        if (members & wall).any():
+            continue
+        plane = _plane(v, f[members])
+        if plane is None or _distance_bound(v, f[members], *plane) > tolerance:
+            continue
+        if not _closed(key, forward, members):
+            grown = _grow(v, f, members, plane, tolerance, key, sorted_keys, key_order)
+            if grown is None or not _closed(key, forward, grown):
+                continue
+            members = grown
+        exact = _exactly_coplanar(v, f[members])
+        delta = 0.0 if exact else _distance_bound(v, f[members], *plane)
+        wall |= members
+        found.append((delta, _area_bound(v, f[members]), exact, int(np.count_nonzero(members))))
+    return wall, found
+
+
+def _plane(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """Unit normal and offset of the plane of faces nearly in one plane (normals aligned to the largest face's,
+    area-weighted), or None when they have no area."""
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    size = np.linalg.norm(normal, axis=1)
+    if not len(size) or not size.max() > 0:
+        return None
+    ref = normal[int(np.argmax(size))]
+    total = np.sum(np.where((normal @ ref >= 0)[:, None], normal, -normal), axis=0)
+    norm = float(np.linalg.norm(total))
+    if not norm > 0:
+        return None
+    unit = total / norm
+    offset = float(np.median(v[np.unique(f.reshape(-1))] @ unit))
+    return unit, offset
+
+
+def _distance_bound(v: np.ndarray, f: np.ndarray, unit: np.ndarray, offset: float) -> float:
+    """m, an upper bound on the distance of the corners of ``f`` from the plane ``unit·x = offset``: the float
+    value plus the rounding of the dot products and the difference, over ``|unit|`` (which is 1 within 4u)."""
+    p = v[np.unique(f.reshape(-1))]
+    dist = np.abs(p @ unit - offset)
+    scale = np.abs(p) @ np.abs(unit) + abs(offset)
+    return float(np.max(dist + 8 * _U * scale)) / (float(np.linalg.norm(unit)) * (1 - 8 * _U))
+
+
+def _area_bound(v: np.ndarray, f: np.ndarray) -> float:
+    """m², the faces' summed area, rounded up."""
+    area = 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+    return float(np.sum(area)) * (1 + 1e-12)
+
+
+def _closed(key: np.ndarray, forward: np.ndarray, members: np.ndarray) -> bool:
+    """Whether the faces ``members`` (m,) bool use every edge equally often in both directions (by index)."""
+    at = np.repeat(members, 3)
+    k = key[at]
+    if not len(k):
+        return False
+    _, inverse = np.unique(k, return_inverse=True)
+    net = np.bincount(inverse.reshape(-1), weights=np.where(forward[at], 1.0, -1.0))
+    return bool(np.all(net == 0))
+
+
+def _grow(v: np.ndarray, f: np.ndarray, members: np.ndarray, plane: tuple[np.ndarray, float], tolerance: float,
+          key: np.ndarray, sorted_keys: np.ndarray, key_order: np.ndarray) -> np.ndarray | None:
+    """``members`` grown through shared edges by the faces within ``tolerance`` of ``plane`` (a wall's faces that
+    overlap no face of the other sheet but only touch it); None when nothing is added."""
+    unit, offset = plane
+    grown = members.copy()
+    near_vertex = np.abs(v @ unit - offset) <= tolerance
+    near = np.all(near_vertex[f], axis=1)
+    edge = np.repeat(grown, 3)
+    frontier_keys = np.unique(key[edge])
+    for _ in range(len(f)):                               # each pass adds at least one face
+        lo = np.searchsorted(sorted_keys, frontier_keys, side="left")
+        hi = np.searchsorted(sorted_keys, frontier_keys, side="right")
+        count = hi - lo
+        slots = np.repeat(lo, count) + (np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count))
+        touched = np.unique(key_order[slots] // 3)
+        new = touched[near[touched] & ~grown[touched]]
+        if not len(new):
+            break
+        grown[new] = True
+        frontier_keys = np.unique(key[(3 * new[:, None] + np.arange(3)).reshape(-1)])
+    return grown if np.count_nonzero(grown) > np.count_nonzero(members) else None
+
+
+def _exactly_coplanar(v: np.ndarray, f: np.ndarray) -> bool:
+    """Whether every corner of ``f`` lies exactly in the plane of its largest face (exact orient3d), that face
+    having nonzero area exactly (exact orient2d on its best projection)."""
+    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    normal = np.cross(p1 - p0, p2 - p0)
+    big = int(np.argmax(np.linalg.norm(normal, axis=1)))
+    keep = _PLANE[int(np.argmax(np.abs(normal[big])))]
+    if int(orient2d_sign(p0[big, keep], p1[big, keep], p2[big, keep])[0]) == 0:
+        return False
+    corners = v[np.unique(f.reshape(-1))]
+    k = len(corners)
+    signs = orient3d_sign(np.repeat(p0[big][None], k, 0), np.repeat(p1[big][None], k, 0),
+                          np.repeat(p2[big][None], k, 0), corners)
+    return bool(np.all(signs == 0))
+
+
+# -- the rule -------------------------------------------------------------------------------------------------
+
+def _flagged_pairs(contacts: SurfaceContacts, labels: np.ndarray) -> np.ndarray:
+    """Crossing pairs, and coplanar-opposite pairs within one shell (k, 2)."""
+    cross = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
+    opp = np.asarray(contacts.coplanar_opposite, dtype=np.int64).reshape(-1, 2)
+    opp = opp[labels[opp[:, 0]] == labels[opp[:, 1]]]
+    return np.concatenate([cross, opp])
+
+
+def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceContacts, labels: np.ndarray, *,
+                 budget: float = ROUNDOFF_RTOL, plane_rtol: float = WALL_PLANE_RTOL) -> Folds | None:
+    """R3a: the surface with its sliver fans and internal walls taken out, when what they change is within
+    ``budget`` and the rest has no crossing face pair (module docstring); else None.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+        A closed, edge-balanced surface.
+    contacts : SurfaceContacts
+        Its face-pair check.
+    labels : (m,) int
+        Shell of each face.
+    budget : float
+        Relative bound on what the folds may change (``tolerances.ROUNDOFF_RTOL``: what "exact" allows).
+    plane_rtol : float
+        A wall's corners lie within this times the largest |coordinate| of its plane.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    labels = np.asarray(labels, dtype=np.int64)
+    if not contacts.complete:
+        return None
+    pairs = _flagged_pairs(contacts, labels)
+    if not len(pairs):
+        return None
+    whole = volume_moments(v, f)
+    cap = budget * abs(whole.volume)
+    g, fans, fan_volume, fan_corners = sliver_fans(v, f, np.unique(pairs.reshape(-1)), volume_cap=cap)
+    if fans:
+        if fan_volume > cap:
+            return None
+        from .checks import shell_labels
+        contacts = surface_contacts(v, g)
+        if not contacts.complete:
+            return None
+        labels, _ = shell_labels(g, len(v))
+        pairs = _flagged_pairs(contacts, labels)
+    wall, found = internal_walls(v, g, pairs, plane_rtol=plane_rtol)
+    cross = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
+    if np.any(~wall[cross[:, 0]] & ~wall[cross[:, 1]]):
+        return None                                       # a crossing that is no fold: R3 as it stands
+    if not fans and not wall.any():
+        return None
+    keep = ~wall
+    if not keep.any():
+        return None                                       # nothing but walls: R2 says what that is
+    h = g[keep]
+    volume = fan_volume + sum(2 * delta * area for delta, area, _, _ in found)
+    rest = volume_moments(v, h)
+    corners = np.unique(np.concatenate([fan_corners, g[wall].reshape(-1)]))
+    reach = float(np.sqrt(np.max(np.sum((v[corners] - rest.centroid) ** 2, axis=1)))) if len(corners) else 0.0
+    reach += max((delta for delta, _, _, _ in found), default=0.0)
+    if not (volume <= budget * abs(rest.volume)
+            and volume * reach ** 2 <= budget * float(np.linalg.norm(rest.second_moment))):
+        return None
+    index = np.cumsum(keep) - 1                           # old face -> new face
+    left = dataclasses.replace(contacts, crossing=np.zeros((0, 2), dtype=np.intp),
+                               coplanar_opposite=_kept_pairs(contacts.coplanar_opposite, keep, index),
+                               contact=_kept_pairs(contacts.contact, keep, index))
+    return Folds(faces=h, contacts=left, fans=fans,
+                 wall_faces=int(np.count_nonzero(wall)), walls=len(found),
+                 exact_walls=sum(1 for _, _, exact, _ in found if exact), volume_bound=float(volume))
+
+
+def _kept_pairs(pairs: np.ndarray, keep: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """Face pairs with both faces kept, renumbered (k, 2) intp."""
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    p = p[keep[p[:, 0]] & keep[p[:, 1]]]
+    return index[p].astype(np.intp).reshape(-1, 2)
