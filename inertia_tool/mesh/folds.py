@@ -22,7 +22,9 @@ off the edge the sliver folds by that rounding, the check rightly finds the fold
 as thin as ``m``'s distance from the edge.  A face of exactly zero area (three collinear corners) subtends no solid
 angle from any point off it, so it cannot change the winding number and cannot make a crossing that matters: the
 face-pair check skips it.  Fans are replaced one at a time (a vertex left with three faces by a replacement is
-tried next, so a chain of points on one edge unwinds), only those touching a face the check flagged.
+tried next, so a chain of points on one edge unwinds), and only thin ones: a tetrahedron of at most
+``tolerances.WALL_PLANE_RTOL`` times the cube of its longest edge (a corner of the part that has three faces is
+no sliver).
 
 Internal walls
 --------------
@@ -60,7 +62,7 @@ from ..values import frozen_value
 from .edges import edge_keys
 from .intersect import O3D_BOUND, SurfaceContacts, orient2d_sign, orient3d_sign, surface_contacts
 
-__all__ = ["Folds", "settle_folds", "sliver_fans", "internal_walls"]
+__all__ = ["Folds", "Wall", "settle_folds", "sliver_fans", "internal_walls"]
 
 _U = 2.0 ** -53
 _PLANE = np.array([[1, 2], [2, 0], [0, 1]])       # coordinates kept when dropping an axis (orientation-preserving)
@@ -111,20 +113,44 @@ class Folds:
                 f"{self.volume_bound:.3g} m³, within the round-off bound of an exact result")
 
 
+@frozen_value
+class Wall:
+    """One internal wall (module docstring): faces near one plane, found together.
+
+    Attributes
+    ----------
+    faces : (k,) int64
+        Indices of its faces.
+    distance : float
+        m, upper bound on the distance of its corners from its plane; 0 when they are exactly coplanar.
+    area : float
+        m², summed area of its faces (rounded up).
+    exact : bool
+        Every corner lies exactly in one plane.
+    """
+
+    faces: np.ndarray
+    distance: float
+    area: float
+    exact: bool
+
+
 # -- sliver fans ----------------------------------------------------------------------------------------------
 
-def sliver_fans(vertices: np.ndarray, faces: np.ndarray, seeds: np.ndarray, *,
-                volume_cap: float) -> tuple[np.ndarray, int, float, np.ndarray]:
-    """Replace the sliver fans (module docstring) at the vertices of faces ``seeds`` by the face they split.
+def sliver_fans(vertices: np.ndarray, faces: np.ndarray, *, volume_cap: float,
+                thin: float = WALL_PLANE_RTOL) -> tuple[np.ndarray, int, float, np.ndarray]:
+    """Replace the sliver fans (module docstring) by the face they split.
 
     Parameters
     ----------
     vertices : (n, 3) float
     faces : (m, 3) int
-    seeds : (s,) int
-        Faces where the search starts (those of the flagged face pairs).
     volume_cap : float
         m³: a fan whose tetrahedron may hold more than this is left alone.
+    thin : float
+        Only fans whose tetrahedron holds at most ``thin`` times the cube of its longest edge are replaced (a
+        point on an edge, rounded off it: the tetrahedron is as thin as the rounding); a corner of the part that
+        happens to have three faces is not.
 
     Returns
     -------
@@ -145,8 +171,7 @@ def sliver_fans(vertices: np.ndarray, faces: np.ndarray, seeds: np.ndarray, *,
     rows = [tuple(r) for r in f.tolist()]
     alive = [True] * m
     added: dict[int, list[int]] = {}
-    seed_vertices = np.unique(f[np.asarray(seeds, dtype=np.int64)].reshape(-1)) if len(seeds) else np.zeros(0, int)
-    queue = deque(int(x) for x in seed_vertices[valence[seed_vertices] == 3])
+    queue = deque(np.flatnonzero(valence == 3).tolist())
     fans, volume, corners = 0, 0.0, []
     for _ in range(m):                                   # each replacement removes two faces: bounded by m
         if not queue:
@@ -166,7 +191,9 @@ def sliver_fans(vertices: np.ndarray, faces: np.ndarray, seeds: np.ndarray, *,
         b = link[a]
         c = link[b]
         tet = _tetra_volume_bound(v[a], v[b], v[c], v[c0])
-        if tet > volume_cap:
+        corners4 = v[[a, b, c, c0]]
+        longest = float(np.max(np.linalg.norm(corners4[:, None] - corners4[None], axis=2)))
+        if tet > volume_cap or tet > thin * longest ** 3:
             continue
         for g in around:
             alive[g] = False
@@ -202,7 +229,7 @@ def _tetra_volume_bound(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarr
 # -- internal walls -------------------------------------------------------------------------------------------
 
 def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *,
-                   plane_rtol: float = WALL_PLANE_RTOL) -> tuple[np.ndarray, list[tuple[float, float, bool, int]]]:
+                   plane_rtol: float = WALL_PLANE_RTOL) -> list[Wall]:
     """The internal walls (module docstring) among the faces of ``pairs``.
 
     Parameters
@@ -216,11 +243,9 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
 
     Returns
     -------
-    wall : (m,) bool
-        Faces of the walls found.
-    walls : list of (δ, area, exact, faces)
-        Per wall: m, the largest distance of a corner from its plane (an upper bound; 0 when exactly coplanar);
-        m², its faces' summed area (rounded up); whether exactly coplanar; its number of faces.
+    list of Wall
+        Disjoint groups of faces, each near one plane (what they leave open by index is closed by
+        :func:`_close_rims`).
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -229,14 +254,14 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
     f = np.asarray(faces, dtype=np.int64)
     m = len(f)
     wall = np.zeros(m, dtype=bool)
-    found: list[tuple[float, float, bool, int]] = []
+    found: list[Wall] = []
     p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     if not len(p):
-        return wall, found
+        return found
     graph = coo_matrix((np.ones(len(p), dtype=np.int8), (p[:, 0], p[:, 1])), shape=(m, m))
     _, comp = connected_components(graph, directed=False)
     flagged = np.unique(p.reshape(-1))
-    key, forward = edge_keys(f, len(v))
+    key, _ = edge_keys(f, len(v))
     key_order = np.argsort(key, kind="stable")
     sorted_keys = key[key_order]
     tolerance = plane_rtol * float(np.abs(v).max())
@@ -251,16 +276,83 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
         plane = _plane(v, f[members])
         if plane is None or _distance_bound(v, f[members], *plane) > tolerance:
             continue
-        if not _closed(key, forward, members):
-            grown = _grow(v, f, members, plane, tolerance, key, sorted_keys, key_order)
-            if grown is None or not _closed(key, forward, grown):
-                continue
-            members = grown
+        grown = _grow(v, f, members, plane, tolerance, key, sorted_keys, key_order)
+        if grown is not None:
+            members = grown & ~wall
+        if not _sheets_cancel(v, f[members]):
+            continue                                    # one sheet (a flat face of the part): no wall
         exact = _exactly_coplanar(v, f[members])
-        delta = 0.0 if exact else _distance_bound(v, f[members], *plane)
         wall |= members
-        found.append((delta, _area_bound(v, f[members]), exact, int(np.count_nonzero(members))))
-    return wall, found
+        found.append(Wall(faces=np.flatnonzero(members),
+                          distance=0.0 if exact else _distance_bound(v, f[members], *plane),
+                          area=_area_bound(v, f[members]), exact=exact))
+    return found
+
+
+def _close_rims(v: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, float, float] | None:
+    """Close by index what the walls left open in ``rest`` (the surface without them): module docstring,
+    "Internal walls".  Each loop of unmatched edges must be one simple cycle; its longest edge ``a → b`` lies in
+    one face ``(a, b, x)``, which is split along the rest of the loop, ``b ← w₁ ← … ← w_k ← a``, into the fan
+    ``(a, w_k, x) … (w₁, b, x)``.  Returns the new surface, the bound on the pyramids' volumes ``Σ |tet(x, a, wᵢ,
+    wᵢ₊₁)|`` (m³) and the area of the loops' cones from ``a`` (m²); None when a loop is not of that form."""
+    key, forward = edge_keys(rest, len(v))
+    uniq, inverse = np.unique(key, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    net = np.bincount(inverse, weights=np.where(forward, -1.0, 1.0)).astype(np.int64)     # lo→hi minus hi→lo
+    open_slot = np.flatnonzero(net[inverse] != 0)
+    if not len(open_slot):
+        return rest, 0.0, 0.0
+    if np.any(np.abs(net) > 1) or len(np.unique(inverse[open_slot])) != len(open_slot):
+        return None                                     # an edge left open twice: not one simple cycle
+    a = rest.reshape(-1)[open_slot]
+    b = rest[:, [1, 2, 0]].reshape(-1)[open_slot]
+    face = open_slot // 3
+    succ = dict(zip(a.tolist(), b.tolist()))
+    if len(succ) != len(a) or set(succ) != set(succ.values()):
+        return None                                     # a vertex twice on the loops
+    slot_of = {(x, y): k for k, (x, y) in enumerate(zip(a.tolist(), b.tolist()))}
+    length = np.linalg.norm(v[b] - v[a], axis=1)
+    keep = np.ones(len(rest), dtype=bool)
+    added: list[list[int]] = []
+    pyramids, cone_area = 0.0, 0.0
+    done: set[int] = set()
+    for k in np.argsort(-length).tolist():              # the longest open edge of each loop first
+        if int(a[k]) in done:
+            continue
+        loop = [int(a[k])]
+        for _ in range(len(a)):                         # bounded: each vertex once
+            nxt = succ[loop[-1]]
+            if nxt == loop[0]:
+                break
+            loop.append(nxt)
+        done.update(loop)
+        if len(loop) < 3:
+            return None
+        # loop a, b, w₁, …, w_k (edges a→b, b→w₁, …, w_k→a): the face holding a → b is split along a, w_k, …, w₁, b
+        head, tail = loop[0], loop[1]
+        chain = [head, *loop[:1:-1], tail]
+        g = int(face[slot_of[(head, tail)]])
+        if not keep[g]:
+            return None                                 # a face on two loops: left to the normal path
+        tri = rest[g].tolist()
+        x = tri[(tri.index(head) + 2) % 3]
+        keep[g] = False
+        for p, q in zip(chain[:-1], chain[1:]):
+            added.append([p, q, x])
+            if p != head:
+                pyramids += _tetra_volume_bound(v[x], v[head], v[p], v[q])
+                cone_area += 0.5 * float(np.linalg.norm(np.cross(v[p] - v[head], v[q] - v[head])))
+    out = np.vstack([rest[keep], np.array(added, dtype=np.int64).reshape(-1, 3)])
+    return out, pyramids, cone_area * (1 + 1e-12)
+
+
+def _sheets_cancel(v: np.ndarray, f: np.ndarray, rtol: float = 1e-6) -> bool:
+    """Whether the faces' vector areas nearly cancel (``|Σ Aᵢnᵢ| ≤ rtol·Σ Aᵢ``), as those of two sheets of
+    opposite orientation over one region do (a closed surface's vector area is zero).  Only a filter: a flat face
+    of the part next to a seam is not taken for a wall; what makes the result exact is the volume bound."""
+    normal = 0.5 * np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    total = float(np.sum(np.linalg.norm(normal, axis=1)))
+    return bool(total > 0 and float(np.linalg.norm(normal.sum(axis=0))) <= rtol * total)
 
 
 def _plane(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, float] | None:
@@ -293,17 +385,6 @@ def _area_bound(v: np.ndarray, f: np.ndarray) -> float:
     """m², the faces' summed area, rounded up."""
     area = 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
     return float(np.sum(area)) * (1 + 1e-12)
-
-
-def _closed(key: np.ndarray, forward: np.ndarray, members: np.ndarray) -> bool:
-    """Whether the faces ``members`` (m,) bool use every edge equally often in both directions (by index)."""
-    at = np.repeat(members, 3)
-    k = key[at]
-    if not len(k):
-        return False
-    _, inverse = np.unique(k, return_inverse=True)
-    net = np.bincount(inverse.reshape(-1), weights=np.where(forward[at], 1.0, -1.0))
-    return bool(np.all(net == 0))
 
 
 def _grow(v: np.ndarray, f: np.ndarray, members: np.ndarray, plane: tuple[np.ndarray, float], tolerance: float,
@@ -385,7 +466,7 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
         return None
     whole = volume_moments(v, f)
     cap = budget * abs(whole.volume)
-    g, fans, fan_volume, fan_corners = sliver_fans(v, f, np.unique(pairs.reshape(-1)), volume_cap=cap)
+    g, fans, fan_volume, fan_corners = sliver_fans(v, f, volume_cap=cap, thin=plane_rtol)
     if fans:
         if fan_volume > cap:
             return None
@@ -395,31 +476,41 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
             return None
         labels, _ = shell_labels(g, len(v))
         pairs = _flagged_pairs(contacts, labels)
-    wall, found = internal_walls(v, g, pairs, plane_rtol=plane_rtol)
+    found = internal_walls(v, g, pairs, plane_rtol=plane_rtol)
+    wall = np.zeros(len(g), dtype=bool)
+    for w in found:
+        wall[w.faces] = True
     cross = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
-    if np.any(~wall[cross[:, 0]] & ~wall[cross[:, 1]]):
-        return None                                       # a crossing that is no fold: R3 as it stands
+    uncovered = bool(np.any(~wall[cross[:, 0]] & ~wall[cross[:, 1]]))    # only a split at a rim can undo them
     if not fans and not wall.any():
         return None
     keep = ~wall
-    if not keep.any():
+    closed = _close_rims(v, g[keep])
+    if closed is None:
+        return None
+    h, pyramids, cone_area = closed
+    if not len(h):
         return None                                       # nothing but walls: R2 says what that is
-    h = g[keep]
-    volume = fan_volume + sum(2 * delta * area for delta, area, _, _ in found)
+    delta = max((w.distance for w in found), default=0.0)
+    volume = fan_volume + pyramids + 2 * delta * (sum(w.area for w in found) + cone_area)
     rest = volume_moments(v, h)
-    corners = np.unique(np.concatenate([fan_corners, g[wall].reshape(-1)]))
+    corners = np.unique(np.concatenate([fan_corners, g[wall].reshape(-1), np.setdiff1d(h, g[keep])]))
     reach = float(np.sqrt(np.max(np.sum((v[corners] - rest.centroid) ** 2, axis=1)))) if len(corners) else 0.0
-    reach += max((delta for delta, _, _, _ in found), default=0.0)
+    reach += delta
     if not (volume <= budget * abs(rest.volume)
             and volume * reach ** 2 <= budget * float(np.linalg.norm(rest.second_moment))):
         return None
-    index = np.cumsum(keep) - 1                           # old face -> new face
-    left = dataclasses.replace(contacts, crossing=np.zeros((0, 2), dtype=np.intp),
-                               coplanar_opposite=_kept_pairs(contacts.coplanar_opposite, keep, index),
-                               contact=_kept_pairs(contacts.contact, keep, index))
-    return Folds(faces=h, contacts=left, fans=fans,
-                 wall_faces=int(np.count_nonzero(wall)), walls=len(found),
-                 exact_walls=sum(1 for _, _, exact, _ in found if exact), volume_bound=float(volume))
+    if len(h) != int(np.count_nonzero(keep)) or uncovered:     # faces split at the rims: checked like any others
+        left = surface_contacts(v, h)
+        if len(left.crossing) or not left.complete:
+            return None
+    else:
+        index = np.cumsum(keep) - 1                       # old face -> new face
+        left = dataclasses.replace(contacts, crossing=np.zeros((0, 2), dtype=np.intp),
+                                   coplanar_opposite=_kept_pairs(contacts.coplanar_opposite, keep, index),
+                                   contact=_kept_pairs(contacts.contact, keep, index))
+    return Folds(faces=h, contacts=left, fans=fans, wall_faces=int(np.count_nonzero(wall)), walls=len(found),
+                 exact_walls=sum(1 for w in found if w.exact), volume_bound=float(volume))
 
 
 def _kept_pairs(pairs: np.ndarray, keep: np.ndarray, index: np.ndarray) -> np.ndarray:

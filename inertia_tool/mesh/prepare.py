@@ -346,7 +346,9 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     kind = "exact" if touch.complete and crossing_note is None else "unverified"
     if touch.complete and not touch.crossing.any() and crossing_note is None:
         checks.append("no-crossing-faces")
-    if candidates.any() or found.nonmanifold_edges:                             # R5, R6
+    # R3a may have taken out every non-manifold edge (a wall's rims): then nothing is left for the boolean to confirm
+    nonmanifold = found.nonmanifold_edges if folds is None else edge_topology(f, len(v), v).nonmanifold_edges
+    if candidates.any() or nonmanifold:                                         # R5, R6
         united = _unite(v, f, labels, owner, source, repair)
         summed = sum(s.volume for s in shells)
         if united is not None and not touch.crossing.any() and \
