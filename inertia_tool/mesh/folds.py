@@ -28,25 +28,41 @@ no sliver).
 
 Internal walls
 --------------
-Faces ``W`` that lie within ``δ`` of one plane ``P`` and are closed by themselves (``∂W = 0`` by index) are two
-sheets of a wall covering one region with opposite orientation: two halves of a part written face to face, each
-half's cut face triangulated on its own, or two bodies touching face to face.  For ``x`` farther than ``δ`` from
-``P`` the ray from ``x`` along the normal away from ``P`` meets no face of ``W``, so ``w_W(x) = 0``; within the
-slab that ray meets at most ``N(x)`` faces, the number of faces of ``W`` whose projection on ``P`` contains that of
-``x``, so ``∫|w_W| ≤ 2δ·Σ area``.  When every corner of ``W`` lies exactly in one plane (exact ``orient3d``) the
+Two sheets of a wall cover one region of a plane with opposite orientation: two halves of a part written face to
+face, each half's cut face triangulated on its own (their corners computed on the cut plane, so off it by
+rounding), or two bodies touching face to face.  The slab lemma: a closed chain ``Z`` whose corners all lie within
+``δ`` of a plane ``P`` has ``w_Z(x) = 0`` for ``x`` farther than ``δ`` from ``P`` (the ray from ``x`` along the
+normal away from ``P`` meets no face of ``Z``); within the slab that ray meets at most ``N(x)`` faces, the number of
+faces of ``Z`` whose projection on ``P`` contains that of ``x``, so ``∫|w_Z| ≤ 2δ·Σ area``, and ``w_Z ≠ 0`` only
+within ``2δ`` of the hull of its corners.  When every corner lies exactly in one plane (exact ``orient3d``) the
 sheets cancel exactly: the density ``Σ ±1_T`` of the projected faces jumps across an edge by that edge's net use
-in ``W``, which is zero, so it is zero everywhere (their signed areas cancel over every region of the plane) and
-``w_W = 0`` off ``P``.  Walls are grown from the faces of crossing or coplanar-opposite pairs (connected through
-those pairs), and, when the faces so found are not closed, through shared edges to faces within ``δ`` of the same
-plane; a group that is still not closed stays on the normal path.
+in ``Z``, which is zero, so it is zero everywhere (their signed areas cancel over every region of the plane) and
+``w_Z = 0`` off ``P``.
+
+A wall ``W`` is grown from the faces of crossing or coplanar-opposite pairs (connected through those pairs), then
+through shared edges to every face within ``tolerances.WALL_PLANE_RTOL`` of the same plane; it is taken for a wall
+only when its faces' vector areas nearly cancel (two sheets of opposite orientation; a closed surface's vector area
+is zero), and walls must not share a corner.  ``W`` need not be closed by index: where one sheet's rim has a corner
+the other's lacks (T-vertices along the rim, common when the halves were cut apart), ``S − W`` is left with open
+loops.  Each loop ``a → b → w₁ → … → w_k → a`` (one simple cycle, its longest edge ``a → b`` in a face
+``F = (a, b, x)`` of ``S − W``) is closed by splitting ``F`` along the rest of the loop into the fan
+``(a, w_k, x) … (w₁, b, x)`` (``X = fan − F``).  With ``Q`` the cone from ``a`` over the loop, ``S − S* = W − X
+= (W + Q) − (X + Q)`` for the closed surface ``S* = S − W + X``: ``W + Q`` is closed with every corner near ``P``
+(the slab lemma: ``2δ·(area W + area Q)``), and ``X + Q`` is the boundary of the pyramid with apex ``x`` over the
+loop (``Σ |tet(x, a, wᵢ, wᵢ₊₁)|``: zero when the loop's corners are collinear with ``a`` and ``b``, or when
+``F`` lies in the plane of the loop).
 
 The bound
 ---------
-``D = Σ ∫|w_Z|`` over the fans and walls taken out.  The result stands for the file's solid (R7) when ``D`` is
-within ``budget`` (``tolerances.ROUNDOFF_RTOL``) of the remaining surface's volume, and ``D·R²`` (``R`` the largest
-distance of a corner of a removed piece from the remaining surface's centroid) within ``budget`` of its second
-moment's norm: the same test as R0's copies up to rounding.  Otherwise, or when the remaining surface still has a
-crossing face pair, nothing is taken out and the surface goes on to R3 as it stands.
+``D = Σ ∫|w_Z|`` over the fans, walls and pyramids (the bounds above, added: the pieces' chains add).  The result
+stands for the file's solid (R7) when ``D`` is within ``budget`` (``tolerances.ROUNDOFF_RTOL``) of the remaining
+surface's volume, and ``D·R²`` (``R`` the largest distance of a corner of a removed or split piece from the
+remaining surface's centroid, plus ``2δ``) within ``budget`` of its second moment's norm: the same test as R0's
+copies up to rounding.  Otherwise, or when the remaining surface still has a crossing face pair (the face-pair
+check runs again on ``S*`` whenever faces were split or replaced), nothing is taken out and the surface goes on to
+R3 as it stands.  Crossings between faces outside every wall (a sliver of overlap along a rim on a flat face of
+the part) are not explained by this rule: unless the splits undo them, the surface stays on the normal path (the
+boolean union, R6 up to rounding).
 """
 
 from __future__ import annotations
@@ -289,61 +305,82 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
     return found
 
 
-def _close_rims(v: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, float, float] | None:
+def _close_rims(v: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, float, float, np.ndarray] | None:
     """Close by index what the walls left open in ``rest`` (the surface without them): module docstring,
-    "Internal walls".  Each loop of unmatched edges must be one simple cycle; its longest edge ``a → b`` lies in
-    one face ``(a, b, x)``, which is split along the rest of the loop, ``b ← w₁ ← … ← w_k ← a``, into the fan
-    ``(a, w_k, x) … (w₁, b, x)``.  Returns the new surface, the bound on the pyramids' volumes ``Σ |tet(x, a, wᵢ,
-    wᵢ₊₁)|`` (m³) and the area of the loops' cones from ``a`` (m²); None when a loop is not of that form."""
+    "Internal walls".  Each loop of unmatched edges must be one simple cycle that runs out along a line and back
+    (two chains, monotone in the position along the line between its two farthest corners: the two sheets' rims
+    with their T-vertices).  Every open edge ``p → q`` lies in one face ``(p, q, x)``, split at the loop's
+    corners lying strictly between ``p`` and ``q`` into the fan ``(p, s₁, x) … (s_k, q, x)``, so that both chains
+    end up with every corner.  Returns the new surface, the bound on the pyramids' volumes ``Σ |tet(x, p, sⱼ,
+    sⱼ₊₁)|`` (m³), the area of the cones from ``p`` over each split edge's polygon (m²) and the corners of the faces
+    split; None when a loop is not of that form."""
     key, forward = edge_keys(rest, len(v))
-    uniq, inverse = np.unique(key, return_inverse=True)
+    _, inverse = np.unique(key, return_inverse=True)
     inverse = inverse.reshape(-1)
     net = np.bincount(inverse, weights=np.where(forward, -1.0, 1.0)).astype(np.int64)     # lo→hi minus hi→lo
     open_slot = np.flatnonzero(net[inverse] != 0)
     if not len(open_slot):
-        return rest, 0.0, 0.0
+        return rest, 0.0, 0.0, np.zeros(0, dtype=np.int64)
     if np.any(np.abs(net) > 1) or len(np.unique(inverse[open_slot])) != len(open_slot):
         return None                                     # an edge left open twice: not one simple cycle
-    a = rest.reshape(-1)[open_slot]
-    b = rest[:, [1, 2, 0]].reshape(-1)[open_slot]
-    face = open_slot // 3
-    succ = dict(zip(a.tolist(), b.tolist()))
+    a = rest.reshape(-1)[open_slot].tolist()
+    b = rest[:, [1, 2, 0]].reshape(-1)[open_slot].tolist()
+    succ = dict(zip(a, b))
     if len(succ) != len(a) or set(succ) != set(succ.values()):
         return None                                     # a vertex twice on the loops
-    slot_of = {(x, y): k for k, (x, y) in enumerate(zip(a.tolist(), b.tolist()))}
-    length = np.linalg.norm(v[b] - v[a], axis=1)
+    face_of = {(x, y): int(s) // 3 for x, y, s in zip(a, b, open_slot.tolist())}
     keep = np.ones(len(rest), dtype=bool)
     added: list[list[int]] = []
     pyramids, cone_area = 0.0, 0.0
     done: set[int] = set()
-    for k in np.argsort(-length).tolist():              # the longest open edge of each loop first
-        if int(a[k]) in done:
+    for start in a:
+        if start in done:
             continue
-        loop = [int(a[k])]
+        loop = [start]
         for _ in range(len(a)):                         # bounded: each vertex once
             nxt = succ[loop[-1]]
-            if nxt == loop[0]:
+            if nxt == start:
                 break
             loop.append(nxt)
         done.update(loop)
         if len(loop) < 3:
             return None
-        # loop a, b, w₁, …, w_k (edges a→b, b→w₁, …, w_k→a): the face holding a → b is split along a, w_k, …, w₁, b
-        head, tail = loop[0], loop[1]
-        chain = [head, *loop[:1:-1], tail]
-        g = int(face[slot_of[(head, tail)]])
-        if not keep[g]:
-            return None                                 # a face on two loops: left to the normal path
-        tri = rest[g].tolist()
-        x = tri[(tri.index(head) + 2) % 3]
-        keep[g] = False
-        for p, q in zip(chain[:-1], chain[1:]):
-            added.append([p, q, x])
-            if p != head:
-                pyramids += _tetra_volume_bound(v[x], v[head], v[p], v[q])
-                cone_area += 0.5 * float(np.linalg.norm(np.cross(v[p] - v[head], v[q] - v[head])))
-    out = np.vstack([rest[keep], np.array(added, dtype=np.int64).reshape(-1, 3)])
-    return out, pyramids, cone_area * (1 + 1e-12)
+        pts = v[loop]
+        gap = np.linalg.norm(pts[:, None] - pts[None], axis=2)
+        i, j = np.unravel_index(int(np.argmax(gap)), gap.shape)
+        along = (pts - pts[i]) @ (pts[j] - pts[i])       # position along the line of the two farthest corners
+        if len(np.unique(along)) != len(loop):
+            return None
+        k = len(loop)
+        rises = np.diff(along[np.r_[np.arange(k), 0]]) > 0
+        turns = int(np.count_nonzero(rises != np.roll(rises, 1)))
+        if turns != 2:
+            return None                                 # not out along the line and back
+        order = np.argsort(along)
+        rank = np.empty(k, dtype=np.int64)
+        rank[order] = np.arange(k)
+        for e in range(k):
+            p, q = loop[e], loop[(e + 1) % k]
+            lo, hi = sorted((int(rank[e]), int(rank[(e + 1) % k])))
+            inner = order[lo + 1:hi]
+            if not len(inner):
+                continue
+            if rank[e] > rank[(e + 1) % k]:
+                inner = inner[::-1]
+            g = face_of[(p, q)]
+            if not keep[g]:
+                return None                             # a face on two open edges: left to the normal path
+            tri = rest[g].tolist()
+            x = tri[(tri.index(p) + 2) % 3]
+            keep[g] = False
+            chain = [p, *[loop[t] for t in inner.tolist()], q]
+            for s0, s1 in zip(chain[:-1], chain[1:]):
+                added.append([s0, s1, x])
+                if s0 != p:
+                    pyramids += _tetra_volume_bound(v[x], v[p], v[s0], v[s1])
+                    cone_area += 0.5 * float(np.linalg.norm(np.cross(v[s0] - v[p], v[s1] - v[p])))
+    split = np.array(added, dtype=np.int64).reshape(-1, 3)
+    return np.vstack([rest[keep], split]), pyramids, cone_area * (1 + 1e-12), np.unique(split)
 
 
 def _sheets_cancel(v: np.ndarray, f: np.ndarray, rtol: float = 1e-6) -> bool:
@@ -484,19 +521,25 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
     uncovered = bool(np.any(~wall[cross[:, 0]] & ~wall[cross[:, 1]]))    # only a split at a rim can undo them
     if not fans and not wall.any():
         return None
+    owner = np.full(len(v), -1, dtype=np.int64)
+    for i, w in enumerate(found):                         # walls sharing a corner: their rims would mix
+        corners_i = np.unique(g[w.faces])
+        if np.any((owner[corners_i] >= 0) & (owner[corners_i] != i)):
+            return None
+        owner[corners_i] = i
     keep = ~wall
     closed = _close_rims(v, g[keep])
     if closed is None:
         return None
-    h, pyramids, cone_area = closed
+    h, pyramids, cone_area, split_corners = closed
     if not len(h):
         return None                                       # nothing but walls: R2 says what that is
     delta = max((w.distance for w in found), default=0.0)
     volume = fan_volume + pyramids + 2 * delta * (sum(w.area for w in found) + cone_area)
     rest = volume_moments(v, h)
-    corners = np.unique(np.concatenate([fan_corners, g[wall].reshape(-1), np.setdiff1d(h, g[keep])]))
+    corners = np.unique(np.concatenate([fan_corners, g[wall].reshape(-1), split_corners]))
     reach = float(np.sqrt(np.max(np.sum((v[corners] - rest.centroid) ** 2, axis=1)))) if len(corners) else 0.0
-    reach += delta
+    reach += 2 * delta                                    # the slab: within 2δ of the hull of the corners
     if not (volume <= budget * abs(rest.volume)
             and volume * reach ** 2 <= budget * float(np.linalg.norm(rest.second_moment))):
         return None
