@@ -474,7 +474,8 @@ def _flagged_pairs(contacts: SurfaceContacts, labels: np.ndarray) -> np.ndarray:
     return np.concatenate([cross, opp])
 
 
-def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceContacts, labels: np.ndarray, *,
+def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceContacts,
+                 labels: np.ndarray | None = None, *,
                  budget: float = ROUNDOFF_RTOL, plane_rtol: float = WALL_PLANE_RTOL) -> Folds | None:
     """R3a: the surface with its sliver fans and internal walls taken out, when what they change is within
     ``budget`` and the rest has no crossing face pair (module docstring); else None.
@@ -486,15 +487,20 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
         A closed, edge-balanced surface.
     contacts : SurfaceContacts
         Its face-pair check.
-    labels : (m,) int
-        Shell of each face.
+    labels : (m,) int, optional
+        Shell of each face; default the edge-connected shells (R1), so that the two sheets of a wall between
+        bodies welded along its rim (which R1b may have split apart) count as one shell's.
     budget : float
         Relative bound on what the folds may change (``tolerances.ROUNDOFF_RTOL``: what "exact" allows).
     plane_rtol : float
         A wall's corners lie within this times the largest |coordinate| of its plane.
     """
+    from .checks import shell_labels
+
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
+    if labels is None:
+        labels, _ = shell_labels(f, len(v))
     labels = np.asarray(labels, dtype=np.int64)
     if not contacts.complete:
         return None
@@ -507,7 +513,6 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
     if fans:
         if fan_volume > cap:
             return None
-        from .checks import shell_labels
         contacts = surface_contacts(v, g)
         if not contacts.complete:
             return None

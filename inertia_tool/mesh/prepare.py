@@ -475,7 +475,7 @@ def _settle_folds(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: in
 
     Returns ``(v, f, labels, n_shells, shells, contacts, bound, folds)`` (``folds`` None when unchanged)."""
     from .folds import settle_folds        # imported on use: only surfaces with flagged face pairs
-    folds = settle_folds(v, f, contacts, labels)
+    folds = settle_folds(v, f, contacts)          # R1 shells: a wall's sheets may lie in two R1b bodies
     if folds is None:
         return v, f, labels, n_shells, shells, contacts, bound, None
     f = folds.faces
