@@ -81,6 +81,9 @@ from .intersect import O3D_BOUND, SurfaceContacts, orient2d_sign, orient3d_sign,
 __all__ = ["Folds", "Wall", "settle_folds", "sliver_fans", "internal_walls"]
 
 _U = 2.0 ** -53
+#: Work bound: groups of flagged faces examined as walls (each may grow through the surface); the rest stay
+#: on the normal path.
+MAX_WALL_GROUPS = 256
 _PLANE = np.array([[1, 2], [2, 0], [0, 1]])       # coordinates kept when dropping an axis (orientation-preserving)
 
 
@@ -187,7 +190,7 @@ def sliver_fans(vertices: np.ndarray, faces: np.ndarray, *, volume_cap: float,
     rows = [tuple(r) for r in f.tolist()]
     alive = [True] * m
     added: dict[int, list[int]] = {}
-    queue = deque(np.flatnonzero(valence == 3).tolist())
+    queue = deque(_thin_fan_vertices(v, f, valence, order, start, thin).tolist())
     fans, volume, corners = 0, 0.0, []
     for _ in range(m):                                   # each replacement removes two faces: bounded by m
         if not queue:
@@ -230,6 +233,25 @@ def sliver_fans(vertices: np.ndarray, faces: np.ndarray, *, volume_cap: float,
     keep = np.flatnonzero(np.array(alive))
     return (np.array([rows[g] for g in keep.tolist()], dtype=np.int64).reshape(-1, 3), fans, volume,
             np.unique(np.array(corners, dtype=np.int64)))
+
+
+def _thin_fan_vertices(v: np.ndarray, f: np.ndarray, valence: np.ndarray, order: np.ndarray, start: np.ndarray,
+                       thin: float) -> np.ndarray:
+    """The vertices of exactly three faces whose tetrahedron (the vertex and the corners following it in its
+    faces) is thin by the test of :func:`sliver_fans` (up to a factor 2 of slack: this only picks the vertices
+    tried; each is tested again exactly as it stands when tried)."""
+    c = np.flatnonzero(valence == 3)
+    if not len(c):
+        return c
+    around = order[start[c][:, None] + np.arange(3)] // 3              # (k, 3) the three faces
+    tri = f[around]                                                     # (k, 3, 3)
+    at = np.argmax(tri == c[:, None, None], axis=2)                     # the vertex's corner in each face
+    nxt = np.take_along_axis(tri, ((at + 1) % 3)[:, :, None], axis=2)[:, :, 0]     # (k, 3) corners after it
+    p = v[nxt] - v[c][:, None, :]
+    det = np.abs(np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])))
+    q = np.concatenate([p, np.zeros_like(p[:, :1])], axis=1)
+    longest = np.max(np.linalg.norm(q[:, :, None] - q[:, None], axis=3), axis=(1, 2))
+    return c[det / 6 <= 2 * thin * longest ** 3 + 1e-300]
 
 
 def _tetra_volume_bound(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> float:
@@ -284,7 +306,7 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
     groups = comp[flagged]
     order = np.argsort(groups, kind="stable")
     bounds = np.flatnonzero(np.r_[True, groups[order][1:] != groups[order][:-1], True])
-    for s0, s1 in zip(bounds[:-1], bounds[1:]):            # one group per connected set of flagged faces
+    for s0, s1 in list(zip(bounds[:-1], bounds[1:]))[:MAX_WALL_GROUPS]:    # one group per set of flagged faces
         members = np.zeros(m, dtype=bool)
         members[flagged[order[s0:s1]]] = True
         if (members & wall).any():
