@@ -299,14 +299,15 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
     graph = coo_matrix((np.ones(len(p), dtype=np.int8), (p[:, 0], p[:, 1])), shape=(m, m))
     _, comp = connected_components(graph, directed=False)
     flagged = np.unique(p.reshape(-1))
-    key, _ = edge_keys(f, len(v))
+    key, forward = edge_keys(f, len(v))
     key_order = np.argsort(key, kind="stable")
     sorted_keys = key[key_order]
     tolerance = plane_rtol * float(np.abs(v).max())
     groups = comp[flagged]
     order = np.argsort(groups, kind="stable")
     bounds = np.flatnonzero(np.r_[True, groups[order][1:] != groups[order][:-1], True])
-    for s0, s1 in list(zip(bounds[:-1], bounds[1:]))[:MAX_WALL_GROUPS]:    # one group per set of flagged faces
+    spans = sorted(zip(bounds[:-1].tolist(), bounds[1:].tolist()), key=lambda b: b[0] - b[1])    # largest first
+    for s0, s1 in spans[:MAX_WALL_GROUPS]:               # one group per connected set of flagged faces
         members = np.zeros(m, dtype=bool)
         members[flagged[order[s0:s1]]] = True
         if (members & wall).any():
@@ -314,9 +315,10 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
         plane = _plane(v, f[members])
         if plane is None or _distance_bound(v, f[members], *plane) > tolerance:
             continue
-        grown = _grow(v, f, members, plane, tolerance, key, sorted_keys, key_order)
-        if grown is not None:
-            members = grown & ~wall
+        if not _closed(key, forward, members):           # the flagged faces alone leave part of the wall out
+            grown = _grow(v, f, members, plane, tolerance, key, sorted_keys, key_order)
+            if grown is not None:
+                members = grown & ~wall
         if not _sheets_cancel(v, f[members]):
             continue                                    # one sheet (a flat face of the part): no wall
         exact = _exactly_coplanar(v, f[members])
@@ -405,6 +407,14 @@ def _close_rims(v: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, float, flo
     return np.vstack([rest[keep], split]), pyramids, cone_area * (1 + 1e-12), np.unique(split)
 
 
+def _closed(key: np.ndarray, forward: np.ndarray, members: np.ndarray) -> bool:
+    """Whether the faces ``members`` (m,) bool use every edge equally often in both directions (by index)."""
+    at = np.repeat(members, 3)
+    _, inverse = np.unique(key[at], return_inverse=True)
+    net = np.bincount(inverse.reshape(-1), weights=np.where(forward[at], 1.0, -1.0))
+    return bool(len(net) and np.all(net == 0))
+
+
 def _sheets_cancel(v: np.ndarray, f: np.ndarray, rtol: float = 1e-6) -> bool:
     """Whether the faces' vector areas nearly cancel (``|Σ Aᵢnᵢ| ≤ rtol·Σ Aᵢ``), as those of two sheets of
     opposite orientation over one region do (a closed surface's vector area is zero).  Only a filter: a flat face
@@ -488,6 +498,38 @@ def _exactly_coplanar(v: np.ndarray, f: np.ndarray) -> bool:
 
 # -- the rule -------------------------------------------------------------------------------------------------
 
+def _merged(v: np.ndarray, f: np.ndarray, walls: list[Wall], plane_rtol: float) -> list[Wall] | None:
+    """The walls with those sharing a corner joined into one (near one plane, or None)."""
+    if len(walls) < 2:
+        return walls
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    corner_wall = np.concatenate([np.full(3 * len(w.faces), i) for i, w in enumerate(walls)])
+    corner = np.concatenate([f[w.faces].reshape(-1) for w in walls])
+    graph = coo_matrix((np.ones(len(corner), dtype=np.int8), (corner_wall, corner)),
+                       shape=(len(walls), int(corner.max()) + 1))
+    n, joined = connected_components(graph @ graph.T, directed=False)
+    if n == len(walls):
+        return walls
+    out = []
+    for k in range(n):
+        members = [walls[i] for i in np.flatnonzero(joined == k).tolist()]
+        if len(members) == 1:
+            out.append(members[0])
+            continue
+        faces = np.concatenate([w.faces for w in members])
+        plane = _plane(v, f[faces])
+        if plane is None:
+            return None
+        delta = _distance_bound(v, f[faces], *plane)
+        if delta > plane_rtol * float(np.abs(v).max()):
+            return None
+        exact = _exactly_coplanar(v, f[faces])
+        out.append(Wall(faces=faces, distance=0.0 if exact else delta, area=_area_bound(v, f[faces]), exact=exact))
+    return out
+
+
 def _flagged_pairs(contacts: SurfaceContacts, labels: np.ndarray) -> np.ndarray:
     """Crossing pairs, and coplanar-opposite pairs within one shell (k, 2)."""
     cross = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
@@ -548,12 +590,9 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
     uncovered = bool(np.any(~wall[cross[:, 0]] & ~wall[cross[:, 1]]))    # only a split at a rim can undo them
     if not fans and not wall.any():
         return None
-    owner = np.full(len(v), -1, dtype=np.int64)
-    for i, w in enumerate(found):                         # walls sharing a corner: their rims would mix
-        corners_i = np.unique(g[w.faces])
-        if np.any((owner[corners_i] >= 0) & (owner[corners_i] != i)):
-            return None
-        owner[corners_i] = i
+    found = _merged(v, g, found, plane_rtol)             # walls sharing a corner are one (their rims would mix)
+    if found is None:
+        return None
     keep = ~wall
     closed = _close_rims(v, g[keep])
     if closed is None:
