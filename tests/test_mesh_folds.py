@@ -241,7 +241,7 @@ def test_solids_cut_by_random_planes_and_written_face_to_face_are_exact(seed, wa
 
 
 def test_an_exactly_coplanar_wall_with_two_triangulations_cancels_exactly():
-    """Two unit... a 2×2×2 box of integer corners cut at z = 1, the cut square split by one diagonal below and by
+    """A 2×2×2 box of integer corners cut at z = 1, the cut square split by one diagonal below and by
     the other above: the sheets overlap (coplanar, opposite) without sharing their inner edges.  Rational truth:
     volume 8, centre (1, 1, 1), inertia 8·(4 + 4)/12 = 16/3 about every axis."""
     v = np.array([[x, y, z] for z in (0, 1, 2) for y in (0, 2) for x in (0, 2)], dtype=float)
@@ -253,11 +253,11 @@ def test_an_exactly_coplanar_wall_with_two_triangulations_cancels_exactly():
         return [[p, q, r], [p, r, s]] if diag_first else [[p, q, s], [q, r, s]]
 
     faces = []
-    for z0, z1, flip in ((0, 1, True), (1, 2, False)):
+    for z0, z1 in ((0, 1), (1, 2)):
         c = [[idx(x, y, z) for x, y in ((0, 0), (2, 0), (2, 2), (0, 2))] for z in (z0, z1)]
         lo, hi = c
-        faces += quad(lo[0], lo[3], lo[2], lo[1], diag_first=flip)        # bottom, outward −z
-        faces += quad(hi[0], hi[1], hi[2], hi[3], diag_first=not flip)    # top, outward +z
+        faces += quad(lo[0], lo[3], lo[2], lo[1], diag_first=True)        # bottom, outward −z, diagonal 0–2
+        faces += quad(hi[0], hi[1], hi[2], hi[3], diag_first=False)       # top, outward +z, diagonal 1–3
         for i in range(4):
             j = (i + 1) % 4
             faces += quad(lo[i], lo[j], hi[j], hi[i])
