@@ -590,9 +590,10 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
     uncovered = bool(np.any(~wall[cross[:, 0]] & ~wall[cross[:, 1]]))    # only a split at a rim can undo them
     if not fans and not wall.any():
         return None
-    found = _merged(v, g, found, plane_rtol)             # walls sharing a corner are one (their rims would mix)
-    if found is None:
+    merged = _merged(v, g, found, plane_rtol)            # walls sharing a corner are one (their rims would mix)
+    if merged is None:
         return None
+    found = merged
     keep = ~wall
     closed = _close_rims(v, g[keep])
     if closed is None:
