@@ -296,12 +296,20 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
     p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     if not len(p):
         return found
-    graph = coo_matrix((np.ones(len(p), dtype=np.int8), (p[:, 0], p[:, 1])), shape=(m, m))
-    _, comp = connected_components(graph, directed=False)
     flagged = np.unique(p.reshape(-1))
     key, forward = edge_keys(f, len(v))
     key_order = np.argsort(key, kind="stable")
     sorted_keys = key[key_order]
+    # flagged faces sharing an edge belong to one group too (a wall's sheets are edge-connected)
+    is_flagged = np.zeros(m, dtype=bool)
+    is_flagged[flagged] = True
+    same = np.flatnonzero(sorted_keys[1:] == sorted_keys[:-1])
+    fa, fb = key_order[same] // 3, key_order[same + 1] // 3
+    both = is_flagged[fa] & is_flagged[fb]
+    rows = np.r_[p[:, 0], fa[both]]
+    cols = np.r_[p[:, 1], fb[both]]
+    graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(m, m))
+    _, comp = connected_components(graph, directed=False)
     tolerance = plane_rtol * float(np.abs(v).max())
     groups = comp[flagged]
     order = np.argsort(groups, kind="stable")
@@ -573,7 +581,10 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
         return None
     whole = volume_moments(v, f)
     cap = budget * abs(whole.volume)
-    g, fans, fan_volume, fan_corners = sliver_fans(v, f, volume_cap=cap, thin=plane_rtol)
+    if len(contacts.crossing):                           # folded slivers cross; without a crossing R3 has no work
+        g, fans, fan_volume, fan_corners = sliver_fans(v, f, volume_cap=cap, thin=plane_rtol)
+    else:
+        g, fans, fan_volume, fan_corners = f, 0, 0.0, np.zeros(0, dtype=np.int64)
     if fans:
         if fan_volume > cap:
             return None

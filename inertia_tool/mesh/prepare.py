@@ -479,13 +479,17 @@ def _settle_folds(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: in
     if folds is None:
         return v, f, labels, n_shells, shells, contacts, bound, None
     f = folds.faces
-    labels, n_shells = _bodies(v, f, split_welded)
+    labels, n_shells = shell_labels(f, len(v))                                  # R1
+    welded = welded_bodies(f, len(v), labels, n_shells, v) if split_welded and n_shells else None
+    if welded is not None and welded.split:                                     # R1b
+        labels, n_shells = welded.labels, welded.n_shells
     shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
     m = len(f)
     f, labels, n_shells, shells, _, bound = _drop_flat(v, f, labels, shells, diag, source, bound, warn=False)
     contacts = folds.contacts if len(f) == m else surface_contacts(v, f)
-    if split_welded:                       # R1b: bodies welded along an edge still meet there (R4 decides)
+    if welded is not None and len(f) != m:                # R2 relabelled: the welded contacts anew
         welded = welded_bodies(f, len(v), labels, n_shells, v)
+    if welded is not None:                 # R1b: bodies welded along an edge still meet there (R4 decides)
         if len(welded.contact):
             contacts = dataclasses.replace(contacts, contact=np.concatenate(
                 [np.asarray(contacts.contact, dtype=np.int64).reshape(-1, 2), welded.contact]))
