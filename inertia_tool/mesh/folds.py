@@ -300,12 +300,18 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
     key, forward = edge_keys(f, len(v))
     key_order = np.argsort(key, kind="stable")
     sorted_keys = key[key_order]
-    # flagged faces sharing an edge belong to one group too (a wall's sheets are edge-connected)
+    # flagged faces sharing an edge and lying in one plane (normals parallel within 1e-6 of the cosine) belong to
+    # one group too (a sheet is edge-connected; a face of the part beside its rim is not in its plane)
     is_flagged = np.zeros(m, dtype=bool)
     is_flagged[flagged] = True
     same = np.flatnonzero(sorted_keys[1:] == sorted_keys[:-1])
     fa, fb = key_order[same] // 3, key_order[same + 1] // 3
     both = is_flagged[fa] & is_flagged[fb]
+    if both.any():
+        normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+        size = np.maximum(np.linalg.norm(normal, axis=1), 1e-300)
+        cos = np.einsum("ij,ij->i", normal[fa[both]], normal[fb[both]]) / (size[fa[both]] * size[fb[both]])
+        both[np.flatnonzero(both)[np.abs(cos) < 1 - 1e-6]] = False
     rows = np.r_[p[:, 0], fa[both]]
     cols = np.r_[p[:, 1], fb[both]]
     graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(m, m))
