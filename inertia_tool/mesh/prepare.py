@@ -23,7 +23,7 @@ from ..errors import (ArrangementError, DegenerateFacesWarning, InsideOutWarning
 from ..integrals import (RoundoffBound, VolumeMoments, accurate_shells, body_volume_moments, bounding_box,
                          total_roundoff, volume_moments)
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE, ROUNDOFF_RTOL
-from .checks import MeshReport, census_and_shells, repeated_corner_faces, shell_labels
+from .checks import MeshReport, census_and_shells, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
                      inward_crossing_outward, near_copies, near_copies_message, negligible_flat, orient_by_depth,
