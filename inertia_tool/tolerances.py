@@ -123,6 +123,13 @@ COINCIDENT_RTOL = 64 * 2.0 ** -53
 #: such as 25 % is therefore printed one step up (26 % at two digits): the price of never printing too little.
 PRINTED_BOUND_RTOL = 1e-12
 
+#: The corners of an internal wall (R3a of mesh/policy.py: two coplanar sheets of opposite orientation, e.g. the
+#: two halves of a part written face to face with their cut faces triangulated apart) lie within ``WALL_PLANE_RTOL``
+#: times the largest |coordinate| of one plane: cut points computed on a plane are off it by a few units of
+#: rounding (2⁻⁵³ each).  Only a filter: whether leaving a wall out keeps the answer exact is decided by the volume
+#: in which its sheets can differ (2·distance·area, mesh/folds.py), which must be within ``ROUNDOFF_RTOL``.
+WALL_PLANE_RTOL = 1e-12
+
 # -- limits on the input (guards, not tolerances; here so that a command's parser states them without loading
 #    the mesh layer) ---------------------------------------------------------------------------------------------
 

@@ -56,6 +56,17 @@ R3 *A surface that passes through itself is not a solid as it stands* (:func:`se
    as overlapping bodies are united by R5), certified ``united`` once the result is closed and has no crossing
    faces.  When the arrangement fails its own checks the mesh is refused with the reason; with ``repair`` the
    winding-number estimate with its bound is given.
+R3a *Folds that enclose nothing are not crossings* (:func:`~.folds.settle_folds`).  Before R3, when the check
+   flags face pairs, sliver fans (a vertex of exactly three faces splitting the face of its three neighbours: a
+   point put on an edge, rounded off it) are replaced by the face they split, and internal walls (faces near one
+   plane whose vector areas cancel: two sheets of opposite orientation over one region, e.g. two halves of a part
+   written face to face with their cut faces triangulated apart) are left out, the faces beside a wall's rim split
+   at the other sheet's T-vertices.  The winding number changes only inside the fans' tetrahedra and within the
+   walls' slabs (2·distance·area; zero when exactly flat), whose summed volume must be within ``ROUNDOFF_RTOL``
+   of the result (as R0 up to rounding), and the rest must pass the face-pair check with no crossing; then the
+   answer is ``exact`` with the check ``zero-volume-folds``.  Otherwise nothing is taken out.  Reason: such folds
+   are crossings only at the level of the coordinates' rounding, and a face of zero area cannot change the
+   winding number at all.
 R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is the number of other shells
    that contain it (whose winding number at a point of it is nonzero and that it does not cross); even depth
    is a body, wound outward, odd depth a cavity, wound inward.  A shell wound the other way is flipped, with
@@ -142,6 +153,10 @@ CHECKS = {
     "consistently-oriented": "every shell is wound outward as a body or inward as a cavity by its nesting depth",
     "no-crossing-faces": "no two faces cross or overlap except along shared edges and vertices (checked over "
                          "every candidate pair)",
+    "zero-volume-folds": "sliver fans (a vertex of three faces splitting the face of its neighbours) and internal "
+                         "walls (faces near one plane whose edges cancel by index) were taken out: the winding "
+                         "number they add is nonzero only in a volume bounded within ROUNDOFF_RTOL of the result, "
+                         "zero when exactly flat (mesh/folds.py)",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
     "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves and the "
                            "faces bounding {winding number ≥ 1} kept (mesh/arrange.py); the result was checked "

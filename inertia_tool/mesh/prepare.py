@@ -23,7 +23,7 @@ from ..errors import (ArrangementError, DegenerateFacesWarning, InsideOutWarning
 from ..integrals import (RoundoffBound, VolumeMoments, accurate_shells, body_volume_moments, bounding_box,
                          total_roundoff, volume_moments)
 from ..tolerances import FLAT_RTOL, MERGE_TOLERANCE, ROUNDOFF_RTOL
-from .checks import MeshReport, census_and_shells, repeated_corner_faces, shell_labels
+from .checks import MeshReport, census_and_shells, edge_topology, repeated_corner_faces, shell_labels
 from .read import RawMesh
 from .policy import (TOUCH_VOLUME_RTOL, Certificate, ShellContacts, coincident_message, coincident_surfaces,
                      inward_crossing_outward, near_copies, near_copies_message, negligible_flat, orient_by_depth,
@@ -270,6 +270,10 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if welded is not None and len(welded.contact):      # R1b: bodies welded along an edge meet there (R4 decides)
         contacts = dataclasses.replace(contacts, contact=np.concatenate(
             [np.asarray(contacts.contact, dtype=np.int64).reshape(-1, 2), welded.contact]))
+    folds = None
+    if patched is None and (len(contacts.crossing) or len(contacts.coplanar_opposite)):                 # R3a
+        v, f, labels, n_shells, shells, contacts, bound, folds = _settle_folds(v, f, labels, n_shells, shells, contacts,
+                                                                               bound, split_welded, diag, source)
     if patched is not None:
         contacts, patch_notes = _outside_patches(contacts, f, n_read)
         found = Resolution(found.vertices, found.faces, found.method, found.notes + patch_notes,
@@ -326,6 +330,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         notes.append(dropped_note)
     if arranged is not None:
         notes.append(arranged)
+    if folds is not None:
+        notes.append(folds.describe())
     if crossing_note is not None:
         notes.append(crossing_note)
     checks = ["edge-balanced", "consistently-oriented"]
@@ -340,7 +346,9 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     kind = "exact" if touch.complete and crossing_note is None else "unverified"
     if touch.complete and not touch.crossing.any() and crossing_note is None:
         checks.append("no-crossing-faces")
-    if candidates.any() or found.nonmanifold_edges:                             # R5, R6
+    # R3a may have taken out every non-manifold edge (a wall's rims): then nothing is left for the boolean to confirm
+    nonmanifold = found.nonmanifold_edges if folds is None else edge_topology(f, len(v), v).nonmanifold_edges
+    if candidates.any() or nonmanifold:                                         # R5, R6
         united = _unite(v, f, labels, owner, source, repair)
         summed = sum(s.volume for s in shells)
         if united is not None and not touch.crossing.any() and \
@@ -447,6 +455,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
             checks = [c for c in checks if c != "no-crossing-faces"]
     if ambiguous and kind in ("exact", "united"):
         kind = "unverified"                   # R4: a reading of the file's winding, not a proven solid
+    if folds is not None and "no-crossing-faces" in checks:
+        checks.insert(checks.index("no-crossing-faces"), "zero-volume-folds")      # R3a: what makes it exact
     certificate = Certificate(kind, tuple(checks) if kind != "estimate" else ())
     report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
                         bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),
@@ -455,6 +465,36 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                         repair_volume_change=None, bbox_min=bbox_min, bbox_max=bbox_max, method=method,
                         uncertainty=uncertainty, notes=tuple(notes), certificate=certificate, **common)
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(shells), owner=owner, report=report)
+
+
+def _settle_folds(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int, shells: list[VolumeMoments],
+                  contacts: SurfaceContacts, bound: RoundoffBound, split_welded: bool, diag: float,
+                  source: str) -> tuple[Any, ...]:
+    """R3a: sliver fans and internal walls taken out (:func:`~.folds.settle_folds`) and the stages after R1 run
+    again on what is left; everything unchanged when there are none or they cannot be shown to enclose nothing.
+
+    Returns ``(v, f, labels, n_shells, shells, contacts, bound, folds)`` (``folds`` None when unchanged)."""
+    from .folds import settle_folds        # imported on use: only surfaces with flagged face pairs
+    folds = settle_folds(v, f, contacts)          # R1 shells: a wall's sheets may lie in two R1b bodies
+    if folds is None:
+        return v, f, labels, n_shells, shells, contacts, bound, None
+    f = folds.faces
+    labels, n_shells = shell_labels(f, len(v))                                  # R1
+    welded = welded_bodies(f, len(v), labels, n_shells, v) if split_welded and n_shells else None
+    if welded is not None and welded.split:                                     # R1b
+        labels, n_shells = welded.labels, welded.n_shells
+    shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+    m = len(f)
+    f, labels, n_shells, shells, _, bound = _drop_flat(v, f, labels, shells, diag, source, bound, warn=False)
+    contacts = folds.contacts if len(f) == m else surface_contacts(v, f)
+    if welded is not None and len(f) != m:                # R2 relabelled: the welded contacts anew
+        welded = welded_bodies(f, len(v), labels, n_shells, v)
+    if welded is not None:                 # R1b: bodies welded along an edge still meet there (R4 decides)
+        if len(welded.contact):
+            contacts = dataclasses.replace(contacts, contact=np.concatenate(
+                [np.asarray(contacts.contact, dtype=np.int64).reshape(-1, 2), welded.contact]))
+    warnings.warn(MeshResolvedWarning(f"{source}: {folds.describe()}"), stacklevel=4)
+    return v, f, labels, n_shells, shells, contacts, bound, folds
 
 
 def _arrange_self_crossing(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: SurfaceContacts,
