@@ -127,3 +127,17 @@ def test_patched_bound_is_not_below_the_truth(repaired):
     u = repaired.mesh.uncertainty
     assert abs(repaired.volume - truth.volume) <= u.mass * repaired.volume
     assert len(f) < len(s.faces)
+
+
+@settings(max_examples=200, deadline=None)
+@given(distance=st.floats(1e-300, 1e3), volume=st.floats(1e-300, 1e3))
+def test_near_copy_note_states_its_distance_and_volume_rounded_up(distance, volume):
+    """R0's note for copies up to rounding prints the corner distance and the Steiner volume bound; with
+    ``:.3g`` to nearest, 1.2349e-9 m³ read 1.23e-09 m³, below the bound the note claims."""
+    from inertia_tool.mesh.policy import NearCopies, near_copies_message
+    note = near_copies_message(NearCopies(drop=np.zeros(0, dtype=bool), copies=1, distance=distance,
+                                          volume_bound=volume))
+    printed_distance = float(re.search(r"within ([0-9.e+-]+) m ", note).group(1))
+    printed_volume = float(re.search(r"at most ([0-9.e+-]+) m³", note).group(1))
+    assert printed_distance >= distance
+    assert printed_volume >= volume

@@ -126,6 +126,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..rounding import round_up
 from ..tolerances import COINCIDENT_RTOL, FLAT_MOMENT_RTOL, FLAT_RTOL, ROUNDOFF_RTOL, TOUCH_VOLUME_RTOL
 from ..values import frozen_value
 
@@ -999,6 +1000,6 @@ def near_copies_message(found: NearCopies) -> str:
     """R0's note for copies up to rounding."""
     n = found.copies
     return (f"{n} closed surface{'s' if n > 1 else ''} repeating another corner for corner within "
-            f"{found.distance:.3g} m (listed twice, the copy's coordinates rounded apart) counted once; the "
-            f"copies differ from the surfaces kept by at most {found.volume_bound:.3g} m³ (the surfaces' "
+            f"{round_up(found.distance):.3g} m (listed twice, the copy's coordinates rounded apart) counted once; the "
+            f"copies differ from the surfaces kept by at most {round_up(found.volume_bound):.3g} m³ (the surfaces' "
             "neighbourhood of that width), within the round-off bound of an exact result")
