@@ -12,7 +12,8 @@ from hypothesis import strategies as st
 
 from inertia_tool import mass_properties
 from inertia_tool.errors import NonPlanarPolygonWarning
-from inertia_tool.mesh.read import _clip_polygon_as_mujoco, load_mesh
+from inertia_tool.mesh.polygons import clip_polygon_as_mujoco
+from inertia_tool.mesh.read import load_mesh
 
 _NAMES = itertools.count()
 
@@ -67,7 +68,7 @@ def test_a_tie_of_the_quad_diagonals_takes_bd_as_mujoco_does(tmp_path):
 def test_a_convex_polygon_is_fanned_from_its_first_corner():
     # on a convex polygon MuJoCo's clipping takes corners 0, 1, 2, removes 1, and so on: the first-corner fan
     corners = np.array([(np.cos(t), np.sin(t), 0.1 * np.sin(3 * t)) for t in np.linspace(0, 2 * np.pi, 7)[:-1]])
-    triangles, dropped = _clip_polygon_as_mujoco(corners + (5.0, 5.0, 0.0))
+    triangles, dropped = clip_polygon_as_mujoco(corners + (5.0, 5.0, 0.0))
     assert triangles == [(0, j, j + 1) for j in range(1, 5)] and dropped == 0
 
 
@@ -131,8 +132,8 @@ def test_non_planar_polygons_give_mujocos_solid(tmp_path, n, heights, star, inne
         model = mujoco.MjModel.from_xml_string(xml)
     except ValueError:                                      # MuJoCo's dropped triangles left it no volume
         return
-    _, dropped_top = _clip_polygon_as_mujoco(vertices[:n])
-    _, dropped_bottom = _clip_polygon_as_mujoco(vertices[n:][::-1])
+    _, dropped_top = clip_polygon_as_mujoco(vertices[:n])
+    _, dropped_bottom = clip_polygon_as_mujoco(vertices[n:][::-1])
     assert int(model.mesh_facenum[0]) == len(raw.faces) - dropped_top - dropped_bottom   # drops predicted too
     if dropped_top or dropped_bottom:                       # MuJoCo's mesh is open there: no solid to compare
         return

@@ -24,10 +24,10 @@ from typing import IO, TYPE_CHECKING, Any, TypeAlias
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import MalformedTextWarning, MeshReadError, NonPlanarPolygonWarning, TrailingDataWarning, UsageError
+from ..errors import MalformedTextWarning, MeshReadError, TrailingDataWarning, UsageError
 from .._native import accel
-from ..rounding import round_up
 from ..units import LENGTH_UNITS, length_scale
+from .polygons import clip_polygons, split_quads_along_shorter_diagonal, warn_clipped_polygons, warn_warped_quads
 from .options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
 from .regular import not_regular_reason, open_regular, regular_file_resolver
 from .scene_counts import GLTF_INSTANCE_FACES, check_collada_instances, check_gltf
@@ -452,192 +452,6 @@ def _obj_vertex_block(path: str, tokens: list[bytes], first_line: int) -> np.nda
         raise _fail(path, "vertex coordinates are not numbers") from None
 
 
-def _split_quads_along_shorter_diagonal(vertices: np.ndarray, faces: np.ndarray,
-                                        first: np.ndarray) -> tuple[int, float]:
-    """Re-split in place the quads whose two triangles start at rows ``first`` of ``faces`` (read as
-    ``abc, acd``) into ``abd, bcd`` unless the diagonal ``ac`` is strictly shorter than ``bd`` (in float32, as
-    MuJoCo compares them: a tie takes ``bd``).
-
-    Returns the number of quads whose corners are not coplanar and six times the volume between the two
-    splits of all of them (the tetrahedron ``abcd`` of each quad: the other split adds or removes it)."""
-    a, b, c = faces[first, 0], faces[first, 1], faces[first, 2]
-    d = faces[first + 1, 2]
-    six = np.abs(np.einsum("ij,ij->i", vertices[b] - vertices[a],
-                           np.cross(vertices[c] - vertices[a], vertices[d] - vertices[a])))
-    warped = int(np.count_nonzero(six))
-    # MuJoCo's loader compares the squared diagonals in float32, summed x, y, z in that order, and keeps ac
-    # only when it is strictly shorter (a tie, as in a symmetric saddle, takes bd)
-    single = vertices.astype(np.float32)
-    e_ac, e_bd = single[c] - single[a], single[d] - single[b]
-    ac = e_ac[:, 0] * e_ac[:, 0] + e_ac[:, 1] * e_ac[:, 1] + e_ac[:, 2] * e_ac[:, 2]
-    bd = e_bd[:, 0] * e_bd[:, 0] + e_bd[:, 1] * e_bd[:, 1] + e_bd[:, 2] * e_bd[:, 2]
-    swap = ~(ac < bd)
-    rows = first[swap]
-    faces[rows] = np.column_stack([a[swap], b[swap], d[swap]])
-    faces[rows + 1] = np.column_stack([b[swap], c[swap], d[swap]])
-    return warped, float(six.sum())
-
-
-#: Polygons with more corners than this are fanned from their first corner instead of ear-clipped (the
-#: clipping below costs up to k² vectorised steps; no mesh exporter writes such polygons for a solid).
-MAX_CLIPPED_CORNERS = 1024
-
-
-def _inside_triangle(x: np.ndarray, y: np.ndarray, tx: np.ndarray, ty: np.ndarray) -> np.ndarray:
-    """Crossing-number test of the points ``(tx, ty)`` (arrays) against the triangle ``(x, y)`` (3 each), in
-    the arithmetic of the arrays (float32 here); True inside (W. R. Franklin's even-odd rule, points on an
-    edge fall on either side as the rounding decides)."""
-    inside = np.zeros(tx.shape, dtype=bool)
-    j = 2
-    for i in range(3):
-        straddles = (y[i] > ty) != (y[j] > ty)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            cut = (x[j] - x[i]) * (ty - y[i]) / (y[j] - y[i]) + x[i]
-        inside ^= straddles & (tx < cut)
-        j = i
-    return inside
-
-
-def _clip_polygon_as_mujoco(corners: np.ndarray) -> tuple[list[tuple[int, int, int]], int]:
-    """Triangles of one polygon of k > 4 corners in the order and shape MuJoCo's OBJ loader makes them.
-
-    MuJoCo (its ``obj_decoder`` on tinyobjloader's built-in triangulation) works in float32 on two coordinate
-    axes: those of the plane most face-on to the first corner triple (a, b, c) whose cross product has a
-    component above float32's epsilon (x dominant: y, z; otherwise x and y if z dominates, else x and z).
-    From corner ``g`` = 0 of the remaining polygon it takes the triangle of corners g, g+1, g+2; it skips
-    it (g += 1) when the turn ``cross`` at g+1 has the sign opposite to ``(x_g y_{g+1} − y_g x_{g+1}) / 2``,
-    or when another remaining corner lies inside it (crossing-number test); else it emits it and removes
-    corner g+1.  After as many skips as corners remain without a removal it stops, and MuJoCo drops what
-    is left.  This reader fans what is left from its first corner instead, so that the surface stays closed;
-    on a planar polygon every such sequence gives the same solid, and on a non-planar one this is the solid
-    MuJoCo integrates whenever it drops nothing.
-
-    Parameters
-    ----------
-    corners : (k, 3) float
-        The polygon's corners in file order.
-
-    Returns
-    -------
-    triangles : list of (int, int, int)
-        ``k − 2`` triangles, indices into ``corners``.
-    dropped : int
-        How many of them MuJoCo's loader leaves out.
-    """
-    k = len(corners)
-    single = corners.astype(np.float32)
-    eps = np.finfo(np.float32).eps
-    axes = (1, 2)
-    for i in range(k):
-        e0 = single[(i + 1) % k] - single[i]
-        e1 = single[(i + 2) % k] - single[(i + 1) % k]
-        cx = abs(e0[1] * e1[2] - e0[2] * e1[1])
-        cy = abs(e0[2] * e1[0] - e0[0] * e1[2])
-        cz = abs(e0[0] * e1[1] - e0[1] * e1[0])
-        if cx > eps or cy > eps or cz > eps:
-            if not (cx > cy and cx > cz):
-                axes = (0, 1) if (cz > cx and cz > cy) else (0, 2)
-            break
-    u, w = single[:, axes[0]], single[:, axes[1]]
-    remaining = list(range(k))
-    triangles: list[tuple[int, int, int]] = []
-    guess, tries, previous = 0, k, k
-    half = np.float32(0.5)
-    while len(remaining) > 3 and tries > 0:          # at most k skips between removals: bounded by k²
-        m = len(remaining)
-        if guess >= m:
-            guess -= m
-        if previous != m:
-            previous, tries = m, m
-        else:
-            tries -= 1
-        tri = [remaining[(guess + j) % m] for j in range(3)]
-        x, y = u[tri], w[tri]
-        cross = (x[1] - x[0]) * (y[2] - y[1]) - (y[1] - y[0]) * (x[2] - x[1])
-        area = (x[0] * y[1] - y[0] * x[1]) * half
-        if cross * area < 0:
-            guess += 1
-            continue
-        others = np.array([remaining[(guess + j) % m] for j in range(3, m)], dtype=np.int64)
-        if others.size and _inside_triangle(x, y, u[others], w[others]).any():
-            guess += 1
-            continue
-        triangles.append((tri[0], tri[1], tri[2]))
-        del remaining[(guess + 1) % m]
-    dropped = len(remaining) - 2 if len(remaining) > 3 else 0
-    triangles.extend((remaining[0], remaining[j], remaining[j + 1]) for j in range(1, len(remaining) - 1))
-    return triangles, dropped
-
-
-def _clip_polygons(vertices: np.ndarray, faces: np.ndarray, polygons: list[tuple[int, list[int]]]
-                   ) -> tuple[int, int, float, int]:
-    """Replace in place the first-corner fans of ``polygons`` ((first row in ``faces``, corner indices) each,
-    k > 4 corners) by :func:`_clip_polygon_as_mujoco`'s triangles.
-
-    Returns the number of polygons whose solid differs from the first-corner fan's, the number whose corners
-    are not coplanar, six times the sum over polygons of the absolute volume between the two triangulations
-    (the closed surface of one and the other reversed, integrated about the polygon's first corner) and the
-    number of triangles MuJoCo's loader drops."""
-    differs = warped = dropped = 0
-    six_between = 0.0
-    for row, idx in polygons:
-        corners = vertices[idx]
-        k = len(idx)
-        fan = [(0, j, j + 1) for j in range(1, k - 1)]
-        clipped, lost = ([], 0) if k > MAX_CLIPPED_CORNERS else _clip_polygon_as_mujoco(corners)
-        dropped += lost
-        relative = corners - corners[0]
-        normal = np.cross(relative[1:-1], relative[2:]).sum(axis=0)
-        if np.any(np.abs(relative @ normal) > 0):
-            warped += 1
-        if not clipped or clipped == fan:
-            continue
-        signed = 0.0
-        for tris, sign in ((clipped, 1.0), (fan, -1.0)):
-            p = relative[np.array(tris)]
-            signed += sign * float(np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])).sum())
-        if signed != 0.0:
-            differs += 1
-            six_between += abs(signed)
-        faces[row:row + k - 2] = np.asarray(idx, dtype=faces.dtype)[np.array(clipped)]
-    return differs, warped, six_between, dropped
-
-
-def _warn_warped_quads(path: str, vertices: np.ndarray, faces: np.ndarray, warped: int, quads: int,
-                       six_between: float) -> None:
-    """Say that non-planar quads were split by rule, with the volume the other split could change, as a
-    fraction of the enclosed volume (unit-free: the reader does not know the file's unit); nothing below
-    1e-9 of it (round-off of a planar export)."""
-    p = vertices[faces]
-    six_volume = abs(float(np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])).sum()))
-    if not six_volume > 0 or six_between <= 1e-9 * six_volume:
-        return
-    warnings.warn(NonPlanarPolygonWarning(
-        f"{_display(path)}: {warped:,} of {quads:,} quadrilaterals are not planar; each was split along its "
-        f"shorter diagonal (as MuJoCo reads OBJ; trimesh splits from the first corner): the other split would "
-        f"change the volume by up to {round_up(100 * six_between / six_volume, 2):.2g} % of the whole"),
-        stacklevel=4)
-
-
-def _warn_clipped_polygons(path: str, vertices: np.ndarray, faces: np.ndarray, differs: int, polygons: int,
-                           six_between: float, dropped: int) -> None:
-    """Say that polygons of more than four corners were ear-clipped as MuJoCo does, with the volume the
-    first-corner fan (trimesh's reading) would change, as a fraction of the enclosed volume rounded up; and
-    how many triangles MuJoCo's own loader leaves out of them.  Nothing below 1e-9 of the volume (round-off
-    of a planar export)."""
-    p = vertices[faces]
-    six_volume = abs(float(np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])).sum()))
-    if not six_volume > 0 or six_between <= 1e-9 * six_volume:
-        return
-    lost = (f"; MuJoCo's loader leaves {dropped:,} of their triangles out (its clipping stops; they are fanned "
-            "here, so that the surface stays closed)") if dropped else ""
-    warnings.warn(NonPlanarPolygonWarning(
-        f"{_display(path)}: {differs:,} of {polygons:,} polygons with more than four corners are not planar; "
-        f"each was ear-clipped as MuJoCo reads OBJ (trimesh fans from the first corner): the fan would change "
-        f"the volume by up to {round_up(100 * six_between / six_volume, 2):.2g} % of the whole{lost}"),
-        stacklevel=4)
-
-
 def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     """Stream a Wavefront OBJ: ``v`` lines and ``f`` polygons (1-based or negative relative indices).
 
@@ -645,7 +459,7 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     ``|ac| ≤ |bd|``, else ``abd, bcd``), the rule of MuJoCo's OBJ loader (checked against ``mujoco`` 4.0 on
     Menagerie's meshes): for a quad that is not planar the two splits bound different solids, and this one is
     the solid a simulator reading the same file integrates.  Polygons with more than four corners are
-    ear-clipped as MuJoCo's loader clips them (:func:`_clip_polygon_as_mujoco`; any triangulation of a planar
+    ear-clipped as MuJoCo's loader clips them (:func:`~.polygons.clip_polygon_as_mujoco`; any triangulation of a planar
     polygon gives the same solid, so this matters for non-planar ones only).  Index 0, a relative index before the
     first vertex, or an index past the last vertex is refused with the line named, never dropped: a dropped face
     would silently change the volume.
@@ -760,18 +574,18 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
         raise _fail(path, f"face index {top + 1:,} is past the last vertex ({nv:,} defined)")
     warped, between = 0, 0.0
     for block_index, rows in quad_blocks:
-        w, v6 = _split_quads_along_shorter_diagonal(vertices, face_blocks[block_index], rows)
+        w, v6 = split_quads_along_shorter_diagonal(vertices, face_blocks[block_index], rows)
         warped, between = warped + w, between + v6
     differs = dropped = 0
     polygon_between = 0.0
     for block_index, polygons in polygon_blocks:
-        d, _, v6, lost = _clip_polygons(vertices, face_blocks[block_index], polygons)
+        d, _, v6, lost = clip_polygons(vertices, face_blocks[block_index], polygons)
         differs, polygon_between, dropped = differs + d, polygon_between + v6, dropped + lost
     faces = np.concatenate(face_blocks)
     if warped:
-        _warn_warped_quads(path, vertices, faces, warped, sum(len(rows) for _, rows in quad_blocks), between)
+        warn_warped_quads(_display(path), vertices, faces, warped, sum(len(rows) for _, rows in quad_blocks), between)
     if differs:
-        _warn_clipped_polygons(path, vertices, faces, differs, sum(len(p) for _, p in polygon_blocks),
+        warn_clipped_polygons(_display(path), vertices, faces, differs, sum(len(p) for _, p in polygon_blocks),
                                polygon_between, dropped)
     if garbage:
         warnings.warn(MalformedTextWarning(f"{_display(path)}: {garbage:,} unrecognised lines were ignored"
