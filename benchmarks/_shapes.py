@@ -22,21 +22,29 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
+def _torus_grid(nu: int, nv: int, major: float, minor: float, phase: float = 0.0):
+    """Points of a torus grid (``nu`` round the ring, ``nv`` round the tube, the tube angle starting at
+    ``phase``) and the corners a, b, c, d of each grid quad, outward when split into (a, b, c), (a, c, d)."""
+    u = 2 * np.pi * np.arange(nu) / nu
+    w = 2 * np.pi * np.arange(nv) / nv + phase
+    uu, ww = np.meshgrid(u, w, indexing="ij")
+    r = major + minor * np.cos(ww)
+    pts = np.stack([r * np.cos(uu), r * np.sin(uu), minor * np.sin(ww)], axis=-1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
+    a = i * nv + j
+    b = ((i + 1) % nu) * nv + j
+    c = ((i + 1) % nu) * nv + (j + 1) % nv
+    d = i * nv + (j + 1) % nv
+    return pts, (a, b, c, d)
+
+
 def torus(n_faces: float, major: float = 1.0, minor: float = 0.35) -> tuple[np.ndarray, np.ndarray]:
     """A closed torus grid of about ``n_faces`` triangles (n around the axis, n/2 around the tube); its quads
     are exactly planar isosceles trapezoids, so each quad's diagonal joins two coplanar faces."""
     n = max(8, int(round(np.sqrt(n_faces))))
     k = max(4, n // 2)
-    u = 2 * np.pi * np.arange(n) / n
-    w = 2 * np.pi * np.arange(k) / k + 0.1234      # off the coordinate planes: no accidental symmetry
-    uu, ww = np.meshgrid(u, w, indexing="ij")
-    r = major + minor * np.cos(ww)
-    v = np.stack([r * np.cos(uu), r * np.sin(uu), minor * np.sin(ww)], axis=-1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(n), np.arange(k), indexing="ij")
-    a = i * k + j
-    b = ((i + 1) % n) * k + j
-    c = ((i + 1) % n) * k + (j + 1) % k
-    d = i * k + (j + 1) % k
+    # the tube angle starts off the coordinate planes: no accidental symmetry
+    v, (a, b, c, d) = _torus_grid(n, k, major, minor, phase=0.1234)
     f = np.r_[np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)]
     return v, f
 
@@ -95,16 +103,7 @@ def ring_torus(nu: int, nv: int, major: float = 40.0, minor: float = 10.0) -> tu
     ``nu`` points round the ring (major radius ``major``), ``nv`` round the tube (minor radius ``minor``);
     grid quad (i, j) becomes the faces (a, b, c) and (a, c, d), written one after the other.
     """
-    u = 2 * np.pi * np.arange(nu) / nu
-    v = 2 * np.pi * np.arange(nv) / nv
-    uu, vv = np.meshgrid(u, v, indexing="ij")
-    r = major + minor * np.cos(vv)
-    pts = np.stack([r * np.cos(uu), r * np.sin(uu), minor * np.sin(vv)], axis=-1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
-    a = i * nv + j
-    b = ((i + 1) % nu) * nv + j
-    c = ((i + 1) % nu) * nv + (j + 1) % nv
-    d = i * nv + (j + 1) % nv
+    pts, (a, b, c, d) = _torus_grid(nu, nv, major, minor)
     faces = np.stack([np.stack([a, b, c], -1), np.stack([a, c, d], -1)], axis=2).reshape(-1, 3)
     return pts, faces.astype(np.int64)
 
@@ -120,16 +119,9 @@ def icosphere(subdivisions: int, radius: float = 50.0) -> tuple[np.ndarray, np.n
                   [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]], dtype=np.int64)
     v /= np.linalg.norm(v, axis=1, keepdims=True)
     for _ in range(subdivisions):
-        edges = np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-        unique, inverse = np.unique(edges, axis=0, return_inverse=True)
-        mid = v[unique].mean(axis=1)
-        mid /= np.linalg.norm(mid, axis=1, keepdims=True)
-        m = (len(v) + inverse.reshape(-1)).reshape(-1, 3)         # midpoints of edges (01, 12, 20)
-        v = np.vstack([v, mid])
-        a, b, c = f[:, 0], f[:, 1], f[:, 2]
-        ab, bc, ca = m[:, 0], m[:, 1], m[:, 2]
-        f = np.concatenate([np.stack([a, ab, ca], 1), np.stack([b, bc, ab], 1), np.stack([c, ca, bc], 1),
-                            np.stack([ab, bc, ca], 1)])
+        n = len(v)
+        v, f = subdivide(v, f)
+        v[n:] /= np.linalg.norm(v[n:], axis=1, keepdims=True)          # the new midpoints pushed to the sphere
     return v * radius, f
 
 
