@@ -77,7 +77,7 @@ PRINTED_MOMENT_TOLERANCE = 0.01
 #: Repair (``repair=True``): boundary vertices closer than ``SEAM_GAP_RTOL · diagonal`` to another boundary
 #: vertex, or to a boundary edge (a T-junction), are taken to be one seam that the export split, and are
 #: sealed.  Openings narrower than this are read as artefacts, not slots; the bound of the sealed estimate
-#: covers the move (see :mod:`inertia_tool.mesh.estimate`).
+#: covers the move (see :mod:`inertia_tool.mesh.uncertainty`).
 SEAM_GAP_RTOL = 1e-4
 
 #: Repair: an estimate whose relative mass bound exceeds this (or whose centre-of-mass or inertia bound is not

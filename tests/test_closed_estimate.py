@@ -1,4 +1,4 @@
-"""mesh/estimate.py closed_surface_estimate: the solid {w ≥ 1} of a closed surface passing through itself when
+"""mesh/grid_estimate.py closed_surface_estimate: the solid {w ≥ 1} of a closed surface passing through itself when
 the exact arrangement cannot be built (issues 21 and 23).
 
 Truths are independent: manifold3d float64 unions of the closed pieces (boxes in special position: coplanar
@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 import adversary_solids as S
 from inertia_tool import mass_properties
 from inertia_tool.errors import ArrangementError, InvalidMeshError
-from inertia_tool.mesh.estimate import closed_surface_estimate, winding_estimate
+from inertia_tool.mesh.grid_estimate import closed_surface_estimate, winding_estimate
 
 
 def _inertia(second_moment):
@@ -154,7 +154,7 @@ def test_qb_move_is_estimated_consistently():
     summed = abs(float(mesh.volume)) * 1e-9
     assert props.volume * (1 - unc.mass) <= summed
     # the coarse first grid's interval and the answer's both contain the truth, so they overlap
-    from inertia_tool.mesh.estimate import winding_estimate
+    from inertia_tool.mesh.grid_estimate import winding_estimate
     mesh.merge_vertices()
     coarse = winding_estimate(np.asarray(mesh.vertices) * 1e-3, np.asarray(mesh.faces))
     lo, hi = coarse.volume * (1 - coarse.uncertainty.mass), coarse.volume * (1 + coarse.uncertainty.mass)
@@ -165,7 +165,7 @@ def test_useless_bound_is_still_refused_with_the_arrangement_reason(monkeypatch)
     """Past the 50 % mass rule the estimate is refused, and the message keeps why the arrangement failed (a
     grid of 24 cells on a thin figure-eight tube: ±97 %)."""
     import inertia_tool.mesh.arrange as arrange
-    import inertia_tool.mesh.estimate as estimate
+    import inertia_tool.mesh.grid_estimate as estimate
 
     def fail(*args, **kwargs):
         raise ArrangementError("a corner of a face lies exactly in the plane of a face it crosses")

@@ -1,5 +1,5 @@
 """Each hole's volume in doubt: the ball over its rim cut to the slab around the plane beside it
-(``mesh/estimate.py``: :func:`hole_doubt_volumes`, :func:`ball_slab_volume`)."""
+(``mesh/holes.py``: :func:`hole_doubt_volumes`, :func:`ball_slab_volume`)."""
 
 import numpy as np
 import pytest
@@ -13,7 +13,8 @@ from conftest import box_arrays
 from inertia_tool import mass_properties
 from inertia_tool.errors import InvalidMeshError, MeshRepairedWarning
 from inertia_tool.integrals import volume_moments
-from inertia_tool.mesh.estimate import ball_slab_volume, boundary_edges, patched_estimate
+from inertia_tool.mesh.holes import ball_slab_volume, patched_estimate
+from inertia_tool.mesh.rims import boundary_edges
 
 
 def _inertia(m):

@@ -1,4 +1,5 @@
-"""Bounded estimates for open meshes and generalized winding numbers (mesh/estimate.py, winding.py)."""
+"""Bounded estimates for open meshes and generalized winding numbers (mesh/holes.py, rims.py,
+grid_estimate.py, winding.py)."""
 
 import numpy as np
 import pytest
@@ -7,7 +8,9 @@ import trimesh
 from conftest import box_arrays
 from inertia_tool import mass_properties
 from inertia_tool.errors import InvalidMeshError, MeshRepairedWarning
-from inertia_tool.mesh.estimate import boundary_edges, enclosing_balls, patched_estimate, winding_estimate
+from inertia_tool.mesh.grid_estimate import winding_estimate
+from inertia_tool.mesh.holes import patched_estimate
+from inertia_tool.mesh.rims import boundary_edges, enclosing_balls
 from inertia_tool.mesh.seal import parallel_body_volume
 from inertia_tool.mesh.winding import winding_numbers
 from inertia_tool.integrals import volume_moments
@@ -174,7 +177,7 @@ def test_seal_bound_is_the_parallel_body_of_the_touched_faces():
 def test_negative_repaired_volume_is_a_refusal_not_a_usage_error():
     """Issue 21 (Spot lower legs): a repaired estimate with a negative total ended in "Expected a positive
     total mass" (UsageError, exit 2).  Now an InvalidMeshError names the volume."""
-    from inertia_tool.mesh.estimate import Uncertainty, check_useful
+    from inertia_tool.mesh.uncertainty import Uncertainty, check_useful
     with pytest.raises(InvalidMeshError, match="volume of -2.6e-08 m³"):
         check_useful(-2.6e-8, Uncertainty(0.01, 0.0, 0.0, 0.0), source="leg.obj", what="the patched surface")
     with pytest.raises(InvalidMeshError, match="unbounded"):
@@ -270,7 +273,7 @@ def test_cells_settled_by_their_region_classify_as_the_exact_winding_number(case
     """Regression (issue 23 item 6, UR5e speed): cells far from every hole take the integer winding number of
     their region instead of an evaluation; each must fall on the same side of 0.1, 0.5 and 0.9 as the exact
     direct sum (an independent evaluation) there."""
-    from inertia_tool.mesh.estimate import _closed_part_numbers, _surface_cells
+    from inertia_tool.mesh.grid_estimate import _closed_part_numbers, _surface_cells
     v, f = _open_and_self_crossing_cases()[case]
     lo, hi = v.min(axis=0), v.max(axis=0)
     h = float(np.max(hi - lo)) / 20
@@ -291,7 +294,7 @@ def test_cells_settled_by_their_region_classify_as_the_exact_winding_number(case
 
 
 def test_winding_estimate_with_and_without_the_region_shortcut_agree(monkeypatch):
-    import inertia_tool.mesh.estimate as est
+    import inertia_tool.mesh.grid_estimate as est
     if not est.TREECODE_RESOLUTION:
         pytest.skip("no grid")
     from inertia_tool.mesh.winding import fast_available
@@ -313,7 +316,7 @@ def test_winding_estimate_with_and_without_the_region_shortcut_agree(monkeypatch
 @pytest.mark.parametrize("resolution", [7, 20])
 def test_surface_cells_hold_every_surface_point(resolution):
     """Every cell holding a point of the surface is marked (brute force: 200,000 random points of the faces)."""
-    from inertia_tool.mesh.estimate import _surface_cells
+    from inertia_tool.mesh.grid_estimate import _surface_cells
     rng = np.random.default_rng(resolution)
     m = trimesh.creation.torus(1.0, 0.35)
     v, f = np.asarray(m.vertices) @ trimesh.transformations.random_rotation_matrix(rng.random(3))[:3, :3].T, \

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from inertia_tool import mass_properties
-from inertia_tool.mesh.estimate import boundary_edges
+from inertia_tool.mesh.rims import boundary_edges
 from inertia_tool.mesh.merge import _groups, merge_close_vertices
 from inertia_tool.mesh.seal import drop_duplicate_faces, seal_seams
 
@@ -127,7 +127,7 @@ def test_jittered_soup_is_welded_then_exact_like_the_clean_part():
 
 def test_holes_meeting_at_a_corner_get_one_cone_each_and_no_nonmanifold_edge():
     from inertia_tool.integrals import volume_moments
-    from inertia_tool.mesh.estimate import patched_estimate
+    from inertia_tool.mesh.holes import patched_estimate
     from inertia_tool.mesh.orient import edge_balance
 
     v, f = _torus(24, 10)
@@ -148,7 +148,7 @@ def test_holes_meeting_at_a_corner_get_one_cone_each_and_no_nonmanifold_edge():
 @pytest.mark.parametrize("seed", range(6))
 def test_scattered_holes_patch_without_nonmanifold_edges(seed):
     from inertia_tool.integrals import volume_moments
-    from inertia_tool.mesh.estimate import patched_estimate
+    from inertia_tool.mesh.holes import patched_estimate
     from inertia_tool.mesh.orient import edge_balance
 
     v, f = _torus(30, 12)
@@ -157,7 +157,7 @@ def test_scattered_holes_patch_without_nonmanifold_edges(seed):
     est = patched_estimate(v, kept, volume_moments)
     census = edge_balance(est.faces, len(est.vertices))
     assert census.balanced
-    from inertia_tool.mesh.estimate import boundary_edges
+    from inertia_tool.mesh.rims import boundary_edges
     rim = boundary_edges(kept, len(v))
     assert np.count_nonzero(np.bincount(rim[:, 1], minlength=len(v)) >= 2) > 5      # pinches are there
     assert census.nonmanifold_edges == 0

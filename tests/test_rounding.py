@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from inertia_tool import mass_properties
 from inertia_tool.errors import InvalidMeshError, MeshRepairedWarning
 from inertia_tool.integrals import volume_moments
-from inertia_tool.mesh.estimate import Uncertainty, check_useful
+from inertia_tool.mesh.uncertainty import Uncertainty, check_useful
 from inertia_tool.reports.html import html_report
 from inertia_tool.reports.text import method_line
 from inertia_tool.rounding import round_up

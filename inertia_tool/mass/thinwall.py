@@ -35,7 +35,7 @@ from ..values import frozen_value
 from ..mesh.checks import MeshReport, edge_topology, repeated_corner_faces, shell_labels
 from ..mesh.policy import Certificate
 from ..errors import InvalidMeshError, UsageError
-from ..mesh.estimate import Uncertainty
+from ..mesh.uncertainty import Uncertainty
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.prepare import prepare_mesh

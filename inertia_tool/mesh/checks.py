@@ -23,7 +23,7 @@ from .policy import Certificate
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
-    from .estimate import Uncertainty
+    from .uncertainty import Uncertainty
 
 __all__ = ["EdgeTopology", "MeshReport", "repeated_corner_faces", "edge_topology", "shell_labels", "census_and_shells",
            "winding_number"]

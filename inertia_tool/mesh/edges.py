@@ -4,7 +4,7 @@ Edge ``k`` of face ``i`` runs from corner ``k`` to corner ``k + 1 (mod 3)``: ``(
 undirected key is ``min(a, b)·n + max(a, b)`` (``n`` the number of vertices, so the key is unique and fits in
 int64 for any mesh below 3·10⁹ vertices) and its direction bit is ``a > b``.  The edge census
 (:mod:`~.checks`), consistent orientation (:mod:`~.orient`), the boundary of an open surface
-(:mod:`~.estimate`), sealing (:mod:`~.seal`) and closed groups (:mod:`~.union`) all use this one key.
+(:mod:`~.rims`), sealing (:mod:`~.seal`) and closed groups (:mod:`~.union`) all use this one key.
 """
 
 from __future__ import annotations

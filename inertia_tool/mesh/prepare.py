@@ -438,7 +438,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     bbox_min, bbox_max = (lo, hi) if v is raw.vertices else bounding_box(v)
     uncertainty = None
     if patched is not None:
-        from .estimate import check_useful, uncertainty_from      # imported on use: repair only
+        from .uncertainty import check_useful, uncertainty_from     # imported on use: repair only
         total = _total(shells)
         uncertainty = uncertainty_from(total.volume, total.centroid, total.second_moment,
                                        patched.uncertainty.volume_in_doubt, patched.far)

@@ -14,9 +14,9 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
 4. Otherwise the file does not define a solid.  Without ``repair`` this refuses in one line (edges counted
    after welding) and says that ``repair=True`` gives a bounded estimate.  With ``repair``: duplicate faces
    are dropped (exact if that balances the surface — method ``"deduplicated"``), then one estimate of
-   ``estimate.py`` is formed, chosen by :data:`REPAIR_RULE` from what the surface is (a soup → the winding
-   number on a grid, method ``"winding"``; otherwise seams sealed and holes patched, method ``"patched"``),
-   before any of it is computed, so no grid is built only to be thrown away.
+   ``holes.py`` or ``grid_estimate.py`` is formed, chosen by :data:`REPAIR_RULE` from what the surface
+   is (a soup → the winding number on a grid, method ``"winding"``; otherwise seams sealed and holes
+   patched, method ``"patched"``), before any of it is computed, so no grid is built only to be thrown away.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
 from ..rounding import round_up
 
 if TYPE_CHECKING:
-    from .estimate import Estimate
+    from .uncertainty import Estimate
     from .orient import EdgeBalance
 
 __all__ = ["Resolution", "resolve_surface", "REPAIR_RULE"]
@@ -145,7 +145,7 @@ def _drop_collapsed(faces: np.ndarray) -> np.ndarray:
 
 
 def _describe(census: EdgeBalance, welded: float | None, vertices: np.ndarray, faces: np.ndarray) -> str:
-    from .estimate import boundary_edges
+    from .rims import boundary_edges
 
     parts = []
     if census.boundary_edges:
@@ -209,7 +209,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         Without ``repair`` when no exact reading exists; with it when nothing encloses a volume.
     """
     # imported on use: a surface that passes the manifold check (nearly every file) never comes here
-    from .estimate import check_useful, closed_surface_estimate, winding_estimate
+    from .grid_estimate import closed_surface_estimate, winding_estimate
+    from .uncertainty import check_useful
     from .merge import merge_close_vertices
     from .orient import edge_balance, orient_consistently
     from .seal import drop_duplicate_faces, on_edge_vertices
@@ -324,7 +325,8 @@ def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, 
     """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed, and
     the non-manifold edges of the surface it integrates (``found`` is the census of ``faces``)."""
     from .edges import edge_keys
-    from .estimate import patched_estimate, winding_estimate
+    from .grid_estimate import winding_estimate
+    from .holes import patched_estimate
     from .seal import seal_seams
     seal = seal_seams(vertices, faces, seam_gap_rtol * diag, boundary=found.boundary)
     if not len(seal.faces) or seal.loose_faces > soup_share * len(seal.faces):

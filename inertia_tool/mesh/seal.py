@@ -67,7 +67,7 @@ class Seal:
         T-junction vertices inserted into an edge.
     boundary : (k, 2) int
         The net boundary of ``faces`` as directed edges with multiplicity (as
-        :func:`~.estimate.boundary_edges` gives it), found on the frontier.
+        :func:`~.rims.boundary_edges` gives it), found on the frontier.
     loose_faces : int
         Faces of ``faces`` sharing no edge with another face (loose triangles of a soup).
     front_start : int
@@ -112,7 +112,7 @@ def parallel_body_volume(vertices: np.ndarray, faces: np.ndarray, radius: np.nda
 def _frontier_boundary(faces: np.ndarray, n: int, region: np.ndarray | None) -> np.ndarray:
     """Boundary edges of the frontier ``faces`` that are boundary edges of the whole surface: those with an end
     in ``region`` (the frontier vertices; None: ``faces`` is the whole surface)."""
-    from .estimate import boundary_edges
+    from .rims import boundary_edges
 
     edges = boundary_edges(faces, n)
     if region is not None and len(edges):
@@ -359,14 +359,14 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
         Drop the repeated faces a weld or split made (same corners, same winding); the faces kept then all
         take the largest slack (a superset of what each could have been).
     boundary : (k, 2) int, optional
-        The net boundary of ``faces`` when the caller has it (as :func:`~.estimate.boundary_edges` gives it).
+        The net boundary of ``faces`` when the caller has it (as :func:`~.rims.boundary_edges` gives it).
 
     Returns
     -------
     Seal
         Its faces are the untouched faces followed by the frontier's, sealed.
     """
-    from .estimate import boundary_edges
+    from .rims import boundary_edges
 
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)

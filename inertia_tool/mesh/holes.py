@@ -1,0 +1,404 @@
+"""Patching holes: a bounded estimate of the solid behind a surface with holes.
+
+:func:`patched_estimate` closes every boundary loop by a cone (a fan of triangles) to the centroid of the
+loop's vertices and integrates the closed result exactly.  The boundary of a triangle 2-chain is a 1-cycle, so
+the cones always close it.  **Assumption: the missing surface of each hole lies within the ball enclosing the
+hole's rim** (:func:`~.rims.enclosing_balls`, close to the smallest such ball; for a round hole in a smooth part
+this is the ball whose great circle is the rim, which holds any cap up to a hemisphere).  The cone lies in the
+rim's convex hull, inside the same ball, so the closed cycle "cone minus missing surface" lies in the ball and
+its winding number — the difference between the patched solid and the true one — vanishes outside it.
+**Second assumption: the missing surface strays from the plane of a face beside the hole no farther than the
+rim does** (:func:`hole_doubt_volumes`); the cone does too, so each ball is cut to that slab, and the volume in
+doubt is the total volume of the cut balls.  The convex hull of the rim is *not* enough (a planar rim has a hull
+of volume 0, yet a spherical cap over it is far from flat), and no hole gets a bound of 0.  **Third assumption,
+for a hole across one crease of a faceted part: the missing surface lies in the two planes that hold its rim**
+(:func:`crease_fills`): each plane's part of the rim is filled in that plane instead of by the cone, and the
+ball is cut to both slabs.  Seams sealed first (cracks, T-junctions; :mod:`~.seal`) add the volume of the
+parallel bodies of the faces sealing touched.  The bounds follow from the volume in doubt as
+:mod:`~.uncertainty` states.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+from ..rounding import round_up
+from ..values import frozen_value
+from .edges import edge_keys
+from .rims import boundary_edges, boundary_loops, enclosing_balls
+from .seal import Seal
+from .uncertainty import Estimate, uncertainty_from
+
+__all__ = ["patched_estimate", "hole_doubt_volumes", "ball_slab_volume", "crease_fills", "CreaseFill"]
+
+
+def ball_slab_volume(radius: np.ndarray, offset: np.ndarray, half_width: np.ndarray) -> np.ndarray:
+    """Volume of the part of a ball that lies in a slab, (k,) m³.
+
+    The ball has radius ``r``; the slab is the set of points whose signed distance from a plane lies in
+    ``[−t, t]`` (``t = half_width``), and the ball's centre is at signed distance ``s = offset`` from that plane.
+    In the ball's own axial coordinate ``z`` the slab is ``[−t − s, t − s]``; clipped to ``[−r, r]`` it is
+    ``[a, b]``, and the volume is ``π ∫_a^b (r² − z²) dz = π [r² z − z³/3]_a^b`` (slices of a ball are discs).
+    """
+    r = np.asarray(radius, dtype=np.float64)
+    lo = np.clip(-np.asarray(half_width) - np.asarray(offset), -r, r)
+    hi = np.clip(np.asarray(half_width) - np.asarray(offset), -r, r)
+    volume: np.ndarray = np.maximum(np.pi * ((r ** 2 * hi - hi ** 3 / 3.0) - (r ** 2 * lo - lo ** 3 / 3.0)), 0.0)
+    return volume
+
+
+def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
+                       n_loops: int, centre: np.ndarray, radius: np.ndarray, vertex_of: np.ndarray,
+                       loop_of: np.ndarray) -> np.ndarray:
+    """Volume in doubt of each hole (boundary loop), (n_loops,) m³: the ball over its rim, cut to a slab.
+
+    Two assumptions, both about the missing surface ``M`` of the hole (the surface the file lost):
+
+    1. ``M`` lies in the ball enclosing the rim (module docstring), and
+    2. ``M`` strays from the plane of a face beside the hole no farther than the rim itself does: of the faces
+       sharing an edge with the rim (the *ring*), take the one whose plane the rim is closest to; if every rim
+       vertex is within ``e`` of that plane, so is ``M``.  A hole inside a flat face of a part (a missing
+       triangle of a CAD face) has ``e`` ≈ 0; a hole in a curved surface has ``e`` of the order of its sagitta
+       (for a spherical cap of half-angle α the ring plane is tilted by about α and the rim's far side lies
+       ``2r sin α`` from it, more than the cap's height ``r tan(α/2)`` above the rim's own plane); a hole
+       across a crease has ``e`` up to its width, and the ball decides.  It fails for a hole that swallowed a
+       whole boss or dimple standing on a flat face (the ring is flat, the missing part is not): the stated
+       limit of this bound.
+
+    The cone that patches the hole has its apex at the centroid of the rim vertices, so it lies in the rim's
+    convex hull, inside both the ball and the slab of half-width ``e`` around the plane (a convex set holding
+    every rim vertex).  The patched and the true solid therefore differ only where the cycle "cone minus
+    ``M``" winds, which is inside ball ∩ slab: its volume (:func:`ball_slab_volume`) is the hole's volume in
+    doubt.  ``e`` carries a round-off margin of 16 ulp of the coordinates, so an exactly flat hole still
+    states a (tiny) positive bound.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+        The surface with the holes (sealed where seams were sealed).
+    edges : (k, 2) int
+        Its boundary edges; ``label`` (k,) the loop of each.
+    centre, radius : (n_loops, 3), (n_loops,) float
+        The ball enclosing each loop's rim (:func:`enclosing_balls`).
+    vertex_of, loop_of : (p,) int
+        The distinct (vertex, loop) pairs of the rims.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    ball: np.ndarray = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=np.float64) ** 3
+    n = len(v)
+    nv = np.int64(max(n, 1))
+    key, _ = edge_keys(faces, n)
+    rim_key = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * nv + np.maximum(edges[:, 0], edges[:, 1])
+    order = np.argsort(rim_key, kind="stable")
+    sorted_rim = rim_key[order]
+    pos = np.searchsorted(sorted_rim, key)
+    hit = (pos < len(sorted_rim)) & (sorted_rim[np.minimum(pos, len(sorted_rim) - 1)] == key)
+    slot = np.flatnonzero(hit)
+    if not len(slot):
+        return ball
+    ring_face = slot // 3
+    ring_loop = label[order[pos[slot]]]
+    # one (face, loop) pair per ring face of each loop
+    pair = np.unique(np.stack([ring_face, ring_loop], axis=1), axis=0)
+    ring_face, ring_loop = pair[:, 0], pair[:, 1]
+    a, b, c = (v[faces[ring_face, k]] for k in range(3))
+    normal = np.cross(b - a, c - a)
+    length = np.linalg.norm(normal, axis=1)
+    usable = length > 0
+    ring_face, ring_loop, a, normal = ring_face[usable], ring_loop[usable], a[usable], normal[usable]
+    if not len(ring_face):
+        return ball
+    unit = normal / length[usable, None]
+    # the farthest rim vertex of each loop from each of its ring faces' planes; (ring face, rim vertex)
+    # pairs are formed loop by loop (rims are short next to the surface, so this stays small)
+    rim_order = np.argsort(loop_of, kind="stable")
+    rim_loop, rim_vertex = loop_of[rim_order], vertex_of[rim_order]
+    rim_start = np.searchsorted(rim_loop, np.arange(n_loops))
+    rim_count = np.diff(np.r_[rim_start, len(rim_loop)])
+    per_face = rim_count[ring_loop]
+    if int(per_face.sum()) > RING_WORK_LIMIT:
+        return ball
+    e_face = np.zeros(len(ring_face))
+    ends = np.cumsum(per_face)
+    lo = 0
+    while lo < len(ring_face):          # ring faces in chunks of about RING_CHUNK (face, vertex) pairs
+        hi = max(lo + 1, int(np.searchsorted(ends, ends[lo] - per_face[lo] + RING_CHUNK, side="right")))
+        hi = min(hi, len(ring_face))
+        count = per_face[lo:hi]
+        which = lo + np.repeat(np.arange(hi - lo), count)
+        offset_in = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+        pts = v[rim_vertex[rim_start[ring_loop[which]] + offset_in]]
+        dist = np.abs(np.einsum("ij,ij->i", pts - a[which], unit[which]))
+        e_face[lo:hi] = np.maximum.reduceat(dist, np.r_[0, np.cumsum(count)[:-1]])
+        lo = hi
+    best = np.full(n_loops, np.inf)
+    np.minimum.at(best, ring_loop, e_face)
+    choice = np.full(n_loops, -1, dtype=np.int64)
+    is_best = e_face <= best[ring_loop]
+    choice[ring_loop[is_best]] = np.flatnonzero(is_best)
+    has = choice >= 0
+    scale = float(np.max(np.abs(v))) if n else 0.0
+    margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
+    doubt: np.ndarray = ball.copy()
+    k = choice[has]
+    offset = np.einsum("ij,ij->i", centre[has] - a[k], unit[k])
+    doubt[has] = np.minimum(ball[has], ball_slab_volume(radius[has], offset, best[has] + margin))
+    return doubt
+
+
+@frozen_value
+class CreaseFill:
+    """A hole across one crease of a faceted part, filled in the two planes that hold its rim.
+
+    Attributes
+    ----------
+    loop : int
+        The boundary loop.
+    apexes : (2, 3) float
+        The centroid of each planar part of the rim (with the two ends of the crease segment), m.
+    caps : (k, 3) int
+        The fill's triangles: each rim edge with the apex of its plane (index ``n_vertices + 0`` or ``+ 1`` of
+        the caller's numbering, shifted by the caller), and the two triangles over the crease segment.
+    doubt : float
+        Volume in doubt, m³: the ball over the rim cut to the slab of each plane, summed.
+    """
+
+    loop: int
+    apexes: np.ndarray
+    caps: np.ndarray
+    doubt: float
+
+
+#: Most distinct planes of the faces beside one rim tried in pairs by :func:`crease_fills`.
+CREASE_MAX_PLANES = 8
+#: Most loops :func:`crease_fills` examines (one at a time, ~0.1 ms each).
+CREASE_MAX_LOOPS = 5000
+
+
+def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                 centre: np.ndarray, radius: np.ndarray) -> list[CreaseFill]:
+    """Holes across one crease, each filled by two planar fans instead of one cone (the third assumption).
+
+    A hole that took triangles from two flat faces of a faceted part meeting at a crease (a box's edge, a
+    cylinder's cap rim) has a rim that no one plane holds, so one slab cannot cut its ball.  It qualifies here
+    when two planes of faces beside it (the ring) hold the rim this way: each holds three rim vertices not on
+    a line (a two-dimensional part of the rim, not an edge: the octahedron's faces hold only an edge each),
+    every rim edge lies in one of them and none in both, and walking the rim the plane changes exactly twice,
+    at two vertices ``a`` and ``b`` lying on both (on the crease).  **Assumption: the missing surface lies in
+    those two planes** (the hole is a piece of the two faces it crosses), as far from each as the rim part it
+    holds (``e₁``, ``e₂``, plus 16 ulp of the coordinates).  Each planar part of the rim, closed by the crease
+    segment ``a–b``, is filled by a fan to the centroid of its vertices; the two fans share ``a–b`` with
+    opposite windings, so the fill has exactly the rim as boundary.  A 2-chain in a plane is fixed by its
+    boundary, so where the assumption holds exactly the fill *is* the missing surface; in general the cycle
+    "fill − missing surface" lies in the ball over the rim (assumption 1; the fans lie in the rim's convex hull)
+    cut to the union of the two slabs, whose complement is connected (each piece of the ball between the slabs
+    reaches its sphere), so the winding number of the cycle vanishes outside it: the volume in doubt is at most
+    the sum of the ball's two slab volumes (:func:`ball_slab_volume`).  Loops of at least four edges are tried,
+    at most ``CREASE_MAX_LOOPS`` of them (beyond, every hole keeps its cone).
+
+    Returns
+    -------
+    list of CreaseFill
+        The loops that qualify (others keep their cone).
+    """
+    from itertools import combinations
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n = len(v)
+    scale = float(np.max(np.abs(v))) if n else 0.0
+    margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
+    on_tol = 4.0 * margin                        # a rim vertex "on" a plane: within round-off of it
+    candidates = np.flatnonzero(np.bincount(label, minlength=n_loops) >= 4).tolist()
+    if not candidates or len(candidates) > CREASE_MAX_LOOPS:
+        return []
+    nv = np.int64(max(n, 1))
+    rim_key = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * nv + np.maximum(edges[:, 0], edges[:, 1])
+    key, _ = edge_keys(f, n)
+    hit = np.isin(key, rim_key[np.isin(label, candidates)])
+    face_loop: dict[int, set[int]] = {}
+    rim_lookup = dict(zip(rim_key.tolist(), label.tolist()))
+    for slot in np.flatnonzero(hit).tolist():
+        face_loop.setdefault(rim_lookup[int(key[slot])], set()).add(slot // 3)
+    out = []
+    for k in candidates:
+        raw = edges[label == k]
+        succ = dict(zip(raw[:, 0].tolist(), raw[:, 1].tolist()))
+        if len(succ) != len(raw) or len(raw) < 4:
+            continue                              # a vertex met twice (a pinch), or too short to cross a crease
+        walk = [int(raw[0, 0])]                   # the rim in its own order (one cycle, else skipped)
+        while len(walk) <= len(raw) and succ.get(walk[-1], walk[0]) != walk[0]:
+            walk.append(succ[walk[-1]])
+        if len(walk) != len(raw):
+            continue
+        loop_edges = np.array([[x, succ[x]] for x in walk], dtype=np.int64)
+        ring = np.array(sorted(face_loop.get(k, ())), dtype=np.int64)
+        if not len(ring):
+            continue
+        a0 = v[f[ring, 0]]
+        normal = np.cross(v[f[ring, 1]] - a0, v[f[ring, 2]] - a0)
+        length = np.linalg.norm(normal, axis=1)
+        keep = length > 0
+        if not keep.any():
+            continue
+        unit, a0 = normal[keep] / length[keep, None], a0[keep]
+        offset = np.einsum("ij,ij->i", unit, a0)
+        rim = np.array(list(succ), dtype=np.int64)
+        dist = np.abs(v[rim] @ unit.T - offset[None, :])          # (rim vertex, ring face)
+        on = dist <= on_tol
+        # distinct planes: ring faces holding the same rim vertices within round-off of one plane
+        _, first = np.unique(on.T, axis=0, return_index=True)
+        planes = [int(p) for p in first if np.count_nonzero(on[:, p]) >= 3]
+        if len(planes) < 2 or len(planes) > CREASE_MAX_PLANES:
+            continue
+        index = {int(x): i for i, x in enumerate(rim.tolist())}
+        found = None
+        for p, q in combinations(planes, 2):
+            if abs(float(unit[p] @ unit[q])) > 1.0 - 1e-9:
+                continue                          # parallel planes meet in no crease
+            in_p, in_q = on[:, p], on[:, q]
+            if not (in_p | in_q).all():
+                continue
+            if any(np.linalg.matrix_rank(v[rim[m]][1:] - v[rim[m]][0], tol=on_tol) < 2 for m in (in_p, in_q)):
+                continue
+            side: list[int] = []
+            for start, end in loop_edges.tolist():
+                ep = in_p[index[start]] and in_p[index[end]]
+                eq = in_q[index[start]] and in_q[index[end]]
+                if ep == eq:
+                    side = []
+                    break                         # an edge in neither plane, or along the crease itself
+                side.append(0 if ep else 1)
+            if side and sum(side[i] != side[i - 1] for i in range(len(side))) == 2:
+                found = (p, q, side)
+                break
+        if found is None:
+            continue
+        p, q, side = found
+        order = loop_edges.tolist()
+        switch = [i for i in range(len(side)) if side[i] != side[i - 1]]
+        # the vertex where plane p's chain ends and q's begins (a), and where q's ends and p's begins (b)
+        a = next(order[i][0] for i in switch if side[i] == 1)
+        b = next(order[i][0] for i in switch if side[i] == 0)
+        parts = []
+        for which in (0, 1):
+            ids = sorted({x for (s0, s1), sd in zip(order, side) if sd == which for x in (s0, s1)})
+            parts.append(v[ids].mean(axis=0))
+        apexes = np.array(parts)
+        caps = [[e1, e0, n + sd] for (e0, e1), sd in zip(order, side)]
+        # p's chain runs b → … → a and closes along a → b; q's runs a → … → b and closes along b → a
+        caps += [[b, a, n + 0], [a, b, n + 1]]
+        doubt = 0.0
+        for which, plane in ((0, p), (1, q)):
+            chain = [index[x] for (s0, s1), sd in zip(order, side) if sd == which for x in (s0, s1)]
+            half = float(dist[chain, plane].max()) + margin
+            centre_offset = float(centre[k] @ unit[plane] - offset[plane])
+            doubt += float(ball_slab_volume(np.array([radius[k]]), np.array([centre_offset]),
+                                            np.array([half]))[0])
+        out.append(CreaseFill(loop=int(k), apexes=apexes, caps=np.array(caps, dtype=np.int64), doubt=doubt))
+    return out
+
+
+#: Most (ring face, rim vertex) pairs measured by :func:`hole_doubt_volumes` (a few seconds); beyond it every
+#: hole keeps its whole ball (a bound that needs no ring).
+RING_WORK_LIMIT = 200_000_000
+#: (ring face, rim vertex) pairs measured at once (bounds the memory: ~100 MB).
+RING_CHUNK = 2_000_000
+
+
+def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[..., Any], *,
+                     seal: Seal | None = None) -> Estimate:
+    """Close each boundary loop by a cone to its centroid and integrate; bound by the balls over the rims.
+
+    Assumption (stated in the module docstring): the missing surface of each boundary component lies in the
+    ball enclosing its rim (:func:`enclosing_balls`); the cone lies there too, so the patched solid and the
+    true one differ only inside those balls; with the second assumption (the missing surface strays from the
+    plane of a face beside the hole no farther than the rim does) only inside each ball's slab around that
+    plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  With ``seal``, the seams it
+    sealed add their own doubt (:mod:`~.seal`).  Limits: a hole whose missing piece joins two rims (a band
+    round a handle) or reaches far outside its rim's ball (a pocket swallowed whole) is not covered.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+        Consistently oriented where possible (see ``orient.py``); the sign of the total decides outward.
+    moments : callable
+        ``moments(vertices, faces) -> VolumeMoments`` (the exact integrator, ``volume.volume_moments``).
+    seal : Seal, optional
+        How ``faces`` were sealed from the input (their slack enters the bound).
+
+    Returns
+    -------
+    Estimate
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    edges = seal.boundary if seal is not None else boundary_edges(f, len(v))
+    label, n_loops = boundary_loops(edges, len(v), f, v) if len(edges) else (np.zeros(0, dtype=np.int64), 0)
+    # the distinct vertices of each loop, grouped: (loop, vertex) pairs sorted by loop
+    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0) if n_loops \
+        else np.zeros((0, 2), dtype=np.int64)
+    loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
+    size = np.bincount(loop_of, minlength=n_loops)
+    apex = np.zeros((n_loops, 3))
+    for i in range(3):
+        apex[:, i] = np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) / np.maximum(size, 1)
+    creases: list[CreaseFill] = []
+    if n_loops:
+        centre, radius = enclosing_balls(v[vertex_of], loop_of, n_loops)
+        hole_doubt = hole_doubt_volumes(v, f, edges, label, n_loops, centre, radius, vertex_of, loop_of)
+        creases = crease_fills(v, f, edges, label, n_loops, centre, radius)
+    else:
+        centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
+    cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
+    extra = np.zeros((0, 3))
+    if creases:               # holes across one crease: two planar fans instead of the cone (third assumption)
+        crossed = np.zeros(n_loops, dtype=bool)
+        fills = []
+        for j, fill in enumerate(creases):
+            crossed[fill.loop] = True
+            hole_doubt[fill.loop] = fill.doubt
+            shifted = fill.caps.copy()
+            shifted[shifted >= len(v)] += n_loops + 2 * j       # apexes after the cones' (kept for numbering)
+            fills.append(shifted)
+        cap = np.vstack([cap[~crossed[label]], *fills])
+        extra = np.vstack([fill.apexes for fill in creases])
+    doubt = float(np.sum(hole_doubt))
+    pv = np.vstack([v, apex, extra])
+    pf = np.vstack([f, cap])
+    closed = moments(pv, pf)
+    if closed.volume < 0:
+        pf = pf[:, ::-1]
+        closed = moments(pv, pf)
+    # the surface as given: the closed surface's area less the cones' (no second pass over every face)
+    ca, cb, cc = pv[cap[:, 0]], pv[cap[:, 1]], pv[cap[:, 2]]
+    area = float(closed.area) - float(0.5 * np.linalg.norm(np.cross(cb - ca, cc - ca), axis=1).sum())
+    far = float(np.max(np.linalg.norm(centre - closed.centroid, axis=1) + radius)) if n_loops else 0.0
+    sealed = ""
+    if seal is not None and (seal.welded or seal.split):
+        doubt += seal.doubt(v)
+        touched = seal.slack > 0
+        if touched.any():
+            corners = v[f[touched]]
+            reach = np.linalg.norm(corners - closed.centroid, axis=2).max(axis=1) + seal.slack[touched]
+            far = max(far, float(reach.max()))
+        moved = round_up(float(seal.slack.max(initial=0.0)))
+        sealed = (f"seams sealed ({seal.welded:,} crack vertices welded, {seal.split:,} T-junction vertices "
+                  f"put on their edges, every corner within {moved:.3g} m of where it was); ")
+    unc = uncertainty_from(closed.volume, closed.centroid, closed.second_moment, doubt, far)
+    if n_loops:
+        detail = (f"{sealed}{n_loops} boundary loop{'s' if n_loops != 1 else ''} ({len(edges):,} edges) "
+                  "closed by cones to their centroids; bounded by the balls enclosing their rims, each cut to the "
+                  "slab around the plane of the face beside it that the rim strays least from "
+                  f"(largest radius {float(radius.max()):.3g} m)")
+        if creases:
+            detail += (f"; {len(creases)} of them across a crease, filled instead in the two planes that hold "
+                       "the rim and bounded by the ball cut to both planes' slabs")
+    else:
+        detail = f"{sealed}no hole left" if sealed else "no hole"
+    return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,
+                    uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far)

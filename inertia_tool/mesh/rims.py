@@ -1,0 +1,217 @@
+"""The rims of an open surface: its net boundary, the loops it forms, and a ball around each.
+
+Shared by hole patching (:mod:`~.holes`), the winding estimate's caps (:mod:`~.grid_estimate`) and the seam
+sealing (:mod:`~.seal`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .edges import edge_keys
+
+__all__ = ["boundary_edges", "boundary_loops", "enclosing_balls"]
+
+
+def boundary_edges(faces: np.ndarray, n_vertices: int) -> np.ndarray:
+    """Net boundary of the surface as directed edges ``a→b`` with multiplicity, (k, 2) int.
+
+    Each undirected edge contributes ``|#(a→b) − #(b→a)|`` copies in its net direction: the boundary 1-chain,
+    which is balanced at every vertex (a union of closed loops).
+    """
+    n = np.int64(max(int(n_vertices), 1))
+    key, forward = edge_keys(faces, n_vertices)
+    sign = np.where(forward, -1, 1)
+    unique, inverse = np.unique(key, return_inverse=True)
+    net = np.bincount(inverse.reshape(-1), weights=sign, minlength=len(unique)).astype(np.int64)
+    pick = net != 0
+    lo, hi, k = unique[pick] // n, unique[pick] % n, net[pick]
+    start = np.where(k > 0, lo, hi)
+    end = np.where(k > 0, hi, lo)
+    reps = np.abs(k)
+    return np.stack([np.repeat(start, reps), np.repeat(end, reps)], axis=1)
+
+
+def boundary_loops(edges: np.ndarray, n_vertices: int, faces: np.ndarray | None = None,
+           vertices: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+    """Loop of each boundary edge: the cycles of the boundary, separated at pinch vertices where ``faces`` tell
+    how (else the components of edges connected through shared vertices).
+
+    At a vertex where two holes meet (in-degree 2 or more), the fans of faces around it tell which in-edge
+    continues into which out-edge: a fan starts with an out-edge and ends with an in-edge, each next to a
+    different hole, so a hole's rim runs from the in-edge of one fan into the out-edge of the next fan around
+    the vertex (with two fans, the other one; with more, the next by the angle of their out-edges about the
+    vertex normal).  Each cycle then gets its own cone, and two cones never share an edge
+    (a shared apex edge would be non-manifold, and send the patched surface to the boolean union).
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    k = len(edges)
+    if k == 0:
+        return np.zeros(0, dtype=np.int64), 0
+    n = max(int(n_vertices), 1)
+    in_deg = np.bincount(edges[:, 1], minlength=n)
+    pinch = in_deg > 1
+    nxt = _successors(edges, n)
+    if faces is not None and vertices is not None and pinch.any():
+        paired = _pinch_successors(edges, faces, n, pinch, vertices)
+        if paired is not None:
+            nxt = np.where(paired >= 0, paired, nxt)
+    if (nxt < 0).any():       # no consistent pairing: components through shared vertices
+        graph = coo_matrix((np.ones(k, dtype=np.int8), (edges[:, 0], edges[:, 1])), shape=(n, n))
+        _, vertex_label = connected_components(graph, directed=False)
+        _, label = np.unique(vertex_label[edges[:, 0]], return_inverse=True)
+        return label.reshape(-1), int(label.max()) + 1
+    graph = coo_matrix((np.ones(k, dtype=np.int8), (np.arange(k), nxt)), shape=(k, k))
+    count, label = connected_components(graph, directed=False)
+    return label.astype(np.int64), int(count)
+
+
+def _successors(edges: np.ndarray, n: int) -> np.ndarray:
+    """For each edge a→b, an edge leaving b (the only one where b is not a pinch); -1 where none."""
+    order = np.argsort(edges[:, 0], kind="stable")
+    first = np.searchsorted(edges[order, 0], edges[:, 1])
+    ok = (first < len(edges)) & (edges[order[np.minimum(first, len(edges) - 1)], 0] == edges[:, 1])
+    return np.where(ok, order[np.minimum(first, len(edges) - 1)], -1)
+
+
+def _pinch_successors(edges: np.ndarray, faces: np.ndarray, n: int, pinch: np.ndarray,
+                      vertices: np.ndarray) -> np.ndarray | None:
+    """Successor of each in-edge at a pinch vertex (-1 for the others), from the fans around the vertex; None
+    when the fans do not give one in- and one out-edge each (then the caller keeps whole components)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    f = np.asarray(faces, dtype=np.int64)
+    corner_hit = pinch[f]
+    fi, ci = np.nonzero(corner_hit)                      # (face, corner) at a pinch vertex
+    p = f[fi, ci]
+    nxt_v, prv_v = f[fi, (ci + 1) % 3], f[fi, (ci + 2) % 3]   # face = (p, nxt, prv): edges p→nxt, prv→p
+    # fans: (p, face) nodes joined through the spokes (p, z) they share
+    node = np.arange(len(fi))
+    spoke = np.concatenate([p * n + nxt_v, p * n + prv_v])
+    owner = np.concatenate([node, node])
+    order = np.argsort(spoke, kind="stable")
+    same = spoke[order][1:] == spoke[order][:-1]
+    a, b = owner[order][:-1][same], owner[order][1:][same]
+    graph = coo_matrix((np.ones(len(a), dtype=np.int8), (a, b)), shape=(len(fi), len(fi)))
+    _, fan = connected_components(graph, directed=False)
+    # the fan of each boundary edge at a pinch: out-edge p→y lies in the face (p, y, ·); in-edge x→p in (p, ·, x)
+    out_key = p * n + nxt_v
+    in_key = p * n + prv_v
+    e_out = np.flatnonzero(pinch[edges[:, 0]])
+    e_in = np.flatnonzero(pinch[edges[:, 1]])
+    fan_out = _lookup(out_key, fan, edges[e_out, 0] * n + edges[e_out, 1])
+    fan_in = _lookup(in_key, fan, edges[e_in, 1] * n + edges[e_in, 0])
+    if fan_out is None or fan_in is None:
+        return None
+    # fans in turn around the vertex (angle of their out-edge about the vertex normal, the faces' winding
+    # sense): a fan runs from its out-edge to its in-edge, then comes a hole, then the next fan's out-edge
+    normal = np.zeros((n, 3))
+    area = np.cross(vertices[nxt_v] - vertices[p], vertices[prv_v] - vertices[p])
+    np.add.at(normal, p, area)
+    nrm = normal[edges[e_out, 0]]
+    trial = np.where(np.abs(nrm[:, :1]) < 0.9 * np.linalg.norm(nrm, axis=1, keepdims=True), [[1.0, 0, 0]],
+                     [[0, 1.0, 0]])
+    u = np.cross(nrm, trial)
+    w = np.cross(nrm, u)
+    d = vertices[edges[e_out, 1]] - vertices[edges[e_out, 0]]
+    angle_by_fan = np.zeros(len(fi))
+    angle_by_fan[fan_out] = np.arctan2(np.einsum("ij,ij->i", d, w), np.einsum("ij,ij->i", d, u))
+    oi = np.lexsort((angle_by_fan[fan_in], edges[e_in, 1]))
+    oo = np.lexsort((angle_by_fan[fan_out], edges[e_out, 0]))
+    vin, vout = edges[e_in[oi], 1], edges[e_out[oo], 0]
+    if len(vin) != len(vout) or (vin != vout).any() or (fan_in[oi] != fan_out[oo]).any():
+        return None           # not one in- and one out-edge per fan
+    start = np.r_[0, np.flatnonzero(vin[1:] != vin[:-1]) + 1]
+    size = np.diff(np.r_[start, len(vin)])
+    rank = np.arange(len(vin)) - np.repeat(start, size)
+    target = np.repeat(start, size) + (rank + 1) % np.repeat(size, size)
+    succ = np.full(len(edges), -1, dtype=np.int64)
+    succ[e_in[oi]] = e_out[oo][target]
+    return succ
+
+
+def _lookup(keys: np.ndarray, values: np.ndarray, query: np.ndarray) -> np.ndarray | None:
+    """values[i] for the unique i with keys[i] == query (each query once); None if one is missing or repeated."""
+    order = np.argsort(keys, kind="stable")
+    sk = keys[order]
+    pos = np.searchsorted(sk, query)
+    if len(query) and (pos.max(initial=0) >= len(sk)):
+        return None
+    if not (sk[pos] == query).all():
+        return None
+    dup = np.searchsorted(sk, query, side="right") - pos
+    if (dup != 1).any():
+        return None
+    found: np.ndarray = values[order[pos]]
+    return found
+
+
+def enclosing_balls(points: np.ndarray, group: np.ndarray, n_groups: int, *, iterations: int = 400
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """A ball enclosing each group of points: centres (g, 3) m and radii (g,) m.
+
+    The centre is found by Bădoiu and Clarkson's iteration (step towards the farthest point by ``1/(k+1)``),
+    started at the centre of the group's bounding box and run for ``iterations`` steps on all groups at
+    once; the radius is then the exact largest distance from that centre, so every ball encloses its group
+    whatever the iteration reached (it converges to the smallest enclosing ball: after ``k`` steps the radius
+    is within a factor ``1 + O(1/√k)`` of the smallest).
+    """
+    p = np.asarray(points, dtype=np.float64)
+    g = np.asarray(group, dtype=np.int64)
+    order = np.argsort(g, kind="stable")
+    p, g = p[order], g[order]
+    starts = np.searchsorted(g, np.arange(n_groups))
+    size = np.diff(np.r_[starts, len(p)])
+    lo = np.minimum.reduceat(p, starts, axis=0)
+    hi = np.maximum.reduceat(p, starts, axis=0)
+    centre = 0.5 * (lo + hi)
+    small = size <= 3
+    if small.any():           # one, two or three points: the smallest ball in closed form
+        centre[small] = _small_ball_centres(p, starts[small], size[small])
+    big = np.flatnonzero(~small)
+    if len(big):              # Bădoiu–Clarkson on the larger groups only
+        pick = np.repeat(starts[big], size[big]) + (np.arange(int(size[big].sum()))
+                                                    - np.repeat(np.cumsum(size[big]) - size[big], size[big]))
+        q, local = p[pick], np.repeat(np.arange(len(big)), size[big])
+        local_starts = np.r_[0, np.cumsum(size[big])[:-1]]
+        c = centre[big]
+        index = np.arange(len(q))
+        for k in range(1, iterations + 1):
+            d = np.einsum("ij,ij->i", q - c[local], q - c[local])
+            top = np.maximum.reduceat(d, local_starts)
+            far = np.minimum.reduceat(np.where(d >= top[local], index, len(q)), local_starts)
+            c = c + (q[far] - c) / (k + 1)
+        centre[big] = c
+    radius = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", p - centre[g], p - centre[g]), starts))
+    return centre, radius
+
+
+def _small_ball_centres(p: np.ndarray, starts: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Centres of the smallest balls around groups of 1–3 consecutive points of ``p`` (the radius is taken
+    afterwards as the largest distance, so round-off here cannot make a ball miss a point)."""
+    a = p[starts]
+    b = p[starts + np.minimum(size - 1, 1)]
+    c = p[starts + np.minimum(size - 1, 2)]
+    centre: np.ndarray = 0.5 * (a + b)             # one or two points: the midpoint
+    tri = size == 3
+    if tri.any():
+        a3, b3, c3 = a[tri], b[tri], c[tri]
+        sides = np.stack([np.linalg.norm(b3 - c3, axis=1), np.linalg.norm(c3 - a3, axis=1),
+                          np.linalg.norm(a3 - b3, axis=1)], axis=1)
+        longest = np.argmax(sides, axis=1)
+        ends = np.stack([0.5 * (b3 + c3), 0.5 * (c3 + a3), 0.5 * (a3 + b3)], axis=1)
+        mid = ends[np.arange(len(a3)), longest]
+        # circumcentre (a + (|u|²(v × w)... ) with u = b − a, v = c − a, w = u × v)
+        u, v = b3 - a3, c3 - a3
+        w = np.cross(u, v)
+        ww = np.einsum("ij,ij->i", w, w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            circ = a3 + (np.einsum("ij,ij->i", u, u)[:, None] * np.cross(v, w)
+                         + np.einsum("ij,ij->i", v, v)[:, None] * np.cross(w, u)) / (2 * ww[:, None])
+        la, lb, lc = sides[:, 0] ** 2, sides[:, 1] ** 2, sides[:, 2] ** 2
+        obtuse = (la >= lb + lc) | (lb >= la + lc) | (lc >= la + lb) | ~(ww > 0)
+        centre[tri] = np.where(obtuse[:, None], mid, circ)
+    return centre
