@@ -53,7 +53,7 @@ class BrepComparison:
     chord : float
         Chord tolerance of the tessellation, m.
     angular_deflection : float
-        rad.
+        rad, of the tessellation compared (finer than asked when the mesher left the first one open).
     faces : int
         Triangles of the tessellation.
     volume_error : float
@@ -73,6 +73,8 @@ class BrepComparison:
         (``exact`` is the sum, shared volume counted twice).
     overlap_volume : float
         m³ the solids shared (their summed volume minus the union's); 0 for one solid.
+    first_open_edges : int
+        Open edges the mesher left at the angular deflection asked (then tessellated again finer); 0 if none.
     """
 
     exact: MassProperties
@@ -87,6 +89,7 @@ class BrepComparison:
     solids: int = 1
     fusion: str = "one solid"
     overlap_volume: float = 0.0
+    first_open_edges: int = 0
 
     def scaled(self, like: MassProperties, *, target_mass: float | None = None) -> MassProperties:
         """The exact B-rep properties at the density of ``like`` (the tessellation's result), or scaled to
@@ -125,9 +128,10 @@ def compare(path: str | os.PathLike[str], *, chord: float | None = None,
     tol = reading.chord
     overlap = max(0.0, reading.summed_volume - exact.volume) if reading.fusion == "fused" else 0.0
     return BrepComparison(
-        exact=exact, mesh=mesh, chord=tol, angular_deflection=float(angular_deflection), faces=len(reading.faces),
+        exact=exact, mesh=mesh, chord=tol, angular_deflection=reading.angular_deflection, faces=len(reading.faces),
         volume_error=abs(mesh.volume - exact.volume) / exact.volume,
         volume_bound=exact.surface_area * tol / exact.volume,
         com_error=float(np.linalg.norm(mesh.center_of_mass - exact.center_of_mass)),
         inertia_error=float(np.linalg.norm(mesh.inertia - exact.inertia) / np.linalg.norm(exact.inertia)),
-        solids=max(reading.solids, 1), fusion=reading.fusion, overlap_volume=overlap)
+        solids=max(reading.solids, 1), fusion=reading.fusion, overlap_volume=overlap,
+        first_open_edges=reading.first_open_edges)

@@ -44,8 +44,8 @@ if TYPE_CHECKING:
     from ..isolate import Limits
 
 __all__ = ["BREP_SUFFIXES", "DEFAULT_CHORD_RTOL", "DEFAULT_ANGULAR_DEFLECTION", "read_brep", "tessellate",
-           "chord_tolerance", "tessellated_arrays", "has_ocp", "read_cad", "CadReading", "solids_fused",
-           "brep_integrals", "FUSIONS", "step_parts", "MAX_ASSEMBLY_DEPTH", "MAX_ASSEMBLY_PARTS"]
+           "chord_tolerance", "tessellate_closed", "tessellated_arrays", "has_ocp", "read_cad", "CadReading",
+           "solids_fused", "brep_integrals", "FUSIONS", "step_parts", "MAX_ASSEMBLY_DEPTH", "MAX_ASSEMBLY_PARTS"]
 
 #: How :func:`solids_fused` made one solid of a file's solids.
 FUSIONS = ("one solid", "apart", "fused", "failed")
@@ -274,8 +274,11 @@ def tessellate(shape: Any, *, chord: float, angular_deflection: float = DEFAULT_
     ``max_faces``: refuse (:class:`UsageError`) a tessellation of more triangles before copying them out.
 
     Each B-rep face is meshed on its own; reversed faces have their triangles flipped so the normals point
-    out of the solid, and each face's location is applied.  Vertices on shared edges coincide (the mesher
-    shares edge discretisations); they are joined here (bit-exact), so the surface is closed.
+    out of the solid, and each face's location is applied.  The faces' nodes on one B-rep edge are the same
+    points of one edge discretisation (the mesher shares it), but each face carries its own copy, moved by its
+    own location, so copies can differ in the last bits: they are joined here by topology
+    (:func:`_seam_nodes`: the same B-rep vertex, or the same node of the same B-rep edge), not by a distance,
+    so the surface arrives closed and no tolerance weld is reported for a clean B-rep.
     """
     from OCP.BRep import BRep_Tool
     from OCP.BRepMesh import BRepMesh_IncrementalMesh
@@ -293,7 +296,11 @@ def tessellate(shape: Any, *, chord: float, angular_deflection: float = DEFAULT_
         if total > max_faces:
             raise UsageError(f"the tessellation at a chord tolerance of {chord:.3g} m has {total:,} triangles, "
                              f"more than `max_faces` ({max_faces:,}) allows")
-    vertices, faces, offset = [], [], 0
+    vertices: list[np.ndarray] = []
+    faces: list[np.ndarray] = []
+    seams: list[tuple[int, tuple[Any, ...]]] = []
+    offset = 0
+    seam_keys = _SeamKeys(shape)
     explorer = TopExp_Explorer(shape, TopAbs_FACE)
     while explorer.More():
         face = TopoDS.Face(explorer.Current())
@@ -309,15 +316,143 @@ def tessellate(shape: Any, *, chord: float, angular_deflection: float = DEFAULT_
                         dtype=np.int64) - 1
         if face.Orientation() == TopAbs_REVERSED:
             tris = tris[:, ::-1]
+        seams.extend((offset + node, key) for node, key in seam_keys.of_face(face, triangulation, location, nodes))
         vertices.append(nodes)
         faces.append(tris + offset)
         offset += len(nodes)
     if not faces:
         raise UsageError("the shape has no faces to tessellate")
-    # each B-rep face carries its own copy of the nodes on its edges, bit-identical to its neighbours': join
-    # them here, so the surface arrives closed and no tolerance merge is reported for a clean B-rep
-    welded_vertices, welded_faces = weld_exact(np.vstack(vertices)[np.vstack(faces)])
+    points, triangles = np.vstack(vertices), np.vstack(faces)
+    joined = _seam_nodes(points, seams, _bounding_diagonal(shape))
+    if joined is not None:
+        points, triangles = _renumber(points, triangles, joined)
+    # the exact weld still joins what topology did not name (bit-identical copies), as before
+    welded_vertices, welded_faces = weld_exact(points[triangles])
     return welded_vertices, welded_faces.astype(np.int64, copy=False)
+
+
+#: Largest distance between two copies of one seam node (a B-rep vertex, or the k-th node of a B-rep edge's
+#: discretisation) that :func:`_seam_nodes` joins, as a fraction of the bounding-box diagonal: copies differ
+#: only by each face's location applied in floating point (~1e-16 of the coordinates); anything farther means
+#: the copies are not what the topology says, and nothing is joined.
+SEAM_JOIN_RTOL = 1e-9
+
+
+class _SeamKeys:
+    """Names of the nodes of a face's triangulation that lie on its B-rep edges: ``("v", i)`` for the B-rep
+    vertex ``i`` at an edge's end, ``("e", j, k)`` for the ``k``-th inner node of B-rep edge ``j`` counted from
+    its first vertex.  Edges and vertices are numbered by ``TopExp.MapShapes`` (the same shape at the same
+    location is one entry, whatever its orientation)."""
+
+    def __init__(self, shape: Any) -> None:
+        from OCP.TopAbs import TopAbs_EDGE, TopAbs_VERTEX
+        from OCP.TopExp import TopExp
+        from OCP.collections import IndexedMap_TopoDS_Shape_TopTools_ShapeMapHasher as ShapeMap
+        self.edges, self.vertices = ShapeMap(), ShapeMap()
+        TopExp.MapShapes_s(shape, TopAbs_EDGE, self.edges)
+        TopExp.MapShapes_s(shape, TopAbs_VERTEX, self.vertices)
+
+    def of_face(self, face: Any, triangulation: Any, location: Any,
+                nodes: np.ndarray) -> list[tuple[int, tuple[Any, ...]]]:
+        """``(node index in this face's triangulation, seam name)`` for every node on the face's edges."""
+        from OCP.BRep import BRep_Tool
+        from OCP.TopAbs import TopAbs_EDGE
+        from OCP.TopExp import TopExp, TopExp_Explorer
+        from OCP.TopoDS import TopoDS
+        out: list[tuple[int, tuple[Any, ...]]] = []
+        explorer = TopExp_Explorer(face, TopAbs_EDGE)
+        while explorer.More():
+            edge = TopoDS.Edge(explorer.Current())
+            explorer.Next()
+            polygon = BRep_Tool.PolygonOnTriangulation_s(edge, triangulation, location)
+            if polygon is None or polygon.NbNodes() < 2:
+                continue
+            index = np.array([polygon.Node(i) for i in range(1, polygon.NbNodes() + 1)], dtype=np.int64) - 1
+            if index.min() < 0 or index.max() >= len(nodes):
+                continue
+            first, last = TopExp.FirstVertex_s(edge), TopExp.LastVertex_s(edge)
+            a = np.array(BRep_Tool.Pnt_s(first).Coord())
+            b = np.array(BRep_Tool.Pnt_s(last).Coord())
+            ends = nodes[index[[0, -1]]]
+            forward = np.linalg.norm(ends[0] - a) + np.linalg.norm(ends[1] - b)
+            backward = np.linalg.norm(ends[0] - b) + np.linalg.norm(ends[1] - a)
+            if backward < forward:              # the polygon runs from the edge's last vertex to its first
+                index = index[::-1]
+            j = self.edges.FindIndex(edge)
+            out.append((int(index[0]), ("v", self.vertices.FindIndex(first))))
+            out.append((int(index[-1]), ("v", self.vertices.FindIndex(last))))
+            out.extend((int(node), ("e", j, k)) for k, node in enumerate(index[1:-1].tolist(), start=1))
+        return out
+
+
+def _seam_nodes(points: np.ndarray, seams: list[tuple[int, tuple[Any, ...]]],
+                diagonal: float) -> np.ndarray | None:
+    """The node each node is joined to (``(n,)`` int, itself when not on a seam), or ``None`` when some copies
+    of one seam node lie farther apart than ``SEAM_JOIN_RTOL`` × ``diagonal`` (then nothing is joined)."""
+    target = np.arange(len(points))
+    if not seams:
+        return None
+    first: dict[tuple[Any, ...], int] = {}
+    for node, key in seams:
+        target[node] = first.setdefault(key, node)
+    gap = np.linalg.norm(points - points[target], axis=1).max(initial=0.0)
+    if not gap <= SEAM_JOIN_RTOL * diagonal:
+        return None
+    return target
+
+
+def _renumber(points: np.ndarray, triangles: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points and triangles with every node replaced by the node it is joined to, unused nodes dropped."""
+    keep = np.unique(target)
+    new_index = np.full(len(points), -1, dtype=np.int64)
+    new_index[keep] = np.arange(len(keep))
+    return points[keep], new_index[target][triangles]
+
+
+#: Further tessellations tried when the mesher leaves a closed B-rep's triangles open (each at
+#: :data:`RETRY_DEFLECTION_FACTOR` times the previous angular deflection).
+TESSELLATION_RETRIES = 2
+RETRY_DEFLECTION_FACTOR = 0.7
+
+
+def _open_edges(faces: np.ndarray) -> int:
+    """Undirected edges of ``faces`` not used by exactly two triangles."""
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    return int(np.count_nonzero(np.unique(edges, axis=0, return_counts=True)[1] != 2))
+
+
+def _has_solid(shape: Any) -> bool:
+    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+    return bool(TopExp_Explorer(shape, TopAbs_SOLID).More())
+
+
+def tessellate_closed(shape: Any, *, chord: float, angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION,
+                      max_faces: int | None = None) -> tuple[np.ndarray, np.ndarray, float, int]:
+    """:func:`tessellate`, again at a finer angular deflection when the mesher left a solid's surface open.
+
+    ``BRepMesh`` sometimes leaves a T-junction where two faces meet (a triangle of one face spans two segments
+    of the shared edge: trimesh's ``featuretype``-like parts and fused solids show it), so a closed B-rep
+    arrives as an open mesh and the mesh analysis refuses it.  When the shape has a solid and the triangles
+    have open edges, the triangulation is cleared and the shape tessellated again at
+    :data:`RETRY_DEFLECTION_FACTOR` × the angular deflection, at most :data:`TESSELLATION_RETRIES` times; the
+    chord tolerance (which bounds the volume error) is unchanged.  Returns ``(vertices, faces, angular
+    deflection used, open edges of the first tessellation)``; the last attempt is returned as it is if none
+    is closed (the mesh analysis then says what is open).
+    """
+    vertices, faces = tessellate(shape, chord=chord, angular_deflection=angular_deflection, max_faces=max_faces)
+    first = _open_edges(faces)
+    if not first or not _has_solid(shape):
+        return vertices, faces, angular_deflection, first
+    from OCP.BRepTools import BRepTools
+    used = angular_deflection
+    for _ in range(TESSELLATION_RETRIES):
+        used *= RETRY_DEFLECTION_FACTOR
+        BRepTools.Clean_s(shape)
+        vertices, faces = tessellate(shape, chord=chord, angular_deflection=used, max_faces=max_faces)
+        if not _open_edges(faces):
+            break
+    return vertices, faces, used, first
 
 
 def _cascadio_arrays(path: str, chord: float, angular_deflection: float) -> tuple[np.ndarray, np.ndarray]:
@@ -471,6 +606,11 @@ class CadReading:
         A STEP assembly of several parts, some with a material (:func:`step_parts`): each part tessellated on its
         own, its face range of ``faces``; the solids are then not fused and ``integrals`` is None (each part has
         its own material).
+    angular_deflection : float
+        Angular deflection of the tessellation returned, rad (finer than asked when the first was open:
+        :func:`tessellate_closed`; the finest of an assembly's parts).
+    first_open_edges : int
+        Open edges the mesher left in the first tessellation (0: closed at the angular deflection asked).
     """
 
     vertices: np.ndarray
@@ -482,6 +622,8 @@ class CadReading:
     summed_volume: float = 0.0
     fusion: str = "one solid"
     parts: tuple[tuple[str, str | None, float | None, int, int], ...] = ()
+    angular_deflection: float = DEFAULT_ANGULAR_DEFLECTION
+    first_open_edges: int = 0
 
 
 def _read_here(path: str, chord: float | None, angular_deflection: float, use_ocp: bool,
@@ -500,8 +642,10 @@ def _read_here(path: str, chord: float | None, angular_deflection: float, use_oc
             tol = chord_tolerance(shape, chord)
         except InvalidMeshError as exc:     # a shape without a bounding box: name the file
             raise _fail(path, str(exc)) from None
-        vertices, faces = tessellate(shape, chord=tol, angular_deflection=angular_deflection, max_faces=max_faces)
-        return {"vertices": vertices, "faces": faces, "chord": tol, "backend": "OCP",
+        vertices, faces, used, first_open = tessellate_closed(shape, chord=tol, angular_deflection=angular_deflection,
+                                                              max_faces=max_faces)
+        return {"vertices": vertices, "faces": faces, "chord": tol, "backend": "OCP", "angular_deflection": used,
+                "first_open_edges": first_open,
                 "integrals": brep_integrals(shape), "solids": solids, "summed_volume": summed, "fusion": fusion}
     if chord is None:
         v, _ = _cascadio_arrays(path, 1e-3, 0.5)
@@ -523,11 +667,12 @@ def _assembly_here(path: str, found: list[tuple[str, str | None, float | None, A
         tol = chord_tolerance(compound, chord)
     except InvalidMeshError as exc:
         raise _fail(path, str(exc)) from None
-    vertices, faces, parts, offset, start = [], [], [], 0, 0
+    vertices, faces, parts, offset, start, finest, first_open = [], [], [], 0, 0, angular_deflection, 0
     for name, material, density, shape in found:
         try:
-            v, f = tessellate(shape, chord=tol, angular_deflection=angular_deflection,
-                              max_faces=None if max_faces is None else max_faces - start)
+            v, f, used, opened = tessellate_closed(shape, chord=tol, angular_deflection=angular_deflection,
+                                                   max_faces=None if max_faces is None else max_faces - start)
+            finest, first_open = min(finest, used), first_open + opened
         except UsageError as exc:
             raise _fail(path, f"part {name!r}: {exc}") from None
         vertices.append(v)
@@ -536,7 +681,8 @@ def _assembly_here(path: str, found: list[tuple[str, str | None, float | None, A
         offset += len(v)
         start += len(f)
     return {"vertices": np.vstack(vertices), "faces": np.vstack(faces), "chord": tol, "backend": "OCP",
-            "integrals": None, "solids": len(found), "summed_volume": 0.0, "fusion": "apart", "parts": parts}
+            "angular_deflection": finest, "first_open_edges": first_open, "integrals": None, "solids": len(found),
+            "summed_volume": 0.0, "fusion": "apart", "parts": parts}
 
 
 #: The last reading, keyed by the file's identity and the tolerances: ``analyze`` reads a STEP file as a mesh
@@ -584,6 +730,8 @@ def read_cad(path: str | os.PathLike[str], *, chord: float | None = None,
                          backend=str(out["backend"]), integrals=out.get("integrals"),
                          solids=int(out.get("solids", 0)), summed_volume=float(out.get("summed_volume", 0.0)),
                          fusion=str(out.get("fusion", "one solid")),
+                         angular_deflection=float(out.get("angular_deflection", angular_deflection)),
+                         first_open_edges=int(out.get("first_open_edges", 0)),
                          parts=tuple((str(n), None if m is None else str(m), None if d is None else float(d), int(a),
                                       int(b)) for n, m, d, a, b in out.get("parts", ())))
     _LAST[:] = [(key, reading)]

@@ -26,6 +26,7 @@ def brep_comparison_dict(cmp: BrepComparison, density: float) -> dict:
         "solids": cmp.solids,
         "fusion": cmp.fusion,
         "overlap_volume": cmp.overlap_volume,
+        "mesher_open_edges": cmp.first_open_edges,
         "exact": {"volume": cmp.exact.volume, "mass": cmp.exact.volume * density,
                   "center_of_mass": cmp.exact.center_of_mass, "inertia": cmp.exact.inertia * density},
         "tessellation": {"volume": m.volume, "mass": m.volume * density, "center_of_mass": m.center_of_mass,
@@ -55,6 +56,9 @@ def format_brep_comparison(cmp: BrepComparison, density: float) -> str:
         f"{cmp.angular_deflection:g} rad): mass {cmp.mesh.volume * density:.9g} kg, volume off by "
         f"{cmp.volume_error:.2e} (at most {round_up(cmp.volume_bound):.2e} = area × chord / volume), centre of mass by "
         f"{cmp.com_error:.2e} m, inertia by {cmp.inertia_error:.2e} (relative, Frobenius)")
+    if cmp.first_open_edges:
+        lines.append(f"    the mesher left {cmp.first_open_edges:,} open edges at the angular deflection asked (a "
+                     f"T-junction between B-rep faces); tessellated again at {cmp.angular_deflection:.3g} rad")
     return "\n".join(lines)
 
 
