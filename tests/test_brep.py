@@ -6,6 +6,8 @@ import os
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import inertia_tool as it
 from inertia_tool.mass import brep, shapes
@@ -456,3 +458,62 @@ def test_a_tessellation_the_mesher_left_open_is_made_again_finer(tmp_path, capsy
     assert brep_out["volume_error"] <= brep_out["volume_error_bound"]
     assert main(["analyze", str(path)]) == 0
     assert "tessellated again at" in capsys.readouterr().out
+
+
+@given(seed=st.integers(0, 2**32 - 1), inserted=st.integers(1, 4))
+@settings(max_examples=40, deadline=None)
+def test_a_triangle_edge_skipping_nodes_of_a_brep_edge_is_split_there(seed, inserted):
+    """The mesher's T-junction, made on purpose: on a closed icosphere one edge a–b gets `inserted` nodes on the
+    neighbouring face's side only (that face is fanned over them), so the other face's edge a–b skips them.
+    `_split_skipped`, given the chain a, nodes..., b, closes the surface, and the volume is that of the same
+    mesh with both sides fanned (exact polyhedron integral, not a tolerance of the fix)."""
+    import trimesh
+
+    from inertia_tool.integrals import volume_moments
+    sphere = trimesh.creation.icosphere(1)
+    v, f = np.array(sphere.vertices), np.array(sphere.faces, dtype=np.int64)
+    rng = np.random.default_rng(seed)
+    t = int(rng.integers(len(f)))
+    corner = int(rng.integers(3))
+    a, b, x = int(f[t, corner]), int(f[t, (corner + 1) % 3]), int(f[t, (corner + 2) % 3])
+    other = next(i for i in range(len(f)) if i != t and {a, b} <= set(f[i].tolist()))
+    y = next(int(c) for c in f[other] if c not in (a, b))
+    along = np.sort(rng.uniform(0.1, 0.9, inserted))
+    new = v[a] + along[:, None] * (v[b] - v[a]) + rng.normal(scale=1e-3, size=(inserted, 3))
+    ids = list(range(len(v), len(v) + inserted))
+    v = np.vstack([v, new])
+    path_ba = [b, *ids[::-1], a]                             # the other face runs b → a
+    fan_other = [[path_ba[i], path_ba[i + 1], y] for i in range(len(path_ba) - 1)]
+    skipping = np.vstack([np.delete(f, other, axis=0), fan_other])
+    assert np.any(_edge_uses(skipping) != 2)                  # the skipped nodes leave it open
+    fixed = cad._split_skipped(skipping, [[a, *ids, b]])
+    assert np.all(_edge_uses(fixed) == 2)
+    path_ab = [a, *ids, b]
+    both = np.vstack([np.delete(f, [t, other], axis=0), fan_other,
+                      [[path_ab[i], path_ab[i + 1], x] for i in range(len(path_ab) - 1)]])
+    assert volume_moments(v, fixed).volume == pytest.approx(volume_moments(v, both).volume, rel=1e-14)
+
+
+@pytest.mark.parametrize("seed", range(200, 206))
+def test_fused_primitives_in_random_placements_tessellate_closed_within_the_bound(seed):
+    """Two of box, cylinder and sphere, each placed by a random rotation and shift, fused: the tessellation is
+    closed (collapsed pole triangles dropped, seams joined by topology, skipped edge nodes split) and its
+    volume is within area × chord / volume of the exact B-rep's. Before: 22 of 40 such fusions came out open."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakeSphere
+
+    from inertia_tool.integrals import volume_moments
+    rng = np.random.default_rng(seed)
+    makers = [lambda: BRepPrimAPI_MakeBox(*rng.uniform(0.2, 1.0, 3)).Shape(),
+              lambda: BRepPrimAPI_MakeCylinder(*rng.uniform(0.1, 0.8, 2)).Shape(),
+              lambda: BRepPrimAPI_MakeSphere(rng.uniform(0.1, 0.6)).Shape()]
+    one = _moved(makers[rng.integers(3)](), rng.uniform(0, 3), rng.normal(size=3), rng.normal(size=3) * 0.2)
+    two = _moved(makers[rng.integers(3)](), rng.uniform(0, 3), rng.normal(size=3), rng.normal(size=3) * 0.2)
+    fuse = BRepAlgoAPI_Fuse(one, two)
+    fuse.Build()
+    shape, *_ = cad.solids_fused(fuse.Shape())
+    chord = cad.chord_tolerance(shape)
+    vertices, faces, _, _ = cad.tessellate_closed(shape, chord=chord)
+    assert np.all(_edge_uses(faces) == 2)
+    volume, _, _, area = cad.brep_integrals(shape)
+    assert abs(volume_moments(vertices, faces).volume - volume) <= area * chord

@@ -325,10 +325,17 @@ def tessellate(shape: Any, *, chord: float, angular_deflection: float = DEFAULT_
     points, triangles = np.vstack(vertices), np.vstack(faces)
     joined = _seam_nodes(points, seams, _bounding_diagonal(shape))
     if joined is not None:
-        points, triangles = _renumber(points, triangles, joined)
+        points, triangles, new_index = _renumber(points, triangles, joined)
+        named = {key: int(new_index[joined[node]]) for node, key in seams}
+        chains = [[named[key] for key in chain] for chain in seam_keys.chains.values()
+                  if all(key in named for key in chain)]
+        triangles = _split_skipped(triangles, chains)
     # the exact weld still joins what topology did not name (bit-identical copies), as before
     welded_vertices, welded_faces = weld_exact(points[triangles])
-    return welded_vertices, welded_faces.astype(np.int64, copy=False)
+    # the nodes of a degenerate B-rep edge (a sphere's or cone's pole) are one point: triangles on them collapse
+    collapsed = (welded_faces[:, 0] == welded_faces[:, 1]) | (welded_faces[:, 1] == welded_faces[:, 2]) \
+        | (welded_faces[:, 2] == welded_faces[:, 0])
+    return welded_vertices, welded_faces[~collapsed].astype(np.int64, copy=False)
 
 
 #: Largest distance between two copies of one seam node (a B-rep vertex, or the k-th node of a B-rep edge's
@@ -351,6 +358,8 @@ class _SeamKeys:
         self.edges, self.vertices = ShapeMap(), ShapeMap()
         TopExp.MapShapes_s(shape, TopAbs_EDGE, self.edges)
         TopExp.MapShapes_s(shape, TopAbs_VERTEX, self.vertices)
+        #: each B-rep edge's nodes in order from its first vertex, by name (as the first face met gives them)
+        self.chains: dict[int, list[tuple[Any, ...]]] = {}
 
     def of_face(self, face: Any, triangulation: Any, location: Any,
                 nodes: np.ndarray) -> list[tuple[int, tuple[Any, ...]]]:
@@ -379,9 +388,10 @@ class _SeamKeys:
             if backward < forward:              # the polygon runs from the edge's last vertex to its first
                 index = index[::-1]
             j = self.edges.FindIndex(edge)
-            out.append((int(index[0]), ("v", self.vertices.FindIndex(first))))
-            out.append((int(index[-1]), ("v", self.vertices.FindIndex(last))))
-            out.extend((int(node), ("e", j, k)) for k, node in enumerate(index[1:-1].tolist(), start=1))
+            names = [("v", self.vertices.FindIndex(first))] + [("e", j, k) for k in range(1, len(index) - 1)] \
+                + [("v", self.vertices.FindIndex(last))]
+            self.chains.setdefault(j, names)
+            out.extend(zip(index.tolist(), names))
         return out
 
 
@@ -401,12 +411,66 @@ def _seam_nodes(points: np.ndarray, seams: list[tuple[int, tuple[Any, ...]]],
     return target
 
 
-def _renumber(points: np.ndarray, triangles: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Points and triangles with every node replaced by the node it is joined to, unused nodes dropped."""
+def _renumber(points: np.ndarray, triangles: np.ndarray,
+              target: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points and triangles with every node replaced by the node it is joined to, unused nodes dropped, and
+    the new number of each kept node (-1 for the others)."""
     keep = np.unique(target)
     new_index = np.full(len(points), -1, dtype=np.int64)
     new_index[keep] = np.arange(len(keep))
-    return points[keep], new_index[target][triangles]
+    return points[keep], new_index[target][triangles], new_index
+
+
+def _split_skipped(triangles: np.ndarray, chains: list[list[int]]) -> np.ndarray:
+    """Triangles with every triangle edge that skips nodes of a B-rep edge's chain split at them.
+
+    OpenCASCADE's mesher can leave a node of a face's edge polygon out of that face's triangles: a triangle
+    edge runs from the node before it to the node after it, a T-junction against the neighbouring face, which
+    uses the node.  Such a triangle edge, used once, whose ends are two nodes of one chain ``k`` apart
+    (``k > 1``), is replaced by the chain between them: the triangle becomes a fan from its third corner over
+    the skipped nodes.  The skipped nodes lie on the B-rep edge, on the face's boundary, as the mesher's own
+    polygon puts them; the fan covers the triangle and the sliver between the triangle edge and the polygon,
+    which is what the face's triangles should have covered.
+    """
+    if not chains:
+        return triangles
+    directed = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    undirected = np.sort(directed, axis=1)
+    _, inverse, uses = np.unique(undirected, axis=0, return_inverse=True, return_counts=True)
+    once = np.flatnonzero(uses[inverse.reshape(-1)] == 1)
+    if not len(once):
+        return triangles
+    where: dict[int, list[tuple[int, int]]] = {}
+    for c, chain in enumerate(chains):
+        for position, node in enumerate(chain):
+            where.setdefault(node, []).append((c, position))
+    replaced: dict[int, list[list[int]]] = {}
+    n = len(triangles)
+    for slot in once.tolist():
+        a, b = (int(x) for x in directed[slot])
+        best: list[int] | None = None
+        for c, pa in where.get(a, ()):
+            for c2, pb in where.get(b, ()):
+                if c2 != c or abs(pa - pb) < 2:
+                    continue
+                inner = chains[c][pa + 1:pb] if pa < pb else chains[c][pb + 1:pa][::-1]
+                if best is None or len(inner) < len(best):
+                    best = inner
+        if best is None:
+            continue
+        t, corner = slot % n, slot // n                # the edge runs from corner `corner` to the next
+        tri = triangles[t].tolist()
+        third = tri[(corner + 2) % 3]
+        if t in replaced:                              # a triangle with two such edges: leave it to the checks
+            continue
+        path = [a, *best, b]
+        replaced[t] = [[path[i], path[i + 1], third] for i in range(len(path) - 1)]
+    if not replaced:
+        return triangles
+    keep = np.ones(n, dtype=bool)
+    keep[list(replaced)] = False
+    fans = np.array([tri for fan in replaced.values() for tri in fan], dtype=triangles.dtype)
+    return np.concatenate([triangles[keep], fans])
 
 
 #: Further tessellations tried when the mesher leaves a closed B-rep's triangles open (each at
