@@ -556,6 +556,9 @@ def accurate_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     lab = np.asarray(labels, dtype=np.intp)
     o = reference_point(v) if origin is None else np.asarray(origin, dtype=np.float64)
     shells = list(shells)
+    if not shells:                             # nothing to bound or refine
+        empty = np.zeros(0)
+        return shells, 0, RoundoffBound(volume=empty, centroid=empty.copy(), second_moment=empty.copy())
     b = roundoff_bounds(v, f if integrated is None else np.asarray(integrated), lab, shells, o)
     e_vol, e_cen, e_sec = b.volume.copy(), b.centroid.copy(), b.second_moment.copy()
     share_v, share_i, total_v, total_i = _shares(shells, e_vol, e_cen, e_sec, magnitude=True)

@@ -224,3 +224,14 @@ def test_roundoff_bounds_of_no_shells_is_empty_on_both_paths():
     bound = roundoff_bounds(v, np.zeros((0, 3), dtype=np.int64), np.zeros(0, dtype=np.intp), [], np.zeros(3))
     for name in ("volume", "centroid", "second_moment"):
         assert getattr(bound, name).shape == (0,)
+
+
+@pytest.mark.parametrize("no_accel", [False, True])
+def test_accurate_shells_of_no_shells_is_empty_on_both_paths(monkeypatch, no_accel):
+    """No shells: nothing to bound or refine (before: a broadcast ValueError on both engine paths)."""
+    from inertia_tool.integrals import accurate_shells
+    if no_accel:
+        monkeypatch.setenv("INERTIA_TOOL_NO_ACCEL", "1")
+    shells, refined, bounds = accurate_shells(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
+                                              np.zeros(0, dtype=np.int64), [])
+    assert shells == [] and refined == 0 and len(bounds.volume) == 0 and len(bounds.second_moment) == 0
