@@ -43,7 +43,8 @@ def test_an_appearance_name_needs_a_default_or_a_map(tmp_path, capsys):
     with pytest.raises(MaterialError, match="Material.001"):
         mass_properties(path)
     assert main(["analyze", str(path)]) == 2
-    assert "--material-map" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "--material-map" in err and "or one for every part with --density or --material" in err
     assert main(["analyze", str(path), "--material", "abs", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert sorted(b["density"] for b in data["bodies"]) == [1040.0, 7850.0]

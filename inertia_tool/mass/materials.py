@@ -99,9 +99,11 @@ def _decide(tag: PartTag, where: str, mapping: dict[str, tuple[str, float | str]
             # an appearance's name ("Material.001") says nothing of the density: the given default does
             return (density if density is not None else material_density(str(material)), material or "",
                     "the file's default")
+        either = (", or one for every part with `density` or `material` (an appearance's name says nothing of "
+                  "the density)") if tag.origin in APPEARANCE_ORIGINS else ""
         raise MaterialError(f"{where}: part {tag.name!r} is of material {tag.material!r} ({tag.origin}), which is "
                             "not in the material table, and the file gives no density for it; give one with "
-                            f"`material_map` ({tag.material}=1.24g/cm3 or {tag.material}=pla)")
+                            f"`material_map` ({tag.material}=1.24g/cm3 or {tag.material}=pla){either}")
     if density is not None:
         return density, "", "the file's default"
     if material is not None:
