@@ -295,3 +295,41 @@ def test_fuel_urls_of_stock_models_are_skipped_and_others_named(tmp_path, gazebo
                      'OpenRobotics/models/Fancy Table</uri></include></world></sdf>')
     with pytest.raises(RobotDescriptionError, match="a Gazebo Fuel model \\('Fancy Table'\\).*'fancy_table'"):
         read_robot(world)
+
+
+def _versions_model(folder, name):
+    """A Gazebo model folder as osrf gazebo_models ships them: one SDFormat file per version, model.config
+    listing them oldest first (the oldest a `<gazebo>` root, which SDFormat 1.5+ readers refuse)."""
+    folder.mkdir(parents=True)
+    (folder / "model.config").write_text(
+        f"<?xml version='1.0'?>\n<model><name>{name}</name><sdf version='1.2'>model-1_2.sdf</sdf>"
+        "<sdf version='1.4'>model-1_4.sdf</sdf><sdf version='1.10'>model.sdf</sdf>"
+        "<sdf version='1.5'>model-1_5.sdf</sdf></model>\n")
+    (folder / "model-1_2.sdf").write_text("<?xml version='1.0'?>\n<gazebo version='1.2'><model name='old'/></gazebo>\n")
+    for file, size in (("model-1_4.sdf", 0.3), ("model-1_5.sdf", 0.2), ("model.sdf", 0.1)):
+        (folder / file).write_text(f"<?xml version='1.0'?>\n<sdf version='1.4'><model name='{name}'><link name='l'>"
+                                   f"<collision name='c'><geometry><box><size>{size} {size} {size}</size></box>"
+                                   "</geometry></collision></link></model></sdf>\n")
+
+
+def test_a_gazebo_model_folder_is_one_model_its_newest_version(tmp_path, gazebo_models):
+    """osrf gazebo_models: 455 descriptions audited for 251 model folders (each version of a model counted, the
+    1.2 files 'unreadable'); a folder with a model.config is one model, the newest version it lists (1.10 is
+    newer than 1.5: versions compare as numbers), which is also what an <include> of the folder reads."""
+    from inertia_tool.robot.corpus import audit_corpus, find_descriptions
+    models = tmp_path / "zoo"
+    _versions_model(models / "bowl", "bowl")
+    found = find_descriptions([models])
+    assert [p.rsplit("/", 2)[-2:] for p in found] == [["bowl", "model.sdf"]]
+    audits = audit_corpus([models], density=1000)
+    assert len(audits) == 1 and audits[0].problem is None
+    assert audits[0].inertials[0].properties.mass == pytest.approx(1.0, rel=1e-12)      # 0.1 m cube
+    # named directly, an older version is still audited
+    older = str(models / "bowl" / "model-1_4.sdf")
+    assert find_descriptions([older]) == [older]
+    # an include of the folder reads the newest version too
+    world = tmp_path / "world.sdf"
+    world.write_text(f"<?xml version='1.0'?>\n<sdf version='1.6'><world name='w'><include><uri>{models / 'bowl'}"
+                     "</uri></include></world></sdf>\n")
+    robot = read_robot(world)
+    assert [r.properties.mass for r in link_inertials(robot, density=1000)] == [pytest.approx(1.0, rel=1e-12)]

@@ -7,7 +7,9 @@ other XML are skipped); ``*.xacro`` only when named directly (in a folder they a
 file that another MJCF file of the corpus includes is audited through the including file only (Menagerie's
 ``scene.xml`` includes the robot); one found in a folder with neither a ``<body>`` nor an ``<include>`` is a
 fragment meant to be included (Menagerie's actuator and keyframe files, sites in a ``<worldbody>``) and is
-skipped: it has no link to audit.  Folders are
+skipped: it has no link to audit.  A Gazebo model folder (a ``model.config`` listing one SDFormat file per
+version: ``model-1_2.sdf`` ... ``model.sdf``) is one model: only the newest version, the file Gazebo loads,
+is audited.  Folders are
 walked in sorted order without following symbolic links, at most :data:`MAX_CORPUS_FILES` descriptions.  A
 model that cannot be read is kept with its reason; it never stops the others.
 """
@@ -20,7 +22,7 @@ import re
 from ..errors import InertiaToolError, RobotDescriptionError, UsageError
 from ..values import frozen_value
 from .audit import audit_links
-from .description import MAX_DESCRIPTION_BYTES, RobotDescription, _read_bytes, read_robot
+from .description import MAX_DESCRIPTION_BYTES, RobotDescription, _read_bytes, model_config_files, read_robot
 from .geometry import MeshCache, link_inertials
 
 __all__ = ["ModelAudit", "find_descriptions", "audit_corpus", "MAX_CORPUS_FILES", "SNIFF_BYTES"]
@@ -85,11 +87,18 @@ def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
             raise UsageError(f"Expected at most {max_files:,} robot descriptions, found more under "
                              f"{', '.join(map(str, paths))}")
 
+    older = set()              # versions of a Gazebo model other than the one its model.config has loaded
     for entry in paths:
         entry = os.fspath(entry)
         if os.path.isdir(entry):
             for folder, subfolders, files in os.walk(entry):
                 subfolders.sort()
+                if "model.config" in files:
+                    try:
+                        newest, listed = model_config_files(folder)
+                    except RobotDescriptionError:   # an unreadable model.config: every file is audited
+                        newest, listed = None, []
+                    older.update(p for p in listed if p != newest)
                 for name in sorted(files):
                     path = os.path.join(folder, name)
                     if os.path.isfile(path) and not os.path.islink(path):
@@ -107,7 +116,8 @@ def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
                 target = os.path.normpath(os.path.join(os.path.dirname(path), os.fsdecode(name)))
                 if target != os.path.normpath(path):
                     left_out.add(target)
-    return [p for p in found if os.path.normpath(p) not in left_out]
+    return [p for p in found if os.path.normpath(p) not in left_out
+            and (p in explicit or os.path.normpath(p) not in older)]
 
 
 def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass: bool = False,

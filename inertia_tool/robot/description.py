@@ -710,10 +710,36 @@ def _fuel_model(scheme: str, rest: str) -> str | None:
     return unquote(rest.split("/models/", 1)[1].split("/", 1)[0]).strip() or None
 
 
+def _version_key(text: str | None) -> tuple[int, ...]:
+    """``"1.10"`` → ``(1, 10)``; anything unreadable sorts first."""
+    parts = re.findall(r"\d+", text or "")
+    return tuple(int(p) for p in parts[:4]) if parts else (-1,)
+
+
+def model_config_files(folder: str) -> tuple[str | None, list[str]]:
+    """The SDFormat file Gazebo loads from a model folder, and every file its ``model.config`` lists.
+
+    A Gazebo model folder lists one ``<sdf version="...">FILE</sdf>`` per SDFormat version it ships
+    (osrf gazebo_models: ``model-1_2.sdf`` ... ``model.sdf``); Gazebo loads the newest version.  Returns
+    ``(None, [])`` when there is no ``model.config`` (or it lists nothing)."""
+    config = os.path.join(folder, "model.config")
+    if not os.path.isfile(config):
+        return None, []
+    tree = parse_xml(_read_bytes(config), config)
+    listed = [(_version_key(e.get("version")), k, (e.text or "").strip())
+              for k, e in enumerate(tree.getroot().iter("sdf")) if (e.text or "").strip()]
+    if not listed:
+        return None, []
+    newest = max(listed, key=lambda item: (item[0], -item[1]))          # the newest; the first of equals
+    return (os.path.normpath(os.path.join(folder, newest[2])),
+            [os.path.normpath(os.path.join(folder, name)) for _, _, name in listed])
+
+
 def _sdf_include_file(include, base: str, packages: dict, source: str) -> str | None:
-    """The SDFormat file an ``<include><uri>`` names: a file, or a model folder (its ``model.config``'s
-    ``<sdf>`` file, else ``model.sdf``); None for a stock model of :data:`STOCK_MODELS_WITHOUT_MASS` that is not
-    on disk (skipped, with a :class:`~inertia_tool.errors.SkippedModelWarning` naming it).
+    """The SDFormat file an ``<include><uri>`` names: a file, or a model folder (the newest version its
+    ``model.config`` lists, :func:`model_config_files`, else ``model.sdf``); None for a stock model of
+    :data:`STOCK_MODELS_WITHOUT_MASS` that is not on disk (skipped, with a
+    :class:`~inertia_tool.errors.SkippedModelWarning` naming it).
 
     A Gazebo Fuel URL (``https://fuel.gazebosim.org/.../models/Sun``, which Gazebo downloads) is never fetched:
     its model is looked up on disk as ``model://`` would be, under its name in lower case with ``_`` for
@@ -752,13 +778,8 @@ def _sdf_include_file(include, base: str, packages: dict, source: str) -> str | 
         path = uri if os.path.isabs(uri) else os.path.join(base, uri)
     path = os.path.normpath(path)
     if os.path.isdir(path):
-        config = os.path.join(path, "model.config")
-        named = None
-        if os.path.isfile(config):
-            tree = parse_xml(_read_bytes(config), config)
-            named = next(((e.text or "").strip() for e in tree.getroot().iter("sdf") if (e.text or "").strip()),
-                         None)
-        path = os.path.join(path, named or "model.sdf")
+        named, _ = model_config_files(path)
+        path = named or os.path.join(path, "model.sdf")
     if not os.path.isfile(path):
         raise _fail(source, f"<include> {uri!r}: resolves to {path}, which does not exist")
     return path
