@@ -333,3 +333,40 @@ def test_a_gazebo_model_folder_is_one_model_its_newest_version(tmp_path, gazebo_
                      "</uri></include></world></sdf>\n")
     robot = read_robot(world)
     assert [r.properties.mass for r in link_inertials(robot, density=1000)] == [pytest.approx(1.0, rel=1e-12)]
+
+
+_SDF_BOX = ("<sdf version='1.6'><model name='m'><link name='l'><inertial><mass>2</mass></inertial>"
+            "<collision name='c'><geometry><box><size>0.1 0.2 0.3</size></box></geometry></collision></link>"
+            "</model></sdf>\n")
+
+
+@pytest.mark.parametrize("head, inside", [
+    ("\n<?xml version='1.0'?>\n", ""),                                   # lunar_tranquillitatis_pit
+    ("<?xml version='1.0'?>\n", "<!-- m from 2700 kg/m3\n <!-- divided by 4 -->"),   # src_doorway
+    ("<!-- licence -->\n  <?xml version='1.0' encoding='UTF-8'?>\n", "<!-- a comment ending in a hyphen--->"),
+])
+def test_what_gazebo_reads_and_xml_does_not_is_read_and_written_back_unchanged(tmp_path, head, inside):
+    """osrf gazebo_models: a blank line before the declaration, '--' inside a comment (a comment opened again
+    inside one), as Gazebo's parser reads them; before, 'not well-formed XML'. A corrected copy keeps every
+    byte of the original outside the changed inertial (the tolerance blanks without moving offsets)."""
+    path = tmp_path / "model.sdf"
+    text = head + _SDF_BOX.replace("<link name='l'>", "<link name='l'>" + inside)
+    path.write_text(text)
+    robot = read_robot(path)
+    [result] = link_inertials(robot, density=1000)
+    assert result.properties.mass == pytest.approx(6.0, rel=1e-12)
+    out = tmp_path / "fixed.sdf"
+    write_corrected(robot, [result], out)
+    written = out.read_text()
+    assert written.startswith(head + "<sdf version='1.6'>")        # the writer adds a note after the root
+    assert "<model name='m'><link name='l'>" + inside + "<inertial>" in written
+    assert written.endswith(text.split("</inertial>", 1)[1])
+    assert read_robot(out).links[0].declared.mass == pytest.approx(6.0, rel=1e-12)
+
+
+def test_unquoted_attributes_stay_refused_with_the_reason(tmp_path):
+    """osrf submarine: `name=blade1_visual` (no quotes), which XML and this reader refuse: one line naming it."""
+    path = tmp_path / "model.sdf"
+    path.write_text(_SDF_BOX.replace("name='c'", "name=c"))
+    with pytest.raises(RobotDescriptionError, match=r"model\.sdf: not well-formed XML"):
+        read_robot(path)

@@ -87,7 +87,7 @@ def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
             raise UsageError(f"Expected at most {max_files:,} robot descriptions, found more under "
                              f"{', '.join(map(str, paths))}")
 
-    older = set()              # versions of a Gazebo model other than the one its model.config has loaded
+    older: set[str] = set()    # versions of a Gazebo model other than the one its model.config has loaded
     for entry in paths:
         entry = os.fspath(entry)
         if os.path.isdir(entry):

@@ -345,15 +345,38 @@ def _scale(values: np.ndarray, what: str, source: str) -> np.ndarray:
 
 
 #: An XML declaration after leading comments (osrf gazebo_models ``mpl_right_arm/model.sdf`` puts its licence
-#: first): not well-formed XML, but what Gazebo reads.  Only comments and whitespace may come before it.
-_LATE_DECLARATION = re.compile(rb"\A(\xef\xbb\xbf)?((?:\s*<!--.*?-->)+\s*)(<\?xml\s[^?]*\?>)", re.DOTALL)
+#: first) or a blank line (``lunar_tranquillitatis_pit``): not well-formed XML, but what Gazebo reads.  Only
+#: comments and whitespace may come before it.
+_LATE_DECLARATION = re.compile(rb"\A(\xef\xbb\xbf)?((?:\s*<!--.*?-->)*\s*)(<\?xml\s[^?]*\?>)", re.DOTALL)
+
+#: A comment's body: ``--`` inside it (osrf ``src_doorway``: a ``<!--`` opened again inside a comment) is not
+#: well-formed XML; Gazebo's parser ends the comment at the first ``-->`` as this does.
+_COMMENT = re.compile(rb"<!--(.*?)-->", re.DOTALL)
+
+
+def _tolerated(data: bytes) -> bytes:
+    """``data`` with what Gazebo's parser accepts and XML 1.0 does not made blank, byte for byte the same length
+    (offsets stay those of the input): a declaration after leading comments or whitespace; ``--`` inside a
+    comment (the second hyphen made a space) and a comment body ending in ``-``."""
+    late = _LATE_DECLARATION.match(data)
+    declared = re.search(rb"encoding\s*=\s*[\"']([^\"']*)", late.group(3)) if late is not None else None
+    if late is not None and late.start(3) > (3 if late.group(1) else 0) \
+            and (declared is None or declared.group(1).lower() in (b"utf-8", b"utf8")):
+        data = data[:late.start(3)] + b" " * len(late.group(3)) + data[late.end(3):]
+
+    def blank(match: re.Match) -> bytes:
+        body = match.group(1).replace(b"--", b"- ")
+        if body.endswith(b"-"):
+            body = body[:-1] + b" "
+        return b"<!--" + body + b"-->"
+    return _COMMENT.sub(blank, data)
 
 
 def parse_xml(data: bytes, source: str):
     """An lxml tree of ``data`` keeping comments and whitespace; no entity expansion, no network.
 
-    A declaration that follows leading comments (not allowed by XML 1.0, read by Gazebo) is read as if it
-    were blank: the same bytes with the declaration replaced by spaces, so offsets stay those of the input.
+    What Gazebo reads and XML 1.0 does not (a declaration after leading comments or a blank line, ``--``
+    inside a comment) is read as if it were blank (:func:`_tolerated`), so offsets stay those of the input.
     """
     from lxml import etree
     parser = etree.XMLParser(remove_blank_text=False, remove_comments=False, resolve_entities=False,
@@ -361,12 +384,10 @@ def parse_xml(data: bytes, source: str):
     try:
         return etree.fromstring(data, parser).getroottree()
     except etree.XMLSyntaxError as exc:
-        late = _LATE_DECLARATION.match(data)
-        declared = re.search(rb"encoding\s*=\s*[\"']([^\"']*)", late.group(3)) if late is not None else None
-        if late is not None and (declared is None or declared.group(1).lower() in (b"utf-8", b"utf8")):
-            blanked = data[:late.start(3)] + b" " * len(late.group(3)) + data[late.end(3):]
+        tolerated = _tolerated(data)
+        if tolerated != data:
             try:
-                return etree.fromstring(blanked, parser).getroottree()
+                return etree.fromstring(tolerated, parser).getroottree()
             except etree.XMLSyntaxError:
                 pass
         raise _fail(source, f"not well-formed XML ({exc})") from None
