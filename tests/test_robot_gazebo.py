@@ -370,3 +370,12 @@ def test_unquoted_attributes_stay_refused_with_the_reason(tmp_path):
     path.write_text(_SDF_BOX.replace("name='c'", "name=c"))
     with pytest.raises(RobotDescriptionError, match=r"model\.sdf: not well-formed XML"):
         read_robot(path)
+
+
+def test_a_light_only_sdf_says_there_is_nothing_to_audit(tmp_path):
+    """osrf sun/model.sdf: a <light> alone, read directly (an include of it adds nothing, as before)."""
+    path = tmp_path / "model.sdf"
+    path.write_text("<?xml version='1.0'?>\n<sdf version='1.5'><light type='directional' name='sun'/></sdf>\n")
+    with pytest.raises(RobotDescriptionError, match=r"no <model> or <world> to audit: the file holds only "
+                                                    r"<light> \(a light or an actor has no links\)"):
+        read_robot(path)

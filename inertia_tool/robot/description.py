@@ -871,6 +871,10 @@ def _read_sdf(root, source: str, base: str, packages: dict, geometry: str) -> tu
     if len(worlds) == 1 and not models:
         links = _sdf_links(worlds[0], "", base, packages, geometry, source, (os.path.realpath(source),))
         return worlds[0].get("name", ""), tuple(links)
+    others = sorted({c.tag for c in root if isinstance(c.tag, str)} - {"model", "world"})
+    if not models and not worlds and others:          # osrf gazebo_models sun/model.sdf: a <light> only
+        raise _fail(source, f"no <model> or <world> to audit: the file holds only "
+                            f"{', '.join(f'<{t}>' for t in others)} (a light or an actor has no links)")
     raise _fail(source, f"expected one <model> or one <world>, found {len(models)} models and {len(worlds)} worlds")
 
 
