@@ -158,6 +158,10 @@ CHECKS = {
                          "walls (faces near one plane whose edges cancel by index) were taken out: the winding "
                          "number they add is nonzero only in a volume bounded within ROUNDOFF_RTOL of the result, "
                          "zero when exactly flat (mesh/folds.py)",
+    "open-sheets": "open sheets were taken out of a surface that did not close (mesh/sheets.py): the rest is "
+                   "closed, no face of it meets a sheet beyond the vertices and edges they share, and the rest's "
+                   "winding number puts each sheet inside its solid (a zero-thickness wall with material on both "
+                   "sides) or, with repair only, outside it (a fin): either encloses no volume",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
     "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves and the "
                            "faces bounding {winding number ≥ 1} kept (mesh/arrange.py); the result was checked "
