@@ -8,6 +8,10 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
    note on the non-manifold edges.
 2. *Oriented*: faces wound the wrong way are turned to agree with their manifold neighbours (the file's
    majority decides which side is out).  Exact if that balances the surface — method ``"oriented"``.
+2b. *Open sheets* (R3b, :mod:`~.sheets`): flat open sheets lying inside the solid of the rest (a cut face kept
+   inside, a CAD face left in) are left out when the rest is closed, no face of it meets a sheet and its winding
+   number puts every sheet inside — method ``"sheets-removed"``, exact without ``repair``.  A fin (a flat sheet
+   outside) is only named in the refusal.
 3. *Welded*: vertices closer than ``merge_tolerance × diagonal`` are merged (a distance query, ``merge.py``),
    collapsed faces dropped, orientation redone.  Exact for the welded polyhedron (which moved no vertex by
    more than the stated distance) — method ``"welded"``.
@@ -66,8 +70,8 @@ class Resolution:
     faces : (m, 3) int
         Faces to integrate (exact methods); the patched surface for ``"patched"``.
     method : str
-        ``"exact"``, ``"oriented"``, ``"welded"``, ``"deduplicated"``, ``"sealed"`` (T-junctions split, crack
-        lips welded, nothing moved: exact), ``"patched"`` or ``"winding"``.
+        ``"exact"``, ``"oriented"``, ``"sheets-removed"`` (R3b), ``"welded"``, ``"deduplicated"``, ``"sealed"``
+        (T-junctions split, crack lips welded, nothing moved: exact), ``"patched"`` or ``"winding"``.
     notes : tuple of str
         What was found and done, one short sentence each.
     flipped_faces : int
