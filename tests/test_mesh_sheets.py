@@ -79,11 +79,8 @@ def _polygon_sheet(rng, equations, centre, radius_share, corners=None):
     u /= np.linalg.norm(u)
     w = np.cross(normal, u)
     k = corners or int(rng.integers(3, 9))
-    angles = np.sort(rng.uniform(0, 2 * np.pi, size=k))
-    keep = np.r_[True, np.diff(angles) > 1e-3]
-    angles = angles[keep]
-    share = np.asarray(radius_share, dtype=float)[keep] if np.ndim(radius_share) \
-        else np.full(len(angles), float(radius_share))
+    angles = (np.arange(k) + rng.uniform(0.05, 0.95, size=k)) * (2 * np.pi / k)     # one in each sector: distinct
+    share = np.asarray(radius_share, dtype=float) if np.ndim(radius_share) else np.full(k, float(radius_share))
     pts = [centre]
     for t, s in zip(angles, share):
         d = np.cos(t) * u + np.sin(t) * w
