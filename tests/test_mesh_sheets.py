@@ -295,3 +295,16 @@ def test_a_sheet_lying_on_a_face_of_the_part_is_not_taken():
 def test_a_surface_with_a_hole_is_no_sheet():
     v, f, _, _ = _convex(5)
     assert open_sheets(v, f[1:]) is None
+
+
+def test_a_cavity_cracked_into_flat_facets_is_not_read_as_walls():
+    """A hollow part whose cavity's faces each carry their own corners, moved apart by 1e-9 (a cracked surface):
+    each face is a flat open piece inside the body, but together they enclose the void; their rims meet each
+    other, so they are not taken for walls (the void would be lost)."""
+    v, f, _, centre = _convex(8)
+    rng = np.random.default_rng(8)
+    inner = centre + 0.3 * (v - centre)
+    tris = inner[f[:, ::-1]] + rng.normal(scale=1e-9, size=(len(f), 3, 3))
+    dv = np.vstack([v, tris.reshape(-1, 3)])
+    df = np.vstack([f, len(v) + np.arange(3 * len(f)).reshape(-1, 3)])
+    assert open_sheets(dv, df) is None

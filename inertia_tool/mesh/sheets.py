@@ -37,6 +37,11 @@ point off it is below 2π, so ``|w_Σ| < 1/2`` and ``{w_S > 1/2} = {w_R ≥ 1}``
 Sorkine-Hornung, "Robust Inside-Outside Segmentation using Generalized Winding Numbers", SIGGRAPH 2013, which the
 winding-number estimate uses).  Curved sheets stay on the normal path.
 
+Flat pieces can still enclose a void together: a cavity whose flat facets were cracked apart (their corners
+no longer shared) is a set of flat open pieces each inside the solid.  So no two sheets taken may have rim corners
+within ``MERGE_TOLERANCE`` of the diagonal of each other (the distance within which the weld would join them);
+walls meet nothing but the rest of the part.
+
 A flat sheet whose point lies outside the solid (``w_R = 0``, an even number of shells around it) is a *fin*: a
 surface of zero thickness standing out of the part (or into a cavity).  Its volume is zero too, but it is not this
 case: it may be a thin plate meant to have thickness.  It is counted, nothing is taken out, and the refusal
@@ -59,7 +64,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..tolerances import WALL_PLANE_RTOL
+from ..tolerances import MERGE_TOLERANCE, WALL_PLANE_RTOL
 from ..values import frozen_value
 from .edges import edge_keys
 
@@ -160,6 +165,28 @@ def _take_out(f: np.ndarray, piece: np.ndarray, n_pieces: int, edge: np.ndarray,
     return np.array(taken, dtype=np.int64)
 
 
+def _rims_meet(v: np.ndarray, f: np.ndarray, piece: np.ndarray, taken: np.ndarray, edge: np.ndarray,
+               sign: np.ndarray, reach: float) -> bool:
+    """Whether a rim corner of one taken sheet lies within ``reach`` of a rim corner of another: flat pieces of a
+    surface cracked apart (a cavity whose facets lost their shared corners) would each pass as a sheet inside the
+    solid, and together they enclose its void.  Walls meet nothing but the rest."""
+    from scipy.spatial import cKDTree
+
+    if len(taken) < 2:
+        return False
+    sheet_of_piece = np.full(int(piece.max()) + 1, -1, dtype=np.int64)
+    sheet_of_piece[taken] = np.arange(len(taken))
+    slot_sheet = sheet_of_piece[piece[np.arange(3 * len(f)) // 3]]
+    inside = slot_sheet >= 0
+    owner_edge = slot_sheet[inside] * (int(edge.max()) + 1) + edge[inside]
+    _, inverse, counts = np.unique(owner_edge, return_inverse=True, return_counts=True)
+    net = np.bincount(inverse.reshape(-1), weights=sign[inside])
+    rim_slot = np.flatnonzero(inside)[net[inverse.reshape(-1)] != 0]
+    corners = np.unique(np.stack([f.reshape(-1)[rim_slot], slot_sheet[rim_slot]], axis=1), axis=0)
+    pairs = cKDTree(v[corners[:, 0]]).query_pairs(reach, output_type="ndarray")
+    return bool(len(pairs) and np.any(corners[pairs[:, 0], 1] != corners[pairs[:, 1], 1]))
+
+
 def _any_degenerate(v: np.ndarray, f: np.ndarray) -> bool:
     """Whether a face has zero area exactly (its corners collinear: every coordinate projection's orient2d
     zero).  The face-pair check skips such faces, so a sheet holding one is not proven apart from the rest."""
@@ -184,7 +211,7 @@ def _shell_windings(point: np.ndarray, v: np.ndarray, f: np.ndarray, labels: np.
 
 
 def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MAX_SHEET_PIECES,
-                plane_rtol: float = WALL_PLANE_RTOL) -> OpenSheets | None:
+                plane_rtol: float = WALL_PLANE_RTOL, rim_rtol: float = MERGE_TOLERANCE) -> OpenSheets | None:
     """R3b: the open sheets of an unbalanced surface, taken out when the rest is closed and each sheet lies inside
     or outside its solid without meeting it (module docstring); else None.
 
@@ -199,6 +226,9 @@ def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MA
     plane_rtol : float
         A sheet's corners lie within ``plane_rtol`` times the largest |coordinate| of one plane (module docstring,
         "Only flat sheets").
+    rim_rtol : float
+        Two sheets whose rims come within ``rim_rtol`` times the bounding-box diagonal of each other are not taken
+        (pieces of one surface cracked apart, e.g. a cavity: module docstring, "Only flat sheets").
 
     Returns
     -------
@@ -231,6 +261,8 @@ def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MA
     rest = f[~is_sheet]
     if len(rest) < 4 or _any_degenerate(v, f[is_sheet]):
         return None                                   # a zero-area face is skipped by the check: not proven apart
+    if _rims_meet(v, f, piece, taken, edge, sign, rim_rtol * float(np.linalg.norm(np.ptp(v, axis=0)))):
+        return None                                   # flat pieces of one cracked surface (a cavity), not walls
     contacts = surface_contacts(v, f)
     if not contacts.complete:
         return None
