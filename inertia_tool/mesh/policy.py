@@ -75,7 +75,8 @@ R3b *A flat open sheet inside a solid encloses nothing* (:func:`~.sheets.open_sh
    (its relative interior is connected and off the rest, where that winding number is constant): a wall of zero
    thickness with material on both sides.  The rest is the solid, ``exact`` with the check ``open-sheets``, without
    ``repair``.  Reason: a cut face kept inside a part, or a CAD face left in, is what the user means as the part;
-   the sheet's face sums are not the boundary of anything.  Curved pieces (a cavity's surface with a hole) and fins
+   the sheet's face sums are not the boundary of anything.  Curved pieces (a cavity's surface with a hole), sheets
+   whose rims meet another's within ``MERGE_TOLERANCE`` (a cavity cracked into flat facets) and fins
    (flat sheets outside the solid, perhaps plates meant to have thickness) are not taken: the fin is named in the
    refusal.
 R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is the number of other shells
