@@ -110,14 +110,24 @@ class OpenSheets:
                 "sides, its rim on the surface or free inside) left out: it encloses no volume")
 
 
+def _codes(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(keys, return_inverse=True)`` by one stable sort (numpy's hash-based unique is several times
+    slower on the millions of edge keys of a large mesh)."""
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    first = np.r_[True, sorted_keys[1:] != sorted_keys[:-1]]
+    inverse = np.empty(len(keys), dtype=np.int64)
+    inverse[order] = np.cumsum(first) - 1
+    return sorted_keys[first], inverse
+
+
 def _pieces(f: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray, np.ndarray]:
     """Faces joined through manifold edges: ``(piece of each face, pieces, edge of each slot, ±1 of each slot)``."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
     key, forward = edge_keys(f, n)
-    _, edge = np.unique(key, return_inverse=True)
-    edge = edge.reshape(-1)
+    _, edge = _codes(key)
     sign = np.where(forward, 1, -1).astype(np.int64)
     count = np.bincount(edge)
     net = np.bincount(edge, weights=sign).astype(np.int64)
@@ -138,13 +148,15 @@ def _take_out(f: np.ndarray, piece: np.ndarray, n_pieces: int, edge: np.ndarray,
     if not total.any():
         return None
     owner = piece[np.arange(3 * len(f)) // 3]
-    pair, inverse = np.unique(owner * n_edges + edge, return_inverse=True)
-    pnet = np.bincount(inverse.reshape(-1), weights=sign).astype(np.int64)
+    pair, inverse = _codes(owner * n_edges + edge)
+    pnet = np.bincount(inverse, weights=sign).astype(np.int64)
     open_rows = np.flatnonzero(pnet != 0)
     if not len(open_rows):
         return None
     row_piece, row_edge, row_net = pair[open_rows] // n_edges, pair[open_rows] % n_edges, pnet[open_rows]
-    candidates = np.unique(row_piece)
+    candidates = row_piece[np.r_[True, row_piece[1:] != row_piece[:-1]]]          # sorted: each once
+    if len(candidates) > 4 * max_pieces:
+        return None                                   # a soup or a shattered surface: no few sheets close it
     piece_area = np.bincount(piece, weights=area, minlength=n_pieces)
     candidates = candidates[np.argsort(piece_area[candidates], kind="stable")][:max_pieces]
     candidates = candidates[[planar(p) for p in candidates.tolist()]]
@@ -248,8 +260,16 @@ def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MA
     normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     area = 0.5 * np.linalg.norm(normal, axis=1)
     tolerance = plane_rtol * float(np.abs(v).max())
+    first = np.full(n_pieces, -1, dtype=np.int64)
+    first[piece[::-1]] = np.arange(len(f))[::-1]                 # a face of each piece
+    ref = normal[first[piece]]
+    size = np.linalg.norm(normal, axis=1) * np.linalg.norm(ref, axis=1)
+    parallel = np.abs(np.einsum("ij,ij->i", normal, ref)) >= (1 - 1e-6) * size
+    bent = np.bincount(piece, weights=(~parallel | ~(size > 0)).astype(np.float64), minlength=n_pieces) > 0
 
-    def planar(p: int) -> bool:
+    def planar(p: int) -> bool:                      # a quick filter on the normals, then the corners' distance
+        if bent[p]:
+            return False
         members = f[piece == p]
         plane = _plane(v, members)
         return plane is not None and _distance_bound(v, members, *plane) <= tolerance
