@@ -334,3 +334,39 @@ def test_two_slabs_welded_face_to_face_are_exact_not_a_short_union():
     assert p.mesh.certificate.kind == "exact"
     assert "zero-volume-folds" in p.mesh.certificate.checks
     _assert_matches(p, truth, rtol=1e-11)
+
+
+def _welded_slabs():
+    rng = np.random.default_rng(1900)
+    v, f = _convex(1900, n=20)
+    normal = rng.normal(size=3)
+    normal /= np.linalg.norm(normal)
+    heights = v @ normal
+    pieces = [(v, f)]
+    for q in sorted(rng.uniform(0.3, 0.7, size=2)):
+        offset = float(heights.min() + q * (heights.max() - heights.min()))
+        upper, lower = _halves(*pieces.pop(), normal, offset)
+        pieces += [(lower[0], _retriangulate_cut(*lower, -normal, -offset, rng)),
+                   (upper[0], _retriangulate_cut(*upper, normal, offset, rng))]
+    return pieces[1:]
+
+
+@pytest.mark.xfail(strict=True, reason="known defect (issue 21 item 3), not fixed: closed_groups hands manifold3d a "
+                   "closed but non-manifold piece; refusing it there also refuses cases R3a leaves to the boolean "
+                   "that it gets right today")
+def test_welded_slabs_without_r3a_are_not_given_a_short_union(monkeypatch):
+    """Root cause of the 3 % low union: the slabs' outer surfaces and cut faces are open patches joined at the
+    rim (each rim edge used by four faces), so ``union.closed_groups`` hands manifold3d one closed but non-manifold
+    piece; manifold3d assumes manifold input, reports no error, and its solid is 3 % short (certified unverified).
+    With R3a out of the way (as for a wall it cannot prove), the answer must not be that union: refused without
+    repair (or exact)."""
+    import inertia_tool.mesh.folds as folds
+
+    monkeypatch.setattr(folds, "settle_folds", lambda *args, **kwargs: None)
+    slabs = _welded_slabs()
+    volume, _, _ = _summed_truth(slabs)
+    try:
+        p = _analyse(*_joined(slabs))
+    except it.errors.InvalidMeshError:
+        return
+    assert abs(p.volume - volume) <= 1e-9 * volume

@@ -109,6 +109,7 @@ class MeshReport:
         ``"oriented"`` (faces wound the wrong way turned, then exact), ``"welded"`` (vertices closer than
         ``welded_tolerance`` merged, then exact), ``"deduplicated"`` (repeated faces dropped, then exact),
         ``"sealed"`` (T-junctions split and crack lips welded without moving any point, then exact),
+        ``"sheets-removed"`` (open sheets inside the solid, or fins outside it with ``repair``, left out; R3b),
         ``"union"`` (overlapping bodies united by a boolean, then exact), ``"sum"`` (overlapping bodies'
         integrals added: shared volume counted twice, on request), ``"patched"`` / ``"winding"`` (estimates
         of ``repair=True``, see ``uncertainty``).

@@ -67,6 +67,18 @@ R3a *Folds that enclose nothing are not crossings* (:func:`~.folds.settle_folds`
    answer is ``exact`` with the check ``zero-volume-folds``.  Otherwise nothing is taken out.  Reason: such folds
    are crossings only at the level of the coordinates' rounding, and a face of zero area cannot change the
    winding number at all.
+R3b *A flat open sheet inside a solid encloses nothing* (:func:`~.sheets.open_sheets`, called by
+   :func:`~.resolve.resolve_surface` when the surface does not balance).  Flat open pieces (joined through manifold
+   edges, corners within ``WALL_PLANE_RTOL`` of one plane) are taken out until the rest balances; when no face of
+   the rest meets a sheet beyond what they share by index (face-pair check) and the rest's winding number is 1 at
+   a point of each sheet with an odd number of its shells around it, every sheet lies inside the solid of the rest
+   (its relative interior is connected and off the rest, where that winding number is constant): a wall of zero
+   thickness with material on both sides.  The rest is the solid, ``exact`` with the check ``open-sheets``, without
+   ``repair``.  Reason: a cut face kept inside a part, or a CAD face left in, is what the user means as the part;
+   the sheet's face sums are not the boundary of anything.  Curved pieces (a cavity's surface with a hole), sheets
+   whose rims meet another's within ``MERGE_TOLERANCE`` (a cavity cracked into flat facets) and fins
+   (flat sheets outside the solid, perhaps plates meant to have thickness) are not taken: the fin is named in the
+   refusal.
 R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is the number of other shells
    that contain it (whose winding number at a point of it is nonzero and that it does not cross); even depth
    is a body, wound outward, odd depth a cavity, wound inward.  A shell wound the other way is flipped, with
@@ -158,6 +170,10 @@ CHECKS = {
                          "walls (faces near one plane whose edges cancel by index) were taken out: the winding "
                          "number they add is nonzero only in a volume bounded within ROUNDOFF_RTOL of the result, "
                          "zero when exactly flat (mesh/folds.py)",
+    "open-sheets": "open sheets were taken out of a surface that did not close (mesh/sheets.py): the rest is "
+                   "closed, no face of it meets a sheet beyond the vertices and edges they share, and the rest's "
+                   "winding number puts each sheet inside its solid (a zero-thickness wall with material on both "
+                   "sides) or, with repair only, outside it (a fin): either encloses no volume",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
     "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves and the "
                            "faces bounding {winding number ≥ 1} kept (mesh/arrange.py); the result was checked "

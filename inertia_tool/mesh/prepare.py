@@ -457,6 +457,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         kind = "unverified"                   # R4: a reading of the file's winding, not a proven solid
     if folds is not None and "no-crossing-faces" in checks:
         checks.insert(checks.index("no-crossing-faces"), "zero-volume-folds")      # R3a: what makes it exact
+    if found.method == "sheets-removed" and "no-crossing-faces" in checks:
+        checks.insert(checks.index("no-crossing-faces"), "open-sheets")            # R3b: what makes it exact
     certificate = Certificate(kind, tuple(checks) if kind != "estimate" else ())
     report = MeshReport(vertices=len(v), faces=len(f), zero_area_faces=sum(s.zero_area_faces for s in shells),
                         bodies=bodies, cavities=cavities, flipped_shells=int(np.count_nonzero(flip)),

@@ -8,6 +8,10 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
    note on the non-manifold edges.
 2. *Oriented*: faces wound the wrong way are turned to agree with their manifold neighbours (the file's
    majority decides which side is out).  Exact if that balances the surface — method ``"oriented"``.
+2b. *Open sheets* (R3b, :mod:`~.sheets`): flat open sheets lying inside the solid of the rest (a cut face kept
+   inside, a CAD face left in) are left out when the rest is closed, no face of it meets a sheet and its winding
+   number puts every sheet inside — method ``"sheets-removed"``, exact without ``repair``.  A fin (a flat sheet
+   outside) is only named in the refusal.
 3. *Welded*: vertices closer than ``merge_tolerance × diagonal`` are merged (a distance query, ``merge.py``),
    collapsed faces dropped, orientation redone.  Exact for the welded polyhedron (which moved no vertex by
    more than the stated distance) — method ``"welded"``.
@@ -35,6 +39,7 @@ from ..rounding import round_up
 if TYPE_CHECKING:
     from .uncertainty import Estimate
     from .orient import EdgeBalance
+    from .sheets import OpenSheets
 
 __all__ = ["Resolution", "resolve_surface", "REPAIR_RULE"]
 
@@ -65,8 +70,8 @@ class Resolution:
     faces : (m, 3) int
         Faces to integrate (exact methods); the patched surface for ``"patched"``.
     method : str
-        ``"exact"``, ``"oriented"``, ``"welded"``, ``"deduplicated"``, ``"sealed"`` (T-junctions split, crack
-        lips welded, nothing moved: exact), ``"patched"`` or ``"winding"``.
+        ``"exact"``, ``"oriented"``, ``"sheets-removed"`` (R3b), ``"welded"``, ``"deduplicated"``, ``"sealed"``
+        (T-junctions split, crack lips welded, nothing moved: exact), ``"patched"`` or ``"winding"``.
     notes : tuple of str
         What was found and done, one short sentence each.
     flipped_faces : int
@@ -244,6 +249,14 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
             return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
                               census.nonmanifold_edges)
         current, flipped = oriented.faces, oriented.flipped_faces
+    from .sheets import open_sheets
+    sheets = open_sheets(v, current)                                                                # R3b
+    if sheets is not None and not sheets.fins:
+        kept = _census(sheets.faces, n).balance
+        notes = ((f"{flipped:,} faces were wound the wrong way and were turned",) if flipped else ()) + \
+            (sheets.describe(),) + _touching_note(kept)
+        return Resolution(v, sheets.faces, "sheets-removed", notes, flipped, None, kept.nonmanifold_edges)
+    fins = _fin_hint(sheets)              # a fin is no internal wall: named in the refusal; repair treats it below
     welded = None
     if merge_tolerance and merge_tolerance > 0:
         tol = merge_tolerance * diag
@@ -281,7 +294,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                     return Resolution(kept_v, kept_f, "welded", notes + _touching_note(census), flipped,
                                       tol, census.nonmanifold_edges)
     if not repair:
-        raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}; "
+        raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}{fins}; "
                                "`repair=True` gives a bounded estimate",
                                details={"boundary_edges": census.boundary_edges,
                                         "unbalanced_edges": census.unbalanced_edges,
@@ -317,6 +330,15 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                           front_nonmanifold)
     return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
                       front_nonmanifold if best.method == "patched" else census.nonmanifold_edges, estimate=best)
+
+
+def _fin_hint(found: OpenSheets | None) -> str:
+    """For the refusal: the fins R3b found (flat open sheets outside the solid of the rest), named; else ''."""
+    if found is None or not found.fins:
+        return ""
+    return (f"; {found.fins:,} open sheet{'s' if found.fins > 1 else ''} of {found.fin_faces:,} faces stand"
+            f"{'' if found.fins > 1 else 's'} outside the solid (a zero-thickness fin: it encloses no volume, "
+            "and `repair=True` leaves it out; if it is a thin plate, mesh it with its thickness)")
 
 
 def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, *, diag: float,
