@@ -424,8 +424,9 @@ class _FaceTriangulation:
 # -- step 3: winding numbers of patches ------------------------------------------------------------------------
 
 def _winding_except(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
-                    skip: int) -> tuple[float, float]:
-    """Generalized winding number at ``point`` of every face but ``skip``, and a bound on its rounding error.
+                    skip: int | np.ndarray) -> tuple[float, float]:
+    """Generalized winding number at ``point`` of every face but ``skip`` (an index, or a boolean mask of the
+    faces left out), and a bound on its rounding error.
 
     Each face contributes ``Ω/4π`` with ``tan(Ω/2) = det/den`` (Van Oosterom and Strackee 1983), ``det = A·(B×C)``,
     ``den = |A||B||C| + (A·B)|C| + (A·C)|B| + (B·C)|A|`` for ``A = a − p`` etc.  In float64 ``|Δdet| ≤ 12u·P``

@@ -711,6 +711,8 @@ class WeldedBodies:
         Shells with non-manifold edges that could not be split into closed bodies (kept whole).
     contact : (c, 2) int
         Face pairs of different shells that share a non-manifold edge by index (R4 tests their points).
+    ambiguous_shells : (s,) bool
+        The given shells counted by ``ambiguous`` (their faces go to the coplanar overlay, :mod:`~.coplanar`).
     """
 
     labels: np.ndarray
@@ -718,6 +720,7 @@ class WeldedBodies:
     split: int
     ambiguous: int
     contact: np.ndarray
+    ambiguous_shells: np.ndarray | None = None
 
 
 def _crossing_pairs_at_edges(vertices: np.ndarray, faces: np.ndarray, at: np.ndarray, edge_faces: np.ndarray,
@@ -904,7 +907,7 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
         pairs.append(np.stack([fs[i][keep], fs[j][keep]], axis=1))
     contact = np.unique(np.sort(np.concatenate(pairs), axis=1), axis=0) if pairs else np.zeros((0, 2), np.int64)
     return WeldedBodies(labels=new.astype(np.intp), n_shells=count_new, split=int(np.count_nonzero(splits)),
-                        ambiguous=ambiguous, contact=contact.astype(np.int64))
+                        ambiguous=ambiguous, contact=contact.astype(np.int64), ambiguous_shells=crossed & bad_shell)
 
 
 @frozen_value
