@@ -44,8 +44,8 @@ import numpy as np
 
 from ..errors import ArrangementError
 from ..values import frozen_value
-from .arrange import (WINDING_MARGIN, _compact, _Exact, _FaceTriangulation, _Hom, _inside_face, _orient2d,
-                      _patches, _projection, _winding_except)
+from .arrange import (_U, WINDING_MARGIN, _compact, _Exact, _FaceTriangulation, _Hom, _inside_face, _orient2d,
+                      _patches, _projection, _winding_terms, _winding_total)
 from .edges import edge_keys
 from .intersect import orient3d_sign, surface_contacts
 
@@ -274,10 +274,7 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
     overlapping = np.concatenate([crossing, np.asarray(found.coplanar_opposite, dtype=np.int64).reshape(-1, 2),
                                   _repeated_pairs(f)])
     involved = np.unique(np.concatenate([overlapping.reshape(-1), contact.reshape(-1)]))
-    if not len(overlapping):
-        raise ArrangementError("no faces overlap in a common plane")
-    near = np.isin(f, np.unique(f[involved])).any(axis=1)
-    exact = _Exact(v, np.unique(f[near]))
+    exact = _Exact(v, np.unique(f))
     hom: dict[int, _Hom] = {vid: (p[0], p[1], p[2], 1) for vid, p in exact.point.items()}
     ids: dict[_Hom, int] = {}
     for vid, corner in hom.items():
@@ -383,7 +380,7 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
     _check_balanced(out_faces, n_all, mult, "the overlay of the coplanar faces does not balance every edge (internal)")
     # 4. labels
     patch, n_patches = _patches(out_faces, n_all, set())
-    front = _label(out_v, out_faces, out_source, mult, patch, n_patches, v, f)
+    front = _label(out_v, out_faces, out_source, mult, patch, n_patches, v, f, exact, hom)
     w_front = front[patch]
     keep = (w_front <= 0) & (w_front + mult >= 1)
     kept = out_faces[keep]
@@ -428,22 +425,90 @@ def _check_balanced(faces: np.ndarray, n_vertices: int, mult: np.ndarray, messag
         raise ArrangementError(message)
 
 
+#: Barycentric weights of the points tried on a piece (its centroid can lie exactly on an edge of a face that is
+#: coplanar with it only to rounding: the diagonals of a square split both ways).
+_WEIGHTS = ((1, 1, 1), (2, 1, 1), (1, 2, 1), (1, 1, 2), (4, 3, 1), (1, 4, 3), (3, 1, 4))
+
+
+def _point_on(hom: dict[int, _Hom], tri: np.ndarray, weights: tuple[int, int, int]) -> _Hom:
+    """The exact point ``Σ wᵢ pᵢ / Σ wᵢ`` of a triangle of homogeneous points."""
+    (x1, y1, z1, w1), (x2, y2, z2, w2), (x3, y3, z3, w3) = (hom[int(k)] for k in tri)
+    u1, u2, u3 = weights[0] * w2 * w3, weights[1] * w1 * w3, weights[2] * w1 * w2
+    return _reduced((u1 * x1 + u2 * x2 + u3 * x3, u1 * y1 + u2 * y2 + u3 * y3, u1 * z1 + u2 * z2 + u3 * z3,
+                     sum(weights) * w1 * w2 * w3))
+
+
+def _near_faces(point: _Hom, p: np.ndarray, exact: _Exact, v: np.ndarray, f: np.ndarray, unsure: np.ndarray,
+                theta: np.ndarray, error: np.ndarray) -> bool:
+    """Settle the faces whose float solid angle at ``p`` has no useful bound (``p`` lies within rounding of their
+    plane): on which side of its plane the exact ``point`` lies is an exact sign, and the face's half solid angle
+    is then within ``π·δ/r`` of ``±π`` over the face (``δ`` the distance from its plane, ``r`` the distance of the
+    foot from its edges: a disk of radius ``r`` at height ``δ`` subtends at least ``2π(1 − δ/r)``) and within
+    ``π·δ/|r|`` of 0 beside it (the face lies outside that disk).  Updates ``theta`` and ``error`` in place;
+    False when ``p`` is too close to a face's edge as well (try another point)."""
+    scale = float(np.max(np.abs(v))) if len(v) else 1.0
+    slop = 16 * _U * scale
+    for g in np.flatnonzero(unsure).tolist():
+        (nx, ny, nz), d = exact.plane(f, g)
+        side = d * point[3] - (nx * point[0] + ny * point[1] + nz * point[2])     # (a − P)·n, times W > 0
+        a, b, c = v[f[g, 0]], v[f[g, 1]], v[f[g, 2]]
+        normal = np.cross(b - a, c - a)
+        length = float(np.linalg.norm(normal))
+        if length == 0.0:
+            return False
+        unit = normal / length
+        delta = abs(float(np.dot(p - a, unit))) + slop
+        foot = p - np.dot(p - a, unit) * unit
+        reach = []
+        for q, r in ((a, b), (b, c), (c, a)):              # signed distance of the foot inside each edge
+            edge = r - q
+            inward = np.cross(unit, edge)
+            reach.append(float(np.dot(foot - q, inward)) / max(float(np.linalg.norm(inward)), 1e-300))
+        inside = min(reach)
+        if side != 0 and inside > 4 * delta:
+            theta[g] = np.pi if side > 0 else -np.pi
+            error[g] = np.pi * delta / (inside - delta)
+        elif inside < -4 * delta:
+            theta[g] = 0.0
+            error[g] = np.pi * delta / (-inside - delta)
+        else:
+            return False
+    return True
+
+
 def _label(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndarray, mult: np.ndarray, patch: np.ndarray,
-           n_patches: int, v: np.ndarray, f: np.ndarray) -> np.ndarray:
+           n_patches: int, v: np.ndarray, f: np.ndarray, exact: _Exact, hom: dict[int, _Hom]) -> np.ndarray:
     """(p,) int: the winding number in front of each patch: ``W − c/2`` at a point of a piece, ``W`` over every
-    input face outside the piece's plane, certified by its rounding bound."""
+    input face outside the piece's plane (faces within rounding of it settled by :func:`_near_faces`), certified
+    by its rounding bound."""
     p0, p1, p2 = out_v[out_faces[:, 0]], out_v[out_faces[:, 1]], out_v[out_faces[:, 2]]
     area2 = np.einsum("ij,ij->i", np.cross(p1 - p0, p2 - p0), np.cross(p1 - p0, p2 - p0))
     order = np.lexsort((-area2, patch))
     starts = np.searchsorted(patch[order], np.arange(n_patches + 1))
     front = np.zeros(n_patches, dtype=np.int64)
+    corners = [v[f[:, j]] for j in range(3)]
+    normals = np.cross(corners[1] - corners[0], corners[2] - corners[0])
+    lengths = np.linalg.norm(normals, axis=1)
+    units = normals / np.maximum(lengths, 1e-300)[:, None]
+    # the float point is the exact point rounded (≤ u·|x| per coordinate): a face whose plane passes within a few
+    # such roundings of it may have the float point on its other side, so its side is taken exactly
+    close = 64 * _U * (float(np.max(np.abs(v))) if len(v) else 1.0)
     for p in range(n_patches):
         members = order[starts[p]:starts[p + 1]]
-        for k in members[:_TRIES].tolist():
-            a, b, c = (v[f[int(out_source[k]), j]] for j in range(3))
-            a, b, c = (np.tile(x, (len(f), 1)) for x in (a, b, c))
-            same_plane = np.all(np.stack([orient3d_sign(a, b, c, v[f[:, j]]) for j in range(3)], axis=1) == 0, axis=1)
-            total, bound = _winding_except(out_v[out_faces[k]].mean(axis=0), v, f, same_plane)
+        tries = [(k, w) for k in members[:_TRIES].tolist() for w in _WEIGHTS][:_TRIES * 2]
+        for k, weights in tries:
+            src = int(out_source[k])
+            a, b, c = (np.tile(v[f[src, j]], (len(f), 1)) for j in range(3))
+            same_plane = np.all(np.stack([orient3d_sign(a, b, c, x) for x in corners], axis=1) == 0, axis=1)
+            point = _point_on(hom, out_faces[k], weights)
+            at = np.array(exact.to_float(point))
+            theta, error = _winding_terms(at, v, f)
+            theta[same_plane] = error[same_plane] = 0.0
+            unsure = (error > 1e-3) | ((np.abs(np.einsum("ij,ij->i", at - corners[0], units)) <= close)
+                                       & (lengths > 0) & ~same_plane)
+            if unsure.any() and not _near_faces(point, at, exact, v, f, unsure, theta, error):
+                continue
+            total, bound = _winding_total(theta, error)
             x = total - mult[k] / 2
             nearest = np.round(x)
             if bound + abs(x - nearest) < WINDING_MARGIN:
