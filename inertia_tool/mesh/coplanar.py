@@ -268,13 +268,17 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
                                "coplanar overlay handles faces overlapping in a common plane only)")
     contact = np.asarray(found.contact, dtype=np.int64).reshape(-1, 2)
     touching = _coplanar_pairs(v, f, contact)
-    if not touching.all():
-        raise ArrangementError(f"{int(np.count_nonzero(~touching)):,} face pairs touch across planes (a corner or "
-                               "edge of a face on a face of another plane): not handled by the coplanar overlay")
+    exact = _Exact(v, np.unique(f))
+    across = contact[~touching]
+    inner = [(int(g), int(h)) for g, h in across.tolist()
+             if _touches_inside(exact, f, g, h) or _touches_inside(exact, f, h, g)]
+    if inner:
+        raise ArrangementError(f"{len(inner):,} face pairs touch across planes inside a face (a corner or edge of a "
+                               "face on the interior of a face of another plane): not handled by the coplanar "
+                               "overlay")
     overlapping = np.concatenate([crossing, np.asarray(found.coplanar_opposite, dtype=np.int64).reshape(-1, 2),
                                   _repeated_pairs(f)])
-    involved = np.unique(np.concatenate([overlapping.reshape(-1), contact.reshape(-1)]))
-    exact = _Exact(v, np.unique(f))
+    involved = np.unique(np.concatenate([overlapping.reshape(-1), contact[touching].reshape(-1)]))
     hom: dict[int, _Hom] = {vid: (p[0], p[1], p[2], 1) for vid, p in exact.point.items()}
     ids: dict[_Hom, int] = {}
     for vid, corner in hom.items():
@@ -398,6 +402,40 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
                                planes=len(groups), split_faces=len(split), new_vertices=len(new_xyz),
                                patches=n_patches, max_winding=int((w_front + mult).max()),
                                crossings_left=left)
+
+
+def _touches_inside(exact: _Exact, faces: np.ndarray, g: int, h: int) -> bool:
+    """A corner of face ``g`` lies in the relative interior of face ``h``, or an edge of ``g`` lying in ``h``'s
+    plane meets its interior (exact).  Contacts only on the boundaries of both faces (a corner on an edge, edges
+    along each other) are split by the overlay where they lie in a plane of overlapping faces, and change no
+    winding number elsewhere; a contact inside a face would cut a patch (different winding numbers on its side)."""
+    n, d = exact.plane(faces, h)
+    i, j = _projection(n)
+    hc = [exact.point[int(k)] for k in faces[h]]
+    h2 = [(c[i], c[j], 1) for c in hc]
+    own = {int(k) for k in faces[h]}
+    corners = [int(k) for k in faces[g]]
+    flat = {k: sum(n[a] * exact.point[k][a] for a in range(3)) == d for k in corners}
+    for k in corners:
+        if k in own or not flat[k]:
+            continue
+        q = (exact.point[k][i], exact.point[k][j], 1)
+        if min(_orient2d(h2[e], h2[(e + 1) % 3], q) for e in range(3)) > 0:
+            return True
+    for e in range(3):
+        a, b = corners[e], corners[(e + 1) % 3]
+        if not (flat[a] and flat[b]):
+            continue
+        pa, pb = (exact.point[a][i], exact.point[a][j], 1), (exact.point[b][i], exact.point[b][j], 1)
+        # separated when both ends lie on or outside one edge line of h, or h lies on one closed side of a–b
+        if any(_orient2d(h2[x], h2[(x + 1) % 3], pa) <= 0 and _orient2d(h2[x], h2[(x + 1) % 3], pb) <= 0
+               for x in range(3)):
+            continue
+        sides = [_orient2d(pa, pb, c) for c in h2]
+        if min(sides) >= 0 or max(sides) <= 0:
+            continue
+        return True
+    return False
 
 
 def _group_edges(f: np.ndarray, members: list[int]) -> set[tuple[int, int]]:
