@@ -621,18 +621,20 @@ def test_nest_copied_rounded_apart_then_welded_is_counted_once():
         assert p.mesh.certificate.kind not in ("exact", "united") or (dvol <= 1e-12 and din <= 1e-12)
 
 
-def test_welded_bodies_with_coplanar_faces_at_a_crossing_edge_are_refused():
+def test_welded_bodies_with_coplanar_faces_at_a_crossing_edge_are_united():
     """Three boxes on a shared grid, some planes shared, welded: at a crossing edge coplanar faces of two bodies
     face the same way, so the order around the edge (which face closes which body) is undefined.  The bodies
-    overlap there and the sum would count it twice: refused with that reason (was: the sum, certified unverified,
-    4 % high); with ``repair`` the winding-number estimate, whose bounds hold."""
-    from inertia_tool.errors import InvalidMeshError
+    overlap there and the sum would count it twice (was: the sum, certified unverified, 4 % high; then refused
+    with that reason).  The solid {winding number ≥ 1} does not depend on the order: formed by the coplanar
+    overlay (mesh/coplanar.py), certified united, and right; with ``repair`` the same."""
     case = _generated("shared_edge_crossing", 319, n_kinds=16)
     assert "welded" in case.recipe and "planes shared" in case.recipe
-    with pytest.raises(InvalidMeshError, match="could not be split into closed bodies"):
-        _props(case.vertices, case.faces)
+    p, _ = _props(case.vertices, case.faces)
+    assert p.mesh.certificate.kind == "united" and "winding-arrangement" in p.mesh.certificate.checks
+    verdict = _assert_honest(case)
+    assert verdict.label == "united" and verdict.wrong is None
     verdict = _assert_honest(case, repair=True)
-    assert verdict.label == "estimate" and verdict.wrong is None
+    assert verdict.wrong is None
 
 
 def test_welded_l_shapes_on_one_plane_truth_agrees_with_manifold3d():

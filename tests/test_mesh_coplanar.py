@@ -101,8 +101,9 @@ def test_welded_l_shapes_match_manifold3d_union():
         rng = np.random.default_rng([26, seed])
         a = S._l_cells(*(int(x) for x in rng.integers(2, 5, size=2)), int(rng.integers(1, 3)),
                        int(rng.integers(1, 4)), 0, (0, 0))
+        turn, offset = int(rng.integers(4)), tuple(int(x) for x in rng.integers(-2, 4, size=2))
         b = S._l_cells(*(int(x) for x in rng.integers(2, 5, size=2)), int(rng.integers(1, 3)),
-                       int(rng.integers(1, 4)), int(rng.integers(4)), tuple(int(x) for x in rng.integers(-2, 4, size=2)))
+                       int(rng.integers(1, 4)), turn, offset)
         if not (a & b) or a <= b or b <= a:
             continue
         pieces = [S.cell_body(a, 0.5, rng), S.cell_body(b, 0.5, rng)]
@@ -191,3 +192,21 @@ def test_shared_edge_crossing_tie_break_case_is_never_certified_wrong():
     case = S.make_case("shared_edge_crossing", np.random.default_rng([22, 69]))
     verdict = S.judge(case)
     assert verdict.label in ("united", "exact", "refused") and verdict.wrong is None, verdict
+
+
+def test_self_crossing_shell_whose_crossings_are_all_coplanar_goes_to_the_overlay():
+    """R3: a shell whose only crossing face pairs overlap in a common plane (no crossing segment to cut along,
+    which ``arrange_crossings`` refuses as degenerate) is arranged by the coplanar overlay instead: the same
+    {w ≥ 1}, here the union's cells (closed form: 0.125 m³ a cell)."""
+    from inertia_tool.mesh.arrange import arrange_shells
+    rng = np.random.default_rng(7)
+    a, b = _box_cells((0, 0, 0), (3, 1, 1)), _box_cells((1, -1, 0), (1, 3, 2))
+    v, f = S._weld_exact(*S.concat(S.cell_body(a, 0.5, rng), S.cell_body(b, 0.5, rng)))
+    found = surface_contacts(v, f)
+    assert len(found.crossing)
+    done = arrange_shells(v, f, np.zeros(len(f), dtype=np.int64), found.crossing)
+    got = volume_moments(done.vertices, done.faces)
+    assert got.volume == pytest.approx(0.125 * len(a | b), rel=1e-14)
+    truth = _cells_truth(a | b, 0.5, np.eye(3), np.zeros(3))
+    assert np.allclose(got.centroid, truth.centroid, atol=1e-14)
+    assert done.crossings_left == 0 and done.arrangements[0].max_winding == 2

@@ -794,6 +794,22 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
                              patches=n_patches, max_winding=int(front.max()) + 1)
 
 
+def _arrange_shell(v: np.ndarray, f: np.ndarray, crossing: np.ndarray) -> Arrangement:
+    """One self-crossing shell: by :func:`arrange_crossings`, or, when every crossing pair lies in one plane
+    (faces overlapping coplanar, facing the same way: no crossing segment to cut along), by the coplanar overlay
+    (:func:`~.coplanar.arrange_coplanar`), which forms the same ``{w ≥ 1}``."""
+    a, b = f[crossing[:, 0]], f[crossing[:, 1]]
+    flat = np.all(np.stack([orient3d_sign(v[a[:, 0]], v[a[:, 1]], v[a[:, 2]], v[b[:, j]]) for j in range(3)],
+                           axis=1) == 0, axis=1)
+    if not len(crossing) or not flat.all():
+        return arrange_crossings(v, f, crossing)
+    from .coplanar import arrange_coplanar      # imported on use: coplanar self-overlaps are rare
+    done = arrange_coplanar(v, f)
+    return Arrangement(vertices=done.vertices, faces=done.faces, crossing_pairs=len(crossing),
+                       split_faces=done.split_faces, new_vertices=done.new_vertices, patches=done.patches,
+                       max_winding=done.max_winding, crossings_left=done.crossings_left)
+
+
 def _compact(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The used vertices (in order) and the faces renumbered onto them (linear time)."""
     used = np.zeros(len(vertices), dtype=bool)
@@ -927,8 +943,8 @@ def arrange_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
         if volume_moments(sv, sf).volume < 0:        # wound inward as a whole: {w ≥ 1} of the turned shell
             sf = sf[:, ::-1].copy()
             inside_out += 1
-        mine = pairs[labels[pairs[:, 0]] == s]
-        arranged = arrange_crossings(sv, sf, position[mine])
+        mine = position[pairs[labels[pairs[:, 0]] == s]]
+        arranged = _arrange_shell(sv, sf, mine)
         done.append(arranged)
         parts_v.append(arranged.vertices)
         parts_f.append(arranged.faces + offset)
