@@ -270,12 +270,12 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
     touching = _coplanar_pairs(v, f, contact)
     exact = _Exact(v, np.unique(f))
     across = contact[~touching]
-    inner = [(int(g), int(h)) for g, h in across.tolist()
-             if _touches_inside(exact, f, g, h) or _touches_inside(exact, f, h, g)]
-    if inner:
-        raise ArrangementError(f"{len(inner):,} face pairs touch across planes inside a face (a corner or edge of a "
-                               "face on the interior of a face of another plane): not handled by the coplanar "
-                               "overlay")
+    inside_touches = [(int(g), int(h)) for g, h in across.tolist()
+                      if _touches_inside(exact, f, g, h) or _touches_inside(exact, f, h, g)]
+    if inside_touches:
+        raise ArrangementError(f"{len(inside_touches):,} face pairs touch across planes inside a face (a corner or "
+                               "edge of a face on the interior of a face of another plane): not handled by the "
+                               "coplanar overlay")
     overlapping = np.concatenate([crossing, np.asarray(found.coplanar_opposite, dtype=np.int64).reshape(-1, 2),
                                   _repeated_pairs(f)])
     involved = np.unique(np.concatenate([overlapping.reshape(-1), contact[touching].reshape(-1)]))
