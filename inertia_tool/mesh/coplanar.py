@@ -392,6 +392,8 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
         raise ArrangementError("no face bounds the region of winding number ≥ 1 (the surface is wound inward)")
     # 5. checks
     result_v, result_f = _compact(out_v, kept)
+    if len(_repeated_pairs(result_f)):
+        raise ArrangementError("the surface of winding number ≥ 1 repeats a face (internal)")
     _check_balanced(result_f, len(result_v), np.ones(len(result_f), dtype=np.int64),
                     "the surface of winding number ≥ 1 is not closed (its edges do not balance)")
     after = surface_contacts(result_v, result_f)
@@ -514,6 +516,18 @@ def _near_faces(point: _Hom, p: np.ndarray, exact: _Exact, v: np.ndarray, f: np.
     return True
 
 
+def _edge_distance(point: np.ndarray, corners: list[np.ndarray]) -> np.ndarray:
+    """(m,) float: distance from ``point`` to the boundary (three edges) of each face (float64; the bound it enters
+    is a first-order term far below the margin unless the distance is tiny, where the face is settled exactly)."""
+    best = np.full(len(corners[0]), np.inf)
+    for j in range(3):
+        a, b = corners[j], corners[(j + 1) % 3]
+        d = b - a
+        t = np.clip(np.einsum("ij,ij->i", point - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(point - (a + t[:, None] * d), axis=1))
+    return best
+
+
 def _label(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndarray, mult: np.ndarray, patch: np.ndarray,
            n_patches: int, v: np.ndarray, f: np.ndarray, exact: _Exact, hom: dict[int, _Hom]) -> np.ndarray:
     """(p,) int: the winding number in front of each patch: ``W − c/2`` at a point of a piece, ``W`` over every
@@ -530,7 +544,10 @@ def _label(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndarray, mul
     units = normals / np.maximum(lengths, 1e-300)[:, None]
     # the float point is the exact point rounded (≤ u·|x| per coordinate): a face whose plane passes within a few
     # such roundings of it may have the float point on its other side, so its side is taken exactly
-    close = 64 * _U * (float(np.max(np.abs(v))) if len(v) else 1.0)
+    scale = float(np.max(np.abs(v))) if len(v) else 1.0
+    close = 64 * _U * scale
+    shift = 4 * _U * scale             # |float point − exact point| (each coordinate rounded once: ≤ √3·u·scale)
+    perimeter = sum(np.linalg.norm(corners[(j + 1) % 3] - corners[j], axis=1) for j in range(3))
     for p in range(n_patches):
         members = order[starts[p]:starts[p + 1]]
         tries = [(k, w) for k in members[:_TRIES].tolist() for w in _WEIGHTS][:_TRIES * 2]
@@ -541,6 +558,12 @@ def _label(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndarray, mul
             point = _point_on(hom, out_faces[k], weights)
             at = np.array(exact.to_float(point))
             theta, error = _winding_terms(at, v, f)
+            # the float point is not the exact one: a face's half solid angle moves by at most shift·L/(2(ρ − shift)²)
+            # between them (|∇Ω| ≤ ∮|dl|/r² over its boundary, ρ the distance from the boundary), unless ρ ≤ shift
+            rho = _edge_distance(at, corners)
+            with np.errstate(divide="ignore"):
+                error += np.where(rho > 2 * shift, shift * perimeter / (2 * np.maximum(rho - shift, 1e-300) ** 2),
+                                  np.inf)
             theta[same_plane] = error[same_plane] = 0.0
             unsure = (error > 1e-3) | ((np.abs(np.einsum("ij,ij->i", at - corners[0], units)) <= close)
                                        & (lengths > 0) & ~same_plane)
