@@ -488,31 +488,33 @@ def _near_faces(point: _Hom, p: np.ndarray, exact: _Exact, v: np.ndarray, f: np.
     False when ``p`` is too close to a face's edge as well (try another point)."""
     scale = float(np.max(np.abs(v))) if len(v) else 1.0
     slop = 16 * _U * scale
-    for g in np.flatnonzero(unsure).tolist():
-        (nx, ny, nz), d = exact.plane(f, g)
+    g = np.flatnonzero(unsure)
+    a, b, c = v[f[g, 0]], v[f[g, 1]], v[f[g, 2]]
+    normal = np.cross(b - a, c - a)
+    length = np.linalg.norm(normal, axis=1)
+    if np.any(length == 0.0):
+        return False
+    unit = normal / length[:, None]
+    height = np.einsum("ij,ij->i", p - a, unit)
+    delta = np.abs(height) + slop
+    foot = p - height[:, None] * unit
+    inside = np.full(len(g), np.inf)
+    for q, r in ((a, b), (b, c), (c, a)):                  # signed distance of the foot inside each edge
+        inward = np.cross(unit, r - q)
+        inside = np.minimum(inside, np.einsum("ij,ij->i", foot - q, inward)
+                            / np.maximum(np.linalg.norm(inward, axis=1), 1e-300))
+    over, beside = inside > 4 * delta, inside < -4 * delta
+    if not np.all(over | beside):
+        return False
+    for k in np.flatnonzero(over).tolist():
+        (nx, ny, nz), d = exact.plane(f, int(g[k]))
         side = d * point[3] - (nx * point[0] + ny * point[1] + nz * point[2])     # (a − P)·n, times W > 0
-        a, b, c = v[f[g, 0]], v[f[g, 1]], v[f[g, 2]]
-        normal = np.cross(b - a, c - a)
-        length = float(np.linalg.norm(normal))
-        if length == 0.0:
+        if side == 0:
             return False
-        unit = normal / length
-        delta = abs(float(np.dot(p - a, unit))) + slop
-        foot = p - np.dot(p - a, unit) * unit
-        reach = []
-        for q, r in ((a, b), (b, c), (c, a)):              # signed distance of the foot inside each edge
-            edge = r - q
-            inward = np.cross(unit, edge)
-            reach.append(float(np.dot(foot - q, inward)) / max(float(np.linalg.norm(inward)), 1e-300))
-        inside = min(reach)
-        if side != 0 and inside > 4 * delta:
-            theta[g] = np.pi if side > 0 else -np.pi
-            error[g] = np.pi * delta / (inside - delta)
-        elif inside < -4 * delta:
-            theta[g] = 0.0
-            error[g] = np.pi * delta / (-inside - delta)
-        else:
-            return False
+        theta[g[k]] = np.pi if side > 0 else -np.pi
+    error[g[over]] = np.pi * delta[over] / (inside[over] - delta[over])
+    theta[g[beside]] = 0.0
+    error[g[beside]] = np.pi * delta[beside] / (-inside[beside] - delta[beside])
     return True
 
 
@@ -548,13 +550,17 @@ def _label(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndarray, mul
     close = 64 * _U * scale
     shift = 4 * _U * scale             # |float point − exact point| (each coordinate rounded once: ≤ √3·u·scale)
     perimeter = sum(np.linalg.norm(corners[(j + 1) % 3] - corners[j], axis=1) for j in range(3))
+    planes: dict[int, np.ndarray] = {}                 # faces exactly in the plane of a source face
     for p in range(n_patches):
         members = order[starts[p]:starts[p + 1]]
         tries = [(k, w) for k in members[:_TRIES].tolist() for w in _WEIGHTS][:_TRIES * 2]
         for k, weights in tries:
             src = int(out_source[k])
-            a, b, c = (np.tile(v[f[src, j]], (len(f), 1)) for j in range(3))
-            same_plane = np.all(np.stack([orient3d_sign(a, b, c, x) for x in corners], axis=1) == 0, axis=1)
+            same_plane = planes.get(src)
+            if same_plane is None:
+                a, b, c = (np.tile(v[f[src, j]], (len(f), 1)) for j in range(3))
+                same_plane = np.all(np.stack([orient3d_sign(a, b, c, x) for x in corners], axis=1) == 0, axis=1)
+                planes[src] = same_plane
             point = _point_on(hom, out_faces[k], weights)
             at = np.array(exact.to_float(point))
             theta, error = _winding_terms(at, v, f)
