@@ -256,3 +256,20 @@ def test_bodies_on_grids_of_different_steps_never_wrong(seed):
         diag = float(np.linalg.norm(v.max(0) - v.min(0)))
         dvol, dcom, din = S.compare(p, union)
         assert dvol <= 1e-9 and dcom <= 1e-9 * diag and din <= 1e-8, (dvol, dcom, din)
+
+
+def test_zero_area_face_is_refused_by_the_overlay_not_crashed():
+    """A face with three collinear corners has no plane: the overlay refuses with that reason (an
+    ArrangementError, so the caller refuses or estimates), never a crash or a guess (was: StopIteration while
+    keying its plane)."""
+    rng = np.random.default_rng(1)
+    a, b = _box_cells((0, 0, 0), (2, 1, 1)), _box_cells((1, -1, 0), (1, 2, 1))
+    v, f = S._weld_exact(*S.concat(S.cell_body(a, 1.0, rng), S.cell_body(b, 1.0, rng)))
+    # a flat sliver pair on the edge a–b of the first face: (a, b, m) and its reverse, m the edge's midpoint (the
+    # surface stays closed)
+    m = len(v)
+    first = f[0]
+    v = np.vstack([v, 0.5 * (v[first[0]] + v[first[1]])])
+    f = np.vstack([f, [[first[0], first[1], m], [first[1], first[0], m]]])
+    with pytest.raises(ArrangementError, match="zero area"):
+        arrange_coplanar(v, f)
