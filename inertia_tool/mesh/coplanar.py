@@ -269,9 +269,9 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
     contact = np.asarray(found.contact, dtype=np.int64).reshape(-1, 2)
     touching = _coplanar_pairs(v, f, contact)
     exact = _Exact(v, np.unique(f))
-    tri = v[f]
-    area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    tiny = np.flatnonzero(area <= 1e-8 * max(float(np.max(np.abs(tri))), 1e-300) ** 2)
+    tri3 = v[f]
+    area = np.linalg.norm(np.cross(tri3[:, 1] - tri3[:, 0], tri3[:, 2] - tri3[:, 0]), axis=1)
+    tiny = np.flatnonzero(area <= 1e-8 * max(float(np.max(np.abs(tri3))), 1e-300) ** 2)
     if any(exact.plane(f, int(k))[0] == (0, 0, 0) for k in tiny.tolist()):
         raise ArrangementError("a face has zero area (three collinear corners): it has no plane to overlay in")
     across = contact[~touching]
