@@ -286,8 +286,8 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
     involved = np.unique(np.concatenate([overlapping.reshape(-1), contact[touching].reshape(-1)]))
     hom: dict[int, _Hom] = {vid: (p[0], p[1], p[2], 1) for vid, p in exact.point.items()}
     ids: dict[_Hom, int] = {}
-    for vid, corner in hom.items():
-        if ids.setdefault(corner, vid) != vid:
+    for vid in np.unique(f[involved]).tolist():
+        if ids.setdefault(hom[vid], vid) != vid:
             raise ArrangementError("two vertices of faces overlapping in a plane have the same coordinates (the "
                                    "surface is not welded there)")
     new_xyz: list[tuple[float, float, float]] = []
