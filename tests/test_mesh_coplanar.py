@@ -273,3 +273,17 @@ def test_zero_area_face_is_refused_by_the_overlay_not_crashed():
     f = np.vstack([f, [[first[0], first[1], m], [first[1], first[0], m]]])
     with pytest.raises(ArrangementError, match="zero area"):
         arrange_coplanar(v, f)
+
+
+def test_overlap_sum_still_refuses_welded_bodies_sharing_a_plane():
+    """``overlap='sum'`` asks for the bodies' summed integrals, which needs the bodies; at a welded edge where
+    coplanar faces face the same way they cannot be told apart, so R1b still refuses (the union is formed only
+    under 'union', the default)."""
+    from inertia_tool import mass_properties
+    case = S.make_case("welded_l_shapes", np.random.default_rng([22, 16]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(InvalidMeshError, match="could not be split into closed bodies"):
+            mass_properties((case.vertices, case.faces), density=1.0, overlap="sum")
+        p = mass_properties((case.vertices, case.faces), density=1.0)
+    assert p.mesh.certificate.kind == "united"
