@@ -249,6 +249,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     welded = None
     welded_arranged, welded_failed = None, ""
     if split_welded:                                                             # R1b (again: R2 relabels)
+        given = labels                           # the shells ``welded.ambiguous_shells`` is indexed by
         welded = welded_bodies(f, len(v), labels, n_shells, v)
         if welded.split:
             labels, n_shells = welded.labels, welded.n_shells
@@ -256,10 +257,17 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         if welded.ambiguous and overlap == "union" and welded.ambiguous_shells is not None:   # R1b: {w ≥ 1}
             try:
                 v, f, labels, n_shells, shells, bound, welded_arranged = _arrange_welded(
-                    v, f, labels, welded.ambiguous_shells, diag, source)
-                welded = None
+                    v, f, given, welded.ambiguous_shells, diag, source)
+                # R1b on the new surface: the other shells' welded bodies are split again (R1 joined them)
+                welded = welded_bodies(f, len(v), labels, n_shells, v)
+                if welded.ambiguous:
+                    raise ArrangementError("its result still has welded bodies whose faces cannot be paired")
+                if welded.split:
+                    labels, n_shells = welded.labels, welded.n_shells
+                    shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
             except ArrangementError as exc:
                 welded_failed = f"; its solid {{winding number ≥ 1}} could not be built: {exc}"
+                welded_arranged = None
         if welded is not None and welded.ambiguous:   # R1b: coplanar faces of two bodies facing the same way
             n_amb = welded.ambiguous
             reason = (f"{n_amb} shell{'s' if n_amb > 1 else ''} with non-manifold edges where coplanar faces of two "
