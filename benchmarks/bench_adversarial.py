@@ -60,6 +60,9 @@ def main(argv=None):
     ap.add_argument("--repair", action="store_true")
     ap.add_argument("--mc", type=int, default=100_000, help="Monte Carlo points for figure-eight cross-checks")
     ap.add_argument("--json", type=Path, default=None, help="write every failure (kind, index, recipe) here")
+    ap.add_argument("--kind", choices=S.KINDS, default=None,
+                    help="only the cases of this kind (case indices i with KINDS[i % len(KINDS)] == kind, "
+                         "--cases of them)")
     args = ap.parse_args(argv)
 
     if args.case is not None:
@@ -74,7 +77,12 @@ def main(argv=None):
     classes: dict[str, list] = defaultdict(list)
     worst_mc = 0.0
     t0 = time.time()
-    for i in range(args.cases):
+    if args.kind is None:
+        indices = range(args.cases)
+    else:
+        first = S.KINDS.index(args.kind)
+        indices = range(first, first + len(S.KINDS) * args.cases, len(S.KINDS))
+    for i in indices:
         case = draw(args.seed, i)
         if case.kind == "figure_eight" and args.mc:
             mc = S.monte_carlo(case.vertices, case.faces, np.random.default_rng([args.seed, i, 1]), args.mc)
@@ -88,7 +96,7 @@ def main(argv=None):
             if S.silent(verdict):
                 row["silent wrong"] += 1
             classes[failure_class(case, verdict)].append((len(case.faces), i, case.recipe, verdict.wrong))
-        if (i + 1) % 1000 == 0:
+        if (i + 1) % 1000 == 0 and args.kind is None:
             print(f"# {i + 1} cases, {time.time() - t0:.0f} s", file=sys.stderr, flush=True)
 
     cols = ("cases",) + LABELS + ("silent wrong",)

@@ -621,18 +621,20 @@ def test_nest_copied_rounded_apart_then_welded_is_counted_once():
         assert p.mesh.certificate.kind not in ("exact", "united") or (dvol <= 1e-12 and din <= 1e-12)
 
 
-def test_welded_bodies_with_coplanar_faces_at_a_crossing_edge_are_refused():
+def test_welded_bodies_with_coplanar_faces_at_a_crossing_edge_are_united():
     """Three boxes on a shared grid, some planes shared, welded: at a crossing edge coplanar faces of two bodies
     face the same way, so the order around the edge (which face closes which body) is undefined.  The bodies
-    overlap there and the sum would count it twice: refused with that reason (was: the sum, certified unverified,
-    4 % high); with ``repair`` the winding-number estimate, whose bounds hold."""
-    from inertia_tool.errors import InvalidMeshError
+    overlap there and the sum would count it twice (was: the sum, certified unverified, 4 % high; then refused
+    with that reason).  The solid {winding number ≥ 1} does not depend on the order: formed by the coplanar
+    overlay (mesh/coplanar.py), certified united, and right; with ``repair`` the same."""
     case = _generated("shared_edge_crossing", 319, n_kinds=16)
     assert "welded" in case.recipe and "planes shared" in case.recipe
-    with pytest.raises(InvalidMeshError, match="could not be split into closed bodies"):
-        _props(case.vertices, case.faces)
+    p, _ = _props(case.vertices, case.faces)
+    assert p.mesh.certificate.kind == "united" and "winding-arrangement" in p.mesh.certificate.checks
+    verdict = _assert_honest(case)
+    assert verdict.label == "united" and verdict.wrong is None
     verdict = _assert_honest(case, repair=True)
-    assert verdict.label == "estimate" and verdict.wrong is None
+    assert verdict.wrong is None
 
 
 def test_welded_l_shapes_on_one_plane_truth_agrees_with_manifold3d():
@@ -651,25 +653,22 @@ def test_welded_l_shapes_on_one_plane_truth_agrees_with_manifold3d():
         assert np.allclose(union.centroid, cells.centroid, atol=1e-12)
 
 
-def test_welded_l_shapes_on_one_plane_are_refused_never_wrong():
-    """Issue 21 item 2: two L-shaped prisms standing on one plane, crossing, welded bit-exactly.  At the crossing
+def test_welded_l_shapes_on_one_plane_are_united_never_wrong():
+    """Issue 21: two L-shaped prisms standing on one plane, crossing, welded bit-exactly.  At the crossing
     edges on the shared plane two coplanar faces of different bodies face the same way; which of them closes
     which body is not fixed by the surface (both lie in one half-plane of the edge, so no angle orders them).
     Breaking the tie by face order was tried: on ``make_case("shared_edge_crossing", rng([22, 69]))`` (two
     boxes sharing planes, welded) it grouped the faces into other closed bodies and certified the sum exact,
-    6 % high.  The solid {winding number ≥ 1} does not depend on the pairing, but forming it needs the
-    arrangement to cut coplanar faces facing the same way, which it refuses.  So R1b refuses (exit 3) with
-    that reason, and ``repair`` gives the winding-number estimate, whose bounds hold."""
-    from inertia_tool.errors import InvalidMeshError
+    6 % high.  The solid {winding number ≥ 1} does not depend on the pairing: the coplanar overlay
+    (mesh/coplanar.py) forms it, certified united, and it matches the union's cells (was: refused, exit 3)."""
+    labels = []
     for seed in range(4):
         case = S.make_case("welded_l_shapes", np.random.default_rng([22, seed]))
         assert "coplanar bottoms facing the same way" in case.recipe
-        with pytest.raises(InvalidMeshError, match="could not be split into closed bodies"):
-            _props(case.vertices, case.faces)
         verdict = _assert_honest(case)
-        assert verdict.label == "refused"
-    verdict = _assert_honest(case, repair=True)
-    assert verdict.label in ("estimate", "refused") and verdict.wrong is None
+        assert verdict.label in ("united", "refused")
+        labels.append(verdict.label)
+    assert "united" in labels
 
 
 def test_welded_grid_of_touching_cubes_is_left_whole_and_exact():

@@ -423,9 +423,9 @@ class _FaceTriangulation:
 
 # -- step 3: winding numbers of patches ------------------------------------------------------------------------
 
-def _winding_except(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
-                    skip: int) -> tuple[float, float]:
-    """Generalized winding number at ``point`` of every face but ``skip``, and a bound on its rounding error.
+def _winding_terms(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Half solid angle ``θ = Ω/2`` of every face seen from ``point`` (radians, so the face adds ``θ/2π`` to the
+    generalized winding number) and a bound on its float64 error (infinite where it cannot be bounded).
 
     Each face contributes ``Ω/4π`` with ``tan(Ω/2) = det/den`` (Van Oosterom and Strackee 1983), ``det = A·(B×C)``,
     ``den = |A||B||C| + (A·B)|C| + (A·C)|B| + (B·C)|A|`` for ``A = a − p`` etc.  In float64 ``|Δdet| ≤ 12u·P``
@@ -454,11 +454,23 @@ def _winding_except(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
         angle_error = np.where(r > h, (np.pi / 2) * h / np.maximum(r, 1e-300), np.inf)
     # atan2 jumps by 2π across den < 0, det = 0 (a point in the plane of a face, over it): unbounded there
     angle_error[(np.abs(det) <= h) & (den <= h)] = np.inf
-    theta = np.arctan2(det, den)
-    theta[skip] = angle_error[skip] = 0.0
+    return np.arctan2(det, den), angle_error
+
+
+def _winding_total(theta: np.ndarray, angle_error: np.ndarray) -> tuple[float, float]:
+    """The winding number ``Σθ/2π`` of :func:`_winding_terms` and the bound on its rounding error."""
     total = float(np.sum(theta)) / (2 * np.pi)
-    bound = float(np.sum(angle_error + 4 * _U * np.abs(theta))) / (2 * np.pi) + len(f) * 4 * _U
+    bound = float(np.sum(angle_error + 4 * _U * np.abs(theta))) / (2 * np.pi) + len(theta) * 4 * _U
     return total, bound
+
+
+def _winding_except(point: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
+                    skip: int | np.ndarray) -> tuple[float, float]:
+    """Generalized winding number at ``point`` of every face but ``skip`` (an index, or a boolean mask of the
+    faces left out), and a bound on its rounding error (:func:`_winding_terms`)."""
+    theta, angle_error = _winding_terms(point, vertices, faces)
+    theta[skip] = angle_error[skip] = 0.0
+    return _winding_total(theta, angle_error)
 
 
 def _patches(faces: np.ndarray, n_vertices: int, cut: set[int]) -> tuple[np.ndarray, int]:
@@ -782,6 +794,22 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
                              patches=n_patches, max_winding=int(front.max()) + 1)
 
 
+def _arrange_shell(v: np.ndarray, f: np.ndarray, crossing: np.ndarray) -> Arrangement:
+    """One self-crossing shell: by :func:`arrange_crossings`, or, when every crossing pair lies in one plane
+    (faces overlapping coplanar, facing the same way: no crossing segment to cut along), by the coplanar overlay
+    (:func:`~.coplanar.arrange_coplanar`), which forms the same ``{w ≥ 1}``."""
+    a, b = f[crossing[:, 0]], f[crossing[:, 1]]
+    flat = np.all(np.stack([orient3d_sign(v[a[:, 0]], v[a[:, 1]], v[a[:, 2]], v[b[:, j]]) for j in range(3)],
+                           axis=1) == 0, axis=1)
+    if not len(crossing) or not flat.all():
+        return arrange_crossings(v, f, crossing)
+    from .coplanar import arrange_coplanar      # imported on use: coplanar self-overlaps are rare
+    done = arrange_coplanar(v, f)
+    return Arrangement(vertices=done.vertices, faces=done.faces, crossing_pairs=len(crossing),
+                       split_faces=done.split_faces, new_vertices=done.new_vertices, patches=done.patches,
+                       max_winding=done.max_winding, crossings_left=done.crossings_left)
+
+
 def _compact(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The used vertices (in order) and the faces renumbered onto them (linear time)."""
     used = np.zeros(len(vertices), dtype=bool)
@@ -915,8 +943,8 @@ def arrange_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
         if volume_moments(sv, sf).volume < 0:        # wound inward as a whole: {w ≥ 1} of the turned shell
             sf = sf[:, ::-1].copy()
             inside_out += 1
-        mine = pairs[labels[pairs[:, 0]] == s]
-        arranged = arrange_crossings(sv, sf, position[mine])
+        mine = position[pairs[labels[pairs[:, 0]] == s]]
+        arranged = _arrange_shell(sv, sf, mine)
         done.append(arranged)
         parts_v.append(arranged.vertices)
         parts_f.append(arranged.faces + offset)

@@ -39,9 +39,17 @@ R1b *Bodies welded along their crossing are still separate bodies* (:func:`welde
    whole, where pairing last in, first out would give the boundary of their union around the boundary of their
    common part, which R4 would read as a body with a cavity (both pairings have the same winding number; only
    this one lets the depth rule agree with it).  Where coplanar faces of two bodies face the same way at such an
-   edge the order is undefined and the bodies overlap there: refused with that reason (``repair``: the
-   winding-number estimate).  Reason: a body is a closed surface, and the faces meeting at a non-manifold edge
-   say nothing about which of them close together.
+   edge the order is undefined and the bodies overlap there, but the winding number of the whole surface is not:
+   under ``overlap`` 'union' the shell is replaced by the boundary of its {winding number ≥ 1}
+   (:func:`~.coplanar.arrange_coplanar`: the faces overlapping in a common plane split along each other's edges
+   with exact predicates, each cell written once with its net cover, every patch labelled by a certified winding
+   number, the pieces kept where it crosses from 0 to ≥ 1), certified ``united`` with the check
+   ``winding-arrangement`` once the result is closed and no two of its faces cross or overlap.  Where that
+   overlay cannot form it (faces also crossing transversally, a face touching the inside of a face of another
+   plane, a winding number too close to call in float64) the shell is refused with that reason (``repair``: the
+   winding-number estimate); never paired by a tie-break (face order once certified a sum 6 % high as exact).
+   Reason: a body is a closed surface, and the faces meeting at a non-manifold edge say nothing about which of
+   them close together.
 R2 *Flat pieces carry no volume* (``tolerances.FLAT_RTOL``).  A closed shell whose |volume| is at most
    ``FLAT_RTOL · diagonal³`` (a face and its reverse, a zero-thickness wall, a collapsed sliver) contributes
    nothing to the integrals, so it is left out with a note and the answer stays exact (:func:`negligible_flat`:
@@ -175,8 +183,9 @@ CHECKS = {
                    "winding number puts each sheet inside its solid (a zero-thickness wall with material on both "
                    "sides) or, with repair only, outside it (a fin): either encloses no volume",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
-    "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves and the "
-                           "faces bounding {winding number ≥ 1} kept (mesh/arrange.py); the result was checked "
+    "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves (or its "
+                           "faces overlapping in a common plane along each other's edges) and the faces bounding "
+                           "{winding number ≥ 1} kept (mesh/arrange.py, mesh/coplanar.py); the result was checked "
                            "closed and free of crossing faces",
     "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
     "touching-up-to-rounding": "faces of touching shells cross only by rounding: the boolean union's volume equals "
@@ -711,6 +720,8 @@ class WeldedBodies:
         Shells with non-manifold edges that could not be split into closed bodies (kept whole).
     contact : (c, 2) int
         Face pairs of different shells that share a non-manifold edge by index (R4 tests their points).
+    ambiguous_shells : (s,) bool
+        The given shells counted by ``ambiguous`` (their faces go to the coplanar overlay, :mod:`~.coplanar`).
     """
 
     labels: np.ndarray
@@ -718,6 +729,7 @@ class WeldedBodies:
     split: int
     ambiguous: int
     contact: np.ndarray
+    ambiguous_shells: np.ndarray | None = None
 
 
 def _crossing_pairs_at_edges(vertices: np.ndarray, faces: np.ndarray, at: np.ndarray, edge_faces: np.ndarray,
@@ -904,7 +916,7 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
         pairs.append(np.stack([fs[i][keep], fs[j][keep]], axis=1))
     contact = np.unique(np.sort(np.concatenate(pairs), axis=1), axis=0) if pairs else np.zeros((0, 2), np.int64)
     return WeldedBodies(labels=new.astype(np.intp), n_shells=count_new, split=int(np.count_nonzero(splits)),
-                        ambiguous=ambiguous, contact=contact.astype(np.int64))
+                        ambiguous=ambiguous, contact=contact.astype(np.int64), ambiguous_shells=crossed & bad_shell)
 
 
 @frozen_value

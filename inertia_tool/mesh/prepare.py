@@ -247,17 +247,33 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     shells, bound = _accurate(v, f, labels, shells, centre)  # R7: signs and moments within the round-off bound
     f, labels, n_shells, shells, dropped_note, bound = _drop_flat(v, f, labels, shells, diag, source, bound)  # R2
     welded = None
+    welded_arranged, welded_failed = None, ""
     if split_welded:                                                             # R1b (again: R2 relabels)
+        given = labels                           # the shells ``welded.ambiguous_shells`` is indexed by
         welded = welded_bodies(f, len(v), labels, n_shells, v)
         if welded.split:
             labels, n_shells = welded.labels, welded.n_shells
             shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
-        if welded.ambiguous:     # R1b: coplanar faces of two bodies facing the same way at a welded edge
+        if welded.ambiguous and overlap == "union" and welded.ambiguous_shells is not None:   # R1b: {w ≥ 1}
+            try:
+                v, f, labels, n_shells, shells, bound, welded_arranged = _arrange_welded(
+                    v, f, given, welded.ambiguous_shells, diag, source)
+                # R1b on the new surface: the other shells' welded bodies are split again (R1 joined them)
+                welded = welded_bodies(f, len(v), labels, n_shells, v)
+                if welded.ambiguous:
+                    raise ArrangementError("its result still has welded bodies whose faces cannot be paired")
+                if welded.split:
+                    labels, n_shells = welded.labels, welded.n_shells
+                    shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+            except ArrangementError as exc:
+                welded_failed = f"; its solid {{winding number ≥ 1}} could not be built: {exc}"
+                welded_arranged = None
+        if welded is not None and welded.ambiguous:   # R1b: coplanar faces of two bodies facing the same way
             n_amb = welded.ambiguous
             reason = (f"{n_amb} shell{'s' if n_amb > 1 else ''} with non-manifold edges where coplanar faces of two "
                       "bodies facing the same way meet could not be split into closed bodies (which faces close "
                       "which body is undefined there); the bodies overlap, and the summed integral would count "
-                      "their common volume twice")
+                      "their common volume twice" + welded_failed)
             if not repair:
                 raise InvalidMeshError(f"{source}: {reason}; `repair=True` gives a bounded estimate of the solid "
                                        "{winding number ≥ 1}")
@@ -279,8 +295,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         found = Resolution(found.vertices, found.faces, found.method, found.notes + patch_notes,
                            found.flipped_faces, found.welded_tolerance, found.nonmanifold_edges, found.estimate)
     touch = shell_contacts(contacts, labels, n_shells)
-    crossing_note = arranged = None
-    arrange_failed, arranged_verified = "", False
+    crossing_note, arranged = None, welded_arranged
+    arrange_failed, arranged_verified = "", welded_arranged is not None
     if touch.self_crossing.any() and self_crossing == "refuse" and overlap == "union" and patched is None:   # R3
         try:
             v, f, labels, n_shells, shells, contacts, touch, arranged, arranged_verified, bound = \
@@ -347,7 +363,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if touch.complete and not touch.crossing.any() and crossing_note is None:
         checks.append("no-crossing-faces")
     # R3a may have taken out every non-manifold edge (a wall's rims): then nothing is left for the boolean to confirm
-    nonmanifold = found.nonmanifold_edges if folds is None else edge_topology(f, len(v), v).nonmanifold_edges
+    nonmanifold = found.nonmanifold_edges if folds is None and welded_arranged is None \
+        else edge_topology(f, len(v), v).nonmanifold_edges
     if candidates.any() or nonmanifold:                                         # R5, R6
         united = _unite(v, f, labels, owner, source, repair)
         summed = sum(s.volume for s in shells)
@@ -530,6 +547,28 @@ def _arrange_self_crossing(v: np.ndarray, f: np.ndarray, labels: np.ndarray, con
                  "points to float64 (a crossing in special position): not verified")
     warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
     return v, f, labels, n_shells, shells, contacts, touch, note, not done.crossings_left, bound
+
+
+def _arrange_welded(v: np.ndarray, f: np.ndarray, labels: np.ndarray, chosen: np.ndarray, diag: float,
+                    source: str) -> tuple[Any, ...]:
+    """R1b: the shells whose welded bodies could not be split replaced by the boundary of their {winding number
+    ≥ 1} (:mod:`~.coplanar`), then R1 and R2 again on the new surface.
+
+    Returns ``(v, f, labels, n_shells, shells, bound, note)``; raises ArrangementError (the result must not
+    cross itself, as R7 needs)."""
+    from .coplanar import arrange_coplanar_shells      # imported on use: welded coplanar bodies are rare
+    v, f, done = arrange_coplanar_shells(v, f, chosen[labels])
+    if done.crossings_left:
+        raise ArrangementError(f"{done.crossings_left:,} face pairs of the result cross after rounding the overlay's "
+                               "points to float64")
+    labels, n_shells = shell_labels(f, len(v))
+    shells, bound = _accurate(v, f, labels, body_volume_moments(v, f, labels, n_shells))
+    f, labels, n_shells, shells, _, bound = _drop_flat(v, f, labels, shells, diag, source, bound, warn=False)
+    note = (f"bodies welded along edges where faces overlap in a common plane ({done.coplanar_pairs:,} face pairs "
+            f"in {done.planes:,} plane{'s' if done.planes != 1 else ''}): the faces bounding the region of winding "
+            "number ≥ 1 kept, split along each other's edges (the common volume counts once)")
+    warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
+    return v, f, labels, n_shells, shells, bound, note
 
 
 def shared_text(summed: float, united: float) -> str:
