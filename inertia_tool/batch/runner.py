@@ -44,7 +44,7 @@ from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, os_error_reason
 from ..mesh.regular import open_regular
 from ..mass.pipeline import mass_properties, resolve_density
 from .chunks import (DASK_CHUNK_SECONDS, DASK_TAIL_SECONDS, POOL_CHUNK_SECONDS, POOL_TAIL_SECONDS, ChunkSizer,
-                     DaskTasks, PoolTasks)
+                     DaskTasks, PoolTasks, file_weights)
 
 __all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "SCHEMA_V1", "ROW_FIELDS_V1", "analyze_chunk",
            "analyze_file", "discover_files", "file_sha256", "run_batch", "upgrade_row", "downgrade_row",
@@ -422,6 +422,14 @@ def analyze_chunk(chunk: Sequence[tuple[str, str | None]], options: BatchOptions
     return [_analyze(path, options, digest, key, worker) for path, digest in chunk]
 
 
+def _analyze_chunk_timed(chunk: Sequence[tuple[str, str | None]], options: BatchOptions) -> tuple[list[dict], float]:
+    """:func:`analyze_chunk` and the CPU seconds this worker process spent on it (``time.process_time``: what
+    sizes the next chunks, which the load of a shared machine does not inflate as it does wall time)."""
+    start = time.process_time()
+    rows = analyze_chunk(chunk, options)
+    return rows, time.process_time() - start
+
+
 #: Seconds between the checks of the pool workers' watchdog that their parent (the batch run) is alive.
 _WATCHDOG_SECONDS = 0.5
 
@@ -566,7 +574,7 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
         Chunks submitted but not finished at most (default two per worker: one running, one queued), so
         memory stays bounded for huge batches.
     chunk_seconds : float, optional
-        Analysis time aimed at per chunk, s (default :data:`~inertia_tool.batch.chunks.POOL_CHUNK_SECONDS`
+        CPU time of analysis aimed at per chunk, s (default :data:`~inertia_tool.batch.chunks.POOL_CHUNK_SECONDS`
         for a process pool or executor, :data:`~inertia_tool.batch.chunks.DASK_CHUNK_SECONDS` for Dask).
 
     Returns
@@ -644,7 +652,8 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
         target = chunk_seconds or (DASK_CHUNK_SECONDS if client is not None else POOL_CHUNK_SECONDS)
         tail = min(target, DASK_TAIL_SECONDS if client is not None else POOL_TAIL_SECONDS)
         try:
-            _run_chunks(todo, options, tasks, ChunkSizer(target, tail_seconds=tail), record, max_in_flight)
+            sizer = ChunkSizer(file_weights([path for path, _ in todo]), target, tail_seconds=tail)
+            _run_chunks(todo, options, tasks, sizer, record, max_in_flight)
         finally:
             tasks.close()
     return BatchSummary(ok=ok, failed=failed, skipped=skipped, skipped_failed=skipped_failed,
@@ -661,6 +670,7 @@ def _run_chunks(todo: list[tuple[str, str | None]], options: BatchOptions, tasks
     chunk, there are at most ``2 * len(todo)`` chunks (each file is in at most one chunk and one retry).
     """
     queue: deque[list[tuple[str, str | None]]] = deque()     # single files to retry, first
+    weights: dict[int, float] = {}                            # of the chunks in flight, by id (retries: none)
     position = 0
     for _ in range(4 * len(todo) + 2):
         workers = tasks.workers
@@ -669,15 +679,19 @@ def _run_chunks(todo: list[tuple[str, str | None]], options: BatchOptions, tasks
             if queue:
                 chunk = queue.popleft()
             else:
-                size = sizer.next_size(len(todo) - position, workers)
+                size = sizer.next_size(position, workers)
                 chunk = todo[position:position + size]
+                weights[id(chunk)] = sizer.weight(position, position + size)
                 position += size
-            tasks.submit(analyze_chunk, chunk, options)
+            tasks.submit(_analyze_chunk_timed, chunk, options)
         if not tasks.in_flight():
             return
-        for chunk, rows, error in tasks.wait():
-            if rows is not None:
-                sizer.observe(len(rows), math.fsum(_as_float(r.get("seconds")) for r in rows))
+        for chunk, result, error in tasks.wait():
+            weight = weights.pop(id(chunk), None)
+            if result is not None:
+                rows, cpu = result
+                if weight is not None:
+                    sizer.observe(weight, cpu)
                 for row in rows:
                     record(row)
             elif len(chunk) > 1:
