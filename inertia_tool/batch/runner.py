@@ -40,7 +40,7 @@ from ..values import frozen_value
 from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, InertiaToolWarning, MeshReadError, UsageError
 from ..mesh.options import LoadOptions
-from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, os_error_reason
+from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, load_mesh, os_error_reason
 from ..mesh.regular import open_regular
 from ..mass.pipeline import mass_properties, resolve_density
 from .chunks import (DASK_CHUNK_SECONDS, DASK_TAIL_SECONDS, POOL_CHUNK_SECONDS, POOL_TAIL_SECONDS, ChunkSizer,
@@ -104,6 +104,11 @@ _TENSOR_ENTRIES = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))
 
 #: Bytes read at a time when hashing a file.
 _HASH_CHUNK = 1 << 20
+
+#: Largest file the batch reads into memory once, to hash it and to parse it from the same bytes (a binary STL of
+#: 330,000 triangles); a larger one is hashed and then read by the streaming reader, as it never holds the whole
+#: file.
+READ_ONCE_BYTES = 1 << 24
 
 
 def upgrade_row(row: dict) -> dict:
@@ -272,6 +277,32 @@ def file_sha256(path: str | os.PathLike) -> str:
     return h.hexdigest()
 
 
+def _read_once(path: str, limit: int = READ_ONCE_BYTES) -> tuple[bytes | None, str]:
+    """The bytes of a regular file of at most ``limit`` bytes and their SHA-256, from one open and one read (the
+    reader then parses those bytes: one file read once, its hash that of the bytes analysed); a larger file's
+    hash only (``None``, hashed in chunks; the reader streams it).
+
+    Raises
+    ------
+    MeshReadError
+        ``path`` is not a regular file (never opened: :func:`inertia_tool.mesh.regular.open_regular`).
+    OSError
+        It cannot be read.
+    """
+    with open_regular(path) as fh:
+        size = os.fstat(fh.fileno()).st_size
+        if size <= limit:
+            data = fh.read(size + 1)               # not read(limit): that would allocate `limit` bytes first
+            if len(data) <= size:                  # all of it (a file that grew since the fstat: streamed on)
+                return data, hashlib.sha256(data).hexdigest()
+            h = hashlib.sha256(data)
+        else:
+            h = hashlib.sha256()
+        while chunk := fh.read(_HASH_CHUNK):
+            h.update(chunk)
+    return None, h.hexdigest()
+
+
 def _one_line(text: object, limit: int = 500) -> str:
     text = " ".join(str(text).split())
     return text if len(text) <= limit else text[: limit - 1] + "…"
@@ -335,18 +366,25 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
     start = time.perf_counter()
     row = _empty_row(path, sha256, options, key, worker)
     try:
-        if row["sha256"] is None:
-            try:
-                row["sha256"] = file_sha256(path)
-            except MeshReadError:       # not a regular file: never opened
-                raise
-            except OSError as exc:       # unreadable: a property of the file, reported like the reader does
-                raise MeshReadError(f"{row['path']}: cannot be read ({os_error_reason(exc, path)})") from None
+        try:
+            # read once: hashed here and parsed from the same bytes (the hash is that of the content analysed;
+            # a hash given by the caller is replaced by the one of the bytes read now)
+            data, digest = _read_once(path)
+        except MeshReadError:       # not a regular file: never opened
+            raise
+        except OSError as exc:       # unreadable: a property of the file, reported like the reader does
+            raise MeshReadError(f"{row['path']}: cannot be read ({os_error_reason(exc, path)})") from None
+        row["sha256"] = digest
         _, described = resolve_density(density=options.density, material=options.material, mass=options.mass)
+        load = options.load
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", InertiaToolWarning)
-            props = mass_properties(path, density=options.density, material=options.material, mass=options.mass,
-                                    options=options.load)
+            raw = load_mesh(path, units=load.units, max_faces=load.max_faces,
+                            declared_units_win=load.declared_units_win, data=data)
+            # a file that names materials per part is integrated part by part from its path (it is read again:
+            # rare); every other file from the mesh just read, as mass_properties(path) would
+            props = mass_properties(path if raw.parts else raw, density=options.density, material=options.material,
+                                    mass=options.mass, options=load)
         pa = props.principal
         numbers = np.concatenate(([props.density, props.mass, props.volume, props.surface_area],
                                   props.center_of_mass, np.asarray(props.inertia)[_TENSOR_ENTRIES], pa.moments,
