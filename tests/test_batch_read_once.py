@@ -73,13 +73,21 @@ def test_each_file_is_opened_once_and_hashed_from_the_bytes_analysed(files, monk
 
 
 def test_a_file_above_the_read_once_limit_is_hashed_and_streamed(files, monkeypatch):
-    monkeypatch.setattr(batch_mod, "READ_ONCE_BYTES", 1000)
-    data, digest = batch_mod._read_once(files[1], limit=1000)
     with open(files[1], "rb") as fh:
-        assert data is None and digest == hashlib.sha256(fh.read()).hexdigest()
-    small, digest = batch_mod._read_once(files[0], limit=1 << 20)
+        real = hashlib.sha256(fh.read()).hexdigest()
+    data, digest = batch_mod._read_once(files[1], limit=1000)
+    assert data is None and digest == real
+    assert batch_mod._read_once(files[1], limit=1000, known="0" * 64) == (None, "0" * 64)   # not read again
+    small, digest = batch_mod._read_once(files[0], limit=1 << 20, known="0" * 64)
     with open(files[0], "rb") as fh:
-        assert small == fh.read() and digest == hashlib.sha256(small).hexdigest()
+        assert small == fh.read() and digest == hashlib.sha256(small).hexdigest()        # the bytes' own hash
+    # the rows of streamed files are those of files read once
+    once = analyze_chunk([(f, None) for f in files], OPTIONS)
+    monkeypatch.setattr(batch_mod, "READ_ONCE_BYTES", 1000)
+    streamed = analyze_chunk([(f, None) for f in files], OPTIONS)
+    strip = lambda r: {k: v for k, v in r.items() if k not in ("seconds", "worker")}  # noqa: E731
+    assert list(map(strip, streamed)) == list(map(strip, once))
+    assert analyze_file(files[1], OPTIONS, sha256="0" * 64)["sha256"] == "0" * 64   # too large to hold: kept
 
 
 @pytest.mark.parametrize("k", range(4))

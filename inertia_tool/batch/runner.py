@@ -277,10 +277,11 @@ def file_sha256(path: str | os.PathLike) -> str:
     return h.hexdigest()
 
 
-def _read_once(path: str, limit: int = READ_ONCE_BYTES) -> tuple[bytes | None, str]:
+def _read_once(path: str, limit: int | None = None, known: str | None = None) -> tuple[bytes | None, str]:
     """The bytes of a regular file of at most ``limit`` bytes and their SHA-256, from one open and one read (the
     reader then parses those bytes: one file read once, its hash that of the bytes analysed); a larger file's
-    hash only (``None``, hashed in chunks; the reader streams it).
+    hash only (``None``, hashed in chunks; the reader streams it), or ``known`` (a hash the caller computed) without
+    reading it.  ``limit`` defaults to :data:`READ_ONCE_BYTES`.
 
     Raises
     ------
@@ -289,6 +290,7 @@ def _read_once(path: str, limit: int = READ_ONCE_BYTES) -> tuple[bytes | None, s
     OSError
         It cannot be read.
     """
+    limit = READ_ONCE_BYTES if limit is None else limit
     with open_regular(path) as fh:
         size = os.fstat(fh.fileno()).st_size
         if size <= limit:
@@ -296,6 +298,8 @@ def _read_once(path: str, limit: int = READ_ONCE_BYTES) -> tuple[bytes | None, s
             if len(data) <= size:                  # all of it (a file that grew since the fstat: streamed on)
                 return data, hashlib.sha256(data).hexdigest()
             h = hashlib.sha256(data)
+        elif known is not None:
+            return None, known
         else:
             h = hashlib.sha256()
         while chunk := fh.read(_HASH_CHUNK):
@@ -347,7 +351,9 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
         Mesh file.
     options : BatchOptions
     sha256 : str, optional
-        The file's content hash if the caller already has it; computed here otherwise.
+        The file's content hash if the caller already has it.  A file read into memory (up to
+        :data:`READ_ONCE_BYTES`) is hashed again from the bytes analysed (they win if the file changed since); a
+        larger one keeps this hash, and is hashed here when it is not given.
 
     Returns
     -------
@@ -368,8 +374,9 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
     try:
         try:
             # read once: hashed here and parsed from the same bytes (the hash is that of the content analysed;
-            # a hash given by the caller is replaced by the one of the bytes read now)
-            data, digest = _read_once(path)
+            # a hash given by the caller is replaced by the one of the bytes read now, but for a file too large
+            # to hold, which is not read twice for it)
+            data, digest = _read_once(path, known=sha256)
         except MeshReadError:       # not a regular file: never opened
             raise
         except OSError as exc:       # unreadable: a property of the file, reported like the reader does
@@ -627,7 +634,8 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
     exactly one row.
 
     The SHA-256 that decides skipping is computed here only for files that have a done row of the same path
-    and options in ``previous_rows``; for the others nothing can be skipped and the worker hashes the file.
+    and options in ``previous_rows``; for the others nothing can be skipped and the worker hashes the file, from
+    the bytes it analyses (:func:`analyze_file`).
     """
     if jobs < 1:
         raise UsageError(f"Expected `jobs` >= 1, got {jobs}")
