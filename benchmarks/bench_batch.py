@@ -21,9 +21,10 @@ imports) is timed separately, not in files/s.
                                      [--baseline DIR]
 
 Run from the repository root (it puts the repository on sys.path).  ``--baseline DIR`` (e.g. a copy of ``main``
-with its built extension) runs the same configurations on DIR's ``inertia_tool`` in a child process after each
-round of this checkout's, so that before and after meet the same load; its rows are marked ``[baseline]`` and
-their ratios are to the baseline's own single process.
+with its built extension) runs each round of the same configurations on this checkout and on DIR's
+``inertia_tool``, each in a fresh child process, in alternating order, so that before and after meet the same
+load and the same conditions; the baseline's rows are marked ``[baseline]`` and their ratios are to its own single
+process.
 """
 
 from __future__ import annotations
@@ -148,10 +149,11 @@ def _catalogue(tmp, name, make, count):
     return files
 
 
-def _baseline_round(args) -> list[tuple[str, str, tuple[float, float]]]:
-    """One round of every configuration on the ``--baseline`` checkout, in a child process running this script
-    with ``--tree``: ``(catalogue, configuration, (seconds, CPU seconds))`` of each."""
-    argv = [sys.executable, os.path.abspath(__file__), "--tree", args.baseline, "--repeat", "1", "--json",
+def _child_round(args, tree: str) -> list[tuple[str, str, tuple[float, float]]]:
+    """One round of every configuration on the checkout ``tree``, in a fresh child process running this script
+    with ``--tree``: ``(catalogue, configuration, (seconds, CPU seconds))`` of each (configuration ``"startup"``:
+    the Dask cluster's start-up, seconds)."""
+    argv = [sys.executable, os.path.abspath(__file__), "--tree", tree, "--repeat", "1", "--json",
             "--set", args.set, "--small", str(args.small), "--files", str(args.files), "--kinds", args.kinds]
     done = subprocess.run(argv, capture_output=True, text=True, check=True)
     rows = [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
@@ -196,8 +198,20 @@ def main() -> None:
         results: dict = {}
         startups = []
         # rounds of every configuration in turn, so that a change in the machine's load hits all of them; the
-        # cluster lives only for its own runs (its client's event loop in this process would slow the others)
-        for r in range(args.repeat):
+        # cluster lives only for its own runs (its client's event loop in this process would slow the others).
+        # With --baseline both checkouts run each round in a fresh child process, in alternating order: in one
+        # process the rounds after the first ran their single process beside the threads a closed Dask client
+        # leaves behind, which the baseline's fresh child did not (0.3-0.6 ms of CPU per file more at load 15)
+        for r in range(args.repeat if args.baseline else 0):
+            trees = [(_tree([]), ""), (args.baseline, "[baseline] ")]
+            for tree, tag in trees if r % 2 == 0 else trees[::-1]:
+                for name, label, got in _child_round(args, tree):
+                    if name == "startup":
+                        if not tag:
+                            startups.append(got[0])
+                        continue
+                    results.setdefault((name, tag + label), []).append(got)
+        for r in range(0 if args.baseline else args.repeat):
             for label, kw in configs:
                 cluster = None
                 if "client" in kw:
@@ -212,18 +226,17 @@ def main() -> None:
                 finally:
                     if cluster is not None:
                         cluster.close()
-            if args.baseline:
-                for name, label, got in _baseline_round(args):
-                    key = (name, label if label.startswith("[baseline] ") else f"[baseline] {label}")
-                    results.setdefault(key, []).append(got)
         if args.json:
             for (name, label), rounds in results.items():
                 for sec, cpu in rounds:
                     print(json.dumps({"catalogue": name, "configuration": label, "seconds": sec, "cpu": cpu}))
+            for sec in startups:
+                print(json.dumps({"catalogue": "startup", "configuration": "startup", "seconds": sec, "cpu": 0.0}))
             return
         startup = min(startups) if startups else None
         if args.baseline:
-            print(f"[baseline]: {os.path.abspath(args.baseline)}, one round after each of this checkout's")
+            print(f"[baseline]: {os.path.abspath(args.baseline)}; each round of both checkouts in a fresh process, "
+                  "in alternating order")
         print("seconds and files/s: the fastest round; CPU: the median of the rounds (under load the fastest round in "
               "wall time is not the one of least CPU)")
         print(f"{'catalogue':9s} {'configuration':47s} {'seconds':>8s} {'files/s':>8s} {'ratio':>6s} "
