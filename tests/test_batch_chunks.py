@@ -192,6 +192,21 @@ def test_sizer_hands_out_every_file_once(n, workers, times, sizes):
     assert position == n and s.next_size(n, workers) == 0
 
 
+def test_chunks_are_measured_in_cpu_time_not_wall_time(many, monkeypatch):
+    """Regression (issue 25 item 6): the sizer was fed the rows' wall time, which a loaded machine inflates, so
+    the last chunks of a Dask run shrank to single files (22 tasks for 200 parts). A chunk's task now returns the
+    worker's CPU time: here 0.15 s of sleeping (no CPU) is not counted."""
+    import time
+
+    real = batch_mod._analyze
+    monkeypatch.setattr(batch_mod, "_analyze", lambda *args: (time.sleep(0.05), real(*args))[1])
+    start = time.perf_counter()
+    rows, cpu = batch_mod._analyze_chunk_timed([(p, None) for p in many[:3]], OPTIONS)
+    wall = time.perf_counter() - start
+    assert [r["status"] for r in rows] == ["ok"] * 3 and wall >= 0.15
+    assert 0 < cpu < wall - 0.1
+
+
 # -- the chunk loop ----------------------------------------------------------------------------------------
 
 def test_analyze_chunk_rows_in_chunk_order_with_hashes(many):
