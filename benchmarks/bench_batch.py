@@ -8,22 +8,23 @@ files (the real writer: lock, one ``write`` per row, fsync at most once a second
 - ``mix``: the 200 larger meshes of issue 8 (icospheres of 5,120-20,480 triangles, boxes, tori of 2k-18k,
   cylinders of 1k-4k; 0.6 kB-1 MB).
 
-It prints files/s and the ratio to one process for each (best of ``--repeat`` rounds, each round running every
+It prints files/s and the ratio to one process for each (the fastest of ``--repeat`` rounds, each round running every
 configuration in turn), with the load average before and after (the machine is shared: other work slows the
 parallel runs).  It also prints the CPU time per file of each configuration (this process, the pool's worker
-processes, the Dask workers: what chunking, IPC and the scheduler add) and the "CPU-bound ratio" that CPU time
-allows on two idle cores (one process's CPU time over half the configuration's), which the load of the machine
-changes less.  The Dask LocalCluster is started for its runs in each round and closed after them (its client's
-event loop would slow the other configurations); its start-up (worker processes, engine imports) is timed
-separately, not in files/s.
+processes, the Dask workers: what chunking, IPC and the scheduler add; the median of the rounds) and the "CPU-bound
+ratio" that CPU time allows on two idle cores (one process's CPU time over half the configuration's), which the
+load of the machine changes less.  The Dask LocalCluster is started for its runs in each round and closed after
+them (its client's event loop would slow the other configurations); its start-up (worker processes, engine
+imports) is timed separately, not in files/s.
 
     python benchmarks/bench_batch.py [--set small|mix|both] [--small 1000] [--files 200] [--repeat 3]
                                      [--baseline DIR]
 
 Run from the repository root (it puts the repository on sys.path).  ``--baseline DIR`` (e.g. a copy of ``main``
-with its built extension) runs the same configurations on DIR's ``inertia_tool`` in a child process after each
-round of this checkout's, so that before and after meet the same load; its rows are marked ``[baseline]`` and
-their ratios are to the baseline's own single process.
+with its built extension) runs each round of the same configurations on this checkout and on DIR's
+``inertia_tool``, each in a fresh child process, in alternating order, so that before and after meet the same
+load and the same conditions; the baseline's rows are marked ``[baseline]`` and their ratios are to its own single
+process.
 """
 
 from __future__ import annotations
@@ -148,10 +149,11 @@ def _catalogue(tmp, name, make, count):
     return files
 
 
-def _baseline_round(args) -> list[tuple[str, str, tuple[float, float]]]:
-    """One round of every configuration on the ``--baseline`` checkout, in a child process running this script
-    with ``--tree``: ``(catalogue, configuration, (seconds, CPU seconds))`` of each."""
-    argv = [sys.executable, os.path.abspath(__file__), "--tree", args.baseline, "--repeat", "1", "--json",
+def _child_round(args, tree: str) -> list[tuple[str, str, tuple[float, float]]]:
+    """One round of every configuration on the checkout ``tree``, in a fresh child process running this script
+    with ``--tree``: ``(catalogue, configuration, (seconds, CPU seconds))`` of each (configuration ``"startup"``:
+    the Dask cluster's start-up, seconds)."""
+    argv = [sys.executable, os.path.abspath(__file__), "--tree", tree, "--repeat", "1", "--json",
             "--set", args.set, "--small", str(args.small), "--files", str(args.files), "--kinds", args.kinds]
     done = subprocess.run(argv, capture_output=True, text=True, check=True)
     rows = [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
@@ -196,8 +198,20 @@ def main() -> None:
         results: dict = {}
         startups = []
         # rounds of every configuration in turn, so that a change in the machine's load hits all of them; the
-        # cluster lives only for its own runs (its client's event loop in this process would slow the others)
-        for r in range(args.repeat):
+        # cluster lives only for its own runs (its client's event loop in this process would slow the others).
+        # With --baseline both checkouts run each round in a fresh child process, in alternating order: in one
+        # process the rounds after the first ran their single process beside the threads a closed Dask client
+        # leaves behind, which the baseline's fresh child did not (0.3-0.6 ms of CPU per file more at load 15)
+        for r in range(args.repeat if args.baseline else 0):
+            trees = [(_tree([]), ""), (args.baseline, "[baseline] ")]
+            for tree, tag in trees if r % 2 == 0 else trees[::-1]:
+                for name, label, got in _child_round(args, tree):
+                    if name == "startup":
+                        if not tag:
+                            startups.append(got[0])
+                        continue
+                    results.setdefault((name, tag + label), []).append(got)
+        for r in range(0 if args.baseline else args.repeat):
             for label, kw in configs:
                 cluster = None
                 if "client" in kw:
@@ -208,28 +222,35 @@ def main() -> None:
                 try:
                     for name, files in catalogues.items():
                         got = _run(files, os.path.join(tmp, f"{name}_{label[:1]}_{r}.jsonl"), **kw)
-                        results[name, label] = min(got, results.get((name, label), got))
+                        results.setdefault((name, label), []).append(got)
                 finally:
                     if cluster is not None:
                         cluster.close()
-            if args.baseline:
-                for name, label, got in _baseline_round(args):
-                    key = (name, f"[baseline] {label}")
-                    results[key] = min(got, results.get(key, got))
         if args.json:
-            for (name, label), (sec, cpu) in results.items():
-                print(json.dumps({"catalogue": name, "configuration": label, "seconds": sec, "cpu": cpu}))
+            for (name, label), rounds in results.items():
+                for sec, cpu in rounds:
+                    print(json.dumps({"catalogue": name, "configuration": label, "seconds": sec, "cpu": cpu}))
+            for sec in startups:
+                print(json.dumps({"catalogue": "startup", "configuration": "startup", "seconds": sec, "cpu": 0.0}))
             return
         startup = min(startups) if startups else None
         if args.baseline:
-            print(f"[baseline]: {os.path.abspath(args.baseline)}, one round after each of this checkout's")
+            print(f"[baseline]: {os.path.abspath(args.baseline)}; each round of both checkouts in a fresh process, "
+                  "in alternating order")
+        print("seconds and files/s: the fastest round; CPU: the median of the rounds (under load the fastest round in "
+              "wall time is not the one of least CPU)")
         print(f"{'catalogue':9s} {'configuration':47s} {'seconds':>8s} {'files/s':>8s} {'ratio':>6s} "
               f"{'CPU ms/file':>11s} {'CPU-bound ratio':>15s}")
+
+        def best(rounds):
+            return min(sec for sec, _ in rounds), float(np.median([cpu for _, cpu in rounds]))
+
         for name, files in catalogues.items():
-            for (n, label), (sec, cpu) in results.items():
+            for (n, label), rounds in results.items():
                 if n == name:
+                    sec, cpu = best(rounds)
                     tree, own = ("[baseline] ", label[11:]) if label.startswith("[baseline] ") else ("", label)
-                    base, base_cpu = results[name, f"{tree}1 process (in-process)"]
+                    base, base_cpu = best(results[name, f"{tree}1 process (in-process)"])
                     # the wall ratio the CPU time allows with both cores to ourselves: the same CPU over 2
                     ideal = base_cpu / (cpu / (1 if own.startswith("1 ") else 2))
                     print(f"{name:9s} {label:47s} {sec:8.2f} {len(files) / sec:8.1f} {base / sec:6.2f} "

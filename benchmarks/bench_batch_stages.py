@@ -1,7 +1,8 @@
 """Where the time of ``inertia-tool batch`` goes per file: each stage timed on its own, in one run.
 
 Writes the ``small`` catalogue of ``bench_batch.py`` (default 1,000 parts of 12-4,800 triangles) and a 12-triangle
-box, then times per file: the SHA-256 of the file, reading it, the whole engine (``mass_properties`` with the
+box, then times per file: the SHA-256 of the file, reading it, what the batch does instead (one open and read that
+hashes the bytes, then the reader parsing those bytes), the whole engine (``mass_properties`` with the
 principal axes) and within it the face-pair check (``surface_contacts`` on the welded mesh), the batch's per-file
 work (``analyze_chunk``: engine, hash, row), formatting a row, one ``write`` of it, one ``fsync``, pickling a
 chunk's rows, and the round trip of an empty task through a 2-process pool (what one task per file paid on top of
@@ -31,7 +32,7 @@ import trimesh  # noqa: E402
 
 from bench_batch import SMALL_KINDS, _write_stl, make_small_meshes  # noqa: E402
 from inertia_tool.batch.rows import format_row  # noqa: E402
-from inertia_tool.batch.runner import BatchOptions, analyze_chunk, discover_files, file_sha256  # noqa: E402
+from inertia_tool.batch.runner import BatchOptions, _read_once, analyze_chunk, discover_files, file_sha256  # noqa: E402
 from inertia_tool.mass.pipeline import mass_properties  # noqa: E402
 from inertia_tool.mesh import LoadOptions  # noqa: E402
 from inertia_tool.mesh.intersect import surface_contacts  # noqa: E402
@@ -75,6 +76,9 @@ def main() -> None:
         stages = [
             ("sha256 of the file", lambda name: _per_file(file_sha256, sets[name])),
             ("read (load_mesh)", lambda name: _per_file(lambda f: load_mesh(f, units="mm"), sets[name])),
+            ("batch: read once (open, read, hash)", lambda name: _per_file(_read_once, sets[name])),
+            ("batch: read once + load_mesh of the bytes",
+             lambda name: _per_file(lambda f: load_mesh(f, units="mm", data=_read_once(f)[0]), sets[name])),
             ("engine (mass_properties + principal axes)",
              lambda name: _per_file(lambda f: mass_properties(f, density=1240.0, units="mm").principal, sets[name])),
             ("  of which the face-pair check (surface_contacts)",

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from conftest import kill_after_lines, write_binary_stl
 from inertia_tool.batch import rows as rows_mod
 from inertia_tool.batch import runner as batch_mod
-from inertia_tool.batch.chunks import ChunkSizer
+from inertia_tool.batch.chunks import ChunkSizer, file_weights
 from inertia_tool.batch.rows import open_results
 from inertia_tool.batch.runner import BatchOptions, analyze_chunk, discover_files, file_sha256, run_batch
 from inertia_tool.mesh import LoadOptions
@@ -44,113 +44,167 @@ def _mass(path):
 
 # -- the sizer -------------------------------------------------------------------------------------------
 
-def test_sizer_starts_with_one_file_then_follows_the_measured_time():
-    s = ChunkSizer(0.5)
-    assert s.next_size(1000, 2) == 1                      # nothing measured yet
-    s.observe(1, 0.001)                                   # 1 ms a file: 500 files wanted ...
-    assert s.next_size(1000, 2) == 4                      # ... but at most 4x the largest chunk so far
-    assert [s.next_size(10_000, 2) for _ in range(4)] == [16, 64, 256, 500]
-    s.observe(100, 1.0)                                   # now 10 ms a file on average with the 1 ms: 5.5 ms
-    assert s.next_size(10_000, 2) == int(0.5 / (0.5 * (0.001 + 0.01)))
+def _drive(sizer, workers, seconds_of):
+    """Hand out every file as run_batch does, telling the sizer each chunk's CPU time ``seconds_of(start, stop)``
+    at once; the chunk sizes."""
+    sizes, position = [], 0
+    for _ in range(sizer.files + 1):
+        size = sizer.next_size(position, workers)
+        if size == 0:
+            break
+        sizes.append(size)
+        sizer.observe(sizer.weight(position, position + size), seconds_of(position, position + size))
+        position += size
+    assert position == sizer.files
+    return sizes
 
 
-def test_sizer_tail_spreads_the_last_files_but_keeps_a_tenth_of_the_target():
-    s = ChunkSizer(0.5, max_files=10_000)
-    s.observe(10, 0.01)
-    s.largest = 10_000
-    assert s.next_size(400, 2) == 100                     # half a fair share of 400 over 2 workers
-    assert s.next_size(120, 2) == 50                      # share 30 < floor 0.05 s / 1 ms = 50
-    assert s.next_size(20, 2) == 20                       # never more than what is left
-    assert s.next_size(0, 2) == 0
+def test_short_batch_is_split_into_two_equal_chunks_per_worker():
+    """200 equal parts whose expected work (200 x 1 ms) is under a round of 0.5 s chunks: 4 chunks of 50 on 2
+    workers (the old sizer probed 1, 2, 4, 8 files and then shrank the tail: 22 tasks on a loaded machine)."""
+    s = ChunkSizer([50_000.0] * 200, 0.5, tail_seconds=0.02, prior_seconds_per_byte=2e-8)
+    assert _drive(s, 2, lambda a, b: (b - a) * 1e-3) == [50, 50, 50, 50]
+    s = ChunkSizer([50_000.0] * 30, 0.5, prior_seconds_per_byte=2e-8)
+    sizes = _drive(s, 4, lambda a, b: (b - a) * 1e-3)
+    assert len(sizes) == 8 and set(sizes) == {3, 4}                    # 30 / 8: 8 chunks, no 9th of rounding
+    # unequal files: equal weight per chunk (100 light files and 24 heavy ones, then 25-26 heavy), not equal counts
+    s = ChunkSizer([1_000.0] * 100 + [99_000.0] * 100, 1.0, prior_seconds_per_byte=2e-8)
+    assert _drive(s, 2, lambda a, b: 0.0) == [124, 25, 26, 25]        # boundaries nearest 2.5, 5, 7.5 MB
 
 
-def test_sizer_tail_floor_is_its_own_setting():
-    s = ChunkSizer(0.5, max_files=10_000, tail_seconds=0.02)             # Dask's target and tail floor
-    s.observe(10, 0.01)
-    s.largest = 10_000
-    assert s.next_size(120, 2) == 30                      # half a fair share: 30 > floor 0.02 s / 1 ms = 20
-    assert s.next_size(40, 2) == 20                       # share 10 < floor 20
+def test_long_batch_follows_the_measured_cpu_time_then_spreads_the_tail():
+    s = ChunkSizer([10_000.0] * 100_000, 0.5, max_files=10_000, tail_seconds=0.02, prior_seconds_per_byte=1e-8)
+    assert s.next_size(0, 2) == 5_000                                  # 0.5 s / (10 kB x 10 ns): the prior
+    s.observe(s.weight(0, 5_000), 5_000 * 1e-3)                        # measured: 1 ms a file (100 ns a byte)
+    assert s.next_size(5_000, 2) == 500                                # replaces the prior: 0.5 s of 1 ms files
+    s.observe(s.weight(0, 100), 100 * 3e-3)                            # 3 ms a file: the average, 2 ms
+    assert s.next_size(10_000, 2) == 250
+    s.observe(s.weight(0, 100), 100 * 1e-3)                            # back to 1.5 ms
+    s.observe(s.weight(0, 100), 100 * 1e-3)                            # 1.25 ms
+    assert s.next_size(90_000, 2) == 400
+    assert s.next_size(99_000, 2) == 250                               # half a fair share of 1,000 over 2 workers
+    assert s.next_size(99_900, 2) == 25                                # ... of 100
+    assert s.next_size(99_950, 2) == 16                                # share 12.5 < floor 0.02 s / 1.25 ms = 16
+    assert s.next_size(99_990, 2) == 10                                # never more than what is left
+    assert s.next_size(100_000, 2) == 0
+
+
+def test_sizer_settings_are_checked():
+    for bad in (dict(tail_seconds=0.6), dict(tail_seconds=0.0), dict(max_files=0), dict(prior_seconds_per_byte=0.0)):
+        with pytest.raises(ValueError):
+            ChunkSizer([1.0], 0.5, **bad)
     with pytest.raises(ValueError):
-        ChunkSizer(0.5, tail_seconds=0.6)
+        ChunkSizer([1.0], 0.0)
     with pytest.raises(ValueError):
-        ChunkSizer(0.5, tail_seconds=0.0)
+        ChunkSizer([1.0, -1.0], 0.5)
 
 
-def _makespan(files: int, seconds_per_file: float, workers: int, sizer: ChunkSizer) -> float:
-    """When the last of ``files`` equal files is done, on ``workers`` workers fed as ``_run_chunks`` feeds a Dask
-    cluster (two chunks in flight per worker, the next queued chunk going to the first idle worker, the sizer
-    told of each chunk as it comes back), with no round-trip time: a model of where the end of a batch waits."""
+def test_file_weights_are_sizes_plus_the_overhead_and_never_open_a_fifo(tmp_path):
+    (tmp_path / "a").write_bytes(b"x" * 100)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    w = file_weights([str(tmp_path / "a"), str(tmp_path / "missing"), str(fifo)], overhead=1000)
+    assert w.tolist() == [1100.0, 1000.0, 1000.0]
+
+
+def _makespan(weights, seconds_per_byte: float, workers: int, sizer: ChunkSizer) -> tuple[float, int]:
+    """When the last file is done and how many chunks it took, on ``workers`` workers fed as ``_run_chunks``
+    feeds a Dask cluster (two chunks in flight per worker, the next queued chunk going to the first idle worker,
+    the sizer told of each chunk's CPU time as it comes back), with no round-trip time: a model of where the end
+    of a batch waits."""
     import heapq
 
-    queue, running, done_at = [], [], 0.0            # running: heap of (finish time, files)
-    handed = 0
+    queue, running, done_at = [], [], 0.0            # running: heap of (finish time, start, stop)
+    position = chunks = 0
     idle = [0.0] * workers                           # when each worker is free
     now = 0.0
-    for _ in range(4 * files + 4):
-        while len(queue) + len(running) < 2 * workers and handed < files:
-            size = sizer.next_size(files - handed, workers)
-            queue.append(size)
-            handed += size
+    n = len(weights)
+    for _ in range(4 * n + 4):
+        while len(queue) + len(running) < 2 * workers and position < n:
+            size = sizer.next_size(position, workers)
+            queue.append((position, position + size))
+            position += size
+            chunks += 1
         while queue and min(idle) <= now:             # idle workers take the queued chunks, in order
             k = idle.index(min(idle))
-            size = queue.pop(0)
-            idle[k] = now + size * seconds_per_file
-            heapq.heappush(running, (idle[k], size))
+            a, b = queue.pop(0)
+            idle[k] = now + sizer.weight(a, b) * seconds_per_byte
+            heapq.heappush(running, (idle[k], a, b))
         if not running:
-            return done_at
-        now, size = heapq.heappop(running)
+            return done_at, chunks
+        now, a, b = heapq.heappop(running)
         done_at = max(done_at, now)
-        sizer.observe(size, size * seconds_per_file)
+        sizer.observe(sizer.weight(a, b), sizer.weight(a, b) * seconds_per_byte)
     raise AssertionError("the model did not finish")
 
 
-def test_dask_tail_floor_bounds_the_last_wait():
-    """Equal files on two workers, in the model of ``_makespan``: the end of the batch waits (beyond the ideal
-    half of the work) at most the tail floor and one file, over a sweep of batch sizes and times per file; with
-    the floor of before (a tenth of the 0.5 s target) the bound was 0.05 s, and the waits summed over the sweep
-    are no shorter."""
+@settings(max_examples=40, deadline=None)
+@given(files=st.integers(1, 3000), per_file=st.sampled_from([0.0005, 0.0015, 0.004, 0.03]),
+       spread=st.floats(0.0, 3.0), seed=st.integers(0, 2**16), prior=st.sampled_from([0.1, 1.0, 10.0]))
+def test_dask_chunks_bound_the_last_wait_and_the_tasks(files, per_file, spread, seed, prior):
+    """Files of random sizes on two workers, in the model of ``_makespan``, with a prior off by 10x either way:
+    the end of the batch waits (beyond the ideal half of the work) at most the larger of a short batch's chunk
+    and the tail floor, plus one file; and a short batch takes 4 chunks, plus one for each file heavier than a
+    chunk (a chunk holds at least one file)."""
     from inertia_tool.batch.chunks import DASK_CHUNK_SECONDS, DASK_TAIL_SECONDS
 
-    new_total = old_total = 0.0
-    for files in (200, 333, 500, 1000, 2000):
-        for per_file in (0.0005, 0.0015, 0.004):
-            ideal = files * per_file / 2
-            new = _makespan(files, per_file, 2, ChunkSizer(DASK_CHUNK_SECONDS, tail_seconds=DASK_TAIL_SECONDS))
-            old = _makespan(files, per_file, 2, ChunkSizer(DASK_CHUNK_SECONDS))
-            assert -1e-12 <= new - ideal <= DASK_TAIL_SECONDS + per_file, (files, per_file)
-            new_total += new - ideal
-            old_total += old - ideal
-    assert new_total <= old_total
+    rng = np.random.default_rng(seed)
+    weights = 33_000.0 * np.exp(spread * rng.standard_normal(files))
+    rate = per_file / 33_000.0
+    sizer = ChunkSizer(weights, DASK_CHUNK_SECONDS, tail_seconds=DASK_TAIL_SECONDS,
+                       prior_seconds_per_byte=rate * prior)
+    total = float(weights.sum()) * rate
+    makespan, chunks = _makespan(weights, rate, 2, sizer)
+    largest = float(weights.max()) * rate
+    short = total * prior <= 4 * DASK_CHUNK_SECONDS
+    assert makespan >= total / 2 - 1e-9
+    if short:
+        heavy = int(np.count_nonzero(weights > weights.sum() / 4))
+        assert chunks <= min(4 + heavy, files) and makespan - total / 2 <= total / 4 + 2 * largest + 1e-9
+    else:
+        assert makespan - total / 2 <= max(DASK_TAIL_SECONDS, DASK_CHUNK_SECONDS / prior) + 2 * largest + 1e-9
 
 
 def test_sizer_bounds():
-    s = ChunkSizer(1.0, max_files=7)
-    s.observe(1, 1e-6)
-    s.largest = 100
-    assert s.next_size(10**6, 1) == 7
-    s2 = ChunkSizer(0.05)
-    s2.observe(1, 3.0)                                    # a file longer than the target: one file a chunk
-    assert s2.next_size(100, 2) == 1
-    with pytest.raises(ValueError):
-        ChunkSizer(0.0)
+    s = ChunkSizer([1.0] * 10**6, 1.0, max_files=7)
+    assert s.next_size(0, 1) == 7
+    s2 = ChunkSizer([1.0] * 100, 0.05, prior_seconds_per_byte=3.0)     # a file longer than the target
+    assert s2.next_size(0, 2) == 1
 
 
 @settings(max_examples=60, deadline=None)
 @given(n=st.integers(1, 3000), workers=st.integers(1, 8),
-       times=st.lists(st.floats(1e-5, 2.0), min_size=1, max_size=50))
-def test_sizer_hands_out_every_file_once(n, workers, times):
+       times=st.lists(st.floats(1e-9, 2e-6), min_size=1, max_size=50),
+       sizes=st.lists(st.floats(0.0, 1e7), min_size=1, max_size=50))
+def test_sizer_hands_out_every_file_once(n, workers, times, sizes):
     """Driving the sizer as run_batch does hands out exactly n files, each chunk non-empty, in a bounded number
-    of chunks."""
-    s = ChunkSizer(0.05)
+    of chunks, whatever the weights (zero ones too) and the measured times."""
+    weights = [sizes[k % len(sizes)] for k in range(n)]
+    s = ChunkSizer(weights, 0.05)
     position = chunks = 0
     while position < n:
-        size = s.next_size(n - position, workers)
+        size = s.next_size(position, workers)
         assert 1 <= size <= n - position
+        s.observe(s.weight(position, position + size), s.weight(position, position + size) * times[chunks % len(times)])
         position += size
-        s.observe(size, size * times[chunks % len(times)])
         chunks += 1
         assert chunks <= n
-    assert position == n and s.next_size(0, workers) == 0
+    assert position == n and s.next_size(n, workers) == 0
+
+
+def test_chunks_are_measured_in_cpu_time_not_wall_time(many, monkeypatch):
+    """Regression (issue 25 item 6): the sizer was fed the rows' wall time, which a loaded machine inflates, so
+    the last chunks of a Dask run shrank to single files (22 tasks for 200 parts). A chunk's task now returns the
+    worker's CPU time: here 0.15 s of sleeping (no CPU) is not counted."""
+    import time
+
+    real = batch_mod._analyze
+    monkeypatch.setattr(batch_mod, "_analyze", lambda *args: (time.sleep(0.05), real(*args))[1])
+    start = time.perf_counter()
+    rows, cpu = batch_mod._analyze_chunk_timed([(p, None) for p in many[:3]], OPTIONS)
+    wall = time.perf_counter() - start
+    assert [r["status"] for r in rows] == ["ok"] * 3 and wall >= 0.15
+    assert 0 < cpu < wall - 0.1
 
 
 # -- the chunk loop ----------------------------------------------------------------------------------------
@@ -245,14 +299,15 @@ def test_rows_stream_back_in_order_of_completion(many, monkeypatch):
     _before_analysing(monkeypatch, slow, lambda: release.wait(30))
     order = []
 
+    # 40 equal boxes, a short batch on 2 workers: 4 chunks of 10, the slow file in the first
     def write(row):
         order.append(row["path"])
-        if len(order) == len(many) - 1:                # everything else is written: let the slow file finish
+        if len(order) == len(many) - 10:               # every other chunk is written: let the slow file finish
             release.set()
 
     with cf.ThreadPoolExecutor(2) as pool:
         run_batch(many, OPTIONS, write, jobs=2, executor=pool, chunk_seconds=100.0)
-    assert order[-1] == slow and sorted(order) == many
+    assert order[-10] == slow and sorted(order[-10:]) == many[:10] and sorted(order) == many
 
 
 # -- the results file: fsync at most once per sync_seconds, every row written at once -----------------------

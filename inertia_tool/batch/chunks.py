@@ -1,13 +1,21 @@
-"""Handing files to workers in chunks sized from a measured per-file time, and taking results back as they come.
+"""Handing files to workers in chunks sized by their expected CPU time, and taking results back as they come.
 
 One task per file makes the per-task cost of the executor the bottleneck on small meshes (a process pool pays
-~0.2 ms a task in pickling and pipes, a Dask scheduler a few ms), so :func:`~inertia_tool.batch.runner.run_batch`
-hands out *chunks*: lists of files analysed one after the other by one worker, which returns their rows
-together.  :class:`ChunkSizer` decides how many files go into the next chunk from the analysis time the workers
-measured (the rows' ``seconds``): the first chunks hold 1, 2, 4, then 8 files (nothing is measured yet), later ones
-hold ``target_seconds / seconds_per_file`` files, growing at most fourfold per chunk, and no more than half a
-fair share of the files left (so that the last chunks spread over every worker) unless that is less than the
-tail floor (:data:`POOL_TAIL_SECONDS`, :data:`DASK_TAIL_SECONDS`: a few of the executor's round trips).
+~0.2 ms a task in pickling and pipes, a Dask LocalCluster 2-5 ms of CPU), so
+:func:`~inertia_tool.batch.runner.run_batch` hands out *chunks*: lists of files analysed one after the other by
+one worker, which returns their rows together.  :class:`ChunkSizer` decides which files go into the next chunk.
+
+It sizes chunks by *weight*, a file's bytes plus :data:`FILE_OVERHEAD_BYTES` (the per-file cost of a small part,
+in bytes of binary STL), times the CPU seconds per byte of weight: assumed (:data:`PRIOR_SECONDS_PER_BYTE`) until
+a chunk comes back, then measured (the workers' CPU time, ``time.process_time``, not their wall time, which the
+load of a shared machine inflates: sized by wall time, a loaded machine shrank the last chunks to single files).
+
+- A *short* batch, whose expected work is at most a round of chunks of the target size (two per worker), is
+  split at once into two chunks per worker of equal weight: 4 tasks for 200 parts on 2 workers, where probing
+  (1, 2, 4, 8 files) and a shrinking tail made 22, each costing the cluster milliseconds of CPU.
+- A longer batch gets chunks of ``target_seconds`` of expected work, and, once what is left is less than a round
+  of them, chunks of half a fair share of what is left (so the last chunks spread over every worker), but not
+  below ``tail_seconds`` (each chunk costs a round trip of the executor).
 
 :class:`PoolTasks` (any ``concurrent.futures`` executor, by default a process pool of this machine) and
 :class:`DaskTasks` (a ``dask.distributed`` client: a LocalCluster or a remote scheduler, the same code) give the
@@ -18,12 +26,16 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import math
+import os
 import pickle
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
+import numpy as np
+
 __all__ = ["ChunkSizer", "PoolTasks", "DaskTasks", "Finished", "POOL_CHUNK_SECONDS", "DASK_CHUNK_SECONDS",
-           "POOL_TAIL_SECONDS", "DASK_TAIL_SECONDS", "run_packed"]
+           "POOL_TAIL_SECONDS", "DASK_TAIL_SECONDS", "FILE_OVERHEAD_BYTES", "PRIOR_SECONDS_PER_BYTE",
+           "file_weights", "run_packed"]
 
 #: Seconds of work aimed at per chunk on a local process pool (task cost ~0.2 ms: 0.05 s makes it < 1 %,
 #: and a killed run loses at most this much work per worker).
@@ -38,39 +50,62 @@ POOL_TAIL_SECONDS = 0.005
 
 #: Least work of a chunk near the end of a batch on Dask, s: above the ~8 ms from ``Client.map`` to a task
 #: starting, so that with two chunks in flight per worker the round trip stays hidden behind the running chunk.
-#: The last chunks bound how long one worker may wait for the other at the end: by a tenth of the target (0.05 s)
-#: before, a third of a 200-part batch's 0.15 s of work per worker; now by this.
 DASK_TAIL_SECONDS = 0.02
 
-#: A finished chunk: ``(chunk, rows, None)`` or ``(chunk, None, exception)`` when the task itself failed (its
+#: What a file costs beyond its bytes, counted in bytes (a file's weight is its size plus this): on the small
+#: catalogue of ``benchmarks/bench_batch.py`` a 12-triangle box (684 bytes) takes ~0.7 ms of CPU and the average
+#: part (56 kB) ~1.6 ms, about 20 ns per byte of size plus this.
+FILE_OVERHEAD_BYTES = 32_768
+
+#: CPU seconds per byte of weight assumed before any chunk has been measured (see :data:`FILE_OVERHEAD_BYTES`;
+#: 2026-11-26, the project's 2-core machine).  A wrong prior only misjudges the first chunks: 10x too low makes
+#: them 10x the target, never unbounded (:attr:`ChunkSizer.max_files`).
+PRIOR_SECONDS_PER_BYTE = 2e-8
+
+#: A finished chunk: ``(chunk, result, None)`` or ``(chunk, None, exception)`` when the task itself failed (its
 #: worker died, the cluster lost it); a chunk is a list of ``(path, sha256 or None)``.
-Finished = tuple[list, "list[dict] | None", "BaseException | None"]
+Finished = tuple[list, Any, "BaseException | None"]
+
+
+def file_weights(paths: Sequence[str], overhead: int = FILE_OVERHEAD_BYTES) -> np.ndarray:
+    """(n,) float: each file's size in bytes (``os.stat``, which never opens it: a FIFO does not hang) plus
+    ``overhead``; a file that cannot be stat'ed weighs ``overhead`` (its worker writes the error row)."""
+    out = np.full(len(paths), float(overhead))
+    for k, path in enumerate(paths):
+        try:
+            out[k] += os.stat(path).st_size
+        except (OSError, ValueError):
+            pass
+    return out
 
 
 class ChunkSizer:
-    """How many files to put in the next chunk, from the measured per-file analysis time.
+    """Which files go into the next chunk: contiguous runs of files of about the same expected CPU time.
 
     Parameters
     ----------
+    weights : (n,) array_like of float
+        The weight of each file of the batch, in order (:func:`file_weights`), all >= 0.
     target_seconds : float
-        Work aimed at per chunk, s.
+        CPU time aimed at per chunk, s.
     max_files : int
         Upper bound of a chunk (bounds memory and the work a killed run loses).
-    growth : float
-        A chunk holds at most this many times the files of the largest one so far (a few fast first files
-        must not make the next chunk huge).
     tail_seconds : float, optional
-        Least work of a chunk when the tail rule (half a fair share of what is left) would make it smaller, s
-        (default a tenth of ``target_seconds``): each chunk costs a round trip of the executor.
+        Least CPU time of a chunk at the end of a long batch, s (default a tenth of ``target_seconds``).
+    prior_seconds_per_byte : float
+        CPU seconds per byte of weight until the first chunk is measured.
 
     Notes
     -----
-    The per-file time is an exponential moving average (weight ``1/2``) of each finished chunk's mean time per
-    file, so a catalogue sorted from small to large parts adapts within a few chunks.
+    The CPU seconds per byte are an exponential moving average (weight ``1/2``) of each finished chunk's, so a
+    catalogue sorted from one kind of part to another adapts within a few chunks.  Expected CPU time of a run of
+    files is its weight times that rate.  A batch is *short* when its expected work is at most
+    ``2 * workers * target_seconds``: its files are split into ``2 * workers`` chunks of equal weight (the first
+    round hands out all of them); the split is fixed at the first call.
     """
 
-    def __init__(self, target_seconds: float, *, max_files: int = 1000, growth: float = 4.0,
-                 tail_seconds: float | None = None):
+    def __init__(self, weights: Sequence[float] | np.ndarray, target_seconds: float, *, max_files: int = 1000,
+                 tail_seconds: float | None = None, prior_seconds_per_byte: float = PRIOR_SECONDS_PER_BYTE):
         if not (target_seconds > 0 and math.isfinite(target_seconds)):
             raise ValueError(f"Expected `target_seconds` > 0, got {target_seconds}")
         if tail_seconds is None:
@@ -79,39 +114,68 @@ class ChunkSizer:
             raise ValueError(f"Expected 0 < `tail_seconds` <= `target_seconds` ({target_seconds}), got {tail_seconds}")
         if max_files < 1:
             raise ValueError(f"Expected `max_files` >= 1, got {max_files}")
+        if not (prior_seconds_per_byte > 0 and math.isfinite(prior_seconds_per_byte)):
+            raise ValueError(f"Expected `prior_seconds_per_byte` > 0, got {prior_seconds_per_byte}")
+        w = np.asarray(weights, dtype=np.float64).reshape(-1)
+        if not (np.isfinite(w).all() and (w >= 0).all()):
+            raise ValueError("Expected finite weights >= 0")
         self.target_seconds = float(target_seconds)
         self.max_files = int(max_files)
-        self.growth = float(growth)
         self.tail_seconds = float(tail_seconds)
-        self.seconds_per_file: float | None = None
-        self.largest = 1
-        self._probes = 0
+        self.prior_seconds_per_byte = float(prior_seconds_per_byte)
+        self.seconds_per_byte: float | None = None
+        self._cumulative = np.concatenate(([0.0], np.cumsum(w)))
+        self._short_weight: float | None = None       # the fixed chunk weight of a short batch, once decided
+        self._short_start = 0.0                        # the cumulative weight where the short batch's chunks start
+        self._decided = False
 
-    def observe(self, files: int, seconds: float) -> None:
-        """Record a finished chunk of ``files`` files that took ``seconds`` of analysis in all."""
-        if files < 1 or not math.isfinite(seconds) or seconds < 0:
+    @property
+    def files(self) -> int:
+        """Files of the batch."""
+        return len(self._cumulative) - 1
+
+    def observe(self, weight: float, seconds: float) -> None:
+        """Record a finished chunk of total ``weight`` that took ``seconds`` of CPU time."""
+        if not (weight > 0 and math.isfinite(weight) and math.isfinite(seconds) and seconds >= 0):
             return
-        mean = seconds / files
-        self.seconds_per_file = mean if self.seconds_per_file is None else 0.5 * (self.seconds_per_file + mean)
+        rate = seconds / weight
+        self.seconds_per_byte = rate if self.seconds_per_byte is None else 0.5 * (self.seconds_per_byte + rate)
 
-    def next_size(self, remaining: int, workers: int) -> int:
-        """Files for the next chunk, given ``remaining`` files not yet handed out and ``workers`` workers."""
+    def weight(self, start: int, stop: int) -> float:
+        """Total weight of files ``start .. stop - 1``."""
+        return float(self._cumulative[stop] - self._cumulative[start])
+
+    def _chunk_weight(self, position: int, workers: int) -> float:
+        rate = max(self.seconds_per_byte if self.seconds_per_byte is not None else self.prior_seconds_per_byte,
+                   1e-300)
+        left = self.weight(position, self.files)
+        round_of_chunks = 2 * max(workers, 1)
+        if not self._decided:
+            self._decided = True
+            if left * rate <= round_of_chunks * self.target_seconds:
+                self._short_weight = left / round_of_chunks
+                self._short_start = self.weight(0, position)
+        if self._short_weight is not None:
+            # boundaries at fixed multiples of the chunk weight (not relative to each chunk's start, where the
+            # rounding to whole files could drift into one more chunk)
+            done = (self.weight(0, position) - self._short_start) / self._short_weight if self._short_weight else 0.0
+            return self._short_start + (math.floor(done + 0.5) + 1) * self._short_weight - self.weight(0, position)
+        # a long batch: the target, then half a fair share of what is left, not below the tail floor
+        return min(self.target_seconds / rate, max(left / round_of_chunks, self.tail_seconds / rate))
+
+    def next_size(self, position: int, workers: int) -> int:
+        """Files for the next chunk, which starts at file ``position`` of the batch, given ``workers`` workers:
+        the run whose weight is nearest the chunk weight, at least 1 and at most :attr:`max_files`."""
+        remaining = self.files - position
         if remaining <= 0:
             return 0
-        if self.seconds_per_file is None:
-            # nothing measured yet: 1, 2, 4, 8 files, so that the workers have work during the first round trip
-            size = 2 ** min(self._probes, 3)
-            self._probes += 1
-        else:
-            per_file = max(self.seconds_per_file, 1e-9)
-            size = int(min(self.target_seconds / per_file, self.growth * self.largest, self.max_files))
-            # the tail: at most half of a fair share of what is left, so that every worker gets some of the
-            # last files, but not below the tail floor (each chunk costs a round trip)
-            share = remaining // (2 * max(workers, 1))
-            size = min(size, max(share, int(self.tail_seconds / per_file)))
-        size = max(1, min(size, remaining))
-        self.largest = max(self.largest, size)
-        return size
+        start = self._cumulative[position]
+        goal = start + self._chunk_weight(position, workers)
+        end = int(np.searchsorted(self._cumulative, goal, side="left"))     # first boundary at or past the goal
+        end = min(end, self.files)
+        if end > position + 1 and self._cumulative[end] - goal > goal - self._cumulative[end - 1]:
+            end -= 1                                                            # the nearer boundary
+        return max(1, min(end - position, remaining, self.max_files))
 
 
 class PoolTasks:

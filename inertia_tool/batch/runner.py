@@ -40,11 +40,11 @@ from ..values import frozen_value
 from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, InertiaToolWarning, MeshReadError, UsageError
 from ..mesh.options import LoadOptions
-from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, os_error_reason
+from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, load_mesh, os_error_reason
 from ..mesh.regular import open_regular
 from ..mass.pipeline import mass_properties, resolve_density
 from .chunks import (DASK_CHUNK_SECONDS, DASK_TAIL_SECONDS, POOL_CHUNK_SECONDS, POOL_TAIL_SECONDS, ChunkSizer,
-                     DaskTasks, PoolTasks)
+                     DaskTasks, PoolTasks, file_weights)
 
 __all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "SCHEMA_V1", "ROW_FIELDS_V1", "analyze_chunk",
            "analyze_file", "discover_files", "file_sha256", "run_batch", "upgrade_row", "downgrade_row",
@@ -104,6 +104,11 @@ _TENSOR_ENTRIES = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))
 
 #: Bytes read at a time when hashing a file.
 _HASH_CHUNK = 1 << 20
+
+#: Largest file the batch reads into memory once, to hash it and to parse it from the same bytes (a binary STL of
+#: 330,000 triangles); a larger one is hashed and then read by the streaming reader, as it never holds the whole
+#: file.
+READ_ONCE_BYTES = 1 << 24
 
 
 def upgrade_row(row: dict) -> dict:
@@ -272,6 +277,36 @@ def file_sha256(path: str | os.PathLike) -> str:
     return h.hexdigest()
 
 
+def _read_once(path: str, limit: int | None = None, known: str | None = None) -> tuple[bytes | None, str]:
+    """The bytes of a regular file of at most ``limit`` bytes and their SHA-256, from one open and one read (the
+    reader then parses those bytes: one file read once, its hash that of the bytes analysed); a larger file's
+    hash only (``None``, hashed in chunks; the reader streams it), or ``known`` (a hash the caller computed) without
+    reading it.  ``limit`` defaults to :data:`READ_ONCE_BYTES`.
+
+    Raises
+    ------
+    MeshReadError
+        ``path`` is not a regular file (never opened: :func:`inertia_tool.mesh.regular.open_regular`).
+    OSError
+        It cannot be read.
+    """
+    limit = READ_ONCE_BYTES if limit is None else limit
+    with open_regular(path) as fh:
+        size = os.fstat(fh.fileno()).st_size
+        if size <= limit:
+            data = fh.read(size + 1)               # not read(limit): that would allocate `limit` bytes first
+            if len(data) <= size:                  # all of it (a file that grew since the fstat: streamed on)
+                return data, hashlib.sha256(data).hexdigest()
+            h = hashlib.sha256(data)
+        elif known is not None:
+            return None, known
+        else:
+            h = hashlib.sha256()
+        while chunk := fh.read(_HASH_CHUNK):
+            h.update(chunk)
+    return None, h.hexdigest()
+
+
 def _one_line(text: object, limit: int = 500) -> str:
     text = " ".join(str(text).split())
     return text if len(text) <= limit else text[: limit - 1] + "…"
@@ -316,7 +351,9 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
         Mesh file.
     options : BatchOptions
     sha256 : str, optional
-        The file's content hash if the caller already has it; computed here otherwise.
+        The file's content hash if the caller already has it.  A file read into memory (up to
+        :data:`READ_ONCE_BYTES`) is hashed again from the bytes analysed (they win if the file changed since); a
+        larger one keeps this hash, and is hashed here when it is not given.
 
     Returns
     -------
@@ -335,18 +372,26 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
     start = time.perf_counter()
     row = _empty_row(path, sha256, options, key, worker)
     try:
-        if row["sha256"] is None:
-            try:
-                row["sha256"] = file_sha256(path)
-            except MeshReadError:       # not a regular file: never opened
-                raise
-            except OSError as exc:       # unreadable: a property of the file, reported like the reader does
-                raise MeshReadError(f"{row['path']}: cannot be read ({os_error_reason(exc, path)})") from None
+        try:
+            # read once: hashed here and parsed from the same bytes (the hash is that of the content analysed;
+            # a hash given by the caller is replaced by the one of the bytes read now, but for a file too large
+            # to hold, which is not read twice for it)
+            data, digest = _read_once(path, known=sha256)
+        except MeshReadError:       # not a regular file: never opened
+            raise
+        except OSError as exc:       # unreadable: a property of the file, reported like the reader does
+            raise MeshReadError(f"{row['path']}: cannot be read ({os_error_reason(exc, path)})") from None
+        row["sha256"] = digest
         _, described = resolve_density(density=options.density, material=options.material, mass=options.mass)
+        load = options.load
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", InertiaToolWarning)
-            props = mass_properties(path, density=options.density, material=options.material, mass=options.mass,
-                                    options=options.load)
+            raw = load_mesh(path, units=load.units, max_faces=load.max_faces,
+                            declared_units_win=load.declared_units_win, data=data)
+            # a file that names materials per part is integrated part by part from its path (it is read again:
+            # rare); every other file from the mesh just read, as mass_properties(path) would
+            props = mass_properties(path if raw.parts else raw, density=options.density, material=options.material,
+                                    mass=options.mass, options=load)
         pa = props.principal
         numbers = np.concatenate(([props.density, props.mass, props.volume, props.surface_area],
                                   props.center_of_mass, np.asarray(props.inertia)[_TENSOR_ENTRIES], pa.moments,
@@ -420,6 +465,14 @@ def analyze_chunk(chunk: Sequence[tuple[str, str | None]], options: BatchOptions
     key = options.key()
     worker = _worker_name()
     return [_analyze(path, options, digest, key, worker) for path, digest in chunk]
+
+
+def _analyze_chunk_timed(chunk: Sequence[tuple[str, str | None]], options: BatchOptions) -> tuple[list[dict], float]:
+    """:func:`analyze_chunk` and the CPU seconds this worker process spent on it (``time.process_time``: what
+    sizes the next chunks, which the load of a shared machine does not inflate as it does wall time)."""
+    start = time.process_time()
+    rows = analyze_chunk(chunk, options)
+    return rows, time.process_time() - start
 
 
 #: Seconds between the checks of the pool workers' watchdog that their parent (the batch run) is alive.
@@ -566,7 +619,7 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
         Chunks submitted but not finished at most (default two per worker: one running, one queued), so
         memory stays bounded for huge batches.
     chunk_seconds : float, optional
-        Analysis time aimed at per chunk, s (default :data:`~inertia_tool.batch.chunks.POOL_CHUNK_SECONDS`
+        CPU time of analysis aimed at per chunk, s (default :data:`~inertia_tool.batch.chunks.POOL_CHUNK_SECONDS`
         for a process pool or executor, :data:`~inertia_tool.batch.chunks.DASK_CHUNK_SECONDS` for Dask).
 
     Returns
@@ -581,7 +634,8 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
     exactly one row.
 
     The SHA-256 that decides skipping is computed here only for files that have a done row of the same path
-    and options in ``previous_rows``; for the others nothing can be skipped and the worker hashes the file.
+    and options in ``previous_rows``; for the others nothing can be skipped and the worker hashes the file, from
+    the bytes it analyses (:func:`analyze_file`).
     """
     if jobs < 1:
         raise UsageError(f"Expected `jobs` >= 1, got {jobs}")
@@ -644,7 +698,8 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
         target = chunk_seconds or (DASK_CHUNK_SECONDS if client is not None else POOL_CHUNK_SECONDS)
         tail = min(target, DASK_TAIL_SECONDS if client is not None else POOL_TAIL_SECONDS)
         try:
-            _run_chunks(todo, options, tasks, ChunkSizer(target, tail_seconds=tail), record, max_in_flight)
+            sizer = ChunkSizer(file_weights([path for path, _ in todo]), target, tail_seconds=tail)
+            _run_chunks(todo, options, tasks, sizer, record, max_in_flight)
         finally:
             tasks.close()
     return BatchSummary(ok=ok, failed=failed, skipped=skipped, skipped_failed=skipped_failed,
@@ -661,6 +716,7 @@ def _run_chunks(todo: list[tuple[str, str | None]], options: BatchOptions, tasks
     chunk, there are at most ``2 * len(todo)`` chunks (each file is in at most one chunk and one retry).
     """
     queue: deque[list[tuple[str, str | None]]] = deque()     # single files to retry, first
+    weights: dict[int, float] = {}                            # of the chunks in flight, by id (retries: none)
     position = 0
     for _ in range(4 * len(todo) + 2):
         workers = tasks.workers
@@ -669,15 +725,19 @@ def _run_chunks(todo: list[tuple[str, str | None]], options: BatchOptions, tasks
             if queue:
                 chunk = queue.popleft()
             else:
-                size = sizer.next_size(len(todo) - position, workers)
+                size = sizer.next_size(position, workers)
                 chunk = todo[position:position + size]
+                weights[id(chunk)] = sizer.weight(position, position + size)
                 position += size
-            tasks.submit(analyze_chunk, chunk, options)
+            tasks.submit(_analyze_chunk_timed, chunk, options)
         if not tasks.in_flight():
             return
-        for chunk, rows, error in tasks.wait():
-            if rows is not None:
-                sizer.observe(len(rows), math.fsum(_as_float(r.get("seconds")) for r in rows))
+        for chunk, result, error in tasks.wait():
+            weight = weights.pop(id(chunk), None)
+            if result is not None:
+                rows, cpu = result
+                if weight is not None:
+                    sizer.observe(weight, cpu)
                 for row in rows:
                     record(row)
             elif len(chunk) > 1:

@@ -12,6 +12,7 @@ corners straight from each chunk of file records, in one pass.
 
 from __future__ import annotations
 
+import io
 import os
 import re
 import stat
@@ -114,6 +115,11 @@ def _display(path: str | bytes | os.PathLike[str] | os.PathLike[bytes]) -> str:
 
 def _fail(path: str | bytes | os.PathLike[str] | os.PathLike[bytes], problem: str) -> MeshReadError:
     return MeshReadError(f"{_display(path)}: {problem}")
+
+
+def _source_bytes(path: str, data: bytes | None) -> IO[bytes]:
+    """The file to parse: ``data`` (its bytes, read by the caller) as a file object, else ``path`` opened."""
+    return io.BytesIO(data) if data is not None else open_regular(path)
 
 
 def os_error_reason(exc: OSError, path: str | os.PathLike[str] | None = None) -> str:
@@ -285,7 +291,7 @@ def _bad_line(path: str, block: bytes, first_line: int, pos: int, problem: str) 
     return _fail(path, f"line {line}: {problem}: {text!r}")
 
 
-def _read_ascii_stl(path: str, size: int, max_faces: int) -> tuple[np.ndarray, int]:
+def _read_ascii_stl(path: str, size: int, max_faces: int, data: bytes | None = None) -> tuple[np.ndarray, int]:
     """Stream an ASCII STL, checking its structure: exactly three ``vertex`` lines per ``facet``.
 
     Unknown lines and missing ``outer loop`` / ``endloop`` / ``endfacet`` lines are tolerated with one
@@ -300,7 +306,7 @@ def _read_ascii_stl(path: str, size: int, max_faces: int) -> tuple[np.ndarray, i
     tallies = dict.fromkeys((b"outer", b"endloop", b"endfacet"), 0)
     garbage = 0
     first_garbage = ""
-    with open_regular(path) as fh:
+    with _source_bytes(path, data) as fh:
         for block in _text_blocks(fh, path):
             words = np.char.lower(np.array(_FIRST_WORD_RE.findall(block), dtype="S12"))
             is_facet = words == b"facet"
@@ -391,20 +397,24 @@ def read_stl(path: str | os.PathLike[str], *, max_faces: int = DEFAULT_MAX_FACES
     return vertices, faces, n
 
 
-def _read_stl(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int, bool]:
-    """:func:`read_stl`, and whether the file was binary (float32 coordinates)."""
-    size = os.path.getsize(path)
+def _read_stl(path: str, max_faces: int, data: bytes | None = None) -> tuple[np.ndarray, np.ndarray, int, bool]:
+    """:func:`read_stl`, and whether the file was binary (float32 coordinates); ``data``: the file's bytes if
+    the caller has read them (:func:`load_mesh`), parsed instead of reading the file."""
+    size = os.path.getsize(path) if data is None else len(data)
     if size == 0:
         raise _fail(path, "empty file (0 bytes)")
-    with open_regular(path) as fh:
-        head = fh.read(4096)
+    if data is None:
+        with open_regular(path) as fh:
+            head = fh.read(4096)
+    else:
+        head = data[:4096]
     announced = int(np.frombuffer(head[80:84], dtype="<u4")[0]) if len(head) >= 84 else -1
 
     def binary() -> tuple[np.ndarray, np.ndarray, int, bool]:
         n = _binary_stl_count(path, size, max_faces, announced)
         if n == 0:
             raise _fail(path, "STL holds no triangles (empty mesh)")
-        whole = head if len(head) == size else None          # a small file is read once
+        whole = data if data is not None else head if len(head) == size else None    # a small file: read once
         vertices, faces = weld_exact_stream(_binary_stl_chunks(path, n, padded=accel() is None, whole=whole),
                                             3 * n)
         if not np.all(np.isfinite(vertices)):
@@ -414,7 +424,7 @@ def _read_stl(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int, b
     if (announced >= 0 and 84 + 50 * announced == size) or not _looks_ascii_stl(head):
         return binary()
     try:
-        corners, n = _read_ascii_stl(path, size, max_faces)
+        corners, n = _read_ascii_stl(path, size, max_faces, data)
     except MeshReadError as ascii_error:
         # a binary STL whose header starts with "solid" and which carries trailing bytes
         if not 0 < announced <= (size - 84) // 50:
@@ -452,7 +462,7 @@ def _obj_vertex_block(path: str, tokens: list[bytes], first_line: int) -> np.nda
         raise _fail(path, "vertex coordinates are not numbers") from None
 
 
-def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
+def _read_obj(path: str, max_faces: int, data: bytes | None = None) -> tuple[np.ndarray, np.ndarray, int]:
     """Stream a Wavefront OBJ: ``v`` lines and ``f`` polygons (1-based or negative relative indices).
 
     A quadrilateral is split along its shorter diagonal (corners ``a b c d``: ``abc, acd`` when
@@ -464,7 +474,8 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     first vertex, or an index past the last vertex is refused with the line named, never dropped: a dropped face
     would silently change the volume.
 
-    Returns ``vertices (n, 3)``, ``faces (m, 3)`` and the number of polygons in the file.
+    Returns ``vertices (n, 3)``, ``faces (m, 3)`` and the number of polygons in the file.  ``data``: the file's
+    bytes if the caller has read them (:func:`load_mesh`), parsed instead of reading the file.
     """
     vertex_blocks: list[np.ndarray] = []
     face_blocks: list[np.ndarray] = []
@@ -476,7 +487,7 @@ def _read_obj(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
     line_no = 0
     pending = b""
     max_vertices = 3 * max_faces + 3
-    with open_regular(path) as fh:
+    with _source_bytes(path, data) as fh:
         for block in _text_blocks(fh, path):
             coords: list[bytes] = []
             tri: list[int] = []
@@ -1088,7 +1099,7 @@ def _read_with_trimesh_rounding(path: str, max_faces: int,
 
 
 def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFAULT_MAX_FACES,
-              declared_units_win: bool = False) -> RawMesh:
+              declared_units_win: bool = False, data: bytes | None = None) -> RawMesh:
     """Read a mesh and convert it to metres.
 
     Parameters
@@ -1107,6 +1118,11 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
     declared_units_win : bool
         A file that declares its length unit is read in it even when ``units`` says otherwise (``units`` is
         then for the files without one); default False: the contradiction is refused (:class:`UsageError`).
+    data : bytes, optional
+        The bytes of the file ``source`` names, when the caller has read them already (``inertia-tool batch``
+        reads a file once, to hash it and to parse it, so that the hash is that of the bytes analysed): an STL
+        or OBJ file is parsed from them, not read again.  Other formats read the file; ignored for a source that
+        is not a path.
 
     Returns
     -------
@@ -1164,17 +1180,17 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
                                   f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
-            if st.st_size == 0:
+            if (st.st_size if data is None else len(data)) == 0:
                 raise _fail(path, "empty file (0 bytes)")
             declared = None
             rounding = 0.0                  # file units until scaled below
             parts: tuple[PartTag, ...] = ()
             if suffix == ".stl":
-                vertices, faces, n, binary = _read_stl(path, max_faces)
+                vertices, faces, n, binary = _read_stl(path, max_faces, data)
                 if binary:
                     rounding = _float32_rounding(vertices)
             elif suffix == ".obj":
-                vertices, faces, n = _read_obj(path, max_faces)
+                vertices, faces, n = _read_obj(path, max_faces, data)
                 if not np.all(np.isfinite(vertices)):
                     raise _fail(path, "vertices have NaN or infinite coordinates")
             elif suffix in BREP_SUFFIXES:
