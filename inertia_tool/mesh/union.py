@@ -27,7 +27,8 @@ import numpy as np
 
 from ..values import frozen_value
 
-__all__ = ["crossing_shells", "closed_groups", "union_surface", "UnionSurface", "UnionError", "common_volumes"]
+__all__ = ["crossing_shells", "closed_groups", "union_surface", "UnionSurface", "UnionError", "common_volumes",
+           "two_manifold"]
 
 
 class UnionError(RuntimeError):
@@ -154,6 +155,21 @@ class UnionSurface:
 
 #: A ``manifold3d.Manifold``: the package ships no type information, so to mypy it is ``Any``.
 _Manifold = Any
+
+
+def two_manifold(faces: np.ndarray, groups: np.ndarray | None = None) -> bool:
+    """Whether every edge of ``faces`` (m, 3) is used by exactly two faces, in opposite directions (by vertex
+    index), within each group of ``groups`` (m,) when given: the input manifold3d's booleans assume."""
+    from .edges import edge_keys
+
+    f = np.asarray(faces, dtype=np.int64)
+    key, forward = edge_keys(f, int(f.max()) + 1 if len(f) else 1)
+    group = np.zeros(len(key), dtype=np.int64) if groups is None else np.repeat(np.asarray(groups, np.int64), 3)
+    order = np.lexsort((key, group))
+    skey, sgroup, fwd = key[order], group[order], forward[order]
+    same = (skey[1:] == skey[:-1]) & (sgroup[1:] == sgroup[:-1])      # slot i and i + 1 on one edge of one group
+    return bool(len(skey) % 2 == 0 and np.all(same[0::2]) and not np.any(same[1::2])
+                and np.all(fwd[0::2] != fwd[1::2]))
 
 
 def _manifold(m3: ModuleType, vertices: np.ndarray, faces: np.ndarray) -> _Manifold:
