@@ -798,7 +798,7 @@ typedef struct {
     PwChunk *chunks;
     size_t n_chunks, chunks_cap;
     PwVertex *verts[MAX_THREADS];      /* vertices of the buckets each thread welded, bucket after bucket */
-    size_t vcount[MAX_THREADS], vcap[MAX_THREADS];
+    size_t vcount[MAX_THREADS], vcap[MAX_THREADS], vbytes[MAX_THREADS];   /* vbytes: the mapping's size */
     uint8_t *owner;                    /* per bucket: the thread that welded it */
     size_t *v0;                        /* per bucket: its first vertex in verts[owner] */
     uint32_t *nv;                      /* per bucket: its vertices */
@@ -839,6 +839,104 @@ arena_free(void *p, size_t bytes)
 #endif
 }
 
+/* The weld's and the census's scratch mappings, kept for the next call in the process.  Fresh anonymous
+ * pages cost the kernel a page fault and a zeroing each (on a 10M-face file about a third of the weld's CPU
+ * time went to clear_page in the kernel); a batch or a second analysis in the same process reuses the
+ * pages instead.  pool_take(&bytes) returns the smallest kept mapping of at least `bytes` (its real size
+ * back in `bytes`: give that to pool_give) or a fresh arena_alloc; its contents are undefined (every user
+ * writes before it reads).  pool_give(p, bytes) keeps the mapping when it fits in POOL_SLOTS and
+ * POOL_MAX_BYTES, and tells the kernel it may take the pages back under memory pressure (MADV_FREE: the
+ * pages stay resident and reusable until then; reading one taken back gives zeros), else unmaps it.
+ * pool_drain() unmaps them all (accel.release_buffers()).  A mutex guards the slots: kernels free
+ * their scratch with the GIL released. */
+#define POOL_SLOTS 6
+#define POOL_MIN_BYTES ((size_t)1 << 21)          /* below this, plain arena_alloc / arena_free (tests lower
+                                                     it with set_pool_floor to reuse small mappings too) */
+#define POOL_MAX_BYTES ((size_t)3 << 30)          /* kept in all, at most */
+
+static struct { void *p; size_t bytes; } pool_slot[POOL_SLOTS];
+static size_t pool_kept, pool_floor = POOL_MIN_BYTES;
+#if defined(_WIN32)
+static SRWLOCK pool_lock_ = SRWLOCK_INIT;
+#define POOL_LOCK() AcquireSRWLockExclusive(&pool_lock_)
+#define POOL_UNLOCK() ReleaseSRWLockExclusive(&pool_lock_)
+#else
+static pthread_mutex_t pool_lock_ = PTHREAD_MUTEX_INITIALIZER;
+#define POOL_LOCK() pthread_mutex_lock(&pool_lock_)
+#define POOL_UNLOCK() pthread_mutex_unlock(&pool_lock_)
+#endif
+
+static void *
+pool_take(size_t *bytes)
+{
+    size_t want = *bytes ? *bytes : 1;
+    int best = -1;
+    POOL_LOCK();
+    if (want >= pool_floor) {
+        for (int i = 0; i < POOL_SLOTS; i++) {
+            if (pool_slot[i].p != NULL && pool_slot[i].bytes >= want
+                    && (best < 0 || pool_slot[i].bytes < pool_slot[best].bytes)) {
+                best = i;
+            }
+        }
+    }
+    if (best >= 0) {
+        void *p = pool_slot[best].p;
+        *bytes = pool_slot[best].bytes;
+        pool_kept -= pool_slot[best].bytes;
+        pool_slot[best].p = NULL;
+        pool_slot[best].bytes = 0;
+        POOL_UNLOCK();
+        return p;
+    }
+    POOL_UNLOCK();
+    *bytes = want;
+    return arena_alloc(want);
+}
+
+static void
+pool_give(void *p, size_t bytes)
+{
+    if (p == NULL) {
+        return;
+    }
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    int kept = 0;
+#if defined(MADV_FREE)
+    madvise(p, bytes, MADV_FREE);        /* before the mapping is in a slot, where another thread may take it */
+#endif
+    POOL_LOCK();
+    if (bytes >= pool_floor && pool_kept + bytes <= POOL_MAX_BYTES) {
+        for (int i = 0; i < POOL_SLOTS && !kept; i++) {
+            if (pool_slot[i].p == NULL) {
+                pool_slot[i].p = p;
+                pool_slot[i].bytes = bytes;
+                pool_kept += bytes;
+                kept = 1;
+            }
+        }
+    }
+    POOL_UNLOCK();
+    if (kept) {
+        return;
+    }
+#endif
+    arena_free(p, bytes);
+}
+
+static void
+pool_drain(void)
+{
+    POOL_LOCK();
+    for (int i = 0; i < POOL_SLOTS; i++) {
+        arena_free(pool_slot[i].p, pool_slot[i].bytes);
+        pool_slot[i].p = NULL;
+        pool_slot[i].bytes = 0;
+    }
+    pool_kept = 0;
+    POOL_UNLOCK();
+}
+
 static inline uint32_t
 popcount64(uint64_t x)
 {
@@ -856,7 +954,7 @@ pw_release(PartWelderObject *w)
     }
     free(w->chunks);
     w->chunks = NULL;
-    arena_free(w->entries, w->arena_bytes);
+    pool_give(w->entries, w->arena_bytes);
     w->entries = NULL;
     w->arena_bytes = 0;
     if (w->has_index) {
@@ -865,11 +963,11 @@ pw_release(PartWelderObject *w)
     }
     w->n_chunks = w->chunks_cap = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
-        arena_free(w->verts[t], w->vcap[t] * sizeof(PwVertex));
+        pool_give(w->verts[t], w->vbytes[t]);
         free(w->mark[t]);
         w->verts[t] = NULL;
         w->mark[t] = NULL;
-        w->vcount[t] = w->vcap[t] = 0;
+        w->vcount[t] = w->vcap[t] = w->vbytes[t] = 0;
     }
     free(w->recent);
     w->recent = NULL;
@@ -1211,7 +1309,7 @@ PartWelder_init(PartWelderObject *w, PyObject *args, PyObject *kwds)
     w->rank = (uint32_t *)malloc(words * sizeof(uint32_t));
     int fits = (size_t)n_points <= (SIZE_MAX - 64) / sizeof(PwEntry);
     w->arena_bytes = fits ? (size_t)n_points * sizeof(PwEntry) + 64 : 0;
-    w->entries = fits ? (PwEntry *)arena_alloc(w->arena_bytes) : NULL;
+    w->entries = fits ? (PwEntry *)pool_take(&w->arena_bytes) : NULL;
     w->recent = (Recent32 *)malloc((size_t)w->threads * WELD_RECENT * sizeof(Recent32));
     int ok = w->owner && w->v0 && w->nv && w->vbase && w->rank && w->entries && w->recent;
     for (int t = 0; t < w->threads && ok; t++) {
@@ -1348,9 +1446,10 @@ PartWelder_finish(PartWelderObject *w, PyObject *unused)
      * (memory from malloc in a worker thread could stay in that thread's heap) */
     for (int t = 0; t < nt; t++) {
         w->vcap[t] = w->partitioned ? w->partitioned : 1;
-        w->verts[t] = (PwVertex *)arena_alloc(w->vcap[t] * sizeof(PwVertex));
+        w->vbytes[t] = w->vcap[t] * sizeof(PwVertex);
+        w->verts[t] = (PwVertex *)pool_take(&w->vbytes[t]);
         if (w->verts[t] == NULL) {
-            w->vcap[t] = 0;
+            w->vcap[t] = w->vbytes[t] = 0;
             pw_release(w);
             w->state = 2;
             return PyErr_NoMemory();
@@ -1409,7 +1508,7 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
         goto fail;
     }
     size_t number_bytes = (w->count ? w->count : 1) * sizeof(uint32_t);
-    uint32_t *number = (uint32_t *)arena_alloc(number_bytes);
+    uint32_t *number = (uint32_t *)pool_take(&number_bytes);
     if (number == NULL) {
         PyErr_NoMemory();
         goto fail;
@@ -1421,7 +1520,7 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
     run_parallel(nt, pw_number_task, &task);
     task.ticket = 0;
     run_parallel(nt, pw_gather_task, &task);
-    arena_free(number, number_bytes);
+    pool_give(number, number_bytes);
     Py_END_ALLOW_THREADS
     pw_release(w);                      /* releases the index buffer: with the GIL */
     w->busy = 0;
@@ -2084,6 +2183,7 @@ typedef struct {
     uint32_t *npairs;                    /* per block of CS_BLOCK vertices: face pairs to unite, kept in place
                                             of the block's words (from its first) */
     CensusTally tally[MAX_THREADS];
+    size_t cnt_bytes[MAX_THREADS], off_bytes, word_bytes, parent_bytes;   /* the mappings' sizes (pool_take) */
 } CsTask;
 
 static inline int64_t
@@ -2109,6 +2209,7 @@ cs_count_task(void *ctx, int t, int nt)
     CsTask *c = (CsTask *)ctx;
     uint32_t *cnt = c->cnt[t];
     uint64_t n = c->n;
+    memset(cnt, 0, (n ? n : 1) * sizeof(uint32_t));     /* a kept mapping holds old counts */
     for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
         int64_t a = index_at(c->f, c->size, 3 * i), b = index_at(c->f, c->size, 3 * i + 1);
         int64_t d = index_at(c->f, c->size, 3 * i + 2);
@@ -2388,12 +2489,12 @@ static void
 cs_free(CsTask *c)
 {
     for (int t = 0; t < MAX_THREADS; t++) {
-        free(c->cnt[t]);
+        pool_give(c->cnt[t], c->cnt_bytes[t]);
     }
     free(c->npairs);
-    free(c->off);
-    free(c->word);
-    free(c->parent);
+    pool_give(c->off, c->off_bytes);
+    pool_give(c->word, c->word_bytes);
+    pool_give(c->parent, c->parent_bytes);
     free(c->rank);
     free(c);
 }
@@ -2436,7 +2537,7 @@ cs_run(CsTask *c)
     if (nt > 1) {
         cs_unite_task(c, nt, nt);        /* the pairs across parts, on this thread */
     }
-    free(c->word);                       /* the pairs are done with */
+    pool_give(c->word, c->word_bytes);   /* the pairs are done with */
     c->word = NULL;
     run_parallel(nt, cs_root_task, c);
     int64_t count = 0;
@@ -2525,12 +2626,16 @@ accel_census_shells(PyObject *self, PyObject *args)
     }
     int ok = 1;
     for (int t = 0; t < nt && ok; t++) {
-        c->cnt[t] = (uint32_t *)calloc(n ? n : 1, sizeof(uint32_t));
+        c->cnt_bytes[t] = (n ? n : 1) * sizeof(uint32_t);      /* zeroed by cs_count_task */
+        c->cnt[t] = (uint32_t *)pool_take(&c->cnt_bytes[t]);
         ok = c->cnt[t] != NULL;
     }
-    c->off = (uint32_t *)malloc((n + 1) * sizeof(uint32_t));
-    c->word = (uint64_t *)malloc((mm ? 3 * mm : 1) * sizeof(uint64_t));
-    c->parent = has_out ? (int32_t *)malloc((mm ? mm : 1) * sizeof(int32_t)) : NULL;
+    c->off_bytes = (n + 1) * sizeof(uint32_t);
+    c->word_bytes = (mm ? 3 * mm : 1) * sizeof(uint64_t);
+    c->parent_bytes = (mm ? mm : 1) * sizeof(int32_t);
+    c->off = (uint32_t *)pool_take(&c->off_bytes);
+    c->word = (uint64_t *)pool_take(&c->word_bytes);
+    c->parent = has_out ? (int32_t *)pool_take(&c->parent_bytes) : NULL;
     c->npairs = (uint32_t *)malloc((n / CS_BLOCK + 1) * sizeof(uint32_t));
     if (!ok || c->off == NULL || c->word == NULL || c->npairs == NULL || (has_out && c->parent == NULL)) {
         PyErr_NoMemory();
@@ -3145,7 +3250,50 @@ static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* secti
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
 
+static PyObject *
+accel_release_buffers(PyObject *self, PyObject *unused)
+{
+    pool_drain();
+    Py_RETURN_NONE;
+}
+
+static PyObject *
+accel_kept_buffers(PyObject *self, PyObject *unused)
+{
+    POOL_LOCK();
+    size_t kept = pool_kept;
+    POOL_UNLOCK();
+    return PyLong_FromSize_t(kept);
+}
+
+static PyObject *
+accel_set_pool_floor(PyObject *self, PyObject *args)
+{
+    Py_ssize_t floor_bytes;
+    if (!PyArg_ParseTuple(args, "n", &floor_bytes)) {
+        return NULL;
+    }
+    if (floor_bytes < 1) {
+        PyErr_Format(PyExc_ValueError, "Expected a positive number of bytes, got %zd", floor_bytes);
+        return NULL;
+    }
+    POOL_LOCK();
+    size_t previous = pool_floor;
+    pool_floor = (size_t)floor_bytes;
+    POOL_UNLOCK();
+    return PyLong_FromSize_t(previous);
+}
+
 static PyMethodDef accel_methods[] = {
+    {"set_pool_floor", accel_set_pool_floor, METH_VARARGS,
+     "set_pool_floor(bytes) -> previous\n\nThe smallest scratch mapping the weld and the census keep for the "
+     "next call (default 2 MiB; tests lower it so that small inputs reuse old, dirty mappings too)."},
+    {"release_buffers", accel_release_buffers, METH_NOARGS,
+     "release_buffers()\n\nUnmap the scratch mappings the weld and the census keep for the next call (section "
+     "2b, pool_give); they are kept marked MADV_FREE, so the kernel takes them back under memory pressure "
+     "anyway."},
+    {"kept_buffers", accel_kept_buffers, METH_NOARGS,
+     "kept_buffers() -> bytes\n\nBytes of scratch mappings kept for the next weld or census (section 2b)."},
     {"edge_census", accel_edge_census, METH_VARARGS,
      "edge_census(faces, n_vertices, threads=1) -> (edges, boundary, nonmanifold, misoriented, sample_boundary, "
      "sample_nonmanifold, sample_misoriented)\n\nEdge census of (m, 3) int32/int64 faces; each sample is a "
