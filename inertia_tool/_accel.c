@@ -849,7 +849,7 @@ arena_free(void *p, size_t bytes)
  * pages stay resident and reusable until then; reading one taken back gives zeros), else unmaps it.
  * pool_drain() unmaps them all (accel.release_buffers()).  A mutex guards the slots: kernels free
  * their scratch with the GIL released. */
-#define POOL_SLOTS 6
+#define POOL_SLOTS 12
 #define POOL_MIN_BYTES ((size_t)1 << 21)          /* below this, plain arena_alloc / arena_free (tests lower
                                                      it with set_pool_floor to reuse small mappings too) */
 #define POOL_MAX_BYTES ((size_t)3 << 30)          /* kept in all, at most */
@@ -1592,6 +1592,75 @@ static PyTypeObject PartWelderType = {
     .tp_dealloc = (destructor)PartWelder_dealloc,
     .tp_methods = PartWelder_methods,
     .tp_getset = PartWelder_getset,
+};
+
+/* Scratch(nbytes): a writable buffer of nbytes taken from the kept mappings (pool_take), given back when the
+ * object is freed (pool_give): the weld's output arrays (numpy.frombuffer over it), so that an analysis after
+ * another in the same process writes its corner ids and vertices into pages faulted in already.  Its
+ * contents start undefined, as numpy.empty's. */
+typedef struct {
+    PyObject_HEAD
+    void *p;
+    size_t bytes;          /* the mapping's size (pool_take may give a larger one) */
+    Py_ssize_t len;        /* the buffer's */
+} ScratchObject;
+
+static PyObject *
+Scratch_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
+{
+    static char *kwlist[] = {"nbytes", NULL};
+    Py_ssize_t len;
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "n", kwlist, &len)) {
+        return NULL;
+    }
+    if (len < 0) {
+        PyErr_Format(PyExc_ValueError, "Expected a number of bytes >= 0, got %zd", len);
+        return NULL;
+    }
+    ScratchObject *b = (ScratchObject *)type->tp_alloc(type, 0);
+    if (b == NULL) {
+        return NULL;
+    }
+    b->bytes = len ? (size_t)len : 1;
+    b->p = pool_take(&b->bytes);
+    b->len = len;
+    if (b->p == NULL) {
+        b->bytes = 0;
+        Py_DECREF(b);
+        return PyErr_NoMemory();
+    }
+    return (PyObject *)b;
+}
+
+static void
+Scratch_dealloc(ScratchObject *b)
+{
+    pool_give(b->p, b->bytes);
+    Py_TYPE(b)->tp_free((PyObject *)b);
+}
+
+static int
+Scratch_getbuffer(ScratchObject *b, Py_buffer *view, int flags)
+{
+    return PyBuffer_FillInfo(view, (PyObject *)b, b->p, b->len, 0, flags);
+}
+
+static PyBufferProcs Scratch_as_buffer = {
+    .bf_getbuffer = (getbufferproc)Scratch_getbuffer,
+};
+
+static PyTypeObject ScratchType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "inertia_tool._accel.Scratch",
+    .tp_doc = "Scratch(nbytes)\n\nA writable buffer of nbytes (contents undefined) from the mappings the weld and "
+              "the census keep; given back to them when freed.  numpy.frombuffer(Scratch(n), dtype) is an "
+              "uninitialised array whose pages an earlier analysis in the process may have faulted in.",
+    .tp_basicsize = sizeof(ScratchObject),
+    .tp_itemsize = 0,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_new = Scratch_new,
+    .tp_dealloc = (destructor)Scratch_dealloc,
+    .tp_as_buffer = &Scratch_as_buffer,
 };
 
 /* ======================================================================================================
@@ -3359,7 +3428,7 @@ static struct PyModuleDef accel_module = {
 PyMODINIT_FUNC
 PyInit__accel(void)
 {
-    if (PyType_Ready(&WelderType) < 0 || PyType_Ready(&PartWelderType) < 0) {
+    if (PyType_Ready(&WelderType) < 0 || PyType_Ready(&PartWelderType) < 0 || PyType_Ready(&ScratchType) < 0) {
         return NULL;
     }
     PyObject *mod = PyModule_Create(&accel_module);
@@ -3375,6 +3444,12 @@ PyInit__accel(void)
     Py_INCREF(&PartWelderType);
     if (PyModule_AddObject(mod, "PartWelder", (PyObject *)&PartWelderType) < 0) {
         Py_DECREF(&PartWelderType);
+        Py_DECREF(mod);
+        return NULL;
+    }
+    Py_INCREF(&ScratchType);
+    if (PyModule_AddObject(mod, "Scratch", (PyObject *)&ScratchType) < 0) {
+        Py_DECREF(&ScratchType);
         Py_DECREF(mod);
         return NULL;
     }
