@@ -811,7 +811,7 @@ typedef struct {
 /* A large zeroed-on-demand allocation, backed by 2 MB pages where the kernel offers them: the points of a
  * 10M-face file are 540 MB, and 4 kB pages would cost one page fault per 227 points. */
 static void *
-arena_alloc(size_t bytes)
+map_fresh(size_t bytes)
 {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
     void *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
@@ -843,14 +843,14 @@ arena_free(void *p, size_t bytes)
  * pages cost the kernel a page fault and a zeroing each (on a 10M-face file about a third of the weld's CPU
  * time went to clear_page in the kernel); a batch or a second analysis in the same process reuses the
  * pages instead.  pool_take(&bytes) returns the smallest kept mapping of at least `bytes` (its real size
- * back in `bytes`: give that to pool_give) or a fresh arena_alloc; its contents are undefined (every user
+ * back in `bytes`: give that to pool_give) or a fresh map_fresh; its contents are undefined (every user
  * writes before it reads).  pool_give(p, bytes) keeps the mapping when it fits in POOL_SLOTS and
  * POOL_MAX_BYTES, and tells the kernel it may take the pages back under memory pressure (MADV_FREE: the
  * pages stay resident and reusable until then; reading one taken back gives zeros), else unmaps it.
  * pool_drain() unmaps them all (accel.release_buffers()).  A mutex guards the slots: kernels free
  * their scratch with the GIL released. */
 #define POOL_SLOTS 12
-#define POOL_MIN_BYTES ((size_t)1 << 21)          /* below this, plain arena_alloc / arena_free (tests lower
+#define POOL_MIN_BYTES ((size_t)1 << 21)          /* below this, plain map_fresh / arena_free (tests lower
                                                      it with set_pool_floor to reuse small mappings too) */
 #define POOL_MAX_BYTES ((size_t)3 << 30)          /* kept in all, at most */
 
@@ -891,7 +891,7 @@ pool_take(size_t *bytes)
     }
     POOL_UNLOCK();
     *bytes = want;
-    return arena_alloc(want);
+    return map_fresh(want);
 }
 
 static void
@@ -922,6 +922,18 @@ pool_give(void *p, size_t bytes)
     }
 #endif
     arena_free(p, bytes);
+}
+
+/* arena_alloc: map_fresh for the kernels outside the weld and the census (the face-pair check), which first
+ * unmaps the mappings kept for the next weld or census (pool_drain): kept pages never coexist with another
+ * kernel's fresh ones, so keeping them never raises the process's peak above what unmapping them would. */
+static void pool_drain(void);
+
+static void *
+arena_alloc(size_t bytes)
+{
+    pool_drain();
+    return map_fresh(bytes);
 }
 
 static void

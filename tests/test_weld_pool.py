@@ -125,3 +125,13 @@ def test_weld_outputs_live_on_scratch_and_match_numpy(lib, monkeypatch):
         ref_v, ref_ids = _dict_weld(pts)
         np.testing.assert_array_equal(vertices.view(np.uint64), ref_v.view(np.uint64))
         np.testing.assert_array_equal(faces.reshape(-1), ref_ids)
+
+
+def test_kept_mappings_are_unmapped_before_another_kernel_maps_fresh_ones(lib):
+    """The face-pair check maps its arrays fresh (arena_alloc): the kept mappings are unmapped first, so that
+    keeping them never raises the peak memory of an analysis (the check sets it)."""
+    pts = _torus_soup(60, 40)
+    vertices, ids = _part_welder(lib, pts, 2)
+    assert lib.kept_buffers() > 0
+    lib.contact_scan(vertices, ids.reshape(-1, 3), -1)
+    assert lib.kept_buffers() == 0
