@@ -12,6 +12,8 @@
  *   1b. threads    -- run_parallel, the work tickets
  *   2. Welder      -- streaming exact weld of float32 or float64 points (mesh/weld.py)
  *   2b. PartWelder -- the same weld of float32 points by radix partition, on several threads
+ *                      (and pool_take / pool_give: the weld's and the census's scratch mappings, kept for
+ *                      the next call; Scratch, a buffer on one, for the weld's output arrays)
  *   3. edge_census -- boundary / non-manifold / misoriented edges (mesh/checks.edge_topology)
  *   4. shell_labels-- union-find connected components of faces (mesh/checks.shell_labels)
  *   4c. census_shells -- the census and the shell labels from one adjacency, on several threads
