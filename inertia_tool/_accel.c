@@ -866,6 +866,11 @@ static SRWLOCK pool_lock_ = SRWLOCK_INIT;
 static pthread_mutex_t pool_lock_ = PTHREAD_MUTEX_INITIALIZER;
 #define POOL_LOCK() pthread_mutex_lock(&pool_lock_)
 #define POOL_UNLOCK() pthread_mutex_unlock(&pool_lock_)
+
+/* fork() while another thread holds the lock would leave it locked in the child for good: the lock is taken
+ * around fork (registered with pthread_atfork when the module loads), so the child starts with it free */
+static void pool_before_fork(void) { pthread_mutex_lock(&pool_lock_); }
+static void pool_after_fork(void) { pthread_mutex_unlock(&pool_lock_); }
 #endif
 
 static void *
@@ -3449,6 +3454,12 @@ PyInit__accel(void)
     if (mod == NULL) {
         return NULL;
     }
+#if !defined(_WIN32)
+    static int fork_handlers = 0;          /* once per process, even if the module is loaded again */
+    if (!fork_handlers) {
+        fork_handlers = pthread_atfork(pool_before_fork, pool_after_fork, pool_after_fork) == 0;
+    }
+#endif
     Py_INCREF(&WelderType);
     if (PyModule_AddObject(mod, "Welder", (PyObject *)&WelderType) < 0) {
         Py_DECREF(&WelderType);

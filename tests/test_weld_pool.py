@@ -8,6 +8,8 @@ The floor below which mappings are not kept is lowered to one byte, so that the 
 reuse mappings as a 10M-face file does.
 """
 
+import os
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -135,3 +137,23 @@ def test_kept_mappings_are_unmapped_before_another_kernel_maps_fresh_ones(lib):
     assert lib.kept_buffers() > 0
     lib.contact_scan(vertices, ids.reshape(-1, 3), -1)
     assert lib.kept_buffers() == 0
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
+def test_forked_child_welds_on_inherited_mappings(lib):
+    """A child forked while the pool holds mappings (a batch worker started by fork) welds on them and gets
+    the dict's result; the lock is free in the child (pthread_atfork)."""
+    pts = _torus_soup(60, 40)
+    _part_welder(lib, pts, 2)
+    assert lib.kept_buffers() > 0
+    pid = os.fork()
+    if pid == 0:                                 # the child: exit status 0 when the weld is right
+        ok = False
+        try:
+            got = _part_welder(lib, pts[::-1].copy(), 2)
+            ok = bool(np.array_equal(got[1], _dict_weld(pts[::-1])[1]))
+        except BaseException:
+            pass
+        os._exit(0 if ok else 1)
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0
