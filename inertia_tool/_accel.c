@@ -2233,9 +2233,9 @@ fail:
  * direction; counts added and smallest keys merged over threads) and, when labels are asked for, the face
  * pairs to unite (consecutive faces of the run).
  *
- * Union-find over faces (union by smaller index, path halving, as 4b): first, on thread p, the pairs whose
- * two faces lie in the p-th part of the faces (they touch only that part's parents; every thread reads all
- * the pairs and keeps its own), then the pairs across parts on one thread.  Whatever the order of the unions, every root ends as its component's first face,
+ * Union-find over faces (union by smaller index, path halving, as 4b): the threads take the vertex blocks'
+ * face pairs by ticket and unite them concurrently, linking a root under a smaller one by compare-and-swap
+ * (cs_unite_task; one thread: plain unions).  Whatever the order of the unions, every root ends as its component's first face,
  * and components are numbered by first face, as 4b.  Then, as checks.shell_labels does with sections 4 and
  * 4b: when no vertex is shared by two components (so that the components through shared vertices, section
  * 4, are these same ones), they are renumbered by their smallest vertex, which is section 4's numbering.
@@ -2427,41 +2427,78 @@ cs_tally_task(void *ctx, int t, int nt)
     (void)nt;
 }
 
-/* Whether faces g and h lie in one part of the faces. */
-static inline int
-cs_same_part(const CsTask *c, uint64_t g, uint64_t h)
+/* Part t of the faces: parents reset (before any thread unites). */
+static void
+cs_reset_task(void *ctx, int t, int nt)
 {
-    int p = 0;
-    while (g >= c->fpart[p + 1]) {
-        p++;
+    CsTask *c = (CsTask *)ctx;
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+        c->parent[i] = (int32_t)i;
     }
-    return h >= c->fpart[p] && h < c->fpart[p + 1];
+    (void)nt;
 }
 
-/* Part t of the faces (t < nt): parents reset, then the pairs with both faces in the part united; t == nt
- * (one thread, after the others): the pairs across parts. */
+/* The root of x when other threads link and halve concurrently (relaxed atomic loads and stores: a parent only
+ * ever moves to an ancestor, and every ancestor of a face is a smaller face, so no path ever cycles), with path
+ * halving. */
+static inline int32_t
+cs_find(int32_t *parent, int32_t x)
+{
+    for (;;) {
+        int32_t p = __atomic_load_n(&parent[x], __ATOMIC_RELAXED);
+        if (p == x) {
+            return x;
+        }
+        int32_t g = __atomic_load_n(&parent[p], __ATOMIC_RELAXED);
+        if (g != p) {
+            __atomic_store_n(&parent[x], g, __ATOMIC_RELAXED);   /* x is no root: only halving writes it */
+        }
+        x = g;
+    }
+}
+
+/* The blocks of face pairs this thread draws, united: the larger root is linked under the smaller by a
+ * compare-and-swap that fails (and is retried) when another thread linked it first.  Whatever the order, every
+ * link points to a smaller face, so each component's root ends as its first face: the same roots as one thread
+ * uniting the pairs in order (union by smaller index).  One thread: plain unite_faces. */
 static void
 cs_unite_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
     int32_t *parent = c->parent;
-    uint64_t lo = t < nt ? c->fpart[t] : 0, hi = t < nt ? c->fpart[t + 1] : 0;
-    if (t < nt) {
-        for (size_t i = lo; i < hi; i++) {
-            parent[i] = (int32_t)i;
-        }
-    }
     size_t blocks = (c->n + CS_BLOCK - 1) / CS_BLOCK;
-    for (size_t b = 0; b < blocks; b++) {
-        const uint64_t *pair = c->word + c->off[b * CS_BLOCK];
-        for (uint32_t k = 0; k < c->npairs[b]; k++) {
-            uint64_t g = pair[k] >> 32, h = pair[k] & 0xffffffffu;
-            int mine = t < nt ? (g >= lo && g < hi && h >= lo && h < hi) : !cs_same_part(c, g, h);
-            if (mine) {
-                unite_faces(parent, (int32_t)g, (int32_t)h);
+    for (;;) {
+        int32_t blk = next_ticket(&c->ticket);
+        if (blk < 0 || (size_t)blk >= blocks) {
+            break;
+        }
+        const uint64_t *pair = c->word + c->off[(size_t)blk * CS_BLOCK];
+        for (uint32_t k = 0; k < c->npairs[blk]; k++) {
+            int32_t a = (int32_t)(pair[k] >> 32), b = (int32_t)(pair[k] & 0xffffffffu);
+            if (nt == 1) {
+                unite_faces(parent, a, b);
+                continue;
+            }
+            for (;;) {
+                a = cs_find(parent, a);
+                b = cs_find(parent, b);
+                if (a == b) {
+                    break;
+                }
+                if (a > b) {
+                    int32_t x = a;
+                    a = b;
+                    b = x;
+                }
+                int32_t expected = b;      /* b is a root unless another thread has just linked it */
+                if (__atomic_compare_exchange_n(&parent[b], &expected, a, 0, __ATOMIC_RELAXED,
+                                                __ATOMIC_RELAXED)) {
+                    break;
+                }
             }
         }
     }
+    (void)t;
 }
 
 /* Part t: every face's parent set to its root (the parents of other parts are read meanwhile: relaxed atomic
@@ -2621,10 +2658,9 @@ cs_run(CsTask *c)
     if (c->parent == NULL) {
         return 0;
     }
+    run_parallel(nt, cs_reset_task, c);
+    c->ticket = 0;
     run_parallel(nt, cs_unite_task, c);
-    if (nt > 1) {
-        cs_unite_task(c, nt, nt);        /* the pairs across parts, on this thread */
-    }
     pool_give(c->word, c->word_bytes);   /* the pairs are done with */
     c->word = NULL;
     run_parallel(nt, cs_root_task, c);
