@@ -157,3 +157,38 @@ def test_forked_child_welds_on_inherited_mappings(lib):
         os._exit(0 if ok else 1)
     _, status = os.waitpid(pid, 0)
     assert os.waitstatus_to_exitcode(status) == 0
+
+
+def test_binary_stl_from_bytes_is_fed_in_chunks_and_matches_the_file(tmp_path, monkeypatch):
+    """load_mesh(path, data=the file's bytes) (the batch's read-once path) feeds the partition weld the same
+    chunks as reading the file does (so its output gathers on several threads), with the same result."""
+    from inertia_tool.mesh import read as read_mod
+    from inertia_tool.mesh import weld as weld_mod
+
+    pts = _torus_soup(40, 30)
+    rec = np.zeros(len(pts) // 3, dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = pts.reshape(-1, 3, 3)
+    path = tmp_path / "torus.stl"
+    path.write_bytes(b"x" * 80 + np.uint32(len(rec)).tobytes() + rec.tobytes())
+    monkeypatch.setattr(weld_mod, "PARTITION_MIN_POINTS", 1)
+    monkeypatch.setattr(read_mod, "_CHUNK_FACES", 500)
+    sizes = []
+    real = _native.accel().PartWelder
+
+    class Spy:
+        def __init__(self, index, *args):
+            self.w = real(index, *args)
+
+        def feed(self, c):
+            sizes.append(len(c))
+            return self.w.feed(c)
+
+        def __getattr__(self, name):
+            return getattr(self.w, name)
+    monkeypatch.setattr(_native.accel(), "PartWelder", Spy)
+    from_file = read_mod.load_mesh(str(path))
+    file_sizes, sizes[:] = list(sizes), []
+    from_bytes = read_mod.load_mesh(str(path), data=path.read_bytes())
+    assert sizes == file_sizes == [500] * 4 + [400]
+    np.testing.assert_array_equal(from_file.vertices, from_bytes.vertices)
+    np.testing.assert_array_equal(from_file.faces, from_bytes.faces)
