@@ -2,7 +2,8 @@
 ``numpy.fromfile`` of the same file, in one process with a warm page cache (issue 25).
 
 For each mesh (a 1M-face torus, the 5.24M-face icosphere of ``bench_engine.py``, a 10M-face torus; written
-into ``benchmarks/out/`` when missing, not committed) it reports the median of ``--repeat`` runs of:
+into ``$INERTIA_TOOL_BENCH_OUT``, else ``benchmarks/out/``, when missing; not committed) it reports the median
+of ``--repeat`` runs of:
 
 * ``fromfile``: ``numpy.fromfile`` of the whole file (a fresh allocation each time, as the reader's is);
 * the stages of :func:`inertia_tool.mass_properties`, called one by one as ``prepare_mesh`` calls them:
@@ -39,7 +40,9 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-OUT = os.path.join(HERE, "out")
+#: Where the meshes are written (not committed): ``$INERTIA_TOOL_BENCH_OUT`` if set (e.g. /tmp/bench), else
+#: ``benchmarks/out``.
+OUT = os.environ.get("INERTIA_TOOL_BENCH_OUT") or os.path.join(HERE, "out")
 _RECORD = np.dtype([("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
 
 

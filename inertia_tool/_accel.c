@@ -12,6 +12,8 @@
  *   1b. threads    -- run_parallel, the work tickets
  *   2. Welder      -- streaming exact weld of float32 or float64 points (mesh/weld.py)
  *   2b. PartWelder -- the same weld of float32 points by radix partition, on several threads
+ *                      (and pool_take / pool_give: the weld's and the census's scratch mappings, kept for
+ *                      the next call; Scratch, a buffer on one, for the weld's output arrays)
  *   3. edge_census -- boundary / non-manifold / misoriented edges (mesh/checks.edge_topology)
  *   4. shell_labels-- union-find connected components of faces (mesh/checks.shell_labels)
  *   4c. census_shells -- the census and the shell labels from one adjacency, on several threads
@@ -798,7 +800,7 @@ typedef struct {
     PwChunk *chunks;
     size_t n_chunks, chunks_cap;
     PwVertex *verts[MAX_THREADS];      /* vertices of the buckets each thread welded, bucket after bucket */
-    size_t vcount[MAX_THREADS], vcap[MAX_THREADS];
+    size_t vcount[MAX_THREADS], vcap[MAX_THREADS], vbytes[MAX_THREADS];   /* vbytes: the mapping's size */
     uint8_t *owner;                    /* per bucket: the thread that welded it */
     size_t *v0;                        /* per bucket: its first vertex in verts[owner] */
     uint32_t *nv;                      /* per bucket: its vertices */
@@ -811,7 +813,7 @@ typedef struct {
 /* A large zeroed-on-demand allocation, backed by 2 MB pages where the kernel offers them: the points of a
  * 10M-face file are 540 MB, and 4 kB pages would cost one page fault per 227 points. */
 static void *
-arena_alloc(size_t bytes)
+map_fresh(size_t bytes)
 {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
     void *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
@@ -839,6 +841,121 @@ arena_free(void *p, size_t bytes)
 #endif
 }
 
+/* The weld's and the census's scratch mappings, kept for the next call in the process.  Fresh anonymous
+ * pages cost the kernel a page fault and a zeroing each (on a 10M-face file about a third of the weld's CPU
+ * time went to clear_page in the kernel); a batch or a second analysis in the same process reuses the
+ * pages instead.  pool_take(&bytes) returns the smallest kept mapping of at least `bytes` (its real size
+ * back in `bytes`: give that to pool_give) or a fresh map_fresh; its contents are undefined (every user
+ * writes before it reads).  pool_give(p, bytes) keeps the mapping when it fits in POOL_SLOTS and
+ * POOL_MAX_BYTES, and tells the kernel it may take the pages back under memory pressure (MADV_FREE: the
+ * pages stay resident and reusable until then; reading one taken back gives zeros), else unmaps it.
+ * pool_drain() unmaps them all (accel.release_buffers()).  A mutex guards the slots: kernels free
+ * their scratch with the GIL released. */
+#define POOL_SLOTS 12
+#define POOL_MIN_BYTES ((size_t)1 << 21)          /* below this, plain map_fresh / arena_free (tests lower
+                                                     it with set_pool_floor to reuse small mappings too) */
+#define POOL_MAX_BYTES ((size_t)3 << 30)          /* kept in all, at most */
+
+static struct { void *p; size_t bytes; } pool_slot[POOL_SLOTS];
+static size_t pool_kept, pool_floor = POOL_MIN_BYTES;
+#if defined(_WIN32)
+static SRWLOCK pool_lock_ = SRWLOCK_INIT;
+#define POOL_LOCK() AcquireSRWLockExclusive(&pool_lock_)
+#define POOL_UNLOCK() ReleaseSRWLockExclusive(&pool_lock_)
+#else
+static pthread_mutex_t pool_lock_ = PTHREAD_MUTEX_INITIALIZER;
+#define POOL_LOCK() pthread_mutex_lock(&pool_lock_)
+#define POOL_UNLOCK() pthread_mutex_unlock(&pool_lock_)
+
+/* fork() while another thread holds the lock would leave it locked in the child for good: the lock is taken
+ * around fork (registered with pthread_atfork when the module loads), so the child starts with it free */
+static void pool_before_fork(void) { pthread_mutex_lock(&pool_lock_); }
+static void pool_after_fork(void) { pthread_mutex_unlock(&pool_lock_); }
+#endif
+
+static void *
+pool_take(size_t *bytes)
+{
+    size_t want = *bytes ? *bytes : 1;
+    int best = -1;
+    POOL_LOCK();
+    if (want >= pool_floor) {
+        for (int i = 0; i < POOL_SLOTS; i++) {
+            if (pool_slot[i].p != NULL && pool_slot[i].bytes >= want
+                    && (best < 0 || pool_slot[i].bytes < pool_slot[best].bytes)) {
+                best = i;
+            }
+        }
+    }
+    if (best >= 0) {
+        void *p = pool_slot[best].p;
+        *bytes = pool_slot[best].bytes;
+        pool_kept -= pool_slot[best].bytes;
+        pool_slot[best].p = NULL;
+        pool_slot[best].bytes = 0;
+        POOL_UNLOCK();
+        return p;
+    }
+    POOL_UNLOCK();
+    *bytes = want;
+    return map_fresh(want);
+}
+
+static void
+pool_give(void *p, size_t bytes)
+{
+    if (p == NULL) {
+        return;
+    }
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    int kept = 0;
+#if defined(MADV_FREE)
+    madvise(p, bytes, MADV_FREE);        /* before the mapping is in a slot, where another thread may take it */
+#endif
+    POOL_LOCK();
+    if (bytes >= pool_floor && pool_kept + bytes <= POOL_MAX_BYTES) {
+        for (int i = 0; i < POOL_SLOTS && !kept; i++) {
+            if (pool_slot[i].p == NULL) {
+                pool_slot[i].p = p;
+                pool_slot[i].bytes = bytes;
+                pool_kept += bytes;
+                kept = 1;
+            }
+        }
+    }
+    POOL_UNLOCK();
+    if (kept) {
+        return;
+    }
+#endif
+    arena_free(p, bytes);
+}
+
+/* arena_alloc: map_fresh for the kernels outside the weld and the census (the face-pair check), which first
+ * unmaps the mappings kept for the next weld or census (pool_drain): kept pages never coexist with another
+ * kernel's fresh ones, so keeping them never raises the process's peak above what unmapping them would. */
+static void pool_drain(void);
+
+static void *
+arena_alloc(size_t bytes)
+{
+    pool_drain();
+    return map_fresh(bytes);
+}
+
+static void
+pool_drain(void)
+{
+    POOL_LOCK();
+    for (int i = 0; i < POOL_SLOTS; i++) {
+        arena_free(pool_slot[i].p, pool_slot[i].bytes);
+        pool_slot[i].p = NULL;
+        pool_slot[i].bytes = 0;
+    }
+    pool_kept = 0;
+    POOL_UNLOCK();
+}
+
 static inline uint32_t
 popcount64(uint64_t x)
 {
@@ -856,7 +973,7 @@ pw_release(PartWelderObject *w)
     }
     free(w->chunks);
     w->chunks = NULL;
-    arena_free(w->entries, w->arena_bytes);
+    pool_give(w->entries, w->arena_bytes);
     w->entries = NULL;
     w->arena_bytes = 0;
     if (w->has_index) {
@@ -865,11 +982,11 @@ pw_release(PartWelderObject *w)
     }
     w->n_chunks = w->chunks_cap = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
-        arena_free(w->verts[t], w->vcap[t] * sizeof(PwVertex));
+        pool_give(w->verts[t], w->vbytes[t]);
         free(w->mark[t]);
         w->verts[t] = NULL;
         w->mark[t] = NULL;
-        w->vcount[t] = w->vcap[t] = 0;
+        w->vcount[t] = w->vcap[t] = w->vbytes[t] = 0;
     }
     free(w->recent);
     w->recent = NULL;
@@ -1211,7 +1328,7 @@ PartWelder_init(PartWelderObject *w, PyObject *args, PyObject *kwds)
     w->rank = (uint32_t *)malloc(words * sizeof(uint32_t));
     int fits = (size_t)n_points <= (SIZE_MAX - 64) / sizeof(PwEntry);
     w->arena_bytes = fits ? (size_t)n_points * sizeof(PwEntry) + 64 : 0;
-    w->entries = fits ? (PwEntry *)arena_alloc(w->arena_bytes) : NULL;
+    w->entries = fits ? (PwEntry *)pool_take(&w->arena_bytes) : NULL;
     w->recent = (Recent32 *)malloc((size_t)w->threads * WELD_RECENT * sizeof(Recent32));
     int ok = w->owner && w->v0 && w->nv && w->vbase && w->rank && w->entries && w->recent;
     for (int t = 0; t < w->threads && ok; t++) {
@@ -1348,9 +1465,10 @@ PartWelder_finish(PartWelderObject *w, PyObject *unused)
      * (memory from malloc in a worker thread could stay in that thread's heap) */
     for (int t = 0; t < nt; t++) {
         w->vcap[t] = w->partitioned ? w->partitioned : 1;
-        w->verts[t] = (PwVertex *)arena_alloc(w->vcap[t] * sizeof(PwVertex));
+        w->vbytes[t] = w->vcap[t] * sizeof(PwVertex);
+        w->verts[t] = (PwVertex *)pool_take(&w->vbytes[t]);
         if (w->verts[t] == NULL) {
-            w->vcap[t] = 0;
+            w->vcap[t] = w->vbytes[t] = 0;
             pw_release(w);
             w->state = 2;
             return PyErr_NoMemory();
@@ -1409,7 +1527,7 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
         goto fail;
     }
     size_t number_bytes = (w->count ? w->count : 1) * sizeof(uint32_t);
-    uint32_t *number = (uint32_t *)arena_alloc(number_bytes);
+    uint32_t *number = (uint32_t *)pool_take(&number_bytes);
     if (number == NULL) {
         PyErr_NoMemory();
         goto fail;
@@ -1421,7 +1539,7 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
     run_parallel(nt, pw_number_task, &task);
     task.ticket = 0;
     run_parallel(nt, pw_gather_task, &task);
-    arena_free(number, number_bytes);
+    pool_give(number, number_bytes);
     Py_END_ALLOW_THREADS
     pw_release(w);                      /* releases the index buffer: with the GIL */
     w->busy = 0;
@@ -1493,6 +1611,75 @@ static PyTypeObject PartWelderType = {
     .tp_dealloc = (destructor)PartWelder_dealloc,
     .tp_methods = PartWelder_methods,
     .tp_getset = PartWelder_getset,
+};
+
+/* Scratch(nbytes): a writable buffer of nbytes taken from the kept mappings (pool_take), given back when the
+ * object is freed (pool_give): the weld's output arrays (numpy.frombuffer over it), so that an analysis after
+ * another in the same process writes its corner ids and vertices into pages faulted in already.  Its
+ * contents start undefined, as numpy.empty's. */
+typedef struct {
+    PyObject_HEAD
+    void *p;
+    size_t bytes;          /* the mapping's size (pool_take may give a larger one) */
+    Py_ssize_t len;        /* the buffer's */
+} ScratchObject;
+
+static PyObject *
+Scratch_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
+{
+    static char *kwlist[] = {"nbytes", NULL};
+    Py_ssize_t len;
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "n", kwlist, &len)) {
+        return NULL;
+    }
+    if (len < 0) {
+        PyErr_Format(PyExc_ValueError, "Expected a number of bytes >= 0, got %zd", len);
+        return NULL;
+    }
+    ScratchObject *b = (ScratchObject *)type->tp_alloc(type, 0);
+    if (b == NULL) {
+        return NULL;
+    }
+    b->bytes = len ? (size_t)len : 1;
+    b->p = pool_take(&b->bytes);
+    b->len = len;
+    if (b->p == NULL) {
+        b->bytes = 0;
+        Py_DECREF(b);
+        return PyErr_NoMemory();
+    }
+    return (PyObject *)b;
+}
+
+static void
+Scratch_dealloc(ScratchObject *b)
+{
+    pool_give(b->p, b->bytes);
+    Py_TYPE(b)->tp_free((PyObject *)b);
+}
+
+static int
+Scratch_getbuffer(ScratchObject *b, Py_buffer *view, int flags)
+{
+    return PyBuffer_FillInfo(view, (PyObject *)b, b->p, b->len, 0, flags);
+}
+
+static PyBufferProcs Scratch_as_buffer = {
+    .bf_getbuffer = (getbufferproc)Scratch_getbuffer,
+};
+
+static PyTypeObject ScratchType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "inertia_tool._accel.Scratch",
+    .tp_doc = "Scratch(nbytes)\n\nA writable buffer of nbytes (contents undefined) from the mappings the weld and "
+              "the census keep; given back to them when freed.  numpy.frombuffer(Scratch(n), dtype) is an "
+              "uninitialised array whose pages an earlier analysis in the process may have faulted in.",
+    .tp_basicsize = sizeof(ScratchObject),
+    .tp_itemsize = 0,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_new = Scratch_new,
+    .tp_dealloc = (destructor)Scratch_dealloc,
+    .tp_as_buffer = &Scratch_as_buffer,
 };
 
 /* ======================================================================================================
@@ -2046,9 +2233,9 @@ fail:
  * direction; counts added and smallest keys merged over threads) and, when labels are asked for, the face
  * pairs to unite (consecutive faces of the run).
  *
- * Union-find over faces (union by smaller index, path halving, as 4b): first, on thread p, the pairs whose
- * two faces lie in the p-th part of the faces (they touch only that part's parents; every thread reads all
- * the pairs and keeps its own), then the pairs across parts on one thread.  Whatever the order of the unions, every root ends as its component's first face,
+ * Union-find over faces (union by smaller index, path halving, as 4b): the threads take the vertex blocks'
+ * face pairs by ticket and unite them concurrently, linking a root under a smaller one by compare-and-swap
+ * (cs_unite_task; one thread: plain unions).  Whatever the order of the unions, every root ends as its component's first face,
  * and components are numbered by first face, as 4b.  Then, as checks.shell_labels does with sections 4 and
  * 4b: when no vertex is shared by two components (so that the components through shared vertices, section
  * 4, are these same ones), they are renumbered by their smallest vertex, which is section 4's numbering.
@@ -2084,6 +2271,7 @@ typedef struct {
     uint32_t *npairs;                    /* per block of CS_BLOCK vertices: face pairs to unite, kept in place
                                             of the block's words (from its first) */
     CensusTally tally[MAX_THREADS];
+    size_t cnt_bytes[MAX_THREADS], off_bytes, word_bytes, parent_bytes;   /* the mappings' sizes (pool_take) */
 } CsTask;
 
 static inline int64_t
@@ -2109,6 +2297,7 @@ cs_count_task(void *ctx, int t, int nt)
     CsTask *c = (CsTask *)ctx;
     uint32_t *cnt = c->cnt[t];
     uint64_t n = c->n;
+    memset(cnt, 0, (n ? n : 1) * sizeof(uint32_t));     /* a kept mapping holds old counts */
     for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
         int64_t a = index_at(c->f, c->size, 3 * i), b = index_at(c->f, c->size, 3 * i + 1);
         int64_t d = index_at(c->f, c->size, 3 * i + 2);
@@ -2238,41 +2427,78 @@ cs_tally_task(void *ctx, int t, int nt)
     (void)nt;
 }
 
-/* Whether faces g and h lie in one part of the faces. */
-static inline int
-cs_same_part(const CsTask *c, uint64_t g, uint64_t h)
+/* Part t of the faces: parents reset (before any thread unites). */
+static void
+cs_reset_task(void *ctx, int t, int nt)
 {
-    int p = 0;
-    while (g >= c->fpart[p + 1]) {
-        p++;
+    CsTask *c = (CsTask *)ctx;
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+        c->parent[i] = (int32_t)i;
     }
-    return h >= c->fpart[p] && h < c->fpart[p + 1];
+    (void)nt;
 }
 
-/* Part t of the faces (t < nt): parents reset, then the pairs with both faces in the part united; t == nt
- * (one thread, after the others): the pairs across parts. */
+/* The root of x when other threads link and halve concurrently (relaxed atomic loads and stores: a parent only
+ * ever moves to an ancestor, and every ancestor of a face is a smaller face, so no path ever cycles), with path
+ * halving. */
+static inline int32_t
+cs_find(int32_t *parent, int32_t x)
+{
+    for (;;) {
+        int32_t p = __atomic_load_n(&parent[x], __ATOMIC_RELAXED);
+        if (p == x) {
+            return x;
+        }
+        int32_t g = __atomic_load_n(&parent[p], __ATOMIC_RELAXED);
+        if (g != p) {
+            __atomic_store_n(&parent[x], g, __ATOMIC_RELAXED);   /* x is no root: only halving writes it */
+        }
+        x = g;
+    }
+}
+
+/* The blocks of face pairs this thread draws, united: the larger root is linked under the smaller by a
+ * compare-and-swap that fails (and is retried) when another thread linked it first.  Whatever the order, every
+ * link points to a smaller face, so each component's root ends as its first face: the same roots as one thread
+ * uniting the pairs in order (union by smaller index).  One thread: plain unite_faces. */
 static void
 cs_unite_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
     int32_t *parent = c->parent;
-    uint64_t lo = t < nt ? c->fpart[t] : 0, hi = t < nt ? c->fpart[t + 1] : 0;
-    if (t < nt) {
-        for (size_t i = lo; i < hi; i++) {
-            parent[i] = (int32_t)i;
-        }
-    }
     size_t blocks = (c->n + CS_BLOCK - 1) / CS_BLOCK;
-    for (size_t b = 0; b < blocks; b++) {
-        const uint64_t *pair = c->word + c->off[b * CS_BLOCK];
-        for (uint32_t k = 0; k < c->npairs[b]; k++) {
-            uint64_t g = pair[k] >> 32, h = pair[k] & 0xffffffffu;
-            int mine = t < nt ? (g >= lo && g < hi && h >= lo && h < hi) : !cs_same_part(c, g, h);
-            if (mine) {
-                unite_faces(parent, (int32_t)g, (int32_t)h);
+    for (;;) {
+        int32_t blk = next_ticket(&c->ticket);
+        if (blk < 0 || (size_t)blk >= blocks) {
+            break;
+        }
+        const uint64_t *pair = c->word + c->off[(size_t)blk * CS_BLOCK];
+        for (uint32_t k = 0; k < c->npairs[blk]; k++) {
+            int32_t a = (int32_t)(pair[k] >> 32), b = (int32_t)(pair[k] & 0xffffffffu);
+            if (nt == 1) {
+                unite_faces(parent, a, b);
+                continue;
+            }
+            for (;;) {
+                a = cs_find(parent, a);
+                b = cs_find(parent, b);
+                if (a == b) {
+                    break;
+                }
+                if (a > b) {
+                    int32_t x = a;
+                    a = b;
+                    b = x;
+                }
+                int32_t expected = b;      /* b is a root unless another thread has just linked it */
+                if (__atomic_compare_exchange_n(&parent[b], &expected, a, 0, __ATOMIC_RELAXED,
+                                                __ATOMIC_RELAXED)) {
+                    break;
+                }
             }
         }
     }
+    (void)t;
 }
 
 /* Part t: every face's parent set to its root (the parents of other parts are read meanwhile: relaxed atomic
@@ -2388,12 +2614,12 @@ static void
 cs_free(CsTask *c)
 {
     for (int t = 0; t < MAX_THREADS; t++) {
-        free(c->cnt[t]);
+        pool_give(c->cnt[t], c->cnt_bytes[t]);
     }
     free(c->npairs);
-    free(c->off);
-    free(c->word);
-    free(c->parent);
+    pool_give(c->off, c->off_bytes);
+    pool_give(c->word, c->word_bytes);
+    pool_give(c->parent, c->parent_bytes);
     free(c->rank);
     free(c);
 }
@@ -2432,11 +2658,10 @@ cs_run(CsTask *c)
     if (c->parent == NULL) {
         return 0;
     }
+    run_parallel(nt, cs_reset_task, c);
+    c->ticket = 0;
     run_parallel(nt, cs_unite_task, c);
-    if (nt > 1) {
-        cs_unite_task(c, nt, nt);        /* the pairs across parts, on this thread */
-    }
-    free(c->word);                       /* the pairs are done with */
+    pool_give(c->word, c->word_bytes);   /* the pairs are done with */
     c->word = NULL;
     run_parallel(nt, cs_root_task, c);
     int64_t count = 0;
@@ -2525,12 +2750,16 @@ accel_census_shells(PyObject *self, PyObject *args)
     }
     int ok = 1;
     for (int t = 0; t < nt && ok; t++) {
-        c->cnt[t] = (uint32_t *)calloc(n ? n : 1, sizeof(uint32_t));
+        c->cnt_bytes[t] = (n ? n : 1) * sizeof(uint32_t);      /* zeroed by cs_count_task */
+        c->cnt[t] = (uint32_t *)pool_take(&c->cnt_bytes[t]);
         ok = c->cnt[t] != NULL;
     }
-    c->off = (uint32_t *)malloc((n + 1) * sizeof(uint32_t));
-    c->word = (uint64_t *)malloc((mm ? 3 * mm : 1) * sizeof(uint64_t));
-    c->parent = has_out ? (int32_t *)malloc((mm ? mm : 1) * sizeof(int32_t)) : NULL;
+    c->off_bytes = (n + 1) * sizeof(uint32_t);
+    c->word_bytes = (mm ? 3 * mm : 1) * sizeof(uint64_t);
+    c->parent_bytes = (mm ? mm : 1) * sizeof(int32_t);
+    c->off = (uint32_t *)pool_take(&c->off_bytes);
+    c->word = (uint64_t *)pool_take(&c->word_bytes);
+    c->parent = has_out ? (int32_t *)pool_take(&c->parent_bytes) : NULL;
     c->npairs = (uint32_t *)malloc((n / CS_BLOCK + 1) * sizeof(uint32_t));
     if (!ok || c->off == NULL || c->word == NULL || c->npairs == NULL || (has_out && c->parent == NULL)) {
         PyErr_NoMemory();
@@ -3145,7 +3374,50 @@ static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* secti
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
 
+static PyObject *
+accel_release_buffers(PyObject *self, PyObject *unused)
+{
+    pool_drain();
+    Py_RETURN_NONE;
+}
+
+static PyObject *
+accel_kept_buffers(PyObject *self, PyObject *unused)
+{
+    POOL_LOCK();
+    size_t kept = pool_kept;
+    POOL_UNLOCK();
+    return PyLong_FromSize_t(kept);
+}
+
+static PyObject *
+accel_set_pool_floor(PyObject *self, PyObject *args)
+{
+    Py_ssize_t floor_bytes;
+    if (!PyArg_ParseTuple(args, "n", &floor_bytes)) {
+        return NULL;
+    }
+    if (floor_bytes < 1) {
+        PyErr_Format(PyExc_ValueError, "Expected a positive number of bytes, got %zd", floor_bytes);
+        return NULL;
+    }
+    POOL_LOCK();
+    size_t previous = pool_floor;
+    pool_floor = (size_t)floor_bytes;
+    POOL_UNLOCK();
+    return PyLong_FromSize_t(previous);
+}
+
 static PyMethodDef accel_methods[] = {
+    {"set_pool_floor", accel_set_pool_floor, METH_VARARGS,
+     "set_pool_floor(bytes) -> previous\n\nThe smallest scratch mapping the weld and the census keep for the "
+     "next call (default 2 MiB; tests lower it so that small inputs reuse old, dirty mappings too)."},
+    {"release_buffers", accel_release_buffers, METH_NOARGS,
+     "release_buffers()\n\nUnmap the scratch mappings the weld and the census keep for the next call (section "
+     "2b, pool_give); they are kept marked MADV_FREE, so the kernel takes them back under memory pressure "
+     "anyway."},
+    {"kept_buffers", accel_kept_buffers, METH_NOARGS,
+     "kept_buffers() -> bytes\n\nBytes of scratch mappings kept for the next weld or census (section 2b)."},
     {"edge_census", accel_edge_census, METH_VARARGS,
      "edge_census(faces, n_vertices, threads=1) -> (edges, boundary, nonmanifold, misoriented, sample_boundary, "
      "sample_nonmanifold, sample_misoriented)\n\nEdge census of (m, 3) int32/int64 faces; each sample is a "
@@ -3211,13 +3483,19 @@ static struct PyModuleDef accel_module = {
 PyMODINIT_FUNC
 PyInit__accel(void)
 {
-    if (PyType_Ready(&WelderType) < 0 || PyType_Ready(&PartWelderType) < 0) {
+    if (PyType_Ready(&WelderType) < 0 || PyType_Ready(&PartWelderType) < 0 || PyType_Ready(&ScratchType) < 0) {
         return NULL;
     }
     PyObject *mod = PyModule_Create(&accel_module);
     if (mod == NULL) {
         return NULL;
     }
+#if !defined(_WIN32)
+    static int fork_handlers = 0;          /* once per process, even if the module is loaded again */
+    if (!fork_handlers) {
+        fork_handlers = pthread_atfork(pool_before_fork, pool_after_fork, pool_after_fork) == 0;
+    }
+#endif
     Py_INCREF(&WelderType);
     if (PyModule_AddObject(mod, "Welder", (PyObject *)&WelderType) < 0) {
         Py_DECREF(&WelderType);
@@ -3227,6 +3505,12 @@ PyInit__accel(void)
     Py_INCREF(&PartWelderType);
     if (PyModule_AddObject(mod, "PartWelder", (PyObject *)&PartWelderType) < 0) {
         Py_DECREF(&PartWelderType);
+        Py_DECREF(mod);
+        return NULL;
+    }
+    Py_INCREF(&ScratchType);
+    if (PyModule_AddObject(mod, "Scratch", (PyObject *)&ScratchType) < 0) {
+        Py_DECREF(&ScratchType);
         Py_DECREF(mod);
         return NULL;
     }

@@ -318,3 +318,24 @@ def test_threads_setting_non_ascii_digits(monkeypatch):
     got = _native.threads()
     monkeypatch.delenv(_native.THREADS_ENV)
     assert got == _native.threads()
+
+
+def test_census_shells_unite_across_threads_on_a_torus_in_file_order(lib):
+    """A 240,000-face torus welded from the benchmark's file order (every quad's two triangles in opposite
+    halves of the faces, so every face pair to unite spans the threads' parts; the threads unite them
+    concurrently by compare-and-swap), plus a second torus far away in shuffled vertex numbers: the separate
+    kernels' census and labels on 1, 2, 3 and 5 threads."""
+    from test_weld_partition import _torus_soup
+
+    from inertia_tool.mesh.weld import weld_exact
+
+    v, f = weld_exact(_torus_soup(400, 300).reshape(-1, 3, 3))
+    perm = np.random.default_rng(5).permutation(len(v))
+    faces = np.concatenate([f, perm[f] + len(v)]).astype(np.int32)
+    n = 2 * len(v)
+    census, (labels, count) = _separate_kernels(lib, faces, n)
+    assert count == 2
+    for threads in (1,) + THREADS:
+        out = np.empty(len(faces), np.int64)
+        assert lib.census_shells(faces, n, out, threads) == census + (count,)
+        np.testing.assert_array_equal(out, labels)

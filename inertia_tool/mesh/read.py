@@ -202,7 +202,9 @@ def _binary_stl_chunks(path: str, n: int, *, padded: bool = True,
     """
     def views() -> Iterator[np.ndarray]:
         if whole is not None and 84 + 50 * n <= len(whole):
-            yield np.frombuffer(whole, dtype=_STL_RECORD, count=n, offset=84)["v"]
+            corners = np.frombuffer(whole, dtype=_STL_RECORD, count=n, offset=84)["v"]
+            for first in range(0, n, _CHUNK_FACES):  # in chunks, as from the file: the partition weld's output
+                yield corners[first:first + _CHUNK_FACES]    # gathers chunk by chunk on the threads
             return
         with open_regular(path) as fh:
             fh.seek(84)

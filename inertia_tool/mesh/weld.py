@@ -96,9 +96,12 @@ def _weld_partitioned(lib: ModuleType, stream: Iterable[np.ndarray], n_points: i
 
     The points are partitioned by hash into buckets as they stream in, each bucket is welded in a table that
     fits in a core's cache, and the vertices are numbered by first appearance: the same vertices and faces as
-    the one-table ``Welder``, on :func:`inertia_tool._native.threads` threads.
+    the one-table ``Welder``, on :func:`inertia_tool._native.threads` threads.  The corner ids and the
+    vertices are written into the extension's ``Scratch`` buffers (uninitialised, like ``numpy.empty``):
+    pages an earlier weld or census in the process faulted in and left behind, when there are any, so that a
+    second large file does not pay the kernel's page faults again.
     """
-    index = np.empty(n_points, dtype=np.int32)
+    index = _scratch(lib, n_points, np.int32)
     welder = lib.PartWelder(index, threads())
     s = 0
     for c in stream:
@@ -116,9 +119,16 @@ def _weld_partitioned(lib: ModuleType, stream: Iterable[np.ndarray], n_points: i
         s += k
     if s != n_points:
         raise ValueError(f"expected {n_points} points from the stream, got {s}")
-    vertices = np.empty((welder.finish(), 3), dtype=np.float64)
+    vertices = _scratch(lib, 3 * welder.finish(), np.float64).reshape(-1, 3)
     welder.output(vertices)
     return vertices, index.reshape(-1, 3)
+
+
+def _scratch(lib: ModuleType, n: int, dtype: type[np.int32] | type[np.float64]) -> np.ndarray:
+    """An uninitialised writable (n,) array on a ``Scratch`` buffer of the C extension (its memory goes back
+    to the extension's kept mappings when the array is freed)."""
+    out: np.ndarray = np.frombuffer(lib.Scratch(n * np.dtype(dtype).itemsize), dtype=dtype)
+    return out
 
 
 def _chain(first: np.ndarray, rest: Iterator[np.ndarray]) -> Iterator[np.ndarray]:

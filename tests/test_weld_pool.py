@@ -1,0 +1,194 @@
+"""The scratch mappings the radix-partition weld (``PartWelder``) and the one-adjacency census
+(``census_shells``) keep for the next call in the process (``_accel.c`` section 2b, ``pool_take`` /
+``pool_give``): a kept mapping holds the previous call's entries, vertices, counts and words, so every
+result here is computed on dirty memory and compared with an independent reference (a Python dict on the
+bit patterns for the weld, the separate one-thread kernels for the census and shells).
+
+The floor below which mappings are not kept is lowered to one byte, so that the small hypothesis streams
+reuse mappings as a 10M-face file does.
+"""
+
+import os
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from conftest import HAVE_ACCEL, REQUIRE_ACCEL
+from inertia_tool import _native
+from test_native_threads import _separate_kernels
+from test_weld_partition import _NAN_A, _NAN_B, _SPECIAL, _dict_weld, _part_welder, _same, _torus_soup
+
+pytestmark = pytest.mark.skipif(not HAVE_ACCEL and not REQUIRE_ACCEL, reason="inertia_tool._accel is not built")
+
+
+@pytest.fixture(scope="module")
+def lib():
+    """The extension with every scratch mapping kept (floor 1 byte); the default floor and an empty pool
+    are restored afterwards."""
+    lib = _native.accel()
+    previous = lib.set_pool_floor(1)
+    yield lib
+    lib.set_pool_floor(previous)
+    lib.release_buffers()
+
+
+def _dirty(lib, n: int, seed: int) -> None:
+    """Fill the pool with mappings written by a weld and a census of unrelated data of about ``n`` points."""
+    rng = np.random.default_rng(seed)
+    junk = rng.integers(0, 2**31, size=(max(n, 3), 3)).astype(np.uint32).view(np.float32)
+    _part_welder(lib, junk, threads=3, bits=4)
+    faces = rng.integers(0, max(n // 2, 3), size=(max(n // 3, 1), 3)).astype(np.int32)
+    lib.census_shells(faces, max(n // 2, 3), np.empty(len(faces), np.int32), 2, 1)
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(0, 2500), alphabet=st.integers(1, 30), seed=st.integers(0, 2**32 - 1),
+       threads=st.integers(1, 5), bits=st.integers(0, 8), feeds=st.integers(1, 5))
+def test_partition_on_kept_mappings_matches_dict(lib, n, alphabet, seed, threads, bits, feeds):
+    """Streams with -0.0, subnormals, infinities, two NaN payloads and many repeats, welded on 1-5 threads
+    right after a weld and a census of junk of a similar size: the dict's vertices and ids, bit for bit."""
+    _dirty(lib, n + 50, seed)
+    assert lib.kept_buffers() > 0
+    rng = np.random.default_rng(seed)
+    coords = np.concatenate([_SPECIAL, [_NAN_A, _NAN_B], rng.normal(size=6).astype(np.float32)])
+    pts = rng.choice(coords, size=(alphabet, 3)).astype(np.float32)[rng.integers(0, alphabet, n)]
+    cuts = np.unique(np.r_[0, rng.integers(0, n + 1, size=feeds - 1), n])
+    _same(_part_welder(lib, pts, threads, bits, list(cuts)), _dict_weld(pts))
+
+
+@settings(max_examples=40, deadline=None)
+@given(n_vertices=st.integers(3, 400), n_faces=st.integers(1, 600), seed=st.integers(0, 2**32 - 1),
+       threads=st.integers(1, 5))
+def test_census_shells_on_kept_mappings_match_separate_kernels(lib, n_vertices, n_faces, seed, threads):
+    """Random faces (duplicates, flips, shells joined at a vertex) on 1-5 threads after a census of junk: the
+    separate one-thread kernels' census and labels (their memory is never kept)."""
+    _dirty(lib, 3 * n_faces + 30, seed)
+    rng = np.random.default_rng(seed)
+    f = rng.integers(0, n_vertices, size=(n_faces, 3)).astype(np.int32)
+    census, (labels, count) = _separate_kernels(lib, f, n_vertices)
+    out = np.empty(n_faces, np.int64)
+    assert lib.census_shells(f, n_vertices, out, threads, 1) == census + (count,)
+    np.testing.assert_array_equal(out, labels)
+
+
+def test_large_weld_keeps_and_releases_its_mappings(lib):
+    """A 240,000-face torus welded twice in a row (the second on the first's mappings) gives the same result
+    as the dict; release_buffers empties the pool."""
+    pts = _torus_soup(400, 300)
+    lib.release_buffers()
+    first = _part_welder(lib, pts, 2)
+    kept = lib.kept_buffers()
+    assert kept >= 16 * 120_000              # at least the entries of the partitioned points
+    second = _part_welder(lib, pts[::-1].copy(), 2)
+    _same(first, _dict_weld(pts))
+    _same(second, _dict_weld(pts[::-1]))
+    lib.release_buffers()
+    assert lib.kept_buffers() == 0
+
+
+def test_pool_floor_refuses_nonsense(lib):
+    with pytest.raises(ValueError, match="positive number of bytes"):
+        lib.set_pool_floor(0)
+
+
+def test_scratch_buffer_is_a_writable_array_whose_memory_goes_back(lib):
+    """Scratch(n): a writable n-byte buffer (numpy.frombuffer gives a writable array over it); freeing the
+    array gives its mapping back to the pool, and the next Scratch of that size reuses it, dirty."""
+    lib.release_buffers()
+    a = np.frombuffer(lib.Scratch(4000), dtype=np.int32)
+    assert a.flags.writeable and a.shape == (1000,)
+    a[:] = np.arange(1000)
+    assert lib.kept_buffers() == 0
+    del a
+    kept = lib.kept_buffers()
+    assert kept >= 4000
+    b = np.frombuffer(lib.Scratch(4000), dtype=np.int32)
+    assert lib.kept_buffers() == 0 and b.flags.writeable             # the one kept mapping, taken again
+    assert np.frombuffer(lib.Scratch(0), dtype=np.int32).shape == (0,)
+    with pytest.raises(ValueError, match="number of bytes >= 0"):
+        lib.Scratch(-1)
+
+
+def test_weld_outputs_live_on_scratch_and_match_numpy(lib, monkeypatch):
+    """weld_exact_stream on the partition writes its faces and vertices into Scratch buffers: the numpy
+    reference's arrays, writable, and still right after the pool has been dirtied by other welds."""
+    from inertia_tool.mesh import weld as weld_mod
+
+    monkeypatch.setattr(weld_mod, "PARTITION_MIN_POINTS", 1)
+    pts = _torus_soup(40, 30)
+    pts[::5] *= -0.0
+    for seed in range(3):
+        _dirty(lib, len(pts), seed)
+        vertices, faces = weld_mod.weld_exact(pts.reshape(-1, 3, 3))
+        assert isinstance(faces.base.base, lib.Scratch) and isinstance(vertices.base.base, lib.Scratch)
+        assert faces.flags.writeable and vertices.flags.writeable
+        ref_v, ref_ids = _dict_weld(pts)
+        np.testing.assert_array_equal(vertices.view(np.uint64), ref_v.view(np.uint64))
+        np.testing.assert_array_equal(faces.reshape(-1), ref_ids)
+
+
+def test_kept_mappings_are_unmapped_before_another_kernel_maps_fresh_ones(lib):
+    """The face-pair check maps its arrays fresh (arena_alloc): the kept mappings are unmapped first, so that
+    keeping them never raises the peak memory of an analysis (the check sets it)."""
+    pts = _torus_soup(60, 40)
+    vertices, ids = _part_welder(lib, pts, 2)
+    assert lib.kept_buffers() > 0
+    lib.contact_scan(vertices, ids.reshape(-1, 3), -1)
+    assert lib.kept_buffers() == 0
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
+def test_forked_child_welds_on_inherited_mappings(lib):
+    """A child forked while the pool holds mappings (a batch worker started by fork) welds on them and gets
+    the dict's result; the lock is free in the child (pthread_atfork)."""
+    pts = _torus_soup(60, 40)
+    _part_welder(lib, pts, 2)
+    assert lib.kept_buffers() > 0
+    pid = os.fork()
+    if pid == 0:                                 # the child: exit status 0 when the weld is right
+        ok = False
+        try:
+            got = _part_welder(lib, pts[::-1].copy(), 2)
+            ok = bool(np.array_equal(got[1], _dict_weld(pts[::-1])[1]))
+        except BaseException:
+            pass
+        os._exit(0 if ok else 1)
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0
+
+
+def test_binary_stl_from_bytes_is_fed_in_chunks_and_matches_the_file(tmp_path, monkeypatch):
+    """load_mesh(path, data=the file's bytes) (the batch's read-once path) feeds the partition weld the same
+    chunks as reading the file does (so its output gathers on several threads), with the same result."""
+    from inertia_tool.mesh import read as read_mod
+    from inertia_tool.mesh import weld as weld_mod
+
+    pts = _torus_soup(40, 30)
+    rec = np.zeros(len(pts) // 3, dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = pts.reshape(-1, 3, 3)
+    path = tmp_path / "torus.stl"
+    path.write_bytes(b"x" * 80 + np.uint32(len(rec)).tobytes() + rec.tobytes())
+    monkeypatch.setattr(weld_mod, "PARTITION_MIN_POINTS", 1)
+    monkeypatch.setattr(read_mod, "_CHUNK_FACES", 500)
+    sizes = []
+    real = _native.accel().PartWelder
+
+    class Spy:
+        def __init__(self, index, *args):
+            self.w = real(index, *args)
+
+        def feed(self, c):
+            sizes.append(len(c))
+            return self.w.feed(c)
+
+        def __getattr__(self, name):
+            return getattr(self.w, name)
+    monkeypatch.setattr(_native.accel(), "PartWelder", Spy)
+    from_file = read_mod.load_mesh(str(path))
+    file_sizes, sizes[:] = list(sizes), []
+    from_bytes = read_mod.load_mesh(str(path), data=path.read_bytes())
+    assert sizes == file_sizes == [500] * 4 + [400]
+    np.testing.assert_array_equal(from_file.vertices, from_bytes.vertices)
+    np.testing.assert_array_equal(from_file.faces, from_bytes.faces)
