@@ -6216,6 +6216,7 @@ done:
 #define OE_RADIX_BITS 11
 #define OE_RADIX (1 << OE_RADIX_BITS)
 #define OE_PASSES 6                                  /* 6 x 11 bits cover the 63 bits of a code */
+#define OE_BLOCK_BITS 15                             /* close_groups' blocks: 32^3 cells */
 
 /* The 21 low bits of v spread to every third bit (bit b to bit 3b). */
 static inline uint64_t
@@ -6390,7 +6391,8 @@ oe_grid_free(OeGrid *g)
 /* Bucket the points xyz(i), i < p (at `stride` doubles apart from `base`, gathered through `pts` when not
  * NULL) into cells of side `cell` above `lo`.  Returns 0, -1 out of memory, -2 a cell index beyond 21 bits. */
 static int
-oe_grid_build(OeGrid *g, const double *base, const int64_t *pts, size_t p, const double lo[3], double cell)
+oe_grid_build(OeGrid *g, const double *base, const int64_t *pts, size_t p, const double lo[3], double cell,
+              int with_table)
 {
     memset(g, 0, sizeof(*g));
     g->p = p;
@@ -6435,7 +6437,7 @@ oe_grid_build(OeGrid *g, const double *base, const int64_t *pts, size_t p, const
         runs += i == 0 || g->code[i] != g->code[i - 1];
     }
     size_t size = 1024;
-    while (size < 2 * runs) {
+    while (with_table && size < 2 * runs) {
         size *= 2;
     }
     g->runs = runs;
@@ -6454,12 +6456,14 @@ oe_grid_build(OeGrid *g, const double *base, const int64_t *pts, size_t p, const
     size_t r = 0;
     for (size_t i = 0; i < p; i++) {
         if (i == 0 || g->code[i] != g->code[i - 1]) {      /* runs inserted in code order: near in the table */
-            size_t s = oe_hash(g->code[i], g->mask);
-            while (g->table[s].key != OE_EMPTY) {
-                s = (s + 1) & g->mask;
+            if (with_table) {
+                size_t s = oe_hash(g->code[i], g->mask);
+                while (g->table[s].key != OE_EMPTY) {
+                    s = (s + 1) & g->mask;
+                }
+                g->table[s].key = g->code[i];
+                g->table[s].run = r;
             }
-            g->table[s].key = g->code[i];
-            g->table[s].run = r;
             g->start[r] = (uint32_t)i;
             g->run_code[r] = g->code[i];
             r++;
@@ -6666,7 +6670,7 @@ accel_edge_point_candidates(PyObject *self, PyObject *args)
             lo[c] = q[c] < lo[c] ? q[c] : lo[c];
         }
     }
-    int built = oe_grid_build(&grid, v, pts, p, lo, cell);
+    int built = oe_grid_build(&grid, v, pts, p, lo, cell, 1);
     if (built == -2) {
         PyErr_Format(PyExc_ValueError, "Expected a cell of at least 2**-%d of the extent, got %g", OE_BITS, cell);
         goto done;
@@ -6852,7 +6856,7 @@ accel_close_groups(PyObject *self, PyObject *args)
         lo[i % 3] = pts[i] < lo[i % 3] ? pts[i] : lo[i % 3];
     }
     const double h = 0.5 * tol * (1.0 + 1e-9);
-    int built = oe_grid_build(&grid, pts, NULL, k, lo, h);
+    int built = oe_grid_build(&grid, pts, NULL, k, lo, h, 0);
     if (built == -2) {
         result = Py_None;                                  /* the grid does not fit 21 bits: the caller's path */
         Py_INCREF(result);
@@ -6866,8 +6870,15 @@ accel_close_groups(PyObject *self, PyObject *args)
         goto done;
     }
     /* the blocks of 8^3 cells (side 4 tol): the runs of a block are consecutive in code order */
+    /* blocks of 32^3 cells (side 16 tol, the codes sharing all but their 15 lowest bits): the runs of a block
+     * are consecutive in code order; a cell's own block is scanned from the cell on, and the table of blocks
+     * is read only for the neighbour blocks its widened box reaches (a few per cent of a soup's cells) */
+    size_t nblocks = 0;
+    for (size_t r = 0; r < grid.runs; r++) {
+        nblocks += r == 0 || grid.run_code[r] >> OE_BLOCK_BITS != grid.run_code[r - 1] >> OE_BLOCK_BITS;
+    }
     size_t bsize = 1024;
-    while (bsize < 2 * grid.runs) {
+    while (bsize < 2 * nblocks) {
         bsize *= 2;
     }
     const size_t bmask = bsize - 1;
@@ -6882,8 +6893,8 @@ accel_close_groups(PyObject *self, PyObject *args)
     }
     for (size_t r = 0; r < grid.runs; r++) {
         parent[r] = (uint32_t)r;
-        const uint64_t block = grid.run_code[r] >> 9;
-        if (r == 0 || block != grid.run_code[r - 1] >> 9) {
+        const uint64_t block = grid.run_code[r] >> OE_BLOCK_BITS;
+        if (r == 0 || block != grid.run_code[r - 1] >> OE_BLOCK_BITS) {
             size_t s = (size_t)oe_mix(block) & bmask;
             while (blocks[s].key != OE_EMPTY) {
                 s = (s + 1) & bmask;
@@ -6893,12 +6904,7 @@ accel_close_groups(PyObject *self, PyObject *args)
         }
     }
     const double tol2 = tol * tol;
-    uint64_t recent_key[64];
-    int64_t recent_run[64];
-    for (int c = 0; c < 64; c++) {
-        recent_key[c] = OE_EMPTY;
-        recent_run[c] = -1;
-    }
+    const int64_t side = (int64_t)1 << (OE_BLOCK_BITS / 3);
     for (size_t a = 0; a < grid.runs; a++) {
         double bmin[3], bmax[3];
         for (int c = 0; c < 3; c++) {
@@ -6920,36 +6926,41 @@ accel_close_groups(PyObject *self, PyObject *args)
             c_lo[c] = q0 < 0.0 ? 0 : (int64_t)q0;
             c_hi[c] = q1 > (double)grid.top[c] ? grid.top[c] : (int64_t)q1;
         }
-        const uint64_t own = grid.run_code[a];
-        for (int64_t bx = c_lo[0] >> 3; bx <= c_hi[0] >> 3; bx++) {
-            for (int64_t by = c_lo[1] >> 3; by <= c_hi[1] >> 3; by++) {
-                for (int64_t bz = c_lo[2] >> 3; bz <= c_hi[2] >> 3; bz++) {
+        const uint64_t own = grid.run_code[a], own_block = own >> OE_BLOCK_BITS;
+        for (int64_t bx = c_lo[0] / side; bx <= c_hi[0] / side; bx++) {
+            for (int64_t by = c_lo[1] / side; by <= c_hi[1] / side; by++) {
+                for (int64_t bz = c_lo[2] / side; bz <= c_hi[2] / side; bz++) {
                     const uint64_t block = oe_code(bx, by, bz);
-                    if (block < own >> 9) {
+                    if (block < own_block) {
                         continue;                            /* every cell there precedes this one */
                     }
-                    /* consecutive cells look up the same few blocks: a small cache of the answers first */
-                    const size_t slot = (size_t)(block * 0x9e3779b97f4a7c15ULL >> 58);
-                    int64_t first;
-                    if (recent_key[slot] == block) {
-                        first = recent_run[slot];
+                    /* the part of the box in this block: its codes lie between those of its corners */
+                    const int64_t b0[3] = {bx * side, by * side, bz * side};
+                    int64_t s_lo[3], s_hi[3];
+                    for (int c = 0; c < 3; c++) {
+                        s_lo[c] = c_lo[c] > b0[c] ? c_lo[c] : b0[c];
+                        s_hi[c] = c_hi[c] < b0[c] + side - 1 ? c_hi[c] : b0[c] + side - 1;
                     }
-                    else {
+                    const uint64_t code_lo = oe_code(s_lo[0], s_lo[1], s_lo[2]);
+                    const uint64_t code_hi = oe_code(s_hi[0], s_hi[1], s_hi[2]);
+                    if (code_hi <= own) {
+                        continue;
+                    }
+                    size_t b = a + 1;
+                    if (block != own_block) {
                         size_t s = (size_t)oe_mix(block) & bmask;
                         while (blocks[s].key != OE_EMPTY && blocks[s].key != block) {
                             s = (s + 1) & bmask;
                         }
-                        first = blocks[s].key == OE_EMPTY ? -1 : (int64_t)blocks[s].run;
-                        recent_key[slot] = block;
-                        recent_run[slot] = first;
+                        if (blocks[s].key == OE_EMPTY) {
+                            continue;
+                        }
+                        b = (size_t)blocks[s].run;
                     }
-                    if (first < 0) {
-                        continue;
-                    }
-                    for (size_t b = (size_t)first; b < grid.runs && grid.run_code[b] >> 9 == block; b++) {
+                    for (; b < grid.runs && grid.run_code[b] <= code_hi; b++) {
                         const uint64_t code = grid.run_code[b];
-                        if (code <= own) {
-                            continue;                        /* that pair of cells is compared from the other */
+                        if (code < code_lo) {
+                            continue;
                         }
                         const int64_t ix = oe_compact(code), iy = oe_compact(code >> 1), iz = oe_compact(code >> 2);
                         if (ix < c_lo[0] || ix > c_hi[0] || iy < c_lo[1] || iy > c_hi[1] || iz < c_lo[2] ||

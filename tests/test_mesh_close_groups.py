@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL
-from inertia_tool.mesh.merge import _groups, _lowest_in_group, merge_close_vertices
+from inertia_tool.mesh.merge import _groups, lowest_in_group, merge_close_vertices
 
 needs_c = pytest.mark.skipif(not HAVE_ACCEL, reason="the C extension is not built")
 
@@ -83,7 +83,7 @@ def test_c_groups_equal_brute_force_and_numpy_grid(case):
     got = c_lowest(pts, tol)
     if got is not None:          # None: the grid would need more than 21 bits per axis (the numpy path)
         assert got.tolist() == ref.tolist()
-    lowest = _lowest_in_group(pts, tol)
+    lowest = lowest_in_group(pts, tol)
     assert (np.arange(len(pts)) if lowest is None else lowest).tolist() == ref.tolist()
     grid = _groups(pts, tol)
     assert (np.arange(len(pts)) if grid is None else lowest_of_groups(grid)).tolist() == ref.tolist()
@@ -111,7 +111,7 @@ def test_c_groups_many_points_in_one_cell_are_one_group():
 def test_c_groups_decline_a_grid_beyond_21_bits():
     pts = np.array([[0.0, 0, 0], [1.0, 0, 0], [1.0 + 1e-9, 0, 0]])
     assert c_lowest(pts, 1.5e-9) is None             # 1.3e9 cells per axis: the numpy path decides
-    assert _lowest_in_group(pts, 1.5e-9).tolist() == [0, 1, 1]
+    assert lowest_in_group(pts, 1.5e-9).tolist() == [0, 1, 1]
 
 
 @pytest.mark.usefixtures("engine_path")

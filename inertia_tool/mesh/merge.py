@@ -17,7 +17,7 @@ import numpy as np
 from .._native import accel
 from ..values import frozen_value
 
-__all__ = ["Merge", "merge_close_vertices"]
+__all__ = ["Merge", "merge_close_vertices", "lowest_in_group"]
 
 
 @frozen_value
@@ -65,7 +65,7 @@ def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: flo
         used = np.flatnonzero(np.bincount(faces.reshape(-1), minlength=len(v)))
     else:
         used = np.flatnonzero(np.bincount(np.asarray(among, dtype=np.int64).reshape(-1), minlength=len(v)))
-    lowest = _lowest_in_group(v[used], tolerance)
+    lowest = lowest_in_group(v[used], tolerance)
     if lowest is None:
         return Merge(faces=faces, merged_vertices=0, largest_move=0.0)
     representative = np.arange(len(v), dtype=np.int64)
@@ -76,7 +76,7 @@ def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: flo
                  largest_move=largest)
 
 
-def _lowest_in_group(points: np.ndarray, tolerance: float) -> np.ndarray | None:
+def lowest_in_group(points: np.ndarray, tolerance: float) -> np.ndarray | None:
     """For each point, the lowest index in its group (points within ``tolerance``, transitively), (k,) int, or None
     when no two points are that close.
 
