@@ -240,26 +240,33 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     np.maximum.at(first_slot, face, slot)
     sel = slot == first_slot[face]
     face, corner, m, t, dist = face[sel], corner[sel], m[sel], t[sel], dist[sel]
-    _, unique_m = np.unique(np.stack([face, m], axis=1), axis=0, return_index=True)
+    if not len(face):
+        return f, slack, 0
+    # each (face, vertex) once, in (face, vertex) order (as numpy.unique of the rows, by one int64 key)
+    _, unique_m = np.unique(face.astype(np.int64) * np.int64(max(len(v), 1)) + m, return_index=True)
     face, corner, m, t, dist = face[unique_m], corner[unique_m], m[unique_m], t[unique_m], dist[unique_m]
     by = np.lexsort((t, face))
     face, corner, m, dist = face[by], corner[by], m[by], dist[by]
     split_faces = np.flatnonzero(np.bincount(face, minlength=len(f)))
-    new_faces: list[np.ndarray] = []
-    new_slack: list[np.ndarray] = []
     starts = np.searchsorted(face, split_faces)
-    ends = np.r_[starts[1:], len(face)]
-    for s, stop in zip(starts.tolist(), ends.tolist()):    # one short fan per split face (bounded by the faces)
-        i, j = int(face[s]), int(corner[s])
-        p, q, c = f[i, j], f[i, (j + 1) % 3], f[i, (j + 2) % 3]
-        chain = np.r_[p, m[s:stop], q]
-        fan = np.stack([chain[:-1], chain[1:], np.full(len(chain) - 1, c)], axis=1)
-        new_faces.append(fan)
-        new_slack.append(np.full(len(fan), max(float(slack[i]), float(dist[s:stop].max()))))
+    count = np.diff(np.r_[starts, len(face)])
+    # one fan per split face p→q (apex c) through its points in order: (p, m0, c), (m0, m1, c), ..., (mk, q, c),
+    # the fans in the order of the split faces (all at once: 26k fans of a T-split 1.3M-face mesh were a loop)
+    j = corner[starts]
+    p, q, c = f[split_faces, j], f[split_faces, (j + 1) % 3], f[split_faces, (j + 2) % 3]
+    group = np.repeat(np.arange(len(split_faces)), count)     # the split face of each point, in order
+    rows = len(face) + len(split_faces)
+    first_row = starts + np.arange(len(split_faces))          # each fan's first row
+    fan = np.empty((rows, 3), dtype=f.dtype)
+    fan[first_row, 0] = p
+    fan[np.arange(len(face)) + group + 1, 0] = m
+    fan[np.arange(len(face)) + group, 1] = m
+    fan[first_row + count, 1] = q
+    fan[:, 2] = np.repeat(c, count + 1)
+    fan_slack = np.repeat(np.maximum(slack[split_faces], np.maximum.reduceat(dist, starts)), count + 1)
     keep_face = np.ones(len(f), dtype=bool)
     keep_face[split_faces] = False
-    return (np.vstack([f[keep_face], *new_faces]), np.concatenate([slack[keep_face], *new_slack]),
-            int(len(m)))
+    return np.vstack([f[keep_face], fan]), np.concatenate([slack[keep_face], fan_slack]), int(len(m))
 
 
 def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
