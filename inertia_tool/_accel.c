@@ -6300,10 +6300,17 @@ oe_find(const OeSlot *table, size_t mask, uint64_t code)
     return -1;
 }
 
+/* floor((x - lo) / cell) as an integer: truncation corrected below zero (floor() is a library call without
+ * SSE4.1, several per edge piece); the library's floor beyond 2^62 (never a grid index: refused by the callers) */
 static inline int64_t
 oe_cell(double x, double lo, double cell)
 {
-    return (int64_t)floor((x - lo) / cell);
+    const double q = (x - lo) / cell;
+    if (!(fabs(q) < 4.611686018427387904e18)) {
+        return (int64_t)floor(q);
+    }
+    const int64_t i = (int64_t)q;
+    return i - (q < (double)i);
 }
 
 static inline double
