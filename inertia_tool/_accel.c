@@ -3473,7 +3473,7 @@ static PyMethodDef accel_methods[] = {
     {"sample_cells", accel_sample_cells, METH_VARARGS,
      "sample_cells(vertices, faces, steps, origin, h, dims, out)\n\nMark in `out` (bytes of the flat grid dims, "
      "C order) the cell floor((p - origin) / h) of every barycentric sample p of each face on its grid of "
-     "steps[f] (estimate._surface_cells); section 10."},
+     "steps[f] (grid_estimate._surface_cells); section 10."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -7011,9 +7011,9 @@ done:
 }
 
 /* ======================================================================================================
- * 10. sample_cells -- the cells a surface passes through, from samples of its triangles (mesh/estimate.py)
+ * 10. sample_cells -- the cells a surface passes through, from samples of its triangles (mesh/grid_estimate.py)
  *
- * The twin of the sampling loop of estimate._surface_cells, bit for bit: triangle f (corners a, b, c) with
+ * The twin of the sampling loop of grid_estimate._surface_cells, bit for bit: triangle f (corners a, b, c) with
  * n = steps[f] is sampled at s = i/n, t = j/n for i + j <= n, the point ((a (1-s-t) + b s) + c t) per
  * coordinate (1-s-t evaluated as (1 - s) - t), and the cell floor((p - origin) / h) per axis, clamped to
  * 0..dims-1, is marked in `out` (bytes of the flat grid, C order).  numpy evaluated the same expressions on

@@ -65,13 +65,14 @@ def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: flo
         used = np.flatnonzero(np.bincount(faces.reshape(-1), minlength=len(v)))
     else:
         used = np.flatnonzero(np.bincount(np.asarray(among, dtype=np.int64).reshape(-1), minlength=len(v)))
-    lowest = lowest_in_group(v[used], tolerance)
+    points = v[used]
+    lowest = lowest_in_group(points, tolerance)
     if lowest is None:
         return Merge(faces=faces, merged_vertices=0, largest_move=0.0)
     representative = np.arange(len(v), dtype=np.int64)
     representative[used] = used[lowest]
-    moved = representative != np.arange(len(v))
-    largest = float(np.max(np.linalg.norm(v[moved] - v[representative[moved]], axis=1))) if moved.any() else 0.0
+    moved = lowest != np.arange(len(used))           # only vertices of `used` move
+    largest = float(np.max(np.linalg.norm(points[moved] - points[lowest[moved]], axis=1))) if moved.any() else 0.0
     return Merge(faces=representative[faces].astype(faces.dtype), merged_vertices=int(np.count_nonzero(moved)),
                  largest_move=largest)
 
