@@ -3372,6 +3372,7 @@ accel_face_measures(PyObject *self, PyObject *args)
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
+static PyObject *accel_close_groups(PyObject *self, PyObject *args);    /* section 9b, after the module */
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
 
 static PyObject *
@@ -3465,10 +3466,14 @@ static PyMethodDef accel_methods[] = {
      "of `edges` ((k, 2) int64) and a vertex of `points` ((p,) int64, not an end of it) near its interior: "
      "within max(gap, 2 rtol * distance from the nearer end) of it, to round-off; bytes of int64 each, by edge; "
      "`cell` only changes the speed (seal.py); section 9."},
+    {"close_groups", accel_close_groups, METH_VARARGS,
+     "close_groups(points, tolerance) -> bytes or None\n\nFor each of the (k, 3) float64 points, the lowest "
+     "index in its group of points joined by distances <= tolerance, transitively (bytes of int64); None when the "
+     "grid of cells tolerance / 2 would need more than 21 bits per axis (merge.py); section 9b."},
     {"sample_cells", accel_sample_cells, METH_VARARGS,
      "sample_cells(vertices, faces, steps, origin, h, dims, out)\n\nMark in `out` (bytes of the flat grid dims, "
      "C order) the cell floor((p - origin) / h) of every barycentric sample p of each face on its grid of "
-     "steps[f] (estimate._surface_cells); section 10."},
+     "steps[f] (grid_estimate._surface_cells); section 10."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -6192,12 +6197,15 @@ done:
  *     |m - (a + t (b-a))| <= max(gap, 2 rtol min(|m-a|, |m-b|)) + 64 eps (|b-a| + scale),
  * tested on squares without roots (a superset of the pairs that pass the callers' tests: those are
  * dist <= gap or dist <= rtol * to_end, evaluated by numpy in another order, so equal to a few ulps).  Each pair
- * once, by edge.  The points are bucketed in a hash table of cubic cells of side `cell` (the cell of a point is
- * floor((x - lo) / cell) per axis, monotone in x; blocks of 8^3 cells hashed, the cells of a block kept
- * together so that neighbours are near in memory); each edge is cut into pieces no longer than cell / 2 and
- * every cell met by a piece's box, widened by the distance above, is visited: a pair that passes lies in one of
- * those boxes, and the test alone decides.  The seconds of a soup's T-vertex search (every vertex on the
- * boundary) were a k-d tree's Python lists: ~9 points per edge.
+ * once, by edge.  The points are bucketed into cubic cells of side `cell` (the cell of a point is
+ * floor((x - lo) / cell) per axis, monotone in x), sorted by the Morton code of their cell (a radix sort), so
+ * that the points of a cell, and of nearby cells, lie together; a hash table of the occupied cells' codes
+ * (blocks of 8^3 cells hashed, the cells of a block kept together) finds them.  The edges are visited in the
+ * Morton order of their first end's cell, so consecutive edges read nearby cells.  Each edge is cut into pieces
+ * no longer than cell / 2 and every cell met by a piece's box, widened by the distance above, is visited (those
+ * of the previous piece's box once): a pair that passes lies in one of those boxes, and the test alone decides.
+ * The seconds of a soup's T-vertex search (every vertex on the boundary) were a k-d tree's Python lists (~9
+ * points per edge), then 5.5 s of this search in the edges' file order on a 1.3M-face soup (random access).
  * ====================================================================================================== */
 
 #include <float.h>
@@ -6205,80 +6213,273 @@ done:
 #define OE_BITS 21
 #define OE_MAXCELL ((int64_t)1 << OE_BITS)
 #define OE_EMPTY UINT64_MAX
+#define OE_RADIX_BITS 11
+#define OE_RADIX (1 << OE_RADIX_BITS)
+#define OE_PASSES 6                                  /* 6 x 11 bits cover the 63 bits of a code */
+#define OE_BLOCK_BITS 15                             /* close_groups' blocks: 32^3 cells */
 
-
+/* The 21 low bits of v spread to every third bit (bit b to bit 3b). */
 static inline uint64_t
-oe_key(int64_t ix, int64_t iy, int64_t iz)
+oe_spread(uint64_t v)
 {
-    return ((uint64_t)ix << (2 * OE_BITS)) | ((uint64_t)iy << OE_BITS) | (uint64_t)iz;
+    v &= 0x1fffffULL;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
 }
 
-/* The slot of a cell: blocks of 8 x 8 x 8 cells are hashed, the cells of a block keep their order inside it, so
- * neighbouring cells (and, stored in slot order, their points) lie close in memory. */
-static inline size_t
-oe_hash(uint64_t key, size_t mask)
+/* Every third bit of v (from bit 0) gathered into the 21 low bits: the inverse of oe_spread. */
+static inline int64_t
+oe_compact(uint64_t v)
 {
-    const uint64_t m21 = OE_MAXCELL - 1;
-    const uint64_t ix = key >> (2 * OE_BITS), iy = (key >> OE_BITS) & m21, iz = key & m21;
-    uint64_t block = ((ix >> 3) << (2 * OE_BITS)) | ((iy >> 3) << OE_BITS) | (iz >> 3);
-    const uint64_t inside = (ix & 7) | ((iy & 7) << 3) | ((iz & 7) << 6);
-    block ^= block >> 33;
-    block *= 0xff51afd7ed558ccdULL;
-    block ^= block >> 33;
-    block *= 0xc4ceb9fe1a85ec53ULL;
-    block ^= block >> 33;
-    return (size_t)((block << 9) | inside) & mask;
+    v &= 0x1249249249249249ULL;
+    v = (v | v >> 2) & 0x10c30c30c30c30c3ULL;
+    v = (v | v >> 4) & 0x100f00f00f00f00fULL;
+    v = (v | v >> 8) & 0x1f0000ff0000ffULL;
+    v = (v | v >> 16) & 0x1f00000000ffffULL;
+    v = (v | v >> 32) & 0x1fffffULL;
+    return (int64_t)v;
+}
+
+static inline void
+oe_prefetch(const void *p)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(p);
+#else
+    (void)p;
+#endif
+}
+
+static inline uint64_t
+oe_mix(uint64_t x)
+{
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    x *= 0xc4ceb9fe1a85ec53ULL;
+    x ^= x >> 33;
+    return x;
+}
+
+/* The Morton code of a cell (x in the lowest of each three bits): a cell's 9 lowest bits are its place in
+ * its block of 8 x 8 x 8 cells, and every aligned block of 2^j cells per axis is one range of codes. */
+static inline uint64_t
+oe_code(int64_t ix, int64_t iy, int64_t iz)
+{
+    return oe_spread((uint64_t)ix) | (oe_spread((uint64_t)iy) << 1) | (oe_spread((uint64_t)iz) << 2);
+}
+
+/* The slot of a code: its block of 8^3 cells is hashed, the cells of a block keep their order inside it, so
+ * neighbouring cells lie close in the table. */
+static inline size_t
+oe_hash(uint64_t code, size_t mask)
+{
+    return (size_t)((oe_mix(code >> 9) << 9) | (code & 511)) & mask;
 }
 
 typedef struct {
-    uint64_t key;
-    uint32_t start;
-    uint32_t count;
+    uint64_t key;                 /* the cell's code, OE_EMPTY for a free slot */
+    uint64_t run;                 /* the cell's rank in code order */
 } OeSlot;
 
-/* Insert `key` (or find it) in the open-addressing table; returns its slot. */
-static inline size_t
-oe_slot(OeSlot *table, size_t mask, uint64_t key)
+/* The run (rank in code order) of the occupied cell `code`, or -1. */
+static inline int64_t
+oe_find(const OeSlot *table, size_t mask, uint64_t code)
 {
-    size_t s = oe_hash(key, mask);
-    while (table[s].key != OE_EMPTY && table[s].key != key) {
+    size_t s = oe_hash(code, mask);
+    while (table[s].key != OE_EMPTY) {
+        if (table[s].key == code) {
+            return (int64_t)table[s].run;
+        }
         s = (s + 1) & mask;
     }
-    return s;
+    return -1;
 }
 
-/* The table at twice the size, every key moved to its new slot (counts kept); NULL when out of memory. */
-static OeSlot *
-oe_grow(OeSlot *table, size_t size)
-{
-    size_t bigger = 2 * size;
-    OeSlot *grown = (OeSlot *)malloc(bigger * sizeof(OeSlot));
-    if (grown == NULL) {
-        return NULL;
-    }
-    for (size_t s = 0; s < bigger; s++) {
-        grown[s].key = OE_EMPTY;
-        grown[s].count = 0;
-    }
-    for (size_t s = 0; s < size; s++) {
-        if (table[s].key != OE_EMPTY) {
-            grown[oe_slot(grown, bigger - 1, table[s].key)] = table[s];
-        }
-    }
-    free(table);
-    return grown;
-}
-
+/* floor((x - lo) / cell) as an integer: truncation corrected below zero (floor() is a library call without
+ * SSE4.1, several per edge piece); the library's floor beyond 2^62 (never a grid index: refused by the callers) */
 static inline int64_t
 oe_cell(double x, double lo, double cell)
 {
-    return (int64_t)floor((x - lo) / cell);
+    const double q = (x - lo) / cell;
+    if (!(fabs(q) < 4.611686018427387904e18)) {
+        return (int64_t)floor(q);
+    }
+    const int64_t i = (int64_t)q;
+    return i - (q < (double)i);
 }
 
 static inline double
 oe_norm(double x, double y, double z)
 {
     return sqrt((x * x + y * y) + z * z);
+}
+
+/* Sort code[0..n) ascending, carrying idx along (stable: least significant digit first, 11 bits a pass,
+ * passes whose digit is the same in every code skipped).  The sorted arrays end in *code / *idx, which may
+ * be swapped with the scratch arrays; returns -1 when out of memory. */
+static int
+oe_radix_sort(uint64_t **code, uint32_t **idx, uint64_t **code2, uint32_t **idx2, size_t n)
+{
+    size_t *hist = (size_t *)calloc((size_t)OE_PASSES * OE_RADIX, sizeof(size_t));
+    if (hist == NULL) {
+        return -1;
+    }
+    const uint64_t *c0 = *code;
+    for (size_t i = 0; i < n; i++) {
+        uint64_t c = c0[i];
+        for (int d = 0; d < OE_PASSES; d++) {
+            hist[(size_t)d * OE_RADIX + ((c >> (d * OE_RADIX_BITS)) & (OE_RADIX - 1))]++;
+        }
+    }
+    for (int d = 0; d < OE_PASSES; d++) {
+        size_t *h = hist + (size_t)d * OE_RADIX, at = 0;
+        int single = 0;
+        for (int b = 0; b < OE_RADIX; b++) {
+            single |= h[b] == n;
+            size_t count = h[b];
+            h[b] = at;
+            at += count;
+        }
+        if (single) {
+            continue;
+        }
+        const uint64_t *src = *code;
+        const uint32_t *isrc = *idx;
+        uint64_t *dst = *code2;
+        uint32_t *idst = *idx2;
+        for (size_t i = 0; i < n; i++) {
+            size_t to = h[(src[i] >> (d * OE_RADIX_BITS)) & (OE_RADIX - 1)]++;
+            dst[to] = src[i];
+            idst[to] = isrc[i];
+        }
+        uint64_t *tc = *code;
+        *code = *code2;
+        *code2 = tc;
+        uint32_t *ti = *idx;
+        *idx = *idx2;
+        *idx2 = ti;
+    }
+    free(hist);
+    return 0;
+}
+
+/* Points bucketed into cubic cells: sorted by the Morton code of their cell, each occupied cell a run of
+ * them, found through a hash table of codes. */
+typedef struct {
+    double lo[3], cell;
+    size_t p, runs, mask;
+    int64_t top[3];               /* the largest cell index used, per axis */
+    OeSlot *table;
+    uint64_t *code;               /* (p) the sorted codes */
+    uint32_t *idx;                /* (p) the position in the input of each sorted point */
+    int64_t *vertex;              /* (p) the vertex (pts[idx], or idx without pts) of each sorted point */
+    uint32_t *start;              /* (runs + 1) the first sorted point of each run */
+    uint64_t *run_code;           /* (runs) */
+    double *coords;               /* (3 p) the points in sorted order */
+} OeGrid;
+
+static void
+oe_grid_free(OeGrid *g)
+{
+    free(g->table);
+    free(g->code);
+    free(g->idx);
+    free(g->vertex);
+    free(g->start);
+    free(g->run_code);
+    free(g->coords);
+}
+
+/* Bucket the points xyz(i), i < p (at `stride` doubles apart from `base`, gathered through `pts` when not
+ * NULL) into cells of side `cell` above `lo`.  Returns 0, -1 out of memory, -2 a cell index beyond 21 bits. */
+static int
+oe_grid_build(OeGrid *g, const double *base, const int64_t *pts, size_t p, const double lo[3], double cell,
+              int with_table)
+{
+    memset(g, 0, sizeof(*g));
+    g->p = p;
+    g->cell = cell;
+    memcpy(g->lo, lo, sizeof(g->lo));
+    uint64_t *code2 = NULL;
+    uint32_t *idx2 = NULL;
+    g->code = (uint64_t *)malloc((p ? p : 1) * sizeof(uint64_t));
+    g->idx = (uint32_t *)malloc((p ? p : 1) * sizeof(uint32_t));
+    code2 = (uint64_t *)malloc((p ? p : 1) * sizeof(uint64_t));
+    idx2 = (uint32_t *)malloc((p ? p : 1) * sizeof(uint32_t));
+    if (g->code == NULL || g->idx == NULL || code2 == NULL || idx2 == NULL) {
+        free(code2);
+        free(idx2);
+        return -1;
+    }
+    int64_t top[3] = {0, 0, 0};
+    for (size_t i = 0; i < p; i++) {
+        const double *q = base + 3 * (pts ? pts[i] : (int64_t)i);
+        int64_t c[3];
+        for (int a = 0; a < 3; a++) {
+            c[a] = oe_cell(q[a], lo[a], cell);
+            if (c[a] < 0 || c[a] >= OE_MAXCELL) {
+                free(code2);
+                free(idx2);
+                return -2;
+            }
+            top[a] = c[a] > top[a] ? c[a] : top[a];
+        }
+        g->code[i] = oe_code(c[0], c[1], c[2]);
+        g->idx[i] = (uint32_t)i;
+    }
+    memcpy(g->top, top, sizeof(top));
+    int sorted = oe_radix_sort(&g->code, &g->idx, &code2, &idx2, p);
+    free(code2);
+    free(idx2);
+    if (sorted < 0) {
+        return -1;
+    }
+    size_t runs = 0;
+    for (size_t i = 0; i < p; i++) {
+        runs += i == 0 || g->code[i] != g->code[i - 1];
+    }
+    size_t size = 1024;
+    while (with_table && size < 2 * runs) {
+        size *= 2;
+    }
+    g->runs = runs;
+    g->mask = size - 1;
+    g->table = (OeSlot *)malloc(size * sizeof(OeSlot));
+    g->start = (uint32_t *)malloc((runs + 1) * sizeof(uint32_t));
+    g->run_code = (uint64_t *)malloc((runs ? runs : 1) * sizeof(uint64_t));
+    g->coords = (double *)malloc((p ? 3 * p : 1) * sizeof(double));
+    g->vertex = (int64_t *)malloc((p ? p : 1) * sizeof(int64_t));
+    if (g->table == NULL || g->start == NULL || g->run_code == NULL || g->coords == NULL || g->vertex == NULL) {
+        return -1;
+    }
+    for (size_t s = 0; s < size; s++) {
+        g->table[s].key = OE_EMPTY;
+    }
+    size_t r = 0;
+    for (size_t i = 0; i < p; i++) {
+        if (i == 0 || g->code[i] != g->code[i - 1]) {      /* runs inserted in code order: near in the table */
+            if (with_table) {
+                size_t s = oe_hash(g->code[i], g->mask);
+                while (g->table[s].key != OE_EMPTY) {
+                    s = (s + 1) & g->mask;
+                }
+                g->table[s].key = g->code[i];
+                g->table[s].run = r;
+            }
+            g->start[r] = (uint32_t)i;
+            g->run_code[r] = g->code[i];
+            r++;
+        }
+        g->vertex[i] = pts ? pts[g->idx[i]] : (int64_t)g->idx[i];
+        memcpy(g->coords + 3 * i, base + 3 * g->vertex[i], 3 * sizeof(double));
+    }
+    g->start[runs] = (uint32_t)p;
+    return 0;
 }
 
 typedef struct {
@@ -6309,6 +6510,100 @@ oe_push(OePairs *pairs, int64_t edge, int64_t point)
     return 0;
 }
 
+/* The candidates of one edge (its index i, its rank `mark` + 1 in the stamps) appended to `pairs`. */
+static int
+oe_edge_pairs(const OeGrid *g, const double *v, int64_t ia, int64_t ib, int64_t i, double rtol, double gap,
+              OePairs *pairs)
+{
+    const double cell = g->cell;
+    const double *A = v + 3 * ia, *B = v + 3 * ib;
+    const double d0 = B[0] - A[0], d1 = B[1] - A[1], d2 = B[2] - A[2];
+    const double len = oe_norm(d0, d1, d2);
+    const double len2 = len * len > DBL_MIN ? len * len : DBL_MIN;
+    double scale = cell;
+    for (int c = 0; c < 3; c++) {
+        scale = fabs(A[c]) > scale ? fabs(A[c]) : scale;
+        scale = fabs(B[c]) > scale ? fabs(B[c]) : scale;
+    }
+    const double slop = 64.0 * DBL_EPSILON * (len + scale);
+    /* every pair passing lies within this distance of the segment */
+    const double r = (gap > rtol * len ? gap : rtol * len) + slop + 1e-12 * scale;
+    const double gap2 = gap * gap, slop2 = slop * slop, rtol2 = 4.0 * rtol * rtol;
+    const double pieces_d = ceil(2.0 * len / cell);
+    const int64_t pieces = pieces_d < 1.0 ? 1 : (int64_t)pieces_d;
+    int64_t prev_lo[3] = {1, 1, 1}, prev_hi[3] = {0, 0, 0};     /* the previous piece's cells (none yet) */
+    for (int64_t s = 0; s < pieces; s++) {
+        double p0[3], p1[3];
+        const double t0 = (double)s / (double)pieces, t1 = (double)(s + 1) / (double)pieces;
+        p0[0] = s == 0 ? A[0] : A[0] + t0 * d0;
+        p0[1] = s == 0 ? A[1] : A[1] + t0 * d1;
+        p0[2] = s == 0 ? A[2] : A[2] + t0 * d2;
+        p1[0] = s + 1 == pieces ? B[0] : A[0] + t1 * d0;
+        p1[1] = s + 1 == pieces ? B[1] : A[1] + t1 * d1;
+        p1[2] = s + 1 == pieces ? B[2] : A[2] + t1 * d2;
+        int64_t c_lo[3], c_hi[3];
+        int empty = 0;
+        for (int c = 0; c < 3; c++) {
+            double mn = p0[c] < p1[c] ? p0[c] : p1[c], mx = p0[c] < p1[c] ? p1[c] : p0[c];
+            c_lo[c] = oe_cell(mn - r, g->lo[c], cell);
+            c_hi[c] = oe_cell(mx + r, g->lo[c], cell);
+            c_lo[c] = c_lo[c] < 0 ? 0 : c_lo[c];
+            c_hi[c] = c_hi[c] > g->top[c] ? g->top[c] : c_hi[c];
+            empty |= c_lo[c] > c_hi[c];
+        }
+        if (empty) {
+            prev_lo[0] = 1;                                   /* (no cell met by this piece's box) */
+            prev_hi[0] = 0;
+            continue;
+        }
+        for (int64_t ix = c_lo[0]; ix <= c_hi[0]; ix++) {
+            for (int64_t iy = c_lo[1]; iy <= c_hi[1]; iy++) {
+                for (int64_t iz = c_lo[2]; iz <= c_hi[2]; iz++) {
+                    if (ix >= prev_lo[0] && ix <= prev_hi[0] && iy >= prev_lo[1] && iy <= prev_hi[1] &&
+                        iz >= prev_lo[2] && iz <= prev_hi[2]) {
+                        continue;                             /* visited for the previous piece */
+                    }
+                    const int64_t run = oe_find(g->table, g->mask, oe_code(ix, iy, iz));
+                    if (run < 0) {
+                        continue;
+                    }
+                    const int64_t first = g->start[run], stop = g->start[run + 1];
+                    for (int64_t j = first; j < stop; j++) {
+                        const int64_t im = g->vertex[j];
+                        if (im == ia || im == ib) {
+                            continue;
+                        }
+                        const double *M = g->coords + 3 * j;
+                        const double w0 = M[0] - A[0], w1 = M[1] - A[1], w2 = M[2] - A[2];
+                        const double dot = (w0 * d0 + w1 * d1) + w2 * d2;
+                        if (!(dot > -1e-12 * len2 && dot < (1.0 + 1e-12) * len2)) {
+                            continue;
+                        }
+                        const double t = dot / len2;
+                        const double e0 = M[0] - (A[0] + t * d0), e1 = M[1] - (A[1] + t * d1),
+                                     e2 = M[2] - (A[2] + t * d2);
+                        const double dist2 = (e0 * e0 + e1 * e1) + e2 * e2;
+                        const double ta2 = (w0 * w0 + w1 * w1) + w2 * w2;
+                        const double b0 = M[0] - B[0], b1 = M[1] - B[1], b2 = M[2] - B[2];
+                        const double tb2 = (b0 * b0 + b1 * b1) + b2 * b2;
+                        const double near2 = rtol2 * (ta2 < tb2 ? ta2 : tb2);
+                        /* (x + y)^2 <= 2 x^2 + 2 y^2: dist <= max(gap, 2 rtol near) + slop implies this */
+                        if (dist2 > 2.0 * (gap2 > near2 ? gap2 : near2) + 2.0 * slop2) {
+                            continue;
+                        }
+                        if (oe_push(pairs, i, im) < 0) {
+                            return -1;
+                        }
+                    }
+                }
+            }
+        }
+        memcpy(prev_lo, c_lo, sizeof(prev_lo));
+        memcpy(prev_hi, c_hi, sizeof(prev_hi));
+    }
+    return 0;
+}
+
 static PyObject *
 accel_edge_point_candidates(PyObject *self, PyObject *args)
 {
@@ -6320,11 +6615,12 @@ accel_edge_point_candidates(PyObject *self, PyObject *args)
     Py_buffer views[3];
     int got = 0;
     PyObject *result = NULL;
-    OeSlot *table = NULL;
-    int64_t *fill = NULL, *order = NULL;
-    double *coords = NULL;
+    OeGrid grid;
+    memset(&grid, 0, sizeof(grid));
     OePairs pairs = {NULL, NULL, 0, 0};
-    uint32_t *stamp = NULL;
+    uint32_t *eidx = NULL, *eidx2 = NULL;
+    uint64_t *ecode = NULL, *ecode2 = NULL;
+    int64_t *out_e = NULL, *out_m = NULL, *per_edge = NULL;
     if (!(cell > 0.0) || !isfinite(cell) || !(rtol >= 0.0) || !isfinite(rtol) || !(gap >= 0.0) || !isfinite(gap)) {
         PyErr_Format(PyExc_ValueError, "Expected a finite cell > 0, rtol >= 0 and gap >= 0, got %g, %g and %g",
                      cell, rtol, gap);
@@ -6366,6 +6662,10 @@ accel_edge_point_candidates(PyObject *self, PyObject *args)
     if (p == 0 || k == 0) {
         goto finish;
     }
+    if (p >= (size_t)UINT32_MAX || k >= (size_t)UINT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "Expected fewer than 2**32 points and edges");
+        goto done;
+    }
     double lo[3] = {INFINITY, INFINITY, INFINITY};
     for (size_t i = 0; i < p; i++) {
         const double *q = v + 3 * pts[i];
@@ -6377,167 +6677,82 @@ accel_edge_point_candidates(PyObject *self, PyObject *args)
             lo[c] = q[c] < lo[c] ? q[c] : lo[c];
         }
     }
-    if (p >= (size_t)UINT32_MAX) {
-        PyErr_SetString(PyExc_ValueError, "Expected fewer than 2**32 points");
+    int built = oe_grid_build(&grid, v, pts, p, lo, cell, 1);
+    if (built == -2) {
+        PyErr_Format(PyExc_ValueError, "Expected a cell of at least 2**-%d of the extent, got %g", OE_BITS, cell);
         goto done;
     }
-    /* the table holds the occupied cells only (grown by doubling at half full): a few per cent of the
-     * points' count on a dense soup, so its lookups stay in cache */
-    size_t size = 1024, used = 0;
-    table = (OeSlot *)malloc(size * sizeof(OeSlot));
-    order = (int64_t *)malloc(p * sizeof(int64_t));
-    coords = (double *)malloc(3 * p * sizeof(double));
-    if (table == NULL || order == NULL || coords == NULL) {
+    if (built < 0) {
         PyErr_NoMemory();
         goto done;
     }
-    for (size_t s = 0; s < size; s++) {
-        table[s].key = OE_EMPTY;
-        table[s].count = 0;
+    /* the edges in the Morton order of their first end's cell, so that consecutive edges visit nearby cells */
+    ecode = (uint64_t *)malloc(k * sizeof(uint64_t));
+    ecode2 = (uint64_t *)malloc(k * sizeof(uint64_t));
+    eidx = (uint32_t *)malloc(k * sizeof(uint32_t));
+    eidx2 = (uint32_t *)malloc(k * sizeof(uint32_t));
+    if (ecode == NULL || ecode2 == NULL || eidx == NULL || eidx2 == NULL) {
+        PyErr_NoMemory();
+        goto done;
     }
-    for (size_t i = 0; i < p; i++) {
-        const double *q = v + 3 * pts[i];
-        int64_t ix = oe_cell(q[0], lo[0], cell), iy = oe_cell(q[1], lo[1], cell), iz = oe_cell(q[2], lo[2], cell);
-        if (ix < 0 || iy < 0 || iz < 0 || ix >= OE_MAXCELL || iy >= OE_MAXCELL || iz >= OE_MAXCELL) {
-            PyErr_Format(PyExc_ValueError, "Expected a cell of at least 2**-%d of the extent, got %g", OE_BITS,
-                         cell);
-            goto done;
+    for (size_t i = 0; i < k; i++) {
+        const double *A = v + 3 * e[2 * i];
+        int64_t c[3];
+        for (int a = 0; a < 3; a++) {
+            double q = floor((A[a] - lo[a]) / cell);        /* an end outside the points' box: clamped */
+            c[a] = q < 0.0 ? 0 : (q > (double)(OE_MAXCELL - 1) ? OE_MAXCELL - 1 : (int64_t)q);
         }
-        uint64_t key = oe_key(ix, iy, iz);
-        size_t s = oe_slot(table, size - 1, key);
-        if (table[s].key == OE_EMPTY) {
-            if (2 * (used + 1) > size) {
-                OeSlot *grown = oe_grow(table, size);
-                if (grown == NULL) {
-                    PyErr_NoMemory();
-                    goto done;
-                }
-                table = grown;
-                size *= 2;
-                s = oe_slot(table, size - 1, key);
-            }
-            table[s].key = key;
-            used++;
-        }
-        table[s].count++;
+        ecode[i] = oe_code(c[0], c[1], c[2]);
+        eidx[i] = (uint32_t)i;
     }
-    const size_t mask = size - 1;
-    uint32_t at = 0;
-    for (size_t s = 0; s < size; s++) {
-        table[s].start = at;
-        at += table[s].count;
-    }
-    fill = (int64_t *)calloc(size, sizeof(int64_t));
-    if (fill == NULL) {
+    if (oe_radix_sort(&ecode, &eidx, &ecode2, &eidx2, k) < 0) {
         PyErr_NoMemory();
         goto done;
     }
-    for (size_t i = 0; i < p; i++) {
-        const double *q = v + 3 * pts[i];
-        size_t s = oe_slot(table, mask, oe_key(oe_cell(q[0], lo[0], cell), oe_cell(q[1], lo[1], cell),
-                                               oe_cell(q[2], lo[2], cell)));
-        int64_t j = (int64_t)table[s].start + fill[s]++;
-        order[j] = pts[i];
-        memcpy(coords + 3 * j, q, 3 * sizeof(double));
-    }
-    if (k >= (size_t)UINT32_MAX) {
-        PyErr_SetString(PyExc_ValueError, "Expected fewer than 2**32 edges");
-        goto done;
-    }
-    stamp = (uint32_t *)malloc(p * sizeof(uint32_t));      /* the last edge (+1) each stored point was tested on */
-    if (stamp == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    memset(stamp, 0, p * sizeof(uint32_t));
     int failed = 0;
     Py_BEGIN_ALLOW_THREADS
-    for (size_t i = 0; i < k && !failed; i++) {
-        const int64_t ia = e[2 * i], ib = e[2 * i + 1];
-        const double *A = v + 3 * ia, *B = v + 3 * ib;
-        const double d0 = B[0] - A[0], d1 = B[1] - A[1], d2 = B[2] - A[2];
-        const double len = oe_norm(d0, d1, d2);
-        const double len2 = len * len > DBL_MIN ? len * len : DBL_MIN;
-        double scale = cell;
-        for (int c = 0; c < 3; c++) {
-            scale = fabs(A[c]) > scale ? fabs(A[c]) : scale;
-            scale = fabs(B[c]) > scale ? fabs(B[c]) : scale;
+    for (size_t r = 0; r < k && !failed; r++) {
+        /* the edges and their ends are read in an order of their own: fetched ahead */
+        if (r + 16 < k) {
+            oe_prefetch(e + 2 * (size_t)eidx[r + 16]);
         }
-        const double slop = 64.0 * DBL_EPSILON * (len + scale);
-        /* every pair passing lies within this distance of the segment */
-        const double r = (gap > rtol * len ? gap : rtol * len) + slop + 1e-12 * scale;
-        const double gap2 = gap * gap, slop2 = slop * slop, rtol2 = 4.0 * rtol * rtol;
-        const double pieces_d = ceil(2.0 * len / cell);
-        const int64_t pieces = pieces_d < 1.0 ? 1 : (int64_t)pieces_d;
-        for (int64_t s = 0; s < pieces; s++) {
-            double p0[3], p1[3];
-            const double t0 = (double)s / (double)pieces, t1 = (double)(s + 1) / (double)pieces;
-            p0[0] = s == 0 ? A[0] : A[0] + t0 * d0;
-            p0[1] = s == 0 ? A[1] : A[1] + t0 * d1;
-            p0[2] = s == 0 ? A[2] : A[2] + t0 * d2;
-            p1[0] = s + 1 == pieces ? B[0] : A[0] + t1 * d0;
-            p1[1] = s + 1 == pieces ? B[1] : A[1] + t1 * d1;
-            p1[2] = s + 1 == pieces ? B[2] : A[2] + t1 * d2;
-            int64_t c_lo[3], c_hi[3];
-            int empty = 0;
-            for (int c = 0; c < 3; c++) {
-                double mn = p0[c] < p1[c] ? p0[c] : p1[c], mx = p0[c] < p1[c] ? p1[c] : p0[c];
-                c_lo[c] = oe_cell(mn - r, lo[c], cell);
-                c_hi[c] = oe_cell(mx + r, lo[c], cell);
-                c_lo[c] = c_lo[c] < 0 ? 0 : c_lo[c];
-                c_hi[c] = c_hi[c] >= OE_MAXCELL ? OE_MAXCELL - 1 : c_hi[c];
-                empty |= c_lo[c] > c_hi[c];
-            }
-            if (empty) {
-                continue;
-            }
-            for (int64_t ix = c_lo[0]; ix <= c_hi[0]; ix++) {
-                for (int64_t iy = c_lo[1]; iy <= c_hi[1]; iy++) {
-                    for (int64_t iz = c_lo[2]; iz <= c_hi[2]; iz++) {
-                        const size_t h = oe_slot(table, mask, oe_key(ix, iy, iz));
-                        if (table[h].key == OE_EMPTY) {
-                            continue;
-                        }
-                        const int64_t first = table[h].start, stop = first + table[h].count;
-                        for (int64_t j = first; j < stop; j++) {
-                            const int64_t im = order[j];
-                            if (im == ia || im == ib || stamp[j] == (uint32_t)(i + 1)) {
-                                continue;
-                            }
-                            stamp[j] = (uint32_t)(i + 1);
-                            const double *M = coords + 3 * j;
-                            const double w0 = M[0] - A[0], w1 = M[1] - A[1], w2 = M[2] - A[2];
-                            const double dot = (w0 * d0 + w1 * d1) + w2 * d2;
-                            if (!(dot > -1e-12 * len2 && dot < (1.0 + 1e-12) * len2)) {
-                                continue;
-                            }
-                            const double t = dot / len2;
-                            const double e0 = M[0] - (A[0] + t * d0), e1 = M[1] - (A[1] + t * d1),
-                                         e2 = M[2] - (A[2] + t * d2);
-                            const double dist2 = (e0 * e0 + e1 * e1) + e2 * e2;
-                            const double ta2 = (w0 * w0 + w1 * w1) + w2 * w2;
-                            const double b0 = M[0] - B[0], b1 = M[1] - B[1], b2 = M[2] - B[2];
-                            const double tb2 = (b0 * b0 + b1 * b1) + b2 * b2;
-                            const double near2 = rtol2 * (ta2 < tb2 ? ta2 : tb2);
-                            /* (x + y)^2 <= 2 x^2 + 2 y^2: dist <= max(gap, 2 rtol near) + slop implies this */
-                            if (dist2 > 2.0 * (gap2 > near2 ? gap2 : near2) + 2.0 * slop2) {
-                                continue;
-                            }
-                            if (oe_push(&pairs, (int64_t)i, im) < 0) {
-                                failed = 1;
-                                break;
-                            }
-                        }
-                    }
-                }
-            }
+        if (r + 8 < k) {
+            const int64_t *ahead = e + 2 * (size_t)eidx[r + 8];
+            oe_prefetch(v + 3 * ahead[0]);
+            oe_prefetch(v + 3 * ahead[1]);
         }
+        const int64_t i = eidx[r];
+        failed = oe_edge_pairs(&grid, v, e[2 * i], e[2 * i + 1], i, rtol, gap, &pairs) < 0;
     }
     Py_END_ALLOW_THREADS
     if (failed) {
         PyErr_NoMemory();
         goto done;
     }
+    /* by edge, as the callers expect (a counting sort; the points of one edge in the order found) */
+    per_edge = (int64_t *)calloc(k + 1, sizeof(int64_t));
+    out_e = (int64_t *)malloc((pairs.count ? pairs.count : 1) * sizeof(int64_t));
+    out_m = (int64_t *)malloc((pairs.count ? pairs.count : 1) * sizeof(int64_t));
+    if (per_edge == NULL || out_e == NULL || out_m == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (size_t j = 0; j < pairs.count; j++) {
+        per_edge[pairs.edge[j] + 1]++;
+    }
+    for (size_t i = 0; i < k; i++) {
+        per_edge[i + 1] += per_edge[i];
+    }
+    for (size_t j = 0; j < pairs.count; j++) {
+        int64_t to = per_edge[pairs.edge[j]]++;
+        out_e[to] = pairs.edge[j];
+        out_m[to] = pairs.point[j];
+    }
+    free(pairs.edge);
+    free(pairs.point);
+    pairs.edge = out_e;
+    pairs.point = out_m;
+    out_e = out_m = NULL;
 finish:
     {
         PyObject *pe = PyBytes_FromStringAndSize((const char *)pairs.edge, (Py_ssize_t)(pairs.count * sizeof(int64_t)));
@@ -6552,20 +6767,253 @@ done:
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
     }
-    free(table);
-    free(fill);
-    free(order);
-    free(coords);
-    free(stamp);
+    oe_grid_free(&grid);
+    free(ecode);
+    free(ecode2);
+    free(eidx);
+    free(eidx2);
+    free(per_edge);
+    free(out_e);
+    free(out_m);
     free(pairs.edge);
     free(pairs.point);
     return result;
 }
 
-/* ======================================================================================================
- * 10. sample_cells -- the cells a surface passes through, from samples of its triangles (mesh/estimate.py)
+/* ------------------------------------------------------------------------------------------------------
+ * 9b. close_groups -- the groups of points closer than a tolerance, transitively (mesh/merge.py)
  *
- * The twin of the sampling loop of estimate._surface_cells, bit for bit: triangle f (corners a, b, c) with
+ * The connected components of the graph joining points p, q with |p - q|^2 <= tol^2 (the square evaluated as
+ * (dx dx + dy dy) + dz dz, as merge._groups does with numpy), each point given the lowest input index of its
+ * group.  The points are bucketed into cubic cells of side h = tol / 2 (1 + 1e-9), sorted by the Morton code
+ * of their cell (section 9's grid): two points of one cell are closer than h sqrt(3) < tol, so a cell is one
+ * group at once; each occupied cell is compared with the occupied cells after it in code order that meet the
+ * box of its points widened by tol (a pair within tol lies in such a pair of cells), point by point until one
+ * pair is within tol (a union-find over the cells; nothing is compared twice once two cells are joined).
+ * The soup of a 1.3M-face mesh (3.9M points, each corner's copies a hair apart) is ~1M cells of a few points.
+ * ------------------------------------------------------------------------------------------------------ */
+
+static inline uint32_t
+oe_root(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("fp-contract=off")))
+#endif
+static inline int
+oe_cells_meet(const OeGrid *g, int64_t a, int64_t b, double tol2)
+{
+    for (uint32_t i = g->start[a]; i < g->start[a + 1]; i++) {
+        const double *P = g->coords + 3 * (size_t)i;
+        for (uint32_t j = g->start[b]; j < g->start[b + 1]; j++) {
+            const double *Q = g->coords + 3 * (size_t)j;
+            const double x = P[0] - Q[0], y = P[1] - Q[1], z = P[2] - Q[2];
+            if ((x * x + y * y) + z * z <= tol2) {
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+static PyObject *
+accel_close_groups(PyObject *self, PyObject *args)
+{
+    PyObject *points_obj;
+    double tol;
+    if (!PyArg_ParseTuple(args, "Od", &points_obj, &tol)) {
+        return NULL;
+    }
+    if (!(tol > 0.0) || !isfinite(tol)) {
+        PyErr_Format(PyExc_ValueError, "Expected a finite tolerance > 0, got %g", tol);
+        return NULL;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(points_obj, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    PyObject *result = NULL;
+    OeGrid grid;
+    memset(&grid, 0, sizeof(grid));
+    uint32_t *parent = NULL;
+    int64_t *lowest = NULL, *out = NULL;
+    OeSlot *blocks = NULL;
+    if (native_code(view.format) != 'd' || view.itemsize != 8 || view.ndim != 2 || view.shape[1] != 3) {
+        PyErr_SetString(PyExc_ValueError, "Expected `points` as a C-contiguous (k, 3) float64 array");
+        goto done;
+    }
+    const double *pts = (const double *)view.buf;
+    const size_t k = (size_t)view.shape[0];
+    if (k >= (size_t)UINT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "Expected fewer than 2**32 points");
+        goto done;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY};
+    for (size_t i = 0; i < 3 * k; i++) {
+        if (!isfinite(pts[i])) {
+            PyErr_SetString(PyExc_ValueError, "Expected finite point coordinates");
+            goto done;
+        }
+        lo[i % 3] = pts[i] < lo[i % 3] ? pts[i] : lo[i % 3];
+    }
+    const double h = 0.5 * tol * (1.0 + 1e-9);
+    int built = oe_grid_build(&grid, pts, NULL, k, lo, h, 0);
+    if (built == -2) {
+        result = Py_None;                                  /* the grid does not fit 21 bits: the caller's path */
+        Py_INCREF(result);
+        goto done;
+    }
+    out = (int64_t *)malloc((k ? k : 1) * sizeof(int64_t));
+    parent = (uint32_t *)malloc((grid.runs ? grid.runs : 1) * sizeof(uint32_t));
+    lowest = (int64_t *)malloc((grid.runs ? grid.runs : 1) * sizeof(int64_t));
+    if (built < 0 || out == NULL || parent == NULL || lowest == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    /* the blocks of 8^3 cells (side 4 tol): the runs of a block are consecutive in code order */
+    /* blocks of 32^3 cells (side 16 tol, the codes sharing all but their 15 lowest bits): the runs of a block
+     * are consecutive in code order; a cell's own block is scanned from the cell on, and the table of blocks
+     * is read only for the neighbour blocks its widened box reaches (a few per cent of a soup's cells) */
+    size_t nblocks = 0;
+    for (size_t r = 0; r < grid.runs; r++) {
+        nblocks += r == 0 || grid.run_code[r] >> OE_BLOCK_BITS != grid.run_code[r - 1] >> OE_BLOCK_BITS;
+    }
+    size_t bsize = 1024;
+    while (bsize < 2 * nblocks) {
+        bsize *= 2;
+    }
+    const size_t bmask = bsize - 1;
+    blocks = (OeSlot *)malloc(bsize * sizeof(OeSlot));
+    if (blocks == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_BEGIN_ALLOW_THREADS
+    for (size_t s = 0; s < bsize; s++) {
+        blocks[s].key = OE_EMPTY;
+    }
+    for (size_t r = 0; r < grid.runs; r++) {
+        parent[r] = (uint32_t)r;
+        const uint64_t block = grid.run_code[r] >> OE_BLOCK_BITS;
+        if (r == 0 || block != grid.run_code[r - 1] >> OE_BLOCK_BITS) {
+            size_t s = (size_t)oe_mix(block) & bmask;
+            while (blocks[s].key != OE_EMPTY) {
+                s = (s + 1) & bmask;
+            }
+            blocks[s].key = block;
+            blocks[s].run = r;
+        }
+    }
+    const double tol2 = tol * tol;
+    const int64_t side = (int64_t)1 << (OE_BLOCK_BITS / 3);
+    for (size_t a = 0; a < grid.runs; a++) {
+        double bmin[3], bmax[3];
+        for (int c = 0; c < 3; c++) {
+            bmin[c] = INFINITY;
+            bmax[c] = -INFINITY;
+        }
+        for (uint32_t i = grid.start[a]; i < grid.start[a + 1]; i++) {
+            for (int c = 0; c < 3; c++) {
+                const double x = grid.coords[3 * (size_t)i + c];
+                bmin[c] = x < bmin[c] ? x : bmin[c];
+                bmax[c] = x > bmax[c] ? x : bmax[c];
+            }
+        }
+        int64_t c_lo[3], c_hi[3];
+        for (int c = 0; c < 3; c++) {
+            /* widened by a little more than the rounding of x - lo and of the division */
+            const double w = tol * (1.0 + 1e-9) + 8.0 * DBL_EPSILON * (fabs(bmin[c]) + fabs(bmax[c]) + fabs(lo[c]));
+            double q0 = floor((bmin[c] - w - lo[c]) / h), q1 = floor((bmax[c] + w - lo[c]) / h);
+            c_lo[c] = q0 < 0.0 ? 0 : (int64_t)q0;
+            c_hi[c] = q1 > (double)grid.top[c] ? grid.top[c] : (int64_t)q1;
+        }
+        const uint64_t own = grid.run_code[a], own_block = own >> OE_BLOCK_BITS;
+        for (int64_t bx = c_lo[0] / side; bx <= c_hi[0] / side; bx++) {
+            for (int64_t by = c_lo[1] / side; by <= c_hi[1] / side; by++) {
+                for (int64_t bz = c_lo[2] / side; bz <= c_hi[2] / side; bz++) {
+                    const uint64_t block = oe_code(bx, by, bz);
+                    if (block < own_block) {
+                        continue;                            /* every cell there precedes this one */
+                    }
+                    /* the part of the box in this block: its codes lie between those of its corners */
+                    const int64_t b0[3] = {bx * side, by * side, bz * side};
+                    int64_t s_lo[3], s_hi[3];
+                    for (int c = 0; c < 3; c++) {
+                        s_lo[c] = c_lo[c] > b0[c] ? c_lo[c] : b0[c];
+                        s_hi[c] = c_hi[c] < b0[c] + side - 1 ? c_hi[c] : b0[c] + side - 1;
+                    }
+                    const uint64_t code_lo = oe_code(s_lo[0], s_lo[1], s_lo[2]);
+                    const uint64_t code_hi = oe_code(s_hi[0], s_hi[1], s_hi[2]);
+                    if (code_hi <= own) {
+                        continue;
+                    }
+                    size_t b = a + 1;
+                    if (block != own_block) {
+                        size_t s = (size_t)oe_mix(block) & bmask;
+                        while (blocks[s].key != OE_EMPTY && blocks[s].key != block) {
+                            s = (s + 1) & bmask;
+                        }
+                        if (blocks[s].key == OE_EMPTY) {
+                            continue;
+                        }
+                        b = (size_t)blocks[s].run;
+                    }
+                    for (; b < grid.runs && grid.run_code[b] <= code_hi; b++) {
+                        const uint64_t code = grid.run_code[b];
+                        if (code < code_lo) {
+                            continue;
+                        }
+                        const int64_t ix = oe_compact(code), iy = oe_compact(code >> 1), iz = oe_compact(code >> 2);
+                        if (ix < c_lo[0] || ix > c_hi[0] || iy < c_lo[1] || iy > c_hi[1] || iz < c_lo[2] ||
+                            iz > c_hi[2]) {
+                            continue;
+                        }
+                        uint32_t ra = oe_root(parent, (uint32_t)a), rb = oe_root(parent, (uint32_t)b);
+                        if (ra != rb && oe_cells_meet(&grid, (int64_t)a, (int64_t)b, tol2)) {
+                            parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for (size_t r = 0; r < grid.runs; r++) {
+        lowest[r] = (int64_t)k;
+    }
+    for (size_t r = 0; r < grid.runs; r++) {
+        const uint32_t root = oe_root(parent, (uint32_t)r);
+        for (uint32_t i = grid.start[r]; i < grid.start[r + 1]; i++) {
+            lowest[root] = (int64_t)grid.idx[i] < lowest[root] ? (int64_t)grid.idx[i] : lowest[root];
+        }
+    }
+    for (size_t r = 0; r < grid.runs; r++) {
+        const int64_t low = lowest[oe_root(parent, (uint32_t)r)];
+        for (uint32_t i = grid.start[r]; i < grid.start[r + 1]; i++) {
+            out[grid.idx[i]] = low;
+        }
+    }
+    Py_END_ALLOW_THREADS
+    result = PyBytes_FromStringAndSize((const char *)out, (Py_ssize_t)(k * sizeof(int64_t)));
+done:
+    PyBuffer_Release(&view);
+    oe_grid_free(&grid);
+    free(parent);
+    free(lowest);
+    free(out);
+    free(blocks);
+    return result;
+}
+
+/* ======================================================================================================
+ * 10. sample_cells -- the cells a surface passes through, from samples of its triangles (mesh/grid_estimate.py)
+ *
+ * The twin of the sampling loop of grid_estimate._surface_cells, bit for bit: triangle f (corners a, b, c) with
  * n = steps[f] is sampled at s = i/n, t = j/n for i + j <= n, the point ((a (1-s-t) + b s) + c t) per
  * coordinate (1-s-t evaluated as (1 - s) - t), and the cell floor((p - origin) / h) per axis, clamped to
  * 0..dims-1, is marked in `out` (bytes of the flat grid, C order).  numpy evaluated the same expressions on
