@@ -5489,6 +5489,389 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
     return n_nodes;
 }
 
+/* ------------------------------------------------------------------------------------------------------
+ * Certified patches (mesh/intersect.py, "Patches").  A node of the hierarchy whose faces K satisfy
+ *   (a) along some coordinate axis every face projects to a triangle of one strict orientation s (exact
+ *       orient2d of its corners in winding order), and
+ *   (b) the boundary chain of K (its directed edges, u -> v cancelling v -> u) is one cycle through distinct
+ *       vertices whose projection along that axis is a simple polygon (exact orient2d),
+ * has no two faces meeting beyond what they share by index, so the descent of the node with itself is left
+ * out.  Proof (the degree argument behind the normal-cone and contour test of self-collision culling): at a
+ * point y of the plane off every projected edge, the number of faces whose projection holds y, times s, is the
+ * winding number of the projected boundary chain round y (the faces' boundaries sum to the chain), which for
+ * a simple closed polygon is 0 or +-1: the projected faces have disjoint interiors.  Then every point of K
+ * off the chain has a neighbourhood that projects one to one (the faces round it cover a disk once), so two
+ * distinct points of K with one projection both lie on the chain, whose projection is one to one: the
+ * projection is one to one on K, and a point common to two faces is one point of K, i.e. in what they share
+ * by index.  Nodes whose boundary grows past CT_PATCH_EDGES, or whose chain holds an edge twice, are not tried
+ * (nor their ancestors); the simple-polygon sweep stops after a bounded number of segment tests (not
+ * certified).  Failing to certify only costs time.
+ * ------------------------------------------------------------------------------------------------------ */
+
+#define CT_PATCH_EDGES 2048
+
+typedef struct {
+    int32_t *edges;             /* boundary chains of the nodes, directed edges (tail, head) */
+    int64_t n, cap;             /* int32 pairs used / allocated */
+    int64_t *off;               /* per node: first pair of its chain */
+    int32_t *len;               /* per node: pairs in its chain; -1 not kept (too long, or an edge twice) */
+    uint8_t *amask;             /* per node: bit 2 a + (s < 0) when every face has orientation s along axis a */
+    /* scratch: an open-addressing table of edges (key (lo, hi) vertex ids, net count) stamped per use */
+    uint64_t *key;
+    int32_t *net;
+    uint32_t *stamp;
+    int32_t *slots;             /* the slots used, in order of first use */
+    uint32_t cur;
+    int64_t tsize;              /* power of two, at least 4 (2 CT_PATCH_EDGES + 3 CT_LEAF) */
+    int oom;
+} CtPatchBuild;
+
+static inline uint64_t
+ct_edge_hash(uint64_t k)
+{
+    k ^= k >> 29;
+    k *= 0xbf58476d1ce4e5b9ULL;
+    k ^= k >> 32;
+    return k;
+}
+
+/* Adds the directed edge u -> v to the table (its first mask + 1 slots, at most a quarter full): net +1 for
+ * u < v, -1 for u > v, on the key (min, max). */
+static inline void
+ct_edge_add(CtPatchBuild *pb, int32_t u, int32_t v, int64_t mask, int64_t *used)
+{
+    int32_t lo = u < v ? u : v, hi = u < v ? v : u;
+    uint64_t k = (uint64_t)(uint32_t)lo << 32 | (uint32_t)hi;
+    int64_t s = (int64_t)(ct_edge_hash(k) & (uint64_t)mask);
+    for (int64_t probe = 0; probe <= mask; probe++) {
+        if (pb->stamp[s] != pb->cur) {
+            pb->stamp[s] = pb->cur;
+            pb->key[s] = k;
+            pb->net[s] = u < v ? 1 : -1;
+            pb->slots[(*used)++] = (int32_t)s;
+            return;
+        }
+        if (pb->key[s] == k) {
+            pb->net[s] += u < v ? 1 : -1;
+            return;
+        }
+        s = (s + 1) & mask;
+    }
+}
+
+/* The chain of node k from its directed edges pairs[0 .. count - 1] (count <= 2 CT_PATCH_EDGES + 3 CT_LEAF):
+ * appended to the pool, off[k] / len[k] set (len -1 when an edge is left twice or more, or too many). */
+static void
+ct_chain_store(CtPatchBuild *pb, int64_t k, const int32_t *pairs, int64_t count)
+{
+    pb->cur++;
+    if (pb->cur == 0) {                                    /* the stamps wrapped: clear them */
+        memset(pb->stamp, 0, (size_t)pb->tsize * sizeof(uint32_t));
+        pb->cur = 1;
+    }
+    int64_t used = 0, mask = 15;
+    while (mask + 1 < 4 * count && mask + 1 < pb->tsize) mask = 2 * mask + 1;
+    for (int64_t e = 0; e < count; e++) ct_edge_add(pb, pairs[2 * e], pairs[2 * e + 1], mask, &used);
+    int64_t left = 0;
+    for (int64_t i = 0; i < used; i++) {
+        int32_t nt = pb->net[pb->slots[i]];
+        if (nt > 1 || nt < -1) {
+            pb->len[k] = -1;
+            return;
+        }
+        left += nt != 0;
+    }
+    if (left > CT_PATCH_EDGES) {
+        pb->len[k] = -1;
+        return;
+    }
+    if (pb->n + left > pb->cap) {
+        int64_t cap = pb->cap ? 2 * pb->cap : 4096;
+        while (cap < pb->n + left) cap *= 2;
+        int32_t *ne = (int32_t *)realloc(pb->edges, (size_t)cap * 2 * sizeof(int32_t));
+        if (ne == NULL) {
+            pb->oom = 1;
+            pb->len[k] = -1;
+            return;
+        }
+        pb->edges = ne;
+        pb->cap = cap;
+    }
+    pb->off[k] = pb->n;
+    pb->len[k] = (int32_t)left;
+    for (int64_t i = 0; i < used; i++) {
+        int32_t s = pb->slots[i], nt = pb->net[s];
+        if (nt == 0) continue;
+        int32_t lo = (int32_t)(pb->key[s] >> 32), hi = (int32_t)(pb->key[s] & 0xffffffffu);
+        pb->edges[2 * pb->n] = nt > 0 ? lo : hi;
+        pb->edges[2 * pb->n + 1] = nt > 0 ? hi : lo;
+        pb->n++;
+    }
+}
+
+/* 1 when the closed segments p1 q1 and p2 q2 (2-d) meet (exact). */
+static int
+ct_segments_meet(const double *p1, const double *q1, const double *p2, const double *q2, CtStats *st)
+{
+    int o1 = ct_orient2d(p1, q1, p2, st), o2 = ct_orient2d(p1, q1, q2, st);
+    int o3 = ct_orient2d(p2, q2, p1, st), o4 = ct_orient2d(p2, q2, q1, st);
+    if (o1 * o2 < 0 && o3 * o4 < 0) return 1;
+#define CT_ON_SEGMENT(a, b, r) ((r)[0] >= ((a)[0] < (b)[0] ? (a)[0] : (b)[0]) \
+                                && (r)[0] <= ((a)[0] > (b)[0] ? (a)[0] : (b)[0]) \
+                                && (r)[1] >= ((a)[1] < (b)[1] ? (a)[1] : (b)[1]) \
+                                && (r)[1] <= ((a)[1] > (b)[1] ? (a)[1] : (b)[1]))
+    if (o1 == 0 && CT_ON_SEGMENT(p1, q1, p2)) return 1;
+    if (o2 == 0 && CT_ON_SEGMENT(p1, q1, q2)) return 1;
+    if (o3 == 0 && CT_ON_SEGMENT(p2, q2, p1)) return 1;
+    if (o4 == 0 && CT_ON_SEGMENT(p2, q2, q1)) return 1;
+#undef CT_ON_SEGMENT
+    return 0;
+}
+
+/* 1 when the segments a b and b c (2-d, nonzero lengths) overlap beyond b: collinear, a and c on one side. */
+static int
+ct_segments_fold(const double *a, const double *b, const double *c, CtStats *st)
+{
+    if (ct_orient2d(a, b, c, st) != 0) return 0;
+    int k = a[0] != b[0] ? 0 : 1;
+    return (a[k] > b[k]) == (c[k] > b[k]);
+}
+
+typedef struct {
+    double lo;
+    int32_t i;
+} CtSweep;
+
+static int
+ct_sweep_cmp(const void *x, const void *y)
+{
+    const CtSweep *a = (const CtSweep *)x, *b = (const CtSweep *)y;
+    return a->lo < b->lo ? -1 : a->lo > b->lo ? 1 : (a->i > b->i) - (a->i < b->i);
+}
+
+/* 1 when the polygon P[0 .. B-1] (2-d, consecutive points distinct) is simple: consecutive edges meet only in
+ * their common point, others not at all.  A sweep along x tests the pairs whose x ranges meet; more than
+ * budget segment tests (or an exact stage that overflowed): 0. */
+static int
+ct_polygon_simple(const double *P, int64_t B, CtSweep *order, int64_t budget, CtStats *st)
+{
+    if (B == 3) {                                          /* a triangle: simple iff not flat */
+        return ct_orient2d(P, P + 2, P + 4, st) != 0 && !st->failed;
+    }
+    for (int64_t i = 0; i < B; i++) {
+        const double *a = P + 2 * i, *b = P + 2 * ((i + 1) % B);
+        order[i].lo = a[0] < b[0] ? a[0] : b[0];
+        order[i].i = (int32_t)i;
+    }
+    qsort(order, (size_t)B, sizeof(CtSweep), ct_sweep_cmp);
+    int64_t tests = 0;
+    for (int64_t x = 0; x < B; x++) {
+        int64_t i = order[x].i;
+        const double *a = P + 2 * i, *b = P + 2 * ((i + 1) % B);
+        double hx = a[0] > b[0] ? a[0] : b[0];
+        double ly = a[1] < b[1] ? a[1] : b[1], hy = a[1] > b[1] ? a[1] : b[1];
+        for (int64_t z = x + 1; z < B && order[z].lo <= hx; z++) {
+            int64_t j = order[z].i;
+            const double *c = P + 2 * j, *d = P + 2 * ((j + 1) % B);
+            if ((c[1] < ly && d[1] < ly) || (c[1] > hy && d[1] > hy)) continue;
+            if (++tests > budget) return 0;
+            int meet;
+            if ((i + 1) % B == j) {                        /* (a, b) then (b, d) */
+                meet = ct_segments_fold(a, b, d, st);
+            }
+            else if ((j + 1) % B == i) {                   /* (c, d) then (d, b) */
+                meet = ct_segments_fold(c, d, b, st);
+            }
+            else {
+                meet = ct_segments_meet(a, b, c, d, st);
+            }
+            if (meet || st->failed) return 0;
+        }
+    }
+    return 1;
+}
+
+/* 1 when the chain edges[0 .. B-1] (directed pairs) is one cycle through distinct vertices whose projection
+ * along some axis of amask (with every face's orientation there) is a simple polygon; 0 otherwise (or out of
+ * memory, *oom set). */
+static int
+ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_t B, unsigned amask)
+{
+    if (B < 3 || amask == 0) return 0;
+    /* the outgoing edge of each tail: the table again, keyed by the tail */
+    pb->cur++;
+    if (pb->cur == 0) {
+        memset(pb->stamp, 0, (size_t)pb->tsize * sizeof(uint32_t));
+        pb->cur = 1;
+    }
+    int64_t mask = 15;
+    while (mask + 1 < 4 * B && mask + 1 < pb->tsize) mask = 2 * mask + 1;
+    for (int64_t e = 0; e < B; e++) {
+        uint64_t k = (uint32_t)edges[2 * e];
+        int64_t s = (int64_t)(ct_edge_hash(k) & (uint64_t)mask);
+        for (int64_t probe = 0; probe <= mask; probe++) {
+            if (pb->stamp[s] != pb->cur) {
+                pb->stamp[s] = pb->cur;
+                pb->key[s] = k;
+                pb->net[s] = (int32_t)e;
+                break;
+            }
+            if (pb->key[s] == k) return 0;                 /* a vertex leaving twice: not one simple cycle */
+            s = (s + 1) & mask;
+        }
+    }
+    int32_t *cycle = (int32_t *)malloc((size_t)B * sizeof(int32_t));
+    double *P = (double *)malloc((size_t)B * 2 * sizeof(double));
+    CtSweep *order = (CtSweep *)malloc((size_t)B * sizeof(CtSweep));
+    int ok = 0;
+    if (cycle == NULL || P == NULL || order == NULL) {
+        pb->oom = 1;
+        goto done;
+    }
+    int64_t e = 0, steps = 0;
+    do {                                                   /* walk the chain from edge 0: B steps back to it */
+        cycle[steps++] = edges[2 * e];
+        uint64_t k = (uint32_t)edges[2 * e + 1];
+        int64_t s = (int64_t)(ct_edge_hash(k) & (uint64_t)mask);
+        e = -1;
+        for (int64_t probe = 0; probe <= mask; probe++) {
+            if (pb->stamp[s] != pb->cur) break;
+            if (pb->key[s] == k) {
+                e = pb->net[s];
+                break;
+            }
+            s = (s + 1) & mask;
+        }
+    } while (e > 0 && steps < B);
+    if (e != 0 || steps != B) goto done;                   /* an open chain, or several cycles */
+    for (int axis = 0; axis < 3 && !ok; axis++) {
+        if (!((amask >> (2 * axis)) & 3u)) continue;
+        int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
+        for (int64_t i = 0; i < B; i++) {
+            P[2 * i] = V[3 * (size_t)cycle[i] + kx];
+            P[2 * i + 1] = V[3 * (size_t)cycle[i] + ky];
+        }
+        CtStats st = {0, 0};
+        ok = ct_polygon_simple(P, B, order, 64 * B + 4096, &st);
+    }
+done:
+    free(cycle);
+    free(P);
+    free(order);
+    return ok;
+}
+
+/* patch[k] <- 1 for the nodes certified as above (the highest ones; their descendants are not tried).
+ * 0, or -1 when out of memory. */
+static int
+ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *flags, const double *V,
+           int64_t m, uint8_t *patch)
+{
+    CtPatchBuild pb;
+    memset(&pb, 0, sizeof(pb));
+    memset(patch, 0, (size_t)n_nodes);
+    pb.tsize = 1;
+    while (pb.tsize < 4 * (2 * CT_PATCH_EDGES + 3 * CT_LEAF)) pb.tsize *= 2;
+    pb.off = (int64_t *)malloc((size_t)n_nodes * sizeof(int64_t));
+    pb.len = (int32_t *)malloc((size_t)n_nodes * sizeof(int32_t));
+    pb.amask = (uint8_t *)malloc((size_t)n_nodes);
+    pb.key = (uint64_t *)malloc((size_t)pb.tsize * sizeof(uint64_t));
+    pb.net = (int32_t *)malloc((size_t)pb.tsize * sizeof(int32_t));
+    pb.stamp = (uint32_t *)calloc((size_t)pb.tsize, sizeof(uint32_t));
+    pb.slots = (int32_t *)malloc((size_t)pb.tsize * sizeof(int32_t));
+    int32_t *pairs = (int32_t *)malloc((size_t)(2 * CT_PATCH_EDGES + 3 * CT_LEAF) * 2 * sizeof(int32_t));
+    int64_t *stack = (int64_t *)malloc((size_t)(n_nodes + 1) * sizeof(int64_t));
+    int rc = 0;
+    if (pb.off == NULL || pb.len == NULL || pb.amask == NULL || pb.key == NULL || pb.net == NULL
+        || pb.stamp == NULL || pb.slots == NULL || pairs == NULL || stack == NULL) {
+        rc = -1;
+        goto done;
+    }
+    pb.cur = 0;
+    for (int64_t k = n_nodes - 1; k >= CT_ROOT && !pb.oom; k--) {      /* children before parents */
+        const CtNode *nd = &nodes[k];
+        if (CT_IS_LEAF(nd)) {
+            int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
+            unsigned am = 63u;
+            int64_t np = 0;
+            for (int64_t i = start; i < start + count; i++) {
+                int32_t c0 = ct_id(ids, i, 0), c1 = ct_id(ids, i, 1), c2 = ct_id(ids, i, 2);
+                if (am != 0 && !(flags[i] >> 2)) {
+                    const double *p0 = V + 3 * (size_t)c0, *p1 = V + 3 * (size_t)c1, *p2 = V + 3 * (size_t)c2;
+                    unsigned fm = 0;
+                    CtStats st = {0, 0};
+                    for (int a = 0; a < 3; a++) {
+                        if (!((am >> (2 * a)) & 3u)) continue;
+                        int o = ct_orient2d_axis(p0, p1, p2, a, &st);
+                        fm |= o > 0 ? 1u << (2 * a) : o < 0 ? 2u << (2 * a) : 0u;
+                    }
+                    am &= st.failed ? 0u : fm;
+                }
+                else {
+                    am = 0;
+                }
+                pairs[2 * np] = c0; pairs[2 * np + 1] = c1; np++;
+                pairs[2 * np] = c1; pairs[2 * np + 1] = c2; np++;
+                pairs[2 * np] = c2; pairs[2 * np + 1] = c0; np++;
+            }
+            pb.amask[k] = (uint8_t)am;
+            ct_chain_store(&pb, k, pairs, np);
+        }
+        else {
+            int64_t l = CT_LEFT(nd), r = CT_RIGHT(nd);
+            pb.amask[k] = pb.amask[l] & pb.amask[r];
+            if (pb.len[l] < 0 || pb.len[r] < 0) {
+                pb.len[k] = -1;
+                continue;
+            }
+            int64_t np = 0;
+            for (int s = 0; s < 2; s++) {
+                int64_t c = s ? r : l;
+                memcpy(pairs + 2 * np, pb.edges + 2 * pb.off[c], (size_t)pb.len[c] * 2 * sizeof(int32_t));
+                np += pb.len[c];
+            }
+            ct_chain_store(&pb, k, pairs, np);
+        }
+    }
+    if (pb.oom) {
+        rc = -1;
+        goto done;
+    }
+    {
+        int64_t top = 0;                                   /* top down: the highest certified nodes */
+        stack[top++] = CT_ROOT;
+        while (top > 0) {
+            int64_t k = stack[--top];
+            const CtNode *nd = &nodes[k];
+            if (pb.len[k] >= 3 && pb.amask[k] != 0
+                && ct_patch_certify(&pb, V, pb.edges + 2 * pb.off[k], pb.len[k], pb.amask[k])) {
+                patch[k] = 1;
+                continue;
+            }
+            if (pb.oom) {
+                rc = -1;
+                break;
+            }
+            if (!CT_IS_LEAF(nd)) {
+                stack[top++] = CT_LEFT(nd);
+                stack[top++] = CT_RIGHT(nd);
+            }
+        }
+    }
+done:
+    free(pb.edges);
+    free(pb.off);
+    free(pb.len);
+    free(pb.amask);
+    free(pb.key);
+    free(pb.net);
+    free(pb.stamp);
+    free(pb.slots);
+    free(pairs);
+    free(stack);
+    return rc;
+}
+
 typedef struct {
     const float *BOX;           /* face boxes rounded outward to float32, in blocks of CT_LEAF (ct_block_mask) */
     const int32_t *order;       /* the caller's face index of each hierarchy position */
@@ -5498,6 +5881,7 @@ typedef struct {
     const CtNode *nodes;
     int64_t m;                  /* faces */
     const uint8_t *stars;       /* certified corners per position (ct_visit), NULL without pruning */
+    const uint8_t *patch;       /* certified patches per node (ct_patches), NULL without them */
     long long max_pairs;        /* < 0: no bound */
     long long candidates, tested;
     long exact;
@@ -5668,6 +6052,9 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         if (p->apex >= 0 && p->apex == q->apex) {
             continue;                       /* every pair below is within one certified star */
         }
+        if (pi == qi && sc->patch != NULL && sc->patch[pi]) {
+            continue;                       /* every pair below is within one certified patch */
+        }
         if (top + 4 > cap) {
             int64_t *ns = (int64_t *)realloc(stack, 4 * cap * sizeof(int64_t));
             if (ns == NULL) {
@@ -5790,10 +6177,11 @@ ct_parallel_task(void *ctx, int t, int nt)
 /* Node pairs covering every candidate pair (the distinct ones with meeting boxes), split near the root into
  * up to about CT_TASKS; their count. */
 static int32_t
-ct_tasks(const CtNode *nodes, int64_t *tasks)
+ct_tasks(const CtNode *nodes, const uint8_t *patch, int64_t *tasks)
 {
     int32_t n = 1;
     tasks[0] = tasks[1] = CT_ROOT;
+    if (patch != NULL && patch[CT_ROOT]) return 0;     /* the whole mesh one certified patch */
     for (int round = 0; round < 16 && n < CT_TASKS / 4; round++) {
         int64_t next[2 * CT_TASKS];
         int32_t m = 0;
@@ -5804,6 +6192,7 @@ ct_tasks(const CtNode *nodes, int64_t *tasks)
                 int64_t add[3][2] = {{CT_LEFT(p), CT_LEFT(p)}, {CT_RIGHT(p), CT_RIGHT(p)}, {CT_LEFT(p), CT_RIGHT(p)}};
                 for (int j = 0; j < 3; j++) {
                     if (j == 2 && !ct_nodes_meet(&nodes[CT_LEFT(p)], &nodes[CT_RIGHT(p)])) continue;
+                    if (j < 2 && patch != NULL && patch[add[j][0]]) continue;     /* within a certified patch */
                     next[2 * m] = add[j][0];
                     next[2 * m + 1] = add[j][1];
                     m++;
@@ -5926,7 +6315,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
     long long max_pairs;
     int threads = 1;
     long long star_faces = 0;
-    if (!PyArg_ParseTuple(args, "OOL|iL", &objs[0], &objs[1], &max_pairs, &threads, &star_faces)) {
+    int patches = 0;
+    if (!PyArg_ParseTuple(args, "OOL|iLp", &objs[0], &objs[1], &max_pairs, &threads, &star_faces, &patches)) {
         return NULL;
     }
     Py_buffer views[2];
@@ -5943,6 +6333,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
     uint8_t *skip_out = NULL;
     uint8_t *cert = NULL;
     uint8_t *stars = NULL;
+    uint8_t *patch = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
     for (; got < 2; got++) {
@@ -6071,7 +6462,15 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         clk[4] = ct_clock();
         if (!oom && !failed && m >= 2) {
-            ct_build(nodes, box, ids, cert, m);
+            int64_t n_nodes = ct_build(nodes, box, ids, cert, m);
+            if (patches && max_pairs < 0) {        /* with a work bound every pair is counted, as on numpy */
+                patch = (uint8_t *)malloc((size_t)n_nodes);
+                if (patch == NULL || ct_patches(nodes, n_nodes, ids, flags, V, m, patch) < 0) {
+                    free(patch);
+                    patch = NULL;           /* out of memory: the scan without patches, the same pairs */
+                }
+            }
+            clk[7] = ct_clock();
             if (cert != NULL) {
                 for (int64_t i = 0; i < m; i++) {
                     unsigned b = 0;
@@ -6084,6 +6483,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
             clk[5] = ct_clock();
             sc.stars = cert != NULL ? stars : NULL;
+            sc.patch = patch;
             sc.BOX = box;
             sc.order = order;
             sc.ids = ids;
@@ -6105,7 +6505,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 }
                 pp.scans = scans;
                 pp.tasks = tasks;
-                pp.n_tasks = ct_tasks(nodes, tasks);
+                pp.n_tasks = ct_tasks(nodes, sc.patch, tasks);
                 pp.next = 0;
                 run_parallel(nt, ct_parallel_task, &pp);
                 long exact0 = sc.exact;
@@ -6140,9 +6540,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
         Py_END_ALLOW_THREADS
         if (profile) {
             fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars %.4f build %.4f "
-                    "traverse %.4f s; candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld\n",
+                    "(patches %.4f) traverse %.4f s; candidates %lld tested %lld; node pairs %lld leaf pairs %lld "
+                    "pair tests %lld\n",
                     (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[4] - clk[3], clk[5] - clk[4],
-                    clk[6] - clk[5], sc.candidates, sc.tested, sc.node_pairs, sc.leaf_pairs, sc.loads);
+                    clk[7] > 0 ? clk[7] - clk[4] : 0.0, clk[6] - clk[5], sc.candidates, sc.tested, sc.node_pairs,
+                    sc.leaf_pairs, sc.loads);
         }
         if (oom) {
             PyErr_NoMemory();
@@ -6182,6 +6584,7 @@ done:
     free(skip_out);
     free(cert);
     free(stars);
+    free(patch);
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);

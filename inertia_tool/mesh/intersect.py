@@ -827,11 +827,11 @@ def _scan_numpy(v: np.ndarray, f: np.ndarray, axis: np.ndarray, degenerate: np.n
 
 
 def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None, pred: _Predicates,
-            star_faces: int) -> tuple[_Scan, np.ndarray, np.ndarray]:
+            star_faces: int, patches: bool) -> tuple[_Scan, np.ndarray, np.ndarray]:
     """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy), with the
     per-face projection axes and zero-area flags it computed."""
     raw_a, raw_b, raw_kind, candidates, tested, exact, complete, raw_axis, raw_skip = lib.contact_scan(
-        v, f, -1 if max_pairs is None else int(max_pairs), threads(), star_faces)
+        v, f, -1 if max_pairs is None else int(max_pairs), threads(), star_faces, patches)
     pred.exact += exact
     axis = np.frombuffer(raw_axis, dtype=np.int8).astype(np.intp)
     degenerate = np.frombuffer(raw_skip, dtype=np.uint8).astype(bool)
@@ -847,7 +847,8 @@ def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None
 # -- entry point ----------------------------------------------------------------------------------------------
 
 def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int | None = None,
-                     chunk: int = CHUNK_PAIRS, _star_faces: int = STAR_MIN_FACES) -> SurfaceContacts:
+                     chunk: int = CHUNK_PAIRS, _star_faces: int = STAR_MIN_FACES,
+                     _patches: bool = True) -> SurfaceContacts:
     """Every pair of faces that meets beyond the vertices and edges it shares by index, classified exactly.
 
     Parameters
@@ -865,6 +866,9 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     _star_faces : int
         Private, for the tests: stars of at least this many faces are certified and their pairs left out
         (module docstring, "Stars"); 0 runs the unpruned scan.  The pairs found do not depend on it.
+    _patches : bool
+        Private, for the tests: False turns off the C scan's certified patches (module docstring, "Patches"),
+        so that its counts are the numpy twin's.  The pairs found do not depend on it.
 
     Returns
     -------
@@ -893,7 +897,7 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
         return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty, complete=True)
     if lib is not None:
         (a, b, kind, candidates, tested, complete), axis, degenerate = _scan_c(lib, v, f, max_pairs, pred,
-                                                                               _star_faces)
+                                                                               _star_faces, _patches)
     else:
         f = f.astype(np.int64, copy=False)
         axis, degenerate = _face_axes(v, f, pred)
