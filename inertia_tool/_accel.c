@@ -5522,7 +5522,7 @@ typedef struct {
     uint32_t *stamp;
     int32_t *slots;             /* the slots used, in order of first use */
     uint32_t cur;
-    int64_t tsize;              /* power of two, at least 4 (2 CT_PATCH_EDGES + 3 CT_LEAF) */
+    int64_t tsize;              /* power of two, at least 4 CT_PATCH_MERGE */
     int oom;
 } CtPatchBuild;
 
@@ -5559,7 +5559,7 @@ ct_edge_add(CtPatchBuild *pb, int32_t u, int32_t v, int64_t mask, int64_t *used)
     }
 }
 
-/* The chain of node k from its directed edges pairs[0 .. count - 1] (count <= 2 CT_PATCH_EDGES + 3 CT_LEAF):
+/* The chain of node k from its directed edges pairs[0 .. count - 1] (count <= CT_PATCH_MERGE + 3 CT_LEAF):
  * appended to the pool, off[k] / len[k] set (len -1 when an edge is left twice or more, or too many). */
 static void
 ct_chain_store(CtPatchBuild *pb, int64_t k, const int32_t *pairs, int64_t count)
@@ -5649,17 +5649,16 @@ ct_sweep_cmp(const void *x, const void *y)
     return a->lo < b->lo ? -1 : a->lo > b->lo ? 1 : (a->i > b->i) - (a->i < b->i);
 }
 
-/* 1 when the polygon P[0 .. B-1] (2-d, consecutive points distinct) is simple: consecutive edges meet only in
- * their common point, others not at all.  A sweep along x tests the pairs whose x ranges meet; more than
- * budget segment tests (or an exact stage that overflowed): 0. */
+/* 1 when the closed polygons P (2-d points, B of them; the segment of point i runs to point succ[i], every
+ * succ cycle of length 3 or more, consecutive points distinct) are simple and pairwise disjoint: segments
+ * meet only where one ends and the next begins (and not folding back along it), others not at all.  A sweep
+ * along x tests the pairs whose x and y ranges meet; more than budget segment tests, or an exact stage that
+ * overflowed: 0. */
 static int
-ct_polygon_simple(const double *P, int64_t B, CtSweep *order, int64_t budget, CtStats *st)
+ct_polygons_simple(const double *P, const int32_t *succ, int64_t B, CtSweep *order, int64_t budget, CtStats *st)
 {
-    if (B == 3) {                                          /* a triangle: simple iff not flat */
-        return ct_orient2d(P, P + 2, P + 4, st) != 0 && !st->failed;
-    }
     for (int64_t i = 0; i < B; i++) {
-        const double *a = P + 2 * i, *b = P + 2 * ((i + 1) % B);
+        const double *a = P + 2 * i, *b = P + 2 * (size_t)succ[i];
         order[i].lo = a[0] < b[0] ? a[0] : b[0];
         order[i].i = (int32_t)i;
     }
@@ -5667,19 +5666,19 @@ ct_polygon_simple(const double *P, int64_t B, CtSweep *order, int64_t budget, Ct
     int64_t tests = 0;
     for (int64_t x = 0; x < B; x++) {
         int64_t i = order[x].i;
-        const double *a = P + 2 * i, *b = P + 2 * ((i + 1) % B);
+        const double *a = P + 2 * i, *b = P + 2 * (size_t)succ[i];
         double hx = a[0] > b[0] ? a[0] : b[0];
         double ly = a[1] < b[1] ? a[1] : b[1], hy = a[1] > b[1] ? a[1] : b[1];
         for (int64_t z = x + 1; z < B && order[z].lo <= hx; z++) {
             int64_t j = order[z].i;
-            const double *c = P + 2 * j, *d = P + 2 * ((j + 1) % B);
+            const double *c = P + 2 * j, *d = P + 2 * (size_t)succ[j];
             if ((c[1] < ly && d[1] < ly) || (c[1] > hy && d[1] > hy)) continue;
             if (++tests > budget) return 0;
             int meet;
-            if ((i + 1) % B == j) {                        /* (a, b) then (b, d) */
+            if (succ[i] == j) {                            /* (a, b) then (b, d) */
                 meet = ct_segments_fold(a, b, d, st);
             }
-            else if ((j + 1) % B == i) {                   /* (c, d) then (d, b) */
+            else if (succ[j] == i) {                       /* (c, d) then (d, b) */
                 meet = ct_segments_fold(c, d, b, st);
             }
             else {
@@ -5691,9 +5690,31 @@ ct_polygon_simple(const double *P, int64_t B, CtSweep *order, int64_t budget, Ct
     return 1;
 }
 
-/* 1 when the chain edges[0 .. B-1] (directed pairs) is one cycle through distinct vertices whose projection
- * along some axis of amask (with every face's orientation there) is a simple polygon; 0 otherwise (or out of
- * memory, *oom set). */
+/* 1 when the point q (2-d) lies inside the closed polygon of points P[i], i = first, succ[first], ... (q on
+ * none of its segments): the parity of the segments crossing the ray from q towards +x (exact orient2d). */
+static int
+ct_point_inside(const double *q, const double *P, const int32_t *succ, int32_t first, int64_t B, CtStats *st)
+{
+    int inside = 0;
+    int32_t i = first;
+    for (int64_t steps = 0; steps < B; steps++) {
+        const double *a = P + 2 * (size_t)i, *b = P + 2 * (size_t)succ[i];
+        if ((a[1] > q[1]) != (b[1] > q[1])) {
+            int o = ct_orient2d(a, b, q, st);
+            if (b[1] > a[1] ? o > 0 : o < 0) inside ^= 1;
+        }
+        i = succ[i];
+        if (i == first) break;
+    }
+    return inside;
+}
+
+#define CT_PATCH_CYCLES 8       /* boundary cycles of a patch, at most */
+
+/* 1 when the chain edges[0 .. B-1] (directed pairs) is a union of cycles through distinct vertices whose
+ * projections along some axis of amask (with every face's orientation there) are simple, pairwise disjoint
+ * polygons none inside another (so their winding numbers add up to 0 or +-1 everywhere); 0 otherwise (or out
+ * of memory, pb->oom set). */
 static int
 ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_t B, unsigned amask)
 {
@@ -5716,62 +5737,141 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
                 pb->net[s] = (int32_t)e;
                 break;
             }
-            if (pb->key[s] == k) return 0;                 /* a vertex leaving twice: not one simple cycle */
+            if (pb->key[s] == k) return 0;                 /* a vertex leaving twice: not simple cycles */
             s = (s + 1) & mask;
         }
     }
-    int32_t *cycle = (int32_t *)malloc((size_t)B * sizeof(int32_t));
+    int32_t *succ = (int32_t *)malloc((size_t)B * sizeof(int32_t));
     double *P = (double *)malloc((size_t)B * 2 * sizeof(double));
     CtSweep *order = (CtSweep *)malloc((size_t)B * sizeof(CtSweep));
     int ok = 0;
-    if (cycle == NULL || P == NULL || order == NULL) {
+    int32_t first[CT_PATCH_CYCLES];
+    int n_cycles = 0;
+    if (succ == NULL || P == NULL || order == NULL) {
         pb->oom = 1;
         goto done;
     }
-    int64_t e = 0, steps = 0;
-    do {                                                   /* walk the chain from edge 0: B steps back to it */
-        cycle[steps++] = edges[2 * e];
+    for (int64_t e = 0; e < B; e++) {                      /* succ[e]: the edge leaving e's head */
         uint64_t k = (uint32_t)edges[2 * e + 1];
         int64_t s = (int64_t)(ct_edge_hash(k) & (uint64_t)mask);
-        e = -1;
+        succ[e] = -1;
         for (int64_t probe = 0; probe <= mask; probe++) {
             if (pb->stamp[s] != pb->cur) break;
             if (pb->key[s] == k) {
-                e = pb->net[s];
+                succ[e] = pb->net[s];
                 break;
             }
             s = (s + 1) & mask;
         }
-    } while (e > 0 && steps < B);
-    if (e != 0 || steps != B) goto done;                   /* an open chain, or several cycles */
+        if (succ[e] < 0) goto done;                        /* an open chain */
+    }
+    /* every edge on one cycle: B edges, each the successor of exactly one (distinct tails, and the walks
+     * from unvisited edges close) */
+    for (int64_t e = 0; e < B; e++) order[e].i = 0;        /* visited marks */
+    for (int64_t e = 0; e < B; e++) {
+        if (order[e].i) continue;
+        if (n_cycles == CT_PATCH_CYCLES) goto done;
+        first[n_cycles++] = (int32_t)e;
+        int64_t x = e, steps = 0;
+        do {
+            if (order[x].i) goto done;                     /* joins a cycle already walked: not disjoint */
+            order[x].i = 1;
+            x = succ[x];
+            steps++;
+        } while (x != e && steps <= B);
+        if (x != e) goto done;
+    }
     for (int axis = 0; axis < 3 && !ok; axis++) {
         if (!((amask >> (2 * axis)) & 3u)) continue;
         int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
-        for (int64_t i = 0; i < B; i++) {
-            P[2 * i] = V[3 * (size_t)cycle[i] + kx];
-            P[2 * i + 1] = V[3 * (size_t)cycle[i] + ky];
+        for (int64_t i = 0; i < B; i++) {                  /* point i: the tail of edge i */
+            P[2 * i] = V[3 * (size_t)edges[2 * i] + kx];
+            P[2 * i + 1] = V[3 * (size_t)edges[2 * i] + ky];
         }
         CtStats st = {0, 0};
-        ok = ct_polygon_simple(P, B, order, 64 * B + 4096, &st);
+        ok = ct_polygons_simple(P, succ, B, order, 64 * B + 4096, &st);
+        for (int c = 0; c < n_cycles && ok; c++) {         /* disjoint, so none inside another */
+            for (int d = 0; d < n_cycles && ok; d++) {
+                if (d != c && ct_point_inside(P + 2 * (size_t)first[c], P, succ, first[d], B, &st)) ok = 0;
+            }
+        }
+        if (st.failed) ok = 0;
     }
 done:
-    free(cycle);
+    free(succ);
     free(P);
     free(order);
     return ok;
 }
 
-/* patch[k] <- 1 for the nodes certified as above (the highest ones; their descendants are not tried).
+/* Bit j set when lane j of one row of a block of corner indices (CT_LEAF int32) is x. */
+static inline unsigned
+ct_row_mask(const int32_t *row, int32_t x)
+{
+#if defined(__SSE2__) && CT_LEAF % 4 == 0
+    __m128i k = _mm_set1_epi32(x);
+    unsigned mask = 0;
+    for (int q = 0; q < CT_LEAF / 4; q++) {
+        __m128i e = _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(row + 4 * q)), k);
+        mask |= (unsigned)_mm_movemask_ps(_mm_castsi128_ps(e)) << (4 * q);
+    }
+    return mask;
+#else
+    unsigned mask = 0;
+    for (int j = 0; j < CT_LEAF; j++) mask |= (unsigned)(row[j] == x) << j;
+    return mask;
+#endif
+}
+
+/* The boundary chain of the faces of one block (corner indices blk, CT_IDBLOCK int32; the first count lanes
+ * are faces, each with three distinct corners) into pairs: its directed edges u -> v that no other face of the
+ * block runs v -> u.  Their number, or -1 when an edge is run twice one way or thrice in all (not a chain of
+ * single edges: the node is not tried).  Faces are matched by corner masks (ct_row_mask), no table. */
+static int
+ct_leaf_chain(const int32_t *blk, int count, int32_t *pairs)
+{
+    unsigned live = ct_leaf_bits(count);
+    int np = 0;
+    for (int a = 0; a < count; a++) {
+        int32_t x[3] = {blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a]};
+        unsigned e[3][3];                                  /* e[c][k]: lanes whose corner k is x[c] */
+        for (int c = 0; c < 3; c++) {
+            for (int k = 0; k < 3; k++) e[c][k] = ct_row_mask(blk + k * CT_LEAF, x[c]) & live;
+        }
+        for (int c = 0; c < 3; c++) {
+            int d = (c + 1) % 3;
+            unsigned same = (e[c][0] & e[d][1]) | (e[c][1] & e[d][2]) | (e[c][2] & e[d][0]);
+            unsigned back = (e[d][0] & e[c][1]) | (e[d][1] & e[c][2]) | (e[d][2] & e[c][0]);
+            if (same != 1u << a || (back & (back - 1)) != 0) return -1;
+            if (back == 0) {
+                pairs[2 * np] = x[c];
+                pairs[2 * np + 1] = x[d];
+                np++;
+            }
+        }
+    }
+    return np;
+}
+
+/* Chains are kept for the leaves and for the inner nodes CT_PATCH_STRIDE levels apart above them (a node
+ * merges the chains of the nearest such nodes below it, at most 2^CT_PATCH_STRIDE), and only for nodes whose
+ * faces share an axis and orientation (amask != 0; their ancestors' amask is then a subset).  Only those nodes
+ * are tried as patches. */
+#define CT_PATCH_STRIDE 2
+#define CT_PATCH_MERGE (4 * CT_PATCH_EDGES)     /* edges merged at once, at most */
+
+/* patch[k] <- 1 for the nodes certified as above (the highest ones; their descendants are not tried); fmask:
+ * per hierarchy position, bit 2 a + (s < 0) when the face's projection along axis a has strict orientation s.
  * 0, or -1 when out of memory. */
 static int
-ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *flags, const double *V,
+ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *fmask, const double *V,
            int64_t m, uint8_t *patch)
 {
     CtPatchBuild pb;
     memset(&pb, 0, sizeof(pb));
     memset(patch, 0, (size_t)n_nodes);
     pb.tsize = 1;
-    while (pb.tsize < 4 * (2 * CT_PATCH_EDGES + 3 * CT_LEAF)) pb.tsize *= 2;
+    while (pb.tsize < 4 * CT_PATCH_MERGE) pb.tsize *= 2;
     pb.off = (int64_t *)malloc((size_t)n_nodes * sizeof(int64_t));
     pb.len = (int32_t *)malloc((size_t)n_nodes * sizeof(int32_t));
     pb.amask = (uint8_t *)malloc((size_t)n_nodes);
@@ -5779,59 +5879,67 @@ ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8
     pb.net = (int32_t *)malloc((size_t)pb.tsize * sizeof(int32_t));
     pb.stamp = (uint32_t *)calloc((size_t)pb.tsize, sizeof(uint32_t));
     pb.slots = (int32_t *)malloc((size_t)pb.tsize * sizeof(int32_t));
-    int32_t *pairs = (int32_t *)malloc((size_t)(2 * CT_PATCH_EDGES + 3 * CT_LEAF) * 2 * sizeof(int32_t));
+    int32_t *pairs = (int32_t *)malloc((size_t)(CT_PATCH_MERGE + 3 * CT_LEAF) * 2 * sizeof(int32_t));
     int64_t *stack = (int64_t *)malloc((size_t)(n_nodes + 1) * sizeof(int64_t));
+    uint8_t *height = (uint8_t *)malloc((size_t)n_nodes);
     int rc = 0;
     if (pb.off == NULL || pb.len == NULL || pb.amask == NULL || pb.key == NULL || pb.net == NULL
-        || pb.stamp == NULL || pb.slots == NULL || pairs == NULL || stack == NULL) {
+        || pb.stamp == NULL || pb.slots == NULL || pairs == NULL || stack == NULL || height == NULL) {
         rc = -1;
         goto done;
     }
     pb.cur = 0;
     for (int64_t k = n_nodes - 1; k >= CT_ROOT && !pb.oom; k--) {      /* children before parents */
         const CtNode *nd = &nodes[k];
+        pb.len[k] = -1;
         if (CT_IS_LEAF(nd)) {
             int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
             unsigned am = 63u;
-            int64_t np = 0;
-            for (int64_t i = start; i < start + count; i++) {
-                int32_t c0 = ct_id(ids, i, 0), c1 = ct_id(ids, i, 1), c2 = ct_id(ids, i, 2);
-                if (am != 0 && !(flags[i] >> 2)) {
-                    const double *p0 = V + 3 * (size_t)c0, *p1 = V + 3 * (size_t)c1, *p2 = V + 3 * (size_t)c2;
-                    unsigned fm = 0;
-                    CtStats st = {0, 0};
-                    for (int a = 0; a < 3; a++) {
-                        if (!((am >> (2 * a)) & 3u)) continue;
-                        int o = ct_orient2d_axis(p0, p1, p2, a, &st);
-                        fm |= o > 0 ? 1u << (2 * a) : o < 0 ? 2u << (2 * a) : 0u;
-                    }
-                    am &= st.failed ? 0u : fm;
-                }
-                else {
-                    am = 0;
-                }
-                pairs[2 * np] = c0; pairs[2 * np + 1] = c1; np++;
-                pairs[2 * np] = c1; pairs[2 * np + 1] = c2; np++;
-                pairs[2 * np] = c2; pairs[2 * np + 1] = c0; np++;
-            }
+            for (int64_t i = start; i < start + count; i++) am &= fmask[i];
             pb.amask[k] = (uint8_t)am;
-            ct_chain_store(&pb, k, pairs, np);
+            height[k] = 0;
+            pb.len[k] = am != 0 ? -3 : -1;     /* -3: computed when needed (ct_leaf_chain), not kept */
+            continue;
         }
-        else {
-            int64_t l = CT_LEFT(nd), r = CT_RIGHT(nd);
-            pb.amask[k] = pb.amask[l] & pb.amask[r];
-            if (pb.len[l] < 0 || pb.len[r] < 0) {
-                pb.len[k] = -1;
+        int64_t l = CT_LEFT(nd), r = CT_RIGHT(nd);
+        pb.amask[k] = pb.amask[l] & pb.amask[r];
+        height[k] = (uint8_t)((height[l] > height[r] ? height[l] : height[r]) + 1);
+        if (height[k] % CT_PATCH_STRIDE != 0 && k != CT_ROOT) {
+            pb.len[k] = -2;                                /* not a chain node: its parent looks below it */
+            continue;
+        }
+        if (pb.amask[k] == 0) continue;
+        /* the nearest chain nodes below k (len != -2) */
+        int64_t top = 0, np = 0;
+        int ok = 1;
+        stack[top++] = l;
+        stack[top++] = r;
+        while (top > 0 && ok) {
+            int64_t c = stack[--top];
+            if (pb.len[c] == -2) {
+                stack[top++] = CT_LEFT(&nodes[c]);
+                stack[top++] = CT_RIGHT(&nodes[c]);
                 continue;
             }
-            int64_t np = 0;
-            for (int s = 0; s < 2; s++) {
-                int64_t c = s ? r : l;
-                memcpy(pairs + 2 * np, pb.edges + 2 * pb.off[c], (size_t)pb.len[c] * 2 * sizeof(int32_t));
-                np += pb.len[c];
+            if (pb.len[c] == -3) {                         /* a leaf: its chain straight into the merge */
+                if (np + 3 * CT_LEAF > CT_PATCH_MERGE) {
+                    ok = 0;
+                    break;
+                }
+                int nl = ct_leaf_chain(ids + CT_IDBLOCK * CT_BLOCK_OF(&nodes[c]), ct_leaf_count(&nodes[c], m),
+                                       pairs + 2 * np);
+                if (nl < 0) ok = 0;
+                else np += nl;
+                continue;
             }
-            ct_chain_store(&pb, k, pairs, np);
+            if (pb.len[c] < 0 || np + pb.len[c] > CT_PATCH_MERGE) {
+                ok = 0;
+                break;
+            }
+            memcpy(pairs + 2 * np, pb.edges + 2 * pb.off[c], (size_t)pb.len[c] * 2 * sizeof(int32_t));
+            np += pb.len[c];
         }
+        if (ok) ct_chain_store(&pb, k, pairs, np);
     }
     if (pb.oom) {
         rc = -1;
@@ -5843,6 +5951,15 @@ ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8
         while (top > 0) {
             int64_t k = stack[--top];
             const CtNode *nd = &nodes[k];
+            if (pb.len[k] == -3) {                         /* a leaf: its chain now */
+                int nl = ct_leaf_chain(ids + CT_IDBLOCK * CT_BLOCK_OF(nd), ct_leaf_count(nd, m), pairs);
+                if (nl >= 3 && ct_patch_certify(&pb, V, pairs, nl, pb.amask[k])) patch[k] = 1;
+                if (pb.oom) {
+                    rc = -1;
+                    break;
+                }
+                continue;
+            }
             if (pb.len[k] >= 3 && pb.amask[k] != 0
                 && ct_patch_certify(&pb, V, pb.edges + 2 * pb.off[k], pb.len[k], pb.amask[k])) {
                 patch[k] = 1;
@@ -5869,6 +5986,7 @@ done:
     free(pb.slots);
     free(pairs);
     free(stack);
+    free(height);
     return rc;
 }
 
@@ -6245,6 +6363,7 @@ typedef struct {
     int32_t *order;
     int32_t *ids;
     uint8_t *flags;
+    uint8_t *fmask;             /* NULL, or per position the orientations of the face's projections (ct_patches) */
     long exact[MAX_THREADS];
     int failed[MAX_THREADS];
 } CtPrep;
@@ -6292,6 +6411,31 @@ ct_prep_task(void *ctx, int t, int nt)
         const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
         const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
         pr->flags[i] = (uint8_t)(pr->axis[f] | pr->skip[f] << 2);
+        if (pr->fmask != NULL) {
+            /* orient2d(p1, p2, p0) along each axis (the sign of orient2d(p0, p1, p2)): its filter shares the
+             * differences e1 = p1 - p0, e2 = p2 - p0 between the axes */
+            unsigned fm = 0;
+            double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+            double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+            for (int a = 0; a < 3 && !pr->skip[f]; a++) {
+                int kx = ct_plane[a][0], ky = ct_plane[a][1];
+                double left = e1[kx] * e2[ky], right = e1[ky] * e2[kx];
+                double det = left - right, perm = fabs(left) + fabs(right);
+                int o;
+                if (perm == 0.0) {
+                    o = 0;
+                }
+                else if (fabs(det) > CONTACT_O2 * perm) {
+                    o = det > 0 ? 1 : -1;
+                }
+                else {
+                    double a2[2] = {p1[kx], p1[ky]}, b2[2] = {p2[kx], p2[ky]}, c2[2] = {p0[kx], p0[ky]};
+                    o = ct_orient2d_exact(a2, b2, c2, &st);
+                }
+                fm |= o > 0 ? 1u << (2 * a) : o < 0 ? 2u << (2 * a) : 0u;
+            }
+            pr->fmask[i] = (uint8_t)fm;
+        }
         for (int k = 0; k < 3; k++) {
             pr->ids[CT_IDBLOCK * (i / CT_LEAF) + k * CT_LEAF + i % CT_LEAF]
                 = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
@@ -6334,6 +6478,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
     uint8_t *cert = NULL;
     uint8_t *stars = NULL;
     uint8_t *patch = NULL;
+    uint8_t *fmask = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
     for (; got < 2; got++) {
@@ -6421,6 +6566,10 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.order = order;
         pr.ids = ids;
         pr.flags = flags;
+        if (patches && max_pairs < 0) {
+            fmask = (uint8_t *)malloc(mm);         /* NULL (out of memory): no patches, the same pairs */
+            pr.fmask = fmask;
+        }
         /* the Morton grid: box centres of the faces, 2^16 cells per axis over their range */
         double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int64_t i = 0; i < n; i++) {       /* every vertex: a bound of the box centres */
@@ -6463,9 +6612,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
         clk[4] = ct_clock();
         if (!oom && !failed && m >= 2) {
             int64_t n_nodes = ct_build(nodes, box, ids, cert, m);
-            if (patches && max_pairs < 0) {        /* with a work bound every pair is counted, as on numpy */
+            if (fmask != NULL) {                    /* with a work bound every pair is counted, as on numpy */
                 patch = (uint8_t *)malloc((size_t)n_nodes);
-                if (patch == NULL || ct_patches(nodes, n_nodes, ids, flags, V, m, patch) < 0) {
+                if (patch == NULL || ct_patches(nodes, n_nodes, ids, fmask, V, m, patch) < 0) {
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
@@ -6585,6 +6734,7 @@ done:
     free(cert);
     free(stars);
     free(patch);
+    free(fmask);
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);
