@@ -4190,7 +4190,10 @@ done:
  * also the star of every vertex of at least CT_STAR_MIN (3) faces is tried: a pair within a small certified
  * star (fewer than star_faces faces) is still enumerated and counted as a candidate and as tested, as the numpy
  * path counts it, but decided "none" by the certificate instead of rebuilding and testing both faces (on a
- * clean mesh that is nearly every candidate pair: the faces sharing a corner).
+ * clean mesh that is nearly every candidate pair: the faces sharing a corner).  With patches (and no work
+ * bound) a node whose faces form a certified patch (ct_patches; mesh/intersect.py, "Patches") is not descended
+ * with itself: on a smooth surface that leaves out nearly every pair of faces sharing a corner, and the
+ * counts fall below the numpy path's.
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
@@ -5493,14 +5496,16 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
  * Certified patches (mesh/intersect.py, "Patches").  A node of the hierarchy whose faces K satisfy
  *   (a) along some coordinate axis every face projects to a triangle of one strict orientation s (exact
  *       orient2d of its corners in winding order), and
- *   (b) the boundary chain of K (its directed edges, u -> v cancelling v -> u) is one cycle through distinct
- *       vertices whose projection along that axis is a simple polygon (exact orient2d),
+ *   (b) the boundary chain of K (its directed edges, u -> v cancelling v -> u) is a union of cycles through
+ *       distinct vertices whose projections along that axis are simple, pairwise disjoint polygons none inside
+ *       another (exact orient2d),
  * has no two faces meeting beyond what they share by index, so the descent of the node with itself is left
  * out.  Proof (the degree argument behind the normal-cone and contour test of self-collision culling): at a
  * point y of the plane off every projected edge, the number of faces whose projection holds y, times s, is the
  * winding number of the projected boundary chain round y (the faces' boundaries sum to the chain), which for
- * a simple closed polygon is 0 or +-1: the projected faces have disjoint interiors.  Then every point of K
- * off the chain has a neighbourhood that projects one to one (the faces round it cover a disk once), so two
+ * disjoint simple polygons none inside another is 0 or +-1: the projected faces have disjoint interiors.
+ * Then every point of K off the chain has a neighbourhood that projects one to one (the faces round it cover
+ * a disk once), so two
  * distinct points of K with one projection both lie on the chain, whose projection is one to one: the
  * projection is one to one on K, and a point common to two faces is one point of K, i.e. in what they share
  * by index.  Nodes whose boundary grows past CT_PATCH_EDGES, or whose chain holds an edge twice, are not tried

@@ -84,6 +84,34 @@ A fan that folds over itself, winds twice or overlaps after less than a turn fai
 pair as before; faces outside the star are always tested against it.  ``surface_contacts(...,
 _star_faces=0)`` runs the unpruned scan (for the tests).
 
+Patches
+-------
+The C scan (below) also leaves out, without testing, the pairs within a *certified patch*: a node of its
+hierarchy whose faces ``K`` (1) all project along one coordinate axis to triangles of one strict orientation
+``s`` (exact ``orient2d`` of the corners in winding order: the normals lie in the open half-space of that
+axis, the normal-cone condition of self-collision culling, Volino and Magnenat-Thalmann, "Efficient
+self-collision detection on smoothly discretized surface animations using geometrical shape regularity",
+Computer Graphics Forum 13(3), 1994), and (2) whose boundary chain (the directed edges of its faces, ``u → v``
+cancelling ``v → u``) is a union of cycles through distinct vertices whose projections along that axis are
+simple, pairwise disjoint polygons none inside another (their contour test; every segment pair and inclusion
+decided by exact ``orient2d``).
+
+Proof that two faces of a certified patch meet only in what they share by index.  For a point ``y`` of the
+plane on no projected edge, the number of faces whose projection holds ``y``, times ``s``, is the winding
+number round ``y`` of the projected boundary chain (the faces' boundaries add up to the chain), and the
+winding numbers of disjoint simple polygons none inside another add up to 0 or ±1: the projected faces have
+pairwise disjoint interiors.  At a point of ``K`` off the chain the faces round it then cover a neighbourhood
+of its projection exactly once (their wedges, all of one orientation, close up into whole turns), so the
+projection is one to one near it; two distinct points of ``K`` with one projection therefore both lie on the
+chain, on which the projection is one to one.  So the projection is one to one on ``K`` and a point common
+to two faces is one point of ``K``, i.e. on what they share by index.  A fold, a fan winding twice, two
+layers of a spiral ramp, coplanar sheets or a patch whose boundary winds twice fail (1) or (2) and are
+descended as before; failing to certify only costs time.
+
+The patches change which pairs are enumerated, not which are found: ``candidate_pairs`` and ``tested_pairs``
+of the C scan are then below the numpy twin's (``surface_contacts(..., _patches=False)`` gives the twin's
+counts, for the tests).  Under a work bound (``max_pairs``) there are no patches, so both twins count alike.
+
 C extension
 -----------
 When ``inertia_tool._accel`` is built (and the coordinates are in the filter's range) the whole scan runs in
@@ -165,7 +193,8 @@ class SurfaceContacts:
         found so far are reported, but the absence of a crossing is then not proven).
     candidate_pairs : int
         Face pairs whose bounding boxes meet, but those within one certified star (module docstring, "Stars":
-        they provably meet only in what they share); the broad phase's output, all of them when ``complete``.
+        they provably meet only in what they share) and, on the C scan without a work bound, those within one
+        certified patch (module docstring, "Patches"); the broad phase's output, all of them when ``complete``.
     tested_pairs : int
         Candidate pairs tested exactly (both faces of nonzero area).
     exact_evaluations : int
