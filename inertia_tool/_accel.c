@@ -5249,6 +5249,11 @@ ct_star_task(void *ctx, int t, int nt)
         int64_t w = v + 1;
         while (w < jb->n && jb->off[w] < 0) w++;
         int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total;
+        if (e - s < jb->min_faces) {                       /* listed for the twins only */
+            jb->cert[v] = 0;
+            v = w;
+            continue;
+        }
         int32_t link_local[2 * CT_STAR_SMALL];
         int32_t *link = e - s <= CT_STAR_SMALL ? link_local : (int32_t *)malloc((size_t)(2 * (e - s)) * sizeof(int32_t));
         int r = -1;
@@ -5274,11 +5279,15 @@ ct_stars_scratch(int64_t n, int64_t m)
 }
 
 /* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
- * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory.
+ * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices), and, when twin is not NULL, the
+ * faces across every edge (ct_twins, 3 m int32); 0 or -1 when out of memory.
  * scratch: ct_stars_scratch(n, m) bytes, any content (the memory of the preparation's sort, reused). */
+static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces,
+                    int64_t total, int32_t *twin, int threads);
+
 static int
 ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
-         uint8_t *cert, int threads, void *scratch)
+         uint8_t *cert, int threads, void *scratch, int32_t *twin)
 {
     memset(cert, 0, (size_t)n);
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
@@ -5287,8 +5296,9 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
     memset(off, 0, off_bytes);
     for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
     int64_t total = 0;
+    int64_t list_min = twin != NULL ? 1 : min_faces;      /* the twins need every vertex's faces */
     for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
-        if (off[v] >= min_faces) {
+        if (off[v] >= list_min) {
             total += off[v];
             off[v] = total;
         }
@@ -5319,6 +5329,9 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
     int rc = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
         if (jb.oom[t]) rc = -1;
+    }
+    if (rc == 0 && twin != NULL) {                         /* the faces across each edge, from the same lists */
+        rc = ct_twins(F, fsize, n, m, off, faces, total, twin, threads);
     }
     return rc;
 }
@@ -5508,26 +5521,24 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
  * a disk once), so two
  * distinct points of K with one projection both lie on the chain, whose projection is one to one: the
  * projection is one to one on K, and a point common to two faces is one point of K, i.e. in what they share
- * by index.  Nodes whose boundary grows past CT_PATCH_EDGES, or whose chain holds an edge twice, are not tried
- * (nor their ancestors); the simple-polygon sweep stops after a bounded number of segment tests (not
+ * by index.  A node's chain is read off its faces' neighbours across their edges (ct_twins: with the faces in
+ * hierarchy order a node is a range of positions, and an edge is on its boundary when the face across it lies
+ * outside the range, or there is none); a face with an edge in three faces or more, run twice one way, or at a
+ * vertex of fewer than CT_STAR_MIN faces is in no patch.  Nodes whose chain is longer than CT_PATCH_EDGES are
+ * not tried (their children are); the simple-polygon sweep stops after a bounded number of segment tests (not
  * certified).  Failing to certify only costs time.
  * ------------------------------------------------------------------------------------------------------ */
 
 #define CT_PATCH_EDGES 2048
 
 typedef struct {
-    int32_t *edges;             /* boundary chains of the nodes, directed edges (tail, head) */
-    int64_t n, cap;             /* int32 pairs used / allocated */
-    int64_t *off;               /* per node: first pair of its chain */
-    int32_t *len;               /* per node: pairs in its chain; -1 not kept (too long, or an edge twice) */
     uint8_t *amask;             /* per node: bit 2 a + (s < 0) when every face has orientation s along axis a */
-    /* scratch: an open-addressing table of edges (key (lo, hi) vertex ids, net count) stamped per use */
+    /* scratch: an open-addressing table of vertex ids stamped per use (ct_patch_certify) */
     uint64_t *key;
     int32_t *net;
     uint32_t *stamp;
-    int32_t *slots;             /* the slots used, in order of first use */
     uint32_t cur;
-    int64_t tsize;              /* power of two, at least 4 CT_PATCH_MERGE */
+    int64_t tsize;              /* power of two, at least 4 CT_PATCH_EDGES */
     int oom;
 } CtPatchBuild;
 
@@ -5540,77 +5551,95 @@ ct_edge_hash(uint64_t k)
     return k;
 }
 
-/* Adds the directed edge u -> v to the table (its first mask + 1 slots, at most a quarter full): net +1 for
- * u < v, -1 for u > v, on the key (min, max). */
-static inline void
-ct_edge_add(CtPatchBuild *pb, int32_t u, int32_t v, int64_t mask, int64_t *used)
+/* Twins: for each face f and corner c, the face across its edge from corner c to corner c + 1 (the one face
+ * running that edge the other way), -1 when no face does, -2 when it is not one (an edge in three faces or
+ * more, run twice one way, a corner held twice, or a vertex whose faces were not listed).  From the faces of
+ * each vertex v (ct_stars' lists: off[v] the start of v's range, -1 when v was not kept, ranges in vertex
+ * order ending at total): the face across v -> x of f is the face of v's list whose corner before v is x.
+ * twin: 3 m int32, all -2 on entry. */
+typedef struct {
+    const void *F;
+    int fsize;
+    const int64_t *off;
+    const int32_t *faces;
+    int64_t n, total;
+    int32_t *twin;
+    int oom[MAX_THREADS];
+} CtTwinJob;
+
+typedef struct {
+    int32_t prev, next, face, corner;
+} CtLink;
+
+static int
+ct_link_prev_cmp(const void *x, const void *y)
 {
-    int32_t lo = u < v ? u : v, hi = u < v ? v : u;
-    uint64_t k = (uint64_t)(uint32_t)lo << 32 | (uint32_t)hi;
-    int64_t s = (int64_t)(ct_edge_hash(k) & (uint64_t)mask);
-    for (int64_t probe = 0; probe <= mask; probe++) {
-        if (pb->stamp[s] != pb->cur) {
-            pb->stamp[s] = pb->cur;
-            pb->key[s] = k;
-            pb->net[s] = u < v ? 1 : -1;
-            pb->slots[(*used)++] = (int32_t)s;
-            return;
-        }
-        if (pb->key[s] == k) {
-            pb->net[s] += u < v ? 1 : -1;
-            return;
-        }
-        s = (s + 1) & mask;
-    }
+    const CtLink *a = (const CtLink *)x, *b = (const CtLink *)y;
+    return (a->prev > b->prev) - (a->prev < b->prev);
 }
 
-/* The chain of node k from its directed edges pairs[0 .. count - 1] (count <= CT_PATCH_MERGE + 3 CT_LEAF):
- * appended to the pool, off[k] / len[k] set (len -1 when an edge is left twice or more, or too many). */
 static void
-ct_chain_store(CtPatchBuild *pb, int64_t k, const int32_t *pairs, int64_t count)
+ct_twin_task(void *ctx, int t, int nt)
 {
-    pb->cur++;
-    if (pb->cur == 0) {                                    /* the stamps wrapped: clear them */
-        memset(pb->stamp, 0, (size_t)pb->tsize * sizeof(uint32_t));
-        pb->cur = 1;
-    }
-    int64_t used = 0, mask = 15;
-    while (mask + 1 < 4 * count && mask + 1 < pb->tsize) mask = 2 * mask + 1;
-    for (int64_t e = 0; e < count; e++) ct_edge_add(pb, pairs[2 * e], pairs[2 * e + 1], mask, &used);
-    int64_t left = 0;
-    for (int64_t i = 0; i < used; i++) {
-        int32_t nt = pb->net[pb->slots[i]];
-        if (nt > 1 || nt < -1) {
-            pb->len[k] = -1;
+    CtTwinJob *jb = (CtTwinJob *)ctx;
+    int64_t v0 = (int64_t)part_start((size_t)jb->n, t, nt), v1 = (int64_t)part_start((size_t)jb->n, t + 1, nt);
+    CtLink local[64];
+    int64_t v = v0;
+    while (v < v1 && jb->off[v] < 0) v++;
+    while (v < v1) {
+        int64_t w = v + 1;
+        while (w < jb->n && jb->off[w] < 0) w++;
+        int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total, k = e - s;
+        CtLink *lk = k <= 64 ? local : (CtLink *)malloc((size_t)k * sizeof(CtLink));
+        if (lk == NULL) {
+            jb->oom[t] = 1;
             return;
         }
-        left += nt != 0;
-    }
-    if (left > CT_PATCH_EDGES) {
-        pb->len[k] = -1;
-        return;
-    }
-    if (pb->n + left > pb->cap) {
-        int64_t cap = pb->cap ? 2 * pb->cap : 4096;
-        while (cap < pb->n + left) cap *= 2;
-        int32_t *ne = (int32_t *)realloc(pb->edges, (size_t)cap * 2 * sizeof(int32_t));
-        if (ne == NULL) {
-            pb->oom = 1;
-            pb->len[k] = -1;
-            return;
+        int ok = 1;
+        for (int64_t i = 0; i < k; i++) {
+            int32_t f = jb->faces[s + i];
+            int64_t x[3];
+            for (int c = 0; c < 3; c++) x[c] = index_at(jb->F, jb->fsize, 3 * (size_t)f + (size_t)c);
+            int c = x[0] == v ? 0 : x[1] == v ? 1 : 2;
+            if ((x[0] == v) + (x[1] == v) + (x[2] == v) != 1) ok = 0;      /* v twice in f: no twins here */
+            lk[i].next = (int32_t)x[(c + 1) % 3];
+            lk[i].prev = (int32_t)x[(c + 2) % 3];
+            lk[i].face = f;
+            lk[i].corner = c;
         }
-        pb->edges = ne;
-        pb->cap = cap;
-    }
-    pb->off[k] = pb->n;
-    pb->len[k] = (int32_t)left;
-    for (int64_t i = 0; i < used; i++) {
-        int32_t s = pb->slots[i], nt = pb->net[s];
-        if (nt == 0) continue;
-        int32_t lo = (int32_t)(pb->key[s] >> 32), hi = (int32_t)(pb->key[s] & 0xffffffffu);
-        pb->edges[2 * pb->n] = nt > 0 ? lo : hi;
-        pb->edges[2 * pb->n + 1] = nt > 0 ? hi : lo;
-        pb->n++;
+        if (ok && k <= 64) {
+            for (int64_t i = 0; i < k; i++) {
+                int32_t back = -1, twin = -1, same = 0;
+                for (int64_t j = 0; j < k; j++) {
+                    if (j == i) continue;
+                    if (lk[j].prev == lk[i].next) {
+                        back++;
+                        twin = lk[j].face;
+                    }
+                    same += lk[j].next == lk[i].next;
+                }
+                jb->twin[3 * (size_t)lk[i].face + (size_t)lk[i].corner] = back < 0 && !same ? -1
+                                                                           : back == 0 && !same ? twin : -2;
+            }
+        }
+        else if (ok) {                             /* a large fan: match by the sorted corners before v */
+            qsort(lk, (size_t)k, sizeof(CtLink), ct_link_prev_cmp);
+            for (int64_t i = 0; i < k; i++) {
+                int64_t lo = 0, hi = k;            /* first entry whose prev is >= lk[i].next */
+                while (lo < hi) {
+                    int64_t mid = (lo + hi) / 2;
+                    if (lk[mid].prev < lk[i].next) lo = mid + 1;
+                    else hi = mid;
+                }
+                int64_t run = 0;
+                while (lo + run < k && lk[lo + run].prev == lk[i].next) run++;
+                /* "run twice one way": another face with the same next; counted through its own prev run */
+                int32_t tw = run == 1 && lk[lo].face != lk[i].face ? lk[lo].face : run == 0 ? -1 : -2;
+                jb->twin[3 * (size_t)lk[i].face + (size_t)lk[i].corner] = tw;
+            }
+        }
+        if (lk != local) free(lk);
+        v = w;
     }
 }
 
@@ -5809,146 +5838,71 @@ done:
     return ok;
 }
 
-/* Bit j set when lane j of one row of a block of corner indices (CT_LEAF int32) is x. */
-static inline unsigned
-ct_row_mask(const int32_t *row, int32_t x)
+/* ct_twin_task over the vertices on threads; 0, or -1 when out of memory. */
+static int
+ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces, int64_t total,
+         int32_t *twin, int threads)
 {
-#if defined(__SSE2__) && CT_LEAF % 4 == 0
-    __m128i k = _mm_set1_epi32(x);
-    unsigned mask = 0;
-    for (int q = 0; q < CT_LEAF / 4; q++) {
-        __m128i e = _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(row + 4 * q)), k);
-        mask |= (unsigned)_mm_movemask_ps(_mm_castsi128_ps(e)) << (4 * q);
+    for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
+    CtTwinJob jb;
+    memset(&jb, 0, sizeof(jb));
+    jb.F = F;
+    jb.fsize = fsize;
+    jb.off = off;
+    jb.faces = faces;
+    jb.n = n;
+    jb.total = total;
+    jb.twin = twin;
+    run_parallel(thread_count(threads, (size_t)n, 20000), ct_twin_task, &jb);
+    for (int t = 0; t < MAX_THREADS; t++) {
+        if (jb.oom[t]) return -1;
     }
-    return mask;
-#else
-    unsigned mask = 0;
-    for (int j = 0; j < CT_LEAF; j++) mask |= (unsigned)(row[j] == x) << j;
-    return mask;
-#endif
+    return 0;
 }
 
-/* The boundary chain of the faces of one block (corner indices blk, CT_IDBLOCK int32; the first count lanes
- * are faces, each with three distinct corners) into pairs: its directed edges u -> v that no other face of the
- * block runs v -> u.  Their number, or -1 when an edge is run twice one way or thrice in all (not a chain of
- * single edges: the node is not tried).  Faces are matched by corner masks (ct_row_mask), no table. */
+/* patch[k] <- 1 for the highest nodes certified as above (their descendants are not tried).  fmask: per
+ * hierarchy position, bit 2 a + (s < 0) when the face's projection along axis a has strict orientation s (0
+ * for a face in no patch); across: per position and corner, the position of the face across the edge from
+ * that corner to the next, or -1 (none).  0, or -1 when out of memory. */
 static int
-ct_leaf_chain(const int32_t *blk, int count, int32_t *pairs)
-{
-    unsigned live = ct_leaf_bits(count);
-    int np = 0;
-    for (int a = 0; a < count; a++) {
-        int32_t x[3] = {blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a]};
-        unsigned e[3][3];                                  /* e[c][k]: lanes whose corner k is x[c] */
-        for (int c = 0; c < 3; c++) {
-            for (int k = 0; k < 3; k++) e[c][k] = ct_row_mask(blk + k * CT_LEAF, x[c]) & live;
-        }
-        for (int c = 0; c < 3; c++) {
-            int d = (c + 1) % 3;
-            unsigned same = (e[c][0] & e[d][1]) | (e[c][1] & e[d][2]) | (e[c][2] & e[d][0]);
-            unsigned back = (e[d][0] & e[c][1]) | (e[d][1] & e[c][2]) | (e[d][2] & e[c][0]);
-            if (same != 1u << a || (back & (back - 1)) != 0) return -1;
-            if (back == 0) {
-                pairs[2 * np] = x[c];
-                pairs[2 * np + 1] = x[d];
-                np++;
-            }
-        }
-    }
-    return np;
-}
-
-/* Chains are kept for the leaves and for the inner nodes CT_PATCH_STRIDE levels apart above them (a node
- * merges the chains of the nearest such nodes below it, at most 2^CT_PATCH_STRIDE), and only for nodes whose
- * faces share an axis and orientation (amask != 0; their ancestors' amask is then a subset).  Only those nodes
- * are tried as patches. */
-#define CT_PATCH_STRIDE 2
-#define CT_PATCH_MERGE (4 * CT_PATCH_EDGES)     /* edges merged at once, at most */
-
-/* patch[k] <- 1 for the nodes certified as above (the highest ones; their descendants are not tried); fmask:
- * per hierarchy position, bit 2 a + (s < 0) when the face's projection along axis a has strict orientation s.
- * 0, or -1 when out of memory. */
-static int
-ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *fmask, const double *V,
-           int64_t m, uint8_t *patch)
+ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *fmask, const int32_t *across,
+           const double *V, int64_t m, uint8_t *patch)
 {
     CtPatchBuild pb;
     memset(&pb, 0, sizeof(pb));
     memset(patch, 0, (size_t)n_nodes);
     pb.tsize = 1;
-    while (pb.tsize < 4 * CT_PATCH_MERGE) pb.tsize *= 2;
-    pb.off = (int64_t *)malloc((size_t)n_nodes * sizeof(int64_t));
-    pb.len = (int32_t *)malloc((size_t)n_nodes * sizeof(int32_t));
+    while (pb.tsize < 4 * CT_PATCH_EDGES) pb.tsize *= 2;
     pb.amask = (uint8_t *)malloc((size_t)n_nodes);
     pb.key = (uint64_t *)malloc((size_t)pb.tsize * sizeof(uint64_t));
     pb.net = (int32_t *)malloc((size_t)pb.tsize * sizeof(int32_t));
     pb.stamp = (uint32_t *)calloc((size_t)pb.tsize, sizeof(uint32_t));
-    pb.slots = (int32_t *)malloc((size_t)pb.tsize * sizeof(int32_t));
-    int32_t *pairs = (int32_t *)malloc((size_t)(CT_PATCH_MERGE + 3 * CT_LEAF) * 2 * sizeof(int32_t));
+    int32_t *pairs = (int32_t *)malloc((size_t)(CT_PATCH_EDGES + 1) * 2 * sizeof(int32_t));
     int64_t *stack = (int64_t *)malloc((size_t)(n_nodes + 1) * sizeof(int64_t));
-    uint8_t *height = (uint8_t *)malloc((size_t)n_nodes);
+    int64_t *first = (int64_t *)malloc((size_t)n_nodes * sizeof(int64_t));     /* positions of each node */
+    int64_t *last = (int64_t *)malloc((size_t)n_nodes * sizeof(int64_t));
     int rc = 0;
-    if (pb.off == NULL || pb.len == NULL || pb.amask == NULL || pb.key == NULL || pb.net == NULL
-        || pb.stamp == NULL || pb.slots == NULL || pairs == NULL || stack == NULL || height == NULL) {
+    if (pb.amask == NULL || pb.key == NULL || pb.net == NULL || pb.stamp == NULL || pairs == NULL || stack == NULL
+        || first == NULL || last == NULL) {
         rc = -1;
         goto done;
     }
     pb.cur = 0;
-    for (int64_t k = n_nodes - 1; k >= CT_ROOT && !pb.oom; k--) {      /* children before parents */
+    for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {    /* children before parents */
         const CtNode *nd = &nodes[k];
-        pb.len[k] = -1;
         if (CT_IS_LEAF(nd)) {
             int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
             unsigned am = 63u;
             for (int64_t i = start; i < start + count; i++) am &= fmask[i];
             pb.amask[k] = (uint8_t)am;
-            height[k] = 0;
-            pb.len[k] = am != 0 ? -3 : -1;     /* -3: computed when needed (ct_leaf_chain), not kept */
-            continue;
+            first[k] = start;
+            last[k] = start + count;
         }
-        int64_t l = CT_LEFT(nd), r = CT_RIGHT(nd);
-        pb.amask[k] = pb.amask[l] & pb.amask[r];
-        height[k] = (uint8_t)((height[l] > height[r] ? height[l] : height[r]) + 1);
-        if (height[k] % CT_PATCH_STRIDE != 0 && k != CT_ROOT) {
-            pb.len[k] = -2;                                /* not a chain node: its parent looks below it */
-            continue;
+        else {
+            pb.amask[k] = pb.amask[CT_LEFT(nd)] & pb.amask[CT_RIGHT(nd)];
+            first[k] = first[CT_LEFT(nd)];
+            last[k] = last[CT_RIGHT(nd)];
         }
-        if (pb.amask[k] == 0) continue;
-        /* the nearest chain nodes below k (len != -2) */
-        int64_t top = 0, np = 0;
-        int ok = 1;
-        stack[top++] = l;
-        stack[top++] = r;
-        while (top > 0 && ok) {
-            int64_t c = stack[--top];
-            if (pb.len[c] == -2) {
-                stack[top++] = CT_LEFT(&nodes[c]);
-                stack[top++] = CT_RIGHT(&nodes[c]);
-                continue;
-            }
-            if (pb.len[c] == -3) {                         /* a leaf: its chain straight into the merge */
-                if (np + 3 * CT_LEAF > CT_PATCH_MERGE) {
-                    ok = 0;
-                    break;
-                }
-                int nl = ct_leaf_chain(ids + CT_IDBLOCK * CT_BLOCK_OF(&nodes[c]), ct_leaf_count(&nodes[c], m),
-                                       pairs + 2 * np);
-                if (nl < 0) ok = 0;
-                else np += nl;
-                continue;
-            }
-            if (pb.len[c] < 0 || np + pb.len[c] > CT_PATCH_MERGE) {
-                ok = 0;
-                break;
-            }
-            memcpy(pairs + 2 * np, pb.edges + 2 * pb.off[c], (size_t)pb.len[c] * 2 * sizeof(int32_t));
-            np += pb.len[c];
-        }
-        if (ok) ct_chain_store(&pb, k, pairs, np);
-    }
-    if (pb.oom) {
-        rc = -1;
-        goto done;
     }
     {
         int64_t top = 0;                                   /* top down: the highest certified nodes */
@@ -5956,23 +5910,30 @@ ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8
         while (top > 0) {
             int64_t k = stack[--top];
             const CtNode *nd = &nodes[k];
-            if (pb.len[k] == -3) {                         /* a leaf: its chain now */
-                int nl = ct_leaf_chain(ids + CT_IDBLOCK * CT_BLOCK_OF(nd), ct_leaf_count(nd, m), pairs);
-                if (nl >= 3 && ct_patch_certify(&pb, V, pairs, nl, pb.amask[k])) patch[k] = 1;
+            if (pb.amask[k] != 0) {
+                /* the chain: the edges whose face across lies outside the node's positions, or is none */
+                int64_t s = first[k], e = last[k], B = 0;
+                for (int64_t i = s; i < e && B <= CT_PATCH_EDGES; i++) {
+                    for (int c = 0; c < 3; c++) {
+                        int32_t t = across[3 * (size_t)i + (size_t)c];
+                        if (t >= s && t < e) continue;
+                        if (B == CT_PATCH_EDGES) {
+                            B++;
+                            break;
+                        }
+                        pairs[2 * B] = ct_id(ids, i, c);
+                        pairs[2 * B + 1] = ct_id(ids, i, (c + 1) % 3);
+                        B++;
+                    }
+                }
+                if (B <= CT_PATCH_EDGES && ct_patch_certify(&pb, V, pairs, B, pb.amask[k])) {
+                    patch[k] = 1;
+                    continue;
+                }
                 if (pb.oom) {
                     rc = -1;
                     break;
                 }
-                continue;
-            }
-            if (pb.len[k] >= 3 && pb.amask[k] != 0
-                && ct_patch_certify(&pb, V, pb.edges + 2 * pb.off[k], pb.len[k], pb.amask[k])) {
-                patch[k] = 1;
-                continue;
-            }
-            if (pb.oom) {
-                rc = -1;
-                break;
             }
             if (!CT_IS_LEAF(nd)) {
                 stack[top++] = CT_LEFT(nd);
@@ -5981,17 +5942,14 @@ ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8
         }
     }
 done:
-    free(pb.edges);
-    free(pb.off);
-    free(pb.len);
     free(pb.amask);
     free(pb.key);
     free(pb.net);
     free(pb.stamp);
-    free(pb.slots);
     free(pairs);
     free(stack);
-    free(height);
+    free(first);
+    free(last);
     return rc;
 }
 
@@ -6484,6 +6442,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
     uint8_t *stars = NULL;
     uint8_t *patch = NULL;
     uint8_t *fmask = NULL;
+    int32_t *twin = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
     for (; got < 2; got++) {
@@ -6609,17 +6568,35 @@ accel_contact_scan(PyObject *self, PyObject *args)
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
             stars = (uint8_t *)malloc(mm);
+            if (fmask != NULL) {
+                twin = (int32_t *)malloc(3 * mm * sizeof(int32_t));    /* NULL: no patches, the same pairs */
+            }
             if (cert == NULL || stars == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
-                                         star_faces, cert, nt, code) < 0) {
+                                         star_faces, cert, nt, code, twin) < 0) {
                 oom = 1;
             }
         }
         clk[4] = ct_clock();
         if (!oom && !failed && m >= 2) {
             int64_t n_nodes = ct_build(nodes, box, ids, cert, m);
-            if (fmask != NULL) {                    /* with a work bound every pair is counted, as on numpy */
+            int32_t *across = (int32_t *)code;     /* the stars' lists are done with: 12 of its >= 16 bytes a face */
+            int32_t *pos = twin != NULL ? (int32_t *)malloc(mm * sizeof(int32_t)) : NULL;
+            if (pos != NULL) {                      /* the faces across, by hierarchy position */
+                for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
+                for (int64_t i = 0; i < m; i++) {
+                    const int32_t *tw = twin + 3 * (size_t)order[i];
+                    for (int c = 0; c < 3; c++) {
+                        across[3 * i + c] = tw[c] >= 0 ? pos[tw[c]] : -1;
+                        if (tw[c] == -2) fmask[i] = 0;     /* not one face across: in no patch */
+                    }
+                }
+            }
+            free(twin);
+            twin = NULL;
+            if (pos != NULL) {                      /* with a work bound every pair is counted, as on numpy */
+                free(pos);
                 patch = (uint8_t *)malloc((size_t)n_nodes);
-                if (patch == NULL || ct_patches(nodes, n_nodes, ids, fmask, V, m, patch) < 0) {
+                if (patch == NULL || ct_patches(nodes, n_nodes, ids, fmask, across, V, m, patch) < 0) {
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
@@ -6740,6 +6717,7 @@ done:
     free(stars);
     free(patch);
     free(fmask);
+    free(twin);
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);
