@@ -21,12 +21,15 @@ at least ``size`` faces (4,332 · 4^k: 1.1M for 1e6; flat faces, fan caps, slive
 instead a closed cylinder of about ``size`` triangles (``size/4`` sections) with
 fan-triangulated caps around a centre vertex, as CAD exports them: every cap face shares the centre, so the
 unpruned scan has about ``size²/16`` candidate pairs; ``--unpruned`` runs the check without the certified-star
-pruning (``_star_faces=0``, module docstring of ``mesh/intersect.py``, "Stars"), the scan as it was before.
+pruning (``_star_faces=0``, module docstring of ``mesh/intersect.py``, "Stars"), the scan as it was before;
+``--unpatched`` runs the C scan without its certified patches (``_patches=False``, "Patches"), as it was before
+them (the same pairs found; the counts of the numpy twin).
 
 The builders are in ``benchmarks/_shapes.py``.  ``INERTIA_TOOL_CT_PROFILE=1`` makes the C scan print the CPU
 time of its stages (Morton codes, sort, preparation, stars, hierarchy, traversal) to stderr.
 
     python benchmarks/bench_intersect.py [--sizes 1e4 1e5 1e6] [--repeat 5] [--shape cylinder|wheel] [--unpruned]
+        [--unpatched]
 """
 
 from __future__ import annotations
@@ -61,6 +64,7 @@ def main(argv=None) -> None:
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--shape", choices=sorted(SHAPES), default="torus")
     parser.add_argument("--unpruned", action="store_true", help="no certified-star pruning (the scan before it)")
+    parser.add_argument("--unpatched", action="store_true", help="no certified patches (the C scan before them)")
     args = parser.parse_args(argv)
     import functools
 
@@ -70,6 +74,8 @@ def main(argv=None) -> None:
 
     if args.unpruned:
         surface_contacts = functools.partial(surface_contacts, _star_faces=0)
+    if args.unpatched:
+        surface_contacts = functools.partial(surface_contacts, _patches=False)
 
     inside = [0.0, 0.0]                                  # CPU and wall time spent in the check by the analysis
 

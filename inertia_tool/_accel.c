@@ -4190,7 +4190,10 @@ done:
  * also the star of every vertex of at least CT_STAR_MIN (3) faces is tried: a pair within a small certified
  * star (fewer than star_faces faces) is still enumerated and counted as a candidate and as tested, as the numpy
  * path counts it, but decided "none" by the certificate instead of rebuilding and testing both faces (on a
- * clean mesh that is nearly every candidate pair: the faces sharing a corner).
+ * clean mesh that is nearly every candidate pair: the faces sharing a corner).  With patches (and no work
+ * bound) a node whose faces form a certified patch (ct_patches; mesh/intersect.py, "Patches") is not descended
+ * with itself: on a smooth surface that leaves out nearly every pair of faces sharing a corner, and the
+ * counts fall below the numpy path's.
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
@@ -5246,6 +5249,11 @@ ct_star_task(void *ctx, int t, int nt)
         int64_t w = v + 1;
         while (w < jb->n && jb->off[w] < 0) w++;
         int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total;
+        if (e - s < jb->min_faces) {                       /* listed for the twins only */
+            jb->cert[v] = 0;
+            v = w;
+            continue;
+        }
         int32_t link_local[2 * CT_STAR_SMALL];
         int32_t *link = e - s <= CT_STAR_SMALL ? link_local : (int32_t *)malloc((size_t)(2 * (e - s)) * sizeof(int32_t));
         int r = -1;
@@ -5271,11 +5279,15 @@ ct_stars_scratch(int64_t n, int64_t m)
 }
 
 /* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
- * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices); 0 or -1 when out of memory.
+ * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices), and, when twin is not NULL, the
+ * faces across every edge (ct_twins, 3 m int32); 0 or -1 when out of memory.
  * scratch: ct_stars_scratch(n, m) bytes, any content (the memory of the preparation's sort, reused). */
+static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces,
+                    int64_t total, int32_t *twin, int threads);
+
 static int
 ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
-         uint8_t *cert, int threads, void *scratch)
+         uint8_t *cert, int threads, void *scratch, int32_t *twin)
 {
     memset(cert, 0, (size_t)n);
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
@@ -5284,8 +5296,9 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
     memset(off, 0, off_bytes);
     for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
     int64_t total = 0;
+    int64_t list_min = twin != NULL ? 1 : min_faces;      /* the twins need every vertex's faces */
     for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
-        if (off[v] >= min_faces) {
+        if (off[v] >= list_min) {
             total += off[v];
             off[v] = total;
         }
@@ -5316,6 +5329,9 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
     int rc = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
         if (jb.oom[t]) rc = -1;
+    }
+    if (rc == 0 && twin != NULL) {                         /* the faces across each edge, from the same lists */
+        rc = ct_twins(F, fsize, n, m, off, faces, total, twin, threads);
     }
     return rc;
 }
@@ -5489,6 +5505,454 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
     return n_nodes;
 }
 
+/* ------------------------------------------------------------------------------------------------------
+ * Certified patches (mesh/intersect.py, "Patches").  A node of the hierarchy whose faces K satisfy
+ *   (a) along some coordinate axis every face projects to a triangle of one strict orientation s (exact
+ *       orient2d of its corners in winding order), and
+ *   (b) the boundary chain of K (its directed edges, u -> v cancelling v -> u) is a union of cycles through
+ *       distinct vertices whose projections along that axis are simple, pairwise disjoint polygons none inside
+ *       another (exact orient2d),
+ * has no two faces meeting beyond what they share by index, so the descent of the node with itself is left
+ * out.  Proof (the degree argument behind the normal-cone and contour test of self-collision culling): at a
+ * point y of the plane off every projected edge, the number of faces whose projection holds y, times s, is the
+ * winding number of the projected boundary chain round y (the faces' boundaries sum to the chain), which for
+ * disjoint simple polygons none inside another is 0 or +-1: the projected faces have disjoint interiors.
+ * Then every point of K off the chain has a neighbourhood that projects one to one (the faces round it cover
+ * a disk once), so two
+ * distinct points of K with one projection both lie on the chain, whose projection is one to one: the
+ * projection is one to one on K, and a point common to two faces is one point of K, i.e. in what they share
+ * by index.  A node's chain is read off its faces' neighbours across their edges (ct_twins: with the faces in
+ * hierarchy order a node is a range of positions, and an edge is on its boundary when the face across it lies
+ * outside the range, or there is none); a face with an edge in three faces or more, run twice one way, or at a
+ * vertex of fewer than CT_STAR_MIN faces is in no patch.  Nodes whose chain is longer than CT_PATCH_EDGES are
+ * not tried (their children are); the simple-polygon sweep stops after a bounded number of segment tests (not
+ * certified).  Failing to certify only costs time.
+ * ------------------------------------------------------------------------------------------------------ */
+
+#define CT_PATCH_EDGES 2048
+
+typedef struct {
+    uint8_t *amask;             /* per node: bit 2 a + (s < 0) when every face has orientation s along axis a */
+    /* scratch: an open-addressing table of vertex ids stamped per use (ct_patch_certify) */
+    uint64_t *key;
+    int32_t *net;
+    uint32_t *stamp;
+    uint32_t cur;
+    int64_t tsize;              /* power of two, at least 4 CT_PATCH_EDGES */
+    int oom;
+} CtPatchBuild;
+
+static inline uint64_t
+ct_edge_hash(uint64_t k)
+{
+    k ^= k >> 29;
+    k *= 0xbf58476d1ce4e5b9ULL;
+    k ^= k >> 32;
+    return k;
+}
+
+/* Twins: for each face f and corner c, the face across its edge from corner c to corner c + 1 (the one face
+ * running that edge the other way), -1 when no face does, -2 when it is not one (an edge in three faces or
+ * more, run twice one way, a corner held twice, or a vertex whose faces were not listed).  From the faces of
+ * each vertex v (ct_stars' lists: off[v] the start of v's range, -1 when v was not kept, ranges in vertex
+ * order ending at total): the face across v -> x of f is the face of v's list whose corner before v is x.
+ * twin: 3 m int32, all -2 on entry. */
+typedef struct {
+    const void *F;
+    int fsize;
+    const int64_t *off;
+    const int32_t *faces;
+    int64_t n, total;
+    int32_t *twin;
+    int oom[MAX_THREADS];
+} CtTwinJob;
+
+typedef struct {
+    int32_t prev, next, face, corner;
+} CtLink;
+
+static int
+ct_link_prev_cmp(const void *x, const void *y)
+{
+    const CtLink *a = (const CtLink *)x, *b = (const CtLink *)y;
+    return (a->prev > b->prev) - (a->prev < b->prev);
+}
+
+static void
+ct_twin_task(void *ctx, int t, int nt)
+{
+    CtTwinJob *jb = (CtTwinJob *)ctx;
+    int64_t v0 = (int64_t)part_start((size_t)jb->n, t, nt), v1 = (int64_t)part_start((size_t)jb->n, t + 1, nt);
+    CtLink local[64];
+    int64_t v = v0;
+    while (v < v1 && jb->off[v] < 0) v++;
+    while (v < v1) {
+        int64_t w = v + 1;
+        while (w < jb->n && jb->off[w] < 0) w++;
+        int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total, k = e - s;
+        CtLink *lk = k <= 64 ? local : (CtLink *)malloc((size_t)k * sizeof(CtLink));
+        if (lk == NULL) {
+            jb->oom[t] = 1;
+            return;
+        }
+        int ok = 1;
+        for (int64_t i = 0; i < k; i++) {
+            int32_t f = jb->faces[s + i];
+            int64_t x[3];
+            for (int c = 0; c < 3; c++) x[c] = index_at(jb->F, jb->fsize, 3 * (size_t)f + (size_t)c);
+            int c = x[0] == v ? 0 : x[1] == v ? 1 : 2;
+            if ((x[0] == v) + (x[1] == v) + (x[2] == v) != 1) ok = 0;      /* v twice in f: no twins here */
+            lk[i].next = (int32_t)x[(c + 1) % 3];
+            lk[i].prev = (int32_t)x[(c + 2) % 3];
+            lk[i].face = f;
+            lk[i].corner = c;
+        }
+        if (ok && k <= 64) {
+            for (int64_t i = 0; i < k; i++) {
+                int32_t back = -1, twin = -1, same = 0;
+                for (int64_t j = 0; j < k; j++) {
+                    if (j == i) continue;
+                    if (lk[j].prev == lk[i].next) {
+                        back++;
+                        twin = lk[j].face;
+                    }
+                    same += lk[j].next == lk[i].next;
+                }
+                jb->twin[3 * (size_t)lk[i].face + (size_t)lk[i].corner] = back < 0 && !same ? -1
+                                                                           : back == 0 && !same ? twin : -2;
+            }
+        }
+        else if (ok) {                             /* a large fan: match by the sorted corners before v */
+            qsort(lk, (size_t)k, sizeof(CtLink), ct_link_prev_cmp);
+            for (int64_t i = 0; i < k; i++) {
+                int64_t lo = 0, hi = k;            /* first entry whose prev is >= lk[i].next */
+                while (lo < hi) {
+                    int64_t mid = (lo + hi) / 2;
+                    if (lk[mid].prev < lk[i].next) lo = mid + 1;
+                    else hi = mid;
+                }
+                int64_t run = 0;
+                while (lo + run < k && lk[lo + run].prev == lk[i].next) run++;
+                /* "run twice one way": another face with the same next; counted through its own prev run */
+                int32_t tw = run == 1 && lk[lo].face != lk[i].face ? lk[lo].face : run == 0 ? -1 : -2;
+                jb->twin[3 * (size_t)lk[i].face + (size_t)lk[i].corner] = tw;
+            }
+        }
+        if (lk != local) free(lk);
+        v = w;
+    }
+}
+
+/* 1 when the closed segments p1 q1 and p2 q2 (2-d) meet (exact). */
+static int
+ct_segments_meet(const double *p1, const double *q1, const double *p2, const double *q2, CtStats *st)
+{
+    int o1 = ct_orient2d(p1, q1, p2, st), o2 = ct_orient2d(p1, q1, q2, st);
+    int o3 = ct_orient2d(p2, q2, p1, st), o4 = ct_orient2d(p2, q2, q1, st);
+    if (o1 * o2 < 0 && o3 * o4 < 0) return 1;
+#define CT_ON_SEGMENT(a, b, r) ((r)[0] >= ((a)[0] < (b)[0] ? (a)[0] : (b)[0]) \
+                                && (r)[0] <= ((a)[0] > (b)[0] ? (a)[0] : (b)[0]) \
+                                && (r)[1] >= ((a)[1] < (b)[1] ? (a)[1] : (b)[1]) \
+                                && (r)[1] <= ((a)[1] > (b)[1] ? (a)[1] : (b)[1]))
+    if (o1 == 0 && CT_ON_SEGMENT(p1, q1, p2)) return 1;
+    if (o2 == 0 && CT_ON_SEGMENT(p1, q1, q2)) return 1;
+    if (o3 == 0 && CT_ON_SEGMENT(p2, q2, p1)) return 1;
+    if (o4 == 0 && CT_ON_SEGMENT(p2, q2, q1)) return 1;
+#undef CT_ON_SEGMENT
+    return 0;
+}
+
+/* 1 when the segments a b and b c (2-d, nonzero lengths) overlap beyond b: collinear, a and c on one side. */
+static int
+ct_segments_fold(const double *a, const double *b, const double *c, CtStats *st)
+{
+    if (ct_orient2d(a, b, c, st) != 0) return 0;
+    int k = a[0] != b[0] ? 0 : 1;
+    return (a[k] > b[k]) == (c[k] > b[k]);
+}
+
+typedef struct {
+    double lo;
+    int32_t i;
+} CtSweep;
+
+static int
+ct_sweep_cmp(const void *x, const void *y)
+{
+    const CtSweep *a = (const CtSweep *)x, *b = (const CtSweep *)y;
+    return a->lo < b->lo ? -1 : a->lo > b->lo ? 1 : (a->i > b->i) - (a->i < b->i);
+}
+
+/* 1 when the closed polygons P (2-d points, B of them; the segment of point i runs to point succ[i], every
+ * succ cycle of length 3 or more, consecutive points distinct) are simple and pairwise disjoint: segments
+ * meet only where one ends and the next begins (and not folding back along it), others not at all.  A sweep
+ * along x tests the pairs whose x and y ranges meet; more than budget segment tests, or an exact stage that
+ * overflowed: 0. */
+static int
+ct_polygons_simple(const double *P, const int32_t *succ, int64_t B, CtSweep *order, int64_t budget, CtStats *st)
+{
+    for (int64_t i = 0; i < B; i++) {
+        const double *a = P + 2 * i, *b = P + 2 * (size_t)succ[i];
+        order[i].lo = a[0] < b[0] ? a[0] : b[0];
+        order[i].i = (int32_t)i;
+    }
+    qsort(order, (size_t)B, sizeof(CtSweep), ct_sweep_cmp);
+    int64_t tests = 0;
+    for (int64_t x = 0; x < B; x++) {
+        int64_t i = order[x].i;
+        const double *a = P + 2 * i, *b = P + 2 * (size_t)succ[i];
+        double hx = a[0] > b[0] ? a[0] : b[0];
+        double ly = a[1] < b[1] ? a[1] : b[1], hy = a[1] > b[1] ? a[1] : b[1];
+        for (int64_t z = x + 1; z < B && order[z].lo <= hx; z++) {
+            int64_t j = order[z].i;
+            const double *c = P + 2 * j, *d = P + 2 * (size_t)succ[j];
+            if ((c[1] < ly && d[1] < ly) || (c[1] > hy && d[1] > hy)) continue;
+            if (++tests > budget) return 0;
+            int meet;
+            if (succ[i] == j) {                            /* (a, b) then (b, d) */
+                meet = ct_segments_fold(a, b, d, st);
+            }
+            else if (succ[j] == i) {                       /* (c, d) then (d, b) */
+                meet = ct_segments_fold(c, d, b, st);
+            }
+            else {
+                meet = ct_segments_meet(a, b, c, d, st);
+            }
+            if (meet || st->failed) return 0;
+        }
+    }
+    return 1;
+}
+
+/* 1 when the point q (2-d) lies inside the closed polygon of points P[i], i = first, succ[first], ... (q on
+ * none of its segments): the parity of the segments crossing the ray from q towards +x (exact orient2d). */
+static int
+ct_point_inside(const double *q, const double *P, const int32_t *succ, int32_t first, int64_t B, CtStats *st)
+{
+    int inside = 0;
+    int32_t i = first;
+    for (int64_t steps = 0; steps < B; steps++) {
+        const double *a = P + 2 * (size_t)i, *b = P + 2 * (size_t)succ[i];
+        if ((a[1] > q[1]) != (b[1] > q[1])) {
+            int o = ct_orient2d(a, b, q, st);
+            if (b[1] > a[1] ? o > 0 : o < 0) inside ^= 1;
+        }
+        i = succ[i];
+        if (i == first) break;
+    }
+    return inside;
+}
+
+#define CT_PATCH_CYCLES 8       /* boundary cycles of a patch, at most */
+
+/* 1 when the chain edges[0 .. B-1] (directed pairs) is a union of cycles through distinct vertices whose
+ * projections along some axis of amask (with every face's orientation there) are simple, pairwise disjoint
+ * polygons none inside another (so their winding numbers add up to 0 or +-1 everywhere); 0 otherwise (or out
+ * of memory, pb->oom set). */
+static int
+ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_t B, unsigned amask)
+{
+    if (B < 3 || amask == 0) return 0;
+    /* the outgoing edge of each tail: the table again, keyed by the tail */
+    pb->cur++;
+    if (pb->cur == 0) {
+        memset(pb->stamp, 0, (size_t)pb->tsize * sizeof(uint32_t));
+        pb->cur = 1;
+    }
+    int64_t mask = 15;
+    while (mask + 1 < 4 * B && mask + 1 < pb->tsize) mask = 2 * mask + 1;
+    for (int64_t e = 0; e < B; e++) {
+        uint64_t k = (uint32_t)edges[2 * e];
+        int64_t s = (int64_t)(ct_edge_hash(k) & (uint64_t)mask);
+        for (int64_t probe = 0; probe <= mask; probe++) {
+            if (pb->stamp[s] != pb->cur) {
+                pb->stamp[s] = pb->cur;
+                pb->key[s] = k;
+                pb->net[s] = (int32_t)e;
+                break;
+            }
+            if (pb->key[s] == k) return 0;                 /* a vertex leaving twice: not simple cycles */
+            s = (s + 1) & mask;
+        }
+    }
+    int32_t *succ = (int32_t *)malloc((size_t)B * sizeof(int32_t));
+    double *P = (double *)malloc((size_t)B * 2 * sizeof(double));
+    CtSweep *order = (CtSweep *)malloc((size_t)B * sizeof(CtSweep));
+    int ok = 0;
+    int32_t first[CT_PATCH_CYCLES];
+    int n_cycles = 0;
+    if (succ == NULL || P == NULL || order == NULL) {
+        pb->oom = 1;
+        goto done;
+    }
+    for (int64_t e = 0; e < B; e++) {                      /* succ[e]: the edge leaving e's head */
+        uint64_t k = (uint32_t)edges[2 * e + 1];
+        int64_t s = (int64_t)(ct_edge_hash(k) & (uint64_t)mask);
+        succ[e] = -1;
+        for (int64_t probe = 0; probe <= mask; probe++) {
+            if (pb->stamp[s] != pb->cur) break;
+            if (pb->key[s] == k) {
+                succ[e] = pb->net[s];
+                break;
+            }
+            s = (s + 1) & mask;
+        }
+        if (succ[e] < 0) goto done;                        /* an open chain */
+    }
+    /* every edge on one cycle: B edges, each the successor of exactly one (distinct tails, and the walks
+     * from unvisited edges close) */
+    for (int64_t e = 0; e < B; e++) order[e].i = 0;        /* visited marks */
+    for (int64_t e = 0; e < B; e++) {
+        if (order[e].i) continue;
+        if (n_cycles == CT_PATCH_CYCLES) goto done;
+        first[n_cycles++] = (int32_t)e;
+        int64_t x = e, steps = 0;
+        do {
+            if (order[x].i) goto done;                     /* joins a cycle already walked: not disjoint */
+            order[x].i = 1;
+            x = succ[x];
+            steps++;
+        } while (x != e && steps <= B);
+        if (x != e) goto done;
+    }
+    for (int axis = 0; axis < 3 && !ok; axis++) {
+        if (!((amask >> (2 * axis)) & 3u)) continue;
+        int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
+        for (int64_t i = 0; i < B; i++) {                  /* point i: the tail of edge i */
+            P[2 * i] = V[3 * (size_t)edges[2 * i] + kx];
+            P[2 * i + 1] = V[3 * (size_t)edges[2 * i] + ky];
+        }
+        CtStats st = {0, 0};
+        ok = ct_polygons_simple(P, succ, B, order, 64 * B + 4096, &st);
+        for (int c = 0; c < n_cycles && ok; c++) {         /* disjoint, so none inside another */
+            for (int d = 0; d < n_cycles && ok; d++) {
+                if (d != c && ct_point_inside(P + 2 * (size_t)first[c], P, succ, first[d], B, &st)) ok = 0;
+            }
+        }
+        if (st.failed) ok = 0;
+    }
+done:
+    free(succ);
+    free(P);
+    free(order);
+    return ok;
+}
+
+/* ct_twin_task over the vertices on threads; 0, or -1 when out of memory. */
+static int
+ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces, int64_t total,
+         int32_t *twin, int threads)
+{
+    for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
+    CtTwinJob jb;
+    memset(&jb, 0, sizeof(jb));
+    jb.F = F;
+    jb.fsize = fsize;
+    jb.off = off;
+    jb.faces = faces;
+    jb.n = n;
+    jb.total = total;
+    jb.twin = twin;
+    run_parallel(thread_count(threads, (size_t)n, 20000), ct_twin_task, &jb);
+    for (int t = 0; t < MAX_THREADS; t++) {
+        if (jb.oom[t]) return -1;
+    }
+    return 0;
+}
+
+/* patch[k] <- 1 for the highest nodes certified as above (their descendants are not tried).  fmask: per
+ * hierarchy position, bit 2 a + (s < 0) when the face's projection along axis a has strict orientation s (0
+ * for a face in no patch); across: per position and corner, the position of the face across the edge from
+ * that corner to the next, or -1 (none).  0, or -1 when out of memory. */
+static int
+ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *fmask, const int32_t *across,
+           const double *V, int64_t m, uint8_t *patch)
+{
+    CtPatchBuild pb;
+    memset(&pb, 0, sizeof(pb));
+    memset(patch, 0, (size_t)n_nodes);
+    pb.tsize = 1;
+    while (pb.tsize < 4 * CT_PATCH_EDGES) pb.tsize *= 2;
+    pb.amask = (uint8_t *)malloc((size_t)n_nodes);
+    pb.key = (uint64_t *)malloc((size_t)pb.tsize * sizeof(uint64_t));
+    pb.net = (int32_t *)malloc((size_t)pb.tsize * sizeof(int32_t));
+    pb.stamp = (uint32_t *)calloc((size_t)pb.tsize, sizeof(uint32_t));
+    int32_t *pairs = (int32_t *)malloc((size_t)(CT_PATCH_EDGES + 1) * 2 * sizeof(int32_t));
+    int64_t *stack = (int64_t *)malloc((size_t)(n_nodes + 1) * sizeof(int64_t));
+    int64_t *first = (int64_t *)malloc((size_t)n_nodes * sizeof(int64_t));     /* positions of each node */
+    int64_t *last = (int64_t *)malloc((size_t)n_nodes * sizeof(int64_t));
+    int rc = 0;
+    if (pb.amask == NULL || pb.key == NULL || pb.net == NULL || pb.stamp == NULL || pairs == NULL || stack == NULL
+        || first == NULL || last == NULL) {
+        rc = -1;
+        goto done;
+    }
+    pb.cur = 0;
+    for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {    /* children before parents */
+        const CtNode *nd = &nodes[k];
+        if (CT_IS_LEAF(nd)) {
+            int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
+            unsigned am = 63u;
+            for (int64_t i = start; i < start + count; i++) am &= fmask[i];
+            pb.amask[k] = (uint8_t)am;
+            first[k] = start;
+            last[k] = start + count;
+        }
+        else {
+            pb.amask[k] = pb.amask[CT_LEFT(nd)] & pb.amask[CT_RIGHT(nd)];
+            first[k] = first[CT_LEFT(nd)];
+            last[k] = last[CT_RIGHT(nd)];
+        }
+    }
+    {
+        int64_t top = 0;                                   /* top down: the highest certified nodes */
+        stack[top++] = CT_ROOT;
+        while (top > 0) {
+            int64_t k = stack[--top];
+            const CtNode *nd = &nodes[k];
+            if (pb.amask[k] != 0) {
+                /* the chain: the edges whose face across lies outside the node's positions, or is none */
+                int64_t s = first[k], e = last[k], B = 0;
+                for (int64_t i = s; i < e && B <= CT_PATCH_EDGES; i++) {
+                    for (int c = 0; c < 3; c++) {
+                        int32_t t = across[3 * (size_t)i + (size_t)c];
+                        if (t >= s && t < e) continue;
+                        if (B == CT_PATCH_EDGES) {
+                            B++;
+                            break;
+                        }
+                        pairs[2 * B] = ct_id(ids, i, c);
+                        pairs[2 * B + 1] = ct_id(ids, i, (c + 1) % 3);
+                        B++;
+                    }
+                }
+                if (B <= CT_PATCH_EDGES && ct_patch_certify(&pb, V, pairs, B, pb.amask[k])) {
+                    patch[k] = 1;
+                    continue;
+                }
+                if (pb.oom) {
+                    rc = -1;
+                    break;
+                }
+            }
+            if (!CT_IS_LEAF(nd)) {
+                stack[top++] = CT_LEFT(nd);
+                stack[top++] = CT_RIGHT(nd);
+            }
+        }
+    }
+done:
+    free(pb.amask);
+    free(pb.key);
+    free(pb.net);
+    free(pb.stamp);
+    free(pairs);
+    free(stack);
+    free(first);
+    free(last);
+    return rc;
+}
+
 typedef struct {
     const float *BOX;           /* face boxes rounded outward to float32, in blocks of CT_LEAF (ct_block_mask) */
     const int32_t *order;       /* the caller's face index of each hierarchy position */
@@ -5498,6 +5962,7 @@ typedef struct {
     const CtNode *nodes;
     int64_t m;                  /* faces */
     const uint8_t *stars;       /* certified corners per position (ct_visit), NULL without pruning */
+    const uint8_t *patch;       /* certified patches per node (ct_patches), NULL without them */
     long long max_pairs;        /* < 0: no bound */
     long long candidates, tested;
     long exact;
@@ -5668,6 +6133,9 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         if (p->apex >= 0 && p->apex == q->apex) {
             continue;                       /* every pair below is within one certified star */
         }
+        if (pi == qi && sc->patch != NULL && sc->patch[pi]) {
+            continue;                       /* every pair below is within one certified patch */
+        }
         if (top + 4 > cap) {
             int64_t *ns = (int64_t *)realloc(stack, 4 * cap * sizeof(int64_t));
             if (ns == NULL) {
@@ -5790,10 +6258,11 @@ ct_parallel_task(void *ctx, int t, int nt)
 /* Node pairs covering every candidate pair (the distinct ones with meeting boxes), split near the root into
  * up to about CT_TASKS; their count. */
 static int32_t
-ct_tasks(const CtNode *nodes, int64_t *tasks)
+ct_tasks(const CtNode *nodes, const uint8_t *patch, int64_t *tasks)
 {
     int32_t n = 1;
     tasks[0] = tasks[1] = CT_ROOT;
+    if (patch != NULL && patch[CT_ROOT]) return 0;     /* the whole mesh one certified patch */
     for (int round = 0; round < 16 && n < CT_TASKS / 4; round++) {
         int64_t next[2 * CT_TASKS];
         int32_t m = 0;
@@ -5804,6 +6273,7 @@ ct_tasks(const CtNode *nodes, int64_t *tasks)
                 int64_t add[3][2] = {{CT_LEFT(p), CT_LEFT(p)}, {CT_RIGHT(p), CT_RIGHT(p)}, {CT_LEFT(p), CT_RIGHT(p)}};
                 for (int j = 0; j < 3; j++) {
                     if (j == 2 && !ct_nodes_meet(&nodes[CT_LEFT(p)], &nodes[CT_RIGHT(p)])) continue;
+                    if (j < 2 && patch != NULL && patch[add[j][0]]) continue;     /* within a certified patch */
                     next[2 * m] = add[j][0];
                     next[2 * m + 1] = add[j][1];
                     m++;
@@ -5856,6 +6326,7 @@ typedef struct {
     int32_t *order;
     int32_t *ids;
     uint8_t *flags;
+    uint8_t *fmask;             /* NULL, or per position the orientations of the face's projections (ct_patches) */
     long exact[MAX_THREADS];
     int failed[MAX_THREADS];
 } CtPrep;
@@ -5903,6 +6374,31 @@ ct_prep_task(void *ctx, int t, int nt)
         const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
         const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
         pr->flags[i] = (uint8_t)(pr->axis[f] | pr->skip[f] << 2);
+        if (pr->fmask != NULL) {
+            /* orient2d(p1, p2, p0) along each axis (the sign of orient2d(p0, p1, p2)): its filter shares the
+             * differences e1 = p1 - p0, e2 = p2 - p0 between the axes */
+            unsigned fm = 0;
+            double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+            double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+            for (int a = 0; a < 3 && !pr->skip[f]; a++) {
+                int kx = ct_plane[a][0], ky = ct_plane[a][1];
+                double left = e1[kx] * e2[ky], right = e1[ky] * e2[kx];
+                double det = left - right, perm = fabs(left) + fabs(right);
+                int o;
+                if (perm == 0.0) {
+                    o = 0;
+                }
+                else if (fabs(det) > CONTACT_O2 * perm) {
+                    o = det > 0 ? 1 : -1;
+                }
+                else {
+                    double a2[2] = {p1[kx], p1[ky]}, b2[2] = {p2[kx], p2[ky]}, c2[2] = {p0[kx], p0[ky]};
+                    o = ct_orient2d_exact(a2, b2, c2, &st);
+                }
+                fm |= o > 0 ? 1u << (2 * a) : o < 0 ? 2u << (2 * a) : 0u;
+            }
+            pr->fmask[i] = (uint8_t)fm;
+        }
         for (int k = 0; k < 3; k++) {
             pr->ids[CT_IDBLOCK * (i / CT_LEAF) + k * CT_LEAF + i % CT_LEAF]
                 = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
@@ -5926,7 +6422,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
     long long max_pairs;
     int threads = 1;
     long long star_faces = 0;
-    if (!PyArg_ParseTuple(args, "OOL|iL", &objs[0], &objs[1], &max_pairs, &threads, &star_faces)) {
+    int patches = 0;
+    if (!PyArg_ParseTuple(args, "OOL|iLp", &objs[0], &objs[1], &max_pairs, &threads, &star_faces, &patches)) {
         return NULL;
     }
     Py_buffer views[2];
@@ -5943,6 +6440,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
     uint8_t *skip_out = NULL;
     uint8_t *cert = NULL;
     uint8_t *stars = NULL;
+    uint8_t *patch = NULL;
+    uint8_t *fmask = NULL;
+    int32_t *twin = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
     for (; got < 2; got++) {
@@ -6030,6 +6530,10 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.order = order;
         pr.ids = ids;
         pr.flags = flags;
+        if (patches && max_pairs < 0) {
+            fmask = (uint8_t *)malloc(mm);         /* NULL (out of memory): no patches, the same pairs */
+            pr.fmask = fmask;
+        }
         /* the Morton grid: box centres of the faces, 2^16 cells per axis over their range */
         double gmin[3] = {INFINITY, INFINITY, INFINITY}, gmax[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int64_t i = 0; i < n; i++) {       /* every vertex: a bound of the box centres */
@@ -6064,14 +6568,40 @@ accel_contact_scan(PyObject *self, PyObject *args)
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
             stars = (uint8_t *)malloc(mm);
+            if (fmask != NULL) {
+                twin = (int32_t *)malloc(3 * mm * sizeof(int32_t));    /* NULL: no patches, the same pairs */
+            }
             if (cert == NULL || stars == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
-                                         star_faces, cert, nt, code) < 0) {
+                                         star_faces, cert, nt, code, twin) < 0) {
                 oom = 1;
             }
         }
         clk[4] = ct_clock();
         if (!oom && !failed && m >= 2) {
-            ct_build(nodes, box, ids, cert, m);
+            int64_t n_nodes = ct_build(nodes, box, ids, cert, m);
+            int32_t *across = (int32_t *)code;     /* the stars' lists are done with: 12 of its >= 16 bytes a face */
+            int32_t *pos = twin != NULL ? (int32_t *)malloc(mm * sizeof(int32_t)) : NULL;
+            if (pos != NULL) {                      /* the faces across, by hierarchy position */
+                for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
+                for (int64_t i = 0; i < m; i++) {
+                    const int32_t *tw = twin + 3 * (size_t)order[i];
+                    for (int c = 0; c < 3; c++) {
+                        across[3 * i + c] = tw[c] >= 0 ? pos[tw[c]] : -1;
+                        if (tw[c] == -2) fmask[i] = 0;     /* not one face across: in no patch */
+                    }
+                }
+            }
+            free(twin);
+            twin = NULL;
+            if (pos != NULL) {                      /* with a work bound every pair is counted, as on numpy */
+                free(pos);
+                patch = (uint8_t *)malloc((size_t)n_nodes);
+                if (patch == NULL || ct_patches(nodes, n_nodes, ids, fmask, across, V, m, patch) < 0) {
+                    free(patch);
+                    patch = NULL;           /* out of memory: the scan without patches, the same pairs */
+                }
+            }
+            clk[7] = ct_clock();
             if (cert != NULL) {
                 for (int64_t i = 0; i < m; i++) {
                     unsigned b = 0;
@@ -6084,6 +6614,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
             clk[5] = ct_clock();
             sc.stars = cert != NULL ? stars : NULL;
+            sc.patch = patch;
             sc.BOX = box;
             sc.order = order;
             sc.ids = ids;
@@ -6105,7 +6636,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 }
                 pp.scans = scans;
                 pp.tasks = tasks;
-                pp.n_tasks = ct_tasks(nodes, tasks);
+                pp.n_tasks = ct_tasks(nodes, sc.patch, tasks);
                 pp.next = 0;
                 run_parallel(nt, ct_parallel_task, &pp);
                 long exact0 = sc.exact;
@@ -6140,9 +6671,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
         Py_END_ALLOW_THREADS
         if (profile) {
             fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars %.4f build %.4f "
-                    "traverse %.4f s; candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld\n",
+                    "(patches %.4f) traverse %.4f s; candidates %lld tested %lld; node pairs %lld leaf pairs %lld "
+                    "pair tests %lld\n",
                     (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[4] - clk[3], clk[5] - clk[4],
-                    clk[6] - clk[5], sc.candidates, sc.tested, sc.node_pairs, sc.leaf_pairs, sc.loads);
+                    clk[7] > 0 ? clk[7] - clk[4] : 0.0, clk[6] - clk[5], sc.candidates, sc.tested, sc.node_pairs,
+                    sc.leaf_pairs, sc.loads);
         }
         if (oom) {
             PyErr_NoMemory();
@@ -6182,6 +6715,9 @@ done:
     free(skip_out);
     free(cert);
     free(stars);
+    free(patch);
+    free(fmask);
+    free(twin);
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);

@@ -197,9 +197,12 @@ def test_t_junction_is_contact_only():
     trimesh.creation.annulus(0.5, 1.0, 1.0),
 ], ids=["icosphere", "torus", "cylinder", "capsule", "annulus"])
 def test_clean_meshes_have_no_contacts(mesh):
-    result = surface_contacts(np.asarray(mesh.vertices), np.asarray(mesh.faces))
-    assert result.complete and result.candidate_pairs > len(mesh.faces)
-    assert len(result.crossing) == len(result.coplanar_opposite) == len(result.contact) == 0
+    v, f = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    unpatched = surface_contacts(v, f, _patches=False)          # the C scan's patches skip most pairs
+    assert unpatched.complete and unpatched.candidate_pairs > len(mesh.faces)
+    for result in (surface_contacts(v, f), unpatched):
+        assert result.complete and result.candidate_pairs <= unpatched.candidate_pairs
+        assert len(result.crossing) == len(result.coplanar_opposite) == len(result.contact) == 0
 
 
 @pytest.mark.parametrize("path", sorted(glob.glob(os.path.join(MESHES, "*.stl"))), ids=os.path.basename)
@@ -562,11 +565,12 @@ def test_c_scan_on_threads_finds_the_same_pairs(kernel, monkeypatch):
     one = surface_contacts(v, f)
     monkeypatch.setenv(_native.THREADS_ENV, "2")
     two = surface_contacts(v, f)
+    unpatched = surface_contacts(v, f, _patches=False)
     monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
     ref = surface_contacts(v, f)
     assert len(f) > 20_000 and len(one.crossing) > 0
-    for other in (two, ref):
-        assert other.candidate_pairs == one.candidate_pairs
+    assert two.candidate_pairs == one.candidate_pairs <= unpatched.candidate_pairs == ref.candidate_pairs
+    for other in (two, ref, unpatched):
         for field in ("crossing", "coplanar_opposite", "contact"):
             assert np.array_equal(getattr(other, field), getattr(one, field)), field
 

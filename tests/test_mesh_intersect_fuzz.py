@@ -97,14 +97,18 @@ def _check(v, f, how, brute):
     f = _layout(np.asarray(f), how)
     ref = _run(v, f, accel=False)
     for star_faces in (None, 0, 3):
-        kwargs = {} if star_faces is None else {"_star_faces": star_faces}
-        fast = _run(v, f, accel=True, **kwargs)
-        assert fast.complete and ref.complete
-        for name in FIELDS:
-            assert np.array_equal(getattr(fast, name), getattr(ref, name)), (name, star_faces)
-        if star_faces is None:
-            assert (fast.candidate_pairs, fast.tested_pairs, fast.degenerate_faces) == \
-                (ref.candidate_pairs, ref.tested_pairs, ref.degenerate_faces)
+        for patches in (True, False):
+            kwargs = {"_patches": patches} if star_faces is None else {"_star_faces": star_faces,
+                                                                       "_patches": patches}
+            fast = _run(v, f, accel=True, **kwargs)
+            assert fast.complete and ref.complete
+            for name in FIELDS:
+                assert np.array_equal(getattr(fast, name), getattr(ref, name)), (name, star_faces, patches)
+            if star_faces is None and not patches:
+                assert (fast.candidate_pairs, fast.tested_pairs, fast.degenerate_faces) == \
+                    (ref.candidate_pairs, ref.tested_pairs, ref.degenerate_faces)
+            if star_faces is None:
+                assert fast.candidate_pairs <= ref.candidate_pairs
     if brute:
         got = pair_kinds(ref)
         ff = np.asarray(f).tolist()

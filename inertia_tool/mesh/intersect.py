@@ -84,6 +84,34 @@ A fan that folds over itself, winds twice or overlaps after less than a turn fai
 pair as before; faces outside the star are always tested against it.  ``surface_contacts(...,
 _star_faces=0)`` runs the unpruned scan (for the tests).
 
+Patches
+-------
+The C scan (below) also leaves out, without testing, the pairs within a *certified patch*: a node of its
+hierarchy whose faces ``K`` (1) all project along one coordinate axis to triangles of one strict orientation
+``s`` (exact ``orient2d`` of the corners in winding order: the normals lie in the open half-space of that
+axis, the normal-cone condition of self-collision culling, Volino and Magnenat-Thalmann, "Efficient
+self-collision detection on smoothly discretized surface animations using geometrical shape regularity",
+Computer Graphics Forum 13(3), 1994), and (2) whose boundary chain (the directed edges of its faces, ``u → v``
+cancelling ``v → u``) is a union of cycles through distinct vertices whose projections along that axis are
+simple, pairwise disjoint polygons none inside another (their contour test; every segment pair and inclusion
+decided by exact ``orient2d``).
+
+Proof that two faces of a certified patch meet only in what they share by index.  For a point ``y`` of the
+plane on no projected edge, the number of faces whose projection holds ``y``, times ``s``, is the winding
+number round ``y`` of the projected boundary chain (the faces' boundaries add up to the chain), and the
+winding numbers of disjoint simple polygons none inside another add up to 0 or ±1: the projected faces have
+pairwise disjoint interiors.  At a point of ``K`` off the chain the faces round it then cover a neighbourhood
+of its projection exactly once (their wedges, all of one orientation, close up into whole turns), so the
+projection is one to one near it; two distinct points of ``K`` with one projection therefore both lie on the
+chain, on which the projection is one to one.  So the projection is one to one on ``K`` and a point common
+to two faces is one point of ``K``, i.e. on what they share by index.  A fold, a fan winding twice, two
+layers of a spiral ramp, coplanar sheets or a patch whose boundary winds twice fail (1) or (2) and are
+descended as before; failing to certify only costs time.
+
+The patches change which pairs are enumerated, not which are found: ``candidate_pairs`` and ``tested_pairs``
+of the C scan are then below the numpy twin's (``surface_contacts(..., _patches=False)`` gives the twin's
+counts, for the tests).  Under a work bound (``max_pairs``) there are no patches, so both twins count alike.
+
 C extension
 -----------
 When ``inertia_tool._accel`` is built (and the coordinates are in the filter's range) the whole scan runs in
@@ -165,7 +193,8 @@ class SurfaceContacts:
         found so far are reported, but the absence of a crossing is then not proven).
     candidate_pairs : int
         Face pairs whose bounding boxes meet, but those within one certified star (module docstring, "Stars":
-        they provably meet only in what they share); the broad phase's output, all of them when ``complete``.
+        they provably meet only in what they share) and, on the C scan without a work bound, those within one
+        certified patch (module docstring, "Patches"); the broad phase's output, all of them when ``complete``.
     tested_pairs : int
         Candidate pairs tested exactly (both faces of nonzero area).
     exact_evaluations : int
@@ -827,11 +856,11 @@ def _scan_numpy(v: np.ndarray, f: np.ndarray, axis: np.ndarray, degenerate: np.n
 
 
 def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None, pred: _Predicates,
-            star_faces: int) -> tuple[_Scan, np.ndarray, np.ndarray]:
+            star_faces: int, patches: bool) -> tuple[_Scan, np.ndarray, np.ndarray]:
     """The same from the C extension's hierarchy of boxes (pairs it leaves, kind -1, decided on numpy), with the
     per-face projection axes and zero-area flags it computed."""
     raw_a, raw_b, raw_kind, candidates, tested, exact, complete, raw_axis, raw_skip = lib.contact_scan(
-        v, f, -1 if max_pairs is None else int(max_pairs), threads(), star_faces)
+        v, f, -1 if max_pairs is None else int(max_pairs), threads(), star_faces, patches)
     pred.exact += exact
     axis = np.frombuffer(raw_axis, dtype=np.int8).astype(np.intp)
     degenerate = np.frombuffer(raw_skip, dtype=np.uint8).astype(bool)
@@ -847,7 +876,8 @@ def _scan_c(lib: ModuleType, v: np.ndarray, f: np.ndarray, max_pairs: int | None
 # -- entry point ----------------------------------------------------------------------------------------------
 
 def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int | None = None,
-                     chunk: int = CHUNK_PAIRS, _star_faces: int = STAR_MIN_FACES) -> SurfaceContacts:
+                     chunk: int = CHUNK_PAIRS, _star_faces: int = STAR_MIN_FACES,
+                     _patches: bool = True) -> SurfaceContacts:
     """Every pair of faces that meets beyond the vertices and edges it shares by index, classified exactly.
 
     Parameters
@@ -865,6 +895,9 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
     _star_faces : int
         Private, for the tests: stars of at least this many faces are certified and their pairs left out
         (module docstring, "Stars"); 0 runs the unpruned scan.  The pairs found do not depend on it.
+    _patches : bool
+        Private, for the tests: False turns off the C scan's certified patches (module docstring, "Patches"),
+        so that its counts are the numpy twin's.  The pairs found do not depend on it.
 
     Returns
     -------
@@ -893,7 +926,7 @@ def surface_contacts(vertices: np.ndarray, faces: np.ndarray, *, max_pairs: int 
         return SurfaceContacts(crossing=empty, coplanar_opposite=empty, contact=empty, complete=True)
     if lib is not None:
         (a, b, kind, candidates, tested, complete), axis, degenerate = _scan_c(lib, v, f, max_pairs, pred,
-                                                                               _star_faces)
+                                                                               _star_faces, _patches)
     else:
         f = f.astype(np.int64, copy=False)
         axis, degenerate = _face_axes(v, f, pred)
