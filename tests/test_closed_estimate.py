@@ -261,3 +261,17 @@ def test_corrected_bounds_hold_for_a_self_crossing_tube():
     est = corrected_estimate(v, f, resolution=48)
     assert est is not None
     _truth_within(est, S.truth_from_manifold(list(halves)))
+
+
+def test_open_self_crossing_thin_part_is_refined_instead_of_enclosing_nothing():
+    """Issue 23 (Barkour vb ``upper_leg_right.stl``: "encloses a volume of 0 m³"): an open surface passing through
+    itself, thinner than the first grid's cells, is estimated again on the finest grid; the union of the
+    closed plates lies within the bounds (one small triangle missing from each)."""
+    from inertia_tool.mesh.grid_estimate import open_surface_estimate
+    pieces = _thin_cross(thickness=0.03, subdivide=3)
+    opened = [(pv, pf[1:]) for pv, pf in pieces]
+    v, f = S.concat(*opened)
+    assert winding_estimate(v, f, resolution=24).volume == 0
+    est = open_surface_estimate(v, f, resolution=24, max_resolution=96)
+    assert est.volume > 0 and np.isfinite(est.uncertainty.mass)
+    _truth_within(est, S.truth_from_manifold(pieces))

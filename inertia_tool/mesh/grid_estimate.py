@@ -21,7 +21,7 @@ import numpy as np
 from .rims import boundary_edges, enclosing_balls
 from .uncertainty import Estimate, Uncertainty, uncertainty_from
 
-__all__ = ["winding_estimate", "closed_surface_estimate", "corrected_estimate"]
+__all__ = ["winding_estimate", "closed_surface_estimate", "open_surface_estimate", "corrected_estimate"]
 
 
 #: Grid resolution of the winding estimate without libigl: the numpy treecode costs a few hundred exact
@@ -374,6 +374,18 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
     if corrected is not None and not corrected.uncertainty.mass >= second.uncertainty.mass:
         return corrected                # both bounds are proven: the narrower one is reported
     return second
+
+
+def open_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64,
+                          max_resolution: int = CLOSED_MAX_RESOLUTION) -> Estimate:
+    """:func:`winding_estimate` of a surface that is open and passes through itself, built once more on the
+    finest grid (``max_resolution`` cells along the longest side) when the first decided no cell inside: a
+    part thinner than the cells, which the first grid reports as enclosing nothing (issue 23: Barkour vb's
+    ``upper_leg_right.stl``).  The assumption and the bounds are :func:`winding_estimate`'s."""
+    first = winding_estimate(vertices, faces, resolution=resolution)
+    if first.volume > 0 or resolution >= max_resolution:
+        return first
+    return winding_estimate(vertices, faces, resolution=max_resolution)
 
 
 # -- the exact signed integral, corrected on a grid only where the winding number may leave {0, 1} -------------
