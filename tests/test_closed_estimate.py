@@ -275,3 +275,27 @@ def test_open_self_crossing_thin_part_is_refined_instead_of_enclosing_nothing():
     est = open_surface_estimate(v, f, resolution=24, max_resolution=96)
     assert est.volume > 0 and np.isfinite(est.uncertainty.mass)
     _truth_within(est, S.truth_from_manifold(pieces))
+
+
+@pytest.mark.parametrize("extent", [(1.0, 1.0, 1.0), (0.2, 0.36, 1.0), (0.01, 1.0, 1.0)])
+def test_budget_resolution_keeps_the_grid_within_its_cells(extent):
+    """Issue 23 item 2: the finest grid is bounded by cells, not by the longest side: a long or flat part
+    goes finer for the same memory, and the padded grid never exceeds the budget."""
+    from inertia_tool.mesh.grid_estimate import budget_resolution
+    v = np.array([[0.0, 0.0, 0.0], extent])
+    n = budget_resolution(v, 226 ** 3)
+    share = np.array(extent) / max(extent)
+    assert np.prod(np.ceil(share * n) + 2) <= 226 ** 3
+    assert n >= 220 and (max(extent) == min(extent) or n > 300)
+
+
+def test_a_long_thin_closed_part_gets_a_bound_within_the_target_from_the_cell_budget():
+    """A long self-crossing figure-eight tube: refined past 224 cells along its length (the cell budget), its
+    bound narrows below what a 224-cell grid gives, and the union of its halves stays within it."""
+    v, f, halves = S.tube_halves(0.1, 0.2, rings=48, sections=8)
+    v = v * np.array([1.0, 1.0, 6.0])
+    halves = [(hv * np.array([1.0, 1.0, 6.0]), hf) for hv, hf in halves]
+    capped = closed_surface_estimate(v, f, resolution=32, max_resolution=64)
+    budget = closed_surface_estimate(v, f, resolution=32, target=1e-3)
+    assert budget.uncertainty.mass < capped.uncertainty.mass
+    _truth_within(budget, S.truth_from_manifold(list(halves)))
