@@ -211,14 +211,14 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
-        file, folders, scale, ref_rotation, ref_translation, _mode = meshes[mesh_name]
+        file, folders, scale, ref_rotation, ref_translation, mode = meshes[mesh_name]
         fit = float(_numbers(attrs.get("fitscale"), 1, f"{what} fitscale", source, default=(1.0,))[0])
         fitted = GeometryElement(kind, rotation, position, **_mesh_source(file, folders, packages, source, link,
                                                                              missing_meshes),
                                  scale=scale, name=name,
                                  reference_rotation=ref_rotation, reference_translation=ref_translation,
                                  fit_scale=_positive(fit, f"{what} fitscale", source), fit_aabb=fitaabb,
-                                 **mass_model)
+                                 mesh_inertia=mode if mode in ("convex", "legacy") else "exact", **mass_model)
         return _noted_first_object(fitted)
     if kind == "mesh":
         mesh_name = attrs.get("mesh")
