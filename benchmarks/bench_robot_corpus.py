@@ -379,15 +379,25 @@ def compare_menagerie_file(path: str, *, rtol: float, repair: bool, cache, geome
             bucket = f"{method}: MuJoCo counts overlaps twice (summed integral agrees)"
         elif rounded <= rtol:
             bucket = f"{method}: MuJoCo approximate (float32 vertices)"
+        elif dropped and all(_first_object_only(link, f, faces[f]) for f in dropped):
+            bucket = (f"{method}: MuJoCo reads only the first object of an OBJ file (the tool the whole file; "
+                      "said in the link's warnings)")
         elif dropped:
-            bucket = (f"{method}: MuJoCo approximate (its OBJ loader keeps fewer triangles: polygons it cannot "
-                      "clip, or only the first object of a file)")
+            bucket = f"{method}: MuJoCo approximate (its OBJ loader keeps fewer triangles: polygons it cannot clip)"
             detail += (f"; {dropped[0]}: MuJoCo {faces[dropped[0]]} triangles, the file "
                        f"{_file_triangles(link, dropped[0])}")
         else:
             bucket = f"{method}, disagrees"
         rows.append((name, bucket, diff, detail))
     return rows
+
+
+def _first_object_only(link, basename: str, kept: int) -> bool:
+    """Whether MuJoCo's ``kept`` triangles of an OBJ file are exactly its first object's (the file has more)."""
+    from inertia_tool.robot.mjcf import obj_object_triangles
+    element = next(e for e in link.elements if e.mesh and os.path.basename(e.mesh) == basename)
+    objects = obj_object_triangles(element.mesh)
+    return len(objects) > 1 and objects[0] == kept
 
 
 def _file_triangles(link, basename: str) -> int:

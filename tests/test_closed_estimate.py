@@ -180,3 +180,122 @@ def test_useless_bound_is_still_refused_with_the_arrangement_reason(monkeypatch)
         with pytest.raises(InvalidMeshError, match=r"could not be built: a corner of a face.*cannot be bounded "
                                                    r"usefully"):
             mass_properties((v, f), density=1.0, repair=True)
+
+
+# -- corrected_estimate: the exact signed integral corrected where w may leave {0, 1} (issue 23) ----------------
+
+from inertia_tool.mesh.grid_estimate import corrected_estimate  # noqa: E402
+
+
+def _thin_cross(thickness=0.004, subdivide=4):
+    """Two thin plates (1 × 1 × ``thickness``) crossing at right angles through each other's middle."""
+    a = S.box([1.0, 1.0, thickness], subdivide=subdivide)
+    b = S.box([1.0, thickness, 1.0], [0.0, 0.0, 0.3], subdivide=subdivide)
+    return [a, b]
+
+
+@pytest.mark.parametrize("resolution", [32, 64])
+def test_thin_crossing_plates_are_found_where_the_grid_found_nothing(resolution):
+    """Issue 23 (TIAGo ``base.stl``, "encloses a volume of 0 m³"): plates thinner than every cell (no cell
+    decided inside: the plain grid encloses nothing) get a positive corrected estimate whose bounds hold
+    (manifold3d's union)."""
+    pieces = _thin_cross()
+    v, f = S.concat(*pieces)
+    assert winding_estimate(v, f, resolution=resolution).volume == 0
+    est = corrected_estimate(v, f, resolution=resolution)
+    assert est is not None and est.volume > 0 and np.isfinite(est.uncertainty.mass)
+    assert "signed integral" in est.detail
+    _truth_within(est, S.truth_from_manifold(pieces))
+
+
+def test_closed_surface_estimate_takes_the_corrected_estimate_for_a_thin_part():
+    """The rule: the first grid decides nothing inside, so the corrected estimate is built on the finest grid;
+    with a bound past the target the plain finest grid is built too and the smaller proven bound is given."""
+    pieces = _thin_cross()
+    v, f = S.concat(*pieces)
+    est = closed_surface_estimate(v, f, resolution=16, max_resolution=48)
+    assert est.volume > 0
+    _truth_within(est, S.truth_from_manifold(pieces))
+
+
+def test_corrected_estimate_of_a_closed_solid_without_crossings_is_its_integral():
+    """No face meets another: every face separates 0 and 1, nothing but round-off is in doubt, and the estimate is the
+    solid's exact integral (a subdivided box)."""
+    piece = S.box([0.3, 0.2, 0.01], subdivide=1)
+    est = corrected_estimate(*piece, resolution=32)
+    assert est is not None and est.uncertainty.volume_in_doubt <= 1e-12 * est.volume   # round-off only
+    assert est.volume == pytest.approx(0.3 * 0.2 * 0.01, rel=1e-12)
+
+
+def test_corrected_estimate_counts_a_region_enclosed_twice_once():
+    """A box inside another, both outward (w = 2 in the inner one): the signed integral counts it twice, the
+    correction removes it exactly (the inner box's cells are decided)."""
+    outer = S.box([1.0, 1.0, 1.0])
+    inner = S.box([0.4, 0.4, 0.4])
+    v, f = S.concat(outer, inner)
+    est = corrected_estimate(v, f, resolution=40)
+    assert est is not None
+    _truth_within(est, S.truth_from_manifold([outer]))
+
+
+@settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data(), count=st.integers(2, 3))
+def test_corrected_bounds_hold_for_overlapping_thin_and_thick_boxes(data, count):
+    """Boxes of random size (some thinner than a cell), position and subdivision, overlapping: manifold3d's
+    union lies within the corrected estimate's bounds whenever it is built."""
+    boxes = []
+    for _ in range(count):
+        size = np.array([data.draw(st.sampled_from([0.003, 0.02, 0.3, 0.7])) for _ in range(3)])
+        centre = np.array([data.draw(st.floats(-0.3, 0.3)) for _ in range(3)])
+        boxes.append(S.box(size, centre, subdivide=data.draw(st.integers(0, 1))))
+    v, f = S.concat(*boxes)
+    est = corrected_estimate(v, f, resolution=data.draw(st.sampled_from([16, 40])))
+    if est is None:
+        return
+    _truth_within(est, S.truth_from_manifold(boxes))
+
+
+def test_corrected_bounds_hold_for_a_self_crossing_tube():
+    """The figure-eight tube (one shell passing through itself): the union of its halves lies within."""
+    v, f, halves = S.tube_halves(0.1, 0.2, rings=48, sections=8)
+    est = corrected_estimate(v, f, resolution=48)
+    assert est is not None
+    _truth_within(est, S.truth_from_manifold(list(halves)))
+
+
+def test_open_self_crossing_thin_part_is_refined_instead_of_enclosing_nothing():
+    """Issue 23 (Barkour vb ``upper_leg_right.stl``: "encloses a volume of 0 m³"): an open surface passing through
+    itself, thinner than the first grid's cells, is estimated again on the finest grid; the union of the
+    closed plates lies within the bounds (one small triangle missing from each)."""
+    from inertia_tool.mesh.grid_estimate import open_surface_estimate
+    pieces = _thin_cross(thickness=0.03, subdivide=3)
+    opened = [(pv, pf[1:]) for pv, pf in pieces]
+    v, f = S.concat(*opened)
+    assert winding_estimate(v, f, resolution=24).volume == 0
+    est = open_surface_estimate(v, f, resolution=24, max_resolution=96)
+    assert est.volume > 0 and np.isfinite(est.uncertainty.mass)
+    _truth_within(est, S.truth_from_manifold(pieces))
+
+
+@pytest.mark.parametrize("extent", [(1.0, 1.0, 1.0), (0.2, 0.36, 1.0), (0.01, 1.0, 1.0)])
+def test_budget_resolution_keeps_the_grid_within_its_cells(extent):
+    """Issue 23 item 2: the finest grid is bounded by cells, not by the longest side: a long or flat part
+    goes finer for the same memory, and the padded grid never exceeds the budget."""
+    from inertia_tool.mesh.grid_estimate import budget_resolution
+    v = np.array([[0.0, 0.0, 0.0], extent])
+    n = budget_resolution(v, 226 ** 3)
+    share = np.array(extent) / max(extent)
+    assert np.prod(np.ceil(share * n) + 2) <= 226 ** 3
+    assert n >= 220 and (max(extent) == min(extent) or n > 300)
+
+
+def test_a_long_thin_closed_part_gets_a_bound_within_the_target_from_the_cell_budget():
+    """A long self-crossing figure-eight tube: refined past 224 cells along its length (the cell budget), its
+    bound narrows below what a 224-cell grid gives, and the union of its halves stays within it."""
+    v, f, halves = S.tube_halves(0.1, 0.2, rings=48, sections=8)
+    v = v * np.array([1.0, 1.0, 6.0])
+    halves = [(hv * np.array([1.0, 1.0, 6.0]), hf) for hv, hf in halves]
+    capped = closed_surface_estimate(v, f, resolution=32, max_resolution=64)
+    budget = closed_surface_estimate(v, f, resolution=32, target=1e-3)
+    assert budget.uncertainty.mass < capped.uncertainty.mass
+    _truth_within(budget, S.truth_from_manifold(list(halves)))

@@ -214,7 +214,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         Without ``repair`` when no exact reading exists; with it when nothing encloses a volume.
     """
     # imported on use: a surface that passes the manifold check (nearly every file) never comes here
-    from .grid_estimate import closed_surface_estimate, winding_estimate
+    from .grid_estimate import closed_surface_estimate, open_surface_estimate
     from .uncertainty import check_useful
     from .merge import merge_close_vertices
     from .orient import edge_balance, orient_consistently
@@ -226,7 +226,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         census = edge_balance(f, n)
         # a closed surface has an integer winding number off it: the decided cells bound the solid with no
         # assumption, and the grid is refined once towards CLOSED_TARGET_MASS_RTOL
-        grid = closed_surface_estimate(v, f) if census.balanced else winding_estimate(v, f)
+        grid = closed_surface_estimate(v, f) if census.balanced else open_surface_estimate(v, f)
         why = reason or "the bodies overlap and their union could not be formed"
         hint = ("`overlap` 'sum' adds the bodies (shared volume counted twice)" if reason is None else
                 "repair the surface so that it does not pass through itself")

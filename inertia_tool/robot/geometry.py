@@ -215,18 +215,23 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
     and half-length ``h_z``, a capsule the same radius ``r`` and half-length ``max(0, h_z − r)`` (checked
     against MuJoCo 4.0: Menagerie's RealSense D435i).
 
-    MuJoCo uses the mesh's own inertia mode for the moments and axes (``legacy`` by default), which equals
-    the solid's only for convex meshes; this fit uses the solid.  Elements that are not fitted are returned as
-    they are.
+    MuJoCo fits to the moments and axes of the mesh's own inertia mode, and so does this fit (issue 23, checked
+    against MuJoCo 4.0's body inertias): ``inertia="convex"`` the convex hull, ``"legacy"`` MuJoCo's legacy
+    formula (:mod:`inertia_tool.robot.mesh_inertia`), otherwise (``exact``, no attribute) the solid.  The
+    fitted size is the model's geom whatever density the tool is run with.  Elements that are not fitted are
+    returned as they are.
     """
     if element.fit_scale is None:
         return element
-    props = element_mass_properties(GeometryElement("mesh", np.eye(3), np.zeros(3), mesh=element.mesh,
-                                                    uri=element.uri, scale=element.scale, name=element.name,
-                                                    vertices=element.vertices, faces=element.faces,
-                                                    reference_rotation=element.reference_rotation,
-                                                    reference_translation=element.reference_translation),
-                                    cache=cache, repair=repair, budget=budget)
+    mesh = GeometryElement("mesh", np.eye(3), np.zeros(3), mesh=element.mesh, uri=element.uri, scale=element.scale,
+                           name=element.name, vertices=element.vertices, faces=element.faces,
+                           reference_rotation=element.reference_rotation,
+                           reference_translation=element.reference_translation,
+                           mesh_inertia=element.mesh_inertia)
+    if element.mesh_inertia in ("convex", "legacy"):
+        props = _mesh_inertia_part(mesh, cache={} if cache is None else cache, budget=budget)[1]
+    else:
+        props = element_mass_properties(mesh, cache=cache, repair=repair, budget=budget)
     moments, axes = np.linalg.eigh(0.5 * (props.inertia + props.inertia.T))
     axes = axes[:, ::-1]                                 # x: the largest moment, z: the smallest
     if np.linalg.det(axes) < 0:

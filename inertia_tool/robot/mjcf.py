@@ -106,6 +106,48 @@ def _hfield_geom(attrs: dict, pose, label: str, link: str, hfields: dict, compil
     return dataclasses.replace(element, note=note)
 
 
+#: Largest OBJ file (bytes) scanned for its objects by :func:`obj_object_triangles`.
+OBJ_SCAN_LIMIT = 256 << 20
+
+
+def obj_object_triangles(path: str, *, limit: int = OBJ_SCAN_LIMIT) -> list[int]:
+    """Triangles of each object of an OBJ file, in file order: a new object starts at an ``o`` or ``g`` line
+    after at least one face (the grouping of MuJoCo's OBJ loader); a polygon of ``n`` corners counts ``n − 2``.
+    An empty list for a file that cannot be read or is larger than ``limit`` bytes."""
+    try:
+        if os.path.getsize(path) > limit:
+            return []
+        with open(path, "rb") as fh:
+            data = fh.read()
+    except OSError:
+        return []
+    counts = [0]
+    for line in data.splitlines():
+        word = line.split(None, 1)[:1]
+        if not word:
+            continue
+        if word[0] == b"f":
+            counts[-1] += max(len(line.split()) - 3, 0)
+        elif word[0] in (b"o", b"g") and counts[-1]:
+            counts.append(0)
+    return [c for c in counts if c]
+
+
+def _noted_first_object(element: GeometryElement) -> GeometryElement:
+    """``element`` with a note when its mesh is an OBJ file of several objects: MuJoCo 4.0 compiles only the
+    first (checked: two cubes under ``o a`` / ``o b`` compile to one cube of 12 triangles), the tool the whole
+    file, so their inertias of this geom differ."""
+    if element.mesh is None or not element.mesh.lower().endswith(".obj"):
+        return element
+    objects = obj_object_triangles(element.mesh)
+    if len(objects) < 2:
+        return element
+    note = (f"mesh {os.path.basename(element.mesh)} holds {len(objects)} objects (OBJ 'o'/'g' groups): the whole "
+            f"file ({sum(objects):,} triangles) is integrated; MuJoCo 4.0 reads only the first object "
+            f"({objects[0]:,} triangles), so its inertia of this geom differs")
+    return dataclasses.replace(element, note=f"{element.note}; {note}" if element.note else note)
+
+
 def _optional_number(attrs: dict, key: str, what: str, source: str) -> float | None:
     if attrs.get(key) is None:
         return None
@@ -169,25 +211,27 @@ def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
-        file, folders, scale, ref_rotation, ref_translation, _mode = meshes[mesh_name]
+        file, folders, scale, ref_rotation, ref_translation, mode = meshes[mesh_name]
         fit = float(_numbers(attrs.get("fitscale"), 1, f"{what} fitscale", source, default=(1.0,))[0])
-        return GeometryElement(kind, rotation, position, **_mesh_source(file, folders, packages, source, link,
-                                                                           missing_meshes),
-                               scale=scale, name=name,
-                               reference_rotation=ref_rotation, reference_translation=ref_translation,
-                               fit_scale=_positive(fit, f"{what} fitscale", source), fit_aabb=fitaabb,
-                               **mass_model)
+        fitted = GeometryElement(kind, rotation, position, **_mesh_source(file, folders, packages, source, link,
+                                                                             missing_meshes),
+                                 scale=scale, name=name,
+                                 reference_rotation=ref_rotation, reference_translation=ref_translation,
+                                 fit_scale=_positive(fit, f"{what} fitscale", source), fit_aabb=fitaabb,
+                                 mesh_inertia=mode if mode in ("convex", "legacy") else "exact", **mass_model)
+        return _noted_first_object(fitted)
     if kind == "mesh":
         mesh_name = attrs.get("mesh")
         if mesh_name not in meshes:
             raise _fail(source, f"{what}: mesh {mesh_name!r} is not defined in <asset>")
         file, folders, scale, ref_rotation, ref_translation, mode = meshes[mesh_name]
         mass_model["shell"] = mode == "shell"    # MuJoCo: a mesh's shell inertia is a property of the asset
-        return GeometryElement("mesh", rotation, position, **_mesh_source(file, folders, packages, source, link,
-                                                                           missing_meshes),
-                               scale=scale, name=name,
-                               reference_rotation=ref_rotation, reference_translation=ref_translation,
-                               mesh_inertia=mode if mode in ("convex", "legacy") else "exact", **mass_model)
+        element = GeometryElement("mesh", rotation, position, **_mesh_source(file, folders, packages, source, link,
+                                                                              missing_meshes),
+                                  scale=scale, name=name,
+                                  reference_rotation=ref_rotation, reference_translation=ref_translation,
+                                  mesh_inertia=mode if mode in ("convex", "legacy") else "exact", **mass_model)
+        return _noted_first_object(element)
     if kind == "sphere":
         return GeometryElement("sphere", rotation, position, size=need(1), name=name, **mass_model)
     if kind in ("capsule", "cylinder"):
