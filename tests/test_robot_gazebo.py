@@ -379,3 +379,208 @@ def test_a_light_only_sdf_says_there_is_nothing_to_audit(tmp_path):
     with pytest.raises(RobotDescriptionError, match=r"no <model> or <world> to audit: the file holds only "
                                                     r"<light> \(a light or an actor has no links\)"):
         read_robot(path)
+
+
+# -- SDFormat <polyline>: an extruded polygonal region, even-odd holes (issue 23 item 4) ---------------------
+
+from hypothesis import given, settings, strategies as st  # noqa: E402
+
+from inertia_tool.errors import InvalidMeshError  # noqa: E402
+from inertia_tool.integrals import second_moment_to_inertia, volume_moments  # noqa: E402
+from inertia_tool.mass.extrusion import extruded_region, polygon_region  # noqa: E402
+from inertia_tool.mass.properties import combine  # noqa: E402
+from inertia_tool.robot.geometry import element_bounds, points_inside_element  # noqa: E402
+
+
+def _ngon(radius, sides, turn=0.0, centre=(0.0, 0.0)):
+    angles = turn + 2 * np.pi * np.arange(sides) / sides
+    return np.column_stack([centre[0] + radius * np.cos(angles), centre[1] + radius * np.sin(angles)])
+
+
+def _same(a, b, rel=1e-10):
+    scale = np.abs(b.inertia).max()
+    assert a.volume == pytest.approx(b.volume, rel=rel)
+    np.testing.assert_allclose(a.center_of_mass, b.center_of_mass, atol=rel * 10)
+    np.testing.assert_allclose(a.inertia, b.inertia, atol=rel * scale)
+
+
+def test_polyline_rectangle_is_the_box():
+    # a 2 × 3 rectangle with a corner at (1, −4), extruded 0.5 from z = 0: the box of mass_shapes, centred
+    rectangle = [(1, -4), (3, -4), (3, -1), (1, -1)]
+    for points in (rectangle, rectangle[::-1], rectangle + rectangle[:1]):      # either winding, closed or not
+        _same(extruded_region([points], 0.5), shapes.box(2, 3, 0.5, center=(2, -2.5, 0.25)).exact)
+
+
+@pytest.mark.parametrize("sides, turn", [(3, 0.0), (6, 0.3), (20, 1.0), (64, -0.2)])
+def test_polyline_regular_ngon_ring_is_the_difference_of_two_prisms(sides, turn):
+    # outer R = 1.3, inner r = 0.8·R·cos(π/n) rotated by `turn` (the in-plane tensor of a regular n-gon is
+    # isotropic, so the turn leaves it alone); the ring is prism(R) − prism(r), both centred at z = h/2
+    h, outer = 0.25, 1.3
+    inner = 0.8 * outer * np.cos(np.pi / sides)
+    big = shapes.prism(outer, h, sides, center=(0, 0, h / 2)).exact
+    small = shapes.prism(inner, h, sides, center=(0, 0, h / 2)).exact
+    ring = extruded_region([_ngon(outer, sides), _ngon(inner, sides, turn)], h)
+    assert ring.volume == pytest.approx(big.volume - small.volume, rel=1e-12)
+    np.testing.assert_allclose(ring.center_of_mass, [0, 0, h / 2], atol=1e-12)
+    np.testing.assert_allclose(ring.inertia, big.inertia - small.inertia, atol=1e-12 * np.abs(big.inertia).max())
+
+
+def test_polyline_island_inside_a_hole_counts_again():
+    # three nested squares (even-odd): the outermost and the innermost are material, the middle one a hole
+    h = 0.2
+    squares = [[(-s, -s), (s, -s), (s, s), (-s, s)] for s in (2.0, 1.5, 0.5)]
+    region = extruded_region(squares, h)
+    box = [shapes.box(2 * s, 2 * s, h, center=(0, 0, h / 2)).exact for s in (2.0, 1.5, 0.5)]
+    assert region.volume == pytest.approx(box[0].volume - box[1].volume + box[2].volume, rel=1e-13)
+    np.testing.assert_allclose(region.inertia, box[0].inertia - box[1].inertia + box[2].inertia, rtol=1e-12)
+    _, signs = polygon_region(squares[::-1])
+    assert signs == (1, -1, 1)
+
+
+def test_polyline_l_shape_is_two_boxes():
+    h = 0.7
+    l_shape = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 3), (0, 3)]
+    boxes = combine([shapes.box(2, 1, h, center=(1, 0.5, h / 2)).exact,
+                     shapes.box(1, 2, h, center=(0.5, 2, h / 2)).exact])
+    _same(extruded_region([l_shape], h), boxes)
+    assert abs(extruded_region([l_shape], h).inertia[0, 1]) > 0.1           # the product of inertia is there
+
+
+def _prism_mesh(polygon, centre, h):
+    """A closed, outward-wound triangle mesh of the prism over a CCW polygon star-shaped from ``centre``."""
+    n = len(polygon)
+    bottom = np.column_stack([polygon, np.zeros(n)])
+    top = np.column_stack([polygon, np.full(n, h)])
+    vertices = np.vstack([bottom, top, [[*centre, 0.0], [*centre, h]]])
+    i = np.arange(n)
+    j = (i + 1) % n
+    faces = np.vstack([np.column_stack([np.full(n, 2 * n), j, i]),                 # bottom, normal −z
+                       np.column_stack([np.full(n, 2 * n + 1), n + i, n + j]),     # top, normal +z
+                       np.column_stack([i, j, n + j]), np.column_stack([i, n + j, n + i])])
+    return vertices, faces
+
+
+def _engine(vertices, faces):
+    moments = volume_moments(vertices, faces)
+    return moments.volume, moments.centroid, second_moment_to_inertia(moments.second_moment)
+
+
+@st.composite
+def _star_polygons(draw):
+    n = draw(st.integers(3, 24))
+    gaps = np.array(draw(st.lists(st.floats(0.05, 1.0), min_size=n, max_size=n)))
+    angles = draw(st.floats(0, 6.3)) + np.cumsum(gaps / gaps.sum() * 2 * np.pi)
+    if np.max(gaps / gaps.sum() * 2 * np.pi) >= 0.95 * np.pi:         # keep the centre in the kernel
+        angles = draw(st.floats(0, 6.3)) + 2 * np.pi * np.arange(n) / n
+    radii = np.array(draw(st.lists(st.floats(0.2, 1.0), min_size=n, max_size=n)))
+    centre = np.array([draw(st.floats(-50, 50)), draw(st.floats(-50, 50))])
+    polygon = centre + radii[:, None] * np.column_stack([np.cos(angles), np.sin(angles)])
+    return polygon, centre, draw(st.floats(0.05, 3.0))
+
+
+@settings(max_examples=60, deadline=None)
+@given(_star_polygons(), st.booleans(), st.floats(0.2, 0.9))
+def test_polyline_random_star_polygons_match_the_engine_on_the_triangulated_prism(star, clockwise, shrink):
+    polygon, centre, h = star
+    volume, centroid, inertia = _engine(*_prism_mesh(polygon, centre, h))
+    given_points = polygon[::-1] if clockwise else polygon
+    solid = extruded_region([given_points], h)
+    assert solid.volume == pytest.approx(volume, rel=1e-9)
+    np.testing.assert_allclose(solid.center_of_mass, centroid, atol=1e-9 * (1 + np.abs(centre).max()))
+    np.testing.assert_allclose(solid.inertia, inertia, atol=1e-8 * np.abs(inertia).max())
+    # the same star shrunk about its centre is a hole: the engine integrates the outer shell plus the inner one
+    # wound inwards
+    hole = centre + shrink * (polygon - centre)
+    v_out, f_out = _prism_mesh(polygon, centre, h)
+    v_in, f_in = _prism_mesh(hole, centre, h)
+    vertices = np.vstack([v_out, v_in])
+    faces = np.vstack([f_out, f_in[:, ::-1] + len(v_out)])
+    volume, centroid, inertia = _engine(vertices, faces)
+    ring = extruded_region([hole, given_points], h)
+    assert ring.volume == pytest.approx(volume, rel=1e-9)
+    np.testing.assert_allclose(ring.center_of_mass, centroid, atol=1e-9 * (1 + np.abs(centre).max()))
+    np.testing.assert_allclose(ring.inertia, inertia, atol=1e-8 * np.abs(inertia).max())
+
+
+@pytest.mark.parametrize("polygons, expected", [
+    ([[(0, 0), (1, 1), (1, 0), (0, 1)]], "polygon 1 crosses itself"),                # a bow tie
+    ([[(0, 0), (2, 0), (1, 0), (1, 1)]], "polygon 1 crosses itself"),                # an edge folding back
+    ([[(0, 0), (2, 0), (2, 2), (1, 0.0), (0, 2)]], "polygon 1 crosses itself"),      # a corner on an edge
+    ([[(0, 0), (1, 0)]], "at least 3 distinct points, found 2"),
+    ([[(0, 0), (1, 0), (1, 0), (0, 0)]], "at least 3 distinct points, found 2"),     # repeats dropped
+    ([[(0, 0), (1, 1), (2, 2)]], "expected a positive area, found its 3 points on one line"),
+    ([[(0, 0), (2, 0), (2, 2), (0, 2)], [(1, 1), (3, 1), (3, 3), (1, 3)]], "polygons 1 and 2 cross"),
+    ([[(0, 0), (2, 0), (2, 2), (0, 2)], [(0, 0.5), (1, 0.5), (1, 1.5), (0, 1.5)]], "polygons 1 and 2 cross"),
+    ([], "at least one polygon"),
+])
+def test_polyline_bad_polygons_are_refused_with_the_reason(polygons, expected):
+    with pytest.raises(InvalidMeshError, match=expected):
+        polygon_region(polygons)
+
+
+def _polyline_sdf(path, polylines, *, pose="0 0 0 0 0 0", inertial=""):
+    body = "".join("<polyline>" + (f"<height>{h}</height>" if h is not None else "")
+                   + "".join(f"<point>{x} {y}</point>" for x, y in points) + "</polyline>"
+                   for points, h in polylines)
+    path.write_text(f'<sdf version="1.6"><model name="m"><link name="hoop">{inertial}<collision name="c">'
+                    f"<pose>{pose}</pose><geometry>{body}</geometry></collision></link></model></sdf>")
+    return path
+
+
+def test_polyline_sdf_ring_reads_as_one_element_placed_by_its_pose(tmp_path):
+    outer, inner = _ngon(1.0, 12).tolist(), _ngon(0.6, 12).tolist()
+    path = _polyline_sdf(tmp_path / "ring.sdf", [(outer, 0.1), (inner, 0.1)], pose="0 0 2 1.5707963267948966 0 0")
+    robot = read_robot(path)
+    (element,) = robot.links[0].elements
+    assert element.kind == "polyline" and element.size == (0.1,) and len(element.polygons) == 2
+    (result,) = link_inertials(robot, density=1000)
+    local = extruded_region([outer, inner], 0.1)
+    assert result.properties.mass == pytest.approx(1000 * local.volume, rel=1e-12)
+    # the pose turns the ring upright (element z → link −y) and lifts it by 2
+    np.testing.assert_allclose(result.properties.center_of_mass, [0, -0.05, 2], atol=1e-12)
+    assert points_inside_element(element, [0.8, -0.05, 2]) and not points_inside_element(element, [0, -0.05, 2])
+    assert not points_inside_element(element, [0.8, 0.05, 2])
+    np.testing.assert_allclose(element_bounds(element), [[-1, -0.1, 1], [1, 0, 3]], atol=1e-12)
+
+
+def test_polyline_height_defaults_to_one_metre_and_different_heights_are_refused(tmp_path):
+    square = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    robot = read_robot(_polyline_sdf(tmp_path / "a.sdf", [(square, None)]))
+    assert robot.links[0].elements[0].size == (1.0,)
+    hole = [(0.2, 0.2), (0.8, 0.2), (0.8, 0.8), (0.2, 0.8)]
+    with pytest.raises(RobotDescriptionError, match="expected one <height> for all <polyline>s.*found 0.1, 0.2"):
+        read_robot(_polyline_sdf(tmp_path / "b.sdf", [(square, 0.1), (hole, 0.2)]))
+
+
+@pytest.mark.parametrize("polylines, expected", [
+    ([([(0, 0), (1, 1), (1, 0), (0, 1)], 0.1)], "polygon 1 crosses itself"),
+    ([([(0, 0), (1, 0)], 0.1)], "at least 3 distinct points"),
+    ([([(0, 0), (1, 0), (1, 1)], 0)], "height"),
+])
+def test_polyline_sdf_refusals_name_the_file_and_the_link(tmp_path, polylines, expected):
+    path = _polyline_sdf(tmp_path / "bad.sdf", polylines)
+    with pytest.raises(RobotDescriptionError, match=expected) as caught:
+        read_robot(path)
+    assert str(path) in str(caught.value) and "link 'hoop'" in str(caught.value) and "\n" not in str(caught.value)
+
+
+HOOP_RED = "/work/data/gazebo/hoop_red/model.sdf"
+
+
+@pytest.mark.skipif(not __import__("os").path.exists(HOOP_RED), reason="osrf gazebo_models not unpacked here")
+def test_osrf_hoop_red_reads():
+    """osrf gazebo_models ``hoop_red``: a static link holding a 5 m pole (0.3 × 0.1 box) and a ring extruded
+    0.1 m from two 20-gons (outer circumradius 1.23625 m, inner 1.05964 m, the first point repeated at the end).
+    The model declares no ``<inertial>`` (it is static), so there is no declared mass to compare with; at
+    1000 kg/m³ the link weighs 1000·(0.15 + A·0.1) kg with A the ring's area."""
+    robot = read_robot(HOOP_RED)
+    (link,) = robot.links
+    kinds = sorted(e.kind for e in link.elements)
+    assert kinds == ["box", "polyline"] and link.declared is None
+    ring = next(e for e in link.elements if e.kind == "polyline")
+    assert [len(p) for p in ring.polygons] == [20, 20]
+    area = extruded_region(ring.polygons, 1.0).volume
+    assert 0.95 * np.pi * (1.23625 ** 2 - 1.05964 ** 2) < area < np.pi * (1.23625 ** 2 - 1.05964 ** 2)
+    (result,) = link_inertials(robot, density=1000)
+    assert result.method == "exact"
+    assert result.properties.mass == pytest.approx(1000 * (0.3 * 0.1 * 5 + 0.1 * area), rel=1e-12)

@@ -13,6 +13,8 @@ Closed forms (unit density, about the element's centre, element axes; M = V):
 * sphere (r): ``2Mr²/5`` — :func:`inertia_tool.mass.shapes.sphere`;
 * ellipsoid (a, b, c): ``V = 4πabc/3``, ``I_xx = M(b² + c²)/5`` (cyclic): the unit sphere's ``∫x² dV = V/5``
   stretched by ``a²``;
+* polyline (SDFormat extruded polygons, even-odd holes): Green's theorem on each polygon's edges —
+  :func:`inertia_tool.mass.extrusion.extruded_region`;
 * capsule (R, cylinder length L) along z: the cylinder plus two hemispheres of mass ``m_h = 2πR³/3`` whose
   centres sit ``3R/8`` beyond the cylinder ends; a hemisphere has ``I_zz = 2 m_h R²/5`` and, about its own
   centre, ``I_xx = 2 m_h R²/5 − m_h (3R/8)² = 83 m_h R²/320``; the parallel-axis theorem moves it to the
@@ -35,6 +37,8 @@ import numpy as np
 
 from ..errors import InertiaToolError, InvalidMeshError, MeshReadError, UsageError
 from ..mass import shapes, shell_shapes
+from ..mass.extrusion import extruded_region
+from ..mass.extrusion import point_in_polygon as _inside_polygon
 from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
 from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
@@ -396,10 +400,12 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
         local = _capsule(*size)
     elif kind == "ellipsoid":
         local = _ellipsoid(*size)
+    elif kind == "polyline":
+        local = extruded_region(element.polygons, size[0])
     elif kind == "mesh":
         local = _cached_mesh(element, cache=cache, repair=repair, budget=budget)
     else:
-        raise UsageError("Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, mesh, "
+        raise UsageError("Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, polyline, mesh, "
                          f"got {kind!r}")
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
@@ -849,6 +855,12 @@ def element_bounds(element: GeometryElement) -> np.ndarray:
         v, _ = _mesh_vertices_faces(element)
         pts = v @ element.rotation.T + element.translation
         return np.array([pts.min(axis=0), pts.max(axis=0)])
+    if kind == "polyline":
+        xy = np.concatenate([np.asarray(p) for p in element.polygons])
+        corners = np.array([[x, y, z] for x in (xy[:, 0].min(), xy[:, 0].max())
+                            for y in (xy[:, 1].min(), xy[:, 1].max()) for z in (0.0, size[0])])
+        pts = corners @ element.rotation.T + element.translation
+        return np.array([pts.min(axis=0), pts.max(axis=0)])
     if kind == "box":
         half = 0.5 * np.asarray(size)
     elif kind == "sphere":
@@ -876,6 +888,9 @@ def points_inside_element(element: GeometryElement, point) -> bool:
         return bool(np.sum((local / np.asarray(size)) ** 2) <= 1.0)
     if kind == "cylinder":
         return bool(local[:2] @ local[:2] <= size[0] ** 2 and abs(local[2]) <= 0.5 * size[1])
+    if kind == "polyline":       # even-odd: inside an odd number of the region's polygons
+        inside = sum(_inside_polygon(local[:2], np.asarray(p)) for p in element.polygons)
+        return bool(0.0 <= local[2] <= size[0] and inside % 2)
     if kind == "capsule":
         z = float(np.clip(local[2], -0.5 * size[1], 0.5 * size[1]))
         d = local - np.array([0.0, 0.0, z])
