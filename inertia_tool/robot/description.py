@@ -165,6 +165,12 @@ class GeometryElement:
         SDFormat ``<polyline>``: the region's polygons in the element's xy plane, m, checked simple, not meeting
         each other, counter-clockwise (:func:`inertia_tool.mass.extrusion.polygon_region`); extruded from
         ``z = 0`` to ``size[0]``, even-odd nesting.  Empty for every other kind.
+    submesh : str
+        SDFormat ``<mesh><submesh><name>``: only the COLLADA file's sub-mesh of this name (the geometry of the
+        nodes so named, :mod:`inertia_tool.mesh.collada_nodes`) is the element; empty for the whole file.
+    submesh_center : bool
+        ``<submesh><center>true``: the sub-mesh is moved so that its bounding-box centre is at the origin of the
+        file's frame, before ``scale``.
     """
 
     kind: str
@@ -187,6 +193,8 @@ class GeometryElement:
     fit_aabb: bool = False
     mesh_inertia: str = "exact"
     polygons: tuple = ()
+    submesh: str = ""
+    submesh_center: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))
@@ -673,14 +681,31 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
         uri = (shape.findtext("uri") or "").strip()
         if not uri:
             raise _fail(source, f"{what}: <mesh> without a <uri>")
-        if shape.find("submesh") is not None:
-            raise _fail(source, f"{what}: <mesh><submesh> is not supported")
         scale = _scale(_numbers(shape.findtext("scale"), 3, f"{what} <mesh><scale>", source, default=(1, 1, 1)),
                        f"{what} <mesh><scale>", source)
         path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name)
-        return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name)
+        submesh, center = _sdf_submesh(shape.find("submesh"), path, what, source)
+        return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name,
+                               submesh=submesh, submesh_center=center)
     raise _fail(source, f"{what}: unsupported geometry <{kind}> (expected box, cylinder, sphere, capsule, "
                         "ellipsoid, polyline or mesh)")
+
+
+def _sdf_submesh(element, path: str, what: str, source: str) -> tuple[str, bool]:
+    """``(name, center)`` of a ``<mesh><submesh>`` (``("", False)`` without one); only COLLADA files name
+    their sub-meshes here (:mod:`inertia_tool.mesh.collada_nodes`)."""
+    if element is None:
+        return "", False
+    name = (element.findtext("name") or "").strip()
+    if not name:
+        raise _fail(source, f"{what}: <mesh><submesh> without a <name>")
+    if not path.lower().endswith(".dae"):
+        raise _fail(source, f"{what}: <mesh><submesh> {name!r} of {os.path.basename(path)!r}: sub-meshes are "
+                            "read from COLLADA (.dae) files only")
+    text = (element.findtext("center") or "false").strip().lower()
+    if text not in ("true", "false", "1", "0"):
+        raise _fail(source, f"{what}: <submesh><center> expected true or false, got {text[:40]!r}")
+    return name, text in ("true", "1")
 
 
 def _sdf_polyline_height(shapes, what: str, source: str) -> float:

@@ -117,7 +117,30 @@ def _raw_mesh(path: str | None, element: GeometryElement | None, max_faces: int 
     from ..mesh.read import load_mesh
     # robot descriptions give mesh coordinates in metres (the element's `scale` is applied here), so the unit is
     # stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
-    return load_mesh(path, units="m") if max_faces is None else load_mesh(path, units="m", max_faces=max_faces)
+    limit = DEFAULT_MAX_FACES if max_faces is None else max_faces
+    if element is None or not element.submesh:
+        return load_mesh(path, units="m", max_faces=limit)
+    return _submesh(path, element, limit)
+
+
+def _submesh(path: str, element: GeometryElement, max_faces: int) -> RawMesh:
+    """The sub-mesh ``element.submesh`` of the COLLADA file ``path`` (SDFormat ``<submesh>``), re-centred on
+    its bounding-box centre when ``element.submesh_center`` (gz-common ``SubMesh::Center``)."""
+    import tempfile
+
+    from ..mesh.collada_nodes import select_collada_node
+    from ..mesh.read import load_mesh
+    selected = select_collada_node(path, element.submesh)
+    with tempfile.TemporaryDirectory(prefix="inertia_tool_submesh_") as folder:
+        copy = os.path.join(folder, os.path.basename(path))
+        with open(copy, "wb") as fh:
+            fh.write(selected)
+        raw = load_mesh(copy, units="m", max_faces=max_faces)
+    raw = replace(raw, source=f"{path} [submesh {element.submesh!r}]")
+    if element.submesh_center:
+        centre = 0.5 * (raw.vertices.min(axis=0) + raw.vertices.max(axis=0))
+        raw = replace(raw, vertices=raw.vertices - centre)
+    return raw
 
 
 def _placed(raw: RawMesh, element: GeometryElement) -> RawMesh:
@@ -167,7 +190,8 @@ def _mesh_key(element: GeometryElement) -> tuple:
         digest.update(np.ascontiguousarray(element.faces, dtype=np.int64).tobytes())
         where = f"inline:{digest.hexdigest()}"
     return (where, tuple(np.asarray(element.scale, dtype=np.float64).tolist()),
-            element.reference_rotation.tobytes(), np.asarray(element.reference_translation).tobytes())
+            element.reference_rotation.tobytes(), np.asarray(element.reference_translation).tobytes(),
+            element.submesh, element.submesh_center)
 
 
 def element_shell_properties(element: GeometryElement) -> MassProperties:
