@@ -8,8 +8,8 @@ solid is the region swept from ``z = 0`` to ``z = h``.
 Area moments by Green's theorem
 -------------------------------
 For a simple polygon wound counter-clockwise with vertices ``(x_i, y_i)`` and ``c_i = x_i y_{i+1} − x_{i+1} y_i``
-(the divergence theorem in the plane, the 2-D case of Eq. (4.10) of Chapter 4, "Rigid Body Motion", applied edge
-by edge as for the signed tetrahedra of a closed surface):
+(Green's theorem, ``∫ f dA = ∮ F dy`` with ``∂F/∂x = f``, integrated exactly along each straight edge; the plane
+counterpart of the signed tetrahedra of a closed surface):
 
 * ``A = ½ Σ c_i``,
 * ``∫x dA = ⅙ Σ (x_i + x_{i+1}) c_i`` (and ``y`` alike),
@@ -19,9 +19,9 @@ by edge as for the signed tetrahedra of a closed surface):
 Each polygon enters the region's moments with the sign ``(−1)^d``, ``d`` the number of the other polygons that
 enclose it (its nesting depth).  The prism then has ``V = A h``, ``∫x dV = h ∫x dA``, ``∫z dV = A h²/2``,
 ``∫x² dV = h ∫x² dA``, ``∫xy dV = h ∫xy dA``, ``∫xz dV = (h²/2) ∫x dA``, ``∫z² dV = A h³/3``; the inertia
-about the origin is ``ρ (tr C 𝟙 − C)`` (Eq. 4.11/4.13) and the parallel-axis theorem (Eq. 4.16) moves it to the
-centre of mass.  The sums are taken about the polygons' bounding-box centre so that a region far from its
-frame's origin keeps its precision.
+about the origin is ``ρ (tr C 𝟙 − C)`` (Chapter 4, "Rigid Body Motion", Eq. 4.11/4.13) and the parallel-axis
+theorem (Eq. 4.16) moves it to the centre of mass.  The sums are taken about the polygons' bounding-box centre
+so that a region far from its frame's origin keeps its precision.
 """
 
 from __future__ import annotations
