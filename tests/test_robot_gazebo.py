@@ -696,3 +696,43 @@ def test_osrf_polaris_steering_wheel_submesh_is_read_and_centred():
     assert element.submesh == "Steering_Wheel" and element.submesh_center
     low, high = element_bounds(replace(element, rotation=np.eye(3), translation=np.zeros(3)))
     np.testing.assert_allclose(low + high, 0, atol=1e-6)
+
+
+@settings(max_examples=30, deadline=None)
+@given(_star_polygons(), st.floats(-1e6, 1e6), st.floats(-1e6, 1e6))
+def test_polyline_moved_in_its_plane_keeps_its_central_tensor(star, dx, dy):
+    # far from the frame's origin the sums are taken about the polygons' box centre: the central tensor of the
+    # moved region matches the original's to round-off of its own size, not of the distance
+    polygon, _, h = star
+    here = extruded_region([polygon], h)
+    there = extruded_region([polygon + [dx, dy]], h)
+    assert there.volume == pytest.approx(here.volume, rel=1e-9)
+    np.testing.assert_allclose(there.center_of_mass - [dx, dy, 0], here.center_of_mass,
+                               atol=1e-9 * (1 + abs(dx) + abs(dy)))
+    np.testing.assert_allclose(there.inertia, here.inertia, atol=1e-7 * np.abs(here.inertia).max())
+
+
+def test_polyline_point_budget_is_checked_before_the_work():
+    from inertia_tool.mass.extrusion import MAX_POLYGON_POINTS
+    with pytest.raises(InvalidMeshError, match=f"at most {MAX_POLYGON_POINTS} polygon points"):
+        polygon_region([_ngon(1.0, MAX_POLYGON_POINTS // 2 + 1), _ngon(0.5, MAX_POLYGON_POINTS // 2 + 1)])
+
+
+def test_submesh_read_failure_names_the_users_file_not_a_copy(tmp_path):
+    # a node that holds only lines: the reader's "no triangle mesh" names vehicle.dae [submesh 'Wire']
+    path = _collada_scene(tmp_path / "vehicle.dae")
+    text = path.read_text().replace("</library_geometries>", '<geometry id="wire" name="wire"><mesh><source '
+                                    'id="w-p"><float_array id="w-a" count="6">0 0 0 1 0 0</float_array>'
+                                    '<technique_common><accessor source="#w-a" count="2" stride="3"><param name="X" '
+                                    'type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>'
+                                    '</accessor></technique_common></source><vertices id="w-v"><input '
+                                    'semantic="POSITION" source="#w-p"/></vertices><lines count="1"><input '
+                                    'semantic="VERTEX" source="#w-v" offset="0"/><p>0 1</p></lines></mesh>'
+                                    '</geometry></library_geometries>')
+    text = text.replace("</visual_scene>", '<node id="n5" name="Wire"><instance_geometry url="#wire"/></node>'
+                                           "</visual_scene>")
+    path.write_text(text)
+    robot = read_robot(_submesh_sdf(tmp_path / "m.sdf", "vehicle.dae", "Wire", "false"))
+    (result,) = link_inertials(robot, density=1)
+    assert result.properties is None and f"{path} [submesh 'Wire']" in result.problem
+    assert "inertia_tool_submesh_" not in result.problem

@@ -142,10 +142,15 @@ def polygon_region(polygons: Iterable[ArrayLike], *,
         between two).
     """
     cleaned = []
+    total = 0
     for k, raw in enumerate(polygons):
         points = np.asarray(raw, dtype=np.float64)
         if points.ndim != 2 or points.shape[1] != 2:
             raise InvalidMeshError(f"polygon {k + 1}: expected (n, 2) points, got shape {points.shape}")
+        total += len(points)
+        if total > MAX_POLYGON_POINTS:
+            raise InvalidMeshError(f"expected at most {MAX_POLYGON_POINTS} polygon points in all, found more "
+                                   f"(polygon {k + 1} reaches {total})")
         if not np.all(np.isfinite(points)):
             raise InvalidMeshError(f"polygon {k + 1}: expected finite coordinates, found a non-finite one")
         points = _cleaned(points)
@@ -159,9 +164,6 @@ def polygon_region(polygons: Iterable[ArrayLike], *,
         cleaned.append(points)
     if not cleaned:
         raise InvalidMeshError("expected at least one polygon, found none")
-    total = sum(len(p) for p in cleaned)
-    if total > MAX_POLYGON_POINTS:
-        raise InvalidMeshError(f"expected at most {MAX_POLYGON_POINTS} polygon points, found {total}")
     crossing = _first_crossing(cleaned)
     if crossing is not None:
         p, e, q, f = crossing

@@ -135,8 +135,12 @@ def _submesh(path: str, element: GeometryElement, max_faces: int) -> RawMesh:
         copy = os.path.join(folder, os.path.basename(path))
         with open(copy, "wb") as fh:
             fh.write(selected)
-        raw = load_mesh(copy, units="m", max_faces=max_faces)
-    raw = replace(raw, source=f"{path} [submesh {element.submesh!r}]")
+        label = f"{path} [submesh {element.submesh!r}]"
+        try:
+            raw = load_mesh(copy, units="m", max_faces=max_faces)
+        except MeshReadError as error:       # name the file the user gave, not the temporary copy
+            raise MeshReadError(str(error).replace(copy, label)) from None
+    raw = replace(raw, source=label)
     if element.submesh_center:
         centre = 0.5 * (raw.vertices.min(axis=0) + raw.vertices.max(axis=0))
         raw = replace(raw, vertices=raw.vertices - centre)
