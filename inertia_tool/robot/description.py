@@ -33,7 +33,7 @@ from dataclasses import field
 
 import numpy as np
 
-from ..errors import MeshReadError, RobotDescriptionError, SkippedModelWarning, UsageError
+from ..errors import InvalidMeshError, MeshReadError, RobotDescriptionError, SkippedModelWarning, UsageError
 from ..mesh.regular import open_regular
 from ..units import DECIMAL
 from ..values import frozen_value
@@ -112,7 +112,7 @@ class GeometryElement:
     Attributes
     ----------
     kind : str
-        ``"box"``, ``"cylinder"``, ``"sphere"``, ``"capsule"``, ``"ellipsoid"`` or ``"mesh"``.
+        ``"box"``, ``"cylinder"``, ``"sphere"``, ``"capsule"``, ``"ellipsoid"``, ``"polyline"`` or ``"mesh"``.
     rotation : (3, 3) float
         Columns are the element frame's axes in link axes (active).
     translation : (3,) float
@@ -120,7 +120,7 @@ class GeometryElement:
     size : tuple of float
         m.  box: full edge lengths ``(x, y, z)``; cylinder, capsule: ``(radius, length)`` with ``length`` the
         cylindrical part along the element z; sphere: ``(radius,)``; ellipsoid: semi-axes ``(a, b, c)``;
-        mesh: ``()``.
+        polyline: ``(height,)``; mesh: ``()``.
     mesh : str or None
         Absolute path of the mesh file (``kind == "mesh"``).
     uri : str or None
@@ -161,6 +161,16 @@ class GeometryElement:
     mesh_inertia : str
         MJCF ``<mesh inertia>`` when it names ``"convex"`` or ``"legacy"`` (taken with the model's own
         densities: :mod:`inertia_tool.robot.mesh_inertia`); ``"exact"`` otherwise (``shell`` is ``shell``).
+    polygons : tuple of tuple of (x, y)
+        SDFormat ``<polyline>``: the region's polygons in the element's xy plane, m, checked simple, not meeting
+        each other, counter-clockwise (:func:`inertia_tool.mass.extrusion.polygon_region`); extruded from
+        ``z = 0`` to ``size[0]``, even-odd nesting.  Empty for every other kind.
+    submesh : str
+        SDFormat ``<mesh><submesh><name>``: only the COLLADA file's sub-mesh of this name (the geometry of the
+        nodes so named, :mod:`inertia_tool.mesh.collada_nodes`) is the element; empty for the whole file.
+    submesh_center : bool
+        ``<submesh><center>true``: the sub-mesh is moved so that its bounding-box centre is at the origin of the
+        file's frame, before ``scale``.
     """
 
     kind: str
@@ -182,6 +192,9 @@ class GeometryElement:
     faces: np.ndarray | None = None
     fit_aabb: bool = False
     mesh_inertia: str = "exact"
+    polygons: tuple = ()
+    submesh: str = ""
+    submesh_center: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3)))
@@ -638,12 +651,17 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
     what = f"link {link_name!r} {label}"
     geometry = element.find("geometry")
     shapes = [c for c in geometry if isinstance(c.tag, str)] if geometry is not None else []
-    if len(shapes) != 1:
-        raise _fail(source, f"{what}: expected one shape inside <geometry>, found {len(shapes)}")
+    polylines = len(shapes) > 1 and all(c.tag == "polyline" for c in shapes)
+    if len(shapes) != 1 and not polylines:
+        raise _fail(source, f"{what}: expected one shape inside <geometry> (or only <polyline>s), "
+                            f"found {len(shapes)}")
     shape = shapes[0]
     rotation, translation = _sdf_pose(element, what, source)
     name = element.get("name") or label
     kind = shape.tag
+    if kind == "polyline":
+        return GeometryElement("polyline", rotation, translation, size=(_sdf_polyline_height(shapes, what, source),),
+                               polygons=_sdf_polygons(shapes, what, source), name=name)
     if kind == "box":
         size = _numbers(shape.findtext("size"), 3, f"{what} <box><size>", source)
         return GeometryElement("box", rotation, translation, size=tuple(_positive(s, what, source) for s in size),
@@ -663,14 +681,60 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
         uri = (shape.findtext("uri") or "").strip()
         if not uri:
             raise _fail(source, f"{what}: <mesh> without a <uri>")
-        if shape.find("submesh") is not None:
-            raise _fail(source, f"{what}: <mesh><submesh> is not supported")
         scale = _scale(_numbers(shape.findtext("scale"), 3, f"{what} <mesh><scale>", source, default=(1, 1, 1)),
                        f"{what} <mesh><scale>", source)
         path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name)
-        return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name)
+        submesh, center = _sdf_submesh(shape.find("submesh"), path, what, source)
+        return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name,
+                               submesh=submesh, submesh_center=center)
     raise _fail(source, f"{what}: unsupported geometry <{kind}> (expected box, cylinder, sphere, capsule, "
-                        "ellipsoid or mesh)")
+                        "ellipsoid, polyline or mesh)")
+
+
+def _sdf_submesh(element, path: str, what: str, source: str) -> tuple[str, bool]:
+    """``(name, center)`` of a ``<mesh><submesh>`` (``("", False)`` without one); only COLLADA files name
+    their sub-meshes here (:mod:`inertia_tool.mesh.collada_nodes`)."""
+    if element is None:
+        return "", False
+    name = (element.findtext("name") or "").strip()
+    if not name:
+        raise _fail(source, f"{what}: <mesh><submesh> without a <name>")
+    if not path.lower().endswith(".dae"):
+        raise _fail(source, f"{what}: <mesh><submesh> {name!r} of {os.path.basename(path)!r}: sub-meshes are "
+                            "read from COLLADA (.dae) files only")
+    text = (element.findtext("center") or "false").strip().lower()
+    if text not in ("true", "false", "1", "0"):
+        raise _fail(source, f"{what}: <submesh><center> expected true or false, got {text[:40]!r}")
+    return name, text in ("true", "1")
+
+
+def _sdf_polyline_height(shapes, what: str, source: str) -> float:
+    """The extrusion height of the ``<polyline>`` elements of one ``<geometry>`` (SDFormat's default 1 m).
+
+    Gazebo extrudes the whole region by one height; polylines that give different ones are refused rather than
+    guessing which one it takes.
+    """
+    heights = {_sdf_number(shape, "height", f"{what} <polyline>", source, default=1.0) for shape in shapes}
+    if len(heights) != 1:
+        raise _fail(source, f"{what}: expected one <height> for all <polyline>s of the <geometry>, found "
+                            f"{', '.join(f'{h:g}' for h in sorted(heights))}")
+    return _positive(heights.pop(), f"{what} <polyline><height>", source)
+
+
+def _sdf_polygons(shapes, what: str, source: str) -> tuple:
+    """The checked, counter-clockwise polygons of ``<polyline>`` elements (even-odd region, see
+    :func:`inertia_tool.mass.extrusion.polygon_region`)."""
+    from ..mass.extrusion import polygon_region
+    polygons = []
+    for k, shape in enumerate(shapes):
+        points = [_numbers(point.text, 2, f"{what} <polyline> {k + 1} <point>", source)
+                  for point in shape.findall("point")]
+        polygons.append(np.array(points, dtype=np.float64).reshape(-1, 2))
+    try:
+        cleaned, _ = polygon_region(polygons)
+    except InvalidMeshError as error:
+        raise _fail(source, f"{what}: <polyline> {error}") from None
+    return tuple(tuple(map(tuple, p.tolist())) for p in cleaned)
 
 
 #: SDFormat shapes that bound no volume: a ground ``<plane>``, a terrain ``<heightmap>``, ``<empty>``.  Like

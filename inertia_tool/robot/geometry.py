@@ -13,6 +13,8 @@ Closed forms (unit density, about the element's centre, element axes; M = V):
 * sphere (r): ``2Mr²/5`` — :func:`inertia_tool.mass.shapes.sphere`;
 * ellipsoid (a, b, c): ``V = 4πabc/3``, ``I_xx = M(b² + c²)/5`` (cyclic): the unit sphere's ``∫x² dV = V/5``
   stretched by ``a²``;
+* polyline (SDFormat extruded polygons, even-odd holes): Green's theorem on each polygon's edges —
+  :func:`inertia_tool.mass.extrusion.extruded_region`;
 * capsule (R, cylinder length L) along z: the cylinder plus two hemispheres of mass ``m_h = 2πR³/3`` whose
   centres sit ``3R/8`` beyond the cylinder ends; a hemisphere has ``I_zz = 2 m_h R²/5`` and, about its own
   centre, ``I_xx = 2 m_h R²/5 − m_h (3R/8)² = 83 m_h R²/320``; the parallel-axis theorem moves it to the
@@ -35,6 +37,8 @@ import numpy as np
 
 from ..errors import InertiaToolError, InvalidMeshError, MeshReadError, UsageError
 from ..mass import shapes, shell_shapes
+from ..mass.extrusion import extruded_region
+from ..mass.extrusion import point_in_polygon as _inside_polygon
 from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
 from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
@@ -113,7 +117,34 @@ def _raw_mesh(path: str | None, element: GeometryElement | None, max_faces: int 
     from ..mesh.read import load_mesh
     # robot descriptions give mesh coordinates in metres (the element's `scale` is applied here), so the unit is
     # stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
-    return load_mesh(path, units="m") if max_faces is None else load_mesh(path, units="m", max_faces=max_faces)
+    limit = DEFAULT_MAX_FACES if max_faces is None else max_faces
+    if element is None or not element.submesh:
+        return load_mesh(path, units="m", max_faces=limit)
+    return _submesh(path, element, limit)
+
+
+def _submesh(path: str, element: GeometryElement, max_faces: int) -> RawMesh:
+    """The sub-mesh ``element.submesh`` of the COLLADA file ``path`` (SDFormat ``<submesh>``), re-centred on
+    its bounding-box centre when ``element.submesh_center`` (gz-common ``SubMesh::Center``)."""
+    import tempfile
+
+    from ..mesh.collada_nodes import select_collada_node
+    from ..mesh.read import load_mesh
+    selected = select_collada_node(path, element.submesh)
+    with tempfile.TemporaryDirectory(prefix="inertia_tool_submesh_") as folder:
+        copy = os.path.join(folder, os.path.basename(path))
+        with open(copy, "wb") as fh:
+            fh.write(selected)
+        label = f"{path} [submesh {element.submesh!r}]"
+        try:
+            raw = load_mesh(copy, units="m", max_faces=max_faces)
+        except MeshReadError as error:       # name the file the user gave, not the temporary copy
+            raise MeshReadError(str(error).replace(copy, label)) from None
+    raw = replace(raw, source=label)
+    if element.submesh_center:
+        centre = 0.5 * (raw.vertices.min(axis=0) + raw.vertices.max(axis=0))
+        raw = replace(raw, vertices=raw.vertices - centre)
+    return raw
 
 
 def _placed(raw: RawMesh, element: GeometryElement) -> RawMesh:
@@ -163,7 +194,8 @@ def _mesh_key(element: GeometryElement) -> tuple:
         digest.update(np.ascontiguousarray(element.faces, dtype=np.int64).tobytes())
         where = f"inline:{digest.hexdigest()}"
     return (where, tuple(np.asarray(element.scale, dtype=np.float64).tolist()),
-            element.reference_rotation.tobytes(), np.asarray(element.reference_translation).tobytes())
+            element.reference_rotation.tobytes(), np.asarray(element.reference_translation).tobytes(),
+            element.submesh, element.submesh_center)
 
 
 def element_shell_properties(element: GeometryElement) -> MassProperties:
@@ -401,10 +433,12 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
         local = _capsule(*size)
     elif kind == "ellipsoid":
         local = _ellipsoid(*size)
+    elif kind == "polyline":
+        local = extruded_region(element.polygons, size[0])
     elif kind == "mesh":
         local = _cached_mesh(element, cache=cache, repair=repair, budget=budget)
     else:
-        raise UsageError("Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, mesh, "
+        raise UsageError("Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, polyline, mesh, "
                          f"got {kind!r}")
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
@@ -854,6 +888,12 @@ def element_bounds(element: GeometryElement) -> np.ndarray:
         v, _ = _mesh_vertices_faces(element)
         pts = v @ element.rotation.T + element.translation
         return np.array([pts.min(axis=0), pts.max(axis=0)])
+    if kind == "polyline":
+        xy = np.concatenate([np.asarray(p) for p in element.polygons])
+        corners = np.array([[x, y, z] for x in (xy[:, 0].min(), xy[:, 0].max())
+                            for y in (xy[:, 1].min(), xy[:, 1].max()) for z in (0.0, size[0])])
+        pts = corners @ element.rotation.T + element.translation
+        return np.array([pts.min(axis=0), pts.max(axis=0)])
     if kind == "box":
         half = 0.5 * np.asarray(size)
     elif kind == "sphere":
@@ -881,6 +921,9 @@ def points_inside_element(element: GeometryElement, point) -> bool:
         return bool(np.sum((local / np.asarray(size)) ** 2) <= 1.0)
     if kind == "cylinder":
         return bool(local[:2] @ local[:2] <= size[0] ** 2 and abs(local[2]) <= 0.5 * size[1])
+    if kind == "polyline":       # even-odd: inside an odd number of the region's polygons
+        inside = sum(_inside_polygon(local[:2], np.asarray(p)) for p in element.polygons)
+        return bool(0.0 <= local[2] <= size[0] and inside % 2)
     if kind == "capsule":
         z = float(np.clip(local[2], -0.5 * size[1], 0.5 * size[1]))
         d = local - np.array([0.0, 0.0, z])
