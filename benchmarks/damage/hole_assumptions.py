@@ -86,7 +86,7 @@ def examine(v, f_before, f_after, truth):
     for k in range(n_loops):
         ball = np.linalg.norm(pts - centre[k], axis=1) <= radius[k] * (1 + 1e-9) + 1e-12 * diag
         in_ball |= ball
-        if slabs.get("has") is not None and slabs["has"][k] and k not in creased:
+        if slabs.get("has") is not None and slabs["has"][k] and k not in creased and not evidence.bare[k]:
             slab = np.abs((pts - slabs["origin"][k]) @ slabs["normal"][k]) <= slabs["half_width"][k] + 1e-12 * diag
             inside |= ball & slab
         else:
@@ -94,9 +94,11 @@ def examine(v, f_before, f_after, truth):
     est = patched_estimate(v, seal.faces, volume_moments, seal=seal)
     inertia = np.trace(est.second_moment) * np.eye(3) - est.second_moment
     true_inertia = np.asarray(truth["inertia"])
-    within = (abs(est.volume - truth["volume"]) <= cov.VOLUME_RTOL * truth["volume"]
-              and np.linalg.norm(est.centroid - np.asarray(truth["center_of_mass"])) <= cov.COM_DTOL * truth["diagonal"]
-              and np.linalg.norm(inertia - true_inertia) <= cov.INERTIA_RTOL * np.linalg.norm(true_inertia))
+    err_mass = abs(est.volume - truth["volume"])
+    err_com = np.linalg.norm(est.centroid - np.asarray(truth["center_of_mass"]))
+    err_inertia = np.linalg.norm(inertia - true_inertia)
+    within = (err_mass <= cov.VOLUME_RTOL * truth["volume"] and err_com <= cov.COM_DTOL * truth["diagonal"]
+              and err_inertia <= cov.INERTIA_RTOL * np.linalg.norm(true_inertia))
     return {"loops": int(n_loops), "assumption": bool(inside.all()), "in_balls": bool(in_ball.all()),
             "outside_share": float(1 - inside.mean()) if len(pts) else 0.0,
             "footprints": int(np.count_nonzero(evidence.flat_all_round & (evidence.bare > 0))),

@@ -325,8 +325,8 @@ class RimEvidence:
         The rim lies in one plane (within ``FLAT_RIM_RTOL`` of its ball's radius) and so does every face left at
         a rim vertex: the hole is an island in the middle of a flat face.
     bare : (n_loops,) int
-        Rim vertices left *bare*: every face left at them lies within about 1° of one plane, while none of their
-        neighbours off the rims is flat that way.  A surface tessellated with vertices only on the loops of its
+        Rim vertices left *bare*: every face left at them lies within about 1° of one plane, on a surface with no
+        such flat vertex anywhere off the rims.  A surface tessellated with vertices only on the loops of its
         flat faces (as CAD exporters do: no vertex inside a flat face) has no flat vertex at all, so a bare rim
         vertex lay on a loop of its face, and the hole took every face of the other surface that met the face
         there.
@@ -346,7 +346,7 @@ FLAT_VERTEX_COSINE = 1.0 - 2e-4
 
 def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
                  radius: np.ndarray, *, flat_rtol: float = FLAT_RIM_RTOL,
-                 flat_cosine: float = FLAT_VERTEX_COSINE) -> RimEvidence:
+                 flat_cosine: float = FLAT_VERTEX_COSINE, bare: np.ndarray | None = None) -> RimEvidence:
     """Read, for each boundary loop, what the faces left at its rim say (see :class:`RimEvidence`).
 
     Parameters
@@ -359,6 +359,8 @@ def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         The radius of the ball over each rim (:func:`~.rims.enclosing_balls`), m.
     flat_rtol, flat_cosine : float
         ``FLAT_RIM_RTOL``, ``FLAT_VERTEX_COSINE``.
+    bare : (n,) bool, optional
+        :func:`bare_vertices` when the caller has it.
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
@@ -404,7 +406,8 @@ def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         scale = float(np.max(np.abs(v)))
         margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
         flat = has & ~pinched & (worst <= flat_rtol * radius + margin)
-    bare = bare_vertices(v, f, edges, flat_cosine=flat_cosine)
+    if bare is None:
+        bare = bare_vertices(v, f, edges, flat_cosine=flat_cosine)
     rim = np.unique(np.stack([edges[:, 0], label], axis=1), axis=0)
     count = np.bincount(rim[:, 1], weights=bare[rim[:, 0]], minlength=n_loops).astype(np.int64)
     return RimEvidence(flat_all_round=flat, bare=count)
@@ -413,7 +416,8 @@ def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
 def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
                   flat_cosine: float = FLAT_VERTEX_COSINE) -> np.ndarray:
     """Rim vertices left bare, (n,) bool (:class:`RimEvidence`): every face left at the vertex lies within
-    ``acos(flat_cosine)`` of their mean plane, and no neighbour of it off the rims is flat that way."""
+    ``acos(flat_cosine)`` of their mean plane, on a surface with no such flat vertex off the rims (else none is
+    bare: the surface has vertices inside its flat faces, and a flat rim vertex proves nothing)."""
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     n = len(v)
@@ -432,14 +436,11 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
     flat = (least >= flat_cosine) & (size > 0)
     on_rim = np.zeros(n, dtype=bool)
     on_rim[np.asarray(edges, dtype=np.int64).reshape(-1)] = True
-    # rim vertices with a flat neighbour off the rims: this surface has vertices inside its flat faces
-    off = flat & ~on_rim
-    near_flat = np.zeros(n, dtype=bool)
-    for k in range(3):
-        for j in range(3):
-            if j != k:
-                near_flat[f[off[f[:, j]], k]] = True
-    bare: np.ndarray = flat & on_rim & ~near_flat
+    used = np.zeros(n, dtype=bool)
+    used[f.reshape(-1)] = True
+    if (flat & used & ~on_rim).any():
+        return np.zeros(n, dtype=bool)      # a vertex inside a flat face away from the holes: no evidence
+    bare: np.ndarray = flat & on_rim
     return bare
 
 
@@ -493,9 +494,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         centre, radius = enclosing_balls(v[vertex_of], loop_of, n_loops)
         hole_doubt = hole_doubt_volumes(v, f, edges, label, n_loops, centre, radius, vertex_of, loop_of)
         bare = bare_vertices(v, f, edges)
-        evidence = rim_evidence(v, f, edges, label, n_loops, radius)
-        # a bare rim vertex: the hole took a surface meeting the face beside it there, which the slab around
-        # that face's plane does not hold (the ball, the first assumption, still bounds it)
+        evidence = rim_evidence(v, f, edges, label, n_loops, radius, bare=bare)
+        # a bare rim vertex: the hole took a surface that met the face beside it there, which need not stay
+        # near that face's plane: the slab is withdrawn, the ball (first assumption) bounds the hole
         withdrawn = evidence.bare > 0
         hole_doubt[withdrawn] = 4.0 / 3.0 * np.pi * radius[withdrawn] ** 3
         creases = crease_fills(v, f, edges, label, n_loops, centre, radius, bare=bare)
