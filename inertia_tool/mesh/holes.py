@@ -16,6 +16,15 @@ for a hole across one crease of a faceted part: the missing surface lies in the 
 ball is cut to both slabs.  Seams sealed first (cracks, T-junctions; :mod:`~.seal`) add the volume of the
 parallel bodies of the faces sealing touched.  The bounds follow from the volume in doubt as
 :mod:`~.uncertainty` states.
+
+**No bound follows from the file alone**: the missing surface of a hole can be anything with the rim as its
+boundary (a boss of any height, a housing that leaves the convex hull of what remains), so every bound here is
+conditional on the assumptions above.  What the file *can* do is contradict them, and then the narrower
+assumption is dropped (:func:`rim_evidence`).  On a surface tessellated with vertices only on the loops of its
+flat faces (as CAD exporters do), a rim vertex whose remaining faces all lie in one plane (*bare*) lay on a loop
+of that face, so the hole took a surface that met the face there: the slab is withdrawn (the ball stays), a
+crease fill is not made, and a hole that is an island of a flat face with a bare rim — the footprint of a
+feature taken whole — is refused (:attr:`~.uncertainty.Estimate.unbounded`), since nothing bounds its height.
 """
 
 from __future__ import annotations
@@ -65,8 +74,9 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
        (for a spherical cap of half-angle α the ring plane is tilted by about α and the rim's far side lies
        ``2r sin α`` from it, more than the cap's height ``r tan(α/2)`` above the rim's own plane); a hole
        across a crease has ``e`` up to its width, and the ball decides.  It fails for a hole that swallowed a
-       whole boss or dimple standing on a flat face (the ring is flat, the missing part is not): the stated
-       limit of this bound.
+       whole boss or dimple standing on a flat face (the ring is flat, the missing part is not); on a CAD
+       tessellation the bare rim vertices that leaves show it (:func:`rim_evidence`), and the caller withdraws
+       the slab or refuses; on a surface with vertices inside its flat faces nothing shows it: the stated limit.
 
     The cone that patches the hole has its apex at the centroid of the rim vertices, so it lies in the rim's
     convex hull, inside both the ball and the slab of half-width ``e`` around the plane (a convex set holding
@@ -459,8 +469,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     ball enclosing its rim (:func:`enclosing_balls`); the cone lies there too, so the patched solid and the
     true one differ only inside those balls; with the second assumption (the missing surface strays from the
     plane of a face beside the hole no farther than the rim does) only inside each ball's slab around that
-    plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  With ``seal``, the seams it
-    sealed add their own doubt (:mod:`~.seal`).  Limits: a hole whose missing piece joins two rims (a band
+    plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  A hole with a bare rim vertex
+    keeps its whole ball, and a footprint of a feature taken whole sets ``unbounded`` (:func:`rim_evidence`;
+    the caller refuses).  With ``seal``, the seams it sealed add their own doubt (:mod:`~.seal`).  Limits: a hole whose missing piece joins two rims (a band
     round a handle) or reaches far outside its rim's ball (a pocket swallowed whole) is not covered.
 
     Parameters
