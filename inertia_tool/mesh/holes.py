@@ -426,8 +426,10 @@ def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
 def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
                   flat_cosine: float = FLAT_VERTEX_COSINE) -> np.ndarray:
     """Rim vertices left bare, (n,) bool (:class:`RimEvidence`): every face left at the vertex lies within
-    ``acos(flat_cosine)`` of their mean plane, on a surface with no such flat vertex off the rims (else none is
-    bare: the surface has vertices inside its flat faces, and a flat rim vertex proves nothing)."""
+    ``acos(flat_cosine)`` of their mean plane, and one of them shares an edge with a face in that plane (they
+    belong to a flat face of the part, not a lone facet of a curved surface), on a surface with no such flat
+    vertex off the rims (else none is bare: the surface has vertices inside its flat faces, and a flat rim
+    vertex proves nothing)."""
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     n = len(v)
@@ -443,7 +445,20 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
     least = np.ones(n)
     for k in range(3):
         np.minimum.at(least, g[:, k], np.einsum("ij,ij->i", unit, mean_unit[g[:, k]]))
-    flat = (least >= flat_cosine) & (size > 0)
+    # a face of a flat *face of the part*: it shares an edge with a face in its plane (a lone triangle of a
+    # curved surface is flat trivially and proves nothing)
+    key, _ = edge_keys(g, n)
+    order = np.argsort(key, kind="stable")
+    same = key[order][1:] == key[order][:-1]
+    first, second = order[:-1][same] // 3, order[1:][same] // 3
+    coplanar = np.einsum("ij,ij->i", unit[first], unit[second]) >= flat_cosine
+    in_flat_face = np.zeros(len(g), dtype=bool)
+    in_flat_face[first[coplanar]] = True
+    in_flat_face[second[coplanar]] = True
+    on_flat_face = np.zeros(n, dtype=bool)
+    for k in range(3):
+        on_flat_face[g[in_flat_face, k]] = True
+    flat = (least >= flat_cosine) & (size > 0) & on_flat_face
     on_rim = np.zeros(n, dtype=bool)
     on_rim[np.asarray(edges, dtype=np.int64).reshape(-1)] = True
     used = np.zeros(n, dtype=bool)
@@ -471,8 +486,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     plane of a face beside the hole no farther than the rim does) only inside each ball's slab around that
     plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  A hole with a bare rim vertex
     keeps its whole ball, and a footprint of a feature taken whole sets ``unbounded`` (:func:`rim_evidence`;
-    the caller refuses).  With ``seal``, the seams it sealed add their own doubt (:mod:`~.seal`).  Limits: a hole whose missing piece joins two rims (a band
-    round a handle) or reaches far outside its rim's ball (a pocket swallowed whole) is not covered.
+    the caller refuses).  With ``seal``, the seams it sealed add their own doubt (:mod:`~.seal`).  Limits: a
+    hole whose missing piece joins two rims (a band round a handle) or reaches far outside its rim's ball (a
+    feature swallowed whole on a surface that shows no bare rim vertex) is not covered.
 
     Parameters
     ----------
