@@ -335,11 +335,11 @@ class RimEvidence:
         The rim lies in one plane (within ``FLAT_RIM_RTOL`` of its ball's radius) and so does every face left at
         a rim vertex: the hole is an island in the middle of a flat face.
     bare : (n_loops,) int
-        Rim vertices left *bare*: every face left at them lies within about 1° of one plane, on a surface with no
-        such flat vertex anywhere off the rims.  A surface tessellated with vertices only on the loops of its
-        flat faces (as CAD exporters do: no vertex inside a flat face) has no flat vertex at all, so a bare rim
-        vertex lay on a loop of its face, and the hole took every face of the other surface that met the face
-        there.
+        Rim vertices left *bare*: every face left at them lies within about 1° of one plane (a flat face of the
+        part), and no neighbour of theirs off the rims is flat that way.  A surface tessellated with vertices
+        only on the loops of its flat faces (as CAD exporters do: no vertex inside a flat face) has no flat
+        vertex, so a bare rim vertex lay on a loop of its face, and the hole took every face of the other surface
+        that met the face there.
     """
 
     flat_all_round: np.ndarray
@@ -427,9 +427,9 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
                   flat_cosine: float = FLAT_VERTEX_COSINE) -> np.ndarray:
     """Rim vertices left bare, (n,) bool (:class:`RimEvidence`): every face left at the vertex lies within
     ``acos(flat_cosine)`` of their mean plane, and one of them shares an edge with a face in that plane (they
-    belong to a flat face of the part, not a lone facet of a curved surface), on a surface with no such flat
-    vertex off the rims (else none is bare: the surface has vertices inside its flat faces, and a flat rim
-    vertex proves nothing)."""
+    belong to a flat face of the part, not a lone facet of a curved surface), and no neighbour of it off the
+    rims is flat that way (else the surface has vertices inside its flat faces there, and a flat rim vertex
+    proves nothing)."""
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     n = len(v)
@@ -461,11 +461,14 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
     flat = (least >= flat_cosine) & (size > 0) & on_flat_face
     on_rim = np.zeros(n, dtype=bool)
     on_rim[np.asarray(edges, dtype=np.int64).reshape(-1)] = True
-    used = np.zeros(n, dtype=bool)
-    used[f.reshape(-1)] = True
-    if (flat & used & ~on_rim).any():
-        return np.zeros(n, dtype=bool)      # a vertex inside a flat face away from the holes: no evidence
-    bare: np.ndarray = flat & on_rim
+    # rim vertices with a flat neighbour off the rims: the surface has vertices inside its flat faces here
+    off = flat & ~on_rim
+    near_flat = np.zeros(n, dtype=bool)
+    for k in range(3):
+        for j in range(3):
+            if j != k:
+                near_flat[f[off[f[:, j]], k]] = True
+    bare: np.ndarray = flat & on_rim & ~near_flat
     return bare
 
 
