@@ -193,3 +193,39 @@ def test_holes_across_creases_of_prisms_are_refused_or_inside_their_bound(sectio
     gone = _patch(v, f, start % len(f), min(count, len(f) - 1))
     est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
     assert _refused_or_holds(est, volume_moments(v, f))
+
+
+# ------------------------------------------------------------------------- the benchmark's two failures
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", ["7-38-crack_hole", "15-38-t_junction_hole"])
+def test_the_xarm7_link_base_holes_of_the_damage_benchmark_are_inside_their_bound(case):
+    """The two bounds that failed in the coverage benchmark (xarm7 ``link_base.stl``, a connector housing taken
+    whole or its top cut off; docs/damage-benchmark.md).  Their rims keep bare vertices (the housing's walls
+    met the flat side or the shoulder there and are gone), so the slab is withdrawn and the ball states the
+    bound, which now holds (the missing surface still leaves the ball: the assumption is false, the bound holds
+    by its volume).  Needs the robot parts of ``benchmarks/damage/make_cases.py`` (skipped without them)."""
+    import sys
+    from pathlib import Path
+    here = Path(__file__).resolve().parents[1] / "benchmarks" / "damage"
+    sys.path.insert(0, str(here))
+    try:
+        import coverage as cov
+    finally:
+        sys.path.remove(str(here))
+    robots = cov.robot_sources()
+    match = [(name, v, f) for name, v, f in robots if name.endswith("xarm7/visual/link_base.stl")]
+    if not match:
+        pytest.skip("the robot parts are not downloaded (benchmarks/damage/make_cases.py)")
+    name, v, f = match[0]
+    seed, kind = int(case.split("-")[0]), case.split("-", 2)[2]
+    truth = cov.truth_of(v, f)
+    rng = np.random.default_rng([seed, 38, cov.KINDS.index(kind), 0])
+    if rng.random() < cov.QUANTISE_SHARE:
+        qv, qf, _ = cov._quantised(v, f, rng, truth["diagonal"])
+        qt = cov.truth_of(qv, qf)
+        if qt is not None:
+            v, f, truth = qv, qf, qt
+    dv, df, _ = cov.make_case(kind, v, f, rng, truth["diagonal"])
+    row = cov.evaluate(dv, df, truth)
+    assert row["status"] == "answer" and row["holds"], row
