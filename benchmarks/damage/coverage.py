@@ -479,6 +479,7 @@ def table(rows):
 #: Refusal messages grouped by their cause (first match wins).
 REFUSAL_CAUSES = (
     ("patched: ball over a hole too large", "the patched surface cannot be bounded usefully"),
+    ("patched: footprint of a feature taken whole", "footprint of a feature"),
     ("winding: passes through itself", "passes through itself"),
     ("winding: union not formed", "union could not be formed"),
     ("winding: loose triangles", "the loose triangles"),

@@ -16,6 +16,15 @@ for a hole across one crease of a faceted part: the missing surface lies in the 
 ball is cut to both slabs.  Seams sealed first (cracks, T-junctions; :mod:`~.seal`) add the volume of the
 parallel bodies of the faces sealing touched.  The bounds follow from the volume in doubt as
 :mod:`~.uncertainty` states.
+
+**No bound follows from the file alone**: the missing surface of a hole can be anything with the rim as its
+boundary (a boss of any height, a housing that leaves the convex hull of what remains), so every bound here is
+conditional on the assumptions above.  What the file *can* do is contradict them, and then the narrower
+assumption is dropped (:func:`rim_evidence`).  On a surface tessellated with vertices only on the loops of its
+flat faces (as CAD exporters do), a rim vertex whose remaining faces all lie in one plane (*bare*) lay on a loop
+of that face, so the hole took a surface that met the face there: the slab is withdrawn (the ball stays), a
+crease fill is not made, and a hole that is an island of a flat face with a bare rim — the footprint of a
+feature taken whole — is refused (:attr:`~.uncertainty.Estimate.unbounded`), since nothing bounds its height.
 """
 
 from __future__ import annotations
@@ -31,7 +40,8 @@ from .rims import boundary_edges, boundary_loops, enclosing_balls
 from .seal import Seal
 from .uncertainty import Estimate, uncertainty_from
 
-__all__ = ["patched_estimate", "hole_doubt_volumes", "ball_slab_volume", "crease_fills", "CreaseFill"]
+__all__ = ["patched_estimate", "hole_doubt_volumes", "ball_slab_volume", "crease_fills", "CreaseFill", "rim_evidence",
+           "RimEvidence", "bare_vertices"]
 
 
 def ball_slab_volume(radius: np.ndarray, offset: np.ndarray, half_width: np.ndarray) -> np.ndarray:
@@ -51,7 +61,7 @@ def ball_slab_volume(radius: np.ndarray, offset: np.ndarray, half_width: np.ndar
 
 def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
                        n_loops: int, centre: np.ndarray, radius: np.ndarray, vertex_of: np.ndarray,
-                       loop_of: np.ndarray) -> np.ndarray:
+                       loop_of: np.ndarray, slabs: dict[str, np.ndarray] | None = None) -> np.ndarray:
     """Volume in doubt of each hole (boundary loop), (n_loops,) m³: the ball over its rim, cut to a slab.
 
     Two assumptions, both about the missing surface ``M`` of the hole (the surface the file lost):
@@ -64,8 +74,9 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
        (for a spherical cap of half-angle α the ring plane is tilted by about α and the rim's far side lies
        ``2r sin α`` from it, more than the cap's height ``r tan(α/2)`` above the rim's own plane); a hole
        across a crease has ``e`` up to its width, and the ball decides.  It fails for a hole that swallowed a
-       whole boss or dimple standing on a flat face (the ring is flat, the missing part is not): the stated
-       limit of this bound.
+       whole boss or dimple standing on a flat face (the ring is flat, the missing part is not); on a CAD
+       tessellation the bare rim vertices that leaves show it (:func:`rim_evidence`), and the caller withdraws
+       the slab or refuses; on a surface with vertices inside its flat faces nothing shows it: the stated limit.
 
     The cone that patches the hole has its apex at the centroid of the rim vertices, so it lies in the rim's
     convex hull, inside both the ball and the slab of half-width ``e`` around the plane (a convex set holding
@@ -85,6 +96,9 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
         The ball enclosing each loop's rim (:func:`enclosing_balls`).
     vertex_of, loop_of : (p,) int
         The distinct (vertex, loop) pairs of the rims.
+    slabs : dict, optional
+        Filled with each loop's slab when given: ``has`` (n_loops,) bool (a ring face was found), ``normal`` and
+        ``origin`` (n_loops, 3) (its plane), ``half_width`` (n_loops,) m (``inf`` where none: the whole ball).
     """
     v = np.asarray(vertices, dtype=np.float64)
     ball: np.ndarray = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=np.float64) ** 3
@@ -146,6 +160,13 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     k = choice[has]
     offset = np.einsum("ij,ij->i", centre[has] - a[k], unit[k])
     doubt[has] = np.minimum(ball[has], ball_slab_volume(radius[has], offset, best[has] + margin))
+    if slabs is not None:          # the slab of each loop, for a caller that checks the assumption
+        slabs["has"] = has
+        slabs["normal"] = np.zeros((n_loops, 3))
+        slabs["normal"][has] = unit[k]
+        slabs["origin"] = np.zeros((n_loops, 3))
+        slabs["origin"][has] = a[k]
+        slabs["half_width"] = np.where(has, best + margin, np.inf)
     return doubt
 
 
@@ -179,7 +200,7 @@ CREASE_MAX_LOOPS = 5000
 
 
 def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
-                 centre: np.ndarray, radius: np.ndarray) -> list[CreaseFill]:
+                 centre: np.ndarray, radius: np.ndarray, *, bare: np.ndarray | None = None) -> list[CreaseFill]:
     """Holes across one crease, each filled by two planar fans instead of one cone (the third assumption).
 
     A hole that took triangles from two flat faces of a faceted part meeting at a crease (a box's edge, a
@@ -283,6 +304,8 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         # the vertex where plane p's chain ends and q's begins (a), and where q's ends and p's begins (b)
         a = next(order[i][0] for i in switch if side[i] == 1)
         b = next(order[i][0] for i in switch if side[i] == 0)
+        if bare is not None and any(bare[x] for x in rim.tolist() if x not in (a, b)):
+            continue                              # the hole took a third surface meeting a plane at a bare vertex
         parts = []
         for which in (0, 1):
             ids = sorted({x for (s0, s1), sd in zip(order, side) if sd == which for x in (s0, s1)})
@@ -302,6 +325,153 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
     return out
 
 
+@frozen_value
+class RimEvidence:
+    """What the surface left at each hole's rim says about the missing surface (:func:`rim_evidence`).
+
+    Attributes
+    ----------
+    flat_all_round : (n_loops,) bool
+        The rim lies in one plane (within ``FLAT_RIM_RTOL`` of its ball's radius) and so does every face left at
+        a rim vertex: the hole is an island in the middle of a flat face.
+    bare : (n_loops,) int
+        Rim vertices left *bare*: every face left at them lies within about 1° of one plane (a flat face of the
+        part), and no neighbour of theirs off the rims is flat that way.  A surface tessellated with vertices
+        only on the loops of its flat faces (as CAD exporters do: no vertex inside a flat face) has no flat
+        vertex, so a bare rim vertex lay on a loop of its face, and the hole took every face of the other surface
+        that met the face there.
+    """
+
+    flat_all_round: np.ndarray
+    bare: np.ndarray
+
+
+#: A rim "lies in a plane" when every rim vertex and every face left at the rim is within this share of the
+#: ball's radius of the plane of a ring face (far above round-off and quantisation to 1e-4 of a diagonal, far
+#: below any boss or pocket a designer draws).
+FLAT_RIM_RTOL = 1e-3
+#: A vertex is *flat* when every face at it is within acos(FLAT_VERTEX_COSINE) ≈ 1.1° of their mean plane.
+FLAT_VERTEX_COSINE = 1.0 - 2e-4
+
+
+def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                 radius: np.ndarray, *, flat_rtol: float = FLAT_RIM_RTOL,
+                 flat_cosine: float = FLAT_VERTEX_COSINE, bare: np.ndarray | None = None) -> RimEvidence:
+    """Read, for each boundary loop, what the faces left at its rim say (see :class:`RimEvidence`).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    edges : (k, 2) int
+        The boundary edges ``a→b`` (each the edge of one face in that direction); ``label`` (k,) their loop.
+    radius : (n_loops,) float
+        The radius of the ball over each rim (:func:`~.rims.enclosing_balls`), m.
+    flat_rtol, flat_cosine : float
+        ``FLAT_RIM_RTOL``, ``FLAT_VERTEX_COSINE``.
+    bare : (n,) bool, optional
+        :func:`bare_vertices` when the caller has it.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n = len(v)
+    flat = np.zeros(n_loops, dtype=bool)
+    if not n_loops or not len(edges) or not len(f):
+        return RimEvidence(flat_all_round=flat, bare=np.zeros(n_loops, dtype=np.int64))
+    # the face holding each rim edge a→b in that direction (the ring face)
+    nv = np.int64(max(n, 1))
+    directed = f.reshape(-1) * nv + f[:, [1, 2, 0]].reshape(-1)
+    order = np.argsort(directed, kind="stable")
+    query = edges[:, 0].astype(np.int64) * nv + edges[:, 1]
+    pos = np.minimum(np.searchsorted(directed[order], query), len(order) - 1)
+    found = directed[order[pos]] == query
+    face = order[pos] // 3
+    a, b, c = (v[f[face, k]] for k in range(3))
+    normal = np.cross(b - a, c - a)
+    area = np.linalg.norm(normal, axis=1)
+    # the plane of each loop's largest ring face; every face at a rim vertex within the tolerance of it
+    score = np.where(found & (area > 0), area, -1.0)
+    top = np.full(n_loops, -1.0)
+    np.maximum.at(top, label, score)
+    pick = np.flatnonzero((score >= top[label]) & (score > 0))
+    best = np.full(n_loops, -1, dtype=np.int64)
+    best[label[pick]] = pick
+    has = best >= 0
+    if has.any():
+        unit = np.zeros((n_loops, 3))
+        unit[has] = normal[best[has]] / area[best[has], None]
+        origin = np.zeros((n_loops, 3))
+        origin[has] = a[best[has]]
+        rim_pairs = np.unique(np.stack([np.r_[edges[:, 0], edges[:, 1]], np.r_[label, label]], axis=1), axis=0)
+        loop_at = np.full(n, -1, dtype=np.int64)
+        loop_at[rim_pairs[:, 0]] = rim_pairs[:, 1]     # a vertex on two rims (a pinch) keeps one: excluded below
+        on_two = np.bincount(rim_pairs[:, 0], minlength=n) > 1
+        fi, ci = np.nonzero(loop_at[f] >= 0)
+        loop = loop_at[f[fi, ci]]
+        dist = np.abs(np.einsum("ijk,ik->ij", v[f[fi]] - origin[loop][:, None, :], unit[loop])).max(axis=1)
+        worst = np.zeros(n_loops)
+        np.maximum.at(worst, loop, dist)
+        pinched = np.zeros(n_loops, dtype=bool)
+        pinched[rim_pairs[on_two[rim_pairs[:, 0]], 1]] = True
+        scale = float(np.max(np.abs(v)))
+        margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
+        flat = has & ~pinched & (worst <= flat_rtol * radius + margin)
+    if bare is None:
+        bare = bare_vertices(v, f, edges, flat_cosine=flat_cosine)
+    rim = np.unique(np.stack([edges[:, 0], label], axis=1), axis=0)
+    count = np.bincount(rim[:, 1], weights=bare[rim[:, 0]], minlength=n_loops).astype(np.int64)
+    return RimEvidence(flat_all_round=flat, bare=count)
+
+
+def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
+                  flat_cosine: float = FLAT_VERTEX_COSINE) -> np.ndarray:
+    """Rim vertices left bare, (n,) bool (:class:`RimEvidence`): every face left at the vertex lies within
+    ``acos(flat_cosine)`` of their mean plane, and one of them shares an edge with a face in that plane (they
+    belong to a flat face of the part, not a lone facet of a curved surface), and no neighbour of it off the
+    rims is flat that way (else the surface has vertices inside its flat faces there, and a flat rim vertex
+    proves nothing)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n = len(v)
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    area = np.linalg.norm(normal, axis=1)
+    good = area > 0
+    g, unit = f[good], normal[good] / area[good, None]
+    mean = np.zeros((n, 3))
+    for k in range(3):
+        np.add.at(mean, g[:, k], normal[good])
+    size = np.linalg.norm(mean, axis=1)
+    mean_unit = mean / np.where(size > 0, size, 1.0)[:, None]
+    least = np.ones(n)
+    for k in range(3):
+        np.minimum.at(least, g[:, k], np.einsum("ij,ij->i", unit, mean_unit[g[:, k]]))
+    # a face of a flat *face of the part*: it shares an edge with a face in its plane (a lone triangle of a
+    # curved surface is flat trivially and proves nothing)
+    key, _ = edge_keys(g, n)
+    order = np.argsort(key, kind="stable")
+    same = key[order][1:] == key[order][:-1]
+    first, second = order[:-1][same] // 3, order[1:][same] // 3
+    coplanar = np.einsum("ij,ij->i", unit[first], unit[second]) >= flat_cosine
+    in_flat_face = np.zeros(len(g), dtype=bool)
+    in_flat_face[first[coplanar]] = True
+    in_flat_face[second[coplanar]] = True
+    on_flat_face = np.zeros(n, dtype=bool)
+    for k in range(3):
+        on_flat_face[g[in_flat_face, k]] = True
+    flat = (least >= flat_cosine) & (size > 0) & on_flat_face
+    on_rim = np.zeros(n, dtype=bool)
+    on_rim[np.asarray(edges, dtype=np.int64).reshape(-1)] = True
+    # rim vertices with a flat neighbour off the rims: the surface has vertices inside its flat faces here
+    off = flat & ~on_rim
+    near_flat = np.zeros(n, dtype=bool)
+    for k in range(3):
+        for j in range(3):
+            if j != k:
+                near_flat[f[off[f[:, j]], k]] = True
+    bare: np.ndarray = flat & on_rim & ~near_flat
+    return bare
+
+
 #: Most (ring face, rim vertex) pairs measured by :func:`hole_doubt_volumes` (a few seconds); beyond it every
 #: hole keeps its whole ball (a bound that needs no ring).
 RING_WORK_LIMIT = 200_000_000
@@ -317,9 +487,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     ball enclosing its rim (:func:`enclosing_balls`); the cone lies there too, so the patched solid and the
     true one differ only inside those balls; with the second assumption (the missing surface strays from the
     plane of a face beside the hole no farther than the rim does) only inside each ball's slab around that
-    plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  With ``seal``, the seams it
-    sealed add their own doubt (:mod:`~.seal`).  Limits: a hole whose missing piece joins two rims (a band
-    round a handle) or reaches far outside its rim's ball (a pocket swallowed whole) is not covered.
+    plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  A hole with a bare rim vertex
+    keeps its whole ball, and a footprint of a feature taken whole sets ``unbounded`` (:func:`rim_evidence`;
+    the caller refuses).  With ``seal``, the seams it sealed add their own doubt (:mod:`~.seal`).  Limits: a
+    hole whose missing piece joins two rims (a band round a handle) or reaches far outside its rim's ball (a
+    feature swallowed whole on a surface that shows no bare rim vertex) is not covered.
 
     Parameters
     ----------
@@ -351,9 +523,17 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     if n_loops:
         centre, radius = enclosing_balls(v[vertex_of], loop_of, n_loops)
         hole_doubt = hole_doubt_volumes(v, f, edges, label, n_loops, centre, radius, vertex_of, loop_of)
-        creases = crease_fills(v, f, edges, label, n_loops, centre, radius)
+        bare = bare_vertices(v, f, edges)
+        evidence = rim_evidence(v, f, edges, label, n_loops, radius, bare=bare)
+        # a bare rim vertex: the hole took a surface that met the face beside it there, which need not stay
+        # near that face's plane: the slab is withdrawn, the ball (first assumption) bounds the hole
+        withdrawn = evidence.bare > 0
+        hole_doubt[withdrawn] = 4.0 / 3.0 * np.pi * radius[withdrawn] ** 3
+        creases = crease_fills(v, f, edges, label, n_loops, centre, radius, bare=bare)
+        unbounded = _contradicted(evidence, radius, size)
     else:
         centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
+        unbounded = ""
     cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
     extra = np.zeros((0, 3))
     if creases:               # holes across one crease: two planar fans instead of the cone (third assumption)
@@ -401,4 +581,27 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     else:
         detail = f"{sealed}no hole left" if sealed else "no hole"
     return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,
-                    uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far)
+                    uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far,
+                    unbounded=unbounded)
+
+
+def _contradicted(evidence: RimEvidence, radius: np.ndarray, size: np.ndarray) -> str:
+    """Why the faces left at some hole's rim contradict the bound's assumption (empty when none does).
+
+    The bound assumes the missing surface of each hole stays near its rim (the ball, cut to the slab).  A hole
+    that is an island in a flat face *and* has a bare rim vertex (:class:`RimEvidence`) contradicts it: on a
+    surface with no vertex inside its flat faces the rim was a loop of the face, the footprint of something
+    standing on it or sunk into it (a boss, a pocket, a connector housing) that the hole took whole, whose
+    height nothing in the file bounds.
+    """
+    found = np.flatnonzero(evidence.flat_all_round & (evidence.bare > 0))
+    if not len(found):
+        return ""
+    k = int(found[np.argmax(radius[found])])
+    many = len(found) != 1
+    return (f"{len(found)} hole{'s' if many else ''} (the largest a rim of {int(size[k])} vertices, "
+            f"{round_up(2 * float(radius[k])):.3g} m across) {'are islands' if many else 'is an island'} in a flat "
+            "face whose rim kept no face off that face, on a surface with no vertex inside its flat faces: the rim "
+            "is the footprint of a feature standing on the face or sunk into it (a boss, a pocket) that the hole "
+            "took whole, and nothing in the file bounds its height (expected a rim that keeps a face of the "
+            "surface beside it)")

@@ -319,6 +319,10 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
                                "thin-walled part use the shell model with a wall `thickness`")
+    if best.unbounded:                        # a hole whose surroundings contradict the bound's assumption
+        raise InvalidMeshError(f"{source}: the patched surface cannot be bounded: {best.unbounded}; close the "
+                               "hole in a mesh editor (or from the part's CAD model)",
+                               details={"reason": "hole bound's assumption contradicted"})
     if best.method == "winding":              # a patched estimate is checked on the classified total (prepare)
         check_useful(best.volume, best.uncertainty, source=source, what="the winding-number estimate",
                      why="the loose triangles do not enclose a definite volume; mesh the part again as a closed "

@@ -72,6 +72,9 @@ class Estimate:
         The closed surface integrated (the patched mesh), or the input for the winding estimate.
     far : float
         Largest distance from ``centroid`` to the region in doubt, m (enters the bounds).
+    unbounded : str
+        Empty, or why no bound follows (the surface beside a hole contradicts the assumption the bound needs):
+        the caller refuses with this reason.
     """
 
     volume: float
@@ -84,6 +87,7 @@ class Estimate:
     vertices: np.ndarray
     faces: np.ndarray
     far: float = 0.0
+    unbounded: str = ""
 
 
 def uncertainty_from(volume: float, centroid: np.ndarray, second_moment: np.ndarray, doubt: float,

@@ -1,0 +1,231 @@
+"""Holes that took a whole feature, and the guarantee every hole bound gives (``mesh/holes.py``:
+:func:`rim_evidence`, the refusal of footprints in :func:`patched_estimate`).
+
+The guarantee tested here: for every generated part and hole, the estimate is either refused (its surroundings
+contradict the assumption, or its mass bound exceeds ``ESTIMATE_MAX_MASS_RTOL``) or its stated bound contains
+the exact integral of the undamaged part.
+"""
+
+import numpy as np
+import pytest
+import trimesh
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from inertia_tool import mass_properties
+from inertia_tool.errors import InvalidMeshError
+from inertia_tool.integrals import volume_moments
+from inertia_tool.mesh.holes import patched_estimate, rim_evidence
+from inertia_tool.mesh.rims import boundary_edges, boundary_loops, enclosing_balls
+from inertia_tool.tolerances import ESTIMATE_MAX_MASS_RTOL
+
+m3d = pytest.importorskip("manifold3d")
+
+
+def _inertia(m):
+    return np.trace(m.second_moment) * np.eye(3) - m.second_moment
+
+
+def _holds(est, truth):
+    """The truth lies inside every bound the estimate states (round-off of 1e-12 allowed)."""
+    u = est.uncertainty
+    return (abs(est.volume - truth.volume) <= u.mass * est.volume * (1 + 1e-12) + 1e-12 * truth.volume
+            and np.linalg.norm(est.centroid - truth.centroid) <= u.center_of_mass * (1 + 1e-12) + 1e-12
+            and np.linalg.norm(_inertia(est) - _inertia(truth))
+            <= u.inertia * np.linalg.norm(_inertia(est)) * (1 + 1e-12) + 1e-12 * np.linalg.norm(_inertia(truth)))
+
+
+def _refused_or_holds(est, truth):
+    """Refused (the reason said) or inside its bound: never a stated bound that misses."""
+    return bool(est.unbounded) or est.uncertainty.mass > ESTIMATE_MAX_MASS_RTOL or _holds(est, truth)
+
+
+def featured_box(extents, place, size, height):
+    """A box with a rectangular boss (``height`` > 0) or pocket (< 0) on its top face, made by manifold3d,
+    whose flat faces are triangulated with vertices on their loops only (as CAD exporters do).
+
+    Returns the vertices, faces, the feature's faces (walls and top or floor) and its top or floor faces."""
+    w, d, h = extents
+    fw, fd = size[0] * w, size[1] * d
+    x0, y0 = place[0] * (w - fw), place[1] * (d - fd)
+    body = m3d.Manifold.cube([w, d, h])
+    if height > 0:
+        body = body + m3d.Manifold.cube([fw, fd, height]).translate([x0, y0, h])
+    else:
+        body = body - m3d.Manifold.cube([fw, fd, 1.0 - height]).translate([x0, y0, h + height])
+    mesh = body.to_mesh()
+    v = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
+    f = np.asarray(mesh.tri_verts, dtype=np.int64)
+    corners = v[f]
+    tol = 1e-5 * max(extents)
+    inside = np.all((corners[:, :, 0] >= x0 - tol) & (corners[:, :, 0] <= x0 + fw + tol)
+                    & (corners[:, :, 1] >= y0 - tol) & (corners[:, :, 1] <= y0 + fd + tol), axis=1)
+    feature = inside & np.any(np.abs(corners[:, :, 2] - h) > tol, axis=1)
+    end = np.all(np.abs(corners[:, :, 2] - (h + height)) <= tol, axis=1)
+    return v, f, np.flatnonzero(feature), np.flatnonzero(end)
+
+
+def _patch(v, f, start, count):
+    """``count`` faces grown breadth-first across edges from face ``start``."""
+    mesh = trimesh.Trimesh(v, f, process=False)
+    neighbours = [[] for _ in range(len(f))]
+    for a, b in mesh.face_adjacency.tolist():
+        neighbours[a].append(b)
+        neighbours[b].append(a)
+    seen, queue = {start}, [start]
+    for face in queue:
+        if len(seen) >= count:
+            break
+        for other in neighbours[face]:
+            if other not in seen and len(seen) < count:
+                seen.add(other)
+                queue.append(other)
+    return np.array(sorted(seen), dtype=np.int64)
+
+
+# ------------------------------------------------------------------------------ the xarm7 housing, made small
+
+@pytest.mark.parametrize("height", [3.0, 0.4, -0.6])
+def test_a_feature_taken_whole_is_refused_with_its_reason(height):
+    """``7-38-crack_hole`` of the damage benchmark (xarm7 ``link_base.stl``: a connector housing taken whole,
+    its rim the footprint on the flat side, a flat patch with a bound of round-off, 1 % low): a boss or pocket
+    on a box taken whole, walls and top.  The rim is an island of the top face with nothing off the face left
+    at it, on a surface with no vertex inside a flat face: refused, the reason named, whatever the height."""
+    v, f, feature, _ = featured_box((5.0, 4.0, 1.0), (0.5, 0.4), (0.2, 0.25), height)
+    open_f = np.delete(f, feature, axis=0)
+    est = patched_estimate(v, open_f, volume_moments)
+    assert "footprint" in est.unbounded
+    with pytest.raises(InvalidMeshError, match="footprint of a feature"):
+        mass_properties((v, open_f), density=1.0, repair=True)
+
+
+def test_a_flat_hole_in_a_cad_face_is_still_answered_exactly():
+    """The other side of the rule: a triangle missing from the top face beside the boss (its rim keeps the
+    box's side and the boss's wall) is a flat hole, answered with a bound of round-off, exactly."""
+    v, f, feature, _ = featured_box((5.0, 4.0, 1.0), (0.5, 0.4), (0.2, 0.25), 2.0)
+    top = np.flatnonzero(np.all(np.abs(v[f][:, :, 2] - 1.0) < 1e-6, axis=1))
+    truth = volume_moments(v, f)
+    for face in top:
+        est = patched_estimate(v, np.delete(f, face, axis=0), volume_moments)
+        assert not est.unbounded
+        assert est.volume == pytest.approx(truth.volume, rel=1e-12)
+        assert est.uncertainty.mass < 1e-9
+        assert _holds(est, truth)
+
+
+def test_rim_evidence_on_a_footprint_and_on_a_finely_tessellated_face():
+    """The footprint's four rim corners are bare on the manifold3d part (no vertex inside its flat faces);
+    the same footprint on the subdivided part is flat all round but not bare (the tessellation puts vertices
+    inside flat faces, so it proves nothing): the rule needs both."""
+    v, f, feature, _ = featured_box((5.0, 4.0, 1.0), (0.5, 0.4), (0.2, 0.25), 1.0)
+    for fine in (False, True):
+        vv, ff = (v, f)
+        gone = feature
+        if fine:
+            mesh = trimesh.Trimesh(v, np.delete(f, feature, axis=0), process=False).subdivide()
+            vv, ff, gone = np.asarray(mesh.vertices), np.asarray(mesh.faces), np.zeros(0, dtype=np.int64)
+        open_f = np.delete(ff, gone, axis=0)
+        edges = boundary_edges(open_f, len(vv))
+        label, n_loops = boundary_loops(edges, len(vv), open_f, vv)
+        pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
+        _, radius = enclosing_balls(vv[pairs[:, 1]], pairs[:, 0], n_loops)
+        found = rim_evidence(vv, open_f, edges, label, n_loops, radius)
+        assert found.flat_all_round.tolist() == [True]
+        assert found.bare.tolist() == ([0] if fine else [4])
+
+
+# ----------------------------------------------------------------------------- the guarantee, generated
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(extents=st.tuples(st.floats(1.0, 6.0), st.floats(1.0, 6.0), st.floats(0.3, 3.0)),
+       place=st.tuples(st.floats(0.05, 0.95), st.floats(0.05, 0.95)),
+       size=st.tuples(st.floats(0.1, 0.6), st.floats(0.1, 0.6)),
+       height=st.one_of(st.floats(0.05, 5.0), st.floats(-0.9, -0.05)),
+       pattern=st.sampled_from(["feature", "end", "patch"]), start=st.integers(0, 10 ** 6),
+       share=st.floats(0.0, 0.6),
+       quat=st.tuples(*[st.floats(-1, 1)] * 4).filter(lambda q: np.linalg.norm(q) > 0.1))
+def test_holes_over_bosses_and_pockets_are_refused_or_inside_their_bound(extents, place, size, height, pattern,
+                                                                          start, share, quat):
+    """A box with a boss or pocket (manifold3d), turned at random, less the whole feature, its top or floor, or
+    a connected patch of faces grown from a random face: refused, or inside the stated bound."""
+    height = height if height > 0 else height * extents[2]
+    v, f, feature, end = featured_box(extents, place, size, height)
+    v = v @ Rotation.from_quat(quat).as_matrix().T
+    if pattern == "feature":
+        gone = feature
+    elif pattern == "end":
+        gone = end
+    else:
+        gone = _patch(v, f, start % len(f), max(1, int(share * len(f))))
+    truth = volume_moments(v, f)
+    est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
+    assert _refused_or_holds(est, truth)
+
+
+@settings(max_examples=40, deadline=None)
+@given(height=st.floats(-0.999, 0.98), quat=st.tuples(*[st.floats(-1, 1)] * 4)
+       .filter(lambda q: np.linalg.norm(q) > 0.1))
+def test_spherical_caps_up_to_nearly_the_whole_sphere_are_refused_or_inside_their_bound(height, quat):
+    """A cap above z = ``height`` cut from an icosphere, turned: up to a hemisphere the cap lies in the ball over
+    its rim and the bound holds; beyond it (``height`` < 0) the cap leaves the ball, and the bound, then more than
+    the whole remaining part, is refused."""
+    s = trimesh.creation.icosphere(3)
+    v0, f = np.asarray(s.vertices), np.asarray(s.faces)
+    open_f = f[~np.all(v0[f][:, :, 2] > height, axis=1)]
+    if not len(open_f):
+        return
+    v = v0 @ Rotation.from_quat(quat).as_matrix().T
+    est = patched_estimate(v, open_f, volume_moments)
+    assert _refused_or_holds(est, volume_moments(v, f))
+
+
+@settings(max_examples=40, deadline=None)
+@given(sections=st.integers(3, 12), start=st.integers(0, 10 ** 6), count=st.integers(1, 12),
+       quat=st.tuples(*[st.floats(-1, 1)] * 4).filter(lambda q: np.linalg.norm(q) > 0.1))
+def test_holes_across_creases_of_prisms_are_refused_or_inside_their_bound(sections, start, count, quat):
+    """A coarse prism (``sections`` sides, CAD-like: no vertex inside a face) less a connected patch of faces,
+    across its creases and caps: refused, or inside the stated bound."""
+    s = trimesh.creation.cylinder(radius=1.0, height=1.3, sections=sections)
+    hull = trimesh.convex.convex_hull(s.vertices)          # caps without their centre vertices
+    v = np.asarray(hull.vertices) @ Rotation.from_quat(quat).as_matrix().T
+    f = np.asarray(hull.faces)
+    gone = _patch(v, f, start % len(f), min(count, len(f) - 1))
+    est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
+    assert _refused_or_holds(est, volume_moments(v, f))
+
+
+# ------------------------------------------------------------------------- the benchmark's two failures
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", ["7-38-crack_hole", "15-38-t_junction_hole"])
+def test_the_xarm7_link_base_holes_of_the_damage_benchmark_are_inside_their_bound(case):
+    """The two bounds that failed in the coverage benchmark (xarm7 ``link_base.stl``, a connector housing taken
+    whole or its top cut off; docs/damage-benchmark.md).  Their rims keep bare vertices (the housing's walls
+    met the flat side or the shoulder there and are gone), so the slab is withdrawn and the ball states the
+    bound, which now holds (the missing surface still leaves the ball: the assumption is false, the bound holds
+    by its volume).  Needs the robot parts of ``benchmarks/damage/make_cases.py`` (skipped without them)."""
+    import sys
+    from pathlib import Path
+    here = Path(__file__).resolve().parents[1] / "benchmarks" / "damage"
+    sys.path.insert(0, str(here))
+    try:
+        import coverage as cov
+    finally:
+        sys.path.remove(str(here))
+    robots = cov.robot_sources()
+    match = [(name, v, f) for name, v, f in robots if name.endswith("xarm7/visual/link_base.stl")]
+    if not match:
+        pytest.skip("the robot parts are not downloaded (benchmarks/damage/make_cases.py)")
+    name, v, f = match[0]
+    seed, kind = int(case.split("-")[0]), case.split("-", 2)[2]
+    truth = cov.truth_of(v, f)
+    rng = np.random.default_rng([seed, 38, cov.KINDS.index(kind), 0])
+    if rng.random() < cov.QUANTISE_SHARE:
+        qv, qf, _ = cov._quantised(v, f, rng, truth["diagonal"])
+        qt = cov.truth_of(qv, qf)
+        if qt is not None:
+            v, f, truth = qv, qf, qt
+    dv, df, _ = cov.make_case(kind, v, f, rng, truth["diagonal"])
+    row = cov.evaluate(dv, df, truth)
+    assert row["status"] == "answer" and row["holds"], row
