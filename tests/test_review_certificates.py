@@ -332,3 +332,35 @@ def test_welded_slabs_never_give_a_wrong_number(seed, k, without_r3a, repair, mo
     p = _analyse(v, f, repair=repair)
     label, ok = _honest(p, S.truth_from_pieces([(1, x) for x in pieces]), _diag(v))
     assert ok, (label, p.mesh.certificate if p is not None else None)
+
+
+@pytest.mark.parametrize("reach", [1, 2])
+@pytest.mark.parametrize("flip", [False, True])
+def test_r3b_sheet_welded_to_a_cavity_wall(reach, flip):
+    """A 5 m cube of cells with a 3 m cubic cavity, and a flat sheet in the wall between them (plane y = 2, from
+    the outer face x = 0 to ``reach``): with reach 1 its rim is welded by index to both the outer face and the
+    cavity's wall (a wall joining them, material on both sides: exact, 98 m³); with reach 2 it runs on into the
+    cavity (a fin there: must not be certified as the solid with that piece as a wall)."""
+    rng = np.random.default_rng(reach + 2 * flip)
+    cells = {(i, j, k) for i in range(5) for j in range(5) for k in range(5)} - \
+        {(i, j, k) for i in range(1, 4) for j in range(1, 4) for k in range(1, 4)}
+    v, f = S.cell_body(cells, 1.0, rng)
+    index = {tuple(p): i for i, p in enumerate(v.tolist())}
+    pts = [tuple(float(x) for x in (i, 2, k)) for i in range(reach + 1) for k in range(1, 5)]
+    for p in pts:
+        index.setdefault(p, len(index))
+    v = np.array(sorted(index, key=index.get), dtype=np.float64)
+    grid = {(i, k): index[(float(i), 2.0, float(k))] for i in range(reach + 1) for k in range(1, 5)}
+    sheet = []
+    for i in range(reach):
+        for k in range(1, 4):
+            a, b, c, d = grid[(i, k)], grid[(i + 1, k)], grid[(i + 1, k + 1)], grid[(i, k + 1)]
+            sheet += [[a, b, c], [a, c, d]]
+    sheet = np.array(sheet)
+    f = np.vstack([f, sheet[:, ::-1] if flip else sheet])
+    p = _analyse(v, f)
+    truth = S.truth_from_pieces([(1, S.box((1.0,) * 3, np.asarray(c, dtype=np.float64) + 0.5)) for c in sorted(cells)])
+    label, ok = _honest(p, truth, _diag(v))
+    assert ok, (label, p.volume if p is not None else None)
+    if reach == 1:
+        assert label == "exact" and "open-sheets" in p.mesh.certificate.checks
