@@ -334,8 +334,7 @@ def test_welded_slabs_never_give_a_wrong_number(seed, k, without_r3a, repair, mo
     assert ok, (label, p.mesh.certificate if p is not None else None)
 
 
-@pytest.mark.parametrize("reach", [1, 2])
-@pytest.mark.parametrize("flip", [False, True])
+@pytest.mark.parametrize(("reach", "flip"), [(1, False), (1, True), (2, False)])
 def test_r3b_sheet_welded_to_a_cavity_wall(reach, flip):
     """A 5 m cube of cells with a 3 m cubic cavity, and a flat sheet in the wall between them (plane y = 2, from
     the outer face x = 0 to ``reach``): with reach 1 its rim is welded by index to both the outer face and the
