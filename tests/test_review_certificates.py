@@ -9,8 +9,8 @@
 Each generator draws inputs near the rule's boundary and compares every answer labelled ``exact``, ``united`` or
 ``summed`` with an independent truth (exact rationals of the intended solid, manifold3d's union of the intended
 bodies, or libigl's generalised winding number); an estimate must hold its own bound; a refusal is always
-allowed.  Inputs on which a rule gives a wrong number under a proven label are kept as strict xfail reproducers
-(the rules are owned elsewhere; the docstring of each says which rule and why).
+allowed.  Inputs on which a rule gave a wrong number under a proven label are kept as reproducers (strict xfails
+until the rule was mended; the docstring of each says which rule and why).
 """
 
 from __future__ import annotations
@@ -101,7 +101,7 @@ def _cavity_truth():
 
 @pytest.mark.parametrize("scale", [0.999, 1.2])
 def test_cracked_cavity_reads_as_a_void_by_the_generalised_winding_number(scale):
-    """The premise of the two xfails below, by independent code (libigl): the cavity's centre has generalised
+    """The premise of the two reproducers below, by independent code (libigl): the cavity's centre has generalised
     winding number below 1/2 (a void), the solid well away from it about 1."""
     import igl
 
@@ -111,7 +111,6 @@ def test_cracked_cavity_reads_as_a_void_by_the_generalised_winding_number(scale)
     assert w[0] < 0.5 and abs(w[1] - 1) < 1e-2, w
 
 
-@pytest.mark.xfail(strict=True, reason="R3b takes the faces of a cracked cavity out as walls: cavity lost, exact")
 def test_r3b_cavity_with_open_slits_is_not_certified_solid():
     """R3b (mesh/sheets.py): a cavity whose four flat faces lost their shared corners (each shrunk by 0.1 % in its
     plane, so its rim corners are ~1e-3 apart, far beyond the ``MERGE_TOLERANCE`` reach of ``_rims_meet``).  Each
@@ -119,7 +118,8 @@ def test_r3b_cavity_with_open_slits_is_not_certified_solid():
     its cavity (volume 64 instead of 63.52, -0.75 %), certified exact.  The module's lemma holds sheet by sheet
     (|w_Σ| < 1/2 for one plane region) but not for several sheets together: their solid angles add up to nearly
     4π, and the generalised winding number reads the cavity as void (test above).  The rims-meet guard only
-    catches corners within the weld distance."""
+    catches corners within the weld distance.  Fixed since (a strict xfail until then): several sheets are taken
+    only when every rim corner of each lies on the rest (``sheets._rim_corners``); a free sheet only alone."""
     v, f = _cracked_cavity(0.999)
     assert MERGE_TOLERANCE * _diag(v) < 1e-4                   # the slits are far wider than the weld reach
     p = _analyse(v, f)
@@ -127,14 +127,13 @@ def test_r3b_cavity_with_open_slits_is_not_certified_solid():
     assert ok, (label, p.volume)
 
 
-@pytest.mark.xfail(strict=True, reason="R3b does not check sheets against each other: crossing cavity faces taken out")
 def test_r3b_cavity_whose_faces_cross_each_other_is_not_certified_solid():
     """R3b (mesh/sheets.py): the cavity's four faces each enlarged by 20 % in their planes, so they cross one
     another along the cavity's edges (and no rim corner is near another).  The face-pair check is applied only to
     sheet-versus-rest pairs (``touches_rest``) and rest-versus-rest crossings; sheet-versus-sheet crossings pass,
     so the four are taken out as walls and the cavity is lost (64 instead of 63.52) under exact.  A one-line guard
     (refuse when any contact pair has both faces in sheets of different pieces) would close this case, but not the
-    slit case above."""
+    slit case above.  Fixed since by the same guard as above: these sheets are free, so several are not taken."""
     v, f = _cracked_cavity(1.2)
     p = _analyse(v, f)
     label, ok = _honest(p, _cavity_truth(), _diag(v))
