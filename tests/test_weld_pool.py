@@ -131,8 +131,9 @@ def test_weld_outputs_live_on_scratch_and_match_numpy(lib, monkeypatch):
 
 def test_kept_mappings_are_unmapped_before_another_kernel_maps_fresh_ones(lib):
     """The face-pair check maps its arrays fresh (arena_alloc): the kept mappings are unmapped first, so that
-    keeping them never raises the peak memory of an analysis (the check sets it)."""
-    pts = _torus_soup(60, 40)
+    keeping them never raises the peak memory of an analysis (the check sets it).  Arrays below 1 MB come from
+    the heap instead (a small part's scan), so the torus is large enough for the mapped path."""
+    pts = _torus_soup(400, 300)
     vertices, ids = _part_welder(lib, pts, 2)
     assert lib.kept_buffers() > 0
     lib.contact_scan(vertices, ids.reshape(-1, 3), -1)
