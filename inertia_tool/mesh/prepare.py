@@ -34,6 +34,7 @@ from .intersect import SurfaceContacts, surface_contacts
 from ..rounding import round_up
 
 if TYPE_CHECKING:       # imported on use at run time (below)
+    from .uncertainty import Estimate
     from .nesting import Nesting
     from .union import UnionSurface
 
@@ -315,6 +316,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                  moments=volume_moments, force_estimate=True,
                                  reason=f"the surface passes through itself at {touch.self_crossing_pairs:,} "
                                         f"face pairs{arrange_failed}")
+        if patched is not None:
+            forced = _with_patch_doubt(forced, patched, source)
         warnings.warn(MeshRepairedWarning(f"{source}: repaired ({forced.method}, an estimate): "
                                           f"{'; '.join(forced.notes)}"), stacklevel=3)
         return _estimated(forced, common)
@@ -852,6 +855,29 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
         raise InvalidMeshError(f"{source}: overlapping bodies whose union cannot be formed ({exc}); "
                                "`overlap` 'sum' adds them (shared volume counted twice), `repair=True` gives a "
                                "bounded estimate") from None
+
+
+def _with_patch_doubt(forced: Resolution, patched: Estimate, source: str) -> Resolution:
+    """The estimate of a patched surface that then turned out to pass through itself, with the patches' own doubt
+    added to the grid's.
+
+    The grid estimate bounds its distance from the solid {w ≥ 1} of the surface it was given, the patched one;
+    that solid differs from the true one only where the patches' bound says (the doubtful regions over the holes,
+    :mod:`~.holes`).  So the volume in doubt is the sum of both, lying within the farther of the two reaches from
+    the estimate's centroid (the patches' measured from the patched centroid, plus the distance between the
+    centroids).  The grid's cell-by-cell first and second moments of doubt are not kept: the bound is wider
+    than either alone, never narrower than the truth allows (before, the patches' doubt was dropped)."""
+    from .uncertainty import check_useful, uncertainty_from
+    est = forced.estimate
+    assert est is not None, "a forced resolution carries its estimate"
+    doubt = est.uncertainty.volume_in_doubt + patched.uncertainty.volume_in_doubt
+    far = max(est.far, patched.far + float(np.linalg.norm(np.asarray(est.centroid) - patched.centroid)))
+    unc = uncertainty_from(est.volume, est.centroid, est.second_moment, doubt, far)
+    check_useful(est.volume, unc, source=source, what="the patched surface's winding-number estimate")
+    note = (f"the holes' patches add their own {patched.uncertainty.volume_in_doubt:.3g} m³ in doubt to the "
+            "grid's")
+    return dataclasses.replace(forced, estimate=dataclasses.replace(est, uncertainty=unc),
+                               notes=forced.notes + (note,))
 
 
 def _estimated(found: Resolution, common: dict[str, Any]) -> PreparedMesh:
