@@ -736,3 +736,47 @@ def test_submesh_read_failure_names_the_users_file_not_a_copy(tmp_path):
     (result,) = link_inertials(robot, density=1)
     assert result.properties is None and f"{path} [submesh 'Wire']" in result.problem
     assert "inertia_tool_submesh_" not in result.problem
+
+
+def test_a_mesh_file_is_read_once_per_content_and_its_warnings_come_every_time(tmp_path):
+    """The link integrals, the audit's bounds and its inside tests each want a link's mesh: it is read once
+    (robot.geometry's read cache), its arrays read-only, the reader's warnings issued on every use; a file
+    rewritten with other bytes of the same size is read again (the key hashes the content)."""
+    import warnings
+
+    from inertia_tool.robot import geometry
+
+    path = tmp_path / "part.stl"
+    shapes.write_stl(shapes.box(0.1, 0.2, 0.3), path)
+    calls = []
+    real = geometry._read_mesh_file
+
+    def counting(*args):
+        calls.append(args[0])
+        return real(*args)
+
+    geometry._READ_CACHE.clear()
+    try:
+        geometry._read_mesh_file = counting
+        first = geometry._raw_mesh(str(path), None)
+        again = geometry._raw_mesh(str(path), None)
+        assert again is first and len(calls) == 1
+        with pytest.raises(ValueError):
+            first.vertices[0, 0] = 1.0                          # shared arrays are read-only
+        shapes.write_stl(shapes.box(0.3, 0.2, 0.1), path)      # same size, other bytes
+        other = geometry._raw_mesh(str(path), None)
+        assert len(calls) == 2 and not np.array_equal(other.vertices, first.vertices)
+        # a warning of the reader (a non-planar quadrilateral of an OBJ) comes with every use, not only the first
+        quad = tmp_path / "quad.obj"
+        quad.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0.3\nv 0 1 0\nv 0.5 0.5 -1\nf 1 2 3 4\nf 2 1 5\nf 3 2 5\n"
+                        "f 4 3 5\nf 1 4 5\n")
+        seen = []
+        for _ in range(2):
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                geometry._raw_mesh(str(quad), None)
+            seen.append(sorted(str(w.message) for w in caught))
+        assert len(calls) == 3 and seen[0] == seen[1] and any("not planar" in m for m in seen[0])
+    finally:
+        geometry._read_mesh_file = real
+        geometry._READ_CACHE.clear()

@@ -114,10 +114,67 @@ def _raw_mesh(path: str | None, element: GeometryElement | None, max_faces: int 
                                 f"({max_faces:,})")
         return RawMesh(vertices=np.array(element.vertices, dtype=np.float64), faces=faces.copy(),
                        source=_mesh_label(element), units="m", file_faces=len(faces))
+    limit = DEFAULT_MAX_FACES if max_faces is None else max_faces
+    submesh = (element.submesh, bool(element.submesh_center)) if element is not None and element.submesh else None
+    key = _content_key(path, submesh)
+    hit = _READ_CACHE.get(key) if key is not None else None
+    if hit is not None and hit[0].file_faces <= limit:
+        _READ_CACHE[key] = _READ_CACHE.pop(key)  # most recently used last
+        _reissue(hit[1])
+        return hit[0]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        raw = _read_mesh_file(path, element, limit)
+    _reissue(caught)
+    if key is not None:
+        _remember(key, raw, tuple(caught))
+    return raw
+
+
+#: Meshes read in this process (``_raw_mesh``): the link integrals, the audit's bounds and its inside tests read
+#: each mesh file of a robot, three reads of every COLLADA file of UR5e's visual geometry before.  Keyed by the
+#: file's real path, size, a hash of its bytes and the sub-mesh (:func:`_content_key`); the arrays are made
+#: read-only; the reader's warnings are kept and issued again on every use.  At most :data:`READ_CACHE_FACES`
+#: faces are kept (least recently used dropped first).
+_READ_CACHE: dict = {}
+READ_CACHE_FACES = 4_000_000
+
+
+#: Files larger than this are read every time, not hashed and kept.
+READ_CACHE_BYTES = 64 << 20
+
+
+def _content_key(path: str, submesh) -> tuple | None:
+    """The cache key of a mesh file: its real path, size and a hash of its bytes (a file rewritten within the
+    file system's timestamp resolution is still told apart), with the sub-mesh; None when it is not kept."""
+    from ..mesh.regular import open_regular
+    try:
+        if os.path.getsize(path) > READ_CACHE_BYTES:
+            return None
+        with open_regular(path) as fh:
+            data = fh.read(READ_CACHE_BYTES + 1)
+    except (OSError, InertiaToolError):          # the reader says what is wrong with the path
+        return None
+    if len(data) > READ_CACHE_BYTES:
+        return None
+    return os.path.realpath(path), len(data), hashlib.blake2b(data, digest_size=16).digest(), submesh
+
+
+def _remember(key, raw: RawMesh, caught: tuple) -> None:
+    faces = len(raw.faces)
+    if faces > READ_CACHE_FACES:
+        return
+    raw.vertices.flags.writeable = False
+    raw.faces.flags.writeable = False
+    _READ_CACHE[key] = (raw, caught)
+    while sum(len(item[0].faces) for item in _READ_CACHE.values()) > READ_CACHE_FACES:
+        _READ_CACHE.pop(next(iter(_READ_CACHE)))
+
+
+def _read_mesh_file(path: str, element: GeometryElement | None, limit: int) -> RawMesh:
     from ..mesh.read import load_mesh
     # robot descriptions give mesh coordinates in metres (the element's `scale` is applied here), so the unit is
     # stated, not assumed: no size warning for a millimetre mesh scaled by 0.001 in the description
-    limit = DEFAULT_MAX_FACES if max_faces is None else max_faces
     if element is None or not element.submesh:
         return load_mesh(path, units="m", max_faces=limit)
     return _submesh(path, element, limit)
