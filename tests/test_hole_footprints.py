@@ -9,7 +9,7 @@ the exact integral of the undamaged part.
 import numpy as np
 import pytest
 import trimesh
-from hypothesis import HealthCheck, given, settings
+from hypothesis import example, HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
@@ -138,6 +138,8 @@ def test_rim_evidence_on_a_footprint_and_on_a_finely_tessellated_face():
 # ----------------------------------------------------------------------------- the guarantee, generated
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@example(extents=(1.0, 1.0, 1.0), place=(0.5, 0.875), size=(0.5, 0.125), height=0.25, pattern="patch", start=2250,
+         share=0.5, quat=(0.0, 0.0, 0.0, 1.0))       # found by CI: a crease fill over the top face's remaining faces
 @given(extents=st.tuples(st.floats(1.0, 6.0), st.floats(1.0, 6.0), st.floats(0.3, 3.0)),
        place=st.tuples(st.floats(0.05, 0.95), st.floats(0.05, 0.95)),
        size=st.tuples(st.floats(0.1, 0.6), st.floats(0.1, 0.6)),
@@ -229,3 +231,24 @@ def test_the_xarm7_link_base_holes_of_the_damage_benchmark_are_inside_their_boun
     dv, df, _ = cov.make_case(kind, v, f, rng, truth["diagonal"])
     row = cov.evaluate(dv, df, truth)
     assert row["status"] == "answer" and row["holds"], row
+
+
+@pytest.mark.xfail(strict=True, reason="crease fill of a part that lost half its faces: the two planes hold the rim "
+                                       "but not the missing surface; stated bound ~1e-13, answer 80 % low")
+@pytest.mark.parametrize("extents, place, size, height, start, quat", [
+    ((1.0, 2.0, 1.0), (0.5, 0.5), (0.5, 0.5), 1.0, 0, (0.0, 0.0, 1.0, 0.5)),          # a boss; estimate = boss
+    ((1.0, 1.0, 1.0), (0.25, 0.5), (0.25, 0.5), -0.5, 27, (0.0, 0.0, 1.0, 1.0)),      # a pocket
+])
+def test_a_crease_fill_when_half_the_part_is_gone_is_refused_or_bounded(extents, place, size, height, start, quat):
+    """Known defect, found by the generated test above on random seeds 11 and 12 (CI's fixed sequence passes):
+    half of a featured box's faces gone in one connected patch leaves a rim of 6 edges in two planes; the crease
+    fill (third assumption: the missing surface lies in those planes) closes the feature alone and states a
+    bound of round-off.  Nothing in the faces left contradicts the assumption the way
+    ``holes._crease_contradicted`` can see (no fill lies over a face of the file).  Kept as a reproducer until a
+    check that holds is found; the hole bounds rest on stated assumptions (docs/meshes.md)."""
+    height = height if height > 0 else height * extents[2]
+    v, f, _, _ = featured_box(extents, place, size, height)
+    v = v @ Rotation.from_quat(quat).as_matrix().T
+    gone = _patch(v, f, start % len(f), max(1, int(0.5 * len(f))))
+    est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
+    assert _refused_or_holds(est, volume_moments(v, f))

@@ -479,6 +479,37 @@ RING_WORK_LIMIT = 200_000_000
 RING_CHUNK = 2_000_000
 
 
+def _crease_contradicted(pv: np.ndarray, pf: np.ndarray, n_given: int, creases: list[CreaseFill], n_loops: int,
+                         n_vertices: int) -> list[int]:
+    """Loops whose crease fill meets a face of the file other than along shared edges and corners (the face-pair
+    check, exact): a fill lying over, or through, surface the file has is not where the surface is missing, so
+    the third assumption is contradicted there (a box with a boss, half its faces gone: the fill of the top
+    face's plane closed the boss alone, 98 % low at a stated ±1e-12)."""
+    from .intersect import surface_contacts
+    contacts = surface_contacts(pv, pf)
+    pairs = np.concatenate([np.asarray(p, dtype=np.int64).reshape(-1, 2)
+                            for p in (contacts.crossing, contacts.coplanar_opposite, contacts.contact)])
+    if not contacts.complete:
+        return sorted({fill.loop for fill in creases})
+    if not len(pairs):
+        return []
+    # the caps follow the given faces: the cones' first, then each fill's in order
+    sizes = [len(fill.caps) for fill in creases]
+    first_fill = len(pf) - sum(sizes)
+    owner = np.full(len(pf), -1, dtype=np.int64)
+    at = first_fill
+    for fill, size in zip(creases, sizes):
+        owner[at:at + size] = fill.loop
+        at += size
+    out = set()
+    for a, b in pairs.tolist():
+        if owner[a] >= 0 and b < n_given:
+            out.add(int(owner[a]))
+        elif owner[b] >= 0 and a < n_given:
+            out.add(int(owner[b]))
+    return sorted(out)
+
+
 def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[..., Any], *,
                      seal: Seal | None = None) -> Estimate:
     """Close each boundary loop by a cone to its centroid and integrate; bound by the balls over the rims.
@@ -534,26 +565,38 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     else:
         centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
         unbounded = ""
-    cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
-    extra = np.zeros((0, 3))
-    if creases:               # holes across one crease: two planar fans instead of the cone (third assumption)
-        crossed = np.zeros(n_loops, dtype=bool)
-        fills = []
-        for j, fill in enumerate(creases):
-            crossed[fill.loop] = True
-            hole_doubt[fill.loop] = fill.doubt
-            shifted = fill.caps.copy()
-            shifted[shifted >= len(v)] += n_loops + 2 * j       # apexes after the cones' (kept for numbering)
-            fills.append(shifted)
-        cap = np.vstack([cap[~crossed[label]], *fills])
-        extra = np.vstack([fill.apexes for fill in creases])
-    doubt = float(np.sum(hole_doubt))
-    pv = np.vstack([v, apex, extra])
-    pf = np.vstack([f, cap])
-    closed = moments(pv, pf)
-    if closed.volume < 0:
-        pf = pf[:, ::-1]
+    cone_doubt = hole_doubt.copy()
+
+    def build(creases: list[CreaseFill]) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any, np.ndarray]:
+        cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
+        extra = np.zeros((0, 3))
+        doubts = cone_doubt.copy()
+        if creases:           # holes across one crease: two planar fans instead of the cone (third assumption)
+            crossed = np.zeros(n_loops, dtype=bool)
+            fills = []
+            for j, fill in enumerate(creases):
+                crossed[fill.loop] = True
+                doubts[fill.loop] = fill.doubt
+                shifted = fill.caps.copy()
+                shifted[shifted >= len(v)] += n_loops + 2 * j       # apexes after the cones' (kept for numbering)
+                fills.append(shifted)
+            cap = np.vstack([cap[~crossed[label]], *fills])
+            extra = np.vstack([fill.apexes for fill in creases])
+        pv = np.vstack([v, apex, extra])
+        pf = np.vstack([f, cap])
         closed = moments(pv, pf)
+        if closed.volume < 0:
+            pf = pf[:, ::-1]
+            closed = moments(pv, pf)
+        return pv, pf, cap, closed, doubts
+
+    pv, pf, cap, closed, hole_doubt = build(creases)
+    contradicted = _crease_contradicted(pv, pf, len(f), creases, n_loops, len(v)) if creases else []
+    if contradicted:          # a crease fill lying over faces the file has: the two planes do not hold the hole
+        cone_doubt[contradicted] = 4.0 / 3.0 * np.pi * radius[contradicted] ** 3
+        creases = [fill for fill in creases if fill.loop not in set(contradicted)]
+        pv, pf, cap, closed, hole_doubt = build(creases)
+    doubt = float(np.sum(hole_doubt))
     # the surface as given: the closed surface's area less the cones' (no second pass over every face)
     ca, cb, cc = pv[cap[:, 0]], pv[cap[:, 1]], pv[cap[:, 2]]
     area = float(closed.area) - float(0.5 * np.linalg.norm(np.cross(cb - ca, cc - ca), axis=1).sum())
