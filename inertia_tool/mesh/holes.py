@@ -576,7 +576,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             fills = []
             for j, fill in enumerate(creases):
                 crossed[fill.loop] = True
-                doubts[fill.loop] = fill.doubt
+                # the fill is kept as the estimate, but its bound is the whole ball: generated holes across
+                # creases (half of a featured box gone) contradicted the third assumption's narrow slab bound
+                doubts[fill.loop] = max(fill.doubt, 4.0 / 3.0 * np.pi * radius[fill.loop] ** 3)
                 shifted = fill.caps.copy()
                 shifted[shifted >= len(v)] += n_loops + 2 * j       # apexes after the cones' (kept for numbering)
                 fills.append(shifted)
