@@ -22,18 +22,9 @@ from inertia_tool.tolerances import ESTIMATE_MAX_MASS_RTOL
 
 m3d = pytest.importorskip("manifold3d")
 
-
-def _inertia(m):
-    return np.trace(m.second_moment) * np.eye(3) - m.second_moment
+from test_hole_bounds import _holds  # noqa: E402  (the one "inside every bound" test of the hole tests)
 
 
-def _holds(est, truth):
-    """The truth lies inside every bound the estimate states (round-off of 1e-12 allowed)."""
-    u = est.uncertainty
-    return (abs(est.volume - truth.volume) <= u.mass * est.volume * (1 + 1e-12) + 1e-12 * truth.volume
-            and np.linalg.norm(est.centroid - truth.centroid) <= u.center_of_mass * (1 + 1e-12) + 1e-12
-            and np.linalg.norm(_inertia(est) - _inertia(truth))
-            <= u.inertia * np.linalg.norm(_inertia(est)) * (1 + 1e-12) + 1e-12 * np.linalg.norm(_inertia(truth)))
 
 
 def _refused_or_holds(est, truth):
@@ -248,5 +239,20 @@ def test_a_crease_fill_when_half_the_part_is_gone_is_refused_or_bounded(extents,
     v, f, _, _ = featured_box(extents, place, size, height)
     v = v @ Rotation.from_quat(quat).as_matrix().T
     gone = _patch(v, f, start % len(f), max(1, int(0.5 * len(f))))
+    est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
+    assert _refused_or_holds(est, volume_moments(v, f))
+
+
+@pytest.mark.xfail(strict=True, reason="second assumption (the missing surface near the plane beside the rim) "
+                                       "false when most of the part is gone: boss alone, 94 % low at ±1e-13")
+def test_a_planar_rim_when_most_of_the_part_is_gone_is_refused_or_bounded():
+    """Known defect, found by the generated test above on a random (non-CI) run: a box with a boss on top that
+    lost 16 of its 28 faces in one patch leaves one planar rim (6 edges) in the top face.  The cone closes it
+    flat, the slab around the top face's plane is as thin as the rim, so the bound is round-off, while the
+    box below is gone: the estimate is the boss alone (0.0625 for 1.0625).  The bare-rim-vertex check does not
+    fire (the rim's corners keep faces in two planes).  Kept as a reproducer: the slab bound needs a check that
+    holds, or must give way to the ball."""
+    v, f, _, _ = featured_box((1.0, 1.0, 1.0), (0.5, 0.25), (0.5, 0.5), 0.25)
+    gone = _patch(v, f, 1, max(1, int(0.59375 * len(f))))
     est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
     assert _refused_or_holds(est, volume_moments(v, f))

@@ -17,8 +17,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import inertia_tool as it
-from inertia_tool.integrals import exact_volume_moments
 from inertia_tool.mesh.sheets import open_sheets
+from test_mesh_folds import _assert_matches, _truth
 
 pytestmark = pytest.mark.usefixtures("engine_path")
 
@@ -29,20 +29,6 @@ def _analyse(v, f, repair=False):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return it.mass_properties((np.asarray(v, dtype=float), np.asarray(f)), density=1.0, repair=repair)
-
-
-def _truth(v, f):
-    m = exact_volume_moments(np.asarray(v, dtype=float), np.asarray(f))
-    inertia = np.trace(m.second_moment) * np.eye(3) - m.second_moment
-    return m.volume, m.centroid, inertia
-
-
-def _assert_matches(p, truth, rtol=1e-12):
-    volume, centre, inertia = truth
-    scale = float(np.max(np.abs(centre))) + volume ** (1 / 3)
-    assert abs(p.volume - volume) <= rtol * volume
-    assert np.max(np.abs(p.center_of_mass - centre)) <= rtol * scale
-    assert np.max(np.abs(p.inertia - inertia)) <= rtol * np.max(np.abs(inertia))
 
 
 def _convex(seed, n=14):
