@@ -780,3 +780,62 @@ def test_a_mesh_file_is_read_once_per_content_and_its_warnings_come_every_time(t
     finally:
         geometry._read_mesh_file = real
         geometry._READ_CACHE.clear()
+
+
+def _exact_turn(a, b, c):
+    from fractions import Fraction as Q
+    (ax, ay), (bx, by), (cx, cy) = [(Q(float(x)), Q(float(y))) for x, y in (a, b, c)]
+    d = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    return (d > 0) - (d < 0)
+
+
+def test_polyline_a_hole_within_rounding_of_the_outline_is_a_hole_not_a_touch():
+    # the hole's first corner c lies 1 part in 1e17 to the left of the outline's edge a → b: a float turn calls
+    # it on the edge ("polygons touch", refused), and a float ray test calls it outside, which made the hole a
+    # second body (+19 % mass).  Exact turns place it inside, so the region is the outline less the triangle.
+    a, b, c = (0.1, 0.1), (0.7, 0.35118216247002565), (0.6702782177955612, 0.33873952659240225)
+    assert _exact_turn(a, b, c) == 1                       # truly inside, not on the edge
+    outline = np.array([a, b, (0.7, 1.0), (0.1, 1.0)])
+    hole = np.array([c, (0.65, 0.6), (0.5, 0.5)])
+    _, signs = polygon_region([outline, hole])
+    assert signs == (1, -1)
+
+    def area(p):
+        x, y = p[:, 0], p[:, 1]
+        return 0.5 * abs(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+    assert extruded_region([outline, hole], 0.2).volume == pytest.approx(0.2 * (area(outline) - area(hole)),
+                                                                          rel=1e-12)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(3, 9), st.integers(0, 2**32 - 1), st.floats(0.0, 1.0), st.floats(0.0, 1.0))
+def test_point_in_polygon_is_exact_near_edges(sides, seed, t, lift):
+    # points placed on an edge by rounded interpolation, then nudged by a few ulps off it: the even-odd answer must
+    # match an exact rational ray test, which a float crossing-abscissa test gets wrong within rounding
+    from fractions import Fraction as Q
+
+    from inertia_tool.mass.extrusion import point_in_polygon
+    rng = np.random.default_rng(seed)
+    angles = np.sort(rng.uniform(0, 2 * np.pi, sides))
+    polygon = np.column_stack([np.cos(angles), np.sin(angles)]) * rng.uniform(0.5, 2.0, (sides, 1))
+    k = int(rng.integers(sides))
+    a, b = polygon[k], polygon[(k + 1) % sides]
+    point = a + t * (b - a)
+    point = point + np.array([1, -1]) * lift * 4 * np.spacing(np.abs(point).max())
+
+    def exact_inside(p):
+        px, py = Q(float(p[0])), Q(float(p[1]))
+        inside = False
+        for i in range(sides):
+            (ax, ay), (bx, by) = [(Q(float(x)), Q(float(y))) for x, y in (polygon[i], polygon[(i + 1) % sides])]
+            if (ay <= py) != (by <= py):
+                x = ax + (py - ay) * (bx - ax) / (by - ay)
+                if x == px:
+                    return None                            # on the boundary: either answer is allowed
+                inside ^= px < x
+        return inside
+
+    truth = exact_inside(point)
+    if truth is not None:
+        assert point_in_polygon(point, polygon) == truth

@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike
 
 from ..errors import InvalidMeshError
 from ..integrals import second_moment_to_inertia
+from ..mesh.intersect import orient2d_sign
 from .properties import MassProperties
 
 __all__ = ["extruded_region", "polygon_region", "point_in_polygon", "MAX_POLYGON_POINTS"]
@@ -58,9 +59,16 @@ def _signed_area(points: np.ndarray) -> float:
 
 
 def _orient(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Sign of the turn a → b → c (+1 left, −1 right, 0 collinear), broadcast over the rows."""
-    turn = (b[..., 0] - a[..., 0]) * (c[..., 1] - a[..., 1]) - (b[..., 1] - a[..., 1]) * (c[..., 0] - a[..., 0])
-    return np.asarray(np.sign(turn))
+    """Exact sign of the turn a → b → c (+1 left, −1 right, 0 collinear), broadcast over the rows.
+
+    Exact (filtered, with an exact fallback): a float determinant can call two edges that touch at a point
+    disjoint, or two that miss each other touching, when the turn is within rounding of zero.
+    """
+    a, b, c = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64),
+                                  np.asarray(c, dtype=np.float64))
+    shape = a.shape[:-1]
+    sign = orient2d_sign(a.reshape(-1, 2), b.reshape(-1, 2), c.reshape(-1, 2))
+    return np.asarray(sign, dtype=np.int64).reshape(shape)
 
 
 def _on_segment(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -104,14 +112,26 @@ def _first_crossing(polygons: list[np.ndarray]) -> tuple[int, int, int, int] | N
 
 
 def point_in_polygon(point: ArrayLike, polygon: ArrayLike) -> bool:
-    """Even-odd test of ``point`` (2,) against ``polygon`` (n, 2) (a point on the boundary may go either way)."""
-    x, y = np.asarray(point, dtype=np.float64)
+    """Even-odd test of ``point`` (2,) against ``polygon`` (n, 2), exact (a point on the boundary may go either
+    way).
+
+    A ray from the point towards +x crosses edge ``a b`` when the edge straddles the point's height (half-open,
+    so a vertex at that height counts once) and the point lies on the edge's left if it runs upwards, on its
+    right if it runs downwards: both decided by the exact turn of ``a → b → point``, so a point within rounding
+    of an edge is still placed on its true side.
+    """
+    p = np.asarray(point, dtype=np.float64).reshape(1, 2)
     a = np.asarray(polygon, dtype=np.float64)
     b = np.roll(a, -1, axis=0)
-    straddle = (a[:, 1] > y) != (b[:, 1] > y)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cross_x = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-    return bool(np.count_nonzero(straddle & (x < cross_x)) % 2)
+    y = p[0, 1]
+    up = (a[:, 1] <= y) & (y < b[:, 1])
+    down = (b[:, 1] <= y) & (y < a[:, 1])
+    straddle = np.flatnonzero(up | down)
+    if not len(straddle):
+        return False
+    turn = _orient(a[straddle], b[straddle], np.broadcast_to(p, (len(straddle), 2)))
+    right = np.where(up[straddle], turn > 0, turn < 0)
+    return bool(np.count_nonzero(right) % 2)
 
 
 def polygon_region(polygons: Iterable[ArrayLike], *,
