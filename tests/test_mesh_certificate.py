@@ -1,4 +1,4 @@
-"""The certificate and the shell-classification policy (mesh/policy.py, mesh/prepare.py).
+"""The certificate and the shell-classification policy (mesh/policy.py and the stages of mesh/prepare.py).
 
 Every case named in issue 21 (items 1–5, 7) is a regression test here, checked against independent truths:
 manifold3d booleans in float64 (``tests/solids.py``) and signed-tetrahedron sums of each closed shell on its
@@ -227,29 +227,34 @@ def test_clean_box_is_exact_only_with_every_check():
     assert set(cert.checks) >= {"edge-balanced", "consistently-oriented", "no-crossing-faces"}
 
 
+def _check_gives_up(monkeypatch, gives_up):
+    """Every stage of prepare_mesh that runs the face-pair check runs ``gives_up`` instead."""
+    from inertia_tool.mesh import classify, self_crossing, settle, unite
+    for stage in (settle, self_crossing, classify, unite):
+        monkeypatch.setattr(stage, "surface_contacts", gives_up)
+
+
 def test_intersection_check_that_gives_up_is_not_exact(monkeypatch):
-    from inertia_tool.mesh import prepare
-    real = prepare.surface_contacts
+    from inertia_tool.mesh.intersect import surface_contacts as real
 
     def gives_up(vertices, faces, *, max_pairs=None):
         found = real(vertices, faces, max_pairs=max_pairs)
         return type(found)(found.crossing, found.coplanar_opposite, found.contact, False)
 
-    monkeypatch.setattr(prepare, "surface_contacts", gives_up)
+    _check_gives_up(monkeypatch, gives_up)
     props = _quiet(*box())
     assert props.mesh.certificate.kind == "unverified" and not props.mesh.exact
 
 
 def test_unfinished_check_does_not_turn_an_overlapping_body_into_a_cavity(monkeypatch):
     """Without the crossing pairs, a shell inside another may overlap it: the depth rule is not applied (R4)."""
-    from inertia_tool.mesh import prepare
-    real = prepare.surface_contacts
+    from inertia_tool.mesh.intersect import surface_contacts as real
 
     def gives_up(vertices, faces, *, max_pairs=None):
         found = real(vertices, faces, max_pairs=max_pairs)
         return type(found)(found.crossing[:0], found.coplanar_opposite[:0], found.contact[:0], False)
 
-    monkeypatch.setattr(prepare, "surface_contacts", gives_up)
+    _check_gives_up(monkeypatch, gives_up)
     a, b = box((2.0, 2.0, 2.0)), box((1.0, 1.0, 1.0), (0.75, 0.75, 0.75))
     props = _quiet(*stack(a, b))
     assert props.volume == pytest.approx(union_volume(a, b), rel=1e-12)
@@ -426,7 +431,7 @@ def test_zero_volume_shell_left_by_the_union_gives_no_nan(monkeypatch):
 
 def test_shared_volume_in_messages_is_never_negative():
     """Issue 21 item 7: a union a rounding larger than the sum was printed as a negative shared volume."""
-    from inertia_tool.mesh.prepare import shared_text
+    from inertia_tool.mesh.unite import shared_text
     assert shared_text(2.0, 1.5) == "0.5 m³ of shared volume"
     text = shared_text(1.0, 1.0 + 5e-12)
     assert "-5e-12" not in text and "no shared volume" in text
@@ -456,7 +461,7 @@ def test_analyze_of_two_touching_copies_exits_0_with_an_exact_sum(tmp_path, caps
 def test_union_larger_than_sum_is_not_called_rounding():
     """A cavity poking out of its body: the union exceeds the summed integral by far more than rounding; the
     message says why instead of "within rounding"."""
-    from inertia_tool.mesh.prepare import shared_text
+    from inertia_tool.mesh.unite import shared_text
     text = shared_text(0.875, 0.8875)
     assert "within rounding" not in text and "cavity reaching out of its body" in text
     assert "within rounding" in shared_text(1.0, 1.0 + 5e-12)

@@ -21,7 +21,8 @@ from ..errors import InvalidMeshError, NearlyEqualMomentsWarning, OverlapWarning
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.precision import warn_storage_precision
-from ..mesh.prepare import PreparedMesh, classify_shells, prepare_mesh
+from ..mesh.classify import classify_shells
+from ..mesh.prepare import PreparedMesh, prepare_mesh
 from ..mesh.read import RawMesh, load_mesh
 from ..tolerances import NEEDLE_RTOL, PART_OVERLAP_RTOL, TRIANGLE_INEQUALITY_RTOL
 from ..units import material_density

@@ -2,7 +2,9 @@
 
 Stages: :mod:`.read` (files, trimesh objects and arrays → :class:`~.read.RawMesh` in metres) →
 :mod:`.weld` (shared vertices) → :mod:`.checks` (edge census, shells, :class:`~.checks.MeshReport`) →
-:mod:`.prepare` (what the triangles mean as a solid: refusals, repair, orientation, cavities, overlaps).
+:mod:`.prepare` (what the triangles mean as a solid: refusals, repair, orientation, cavities, overlaps; its stages
+:mod:`.surface`, :mod:`.shells`, :mod:`.welded`, :mod:`.settle`, :mod:`.self_crossing`, :mod:`.classify`,
+:mod:`.unite`, :mod:`.certify`).
 :mod:`.intersect` finds, exactly, the face pairs that meet beyond what they share by index (crossings,
 face-to-face contact, edge and vertex contact), which is what lets an answer be certified exact.
 :class:`~.options.LoadOptions` says how, for every entry point.  :mod:`.plausibility` warns when a part read

@@ -1,0 +1,195 @@
+"""R4 to R6 of :mod:`~.policy`, the reading of closed shells: which is a body and which a cavity (by nesting
+depth, turning shells wound against it), the body each cavity belongs to, and which shells may overlap
+(candidates for the boolean of :mod:`~.unite`).
+
+:func:`orient_shells` is the stage :func:`~.prepare.prepare_mesh` runs once no shell passes through itself;
+:func:`classify_shells` applies the same rules for callers that hold several prepared meshes side by side.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+
+from ..errors import InsideOutWarning
+from ..integrals import VolumeMoments
+from .intersect import SurfaceContacts, surface_contacts
+from .policy import ShellContacts, inward_crossing_outward, orient_by_depth, shell_contacts, within_up_to_rounding
+from .settle import settle_touching
+from .shells import Shells, apply_flips
+
+if TYPE_CHECKING:       # imported on use at run time (below)
+    from .nesting import Nesting
+
+__all__ = ["Orientation", "orient_shells", "classify_shells", "shell_nesting_or_none", "boxes_meet",
+           "MAX_WITHIN_PAIRS"]
+
+
+class Orientation(NamedTuple):
+    """What :func:`orient_shells` read.
+
+    Attributes
+    ----------
+    shells : Shells
+        Turned where R4 says (bodies outward, cavities inward).
+    touch : ShellContacts
+        The shells' contacts, with touching pairs settled by their vertices.
+    flip : (s,) bool
+        Shells turned.
+    owner : (s,) int
+        Body each shell belongs to.
+    depth : (s,) int
+        Nesting depth (odd: a cavity).
+    candidates : (s,) bool
+        Shells the boolean must look at (crossing, touching, undecided; every shell whose box meets another's
+        when the contact check gave up).
+    crossing : (s,) bool
+        Shells that cross another for real (R4 could not read one within the other).
+    ambiguous : int
+        Inward-wound shells crossing an outward one (read as cavities cut from it: a reading, not proven).
+    notes : tuple of str
+        What was read, in words (the ``ambiguous`` one warned).
+    """
+
+    shells: Shells
+    touch: ShellContacts
+    flip: np.ndarray
+    owner: np.ndarray
+    depth: np.ndarray
+    candidates: np.ndarray
+    crossing: np.ndarray
+    ambiguous: int
+    notes: tuple[str, ...]
+
+
+def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContacts, *, source: str) -> Orientation:
+    """R4: the shells oriented by nesting depth (touching pairs decided by their vertices, crossing pairs that lie
+    one within the other up to rounding by the boolean), with the overlap candidates of R5 and R6."""
+    v, f, labels, n_shells = shells.vertices, shells.faces, shells.labels, shells.n_shells
+    nest = shell_nesting_or_none(v, f, labels, n_shells)
+    file_volumes = np.array([s.volume for s in shells.moments])
+    touch, nest, touch_within = settle_touching(v, f, labels, contacts, touch, nest)
+    within, crossing_with = None, touch.crossing_with
+    if touch.complete:
+        within, crossing_with = _within(v, f, labels, file_volumes, crossing_with)
+    flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
+                                         within=_both(within, touch_within))
+    shells = apply_flips(shells, flip, source)
+    notes = []
+    ambiguous = inward_crossing_outward(file_volumes, flip, crossing_with)
+    if ambiguous:
+        plural = ambiguous > 1
+        notes.append(f"{ambiguous} inward-wound shell{'s' if plural else ''} cross{'' if plural else 'es'} "
+                     "an outward one: read as a cavity cut from it (the solid where the winding number is at least "
+                     "one); if it is a body written inside out, fix its winding. Not verified")
+        warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+    if within is not None and len(within):
+        n_within = len(np.unique(within[:, 0]))
+        notes.append(f"{n_within} shell{'s' if n_within > 1 else ''} meet{'' if n_within > 1 else 's'} the "
+                     "shell around it only on its boundary (a cavity flush with its body's face, a part resting on "
+                     "a cavity's floor; the faces there coincide or cross by rounding): read by nesting depth and "
+                     "formed by the boolean")
+    undecided = nest.undecided if nest is not None else np.zeros(n_shells, dtype=bool)
+    if touch.complete:
+        candidates = touch.crossing | touch.touching | undecided
+    else:       # the check gave up: every shell whose box meets another's goes to the boolean
+        candidates = boxes_meet(v, shells.faces, labels, n_shells) | undecided
+    crossing = np.zeros(n_shells, dtype=bool)
+    crossing[crossing_with.reshape(-1)] = True
+    return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes))
+
+
+def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n_shells: int,
+                    shells: Sequence[VolumeMoments], diag: float, *, source: str = "mesh",
+                    check_crossing: bool = True) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """Orient shells by nesting depth (R4), attach cavities to their bodies, count overlap candidates (R5, R6).
+
+    The same rules :func:`~.prepare.prepare_mesh` applies (:mod:`~.policy`), for callers that hold several
+    prepared meshes side by side (an assembly's parts).
+
+    Returns
+    -------
+    flip : (s,) bool
+        Shells to turn inside out.
+    owner : (s,) int
+        Body each shell belongs to.
+    cavities : int
+    overlaps : int
+        Shells whose surface crosses another's, that R4 had to turn (inside another shell against their own
+        winding), or whose probes all lie on another surface; or (when the intersection check cannot finish,
+        or ``check_crossing`` is False) whose box meets another's: candidates for the boolean to confirm.
+        Shells that only touch are not counted.
+    """
+    vols = np.array([s.volume for s in shells])
+    if n_shells == 1:
+        return vols < 0, np.zeros(1, dtype=np.intp), 0, 0
+    contacts = surface_contacts(vertices, faces) if check_crossing else None
+    touch = shell_contacts(contacts, labels, n_shells) if contacts is not None else None
+    nest = shell_nesting_or_none(vertices, faces, labels, n_shells)
+    touch_within = np.zeros((0, 2), dtype=np.int64)
+    if touch is not None and contacts is not None:
+        touch, nest, touch_within = settle_touching(vertices, faces, labels, contacts, touch, nest)
+    crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
+    within = None
+    if touch is not None and touch.complete:
+        within, crossing_with = _within(vertices, faces, labels, vols, crossing_with)
+    flip, owner, depth = orient_by_depth(vols, nest, crossing_with,
+                                         crossing_known=touch is not None and touch.complete,
+                                         within=_both(within, touch_within))
+    undecided = nest.undecided if nest is not None else np.zeros(n_shells, dtype=bool)
+    if touch is not None and touch.complete:
+        # touching shells that their points found apart or nested share no volume (R4: those crossing along shared
+        # edges are in ``touch.crossing`` now, those the points could not decide in ``crossing_with``); a shell
+        # that R4 had to turn lies in another's material or void against its own winding: counted as a candidate
+        candidates = touch.crossing | flip | undecided
+        candidates[np.asarray(touch.crossing_with, dtype=np.int64).reshape(-1)] = True
+    else:
+        candidates = boxes_meet(vertices, faces, labels, n_shells) | undecided
+    return flip, owner, int(np.count_nonzero(depth % 2 == 1)), int(np.count_nonzero(candidates))
+
+
+def shell_nesting_or_none(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) -> Nesting | None:
+    """The shells' winding numbers at each other's probe points (None for one shell)."""
+    if n_shells < 2:
+        return None
+    from .nesting import shell_nesting      # imported on use: one shell needs none
+    return shell_nesting(v, f, labels, n_shells)
+
+
+def _both(within: np.ndarray | None, more: np.ndarray) -> np.ndarray | None:
+    """``(shell, container)`` pairs from the boolean (R4's ``within_up_to_rounding``) and from the vertices."""
+    if within is None:
+        return more if len(more) else None
+    return np.concatenate([np.asarray(within, dtype=np.int64).reshape(-1, 2), more]).reshape(-1, 2)
+
+
+#: Crossing shell pairs tested for lying one within the other (R4), at most; beyond, a pair stays crossing.
+MAX_WITHIN_PAIRS = 256
+
+
+def _within(v: np.ndarray, f: np.ndarray, labels: np.ndarray, volumes: np.ndarray,
+            crossing_with: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """R4: the crossing pairs whose one shell lies within the other up to rounding (``(shell, container)``), and the
+    pairs that cross for real (:func:`~.policy.within_up_to_rounding`, volumes shared by manifold3d)."""
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    if not len(pairs):
+        return np.zeros((0, 2), dtype=np.int64), pairs
+    from .union import common_volumes            # imported on use: crossings are rare
+    tested = pairs[:MAX_WITHIN_PAIRS]
+    within, really = within_up_to_rounding(volumes, tested, common_volumes(v, f, labels, volumes, tested))
+    return within, np.concatenate([really, pairs[MAX_WITHIN_PAIRS:]])
+
+
+def boxes_meet(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) -> np.ndarray:
+    """(s,) bool: shells whose bounding box meets another shell's."""
+    order = np.argsort(labels, kind="stable")
+    starts = np.searchsorted(labels[order], np.arange(n_shells))
+    tri = v[f[order]]
+    lo = np.minimum.reduceat(tri.min(axis=1), starts, axis=0)
+    hi = np.maximum.reduceat(tri.max(axis=1), starts, axis=0)
+    meet = np.all(lo[:, None] <= hi[None], axis=2) & np.all(lo[None] <= hi[:, None], axis=2)
+    np.fill_diagonal(meet, False)
+    return np.asarray(meet.any(axis=1))

@@ -1,0 +1,238 @@
+"""R5 and R6 of :mod:`~.policy`: shells that may overlap go to a robust boolean (:mod:`~.union`, manifold3d).
+Its union's volume equal to the summed integral confirms they only touch; a smaller one is shared volume,
+counted once (the union integrated, ``overlap`` "union") or twice (``overlap`` "sum", said in the report).
+
+:func:`unite_overlaps` is the stage :func:`~.prepare.prepare_mesh` runs once the shells are oriented.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+
+from ..errors import InvalidMeshError, MeshResolvedWarning, OverlapWarning
+from ..integrals import body_volume_moments, bounding_box, volume_moments
+from ..tolerances import FLAT_RTOL
+from .checks import edge_topology
+from .classify import Orientation, shell_nesting_or_none
+from .intersect import SurfaceContacts, surface_contacts
+from .policy import TOUCH_VOLUME_RTOL, orient_by_depth
+from .resolve import Resolution, resolve_surface
+from .shells import Shells, apply_flips, reshelled
+
+if TYPE_CHECKING:       # imported on use at run time (below)
+    from .union import UnionSurface
+
+__all__ = ["United", "unite_overlaps", "shared_text"]
+
+
+class United(NamedTuple):
+    """What :func:`unite_overlaps` made of the oriented shells, and the certificate so far.
+
+    Attributes
+    ----------
+    shells : Shells
+        The union's shells when it is integrated, else the shells given.
+    owner : (s,) int
+        Body each shell belongs to.
+    cavities : int
+    overlaps : int
+        Shells that overlap another (0 when the boolean found them only touching).
+    method : str
+        ``"union"`` or ``"sum"`` when the boolean's result decided, else the method given.
+    kind : str
+        The certificate's kind so far (:data:`~.policy.CERTIFICATE_KINDS`).
+    checks : list of str
+        The checks that passed so far.
+    notes : tuple of str
+        What the boolean found, in words (each warned where it changes the answer).
+    forced : Resolution or None
+        The estimate that replaces the result when the boolean refused (``repair``), else None.
+    """
+
+    shells: Shells
+    owner: np.ndarray
+    cavities: int
+    overlaps: int
+    method: str
+    kind: str
+    checks: list[str]
+    notes: tuple[str, ...]
+    forced: Resolution | None
+
+
+def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanifold_edges: int | None,
+                   method: str, kind: str, checks: list[str], overlap: str, repair: bool, diag: float,
+                   source: str) -> United:
+    """R5, R6: the boolean's verdict on the overlap candidates of ``oriented`` (and on any surface with
+    non-manifold edges).
+
+    Parameters
+    ----------
+    oriented : Orientation
+        R4's reading of the shells.
+    contacts : SurfaceContacts
+        The shells' face pairs that meet (the crossing ones counted in a note).
+    nonmanifold_edges : int or None
+        Non-manifold edges of the surface as resolved, or None when a later stage changed it (counted anew).
+    method, kind, checks
+        The method, certificate kind and checks so far.
+    overlap, repair
+        As for :func:`~.prepare.prepare_mesh`.
+    diag : float
+        m, R2's scale.
+    source : str
+        Names the mesh in messages.
+
+    Raises
+    ------
+    InvalidMeshError
+        Overlapping bodies whose union cannot be formed (``repair`` off).
+    """
+    shells, owner, touch = oriented.shells, oriented.owner, oriented.touch
+    v, f, labels = shells.vertices, shells.faces, shells.labels
+    candidates, crossing = oriented.candidates, oriented.crossing
+    cavities = int(np.count_nonzero(oriented.depth % 2 == 1))
+    overlaps = int(np.count_nonzero(crossing))
+    checks = list(checks)
+    notes: list[str] = []
+    # R3a may have taken out every non-manifold edge (a wall's rims): then nothing is left for the boolean to confirm
+    nonmanifold = nonmanifold_edges if nonmanifold_edges is not None else edge_topology(f, len(v), v).nonmanifold_edges
+    if not (candidates.any() or nonmanifold):                                    # R5, R6
+        return United(shells, owner, cavities, overlaps, method, kind, checks, (), None)
+    united = _unite(v, f, labels, owner, source, repair)
+    summed = sum(s.volume for s in shells.moments)
+    if united is not None and not touch.crossing.any() and \
+            abs(united.volume - summed) <= TOUCH_VOLUME_RTOL * abs(summed):
+        overlaps = 0                      # surfaces touch, no volume is shared: the sum is the solid
+        checks.append("touching-confirmed")
+        if int(np.count_nonzero(candidates)):
+            notes.append(f"{int(np.count_nonzero(candidates))} shells touch another (the boolean union's "
+                         "volume equals their sum: no volume is shared)")
+    elif united is not None and overlap == "union" and touch.complete and \
+            abs(united.volume - summed) <= TOUCH_VOLUME_RTOL * abs(summed):
+        # R6 up to rounding: faces cross, yet the boolean finds no volume shared beyond TOUCH_VOLUME_RTOL (copies
+        # touching face to face after a rotation, a cavity flush with its body's face): the surface as written
+        # is the solid to that tolerance, not exactly (the crossing slivers are thinner than the rounding)
+        overlaps = 0
+        kind = "united"
+        checks = ["edge-balanced", "consistently-oriented", "boolean-union", "touching-up-to-rounding"]
+        crossed = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
+        n_pairs = int(np.count_nonzero(labels[crossed[:, 0]] != labels[crossed[:, 1]]))
+        notes.append(f"touching up to rounding: {n_pairs:,} face pairs of shells that touch cross by float64 "
+                     f"rounding (faces coplanar only to rounding, e.g. after a rotation); the boolean union's "
+                     f"volume equals the summed volume within {TOUCH_VOLUME_RTOL:g} (difference "
+                     f"{abs(united.volume - summed):.3g} m³), so the summed integral is given, certified united "
+                     "(the solid is ambiguous at the rounding level: not exact)")
+        warnings.warn(MeshResolvedWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+    elif united is None:
+        forced = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
+                                 moments=volume_moments, force_estimate=True)
+        return United(shells, owner, cavities, max(overlaps, 1), method, kind, checks, tuple(notes), forced)
+    else:
+        overlaps = max(overlaps, 1) if crossing.any() or not touch.crossing.any() else 0
+        shared = shared_text(summed, united.volume)
+        if overlap == "sum" and overlaps:
+            method, kind = "sum", "summed"
+            notes.append(f"overlapping bodies: their integrals are added, so {shared} is counted twice "
+                         "(`overlap` 'sum')")
+            warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+        else:
+            excess = united.volume - summed
+            if excess > TOUCH_VOLUME_RTOL * abs(summed):
+                # the union of the bodies, each with its own cavities cut, cannot exceed the summed integral
+                # unless a shell read as a cavity reaches out of its body: the boolean cuts it only where it
+                # lies in the body.  Unless the file's winding said so (``ambiguous``: an inward shell crossing
+                # an outward one), R4 misread a nesting: not a proven solid.
+                notes.append(f"the boolean union is {excess:.3g} m³ larger than the summed integral: a shell "
+                             "read as a cavity reaches out of the body around it and is cut only where it lies "
+                             "in the body" + ("" if oriented.ambiguous else "; the nesting read by R4 disagrees "
+                                              "with the boolean: not verified"))
+                warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+            elif overlaps:        # else only shells within others (R4): their cavities are cut, nothing shared
+                notes.append(f"overlapping bodies united by a boolean: {shared} counted once")
+                warnings.warn(OverlapWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+            method = "union"
+            # R6/R7: the boolean found shared volume; "united" is proven only when crossing faces were found
+            # too (else the two checks disagree: manifold3d's tolerance or a crossing the check cannot see)
+            kind = "united" if touch.complete and touch.crossing.any() and \
+                not excess > TOUCH_VOLUME_RTOL * abs(summed) else "unverified"
+            if touch.complete and not touch.crossing.any():
+                notes.append(f"no faces were found crossing, yet the union's volume differs from the sum by "
+                             f"{abs(summed - united.volume):.3g} m³ (manifold3d's tolerance, or bodies passing "
+                             "through each other at shared edges): the result is the union, not verified")
+            checks = ["edge-balanced", "consistently-oriented", "boolean-union"]
+            after = surface_contacts(united.vertices, united.faces)   # manifold3d's output can cross itself by rounding
+            if len(after.crossing) or not after.complete:
+                kind = "unverified"
+                notes.append(f"the union formed by the boolean passes through itself at {len(after.crossing):,} "
+                             "face pairs (rounding in manifold3d): not verified")
+            shells, owner, cavities = _oriented_anew(united.vertices, united.faces, diag, source)
+    return United(shells, owner, cavities, overlaps, method, kind, checks, tuple(notes), None)
+
+
+def _oriented_anew(v: np.ndarray, f: np.ndarray, diag: float, source: str) -> tuple[Shells, np.ndarray, int]:
+    """The union's shells (R1, R7, R2) oriented by nesting depth (R4: nothing crosses), each shell's body, and the
+    number of cavities."""
+    shells = reshelled(v, f, diag, source)
+    nest = shell_nesting_or_none(shells.vertices, shells.faces, shells.labels, shells.n_shells)
+    flip, owner, depth = orient_by_depth(np.array([s.volume for s in shells.moments]), nest,
+                                         np.zeros((0, 2), dtype=np.int64))
+    shells = apply_flips(shells, flip, source, warn=False)
+    return shells, owner, int(np.count_nonzero(depth % 2 == 1))
+
+
+def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: np.ndarray, source: str,
+           repair: bool) -> UnionSurface | None:
+    """The union of the closed pieces (a :class:`~.union.UnionSurface`), or None when the boolean refuses.
+
+    Each piece belongs to the body that owns its shell, so cavities are cut from their own body only.
+    """
+    from .union import UnionError, closed_groups, two_manifold, union_surface      # on use: overlaps are rare
+    groups, n_groups = closed_groups(faces, len(vertices))
+    # within the shells: bodies welded along their crossing (R1b) are closed apart, though one group to closed_groups
+    _, groups = np.unique(np.stack([np.asarray(labels, dtype=np.int64), groups], axis=1), axis=0, return_inverse=True)
+    groups = groups.reshape(-1)
+    n_groups = int(groups.max()) + 1 if len(groups) else 0
+    pieces = body_volume_moments(vertices, faces, groups, n_groups)
+    volume = np.array([p.volume for p in pieces])
+    lo, hi = bounding_box(vertices)
+    solid = np.abs(volume) > FLAT_RTOL * float(np.linalg.norm(hi - lo)) ** 3    # sheets (a face and its reverse)
+    shell_of_group = np.zeros(n_groups, dtype=np.int64)
+    shell_of_group[groups] = labels
+    keep = solid[groups]
+    _, groups = np.unique(groups[keep], return_inverse=True)
+    groups = groups.reshape(-1)
+    try:
+        united = union_surface(vertices, faces[keep], groups, int(np.count_nonzero(solid)),
+                               volume[solid] > 0, body=np.asarray(owner)[shell_of_group[solid]])
+        summed = float(np.sum(volume[solid]))
+        # manifold3d assumes manifold pieces and does not always say when one is not (bodies welded face to face,
+        # joined by closed_groups at four-face rims): its union of such a piece is no witness (welded slabs came
+        # back 3 % short); when it disagrees with the summed integral, the union is not formed
+        if abs(united.volume - summed) > TOUCH_VOLUME_RTOL * abs(summed) and \
+                not two_manifold(faces[keep], groups):
+            raise UnionError("a closed piece has non-manifold edges (shared by more than two faces) and the "
+                             "boolean's union of it disagrees with the summed integral")
+        return united
+    except UnionError as exc:
+        if repair:
+            return None
+        raise InvalidMeshError(f"{source}: overlapping bodies whose union cannot be formed ({exc}); "
+                               "`overlap` 'sum' adds them (shared volume counted twice), `repair=True` gives a "
+                               "bounded estimate") from None
+
+
+def shared_text(summed: float, united: float) -> str:
+    """The shared volume of overlapping bodies in words, m³ (never negative).  A union larger than the summed
+    integral beyond rounding (``TOUCH_VOLUME_RTOL``) is a cavity reaching out of its body: the boolean cuts it
+    only where it lies in the body, the summed integral all of it."""
+    shared = summed - united
+    if shared >= 0:
+        return f"{shared:.6g} m³ of shared volume"
+    if -shared <= TOUCH_VOLUME_RTOL * abs(summed):
+        return f"no shared volume (the union is {-shared:.3g} m³ larger than the sum, within rounding)"
+    return (f"no shared volume; the union is {-shared:.3g} m³ larger than the summed integral (a cavity reaching "
+            "out of its body is cut only where it lies in the body)")
