@@ -203,7 +203,15 @@ def run_caption(script: str, argv: list[str]) -> str:
     except (OSError, subprocess.CalledProcessError):
         commit = "unknown commit"
     day = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
-    return f"python benchmarks/{script} {' '.join(argv)}".rstrip() + f", {day}, code at {commit}"
+    kept, skip = [], False                     # where the output went is not part of what was measured
+    for arg in argv:
+        if skip:
+            skip = False
+        elif arg in ("--json", "--plot"):
+            skip = True
+        elif not arg.startswith(("--json=", "--plot=")):
+            kept.append(arg)
+    return f"python benchmarks/{script} {' '.join(kept)}".rstrip() + f", {day}, code at {commit}"
 
 
 def report(rows: list[dict], load: list[float], caption: str, plot_to: str | None) -> None:
