@@ -9,7 +9,8 @@ whatever the damage makes of the file.
 """
 
 import json
-import os
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -166,8 +167,7 @@ def test_damaged_part_row_agrees_with_analyze(tmp_path, capsys, cut, writes, twe
     """Whatever a cut or a few overwritten bytes make of a binary STL box (still fine, refused as truncated, open,
     NaN, crossing itself...), its batch row says what ``analyze`` says."""
     m = trimesh.creation.box((10.0, 20.0, 30.0))
-    directory = tmp_path / f"d{os.getpid()}_{abs(hash((cut, tuple(writes), twelve)))}"
-    directory.mkdir()
+    directory = Path(tempfile.mkdtemp(dir=tmp_path))      # tmp_path is shared by the examples: one directory each
     path = directory / "part.stl"
     write_binary_stl(path, m.vertices, m.faces if twelve else m.faces[:11])
     data = bytearray(path.read_bytes())
