@@ -11,7 +11,9 @@ files (the real writer: lock, one ``write`` per row, fsync at most once a second
 It prints files/s and the ratio to one process for each (the fastest of ``--repeat`` rounds, each round running every
 configuration in turn), with the load average before and after (the machine is shared: other work slows the
 parallel runs).  It also prints the CPU time per file of each configuration (this process, the pool's worker
-processes, the Dask workers: what chunking, IPC and the scheduler add; the median of the rounds) and the "CPU-bound
+processes, the Dask workers: what chunking, IPC and the scheduler add; the median of the rounds), and of it the
+part spent in this process ("of which here": the writer, the pool's threads, or Dask's scheduler, client and
+nannies, which a LocalCluster runs here) and the "CPU-bound
 ratio" that CPU time allows on two idle cores (one process's CPU time over half the configuration's), which the
 load of the machine changes less.  The Dask LocalCluster is started for its runs in each round and closed after
 them (its client's event loop would slow the other configurations); its start-up (worker processes, engine
@@ -133,9 +135,10 @@ def _run(files, out, **kw):
         summary = run_batch(files, BatchOptions(load=LoadOptions(units="mm"), density=1240.0), r.write_row, **kw)
     after = os.times()              # the pool's processes are joined by now: their time is in children_*
     cpu = (sum(after[:4]) - sum(before[:4])) + _worker_cpu(client) - workers_before
+    parent = sum(after[:2]) - sum(before[:2])      # this process: the writer, the pool's or Dask's threads here
     if summary.ok != len(files):
         raise SystemExit(f"benchmark: {summary.failed} files failed")
-    return summary.seconds, cpu
+    return summary.seconds, cpu, parent
 
 
 def _catalogue(tmp, name, make, count):
@@ -157,7 +160,8 @@ def _child_round(args, tree: str) -> list[tuple[str, str, tuple[float, float]]]:
             "--set", args.set, "--small", str(args.small), "--files", str(args.files), "--kinds", args.kinds]
     done = subprocess.run(argv, capture_output=True, text=True, check=True)
     rows = [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
-    return [(r["catalogue"], r["configuration"], (r["seconds"], r["cpu"])) for r in rows]
+    return [(r["catalogue"], r["configuration"], (r["seconds"], r["cpu"], r.get("parent", float("nan"))))
+            for r in rows]
 
 
 def main() -> None:
@@ -228,8 +232,9 @@ def main() -> None:
                         cluster.close()
         if args.json:
             for (name, label), rounds in results.items():
-                for sec, cpu in rounds:
-                    print(json.dumps({"catalogue": name, "configuration": label, "seconds": sec, "cpu": cpu}))
+                for sec, cpu, parent in rounds:
+                    print(json.dumps({"catalogue": name, "configuration": label, "seconds": sec, "cpu": cpu,
+                                      "parent": parent}))
             for sec in startups:
                 print(json.dumps({"catalogue": "startup", "configuration": "startup", "seconds": sec, "cpu": 0.0}))
             return
@@ -240,21 +245,23 @@ def main() -> None:
         print("seconds and files/s: the fastest round; CPU: the median of the rounds (under load the fastest round in "
               "wall time is not the one of least CPU)")
         print(f"{'catalogue':9s} {'configuration':47s} {'seconds':>8s} {'files/s':>8s} {'ratio':>6s} "
-              f"{'CPU ms/file':>11s} {'CPU-bound ratio':>15s}")
+              f"{'CPU ms/file':>11s} {'of which here':>13s} {'CPU-bound ratio':>15s}")
 
         def best(rounds):
-            return min(sec for sec, _ in rounds), float(np.median([cpu for _, cpu in rounds]))
+            """The fastest round's seconds, the median CPU seconds and the median CPU of this process."""
+            return (min(r[0] for r in rounds), float(np.median([r[1] for r in rounds])),
+                    float(np.median([r[2] for r in rounds])))
 
         for name, files in catalogues.items():
             for (n, label), rounds in results.items():
                 if n == name:
-                    sec, cpu = best(rounds)
+                    sec, cpu, here = best(rounds)
                     tree, own = ("[baseline] ", label[11:]) if label.startswith("[baseline] ") else ("", label)
-                    base, base_cpu = best(results[name, f"{tree}1 process (in-process)"])
+                    base, base_cpu, _ = best(results[name, f"{tree}1 process (in-process)"])
                     # the wall ratio the CPU time allows with both cores to ourselves: the same CPU over 2
                     ideal = base_cpu / (cpu / (1 if own.startswith("1 ") else 2))
                     print(f"{name:9s} {label:47s} {sec:8.2f} {len(files) / sec:8.1f} {base / sec:6.2f} "
-                          f"{1e3 * cpu / len(files):11.2f} {ideal:15.2f}")
+                          f"{1e3 * cpu / len(files):11.2f} {1e3 * here / len(files):13.2f} {ideal:15.2f}")
         if startup is not None:
             print(f"(Dask LocalCluster start-up with the workers' warm-up, not included above: {startup:.2f} s, "
                   "the fastest of the rounds)")

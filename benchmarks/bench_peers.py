@@ -48,7 +48,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 
-from bench_scaling import write_torus  # noqa: E402
+from bench_scaling import run_caption, write_torus  # noqa: E402
 
 _COMMON = r"""
 import json, resource, sys, time
@@ -171,7 +171,7 @@ def disagreement(ours: dict, theirs: dict, diag: float) -> tuple[float, float, f
             float(np.linalg.norm(ti - ii) / np.linalg.norm(ii)))
 
 
-def plot(rows: list[dict], out: str, load: tuple[float, float]) -> None:
+def plot(rows: list[dict], out: str, load: tuple[float, float], caption: str = "") -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -192,7 +192,8 @@ def plot(rows: list[dict], out: str, load: tuple[float, float]) -> None:
         ax.legend(fontsize=8)
     fig.suptitle(f"Binary STL tori, one run, load average {load[0]:.1f} before, {load[1]:.1f} after on "
                  f"{os.cpu_count()} CPUs\ninertia_tool runs every check of its "
-                 "certificate, numpy-stl a closedness check, trimesh and MuJoCo none", fontsize=9)
+                 "certificate, numpy-stl a closedness check, trimesh and MuJoCo none"
+                 + (f"\n{caption}" if caption else ""), fontsize=9)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
 
@@ -264,14 +265,16 @@ def main() -> None:
     if args.from_json:
         with open(args.from_json) as fh:
             saved = json.load(fh)
+        print(saved.get("caption", ""))
         print(readme_table(saved["rows"]), end="\n\n")
         for key in ("total", "cpu", "compute", "cpu_compute"):
             print(table(saved["rows"], tuple(saved["load"]), key=key), end="\n\n")
         if args.plot:
-            plot(saved["rows"], args.plot, tuple(saved["load"]))
+            plot(saved["rows"], args.plot, tuple(saved["load"]), saved.get("caption", ""))
         return
     limits = {k: float(v) for k, v in (item.rsplit("=", 1) for item in args.limit)}
     load_before = os.getloadavg()[0]
+    caption = run_caption("bench_peers.py", sys.argv[1:])
     rows = []
     for target in args.sizes:
         path, m = write_torus(int(target))
@@ -312,7 +315,8 @@ def main() -> None:
         rows.append(row)
         if args.json:
             with open(args.json, "w") as fh:
-                json.dump({"rows": rows, "load": [load_before, os.getloadavg()[0]]}, fh, indent=1)
+                json.dump({"rows": rows, "load": [load_before, os.getloadavg()[0]], "caption": caption}, fh,
+                          indent=1)
     load_after = os.getloadavg()[0]
     for r in rows:
         for peer, got in r["peers"].items():
@@ -320,7 +324,7 @@ def main() -> None:
                 dv, dc, di = got["difference"]
                 print(f"check {r['faces']:>10,} {peer:<22} volume {dv:.1e}  centre {dc:.1e}  inertia {di:.1e}  "
                       f"{'agrees' if got['agrees'] else 'DISAGREES'}")
-    print("\nREADME table (CPU time, imports included):\n")
+    print(f"\nREADME table (CPU time, imports included; {caption}):\n")
     print(readme_table(rows))
     print()
     print(table(rows, (load_before, load_after)))
@@ -329,9 +333,9 @@ def main() -> None:
         print(table(rows, (load_before, load_after), key=key))
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump({"rows": rows, "load": [load_before, load_after]}, fh, indent=1)
+            json.dump({"rows": rows, "load": [load_before, load_after], "caption": caption}, fh, indent=1)
     if args.plot:
-        plot(rows, args.plot, (load_before, load_after))
+        plot(rows, args.plot, (load_before, load_after), caption)
         print(f"\nwrote {args.plot}")
 
 

@@ -541,3 +541,26 @@ def test_progress_bar_on_a_terminal_is_redrawn_at_most_every_redraw_seconds():
     for k in range(1, 6):
         p(k, 5, k, 0)
     assert every.getvalue().count("\r") == 5
+
+
+
+def test_pool_workers_import_the_writer_only_when_the_parent_had():
+    """A worker closes the results file it inherited; a parent that never imported the writer has none open,
+    and its workers need not import it (7 ms of CPU each).  In a fresh interpreter, so that this test session's
+    imports do not decide it."""
+    code = ("import sys\n"
+            "from inertia_tool.batch.runner import _process_pool\n"
+            "def _writer_imported(_):\n"
+            "    return 'inertia_tool.batch.rows' in sys.modules\n"
+            "def run():\n"
+            "    with _process_pool(2) as pool:\n"
+            "        return list(pool.map(_writer_imported, range(4)))\n"
+            "if __name__ == '__main__':\n"
+            "    before = any(run())\n"
+            "    import inertia_tool.batch.rows\n"
+            "    print(before, all(run()))\n")
+    env = {**os.environ, "PYTHONPATH": ROOT}
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["False", "True"]

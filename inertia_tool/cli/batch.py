@@ -149,6 +149,7 @@ def register(subparsers) -> None:
 def run(args) -> int:
     from ..batch.rows import open_results, results_format
     from ..batch.runner import BatchOptions, discover_files, run_batch
+    from . import speak_options
 
     results_format(args.out)                      # a bad suffix is a usage error before any work
     density, mass = density_and_mass(args)
@@ -176,10 +177,15 @@ def run(args) -> int:
         progress = None if args.quiet else Progress(sys.stderr)
         try:
             implausible = []
+            owner = getattr(args, "_subparsers", {}).get("batch")
 
             def write_row(row):
                 if "metres assumed" in str(row.get("warnings") or ""):     # ImplausibleSizeWarning of this file
                     implausible.append(row["path"])
+                # the rows of the command speak its options, as `analyze` does ("--repair", not "`repair=True`")
+                for column in ("error", "warnings"):
+                    if row.get(column) and "`" in row[column]:
+                        row[column] = speak_options(row[column], owner)
                 out.write_row(row)
 
             summary = run_batch(files, options, write_row, previous_rows=out.previous_rows,
