@@ -16,10 +16,13 @@ Shared by ``bench_intersect.py`` and any benchmark that needs the same surfaces 
 from __future__ import annotations
 
 import os
+import sys
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, os.pardir, "tests"))       # the icosahedron's one table: tests/solids.py
+from solids import icosahedron  # noqa: E402
 
 
 def _torus_grid(nu: int, nv: int, major: float, minor: float, phase: float = 0.0):
@@ -111,13 +114,7 @@ def ring_torus(nu: int, nv: int, major: float = 40.0, minor: float = 10.0) -> tu
 def icosphere(subdivisions: int, radius: float = 50.0) -> tuple[np.ndarray, np.ndarray]:
     """A subdivided icosahedron projected on the sphere of ``radius``: 20·4^s faces, outward
     ((n, 3) float64 vertices, (m, 3) int64 faces)."""
-    t = (1 + 5 ** 0.5) / 2
-    v = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t], [0, 1, -t],
-                  [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], dtype=np.float64)
-    f = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
-                  [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
-                  [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]], dtype=np.int64)
-    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    v, f = icosahedron()
     for _ in range(subdivisions):
         n = len(v)
         v, f = subdivide(v, f)

@@ -28,6 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
+from solids import icosahedron
+
 MESH_DIR = Path(__file__).resolve().parent.parent / "meshes"
 
 #: Composition kinds, in the order of the benchmark table.
@@ -68,13 +70,7 @@ def _subdivide(v, f):
 
 def icosphere(radius=1.0, subdivisions=1):
     """Icosphere (vertices pushed to the sphere after each split), outward."""
-    t = (1 + 5 ** 0.5) / 2
-    v = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t], [0, 1, -t],
-                  [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], dtype=np.float64)
-    f = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
-                  [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
-                  [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]], dtype=np.int64)
-    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    v, f = icosahedron()
     for _ in range(subdivisions):
         v, f = _subdivide(v, f)
         v /= np.linalg.norm(v, axis=1, keepdims=True)

@@ -7,6 +7,8 @@ truths they are checked against come from independent code (manifold3d booleans 
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 
@@ -94,6 +96,48 @@ def rotation(axis, angle):
     axis = axis / np.linalg.norm(axis)
     k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+
+
+def icosahedron():
+    """The regular icosahedron on the unit sphere, outward: ((12, 3) float64 corners, (20, 3) int64 faces).
+
+    The corners are the cyclic permutations of (0, ±1, ±φ), φ the golden ratio, scaled to unit length; the one
+    table of it (``tests/adversary_solids.py`` and ``benchmarks/_shapes.py`` subdivide it into icospheres)."""
+    t = (1 + 5 ** 0.5) / 2
+    v = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t], [0, 1, -t],
+                  [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], dtype=np.float64)
+    f = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
+                  [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
+                  [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]], dtype=np.int64)
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    return v, f
+
+
+class ConvexSolid(NamedTuple):
+    """A convex polyhedron: outward ``vertices`` (n, 3) and ``faces`` (m, 3), its hull's plane ``equations``
+    (k, 4: ``a · x + b ≤ 0`` inside, scipy's ``ConvexHull.equations``) and ``centre``, the mean of its corners
+    (inside)."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    equations: np.ndarray
+    centre: np.ndarray
+
+
+def random_convex(seed, n=14):
+    """The convex hull of ``n`` random points (a random solid, not tuned on), wound outward."""
+    from scipy.spatial import ConvexHull
+
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(n, 3)) * rng.uniform(0.5, 2.0, size=3) + rng.uniform(-5, 5, size=3)
+    hull = ConvexHull(pts)
+    f = hull.simplices.copy()
+    centre = pts[hull.vertices].mean(axis=0)
+    normal = np.cross(pts[f[:, 1]] - pts[f[:, 0]], pts[f[:, 2]] - pts[f[:, 0]])
+    inward = np.einsum("ij,ij->i", normal, pts[f[:, 0]] - centre) < 0
+    f[inward] = f[inward][:, ::-1]
+    used, f = np.unique(f, return_inverse=True)
+    return ConvexSolid(pts[used], f.reshape(-1, 3), hull.equations, centre)
 
 
 def stack(*parts):

@@ -19,6 +19,7 @@ from inertia_tool.mesh.folds import internal_walls, settle_folds, sliver_fans
 from inertia_tool.mesh.intersect import surface_contacts
 
 from intersect_reference import CROSSING, OPPOSITE, pair_kinds
+from solids import random_convex
 
 pytestmark = pytest.mark.usefixtures("engine_path")
 
@@ -44,22 +45,6 @@ def _assert_matches(p, truth, rtol=1e-12):
     assert abs(p.volume - volume) <= rtol * volume
     assert np.max(np.abs(p.center_of_mass - centre)) <= rtol * scale
     assert np.max(np.abs(p.inertia - inertia)) <= rtol * np.max(np.abs(inertia))
-
-
-def _convex(seed, n=14):
-    """A convex polyhedron with outward faces: the hull of random points (a random solid, not tuned on)."""
-    from scipy.spatial import ConvexHull
-
-    rng = np.random.default_rng(seed)
-    pts = rng.normal(size=(n, 3)) * rng.uniform(0.5, 2.0, size=3) + rng.uniform(-5, 5, size=3)
-    hull = ConvexHull(pts)
-    f = hull.simplices.copy()
-    centre = pts[hull.vertices].mean(axis=0)
-    normal = np.cross(pts[f[:, 1]] - pts[f[:, 0]], pts[f[:, 2]] - pts[f[:, 0]])
-    inward = np.einsum("ij,ij->i", normal, pts[f[:, 0]] - centre) < 0
-    f[inward] = f[inward][:, ::-1]
-    used, f = np.unique(f, return_inverse=True)
-    return pts[used], f.reshape(-1, 3)
 
 
 def _insert_points(v, f, rng, share, exact_on_edge=False):
@@ -99,7 +84,7 @@ def _insert_points(v, f, rng, share, exact_on_edge=False):
 @FAST
 @given(seed=st.integers(0, 2 ** 32 - 1), share=st.floats(0.05, 0.6))
 def test_points_rounded_off_edges_leave_the_part_exact(seed, share):
-    v, f = _convex(seed)
+    v, f = random_convex(seed)[:2]
     truth = _truth(v, f)
     dv, df = _insert_points(v, f, np.random.default_rng(seed + 1), share)
     p = _analyse(dv, df)
@@ -135,7 +120,7 @@ def test_a_fan_is_replaced_by_the_face_it_splits_and_a_chain_unwinds():
 def test_a_thick_fan_through_the_part_is_not_taken_for_a_sliver():
     """A vertex of three faces pushed through the opposite face: a real crossing, its tetrahedron far above the
     round-off budget; R3a leaves it alone (the check stays the one that decides)."""
-    v, f = _convex(7)
+    v, f = random_convex(7)[:2]
     truth_volume = _truth(v, f)[0]
     centre = v.mean(axis=0)
     normal = np.cross(v[f[0, 1]] - v[f[0, 0]], v[f[0, 2]] - v[f[0, 0]])
@@ -217,7 +202,7 @@ def _summed_truth(pieces):
 def test_solids_cut_by_random_planes_and_written_face_to_face_are_exact(seed, walls):
     """One or two internal walls (parallel cuts: three slabs), each cut face triangulated on its own."""
     rng = np.random.default_rng(seed)
-    v, f = _convex(seed, n=20)
+    v, f = random_convex(seed, n=20)[:2]
     normal = rng.normal(size=3)
     normal /= np.linalg.norm(normal)
     heights = v @ normal
@@ -276,7 +261,7 @@ def test_an_exactly_coplanar_wall_with_two_triangulations_cancels_exactly():
 
 def test_a_bulging_wall_is_no_wall():
     """One sheet pushed 1e-4 of the size into the other half: a real overlap, far above rounding; R3a leaves it."""
-    v, f = _convex(3, n=20)
+    v, f = random_convex(3, n=20)[:2]
     normal = np.array([0.0, 0.0, 1.0])
     offset = float(np.median(v[:, 2]))
     halves = _halves(v, f, normal, offset)
@@ -318,7 +303,7 @@ def test_two_slabs_welded_face_to_face_are_exact_not_a_short_union():
     """Regression: two slabs of a solid welded face to face, their shared face triangulated apart (one face pair
     coplanar-opposite, none crossing), were given the boolean union's volume, 3 % low, certified unverified."""
     rng = np.random.default_rng(1900)
-    v, f = _convex(1900, n=20)
+    v, f = random_convex(1900, n=20)[:2]
     normal = rng.normal(size=3)
     normal /= np.linalg.norm(normal)
     heights = v @ normal
@@ -338,7 +323,7 @@ def test_two_slabs_welded_face_to_face_are_exact_not_a_short_union():
 
 def _welded_slabs():
     rng = np.random.default_rng(1900)
-    v, f = _convex(1900, n=20)
+    v, f = random_convex(1900, n=20)[:2]
     normal = rng.normal(size=3)
     normal /= np.linalg.norm(normal)
     heights = v @ normal

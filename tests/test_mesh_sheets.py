@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 
 import inertia_tool as it
 from inertia_tool.mesh.sheets import open_sheets
+from solids import random_convex
 from test_mesh_folds import _assert_matches, _truth
 
 pytestmark = pytest.mark.usefixtures("engine_path")
@@ -29,22 +30,6 @@ def _analyse(v, f, repair=False):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return it.mass_properties((np.asarray(v, dtype=float), np.asarray(f)), density=1.0, repair=repair)
-
-
-def _convex(seed, n=14):
-    """A convex polyhedron with outward faces (the hull of random points) and its hull's plane equations."""
-    from scipy.spatial import ConvexHull
-
-    rng = np.random.default_rng(seed)
-    pts = rng.normal(size=(n, 3)) * rng.uniform(0.5, 2.0, size=3) + rng.uniform(-5, 5, size=3)
-    hull = ConvexHull(pts)
-    f = hull.simplices.copy()
-    centre = pts[hull.vertices].mean(axis=0)
-    normal = np.cross(pts[f[:, 1]] - pts[f[:, 0]], pts[f[:, 2]] - pts[f[:, 0]])
-    inward = np.einsum("ij,ij->i", normal, pts[f[:, 0]] - centre) < 0
-    f[inward] = f[inward][:, ::-1]
-    used, f = np.unique(f, return_inverse=True)
-    return pts[used], f.reshape(-1, 3), hull.equations, centre
 
 
 def _reach(equations, centre, direction):
@@ -87,7 +72,7 @@ def _with(v, f, sv, sf):
 @FAST
 @given(seed=st.integers(0, 2 ** 32 - 1), share=st.floats(0.05, 0.95))
 def test_a_flat_sheet_free_inside_leaves_the_part_exact(seed, share):
-    v, f, eq, centre = _convex(seed)
+    v, f, eq, centre = random_convex(seed)
     truth = _truth(v, f)
     sv, sf = _polygon_sheet(np.random.default_rng(seed + 1), eq, centre, share)
     dv, df = _with(v, f, sv, sf)
@@ -139,7 +124,7 @@ def _fan_cut(hv, hf, on, rng):
 def test_a_cut_face_kept_inside_with_its_rim_on_the_surface_is_exact(seed, along):
     """The part cut by a random plane and joined again, one half's cut face kept (fanned anew) and welded at its
     rim: a single internal wall.  Truth: the two closed halves (manifold3d's cut points), by exact arithmetic."""
-    v, f, _, centre = _convex(seed)
+    v, f, _, centre = random_convex(seed)
     rng = np.random.default_rng(seed + 2)
     normal = rng.normal(size=3)
     normal /= np.linalg.norm(normal)
@@ -170,7 +155,7 @@ def test_two_sheets_and_a_cavity():
     """Two flat sheets in the body around a cavity written inward: both inside the solid (the body's winding 1
     at each), the cavity kept; a third sheet inside the cavity is a fin (named in the refusal without repair; with
     it, repair's normal path)."""
-    v, f, eq, centre = _convex(3)
+    v, f, eq, centre = random_convex(3)
     truth_body = _truth(v, f)
     inner_v = centre + 0.2 * (v - centre)
     inner_f = f[:, ::-1]                                     # the cavity: the body shrunk about its centre, inward
@@ -209,7 +194,7 @@ def test_two_sheets_and_a_cavity():
 @FAST
 @given(seed=st.integers(0, 2 ** 32 - 1), reach=st.floats(1.05, 3.0))
 def test_a_sheet_poking_out_through_the_surface_is_not_taken(seed, reach):
-    v, f, eq, centre = _convex(seed)
+    v, f, eq, centre = random_convex(seed)
     rng = np.random.default_rng(seed + 3)
     share = np.r_[reach, rng.uniform(0.2, 0.9, size=7)]      # one corner beyond the surface
     sv, sf = _polygon_sheet(rng, eq, centre, share, corners=8)
@@ -223,7 +208,7 @@ def test_a_sheet_poking_out_through_the_surface_is_not_taken(seed, reach):
 @given(seed=st.integers(0, 2 ** 32 - 1))
 def test_a_sheet_crossing_the_surface_is_not_taken(seed):
     """A flat polygon about a point on the surface: half inside, half outside."""
-    v, f, eq, centre = _convex(seed)
+    v, f, eq, centre = random_convex(seed)
     rng = np.random.default_rng(seed + 4)
     d = rng.normal(size=3)
     d /= np.linalg.norm(d)
@@ -244,7 +229,7 @@ def test_a_sheet_crossing_the_surface_is_not_taken(seed):
 
 
 def test_a_fin_standing_out_of_the_part_needs_repair():
-    v, f, eq, centre = _convex(11)
+    v, f, eq, centre = random_convex(11)
     truth = _truth(v, f)
     far = centre + 3 * (v.max(axis=0) - v.min(axis=0))
     sv = far + np.array([[0, 0, 0], [1.0, 0, 0], [0, 1.0, 0]])
@@ -272,14 +257,14 @@ def test_a_cavity_with_a_hole_is_not_read_as_a_wall():
 
 def test_a_sheet_lying_on_a_face_of_the_part_is_not_taken():
     """A copy of a face of the part, wound either way: it touches the outside, so it is no internal wall."""
-    v, f, _, _ = _convex(4)
+    v, f, _, _ = random_convex(4)
     for sheet in (f[:1], f[:1, ::-1]):
         dv, df = v, np.vstack([f, sheet])
         assert open_sheets(dv, df) is None
 
 
 def test_a_surface_with_a_hole_is_no_sheet():
-    v, f, _, _ = _convex(5)
+    v, f, _, _ = random_convex(5)
     assert open_sheets(v, f[1:]) is None
 
 
@@ -287,7 +272,7 @@ def test_a_cavity_cracked_into_flat_facets_is_not_read_as_walls():
     """A hollow part whose cavity's faces each carry their own corners, moved apart by 1e-9 (a cracked surface):
     each face is a flat open piece inside the body, but together they enclose the void; their rims meet each
     other, so they are not taken for walls (the void would be lost)."""
-    v, f, _, centre = _convex(8)
+    v, f, _, centre = random_convex(8)
     rng = np.random.default_rng(8)
     inner = centre + 0.3 * (v - centre)
     tris = inner[f[:, ::-1]] + rng.normal(scale=1e-9, size=(len(f), 3, 3))

@@ -18,10 +18,10 @@ from typing import TYPE_CHECKING, Any, Iterable, Mapping, TypeAlias
 import numpy as np
 
 from ..errors import InvalidMeshError, NearlyEqualMomentsWarning, OverlapWarning, PhysicalValidityWarning, UsageError
+from ..mesh.classify import classify_shells
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.precision import warn_storage_precision
-from ..mesh.classify import classify_shells
 from ..mesh.prepare import PreparedMesh, prepare_mesh
 from ..mesh.read import RawMesh, load_mesh
 from ..tolerances import NEEDLE_RTOL, PART_OVERLAP_RTOL, TRIANGLE_INEQUALITY_RTOL

@@ -1,6 +1,6 @@
 """Every rule that turns a closed surface into a solid, each stated once with its reason, and the certificate.
 
-:func:`~inertia_tool.mesh.prepare.prepare_mesh` applies these rules in order; nothing else in the pipeline
+:func:`~inertia_tool.mesh.prepare.prepare_mesh` applies these rules in order, by stage; nothing else in the pipeline
 decides when to flip, unite, drop or refuse.  The solid of a surface is the set where its winding number is
 at least one (Rigid Body Motion, Ch. 4, the divergence-theorem volume integrals hold for that set only when
 the surface bounds it exactly once).
@@ -952,6 +952,22 @@ def _steiner_bound(vertices: np.ndarray, faces: np.ndarray, delta: float) -> flo
     return float(np.sum(parallel_body_volume(vertices, faces, np.full(len(faces), delta))) * (1 + 1e-12))
 
 
+def copy_candidates(shells: Sequence[VolumeMoments], labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """R0's candidates: pairs ``(first[i], second[i])`` of shells that could be copies of each other, neighbours in
+    the order of face count and |volume| whose face counts are equal and whose |volume| and area agree to 1e-9.
+    ``labels``: (m,) int, the shell of each face."""
+    n = len(shells)
+    if n < 2:
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
+    count = np.bincount(labels, minlength=n)
+    size = np.array([[abs(s.volume), s.area] for s in shells])
+    order = np.lexsort((size[:, 0], count))
+    first, second = order[:-1], order[1:]
+    close = (count[first] == count[second]) & \
+        np.all(np.abs(size[first] - size[second]) <= 1e-9 * np.maximum(size[first], size[second]), axis=1)
+    return first[close], second[close]
+
+
 def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, shells: Sequence[VolumeMoments], *,
                 rtol: float = COINCIDENT_RTOL, budget: float = ROUNDOFF_RTOL) -> NearCopies:
     """R0 up to rounding: the later of two closed surfaces that repeat each other corner for corner, the same
@@ -977,15 +993,10 @@ def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, she
     none = NearCopies(drop=drop, copies=0, distance=0.0, volume_bound=0.0)
     if n < 2:
         return none
-    count = np.bincount(labels, minlength=n)
-    size = np.array([[abs(s.volume), s.area] for s in shells])
-    order = np.lexsort((size[:, 0], count))
-    first, second = order[:-1], order[1:]
-    close = (count[first] == count[second]) & \
-        np.all(np.abs(size[first] - size[second]) <= 1e-9 * np.maximum(size[first], size[second]), axis=1)
+    first, second = copy_candidates(shells, labels)
     gone = np.zeros(n, dtype=bool)
     copies, distance, volume_bound = 0, 0.0, 0.0
-    for a, b in zip(first[close][:MAX_NEAR_COPY_PAIRS].tolist(), second[close][:MAX_NEAR_COPY_PAIRS].tolist()):
+    for a, b in zip(first[:MAX_NEAR_COPY_PAIRS].tolist(), second[:MAX_NEAR_COPY_PAIRS].tolist()):
         if gone[a] or gone[b]:
             continue
         if np.linalg.norm(shells[a].centroid - shells[b].centroid) > 1e-6 * np.sqrt(shells[a].area):

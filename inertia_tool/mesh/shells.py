@@ -17,8 +17,8 @@ from ..errors import InsideOutWarning, InvalidMeshError, MeshResolvedWarning
 from ..integrals import RoundoffBound, VolumeMoments, accurate_shells, body_volume_moments
 from ..tolerances import FLAT_RTOL
 from .checks import shell_labels
-from .policy import (coincident_message, coincident_surfaces, near_copies, near_copies_message, negligible_flat,
-                     welded_bodies)
+from .policy import (coincident_message, coincident_surfaces, copy_candidates, near_copies, near_copies_message,
+                     negligible_flat, welded_bodies)
 
 __all__ = ["Shells", "FoundShells", "find_shells", "bodies", "measured", "reshelled", "drop_flat", "apply_flips",
            "leave_out_coincident", "total"]
@@ -154,20 +154,13 @@ def reshelled(v: np.ndarray, f: np.ndarray, diag: float, source: str) -> Shells:
 
 
 def _twin_candidates(shells: Sequence[VolumeMoments], labels: np.ndarray) -> np.ndarray | None:
-    """(m,) bool: faces of shells that could be copies of another (R0: same face count, |volume| and area equal
-    to 1e-9), or None when no two shells could be."""
-    n = len(shells)
-    if n < 2:
+    """(m,) bool: faces of shells that could be copies of another (R0, :func:`~.policy.copy_candidates`), or None
+    when no two shells could be."""
+    first, second = copy_candidates(shells, labels)
+    if not len(first):
         return None
-    count = np.bincount(labels, minlength=n)
-    size = np.array([[abs(s.volume), s.area] for s in shells])
-    order = np.lexsort((size[:, 0], count))
-    a, b = order[:-1], order[1:]
-    close = (count[a] == count[b]) & np.all(np.abs(size[a] - size[b]) <= 1e-9 * np.maximum(size[a], size[b]), axis=1)
-    if not close.any():
-        return None
-    shell = np.zeros(n, dtype=bool)
-    shell[a[close]] = shell[b[close]] = True
+    shell = np.zeros(len(shells), dtype=bool)
+    shell[first] = shell[second] = True
     return np.asarray(shell[labels])
 
 
