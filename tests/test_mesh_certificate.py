@@ -485,3 +485,24 @@ def test_face_counts_in_the_report_add_up():
         united = mass_properties(stack(cube, moved), density=1.0).mesh
     assert "union's surface" in face_count_text(united)
     assert face_count_text(mass_properties(cube, density=1.0).mesh) == "12 (as in the file)"
+
+
+def test_a_welded_pair_and_a_self_crossing_tube_keep_both_arrangements_notes():
+    # R1b arranges the welded L-shapes, then R3 the figure-eight beside them: the report kept only R3's note before
+    import adversary_solids as A
+
+    from inertia_tool.mesh.prepare import prepare_mesh
+    from inertia_tool.mesh.read import RawMesh
+    case = A.make_case("welded_l_shapes", np.random.default_rng(0))
+    tube_v, tube_f = figure_eight()
+    tube_v = tube_v + [case.vertices[:, 0].max() + 3.0, 0.0, 0.0]
+    v = np.vstack([case.vertices, tube_v])
+    f = np.vstack([case.faces, tube_f + len(case.vertices)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        prepared = prepare_mesh(RawMesh(vertices=v, faces=f, source="pair_and_tube.stl", file_faces=len(f)))
+    notes = " | ".join(prepared.report.notes)
+    assert "overlap in a common plane" in notes and "passes through itself at" in notes
+    assert prepared.report.certificate.kind == "united"
+    tube_volume, _ = _figure_eight_truth()
+    assert sum(s.volume for s in prepared.shells) == pytest.approx(case.truth.volume + tube_volume, rel=1e-12)

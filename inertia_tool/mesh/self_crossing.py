@@ -72,7 +72,10 @@ def settle_self_crossing(shells: Shells, contacts: SurfaceContacts, *, arranged:
     arrange_failed, verified = "", arranged is not None
     if touch.self_crossing.any() and self_crossing == "refuse" and overlap == "union" and patched is None:   # R3
         try:
+            before = arranged
             shells, contacts, touch, arranged, verified = _arrange_self_crossing(shells, contacts, diag, source)
+            if before is not None:               # R1b's note stays: both arrangements reach the report
+                arranged = f"{before}; then {arranged}"
         except ArrangementError as exc:
             arrange_failed = f"; its solid {{winding number ≥ 1}} could not be built: {exc}"
     if touch.self_crossing.any() and self_crossing == "unverified" and not repair:
