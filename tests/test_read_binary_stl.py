@@ -115,3 +115,19 @@ def test_finite_magnitude_refuses_nan_and_infinity(bad):
     v[617, 2] = bad
     assert read_mod._finite_magnitude(v) is None
     assert read_mod._finite_magnitude(v[:, ::-1]) is None                   # not contiguous: numpy's pass
+
+
+def test_binary_stl_cut_short_while_read_is_refused(tmp_path, monkeypatch):
+    """A file that holds fewer records than the count checked before reading (cut short meanwhile) ends the
+    chunk reader with a one-line error saying how many triangles were there, not a short or stale chunk of the
+    reused buffer."""
+    corners = np.arange(3 * 3 * 100, dtype=np.float32).reshape(-1, 3, 3)
+    path = tmp_path / "cut.stl"
+    _write(path, corners)
+    monkeypatch.setattr(read_mod, "_CHUNK_FACES", 30)
+    views = read_mod._binary_stl_chunks(str(path), 130, padded=False)
+    seen = []
+    with pytest.raises(MeshReadError, match=r"ended after 100 of 130 triangles"):
+        for v in views():
+            seen.append(v.copy())
+    np.testing.assert_array_equal(np.concatenate(seen), corners[:90])
