@@ -757,10 +757,12 @@ static PyTypeObject WelderType = {
  *            share a bucket, and a bucket holds its points in file order (chunks in order, a chunk's parts in
  *            order, a part's points in order), so the first point of each distinct key in its bucket is its
  *            first corner in the whole stream; that corner is marked in a bitmap of all corners;
+ *            each point's entry then names its vertex's first corner;
  *   output   a vertex's number is the count of marked corners before its first corner (first appearance
- *            order, exactly the Welder's numbering); the vertices are written at their numbers, and every
- *            corner's number is gathered in file order through its bucket's cursor (or copied from the
- *            earlier corner it refers to, which is in the same chunk: done already).
+ *            order, exactly the Welder's numbering); every corner's number is gathered in file order through
+ *            its bucket's cursor (a vertex's first corner writes the vertex; a corner whose vertex came first
+ *            earlier in its part copies that corner's number, any other counts the marks before that first
+ *            corner), or copied from the earlier corner it refers to, which is in the same part: done already.
  *
  * The result is the Welder's bit for bit (same keys, same equality, same numbering); only the order of the
  * work differs, and no step depends on which thread did it.  Memory until output returns: 16 bytes (key,
@@ -773,8 +775,8 @@ static PyTypeObject WelderType = {
 #define PW_MAX_BITS 12
 #define PW_TARGET_POINTS ((size_t)1 << 15)   /* points per bucket aimed at: table and keys stay in L2 */
 
-typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* corner: after finish the local vertex id, after
-                                                                 * numbering the vertex's number */
+typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* corner: after finish, its vertex's first
+                                                                 * corner */
 typedef struct { uint32_t k[3]; uint32_t first; } PwVertex;   /* first corner; after output, its number */
 
 typedef struct {
@@ -794,6 +796,8 @@ typedef struct {
     size_t entries_used;               /* entries of the chunks so far, with the gaps between parts */
     size_t partitioned;                /* points copied into the buckets (not found in a recent cache) */
     Recent32 *recent;                  /* per thread: WELD_RECENT points seen last in the part it feeds */
+    PwEntry *stage;                    /* the misses of the chunk being fed, before the scatter */
+    size_t stage_cap, stage_bytes;     /* its entries; its mapping's size */
     Py_buffer index;                   /* the caller's int32 output: bucket numbers until output() */
     int has_index;
     size_t arena_bytes;
@@ -990,6 +994,9 @@ pw_release(PartWelderObject *w)
     }
     free(w->recent);
     w->recent = NULL;
+    pool_give(w->stage, w->stage_bytes);
+    w->stage = NULL;
+    w->stage_cap = w->stage_bytes = 0;
     free(w->owner);
     free(w->v0);
     free(w->nv);
@@ -1018,12 +1025,16 @@ typedef struct {
     Py_ssize_t n0, n1, s0, s1, sc;
     PwChunk *chunk;
     int bits;
+    PwEntry *stage;                    /* the chunk's size: part t stages its misses from its first point's place */
     Recent32 *recent[MAX_THREADS];
 } PwFeedTask;
 
 /* Part t of the chunk.  A point the part's recent-point cache holds (full key compared) refers to that
- * earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and then, in a
- * second pass, copied with its corner into the part's range of the chunk's entries (a stable scatter). */
+ * earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and staged, with
+ * its corner, in order; then the staged points are copied into the part's range of the chunk's entries (a
+ * stable scatter).  The scatter reads the staged misses (16 bytes each, in order) rather than the part's
+ * records again (50 bytes per three points, past the L2 cache by then) and skips the hits without a branch
+ * on each point. */
 static void
 pw_feed_task(void *ctx, int t, int nt)
 {
@@ -1034,6 +1045,7 @@ pw_feed_task(void *ctx, int t, int nt)
     uint32_t *off = c->off + (size_t)t * (nb + 1);
     uint32_t cursor[(size_t)1 << PW_MAX_BITS];
     Recent32 *recent = f->recent[t];
+    PwEntry *stage = f->stage + lo, *staged = stage;
     memset(off, 0, (nb + 1) * sizeof(uint32_t));
     memset(recent, 0, WELD_RECENT * sizeof(Recent32));
     Py_ssize_t i0 = (Py_ssize_t)lo / f->n1, i1 = (Py_ssize_t)lo % f->n1;
@@ -1050,9 +1062,11 @@ pw_feed_task(void *ctx, int t, int nt)
         int32_t b = f->bits ? (int32_t)(h >> shift) : 0;
         c->bucket[k] = b;
         off[b + 1]++;
-        r->k[0] = key[0];
-        r->k[1] = key[1];
-        r->k[2] = key[2];
+        r->k[0] = staged->k[0] = key[0];
+        r->k[1] = staged->k[1] = key[1];
+        r->k[2] = staged->k[2] = key[2];
+        staged->corner = c->corner0 + (uint32_t)k;
+        staged++;
         r->id = c->corner0 + (uint32_t)k + 1;
     }
     off[0] = (uint32_t)lo;
@@ -1060,16 +1074,9 @@ pw_feed_task(void *ctx, int t, int nt)
         off[b + 1] += off[b];
         cursor[b] = off[b];
     }
-    i0 = (Py_ssize_t)lo / f->n1;
-    i1 = (Py_ssize_t)lo % f->n1;
-    for (size_t k = lo; k < hi; k++) {
-        int32_t b = c->bucket[k];
-        if (b >= 0) {
-            PwEntry *e = c->entries + cursor[b]++;
-            pw_load(f->base + i0 * f->s0 + i1 * f->s1, f->sc, e->k);
-            e->corner = c->corner0 + (uint32_t)k;
-        }
-        if (++i1 == f->n1) { i1 = 0; i0++; }
+    for (const PwEntry *e = stage; e < staged; e++) {
+        int32_t b = c->bucket[e->corner - c->corner0];
+        c->entries[cursor[b]++] = *e;
     }
 }
 
@@ -1174,7 +1181,8 @@ pw_weld_task(void *ctx, int t, int nt)
                             mask = cap - 1;
                         }
                     }
-                    e->corner = id - 1;      /* the key stays: output writes the vertex from it */
+                    e->corner = vs[id - 1].first;    /* its vertex's first corner (the key stays: output
+                                                       * writes the vertex from it) */
                 }
             }
         }
@@ -1194,47 +1202,8 @@ typedef struct {
     PartWelderObject *w;
     double *vertices;
     int32_t *index;
-    uint32_t *number;     /* per vertex in bucket order: its number */
     int32_t ticket;
 } PwOutTask;
-
-/* Number the vertices of the buckets this thread draws and replace each of the bucket's points' local id by
- * its vertex's number (the coordinates are written in file order by the gather, where each vertex's first
- * corner comes: sequential writes instead of one cache miss per vertex). */
-static void
-pw_number_task(void *ctx, int t, int nt)
-{
-    PwOutTask *o = (PwOutTask *)ctx;
-    PartWelderObject *w = o->w;
-    size_t nb = (size_t)1 << w->bits;
-    const uint64_t *mark = w->mark[0];
-    for (;;) {
-        int32_t b = next_ticket(&o->ticket);
-        if (b < 0 || (size_t)b >= nb) {
-            break;
-        }
-        const PwVertex *vs = w->verts[w->owner[b]] + w->v0[b];
-        uint32_t *number = o->number + w->vbase[b];
-        for (size_t l = 0; l < w->nv[b]; l++) {
-            uint32_t p = vs[l].first;
-            uint64_t below = mark[p >> 6] & (((uint64_t)1 << (p & 63)) - 1);
-            uint32_t g = w->rank[p >> 6] + popcount64(below);
-            number[l] = g;
-        }
-        /* the bucket's points: local id -> number, while the bucket's numbers are in this core's cache */
-        for (size_t i = 0; i < w->n_chunks; i++) {
-            const PwChunk *c = &w->chunks[i];
-            for (int p = 0; p < c->nt; p++) {
-                const uint32_t *off = c->off + (size_t)p * (nb + 1);
-                for (PwEntry *e = c->entries + off[b], *end = c->entries + off[b + 1]; e < end; e++) {
-                    e->corner = number[e->corner];
-                }
-            }
-        }
-    }
-    (void)t;
-    (void)nt;
-}
 
 /* The corners of the chunks this thread draws, in file order, each through its bucket's cursor. */
 static void
@@ -1244,6 +1213,7 @@ pw_gather_task(void *ctx, int t, int nt)
     PartWelderObject *w = o->w;
     size_t nb = (size_t)1 << w->bits;
     uint32_t cursor[(size_t)1 << PW_MAX_BITS];
+    const uint64_t *mark = w->mark[0];
     for (;;) {
         int32_t u = next_ticket(&o->ticket);
         if (u < 0 || (size_t)u >= w->n_chunks) {
@@ -1255,10 +1225,13 @@ pw_gather_task(void *ctx, int t, int nt)
             const uint32_t *off = c->off + (size_t)p * (nb + 1);
             memcpy(cursor, off, nb * sizeof(uint32_t));
             size_t lo = part_start(c->size, p, c->nt), hi = part_start(c->size, p + 1, c->nt);
-            /* numbers by first appearance: a corner is its vertex's first exactly when its number is the
-             * count of vertices first seen before it, `next` (the marked corners before the part's first) */
+            /* numbers by first appearance: each entry names its vertex's first corner; a corner that is its
+             * own vertex's first is numbered `next`, the count of vertices first seen before it (marked corners
+             * before the part's first, then counted along); any other takes the number of that first corner:
+             * written already when it is in this part, else the marked corners before it (no pass over the
+             * buckets to number them) */
             size_t c0 = c->corner0 + lo;
-            uint32_t next = w->rank[c0 >> 6] + popcount64(w->mark[0][c0 >> 6] & (((uint64_t)1 << (c0 & 63)) - 1));
+            uint32_t next = w->rank[c0 >> 6] + popcount64(mark[c0 >> 6] & (((uint64_t)1 << (c0 & 63)) - 1));
             for (size_t k = lo; k < hi; k++) {
                 int32_t b = c->bucket[k];        /* the same memory as out[k] */
                 if (b < 0) {
@@ -1266,16 +1239,23 @@ pw_gather_task(void *ctx, int t, int nt)
                     continue;
                 }
                 const PwEntry *e = c->entries + cursor[b]++;
-                if (e->corner == next) {         /* the vertex's first corner: its coordinates, in order */
+                uint32_t first = e->corner, g;
+                if (first == c->corner0 + k) {   /* the vertex's first corner: its coordinates, in order */
                     double *v = o->vertices + 3 * (size_t)next;
                     for (int q = 0; q < 3; q++) {
                         float x;
                         memcpy(&x, &e->k[q], 4);
                         v[q] = (double)x;
                     }
-                    next++;
+                    g = next++;
                 }
-                out[k] = (int32_t)e->corner;
+                else if (first >= c0) {          /* first seen earlier in this part: numbered already */
+                    g = (uint32_t)out[first - c->corner0];
+                }
+                else {                           /* the marked corners before its first */
+                    g = w->rank[first >> 6] + popcount64(mark[first >> 6] & (((uint64_t)1 << (first & 63)) - 1));
+                }
+                out[k] = (int32_t)g;
             }
         }
     }
@@ -1426,9 +1406,22 @@ PartWelder_feed(PartWelderObject *w, PyObject *points_obj)
         PyBuffer_Release(&pts);
         return PyErr_NoMemory();
     }
+    if (total > w->stage_cap) {         /* the staging area: kept for the next chunk (the same size) */
+        pool_give(w->stage, w->stage_bytes);
+        w->stage_bytes = total * sizeof(PwEntry);
+        w->stage = (PwEntry *)pool_take(&w->stage_bytes);
+        w->stage_cap = w->stage ? total : 0;
+        if (w->stage == NULL) {
+            w->stage_bytes = 0;
+            free(c->off);
+            c->off = NULL;
+            PyBuffer_Release(&pts);
+            return PyErr_NoMemory();
+        }
+    }
     w->n_chunks++;
     PwFeedTask task = {(const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
-                       pts.strides[pts.ndim - 1], c, w->bits, {NULL}};
+                       pts.strides[pts.ndim - 1], c, w->bits, w->stage, {NULL}};
     for (int t = 0; t < nt; t++) {
         task.recent[t] = w->recent + (size_t)t * WELD_RECENT;
     }
@@ -1459,6 +1452,9 @@ PartWelder_finish(PartWelderObject *w, PyObject *unused)
     }
     size_t nb = (size_t)1 << w->bits, words = (w->n_points + 63) / 64 + 1;
     PwTask task = {w, 0, 0};
+    pool_give(w->stage, w->stage_bytes);        /* every chunk is fed */
+    w->stage = NULL;
+    w->stage_cap = w->stage_bytes = 0;
     int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
     /* each thread's vertices: reserved for every partitioned point (a thread's buckets hold no more), only
      * the pages written become resident, and the pages go back to the system when the welder is done
@@ -1526,20 +1522,11 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
                      w->count);
         goto fail;
     }
-    size_t number_bytes = (w->count ? w->count : 1) * sizeof(uint32_t);
-    uint32_t *number = (uint32_t *)pool_take(&number_bytes);
-    if (number == NULL) {
-        PyErr_NoMemory();
-        goto fail;
-    }
-    PwOutTask task = {w, (double *)vert.buf, (int32_t *)w->index.buf, number, 0};
+    PwOutTask task = {w, (double *)vert.buf, (int32_t *)w->index.buf, 0};
     int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
-    run_parallel(nt, pw_number_task, &task);
-    task.ticket = 0;
     run_parallel(nt, pw_gather_task, &task);
-    pool_give(number, number_bytes);
     Py_END_ALLOW_THREADS
     pw_release(w);                      /* releases the index buffer: with the GIL */
     w->busy = 0;
