@@ -768,7 +768,8 @@ static PyTypeObject WelderType = {
  * work differs, and no step depends on which thread did it.  Memory until output returns: 16 bytes (key,
  * corner) per point the recent-point cache did not hold -- at most 48 per triangle, about the size of the
  * binary STL (50 per triangle), 18-52 % of that on the benchmark meshes; the arena is reserved for
- * all points but only the pages written are resident -- plus 20 per vertex and a bit per point per thread.
+ * all points but only the pages written are resident -- plus 20 per vertex, a bit per point per thread, and
+ * while feeding 16 bytes per point of one chunk (the staged misses; 6 MB for the reader's chunks).
  * The Welder's table is about 12 bytes per triangle.
  * ------------------------------------------------------------------------------------------------------ */
 
@@ -848,11 +849,18 @@ arena_free(void *p, size_t bytes)
 /* The weld's and the census's scratch mappings, kept for the next call in the process.  Fresh anonymous
  * pages cost the kernel a page fault and a zeroing each (on a 10M-face file about a third of the weld's CPU
  * time went to clear_page in the kernel); a batch or a second analysis in the same process reuses the
- * pages instead.  pool_take(&bytes) returns the smallest kept mapping of at least `bytes` (its real size
- * back in `bytes`: give that to pool_give) or a fresh map_fresh; its contents are undefined (every user
- * writes before it reads).  pool_give(p, bytes) keeps the mapping when it fits in POOL_SLOTS and
- * POOL_MAX_BYTES, and tells the kernel it may take the pages back under memory pressure (MADV_FREE: the
- * pages stay resident and reusable until then; reading one taken back gives zeros), else unmaps it.
+ * pages instead.  pool_take(&bytes) returns a kept mapping of at least `bytes` (its real size back in
+ * `bytes`: give that to pool_give) or a fresh map_fresh; its contents are undefined (every user writes
+ * before it reads).  Of the kept mappings large enough it takes the one whose written pages cover most of
+ * `bytes` (then the smallest): a mapping of which the last user wrote only the start is a poor choice for a
+ * user who writes all of it (a census taking the weld's vertex list, 240 MB mapped and 40 MB written, for
+ * its 240 MB of words faulted in 200 MB of fresh pages and raised the analysis's peak by that).  Written
+ * pages past `bytes` are given back to the kernel (MADV_DONTNEED) when taken, so that a small user does
+ * not carry a large user's resident pages through the kernels after it.  pool_give(p, bytes) (written:
+ * all of it) or pool_give_used(p, bytes, used) (the first `used` bytes) keeps the mapping when it fits in
+ * POOL_SLOTS and POOL_MAX_BYTES, and tells the kernel it may take the pages back under memory pressure
+ * (MADV_FREE: the pages stay resident and reusable until then; reading one taken back gives zeros), else
+ * unmaps it.
  * pool_drain() unmaps them all (accel.release_buffers()).  A mutex guards the slots: kernels free
  * their scratch with the GIL released. */
 #define POOL_SLOTS 12
@@ -860,7 +868,7 @@ arena_free(void *p, size_t bytes)
                                                      it with set_pool_floor to reuse small mappings too) */
 #define POOL_MAX_BYTES ((size_t)3 << 30)          /* kept in all, at most */
 
-static struct { void *p; size_t bytes; } pool_slot[POOL_SLOTS];
+static struct { void *p; size_t bytes, used; } pool_slot[POOL_SLOTS];   /* used: bytes written, from the start */
 static size_t pool_kept, pool_floor = POOL_MIN_BYTES;
 #if defined(_WIN32)
 static SRWLOCK pool_lock_ = SRWLOCK_INIT;
@@ -880,24 +888,37 @@ static void pool_after_fork(void) { pthread_mutex_unlock(&pool_lock_); }
 static void *
 pool_take(size_t *bytes)
 {
-    size_t want = *bytes ? *bytes : 1;
+    size_t want = *bytes ? *bytes : 1, best_reuse = 0;
     int best = -1;
     POOL_LOCK();
     if (want >= pool_floor) {
         for (int i = 0; i < POOL_SLOTS; i++) {
-            if (pool_slot[i].p != NULL && pool_slot[i].bytes >= want
-                    && (best < 0 || pool_slot[i].bytes < pool_slot[best].bytes)) {
+            if (pool_slot[i].p == NULL || pool_slot[i].bytes < want) {
+                continue;
+            }
+            size_t reuse = pool_slot[i].used < want ? pool_slot[i].used : want;
+            if (best < 0 || reuse > best_reuse || (reuse == best_reuse && pool_slot[i].bytes < pool_slot[best].bytes)) {
                 best = i;
+                best_reuse = reuse;
             }
         }
     }
     if (best >= 0) {
         void *p = pool_slot[best].p;
+        size_t used = pool_slot[best].used;
         *bytes = pool_slot[best].bytes;
         pool_kept -= pool_slot[best].bytes;
         pool_slot[best].p = NULL;
-        pool_slot[best].bytes = 0;
+        pool_slot[best].bytes = pool_slot[best].used = 0;
         POOL_UNLOCK();
+#if defined(__linux__) && defined(MADV_DONTNEED)
+        size_t keep = (want + 4095) & ~(size_t)4095;
+        if (used > keep && keep < *bytes) {
+            madvise((char *)p + keep, (used < *bytes ? used : *bytes) - keep, MADV_DONTNEED);
+        }
+#else
+        (void)used;
+#endif
         return p;
     }
     POOL_UNLOCK();
@@ -906,8 +927,9 @@ pool_take(size_t *bytes)
 }
 
 static void
-pool_give(void *p, size_t bytes)
+pool_give_used(void *p, size_t bytes, size_t used)
 {
+    (void)used;
     if (p == NULL) {
         return;
     }
@@ -922,6 +944,7 @@ pool_give(void *p, size_t bytes)
             if (pool_slot[i].p == NULL) {
                 pool_slot[i].p = p;
                 pool_slot[i].bytes = bytes;
+                pool_slot[i].used = used < bytes ? used : bytes;
                 pool_kept += bytes;
                 kept = 1;
             }
@@ -933,6 +956,12 @@ pool_give(void *p, size_t bytes)
     }
 #endif
     arena_free(p, bytes);
+}
+
+static void
+pool_give(void *p, size_t bytes)
+{
+    pool_give_used(p, bytes, bytes);
 }
 
 /* arena_alloc: map_fresh for the kernels outside the weld and the census (the face-pair check), which first
@@ -954,7 +983,7 @@ pool_drain(void)
     for (int i = 0; i < POOL_SLOTS; i++) {
         arena_free(pool_slot[i].p, pool_slot[i].bytes);
         pool_slot[i].p = NULL;
-        pool_slot[i].bytes = 0;
+        pool_slot[i].bytes = pool_slot[i].used = 0;
     }
     pool_kept = 0;
     POOL_UNLOCK();
@@ -977,7 +1006,7 @@ pw_release(PartWelderObject *w)
     }
     free(w->chunks);
     w->chunks = NULL;
-    pool_give(w->entries, w->arena_bytes);
+    pool_give_used(w->entries, w->arena_bytes, w->entries_used * sizeof(PwEntry));
     w->entries = NULL;
     w->arena_bytes = 0;
     if (w->has_index) {
@@ -986,7 +1015,7 @@ pw_release(PartWelderObject *w)
     }
     w->n_chunks = w->chunks_cap = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
-        pool_give(w->verts[t], w->vbytes[t]);
+        pool_give_used(w->verts[t], w->vbytes[t], w->vcount[t] * sizeof(PwVertex));
         free(w->mark[t]);
         w->verts[t] = NULL;
         w->mark[t] = NULL;
@@ -1641,7 +1670,7 @@ Scratch_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
 static void
 Scratch_dealloc(ScratchObject *b)
 {
-    pool_give(b->p, b->bytes);
+    pool_give_used(b->p, b->bytes, (size_t)b->len);
     Py_TYPE(b)->tp_free((PyObject *)b);
 }
 
