@@ -19,7 +19,7 @@ import stat
 import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
-from typing import IO, TYPE_CHECKING, Any, TypeAlias
+from typing import IO, TYPE_CHECKING, Any, TypeAlias, cast
 
 
 import numpy as np
@@ -209,13 +209,14 @@ def _binary_stl_chunks(path: str, n: int, *, padded: bool = True,
                 yield corners[first:first + _CHUNK_FACES]    # gathers chunk by chunk on the threads
             return
         buffer = np.empty(min(_CHUNK_FACES, n), dtype=_STL_RECORD)
-        with open_regular(path) as fh:
-            fh.seek(84)
+        with open_regular(path) as opened:
+            fh = cast(io.BufferedIOBase, opened)           # open_regular's file is buffered: readinto fills
+            fh.seek(84)                                    # the buffer unless the file ends first
             done = 0
             while done < n:
                 k = min(_CHUNK_FACES, n - done)
                 rec = buffer[:k]
-                got = fh.readinto(memoryview(rec).cast("B"))
+                got = fh.readinto(rec.data.cast("B"))
                 if got != rec.nbytes:
                     raise _fail(path, f"ended after {done + (got or 0) // _STL_RECORD.itemsize:,} of {n:,} "
                                       "triangles")
