@@ -6,9 +6,10 @@ interleave the variants, so a burst of load on the shared machine hits all of th
 
 * ``read``: the file's records chunk by chunk (what both welders are fed from);
 * ``welder``: the one-table ``Welder`` fed the same chunks, read included;
-* ``feed``: ``PartWelder.feed`` of every chunk (recent-point cache, histogram, scatter), read included;
-* ``finish``: the buckets welded in their tables, first corners marked;
-* ``output``: vertices numbered and written, every corner's id gathered in file order;
+* ``feed``: ``PartWelder.feed`` of every chunk (recent-point cache, histogram and staging, scatter), read
+  included;
+* ``finish``: the buckets welded in their tables, first corners marked, each corner given its vertex's first;
+* ``output``: every corner's number gathered in file order, each vertex written at its first corner;
 * ``total``: feed + finish + output, read included.
 
 Wall and CPU time (all threads of the process), ns per corner (three per face); every round checks that both

@@ -748,33 +748,37 @@ static PyTypeObject WelderType = {
  * memory and every lookup the recent-point cache misses costs one or two cache misses (72 ns per corner on
  * a 10M-face torus).  PartWelder splits the work so that every table fits in a core's L2 cache:
  *
- *   feed     each point is hashed (hash32, -0.0 folded onto +0.0); one that the thread's cache of the
+ *   feed     each point is hashed (pw_hash, -0.0 folded onto +0.0); one that the thread's cache of the
  *            4,096 points seen last holds (full key compared) refers to that earlier corner; any other is
  *            copied with its corner number into one of 2**bits buckets chosen by the hash's top bits (a
- *            radix partition: per thread a histogram of its half of the chunk, then a scatter); the output
- *            index keeps each point's bucket or reference until output;
+ *            radix partition: per thread a histogram of its half of the chunk while staging its misses in
+ *            order, then a scatter of the staged misses); the output index keeps each point's bucket or
+ *            reference until output;
  *   finish   each bucket (threads take the next bucket free) is welded in a small table: equal keys always
  *            share a bucket, and a bucket holds its points in file order (chunks in order, a chunk's parts in
  *            order, a part's points in order), so the first point of each distinct key in its bucket is its
  *            first corner in the whole stream; that corner is marked in a bitmap of all corners;
+ *            each point's entry then names its vertex's first corner;
  *   output   a vertex's number is the count of marked corners before its first corner (first appearance
- *            order, exactly the Welder's numbering); the vertices are written at their numbers, and every
- *            corner's number is gathered in file order through its bucket's cursor (or copied from the
- *            earlier corner it refers to, which is in the same chunk: done already).
+ *            order, exactly the Welder's numbering); every corner's number is gathered in file order through
+ *            its bucket's cursor (a vertex's first corner writes the vertex; a corner whose vertex came first
+ *            earlier in its part copies that corner's number, any other counts the marks before that first
+ *            corner), or copied from the earlier corner it refers to, which is in the same part: done already.
  *
  * The result is the Welder's bit for bit (same keys, same equality, same numbering); only the order of the
  * work differs, and no step depends on which thread did it.  Memory until output returns: 16 bytes (key,
  * corner) per point the recent-point cache did not hold -- at most 48 per triangle, about the size of the
  * binary STL (50 per triangle), 18-52 % of that on the benchmark meshes; the arena is reserved for
- * all points but only the pages written are resident -- plus 20 per vertex and a bit per point per thread.
+ * all points but only the pages written are resident -- plus 20 per vertex, a bit per point per thread, and
+ * while feeding 16 bytes per point of one chunk (the staged misses; 6 MB for the reader's chunks).
  * The Welder's table is about 12 bytes per triangle.
  * ------------------------------------------------------------------------------------------------------ */
 
 #define PW_MAX_BITS 12
 #define PW_TARGET_POINTS ((size_t)1 << 15)   /* points per bucket aimed at: table and keys stay in L2 */
 
-typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* corner: after finish the local vertex id, after
-                                                                 * numbering the vertex's number */
+typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* corner: after finish, its vertex's first
+                                                                 * corner */
 typedef struct { uint32_t k[3]; uint32_t first; } PwVertex;   /* first corner; after output, its number */
 
 typedef struct {
@@ -794,6 +798,8 @@ typedef struct {
     size_t entries_used;               /* entries of the chunks so far, with the gaps between parts */
     size_t partitioned;                /* points copied into the buckets (not found in a recent cache) */
     Recent32 *recent;                  /* per thread: WELD_RECENT points seen last in the part it feeds */
+    PwEntry *stage;                    /* the misses of the chunk being fed, before the scatter */
+    size_t stage_cap, stage_bytes;     /* its entries; its mapping's size */
     Py_buffer index;                   /* the caller's int32 output: bucket numbers until output() */
     int has_index;
     size_t arena_bytes;
@@ -844,11 +850,18 @@ arena_free(void *p, size_t bytes)
 /* The weld's and the census's scratch mappings, kept for the next call in the process.  Fresh anonymous
  * pages cost the kernel a page fault and a zeroing each (on a 10M-face file about a third of the weld's CPU
  * time went to clear_page in the kernel); a batch or a second analysis in the same process reuses the
- * pages instead.  pool_take(&bytes) returns the smallest kept mapping of at least `bytes` (its real size
- * back in `bytes`: give that to pool_give) or a fresh map_fresh; its contents are undefined (every user
- * writes before it reads).  pool_give(p, bytes) keeps the mapping when it fits in POOL_SLOTS and
- * POOL_MAX_BYTES, and tells the kernel it may take the pages back under memory pressure (MADV_FREE: the
- * pages stay resident and reusable until then; reading one taken back gives zeros), else unmaps it.
+ * pages instead.  pool_take(&bytes) returns a kept mapping of at least `bytes` (its real size back in
+ * `bytes`: give that to pool_give) or a fresh map_fresh; its contents are undefined (every user writes
+ * before it reads).  Of the kept mappings large enough it takes the one whose written pages cover most of
+ * `bytes` (then the smallest): a mapping of which the last user wrote only the start is a poor choice for a
+ * user who writes all of it (a census taking the weld's vertex list, 240 MB mapped and 40 MB written, for
+ * its 240 MB of words faulted in 200 MB of fresh pages and raised the analysis's peak by that).  Written
+ * pages past `bytes` are given back to the kernel (MADV_DONTNEED) when taken, so that a small user does
+ * not carry a large user's resident pages through the kernels after it.  pool_give(p, bytes) (written:
+ * all of it) or pool_give_used(p, bytes, used) (the first `used` bytes) keeps the mapping when it fits in
+ * POOL_SLOTS and POOL_MAX_BYTES, and tells the kernel it may take the pages back under memory pressure
+ * (MADV_FREE: the pages stay resident and reusable until then; reading one taken back gives zeros), else
+ * unmaps it.
  * pool_drain() unmaps them all (accel.release_buffers()).  A mutex guards the slots: kernels free
  * their scratch with the GIL released. */
 #define POOL_SLOTS 12
@@ -856,7 +869,7 @@ arena_free(void *p, size_t bytes)
                                                      it with set_pool_floor to reuse small mappings too) */
 #define POOL_MAX_BYTES ((size_t)3 << 30)          /* kept in all, at most */
 
-static struct { void *p; size_t bytes; } pool_slot[POOL_SLOTS];
+static struct { void *p; size_t bytes, used; } pool_slot[POOL_SLOTS];   /* used: bytes written, from the start */
 static size_t pool_kept, pool_floor = POOL_MIN_BYTES;
 #if defined(_WIN32)
 static SRWLOCK pool_lock_ = SRWLOCK_INIT;
@@ -876,24 +889,37 @@ static void pool_after_fork(void) { pthread_mutex_unlock(&pool_lock_); }
 static void *
 pool_take(size_t *bytes)
 {
-    size_t want = *bytes ? *bytes : 1;
+    size_t want = *bytes ? *bytes : 1, best_reuse = 0;
     int best = -1;
     POOL_LOCK();
     if (want >= pool_floor) {
         for (int i = 0; i < POOL_SLOTS; i++) {
-            if (pool_slot[i].p != NULL && pool_slot[i].bytes >= want
-                    && (best < 0 || pool_slot[i].bytes < pool_slot[best].bytes)) {
+            if (pool_slot[i].p == NULL || pool_slot[i].bytes < want) {
+                continue;
+            }
+            size_t reuse = pool_slot[i].used < want ? pool_slot[i].used : want;
+            if (best < 0 || reuse > best_reuse || (reuse == best_reuse && pool_slot[i].bytes < pool_slot[best].bytes)) {
                 best = i;
+                best_reuse = reuse;
             }
         }
     }
     if (best >= 0) {
         void *p = pool_slot[best].p;
+        size_t used = pool_slot[best].used;
         *bytes = pool_slot[best].bytes;
         pool_kept -= pool_slot[best].bytes;
         pool_slot[best].p = NULL;
-        pool_slot[best].bytes = 0;
+        pool_slot[best].bytes = pool_slot[best].used = 0;
         POOL_UNLOCK();
+#if defined(__linux__) && defined(MADV_DONTNEED)
+        size_t keep = (want + 4095) & ~(size_t)4095;
+        if (used > keep && keep < *bytes) {
+            madvise((char *)p + keep, (used < *bytes ? used : *bytes) - keep, MADV_DONTNEED);
+        }
+#else
+        (void)used;
+#endif
         return p;
     }
     POOL_UNLOCK();
@@ -902,8 +928,9 @@ pool_take(size_t *bytes)
 }
 
 static void
-pool_give(void *p, size_t bytes)
+pool_give_used(void *p, size_t bytes, size_t used)
 {
+    (void)used;
     if (p == NULL) {
         return;
     }
@@ -918,6 +945,7 @@ pool_give(void *p, size_t bytes)
             if (pool_slot[i].p == NULL) {
                 pool_slot[i].p = p;
                 pool_slot[i].bytes = bytes;
+                pool_slot[i].used = used < bytes ? used : bytes;
                 pool_kept += bytes;
                 kept = 1;
             }
@@ -929,6 +957,12 @@ pool_give(void *p, size_t bytes)
     }
 #endif
     arena_free(p, bytes);
+}
+
+static void
+pool_give(void *p, size_t bytes)
+{
+    pool_give_used(p, bytes, bytes);
 }
 
 /* arena_alloc: map_fresh for the kernels outside the weld and the census (the face-pair check), which first
@@ -950,7 +984,7 @@ pool_drain(void)
     for (int i = 0; i < POOL_SLOTS; i++) {
         arena_free(pool_slot[i].p, pool_slot[i].bytes);
         pool_slot[i].p = NULL;
-        pool_slot[i].bytes = 0;
+        pool_slot[i].bytes = pool_slot[i].used = 0;
     }
     pool_kept = 0;
     POOL_UNLOCK();
@@ -973,7 +1007,7 @@ pw_release(PartWelderObject *w)
     }
     free(w->chunks);
     w->chunks = NULL;
-    pool_give(w->entries, w->arena_bytes);
+    pool_give_used(w->entries, w->arena_bytes, w->entries_used * sizeof(PwEntry));
     w->entries = NULL;
     w->arena_bytes = 0;
     if (w->has_index) {
@@ -982,7 +1016,7 @@ pw_release(PartWelderObject *w)
     }
     w->n_chunks = w->chunks_cap = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
-        pool_give(w->verts[t], w->vbytes[t]);
+        pool_give_used(w->verts[t], w->vbytes[t], w->vcount[t] * sizeof(PwVertex));
         free(w->mark[t]);
         w->verts[t] = NULL;
         w->mark[t] = NULL;
@@ -990,6 +1024,9 @@ pw_release(PartWelderObject *w)
     }
     free(w->recent);
     w->recent = NULL;
+    pool_give(w->stage, w->stage_bytes);
+    w->stage = NULL;
+    w->stage_cap = w->stage_bytes = 0;
     free(w->owner);
     free(w->v0);
     free(w->nv);
@@ -1013,17 +1050,34 @@ pw_load(const char *p, Py_ssize_t sc, uint32_t *key)
     }
 }
 
+/* The feed's hash of a point: hash32's two multiplies, then one xor-shift and one multiply, whose top bits (the
+ * bucket) and bits 40-51 (the recent-point slot) depend on every bit of the key.  Cheaper than hash32's full
+ * finaliser, which finish keeps for its tables' slots (the low bits); any hash gives the same result (equal
+ * points, equal hashes), only the balance of the buckets and the speed depend on it (feed 12.9 -> 11.2 ns per
+ * corner of CPU on the 10M-face torus, same hit rate). */
+static inline uint64_t
+pw_hash(const uint32_t *k)
+{
+    uint64_t h = (((uint64_t)k[1] << 32) | k[0]) * 0x9E3779B97F4A7C15ULL;
+    h ^= (uint64_t)k[2] * 0xC2B2AE3D27D4EB4FULL;
+    return (h ^ (h >> 29)) * 0xff51afd7ed558ccdULL;
+}
+
 typedef struct {
     const char *base;
     Py_ssize_t n0, n1, s0, s1, sc;
     PwChunk *chunk;
     int bits;
+    PwEntry *stage;                    /* the chunk's size: part t stages its misses from its first point's place */
     Recent32 *recent[MAX_THREADS];
 } PwFeedTask;
 
 /* Part t of the chunk.  A point the part's recent-point cache holds (full key compared) refers to that
- * earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and then, in a
- * second pass, copied with its corner into the part's range of the chunk's entries (a stable scatter). */
+ * earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and staged, with
+ * its corner, in order; then the staged points are copied into the part's range of the chunk's entries (a
+ * stable scatter).  The scatter reads the staged misses (16 bytes each, in order) rather than the part's
+ * records again (50 bytes per three points, past the L2 cache by then) and skips the hits without a branch
+ * on each point. */
 static void
 pw_feed_task(void *ctx, int t, int nt)
 {
@@ -1034,6 +1088,7 @@ pw_feed_task(void *ctx, int t, int nt)
     uint32_t *off = c->off + (size_t)t * (nb + 1);
     uint32_t cursor[(size_t)1 << PW_MAX_BITS];
     Recent32 *recent = f->recent[t];
+    PwEntry *stage = f->stage + lo, *staged = stage;
     memset(off, 0, (nb + 1) * sizeof(uint32_t));
     memset(recent, 0, WELD_RECENT * sizeof(Recent32));
     Py_ssize_t i0 = (Py_ssize_t)lo / f->n1, i1 = (Py_ssize_t)lo % f->n1;
@@ -1041,7 +1096,7 @@ pw_feed_task(void *ctx, int t, int nt)
         uint32_t key[3];
         pw_load(f->base + i0 * f->s0 + i1 * f->s1, f->sc, key);
         if (++i1 == f->n1) { i1 = 0; i0++; }
-        uint64_t h = hash32(key);
+        uint64_t h = pw_hash(key);
         Recent32 *r = recent + ((h >> 40) & (WELD_RECENT - 1));
         if (r->id != 0 && r->k[0] == key[0] && r->k[1] == key[1] && r->k[2] == key[2]) {
             c->bucket[k] = -(int32_t)r->id;                 /* id = corner + 1 */
@@ -1050,9 +1105,11 @@ pw_feed_task(void *ctx, int t, int nt)
         int32_t b = f->bits ? (int32_t)(h >> shift) : 0;
         c->bucket[k] = b;
         off[b + 1]++;
-        r->k[0] = key[0];
-        r->k[1] = key[1];
-        r->k[2] = key[2];
+        r->k[0] = staged->k[0] = key[0];
+        r->k[1] = staged->k[1] = key[1];
+        r->k[2] = staged->k[2] = key[2];
+        staged->corner = c->corner0 + (uint32_t)k;
+        staged++;
         r->id = c->corner0 + (uint32_t)k + 1;
     }
     off[0] = (uint32_t)lo;
@@ -1060,16 +1117,9 @@ pw_feed_task(void *ctx, int t, int nt)
         off[b + 1] += off[b];
         cursor[b] = off[b];
     }
-    i0 = (Py_ssize_t)lo / f->n1;
-    i1 = (Py_ssize_t)lo % f->n1;
-    for (size_t k = lo; k < hi; k++) {
-        int32_t b = c->bucket[k];
-        if (b >= 0) {
-            PwEntry *e = c->entries + cursor[b]++;
-            pw_load(f->base + i0 * f->s0 + i1 * f->s1, f->sc, e->k);
-            e->corner = c->corner0 + (uint32_t)k;
-        }
-        if (++i1 == f->n1) { i1 = 0; i0++; }
+    for (const PwEntry *e = stage; e < staged; e++) {
+        int32_t b = c->bucket[e->corner - c->corner0];
+        c->entries[cursor[b]++] = *e;
     }
 }
 
@@ -1174,7 +1224,8 @@ pw_weld_task(void *ctx, int t, int nt)
                             mask = cap - 1;
                         }
                     }
-                    e->corner = id - 1;      /* the key stays: output writes the vertex from it */
+                    e->corner = vs[id - 1].first;    /* its vertex's first corner (the key stays: output
+                                                       * writes the vertex from it) */
                 }
             }
         }
@@ -1194,47 +1245,8 @@ typedef struct {
     PartWelderObject *w;
     double *vertices;
     int32_t *index;
-    uint32_t *number;     /* per vertex in bucket order: its number */
     int32_t ticket;
 } PwOutTask;
-
-/* Number the vertices of the buckets this thread draws and replace each of the bucket's points' local id by
- * its vertex's number (the coordinates are written in file order by the gather, where each vertex's first
- * corner comes: sequential writes instead of one cache miss per vertex). */
-static void
-pw_number_task(void *ctx, int t, int nt)
-{
-    PwOutTask *o = (PwOutTask *)ctx;
-    PartWelderObject *w = o->w;
-    size_t nb = (size_t)1 << w->bits;
-    const uint64_t *mark = w->mark[0];
-    for (;;) {
-        int32_t b = next_ticket(&o->ticket);
-        if (b < 0 || (size_t)b >= nb) {
-            break;
-        }
-        const PwVertex *vs = w->verts[w->owner[b]] + w->v0[b];
-        uint32_t *number = o->number + w->vbase[b];
-        for (size_t l = 0; l < w->nv[b]; l++) {
-            uint32_t p = vs[l].first;
-            uint64_t below = mark[p >> 6] & (((uint64_t)1 << (p & 63)) - 1);
-            uint32_t g = w->rank[p >> 6] + popcount64(below);
-            number[l] = g;
-        }
-        /* the bucket's points: local id -> number, while the bucket's numbers are in this core's cache */
-        for (size_t i = 0; i < w->n_chunks; i++) {
-            const PwChunk *c = &w->chunks[i];
-            for (int p = 0; p < c->nt; p++) {
-                const uint32_t *off = c->off + (size_t)p * (nb + 1);
-                for (PwEntry *e = c->entries + off[b], *end = c->entries + off[b + 1]; e < end; e++) {
-                    e->corner = number[e->corner];
-                }
-            }
-        }
-    }
-    (void)t;
-    (void)nt;
-}
 
 /* The corners of the chunks this thread draws, in file order, each through its bucket's cursor. */
 static void
@@ -1244,6 +1256,7 @@ pw_gather_task(void *ctx, int t, int nt)
     PartWelderObject *w = o->w;
     size_t nb = (size_t)1 << w->bits;
     uint32_t cursor[(size_t)1 << PW_MAX_BITS];
+    const uint64_t *mark = w->mark[0];
     for (;;) {
         int32_t u = next_ticket(&o->ticket);
         if (u < 0 || (size_t)u >= w->n_chunks) {
@@ -1255,10 +1268,13 @@ pw_gather_task(void *ctx, int t, int nt)
             const uint32_t *off = c->off + (size_t)p * (nb + 1);
             memcpy(cursor, off, nb * sizeof(uint32_t));
             size_t lo = part_start(c->size, p, c->nt), hi = part_start(c->size, p + 1, c->nt);
-            /* numbers by first appearance: a corner is its vertex's first exactly when its number is the
-             * count of vertices first seen before it, `next` (the marked corners before the part's first) */
+            /* numbers by first appearance: each entry names its vertex's first corner; a corner that is its
+             * own vertex's first is numbered `next`, the count of vertices first seen before it (marked corners
+             * before the part's first, then counted along); any other takes the number of that first corner:
+             * written already when it is in this part, else the marked corners before it (no pass over the
+             * buckets to number them) */
             size_t c0 = c->corner0 + lo;
-            uint32_t next = w->rank[c0 >> 6] + popcount64(w->mark[0][c0 >> 6] & (((uint64_t)1 << (c0 & 63)) - 1));
+            uint32_t next = w->rank[c0 >> 6] + popcount64(mark[c0 >> 6] & (((uint64_t)1 << (c0 & 63)) - 1));
             for (size_t k = lo; k < hi; k++) {
                 int32_t b = c->bucket[k];        /* the same memory as out[k] */
                 if (b < 0) {
@@ -1266,16 +1282,23 @@ pw_gather_task(void *ctx, int t, int nt)
                     continue;
                 }
                 const PwEntry *e = c->entries + cursor[b]++;
-                if (e->corner == next) {         /* the vertex's first corner: its coordinates, in order */
+                uint32_t first = e->corner, g;
+                if (first == c->corner0 + k) {   /* the vertex's first corner: its coordinates, in order */
                     double *v = o->vertices + 3 * (size_t)next;
                     for (int q = 0; q < 3; q++) {
                         float x;
                         memcpy(&x, &e->k[q], 4);
                         v[q] = (double)x;
                     }
-                    next++;
+                    g = next++;
                 }
-                out[k] = (int32_t)e->corner;
+                else if (first >= c0) {          /* first seen earlier in this part: numbered already */
+                    g = (uint32_t)out[first - c->corner0];
+                }
+                else {                           /* the marked corners before its first */
+                    g = w->rank[first >> 6] + popcount64(mark[first >> 6] & (((uint64_t)1 << (first & 63)) - 1));
+                }
+                out[k] = (int32_t)g;
             }
         }
     }
@@ -1426,9 +1449,22 @@ PartWelder_feed(PartWelderObject *w, PyObject *points_obj)
         PyBuffer_Release(&pts);
         return PyErr_NoMemory();
     }
+    if (total > w->stage_cap) {         /* the staging area: kept for the next chunk (the same size) */
+        pool_give(w->stage, w->stage_bytes);
+        w->stage_bytes = total * sizeof(PwEntry);
+        w->stage = (PwEntry *)pool_take(&w->stage_bytes);
+        w->stage_cap = w->stage ? total : 0;
+        if (w->stage == NULL) {
+            w->stage_bytes = 0;
+            free(c->off);
+            c->off = NULL;
+            PyBuffer_Release(&pts);
+            return PyErr_NoMemory();
+        }
+    }
     w->n_chunks++;
     PwFeedTask task = {(const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
-                       pts.strides[pts.ndim - 1], c, w->bits, {NULL}};
+                       pts.strides[pts.ndim - 1], c, w->bits, w->stage, {NULL}};
     for (int t = 0; t < nt; t++) {
         task.recent[t] = w->recent + (size_t)t * WELD_RECENT;
     }
@@ -1459,6 +1495,9 @@ PartWelder_finish(PartWelderObject *w, PyObject *unused)
     }
     size_t nb = (size_t)1 << w->bits, words = (w->n_points + 63) / 64 + 1;
     PwTask task = {w, 0, 0};
+    pool_give(w->stage, w->stage_bytes);        /* every chunk is fed */
+    w->stage = NULL;
+    w->stage_cap = w->stage_bytes = 0;
     int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
     /* each thread's vertices: reserved for every partitioned point (a thread's buckets hold no more), only
      * the pages written become resident, and the pages go back to the system when the welder is done
@@ -1526,20 +1565,11 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
                      w->count);
         goto fail;
     }
-    size_t number_bytes = (w->count ? w->count : 1) * sizeof(uint32_t);
-    uint32_t *number = (uint32_t *)pool_take(&number_bytes);
-    if (number == NULL) {
-        PyErr_NoMemory();
-        goto fail;
-    }
-    PwOutTask task = {w, (double *)vert.buf, (int32_t *)w->index.buf, number, 0};
+    PwOutTask task = {w, (double *)vert.buf, (int32_t *)w->index.buf, 0};
     int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
-    run_parallel(nt, pw_number_task, &task);
-    task.ticket = 0;
     run_parallel(nt, pw_gather_task, &task);
-    pool_give(number, number_bytes);
     Py_END_ALLOW_THREADS
     pw_release(w);                      /* releases the index buffer: with the GIL */
     w->busy = 0;
@@ -1654,7 +1684,7 @@ Scratch_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
 static void
 Scratch_dealloc(ScratchObject *b)
 {
-    pool_give(b->p, b->bytes);
+    pool_give_used(b->p, b->bytes, (size_t)b->len);
     Py_TYPE(b)->tp_free((PyObject *)b);
 }
 

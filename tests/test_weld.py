@@ -24,6 +24,16 @@ def test_weld_exact_treats_negative_zero_as_zero():
     assert f[0, 0] == f[1, 0]
 
 
+def test_weld_exact_writes_a_zero_first_seen_as_negative_as_positive():
+    """A vertex whose first corner has -0.0 comes out +0.0 on both paths (the numpy reference wrote -0.0 and
+    the C extension +0.0: twins that differed in the sign of zero)."""
+    corners = np.array([[[-0.0, 1, -0.0], [1, 0, 0], [0, 0, 1]], [[-0.0, 1, 0.0], [0, 0, 1], [1, 0, 0]]])
+    for dtype in (np.float32, np.float64):
+        v, f = weld_exact(corners.astype(dtype))
+        assert len(v) == 3 and f[0, 0] == f[1, 0]
+        assert not np.signbit(v).any()
+
+
 def test_weld_exact_keeps_points_one_ulp_apart_distinct():
     x = np.float32(1.0)
     y = np.nextafter(x, np.float32(2))

@@ -319,7 +319,9 @@ def census_and_shells(faces: np.ndarray, n_vertices: int,
     if lib is None or len(faces) > _CENSUS_SHELLS_MAX_FACES:
         labels, count = shell_labels(faces, n_vertices)
         return edge_topology(faces, n_vertices, vertices), labels, count
-    labels = np.empty(len(faces), dtype=np.intp)
+    # on a kept mapping of the extension (uninitialised, like numpy.empty): a later analysis in the process
+    # writes its labels into pages faulted in already
+    labels = np.frombuffer(lib.Scratch(len(faces) * np.dtype(np.intp).itemsize), dtype=np.intp)
     *counts, count = lib.census_shells(faces_for_c(faces), int(n_vertices), labels, threads())
     if len(faces) == 0:
         return EdgeTopology(0, 0, 0, 0, np.zeros((0, 2, 3))), labels, 0

@@ -242,7 +242,7 @@ def weld_exact_stream(chunks: Callable[[], Iterable[np.ndarray]], n_points: int)
         c = c[:, :3]
         inv = inverse[s:s + len(c)]
         fresh = ~written[inv]
-        vertices[inv[fresh]] = c[fresh]
+        vertices[inv[fresh]] = c[fresh].astype(np.float64) + 0.0    # -0.0 -> +0.0, as the C extension writes it
         written[inv] = True
         if not np.array_equal(vertices[inv], c.astype(np.float64) + 0.0):
             pts = np.concatenate([x[:, :3].astype(np.float64) + 0.0 for x in chunks()])
