@@ -83,7 +83,13 @@ R3b *A flat open sheet inside a solid encloses nothing* (:func:`~.sheets.open_sh
    (its relative interior is connected and off the rest, where that winding number is constant): a wall of zero
    thickness with material on both sides.  The rest is the solid, ``exact`` with the check ``open-sheets``, without
    ``repair``.  Reason: a cut face kept inside a part, or a CAD face left in, is what the user means as the part;
-   the sheet's face sums are not the boundary of anything.  Curved pieces (a cavity's surface with a hole), sheets
+   the sheet's face sums are not the boundary of anything.  *Through T-vertices* (a cut face whose rim meets the
+   part at corners of one side lying on edges of the other to rounding, so that nothing closes by index): when the
+   corners of the open edges lie within ``WALL_PLANE_RTOL`` of one plane, the faces there are the sheet, the rest's
+   open edges are split at the corners lying within that distance of them (the sheet's alike) and must then close
+   by index, the checks above hold on the split surface, and the volume the splits can change (their pyramids and
+   the slab of the gaps, :mod:`~.sheets` "Seams") is within ``ROUNDOFF_RTOL``: ``exact`` as well, the bound in the
+   note.  Curved pieces (a cavity's surface with a hole), sheets
    whose rims meet another's within ``MERGE_TOLERANCE`` (a cavity cracked into flat facets) and fins
    (flat sheets outside the solid, perhaps plates meant to have thickness) are not taken: the fin is named in the
    refusal.
@@ -179,9 +185,11 @@ CHECKS = {
                          "number they add is nonzero only in a volume bounded within ROUNDOFF_RTOL of the result, "
                          "zero when exactly flat (mesh/folds.py)",
     "open-sheets": "open sheets were taken out of a surface that did not close (mesh/sheets.py): the rest is "
-                   "closed, no face of it meets a sheet beyond the vertices and edges they share, and the rest's "
-                   "winding number puts each sheet inside its solid (a zero-thickness wall with material on both "
-                   "sides) or, with repair only, outside it (a fin): either encloses no volume",
+                   "closed (by index, or once its faces are split at T-vertices on the sheet's rim, what that "
+                   "changes bounded within ROUNDOFF_RTOL), no face of it meets a sheet beyond the vertices and "
+                   "edges they share, and the rest's winding number puts each sheet inside its solid (a "
+                   "zero-thickness wall with material on both sides) or, with repair only, outside it (a fin): "
+                   "either encloses no volume",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
     "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves (or its "
                            "faces overlapping in a common plane along each other's edges) and the faces bounding "

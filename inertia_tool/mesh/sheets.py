@@ -53,6 +53,32 @@ case: it may be a thin plate meant to have thickness.  It is counted, nothing is
 by R2).  A sheet that crosses or touches ``R`` beyond the features they share (it pokes through the surface) is
 not decided here either: the surface goes on to the normal path.
 
+Seams
+-----
+A cut face kept inside is often joined to the part not by index but through *T-vertices*: the two halves were cut
+apart on their own, so a corner of one side's rim lies on an edge of the other's (to rounding: computed cut points
+are off the line by ~1e-16 of the coordinates, so no exact predicate finds them on it).  The sheet's rim edges are
+then used by the sheet and one side only, the sheet is joined to that side through manifold edges, and the rest
+does not close by index.  :func:`_seamed_sheet` reads such a surface when every corner of its unbalanced edges lies
+within ``WALL_PLANE_RTOL`` of one plane ``P``: the sheet ``Σ`` is the faces within that distance of ``P`` that hold
+such a corner (joined through shared edges); in the rest ``R`` every open edge ``p → q`` is split, in the one face
+``F = (p, q, x)`` using it that way, into the fan ``(p, s₁, x) … (s_k, q, x)`` through the corners ``s`` of open
+edges lying within ``WALL_PLANE_RTOL`` of the segment's interior (:func:`_split_at_seams`), and the result ``R*``
+must close by index.  ``Σ`` is split alike (faces with a split edge fanned from their centroids), so that its rim
+matches ``R*``'s by index, and the lemma above is applied to ``R* + Σ*`` as it stands: the face-pair check
+between the sheet and the rest, ``R*`` closed, the winding number 1 at the sheet.
+
+What the splits change: ``fan − F = ∂(pyramid with apex x over the polygon p, s₁, …, s_k, q) + Q_F`` with
+``Q_F`` the cone from ``p`` over that polygon, so ``R* = R + Σ Q_F + Σ ∂pyramid``: ``R`` closed by its thin cones
+``Q`` (the gaps of the seams, each within ``δ`` of ``P``) is ``R*`` except in the pyramids, ``Σ |tet(x, p, sⱼ,
+sⱼ₊₁)|`` of volume; and any other surface spanning the gaps within ``δ`` of ``P`` with at most the cones' area
+differs from ``Q`` by a closed chain within ``δ`` of ``P``, whose winding number is nonzero in at most
+``2δ·(2·area Q)`` (the slab lemma of :mod:`~.folds`).  ``D = Σ pyramids + 4δ·area Q`` must be within
+``ROUNDOFF_RTOL`` of ``R*``'s volume (and ``D·reach²`` of its second moment), the test of R0's copies up to
+rounding and of R3a; then the answer is ``exact`` (check ``open-sheets``) and the note states ``D``.  A T-vertex
+moved off its edge in the plane (the rims cracked apart) or pushed through the sheet is farther than
+``WALL_PLANE_RTOL`` from the segment or from ``P``: not split, the rest does not close, nothing is taken.
+
 Finding the sheets
 ------------------
 The faces are split into *pieces* joined through manifold edges (two faces, opposite directions).  The flat open
