@@ -165,7 +165,8 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
            "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
-           "near_copies", "NearCopies", "near_copies_message"]
+           "near_copies", "NearCopies", "near_copies_message", "MisreadNesting", "misread_nesting",
+           "misread_message"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -557,6 +558,80 @@ def inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with
         hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
         inward[pairs[hit, a]] = True
     return int(np.count_nonzero(inward))
+
+
+@frozen_value
+class MisreadNesting:
+    """R4: shells wound outward in the file that nesting depth reads as cavities (a body drawn wholly inside
+    another, flush with its floor or free inside it).  The file does not decide between the two readings: its own
+    winding number is 2 inside such a shell, so ``{w ≥ 1}`` is the union of the bodies, while a cavity written
+    with the wrong winding reads exactly the same.  R4 keeps the nesting parity; the note names the other reading.
+
+    Attributes
+    ----------
+    shells : (k,) int
+        The shells so read.
+    volume : float
+        m³, their summed volume: the union (the file's own winding) holds at most this much more material than the
+        parity solid, all of it inside these shells; exactly this much more when ``nested`` is False.
+    nested : bool
+        Some other shell lies inside one of them (its own reading then differs too; the volume is a bound).
+    reach : float
+        m, the largest distance of a corner of these shells from the parity solid's centroid (set by the caller).
+    """
+
+    shells: np.ndarray
+    volume: float
+    nested: bool
+    reach: float = 0.0
+
+
+def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray, nest: Nesting | None,
+                    within: np.ndarray | None) -> MisreadNesting | None:
+    """R4: the shells the file winds outward that nesting depth made cavities (odd depth, flipped), or None.
+
+    Parameters
+    ----------
+    file_volumes : (s,) float
+        Signed volume of each shell as wound in the file, m³.
+    flip, depth : (s,) arrays
+        From :func:`orient_by_depth`.
+    nest : Nesting or None
+        Winding numbers at each shell's probe point (who contains whom).
+    within : (j, 2) int or None
+        ``(shell, container)`` pairs placed by touching or by the boolean (:func:`within_up_to_rounding`).
+    """
+    vols = np.asarray(file_volumes, dtype=np.float64)
+    misread = (vols > 0) & np.asarray(flip, dtype=bool) & (np.asarray(depth) % 2 == 1)
+    if not misread.any():
+        return None
+    inside = np.zeros(len(vols), dtype=bool)
+    if nest is not None:
+        held = np.asarray(nest.winding) != 0
+        inside[np.asarray(nest.other)[held & misread[np.asarray(nest.other)] &
+                                     (np.asarray(nest.shell) != np.asarray(nest.other))]] = True
+    if within is not None and len(within):
+        pairs = np.asarray(within, dtype=np.int64).reshape(-1, 2)
+        inside[pairs[misread[pairs[:, 1]], 1]] = True
+    shells = np.flatnonzero(misread)
+    return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=bool(inside[shells].any()))
+
+
+def misread_message(found: MisreadNesting, parity_volume: float, proven: bool) -> str:
+    """R4's note for :class:`MisreadNesting`: the reading kept, the other one and its volume."""
+    n = len(found.shells)
+    them = "them" if n > 1 else "it"
+    other = (f"at most {round_up(found.volume):.6g} m³ more" if found.nested else
+             f"{parity_volume + found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % more mass")
+    kept = ("the parity solid is proven (exact)" if proven else
+            "the parity solid is not proven apart from that reading (its faces meet the body's only to rounding): "
+            "an estimate whose bounds span both readings")
+    return (f"{n} shell{'s' if n > 1 else ''} wound outward lie{'' if n > 1 else 's'} wholly inside another body "
+            f"(free inside it or flush with its boundary): read by nesting depth as cavit{'ies' if n > 1 else 'y'} "
+            f"(R4; a cavity written with the wrong winding reads the same), {found.volume:.6g} m³ taken "
+            f"out; the file's own winding reads {them} as part of the body, the union of the bodies: {other}. "
+            f"The file does not decide; {kept}. If {them} {'are bodies' if n > 1 else 'is a body'}, unite "
+            f"{them} with the body around {them} in the model; if a cavity, wind {them} inward")
 
 
 @frozen_value
