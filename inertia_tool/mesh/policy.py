@@ -106,12 +106,17 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    depth from it like any nested shell, whether the contact is exactly coplanar or coplanar only to rounding
    after a rotation: a cavity flush with its body's face is a cavity (cut from the body by the boolean, certified
    ``united``), an outward-wound one included.  One rule covers a shell strictly inside another and one
-   touching the other's boundary from inside: *the role is the depth of the closed solid*.  Shells that touch
-   without a crossing face pair are never placed by one probe point: their surfaces can still cross exactly along
-   edges and vertices of both meshes (CAD tessellations sharing the intersection curve), so the points of each
-   near the contact and a sample of its vertices decide (:func:`touching_relations`): points strictly inside and
-   strictly outside the other make the pair crossing, all inside make it contained, all outside apart; a pair the
-   points cannot decide goes to the boolean like a crossing one.  When the intersection
+   touching the other's boundary from inside: *the role is the depth of the closed solid*.  A shell the file
+   winds outward that depth makes a cavity (:func:`misread_nesting`) is a reading the file does not decide: its
+   own winding number is 2 there, so ``{w ≥ 1}`` is the union of the bodies, and a cavity written with the wrong
+   winding reads the same.  The parity reading is kept, a warning names the other one and its volume, and the
+   certificate is never ``united`` for it (:func:`~.certify.misread_reading`): ``exact`` when the turned surface
+   has no crossing face pair (the parity solid proven), otherwise an estimate whose bounds span both readings.
+   Shells that touch without a crossing face pair are never placed by one probe point: their surfaces can still
+   cross exactly along edges and vertices of both meshes (CAD tessellations sharing the intersection curve), so
+   the points of each near the contact and a sample of its vertices decide (:func:`touching_relations`): points
+   strictly inside and strictly outside the other make the pair crossing, all inside make it contained, all
+   outside apart; a pair the points cannot decide goes to the boolean like a crossing one.  When the intersection
    check did not finish (crossings unknown, so "inside" may mean "overlapping"), each shell keeps what its own
    sign says instead.
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
@@ -122,7 +127,10 @@ R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL`
    at edges, vertices or face to face with opposite normals (touching copies), or whose probe points all lie
    on another surface, or that share non-manifold edges, go to the boolean; when the union's volume equals
    the summed volume within ``TOUCH_VOLUME_RTOL`` the interiors are disjoint and the sum, exact as it
-   stands, is the answer (certificate ``exact``).  When the union is smaller although no crossing was found,
+   stands, is the answer (certificate ``exact``).  The check ``touching-confirmed`` is listed only when every
+   piece given to the boolean was two-manifold (the input manifold3d's guarantees assume); pieces that
+   :func:`~.union.closed_groups` joined at non-manifold edges make its union no witness, and the sum then rests
+   on the face-pair check and R4 alone (said in a note).  When the union is smaller although no crossing was found,
    the two checks disagree (manifold3d's tolerance, or a crossing the check cannot see): the union is the
    answer, certified ``unverified``.  A union *larger* than the summed integral beyond ``TOUCH_VOLUME_RTOL``
    shares nothing: a shell read as a cavity reaches out of its body and the boolean cuts it only inside the body;
@@ -196,7 +204,8 @@ CHECKS = {
                            "faces overlapping in a common plane along each other's edges) and the faces bounding "
                            "{winding number ≥ 1} kept (mesh/arrange.py, mesh/coplanar.py); the result was checked "
                            "closed and free of crossing faces",
-    "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
+    "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch (listed "
+                          "only when every piece given to the boolean was two-manifold)",
     "touching-up-to-rounding": "faces of touching shells cross only by rounding: the boolean union's volume equals "
                                "the summed volume within TOUCH_VOLUME_RTOL, so the summed integral is the solid's "
                                "to that tolerance",
