@@ -100,7 +100,9 @@ def test_a_turned_body_flush_with_the_floor_spans_both_readings(seed, lo, size):
                                   shift=(0.3, -1.0, 2.0))
     p, said = _analyse(v, f)
     kind = p.mesh.certificate.kind
-    assert kind in ("exact", "estimate"), kind
+    assert kind in ("exact", "estimate", "unverified"), kind       # never united; unverified claims nothing
+    if kind == "unverified":
+        return
     if kind == "exact":
         _assert_matches(p, parity)
         return
