@@ -316,7 +316,8 @@ def test_core_filling_its_cavity_exactly_cancels():
 def test_flush_cavity_is_a_cavity_however_turned(seed, cavity_inward, turned):
     """A cavity flush with its body's face, wound either way, axis-aligned or under a random rotation (so the
     contact is coplanar exactly, or only to rounding): one rule, the depth of the closed solid, makes it a
-    cavity; the answer is the notched box (rational truth) or a label that says it is not proven."""
+    cavity; the answer is the notched box (rational truth) or a label that says it is not proven (an outward-wound
+    one is a reading the file does not decide: exact when proven, else an estimate spanning the union too)."""
     rng = np.random.default_rng(seed)
     ea = rng.integers(4, 9, size=3) * 0.125
     ec = np.minimum(rng.integers(1, 4, size=3) * 0.125, ea - 0.25)
@@ -328,7 +329,8 @@ def test_flush_cavity_is_a_cavity_however_turned(seed, cavity_inward, turned):
     mesh = S.concat(outer, S.flipped(cavity) if cavity_inward else cavity)
     case = S.Case("flush_cavity", *mesh, S.truth_from_pieces([(1, outer), (-1, cavity)]), "flush cavity")
     verdict = _assert_honest(case)
-    assert verdict.label in ("exact", "united", "unverified")
+    assert verdict.label in ("exact", "united", "unverified", "estimate")
+    assert not (verdict.label == "united" and not cavity_inward)     # issue 21 item 3: never united for R4's reading
     if not turned:
         assert verdict.wrong is None and verdict.label in ("exact", "united")
 

@@ -7,18 +7,24 @@ check (complete, nothing crossing), and the float64 round-off of the integrals w
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING, NamedTuple
 
+import numpy as np
+
+from ..errors import InsideOutWarning
 from ..integrals import total_roundoff
 from ..rounding import round_up
 from ..tolerances import ROUNDOFF_RTOL
-from .policy import Certificate, ShellContacts
+from .policy import Certificate, ShellContacts, misread_message
 from .shells import Shells, total
 
 if TYPE_CHECKING:
+    from .classify import Orientation
     from .uncertainty import Estimate, Uncertainty
+    from .unite import United
 
-__all__ = ["Certified", "first_checks", "certify"]
+__all__ = ["Certified", "first_checks", "certify", "misread_reading"]
 
 
 class Certified(NamedTuple):
@@ -52,9 +58,50 @@ def first_checks(touch: ShellContacts, unverified: str | None) -> tuple[str, lis
     return kind, checks
 
 
+def misread_reading(oriented: Orientation, united: United, *, method: str,
+                    source: str) -> tuple[United, tuple[float, float] | None]:
+    """R4's label for shells the file winds outward that nesting depth reads as cavities (``oriented.misread``):
+    the file does not decide between that reading and the union its own winding gives, so the certificate may say
+    only what is proven about the reading kept.
+
+    ``exact`` when the parity solid is proven: the surface with those shells turned (as R4 turned them) passes the
+    face-pair check with nothing crossing, so its summed integral is that solid's (a body flush with its body's
+    floor: after the turn the faces there are coplanar and opposite, a contact).  ``united`` is never given for it
+    (the boolean formed a reading, it did not decide one): when the turned surface still has crossing face pairs
+    (faces coplanar only to rounding) the result is an estimate whose bound spans both readings (they differ only
+    inside those shells: their volume, within their reach of the centroid).  The note, warned, names the other
+    reading and its volume.  Returns the result and, for an estimate, ``(volume in doubt, reach)``."""
+    from .intersect import surface_contacts
+
+    found = oriented.misread
+    if found is None or united.forced is not None or united.kind not in ("exact", "united"):
+        return united, None
+    spread = None
+    proven = united.kind == "exact"
+    if not proven:
+        turned = oriented.shells
+        again = surface_contacts(turned.vertices, turned.faces)
+        if again.complete and not len(again.crossing):
+            proven = True
+            united = united._replace(shells=turned, owner=oriented.owner, overlaps=0, method=method, kind="exact",
+                                     checks=["edge-balanced", "consistently-oriented", "no-crossing-faces"],
+                                     cavities=int(np.count_nonzero(oriented.depth % 2 == 1)),
+                                     notes=tuple(n for n in united.notes if not n.startswith("touching up to")))
+    shells = united.shells
+    whole = total(shells.moments)
+    if not proven:
+        turned = oriented.shells
+        corners = np.unique(turned.faces[np.isin(turned.labels, found.shells)])
+        reach = float(np.sqrt(np.max(np.sum((turned.vertices[corners] - whole.centroid) ** 2, axis=1))))
+        spread = (found.volume * (1 + 1e-9), reach)
+    note = misread_message(found, float(whole.volume), proven)
+    warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=3)
+    return united._replace(notes=(*united.notes, note)), spread
+
+
 def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patched: Estimate | None,
             arranged: bool, verified: bool, ambiguous: bool, folds: bool, sheets_removed: bool,
-            source: str) -> Certified:
+            source: str, spread: tuple[float, float] | None = None) -> Certified:
     """R7 and what each earlier stage implies for the certificate of ``shells``.
 
     Parameters
@@ -73,6 +120,9 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         Folds enclosing nothing were taken out (R3a); open sheets inside the solid were left out (R3b).
     source : str
         Names the mesh in messages.
+    spread : (float, float) or None
+        ``(volume in doubt m³, reach m)`` of a reading the file does not decide (:func:`misread_reading`): the
+        result is then an estimate whose bounds cover that volume.
     """
     notes: list[str] = []
     checks = list(checks)
@@ -94,6 +144,11 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         # a patched surface whose union could not be verified (R6) keeps "unverified": the patches' bound does
         # not cover what the boolean changed beyond them
         method, kind = "patched", ("unverified" if kind == "unverified" else "estimate")
+    elif spread is not None and kind in ("exact", "united"):         # R4: both readings within the bound
+        from .uncertainty import uncertainty_from
+        whole = total(shells.moments)
+        uncertainty = uncertainty_from(whole.volume, whole.centroid, whole.second_moment, *spread)
+        kind = "estimate"
     if arranged:                              # R3: the arrangement's surface, checked like any other
         method = "union" if method == "exact" else method
         kind = {"exact": "united"}.get(kind, kind)

@@ -17,7 +17,8 @@ import numpy as np
 from ..errors import InsideOutWarning
 from ..integrals import VolumeMoments
 from .intersect import SurfaceContacts, surface_contacts
-from .policy import ShellContacts, inward_crossing_outward, orient_by_depth, shell_contacts, within_up_to_rounding
+from .policy import (MisreadNesting, ShellContacts, inward_crossing_outward, misread_nesting, orient_by_depth,
+                     shell_contacts, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
 
@@ -52,6 +53,9 @@ class Orientation(NamedTuple):
         Inward-wound shells crossing an outward one (read as cavities cut from it: a reading, not proven).
     notes : tuple of str
         What was read, in words (the ``ambiguous`` one warned).
+    misread : MisreadNesting or None
+        Shells the file winds outward that nesting depth reads as cavities (a reading the file does not decide:
+        :func:`~.certify.misread_reading` labels it).
     """
 
     shells: Shells
@@ -63,6 +67,7 @@ class Orientation(NamedTuple):
     crossing: np.ndarray
     ambiguous: int
     notes: tuple[str, ...]
+    misread: MisreadNesting | None = None
 
 
 def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContacts, *, source: str) -> Orientation:
@@ -99,7 +104,9 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
         candidates = boxes_meet(v, shells.faces, labels, n_shells) | undecided
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[crossing_with.reshape(-1)] = True
-    return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes))
+    misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
+        if touch.complete else None                                                   # R4: the file does not decide
+    return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread)
 
 
 def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n_shells: int,

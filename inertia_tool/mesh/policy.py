@@ -83,7 +83,13 @@ R3b *A flat open sheet inside a solid encloses nothing* (:func:`~.sheets.open_sh
    (its relative interior is connected and off the rest, where that winding number is constant): a wall of zero
    thickness with material on both sides.  The rest is the solid, ``exact`` with the check ``open-sheets``, without
    ``repair``.  Reason: a cut face kept inside a part, or a CAD face left in, is what the user means as the part;
-   the sheet's face sums are not the boundary of anything.  Curved pieces (a cavity's surface with a hole), sheets
+   the sheet's face sums are not the boundary of anything.  *Through T-vertices* (a cut face whose rim meets the
+   part at corners of one side lying on edges of the other to rounding, so that nothing closes by index): when the
+   corners of the open edges lie within ``WALL_PLANE_RTOL`` of one plane, the faces there are the sheet, the rest's
+   open edges are split at the corners lying within that distance of them (the sheet's alike) and must then close
+   by index, the checks above hold on the split surface, and the volume the splits can change (their pyramids and
+   the slab of the gaps, :mod:`~.sheets` "Seams") is within ``ROUNDOFF_RTOL``: ``exact`` as well, the bound in the
+   note.  Curved pieces (a cavity's surface with a hole), sheets
    whose rims meet another's within ``MERGE_TOLERANCE`` (a cavity cracked into flat facets) and fins
    (flat sheets outside the solid, perhaps plates meant to have thickness) are not taken: the fin is named in the
    refusal.
@@ -100,12 +106,17 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    depth from it like any nested shell, whether the contact is exactly coplanar or coplanar only to rounding
    after a rotation: a cavity flush with its body's face is a cavity (cut from the body by the boolean, certified
    ``united``), an outward-wound one included.  One rule covers a shell strictly inside another and one
-   touching the other's boundary from inside: *the role is the depth of the closed solid*.  Shells that touch
-   without a crossing face pair are never placed by one probe point: their surfaces can still cross exactly along
-   edges and vertices of both meshes (CAD tessellations sharing the intersection curve), so the points of each
-   near the contact and a sample of its vertices decide (:func:`touching_relations`): points strictly inside and
-   strictly outside the other make the pair crossing, all inside make it contained, all outside apart; a pair the
-   points cannot decide goes to the boolean like a crossing one.  When the intersection
+   touching the other's boundary from inside: *the role is the depth of the closed solid*.  A shell the file
+   winds outward that depth makes a cavity (:func:`misread_nesting`) is a reading the file does not decide: its
+   own winding number is 2 there, so ``{w ≥ 1}`` is the union of the bodies, and a cavity written with the wrong
+   winding reads the same.  The parity reading is kept, a warning names the other one and its volume, and the
+   certificate is never ``united`` for it (:func:`~.certify.misread_reading`): ``exact`` when the turned surface
+   has no crossing face pair (the parity solid proven), otherwise an estimate whose bounds span both readings.
+   Shells that touch without a crossing face pair are never placed by one probe point: their surfaces can still
+   cross exactly along edges and vertices of both meshes (CAD tessellations sharing the intersection curve), so
+   the points of each near the contact and a sample of its vertices decide (:func:`touching_relations`): points
+   strictly inside and strictly outside the other make the pair crossing, all inside make it contained, all
+   outside apart; a pair the points cannot decide goes to the boolean like a crossing one.  When the intersection
    check did not finish (crossings unknown, so "inside" may mean "overlapping"), each shell keeps what its own
    sign says instead.
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
@@ -116,7 +127,10 @@ R6 *Touching shells are decided by the boolean* (``tolerances.TOUCH_VOLUME_RTOL`
    at edges, vertices or face to face with opposite normals (touching copies), or whose probe points all lie
    on another surface, or that share non-manifold edges, go to the boolean; when the union's volume equals
    the summed volume within ``TOUCH_VOLUME_RTOL`` the interiors are disjoint and the sum, exact as it
-   stands, is the answer (certificate ``exact``).  When the union is smaller although no crossing was found,
+   stands, is the answer (certificate ``exact``).  The check ``touching-confirmed`` is listed only when every
+   piece given to the boolean was two-manifold (the input manifold3d's guarantees assume); pieces that
+   :func:`~.union.closed_groups` joined at non-manifold edges make its union no witness, and the sum then rests
+   on the face-pair check and R4 alone (said in a note).  When the union is smaller although no crossing was found,
    the two checks disagree (manifold3d's tolerance, or a crossing the check cannot see): the union is the
    answer, certified ``unverified``.  A union *larger* than the summed integral beyond ``TOUCH_VOLUME_RTOL``
    shares nothing: a shell read as a cavity reaches out of its body and the boolean cuts it only inside the body;
@@ -159,7 +173,8 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
            "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
-           "near_copies", "NearCopies", "near_copies_message"]
+           "near_copies", "NearCopies", "near_copies_message", "MisreadNesting", "misread_nesting",
+           "misread_message"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -179,15 +194,18 @@ CHECKS = {
                          "number they add is nonzero only in a volume bounded within ROUNDOFF_RTOL of the result, "
                          "zero when exactly flat (mesh/folds.py)",
     "open-sheets": "open sheets were taken out of a surface that did not close (mesh/sheets.py): the rest is "
-                   "closed, no face of it meets a sheet beyond the vertices and edges they share, and the rest's "
-                   "winding number puts each sheet inside its solid (a zero-thickness wall with material on both "
-                   "sides) or, with repair only, outside it (a fin): either encloses no volume",
+                   "closed (by index, or once its faces are split at T-vertices on the sheet's rim, what that "
+                   "changes bounded within ROUNDOFF_RTOL), no face of it meets a sheet beyond the vertices and "
+                   "edges they share, and the rest's winding number puts each sheet inside its solid (a "
+                   "zero-thickness wall with material on both sides) or, with repair only, outside it (a fin): "
+                   "either encloses no volume",
     "boolean-union": "manifold3d formed the union of the bodies (float64)",
     "winding-arrangement": "a shell passing through itself was cut along its exact intersection curves (or its "
                            "faces overlapping in a common plane along each other's edges) and the faces bounding "
                            "{winding number ≥ 1} kept (mesh/arrange.py, mesh/coplanar.py); the result was checked "
                            "closed and free of crossing faces",
-    "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch",
+    "touching-confirmed": "the boolean union's volume equals the summed volume: the bodies only touch (listed "
+                          "only when every piece given to the boolean was two-manifold)",
     "touching-up-to-rounding": "faces of touching shells cross only by rounding: the boolean union's volume equals "
                                "the summed volume within TOUCH_VOLUME_RTOL, so the summed integral is the solid's "
                                "to that tolerance",
@@ -549,6 +567,80 @@ def inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with
         hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
         inward[pairs[hit, a]] = True
     return int(np.count_nonzero(inward))
+
+
+@frozen_value
+class MisreadNesting:
+    """R4: shells wound outward in the file that nesting depth reads as cavities (a body drawn wholly inside
+    another, flush with its floor or free inside it).  The file does not decide between the two readings: its own
+    winding number is 2 inside such a shell, so ``{w ≥ 1}`` is the union of the bodies, while a cavity written
+    with the wrong winding reads exactly the same.  R4 keeps the nesting parity; the note names the other reading.
+
+    Attributes
+    ----------
+    shells : (k,) int
+        The shells so read.
+    volume : float
+        m³, their summed volume: the union (the file's own winding) holds at most this much more material than the
+        parity solid, all of it inside these shells; exactly this much more when ``nested`` is False.
+    nested : bool
+        Some other shell lies inside one of them (its own reading then differs too; the volume is a bound).
+    reach : float
+        m, the largest distance of a corner of these shells from the parity solid's centroid (set by the caller).
+    """
+
+    shells: np.ndarray
+    volume: float
+    nested: bool
+    reach: float = 0.0
+
+
+def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray, nest: Nesting | None,
+                    within: np.ndarray | None) -> MisreadNesting | None:
+    """R4: the shells the file winds outward that nesting depth made cavities (odd depth, flipped), or None.
+
+    Parameters
+    ----------
+    file_volumes : (s,) float
+        Signed volume of each shell as wound in the file, m³.
+    flip, depth : (s,) arrays
+        From :func:`orient_by_depth`.
+    nest : Nesting or None
+        Winding numbers at each shell's probe point (who contains whom).
+    within : (j, 2) int or None
+        ``(shell, container)`` pairs placed by touching or by the boolean (:func:`within_up_to_rounding`).
+    """
+    vols = np.asarray(file_volumes, dtype=np.float64)
+    misread = (vols > 0) & np.asarray(flip, dtype=bool) & (np.asarray(depth) % 2 == 1)
+    if not misread.any():
+        return None
+    inside = np.zeros(len(vols), dtype=bool)
+    if nest is not None:
+        held = np.asarray(nest.winding) != 0
+        inside[np.asarray(nest.other)[held & misread[np.asarray(nest.other)] &
+                                     (np.asarray(nest.shell) != np.asarray(nest.other))]] = True
+    if within is not None and len(within):
+        pairs = np.asarray(within, dtype=np.int64).reshape(-1, 2)
+        inside[pairs[misread[pairs[:, 1]], 1]] = True
+    shells = np.flatnonzero(misread)
+    return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=bool(inside[shells].any()))
+
+
+def misread_message(found: MisreadNesting, parity_volume: float, proven: bool) -> str:
+    """R4's note for :class:`MisreadNesting`: the reading kept, the other one and its volume."""
+    n = len(found.shells)
+    them = "them" if n > 1 else "it"
+    other = (f"at most {round_up(found.volume):.6g} m³ more" if found.nested else
+             f"{parity_volume + found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % more mass")
+    kept = ("the parity solid is proven (exact)" if proven else
+            "the parity solid is not proven apart from that reading (its faces meet the body's only to rounding): "
+            "an estimate whose bounds span both readings")
+    return (f"{n} shell{'s' if n > 1 else ''} wound outward lie{'' if n > 1 else 's'} wholly inside another body "
+            f"(free inside it or flush with its boundary): read by nesting depth as cavit{'ies' if n > 1 else 'y'} "
+            f"(R4; a cavity written with the wrong winding reads the same), {found.volume:.6g} m³ taken "
+            f"out; the file's own winding reads {them} as part of the body, the union of the bodies: {other}. "
+            f"The file does not decide; {kept}. If {them} {'are bodies' if n > 1 else 'is a body'}, unite "
+            f"{them} with the body around {them} in the model; if a cavity, wind {them} inward")
 
 
 @frozen_value

@@ -28,7 +28,7 @@ from ..errors import UsageError
 from ..integrals import VolumeMoments, bounding_box
 from ..tolerances import MERGE_TOLERANCE
 from ..values import frozen_value
-from .certify import certify, first_checks
+from .certify import certify, first_checks, misread_reading
 from .checks import MeshReport
 from .classify import orient_shells
 from .policy import Certificate
@@ -146,11 +146,12 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                             source=source)                                                     # R5, R6
     if united.forced is not None:
         return _estimated(united.forced, {**common, "overlapping_shells": united.overlaps})
+    united, spread = misread_reading(oriented, united, method=found.method, source=source)     # R4's label
     shells = united.shells
     certified = certify(shells, kind=united.kind, checks=united.checks, method=united.method, patched=patched,
                         arranged=crossed.arranged is not None, verified=crossed.verified,
                         ambiguous=bool(oriented.ambiguous), folds=met.folds is not None,
-                        sheets_removed=found.method == "sheets-removed", source=source)          # R7
+                        sheets_removed=found.method == "sheets-removed", source=source, spread=spread)  # R7
     stages = (first.dropped, crossed.arranged, met.folds.describe() if met.folds is not None else None,
               crossed.unverified)
     notes = (*found.notes, *surface.coincident, *first.coincident, *oriented.notes,

@@ -53,6 +53,32 @@ case: it may be a thin plate meant to have thickness.  It is counted, nothing is
 by R2).  A sheet that crosses or touches ``R`` beyond the features they share (it pokes through the surface) is
 not decided here either: the surface goes on to the normal path.
 
+Seams
+-----
+A cut face kept inside is often joined to the part not by index but through *T-vertices*: the two halves were cut
+apart on their own, so a corner of one side's rim lies on an edge of the other's (to rounding: computed cut points
+are off the line by ~1e-16 of the coordinates, so no exact predicate finds them on it).  The sheet's rim edges are
+then used by the sheet and one side only, the sheet is joined to that side through manifold edges, and the rest
+does not close by index.  :func:`_seamed_sheet` reads such a surface when every corner of its unbalanced edges lies
+within ``WALL_PLANE_RTOL`` of one plane ``P``: the sheet ``Σ`` is the faces within that distance of ``P`` that hold
+such a corner (joined through shared edges); in the rest ``R`` every open edge ``p → q`` is split, in the one face
+``F = (p, q, x)`` using it that way, into the fan ``(p, s₁, x) … (s_k, q, x)`` through the corners ``s`` of open
+edges lying within ``WALL_PLANE_RTOL`` of the segment's interior (:func:`_split_at_seams`), and the result ``R*``
+must close by index.  ``Σ`` is split alike (faces with a split edge fanned from their centroids), so that its rim
+matches ``R*``'s by index, and the lemma above is applied to ``R* + Σ*`` as it stands: the face-pair check
+between the sheet and the rest, ``R*`` closed, the winding number 1 at the sheet.
+
+What the splits change: ``fan − F = ∂(pyramid with apex x over the polygon p, s₁, …, s_k, q) + Q_F`` with
+``Q_F`` the cone from ``p`` over that polygon, so ``R* = R + Σ Q_F + Σ ∂pyramid``: ``R`` closed by its thin cones
+``Q`` (the gaps of the seams, each within ``δ`` of ``P``) is ``R*`` except in the pyramids, ``Σ |tet(x, p, sⱼ,
+sⱼ₊₁)|`` of volume; and any other surface spanning the gaps within ``δ`` of ``P`` with at most the cones' area
+differs from ``Q`` by a closed chain within ``δ`` of ``P``, whose winding number is nonzero in at most
+``2δ·(2·area Q)`` (the slab lemma of :mod:`~.folds`).  ``D = Σ pyramids + 4δ·area Q`` must be within
+``ROUNDOFF_RTOL`` of ``R*``'s volume (and ``D·reach²`` of its second moment), the test of R0's copies up to
+rounding and of R3a; then the answer is ``exact`` (check ``open-sheets``) and the note states ``D``.  A T-vertex
+moved off its edge in the plane (the rims cracked apart) or pushed through the sheet is farther than
+``WALL_PLANE_RTOL`` from the segment or from ``P``: not split, the rest does not close, nothing is taken.
+
 Finding the sheets
 ------------------
 The faces are split into *pieces* joined through manifold edges (two faces, opposite directions).  The flat open
@@ -68,7 +94,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..tolerances import MERGE_TOLERANCE, WALL_PLANE_RTOL
+from ..tolerances import MERGE_TOLERANCE, ROUNDOFF_RTOL, WALL_PLANE_RTOL
 from ..values import frozen_value
 from .edges import edge_keys
 
@@ -106,12 +132,20 @@ class OpenSheets:
     fin_faces: int
     inside_area: float
     fin_area: float
+    seam_points: int = 0
+    volume_bound: float = 0.0
 
     def describe(self) -> str:
         """One line for the report's notes (the sheets taken out)."""
+        seam = ""
+        if self.seam_points:
+            seam = (f"; its rim meets the part's surface at {self.seam_points:,} T-vertices (corners of one side "
+                    "lying on an edge of the other to rounding), the faces there split so that the rest closes by "
+                    f"index: the winding number that changes is nonzero in at most {self.volume_bound:.3g} m³, "
+                    "within the round-off bound of an exact result")
         return (f"{self.inside:,} open sheet{'s' if self.inside > 1 else ''} ({self.inside_faces:,} faces, "
                 f"{self.inside_area:.3g} m²) lying inside the solid (a wall of zero thickness with material on both "
-                "sides, its rim on the surface or free inside) left out: it encloses no volume")
+                f"sides, its rim on the surface or free inside) left out: it encloses no volume{seam}")
 
 
 def _codes(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -243,7 +277,8 @@ def _shell_windings(point: np.ndarray, v: np.ndarray, f: np.ndarray, labels: np.
 
 
 def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MAX_SHEET_PIECES,
-                plane_rtol: float = WALL_PLANE_RTOL, rim_rtol: float = MERGE_TOLERANCE) -> OpenSheets | None:
+                plane_rtol: float = WALL_PLANE_RTOL, rim_rtol: float = MERGE_TOLERANCE,
+                budget: float = ROUNDOFF_RTOL) -> OpenSheets | None:
     """R3b: the open sheets of an unbalanced surface, taken out when the rest is closed and each sheet lies inside
     or outside its solid without meeting it (module docstring); else None.
 
@@ -261,6 +296,10 @@ def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MA
     rim_rtol : float
         Two sheets whose rims come within ``rim_rtol`` times the bounding-box diagonal of each other are not taken
         (pieces of one surface cracked apart, e.g. a cavity: module docstring, "Only flat sheets").
+    budget : float
+        A sheet joined to the rest through T-vertices (module docstring, "Seams") is taken only when the volume in
+        which splitting the faces there changes the winding number is within ``budget`` of the rest's volume (and
+        its second moment likewise): ``tolerances.ROUNDOFF_RTOL``, what "exact" allows.
 
     Returns
     -------
@@ -268,14 +307,24 @@ def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MA
         None when no set of open pieces leaves a closed rest, or a sheet meets the rest beyond what they share by
         index, or the rest passes through itself, or a sheet's side cannot be decided.
     """
-    from .checks import shell_labels
-    from .folds import _distance_bound, _plane
-    from .intersect import surface_contacts
-
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     if len(f) < 5:                                    # a closed rest and a sheet need at least 4 + 1 faces
         return None
+    found = _indexed_sheets(v, f, max_pieces, plane_rtol, rim_rtol)
+    if found is not None:
+        return found
+    return _seamed_sheet(v, f, max_pieces, plane_rtol, rim_rtol, budget)
+
+
+def _indexed_sheets(v: np.ndarray, f: np.ndarray, max_pieces: int, plane_rtol: float,
+                    rim_rtol: float) -> OpenSheets | None:
+    """:func:`open_sheets` for sheets whose rims the rest shares by index (the pieces joined through manifold edges
+    come apart at the rim, where the sheet and both sides of the part use each edge)."""
+    from .checks import shell_labels
+    from .folds import _distance_bound, _plane
+    from .intersect import surface_contacts
+
     piece, n_pieces, edge, sign = _pieces(f, len(v))
     normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     area = 0.5 * np.linalg.norm(normal, axis=1)
@@ -337,3 +386,184 @@ def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MA
             return None                               # the file's winding and the nesting depth disagree
     return OpenSheets(faces=rest, inside=inside, fins=fins, inside_faces=inside_faces, fin_faces=fin_faces,
                       inside_area=inside_area, fin_area=fin_area)
+
+
+def _seam_plane(v: np.ndarray, f: np.ndarray, tolerance: float) -> tuple[np.ndarray, float] | None:
+    """Unit normal and offset of the plane holding every corner of the surface's unbalanced edges within
+    ``tolerance`` (the rim of one sheet whose faces are joined to the part's through T-vertices: the edges left
+    open are the other side's rim), or None."""
+    key, forward = edge_keys(f, len(v))
+    codes, inverse = _codes(key)
+    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
+    nv = np.int64(max(len(v), 1))
+    bad = codes[net != 0]
+    corners = np.unique(np.r_[bad // nv, bad % nv])
+    if len(corners) < 3:
+        return None
+    p = v[corners]
+    centre = p.mean(axis=0)
+    _, _, vt = np.linalg.svd(p - centre, full_matrices=False)
+    unit = vt[-1] / np.linalg.norm(vt[-1])
+    offset = float(centre @ unit)
+    dist = np.abs(p @ unit - offset) + 8 * 2.0 ** -53 * (np.abs(p) @ np.abs(unit) + abs(offset))
+    if not float(dist.max()) <= tolerance:
+        return None
+    return unit, offset
+
+
+def _split_like(v: np.ndarray, f: np.ndarray, splits: dict[tuple[int, int], list[int]]
+                ) -> tuple[np.ndarray, np.ndarray, int]:
+    """The faces ``f`` (a sheet) with each edge that ``splits`` lists, in either direction, given the corners put
+    into it (:func:`_split_at_seams`), so that the sheet's rim matches the rest's by index: a face with such an
+    edge becomes the fan from its centroid (a vertex appended) over its corners and those put into its edges.
+    Returns the vertices (``v`` and the centroids), the faces and the number of faces split.  The sheet is not
+    integrated: only its rim's indices and its place matter (the face-pair check, the winding number at it)."""
+    rows: list[list[int]] = []
+    centres: list[np.ndarray] = []
+    for tri in f.tolist():                            # bounded by the sheet's faces
+        ring: list[int] = []
+        for k in range(3):
+            p, q = tri[k], tri[(k + 1) % 3]
+            inner = splits.get((p, q), splits[(q, p)][::-1] if (q, p) in splits else [])
+            ring.extend([p, *inner])
+        if len(ring) == 3:
+            rows.append(tri)
+            continue
+        centre = len(v) + len(centres)
+        centres.append(v[tri].mean(axis=0))
+        rows.extend([a, b, centre] for a, b in zip(ring, ring[1:] + ring[:1]))
+    extended = np.vstack([v, *centres]) if centres else v
+    return extended, np.array(rows, dtype=np.int64).reshape(-1, 3), len(centres)
+
+
+def _seamed_sheet(v: np.ndarray, f: np.ndarray, max_pieces: int, plane_rtol: float, rim_rtol: float,
+                  budget: float) -> OpenSheets | None:
+    """:func:`open_sheets` for one flat sheet joined to the rest through T-vertices (module docstring, "Seams")."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from ..integrals import volume_moments
+    from .folds import _distance_bound
+
+    tolerance = plane_rtol * float(np.abs(v).max())
+    plane = _seam_plane(v, f, tolerance)
+    if plane is None:
+        return None
+    unit, offset = plane
+    near_vertex = np.abs(v @ unit - offset) <= tolerance
+    near = np.flatnonzero(np.all(near_vertex[f], axis=1))
+    if not len(near) or len(near) == len(f):
+        return None
+    # the faces in the plane, joined through shared edges; the sheet is those pieces holding a corner of the seam
+    key, _ = edge_keys(f[near], len(v))
+    codes, inverse = _codes(key)
+    slot_face = np.arange(3 * len(near)) // 3
+    order = np.argsort(inverse, kind="stable")
+    same = np.flatnonzero(inverse[order][1:] == inverse[order][:-1])
+    graph = coo_matrix((np.ones(len(same), dtype=np.int8), (slot_face[order][same], slot_face[order][same + 1])),
+                       shape=(len(near), len(near)))
+    _, comp = connected_components(graph, directed=False)
+    seam = _seam_corners(f, len(v))
+    touching = np.unique(comp[np.isin(f[near], seam).any(axis=1)])
+    sheet = near[np.isin(comp, touching)]
+    is_sheet = np.zeros(len(f), dtype=bool)
+    is_sheet[sheet] = True
+    closed = _split_at_seams(v, f[~is_sheet], tolerance)
+    if closed is None:
+        return None
+    rest, pyramids, cone_area, split_corners, splits = closed
+    extended, sheet_faces, _ = _split_like(v, f[sheet], splits)
+    seamed = np.vstack([rest, sheet_faces])
+    found = _indexed_sheets(extended, seamed, max_pieces, plane_rtol, rim_rtol)
+    if found is None or found.fins or not np.array_equal(found.faces, rest):
+        return None                                   # not the sheet, inside the solid, its rim matching the rest's
+    delta = _distance_bound(extended, sheet_faces, unit, offset)
+    volume = pyramids + 4 * delta * cone_area
+    whole = volume_moments(v, rest)
+    corners = np.unique(np.r_[split_corners, sheet_faces.reshape(-1)])
+    reach = float(np.sqrt(np.max(np.sum((extended[corners] - whole.centroid) ** 2, axis=1)))) + 2 * delta
+    if not (volume <= budget * abs(whole.volume)
+            and volume * reach ** 2 <= budget * float(np.linalg.norm(whole.second_moment))):
+        return None
+    points = sum(len(c) for c in splits.values())
+    return OpenSheets(faces=found.faces, inside=found.inside, fins=0, inside_faces=int(len(sheet)), fin_faces=0,
+                      inside_area=found.inside_area, fin_area=0.0, seam_points=points,
+                      volume_bound=float(volume) * (1 + 1e-12))
+
+
+def _seam_corners(f: np.ndarray, n: int) -> np.ndarray:
+    """Corners of the surface's unbalanced edges (k,) int."""
+    key, forward = edge_keys(f, n)
+    codes, inverse = _codes(key)
+    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
+    nv = np.int64(max(n, 1))
+    bad = codes[net != 0]
+    return np.unique(np.r_[bad // nv, bad % nv])
+
+
+def _split_at_seams(v: np.ndarray, rest: np.ndarray, reach: float
+                    ) -> tuple[np.ndarray, float, float, np.ndarray, dict[tuple[int, int], list[int]]] | None:
+    """Close ``rest`` by index at its seams (module docstring, "Seams"): every open edge ``p → q`` (used once more
+    in one direction than the other) lies in one face ``(p, q, x)`` using it that way, split into the fan ``(p, s₁,
+    x) … (s_k, q, x)`` through the corners ``s`` of open edges lying within ``reach`` of the segment's interior, in
+    order along it.  Returns the new faces, ``Σ |tet(x, p, sⱼ, sⱼ₊₁)|`` over the fans (m³, the pyramids), the area
+    of the cones from ``p`` over each chain (m²), the corners of the faces split and the chains put into each edge;
+    None when nothing is split, a face holds two split edges, or the result does not close by index."""
+    from scipy.spatial import cKDTree
+
+    from .folds import _tetra_volume_bound
+
+    key, forward = edge_keys(rest, len(v))
+    codes, inverse = _codes(key)
+    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0)).astype(np.int64)
+    if not net.any() or np.abs(net).max() > 1:
+        return None
+    # the slot using each open edge in its net direction (forward: lo -> hi, as edge_keys orders the key)
+    slot_net = net[inverse]
+    chosen = np.flatnonzero((slot_net != 0) & ((slot_net > 0) == forward))
+    if len(np.unique(inverse[chosen])) != len(chosen):
+        return None                                   # two faces use one open edge the same way
+    face = chosen // 3
+    p = rest.reshape(-1)[chosen]
+    q = rest[:, [1, 2, 0]].reshape(-1)[chosen]
+    corners = np.unique(np.r_[p, q])
+    a, b = v[p], v[q]
+    mid, half = 0.5 * (a + b), 0.5 * np.linalg.norm(b - a, axis=1)
+    tree = cKDTree(v[corners])
+    rows: list[list[int]] = []
+    drop = np.zeros(len(rest), dtype=bool)
+    splits: dict[tuple[int, int], list[int]] = {}
+    pyramids = cone_area = 0.0
+    for g, s0, s1, centre, radius in zip(face.tolist(), p.tolist(), q.tolist(), mid, half.tolist()):  # open edges
+        near = corners[tree.query_ball_point(centre, radius + reach)]
+        near = near[(near != s0) & (near != s1)]
+        if not len(near):
+            continue
+        edge = v[s1] - v[s0]
+        t = (v[near] - v[s0]) @ edge / float(edge @ edge)
+        dist = np.linalg.norm(v[near] - v[s0] - t[:, None] * edge, axis=1)
+        on = (t > 0) & (t < 1) & (dist <= reach)
+        if not on.any():
+            continue
+        if drop[g]:
+            return None                               # a face on two split edges: left to the normal path
+        inner = near[on][np.argsort(t[on], kind="stable")].tolist()
+        tri = rest[g].tolist()
+        x = tri[(tri.index(s0) + 2) % 3]
+        chain = [s0, *inner, s1]
+        drop[g] = True
+        splits[(s0, s1)] = inner
+        for c0, c1 in zip(chain[:-1], chain[1:]):
+            rows.append([c0, c1, x])
+            if c0 != s0:
+                pyramids += _tetra_volume_bound(v[x], v[s0], v[c0], v[c1])
+                cone_area += 0.5 * float(np.linalg.norm(np.cross(v[c0] - v[s0], v[c1] - v[s0])))
+    if not splits:
+        return None
+    split = np.array(rows, dtype=np.int64).reshape(-1, 3)
+    closed = np.vstack([rest[~drop], split])
+    key, forward = edge_keys(closed, len(v))
+    _, inverse = _codes(key)
+    if np.bincount(inverse, weights=np.where(forward, 1.0, -1.0)).any():
+        return None                                   # the seams do not close by index
+    return closed, pyramids, cone_area * (1 + 1e-12), np.unique(split), splits

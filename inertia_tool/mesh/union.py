@@ -146,11 +146,16 @@ class UnionSurface:
         Outward-wound, closed, manifold.
     volume : float
         manifold3d's own volume of the result, m³ (a cross-check of the exact integral).
+    manifold_pieces : bool
+        Every piece given to the boolean was two-manifold (:func:`two_manifold`), the input manifold3d's
+        guarantees assume.  A piece that :func:`closed_groups` joined at non-manifold edges (bodies welded at
+        shared edges or faces) is not: the union then proves nothing about it, even where its volume agrees.
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     volume: float
+    manifold_pieces: bool = True
 
 
 #: A ``manifold3d.Manifold``: the package ships no type information, so to mypy it is ``Any``.
@@ -240,7 +245,8 @@ def union_surface(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
     out = solid.to_mesh64()
     verts = np.asarray(out.vert_properties, dtype=np.float64)[:, :3] + centre
     tris = np.asarray(out.tri_verts, dtype=np.int64).reshape(-1, 3)
-    return UnionSurface(vertices=verts, faces=tris, volume=float(solid.volume()))
+    return UnionSurface(vertices=verts, faces=tris, volume=float(solid.volume()),
+                        manifold_pieces=two_manifold(f, groups))
 
 
 def common_volumes(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, volumes: np.ndarray,
