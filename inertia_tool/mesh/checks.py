@@ -112,7 +112,9 @@ class MeshReport:
         ``"sheets-removed"`` (open sheets inside the solid, or fins outside it with ``repair``, left out; R3b),
         ``"union"`` (overlapping bodies united by a boolean, then exact), ``"sum"`` (overlapping bodies'
         integrals added: shared volume counted twice, on request), ``"patched"`` / ``"winding"`` (estimates
-        of ``repair=True``, see ``uncertainty``).
+        of ``repair=True``, see ``uncertainty``), ``"nesting"`` (a shell wound outward inside another read as a
+        cavity by nesting depth where the file does not decide between that and the union: an estimate whose
+        bounds cover both, R4).
     uncertainty : Uncertainty or None
         Bounds when ``method`` is an estimate (``mass`` relative, ``center_of_mass`` m, ``inertia`` relative
         Frobenius); None when the result is exact for the polyhedron.

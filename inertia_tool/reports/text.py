@@ -70,7 +70,8 @@ def method_line(mesh) -> str:
         extra = " (shared volume of overlapping bodies counted twice, on request)" if mesh.method == "sum" else ""
         return f"exact for the polyhedron (method: {mesh.method}){extra}"
     why = ("the printed part's core is integrated numerically" if mesh.method.endswith("inward offset")
-           else "the file does not define a closed solid")
+           else "the file's winding does not decide whether a shell inside another is a cavity or a body"
+           if mesh.method == "nesting" else "the file does not define a closed solid")
     return (f"ESTIMATE (method: {mesh.method}; {why}): mass within "
             f"±{round_up(100 * u.mass):.3g}%, centre of mass within {round_up(u.center_of_mass):.3g} m, inertia within "
             f"±{round_up(100 * u.inertia):.3g}% (Frobenius)")
