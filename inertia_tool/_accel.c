@@ -5258,6 +5258,7 @@ typedef struct {
     const int32_t *faces;       /* the faces holding each kept vertex, vertex after vertex */
     int64_t n, total, min_faces, big_faces;
     uint8_t *cert;
+    const int32_t *label;       /* NULL, or per face its certified patch (0: none; ct_patch_labels) */
     int oom[MAX_THREADS];
 } CtStarJob;
 
@@ -5294,6 +5295,19 @@ ct_star_task(void *ctx, int t, int nt)
             v = w;
             continue;
         }
+        if (jb->label != NULL) {
+            /* every face of v in one certified patch: no pair of them is enumerated (the patch's node is not
+             * paired with itself, and no node pair below it is reached), so v's certificate would decide
+             * nothing */
+            int32_t l0 = jb->label[jb->faces[s]];
+            int64_t i = s + 1;
+            while (i < e && jb->label[jb->faces[i]] == l0) i++;
+            if (l0 != 0 && i == e) {
+                jb->cert[v] = 0;
+                v = w;
+                continue;
+            }
+        }
         int32_t link_local[2 * CT_STAR_SMALL];
         int32_t *link = e - s <= CT_STAR_SMALL ? link_local : (int32_t *)malloc((size_t)(2 * (e - s)) * sizeof(int32_t));
         int r = -1;
@@ -5318,25 +5332,22 @@ ct_stars_scratch(int64_t n, int64_t m)
     return (size_t)(n > 0 ? n : 1) * sizeof(int64_t) + 3 * (size_t)(m > 0 ? m : 1) * sizeof(int32_t);
 }
 
-/* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
- * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices), and, when twin is not NULL, the
- * faces across every edge (ct_twins, 3 m int32); 0 or -1 when out of memory.
- * scratch: ct_stars_scratch(n, m) bytes, any content (the memory of the preparation's sort, reused). */
 static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces,
-                    int64_t total, int32_t *twin, int threads);
+                    int64_t total, const int32_t *pos, int32_t *twin, int threads);
 
-static int
-ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
-         uint8_t *cert, int threads, void *scratch, int32_t *twin)
+/* The faces of each vertex of at least list_min faces (in scratch, ct_stars_scratch(n, m) bytes, any content):
+ * *off (n int64: the start of each kept vertex's range of faces, -1 for the others) and *faces (the faces of
+ * each kept vertex, vertex after vertex, *total of them; a face holding v twice is listed twice). */
+static void
+ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, void *scratch, int64_t **off_out,
+              int32_t **faces_out, int64_t *total_out)
 {
-    memset(cert, 0, (size_t)n);
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
     int64_t *off = (int64_t *)scratch;
     int32_t *faces = (int32_t *)((char *)scratch + off_bytes);
     memset(off, 0, off_bytes);
     for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
     int64_t total = 0;
-    int64_t list_min = twin != NULL ? 1 : min_faces;      /* the twins need every vertex's faces */
     for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
         if (off[v] >= list_min) {
             total += off[v];
@@ -5353,6 +5364,20 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
             faces[--off[v]] = (int32_t)f;           /* a face holding v twice is listed twice (then rejected) */
         }
     }
+    *off_out = off;
+    *faces_out = faces;
+    *total_out = total;
+}
+
+/* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
+ * certified one of min_faces .. big_faces - 1, from the lists of ct_star_lists; with label (per face, its
+ * certified patch or 0), a vertex whose faces all lie in one certified patch is not tried (cert 0: its
+ * certificate would decide no pair).  0, or -1 when out of memory. */
+static int
+ct_star_certs(const double *V, int64_t n, const void *F, int fsize, const int64_t *off, const int32_t *faces,
+              int64_t total, int64_t min_faces, int64_t big_faces, uint8_t *cert, int threads, const int32_t *label)
+{
+    memset(cert, 0, (size_t)n);
     CtStarJob jb;
     memset(&jb, 0, sizeof(jb));
     jb.V = V;
@@ -5365,15 +5390,24 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
     jb.min_faces = min_faces;
     jb.big_faces = big_faces;
     jb.cert = cert;
+    jb.label = label;
     run_parallel(thread_count(threads, (size_t)n, 20000), ct_star_task, &jb);
-    int rc = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
-        if (jb.oom[t]) rc = -1;
+        if (jb.oom[t]) return -1;
     }
-    if (rc == 0 && twin != NULL) {                         /* the faces across each edge, from the same lists */
-        rc = ct_twins(F, fsize, n, m, off, faces, total, twin, threads);
-    }
-    return rc;
+    return 0;
+}
+
+/* cert as ct_star_certs for every vertex (no patches), the lists in scratch (ct_stars_scratch(n, m) bytes, any
+ * content: the memory of the preparation's sort, reused); 0 or -1 when out of memory. */
+static int
+ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
+         uint8_t *cert, int threads, void *scratch)
+{
+    int64_t *off, total;
+    int32_t *faces;
+    ct_star_lists(n, F, fsize, m, min_faces, scratch, &off, &faces, &total);
+    return ct_star_certs(V, n, F, fsize, off, faces, total, min_faces, big_faces, cert, threads, NULL);
 }
 
 /* The certified vertex shared by every face at hierarchy positions s .. s+count-1, or -1. */
@@ -5603,6 +5637,7 @@ typedef struct {
     const int64_t *off;
     const int32_t *faces;
     int64_t n, total;
+    const int32_t *pos;         /* NULL, or each face's hierarchy position: twin is then indexed and valued by it */
     int32_t *twin;
     int oom[MAX_THREADS];
 } CtTwinJob;
@@ -5616,6 +5651,18 @@ ct_link_prev_cmp(const void *x, const void *y)
 {
     const CtLink *a = (const CtLink *)x, *b = (const CtLink *)y;
     return (a->prev > b->prev) - (a->prev < b->prev);
+}
+
+/* twin of face f across the edge from its corner c: by face, or by hierarchy position when jb->pos is given */
+static inline void
+ct_twin_put(CtTwinJob *jb, int32_t f, int c, int32_t tw)
+{
+    if (jb->pos != NULL) {
+        jb->twin[3 * (size_t)jb->pos[f] + (size_t)c] = tw >= 0 ? jb->pos[tw] : tw;
+    }
+    else {
+        jb->twin[3 * (size_t)f + (size_t)c] = tw;
+    }
 }
 
 static void
@@ -5658,8 +5705,8 @@ ct_twin_task(void *ctx, int t, int nt)
                     }
                     same += lk[j].next == lk[i].next;
                 }
-                jb->twin[3 * (size_t)lk[i].face + (size_t)lk[i].corner] = back < 0 && !same ? -1
-                                                                           : back == 0 && !same ? twin : -2;
+                int32_t tw = back < 0 && !same ? -1 : back == 0 && !same ? twin : -2;
+                ct_twin_put(jb, lk[i].face, lk[i].corner, tw);
             }
         }
         else if (ok) {                             /* a large fan: match by the sorted corners before v */
@@ -5675,7 +5722,7 @@ ct_twin_task(void *ctx, int t, int nt)
                 while (lo + run < k && lk[lo + run].prev == lk[i].next) run++;
                 /* "run twice one way": another face with the same next; counted through its own prev run */
                 int32_t tw = run == 1 && lk[lo].face != lk[i].face ? lk[lo].face : run == 0 ? -1 : -2;
-                jb->twin[3 * (size_t)lk[i].face + (size_t)lk[i].corner] = tw;
+                ct_twin_put(jb, lk[i].face, lk[i].corner, tw);
             }
         }
         if (lk != local) free(lk);
@@ -5881,7 +5928,7 @@ done:
 /* ct_twin_task over the vertices on threads; 0, or -1 when out of memory. */
 static int
 ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces, int64_t total,
-         int32_t *twin, int threads)
+         const int32_t *pos, int32_t *twin, int threads)
 {
     for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
     CtTwinJob jb;
@@ -5892,6 +5939,7 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, con
     jb.faces = faces;
     jb.n = n;
     jb.total = total;
+    jb.pos = pos;
     jb.twin = twin;
     run_parallel(thread_count(threads, (size_t)n, 20000), ct_twin_task, &jb);
     for (int t = 0; t < MAX_THREADS; t++) {
@@ -5991,6 +6039,53 @@ done:
     free(first);
     free(last);
     return rc;
+}
+
+/* label[f] <- the certified patch (its node) holding face f, 0 for a face in none; order: the face at each
+ * hierarchy position.  Top down; the stack holds at most one node per level and one more (depth <= 32: the
+ * tree halves ranges of fewer than 2^31 blocks). */
+static void
+ct_patch_labels(const CtNode *nodes, const uint8_t *patch, const int32_t *order, int64_t m, int32_t *label)
+{
+    int64_t stack[2 * 80];
+    int top = 0;
+    stack[0] = CT_ROOT;
+    stack[1] = 0;
+    top = 1;
+    while (top > 0) {
+        top--;
+        int64_t k = stack[2 * top], lab = stack[2 * top + 1];
+        const CtNode *nd = &nodes[k];
+        if (lab == 0 && patch[k]) lab = k;
+        if (CT_IS_LEAF(nd)) {
+            int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
+            for (int64_t i = start; i < start + count; i++) label[order[i]] = (int32_t)lab;
+            continue;
+        }
+        stack[2 * top] = CT_LEFT(nd);
+        stack[2 * top + 1] = lab;
+        top++;
+        stack[2 * top] = CT_RIGHT(nd);
+        stack[2 * top + 1] = lab;
+        top++;
+    }
+}
+
+/* The apexes of a hierarchy ct_build made without certificates (every apex -1), from cert, children before
+ * parents, as ct_build sets them. */
+static void
+ct_set_apex(CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *cert, int64_t m)
+{
+    for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
+        CtNode *nd = &nodes[k];
+        if (CT_IS_LEAF(nd)) {
+            nd->apex = (int32_t)ct_leaf_apex(ids, cert, CT_LEAF * CT_BLOCK_OF(nd), ct_leaf_count(nd, m));
+        }
+        else {
+            const CtNode *p = &nodes[CT_LEFT(nd)], *q = &nodes[CT_RIGHT(nd)];
+            nd->apex = p->apex == q->apex ? p->apex : -1;
+        }
+    }
 }
 
 typedef struct {
@@ -6553,7 +6648,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         int oom = 0, failed = 0;
         int profile = getenv("INERTIA_TOOL_CT_PROFILE") != NULL;
-        double clk[8] = {0};
+        double clk[12] = {0};
         Py_BEGIN_ALLOW_THREADS
         clk[0] = ct_clock();
         int nt = thread_count(threads, (size_t)m, 20000);
@@ -6605,43 +6700,74 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
             /* order holds the face indices in hierarchy order: code's memory is the stars' scratch now */
         }
+        int64_t n_nodes = 0;
+        int64_t star_min = star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN;
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
             stars = (uint8_t *)malloc(mm);
-            if (fmask != NULL) {
-                twin = (int32_t *)malloc(3 * mm * sizeof(int32_t));    /* NULL: no patches, the same pairs */
-            }
-            if (cert == NULL || stars == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
-                                         star_faces, cert, nt, code, twin) < 0) {
-                oom = 1;
+            if (cert == NULL || stars == NULL) oom = 1;
+        }
+        int32_t *pos = NULL;
+        if (!oom && !failed && m >= 2 && cert != NULL && fmask != NULL) {
+            twin = (int32_t *)malloc(3 * mm * sizeof(int32_t));    /* NULL: no patches, the same pairs */
+            pos = (int32_t *)malloc(mm * sizeof(int32_t));
+            if (twin == NULL || pos == NULL) {
+                free(twin);
+                free(pos);
+                twin = NULL;
+                pos = NULL;
             }
         }
-        clk[4] = ct_clock();
-        if (!oom && !failed && m >= 2) {
-            int64_t n_nodes = ct_build(nodes, box, ids, cert, m);
-            int32_t *across = (int32_t *)code;     /* the stars' lists are done with: 12 of its >= 16 bytes a face */
-            int32_t *pos = twin != NULL ? (int32_t *)malloc(mm * sizeof(int32_t)) : NULL;
-            if (pos != NULL) {                      /* the faces across, by hierarchy position */
-                for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
-                for (int64_t i = 0; i < m; i++) {
-                    const int32_t *tw = twin + 3 * (size_t)order[i];
-                    for (int c = 0; c < 3; c++) {
-                        across[3 * i + c] = tw[c] >= 0 ? pos[tw[c]] : -1;
-                        if (tw[c] == -2) fmask[i] = 0;     /* not one face across: in no patch */
+        if (!oom && !failed && m >= 2 && twin != NULL) {
+            /* with patches: the faces across each edge by hierarchy position (ct_twins into twin, the lists
+             * kept in code's memory), the hierarchy, the patches, then the star certificates of the vertices
+             * whose faces are not all in one certified patch (the others decide no pair), then the apexes */
+            int64_t *off, total;
+            int32_t *vfaces;
+            for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
+            ct_star_lists(n, F, fsize, m, 1, code, &off, &vfaces, &total);
+            clk[8] = ct_clock();
+            if (ct_twins(F, fsize, n, m, off, vfaces, total, pos, twin, nt) < 0) {
+                oom = 1;
+            }
+            clk[9] = ct_clock();
+            if (!oom) {
+                int32_t *across = twin;
+                for (int64_t i = 0; i < 3 * m; i++) {
+                    if (across[i] == -2) {
+                        fmask[i / 3] = 0;          /* not one face across: in no patch */
+                        across[i] = -1;
                     }
                 }
-            }
-            free(twin);
-            twin = NULL;
-            if (pos != NULL) {                      /* with a work bound every pair is counted, as on numpy */
-                free(pos);
+                n_nodes = ct_build(nodes, box, ids, NULL, m);
+                clk[10] = ct_clock();
                 patch = (uint8_t *)malloc((size_t)n_nodes);
                 if (patch == NULL || ct_patches(nodes, n_nodes, ids, fmask, across, V, m, patch) < 0) {
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
+                clk[7] = ct_clock();
+                int32_t *label = pos;                  /* pos is done with: each face's certified patch */
+                if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
+                if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
+                                  patch != NULL ? label : NULL) < 0) {
+                    oom = 1;
+                }
+                clk[11] = ct_clock();
+                ct_set_apex(nodes, n_nodes, ids, cert, m);
             }
-            clk[7] = ct_clock();
+        }
+        else if (!oom && !failed && m >= 2) {
+            if (cert != NULL && ct_stars(V, n, F, fsize, m, star_min, star_faces, cert, nt, code) < 0) {
+                oom = 1;
+            }
+            n_nodes = ct_build(nodes, box, ids, cert, m);
+        }
+        free(pos);
+        free(twin);
+        twin = NULL;
+        clk[4] = ct_clock();
+        if (!oom && !failed && m >= 2) {
             if (cert != NULL) {
                 for (int64_t i = 0; i < m; i++) {
                     unsigned b = 0;
@@ -6710,12 +6836,20 @@ accel_contact_scan(PyObject *self, PyObject *args)
         clk[6] = ct_clock();
         Py_END_ALLOW_THREADS
         if (profile) {
-            fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars %.4f build %.4f "
-                    "(patches %.4f) traverse %.4f s; candidates %lld tested %lld; node pairs %lld leaf pairs %lld "
-                    "pair tests %lld\n",
-                    (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[4] - clk[3], clk[5] - clk[4],
-                    clk[7] > 0 ? clk[7] - clk[4] : 0.0, clk[6] - clk[5], sc.candidates, sc.tested, sc.node_pairs,
-                    sc.leaf_pairs, sc.loads);
+            if (clk[11] > 0) {
+                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f lists %.4f twins %.4f "
+                        "build %.4f patches %.4f stars %.4f apex+bits %.4f traverse %.4f s; ",
+                        (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[8] - clk[3],
+                        clk[9] - clk[8], clk[10] - clk[9], clk[7] - clk[10], clk[11] - clk[7], clk[5] - clk[11],
+                        clk[6] - clk[5]);
+            }
+            else {
+                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars+build %.4f "
+                        "traverse %.4f s; ", (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2],
+                        clk[5] - clk[3], clk[6] - clk[5]);
+            }
+            fprintf(stderr, "candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld\n",
+                    sc.candidates, sc.tested, sc.node_pairs, sc.leaf_pairs, sc.loads);
         }
         if (oom) {
             PyErr_NoMemory();
