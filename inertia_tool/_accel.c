@@ -5771,12 +5771,15 @@ ct_sweep_cmp(const void *x, const void *y)
 }
 
 /* 1 when the closed polygons P (2-d points, B of them; the segment of point i runs to point succ[i], every
- * succ cycle of length 3 or more, consecutive points distinct) are simple and pairwise disjoint: segments
- * meet only where one ends and the next begins (and not folding back along it), others not at all.  A sweep
- * along x tests the pairs whose x and y ranges meet; more than budget segment tests, or an exact stage that
- * overflowed: 0. */
+ * succ cycle of length 3 or more, consecutive points distinct) are simple and pairwise meet only at common
+ * vertices: segments meet only where one ends and the next begins (and not folding back along it), two
+ * segments of different polygons ending at one vertex by index (edges: the tail and head ids of each segment;
+ * a vertex two polygons pass through) only there (not overlapping along a common line), others not at all.
+ * A sweep along x tests the pairs whose x and y ranges meet; more than budget segment tests, or an exact
+ * stage that overflowed: 0. */
 static int
-ct_polygons_simple(const double *P, const int32_t *succ, int64_t B, CtSweep *order, int64_t budget, CtStats *st)
+ct_polygons_simple(const double *P, const int32_t *succ, const int32_t *edges, int64_t B, CtSweep *order,
+                   int64_t budget, CtStats *st)
 {
     for (int64_t i = 0; i < B; i++) {
         const double *a = P + 2 * i, *b = P + 2 * (size_t)succ[i];
@@ -5803,7 +5806,16 @@ ct_polygons_simple(const double *P, const int32_t *succ, int64_t B, CtSweep *ord
                 meet = ct_segments_fold(c, d, b, st);
             }
             else {
-                meet = ct_segments_meet(a, b, c, d, st);
+                int32_t ti = edges[2 * i], hi = edges[2 * i + 1], tj = edges[2 * j], hj = edges[2 * j + 1];
+                int shared = (ti == tj) + (ti == hj) + (hi == tj) + (hi == hj);
+                if (shared == 1) {                         /* one vertex w by index: they meet beyond it iff */
+                    const double *w = ti == tj || ti == hj ? a : b;       /* they overlap along one line */
+                    const double *x = w == a ? b : a, *y = tj == ti || tj == hi ? d : c;
+                    meet = ct_segments_fold(x, w, y, st);
+                }
+                else {
+                    meet = shared != 0 || ct_segments_meet(a, b, c, d, st);
+                }
             }
             if (meet || st->failed) return 0;
         }
@@ -5831,16 +5843,81 @@ ct_point_inside(const double *q, const double *P, const int32_t *succ, int32_t f
 }
 
 #define CT_PATCH_CYCLES 8       /* boundary cycles of a patch, at most */
+#define CT_PINCH_MAX 4          /* boundary passes through one vertex, at most */
 
-/* 1 when the chain edges[0 .. B-1] (directed pairs) is a union of cycles through distinct vertices whose
- * projections along some axis of amask (with every face's orientation there) are simple, pairwise disjoint
- * polygons none inside another (so their winding numbers add up to 0 or +-1 everywhere); 0 otherwise (or out
- * of memory, pb->oom set). */
+/* Exact angular order about w (2-d) of the directions x - w and y - w (both nonzero): -1 when x comes first
+ * counterclockwise from the +x axis (angles in [0, 2 pi)), 1 when y does, 0 when they point the same way. */
+static int
+ct_angle_cmp(const double *w, const double *x, const double *y, CtStats *st)
+{
+    int hx = x[1] > w[1] || (x[1] == w[1] && x[0] > w[0]) ? 0 : 1;      /* upper half-plane (angle < pi) */
+    int hy = y[1] > w[1] || (y[1] == w[1] && y[0] > w[0]) ? 0 : 1;
+    if (hx != hy) return hx < hy ? -1 : 1;
+    int o = ct_orient2d(w, x, y, st);                      /* within one half-plane: counterclockwise first */
+    return o > 0 ? -1 : o < 0 ? 1 : 0;
+}
+
+/* Resolves one pinch vertex w (2-d) of a boundary chain, left by the k >= 2 edges outs[] toward the points
+ * head[] and entered by the k edges ins[] from the points tail[]: the 2k directions about w sorted exactly
+ * must alternate between leaving and entering, no two the same way; then each entering edge is followed
+ * (succ) by the leaving edge next to it clockwise for s > 0 (counterclockwise for s < 0), so the cycles
+ * resolved there pass w in disjoint sectors each bounded by two adjacent directions: they touch at w without
+ * crossing.  0 when not so. */
+static int
+ct_pinch_resolve(const double *w, const int32_t *outs, const double (*head)[2], const int32_t *ins,
+                 const double (*tail)[2], int k, int s, int32_t *succ, CtStats *st)
+{
+    int32_t dir[2 * CT_PINCH_MAX];              /* a leaving edge e as e, an entering one as -1 - e */
+    const double *pt[2 * CT_PINCH_MAX];
+    for (int i = 0; i < k; i++) {
+        dir[2 * i] = outs[i];
+        pt[2 * i] = head[i];
+        dir[2 * i + 1] = -1 - ins[i];
+        pt[2 * i + 1] = tail[i];
+    }
+    for (int i = 0; i < 2 * k; i++) {
+        if (pt[i][0] == w[0] && pt[i][1] == w[1]) return 0;      /* no direction */
+    }
+    for (int i = 1; i < 2 * k; i++) {                  /* insertion sort by exact angle */
+        int32_t d = dir[i];
+        const double *q = pt[i];
+        int j = i;
+        while (j > 0) {
+            int c = ct_angle_cmp(w, pt[j - 1], q, st);
+            if (c == 0) return 0;                          /* two edges along one ray: overlapping */
+            if (c < 0) break;
+            dir[j] = dir[j - 1];
+            pt[j] = pt[j - 1];
+            j--;
+        }
+        dir[j] = d;
+        pt[j] = q;
+    }
+    if (st->failed) return 0;
+    for (int i = 0; i < 2 * k; i++) {
+        if ((dir[i] >= 0) == (dir[(i + 1) % (2 * k)] >= 0)) return 0;       /* not alternating */
+    }
+    for (int i = 0; i < 2 * k; i++) {
+        if (dir[i] >= 0) continue;
+        int j = s > 0 ? (i + 2 * k - 1) % (2 * k) : (i + 1) % (2 * k);
+        succ[-1 - dir[i]] = dir[j];
+    }
+    return 1;
+}
+
+/* 1 when the chain edges[0 .. B-1] (directed pairs of vertex ids) is, along some axis of amask (every face's
+ * projection of one strict orientation s there), a union of at most CT_PATCH_CYCLES cycles whose projections
+ * are simple polygons, pairwise meeting only at common vertices, none inside another: a vertex the chain
+ * leaves k = 2 .. CT_PINCH_MAX times (a pinch) has its passes resolved by ct_pinch_resolve into cycles that
+ * touch there without crossing, each through it once; then no polygon's boundary crosses another's, and one
+ * vertex of each (one the chain leaves once, so on no other polygon) outside every other proves their
+ * interiors disjoint, so their winding numbers add up to 0 or +-1 everywhere.  0 otherwise (or out of memory,
+ * pb->oom set). */
 static int
 ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_t B, unsigned amask)
 {
     if (B < 3 || amask == 0) return 0;
-    /* the outgoing edge of each tail: the table again, keyed by the tail */
+    /* the edges leaving each tail: the table keyed by the tail holds the last listed, nxt chains the others */
     pb->cur++;
     if (pb->cur == 0) {
         memset(pb->stamp, 0, (size_t)pb->tsize * sizeof(uint32_t));
@@ -5848,9 +5925,25 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
     }
     int64_t mask = 15;
     while (mask + 1 < 4 * B && mask + 1 < pb->tsize) mask = 2 * mask + 1;
+    int32_t *succ = (int32_t *)malloc((size_t)B * sizeof(int32_t));
+    int32_t *nxt = (int32_t *)malloc((size_t)B * sizeof(int32_t));
+    int32_t *cyc = (int32_t *)malloc((size_t)B * sizeof(int32_t));
+    int32_t *pin = (int32_t *)malloc((size_t)B * sizeof(int32_t));      /* edges entering a pinch */
+    int32_t *pin_out = (int32_t *)malloc((size_t)B * sizeof(int32_t));  /* the first edge leaving it */
+    uint8_t *twice = (uint8_t *)calloc((size_t)B, 1);                    /* the tail is a pinch */
+    double *P = (double *)malloc((size_t)B * 2 * sizeof(double));
+    CtSweep *order = (CtSweep *)malloc((size_t)B * sizeof(CtSweep));
+    int ok = 0;
+    int64_t n_pin = 0;
+    if (succ == NULL || nxt == NULL || cyc == NULL || pin == NULL || pin_out == NULL || twice == NULL || P == NULL
+        || order == NULL) {
+        pb->oom = 1;
+        goto done;
+    }
     for (int64_t e = 0; e < B; e++) {
         uint64_t k = (uint32_t)edges[2 * e];
         int64_t s = (int64_t)(ct_edge_hash(k) & (uint64_t)mask);
+        nxt[e] = -1;
         for (int64_t probe = 0; probe <= mask; probe++) {
             if (pb->stamp[s] != pb->cur) {
                 pb->stamp[s] = pb->cur;
@@ -5858,19 +5951,15 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
                 pb->net[s] = (int32_t)e;
                 break;
             }
-            if (pb->key[s] == k) return 0;                 /* a vertex leaving twice: not simple cycles */
+            if (pb->key[s] == k) {                         /* a vertex left twice or more: a pinch */
+                nxt[e] = pb->net[s];
+                pb->net[s] = (int32_t)e;
+                twice[e] = 1;
+                twice[nxt[e]] = 1;
+                break;
+            }
             s = (s + 1) & mask;
         }
-    }
-    int32_t *succ = (int32_t *)malloc((size_t)B * sizeof(int32_t));
-    double *P = (double *)malloc((size_t)B * 2 * sizeof(double));
-    CtSweep *order = (CtSweep *)malloc((size_t)B * sizeof(CtSweep));
-    int ok = 0;
-    int32_t first[CT_PATCH_CYCLES];
-    int n_cycles = 0;
-    if (succ == NULL || P == NULL || order == NULL) {
-        pb->oom = 1;
-        goto done;
     }
     for (int64_t e = 0; e < B; e++) {                      /* succ[e]: the edge leaving e's head */
         uint64_t k = (uint32_t)edges[2 * e + 1];
@@ -5885,41 +5974,116 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
             s = (s + 1) & mask;
         }
         if (succ[e] < 0) goto done;                        /* an open chain */
+        if (twice[succ[e]]) pin[n_pin++] = (int32_t)e;     /* entering a pinch: resolved per axis */
     }
-    /* every edge on one cycle: B edges, each the successor of exactly one (distinct tails, and the walks
-     * from unvisited edges close) */
-    for (int64_t e = 0; e < B; e++) order[e].i = 0;        /* visited marks */
-    for (int64_t e = 0; e < B; e++) {
-        if (order[e].i) continue;
-        if (n_cycles == CT_PATCH_CYCLES) goto done;
-        first[n_cycles++] = (int32_t)e;
-        int64_t x = e, steps = 0;
-        do {
-            if (order[x].i) goto done;                     /* joins a cycle already walked: not disjoint */
-            order[x].i = 1;
-            x = succ[x];
-            steps++;
-        } while (x != e && steps <= B);
-        if (x != e) goto done;
+    for (int64_t i = 1; i < n_pin; i++) {                  /* the edges entering pinches, by head vertex */
+        int32_t x = pin[i];
+        int64_t j = i;
+        while (j > 0 && edges[2 * pin[j - 1] + 1] > edges[2 * x + 1]) {
+            pin[j] = pin[j - 1];
+            j--;
+        }
+        pin[j] = x;
     }
+    for (int64_t i = 0; i < n_pin; i++) pin_out[i] = succ[pin[i]];
     for (int axis = 0; axis < 3 && !ok; axis++) {
-        if (!((amask >> (2 * axis)) & 3u)) continue;
+        unsigned bits = (amask >> (2 * axis)) & 3u;
+        if (bits != 1u && bits != 2u) continue;
+        int sgn = bits == 1u ? 1 : -1;
         int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
+        CtStats st = {0, 0};
         for (int64_t i = 0; i < B; i++) {                  /* point i: the tail of edge i */
             P[2 * i] = V[3 * (size_t)edges[2 * i] + kx];
             P[2 * i + 1] = V[3 * (size_t)edges[2 * i] + ky];
         }
-        CtStats st = {0, 0};
-        ok = ct_polygons_simple(P, succ, B, order, 64 * B + 4096, &st);
-        for (int c = 0; c < n_cycles && ok; c++) {         /* disjoint, so none inside another */
-            for (int d = 0; d < n_cycles && ok; d++) {
-                if (d != c && ct_point_inside(P + 2 * (size_t)first[c], P, succ, first[d], B, &st)) ok = 0;
+        int good = 1;
+        for (int64_t i = 0; i < n_pin && good;) {          /* each pinch: its k entering and k leaving edges */
+            int64_t j = i;
+            while (j < n_pin && edges[2 * pin[j] + 1] == edges[2 * pin[i] + 1]) j++;
+            int32_t outs[CT_PINCH_MAX] = {0}, ins[CT_PINCH_MAX] = {0};
+            double head[CT_PINCH_MAX][2], tail[CT_PINCH_MAX][2];
+            int k = 0;
+            for (int32_t x = pin_out[i]; x >= 0; x = nxt[x]) {
+                if (k == CT_PINCH_MAX) {
+                    k = -1;
+                    break;
+                }
+                outs[k] = x;
+                head[k][0] = V[3 * (size_t)edges[2 * x + 1] + kx];
+                head[k][1] = V[3 * (size_t)edges[2 * x + 1] + ky];
+                k++;
+            }
+            if (k < 2 || k != j - i) {
+                good = 0;
+                break;
+            }
+            for (int64_t x = i; x < j; x++) {
+                ins[x - i] = pin[x];
+                tail[x - i][0] = P[2 * (size_t)pin[x]];
+                tail[x - i][1] = P[2 * (size_t)pin[x] + 1];
+            }
+            good = ct_pinch_resolve(P + 2 * (size_t)outs[0], outs, (const double (*)[2])head, ins,
+                                    (const double (*)[2])tail, k, sgn, succ, &st);
+            i = j;
+        }
+        if (!good || st.failed) continue;
+        /* every edge on one cycle (succ a permutation), at most CT_PATCH_CYCLES of them */
+        int32_t first[CT_PATCH_CYCLES];
+        int n_cycles = 0;
+        for (int64_t e = 0; e < B; e++) cyc[e] = -1;
+        for (int64_t e = 0; e < B && good; e++) {
+            if (cyc[e] >= 0) continue;
+            if (n_cycles == CT_PATCH_CYCLES) {
+                good = 0;
+                break;
+            }
+            first[n_cycles] = (int32_t)e;
+            int64_t x = e, steps = 0;
+            do {
+                if (cyc[x] >= 0) {                         /* joins a cycle already walked: not disjoint */
+                    good = 0;
+                    break;
+                }
+                cyc[x] = n_cycles;
+                x = succ[x];
+                steps++;
+            } while (x != e && steps <= B);
+            if (good && x != e) good = 0;
+            n_cycles++;
+        }
+        for (int64_t i = 0; i < n_pin && good; i++) {      /* each cycle through a pinch once */
+            for (int32_t x = pin_out[i]; x >= 0 && good; x = nxt[x]) {
+                for (int32_t y = nxt[x]; y >= 0 && good; y = nxt[y]) {
+                    if (cyc[x] == cyc[y]) good = 0;
+                }
             }
         }
-        if (st.failed) ok = 0;
+        if (!good) continue;
+        int ax = ct_polygons_simple(P, succ, edges, B, order, 64 * B + 4096, &st);
+        for (int c = 0; c < n_cycles && ax && n_cycles > 1; c++) {        /* none inside another */
+            int64_t q = first[c], steps = 0;
+            while (twice[q] && steps < B) {                /* a vertex of c on no other cycle */
+                q = succ[q];
+                steps++;
+            }
+            if (twice[q]) {
+                ax = 0;
+                break;
+            }
+            for (int d = 0; d < n_cycles && ax; d++) {
+                if (d != c && ct_point_inside(P + 2 * (size_t)q, P, succ, first[d], B, &st)) ax = 0;
+            }
+        }
+        if (st.failed) ax = 0;
+        ok = ax;
     }
 done:
     free(succ);
+    free(nxt);
+    free(cyc);
+    free(pin);
+    free(pin_out);
+    free(twice);
     free(P);
     free(order);
     return ok;
