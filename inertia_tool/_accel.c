@@ -5860,12 +5860,13 @@ ct_angle_cmp(const double *w, const double *x, const double *y, CtStats *st)
 /* Resolves one pinch vertex w (2-d) of a boundary chain, left by the k >= 2 edges outs[] toward the points
  * head[] and entered by the k edges ins[] from the points tail[]: the 2k directions about w sorted exactly
  * must alternate between leaving and entering, no two the same way; then each entering edge is followed
- * (succ) by the leaving edge next to it clockwise for s > 0 (counterclockwise for s < 0), so the cycles
- * resolved there pass w in disjoint sectors each bounded by two adjacent directions: they touch at w without
- * crossing.  0 when not so. */
+ * (succ) by the leaving edge next to it on one side, clockwise when side > 0 (across the sectors the faces
+ * cover, for s > 0: lobes touching at w), counterclockwise when side < 0 (across the others: a region touching
+ * itself round a hole), so the cycles resolved there pass w in disjoint sectors each bounded by two adjacent
+ * directions: they touch at w without crossing, whichever side.  0 when not so. */
 static int
 ct_pinch_resolve(const double *w, const int32_t *outs, const double (*head)[2], const int32_t *ins,
-                 const double (*tail)[2], int k, int s, int32_t *succ, CtStats *st)
+                 const double (*tail)[2], int k, int side, int32_t *succ, CtStats *st)
 {
     int32_t dir[2 * CT_PINCH_MAX];              /* a leaving edge e as e, an entering one as -1 - e */
     const double *pt[2 * CT_PINCH_MAX];
@@ -5899,7 +5900,7 @@ ct_pinch_resolve(const double *w, const int32_t *outs, const double (*head)[2], 
     }
     for (int i = 0; i < 2 * k; i++) {
         if (dir[i] >= 0) continue;
-        int j = s > 0 ? (i + 2 * k - 1) % (2 * k) : (i + 1) % (2 * k);
+        int j = side > 0 ? (i + 2 * k - 1) % (2 * k) : (i + 1) % (2 * k);
         succ[-1 - dir[i]] = dir[j];
     }
     return 1;
@@ -5909,9 +5910,11 @@ ct_pinch_resolve(const double *w, const int32_t *outs, const double (*head)[2], 
  * projection of one strict orientation s there), a union of at most CT_PATCH_CYCLES cycles whose projections
  * are simple polygons, pairwise meeting only at common vertices, none inside another: a vertex the chain
  * leaves k = 2 .. CT_PINCH_MAX times (a pinch) has its passes resolved by ct_pinch_resolve into cycles that
- * touch there without crossing, each through it once; then no polygon's boundary crosses another's, and one
- * vertex of each (one the chain leaves once, so on no other polygon) outside every other proves their
- * interiors disjoint, so their winding numbers add up to 0 or +-1 everywhere.  0 otherwise (or out of memory,
+ * touch there without crossing, each through it once; then no polygon's boundary crosses another's, so any
+ * two are apart or one holds the other, which one vertex of each (one the chain leaves once, so on no other
+ * polygon) tested against every other tells: the polygons holding a point are nested, and when each
+ * polygon's orientation is s under an even number of others and -s under an odd one (an outline, a hole, an
+ * island in the hole ...) their winding numbers add up to 0 or s everywhere.  0 otherwise (or out of memory,
  * pb->oom set). */
 static int
 ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_t B, unsigned amask)
@@ -5986,9 +5989,13 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
         pin[j] = x;
     }
     for (int64_t i = 0; i < n_pin; i++) pin_out[i] = succ[pin[i]];
-    for (int axis = 0; axis < 3 && !ok; axis++) {
+    for (int attempt = 0; attempt < 6 && !ok; attempt++) {
+        /* each axis of amask, with the pinches resolved across the faces' sectors, then (when there are
+         * pinches) across the others */
+        int axis = attempt >> 1, mode = attempt & 1;
         unsigned bits = (amask >> (2 * axis)) & 3u;
         if (bits != 1u && bits != 2u) continue;
+        if (mode == 1 && n_pin == 0) continue;
         int sgn = bits == 1u ? 1 : -1;
         int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
         CtStats st = {0, 0};
@@ -6023,7 +6030,7 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
                 tail[x - i][1] = P[2 * (size_t)pin[x] + 1];
             }
             good = ct_pinch_resolve(P + 2 * (size_t)outs[0], outs, (const double (*)[2])head, ins,
-                                    (const double (*)[2])tail, k, sgn, succ, &st);
+                                    (const double (*)[2])tail, k, mode == 0 ? sgn : -sgn, succ, &st);
             i = j;
         }
         if (!good || st.failed) continue;
@@ -6060,7 +6067,10 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
         }
         if (!good) continue;
         int ax = ct_polygons_simple(P, succ, edges, B, order, 64 * B + 4096, &st);
-        for (int c = 0; c < n_cycles && ax && n_cycles > 1; c++) {        /* none inside another */
+        for (int c = 0; c < n_cycles && ax && n_cycles > 1; c++) {
+            /* c's depth (the cycles holding it, tested at a vertex of c on no other) and orientation (the
+             * turn at its lowest-leftmost vertex, strict for a simple polygon) must alternate s, -s, ...
+             * from the outermost in: then the winding numbers add up to 0 or s everywhere */
             int64_t q = first[c], steps = 0;
             while (twice[q] && steps < B) {                /* a vertex of c on no other cycle */
                 q = succ[q];
@@ -6070,9 +6080,31 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
                 ax = 0;
                 break;
             }
-            for (int d = 0; d < n_cycles && ax; d++) {
-                if (d != c && ct_point_inside(P + 2 * (size_t)q, P, succ, first[d], B, &st)) ax = 0;
+            int depth = 0;
+            for (int d = 0; d < n_cycles; d++) {
+                if (d != c && ct_point_inside(P + 2 * (size_t)q, P, succ, first[d], B, &st)) depth++;
             }
+            int64_t low = first[c], prev = -1, x = first[c];
+            steps = 0;
+            do {                                           /* the lowest-leftmost vertex and the edge into it */
+                int64_t y = succ[x];
+                const double *py = P + 2 * (size_t)y, *pl = P + 2 * (size_t)low;
+                if (py[0] < pl[0] || (py[0] == pl[0] && py[1] < pl[1])) {
+                    low = y;
+                    prev = x;
+                }
+                x = y;
+                steps++;
+            } while (x != first[c] && steps <= B);
+            if (prev < 0) {                                /* first[c] itself: the edge into it */
+                prev = first[c];
+                while (succ[prev] != first[c] && steps <= 2 * B) {
+                    prev = succ[prev];
+                    steps++;
+                }
+            }
+            int turn = ct_orient2d(P + 2 * (size_t)prev, P + 2 * (size_t)low, P + 2 * (size_t)succ[low], &st);
+            if (turn == 0 || turn != ((depth & 1) ? -sgn : sgn)) ax = 0;
         }
         if (st.failed) ax = 0;
         ok = ax;

@@ -1,18 +1,22 @@
-"""mesh/intersect.py, certified patches whose boundary passes through one vertex more than once (a *pinch*).
+"""mesh/intersect.py, certified patches whose boundary passes through one vertex more than once (a *pinch*) or has
+holes.
 
 A node of the C scan's hierarchy is a range of faces in Morton order, which often touches itself at a corner:
-its boundary chain then leaves and enters one vertex two to four times.  The C scan resolves such a vertex
-(the directions of its boundary edges about it, in exact angular order, must alternate between leaving and
-entering; each entering edge is followed by the leaving edge beside it) into cycles that touch there without
-crossing, and certifies the node only if those cycles project to simple polygons that meet only at such
-vertices and lie none inside another (module docstring of ``mesh/intersect.py``, "Patches").
+its boundary chain then leaves and enters one vertex two to four times. The C scan resolves such a vertex (the
+directions of its boundary edges about it, in exact angular order, must alternate between leaving and entering;
+each entering edge is followed by the leaving edge beside it) into cycles that touch there without crossing, and
+certifies the node only if those cycles project to simple polygons that meet only at such vertices, nested only
+as outline, hole, island in the hole ..., their orientations alternating from the outermost in (module docstring
+of ``mesh/intersect.py``, "Patches").
 
-The meshes here are made to defeat that rule: fans of one to three triangles round one shared vertex, in
-sectors that are disjoint, touch along a ray, overlap, nest or fold back, lifted by lattice steps or by one unit
-in the last place (near-coplanar sheets), some dipping through another fan right next to the shared vertex,
-some with a ring point repeated by coordinates under another index.  Each mesh has at most 16 faces, so the
-whole of it is one leaf of the hierarchy, the first node tried as a patch.  Every verdict is compared pair for
-pair with the scan without patches, the numpy twin and the independent rational classifier
+The meshes here are made to defeat that rule: fans of one to three triangles round one shared vertex, in sectors
+that are disjoint, touch along a ray, overlap, nest or fold back, lifted by lattice steps or by one unit in the
+last place (near-coplanar sheets), some dipping through another fan right next to the shared vertex, some with a
+ring point repeated by coordinates under another index; square rings (a patch with a hole) with an island in or
+across the hole, and squares stacked on squares facing the same way (nested outlines of one orientation: the
+projection covers the inner square twice) a lattice step, one ulp or nothing apart. Each mesh has at most 16
+faces, so the whole of it is one leaf of the hierarchy, the first node tried as a patch. Every verdict is
+compared pair for pair with the scan without patches, the numpy twin and the independent rational classifier
 (``intersect_reference.brute_kind``).
 """
 
@@ -156,3 +160,68 @@ def test_icosphere_pinched_nodes_keep_every_pair(seed):
     rng = np.random.default_rng(seed)
     v2, f2 = _push(v * 8, f, rng, 3)
     _check(v2, f2)
+
+
+def _square(half, z, lo=0.0):
+    """Corners (ccw seen from +z) of the square [lo - half, lo + half]^2 at heights z (one per corner)."""
+    return [(lo - half, lo - half, z[0]), (lo + half, lo - half, z[1]), (lo + half, lo + half, z[2]),
+            (lo - half, lo + half, z[3])]
+
+
+def _ring(outer, inner):
+    """Faces of the square ring between the corner lists ``outer`` and ``inner`` (vertices 0-3 and 4-7), facing
+    +z: the boundary is the outer square counterclockwise and the inner one clockwise (a hole)."""
+    return [f for k in range(4) for f in ([k, (k + 1) % 4, 4 + (k + 1) % 4], [k, 4 + (k + 1) % 4, 4 + k])]
+
+
+@st.composite
+def rings_and_stacks(draw):
+    """A square ring (outer half-size 6, inner 2..4; heights per corner) with, maybe, an island square (two
+    faces, facing up or down) of half-size 1..3 anywhere near the hole at any height; or a square with a smaller
+    square facing the same way inside its projection, a lattice step, one ulp or nothing above."""
+    heights = st.sampled_from(HEIGHTS)
+    if draw(st.booleans()):
+        outer = _square(6.0, [draw(heights) for _ in range(4)])
+        inner = _square(float(draw(st.integers(2, 4))), [draw(heights) for _ in range(4)])
+        v = outer + inner
+        f = _ring(outer, inner)
+        if draw(st.booleans()):
+            island = _square(float(draw(st.integers(1, 3))), [draw(heights)] * 4, lo=float(draw(st.integers(-3, 3))))
+            f += [[8, 9, 10], [8, 10, 11]] if draw(st.integers(0, 3)) else [[8, 10, 9], [8, 11, 10]]
+            v += island
+    else:
+        z = draw(heights)
+        v = _square(6.0, [1.0] * 4) + _square(float(draw(st.integers(1, 5))), [z] * 4,
+                                              lo=float(draw(st.integers(-1, 1))))
+        f = [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]
+    return np.array(v, dtype=float), np.array(f, dtype=np.int64)
+
+
+@pytest.mark.slow
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(rings_and_stacks())
+def test_rings_and_stacks_match_brute_force(mesh):
+    v, f = mesh
+    fast, unpatched = _check(v, f, brute=True)
+    event("certified" if fast.candidate_pairs < unpatched.candidate_pairs else "not certified")
+
+
+def test_square_ring_with_an_island_is_one_patch():
+    """A ring with an island in its hole, both facing up: outline, hole and island alternate in orientation,
+    so the projection is one to one and no pair is tested."""
+    outer, inner = _square(6.0, [1.0, 2.0, 1.0, 0.0]), _square(3.0, [1.0, ULP, 1.0, 2.0])
+    v = np.array(outer + inner + _square(1.0, [5.0] * 4), dtype=float)
+    f = np.array(_ring(outer, inner) + [[8, 9, 10], [8, 10, 11]])
+    fast, unpatched = _check(v, f, brute=True)
+    assert fast.candidate_pairs == 0 < unpatched.candidate_pairs
+
+
+@pytest.mark.parametrize("z, meets", [(3.0, False), (ULP, False), (1.0, True)])
+def test_square_stacked_on_a_square_is_not_certified(z, meets):
+    """A smaller square above a larger one, both facing up: their outlines are disjoint and nested, but of one
+    orientation, so the inner square is covered twice and the pair is tested (and found when coplanar)."""
+    v = np.array(_square(6.0, [1.0] * 4) + _square(2.0, [z] * 4), dtype=float)
+    f = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    fast, unpatched = _check(v, f, brute=True)
+    assert fast.candidate_pairs == unpatched.candidate_pairs
+    assert (_found(fast) > 0) == meets
