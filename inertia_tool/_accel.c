@@ -4223,13 +4223,17 @@ done:
  * clean mesh that is nearly every candidate pair: the faces sharing a corner).  With patches (and no work
  * bound) a node whose faces form a certified patch (ct_patches; mesh/intersect.py, "Patches") is not descended
  * with itself: on a smooth surface that leaves out nearly every pair of faces sharing a corner, and the
- * counts fall below the numpy path's.
+ * counts fall below the numpy path's.  Then the patches come first (the faces across each edge, the
+ * hierarchy, the patches) and only the stars of vertices whose faces are not all in one certified patch are
+ * certified (the others would decide no pair), the node apexes last.
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
 
 /* Stage timing of contact_scan for profiling: with INERTIA_TOOL_CT_PROFILE set in the environment each call
- * prints the CPU time (all threads) of its stages (preparation, sort, stars, build, traversal) to stderr. */
+ * prints the CPU time (all threads) of its stages (Morton codes, sort, preparation, then with patches the
+ * vertices' face lists, the faces across each edge, the hierarchy, the patches, the star certificates, the
+ * apexes and per-face star bits; else the stars and the hierarchy together; the traversal) to stderr. */
 #if defined(__linux__) || defined(__APPLE__)
 #include <time.h>
 static double
@@ -5583,14 +5587,17 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
  * Certified patches (mesh/intersect.py, "Patches").  A node of the hierarchy whose faces K satisfy
  *   (a) along some coordinate axis every face projects to a triangle of one strict orientation s (exact
  *       orient2d of its corners in winding order), and
- *   (b) the boundary chain of K (its directed edges, u -> v cancelling v -> u) is a union of cycles through
- *       distinct vertices whose projections along that axis are simple, pairwise disjoint polygons none inside
- *       another (exact orient2d),
+ *   (b) the boundary chain of K (its directed edges, u -> v cancelling v -> u) is a union of cycles whose
+ *       projections along that axis are simple polygons meeting only at common vertices without crossing
+ *       there, nested only as outline, hole, island ... with orientations s, -s, s ... from the outermost in
+ *       (a vertex the chain passes 2 .. 4 times resolved into cycles touching there: ct_pinch_resolve; exact
+ *       orient2d throughout),
  * has no two faces meeting beyond what they share by index, so the descent of the node with itself is left
  * out.  Proof (the degree argument behind the normal-cone and contour test of self-collision culling): at a
  * point y of the plane off every projected edge, the number of faces whose projection holds y, times s, is the
- * winding number of the projected boundary chain round y (the faces' boundaries sum to the chain), which for
- * disjoint simple polygons none inside another is 0 or +-1: the projected faces have disjoint interiors.
+ * winding number of the projected boundary chain round y (the faces' boundaries sum to the chain), the sum of
+ * the resolved cycles' winding numbers, which for such polygons (the ones holding y nested, alternating in
+ * orientation) is 0 or s: the projected faces have disjoint interiors.
  * Then every point of K off the chain has a neighbourhood that projects one to one (the faces round it cover
  * a disk once), so two
  * distinct points of K with one projection both lie on the chain, whose projection is one to one: the
