@@ -4697,37 +4697,6 @@ ct_face_normal(CtFace *F)
     F->na[2] = fabs(e1[0]) * fabs(e2[1]) + fabs(e1[1]) * fabs(e2[0]);
 }
 
-/* The projection axis of the face p0, p1, p2 and *skip (1: zero area): the axis of the largest |normal
- * component| of the float normal (the first of equals), then the next ones until the projected triangle has an
- * exactly nonzero orientation (as mesh/intersect._face_axes). */
-static inline int
-ct_face_axis(const double *p0, const double *p1, const double *p2, int *skip, CtStats *st)
-{
-    double e1[3], e2[3], n[3];
-    for (int c = 0; c < 3; c++) {
-        e1[c] = p1[c] - p0[c];
-        e2[c] = p2[c] - p0[c];
-    }
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];         /* the arithmetic of ct_face_normal */
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    int k = 0;
-    for (int c = 1; c < 3; c++) {
-        if (fabs(n[c]) > fabs(n[k])) k = c;
-    }
-    *skip = 1;
-    for (int tries = 0; tries < 3; tries++, k = (k + 1) % 3) {
-        double a[2] = {p0[ct_plane[k][0]], p0[ct_plane[k][1]]};
-        double b[2] = {p1[ct_plane[k][0]], p1[ct_plane[k][1]]};
-        double c[2] = {p2[ct_plane[k][0]], p2[ct_plane[k][1]]};
-        if (ct_orient2d(a, b, c, st) != 0) {
-            *skip = 0;
-            break;
-        }
-    }
-    return k % 3;
-}
-
 /* Kind of the pair of faces A, B (A the lower face index); computes their normals when a side test needs them. */
 static int
 ct_classify(CtFace *A, CtFace *B, CtStats *st)
@@ -5701,7 +5670,32 @@ ct_twin_task(void *ctx, int t, int nt)
             lk[i].face = f;
             lk[i].corner = c;
         }
-        if (ok && k <= 64) {
+        int32_t first[64];
+        uint64_t hit = 0;
+        int all = ok && k <= 64;
+        for (int64_t i = 0; i < k && all; i++) {
+            /* the common case, a closed fan consistently oriented round v: each face's first other face whose
+             * corner before v is its corner after v, all distinct (and no face whose corners after and before v
+             * are one vertex).  Then every face has exactly one such face and no other face has its corner
+             * after v (two faces with one next, or two with one prev, would make two first matches equal),
+             * i.e. what the general count below would find */
+            if (lk[i].next == lk[i].prev) {
+                all = 0;
+                break;
+            }
+            int64_t j = 0;
+            while (j < k && (j == i || lk[j].prev != lk[i].next)) j++;
+            if (j == k || (hit >> j) & 1u) {
+                all = 0;
+                break;
+            }
+            hit |= (uint64_t)1 << j;
+            first[i] = (int32_t)j;
+        }
+        if (all) {
+            for (int64_t i = 0; i < k; i++) ct_twin_put(jb, lk[i].face, lk[i].corner, lk[first[i]].face);
+        }
+        else if (ok && k <= 64) {
             for (int64_t i = 0; i < k; i++) {
                 int32_t back = -1, twin = -1, same = 0;
                 for (int64_t j = 0; j < k; j++) {
@@ -6310,7 +6304,7 @@ typedef struct {
 } CtScan;
 
 /* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
- * (the arithmetic of ct_face_normal, when first needed), its corner indices, and the axis and zero-area flag ct_face_axis
+ * (the arithmetic of ct_face_normal, when first needed), its corner indices, and the axis and zero-area flag ct_prep_task
  * gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
  * when a box meets its (16 + 1 bytes per face instead). */
 static inline void
@@ -6675,14 +6669,52 @@ ct_prep_task(void *ctx, int t, int nt)
     CtPrep *pr = (CtPrep *)ctx;
     int64_t s = (int64_t)part_start((size_t)pr->m, t, nt), e = (int64_t)part_start((size_t)pr->m, t + 1, nt);
     CtStats st = {0, 0};
+    if (pr->pass == 2) {                       /* axis[f] held axis | orientations << 2: unpacked */
+        for (int64_t f = s; f < e; f++) {
+            pr->skip[f] = (uint8_t)((uint8_t)pr->axis[f] >> 2 == 0);
+            pr->axis[f] = (int8_t)(pr->axis[f] & 3);
+        }
+        return;
+    }
     if (pr->pass == 0) {
         for (int64_t f = s; f < e; f++) {
             const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
             const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
             const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
-            int skip;
-            pr->axis[f] = (int8_t)ct_face_axis(p0, p1, p2, &skip, &st);
-            pr->skip[f] = (uint8_t)skip;
+            /* the exact orientation of the face's projection along each axis, orient2d(p1, p2, p0) (the sign
+             * of orient2d(p0, p1, p2)): each filter's value is the float normal's component, n = e1 x e2 with
+             * e1 = p1 - p0, e2 = p2 - p0 (the arithmetic of ct_face_normal); then the projection axis (the
+             * largest |n| component, the first of equals, then the next ones until the orientation is nonzero;
+             * as mesh/intersect._face_axes) and zero area when all three are zero.  axis[f] <- axis |
+             * orientations << 2 (pass 2 unpacks it). */
+            double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+            double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+            double n[3];
+            unsigned fm = 0;
+            for (int a = 0; a < 3; a++) {
+                int kx = ct_plane[a][0], ky = ct_plane[a][1];
+                double left = e1[kx] * e2[ky], right = e1[ky] * e2[kx];
+                double det = left - right, perm = fabs(left) + fabs(right);
+                int o;
+                n[a] = det;
+                if (perm == 0.0) {
+                    o = 0;
+                }
+                else if (fabs(det) > CONTACT_O2 * perm) {
+                    o = det > 0 ? 1 : -1;
+                }
+                else {
+                    double a2[2] = {p1[kx], p1[ky]}, b2[2] = {p2[kx], p2[ky]}, c2[2] = {p0[kx], p0[ky]};
+                    o = ct_orient2d_exact(a2, b2, c2, &st);
+                }
+                fm |= o > 0 ? 1u << (2 * a) : o < 0 ? 2u << (2 * a) : 0u;
+            }
+            int k = 0;
+            for (int c = 1; c < 3; c++) {
+                if (fabs(n[c]) > fabs(n[k])) k = c;
+            }
+            for (int tries = 0; tries < 3 && !((fm >> (2 * k)) & 3u); tries++) k = (k + 1) % 3;
+            pr->axis[f] = (int8_t)(uint8_t)((unsigned)k | fm << 2);
             uint64_t code = 0;
             for (int c = 0; c < 3; c++) {
                 double lo = ct_min3(p0[c], p1[c], p2[c]), hi = ct_max3(p0[c], p1[c], p2[c]);
@@ -6711,32 +6743,9 @@ ct_prep_task(void *ctx, int t, int nt)
         const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
         const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
         const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
-        pr->flags[i] = (uint8_t)(pr->axis[f] | pr->skip[f] << 2);
-        if (pr->fmask != NULL) {
-            /* orient2d(p1, p2, p0) along each axis (the sign of orient2d(p0, p1, p2)): its filter shares the
-             * differences e1 = p1 - p0, e2 = p2 - p0 between the axes */
-            unsigned fm = 0;
-            double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-            double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-            for (int a = 0; a < 3 && !pr->skip[f]; a++) {
-                int kx = ct_plane[a][0], ky = ct_plane[a][1];
-                double left = e1[kx] * e2[ky], right = e1[ky] * e2[kx];
-                double det = left - right, perm = fabs(left) + fabs(right);
-                int o;
-                if (perm == 0.0) {
-                    o = 0;
-                }
-                else if (fabs(det) > CONTACT_O2 * perm) {
-                    o = det > 0 ? 1 : -1;
-                }
-                else {
-                    double a2[2] = {p1[kx], p1[ky]}, b2[2] = {p2[kx], p2[ky]}, c2[2] = {p0[kx], p0[ky]};
-                    o = ct_orient2d_exact(a2, b2, c2, &st);
-                }
-                fm |= o > 0 ? 1u << (2 * a) : o < 0 ? 2u << (2 * a) : 0u;
-            }
-            pr->fmask[i] = (uint8_t)fm;
-        }
+        unsigned packed = (uint8_t)pr->axis[f];         /* axis | orientations << 2, from pass 0 */
+        pr->flags[i] = (uint8_t)((packed & 3u) | (packed >> 2 == 0) << 2);
+        if (pr->fmask != NULL) pr->fmask[i] = (uint8_t)(packed >> 2);
         for (int k = 0; k < 3; k++) {
             pr->ids[CT_IDBLOCK * (i / CT_LEAF) + k * CT_LEAF + i % CT_LEAF]
                 = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
@@ -6895,6 +6904,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
         else {
             clk[2] = ct_clock();
             pr.pass = 1;
+            run_parallel(nt, ct_prep_task, &pr);
+            pr.pass = 2;
             run_parallel(nt, ct_prep_task, &pr);
             clk[3] = ct_clock();
             for (int t = 0; t < MAX_THREADS; t++) {
