@@ -5845,6 +5845,7 @@ ct_point_inside(const double *q, const double *P, const int32_t *succ, int32_t f
 
 #define CT_PATCH_CYCLES 8       /* boundary cycles of a patch, at most */
 #define CT_PINCH_MAX 4          /* boundary passes through one vertex, at most */
+#define CT_PINCH_EDGES 256      /* boundary edges entering pinches, at most */
 
 /* Exact angular order about w (2-d) of the directions x - w and y - w (both nonzero): -1 when x comes first
  * counterclockwise from the +x axis (angles in [0, 2 pi)), 1 when y does, 0 when they point the same way. */
@@ -5980,6 +5981,7 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
         if (succ[e] < 0) goto done;                        /* an open chain */
         if (twice[succ[e]]) pin[n_pin++] = (int32_t)e;     /* entering a pinch: resolved per axis */
     }
+    if (n_pin > CT_PINCH_EDGES) goto done;                /* many pinches: not tried (the sort below is quadratic) */
     for (int64_t i = 1; i < n_pin; i++) {                  /* the edges entering pinches, by head vertex */
         int32_t x = pin[i];
         int64_t j = i;
@@ -6304,8 +6306,8 @@ typedef struct {
 } CtScan;
 
 /* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
- * (the arithmetic of ct_face_normal, when first needed), its corner indices, and the axis and zero-area flag ct_prep_task
- * gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
+ * (the arithmetic of ct_face_normal, when first needed), its corner indices, and the axis and zero-area flag
+ * ct_prep_task gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
  * when a box meets its (16 + 1 bytes per face instead). */
 static inline void
 ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
