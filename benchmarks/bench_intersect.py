@@ -69,7 +69,6 @@ def main(argv=None) -> None:
     import functools
 
     import inertia_tool
-    from inertia_tool.mesh import prepare
     from inertia_tool.mesh.intersect import surface_contacts
 
     if args.unpruned:
@@ -94,7 +93,15 @@ def main(argv=None) -> None:
             inertia_tool.mass_properties((v, f))
         return tuple(inside)
 
-    prepare.surface_contacts = timed                     # type: ignore[attr-defined]
+    # every module of the package that took the check by name (the stage modules of mesh/prepare.py and those
+    # importing it inside a function, through mesh/intersect.py itself) calls the timed one
+    import inertia_tool.mass.pipeline  # noqa: F401  (loads the stages the analysis runs)
+    from inertia_tool.mesh import intersect
+    original = intersect.surface_contacts
+    for module in list(sys.modules.values()):
+        if getattr(module, "__name__", "").startswith("inertia_tool.") \
+                and getattr(module, "surface_contacts", None) is original:
+            module.surface_contacts = timed              # type: ignore[attr-defined]
     print(f"{'faces':>10} | {'check cpu':>9} {'wall':>6} | {'analysis cpu':>12} {'wall':>6} | {'rest cpu':>8} "
           f"{'wall':>6} | {'ratio cpu':>9} {'wall':>5} | {'ns/face':>7} {'pairs/face':>10} {'exact':>6} found")
     for size in args.sizes:

@@ -4223,13 +4223,17 @@ done:
  * clean mesh that is nearly every candidate pair: the faces sharing a corner).  With patches (and no work
  * bound) a node whose faces form a certified patch (ct_patches; mesh/intersect.py, "Patches") is not descended
  * with itself: on a smooth surface that leaves out nearly every pair of faces sharing a corner, and the
- * counts fall below the numpy path's.
+ * counts fall below the numpy path's.  Then the patches come first (the faces across each edge, the
+ * hierarchy, the patches) and only the stars of vertices whose faces are not all in one certified patch are
+ * certified (the others would decide no pair), the node apexes last.
  * ====================================================================================================== */
 
 #define CONTACT_EXP_MAX 192
 
 /* Stage timing of contact_scan for profiling: with INERTIA_TOOL_CT_PROFILE set in the environment each call
- * prints the CPU time (all threads) of its stages (preparation, sort, stars, build, traversal) to stderr. */
+ * prints the CPU time (all threads) of its stages (Morton codes, sort, preparation, then with patches the
+ * vertices' face lists, the faces across each edge, the hierarchy, the patches, the star certificates, the
+ * apexes and per-face star bits; else the stars and the hierarchy together; the traversal) to stderr. */
 #if defined(__linux__) || defined(__APPLE__)
 #include <time.h>
 static double
@@ -4691,37 +4695,6 @@ ct_face_normal(CtFace *F)
     F->na[0] = fabs(e1[1]) * fabs(e2[2]) + fabs(e1[2]) * fabs(e2[1]);
     F->na[1] = fabs(e1[2]) * fabs(e2[0]) + fabs(e1[0]) * fabs(e2[2]);
     F->na[2] = fabs(e1[0]) * fabs(e2[1]) + fabs(e1[1]) * fabs(e2[0]);
-}
-
-/* The projection axis of the face p0, p1, p2 and *skip (1: zero area): the axis of the largest |normal
- * component| of the float normal (the first of equals), then the next ones until the projected triangle has an
- * exactly nonzero orientation (as mesh/intersect._face_axes). */
-static inline int
-ct_face_axis(const double *p0, const double *p1, const double *p2, int *skip, CtStats *st)
-{
-    double e1[3], e2[3], n[3];
-    for (int c = 0; c < 3; c++) {
-        e1[c] = p1[c] - p0[c];
-        e2[c] = p2[c] - p0[c];
-    }
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];         /* the arithmetic of ct_face_normal */
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    int k = 0;
-    for (int c = 1; c < 3; c++) {
-        if (fabs(n[c]) > fabs(n[k])) k = c;
-    }
-    *skip = 1;
-    for (int tries = 0; tries < 3; tries++, k = (k + 1) % 3) {
-        double a[2] = {p0[ct_plane[k][0]], p0[ct_plane[k][1]]};
-        double b[2] = {p1[ct_plane[k][0]], p1[ct_plane[k][1]]};
-        double c[2] = {p2[ct_plane[k][0]], p2[ct_plane[k][1]]};
-        if (ct_orient2d(a, b, c, st) != 0) {
-            *skip = 0;
-            break;
-        }
-    }
-    return k % 3;
 }
 
 /* Kind of the pair of faces A, B (A the lower face index); computes their normals when a side test needs them. */
@@ -5258,6 +5231,7 @@ typedef struct {
     const int32_t *faces;       /* the faces holding each kept vertex, vertex after vertex */
     int64_t n, total, min_faces, big_faces;
     uint8_t *cert;
+    const int32_t *label;       /* NULL, or per face its certified patch (0: none; ct_patch_labels) */
     int oom[MAX_THREADS];
 } CtStarJob;
 
@@ -5294,6 +5268,19 @@ ct_star_task(void *ctx, int t, int nt)
             v = w;
             continue;
         }
+        if (jb->label != NULL) {
+            /* every face of v in one certified patch: no pair of them is enumerated (the patch's node is not
+             * paired with itself, and no node pair below it is reached), so v's certificate would decide
+             * nothing */
+            int32_t l0 = jb->label[jb->faces[s]];
+            int64_t i = s + 1;
+            while (i < e && jb->label[jb->faces[i]] == l0) i++;
+            if (l0 != 0 && i == e) {
+                jb->cert[v] = 0;
+                v = w;
+                continue;
+            }
+        }
         int32_t link_local[2 * CT_STAR_SMALL];
         int32_t *link = e - s <= CT_STAR_SMALL ? link_local : (int32_t *)malloc((size_t)(2 * (e - s)) * sizeof(int32_t));
         int r = -1;
@@ -5318,25 +5305,22 @@ ct_stars_scratch(int64_t n, int64_t m)
     return (size_t)(n > 0 ? n : 1) * sizeof(int64_t) + 3 * (size_t)(m > 0 ? m : 1) * sizeof(int32_t);
 }
 
-/* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
- * certified one of min_faces .. big_faces - 1 (faces F, m of them, n vertices), and, when twin is not NULL, the
- * faces across every edge (ct_twins, 3 m int32); 0 or -1 when out of memory.
- * scratch: ct_stars_scratch(n, m) bytes, any content (the memory of the preparation's sort, reused). */
 static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces,
-                    int64_t total, int32_t *twin, int threads);
+                    int64_t total, const int32_t *pos, int32_t *twin, int threads);
 
-static int
-ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
-         uint8_t *cert, int threads, void *scratch, int32_t *twin)
+/* The faces of each vertex of at least list_min faces (in scratch, ct_stars_scratch(n, m) bytes, any content):
+ * *off (n int64: the start of each kept vertex's range of faces, -1 for the others) and *faces (the faces of
+ * each kept vertex, vertex after vertex, *total of them; a face holding v twice is listed twice). */
+static void
+ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, void *scratch, int64_t **off_out,
+              int32_t **faces_out, int64_t *total_out)
 {
-    memset(cert, 0, (size_t)n);
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
     int64_t *off = (int64_t *)scratch;
     int32_t *faces = (int32_t *)((char *)scratch + off_bytes);
     memset(off, 0, off_bytes);
     for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
     int64_t total = 0;
-    int64_t list_min = twin != NULL ? 1 : min_faces;      /* the twins need every vertex's faces */
     for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
         if (off[v] >= list_min) {
             total += off[v];
@@ -5353,6 +5337,20 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
             faces[--off[v]] = (int32_t)f;           /* a face holding v twice is listed twice (then rejected) */
         }
     }
+    *off_out = off;
+    *faces_out = faces;
+    *total_out = total;
+}
+
+/* cert[v] <- CT_STAR_BIG for every certified vertex of at least big_faces faces, CT_STAR_SMALL_CERT for every
+ * certified one of min_faces .. big_faces - 1, from the lists of ct_star_lists; with label (per face, its
+ * certified patch or 0), a vertex whose faces all lie in one certified patch is not tried (cert 0: its
+ * certificate would decide no pair).  0, or -1 when out of memory. */
+static int
+ct_star_certs(const double *V, int64_t n, const void *F, int fsize, const int64_t *off, const int32_t *faces,
+              int64_t total, int64_t min_faces, int64_t big_faces, uint8_t *cert, int threads, const int32_t *label)
+{
+    memset(cert, 0, (size_t)n);
     CtStarJob jb;
     memset(&jb, 0, sizeof(jb));
     jb.V = V;
@@ -5365,15 +5363,24 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
     jb.min_faces = min_faces;
     jb.big_faces = big_faces;
     jb.cert = cert;
+    jb.label = label;
     run_parallel(thread_count(threads, (size_t)n, 20000), ct_star_task, &jb);
-    int rc = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
-        if (jb.oom[t]) rc = -1;
+        if (jb.oom[t]) return -1;
     }
-    if (rc == 0 && twin != NULL) {                         /* the faces across each edge, from the same lists */
-        rc = ct_twins(F, fsize, n, m, off, faces, total, twin, threads);
-    }
-    return rc;
+    return 0;
+}
+
+/* cert as ct_star_certs for every vertex (no patches), the lists in scratch (ct_stars_scratch(n, m) bytes, any
+ * content: the memory of the preparation's sort, reused); 0 or -1 when out of memory. */
+static int
+ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_t min_faces, int64_t big_faces,
+         uint8_t *cert, int threads, void *scratch)
+{
+    int64_t *off, total;
+    int32_t *faces;
+    ct_star_lists(n, F, fsize, m, min_faces, scratch, &off, &faces, &total);
+    return ct_star_certs(V, n, F, fsize, off, faces, total, min_faces, big_faces, cert, threads, NULL);
 }
 
 /* The certified vertex shared by every face at hierarchy positions s .. s+count-1, or -1. */
@@ -5549,14 +5556,17 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
  * Certified patches (mesh/intersect.py, "Patches").  A node of the hierarchy whose faces K satisfy
  *   (a) along some coordinate axis every face projects to a triangle of one strict orientation s (exact
  *       orient2d of its corners in winding order), and
- *   (b) the boundary chain of K (its directed edges, u -> v cancelling v -> u) is a union of cycles through
- *       distinct vertices whose projections along that axis are simple, pairwise disjoint polygons none inside
- *       another (exact orient2d),
+ *   (b) the boundary chain of K (its directed edges, u -> v cancelling v -> u) is a union of cycles whose
+ *       projections along that axis are simple polygons meeting only at common vertices without crossing
+ *       there, nested only as outline, hole, island ... with orientations s, -s, s ... from the outermost in
+ *       (a vertex the chain passes 2 .. 4 times resolved into cycles touching there: ct_pinch_resolve; exact
+ *       orient2d throughout),
  * has no two faces meeting beyond what they share by index, so the descent of the node with itself is left
  * out.  Proof (the degree argument behind the normal-cone and contour test of self-collision culling): at a
  * point y of the plane off every projected edge, the number of faces whose projection holds y, times s, is the
- * winding number of the projected boundary chain round y (the faces' boundaries sum to the chain), which for
- * disjoint simple polygons none inside another is 0 or +-1: the projected faces have disjoint interiors.
+ * winding number of the projected boundary chain round y (the faces' boundaries sum to the chain), the sum of
+ * the resolved cycles' winding numbers, which for such polygons (the ones holding y nested, alternating in
+ * orientation) is 0 or s: the projected faces have disjoint interiors.
  * Then every point of K off the chain has a neighbourhood that projects one to one (the faces round it cover
  * a disk once), so two
  * distinct points of K with one projection both lie on the chain, whose projection is one to one: the
@@ -5603,6 +5613,7 @@ typedef struct {
     const int64_t *off;
     const int32_t *faces;
     int64_t n, total;
+    const int32_t *pos;         /* NULL, or each face's hierarchy position: twin is then indexed and valued by it */
     int32_t *twin;
     int oom[MAX_THREADS];
 } CtTwinJob;
@@ -5616,6 +5627,18 @@ ct_link_prev_cmp(const void *x, const void *y)
 {
     const CtLink *a = (const CtLink *)x, *b = (const CtLink *)y;
     return (a->prev > b->prev) - (a->prev < b->prev);
+}
+
+/* twin of face f across the edge from its corner c: by face, or by hierarchy position when jb->pos is given */
+static inline void
+ct_twin_put(CtTwinJob *jb, int32_t f, int c, int32_t tw)
+{
+    if (jb->pos != NULL) {
+        jb->twin[3 * (size_t)jb->pos[f] + (size_t)c] = tw >= 0 ? jb->pos[tw] : tw;
+    }
+    else {
+        jb->twin[3 * (size_t)f + (size_t)c] = tw;
+    }
 }
 
 static void
@@ -5647,7 +5670,32 @@ ct_twin_task(void *ctx, int t, int nt)
             lk[i].face = f;
             lk[i].corner = c;
         }
-        if (ok && k <= 64) {
+        int32_t first[64];
+        uint64_t hit = 0;
+        int all = ok && k <= 64;
+        for (int64_t i = 0; i < k && all; i++) {
+            /* the common case, a closed fan consistently oriented round v: each face's first other face whose
+             * corner before v is its corner after v, all distinct (and no face whose corners after and before v
+             * are one vertex).  Then every face has exactly one such face and no other face has its corner
+             * after v (two faces with one next, or two with one prev, would make two first matches equal),
+             * i.e. what the general count below would find */
+            if (lk[i].next == lk[i].prev) {
+                all = 0;
+                break;
+            }
+            int64_t j = 0;
+            while (j < k && (j == i || lk[j].prev != lk[i].next)) j++;
+            if (j == k || (hit >> j) & 1u) {
+                all = 0;
+                break;
+            }
+            hit |= (uint64_t)1 << j;
+            first[i] = (int32_t)j;
+        }
+        if (all) {
+            for (int64_t i = 0; i < k; i++) ct_twin_put(jb, lk[i].face, lk[i].corner, lk[first[i]].face);
+        }
+        else if (ok && k <= 64) {
             for (int64_t i = 0; i < k; i++) {
                 int32_t back = -1, twin = -1, same = 0;
                 for (int64_t j = 0; j < k; j++) {
@@ -5658,8 +5706,8 @@ ct_twin_task(void *ctx, int t, int nt)
                     }
                     same += lk[j].next == lk[i].next;
                 }
-                jb->twin[3 * (size_t)lk[i].face + (size_t)lk[i].corner] = back < 0 && !same ? -1
-                                                                           : back == 0 && !same ? twin : -2;
+                int32_t tw = back < 0 && !same ? -1 : back == 0 && !same ? twin : -2;
+                ct_twin_put(jb, lk[i].face, lk[i].corner, tw);
             }
         }
         else if (ok) {                             /* a large fan: match by the sorted corners before v */
@@ -5675,7 +5723,7 @@ ct_twin_task(void *ctx, int t, int nt)
                 while (lo + run < k && lk[lo + run].prev == lk[i].next) run++;
                 /* "run twice one way": another face with the same next; counted through its own prev run */
                 int32_t tw = run == 1 && lk[lo].face != lk[i].face ? lk[lo].face : run == 0 ? -1 : -2;
-                jb->twin[3 * (size_t)lk[i].face + (size_t)lk[i].corner] = tw;
+                ct_twin_put(jb, lk[i].face, lk[i].corner, tw);
             }
         }
         if (lk != local) free(lk);
@@ -5724,12 +5772,15 @@ ct_sweep_cmp(const void *x, const void *y)
 }
 
 /* 1 when the closed polygons P (2-d points, B of them; the segment of point i runs to point succ[i], every
- * succ cycle of length 3 or more, consecutive points distinct) are simple and pairwise disjoint: segments
- * meet only where one ends and the next begins (and not folding back along it), others not at all.  A sweep
- * along x tests the pairs whose x and y ranges meet; more than budget segment tests, or an exact stage that
- * overflowed: 0. */
+ * succ cycle of length 3 or more, consecutive points distinct) are simple and pairwise meet only at common
+ * vertices: segments meet only where one ends and the next begins (and not folding back along it), two
+ * segments of different polygons ending at one vertex by index (edges: the tail and head ids of each segment;
+ * a vertex two polygons pass through) only there (not overlapping along a common line), others not at all.
+ * A sweep along x tests the pairs whose x and y ranges meet; more than budget segment tests, or an exact
+ * stage that overflowed: 0. */
 static int
-ct_polygons_simple(const double *P, const int32_t *succ, int64_t B, CtSweep *order, int64_t budget, CtStats *st)
+ct_polygons_simple(const double *P, const int32_t *succ, const int32_t *edges, int64_t B, CtSweep *order,
+                   int64_t budget, CtStats *st)
 {
     for (int64_t i = 0; i < B; i++) {
         const double *a = P + 2 * i, *b = P + 2 * (size_t)succ[i];
@@ -5756,7 +5807,16 @@ ct_polygons_simple(const double *P, const int32_t *succ, int64_t B, CtSweep *ord
                 meet = ct_segments_fold(c, d, b, st);
             }
             else {
-                meet = ct_segments_meet(a, b, c, d, st);
+                int32_t ti = edges[2 * i], hi = edges[2 * i + 1], tj = edges[2 * j], hj = edges[2 * j + 1];
+                int shared = (ti == tj) + (ti == hj) + (hi == tj) + (hi == hj);
+                if (shared == 1) {                         /* one vertex w by index: they meet beyond it iff */
+                    const double *w = ti == tj || ti == hj ? a : b;       /* they overlap along one line */
+                    const double *x = w == a ? b : a, *y = tj == ti || tj == hi ? d : c;
+                    meet = ct_segments_fold(x, w, y, st);
+                }
+                else {
+                    meet = shared != 0 || ct_segments_meet(a, b, c, d, st);
+                }
             }
             if (meet || st->failed) return 0;
         }
@@ -5784,16 +5844,85 @@ ct_point_inside(const double *q, const double *P, const int32_t *succ, int32_t f
 }
 
 #define CT_PATCH_CYCLES 8       /* boundary cycles of a patch, at most */
+#define CT_PINCH_MAX 4          /* boundary passes through one vertex, at most */
+#define CT_PINCH_EDGES 256      /* boundary edges entering pinches, at most */
 
-/* 1 when the chain edges[0 .. B-1] (directed pairs) is a union of cycles through distinct vertices whose
- * projections along some axis of amask (with every face's orientation there) are simple, pairwise disjoint
- * polygons none inside another (so their winding numbers add up to 0 or +-1 everywhere); 0 otherwise (or out
- * of memory, pb->oom set). */
+/* Exact angular order about w (2-d) of the directions x - w and y - w (both nonzero): -1 when x comes first
+ * counterclockwise from the +x axis (angles in [0, 2 pi)), 1 when y does, 0 when they point the same way. */
+static int
+ct_angle_cmp(const double *w, const double *x, const double *y, CtStats *st)
+{
+    int hx = x[1] > w[1] || (x[1] == w[1] && x[0] > w[0]) ? 0 : 1;      /* upper half-plane (angle < pi) */
+    int hy = y[1] > w[1] || (y[1] == w[1] && y[0] > w[0]) ? 0 : 1;
+    if (hx != hy) return hx < hy ? -1 : 1;
+    int o = ct_orient2d(w, x, y, st);                      /* within one half-plane: counterclockwise first */
+    return o > 0 ? -1 : o < 0 ? 1 : 0;
+}
+
+/* Resolves one pinch vertex w (2-d) of a boundary chain, left by the k >= 2 edges outs[] toward the points
+ * head[] and entered by the k edges ins[] from the points tail[]: the 2k directions about w sorted exactly
+ * must alternate between leaving and entering, no two the same way; then each entering edge is followed
+ * (succ) by the leaving edge next to it on one side, clockwise when side > 0 (across the sectors the faces
+ * cover, for s > 0: lobes touching at w), counterclockwise when side < 0 (across the others: a region touching
+ * itself round a hole), so the cycles resolved there pass w in disjoint sectors each bounded by two adjacent
+ * directions: they touch at w without crossing, whichever side.  0 when not so. */
+static int
+ct_pinch_resolve(const double *w, const int32_t *outs, const double (*head)[2], const int32_t *ins,
+                 const double (*tail)[2], int k, int side, int32_t *succ, CtStats *st)
+{
+    int32_t dir[2 * CT_PINCH_MAX];              /* a leaving edge e as e, an entering one as -1 - e */
+    const double *pt[2 * CT_PINCH_MAX];
+    for (int i = 0; i < k; i++) {
+        dir[2 * i] = outs[i];
+        pt[2 * i] = head[i];
+        dir[2 * i + 1] = -1 - ins[i];
+        pt[2 * i + 1] = tail[i];
+    }
+    for (int i = 0; i < 2 * k; i++) {
+        if (pt[i][0] == w[0] && pt[i][1] == w[1]) return 0;      /* no direction */
+    }
+    for (int i = 1; i < 2 * k; i++) {                  /* insertion sort by exact angle */
+        int32_t d = dir[i];
+        const double *q = pt[i];
+        int j = i;
+        while (j > 0) {
+            int c = ct_angle_cmp(w, pt[j - 1], q, st);
+            if (c == 0) return 0;                          /* two edges along one ray: overlapping */
+            if (c < 0) break;
+            dir[j] = dir[j - 1];
+            pt[j] = pt[j - 1];
+            j--;
+        }
+        dir[j] = d;
+        pt[j] = q;
+    }
+    if (st->failed) return 0;
+    for (int i = 0; i < 2 * k; i++) {
+        if ((dir[i] >= 0) == (dir[(i + 1) % (2 * k)] >= 0)) return 0;       /* not alternating */
+    }
+    for (int i = 0; i < 2 * k; i++) {
+        if (dir[i] >= 0) continue;
+        int j = side > 0 ? (i + 2 * k - 1) % (2 * k) : (i + 1) % (2 * k);
+        succ[-1 - dir[i]] = dir[j];
+    }
+    return 1;
+}
+
+/* 1 when the chain edges[0 .. B-1] (directed pairs of vertex ids) is, along some axis of amask (every face's
+ * projection of one strict orientation s there), a union of at most CT_PATCH_CYCLES cycles whose projections
+ * are simple polygons, pairwise meeting only at common vertices, none inside another: a vertex the chain
+ * leaves k = 2 .. CT_PINCH_MAX times (a pinch) has its passes resolved by ct_pinch_resolve into cycles that
+ * touch there without crossing, each through it once; then no polygon's boundary crosses another's, so any
+ * two are apart or one holds the other, which one vertex of each (one the chain leaves once, so on no other
+ * polygon) tested against every other tells: the polygons holding a point are nested, and when each
+ * polygon's orientation is s under an even number of others and -s under an odd one (an outline, a hole, an
+ * island in the hole ...) their winding numbers add up to 0 or s everywhere.  0 otherwise (or out of memory,
+ * pb->oom set). */
 static int
 ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_t B, unsigned amask)
 {
     if (B < 3 || amask == 0) return 0;
-    /* the outgoing edge of each tail: the table again, keyed by the tail */
+    /* the edges leaving each tail: the table keyed by the tail holds the last listed, nxt chains the others */
     pb->cur++;
     if (pb->cur == 0) {
         memset(pb->stamp, 0, (size_t)pb->tsize * sizeof(uint32_t));
@@ -5801,9 +5930,25 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
     }
     int64_t mask = 15;
     while (mask + 1 < 4 * B && mask + 1 < pb->tsize) mask = 2 * mask + 1;
+    int32_t *succ = (int32_t *)malloc((size_t)B * sizeof(int32_t));
+    int32_t *nxt = (int32_t *)malloc((size_t)B * sizeof(int32_t));
+    int32_t *cyc = (int32_t *)malloc((size_t)B * sizeof(int32_t));
+    int32_t *pin = (int32_t *)malloc((size_t)B * sizeof(int32_t));      /* edges entering a pinch */
+    int32_t *pin_out = (int32_t *)malloc((size_t)B * sizeof(int32_t));  /* the first edge leaving it */
+    uint8_t *twice = (uint8_t *)calloc((size_t)B, 1);                    /* the tail is a pinch */
+    double *P = (double *)malloc((size_t)B * 2 * sizeof(double));
+    CtSweep *order = (CtSweep *)malloc((size_t)B * sizeof(CtSweep));
+    int ok = 0;
+    int64_t n_pin = 0;
+    if (succ == NULL || nxt == NULL || cyc == NULL || pin == NULL || pin_out == NULL || twice == NULL || P == NULL
+        || order == NULL) {
+        pb->oom = 1;
+        goto done;
+    }
     for (int64_t e = 0; e < B; e++) {
         uint64_t k = (uint32_t)edges[2 * e];
         int64_t s = (int64_t)(ct_edge_hash(k) & (uint64_t)mask);
+        nxt[e] = -1;
         for (int64_t probe = 0; probe <= mask; probe++) {
             if (pb->stamp[s] != pb->cur) {
                 pb->stamp[s] = pb->cur;
@@ -5811,19 +5956,15 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
                 pb->net[s] = (int32_t)e;
                 break;
             }
-            if (pb->key[s] == k) return 0;                 /* a vertex leaving twice: not simple cycles */
+            if (pb->key[s] == k) {                         /* a vertex left twice or more: a pinch */
+                nxt[e] = pb->net[s];
+                pb->net[s] = (int32_t)e;
+                twice[e] = 1;
+                twice[nxt[e]] = 1;
+                break;
+            }
             s = (s + 1) & mask;
         }
-    }
-    int32_t *succ = (int32_t *)malloc((size_t)B * sizeof(int32_t));
-    double *P = (double *)malloc((size_t)B * 2 * sizeof(double));
-    CtSweep *order = (CtSweep *)malloc((size_t)B * sizeof(CtSweep));
-    int ok = 0;
-    int32_t first[CT_PATCH_CYCLES];
-    int n_cycles = 0;
-    if (succ == NULL || P == NULL || order == NULL) {
-        pb->oom = 1;
-        goto done;
     }
     for (int64_t e = 0; e < B; e++) {                      /* succ[e]: the edge leaving e's head */
         uint64_t k = (uint32_t)edges[2 * e + 1];
@@ -5838,41 +5979,146 @@ ct_patch_certify(CtPatchBuild *pb, const double *V, const int32_t *edges, int64_
             s = (s + 1) & mask;
         }
         if (succ[e] < 0) goto done;                        /* an open chain */
+        if (twice[succ[e]]) pin[n_pin++] = (int32_t)e;     /* entering a pinch: resolved per axis */
     }
-    /* every edge on one cycle: B edges, each the successor of exactly one (distinct tails, and the walks
-     * from unvisited edges close) */
-    for (int64_t e = 0; e < B; e++) order[e].i = 0;        /* visited marks */
-    for (int64_t e = 0; e < B; e++) {
-        if (order[e].i) continue;
-        if (n_cycles == CT_PATCH_CYCLES) goto done;
-        first[n_cycles++] = (int32_t)e;
-        int64_t x = e, steps = 0;
-        do {
-            if (order[x].i) goto done;                     /* joins a cycle already walked: not disjoint */
-            order[x].i = 1;
-            x = succ[x];
-            steps++;
-        } while (x != e && steps <= B);
-        if (x != e) goto done;
+    if (n_pin > CT_PINCH_EDGES) goto done;                /* many pinches: not tried (the sort below is quadratic) */
+    for (int64_t i = 1; i < n_pin; i++) {                  /* the edges entering pinches, by head vertex */
+        int32_t x = pin[i];
+        int64_t j = i;
+        while (j > 0 && edges[2 * pin[j - 1] + 1] > edges[2 * x + 1]) {
+            pin[j] = pin[j - 1];
+            j--;
+        }
+        pin[j] = x;
     }
-    for (int axis = 0; axis < 3 && !ok; axis++) {
-        if (!((amask >> (2 * axis)) & 3u)) continue;
+    for (int64_t i = 0; i < n_pin; i++) pin_out[i] = succ[pin[i]];
+    for (int attempt = 0; attempt < 6 && !ok; attempt++) {
+        /* each axis of amask, with the pinches resolved across the faces' sectors, then (when there are
+         * pinches) across the others */
+        int axis = attempt >> 1, mode = attempt & 1;
+        unsigned bits = (amask >> (2 * axis)) & 3u;
+        if (bits != 1u && bits != 2u) continue;
+        if (mode == 1 && n_pin == 0) continue;
+        int sgn = bits == 1u ? 1 : -1;
         int kx = ct_plane[axis][0], ky = ct_plane[axis][1];
+        CtStats st = {0, 0};
         for (int64_t i = 0; i < B; i++) {                  /* point i: the tail of edge i */
             P[2 * i] = V[3 * (size_t)edges[2 * i] + kx];
             P[2 * i + 1] = V[3 * (size_t)edges[2 * i] + ky];
         }
-        CtStats st = {0, 0};
-        ok = ct_polygons_simple(P, succ, B, order, 64 * B + 4096, &st);
-        for (int c = 0; c < n_cycles && ok; c++) {         /* disjoint, so none inside another */
-            for (int d = 0; d < n_cycles && ok; d++) {
-                if (d != c && ct_point_inside(P + 2 * (size_t)first[c], P, succ, first[d], B, &st)) ok = 0;
+        int good = 1;
+        for (int64_t i = 0; i < n_pin && good;) {          /* each pinch: its k entering and k leaving edges */
+            int64_t j = i;
+            while (j < n_pin && edges[2 * pin[j] + 1] == edges[2 * pin[i] + 1]) j++;
+            int32_t outs[CT_PINCH_MAX] = {0}, ins[CT_PINCH_MAX] = {0};
+            double head[CT_PINCH_MAX][2], tail[CT_PINCH_MAX][2];
+            int k = 0;
+            for (int32_t x = pin_out[i]; x >= 0; x = nxt[x]) {
+                if (k == CT_PINCH_MAX) {
+                    k = -1;
+                    break;
+                }
+                outs[k] = x;
+                head[k][0] = V[3 * (size_t)edges[2 * x + 1] + kx];
+                head[k][1] = V[3 * (size_t)edges[2 * x + 1] + ky];
+                k++;
+            }
+            if (k < 2 || k != j - i) {
+                good = 0;
+                break;
+            }
+            for (int64_t x = i; x < j; x++) {
+                ins[x - i] = pin[x];
+                tail[x - i][0] = P[2 * (size_t)pin[x]];
+                tail[x - i][1] = P[2 * (size_t)pin[x] + 1];
+            }
+            good = ct_pinch_resolve(P + 2 * (size_t)outs[0], outs, (const double (*)[2])head, ins,
+                                    (const double (*)[2])tail, k, mode == 0 ? sgn : -sgn, succ, &st);
+            i = j;
+        }
+        if (!good || st.failed) continue;
+        /* every edge on one cycle (succ a permutation), at most CT_PATCH_CYCLES of them */
+        int32_t first[CT_PATCH_CYCLES];
+        int n_cycles = 0;
+        for (int64_t e = 0; e < B; e++) cyc[e] = -1;
+        for (int64_t e = 0; e < B && good; e++) {
+            if (cyc[e] >= 0) continue;
+            if (n_cycles == CT_PATCH_CYCLES) {
+                good = 0;
+                break;
+            }
+            first[n_cycles] = (int32_t)e;
+            int64_t x = e, steps = 0;
+            do {
+                if (cyc[x] >= 0) {                         /* joins a cycle already walked: not disjoint */
+                    good = 0;
+                    break;
+                }
+                cyc[x] = n_cycles;
+                x = succ[x];
+                steps++;
+            } while (x != e && steps <= B);
+            if (good && x != e) good = 0;
+            n_cycles++;
+        }
+        for (int64_t i = 0; i < n_pin && good; i++) {      /* each cycle through a pinch once */
+            for (int32_t x = pin_out[i]; x >= 0 && good; x = nxt[x]) {
+                for (int32_t y = nxt[x]; y >= 0 && good; y = nxt[y]) {
+                    if (cyc[x] == cyc[y]) good = 0;
+                }
             }
         }
-        if (st.failed) ok = 0;
+        if (!good) continue;
+        int ax = ct_polygons_simple(P, succ, edges, B, order, 64 * B + 4096, &st);
+        for (int c = 0; c < n_cycles && ax && n_cycles > 1; c++) {
+            /* c's depth (the cycles holding it, tested at a vertex of c on no other) and orientation (the
+             * turn at its lowest-leftmost vertex, strict for a simple polygon) must alternate s, -s, ...
+             * from the outermost in: then the winding numbers add up to 0 or s everywhere */
+            int64_t q = first[c], steps = 0;
+            while (twice[q] && steps < B) {                /* a vertex of c on no other cycle */
+                q = succ[q];
+                steps++;
+            }
+            if (twice[q]) {
+                ax = 0;
+                break;
+            }
+            int depth = 0;
+            for (int d = 0; d < n_cycles; d++) {
+                if (d != c && ct_point_inside(P + 2 * (size_t)q, P, succ, first[d], B, &st)) depth++;
+            }
+            int64_t low = first[c], prev = -1, x = first[c];
+            steps = 0;
+            do {                                           /* the lowest-leftmost vertex and the edge into it */
+                int64_t y = succ[x];
+                const double *py = P + 2 * (size_t)y, *pl = P + 2 * (size_t)low;
+                if (py[0] < pl[0] || (py[0] == pl[0] && py[1] < pl[1])) {
+                    low = y;
+                    prev = x;
+                }
+                x = y;
+                steps++;
+            } while (x != first[c] && steps <= B);
+            if (prev < 0) {                                /* first[c] itself: the edge into it */
+                prev = first[c];
+                while (succ[prev] != first[c] && steps <= 2 * B) {
+                    prev = succ[prev];
+                    steps++;
+                }
+            }
+            int turn = ct_orient2d(P + 2 * (size_t)prev, P + 2 * (size_t)low, P + 2 * (size_t)succ[low], &st);
+            if (turn == 0 || turn != ((depth & 1) ? -sgn : sgn)) ax = 0;
+        }
+        if (st.failed) ax = 0;
+        ok = ax;
     }
 done:
     free(succ);
+    free(nxt);
+    free(cyc);
+    free(pin);
+    free(pin_out);
+    free(twice);
     free(P);
     free(order);
     return ok;
@@ -5881,7 +6127,7 @@ done:
 /* ct_twin_task over the vertices on threads; 0, or -1 when out of memory. */
 static int
 ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces, int64_t total,
-         int32_t *twin, int threads)
+         const int32_t *pos, int32_t *twin, int threads)
 {
     for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
     CtTwinJob jb;
@@ -5892,6 +6138,7 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, con
     jb.faces = faces;
     jb.n = n;
     jb.total = total;
+    jb.pos = pos;
     jb.twin = twin;
     run_parallel(thread_count(threads, (size_t)n, 20000), ct_twin_task, &jb);
     for (int t = 0; t < MAX_THREADS; t++) {
@@ -5993,6 +6240,53 @@ done:
     return rc;
 }
 
+/* label[f] <- the certified patch (its node) holding face f, 0 for a face in none; order: the face at each
+ * hierarchy position.  Top down; the stack holds at most one node per level and one more (depth <= 32: the
+ * tree halves ranges of fewer than 2^31 blocks). */
+static void
+ct_patch_labels(const CtNode *nodes, const uint8_t *patch, const int32_t *order, int64_t m, int32_t *label)
+{
+    int64_t stack[2 * 80];
+    int top = 0;
+    stack[0] = CT_ROOT;
+    stack[1] = 0;
+    top = 1;
+    while (top > 0) {
+        top--;
+        int64_t k = stack[2 * top], lab = stack[2 * top + 1];
+        const CtNode *nd = &nodes[k];
+        if (lab == 0 && patch[k]) lab = k;
+        if (CT_IS_LEAF(nd)) {
+            int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
+            for (int64_t i = start; i < start + count; i++) label[order[i]] = (int32_t)lab;
+            continue;
+        }
+        stack[2 * top] = CT_LEFT(nd);
+        stack[2 * top + 1] = lab;
+        top++;
+        stack[2 * top] = CT_RIGHT(nd);
+        stack[2 * top + 1] = lab;
+        top++;
+    }
+}
+
+/* The apexes of a hierarchy ct_build made without certificates (every apex -1), from cert, children before
+ * parents, as ct_build sets them. */
+static void
+ct_set_apex(CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *cert, int64_t m)
+{
+    for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
+        CtNode *nd = &nodes[k];
+        if (CT_IS_LEAF(nd)) {
+            nd->apex = (int32_t)ct_leaf_apex(ids, cert, CT_LEAF * CT_BLOCK_OF(nd), ct_leaf_count(nd, m));
+        }
+        else {
+            const CtNode *p = &nodes[CT_LEFT(nd)], *q = &nodes[CT_RIGHT(nd)];
+            nd->apex = p->apex == q->apex ? p->apex : -1;
+        }
+    }
+}
+
 typedef struct {
     const float *BOX;           /* face boxes rounded outward to float32, in blocks of CT_LEAF (ct_block_mask) */
     const int32_t *order;       /* the caller's face index of each hierarchy position */
@@ -6012,8 +6306,8 @@ typedef struct {
 } CtScan;
 
 /* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
- * (the arithmetic of ct_face_normal, when first needed), its corner indices, and the axis and zero-area flag ct_face_axis
- * gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
+ * (the arithmetic of ct_face_normal, when first needed), its corner indices, and the axis and zero-area flag
+ * ct_prep_task gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
  * when a box meets its (16 + 1 bytes per face instead). */
 static inline void
 ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
@@ -6377,14 +6671,52 @@ ct_prep_task(void *ctx, int t, int nt)
     CtPrep *pr = (CtPrep *)ctx;
     int64_t s = (int64_t)part_start((size_t)pr->m, t, nt), e = (int64_t)part_start((size_t)pr->m, t + 1, nt);
     CtStats st = {0, 0};
+    if (pr->pass == 2) {                       /* axis[f] held axis | orientations << 2: unpacked */
+        for (int64_t f = s; f < e; f++) {
+            pr->skip[f] = (uint8_t)((uint8_t)pr->axis[f] >> 2 == 0);
+            pr->axis[f] = (int8_t)(pr->axis[f] & 3);
+        }
+        return;
+    }
     if (pr->pass == 0) {
         for (int64_t f = s; f < e; f++) {
             const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
             const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
             const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
-            int skip;
-            pr->axis[f] = (int8_t)ct_face_axis(p0, p1, p2, &skip, &st);
-            pr->skip[f] = (uint8_t)skip;
+            /* the exact orientation of the face's projection along each axis, orient2d(p1, p2, p0) (the sign
+             * of orient2d(p0, p1, p2)): each filter's value is the float normal's component, n = e1 x e2 with
+             * e1 = p1 - p0, e2 = p2 - p0 (the arithmetic of ct_face_normal); then the projection axis (the
+             * largest |n| component, the first of equals, then the next ones until the orientation is nonzero;
+             * as mesh/intersect._face_axes) and zero area when all three are zero.  axis[f] <- axis |
+             * orientations << 2 (pass 2 unpacks it). */
+            double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+            double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+            double n[3];
+            unsigned fm = 0;
+            for (int a = 0; a < 3; a++) {
+                int kx = ct_plane[a][0], ky = ct_plane[a][1];
+                double left = e1[kx] * e2[ky], right = e1[ky] * e2[kx];
+                double det = left - right, perm = fabs(left) + fabs(right);
+                int o;
+                n[a] = det;
+                if (perm == 0.0) {
+                    o = 0;
+                }
+                else if (fabs(det) > CONTACT_O2 * perm) {
+                    o = det > 0 ? 1 : -1;
+                }
+                else {
+                    double a2[2] = {p1[kx], p1[ky]}, b2[2] = {p2[kx], p2[ky]}, c2[2] = {p0[kx], p0[ky]};
+                    o = ct_orient2d_exact(a2, b2, c2, &st);
+                }
+                fm |= o > 0 ? 1u << (2 * a) : o < 0 ? 2u << (2 * a) : 0u;
+            }
+            int k = 0;
+            for (int c = 1; c < 3; c++) {
+                if (fabs(n[c]) > fabs(n[k])) k = c;
+            }
+            for (int tries = 0; tries < 3 && !((fm >> (2 * k)) & 3u); tries++) k = (k + 1) % 3;
+            pr->axis[f] = (int8_t)(uint8_t)((unsigned)k | fm << 2);
             uint64_t code = 0;
             for (int c = 0; c < 3; c++) {
                 double lo = ct_min3(p0[c], p1[c], p2[c]), hi = ct_max3(p0[c], p1[c], p2[c]);
@@ -6413,32 +6745,9 @@ ct_prep_task(void *ctx, int t, int nt)
         const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
         const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
         const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
-        pr->flags[i] = (uint8_t)(pr->axis[f] | pr->skip[f] << 2);
-        if (pr->fmask != NULL) {
-            /* orient2d(p1, p2, p0) along each axis (the sign of orient2d(p0, p1, p2)): its filter shares the
-             * differences e1 = p1 - p0, e2 = p2 - p0 between the axes */
-            unsigned fm = 0;
-            double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-            double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-            for (int a = 0; a < 3 && !pr->skip[f]; a++) {
-                int kx = ct_plane[a][0], ky = ct_plane[a][1];
-                double left = e1[kx] * e2[ky], right = e1[ky] * e2[kx];
-                double det = left - right, perm = fabs(left) + fabs(right);
-                int o;
-                if (perm == 0.0) {
-                    o = 0;
-                }
-                else if (fabs(det) > CONTACT_O2 * perm) {
-                    o = det > 0 ? 1 : -1;
-                }
-                else {
-                    double a2[2] = {p1[kx], p1[ky]}, b2[2] = {p2[kx], p2[ky]}, c2[2] = {p0[kx], p0[ky]};
-                    o = ct_orient2d_exact(a2, b2, c2, &st);
-                }
-                fm |= o > 0 ? 1u << (2 * a) : o < 0 ? 2u << (2 * a) : 0u;
-            }
-            pr->fmask[i] = (uint8_t)fm;
-        }
+        unsigned packed = (uint8_t)pr->axis[f];         /* axis | orientations << 2, from pass 0 */
+        pr->flags[i] = (uint8_t)((packed & 3u) | (packed >> 2 == 0) << 2);
+        if (pr->fmask != NULL) pr->fmask[i] = (uint8_t)(packed >> 2);
         for (int k = 0; k < 3; k++) {
             pr->ids[CT_IDBLOCK * (i / CT_LEAF) + k * CT_LEAF + i % CT_LEAF]
                 = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
@@ -6553,7 +6862,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         int oom = 0, failed = 0;
         int profile = getenv("INERTIA_TOOL_CT_PROFILE") != NULL;
-        double clk[8] = {0};
+        double clk[12] = {0};
         Py_BEGIN_ALLOW_THREADS
         clk[0] = ct_clock();
         int nt = thread_count(threads, (size_t)m, 20000);
@@ -6598,6 +6907,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
             clk[2] = ct_clock();
             pr.pass = 1;
             run_parallel(nt, ct_prep_task, &pr);
+            pr.pass = 2;
+            run_parallel(nt, ct_prep_task, &pr);
             clk[3] = ct_clock();
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
@@ -6605,43 +6916,74 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
             /* order holds the face indices in hierarchy order: code's memory is the stars' scratch now */
         }
+        int64_t n_nodes = 0;
+        int64_t star_min = star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN;
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
             stars = (uint8_t *)malloc(mm);
-            if (fmask != NULL) {
-                twin = (int32_t *)malloc(3 * mm * sizeof(int32_t));    /* NULL: no patches, the same pairs */
-            }
-            if (cert == NULL || stars == NULL || ct_stars(V, n, F, fsize, m, star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN,
-                                         star_faces, cert, nt, code, twin) < 0) {
-                oom = 1;
+            if (cert == NULL || stars == NULL) oom = 1;
+        }
+        int32_t *pos = NULL;
+        if (!oom && !failed && m >= 2 && cert != NULL && fmask != NULL) {
+            twin = (int32_t *)malloc(3 * mm * sizeof(int32_t));    /* NULL: no patches, the same pairs */
+            pos = (int32_t *)malloc(mm * sizeof(int32_t));
+            if (twin == NULL || pos == NULL) {
+                free(twin);
+                free(pos);
+                twin = NULL;
+                pos = NULL;
             }
         }
-        clk[4] = ct_clock();
-        if (!oom && !failed && m >= 2) {
-            int64_t n_nodes = ct_build(nodes, box, ids, cert, m);
-            int32_t *across = (int32_t *)code;     /* the stars' lists are done with: 12 of its >= 16 bytes a face */
-            int32_t *pos = twin != NULL ? (int32_t *)malloc(mm * sizeof(int32_t)) : NULL;
-            if (pos != NULL) {                      /* the faces across, by hierarchy position */
-                for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
-                for (int64_t i = 0; i < m; i++) {
-                    const int32_t *tw = twin + 3 * (size_t)order[i];
-                    for (int c = 0; c < 3; c++) {
-                        across[3 * i + c] = tw[c] >= 0 ? pos[tw[c]] : -1;
-                        if (tw[c] == -2) fmask[i] = 0;     /* not one face across: in no patch */
+        if (!oom && !failed && m >= 2 && twin != NULL) {
+            /* with patches: the faces across each edge by hierarchy position (ct_twins into twin, the lists
+             * kept in code's memory), the hierarchy, the patches, then the star certificates of the vertices
+             * whose faces are not all in one certified patch (the others decide no pair), then the apexes */
+            int64_t *off, total;
+            int32_t *vfaces;
+            for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
+            ct_star_lists(n, F, fsize, m, 1, code, &off, &vfaces, &total);
+            clk[8] = ct_clock();
+            if (ct_twins(F, fsize, n, m, off, vfaces, total, pos, twin, nt) < 0) {
+                oom = 1;
+            }
+            clk[9] = ct_clock();
+            if (!oom) {
+                int32_t *across = twin;
+                for (int64_t i = 0; i < 3 * m; i++) {
+                    if (across[i] == -2) {
+                        fmask[i / 3] = 0;          /* not one face across: in no patch */
+                        across[i] = -1;
                     }
                 }
-            }
-            free(twin);
-            twin = NULL;
-            if (pos != NULL) {                      /* with a work bound every pair is counted, as on numpy */
-                free(pos);
+                n_nodes = ct_build(nodes, box, ids, NULL, m);
+                clk[10] = ct_clock();
                 patch = (uint8_t *)malloc((size_t)n_nodes);
                 if (patch == NULL || ct_patches(nodes, n_nodes, ids, fmask, across, V, m, patch) < 0) {
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
+                clk[7] = ct_clock();
+                int32_t *label = pos;                  /* pos is done with: each face's certified patch */
+                if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
+                if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
+                                  patch != NULL ? label : NULL) < 0) {
+                    oom = 1;
+                }
+                clk[11] = ct_clock();
+                ct_set_apex(nodes, n_nodes, ids, cert, m);
             }
-            clk[7] = ct_clock();
+        }
+        else if (!oom && !failed && m >= 2) {
+            if (cert != NULL && ct_stars(V, n, F, fsize, m, star_min, star_faces, cert, nt, code) < 0) {
+                oom = 1;
+            }
+            n_nodes = ct_build(nodes, box, ids, cert, m);
+        }
+        free(pos);
+        free(twin);
+        twin = NULL;
+        clk[4] = ct_clock();
+        if (!oom && !failed && m >= 2) {
             if (cert != NULL) {
                 for (int64_t i = 0; i < m; i++) {
                     unsigned b = 0;
@@ -6710,12 +7052,20 @@ accel_contact_scan(PyObject *self, PyObject *args)
         clk[6] = ct_clock();
         Py_END_ALLOW_THREADS
         if (profile) {
-            fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars %.4f build %.4f "
-                    "(patches %.4f) traverse %.4f s; candidates %lld tested %lld; node pairs %lld leaf pairs %lld "
-                    "pair tests %lld\n",
-                    (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[4] - clk[3], clk[5] - clk[4],
-                    clk[7] > 0 ? clk[7] - clk[4] : 0.0, clk[6] - clk[5], sc.candidates, sc.tested, sc.node_pairs,
-                    sc.leaf_pairs, sc.loads);
+            if (clk[11] > 0) {
+                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f lists %.4f twins %.4f "
+                        "build %.4f patches %.4f stars %.4f apex+bits %.4f traverse %.4f s; ",
+                        (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[8] - clk[3],
+                        clk[9] - clk[8], clk[10] - clk[9], clk[7] - clk[10], clk[11] - clk[7], clk[5] - clk[11],
+                        clk[6] - clk[5]);
+            }
+            else {
+                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars+build %.4f "
+                        "traverse %.4f s; ", (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2],
+                        clk[5] - clk[3], clk[6] - clk[5]);
+            }
+            fprintf(stderr, "candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld\n",
+                    sc.candidates, sc.tested, sc.node_pairs, sc.leaf_pairs, sc.loads);
         }
         if (oom) {
             PyErr_NoMemory();

@@ -592,3 +592,26 @@ def test_result_does_not_depend_on_scale(exponent):
     assert len(base.crossing) and len(base.contact)
     for field in ("crossing", "coplanar_opposite", "contact"):
         assert np.array_equal(getattr(scaled, field), getattr(base, field)), field
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 3 * (1 << 15) + 7), st.integers(0, 2**32 - 1),
+       st.sampled_from([None, np.nan, np.inf, -np.inf, 0.0, 5e-324, 1e300]))
+def test_magnitudes_chunk_by_chunk_match_numpy(rows, seed, planted):
+    """The chunked magnitude scan (no mesh-sized temporary) gives numpy's largest and smallest nonzero |x|,
+    NaN and infinities included, across chunk boundaries."""
+    from inertia_tool.mesh.intersect import _MAGNITUDE_CHUNK, _magnitudes
+    rng = np.random.default_rng(seed)
+    v = rng.choice([0.0, 1.0, -2.5, 1e-200, 3e10], size=(rows, 3)) * rng.random((rows, 3))
+    if planted is not None and rows:
+        v.reshape(-1)[int(rng.integers(v.size))] = planted
+    if rows and rng.integers(2):
+        v.reshape(-1)[min(_MAGNITUDE_CHUNK, v.size - 1)] = -7.0       # at a chunk boundary
+    largest, smallest = _magnitudes(v) if v.size else (0.0, np.inf)
+    mag = np.abs(v)
+    if np.isnan(v).any():
+        assert np.isnan(largest)
+        return
+    assert largest == (mag.max() if v.size else 0.0)
+    nonzero = mag[mag != 0]
+    assert smallest == (nonzero.min() if nonzero.size else np.inf)
