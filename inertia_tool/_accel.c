@@ -3492,10 +3492,10 @@ static PyMethodDef accel_methods[] = {
      "kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
     {"edge_point_candidates", accel_edge_point_candidates, METH_VARARGS,
-     "edge_point_candidates(vertices, edges, points, cell, rtol, gap) -> (edge, point)\n\nEvery pair of an edge "
-     "of `edges` ((k, 2) int64) and a vertex of `points` ((p,) int64, not an end of it) near its interior: "
-     "within max(gap, 2 rtol * distance from the nearer end) of it, to round-off; bytes of int64 each, by edge; "
-     "`cell` only changes the speed (seal.py); section 9."},
+     "edge_point_candidates(vertices, edges, points, cell, rtol, gap, threads=1) -> (edge, point)\n\nEvery pair "
+     "of an edge of `edges` ((k, 2) int64) and a vertex of `points` ((p,) int64, not an end of it) near its "
+     "interior: within max(gap, 2 rtol * distance from the nearer end) of it, to round-off; bytes of int64 each, "
+     "by edge; `cell` and `threads` only change the speed (seal.py); section 9."},
     {"close_groups", accel_close_groups, METH_VARARGS,
      "close_groups(points, tolerance) -> bytes or None\n\nFor each of the (k, 3) float64 points, the lowest "
      "index in its group of points joined by distances <= tolerance, transitively (bytes of int64); None when the "
@@ -7405,6 +7405,8 @@ oe_grid_build(OeGrid *g, const double *base, const int64_t *pts, size_t p, const
         memcpy(g->coords + 3 * i, base + 3 * g->vertex[i], 3 * sizeof(double));
     }
     g->start[runs] = (uint32_t)p;
+    free(g->code);                                   /* the runs' codes are kept; the points' are not needed */
+    g->code = NULL;
     return 0;
 }
 
@@ -7530,12 +7532,64 @@ oe_edge_pairs(const OeGrid *g, const double *v, int64_t ia, int64_t ib, int64_t 
     return 0;
 }
 
+/* Edges (in the sorted order) handed out in blocks of this many to whichever thread is free. */
+#define OE_EDGE_BLOCK 4096
+/* Fewer edges than this run on one thread. */
+#define OE_THREAD_MIN_EDGES 65536
+
+typedef struct {
+    const OeGrid *grid;
+    const double *v;
+    const int64_t *e;
+    const uint32_t *order;        /* the edges in the Morton order of their first end's cell */
+    size_t k;
+    double rtol, gap;
+    OePairs *part;                /* one list of pairs per thread */
+    int failed[MAX_THREADS];
+    int32_t ticket;
+} OeEdgeTask;
+
+static void
+oe_edge_task(void *ctx, int t, int nt)
+{
+    OeEdgeTask *task = (OeEdgeTask *)ctx;
+    (void)nt;
+    const size_t k = task->k;
+    const uint32_t *order = task->order;
+    const int64_t *e = task->e;
+    const double *v = task->v;
+    for (;;) {
+        const size_t first = (size_t)next_ticket(&task->ticket) * OE_EDGE_BLOCK;
+        if (first >= k || task->failed[t]) {
+            return;
+        }
+        const size_t stop = first + OE_EDGE_BLOCK < k ? first + OE_EDGE_BLOCK : k;
+        for (size_t r = first; r < stop; r++) {
+            /* the edges and their ends are read in an order of their own: fetched ahead */
+            if (r + 16 < stop) {
+                oe_prefetch(e + 2 * (size_t)order[r + 16]);
+            }
+            if (r + 8 < stop) {
+                const int64_t *ahead = e + 2 * (size_t)order[r + 8];
+                oe_prefetch(v + 3 * ahead[0]);
+                oe_prefetch(v + 3 * ahead[1]);
+            }
+            const int64_t i = order[r];
+            if (oe_edge_pairs(task->grid, v, e[2 * i], e[2 * i + 1], i, task->rtol, task->gap, &task->part[t]) < 0) {
+                task->failed[t] = 1;
+                return;
+            }
+        }
+    }
+}
+
 static PyObject *
 accel_edge_point_candidates(PyObject *self, PyObject *args)
 {
     PyObject *vert_obj, *edges_obj, *points_obj;
     double cell, rtol, gap;
-    if (!PyArg_ParseTuple(args, "OOOddd", &vert_obj, &edges_obj, &points_obj, &cell, &rtol, &gap)) {
+    int threads = 1;
+    if (!PyArg_ParseTuple(args, "OOOddd|i", &vert_obj, &edges_obj, &points_obj, &cell, &rtol, &gap, &threads)) {
         return NULL;
     }
     Py_buffer views[3];
@@ -7544,6 +7598,8 @@ accel_edge_point_candidates(PyObject *self, PyObject *args)
     OeGrid grid;
     memset(&grid, 0, sizeof(grid));
     OePairs pairs = {NULL, NULL, 0, 0};
+    OePairs part[MAX_THREADS];
+    memset(part, 0, sizeof(part));
     uint32_t *eidx = NULL, *eidx2 = NULL;
     uint64_t *ecode = NULL, *ecode2 = NULL;
     int64_t *out_e = NULL, *out_m = NULL, *per_edge = NULL;
@@ -7635,45 +7691,53 @@ accel_edge_point_candidates(PyObject *self, PyObject *args)
         PyErr_NoMemory();
         goto done;
     }
-    int failed = 0;
+    free(ecode);                                     /* only the order is needed from here on */
+    free(ecode2);
+    free(eidx2);
+    ecode = ecode2 = NULL;
+    eidx2 = NULL;
+    const int nt = thread_count(threads, k, OE_THREAD_MIN_EDGES);
+    OeEdgeTask task = {&grid, v, e, eidx, k, rtol, gap, part, {0}, 0};
     Py_BEGIN_ALLOW_THREADS
-    for (size_t r = 0; r < k && !failed; r++) {
-        /* the edges and their ends are read in an order of their own: fetched ahead */
-        if (r + 16 < k) {
-            oe_prefetch(e + 2 * (size_t)eidx[r + 16]);
-        }
-        if (r + 8 < k) {
-            const int64_t *ahead = e + 2 * (size_t)eidx[r + 8];
-            oe_prefetch(v + 3 * ahead[0]);
-            oe_prefetch(v + 3 * ahead[1]);
-        }
-        const int64_t i = eidx[r];
-        failed = oe_edge_pairs(&grid, v, e[2 * i], e[2 * i + 1], i, rtol, gap, &pairs) < 0;
-    }
+    run_parallel(nt, oe_edge_task, &task);
     Py_END_ALLOW_THREADS
+    int failed = 0;
+    for (int t = 0; t < nt; t++) {
+        failed |= task.failed[t];
+    }
     if (failed) {
         PyErr_NoMemory();
         goto done;
     }
-    /* by edge, as the callers expect (a counting sort; the points of one edge in the order found) */
+    /* by edge, as the callers expect (a counting sort; the points of one edge in the order found: each edge is
+     * searched by one thread, so the order does not depend on the threads) */
+    size_t total = 0;
+    for (int t = 0; t < nt; t++) {
+        total += part[t].count;
+    }
     per_edge = (int64_t *)calloc(k + 1, sizeof(int64_t));
-    out_e = (int64_t *)malloc((pairs.count ? pairs.count : 1) * sizeof(int64_t));
-    out_m = (int64_t *)malloc((pairs.count ? pairs.count : 1) * sizeof(int64_t));
+    out_e = (int64_t *)malloc((total ? total : 1) * sizeof(int64_t));
+    out_m = (int64_t *)malloc((total ? total : 1) * sizeof(int64_t));
     if (per_edge == NULL || out_e == NULL || out_m == NULL) {
         PyErr_NoMemory();
         goto done;
     }
-    for (size_t j = 0; j < pairs.count; j++) {
-        per_edge[pairs.edge[j] + 1]++;
+    for (int t = 0; t < nt; t++) {
+        for (size_t j = 0; j < part[t].count; j++) {
+            per_edge[part[t].edge[j] + 1]++;
+        }
     }
     for (size_t i = 0; i < k; i++) {
         per_edge[i + 1] += per_edge[i];
     }
-    for (size_t j = 0; j < pairs.count; j++) {
-        int64_t to = per_edge[pairs.edge[j]]++;
-        out_e[to] = pairs.edge[j];
-        out_m[to] = pairs.point[j];
+    for (int t = 0; t < nt; t++) {
+        for (size_t j = 0; j < part[t].count; j++) {
+            int64_t to = per_edge[part[t].edge[j]]++;
+            out_e[to] = part[t].edge[j];
+            out_m[to] = part[t].point[j];
+        }
     }
+    pairs.count = total;
     free(pairs.edge);
     free(pairs.point);
     pairs.edge = out_e;
@@ -7703,6 +7767,10 @@ done:
     free(out_m);
     free(pairs.edge);
     free(pairs.point);
+    for (int t = 0; t < MAX_THREADS; t++) {
+        free(part[t].edge);
+        free(part[t].point);
+    }
     return result;
 }
 

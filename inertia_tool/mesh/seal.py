@@ -32,11 +32,11 @@ through untouched, and a big part with a small hole costs what the hole costs.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from .._native import accel
+from .._native import accel, threads
 from ..values import frozen_value
 from .edges import edge_keys
 
@@ -389,6 +389,20 @@ def _unique_rows(edges: np.ndarray, n: int) -> np.ndarray:
     return rows
 
 
+#: Points gathered at a time for their bounds (a soup's 3.9M boundary vertices were a 94 MB copy at the peak).
+_BOUNDS_CHUNK = 1 << 18
+
+
+def _bounds_of(lib: Any, v: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
+    """``lib.bounds(v[index])`` (lowest and highest coordinates, all finite) a chunk of points at a time."""
+    lo, hi, finite = np.full(3, np.inf), np.full(3, -np.inf), True
+    for start in range(0, len(index), _BOUNDS_CHUNK):          # bounded by len(index) / _BOUNDS_CHUNK + 1
+        part_lo, part_hi, part_finite = lib.bounds(np.ascontiguousarray(v[index[start:start + _BOUNDS_CHUNK]]))
+        finite = finite and bool(part_finite)
+        lo, hi = np.minimum(lo, part_lo), np.maximum(hi, part_hi)
+    return lo, hi, finite
+
+
 def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tuple[np.ndarray, np.ndarray]:
     """(edge row, vertex) pairs, by edge, of the edges' own vertices ``m`` (not an end of the edge) that may lie
     within ``gap`` of the edge's interior or on it to ``ON_EDGE_RTOL``: a superset of the pairs the callers'
@@ -401,11 +415,10 @@ def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tupl
     """
     bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v)))
     lib = accel()
-    points = v[bv]
     cell = np.inf
     finite = False
-    if lib is not None and len(points):
-        lo, hi, finite = lib.bounds(np.ascontiguousarray(points))
+    if lib is not None and len(bv):
+        lo, hi, finite = _bounds_of(lib, v, bv)
     if lib is not None and finite:
         extent = float(np.max(np.subtract(hi, lo)))
         # the edges' lengths on a sample (only the speed depends on the cell, so an estimate serves)
@@ -420,10 +433,11 @@ def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tupl
                    np.finfo(float).tiny)
     if lib is not None and np.isfinite(cell):      # else (no C extension, or coordinates overflowing): the tree
         pe, pm = lib.edge_point_candidates(np.ascontiguousarray(v), np.ascontiguousarray(edges, dtype=np.int64),
-                                           bv, cell, ON_EDGE_RTOL, float(gap))
+                                           bv, cell, ON_EDGE_RTOL, float(gap), threads())
         return np.frombuffer(pe, dtype=np.int64), np.frombuffer(pm, dtype=np.int64)
     from scipy.spatial import cKDTree
 
+    points = v[bv]
     a, b = v[edges[:, 0]], v[edges[:, 1]]
     length = np.linalg.norm(b - a, axis=1)
     near = cKDTree(points, balanced_tree=False, compact_nodes=False).query_ball_point(
