@@ -368,12 +368,13 @@ def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
     e, m = _edge_point_candidates(v, edges, 0.0)
     if not len(e):
         return np.zeros(0, dtype=np.int64)
-    a, b = v[edges[:, 0]], v[edges[:, 1]]
+    # the candidates' edges only (a soup's 3.9M edges as (k, 3) arrays were 300 MB at the peak for a few pairs)
+    a, b = v[edges[e, 0]], v[edges[e, 1]]
     ab = b - a
     length = np.linalg.norm(ab, axis=1)
-    t = np.einsum("ij,ij->i", v[m] - a[e], ab[e]) / np.maximum(length[e] ** 2, np.finfo(float).tiny)
-    dist = np.linalg.norm(v[m] - (a[e] + t[:, None] * ab[e]), axis=1)
-    to_end = np.minimum(np.linalg.norm(v[m] - a[e], axis=1), np.linalg.norm(v[m] - b[e], axis=1))
+    t = np.einsum("ij,ij->i", v[m] - a, ab) / np.maximum(length ** 2, np.finfo(float).tiny)
+    dist = np.linalg.norm(v[m] - (a + t[:, None] * ab), axis=1)
+    to_end = np.minimum(np.linalg.norm(v[m] - a, axis=1), np.linalg.norm(v[m] - b, axis=1))
     on = (t > 0) & (t < 1) & (dist <= ON_EDGE_RTOL * to_end)
     found: np.ndarray = np.flatnonzero(np.bincount(m[on], minlength=len(v)))    # sorted, each once
     return found
