@@ -305,11 +305,15 @@ def _split(v: np.ndarray, f: np.ndarray, slack: np.ndarray, gap: float, chain: _
     # the face holding each directed edge a→b, and which of its edges it is
     undirected, forward = edge_keys(f, len(v))            # edge slot j of face i: f[i, j] → f[i, j+1]
     key = 2 * undirected + forward
-    order = np.argsort(key, kind="stable")
     start, end = edges[e, 0].astype(np.int64), edges[e, 1].astype(np.int64)
     want = 2 * edge_keys(np.stack([start, end, end], axis=1), len(v))[0][0::3] + (start > end)
+    # the lowest slot holding each wanted key: only the slots holding one are sorted (not the whole frontier's)
+    targets = np.unique(want)
+    at = np.minimum(np.searchsorted(targets, key), len(targets) - 1)
+    hit = np.flatnonzero(targets[at] == key)
+    order = hit[np.argsort(key[hit], kind="stable")]
     pos = np.searchsorted(key[order], want)
-    found = (pos < len(key)) & (key[order][np.minimum(pos, len(key) - 1)] == want)
+    found = (pos < len(order)) & (key[order][np.minimum(pos, len(order) - 1)] == want)
     e, m, t, dist, pos = e[found], m[found], t[found], dist[found], pos[found]
     slot = order[pos]
     face, corner = slot // 3, slot % 3
