@@ -141,3 +141,14 @@ def test_a_cut_face_kept_inside_does_not_exit(seed):
     df = inverse.reshape(-1)[np.vstack([af[~on_a], fan, bf[~on_b] + len(av)])]
     exits, truth = _check(uniq, df)
     assert not exits and truth is not None and truth.inside == 1
+
+
+def test_thousands_of_holes_exit_on_a_sample_of_their_edges():
+    """More unbalanced edges than the exit tests (every k-th by key): one witness among them is enough."""
+    s = trimesh.creation.icosphere(6)
+    v, f = np.asarray(s.vertices), np.asarray(s.faces)
+    f = f[np.random.default_rng(2).random(len(f)) >= 0.1]
+    boundary = _boundary(v, f)
+    assert len(boundary) > 4 * sheets._GUARD_EDGES
+    assert _nothing_to_take(v, f, boundary, _tolerance(v), MAX_SHEET_PIECES)
+    assert _unguarded(v, f) is None

@@ -106,6 +106,8 @@ MAX_SHEET_PIECES = 64
 #: the surface for its solid-angle sum).
 _WINDING_SLACK = 0.05
 _EPS = float(np.finfo(np.float64).eps)
+#: Unbalanced edges the early exit tests at most (every k-th by key): one witness suffices.
+_GUARD_EDGES = 4096
 
 
 @frozen_value
@@ -291,7 +293,8 @@ def _nothing_to_take(v: np.ndarray, f: np.ndarray, boundary: np.ndarray | None, 
         opposite directions: one piece) then have their four corners in a slab of width ``2 · tolerance``, so
         the volume of the tetrahedron they span is at most ``2 · tolerance`` times its projected area, itself at
         most half its surface area ``S``: ``V ≤ tolerance · S``.  An unbalanced edge every face of which has such
-        a neighbour with ``V > tolerance · S`` beyond the rounding of both sides cannot be balanced.
+        a neighbour with ``V > tolerance · S`` beyond the rounding of both sides cannot be balanced (at most
+        ``_GUARD_EDGES`` unbalanced edges are tested, spread over their keys; no witness among them: False).
     """
     n = len(v)
     valence = np.bincount(f.reshape(-1), minlength=n)
@@ -302,9 +305,13 @@ def _nothing_to_take(v: np.ndarray, f: np.ndarray, boundary: np.ndarray | None, 
     nv = np.int64(max(n, 1))
     b = np.asarray(boundary, dtype=np.int64).reshape(-1, 2)
     unbalanced = np.unique(np.minimum(b[:, 0], b[:, 1]) * nv + np.maximum(b[:, 0], b[:, 1]))
+    # one unbalanced edge that nothing can balance is enough: a sample of them, spread over the keys, is tested
+    # (a surface with thousands of holes would otherwise cost a sort of most of its edges)
+    unbalanced = unbalanced[::-(-len(unbalanced) // _GUARD_EDGES)]
     on_rim = np.zeros(n, dtype=bool)
-    on_rim[b.reshape(-1)] = True
-    near = np.flatnonzero(on_rim[f].sum(axis=1) >= 2)               # every face using an unbalanced edge
+    on_rim[unbalanced // nv] = True
+    on_rim[unbalanced % nv] = True
+    near = np.flatnonzero(on_rim[f].sum(axis=1) >= 2)               # every face using an edge tested
     key = edge_keys(f[near], n)[0]
     pos = np.minimum(np.searchsorted(unbalanced, key), len(unbalanced) - 1)
     uses = np.flatnonzero(unbalanced[pos] == key)                   # (slot in near) of each use of one
@@ -334,7 +341,7 @@ def _nothing_to_take(v: np.ndarray, f: np.ndarray, boundary: np.ndarray | None, 
     curved = np.zeros(len(f), dtype=bool)
     curved[face_f[bent]] = True
     curved[face_g[bent]] = True
-    # an unbalanced edge none of whose faces can lie in a flat piece: nothing balances it
+    # a tested edge none of whose faces can lie in a flat piece: nothing balances it
     ok = np.zeros(len(unbalanced), dtype=bool)
     ok[pos[uses][~curved[near[uses // 3]]]] = True
     return not bool(ok.all())
