@@ -17,7 +17,8 @@ from inertia_tool.mesh import sheets
 from inertia_tool.mesh.resolve import _census
 from inertia_tool.mesh.sheets import MAX_SHEET_PIECES, _nothing_to_take, open_sheets
 from inertia_tool.tolerances import WALL_PLANE_RTOL
-from test_mesh_sheets import _convex, _polygon_sheet, _with
+from solids import random_convex as _convex
+from test_mesh_sheets import _polygon_sheet, _with
 
 FAST = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
