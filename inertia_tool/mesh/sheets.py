@@ -342,7 +342,8 @@ def _nothing_to_take(v: np.ndarray, f: np.ndarray, boundary: np.ndarray | None, 
     curved[face_f[bent]] = True
     curved[face_g[bent]] = True
     # a tested edge none of whose faces can lie in a flat piece: nothing balances it
-    ok = np.zeros(len(unbalanced), dtype=bool)
+    ok = np.ones(len(unbalanced), dtype=bool)
+    ok[pos[uses]] = False                          # (an edge no face uses, as in no census, witnesses nothing)
     ok[pos[uses][~curved[near[uses // 3]]]] = True
     return not bool(ok.all())
 
