@@ -25,9 +25,12 @@ wrong answer shows.  The machine's load average is printed with the table (timin
 the CPU time is the steadier figure).
 
     python benchmarks/bench_repair.py [--bases torus sphere] [--kinds hole scattered soup tjunction]
-                                      [--repeat 1] [--seed 0] [--profile CASE]
+                                      [--repeat 1] [--seed 0] [--profile CASE] [--baseline DIR]
 
-``--profile torus_soup`` runs one case in-process under cProfile and prints the 25 most expensive functions.
+``--profile torus_soup`` runs one case in-process under cProfile (CPU time) and prints the 25 most expensive
+functions.  ``--baseline DIR`` (another checkout of the repository, its C extension built) runs every case on
+it too, alternating with this checkout repeat by repeat (so both see the same load), and prints CPU time and
+peak memory as ``before → after`` with a column saying whether the answers (the whole JSON report) are the same.
 """
 
 from __future__ import annotations
@@ -115,9 +118,10 @@ def build(bases: list[str], kinds: list[str], seed: int) -> list[dict]:
     for base in bases:
         v, f = BASES[base]()
         truth = clean_volume(v, f)
-        for k, kind in enumerate(kinds):
+        for kind in kinds:
             path = os.path.join(OUT, f"{base}_{kind}_s{seed}.stl")
-            rng = np.random.default_rng([seed, k, len(f)])
+            # seeded by the kind's place in KINDS, not in `kinds`: a subset builds the same files
+            rng = np.random.default_rng([seed, KINDS.index(kind), len(f)])
             tri = damage(kind, v, f, rng)
             if not os.path.exists(path):
                 write_binary_stl(path, tri, header=b"inertia_tool repair benchmark")
@@ -125,19 +129,33 @@ def build(bases: list[str], kinds: list[str], seed: int) -> list[dict]:
     return cases
 
 
-def run(case: dict, repeat: int) -> dict:
+def child(path: str, root: str) -> dict:
+    """One run of the case in a fresh process importing ``inertia_tool`` from ``root`` (its working directory
+    too: ``python -c`` puts the current directory first on the path)."""
     env = {k: val for k, val in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    env["PYTHONPATH"] = ROOT
+    env["PYTHONPATH"] = root
+    r = subprocess.run([sys.executable, "-c", CHILD, path], capture_output=True, text=True, env=env, cwd=root)
+    if r.returncode != 0:
+        raise RuntimeError(f"child failed on {path}: {r.stderr[-2000:]}")
+    got: dict = json.loads(r.stdout.strip().splitlines()[-1])
+    return got
+
+
+def run(case: dict, repeat: int, baseline: str | None = None) -> dict:
     best: dict | None = None
+    before: dict | None = None
     for _ in range(repeat):
-        r = subprocess.run([sys.executable, "-c", CHILD, case["path"]], capture_output=True, text=True, env=env)
-        if r.returncode != 0:
-            raise RuntimeError(f"child failed on {case['path']}: {r.stderr[-2000:]}")
-        got = json.loads(r.stdout.strip().splitlines()[-1])
+        if baseline is not None:
+            old = child(case["path"], baseline)
+            before = old if before is None or old["cpu"] < before["cpu"] else before
+        got = child(case["path"], ROOT)
         if best is None or got["wall"] < best["wall"]:
             best = got
     assert best is not None
     row = dict(case, wall=best["wall"], cpu=best["cpu"], peak_mb=best["peak"] / 2 ** 20, rc=best["rc"])
+    if before is not None:
+        row.update(cpu_before=before["cpu"], peak_mb_before=before["peak"] / 2 ** 20,
+                   same=(before["rc"], before["out"]) == (best["rc"], best["out"]))
     if best["rc"] == 0:
         doc = json.loads(best["out"])
         row["method"] = doc.get("method")
@@ -157,7 +175,8 @@ def profile(name: str, seed: int) -> None:
     from inertia_tool.cli import main
     import contextlib
     import io
-    prof = cProfile.Profile()
+    import time
+    prof = cProfile.Profile(time.process_time)      # CPU time: the machine is shared
     with contextlib.redirect_stdout(io.StringIO()), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         prof.enable()
@@ -173,23 +192,34 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--profile", help="run one case (e.g. torus_soup) in-process under cProfile")
+    parser.add_argument("--baseline", help="another checkout to compare with (CPU and peak memory before → after)")
     args = parser.parse_args()
     if args.profile:
         profile(args.profile, args.seed)
         return
+    baseline = os.path.abspath(args.baseline) if args.baseline else None
     cases = build(args.bases, args.kinds, args.seed)
     print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}; {os.cpu_count()} cores")
-    print(f"{'case':<18} {'faces':>9} {'wall s':>7} {'cpu s':>7} {'peak MB':>8}  {'method':<12} {'cert':<10} "
-          f"{'vol err':>9} {'bound':>9}")
+    if baseline:
+        print(f"before: {baseline}; after: {ROOT}")
+        print(f"{'case':<18} {'faces':>9} {'cpu s before → after':>22} {'peak MB before → after':>24} {'wall s':>7}  "
+              f"{'same':<5} {'method':<12} {'cert':<10} {'vol err':>9} {'bound':>9}")
+    else:
+        print(f"{'case':<18} {'faces':>9} {'wall s':>7} {'cpu s':>7} {'peak MB':>8}  {'method':<12} {'cert':<10} "
+              f"{'vol err':>9} {'bound':>9}")
     for case in cases:
-        row = run(case, args.repeat)
+        row = run(case, args.repeat, baseline)
+        if baseline:
+            head = (f"{row['case']:<18} {row['faces']:>9,} {row['cpu_before']:10.2f} → {row['cpu']:<9.2f} "
+                    f"{row['peak_mb_before']:11.0f} → {row['peak_mb']:<10.0f} {row['wall']:7.2f}  "
+                    f"{'yes' if row['same'] else 'NO':<5}")
+        else:
+            head = f"{row['case']:<18} {row['faces']:>9,} {row['wall']:7.2f} {row['cpu']:7.2f} {row['peak_mb']:8.0f} "
         if row["rc"] != 0:
-            print(f"{row['case']:<18} {row['faces']:>9,} {row['wall']:7.2f} {row['cpu']:7.2f} {row['peak_mb']:8.0f}  "
-                  f"refused (exit {row['rc']})")
+            print(f"{head} refused (exit {row['rc']})")
             continue
         err = (row["volume_mm3"] - row["truth_mm3"]) / row["truth_mm3"] if row.get("volume_mm3") else float("nan")
-        print(f"{row['case']:<18} {row['faces']:>9,} {row['wall']:7.2f} {row['cpu']:7.2f} {row['peak_mb']:8.0f}  "
-              f"{row['method'] or '?':<12} {row['certificate'] or '?':<10} {err:9.2e} {row['mass_bound']:9.2e}")
+        print(f"{head} {row['method'] or '?':<12} {row['certificate'] or '?':<10} {err:9.2e} {row['mass_bound']:9.2e}")
     print(f"load average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 

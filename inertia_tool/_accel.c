@@ -3492,10 +3492,10 @@ static PyMethodDef accel_methods[] = {
      "kind (bytes of int8, -1: left to numpy) list the pairs that meet; "
      "axis (bytes of int8) and degenerate (bytes of uint8) per face; ""max_pairs < 0: no bound; section 8."},
     {"edge_point_candidates", accel_edge_point_candidates, METH_VARARGS,
-     "edge_point_candidates(vertices, edges, points, cell, rtol, gap) -> (edge, point)\n\nEvery pair of an edge "
-     "of `edges` ((k, 2) int64) and a vertex of `points` ((p,) int64, not an end of it) near its interior: "
-     "within max(gap, 2 rtol * distance from the nearer end) of it, to round-off; bytes of int64 each, by edge; "
-     "`cell` only changes the speed (seal.py); section 9."},
+     "edge_point_candidates(vertices, edges, points, cell, rtol, gap, threads=1) -> (edge, point)\n\nEvery pair "
+     "of an edge of `edges` ((k, 2) int64) and a vertex of `points` ((p,) int64, not an end of it) near its "
+     "interior: within max(gap, 2 rtol * distance from the nearer end) of it, to round-off; bytes of int64 each, "
+     "by edge; `cell` and `threads` only change the speed (seal.py); section 9."},
     {"close_groups", accel_close_groups, METH_VARARGS,
      "close_groups(points, tolerance) -> bytes or None\n\nFor each of the (k, 3) float64 points, the lowest "
      "index in its group of points joined by distances <= tolerance, transitively (bytes of int64); None when the "
@@ -7130,6 +7130,10 @@ done:
  * Morton order of their first end's cell, so consecutive edges read nearby cells.  Each edge is cut into pieces
  * no longer than cell / 2 and every cell met by a piece's box, widened by the distance above, is visited (those
  * of the previous piece's box once): a pair that passes lies in one of those boxes, and the test alone decides.
+ * A cell's slot in the table holds its span of sorted points, and each sorted point its coordinates and vertex
+ * together (one read each).  The edges are searched on `threads` threads, in blocks of the sorted order handed
+ * to whichever thread is free; each edge's pairs come from one thread, so the merged list does not depend on
+ * the count.
  * The seconds of a soup's T-vertex search (every vertex on the boundary) were a k-d tree's Python lists (~9
  * points per edge), then 5.5 s of this search in the edges' file order on a 1.3M-face soup (random access).
  * ====================================================================================================== */
@@ -7209,21 +7213,22 @@ oe_hash(uint64_t code, size_t mask)
 
 typedef struct {
     uint64_t key;                 /* the cell's code, OE_EMPTY for a free slot */
-    uint64_t run;                 /* the cell's rank in code order */
+    uint64_t run;                 /* close_groups' blocks: the first run's rank; the grid's cells: their span */
 } OeSlot;
 
-/* The run (rank in code order) of the occupied cell `code`, or -1. */
-static inline int64_t
+/* The span of the occupied cell `code` in the grid's table (its first sorted point in the low 32 bits, the end
+ * in the high 32: read with the slot, not from another array), or OE_EMPTY. */
+static inline uint64_t
 oe_find(const OeSlot *table, size_t mask, uint64_t code)
 {
     size_t s = oe_hash(code, mask);
     while (table[s].key != OE_EMPTY) {
         if (table[s].key == code) {
-            return (int64_t)table[s].run;
+            return table[s].run;
         }
         s = (s + 1) & mask;
     }
-    return -1;
+    return OE_EMPTY;
 }
 
 /* floor((x - lo) / cell) as an integer: truncation corrected below zero (floor() is a library call without
@@ -7296,17 +7301,23 @@ oe_radix_sort(uint64_t **code, uint32_t **idx, uint64_t **code2, uint32_t **idx2
 
 /* Points bucketed into cubic cells: sorted by the Morton code of their cell, each occupied cell a run of
  * them, found through a hash table of codes. */
+/* A sorted point of the grid with a table: its coordinates and vertex together, one read for both. */
+typedef struct {
+    double x[3];
+    int64_t vertex;               /* pts[idx], or idx without pts */
+} OePoint;
+
 typedef struct {
     double lo[3], cell;
     size_t p, runs, mask;
     int64_t top[3];               /* the largest cell index used, per axis */
-    OeSlot *table;
-    uint64_t *code;               /* (p) the sorted codes */
+    OeSlot *table;                /* with a table: each occupied cell's code and span */
+    uint64_t *code;               /* (p) the sorted codes (while building) */
     uint32_t *idx;                /* (p) the position in the input of each sorted point */
-    int64_t *vertex;              /* (p) the vertex (pts[idx], or idx without pts) of each sorted point */
     uint32_t *start;              /* (runs + 1) the first sorted point of each run */
     uint64_t *run_code;           /* (runs) */
-    double *coords;               /* (3 p) the points in sorted order */
+    double *coords;               /* (3 p) the points in sorted order (without a table) */
+    OePoint *point;               /* (p) the points in sorted order with their vertices (with a table) */
 } OeGrid;
 
 static void
@@ -7315,10 +7326,10 @@ oe_grid_free(OeGrid *g)
     free(g->table);
     free(g->code);
     free(g->idx);
-    free(g->vertex);
     free(g->start);
     free(g->run_code);
     free(g->coords);
+    free(g->point);
 }
 
 /* Bucket the points xyz(i), i < p (at `stride` doubles apart from `base`, gathered through `pts` when not
@@ -7378,9 +7389,14 @@ oe_grid_build(OeGrid *g, const double *base, const int64_t *pts, size_t p, const
     g->table = (OeSlot *)malloc(size * sizeof(OeSlot));
     g->start = (uint32_t *)malloc((runs + 1) * sizeof(uint32_t));
     g->run_code = (uint64_t *)malloc((runs ? runs : 1) * sizeof(uint64_t));
-    g->coords = (double *)malloc((p ? 3 * p : 1) * sizeof(double));
-    g->vertex = (int64_t *)malloc((p ? p : 1) * sizeof(int64_t));
-    if (g->table == NULL || g->start == NULL || g->run_code == NULL || g->coords == NULL || g->vertex == NULL) {
+    if (with_table) {
+        g->point = (OePoint *)malloc((p ? p : 1) * sizeof(OePoint));
+    }
+    else {
+        g->coords = (double *)malloc((p ? 3 * p : 1) * sizeof(double));
+    }
+    if (g->table == NULL || g->start == NULL || g->run_code == NULL || (with_table ? g->point == NULL :
+                                                                        g->coords == NULL)) {
         return -1;
     }
     for (size_t s = 0; s < size; s++) {
@@ -7388,23 +7404,31 @@ oe_grid_build(OeGrid *g, const double *base, const int64_t *pts, size_t p, const
     }
     size_t r = 0;
     for (size_t i = 0; i < p; i++) {
-        if (i == 0 || g->code[i] != g->code[i - 1]) {      /* runs inserted in code order: near in the table */
-            if (with_table) {
-                size_t s = oe_hash(g->code[i], g->mask);
-                while (g->table[s].key != OE_EMPTY) {
-                    s = (s + 1) & g->mask;
-                }
-                g->table[s].key = g->code[i];
-                g->table[s].run = r;
-            }
+        if (i == 0 || g->code[i] != g->code[i - 1]) {
             g->start[r] = (uint32_t)i;
             g->run_code[r] = g->code[i];
             r++;
         }
-        g->vertex[i] = pts ? pts[g->idx[i]] : (int64_t)g->idx[i];
-        memcpy(g->coords + 3 * i, base + 3 * g->vertex[i], 3 * sizeof(double));
+        const int64_t vertex = pts ? pts[g->idx[i]] : (int64_t)g->idx[i];
+        if (with_table) {
+            g->point[i].vertex = vertex;
+            memcpy(g->point[i].x, base + 3 * vertex, 3 * sizeof(double));
+        }
+        else {
+            memcpy(g->coords + 3 * i, base + 3 * vertex, 3 * sizeof(double));
+        }
     }
     g->start[runs] = (uint32_t)p;
+    for (size_t q = 0; with_table && q < runs; q++) {  /* runs inserted in code order: near in the table */
+        size_t s = oe_hash(g->run_code[q], g->mask);
+        while (g->table[s].key != OE_EMPTY) {
+            s = (s + 1) & g->mask;
+        }
+        g->table[s].key = g->run_code[q];
+        g->table[s].run = ((uint64_t)g->start[q + 1] << 32) | (uint64_t)g->start[q];
+    }
+    free(g->code);                                   /* the runs' codes are kept; the points' are not needed */
+    g->code = NULL;
     return 0;
 }
 
@@ -7489,17 +7513,17 @@ oe_edge_pairs(const OeGrid *g, const double *v, int64_t ia, int64_t ib, int64_t 
                         iz >= prev_lo[2] && iz <= prev_hi[2]) {
                         continue;                             /* visited for the previous piece */
                     }
-                    const int64_t run = oe_find(g->table, g->mask, oe_code(ix, iy, iz));
-                    if (run < 0) {
+                    const uint64_t span = oe_find(g->table, g->mask, oe_code(ix, iy, iz));
+                    if (span == OE_EMPTY) {
                         continue;
                     }
-                    const int64_t first = g->start[run], stop = g->start[run + 1];
+                    const int64_t first = (int64_t)(span & 0xffffffffULL), stop = (int64_t)(span >> 32);
                     for (int64_t j = first; j < stop; j++) {
-                        const int64_t im = g->vertex[j];
+                        const int64_t im = g->point[j].vertex;
                         if (im == ia || im == ib) {
                             continue;
                         }
-                        const double *M = g->coords + 3 * j;
+                        const double *M = g->point[j].x;
                         const double w0 = M[0] - A[0], w1 = M[1] - A[1], w2 = M[2] - A[2];
                         const double dot = (w0 * d0 + w1 * d1) + w2 * d2;
                         if (!(dot > -1e-12 * len2 && dot < (1.0 + 1e-12) * len2)) {
@@ -7530,12 +7554,64 @@ oe_edge_pairs(const OeGrid *g, const double *v, int64_t ia, int64_t ib, int64_t 
     return 0;
 }
 
+/* Edges (in the sorted order) handed out in blocks of this many to whichever thread is free. */
+#define OE_EDGE_BLOCK 4096
+/* Fewer edges than this run on one thread. */
+#define OE_THREAD_MIN_EDGES 65536
+
+typedef struct {
+    const OeGrid *grid;
+    const double *v;
+    const int64_t *e;
+    const uint32_t *order;        /* the edges in the Morton order of their first end's cell */
+    size_t k;
+    double rtol, gap;
+    OePairs *part;                /* one list of pairs per thread */
+    int failed[MAX_THREADS];
+    int32_t ticket;
+} OeEdgeTask;
+
+static void
+oe_edge_task(void *ctx, int t, int nt)
+{
+    OeEdgeTask *task = (OeEdgeTask *)ctx;
+    (void)nt;
+    const size_t k = task->k;
+    const uint32_t *order = task->order;
+    const int64_t *e = task->e;
+    const double *v = task->v;
+    for (;;) {
+        const size_t first = (size_t)next_ticket(&task->ticket) * OE_EDGE_BLOCK;
+        if (first >= k || task->failed[t]) {
+            return;
+        }
+        const size_t stop = first + OE_EDGE_BLOCK < k ? first + OE_EDGE_BLOCK : k;
+        for (size_t r = first; r < stop; r++) {
+            /* the edges and their ends are read in an order of their own: fetched ahead */
+            if (r + 16 < stop) {
+                oe_prefetch(e + 2 * (size_t)order[r + 16]);
+            }
+            if (r + 8 < stop) {
+                const int64_t *ahead = e + 2 * (size_t)order[r + 8];
+                oe_prefetch(v + 3 * ahead[0]);
+                oe_prefetch(v + 3 * ahead[1]);
+            }
+            const int64_t i = order[r];
+            if (oe_edge_pairs(task->grid, v, e[2 * i], e[2 * i + 1], i, task->rtol, task->gap, &task->part[t]) < 0) {
+                task->failed[t] = 1;
+                return;
+            }
+        }
+    }
+}
+
 static PyObject *
 accel_edge_point_candidates(PyObject *self, PyObject *args)
 {
     PyObject *vert_obj, *edges_obj, *points_obj;
     double cell, rtol, gap;
-    if (!PyArg_ParseTuple(args, "OOOddd", &vert_obj, &edges_obj, &points_obj, &cell, &rtol, &gap)) {
+    int threads = 1;
+    if (!PyArg_ParseTuple(args, "OOOddd|i", &vert_obj, &edges_obj, &points_obj, &cell, &rtol, &gap, &threads)) {
         return NULL;
     }
     Py_buffer views[3];
@@ -7544,6 +7620,8 @@ accel_edge_point_candidates(PyObject *self, PyObject *args)
     OeGrid grid;
     memset(&grid, 0, sizeof(grid));
     OePairs pairs = {NULL, NULL, 0, 0};
+    OePairs part[MAX_THREADS];
+    memset(part, 0, sizeof(part));
     uint32_t *eidx = NULL, *eidx2 = NULL;
     uint64_t *ecode = NULL, *ecode2 = NULL;
     int64_t *out_e = NULL, *out_m = NULL, *per_edge = NULL;
@@ -7635,45 +7713,53 @@ accel_edge_point_candidates(PyObject *self, PyObject *args)
         PyErr_NoMemory();
         goto done;
     }
-    int failed = 0;
+    free(ecode);                                     /* only the order is needed from here on */
+    free(ecode2);
+    free(eidx2);
+    ecode = ecode2 = NULL;
+    eidx2 = NULL;
+    const int nt = thread_count(threads, k, OE_THREAD_MIN_EDGES);
+    OeEdgeTask task = {&grid, v, e, eidx, k, rtol, gap, part, {0}, 0};
     Py_BEGIN_ALLOW_THREADS
-    for (size_t r = 0; r < k && !failed; r++) {
-        /* the edges and their ends are read in an order of their own: fetched ahead */
-        if (r + 16 < k) {
-            oe_prefetch(e + 2 * (size_t)eidx[r + 16]);
-        }
-        if (r + 8 < k) {
-            const int64_t *ahead = e + 2 * (size_t)eidx[r + 8];
-            oe_prefetch(v + 3 * ahead[0]);
-            oe_prefetch(v + 3 * ahead[1]);
-        }
-        const int64_t i = eidx[r];
-        failed = oe_edge_pairs(&grid, v, e[2 * i], e[2 * i + 1], i, rtol, gap, &pairs) < 0;
-    }
+    run_parallel(nt, oe_edge_task, &task);
     Py_END_ALLOW_THREADS
+    int failed = 0;
+    for (int t = 0; t < nt; t++) {
+        failed |= task.failed[t];
+    }
     if (failed) {
         PyErr_NoMemory();
         goto done;
     }
-    /* by edge, as the callers expect (a counting sort; the points of one edge in the order found) */
+    /* by edge, as the callers expect (a counting sort; the points of one edge in the order found: each edge is
+     * searched by one thread, so the order does not depend on the threads) */
+    size_t total = 0;
+    for (int t = 0; t < nt; t++) {
+        total += part[t].count;
+    }
     per_edge = (int64_t *)calloc(k + 1, sizeof(int64_t));
-    out_e = (int64_t *)malloc((pairs.count ? pairs.count : 1) * sizeof(int64_t));
-    out_m = (int64_t *)malloc((pairs.count ? pairs.count : 1) * sizeof(int64_t));
+    out_e = (int64_t *)malloc((total ? total : 1) * sizeof(int64_t));
+    out_m = (int64_t *)malloc((total ? total : 1) * sizeof(int64_t));
     if (per_edge == NULL || out_e == NULL || out_m == NULL) {
         PyErr_NoMemory();
         goto done;
     }
-    for (size_t j = 0; j < pairs.count; j++) {
-        per_edge[pairs.edge[j] + 1]++;
+    for (int t = 0; t < nt; t++) {
+        for (size_t j = 0; j < part[t].count; j++) {
+            per_edge[part[t].edge[j] + 1]++;
+        }
     }
     for (size_t i = 0; i < k; i++) {
         per_edge[i + 1] += per_edge[i];
     }
-    for (size_t j = 0; j < pairs.count; j++) {
-        int64_t to = per_edge[pairs.edge[j]]++;
-        out_e[to] = pairs.edge[j];
-        out_m[to] = pairs.point[j];
+    for (int t = 0; t < nt; t++) {
+        for (size_t j = 0; j < part[t].count; j++) {
+            int64_t to = per_edge[part[t].edge[j]]++;
+            out_e[to] = part[t].edge[j];
+            out_m[to] = part[t].point[j];
+        }
     }
+    pairs.count = total;
     free(pairs.edge);
     free(pairs.point);
     pairs.edge = out_e;
@@ -7703,6 +7789,10 @@ done:
     free(out_m);
     free(pairs.edge);
     free(pairs.point);
+    for (int t = 0; t < MAX_THREADS; t++) {
+        free(part[t].edge);
+        free(part[t].point);
+    }
     return result;
 }
 

@@ -206,3 +206,32 @@ def test_long_edges_over_a_fine_part():
     found = on_edge_vertices(v, edges)
     np.testing.assert_array_equal(found, brute_force(v, edges))
     assert 3004 in found
+
+
+@pytest.mark.skipif(not HAVE_ACCEL, reason="the C kernel's threads")
+@pytest.mark.parametrize("gap", [0.0, 2e-3])
+def test_the_kernel_lists_the_same_pairs_on_any_number_of_threads(gap):
+    """The edges are searched in blocks by whichever thread is free and merged by edge: the pairs, and their
+    order within an edge, do not depend on the threads (a jittered soup of 245,760 edges, above the kernel's
+    threshold for threads, with T-vertices put on some edges; with a gap, millions of pairs)."""
+    import trimesh
+
+    from inertia_tool._native import accel
+
+    rng = np.random.default_rng(4)
+    s = trimesh.creation.icosphere(6)
+    tri = np.asarray(s.vertices)[np.asarray(s.faces)]
+    tri = tri + rng.normal(size=tri.shape) * 1e-7
+    v = tri.reshape(-1, 3)
+    edges = np.stack([np.arange(len(v)), np.arange(len(v)).reshape(-1, 3)[:, [1, 2, 0]].reshape(-1)], axis=1)
+    pick = rng.choice(len(edges), size=500, replace=False)
+    v = np.vstack([v, 0.5 * (v[edges[pick, 0]] + v[edges[pick, 1]])])      # midpoints: on their edges
+    edges = np.vstack([edges, edges[pick][:, ::-1]])                       # and the coarse sides, reversed
+    points = np.arange(len(v))
+    lib = accel()
+    cell = float(np.median(np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1)))
+    args = (np.ascontiguousarray(v), np.ascontiguousarray(edges, dtype=np.int64), points, cell, ON_EDGE_RTOL, gap)
+    one = lib.edge_point_candidates(*args)
+    assert len(one[0]) // 8 >= 500
+    for threads in (1, 2, 3, 16):
+        assert lib.edge_point_candidates(*args, threads) == one

@@ -250,7 +250,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                               census.nonmanifold_edges)
         current, flipped = oriented.faces, oriented.flipped_faces
     from .sheets import open_sheets
-    sheets = open_sheets(v, current)                                                                # R3b
+    sheets = open_sheets(v, current, boundary=found.boundary)                                       # R3b
     if sheets is not None and not sheets.fins:
         kept = _census(sheets.faces, n).balance
         notes = ((f"{flipped:,} faces were wound the wrong way and were turned",) if flipped else ()) + \

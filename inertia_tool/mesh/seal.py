@@ -32,9 +32,11 @@ through untouched, and a big part with a small hole costs what the hole costs.
 
 from __future__ import annotations
 
+from typing import Any, NamedTuple
+
 import numpy as np
 
-from .._native import accel
+from .._native import accel, threads
 from ..values import frozen_value
 from .edges import edge_keys
 
@@ -125,6 +127,71 @@ def _boundary_vertices(faces: np.ndarray, n: int, region: np.ndarray | None = No
     return np.flatnonzero(np.bincount(edges.reshape(-1), minlength=n)) if len(edges) else np.zeros(0, np.int64)
 
 
+class _Chain(NamedTuple):
+    """The frontier's boundary 1-chain, kept up to date as sealing replaces faces instead of found again from all
+    the frontier's faces each round (seven times on a T-split part, 1 s of its 1.7 s seal): ``key`` (k,) int64 the
+    edges' undirected keys (:func:`~.edges.edge_keys`), ascending, each once; ``net`` (k,) int64, nonzero, the uses
+    ``min→max`` minus ``max→min``.  Only edges with an end in the region (every other edge is balanced)."""
+
+    key: np.ndarray
+    net: np.ndarray
+
+
+def _signed_keys(faces: np.ndarray, n: int, region: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    key, forward = edge_keys(faces, n)
+    sign = np.where(forward, -1, 1).astype(np.int64)
+    if region is not None and len(key):
+        nn = np.int64(max(n, 1))
+        near = region[key // nn] | region[key % nn]
+        key, sign = key[near], sign[near]
+    return key, sign
+
+
+def _reduce(key: np.ndarray, sign: np.ndarray) -> _Chain:
+    order = np.argsort(key, kind="stable")
+    key, sign = key[order], sign[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]]) if len(key) else np.zeros(0, dtype=np.int64)
+    net = np.add.reduceat(sign, starts) if len(key) else np.zeros(0, dtype=np.int64)
+    keep = net != 0
+    return _Chain(key[starts][keep], net[keep])
+
+
+def _chain_of_faces(faces: np.ndarray, n: int, region: np.ndarray | None) -> _Chain:
+    return _reduce(*_signed_keys(faces, n, region))
+
+
+def _chain_of_edges(edges: np.ndarray, n: int) -> _Chain:
+    """The chain of directed edges with multiplicity (a boundary as :func:`~.rims.boundary_edges` gives it)."""
+    a, b = edges[:, 0].astype(np.int64), edges[:, 1].astype(np.int64)
+    nn = np.int64(max(n, 1))
+    return _reduce(np.minimum(a, b) * nn + np.maximum(a, b), np.where(a < b, 1, -1).astype(np.int64))
+
+
+def _chain_update(chain: _Chain, removed: np.ndarray, added: np.ndarray, n: int,
+                  region: np.ndarray | None) -> _Chain:
+    """``chain`` with the faces ``removed`` taken out and ``added`` put in (chains add: the boundary of a sum of
+    faces is the sum of their boundaries)."""
+    k_out, s_out = _signed_keys(removed, n, region)
+    k_in, s_in = _signed_keys(added, n, region)
+    return _reduce(np.concatenate([chain.key, k_out, k_in]), np.concatenate([chain.net, -s_out, s_in]))
+
+
+def _chain_edges(chain: _Chain, n: int) -> np.ndarray:
+    """Directed edges with multiplicity, in the order of :func:`_frontier_boundary` (by key, each ``|net|``
+    times in its net direction)."""
+    nn = np.int64(max(n, 1))
+    lo, hi = chain.key // nn, chain.key % nn
+    reps = np.abs(chain.net)
+    return np.stack([np.repeat(np.where(chain.net > 0, lo, hi), reps),
+                     np.repeat(np.where(chain.net > 0, hi, lo), reps)], axis=1)
+
+
+def _chain_vertices(chain: _Chain, n: int) -> np.ndarray:
+    nn = np.int64(max(n, 1))
+    ends = np.concatenate([chain.key // nn, chain.key % nn])
+    return np.flatnonzero(np.bincount(ends, minlength=n)) if len(ends) else np.zeros(0, np.int64)
+
+
 def drop_duplicate_faces(faces: np.ndarray) -> tuple[np.ndarray, int]:
     """Drop repeated copies of a face (same corners, same winding); a face and its reverse both stay.
 
@@ -170,14 +237,20 @@ def _weld_lips(v: np.ndarray, f: np.ndarray, slack: np.ndarray, vertex_slack: np
 
     The groups (vertices within ``gap``, transitively) are :func:`~.merge.lowest_in_group`'s, the tolerance
     weld's search (a C kernel; a k-d tree here cost the soup scipy's import, ~1 s, besides the search)."""
+    return _weld(v, f, slack, vertex_slack, gap, _chain_of_faces(f, len(v), region), region)[:4]
+
+
+def _weld(v: np.ndarray, f: np.ndarray, slack: np.ndarray, vertex_slack: np.ndarray, gap: float, chain: _Chain,
+          region: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, float, int, _Chain]:
+    """:func:`_weld_lips` on the frontier whose boundary is ``chain``; also returns the chain after it."""
     from .merge import lowest_in_group
 
-    bv = _boundary_vertices(f, len(v), region)
+    bv = _chain_vertices(chain, len(v))
     if len(bv) < 2:
-        return f, slack, 0.0, 0
+        return f, slack, 0.0, 0, chain
     lowest = lowest_in_group(v[bv], gap)
     if lowest is None:
-        return f, slack, 0.0, 0
+        return f, slack, 0.0, 0, chain
     rep = bv[lowest]                                        # lowest local index = lowest vertex (bv is sorted)
     move = np.linalg.norm(v[bv] - v[rep], axis=1) + vertex_slack[bv]
     np.maximum.at(vertex_slack, rep, move)
@@ -188,7 +261,9 @@ def _weld_lips(v: np.ndarray, f: np.ndarray, slack: np.ndarray, vertex_slack: np
     collapsed = (g[:, 0] == g[:, 1]) | (g[:, 1] == g[:, 2]) | (g[:, 2] == g[:, 0])
     d = np.maximum(slack, vertex_slack[g].max(axis=1))
     dropped = float(np.sum(parallel_body_volume(v, f[collapsed], d[collapsed]))) if collapsed.any() else 0.0
-    return g[~collapsed], d[~collapsed], dropped, merged
+    changed = (g != f).any(axis=1)
+    chain = _chain_update(chain, f[changed], g[changed & ~collapsed], len(v), region)
+    return g[~collapsed], d[~collapsed], dropped, merged, chain
 
 
 def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
@@ -196,16 +271,22 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
                        ) -> tuple[np.ndarray, np.ndarray, int]:
     """Step 2: split faces at boundary vertices lying on the interior of a boundary edge; returns faces,
     slack and the number of vertices inserted (``on_edge_only``: only vertices on the edge to round-off)."""
-    edges = _frontier_boundary(f, len(v), region)
-    if not len(edges):
-        return f, slack, 0
+    return _split(v, f, slack, gap, _chain_of_faces(f, len(v), region), region, on_edge_only)[:3]
+
+
+def _split(v: np.ndarray, f: np.ndarray, slack: np.ndarray, gap: float, chain: _Chain, region: np.ndarray | None,
+           on_edge_only: bool) -> tuple[np.ndarray, np.ndarray, int, _Chain]:
+    """:func:`_split_t_junctions` on the frontier whose boundary is ``chain``; also returns the chain after it."""
+    if not len(chain.key):
+        return f, slack, 0, chain
+    edges = _chain_edges(chain, len(v))
     edges = _unique_rows(edges, len(v))
     a, b = v[edges[:, 0]], v[edges[:, 1]]
     ab = b - a
     length = np.linalg.norm(ab, axis=1)
     e, m = _edge_point_candidates(v, edges, 0.0 if on_edge_only else gap)
     if not len(e):
-        return f, slack, 0
+        return f, slack, 0, chain
     t = np.einsum("ij,ij->i", v[m] - a[e], ab[e]) / np.maximum(length[e] ** 2, np.finfo(float).tiny)
     foot = a[e] + t[:, None] * ab[e]
     dist = np.linalg.norm(v[m] - foot, axis=1)
@@ -216,7 +297,7 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     ok = (dist <= gap) & (t > 0) & (t < 1) & (to_end > 0) & (on_edge if on_edge_only else (to_end > gap) | on_edge)
     e, m, t, dist = e[ok], m[ok], t[ok], dist[ok]
     if not len(e):
-        return f, slack, 0
+        return f, slack, 0, chain
     # each vertex onto its nearest edge only (a thin part can hold other boundary edges within the gap)
     nearest = np.lexsort((dist, m))
     first = nearest[np.r_[True, m[nearest][1:] != m[nearest][:-1]]]
@@ -224,11 +305,15 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     # the face holding each directed edge a→b, and which of its edges it is
     undirected, forward = edge_keys(f, len(v))            # edge slot j of face i: f[i, j] → f[i, j+1]
     key = 2 * undirected + forward
-    order = np.argsort(key, kind="stable")
     start, end = edges[e, 0].astype(np.int64), edges[e, 1].astype(np.int64)
     want = 2 * edge_keys(np.stack([start, end, end], axis=1), len(v))[0][0::3] + (start > end)
+    # the lowest slot holding each wanted key: only the slots holding one are sorted (not the whole frontier's)
+    targets = np.unique(want)
+    at = np.minimum(np.searchsorted(targets, key), len(targets) - 1)
+    hit = np.flatnonzero(targets[at] == key)
+    order = hit[np.argsort(key[hit], kind="stable")]
     pos = np.searchsorted(key[order], want)
-    found = (pos < len(key)) & (key[order][np.minimum(pos, len(key) - 1)] == want)
+    found = (pos < len(order)) & (key[order][np.minimum(pos, len(order) - 1)] == want)
     e, m, t, dist, pos = e[found], m[found], t[found], dist[found], pos[found]
     slot = order[pos]
     face, corner = slot // 3, slot % 3
@@ -241,7 +326,7 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     sel = slot == first_slot[face]
     face, corner, m, t, dist = face[sel], corner[sel], m[sel], t[sel], dist[sel]
     if not len(face):
-        return f, slack, 0
+        return f, slack, 0, chain
     # each (face, vertex) once, in (face, vertex) order (as numpy.unique of the rows, by one int64 key)
     _, unique_m = np.unique(face.astype(np.int64) * np.int64(max(len(v), 1)) + m, return_index=True)
     face, corner, m, t, dist = face[unique_m], corner[unique_m], m[unique_m], t[unique_m], dist[unique_m]
@@ -266,7 +351,8 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     fan_slack = np.repeat(np.maximum(slack[split_faces], np.maximum.reduceat(dist, starts)), count + 1)
     keep_face = np.ones(len(f), dtype=bool)
     keep_face[split_faces] = False
-    return np.vstack([f[keep_face], fan]), np.concatenate([slack[keep_face], fan_slack]), int(len(m))
+    chain = _chain_update(chain, f[split_faces], fan, len(v), region)
+    return np.vstack([f[keep_face], fan]), np.concatenate([slack[keep_face], fan_slack]), int(len(m)), chain
 
 
 def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
@@ -286,12 +372,13 @@ def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
     e, m = _edge_point_candidates(v, edges, 0.0)
     if not len(e):
         return np.zeros(0, dtype=np.int64)
-    a, b = v[edges[:, 0]], v[edges[:, 1]]
+    # the candidates' edges only (a soup's 3.9M edges as (k, 3) arrays were 300 MB at the peak for a few pairs)
+    a, b = v[edges[e, 0]], v[edges[e, 1]]
     ab = b - a
     length = np.linalg.norm(ab, axis=1)
-    t = np.einsum("ij,ij->i", v[m] - a[e], ab[e]) / np.maximum(length[e] ** 2, np.finfo(float).tiny)
-    dist = np.linalg.norm(v[m] - (a[e] + t[:, None] * ab[e]), axis=1)
-    to_end = np.minimum(np.linalg.norm(v[m] - a[e], axis=1), np.linalg.norm(v[m] - b[e], axis=1))
+    t = np.einsum("ij,ij->i", v[m] - a, ab) / np.maximum(length ** 2, np.finfo(float).tiny)
+    dist = np.linalg.norm(v[m] - (a + t[:, None] * ab), axis=1)
+    to_end = np.minimum(np.linalg.norm(v[m] - a, axis=1), np.linalg.norm(v[m] - b, axis=1))
     on = (t > 0) & (t < 1) & (dist <= ON_EDGE_RTOL * to_end)
     found: np.ndarray = np.flatnonzero(np.bincount(m[on], minlength=len(v)))    # sorted, each once
     return found
@@ -307,6 +394,20 @@ def _unique_rows(edges: np.ndarray, n: int) -> np.ndarray:
     return rows
 
 
+#: Points gathered at a time for their bounds (a soup's 3.9M boundary vertices were a 94 MB copy at the peak).
+_BOUNDS_CHUNK = 1 << 18
+
+
+def _bounds_of(lib: Any, v: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
+    """``lib.bounds(v[index])`` (lowest and highest coordinates, all finite) a chunk of points at a time."""
+    lo, hi, finite = np.full(3, np.inf), np.full(3, -np.inf), True
+    for start in range(0, len(index), _BOUNDS_CHUNK):          # bounded by len(index) / _BOUNDS_CHUNK + 1
+        part_lo, part_hi, part_finite = lib.bounds(np.ascontiguousarray(v[index[start:start + _BOUNDS_CHUNK]]))
+        finite = finite and bool(part_finite)
+        lo, hi = np.minimum(lo, part_lo), np.maximum(hi, part_hi)
+    return lo, hi, finite
+
+
 def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tuple[np.ndarray, np.ndarray]:
     """(edge row, vertex) pairs, by edge, of the edges' own vertices ``m`` (not an end of the edge) that may lie
     within ``gap`` of the edge's interior or on it to ``ON_EDGE_RTOL``: a superset of the pairs the callers'
@@ -319,11 +420,10 @@ def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tupl
     """
     bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v)))
     lib = accel()
-    points = v[bv]
     cell = np.inf
     finite = False
-    if lib is not None and len(points):
-        lo, hi, finite = lib.bounds(np.ascontiguousarray(points))
+    if lib is not None and len(bv):
+        lo, hi, finite = _bounds_of(lib, v, bv)
     if lib is not None and finite:
         extent = float(np.max(np.subtract(hi, lo)))
         # the edges' lengths on a sample (only the speed depends on the cell, so an estimate serves)
@@ -338,10 +438,11 @@ def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tupl
                    np.finfo(float).tiny)
     if lib is not None and np.isfinite(cell):      # else (no C extension, or coordinates overflowing): the tree
         pe, pm = lib.edge_point_candidates(np.ascontiguousarray(v), np.ascontiguousarray(edges, dtype=np.int64),
-                                           bv, cell, ON_EDGE_RTOL, float(gap))
+                                           bv, cell, ON_EDGE_RTOL, float(gap), threads())
         return np.frombuffer(pe, dtype=np.int64), np.frombuffer(pm, dtype=np.int64)
     from scipy.spatial import cKDTree
 
+    points = v[bv]
     a, b = v[edges[:, 0]], v[edges[:, 1]]
     length = np.linalg.norm(b - a, axis=1)
     near = cKDTree(points, balanced_tree=False, compact_nodes=False).query_ball_point(
@@ -392,20 +493,21 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
     slack = np.zeros(len(front))
     vertex_slack = np.zeros(n)
     dropped, welded, split = 0.0, 0, 0
+    chain = _chain_of_edges(edges, n)              # the frontier's boundary, updated as faces are replaced
     if gap > 0:
         # first the T-junctions exactly on their edges (exact splits, nothing moves), until none is left: a
         # vertex that only comes near an edge (a sliver's apex) is not put on it while the exact ones still
         # leave that edge open
         for _ in range(3 * MAX_SEAL_ROUNDS):
-            front, slack, more = _split_t_junctions(v, front, slack, gap, region, on_edge_only=True)
+            front, slack, more, chain = _split(v, front, slack, gap, chain, region, True)
             split += more
             if not more:
                 break
         for _ in range(MAX_SEAL_ROUNDS):
-            front, slack, lost, merged = _weld_lips(v, front, slack, vertex_slack, gap, region)
+            front, slack, lost, merged, chain = _weld(v, front, slack, vertex_slack, gap, chain, region)
             inserted = 0
             for _ in range(3):          # a face splits one edge per pass and has three
-                front, slack, more = _split_t_junctions(v, front, slack, gap, region)
+                front, slack, more, chain = _split(v, front, slack, gap, chain, region, False)
                 inserted += more
                 if not more:
                     break
@@ -425,6 +527,9 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
         all_slack = np.full(len(out), float(slack.max(initial=0.0)))
     else:
         all_slack = np.concatenate([np.zeros(len(rest)), slack])
-    boundary = _frontier_boundary(front, n, region) if (welded or split or duplicates) else edges
+    if duplicates:
+        boundary = _frontier_boundary(front, n, region)
+    else:
+        boundary = _chain_edges(chain, n) if (welded or split) else edges
     return Seal(out, all_slack, dropped, welded, split, boundary, _loose_faces(front, n, region), duplicates,
                 len(rest))

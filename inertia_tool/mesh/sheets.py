@@ -105,6 +105,9 @@ MAX_SHEET_PIECES = 64
 #: A winding number whose float value is farther than this from an integer is not trusted (a point too close to
 #: the surface for its solid-angle sum).
 _WINDING_SLACK = 0.05
+_EPS = float(np.finfo(np.float64).eps)
+#: Unbalanced edges the early exit tests at most (every k-th by key): one witness suffices.
+_GUARD_EDGES = 4096
 
 
 @frozen_value
@@ -276,9 +279,78 @@ def _shell_windings(point: np.ndarray, v: np.ndarray, f: np.ndarray, labels: np.
     return np.bincount(labels, weights=2.0 * np.arctan2(num, den), minlength=n_shells) / (4.0 * np.pi)
 
 
+def _nothing_to_take(v: np.ndarray, f: np.ndarray, boundary: np.ndarray | None, tolerance: float,
+                     max_pieces: int) -> bool:
+    """A cheap exact early exit: True only when :func:`_indexed_sheets` would return None for one of two necessary
+    conditions of an answer, checked without forming the pieces (on a large part with one hole, forming them cost
+    more than the rest of the repair).
+
+    (a) More than ``4 · max_pieces`` faces share no vertex with another face: each is an open piece of its own, so
+        :func:`_take_out` gives up (a soup).
+    (b) With ``boundary`` (the net boundary 1-chain, directed edges): every unbalanced edge must be balanced by a
+        taken piece using it, and a taken piece has all its corners within ``tolerance`` of one plane (the bound
+        of ``planar``).  A face ``F`` using the edge and a face ``G`` sharing a manifold edge with it (two faces,
+        opposite directions: one piece) then have their four corners in a slab of width ``2 · tolerance``, so
+        the volume of the tetrahedron they span is at most ``2 · tolerance`` times its projected area, itself at
+        most half its surface area ``S``: ``V ≤ tolerance · S``.  An unbalanced edge every face of which has such
+        a neighbour with ``V > tolerance · S`` beyond the rounding of both sides cannot be balanced (at most
+        ``_GUARD_EDGES`` unbalanced edges are tested, spread over their keys; no witness among them: False).
+    """
+    n = len(v)
+    valence = np.bincount(f.reshape(-1), minlength=n)
+    if int(np.count_nonzero((valence[f] == 1).all(axis=1))) > 4 * max_pieces:
+        return True
+    if boundary is None or not len(boundary):
+        return False
+    nv = np.int64(max(n, 1))
+    b = np.asarray(boundary, dtype=np.int64).reshape(-1, 2)
+    unbalanced = np.unique(np.minimum(b[:, 0], b[:, 1]) * nv + np.maximum(b[:, 0], b[:, 1]))
+    # one unbalanced edge that nothing can balance is enough: a sample of them, spread over the keys, is tested
+    # (a surface with thousands of holes would otherwise cost a sort of most of its edges)
+    unbalanced = unbalanced[::-(-len(unbalanced) // _GUARD_EDGES)]
+    on_rim = np.zeros(n, dtype=bool)
+    on_rim[unbalanced // nv] = True
+    on_rim[unbalanced % nv] = True
+    near = np.flatnonzero(on_rim[f].sum(axis=1) >= 2)               # every face using an edge tested
+    key = edge_keys(f[near], n)[0]
+    pos = np.minimum(np.searchsorted(unbalanced, key), len(unbalanced) - 1)
+    uses = np.flatnonzero(unbalanced[pos] == key)                   # (slot in near) of each use of one
+    rim_face = np.zeros(len(f), dtype=bool)
+    rim_face[near[uses // 3]] = True
+    corner = np.zeros(n, dtype=bool)
+    corner[f[rim_face].reshape(-1)] = True
+    around = np.flatnonzero(corner[f].sum(axis=1) >= 2)              # every face using an edge of a rim face
+    key, forward = edge_keys(f[around], n)
+    order = np.argsort(key, kind="stable")
+    sk = key[order]
+    starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
+    count = np.diff(np.r_[starts, len(sk)])
+    pair = starts[(count == 2) & (forward[order[starts]] != forward[order[np.minimum(starts + 1, len(sk) - 1)]])]
+    slot_f, slot_g = order[pair], order[pair + 1]
+    face_f, face_g = around[slot_f // 3], around[slot_g // 3]
+    mine = rim_face[face_f] | rim_face[face_g]                      # both ends of their edge are corners: exact
+    face_f, face_g, slot_g = face_f[mine], face_g[mine], slot_g[mine]
+    opposite = f[face_g, (slot_g % 3 + 2) % 3]
+    a, bb, c, d = v[f[face_f, 0]], v[f[face_f, 1]], v[f[face_f, 2]], v[opposite]
+    x, y, z = bb - a, c - a, d - a
+    six_v = np.abs(np.einsum("ij,ij->i", x, np.cross(y, z)))
+    rounding = 128 * _EPS * (np.linalg.norm(x, axis=1) * np.linalg.norm(y, axis=1) * np.linalg.norm(z, axis=1))
+    two_s = sum(np.linalg.norm(np.cross(q - p, r - p), axis=1) for p, q, r in ((a, bb, c), (a, bb, d), (a, c, d),
+                                                                            (bb, c, d)))
+    bent = (six_v - rounding) / 6.0 > tolerance * (two_s / 2.0) * (1 + 1e-6)
+    curved = np.zeros(len(f), dtype=bool)
+    curved[face_f[bent]] = True
+    curved[face_g[bent]] = True
+    # a tested edge none of whose faces can lie in a flat piece: nothing balances it
+    ok = np.ones(len(unbalanced), dtype=bool)
+    ok[pos[uses]] = False                          # (an edge no face uses, as in no census, witnesses nothing)
+    ok[pos[uses][~curved[near[uses // 3]]]] = True
+    return not bool(ok.all())
+
+
 def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MAX_SHEET_PIECES,
                 plane_rtol: float = WALL_PLANE_RTOL, rim_rtol: float = MERGE_TOLERANCE,
-                budget: float = ROUNDOFF_RTOL) -> OpenSheets | None:
+                budget: float = ROUNDOFF_RTOL, boundary: np.ndarray | None = None) -> OpenSheets | None:
     """R3b: the open sheets of an unbalanced surface, taken out when the rest is closed and each sheet lies inside
     or outside its solid without meeting it (module docstring); else None.
 
@@ -300,6 +372,9 @@ def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MA
         A sheet joined to the rest through T-vertices (module docstring, "Seams") is taken only when the volume in
         which splitting the faces there changes the winding number is within ``budget`` of the rest's volume (and
         its second moment likewise): ``tolerances.ROUNDOFF_RTOL``, what "exact" allows.
+    boundary : (k, 2) int, optional
+        The net boundary of ``faces`` (directed edges, as :func:`~.rims.boundary_edges` gives it) when the caller
+        has it: lets :func:`_nothing_to_take` return early on a surface with holes and no flat piece at them.
 
     Returns
     -------
@@ -311,7 +386,9 @@ def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MA
     f = np.asarray(faces, dtype=np.int64)
     if len(f) < 5:                                    # a closed rest and a sheet need at least 4 + 1 faces
         return None
-    found = _indexed_sheets(v, f, max_pieces, plane_rtol, rim_rtol)
+    tolerance = plane_rtol * float(np.abs(v).max())
+    indexed = not _nothing_to_take(v, f, boundary, tolerance, max_pieces)      # (else it would find nothing)
+    found = _indexed_sheets(v, f, max_pieces, plane_rtol, rim_rtol) if indexed else None
     if found is not None:
         return found
     return _seamed_sheet(v, f, max_pieces, plane_rtol, rim_rtol, budget)
