@@ -5,11 +5,13 @@ Truths are independent of the arrangement: exact rational integrals of boxes by 
 tube between consecutive rings), and a local Monte Carlo over winding numbers.
 """
 
+import itertools
+import types
 import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import adversary_solids as S
@@ -196,23 +198,45 @@ def _curve_tube(coeffs, radius, rings, sections):
 
 @settings(max_examples=25, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@example(coeffs=[-0.5, 0.0, -0.1875, 0.75, -0.0625, 0.0, -0.875, -1.0, -0.3125, 0.0, 0.0, -0.25, -1.0, -0.5, -1.0, 0.5,
+                 0.0, 0.0], radius=0.25, rings=24, sections=5)   # manifold3d's union of the slabs was off here
 @given(coeffs=st.lists(st.floats(-1.0, 1.0), min_size=18, max_size=18),
        radius=st.floats(0.05, 0.3), rings=st.integers(24, 48), sections=st.integers(5, 8))
 def test_tubes_along_random_curves_match_the_union_of_their_slabs(coeffs, radius, rings, sections):
     """Whatever the curve does (crossing itself once, several times, or not at all), the answer is the union of
-    the slabs (manifold3d) when certified, or a refusal that says why: never a wrong 'exact' or 'united'."""
-    import manifold3d as m3
+    the slabs (by inclusion-exclusion of manifold3d's pairwise intersections) when certified, or a refusal that
+    says why: never a wrong 'exact' or 'united'."""
     built = _curve_tube(np.asarray(coeffs).reshape(3, 6), radius, rings, sections)
     if built is None:
         return
     v, f, slabs = built
     if any(len(surface_contacts(sv, sf).crossing) for sv, sf in slabs):
         return                                          # a twisted slab: the truth would not hold
-    solid = m3.Manifold.batch_boolean([S.to_manifold(s) for s in slabs], m3.OpType.Add)
-    out = solid.to_mesh64()
-    tv = np.asarray(out.vert_properties, dtype=np.float64)[:, :3]
-    tf = np.asarray(out.tri_verts, dtype=np.int64)
-    truth = volume_moments(tv, tf)
+    # the truth by inclusion-exclusion: the tube's signed integral less each pair of slabs' common part (manifold3d
+    # intersections of two slabs).  A union of all the slabs at once is not used: adjacent slabs share their caps
+    # and manifold3d's union of them dropped the one crossing's volume twice (coeffs [-0.5, 0, -0.1875, 0.75,
+    # -0.0625, 0, -0.875, -1, -0.3125, 0, 0, -0.25, -1, -0.5, -1, 0.5, 0, 0], radius 0.25, 24 rings, 5 sections:
+    # 0.170940 against 0.170988, which the pairwise parts and a Monte Carlo winding count both give).
+    pieces = [S.to_manifold(s) for s in slabs]
+    boxes = [(sv.min(axis=0), sv.max(axis=0)) for sv, _ in slabs]
+    common = []
+    for i in range(len(pieces)):
+        for j in range(i + 2, len(pieces) - (i == 0)):              # neighbours share only a cap
+            if np.all(boxes[i][0] <= boxes[j][1]) and np.all(boxes[j][0] <= boxes[i][1]):
+                both = pieces[i] ^ pieces[j]
+                if both.volume() > 0:
+                    common.append((i, j, both))
+    for (i, j, a), (k, m, b) in itertools.combinations(common, 2):
+        if {i, j} & {k, m} and (a ^ b).volume() > 1e-12 * abs(volume_moments(v, f).volume):
+            return                                      # three slabs share volume: beyond inclusion-exclusion
+    whole = volume_moments(v, f)
+    volume, first = whole.volume, whole.volume * whole.centroid
+    for _, _, both in common:
+        out = both.to_mesh64()
+        part = volume_moments(np.asarray(out.vert_properties, dtype=np.float64)[:, :3],
+                              np.asarray(out.tri_verts, dtype=np.int64))
+        volume, first = volume - part.volume, first - part.volume * part.centroid
+    truth = types.SimpleNamespace(volume=volume, centroid=first / volume)
     try:
         props = _quiet(v, f)
     except InvalidMeshError as exc:
