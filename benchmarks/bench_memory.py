@@ -13,10 +13,17 @@ per hostile file of issue 22 (scaled down), as the child's ``ru_maxrss`` through
 the number of triangles: the multiple of the file size (and of the faces) that each reader costs, and the
 cost of a refusal (which must stay at the interpreter's baseline: the counts are checked before allocating).
 
+With ``--stages FILE ...`` it runs ``analyze FILE --json --units mm`` in a fresh process with each stage of
+``prepare_mesh`` (and ``load_mesh``) wrapped: the peak resident memory within each stage (VmHWM, reset through
+``/proc/self/clear_refs`` at every stage boundary and folded into the stages still open), the memory on entry
+and on exit and the stage's CPU time (Linux only).  Generate the files outside the repository (e.g. the tori of
+``bench_scaling.py`` under /tmp).
+
 Usage::
 
     python benchmarks/bench_memory.py [--largest 9]      # icosphere subdivisions 6..largest
     python benchmarks/bench_memory.py --formats [--subdivisions 7]
+    python benchmarks/bench_memory.py --stages /tmp/torus_9999392.stl
 """
 
 from __future__ import annotations
@@ -167,13 +174,96 @@ def formats(subdivisions: int) -> None:
               f"{per_face} |", flush=True)
 
 
+# -- per stage: peak RSS within each stage of one analysis --------------------------------------------------------
+
+_STAGES_CHILD = r"""
+import contextlib, functools, importlib, io, os, sys, time
+MIB = 1 << 20
+stack, rows = [], []          # open stages: [label, rss on entry, peak]; closed: (depth, label, in, peak, out, cpu)
+
+
+def status():
+    d = {}
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith(("VmHWM", "VmRSS")):
+                key, value = line.split(":")
+                d[key] = int(value.split()[0]) * 1024
+    return d
+
+
+def checkpoint():
+    s = status()
+    for frame in stack:
+        frame[2] = max(frame[2], s["VmHWM"])
+    with open("/proc/self/clear_refs", "w") as fh:
+        fh.write("5")                               # reset VmHWM to the current RSS
+    return s["VmRSS"]
+
+
+def wrap(modname, name):
+    mod = importlib.import_module(modname)
+    inner = getattr(mod, name)
+
+    @functools.wraps(inner)
+    def outer(*args, **kwargs):
+        rss = checkpoint()
+        depth = len(stack)
+        stack.append([name, rss, rss])
+        cpu = time.process_time()
+        try:
+            return inner(*args, **kwargs)
+        finally:
+            out = checkpoint()
+            frame = stack.pop()
+            rows.append((depth, name, frame[1], frame[2], out, time.process_time() - cpu))
+    setattr(mod, name, outer)
+
+
+for stage in ("close_surface", "find_shells", "settle_welded", "find_contacts", "settle_self_crossing",
+              "orient_shells", "unite_overlaps", "certify"):
+    wrap("inertia_tool.mesh.prepare", stage)
+for stage in ("load_mesh", "prepare_mesh", "_bodies"):
+    wrap("inertia_tool.mass.pipeline", stage)
+from inertia_tool.cli import main
+rss0 = checkpoint()
+stack.append(["analyze", rss0, rss0])
+with contextlib.redirect_stdout(io.StringIO()):
+    rc = main(["analyze", sys.argv[1], "--json", "--units", "mm"])
+checkpoint()
+whole = stack.pop()
+size = os.path.getsize(sys.argv[1])
+print(f"{sys.argv[1]}: exit {rc}, file {size / MIB:,.1f} MiB, "
+      f"peak {whole[2] / MIB:,.0f} MiB = {whole[2] / size:.2f}x the file")
+print(f"{'stage':26s} {'in':>8s} {'peak':>8s} {'+':>7s} {'out':>8s} {'CPU s':>7s}  (MiB)")
+for depth, name, rss_in, peak, out, cpu in rows:
+    print(f"{'  ' * depth + name:26s} {rss_in / MIB:8.0f} {peak / MIB:8.0f} {(peak - rss_in) / MIB:7.0f} "
+          f"{out / MIB:8.0f} {cpu:7.2f}")
+"""
+
+
+def stages(paths: list) -> None:
+    """Print the peak memory within each stage of ``analyze`` on each file (a fresh process per file)."""
+    import subprocess
+    env = {**os.environ, "PYTHONPATH": os.path.dirname(HERE)}
+    for path in paths:
+        r = subprocess.run([sys.executable, "-c", _STAGES_CHILD, path], capture_output=True, text=True, env=env)
+        if r.returncode:
+            raise RuntimeError(f"the stage child failed on {path}: {r.stderr[-2000:]}")
+        print(r.stdout)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--largest", type=int, default=9, help="largest icosphere subdivision (9: 5.2M faces)")
     ap.add_argument("--largest-3mf", type=int, default=7, help="largest 3MF subdivision (7: 328k faces)")
     ap.add_argument("--formats", action="store_true", help="peak per file format and per hostile file instead")
     ap.add_argument("--subdivisions", type=int, default=7, help="--formats: icosphere subdivision (7: 328k faces)")
+    ap.add_argument("--stages", nargs="+", metavar="FILE", help="peak memory within each stage of analyze instead")
     args = ap.parse_args()
+    if args.stages:
+        stages(args.stages)
+        return
     if args.formats:
         formats(args.subdivisions)
         return

@@ -649,3 +649,40 @@ def test_obj_names_with_underscores_still_read(tmp_path):
     path = tmp_path / "odd.obj"
     path.write_bytes(_obj_text("1").encode())
     assert len(load_mesh(path).faces) == 1
+
+
+# -- issue 25: an OBJ coordinate that is not a number is reported on its own line --------------------------
+
+_OBJ_FILLER = {"comment": "# a comment", "blank": "", "normal": "vn 0 0 1", "vertex": "v 0.5 0.25 0.125",
+               "continued": "v 1 \\\n2 3"}         # one statement on two lines
+
+
+@pytest.mark.parametrize("bad_line", [3, 9])
+def test_obj_bad_coordinate_names_its_line(tmp_path, bad_line):
+    lines = ["v 0 0 0", "v 1 0 0", "v 0 1 0", "v 0 0 1", "f 1 2 3", "f 1 3 4", "f 1 4 2", "f 2 4 3", "v 1 1 1"]
+    lines[bad_line - 1] = "v 0 1 abc" if bad_line == 3 else "v 1 2 x"
+    path = tmp_path / "bad.obj"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(MeshReadError, match=rf"bad\.obj: line {bad_line}: vertex coordinate '(abc|x)' is not a number"):
+        load_mesh(path)
+    err = io.StringIO()
+    with redirect_stderr(err):
+        assert main(["analyze", str(path)]) == 3
+    assert f"line {bad_line}:" in err.getvalue() and "after line" not in err.getvalue()
+
+
+@settings(max_examples=40, deadline=None)
+@given(before=st.lists(st.sampled_from(sorted(_OBJ_FILLER)), max_size=30),
+       after=st.lists(st.sampled_from(sorted(_OBJ_FILLER)), max_size=10),
+       column=st.integers(0, 2))
+def test_obj_bad_coordinate_line_is_counted_past_comments_and_continuations(tmp_path_factory, before, after, column):
+    text = "".join(_OBJ_FILLER[k] + "\n" for k in before)
+    expected = text.count("\n") + 1                     # the physical line the bad statement starts on
+    coords = ["1", "2", "3"]
+    coords[column] = "1.0e"
+    text += "v " + " ".join(coords) + "\n" + "".join(_OBJ_FILLER[k] + "\n" for k in after)
+    text += "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -3\n"
+    path = tmp_path_factory.mktemp("obj") / "bad.obj"
+    path.write_text(text)
+    with pytest.raises(MeshReadError, match=rf": line {expected}: vertex coordinate '1\.0e' is not a number"):
+        load_mesh(path)

@@ -478,17 +478,19 @@ _OBJ_SKIPPED = frozenset(b"vt vn vp o g s usemtl mtllib cstype deg bmat step cur
                          b"ctech stech call csh".split())
 
 
-def _obj_vertex_block(path: str, tokens: list[bytes], first_line: int) -> np.ndarray:
+def _obj_vertex_block(path: str, tokens: list[bytes], lines: list[int]) -> np.ndarray:
+    """The ``(n, 3)`` coordinates of one block's ``v`` statements; ``lines[i]``: the line of vertex ``i``, named
+    when one of its coordinates is not a number."""
     try:
         return np.array(tokens, dtype=np.float64).reshape(-1, 3)
     except ValueError:
-        for tok in tokens:
+        for k, tok in enumerate(tokens):
             try:
                 float(tok)
             except ValueError:
-                raise _fail(path, f"a vertex coordinate after line {first_line} is not a number: "
-                                  f"{tok[:40].decode('utf-8', 'replace')!r}") from None
-        raise _fail(path, "vertex coordinates are not numbers") from None
+                raise _fail(path, f"line {lines[k // 3]}: vertex coordinate "
+                                  f"{tok[:40].decode('utf-8', 'replace')!r} is not a number") from None
+        raise _fail(path, f"vertex coordinates on lines {lines[0]} to {lines[-1]} are not numbers") from None
 
 
 def _read_obj(path: str, max_faces: int, data: bytes | None = None) -> tuple[np.ndarray, np.ndarray, int]:
@@ -519,10 +521,10 @@ def _read_obj(path: str, max_faces: int, data: bytes | None = None) -> tuple[np.
     with _source_bytes(path, data) as fh:
         for block in _text_blocks(fh, path):
             coords: list[bytes] = []
+            coord_lines: list[int] = []                 # the line of each vertex, for an error message
             tri: list[int] = []
             quads: list[int] = []
             polygons: list[tuple[int, list[int]]] = []
-            block_start = line_no + 1
             odd = _has_odd_bytes(block)                  # names and comments may hold '_'; numbers may not
             lines = block.split(b"\n")
             lines.pop()  # every block ends with a newline
@@ -547,6 +549,7 @@ def _read_obj(path: str, max_faces: int, data: bytes | None = None) -> tuple[np.
                                           f"{bad[:40].decode('utf-8', 'replace')!r} is not a decimal number "
                                           "(no '_', ASCII digits only)")
                     coords.extend(parts[1:4])
+                    coord_lines.append(line_no)
                     nv += 1
                     if nv > max_vertices:
                         raise _fail(path, f"holds more than {max_vertices:,} vertices (3 × `max_faces`)")
@@ -596,7 +599,7 @@ def _read_obj(path: str, max_faces: int, data: bytes | None = None) -> tuple[np.
                         first_garbage = f" (first: line {line_no})"
                     garbage += 1
             if coords:
-                vertex_blocks.append(_obj_vertex_block(path, coords, block_start))
+                vertex_blocks.append(_obj_vertex_block(path, coords, coord_lines))
             if tri:
                 face_blocks.append(np.array(tri, dtype=np.int64).reshape(-1, 3))
                 if quads:
