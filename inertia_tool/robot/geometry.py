@@ -317,10 +317,18 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
                            reference_rotation=element.reference_rotation,
                            reference_translation=element.reference_translation,
                            mesh_inertia=element.mesh_inertia)
-    if element.mesh_inertia in ("convex", "legacy"):
+    memo = _fit_memo_key(mesh, repair) if cache is None else None
+    props = _FIT_BODIES.get(memo) if memo is not None else None
+    if props is not None:
+        _FIT_BODIES[memo] = _FIT_BODIES.pop(memo)          # most recently used last
+    elif element.mesh_inertia in ("convex", "legacy"):
         props = _mesh_inertia_part(mesh, cache={} if cache is None else cache, budget=budget)[1]
     else:
         props = element_mass_properties(mesh, cache=cache, repair=repair, budget=budget)
+    if memo is not None and memo not in _FIT_BODIES:
+        _FIT_BODIES[memo] = props
+        while len(_FIT_BODIES) > FIT_BODIES_KEPT:
+            _FIT_BODIES.pop(next(iter(_FIT_BODIES)))
     moments, axes = np.linalg.eigh(0.5 * (props.inertia + props.inertia.T))
     axes = axes[:, ::-1]                                 # x: the largest moment, z: the smallest
     if np.linalg.det(axes) < 0:
@@ -361,6 +369,27 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
     return GeometryElement(kind, element.rotation @ axes, element.rotation @ props.center_of_mass + element.translation,
                            size=size, name=element.name, density=element.density, mass=element.mass,
                            shell=element.shell)
+
+
+#: Unit-density bodies of the meshes that primitives are fitted to, for the calls of :func:`fitted_element`
+#: without a robot cache (the audit's bounding boxes and inside tests fit every fitted geom again: before this
+#: memo, each such call integrated the mesh anew, 22 of the 57 s of CPU of a Menagerie corpus audit).  Keyed by
+#: :func:`_fit_memo_key` (the file's content, how the element places it, its inertia mode and ``repair``), at
+#: most :data:`FIT_BODIES_KEPT` entries (least recently used dropped first); refusals are not kept.
+_FIT_BODIES: dict = {}
+FIT_BODIES_KEPT = 256
+
+
+def _fit_memo_key(mesh: GeometryElement, repair: bool) -> tuple | None:
+    """The :data:`_FIT_BODIES` key of a fitted geom's mesh element, or None when its file is not kept (too
+    large or unreadable: :func:`_content_key`)."""
+    content = None
+    if mesh.mesh is not None:
+        submesh = (mesh.submesh, bool(mesh.submesh_center)) if mesh.submesh else None
+        content = _content_key(mesh.mesh, submesh)
+        if content is None:
+            return None
+    return (content, _mesh_key(mesh), mesh.mesh_inertia, bool(repair))
 
 
 class MeshCache:
