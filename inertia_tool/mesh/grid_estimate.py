@@ -34,7 +34,9 @@ TREECODE_RESOLUTION = 24
 def _cell_centres(cells: np.ndarray, lo: np.ndarray, h: float, dims: tuple[int, ...]) -> np.ndarray:
     """(k, 3) m: the centres of the cells with flat (C-order) indices ``cells`` of the grid ``lo``, ``h``,
     ``dims`` (the grid's centres are never stored whole: 24 bytes a cell)."""
-    return lo + h * (np.stack(np.unravel_index(np.asarray(cells, dtype=np.int64), dims), axis=1) + 0.5)
+    centres: np.ndarray = lo + h * (np.stack(np.unravel_index(np.asarray(cells, dtype=np.int64), dims), axis=1)
+                                    + 0.5)
+    return centres
 
 
 def _grid_moments(weight: np.ndarray, lo: np.ndarray, h: float, scale: float = 1.0
