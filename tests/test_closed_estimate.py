@@ -384,3 +384,50 @@ def test_the_winding_grid_holds_no_per_cell_coordinates():
     cells = np.prod([int(x) for x in est.detail.split(" grid")[0].split()[-1].split("×")])
     assert cells > 2_000_000
     assert peak < 40 * cells, (peak, cells)
+
+
+@pytest.mark.slow
+@settings(max_examples=10, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(data=st.data(), count=st.integers(2, 3), holes=st.integers(1, 3))
+def test_crossing_boxes_with_holes_lie_within_the_repair_bounds(data, count, holes, monkeypatch):
+    """Issue 23 item 6 (robots4): crossing boxes with triangles missing (holes), the boolean union and the
+    arrangement made to fail so that `repair=True` patches the holes and takes the one-grid winding estimate (the
+    patches' doubt added); the manifold3d union of the undamaged boxes (which the estimate never sees) lies
+    within the reported bounds, or the mesh is refused."""
+    import inertia_tool.mesh.arrange as arrange
+    import inertia_tool.mesh.union as union
+
+    def fail(*args, **kwargs):
+        raise ArrangementError("forced: the arrangement is not built in this test")
+
+    def no_union(*args, **kwargs):
+        raise union.UnionError("forced: the boolean union is not formed in this test")
+
+    monkeypatch.setattr(arrange, "arrange_crossings", fail)
+    monkeypatch.setattr(union, "union_surface", no_union)
+    boxes = []
+    for _ in range(count):
+        size = np.array([data.draw(st.integers(2, 6)) for _ in range(3)]) / 4
+        centre = np.array([data.draw(st.integers(-3, 3)) for _ in range(3)]) / 8 + 0.013 * len(boxes)
+        boxes.append(S.box(size, centre, subdivide=1))
+    v, f = S.concat(*boxes)
+    # one triangle missing from `holes` boxes' faces, none sharing an edge with another missing one
+    drop: list = []
+    for index in data.draw(st.lists(st.integers(0, len(f) - 1), min_size=holes, max_size=holes, unique=True)):
+        if all(len(set(f[index]) & set(f[j])) < 2 for j in drop):
+            drop.append(index)
+    damaged = np.delete(f, drop, axis=0)
+    truth = S.truth_from_manifold(boxes)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            props = mass_properties((v, damaged), density=1.0, repair=True)
+        except InvalidMeshError:
+            return                                         # refused: no number, nothing to hold
+    unc = props.mesh.uncertainty
+    assert props.mesh.certificate.kind == "estimate"
+    assert abs(props.volume - truth.volume) <= unc.mass * props.volume * (1 + 1e-9) + 1e-12
+    assert np.linalg.norm(props.center_of_mass - truth.centroid) <= unc.center_of_mass * (1 + 1e-9) + 1e-12
+    assert np.linalg.norm(props.central_inertia - truth.inertia) <= \
+        unc.inertia * np.linalg.norm(props.central_inertia) * (1 + 1e-9) + 1e-12
