@@ -234,3 +234,41 @@ def test_the_audit_fits_a_primitive_to_a_mesh_once_per_file_content(tmp_path, mo
     write_binary_stl(root / "b" / "box.stl", v, f)
     longer = audit_links(robot, link_inertials(robot, density=1000))[0]
     assert longer.size > audits[0].size
+
+
+def test_a_byte_identical_copy_in_another_folder_is_integrated_once_with_its_own_warnings(tmp_path, monkeypatch):
+    """TIAGo and TIAGo dual ship the same mesh bytes under two paths: a result is shared by content, and each
+    model's warnings and result name its own file; a refusal is not shared (each copy is refused by itself)."""
+    import shutil
+    import warnings
+
+    import inertia_tool.robot.geometry as geometry
+    from inertia_tool.robot.corpus import audit_corpus
+    calls = []
+    real = geometry.mesh_properties
+    monkeypatch.setattr(geometry, "mesh_properties", lambda path, **kw: calls.append(path) or real(path, **kw))
+    first, second = tmp_path / "tiago", tmp_path / "tiago_dual"
+    first.mkdir()
+    second.mkdir()
+    _box_stl(first / "flipped.stl", inside_out=True)
+    shutil.copyfile(first / "flipped.stl", second / "flipped.stl")
+    _box_stl(first / "open.stl", open_=True)
+    shutil.copyfile(first / "open.stl", second / "open.stl")
+    for folder in (first, second):
+        _mjcf_using(folder / "scene.xml", "flipped.stl")
+        _mjcf_using(folder / "other.xml", "open.stl")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        models = audit_corpus([tmp_path], density=1000)
+    names = sorted(os.path.relpath(p, tmp_path) for p in calls)
+    assert names == ["tiago/flipped.stl", "tiago/open.stl", "tiago_dual/open.stl"]      # the refusal twice
+    by_model = {os.path.relpath(m.source, tmp_path): m for m in models}
+    for folder in ("tiago", "tiago_dual"):
+        left = by_model[f"{folder}/scene.xml"].inertials[0]
+        assert left.properties.mass == pytest.approx(1000 * 0.1 * 0.2 * 0.3, rel=1e-6)
+        own = [w for w in left.warnings if "inside out" in w]
+        assert own and all(f"{folder}/flipped.stl" in w for w in own), left.warnings
+        refused = by_model[f"{folder}/other.xml"].inertials[0]
+        assert refused.properties is None and f"{folder}/open.stl" in refused.problem
+    texts = [str(w.message) for w in caught if "inside out" in str(w.message)]
+    assert any("tiago_dual/flipped.stl" in t for t in texts) and any("tiago/flipped.stl" in t for t in texts)
