@@ -43,6 +43,8 @@ def cause_of(problem: str) -> str:
         return "self-crossing: the winding estimate is too loose"
     if "cannot be bounded usefully" in problem:
         return "holes too large for a bounded patch"
+    if "is an island in a flat face" in problem or "are islands in a flat face" in problem:
+        return "holes: an island in a flat face (nothing bounds the feature's height)"
     if "mesh file missing" in problem or "which does not exist" in problem:
         return "mesh file missing"
     if "encloses no volume" in problem:

@@ -411,10 +411,12 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
     the longest side, and the signed volume; at most ``max_resolution``), and it is the answer (chosen by this
     rule, not by which bound is smaller); when its bound misses ``target`` by more than
     :data:`CLOSED_PREDICTION_SLACK` (the signed volume counts overlaps twice), it is built once more at
-    ``resolution · bound / target`` cells and that grid is the answer — except when it decided no cell
-    inside (a part thinner than the cells, which no affordable plain grid resolves): then
-    :func:`corrected_estimate` (the exact signed integral, corrected only near faces where the winding number
-    may leave {0, 1}) is built on the finest grid and is the answer when its mass bound meets ``target``;
+    ``resolution · bound / target`` cells; when that grid still misses it by more than the slack,
+    :func:`corrected_estimate` is built on the finest grid too and the narrower of the two proven bounds is the
+    answer.  When the grid decided no cell inside (a part thinner than the cells, which no affordable plain
+    grid resolves): :func:`corrected_estimate` (the exact signed integral, corrected only near faces where the
+    winding number may leave {0, 1}) is built on the finest grid and is the answer when its mass bound meets
+    ``target``;
     otherwise the plain finest grid is built too and the one with the smaller proven mass bound is the answer
     (each bound holds for its own estimate: a choice between two proven bounds, not between claims).  A thin
     part is thus found wherever its faces do not cross; where they do,
@@ -443,12 +445,20 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
                                  max_resolution=max_resolution)
     grid = winding_estimate(vertices, faces, resolution=finer)
     bound = grid.uncertainty.mass
-    if grid.volume > 0 and finer < max_resolution and bound > CLOSED_PREDICTION_SLACK * target:
-        # predicted too coarse (overlapping bodies count twice in the signed volume): refined once by the
-        # grid's own bound, and that grid is the answer
-        again = int(min(max_resolution, np.ceil(finer * bound / target)))
-        return winding_estimate(vertices, faces, resolution=again) if again > finer else grid
     if grid.volume > 0:
+        if finer < max_resolution and bound > CLOSED_PREDICTION_SLACK * target:
+            # predicted too coarse (overlapping bodies count twice in the signed volume): refined once by the
+            # grid's own bound
+            again = int(min(max_resolution, np.ceil(finer * bound / target)))
+            grid = winding_estimate(vertices, faces, resolution=again) if again > finer else grid
+        if not grid.uncertainty.mass > CLOSED_PREDICTION_SLACK * target:
+            return grid
+        # the plain grid misses the target: the corrected estimate on the finest grid too, and the narrower of
+        # the two proven bounds (as for a thin part below; before the one-grid rule a part the 64-cell grid
+        # found nothing inside came here, issue 23: Barkour vb's upper_leg_left.stl, ±48.6 % this way)
+        corrected = corrected_estimate(vertices, faces, resolution=max_resolution)
+        if corrected is not None and corrected.uncertainty.mass < grid.uncertainty.mass:
+            return corrected
         return grid
     # thinner than the cells: the plain grid decides nothing inside at any resolution it can afford
     corrected = corrected_estimate(vertices, faces, resolution=max_resolution)
