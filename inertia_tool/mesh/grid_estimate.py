@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tolerances import ESTIMATE_MAX_MASS_RTOL
 from .rims import boundary_edges, enclosing_balls
 from .uncertainty import Estimate, Uncertainty, uncertainty_from
 
@@ -411,10 +412,11 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
     the longest side, and the signed volume; at most ``max_resolution``), and it is the answer (chosen by this
     rule, not by which bound is smaller); when its bound misses ``target`` by more than
     :data:`CLOSED_PREDICTION_SLACK` (the signed volume counts overlaps twice), it is built once more at
-    ``resolution · bound / target`` cells; when that grid still misses it by more than the slack,
-    :func:`corrected_estimate` is built on the finest grid too and the narrower of the two proven bounds is the
-    answer.  When the grid decided no cell inside (a part thinner than the cells, which no affordable plain
-    grid resolves): :func:`corrected_estimate` (the exact signed integral, corrected only near faces where the
+    ``resolution · bound / target`` cells; when that grid's bound is past the ±50 % at which an estimate is
+    refused (:data:`~inertia_tool.tolerances.ESTIMATE_MAX_MASS_RTOL`), :func:`corrected_estimate` is built on
+    the finest grid too and the narrower of the two proven bounds is the answer.  When the grid decided no
+    cell inside (a part thinner than the cells, which no affordable plain grid resolves):
+    :func:`corrected_estimate` (the exact signed integral, corrected only near faces where the
     winding number may leave {0, 1}) is built on the finest grid and is the answer when its mass bound meets
     ``target``;
     otherwise the plain finest grid is built too and the one with the smaller proven mass bound is the answer
@@ -451,11 +453,13 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
             # grid's own bound
             again = int(min(max_resolution, np.ceil(finer * bound / target)))
             grid = winding_estimate(vertices, faces, resolution=again) if again > finer else grid
-        if not grid.uncertainty.mass > CLOSED_PREDICTION_SLACK * target:
+        if not grid.uncertainty.mass > ESTIMATE_MAX_MASS_RTOL:
             return grid
-        # the plain grid misses the target: the corrected estimate on the finest grid too, and the narrower of
-        # the two proven bounds (as for a thin part below; before the one-grid rule a part the 64-cell grid
-        # found nothing inside came here, issue 23: Barkour vb's upper_leg_left.stl, ±48.6 % this way)
+        # the plain grid's bound would be refused: the corrected estimate on the finest grid too, and the
+        # narrower of the two proven bounds (as for a thin part below; before the one-grid rule a part the
+        # 64-cell grid found nothing inside came here, issue 23: Barkour vb's upper_leg_left.stl, ±48.6 % this
+        # way).  Only past the refusal bound: on Barkour and Piper every grid between the target and it paid for
+        # a corrected estimate it did not need (358 s of CPU for four Menagerie folders)
         corrected = corrected_estimate(vertices, faces, resolution=max_resolution)
         if corrected is not None and corrected.uncertainty.mass < grid.uncertainty.mass:
             return corrected
