@@ -8,7 +8,7 @@ The totals (links computed by method, links refused, CPU seconds, load average) 
 Markdown table (``--markdown``: one row per model folder and mesh file, the links refused counted over every
 file that uses them, so a model's links count once per scene that includes it).
 
-    python benchmarks/bench_robot_refusals.py ROOT [--markdown] [--only FOLDER ...]
+    python benchmarks/bench_robot_refusals.py ROOT [--markdown] [--only FOLDER ...] [--slowest N]
 """
 
 from __future__ import annotations
@@ -43,6 +43,8 @@ def cause_of(problem: str) -> str:
         return "self-crossing: the winding estimate is too loose"
     if "cannot be bounded usefully" in problem:
         return "holes too large for a bounded patch"
+    if "is an island in a flat face" in problem or "are islands in a flat face" in problem:
+        return "holes: an island in a flat face (nothing bounds the feature's height)"
     if "mesh file missing" in problem or "which does not exist" in problem:
         return "mesh file missing"
     if "encloses no volume" in problem:
@@ -50,11 +52,31 @@ def cause_of(problem: str) -> str:
     return problem.split(":")[0][:60]
 
 
+#: (CPU seconds, mesh file) of every mesh integrated by :func:`refused_links` (``--slowest``).
+MESH_TIMES: list = []
+
+
+def _timed_mesh_properties():
+    """Wrap ``geometry.mesh_properties`` to record the CPU time of each mesh integrated (each mesh once: the run
+    shares its meshes)."""
+    import inertia_tool.robot.geometry as geometry
+    real = geometry.mesh_properties
+
+    def timed(path, **kw):
+        start = time.process_time()
+        try:
+            return real(path, **kw)
+        finally:
+            MESH_TIMES.append((time.process_time() - start, str(path)))
+    geometry.mesh_properties = timed
+
+
 def refused_links(root: str, only: tuple = ()) -> tuple[list, collections.Counter, float, float]:
     """[(folder, xml, link, mesh file, cause, mass bound % or None, problem)], methods of the links computed,
     CPU seconds and wall seconds."""
     models, scenes = menagerie_files(root)
     cache = MeshCache()
+    MESH_TIMES.clear()
     rows: list = []
     methods: collections.Counter = collections.Counter()
     cpu0, wall0 = time.process_time(), time.perf_counter()
@@ -102,13 +124,22 @@ def main(argv=None) -> int:
     parser.add_argument("root")
     parser.add_argument("--markdown", action="store_true")
     parser.add_argument("--only", nargs="*", default=[], help="model folders to run (default: all)")
+    parser.add_argument("--slowest", type=int, default=0, metavar="N",
+                        help="print the N meshes whose integration took the most CPU time")
     args = parser.parse_args(argv)
+    if args.slowest:
+        _timed_mesh_properties()
     load = os.getloadavg()[0]
     rows, methods, cpu, wall = refused_links(args.root, tuple(args.only))
     print(f"links computed {sum(methods.values())} ({', '.join(f'{k} {v}' for k, v in methods.most_common())}); "
           f"refused {len(rows)}; CPU {cpu:.1f} s, wall {wall:.1f} s, load average {load:.1f} at start")
     for cause, n in collections.Counter(r[4] for r in rows).most_common():
         print(f"  {n:5d}  {cause}")
+    if args.slowest:
+        total = sum(t for t, _ in MESH_TIMES)
+        print(f"  meshes integrated {len(MESH_TIMES)}, {total:.1f} s CPU; the slowest:")
+        for seconds, path in sorted(MESH_TIMES, reverse=True)[:args.slowest]:
+            print(f"    {seconds:7.2f} s  {os.path.relpath(path, args.root)}")
     by_model = collections.Counter(r[0] for r in rows)
     print("  by model: " + ", ".join(f"{k} {v}" for k, v in by_model.most_common()))
     if args.markdown:

@@ -237,7 +237,9 @@ defs["robot_link"] = obj({
     "method": d("exact, united, summed or estimate (a link's elements combined: the least certain wins); null "
                 "without a result (see problem).", {"enum": ["exact", "united", "summed", "estimate", None]}),
     "uncertainty": ref("uncertainty"), "certificate": ref("certificate"),
-    "geometry": arr(obj({"kind": S, "name": SN, "mesh": SN}, ["kind"])),
+    "geometry": arr(obj({"kind": S, "name": SN, "mesh": SN,
+                         "submesh": d("SDFormat <submesh><name>: the sub-mesh of the COLLADA file that is the "
+                                      "geometry (null: the whole file)", SN)}, ["kind"])),
     "problem": SN,
     "declared": {"type": ["object", "null"], "properties": {
         "mass": NN, "center_of_mass": {"anyOf": [V3, {"type": "null"}]}, "inertia": {"anyOf": [M3, {"type": "null"}]}}},

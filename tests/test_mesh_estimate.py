@@ -282,7 +282,7 @@ def test_cells_settled_by_their_region_classify_as_the_exact_winding_number(case
     axes = [lo[i] + h * (np.arange(dims[i]) + 0.5) for i in range(3)]
     centres = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     crossed = _surface_cells(v, f, lo, h, dims)
-    found = _closed_part_numbers(v, f, centres, crossed, lo, h, dims, fast=False, margin=0.1)
+    found = _closed_part_numbers(v, f, crossed, lo, h, dims, fast=False, margin=0.1)
     assert found is not None
     settled, value = found
     assert settled.sum() > 0.3 * (~crossed).sum()              # the shortcut does its job

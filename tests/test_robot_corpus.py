@@ -142,3 +142,133 @@ def test_the_shared_cache_still_counts_each_robots_face_budget(tmp_path):
     assert len(shared) == 1
     small = link_inertials(read_robot(tmp_path / "a.xml"), density=1000, mesh_cache=shared, max_faces=5)[0]
     assert small.properties is None and "max_faces" in small.problem and "12 triangles" in small.problem
+
+
+def _two_folder_corpus(tmp_path):
+    """Two model folders (a shared flipped mesh in one, an open mesh and a fitted capsule in the other) and a
+    broken file: warnings, refusals and fitted primitives in both."""
+    first, second = tmp_path / "a", tmp_path / "b"
+    first.mkdir()
+    second.mkdir()
+    _box_stl(first / "flipped.stl", inside_out=True)
+    for name in ("scene", "scene_mjx"):
+        _mjcf_using(first / f"{name}.xml", "flipped.stl")
+    _box_stl(second / "open.stl", open_=True)
+    _box_stl(second / "box.stl")
+    _mjcf_using(second / "other.xml", "open.stl")
+    (second / "fit.xml").write_text('<mujoco><asset><mesh name="m" file="box.stl"/></asset><worldbody>'
+                                    '<body name="c"><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+                                    '<geom type="capsule" mesh="m"/></body></worldbody></mujoco>')
+    (second / "broken.urdf").write_text("<robot name='b'><link name='x'>")
+    return tmp_path
+
+
+def _summary(models):
+    rows = []
+    for m in models:
+        rows.append((os.path.basename(m.source), m.problem))
+        for link, audit in zip(m.inertials, m.audits):
+            props = link.properties
+            rows.append((link.name, link.problem, link.warnings, audit.issues,
+                         None if props is None else (props.mass, tuple(props.center_of_mass),
+                                                     tuple(props.inertia.reshape(-1)))))
+    return rows
+
+
+def test_jobs_2_gives_the_serial_results_and_warnings_in_the_serial_order(tmp_path):
+    import warnings
+
+    from inertia_tool.robot.corpus import audit_corpus
+    root = _two_folder_corpus(tmp_path)
+    runs = []
+    for jobs in (1, 2):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            models = audit_corpus([root], density=1000, jobs=jobs)
+        runs.append((_summary(models), [str(w.message) for w in caught]))
+    (serial, serial_warnings), (parallel, parallel_warnings) = runs
+    assert parallel == serial
+    assert parallel_warnings == serial_warnings and any("inside out" in w for w in serial_warnings)
+    assert [r[0] for r in serial if r[0].endswith((".xml", ".urdf"))] == \
+        ["scene.xml", "scene_mjx.xml", "broken.urdf", "fit.xml", "other.xml"]
+
+
+@pytest.mark.parametrize("jobs", [0, -1, 1.5, True])
+def test_jobs_must_be_a_positive_integer(tmp_path, jobs):
+    from inertia_tool.errors import UsageError
+    from inertia_tool.robot.corpus import audit_corpus
+    with pytest.raises(UsageError, match="jobs"):
+        audit_corpus([_two_folder_corpus(tmp_path)], density=1000, jobs=jobs)
+
+
+def test_cli_jobs_prints_what_one_process_prints(tmp_path, capsys):
+    root = _two_folder_corpus(tmp_path)
+    outputs = []
+    for jobs in ("1", "2"):
+        assert main(["robot", str(root), "--density", "1000", "--json", "-j", jobs]) == EXIT_INCOMPLETE
+        outputs.append(capsys.readouterr())
+    assert outputs[0].out == outputs[1].out and outputs[0].err == outputs[1].err
+    assert main(["robot", str(root), "--density", "1000", "--jobs", "0"]) == 2
+    assert "--jobs" in capsys.readouterr().err
+
+
+def test_the_audit_fits_a_primitive_to_a_mesh_once_per_file_content(tmp_path, monkeypatch):
+    """The audit's bounding boxes and inside tests fit each fitted geom again; the mesh under it is integrated
+    once (issue 23: 22 of 57 s of a Menagerie audit), and again when the file's bytes change."""
+    import inertia_tool.robot.geometry as geometry
+    from inertia_tool.robot import audit_links, link_inertials, read_robot
+    calls = []
+    real = geometry.mesh_properties
+    monkeypatch.setattr(geometry, "mesh_properties", lambda path, **kw: calls.append(path) or real(path, **kw))
+    monkeypatch.setattr(geometry, "_FIT_BODIES", {})
+    root = _two_folder_corpus(tmp_path)
+    robot = read_robot(root / "b" / "fit.xml")
+    audits = audit_links(robot, link_inertials(robot, density=1000))
+    assert audits[0].com_in_bounding_box is True and audits[0].com_inside_geometry is True
+    before = len(calls)
+    for _ in range(3):
+        audit_links(robot, link_inertials(robot, density=1000))
+    assert len(calls) - before <= 3                      # the link integrals' own fit, once per call
+    from conftest import box_arrays, write_binary_stl
+    v, f = box_arrays((0.1, 0.2, 0.5))                  # the same file name, other bytes: fitted anew
+    write_binary_stl(root / "b" / "box.stl", v, f)
+    longer = audit_links(robot, link_inertials(robot, density=1000))[0]
+    assert longer.size > audits[0].size
+
+
+def test_a_byte_identical_copy_in_another_folder_is_integrated_once_with_its_own_warnings(tmp_path, monkeypatch):
+    """TIAGo and TIAGo dual ship the same mesh bytes under two paths: a result is shared by content, and each
+    model's warnings and result name its own file; a refusal is not shared (each copy is refused by itself)."""
+    import shutil
+    import warnings
+
+    import inertia_tool.robot.geometry as geometry
+    from inertia_tool.robot.corpus import audit_corpus
+    calls = []
+    real = geometry.mesh_properties
+    monkeypatch.setattr(geometry, "mesh_properties", lambda path, **kw: calls.append(path) or real(path, **kw))
+    first, second = tmp_path / "tiago", tmp_path / "tiago_dual"
+    first.mkdir()
+    second.mkdir()
+    _box_stl(first / "flipped.stl", inside_out=True)
+    shutil.copyfile(first / "flipped.stl", second / "flipped.stl")
+    _box_stl(first / "open.stl", open_=True)
+    shutil.copyfile(first / "open.stl", second / "open.stl")
+    for folder in (first, second):
+        _mjcf_using(folder / "scene.xml", "flipped.stl")
+        _mjcf_using(folder / "other.xml", "open.stl")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        models = audit_corpus([tmp_path], density=1000)
+    names = sorted(os.path.relpath(p, tmp_path) for p in calls)
+    assert names == ["tiago/flipped.stl", "tiago/open.stl", "tiago_dual/open.stl"]      # the refusal twice
+    by_model = {os.path.relpath(m.source, tmp_path): m for m in models}
+    for folder in ("tiago", "tiago_dual"):
+        left = by_model[f"{folder}/scene.xml"].inertials[0]
+        assert left.properties.mass == pytest.approx(1000 * 0.1 * 0.2 * 0.3, rel=1e-6)
+        own = [w for w in left.warnings if "inside out" in w]
+        assert own and all(f"{folder}/flipped.stl" in w for w in own), left.warnings
+        refused = by_model[f"{folder}/other.xml"].inertials[0]
+        assert refused.properties is None and f"{folder}/open.stl" in refused.problem
+    texts = [str(w.message) for w in caught if "inside out" in str(w.message)]
+    assert any("tiago_dual/flipped.stl" in t for t in texts) and any("tiago/flipped.stl" in t for t in texts)

@@ -839,3 +839,25 @@ def test_point_in_polygon_is_exact_near_edges(sides, seed, t, lift):
     truth = exact_inside(point)
     if truth is not None:
         assert point_in_polygon(point, polygon) == truth
+
+
+def test_json_geometry_names_the_submesh(tmp_path, capsys):
+    """Issue 23 item 5 (robots4): each ``geometry`` entry of ``robot --json`` names its SDFormat sub-mesh (the
+    COLLADA node integrated), null for a whole file; the output still validates against the shipped schema."""
+    import json
+
+    from inertia_tool.cli import main
+    from inertia_tool.reports.serialize import output_schema
+    _collada_scene(tmp_path / "vehicle.dae")
+    path = _submesh_sdf(tmp_path / "m.sdf", "vehicle.dae", "Wheel", "true")
+    assert main(["robot", str(path), "--density", "1000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["links"][0]["geometry"] == [{"kind": "mesh", "name": "c", "mesh": "vehicle.dae", "submesh": "Wheel"}]
+    jsonschema = pytest.importorskip("jsonschema")
+    jsonschema.Draft202012Validator(output_schema()).validate(out)
+    whole = tmp_path / "w.sdf"
+    whole.write_text(path.read_text().replace("<submesh><name>Wheel</name><center>true</center></submesh>", ""))
+    assert main(["robot", str(whole), "--density", "1000", "--json"]) == 0
+    entry = json.loads(capsys.readouterr().out)["links"][0]["geometry"][0]
+    assert entry["submesh"] is None and entry["mesh"] == "vehicle.dae"
+    assert "submesh" in output_schema()["$defs"]["robot_link"]["properties"]["geometry"]["items"]["properties"]

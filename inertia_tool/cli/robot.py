@@ -70,6 +70,9 @@ def register(subparsers) -> None:
                         f"{DEFAULT_MAX_FACES:,}; protects memory: each file is checked before it is read in full)")
     p.add_argument("--repair", action="store_true",
                    help="repair open or inconsistently wound link meshes instead of reporting them (warned)")
+    p.add_argument("--jobs", "-j", type=int, default=1, metavar="N",
+                   help="with several descriptions (a corpus): audit them in N worker processes, the descriptions "
+                        "of one folder together (default 1)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     p.add_argument("--write", metavar="OUT", help="write a copy of the description with corrected <inertial> elements")
     p.add_argument("--force", action="store_true", help="let --write replace an existing file")
@@ -118,11 +121,12 @@ def _run_corpus(args, packages: dict) -> int:
         raise UsageError("--write and --arg apply to one description; a corpus (several files or a folder) is "
                          "only audited")
     check_option("--max-faces", args.max_faces)
+    check_option("--jobs", args.jobs)
     density = _density(args)
     with recorded_warnings(args, parser=getattr(args, "robot_parser", None)) as messages:
         models = audit_corpus(args.robot, density=density, material=args.material, keep_mass=args.keep_mass,
                               repair=args.repair, packages=packages, geometry=args.geometry,
-                              max_faces=args.max_faces, run_xacro=args.run_xacro)
+                              max_faces=args.max_faces, run_xacro=args.run_xacro, jobs=args.jobs)
     if not models:
         raise UsageError(f"no robot description found in {', '.join(args.robot)}")
     if args.json:

@@ -90,6 +90,9 @@ def ray_winding(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, gro
     lo = np.searchsorted(sorted_y, np.minimum(np.minimum(y0, y1), y2), side="left")
     hi = np.searchsorted(sorted_y, np.maximum(np.maximum(y0, y1), y2), side="right")
     del y0, y1, y2
+    z_of_face = vertices[:, 2][f]
+    z_lo, z_hi = z_of_face.min(axis=1), z_of_face.max(axis=1)      # once per face, not once per pair
+    del z_of_face
     counts = hi - lo
     candidates = np.flatnonzero(counts)
     keys: list[np.ndarray] = []
@@ -105,12 +108,12 @@ def ray_winding(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, gro
         face = np.repeat(fc, c)
         offset = np.arange(len(face)) - np.repeat(np.cumsum(c) - c, c)
         point = order[lo[face] + offset]
-        p = points[point]
-        zs = vertices[:, 2][f[face]]
-        inside_z = (zs.min(axis=1) <= p[:, 2]) & (p[:, 2] <= zs.max(axis=1))
+        pz = points[point, 2]
+        inside_z = (z_lo[face] <= pz) & (pz <= z_hi[face])
         if exclude is not None:
             inside_z &= groups[face] != exclude[point]
-        face, point, p = face[inside_z], point[inside_z], p[inside_z]
+        face, point = face[inside_z], point[inside_z]
+        p = points[point]
         ia, ib, ic = f[face, 0], f[face, 1], f[face, 2]
         a, b, cc = vertices[ia], vertices[ib], vertices[ic]
         d_ab = _edge_test(a, b, ia, ib, p[:, 1], p[:, 2])

@@ -113,7 +113,8 @@ def robot_report_dict(robot: RobotDescription, inertials, audits) -> dict:
             "density_basis": result.basis,
             "center_of_mass": None if props is None else props.center_of_mass,
             "inertia": None if props is None else props.inertia,
-            "geometry": [{"kind": e.kind, "name": e.name, "mesh": e.uri} for e in geometry.elements],
+            "geometry": [{"kind": e.kind, "name": e.name, "mesh": e.uri, "submesh": e.submesh or None}
+                         for e in geometry.elements],
             "problem": result.problem,
             "method": result.method,
             "uncertainty": None if result.uncertainty is None else {

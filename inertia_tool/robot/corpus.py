@@ -18,6 +18,9 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
+
+import numpy as np
 
 from ..errors import InertiaToolError, RobotDescriptionError, UsageError
 from ..values import frozen_value
@@ -120,24 +123,94 @@ def find_descriptions(paths, *, max_files: int = MAX_CORPUS_FILES) -> list:
             and (p in explicit or os.path.normpath(p) not in older)]
 
 
+def _audit_one(path: str, meshes: MeshCache, settings: dict) -> ModelAudit:
+    """Read, compute and audit one description (a refusal is kept as the model's ``problem``)."""
+    try:
+        robot = read_robot(path, packages=settings["packages"], geometry=settings["geometry"],
+                           run_xacro=settings["run_xacro"])
+        inertials = link_inertials(robot, density=settings["density"], material=settings["material"],
+                                   keep_mass=settings["keep_mass"], repair=settings["repair"], mesh_cache=meshes,
+                                   **settings["options"])
+        audits = audit_links(robot, inertials, keep_mass=settings["keep_mass"])
+    except InertiaToolError as exc:
+        return ModelAudit(source=path, robot=None, problem=str(exc))
+    return ModelAudit(source=path, robot=robot, inertials=inertials, audits=audits)
+
+
+#: The mesh bodies a worker process of a parallel corpus run keeps across the folders it is given.
+_WORKER_MESHES: MeshCache | None = None
+
+
+def _audit_folder(paths: list, settings: dict) -> list:
+    """In a worker process: ``[(index, ModelAudit, [(warning category, message), ...]), ...]`` for ``paths``
+    (``(index, path)`` of the descriptions of one folder), each with the warnings raised while it was audited,
+    to be issued again by the parent in the order of a serial run."""
+    global _WORKER_MESHES
+    if _WORKER_MESHES is None:
+        _WORKER_MESHES = MeshCache()
+    out = []
+    for index, path in paths:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            audit = _audit_one(path, _WORKER_MESHES, settings)
+        out.append((index, audit, [(w.category, str(w.message)) for w in caught]))
+    return out
+
+
+def _folder_weight(folder: str, limit: int = 100_000) -> int:
+    """Bytes of the files under ``folder`` (at most ``limit`` files looked at): the work a folder's models are
+    expected to take, to start the largest first."""
+    total = seen = 0
+    for root, _, files in os.walk(folder):
+        for name in files:
+            seen += 1
+            if seen > limit:
+                return total
+            try:
+                total += os.path.getsize(os.path.join(root, name))
+            except OSError:
+                continue
+    return total
+
+
 def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass: bool = False,
                  repair: bool = False, packages: dict | None = None, geometry: str = "collision",
-                 run_xacro: bool = False, **options) -> tuple:
+                 run_xacro: bool = False, jobs: int = 1, **options) -> tuple:
     """Read, compute and audit every description under ``paths``; one :class:`ModelAudit` each.
 
     Parameters are those of :func:`~inertia_tool.robot.read_robot`, :func:`~inertia_tool.robot.link_inertials`
-    and :func:`~inertia_tool.robot.audit_links` (``options`` go to ``link_inertials``).
+    and :func:`~inertia_tool.robot.audit_links` (``options`` go to ``link_inertials``), and
+
+    jobs : int
+        Worker processes (default 1: this process).  With more, the descriptions of each folder go to one
+        worker together (a Menagerie folder's scenes share their meshes), the folders holding the most bytes
+        first; each worker keeps one :class:`MeshCache` for the folders it is given.  The results and every
+        model's warnings come back in the order of a serial run, and are the same as its (a mesh shared
+        between folders may be integrated once per worker instead of once).
     """
+    if not (isinstance(jobs, (int, np.integer)) and not isinstance(jobs, bool) and jobs >= 1):
+        raise UsageError(f"Expected `jobs` to be an integer >= 1, got {jobs!r}")
+    settings = dict(density=density, material=material, keep_mass=keep_mass, repair=repair, packages=packages,
+                    geometry=geometry, run_xacro=run_xacro, options=options)
+    found = find_descriptions(paths)
+    folders: dict = {}
+    for index, path in enumerate(found):
+        folders.setdefault(os.path.dirname(os.path.abspath(path)), []).append((index, path))
+    if jobs == 1 or len(folders) < 2:
+        meshes = MeshCache()             # scene variants and sibling models share mesh files: each integrated once
+        return tuple(_audit_one(path, meshes, settings) for path in found)
+    from ..batch.runner import _process_pool
+    done: dict = {}
+    order = sorted(folders, key=lambda folder: -_folder_weight(folder))
+    with _process_pool(min(int(jobs), len(folders))) as pool:
+        futures = [pool.submit(_audit_folder, folders[folder], settings) for folder in order]
+        for future in futures:
+            for index, audit, caught in future.result():
+                done[index] = (audit, caught)
     out = []
-    meshes = MeshCache()                 # scene variants and sibling models share mesh files: each integrated once
-    for path in find_descriptions(paths):
-        try:
-            robot = read_robot(path, packages=packages, geometry=geometry, run_xacro=run_xacro)
-            inertials = link_inertials(robot, density=density, material=material, keep_mass=keep_mass,
-                                       repair=repair, mesh_cache=meshes, **options)
-            audits = audit_links(robot, inertials, keep_mass=keep_mass)
-        except InertiaToolError as exc:
-            out.append(ModelAudit(source=path, robot=None, problem=str(exc)))
-            continue
-        out.append(ModelAudit(source=path, robot=robot, inertials=inertials, audits=audits))
+    for index in range(len(found)):
+        audit, caught = done[index]
+        for category, message in caught:
+            warnings.warn(message, category, stacklevel=2)
+        out.append(audit)
     return tuple(out)

@@ -317,10 +317,18 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
                            reference_rotation=element.reference_rotation,
                            reference_translation=element.reference_translation,
                            mesh_inertia=element.mesh_inertia)
-    if element.mesh_inertia in ("convex", "legacy"):
+    memo = _fit_memo_key(mesh, repair) if cache is None else None
+    props = _FIT_BODIES.get(memo) if memo is not None else None
+    if props is not None:
+        _FIT_BODIES[memo] = _FIT_BODIES.pop(memo)          # most recently used last
+    elif element.mesh_inertia in ("convex", "legacy"):
         props = _mesh_inertia_part(mesh, cache={} if cache is None else cache, budget=budget)[1]
     else:
         props = element_mass_properties(mesh, cache=cache, repair=repair, budget=budget)
+    if memo is not None and memo not in _FIT_BODIES:
+        _FIT_BODIES[memo] = props
+        while len(_FIT_BODIES) > FIT_BODIES_KEPT:
+            _FIT_BODIES.pop(next(iter(_FIT_BODIES)))
     moments, axes = np.linalg.eigh(0.5 * (props.inertia + props.inertia.T))
     axes = axes[:, ::-1]                                 # x: the largest moment, z: the smallest
     if np.linalg.det(axes) < 0:
@@ -363,6 +371,27 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
                            shell=element.shell)
 
 
+#: Unit-density bodies of the meshes that primitives are fitted to, for the calls of :func:`fitted_element`
+#: without a robot cache (the audit's bounding boxes and inside tests fit every fitted geom again: before this
+#: memo, each such call integrated the mesh anew, 22 of the 57 s of CPU of a Menagerie corpus audit).  Keyed by
+#: :func:`_fit_memo_key` (the file's content, how the element places it, its inertia mode and ``repair``), at
+#: most :data:`FIT_BODIES_KEPT` entries (least recently used dropped first); refusals are not kept.
+_FIT_BODIES: dict = {}
+FIT_BODIES_KEPT = 256
+
+
+def _fit_memo_key(mesh: GeometryElement, repair: bool) -> tuple | None:
+    """The :data:`_FIT_BODIES` key of a fitted geom's mesh element, or None when its file is not kept (too
+    large or unreadable: :func:`_content_key`)."""
+    content = None
+    if mesh.mesh is not None:
+        submesh = (mesh.submesh, bool(mesh.submesh_center)) if mesh.submesh else None
+        content = _content_key(mesh.mesh, submesh)
+        if content is None:
+            return None
+    return (content, _mesh_key(mesh), mesh.mesh_inertia, bool(repair))
+
+
 class MeshCache:
     """Unit-density mesh bodies kept across the robots of one run (a corpus: Menagerie's scene variants, the
     left and right links of a robot, share mesh files), failures included.
@@ -371,10 +400,16 @@ class MeshCache:
     (or the exception that refused the mesh), the engine's warnings about it (issued again on every robot that
     uses it, so that each link still names what was done to its meshes) and the file's triangle count (taken
     off each robot's ``max_faces`` budget as if it had been read).  Entries are never changed once stored.
+
+    A result (not a refusal) is also kept by the file's *content* (:func:`_content_key` without the path: its
+    size and a hash of its bytes, with the file's suffix, the placement and ``repair``), so that a byte-identical
+    copy in another folder (TIAGo and TIAGo dual ship the same ``gripper_link.stl``) is integrated once; the copy
+    gets the result with every warning addressed to its own file (:meth:`get_copy`).
     """
 
     def __init__(self) -> None:
         self._entries: dict = {}
+        self._by_content: dict = {}
 
     def __len__(self) -> int:
         return len(self._entries)
@@ -383,8 +418,33 @@ class MeshCache:
         """``(result or exception, warnings, faces)`` for ``key``, or None."""
         return self._entries.get(key)
 
-    def put(self, key, outcome, caught: tuple, faces: int) -> None:
+    def put(self, key, outcome, caught: tuple, faces: int, content=None) -> None:
         self._entries.setdefault(key, (outcome, caught, faces))
+        if content is not None and not isinstance(outcome, BaseException):
+            self._by_content.setdefault(content, (key[0][0], outcome, caught, faces))
+
+    def get_copy(self, content, path: str):
+        """``(result, warnings, faces)`` of a file with the same content integrated under another path, the
+        warnings' text and the result's mesh report re-addressed to ``path``; None when there is none (or a
+        warning cannot be rebuilt with the new text)."""
+        found = self._by_content.get(content) if content is not None else None
+        if found is None:
+            return None
+        other, outcome, caught, faces = found
+        if other == path:
+            return outcome, caught, faces
+        moved = []
+        for item in caught:
+            text = str(item.message).replace(other, path)
+            try:
+                message = item.category(text)
+            except TypeError:                      # a warning class that takes more than its text
+                return None
+            moved.append(warnings.WarningMessage(message, item.category, item.filename, item.lineno))
+        report = outcome.mesh
+        if report is not None and getattr(report, "source", None) == other:
+            outcome = replace(outcome, mesh=replace(report, source=path))
+        return outcome, tuple(moved), faces
 
 
 def _reissue(caught) -> None:
@@ -404,6 +464,13 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
         return found
     shared = cache.get(_SHARED) if cache is not None else None
     entry = shared.get((key, repair)) if shared is not None else None
+    content = None
+    if shared is not None and entry is None and element.mesh is not None:
+        found = _content_key(element.mesh, (element.submesh, bool(element.submesh_center)) if element.submesh
+                             else None)
+        if found is not None:
+            content = (found[1:], os.path.splitext(element.mesh)[1].lower(), key[1:], repair)
+            entry = shared.get_copy(content, element.mesh)
     if entry is not None:
         outcome, caught, faces = entry
         if budget is not None and faces > budget[0] and not isinstance(outcome, BaseException):
@@ -439,7 +506,8 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
             if budget is not None:
                 budget[0] -= faces
         if shared is not None and not (isinstance(outcome, MeshReadError) and "`max_faces`" in str(outcome)):
-            shared.put((key, repair), outcome, caught, faces)     # a budget refusal is this robot's, not the file's
+            shared.put((key, repair), outcome, caught, faces,     # a budget refusal is this robot's, not the file's
+                       content=content)
     if cache is not None:
         cache[key] = outcome
     if isinstance(outcome, BaseException):
