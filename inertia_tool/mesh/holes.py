@@ -41,7 +41,7 @@ from .seal import Seal
 from .uncertainty import Estimate, uncertainty_from
 
 __all__ = ["patched_estimate", "hole_doubt_volumes", "ball_slab_volume", "crease_fills", "CreaseFill", "rim_evidence",
-           "RimEvidence", "bare_vertices"]
+           "RimEvidence", "bare_vertices", "slab_contradicted"]
 
 
 def ball_slab_volume(radius: np.ndarray, offset: np.ndarray, half_width: np.ndarray) -> np.ndarray:
@@ -472,6 +472,116 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
     return bare
 
 
+def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
+                      n_loops: int, slabs: dict[str, np.ndarray], radius: np.ndarray, *,
+                      flat_rtol: float = FLAT_RIM_RTOL, flat_cosine: float = FLAT_VERTEX_COSINE
+                      ) -> np.ndarray:
+    """Loops whose flat slab the faces left at the rim contradict, (n_loops,) bool.
+
+    Only rims that are flat (within ``flat_rtol`` of the ball's radius of their slab plane ``P``, the hole in a
+    flat face of the part) are examined; the second assumption then says the missing surface ``M`` *is* the
+    planar region the rim bounds in ``P``.  Two things the file can show contradict it:
+
+    1. **A face beside the rim lying in ``P`` but facing against the patch** (its normal opposite to the rim's
+       vector area as the cone closes it): the planar ``M`` would fold back onto that face, a fin of no
+       thickness, which no solid's surface has (a box with a boss that lost 16 of its 28 faces: the two top
+       triangles left face up while the patch over the hexagonal rim faces down; the patch closed the boss
+       alone, 94 % low at ±1e-13).
+    2. **A rim vertex whose every remaining face lies in ``P``** (within ``acos(flat_cosine)``), on a surface
+       with no vertex inside its flat faces there (no flat neighbour off the rims, as :func:`bare_vertices`
+       asks): on such a (CAD) tessellation every vertex lies on a loop of its flat face, where another face of
+       the part meets ``P``; that face is gone, so ``M`` leaves ``P`` at the vertex, by an amount nothing in the
+       file bounds (a pocket taken whole with the half of the top face around it, its rim touching the pocket's
+       footprint at one corner: 0.7 % high at ±2e-14).  :func:`bare_vertices` asks the same of vertices whose
+       faces form a flat face of the part; here one face in ``P`` suffices, since ``P`` is the plane the whole
+       rim lies in, not just that face's own.
+
+    ``slabs`` is what :func:`hole_doubt_volumes` fills (``has``, ``normal``, ``origin``, ``half_width``).
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n = len(v)
+    out = np.zeros(n_loops, dtype=bool)
+    if not n_loops or not len(edges) or not len(f):
+        return out
+    flat = slabs["has"] & (slabs["half_width"] <= flat_rtol * radius + _round_off(v))
+    if not flat.any():
+        return out
+    unit_p = slabs["normal"]
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    size = np.linalg.norm(normal, axis=1)
+    unit = normal / np.where(size > 0, size, 1.0)[:, None]
+    # the rim's vector area: the cone (b, a, apex) over each rim edge a -> b faces along minus it
+    e = np.asarray(edges, dtype=np.int64)
+    rim_area = np.zeros((n_loops, 3))
+    np.add.at(rim_area, label, 0.5 * np.cross(v[e[:, 0]], v[e[:, 1]]))
+    cone_side = -np.einsum("ij,ij->i", rim_area, unit_p)
+    # (1) ring faces (the face holding each rim edge a -> b) in P facing against the patch
+    nv = np.int64(max(n, 1))
+    directed = f.reshape(-1) * nv + f[:, [1, 2, 0]].reshape(-1)
+    order = np.argsort(directed, kind="stable")
+    query = e[:, 0] * nv + e[:, 1]
+    pos = np.minimum(np.searchsorted(directed[order], query), len(order) - 1)
+    found = directed[order[pos]] == query
+    ring = order[pos] // 3
+    along = np.einsum("ij,ij->i", unit[ring], unit_p[label])
+    against = found & flat[label] & (size[ring] > 0) & (np.abs(along) >= flat_cosine) \
+        & (along * cone_side[label] < 0)
+    out[label[against]] = True
+    # (2) rim vertices whose every face lies in P, with no flat vertex off the rims beside them
+    pairs = np.unique(np.stack([e.reshape(-1), np.repeat(label, 2)], axis=1), axis=0)
+    pairs = pairs[flat[pairs[:, 1]]]
+    if len(pairs):
+        first = np.searchsorted(pairs[:, 0], np.arange(n))
+        count = np.bincount(pairs[:, 0], minlength=n)
+        fi, ci = np.nonzero(count[f] > 0)
+        x = f[fi, ci]
+        reps = count[x]
+        which = np.repeat(first[x], reps) + (np.arange(int(reps.sum())) - np.repeat(np.cumsum(reps) - reps, reps))
+        face, pair = np.repeat(fi, reps), which
+        in_p = (size[face] > 0) & (np.abs(np.einsum("ij,ij->i", unit[face], unit_p[pairs[pair, 1]]))
+                                   >= flat_cosine)
+        off_p = np.bincount(pair, weights=~in_p, minlength=len(pairs)) > 0
+        interior = _flat_off_rim_nearby(v, f, e, flat_cosine=flat_cosine)
+        bare_in_p = ~off_p & ~interior[pairs[:, 0]]
+        out[pairs[bare_in_p, 1]] = True
+    return out
+
+
+def _round_off(v: np.ndarray) -> float:
+    """16 ulp of the largest coordinate: the margin every plane distance here carries."""
+    scale = float(np.max(np.abs(v))) if len(v) else 0.0
+    return 16.0 * float(np.finfo(np.float64).eps) * max(scale, 1e-300)
+
+
+def _flat_off_rim_nearby(v: np.ndarray, f: np.ndarray, edges: np.ndarray, *,
+                         flat_cosine: float = FLAT_VERTEX_COSINE) -> np.ndarray:
+    """Vertices with a neighbour off the rims whose faces all lie within ``acos(flat_cosine)`` of one plane,
+    (n,) bool: the surface has vertices inside its flat faces there, so a flat rim vertex proves nothing."""
+    n = len(v)
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    area = np.linalg.norm(normal, axis=1)
+    good = area > 0
+    g, unit = f[good], normal[good] / area[good, None]
+    mean = np.zeros((n, 3))
+    for k in range(3):
+        np.add.at(mean, g[:, k], normal[good])
+    size = np.linalg.norm(mean, axis=1)
+    mean_unit = mean / np.where(size > 0, size, 1.0)[:, None]
+    least = np.ones(n)
+    for k in range(3):
+        np.minimum.at(least, g[:, k], np.einsum("ij,ij->i", unit, mean_unit[g[:, k]]))
+    on_rim = np.zeros(n, dtype=bool)
+    on_rim[np.asarray(edges, dtype=np.int64).reshape(-1)] = True
+    off = (least >= flat_cosine) & (size > 0) & ~on_rim
+    near = np.zeros(n, dtype=bool)
+    for k in range(3):
+        for j in range(3):
+            if j != k:
+                near[f[off[f[:, j]], k]] = True
+    return near
+
+
 #: Most (ring face, rim vertex) pairs measured by :func:`hole_doubt_volumes` (a few seconds); beyond it every
 #: hole keeps its whole ball (a bound that needs no ring).
 RING_WORK_LIMIT = 200_000_000
@@ -553,12 +663,17 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     creases: list[CreaseFill] = []
     if n_loops:
         centre, radius = enclosing_balls(v[vertex_of], loop_of, n_loops)
-        hole_doubt = hole_doubt_volumes(v, f, edges, label, n_loops, centre, radius, vertex_of, loop_of)
+        slabs: dict[str, np.ndarray] = {}
+        hole_doubt = hole_doubt_volumes(v, f, edges, label, n_loops, centre, radius, vertex_of, loop_of,
+                                        slabs=slabs)
         bare = bare_vertices(v, f, edges)
         evidence = rim_evidence(v, f, edges, label, n_loops, radius, bare=bare)
         # a bare rim vertex: the hole took a surface that met the face beside it there, which need not stay
-        # near that face's plane: the slab is withdrawn, the ball (first assumption) bounds the hole
+        # near that face's plane; a flat rim whose faces say the missing surface leaves its plane
+        # (slab_contradicted): the slab is withdrawn, the ball (first assumption) bounds the hole
         withdrawn = evidence.bare > 0
+        if slabs:
+            withdrawn |= slab_contradicted(v, f, edges, label, n_loops, slabs, radius)
         hole_doubt[withdrawn] = 4.0 / 3.0 * np.pi * radius[withdrawn] ** 3
         creases = crease_fills(v, f, edges, label, n_loops, centre, radius, bare=bare)
         unbounded = _contradicted(evidence, radius, size)
