@@ -185,14 +185,25 @@ class CreaseFill:
         the caller's numbering, shifted by the caller), and the two triangles over the crease segment.
     doubt : float
         Volume in doubt, m³: the ball over the rim cut to the slab of each plane, summed.
+    narrow : bool
+        The faces left at the rim do not contradict the third assumption (no rim vertex off the crease keeps
+        faces in its plane only, on a surface with no vertex inside its flat faces: :func:`crease_fills`), so
+        ``doubt`` bounds the hole; else the whole ball does.
     """
 
     loop: int
     apexes: np.ndarray
     caps: np.ndarray
     doubt: float
+    narrow: bool = False
 
 
+#: A rim "lies in a plane" when every rim vertex and every face left at the rim is within this share of the
+#: ball's radius of the plane of a ring face (far above round-off and quantisation to 1e-4 of a diagonal, far
+#: below any boss or pocket a designer draws).
+FLAT_RIM_RTOL = 1e-3
+#: A vertex is *flat* when every face at it is within acos(FLAT_VERTEX_COSINE) ≈ 1.1° of their mean plane.
+FLAT_VERTEX_COSINE = 1.0 - 2e-4
 #: Most distinct planes of the faces beside one rim tried in pairs by :func:`crease_fills`.
 CREASE_MAX_PLANES = 8
 #: Most loops :func:`crease_fills` examines (one at a time, ~0.1 ms each).
@@ -200,7 +211,8 @@ CREASE_MAX_LOOPS = 5000
 
 
 def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
-                 centre: np.ndarray, radius: np.ndarray, *, bare: np.ndarray | None = None) -> list[CreaseFill]:
+                 centre: np.ndarray, radius: np.ndarray, *, bare: np.ndarray | None = None,
+                 flat_rtol: float = FLAT_RIM_RTOL, flat_cosine: float = FLAT_VERTEX_COSINE) -> list[CreaseFill]:
     """Holes across one crease, each filled by two planar fans instead of one cone (the third assumption).
 
     A hole that took triangles from two flat faces of a faceted part meeting at a crease (a box's edge, a
@@ -244,6 +256,14 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
     rim_lookup = dict(zip(rim_key.tolist(), label.tolist()))
     for slot in np.flatnonzero(hit).tolist():
         face_loop.setdefault(rim_lookup[int(key[slot])], set()).add(slot // 3)
+    interior = _flat_off_rim_nearby(v, f, edges, flat_cosine=flat_cosine)
+    corner_order = np.argsort(f.reshape(-1), kind="stable")
+    corner_start = np.searchsorted(f.reshape(-1)[corner_order], np.arange(n + 1))
+
+    def vertex_faces(x: int) -> np.ndarray:
+        faces_at: np.ndarray = corner_order[corner_start[x]:corner_start[x + 1]] // 3
+        return faces_at
+
     out = []
     for k in candidates:
         raw = edges[label == k]
@@ -314,6 +334,8 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         caps = [[e1, e0, n + sd] for (e0, e1), sd in zip(order, side)]
         # p's chain runs b → … → a and closes along a → b; q's runs a → … → b and closes along b → a
         caps += [[b, a, n + 0], [a, b, n + 1]]
+        narrow = not _crease_rim_contradicts(v, f, loop_edges, side, (a, b), unit[[p, q]], offset[[p, q]],
+                                             flat_rtol * float(radius[k]) + margin, vertex_faces, interior)
         doubt = 0.0
         for which, plane in ((0, p), (1, q)):
             chain = [index[x] for (s0, s1), sd in zip(order, side) if sd == which for x in (s0, s1)]
@@ -321,8 +343,36 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
             centre_offset = float(centre[k] @ unit[plane] - offset[plane])
             doubt += float(ball_slab_volume(np.array([radius[k]]), np.array([centre_offset]),
                                             np.array([half]))[0])
-        out.append(CreaseFill(loop=int(k), apexes=apexes, caps=np.array(caps, dtype=np.int64), doubt=doubt))
+        out.append(CreaseFill(loop=int(k), apexes=apexes, caps=np.array(caps, dtype=np.int64), doubt=doubt,
+                              narrow=narrow))
     return out
+
+
+def _crease_rim_contradicts(v: np.ndarray, f: np.ndarray, loop_edges: np.ndarray, side: list[int],
+                            crease: tuple[int, int], plane_unit: np.ndarray, plane_offset: np.ndarray,
+                            tol: float, vertex_faces: Callable[[int], np.ndarray], interior: np.ndarray) -> bool:
+    """Whether the faces left at a crease fill's rim contradict the third assumption (the missing surface lies
+    in the two planes), read as :func:`slab_contradicted` reads one plane: a rim vertex off the crease (not
+    ``a`` or ``b``, so in one plane only) whose every remaining face lies in its plane (each corner within
+    ``tol``), on a surface with no vertex inside its flat faces there (``interior`` false).  Another face of the
+    part met the plane at that vertex and is gone, and it is not the other plane (the vertex is not on it), so
+    the missing surface leaves both planes there (a featured box that lost half its faces: the fill closed the
+    boss alone, 80-98 % low inside the two slabs)."""
+    plane_of: dict[int, set[int]] = {}
+    for (e0, e1), sd in zip(loop_edges.tolist(), side):
+        plane_of.setdefault(e0, set()).add(sd)
+        plane_of.setdefault(e1, set()).add(sd)
+    for x, sides in plane_of.items():
+        if x in crease or len(sides) != 1 or interior[x]:
+            continue
+        sd = next(iter(sides))
+        faces_at = vertex_faces(x)
+        if not len(faces_at):
+            continue
+        off = np.abs(v[f[faces_at]] @ plane_unit[sd] - plane_offset[sd])
+        if float(off.max()) <= tol:
+            return True
+    return False
 
 
 @frozen_value
@@ -346,12 +396,6 @@ class RimEvidence:
     bare: np.ndarray
 
 
-#: A rim "lies in a plane" when every rim vertex and every face left at the rim is within this share of the
-#: ball's radius of the plane of a ring face (far above round-off and quantisation to 1e-4 of a diagonal, far
-#: below any boss or pocket a designer draws).
-FLAT_RIM_RTOL = 1e-3
-#: A vertex is *flat* when every face at it is within acos(FLAT_VERTEX_COSINE) ≈ 1.1° of their mean plane.
-FLAT_VERTEX_COSINE = 1.0 - 2e-4
 
 
 def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
@@ -478,23 +522,19 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
                       ) -> np.ndarray:
     """Loops whose flat slab the faces left at the rim contradict, (n_loops,) bool.
 
-    Only rims that are flat (within ``flat_rtol`` of the ball's radius of their slab plane ``P``, the hole in a
+    Only rims that are flat (within ``flat_rtol`` of the ball's radius of their slab plane ``P``: a hole in a
     flat face of the part) are examined; the second assumption then says the missing surface ``M`` *is* the
-    planar region the rim bounds in ``P``.  Two things the file can show contradict it:
-
-    1. **A face beside the rim lying in ``P`` but facing against the patch** (its normal opposite to the rim's
-       vector area as the cone closes it): the planar ``M`` would fold back onto that face, a fin of no
-       thickness, which no solid's surface has (a box with a boss that lost 16 of its 28 faces: the two top
-       triangles left face up while the patch over the hexagonal rim faces down; the patch closed the boss
-       alone, 94 % low at ±1e-13).
-    2. **A rim vertex whose every remaining face lies in ``P``** (within ``acos(flat_cosine)``), on a surface
-       with no vertex inside its flat faces there (no flat neighbour off the rims, as :func:`bare_vertices`
-       asks): on such a (CAD) tessellation every vertex lies on a loop of its flat face, where another face of
-       the part meets ``P``; that face is gone, so ``M`` leaves ``P`` at the vertex, by an amount nothing in the
-       file bounds (a pocket taken whole with the half of the top face around it, its rim touching the pocket's
-       footprint at one corner: 0.7 % high at ±2e-14).  :func:`bare_vertices` asks the same of vertices whose
-       faces form a flat face of the part; here one face in ``P`` suffices, since ``P`` is the plane the whole
-       rim lies in, not just that face's own.
+    planar region the rim bounds in ``P``.  The file contradicts it at **a rim vertex whose every remaining face
+    lies in ``P``** (each corner within ``flat_rtol`` of the radius of it), on a surface with no vertex inside
+    its flat faces there (no neighbour off the rims whose faces lie within ``acos(flat_cosine)`` of one plane,
+    as :func:`bare_vertices` asks): on such a (CAD) tessellation every vertex lies on a loop of its flat face,
+    where another face of the part meets ``P``; that face is gone with the hole, so ``M`` leaves ``P`` at the
+    vertex, by an amount nothing in the file bounds.  Found by the generated featured-box test: a box that
+    lost most of its faces keeps a boss and two top triangles, whose outer corners keep nothing else (the patch
+    closed the boss alone, 94 % low at ±1e-13); half a top face gone with the pocket in it, the rim touching
+    the pocket's footprint at one corner (0.7 % high at ±2e-14).  :func:`bare_vertices` asks the same of
+    vertices whose faces form a flat face of the part by themselves; here one face in ``P`` suffices, since
+    ``P`` is the plane the whole rim lies in, not just that face's own.
 
     ``slabs`` is what :func:`hole_doubt_volumes` fills (``has``, ``normal``, ``origin``, ``half_width``).
     """
@@ -504,47 +544,26 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
     out = np.zeros(n_loops, dtype=bool)
     if not n_loops or not len(edges) or not len(f):
         return out
-    flat = slabs["has"] & (slabs["half_width"] <= flat_rtol * radius + _round_off(v))
+    margin = _round_off(v)
+    tol = flat_rtol * np.asarray(radius, dtype=np.float64) + margin
+    flat = slabs["has"] & (slabs["half_width"] <= tol)
     if not flat.any():
         return out
-    unit_p = slabs["normal"]
-    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    size = np.linalg.norm(normal, axis=1)
-    unit = normal / np.where(size > 0, size, 1.0)[:, None]
-    # the rim's vector area: the cone (b, a, apex) over each rim edge a -> b faces along minus it
     e = np.asarray(edges, dtype=np.int64)
-    rim_area = np.zeros((n_loops, 3))
-    np.add.at(rim_area, label, 0.5 * np.cross(v[e[:, 0]], v[e[:, 1]]))
-    cone_side = -np.einsum("ij,ij->i", rim_area, unit_p)
-    # (1) ring faces (the face holding each rim edge a -> b) in P facing against the patch
-    nv = np.int64(max(n, 1))
-    directed = f.reshape(-1) * nv + f[:, [1, 2, 0]].reshape(-1)
-    order = np.argsort(directed, kind="stable")
-    query = e[:, 0] * nv + e[:, 1]
-    pos = np.minimum(np.searchsorted(directed[order], query), len(order) - 1)
-    found = directed[order[pos]] == query
-    ring = order[pos] // 3
-    along = np.einsum("ij,ij->i", unit[ring], unit_p[label])
-    against = found & flat[label] & (size[ring] > 0) & (np.abs(along) >= flat_cosine) \
-        & (along * cone_side[label] < 0)
-    out[label[against]] = True
-    # (2) rim vertices whose every face lies in P, with no flat vertex off the rims beside them
+    # (rim vertex, loop) pairs of the flat rims, sorted by vertex; each face at such a vertex, once per pair
     pairs = np.unique(np.stack([e.reshape(-1), np.repeat(label, 2)], axis=1), axis=0)
     pairs = pairs[flat[pairs[:, 1]]]
-    if len(pairs):
-        first = np.searchsorted(pairs[:, 0], np.arange(n))
-        count = np.bincount(pairs[:, 0], minlength=n)
-        fi, ci = np.nonzero(count[f] > 0)
-        x = f[fi, ci]
-        reps = count[x]
-        which = np.repeat(first[x], reps) + (np.arange(int(reps.sum())) - np.repeat(np.cumsum(reps) - reps, reps))
-        face, pair = np.repeat(fi, reps), which
-        in_p = (size[face] > 0) & (np.abs(np.einsum("ij,ij->i", unit[face], unit_p[pairs[pair, 1]]))
-                                   >= flat_cosine)
-        off_p = np.bincount(pair, weights=~in_p, minlength=len(pairs)) > 0
-        interior = _flat_off_rim_nearby(v, f, e, flat_cosine=flat_cosine)
-        bare_in_p = ~off_p & ~interior[pairs[:, 0]]
-        out[pairs[bare_in_p, 1]] = True
+    first = np.searchsorted(pairs[:, 0], np.arange(n))
+    count = np.bincount(pairs[:, 0], minlength=n)
+    fi, ci = np.nonzero(count[f] > 0)
+    reps = count[f[fi, ci]]
+    pair = np.repeat(first[f[fi, ci]], reps) + (np.arange(int(reps.sum())) - np.repeat(np.cumsum(reps) - reps, reps))
+    face, loop = np.repeat(fi, reps), pairs[pair, 1]
+    corners = v[f[face]] - slabs["origin"][loop][:, None, :]
+    off = np.abs(np.einsum("ijk,ik->ij", corners, slabs["normal"][loop])).max(axis=1)
+    off_p = np.bincount(pair, weights=off > tol[loop], minlength=len(pairs)) > 0
+    interior = _flat_off_rim_nearby(v, f, e, flat_cosine=flat_cosine)
+    out[pairs[~off_p & ~interior[pairs[:, 0]], 1]] = True
     return out
 
 
@@ -691,9 +710,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             fills = []
             for j, fill in enumerate(creases):
                 crossed[fill.loop] = True
-                # the fill is kept as the estimate, but its bound is the whole ball: generated holes across
-                # creases (half of a featured box gone) contradicted the third assumption's narrow slab bound
-                doubts[fill.loop] = max(fill.doubt, 4.0 / 3.0 * np.pi * radius[fill.loop] ** 3)
+                # the two slabs bound the fill where the faces at its rim do not contradict the third
+                # assumption (CreaseFill.narrow); else the whole ball (generated featured boxes that lost half
+                # their faces showed fills 80-98 % low inside the two slabs)
+                ball = 4.0 / 3.0 * np.pi * radius[fill.loop] ** 3
+                doubts[fill.loop] = min(fill.doubt, ball) if fill.narrow else max(fill.doubt, ball)
                 shifted = fill.caps.copy()
                 shifted[shifted >= len(v)] += n_loops + 2 * j       # apexes after the cones' (kept for numbering)
                 fills.append(shifted)
