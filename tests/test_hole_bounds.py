@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from conftest import box_arrays
 from inertia_tool import mass_properties
-from inertia_tool.errors import InvalidMeshError, MeshRepairedWarning
+from inertia_tool.errors import MeshRepairedWarning
 from inertia_tool.integrals import volume_moments
 from inertia_tool.mesh.holes import ball_slab_volume, patched_estimate
 from inertia_tool.mesh.rims import boundary_edges
@@ -167,13 +167,44 @@ def test_a_hole_that_took_a_whole_boss_on_a_grid_tessellation_is_inside_its_boun
     assert _holds(est, truth)
 
 
-def test_octahedron_missing_a_face_stays_refused():
-    """Every face beside the hole meets it at 109.5°: nothing says the hole is flat, the ball decides and
-    holds 330 % of the solid; refused with its reason (an honest refusal, not a bound traded away)."""
+def test_octahedron_missing_a_face_is_bounded_by_the_planes_of_its_other_faces():
+    """Every face beside the hole meets it at 109.5°: nothing says the hole is flat, and the ball holds 330 % of
+    the solid (refused before).  What remains is convex, so the part is taken to be convex (fourth assumption,
+    ``holes.convex_hole_bound``): it lies inside the other seven faces' half-spaces, the octahedron plus the
+    tetrahedron over the missing face with apex (1, 1, 1), volume 1/3 (a closed form): the volume in doubt is
+    1/3 of 4/3, a 25 % bound, and the patched answer (exact here) lies inside it."""
     v = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=float)
     f = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
-    with pytest.raises(InvalidMeshError, match="cannot be bounded usefully"):
-        mass_properties((v, f[1:]), repair=True)
+    est = patched_estimate(v, f[1:], volume_moments)
+    assert "convex" in est.detail
+    assert est.uncertainty.volume_in_doubt == pytest.approx(1 / 3, rel=3e-3)
+    assert 0.25 <= est.uncertainty.mass <= 0.251
+    assert _holds(est, volume_moments(v, f))
+    with pytest.warns(MeshRepairedWarning):
+        p = mass_properties((v, f[1:]), repair=True)
+    assert p.mesh.certificate.kind == "estimate" and p.volume == pytest.approx(4 / 3, rel=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(height=st.floats(-0.9, 0.98), quat=st.lists(st.floats(-1, 1), min_size=4, max_size=4)
+       .filter(lambda q: np.linalg.norm(q) > 0.1))
+def test_convex_bound_of_sphere_caps_holds_and_is_never_wider_than_the_ball(height, quat):
+    """A cap above z = height cut from an icosphere (convex), turned: the bound of the planes of the faces left
+    (``convex_hole_bound``) contains the truth, and it is chosen only where it is narrower than the ball's."""
+    from inertia_tool.mesh.holes import convex_hole_bound
+    s = trimesh.creation.icosphere(3)
+    v0, f = np.asarray(s.vertices), np.asarray(s.faces)
+    open_f = f[~np.all(v0[f][:, :, 2] > height, axis=1)]
+    v = v0 @ Rotation.from_quat(quat).as_matrix().T
+    est = patched_estimate(v, open_f, volume_moments)
+    truth = volume_moments(v, f)
+    assert est.uncertainty.mass > 0.5 or _holds(est, truth)       # beyond a hemisphere: refused by the ball
+    bound = convex_hole_bound(v, open_f, est.volume)
+    if height >= 0:                  # the faces left close the part in (below the equator they do not: None)
+        assert bound is not None
+    if bound is not None:
+        assert bound[0] >= truth.volume - est.volume >= 0
+        assert est.uncertainty.volume_in_doubt <= bound[0] * (1 + 1e-12)
 
 
 # ---------------------------------------------------------------------------------- curved holes hold

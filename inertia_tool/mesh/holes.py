@@ -41,7 +41,8 @@ from .seal import Seal
 from .uncertainty import Estimate, uncertainty_from
 
 __all__ = ["patched_estimate", "hole_doubt_volumes", "ball_slab_volume", "crease_fills", "CreaseFill", "rim_evidence",
-           "RimEvidence", "bare_vertices", "slab_contradicted"]
+           "RimEvidence", "bare_vertices", "slab_contradicted",
+           "convex_hole_bound"]
 
 
 def ball_slab_volume(radius: np.ndarray, offset: np.ndarray, half_width: np.ndarray) -> np.ndarray:
@@ -693,12 +694,14 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         withdrawn = evidence.bare > 0
         if slabs:
             withdrawn |= slab_contradicted(v, f, edges, label, n_loops, slabs, radius)
+        taken = bool(withdrawn.any())      # a feature may have gone with a hole: no convex bound either
         hole_doubt[withdrawn] = 4.0 / 3.0 * np.pi * radius[withdrawn] ** 3
         creases = crease_fills(v, f, edges, label, n_loops, centre, radius, bare=bare)
         unbounded = _contradicted(evidence, radius, size)
     else:
         centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
         unbounded = ""
+        taken = False
     cone_doubt = hole_doubt.copy()
 
     def build(creases: list[CreaseFill]) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any, np.ndarray]:
@@ -739,6 +742,15 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     ca, cb, cc = pv[cap[:, 0]], pv[cap[:, 1]], pv[cap[:, 2]]
     area = float(closed.area) - float(0.5 * np.linalg.norm(np.cross(cb - ca, cc - ca), axis=1).sum())
     far = float(np.max(np.linalg.norm(centre - closed.centroid, axis=1) + radius)) if n_loops else 0.0
+    convex = False
+    if n_loops and doubt > 0 and not taken:
+        # fourth assumption, where what remains is convex: the complete part is too (convex_hole_bound)
+        outward = pf[:len(f)]
+        bound = convex_hole_bound(pv, outward, float(closed.volume))
+        if bound is not None and bound[0] < doubt:
+            doubt, corners = bound
+            far = float(np.max(np.linalg.norm(corners - closed.centroid, axis=1)))
+            convex = True
     sealed = ""
     if seal is not None and (seal.welded or seal.split):
         doubt += seal.doubt(v)
@@ -756,6 +768,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                   "closed by cones to their centroids; bounded by the balls enclosing their rims, each cut to the "
                   "slab around the plane of the face beside it that the rim strays least from "
                   f"(largest radius {float(radius.max()):.3g} m)")
+        if convex:
+            detail += ("; what remains is convex, so the part is taken to be convex too and the holes bounded "
+                       "instead by the polytope its faces' planes enclose")
         if creases:
             detail += (f"; {len(creases)} of them across a crease, filled instead in the two planes that hold "
                        "the rim and bounded by the ball cut to both planes' slabs")
@@ -764,6 +779,87 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,
                     uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far,
                     unbounded=unbounded)
+
+
+#: Most (plane, hull vertex) pairs :func:`convex_hole_bound` checks (beyond it no convex bound is tried).
+CONVEX_WORK_LIMIT = 50_000_000
+#: What remains counts as convex when no vertex lies farther than this share of the largest coordinate
+#: (times 16 ulp) outside the plane of a face: round-off, not quantisation or design.
+CONVEX_ROUND_OFF = 1024.0
+
+
+def convex_hole_bound(vertices: np.ndarray, faces: np.ndarray, patched_volume: float
+                      ) -> tuple[float, np.ndarray] | None:
+    """Volume in doubt of every hole at once when what remains of the surface is convex, m³, with the corners of
+    the region in doubt ((k, 3) m); None where it does not apply.
+
+    **Fourth assumption: where the faces that remain are convex, so is the complete part** ``K``.  The check:
+    every vertex of the given faces lies on the inner side of the plane of every given face (within
+    ``CONVEX_ROUND_OFF`` × 16 ulp of the coordinates; the planes are moved out by the largest excess found).
+    Then each given face lies on ``∂K`` and its plane supports ``K``, so ``K`` lies in the polytope ``U``
+    the planes enclose (their half-spaces' intersection, :class:`scipy.spatial.HalfspaceIntersection`), and
+    the patched solid ``P`` in ``K`` (its surface, the given faces and the cones in the rims' convex hulls,
+    lies in ``K``).  So ``vol P ≤ vol K ≤ vol U``: the volume in doubt is ``vol U − vol P``, with no ball at
+    all, and the region in doubt lies in ``U`` (its corners bound the centre of mass).  ``U`` must be bounded
+    (the planes left must surround the part); it is ``K`` itself when every plane of ``K`` keeps a face.  What
+    the check cannot see: a dent or pocket the holes took whole (the rest is convex, the part is not); the
+    bare-vertex checks see it on CAD tessellations (footprints), not on others: the stated limit, as for the
+    slab.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+        The given faces, wound outward (as the patched surface is).
+    patched_volume : float
+        ``vol P``, m³.
+    """
+    from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    if not len(f) or not patched_volume > 0:
+        return None
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    size = np.linalg.norm(normal, axis=1)
+    keep = size > 0
+    if not keep.any():
+        return None
+    unit = normal[keep] / size[keep, None]
+    offset = np.einsum("ij,ij->i", unit, v[f[keep, 0]])
+    planes = np.unique(np.round(np.column_stack([unit, offset]), 12), axis=0)
+    used = np.unique(f)
+    try:
+        hull = ConvexHull(v[used])
+    except (QhullError, ValueError):
+        return None
+    corners = v[used][hull.vertices]
+    if len(planes) * len(corners) > CONVEX_WORK_LIMIT:
+        return None
+    tol = CONVEX_ROUND_OFF * _round_off(v)
+    excess = np.full(len(planes), -np.inf)
+    for lo in range(0, len(corners), 4096):
+        chunk = corners[lo:lo + 4096]
+        excess = np.maximum(excess, (chunk @ planes[:, :3].T - planes[:, 3]).max(axis=0))
+    if float(excess.max()) > tol:
+        return None                      # what remains is not convex
+    shift = max(float(excess.max()), 0.0) + _round_off(v)
+    inside = v[used].mean(axis=0)
+    slack = planes[:, 3] + shift - planes[:, :3] @ inside
+    if float(slack.min()) <= 10 * shift:
+        return None
+    halfspaces = np.column_stack([planes[:, :3], -(planes[:, 3] + shift)])
+    try:
+        region = HalfspaceIntersection(halfspaces, inside)
+        points = region.intersections
+        if not np.all(np.isfinite(points)) or float(np.abs(points).max()) > 1e6 * max(float(np.abs(v).max()), 1e-300):
+            return None                  # the planes left do not close the part in
+        volume = float(ConvexHull(points).volume)
+    except (QhullError, ValueError):
+        return None
+    if not volume >= patched_volume * (1 - 1e-9):
+        return None
+    return round_up(max(volume - patched_volume, 0.0) + 1e-12 * volume), points
 
 
 def _contradicted(evidence: RimEvidence, radius: np.ndarray, size: np.ndarray) -> str:
