@@ -187,9 +187,9 @@ class CreaseFill:
     doubt : float
         Volume in doubt, m³: the ball over the rim cut to the slab of each plane, summed.
     narrow : bool
-        The faces left at the rim do not contradict the third assumption (no rim vertex off the crease keeps
-        faces in its plane only, on a surface with no vertex inside its flat faces: :func:`crease_fills`), so
-        ``doubt`` bounds the hole; else the whole ball does.
+        The surface is tessellated the CAD way (no vertex inside a flat face anywhere off the rims), so the
+        check can see a contradiction, and the faces left at the rim show none (no rim vertex off the crease
+        keeps faces in its plane only: :func:`crease_fills`): ``doubt`` bounds the hole; else the whole ball.
     """
 
     loop: int
@@ -335,7 +335,7 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         caps = [[e1, e0, n + sd] for (e0, e1), sd in zip(order, side)]
         # p's chain runs b → … → a and closes along a → b; q's runs a → … → b and closes along b → a
         caps += [[b, a, n + 0], [a, b, n + 1]]
-        narrow = not _crease_rim_contradicts(v, f, loop_edges, side, (a, b), unit[[p, q]], offset[[p, q]],
+        narrow = not interior.any() and not _crease_rim_contradicts(v, f, loop_edges, side, (a, b), unit[[p, q]], offset[[p, q]],
                                              flat_rtol * float(radius[k]) + margin, vertex_faces, interior)
         doubt = 0.0
         for which, plane in ((0, p), (1, q)):
@@ -527,8 +527,8 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
     flat face of the part) are examined; the second assumption then says the missing surface ``M`` *is* the
     planar region the rim bounds in ``P``.  The file contradicts it at **a rim vertex whose every remaining face
     lies in ``P``** (each corner within ``flat_rtol`` of the radius of it), on a surface with no vertex inside
-    its flat faces there (no neighbour off the rims whose faces lie within ``acos(flat_cosine)`` of one plane,
-    as :func:`bare_vertices` asks): on such a (CAD) tessellation every vertex lies on a loop of its flat face,
+    its flat faces (no vertex off the rims whose faces all lie within ``acos(flat_cosine)`` of one plane; a
+    surface that has one anywhere proves nothing: :func:`_flat_off_rim_nearby`): on such a (CAD) tessellation every vertex lies on a loop of its flat face,
     where another face of the part meets ``P``; that face is gone with the hole, so ``M`` leaves ``P`` at the
     vertex, by an amount nothing in the file bounds.  Found by the generated featured-box test: a box that
     lost most of its faces keeps a boss and two top triangles, whose outer corners keep nothing else (the patch
@@ -576,8 +576,10 @@ def _round_off(v: np.ndarray) -> float:
 
 def _flat_off_rim_nearby(v: np.ndarray, f: np.ndarray, edges: np.ndarray, *,
                          flat_cosine: float = FLAT_VERTEX_COSINE) -> np.ndarray:
-    """Vertices with a neighbour off the rims whose faces all lie within ``acos(flat_cosine)`` of one plane,
-    (n,) bool: the surface has vertices inside its flat faces there, so a flat rim vertex proves nothing."""
+    """Where a flat rim vertex proves nothing, (n,) bool: everywhere when some vertex off the rims has all its
+    faces within ``acos(flat_cosine)`` of one plane (the surface has vertices inside its flat faces, so it is
+    not tessellated the CAD way, and a rim vertex may be one of them: robot parts with Steiner points inside
+    flat faces lost their exact flat answers to the local reading), else nowhere."""
     n = len(v)
     normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     area = np.linalg.norm(normal, axis=1)
@@ -594,12 +596,8 @@ def _flat_off_rim_nearby(v: np.ndarray, f: np.ndarray, edges: np.ndarray, *,
     on_rim = np.zeros(n, dtype=bool)
     on_rim[np.asarray(edges, dtype=np.int64).reshape(-1)] = True
     off = (least >= flat_cosine) & (size > 0) & ~on_rim
-    near = np.zeros(n, dtype=bool)
-    for k in range(3):
-        for j in range(3):
-            if j != k:
-                near[f[off[f[:, j]], k]] = True
-    return near
+    anywhere: np.ndarray = np.full(n, bool(off.any()))
+    return anywhere
 
 
 #: Most (ring face, rim vertex) pairs measured by :func:`hole_doubt_volumes` (a few seconds); beyond it every
