@@ -335,8 +335,9 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         caps = [[e1, e0, n + sd] for (e0, e1), sd in zip(order, side)]
         # p's chain runs b → … → a and closes along a → b; q's runs a → … → b and closes along b → a
         caps += [[b, a, n + 0], [a, b, n + 1]]
-        narrow = not interior.any() and not _crease_rim_contradicts(v, f, loop_edges, side, (a, b), unit[[p, q]], offset[[p, q]],
-                                             flat_rtol * float(radius[k]) + margin, vertex_faces, interior)
+        narrow = not interior.any() and not _crease_rim_contradicts(
+            v, f, loop_edges, side, (a, b), unit[[p, q]], offset[[p, q]], flat_rtol * float(radius[k]) + margin,
+            vertex_faces, interior)
         doubt = 0.0
         for which, plane in ((0, p), (1, q)):
             chain = [index[x] for (s0, s1), sd in zip(order, side) if sd == which for x in (s0, s1)]
@@ -528,9 +529,9 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
     planar region the rim bounds in ``P``.  The file contradicts it at **a rim vertex whose every remaining face
     lies in ``P``** (each corner within ``flat_rtol`` of the radius of it), on a surface with no vertex inside
     its flat faces (no vertex off the rims whose faces all lie within ``acos(flat_cosine)`` of one plane; a
-    surface that has one anywhere proves nothing: :func:`_flat_off_rim_nearby`): on such a (CAD) tessellation every vertex lies on a loop of its flat face,
-    where another face of the part meets ``P``; that face is gone with the hole, so ``M`` leaves ``P`` at the
-    vertex, by an amount nothing in the file bounds.  Found by the generated featured-box test: a box that
+    surface that has one anywhere proves nothing: :func:`_flat_off_rim_nearby`): on such a (CAD) tessellation
+    every vertex lies on a loop of its flat face, where another face of the part meets ``P``; that face is gone
+    with the hole, so ``M`` leaves ``P`` at the vertex, by an amount nothing in the file bounds.  Found by the generated featured-box test: a box that
     lost most of its faces keeps a boss and two top triangles, whose outer corners keep nothing else (the patch
     closed the boss alone, 94 % low at ±1e-13); half a top face gone with the pocket in it, the rim touching
     the pocket's footprint at one corner (0.7 % high at ±2e-14).  :func:`bare_vertices` asks the same of
