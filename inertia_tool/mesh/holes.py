@@ -531,7 +531,8 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
     its flat faces (no vertex off the rims whose faces all lie within ``acos(flat_cosine)`` of one plane; a
     surface that has one anywhere proves nothing: :func:`_flat_off_rim_nearby`): on such a (CAD) tessellation
     every vertex lies on a loop of its flat face, where another face of the part meets ``P``; that face is gone
-    with the hole, so ``M`` leaves ``P`` at the vertex, by an amount nothing in the file bounds.  Found by the generated featured-box test: a box that
+    with the hole, so ``M`` leaves ``P`` at the vertex, by an amount nothing in the file bounds.  Found by
+    the generated featured-box test: a box that
     lost most of its faces keeps a boss and two top triangles, whose outer corners keep nothing else (the patch
     closed the boss alone, 94 % low at ±1e-13); half a top face gone with the pocket in it, the rim touching
     the pocket's footprint at one corner (0.7 % high at ±2e-14).  :func:`bare_vertices` asks the same of
