@@ -107,10 +107,14 @@ def test_sphere_with_a_planar_cap_removed_is_within_its_bound_or_refused(z):
         assert 0 < p.mesh.uncertainty.mass <= 0.5
 
 
-def test_cap_at_half_height_is_refused_not_printed_14_percent_low():
+def test_cap_at_half_height_is_not_printed_14_percent_low_without_a_bound_that_says_so():
+    """Refused by the ball (±300 %); the sphere left is convex, so the planes of its faces bound it instead
+    (holes.convex_hole_bound): the answer, 13 % low, is printed only with a mass bound that contains the truth."""
     v, f, open_f = _sphere_without_cap(0.5)
-    with pytest.raises(InvalidMeshError, match=r"mass ±\d+(\.\d+)? %.*close them in a mesh editor"):
-        mass_properties((v, open_f), repair=True)
+    truth = volume_moments(v, f).volume
+    p = mass_properties((v, open_f), repair=True)
+    assert abs(p.volume - truth) > 0.1 * truth
+    assert abs(p.volume - truth) <= p.mesh.uncertainty.mass * p.volume
 
 
 def test_enclosing_balls_hold_their_points_and_are_near_the_smallest():
