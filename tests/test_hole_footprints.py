@@ -131,6 +131,8 @@ def test_rim_evidence_on_a_footprint_and_on_a_finely_tessellated_face():
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @example(extents=(1.0, 1.0, 1.0), place=(0.5, 0.875), size=(0.5, 0.125), height=0.25, pattern="patch", start=2250,
          share=0.5, quat=(0.0, 0.0, 0.0, 1.0))       # found by CI: a crease fill over the top face's remaining faces
+@example(extents=(1.0, 1.0, 1.0), place=(0.5, 0.875), size=(0.25, 0.25), height=0.25, pattern="patch", start=0,
+         share=0.59375, quat=(0.0, 0.0, 0.0, 1.0))   # found by a random run on main before the flat-rim slab check
 @given(extents=st.tuples(st.floats(1.0, 6.0), st.floats(1.0, 6.0), st.floats(0.3, 3.0)),
        place=st.tuples(st.floats(0.05, 0.95), st.floats(0.05, 0.95)),
        size=st.tuples(st.floats(0.1, 0.6), st.floats(0.1, 0.6)),
