@@ -135,9 +135,10 @@ def _pocketed_box(n, depth, pocket):
     return v, f[~(inside & ~outer)], truth
 
 
-@pytest.mark.xfail(strict=True, reason="holes3 convex_hole_bound: a pocket taken whole on a finely meshed box "
-                   "leaves a convex rest, so the bound is the box minus the flat-patched box (0) while the "
-                   "truth lacks the pocket: mass 50 stated within ~1e-15, truth 49 (the stated limit, silent)")
+@pytest.mark.xfail(strict=True, reason="second assumption (slab) unchecked on a finely meshed surface: a pocket "
+                   "taken whole leaves a flat rim in a flat region; slab_contradicted applies only to CAD-style "
+                   "surfaces, and convex_hole_bound agrees (the same bound with it disabled): mass 50 stated "
+                   "within ~1e-15, truth 49")
 def test_a_pocket_taken_whole_on_a_grid_box_is_inside_its_bound():
     import warnings
 
