@@ -479,18 +479,7 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     n = len(v)
-    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    area = np.linalg.norm(normal, axis=1)
-    good = area > 0
-    g, unit = f[good], normal[good] / area[good, None]
-    mean = np.zeros((n, 3))
-    for k in range(3):
-        np.add.at(mean, g[:, k], normal[good])
-    size = np.linalg.norm(mean, axis=1)
-    mean_unit = mean / np.where(size > 0, size, 1.0)[:, None]
-    least = np.ones(n)
-    for k in range(3):
-        np.minimum.at(least, g[:, k], np.einsum("ij,ij->i", unit, mean_unit[g[:, k]]))
+    g, unit, least, size = _vertex_flatness(v, f)
     # a face of a flat *face of the part*: it shares an edge with a face in its plane (a lone triangle of a
     # curved surface is flat trivially and proves nothing)
     key, _ = edge_keys(g, n)
@@ -578,12 +567,10 @@ def _round_off(v: np.ndarray) -> float:
     return 16.0 * float(np.finfo(np.float64).eps) * max(scale, 1e-300)
 
 
-def _flat_off_rim_nearby(v: np.ndarray, f: np.ndarray, edges: np.ndarray, *,
-                         flat_cosine: float = FLAT_VERTEX_COSINE) -> np.ndarray:
-    """Where a flat rim vertex proves nothing, (n,) bool: everywhere when some vertex off the rims has all its
-    faces within ``acos(flat_cosine)`` of one plane (the surface has vertices inside its flat faces, so it is
-    not tessellated the CAD way, and a rim vertex may be one of them: robot parts with Steiner points inside
-    flat faces lost their exact flat answers to the local reading), else nowhere."""
+def _vertex_flatness(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per vertex, how flat its faces lie: ``(g, unit, least, size)``, the faces of nonzero area and their unit
+    normals, and for each vertex the least cosine between one of its faces' normals and their area-weighted mean
+    (1 where all lie in one plane) and that mean's length (0: no face, or normals cancelling)."""
     n = len(v)
     normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     area = np.linalg.norm(normal, axis=1)
@@ -597,6 +584,17 @@ def _flat_off_rim_nearby(v: np.ndarray, f: np.ndarray, edges: np.ndarray, *,
     least = np.ones(n)
     for k in range(3):
         np.minimum.at(least, g[:, k], np.einsum("ij,ij->i", unit, mean_unit[g[:, k]]))
+    return g, unit, least, size
+
+
+def _flat_off_rim_nearby(v: np.ndarray, f: np.ndarray, edges: np.ndarray, *,
+                         flat_cosine: float = FLAT_VERTEX_COSINE) -> np.ndarray:
+    """Where a flat rim vertex proves nothing, (n,) bool: everywhere when some vertex off the rims has all its
+    faces within ``acos(flat_cosine)`` of one plane (the surface has vertices inside its flat faces, so it is
+    not tessellated the CAD way, and a rim vertex may be one of them: robot parts with Steiner points inside
+    flat faces lost their exact flat answers to the local reading), else nowhere."""
+    n = len(v)
+    g, unit, least, size = _vertex_flatness(v, f)
     on_rim = np.zeros(n, dtype=bool)
     on_rim[np.asarray(edges, dtype=np.int64).reshape(-1)] = True
     off = (least >= flat_cosine) & (size > 0) & ~on_rim
