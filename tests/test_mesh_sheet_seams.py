@@ -20,6 +20,7 @@ from hypothesis import strategies as st
 import inertia_tool as it
 from inertia_tool.mesh.sheets import open_sheets
 from test_mesh_folds import _assert_matches, _truth
+from test_mesh_sheets import _halves, _on_plane
 
 pytestmark = pytest.mark.usefixtures("engine_path")
 
@@ -43,24 +44,6 @@ def _solid(rng, union):
     solid = solid.rotate(tuple(rng.uniform(0, 360, size=3))).translate(tuple(rng.uniform(-3, 3, size=3)))
     mesh = solid.to_mesh64()
     return np.array(mesh.vert_properties, dtype=np.float64)[:, :3].copy(), np.array(mesh.tri_verts, dtype=np.int64)
-
-
-def _halves(v, f, normal, offset):
-    import manifold3d as m3d
-
-    solid = m3d.Manifold(m3d.Mesh64(vert_properties=np.ascontiguousarray(v, dtype=np.float64),
-                                    tri_verts=np.ascontiguousarray(f, dtype=np.uint64)))
-    out = []
-    for half in solid.split_by_plane(tuple(float(x) for x in normal), float(offset)):
-        mesh = half.to_mesh64()
-        out.append((np.array(mesh.vert_properties, dtype=np.float64)[:, :3].copy(),
-                    np.array(mesh.tri_verts, dtype=np.int64)))
-    return out
-
-
-def _on_plane(hv, hf, normal, offset):
-    scale = float(np.abs(hv).max())
-    return np.all(np.abs(hv[hf] @ normal - offset) <= 1e-12 * scale, axis=1)
 
 
 def _put_t_vertices(hv, hf, on, rng, share):
