@@ -270,11 +270,24 @@ def _main(argv) -> int:
         # a failed command prints one line: warnings about a result that was never produced are dropped
         print(escape_terminal(error_line.replace("\n", " ")), file=sys.stderr)
         return int(code)
+    # a warning the command already printed with its report is not printed again when standard output and
+    # standard error are the same terminal (the user would read it twice); redirected, stderr keeps them all
+    shown: frozenset[str] = getattr(args, "warnings_shown", frozenset()) if _same_terminal() else frozenset()
+    owner = args._subparsers.get(getattr(args, "command", None))
     for w in caught:
-        if issubclass(w.category, InertiaToolWarning):
-            owner = args._subparsers.get(getattr(args, "command", None))
+        if issubclass(w.category, InertiaToolWarning) and speak_options(str(w.message), owner) not in shown:
             print(escape_terminal(f"inertia-tool: {speak_options(_format_warning(w), owner)}"), file=sys.stderr)
     return int(code or 0)
+
+
+def _same_terminal() -> bool:
+    """True when standard output and standard error are one terminal (both a tty, the same device)."""
+    try:
+        out, err = sys.stdout, sys.stderr
+        return bool(out.isatty() and err.isatty()
+                    and os.path.samestat(os.fstat(out.fileno()), os.fstat(err.fileno())))
+    except (AttributeError, OSError, ValueError):      # a captured or closed stream
+        return False
 
 
 if __name__ == "__main__":  # pragma: no cover

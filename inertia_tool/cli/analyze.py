@@ -15,7 +15,8 @@ from ..tolerances import PRINTED_MOMENT_TOLERANCE
 from ..reports.cad import CAD_UNITS
 from ..robot.formats import FRAMES, ROBOT_FORMATS
 from .help import add_command
-from .model_options import (add_files_argument, add_model_options, load_model, model_words, split_part_spec,
+from .model_options import (add_files_argument, add_model_options, load_model, model_words, shown_with_report,
+                            split_part_spec,
                             with_warnings)
 from .options import check_option, density_and_mass
 from .report_option import add_report_options, check_report_path, write_report_from_args
@@ -111,6 +112,7 @@ def run(args) -> int:
         out = command_output("analyze", out, warnings=messages)
         # one string, one write: json.dump writes each of its hundreds of pieces through the terminal-safe stream
         sys.stdout.write(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False) + "\n")
+        shown_with_report(args, messages)
     elif fmt in ROBOT_FORMATS:
         from ..robot.inertial import inertial_frame
         frame = inertial_frame(props, args.frame or "principal")
@@ -126,6 +128,7 @@ def run(args) -> int:
     else:
         print(with_warnings(format_mass_properties(props, density_source=described, result=result), messages,
                             loaded.notes()))
+        shown_with_report(args, messages)
         if cad is not None:
             from ..reports.brep import format_brep_comparison
             print(format_brep_comparison(cad, props.density))

@@ -13,7 +13,8 @@ from ..errors import UsageError
 from ..units import parse_angular_rate, parse_length
 from . import speak_options
 from .help import add_command
-from .model_options import add_files_argument, add_model_options, command_parser, length_unit, load_model, with_warnings
+from .model_options import (add_files_argument, add_model_options, command_parser, length_unit, load_model,
+                            shown_with_report, with_warnings)
 from .options import check_option
 from .report_option import say_written
 
@@ -158,4 +159,5 @@ def run(args) -> int:
     else:
         print(with_warnings(speak_options(format_balance_text(report), parser), loaded.warnings,
                             loaded.notes()), end="")
+    shown_with_report(args, loaded.warnings)
     return 0

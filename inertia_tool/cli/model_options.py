@@ -41,7 +41,8 @@ if TYPE_CHECKING:     # the engine loads when a part is loaded, not to build a p
 __all__ = ["add_files_argument", "add_model_options", "add_material_options", "add_mesh_options",
            "add_material_map_option", "parse_material_map", "split_part_spec",
            "length_unit", "load_options_from_args", "read_meshes", "load_model",
-           "LoadedModel", "model_words", "with_warnings", "command_parser", "recorded_warnings"]
+           "LoadedModel", "model_words", "with_warnings", "command_parser", "recorded_warnings",
+           "shown_with_report"]
 
 FILES_HELP = ("mesh file(s): STL, OBJ, PLY, OFF, 3MF; several FILE:material or FILE:density make an "
               "assembly (e.g. a.stl:steel b.stl:1.2g/cm3)")
@@ -254,6 +255,13 @@ class LoadedModel:
 def command_parser(args):
     """The parser of the running subcommand (for :func:`~inertia_tool.cli.speak_options`), or None."""
     return getattr(args, "_subparsers", {}).get(getattr(args, "command", None))
+
+
+def shown_with_report(args, messages) -> None:
+    """Record that ``messages`` (warnings in command-line words) were printed on standard output with the
+    command's report or JSON: when standard error is the same terminal the command line does not print them
+    there a second time (:func:`inertia_tool.cli.main`)."""
+    args.warnings_shown = frozenset(getattr(args, "warnings_shown", frozenset())) | frozenset(messages)
 
 
 def with_warnings(report: str, messages, notes=()) -> str:

@@ -14,7 +14,7 @@ from . import EXIT_INCOMPLETE, EXIT_OK, speak_options
 from .help import add_command
 from .options import check_option
 from ..reports.escape import escape_terminal
-from .model_options import recorded_warnings
+from .model_options import recorded_warnings, shown_with_report
 from .report_option import check_output_file
 
 # the readers, the engine and the reports load in run(): ``robot --help`` needs none of them (issue 25 item 4)
@@ -132,6 +132,7 @@ def _run_corpus(args, packages: dict) -> int:
     if args.json:
         out = command_output("robot-corpus", corpus_report_dict(models), warnings=messages)
         print(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False))
+        shown_with_report(args, messages)
     else:
         print(speak_options(format_corpus_report(models), getattr(args, "robot_parser", None)))
     incomplete = any(m.robot is None or links_without_result(m.robot, m.inertials) for m in models)
@@ -185,9 +186,13 @@ def run(args) -> int:
     if args.json:
         out = command_output("robot", robot_report_dict(robot, inertials, audits), warnings=messages)
         print(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False))
+        shown_with_report(args, messages)
     else:
         # engine sentences name API parameters (`repair=True`); here they name this command's options
-        print(speak_options(format_robot_report(robot, inertials, audits), getattr(args, "robot_parser", None)))
+        parser = getattr(args, "robot_parser", None)
+        print(speak_options(format_robot_report(robot, inertials, audits), parser))
+        # the report lists the links' warnings, not those of reading the description
+        shown_with_report(args, [speak_options(w, parser) for r in inertials for w in r.warnings])
     if links_without_result(robot, inertials):
         if args.json:        # the table ends with the same line
             print(escape_terminal(f"inertia-tool robot: {summary_line(robot, inertials)}"), file=sys.stderr)

@@ -11,7 +11,8 @@ from ..tolerances import EQUAL_MOMENTS_RTOL as DEFAULT_EQUAL_RTOL
 from ..tolerances import MAX_TRAJECTORY_SAMPLES as MAX_SAMPLES
 from ..units import parse_angular_rate, parse_duration
 from .help import add_command
-from .model_options import add_files_argument, add_model_options, load_model, model_words, with_warnings
+from .model_options import (add_files_argument, add_model_options, load_model, model_words, shown_with_report,
+                            with_warnings)
 from .options import check_option, require_range
 from .report_option import save_figure, say_written
 
@@ -147,4 +148,5 @@ def run(args) -> int:
                             loaded.warnings, loaded.notes()))
         print("\n".join(format_stability(experiment.report, perturbation=args.perturbation)))
         print(format_spin(experiment, name=props.name))
+    shown_with_report(args, loaded.warnings)
     return 0

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from ..errors import UsageError
 from ..units import length_scale, parse_density, parse_length, parse_vector
 from .help import add_command
-from .model_options import add_material_options, length_unit, recorded_warnings
+from .model_options import add_material_options, length_unit, recorded_warnings, shown_with_report
 from .options import check_option, density_and_mass
 from .report_option import save_figure, say_written
 
@@ -246,6 +246,7 @@ def run(args) -> int:
         json.dump(command_output("spin-it", body, warnings=messages), sys.stdout, indent=2, ensure_ascii=False,
                   allow_nan=False)
         sys.stdout.write("\n")
+        shown_with_report(args, messages)
     else:
         sys.stdout.write(format_spin_it_text(result, name=args.files, output=args.out))
         sys.stdout.write(format_verification(verdicts))

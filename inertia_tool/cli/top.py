@@ -10,7 +10,8 @@ from ..errors import NearlyEqualMomentsWarning, UsageError
 from ..tolerances import MAX_TRAJECTORY_SAMPLES as MAX_SAMPLES
 from ..units import STANDARD_GRAVITY, parse_angle, parse_angular_rate, parse_duration, parse_vector
 from .help import add_command
-from .model_options import add_files_argument, add_model_options, length_unit, load_model, model_words, with_warnings
+from .model_options import (add_files_argument, add_model_options, length_unit, load_model, model_words,
+                            shown_with_report, with_warnings)
 from .options import check_option, require_range
 from .report_option import save_figure, say_written
 
@@ -194,4 +195,5 @@ def run(args) -> int:
         print(with_warnings(f"{props.name}: mass {props.mass:.6g} kg ({described}{model_words(loaded.model)})",
                             loaded.warnings, loaded.notes()))
         print(format_heavy_top(top, traj))
+    shown_with_report(args, loaded.warnings)
     return 0
