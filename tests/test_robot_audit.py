@@ -61,6 +61,23 @@ def test_com_in_the_box_but_outside_the_material_of_a_ring(tmp_path):
     (a,) = audit(robot, link_inertials(robot, keep_mass=True), keep_mass=True)
     assert a.com_in_bounding_box is True and a.com_inside_geometry is False
     assert a.com_distance < 1e-15
+    # the ring's own centre of mass is outside its material too: no evidence of a slip, no issue raised
+    assert not any("outside the link geometry" in i for i in a.issues), a.issues
+
+
+def test_a_declared_com_outside_a_solid_link_whose_own_com_is_inside_is_an_issue(tmp_path):
+    # one box: the geometry's centre of mass is inside; a declared centre in the box's bounding box but in a
+    # notch cut out of an L made of two boxes is outside the material while the L's own centre is inside
+    f = tmp_path / "ell.urdf"
+    f.write_text('<robot name="r"><link name="ell"><inertial><origin xyz="0.03 -0.03 0"/><mass value="1"/>'
+                 '<inertia ixx="1" iyy="1" izz="1"/></inertial>'
+                 '<collision><origin xyz="0 0.03 0"/><geometry><box size="0.1 0.04 0.1"/></geometry></collision>'
+                 '<collision><origin xyz="-0.03 -0.02 0"/><geometry><box size="0.04 0.06 0.1"/></geometry>'
+                 '</collision></link></robot>')
+    robot = read_robot(f)
+    (a,) = audit(robot, link_inertials(robot, keep_mass=True), keep_mass=True)
+    assert a.com_in_bounding_box is True and a.com_inside_geometry is False
+    assert any("outside the link geometry (in its bounding box)" in i for i in a.issues), a.issues
 
 
 def test_ur5_wrist_inertias_are_flagged_and_the_upper_arm_is_not():

@@ -217,8 +217,11 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
                 issues += [f"likely cause: {c.explanation}" for c in causes]
             if in_box is False:
                 issues.append("declared centre of mass lies outside the link geometry's bounding box")
-            elif inside is False:
-                issues.append("declared centre of mass lies outside the link geometry (in its bounding box)")
+            elif inside is False and _own_centre_inside(link, computed.center_of_mass):
+                # a hollow or bent link's own centre of mass lies outside its material too: there a declared
+                # centre outside is no evidence of a slip (its distance from the geometry's is judged above)
+                issues.append("declared centre of mass lies outside the link geometry (in its bounding box), "
+                              "where the geometry's own centre of mass lies inside it")
         out.append(LinkAudit(name=link.name, declared=declared, computed=computed, mass_ratio=mass_ratio,
                              com_distance=com_distance, com_distance_relative=com_rel, inertia_difference=inertia_diff,
                              declared_check=check, implied_density=implied, density_plausible=plausible,
@@ -234,3 +237,11 @@ def audit_links(robot: RobotDescription, inertials, *, com_tolerance: float = DE
     return tuple(replace(a, causes=a.causes + (copied[a.name],),
                          issues=a.issues + (f"likely cause: {copied[a.name].explanation}",))
                  if a.name in copied else a for a in out)
+
+
+def _own_centre_inside(link, centre: np.ndarray) -> bool:
+    """True unless the geometry's own centre of mass is known to lie outside every element of ``link``."""
+    try:
+        return any(points_inside_element(e, centre) for e in link.elements)
+    except (InertiaToolError, ValueError):
+        return True
