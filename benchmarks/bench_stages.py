@@ -17,7 +17,9 @@ times each:
 
 Each stage in ns per corner (3 per face), CPU time of all threads of the process (the C kernels' worker
 threads included; on a loaded machine the steadier measure) and wall time: the breakdown of the profiled run
-with the least CPU time (its rows sum to its total), and the least of each row over the runs.  ``total`` and
+with the least CPU time (its rows sum to its total), and the least of each row over the runs; with the system
+(kernel) part of each row's CPU time and its minor page faults (``getrusage``): fresh anonymous pages cost a
+fault and a zeroing each, which shows there rather than in the kernels' own loops.  ``total`` and
 ``fromfile`` are also reported as medians and best with best (the issue's yardstick: the fastest analysis
 against the fastest ``fromfile``, whose own time moves with the page faults of its fresh buffer).
 
@@ -38,6 +40,7 @@ import argparse
 import importlib.util
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -172,6 +175,13 @@ def _stage_codes() -> dict[CodeType, str]:
     return codes
 
 
+def _kernel_clock() -> tuple[float, int]:
+    """System CPU seconds and minor page faults of the process so far (all threads; Linux counts the system
+    time by the scheduler's accounting, coarser than ``process_time``)."""
+    use = resource.getrusage(resource.RUSAGE_SELF)
+    return use.ru_stime, use.ru_minflt
+
+
 class StageClock:
     """A :func:`sys.setprofile` hook that charges the CPU (all threads) and wall time between consecutive
     events to the stage innermost on the call stack, and, for ``other``, to the innermost function by name.
@@ -183,30 +193,40 @@ class StageClock:
     """
 
     def __init__(self, cpu_clock: Callable[[], float] = time.process_time,
-                 wall_clock: Callable[[], float] = time.perf_counter) -> None:
+                 wall_clock: Callable[[], float] = time.perf_counter,
+                 kernel_clock: Callable[[], tuple[float, int]] = _kernel_clock) -> None:
         self.codes = _stage_codes()
-        self.cpu_clock, self.wall_clock = cpu_clock, wall_clock
+        self.cpu_clock, self.wall_clock, self.kernel_clock = cpu_clock, wall_clock, kernel_clock
         self.events = 0
+        #: of the last run, by row: system CPU seconds (the kernel's share of the CPU time: page faults and the
+        #: zeroing of fresh pages, the file's copy out of the page cache) and minor page faults
+        self.sys: dict[str, float] = {}
+        self.faults: dict[str, int] = {}
 
     def run(self, fn: Callable[[], object]) -> tuple[dict[str, float], dict[str, float], dict[str, float]]:
         """Run ``fn`` under the hook; CPU and wall seconds by row, and CPU seconds of ``other`` by function."""
-        cpu_clock, wall_clock = self.cpu_clock, self.wall_clock
+        cpu_clock, wall_clock, kernel_clock = self.cpu_clock, self.wall_clock, self.kernel_clock
         codes = self.codes
         cpu: dict[str, float] = dict.fromkeys((*STAGES, OTHER), 0.0)
         wall: dict[str, float] = dict.fromkeys((*STAGES, OTHER), 0.0)
         other: dict[str, float] = {}
         stack: list[tuple[str, str]] = [(OTHER, "run")]
-        last = [cpu_clock(), wall_clock()]
+        sys_time: dict[str, float] = dict.fromkeys((*STAGES, OTHER), 0.0)
+        faults: dict[str, int] = dict.fromkeys((*STAGES, OTHER), 0)
+        last: list[Any] = [cpu_clock(), wall_clock(), *kernel_clock()]
         events = [0]
 
         def charge() -> None:
             c, w = cpu_clock(), wall_clock()
+            k, f = kernel_clock()
             row, where = stack[-1]
             cpu[row] += c - last[0]
             wall[row] += w - last[1]
+            sys_time[row] += k - last[2]
+            faults[row] += f - last[3]
             if row == OTHER:
                 other[where] = other.get(where, 0.0) + c - last[0]
-            last[0], last[1] = c, w
+            last[:] = c, w, k, f
 
         def hook(frame: FrameType, event: str, arg: Any) -> None:
             events[0] += 1
@@ -230,6 +250,7 @@ class StageClock:
             sys.setprofile(None)
             charge()
         self.events = events[0]
+        self.sys, self.faults = sys_time, faults
         return cpu, wall, other
 
 
@@ -275,7 +296,7 @@ def measure(path: str, repeat: int) -> dict:
         w, c = _times(lambda: mass_properties(path, density=1000.0), 1)
         total_wall += w
         total_cpu += c
-        runs.append(clock.run(lambda: mass_properties(path, density=1000.0)))
+        runs.append((*clock.run(lambda: mass_properties(path, density=1000.0)), clock.sys, clock.faults))
     best = min(range(repeat), key=lambda i: sum(runs[i][0].values()))
     rows = (*STAGES, OTHER)
     cpu_best_run = {k: runs[best][0][k] * ns for k in rows}
@@ -283,6 +304,8 @@ def measure(path: str, repeat: int) -> dict:
     cpu_min = {k: min(r[0][k] for r in runs) * ns for k in rows}
     profiled_cpu = sum(runs[best][0].values())
     other = sorted(runs[best][2].items(), key=lambda kv: -kv[1])[:8]
+    sys_best_run = {k: runs[best][3][k] * ns for k in rows}
+    faults_best_run = {k: runs[best][4][k] / corners * 1e3 for k in rows}
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (_package_root(), os.environ.get("PYTHONPATH")) if p)
     child = subprocess.run([sys.executable, "-c", _CHILD, path], capture_output=True, text=True, check=True,
@@ -292,6 +315,7 @@ def measure(path: str, repeat: int) -> dict:
     return {
         "file": os.path.basename(path), "faces": n, "file_bytes": size, "profile_events": clock.events,
         "cpu_ns_per_corner": cpu_best_run, "wall_ns_per_corner": wall_best_run, "cpu_ns_per_corner_min": cpu_min,
+        "sys_ns_per_corner": sys_best_run, "faults_per_1000_corners": faults_best_run,
         "other_cpu_ns_per_corner": {k: v * ns for k, v in other},
         "profiled_total_cpu_ns_per_corner": profiled_cpu * ns,
         "total_cpu_ns_per_corner": min(total_cpu) * ns, "total_wall_ns_per_corner": min(total_wall) * ns,
@@ -332,11 +356,14 @@ def main(argv: list[str] | None = None) -> int:
               f"peak {r['peak_bytes'] / 1e6:.0f} MB = {r['peak_vs_file']:.2f}x the file "
               f"({r['peak_above_imports_vs_file']:.2f}x above the imports)")
         cpu, wall, low = r["cpu_ns_per_corner"], r["wall_ns_per_corner"], r["cpu_ns_per_corner_min"]
-        print(f"  {'ns per corner':<15}{'CPU':>8}{'wall':>8}{'CPU min':>9}   (CPU and wall: the profiled run "
-              "with the least CPU; CPU min: each row's least)")
+        kernel, faults = r["sys_ns_per_corner"], r["faults_per_1000_corners"]
+        print(f"  {'ns per corner':<15}{'CPU':>8}{'wall':>8}{'CPU min':>9}{'of CPU: sys':>13}{'faults/1k':>11}   "
+              "(the profiled run with the least CPU; CPU min: each row's least over the runs; sys: the kernel's "
+              "share of CPU, mostly zeroing fresh pages; faults per 1,000 corners)")
         for k in cpu:
-            print(f"  {k:<15}{cpu[k]:8.1f}{wall[k]:8.1f}{low[k]:9.1f}")
-        print(f"  {'sum':<15}{sum(cpu.values()):8.1f}{sum(wall.values()):8.1f}")
+            print(f"  {k:<15}{cpu[k]:8.1f}{wall[k]:8.1f}{low[k]:9.1f}{kernel[k]:13.1f}{faults[k]:11.2f}")
+        print(f"  {'sum':<15}{sum(cpu.values()):8.1f}{sum(wall.values()):8.1f}{'':9}{sum(kernel.values()):13.1f}"
+              f"{sum(faults.values()):11.2f}")
         print(f"  plain total    {r['total_cpu_ns_per_corner']:8.1f}{r['total_wall_ns_per_corner']:8.1f}"
               f"   (least of the unprofiled runs; hook {r['hook_cpu_ns_per_corner']:+.1f} ns CPU, "
               f"{r['profile_events']:,} events)")

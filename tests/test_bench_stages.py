@@ -45,7 +45,8 @@ def test_each_stage_is_charged_to_its_row_and_the_rows_add_up(torus_stl, monkeyp
     # "read" though the weld calls them), a pipeline check "4 s": each lands in its row, and the rows sum to
     # the clock's whole advance
     clock = Clock()
-    stage = StageClock(cpu_clock=clock, wall_clock=clock)     # before the stand-ins: it finds the real stages
+    stage = StageClock(cpu_clock=clock, wall_clock=clock,     # before the stand-ins: it finds the real stages
+                       kernel_clock=lambda: (clock.now / 2, int(clock.now) * 10))
     real_census, real_weld, real_size = checks.census_and_shells, read.weld_exact_stream, pipeline.warn_implausible_size
 
     def census(*args, **kwargs):        # one function each: the hook tells them apart by their code
@@ -93,6 +94,8 @@ def test_each_stage_is_charged_to_its_row_and_the_rows_add_up(torus_stl, monkeyp
     assert cpu["read"] == 8.0 * len(reads)
     assert cpu[OTHER] == 4.0
     assert sum(cpu.values()) == clock.now
+    assert stage.sys == {row: t / 2 for row, t in cpu.items()}
+    assert stage.faults == {row: int(t) * 10 for row, t in cpu.items()}
     charged = {name: t for name, t in other.items() if t}
     assert list(charged.values()) == [4.0] and next(iter(charged)).endswith(".<locals>.size")
     assert stage.events > 100
