@@ -28,7 +28,8 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+# bench_stages (imported in main) puts this checkout on sys.path only when no inertia_tool is importable:
+# a PYTHONPATH or an installed package is the one measured
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 

@@ -754,11 +754,12 @@ static PyTypeObject WelderType = {
  *            radix partition: per thread a histogram of its half of the chunk while staging its misses in
  *            order, then a scatter of the staged misses); the output index keeps each point's bucket or
  *            reference until output;
- *   finish   each bucket (threads take the next bucket free) is welded in a small table: equal keys always
- *            share a bucket, and a bucket holds its points in file order (chunks in order, a chunk's parts in
- *            order, a part's points in order), so the first point of each distinct key in its bucket is its
- *            first corner in the whole stream; that corner is marked in a bitmap of all corners;
- *            each point's entry then names its vertex's first corner;
+ *   finish   each bucket (threads take the next bucket free) is welded in a small table of entry numbers
+ *            (the table compares a point with the entry of each vertex's first point, in place: no copy of
+ *            the vertices): equal keys always share a bucket, and a bucket holds its points in file order
+ *            (chunks in order, a chunk's parts in order, a part's points in order), so the first point of
+ *            each distinct key in its bucket is its first corner in the whole stream; that corner is marked in
+ *            a bitmap of all corners; each point's entry then names its vertex's first corner;
  *   output   a vertex's number is the count of marked corners before its first corner (first appearance
  *            order, exactly the Welder's numbering); every corner's number is gathered in file order through
  *            its bucket's cursor (a vertex's first corner writes the vertex; a corner whose vertex came first
@@ -769,8 +770,11 @@ static PyTypeObject WelderType = {
  * work differs, and no step depends on which thread did it.  Memory until output returns: 16 bytes (key,
  * corner) per point the recent-point cache did not hold -- at most 48 per triangle, about the size of the
  * binary STL (50 per triangle), 18-52 % of that on the benchmark meshes; the arena is reserved for
- * all points but only the pages written are resident -- plus 20 per vertex, a bit per point per thread, and
- * while feeding 16 bytes per point of one chunk (the staged misses; 6 MB for the reader's chunks).
+ * all points but only the pages written are resident -- plus, while finishing, a table of 4 bytes per slot
+ * per thread (at most 2**17 slots), a bit per point per thread, and while feeding 16 bytes per point of one
+ * chunk (the staged misses; 6 MB for the reader's chunks).  (Until issue 25's fifth pass the buckets were
+ * welded into per-thread copies of their vertices, 16 bytes per vertex more: 42 MB of fresh pages on the
+ * 5.24M-face icosphere, whose zeroing by the kernel cost about as much as welding into them.)
  * The Welder's table is about 12 bytes per triangle.
  * ------------------------------------------------------------------------------------------------------ */
 
@@ -779,7 +783,6 @@ static PyTypeObject WelderType = {
 
 typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* corner: after finish, its vertex's first
                                                                  * corner */
-typedef struct { uint32_t k[3]; uint32_t first; } PwVertex;   /* first corner; after output, its number */
 
 typedef struct {
     PwEntry *entries;      /* the chunk's points; part t (corners [lo_t, hi_t)) occupies entries[lo_t, hi_t) */
@@ -805,12 +808,7 @@ typedef struct {
     size_t arena_bytes;
     PwChunk *chunks;
     size_t n_chunks, chunks_cap;
-    PwVertex *verts[MAX_THREADS];      /* vertices of the buckets each thread welded, bucket after bucket */
-    size_t vcount[MAX_THREADS], vcap[MAX_THREADS], vbytes[MAX_THREADS];   /* vbytes: the mapping's size */
-    uint8_t *owner;                    /* per bucket: the thread that welded it */
-    size_t *v0;                        /* per bucket: its first vertex in verts[owner] */
     uint32_t *nv;                      /* per bucket: its vertices */
-    uint32_t *vbase;                   /* per bucket: its first vertex in bucket order (B + 1) */
     uint64_t *mark[MAX_THREADS];       /* per thread: bit c set when corner c is a vertex's first */
     uint32_t *rank;                    /* per mark word: marked corners before it */
     size_t count;
@@ -1028,26 +1026,17 @@ pw_release(PartWelderObject *w)
     }
     w->n_chunks = w->chunks_cap = 0;
     for (int t = 0; t < MAX_THREADS; t++) {
-        pool_give_used(w->verts[t], w->vbytes[t], w->vcount[t] * sizeof(PwVertex));
         free(w->mark[t]);
-        w->verts[t] = NULL;
         w->mark[t] = NULL;
-        w->vcount[t] = w->vcap[t] = w->vbytes[t] = 0;
     }
     free(w->recent);
     w->recent = NULL;
     pool_give(w->stage, w->stage_bytes);
     w->stage = NULL;
     w->stage_cap = w->stage_bytes = 0;
-    free(w->owner);
-    free(w->v0);
     free(w->nv);
-    free(w->vbase);
     free(w->rank);
-    w->owner = NULL;
-    w->v0 = NULL;
     w->nv = NULL;
-    w->vbase = NULL;
     w->rank = NULL;
 }
 
@@ -1141,7 +1130,8 @@ typedef struct {
     int nomem;
 } PwTask;
 
-/* Weld the buckets this thread draws: a table of local ids (load <= 1/2, doubled when full) per bucket. */
+/* Weld the buckets this thread draws: a table (load <= 1/2, doubled when full) of the entry numbers of the
+ * bucket's distinct points so far, each compared in place with the point it names. */
 static void
 pw_weld_task(void *ctx, int t, int nt)
 {
@@ -1151,6 +1141,7 @@ pw_weld_task(void *ctx, int t, int nt)
     uint32_t *slots = NULL;
     size_t slots_cap = 0;
     uint64_t *mark = w->mark[t];
+    PwEntry *entries = w->entries;         /* fewer than 2**31 - 1 entries: an entry number + 1 fits a slot */
     for (;;) {
         int32_t b = next_ticket(&task->ticket);
         if (b < 0 || (size_t)b >= nb || __atomic_load_n(&task->nomem, __ATOMIC_RELAXED)) {
@@ -1163,10 +1154,6 @@ pw_weld_task(void *ctx, int t, int nt)
                 const uint32_t *off = c->off + (size_t)p * (nb + 1);
                 points += off[b + 1] - off[b];
             }
-        }
-        if (w->vcount[t] + points > w->vcap[t]) {     /* cannot happen: vcap is all the points partitioned */
-            __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
-            break;
         }
         /* a table for every point of the bucket at load <= 1/2 (a bucket holds at most as many vertices as
          * points: no growth); a bucket of more than 2**20 points (one point recurring past the recent-point
@@ -1186,7 +1173,6 @@ pw_weld_task(void *ctx, int t, int nt)
         }
         memset(slots, 0, cap * sizeof(uint32_t));
         size_t mask = cap - 1, count = 0;
-        PwVertex *vs = w->verts[t] + w->vcount[t];
         int failed = 0;
         for (size_t i = 0; i < w->n_chunks && !failed; i++) {
             const PwChunk *c = &w->chunks[i];
@@ -1200,56 +1186,53 @@ pw_weld_task(void *ctx, int t, int nt)
                         if (id == 0) {
                             break;
                         }
-                        const PwVertex *o = vs + (id - 1);
+                        const PwEntry *o = entries + (id - 1);
                         if (o->k[0] == e->k[0] && o->k[1] == e->k[1] && o->k[2] == e->k[2]) {
                             break;
                         }
                         j = (j + 1) & mask;
                     }
-                    if (id == 0) {
-                        PwVertex *nv = vs + count;
-                        nv->k[0] = e->k[0];
-                        nv->k[1] = e->k[1];
-                        nv->k[2] = e->k[2];
-                        nv->first = e->corner;
-                        mark[e->corner >> 6] |= (uint64_t)1 << (e->corner & 63);
-                        id = (uint32_t)++count;
-                        slots[j] = id;
-                        if (2 * count > cap) {       /* double the table and re-insert the ids */
-                            size_t ncap = 2 * cap;
-                            uint32_t *ns = (uint32_t *)calloc(ncap, sizeof(uint32_t));
-                            if (ns == NULL) {
-                                __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
-                                failed = 1;
-                                break;
-                            }
-                            for (size_t v = 0; v < count; v++) {
-                                size_t q = (size_t)hash32(vs[v].k) & (ncap - 1);
-                                while (ns[q] != 0) {
-                                    q = (q + 1) & (ncap - 1);
-                                }
-                                ns[q] = (uint32_t)(v + 1);
-                            }
-                            free(slots);
-                            slots = ns;
-                            cap = slots_cap = ncap;
-                            mask = cap - 1;
-                        }
+                    if (id != 0) {
+                        e->corner = entries[id - 1].corner;   /* its vertex's first corner (the key stays:
+                                                                * output writes the vertex from it) */
+                        continue;
                     }
-                    e->corner = vs[id - 1].first;    /* its vertex's first corner (the key stays: output
-                                                       * writes the vertex from it) */
+                    /* a new vertex: this point is its first corner (its entry keeps its own corner) */
+                    mark[e->corner >> 6] |= (uint64_t)1 << (e->corner & 63);
+                    slots[j] = (uint32_t)(e - entries) + 1;
+                    if (2 * ++count > cap) {       /* double the table and re-insert the entry numbers */
+                        size_t ncap = 2 * cap;
+                        uint32_t *ns = (uint32_t *)calloc(ncap, sizeof(uint32_t));
+                        if (ns == NULL) {
+                            __atomic_store_n(&task->nomem, 1, __ATOMIC_RELAXED);
+                            failed = 1;
+                            break;
+                        }
+                        for (size_t q = 0; q < cap; q++) {
+                            if (slots[q] == 0) {
+                                continue;
+                            }
+                            size_t r = (size_t)hash32(entries[slots[q] - 1].k) & (ncap - 1);
+                            while (ns[r] != 0) {
+                                r = (r + 1) & (ncap - 1);
+                            }
+                            ns[r] = slots[q];
+                        }
+                        free(slots);
+                        slots = ns;
+                        cap = slots_cap = ncap;
+                        mask = cap - 1;
+                    }
                 }
             }
         }
         if (failed) {
             break;
         }
-        w->owner[b] = (uint8_t)t;
-        w->v0[b] = w->vcount[t];
         w->nv[b] = (uint32_t)count;
-        w->vcount[t] += count;
     }
     free(slots);
+    (void)t;
     (void)nt;
 }
 
@@ -1327,7 +1310,7 @@ PartWelder_init(PartWelderObject *w, PyObject *args, PyObject *kwds)
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "O|ii", kwlist, &index_obj, &threads, &bits)) {
         return -1;
     }
-    if (w->owner != NULL || w->state != 0 || w->points != 0) {
+    if (w->nv != NULL || w->state != 0 || w->points != 0) {
         PyErr_SetString(PyExc_RuntimeError, "PartWelder is already initialised");
         return -1;
     }
@@ -1356,16 +1339,13 @@ PartWelder_init(PartWelderObject *w, PyObject *args, PyObject *kwds)
     w->threads = thread_count(threads, (size_t)n_points, 1);
     w->bits = bits;
     w->n_points = (size_t)n_points;
-    w->owner = (uint8_t *)calloc(nb, 1);
-    w->v0 = (size_t *)calloc(nb, sizeof(size_t));
     w->nv = (uint32_t *)calloc(nb, sizeof(uint32_t));
-    w->vbase = (uint32_t *)calloc(nb + 1, sizeof(uint32_t));
     w->rank = (uint32_t *)malloc(words * sizeof(uint32_t));
     int fits = (size_t)n_points <= (SIZE_MAX - 64) / sizeof(PwEntry);
     w->arena_bytes = fits ? (size_t)n_points * sizeof(PwEntry) + 64 : 0;
     w->entries = fits ? (PwEntry *)pool_take(&w->arena_bytes) : NULL;
     w->recent = (Recent32 *)malloc((size_t)w->threads * WELD_RECENT * sizeof(Recent32));
-    int ok = w->owner && w->v0 && w->nv && w->vbase && w->rank && w->entries && w->recent;
+    int ok = w->nv && w->rank && w->entries && w->recent;
     for (int t = 0; t < w->threads && ok; t++) {
         w->mark[t] = (uint64_t *)calloc(words, sizeof(uint64_t));
         ok = w->mark[t] != NULL;
@@ -1388,7 +1368,7 @@ PartWelder_dealloc(PartWelderObject *w)
 static int
 pw_ready(PartWelderObject *w, int state)
 {
-    if (w->owner == NULL && w->state == 0) {
+    if (w->nv == NULL && w->state == 0) {
         PyErr_SetString(PyExc_RuntimeError, "PartWelder was not initialised");
         return -1;
     }
@@ -1505,26 +1485,12 @@ PartWelder_finish(PartWelderObject *w, PyObject *unused)
         PyErr_Format(PyExc_ValueError, "Expected %zu points, got %zu", w->n_points, (size_t)w->points);
         return NULL;
     }
-    size_t nb = (size_t)1 << w->bits, words = (w->n_points + 63) / 64 + 1;
+    size_t words = (w->n_points + 63) / 64 + 1;
     PwTask task = {w, 0, 0};
     pool_give(w->stage, w->stage_bytes);        /* every chunk is fed */
     w->stage = NULL;
     w->stage_cap = w->stage_bytes = 0;
     int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
-    /* each thread's vertices: reserved for every partitioned point (a thread's buckets hold no more), only
-     * the pages written become resident, and the pages go back to the system when the welder is done
-     * (memory from malloc in a worker thread could stay in that thread's heap) */
-    for (int t = 0; t < nt; t++) {
-        w->vcap[t] = w->partitioned ? w->partitioned : 1;
-        w->vbytes[t] = w->vcap[t] * sizeof(PwVertex);
-        w->verts[t] = (PwVertex *)pool_take(&w->vbytes[t]);
-        if (w->verts[t] == NULL) {
-            w->vcap[t] = w->vbytes[t] = 0;
-            pw_release(w);
-            w->state = 2;
-            return PyErr_NoMemory();
-        }
-    }
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
     run_parallel(nt, pw_weld_task, &task);
@@ -1545,9 +1511,6 @@ PartWelder_finish(PartWelderObject *w, PyObject *unused)
             w->mark[t] = NULL;
         }
         w->count = run;
-        for (size_t b = 0; b < nb; b++) {
-            w->vbase[b + 1] = w->vbase[b] + w->nv[b];
-        }
     }
     Py_END_ALLOW_THREADS
     w->busy = 0;
