@@ -189,3 +189,53 @@ def test_frozen_value_init_stores_fields_in_the_instance_dictionary():
     assert Sample(arr) == s and hash(Sample(arr)) == hash(s)
     with pytest.raises(dataclasses.FrozenInstanceError):
         s.b = 4  # type: ignore[misc]
+
+
+# -- Dask's short batches: one chunk per worker --------------------------------------------------------------
+
+def test_dask_short_batch_is_one_equal_chunk_per_worker():
+    """200 equal parts under a round of 0.5 s chunks on 2 workers: 2 chunks of 100 on Dask (each task costs the
+    cluster milliseconds), 4 of 50 on a process pool; unequal files split by weight, not by count."""
+    from test_batch_chunks import _drive
+
+    from inertia_tool.batch.chunks import DASK_SHORT_CHUNKS_PER_WORKER, POOL_SHORT_CHUNKS_PER_WORKER, ChunkSizer
+
+    assert (DASK_SHORT_CHUNKS_PER_WORKER, POOL_SHORT_CHUNKS_PER_WORKER) == (1, 2)
+    s = ChunkSizer([50_000.0] * 200, 0.5, tail_seconds=0.02, prior_seconds_per_byte=2e-8, short_chunks_per_worker=1)
+    assert _drive(s, 2, lambda a, b: (b - a) * 1e-3) == [100, 100]
+    s = ChunkSizer([50_000.0] * 200, 0.5, tail_seconds=0.02, prior_seconds_per_byte=2e-8)
+    assert _drive(s, 2, lambda a, b: (b - a) * 1e-3) == [50, 50, 50, 50]
+    s = ChunkSizer([1_000.0] * 100 + [99_000.0] * 100, 1.0, prior_seconds_per_byte=2e-8, short_chunks_per_worker=1)
+    assert _drive(s, 2, lambda a, b: 0.0) == [149, 51]                    # the boundary nearest 5 MB
+    s = ChunkSizer([50_000.0] * 30, 0.5, prior_seconds_per_byte=2e-8, short_chunks_per_worker=1)
+    sizes = _drive(s, 4, lambda a, b: (b - a) * 1e-3)
+    assert len(sizes) == 4 and set(sizes) == {7, 8}                       # 30 / 4, no 5th chunk of rounding
+    with pytest.raises(ValueError, match="short_chunks_per_worker"):
+        ChunkSizer([1.0], 0.5, short_chunks_per_worker=0)
+
+
+@settings(max_examples=40, deadline=None)
+@given(files=st.integers(1, 3000), per_file=st.sampled_from([0.0005, 0.0015, 0.004, 0.03]),
+       spread=st.floats(0.0, 3.0), seed=st.integers(0, 2**16), prior=st.sampled_from([0.1, 1.0, 10.0]))
+def test_dask_short_batches_take_one_task_per_worker_and_bound_the_wait(files, per_file, spread, seed, prior):
+    """Files of random sizes on two Dask workers (the model of ``test_batch_chunks._makespan``), the prior off by
+    10x either way: a short batch takes 2 chunks plus one per file heavier than a chunk, and ends at most half
+    its work plus two files after the ideal; a long one is sized as before."""
+    from test_batch_chunks import _makespan
+
+    from inertia_tool.batch.chunks import DASK_CHUNK_SECONDS, DASK_TAIL_SECONDS, ChunkSizer
+
+    rng = np.random.default_rng(seed)
+    weights = 33_000.0 * np.exp(spread * rng.standard_normal(files))
+    rate = per_file / 33_000.0
+    sizer = ChunkSizer(weights, DASK_CHUNK_SECONDS, tail_seconds=DASK_TAIL_SECONDS,
+                       prior_seconds_per_byte=rate * prior, short_chunks_per_worker=1)
+    total = float(weights.sum()) * rate
+    makespan, chunks = _makespan(weights, rate, 2, sizer)
+    largest = float(weights.max()) * rate
+    assert makespan >= total / 2 - 1e-9
+    if total * prior <= 4 * DASK_CHUNK_SECONDS:
+        heavy = int(np.count_nonzero(weights > weights.sum() / 2))
+        assert chunks <= min(2 + heavy, files) and makespan - total / 2 <= total / 2 + 2 * largest + 1e-9
+    else:
+        assert makespan - total / 2 <= max(DASK_TAIL_SECONDS, DASK_CHUNK_SECONDS / prior) + 2 * largest + 1e-9
