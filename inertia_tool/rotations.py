@@ -20,6 +20,7 @@ scipy in ``tests/test_rotations.py``.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -313,12 +314,19 @@ def perpendicular_basis(normal: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     Used wherever a free choice of axes must be reproducible (equal principal moments, the shaft frame,
     the invariant plane); see ``docs/conventions.md``.
     """
-    n = np.asarray(normal, dtype=np.float64)
-    k = int(np.argmin(np.abs(n)))
-    e1 = -n[k] * n
+    arr = np.asarray(normal, dtype=np.float64)
+    if arr.shape != (3,):
+        raise UsageError(f"Expected `normal` to have shape (3,), got {arr.shape}")
+    # on Python floats: numpy's per-call overhead on 3-vectors was ~30 times the arithmetic (principal axes of
+    # every axisymmetric part come here); the same operations as the array form, norms to the last unit
+    n = arr.tolist()
+    k = min(range(3), key=lambda i: abs(n[i]))        # the first on a tie, as argmin
+    e1 = [-n[k] * x for x in n]
     e1[k] += 1.0
-    e1 /= np.linalg.norm(e1)
-    return e1, np.cross(n, e1)
+    norm = math.sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2])
+    e1 = [x / norm for x in e1]
+    e2 = [n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]]
+    return np.array(e1), np.array(e2)
 
 
 # ---------------------------------------------------------------------------------------------------------------

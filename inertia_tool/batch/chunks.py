@@ -11,8 +11,9 @@ a chunk comes back, then measured (the workers' CPU time, ``time.process_time``,
 load of a shared machine inflates: sized by wall time, a loaded machine shrank the last chunks to single files).
 
 - A *short* batch, whose expected work is at most a round of chunks of the target size (two per worker), is
-  split at once into two chunks per worker of equal weight: 4 tasks for 200 parts on 2 workers, where probing
-  (1, 2, 4, 8 files) and a shrinking tail made 22, each costing the cluster milliseconds of CPU.
+  split at once into chunks of equal weight, two per worker on a process pool (4 tasks for 200 parts on 2
+  workers, where probing (1, 2, 4, 8 files) and a shrinking tail made 22) and one per worker on Dask
+  (:data:`DASK_SHORT_CHUNKS_PER_WORKER`: each task costs the cluster milliseconds of CPU).
 - A longer batch gets chunks of ``target_seconds`` of expected work, and, once what is left is less than a round
   of them, chunks of half a fair share of what is left (so the last chunks spread over every worker), but not
   below ``tail_seconds`` (each chunk costs a round trip of the executor).
@@ -35,6 +36,7 @@ import numpy as np
 
 __all__ = ["ChunkSizer", "PoolTasks", "DaskTasks", "Finished", "POOL_CHUNK_SECONDS", "DASK_CHUNK_SECONDS",
            "POOL_TAIL_SECONDS", "DASK_TAIL_SECONDS", "FILE_OVERHEAD_BYTES", "PRIOR_SECONDS_PER_BYTE",
+           "POOL_SHORT_CHUNKS_PER_WORKER", "DASK_SHORT_CHUNKS_PER_WORKER",
            "file_weights", "run_packed"]
 
 #: Seconds of work aimed at per chunk on a local process pool (task cost ~0.2 ms: 0.05 s makes it < 1 %,
@@ -51,6 +53,17 @@ POOL_TAIL_SECONDS = 0.005
 #: Least work of a chunk near the end of a batch on Dask, s: above the ~8 ms from ``Client.map`` to a task
 #: starting, so that with two chunks in flight per worker the round trip stays hidden behind the running chunk.
 DASK_TAIL_SECONDS = 0.02
+
+#: Chunks per worker of a short batch on a process pool: the second lets the pool even out a worker slowed by
+#: the load (its task costs ~0.2 ms).
+POOL_SHORT_CHUNKS_PER_WORKER = 2
+
+#: Chunks per worker of a short batch on Dask: one.  Each task costs the LocalCluster ~5 ms of CPU in the
+#: batch's process (scheduler, client, nannies) and some in the worker; on 200 small parts (~0.35 s of work) on
+#: 2 workers, one chunk each instead of two took the batch's process from 31-49 to 20-26 ms and the workers from
+#: 356-429 to 339-373 ms of CPU (four paired runs, load average 29), wall 1.56-1.82 -> 1.44-1.57 s.  What it
+#: gives up, evening out the two workers, is bounded by the short batch's size (at most the target per worker).
+DASK_SHORT_CHUNKS_PER_WORKER = 1
 
 #: What a file costs beyond its bytes, counted in bytes (a file's weight is its size plus this): on the small
 #: catalogue of ``benchmarks/bench_batch.py`` a 12-triangle box (684 bytes) takes ~0.7 ms of CPU and the average
@@ -94,18 +107,22 @@ class ChunkSizer:
         Least CPU time of a chunk at the end of a long batch, s (default a tenth of ``target_seconds``).
     prior_seconds_per_byte : float
         CPU seconds per byte of weight until the first chunk is measured.
+    short_chunks_per_worker : int
+        Chunks per worker of a short batch (:data:`POOL_SHORT_CHUNKS_PER_WORKER`,
+        :data:`DASK_SHORT_CHUNKS_PER_WORKER`).
 
     Notes
     -----
     The CPU seconds per byte are an exponential moving average (weight ``1/2``) of each finished chunk's, so a
     catalogue sorted from one kind of part to another adapts within a few chunks.  Expected CPU time of a run of
     files is its weight times that rate.  A batch is *short* when its expected work is at most
-    ``2 * workers * target_seconds``: its files are split into ``2 * workers`` chunks of equal weight (the first
-    round hands out all of them); the split is fixed at the first call.
+    ``2 * workers * target_seconds``: its files are split into ``short_chunks_per_worker * workers`` chunks of
+    equal weight (the first round hands out all of them); the split is fixed at the first call.
     """
 
     def __init__(self, weights: Sequence[float] | np.ndarray, target_seconds: float, *, max_files: int = 1000,
-                 tail_seconds: float | None = None, prior_seconds_per_byte: float = PRIOR_SECONDS_PER_BYTE):
+                 tail_seconds: float | None = None, prior_seconds_per_byte: float = PRIOR_SECONDS_PER_BYTE,
+                 short_chunks_per_worker: int = POOL_SHORT_CHUNKS_PER_WORKER):
         if not (target_seconds > 0 and math.isfinite(target_seconds)):
             raise ValueError(f"Expected `target_seconds` > 0, got {target_seconds}")
         if tail_seconds is None:
@@ -116,6 +133,8 @@ class ChunkSizer:
             raise ValueError(f"Expected `max_files` >= 1, got {max_files}")
         if not (prior_seconds_per_byte > 0 and math.isfinite(prior_seconds_per_byte)):
             raise ValueError(f"Expected `prior_seconds_per_byte` > 0, got {prior_seconds_per_byte}")
+        if not (isinstance(short_chunks_per_worker, int) and short_chunks_per_worker >= 1):
+            raise ValueError(f"Expected an integer `short_chunks_per_worker` >= 1, got {short_chunks_per_worker!r}")
         w = np.asarray(weights, dtype=np.float64).reshape(-1)
         if not (np.isfinite(w).all() and (w >= 0).all()):
             raise ValueError("Expected finite weights >= 0")
@@ -123,6 +142,7 @@ class ChunkSizer:
         self.max_files = int(max_files)
         self.tail_seconds = float(tail_seconds)
         self.prior_seconds_per_byte = float(prior_seconds_per_byte)
+        self.short_chunks_per_worker = short_chunks_per_worker
         self.seconds_per_byte: float | None = None
         self._cumulative = np.concatenate(([0.0], np.cumsum(w)))
         self._short_weight: float | None = None       # the fixed chunk weight of a short batch, once decided
@@ -153,7 +173,7 @@ class ChunkSizer:
         if not self._decided:
             self._decided = True
             if left * rate <= round_of_chunks * self.target_seconds:
-                self._short_weight = left / round_of_chunks
+                self._short_weight = left / (self.short_chunks_per_worker * max(workers, 1))
                 self._short_start = self.weight(0, position)
         if self._short_weight is not None:
             # boundaries at fixed multiples of the chunk weight (not relative to each chunk's start, where the

@@ -43,8 +43,8 @@ from ..mesh.options import LoadOptions
 from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, load_mesh, os_error_reason
 from ..mesh.regular import open_regular
 from ..mass.pipeline import mass_properties, resolve_density
-from .chunks import (DASK_CHUNK_SECONDS, DASK_TAIL_SECONDS, POOL_CHUNK_SECONDS, POOL_TAIL_SECONDS, ChunkSizer,
-                     DaskTasks, PoolTasks, file_weights)
+from .chunks import (DASK_CHUNK_SECONDS, DASK_SHORT_CHUNKS_PER_WORKER, DASK_TAIL_SECONDS, POOL_CHUNK_SECONDS,
+                     POOL_SHORT_CHUNKS_PER_WORKER, POOL_TAIL_SECONDS, ChunkSizer, DaskTasks, PoolTasks, file_weights)
 
 __all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "SCHEMA_V1", "ROW_FIELDS_V1", "analyze_chunk",
            "analyze_file", "discover_files", "file_sha256", "run_batch", "upgrade_row", "downgrade_row",
@@ -700,7 +700,9 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
         target = chunk_seconds or (DASK_CHUNK_SECONDS if client is not None else POOL_CHUNK_SECONDS)
         tail = min(target, DASK_TAIL_SECONDS if client is not None else POOL_TAIL_SECONDS)
         try:
-            sizer = ChunkSizer(file_weights([path for path, _ in todo]), target, tail_seconds=tail)
+            short = DASK_SHORT_CHUNKS_PER_WORKER if client is not None else POOL_SHORT_CHUNKS_PER_WORKER
+            sizer = ChunkSizer(file_weights([path for path, _ in todo]), target, tail_seconds=tail,
+                               short_chunks_per_worker=short)
             _run_chunks(todo, options, tasks, sizer, record, max_in_flight)
         finally:
             tasks.close()

@@ -43,6 +43,9 @@ MeshSource: TypeAlias = "str | os.PathLike[str] | trimesh.Trimesh | tuple[ArrayL
 #: Density used when none of density / material / mass is given (water), kg/m³.  Reports say so.
 DEFAULT_DENSITY = 1000.0
 
+_EPS = float(np.finfo(np.float64).eps)
+_TINY = float(np.finfo(np.float64).tiny)
+
 
 
 def resolve_density(*, density: float | None = None, material: str | None = None,
@@ -102,9 +105,10 @@ def _warn_about_principal(props: MassProperties, source: str) -> None:
         warnings.warn(NearlyEqualMomentsWarning(
             f"{source}: principal moments I{a + 1} and I{b + 1} are equal within {pa.rtol:g} (relative); the "
             "axes in their plane are an arbitrary choice"), stacklevel=3)
-    top = float(np.max(np.abs(pa.moments)))
-    if top > 0 and pa.moments[0] <= NEEDLE_RTOL * top:
-        digits = -np.log10(np.finfo(float).eps * top / max(abs(pa.moments[0]), np.finfo(float).tiny))
+    moments = pa.moments.tolist()
+    top = max(abs(m) for m in moments)                 # NaN cannot reach here: the tensor was checked finite
+    if top > 0 and moments[0] <= NEEDLE_RTOL * top:
+        digits = -math.log10(_EPS * top / max(abs(moments[0]), _TINY))
         warnings.warn(PhysicalValidityWarning(
             f"{source}: the smallest principal moment ({pa.moments[0]:.3g} kg·m²) is below {NEEDLE_RTOL:g} of "
             f"the largest (a needle); it carries only about {max(digits, 0):.0f} correct digits"), stacklevel=3)

@@ -143,18 +143,21 @@ class MassProperties:
     def __post_init__(self) -> None:
         com = np.array(self.center_of_mass, dtype=np.float64).reshape(3)
         ten = np.array(self.inertia, dtype=np.float64).reshape(3, 3)
-        com.flags.writeable = False
-        ten.flags.writeable = False
-        object.__setattr__(self, "center_of_mass", com)
-        object.__setattr__(self, "inertia", ten)
-        object.__setattr__(self, "mass", float(self.mass))
-        object.__setattr__(self, "volume", float(self.volume))
-        object.__setattr__(self, "surface_area", float(self.surface_area))
-        object.__setattr__(self, "density", float(self.density))
-        for what, value in (("mass", self.mass), ("volume", self.volume), ("centre of mass", com),
-                            ("inertia tensor", ten), ("surface area", self.surface_area)):
-            NonFiniteResultError.check(f"{self.name or 'body'}: the {what}", value)
-        if self.volume > 0 and self.density > 0 and self.mass < sys.float_info.min:
+        com.setflags(write=False)
+        ten.setflags(write=False)
+        mass, volume, area = float(self.mass), float(self.volume), float(self.surface_area)
+        stored = self.__dict__              # a frozen value: its fields are set once, here, before anyone sees it
+        stored.update(center_of_mass=com, inertia=ten, mass=mass, volume=volume, surface_area=area,
+                      density=float(self.density))
+        # one finite sum says all are finite (a NaN or an infinity makes it non-finite; so may an overflow of
+        # finite values, which the checks one by one then let through): a body made every few hundred µs
+        # pays one test, not five array checks
+        total = mass + volume + area + sum(com.tolist()) + sum(ten.ravel().tolist())
+        if not total - total == 0.0:
+            for what, value in (("mass", mass), ("volume", volume), ("centre of mass", com),
+                                ("inertia tensor", ten), ("surface area", area)):
+                NonFiniteResultError.check(f"{self.name or 'body'}: the {what}", value)
+        if volume > 0 and self.density > 0 and mass < sys.float_info.min:
             raise NonFiniteResultError(f"{self.name or 'body'}: the mass underflows to {self.mass:g} kg (density "
                                        f"{self.density:g} kg/m³ times volume {self.volume:g} m³): the density "
                                        "is outside any physically meaningful range")

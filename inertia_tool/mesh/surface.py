@@ -7,6 +7,7 @@ that is not a closed, consistently wound 2-manifold to :func:`~.resolve.resolve_
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import NamedTuple
 
@@ -71,12 +72,15 @@ class ClosedSurface(NamedTuple):
 def check_magnitude(lo: np.ndarray, hi: np.ndarray, source: str) -> None:
     """Refuse coordinates (bounding box ``lo``, ``hi``) whose volume integrals (∝ L⁵) would overflow or underflow
     float64."""
-    top = float(np.max(np.abs(np.concatenate((lo, hi)))))    # = max |coordinate| (NaN propagates)
+    corners = lo.tolist() + hi.tolist()
+    top = max(abs(x) for x in corners)                     # = max |coordinate|
+    if any(x != x for x in corners):                       # NaN propagates, as numpy's max would
+        top = math.nan
     if not top <= MAX_COORDINATE:
         raise InvalidMeshError(f"{source}: coordinates reach {top:.3g} m, beyond the ±{MAX_COORDINATE:g} m the "
                                "volume integrals can hold without overflow (check the length `units`)")
-    span = hi - lo
-    diag = float(np.hypot(np.hypot(span[0], span[1]), span[2]))   # no underflow in the squares
+    span = [b - a for a, b in zip(corners[:3], corners[3:])]
+    diag = math.hypot(math.hypot(span[0], span[1]), span[2])      # no underflow in the squares
     if 0 < diag < MIN_EXTENT:
         raise InvalidMeshError(f"{source}: the mesh spans only {diag:.3g} m, below the {MIN_EXTENT:g} m the "
                                "volume integrals can hold without underflow (check the length `units`)")
