@@ -5495,11 +5495,11 @@ ct_popcount(unsigned x)         /* bits set in x (SWAR: no library call without 
     return (int)((v * 0x01010101u) >> 24);
 }
 
-/* Builds the hierarchy over the boxes BOX (blocks above, already in hierarchy order): the tree halving block
- * ranges (a leaf is one block of at most CT_LEAF faces), node boxes from the leaves up.  Returns the node
- * count. */
+/* The hierarchy's shape: the tree halving block ranges (a leaf is one block of at most CT_LEAF faces), which
+ * depends on m alone, so it is built before any box (ct_patches needs only the ranges).  Returns the node
+ * count; boxes and apexes are set by ct_build_boxes. */
 static int64_t
-ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cert, int64_t m)
+ct_build_tree(CtNode *nodes, int64_t m)
 {
     /* top down, halving block ranges (a parent always precedes its children, which are adjacent); while
      * building, link holds a node's first block and apex its block count */
@@ -5521,7 +5521,14 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
         nodes[r].apex = (int32_t)(blocks - blocks / 2);
         nd->link = (int32_t)l;
     }
-    /* boxes and apexes, children before parents */
+    return n_nodes;
+}
+
+/* The node boxes over the boxes BOX (blocks above, in hierarchy order) and the apexes from cert (NULL: none),
+ * children before parents, on the tree of ct_build_tree. */
+static void
+ct_build_boxes(CtNode *nodes, int64_t n_nodes, const float *BOX, const int32_t *ids, const uint8_t *cert, int64_t m)
+{
     for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
         CtNode *nd = &nodes[k];
         if (CT_IS_LEAF(nd)) {
@@ -5561,7 +5568,6 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
             }
         }
     }
-    return n_nodes;
 }
 
 /* ------------------------------------------------------------------------------------------------------
@@ -6162,10 +6168,11 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, con
 /* patch[k] <- 1 for the highest nodes certified as above (their descendants are not tried).  fmask: per
  * hierarchy position, bit 2 a + (s < 0) when the face's projection along axis a has strict orientation s (0
  * for a face in no patch); across: per position and corner, the position of the face across the edge from
- * that corner to the next, or -1 (none).  0, or -1 when out of memory. */
+ * that corner to the next, or -1 (none); the corners read from the faces F through order (the face at each
+ * position), as the hierarchy's boxes and corner indices do not exist yet.  0, or -1 when out of memory. */
 static int
-ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *fmask, const int32_t *across,
-           const double *V, int64_t m, uint8_t *patch)
+ct_patches(const CtNode *nodes, int64_t n_nodes, const void *F, int fsize, const int32_t *order, const uint8_t *fmask,
+           const int32_t *across, const double *V, int64_t m, uint8_t *patch)
 {
     CtPatchBuild pb;
     memset(&pb, 0, sizeof(pb));
@@ -6220,8 +6227,9 @@ ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8
                             B++;
                             break;
                         }
-                        pairs[2 * B] = ct_id(ids, i, c);
-                        pairs[2 * B + 1] = ct_id(ids, i, (c + 1) % 3);
+                        size_t row = 3 * (size_t)order[i];
+                        pairs[2 * B] = (int32_t)index_at(F, fsize, row + (size_t)c);
+                        pairs[2 * B + 1] = (int32_t)index_at(F, fsize, row + (size_t)((c + 1) % 3));
                         B++;
                     }
                 }
@@ -6279,23 +6287,6 @@ ct_patch_labels(const CtNode *nodes, const uint8_t *patch, const int32_t *order,
         stack[2 * top] = CT_RIGHT(nd);
         stack[2 * top + 1] = lab;
         top++;
-    }
-}
-
-/* The apexes of a hierarchy ct_build made without certificates (every apex -1), from cert, children before
- * parents, as ct_build sets them. */
-static void
-ct_set_apex(CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *cert, int64_t m)
-{
-    for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
-        CtNode *nd = &nodes[k];
-        if (CT_IS_LEAF(nd)) {
-            nd->apex = (int32_t)ct_leaf_apex(ids, cert, CT_LEAF * CT_BLOCK_OF(nd), ct_leaf_count(nd, m));
-        }
-        else {
-            const CtNode *p = &nodes[CT_LEFT(nd)], *q = &nodes[CT_RIGHT(nd)];
-            nd->apex = p->apex == q->apex ? p->apex : -1;
-        }
     }
 }
 
@@ -6656,8 +6647,10 @@ ct_prefetch(const void *p)
 }
 
 /* Per-face preparation, split over threads by position: Morton codes and each face's projection axis and
- * zero-area flag, in the caller's order (pass 0: the rows are read in sequence), then the corner indices, flags
- * and boxes in hierarchy order (pass 1). */
+ * zero-area flag, in the caller's order (pass 0: the rows are read in sequence); once the codes are sorted, the
+ * faces in hierarchy order and their projections' orientations (pass 1), the axes and flags unpacked (pass 2);
+ * and only once the sort's words, the edge twins and the stars' lists are given back, the corner indices, flags
+ * and boxes in hierarchy order (pass 3), so that those 37 bytes a face never coexist with the others. */
 typedef struct {
     int pass;
     int64_t m;
@@ -6743,28 +6736,33 @@ ct_prep_task(void *ctx, int t, int nt)
         pr->failed[t] |= st.failed;
         return;
     }
-    for (int64_t i = s; i < e; i++) {
+    if (pr->pass == 1) {                       /* the sorted codes: faces in hierarchy order (and fmask) */
+        for (int64_t i = s; i < e; i++) {
+            int32_t f = (int32_t)(pr->code[i] & 0x7fffffff);
+            pr->order[i] = f;
+            if (pr->fmask != NULL) pr->fmask[i] = (uint8_t)((uint8_t)pr->axis[f] >> 2);
+        }
+        return;
+    }
+    for (int64_t i = s; i < e; i++) {          /* pass 3, after pass 2's unpacking: by hierarchy position */
         /* the faces are read in hierarchy order, i.e. at random in the caller's: their rows are fetched
          * CT_AHEAD positions ahead, their corners CT_AHEAD / 2 ahead (from the rows fetched by then) */
         if (i + CT_AHEAD < e) {
-            ct_prefetch((const char *)pr->F + (size_t)pr->size * 3 * (size_t)(pr->code[i + CT_AHEAD] & 0x7fffffff));
+            ct_prefetch((const char *)pr->F + (size_t)pr->size * 3 * (size_t)pr->order[i + CT_AHEAD]);
         }
         if (i + CT_AHEAD / 2 < e) {
-            size_t g = 3 * (size_t)(pr->code[i + CT_AHEAD / 2] & 0x7fffffff);
+            size_t g = 3 * (size_t)pr->order[i + CT_AHEAD / 2];
             for (int k = 0; k < 3; k++) ct_prefetch(pr->V + 3 * index_at(pr->F, pr->size, g + (size_t)k));
         }
-        int64_t f = (int64_t)(pr->code[i] & 0x7fffffff);
+        int64_t f = pr->order[i];
         const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
         const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
         const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
-        unsigned packed = (uint8_t)pr->axis[f];         /* axis | orientations << 2, from pass 0 */
-        pr->flags[i] = (uint8_t)((packed & 3u) | (packed >> 2 == 0) << 2);
-        if (pr->fmask != NULL) pr->fmask[i] = (uint8_t)(packed >> 2);
+        pr->flags[i] = (uint8_t)((unsigned)pr->axis[f] | (unsigned)pr->skip[f] << 2);
         for (int k = 0; k < 3; k++) {
             pr->ids[CT_IDBLOCK * (i / CT_LEAF) + k * CT_LEAF + i % CT_LEAF]
                 = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
         }
-        pr->order[i] = (int32_t)f;
         for (int c = 0; c < 3; c++) {
             float *blk = pr->box + CT_BLOCK * (i / CT_LEAF);
             blk[c * CT_LEAF + i % CT_LEAF] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
@@ -6846,7 +6844,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
         size_t mm = m > 0 ? (size_t)m : 1;
         size_t n_blocks = (mm + CT_LEAF - 1) / CT_LEAF;
         nodes_bytes = (2 * n_blocks + 1) * sizeof(CtNode);     /* a leaf per block: 2 n_blocks - 1 nodes, from 1 */
-        /* the sort's keys and scratch (2 m words), then the stars' arrays, in one mapping */
+        /* the sort's keys and scratch (2 m words), then the stars' lists, in one mapping; the boxes and corner
+         * indices are mapped only once it is given back (below) */
         code_bytes = 2 * mm * sizeof(uint64_t);
         if (ct_stars_scratch(n, m) > code_bytes) code_bytes = ct_stars_scratch(n, m);
         box_bytes = n_blocks * CT_BLOCK * sizeof(float);
@@ -6854,23 +6853,12 @@ accel_contact_scan(PyObject *self, PyObject *args)
         ids_bytes = n_blocks * CT_IDBLOCK * sizeof(int32_t);
         nodes = (CtNode *)ct_alloc(nodes_bytes);
         code = (uint64_t *)ct_alloc(code_bytes);
-        box = (float *)ct_alloc(box_bytes);
         order = (int32_t *)ct_alloc(order_bytes);
-        ids = (int32_t *)ct_alloc(ids_bytes);
-        flags = (uint8_t *)malloc(mm);
         axis_out = (int8_t *)malloc(mm);
         skip_out = (uint8_t *)malloc(mm);
-        if (nodes == NULL || code == NULL || box == NULL || order == NULL || ids == NULL || flags == NULL
-            || axis_out == NULL || skip_out == NULL) {
+        if (nodes == NULL || code == NULL || order == NULL || axis_out == NULL || skip_out == NULL) {
             PyErr_NoMemory();
             goto done;
-        }
-        for (size_t i = (size_t)m; i < n_blocks * CT_LEAF; i++) {     /* the last block's empty boxes */
-            for (int c = 0; c < 3; c++) {
-                box[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = INFINITY;
-                box[CT_BLOCK * (i / CT_LEAF) + (3 + c) * CT_LEAF + i % CT_LEAF] = -INFINITY;
-                ids[CT_IDBLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = -1;
-            }
         }
         int oom = 0, failed = 0;
         /* the stage clocks only when profiling: CLOCK_PROCESS_CPUTIME_ID is a system call, and reading it at
@@ -6889,10 +6877,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.code = code;
         pr.axis = axis_out;
         pr.skip = skip_out;
-        pr.box = box;
         pr.order = order;
-        pr.ids = ids;
-        pr.flags = flags;
         if (patches && max_pairs < 0) {
             fmask = (uint8_t *)malloc(mm);         /* NULL (out of memory): no patches, the same pairs */
             pr.fmask = fmask;
@@ -6934,8 +6919,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         int64_t star_min = star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN;
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
-            stars = (uint8_t *)malloc(mm);
-            if (cert == NULL || stars == NULL) oom = 1;
+            if (cert == NULL) oom = 1;
         }
         int32_t *pos = NULL;
         if (!oom && !failed && m >= 2 && cert != NULL && fmask != NULL) {
@@ -6948,10 +6932,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 pos = NULL;
             }
         }
+        if (!oom && !failed && m >= 2) n_nodes = ct_build_tree(nodes, m);
         if (!oom && !failed && m >= 2 && twin != NULL) {
             /* with patches: the faces across each edge by hierarchy position (ct_twins into twin, the lists
-             * kept in code's memory), the hierarchy, the patches, then the star certificates of the vertices
-             * whose faces are not all in one certified patch (the others decide no pair), then the apexes */
+             * kept in code's memory), the patches on the hierarchy's shape, then the star certificates of the
+             * vertices whose faces are not all in one certified patch (the others decide no pair) */
             int64_t *off, total;
             int32_t *vfaces;
             for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
@@ -6969,13 +6954,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
                         across[i] = -1;
                     }
                 }
-                n_nodes = ct_build(nodes, box, ids, NULL, m);
                 clk[10] = profile ? ct_clock() : 0.0;
                 patch = (uint8_t *)malloc((size_t)n_nodes);
-                if (patch == NULL || ct_patches(nodes, n_nodes, ids, fmask, across, V, m, patch) < 0) {
+                if (patch == NULL || ct_patches(nodes, n_nodes, F, fsize, order, fmask, across, V, m, patch) < 0) {
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
+                free(twin);
+                twin = NULL;
                 clk[7] = profile ? ct_clock() : 0.0;
                 int32_t *label = pos;                  /* pos is done with: each face's certified patch */
                 if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
@@ -6984,18 +6970,43 @@ accel_contact_scan(PyObject *self, PyObject *args)
                     oom = 1;
                 }
                 clk[11] = profile ? ct_clock() : 0.0;
-                ct_set_apex(nodes, n_nodes, ids, cert, m);
             }
         }
         else if (!oom && !failed && m >= 2) {
             if (cert != NULL && ct_stars(V, n, F, fsize, m, star_min, star_faces, cert, nt, code) < 0) {
                 oom = 1;
             }
-            n_nodes = ct_build(nodes, box, ids, cert, m);
         }
         free(pos);
         free(twin);
         twin = NULL;
+        /* the sort's words and the stars' lists, the twins and the positions are given back before the boxes
+         * and corner indices are written: the check's high point is then the traversal's arrays alone */
+        ct_free(code, code_bytes);
+        code = NULL;
+        code_bytes = 0;
+        if (!oom && !failed && m >= 2) {
+            box = (float *)ct_alloc(box_bytes);
+            ids = (int32_t *)ct_alloc(ids_bytes);
+            flags = (uint8_t *)malloc(mm);
+            stars = cert != NULL ? (uint8_t *)malloc(mm) : NULL;
+            if (box == NULL || ids == NULL || flags == NULL || (cert != NULL && stars == NULL)) oom = 1;
+        }
+        if (!oom && !failed && m >= 2) {
+            for (size_t i = (size_t)m; i < n_blocks * CT_LEAF; i++) {     /* the last block's empty boxes */
+                for (int c = 0; c < 3; c++) {
+                    box[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = INFINITY;
+                    box[CT_BLOCK * (i / CT_LEAF) + (3 + c) * CT_LEAF + i % CT_LEAF] = -INFINITY;
+                    ids[CT_IDBLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = -1;
+                }
+            }
+            pr.box = box;
+            pr.ids = ids;
+            pr.flags = flags;
+            pr.pass = 3;
+            run_parallel(nt, ct_prep_task, &pr);
+            ct_build_boxes(nodes, n_nodes, box, ids, cert, m);
+        }
         clk[4] = profile ? ct_clock() : 0.0;
         if (!oom && !failed && m >= 2) {
             if (cert != NULL) {
@@ -7067,14 +7078,13 @@ accel_contact_scan(PyObject *self, PyObject *args)
         Py_END_ALLOW_THREADS
         if (profile) {
             if (clk[11] > 0) {
-                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f lists %.4f twins %.4f "
-                        "build %.4f patches %.4f stars %.4f apex+bits %.4f traverse %.4f s; ",
+                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f order %.4f lists %.4f twins %.4f "
+                        "patches %.4f stars %.4f boxes+apex+bits %.4f traverse %.4f s; ",
                         (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[8] - clk[3],
-                        clk[9] - clk[8], clk[10] - clk[9], clk[7] - clk[10], clk[11] - clk[7], clk[5] - clk[11],
-                        clk[6] - clk[5]);
+                        clk[10] - clk[8], clk[7] - clk[10], clk[11] - clk[7], clk[5] - clk[11], clk[6] - clk[5]);
             }
             else {
-                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars+build %.4f "
+                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f order %.4f stars+boxes %.4f "
                         "traverse %.4f s; ", (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2],
                         clk[5] - clk[3], clk[6] - clk[5]);
             }
