@@ -5412,11 +5412,96 @@ ct_leaf_apex(const int32_t *ids, const uint8_t *cert, int64_t s, int64_t count)
     return -1;
 }
 
-/* Boxes of the faces in blocks of CT_LEAF hierarchy positions, coordinate by coordinate (structure of arrays):
- * block b holds lo x, lo y, lo z, hi x, hi y, hi z of positions CT_LEAF b .. CT_LEAF b + CT_LEAF - 1, CT_LEAF
- * floats each; positions past the last face are empty boxes (lo +inf, hi -inf) that meet nothing.  One leaf
- * of the hierarchy is one block, so a face is tested against a whole leaf's boxes at once (ct_block_mask). */
+/* Boxes of the faces in blocks of CT_LEAF hierarchy positions, coordinate by coordinate (structure of arrays),
+ * one byte per bound: block b holds lo x, lo y, lo z, hi x, hi y, hi z of positions CT_LEAF b .. CT_LEAF b +
+ * CT_LEAF - 1, CT_LEAF bytes each, on its leaf's grid (ct_grid: the leaf's float32 box cut into 254 steps per
+ * axis), rounded outward: 6 bytes a face instead of 24 for float32 boxes.  Positions past the last face hold
+ * lo 255, hi 0, and every block mask is cut to the positions that hold faces (ct_leaf_bits).  One leaf of the
+ * hierarchy is one block, so a face is tested against a whole leaf's boxes at once (ct_block_mask).
+ *
+ * Why the test stays conservative (a pair whose exact boxes meet always passes; the float64 boxes then decide,
+ * so the pairs, counts and classes are those of float32 or float64 boxes): on an axis of a leaf with finite
+ * float32 bounds L <= H the grid is T(x) = fl(fl(x - L) * inv), inv = fl(254 / fl(H - L)) (inv = 1 when
+ * H = L), a composition of correctly rounded operations with positive constants, hence monotone in x; T(L) = 0
+ * and T(H) < 255 (254 to within a few units in the last place).  A face is stored as floor(T(lo)) and
+ * ceil(T(hi)) of its exact (float64) box.  A query box [la, ha] containing another face's exact box gets
+ * ql = floor(T(la)) (0 below 0; no face of the leaf meets it when T(la) >= 255) and qh = ceil(T(ha)) (255
+ * above; none when T(ha) < 0), so exact boxes that meet, lo_b <= hi_a and lo_a <= hi_b, give by monotonicity
+ * ql <= T(la) <= T(hi_b) <= qhi_b and qlo_b <= T(lo_b) <= T(ha) <= qh.  A query from another leaf is that
+ * face's grid box mapped back (ct_grid_lo / ct_grid_hi: L + q s moved outward by a margin of 2^-48 (|L| + 256 s),
+ * far above the few rounding errors of the map there and back), or a node's float32 box; within one leaf the
+ * bytes are compared as they are.  An axis with an infinite bound (coordinates beyond float32's range, a direct
+ * call) is not cut: its bytes are 0 and 255 and every query covers them. */
 #define CT_BLOCK (6 * CT_LEAF)
+
+typedef struct {
+    double L[3], s[3], inv[3];  /* per axis: the grid's origin, step and inverse step */
+    int ok[3];                  /* 0: an infinite bound, every box of the leaf spans the axis */
+} CtGrid;
+
+static inline void
+ct_grid(const CtNode *leaf, CtGrid *g)
+{
+    for (int c = 0; c < 3; c++) {
+        double lo = leaf->lo[c], hi = leaf->hi[c];
+        g->ok[c] = isfinite(lo) && isfinite(hi);
+        double span = hi - lo;
+        g->L[c] = lo;
+        g->s[c] = g->ok[c] && span > 0 ? span / 254.0 : 1.0;
+        g->inv[c] = g->ok[c] && span > 0 ? 254.0 / span : 1.0;
+    }
+}
+
+/* The stored bytes of the exact bounds lo <= hi on axis c of grid g. */
+static inline void
+ct_grid_store(const CtGrid *g, int c, double lo, double hi, uint8_t *qlo, uint8_t *qhi)
+{
+    if (!g->ok[c]) {
+        *qlo = 0;
+        *qhi = 255;
+        return;
+    }
+    double tl = (lo - g->L[c]) * g->inv[c], th = (hi - g->L[c]) * g->inv[c];     /* 0 <= tl <= th < 255 */
+    unsigned a = tl > 0 ? (unsigned)tl : 0u;                                     /* floor */
+    unsigned b = th > 0 ? (unsigned)th : 0u;
+    if ((double)b < th) b++;                                                     /* ceil */
+    *qlo = (uint8_t)(a < 255 ? a : 255);
+    *qhi = (uint8_t)(b < 255 ? b : 255);
+}
+
+/* The query [la, ha] on axis c of grid g as bytes [*ql, *qh]; 0 when it meets no box of the leaf. */
+static inline int
+ct_grid_query(const CtGrid *g, int c, double la, double ha, unsigned *ql, unsigned *qh)
+{
+    if (!g->ok[c]) {
+        *ql = 0;
+        *qh = 255;
+        return 1;
+    }
+    double tl = (la - g->L[c]) * g->inv[c], th = (ha - g->L[c]) * g->inv[c];
+    if (!(tl < 255.0) || !(th >= 0.0)) return 0;
+    unsigned a = tl > 0 ? (unsigned)tl : 0u;
+    unsigned b = th < 255.0 ? (unsigned)th : 255u;
+    if (th < 255.0 && (double)b < th) b++;
+    *ql = a;
+    *qh = b;
+    return 1;
+}
+
+/* A stored byte mapped back outward: at most the exact bound it was stored from (lo), at least it (hi). */
+static inline double
+ct_grid_lo(const CtGrid *g, int c, unsigned q, float node_lo)
+{
+    if (!g->ok[c]) return node_lo;
+    return (g->L[c] + (double)q * g->s[c]) - 0x1p-48 * (fabs(g->L[c]) + 256.0 * g->s[c]);
+}
+
+static inline double
+ct_grid_hi(const CtGrid *g, int c, unsigned q, float node_hi)
+{
+    if (!g->ok[c]) return node_hi;
+    return (g->L[c] + (double)q * g->s[c]) + 0x1p-48 * (fabs(g->L[c]) + 256.0 * g->s[c]);
+}
 
 static inline int
 ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
@@ -5433,32 +5518,41 @@ ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
 #endif
 }
 
-/* Bit j set when box j of the block meets the box (lx, ly, lz)-(hx, hy, hz) (closed boxes). */
+/* Bit j set when box j of the block meets the query bytes ql .. qh on every axis (closed boxes). */
 static inline unsigned
-ct_block_mask(const float *blk, float lx, float ly, float lz, float hx, float hy, float hz)
+ct_block_mask(const uint8_t *blk, const unsigned *ql, const unsigned *qh)
 {
-#if defined(__SSE2__) && CT_LEAF % 4 == 0
-    unsigned mask = 0;
-    for (int half = 0; half < CT_LEAF / 4; half++) {
-        const float *b = blk + 4 * half;
-        __m128 ok = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b), _mm_set1_ps(hx)),
-                               _mm_cmple_ps(_mm_set1_ps(lx), _mm_loadu_ps(b + 3 * CT_LEAF)));
-        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + CT_LEAF), _mm_set1_ps(hy)),
-                                       _mm_cmple_ps(_mm_set1_ps(ly), _mm_loadu_ps(b + 4 * CT_LEAF))));
-        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + 2 * CT_LEAF), _mm_set1_ps(hz)),
-                                       _mm_cmple_ps(_mm_set1_ps(lz), _mm_loadu_ps(b + 5 * CT_LEAF))));
-        mask |= (unsigned)_mm_movemask_ps(ok) << (4 * half);
+#if defined(__SSE2__) && CT_LEAF == 16
+    __m128i ok = _mm_set1_epi8((char)-1);
+    for (int c = 0; c < 3; c++) {
+        __m128i lo = _mm_loadu_si128((const __m128i *)(blk + c * CT_LEAF));
+        __m128i hi = _mm_loadu_si128((const __m128i *)(blk + (3 + c) * CT_LEAF));
+        /* unsigned bytes: lo <= qh iff min(lo, qh) == lo; hi >= ql iff max(hi, ql) == hi */
+        ok = _mm_and_si128(ok, _mm_cmpeq_epi8(_mm_min_epu8(lo, _mm_set1_epi8((char)qh[c])), lo));
+        ok = _mm_and_si128(ok, _mm_cmpeq_epi8(_mm_max_epu8(hi, _mm_set1_epi8((char)ql[c])), hi));
     }
-    return mask;
+    return (unsigned)_mm_movemask_epi8(ok);
 #else
     unsigned mask = 0;
     for (int j = 0; j < CT_LEAF; j++) {
-        mask |= (unsigned)((blk[j] <= hx) & (lx <= blk[3 * CT_LEAF + j]) & (blk[CT_LEAF + j] <= hy)
-                           & (ly <= blk[4 * CT_LEAF + j]) & (blk[2 * CT_LEAF + j] <= hz)
-                           & (lz <= blk[5 * CT_LEAF + j])) << j;
+        int meet = 1;
+        for (int c = 0; c < 3; c++) {
+            meet &= (blk[c * CT_LEAF + j] <= qh[c]) & (ql[c] <= blk[(3 + c) * CT_LEAF + j]);
+        }
+        mask |= (unsigned)meet << j;
     }
     return mask;
 #endif
+}
+
+/* The bytes of position a of a block as a query on its own leaf's grid. */
+static inline void
+ct_block_query(const uint8_t *blk, int a, unsigned *ql, unsigned *qh)
+{
+    for (int c = 0; c < 3; c++) {
+        ql[c] = blk[c * CT_LEAF + a];
+        qh[c] = blk[(3 + c) * CT_LEAF + a];
+    }
 }
 
 /* Bit j set when vertex x is a corner of the face at position j of the block ids (one CT_IDBLOCK). */
@@ -5524,39 +5618,21 @@ ct_build_tree(CtNode *nodes, int64_t m)
     return n_nodes;
 }
 
-/* The node boxes over the boxes BOX (blocks above, in hierarchy order) and the apexes from cert (NULL: none),
- * children before parents, on the tree of ct_build_tree. */
+/* The node boxes from the leaves' float32 boxes LBOX (6 floats a block: lo x, y, z, hi x, y, z, the faces'
+ * boxes rounded outward, as ct_prep_task computed them before cutting the faces' boxes to bytes on them) and
+ * the apexes from cert (NULL: none), children before parents, on the tree of ct_build_tree. */
 static void
-ct_build_boxes(CtNode *nodes, int64_t n_nodes, const float *BOX, const int32_t *ids, const uint8_t *cert, int64_t m)
+ct_build_boxes(CtNode *nodes, int64_t n_nodes, const float *LBOX, const int32_t *ids, const uint8_t *cert, int64_t m)
 {
     for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
         CtNode *nd = &nodes[k];
         if (CT_IS_LEAF(nd)) {
             int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
             nd->apex = (int32_t)ct_leaf_apex(ids, cert, start, count);
-            /* the whole block: its empty positions (lo +inf, hi -inf) change no minimum or maximum */
-            const float *blk = BOX + CT_BLOCK * CT_BLOCK_OF(nd);
+            const float *lb = LBOX + 6 * CT_BLOCK_OF(nd);
             for (int c = 0; c < 3; c++) {
-#if defined(__SSE2__) && CT_LEAF % 4 == 0
-                __m128 lo = _mm_loadu_ps(blk + c * CT_LEAF), hi = _mm_loadu_ps(blk + (3 + c) * CT_LEAF);
-                for (int q = 4; q < CT_LEAF; q += 4) {
-                    lo = _mm_min_ps(lo, _mm_loadu_ps(blk + c * CT_LEAF + q));
-                    hi = _mm_max_ps(hi, _mm_loadu_ps(blk + (3 + c) * CT_LEAF + q));
-                }
-                lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(1, 0, 3, 2)));
-                lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(2, 3, 0, 1)));
-                hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(1, 0, 3, 2)));
-                hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(2, 3, 0, 1)));
-                nd->lo[c] = _mm_cvtss_f32(lo);
-                nd->hi[c] = _mm_cvtss_f32(hi);
-#else
-                nd->lo[c] = INFINITY;
-                nd->hi[c] = -INFINITY;
-                for (int j = 0; j < CT_LEAF; j++) {
-                    if (blk[c * CT_LEAF + j] < nd->lo[c]) nd->lo[c] = blk[c * CT_LEAF + j];
-                    if (blk[(3 + c) * CT_LEAF + j] > nd->hi[c]) nd->hi[c] = blk[(3 + c) * CT_LEAF + j];
-                }
-#endif
+                nd->lo[c] = lb[c];
+                nd->hi[c] = lb[3 + c];
             }
         }
         else {
@@ -6291,7 +6367,7 @@ ct_patch_labels(const CtNode *nodes, const uint8_t *patch, const int32_t *order,
 }
 
 typedef struct {
-    const float *BOX;           /* face boxes rounded outward to float32, in blocks of CT_LEAF (ct_block_mask) */
+    const uint8_t *BOX;         /* face boxes as bytes on their leaf's grid, in blocks of CT_LEAF (ct_block_mask) */
     const int32_t *order;       /* the caller's face index of each hierarchy position */
     const int32_t *ids;         /* corner indices in hierarchy order, in blocks of CT_LEAF (ct_id) */
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
@@ -6489,10 +6565,11 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 int pcount = ct_leaf_count(p, sc->m);
                 CtFace leaf[CT_LEAF];
                 uint8_t have[CT_LEAF] = {0};
-                const float *blk = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+                const uint8_t *blk = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
                 for (int a = 0; a + 1 < pcount; a++) {
-                    unsigned mask = ct_block_mask(blk, blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a],
-                                                  blk[3 * CT_LEAF + a], blk[4 * CT_LEAF + a], blk[5 * CT_LEAF + a]);
+                    unsigned ql[3], qh[3];          /* one grid: the bytes compare as they are */
+                    ct_block_query(blk, a, ql, qh);
+                    unsigned mask = ct_block_mask(blk, ql, qh);
                     mask &= ~((2u << a) - 1) & ct_leaf_bits(pcount);     /* the later faces j > i only */
                     if (mask && ct_visit_block(sc, pstart + a, pstart, mask, &leaf[a], &have[a], leaf, have)) {
                         goto out;
@@ -6513,17 +6590,28 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             int64_t pstart = CT_LEAF * CT_BLOCK_OF(p), qstart = CT_LEAF * CT_BLOCK_OF(q);
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
-            const float *pb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
-            const float *qb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(q);
-            /* p's faces against q's box first, then each that meets it against q's faces */
-            unsigned pmask = ct_block_mask(pb, q->lo[0], q->lo[1], q->lo[2], q->hi[0], q->hi[1], q->hi[2])
-                             & ct_leaf_bits(ct_leaf_count(p, sc->m));
+            const uint8_t *pb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+            const uint8_t *qb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(q);
+            CtGrid gp, gq;
+            ct_grid(p, &gp);
+            ct_grid(q, &gq);
+            /* p's faces against q's box first (on p's grid), then each that meets it against q's faces (its
+             * bytes mapped back outward, then onto q's grid) */
+            unsigned ql[3] = {0, 0, 0}, qh[3] = {0, 0, 0};
+            int meets = 1;
+            for (int c = 0; c < 3; c++) meets &= ct_grid_query(&gp, c, q->lo[c], q->hi[c], &ql[c], &qh[c]);
+            unsigned pmask = meets ? ct_block_mask(pb, ql, qh) & ct_leaf_bits(ct_leaf_count(p, sc->m)) : 0u;
             unsigned qbits = ct_leaf_bits(ct_leaf_count(q, sc->m));
             while (pmask) {
                 int a = ct_ctz(pmask);
                 pmask &= pmask - 1;
-                unsigned mask = ct_block_mask(qb, pb[a], pb[CT_LEAF + a], pb[2 * CT_LEAF + a], pb[3 * CT_LEAF + a],
-                                              pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]) & qbits;
+                meets = 1;
+                for (int c = 0; c < 3; c++) {
+                    double la = ct_grid_lo(&gp, c, pb[c * CT_LEAF + a], p->lo[c]);
+                    double ha = ct_grid_hi(&gp, c, pb[(3 + c) * CT_LEAF + a], p->hi[c]);
+                    meets &= ct_grid_query(&gq, c, la, ha, &ql[c], &qh[c]);
+                }
+                unsigned mask = meets ? ct_block_mask(qb, ql, qh) & qbits : 0u;
                 CtFace FI;
                 uint8_t have_i = 0;
                 if (mask && ct_visit_block(sc, pstart + a, qstart, mask, &FI, &have_i, leaf, have)) goto out;
@@ -6661,7 +6749,8 @@ typedef struct {
     double gmin[3], scale[3];
     int8_t *axis;
     uint8_t *skip;
-    float *box;
+    uint8_t *box;               /* the faces' boxes as bytes on their leaf's grid, in blocks (pass 3) */
+    float *lbox;                /* each leaf's float32 box (pass 3; ct_build_boxes) */
     int32_t *order;
     int32_t *ids;
     uint8_t *flags;
@@ -6744,29 +6833,64 @@ ct_prep_task(void *ctx, int t, int nt)
         }
         return;
     }
-    for (int64_t i = s; i < e; i++) {          /* pass 3, after pass 2's unpacking: by hierarchy position */
-        /* the faces are read in hierarchy order, i.e. at random in the caller's: their rows are fetched
-         * CT_AHEAD positions ahead, their corners CT_AHEAD / 2 ahead (from the rows fetched by then) */
-        if (i + CT_AHEAD < e) {
-            ct_prefetch((const char *)pr->F + (size_t)pr->size * 3 * (size_t)pr->order[i + CT_AHEAD]);
+    /* pass 3, after pass 2's unpacking: by whole blocks of hierarchy positions (a block's bytes need its
+     * leaf's box, i.e. all its faces' boxes first) */
+    int64_t n_blocks = (pr->m + CT_LEAF - 1) / CT_LEAF;
+    int64_t b0 = (int64_t)part_start((size_t)n_blocks, t, nt), b1 = (int64_t)part_start((size_t)n_blocks, t + 1, nt);
+    e = b1 * CT_LEAF < pr->m ? b1 * CT_LEAF : pr->m;
+    for (int64_t blk_i = b0; blk_i < b1; blk_i++) {
+        double lo[CT_LEAF][3], hi[CT_LEAF][3];
+        CtNode leaf;
+        int64_t start = blk_i * CT_LEAF, count = pr->m - start < CT_LEAF ? pr->m - start : CT_LEAF;
+        uint8_t *blk = pr->box + CT_BLOCK * blk_i;
+        for (int c = 0; c < 3; c++) {
+            leaf.lo[c] = INFINITY;
+            leaf.hi[c] = -INFINITY;
         }
-        if (i + CT_AHEAD / 2 < e) {
-            size_t g = 3 * (size_t)pr->order[i + CT_AHEAD / 2];
-            for (int k = 0; k < 3; k++) ct_prefetch(pr->V + 3 * index_at(pr->F, pr->size, g + (size_t)k));
-        }
-        int64_t f = pr->order[i];
-        const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
-        const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
-        const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
-        pr->flags[i] = (uint8_t)((unsigned)pr->axis[f] | (unsigned)pr->skip[f] << 2);
-        for (int k = 0; k < 3; k++) {
-            pr->ids[CT_IDBLOCK * (i / CT_LEAF) + k * CT_LEAF + i % CT_LEAF]
-                = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
+        for (int64_t j = 0; j < count; j++) {
+            int64_t i = start + j;
+            /* the faces are read in hierarchy order, i.e. at random in the caller's: their rows are fetched
+             * CT_AHEAD positions ahead, their corners CT_AHEAD / 2 ahead (from the rows fetched by then) */
+            if (i + CT_AHEAD < e) {
+                ct_prefetch((const char *)pr->F + (size_t)pr->size * 3 * (size_t)pr->order[i + CT_AHEAD]);
+            }
+            if (i + CT_AHEAD / 2 < e) {
+                size_t g = 3 * (size_t)pr->order[i + CT_AHEAD / 2];
+                for (int k = 0; k < 3; k++) ct_prefetch(pr->V + 3 * index_at(pr->F, pr->size, g + (size_t)k));
+            }
+            int64_t f = pr->order[i];
+            const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
+            const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
+            const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
+            pr->flags[i] = (uint8_t)((unsigned)pr->axis[f] | (unsigned)pr->skip[f] << 2);
+            for (int k = 0; k < 3; k++) {
+                pr->ids[CT_IDBLOCK * blk_i + k * CT_LEAF + j] = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
+            }
+            for (int c = 0; c < 3; c++) {
+                lo[j][c] = ct_min3(p0[c], p1[c], p2[c]);
+                hi[j][c] = ct_max3(p0[c], p1[c], p2[c]);
+                float l32 = ct_f32_down(lo[j][c]), h32 = ct_f32_up(hi[j][c]);
+                if (l32 < leaf.lo[c]) leaf.lo[c] = l32;
+                if (h32 > leaf.hi[c]) leaf.hi[c] = h32;
+            }
         }
         for (int c = 0; c < 3; c++) {
-            float *blk = pr->box + CT_BLOCK * (i / CT_LEAF);
-            blk[c * CT_LEAF + i % CT_LEAF] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
-            blk[(3 + c) * CT_LEAF + i % CT_LEAF] = ct_f32_up(ct_max3(p0[c], p1[c], p2[c]));
+            pr->lbox[6 * blk_i + c] = leaf.lo[c];
+            pr->lbox[6 * blk_i + 3 + c] = leaf.hi[c];
+        }
+        CtGrid grid;
+        ct_grid(&leaf, &grid);
+        for (int64_t j = 0; j < CT_LEAF; j++) {
+            for (int c = 0; c < 3; c++) {
+                if (j < count) {
+                    ct_grid_store(&grid, c, lo[j][c], hi[j][c], &blk[c * CT_LEAF + j], &blk[(3 + c) * CT_LEAF + j]);
+                }
+                else {                                  /* past the last face: no box, no vertex */
+                    blk[c * CT_LEAF + j] = 255;
+                    blk[(3 + c) * CT_LEAF + j] = 0;
+                    pr->ids[CT_IDBLOCK * blk_i + c * CT_LEAF + j] = -1;
+                }
+            }
         }
     }
 }
@@ -6790,10 +6914,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
     PyObject *result = NULL;
     CtNode *nodes = NULL;
     uint64_t *code = NULL;
-    float *box = NULL;
+    uint8_t *box = NULL;
+    float *lbox = NULL;
     int32_t *order = NULL;
     int32_t *ids = NULL;
-    size_t nodes_bytes = 0, code_bytes = 0, box_bytes = 0, order_bytes = 0, ids_bytes = 0;
+    size_t nodes_bytes = 0, code_bytes = 0, box_bytes = 0, lbox_bytes = 0, order_bytes = 0, ids_bytes = 0;
     uint8_t *flags = NULL;
     int8_t *axis_out = NULL;
     uint8_t *skip_out = NULL;
@@ -6848,7 +6973,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
          * indices are mapped only once it is given back (below) */
         code_bytes = 2 * mm * sizeof(uint64_t);
         if (ct_stars_scratch(n, m) > code_bytes) code_bytes = ct_stars_scratch(n, m);
-        box_bytes = n_blocks * CT_BLOCK * sizeof(float);
+        box_bytes = n_blocks * CT_BLOCK;                       /* one byte per bound */
+        lbox_bytes = n_blocks * 6 * sizeof(float);
         order_bytes = mm * sizeof(int32_t);
         ids_bytes = n_blocks * CT_IDBLOCK * sizeof(int32_t);
         nodes = (CtNode *)ct_alloc(nodes_bytes);
@@ -6986,26 +7112,25 @@ accel_contact_scan(PyObject *self, PyObject *args)
         code = NULL;
         code_bytes = 0;
         if (!oom && !failed && m >= 2) {
-            box = (float *)ct_alloc(box_bytes);
+            box = (uint8_t *)ct_alloc(box_bytes);
+            lbox = (float *)ct_alloc(lbox_bytes);
             ids = (int32_t *)ct_alloc(ids_bytes);
             flags = (uint8_t *)malloc(mm);
             stars = cert != NULL ? (uint8_t *)malloc(mm) : NULL;
-            if (box == NULL || ids == NULL || flags == NULL || (cert != NULL && stars == NULL)) oom = 1;
+            if (box == NULL || lbox == NULL || ids == NULL || flags == NULL || (cert != NULL && stars == NULL)) {
+                oom = 1;
+            }
         }
         if (!oom && !failed && m >= 2) {
-            for (size_t i = (size_t)m; i < n_blocks * CT_LEAF; i++) {     /* the last block's empty boxes */
-                for (int c = 0; c < 3; c++) {
-                    box[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = INFINITY;
-                    box[CT_BLOCK * (i / CT_LEAF) + (3 + c) * CT_LEAF + i % CT_LEAF] = -INFINITY;
-                    ids[CT_IDBLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = -1;
-                }
-            }
             pr.box = box;
+            pr.lbox = lbox;
             pr.ids = ids;
             pr.flags = flags;
             pr.pass = 3;
-            run_parallel(nt, ct_prep_task, &pr);
-            ct_build_boxes(nodes, n_nodes, box, ids, cert, m);
+            run_parallel(thread_count(threads, (size_t)n_blocks, 20000 / CT_LEAF), ct_prep_task, &pr);
+            ct_build_boxes(nodes, n_nodes, lbox, ids, cert, m);
+            ct_free(lbox, lbox_bytes);         /* the leaves' boxes are in the nodes now */
+            lbox = NULL;
         }
         clk[4] = profile ? ct_clock() : 0.0;
         if (!oom && !failed && m >= 2) {
@@ -7122,6 +7247,7 @@ done:
     ct_free(nodes, nodes_bytes);
     ct_free(code, code_bytes);
     ct_free(box, box_bytes);
+    ct_free(lbox, lbox_bytes);
     ct_free(order, order_bytes);
     ct_free(ids, ids_bytes);
     free(flags);
