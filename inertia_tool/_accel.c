@@ -5322,16 +5322,39 @@ static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_
 
 /* The faces of each vertex of at least list_min faces (in scratch, ct_stars_scratch(n, m) bytes, any content):
  * *off (n int64: the start of each kept vertex's range of faces, -1 for the others) and *faces (the faces of
- * each kept vertex, vertex after vertex, *total of them; a face holding v twice is listed twice). */
+ * each kept vertex, vertex after vertex, *total of them; a face holding v twice is listed twice).  With label
+ * (per face, its certified patch or 0) a vertex whose faces all lie in one certified patch is not kept either
+ * (ct_star_certs would not try it): on a smooth surface that is nearly every vertex, so the lists of the star
+ * certificates take a few bytes a face instead of 16 when they are made after the patches. */
 static void
-ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, void *scratch, int64_t **off_out,
-              int32_t **faces_out, int64_t *total_out)
+ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, const int32_t *label, void *scratch,
+              int64_t **off_out, int32_t **faces_out, int64_t *total_out)
 {
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
     int64_t *off = (int64_t *)scratch;
     int32_t *faces = (int32_t *)((char *)scratch + off_bytes);
     memset(off, 0, off_bytes);
-    for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
+    if (label == NULL) {
+        for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
+    }
+    else {
+        /* per vertex, the count of its corners (low 33 bits: at most 3 m < 2^33) and above it its faces' common
+         * label, 0 once two differ (0 is also "in no patch": either way the vertex is tried) */
+        uint64_t *word = (uint64_t *)off;
+        for (int64_t f = 0; f < m; f++) {
+            uint64_t l = (uint64_t)(uint32_t)label[f];
+            for (int c = 0; c < 3; c++) {
+                uint64_t *x = &word[index_at(F, fsize, 3 * (size_t)f + (size_t)c)];
+                uint64_t count = *x & ((1ULL << 33) - 1), common = *x >> 33;
+                if (count == 0) common = l;
+                else if (common != l) common = 0;
+                *x = common << 33 | (count + 1);
+            }
+        }
+        for (int64_t v = 0; v < n; v++) {
+            off[v] = word[v] >> 33 != 0 ? 0 : (int64_t)(word[v] & ((1ULL << 33) - 1));
+        }
+    }
     int64_t total = 0;
     for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
         if (off[v] >= list_min) {
@@ -5391,7 +5414,7 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
 {
     int64_t *off, total;
     int32_t *faces;
-    ct_star_lists(n, F, fsize, m, min_faces, scratch, &off, &faces, &total);
+    ct_star_lists(n, F, fsize, m, min_faces, NULL, scratch, &off, &faces, &total);
     return ct_star_certs(V, n, F, fsize, off, faces, total, min_faces, big_faces, cert, threads, NULL);
 }
 
@@ -7058,19 +7081,22 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 pos = NULL;
             }
         }
-        if (!oom && !failed && m >= 2) n_nodes = ct_build_tree(nodes, m);
         if (!oom && !failed && m >= 2 && twin != NULL) {
-            /* with patches: the faces across each edge by hierarchy position (ct_twins into twin, the lists
-             * kept in code's memory), the patches on the hierarchy's shape, then the star certificates of the
-             * vertices whose faces are not all in one certified patch (the others decide no pair) */
+            /* with patches: the faces across each edge by hierarchy position (ct_twins into twin, from every
+             * vertex's faces listed in code's memory, then given back), the patches on the hierarchy's shape,
+             * the twins given back, then the star certificates of the vertices whose faces are not all in one
+             * certified patch (the others decide no pair), from their lists alone */
             int64_t *off, total;
             int32_t *vfaces;
             for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
-            ct_star_lists(n, F, fsize, m, 1, code, &off, &vfaces, &total);
+            ct_star_lists(n, F, fsize, m, 1, NULL, code, &off, &vfaces, &total);
             clk[8] = profile ? ct_clock() : 0.0;
             if (ct_twins(F, fsize, n, m, off, vfaces, total, pos, twin, nt) < 0) {
                 oom = 1;
             }
+            ct_free(code, code_bytes);
+            code = NULL;
+            code_bytes = 0;
             clk[9] = profile ? ct_clock() : 0.0;
             if (!oom) {
                 int32_t *across = twin;
@@ -7080,6 +7106,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
                         across[i] = -1;
                     }
                 }
+                n_nodes = ct_build_tree(nodes, m);
                 clk[10] = profile ? ct_clock() : 0.0;
                 patch = (uint8_t *)malloc((size_t)n_nodes);
                 if (patch == NULL || ct_patches(nodes, n_nodes, F, fsize, order, fmask, across, V, m, patch) < 0) {
@@ -7091,9 +7118,19 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 clk[7] = profile ? ct_clock() : 0.0;
                 int32_t *label = pos;                  /* pos is done with: each face's certified patch */
                 if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
-                if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
-                                  patch != NULL ? label : NULL) < 0) {
+                size_t lists_bytes = ct_stars_scratch(n, m);
+                void *lists = ct_alloc(lists_bytes);   /* only the kept vertices' part of it is written */
+                if (lists == NULL) {
                     oom = 1;
+                }
+                else {
+                    ct_star_lists(n, F, fsize, m, star_min, patch != NULL ? label : NULL, lists, &off, &vfaces,
+                                  &total);
+                    if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
+                                      patch != NULL ? label : NULL) < 0) {
+                        oom = 1;
+                    }
+                    ct_free(lists, lists_bytes);
                 }
                 clk[11] = profile ? ct_clock() : 0.0;
             }
@@ -7102,6 +7139,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             if (cert != NULL && ct_stars(V, n, F, fsize, m, star_min, star_faces, cert, nt, code) < 0) {
                 oom = 1;
             }
+            n_nodes = ct_build_tree(nodes, m);
         }
         free(pos);
         free(twin);
