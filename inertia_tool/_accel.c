@@ -5318,17 +5318,19 @@ ct_stars_scratch(int64_t n, int64_t m)
 }
 
 static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces,
-                    int64_t total, const int32_t *pos, int32_t *twin, int threads);
+                    int64_t total, const int32_t *order, int32_t *twin, int threads);
 
 /* The faces of each vertex of at least list_min faces (in scratch, ct_stars_scratch(n, m) bytes, any content):
  * *off (n int64: the start of each kept vertex's range of faces, -1 for the others) and *faces (the faces of
  * each kept vertex, vertex after vertex, *total of them; a face holding v twice is listed twice).  With label
  * (per face, its certified patch or 0) a vertex whose faces all lie in one certified patch is not kept either
  * (ct_star_certs would not try it): on a smooth surface that is nearly every vertex, so the lists of the star
- * certificates take a few bytes a face instead of 16 when they are made after the patches. */
+ * certificates take a few bytes a face instead of 16 when they are made after the patches.  With order (the
+ * face at each hierarchy position) the lists hold positions instead of faces (ct_twins then needs no map from
+ * faces to positions: 4 bytes a face less at the check's high point). */
 static void
-ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, const int32_t *label, void *scratch,
-              int64_t **off_out, int32_t **faces_out, int64_t *total_out)
+ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, const int32_t *label,
+              const int32_t *order, void *scratch, int64_t **off_out, int32_t **faces_out, int64_t *total_out)
 {
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
     int64_t *off = (int64_t *)scratch;
@@ -5365,11 +5367,12 @@ ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, 
             off[v] = -1;
         }
     }
-    for (int64_t f = 0; f < m; f++) {
+    for (int64_t i = 0; i < m; i++) {
+        int64_t f = order != NULL ? order[i] : i;
         for (int c = 0; c < 3; c++) {
             int64_t v = index_at(F, fsize, 3 * (size_t)f + (size_t)c);
             if (off[v] < 0) continue;
-            faces[--off[v]] = (int32_t)f;           /* a face holding v twice is listed twice (then rejected) */
+            faces[--off[v]] = (int32_t)i;           /* a face holding v twice is listed twice (then rejected) */
         }
     }
     *off_out = off;
@@ -5414,7 +5417,7 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
 {
     int64_t *off, total;
     int32_t *faces;
-    ct_star_lists(n, F, fsize, m, min_faces, NULL, scratch, &off, &faces, &total);
+    ct_star_lists(n, F, fsize, m, min_faces, NULL, NULL, scratch, &off, &faces, &total);
     return ct_star_certs(V, n, F, fsize, off, faces, total, min_faces, big_faces, cert, threads, NULL);
 }
 
@@ -5730,7 +5733,8 @@ typedef struct {
     const int64_t *off;
     const int32_t *faces;
     int64_t n, total;
-    const int32_t *pos;         /* NULL, or each face's hierarchy position: twin is then indexed and valued by it */
+    const int32_t *order;       /* NULL, or the face at each hierarchy position: the lists then hold positions,
+                                 * and twin is indexed and valued by them */
     int32_t *twin;
     int oom[MAX_THREADS];
 } CtTwinJob;
@@ -5746,16 +5750,11 @@ ct_link_prev_cmp(const void *x, const void *y)
     return (a->prev > b->prev) - (a->prev < b->prev);
 }
 
-/* twin of face f across the edge from its corner c: by face, or by hierarchy position when jb->pos is given */
+/* twin of listed face f (a face, or a hierarchy position with jb->order) across the edge from its corner c */
 static inline void
 ct_twin_put(CtTwinJob *jb, int32_t f, int c, int32_t tw)
 {
-    if (jb->pos != NULL) {
-        jb->twin[3 * (size_t)jb->pos[f] + (size_t)c] = tw >= 0 ? jb->pos[tw] : tw;
-    }
-    else {
-        jb->twin[3 * (size_t)f + (size_t)c] = tw;
-    }
+    jb->twin[3 * (size_t)f + (size_t)c] = tw;
 }
 
 static void
@@ -5778,8 +5777,9 @@ ct_twin_task(void *ctx, int t, int nt)
         int ok = 1;
         for (int64_t i = 0; i < k; i++) {
             int32_t f = jb->faces[s + i];
+            size_t row = 3 * (size_t)(jb->order != NULL ? jb->order[f] : f);
             int64_t x[3];
-            for (int c = 0; c < 3; c++) x[c] = index_at(jb->F, jb->fsize, 3 * (size_t)f + (size_t)c);
+            for (int c = 0; c < 3; c++) x[c] = index_at(jb->F, jb->fsize, row + (size_t)c);
             int c = x[0] == v ? 0 : x[1] == v ? 1 : 2;
             if ((x[0] == v) + (x[1] == v) + (x[2] == v) != 1) ok = 0;      /* v twice in f: no twins here */
             lk[i].next = (int32_t)x[(c + 1) % 3];
@@ -6244,7 +6244,7 @@ done:
 /* ct_twin_task over the vertices on threads; 0, or -1 when out of memory. */
 static int
 ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces, int64_t total,
-         const int32_t *pos, int32_t *twin, int threads)
+         const int32_t *order, int32_t *twin, int threads)
 {
     for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
     CtTwinJob jb;
@@ -6255,7 +6255,7 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, con
     jb.faces = faces;
     jb.n = n;
     jb.total = total;
-    jb.pos = pos;
+    jb.order = order;
     jb.twin = twin;
     run_parallel(thread_count(threads, (size_t)n, 20000), ct_twin_task, &jb);
     for (int t = 0; t < MAX_THREADS; t++) {
@@ -7070,16 +7070,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
             cert = (uint8_t *)malloc((size_t)n);
             if (cert == NULL) oom = 1;
         }
-        int32_t *pos = NULL;
+        int32_t *labels = NULL;              /* per face, its certified patch (ct_patch_labels) */
         if (!oom && !failed && m >= 2 && cert != NULL && fmask != NULL) {
             twin = (int32_t *)malloc(3 * mm * sizeof(int32_t));    /* NULL: no patches, the same pairs */
-            pos = (int32_t *)malloc(mm * sizeof(int32_t));
-            if (twin == NULL || pos == NULL) {
-                free(twin);
-                free(pos);
-                twin = NULL;
-                pos = NULL;
-            }
         }
         if (!oom && !failed && m >= 2 && twin != NULL) {
             /* with patches: the faces across each edge by hierarchy position (ct_twins into twin, from every
@@ -7088,10 +7081,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
              * certified patch (the others decide no pair), from their lists alone */
             int64_t *off, total;
             int32_t *vfaces;
-            for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
-            ct_star_lists(n, F, fsize, m, 1, NULL, code, &off, &vfaces, &total);
+            ct_star_lists(n, F, fsize, m, 1, NULL, order, code, &off, &vfaces, &total);
             clk[8] = profile ? ct_clock() : 0.0;
-            if (ct_twins(F, fsize, n, m, off, vfaces, total, pos, twin, nt) < 0) {
+            if (ct_twins(F, fsize, n, m, off, vfaces, total, order, twin, nt) < 0) {
                 oom = 1;
             }
             ct_free(code, code_bytes);
@@ -7116,16 +7108,26 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 free(twin);
                 twin = NULL;
                 clk[7] = profile ? ct_clock() : 0.0;
-                int32_t *label = pos;                  /* pos is done with: each face's certified patch */
-                if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
+                int32_t *label = NULL;                 /* each face's certified patch */
+                if (patch != NULL) {
+                    labels = (int32_t *)malloc(mm * sizeof(int32_t));
+                    label = labels;
+                    if (label == NULL) {
+                        free(patch);               /* out of memory: the scan without patches, the same pairs */
+                        patch = NULL;
+                    }
+                    else {
+                        ct_patch_labels(nodes, patch, order, m, label);
+                    }
+                }
                 size_t lists_bytes = ct_stars_scratch(n, m);
                 void *lists = ct_alloc(lists_bytes);   /* only the kept vertices' part of it is written */
                 if (lists == NULL) {
                     oom = 1;
                 }
                 else {
-                    ct_star_lists(n, F, fsize, m, star_min, patch != NULL ? label : NULL, lists, &off, &vfaces,
-                                  &total);
+                    ct_star_lists(n, F, fsize, m, star_min, patch != NULL ? label : NULL, NULL, lists, &off,
+                                  &vfaces, &total);
                     if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
                                       patch != NULL ? label : NULL) < 0) {
                         oom = 1;
@@ -7141,7 +7143,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
             n_nodes = ct_build_tree(nodes, m);
         }
-        free(pos);
+        free(labels);
         free(twin);
         twin = NULL;
         /* the sort's words and the stars' lists, the twins and the positions are given back before the boxes
