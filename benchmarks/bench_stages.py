@@ -1,7 +1,8 @@
 """Stage benchmark: where the time of the validated analysis of a large binary STL goes, in ns per corner,
 against ``numpy.fromfile`` of the same file, in one process with a warm page cache (issue 25).
 
-For each mesh (a 1M-face torus, the 5.24M-face icosphere of ``bench_engine.py``, a 10M-face torus; written
+For each mesh (a 1M-face torus, the 1.1M-face CAD part of ``bench_intersect.py --shape wheel``, the 5.24M-face
+icosphere of ``bench_engine.py``, a 10M-face torus; written
 into ``$INERTIA_TOOL_BENCH_OUT``, else ``benchmarks/out/``, when missing; not committed) it times, ``--repeat``
 times each:
 
@@ -31,7 +32,7 @@ The package measured is the one ``import inertia_tool`` finds (``PYTHONPATH``, e
 repository holding this script only when neither has it), printed first; the child imports the same one.
 The machine is shared: wall times are noisy, so compare ratios within one run, and note the load (printed).
 
-    python benchmarks/bench_stages.py [--sizes 1m 5m 10m] [--repeat 5] [--json out.json]
+    python benchmarks/bench_stages.py [--sizes 1m cad 5m 10m] [--repeat 5] [--json out.json]
 """
 
 from __future__ import annotations
@@ -106,8 +107,23 @@ def icosphere(subdivisions: int) -> str:
     return path
 
 
+def cad_part() -> str:
+    """The CAD part of ``bench_intersect.py --shape wheel`` (``meshes/unbalanced_wheel.stl`` midpoint-subdivided
+    to 1,108,992 faces: flat faces, fan caps, slivers), float32 corners, written once."""
+    path = os.path.join(OUT, "wheel_1108992.stl")
+    if os.path.exists(path):
+        return path
+    sys.path.insert(0, HERE)            # _shapes (benchmarks/ is not a package)
+    from _shapes import wheel
+    os.makedirs(OUT, exist_ok=True)
+    v, f = wheel(1e6)
+    _write_stl(path, v.astype(np.float32)[f])
+    return path
+
+
 SIZES: dict[str, Callable[[], str]] = {
     "1m": lambda: torus(1000, 500),          # 1,000,000 faces
+    "cad": cad_part,                         # 1,108,992 faces
     "5m": lambda: icosphere(9),              # 5,242,880 faces
     "10m": lambda: torus(3162, 1581),        # 9,998,244 faces
 }

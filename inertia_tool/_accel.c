@@ -5281,20 +5281,45 @@ ct_stars_scratch(int64_t n, int64_t m)
 }
 
 static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces,
-                    int64_t total, const int32_t *pos, int32_t *twin, int threads);
+                    int64_t total, const int32_t *order, int32_t *twin, int threads);
 
 /* The faces of each vertex of at least list_min faces (in scratch, ct_stars_scratch(n, m) bytes, any content):
  * *off (n int64: the start of each kept vertex's range of faces, -1 for the others) and *faces (the faces of
- * each kept vertex, vertex after vertex, *total of them; a face holding v twice is listed twice). */
+ * each kept vertex, vertex after vertex, *total of them; a face holding v twice is listed twice).  With label
+ * (per face, its certified patch or 0) a vertex whose faces all lie in one certified patch is not kept either
+ * (ct_star_certs would not try it): on a smooth surface that is nearly every vertex, so the lists of the star
+ * certificates take a few bytes a face instead of 16 when they are made after the patches.  With order (the
+ * face at each hierarchy position) the lists hold positions instead of faces (ct_twins then needs no map from
+ * faces to positions: 4 bytes a face less at the check's high point). */
 static void
-ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, void *scratch, int64_t **off_out,
-              int32_t **faces_out, int64_t *total_out)
+ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, const int32_t *label,
+              const int32_t *order, void *scratch, int64_t **off_out, int32_t **faces_out, int64_t *total_out)
 {
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
     int64_t *off = (int64_t *)scratch;
     int32_t *faces = (int32_t *)((char *)scratch + off_bytes);
     memset(off, 0, off_bytes);
-    for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
+    if (label == NULL) {
+        for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
+    }
+    else {
+        /* per vertex, the count of its corners (low 33 bits: at most 3 m < 2^33) and above it its faces' common
+         * label, 0 once two differ (0 is also "in no patch": either way the vertex is tried) */
+        uint64_t *word = (uint64_t *)off;
+        for (int64_t f = 0; f < m; f++) {
+            uint64_t l = (uint64_t)(uint32_t)label[f];
+            for (int c = 0; c < 3; c++) {
+                uint64_t *x = &word[index_at(F, fsize, 3 * (size_t)f + (size_t)c)];
+                uint64_t count = *x & ((1ULL << 33) - 1), common = *x >> 33;
+                if (count == 0) common = l;
+                else if (common != l) common = 0;
+                *x = common << 33 | (count + 1);
+            }
+        }
+        for (int64_t v = 0; v < n; v++) {
+            off[v] = word[v] >> 33 != 0 ? 0 : (int64_t)(word[v] & ((1ULL << 33) - 1));
+        }
+    }
     int64_t total = 0;
     for (int64_t v = 0; v < n; v++) {                      /* end of each kept star's range, -1 for the others */
         if (off[v] >= list_min) {
@@ -5305,11 +5330,12 @@ ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, 
             off[v] = -1;
         }
     }
-    for (int64_t f = 0; f < m; f++) {
+    for (int64_t i = 0; i < m; i++) {
+        int64_t f = order != NULL ? order[i] : i;
         for (int c = 0; c < 3; c++) {
             int64_t v = index_at(F, fsize, 3 * (size_t)f + (size_t)c);
             if (off[v] < 0) continue;
-            faces[--off[v]] = (int32_t)f;           /* a face holding v twice is listed twice (then rejected) */
+            faces[--off[v]] = (int32_t)i;           /* a face holding v twice is listed twice (then rejected) */
         }
     }
     *off_out = off;
@@ -5354,7 +5380,7 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
 {
     int64_t *off, total;
     int32_t *faces;
-    ct_star_lists(n, F, fsize, m, min_faces, scratch, &off, &faces, &total);
+    ct_star_lists(n, F, fsize, m, min_faces, NULL, NULL, scratch, &off, &faces, &total);
     return ct_star_certs(V, n, F, fsize, off, faces, total, min_faces, big_faces, cert, threads, NULL);
 }
 
@@ -5375,11 +5401,96 @@ ct_leaf_apex(const int32_t *ids, const uint8_t *cert, int64_t s, int64_t count)
     return -1;
 }
 
-/* Boxes of the faces in blocks of CT_LEAF hierarchy positions, coordinate by coordinate (structure of arrays):
- * block b holds lo x, lo y, lo z, hi x, hi y, hi z of positions CT_LEAF b .. CT_LEAF b + CT_LEAF - 1, CT_LEAF
- * floats each; positions past the last face are empty boxes (lo +inf, hi -inf) that meet nothing.  One leaf
- * of the hierarchy is one block, so a face is tested against a whole leaf's boxes at once (ct_block_mask). */
+/* Boxes of the faces in blocks of CT_LEAF hierarchy positions, coordinate by coordinate (structure of arrays),
+ * one byte per bound: block b holds lo x, lo y, lo z, hi x, hi y, hi z of positions CT_LEAF b .. CT_LEAF b +
+ * CT_LEAF - 1, CT_LEAF bytes each, on its leaf's grid (ct_grid: the leaf's float32 box cut into 254 steps per
+ * axis), rounded outward: 6 bytes a face instead of 24 for float32 boxes.  Positions past the last face hold
+ * lo 255, hi 0, and every block mask is cut to the positions that hold faces (ct_leaf_bits).  One leaf of the
+ * hierarchy is one block, so a face is tested against a whole leaf's boxes at once (ct_block_mask).
+ *
+ * Why the test stays conservative (a pair whose exact boxes meet always passes; the float64 boxes then decide,
+ * so the pairs, counts and classes are those of float32 or float64 boxes): on an axis of a leaf with finite
+ * float32 bounds L <= H the grid is T(x) = fl(fl(x - L) * inv), inv = fl(254 / fl(H - L)) (inv = 1 when
+ * H = L), a composition of correctly rounded operations with positive constants, hence monotone in x; T(L) = 0
+ * and T(H) < 255 (254 to within a few units in the last place).  A face is stored as floor(T(lo)) and
+ * ceil(T(hi)) of its exact (float64) box.  A query box [la, ha] containing another face's exact box gets
+ * ql = floor(T(la)) (0 below 0; no face of the leaf meets it when T(la) >= 255) and qh = ceil(T(ha)) (255
+ * above; none when T(ha) < 0), so exact boxes that meet, lo_b <= hi_a and lo_a <= hi_b, give by monotonicity
+ * ql <= T(la) <= T(hi_b) <= qhi_b and qlo_b <= T(lo_b) <= T(ha) <= qh.  A query from another leaf is that
+ * face's grid box mapped back (ct_grid_lo / ct_grid_hi: L + q s moved outward by a margin of 2^-48 (|L| + 256 s),
+ * far above the few rounding errors of the map there and back), or a node's float32 box; within one leaf the
+ * bytes are compared as they are.  An axis with an infinite bound (coordinates beyond float32's range, a direct
+ * call) is not cut: its bytes are 0 and 255 and every query covers them. */
 #define CT_BLOCK (6 * CT_LEAF)
+
+typedef struct {
+    double L[3], s[3], inv[3];  /* per axis: the grid's origin, step and inverse step */
+    int ok[3];                  /* 0: an infinite bound, every box of the leaf spans the axis */
+} CtGrid;
+
+static inline void
+ct_grid(const CtNode *leaf, CtGrid *g)
+{
+    for (int c = 0; c < 3; c++) {
+        double lo = leaf->lo[c], hi = leaf->hi[c];
+        g->ok[c] = isfinite(lo) && isfinite(hi);
+        double span = hi - lo;
+        g->L[c] = lo;
+        g->s[c] = g->ok[c] && span > 0 ? span / 254.0 : 1.0;
+        g->inv[c] = g->ok[c] && span > 0 ? 254.0 / span : 1.0;
+    }
+}
+
+/* The stored bytes of the exact bounds lo <= hi on axis c of grid g. */
+static inline void
+ct_grid_store(const CtGrid *g, int c, double lo, double hi, uint8_t *qlo, uint8_t *qhi)
+{
+    if (!g->ok[c]) {
+        *qlo = 0;
+        *qhi = 255;
+        return;
+    }
+    double tl = (lo - g->L[c]) * g->inv[c], th = (hi - g->L[c]) * g->inv[c];     /* 0 <= tl <= th < 255 */
+    unsigned a = tl > 0 ? (unsigned)tl : 0u;                                     /* floor */
+    unsigned b = th > 0 ? (unsigned)th : 0u;
+    if ((double)b < th) b++;                                                     /* ceil */
+    *qlo = (uint8_t)(a < 255 ? a : 255);
+    *qhi = (uint8_t)(b < 255 ? b : 255);
+}
+
+/* The query [la, ha] on axis c of grid g as bytes [*ql, *qh]; 0 when it meets no box of the leaf. */
+static inline int
+ct_grid_query(const CtGrid *g, int c, double la, double ha, unsigned *ql, unsigned *qh)
+{
+    if (!g->ok[c]) {
+        *ql = 0;
+        *qh = 255;
+        return 1;
+    }
+    double tl = (la - g->L[c]) * g->inv[c], th = (ha - g->L[c]) * g->inv[c];
+    if (!(tl < 255.0) || !(th >= 0.0)) return 0;
+    unsigned a = tl > 0 ? (unsigned)tl : 0u;
+    unsigned b = th < 255.0 ? (unsigned)th : 255u;
+    if (th < 255.0 && (double)b < th) b++;
+    *ql = a;
+    *qh = b;
+    return 1;
+}
+
+/* A stored byte mapped back outward: at most the exact bound it was stored from (lo), at least it (hi). */
+static inline double
+ct_grid_lo(const CtGrid *g, int c, unsigned q, float node_lo)
+{
+    if (!g->ok[c]) return node_lo;
+    return (g->L[c] + (double)q * g->s[c]) - 0x1p-48 * (fabs(g->L[c]) + 256.0 * g->s[c]);
+}
+
+static inline double
+ct_grid_hi(const CtGrid *g, int c, unsigned q, float node_hi)
+{
+    if (!g->ok[c]) return node_hi;
+    return (g->L[c] + (double)q * g->s[c]) + 0x1p-48 * (fabs(g->L[c]) + 256.0 * g->s[c]);
+}
 
 static inline int
 ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
@@ -5396,32 +5507,41 @@ ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
 #endif
 }
 
-/* Bit j set when box j of the block meets the box (lx, ly, lz)-(hx, hy, hz) (closed boxes). */
+/* Bit j set when box j of the block meets the query bytes ql .. qh on every axis (closed boxes). */
 static inline unsigned
-ct_block_mask(const float *blk, float lx, float ly, float lz, float hx, float hy, float hz)
+ct_block_mask(const uint8_t *blk, const unsigned *ql, const unsigned *qh)
 {
-#if defined(__SSE2__) && CT_LEAF % 4 == 0
-    unsigned mask = 0;
-    for (int half = 0; half < CT_LEAF / 4; half++) {
-        const float *b = blk + 4 * half;
-        __m128 ok = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b), _mm_set1_ps(hx)),
-                               _mm_cmple_ps(_mm_set1_ps(lx), _mm_loadu_ps(b + 3 * CT_LEAF)));
-        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + CT_LEAF), _mm_set1_ps(hy)),
-                                       _mm_cmple_ps(_mm_set1_ps(ly), _mm_loadu_ps(b + 4 * CT_LEAF))));
-        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + 2 * CT_LEAF), _mm_set1_ps(hz)),
-                                       _mm_cmple_ps(_mm_set1_ps(lz), _mm_loadu_ps(b + 5 * CT_LEAF))));
-        mask |= (unsigned)_mm_movemask_ps(ok) << (4 * half);
+#if defined(__SSE2__) && CT_LEAF == 16
+    __m128i ok = _mm_set1_epi8((char)-1);
+    for (int c = 0; c < 3; c++) {
+        __m128i lo = _mm_loadu_si128((const __m128i *)(blk + c * CT_LEAF));
+        __m128i hi = _mm_loadu_si128((const __m128i *)(blk + (3 + c) * CT_LEAF));
+        /* unsigned bytes: lo <= qh iff min(lo, qh) == lo; hi >= ql iff max(hi, ql) == hi */
+        ok = _mm_and_si128(ok, _mm_cmpeq_epi8(_mm_min_epu8(lo, _mm_set1_epi8((char)qh[c])), lo));
+        ok = _mm_and_si128(ok, _mm_cmpeq_epi8(_mm_max_epu8(hi, _mm_set1_epi8((char)ql[c])), hi));
     }
-    return mask;
+    return (unsigned)_mm_movemask_epi8(ok);
 #else
     unsigned mask = 0;
     for (int j = 0; j < CT_LEAF; j++) {
-        mask |= (unsigned)((blk[j] <= hx) & (lx <= blk[3 * CT_LEAF + j]) & (blk[CT_LEAF + j] <= hy)
-                           & (ly <= blk[4 * CT_LEAF + j]) & (blk[2 * CT_LEAF + j] <= hz)
-                           & (lz <= blk[5 * CT_LEAF + j])) << j;
+        int meet = 1;
+        for (int c = 0; c < 3; c++) {
+            meet &= (blk[c * CT_LEAF + j] <= qh[c]) & (ql[c] <= blk[(3 + c) * CT_LEAF + j]);
+        }
+        mask |= (unsigned)meet << j;
     }
     return mask;
 #endif
+}
+
+/* The bytes of position a of a block as a query on its own leaf's grid. */
+static inline void
+ct_block_query(const uint8_t *blk, int a, unsigned *ql, unsigned *qh)
+{
+    for (int c = 0; c < 3; c++) {
+        ql[c] = blk[c * CT_LEAF + a];
+        qh[c] = blk[(3 + c) * CT_LEAF + a];
+    }
 }
 
 /* Bit j set when vertex x is a corner of the face at position j of the block ids (one CT_IDBLOCK). */
@@ -5458,11 +5578,11 @@ ct_popcount(unsigned x)         /* bits set in x (SWAR: no library call without 
     return (int)((v * 0x01010101u) >> 24);
 }
 
-/* Builds the hierarchy over the boxes BOX (blocks above, already in hierarchy order): the tree halving block
- * ranges (a leaf is one block of at most CT_LEAF faces), node boxes from the leaves up.  Returns the node
- * count. */
+/* The hierarchy's shape: the tree halving block ranges (a leaf is one block of at most CT_LEAF faces), which
+ * depends on m alone, so it is built before any box (ct_patches needs only the ranges).  Returns the node
+ * count; boxes and apexes are set by ct_build_boxes. */
 static int64_t
-ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cert, int64_t m)
+ct_build_tree(CtNode *nodes, int64_t m)
 {
     /* top down, halving block ranges (a parent always precedes its children, which are adjacent); while
      * building, link holds a node's first block and apex its block count */
@@ -5484,35 +5604,24 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
         nodes[r].apex = (int32_t)(blocks - blocks / 2);
         nd->link = (int32_t)l;
     }
-    /* boxes and apexes, children before parents */
+    return n_nodes;
+}
+
+/* The node boxes from the leaves' float32 boxes LBOX (6 floats a block: lo x, y, z, hi x, y, z, the faces'
+ * boxes rounded outward, as ct_prep_task computed them before cutting the faces' boxes to bytes on them) and
+ * the apexes from cert (NULL: none), children before parents, on the tree of ct_build_tree. */
+static void
+ct_build_boxes(CtNode *nodes, int64_t n_nodes, const float *LBOX, const int32_t *ids, const uint8_t *cert, int64_t m)
+{
     for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
         CtNode *nd = &nodes[k];
         if (CT_IS_LEAF(nd)) {
             int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
             nd->apex = (int32_t)ct_leaf_apex(ids, cert, start, count);
-            /* the whole block: its empty positions (lo +inf, hi -inf) change no minimum or maximum */
-            const float *blk = BOX + CT_BLOCK * CT_BLOCK_OF(nd);
+            const float *lb = LBOX + 6 * CT_BLOCK_OF(nd);
             for (int c = 0; c < 3; c++) {
-#if defined(__SSE2__) && CT_LEAF % 4 == 0
-                __m128 lo = _mm_loadu_ps(blk + c * CT_LEAF), hi = _mm_loadu_ps(blk + (3 + c) * CT_LEAF);
-                for (int q = 4; q < CT_LEAF; q += 4) {
-                    lo = _mm_min_ps(lo, _mm_loadu_ps(blk + c * CT_LEAF + q));
-                    hi = _mm_max_ps(hi, _mm_loadu_ps(blk + (3 + c) * CT_LEAF + q));
-                }
-                lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(1, 0, 3, 2)));
-                lo = _mm_min_ps(lo, _mm_shuffle_ps(lo, lo, _MM_SHUFFLE(2, 3, 0, 1)));
-                hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(1, 0, 3, 2)));
-                hi = _mm_max_ps(hi, _mm_shuffle_ps(hi, hi, _MM_SHUFFLE(2, 3, 0, 1)));
-                nd->lo[c] = _mm_cvtss_f32(lo);
-                nd->hi[c] = _mm_cvtss_f32(hi);
-#else
-                nd->lo[c] = INFINITY;
-                nd->hi[c] = -INFINITY;
-                for (int j = 0; j < CT_LEAF; j++) {
-                    if (blk[c * CT_LEAF + j] < nd->lo[c]) nd->lo[c] = blk[c * CT_LEAF + j];
-                    if (blk[(3 + c) * CT_LEAF + j] > nd->hi[c]) nd->hi[c] = blk[(3 + c) * CT_LEAF + j];
-                }
-#endif
+                nd->lo[c] = lb[c];
+                nd->hi[c] = lb[3 + c];
             }
         }
         else {
@@ -5524,7 +5633,6 @@ ct_build(CtNode *nodes, const float *BOX, const int32_t *ids, const uint8_t *cer
             }
         }
     }
-    return n_nodes;
 }
 
 /* ------------------------------------------------------------------------------------------------------
@@ -5588,7 +5696,8 @@ typedef struct {
     const int64_t *off;
     const int32_t *faces;
     int64_t n, total;
-    const int32_t *pos;         /* NULL, or each face's hierarchy position: twin is then indexed and valued by it */
+    const int32_t *order;       /* NULL, or the face at each hierarchy position: the lists then hold positions,
+                                 * and twin is indexed and valued by them */
     int32_t *twin;
     int oom[MAX_THREADS];
 } CtTwinJob;
@@ -5604,16 +5713,11 @@ ct_link_prev_cmp(const void *x, const void *y)
     return (a->prev > b->prev) - (a->prev < b->prev);
 }
 
-/* twin of face f across the edge from its corner c: by face, or by hierarchy position when jb->pos is given */
+/* twin of listed face f (a face, or a hierarchy position with jb->order) across the edge from its corner c */
 static inline void
 ct_twin_put(CtTwinJob *jb, int32_t f, int c, int32_t tw)
 {
-    if (jb->pos != NULL) {
-        jb->twin[3 * (size_t)jb->pos[f] + (size_t)c] = tw >= 0 ? jb->pos[tw] : tw;
-    }
-    else {
-        jb->twin[3 * (size_t)f + (size_t)c] = tw;
-    }
+    jb->twin[3 * (size_t)f + (size_t)c] = tw;
 }
 
 static void
@@ -5636,8 +5740,9 @@ ct_twin_task(void *ctx, int t, int nt)
         int ok = 1;
         for (int64_t i = 0; i < k; i++) {
             int32_t f = jb->faces[s + i];
+            size_t row = 3 * (size_t)(jb->order != NULL ? jb->order[f] : f);
             int64_t x[3];
-            for (int c = 0; c < 3; c++) x[c] = index_at(jb->F, jb->fsize, 3 * (size_t)f + (size_t)c);
+            for (int c = 0; c < 3; c++) x[c] = index_at(jb->F, jb->fsize, row + (size_t)c);
             int c = x[0] == v ? 0 : x[1] == v ? 1 : 2;
             if ((x[0] == v) + (x[1] == v) + (x[2] == v) != 1) ok = 0;      /* v twice in f: no twins here */
             lk[i].next = (int32_t)x[(c + 1) % 3];
@@ -6102,7 +6207,7 @@ done:
 /* ct_twin_task over the vertices on threads; 0, or -1 when out of memory. */
 static int
 ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces, int64_t total,
-         const int32_t *pos, int32_t *twin, int threads)
+         const int32_t *order, int32_t *twin, int threads)
 {
     for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
     CtTwinJob jb;
@@ -6113,7 +6218,7 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, con
     jb.faces = faces;
     jb.n = n;
     jb.total = total;
-    jb.pos = pos;
+    jb.order = order;
     jb.twin = twin;
     run_parallel(thread_count(threads, (size_t)n, 20000), ct_twin_task, &jb);
     for (int t = 0; t < MAX_THREADS; t++) {
@@ -6125,10 +6230,11 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, con
 /* patch[k] <- 1 for the highest nodes certified as above (their descendants are not tried).  fmask: per
  * hierarchy position, bit 2 a + (s < 0) when the face's projection along axis a has strict orientation s (0
  * for a face in no patch); across: per position and corner, the position of the face across the edge from
- * that corner to the next, or -1 (none).  0, or -1 when out of memory. */
+ * that corner to the next, or -1 (none); the corners read from the faces F through order (the face at each
+ * position), as the hierarchy's boxes and corner indices do not exist yet.  0, or -1 when out of memory. */
 static int
-ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *fmask, const int32_t *across,
-           const double *V, int64_t m, uint8_t *patch)
+ct_patches(const CtNode *nodes, int64_t n_nodes, const void *F, int fsize, const int32_t *order, const uint8_t *fmask,
+           const int32_t *across, const double *V, int64_t m, uint8_t *patch)
 {
     CtPatchBuild pb;
     memset(&pb, 0, sizeof(pb));
@@ -6183,8 +6289,9 @@ ct_patches(const CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8
                             B++;
                             break;
                         }
-                        pairs[2 * B] = ct_id(ids, i, c);
-                        pairs[2 * B + 1] = ct_id(ids, i, (c + 1) % 3);
+                        size_t row = 3 * (size_t)order[i];
+                        pairs[2 * B] = (int32_t)index_at(F, fsize, row + (size_t)c);
+                        pairs[2 * B + 1] = (int32_t)index_at(F, fsize, row + (size_t)((c + 1) % 3));
                         B++;
                     }
                 }
@@ -6245,25 +6352,8 @@ ct_patch_labels(const CtNode *nodes, const uint8_t *patch, const int32_t *order,
     }
 }
 
-/* The apexes of a hierarchy ct_build made without certificates (every apex -1), from cert, children before
- * parents, as ct_build sets them. */
-static void
-ct_set_apex(CtNode *nodes, int64_t n_nodes, const int32_t *ids, const uint8_t *cert, int64_t m)
-{
-    for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
-        CtNode *nd = &nodes[k];
-        if (CT_IS_LEAF(nd)) {
-            nd->apex = (int32_t)ct_leaf_apex(ids, cert, CT_LEAF * CT_BLOCK_OF(nd), ct_leaf_count(nd, m));
-        }
-        else {
-            const CtNode *p = &nodes[CT_LEFT(nd)], *q = &nodes[CT_RIGHT(nd)];
-            nd->apex = p->apex == q->apex ? p->apex : -1;
-        }
-    }
-}
-
 typedef struct {
-    const float *BOX;           /* face boxes rounded outward to float32, in blocks of CT_LEAF (ct_block_mask) */
+    const uint8_t *BOX;         /* face boxes as bytes on their leaf's grid, in blocks of CT_LEAF (ct_block_mask) */
     const int32_t *order;       /* the caller's face index of each hierarchy position */
     const int32_t *ids;         /* corner indices in hierarchy order, in blocks of CT_LEAF (ct_id) */
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
@@ -6461,10 +6551,11 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 int pcount = ct_leaf_count(p, sc->m);
                 CtFace leaf[CT_LEAF];
                 uint8_t have[CT_LEAF] = {0};
-                const float *blk = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+                const uint8_t *blk = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
                 for (int a = 0; a + 1 < pcount; a++) {
-                    unsigned mask = ct_block_mask(blk, blk[a], blk[CT_LEAF + a], blk[2 * CT_LEAF + a],
-                                                  blk[3 * CT_LEAF + a], blk[4 * CT_LEAF + a], blk[5 * CT_LEAF + a]);
+                    unsigned ql[3], qh[3];          /* one grid: the bytes compare as they are */
+                    ct_block_query(blk, a, ql, qh);
+                    unsigned mask = ct_block_mask(blk, ql, qh);
                     mask &= ~((2u << a) - 1) & ct_leaf_bits(pcount);     /* the later faces j > i only */
                     if (mask && ct_visit_block(sc, pstart + a, pstart, mask, &leaf[a], &have[a], leaf, have)) {
                         goto out;
@@ -6485,17 +6576,28 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             int64_t pstart = CT_LEAF * CT_BLOCK_OF(p), qstart = CT_LEAF * CT_BLOCK_OF(q);
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
-            const float *pb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
-            const float *qb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(q);
-            /* p's faces against q's box first, then each that meets it against q's faces */
-            unsigned pmask = ct_block_mask(pb, q->lo[0], q->lo[1], q->lo[2], q->hi[0], q->hi[1], q->hi[2])
-                             & ct_leaf_bits(ct_leaf_count(p, sc->m));
+            const uint8_t *pb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+            const uint8_t *qb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(q);
+            CtGrid gp, gq;
+            ct_grid(p, &gp);
+            ct_grid(q, &gq);
+            /* p's faces against q's box first (on p's grid), then each that meets it against q's faces (its
+             * bytes mapped back outward, then onto q's grid) */
+            unsigned ql[3] = {0, 0, 0}, qh[3] = {0, 0, 0};
+            int meets = 1;
+            for (int c = 0; c < 3; c++) meets &= ct_grid_query(&gp, c, q->lo[c], q->hi[c], &ql[c], &qh[c]);
+            unsigned pmask = meets ? ct_block_mask(pb, ql, qh) & ct_leaf_bits(ct_leaf_count(p, sc->m)) : 0u;
             unsigned qbits = ct_leaf_bits(ct_leaf_count(q, sc->m));
             while (pmask) {
                 int a = ct_ctz(pmask);
                 pmask &= pmask - 1;
-                unsigned mask = ct_block_mask(qb, pb[a], pb[CT_LEAF + a], pb[2 * CT_LEAF + a], pb[3 * CT_LEAF + a],
-                                              pb[4 * CT_LEAF + a], pb[5 * CT_LEAF + a]) & qbits;
+                meets = 1;
+                for (int c = 0; c < 3; c++) {
+                    double la = ct_grid_lo(&gp, c, pb[c * CT_LEAF + a], p->lo[c]);
+                    double ha = ct_grid_hi(&gp, c, pb[(3 + c) * CT_LEAF + a], p->hi[c]);
+                    meets &= ct_grid_query(&gq, c, la, ha, &ql[c], &qh[c]);
+                }
+                unsigned mask = meets ? ct_block_mask(qb, ql, qh) & qbits : 0u;
                 CtFace FI;
                 uint8_t have_i = 0;
                 if (mask && ct_visit_block(sc, pstart + a, qstart, mask, &FI, &have_i, leaf, have)) goto out;
@@ -6619,8 +6721,10 @@ ct_prefetch(const void *p)
 }
 
 /* Per-face preparation, split over threads by position: Morton codes and each face's projection axis and
- * zero-area flag, in the caller's order (pass 0: the rows are read in sequence), then the corner indices, flags
- * and boxes in hierarchy order (pass 1). */
+ * zero-area flag, in the caller's order (pass 0: the rows are read in sequence); once the codes are sorted, the
+ * faces in hierarchy order and their projections' orientations (pass 1), the axes and flags unpacked (pass 2);
+ * and only once the sort's words, the edge twins and the stars' lists are given back, the corner indices, flags
+ * and boxes in hierarchy order (pass 3), so that those 37 bytes a face never coexist with the others. */
 typedef struct {
     int pass;
     int64_t m;
@@ -6631,7 +6735,8 @@ typedef struct {
     double gmin[3], scale[3];
     int8_t *axis;
     uint8_t *skip;
-    float *box;
+    uint8_t *box;               /* the faces' boxes as bytes on their leaf's grid, in blocks (pass 3) */
+    float *lbox;                /* each leaf's float32 box (pass 3; ct_build_boxes) */
     int32_t *order;
     int32_t *ids;
     uint8_t *flags;
@@ -6706,32 +6811,72 @@ ct_prep_task(void *ctx, int t, int nt)
         pr->failed[t] |= st.failed;
         return;
     }
-    for (int64_t i = s; i < e; i++) {
-        /* the faces are read in hierarchy order, i.e. at random in the caller's: their rows are fetched
-         * CT_AHEAD positions ahead, their corners CT_AHEAD / 2 ahead (from the rows fetched by then) */
-        if (i + CT_AHEAD < e) {
-            ct_prefetch((const char *)pr->F + (size_t)pr->size * 3 * (size_t)(pr->code[i + CT_AHEAD] & 0x7fffffff));
+    if (pr->pass == 1) {                       /* the sorted codes: faces in hierarchy order (and fmask) */
+        for (int64_t i = s; i < e; i++) {
+            int32_t f = (int32_t)(pr->code[i] & 0x7fffffff);
+            pr->order[i] = f;
+            if (pr->fmask != NULL) pr->fmask[i] = (uint8_t)((uint8_t)pr->axis[f] >> 2);
         }
-        if (i + CT_AHEAD / 2 < e) {
-            size_t g = 3 * (size_t)(pr->code[i + CT_AHEAD / 2] & 0x7fffffff);
-            for (int k = 0; k < 3; k++) ct_prefetch(pr->V + 3 * index_at(pr->F, pr->size, g + (size_t)k));
-        }
-        int64_t f = (int64_t)(pr->code[i] & 0x7fffffff);
-        const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
-        const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
-        const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
-        unsigned packed = (uint8_t)pr->axis[f];         /* axis | orientations << 2, from pass 0 */
-        pr->flags[i] = (uint8_t)((packed & 3u) | (packed >> 2 == 0) << 2);
-        if (pr->fmask != NULL) pr->fmask[i] = (uint8_t)(packed >> 2);
-        for (int k = 0; k < 3; k++) {
-            pr->ids[CT_IDBLOCK * (i / CT_LEAF) + k * CT_LEAF + i % CT_LEAF]
-                = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
-        }
-        pr->order[i] = (int32_t)f;
+        return;
+    }
+    /* pass 3, after pass 2's unpacking: by whole blocks of hierarchy positions (a block's bytes need its
+     * leaf's box, i.e. all its faces' boxes first) */
+    int64_t n_blocks = (pr->m + CT_LEAF - 1) / CT_LEAF;
+    int64_t b0 = (int64_t)part_start((size_t)n_blocks, t, nt), b1 = (int64_t)part_start((size_t)n_blocks, t + 1, nt);
+    e = b1 * CT_LEAF < pr->m ? b1 * CT_LEAF : pr->m;
+    for (int64_t blk_i = b0; blk_i < b1; blk_i++) {
+        double lo[CT_LEAF][3], hi[CT_LEAF][3];
+        CtNode leaf;
+        int64_t start = blk_i * CT_LEAF, count = pr->m - start < CT_LEAF ? pr->m - start : CT_LEAF;
+        uint8_t *blk = pr->box + CT_BLOCK * blk_i;
         for (int c = 0; c < 3; c++) {
-            float *blk = pr->box + CT_BLOCK * (i / CT_LEAF);
-            blk[c * CT_LEAF + i % CT_LEAF] = ct_f32_down(ct_min3(p0[c], p1[c], p2[c]));
-            blk[(3 + c) * CT_LEAF + i % CT_LEAF] = ct_f32_up(ct_max3(p0[c], p1[c], p2[c]));
+            leaf.lo[c] = INFINITY;
+            leaf.hi[c] = -INFINITY;
+        }
+        for (int64_t j = 0; j < count; j++) {
+            int64_t i = start + j;
+            /* the faces are read in hierarchy order, i.e. at random in the caller's: their rows are fetched
+             * CT_AHEAD positions ahead, their corners CT_AHEAD / 2 ahead (from the rows fetched by then) */
+            if (i + CT_AHEAD < e) {
+                ct_prefetch((const char *)pr->F + (size_t)pr->size * 3 * (size_t)pr->order[i + CT_AHEAD]);
+            }
+            if (i + CT_AHEAD / 2 < e) {
+                size_t g = 3 * (size_t)pr->order[i + CT_AHEAD / 2];
+                for (int k = 0; k < 3; k++) ct_prefetch(pr->V + 3 * index_at(pr->F, pr->size, g + (size_t)k));
+            }
+            int64_t f = pr->order[i];
+            const double *p0 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f);
+            const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
+            const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
+            pr->flags[i] = (uint8_t)((unsigned)pr->axis[f] | (unsigned)pr->skip[f] << 2);
+            for (int k = 0; k < 3; k++) {
+                pr->ids[CT_IDBLOCK * blk_i + k * CT_LEAF + j] = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
+            }
+            for (int c = 0; c < 3; c++) {
+                lo[j][c] = ct_min3(p0[c], p1[c], p2[c]);
+                hi[j][c] = ct_max3(p0[c], p1[c], p2[c]);
+                float l32 = ct_f32_down(lo[j][c]), h32 = ct_f32_up(hi[j][c]);
+                if (l32 < leaf.lo[c]) leaf.lo[c] = l32;
+                if (h32 > leaf.hi[c]) leaf.hi[c] = h32;
+            }
+        }
+        for (int c = 0; c < 3; c++) {
+            pr->lbox[6 * blk_i + c] = leaf.lo[c];
+            pr->lbox[6 * blk_i + 3 + c] = leaf.hi[c];
+        }
+        CtGrid grid;
+        ct_grid(&leaf, &grid);
+        for (int64_t j = 0; j < CT_LEAF; j++) {
+            for (int c = 0; c < 3; c++) {
+                if (j < count) {
+                    ct_grid_store(&grid, c, lo[j][c], hi[j][c], &blk[c * CT_LEAF + j], &blk[(3 + c) * CT_LEAF + j]);
+                }
+                else {                                  /* past the last face: no box, no vertex */
+                    blk[c * CT_LEAF + j] = 255;
+                    blk[(3 + c) * CT_LEAF + j] = 0;
+                    pr->ids[CT_IDBLOCK * blk_i + c * CT_LEAF + j] = -1;
+                }
+            }
         }
     }
 }
@@ -6755,10 +6900,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
     PyObject *result = NULL;
     CtNode *nodes = NULL;
     uint64_t *code = NULL;
-    float *box = NULL;
+    uint8_t *box = NULL;
+    float *lbox = NULL;
     int32_t *order = NULL;
     int32_t *ids = NULL;
-    size_t nodes_bytes = 0, code_bytes = 0, box_bytes = 0, order_bytes = 0, ids_bytes = 0;
+    size_t nodes_bytes = 0, code_bytes = 0, box_bytes = 0, lbox_bytes = 0, order_bytes = 0, ids_bytes = 0;
     uint8_t *flags = NULL;
     int8_t *axis_out = NULL;
     uint8_t *skip_out = NULL;
@@ -6809,31 +6955,22 @@ accel_contact_scan(PyObject *self, PyObject *args)
         size_t mm = m > 0 ? (size_t)m : 1;
         size_t n_blocks = (mm + CT_LEAF - 1) / CT_LEAF;
         nodes_bytes = (2 * n_blocks + 1) * sizeof(CtNode);     /* a leaf per block: 2 n_blocks - 1 nodes, from 1 */
-        /* the sort's keys and scratch (2 m words), then the stars' arrays, in one mapping */
+        /* the sort's keys and scratch (2 m words), then the stars' lists, in one mapping; the boxes and corner
+         * indices are mapped only once it is given back (below) */
         code_bytes = 2 * mm * sizeof(uint64_t);
         if (ct_stars_scratch(n, m) > code_bytes) code_bytes = ct_stars_scratch(n, m);
-        box_bytes = n_blocks * CT_BLOCK * sizeof(float);
+        box_bytes = n_blocks * CT_BLOCK;                       /* one byte per bound */
+        lbox_bytes = n_blocks * 6 * sizeof(float);
         order_bytes = mm * sizeof(int32_t);
         ids_bytes = n_blocks * CT_IDBLOCK * sizeof(int32_t);
         nodes = (CtNode *)ct_alloc(nodes_bytes);
         code = (uint64_t *)ct_alloc(code_bytes);
-        box = (float *)ct_alloc(box_bytes);
         order = (int32_t *)ct_alloc(order_bytes);
-        ids = (int32_t *)ct_alloc(ids_bytes);
-        flags = (uint8_t *)malloc(mm);
         axis_out = (int8_t *)malloc(mm);
         skip_out = (uint8_t *)malloc(mm);
-        if (nodes == NULL || code == NULL || box == NULL || order == NULL || ids == NULL || flags == NULL
-            || axis_out == NULL || skip_out == NULL) {
+        if (nodes == NULL || code == NULL || order == NULL || axis_out == NULL || skip_out == NULL) {
             PyErr_NoMemory();
             goto done;
-        }
-        for (size_t i = (size_t)m; i < n_blocks * CT_LEAF; i++) {     /* the last block's empty boxes */
-            for (int c = 0; c < 3; c++) {
-                box[CT_BLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = INFINITY;
-                box[CT_BLOCK * (i / CT_LEAF) + (3 + c) * CT_LEAF + i % CT_LEAF] = -INFINITY;
-                ids[CT_IDBLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF] = -1;
-            }
         }
         int oom = 0, failed = 0;
         /* the stage clocks only when profiling: CLOCK_PROCESS_CPUTIME_ID is a system call, and reading it at
@@ -6852,10 +6989,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.code = code;
         pr.axis = axis_out;
         pr.skip = skip_out;
-        pr.box = box;
         pr.order = order;
-        pr.ids = ids;
-        pr.flags = flags;
         if (patches && max_pairs < 0) {
             fmask = (uint8_t *)malloc(mm);         /* NULL (out of memory): no patches, the same pairs */
             pr.fmask = fmask;
@@ -6897,32 +7031,27 @@ accel_contact_scan(PyObject *self, PyObject *args)
         int64_t star_min = star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN;
         if (!oom && !failed && m >= 2 && star_faces > 0) {
             cert = (uint8_t *)malloc((size_t)n);
-            stars = (uint8_t *)malloc(mm);
-            if (cert == NULL || stars == NULL) oom = 1;
+            if (cert == NULL) oom = 1;
         }
-        int32_t *pos = NULL;
+        int32_t *labels = NULL;              /* per face, its certified patch (ct_patch_labels) */
         if (!oom && !failed && m >= 2 && cert != NULL && fmask != NULL) {
             twin = (int32_t *)malloc(3 * mm * sizeof(int32_t));    /* NULL: no patches, the same pairs */
-            pos = (int32_t *)malloc(mm * sizeof(int32_t));
-            if (twin == NULL || pos == NULL) {
-                free(twin);
-                free(pos);
-                twin = NULL;
-                pos = NULL;
-            }
         }
         if (!oom && !failed && m >= 2 && twin != NULL) {
-            /* with patches: the faces across each edge by hierarchy position (ct_twins into twin, the lists
-             * kept in code's memory), the hierarchy, the patches, then the star certificates of the vertices
-             * whose faces are not all in one certified patch (the others decide no pair), then the apexes */
+            /* with patches: the faces across each edge by hierarchy position (ct_twins into twin, from every
+             * vertex's faces listed in code's memory, then given back), the patches on the hierarchy's shape,
+             * the twins given back, then the star certificates of the vertices whose faces are not all in one
+             * certified patch (the others decide no pair), from their lists alone */
             int64_t *off, total;
             int32_t *vfaces;
-            for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
-            ct_star_lists(n, F, fsize, m, 1, code, &off, &vfaces, &total);
+            ct_star_lists(n, F, fsize, m, 1, NULL, order, code, &off, &vfaces, &total);
             clk[8] = profile ? ct_clock() : 0.0;
-            if (ct_twins(F, fsize, n, m, off, vfaces, total, pos, twin, nt) < 0) {
+            if (ct_twins(F, fsize, n, m, off, vfaces, total, order, twin, nt) < 0) {
                 oom = 1;
             }
+            ct_free(code, code_bytes);
+            code = NULL;
+            code_bytes = 0;
             clk[9] = profile ? ct_clock() : 0.0;
             if (!oom) {
                 int32_t *across = twin;
@@ -6932,33 +7061,80 @@ accel_contact_scan(PyObject *self, PyObject *args)
                         across[i] = -1;
                     }
                 }
-                n_nodes = ct_build(nodes, box, ids, NULL, m);
+                n_nodes = ct_build_tree(nodes, m);
                 clk[10] = profile ? ct_clock() : 0.0;
                 patch = (uint8_t *)malloc((size_t)n_nodes);
-                if (patch == NULL || ct_patches(nodes, n_nodes, ids, fmask, across, V, m, patch) < 0) {
+                if (patch == NULL || ct_patches(nodes, n_nodes, F, fsize, order, fmask, across, V, m, patch) < 0) {
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
+                free(twin);
+                twin = NULL;
                 clk[7] = profile ? ct_clock() : 0.0;
-                int32_t *label = pos;                  /* pos is done with: each face's certified patch */
-                if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
-                if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
-                                  patch != NULL ? label : NULL) < 0) {
+                int32_t *label = NULL;                 /* each face's certified patch */
+                if (patch != NULL) {
+                    labels = (int32_t *)malloc(mm * sizeof(int32_t));
+                    label = labels;
+                    if (label == NULL) {
+                        free(patch);               /* out of memory: the scan without patches, the same pairs */
+                        patch = NULL;
+                    }
+                    else {
+                        ct_patch_labels(nodes, patch, order, m, label);
+                    }
+                }
+                size_t lists_bytes = ct_stars_scratch(n, m);
+                void *lists = ct_alloc(lists_bytes);   /* only the kept vertices' part of it is written */
+                if (lists == NULL) {
                     oom = 1;
                 }
+                else {
+                    ct_star_lists(n, F, fsize, m, star_min, patch != NULL ? label : NULL, NULL, lists, &off,
+                                  &vfaces, &total);
+                    if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
+                                      patch != NULL ? label : NULL) < 0) {
+                        oom = 1;
+                    }
+                    ct_free(lists, lists_bytes);
+                }
                 clk[11] = profile ? ct_clock() : 0.0;
-                ct_set_apex(nodes, n_nodes, ids, cert, m);
             }
         }
         else if (!oom && !failed && m >= 2) {
             if (cert != NULL && ct_stars(V, n, F, fsize, m, star_min, star_faces, cert, nt, code) < 0) {
                 oom = 1;
             }
-            n_nodes = ct_build(nodes, box, ids, cert, m);
+            n_nodes = ct_build_tree(nodes, m);
         }
-        free(pos);
+        free(labels);
         free(twin);
         twin = NULL;
+        /* the sort's words and the stars' lists, the twins and the positions are given back before the boxes
+         * and corner indices are written: the check's high point is then the traversal's arrays alone */
+        ct_free(code, code_bytes);
+        code = NULL;
+        code_bytes = 0;
+        if (!oom && !failed && m >= 2) {
+            box = (uint8_t *)ct_alloc(box_bytes);
+            lbox = (float *)ct_alloc(lbox_bytes);
+            ids = (int32_t *)ct_alloc(ids_bytes);
+            flags = (uint8_t *)malloc(mm);
+            stars = cert != NULL ? (uint8_t *)malloc(mm) : NULL;
+            if (box == NULL || lbox == NULL || ids == NULL || flags == NULL || (cert != NULL && stars == NULL)) {
+                oom = 1;
+            }
+        }
+        if (!oom && !failed && m >= 2) {
+            pr.box = box;
+            pr.lbox = lbox;
+            pr.ids = ids;
+            pr.flags = flags;
+            pr.pass = 3;
+            run_parallel(thread_count(threads, (size_t)n_blocks, 20000 / CT_LEAF), ct_prep_task, &pr);
+            ct_build_boxes(nodes, n_nodes, lbox, ids, cert, m);
+            ct_free(lbox, lbox_bytes);         /* the leaves' boxes are in the nodes now */
+            lbox = NULL;
+        }
         clk[4] = profile ? ct_clock() : 0.0;
         if (!oom && !failed && m >= 2) {
             if (cert != NULL) {
@@ -7030,14 +7206,13 @@ accel_contact_scan(PyObject *self, PyObject *args)
         Py_END_ALLOW_THREADS
         if (profile) {
             if (clk[11] > 0) {
-                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f lists %.4f twins %.4f "
-                        "build %.4f patches %.4f stars %.4f apex+bits %.4f traverse %.4f s; ",
+                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f order %.4f lists %.4f twins %.4f "
+                        "patches %.4f stars %.4f boxes+apex+bits %.4f traverse %.4f s; ",
                         (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[8] - clk[3],
-                        clk[9] - clk[8], clk[10] - clk[9], clk[7] - clk[10], clk[11] - clk[7], clk[5] - clk[11],
-                        clk[6] - clk[5]);
+                        clk[10] - clk[8], clk[7] - clk[10], clk[11] - clk[7], clk[5] - clk[11], clk[6] - clk[5]);
             }
             else {
-                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f prep %.4f stars+build %.4f "
+                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f order %.4f stars+boxes %.4f "
                         "traverse %.4f s; ", (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2],
                         clk[5] - clk[3], clk[6] - clk[5]);
             }
@@ -7075,6 +7250,7 @@ done:
     ct_free(nodes, nodes_bytes);
     ct_free(code, code_bytes);
     ct_free(box, box_bytes);
+    ct_free(lbox, lbox_bytes);
     ct_free(order, order_bytes);
     ct_free(ids, ids_bytes);
     free(flags);
