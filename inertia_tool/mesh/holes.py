@@ -251,7 +251,8 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         return []
     nv = np.int64(max(n, 1))
     rim_key = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * nv + np.maximum(edges[:, 0], edges[:, 1])
-    ring_of = _ring_faces(f, n, rim_key, label, candidates, n_loops)
+    ring_pairs, ring_start = _ring_faces(f, n, rim_key, label, candidates, n_loops)
+    maybe = _may_hold_two_planes(v, f, edges, label, n_loops, candidates, ring_pairs, ring_start, 2.0 * on_tol)
     # read only where a fill is about to be made (issue 25: both read every face, ~0.5 s at 1.3M faces)
     interior: np.ndarray | None = None
     corner_order = corner_start = np.zeros(0, dtype=np.int64)
@@ -264,6 +265,8 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
     loop_start = np.searchsorted(label[by_loop], np.arange(n_loops + 1))
     out = []
     for k in candidates:
+        if not maybe[k]:
+            continue                              # fewer than two ring faces whose planes hold three rim vertices
         raw = edges[by_loop[loop_start[k]:loop_start[k + 1]]]
         succ = dict(zip(raw[:, 0].tolist(), raw[:, 1].tolist()))
         if len(succ) != len(raw) or len(raw) < 4:
@@ -274,7 +277,7 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         if len(walk) != len(raw):
             continue
         loop_edges = np.array([[x, succ[x]] for x in walk], dtype=np.int64)
-        ring = ring_of(k)
+        ring = ring_pairs[ring_start[k]:ring_start[k + 1], 1]
         if not len(ring):
             continue
         a0 = v[f[ring, 0]]
@@ -352,9 +355,10 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
 
 
 def _ring_faces(f: np.ndarray, n: int, rim_key: np.ndarray, label: np.ndarray, candidates: list[int],
-                n_loops: int) -> Callable[[int], np.ndarray]:
-    """The faces with an edge on the rim of each candidate loop of :func:`crease_fills`, ascending: a function
-    of the loop.  A face edge counts for the loop of the *last* rim edge with its key (the rim edges listed in
+                n_loops: int) -> tuple[np.ndarray, np.ndarray]:
+    """The faces with an edge on the rim of each candidate loop of :func:`crease_fills` (the ring): ``(pairs,
+    start)``, the (loop, face) pairs sorted, loop ``k``'s faces ascending in ``pairs[start[k]:start[k + 1], 1]``.
+    A face edge counts for the loop of the *last* rim edge with its key (the rim edges listed in
     ``edges`` order), and only keys of candidate loops' rim edges are looked up.  Sorting only the face edges
     whose two ends lie on a candidate rim keeps this to the rims' size (issue 25: every face edge was, ~0.4 s
     at 1.3M faces, and a Python loop ran over the ring)."""
@@ -376,12 +380,67 @@ def _ring_faces(f: np.ndarray, n: int, rim_key: np.ndarray, label: np.ndarray, c
     loop = loop_of_key[np.searchsorted(unique_key, key)]
     pairs = np.unique(np.stack([loop, slot // 3], axis=1), axis=0) if len(slot) else np.zeros((0, 2), np.int64)
     start = np.searchsorted(pairs[:, 0], np.arange(n_loops + 1))
+    return pairs, start
 
-    def ring(k: int) -> np.ndarray:
-        faces_of: np.ndarray = pairs[start[k]:start[k + 1], 1]
-        return faces_of
 
-    return ring
+#: Most (ring face, rim vertex) pairs :func:`_may_hold_two_planes` measures at once over all loops (~100 MB);
+#: loops beyond it are examined one by one as before.
+CREASE_SCREEN_PAIRS = 4_000_000
+
+
+def _may_hold_two_planes(v: np.ndarray, f: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                         candidates: list[int], ring_pairs: np.ndarray, ring_start: np.ndarray, loose: float
+                         ) -> np.ndarray:
+    """Loops that may still qualify for :func:`crease_fills`, (n_loops,) bool: a necessary condition measured on
+    all candidate loops at once, so that the loop over them skips the rest without a step of their own
+    (issue 25: thousands of small holes, ~0.1 ms each).
+
+    A loop qualifies only if two ring faces have planes each holding at least three of its rim vertices within
+    ``on_tol``.  Here the distances are measured another way (one product per (face, vertex) pair rather than a
+    matrix product), which may differ from the loop's by a few ulp of the coordinates, so a vertex counts when
+    within ``loose`` (twice ``on_tol``, 64 ulp more than any such difference): every loop the loop would keep is
+    kept.  Loops whose pairs would pass ``CREASE_SCREEN_PAIRS`` in total are kept unmeasured."""
+    maybe = np.ones(n_loops, dtype=bool)
+    cand = np.zeros(n_loops, dtype=bool)
+    cand[candidates] = True
+    nv = np.int64(max(len(v), 1))
+    # the distinct (loop, vertex) pairs of the candidate loops' rims, by loop
+    sel = cand[label]
+    rim = np.unique(label[sel].astype(np.int64) * nv + edges[sel, 0])
+    rim_loop, rim_vertex = rim // nv, rim % nv
+    rim_start = np.searchsorted(rim_loop, np.arange(n_loops + 1))
+    rim_count = np.diff(rim_start)
+    ring_count = np.diff(ring_start)
+    work = rim_count * ring_count
+    order = np.argsort(work, kind="stable")
+    measured = np.zeros(n_loops, dtype=bool)
+    measured[order[np.cumsum(work[order]) <= CREASE_SCREEN_PAIRS]] = True
+    measured &= cand
+    loops = np.flatnonzero(measured)
+    if not len(loops):
+        return maybe
+    maybe[loops] = False
+    # every (ring face, rim vertex) pair of each measured loop
+    faces_per = ring_count[loops]
+    face_row = np.repeat(ring_start[loops], faces_per) + (np.arange(int(faces_per.sum()))
+                                                          - np.repeat(np.cumsum(faces_per) - faces_per, faces_per))
+    face = ring_pairs[face_row, 1]
+    loop_of_face = np.repeat(loops, faces_per)
+    a0 = v[f[face, 0]]
+    normal = np.cross(v[f[face, 1]] - a0, v[f[face, 2]] - a0)
+    length = np.linalg.norm(normal, axis=1)
+    good = length > 0
+    unit = normal / np.where(good, length, 1.0)[:, None]
+    offset = np.einsum("ij,ij->i", unit, a0)
+    per = rim_count[loop_of_face]
+    owner = np.repeat(np.arange(len(face)), per)
+    vertex = rim_vertex[np.repeat(rim_start[loop_of_face], per) + (np.arange(int(per.sum()))
+                                                                  - np.repeat(np.cumsum(per) - per, per))]
+    dist = np.abs(np.einsum("ij,ij->i", v[vertex], unit[owner]) - offset[owner])
+    held = np.bincount(owner, weights=dist <= loose, minlength=len(face))
+    planes = np.bincount(loop_of_face, weights=good & (held >= 3), minlength=n_loops)
+    maybe[loops] = planes[loops] >= 2
+    return maybe
 
 
 def _crease_rim_contradicts(v: np.ndarray, f: np.ndarray, loop_edges: np.ndarray, side: list[int],
