@@ -681,7 +681,14 @@ def _vertex_flatness(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarr
     normals, and for each vertex the least cosine between one of its faces' normals and their area-weighted mean
     (1 where all lie in one plane) and that mean's length (0: no face, or normals cancelling)."""
     n = len(v)
-    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    # the cross product as numpy.cross forms it (each product, then the difference), bit for bit, without its
+    # axis shuffling (0.19 -> 0.12 s at 1.3M faces)
+    a = v[f[:, 0]]
+    u, w = v[f[:, 1]] - a, v[f[:, 2]] - a
+    normal = np.empty_like(u)
+    for axis, (p, q) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.multiply(u[:, p], w[:, q], out=normal[:, axis])
+        normal[:, axis] -= u[:, q] * w[:, p]
     area = np.linalg.norm(normal, axis=1)
     good = area > 0
     g, unit = f[good], normal[good] / area[good, None]
