@@ -347,7 +347,48 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
         found.append(Wall(faces=np.flatnonzero(members),
                           distance=0.0 if exact else _distance_bound(v, f[members], *plane),
                           area=_area_bound(v, f[members]), exact=exact))
-    return found
+    return found + _unflagged_walls(v, f, found, wall, tolerance, key)
+
+
+def _unflagged_walls(v: np.ndarray, f: np.ndarray, found: list[Wall], wall: np.ndarray, tolerance: float,
+                     key: np.ndarray) -> list[Wall]:
+    """Walls in the plane of a wall found, that no flagged pair reached: a small piece of the cut apart from the
+    rest of it (where the cut clips a corner of the part) whose two sheets meet only at shared corners and edges.
+    Left in, its sheets are a flat fold of the surface (edges used by four faces) that the later stages read as
+    bodies welded along an edge.  The faces within ``tolerance`` of that plane outside every wall, joined through
+    shared edges, are a wall when their vector areas cancel (:func:`_sheets_cancel`)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    out: list[Wall] = []
+    planes: list[tuple[np.ndarray, float]] = []
+    for w in found:
+        plane = _plane(v, f[w.faces])
+        if plane is None or any(abs(float(plane[0] @ u)) > 1 - 1e-12 and abs(plane[1] - o) <= tolerance
+                                for u, o in planes):
+            continue
+        planes.append(plane)
+        unit, offset = plane
+        near = np.all((np.abs(v @ unit - offset) <= tolerance)[f], axis=1) & ~wall
+        if not near.any():
+            continue
+        slots = (3 * np.flatnonzero(near)[:, None] + np.arange(3)).reshape(-1)
+        _, edge = np.unique(key[slots], return_inverse=True)      # faces and their edges: a bipartite graph (an
+        m = len(f)                                                 # edge of four faces joins all four)
+        graph = coo_matrix((np.ones(len(slots), dtype=np.int8), (slots // 3, m + edge.reshape(-1))),
+                           shape=(m + len(slots), m + len(slots)))
+        _, comp = connected_components(graph, directed=False)
+        comp = comp[:m]
+        for c in np.unique(comp[near]).tolist():
+            members = near & (comp == c)
+            if np.count_nonzero(members) < 2 or not _sheets_cancel(v, f[members]):
+                continue
+            exact = _exactly_coplanar(v, f[members])
+            wall |= members
+            out.append(Wall(faces=np.flatnonzero(members),
+                            distance=0.0 if exact else _distance_bound(v, f[members], unit, offset),
+                            area=_area_bound(v, f[members]), exact=exact))
+    return out
 
 
 def _close_rims(v: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, float, float, np.ndarray] | None:
