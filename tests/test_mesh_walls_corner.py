@@ -164,16 +164,16 @@ def _check(pieces, name="<arrays>"):
                                                                 *REAL_PARTS]))
 def test_a_part_cut_near_a_corner_and_written_face_to_face_is_right(seed, kind):
     """A plane cut through a point near a corner or an edge of the part: the rim turns round the part's
-    corners.  Exact or united answers match the truth; on the axis-aligned box (flat sides exactly flat) the
-    answer is exact."""
+    corners.  Exact or united answers match the truth; on the boxes (grid-meshed sides, so that the halves' rims
+    carry different corners) the answer is exact."""
     rng = np.random.default_rng(seed)
     v, f = _shape(kind, rng)
     halves = _plane_cut(v, f, rng)
     if halves is None:
         return
     got = _check(halves)
-    if kind == "box":
-        assert got == "exact"
+    if kind in ("box", "turned box"):
+        assert got == "exact"                      # 150/150 and 139/139 of seeds 0-149 (1 % and 9 % refused before)
 
 
 @pytest.mark.slow

@@ -651,12 +651,41 @@ def _merged(v: np.ndarray, f: np.ndarray, walls: list[Wall], plane_rtol: float) 
     return out
 
 
-def _flagged_pairs(contacts: SurfaceContacts, labels: np.ndarray) -> np.ndarray:
-    """Crossing pairs, and coplanar-opposite pairs within one shell (k, 2)."""
+def _flagged_pairs(contacts: SurfaceContacts, labels: np.ndarray, v: np.ndarray | None = None,
+                   f: np.ndarray | None = None) -> np.ndarray:
+    """Crossing pairs, coplanar-opposite pairs within one shell, and (given ``v`` and ``f``) the facing pairs at
+    edges of four or more faces (:func:`_facing_at_folded_edges`) (k, 2)."""
     cross = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
     opp = np.asarray(contacts.coplanar_opposite, dtype=np.int64).reshape(-1, 2)
     opp = opp[labels[opp[:, 0]] == labels[opp[:, 1]]]
-    return np.concatenate([cross, opp])
+    if v is None or f is None:
+        return np.concatenate([cross, opp])
+    return np.concatenate([cross, opp, _facing_at_folded_edges(v, f)])
+
+
+def _facing_at_folded_edges(v: np.ndarray, f: np.ndarray, cos_max: float = -1 + 1e-6) -> np.ndarray:
+    """(k, 2) pairs of faces on one edge of four or more faces that use it in opposite directions and face
+    opposite ways (cosine of their normals at most ``cos_max``): the two sheets of a wall at an edge both have.
+    Where the sheets' corners are coplanar only to rounding they can meet without crossing or overlapping
+    (the face-pair check calls them touching), so nothing else flags such a wall; the pairs only seed the
+    search (:func:`internal_walls`), which decides."""
+    key, forward = edge_keys(f, len(v))
+    order = np.argsort(key, kind="stable")
+    k = key[order]
+    starts = np.flatnonzero(np.r_[True, k[1:] != k[:-1]])
+    counts = np.diff(np.r_[starts, len(k)])
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    unit = normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    out = []
+    for i in range(int(counts.max(initial=0))):
+        for j in range(i + 1, int(counts.max(initial=0))):
+            at = starts[counts > j]
+            a, b = order[at + i], order[at + j]
+            ga, gb = a // 3, b // 3
+            keep = ((forward[a] != forward[b]) & (ga != gb)
+                    & (np.einsum("ij,ij->i", unit[ga], unit[gb]) <= cos_max))
+            out.append(np.stack([ga[keep], gb[keep]], axis=1))
+    return np.concatenate(out) if out else np.zeros((0, 2), dtype=np.int64)
 
 
 def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceContacts,
@@ -689,7 +718,7 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
     labels = np.asarray(labels, dtype=np.int64)
     if not contacts.complete:
         return None
-    pairs = _flagged_pairs(contacts, labels)
+    pairs = _flagged_pairs(contacts, labels, v, f)
     if not len(pairs):
         return None
     whole = volume_moments(v, f)
@@ -705,7 +734,7 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
         if not contacts.complete:
             return None
         labels, _ = shell_labels(g, len(v))
-        pairs = _flagged_pairs(contacts, labels)
+        pairs = _flagged_pairs(contacts, labels, v, g)
     found = internal_walls(v, g, pairs, plane_rtol=plane_rtol)
     wall = np.zeros(len(g), dtype=bool)
     for w in found:
