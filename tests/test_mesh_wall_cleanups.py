@@ -5,6 +5,8 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import inertia_tool as it
 from inertia_tool.errors import InsideOutWarning
@@ -57,3 +59,34 @@ def test_an_estimate_missing_from_an_estimated_resolution_is_a_named_internal_er
         _estimated(broken, {})
     with pytest.raises(InternalInvariantError, match="<arrays>: the forced .* found none"):
         _with_patch_doubt(broken, None, "<arrays>")
+
+
+def _seam_corners_by_counting(f, n):
+    """Reference: the corners of the edges used a different number of times in each direction (a dictionary)."""
+    use = {}
+    for tri in np.asarray(f).tolist():
+        for a, b in zip(tri, tri[1:] + tri[:1]):
+            use[(a, b)] = use.get((a, b), 0) + 1
+    bad = {x for (a, b), k in use.items() if k != use.get((b, a), 0) for x in (a, b)}
+    return np.array(sorted(bad), dtype=np.int64)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2 ** 32 - 1), subdivide=st.integers(0, 2), holes=st.integers(0, 6),
+       sheet=st.booleans())
+def test_seam_corners_from_the_boundary_equal_those_by_sorting_every_edge(seed, subdivide, holes, sheet):
+    """``_seam_corners`` (mesh/sheets.py) sorted every edge of the surface, a second time after ``_seam_plane``:
+    now computed once, and taken from the net boundary the caller already has.  Same corners as sorting every
+    edge and as counting by hand, on boxes with random faces taken out and a sheet of faces added."""
+    from adversary_solids import box
+    from inertia_tool.mesh.rims import boundary_edges
+    from inertia_tool.mesh.sheets import _seam_corners
+
+    rng = np.random.default_rng(seed)
+    v, f = box(rng.uniform(0.5, 2.0, size=3), subdivide=subdivide)
+    f = f[rng.permutation(len(f))[holes:]]
+    if sheet:
+        f = np.vstack([f, f[rng.integers(len(f), size=2)][:, ::-1]])   # reversed copies: unbalanced twice over
+    truth = _seam_corners_by_counting(f, len(v))
+    assert np.array_equal(_seam_corners(f, len(v)), truth)
+    assert np.array_equal(_seam_corners(f, len(v), boundary_edges(f, len(v))), truth)
