@@ -48,6 +48,7 @@ __all__ = [
     "NoRoomError",
     "PhysicsError",
     "OutputCheckError",
+    "InternalInvariantError",
     "IsolatedProcessError",
     "InertiaToolWarning",
     "MeshRepairedWarning",
@@ -183,6 +184,14 @@ class OutputCheckError(InertiaToolError, RuntimeError):
     """A file the tool was about to write failed the check made before it is written (e.g. a corrected robot
     description that, read back, differs from its input outside the corrected elements).  Nothing is written;
     it is a bug of the tool (exit code 1), and the message says which element differed and how.
+    """
+
+
+class InternalInvariantError(InertiaToolError, RuntimeError):
+    """A condition the tool's own pipeline guarantees did not hold (e.g. an estimated result without its
+    estimate).  Never caused by the input alone: it is a bug of the tool (exit code 1, "unexpected internal
+    error"), raised instead of going on with a number that rests on the broken condition.  The message names the
+    condition expected and what was found.
     """
 
 

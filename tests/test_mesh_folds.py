@@ -143,16 +143,10 @@ def test_a_thick_fan_through_the_part_is_not_taken_for_a_sliver():
 # -- internal walls ---------------------------------------------------------------------------------------------
 
 def _halves(v, f, normal, offset):
-    import manifold3d as m3d
-
-    solid = m3d.Manifold(m3d.Mesh64(vert_properties=np.ascontiguousarray(v, dtype=np.float64),
-                                    tri_verts=np.ascontiguousarray(f, dtype=np.uint64)))
-    out = []
-    for half in solid.split_by_plane(tuple(float(x) for x in normal), float(offset)):
-        mesh = half.to_mesh64()
-        out.append((np.array(mesh.vert_properties, dtype=np.float64)[:, :3].copy(),
-                    np.array(mesh.tri_verts, dtype=np.int64)))
-    return out
+    """The two closed halves by manifold3d: ``tests/test_mesh_sheets.py``'s, imported on use (that module imports
+    this one's truths at load, so a load-time import would be circular)."""
+    from test_mesh_sheets import _halves as halves
+    return halves(v, f, normal, offset)
 
 
 def _retriangulate_cut(hv, hf, normal, offset, rng):

@@ -1,12 +1,12 @@
-"""Stated limits of the internal-wall rules (issue 21, item 2), kept as strict-xfail reproducers so that a change
-that lifts one is noticed.
+"""Double walls whose rim turns round the part's corner (issue 21, item 2; strict-xfail reproducers until the
+walls4 pass lifted them).
 
-A double wall whose halves' faces on a flat side of the part overlap in slivers along the rim where the rim turns
-round the part's corner (coverage case ``7-05-internal_wall-0``: the generated box cut by a random plane, both cut
-faces kept, welded): R3a's walls are each near one plane and their rims' loops must run out along a line and back,
-so the slivers on the box's sides are left crossing; the boolean then finds the shells touching up to rounding and
-the answer is ``united`` (right to 1e-16, not proven exact).  The same holds for the so101 upper arm cases
-``9-33``/``23-33`` (refused without ``repair``: 1,078-1,251 face pairs cross outside every planar wall).
+The generated box cut by a random plane, both cut faces kept, welded (coverage case ``7-05-internal_wall-0``):
+the halves' rims differ on two sides of the box and share the box's edge between them, so what the wall leaves
+open is two loops through one corner.  R3a's ``_close_rims`` took only one loop per corner and left the case to
+the boolean (``united``, touching up to rounding); the loops are now paired at the shared corner and the answer
+is ``exact`` with the check ``zero-volume-folds``.  The so101 upper arm cases ``9-33``/``23-33`` (refused without
+``repair``: 1,078-1,251 face pairs crossing) are in ``tests/test_mesh_walls_corner.py``.
 """
 
 import importlib.util
@@ -14,7 +14,6 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 import inertia_tool as it
 
@@ -48,8 +47,6 @@ def _box_double_wall():
     raise AssertionError("case not drawn")
 
 
-@pytest.mark.xfail(strict=True, reason="issue 21 item 2: a double wall whose halves overlap in slivers round the "
-                   "part's corner is united (touching up to rounding), not proven exact")
 def test_a_double_wall_round_a_corner_of_the_box_is_exact():
     name, v, f, truth, meta = _box_double_wall()
     assert name == "generated/box" and meta["wall"] == "double"

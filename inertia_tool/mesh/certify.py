@@ -74,7 +74,12 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
     from .intersect import surface_contacts
 
     found = oriented.misread
-    if found is None or united.forced is not None or united.kind not in ("exact", "united"):
+    if found is None:
+        return united, None
+    if united.forced is not None or united.kind not in ("exact", "united"):
+        # R4 turned those shells without a warning of its own (this is the one): say both readings here too
+        note = misread_message(found, float(total(united.shells.moments).volume), proven=False, kept="")
+        warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=3)
         return united, None
     spread = None
     proven = united.kind == "exact"

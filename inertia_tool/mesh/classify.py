@@ -82,7 +82,13 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
         within, crossing_with = _within(v, f, labels, file_volumes, crossing_with)
     flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
                                          within=_both(within, touch_within))
-    shells = apply_flips(shells, flip, source)
+    misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
+        if touch.complete else None                                                   # R4: the file does not decide
+    quiet = np.zeros(n_shells, dtype=bool)
+    if misread is not None:           # warned once, with both readings, by certify.misread_reading
+        quiet[misread.shells] = True
+    shells = apply_flips(shells, flip & ~quiet, source)
+    shells = apply_flips(shells, flip & quiet, source, warn=False)
     notes = []
     ambiguous = inward_crossing_outward(file_volumes, flip, crossing_with)
     if ambiguous:
@@ -104,8 +110,6 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
         candidates = boxes_meet(v, shells.faces, labels, n_shells) | undecided
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[crossing_with.reshape(-1)] = True
-    misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
-        if touch.complete else None                                                   # R4: the file does not decide
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread)
 
 

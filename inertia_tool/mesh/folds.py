@@ -84,6 +84,9 @@ _U = 2.0 ** -53
 #: Work bound: groups of flagged faces examined as walls (each may grow through the surface); the rest stay
 #: on the normal path.
 MAX_WALL_GROUPS = 256
+#: Open edges leaving one corner of the rims that are paired into loops (:func:`_rim_loops`); more are left to the
+#: normal path.
+MAX_RIM_VALENCE = 4
 _PLANE = np.array([[1, 2], [2, 0], [0, 1]])       # coordinates kept when dropping an axis (orientation-preserving)
 
 
@@ -312,11 +315,15 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
         size = np.maximum(np.linalg.norm(normal, axis=1), 1e-300)
         cos = np.einsum("ij,ij->i", normal[fa[both]], normal[fb[both]]) / (size[fa[both]] * size[fb[both]])
         both[np.flatnonzero(both)[np.abs(cos) < 1 - 1e-6]] = False
+    tolerance = plane_rtol * float(np.abs(v).max())
+    # a flagged pair joins its faces into one group only when they lie in one plane: where the rim runs along a
+    # flat side of the part, a wall's face crosses that side's faces by rounding, and a group spanning both
+    # planes would be no wall (its faces stay flagged, each a group of its own, grown through its plane below)
+    p = p[_in_one_plane(v, f, p, tolerance)]
     rows = np.r_[p[:, 0], fa[both]]
     cols = np.r_[p[:, 1], fb[both]]
     graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(m, m))
     _, comp = connected_components(graph, directed=False)
-    tolerance = plane_rtol * float(np.abs(v).max())
     groups = comp[flagged]
     order = np.argsort(groups, kind="stable")
     bounds = np.flatnonzero(np.r_[True, groups[order][1:] != groups[order][:-1], True])
@@ -340,7 +347,48 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
         found.append(Wall(faces=np.flatnonzero(members),
                           distance=0.0 if exact else _distance_bound(v, f[members], *plane),
                           area=_area_bound(v, f[members]), exact=exact))
-    return found
+    return found + _unflagged_walls(v, f, found, wall, tolerance, key)
+
+
+def _unflagged_walls(v: np.ndarray, f: np.ndarray, found: list[Wall], wall: np.ndarray, tolerance: float,
+                     key: np.ndarray) -> list[Wall]:
+    """Walls in the plane of a wall found, that no flagged pair reached: a small piece of the cut apart from the
+    rest of it (where the cut clips a corner of the part) whose two sheets meet only at shared corners and edges.
+    Left in, its sheets are a flat fold of the surface (edges used by four faces) that the later stages read as
+    bodies welded along an edge.  The faces within ``tolerance`` of that plane outside every wall, joined through
+    shared edges, are a wall when their vector areas cancel (:func:`_sheets_cancel`)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    out: list[Wall] = []
+    planes: list[tuple[np.ndarray, float]] = []
+    for w in found:
+        plane = _plane(v, f[w.faces])
+        if plane is None or any(abs(float(plane[0] @ u)) > 1 - 1e-12 and abs(plane[1] - o) <= tolerance
+                                for u, o in planes):
+            continue
+        planes.append(plane)
+        unit, offset = plane
+        near = np.all((np.abs(v @ unit - offset) <= tolerance)[f], axis=1) & ~wall
+        if not near.any():
+            continue
+        slots = (3 * np.flatnonzero(near)[:, None] + np.arange(3)).reshape(-1)
+        _, edge = np.unique(key[slots], return_inverse=True)      # faces and their edges: a bipartite graph (an
+        m = len(f)                                                 # edge of four faces joins all four)
+        graph = coo_matrix((np.ones(len(slots), dtype=np.int8), (slots // 3, m + edge.reshape(-1))),
+                           shape=(m + len(slots), m + len(slots)))
+        _, comp = connected_components(graph, directed=False)
+        comp = comp[:m]
+        for c in np.unique(comp[near]).tolist():
+            members = near & (comp == c)
+            if np.count_nonzero(members) < 2 or not _sheets_cancel(v, f[members]):
+                continue
+            exact = _exactly_coplanar(v, f[members])
+            wall |= members
+            out.append(Wall(faces=np.flatnonzero(members),
+                            distance=0.0 if exact else _distance_bound(v, f[members], unit, offset),
+                            area=_area_bound(v, f[members]), exact=exact))
+    return out
 
 
 def _close_rims(v: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, float, float, np.ndarray] | None:
@@ -363,24 +411,14 @@ def _close_rims(v: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, float, flo
         return None                                     # an edge left open twice: not one simple cycle
     a = rest.reshape(-1)[open_slot].tolist()
     b = rest[:, [1, 2, 0]].reshape(-1)[open_slot].tolist()
-    succ = dict(zip(a, b))
-    if len(succ) != len(a) or set(succ) != set(succ.values()):
-        return None                                     # a vertex twice on the loops
+    loops = _rim_loops(v, a, b)
+    if loops is None:
+        return None
     face_of = {(x, y): int(s) // 3 for x, y, s in zip(a, b, open_slot.tolist())}
     keep = np.ones(len(rest), dtype=bool)
     added: list[list[int]] = []
     pyramids, cone_area = 0.0, 0.0
-    done: set[int] = set()
-    for start in a:
-        if start in done:
-            continue
-        loop = [start]
-        for _ in range(len(a)):                         # bounded: each vertex once
-            nxt = succ[loop[-1]]
-            if nxt == start:
-                break
-            loop.append(nxt)
-        done.update(loop)
+    for loop in loops:
         if len(loop) < 3:
             return None
         pts = v[loop]
@@ -419,6 +457,75 @@ def _close_rims(v: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, float, flo
                     cone_area += 0.5 * float(np.linalg.norm(np.cross(v[s0] - v[p], v[s1] - v[p])))
     split = np.array(added, dtype=np.int64).reshape(-1, 3)
     return np.vstack([rest[keep], split]), pyramids, cone_area * (1 + 1e-12), np.unique(split)
+
+
+def _in_one_plane(v: np.ndarray, f: np.ndarray, pairs: np.ndarray, tolerance: float) -> np.ndarray:
+    """(k,) bool: whether the corners of the smaller face of each pair lie within ``tolerance`` (m) of the plane of
+    the larger (a sliver's own normal says nothing of its plane; the larger face's does)."""
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    size = np.linalg.norm(normal, axis=1)
+    big = np.where(size[pairs[:, 0]] >= size[pairs[:, 1]], pairs[:, 0], pairs[:, 1])
+    small = np.where(big == pairs[:, 0], pairs[:, 1], pairs[:, 0])
+    unit = normal[big] / np.maximum(size[big], 1e-300)[:, None]
+    reach = np.abs(np.einsum("kij,kj->ki", v[f[small]] - v[f[big, 0]][:, None, :], unit))
+    return np.asarray(np.all(reach <= tolerance, axis=1) & (size[big] > 0))
+
+
+def _rim_loops(v: np.ndarray, a: list[int], b: list[int]) -> list[list[int]] | None:
+    """The open edges ``a[i] → b[i]`` (each used once) as simple cycles of corners, or None.
+
+    Where a corner lies on two loops (the two sheets' rims share a corner of the part, where the rim turns round
+    it, and differ on both sides of it), each edge arriving there is followed by the leaving edge that turns back
+    most sharply (the largest cosine between the directions to the two other ends): the loop along one side of
+    the part runs out and back along that side, so its chains leave the shared corner in nearly the same
+    direction.  Any pairing gives closed loops whose sum is the rim (what the bound of the module docstring
+    needs); this one gives the loops :func:`_close_rims` can split."""
+    outs: dict[int, list[int]] = {}
+    ins: dict[int, list[int]] = {}
+    for e, (x, y) in enumerate(zip(a, b)):
+        outs.setdefault(x, []).append(e)
+        ins.setdefault(y, []).append(e)
+    if any(len(ins.get(x, ())) != len(es) for x, es in outs.items()) or set(ins) != set(outs):
+        return None                                     # not a union of cycles
+    follow = [-1] * len(a)
+    for x, leaving in outs.items():
+        arriving = ins[x]
+        if len(leaving) == 1:
+            follow[arriving[0]] = leaving[0]
+            continue
+        if len(leaving) > MAX_RIM_VALENCE:
+            return None
+        back = v[[a[e] for e in arriving]] - v[x]      # from the corner to where each arriving edge came from
+        ahead = v[[b[e] for e in leaving]] - v[x]
+        back /= np.maximum(np.linalg.norm(back, axis=1), 1e-300)[:, None]
+        ahead /= np.maximum(np.linalg.norm(ahead, axis=1), 1e-300)[:, None]
+        cos = back @ ahead.T
+        used_in, used_out = set(), set()
+        for flat in np.argsort(-cos, axis=None, kind="stable").tolist():
+            i, j = divmod(flat, len(leaving))
+            if i in used_in or j in used_out:
+                continue
+            follow[arriving[i]] = leaving[j]
+            used_in.add(i)
+            used_out.add(j)
+    loops: list[list[int]] = []
+    seen = [False] * len(a)
+    for e0 in range(len(a)):
+        if seen[e0]:
+            continue
+        loop, e = [], e0
+        for _ in range(len(a)):                         # bounded: each edge once
+            seen[e] = True
+            loop.append(a[e])
+            e = follow[e]
+            if e == e0:
+                break
+        else:
+            return None
+        if len(set(loop)) != len(loop) or len(loop) < 3:
+            return None                                 # a corner twice on one loop
+        loops.append(loop)
+    return loops
 
 
 def _closed(key: np.ndarray, forward: np.ndarray, members: np.ndarray) -> bool:
@@ -544,12 +651,41 @@ def _merged(v: np.ndarray, f: np.ndarray, walls: list[Wall], plane_rtol: float) 
     return out
 
 
-def _flagged_pairs(contacts: SurfaceContacts, labels: np.ndarray) -> np.ndarray:
-    """Crossing pairs, and coplanar-opposite pairs within one shell (k, 2)."""
+def _flagged_pairs(contacts: SurfaceContacts, labels: np.ndarray, v: np.ndarray | None = None,
+                   f: np.ndarray | None = None) -> np.ndarray:
+    """Crossing pairs, coplanar-opposite pairs within one shell, and (given ``v`` and ``f``) the facing pairs at
+    edges of four or more faces (:func:`_facing_at_folded_edges`) (k, 2)."""
     cross = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
     opp = np.asarray(contacts.coplanar_opposite, dtype=np.int64).reshape(-1, 2)
     opp = opp[labels[opp[:, 0]] == labels[opp[:, 1]]]
-    return np.concatenate([cross, opp])
+    if v is None or f is None:
+        return np.concatenate([cross, opp])
+    return np.concatenate([cross, opp, _facing_at_folded_edges(v, f)])
+
+
+def _facing_at_folded_edges(v: np.ndarray, f: np.ndarray, cos_max: float = -1 + 1e-6) -> np.ndarray:
+    """(k, 2) pairs of faces on one edge of four or more faces that use it in opposite directions and face
+    opposite ways (cosine of their normals at most ``cos_max``): the two sheets of a wall at an edge both have.
+    Where the sheets' corners are coplanar only to rounding they can meet without crossing or overlapping
+    (the face-pair check calls them touching), so nothing else flags such a wall; the pairs only seed the
+    search (:func:`internal_walls`), which decides."""
+    key, forward = edge_keys(f, len(v))
+    order = np.argsort(key, kind="stable")
+    k = key[order]
+    starts = np.flatnonzero(np.r_[True, k[1:] != k[:-1]])
+    counts = np.diff(np.r_[starts, len(k)])
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    unit = normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    out = []
+    for i in range(int(counts.max(initial=0))):
+        for j in range(i + 1, int(counts.max(initial=0))):
+            at = starts[counts > j]
+            a, b = order[at + i], order[at + j]
+            ga, gb = a // 3, b // 3
+            keep = ((forward[a] != forward[b]) & (ga != gb)
+                    & (np.einsum("ij,ij->i", unit[ga], unit[gb]) <= cos_max))
+            out.append(np.stack([ga[keep], gb[keep]], axis=1))
+    return np.concatenate(out) if out else np.zeros((0, 2), dtype=np.int64)
 
 
 def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceContacts,
@@ -582,7 +718,7 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
     labels = np.asarray(labels, dtype=np.int64)
     if not contacts.complete:
         return None
-    pairs = _flagged_pairs(contacts, labels)
+    pairs = _flagged_pairs(contacts, labels, v, f)
     if not len(pairs):
         return None
     whole = volume_moments(v, f)
@@ -598,7 +734,7 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
         if not contacts.complete:
             return None
         labels, _ = shell_labels(g, len(v))
-        pairs = _flagged_pairs(contacts, labels)
+        pairs = _flagged_pairs(contacts, labels, v, g)
     found = internal_walls(v, g, pairs, plane_rtol=plane_rtol)
     wall = np.zeros(len(g), dtype=bool)
     for w in found:

@@ -626,20 +626,23 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=bool(inside[shells].any()))
 
 
-def misread_message(found: MisreadNesting, parity_volume: float, proven: bool) -> str:
-    """R4's note for :class:`MisreadNesting`: the reading kept, the other one and its volume."""
+def misread_message(found: MisreadNesting, parity_volume: float, proven: bool, kept: str | None = None) -> str:
+    """R4's note for :class:`MisreadNesting`: the reading kept, the other one and its volume (``kept``: what is
+    proven of the reading kept, when not the default sentence for ``proven``; "" for nothing)."""
     n = len(found.shells)
     them = "them" if n > 1 else "it"
     other = (f"at most {round_up(found.volume):.6g} m³ more" if found.nested else
              f"{parity_volume + found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % more mass")
-    kept = ("the parity solid is proven (exact)" if proven else
-            "the parity solid is not proven apart from that reading (its faces meet the body's only to rounding): "
-            "an estimate whose bounds span both readings")
+    if kept is None:
+        kept = ("the parity solid is proven (exact)" if proven else
+                "the parity solid is not proven apart from that reading (its faces meet the body's only to "
+                "rounding): an estimate whose bounds span both readings")
+    decide = f"The file does not decide; {kept}." if kept else "The file does not decide."
     return (f"{n} shell{'s' if n > 1 else ''} wound outward lie{'' if n > 1 else 's'} wholly inside another body "
             f"(free inside it or flush with its boundary): read by nesting depth as cavit{'ies' if n > 1 else 'y'} "
             f"(R4; a cavity written with the wrong winding reads the same), {found.volume:.6g} m³ taken "
             f"out; the file's own winding reads {them} as part of the body, the union of the bodies: {other}. "
-            f"The file does not decide; {kept}. If {them} {'are bodies' if n > 1 else 'is a body'}, unite "
+            f"{decide} If {them} {'are bodies' if n > 1 else 'is a body'}, unite "
             f"{them} with the body around {them} in the model; if a cavity, wind {them} inward")
 
 

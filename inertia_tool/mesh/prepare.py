@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import UsageError
+from ..errors import InternalInvariantError, UsageError
 from ..integrals import VolumeMoments, bounding_box
 from ..tolerances import MERGE_TOLERANCE
 from ..values import frozen_value
@@ -172,7 +172,9 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
 def _estimated(found: Resolution, common: dict[str, Any]) -> PreparedMesh:
     """A PreparedMesh holding one estimated solid (``repair=True``)."""
     est = found.estimate
-    assert est is not None, "only an estimated Resolution reaches here"
+    if est is None:
+        raise InternalInvariantError("an estimated resolution was expected to carry its estimate; found none "
+                                     f"(method {found.method!r})")
     moments = VolumeMoments(volume=est.volume, centroid=est.centroid, second_moment=est.second_moment,
                             area=est.area)
     lo, hi = bounding_box(found.vertices)

@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ..errors import ArrangementError, InvalidMeshError, MeshRepairedWarning, MeshResolvedWarning
+from ..errors import (ArrangementError, InternalInvariantError, InvalidMeshError, MeshRepairedWarning,
+                      MeshResolvedWarning)
 from ..integrals import volume_moments
 from .intersect import SurfaceContacts, surface_contacts
 from .policy import ShellContacts, self_crossing_message, shell_contacts
@@ -141,7 +142,9 @@ def _with_patch_doubt(forced: Resolution, patched: Estimate, source: str) -> Res
     than either alone, never narrower than the truth allows (before, the patches' doubt was dropped)."""
     from .uncertainty import check_useful, uncertainty_from
     est = forced.estimate
-    assert est is not None, "a forced resolution carries its estimate"
+    if est is None:
+        raise InternalInvariantError(f"{source}: the forced winding-number resolution was expected to carry its "
+                                     f"estimate; found none (method {forced.method!r})")
     doubt = est.uncertainty.volume_in_doubt + patched.uncertainty.volume_in_doubt
     far = max(est.far, patched.far + float(np.linalg.norm(np.asarray(est.centroid) - patched.centroid)))
     unc = uncertainty_from(est.volume, est.centroid, est.second_moment, doubt, far)

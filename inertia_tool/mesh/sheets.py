@@ -391,7 +391,7 @@ def open_sheets(vertices: np.ndarray, faces: np.ndarray, *, max_pieces: int = MA
     found = _indexed_sheets(v, f, max_pieces, plane_rtol, rim_rtol) if indexed else None
     if found is not None:
         return found
-    return _seamed_sheet(v, f, max_pieces, plane_rtol, rim_rtol, budget)
+    return _seamed_sheet(v, f, max_pieces, plane_rtol, rim_rtol, budget, boundary)
 
 
 def _indexed_sheets(v: np.ndarray, f: np.ndarray, max_pieces: int, plane_rtol: float,
@@ -465,16 +465,10 @@ def _indexed_sheets(v: np.ndarray, f: np.ndarray, max_pieces: int, plane_rtol: f
                       inside_area=inside_area, fin_area=fin_area)
 
 
-def _seam_plane(v: np.ndarray, f: np.ndarray, tolerance: float) -> tuple[np.ndarray, float] | None:
-    """Unit normal and offset of the plane holding every corner of the surface's unbalanced edges within
-    ``tolerance`` (the rim of one sheet whose faces are joined to the part's through T-vertices: the edges left
-    open are the other side's rim), or None."""
-    key, forward = edge_keys(f, len(v))
-    codes, inverse = _codes(key)
-    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
-    nv = np.int64(max(len(v), 1))
-    bad = codes[net != 0]
-    corners = np.unique(np.r_[bad // nv, bad % nv])
+def _seam_plane(v: np.ndarray, corners: np.ndarray, tolerance: float) -> tuple[np.ndarray, float] | None:
+    """Unit normal and offset of the plane holding every corner of the surface's unbalanced edges (``corners``,
+    :func:`_seam_corners`) within ``tolerance`` (the rim of one sheet whose faces are joined to the part's through
+    T-vertices: the edges left open are the other side's rim), or None."""
     if len(corners) < 3:
         return None
     p = v[corners]
@@ -514,7 +508,7 @@ def _split_like(v: np.ndarray, f: np.ndarray, splits: dict[tuple[int, int], list
 
 
 def _seamed_sheet(v: np.ndarray, f: np.ndarray, max_pieces: int, plane_rtol: float, rim_rtol: float,
-                  budget: float) -> OpenSheets | None:
+                  budget: float, boundary: np.ndarray | None = None) -> OpenSheets | None:
     """:func:`open_sheets` for one flat sheet joined to the rest through T-vertices (module docstring, "Seams")."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -523,7 +517,8 @@ def _seamed_sheet(v: np.ndarray, f: np.ndarray, max_pieces: int, plane_rtol: flo
     from .folds import _distance_bound
 
     tolerance = plane_rtol * float(np.abs(v).max())
-    plane = _seam_plane(v, f, tolerance)
+    seam = _seam_corners(f, len(v), boundary)         # once: the plane's test and the sheet's pieces both use them
+    plane = _seam_plane(v, seam, tolerance)
     if plane is None:
         return None
     unit, offset = plane
@@ -540,7 +535,6 @@ def _seamed_sheet(v: np.ndarray, f: np.ndarray, max_pieces: int, plane_rtol: flo
     graph = coo_matrix((np.ones(len(same), dtype=np.int8), (slot_face[order][same], slot_face[order][same + 1])),
                        shape=(len(near), len(near)))
     _, comp = connected_components(graph, directed=False)
-    seam = _seam_corners(f, len(v))
     touching = np.unique(comp[np.isin(f[near], seam).any(axis=1)])
     sheet = near[np.isin(comp, touching)]
     is_sheet = np.zeros(len(f), dtype=bool)
@@ -568,8 +562,12 @@ def _seamed_sheet(v: np.ndarray, f: np.ndarray, max_pieces: int, plane_rtol: flo
                       volume_bound=float(volume) * (1 + 1e-12))
 
 
-def _seam_corners(f: np.ndarray, n: int) -> np.ndarray:
-    """Corners of the surface's unbalanced edges (k,) int."""
+def _seam_corners(f: np.ndarray, n: int, boundary: np.ndarray | None = None) -> np.ndarray:
+    """Corners of the surface's unbalanced edges (k,) int, sorted: those of ``boundary`` (the net boundary,
+    :func:`~.rims.boundary_edges`, whose edges are exactly the unbalanced ones) when the caller has it, without
+    sorting every edge again."""
+    if boundary is not None:
+        return np.unique(np.asarray(boundary, dtype=np.int64).reshape(-1))
     key, forward = edge_keys(f, n)
     codes, inverse = _codes(key)
     net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
