@@ -70,20 +70,24 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
     (the boolean formed a reading, it did not decide one): when the turned surface still has crossing face pairs
     (faces coplanar only to rounding) the result is an estimate whose bound spans both readings (they differ only
     inside those shells: their volume, within their reach of the centroid).  The note, warned, names the other
-    reading and its volume.  Returns the result and, for an estimate, ``(volume in doubt, reach)``."""
+    reading and its volume.  Groups of crossing shells wound outward at odd depth (``oriented.groups``, kept as
+    bodies by the file's winding) have the same two readings and are never proven: an estimate whose bound spans
+    both.  Returns the result and, for an estimate, ``(volume in doubt, reach)``."""
     from .intersect import surface_contacts
 
-    found = oriented.misread
-    if found is None:
+    found, groups = oriented.misread, oriented.groups
+    if found is None and groups is None:
         return united, None
     if united.forced is not None or united.kind not in ("exact", "united"):
         # R4 turned those shells without a warning of its own (this is the one): say both readings here too
-        note = misread_message(found, float(total(united.shells.moments).volume), proven=False, kept="")
-        warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=3)
+        volume = float(total(united.shells.moments).volume)
+        for reading in (r for r in (found, groups) if r is not None):
+            note = misread_message(reading, volume, proven=False, kept="")
+            warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=3)
         return united, None
     spread = None
-    proven = united.kind == "exact"
-    if not proven:
+    proven = united.kind == "exact" and groups is None
+    if not proven and groups is None:
         turned = oriented.shells
         again = surface_contacts(turned.vertices, turned.faces)
         if again.complete and not len(again.crossing):
@@ -94,14 +98,18 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
                                      notes=tuple(n for n in united.notes if not n.startswith("touching up to")))
     shells = united.shells
     whole = total(shells.moments)
+    notes = []
     if not proven:
+        readings = [r for r in (found, groups) if r is not None]
         turned = oriented.shells
-        corners = np.unique(turned.faces[np.isin(turned.labels, found.shells)])
+        ids = np.concatenate([r.shells for r in readings])
+        corners = np.unique(turned.faces[np.isin(turned.labels, ids)])
         reach = float(np.sqrt(np.max(np.sum((turned.vertices[corners] - whole.centroid) ** 2, axis=1))))
-        spread = (found.volume * (1 + 1e-9), reach)
-    note = misread_message(found, float(whole.volume), proven)
-    warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=3)
-    return united._replace(notes=(*united.notes, note)), spread
+        spread = (sum(r.volume for r in readings) * (1 + 1e-9), reach)
+    for reading in (r for r in (found, groups) if r is not None):
+        notes.append(misread_message(reading, float(whole.volume), proven))
+        warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+    return united._replace(notes=(*united.notes, *notes)), spread
 
 
 def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patched: Estimate | None,

@@ -18,7 +18,7 @@ from ..errors import InsideOutWarning
 from ..integrals import VolumeMoments
 from .intersect import SurfaceContacts, surface_contacts
 from .policy import (MisreadNesting, ShellContacts, inward_crossing_outward, misread_nesting, orient_by_depth,
-                     shell_contacts, within_up_to_rounding)
+                     outward_crossing_groups, shell_contacts, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
 
@@ -56,6 +56,9 @@ class Orientation(NamedTuple):
     misread : MisreadNesting or None
         Shells the file winds outward that nesting depth reads as cavities (a reading the file does not decide:
         :func:`~.certify.misread_reading` labels it).
+    groups : MisreadNesting or None
+        Groups of crossing shells wound outward at odd depth, kept as bodies (``kept="union"``): the same two
+        readings (:func:`~.policy.outward_crossing_groups`; labelled by :func:`~.certify.misread_reading`).
     """
 
     shells: Shells
@@ -68,6 +71,7 @@ class Orientation(NamedTuple):
     ambiguous: int
     notes: tuple[str, ...]
     misread: MisreadNesting | None = None
+    groups: MisreadNesting | None = None
 
 
 def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContacts, *, source: str) -> Orientation:
@@ -80,10 +84,12 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     within, crossing_with = None, touch.crossing_with
     if touch.complete:
         within, crossing_with = _within(v, f, labels, file_volumes, crossing_with)
+        nest = _decide_past_partners(v, f, labels, n_shells, nest, crossing_with)
     flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
                                          within=_both(within, touch_within))
     misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
         if touch.complete else None                                                   # R4: the file does not decide
+    groups = outward_crossing_groups(file_volumes, flip, depth, crossing_with) if touch.complete else None
     quiet = np.zeros(n_shells, dtype=bool)
     if misread is not None:           # warned once, with both readings, by certify.misread_reading
         quiet[misread.shells] = True
@@ -110,7 +116,8 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
         candidates = boxes_meet(v, shells.faces, labels, n_shells) | undecided
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[crossing_with.reshape(-1)] = True
-    return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread)
+    return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
+                       groups)
 
 
 def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n_shells: int,
@@ -175,6 +182,49 @@ def _both(within: np.ndarray | None, more: np.ndarray) -> np.ndarray | None:
     if within is None:
         return more if len(more) else None
     return np.concatenate([np.asarray(within, dtype=np.int64).reshape(-1, 2), more]).reshape(-1, 2)
+
+
+#: Undecided shells that cross others probed again without those others (R4), at most; beyond, they stay undecided.
+MAX_REPROBED = 16
+
+
+def _decide_past_partners(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int, nest: Nesting | None,
+                          crossing_with: np.ndarray) -> Nesting | None:
+    """R4: shells left undecided because every probe lay on the surface of a shell they cross (a copy listed twice,
+    its coordinates rounded apart) probed again with those shells left out.  Their depth never counts the shells
+    they cross (:func:`~.policy.orient_by_depth`), so those surfaces need not be kept clear of; the winding numbers
+    of the others at the new probe are added to ``nest`` and the shell is decided."""
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    if nest is None or not len(pairs) or not np.asarray(nest.undecided).any():
+        return nest
+    undecided = np.asarray(nest.undecided, dtype=bool).copy()
+    todo = [s for s in np.flatnonzero(undecided) if np.any(pairs == s)][:MAX_REPROBED]
+    if not todo:
+        return nest
+    from .nesting import Nesting as Found, shell_nesting
+    shell, other, winding = [nest.shell], [nest.other], [nest.winding]
+    probes = np.array(nest.probes, dtype=np.float64, copy=True)
+    for s in todo:
+        partners = np.unique(np.concatenate([pairs[pairs[:, 0] == s, 1], pairs[pairs[:, 1] == s, 0]]))
+        keep = ~np.isin(labels, partners)
+        kept = np.flatnonzero(np.bincount(labels[keep], minlength=n_shells) > 0)   # old labels, ascending
+        if len(kept) < 2:
+            undecided[s] = False           # nothing else to lie in: depth 0
+            continue
+        relabel = np.full(n_shells, -1, dtype=np.int64)
+        relabel[kept] = np.arange(len(kept))
+        sub = shell_nesting(v, f[keep], relabel[labels[keep]], len(kept))
+        mine = int(relabel[s])
+        if sub.undecided[mine]:
+            continue
+        rows = sub.shell == mine
+        shell.append(np.full(int(np.count_nonzero(rows)), s, dtype=np.int64))
+        other.append(kept[sub.other[rows]])
+        winding.append(sub.winding[rows])
+        probes[s] = sub.probes[mine]
+        undecided[s] = False
+    return Found(shell=np.concatenate(shell), other=np.concatenate(other), winding=np.concatenate(winding),
+                 probes=probes, undecided=undecided)
 
 
 #: Crossing shell pairs tested for lying one within the other (R4), at most; beyond, a pair stays crossing.

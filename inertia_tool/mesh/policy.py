@@ -174,6 +174,7 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
            "near_copies", "NearCopies", "near_copies_message", "MisreadNesting", "misread_nesting",
+           "outward_crossing_groups",
            "misread_message"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
@@ -587,12 +588,16 @@ class MisreadNesting:
         Some other shell lies inside one of them (its own reading then differs too; the volume is a bound).
     reach : float
         m, the largest distance of a corner of these shells from the parity solid's centroid (set by the caller).
+    kept : str
+        The reading given: ``"parity"`` (the shells read as cavities, :func:`misread_nesting`), or ``"union"``
+        for a group of crossing shells that keep the file's winding (:func:`outward_crossing_groups`).
     """
 
     shells: np.ndarray
     volume: float
     nested: bool
     reach: float = 0.0
+    kept: str = "parity"
 
 
 def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray, nest: Nesting | None,
@@ -626,11 +631,61 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=bool(inside[shells].any()))
 
 
+def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray,
+                            crossing_with: np.ndarray) -> MisreadNesting | None:
+    """R4: groups of shells that cross one another, all wound outward in the file and kept so (bodies by the
+    file's winding, united by R6), that lie inside an odd number of other shells, or None.
+
+    One such shell alone would be R4's misread reading (:func:`misread_nesting`: nesting depth makes it a
+    cavity); crossing, the group has no depth of its own and keeps the file's winding, yet the same two readings
+    remain: the union (kept) and the group as one cavity (a cavity listed twice, its copies rounded apart).  The
+    file does not decide, so the answer is never certified ``united`` for them (:func:`~.certify.misread_reading`:
+    an estimate whose bounds span both readings).  ``volume``: their summed volume, a bound on what the readings
+    differ by."""
+    vols = np.asarray(file_volumes, dtype=np.float64)
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    if not len(pairs):
+        return None
+    n = len(vols)
+    parent = np.arange(n)
+
+    def root(k: int) -> int:
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = int(parent[k])
+        return k
+
+    for a, b in pairs.tolist():
+        ra, rb = root(a), root(b)
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    group = np.array([root(k) for k in range(n)])
+    member = np.zeros(n, dtype=bool)
+    member[pairs.reshape(-1)] = True
+    kept = (vols > 0) & ~np.asarray(flip, dtype=bool) & (np.asarray(depth) % 2 == 1)
+    found = np.zeros(n, dtype=bool)
+    for g in np.unique(group[member]):
+        members = member & (group == g)
+        if kept[members].all():
+            found |= members
+    if not found.any():
+        return None
+    shells = np.flatnonzero(found)
+    return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=True, kept="union")
+
+
 def misread_message(found: MisreadNesting, parity_volume: float, proven: bool, kept: str | None = None) -> str:
     """R4's note for :class:`MisreadNesting`: the reading kept, the other one and its volume (``kept``: what is
     proven of the reading kept, when not the default sentence for ``proven``; "" for nothing)."""
     n = len(found.shells)
     them = "them" if n > 1 else "it"
+    if found.kept == "union":
+        return (f"{n} shells wound outward that cross one another lie wholly inside another body: read by the "
+                f"file's winding as bodies and united with it; by nesting depth they would be one cavity (a "
+                f"cavity listed twice, its copies rounded apart, reads the same), at most {round_up(found.volume):.6g} "
+                "m³ less material. The file does not decide: an estimate whose bounds span both readings. If they "
+                "are bodies, unite them with the body around them in the model; if a cavity, keep one copy wound "
+                "inward")
     other = (f"at most {round_up(found.volume):.6g} m³ more" if found.nested else
              f"{parity_volume + found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % more mass")
     if kept is None:

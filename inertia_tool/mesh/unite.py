@@ -132,7 +132,7 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
                      f"volume equals the summed volume within {TOUCH_VOLUME_RTOL:g} (difference "
                      f"{abs(united.volume - summed):.3g} m³), so the summed integral is given, certified united "
                      "(the solid is ambiguous at the rounding level: not exact)")
-        if oriented.misread is None:      # else R4's reading decides the label and warns (certify.misread_reading)
+        if oriented.misread is None and oriented.groups is None:     # else R4's reading labels and warns (certify)
             warnings.warn(MeshResolvedWarning(f"{source}: {notes[-1]}"), stacklevel=4)
     elif united is None:
         forced = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
