@@ -59,6 +59,18 @@ from inertia_tool.batch.runner import BatchOptions, discover_files, run_batch  #
 from inertia_tool.batch.rows import open_results  # noqa: E402
 
 
+def _require_c_kernels() -> None:
+    """Stop unless the C kernels are loaded, or switched off on purpose (``INERTIA_TOOL_NO_ACCEL``): a checkout
+    whose ``_accel.c`` changed (a rebase) without a rebuild falls back to numpy with one warning, and its
+    numbers would be those of another program."""
+    from inertia_tool._native import NO_ACCEL_ENV, accel
+
+    if accel() is None and os.environ.get(NO_ACCEL_ENV, "").strip() in ("", "0"):
+        raise SystemExit(f"benchmark: the C kernels of {os.path.dirname(os.path.dirname(accel.__code__.co_filename))}"
+                         " are not loaded (a stale or missing build: rebuild the extension), so its numbers would "
+                         f"be numpy's; set {NO_ACCEL_ENV}=1 to time numpy on purpose")
+
+
 def _write_stl(path, mesh):
     tri = np.asarray(mesh.vertices, dtype=np.float32)[np.asarray(mesh.faces)]
     rec = np.zeros(len(tri), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
@@ -182,6 +194,7 @@ def main() -> None:
     kinds = tuple(k.strip() for k in args.kinds.split(",") if k.strip())
     if not kinds or not set(kinds) <= set(SMALL_KINDS):
         ap.error(f"--kinds takes some of {','.join(SMALL_KINDS)}, got {args.kinds!r}")
+    _require_c_kernels()
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, Python "
           f"{platform.python_version()}; load average before {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     with tempfile.TemporaryDirectory() as tmp:

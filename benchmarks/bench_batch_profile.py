@@ -36,7 +36,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 sys.path.insert(1, ROOT)
 
-from bench_batch import SMALL_KINDS, make_small_meshes  # noqa: E402
+from bench_batch import SMALL_KINDS, _require_c_kernels, make_small_meshes  # noqa: E402
 from inertia_tool.batch.runner import BatchOptions, analyze_chunk, discover_files  # noqa: E402
 from inertia_tool.mesh import LoadOptions  # noqa: E402
 
@@ -99,6 +99,7 @@ def main() -> None:
     ap.add_argument("--kinds", default=",".join(SMALL_KINDS), help="kinds of generated part, comma-separated")
     args = ap.parse_args()
     kinds = tuple(k.strip() for k in args.kinds.split(",") if k.strip())
+    _require_c_kernels()
     warnings.simplefilter("ignore")
     options = BatchOptions(load=LoadOptions(units="mm"), density=1240.0)
     with tempfile.TemporaryDirectory() as tmp:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -219,8 +220,9 @@ def test_dask_short_batch_is_one_equal_chunk_per_worker():
        spread=st.floats(0.0, 3.0), seed=st.integers(0, 2**16), prior=st.sampled_from([0.1, 1.0, 10.0]))
 def test_dask_short_batches_take_one_task_per_worker_and_bound_the_wait(files, per_file, spread, seed, prior):
     """Files of random sizes on two Dask workers (the model of ``test_batch_chunks._makespan``), the prior off by
-    10x either way: a short batch takes 2 chunks plus one per file heavier than a chunk, and ends at most half
-    its work plus two files after the ideal; a long one is sized as before."""
+    10x either way: a short batch takes 2 chunks plus one per file heavier than a chunk (and more where a half
+    holds over ``max_files`` files), and ends at most half its work plus two files after the ideal; a long one is
+    sized as before."""
     from test_batch_chunks import _makespan
 
     from inertia_tool.batch.chunks import DASK_CHUNK_SECONDS, DASK_TAIL_SECONDS, ChunkSizer
@@ -236,6 +238,71 @@ def test_dask_short_batches_take_one_task_per_worker_and_bound_the_wait(files, p
     assert makespan >= total / 2 - 1e-9
     if total * prior <= 4 * DASK_CHUNK_SECONDS:
         heavy = int(np.count_nonzero(weights > weights.sum() / 2))
-        assert chunks <= min(2 + heavy, files) and makespan - total / 2 <= total / 2 + 2 * largest + 1e-9
+        # a chunk holds at most max_files (1,000) files: a half of more is cut again
+        assert chunks <= min(2 + heavy + files // sizer.max_files, files)
+        assert makespan - total / 2 <= total / 2 + 2 * largest + 1e-9
     else:
         assert makespan - total / 2 <= max(DASK_TAIL_SECONDS, DASK_CHUNK_SECONDS / prior) + 2 * largest + 1e-9
+
+
+# -- the steps moved onto Python floats: the same bits as their array form ---------------------------------
+
+_COORD = st.floats(-1e6, 1e6, allow_nan=False)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.floats(1e-9, 1e9) | st.floats(-1e9, -1e-9), st.lists(_COORD, min_size=3, max_size=3),
+       st.lists(_COORD, min_size=9, max_size=9), st.lists(_COORD, min_size=3, max_size=3))
+def test_shell_moments_on_floats_are_the_array_form_bit_for_bit(volume, first, second, origin):
+    """``_finish`` (a shell's centroid and central second moment) on floats: the array form's bits."""
+    from inertia_tool.integrals import _finish
+
+    first_a, second_a, origin_a = np.array(first), np.array(second).reshape(3, 3), np.array(origin)
+    got = _finish(volume, first_a, second_a, 1.0, origin_a)
+    d = first_a / volume
+    central = second_a - volume * np.outer(d, d)
+    central = 0.5 * (central + central.T)
+    assert got.second_moment.tobytes() == central.tobytes()
+    assert got.centroid.tobytes() == (origin_a + d).tobytes()
+    assert got.volume == volume and got.area == 1.0
+
+
+def test_shell_of_no_volume_has_no_centroid():
+    from inertia_tool.integrals import _finish
+
+    got = _finish(0.0, np.zeros(3), np.eye(3), 2.0, np.ones(3))
+    assert np.isnan(got.centroid).all() and got.second_moment.tobytes() == np.eye(3).tobytes()
+
+
+@pytest.mark.parametrize("lo, hi, match", [
+    ([0.0, 0.0, 0.0], [1e31, 1.0, 1.0], r"reach 1e\+31 m"),
+    ([-math.inf, 0.0, 0.0], [math.inf, 1.0, 1.0], "reach inf m"),
+    ([math.nan, 0.0, 0.0], [1.0, 1.0, 1.0], "reach nan m"),
+    ([0.0, 0.0, 0.0], [1e-31, 0.0, 0.0], "spans only 1e-31 m"),
+])
+def test_magnitude_check_on_floats_keeps_its_messages(lo, hi, match):
+    """The bounding box's magnitude check on floats refuses what it refused, with the same words (NaN and
+    infinity named as numpy's max named them)."""
+    from inertia_tool.errors import InvalidMeshError
+    from inertia_tool.mesh.surface import check_magnitude
+
+    with pytest.raises(InvalidMeshError, match=match):
+        check_magnitude(np.array(lo), np.array(hi), "part.stl")
+    check_magnitude(np.array([-1.0, -2.0, -3.0]), np.array([1.0, 2.0, 3.0]), "part.stl")   # a plain box passes
+
+
+def test_needle_warning_still_names_the_digits():
+    """The needle check of the principal moments (on floats now): a rod whose smallest moment is 1e-12 of the
+    largest warns with the digits it carries, -log10(eps · I3 / I1) = 3.65, printed 4."""
+    from inertia_tool.errors import PhysicalValidityWarning
+    from inertia_tool.mass.pipeline import _warn_about_principal
+
+    props = MassProperties(mass=1.0, volume=1.0, center_of_mass=np.zeros(3),
+                           inertia=np.diag([1e-12, 1.0, 1.0 + 1e-3]), density=1.0, name="rod")
+    with pytest.warns(PhysicalValidityWarning, match=r"a needle\); it carries only about 4 correct digits"):
+        _warn_about_principal(props, "rod")
+    thick = MassProperties(mass=1.0, volume=1.0, center_of_mass=np.zeros(3),
+                           inertia=np.diag([1e-9, 1.0, 1.0 + 1e-3]), density=1.0, name="rod")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _warn_about_principal(thick, "rod")                  # 1e-9 of the largest: above the needle limit
