@@ -52,7 +52,10 @@ def test_an_estimate_missing_from_an_estimated_resolution_is_a_named_internal_er
     from inertia_tool.mesh.resolve import Resolution
     from inertia_tool.mesh.self_crossing import _with_patch_doubt
 
+    from inertia_tool.cli import EXIT_INTERNAL, exit_code
+
     assert issubclass(InternalInvariantError, InertiaToolError) and issubclass(InternalInvariantError, RuntimeError)
+    assert exit_code(InternalInvariantError("x")) == EXIT_INTERNAL == 1           # docs/usage.md: a bug, exit 1
     broken = Resolution(vertices=np.zeros((0, 3)), faces=np.zeros((0, 3), dtype=np.int64), method="winding",
                         notes=(), flipped_faces=0, welded_tolerance=None, nonmanifold_edges=0, estimate=None)
     with pytest.raises(InternalInvariantError, match="expected to carry its estimate; found none"):
