@@ -84,6 +84,9 @@ _U = 2.0 ** -53
 #: Work bound: groups of flagged faces examined as walls (each may grow through the surface); the rest stay
 #: on the normal path.
 MAX_WALL_GROUPS = 256
+#: Work bound: faces at one edge whose pairs seed the wall search (:func:`_facing_at_folded_edges`; the pairs grow
+#: with the square); edges of more faces seed nothing.
+MAX_FOLD_VALENCE = 8
 #: Open edges leaving one corner of the rims that are paired into loops (:func:`_rim_loops`); more are left to the
 #: normal path.
 MAX_RIM_VALENCE = 4
@@ -677,9 +680,10 @@ def _facing_at_folded_edges(v: np.ndarray, f: np.ndarray, cos_max: float = -1 + 
     normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     unit = normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
     out = []
-    for i in range(int(counts.max(initial=0))):
-        for j in range(i + 1, int(counts.max(initial=0))):
-            at = starts[counts > j]
+    top = min(int(counts.max(initial=0)), MAX_FOLD_VALENCE)
+    for i in range(top):
+        for j in range(i + 1, top):
+            at = starts[(counts > j) & (counts <= MAX_FOLD_VALENCE)]
             a, b = order[at + i], order[at + j]
             ga, gb = a // 3, b // 3
             keep = ((forward[a] != forward[b]) & (ga != gb)
