@@ -29,6 +29,7 @@ def test_an_outward_body_read_as_a_cavity_gets_one_warning_naming_both_readings(
     v, f, parity, union = _nested(lo, (1.0, 1.0, 1.0), inward=False)
     p, said = _inside_out_warnings(v, f)
     assert len(said) == 1, said
+    assert "1 of 2 shells are inside out for its nesting depth" in said[0]      # the flip, said once
     assert "does not decide" in said[0] and "cavit" in said[0] and "8 m³" in said[0] and "union" in said[0]
     assert p.volume == pytest.approx(parity[0], rel=1e-12)
 
