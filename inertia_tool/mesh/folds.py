@@ -84,6 +84,9 @@ _U = 2.0 ** -53
 #: Work bound: groups of flagged faces examined as walls (each may grow through the surface); the rest stay
 #: on the normal path.
 MAX_WALL_GROUPS = 256
+#: Work bound: planes of walls found in which unflagged walls are looked for (:func:`_unflagged_walls`; each
+#: plane tests every vertex).
+MAX_WALL_PLANES = 32
 #: Work bound: faces at one edge whose pairs seed the wall search (:func:`_facing_at_folded_edges`; the pairs grow
 #: with the square); edges of more faces seed nothing.
 MAX_FOLD_VALENCE = 8
@@ -366,6 +369,8 @@ def _unflagged_walls(v: np.ndarray, f: np.ndarray, found: list[Wall], wall: np.n
     out: list[Wall] = []
     planes: list[tuple[np.ndarray, float]] = []
     for w in found:
+        if len(planes) >= MAX_WALL_PLANES:
+            break
         plane = _plane(v, f[w.faces])
         if plane is None or any(abs(float(plane[0] @ u)) > 1 - 1e-12 and abs(plane[1] - o) <= tolerance
                                 for u, o in planes):
