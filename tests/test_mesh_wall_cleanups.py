@@ -29,6 +29,7 @@ def test_an_outward_body_read_as_a_cavity_gets_one_warning_naming_both_readings(
     v, f, parity, union = _nested(lo, (1.0, 1.0, 1.0), inward=False)
     p, said = _inside_out_warnings(v, f)
     assert len(said) == 1, said
+    assert "1 of 2 shells are inside out for its nesting depth" in said[0]      # the flip, said once
     assert "does not decide" in said[0] and "cavit" in said[0] and "8 m³" in said[0] and "union" in said[0]
     assert p.volume == pytest.approx(parity[0], rel=1e-12)
 
@@ -52,7 +53,10 @@ def test_an_estimate_missing_from_an_estimated_resolution_is_a_named_internal_er
     from inertia_tool.mesh.resolve import Resolution
     from inertia_tool.mesh.self_crossing import _with_patch_doubt
 
+    from inertia_tool.cli import EXIT_INTERNAL, exit_code
+
     assert issubclass(InternalInvariantError, InertiaToolError) and issubclass(InternalInvariantError, RuntimeError)
+    assert exit_code(InternalInvariantError("x")) == EXIT_INTERNAL == 1           # docs/usage.md: a bug, exit 1
     broken = Resolution(vertices=np.zeros((0, 3)), faces=np.zeros((0, 3), dtype=np.int64), method="winding",
                         notes=(), flipped_faces=0, welded_tolerance=None, nonmanifold_edges=0, estimate=None)
     with pytest.raises(InternalInvariantError, match="expected to carry its estimate; found none"):

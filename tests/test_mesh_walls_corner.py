@@ -240,3 +240,20 @@ def test_the_so101_upper_arm_cut_round_its_corner_is_exact(case_id):
     assert abs(p.volume - truth["volume"]) <= 1e-12 * truth["volume"]
     inertia = np.asarray(truth["inertia"])
     assert np.max(np.abs(p.inertia - inertia)) <= 1e-11 * np.max(np.abs(inertia))
+
+
+def test_an_edge_of_many_faces_seeds_no_quadratic_work():
+    """The facing pairs at four-face edges seed the wall search; an edge of 400 faces (a fan of slivers around
+    one edge) is past the work bound and seeds nothing, at once."""
+    from inertia_tool.mesh.folds import MAX_FOLD_VALENCE, _facing_at_folded_edges
+
+    k = 400
+    angle = np.linspace(0, 2 * np.pi, k, endpoint=False)
+    v = np.vstack([[0, 0, 0], [0, 0, 1], np.stack([np.cos(angle), np.sin(angle), np.full(k, 0.5)], axis=1)])
+    f = np.array([[0, 1, 2 + i] if i % 2 else [1, 0, 2 + i] for i in range(k)], dtype=np.int64)
+    assert len(_facing_at_folded_edges(v, f)) == 0 and MAX_FOLD_VALENCE < k
+    # four faces: a wall's two sheets (opposite ways, opposite normals) and two faces of the part
+    v4 = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, 1, 0], [0.5, 0, 1], [0.5, 0, -1]], dtype=float)
+    f4 = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4], [1, 0, 5]], dtype=np.int64)
+    pairs = {tuple(sorted(p)) for p in _facing_at_folded_edges(v4, f4).tolist()}
+    assert (0, 1) in pairs

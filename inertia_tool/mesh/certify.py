@@ -16,8 +16,8 @@ from ..errors import InsideOutWarning
 from ..integrals import total_roundoff
 from ..rounding import round_up
 from ..tolerances import ROUNDOFF_RTOL
-from .policy import Certificate, ShellContacts, misread_message
-from .shells import Shells, total
+from .policy import Certificate, MisreadNesting, ShellContacts, misread_message
+from .shells import Shells, flipped_text, total
 
 if TYPE_CHECKING:
     from .classify import Orientation
@@ -83,7 +83,8 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
         volume = float(total(united.shells.moments).volume)
         for reading in (r for r in (found, groups) if r is not None):
             note = misread_message(reading, volume, proven=False, kept="")
-            warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=3)
+            said = f"{_turned(reading, oriented)}: " if reading is found else ""        # R4 flipped these: said once
+            warnings.warn(InsideOutWarning(f"{source}: {said}{note}"), stacklevel=3)
         return united, None
     spread = None
     proven = united.kind == "exact" and groups is None
@@ -108,8 +109,14 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
         spread = (sum(r.volume for r in readings) * (1 + 1e-9), reach)
     for reading in (r for r in (found, groups) if r is not None):
         notes.append(misread_message(reading, float(whole.volume), proven))
-        warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=3)
+        said = f"{_turned(reading, oriented)}: " if reading is found else ""            # R4 flipped these: said once
+        warnings.warn(InsideOutWarning(f"{source}: {said}{notes[-1]}"), stacklevel=3)
     return united._replace(notes=(*united.notes, *notes)), spread
+
+
+def _turned(found: MisreadNesting, oriented: Orientation) -> str:
+    """The flip said once (R4 turned these shells without a warning of its own): the start of the one warning."""
+    return flipped_text(len(found.shells), oriented.shells.n_shells)
 
 
 def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patched: Estimate | None,

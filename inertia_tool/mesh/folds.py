@@ -39,10 +39,15 @@ sheets cancel exactly: the density ``Σ ±1_T`` of the projected faces jumps acr
 in ``Z``, which is zero, so it is zero everywhere (their signed areas cancel over every region of the plane) and
 ``w_Z = 0`` off ``P``.
 
-A wall ``W`` is grown from the faces of crossing or coplanar-opposite pairs (connected through those pairs), then
-through shared edges to every face within ``tolerances.WALL_PLANE_RTOL`` of the same plane; it is taken for a wall
-only when its faces' vector areas nearly cancel (two sheets of opposite orientation; a closed surface's vector area
-is zero), and walls must not share a corner.  ``W`` need not be closed by index: where one sheet's rim has a corner
+A wall ``W`` is grown from the faces of crossing or coplanar-opposite pairs, and of pairs facing each other at an
+edge of four or more faces (sheets coplanar only to rounding can meet there without crossing), connected through
+those pairs whose faces lie in one plane (where the rim runs along a flat side of the part, a wall face crosses
+that side's faces by rounding: a group of two planes would be no wall), then through shared edges to every face
+within ``tolerances.WALL_PLANE_RTOL`` of the same plane; it is taken for a wall only when its faces' vector areas
+nearly cancel (two sheets of opposite orientation; a closed surface's vector area is zero), and walls must not
+share a corner.  In the plane of a wall found, the other faces joined through shared edges whose vector areas
+cancel are a wall too (a piece of the cut apart from the rest, which no flagged pair reached).
+``W`` need not be closed by index: where one sheet's rim has a corner
 the other's lacks (T-vertices along the rim, common when the halves were cut apart), ``S − W`` is left with open
 loops.  Each loop ``a → b → w₁ → … → w_k → a`` (one simple cycle, its longest edge ``a → b`` in a face
 ``F = (a, b, x)`` of ``S − W``) is closed by splitting ``F`` along the rest of the loop into the fan
@@ -50,7 +55,10 @@ loops.  Each loop ``a → b → w₁ → … → w_k → a`` (one simple cycle, 
 = (W + Q) − (X + Q)`` for the closed surface ``S* = S − W + X``: ``W + Q`` is closed with every corner near ``P``
 (the slab lemma: ``2δ·(area W + area Q)``), and ``X + Q`` is the boundary of the pyramid with apex ``x`` over the
 loop (``Σ |tet(x, a, wᵢ, wᵢ₊₁)|``: zero when the loop's corners are collinear with ``a`` and ``b``, or when
-``F`` lies in the plane of the loop).
+``F`` lies in the plane of the loop).  Where the rim turns round a corner of the part that both sheets' rims share,
+and they differ on both sides of it, the open edges form two loops through that corner: each edge arriving there
+is followed by the leaving edge that turns back most sharply.  Any pairing gives closed loops whose sum is the rim,
+which is all the bound needs; this one gives loops that run out along one side and back.
 
 The bound
 ---------
@@ -84,6 +92,12 @@ _U = 2.0 ** -53
 #: Work bound: groups of flagged faces examined as walls (each may grow through the surface); the rest stay
 #: on the normal path.
 MAX_WALL_GROUPS = 256
+#: Work bound: planes of walls found in which unflagged walls are looked for (:func:`_unflagged_walls`; each
+#: plane tests every vertex).
+MAX_WALL_PLANES = 32
+#: Work bound: faces at one edge whose pairs seed the wall search (:func:`_facing_at_folded_edges`; the pairs grow
+#: with the square); edges of more faces seed nothing.
+MAX_FOLD_VALENCE = 8
 #: Open edges leaving one corner of the rims that are paired into loops (:func:`_rim_loops`); more are left to the
 #: normal path.
 MAX_RIM_VALENCE = 4
@@ -363,6 +377,8 @@ def _unflagged_walls(v: np.ndarray, f: np.ndarray, found: list[Wall], wall: np.n
     out: list[Wall] = []
     planes: list[tuple[np.ndarray, float]] = []
     for w in found:
+        if len(planes) >= MAX_WALL_PLANES:
+            break
         plane = _plane(v, f[w.faces])
         if plane is None or any(abs(float(plane[0] @ u)) > 1 - 1e-12 and abs(plane[1] - o) <= tolerance
                                 for u, o in planes):
@@ -677,9 +693,10 @@ def _facing_at_folded_edges(v: np.ndarray, f: np.ndarray, cos_max: float = -1 + 
     normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     unit = normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
     out = []
-    for i in range(int(counts.max(initial=0))):
-        for j in range(i + 1, int(counts.max(initial=0))):
-            at = starts[counts > j]
+    top = min(int(counts.max(initial=0)), MAX_FOLD_VALENCE)
+    for i in range(top):
+        for j in range(i + 1, top):
+            at = starts[(counts > j) & (counts <= MAX_FOLD_VALENCE)]
             a, b = order[at + i], order[at + j]
             ga, gb = a // 3, b // 3
             keep = ((forward[a] != forward[b]) & (ga != gb)

@@ -223,11 +223,15 @@ def apply_flips(shells: Shells, flip: np.ndarray, source: str, *, warn: bool = T
     moments = [VolumeMoments(-s.volume, s.centroid, -s.second_moment, s.area, s.zero_area_faces) if flip[k] else s
                for k, s in enumerate(moments)]
     if warn:
-        n_flipped = int(np.count_nonzero(flip))
-        what = "the mesh is" if n_shells == 1 or n_flipped == n_shells else f"{n_flipped} of {n_shells} shells are"
-        warnings.warn(InsideOutWarning(f"{source}: {what} inside out for its nesting depth (a body wound inward "
-                                       "or a cavity outward); flipped"), stacklevel=5)
+        warnings.warn(InsideOutWarning(f"{source}: {flipped_text(int(np.count_nonzero(flip)), n_shells)}"),
+                      stacklevel=5)
     return Shells(v, f, labels, n_shells, moments, bound)
+
+
+def flipped_text(n_flipped: int, n_shells: int) -> str:
+    """R4's words for shells turned for their nesting depth (the start of its warning)."""
+    what = "the mesh is" if n_shells == 1 or n_flipped == n_shells else f"{n_flipped} of {n_shells} shells are"
+    return f"{what} inside out for its nesting depth (a body wound inward or a cavity outward); flipped"
 
 
 def total(shells: Sequence[VolumeMoments]) -> VolumeMoments:
