@@ -708,6 +708,21 @@ def _facing_at_folded_edges(v: np.ndarray, f: np.ndarray, cos_max: float = -1 + 
 def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceContacts,
                  labels: np.ndarray | None = None, *,
                  budget: float = ROUNDOFF_RTOL, plane_rtol: float = WALL_PLANE_RTOL) -> Folds | None:
+    """R3a (:func:`_settle_folds`): the wall search seeded by the flagged pairs and the facing pairs at edges of
+    four or more faces; when that settles nothing, seeded by the flagged pairs alone.  More seeds can join a
+    found wall's faces to faces of another plane (two touching copies' contact faces with the faces facing
+    them round its rim), and then no wall passes; either search's result passes the same checks."""
+    found = _settle_folds(vertices, faces, contacts, labels, budget=budget, plane_rtol=plane_rtol, facing=True)
+    if found is None:
+        found = _settle_folds(vertices, faces, contacts, labels, budget=budget, plane_rtol=plane_rtol,
+                              facing=False)
+    return found
+
+
+def _settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceContacts,
+                  labels: np.ndarray | None = None, *,
+                  budget: float = ROUNDOFF_RTOL, plane_rtol: float = WALL_PLANE_RTOL,
+                  facing: bool = True) -> Folds | None:
     """R3a: the surface with its sliver fans and internal walls taken out, when what they change is within
     ``budget`` and the rest has no crossing face pair (module docstring); else None.
 
@@ -735,7 +750,7 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
     labels = np.asarray(labels, dtype=np.int64)
     if not contacts.complete:
         return None
-    pairs = _flagged_pairs(contacts, labels, v, f)
+    pairs = _flagged_pairs(contacts, labels, v, f) if facing else _flagged_pairs(contacts, labels)
     if not len(pairs):
         return None
     whole = volume_moments(v, f)
@@ -751,7 +766,7 @@ def settle_folds(vertices: np.ndarray, faces: np.ndarray, contacts: SurfaceConta
         if not contacts.complete:
             return None
         labels, _ = shell_labels(g, len(v))
-        pairs = _flagged_pairs(contacts, labels, v, g)
+        pairs = _flagged_pairs(contacts, labels, v, g) if facing else _flagged_pairs(contacts, labels)
     found = internal_walls(v, g, pairs, plane_rtol=plane_rtol)
     wall = np.zeros(len(g), dtype=bool)
     for w in found:
