@@ -74,7 +74,7 @@ def peak_of(argv: list) -> tuple[int, int]:
     root = os.path.dirname(HERE)
     env = {**os.environ, "PYTHONPATH": root}
     cmd = [sys.executable, "-c", _WRAPPER, sys.executable, "-m", "inertia_tool", *argv]
-    out = subprocess.run(cmd, capture_output=True, text=True, env=env, check=True).stdout.split()
+    out = subprocess.run(cmd, capture_output=True, text=True, env=env, check=True, cwd=root).stdout.split()
     return int(out[0]), int(out[1])
 
 
@@ -247,7 +247,9 @@ def stages(paths: list) -> None:
     import subprocess
     env = {**os.environ, "PYTHONPATH": os.path.dirname(HERE)}
     for path in paths:
-        r = subprocess.run([sys.executable, "-c", _STAGES_CHILD, path], capture_output=True, text=True, env=env)
+        # cwd: a ``-c`` child puts its working directory first on sys.path, which would shadow PYTHONPATH
+        r = subprocess.run([sys.executable, "-c", _STAGES_CHILD, path], capture_output=True, text=True, env=env,
+                           cwd=os.path.dirname(HERE))
         if r.returncode:
             raise RuntimeError(f"the stage child failed on {path}: {r.stderr[-2000:]}")
         print(r.stdout)

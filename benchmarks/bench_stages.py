@@ -324,8 +324,9 @@ def measure(path: str, repeat: int) -> dict:
     faults_best_run = {k: runs[best][4][k] / corners * 1e3 for k in rows}
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (_package_root(), os.environ.get("PYTHONPATH")) if p)
+    # cwd: a ``-c`` child puts its working directory first on sys.path, ahead of PYTHONPATH
     child = subprocess.run([sys.executable, "-c", _CHILD, path], capture_output=True, text=True, check=True,
-                           env=env)
+                           env=env, cwd=_package_root())
     base, peak = (int(x) for x in child.stdout.split()[-2:])
     med = statistics.median
     return {

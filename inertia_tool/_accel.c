@@ -4800,6 +4800,20 @@ ct_classify(CtFace *A, CtFace *B, CtStats *st)
 #endif
 #define CT_MORTON_BITS 11       /* per axis: a 33-bit code, sorted in three passes of 11 bits */
 
+/* Reads at random (faces in hierarchy order, rows of the caller's faces) are fetched this many places ahead. */
+#define CT_AHEAD 32
+
+static inline void
+ct_prefetch(const void *p)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(p);
+#else
+    (void)p;
+#endif
+}
+
+
 static inline double
 ct_min3(double a, double b, double c)
 {
@@ -5281,19 +5295,17 @@ ct_stars_scratch(int64_t n, int64_t m)
 }
 
 static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces,
-                    int64_t total, const int32_t *order, int32_t *twin, int threads);
+                    int64_t total, const int32_t *pos, int32_t *twin, int threads);
 
 /* The faces of each vertex of at least list_min faces (in scratch, ct_stars_scratch(n, m) bytes, any content):
  * *off (n int64: the start of each kept vertex's range of faces, -1 for the others) and *faces (the faces of
  * each kept vertex, vertex after vertex, *total of them; a face holding v twice is listed twice).  With label
  * (per face, its certified patch or 0) a vertex whose faces all lie in one certified patch is not kept either
  * (ct_star_certs would not try it): on a smooth surface that is nearly every vertex, so the lists of the star
- * certificates take a few bytes a face instead of 16 when they are made after the patches.  With order (the
- * face at each hierarchy position) the lists hold positions instead of faces (ct_twins then needs no map from
- * faces to positions: 4 bytes a face less at the check's high point). */
+ * certificates take a few bytes a face instead of 16 when they are made after the patches. */
 static void
-ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, const int32_t *label,
-              const int32_t *order, void *scratch, int64_t **off_out, int32_t **faces_out, int64_t *total_out)
+ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, const int32_t *label, void *scratch,
+              int64_t **off_out, int32_t **faces_out, int64_t *total_out)
 {
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
     int64_t *off = (int64_t *)scratch;
@@ -5330,12 +5342,11 @@ ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, 
             off[v] = -1;
         }
     }
-    for (int64_t i = 0; i < m; i++) {
-        int64_t f = order != NULL ? order[i] : i;
+    for (int64_t f = 0; f < m; f++) {
         for (int c = 0; c < 3; c++) {
             int64_t v = index_at(F, fsize, 3 * (size_t)f + (size_t)c);
             if (off[v] < 0) continue;
-            faces[--off[v]] = (int32_t)i;           /* a face holding v twice is listed twice (then rejected) */
+            faces[--off[v]] = (int32_t)f;           /* a face holding v twice is listed twice (then rejected) */
         }
     }
     *off_out = off;
@@ -5380,7 +5391,7 @@ ct_stars(const double *V, int64_t n, const void *F, int fsize, int64_t m, int64_
 {
     int64_t *off, total;
     int32_t *faces;
-    ct_star_lists(n, F, fsize, m, min_faces, NULL, NULL, scratch, &off, &faces, &total);
+    ct_star_lists(n, F, fsize, m, min_faces, NULL, scratch, &off, &faces, &total);
     return ct_star_certs(V, n, F, fsize, off, faces, total, min_faces, big_faces, cert, threads, NULL);
 }
 
@@ -5402,26 +5413,32 @@ ct_leaf_apex(const int32_t *ids, const uint8_t *cert, int64_t s, int64_t count)
 }
 
 /* Boxes of the faces in blocks of CT_LEAF hierarchy positions, coordinate by coordinate (structure of arrays),
- * one byte per bound: block b holds lo x, lo y, lo z, hi x, hi y, hi z of positions CT_LEAF b .. CT_LEAF b +
- * CT_LEAF - 1, CT_LEAF bytes each, on its leaf's grid (ct_grid: the leaf's float32 box cut into 254 steps per
- * axis), rounded outward: 6 bytes a face instead of 24 for float32 boxes.  Positions past the last face hold
- * lo 255, hi 0, and every block mask is cut to the positions that hold faces (ct_leaf_bits).  One leaf of the
+ * one 16-bit step number per bound: block b holds lo x, lo y, lo z, hi x, hi y, hi z of positions CT_LEAF b ..
+ * CT_LEAF b + CT_LEAF - 1, CT_LEAF CtQ each, on its leaf's grid (ct_grid: the leaf's float32 box cut into
+ * CT_QSTEPS steps per axis), rounded outward: 12 bytes a face instead of 24 for float32 boxes.  (Bytes, 254
+ * steps, took 6 but tested 75 % more pairs on a CAD part, whose slivers stretch a leaf's box.)  Positions past
+ * the last face hold lo CT_QMAX, hi 0, and every block mask is cut to the positions that hold faces
+ * (ct_leaf_bits).  One leaf of the
  * hierarchy is one block, so a face is tested against a whole leaf's boxes at once (ct_block_mask).
  *
  * Why the test stays conservative (a pair whose exact boxes meet always passes; the float64 boxes then decide,
  * so the pairs, counts and classes are those of float32 or float64 boxes): on an axis of a leaf with finite
- * float32 bounds L <= H the grid is T(x) = fl(fl(x - L) * inv), inv = fl(254 / fl(H - L)) (inv = 1 when
+ * float32 bounds L <= H the grid is T(x) = fl(fl(x - L) * inv), inv = fl(S / fl(H - L)), S = CT_QSTEPS (inv = 1 when
  * H = L), a composition of correctly rounded operations with positive constants, hence monotone in x; T(L) = 0
- * and T(H) < 255 (254 to within a few units in the last place).  A face is stored as floor(T(lo)) and
+ * and T(H) < S + 1 (S to within a few units in the last place).  A face is stored as floor(T(lo)) and
  * ceil(T(hi)) of its exact (float64) box.  A query box [la, ha] containing another face's exact box gets
- * ql = floor(T(la)) (0 below 0; no face of the leaf meets it when T(la) >= 255) and qh = ceil(T(ha)) (255
+ * ql = floor(T(la)) (0 below 0; no face of the leaf meets it when T(la) >= S + 1) and qh = ceil(T(ha)) (S + 1
  * above; none when T(ha) < 0), so exact boxes that meet, lo_b <= hi_a and lo_a <= hi_b, give by monotonicity
  * ql <= T(la) <= T(hi_b) <= qhi_b and qlo_b <= T(lo_b) <= T(ha) <= qh.  A query from another leaf is that
- * face's grid box mapped back (ct_grid_lo / ct_grid_hi: L + q s moved outward by a margin of 2^-48 (|L| + 256 s),
- * far above the few rounding errors of the map there and back), or a node's float32 box; within one leaf the
+ * face's grid box mapped back (ct_grid_lo / ct_grid_hi: L + q s moved outward by a margin of 2^-48 (|L| + 2^16 s);
+ * the map there and back errs by at most about 7 u (|L| + q s), q < 2^16, u = 2^-53: the rounding of T, of
+ * s = fl(span fl(1 / S)) against 1 / inv, of q s and of the sum), or a node's float32 box; within one leaf the
  * bytes are compared as they are.  An axis with an infinite bound (coordinates beyond float32's range, a direct
- * call) is not cut: its bytes are 0 and 255 and every query covers them. */
+ * call) is not cut: its steps are 0 and CT_QMAX and every query covers them. */
 #define CT_BLOCK (6 * CT_LEAF)
+typedef uint16_t CtQ;           /* a bound's step number on its leaf's grid */
+#define CT_QMAX 65535u
+#define CT_QSTEPS 65534.0       /* T(H) < CT_QMAX */
 
 typedef struct {
     double L[3], s[3], inv[3];  /* per axis: the grid's origin, step and inverse step */
@@ -5436,26 +5453,26 @@ ct_grid(const CtNode *leaf, CtGrid *g)
         g->ok[c] = isfinite(lo) && isfinite(hi);
         double span = hi - lo;
         g->L[c] = lo;
-        g->s[c] = g->ok[c] && span > 0 ? span / 254.0 : 1.0;
-        g->inv[c] = g->ok[c] && span > 0 ? 254.0 / span : 1.0;
+        g->s[c] = g->ok[c] && span > 0 ? span * (1.0 / CT_QSTEPS) : 1.0;    /* 1 / inv within a few ulps */
+        g->inv[c] = g->ok[c] && span > 0 ? CT_QSTEPS / span : 1.0;
     }
 }
 
 /* The stored bytes of the exact bounds lo <= hi on axis c of grid g. */
 static inline void
-ct_grid_store(const CtGrid *g, int c, double lo, double hi, uint8_t *qlo, uint8_t *qhi)
+ct_grid_store(const CtGrid *g, int c, double lo, double hi, CtQ *qlo, CtQ *qhi)
 {
     if (!g->ok[c]) {
         *qlo = 0;
-        *qhi = 255;
+        *qhi = (CtQ)CT_QMAX;
         return;
     }
-    double tl = (lo - g->L[c]) * g->inv[c], th = (hi - g->L[c]) * g->inv[c];     /* 0 <= tl <= th < 255 */
+    double tl = (lo - g->L[c]) * g->inv[c], th = (hi - g->L[c]) * g->inv[c];     /* 0 <= tl <= th < QMAX */
     unsigned a = tl > 0 ? (unsigned)tl : 0u;                                     /* floor */
     unsigned b = th > 0 ? (unsigned)th : 0u;
     if ((double)b < th) b++;                                                     /* ceil */
-    *qlo = (uint8_t)(a < 255 ? a : 255);
-    *qhi = (uint8_t)(b < 255 ? b : 255);
+    *qlo = (CtQ)(a < CT_QMAX ? a : CT_QMAX);
+    *qhi = (CtQ)(b < CT_QMAX ? b : CT_QMAX);
 }
 
 /* The query [la, ha] on axis c of grid g as bytes [*ql, *qh]; 0 when it meets no box of the leaf. */
@@ -5464,14 +5481,14 @@ ct_grid_query(const CtGrid *g, int c, double la, double ha, unsigned *ql, unsign
 {
     if (!g->ok[c]) {
         *ql = 0;
-        *qh = 255;
+        *qh = CT_QMAX;
         return 1;
     }
     double tl = (la - g->L[c]) * g->inv[c], th = (ha - g->L[c]) * g->inv[c];
-    if (!(tl < 255.0) || !(th >= 0.0)) return 0;
+    if (!(tl < (double)CT_QMAX) || !(th >= 0.0)) return 0;
     unsigned a = tl > 0 ? (unsigned)tl : 0u;
-    unsigned b = th < 255.0 ? (unsigned)th : 255u;
-    if (th < 255.0 && (double)b < th) b++;
+    unsigned b = th < (double)CT_QMAX ? (unsigned)th : CT_QMAX;
+    if (th < (double)CT_QMAX && (double)b < th) b++;
     *ql = a;
     *qh = b;
     return 1;
@@ -5482,14 +5499,14 @@ static inline double
 ct_grid_lo(const CtGrid *g, int c, unsigned q, float node_lo)
 {
     if (!g->ok[c]) return node_lo;
-    return (g->L[c] + (double)q * g->s[c]) - 0x1p-48 * (fabs(g->L[c]) + 256.0 * g->s[c]);
+    return (g->L[c] + (double)q * g->s[c]) - 0x1p-48 * (fabs(g->L[c]) + 65536.0 * g->s[c]);
 }
 
 static inline double
 ct_grid_hi(const CtGrid *g, int c, unsigned q, float node_hi)
 {
     if (!g->ok[c]) return node_hi;
-    return (g->L[c] + (double)q * g->s[c]) + 0x1p-48 * (fabs(g->L[c]) + 256.0 * g->s[c]);
+    return (g->L[c] + (double)q * g->s[c]) + 0x1p-48 * (fabs(g->L[c]) + 65536.0 * g->s[c]);
 }
 
 static inline int
@@ -5507,20 +5524,67 @@ ct_ctz(unsigned x)              /* index of the lowest set bit of x != 0 */
 #endif
 }
 
-/* Bit j set when box j of the block meets the query bytes ql .. qh on every axis (closed boxes). */
+/* A face of leaf p as a query on leaf q's grid without mapping each bound back to a coordinate: per axis
+ * with both grids cut, t = A + q B with A = fl(fl(L_p - L_q) inv_q), B = fl(s_p inv_q), widened by
+ * E = m_p inv_q + 2^-44 (|A| + 2^16 B + 2^16), m_p the margin of ct_grid_lo: in exact arithmetic
+ * A + q B - m_p inv_q is (la - L_q) inv_q for the la of ct_grid_lo (at most the face's lower bound), and E also
+ * covers the roundings of A, B and of the evaluation (a few u (|A| + 2^16 B)) and T's own (2 u 2^16 on q's
+ * range): so floor(A + q_lo B - E) is at most T_q of any bound at or above the face's lower bound, and
+ * ceil(A + q_hi B + E) at least T_q of any bound at or below its upper one -- the conditions the monotone
+ * argument above asks of ql and qh.  Where q's grid is not cut every face covers the axis; where p's is not,
+ * p's node box is the query of every face of p.  0 when no face of p can meet q. */
+typedef struct {
+    double A[3], B[3], E[3];
+    int affine[3];
+    unsigned ql[3], qh[3];      /* the query of every face where !affine */
+} CtMap;
+
+static inline int
+ct_pair_map(const CtGrid *gp, const CtGrid *gq, const CtNode *p, CtMap *map)
+{
+    int ok = 1;
+    for (int c = 0; c < 3; c++) {
+        map->affine[c] = 0;
+        map->A[c] = map->B[c] = map->E[c] = 0.0;
+        map->ql[c] = map->qh[c] = 0;
+        if (!gq->ok[c]) {
+            map->ql[c] = 0;
+            map->qh[c] = CT_QMAX;
+        }
+        else if (!gp->ok[c]) {
+            ok &= ct_grid_query(gq, c, p->lo[c], p->hi[c], &map->ql[c], &map->qh[c]);
+        }
+        else {
+            map->affine[c] = 1;
+            map->A[c] = (gp->L[c] - gq->L[c]) * gq->inv[c];
+            map->B[c] = gp->s[c] * gq->inv[c];
+            map->E[c] = 0x1p-48 * (fabs(gp->L[c]) + 65536.0 * gp->s[c]) * gq->inv[c]
+                        + 0x1p-44 * (fabs(map->A[c]) + 65536.0 * map->B[c] + 65536.0);
+        }
+    }
+    return ok;
+}
+
+/* Bit j set when box j of the block meets the query steps ql .. qh on every axis (closed boxes). */
 static inline unsigned
-ct_block_mask(const uint8_t *blk, const unsigned *ql, const unsigned *qh)
+ct_block_mask(const CtQ *blk, const unsigned *ql, const unsigned *qh)
 {
 #if defined(__SSE2__) && CT_LEAF == 16
-    __m128i ok = _mm_set1_epi8((char)-1);
+    /* SSE2 compares signed 16-bit words: both sides are moved by 2^15 (x ^ 0x8000), which keeps their order */
+    const __m128i flip = _mm_set1_epi16((short)0x8000);
+    __m128i bad0 = _mm_setzero_si128(), bad1 = _mm_setzero_si128();    /* positions 0-7, 8-15 */
     for (int c = 0; c < 3; c++) {
-        __m128i lo = _mm_loadu_si128((const __m128i *)(blk + c * CT_LEAF));
-        __m128i hi = _mm_loadu_si128((const __m128i *)(blk + (3 + c) * CT_LEAF));
-        /* unsigned bytes: lo <= qh iff min(lo, qh) == lo; hi >= ql iff max(hi, ql) == hi */
-        ok = _mm_and_si128(ok, _mm_cmpeq_epi8(_mm_min_epu8(lo, _mm_set1_epi8((char)qh[c])), lo));
-        ok = _mm_and_si128(ok, _mm_cmpeq_epi8(_mm_max_epu8(hi, _mm_set1_epi8((char)ql[c])), hi));
+        __m128i QH = _mm_xor_si128(_mm_set1_epi16((short)qh[c]), flip);
+        __m128i QL = _mm_xor_si128(_mm_set1_epi16((short)ql[c]), flip);
+        const __m128i *lo = (const __m128i *)(blk + c * CT_LEAF), *hi = (const __m128i *)(blk + (3 + c) * CT_LEAF);
+        /* apart when lo > qh or ql > hi */
+        bad0 = _mm_or_si128(bad0, _mm_cmpgt_epi16(_mm_xor_si128(_mm_loadu_si128(lo), flip), QH));
+        bad1 = _mm_or_si128(bad1, _mm_cmpgt_epi16(_mm_xor_si128(_mm_loadu_si128(lo + 1), flip), QH));
+        bad0 = _mm_or_si128(bad0, _mm_cmpgt_epi16(QL, _mm_xor_si128(_mm_loadu_si128(hi), flip)));
+        bad1 = _mm_or_si128(bad1, _mm_cmpgt_epi16(QL, _mm_xor_si128(_mm_loadu_si128(hi + 1), flip)));
     }
-    return (unsigned)_mm_movemask_epi8(ok);
+    /* one bit per word: pack the two halves' 16-bit masks to bytes (saturation keeps 0 and -1) */
+    return ~(unsigned)_mm_movemask_epi8(_mm_packs_epi16(bad0, bad1)) & 0xffffu;
 #else
     unsigned mask = 0;
     for (int j = 0; j < CT_LEAF; j++) {
@@ -5534,9 +5598,9 @@ ct_block_mask(const uint8_t *blk, const unsigned *ql, const unsigned *qh)
 #endif
 }
 
-/* The bytes of position a of a block as a query on its own leaf's grid. */
+/* The steps of position a of a block as a query on its own leaf's grid. */
 static inline void
-ct_block_query(const uint8_t *blk, int a, unsigned *ql, unsigned *qh)
+ct_block_query(const CtQ *blk, int a, unsigned *ql, unsigned *qh)
 {
     for (int c = 0; c < 3; c++) {
         ql[c] = blk[c * CT_LEAF + a];
@@ -5608,7 +5672,7 @@ ct_build_tree(CtNode *nodes, int64_t m)
 }
 
 /* The node boxes from the leaves' float32 boxes LBOX (6 floats a block: lo x, y, z, hi x, y, z, the faces'
- * boxes rounded outward, as ct_prep_task computed them before cutting the faces' boxes to bytes on them) and
+ * boxes rounded outward, as ct_prep_task computed them before cutting the faces' boxes to steps on them) and
  * the apexes from cert (NULL: none), children before parents, on the tree of ct_build_tree. */
 static void
 ct_build_boxes(CtNode *nodes, int64_t n_nodes, const float *LBOX, const int32_t *ids, const uint8_t *cert, int64_t m)
@@ -5696,8 +5760,7 @@ typedef struct {
     const int64_t *off;
     const int32_t *faces;
     int64_t n, total;
-    const int32_t *order;       /* NULL, or the face at each hierarchy position: the lists then hold positions,
-                                 * and twin is indexed and valued by them */
+    const int32_t *pos;         /* NULL, or each face's hierarchy position: twin is then indexed and valued by it */
     int32_t *twin;
     int oom[MAX_THREADS];
 } CtTwinJob;
@@ -5713,11 +5776,16 @@ ct_link_prev_cmp(const void *x, const void *y)
     return (a->prev > b->prev) - (a->prev < b->prev);
 }
 
-/* twin of listed face f (a face, or a hierarchy position with jb->order) across the edge from its corner c */
+/* twin of face f across the edge from its corner c: by face, or by hierarchy position when jb->pos is given */
 static inline void
 ct_twin_put(CtTwinJob *jb, int32_t f, int c, int32_t tw)
 {
-    jb->twin[3 * (size_t)f + (size_t)c] = tw;
+    if (jb->pos != NULL) {
+        jb->twin[3 * (size_t)jb->pos[f] + (size_t)c] = tw >= 0 ? jb->pos[tw] : tw;
+    }
+    else {
+        jb->twin[3 * (size_t)f + (size_t)c] = tw;
+    }
 }
 
 static void
@@ -5740,9 +5808,8 @@ ct_twin_task(void *ctx, int t, int nt)
         int ok = 1;
         for (int64_t i = 0; i < k; i++) {
             int32_t f = jb->faces[s + i];
-            size_t row = 3 * (size_t)(jb->order != NULL ? jb->order[f] : f);
             int64_t x[3];
-            for (int c = 0; c < 3; c++) x[c] = index_at(jb->F, jb->fsize, row + (size_t)c);
+            for (int c = 0; c < 3; c++) x[c] = index_at(jb->F, jb->fsize, 3 * (size_t)f + (size_t)c);
             int c = x[0] == v ? 0 : x[1] == v ? 1 : 2;
             if ((x[0] == v) + (x[1] == v) + (x[2] == v) != 1) ok = 0;      /* v twice in f: no twins here */
             lk[i].next = (int32_t)x[(c + 1) % 3];
@@ -6207,7 +6274,7 @@ done:
 /* ct_twin_task over the vertices on threads; 0, or -1 when out of memory. */
 static int
 ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces, int64_t total,
-         const int32_t *order, int32_t *twin, int threads)
+         const int32_t *pos, int32_t *twin, int threads)
 {
     for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
     CtTwinJob jb;
@@ -6218,7 +6285,7 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, con
     jb.faces = faces;
     jb.n = n;
     jb.total = total;
-    jb.order = order;
+    jb.pos = pos;
     jb.twin = twin;
     run_parallel(thread_count(threads, (size_t)n, 20000), ct_twin_task, &jb);
     for (int t = 0; t < MAX_THREADS; t++) {
@@ -6353,7 +6420,7 @@ ct_patch_labels(const CtNode *nodes, const uint8_t *patch, const int32_t *order,
 }
 
 typedef struct {
-    const uint8_t *BOX;         /* face boxes as bytes on their leaf's grid, in blocks of CT_LEAF (ct_block_mask) */
+    const CtQ *BOX;             /* face boxes as steps on their leaf's grid, in blocks of CT_LEAF (ct_block_mask) */
     const int32_t *order;       /* the caller's face index of each hierarchy position */
     const int32_t *ids;         /* corner indices in hierarchy order, in blocks of CT_LEAF (ct_id) */
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
@@ -6521,6 +6588,10 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
         return;
     }
     const CtNode *nodes = sc->nodes;
+    CtGrid gp, gq;
+    memset(&gp, 0, sizeof(gp));
+    memset(&gq, 0, sizeof(gq));
+    int64_t gp_node = -1, gq_node = -1;
     stack[0] = p0;
     stack[1] = q0;
     top = 1;
@@ -6551,9 +6622,9 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 int pcount = ct_leaf_count(p, sc->m);
                 CtFace leaf[CT_LEAF];
                 uint8_t have[CT_LEAF] = {0};
-                const uint8_t *blk = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+                const CtQ *blk = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
                 for (int a = 0; a + 1 < pcount; a++) {
-                    unsigned ql[3], qh[3];          /* one grid: the bytes compare as they are */
+                    unsigned ql[3], qh[3];          /* one grid: the steps compare as they are */
                     ct_block_query(blk, a, ql, qh);
                     unsigned mask = ct_block_mask(blk, ql, qh);
                     mask &= ~((2u << a) - 1) & ct_leaf_bits(pcount);     /* the later faces j > i only */
@@ -6576,11 +6647,16 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             int64_t pstart = CT_LEAF * CT_BLOCK_OF(p), qstart = CT_LEAF * CT_BLOCK_OF(q);
             CtFace leaf[CT_LEAF];
             uint8_t have[CT_LEAF] = {0};
-            const uint8_t *pb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
-            const uint8_t *qb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(q);
-            CtGrid gp, gq;
-            ct_grid(p, &gp);
-            ct_grid(q, &gq);
+            const CtQ *pb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+            const CtQ *qb = sc->BOX + CT_BLOCK * CT_BLOCK_OF(q);
+            if (pi != gp_node) {                 /* the leaves' grids, kept while the same leaf recurs */
+                ct_grid(p, &gp);
+                gp_node = pi;
+            }
+            if (qi != gq_node) {
+                ct_grid(q, &gq);
+                gq_node = qi;
+            }
             /* p's faces against q's box first (on p's grid), then each that meets it against q's faces (its
              * bytes mapped back outward, then onto q's grid) */
             unsigned ql[3] = {0, 0, 0}, qh[3] = {0, 0, 0};
@@ -6588,14 +6664,30 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
             for (int c = 0; c < 3; c++) meets &= ct_grid_query(&gp, c, q->lo[c], q->hi[c], &ql[c], &qh[c]);
             unsigned pmask = meets ? ct_block_mask(pb, ql, qh) & ct_leaf_bits(ct_leaf_count(p, sc->m)) : 0u;
             unsigned qbits = ct_leaf_bits(ct_leaf_count(q, sc->m));
+            /* p's steps onto q's grid, per axis: the affine map t = A + q B of ct_grid_lo / ct_grid_hi followed
+             * by T of q, widened by E (ct_pair_map); or, where a grid is not cut, one query for every face */
+            CtMap map;
+            if (!ct_pair_map(&gp, &gq, p, &map)) pmask = 0;
             while (pmask) {
                 int a = ct_ctz(pmask);
                 pmask &= pmask - 1;
                 meets = 1;
                 for (int c = 0; c < 3; c++) {
-                    double la = ct_grid_lo(&gp, c, pb[c * CT_LEAF + a], p->lo[c]);
-                    double ha = ct_grid_hi(&gp, c, pb[(3 + c) * CT_LEAF + a], p->hi[c]);
-                    meets &= ct_grid_query(&gq, c, la, ha, &ql[c], &qh[c]);
+                    if (!map.affine[c]) {
+                        ql[c] = map.ql[c];
+                        qh[c] = map.qh[c];
+                        continue;
+                    }
+                    double tl = (map.A[c] + (double)pb[c * CT_LEAF + a] * map.B[c]) - map.E[c];
+                    double th = (map.A[c] + (double)pb[(3 + c) * CT_LEAF + a] * map.B[c]) + map.E[c];
+                    if (!(tl < (double)CT_QMAX) || !(th >= 0.0)) {
+                        meets = 0;
+                        break;
+                    }
+                    ql[c] = tl > 0 ? (unsigned)tl : 0u;
+                    unsigned b = th < (double)CT_QMAX ? (unsigned)th : CT_QMAX;
+                    if (th < (double)CT_QMAX && (double)b < th) b++;
+                    qh[c] = b;
                 }
                 unsigned mask = meets ? ct_block_mask(qb, ql, qh) & qbits : 0u;
                 CtFace FI;
@@ -6708,18 +6800,6 @@ ct_tasks(const CtNode *nodes, const uint8_t *patch, int64_t *tasks)
     return n;
 }
 
-#define CT_AHEAD 32
-
-static inline void
-ct_prefetch(const void *p)
-{
-#if defined(__GNUC__) || defined(__clang__)
-    __builtin_prefetch(p);
-#else
-    (void)p;
-#endif
-}
-
 /* Per-face preparation, split over threads by position: Morton codes and each face's projection axis and
  * zero-area flag, in the caller's order (pass 0: the rows are read in sequence); once the codes are sorted, the
  * faces in hierarchy order and their projections' orientations (pass 1), the axes and flags unpacked (pass 2);
@@ -6735,7 +6815,7 @@ typedef struct {
     double gmin[3], scale[3];
     int8_t *axis;
     uint8_t *skip;
-    uint8_t *box;               /* the faces' boxes as bytes on their leaf's grid, in blocks (pass 3) */
+    CtQ *box;                   /* the faces' boxes as steps on their leaf's grid, in blocks (pass 3) */
     float *lbox;                /* each leaf's float32 box (pass 3; ct_build_boxes) */
     int32_t *order;
     int32_t *ids;
@@ -6828,7 +6908,7 @@ ct_prep_task(void *ctx, int t, int nt)
         double lo[CT_LEAF][3], hi[CT_LEAF][3];
         CtNode leaf;
         int64_t start = blk_i * CT_LEAF, count = pr->m - start < CT_LEAF ? pr->m - start : CT_LEAF;
-        uint8_t *blk = pr->box + CT_BLOCK * blk_i;
+        CtQ *blk = pr->box + CT_BLOCK * blk_i;
         for (int c = 0; c < 3; c++) {
             leaf.lo[c] = INFINITY;
             leaf.hi[c] = -INFINITY;
@@ -6872,7 +6952,7 @@ ct_prep_task(void *ctx, int t, int nt)
                     ct_grid_store(&grid, c, lo[j][c], hi[j][c], &blk[c * CT_LEAF + j], &blk[(3 + c) * CT_LEAF + j]);
                 }
                 else {                                  /* past the last face: no box, no vertex */
-                    blk[c * CT_LEAF + j] = 255;
+                    blk[c * CT_LEAF + j] = (CtQ)CT_QMAX;
                     blk[(3 + c) * CT_LEAF + j] = 0;
                     pr->ids[CT_IDBLOCK * blk_i + c * CT_LEAF + j] = -1;
                 }
@@ -6900,7 +6980,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
     PyObject *result = NULL;
     CtNode *nodes = NULL;
     uint64_t *code = NULL;
-    uint8_t *box = NULL;
+    CtQ *box = NULL;
     float *lbox = NULL;
     int32_t *order = NULL;
     int32_t *ids = NULL;
@@ -6959,7 +7039,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
          * indices are mapped only once it is given back (below) */
         code_bytes = 2 * mm * sizeof(uint64_t);
         if (ct_stars_scratch(n, m) > code_bytes) code_bytes = ct_stars_scratch(n, m);
-        box_bytes = n_blocks * CT_BLOCK;                       /* one byte per bound */
+        box_bytes = n_blocks * CT_BLOCK * sizeof(CtQ);         /* two bytes per bound */
         lbox_bytes = n_blocks * 6 * sizeof(float);
         order_bytes = mm * sizeof(int32_t);
         ids_bytes = n_blocks * CT_IDBLOCK * sizeof(int32_t);
@@ -7033,9 +7113,19 @@ accel_contact_scan(PyObject *self, PyObject *args)
             cert = (uint8_t *)malloc((size_t)n);
             if (cert == NULL) oom = 1;
         }
-        int32_t *labels = NULL;              /* per face, its certified patch (ct_patch_labels) */
+        int32_t *pos = NULL;
+        size_t twin_bytes = 3 * mm * sizeof(int32_t), pos_bytes = mm * sizeof(int32_t);
         if (!oom && !failed && m >= 2 && cert != NULL && fmask != NULL) {
-            twin = (int32_t *)malloc(3 * mm * sizeof(int32_t));    /* NULL: no patches, the same pairs */
+            /* mappings, not the heap: a heap block freed below the top stays resident (and glibc's mmap
+             * threshold rises to the size of a block once freed), so the twins would sit under the boxes */
+            twin = (int32_t *)ct_alloc(twin_bytes);    /* NULL: no patches, the same pairs */
+            pos = (int32_t *)ct_alloc(pos_bytes);
+            if (twin == NULL || pos == NULL) {
+                ct_free(twin, twin_bytes);
+                ct_free(pos, pos_bytes);
+                twin = NULL;
+                pos = NULL;
+            }
         }
         if (!oom && !failed && m >= 2 && twin != NULL) {
             /* with patches: the faces across each edge by hierarchy position (ct_twins into twin, from every
@@ -7044,9 +7134,10 @@ accel_contact_scan(PyObject *self, PyObject *args)
              * certified patch (the others decide no pair), from their lists alone */
             int64_t *off, total;
             int32_t *vfaces;
-            ct_star_lists(n, F, fsize, m, 1, NULL, order, code, &off, &vfaces, &total);
+            for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
+            ct_star_lists(n, F, fsize, m, 1, NULL, code, &off, &vfaces, &total);
             clk[8] = profile ? ct_clock() : 0.0;
-            if (ct_twins(F, fsize, n, m, off, vfaces, total, order, twin, nt) < 0) {
+            if (ct_twins(F, fsize, n, m, off, vfaces, total, pos, twin, nt) < 0) {
                 oom = 1;
             }
             ct_free(code, code_bytes);
@@ -7068,29 +7159,19 @@ accel_contact_scan(PyObject *self, PyObject *args)
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
-                free(twin);
+                ct_free(twin, twin_bytes);
                 twin = NULL;
                 clk[7] = profile ? ct_clock() : 0.0;
-                int32_t *label = NULL;                 /* each face's certified patch */
-                if (patch != NULL) {
-                    labels = (int32_t *)malloc(mm * sizeof(int32_t));
-                    label = labels;
-                    if (label == NULL) {
-                        free(patch);               /* out of memory: the scan without patches, the same pairs */
-                        patch = NULL;
-                    }
-                    else {
-                        ct_patch_labels(nodes, patch, order, m, label);
-                    }
-                }
+                int32_t *label = pos;                  /* pos is done with: each face's certified patch */
+                if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
                 size_t lists_bytes = ct_stars_scratch(n, m);
                 void *lists = ct_alloc(lists_bytes);   /* only the kept vertices' part of it is written */
                 if (lists == NULL) {
                     oom = 1;
                 }
                 else {
-                    ct_star_lists(n, F, fsize, m, star_min, patch != NULL ? label : NULL, NULL, lists, &off,
-                                  &vfaces, &total);
+                    ct_star_lists(n, F, fsize, m, star_min, patch != NULL ? label : NULL, lists, &off, &vfaces,
+                                  &total);
                     if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
                                       patch != NULL ? label : NULL) < 0) {
                         oom = 1;
@@ -7106,8 +7187,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
             n_nodes = ct_build_tree(nodes, m);
         }
-        free(labels);
-        free(twin);
+        ct_free(pos, pos_bytes);
+        ct_free(twin, twin_bytes);
         twin = NULL;
         /* the sort's words and the stars' lists, the twins and the positions are given back before the boxes
          * and corner indices are written: the check's high point is then the traversal's arrays alone */
@@ -7115,7 +7196,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         code = NULL;
         code_bytes = 0;
         if (!oom && !failed && m >= 2) {
-            box = (uint8_t *)ct_alloc(box_bytes);
+            box = (CtQ *)ct_alloc(box_bytes);
             lbox = (float *)ct_alloc(lbox_bytes);
             ids = (int32_t *)ct_alloc(ids_bytes);
             flags = (uint8_t *)malloc(mm);
@@ -7260,7 +7341,6 @@ done:
     free(stars);
     free(patch);
     free(fmask);
-    free(twin);
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);

@@ -126,6 +126,7 @@ def test_a_row_of_triangles_touching_at_corners_far_from_the_origin(scale):
 _PEAK_CHILD = textwrap.dedent(r"""
     import sys
     import numpy as np
+    from inertia_tool._native import accel
     from inertia_tool.mesh.intersect import surface_contacts
 
     def status(key):
@@ -151,7 +152,7 @@ _PEAK_CHILD = textwrap.dedent(r"""
     before = status("VmRSS:")
     r = surface_contacts(v, f)
     assert not len(r.crossing) and not len(r.contact) and not len(r.coplanar_opposite)
-    print(len(f), status("VmHWM:") - before)
+    print(len(f), status("VmHWM:") - before, int(accel() is not None))
 """)
 
 
@@ -159,11 +160,14 @@ _PEAK_CHILD = textwrap.dedent(r"""
 def test_check_peak_memory_per_face():
     """Regression (issue 25): the face-pair check's own peak, above what the process held before it, on a
     300,000-face torus in a fresh process.  It was ~75 bytes a face (the sort's words, the float32 boxes, the
-    corner indices, the twins, the stars' lists and the positions all at once); now the boxes are bytes and
-    the arrays of the hierarchy are mapped only after the sort's and the twins' are given back: at most 48."""
+    corner indices, the twins, the stars' lists and the positions all at once); now the boxes are 16-bit steps
+    on their leaf's grid and the arrays of the hierarchy are mapped only after the sort's and the twins' are
+    given back: about 37 (34-40 at 1e7 faces, depending on the phase), asserted at most 44."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
     env.pop(_native.NO_ACCEL_ENV, None)
     out = subprocess.run([sys.executable, "-c", _PEAK_CHILD], capture_output=True, text=True, env=env,
                          check=True, timeout=120).stdout.split()
-    faces, extra = int(out[0]), int(out[1])
-    assert extra / faces <= 48, f"the check's peak: {extra / faces:.1f} bytes a face above its caller's"
+    faces, extra, c_path = int(out[0]), int(out[1]), int(out[2])
+    if not c_path:                              # e.g. _accel.c edited since the build: the numpy twin ran
+        pytest.skip("the child process did not load the C extension")
+    assert extra / faces <= 44, f"the check's peak: {extra / faces:.1f} bytes a face above its caller's"

@@ -164,19 +164,20 @@ no sort; any other star by matching link vertices as before; either way the cert
 module's numpy code stays the reference and the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on
 both.
 
-Memory of the C scan (issue 25): a face's box is six bytes on its leaf's grid — the leaf's float32 box cut
-into 254 steps per axis by ``T(x) = fl(fl(x − L)·inv)``, a composition of correctly rounded operations with
-positive constants and so monotone in ``x``; the lower bound is stored as ``⌊T(lo)⌋``, the upper as
-``⌈T(hi)⌉``, and a box from another leaf is mapped back outward and onto this grid the same way.  Monotonicity
-alone makes the test conservative: closed boxes that meet, ``lo_b ≤ hi_a`` and ``lo_a ≤ hi_b``, give
-``⌊T(lo_a)⌋ ≤ T(hi_b) ≤ ⌈T(hi_b)⌉`` and the same with ``a`` and ``b`` exchanged, so every pair whose boxes
-meet is still visited, and its float64 boxes decide whether it is a candidate (the pairs, counts and classes
-are those of float32 or float64 boxes; an axis with an infinite float32 bound is not cut).  The scan's
-arrays are mapped in three phases that never coexist: the sort (16 bytes a face), then the faces across each
-edge (12) with every vertex's faces listed by hierarchy position (16), the patches on the hierarchy's shape
-(which depends on the face count alone), the star certificates from the lists of the vertices not inside one
-certified patch; and only then the boxes (6), corner indices (12) and flags the traversal reads.  Its high
-point is about 34 bytes a face (the twins' phase), against about 75 before.
+Memory of the C scan (issue 25): a face's box is six 16-bit step numbers on its leaf's grid — the leaf's
+float32 box cut into 65,534 steps per axis by ``T(x) = fl(fl(x − L)·inv)``, a composition of correctly rounded
+operations with positive constants and so monotone in ``x``; the lower bound is stored as ``⌊T(lo)⌋``, the
+upper as ``⌈T(hi)⌉``, and a face of another leaf is put on this grid by one affine map per pair of leaves,
+widened by a bound of its roundings.  Monotonicity alone makes the test conservative: closed boxes that meet,
+``lo_b ≤ hi_a`` and ``lo_a ≤ hi_b``, give ``⌊T(lo_a)⌋ ≤ T(hi_b) ≤ ⌈T(hi_b)⌉`` and the same with ``a`` and
+``b`` exchanged, so every pair whose boxes meet is still visited, and its float64 boxes decide whether it is a
+candidate (the pairs, counts and classes are those of float32 or float64 boxes; an axis with an infinite
+float32 bound is not cut).  The scan's arrays are mapped in three phases that never coexist: the sort (16
+bytes a face); the faces across each edge (12) from every vertex's faces (16) and each face's hierarchy
+position (4), the patches on the hierarchy's shape (which depends on the face count alone), the star
+certificates from the lists of the vertices not inside one certified patch; and only then the boxes (12),
+corner indices (12), nodes (4) and flags the traversal reads.  Its high point is about 37–40 bytes a face,
+against about 80 before.
 """
 
 from __future__ import annotations
