@@ -383,9 +383,9 @@ def _ring_faces(f: np.ndarray, n: int, rim_key: np.ndarray, label: np.ndarray, c
     return pairs, start
 
 
-#: Most (ring face, rim vertex) pairs :func:`_may_hold_two_planes` measures at once over all loops (~100 MB);
-#: loops beyond it are examined one by one as before.
-CREASE_SCREEN_PAIRS = 4_000_000
+#: Most (ring face, rim vertex) pairs :func:`_may_hold_two_planes` measures over all loops (~80 bytes each at
+#: once, so ~80 MB); loops beyond it are examined one by one as before.
+CREASE_SCREEN_PAIRS = 1_000_000
 
 
 def _may_hold_two_planes(v: np.ndarray, f: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
@@ -594,8 +594,11 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
     # curved surface is flat trivially and proves nothing)
     key, _ = edge_keys(g, n)
     order = np.argsort(key, kind="stable")
-    same = key[order][1:] == key[order][:-1]
+    key = key[order]
+    same = key[1:] == key[:-1]
+    del key                                       # (the peak of a hole's bounds: temporaries freed on the way)
     first, second = order[:-1][same] // 3, order[1:][same] // 3
+    del order, same
     coplanar = np.einsum("ij,ij->i", unit[first], unit[second]) >= flat_cosine
     in_flat_face = np.zeros(len(g), dtype=bool)
     in_flat_face[first[coplanar]] = True
@@ -684,20 +687,25 @@ def _vertex_flatness(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarr
     # the cross product as numpy.cross forms it (each product, then the difference), bit for bit, without its
     # axis shuffling (0.19 -> 0.12 s at 1.3M faces)
     a = v[f[:, 0]]
-    u, w = v[f[:, 1]] - a, v[f[:, 2]] - a
+    u = v[f[:, 1]] - a
+    w = np.subtract(v[f[:, 2]], a, out=a)
     normal = np.empty_like(u)
     for axis, (p, q) in enumerate(((1, 2), (2, 0), (0, 1))):
         np.multiply(u[:, p], w[:, q], out=normal[:, axis])
         normal[:, axis] -= u[:, q] * w[:, p]
+    del a, u, w                                   # the peak of a hole's bounds is here: free before the sums
     area = np.linalg.norm(normal, axis=1)
     good = area > 0
-    g, unit = f[good], normal[good] / area[good, None]
+    if not good.all():
+        normal, area = normal[good], area[good]
+    g, unit = f[good], normal / area[:, None]
     # the sum of the normals at each vertex, added in the order corner 0 of every face, corner 1, corner 2
     # (bincount adds its weights in index order, as np.add.at does, at a tenth of the time: issue 25)
     corner_vertex = g.T.reshape(-1)
     mean = np.empty((n, 3))
     for axis in range(3):
-        mean[:, axis] = np.bincount(corner_vertex, weights=np.tile(normal[good, axis], 3), minlength=n)
+        mean[:, axis] = np.bincount(corner_vertex, weights=np.tile(normal[:, axis], 3), minlength=n)
+    del corner_vertex, normal, area
     size = np.linalg.norm(mean, axis=1)
     mean_unit = mean / np.where(size > 0, size, 1.0)[:, None]
     least = np.ones(n)
