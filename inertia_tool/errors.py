@@ -44,6 +44,7 @@ __all__ = [
     "RobotDescriptionError",
     "InvalidMeshError",
     "ArrangementError",
+    "WorkBudgetError",
     "DesignRejectedError",
     "NoRoomError",
     "PhysicsError",
@@ -133,6 +134,13 @@ class ArrangementError(InvalidMeshError):
     """The solid {winding number ≥ 1} of a surface passing through itself could not be built by the mesh
     arrangement (:mod:`inertia_tool.mesh.arrange`): a degenerate crossing, or an output that failed its checks.
     The message says which."""
+
+
+class WorkBudgetError(InvalidMeshError):
+    """An estimate would do more work than its stated, deterministic budget (counted before the work is done,
+    never timed: the same answer on every machine), e.g. the winding numbers of more grid cells than
+    :data:`inertia_tool.mesh.grid_estimate.WINDING_EVALUATION_BUDGET`.  ``details`` holds ``evaluations``,
+    ``budget`` and ``resolution``."""
 
 
 class IsolatedProcessError(InertiaToolError, OSError):

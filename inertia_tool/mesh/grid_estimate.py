@@ -16,15 +16,27 @@ follow from the volume in doubt as :mod:`~.uncertainty` states.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
+from ..errors import WorkBudgetError
 from ..tolerances import ESTIMATE_MAX_MASS_RTOL
 from .rims import boundary_edges, enclosing_balls
 from .uncertainty import Estimate, Uncertainty, uncertainty_from
 
 __all__ = ["winding_estimate", "closed_surface_estimate", "open_surface_estimate", "corrected_estimate",
-           "predicted_resolution"]
+           "predicted_resolution", "affordable_resolution", "WINDING_EVALUATION_BUDGET"]
 
+
+#: Most grid cells whose winding number :func:`winding_estimate` evaluates one by one (libigl's hierarchical
+#: evaluation, one call per cell): the work is counted before it is done and refused past this budget
+#: (:class:`~inertia_tool.errors.WorkBudgetError`), never timed, so the answer is the same on every machine.
+#: A 64-cell grid never reaches it (at most 66³ ≈ 287k cells); refinements are sized to stay within it
+#: (:func:`open_surface_estimate`, :func:`closed_surface_estimate`).  At the 10–40 µs an evaluation near a
+#: CAD part's surface costs (libigl, 2 cores at load 2–20), about 4–16 s of CPU; issue 23: ALOHA's
+#: ``vx300s_7_gripper_prop.stl`` asked for 1,181,078 (44 s of CPU) and was then refused for its holes' doubt.
+WINDING_EVALUATION_BUDGET = 400_000
 
 #: Grid resolution of the winding estimate without libigl: the numpy treecode costs a few hundred exact
 #: solid angles per cell whatever the face count, so 24 cells along the longest side (~17k cells) keeps a
@@ -260,7 +272,8 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
 
 
 def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64, w_low: float = 0.1,
-                     w_high: float = 0.9, fast: bool | None = None, tolerance: float = 2e-3) -> Estimate:
+                     w_high: float = 0.9, fast: bool | None = None, tolerance: float = 2e-3,
+                     max_evaluations: int | None = None) -> Estimate:
     """Material where the generalized winding number exceeds 1/2, on a grid, with the doubtful cells as bounds.
 
     Parameters
@@ -278,22 +291,68 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
         whose bound could carry its ``w`` across 1/2 from outside the doubtful band is doubtful too.
     tolerance : float
         Error allowed per cluster of the treecode (the per-cell bound is the sum over the clusters used).
+    max_evaluations : int, optional
+        Most cells whose winding number is evaluated one by one (default :data:`WINDING_EVALUATION_BUDGET`, read
+        at the call); counted once the grid's crossed and settled cells are known, before any is evaluated.
 
     Returns
     -------
     Estimate
+
+    Raises
+    ------
+    WorkBudgetError
+        More than ``max_evaluations`` cells would be evaluated; ``details`` has ``evaluations``, ``budget`` and
+        ``resolution``.
     """
+    return _winding_grid(vertices, faces, resolution=resolution, w_low=w_low, w_high=w_high, fast=fast,
+                         tolerance=tolerance, max_evaluations=max_evaluations).estimate
+
+
+class _GridWork(NamedTuple):
+    """A grid estimate and its work: ``evaluated`` cells whose winding number was evaluated one by one, and
+    ``crossed`` cells the surface crosses (counted half, not evaluated; at a finer grid many become free)."""
+
+    estimate: Estimate
+    evaluated: int
+    crossed: int
+
+
+def _grid_shape(vertices: np.ndarray, resolution: int) -> tuple[np.ndarray, float, tuple[int, ...]]:
+    """``(lo, h, dims)`` of the grid of ``resolution`` cells along the longest side of ``vertices``' box, padded
+    by one cell each way (the grid of :func:`winding_estimate`)."""
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    h = float(np.max(hi - lo)) / int(resolution)
+    lo = lo - h
+    dims = tuple(int(x) for x in np.ceil((hi + h - lo) / h).astype(np.int64))
+    return lo, h, dims
+
+
+def _budget_refusal(evaluations: int, budget: int, resolution: int, dims: tuple[int, ...], faces: int,
+                    crossed: int) -> WorkBudgetError:
+    """The one-line refusal of a grid whose cells to evaluate exceed the budget."""
+    return WorkBudgetError(
+        f"the winding-number estimate would evaluate {evaluations:,} grid cells one by one ({dims[0]}×{dims[1]}×"
+        f"{dims[2]} grid, {faces:,} triangles), more than its budget of {budget:,} evaluations; close the holes "
+        "or the crossings in a mesh editor", details={"evaluations": evaluations, "budget": budget,
+                                                       "resolution": resolution, "crossed": crossed})
+
+
+def _winding_grid(vertices: np.ndarray, faces: np.ndarray, *, resolution: int, w_low: float = 0.1,
+                  w_high: float = 0.9, fast: bool | None = None, tolerance: float = 2e-3,
+                  max_evaluations: int | None = None) -> _GridWork:
+    """:func:`winding_estimate`, with the cells it evaluated one by one (the work its budget counts) and the
+    cells the surface crosses."""
+    budget = WINDING_EVALUATION_BUDGET if max_evaluations is None else int(max_evaluations)
     from .winding import fast_available, winding_numbers, winding_numbers_bounded
 
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
-    lo, hi = v.min(axis=0), v.max(axis=0)
     use_igl = fast_available() if fast is None else (fast and fast_available())
     n = int(resolution) if use_igl else min(int(resolution), TREECODE_RESOLUTION)
-    h = float(np.max(hi - lo)) / n
-    lo = lo - h
-    dims = tuple(int(x) for x in np.ceil((hi + h - lo) / h).astype(np.int64))
+    lo, h, dims = _grid_shape(v, n)
     crossed = _surface_cells(v, f, lo, h, dims)
+    n_crossed = int(np.count_nonzero(crossed))
     # the grid's per-cell arrays: crossed (bool), w (float64) and two uint8 codes, ~11 bytes a cell; the cell
     # centres are formed only for the cells evaluated and the cells in doubt
     w = np.full(len(crossed), 0.5)                  # cells the surface crosses: half material, half in doubt
@@ -308,9 +367,15 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
         del value
         ask = np.flatnonzero(free & ~settled)
         del settled, free
+        evaluations = len(ask)
+        if evaluations > budget:
+            raise _budget_refusal(evaluations, budget, n, dims, len(f), n_crossed)
         w[ask] = winding_numbers(_cell_centres(ask, lo, h, dims), v, f, fast=True)
     else:
         free_cells = np.flatnonzero(~crossed)
+        evaluations = len(free_cells)
+        if evaluations > budget:
+            raise _budget_refusal(evaluations, budget, n, dims, len(f), n_crossed)
         points = _cell_centres(free_cells, lo, h, dims)
         if use_igl:
             w[free_cells] = winding_numbers(points, v, f, fast=True)
@@ -331,8 +396,9 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
     area = float(0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1).sum())
     if not np.any(material2[~crossed]):
         zero = np.zeros(3)
-        return Estimate(0.0, zero, np.zeros((3, 3)), area, Uncertainty(np.inf, np.inf, np.inf, 0.0), "winding",
-                        "no grid cell has a winding number above 1/2", v, f)
+        empty = Estimate(0.0, zero, np.zeros((3, 3)), area, Uncertainty(np.inf, np.inf, np.inf, 0.0), "winding",
+                         "no grid cell has a winding number above 1/2", v, f)
+        return _GridWork(empty, evaluations, n_crossed)
     vol, c, second = _grid_moments(material2.reshape(dims), lo, h, scale=0.5)
     del material2
     # each doubtful cell's points lie within its centre's distance + half its diagonal of the centroid; the
@@ -350,10 +416,10 @@ def winding_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int
     unc = uncertainty_from(vol, c, second, doubt, far, first_doubt=first_doubt, second_doubt=second_doubt)
     how = "libigl fast winding numbers" if use_igl else "winding numbers by a treecode with an error bound"
     detail = (f"winding number > 1/2 on a {dims[0]}×{dims[1]}×{dims[2]} grid of {h:.3g} m cells ({how}); "
-              f"{int(np.count_nonzero(crossed)):,} cells crossed by the surface counted half, "
+              f"{n_crossed:,} cells crossed by the surface counted half, "
               f"{undecided:,} more undecided")
-    return Estimate(volume=vol, centroid=c, second_moment=second, area=area, uncertainty=unc, method="winding",
-                    detail=detail, vertices=v, faces=f, far=far)
+    return _GridWork(Estimate(volume=vol, centroid=c, second_moment=second, area=area, uncertainty=unc,
+                              method="winding", detail=detail, vertices=v, faces=f, far=far), evaluations, n_crossed)
 
 
 #: Closed-surface estimate (:func:`closed_surface_estimate`): the mass bound it refines towards, relative.
@@ -389,8 +455,8 @@ def budget_resolution(vertices: np.ndarray, max_cells: int = CLOSED_MAX_CELLS) -
 
 
 def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64,
-                            target: float = CLOSED_TARGET_MASS_RTOL,
-                            max_resolution: int | None = None) -> Estimate:
+                            target: float = CLOSED_TARGET_MASS_RTOL, max_resolution: int | None = None,
+                            max_evaluations: int | None = None) -> Estimate:
     """The solid ``{w ≥ 1}`` of a closed, edge-balanced surface that passes through itself, on a grid, with an
     assumption-free bound.
 
@@ -435,24 +501,46 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
     max_resolution : int, optional
         Finest grid, cells along the longest side; by default as many as :data:`CLOSED_MAX_CELLS` cells allow
         (:func:`budget_resolution`: a flat or long part goes finer than a cubic one for the same memory).
+    max_evaluations : int, optional
+        Most cells a grid evaluates one by one (:func:`winding_estimate`; none where every region's integer is
+        found, every free cell where one is not): a grid that would exceed it is built again at
+        :func:`affordable_resolution` instead, and a refinement that would exceed it is not made (the grid
+        before stands; counted before any cell is evaluated).
 
     Returns
     -------
     Estimate
         ``method`` ``"winding"``.
+
+    Raises
+    ------
+    WorkBudgetError
+        Even a grid of 8 cells along the longest side would evaluate more than ``max_evaluations`` cells.
     """
     if max_resolution is None:
         max_resolution = budget_resolution(vertices)
     finer = predicted_resolution(vertices, faces, resolution=resolution, target=target,
                                  max_resolution=max_resolution)
-    grid = winding_estimate(vertices, faces, resolution=finer)
+    try:
+        grid = winding_estimate(vertices, faces, resolution=finer, max_evaluations=max_evaluations)
+    except WorkBudgetError as over:
+        # a region's integer was uncertain, so every free cell would be evaluated: the grid the budget affords
+        finer = min(finer - 1, affordable_resolution(vertices, finer, over.details["evaluations"],
+                                                     over.details["crossed"], max_evaluations))
+        if finer < 8:
+            raise
+        grid = winding_estimate(vertices, faces, resolution=finer, max_evaluations=max_evaluations)
     bound = grid.uncertainty.mass
     if grid.volume > 0:
         if finer < max_resolution and bound > CLOSED_PREDICTION_SLACK * target:
             # predicted too coarse (overlapping bodies count twice in the signed volume): refined once by the
-            # grid's own bound
+            # grid's own bound; a grid over the budget of evaluations is refused before it evaluates anything
             again = int(min(max_resolution, np.ceil(finer * bound / target)))
-            grid = winding_estimate(vertices, faces, resolution=again) if again > finer else grid
+            if again > finer:
+                try:
+                    grid = winding_estimate(vertices, faces, resolution=again, max_evaluations=max_evaluations)
+                except WorkBudgetError:
+                    pass                        # counted, not timed: the first grid stands
         if not grid.uncertainty.mass > ESTIMATE_MAX_MASS_RTOL:
             return grid
         # the plain grid's bound would be refused: the corrected estimate on the finest grid too, and the
@@ -468,7 +556,12 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
     corrected = corrected_estimate(vertices, faces, resolution=max_resolution)
     if corrected is not None and corrected.uncertainty.mass <= target:
         return corrected
-    second = winding_estimate(vertices, faces, resolution=max_resolution) if finer < max_resolution else grid
+    second = grid
+    if finer < max_resolution:
+        try:
+            second = winding_estimate(vertices, faces, resolution=max_resolution, max_evaluations=max_evaluations)
+        except WorkBudgetError:
+            pass                                # counted, not timed: the grid built stands
     if corrected is not None and not corrected.uncertainty.mass >= second.uncertainty.mass:
         return corrected                # both bounds are proven: the narrower one is reported
     return second
@@ -513,25 +606,76 @@ def predicted_resolution(vertices: np.ndarray, faces: np.ndarray, *, resolution:
 
 
 def open_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64,
-                          target: float = CLOSED_TARGET_MASS_RTOL, max_resolution: int | None = None) -> Estimate:
+                          target: float = CLOSED_TARGET_MASS_RTOL, max_resolution: int | None = None,
+                          max_evaluations: int | None = None) -> Estimate:
     """:func:`winding_estimate` of a surface that is open and passes through itself, refined once as
     :func:`closed_surface_estimate` refines: when the first grid's mass bound exceeds ``target``, the grid is
     built again at ``resolution · bound / target`` cells along the longest side, at most ``max_resolution``
     (default: :func:`budget_resolution` of :data:`OPEN_MAX_CELLS`), and exactly that when the first decided no
     cell inside (a part thinner than the cells, which the first grid reports as enclosing nothing; issue 23:
-    Barkour vb's ``upper_leg_right.stl``).  The second grid is the answer (by this rule).  The assumption and the bounds
-    are :func:`winding_estimate`'s."""
+    Barkour vb's ``upper_leg_right.stl``), and at most as fine as ``max_evaluations`` allows
+    (:func:`affordable_resolution`, from the cells the first grid evaluated).  The second grid is the answer (by
+    this rule), unless it would still evaluate more cells than ``max_evaluations``: then the first is (decided by
+    counting cells, never by time).  The assumption and the bounds are :func:`winding_estimate`'s.
+
+    Raises
+    ------
+    WorkBudgetError
+        The first grid alone would evaluate more than ``max_evaluations`` cells.
+    """
     if max_resolution is None:
         max_resolution = budget_resolution(vertices, OPEN_MAX_CELLS)
-    first = winding_estimate(vertices, faces, resolution=resolution)
+    first, evaluated, crossed = _winding_grid(vertices, faces, resolution=resolution, max_evaluations=max_evaluations)
     bound = first.uncertainty.mass
     if resolution >= max_resolution or (np.isfinite(bound) and bound <= target):
         return first
     finer = max_resolution if not (np.isfinite(bound) and first.volume > 0) else \
         int(min(max_resolution, np.ceil(resolution * bound / target)))
+    finer = min(finer, affordable_resolution(vertices, resolution, evaluated, crossed, max_evaluations))
     if finer <= resolution:
         return first
-    return winding_estimate(vertices, faces, resolution=finer)
+    try:
+        return winding_estimate(vertices, faces, resolution=finer, max_evaluations=max_evaluations)
+    except WorkBudgetError:
+        return first
+
+
+def affordable_resolution(vertices: np.ndarray, resolution: int, evaluated: int, crossed: int,
+                          max_evaluations: int | None = None) -> int:
+    """The finest grid (cells along the longest side, 8 to 4096) expected to evaluate at most ``max_evaluations``
+    cells one by one, from the grid of ``resolution`` that evaluated ``evaluated`` cells and found ``crossed``
+    cells crossed by the surface.
+
+    The cells evaluated fill a volume (near the holes; or every free cell), so their number grows with the
+    grid's cell count; at a finer grid the crossed cells shrink in share and their room is free, evaluated or
+    settled.  The expectation is therefore ``(evaluated + crossed) · cells(n) / cells(resolution)``, with
+    ``cells(n)`` the padded grid's exact count (:func:`_grid_shape`): an over-estimate where the evaluated
+    cells lie near the surface (their number grows as the area).  ALOHA's ``vx300s_7_gripper_prop.stl``:
+    48,795 evaluated and 37,042 crossed at 64 cells; at 180, expected 1.72M, evaluated 1.18M.  Only the choice
+    of the grid rests on this expectation; the grid built counts its own cells against the budget.
+    """
+    budget = WINDING_EVALUATION_BUDGET if max_evaluations is None else int(max_evaluations)
+    v = np.asarray(vertices, dtype=np.float64)
+    base = evaluated + crossed
+    if base <= 0:
+        return 4096
+
+    def cells(n: int) -> float:
+        return float(np.prod(_grid_shape(v, n)[2], dtype=np.float64))
+
+    per_cell = base / cells(int(resolution))
+    low, high = 8, 4096                         # the largest n in [8, 4096] whose expectation fits, by bisection
+    if per_cell * cells(low) > budget:
+        return low - 1
+    for _ in range(16):                         # 2^12 > 4096 - 8: at most 12 halvings
+        if high - low <= 0:
+            break
+        mid = (low + high + 1) // 2
+        if per_cell * cells(mid) <= budget:
+            low = mid
+        else:
+            high = mid - 1
+    return low
 
 
 # -- the exact signed integral, corrected on a grid only where the winding number may leave {0, 1} -------------

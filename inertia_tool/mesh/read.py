@@ -974,12 +974,7 @@ def _declared_scale(path: str, suffix: str, loaded: object) -> tuple[float, str]
         scale = float(unit_conversion(str(units), "meters"))
     except Exception:  # noqa: BLE001 - trimesh raises ValueError/KeyError for names it does not know
         raise _fail(path, f"declares an unknown length unit {str(units)[:40]!r}") from None
-    if not (np.isfinite(scale) and scale > 0):
-        raise _fail(path, f"declares an invalid length unit {str(units)[:40]!r}")
-    for name, value in LENGTH_UNITS.items():      # snap "centimeter" → 0.01 exactly (trimesh gives 0.00999…)
-        if abs(scale - value) <= 1e-12 * value:
-            return value, name
-    return scale, f"{scale:g} m"
+    return _named_scale(path, scale, str(units))
 
 
 #: COLLADA elements that say how a surface looks, not where it is: dropped by :func:`_collada_geometry_only`.
@@ -1007,6 +1002,46 @@ def _read_with_trimesh(path: str, max_faces: int) -> _Arrays:
     """``(vertices, faces, declared unit)`` of a file trimesh reads (see :func:`_read_with_trimesh_rounding`)."""
     vertices, faces, declared, _ = _read_with_trimesh_rounding(path, max_faces)
     return vertices, faces, declared
+
+
+def _read_collada(path: str) -> tuple[np.ndarray, np.ndarray, tuple[float, str] | None, float]:
+    """``(vertices, faces, declared unit, float32 rounding in file units)`` of a ``.dae`` file through pycollada
+    (:mod:`.collada`: trimesh's reading of it, without trimesh); a document whose every geometry pycollada drops
+    (bound to a material it cannot build: an ``<image>`` without a path, Gazebo's pulley.dae, gear.dae, disk.dae)
+    is read again without its appearance (:func:`_collada_geometry_only`)."""
+    try:
+        import collada  # noqa: F401 - the COLLADA parser
+    except ImportError:
+        raise _fail(path, "reading COLLADA needs pycollada (pip install pycollada)") from None
+    from .collada import collada_triangles
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with open_regular(path) as fh:
+                found = collada_triangles(fh)
+            if not found.instances:
+                found = collada_triangles(_collada_geometry_only(path))
+    except MeshReadError:
+        raise
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any parser failure is a read error with the file named
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise _fail(path, f"could not be parsed ({msg[:200]})") from None
+    if not found.instances or found.declared is None:
+        raise _fail(path, "contains no triangle mesh (empty scene or only points/lines)")
+    return found.vertices, found.faces, _named_scale(path, *found.declared), found.rounding
+
+
+def _named_scale(path: str, scale: float, spelled: str) -> tuple[float, str]:
+    """``(metres per file unit, name)`` of a declared unit: a named unit when within 1e-12 of one, else
+    ``"<factor> m"``; refused unless finite and positive (``spelled``: the file's spelling, for the message)."""
+    if not (np.isfinite(scale) and scale > 0):
+        raise _fail(path, f"declares an invalid length unit {spelled[:40]!r}")
+    for name, value in LENGTH_UNITS.items():      # snap "centimeter" → 0.01 exactly (trimesh gives 0.00999…)
+        if abs(scale - value) <= 1e-12 * value:
+            return value, name
+    return scale, f"{scale:g} m"
 
 
 #: Formats whose coordinates the reader receives as float32 (glTF's POSITION accessor is float32 by the
@@ -1054,11 +1089,15 @@ def _read_with_trimesh_rounding(path: str, max_faces: int,
         counts = _check_zipped_collada(path, max_faces)
     else:
         counts = {}
+    if suffix == ".dae":
+        # pycollada without trimesh: the same triangles, without importing trimesh (~2.5 s of CPU; issue 23)
+        v, f, declared, rounding = _read_collada(path)
+        return (*_checked_arrays(path, v, f, counts, max_faces), declared, rounding)
     try:
         import trimesh
     except ImportError as exc:  # pragma: no cover - trimesh is a dependency
         raise _fail(path, "reading this format needs trimesh (pip install trimesh)") from exc
-    if suffix in (".dae", ".zae"):
+    if suffix == ".zae":
         try:
             import collada  # noqa: F401 - trimesh reads COLLADA through pycollada
         except ImportError:
@@ -1079,11 +1118,6 @@ def _read_with_trimesh_rounding(path: str, max_faces: int,
                 with open_regular(path) as fh:
                     loaded = trimesh.load(fh, file_type=suffix[1:], process=False, force=None,
                                           resolver=regular_file_resolver(path), **extra)
-                if suffix == ".dae" and isinstance(loaded, trimesh.Scene) and not loaded.geometry:
-                    # pycollada drops every geometry bound to a material it cannot build (an <image> without
-                    # a path: Gazebo's pulley.dae, gear.dae, disk.dae); read the geometry alone
-                    loaded = trimesh.load(_collada_geometry_only(path), file_type="dae", process=False,
-                                          force=None)
             finally:
                 quiet.setLevel(level)
             declared = _declared_scale(path, suffix, loaded)
@@ -1106,8 +1140,17 @@ def _read_with_trimesh_rounding(path: str, max_faces: int,
         raise _fail(path, f"could not be parsed ({msg[:200]})") from None
     if not isinstance(loaded, trimesh.Trimesh):
         raise _fail(path, f"contains no triangle mesh (found {type(loaded).__name__}: a point cloud or lines)")
-    v = np.asarray(loaded.vertices, dtype=np.float64)
-    f = np.asarray(loaded.faces)
+    v, f = _checked_arrays(path, np.asarray(loaded.vertices, dtype=np.float64), np.asarray(loaded.faces), counts,
+                           max_faces)
+    if parts_out is not None:
+        parts_out.extend(parts)
+    return v, f, declared, rounding
+
+
+def _checked_arrays(path: str, v: np.ndarray, f: np.ndarray, counts: _Counts,
+                    max_faces: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(v, f)`` of a file read whole, refused unless they are triangles in 3-D, indexed in range, finite, and
+    as many as its header announced (``counts``)."""
     if len(f) == 0:
         raise _fail(path, "contains no triangles (empty mesh or point cloud)")
     _check_face_budget(path, len(f), max_faces)
@@ -1125,9 +1168,7 @@ def _read_with_trimesh_rounding(path: str, max_faces: int,
                           "(faces dropped or truncated file)")
     if not np.all(np.isfinite(v)):
         raise _fail(path, "vertices have NaN or infinite coordinates")
-    if parts_out is not None:
-        parts_out.extend(parts)
-    return v, f, declared, rounding
+    return v, f
 
 
 def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFAULT_MAX_FACES,

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..values import frozen_value
-from ..errors import InvalidMeshError
+from ..errors import InvalidMeshError, WorkBudgetError
 from ..tolerances import FLAT_RTOL
 from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
 from ..rounding import round_up
@@ -226,7 +226,10 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         census = edge_balance(f, n)
         # a closed surface has an integer winding number off it: the decided cells bound the solid with no
         # assumption, and the grid is refined once towards CLOSED_TARGET_MASS_RTOL
-        grid = closed_surface_estimate(v, f) if census.balanced else open_surface_estimate(v, f)
+        try:
+            grid = closed_surface_estimate(v, f) if census.balanced else open_surface_estimate(v, f)
+        except WorkBudgetError as over:        # counted before the work, so the refusal comes early
+            raise WorkBudgetError(f"{source}: {over}", details=over.details) from None
         why = reason or "the bodies overlap and their union could not be formed"
         hint = ("`overlap` 'sum' adds the bodies (shared volume counted twice)" if reason is None else
                 "repair the surface so that it does not pass through itself")
