@@ -26,6 +26,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import adversary_solids as S
+from test_mesh_sheets import _halves, _on_plane
 
 FAST = settings(max_examples=10, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
@@ -103,3 +104,238 @@ def _patch(f, start, size):
                 seen.add(n)
                 queue.append(n)
     return np.array(sorted(seen), dtype=np.int64)
+
+
+# ------------------------------------------------------------------------ R3b through T-vertices (seams)
+def _solid(rng, shape):
+    """A manifold3d solid of a named shape, turned and moved at random (sometimes far from the origin, sometimes
+    scaled to a millimetre or a kilometre): ``box``, ``union`` (two or three boxes), ``ushape`` (a box less a
+    box through one side: a cut plane may meet it in two regions), ``hollow`` (a box with a box cavity),
+    ``cylinder``, ``sphere``, ``torus``."""
+    import manifold3d as m3d
+
+    e = rng.uniform(0.5, 2.0, size=3)
+    if shape == "box":
+        solid = m3d.Manifold.cube(tuple(e))
+    elif shape == "union":
+        solid = m3d.Manifold.cube(tuple(e))
+        for _ in range(int(rng.integers(1, 3))):
+            solid = solid + m3d.Manifold.cube(tuple(rng.uniform(0.3, 1.5, size=3))).translate(
+                tuple(rng.uniform(0.1, 0.9, size=3) * e))
+    elif shape == "ushape":
+        solid = m3d.Manifold.cube(tuple(e)) - m3d.Manifold.cube((e[0] / 3, e[1] * 2, e[2] * 0.7)).translate(
+            (e[0] / 3, -e[1] / 2, e[2] * 0.4))
+    elif shape == "hollow":
+        solid = m3d.Manifold.cube(tuple(e)) - m3d.Manifold.cube(tuple(e * 0.6)).translate(tuple(e * 0.2))
+    elif shape == "cylinder":
+        solid = m3d.Manifold.cylinder(float(e[2]), float(e[0] / 2), float(e[0] / 2), int(rng.integers(5, 24)))
+    elif shape == "sphere":
+        solid = m3d.Manifold.sphere(float(e[0] / 2), int(rng.integers(8, 24)))
+    else:
+        v, f = S.torus(float(e[0]), float(e[0]) * rng.uniform(0.15, 0.45), int(rng.integers(6, 16)),
+                       int(rng.integers(4, 9)))
+        solid = S.to_manifold((v, f))
+    solid = solid.rotate(tuple(rng.uniform(0, 360, size=3)))
+    scale = float(rng.choice([1e-3, 1.0, 1.0, 1.0, 1e3]))
+    far = float(rng.choice([0.0, 3.0, 3.0, 1e3]))
+    solid = solid.scale((scale, scale, scale)).translate(tuple(rng.uniform(-1, 1, size=3) * far * scale))
+    mesh = solid.to_mesh64()
+    return np.array(mesh.vert_properties, dtype=np.float64)[:, :3].copy(), np.array(mesh.tri_verts, dtype=np.int64)
+
+
+def _rim(hf, on):
+    """Directed rim edges of the cut faces ``hf[on]`` (used by one cut face and not back)."""
+    cut = {(int(x), int(y)) for tri in hf[on].tolist() for x, y in zip(tri, tri[1:] + tri[:1])}
+    return sorted((x, y) for x, y in cut if (y, x) not in cut)
+
+
+def _t_vertices(hv, hf, on, rng, share, ends):
+    """Points put on about ``share`` of the rim edges of one half (every face holding such an edge fanned
+    through them, so the half stays closed by index): 1-5 points at fractions drawn uniformly in (0.05, 0.95),
+    or with ``ends`` log-uniformly from 1e-9 to 0.5 of either end.  Float: off the edge by rounding.  Returns
+    vertices, faces, cut-face mask and the number of points."""
+    holder: dict[tuple[int, int], list[int]] = {}
+    for i, tri in enumerate(hf.tolist()):
+        for x, y in zip(tri, tri[1:] + tri[:1]):
+            holder.setdefault((min(x, y), max(x, y)), []).append(i)
+    chosen, busy = [], set()
+    for x, y in _rim(hf, on):                         # each face on at most one chosen edge
+        faces = holder[(min(x, y), max(x, y))]
+        if rng.random() < share and not busy.intersection(faces):
+            chosen.append((x, y))
+            busy.update(faces)
+    verts, n, inner = [hv], len(hv), {}
+    for p, q in chosen:
+        k = int(rng.integers(1, 6))
+        if ends:
+            ts = np.exp(rng.uniform(np.log(1e-9), np.log(0.5), size=k))
+            ts = np.where(rng.random(k) < 0.5, ts, 1.0 - ts)
+        else:
+            ts = rng.uniform(0.05, 0.95, size=k)
+        ts = np.unique(ts)
+        pts = hv[p] + ts[:, None] * (hv[q] - hv[p])
+        keep = np.any(pts != hv[p], axis=1) & np.any(pts != hv[q], axis=1)
+        pts = np.unique(pts[keep], axis=0)
+        if not len(pts):
+            continue
+        order = np.argsort((pts - hv[p]) @ (hv[q] - hv[p]))
+        inner[(p, q)] = list(range(n, n + len(pts)))
+        verts.append(pts[order])
+        n += len(pts)
+    rows, new_on = [], []
+    for tri, is_cut in zip(hf.tolist(), on.tolist()):
+        hit = None
+        for k in range(3):
+            a, b = tri[k], tri[(k + 1) % 3]
+            if (a, b) in inner:
+                hit = (k, inner[(a, b)])
+            elif (b, a) in inner:
+                hit = (k, inner[(b, a)][::-1])
+        if hit is None:
+            rows.append(tri)
+            new_on.append(is_cut)
+            continue
+        k, mids = hit
+        a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+        chain = [a, *mids, b]
+        rows.extend([s, t, c] for s, t in zip(chain[:-1], chain[1:]))
+        new_on.extend([is_cut] * (len(chain) - 1))
+    return np.vstack(verts), np.array(rows, dtype=np.int64), np.array(new_on, dtype=bool), n - len(hv)
+
+
+def _seamed_case(seed, shape, along, share, which, ends):
+    """A random solid cut by a random plane (manifold3d), joined again with half A's cut face kept inside and
+    half B's left out, T-vertices on the rim of A (``which`` 0), B (1) or both (2), welded bit-exactly; with the
+    exact truth of the two closed halves.  None when the cut does not give two halves with cut faces."""
+    rng = np.random.default_rng(seed)
+    v, f = _solid(rng, shape)
+    normal = rng.normal(size=3)
+    normal /= np.linalg.norm(normal)
+    lo, hi = (v @ normal).min(), (v @ normal).max()
+    offset = float(lo + along * (hi - lo))
+    halves = _halves(v, f, normal, offset)
+    if len(halves) != 2:
+        return None
+    (av, af), (bv, bf) = halves
+    on_a, on_b = _on_plane(av, af, normal, offset), _on_plane(bv, bf, normal, offset)
+    if not on_a.any() or not on_b.any():
+        return None
+    points = 0
+    if which in (0, 2):
+        av, af, on_a, k = _t_vertices(av, af, on_a, rng, share, ends)
+        points += k
+    if which in (1, 2):
+        bv, bf, on_b, k = _t_vertices(bv, bf, on_b, rng, share, ends)
+        points += k
+    truth = S.truth_from_pieces([(1, (av, af)), (1, (bv, bf))])
+    dv, df = S._weld_exact(np.vstack([av, bv]), np.vstack([af, bf[~on_b] + len(av)]))
+    recipe = (f"_seamed_case({seed}, {shape!r}, {along!r}, {share!r}, {which}, {ends}): {points} T-vertices, "
+              f"{len(df)} faces")
+    return dv, df, truth, recipe, points
+
+
+@FAST
+@given(seed=st.integers(0, 2 ** 32 - 1),
+       shape=st.sampled_from(["box", "union", "ushape", "hollow", "cylinder", "sphere", "torus"]),
+       along=st.floats(0.03, 0.97), share=st.floats(0.1, 1.0), which=st.integers(0, 2), ends=st.booleans())
+def test_seamed_sheets_of_generated_parts_are_never_wrong(seed, shape, along, share, which, ends):
+    """R3b through T-vertices on parts the rule's own tests do not draw (non-convex cuts meeting the part in
+    several regions, hollow parts whose cut is an annulus, curved parts, tori, T-vertices a hair from an edge's
+    end, millimetre and kilometre parts far from the origin): exact and right, an estimate within its bounds, or
+    refused; with and without repair."""
+    case = _seamed_case(seed, shape, along, share, which, ends)
+    if case is None:
+        return
+    dv, df, truth, recipe, _ = case
+    for repair in (False, True):
+        _assert_honest(_verdict(dv, df, truth, recipe, repair=repair), recipe)
+
+
+# ------------------------------------------------------- R4: a body wound outward wholly inside another
+def _standing(rng, kind, floor_z, span):
+    """An outward body of ``kind`` standing on the plane z = ``floor_z`` (its lowest corners exactly on it) inside
+    the square |x|, |y| < ``span`` (a flat bottom for ``box`` and ``cylinder``; a point or an edge for the others)."""
+    size = float(rng.uniform(0.15, 0.45)) * span
+    if kind == "box":
+        v, f = S.box(rng.uniform(0.3, 1.0, size=3) * size)
+    elif kind == "cylinder":
+        v, f = S.cylinder(size / 2, float(rng.uniform(0.3, 1.0)) * size, int(rng.integers(5, 17)))
+    elif kind == "icosphere":
+        v, f = S.icosphere(size / 2, int(rng.integers(0, 2)))
+        v = v @ S.random_rotation(rng).T
+    else:
+        name, (v, f) = S.random_piece(rng, convex=True)
+        v = v / float(np.ptp(v, axis=0).max()) * size
+    v = v - [0.0, 0.0, float(v[:, 2].min())]                 # the lowest corners land exactly on z = 0
+    xy = rng.uniform(-1, 1, size=2) * (span - size)
+    return v + [float(xy[0]), float(xy[1]), float(floor_z)], f
+
+
+def _misread_case(seed, inner_kind, outer_kind, core, second, motion):
+    """A 2 m outer body (a box, or a 16-sided prism) with an outward body standing on its floor (R4 reads it as a
+    cavity), optionally a core inside that one (a body again by nesting depth) and a second outward body free
+    inside; moved by ``motion`` ("none", a right-angle rotation with a dyadic shift, a random rotation, or far).
+    Returns the mesh, the parity truth, the union truth and a recipe."""
+    rng = np.random.default_rng(seed)
+    outer = S.box([2.0, 2.0, 2.0]) if outer_kind == "box" else S.cylinder(1.0, 2.0, 16)
+    span = 0.95 if outer_kind == "box" else 0.65
+    inner = _standing(rng, inner_kind, -1.0, span)
+    pieces = [(1, outer), (-1, inner)]
+    bodies = [outer, inner]
+    if core:
+        iv, fi = inner
+        centre = iv.mean(axis=0)
+        reach = float(np.min(np.abs(iv - centre))) if inner_kind == "box" else 0.0
+        small = S.box([max(reach, 1e-3) * 0.5] * 3, centre) if reach > 1e-3 else None
+        if small is not None:
+            pieces.append((1, small))
+            bodies.append(small)
+    if second:
+        free = S.icosphere(0.12, 1)
+        spot = np.array([0.0, 0.0, 0.7])
+        free = (free[0] + spot, free[1])
+        pieces.append((-1, free))
+        bodies.append(free)
+    if motion == "right":
+        rot, shift = S.right_angle_rotation(rng), rng.integers(-8, 9, size=3) * 0.125
+    elif motion == "generic":
+        rot, shift = S.random_rotation(rng), rng.normal(size=3)
+    elif motion == "far":
+        rot, shift = S.random_rotation(rng), rng.normal(size=3) * 1000.0
+    else:
+        rot, shift = np.eye(3), np.zeros(3)
+    moved = [S.moved(b, rot, shift) for b in bodies]
+    signed = [(sign, S.moved(p, rot, shift)) for sign, p in pieces]
+    v, f = S.concat(*moved)
+    parity = S.truth_from_pieces(signed)
+    union = S.truth_from_pieces([signed[0]])
+    recipe = f"_misread_case({seed}, {inner_kind!r}, {outer_kind!r}, {core}, {second}, {motion!r})"
+    return v, f, parity, union, recipe
+
+
+def _judge_misread(v, f, parity, union, recipe):
+    """R4's rule for a misread body: exact only as the parity solid; an estimate whose bounds hold for both
+    readings; never united unless right; or refused / unverified."""
+    case = S.Case("review7", v, f, parity, recipe)
+    to_parity = S.judge_truth(case, parity)
+    assert to_parity.label != "crashed", f"{recipe}: {to_parity.wrong}"
+    if to_parity.label == "estimate":
+        to_union = S.judge_truth(case, union)
+        assert to_parity.wrong is None and to_union.wrong is None, (
+            f"{recipe}: the estimate's bounds must span both readings; parity: {to_parity.wrong}; "
+            f"union: {to_union.wrong}")
+    elif to_parity.label in S.PROVEN:
+        assert to_parity.wrong is None, f"{recipe}: {to_parity.label} but not the parity solid: {to_parity.wrong}"
+    return to_parity.label
+
+
+@FAST
+@given(seed=st.integers(0, 2 ** 32 - 1), inner_kind=st.sampled_from(["box", "cylinder", "icosphere", "piece"]),
+       outer_kind=st.sampled_from(["box", "prism"]), core=st.booleans(), second=st.booleans(),
+       motion=st.sampled_from(["none", "right", "generic", "far"]))
+def test_an_outward_body_standing_inside_another_is_never_wrong(seed, inner_kind, outer_kind, core, second,
+                                                                   motion):
+    """R4's misread-nesting reading on bodies the rule's own tests do not draw: prisms, icospheres and parts
+    standing on the floor of a box or of a prism (flush, on an edge or on a point), with a core inside (a body
+    again by depth) and a second outward body free inside, turned exactly, generically or far from the origin."""
+    _judge_misread(*_misread_case(seed, inner_kind, outer_kind, core, second, motion))
