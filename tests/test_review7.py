@@ -469,3 +469,63 @@ def test_pinched_grids_match_brute_force(mesh):
     fast, unpatched = _check(v, f, brute=True)
     event("certified" if fast.candidate_pairs < unpatched.candidate_pairs else "not certified")
     event("crossing found" if len(fast.crossing) else "no crossing")
+
+
+# ------------------------------------------------------------------- real files with random damage
+def _real_files_module():
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    if "damage_real_files" in sys.modules:
+        return sys.modules["damage_real_files"]
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "damage" / "real_files.py"
+    spec = importlib.util.spec_from_file_location("damage_real_files", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["damage_real_files"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def _repo_sources():
+    rf = _real_files_module()
+    out = []
+    for name, v, f in rf.cov.repo_sources():
+        truth = rf.cov.truth_of(v, f)
+        if truth is not None and len(f) <= 4000:
+            out.append((name, v, f, truth))
+    return out
+
+
+def _assert_rows_honest(rows):
+    for row in rows:
+        assert row["status"] != "error", row
+        assert row.get("holds") is not False, row
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["duplicate", "flipped", "flip_patch", "touching_translate", "t_junction",
+                                  "sliver", "hole"])
+def test_repository_meshes_with_damage_that_keeps_the_solid(kind):
+    """Each repository mesh (clean, exact) damaged once by ``kind`` (benchmarks/damage/real_files.py; a third of
+    them quantised first): every answer, with and without repair, right within its certificate or refused."""
+    rf = _real_files_module()
+    for s, source in enumerate(_repo_sources()):
+        _assert_rows_honest(rf.run_case(source, kind, [707, s, len(kind)]))
+
+
+def test_real_files_from_the_environment():
+    """``INERTIA_TOOL_REAL_MESHES`` (folders, separated by the path separator; unset: skipped): a seeded sample of
+    the clean closed files there, each damaged once by every kind of ``real_files.py``."""
+    import os
+
+    roots = [r for r in os.environ.get("INERTIA_TOOL_REAL_MESHES", "").split(os.pathsep) if r]
+    if not roots:
+        pytest.skip("INERTIA_TOOL_REAL_MESHES is not set")
+    rf = _real_files_module()
+    count = int(os.environ.get("INERTIA_TOOL_REAL_MESHES_COUNT", "5"))
+    sources = rf.find_sources(roots, 3000, np.random.default_rng(7), count)
+    for s, source in enumerate(sources):
+        for k, kind in enumerate(rf.cov.KINDS + rf.EXTRA_KINDS):
+            _assert_rows_honest(rf.run_case(source, kind, [708, s, k]))

@@ -36,11 +36,26 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
-for p in (str(HERE), str(ROOT)):
-    if p not in sys.path:
-        sys.path.insert(0, p)
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
 
-import coverage as cov  # noqa: E402
+
+def _coverage_module():
+    """``coverage.py`` beside this file, loaded under its own name (a ``coverage`` package may be imported)."""
+    import importlib.util
+
+    if "damage_coverage" in sys.modules:
+        return sys.modules["damage_coverage"]
+    spec = importlib.util.spec_from_file_location("damage_coverage", HERE / "coverage.py")
+    if spec is None or spec.loader is None:
+        raise ImportError(f"expected {HERE / 'coverage.py'}, found nothing loadable")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["damage_coverage"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+cov = _coverage_module()
 
 EXTRA_KINDS = ("duplicate", "flipped", "flip_patch", "touching_translate")
 CLOSED_KINDS = ("t_junction", "sliver", "internal_wall", "touching_copy") + EXTRA_KINDS
