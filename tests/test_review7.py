@@ -18,8 +18,6 @@ kept below as strict-xfail reproducers whose reason names the rule at fault.
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, event, given, settings
@@ -275,13 +273,21 @@ def _standing(rng, kind, floor_z, span):
 
 def _misread_case(seed, inner_kind, outer_kind, core, second, motion):
     """A 2 m outer body (a box, or a 16-sided prism) with an outward body standing on its floor (R4 reads it as a
-    cavity), optionally a core inside that one (a body again by nesting depth) and a second outward body free
-    inside; moved by ``motion`` ("none", a right-angle rotation with a dyadic shift, a random rotation, or far).
+    cavity; in a box, a third of the time pushed into a corner, flush with two walls as well), optionally a core
+    inside that one (a body again by nesting depth) and a second outward body free inside; moved by ``motion``
+    ("none", a right-angle rotation with a dyadic shift, a random rotation, or far).
     Returns the mesh, the parity truth, the union truth and a recipe."""
     rng = np.random.default_rng(seed)
     outer = S.box([2.0, 2.0, 2.0]) if outer_kind == "box" else S.cylinder(1.0, 2.0, 16)
     span = 0.95 if outer_kind == "box" else 0.65
     inner = _standing(rng, inner_kind, -1.0, span)
+    if outer_kind == "box" and rng.random() < 0.3:        # pushed into a corner: flush with two walls too
+        iv, fi = inner
+        iv = iv.copy()
+        for axis in (0, 1):
+            top = iv[:, axis].max()
+            iv[:, axis] = np.where(iv[:, axis] == top, 1.0, iv[:, axis] + (1.0 - top))
+        inner = (iv, fi)
     pieces = [(1, outer), (-1, inner)]
     bodies = [outer, inner]
     if core:
