@@ -14,6 +14,9 @@ Gazebo model library, MuJoCo Menagerie) that inertia_tool reads as one clean clo
 - ``touching_translate``: a copy moved by the bounding box's extent along a random axis (interiors disjoint,
   touching where the part has a flat face on that side), vertices welded bit-exactly; truth: both bodies.
 
+A hole that takes a whole shell of a file with several (a small part, a cavity) does not keep the solid: such a
+case is counted as skipped.
+
 The closed kinds (T-junctions, slivers, walls, touching copies, duplicates, flips) are also answered without
 repair.  The rule is that of ``coverage.py``: an answer certified ``exact``/``united``/``summed`` within 1e-9 of the
 truth, an estimate within its bounds (``holds``), ``unverified`` claims nothing, a refusal is allowed; any
@@ -151,6 +154,22 @@ def damage_extra(kind, v, f, rng, truth):
     return wv, wf, cov._moments_truth(both_v, both_f), {"axis": "xyz"[axis], "shared": int(len(both_v) - len(wv))}
 
 
+def _components(f, n):
+    """Connected components of the faces (through shared vertices)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    f = np.asarray(f, dtype=np.int64)
+    if not len(f):
+        return 0
+    rows = np.repeat(np.arange(len(f)), 3)
+    graph = coo_matrix((np.ones(3 * len(f), dtype=np.int8), (rows, f.reshape(-1))), shape=(len(f), n))
+    used = np.unique(f)
+    both = coo_matrix(graph.T @ graph)
+    count, labels = connected_components(both, directed=False)
+    return len(np.unique(labels[used]))
+
+
 def run_case(source, kind, entropy):
     name, v, f, clean = source
     rng = np.random.default_rng(entropy)
@@ -170,6 +189,10 @@ def run_case(source, kind, entropy):
         truth = cut if cut is not None else truth
     else:
         dv, df, meta = cov.make_case(kind, v, f, rng, truth["diagonal"])
+    if _components(df, len(dv)) < _components(f, len(v)) and kind not in EXTRA_KINDS + ("touching_copy",):
+        # the damage took a whole shell of a multi-shell file (a small part, a cavity): the solid is not kept
+        return [{"source": name, "kind": kind, "entropy": list(entropy), "faces": int(len(df)), "quantum": quantum,
+                 "repair": True, "status": "skipped", "reason": "the damage removed a whole shell", **meta}]
     rows = []
     cpu = time.process_time()
     rows.append({"repair": True, **cov.evaluate(dv, df, truth)})
