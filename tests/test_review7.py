@@ -470,7 +470,7 @@ def pinched_grids(draw):
 
 
 @pytest.mark.skipif(not HAVE_ACCEL, reason="inertia_tool._accel is not built")
-@settings(max_examples=60, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
+@settings(max_examples=30, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 @given(pinched_grids())
 def test_pinched_grids_match_brute_force(mesh):
     """The C scan with its certified patches finds, pair for pair, what the unpatched scan, the numpy twin and the
@@ -558,6 +558,7 @@ def test_a_misread_body_inside_a_part_with_a_hole_spans_both_readings():
         == "estimate"
 
 
+@pytest.mark.slow
 @FAST
 @given(seed=st.integers(0, 2 ** 32 - 1), inner_kind=st.sampled_from(["box", "cylinder", "icosphere", "piece"]),
        core=st.booleans(), second=st.booleans(), motion=st.sampled_from(["generic", "far"]))
