@@ -632,8 +632,8 @@ _COPIES = {
 
 @pytest.mark.xfail(strict=True, reason="R0 / unite: a closed surface with its inverted copy rounded apart (not an "
                    "exact copy, so R0's 'cancel to nothing' refusal does not fire) is read as a cavity crossing its "
-                   "body; the union is empty and the pipeline crashes (ValueError from the C integrator's wrapper, or UsageError "
-                   "'Expected a positive total mass') instead of refusing")
+                   "body; the union is empty and the pipeline crashes (ValueError from the C integrator's wrapper, or "
+                   "UsageError 'Expected a positive total mass') instead of refusing")
 @pytest.mark.parametrize("found", sorted(_COPIES))
 def test_a_body_with_its_inverted_copy_rounded_apart_is_refused_not_a_crash(found):
     """A 1.76 × 0.66 × 1.81 m box and its inverted copy, the copy's corners a few ulp from the box's (turned about
