@@ -659,19 +659,25 @@ def test_a_body_with_its_inverted_copy_rounded_apart_is_refused_not_a_crash(foun
             pass
 
 
-# ------------------------------------------ a seamed wall in a hollow part with a hole: the winding estimate
+# ------------------------------------------------ a seamed wall inside a part with a hole: repair's estimates
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="the winding-number estimate (repair's fallback, mesh/grid_estimate.py): on a "
-                   "hollow part with a wall inside and a hole, {w > 1/2} is not the solid; the bound covers only the "
-                   "grid's cells, and misses the truth by 16 %")
-def test_a_hollow_part_with_a_seamed_wall_and_a_hole_stays_inside_its_bound():
-    """A hollow box cut near its middle and joined again, one half's cut face (a frame round the cavity) kept inside
-    with T-vertices on both rims (``_seamed_case(1993102077, "hollow", ...)``), then three faces removed (a hole).
-    Without the hole the answer is exact (4.4431 m³).  With it, the union could not be formed and repair's
-    winding-number estimate answers 3.7291 m³ within ±14.1 %: 16.1 % low."""
-    case = _seamed_case(1993102077, "hollow", 0.49037461818697947, 0.21577182756018304, 2, True)
+@pytest.mark.xfail(strict=True, reason="repair on a part with a wall kept inside (R3b's seamed sheet) and a hole: the "
+                   "wall is not taken out, and the estimate misses its own bound (the winding-number grid, whose "
+                   "{w > 1/2} is not the solid there; or the patch, after orient turned faces to agree with the wall)")
+@pytest.mark.parametrize("args, gone", [
+    ((1993102077, "hollow", 0.49037461818697947, 0.21577182756018304, 2, True), [54, 56, 57]),
+    ((1596054528, "hollow", 0.5245655717771776, 0.539956890146432, 1, False), [2]),
+    ((1453299742, "sphere", 0.7324975718589595, 0.12998286392214461, 0, False), [6, 9]),
+])
+def test_a_part_with_a_seamed_wall_and_a_hole_stays_inside_its_bound(args, gone):
+    """Three draws of the seamed-sheet generator with one to three faces removed (a hole), with repair; without the
+    hole each is exact.  A hollow box cut near its middle, one half's cut face (a frame round the cavity) kept
+    inside: the union is not formed and the winding-number estimate answers 3.7291 m³ within ±14.1 % (truth
+    4.4431, 16.1 % low), or 1.3445 within ±13.2 % (truth 1.1758, 14.3 % high).  A millimetre sphere cut near a
+    pole, its cap's cut face kept: 56 faces turned to agree with their neighbours, the patch answers 1.041e-9 m³
+    within ±17.8 % (truth 1.536e-9, 32 % low)."""
+    case = _seamed_case(*args)
     assert case is not None
     dv, df, truth, recipe, _ = case
-    assert len(df) == 65
-    _assert_honest(_verdict(dv, np.delete(df, [54, 56, 57], axis=0), truth, recipe + "; faces 54, 56, 57 removed",
-                            repair=True), recipe)
+    _assert_honest(_verdict(dv, np.delete(df, gone, axis=0), truth, f"{recipe}; faces {gone} removed", repair=True),
+                   recipe)
