@@ -15,6 +15,28 @@ settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
 
+#: A developer's scaled run of the property tests (the adversarial review at scale): every hypothesis test's
+#: max_examples multiplied by this factor, and its examples drawn from ``--hypothesis-seed`` instead of a fixed
+#: sequence (``derandomize`` off), e.g. ``INERTIA_TOOL_HYPOTHESIS_SCALE=20 pytest tests/test_review_proofs.py
+#: --hypothesis-seed 7``.  Unset (CI, ordinary runs): nothing changes.
+HYPOTHESIS_SCALE = float(os.environ.get("INERTIA_TOOL_HYPOTHESIS_SCALE", "0") or 0)
+
+
+def pytest_collection_modifyitems(items):
+    """Apply :data:`HYPOTHESIS_SCALE` to the collected hypothesis tests (their settings are read when they run,
+    so the explicit ``@settings(max_examples=...)`` of each is scaled, not replaced)."""
+    if HYPOTHESIS_SCALE <= 0:
+        return
+    for item in items:
+        test = getattr(item, "obj", None)
+        current = getattr(test, "_hypothesis_internal_use_settings", None)
+        if current is None or getattr(test, "_inertia_tool_scaled", False):
+            continue
+        test._hypothesis_internal_use_settings = settings(
+            current, max_examples=max(1, int(round(current.max_examples * HYPOTHESIS_SCALE))), derandomize=False,
+            database=None)
+        test._inertia_tool_scaled = True
+
 
 class MujocoWarning(UserWarning):
     """A warning MuJoCo issued (it would otherwise append it to MUJOCO_LOG.TXT in the working directory)."""

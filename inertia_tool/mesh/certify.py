@@ -158,9 +158,12 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
     if patched is not None:
         from .uncertainty import check_useful, uncertainty_from     # imported on use: repair only
         whole = total(shells.moments)
-        uncertainty = uncertainty_from(whole.volume, whole.centroid, whole.second_moment,
-                                       patched.uncertainty.volume_in_doubt, patched.far)
-        check_useful(whole.volume, uncertainty, source=source, what="the patched surface")
+        doubt, far = patched.uncertainty.volume_in_doubt, patched.far
+        if spread is not None:                # R4: the reading the file does not decide is in doubt as well
+            doubt, far = doubt + spread[0], max(far, spread[1])
+        uncertainty = uncertainty_from(whole.volume, whole.centroid, whole.second_moment, doubt, far)
+        what = "the patched surface" + (" and a shell wound outward inside another" if spread is not None else "")
+        check_useful(whole.volume, uncertainty, source=source, what=what)
         # a patched surface whose union could not be verified (R6) keeps "unverified": the patches' bound does
         # not cover what the boolean changed beyond them
         method, kind = "patched", ("unverified" if kind == "unverified" else "estimate")
