@@ -567,13 +567,21 @@ def _seam_corners(f: np.ndarray, n: int, boundary: np.ndarray | None = None) -> 
     :func:`~.rims.boundary_edges`, whose edges are exactly the unbalanced ones) when the caller has it, without
     sorting every edge again."""
     if boundary is not None:
-        return np.unique(np.asarray(boundary, dtype=np.int64).reshape(-1))
+        return _distinct(np.asarray(boundary, dtype=np.int64).reshape(-1), n)
     key, forward = edge_keys(f, n)
     codes, inverse = _codes(key)
     net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
     nv = np.int64(max(n, 1))
     bad = codes[net != 0]
-    return np.unique(np.r_[bad // nv, bad % nv])
+    return _distinct(np.r_[bad // nv, bad % nv], n)
+
+
+def _distinct(corners: np.ndarray, n: int) -> np.ndarray:
+    """``numpy.unique`` of vertex indices in ``[0, n)`` by counting (k,) int64: the same sorted array without a
+    sort (a soup's 7.9M rim corners: 6 s → 0.02 s)."""
+    if not len(corners):
+        return np.zeros(0, dtype=np.int64)
+    return np.flatnonzero(np.bincount(corners, minlength=max(n, 1))).astype(np.int64)
 
 
 def _split_at_seams(v: np.ndarray, rest: np.ndarray, reach: float
