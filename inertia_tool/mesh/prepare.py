@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InternalInvariantError, UsageError
+from ..errors import InternalInvariantError, InvalidMeshError, UsageError
 from ..integrals import VolumeMoments, bounding_box
 from ..tolerances import MERGE_TOLERANCE
 from ..values import frozen_value
@@ -38,7 +38,7 @@ from .self_crossing import settle_self_crossing
 from .settle import find_contacts
 from .shells import find_shells
 from .surface import close_surface
-from .unite import unite_overlaps
+from .unite import NOTHING_LEFT, unite_overlaps
 from .welded import settle_welded
 
 __all__ = ["PreparedMesh", "prepare_mesh", "OVERLAP_MODES"]
@@ -148,6 +148,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         return _estimated(united.forced, {**common, "overlapping_shells": united.overlaps})
     united, spread = misread_reading(oriented, united, method=found.method, source=source)     # R4's label
     shells = united.shells
+    if not sum(s.volume for s in shells.moments) > 0:        # bodies and cavities cancel: no solid to certify
+        raise InvalidMeshError(NOTHING_LEFT.format(source=source))
     certified = certify(shells, kind=united.kind, checks=united.checks, method=united.method, patched=patched,
                         arranged=crossed.arranged is not None, verified=crossed.verified,
                         ambiguous=bool(oriented.ambiguous), folds=met.folds is not None,

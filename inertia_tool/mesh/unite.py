@@ -176,8 +176,17 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
                 kind = "unverified"
                 notes.append(f"the union formed by the boolean passes through itself at {len(after.crossing):,} "
                              "face pairs (rounding in manifold3d): not verified")
+            if not len(united.faces) or not united.volume > 0:
+                raise InvalidMeshError(NOTHING_LEFT.format(source=source))
             shells, owner, cavities = _oriented_anew(united.vertices, united.faces, diag, source)
     return United(shells, owner, cavities, overlaps, method, kind, checks, tuple(notes), None)
+
+
+#: The refusal when the bodies, as wound and nested, leave no material (a closed surface with its inverted copy
+#: rounded apart: R0 refuses the exact copy, "cancel to nothing").
+NOTHING_LEFT = ("{source}: the shells, as wound and nested, enclose no material: the union of the bodies less "
+                 "their cavities is empty (a closed surface listed with an inverted copy of itself, the copy's "
+                 "corners rounded apart?); remove the inverted copy, or fix the winding of the part meant")
 
 
 def _oriented_anew(v: np.ndarray, f: np.ndarray, diag: float, source: str) -> tuple[Shells, np.ndarray, int]:
