@@ -6,7 +6,12 @@ the cones always close it.  **Assumption: the missing surface of each hole lies 
 hole's rim** (:func:`~.rims.enclosing_balls`, close to the smallest such ball; for a round hole in a smooth part
 this is the ball whose great circle is the rim, which holds any cap up to a hemisphere).  The cone lies in the
 rim's convex hull, inside the same ball, so the closed cycle "cone minus missing surface" lies in the ball and
-its winding number — the difference between the patched solid and the true one — vanishes outside it.
+its winding number — the difference between the patched solid and the true one — vanishes outside it.  The
+same assumption, for a long thin rim: **the missing surface also lies within the capsule round the rim's
+principal axis that holds the rim** (:func:`~.rims.enclosing_capsules`: no farther from the axis than the rim
+is; round a circle the capsule is the ball).  The capsule is convex and holds the cone too, so the region in
+doubt lies in it as well, and each hole's doubt is the smaller of the two volumes (a strip of facets taken
+along a cylinder has a ball as long as the strip, larger than the part, and a capsule as thin as the strip).
 **Second assumption: the missing surface strays from the plane of a face beside the hole no farther than the
 rim does** (:func:`hole_doubt_volumes`); the cone does too, so each ball is cut to that slab, and the volume in
 doubt is the total volume of the cut balls.  The convex hull of the rim is *not* enough (a planar rim has a hull
@@ -36,7 +41,7 @@ import numpy as np
 from ..rounding import round_up
 from ..values import frozen_value
 from .edges import edge_keys
-from .rims import boundary_edges, boundary_loops, enclosing_balls
+from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal
 from .uncertainty import Estimate, uncertainty_from
 
@@ -772,8 +777,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     """Close each boundary loop by a cone to its centroid and integrate; bound by the balls over the rims.
 
     Assumption (stated in the module docstring): the missing surface of each boundary component lies in the
-    ball enclosing its rim (:func:`enclosing_balls`); the cone lies there too, so the patched solid and the
-    true one differ only inside those balls; with the second assumption (the missing surface strays from the
+    ball enclosing its rim (:func:`enclosing_balls`) and in the capsule enclosing it
+    (:func:`~.rims.enclosing_capsules`); the cone lies there too, so the patched solid and the true one differ
+    only inside both (each hole's doubt is at most the smaller volume, and its reach from the centroid the
+    nearer of the two regions' far points); with the second assumption (the missing surface strays from the
     plane of a face beside the hole no farther than the rim does) only inside each ball's slab around that
     plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  A hole with a bare rim vertex
     keeps its whole ball, and a footprint of a feature taken whole sets ``unbounded`` (:func:`rim_evidence`;
@@ -864,11 +871,18 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         cone_doubt[contradicted] = 4.0 / 3.0 * np.pi * radius[contradicted] ** 3
         creases = [fill for fill in creases if fill.loop not in set(contradicted)]
         pv, pf, cap, closed, hole_doubt = build(creases)
+    # the capsule over each rim (first assumption, for long thin rims): the region in doubt lies in it too
+    reach = np.linalg.norm(centre - closed.centroid, axis=1) + radius
+    if n_loops:
+        start, end, thick = enclosing_capsules(v[vertex_of], loop_of, n_loops)
+        hole_doubt = np.minimum(hole_doubt, capsule_volumes(start, end, thick))
+        reach = np.minimum(reach, np.maximum(np.linalg.norm(start - closed.centroid, axis=1),
+                                             np.linalg.norm(end - closed.centroid, axis=1)) + thick)
     doubt = float(np.sum(hole_doubt))
     # the surface as given: the closed surface's area less the cones' (no second pass over every face)
     ca, cb, cc = pv[cap[:, 0]], pv[cap[:, 1]], pv[cap[:, 2]]
     area = float(closed.area) - float(0.5 * np.linalg.norm(np.cross(cb - ca, cc - ca), axis=1).sum())
-    far = float(np.max(np.linalg.norm(centre - closed.centroid, axis=1) + radius)) if n_loops else 0.0
+    far = float(np.max(reach)) if n_loops else 0.0
     convex = False
     if n_loops and doubt > 0 and not taken:
         # fourth assumption, where what remains is convex: the complete part is too (convex_hole_bound)

@@ -1,0 +1,201 @@
+"""The capsule over a long thin rim (``mesh/rims.py``: :func:`enclosing_capsules`, :func:`capsule_volumes`; its use
+in ``mesh/holes.py``: :func:`patched_estimate`).
+
+The first assumption of the hole bound says the missing surface lies in the ball over its rim *and* in the
+capsule round the rim's principal axis, as wide as the rim strays from that axis; the region in doubt lies in
+both, so each hole's doubt is at most the smaller volume.  A strip-shaped hole along a cylinder or a CAD
+part's long face has a ball as long as the strip (larger than the part) but a capsule as thin as the strip.
+The guarantee tested: refused, or inside the stated bound, on spheres, tori, cylinders and featured boxes with
+long ribs and slots (a feature taken whole, the case the narrower capsule could miss).
+"""
+
+import numpy as np
+import pytest
+import trimesh
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from inertia_tool.integrals import volume_moments
+from inertia_tool.mesh.holes import patched_estimate
+from inertia_tool.mesh.rims import capsule_volumes, enclosing_balls, enclosing_capsules
+from inertia_tool.tolerances import ESTIMATE_MAX_MASS_RTOL
+
+from test_hole_bounds import _holds
+from test_hole_footprints import _patch, _refused_or_holds, featured_box
+
+pytest.importorskip("manifold3d")
+
+
+def _segment_distance(p, a, b):
+    ab = b - a
+    t = np.clip((p - a) @ ab / max(float(ab @ ab), 1e-300), 0.0, 1.0)
+    return np.linalg.norm(p - (a + t[:, None] * ab), axis=1)
+
+
+# ------------------------------------------------------------------------------------------- the capsule
+
+def test_capsule_of_a_circle_is_its_ball_and_of_a_strip_is_the_strip():
+    """Closed forms: round a circle of radius ``a`` the axial segment shrinks to a point (the capsule is the ball
+    of radius ``a``); round the corners of a 10 × 0.2 strip it is the 10-long segment of radius 0.1, volume
+    ``π 0.1² 10 + (4/3) π 0.1³``, against the ball's ``(4/3) π 5.001³``."""
+    angle = np.linspace(0, 2 * np.pi, 4096, endpoint=False)
+    circle = 2.0 * np.c_[np.cos(angle), np.sin(angle), np.zeros_like(angle)]
+    strip = np.array([[x, y, 0.0] for x in (0.0, 10.0) for y in (-0.1, 0.1)])
+    points = np.vstack([circle, strip])
+    group = np.r_[np.zeros(len(circle), dtype=np.int64), np.ones(4, dtype=np.int64)]
+    start, end, radius = enclosing_capsules(points, group, 2)
+    assert np.linalg.norm(end[0] - start[0]) < 1e-5 and radius[0] == pytest.approx(2.0, rel=1e-6)
+    assert np.linalg.norm(end[1] - start[1]) == pytest.approx(10.0, rel=1e-12)
+    assert radius[1] == pytest.approx(0.1, rel=1e-12)
+    volume = capsule_volumes(start, end, radius)
+    assert volume[1] == pytest.approx(np.pi * 0.01 * 10 + 4 / 3 * np.pi * 1e-3, rel=1e-12)
+    _, ball = enclosing_balls(points, group, 2)
+    assert volume[1] < 1e-3 * 4 / 3 * np.pi * ball[1] ** 3
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2 ** 31 - 1), groups=st.integers(1, 6), stretch=st.floats(1e-3, 1e3),
+       offset=st.floats(-1e4, 1e4))
+def test_every_capsule_encloses_its_group(seed, groups, stretch, offset):
+    """Random groups of 1-40 points, stretched along a random axis and moved far from the origin: every point
+    lies within the capsule's radius of its segment (to round-off), as the bound needs whatever the axis."""
+    rng = np.random.default_rng(seed)
+    size = rng.integers(1, 41, size=groups)
+    group = np.repeat(np.arange(groups), size)
+    axis = Rotation.random(random_state=seed).as_matrix()
+    points = (rng.normal(size=(len(group), 3)) * [stretch, 1.0, 1.0]) @ axis.T + offset
+    rng.shuffle(group)                          # groups need not come sorted
+    start, end, radius = enclosing_capsules(points, group, groups)
+    gap = np.array([_segment_distance(points[i:i + 1], start[group[i]], end[group[i]])[0]
+                    for i in range(len(points))])
+    scale = 1e-12 * (abs(offset) + stretch + 1.0)
+    assert np.all(gap <= radius[group] + scale)
+
+
+# ------------------------------------------------------------------------------------ long thin holes
+
+def _strip_of_a_cylinder(sections, width, quat):
+    """A faceted cylinder (radius 1, length 3, trimesh) less the side faces of ``width`` adjacent facets (a strip
+    along its whole length)."""
+    s = trimesh.creation.cylinder(radius=1.0, height=3.0, sections=sections)
+    v = np.asarray(s.vertices) @ Rotation.from_quat(quat).as_matrix().T
+    f = np.asarray(s.faces)
+    local = np.asarray(s.vertices)[f].mean(axis=1)
+    side = np.abs(np.asarray(s.vertices)[f][:, :, 2]).max(axis=1) - np.abs(np.asarray(s.vertices)[f][:, :, 2]).min(
+        axis=1) > 1.0
+    angle = np.mod(np.arctan2(local[:, 1], local[:, 0]), 2 * np.pi)
+    gone = np.flatnonzero(side & (angle < width * 2 * np.pi / sections))
+    return v, f, gone
+
+
+def test_a_strip_along_a_cylinder_is_answered_inside_its_bound():
+    """A strip of two facets taken along a 48-facet cylinder, turned: answered (what remains is convex, so the
+    convex bound applies too), inside its bound."""
+    v, f, gone = _strip_of_a_cylinder(48, 2, (0.3, -0.2, 0.5, 0.8))
+    truth = volume_moments(v, f)
+    est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
+    assert not est.unbounded and est.uncertainty.mass < 0.05
+    assert _holds(est, truth)
+
+
+def _coverage():
+    import sys
+    from pathlib import Path
+    here = Path(__file__).resolve().parents[1] / "benchmarks" / "damage"
+    sys.path.insert(0, str(here))
+    try:
+        import coverage
+    finally:
+        sys.path.remove(str(here))
+    return coverage
+
+
+@pytest.mark.parametrize("case, source", [("6-01-hole", "generated/capsule"),
+                                          ("6-02-crack_hole", "generated/cylinder")])
+def test_the_benchmarks_strips_along_a_capsule_and_a_cylinder_are_answered_inside_their_bound(case, source):
+    """Coverage cases refused at ±294 % and ±179 % (docs/damage-benchmark.md): the damage took faces of the side
+    along the whole length (trimesh's capsule and cylinder have side facets as long as the part), so the ball
+    over the rim is longer than the part; a rim vertex keeps only its facet's two triangles (bare), so neither
+    the slab nor the convex bound applies.  The capsule over the strip gives ±33 % and ±47 %: answered, inside
+    the bound, and within 1 %/1 %/2 % of the truth."""
+    cov = _coverage()
+    names = [name for name, _, _ in cov.generated_sources()]
+    index = names.index(source)
+    _, v, f = cov.generated_sources()[index]
+    truth = cov.truth_of(v, f)
+    seed, kind = int(case.split("-")[0]), case.split("-", 2)[2]
+    rng = np.random.default_rng([seed, index, cov.KINDS.index(kind), 0])
+    if rng.random() < cov.QUANTISE_SHARE:
+        qv, qf, _ = cov._quantised(v, f, rng, truth["diagonal"])
+        qt = cov.truth_of(qv, qf)
+        if qt is not None:
+            v, f, truth = qv, qf, qt
+    dv, df, _ = cov.make_case(kind, v, f, rng, truth["diagonal"])
+    row = cov.evaluate(dv, df, truth)
+    assert row["status"] == "answer" and row["holds"] and row["within"], row
+    assert row["mass_bound"] < ESTIMATE_MAX_MASS_RTOL
+
+
+@settings(max_examples=25, deadline=None)
+@given(sections=st.integers(6, 64), width=st.integers(1, 12),
+       quat=st.tuples(*[st.floats(-1, 1)] * 4).filter(lambda q: np.linalg.norm(q) > 0.1))
+def test_strips_along_cylinders_are_refused_or_inside_their_bound(sections, width, quat):
+    """Strips of 1-12 facets taken along a cylinder's length (up to the whole side: then two rims, each a cap's
+    edge): refused, or inside the stated bound."""
+    v, f, gone = _strip_of_a_cylinder(sections, min(width, sections), quat)
+    est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
+    assert _refused_or_holds(est, volume_moments(v, f))
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2 ** 31 - 1), length=st.integers(2, 40))
+def test_long_thin_holes_on_spheres_and_tori_are_refused_or_inside_their_bound(seed, length):
+    """A path of faces grown along one direction (each next face the neighbour farthest along it: a long
+    thin hole) on an icosphere or a torus (saddles): refused, or inside the stated bound."""
+    rng = np.random.default_rng(seed)
+    shape = (trimesh.creation.icosphere(3) if rng.random() < 0.5 else
+             trimesh.creation.torus(major_radius=1.0, minor_radius=0.3, major_sections=48, minor_sections=24))
+    v, f = np.asarray(shape.vertices), np.asarray(shape.faces)
+    centroid = v[f].mean(axis=1)
+    direction = rng.normal(size=3)
+    neighbours = [[] for _ in range(len(f))]
+    for a, b in shape.face_adjacency.tolist():
+        neighbours[a].append(b)
+        neighbours[b].append(a)
+    path = [int(rng.integers(len(f)))]
+    for _ in range(length):
+        options = [n for n in neighbours[path[-1]] if n not in path]
+        if not options:
+            break
+        path.append(max(options, key=lambda n: float(centroid[n] @ direction)))
+    est = patched_estimate(v, np.delete(f, path, axis=0), volume_moments)
+    assert _refused_or_holds(est, volume_moments(v, f))
+
+
+@settings(max_examples=40, deadline=None)
+@given(extents=st.tuples(st.floats(2.0, 6.0), st.floats(1.0, 3.0), st.floats(0.3, 2.0)),
+       place=st.tuples(st.floats(0.05, 0.95), st.floats(0.05, 0.95)),
+       size=st.tuples(st.floats(0.5, 0.95), st.floats(0.01, 0.08)), turn=st.booleans(),
+       height=st.one_of(st.floats(0.1, 3.0), st.floats(-0.9, -0.05)),
+       pattern=st.sampled_from(["feature", "feature and around", "patch"]), start=st.integers(0, 10 ** 6),
+       extra=st.integers(1, 40),
+       quat=st.tuples(*[st.floats(-1, 1)] * 4).filter(lambda q: np.linalg.norm(q) > 0.1))
+def test_ribs_and_slots_taken_with_long_holes_are_refused_or_inside_their_bound(extents, place, size, turn, height,
+                                                                              pattern, start, extra, quat):
+    """The capsule's adversary: a box with a long thin rib (up to 300 times taller than wide) or slot, turned at
+    random, less the rib alone, the rib and faces grown round it, or a patch grown from a random face.  The
+    rim round a rib is long and thin, so its capsule is thin too and would miss a tall rib; it is refused (a
+    footprint in a flat face) or its bound holds."""
+    size = size[::-1] if turn else size
+    height = height if height > 0 else height * extents[2]
+    v, f, feature, _ = featured_box(extents, place, size, height)
+    v = v @ Rotation.from_quat(quat).as_matrix().T
+    if pattern == "feature":
+        gone = feature
+    elif pattern == "feature and around":
+        gone = np.union1d(feature, _patch(v, f, int(feature[start % len(feature)]), len(feature) + extra))
+    else:
+        gone = _patch(v, f, start % len(f), min(extra, len(f) - 1))
+    est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
+    assert _refused_or_holds(est, volume_moments(v, f))
