@@ -1051,6 +1051,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                 fills.append(shifted)
                 at += len(bend.points)
             cap = np.vstack([cap[~bent[label]], *fills])
+            label_of = np.r_[label[~bent[label]], np.full(len(cap) - int(np.count_nonzero(~bent[label])), -1)]
+        else:
+            label_of = label
         doubts = cone_doubt.copy()
         if creases:           # holes across one crease: two planar fans instead of the cone (third assumption)
             crossed = np.zeros(n_loops, dtype=bool)
@@ -1065,7 +1068,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                 shifted = fill.caps.copy()
                 shifted[shifted >= len(v)] += n_loops + 2 * j       # apexes after the cones' (kept for numbering)
                 fills.append(shifted)
-            cap = np.vstack([cap[~crossed[label]], *fills])
+            # the cones (and bent fills: label −1) kept, the crease fills last (_crease_contradicted counts on it)
+            cap = np.vstack([cap[(label_of < 0) | ~crossed[np.maximum(label_of, 0)]], *fills])
             extra = np.vstack([fill.apexes for fill in creases])
         pv = np.vstack([v, tops, extra, *[bend.points for bend in curved]])
         pf = np.vstack([f, cap])
