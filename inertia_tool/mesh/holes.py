@@ -1108,7 +1108,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         curved = curved_fills(v, f, edges, label, n_loops, apex, centre, radius, (start, end, thick), slab, order)
         if curved:
             pv, pf, cap, closed, hole_doubt = build(creases, curved)
-        alone = _alone(centre, radius) & ~engulfed
+        # the capsule reads the hole as its rim's own thin disc: only where the ball over the rim is no larger
+        # than the solid patched (where it is larger, what remains may be the small side: a box with a slot
+        # that lost 17 of its 28 faces kept the slot's walls, and the capsule stated ±37 % for a truth 40 times
+        # the estimate; found by tests/test_hole_capsules.py, hypothesis seed 202)
+        alone = _alone(centre, radius) & ~engulfed & (4.0 / 3.0 * np.pi * radius ** 3 <= abs(float(closed.volume)))
         hole_doubt = np.where(alone, np.minimum(hole_doubt, capsule_volumes(start, end, thick)), hole_doubt)
     doubt = float(np.sum(hole_doubt))
     # the surface as given: the closed surface's area less the cones' (no second pass over every face)
