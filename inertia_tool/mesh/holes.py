@@ -6,7 +6,12 @@ the cones always close it.  **Assumption: the missing surface of each hole lies 
 hole's rim** (:func:`~.rims.enclosing_balls`, close to the smallest such ball; for a round hole in a smooth part
 this is the ball whose great circle is the rim, which holds any cap up to a hemisphere).  The cone lies in the
 rim's convex hull, inside the same ball, so the closed cycle "cone minus missing surface" lies in the ball and
-its winding number — the difference between the patched solid and the true one — vanishes outside it.
+its winding number — the difference between the patched solid and the true one — vanishes outside it.  The
+same assumption, for a long thin rim: **the missing surface also lies within the capsule round the rim's
+principal axis that holds the rim** (:func:`~.rims.enclosing_capsules`: no farther from the axis than the rim
+is; round a circle the capsule is the ball).  The capsule is convex and holds the cone too, so the region in
+doubt lies in it as well, and each hole's doubt is the smaller of the two volumes (a strip of facets taken
+along a cylinder has a ball as long as the strip, larger than the part, and a capsule as thin as the strip).
 **Second assumption: the missing surface strays from the plane of a face beside the hole no farther than the
 rim does** (:func:`hole_doubt_volumes`); the cone does too, so each ball is cut to that slab, and the volume in
 doubt is the total volume of the cut balls.  The convex hull of the rim is *not* enough (a planar rim has a hull
@@ -36,11 +41,12 @@ import numpy as np
 from ..rounding import round_up
 from ..values import frozen_value
 from .edges import edge_keys
-from .rims import boundary_edges, boundary_loops, enclosing_balls
+from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal
 from .uncertainty import Estimate, uncertainty_from
 
 __all__ = ["patched_estimate", "hole_doubt_volumes", "ball_slab_volume", "crease_fills", "CreaseFill", "rim_evidence",
+           "curved_fills", "CurvedFill",
            "RimEvidence", "bare_vertices", "slab_contradicted",
            "convex_hole_bound"]
 
@@ -767,13 +773,206 @@ def _crease_contradicted(pv: np.ndarray, pf: np.ndarray, n_given: int, creases: 
     return sorted(out)
 
 
+#: A hole's neighbourhood "is" a quadric when every point of it lies within this share of the ball's radius of
+#: the fitted surface (first-order distance ``|Q|/|∇Q|``): far above round-off, below the sagitta of any facet
+#: a curved fill could improve on.
+QUADRIC_FIT_RTOL = 1e-3
+#: Levels of the curved fill between rim and apex (each cone triangle becomes ``2 · levels − 1`` triangles).
+CURVED_FILL_LEVELS = 6
+#: Most holes given a curved fill (those with the most doubt first; the rest keep their cone).
+CURVED_MAX_LOOPS = 64
+
+
+@frozen_value
+class CurvedFill:
+    """A hole filled by a fan bent onto the quadric its surroundings lie on (:func:`curved_fills`).
+
+    Attributes
+    ----------
+    loop : int
+        The boundary loop.
+    apex : (3,) float
+        Where the cone's apex moved to (onto the quadric), m.
+    points : (p, 3) float
+        The fill's inner vertices, m.
+    caps : (q, 3) int
+        Its triangles: rim vertices by their index, the apex as ``n_vertices + loop`` (the cone's), the inner
+        vertices as ``−1 − i`` (the caller numbers them).
+    """
+
+    loop: int
+    apex: np.ndarray
+    points: np.ndarray
+    caps: np.ndarray
+
+
+def curved_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                 apex: np.ndarray, centre: np.ndarray, radius: np.ndarray, capsule: tuple[np.ndarray, ...],
+                 slab: tuple[np.ndarray, np.ndarray, np.ndarray], order: np.ndarray, *,
+                 fit_rtol: float = QUADRIC_FIT_RTOL, levels: int = CURVED_FILL_LEVELS,
+                 max_loops: int = CURVED_MAX_LOOPS) -> list[CurvedFill]:
+    """Holes whose surroundings lie on one quadric, filled on it instead of by the flat cone (a better estimate,
+    the same bound).
+
+    The vertices of the faces within two rings of the rim are fitted by the quadric ``Q(x) = 0`` (ten
+    coefficients, the right singular vector of the smallest singular value of ``[x², y², z², xy, yz, zx, x, y,
+    z, 1]``, in coordinates centred on the ball and scaled by its radius).  It is used when it is unique (the
+    next singular value is not round-off: a planar neighbourhood fits many quadrics, and keeps its cone) and
+    every fitted point lies within ``fit_rtol`` of the radius of it (``|Q|/|∇Q|``): spheres, cylinders, cones
+    and their facets' vertices fit exactly, a torus or a feature does not.  The cone's fan is split into
+    ``levels`` rings (points ``apex + s (rim − apex)``, ``s = sin(π/2 · (levels − L)/levels)`` at ring ``L``:
+    even in angle over a hemisphere), and each inner point and the apex are moved along the
+    normal of the rim's mean plane onto the quadric (the root of ``Q(p + λ d) = 0`` nearest ``λ = 0``).
+
+    The bound does not change: the region in doubt lies where the cycle "fill − missing surface" winds, and
+    both lie in the ball, the capsule and (where it applies) the slab over the rim — convex sets, so a fill
+    whose every vertex lies in all three does too (*checked*; a fill with a vertex outside keeps its cone).
+    ``order`` lists the loops by decreasing doubt; at most ``max_loops`` of them are tried, one at a time.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n = len(v)
+    start, end, thick = capsule
+    normal, origin, half = slab
+    out: list[CurvedFill] = []
+    tried = 0
+    for k in order.tolist():
+        if tried >= max_loops:
+            break
+        rim_edges = edges[label == k]
+        rim = np.unique(rim_edges)
+        if len(rim) < 5 or len(rim_edges) != len(rim):
+            continue                               # too short to be curved, or a pinch
+        tried += 1
+        near = np.zeros(n, dtype=bool)
+        near[rim] = True
+        for _ in range(2):
+            near[f[near[f].any(axis=1)].reshape(-1)] = True
+        x = (v[near] - centre[k]) / radius[k]
+        if len(x) < 12:
+            continue
+        design = np.column_stack([x * x, x[:, 0] * x[:, 1], x[:, 1] * x[:, 2], x[:, 2] * x[:, 0], x,
+                                  np.ones(len(x))])
+        try:
+            _, sv, vt = np.linalg.svd(design, full_matrices=False)
+        except np.linalg.LinAlgError:
+            continue
+        if not sv[-2] > 1e-6 * sv[0]:
+            continue                               # many quadrics fit (a plane): the cone stays
+        q = vt[-1]
+        a = np.array([[q[0], q[3] / 2, q[5] / 2], [q[3] / 2, q[1], q[4] / 2], [q[5] / 2, q[4] / 2, q[2]]])
+        b = q[6:9]
+        grad = 2 * x @ a + b
+        size = np.linalg.norm(grad, axis=1)
+        if not (size > 0).all() or float(np.max(np.abs(_quadric(x, a, b, q[9])) / size)) > fit_rtol:
+            continue                               # the surroundings are not one quadric
+        rim_x = (v[rim] - centre[k]) / radius[k]
+        _, _, axes = np.linalg.svd(rim_x - rim_x.mean(axis=0), full_matrices=False)
+        d = axes[2]
+        top = (apex[k] - centre[k]) / radius[k]
+        # inner rings, outermost first, at s = sin(π/2 · (levels − L)/levels): evenly spaced in angle on a
+        # hemisphere over the rim (a steep cap is not left one long chord from the rim to the first ring)
+        steps = np.sin(0.5 * np.pi * np.arange(levels - 1, 0, -1) / levels)
+        spoke = top + steps[None, :, None] * (rim_x[:, None, :] - top)        # (rim vertex, level, 3)
+        flat = np.vstack([top[None, :], spoke.reshape(-1, 3)])
+        alpha = float(d @ a @ d)
+        beta = 2 * flat @ a @ d + float(b @ d)
+        gamma = _quadric(flat, a, b, q[9])
+        if abs(alpha) > 1e-12:
+            disc = beta * beta - 4 * alpha * gamma
+            if (disc < 0).any():
+                continue
+            root = np.sqrt(disc)
+            one, two = (-beta + root) / (2 * alpha), (-beta - root) / (2 * alpha)
+            lam = np.where(np.abs(one) <= np.abs(two), one, two)
+        elif (np.abs(beta) > 0).all():
+            lam = -gamma / beta
+        else:
+            continue
+        moved = centre[k] + radius[k] * (flat + lam[:, None] * d)
+        if not np.isfinite(moved).all():
+            continue
+        # the fill must lie where the bound looks: in the ball, the capsule and the slab over the rim
+        seg = end[k] - start[k]
+        t = np.clip((moved - start[k]) @ seg / max(float(seg @ seg), 1e-300), 0.0, 1.0)
+        inside = ((np.linalg.norm(moved - centre[k], axis=1) <= radius[k])
+                  & (np.linalg.norm(moved - (start[k] + t[:, None] * seg), axis=1) <= thick[k]))
+        if np.isfinite(half[k]):
+            inside &= np.abs((moved - origin[k]) @ normal[k]) <= half[k]
+        if not inside.all():
+            continue
+        # spoke points: level 0 is the rim vertex, ``levels`` the apex (n + k), between them inner point
+        # −1 − (slot · (levels − 1) + level − 1), ``slot`` the vertex's place in ``rim``
+        slot = np.searchsorted(rim, rim_edges)
+        index = np.empty((len(rim_edges), 2, levels + 1), dtype=np.int64)
+        index[:, :, 0] = rim_edges
+        index[:, :, levels] = n + k
+        for level in range(1, levels):
+            index[:, :, level] = -1 - (slot * (levels - 1) + level - 1)
+        first, second = index[:, 0], index[:, 1]          # e0's spoke, e1's spoke
+        outer = np.arange(levels)
+        # the cone's (e1, e0, apex), split between the rings
+        caps = [np.stack([second[:, outer], first[:, outer], first[:, outer + 1]], axis=2).reshape(-1, 3),
+                np.stack([second[:, outer[:-1]], first[:, outer[:-1] + 1], second[:, outer[:-1] + 1]],
+                         axis=2).reshape(-1, 3)]
+        # the moved spoke points are ordered (rim vertex, level), as the inner indices count them
+        out.append(CurvedFill(loop=int(k), apex=moved[0], points=moved[1:], caps=np.vstack(caps)))
+    return out
+
+
+def _engulfing(v: np.ndarray, f: np.ndarray, centre: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """Holes whose ball holds every vertex of the surface left, (n_loops,) bool.
+
+    Then nothing says which side of the rim is the hole: what remains may be the small part (a sphere less all
+    but a cap at its pole, the ring nearly in the rim's plane), and the slab and the capsule, which read the
+    hole as the rim's own small disc, stated ±40 % for a solid 1,000 times larger (found by the generated
+    spherical-cap test of ``tests/test_hole_footprints.py``, height −0.969).  Such a hole keeps its whole ball.
+    """
+    used = v[np.unique(f)] if len(f) else v[:0]
+    out = np.zeros(len(radius), dtype=bool)
+    if not len(used):
+        return out
+    lo, hi = used.min(axis=0), used.max(axis=0)
+    # a ball holding every vertex has a radius of at least half the box's longest side: check only those
+    for k in np.flatnonzero(radius >= 0.5 * float(np.max(hi - lo)) * (1 - 1e-12)).tolist():
+        out[k] = float(np.max(np.linalg.norm(used - centre[k], axis=1))) <= radius[k]
+    return out
+
+
+def _alone(centre: np.ndarray, radius: np.ndarray, *, chunk: int = 512) -> np.ndarray:
+    """Holes whose ball meets no other hole's ball, (n,) bool: only those get the capsule.
+
+    A band round a handle (a washer's sector taken top, walls and bottom) leaves two rims joined by the missing
+    surface, which the bound does not cover (each rim is assumed to close over its own disc).  Where the two
+    balls are disjoint the band must leave both, so the ball assumption is false there too and nothing is lost;
+    where they meet (the band 25° of a washer, its rims 18 × 4 across: balls of radius 9.2, 13 apart) the balls
+    happened to hold it, and a capsule as thin as the rims would not (benchmark case 25-15-crack_hole: 7.0 %
+    off at a stated ±6.5 %)."""
+    n = len(radius)
+    out = np.ones(n, dtype=bool)
+    for lo in range(0, n, chunk):
+        gap = np.linalg.norm(centre[lo:lo + chunk, None, :] - centre[None, :, :], axis=2)
+        meet = gap <= radius[lo:lo + chunk, None] + radius[None, :]
+        meet[np.arange(len(meet)), lo + np.arange(len(meet))] = False
+        out[lo:lo + chunk] = ~meet.any(axis=1)
+    return out
+
+
+def _quadric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: float) -> np.ndarray:
+    """``Q(p) = pᵀ A p + b·p + c`` at each row of ``p`` (k, 3)."""
+    value: np.ndarray = np.einsum("ij,jk,ik->i", p, a, p) + p @ b + c
+    return value
+
+
 def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[..., Any], *,
                      seal: Seal | None = None) -> Estimate:
     """Close each boundary loop by a cone to its centroid and integrate; bound by the balls over the rims.
 
     Assumption (stated in the module docstring): the missing surface of each boundary component lies in the
-    ball enclosing its rim (:func:`enclosing_balls`); the cone lies there too, so the patched solid and the
-    true one differ only inside those balls; with the second assumption (the missing surface strays from the
+    ball enclosing its rim (:func:`enclosing_balls`) and in the capsule enclosing it
+    (:func:`~.rims.enclosing_capsules`); the cone lies there too, so the patched solid and the true one differ
+    only inside both (each hole's doubt is at most the smaller volume, and its reach from the centroid the
+    nearer of the two regions' far points); with the second assumption (the missing surface strays from the
     plane of a face beside the hole no farther than the rim does) only inside each ball's slab around that
     plane (:func:`hole_doubt_volumes`), whose total volume is the volume in doubt.  A hole with a bare rim vertex
     keeps its whole ball, and a footprint of a feature taken whole sets ``unbounded`` (:func:`rim_evidence`;
@@ -821,19 +1020,40 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         withdrawn = evidence.bare > 0
         if slabs:
             withdrawn |= slab_contradicted(v, f, edges, label, n_loops, slabs, radius)
+        engulfed = _engulfing(v, f, centre, radius)
+        withdrawn |= engulfed
         taken = bool(withdrawn.any())      # a feature may have gone with a hole: no convex bound either
         hole_doubt[withdrawn] = 4.0 / 3.0 * np.pi * radius[withdrawn] ** 3
         creases = crease_fills(v, f, edges, label, n_loops, centre, radius, bare=bare)
         unbounded = _contradicted(evidence, radius, size)
     else:
         centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
+        engulfed = np.zeros(0, dtype=bool)
         unbounded = ""
         taken = False
     cone_doubt = hole_doubt.copy()
+    curved: list[CurvedFill] = []
 
-    def build(creases: list[CreaseFill]) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any, np.ndarray]:
+    def build(creases: list[CreaseFill], curved: list[CurvedFill]
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any, np.ndarray]:
         cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
         extra = np.zeros((0, 3))
+        tops = apex.copy()
+        if curved:            # holes on a quadric: the fan bent onto it (same bound: curved_fills)
+            bent = np.zeros(n_loops, dtype=bool)
+            base = len(v) + n_loops + 2 * len(creases)
+            fills, at = [], 0
+            for bend in curved:
+                bent[bend.loop] = True
+                tops[bend.loop] = bend.apex
+                shifted = bend.caps.copy()
+                shifted[shifted < 0] = base + at + (-1 - shifted[shifted < 0])
+                fills.append(shifted)
+                at += len(bend.points)
+            cap = np.vstack([cap[~bent[label]], *fills])
+            label_of = np.r_[label[~bent[label]], np.full(len(cap) - int(np.count_nonzero(~bent[label])), -1)]
+        else:
+            label_of = label
         doubts = cone_doubt.copy()
         if creases:           # holes across one crease: two planar fans instead of the cone (third assumption)
             crossed = np.zeros(n_loops, dtype=bool)
@@ -848,9 +1068,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                 shifted = fill.caps.copy()
                 shifted[shifted >= len(v)] += n_loops + 2 * j       # apexes after the cones' (kept for numbering)
                 fills.append(shifted)
-            cap = np.vstack([cap[~crossed[label]], *fills])
+            # the cones (and bent fills: label −1) kept, the crease fills last (_crease_contradicted counts on it)
+            cap = np.vstack([cap[(label_of < 0) | ~crossed[np.maximum(label_of, 0)]], *fills])
             extra = np.vstack([fill.apexes for fill in creases])
-        pv = np.vstack([v, apex, extra])
+        pv = np.vstack([v, tops, extra, *[bend.points for bend in curved]])
         pf = np.vstack([f, cap])
         closed = moments(pv, pf)
         if closed.volume < 0:
@@ -858,22 +1079,60 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             closed = moments(pv, pf)
         return pv, pf, cap, closed, doubts
 
-    pv, pf, cap, closed, hole_doubt = build(creases)
+    pv, pf, cap, closed, hole_doubt = build(creases, curved)
     contradicted = _crease_contradicted(pv, pf, len(f), creases, n_loops, len(v)) if creases else []
     if contradicted:          # a crease fill lying over faces the file has: the two planes do not hold the hole
         cone_doubt[contradicted] = 4.0 / 3.0 * np.pi * radius[contradicted] ** 3
         creases = [fill for fill in creases if fill.loop not in set(contradicted)]
-        pv, pf, cap, closed, hole_doubt = build(creases)
+        pv, pf, cap, closed, hole_doubt = build(creases, curved)
+    # the capsule over each rim (first assumption, for long thin rims): the region in doubt lies in it too
+    start, end, thick = enclosing_capsules(v[vertex_of], loop_of, n_loops) if n_loops else (centre, centre, radius)
+
+    def reach_of(point: np.ndarray) -> np.ndarray:
+        """Per hole, the farthest a point of its region in doubt (ball ∩ capsule) can be from ``point``, m."""
+        ball_reach = np.linalg.norm(centre - point, axis=1) + radius
+        capsule_reach = np.maximum(np.linalg.norm(start - point, axis=1), np.linalg.norm(end - point, axis=1)) + thick
+        nearer: np.ndarray = np.where(alone, np.minimum(ball_reach, capsule_reach), ball_reach)
+        return nearer
+
+    alone = np.zeros(n_loops, dtype=bool)
+
+    if n_loops:
+        in_slab = slabs["has"] & ~withdrawn if slabs else np.zeros(n_loops, dtype=bool)
+        slab = ((slabs["normal"], slabs["origin"], np.where(in_slab, slabs["half_width"], np.inf)) if slabs else
+                (np.zeros((n_loops, 3)), np.zeros((n_loops, 3)), np.full(n_loops, np.inf)))
+        crossed = np.zeros(n_loops, dtype=bool)
+        crossed[[fill.loop for fill in creases]] = True
+        order = np.argsort(-np.where(crossed, -1.0, hole_doubt), kind="stable")
+        order = order[~crossed[order]]
+        curved = curved_fills(v, f, edges, label, n_loops, apex, centre, radius, (start, end, thick), slab, order)
+        if curved:
+            pv, pf, cap, closed, hole_doubt = build(creases, curved)
+        # the capsule reads the hole as its rim's own thin disc: only where the ball over the rim is no larger
+        # than the solid patched (where it is larger, what remains may be the small side: a box with a slot
+        # that lost 17 of its 28 faces kept the slot's walls, and the capsule stated ±37 % for a truth 40 times
+        # the estimate; found by tests/test_hole_capsules.py, hypothesis seed 202)
+        alone = _alone(centre, radius) & ~engulfed & (4.0 / 3.0 * np.pi * radius ** 3 <= abs(float(closed.volume)))
+        hole_doubt = np.where(alone, np.minimum(hole_doubt, capsule_volumes(start, end, thick)), hole_doubt)
     doubt = float(np.sum(hole_doubt))
     # the surface as given: the closed surface's area less the cones' (no second pass over every face)
     ca, cb, cc = pv[cap[:, 0]], pv[cap[:, 1]], pv[cap[:, 2]]
     area = float(closed.area) - float(0.5 * np.linalg.norm(np.cross(cb - ca, cc - ca), axis=1).sum())
-    far = float(np.max(np.linalg.norm(centre - closed.centroid, axis=1) + radius)) if n_loops else 0.0
+    far = float(np.max(reach_of(closed.centroid))) if n_loops else 0.0
     convex = False
     if n_loops and doubt > 0 and not taken:
         # fourth assumption, where what remains is convex: the complete part is too (convex_hole_bound)
         outward = pf[:len(f)]
-        bound = convex_hole_bound(pv, outward, float(closed.volume))
+        bound = convex_hole_bound(pv, outward, float(closed.volume)) if not curved else None
+        if curved:
+            # where what remains is convex the cones stay: the convex bound needs the patch inside the part, as
+            # the cones are (in the rims' hulls) and a bent fill need not be
+            cones = build(creases, [])
+            bound = convex_hole_bound(cones[0], cones[1][:len(f)], float(cones[3].volume))
+            if bound is not None:
+                curved = []
+                pv, pf, cap, closed, _ = cones
+                far = float(np.max(reach_of(closed.centroid)))
         if bound is not None and bound[0] < doubt:
             doubt, corners = bound
             far = float(np.max(np.linalg.norm(corners - closed.centroid, axis=1)))

@@ -10,7 +10,7 @@ import numpy as np
 
 from .edges import edge_keys
 
-__all__ = ["boundary_edges", "boundary_loops", "enclosing_balls"]
+__all__ = ["boundary_edges", "boundary_loops", "enclosing_balls", "enclosing_capsules", "capsule_volumes"]
 
 
 def boundary_edges(faces: np.ndarray, n_vertices: int) -> np.ndarray:
@@ -215,3 +215,58 @@ def _small_ball_centres(p: np.ndarray, starts: np.ndarray, size: np.ndarray) -> 
         obtuse = (la >= lb + lc) | (lb >= la + lc) | (lc >= la + lb) | ~(ww > 0)
         centre[tri] = np.where(obtuse[:, None], mid, circ)
     return centre
+
+
+def enclosing_capsules(points: np.ndarray, group: np.ndarray, n_groups: int
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A capsule enclosing each group of points: segment ends ``(g, 3)``, ``(g, 3)`` m and radii ``(g,)`` m.
+
+    The axis is the group's principal axis (the eigenvector of the largest eigenvalue of its covariance),
+    through its mean; ``ρ⊥`` is the largest distance of a point from that line.  With the points at axial
+    coordinates ``t_p`` and distances ``d_p`` from the line, each point lies within ``ρ⊥`` of the axial segment
+    ``[t_lo, t_hi]`` when ``t_lo = min_p (t_p + s_p)`` and ``t_hi = max_p (t_p − s_p)``, ``s_p = √(ρ⊥² − d_p²)``
+    (where ``t_lo > t_hi`` a single point of ``[t_hi, t_lo]`` does: the capsule is a ball, e.g. of radius ``a``
+    round a circle of radius ``a``).  The radius is then measured exactly as the largest distance from that
+    segment, so every capsule encloses its group whatever round-off did to the axis.  Its volume is
+    ``π ρ² L + (4/3) π ρ³`` (a cylinder and two half balls), never more than the ball over the same points
+    when the group is long and thin; the caller takes the smaller of the two sets' volumes.
+    """
+    p = np.asarray(points, dtype=np.float64)
+    g = np.asarray(group, dtype=np.int64)
+    order = np.argsort(g, kind="stable")
+    p, g = p[order], g[order]
+    starts = np.searchsorted(g, np.arange(n_groups))
+    size = np.maximum(np.bincount(g, minlength=n_groups), 1)
+    mean = np.stack([np.bincount(g, weights=p[:, k], minlength=n_groups) for k in range(3)], axis=1) / size[:, None]
+    d = p - mean[g]
+    cov = np.zeros((n_groups, 3, 3))
+    for i in range(3):
+        for j in range(i, 3):
+            cov[:, i, j] = cov[:, j, i] = np.bincount(g, weights=d[:, i] * d[:, j], minlength=n_groups)
+    _, vectors = np.linalg.eigh(cov)
+    axis = vectors[:, :, 2]                       # eigh sorts ascending: the last is the principal axis
+    t = np.einsum("ij,ij->i", d, axis[g])
+    perp = np.sqrt(np.maximum(np.einsum("ij,ij->i", d, d) - t * t, 0.0))
+    top = np.maximum.reduceat(perp, starts) if len(p) else np.zeros(n_groups)
+    s = np.sqrt(np.maximum(top[g] ** 2 - perp ** 2, 0.0))
+    lo = np.minimum.reduceat(t + s, starts) if len(p) else np.zeros(n_groups)
+    hi = np.maximum.reduceat(t - s, starts) if len(p) else np.zeros(n_groups)
+    mid = 0.5 * (lo + hi)
+    lo, hi = np.where(lo <= hi, lo, mid), np.where(lo <= hi, hi, mid)
+    start = mean + lo[:, None] * axis
+    end = mean + hi[:, None] * axis
+    # the exact largest distance of a point from its segment
+    ab = end - start
+    length2 = np.einsum("ij,ij->i", ab, ab)
+    u = np.clip(np.einsum("ij,ij->i", p - start[g], ab[g]) / np.where(length2 > 0, length2, 1.0)[g], 0.0, 1.0)
+    gap = p - (start[g] + u[:, None] * ab[g])
+    radius = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", gap, gap), starts)) if len(p) else np.zeros(n_groups)
+    return start, end, radius
+
+
+def capsule_volumes(start: np.ndarray, end: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """Volume of each capsule (segment ``start–end``, radius ``ρ``), (g,) m³: ``π ρ² L + (4/3) π ρ³``."""
+    length = np.linalg.norm(np.asarray(end) - np.asarray(start), axis=1)
+    r = np.asarray(radius, dtype=np.float64)
+    volume: np.ndarray = np.pi * r ** 2 * length + 4.0 / 3.0 * np.pi * r ** 3
+    return volume
