@@ -45,13 +45,13 @@ def test_a_lone_body_wound_inward_still_gets_the_generic_warning():
 
 
 def test_an_estimate_missing_from_an_estimated_resolution_is_a_named_internal_error():
-    """``_estimated`` (mesh/prepare.py) and ``_with_patch_doubt`` (mesh/self_crossing.py) checked their invariant
+    """``_estimated`` (mesh/prepare.py) and ``with_patch_doubt`` (mesh/self_crossing.py) checked their invariant
     with ``assert`` (gone under ``python -O``): now an InternalInvariantError, also a RuntimeError, naming what was
     expected and what was found."""
     from inertia_tool.errors import InertiaToolError, InternalInvariantError
     from inertia_tool.mesh.prepare import _estimated
     from inertia_tool.mesh.resolve import Resolution
-    from inertia_tool.mesh.self_crossing import _with_patch_doubt
+    from inertia_tool.mesh.self_crossing import with_patch_doubt
 
     from inertia_tool.cli import EXIT_INTERNAL, exit_code
 
@@ -62,7 +62,7 @@ def test_an_estimate_missing_from_an_estimated_resolution_is_a_named_internal_er
     with pytest.raises(InternalInvariantError, match="expected to carry its estimate; found none"):
         _estimated(broken, {})
     with pytest.raises(InternalInvariantError, match="<arrays>: the forced .* found none"):
-        _with_patch_doubt(broken, None, "<arrays>")
+        with_patch_doubt(broken, None, "<arrays>")
 
 
 def _seam_corners_by_counting(f, n):

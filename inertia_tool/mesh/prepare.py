@@ -34,7 +34,7 @@ from .classify import orient_shells
 from .policy import Certificate
 from .read import RawMesh
 from .resolve import Resolution
-from .self_crossing import settle_self_crossing
+from .self_crossing import with_patch_doubt, settle_self_crossing
 from .settle import find_contacts
 from .shells import find_shells
 from .surface import close_surface
@@ -128,8 +128,9 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                         centre=0.5 * (surface.lo + surface.hi) if as_read else None, diag=diag, source=source)
     welded = settle_welded(first.shells, split_welded=split_welded, overlap=overlap, repair=repair, diag=diag,
                            source=source)                                                           # R1b
-    if welded.forced is not None:
-        return _estimated(welded.forced, common)
+    if welded.forced is not None:      # on a patched surface the patches' doubt is added (as R3's forced estimate)
+        forced = welded.forced if patched is None else with_patch_doubt(welded.forced, patched, source)
+        return _estimated(forced, common)
     met = find_contacts(welded.shells, welded=welded.welded, patched=patched is not None,
                         split_welded=split_welded, n_read=len(raw.vertices), diag=diag, source=source)   # R3a
     if patched is not None:
@@ -145,7 +146,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                             kind=kind, checks=checks, overlap=overlap, repair=repair, diag=diag,
                             source=source)                                                     # R5, R6
     if united.forced is not None:
-        return _estimated(united.forced, {**common, "overlapping_shells": united.overlaps})
+        forced = united.forced if patched is None else with_patch_doubt(united.forced, patched, source)
+        return _estimated(forced, {**common, "overlapping_shells": united.overlaps})
     united, spread = misread_reading(oriented, united, method=found.method, source=source)     # R4's label
     shells = united.shells
     if not sum(s.volume for s in shells.moments) > 0:        # bodies and cavities cancel: no solid to certify

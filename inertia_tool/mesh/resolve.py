@@ -25,6 +25,7 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -242,6 +243,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     if census.balanced:
         return Resolution(v, f, "exact", _touching_note(census), 0, None, census.nonmanifold_edges)
     current, flipped = f, 0
+    turned_tris = np.zeros((0, 3, 3))        # the faces orientation turned (corners, m): either winding may be right
     if found.misoriented_pairs:     # else orienting would turn nothing (each patch already agrees with itself)
         oriented = orient_consistently(f, n, v)
         found = _census(oriented.faces, n)
@@ -252,6 +254,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
             return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
                               census.nonmanifold_edges)
         current, flipped = oriented.faces, oriented.flipped_faces
+        turned_mask = np.any(oriented.faces != f, axis=1)
+        turned_tris = v[oriented.faces[turned_mask]]
     from .sheets import open_sheets
     sheets = open_sheets(v, current, boundary=found.boundary)                                       # R3b
     if sheets is not None and not sheets.fins:
@@ -283,6 +287,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                 census, found = again.balance, again
                 current = turned.faces if turned is not None else welded_faces
                 flipped = turned.flipped_faces if turned is not None else 0
+                turned_tris = v[turned.faces[np.any(turned.faces != welded_faces, axis=1)]] if turned is not None \
+                    else np.zeros((0, 3, 3))
                 welded = tol
                 if census.balanced:
                     if merged.largest_move > 0:
@@ -318,6 +324,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
             return Resolution(v, unique, "deduplicated", tuple(repair_notes) + _touching_note(census), flipped, welded,
                               census.nonmanifold_edges)
     best, front_nonmanifold = _repaired_estimate(v, unique, found, diag=diag, moments=moments)
+    if len(turned_tris):
+        best = _with_turned_doubt(best, turned_tris)
     flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
     if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
@@ -337,6 +345,26 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                           front_nonmanifold)
     return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
                       front_nonmanifold if best.method == "patched" else census.nonmanifold_edges, estimate=best)
+
+
+def _with_turned_doubt(best: Estimate, turned: np.ndarray) -> Estimate:
+    """``best`` with the faces that orientation turned to agree with their neighbours in doubt as well.
+
+    On an open surface the majority that decides a patch's winding can be wrong (a sheet kept inside a part,
+    joined to the surface by its rim, turns with the wrong neighbours), and the estimate then integrates a solid
+    that differs from either reading by at most what those faces contribute: the signed integral is linear in
+    each face's winding, so turning them back changes it by twice their cones from the centroid, leaving them out
+    by once.  The volume in doubt grows by ``2 Σ |det(a − c, b − c, d − c)| / 6`` over them and the reach to the
+    farthest of their corners (the bound's formulas, :func:`~.uncertainty.uncertainty_from`)."""
+    from .uncertainty import uncertainty_from
+
+    c = np.asarray(best.centroid, dtype=np.float64)
+    rel = np.asarray(turned, dtype=np.float64) - c
+    cones = np.abs(np.einsum("ij,ij->i", rel[:, 0], np.cross(rel[:, 1], rel[:, 2]))) / 6.0
+    doubt = float(best.uncertainty.volume_in_doubt + 2.0 * cones.sum() * (1 + 1e-12))
+    far = max(float(best.far), float(np.sqrt(np.max(np.sum(rel ** 2, axis=2)))))
+    unc = uncertainty_from(best.volume, c, best.second_moment, doubt, far)
+    return dataclasses.replace(best, uncertainty=unc, far=far)
 
 
 def _fin_hint(found: OpenSheets | None) -> str:

@@ -94,7 +94,7 @@ def settle_self_crossing(shells: Shells, contacts: SurfaceContacts, *, arranged:
                                  reason=f"the surface passes through itself at {touch.self_crossing_pairs:,} "
                                         f"face pairs{arrange_failed}")
         if patched is not None:
-            forced = _with_patch_doubt(forced, patched, source)
+            forced = with_patch_doubt(forced, patched, source)
         warnings.warn(MeshRepairedWarning(f"{source}: repaired ({forced.method}, an estimate): "
                                           f"{'; '.join(forced.notes)}"), stacklevel=4)
         return SettledCrossing(shells, contacts, touch, arranged, verified, None, forced)
@@ -130,7 +130,7 @@ def _arrange_self_crossing(shells: Shells, contacts: SurfaceContacts, diag: floa
     return shells, contacts, touch, note, not done.crossings_left
 
 
-def _with_patch_doubt(forced: Resolution, patched: Estimate, source: str) -> Resolution:
+def with_patch_doubt(forced: Resolution, patched: Estimate, source: str) -> Resolution:
     """The estimate of a patched surface that then turned out to pass through itself, with the patches' own doubt
     added to the grid's.
 
