@@ -658,15 +658,15 @@ def test_a_body_with_its_inverted_copy_rounded_apart_is_refused_not_a_crash(foun
     ((872029316, "sphere", 0.9371485979357826, 0.23290742249393626, 0, True), [24, 28]),
 ])
 def test_a_part_with_a_seamed_wall_and_a_hole_stays_inside_its_bound(args, gone):
-    """Fixed: the winding estimate forced on the patched surface (R1b, R6) now adds the patches' doubt (as R3's
-    did), and faces that orientation turned on the open surface are in doubt too (resolve); three are refused,
-    one answered within its bound.  Four draws (of 350, 109 of them estimates) of the seamed-sheet generator with one to three faces removed
-    (a hole), with repair; without the hole each is exact.  A hollow box cut near its middle, one half's cut face
-    (a frame round the cavity) kept inside: the union is not formed and the winding-number estimate answers
-    3.7291 m³ within ±14.1 % (truth 4.4431, 16.1 % low), or 1.3445 within ±13.2 % (truth 1.1758, 14.3 % high).
-    A millimetre sphere cut near a pole, its cap's cut face kept: 56 faces turned to agree with their neighbours,
-    the patch answers 1.041e-9 m³ within ±17.8 % (truth 1.536e-9, 32 % low); a sphere cut near a pole, 0.16045 m³
-    within ±0.96 % (truth 0.16348, 1.9 % low)."""
+    """Fixed: the winding estimate forced on the patched surface (R1b, R6) now adds the patches' doubt (as R3's did),
+    and faces that orientation turned on the open surface are in doubt too (resolve); three are refused, one answered
+    within its bound. Four draws (of 350, 109 of them estimates) of the seamed-sheet generator with one to three
+    faces removed (a hole), with repair; without the hole each is exact. A hollow box cut near its middle, one
+    half's cut face (a frame round the cavity) kept inside: the union is not formed and the winding-number estimate
+    answers 3.7291 m³ within ±14.1 % (truth 4.4431, 16.1 % low), or 1.3445 within ±13.2 % (truth 1.1758, 14.3 %
+    high). A millimetre sphere cut near a pole, its cap's cut face kept: 56 faces turned to agree with their
+    neighbours, the patch answers 1.041e-9 m³ within ±17.8 % (truth 1.536e-9, 32 % low); a sphere cut near a pole,
+    0.16045 m³ within ±0.96 % (truth 0.16348, 1.9 % low)."""
     case = _seamed_case(*args)
     assert case is not None
     dv, df, truth, recipe, _ = case
