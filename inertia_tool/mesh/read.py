@@ -18,6 +18,7 @@ import re
 import stat
 import sys
 import warnings
+from contextlib import contextmanager
 from collections.abc import Callable, Iterator, Sequence
 from typing import IO, TYPE_CHECKING, Any, TypeAlias, cast
 
@@ -115,6 +116,24 @@ def _display(path: str | bytes | os.PathLike[str] | os.PathLike[bytes]) -> str:
 
 def _fail(path: str | bytes | os.PathLike[str] | os.PathLike[bytes], problem: str) -> MeshReadError:
     return MeshReadError(f"{_display(path)}: {problem}")
+
+
+def _parse_failure(path: str, exc: Exception) -> MeshReadError:
+    """A parser's exception as the one-line read error naming the file (its first line, at most 200 characters)."""
+    msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    return _fail(path, f"could not be parsed ({msg[:200]})")
+
+
+@contextmanager
+def _parsing(path: str) -> Iterator[None]:
+    """Any exception of a third-party parser inside the block becomes :func:`_parse_failure` (our own read errors
+    and ``MemoryError`` pass through)."""
+    try:
+        yield
+    except (MeshReadError, MemoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - any parser failure is a read error with the file named
+        raise _parse_failure(path, exc) from None
 
 
 def _source_bytes(path: str, data: bytes | None) -> IO[bytes]:
@@ -1014,20 +1033,12 @@ def _read_collada(path: str) -> tuple[np.ndarray, np.ndarray, tuple[float, str] 
     except ImportError:
         raise _fail(path, "reading COLLADA needs pycollada (pip install pycollada)") from None
     from .collada import collada_triangles
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            with open_regular(path) as fh:
-                found = collada_triangles(fh)
-            if not found.instances:
-                found = collada_triangles(_collada_geometry_only(path))
-    except MeshReadError:
-        raise
-    except MemoryError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - any parser failure is a read error with the file named
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise _fail(path, f"could not be parsed ({msg[:200]})") from None
+    with _parsing(path), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with open_regular(path) as fh:
+            found = collada_triangles(fh)
+        if not found.instances:
+            found = collada_triangles(_collada_geometry_only(path))
     if not found.instances or found.declared is None:
         raise _fail(path, "contains no triangle mesh (empty scene or only points/lines)")
     return found.vertices, found.faces, _named_scale(path, *found.declared), found.rounding
@@ -1136,8 +1147,7 @@ def _read_with_trimesh_rounding(path: str, max_faces: int,
     except MemoryError:
         raise
     except Exception as exc:  # noqa: BLE001 - any parser failure is a read error with the file named
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise _fail(path, f"could not be parsed ({msg[:200]})") from None
+        raise _parse_failure(path, exc) from None
     if not isinstance(loaded, trimesh.Trimesh):
         raise _fail(path, f"contains no triangle mesh (found {type(loaded).__name__}: a point cloud or lines)")
     v, f = _checked_arrays(path, np.asarray(loaded.vertices, dtype=np.float64), np.asarray(loaded.faces), counts,
