@@ -495,6 +495,24 @@ def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.nda
     return within.reshape(-1, 2), p[~one]
 
 
+def _groups(n: int, pairs: np.ndarray) -> np.ndarray:
+    """(n,) int: for each of ``n`` shells the least shell of its group, the groups being connected through the
+    ``(k, 2)`` pairs (union-find; a shell in no pair is its own group)."""
+    parent = np.arange(n)
+
+    def root(k: int) -> int:
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = int(parent[k])
+        return k
+
+    for a, b in np.asarray(pairs, dtype=np.int64).reshape(-1, 2).tolist():
+        ra, rb = root(a), root(b)
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    return np.array([root(k) for k in range(n)], dtype=np.int64)
+
+
 def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, depth: np.ndarray,
                      flip: np.ndarray, owner: np.ndarray) -> None:
     """R4 for shells whose surfaces cross another's (in place): they have no nesting depth of their own.
@@ -504,18 +522,7 @@ def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, d
     from the outward shell it crosses (the smallest, if several).  A group of crossing shells that are all wound
     inward and lie in no body (even depth) is a group of bodies written inside out, and is turned as a whole.
     """
-    n = len(vols)
-    component = np.full(n, -1, dtype=np.int64)
-    for start in np.flatnonzero(crosses):                 # connected groups of crossing shells (bounded by n)
-        if component[start] >= 0:
-            continue
-        component[start] = start
-        stack = [int(start)]
-        while stack:
-            k = stack.pop()
-            for j in np.flatnonzero(cross[k] & (component < 0)):
-                component[j] = start
-                stack.append(int(j))
+    component = _groups(len(vols), np.argwhere(np.triu(cross)))     # connected groups of crossing shells
     for root in np.unique(component[crosses]):
         members = np.flatnonzero(component == root)
         inside_out = bool(np.all(vols[members] < 0)) and int(depth[members].min()) % 2 == 0
@@ -647,19 +654,7 @@ def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: n
     if not len(pairs):
         return None
     n = len(vols)
-    parent = np.arange(n)
-
-    def root(k: int) -> int:
-        while parent[k] != k:
-            parent[k] = parent[parent[k]]
-            k = int(parent[k])
-        return k
-
-    for a, b in pairs.tolist():
-        ra, rb = root(a), root(b)
-        if ra != rb:
-            parent[max(ra, rb)] = min(ra, rb)
-    group = np.array([root(k) for k in range(n)])
+    group = _groups(n, pairs)
     member = np.zeros(n, dtype=bool)
     member[pairs.reshape(-1)] = True
     kept = (vols > 0) & ~np.asarray(flip, dtype=bool) & (np.asarray(depth) % 2 == 1)
