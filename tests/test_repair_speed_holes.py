@@ -14,7 +14,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from inertia_tool.mesh import holes
+from inertia_tool.mesh import hole_fills, holes
 from inertia_tool.mesh.edges import edge_keys
 from inertia_tool.mesh.rims import boundary_edges, boundary_loops
 
@@ -329,19 +329,19 @@ def test_crease_screen_keeps_every_fill(seed, turned, sphere):
     rng = np.random.default_rng(seed)
     v, faces = _sphere_with_patches(rng) if sphere else _box_with_edge_holes(rng, turned)
     screened = _all_fills(v, faces)
-    original = holes._may_hold_two_planes
+    original = hole_fills._may_hold_two_planes
     try:
-        holes._may_hold_two_planes = lambda *a, **k: np.ones(a[4], dtype=bool)
+        hole_fills._may_hold_two_planes = lambda *a, **k: np.ones(a[4], dtype=bool)
         unscreened = _all_fills(v, faces)
     finally:
-        holes._may_hold_two_planes = original
+        hole_fills._may_hold_two_planes = original
     assert screened == unscreened
 
 
 def test_crease_screen_is_exercised_and_lets_the_fills_through():
     """Non-vacuous: across these boxes the screen skips loops and some fills are made."""
     skipped = made = 0
-    original = holes._may_hold_two_planes
+    original = hole_fills._may_hold_two_planes
 
     def counting(*a, **k):
         nonlocal skipped
@@ -349,11 +349,11 @@ def test_crease_screen_is_exercised_and_lets_the_fills_through():
         skipped += int(np.count_nonzero(~got[np.asarray(a[5], dtype=np.int64)]))
         return got
 
-    holes._may_hold_two_planes = counting
+    hole_fills._may_hold_two_planes = counting
     try:
         for seed in range(8):
             made += len(_all_fills(*_box_with_edge_holes(np.random.default_rng(seed), seed % 2 == 1)))
             _all_fills(*_sphere_with_patches(np.random.default_rng(seed)))
     finally:
-        holes._may_hold_two_planes = original
+        hole_fills._may_hold_two_planes = original
     assert skipped > 0 and made > 0

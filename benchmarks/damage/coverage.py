@@ -37,7 +37,9 @@ An answer certified ``unverified`` states no bound and is counted apart (``unver
 bounds *hold* when
 ``|m − m*| ≤ u_m·m``, ``|c − c*| ≤ u_c`` and ``‖I − I*‖_F ≤ u_I·‖I‖_F`` (an answer without bounds claims to be
 exact: round-off of 1e-9 allowed); it is *within tolerance* when the volume is within 1 %, the centre of mass
-within 1 % of the diagonal and the inertia within 2 %.  Any other exception is an error (a bug).
+within 1 % of the diagonal and the inertia within 2 %.  Any other exception is an error (a bug).  A case whose
+damage removed every face of one shell of a multi-shell source (``hollow_sphere.stl``'s cavity) does not keep
+the solid: it is counted as ``skipped``, apart from the cases (:func:`_shell_removed`).
 
 Seeds 0–2 were used while developing; the report uses other seeds (``--seeds``).
 
@@ -431,6 +433,11 @@ def run_case(args):
         truth = cut_truth if cut_truth is not None else truth
     else:
         dv, df, meta = make_case(kind, v, f, rng, truth["diagonal"])
+    if kind not in ("touching_copy", "internal_wall") and _shell_removed(v, f, dv, df):
+        # the damage took a whole shell of a multi-shell source (a cavity, a small part): the solid is not kept,
+        # so the truth is not the answer's (review7 found it in real_files.py; here hollow_sphere.stl's cavity)
+        return {"id": case_id, "source": name, "kind": kind, "faces": int(len(df)), "quantum": quantum, **meta,
+                "status": "skipped", "reason": "the damage removed a whole shell"}
     cpu = time.process_time()
     result = evaluate(dv, df, truth)
     result["cpu_seconds"] = time.process_time() - cpu
@@ -438,6 +445,30 @@ def run_case(args):
     if result["status"] == "refused" and refusal_cause(result["reason"]) == BALL_CAUSE:
         result["bypassed"] = bypassed(dv, df, truth)
     return {"id": case_id, "source": name, "kind": kind, "faces": int(len(df)), "quantum": quantum, **meta, **result}
+
+
+def _shell_removed(v, f, dv, df):
+    """Whether the damaged surface ``(dv, df)`` lost every face of some shell (connected component) of the clean
+    ``(v, f)``.  Each vertex the damaged faces use is matched to the nearest clean vertex (holes keep the clean
+    vertices, T-junctions add points on clean edges, cracks move corners by at most 5e-5 of the diagonal); a
+    shell none of whose vertices is matched is gone."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    f = np.asarray(f, dtype=np.int64)
+    rows = np.repeat(np.arange(len(f)), 3)
+    graph = coo_matrix((np.ones(3 * len(f), dtype=np.int8), (rows, f.reshape(-1))), shape=(len(f), len(v)))
+    count, label = connected_components(coo_matrix(graph.T @ graph), directed=False)
+    used = np.unique(f)
+    shells = np.unique(label[used])
+    if len(shells) < 2:
+        return len(np.asarray(df)) == 0
+    kept_points = np.asarray(dv, dtype=np.float64)[np.unique(np.asarray(df, dtype=np.int64))]
+    if not len(kept_points):
+        return True
+    _, nearest = cKDTree(np.asarray(v, dtype=np.float64)[used]).query(kept_points)
+    return bool(len(np.setdiff1d(shells, np.unique(label[used][nearest]))))
 
 
 def _area_lost(v, f, dv, df):
@@ -481,6 +512,8 @@ def _loop_count(v, f):
 
 
 def summarise(rows):
+    skipped = [r for r in rows if r["status"] == "skipped"]
+    rows = [r for r in rows if r["status"] != "skipped"]
     answered = [r for r in rows if r["status"] == "answer"]
     refused = [r for r in rows if r["status"] == "refused"]
     errors = [r for r in rows if r["status"] == "error"]
@@ -488,7 +521,8 @@ def summarise(rows):
     held = sum(bool(r["holds"]) for r in certified)
     within = sum(r["within"] for r in answered)
     bound = [r["mass_bound"] for r in certified]
-    return {"cases": len(rows), "answered": len(answered), "refused": len(refused), "errors": len(errors),
+    return {"cases": len(rows), "skipped": len(skipped), "answered": len(answered), "refused": len(refused),
+            "errors": len(errors),
             "unverified": len(answered) - len(certified), "certified": len(certified),
             "bounds_hold": held, "coverage": held / len(certified) if certified else float("nan"),
             "within_tolerance": within,
@@ -501,13 +535,13 @@ def summarise(rows):
                                                                           if r["certificate"] == "estimate"])
             else float("nan"),
             "cpu_seconds": float(sum(r.get("cpu_seconds", 0.0) for r in rows)),
-            "slowest_seconds": max((r["seconds"] for r in rows), default=0.0)}
+            "slowest_seconds": max((r.get("seconds", 0.0) for r in rows), default=0.0)}
 
 
 def table(rows):
     lines = ["| kind | cases | answered | bounds hold (of certified) | unverified | within 1 %/1 %/2 % (of all) "
-             "| refused | errors | median mass bound (estimates) | CPU (s) | slowest (s) |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "| refused | errors | median mass bound (estimates) | CPU (s) | slowest (s) | skipped |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for kind in (*KINDS, "all"):
         sel = rows if kind == "all" else [r for r in rows if r["kind"] == kind]
         if not sel:
@@ -517,13 +551,14 @@ def table(rows):
                      f"({100 * s['coverage']:.1f} %) | {s['unverified']} "
                      f"| {s['within_tolerance']} ({100 * s['within_share_of_all']:.1f} %) "
                      f"| {s['refused']} | {s['errors']} | {100 * s['median_estimate_mass_bound']:.2g} % "
-                     f"| {s['cpu_seconds']:.2f} | {s['slowest_seconds']:.2f} |")
+                     f"| {s['cpu_seconds']:.2f} | {s['slowest_seconds']:.2f} | {s['skipped']} |")
     return "\n".join(lines)
 
 
 #: Refusal messages grouped by their cause (first match wins).
 REFUSAL_CAUSES = (
     ("patched: ball over a hole too large", "the patched surface cannot be bounded usefully"),
+    ("patched: body or cavity undecided", "the file does not say whether it is a body or a cavity"),
     ("patched: footprint of a feature taken whole", "footprint of a feature"),
     ("winding: passes through itself", "passes through itself"),
     ("winding: union not formed", "union could not be formed"),

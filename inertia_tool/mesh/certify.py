@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import InsideOutWarning
 from ..integrals import total_roundoff
 from ..rounding import round_up
-from ..tolerances import ROUNDOFF_RTOL
+from ..tolerances import ESTIMATE_MAX_MASS_RTOL, ROUNDOFF_RTOL
 from .policy import Certificate, MisreadNesting, ShellContacts, misread_message
 from .shells import Shells, flipped_text, total
 
@@ -163,7 +163,16 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
             doubt, far = doubt + spread[0], max(far, spread[1])
         uncertainty = uncertainty_from(whole.volume, whole.centroid, whole.second_moment, doubt, far)
         what = "the patched surface" + (" and a shell wound outward inside another" if spread is not None else "")
-        check_useful(whole.volume, uncertainty, source=source, what=what)
+        holes_alone = patched.uncertainty.volume_in_doubt / whole.volume if whole.volume > 0 else np.inf
+        if spread is not None and holes_alone <= ESTIMATE_MAX_MASS_RTOL:
+            # the holes alone are bounded usefully: the reading the file does not decide is what widens the bound
+            check_useful(whole.volume, uncertainty, source=source, what=what,
+                         why="a shell wound outward lies inside another, the file does not say whether it is a "
+                         "body or a cavity, and the two readings are that far apart (the holes alone are bounded "
+                         f"within ±{round_up(100 * holes_alone):.3g} % mass); wind the inner shell inward if it is a "
+                         "cavity, or unite the bodies in a mesh editor if it is a body")
+        else:
+            check_useful(whole.volume, uncertainty, source=source, what=what)
         # a patched surface whose union could not be verified (R6) keeps "unverified": the patches' bound does
         # not cover what the boolean changed beyond them
         method, kind = "patched", ("unverified" if kind == "unverified" else "estimate")

@@ -1,0 +1,493 @@
+"""Filling holes: the surfaces that close each boundary loop other than the plain cone to its centroid.
+
+A hole across one crease of a faceted part is filled in the two planes that hold its rim (:func:`crease_fills`,
+the third assumption of :mod:`~.holes`), and withdrawn where the file contradicts it (:func:`_crease_contradicted`);
+a hole whose surroundings lie on one quadric is filled on it (:func:`curved_fills`).  The bounds they keep are in
+:mod:`~.hole_bounds`; :func:`~.holes.patched_estimate` puts the two together.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from ..values import frozen_value
+from .hole_bounds import FLAT_RIM_RTOL, FLAT_VERTEX_COSINE, _flat_off_rim_nearby, ball_slab_volume
+
+
+@frozen_value
+class CreaseFill:
+    """A hole across one crease of a faceted part, filled in the two planes that hold its rim.
+
+    Attributes
+    ----------
+    loop : int
+        The boundary loop.
+    apexes : (2, 3) float
+        The centroid of each planar part of the rim (with the two ends of the crease segment), m.
+    caps : (k, 3) int
+        The fill's triangles: each rim edge with the apex of its plane (index ``n_vertices + 0`` or ``+ 1`` of
+        the caller's numbering, shifted by the caller), and the two triangles over the crease segment.
+    doubt : float
+        Volume in doubt, m³: the ball over the rim cut to the slab of each plane, summed.
+    narrow : bool
+        The surface is tessellated the CAD way (no vertex inside a flat face anywhere off the rims), so the
+        check can see a contradiction, and the faces left at the rim show none (no rim vertex off the crease
+        keeps faces in its plane only: :func:`crease_fills`): ``doubt`` bounds the hole; else the whole ball.
+    """
+
+    loop: int
+    apexes: np.ndarray
+    caps: np.ndarray
+    doubt: float
+    narrow: bool = False
+
+
+#: Most distinct planes of the faces beside one rim tried in pairs by :func:`crease_fills`.
+CREASE_MAX_PLANES = 8
+#: Most loops :func:`crease_fills` examines (one at a time, ~0.1 ms each).
+CREASE_MAX_LOOPS = 5000
+
+
+def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                 centre: np.ndarray, radius: np.ndarray, *, bare: np.ndarray | None = None,
+                 flat_rtol: float = FLAT_RIM_RTOL, flat_cosine: float = FLAT_VERTEX_COSINE) -> list[CreaseFill]:
+    """Holes across one crease, each filled by two planar fans instead of one cone (the third assumption).
+
+    A hole that took triangles from two flat faces of a faceted part meeting at a crease (a box's edge, a
+    cylinder's cap rim) has a rim that no one plane holds, so one slab cannot cut its ball.  It qualifies here
+    when two planes of faces beside it (the ring) hold the rim this way: each holds three rim vertices not on
+    a line (a two-dimensional part of the rim, not an edge: the octahedron's faces hold only an edge each),
+    every rim edge lies in one of them and none in both, and walking the rim the plane changes exactly twice,
+    at two vertices ``a`` and ``b`` lying on both (on the crease).  **Assumption: the missing surface lies in
+    those two planes** (the hole is a piece of the two faces it crosses), as far from each as the rim part it
+    holds (``e₁``, ``e₂``, plus 16 ulp of the coordinates).  Each planar part of the rim, closed by the crease
+    segment ``a–b``, is filled by a fan to the centroid of its vertices; the two fans share ``a–b`` with
+    opposite windings, so the fill has exactly the rim as boundary.  A 2-chain in a plane is fixed by its
+    boundary, so where the assumption holds exactly the fill *is* the missing surface; in general the cycle
+    "fill − missing surface" lies in the ball over the rim (assumption 1; the fans lie in the rim's convex hull)
+    cut to the union of the two slabs, whose complement is connected (each piece of the ball between the slabs
+    reaches its sphere), so the winding number of the cycle vanishes outside it: the volume in doubt is at most
+    the sum of the ball's two slab volumes (:func:`ball_slab_volume`).  Loops of at least four edges are tried,
+    at most ``CREASE_MAX_LOOPS`` of them (beyond, every hole keeps its cone).
+
+    Returns
+    -------
+    list of CreaseFill
+        The loops that qualify (others keep their cone).
+    """
+    from itertools import combinations
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n = len(v)
+    scale = float(np.max(np.abs(v))) if n else 0.0
+    margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
+    on_tol = 4.0 * margin                        # a rim vertex "on" a plane: within round-off of it
+    candidates = np.flatnonzero(np.bincount(label, minlength=n_loops) >= 4).tolist()
+    if not candidates or len(candidates) > CREASE_MAX_LOOPS:
+        return []
+    nv = np.int64(max(n, 1))
+    rim_key = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * nv + np.maximum(edges[:, 0], edges[:, 1])
+    ring_pairs, ring_start = _ring_faces(f, n, rim_key, label, candidates, n_loops)
+    maybe = _may_hold_two_planes(v, f, edges, label, n_loops, candidates, ring_pairs, ring_start, 2.0 * on_tol)
+    # read only where a fill is about to be made (issue 25: both read every face, ~0.5 s at 1.3M faces)
+    interior: np.ndarray | None = None
+    corner_order = corner_start = np.zeros(0, dtype=np.int64)
+
+    def vertex_faces(x: int) -> np.ndarray:
+        faces_at: np.ndarray = corner_order[corner_start[x]:corner_start[x + 1]] // 3
+        return faces_at
+
+    by_loop = np.argsort(label, kind="stable")          # each loop's edges in their order in ``edges``
+    loop_start = np.searchsorted(label[by_loop], np.arange(n_loops + 1))
+    out = []
+    for k in candidates:
+        if not maybe[k]:
+            continue                              # fewer than two ring faces whose planes hold three rim vertices
+        raw = edges[by_loop[loop_start[k]:loop_start[k + 1]]]
+        succ = dict(zip(raw[:, 0].tolist(), raw[:, 1].tolist()))
+        if len(succ) != len(raw) or len(raw) < 4:
+            continue                              # a vertex met twice (a pinch), or too short to cross a crease
+        walk = [int(raw[0, 0])]                   # the rim in its own order (one cycle, else skipped)
+        while len(walk) <= len(raw) and succ.get(walk[-1], walk[0]) != walk[0]:
+            walk.append(succ[walk[-1]])
+        if len(walk) != len(raw):
+            continue
+        loop_edges = np.array([[x, succ[x]] for x in walk], dtype=np.int64)
+        ring = ring_pairs[ring_start[k]:ring_start[k + 1], 1]
+        if not len(ring):
+            continue
+        a0 = v[f[ring, 0]]
+        normal = np.cross(v[f[ring, 1]] - a0, v[f[ring, 2]] - a0)
+        length = np.linalg.norm(normal, axis=1)
+        keep = length > 0
+        if not keep.any():
+            continue
+        unit, a0 = normal[keep] / length[keep, None], a0[keep]
+        offset = np.einsum("ij,ij->i", unit, a0)
+        rim = np.array(list(succ), dtype=np.int64)
+        dist = np.abs(v[rim] @ unit.T - offset[None, :])          # (rim vertex, ring face)
+        on = dist <= on_tol
+        # distinct planes: ring faces holding the same rim vertices within round-off of one plane
+        _, first = np.unique(on.T, axis=0, return_index=True)
+        planes = [int(p) for p in first if np.count_nonzero(on[:, p]) >= 3]
+        if len(planes) < 2 or len(planes) > CREASE_MAX_PLANES:
+            continue
+        index = {int(x): i for i, x in enumerate(rim.tolist())}
+        found = None
+        for p, q in combinations(planes, 2):
+            if abs(float(unit[p] @ unit[q])) > 1.0 - 1e-9:
+                continue                          # parallel planes meet in no crease
+            in_p, in_q = on[:, p], on[:, q]
+            if not (in_p | in_q).all():
+                continue
+            if any(np.linalg.matrix_rank(v[rim[m]][1:] - v[rim[m]][0], tol=on_tol) < 2 for m in (in_p, in_q)):
+                continue
+            side: list[int] = []
+            for start, end in loop_edges.tolist():
+                ep = in_p[index[start]] and in_p[index[end]]
+                eq = in_q[index[start]] and in_q[index[end]]
+                if ep == eq:
+                    side = []
+                    break                         # an edge in neither plane, or along the crease itself
+                side.append(0 if ep else 1)
+            if side and sum(side[i] != side[i - 1] for i in range(len(side))) == 2:
+                found = (p, q, side)
+                break
+        if found is None:
+            continue
+        p, q, side = found
+        order = loop_edges.tolist()
+        switch = [i for i in range(len(side)) if side[i] != side[i - 1]]
+        # the vertex where plane p's chain ends and q's begins (a), and where q's ends and p's begins (b)
+        a = next(order[i][0] for i in switch if side[i] == 1)
+        b = next(order[i][0] for i in switch if side[i] == 0)
+        if bare is not None and any(bare[x] for x in rim.tolist() if x not in (a, b)):
+            continue                              # the hole took a third surface meeting a plane at a bare vertex
+        parts = []
+        for which in (0, 1):
+            ids = sorted({x for (s0, s1), sd in zip(order, side) if sd == which for x in (s0, s1)})
+            parts.append(v[ids].mean(axis=0))
+        apexes = np.array(parts)
+        caps = [[e1, e0, n + sd] for (e0, e1), sd in zip(order, side)]
+        # p's chain runs b → … → a and closes along a → b; q's runs a → … → b and closes along b → a
+        caps += [[b, a, n + 0], [a, b, n + 1]]
+        if interior is None:
+            interior = _flat_off_rim_nearby(v, f, edges, flat_cosine=flat_cosine)
+            corner_order = np.argsort(f.reshape(-1), kind="stable")
+            corner_start = np.searchsorted(f.reshape(-1)[corner_order], np.arange(n + 1))
+        narrow = not interior.any() and not _crease_rim_contradicts(
+            v, f, loop_edges, side, (a, b), unit[[p, q]], offset[[p, q]], flat_rtol * float(radius[k]) + margin,
+            vertex_faces, interior)
+        doubt = 0.0
+        for which, plane in ((0, p), (1, q)):
+            chain = [index[x] for (s0, s1), sd in zip(order, side) if sd == which for x in (s0, s1)]
+            half = float(dist[chain, plane].max()) + margin
+            centre_offset = float(centre[k] @ unit[plane] - offset[plane])
+            doubt += float(ball_slab_volume(np.array([radius[k]]), np.array([centre_offset]),
+                                            np.array([half]))[0])
+        out.append(CreaseFill(loop=int(k), apexes=apexes, caps=np.array(caps, dtype=np.int64), doubt=doubt,
+                              narrow=narrow))
+    return out
+
+
+def _ring_faces(f: np.ndarray, n: int, rim_key: np.ndarray, label: np.ndarray, candidates: list[int],
+                n_loops: int) -> tuple[np.ndarray, np.ndarray]:
+    """The faces with an edge on the rim of each candidate loop of :func:`crease_fills` (the ring): ``(pairs,
+    start)``, the (loop, face) pairs sorted, loop ``k``'s faces ascending in ``pairs[start[k]:start[k + 1], 1]``.
+    A face edge counts for the loop of the *last* rim edge with its key (the rim edges listed in
+    ``edges`` order), and only keys of candidate loops' rim edges are looked up.  Sorting only the face edges
+    whose two ends lie on a candidate rim keeps this to the rims' size (issue 25: every face edge was, ~0.4 s
+    at 1.3M faces, and a Python loop ran over the ring)."""
+    wanted = np.zeros(n_loops, dtype=bool)
+    wanted[candidates] = True
+    nv = np.int64(max(n, 1))
+    sel = wanted[label]
+    rim_vertex = np.zeros(int(nv), dtype=bool)
+    rim_vertex[rim_key[sel] // nv] = True
+    rim_vertex[rim_key[sel] % nv] = True
+    a, b = f.reshape(-1), f[:, [1, 2, 0]].reshape(-1)
+    slot = np.flatnonzero(rim_vertex[a] & rim_vertex[b])
+    key = np.minimum(a[slot], b[slot]) * nv + np.maximum(a[slot], b[slot])
+    slot = slot[np.isin(key, rim_key[sel])]
+    key = np.minimum(a[slot], b[slot]) * nv + np.maximum(a[slot], b[slot])
+    # the loop of the last rim edge with each key
+    unique_key, last = np.unique(rim_key[::-1], return_index=True)
+    loop_of_key = label[::-1][last]
+    loop = loop_of_key[np.searchsorted(unique_key, key)]
+    pairs = np.unique(np.stack([loop, slot // 3], axis=1), axis=0) if len(slot) else np.zeros((0, 2), np.int64)
+    start = np.searchsorted(pairs[:, 0], np.arange(n_loops + 1))
+    return pairs, start
+
+
+#: Most (ring face, rim vertex) pairs :func:`_may_hold_two_planes` measures over all loops (~80 bytes each at
+#: once, so ~80 MB); loops beyond it are examined one by one as before.
+CREASE_SCREEN_PAIRS = 1_000_000
+
+
+def _may_hold_two_planes(v: np.ndarray, f: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                         candidates: list[int], ring_pairs: np.ndarray, ring_start: np.ndarray, loose: float
+                         ) -> np.ndarray:
+    """Loops that may still qualify for :func:`crease_fills`, (n_loops,) bool: a necessary condition measured on
+    all candidate loops at once, so that the loop over them skips the rest without a step of their own
+    (issue 25: thousands of small holes, ~0.1 ms each).
+
+    A loop qualifies only if two ring faces have planes each holding at least three of its rim vertices within
+    ``on_tol``.  Here the distances are measured another way (one product per (face, vertex) pair rather than a
+    matrix product), which may differ from the loop's by a few ulp of the coordinates, so a vertex counts when
+    within ``loose`` (twice ``on_tol``, 64 ulp more than any such difference): every loop the loop would keep is
+    kept.  Loops whose pairs would pass ``CREASE_SCREEN_PAIRS`` in total are kept unmeasured."""
+    maybe = np.ones(n_loops, dtype=bool)
+    cand = np.zeros(n_loops, dtype=bool)
+    cand[candidates] = True
+    nv = np.int64(max(len(v), 1))
+    # the distinct (loop, vertex) pairs of the candidate loops' rims, by loop
+    sel = cand[label]
+    rim = np.unique(label[sel].astype(np.int64) * nv + edges[sel, 0])
+    rim_loop, rim_vertex = rim // nv, rim % nv
+    rim_start = np.searchsorted(rim_loop, np.arange(n_loops + 1))
+    rim_count = np.diff(rim_start)
+    ring_count = np.diff(ring_start)
+    work = rim_count * ring_count
+    order = np.argsort(work, kind="stable")
+    measured = np.zeros(n_loops, dtype=bool)
+    measured[order[np.cumsum(work[order]) <= CREASE_SCREEN_PAIRS]] = True
+    measured &= cand
+    loops = np.flatnonzero(measured)
+    if not len(loops):
+        return maybe
+    maybe[loops] = False
+    # every (ring face, rim vertex) pair of each measured loop
+    faces_per = ring_count[loops]
+    face_row = np.repeat(ring_start[loops], faces_per) + (np.arange(int(faces_per.sum()))
+                                                          - np.repeat(np.cumsum(faces_per) - faces_per, faces_per))
+    face = ring_pairs[face_row, 1]
+    loop_of_face = np.repeat(loops, faces_per)
+    a0 = v[f[face, 0]]
+    normal = np.cross(v[f[face, 1]] - a0, v[f[face, 2]] - a0)
+    length = np.linalg.norm(normal, axis=1)
+    good = length > 0
+    unit = normal / np.where(good, length, 1.0)[:, None]
+    offset = np.einsum("ij,ij->i", unit, a0)
+    per = rim_count[loop_of_face]
+    owner = np.repeat(np.arange(len(face)), per)
+    vertex = rim_vertex[np.repeat(rim_start[loop_of_face], per) + (np.arange(int(per.sum()))
+                                                                  - np.repeat(np.cumsum(per) - per, per))]
+    dist = np.abs(np.einsum("ij,ij->i", v[vertex], unit[owner]) - offset[owner])
+    held = np.bincount(owner, weights=dist <= loose, minlength=len(face))
+    planes = np.bincount(loop_of_face, weights=good & (held >= 3), minlength=n_loops)
+    maybe[loops] = planes[loops] >= 2
+    return maybe
+
+
+def _crease_rim_contradicts(v: np.ndarray, f: np.ndarray, loop_edges: np.ndarray, side: list[int],
+                            crease: tuple[int, int], plane_unit: np.ndarray, plane_offset: np.ndarray,
+                            tol: float, vertex_faces: Callable[[int], np.ndarray], interior: np.ndarray) -> bool:
+    """Whether the faces left at a crease fill's rim contradict the third assumption (the missing surface lies
+    in the two planes), read as :func:`slab_contradicted` reads one plane: a rim vertex off the crease (not
+    ``a`` or ``b``, so in one plane only) whose every remaining face lies in its plane (each corner within
+    ``tol``), on a surface with no vertex inside its flat faces there (``interior`` false).  Another face of the
+    part met the plane at that vertex and is gone, and it is not the other plane (the vertex is not on it), so
+    the missing surface leaves both planes there (a featured box that lost half its faces: the fill closed the
+    boss alone, 80-98 % low inside the two slabs)."""
+    plane_of: dict[int, set[int]] = {}
+    for (e0, e1), sd in zip(loop_edges.tolist(), side):
+        plane_of.setdefault(e0, set()).add(sd)
+        plane_of.setdefault(e1, set()).add(sd)
+    for x, sides in plane_of.items():
+        if x in crease or len(sides) != 1 or interior[x]:
+            continue
+        sd = next(iter(sides))
+        faces_at = vertex_faces(x)
+        if not len(faces_at):
+            continue
+        off = np.abs(v[f[faces_at]] @ plane_unit[sd] - plane_offset[sd])
+        if float(off.max()) <= tol:
+            return True
+    return False
+
+
+def _crease_contradicted(pv: np.ndarray, pf: np.ndarray, n_given: int, creases: list[CreaseFill], n_loops: int,
+                         n_vertices: int) -> list[int]:
+    """Loops whose crease fill meets a face of the file other than along shared edges and corners (the face-pair
+    check, exact): a fill lying over, or through, surface the file has is not where the surface is missing, so
+    the third assumption is contradicted there (a box with a boss, half its faces gone: the fill of the top
+    face's plane closed the boss alone, 98 % low at a stated ±1e-12)."""
+    from .intersect import surface_contacts
+    contacts = surface_contacts(pv, pf)
+    pairs = np.concatenate([np.asarray(p, dtype=np.int64).reshape(-1, 2)
+                            for p in (contacts.crossing, contacts.coplanar_opposite, contacts.contact)])
+    if not contacts.complete:
+        return sorted({fill.loop for fill in creases})
+    if not len(pairs):
+        return []
+    # the caps follow the given faces: the cones' first, then each fill's in order
+    sizes = [len(fill.caps) for fill in creases]
+    first_fill = len(pf) - sum(sizes)
+    owner = np.full(len(pf), -1, dtype=np.int64)
+    at = first_fill
+    for fill, size in zip(creases, sizes):
+        owner[at:at + size] = fill.loop
+        at += size
+    out = set()
+    for a, b in pairs.tolist():
+        if owner[a] >= 0 and b < n_given:
+            out.add(int(owner[a]))
+        elif owner[b] >= 0 and a < n_given:
+            out.add(int(owner[b]))
+    return sorted(out)
+
+
+#: A hole's neighbourhood "is" a quadric when every point of it lies within this share of the ball's radius of
+#: the fitted surface (first-order distance ``|Q|/|∇Q|``): far above round-off, below the sagitta of any facet
+#: a curved fill could improve on.
+QUADRIC_FIT_RTOL = 1e-3
+#: Levels of the curved fill between rim and apex (each cone triangle becomes ``2 · levels − 1`` triangles).
+CURVED_FILL_LEVELS = 6
+#: Most holes given a curved fill (those with the most doubt first; the rest keep their cone).
+CURVED_MAX_LOOPS = 64
+
+
+@frozen_value
+class CurvedFill:
+    """A hole filled by a fan bent onto the quadric its surroundings lie on (:func:`curved_fills`).
+
+    Attributes
+    ----------
+    loop : int
+        The boundary loop.
+    apex : (3,) float
+        Where the cone's apex moved to (onto the quadric), m.
+    points : (p, 3) float
+        The fill's inner vertices, m.
+    caps : (q, 3) int
+        Its triangles: rim vertices by their index, the apex as ``n_vertices + loop`` (the cone's), the inner
+        vertices as ``−1 − i`` (the caller numbers them).
+    """
+
+    loop: int
+    apex: np.ndarray
+    points: np.ndarray
+    caps: np.ndarray
+
+
+def curved_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                 apex: np.ndarray, centre: np.ndarray, radius: np.ndarray, capsule: tuple[np.ndarray, ...],
+                 slab: tuple[np.ndarray, np.ndarray, np.ndarray], order: np.ndarray, *,
+                 fit_rtol: float = QUADRIC_FIT_RTOL, levels: int = CURVED_FILL_LEVELS,
+                 max_loops: int = CURVED_MAX_LOOPS) -> list[CurvedFill]:
+    """Holes whose surroundings lie on one quadric, filled on it instead of by the flat cone (a better estimate,
+    the same bound).
+
+    The vertices of the faces within two rings of the rim are fitted by the quadric ``Q(x) = 0`` (ten
+    coefficients, the right singular vector of the smallest singular value of ``[x², y², z², xy, yz, zx, x, y,
+    z, 1]``, in coordinates centred on the ball and scaled by its radius).  It is used when it is unique (the
+    next singular value is not round-off: a planar neighbourhood fits many quadrics, and keeps its cone) and
+    every fitted point lies within ``fit_rtol`` of the radius of it (``|Q|/|∇Q|``): spheres, cylinders, cones
+    and their facets' vertices fit exactly, a torus or a feature does not.  The cone's fan is split into
+    ``levels`` rings (points ``apex + s (rim − apex)``, ``s = sin(π/2 · (levels − L)/levels)`` at ring ``L``:
+    even in angle over a hemisphere), and each inner point and the apex are moved along the
+    normal of the rim's mean plane onto the quadric (the root of ``Q(p + λ d) = 0`` nearest ``λ = 0``).
+
+    The bound does not change: the region in doubt lies where the cycle "fill − missing surface" winds, and
+    both lie in the ball, the capsule and (where it applies) the slab over the rim — convex sets, so a fill
+    whose every vertex lies in all three does too (*checked*; a fill with a vertex outside keeps its cone).
+    ``order`` lists the loops by decreasing doubt; at most ``max_loops`` of them are tried, one at a time.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n = len(v)
+    start, end, thick = capsule
+    normal, origin, half = slab
+    out: list[CurvedFill] = []
+    tried = 0
+    for k in order.tolist():
+        if tried >= max_loops:
+            break
+        rim_edges = edges[label == k]
+        rim = np.unique(rim_edges)
+        if len(rim) < 5 or len(rim_edges) != len(rim):
+            continue                               # too short to be curved, or a pinch
+        tried += 1
+        near = np.zeros(n, dtype=bool)
+        near[rim] = True
+        for _ in range(2):
+            near[f[near[f].any(axis=1)].reshape(-1)] = True
+        x = (v[near] - centre[k]) / radius[k]
+        if len(x) < 12:
+            continue
+        design = np.column_stack([x * x, x[:, 0] * x[:, 1], x[:, 1] * x[:, 2], x[:, 2] * x[:, 0], x,
+                                  np.ones(len(x))])
+        try:
+            _, sv, vt = np.linalg.svd(design, full_matrices=False)
+        except np.linalg.LinAlgError:
+            continue
+        if not sv[-2] > 1e-6 * sv[0]:
+            continue                               # many quadrics fit (a plane): the cone stays
+        q = vt[-1]
+        a = np.array([[q[0], q[3] / 2, q[5] / 2], [q[3] / 2, q[1], q[4] / 2], [q[5] / 2, q[4] / 2, q[2]]])
+        b = q[6:9]
+        grad = 2 * x @ a + b
+        size = np.linalg.norm(grad, axis=1)
+        if not (size > 0).all() or float(np.max(np.abs(_quadric(x, a, b, q[9])) / size)) > fit_rtol:
+            continue                               # the surroundings are not one quadric
+        rim_x = (v[rim] - centre[k]) / radius[k]
+        _, _, axes = np.linalg.svd(rim_x - rim_x.mean(axis=0), full_matrices=False)
+        d = axes[2]
+        top = (apex[k] - centre[k]) / radius[k]
+        # inner rings, outermost first, at s = sin(π/2 · (levels − L)/levels): evenly spaced in angle on a
+        # hemisphere over the rim (a steep cap is not left one long chord from the rim to the first ring)
+        steps = np.sin(0.5 * np.pi * np.arange(levels - 1, 0, -1) / levels)
+        spoke = top + steps[None, :, None] * (rim_x[:, None, :] - top)        # (rim vertex, level, 3)
+        flat = np.vstack([top[None, :], spoke.reshape(-1, 3)])
+        alpha = float(d @ a @ d)
+        beta = 2 * flat @ a @ d + float(b @ d)
+        gamma = _quadric(flat, a, b, q[9])
+        if abs(alpha) > 1e-12:
+            disc = beta * beta - 4 * alpha * gamma
+            if (disc < 0).any():
+                continue
+            root = np.sqrt(disc)
+            one, two = (-beta + root) / (2 * alpha), (-beta - root) / (2 * alpha)
+            lam = np.where(np.abs(one) <= np.abs(two), one, two)
+        elif (np.abs(beta) > 0).all():
+            lam = -gamma / beta
+        else:
+            continue
+        moved = centre[k] + radius[k] * (flat + lam[:, None] * d)
+        if not np.isfinite(moved).all():
+            continue
+        # the fill must lie where the bound looks: in the ball, the capsule and the slab over the rim
+        seg = end[k] - start[k]
+        t = np.clip((moved - start[k]) @ seg / max(float(seg @ seg), 1e-300), 0.0, 1.0)
+        inside = ((np.linalg.norm(moved - centre[k], axis=1) <= radius[k])
+                  & (np.linalg.norm(moved - (start[k] + t[:, None] * seg), axis=1) <= thick[k]))
+        if np.isfinite(half[k]):
+            inside &= np.abs((moved - origin[k]) @ normal[k]) <= half[k]
+        if not inside.all():
+            continue
+        # spoke points: level 0 is the rim vertex, ``levels`` the apex (n + k), between them inner point
+        # −1 − (slot · (levels − 1) + level − 1), ``slot`` the vertex's place in ``rim``
+        slot = np.searchsorted(rim, rim_edges)
+        index = np.empty((len(rim_edges), 2, levels + 1), dtype=np.int64)
+        index[:, :, 0] = rim_edges
+        index[:, :, levels] = n + k
+        for level in range(1, levels):
+            index[:, :, level] = -1 - (slot * (levels - 1) + level - 1)
+        first, second = index[:, 0], index[:, 1]          # e0's spoke, e1's spoke
+        outer = np.arange(levels)
+        # the cone's (e1, e0, apex), split between the rings
+        caps = [np.stack([second[:, outer], first[:, outer], first[:, outer + 1]], axis=2).reshape(-1, 3),
+                np.stack([second[:, outer[:-1]], first[:, outer[:-1] + 1], second[:, outer[:-1] + 1]],
+                         axis=2).reshape(-1, 3)]
+        # the moved spoke points are ordered (rim vertex, level), as the inner indices count them
+        out.append(CurvedFill(loop=int(k), apex=moved[0], points=moved[1:], caps=np.vstack(caps)))
+    return out
+
+
+def _quadric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: float) -> np.ndarray:
+    """``Q(p) = pᵀ A p + b·p + c`` at each row of ``p`` (k, 3)."""
+    value: np.ndarray = np.einsum("ij,jk,ik->i", p, a, p) + p @ b + c
+    return value
