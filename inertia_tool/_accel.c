@@ -785,7 +785,7 @@ typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* corner: after f
                                                                  * corner */
 
 typedef struct {
-    PwEntry *entries;      /* the chunk's points; part t (corners [lo_t, hi_t)) occupies entries[lo_t, hi_t) */
+    PwEntry *entries;      /* the chunk's misses, part after part (part t's at [off_t[0], off_t[B])) */
     int32_t *bucket;       /* bucket of each point of the chunk, in file order (its part of `index`) */
     uint32_t *off;         /* nt * (B + 1): start of bucket b of part t at off[t * (B + 1) + b] */
     uint32_t corner0;      /* the chunk's first corner */
@@ -798,7 +798,8 @@ typedef struct {
     int threads, bits, busy, state;    /* state: 0 feeding, 1 finished, 2 output written (released) */
     size_t n_points, points;
     PwEntry *entries;                  /* n_points entries: chunk after chunk (a big-page arena) */
-    size_t entries_used;               /* entries of the chunks so far, with the gaps between parts */
+    size_t entries_used;               /* entries of the chunks so far */
+    size_t released;                   /* bytes of the arena, from its start, given back by the gather */
     size_t partitioned;                /* points copied into the buckets (not found in a recent cache) */
     Recent32 *recent;                  /* per thread: WELD_RECENT points seen last in the part it feeds */
     PwEntry *stage;                    /* the misses of the chunk being fed, before the scatter */
@@ -1017,7 +1018,8 @@ pw_release(PartWelderObject *w)
     }
     free(w->chunks);
     w->chunks = NULL;
-    pool_give_used(w->entries, w->arena_bytes, w->entries_used * sizeof(PwEntry));
+    size_t used = w->entries_used * sizeof(PwEntry);
+    pool_give_used(w->entries, w->arena_bytes, used > w->released ? used : 0);   /* released: the gather's */
     w->entries = NULL;
     w->arena_bytes = 0;
     if (w->has_index) {
@@ -1070,24 +1072,21 @@ typedef struct {
     PwChunk *chunk;
     int bits;
     PwEntry *stage;                    /* the chunk's size: part t stages its misses from its first point's place */
+    size_t staged[MAX_THREADS];        /* per part: its misses */
     Recent32 *recent[MAX_THREADS];
 } PwFeedTask;
 
-/* Part t of the chunk.  A point the part's recent-point cache holds (full key compared) refers to that
- * earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and staged, with
- * its corner, in order; then the staged points are copied into the part's range of the chunk's entries (a
- * stable scatter).  The scatter reads the staged misses (16 bytes each, in order) rather than the part's
- * records again (50 bytes per three points, past the L2 cache by then) and skips the hits without a branch
- * on each point. */
+/* Part t of the chunk, first pass.  A point the part's recent-point cache holds (full key compared) refers to
+ * that earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and staged,
+ * with its corner, in order. */
 static void
-pw_feed_task(void *ctx, int t, int nt)
+pw_stage_task(void *ctx, int t, int nt)
 {
     PwFeedTask *f = (PwFeedTask *)ctx;
     PwChunk *c = f->chunk;
     size_t nb = (size_t)1 << f->bits, lo = part_start(c->size, t, nt), hi = part_start(c->size, t + 1, nt);
     int shift = 64 - f->bits;
     uint32_t *off = c->off + (size_t)t * (nb + 1);
-    uint32_t cursor[(size_t)1 << PW_MAX_BITS];
     Recent32 *recent = f->recent[t];
     PwEntry *stage = f->stage + lo, *staged = stage;
     memset(off, 0, (nb + 1) * sizeof(uint32_t));
@@ -1113,12 +1112,34 @@ pw_feed_task(void *ctx, int t, int nt)
         staged++;
         r->id = c->corner0 + (uint32_t)k + 1;
     }
-    off[0] = (uint32_t)lo;
+    f->staged[t] = (size_t)(staged - stage);
+}
+
+/* Part t of the chunk, second pass (after every part is staged): the part's staged points are copied into
+ * the chunk's entries right after those of the parts before it (a stable scatter), so that the chunk's
+ * entries are contiguous: until issue 25's sixth pass part t started at its first point's place, leaving a
+ * gap of the hits between parts whose pages were written all the same (125 of the 361 MiB of entries of
+ * the 10M-face torus).  The scatter reads the staged misses (16 bytes each, in order) rather than the part's
+ * records again (50 bytes per three points, past the L2 cache by then) and skips the hits without a branch on
+ * each point. */
+static void
+pw_scatter_task(void *ctx, int t, int nt)
+{
+    PwFeedTask *f = (PwFeedTask *)ctx;
+    PwChunk *c = f->chunk;
+    size_t nb = (size_t)1 << f->bits, lo = part_start(c->size, t, nt), start = 0;
+    uint32_t *off = c->off + (size_t)t * (nb + 1);
+    uint32_t cursor[(size_t)1 << PW_MAX_BITS];
+    for (int s = 0; s < t; s++) {
+        start += f->staged[s];
+    }
+    off[0] = (uint32_t)start;
     for (size_t b = 0; b < nb; b++) {
         off[b + 1] += off[b];
         cursor[b] = off[b];
     }
-    for (const PwEntry *e = stage; e < staged; e++) {
+    const PwEntry *stage = f->stage + lo;
+    for (const PwEntry *e = stage; e < stage + f->staged[t]; e++) {
         int32_t b = c->bucket[e->corner - c->corner0];
         c->entries[cursor[b]++] = *e;
     }
@@ -1241,7 +1262,39 @@ typedef struct {
     double *vertices;
     int32_t *index;
     int32_t ticket;
+    uint8_t *done;         /* per chunk: gathered (its entries are read no more) */
+    size_t gathered;       /* chunks [0, gathered) all gathered */
+    int lock;              /* held by the thread moving `gathered` and releasing pages */
 } PwOutTask;
+
+/* The entries' pages before chunk o->gathered (or, once all are gathered, all of them) given back to the
+ * kernel (MADV_DONTNEED): the gather reads each chunk's entries once, in the chunks' order give or take a
+ * thread, so the entries shrink while the vertices grow and the two never peak together (issue 25: the
+ * entries and the vertices, 236 + 114 MiB on the 10M-face torus, had been resident together until the weld
+ * returned, and the entries went on into the census's pages, kept).  Pages of the arena's mapping only
+ * (a heap block below POOL_HEAP_BYTES is small). */
+static void
+pw_release_gathered(PwOutTask *o)
+{
+#if defined(__linux__) && defined(MADV_DONTNEED) && defined(MADV_HUGEPAGE)
+    PartWelderObject *w = o->w;
+    if (w->arena_bytes < POOL_HEAP_BYTES) {
+        return;
+    }
+    while (o->gathered < w->n_chunks && __atomic_load_n(&o->done[o->gathered], __ATOMIC_ACQUIRE)) {
+        o->gathered++;
+    }
+    size_t upto = o->gathered < w->n_chunks ? (size_t)((char *)w->chunks[o->gathered].entries - (char *)w->entries)
+                                            : w->arena_bytes;
+    upto &= ~(size_t)4095;
+    if (upto > w->released && (upto - w->released >= ((size_t)1 << 21) || o->gathered == w->n_chunks)) {
+        madvise((char *)w->entries + w->released, upto - w->released, MADV_DONTNEED);
+        w->released = upto;
+    }
+#else
+    (void)o;
+#endif
+}
 
 /* The corners of the chunks this thread draws, in file order, each through its bucket's cursor. */
 static void
@@ -1295,6 +1348,12 @@ pw_gather_task(void *ctx, int t, int nt)
                 }
                 out[k] = (int32_t)g;
             }
+        }
+        __atomic_store_n(&o->done[u], 1, __ATOMIC_RELEASE);
+        if (__atomic_exchange_n(&o->lock, 1, __ATOMIC_ACQUIRE) == 0) {   /* busy: its holder, or the caller
+                                                                            after the threads, releases */
+            pw_release_gathered(o);
+            __atomic_store_n(&o->lock, 0, __ATOMIC_RELEASE);
         }
     }
     (void)t;
@@ -1456,13 +1515,14 @@ PartWelder_feed(PartWelderObject *w, PyObject *points_obj)
     }
     w->n_chunks++;
     PwFeedTask task = {(const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
-                       pts.strides[pts.ndim - 1], c, w->bits, w->stage, {NULL}};
+                       pts.strides[pts.ndim - 1], c, w->bits, w->stage, {0}, {NULL}};
     for (int t = 0; t < nt; t++) {
         task.recent[t] = w->recent + (size_t)t * WELD_RECENT;
     }
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
-    run_parallel(nt, pw_feed_task, &task);
+    run_parallel(nt, pw_stage_task, &task);
+    run_parallel(nt, pw_scatter_task, &task);
     Py_END_ALLOW_THREADS
     w->busy = 0;
     w->points += total;
@@ -1540,12 +1600,19 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
                      w->count);
         goto fail;
     }
-    PwOutTask task = {w, (double *)vert.buf, (int32_t *)w->index.buf, 0};
+    PwOutTask task = {w, (double *)vert.buf, (int32_t *)w->index.buf, 0,
+                      (uint8_t *)calloc(w->n_chunks ? w->n_chunks : 1, 1), 0, 0};
+    if (task.done == NULL) {
+        PyErr_NoMemory();
+        goto fail;
+    }
     int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
     run_parallel(nt, pw_gather_task, &task);
+    pw_release_gathered(&task);         /* all gathered: the rest of the entries */
     Py_END_ALLOW_THREADS
+    free(task.done);
     pw_release(w);                      /* releases the index buffer: with the GIL */
     w->busy = 0;
     w->state = 2;
