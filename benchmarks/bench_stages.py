@@ -31,6 +31,9 @@ after the imports).
 The package measured is the one ``import inertia_tool`` finds (``PYTHONPATH``, else the installed one; the
 repository holding this script only when neither has it), printed first; the child imports the same one.
 The machine is shared: wall times are noisy, so compare ratios within one run, and note the load (printed).
+It refuses to run when the C kernels are not loaded (a missing build, or one from another ``_accel.c``: the
+package then falls back to numpy with one warning, and the rows would time another program), unless
+``INERTIA_TOOL_NO_ACCEL`` asks for numpy on purpose.
 
     python benchmarks/bench_stages.py [--sizes 1m cad 5m 10m] [--repeat 5] [--json out.json]
 """
@@ -295,6 +298,21 @@ def _package_root() -> str:
     return os.path.dirname(os.path.dirname(os.path.abspath(inertia_tool.__file__)))
 
 
+def require_c_kernels() -> None:
+    """Stop unless the C kernels are loaded, or switched off on purpose (``INERTIA_TOOL_NO_ACCEL``): a checkout
+    whose ``_accel.c`` changed (a rebase) without a rebuild falls back to numpy with one warning, and its
+    numbers would be numpy's."""
+    from inertia_tool._native import NO_ACCEL_ENV, accel
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # the stale-build warning: said below, in one line
+        loaded = accel() is not None
+    if not loaded and os.environ.get(NO_ACCEL_ENV, "").strip() in ("", "0"):
+        raise SystemExit(f"bench_stages: expected the C kernels of {_package_root()} loaded, found them missing or "
+                         "built from another _accel.c (rebuild the extension); its numbers would be numpy's. Set "
+                         f"{NO_ACCEL_ENV}=1 to time the numpy path on purpose")
+
+
 def measure(path: str, repeat: int) -> dict:
     from inertia_tool.mass.pipeline import mass_properties
 
@@ -357,6 +375,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--json", help="also write the results here")
     args = ap.parse_args(argv)
+    require_c_kernels()
     from inertia_tool._native import accel, threads
     print(f"inertia_tool from {_package_root()}")
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs; C extension "

@@ -774,7 +774,12 @@ static PyTypeObject WelderType = {
  * per thread (at most 2**17 slots), a bit per point per thread, and while feeding 16 bytes per point of one
  * chunk (the staged misses; 6 MB for the reader's chunks).  (Until issue 25's fifth pass the buckets were
  * welded into per-thread copies of their vertices, 16 bytes per vertex more: 42 MB of fresh pages on the
- * 5.24M-face icosphere, whose zeroing by the kernel cost about as much as welding into them.)
+ * 5.24M-face icosphere, whose zeroing by the kernel cost about as much as welding into them.)  Since its
+ * sixth pass a chunk's entries are packed part after part (before, each part's started at its first point's
+ * place, and the hits' gaps between them were resident too: 361 instead of 236 MiB on the 10M-face torus),
+ * and output gives the entries' pages back chunk by chunk as it gathers (pw_release_gathered), so the
+ * vertices it writes take the place of the entries instead of adding to them: the weld's peak on that torus
+ * 626 -> 410 MiB, 0.86x the file.
  * The Welder's table is about 12 bytes per triangle.
  * ------------------------------------------------------------------------------------------------------ */
 
@@ -785,7 +790,7 @@ typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* corner: after f
                                                                  * corner */
 
 typedef struct {
-    PwEntry *entries;      /* the chunk's points; part t (corners [lo_t, hi_t)) occupies entries[lo_t, hi_t) */
+    PwEntry *entries;      /* the chunk's misses, part after part (part t's at [off_t[0], off_t[B])) */
     int32_t *bucket;       /* bucket of each point of the chunk, in file order (its part of `index`) */
     uint32_t *off;         /* nt * (B + 1): start of bucket b of part t at off[t * (B + 1) + b] */
     uint32_t corner0;      /* the chunk's first corner */
@@ -798,7 +803,8 @@ typedef struct {
     int threads, bits, busy, state;    /* state: 0 feeding, 1 finished, 2 output written (released) */
     size_t n_points, points;
     PwEntry *entries;                  /* n_points entries: chunk after chunk (a big-page arena) */
-    size_t entries_used;               /* entries of the chunks so far, with the gaps between parts */
+    size_t entries_used;               /* entries of the chunks so far */
+    size_t released;                   /* bytes of the arena, from its start, given back by the gather */
     size_t partitioned;                /* points copied into the buckets (not found in a recent cache) */
     Recent32 *recent;                  /* per thread: WELD_RECENT points seen last in the part it feeds */
     PwEntry *stage;                    /* the misses of the chunk being fed, before the scatter */
@@ -975,6 +981,26 @@ pool_give(void *p, size_t bytes)
     pool_give_used(p, bytes, bytes);
 }
 
+/* At and above POOL_DROP_BYTES written, a user's scratch is given back with its pages dropped
+ * (MADV_DONTNEED: the mapping is kept, its pages are not): the census's slots and the weld's entries of a
+ * 10M-face file (114 and 236 MiB) would otherwise stay resident, lazily freed, into the stages after it and
+ * set the analysis's peak (issue 25: 1.50x the file).  Below, a batch of smaller parts keeps reusing the
+ * pages written, as before. */
+#define POOL_DROP_BYTES ((size_t)32 << 20)
+
+static void
+pool_give_dropped(void *p, size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_DONTNEED) && defined(MADV_HUGEPAGE)
+    if (p != NULL && bytes >= POOL_DROP_BYTES) {
+        madvise(p, bytes, MADV_DONTNEED);
+        pool_give_used(p, bytes, 0);
+        return;
+    }
+#endif
+    pool_give(p, bytes);
+}
+
 /* arena_alloc: map_fresh for the kernels outside the weld and the census (the face-pair check), which first
  * unmaps the mappings kept for the next weld or census (pool_drain): kept pages never coexist with another
  * kernel's fresh ones, so keeping them never raises the process's peak above what unmapping them would. */
@@ -1017,7 +1043,8 @@ pw_release(PartWelderObject *w)
     }
     free(w->chunks);
     w->chunks = NULL;
-    pool_give_used(w->entries, w->arena_bytes, w->entries_used * sizeof(PwEntry));
+    size_t used = w->entries_used * sizeof(PwEntry);
+    pool_give_used(w->entries, w->arena_bytes, used > w->released ? used : 0);   /* released: the gather's */
     w->entries = NULL;
     w->arena_bytes = 0;
     if (w->has_index) {
@@ -1070,24 +1097,21 @@ typedef struct {
     PwChunk *chunk;
     int bits;
     PwEntry *stage;                    /* the chunk's size: part t stages its misses from its first point's place */
+    size_t staged[MAX_THREADS];        /* per part: its misses */
     Recent32 *recent[MAX_THREADS];
 } PwFeedTask;
 
-/* Part t of the chunk.  A point the part's recent-point cache holds (full key compared) refers to that
- * earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and staged, with
- * its corner, in order; then the staged points are copied into the part's range of the chunk's entries (a
- * stable scatter).  The scatter reads the staged misses (16 bytes each, in order) rather than the part's
- * records again (50 bytes per three points, past the L2 cache by then) and skips the hits without a branch
- * on each point. */
+/* Part t of the chunk, first pass.  A point the part's recent-point cache holds (full key compared) refers to
+ * that earlier corner (-1 - corner in the index); any other is counted in its bucket's histogram and staged,
+ * with its corner, in order. */
 static void
-pw_feed_task(void *ctx, int t, int nt)
+pw_stage_task(void *ctx, int t, int nt)
 {
     PwFeedTask *f = (PwFeedTask *)ctx;
     PwChunk *c = f->chunk;
     size_t nb = (size_t)1 << f->bits, lo = part_start(c->size, t, nt), hi = part_start(c->size, t + 1, nt);
     int shift = 64 - f->bits;
     uint32_t *off = c->off + (size_t)t * (nb + 1);
-    uint32_t cursor[(size_t)1 << PW_MAX_BITS];
     Recent32 *recent = f->recent[t];
     PwEntry *stage = f->stage + lo, *staged = stage;
     memset(off, 0, (nb + 1) * sizeof(uint32_t));
@@ -1113,12 +1137,34 @@ pw_feed_task(void *ctx, int t, int nt)
         staged++;
         r->id = c->corner0 + (uint32_t)k + 1;
     }
-    off[0] = (uint32_t)lo;
+    f->staged[t] = (size_t)(staged - stage);
+}
+
+/* Part t of the chunk, second pass (after every part is staged): the part's staged points are copied into
+ * the chunk's entries right after those of the parts before it (a stable scatter), so that the chunk's
+ * entries are contiguous: until issue 25's sixth pass part t started at its first point's place, leaving a
+ * gap of the hits between parts whose pages were written all the same (125 of the 361 MiB of entries of
+ * the 10M-face torus).  The scatter reads the staged misses (16 bytes each, in order) rather than the part's
+ * records again (50 bytes per three points, past the L2 cache by then) and skips the hits without a branch on
+ * each point. */
+static void
+pw_scatter_task(void *ctx, int t, int nt)
+{
+    PwFeedTask *f = (PwFeedTask *)ctx;
+    PwChunk *c = f->chunk;
+    size_t nb = (size_t)1 << f->bits, lo = part_start(c->size, t, nt), start = 0;
+    uint32_t *off = c->off + (size_t)t * (nb + 1);
+    uint32_t cursor[(size_t)1 << PW_MAX_BITS];
+    for (int s = 0; s < t; s++) {
+        start += f->staged[s];
+    }
+    off[0] = (uint32_t)start;
     for (size_t b = 0; b < nb; b++) {
         off[b + 1] += off[b];
         cursor[b] = off[b];
     }
-    for (const PwEntry *e = stage; e < staged; e++) {
+    const PwEntry *stage = f->stage + lo;
+    for (const PwEntry *e = stage; e < stage + f->staged[t]; e++) {
         int32_t b = c->bucket[e->corner - c->corner0];
         c->entries[cursor[b]++] = *e;
     }
@@ -1241,7 +1287,39 @@ typedef struct {
     double *vertices;
     int32_t *index;
     int32_t ticket;
+    uint8_t *done;         /* per chunk: gathered (its entries are read no more) */
+    size_t gathered;       /* chunks [0, gathered) all gathered */
+    int lock;              /* held by the thread moving `gathered` and releasing pages */
 } PwOutTask;
+
+/* The entries' pages before chunk o->gathered (or, once all are gathered, all of them) given back to the
+ * kernel (MADV_DONTNEED): the gather reads each chunk's entries once, in the chunks' order give or take a
+ * thread, so the entries shrink while the vertices grow and the two never peak together (issue 25: the
+ * entries and the vertices, 236 + 114 MiB on the 10M-face torus, had been resident together until the weld
+ * returned, and the entries went on into the census's pages, kept).  Only entries of POOL_DROP_BYTES and
+ * more (a mapping): a batch of smaller parts keeps reusing the pages written. */
+static void
+pw_release_gathered(PwOutTask *o)
+{
+#if defined(__linux__) && defined(MADV_DONTNEED) && defined(MADV_HUGEPAGE)
+    PartWelderObject *w = o->w;
+    if (w->entries_used * sizeof(PwEntry) < POOL_DROP_BYTES) {    /* smaller: kept for the next weld */
+        return;
+    }
+    while (o->gathered < w->n_chunks && __atomic_load_n(&o->done[o->gathered], __ATOMIC_ACQUIRE)) {
+        o->gathered++;
+    }
+    size_t upto = o->gathered < w->n_chunks ? (size_t)((char *)w->chunks[o->gathered].entries - (char *)w->entries)
+                                            : w->arena_bytes;
+    upto &= ~(size_t)4095;
+    if (upto > w->released && (upto - w->released >= ((size_t)1 << 21) || o->gathered == w->n_chunks)) {
+        madvise((char *)w->entries + w->released, upto - w->released, MADV_DONTNEED);
+        w->released = upto;
+    }
+#else
+    (void)o;
+#endif
+}
 
 /* The corners of the chunks this thread draws, in file order, each through its bucket's cursor. */
 static void
@@ -1295,6 +1373,12 @@ pw_gather_task(void *ctx, int t, int nt)
                 }
                 out[k] = (int32_t)g;
             }
+        }
+        __atomic_store_n(&o->done[u], 1, __ATOMIC_RELEASE);
+        if (__atomic_exchange_n(&o->lock, 1, __ATOMIC_ACQUIRE) == 0) {   /* busy: its holder, or the caller
+                                                                            after the threads, releases */
+            pw_release_gathered(o);
+            __atomic_store_n(&o->lock, 0, __ATOMIC_RELEASE);
         }
     }
     (void)t;
@@ -1456,13 +1540,14 @@ PartWelder_feed(PartWelderObject *w, PyObject *points_obj)
     }
     w->n_chunks++;
     PwFeedTask task = {(const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
-                       pts.strides[pts.ndim - 1], c, w->bits, w->stage, {NULL}};
+                       pts.strides[pts.ndim - 1], c, w->bits, w->stage, {0}, {NULL}};
     for (int t = 0; t < nt; t++) {
         task.recent[t] = w->recent + (size_t)t * WELD_RECENT;
     }
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
-    run_parallel(nt, pw_feed_task, &task);
+    run_parallel(nt, pw_stage_task, &task);
+    run_parallel(nt, pw_scatter_task, &task);
     Py_END_ALLOW_THREADS
     w->busy = 0;
     w->points += total;
@@ -1540,12 +1625,19 @@ PartWelder_output(PartWelderObject *w, PyObject *vert_obj)
                      w->count);
         goto fail;
     }
-    PwOutTask task = {w, (double *)vert.buf, (int32_t *)w->index.buf, 0};
+    PwOutTask task = {w, (double *)vert.buf, (int32_t *)w->index.buf, 0,
+                      (uint8_t *)calloc(w->n_chunks ? w->n_chunks : 1, 1), 0, 0};
+    if (task.done == NULL) {
+        PyErr_NoMemory();
+        goto fail;
+    }
     int nt = thread_count(w->threads, w->n_points, (size_t)1 << 14);
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS
     run_parallel(nt, pw_gather_task, &task);
+    pw_release_gathered(&task);         /* all gathered: the rest of the entries */
     Py_END_ALLOW_THREADS
+    free(task.done);
     pw_release(w);                      /* releases the index buffer: with the GIL */
     w->busy = 0;
     w->state = 2;
@@ -2229,30 +2321,41 @@ fail:
 /* ------------------------------------------------------------------------------------------------------
  * 4c. census_shells -- the edge census and the shell labels from one sorted adjacency, on several threads
  *
- * Each face edge a->b is bucketed by its smaller end u = min(a, b) as the word (v << 32) | (d << 31) | face,
- * v = max(a, b), d = [a > b]: a CSR over vertices, built by threads that each count and then place the
- * edges of their part of the faces (thread t's edges after those of threads < t in every bucket).  Threads
- * then take blocks of vertices by ticket and sort each bucket, so that the uses of one undirected edge
- * {u, v} form a run: its length is fwd + bwd and its d bits say the directions.  The run gives the census
- * (as section 3: boundary = used once, non-manifold = more than twice, misoriented = twice in one
+ * Each face edge k of face i (a -> b, a = f[i][k], b = f[i][k + 1 mod 3]) is bucketed by its smaller end
+ * u = min(a, b) as its slot number 3i + k (32 bits): a CSR over vertices.  Thread t owns the vertices of the
+ * t-th of nt equal ranges: it scans every face, counting and then placing only the edges whose u is in its
+ * range (no per-thread counts, no atomics).  Threads then take blocks of vertices by ticket; each bucket's
+ * slots are expanded, in a small buffer of the thread's, into the words (v << 32) | (d << 31) | i,
+ * v = max(a, b), d = [a > b] (the face read back through the slot), and sorted, so that the uses of one
+ * undirected edge {u, v} form a run: its length is fwd + bwd and its d bits say the directions.  The run gives
+ * the census (as section 3: boundary = used once, non-manifold = more than twice, misoriented = twice in one
  * direction; counts added and smallest keys merged over threads) and, when labels are asked for, the face
- * pairs to unite (consecutive faces of the run).
+ * pairs to unite (consecutive faces of the run), united at once.
  *
- * Union-find over faces (union by smaller index, path halving, as 4b): the threads take the vertex blocks'
- * face pairs by ticket and unite them concurrently, linking a root under a smaller one by compare-and-swap
- * (cs_unite_task; one thread: plain unions).  Whatever the order of the unions, every root ends as its component's first face,
- * and components are numbered by first face, as 4b.  Then, as checks.shell_labels does with sections 4 and
- * 4b: when no vertex is shared by two components (so that the components through shared vertices, section
- * 4, are these same ones), they are renumbered by their smallest vertex, which is section 4's numbering.
- * The result is 3 and 4b (and 4 where it applies) bit for bit whatever the thread count.
+ * Union-find over faces (union by smaller index, path halving, as 4b): the threads unite concurrently,
+ * linking a root under a smaller one by compare-and-swap (one thread: plain unions).  Whatever the order of
+ * the unions, every root ends as its component's first face, and components are numbered by first face, as
+ * 4b (a bitmap of the roots and its running counts give each root's number).  Then, as checks.shell_labels
+ * does with sections 4 and 4b: when no vertex is shared by two components (so that the components through
+ * shared vertices, section 4, are these same ones), they are renumbered by their smallest vertex, which is
+ * section 4's numbering.  The result is 3 and 4b (and 4 where it applies) bit for bit whatever the thread
+ * count.
  *
- * Memory: 24 bytes per face (the words; the face pairs to unite are written over them, block by block),
- * 4 per face (parents), 4 per vertex per thread (counts, then the vertex owners) and 4 per vertex (offsets).
- * The adjacency's offsets are 32-bit: 3 * faces must stay below 2**32 (checks.py falls back otherwise).
+ * Memory (issue 25's sixth pass): 12 bytes per face (the slots) and 4 per vertex (the offsets), plus a bit
+ * per face and a few kB per thread; the parents live in the caller's label array (int32: in place; int64:
+ * its first half, widened into labels in rounds from the top, each round's writes landing on parents read
+ * in the rounds before), and so do the offsets when the labels are int64 and the vertices fewer than the
+ * faces (its second half, read no more once the tally is done).  The vertex owners of the renumbering reuse the slots.  Until then the census
+ * bucketed 8-byte words carrying the face and the far end (24 bytes per face), the parents apart (4) and
+ * per-thread counts (4 per vertex per thread): 401 against 135 MiB above its input on the 10M-face torus.
+ * The big arrays are given back to the pool with their pages dropped (pool_give_dropped) so that they do not
+ * stay resident into the stages after.  The offsets are 32-bit: 3 * faces must stay below 2**32 (checks.py
+ * falls back otherwise).
  * ------------------------------------------------------------------------------------------------------ */
 
-#define CS_BLOCK 2048               /* vertices per ticket when sorting and tallying */
+#define CS_BLOCK 2048               /* vertices per ticket when tallying */
 #define CS_PARALLEL_MIN ((size_t)1 << 15)   /* faces below which one thread does everything */
+#define CS_AHEAD 16                 /* prefetch distance (slots) of the tally */
 
 typedef struct {
     const void *f;
@@ -2262,21 +2365,24 @@ typedef struct {
     int bad;                             /* a face index out of range: nothing is computed */
     int several;                         /* more than one shell: the labels' numbering must be checked */
     int shared;                          /* a vertex carries faces of two components */
+    int nomem;                           /* a thread's word buffer could not grow */
     int32_t ticket;
-    size_t fpart[MAX_THREADS + 1];       /* part t of the faces: [fpart[t], fpart[t + 1]) */
-    uint32_t *cnt[MAX_THREADS];          /* per thread and vertex: edges counted, then its cursor; later the
-                                            vertex's component seen by that thread (-1: none) */
-    uint32_t *off;                       /* n + 1: start of each vertex's bucket */
-    uint64_t *word;                      /* 3m */
-    int32_t *parent;                     /* m, or NULL for the census alone */
+    size_t fpart[MAX_THREADS + 1];       /* part t of the faces: [fpart[t], fpart[t + 1]), 64-aligned starts */
+    uint32_t *off;                       /* n + 1: counts, then bucket starts, then (placed) bucket ends; in
+                                            the second half of int64 labels when it fits there */
+    uint32_t *slot;                      /* 3m: slot 3i + k of each edge, by bucket */
+    int32_t *parent;                     /* m (in the caller's labels), or NULL for the census alone */
+    uint64_t *rootbit;                   /* m bits: face i is a root */
+    uint32_t *rootrank;                  /* per word of rootbit: roots before it */
+    int32_t *owner[MAX_THREADS];         /* per thread and vertex: the component it saw there (-1: none) */
     void *out;                           /* labels: m of out_size bytes */
     int out_size;
-    int64_t roots[MAX_THREADS];          /* per part: its roots; then the labels before the part's first */
+    size_t lo, hi;                       /* the faces of the current widening round */
+    int64_t roots[MAX_THREADS];          /* per part: its edges, later its roots */
     int32_t *rank;                       /* per component: its rank by smallest vertex */
-    uint32_t *npairs;                    /* per block of CS_BLOCK vertices: face pairs to unite, kept in place
-                                            of the block's words (from its first) */
     CensusTally tally[MAX_THREADS];
-    size_t cnt_bytes[MAX_THREADS], off_bytes, word_bytes, parent_bytes;   /* the mappings' sizes (pool_take) */
+    size_t off_bytes, slot_bytes, owner_bytes;   /* the mappings' sizes (pool_take); 0: off in the labels,
+                                                    the owners in the slots */
 } CsTask;
 
 static inline int64_t
@@ -2285,48 +2391,39 @@ label_at(const void *out, int size, size_t i)
     return size == 8 ? ((const int64_t *)out)[i] : (int64_t)((const int32_t *)out)[i];
 }
 
-static inline void
-set_label(void *out, int size, size_t i, int64_t label)
-{
-    if (size == 8) {
-        ((int64_t *)out)[i] = label;
-    }
-    else {
-        ((int32_t *)out)[i] = (int32_t)label;
-    }
-}
-
+/* Vertex range of thread t: the buckets it counts, places and (by its ticket blocks, any range) tallies. */
 static void
 cs_count_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
-    uint32_t *cnt = c->cnt[t];
-    uint64_t n = c->n;
-    memset(cnt, 0, (n ? n : 1) * sizeof(uint32_t));     /* a kept mapping holds old counts */
-    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+    uint32_t *cnt = c->off;
+    uint64_t n = c->n, lo = part_start(c->n, t, nt), hi = part_start(c->n, t + 1, nt);
+    if (hi > lo) {
+        memset(cnt + lo, 0, (hi - lo) * sizeof(uint32_t));     /* a kept mapping holds old counts */
+    }
+    for (size_t i = 0; i < c->m; i++) {
         int64_t a = index_at(c->f, c->size, 3 * i), b = index_at(c->f, c->size, 3 * i + 1);
         int64_t d = index_at(c->f, c->size, 3 * i + 2);
         if ((uint64_t)a >= n || (uint64_t)b >= n || (uint64_t)d >= n) {   /* the caller reports where */
             __atomic_store_n(&c->bad, 1, __ATOMIC_RELAXED);
             return;
         }
-        cnt[a < b ? a : b]++;
-        cnt[b < d ? b : d]++;
-        cnt[d < a ? d : a]++;
+        uint64_t u0 = (uint64_t)(a < b ? a : b) - lo, u1 = (uint64_t)(b < d ? b : d) - lo;
+        uint64_t u2 = (uint64_t)(d < a ? d : a) - lo;
+        if (u0 < hi - lo) cnt[lo + u0]++;                      /* unsigned: below lo wraps past hi - lo */
+        if (u1 < hi - lo) cnt[lo + u1]++;
+        if (u2 < hi - lo) cnt[lo + u2]++;
     }
-    (void)nt;
 }
 
-/* Bucket starts for the vertices of part t: first the sums of each part (ticket 0), then the starts. */
+/* Bucket starts for the vertices of part t: first the sums of each part, then the starts. */
 static void
 cs_sum_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
     uint64_t sum = 0;
     for (size_t u = part_start(c->n, t, nt); u < part_start(c->n, t + 1, nt); u++) {
-        for (int s = 0; s < c->nt; s++) {
-            sum += c->cnt[s][u];
-        }
+        sum += c->off[u];
     }
     c->roots[t] = (int64_t)sum;
 }
@@ -2337,110 +2434,29 @@ cs_start_task(void *ctx, int t, int nt)
     CsTask *c = (CsTask *)ctx;
     uint32_t run = (uint32_t)c->roots[t];      /* the edges of the vertices before the part */
     for (size_t u = part_start(c->n, t, nt); u < part_start(c->n, t + 1, nt); u++) {
+        uint32_t k = c->off[u];
         c->off[u] = run;
-        for (int s = 0; s < c->nt; s++) {
-            uint32_t k = c->cnt[s][u];
-            c->cnt[s][u] = run;
-            run += k;
-        }
+        run += k;
     }
 }
 
+/* Thread t places the edges whose smaller end is in its vertex range; off[u] ends as the end of u's bucket. */
 static void
 cs_place_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
-    uint32_t *cursor = c->cnt[t];
-    uint64_t *word = c->word;
-    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
-        int64_t x[3] = {index_at(c->f, c->size, 3 * i), index_at(c->f, c->size, 3 * i + 1),
-                        index_at(c->f, c->size, 3 * i + 2)};
-        for (int k = 0; k < 3; k++) {
-            int64_t a = x[k], b = x[k == 2 ? 0 : k + 1];
-            uint64_t u = (uint64_t)(a < b ? a : b), v = (uint64_t)(a < b ? b : a);
-            word[cursor[u]++] = (v << 32) | ((uint64_t)(a > b) << 31) | (uint64_t)i;
-        }
+    uint32_t *cursor = c->off, *slot = c->slot;
+    uint64_t lo = part_start(c->n, t, nt), width = part_start(c->n, t + 1, nt) - lo;
+    for (size_t i = 0; i < c->m; i++) {
+        int64_t x0 = index_at(c->f, c->size, 3 * i), x1 = index_at(c->f, c->size, 3 * i + 1);
+        int64_t x2 = index_at(c->f, c->size, 3 * i + 2);
+        uint64_t u0 = (uint64_t)(x0 < x1 ? x0 : x1) - lo, u1 = (uint64_t)(x1 < x2 ? x1 : x2) - lo;
+        uint64_t u2 = (uint64_t)(x2 < x0 ? x2 : x0) - lo;
+        uint32_t s = (uint32_t)(3 * i);
+        if (u0 < width) slot[cursor[lo + u0]++] = s;
+        if (u1 < width) slot[cursor[lo + u1]++] = s + 1;
+        if (u2 < width) slot[cursor[lo + u2]++] = s + 2;
     }
-    (void)nt;
-}
-
-/* Sort the buckets of the vertex blocks this thread draws, take their census and list the faces to unite:
- * the pairs (first << 32 | second) overwrite the block's words from its first on, never a word not yet read
- * (a run of L words gives at most L - 1 pairs). */
-static void
-cs_tally_task(void *ctx, int t, int nt)
-{
-    CsTask *c = (CsTask *)ctx;
-    CensusTally *y = &c->tally[t];
-    uint64_t *word = c->word;
-    const uint32_t *off = c->off;
-    uint64_t n = c->n;
-    memset(y, 0, sizeof(*y));
-    for (;;) {
-        int32_t blk = next_ticket(&c->ticket);
-        if (blk < 0 || (size_t)blk * CS_BLOCK >= c->n) {
-            break;
-        }
-        size_t u0 = (size_t)blk * CS_BLOCK, u1 = u0 + CS_BLOCK < c->n ? u0 + CS_BLOCK : c->n;
-        size_t put = off[u0];
-        for (size_t u = u0; u < u1; u++) {
-            size_t lo = off[u], hi = off[u + 1];
-            if (hi - lo > 32) {
-                qsort(word + lo, hi - lo, sizeof(uint64_t), cmp_uint64);
-            }
-            else {
-                sort_words(word + lo, hi - lo);
-            }
-            size_t p = lo;
-            while (p < hi) {
-                uint64_t v = word[p] >> 32;
-                size_t q = p + 1, backward = (word[p] >> 31) & 1;
-                while (q < hi && (word[q] >> 32) == v) {
-                    backward += (word[q] >> 31) & 1;
-                    q++;
-                }
-                size_t total = q - p;
-                uint64_t key = (uint64_t)u * n + v;
-                y->edges++;
-                if (total == 1) {
-                    y->boundary++;
-                    keep_smallest(&y->sb, key);
-                }
-                else if (total > 2) {
-                    y->nonmanifold++;
-                    keep_smallest(&y->sn, key);
-                }
-                else if (backward != 1) {
-                    y->misoriented++;
-                    keep_smallest(&y->sm, key);
-                }
-                if (c->parent != NULL) {
-                    uint64_t g = word[p] & 0x7fffffffu;
-                    for (size_t r = p + 1; r < q; r++) {      /* put <= r - 1: word[r] is read first */
-                        uint64_t h = word[r] & 0x7fffffffu;
-                        if (g != h) {
-                            word[put++] = (g << 32) | h;
-                        }
-                        g = h;
-                    }
-                }
-                p = q;
-            }
-        }
-        c->npairs[blk] = (uint32_t)(put - off[u0]);
-    }
-    (void)nt;
-}
-
-/* Part t of the faces: parents reset (before any thread unites). */
-static void
-cs_reset_task(void *ctx, int t, int nt)
-{
-    CsTask *c = (CsTask *)ctx;
-    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
-        c->parent[i] = (int32_t)i;
-    }
-    (void)nt;
 }
 
 /* The root of x when other threads link and halve concurrently (relaxed atomic loads and stores: a parent only
@@ -2462,52 +2478,143 @@ cs_find(int32_t *parent, int32_t x)
     }
 }
 
-/* The blocks of face pairs this thread draws, united: the larger root is linked under the smaller by a
- * compare-and-swap that fails (and is retried) when another thread linked it first.  Whatever the order, every
- * link points to a smaller face, so each component's root ends as its first face: the same roots as one thread
- * uniting the pairs in order (union by smaller index).  One thread: plain unite_faces. */
+/* Link the roots of faces a and b, the larger under the smaller (one thread: plain unite_faces). */
+static inline void
+cs_unite(int32_t *parent, int32_t a, int32_t b, int nt)
+{
+    if (nt == 1) {
+        unite_faces(parent, a, b);
+        return;
+    }
+    for (;;) {
+        a = cs_find(parent, a);
+        b = cs_find(parent, b);
+        if (a == b) {
+            return;
+        }
+        if (a > b) {
+            int32_t x = a;
+            a = b;
+            b = x;
+        }
+        int32_t expected = b;      /* b is a root unless another thread has just linked it */
+        if (__atomic_compare_exchange_n(&parent[b], &expected, a, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+            return;
+        }
+    }
+}
+
+/* The vertex blocks this thread draws: each bucket's slots expanded into words and sorted, the census of its
+ * runs taken and the consecutive faces of each run united. */
 static void
-cs_unite_task(void *ctx, int t, int nt)
+cs_tally_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
-    int32_t *parent = c->parent;
-    size_t blocks = (c->n + CS_BLOCK - 1) / CS_BLOCK;
+    CensusTally *y = &c->tally[t];
+    const uint32_t *off = c->off, *slot = c->slot;
+    uint64_t n = c->n;
+    uint64_t local[64], *word = local;
+    size_t cap = 64;
+    memset(y, 0, sizeof(*y));
     for (;;) {
         int32_t blk = next_ticket(&c->ticket);
-        if (blk < 0 || (size_t)blk >= blocks) {
+        if (blk < 0 || (size_t)blk * CS_BLOCK >= c->n || __atomic_load_n(&c->nomem, __ATOMIC_RELAXED)) {
             break;
         }
-        const uint64_t *pair = c->word + c->off[(size_t)blk * CS_BLOCK];
-        for (uint32_t k = 0; k < c->npairs[blk]; k++) {
-            int32_t a = (int32_t)(pair[k] >> 32), b = (int32_t)(pair[k] & 0xffffffffu);
-            if (nt == 1) {
-                unite_faces(parent, a, b);
-                continue;
+        size_t u0 = (size_t)blk * CS_BLOCK, u1 = u0 + CS_BLOCK < c->n ? u0 + CS_BLOCK : c->n;
+        size_t last = off[u1 - 1];               /* the block's slots end here (bucket ends, after placing) */
+        for (size_t u = u0; u < u1; u++) {
+            size_t lo = u ? off[u - 1] : 0, hi = off[u], len = hi - lo;
+            if (len > cap) {
+                size_t ncap = cap;
+                while (ncap < len) {
+                    ncap *= 2;
+                }
+                uint64_t *grown = (uint64_t *)malloc(ncap * sizeof(uint64_t));
+                if (grown == NULL) {
+                    __atomic_store_n(&c->nomem, 1, __ATOMIC_RELAXED);
+                    break;
+                }
+                if (word != local) {
+                    free(word);
+                }
+                word = grown;
+                cap = ncap;
             }
-            for (;;) {
-                a = cs_find(parent, a);
-                b = cs_find(parent, b);
-                if (a == b) {
-                    break;
+            for (size_t p = lo; p < hi; p++) {
+                if (p + CS_AHEAD < last) {
+                    uint32_t ahead = slot[p + CS_AHEAD];
+                    __builtin_prefetch(c->size == 8 ? (const void *)((const int64_t *)c->f + ahead)
+                                                    : (const void *)((const int32_t *)c->f + ahead));
                 }
-                if (a > b) {
-                    int32_t x = a;
-                    a = b;
-                    b = x;
+                uint32_t s = slot[p];
+                uint32_t i = s / 3, k = s - 3 * i;
+                int64_t a = index_at(c->f, c->size, s), b = index_at(c->f, c->size, 3 * (size_t)i + (k == 2 ? 0 : k + 1));
+                uint64_t v = (uint64_t)(a < b ? b : a);
+                word[p - lo] = (v << 32) | ((uint64_t)(a > b) << 31) | (uint64_t)i;
+            }
+            if (len > 32) {
+                qsort(word, len, sizeof(uint64_t), cmp_uint64);
+            }
+            else {
+                sort_words(word, len);
+            }
+            size_t p = 0;
+            while (p < len) {
+                uint64_t v = word[p] >> 32;
+                size_t q = p + 1, backward = (word[p] >> 31) & 1;
+                while (q < len && (word[q] >> 32) == v) {
+                    backward += (word[q] >> 31) & 1;
+                    q++;
                 }
-                int32_t expected = b;      /* b is a root unless another thread has just linked it */
-                if (__atomic_compare_exchange_n(&parent[b], &expected, a, 0, __ATOMIC_RELAXED,
-                                                __ATOMIC_RELAXED)) {
-                    break;
+                size_t total = q - p;
+                uint64_t key = (uint64_t)u * n + v;
+                y->edges++;
+                if (total == 1) {
+                    y->boundary++;
+                    keep_smallest(&y->sb, key);
                 }
+                else if (total > 2) {
+                    y->nonmanifold++;
+                    keep_smallest(&y->sn, key);
+                }
+                else if (backward != 1) {
+                    y->misoriented++;
+                    keep_smallest(&y->sm, key);
+                }
+                if (c->parent != NULL) {
+                    int32_t g = (int32_t)(word[p] & 0x7fffffffu);
+                    for (size_t r = p + 1; r < q; r++) {
+                        int32_t h = (int32_t)(word[r] & 0x7fffffffu);
+                        if (g != h) {
+                            cs_unite(c->parent, g, h, nt);
+                        }
+                        g = h;
+                    }
+                }
+                p = q;
             }
         }
     }
-    (void)t;
+    if (word != local) {
+        free(word);
+    }
 }
 
-/* Part t: every face's parent set to its root (the parents of other parts are read meanwhile: relaxed atomic
- * loads and stores, each value an ancestor of the face), roots counted. */
+/* Part t of the faces: parents reset (before any thread unites). */
+static void
+cs_reset_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
+        c->parent[i] = (int32_t)i;
+    }
+    (void)nt;
+}
+
+/* Part t (64-aligned, so that its root bits are its own words): every face's parent set to its root (the
+ * parents of other parts are read meanwhile: relaxed atomic loads and stores, each value an ancestor of the
+ * face), roots marked and counted. */
 static void
 cs_root_task(void *ctx, int t, int nt)
 {
@@ -2521,6 +2628,7 @@ cs_root_task(void *ctx, int t, int nt)
         }
         if (r == (int32_t)i) {
             roots++;
+            c->rootbit[i >> 6] |= (uint64_t)1 << (i & 63);
         }
         else {
             __atomic_store_n(&parent[i], r, __ATOMIC_RELAXED);
@@ -2530,43 +2638,59 @@ cs_root_task(void *ctx, int t, int nt)
     (void)nt;
 }
 
-/* Part t: roots numbered in face order from the part's first label. */
+/* Number of roots before face r: the component number of a root r (components numbered by first face). */
+static inline int64_t
+cs_root_number(const CsTask *c, int32_t r)
+{
+    size_t w = (size_t)r >> 6;
+    return (int64_t)c->rootrank[w] + popcount64(c->rootbit[w] & (((uint64_t)1 << (r & 63)) - 1));
+}
+
+/* int32 labels (the parents in place): part t of the faces, each parent replaced by its root's number. */
 static void
-cs_number_task(void *ctx, int t, int nt)
+cs_label32_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
-    int64_t label = c->roots[t];
+    int32_t *out = (int32_t *)c->out;
     for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
-        if (c->parent[i] == (int32_t)i) {
-            set_label(c->out, c->out_size, i, label++);
-        }
+        out[i] = (int32_t)cs_root_number(c, out[i]);
     }
     (void)nt;
 }
 
-/* Part t: every other face takes its root's label; each vertex of the part's faces notes the component
- * (cnt[t], -1 when none) and a vertex seen in two components is flagged. */
+/* int64 labels over int32 parents in the array's first half: the faces [lo, hi) of this round, split over the
+ * threads.  The label of face i overwrites parents 2i and 2i + 1, at least hi (lo >= hi / 2): faces of the
+ * rounds before, done. */
 static void
-cs_label_task(void *ctx, int t, int nt)
+cs_label64_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
-    int32_t *owner = (int32_t *)c->cnt[t];
-    int shared = 0;
-    if (c->several) {
-        memset(owner, 0xff, c->n * sizeof(int32_t));
+    int64_t *out = (int64_t *)c->out;
+    const int32_t *parent = c->parent;
+    size_t a = c->lo + part_start(c->hi - c->lo, t, nt), b = c->lo + part_start(c->hi - c->lo, t + 1, nt);
+    for (size_t i = b; i-- > a;) {
+        int32_t r = parent[i];
+        out[i] = cs_root_number(c, r);
     }
-    for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
-        int32_t r = c->parent[i];
-        int64_t label = label_at(c->out, c->out_size, (size_t)r);
-        if (r != (int32_t)i) {
-            set_label(c->out, c->out_size, i, label);
-        }
-        for (int k = 0; k < 3 && c->several; k++) {   /* one shell: no vertex can join two */
+}
+
+/* Part t: each vertex of the part's faces notes its component (owner[t], -1 when none); a vertex seen in two
+ * components is flagged. */
+static void
+cs_owner_scan_task(void *ctx, int t, int nt)
+{
+    CsTask *c = (CsTask *)ctx;
+    int32_t *owner = c->owner[t];
+    int shared = 0;
+    memset(owner, 0xff, c->n * sizeof(int32_t));
+    for (size_t i = c->fpart[t]; i < c->fpart[t + 1] && !shared; i++) {
+        int32_t label = (int32_t)label_at(c->out, c->out_size, i);
+        for (int k = 0; k < 3; k++) {
             int64_t v = index_at(c->f, c->size, 3 * i + k);
             if (owner[v] < 0) {
-                owner[v] = (int32_t)label;
+                owner[v] = label;
             }
-            else if (owner[v] != (int32_t)label) {
+            else if (owner[v] != label) {
                 shared = 1;
             }
         }
@@ -2577,17 +2701,17 @@ cs_label_task(void *ctx, int t, int nt)
     (void)nt;
 }
 
-/* Vertices of part t: the components the threads saw at each must agree; the agreed one into cnt[0]. */
+/* Vertices of part t: the components the threads saw at each must agree; the agreed one into owner[0]. */
 static void
 cs_owner_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
-    int32_t *merged = (int32_t *)c->cnt[0];
+    int32_t *merged = c->owner[0];
     int shared = 0;
     for (size_t v = part_start(c->n, t, nt); v < part_start(c->n, t + 1, nt) && !shared; v++) {
         int32_t o = merged[v];
         for (int s = 1; s < c->nt; s++) {
-            int32_t x = ((const int32_t *)c->cnt[s])[v];
+            int32_t x = c->owner[s][v];
             if (x >= 0) {
                 if (o < 0) {
                     o = x;
@@ -2610,7 +2734,12 @@ cs_rank_task(void *ctx, int t, int nt)
 {
     CsTask *c = (CsTask *)ctx;
     for (size_t i = c->fpart[t]; i < c->fpart[t + 1]; i++) {
-        set_label(c->out, c->out_size, i, c->rank[label_at(c->out, c->out_size, i)]);
+        if (c->out_size == 8) {
+            ((int64_t *)c->out)[i] = c->rank[((int64_t *)c->out)[i]];
+        }
+        else {
+            ((int32_t *)c->out)[i] = c->rank[((int32_t *)c->out)[i]];
+        }
     }
     (void)nt;
 }
@@ -2618,13 +2747,15 @@ cs_rank_task(void *ctx, int t, int nt)
 static void
 cs_free(CsTask *c)
 {
-    for (int t = 0; t < MAX_THREADS; t++) {
-        pool_give(c->cnt[t], c->cnt_bytes[t]);
+    if (c->off_bytes) {                  /* 0: in the caller's labels */
+        pool_give_dropped(c->off, c->off_bytes);
     }
-    free(c->npairs);
-    pool_give(c->off, c->off_bytes);
-    pool_give(c->word, c->word_bytes);
-    pool_give(c->parent, c->parent_bytes);
+    pool_give_dropped(c->slot, c->slot_bytes);
+    if (c->owner_bytes) {
+        pool_give_dropped(c->owner[0], c->owner_bytes);
+    }
+    free(c->rootbit);
+    free(c->rootrank);
     free(c->rank);
     free(c);
 }
@@ -2649,7 +2780,14 @@ cs_run(CsTask *c)
     c->off[c->n] = (uint32_t)run;
     run_parallel(nt, cs_start_task, c);
     run_parallel(nt, cs_place_task, c);
+    if (c->parent != NULL) {
+        run_parallel(nt, cs_reset_task, c);
+    }
+    c->ticket = 0;
     run_parallel(nt, cs_tally_task, c);
+    if (c->nomem) {
+        return -1;
+    }
     for (int t = 1; t < nt; t++) {
         CensusTally *y = &c->tally[t];
         c->tally[0].edges += y->edges;
@@ -2663,31 +2801,64 @@ cs_run(CsTask *c)
     if (c->parent == NULL) {
         return 0;
     }
-    run_parallel(nt, cs_reset_task, c);
-    c->ticket = 0;
-    run_parallel(nt, cs_unite_task, c);
-    pool_give(c->word, c->word_bytes);   /* the pairs are done with */
-    c->word = NULL;
+    size_t words = c->m / 64 + 1;
+    c->rootbit = (uint64_t *)calloc(words, sizeof(uint64_t));
+    c->rootrank = (uint32_t *)malloc(words * sizeof(uint32_t));
+    if (c->rootbit == NULL || c->rootrank == NULL) {
+        return -1;
+    }
     run_parallel(nt, cs_root_task, c);
     int64_t count = 0;
     for (int t = 0; t < nt; t++) {
-        int64_t r = c->roots[t];
-        c->roots[t] = count;
-        count += r;
+        count += c->roots[t];
     }
-    run_parallel(nt, cs_number_task, c);
+    uint32_t before = 0;
+    for (size_t w = 0; w < words; w++) {
+        c->rootrank[w] = before;
+        before += popcount64(c->rootbit[w]);
+    }
+    if (c->out_size == 4) {
+        run_parallel(nt, cs_label32_task, c);
+    }
+    else {
+        size_t hi = c->m;
+        while (hi > 0) {                      /* rounds [lo, hi), lo = ceil(hi / 2); the last: [0, 1) */
+            size_t lo = hi > 1 ? (hi + 1) / 2 : 0;
+            c->lo = lo;
+            c->hi = hi;
+            run_parallel(hi - lo >= CS_PARALLEL_MIN ? nt : 1, cs_label64_task, c);
+            hi = lo;
+        }
+    }
     c->several = count > 1;              /* one shell: numbered 0 by first face and by smallest vertex alike */
-    run_parallel(nt, cs_label_task, c);
-    if (c->several && !c->shared) {
+    if (!c->several) {
+        return count;
+    }
+    /* the vertex owners: in the slots (done with) when they fit, else a mapping of their own */
+    size_t need = (size_t)nt * (c->n ? c->n : 1) * sizeof(int32_t);
+    int32_t *owners = (int32_t *)c->slot;
+    if (need > c->slot_bytes) {
+        c->owner_bytes = need;
+        owners = (int32_t *)pool_take(&c->owner_bytes);
+        if (owners == NULL) {
+            c->owner_bytes = 0;
+            return -1;
+        }
+    }
+    for (int t = 0; t < nt; t++) {
+        c->owner[t] = owners + (size_t)t * (c->n ? c->n : 1);
+    }
+    run_parallel(nt, cs_owner_scan_task, c);
+    if (!c->shared) {
         run_parallel(nt, cs_owner_task, c);
     }
-    if (c->several && !c->shared) {                    /* renumber by smallest vertex: components in order of first owner */
-        c->rank = (int32_t *)malloc((count ? (size_t)count : 1) * sizeof(int32_t));
+    if (!c->shared) {                    /* renumber by smallest vertex: components in order of first owner */
+        c->rank = (int32_t *)malloc((size_t)count * sizeof(int32_t));
         if (c->rank == NULL) {
             return -1;
         }
-        memset(c->rank, 0xff, (count ? (size_t)count : 1) * sizeof(int32_t));
-        const int32_t *owner = (const int32_t *)c->cnt[0];
+        memset(c->rank, 0xff, (size_t)count * sizeof(int32_t));
+        const int32_t *owner = c->owner[0];
         int32_t next = 0;
         for (size_t v = 0; v < c->n; v++) {
             int32_t o = owner[v];
@@ -2750,23 +2921,20 @@ accel_census_shells(PyObject *self, PyObject *args)
     c->nt = nt;
     c->out = has_out ? out.buf : NULL;
     c->out_size = out_size;
+    c->parent = has_out ? (int32_t *)out.buf : NULL;     /* int64 labels: their first half until widened */
     for (int t = 0; t <= nt; t++) {
-        c->fpart[t] = part_start(mm, t, nt);
+        c->fpart[t] = t == nt ? mm : part_start(mm, t, nt) & ~(size_t)63;   /* root bits: whole words */
     }
-    int ok = 1;
-    for (int t = 0; t < nt && ok; t++) {
-        c->cnt_bytes[t] = (n ? n : 1) * sizeof(uint32_t);      /* zeroed by cs_count_task */
-        c->cnt[t] = (uint32_t *)pool_take(&c->cnt_bytes[t]);
-        ok = c->cnt[t] != NULL;
+    c->slot_bytes = (mm ? 3 * mm : 1) * sizeof(uint32_t);
+    if (has_out && out_size == 8 && n + 1 <= mm) {
+        c->off = (uint32_t *)((char *)out.buf + 4 * mm);    /* the labels' second half, free until widened */
     }
-    c->off_bytes = (n + 1) * sizeof(uint32_t);
-    c->word_bytes = (mm ? 3 * mm : 1) * sizeof(uint64_t);
-    c->parent_bytes = (mm ? mm : 1) * sizeof(int32_t);
-    c->off = (uint32_t *)pool_take(&c->off_bytes);
-    c->word = (uint64_t *)pool_take(&c->word_bytes);
-    c->parent = has_out ? (int32_t *)pool_take(&c->parent_bytes) : NULL;
-    c->npairs = (uint32_t *)malloc((n / CS_BLOCK + 1) * sizeof(uint32_t));
-    if (!ok || c->off == NULL || c->word == NULL || c->npairs == NULL || (has_out && c->parent == NULL)) {
+    else {
+        c->off_bytes = (n + 1) * sizeof(uint32_t);
+        c->off = (uint32_t *)pool_take(&c->off_bytes);
+    }
+    c->slot = (uint32_t *)pool_take(&c->slot_bytes);
+    if (c->off == NULL || c->slot == NULL) {
         PyErr_NoMemory();
         goto done;
     }

@@ -109,6 +109,7 @@ def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float) -> Clos
         f = f[~repeated]
         warnings.warn(DegenerateFacesWarning(f"{source}: {n_repeated:,} degenerate triangles (a repeated corner) "
                                              "were ignored"), stacklevel=4)
+    del repeated                      # (m,) bool: not held through the census, the analysis's high point
     diag = float(np.linalg.norm(hi - lo))
     if not diag > 0:
         raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")

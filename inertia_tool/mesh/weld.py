@@ -12,7 +12,8 @@ Three implementations give identical results: the C extension's ``Welder`` (an o
 the exact 12 or 24 bytes of a point, fed chunk by chunk in one pass, about 12 bytes per triangle beyond
 the output; see ``inertia_tool._native``); its ``PartWelder`` for large float32 streams (binary STL), which
 partitions the points by hash into buckets as they stream in and welds each bucket in a table that fits in
-a core's cache, on several threads (48 bytes per triangle until it returns, about the file's size); and
+a core's cache, on several threads (16 bytes per corner that reaches a bucket, at most 48 per triangle,
+given back chunk by chunk while the vertices are written); and
 the numpy reference below, which reads the corners in chunks (twice) and holds only 64-bit keys and 32-bit
 indices, about 72 bytes per triangle at its peak.  Either way a 5M-face binary STL never exists as a
 float64 soup.
