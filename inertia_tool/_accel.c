@@ -5007,26 +5007,141 @@ ct_id(const int32_t *ids, int64_t i, int c)      /* corner c of the face at posi
     return ids[CT_IDBLOCK * (i / CT_LEAF) + c * CT_LEAF + i % CT_LEAF];
 }
 
-/* The large per-face arrays of contact_scan: zeroed-on-demand mappings backed by 2 MB pages where the kernel
- * offers them (arena_alloc, section 2b), so that a 1M-face scan does not take one page fault per 4 kB.  Below
- * CT_SMALL_BYTES a zeroed heap block instead: a small part's scan made five mmap/munmap pairs, most of its
- * time (12-face box 52 -> 11 us).  ct_free must be given the size ct_alloc was. */
+/* The large per-face arrays of contact_scan (issue 25: fresh pages cost the kernel a page fault and a zeroing
+ * each, a fifth of the check's CPU time at 1M faces).  Every array of the scan is written before it is read
+ * (none relies on zeroed memory: INERTIA_TOOL_CT_POISON fills each block with 0xA5 bytes, for the tests), so
+ * one call's blocks come, in this order, from:
+ *   1. a block the same call gave back (CtArena: the smallest that fits; the scan's phases never coexist, so
+ *      a later phase's boxes and corner indices reuse the pages of an earlier phase's sort words and twins);
+ *   2. a mapping the weld or the census kept for the next call (pool_take's slots, section 2b: the smallest
+ *      that fits), only while the scan has mapped nothing fresh;
+ *   3. a fresh mapping (map_fresh: 2 MB pages where the kernel offers them), after the arena's blocks that did
+ *      not fit and the pool's mappings are unmapped (pool_drain), so kept pages never coexist with fresh ones
+ *      and the check's high point is never above what unmapping everything first would give.
+ The arrays of one size class are asked for in one size (the twins', boxes' and corner indices' 12 bytes a
+ * face, the positions' 4, all padded to whole leaves), so that they fit each other's blocks; sizes are not
+ * rounded up to 2 MB, which would make each array's last huge page resident whole (+23 bytes a face at 3e5
+ * faces).  Below CT_SMALL_BYTES a heap block (malloc; a small part's scan made five mmap/munmap pairs, most of
+ * its time: 12-face box 52 -> 11 us; malloc, not calloc: nothing reads before it writes).  ct_arena_trim
+ * unmaps the blocks given back (before the traversal, whose arrays are all taken by then), ct_arena_release
+ * everything at the end.  ct_free must be given the size ct_alloc returned in *bytes. */
 #define CT_SMALL_BYTES ((size_t)1 << 20)
+#define CT_ARENA_SLOTS 8
 
-static inline void *
-ct_alloc(size_t bytes)
+typedef struct {
+    void *p[CT_ARENA_SLOTS];            /* blocks given back by this call, NULL for an empty slot */
+    size_t bytes[CT_ARENA_SLOTS];
+    int fresh;                          /* a fresh mapping was made: the pool is drained, no longer taken from */
+    int poison;                         /* fill every block with 0xA5 bytes (INERTIA_TOOL_CT_POISON, tests) */
+    size_t mapped, reused, pooled;      /* bytes mapped fresh, taken from the arena, taken from the pool */
+} CtArena;
+
+/* A mapping of at least want bytes from the weld's and census's kept ones (the smallest that fits; its size in
+ * *bytes), or NULL. */
+static void *
+ct_pool_take(size_t want, size_t *bytes)
 {
-    if (bytes < CT_SMALL_BYTES)
-        return calloc(1, bytes > 0 ? bytes : 1);
-    return arena_alloc(bytes);
+    int best = -1;
+    POOL_LOCK();
+    for (int i = 0; i < POOL_SLOTS; i++) {
+        if (pool_slot[i].p != NULL && pool_slot[i].bytes >= want
+            && (best < 0 || pool_slot[i].bytes < pool_slot[best].bytes)) {
+            best = i;
+        }
+    }
+    void *p = NULL;
+    if (best >= 0) {
+        p = pool_slot[best].p;
+        *bytes = pool_slot[best].bytes;
+        pool_kept -= pool_slot[best].bytes;
+        pool_slot[best].p = NULL;
+        pool_slot[best].bytes = pool_slot[best].used = 0;
+    }
+    POOL_UNLOCK();
+    return p;
 }
 
-static inline void
-ct_free(void *p, size_t bytes)
+/* Unmaps the blocks ar holds (given back by this call and not taken again). */
+static void
+ct_arena_trim(CtArena *ar)
 {
+    for (int i = 0; i < CT_ARENA_SLOTS; i++) {
+        if (ar->p[i] != NULL) arena_free(ar->p[i], ar->bytes[i]);
+        ar->p[i] = NULL;
+        ar->bytes[i] = 0;
+    }
+}
+
+/* At the end of a call: the blocks ar holds go to the pool (pool_give: kept, with MADV_FREE, for the next
+ * weld, census or check in the process, when they fit its slots and bound; else unmapped). */
+static void
+ct_arena_release(CtArena *ar)
+{
+    for (int i = 0; i < CT_ARENA_SLOTS; i++) {
+        if (ar->p[i] != NULL) pool_give(ar->p[i], ar->bytes[i]);
+        ar->p[i] = NULL;
+        ar->bytes[i] = 0;
+    }
+}
+
+static void *
+ct_alloc(CtArena *ar, size_t *bytes)
+{
+    size_t want = *bytes > 0 ? *bytes : 1;
+    void *p = NULL;
+    if (want < CT_SMALL_BYTES) {
+        p = malloc(want);
+        *bytes = want;
+    }
+    else {
+        int best = -1;
+        for (int i = 0; i < CT_ARENA_SLOTS; i++) {
+            if (ar->p[i] != NULL && ar->bytes[i] >= want && (best < 0 || ar->bytes[i] < ar->bytes[best])) best = i;
+        }
+        if (best >= 0) {
+            p = ar->p[best];
+            *bytes = ar->bytes[best];
+            ar->p[best] = NULL;
+            ar->bytes[best] = 0;
+            ar->reused += *bytes;
+        }
+        else if (!ar->fresh && (p = ct_pool_take(want, bytes)) != NULL) {
+            ar->pooled += *bytes;
+        }
+        else {
+            ct_arena_trim(ar);
+            ar->fresh = 1;
+            p = arena_alloc(want);                  /* pool_drain, then map_fresh */
+            *bytes = want;
+            if (p != NULL) ar->mapped += want;
+        }
+    }
+#if defined(__linux__) && defined(MADV_DONTNEED)
+    /* a reused block larger than asked: its pages past the request are given back, so that they do not sit
+     * resident under the arrays of the phase that takes it (the corner indices in the sort words' block) */
+    size_t keep = (want + 4095) & ~(size_t)4095;
+    if (p != NULL && want >= CT_SMALL_BYTES && keep < *bytes) {
+        madvise((char *)p + keep, *bytes - keep, MADV_DONTNEED);
+    }
+#endif
+    if (p != NULL && ar->poison) memset(p, 0xA5, want);
+    return p;
+}
+
+static void
+ct_free(CtArena *ar, void *p, size_t bytes)
+{
+    if (p == NULL) return;
     if (bytes < CT_SMALL_BYTES) {
         free(p);
         return;
+    }
+    for (int i = 0; i < CT_ARENA_SLOTS; i++) {
+        if (ar->p[i] == NULL) {
+            ar->p[i] = p;
+            ar->bytes[i] = bytes;
+            return;
+        }
     }
     arena_free(p, bytes);
 }
@@ -7163,6 +7278,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
     int32_t *twin = NULL;
     CtScan sc;
     memset(&sc, 0, sizeof(sc));
+    CtArena ar;
+    memset(&ar, 0, sizeof(ar));
+    ar.poison = getenv("INERTIA_TOOL_CT_POISON") != NULL;
     for (; got < 2; got++) {
         if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
             goto done;
@@ -7209,11 +7327,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
         if (ct_stars_scratch(n, m) > code_bytes) code_bytes = ct_stars_scratch(n, m);
         box_bytes = n_blocks * CT_BLOCK * sizeof(CtQ);         /* two bytes per bound */
         lbox_bytes = n_blocks * 6 * sizeof(float);
-        order_bytes = mm * sizeof(int32_t);
+        order_bytes = n_blocks * CT_LEAF * sizeof(int32_t);   /* whole leaves: the size of pos (below) */
         ids_bytes = n_blocks * CT_IDBLOCK * sizeof(int32_t);
-        nodes = (CtNode *)ct_alloc(nodes_bytes);
-        code = (uint64_t *)ct_alloc(code_bytes);
-        order = (int32_t *)ct_alloc(order_bytes);
+        nodes = (CtNode *)ct_alloc(&ar, &nodes_bytes);
+        code = (uint64_t *)ct_alloc(&ar, &code_bytes);
+        order = (int32_t *)ct_alloc(&ar, &order_bytes);
         axis_out = (int8_t *)malloc(mm);
         skip_out = (uint8_t *)malloc(mm);
         if (nodes == NULL || code == NULL || order == NULL || axis_out == NULL || skip_out == NULL) {
@@ -7282,15 +7400,17 @@ accel_contact_scan(PyObject *self, PyObject *args)
             if (cert == NULL) oom = 1;
         }
         int32_t *pos = NULL;
-        size_t twin_bytes = 3 * mm * sizeof(int32_t), pos_bytes = mm * sizeof(int32_t);
+        /* asked for in the sizes of the corner indices and the order (whole leaves; the tails are not written)
+         * so that those reuse these blocks (CtArena) */
+        size_t twin_bytes = ids_bytes, pos_bytes = order_bytes;
         if (!oom && !failed && m >= 2 && cert != NULL && fmask != NULL) {
             /* mappings, not the heap: a heap block freed below the top stays resident (and glibc's mmap
              * threshold rises to the size of a block once freed), so the twins would sit under the boxes */
-            twin = (int32_t *)ct_alloc(twin_bytes);    /* NULL: no patches, the same pairs */
-            pos = (int32_t *)ct_alloc(pos_bytes);
+            twin = (int32_t *)ct_alloc(&ar, &twin_bytes);    /* NULL: no patches, the same pairs */
+            pos = (int32_t *)ct_alloc(&ar, &pos_bytes);
             if (twin == NULL || pos == NULL) {
-                ct_free(twin, twin_bytes);
-                ct_free(pos, pos_bytes);
+                ct_free(&ar, twin, twin_bytes);
+                ct_free(&ar, pos, pos_bytes);
                 twin = NULL;
                 pos = NULL;
             }
@@ -7308,7 +7428,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             if (ct_twins(F, fsize, n, m, off, vfaces, total, pos, twin, nt) < 0) {
                 oom = 1;
             }
-            ct_free(code, code_bytes);
+            ct_free(&ar, code, code_bytes);
             code = NULL;
             code_bytes = 0;
             clk[9] = profile ? ct_clock() : 0.0;
@@ -7327,13 +7447,13 @@ accel_contact_scan(PyObject *self, PyObject *args)
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
-                ct_free(twin, twin_bytes);
+                ct_free(&ar, twin, twin_bytes);
                 twin = NULL;
                 clk[7] = profile ? ct_clock() : 0.0;
                 int32_t *label = pos;                  /* pos is done with: each face's certified patch */
                 if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
                 size_t lists_bytes = ct_stars_scratch(n, m);
-                void *lists = ct_alloc(lists_bytes);   /* only the kept vertices' part of it is written */
+                void *lists = ct_alloc(&ar, &lists_bytes);   /* only the kept vertices' part of it is written */
                 if (lists == NULL) {
                     oom = 1;
                 }
@@ -7344,7 +7464,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
                                       patch != NULL ? label : NULL) < 0) {
                         oom = 1;
                     }
-                    ct_free(lists, lists_bytes);
+                    ct_free(&ar, lists, lists_bytes);
                 }
                 clk[11] = profile ? ct_clock() : 0.0;
             }
@@ -7355,18 +7475,18 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
             n_nodes = ct_build_tree(nodes, m);
         }
-        ct_free(pos, pos_bytes);
-        ct_free(twin, twin_bytes);
+        ct_free(&ar, pos, pos_bytes);
+        ct_free(&ar, twin, twin_bytes);
         twin = NULL;
         /* the sort's words and the stars' lists, the twins and the positions are given back before the boxes
          * and corner indices are written: the check's high point is then the traversal's arrays alone */
-        ct_free(code, code_bytes);
+        ct_free(&ar, code, code_bytes);
         code = NULL;
         code_bytes = 0;
         if (!oom && !failed && m >= 2) {
-            box = (CtQ *)ct_alloc(box_bytes);
-            lbox = (float *)ct_alloc(lbox_bytes);
-            ids = (int32_t *)ct_alloc(ids_bytes);
+            box = (CtQ *)ct_alloc(&ar, &box_bytes);
+            lbox = (float *)ct_alloc(&ar, &lbox_bytes);
+            ids = (int32_t *)ct_alloc(&ar, &ids_bytes);
             flags = (uint8_t *)malloc(mm);
             stars = cert != NULL ? (uint8_t *)malloc(mm) : NULL;
             if (box == NULL || lbox == NULL || ids == NULL || flags == NULL || (cert != NULL && stars == NULL)) {
@@ -7381,9 +7501,10 @@ accel_contact_scan(PyObject *self, PyObject *args)
             pr.pass = 3;
             run_parallel(thread_count(threads, (size_t)n_blocks, 20000 / CT_LEAF), ct_prep_task, &pr);
             ct_build_boxes(nodes, n_nodes, lbox, ids, cert, m);
-            ct_free(lbox, lbox_bytes);         /* the leaves' boxes are in the nodes now */
+            ct_free(&ar, lbox, lbox_bytes);         /* the leaves' boxes are in the nodes now */
             lbox = NULL;
         }
+        ct_arena_trim(&ar);                    /* every array of the traversal is taken: the rest unmapped */
         clk[4] = profile ? ct_clock() : 0.0;
         if (!oom && !failed && m >= 2) {
             if (cert != NULL) {
@@ -7465,8 +7586,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
                         "traverse %.4f s; ", (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2],
                         clk[5] - clk[3], clk[6] - clk[5]);
             }
-            fprintf(stderr, "candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld\n",
-                    sc.candidates, sc.tested, sc.node_pairs, sc.leaf_pairs, sc.loads);
+            fprintf(stderr, "candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld; "
+                    "MB mapped %.1f reused %.1f from the pool %.1f\n", sc.candidates, sc.tested, sc.node_pairs,
+                    sc.leaf_pairs, sc.loads, ar.mapped / 1e6, ar.reused / 1e6, ar.pooled / 1e6);
         }
         if (oom) {
             PyErr_NoMemory();
@@ -7496,12 +7618,12 @@ done:
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
     }
-    ct_free(nodes, nodes_bytes);
-    ct_free(code, code_bytes);
-    ct_free(box, box_bytes);
-    ct_free(lbox, lbox_bytes);
-    ct_free(order, order_bytes);
-    ct_free(ids, ids_bytes);
+    ct_free(&ar, nodes, nodes_bytes);
+    ct_free(&ar, code, code_bytes);
+    ct_free(&ar, box, box_bytes);
+    ct_free(&ar, lbox, lbox_bytes);
+    ct_free(&ar, order, order_bytes);
+    ct_free(&ar, ids, ids_bytes);
     free(flags);
     free(axis_out);
     free(skip_out);
@@ -7512,6 +7634,7 @@ done:
     free(sc.found.a);
     free(sc.found.b);
     free(sc.found.kind);
+    ct_arena_release(&ar);
     return result;
 }
 
