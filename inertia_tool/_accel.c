@@ -3547,6 +3547,7 @@ static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* secti
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
 static PyObject *accel_close_groups(PyObject *self, PyObject *args);    /* section 9b, after the module */
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
+static PyObject *accel_label_cells(PyObject *self, PyObject *args);     /* section 11, after the module */
 
 static PyObject *
 accel_release_buffers(PyObject *self, PyObject *unused)
@@ -3647,6 +3648,11 @@ static PyMethodDef accel_methods[] = {
      "sample_cells(vertices, faces, steps, origin, h, dims, out)\n\nMark in `out` (bytes of the flat grid dims, "
      "C order) the cell floor((p - origin) / h) of every barycentric sample p of each face on its grid of "
      "steps[f] (grid_estimate._surface_cells); section 10."},
+    {"label_cells", accel_label_cells, METH_VARARGS,
+     "label_cells(mask, dims, out) -> (count, first, sizes)\n\nNumber the face-connected regions of the nonzero "
+     "bytes of `mask` (the flat grid dims, C order) 1..count in the order of their first cells, into `out` "
+     "((cells,) int32; 0 off the mask), as scipy.ndimage.label with its default structure; `first` and `sizes` "
+     "(bytes of int64) are each region's first cell and cell count (grid_estimate._label_regions); section 11."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -8621,28 +8627,59 @@ accel_sample_cells(PyObject *self, PyObject *args)
             goto done;
         }
     }
+    int64_t most = 1;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        most = steps[i] > most ? steps[i] : most;
+    }
+    double *fraction = (double *)malloc((size_t)(most + 1) * sizeof(double));
+    if (fraction == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
     {
         const double *v = (const double *)vv->buf;
         uint8_t *out = (uint8_t *)ov->buf;
         const double origin[3] = {o0, o1, o2};
         const long long dims[3] = {n0, n1, n2};
+        /* floor((p - origin) / h) without a division per sample: the product with 1/h is within 2.3e-16 of
+           the quotient relatively (two roundings against one), so within 5e-7 absolutely below 2^30, and its
+           floor is the quotient's unless an integer lies within 1e-6 of it; there (and for NaN or far off the
+           grid) the quotient is taken as before */
+        const double inverse = 1.0 / h;
         Py_BEGIN_ALLOW_THREADS
+        int64_t filled = 0;                         /* fraction[j] = j / n for the n filled */
         for (Py_ssize_t f = 0; f < m; f++) {
             const double *A = v + 3 * index_at(fv->buf, size, 3 * (size_t)f);
             const double *B = v + 3 * index_at(fv->buf, size, 3 * (size_t)f + 1);
             const double *C = v + 3 * index_at(fv->buf, size, 3 * (size_t)f + 2);
             const int64_t n = steps[f];
+            if (n != filled) {
+                for (int64_t j = 0; j <= n; j++) {
+                    fraction[j] = (double)j / (double)n;
+                }
+                filled = n;
+            }
             for (int64_t i = 0; i <= n; i++) {
-                const double s = (double)i / (double)n;
+                const double s = fraction[i];
                 for (int64_t j = 0; i + j <= n; j++) {
-                    const double t = (double)j / (double)n;
+                    const double t = fraction[j];
                     const double w = (1.0 - s) - t;
                     long long idx[3];
                     for (int c = 0; c < 3; c++) {
                         const double p = (A[c] * w + B[c] * s) + C[c] * t;
-                        const double q = floor((p - origin[c]) / h);
-                        long long k = q < 0.0 ? 0 : (q > (double)(dims[c] - 1) ? dims[c] - 1 : (long long)q);
-                        idx[c] = k;
+                        const double d = p - origin[c];
+                        const double guess = d * inverse;
+                        if (fabs(guess) < 1073741824.0) {        /* false for NaN */
+                            long long k = (long long)guess;         /* truncated: floor by one step down */
+                            k -= (double)k > guess;
+                            const double part = guess - (double)k;
+                            if (part > 1e-6 && part < 1.0 - 1e-6) {
+                                idx[c] = k < 0 ? 0 : (k > dims[c] - 1 ? dims[c] - 1 : k);
+                                continue;
+                            }
+                        }
+                        const double q = floor(d / h);
+                        idx[c] = q < 0.0 ? 0 : (q > (double)(dims[c] - 1) ? dims[c] - 1 : (long long)q);
                     }
                     out[(idx[0] * dims[1] + idx[1]) * dims[2] + idx[2]] = 1;
                 }
@@ -8650,9 +8687,194 @@ accel_sample_cells(PyObject *self, PyObject *args)
         }
         Py_END_ALLOW_THREADS
     }
+    free(fraction);
     result = Py_None;
     Py_INCREF(result);
 done:
+    for (int i = 0; i < got; i++) {
+        PyBuffer_Release(&views[i]);
+    }
+    return result;
+}
+
+/* ======================================================================================================
+ * 11. label_cells -- the face-connected regions of a grid of cells (mesh/grid_estimate.py)
+ *
+ * The regions of free cells of the winding-number grid, as scipy.ndimage.label numbers them with its default
+ * structure (the 6 face neighbours): 1..count in the order of each region's first cell in C order.  One scan
+ * in C order gives each cell the provisional label of its k-1 neighbour, else of its j-1, else of its i-1
+ * neighbour, else a new one, and joins the labels of the neighbours met (a union-find whose root is the
+ * smallest label, so each region's root is the label made at its first cell: every earlier face neighbour of
+ * that cell is off the mask, or it would be in the region and earlier).  A j-1 (i-1) neighbour need not be
+ * joined when the k-1 cell and the k-1 cell of that neighbour's row are both on the mask: the four are joined
+ * already.  The roots are then numbered in increasing order (the order of the regions' first cells) and a
+ * second scan writes the numbers.  Work: two scans of the grid; memory: the labels, 12 bytes per provisional
+ * label.  The regions' cell counts come with the second scan.
+ * ====================================================================================================== */
+
+static int32_t
+lc_find(int32_t *parent, int32_t a)
+{
+    while (parent[a] != a) {
+        parent[a] = parent[parent[a]];              /* path halving */
+        a = parent[a];
+    }
+    return a;
+}
+
+static void
+lc_unite(int32_t *parent, int32_t a, int32_t b)
+{
+    a = lc_find(parent, a);
+    b = lc_find(parent, b);
+    if (a < b) {
+        parent[b] = a;
+    }
+    else if (b < a) {
+        parent[a] = b;
+    }
+}
+
+static PyObject *
+accel_label_cells(PyObject *self, PyObject *args)
+{
+    PyObject *mask_obj, *out_obj;
+    long long n0, n1, n2;
+    if (!PyArg_ParseTuple(args, "O(LLL)O", &mask_obj, &n0, &n1, &n2, &out_obj)) {
+        return NULL;
+    }
+    if (n0 < 1 || n1 < 1 || n2 < 1 || n0 > INT32_MAX || n1 > INT32_MAX || n2 > INT32_MAX
+        || n0 * n1 > INT32_MAX || n0 * n1 * n2 >= INT32_MAX) {
+        PyErr_Format(PyExc_ValueError, "Expected dims >= 1 with fewer than 2**31 - 1 cells, got (%lld, %lld, %lld)",
+                     n0, n1, n2);
+        return NULL;
+    }
+    Py_buffer views[2];
+    int got = 0;
+    PyObject *result = NULL;
+    int32_t *parent = NULL;
+    int64_t *made = NULL, *sizes = NULL;
+    if (PyObject_GetBuffer(mask_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    got++;
+    if (PyObject_GetBuffer(out_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        goto done;
+    }
+    got++;
+    const long long total = n0 * n1 * n2;
+    Py_buffer *mv = &views[0], *ov = &views[1];
+    if (mv->itemsize != 1 || mv->ndim != 1 || (long long)mv->shape[0] != total) {
+        PyErr_SetString(PyExc_ValueError, "Expected `mask` as a C-contiguous byte array of prod(dims)");
+        goto done;
+    }
+    if (signed_int_size(ov) != 4 || ov->ndim != 1 || (long long)ov->shape[0] != total) {
+        PyErr_SetString(PyExc_ValueError, "Expected `out` as a writable C-contiguous (prod(dims),) int32 array");
+        goto done;
+    }
+    {
+        const uint8_t *mask = (const uint8_t *)mv->buf;
+        int32_t *out = (int32_t *)ov->buf;
+        size_t capacity = 1024, next = 0;       /* provisional labels 1..next; 0 is "off the mask" */
+        int failed = 0;
+        long long count = 0;
+        parent = (int32_t *)malloc(capacity * sizeof(int32_t));
+        made = (int64_t *)malloc(capacity * sizeof(int64_t));
+        if (parent == NULL || made == NULL) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        parent[0] = 0;
+        made[0] = -1;
+        Py_BEGIN_ALLOW_THREADS
+        const long long plane = n1 * n2;
+        for (long long i = 0; i < n0 && !failed; i++) {
+            for (long long j = 0; j < n1 && !failed; j++) {
+                const long long row = (i * n1 + j) * n2;
+                for (long long k = 0; k < n2; k++) {
+                    const long long idx = row + k;
+                    if (!mask[idx]) {
+                        out[idx] = 0;
+                        continue;
+                    }
+                    const int left = k > 0 && mask[idx - 1];
+                    int32_t label = left ? out[idx - 1] : 0;
+                    if (j > 0 && mask[idx - n2]) {
+                        if (label == 0) {
+                            label = out[idx - n2];
+                        }
+                        else if (!(left && mask[idx - n2 - 1])) {
+                            lc_unite(parent, label, out[idx - n2]);
+                        }
+                    }
+                    if (i > 0 && mask[idx - plane]) {
+                        if (label == 0) {
+                            label = out[idx - plane];
+                        }
+                        else if (!(left && mask[idx - plane - 1])) {
+                            lc_unite(parent, label, out[idx - plane]);
+                        }
+                    }
+                    if (label == 0) {
+                        if (next + 1 >= capacity) {
+                            size_t grown = 2 * capacity;
+                            int32_t *p2 = (int32_t *)realloc(parent, grown * sizeof(int32_t));
+                            if (p2 != NULL) {
+                                parent = p2;
+                            }
+                            int64_t *m2 = p2 == NULL ? NULL : (int64_t *)realloc(made, grown * sizeof(int64_t));
+                            if (m2 == NULL) {
+                                failed = 1;
+                                break;
+                            }
+                            made = m2;
+                            capacity = grown;
+                        }
+                        next++;
+                        parent[next] = (int32_t)next;
+                        made[next] = idx;
+                        label = (int32_t)next;
+                    }
+                    out[idx] = label;
+                }
+            }
+        }
+        if (!failed) {
+            /* the roots numbered in increasing order; a label's parent is smaller, so numbered before it */
+            for (size_t a = 1; a <= next; a++) {
+                if (parent[a] == (int32_t)a) {
+                    parent[a] = (int32_t)(++count);
+                    made[count] = made[a];              /* count <= a: made[a] is read before it is overwritten */
+                }
+                else {
+                    parent[a] = parent[parent[a]];      /* the parent's number (it was numbered already) */
+                }
+            }
+            sizes = (int64_t *)calloc((size_t)count + 1, sizeof(int64_t));
+            if (sizes == NULL) {
+                failed = 1;
+            }
+            else {
+                for (long long idx = 0; idx < total; idx++) {
+                    const int32_t number = parent[out[idx]];
+                    out[idx] = number;
+                    sizes[number]++;
+                }
+            }
+        }
+        Py_END_ALLOW_THREADS
+        if (failed) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        result = Py_BuildValue("(Ly#y#)", count, (const char *)(made + 1),
+                               (Py_ssize_t)(count * (long long)sizeof(int64_t)), (const char *)(sizes + 1),
+                               (Py_ssize_t)(count * (long long)sizeof(int64_t)));
+    }
+done:
+    free(parent);
+    free(made);
+    free(sizes);
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
     }

@@ -16,11 +16,11 @@ follow from the volume in doubt as :mod:`~.uncertainty` states.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Literal, NamedTuple, overload
 
 import numpy as np
 
-from ..errors import WorkBudgetError
+from ..errors import InternalInvariantError, WorkBudgetError
 from ..tolerances import ESTIMATE_MAX_MASS_RTOL
 from .rims import boundary_edges, enclosing_balls
 from .uncertainty import Estimate, Uncertainty, uncertainty_from
@@ -163,9 +163,84 @@ def _cap_bound(points: np.ndarray, reach: float, ball_centre: np.ndarray, ball_r
     return bound
 
 
+class _Regions(NamedTuple):
+    """The settled cells of :func:`_closed_part_numbers` as their regions (``per_cell=False``): a cell's value
+    is ``whole[region[cell]]`` where it is ``settled``, without a (cells,) array of values."""
+
+    settled: np.ndarray     #: (cells,) bool: cells given their region's integer
+    region: np.ndarray      #: (cells,) int: the region of each free cell off the caps, 1…; 0 elsewhere
+    whole: np.ndarray       #: (regions + 1,) float64: 0, then the integer winding number of each region
+    sizes: np.ndarray | None = None     #: (regions,) int64: the cells of each region, when the labels gave them
+
+
+def _label_regions(cells: np.ndarray, dims: tuple[int, ...]
+                   ) -> tuple[np.ndarray, int, np.ndarray | None, np.ndarray | None]:
+    """The face-connected regions of the true ``cells`` ((cells,) bool, the grid ``dims`` in C order), numbered
+    1… in the order of their first cells (0 off them) as ``scipy.ndimage.label`` numbers them with its default
+    structure: ``(labels (cells,) int32, count, first cells (count,) int64 or None, cells of each region
+    (count,) int64 or None)``.
+
+    The C kernel (``_accel.c`` section 11, which also gives each region's first cell and size) when built;
+    otherwise scipy's (the first cells are then left to :func:`_first_cells`, the sizes to a count).
+    scipy.ndimage was imported for this alone on the repair's path (issue 23: ~0.15 s of CPU on top of its
+    label, 0.25 s for UR5e's three grids; the kernel labels them in a sixth of scipy's time).
+    """
+    from .._native import accel
+
+    lib = accel()
+    if lib is not None and len(cells) < 2 ** 31 - 1:
+        labels = np.empty(len(cells), dtype=np.int32)
+        count, first, sizes = lib.label_cells(cells.view(np.uint8), tuple(int(d) for d in dims), labels)
+        return labels, int(count), np.frombuffer(first, dtype=np.int64), np.frombuffer(sizes, dtype=np.int64)
+    from scipy import ndimage
+
+    region, n_regions = ndimage.label(cells.reshape(dims))
+    flat: np.ndarray = region.reshape(-1)
+    return flat, int(n_regions), None, None
+
+
+def _first_cells(region: np.ndarray, n_regions: int) -> np.ndarray:
+    """(n_regions,) int64: the first cell in C order of each region of ``region`` (labels 1…n_regions, 0 for
+    no region).
+
+    scipy's and the C labels number the regions in the order their first cells come (C order), so the running
+    maximum of the labels first reaches ``k`` at region ``k``'s first cell; that is checked (the label found
+    there must be ``k``: a cell where the maximum first reaches ``k`` or more, all before it below ``k``), and
+    the regions are otherwise found by a scatter of every cell's index (the same cells, slower)."""
+    if n_regions == 0:
+        return np.zeros(0, dtype=np.int64)
+    peak = np.maximum.accumulate(region)
+    first = np.searchsorted(peak, np.arange(1, n_regions + 1, dtype=peak.dtype), side="left").astype(np.int64)
+    del peak
+    if np.array_equal(region[first], np.arange(1, n_regions + 1)):
+        return first
+    # one cell of each region by a scatter instead of numpy.unique's sort of every cell; written in reverse so
+    # that, as numpy's repeated-index assignment keeps the last value written, it is the region's first cell
+    first = np.empty(n_regions + 1, dtype=np.int64)
+    step = 1 << 22
+    for start in reversed(range(0, len(region), step)):        # in blocks, to hold no index of every cell
+        labels = region[start:start + step]
+        where = np.flatnonzero(labels)[::-1]
+        first[labels[where]] = where + start
+    scattered: np.ndarray = first[1:]
+    return scattered
+
+
+@overload
+def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.ndarray, lo: np.ndarray, h: float,
+                         dims: tuple[int, ...], *, fast: bool, margin: float, per_cell: Literal[True] = ...
+                         ) -> tuple[np.ndarray, np.ndarray] | None: ...
+
+
+@overload
+def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.ndarray, lo: np.ndarray, h: float,
+                         dims: tuple[int, ...], *, fast: bool, margin: float, per_cell: Literal[False]
+                         ) -> _Regions | None: ...
+
+
 def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.ndarray,
-                         lo: np.ndarray, h: float, dims: tuple[int, ...], *, fast: bool, margin: float
-                         ) -> tuple[np.ndarray, np.ndarray] | None:
+                         lo: np.ndarray, h: float, dims: tuple[int, ...], *, fast: bool, margin: float,
+                         per_cell: bool = True) -> tuple[np.ndarray, np.ndarray] | _Regions | None:
     """Winding numbers of the cells far from the surface's holes without evaluating them one by one.
 
     Close the surface ``S`` by a cone ``C`` over each component of its boundary (apex at the centroid of the
@@ -190,10 +265,12 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
         Cells given a value here.
     value : (cells,) float32
         The integer of each settled cell's region (0 elsewhere; small integers, exact in float32).
+    _Regions
+        With ``per_cell=False``: the settled cells, their regions and each region's integer instead of
+        ``value`` (the caller that needs no per-cell values skips their array).
     None
         When the caps are too large to help or a region's integer is uncertain.
     """
-    from scipy import ndimage
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -227,20 +304,14 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
         n_loops, on_cap = 0, np.zeros(len(crossed), dtype=bool)
     open_cells = ~crossed & ~on_cap
     del on_cap
-    region, n_regions = ndimage.label(open_cells.reshape(dims))
-    region = region.reshape(-1)
+    region, n_regions, first_cells, sizes = _label_regions(open_cells, dims)
     if n_regions == 0:
+        if not per_cell:
+            return _Regions(np.zeros(len(crossed), dtype=bool), region, np.zeros(1))
         return np.zeros(len(crossed), dtype=bool), np.zeros(len(crossed))
-    # one cell of each region (any cell would do: the region's winding number is the same at all of them),
-    # by a scatter instead of numpy.unique's sort of every cell; written in reverse so that, as numpy's
-    # repeated-index assignment keeps the last value written, it is the region's first cell in C order
-    first = np.empty(n_regions + 1, dtype=np.int64)
-    step = 1 << 22
-    for start in reversed(range(0, len(region), step)):        # in blocks, to hold no index of every cell
-        labels = region[start:start + step]
-        where = np.flatnonzero(labels)[::-1]
-        first[labels[where]] = where + start
-    first = first[1:]
+    # one cell of each region (any cell would do: the region's winding number is the same at all of them): the
+    # first in C order
+    first = _first_cells(region, n_regions) if first_cells is None else first_cells
     points = _cell_centres(first, lo, h, dims)
     if fast and len(first) <= BOUNDED_REGION_POINTS:
         # one point per region: the treecode's proven error bound instead of libigl's unbounded approximation
@@ -266,6 +337,8 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
             fine[rest] = _cap_bound(_cell_centres(rest, lo, h, dims), 0.0, ball_centre, ball_radius,
                                     cap_area) < margin
         settled = open_cells & fine
+    if not per_cell:
+        return _Regions(settled, region, np.concatenate([[0.0], whole]), sizes)
     value: np.ndarray = np.concatenate([[0.0], whole]).astype(np.float32)[region]     # small integers: exact
     value[~settled] = 0.0
     return settled, value
@@ -338,6 +411,45 @@ def _budget_refusal(evaluations: int, budget: int, resolution: int, dims: tuple[
                                                        "resolution": resolution, "crossed": crossed})
 
 
+def _cell_codes(w: np.ndarray, err: np.ndarray | None, crossed: np.ndarray, w_low: float, w_high: float
+                ) -> tuple[np.ndarray, np.ndarray, int]:
+    """The codes of :func:`_winding_grid` from every cell's winding number ``w`` (0.5 on crossed cells; turned
+    over in place when the surface is inside out as a whole) and its error bound ``err`` (or None): twice the
+    material (crossed 1, decided inside 2), twice the density in doubt (crossed 1, ambiguous 2), both (cells,)
+    uint8, and the number of free cells undecided."""
+    if np.sum(w[w > 0.5]) < np.sum(-w[w < -0.5]):
+        np.negative(w, out=w)                       # the surface is inside out as a whole
+    material2 = np.where(crossed, np.uint8(1), (w > 0.5).astype(np.uint8) * np.uint8(2))
+    ambiguous = (w > w_low) & (w < w_high)
+    if err is not None:
+        ambiguous |= err >= min(0.5 - w_low, w_high - 0.5)
+    doubt2 = np.where(crossed, np.uint8(1), ambiguous.astype(np.uint8) * np.uint8(2))
+    undecided = int(np.count_nonzero(ambiguous & ~crossed))
+    return material2, doubt2, undecided
+
+
+def _region_codes(regions: _Regions, w_low: float, w_high: float) -> tuple[np.ndarray, np.ndarray, int]:
+    """:func:`_cell_codes` where every free cell is settled by its region (``regions.region`` > 0 exactly on the
+    free cells): each code is looked up by region, and the sums deciding whether the surface is inside out are
+    each region's integer times its cell count.  They are the per-cell sums exactly (integers below 2⁵³ add
+    without rounding in any order), so every code is the one :func:`_cell_codes` gives."""
+    region, whole = regions.region, regions.whole.copy()
+    if regions.sizes is not None:
+        count = np.concatenate([[0.0], regions.sizes.astype(np.float64)])
+    else:
+        count = np.bincount(region, minlength=len(whole)).astype(np.float64)
+    count[0] = 0.0                                  # the crossed cells: w = 1/2, in neither sum
+    if float(np.sum(count * np.where(whole > 0.5, whole, 0.0))) < float(np.sum(count * np.where(whole < -0.5,
+                                                                                                 -whole, 0.0))):
+        np.negative(whole, out=whole)               # the surface is inside out as a whole
+    material = np.where(whole > 0.5, 2, 0).astype(np.uint8)
+    ambiguous = (whole > w_low) & (whole < w_high)
+    doubt = np.where(ambiguous, 2, 0).astype(np.uint8)
+    material[0] = doubt[0] = 1                      # label 0: the cells the surface crosses
+    undecided = int(np.sum(count[ambiguous]))
+    return material[region], doubt[region], undecided
+
+
 def _winding_grid(vertices: np.ndarray, faces: np.ndarray, *, resolution: int, w_low: float = 0.1,
                   w_high: float = 0.9, fast: bool | None = None, tolerance: float = 2e-3,
                   max_evaluations: int | None = None) -> _GridWork:
@@ -354,24 +466,31 @@ def _winding_grid(vertices: np.ndarray, faces: np.ndarray, *, resolution: int, w
     crossed = _surface_cells(v, f, lo, h, dims)
     n_crossed = int(np.count_nonzero(crossed))
     # the grid's per-cell arrays: crossed (bool), w (float64) and two uint8 codes, ~11 bytes a cell; the cell
-    # centres are formed only for the cells evaluated and the cells in doubt
-    w = np.full(len(crossed), 0.5)                  # cells the surface crosses: half material, half in doubt
-    err = None
-    known = _closed_part_numbers(v, f, crossed, lo, h, dims, fast=use_igl,
-                                 margin=min(w_low, 1.0 - w_high)) if use_igl else None
+    # centres are formed only for the cells evaluated and the cells in doubt.  When every free cell is settled
+    # by its region (a closed surface: issue 23, UR5e), w is not formed: the codes come from the regions
+    w = err = None
+    regions = None
+    known = _closed_part_numbers(v, f, crossed, lo, h, dims, fast=use_igl, margin=min(w_low, 1.0 - w_high),
+                                 per_cell=False) if use_igl else None
     if known is not None:
         # cells far from every cap take the integer of their component; the others are evaluated
-        settled, value = known
         free = ~crossed
-        np.copyto(w, value, where=free)
-        del value
-        ask = np.flatnonzero(free & ~settled)
-        del settled, free
+        ask = np.flatnonzero(free & ~known.settled)
         evaluations = len(ask)
         if evaluations > budget:
             raise _budget_refusal(evaluations, budget, n, dims, len(f), n_crossed)
-        w[ask] = winding_numbers(_cell_centres(ask, lo, h, dims), v, f, fast=True)
+        if evaluations == 0:
+            regions = known                         # every free cell is settled (so in a region, label > 0)
+        else:
+            w = np.full(len(crossed), 0.5)          # cells the surface crosses: half material, half in doubt
+            value = known.whole.astype(np.float32)[known.region]       # small integers: exact
+            value[~known.settled] = 0.0
+            np.copyto(w, value, where=free)
+            del value
+            w[ask] = winding_numbers(_cell_centres(ask, lo, h, dims), v, f, fast=True)
+        del known, free, ask
     else:
+        w = np.full(len(crossed), 0.5)
         free_cells = np.flatnonzero(~crossed)
         evaluations = len(free_cells)
         if evaluations > budget:
@@ -383,16 +502,15 @@ def _winding_grid(vertices: np.ndarray, faces: np.ndarray, *, resolution: int, w
             err = np.zeros(len(crossed))
             w[free_cells], err[free_cells] = winding_numbers_bounded(points, v, f, tolerance=tolerance)
         del points, free_cells
-    if np.sum(w[w > 0.5]) < np.sum(-w[w < -0.5]):
-        np.negative(w, out=w)                       # the surface is inside out as a whole
-    # twice the material (crossed 1, decided inside 2) and twice the density in doubt (crossed 1, ambiguous 2)
-    material2 = np.where(crossed, np.uint8(1), (w > 0.5).astype(np.uint8) * np.uint8(2))
-    ambiguous = (w > w_low) & (w < w_high)
-    if err is not None:
-        ambiguous |= err >= min(0.5 - w_low, w_high - 0.5)
-    doubt2 = np.where(crossed, np.uint8(1), ambiguous.astype(np.uint8) * np.uint8(2))
-    undecided = int(np.count_nonzero(ambiguous & ~crossed))
-    del w, err, ambiguous
+    if regions is not None:
+        material2, doubt2, undecided = _region_codes(regions, w_low, w_high)
+        del regions
+    elif w is not None:
+        material2, doubt2, undecided = _cell_codes(w, err, crossed, w_low, w_high)
+        del w, err
+    else:                                           # every path above sets one of them
+        raise InternalInvariantError("expected the winding numbers of the grid's cells or their regions, got "
+                                     "neither")
     area = float(0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1).sum())
     if not np.any(material2[~crossed]):
         zero = np.zeros(3)
