@@ -41,7 +41,7 @@ from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, InertiaToolWarning, MeshReadError, UsageError
 from ..mesh.options import LoadOptions
 from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, load_mesh, os_error_reason
-from ..mesh.regular import open_regular
+from ..mesh.regular import open_regular, open_regular_fd
 from ..mass.pipeline import mass_properties, resolve_density
 from .chunks import (DASK_CHUNK_SECONDS, DASK_SHORT_CHUNKS_PER_WORKER, DASK_TAIL_SECONDS, POOL_CHUNK_SECONDS,
                      POOL_SHORT_CHUNKS_PER_WORKER, POOL_TAIL_SECONDS, ChunkSizer, DaskTasks, PoolTasks, file_weights)
@@ -104,6 +104,10 @@ _TENSOR_ENTRIES = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))
 
 #: Bytes read at a time when hashing a file.
 _HASH_CHUNK = 1 << 20
+
+#: Most chunks of :data:`_HASH_CHUNK` bytes hashed from one file by the batch's reader (1 TiB): the bound of its
+#: loop; a file still growing beyond it is refused.
+_MAX_HASH_CHUNKS = 1 << 20
 
 #: Largest file the batch reads into memory once, to hash it and to parse it from the same bytes (a binary STL of
 #: 330,000 triangles); a larger one is hashed and then read by the streaming reader, as it never holds the whole
@@ -283,28 +287,57 @@ def _read_once(path: str, limit: int | None = None, known: str | None = None) ->
     hash only (``None``, hashed in chunks; the reader streams it), or ``known`` (a hash the caller computed) without
     reading it.  ``limit`` defaults to :data:`READ_ONCE_BYTES`.
 
+    Five system calls for a small file: ``stat``, ``open``, ``fstat``, one ``read`` of the size ``fstat`` gave
+    plus one byte (a file that grew since is hashed on to its end, and its bytes not kept: the reader streams
+    it; a read that stops short is continued until the size or the end), ``close``.
+
     Raises
     ------
     MeshReadError
-        ``path`` is not a regular file (never opened: :func:`inertia_tool.mesh.regular.open_regular`).
+        ``path`` is not a regular file (never opened: :func:`inertia_tool.mesh.regular.open_regular_fd`).
     OSError
         It cannot be read.
     """
     limit = READ_ONCE_BYTES if limit is None else limit
-    with open_regular(path) as fh:
-        size = os.fstat(fh.fileno()).st_size
+    fd, st = open_regular_fd(path)
+    try:
+        size = st.st_size
         if size <= limit:
-            data = fh.read(size + 1)               # not read(limit): that would allocate `limit` bytes first
-            if len(data) <= size:                  # all of it (a file that grew since the fstat: streamed on)
+            data = _read_upto(fd, size)
+            if len(data) <= size:                  # all of it (a file that grew since the fstat: hashed on)
                 return data, hashlib.sha256(data).hexdigest()
             h = hashlib.sha256(data)
         elif known is not None:
             return None, known
         else:
             h = hashlib.sha256()
-        while chunk := fh.read(_HASH_CHUNK):
+        for _ in range(_MAX_HASH_CHUNKS):          # to the end of the file (a file growing without end: stopped)
+            chunk = os.read(fd, _HASH_CHUNK)
+            if not chunk:
+                return None, h.hexdigest()
             h.update(chunk)
-    return None, h.hexdigest()
+    finally:
+        os.close(fd)
+    raise MeshReadError(f"{row_path(path)}: still growing after {_MAX_HASH_CHUNKS * _HASH_CHUNK:,} bytes were read "
+                        "(is something writing to it?)")
+
+
+def _read_upto(fd: int, size: int) -> bytes:
+    """Up to ``size + 1`` bytes of the descriptor from its position: reads until ``size`` bytes (a file of the size
+    ``fstat`` gave is then whole: one ``read``), one more (it grew) or the end (it shrank)."""
+    first = os.read(fd, size + 1)       # not a read of `limit`: that would allocate `limit` bytes first
+    if len(first) >= size or not first:
+        return first
+    parts, got = [first], len(first)
+    for _ in range(size):                       # each pass reads at least one byte, or stops
+        chunk = os.read(fd, size + 1 - got)
+        if not chunk:
+            break
+        parts.append(chunk)
+        got += len(chunk)
+        if got >= size:
+            break
+    return b"".join(parts)
 
 
 def _one_line(text: object, limit: int = 500) -> str:
