@@ -32,16 +32,15 @@ import warnings
 from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, field
-from typing import Any, cast
+from typing import Any, NamedTuple, cast
 
-import numpy as np
 
 from ..values import frozen_value
 from ..mesh.checks import MeshReport
 from ..errors import InertiaToolError, InertiaToolWarning, MeshReadError, UsageError
 from ..mesh.options import LoadOptions
 from ..mesh.read import COMPRESSED_SUFFIXES, SUPPORTED_SUFFIXES, load_mesh, os_error_reason
-from ..mesh.regular import open_regular
+from ..mesh.regular import open_regular, open_regular_fd
 from ..mass.pipeline import mass_properties, resolve_density
 from .chunks import (DASK_CHUNK_SECONDS, DASK_SHORT_CHUNKS_PER_WORKER, DASK_TAIL_SECONDS, POOL_CHUNK_SECONDS,
                      POOL_SHORT_CHUNKS_PER_WORKER, POOL_TAIL_SECONDS, ChunkSizer, DaskTasks, PoolTasks, file_weights)
@@ -94,16 +93,26 @@ ROW_FIELDS_V1 = (
     "faces", "bodies", "cavities", "watertight", "repaired", "warnings", "seconds", "worker",
 )
 
-#: The numeric columns of an ``ok`` row, in the order :func:`_analyze` fills them from one array.
+#: The numeric columns of an ``ok`` row, in the order :func:`_analyze` fills them from one list.
 _NUMBER_FIELDS = ("density", "mass", "volume", "surface_area", "com_x", "com_y", "com_z",
                   "ixx", "iyy", "izz", "ixy", "ixz", "iyz", "i1", "i2", "i3",
                   *(f"axis{k}_{c}" for k in (1, 2, 3) for c in "xyz"))
 
 #: Row and column of ``ixx, iyy, izz, ixy, ixz, iyz`` in the inertia tensor.
-_TENSOR_ENTRIES = (np.array([0, 1, 2, 0, 0, 1]), np.array([0, 1, 2, 1, 2, 2]))
+_TENSOR_ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 #: Bytes read at a time when hashing a file.
 _HASH_CHUNK = 1 << 20
+
+#: Most chunks of :data:`_HASH_CHUNK` bytes hashed from one file by the batch's reader (1 TiB): the bound of its
+#: loop; a file still growing beyond it is refused.
+_MAX_HASH_CHUNKS = 1 << 20
+
+#: A batch in one process (``jobs=1``) analyses its files in runs of at most this many files or this many seconds
+#: under one warnings context (:class:`_CaughtWarnings`), then writes their rows: the rows of a file reach the
+#: results file and the progress bar at most this long after it is done.
+_RUN_FILES = 64
+_RUN_SECONDS = 0.05
 
 #: Largest file the batch reads into memory once, to hash it and to parse it from the same bytes (a binary STL of
 #: 330,000 triangles); a larger one is hashed and then read by the streaming reader, as it never holds the whole
@@ -283,28 +292,57 @@ def _read_once(path: str, limit: int | None = None, known: str | None = None) ->
     hash only (``None``, hashed in chunks; the reader streams it), or ``known`` (a hash the caller computed) without
     reading it.  ``limit`` defaults to :data:`READ_ONCE_BYTES`.
 
+    Five system calls for a small file: ``stat``, ``open``, ``fstat``, one ``read`` of the size ``fstat`` gave
+    plus one byte (a file that grew since is hashed on to its end, and its bytes not kept: the reader streams
+    it; a read that stops short is continued until the size or the end), ``close``.
+
     Raises
     ------
     MeshReadError
-        ``path`` is not a regular file (never opened: :func:`inertia_tool.mesh.regular.open_regular`).
+        ``path`` is not a regular file (never opened: :func:`inertia_tool.mesh.regular.open_regular_fd`).
     OSError
         It cannot be read.
     """
     limit = READ_ONCE_BYTES if limit is None else limit
-    with open_regular(path) as fh:
-        size = os.fstat(fh.fileno()).st_size
+    fd, st = open_regular_fd(path)
+    try:
+        size = st.st_size
         if size <= limit:
-            data = fh.read(size + 1)               # not read(limit): that would allocate `limit` bytes first
-            if len(data) <= size:                  # all of it (a file that grew since the fstat: streamed on)
+            data = _read_upto(fd, size)
+            if len(data) <= size:                  # all of it (a file that grew since the fstat: hashed on)
                 return data, hashlib.sha256(data).hexdigest()
             h = hashlib.sha256(data)
         elif known is not None:
             return None, known
         else:
             h = hashlib.sha256()
-        while chunk := fh.read(_HASH_CHUNK):
+        for _ in range(_MAX_HASH_CHUNKS):          # to the end of the file (a file growing without end: stopped)
+            chunk = os.read(fd, _HASH_CHUNK)
+            if not chunk:
+                return None, h.hexdigest()
             h.update(chunk)
-    return None, h.hexdigest()
+    finally:
+        os.close(fd)
+    raise MeshReadError(f"{row_path(path)}: still growing after {_MAX_HASH_CHUNKS * _HASH_CHUNK:,} bytes were read "
+                        "(is something writing to it?)")
+
+
+def _read_upto(fd: int, size: int) -> bytes:
+    """Up to ``size + 1`` bytes of the descriptor from its position: reads until ``size`` bytes (a file of the size
+    ``fstat`` gave is then whole: one ``read``), one more (it grew) or the end (it shrank)."""
+    first = os.read(fd, size + 1)       # not a read of `limit`: that would allocate `limit` bytes first
+    if len(first) >= size or not first:
+        return first
+    parts, got = [first], len(first)
+    for _ in range(size):                       # each pass reads at least one byte, or stops
+        chunk = os.read(fd, size + 1 - got)
+        if not chunk:
+            break
+        parts.append(chunk)
+        got += len(chunk)
+        if got >= size:
+            break
+    return b"".join(parts)
 
 
 def _one_line(text: object, limit: int = 500) -> str:
@@ -342,6 +380,39 @@ def _empty_row(path: str, sha256: str | None, options: BatchOptions, key: str | 
     return row
 
 
+class _Chunk(NamedTuple):
+    """What every file of a chunk shares, worked out once per chunk (:func:`_chunk_context`): the options, the
+    empty row of this options key and worker (copied per file), the density's description and the warnings
+    list that one ``warnings.catch_warnings`` fills for the whole chunk (emptied before each file)."""
+
+    options: BatchOptions
+    template: dict
+    described: str
+    caught: list
+
+
+def _chunk_context(options: BatchOptions, caught: list, key: str | None = None, worker: str | None = None) -> _Chunk:
+    template = dict.fromkeys(ROW_FIELDS)
+    template.update(schema=SCHEMA, options_key=key or options.key(), mesh_length_unit=options.load.units or "m",
+                    worker=worker or _worker_name())
+    _, described = resolve_density(density=options.density, material=options.material, mass=options.mass)
+    return _Chunk(options, template, described, caught)
+
+
+class _CaughtWarnings:
+    """``warnings.catch_warnings(record=True)`` with every :class:`InertiaToolWarning` recorded each time it is
+    issued (``"always"``): the context of a whole chunk, so that a chunk pays for one, not one per file."""
+
+    def __enter__(self) -> list:
+        self._context = warnings.catch_warnings(record=True)
+        caught = self._context.__enter__()
+        warnings.simplefilter("always", InertiaToolWarning)
+        return cast(list, caught)
+
+    def __exit__(self, *exc: Any) -> None:
+        self._context.__exit__(*exc)
+
+
 def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) -> dict:
     """Mass properties of one mesh file as a result row (:data:`ROW_FIELDS`); never raises.
 
@@ -364,13 +435,20 @@ def analyze_file(path: str, options: BatchOptions, sha256: str | None = None) ->
         ``" | "``; ``seconds`` is the time
         spent on this file.
     """
-    return _analyze(path, options, sha256, options.key(), _worker_name())
+    with _CaughtWarnings() as caught:
+        return _analyze(path, sha256, _chunk_context(options, caught))
 
 
-def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, worker: str) -> dict:
-    """:func:`analyze_file` with the options key and the worker name computed once by the caller."""
+def _analyze(path: str, sha256: str | None, chunk: _Chunk) -> dict:
+    """:func:`analyze_file` with what the files of a chunk share worked out once (:func:`_chunk_context`); the
+    warnings of this file are those ``chunk.caught`` holds when it returns."""
     start = time.perf_counter()
-    row = _empty_row(path, sha256, options, key, worker)
+    row = chunk.template.copy()
+    row["path"] = name = row_path(path)
+    row["sha256"] = sha256
+    caught = chunk.caught
+    caught.clear()
+    options = chunk.options
     try:
         try:
             # read once: hashed here and parsed from the same bytes (the hash is that of the content analysed;
@@ -380,36 +458,37 @@ def _analyze(path: str, options: BatchOptions, sha256: str | None, key: str, wor
         except MeshReadError:       # not a regular file: never opened
             raise
         except OSError as exc:       # unreadable: a property of the file, reported like the reader does
-            raise MeshReadError(f"{row['path']}: cannot be read ({os_error_reason(exc, path)})") from None
+            raise MeshReadError(f"{name}: cannot be read ({os_error_reason(exc, path)})") from None
         row["sha256"] = digest
-        _, described = resolve_density(density=options.density, material=options.material, mass=options.mass)
+        described = chunk.described
         load = options.load
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", InertiaToolWarning)
-            raw = load_mesh(path, units=load.units, max_faces=load.max_faces,
-                            declared_units_win=load.declared_units_win, data=data)
-            # a file that names materials per part is integrated part by part from its path (it is read again:
-            # rare); every other file from the mesh just read, as mass_properties(path) would
-            props = mass_properties(path if raw.parts else raw, density=options.density, material=options.material,
-                                    mass=options.mass, options=load)
+        raw = load_mesh(path, units=load.units, max_faces=load.max_faces,
+                        declared_units_win=load.declared_units_win, data=data)
+        # a file that names materials per part is integrated part by part from its path (it is read again:
+        # rare); every other file from the mesh just read, as mass_properties(path) would
+        props = mass_properties(path if raw.parts else raw, density=options.density, material=options.material,
+                                mass=options.mass, options=load)
         pa = props.principal
-        numbers = np.concatenate(([props.density, props.mass, props.volume, props.surface_area],
-                                  props.center_of_mass, np.asarray(props.inertia)[_TENSOR_ENTRIES], pa.moments,
-                                  np.asarray(pa.axes).T.ravel()))                 # axis k = column k of `axes`
-        row.update(zip(_NUMBER_FIELDS, [v if math.isfinite(v) else None for v in numbers.tolist()]))
+        tensor = props.inertia.tolist()
+        axes = pa.axes.tolist()                     # axis k = column k of `axes`
+        numbers = [float(props.density), float(props.mass), float(props.volume), float(props.surface_area),
+                   *props.center_of_mass.tolist(), *(tensor[i][j] for i, j in _TENSOR_ENTRIES),
+                   *pa.moments.tolist(), *(axes[i][k] for k in range(3) for i in range(3))]
+        row.update(zip(_NUMBER_FIELDS, [v if math.isfinite(v) else None for v in numbers]))
         if props.mesh is None:           # a multi-material file: its parts, each with its own mesh report
             row.update(_parts_fields(props))
             described = "per part (the file's materials)"
         else:
             mesh = props.mesh
-            row.update(method=mesh.method, **_bounds(mesh.uncertainty), faces=int(mesh.faces),
-                       bodies=int(mesh.bodies), cavities=int(mesh.cavities), watertight=bool(mesh.watertight),
+            row.update(method=mesh.method, faces=int(mesh.faces), bodies=int(mesh.bodies),
+                       cavities=int(mesh.cavities), watertight=bool(mesh.watertight),
                        repaired=bool(mesh.repaired), certificate=mesh.certificate.kind)
-        row.update(
-            status="ok", density_source=described,
-            warnings=" | ".join(_one_line(w.message) for w in caught
-                                if issubclass(w.category, InertiaToolWarning)) or None,
-        )
+            if mesh.uncertainty is not None:
+                row.update(_bounds(mesh.uncertainty))
+        row["status"] = "ok"
+        row["density_source"] = described
+        row["warnings"] = " | ".join(_one_line(w.message) for w in caught
+                                     if issubclass(w.category, InertiaToolWarning)) or None
     except InertiaToolError as exc:
         row.update(status="error", error_type=type(exc).__name__, error=row_path(_one_line(exc)))
     except Exception as exc:  # noqa: BLE001 - one bad file must never stop a batch
@@ -462,9 +541,9 @@ def analyze_chunk(chunk: Sequence[tuple[str, str | None]], options: BatchOptions
     list of dict
         One row per file (:func:`analyze_file`), in the order of ``chunk``.
     """
-    key = options.key()
-    worker = _worker_name()
-    return [_analyze(path, options, digest, key, worker) for path, digest in chunk]
+    with _CaughtWarnings() as caught:
+        context = _chunk_context(options, caught)
+        return [_analyze(path, digest, context) for path, digest in chunk]
 
 
 def _analyze_chunk_timed(chunk: Sequence[tuple[str, str | None]], options: BatchOptions) -> tuple[list[dict], float]:
@@ -686,9 +765,23 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
             progress(skipped + ok + failed, total, ok, failed)
 
     if executor is None and client is None and jobs == 1:
+        # in runs of files under one warnings context (not one per file), each run's rows handed over after it,
+        # outside the context (what the writer and the progress bar warn is shown, not recorded)
         worker = _worker_name()
-        for path, digest in todo:
-            record(_analyze(path, options, digest, key, worker))
+        pending = iter(todo)
+        for _ in range(len(todo) + 1):
+            rows = []
+            with _CaughtWarnings() as caught:
+                context = _chunk_context(options, caught, key, worker)
+                began = time.perf_counter()
+                for path, digest in pending:
+                    rows.append(_analyze(path, digest, context))
+                    if len(rows) >= _RUN_FILES or time.perf_counter() - began >= _RUN_SECONDS:
+                        break
+            for row in rows:
+                record(row)
+            if not rows:
+                break
     else:
         tasks: PoolTasks | DaskTasks
         if client is not None:

@@ -31,6 +31,8 @@ from ..integrals import VolumeMoments, second_moment_to_inertia
 
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh
+
+    from ..mesh.checks import MeshReport
     from numpy.typing import ArrayLike
 
 
@@ -114,10 +116,10 @@ def _warn_about_principal(props: MassProperties, source: str) -> None:
             f"the largest (a needle); it carries only about {max(digits, 0):.0f} correct digits"), stacklevel=3)
 
 
-def _shell_properties(s: VolumeMoments, density: float, name: str) -> MassProperties:
+def _shell_properties(s: VolumeMoments, density: float, name: str, mesh: MeshReport | None = None) -> MassProperties:
     return MassProperties(mass=density * s.volume, volume=s.volume, center_of_mass=s.centroid,
                           inertia=second_moment_to_inertia(s.second_moment, density), surface_area=s.area,
-                          density=density, name=name)
+                          density=density, name=name, mesh=mesh)
 
 
 def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassProperties]:
@@ -211,12 +213,15 @@ def _part(source: MeshSource, rho: float | None, mass: float | None, options: Lo
                             overlap=options.overlap, self_crossing=self_crossing)
     label = name or raw.source
     warn_implausible_size(raw, stacklevel=4)
-    bodies = _bodies(prepared, rho if rho is not None else 1.0, label)
-    total = bodies[0] if len(bodies) == 1 else combine(bodies, name=label)
-    result = MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
-                            inertia=total.inertia, surface_area=total.surface_area,
-                            density=rho if rho is not None else 1.0, name=label, mesh=prepared.report,
-                            parts=tuple(bodies) if len(bodies) > 1 else ())
+    if len(prepared.shells) == 1:          # one shell, one body: made once, with its report (what the copy below is)
+        result = _shell_properties(prepared.shells[0], rho if rho is not None else 1.0, label, prepared.report)
+    else:
+        bodies = _bodies(prepared, rho if rho is not None else 1.0, label)
+        total = bodies[0] if len(bodies) == 1 else combine(bodies, name=label)
+        result = MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
+                                inertia=total.inertia, surface_area=total.surface_area,
+                                density=rho if rho is not None else 1.0, name=label, mesh=prepared.report,
+                                parts=tuple(bodies) if len(bodies) > 1 else ())
     if rho is None:
         assert mass is not None, "resolve_density leaves the density open only for a target mass"
         result = result.with_mass(mass)

@@ -293,6 +293,11 @@ def shell_contacts(contacts: SurfaceContacts, labels: np.ndarray, n_shells: int)
     """
     labels = np.asarray(labels)
     cross = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
+    if not len(cross) and not np.size(contacts.coplanar_opposite) and not np.size(contacts.contact):
+        # no face meets another (every clean part): the same summary without indexing empty arrays
+        return ShellContacts(self_crossing=np.zeros(n_shells, dtype=bool), self_crossing_pairs=0,
+                             crossing=np.zeros(n_shells, dtype=bool), crossing_with=np.zeros((0, 2), dtype=np.int64),
+                             touching=np.zeros(n_shells, dtype=bool), complete=bool(contacts.complete))
     la, lb = labels[cross[:, 0]], labels[cross[:, 1]]
     same = la == lb
     self_crossing = np.zeros(n_shells, dtype=bool)

@@ -1181,6 +1181,11 @@ def _checked_arrays(path: str, v: np.ndarray, f: np.ndarray, counts: _Counts,
     return v, f
 
 
+#: The suffixes :func:`load_mesh` parses from the ``data`` a caller read (the file is then neither stat'ed nor
+#: opened again); other formats are read from the file.
+_PARSED_FROM_DATA = (".stl", ".obj")
+
+
 def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFAULT_MAX_FACES,
               declared_units_win: bool = False, data: bytes | None = None) -> RawMesh:
     """Read a mesh and convert it to metres.
@@ -1204,8 +1209,8 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
     data : bytes, optional
         The bytes of the file ``source`` names, when the caller has read them already (``inertia-tool batch``
         reads a file once, to hash it and to parse it, so that the hash is that of the bytes analysed): an STL
-        or OBJ file is parsed from them, not read again.  Other formats read the file; ignored for a source that
-        is not a path.
+        or OBJ file is parsed from them, not stat'ed or read again (the caller opened it as a regular file).
+        Other formats read the file; ignored for a source that is not a path.
 
     Returns
     -------
@@ -1234,17 +1239,19 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
     if isinstance(source, (str, bytes, os.PathLike)):
         path = os.fsdecode(os.fspath(source))
         try:
-            try:
-                st = os.stat(path)
-            except OSError as exc:
-                raise _fail(path, os_error_reason(exc, path)) from None
-            mode = st.st_mode
-            if stat.S_ISDIR(mode):
-                raise _fail(path, "is a directory, not a mesh file")
-            reason = not_regular_reason(mode, path)   # a FIFO, a device or a link to one: refused before opening
-            if reason is not None:
-                raise _fail(path, reason)
             suffix = os.path.splitext(path)[1].lower()
+            if data is None or suffix not in _PARSED_FROM_DATA:
+                # the file is opened here (the bytes given by a caller that read it are not stat'ed again)
+                try:
+                    st = os.stat(path)
+                except OSError as exc:
+                    raise _fail(path, os_error_reason(exc, path)) from None
+                mode = st.st_mode
+                if stat.S_ISDIR(mode):
+                    raise _fail(path, "is a directory, not a mesh file")
+                reason = not_regular_reason(mode, path)   # a FIFO, a device or a link to one: refused before opening
+                if reason is not None:
+                    raise _fail(path, reason)
             if suffix in COMPRESSED_SUFFIXES:
                 if os.path.getsize(path) == 0:
                     raise _fail(path, "empty file (0 bytes)")
@@ -1263,7 +1270,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
                                   f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
-            if (st.st_size if data is None else len(data)) == 0:
+            if (len(data) if data is not None and suffix in _PARSED_FROM_DATA else st.st_size) == 0:
                 raise _fail(path, "empty file (0 bytes)")
             declared = None
             rounding = 0.0                  # file units until scaled below

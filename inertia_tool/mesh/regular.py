@@ -11,6 +11,11 @@ suffix; opening one blocks forever (a FIFO no one writes to) or reads without en
 2. the file is opened with ``O_NONBLOCK``, so that a FIFO put in its place after the check cannot block the
    open, and ``fstat`` of the open descriptor must again say ``S_ISREG`` (what is read is what was checked);
 3. ``O_NONBLOCK`` is cleared (it means nothing for a regular file) and the descriptor wrapped as a binary file.
+
+:func:`open_regular_fd` stops after step 2 and returns the descriptor with the ``fstat`` it made: ``inertia-tool
+batch`` reads a small file whole with ``os.read`` (stat, open, fstat, read, close: five system calls, where the
+buffered file object adds an ``ioctl`` to clear ``O_NONBLOCK``, one to ask whether it is a terminal, a ``seek``,
+another ``fstat`` and two more ``read`` calls to find the end).
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ from typing import Any, BinaryIO, TypeAlias
 
 from ..errors import MeshReadError
 
-__all__ = ["open_regular", "check_regular", "not_regular_reason", "regular_file_resolver"]
+__all__ = ["open_regular", "open_regular_fd", "check_regular", "not_regular_reason", "regular_file_resolver"]
 
 #: A file name as :func:`os.open` takes it (a ``bytes`` name keeps undecodable bytes).
 PathName: TypeAlias = "str | bytes | os.PathLike[str] | os.PathLike[bytes]"
@@ -62,6 +67,41 @@ def check_regular(path: PathName) -> os.stat_result:
     return st
 
 
+def open_regular_fd(path: PathName) -> tuple[int, os.stat_result]:
+    """Open a regular file for reading as a raw descriptor, never blocking on what is not one (steps 1 and 2
+    of the module docstring).
+
+    Parameters
+    ----------
+    path : str, bytes or path
+
+    Returns
+    -------
+    (int, os.stat_result)
+        The descriptor (``O_NONBLOCK`` left set: a regular file's reads ignore it; the caller closes it) and
+        its ``fstat``, which says it is a regular file (its ``st_size`` is the size when opened).
+
+    Raises
+    ------
+    MeshReadError
+        ``path`` is (or, by the time it is opened, has become) a FIFO, a device, a socket or a directory.
+    OSError
+        It cannot be opened (no such file, permission denied, ...).
+    """
+    check_regular(path)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0) | getattr(os, "O_CLOEXEC", 0)
+    fd = os.open(path, flags)
+    try:
+        st = os.fstat(fd)
+        reason = not_regular_reason(st.st_mode)
+        if reason is not None:
+            raise MeshReadError(f"{_display(path)}: {reason} (it changed while being opened)")
+        return fd, st
+    except BaseException:
+        os.close(fd)
+        raise
+
+
 def open_regular(path: PathName) -> BinaryIO:
     """Open a regular file for reading in binary mode, never blocking on what is not one.
 
@@ -81,13 +121,8 @@ def open_regular(path: PathName) -> BinaryIO:
     OSError
         It cannot be opened (no such file, permission denied, ...).
     """
-    check_regular(path)
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0) | getattr(os, "O_CLOEXEC", 0)
-    fd = os.open(path, flags)
+    fd, _ = open_regular_fd(path)
     try:
-        reason = not_regular_reason(os.fstat(fd).st_mode)
-        if reason is not None:
-            raise MeshReadError(f"{_display(path)}: {reason} (it changed while being opened)")
         if hasattr(os, "set_blocking"):
             os.set_blocking(fd, True)
         return os.fdopen(fd, "rb")
