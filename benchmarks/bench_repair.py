@@ -1,7 +1,7 @@
 """Speed of ``inertia-tool analyze --repair`` on large damaged meshes and soups (issue 25 item 3).
 
-Builds the cases deterministically (``--seed``) into ``benchmarks/out/repair/`` (not committed) as binary STL in
-mm, from two closed bases written by this script, so nothing is downloaded:
+Builds the cases deterministically (``--seed``) into ``--out`` (default ``/tmp/inertia_tool_bench_repair``,
+nothing in the repository) as binary STL in mm, from two closed bases written by this script, so nothing is downloaded:
 
 * ``torus`` — a ring of 2·760·190 = 288,800 faces (major radius 40 mm, minor 10 mm), the "part under 300k";
 * ``sphere`` — a subdivided icosahedron of 1,310,720 faces (radius 50 mm), the "1.3M-face mesh".
@@ -24,13 +24,23 @@ answer, the volume against the clean base's (exact polyhedral volume) and the st
 wrong answer shows.  The machine's load average is printed with the table (timings on a shared machine are noisy:
 the CPU time is the steadier figure).
 
-    python benchmarks/bench_repair.py [--bases torus sphere] [--kinds hole scattered soup tjunction]
-                                      [--repeat 1] [--seed 0] [--profile CASE] [--baseline DIR]
+The truth of ``soup`` is its *welded* surface, not the unperturbed base: the file's triangles with every corner
+replaced by the first copy of that base vertex in the file (the corner the weld keeps, the lowest-numbered), as
+float32 — the surface the repair integrates, which differs from the base by the 1e-7 jitter.  The other kinds
+keep the clean base's volume (their damage moves no corner).
 
-``--profile torus_soup`` runs one case in-process under cProfile (CPU time) and prints the 25 most expensive
-functions.  ``--baseline DIR`` (another checkout of the repository, its C extension built) runs every case on
-it too, alternating with this checkout repeat by repeat (so both see the same load), and prints CPU time and
-peak memory as ``before → after`` with a column saying whether the answers (the whole JSON report) are the same.
+Both checkouts must run their C kernels: a checkout whose ``_accel.c`` changed without a rebuild silently uses
+numpy, whose timings are another program's, so the benchmark stops with a message unless
+``INERTIA_TOOL_NO_ACCEL=1`` asks for numpy on purpose.
+
+    python benchmarks/bench_repair.py [--bases torus sphere] [--kinds hole scattered soup tjunction]
+                                      [--repeat 1] [--seed 0] [--profile CASE] [--baseline DIR] [--out DIR]
+
+``--profile torus_soup`` runs one case in-process under cProfile (CPU time) and prints the 25 (``--profile-rows``)
+most expensive functions (``--profile-sort tottime``: by their own time).  ``--baseline DIR`` (another checkout
+of the repository, its C extension built) runs every case on it too, alternating with this checkout repeat by
+repeat (so both see the same load), and prints CPU time and peak memory as ``before → after`` with a column saying
+whether the answers (the whole JSON report) are the same.
 """
 
 from __future__ import annotations
@@ -40,6 +50,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 
 import numpy as np
 
@@ -49,13 +60,14 @@ sys.path.insert(0, HERE)
 from _shapes import icosphere, ring_torus, write_binary_stl  # noqa: E402
 
 ROOT = os.path.dirname(HERE)
-OUT = os.path.join(HERE, "out", "repair")
+OUT = os.path.join(tempfile.gettempdir(), "inertia_tool_bench_repair")
 
 CHILD = r"""
 import io, contextlib, json, os, resource, sys, time, warnings
 t = time.perf_counter()
 c = os.times()
 from inertia_tool.cli import main
+from inertia_tool._native import accel
 buf = io.StringIO()
 with contextlib.redirect_stdout(buf), contextlib.redirect_stderr(io.StringIO()), warnings.catch_warnings():
     warnings.simplefilter("ignore")
@@ -68,7 +80,8 @@ with open("/proc/self/status") as fh:
     for line in fh:
         if line.startswith("VmHWM:"):
             peak = int(line.split()[1]) * 1024
-print(json.dumps({"rc": rc, "wall": dt, "cpu": cpu, "peak": peak, "out": buf.getvalue()}))
+print(json.dumps({"rc": rc, "wall": dt, "cpu": cpu, "peak": peak, "out": buf.getvalue(),
+                  "accel": accel() is not None}))
 """
 
 
@@ -108,25 +121,58 @@ def damage(kind: str, v: np.ndarray, f: np.ndarray, rng: np.random.Generator) ->
 
 def clean_volume(v: np.ndarray, f: np.ndarray) -> float:
     """Exact polyhedral volume (mm³) of the clean base as written (float32 corners)."""
-    tri = v.astype(np.float32).astype(np.float64)[f]
+    return _volume(v.astype(np.float32).astype(np.float64)[f])
+
+
+def _volume(tri: np.ndarray) -> float:
+    """Signed volume (mm³) enclosed by triangles (k, 3, 3): the divergence theorem, one cone per face."""
     return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)
 
 
-def build(bases: list[str], kinds: list[str], seed: int) -> list[dict]:
-    os.makedirs(OUT, exist_ok=True)
+def welded_volume(tri: np.ndarray, f: np.ndarray) -> float:
+    """Volume (mm³) of a soup (``tri`` (m, 3, 3), face i the jittered copy of base face ``f[i]``) welded as the
+    repair welds it: each base vertex replaced by its first copy in the file (float32), the faces kept."""
+    corners = f.reshape(-1)
+    first = np.full(int(corners.max()) + 1, -1, dtype=np.int64)
+    order = np.arange(len(corners))[::-1]
+    first[corners[order]] = order              # the last write of each vertex is its first corner in the file
+    flat = tri.astype(np.float32).astype(np.float64).reshape(-1, 3)
+    return _volume(flat[first[f]])
+
+
+def build(bases: list[str], kinds: list[str], seed: int, out: str = OUT) -> list[dict]:
+    os.makedirs(out, exist_ok=True)
     cases = []
     for base in bases:
         v, f = BASES[base]()
         truth = clean_volume(v, f)
         for kind in kinds:
-            path = os.path.join(OUT, f"{base}_{kind}_s{seed}.stl")
+            path = os.path.join(out, f"{base}_{kind}_s{seed}.stl")
             # seeded by the kind's place in KINDS, not in `kinds`: a subset builds the same files
             rng = np.random.default_rng([seed, KINDS.index(kind), len(f)])
             tri = damage(kind, v, f, rng)
             if not os.path.exists(path):
                 write_binary_stl(path, tri, header=b"inertia_tool repair benchmark")
-            cases.append({"case": f"{base}_{kind}", "path": path, "faces": len(tri), "truth_mm3": truth})
+            # a soup's truth is its welded surface (1e-7 from the base: the jitter is the file's, not an error)
+            case_truth = welded_volume(tri, f) if kind == "soup" else truth
+            cases.append({"case": f"{base}_{kind}", "path": path, "faces": len(tri), "truth_mm3": case_truth})
     return cases
+
+
+def require_c_kernels(root: str) -> None:
+    """Stop unless the checkout ``root`` loads its C kernels, or they are switched off on purpose
+    (``INERTIA_TOOL_NO_ACCEL``): a checkout whose ``_accel.c`` changed (a rebase) without a rebuild falls back to
+    numpy with one warning, and its numbers would be those of another program."""
+    if os.environ.get("INERTIA_TOOL_NO_ACCEL", "").strip() not in ("", "0"):
+        return
+    probe = "import warnings; warnings.simplefilter('ignore'); from inertia_tool._native import accel; " \
+            "print(accel() is not None)"
+    env = dict(os.environ, PYTHONPATH=root)
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env, cwd=root)
+    if r.returncode != 0 or r.stdout.strip() != "True":
+        raise SystemExit(f"bench_repair: the C kernels of {root} are not loaded (a stale or missing build: rebuild "
+                         "the extension), so its numbers would be numpy's; set INERTIA_TOOL_NO_ACCEL=1 to time "
+                         "numpy on purpose")
 
 
 def child(path: str, root: str) -> dict:
@@ -138,6 +184,8 @@ def child(path: str, root: str) -> dict:
     if r.returncode != 0:
         raise RuntimeError(f"child failed on {path}: {r.stderr[-2000:]}")
     got: dict = json.loads(r.stdout.strip().splitlines()[-1])
+    if not got.pop("accel") and os.environ.get("INERTIA_TOOL_NO_ACCEL", "").strip() in ("", "0"):
+        raise SystemExit(f"bench_repair: {root} ran {path} without its C kernels (a stale build?); rebuild them")
     return got
 
 
@@ -165,12 +213,12 @@ def run(case: dict, repeat: int, baseline: str | None = None) -> dict:
     return row
 
 
-def profile(name: str, seed: int) -> None:
+def profile(name: str, seed: int, out: str = OUT, sort: str = "cumulative", rows: int = 25) -> None:
     import cProfile
     import pstats
     import warnings
     base, kind = name.split("_", 1)
-    case = next(c for c in build([base], [kind], seed))
+    case = next(c for c in build([base], [kind], seed, out))
     sys.path.insert(0, ROOT)
     from inertia_tool.cli import main
     import contextlib
@@ -182,7 +230,7 @@ def profile(name: str, seed: int) -> None:
         prof.enable()
         main(["analyze", case["path"], "--repair", "--json", "--units", "mm"])
         prof.disable()
-    pstats.Stats(prof).sort_stats("cumulative").print_stats(25)
+    pstats.Stats(prof).sort_stats(sort).print_stats(rows)
 
 
 def main() -> None:
@@ -193,12 +241,18 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--profile", help="run one case (e.g. torus_soup) in-process under cProfile")
     parser.add_argument("--baseline", help="another checkout to compare with (CPU and peak memory before → after)")
+    parser.add_argument("--profile-sort", default="cumulative", help="pstats order: cumulative or tottime")
+    parser.add_argument("--profile-rows", type=int, default=25, help="functions listed by --profile")
+    parser.add_argument("--out", default=OUT, help=f"folder of the generated cases (default {OUT})")
     args = parser.parse_args()
+    require_c_kernels(ROOT)
     if args.profile:
-        profile(args.profile, args.seed)
+        profile(args.profile, args.seed, args.out, args.profile_sort, args.profile_rows)
         return
     baseline = os.path.abspath(args.baseline) if args.baseline else None
-    cases = build(args.bases, args.kinds, args.seed)
+    if baseline:
+        require_c_kernels(baseline)
+    cases = build(args.bases, args.kinds, args.seed, args.out)
     print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}; {os.cpu_count()} cores")
     if baseline:
         print(f"before: {baseline}; after: {ROOT}")

@@ -8009,6 +8009,14 @@ oe_edge_pairs(const OeGrid *g, const double *v, int64_t ia, int64_t ib, int64_t 
     /* every pair passing lies within this distance of the segment */
     const double r = (gap > rtol * len ? gap : rtol * len) + slop + 1e-12 * scale;
     const double gap2 = gap * gap, slop2 = slop * slop, rtol2 = 4.0 * rtol * rtol;
+    /* the edge's box widened by r: a pair the callers accept (within gap, or within rtol of the nearer end's
+     * distance <= rtol len / 2, of a point of the segment, to round-off) lies in it; most points of the cells
+     * visited (a soup's copies of the ends, jittered) do not, and are set aside by six comparisons */
+    double box_lo[3], box_hi[3];
+    for (int c = 0; c < 3; c++) {
+        box_lo[c] = (A[c] < B[c] ? A[c] : B[c]) - r;
+        box_hi[c] = (A[c] < B[c] ? B[c] : A[c]) + r;
+    }
     const double pieces_d = ceil(2.0 * len / cell);
     const int64_t pieces = pieces_d < 1.0 ? 1 : (int64_t)pieces_d;
     int64_t prev_lo[3] = {1, 1, 1}, prev_hi[3] = {0, 0, 0};     /* the previous piece's cells (none yet) */
@@ -8054,6 +8062,10 @@ oe_edge_pairs(const OeGrid *g, const double *v, int64_t ia, int64_t ib, int64_t 
                             continue;
                         }
                         const double *M = g->point[j].x;
+                        if ((M[0] < box_lo[0]) | (M[0] > box_hi[0]) | (M[1] < box_lo[1]) | (M[1] > box_hi[1]) |
+                            (M[2] < box_lo[2]) | (M[2] > box_hi[2])) {
+                            continue;
+                        }
                         const double w0 = M[0] - A[0], w1 = M[1] - A[1], w2 = M[2] - A[2];
                         const double dot = (w0 * d0 + w1 * d1) + w2 * d2;
                         if (!(dot > -1e-12 * len2 && dot < (1.0 + 1e-12) * len2)) {
