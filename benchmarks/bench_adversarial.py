@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import sys
 import time
@@ -31,6 +32,29 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 import adversary_solids as S  # noqa: E402
 
 LABELS = ("exact", "united", "estimate", "summed", "unverified", "refused", "crashed")
+
+
+def require_c_kernels() -> None:
+    """Stop unless the C kernels are loaded, or switched off on purpose (``INERTIA_TOOL_NO_ACCEL``).
+
+    A checkout whose ``_accel.c`` changed (a rebase) without a rebuild, or one where the extension was never
+    built, falls back to numpy with at most one warning: the verdicts are the same to round-off but the run is
+    several times slower and its timings are those of another program, so the benchmark refuses instead."""
+    import warnings
+
+    from inertia_tool._native import NO_ACCEL_ENV, accel
+
+    if os.environ.get(NO_ACCEL_ENV, "").strip() not in ("", "0"):
+        return
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lib = accel()
+    if lib is None:
+        package = Path(accel.__code__.co_filename).parent
+        why = "; ".join(str(w.message).split(":")[0] for w in caught) or "no built inertia_tool._accel was found"
+        raise SystemExit(f"bench_adversarial: expected the C kernels of {package} to be loaded, found none ({why}). "
+                         "Rebuild the extension from the checkout's inertia_tool/_accel.c "
+                         f"(`pip install -e .`), or set {NO_ACCEL_ENV}=1 to run the numpy path on purpose.")
 
 
 def draw(seed, i):
@@ -64,6 +88,7 @@ def main(argv=None):
                     help="only the cases of this kind (case indices i with KINDS[i % len(KINDS)] == kind, "
                          "--cases of them)")
     args = ap.parse_args(argv)
+    require_c_kernels()
 
     if args.case is not None:
         case = draw(args.seed, args.case)
