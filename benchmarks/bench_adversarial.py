@@ -76,6 +76,28 @@ def failure_class(case, verdict):
     return f"{case.kind}{'[' + head + ']' if head else ''}{detail} → {verdict.label}"
 
 
+#: Labels that are honest but not a proven answer: each such outcome is classified by its reason.
+NON_CLEAN = ("estimate", "summed", "unverified", "refused", "crashed")
+
+
+def outcome_reason(case, verdict, repair=False):
+    """Why a case was not answered with a proven number: the refusal's first line, or the notes of the
+    certificate (an estimate's or an unverified result's), shortened to their first clause."""
+    if verdict.label in ("refused", "crashed"):
+        text = verdict.message or verdict.wrong or ""
+    else:
+        import warnings
+
+        from inertia_tool import mass_properties
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            props = mass_properties((case.vertices, case.faces), density=1.0, repair=repair)
+        mesh = props.mesh
+        text = "; ".join(n for n in mesh.notes)[:400] or f"checks {', '.join(mesh.certificate.checks)}"
+    return re.sub(r"[-+]?\d[\d.,eE+-]*", "#", text.split(". ")[0])[:160]
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=10_000)
@@ -100,6 +122,7 @@ def main(argv=None):
 
     table: dict[str, Counter] = defaultdict(Counter)
     classes: dict[str, list] = defaultdict(list)
+    outcomes: dict[str, list] = defaultdict(list)
     worst_mc = 0.0
     t0 = time.time()
     if args.kind is None:
@@ -116,6 +139,8 @@ def main(argv=None):
         row = table[case.kind]
         row["cases"] += 1
         row[verdict.label] += 1
+        if verdict.label in NON_CLEAN and verdict.wrong is None:
+            outcomes[f"{case.kind} → {verdict.label}: {outcome_reason(case, verdict, args.repair)}"].append(i)
         if verdict.wrong is not None:
             row["wrong"] += 1
             if S.silent(verdict):
@@ -140,6 +165,12 @@ def main(argv=None):
         print(f"Monte Carlo cross-check of the figure-eight truths ({args.mc:,} points each): largest "
               f"disagreement {worst_mc:.2f} standard errors")
         print()
+    if outcomes:
+        print("Honest outcomes that are not a proven answer (kind → label: reason, numbers as #; count; cases):")
+        print()
+        for name, where in sorted(outcomes.items(), key=lambda kv: -len(kv[1])):
+            print(f"- {name}: {len(where)}; cases {', '.join(map(str, where[:8]))}{' …' if len(where) > 8 else ''}")
+        print()
     if classes:
         print("Failure classes (count; smallest reproducer: `python benchmarks/bench_adversarial.py "
               f"--seed {args.seed} --case N`):")
@@ -148,7 +179,8 @@ def main(argv=None):
             faces, i, recipe, wrong = min(rows)
             print(f"- {name}: {len(rows)}; case {i} ({faces} faces): {recipe}\n    {wrong}")
     if args.json:
-        args.json.write_text(json.dumps({k: [r[1] for r in v] for k, v in classes.items()}, indent=1))
+        args.json.write_text(json.dumps({"failures": {k: [r[1] for r in v] for k, v in classes.items()},
+                                         "outcomes": dict(outcomes)}, indent=1))
     return 1 if total["silent wrong"] else 0
 
 
