@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import sys
 import time
@@ -31,6 +32,29 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 import adversary_solids as S  # noqa: E402
 
 LABELS = ("exact", "united", "estimate", "summed", "unverified", "refused", "crashed")
+
+
+def require_c_kernels() -> None:
+    """Stop unless the C kernels are loaded, or switched off on purpose (``INERTIA_TOOL_NO_ACCEL``).
+
+    A checkout whose ``_accel.c`` changed (a rebase) without a rebuild, or one where the extension was never
+    built, falls back to numpy with at most one warning: the verdicts are the same to round-off but the run is
+    several times slower and its timings are those of another program, so the benchmark refuses instead."""
+    import warnings
+
+    from inertia_tool._native import NO_ACCEL_ENV, accel
+
+    if os.environ.get(NO_ACCEL_ENV, "").strip() not in ("", "0"):
+        return
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lib = accel()
+    if lib is None:
+        package = Path(accel.__code__.co_filename).parent
+        why = "; ".join(str(w.message).split(":")[0] for w in caught) or "no built inertia_tool._accel was found"
+        raise SystemExit(f"bench_adversarial: expected the C kernels of {package} to be loaded, found none ({why}). "
+                         "Rebuild the extension from the checkout's inertia_tool/_accel.c "
+                         f"(`pip install -e .`), or set {NO_ACCEL_ENV}=1 to run the numpy path on purpose.")
 
 
 def draw(seed, i):
@@ -52,6 +76,28 @@ def failure_class(case, verdict):
     return f"{case.kind}{'[' + head + ']' if head else ''}{detail} → {verdict.label}"
 
 
+#: Labels that are honest but not a proven answer: each such outcome is classified by its reason.
+NON_CLEAN = ("estimate", "summed", "unverified", "refused", "crashed")
+
+
+def outcome_reason(case, verdict, repair=False):
+    """Why a case was not answered with a proven number: the refusal's first line, or the notes of the
+    certificate (an estimate's or an unverified result's), shortened to their first clause."""
+    if verdict.label in ("refused", "crashed"):
+        text = verdict.message or verdict.wrong or ""
+    else:
+        import warnings
+
+        from inertia_tool import mass_properties
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            props = mass_properties((case.vertices, case.faces), density=1.0, repair=repair)
+        mesh = props.mesh
+        text = "; ".join(n for n in mesh.notes)[:400] or f"checks {', '.join(mesh.certificate.checks)}"
+    return re.sub(r"[-+]?\d[\d.,eE+-]*", "#", text.split(". ")[0])[:160]
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=10_000)
@@ -64,6 +110,7 @@ def main(argv=None):
                     help="only the cases of this kind (case indices i with KINDS[i % len(KINDS)] == kind, "
                          "--cases of them)")
     args = ap.parse_args(argv)
+    require_c_kernels()
 
     if args.case is not None:
         case = draw(args.seed, args.case)
@@ -75,6 +122,7 @@ def main(argv=None):
 
     table: dict[str, Counter] = defaultdict(Counter)
     classes: dict[str, list] = defaultdict(list)
+    outcomes: dict[str, list] = defaultdict(list)
     worst_mc = 0.0
     t0 = time.time()
     if args.kind is None:
@@ -91,6 +139,8 @@ def main(argv=None):
         row = table[case.kind]
         row["cases"] += 1
         row[verdict.label] += 1
+        if verdict.label in NON_CLEAN and verdict.wrong is None:
+            outcomes[f"{case.kind} → {verdict.label}: {outcome_reason(case, verdict, args.repair)}"].append(i)
         if verdict.wrong is not None:
             row["wrong"] += 1
             if S.silent(verdict):
@@ -115,6 +165,12 @@ def main(argv=None):
         print(f"Monte Carlo cross-check of the figure-eight truths ({args.mc:,} points each): largest "
               f"disagreement {worst_mc:.2f} standard errors")
         print()
+    if outcomes:
+        print("Honest outcomes that are not a proven answer (kind → label: reason, numbers as #; count; cases):")
+        print()
+        for name, where in sorted(outcomes.items(), key=lambda kv: -len(kv[1])):
+            print(f"- {name}: {len(where)}; cases {', '.join(map(str, where[:8]))}{' …' if len(where) > 8 else ''}")
+        print()
     if classes:
         print("Failure classes (count; smallest reproducer: `python benchmarks/bench_adversarial.py "
               f"--seed {args.seed} --case N`):")
@@ -123,7 +179,8 @@ def main(argv=None):
             faces, i, recipe, wrong = min(rows)
             print(f"- {name}: {len(rows)}; case {i} ({faces} faces): {recipe}\n    {wrong}")
     if args.json:
-        args.json.write_text(json.dumps({k: [r[1] for r in v] for k, v in classes.items()}, indent=1))
+        args.json.write_text(json.dumps({"failures": {k: [r[1] for r in v] for k, v in classes.items()},
+                                         "outcomes": dict(outcomes)}, indent=1))
     return 1 if total["silent wrong"] else 0
 
 

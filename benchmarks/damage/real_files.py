@@ -22,7 +22,7 @@ repair.  The rule is that of ``coverage.py``: an answer certified ``exact``/``un
 truth, an estimate within its bounds (``holds``), ``unverified`` claims nothing, a refusal is allowed; any
 other exception is an error.  Prints the count per kind, every failure, and writes JSON.
 
-Run: ``python benchmarks/damage/real_files.py --roots /path/to/models,/path/to/gazebo --files 60 --seed 7``.
+Run: ``python benchmarks/damage/real_files.py --roots /path/to/models /path/to/gazebo --files 60 --seed 7``.
 """
 
 from __future__ import annotations
@@ -205,7 +205,8 @@ def run_case(source, kind, entropy):
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--roots", required=True, help="comma-separated folders searched for mesh files")
+    parser.add_argument("--roots", required=True, nargs="+",
+                        help="folders searched for mesh files (several, or comma-separated)")
     parser.add_argument("--files", type=int, default=40)
     parser.add_argument("--max-faces", type=int, default=5000)
     parser.add_argument("--seed", type=int, default=7)
@@ -213,7 +214,7 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=cov.OUT / "real_files.json")
     args = parser.parse_args(argv)
     rng = np.random.default_rng(args.seed)
-    sources = find_sources(args.roots.split(","), args.max_faces, rng, args.files)
+    sources = find_sources([r for root in args.roots for r in root.split(",") if r], args.max_faces, rng, args.files)
     kinds = args.kinds.split(",")
     print(f"{len(sources)} clean sources, {len(kinds)} kinds, seed {args.seed}", flush=True)
     rows, table = [], Counter()
