@@ -559,6 +559,7 @@ def table(rows):
 REFUSAL_CAUSES = (
     ("patched: ball over a hole too large", "the patched surface cannot be bounded usefully"),
     ("patched: body or cavity undecided", "the file does not say whether it is a body or a cavity"),
+    ("patched: winding estimate past ±50 %", "the patched surface's winding-number estimate cannot be bounded"),
     ("patched: footprint of a feature taken whole", "footprint of a feature"),
     ("winding: passes through itself", "passes through itself"),
     ("winding: union not formed", "union could not be formed"),
