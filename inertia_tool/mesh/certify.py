@@ -47,6 +47,12 @@ class Certified(NamedTuple):
     notes: tuple[str, ...]
 
 
+
+#: Why an estimate widened by R4's undecided reading (a shell wound outward inside another) is refused.
+_R4_WHY = ("a shell wound outward lies inside another, the file does not say whether it is a body or a cavity, and "
+           "the two readings are that far apart; wind the inner shell inward if it is a cavity, or unite the bodies "
+           "in a mesh editor if it is a body")
+
 def first_checks(touch: ShellContacts, unverified: str | None) -> tuple[str, list[str]]:
     """The certificate kind and checks before the boolean (R5, R6): exact when the face-pair check finished and no
     self-crossing surface was integrated as it stands (``unverified``: its note); "no-crossing-faces" when, in
@@ -167,10 +173,8 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         if spread is not None and holes_alone <= ESTIMATE_MAX_MASS_RTOL:
             # the holes alone are bounded usefully: the reading the file does not decide is what widens the bound
             check_useful(whole.volume, uncertainty, source=source, what=what,
-                         why="a shell wound outward lies inside another, the file does not say whether it is a "
-                         "body or a cavity, and the two readings are that far apart (the holes alone are bounded "
-                         f"within ±{round_up(100 * holes_alone):.3g} % mass); wind the inner shell inward if it is a "
-                         "cavity, or unite the bodies in a mesh editor if it is a body")
+                         why=_R4_WHY.replace("far apart;", "far apart (the holes alone are bounded within "
+                                             f"±{round_up(100 * holes_alone):.3g} % mass);"))
         else:
             check_useful(whole.volume, uncertainty, source=source, what=what)
         # a patched surface whose union could not be verified (R6) keeps "unverified": the patches' bound does
@@ -179,7 +183,11 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
     elif spread is not None and kind in ("exact", "united"):         # R4: both readings within the bound
         from .uncertainty import uncertainty_from
         whole = total(shells.moments)
+        from .uncertainty import check_useful
         uncertainty = uncertainty_from(whole.volume, whole.centroid, whole.second_moment, *spread)
+        # the same ±50 % limit as every estimate (holes6's review: two crossing outward cubes inside a cube were
+        # answered at ±61.5 % mass)
+        check_useful(whole.volume, uncertainty, source=source, what="the reading by nesting depth", why=_R4_WHY)
         kind, method = "estimate", "nesting"      # a reading by nesting depth, not the surface integral proven
     if arranged:                              # R3: the arrangement's surface, checked like any other
         method = "union" if method == "exact" else method
