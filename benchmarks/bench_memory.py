@@ -14,10 +14,10 @@ the number of triangles: the multiple of the file size (and of the faces) that e
 cost of a refusal (which must stay at the interpreter's baseline: the counts are checked before allocating).
 
 With ``--stages FILE ...`` it runs ``analyze FILE --json --units mm`` in a fresh process with each stage of
-``prepare_mesh`` (and ``load_mesh``) wrapped: the peak resident memory within each stage (VmHWM, reset through
-``/proc/self/clear_refs`` at every stage boundary and folded into the stages still open), the memory on entry
-and on exit and the stage's CPU time (Linux only).  Generate the files outside the repository (e.g. the tori of
-``bench_scaling.py`` under /tmp).
+``prepare_mesh`` (and ``load_mesh``, the weld and the census) wrapped: the peak resident memory within each
+stage (VmHWM, reset through ``/proc/self/clear_refs`` at every stage boundary and folded into the stages still
+open), the memory on entry and on exit and the stage's CPU time (Linux only).  Generate the files outside the
+repository (e.g. the tori of ``bench_scaling.py`` under /tmp).
 
 Usage::
 
@@ -225,6 +225,8 @@ for stage in ("close_surface", "find_shells", "settle_welded", "find_contacts", 
     wrap("inertia_tool.mesh.prepare", stage)
 for stage in ("load_mesh", "prepare_mesh", "_bodies"):
     wrap("inertia_tool.mass.pipeline", stage)
+wrap("inertia_tool.mesh.read", "weld_exact_stream")        # the weld inside load_mesh (issue 25)
+wrap("inertia_tool.mesh.surface", "census_and_shells")     # the census inside close_surface
 from inertia_tool.cli import main
 rss0 = checkpoint()
 stack.append(["analyze", rss0, rss0])

@@ -749,7 +749,7 @@ static PyTypeObject WelderType = {
  * a 10M-face torus).  PartWelder splits the work so that every table fits in a core's L2 cache:
  *
  *   feed     each point is hashed (pw_hash, -0.0 folded onto +0.0); one that the thread's cache of the
- *            4,096 points seen last holds (full key compared) refers to that earlier corner; any other is
+ *            16,384 points seen last holds (full key compared) refers to that earlier corner; any other is
  *            copied with its corner number into one of 2**bits buckets chosen by the hash's top bits (a
  *            radix partition: per thread a histogram of its half of the chunk while staging its misses in
  *            order, then a scatter of the staged misses); the output index keeps each point's bucket or
@@ -784,6 +784,11 @@ static PyTypeObject WelderType = {
  * ------------------------------------------------------------------------------------------------------ */
 
 #define PW_MAX_BITS 12
+/* Entries of each feeding thread's recent-point cache (16 bytes each: 256 kB, about a core's L2).  4,096 (the
+ * Welder's) until issue 25's sixth pass: on the benchmark torus, whose rows of quads reuse the row before's
+ * corners ~3,200 distinct points later, 52 % of the points reached a bucket; at 16,384, 40 % (icosphere
+ * 17.8 -> 17.2 %), and the weld took 20-30 % less CPU time (A/B in one process, docs/performance.md). */
+#define PW_RECENT 16384
 #define PW_TARGET_POINTS ((size_t)1 << 15)   /* points per bucket aimed at: table and keys stay in L2 */
 
 typedef struct { uint32_t k[3]; uint32_t corner; } PwEntry;   /* corner: after finish, its vertex's first
@@ -806,7 +811,7 @@ typedef struct {
     size_t entries_used;               /* entries of the chunks so far */
     size_t released;                   /* bytes of the arena, from its start, given back by the gather */
     size_t partitioned;                /* points copied into the buckets (not found in a recent cache) */
-    Recent32 *recent;                  /* per thread: WELD_RECENT points seen last in the part it feeds */
+    Recent32 *recent;                  /* per thread: PW_RECENT points seen last in the part it feeds */
     PwEntry *stage;                    /* the misses of the chunk being fed, before the scatter */
     size_t stage_cap, stage_bytes;     /* its entries; its mapping's size */
     Py_buffer index;                   /* the caller's int32 output: bucket numbers until output() */
@@ -1079,7 +1084,7 @@ pw_load(const char *p, Py_ssize_t sc, uint32_t *key)
 }
 
 /* The feed's hash of a point: hash32's two multiplies, then one xor-shift and one multiply, whose top bits (the
- * bucket) and bits 40-51 (the recent-point slot) depend on every bit of the key.  Cheaper than hash32's full
+ * bucket) and bits 40-53 (the recent-point slot) depend on every bit of the key.  Cheaper than hash32's full
  * finaliser, which finish keeps for its tables' slots (the low bits); any hash gives the same result (equal
  * points, equal hashes), only the balance of the buckets and the speed depend on it (feed 12.9 -> 11.2 ns per
  * corner of CPU on the 10M-face torus, same hit rate). */
@@ -1115,14 +1120,14 @@ pw_stage_task(void *ctx, int t, int nt)
     Recent32 *recent = f->recent[t];
     PwEntry *stage = f->stage + lo, *staged = stage;
     memset(off, 0, (nb + 1) * sizeof(uint32_t));
-    memset(recent, 0, WELD_RECENT * sizeof(Recent32));
+    memset(recent, 0, PW_RECENT * sizeof(Recent32));
     Py_ssize_t i0 = (Py_ssize_t)lo / f->n1, i1 = (Py_ssize_t)lo % f->n1;
     for (size_t k = lo; k < hi; k++) {
         uint32_t key[3];
         pw_load(f->base + i0 * f->s0 + i1 * f->s1, f->sc, key);
         if (++i1 == f->n1) { i1 = 0; i0++; }
         uint64_t h = pw_hash(key);
-        Recent32 *r = recent + ((h >> 40) & (WELD_RECENT - 1));
+        Recent32 *r = recent + ((h >> 40) & (PW_RECENT - 1));
         if (r->id != 0 && r->k[0] == key[0] && r->k[1] == key[1] && r->k[2] == key[2]) {
             c->bucket[k] = -(int32_t)r->id;                 /* id = corner + 1 */
             continue;
@@ -1428,7 +1433,7 @@ PartWelder_init(PartWelderObject *w, PyObject *args, PyObject *kwds)
     int fits = (size_t)n_points <= (SIZE_MAX - 64) / sizeof(PwEntry);
     w->arena_bytes = fits ? (size_t)n_points * sizeof(PwEntry) + 64 : 0;
     w->entries = fits ? (PwEntry *)pool_take(&w->arena_bytes) : NULL;
-    w->recent = (Recent32 *)malloc((size_t)w->threads * WELD_RECENT * sizeof(Recent32));
+    w->recent = (Recent32 *)malloc((size_t)w->threads * PW_RECENT * sizeof(Recent32));
     int ok = w->nv && w->rank && w->entries && w->recent;
     for (int t = 0; t < w->threads && ok; t++) {
         w->mark[t] = (uint64_t *)calloc(words, sizeof(uint64_t));
@@ -1542,7 +1547,7 @@ PartWelder_feed(PartWelderObject *w, PyObject *points_obj)
     PwFeedTask task = {(const char *)pts.buf, n0, n1, pts.strides[0], pts.ndim == 3 ? pts.strides[1] : 0,
                        pts.strides[pts.ndim - 1], c, w->bits, w->stage, {0}, {NULL}};
     for (int t = 0; t < nt; t++) {
-        task.recent[t] = w->recent + (size_t)t * WELD_RECENT;
+        task.recent[t] = w->recent + (size_t)t * PW_RECENT;
     }
     w->busy = 1;
     Py_BEGIN_ALLOW_THREADS

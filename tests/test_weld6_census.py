@@ -111,8 +111,12 @@ def test_shells_joined_at_a_vertex_keep_first_face_numbering(lib, monkeypatch):
     _check(lib, f.astype(np.int32), n, 2, monkeypatch)
 
 
-def test_a_bad_index_is_named_and_nothing_is_written(lib):
-    f = np.array([[0, 1, 2], [0, 2, 7]], np.int32)
-    out = np.full(2, -7, np.int64)
-    with pytest.raises(ValueError, match="7"):
-        lib.census_shells(f, 3, out, 2, 1)
+@pytest.mark.parametrize("n_vertices", [3, 60])
+def test_a_bad_index_is_named(lib, n_vertices):
+    """An index past the vertices is refused with the index named, whether the offsets live apart (3 vertices,
+    2 faces) or in the labels' second half (60 vertices, 100 faces)."""
+    f = np.tile(np.array([[0, 1, 2]], np.int32), (100 if n_vertices == 60 else 2, 1))
+    f[-1, 2] = n_vertices + 4
+    out = np.full(len(f), -7, np.int64)
+    with pytest.raises(ValueError, match=str(n_vertices + 4)):
+        lib.census_shells(f, n_vertices, out, 2, 1)
