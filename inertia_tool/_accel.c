@@ -5050,8 +5050,8 @@ ct_id(const int32_t *ids, int64_t i, int c)      /* corner c of the face at posi
  * The sort's words are unmapped when the twins are made (ct_drop: held under the stars' lists they raised the
  * check's high point by 6 bytes a face), and the blocks no array of the traversal takes are unmapped before
  * the boxes are written (ct_arena_trim): the check's high point is that of the phases alone, as before (37
- * bytes a face on a 300k torus).  At the end the blocks go to the pool (ct_arena_release: pool_give keeps them,
- * with MADV_FREE, for the next weld or census in the process).  Below CT_SMALL_BYTES a heap block (malloc;
+ * bytes a face on a 300k torus).  At the end the blocks go to the pool (ct_arena_release: pool_give_dropped,
+ * for the next weld or census in the process).  Below CT_SMALL_BYTES a heap block (malloc;
  * a small part's scan made five mmap/munmap pairs, most of its time: 12-face box 52 -> 11 us; malloc, not
  * calloc: nothing reads before it writes).  ct_free must be given the size ct_alloc returned in *bytes. */
 #define CT_SMALL_BYTES ((size_t)1 << 20)
@@ -5075,13 +5075,14 @@ ct_arena_trim(CtArena *ar)
     }
 }
 
-/* At the end of a call: the blocks ar holds go to the pool (pool_give: kept, with MADV_FREE, for the next
- * weld, census or check in the process, when they fit its slots and bound; else unmapped). */
+/* At the end of a call: the blocks ar holds go to the pool for the next weld or census in the process
+ * (pool_give_dropped, section 2b: from POOL_DROP_BYTES up the mapping is kept but its pages dropped, so that
+ * they do not stay resident into the stages after the check; below, kept with its pages, MADV_FREE). */
 static void
 ct_arena_release(CtArena *ar)
 {
     for (int i = 0; i < CT_ARENA_SLOTS; i++) {
-        if (ar->p[i] != NULL) pool_give(ar->p[i], ar->bytes[i]);
+        if (ar->p[i] != NULL) pool_give_dropped(ar->p[i], ar->bytes[i]);
         ar->p[i] = NULL;
         ar->bytes[i] = 0;
     }
