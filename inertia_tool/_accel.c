@@ -4413,10 +4413,23 @@ typedef struct {
     double e[CONTACT_EXP_MAX];
 } Expansion;
 
+/* Two-Sum needs each operation rounded once to double, in the written order.  Where doubles are evaluated in
+ * their own precision (FLT_EVAL_METHOD 0: SSE2 on x86-64, AArch64) and the compiler may not reassociate
+ * (no -ffast-math), plain arithmetic does that; elsewhere (x87's excess precision, fast-math) the sum is
+ * forced through memory (volatile), which costs a store and a load per Two-Sum: on a fan-capped cylinder's
+ * check (every side quad's fourth corner exactly on the plane of its other three) about a third of the
+ * exact stage's time. */
+#include <float.h>
+#if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0 && !defined(__FAST_MATH__)
+#define CT_EXACT_DOUBLE double
+#else
+#define CT_EXACT_DOUBLE volatile double
+#endif
+
 static inline void
 ct_two_sum(double a, double b, double *x, double *y)
 {
-    volatile double s = a + b;          /* volatile: no reassociation or excess precision */
+    CT_EXACT_DOUBLE s = a + b;
     double bv = s - a;
     double av = s - bv;
     *x = s;
@@ -5021,56 +5034,35 @@ ct_id(const int32_t *ids, int64_t i, int c)      /* corner c of the face at posi
 /* The large per-face arrays of contact_scan (issue 25: fresh pages cost the kernel a page fault and a zeroing
  * each, a fifth of the check's CPU time at 1M faces).  Every array of the scan is written before it is read
  * (none relies on zeroed memory: INERTIA_TOOL_CT_POISON fills each block with 0xA5 bytes, for the tests), so
- * one call's blocks come, in this order, from:
+ * a block of CT_SMALL_BYTES or more is, in this order:
  *   1. a block the same call gave back (CtArena: the smallest that fits; the scan's phases never coexist, so
- *      a later phase's boxes and corner indices reuse the pages of an earlier phase's sort words and twins);
- *   2. a mapping the weld or the census kept for the next call (pool_take's slots, section 2b: the smallest
- *      that fits), only while the scan has mapped nothing fresh;
- *   3. a fresh mapping (map_fresh: 2 MB pages where the kernel offers them), after the arena's blocks that did
- *      not fit and the pool's mappings are unmapped (pool_drain), so kept pages never coexist with fresh ones
- *      and the check's high point is never above what unmapping everything first would give.
- The arrays of one size class are asked for in one size (the twins', boxes' and corner indices' 12 bytes a
- * face, the positions' 4, all padded to whole leaves), so that they fit each other's blocks; sizes are not
- * rounded up to 2 MB, which would make each array's last huge page resident whole (+23 bytes a face at 3e5
- * faces).  Below CT_SMALL_BYTES a heap block (malloc; a small part's scan made five mmap/munmap pairs, most of
- * its time: 12-face box 52 -> 11 us; malloc, not calloc: nothing reads before it writes).  ct_arena_trim
- * unmaps the blocks given back (before the traversal, whose arrays are all taken by then), ct_arena_release
- * everything at the end.  ct_free must be given the size ct_alloc returned in *bytes. */
+ *      the boxes take the twins' pages, the hierarchy's leaf boxes the positions', the corner indices the
+ *      stars' lists');
+ *   2. else a fresh mapping (arena_alloc: the weld's and census's kept mappings unmapped first, then
+ *      map_fresh, on 2 MB pages where the kernel offers them); the blocks held meanwhile are the twins' (for
+ *      the boxes) under the stars' lists, a few bytes a face, below the traversal's high point.  (Taking the weld's kept mappings instead was tried: a reused block is resident from the
+ *      start, while a fresh one only once written, and the analysis's peak rose by 18 MB at 5.24M faces, 32 MB
+ *      at 1e7.)
+ * The arrays of one size class are asked for in one size (the twins', boxes' and corner indices' 12 bytes a
+ * face, the order's and positions' 4, all padded to whole leaves), so that they fit each other's blocks; sizes
+ * are not rounded up to 2 MB, which would make each array's last huge page resident whole (+23 bytes a face at
+ * 3e5 faces).  A block reused for a smaller array has its pages past the request given back (MADV_DONTNEED).
+ * The sort's words are unmapped when the twins are made (ct_drop: held under the stars' lists they raised the
+ * check's high point by 6 bytes a face), and the blocks no array of the traversal takes are unmapped before
+ * the boxes are written (ct_arena_trim): the check's high point is that of the phases alone, as before (37
+ * bytes a face on a 300k torus).  At the end the blocks go to the pool (ct_arena_release: pool_give_dropped,
+ * for the next weld or census in the process).  Below CT_SMALL_BYTES a heap block (malloc;
+ * a small part's scan made five mmap/munmap pairs, most of its time: 12-face box 52 -> 11 us; malloc, not
+ * calloc: nothing reads before it writes).  ct_free must be given the size ct_alloc returned in *bytes. */
 #define CT_SMALL_BYTES ((size_t)1 << 20)
 #define CT_ARENA_SLOTS 8
 
 typedef struct {
     void *p[CT_ARENA_SLOTS];            /* blocks given back by this call, NULL for an empty slot */
     size_t bytes[CT_ARENA_SLOTS];
-    int fresh;                          /* a fresh mapping was made: the pool is drained, no longer taken from */
     int poison;                         /* fill every block with 0xA5 bytes (INERTIA_TOOL_CT_POISON, tests) */
-    size_t mapped, reused, pooled;      /* bytes mapped fresh, taken from the arena, taken from the pool */
+    size_t mapped, reused;              /* bytes mapped fresh, taken from the arena */
 } CtArena;
-
-/* A mapping of at least want bytes from the weld's and census's kept ones (the smallest that fits; its size in
- * *bytes), or NULL. */
-static void *
-ct_pool_take(size_t want, size_t *bytes)
-{
-    int best = -1;
-    POOL_LOCK();
-    for (int i = 0; i < POOL_SLOTS; i++) {
-        if (pool_slot[i].p != NULL && pool_slot[i].bytes >= want
-            && (best < 0 || pool_slot[i].bytes < pool_slot[best].bytes)) {
-            best = i;
-        }
-    }
-    void *p = NULL;
-    if (best >= 0) {
-        p = pool_slot[best].p;
-        *bytes = pool_slot[best].bytes;
-        pool_kept -= pool_slot[best].bytes;
-        pool_slot[best].p = NULL;
-        pool_slot[best].bytes = pool_slot[best].used = 0;
-    }
-    POOL_UNLOCK();
-    return p;
-}
 
 /* Unmaps the blocks ar holds (given back by this call and not taken again). */
 static void
@@ -5083,13 +5075,14 @@ ct_arena_trim(CtArena *ar)
     }
 }
 
-/* At the end of a call: the blocks ar holds go to the pool (pool_give: kept, with MADV_FREE, for the next
- * weld, census or check in the process, when they fit its slots and bound; else unmapped). */
+/* At the end of a call: the blocks ar holds go to the pool for the next weld or census in the process
+ * (pool_give_dropped, section 2b: from POOL_DROP_BYTES up the mapping is kept but its pages dropped, so that
+ * they do not stay resident into the stages after the check; below, kept with its pages, MADV_FREE). */
 static void
 ct_arena_release(CtArena *ar)
 {
     for (int i = 0; i < CT_ARENA_SLOTS; i++) {
-        if (ar->p[i] != NULL) pool_give(ar->p[i], ar->bytes[i]);
+        if (ar->p[i] != NULL) pool_give_dropped(ar->p[i], ar->bytes[i]);
         ar->p[i] = NULL;
         ar->bytes[i] = 0;
     }
@@ -5116,12 +5109,7 @@ ct_alloc(CtArena *ar, size_t *bytes)
             ar->bytes[best] = 0;
             ar->reused += *bytes;
         }
-        else if (!ar->fresh && (p = ct_pool_take(want, bytes)) != NULL) {
-            ar->pooled += *bytes;
-        }
         else {
-            ct_arena_trim(ar);
-            ar->fresh = 1;
             p = arena_alloc(want);                  /* pool_drain, then map_fresh */
             *bytes = want;
             if (p != NULL) ar->mapped += want;
@@ -5137,6 +5125,14 @@ ct_alloc(CtArena *ar, size_t *bytes)
 #endif
     if (p != NULL && ar->poison) memset(p, 0xA5, want);
     return p;
+}
+
+/* A block given back for good (not to the arena: no later phase takes it). */
+static void
+ct_drop(void *p, size_t bytes)
+{
+    if (bytes < CT_SMALL_BYTES) free(p);
+    else arena_free(p, bytes);
 }
 
 static void
@@ -7439,7 +7435,9 @@ accel_contact_scan(PyObject *self, PyObject *args)
             if (ct_twins(F, fsize, n, m, off, vfaces, total, pos, twin, nt) < 0) {
                 oom = 1;
             }
-            ct_free(&ar, code, code_bytes);
+            /* unmapped, not kept for a later phase: held under the stars' lists, the sort words' 16 bytes a face
+             * raised the check's high point by 6 (the twins' block, kept for the boxes, is enough to hold) */
+            ct_drop(code, code_bytes);
             code = NULL;
             code_bytes = 0;
             clk[9] = profile ? ct_clock() : 0.0;
@@ -7503,6 +7501,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
             if (box == NULL || lbox == NULL || ids == NULL || flags == NULL || (cert != NULL && stars == NULL)) {
                 oom = 1;
             }
+            ct_arena_trim(&ar);                /* the blocks no array of the traversal took: unmapped before the
+                                                  boxes are written (the positions' would sit under them) */
         }
         if (!oom && !failed && m >= 2) {
             pr.box = box;
@@ -7598,8 +7598,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
                         clk[5] - clk[3], clk[6] - clk[5]);
             }
             fprintf(stderr, "candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld; "
-                    "MB mapped %.1f reused %.1f from the pool %.1f\n", sc.candidates, sc.tested, sc.node_pairs,
-                    sc.leaf_pairs, sc.loads, ar.mapped / 1e6, ar.reused / 1e6, ar.pooled / 1e6);
+                    "MB mapped %.1f reused %.1f\n", sc.candidates, sc.tested, sc.node_pairs, sc.leaf_pairs,
+                    sc.loads, ar.mapped / 1e6, ar.reused / 1e6);
         }
         if (oom) {
             PyErr_NoMemory();

@@ -1,6 +1,6 @@
-"""The face-pair check's memory reuse (issue 25): the C scan's blocks come from earlier phases of the same call,
-from the weld's and census's kept mappings, and go to the pool for the next call; none of its arrays may be
-read before it is written.
+"""The face-pair check's memory reuse (issue 25): the C scan's later phases take the blocks of its earlier ones
+(the boxes the twins', the corner indices the stars' lists'), and its blocks go to the pool for the next weld or
+census; none of its arrays may be read before it is written.
 
 ``INERTIA_TOOL_CT_POISON=1`` fills every block the scan takes with 0xA5 bytes: a read before a write would then
 change a pair, a count or a class.  Every field of ``surface_contacts`` must be the same with and without it,
@@ -71,19 +71,19 @@ def test_poisoned_blocks_give_the_same_answer_on_large_arrays(monkeypatch):
 
 
 @needs_c
-def test_pool_mappings_of_another_kernel_are_reused_with_the_same_answer():
-    """The check takes the weld's and census's kept mappings (dirty, of another size and content) when they
-    fit: a census run just before leaves its scratch in the pool; the answer is that of a cold call."""
+def test_blocks_given_to_the_pool_and_reused_dirty_give_the_same_answer():
+    """At the end of a call the check's blocks go to the pool (for the next weld or census); a census then takes
+    them dirty, and the next check maps its own again: the answers of a cold call, a warm one and one after the
+    census are the same."""
     from inertia_tool.mesh.checks import census_and_shells
 
     lib = _native.accel()
     v, f = _torus(400, 200, seed=3)                     # 160k faces: blocks above the pool's 2 MB floor
     lib.release_buffers()
     cold = _fields(surface_contacts(v, f))
-    census_and_shells(f, len(v))                         # its scratch kept for the next call
-    warm = _fields(surface_contacts(v, f))
-    assert cold == warm
-    assert lib.kept_buffers() > 0                        # the check's blocks given to the pool for next time
+    assert lib.kept_buffers() > 0                        # the check's blocks kept for the next call
+    census_and_shells(f, len(v))
+    assert _fields(surface_contacts(v, f)) == cold
     lib.release_buffers()
     assert lib.kept_buffers() == 0
 
