@@ -108,12 +108,6 @@ _HASH_CHUNK = 1 << 20
 #: loop; a file still growing beyond it is refused.
 _MAX_HASH_CHUNKS = 1 << 20
 
-#: A batch in one process (``jobs=1``) analyses its files in runs of at most this many files or this many seconds
-#: under one warnings context (:class:`_CaughtWarnings`), then writes their rows: the rows of a file reach the
-#: results file and the progress bar at most this long after it is done.
-_RUN_FILES = 64
-_RUN_SECONDS = 0.05
-
 #: Largest file the batch reads into memory once, to hash it and to parse it from the same bytes (a binary STL of
 #: 330,000 triangles); a larger one is hashed and then read by the streaming reader, as it never holds the whole
 #: file.
@@ -765,23 +759,13 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
             progress(skipped + ok + failed, total, ok, failed)
 
     if executor is None and client is None and jobs == 1:
-        # in runs of files under one warnings context (not one per file), each run's rows handed over after it,
-        # outside the context (what the writer and the progress bar warn is shown, not recorded)
-        worker = _worker_name()
-        pending = iter(todo)
-        for _ in range(len(todo) + 1):
-            rows = []
+        # one warnings context per file here (each row is written as soon as its file is done, outside it: what
+        # the writer or the progress bar warns is shown, not recorded); a chunk on a worker shares one
+        context = _chunk_context(options, [], key, _worker_name())
+        for path, digest in todo:
             with _CaughtWarnings() as caught:
-                context = _chunk_context(options, caught, key, worker)
-                began = time.perf_counter()
-                for path, digest in pending:
-                    rows.append(_analyze(path, digest, context))
-                    if len(rows) >= _RUN_FILES or time.perf_counter() - began >= _RUN_SECONDS:
-                        break
-            for row in rows:
-                record(row)
-            if not rows:
-                break
+                row = _analyze(path, digest, context._replace(caught=caught))
+            record(row)
     else:
         tasks: PoolTasks | DaskTasks
         if client is not None:
