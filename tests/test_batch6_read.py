@@ -135,3 +135,20 @@ def test_short_reads_and_a_size_that_changed_give_the_bytes_on_disk(tmp_path, mo
         assert data == content
     big, known = batch_mod._read_once(str(path), limit=-1, known="f" * 64)     # above the limit: not read
     assert (big, known) == (None, "f" * 64)
+
+
+def test_a_file_system_answering_eagain_is_read_blocking(part, monkeypatch):
+    """``O_NONBLOCK`` (left set: regular files ignore it) on a file system that answers ``EAGAIN`` anyway: the flag
+    is cleared and the read made again, not an unreadable-file row."""
+    real_read = os.read
+    refused: list[int] = []
+
+    def eagain_once(fd, n):
+        if not refused and os.get_blocking(fd) is False:
+            refused.append(fd)
+            raise BlockingIOError(11, "Resource temporarily unavailable")
+        return real_read(fd, n)
+
+    monkeypatch.setattr(os, "read", eagain_once)
+    data, digest = batch_mod._read_once(part)
+    assert refused and digest == _sha(part) and len(data) == os.path.getsize(part)

@@ -311,7 +311,7 @@ def _read_once(path: str, limit: int | None = None, known: str | None = None) ->
         else:
             h = hashlib.sha256()
         for _ in range(_MAX_HASH_CHUNKS):          # to the end of the file (a file growing without end: stopped)
-            chunk = os.read(fd, _HASH_CHUNK)
+            chunk = _read(fd, _HASH_CHUNK)
             if not chunk:
                 return None, h.hexdigest()
             h.update(chunk)
@@ -321,15 +321,26 @@ def _read_once(path: str, limit: int | None = None, known: str | None = None) ->
                         "(is something writing to it?)")
 
 
+def _read(fd: int, n: int) -> bytes:
+    """``os.read(fd, n)`` on a descriptor opened with ``O_NONBLOCK`` (``open_regular_fd``): a regular file's reads
+    ignore the flag, but should a file system answer ``EAGAIN`` the flag is cleared and the read made again
+    (blocking), rather than the file reported unreadable."""
+    try:
+        return os.read(fd, n)
+    except BlockingIOError:
+        os.set_blocking(fd, True)
+        return os.read(fd, n)
+
+
 def _read_upto(fd: int, size: int) -> bytes:
     """Up to ``size + 1`` bytes of the descriptor from its position: reads until ``size`` bytes (a file of the size
     ``fstat`` gave is then whole: one ``read``), one more (it grew) or the end (it shrank)."""
-    first = os.read(fd, size + 1)       # not a read of `limit`: that would allocate `limit` bytes first
+    first = _read(fd, size + 1)         # not a read of `limit`: that would allocate `limit` bytes first
     if len(first) >= size or not first:
         return first
     parts, got = [first], len(first)
     for _ in range(size):                       # each pass reads at least one byte, or stops
-        chunk = os.read(fd, size + 1 - got)
+        chunk = _read(fd, size + 1 - got)
         if not chunk:
             break
         parts.append(chunk)
