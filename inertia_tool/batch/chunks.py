@@ -49,8 +49,8 @@ POOL_CHUNK_SECONDS = 0.2
 #: Seconds of work aimed at per chunk on Dask (the scheduler and its round trip cost a few ms a task).
 DASK_CHUNK_SECONDS = 0.5
 
-#: Least work of a chunk near the end of a batch on a process pool, s (a tenth of the target; a task's round
-#: trip is ~0.2-0.6 ms).
+#: Least work of a chunk near the end of a batch on a process pool, s (a task's round trip is ~0.2-0.6 ms; the
+#: last chunks spread over every worker, down to this).
 POOL_TAIL_SECONDS = 0.005
 
 #: Least work of a chunk near the end of a batch on Dask, s: above the ~8 ms from ``Client.map`` to a task

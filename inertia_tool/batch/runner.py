@@ -108,12 +108,6 @@ _HASH_CHUNK = 1 << 20
 #: loop; a file still growing beyond it is refused.
 _MAX_HASH_CHUNKS = 1 << 20
 
-#: A batch in one process (``jobs=1``) analyses its files in runs of at most this many files or this many seconds
-#: under one warnings context (:class:`_CaughtWarnings`), then writes their rows: the rows of a file reach the
-#: results file and the progress bar at most this long after it is done.
-_RUN_FILES = 64
-_RUN_SECONDS = 0.05
-
 #: Largest file the batch reads into memory once, to hash it and to parse it from the same bytes (a binary STL of
 #: 330,000 triangles); a larger one is hashed and then read by the streaming reader, as it never holds the whole
 #: file.
@@ -317,7 +311,7 @@ def _read_once(path: str, limit: int | None = None, known: str | None = None) ->
         else:
             h = hashlib.sha256()
         for _ in range(_MAX_HASH_CHUNKS):          # to the end of the file (a file growing without end: stopped)
-            chunk = os.read(fd, _HASH_CHUNK)
+            chunk = _read(fd, _HASH_CHUNK)
             if not chunk:
                 return None, h.hexdigest()
             h.update(chunk)
@@ -327,15 +321,26 @@ def _read_once(path: str, limit: int | None = None, known: str | None = None) ->
                         "(is something writing to it?)")
 
 
+def _read(fd: int, n: int) -> bytes:
+    """``os.read(fd, n)`` on a descriptor opened with ``O_NONBLOCK`` (``open_regular_fd``): a regular file's reads
+    ignore the flag, but should a file system answer ``EAGAIN`` the flag is cleared and the read made again
+    (blocking), rather than the file reported unreadable."""
+    try:
+        return os.read(fd, n)
+    except BlockingIOError:
+        os.set_blocking(fd, True)
+        return os.read(fd, n)
+
+
 def _read_upto(fd: int, size: int) -> bytes:
     """Up to ``size + 1`` bytes of the descriptor from its position: reads until ``size`` bytes (a file of the size
     ``fstat`` gave is then whole: one ``read``), one more (it grew) or the end (it shrank)."""
-    first = os.read(fd, size + 1)       # not a read of `limit`: that would allocate `limit` bytes first
+    first = _read(fd, size + 1)         # not a read of `limit`: that would allocate `limit` bytes first
     if len(first) >= size or not first:
         return first
     parts, got = [first], len(first)
     for _ in range(size):                       # each pass reads at least one byte, or stops
-        chunk = os.read(fd, size + 1 - got)
+        chunk = _read(fd, size + 1 - got)
         if not chunk:
             break
         parts.append(chunk)
@@ -765,23 +770,13 @@ def run_batch(files: Sequence[str], options: BatchOptions, write_row: Callable[[
             progress(skipped + ok + failed, total, ok, failed)
 
     if executor is None and client is None and jobs == 1:
-        # in runs of files under one warnings context (not one per file), each run's rows handed over after it,
-        # outside the context (what the writer and the progress bar warn is shown, not recorded)
-        worker = _worker_name()
-        pending = iter(todo)
-        for _ in range(len(todo) + 1):
-            rows = []
+        # one warnings context per file here (each row is written as soon as its file is done, outside it: what
+        # the writer or the progress bar warns is shown, not recorded); a chunk on a worker shares one
+        context = _chunk_context(options, [], key, _worker_name())
+        for path, digest in todo:
             with _CaughtWarnings() as caught:
-                context = _chunk_context(options, caught, key, worker)
-                began = time.perf_counter()
-                for path, digest in pending:
-                    rows.append(_analyze(path, digest, context))
-                    if len(rows) >= _RUN_FILES or time.perf_counter() - began >= _RUN_SECONDS:
-                        break
-            for row in rows:
-                record(row)
-            if not rows:
-                break
+                row = _analyze(path, digest, context._replace(caught=caught))
+            record(row)
     else:
         tasks: PoolTasks | DaskTasks
         if client is not None:
