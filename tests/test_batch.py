@@ -399,7 +399,6 @@ _GATED_BATCH = """
 import os, sys, time
 import inertia_tool.batch.runner as b
 real = b._analyze
-b._RUN_FILES = 1                        # each row written as its file ends (one process writes runs of files)
 gate = sys.argv[1]
 calls = []
 def gated(*args):
