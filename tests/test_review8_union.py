@@ -61,3 +61,34 @@ def test_turned_touching_boxes_are_never_a_silent_wrong_answer():
     verdict = S.judge(case)
     assert verdict.label != "crashed", verdict.wrong
     assert not S.silent(verdict), f"silent wrong answer ({verdict.label}): {verdict.wrong}"
+
+
+def _far_octahedron_listed_twice_rounded_apart():
+    """``test_copy_rounded_apart_is_counted_once_exactly`` (far) at hypothesis seed 52 ×20, example 79853: the
+    repository's octahedron turned and moved ~2,000 m out, listed twice, the copy's coordinates rounded apart by one
+    ulp ((v + c) − c), its faces shuffled."""
+    rng = np.random.default_rng(79853)
+    name, piece = S.random_piece(rng)
+    v, f = S.moved(piece, S.random_rotation(rng), rng.normal(size=3) * 1000.0)
+    c = rng.normal(size=3) * float(np.abs(v).max()) * 0.37
+    copy = (v + c) - c
+    return name, v, f, np.vstack([v, copy]), np.concatenate([f, (f + len(v))[rng.permutation(len(f))]])
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "mesh/policy.near_copies (R0 up to rounding) declines a copy one ulp off (2.3e-13 m, 64 ulp allowed) of a part "
+    "~2,000 m from the origin: the pair goes on to R5 and is united (right to 8e-14, but certified united with "
+    "'0.0213449 m³ of shared volume counted once' instead of exact with R0's note)"))
+def test_far_copy_one_ulp_apart_is_counted_once():
+    """The copy is the part up to one ulp: counted once, exact (the union's value is right either way: not a silent
+    wrong answer, a proof not made and a warning that names shared volume that is the part itself)."""
+    from inertia_tool import mass_properties
+    import warnings
+    name, v, f, verts, faces = _far_octahedron_listed_twice_rounded_apart()
+    assert name == "part(octahedron.stl)"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = mass_properties((verts, faces), density=1.0)
+    exact = S.truth_from_pieces([(1, (v, f))])
+    assert abs(p.mass - exact.volume) <= 1e-12 * exact.volume
+    assert p.mesh.certificate.kind == "exact", p.mesh.notes
