@@ -361,13 +361,22 @@ def _thin_far_tetrahedron(rng):
 def test_exact_integer_moments_match_rationals(seed):
     """exact_volume_moments (integers over a power of two) against the rational integral of the harness, on
     thin tetrahedra far from the origin and on small pieces: equal to one rounding."""
+    from unittest import mock
+
     from inertia_tool.integrals import exact_volume_moments
     rng = np.random.default_rng(seed)
     v, f = _thin_far_tetrahedron(rng) if seed % 2 else S.random_piece(rng, small=True)[1]
     got = exact_volume_moments(v, f)
-    want = S.truth_from_pieces([(1, (v, f))])
+    # the truth in rationals whatever the size (a part of more than FRACTION_MAX_FACES faces, the washer or the
+    # spinning top, would otherwise be integrated in float64, ~1e-17 m off a centroid coordinate that is 0)
+    with mock.patch.object(S, "FRACTION_MAX_FACES", len(f)):
+        want = S.truth_from_pieces([(1, (v, f))])
+    assert want.source == "fraction"
     assert abs(got.volume - want.volume) <= 2 ** -52 * abs(want.volume)
-    assert np.allclose(got.centroid, want.centroid, rtol=2 ** -51, atol=0)
+    # each side rounded once from the same rational: one ulp of the coordinate, absolute (a coordinate that is
+    # 0 exactly has no relative error to speak of), within 2⁻⁵² of the largest |coordinate|
+    scale = float(np.abs(v).max())
+    assert np.allclose(got.centroid, want.centroid, rtol=2 ** -52, atol=2 ** -52 * scale)
     inertia = np.trace(got.second_moment) * np.eye(3) - got.second_moment
     assert np.linalg.norm(inertia - want.inertia) <= 1e-15 * np.linalg.norm(want.inertia)
 
@@ -390,6 +399,10 @@ def test_roundoff_bound_holds(seed):
     for k in range(3):
         truth = exact_volume_moments(v, f[labels == k])
         assert abs(shells[k].volume - truth.volume) <= bound.volume[k] + 2 ** -53 * abs(truth.volume)
+        if truth.volume == 0:
+            # the thin tetrahedron moved far can round flat: its exact volume is 0, its centroid undefined (NaN)
+            # and its central second moment not defined either; the volume bound above is all there is to check
+            continue
         if np.isfinite(bound.centroid[k]):
             assert np.linalg.norm(shells[k].centroid - truth.centroid) <= bound.centroid[k] * (1 + 1e-6)
             assert np.linalg.norm(shells[k].second_moment - truth.second_moment) <= \
@@ -413,8 +426,12 @@ def test_far_thin_solid_beside_a_part_is_exact(seed):
         assert isinstance(exc, InvalidMeshError)
         return
     if p.mesh.certificate.kind in ("exact", "united"):
+        # "exact" promises the polyhedron's moments within ROUNDOFF_RTOL (R7, by the derived float64 bound), not
+        # to 1e-12: at hypothesis seed 72 example 139 (an icosphere and a tetrahedron 6e-16 m³ far away) the
+        # inertia is 1.06e-12 off, a hundred times inside the promise
+        from inertia_tool.tolerances import ROUNDOFF_RTOL
         dvol, dcom, din = S.compare(p, case.truth)
-        assert dvol <= 1e-12 and din <= 1e-12, (dvol, din)
+        assert dvol <= ROUNDOFF_RTOL and din <= ROUNDOFF_RTOL, (dvol, din)
 
 
 # ------------------------------------ bodies crossing exactly along shared edges (issue 21 item 2: Go1's mechanism)
@@ -579,7 +596,16 @@ def test_copy_rounded_apart_is_counted_once_exactly(seed, far):
     union = S.truth_from_manifold([(v, f), (copy, f)])
     dvol, dcom, din = S.compare(p, union)
     assert p.mesh.certificate.kind == "exact", (name, p.mesh.notes)
-    assert dvol <= 1e-12 and din <= 1e-12
+    # the tool promises the copy adds at most ROUNDOFF_RTOL (R0 up to rounding, R7); the manifold3d truth is a
+    # float64 union integrated in float64 about its vertex mean, each coordinate carrying its rounding (2⁻⁵³ of
+    # the largest |coordinate|, up to ~3,000 m when far) relative to the part's size: 64 such units cover it
+    # (at hypothesis seed 52 a part 1,000 m out was 1.4e-12 off manifold3d in inertia)
+    from inertia_tool.tolerances import ROUNDOFF_RTOL
+    diag = float(np.linalg.norm(v.max(0) - v.min(0)))
+    float_error = 64 * 2.0 ** -53 * float(np.abs(v).max()) / diag
+    assert dvol <= ROUNDOFF_RTOL + float_error and din <= ROUNDOFF_RTOL + float_error, (dvol, din, float_error)
+    exact = S.truth_from_pieces([(1, (v, f))])
+    assert S.compare(p, exact)[0] <= ROUNDOFF_RTOL and S.compare(p, exact)[2] <= ROUNDOFF_RTOL
     assert any("repeating another corner for corner within" in w for w in said), said
 
 
