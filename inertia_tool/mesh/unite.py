@@ -171,6 +171,13 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
                              f"{abs(summed - united.volume):.3g} m³ (manifold3d's tolerance, or bodies passing "
                              "through each other at shared edges): the result is the union, not verified")
             checks = ["edge-balanced", "consistently-oriented", "boolean-union"]
+            if kind == "united" and not cavities:
+                lost = _union_lost_volume(shells, united.volume)
+                if lost is not None and lost > TOUCH_VOLUME_RTOL * abs(summed):
+                    kind = "unverified"
+                    notes.append(f"the boolean union is {lost:.3g} m³ smaller than the bodies' volumes less the "
+                                 "volume each pair of them shares (manifold3d's own intersections; a union is "
+                                 "never smaller): the boolean lost volume to rounding, not verified")
             after = surface_contacts(united.vertices, united.faces)   # manifold3d's output can cross itself by rounding
             if len(after.crossing) or not after.complete:
                 kind = "unverified"
@@ -180,6 +187,42 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
                 raise InvalidMeshError(NOTHING_LEFT.format(source=source))
             shells, owner, cavities = _oriented_anew(united.vertices, united.faces, diag, source)
     return United(shells, owner, cavities, overlaps, method, kind, checks, tuple(notes), None)
+
+
+#: Most pairs of shells whose common volume :func:`_union_lost_volume` computes (one boolean each); beyond it the
+#: witness is not run (the union keeps the certificate the face-pair check and the sum give it).
+UNION_WITNESS_PAIRS = 64
+
+
+def _union_lost_volume(shells: Shells, union_volume: float) -> float | None:
+    """How far the boolean's union falls below Bonferroni's lower bound, m³ (positive: volume lost), or None where
+    the witness is not run.
+
+    For bodies ``A_i`` (every shell wound outward, no cavity), ``vol ∪A_i ≥ Σ vol A_i − Σ_{i<j} vol(A_i ∩ A_j)``
+    (inclusion-exclusion cut after the pairs), with equality for two bodies.  The pairwise intersections are
+    manifold3d's own, taken on the shells as given; pairs whose bounding boxes are apart share nothing.  Review 8
+    found two unit boxes touching face to face, turned at random, whose union came back 1/60 m³ short while their
+    intersection was empty: certified united, 0.83 % low.
+    """
+    from .union import common_volumes
+    volumes = np.array([m.volume for m in shells.moments])
+    if not len(volumes) or not np.all(volumes > 0):
+        return None
+    v, f, labels = shells.vertices, shells.faces, shells.labels
+    corners = v[f]                                                  # (m, 3, 3)
+    lo = np.full((len(volumes), 3), np.inf)
+    hi = np.full((len(volumes), 3), -np.inf)
+    np.minimum.at(lo, labels, corners.min(axis=1))
+    np.maximum.at(hi, labels, corners.max(axis=1))
+    i, j = np.triu_indices(len(volumes), k=1)
+    apart = np.any((hi[i] < lo[j]) | (hi[j] < lo[i]), axis=1)
+    pairs = np.stack([i[~apart], j[~apart]], axis=1)
+    if len(pairs) > UNION_WITNESS_PAIRS:
+        return None
+    common = common_volumes(v, f, labels, volumes, pairs) if len(pairs) else np.zeros(0)
+    if not np.all(np.isfinite(common)):
+        return None
+    return float(volumes.sum() - common.sum() - union_volume)
 
 
 #: The refusal when the bodies, as wound and nested, leave no material (a closed surface with its inverted copy
