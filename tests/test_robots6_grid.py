@@ -233,3 +233,17 @@ def test_the_open_estimate_is_not_refined_when_the_added_doubt_refuses_it(monkey
     built.clear()
     est.open_surface_estimate(v, f, resolution=32, target=1e-3, max_resolution=40, added_doubt=0.999 * added)
     assert built == [32, 40]                            # not proven: refined as before
+
+
+def test_summed_winding_numbers_are_within_their_round_off_of_the_exact_integers_and_the_treecode():
+    """The regions' one point each takes the exact sum over every face when that is cheap; on a closed sphere far
+    from the origin its value is the integer within its stated round-off bound, and within the treecode's bound
+    of the treecode's value."""
+    from inertia_tool.mesh.winding import winding_numbers_bounded, winding_numbers_summed
+    v, f = uv_sphere(0.5, center=(300.0, -20.0, 7.0), segments=24, rings=12)
+    points = np.array([[300.0, -20.0, 7.0], [300.2, -20.1, 7.1], [301.0, -20.0, 7.0], [299.4, -20.0, 7.0]])
+    w, err = winding_numbers_summed(points, v, f)
+    assert np.all(err > 0) and np.all(err < 1e-9)
+    assert np.all(np.abs(w - [1, 1, 0, 0]) <= err)
+    tree, tree_err = winding_numbers_bounded(points, v, f)
+    assert np.all(np.abs(w - tree) <= tree_err + err)
