@@ -8,7 +8,7 @@ The totals (links computed by method, links refused, CPU seconds, load average) 
 Markdown table (``--markdown``: one row per model folder and mesh file, the links refused counted over every
 file that uses them, so a model's links count once per scene that includes it).
 
-    python benchmarks/bench_robot_refusals.py ROOT [--markdown] [--only FOLDER ...] [--slowest N]
+    python benchmarks/bench_robot_refusals.py ROOT [--markdown] [--only FOLDER ...] [--slowest N] [--rows FILE]
 """
 
 from __future__ import annotations
@@ -37,6 +37,8 @@ _BOUND = re.compile(r"mass ±([0-9.]+) %")
 
 def cause_of(problem: str) -> str:
     """A cause bucket for a refused link's ``problem``."""
+    if "a shell wound outward lies inside another" in problem:
+        return "R4: a shell wound outward inside another (body or cavity undecided) widens the bound"
     if "encloses a volume of" in problem:
         return "self-crossing: the winding estimate encloses no volume"
     if "cannot be bounded usefully" in problem and "winding-number" in problem:
@@ -126,6 +128,7 @@ def main(argv=None) -> int:
     parser.add_argument("--only", nargs="*", default=[], help="model folders to run (default: all)")
     parser.add_argument("--slowest", type=int, default=0, metavar="N",
                         help="print the N meshes whose integration took the most CPU time")
+    parser.add_argument("--rows", metavar="FILE", help="also write every refused link (with its problem) as JSON")
     args = parser.parse_args(argv)
     if args.slowest:
         _timed_mesh_properties()
@@ -140,6 +143,11 @@ def main(argv=None) -> int:
         print(f"  meshes integrated {len(MESH_TIMES)}, {total:.1f} s CPU; the slowest:")
         for seconds, path in sorted(MESH_TIMES, reverse=True)[:args.slowest]:
             print(f"    {seconds:7.2f} s  {os.path.relpath(path, args.root)}")
+    if args.rows:
+        import json
+        with open(args.rows, "w") as sink:
+            keys = ("folder", "file", "link", "mesh", "cause", "mass_bound", "problem")
+            json.dump([dict(zip(keys, r)) for r in rows], sink, indent=1)
     by_model = collections.Counter(r[0] for r in rows)
     print("  by model: " + ", ".join(f"{k} {v}" for k, v in by_model.most_common()))
     if args.markdown:

@@ -169,3 +169,81 @@ def test_codes_from_regions_equal_the_codes_from_every_cell(name, monkeypatch):
     assert fast.volume > 0
     if name == "nested":                    # the inner box counts once: {w > 1/2} is the outer box
         assert fast.volume == pytest.approx(0.3, rel=0.2)
+
+
+# -- a refusal the first grid already proves (issue 23: ALOHA's gripper_prop refined for 10 s, then refused) ----
+
+def _open_crossing(seed):
+    """Two crossing spheres, one with a band of faces missing (open and self-crossing: the open estimate)."""
+    rng = np.random.default_rng(seed)
+    a = uv_sphere(0.5, segments=12, rings=6)
+    b = uv_sphere(0.35, center=tuple(rng.uniform(-0.3, 0.3, 3)), segments=10, rings=5)
+    fa = a[1][rng.random(len(a[1])) > 0.08]                   # scattered holes
+    return np.vstack([a[0], b[0]]), np.vstack([fa, b[1] + len(a[0])])
+
+
+@pytest.mark.parametrize("kind, seed", [("closed", 0), ("closed", 1), ("closed", 2), ("open", 0), ("open", 3)])
+def test_a_finer_grid_never_escapes_a_refusal_the_coarse_grid_proves(kind, seed):
+    """``refusal_proven``'s claim: once the added doubt exceeds half the coarse grid's ``V + δ`` (its cap on the
+    solid), every finer grid's bound with that doubt is past ±50 %: ``V' − δ' ≤ |S| ≤ V + δ`` (closed surfaces
+    without assumption, open ones under the grid's own)."""
+    from inertia_tool.mesh.winding import fast_available
+    if not fast_available():
+        pytest.skip("libigl grids")
+    rng = np.random.default_rng(seed)
+    if kind == "closed":
+        a = box((1.0, 0.6, 0.5))
+        b = box(tuple(rng.uniform(0.3, 1.2, 3)), center=tuple(rng.uniform(-0.3, 0.3, 3)))
+        v, f = np.vstack([a[0], b[0]]), np.vstack([a[1], b[1] + len(a[0])])
+    else:
+        v, f = _open_crossing(seed)
+    coarse = est.winding_estimate(v, f, resolution=12)
+    cap = coarse.volume + coarse.uncertainty.volume_in_doubt
+    added = 0.5 * cap * (1 + 1e-9)
+    assert est.refusal_proven(coarse, added) == (coarse.uncertainty.mass <= 0.5)
+    assert not est.refusal_proven(coarse, 0.5 * cap * (1 - 1e-9))
+    for n in (16, 28):
+        fine = est.winding_estimate(v, f, resolution=n)
+        assert (added + fine.uncertainty.volume_in_doubt) / fine.volume > 0.5, n
+
+
+def test_the_open_estimate_is_not_refined_when_the_added_doubt_refuses_it(monkeypatch):
+    from inertia_tool.mesh.winding import fast_available
+    if not fast_available():
+        pytest.skip("libigl grids")
+    v, f = _open_crossing(4)
+    built = []
+    real = est._winding_grid
+
+    def count(*args, **kwargs):
+        built.append(kwargs["resolution"])
+        return real(*args, **kwargs)
+    monkeypatch.setattr(est, "_winding_grid", count)
+    plain = est.open_surface_estimate(v, f, resolution=32, target=1e-3, max_resolution=40)
+    assert built == [32, 40]                            # refined: the bound misses a target this small
+    coarse = est.winding_estimate(v, f, resolution=32)
+    assert coarse.uncertainty.mass <= 0.5
+    added = 0.5 * (coarse.volume + coarse.uncertainty.volume_in_doubt) * (1 + 1e-9)
+    built.clear()
+    first = est.open_surface_estimate(v, f, resolution=32, target=1e-3, max_resolution=40, added_doubt=added)
+    assert built == [32]
+    assert first.volume == coarse.volume
+    assert (added + first.uncertainty.volume_in_doubt) / first.volume > 0.5
+    assert (added + plain.uncertainty.volume_in_doubt) / plain.volume > 0.5     # the refined one refused as well
+    built.clear()
+    est.open_surface_estimate(v, f, resolution=32, target=1e-3, max_resolution=40, added_doubt=0.999 * added)
+    assert built == [32, 40]                            # not proven: refined as before
+
+
+def test_summed_winding_numbers_are_within_their_round_off_of_the_exact_integers_and_the_treecode():
+    """The regions' one point each takes the exact sum over every face when that is cheap; on a closed sphere far
+    from the origin its value is the integer within its stated round-off bound, and within the treecode's bound
+    of the treecode's value."""
+    from inertia_tool.mesh.winding import winding_numbers_bounded, winding_numbers_summed
+    v, f = uv_sphere(0.5, center=(300.0, -20.0, 7.0), segments=24, rings=12)
+    points = np.array([[300.0, -20.0, 7.0], [300.2, -20.1, 7.1], [301.0, -20.0, 7.0], [299.4, -20.0, 7.0]])
+    w, err = winding_numbers_summed(points, v, f)
+    assert np.all(err > 0) and np.all(err < 1e-9)
+    assert np.all(np.abs(w - [1, 1, 0, 0]) <= err)
+    tree, tree_err = winding_numbers_bounded(points, v, f)
+    assert np.all(np.abs(w - tree) <= tree_err + err)

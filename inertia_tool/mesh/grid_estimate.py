@@ -26,7 +26,7 @@ from .rims import boundary_edges, enclosing_balls
 from .uncertainty import Estimate, Uncertainty, uncertainty_from
 
 __all__ = ["winding_estimate", "closed_surface_estimate", "open_surface_estimate", "corrected_estimate",
-           "predicted_resolution", "affordable_resolution", "WINDING_EVALUATION_BUDGET"]
+           "predicted_resolution", "affordable_resolution", "refusal_proven", "WINDING_EVALUATION_BUDGET"]
 
 
 #: Most grid cells whose winding number :func:`winding_estimate` evaluates one by one (libigl's hierarchical
@@ -145,6 +145,9 @@ CAP_BOUND_WORK = 20_000_000
 #: Most regions whose one winding number each is taken from the bounded treecode (a proven error bound, about
 #: 1 ms per point at 8k faces) rather than from libigl's approximation (no proven bound).
 BOUNDED_REGION_POINTS = 4096
+#: Most (region point, face) pairs for which the regions' winding numbers are the exact sum over every face
+#: instead of the treecode (whose tree costs ~0.1 s for 40k faces; the sum ~0.035 s for three points of them).
+DIRECT_REGION_WORK = 250_000
 
 
 def _cap_bound(points: np.ndarray, reach: float, ball_centre: np.ndarray, ball_radius: np.ndarray,
@@ -251,7 +254,8 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
     form a box that meets neither surface); ``w_{S+C}`` is found once per region, at one cell, from
     ``w_S + w_C`` rounded (refused, returning None, when that is more than 1/4 from an integer, counting the
     error bound of :func:`~.winding.winding_numbers_bounded`, used for ``w_S`` when libigl would be and there
-    are at most ``BOUNDED_REGION_POINTS`` regions; ``w_C`` is the exact direct sum).  A triangle
+    are at most ``BOUNDED_REGION_POINTS`` regions, or the exact direct sum with its round-off bound when the
+    regions' points times the faces are at most ``DIRECT_REGION_WORK``; ``w_C`` is the exact direct sum).  A triangle
     of area ``a`` at distance at least ``s`` subtends a solid angle of at most ``a/s²``; each cone lies in the
     ball enclosing its rim (:func:`enclosing_balls`: the apex is in the rim's convex hull), so at a cell at
     distance ``s`` from the ball ``|w_C| ≤ A_C / (4π s²)``.  Where the sum of these bounds over the cones is
@@ -274,7 +278,7 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from .winding import winding_numbers, winding_numbers_bounded
+    from .winding import winding_numbers, winding_numbers_bounded, winding_numbers_summed
 
     v, f = vertices, faces
     edges = boundary_edges(f, len(v))
@@ -313,7 +317,10 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
     # first in C order
     first = _first_cells(region, n_regions) if first_cells is None else first_cells
     points = _cell_centres(first, lo, h, dims)
-    if fast and len(first) <= BOUNDED_REGION_POINTS:
+    if fast and len(first) * len(f) <= DIRECT_REGION_WORK:
+        # one point per region, few enough for the exact sum over every face (its round-off bounded)
+        w_s, w_err = winding_numbers_summed(points, v, f)
+    elif fast and len(first) <= BOUNDED_REGION_POINTS:
         # one point per region: the treecode's proven error bound instead of libigl's unbounded approximation
         w_s, w_err = winding_numbers_bounded(points, v, f)
     else:
@@ -574,7 +581,7 @@ def budget_resolution(vertices: np.ndarray, max_cells: int = CLOSED_MAX_CELLS) -
 
 def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64,
                             target: float = CLOSED_TARGET_MASS_RTOL, max_resolution: int | None = None,
-                            max_evaluations: int | None = None) -> Estimate:
+                            max_evaluations: int | None = None, added_doubt: float = 0.0) -> Estimate:
     """The solid ``{w ≥ 1}`` of a closed, edge-balanced surface that passes through itself, on a grid, with an
     assumption-free bound.
 
@@ -624,6 +631,10 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
         found, every free cell where one is not): a grid that would exceed it is built again at
         :func:`affordable_resolution` instead, and a refinement that would exceed it is not made (the grid
         before stands; counted before any cell is evaluated).
+    added_doubt : float
+        m³ the caller adds to the estimate's volume in doubt (the holes' patches of a patched surface): when the
+        first grid shows that every estimate would then be refused (:func:`refusal_proven`), it is the answer and
+        nothing finer is built.
 
     Returns
     -------
@@ -650,6 +661,8 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
         grid = winding_estimate(vertices, faces, resolution=finer, max_evaluations=max_evaluations)
     bound = grid.uncertainty.mass
     if grid.volume > 0:
+        if refusal_proven(grid, added_doubt):
+            return grid                         # refused with the added doubt, as any finer grid would be
         if finer < max_resolution and bound > CLOSED_PREDICTION_SLACK * target:
             # predicted too coarse (overlapping bodies count twice in the signed volume): refined once by the
             # grid's own bound; a grid over the budget of evaluations is refused before it evaluates anything
@@ -683,6 +696,24 @@ def closed_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resoluti
     if corrected is not None and not corrected.uncertainty.mass >= second.uncertainty.mass:
         return corrected                # both bounds are proven: the narrower one is reported
     return second
+
+
+def refusal_proven(grid: Estimate, added_doubt: float, max_mass_rtol: float = ESTIMATE_MAX_MASS_RTOL) -> bool:
+    """Whether every estimate of the solid ``grid`` estimates, with ``added_doubt`` m³ more in doubt, would have a
+    mass bound past ``max_mass_rtol`` (and be refused), while ``grid``'s own bound is within it.
+
+    The grid claims that the solid ``S`` lies within its decided and doubtful cells: ``|S| ≤ V + δ`` (its volume
+    and its volume in doubt; the decided cells plus the crossed and ambiguous ones).  Any estimate ``(V', δ')``
+    whose bound holds has ``V' − δ' ≤ |S|``, so with ``p = added_doubt`` its relative mass bound is
+    ``(p + δ')/V' ≥ (p + δ')/(|S|max + δ') ≥ min(1, p/|S|max)``: past ``max_mass_rtol`` (< 1) whenever
+    ``p > max_mass_rtol · (V + δ)``, however fine its grid.  The grid itself is then refused with the added
+    doubt, by the same message as a finer one; its own bound within the limit keeps the refusal that of the
+    added doubt (the caller's check of the grid alone passes as before).
+    """
+    unc = grid.uncertainty
+    most = grid.volume + unc.volume_in_doubt
+    return bool(added_doubt > 0 and grid.volume > 0 and np.isfinite(most) and unc.mass <= max_mass_rtol
+                and added_doubt > max_mass_rtol * most)
 
 
 def predicted_resolution(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64,
@@ -725,7 +756,7 @@ def predicted_resolution(vertices: np.ndarray, faces: np.ndarray, *, resolution:
 
 def open_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: int = 64,
                           target: float = CLOSED_TARGET_MASS_RTOL, max_resolution: int | None = None,
-                          max_evaluations: int | None = None) -> Estimate:
+                          max_evaluations: int | None = None, added_doubt: float = 0.0) -> Estimate:
     """:func:`winding_estimate` of a surface that is open and passes through itself, refined once as
     :func:`closed_surface_estimate` refines: when the first grid's mass bound exceeds ``target``, the grid is
     built again at ``resolution · bound / target`` cells along the longest side, at most ``max_resolution``
@@ -734,7 +765,10 @@ def open_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution
     Barkour vb's ``upper_leg_right.stl``), and at most as fine as ``max_evaluations`` allows
     (:func:`affordable_resolution`, from the cells the first grid evaluated).  The second grid is the answer (by
     this rule), unless it would still evaluate more cells than ``max_evaluations``: then the first is (decided by
-    counting cells, never by time).  The assumption and the bounds are :func:`winding_estimate`'s.
+    counting cells, never by time).  The assumption and the bounds are :func:`winding_estimate`'s.  With
+    ``added_doubt`` (m³ the caller adds to the volume in doubt: a patched surface's holes), the first grid is the
+    answer when it shows that every estimate would be refused with it (:func:`refusal_proven`; issue 23: ALOHA's
+    ``vx300s_7_gripper_prop.stl`` built a 109-cell grid, 10 of its 12 s, only to be refused).
 
     Raises
     ------
@@ -745,7 +779,8 @@ def open_surface_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution
         max_resolution = budget_resolution(vertices, OPEN_MAX_CELLS)
     first, evaluated, crossed = _winding_grid(vertices, faces, resolution=resolution, max_evaluations=max_evaluations)
     bound = first.uncertainty.mass
-    if resolution >= max_resolution or (np.isfinite(bound) and bound <= target):
+    if resolution >= max_resolution or (np.isfinite(bound) and bound <= target) or refusal_proven(first,
+                                                                                                 added_doubt):
         return first
     finer = max_resolution if not (np.isfinite(bound) and first.volume > 0) else \
         int(min(max_resolution, np.ceil(resolution * bound / target)))

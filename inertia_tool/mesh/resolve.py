@@ -180,7 +180,7 @@ def _touching_note(census: EdgeBalance) -> tuple[str, ...]:
 
 def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
                     merge_tolerance: float, moments: Callable[..., Any], force_estimate: bool = False,
-                    reason: str | None = None) -> Resolution:
+                    reason: str | None = None, added_doubt: float = 0.0) -> Resolution:
     """Read a surface that failed the manifold check as a solid (exact), as an estimate (repair), or refuse.
 
     Parameters
@@ -204,6 +204,9 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         could not unite, or that passes through itself).
     reason : str, optional
         Why the estimate is forced, for the notes (default: the union could not be formed).
+    added_doubt : float
+        m³ the caller will add to a forced estimate's volume in doubt (a patched surface's holes): the grid is
+        not refined when that alone would refuse every estimate (:func:`~.grid_estimate.refusal_proven`).
 
     Returns
     -------
@@ -228,7 +231,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         # a closed surface has an integer winding number off it: the decided cells bound the solid with no
         # assumption, and the grid is refined once towards CLOSED_TARGET_MASS_RTOL
         try:
-            grid = closed_surface_estimate(v, f) if census.balanced else open_surface_estimate(v, f)
+            grid = closed_surface_estimate(v, f, added_doubt=added_doubt) if census.balanced else \
+                open_surface_estimate(v, f, added_doubt=added_doubt)
         except WorkBudgetError as over:        # counted before the work, so the refusal comes early
             raise WorkBudgetError(f"{source}: {over}", details=over.details) from None
         why = reason or "the bodies overlap and their union could not be formed"

@@ -89,10 +89,13 @@ def settle_self_crossing(shells: Shells, contacts: SurfaceContacts, *, arranged:
         message = self_crossing_message(source, touch, v, f, contacts.crossing, shells.labels) + arrange_failed
         if not repair:
             raise InvalidMeshError(message, details={"self_crossing_face_pairs": touch.self_crossing_pairs})
+        # the patches' doubt is added to the grid's below: a grid that already shows the sum refused is not refined
+        # (issue 23: ALOHA's gripper_prop, 12 s for a refusal)
         forced = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
                                  moments=volume_moments, force_estimate=True,
                                  reason=f"the surface passes through itself at {touch.self_crossing_pairs:,} "
-                                        f"face pairs{arrange_failed}")
+                                        f"face pairs{arrange_failed}",
+                                 added_doubt=patched.uncertainty.volume_in_doubt if patched is not None else 0.0)
         if patched is not None:
             forced = with_patch_doubt(forced, patched, source)
         warnings.warn(MeshRepairedWarning(f"{source}: repaired ({forced.method}, an estimate): "

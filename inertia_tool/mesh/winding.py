@@ -197,6 +197,27 @@ def winding_numbers(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
     return _direct(points, vertices, faces)
 
 
+#: Relative round-off of one solid angle of :func:`_direct` (``2·atan2``) in units of machine epsilon, used for
+#: the error bound of :func:`winding_numbers_summed`: each term is off by a few ulps of π, the sum by at most
+#: the terms' count times that, divided by 4π.
+DIRECT_ROUNDOFF_ULPS = 8.0
+
+
+def winding_numbers_summed(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """Winding numbers by the exact direct sum over every face, with a bound on their round-off: ``(winding,
+    error)``, both (p,) float, ``error = DIRECT_ROUNDOFF_ULPS · ε · m`` (``m`` faces).  About the bounding box's
+    centre, as :func:`winding_numbers_bounded`; cheaper than its treecode for a few points (issue 23: the one
+    point per region of UR5e's grids, 0.035 s against 0.1 s for the tree of 40k faces)."""
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    vertices = np.ascontiguousarray(vertices, dtype=np.float64)
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    if len(points) == 0 or len(faces) == 0:
+        return np.zeros(len(points)), np.zeros(len(points))
+    centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
+    bound = DIRECT_ROUNDOFF_ULPS * np.finfo(np.float64).eps * len(faces)
+    return _direct(points - centre, vertices - centre, faces), np.full(len(points), bound)
+
 def winding_numbers_bounded(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, *,
                             tolerance: float = 1e-4) -> tuple[np.ndarray, np.ndarray]:
     """Winding numbers with a bound on their error, by the numpy treecode (no libigl needed).
