@@ -10,6 +10,7 @@ heap blocks the junk weld and census have just freed (dirty as well), and the la
 """
 
 import os
+import re
 import sys
 
 import numpy as np
@@ -175,14 +176,29 @@ def test_weld_outputs_live_on_scratch_and_match_numpy(lib, monkeypatch):
         np.testing.assert_array_equal(faces.reshape(-1), ref_ids)
 
 
-def test_kept_mappings_are_unmapped_before_another_kernel_maps_fresh_ones(lib):
-    """The face-pair check maps its arrays fresh (arena_alloc): the kept mappings are unmapped first, so that
-    keeping them never raises the peak memory of an analysis (the check sets it).  Arrays below 1 MB come from
-    the heap instead (a small part's scan), so the torus is large enough for the mapped path."""
+def test_kept_mappings_are_unmapped_before_the_check_maps_fresh_ones(lib, capfd, monkeypatch):
+    """The face-pair check takes its large blocks from its own earlier phases, and maps fresh ones only after
+    unmapping the mappings the weld kept (arena_alloc's pool_drain), so kept pages never sit beside fresh ones and
+    keeping them never raises the peak of an analysis (the check sets it).  At the end its blocks go to the pool
+    for the next call: what is kept after the scan is at most what the scan itself mapped (check6 changed the end
+    from "nothing kept" to this; arrays below 1 MB come from the heap, so the torus is large enough for the
+    mapped path)."""
+    monkeypatch.setenv("INERTIA_TOOL_CT_PROFILE", "1")
     pts = _torus_soup(400, 300)
     vertices, ids = _part_welder(lib, pts, 2)
-    assert lib.kept_buffers() > 0
+    before = lib.kept_buffers()
+    assert before > 0
+    capfd.readouterr()
     lib.contact_scan(vertices, ids.reshape(-1, 3), -1)
+    err = capfd.readouterr().err
+    found = re.search(r"MB mapped ([0-9.]+) reused ([0-9.]+)", err)
+    assert found, err
+    mapped = float(found.group(1)) * 1e6
+    after = lib.kept_buffers()
+    assert mapped > 0                                            # the mapped path ran, so the pool was drained
+    assert after <= mapped + 0.1e6                               # the scan's own blocks only (printed to 0.1 MB)
+    assert after < before + mapped                               # the weld's kept mappings are gone
+    lib.release_buffers()
     assert lib.kept_buffers() == 0
 
 
