@@ -218,13 +218,16 @@ PLAUSIBLE_EXTENT = (1e-4, 20.0)
 PLAUSIBLE_DENSITY = (100.0, 22_600.0)
 
 
-def _length_text(metres: float) -> str:
-    """``0.15`` → ``"0.15 m"``, ``1.5e-5`` → ``"0.015 mm"``: a length in the unit that reads best."""
-    if metres >= 0.1 or metres == 0:
-        return f"{metres:.3g} m"
-    if metres >= 1e-3:
-        return f"{metres * 1e3:.3g} mm"
-    return f"{metres * 1e6:.3g} µm"
+def _length_text(metres: float, beyond: float | None = None) -> str:
+    """``0.15`` → ``"0.15 m"``, ``1.5e-5`` → ``"0.015 mm"``: a length in the unit that reads best, to 3
+    significant digits, or to as many more as it takes to read beyond ``beyond`` (a limit it was found past:
+    20.0000019 m is "20.0000019 m", not "20 m", beside "above 20 m")."""
+    scale, unit = (1.0, "m") if metres >= 0.1 or metres == 0 else (1e3, "mm") if metres >= 1e-3 else (1e6, "µm")
+    for digits in range(3, 18):
+        text = f"{metres * scale:.{digits}g}"
+        if beyond is None or (float(text) / scale != beyond and (float(text) / scale > beyond) == (metres > beyond)):
+            break
+    return f"{text} {unit}"
 
 
 def implausible_extent(extent: float, *, low: float = PLAUSIBLE_EXTENT[0],
@@ -252,10 +255,11 @@ def implausible_extent(extent: float, *, low: float = PLAUSIBLE_EXTENT[0],
     # the usual CAD export units first: mm, then in, cm, um, ft
     order = {"mm": 0, "in": 1, "cm": 2, "um": 3, "ft": 4}
     fits.sort(key=lambda item: order.get(item[0], 9))
+    shown = _length_text(extent, beyond=high if extent > high else low)
     if not fits:
-        return f"largest extent {_length_text(extent)}, {side}: check the mesh and its length `units`"
+        return f"largest extent {shown}, {side}: check the mesh and its length `units`"
     name, size = fits[0]
-    return (f"largest extent {_length_text(extent)}, {side}: if the file is in {name}, `units` {name} "
+    return (f"largest extent {shown}, {side}: if the file is in {name}, `units` {name} "
             f"gives {_length_text(size)}")
 
 

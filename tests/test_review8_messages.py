@@ -1,8 +1,9 @@
 """Adversarial review 8: notes and warnings whose words or numbers contradict the result they come with.
 
-Each is a strict-xfail reproducer (the reason names the stage at fault); it fails the suite once fixed, so that the
-mark is removed.  A real file that is not a package's data is read only when present: from the folders listed in
-``INERTIA_TOOL_REAL_MESHES`` (``os.pathsep``-separated, as ``tests/test_review7.py``), else skipped.
+Each was a strict-xfail reproducer (the reason named the stage at fault) until the lead fixed it (unite.py's R6
+note, units.implausible_extent); they now pass.  A real file that is not a package's data is read only when
+present: from the folders listed in ``INERTIA_TOOL_REAL_MESHES`` (``os.pathsep``-separated, as
+``tests/test_review7.py``), else skipped.
 """
 
 from __future__ import annotations
@@ -38,10 +39,6 @@ def _touching_boxes_one_open(seed):
     return S.concat((a[0], open_a), b)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "mesh/unite.unite_overlaps (R6 up to rounding) writes its note, 'so the summed integral is given, certified "
-    "united', before certify (R7) makes a patched surface an estimate: the note and the warning say united on "
-    "a result certified estimate"))
 @pytest.mark.parametrize("seed", [0, 1])
 def test_patched_touching_copies_do_not_claim_united(seed):
     """Two turned boxes touching face to face, one with a hole: ``repair`` patches the hole and the boxes touch up
@@ -62,11 +59,6 @@ def _real_file(name):
     pytest.skip(f"{name} not found under INERTIA_TOOL_REAL_MESHES")
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "mesh/unite.unite_overlaps (R6 up to rounding) takes the decision on R4's touching relations "
-    "(touch.crossing) but counts the crossing face pairs from the contacts left after the patches' crossings were "
-    "set aside: 'touching up to rounding: 0 face pairs of shells that touch cross' on a file whose only crossings "
-    "are the patches' (139 face pairs)"))
 def test_menagerie_wx250s_gripper_bar_counts_the_pairs_it_names():
     """MuJoCo Menagerie's ``trossen_wx250s/assets/wx250s_9_gripper_bar.stl`` (two holes) under ``repair``: a note
     that says faces cross by rounding counts at least one such pair."""
@@ -81,9 +73,6 @@ def test_menagerie_wx250s_gripper_bar_counts_the_pairs_it_names():
         assert count >= 1, note
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "units.implausible_extent prints the extent at 3 significant digits beside the limit it exceeds: trimesh's "
-    "20mm-xyz-cube.stl (largest extent 20.0000019 in the file, float32) is warned 'largest extent 20 m, above 20 m'"))
 def test_implausible_extent_prints_a_number_beyond_its_limit():
     """The warning names an extent that reads as beyond the limit it is compared with (a 20 mm test cube exported
     in mm: 20.0000019 m as metres)."""

@@ -127,11 +127,14 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
         checks = ["edge-balanced", "consistently-oriented", "boolean-union", "touching-up-to-rounding"]
         crossed = np.asarray(contacts.crossing, dtype=np.int64).reshape(-1, 2)
         n_pairs = int(np.count_nonzero(labels[crossed[:, 0]] != labels[crossed[:, 1]]))
-        notes.append(f"touching up to rounding: {n_pairs:,} face pairs of shells that touch cross by float64 "
-                     f"rounding (faces coplanar only to rounding, e.g. after a rotation); the boolean union's "
-                     f"volume equals the summed volume within {TOUCH_VOLUME_RTOL:g} (difference "
-                     f"{abs(united.volume - summed):.3g} m³), so the summed integral is given, certified united "
-                     "(the solid is ambiguous at the rounding level: not exact)")
+        # the decision is R4's (touch: shells that cross); the face pairs left in ``contacts`` may be none when
+        # the crossings were a patch's, set aside before (review 8: "0 face pairs ... cross")
+        what = (f"{n_pairs:,} face pairs of shells that touch cross" if n_pairs else
+                f"{max(len(touch.crossing_with), 1):,} pairs of shells that touch cross")
+        notes.append(f"touching up to rounding: {what} by float64 rounding (faces coplanar only to rounding, e.g. "
+                     f"after a rotation); the boolean union's volume equals the summed volume within "
+                     f"{TOUCH_VOLUME_RTOL:g} (difference {abs(united.volume - summed):.3g} m³), so the summed "
+                     "integral is given (the solid is ambiguous at the rounding level: not exact)")
         if oriented.misread is None and oriented.groups is None:     # else R4's reading labels and warns (certify)
             warnings.warn(MeshResolvedWarning(f"{source}: {notes[-1]}"), stacklevel=4)
     elif united is None:
