@@ -365,7 +365,9 @@ def _read_ascii_stl(path: str, size: int, max_faces: int, data: bytes | None = N
             if len(bad):
                 k = int(complete_lines[bad[0]])
                 where = f"line {line_no + k}" if k >= 0 else "a facet before this block"
-                raise _fail(path, f"{where}: a facet has {int(complete[bad[0]])} vertices instead of 3")
+                n_corners = int(complete[bad[0]])
+                raise _fail(path, f"{where}: a facet has {n_corners} vert{'ex' if n_corners == 1 else 'ices'} "
+                                  "instead of 3")
             if n_new or open_count is not None:
                 open_count = int(per_facet[-1])
                 if open_count > 3:
@@ -400,7 +402,8 @@ def _read_ascii_stl(path: str, size: int, max_faces: int, data: bytes | None = N
     if count == 0:
         raise _fail(path, "ASCII STL without any 'vertex' line (empty mesh)")
     if open_count not in (None, 3):
-        raise _fail(path, f"the last facet has {open_count} vertices instead of 3 (truncated?)")
+        raise _fail(path, f"the last facet has {open_count} vert{'ex' if open_count == 1 else 'ices'} instead of 3 "
+                    "(truncated?)")
     missing = [f"{facets - n:,} facets lack '{k.decode()}{' loop' if k == b'outer' else ''}'"
                for k, n in tallies.items() if n < facets]
     if garbage or missing:

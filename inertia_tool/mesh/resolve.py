@@ -296,8 +296,9 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                 welded = tol
                 if census.balanced:
                     if merged.largest_move > 0:
-                        notes = (f"{merged.merged_vertices:,} vertices within {round_up(tol):.3g} m of another were "
-                                 "merged "
+                        n_merged = merged.merged_vertices
+                        notes = (f"{n_merged:,} vert{'ex' if n_merged == 1 else 'ices'} within {round_up(tol):.3g} m "
+                                 f"of another {'was' if n_merged == 1 else 'were'} merged "
                                  f"(largest move {round_up(merged.largest_move):.3g} m)",)
                     else:   # repeated records of one point (e.g. CAD faces tessellated one by one): nothing moved
                         notes = (f"{merged.merged_vertices:,} repeated vertices (identical coordinates) were joined",)
