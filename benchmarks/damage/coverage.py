@@ -637,9 +637,12 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=1)
     parser.add_argument("--kinds", default=",".join(KINDS), help="damage kinds to run (default: all)")
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--out", type=Path, default=OUT / "coverage.json")
+    parser.add_argument("--out", type=Path, default=OUT / "coverage.json",
+                        help="the results file (JSON); a folder given here gets coverage.json in it")
     parser.add_argument("--subset", action="store_true", help="the CI subset only")
     args = parser.parse_args(argv)
+    if args.out.is_dir():             # a folder: its coverage.json (a run of minutes must not end unable to write)
+        args.out = args.out / "coverage.json"
     sys.path.insert(0, str(ROOT))
     if args.subset:
         rows = subset()
