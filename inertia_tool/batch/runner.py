@@ -288,7 +288,9 @@ def _read_once(path: str, limit: int | None = None, known: str | None = None) ->
 
     Five system calls for a small file: ``stat``, ``open``, ``fstat``, one ``read`` of the size ``fstat`` gave
     plus one byte (a file that grew since is hashed on to its end, and its bytes not kept: the reader streams
-    it; a read that stops short is continued until the size or the end), ``close``.
+    it; a read that stops short is continued until the size or the end), ``close``.  A file system whose short
+    reads end exactly at the size ``fstat`` gave hides a growth since (a local file's read is short only at its
+    end): the bytes returned are then the ones hashed, so the row's hash is still that of the bytes analysed.
 
     Raises
     ------
