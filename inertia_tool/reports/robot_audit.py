@@ -32,7 +32,8 @@ def links_without_result(robot: RobotDescription, inertials) -> list:
 
 #: The start of a link's problem that stands for all of it in :func:`left_unchanged` (the rest names files and
 #: is in the table).
-_SHORT_PROBLEMS = ("mesh needs repair or cannot be read", "cannot be computed")
+_SHORT_PROBLEMS = ("mesh needs repair or cannot be read", "mesh cannot be read or bounded, even with repair",
+                   "cannot be computed")
 
 
 def left_unchanged(inertials, changed) -> str:

@@ -869,6 +869,11 @@ def _one_link(link: LinkGeometry, **options) -> LinkInertial:
     return _with_engine_warnings(result, caught)
 
 
+#: The start of a link's problem when its mesh was refused: without ``repair``, and with it.
+REFUSED = "mesh needs repair or cannot be read"
+REFUSED_REPAIRED = "mesh cannot be read or bounded, even with repair"
+
+
 def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, model: bool, repair: bool,
                      cache: dict, geometry: str, budget: list | None = None) -> LinkInertial:
     """The result for one link, or the reason there is none (never raises for the link's own problems)."""
@@ -886,7 +891,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     try:
         parts, massless, joined = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
     except InertiaToolError as exc:
-        return LinkInertial(link.name, None, nan, basis, f"mesh needs repair or cannot be read: {exc}")
+        # with repair on, "needs repair" would contradict the warning that it was tried (review 8)
+        return LinkInertial(link.name, None, nan, basis, f"{REFUSED_REPAIRED if repair else REFUSED}: {exc}")
     except (ValueError, ArithmeticError) as exc:     # numerical trouble in one link's geometry: its reason
         return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}")
     warned = [e.note for e in link.elements if e.note] + joined
