@@ -5,7 +5,9 @@ intersections) is not independent of manifold3d.  Here the truth is: for convex 
 icospheres, polygon prisms), every intersection ``A_S`` is convex and is computed as a half-space intersection
 by qhull (``scipy.spatial.HalfspaceIntersection``, interior point from a Chebyshev-centre linear program), its
 moments integrated over its convex hull; the union's volume, first and second moments are the
-inclusion–exclusion sums ``Σ_S (−1)^{|S|+1} M(A_S)`` (all three are measures).  An intersection whose Chebyshev
+inclusion–exclusion sums ``Σ_S (−1)^{|S|+1} M(A_S)`` (all three are measures).  Where one of two pieces lies
+wholly inside the other (libigl winding numbers of its corners), R4's depth reading (the inner one a cavity) is
+accepted as well.  An intersection whose Chebyshev
 radius is below 1e-13 of the piece size is taken as empty; its volume is at most radius × surface (a convex body
 lies within its inradius of a face... times its surface), added to the stated error of the truth.
 
@@ -240,7 +242,22 @@ def run(mode, seed, i, repair):
     v, f = S.concat(*given)
     case = S.Case(mode, v, f, truth, f"{recipe}; {where}")
     bound_rel = err / abs(truth.volume)
-    return case, judged(case, truth, bound_rel, repair), bound_rel
+    verdict = judged(case, truth, bound_rel, repair)
+    inside = S._contained(local) if verdict.wrong is not None and len(local) == 2 else np.zeros(0, dtype=bool)
+    if inside.any() and not inside.all():
+        # R4's reading (issue 21: orient by nesting depth): a piece wholly inside the other is its cavity
+        outer, inner = (local[1], local[0]) if inside[0] else (local[0], local[1])
+        (vo, co, so), (vi, ci, si) = S.float_moments(*outer), S.float_moments(*inner)
+        vol = vo - vi
+        first = vo * co - vi * ci
+        second = (so + vo * np.outer(co, co)) - (si + vi * np.outer(ci, ci))
+        cen = first / vol
+        alt = S.Truth(vol, cen + shift, S._inertia(second - vol * np.outer(cen, cen)), "depth reading")
+        other = judged(case, alt, bound_rel, repair)
+        if other.wrong is None:
+            return case, other, bound_rel
+        case.recipe += "; one piece wholly inside the other (the depth reading misses too)"
+    return case, verdict, bound_rel
 
 
 def main(argv=None):
