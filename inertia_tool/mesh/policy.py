@@ -629,6 +629,13 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
     """
     vols = np.asarray(file_volumes, dtype=np.float64)
     misread = (vols > 0) & np.asarray(flip, dtype=bool) & (np.asarray(depth) % 2 == 1)
+    if misread.any() and nest is not None:
+        # the file's winding number just inside such a shell is 1 + the others' there; where the shells around
+        # it are wound inward (the whole nest written inside out) that is 0 or less: the file reads it as a
+        # cavity too (review 9: an inverted hollow box was said to read as "the union of the bodies")
+        around = np.zeros(len(vols), dtype=np.int64)
+        np.add.at(around, np.asarray(nest.shell, dtype=np.int64), np.asarray(nest.winding, dtype=np.int64))
+        misread &= around >= 0
     if not misread.any():
         return None
     inside = np.zeros(len(vols), dtype=bool)
