@@ -21,14 +21,14 @@ manifold output for manifold inputs, with symbolic perturbation for coplanar and
 from __future__ import annotations
 
 from types import ModuleType
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from ..values import frozen_value
 
 __all__ = ["crossing_shells", "closed_groups", "union_surface", "UnionSurface", "UnionError", "common_volumes",
-           "two_manifold"]
+           "two_manifold", "piece_solids", "PieceSolids"]
 
 
 class UnionError(RuntimeError):
@@ -188,8 +188,73 @@ def _manifold(m3: ModuleType, vertices: np.ndarray, faces: np.ndarray) -> _Manif
     return solid
 
 
+class PieceSolids(NamedTuple):
+    """manifold3d solids built once and shared by the booleans that need them (:func:`union_surface` builds the
+    closed pieces' solids; :func:`common_volumes` reuses those that are whole shells).
+
+    Attributes
+    ----------
+    centre : (3,) float64
+        m, mesh axes: the solids are built on the vertices less it (the centre of their bounding box; the boolean
+        works near the origin).  A solid is only reused by a caller whose vertices give the same centre.
+    solids : dict of int to Manifold
+        The solid of each piece (or shell), wound outward (material), keyed by its index.
+    """
+
+    centre: np.ndarray
+    solids: dict[int, _Manifold]
+
+
+def _local_frame(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """float64 vertices less the centre of their bounding box (the boolean works near the origin), and the
+    centre."""
+    v = np.asarray(vertices, dtype=np.float64)
+    centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
+    return v - centre, centre
+
+
+def _import_manifold3d() -> ModuleType:
+    try:
+        import manifold3d as m3
+    except ImportError as exc:  # pragma: no cover - a runtime dependency
+        raise UnionError("the union of overlapping bodies needs the manifold3d package") from exc
+    module: ModuleType = m3
+    return module
+
+
+def piece_solids(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n_groups: int,
+                 outward: np.ndarray, body: np.ndarray | None = None) -> PieceSolids:
+    """The manifold3d solid of each closed piece, each wound outward (a cavity turned), in the order
+    :func:`union_surface` takes them (body by body); parameters as for :func:`union_surface`.
+
+    Returns
+    -------
+    PieceSolids
+        Keyed by piece; a piece without faces has no solid.
+
+    Raises
+    ------
+    UnionError
+        manifold3d is missing, or refuses a piece (the first refused in that order is named).
+    """
+    m3 = _import_manifold3d()
+    local, centre = _local_frame(vertices)
+    f = np.asarray(faces, dtype=np.int64)
+    body = np.zeros(n_groups, dtype=np.int64) if body is None else np.asarray(body)
+    order = np.argsort(groups, kind="stable")
+    starts = np.searchsorted(groups[order], np.arange(n_groups + 1))
+    solids: dict[int, _Manifold] = {}
+    for b in np.unique(body):
+        for g in np.flatnonzero(body == b).tolist():
+            piece = f[order[starts[g]:starts[g + 1]]]
+            if len(piece):
+                solids[g] = _manifold(m3, local, piece if outward[g] else piece[:, ::-1])
+    return PieceSolids(centre, solids)
+
+
 def union_surface(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n_groups: int,
-                  outward: np.ndarray, body: np.ndarray | None = None) -> UnionSurface:
+                  outward: np.ndarray, body: np.ndarray | None = None, *,
+                  solids: PieceSolids | None = None) -> UnionSurface:
     """The solid of overlapping pieces: per body, its outward pieces united minus its inward ones; all united.
 
     Parameters
@@ -204,6 +269,9 @@ def union_surface(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
     body : (n_groups,) int, optional
         The body each piece belongs to (a cavity belongs to the body around it); cavities are subtracted
         from their own body only, so a part sitting inside another part's void stays.  Default: one body.
+    solids : PieceSolids, optional
+        The pieces' solids as :func:`piece_solids` builds them from the same arguments (built here when not
+        given; a caller that reuses them builds them once).
 
     Returns
     -------
@@ -213,44 +281,35 @@ def union_surface(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
     ------
     UnionError
     """
-    try:
-        import manifold3d as m3
-    except ImportError as exc:  # pragma: no cover - a runtime dependency
-        raise UnionError("the union of overlapping bodies needs the manifold3d package") from exc
-    v = np.asarray(vertices, dtype=np.float64)
-    f = np.asarray(faces, dtype=np.int64)
+    m3 = _import_manifold3d()
+    if solids is None:
+        solids = piece_solids(vertices, faces, groups, n_groups, outward, body)
     body = np.zeros(n_groups, dtype=np.int64) if body is None else np.asarray(body)
-    centre = 0.5 * (v.min(axis=0) + v.max(axis=0))   # the boolean works near the origin
-    local = v - centre
-    order = np.argsort(groups, kind="stable")
-    starts = np.searchsorted(groups[order], np.arange(n_groups + 1))
-    solids = []
+    united = []
     for b in np.unique(body):
         material: list[_Manifold] = []
         voids: list[_Manifold] = []
-        for g in np.flatnonzero(body == b):
-            piece = f[order[starts[g]:starts[g + 1]]]
-            if len(piece):
-                oriented = piece if outward[g] else piece[:, ::-1]
-                (material if outward[g] else voids).append(_manifold(m3, local, oriented))
+        for g in np.flatnonzero(body == b).tolist():
+            if g in solids.solids:
+                (material if outward[g] else voids).append(solids.solids[g])
         if not material:
             continue
         solid = m3.Manifold.batch_boolean(material, m3.OpType.Add) if len(material) > 1 else material[0]
         if voids:
             solid = solid - (m3.Manifold.batch_boolean(voids, m3.OpType.Add) if len(voids) > 1 else voids[0])
-        solids.append(solid)
-    if not solids:
+        united.append(solid)
+    if not united:
         raise UnionError("no outward-wound piece to unite")
-    solid = m3.Manifold.batch_boolean(solids, m3.OpType.Add) if len(solids) > 1 else solids[0]
+    solid = m3.Manifold.batch_boolean(united, m3.OpType.Add) if len(united) > 1 else united[0]
     out = solid.to_mesh64()
-    verts = np.asarray(out.vert_properties, dtype=np.float64)[:, :3] + centre
+    verts = np.asarray(out.vert_properties, dtype=np.float64)[:, :3] + solids.centre
     tris = np.asarray(out.tri_verts, dtype=np.int64).reshape(-1, 3)
     return UnionSurface(vertices=verts, faces=tris, volume=float(solid.volume()),
-                        manifold_pieces=two_manifold(f, groups))
+                        manifold_pieces=two_manifold(np.asarray(faces, dtype=np.int64), groups))
 
 
 def common_volumes(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, volumes: np.ndarray,
-                   pairs: np.ndarray) -> np.ndarray:
+                   pairs: np.ndarray, *, solids: PieceSolids | None = None) -> np.ndarray:
     """Volume shared by the solids of two shells, each taken wound outward, for each pair (manifold3d, float64).
 
     Parameters
@@ -263,6 +322,10 @@ def common_volumes(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, 
         Signed volume of each shell as wound (the sign says which way to turn it outward).
     pairs : (k, 2) int
         Pairs of shells.
+    solids : PieceSolids, optional
+        Solids already built of some shells, keyed by shell, each wound outward (e.g. the pieces
+        :func:`union_surface` took that are whole shells): used for the shells of positive volume when their
+        centre is this surface's; every other shell's solid is built here.
 
     Returns
     -------
@@ -274,18 +337,19 @@ def common_volumes(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, 
         import manifold3d as m3
     except ImportError:  # pragma: no cover - a runtime dependency
         return out
-    v = np.asarray(vertices, dtype=np.float64)
-    local = v - 0.5 * (v.min(axis=0) + v.max(axis=0))      # the boolean works near the origin
-    solids: dict[int, _Manifold | None] = {}
+    local, centre = _local_frame(vertices)
+    built: dict[int, _Manifold | None] = {}
+    if solids is not None and np.array_equal(solids.centre, centre):       # the same frame: the same solids
+        built.update((k, s) for k, s in solids.solids.items() if volumes[k] > 0)
 
     def solid(k: int) -> _Manifold | None:
-        if k not in solids:
+        if k not in built:
             piece = np.asarray(faces)[labels == k]
             try:
-                solids[k] = _manifold(m3, local, piece if volumes[k] > 0 else piece[:, ::-1])
+                built[k] = _manifold(m3, local, piece if volumes[k] > 0 else piece[:, ::-1])
             except UnionError:
-                solids[k] = None
-        return solids[k]
+                built[k] = None
+        return built[k]
 
     for row, (a, b) in enumerate(np.asarray(pairs, dtype=np.int64).reshape(-1, 2).tolist()):
         sa, sb = solid(a), solid(b)

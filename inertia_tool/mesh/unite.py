@@ -23,7 +23,7 @@ from .resolve import Resolution, resolve_surface
 from .shells import Shells, apply_flips, reshelled
 
 if TYPE_CHECKING:       # imported on use at run time (below)
-    from .union import UnionSurface
+    from .union import PieceSolids, UnionSurface
 
 __all__ = ["United", "unite_overlaps", "shared_text"]
 
@@ -102,7 +102,7 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
     nonmanifold = nonmanifold_edges if nonmanifold_edges is not None else edge_topology(f, len(v), v).nonmanifold_edges
     if not (candidates.any() or nonmanifold):                                    # R5, R6
         return United(shells, owner, cavities, overlaps, method, kind, checks, (), None)
-    united = _unite(v, f, labels, owner, source, repair)
+    united, built = _unite(v, f, labels, owner, source, repair)
     summed = sum(s.volume for s in shells.moments)
     if united is not None and not touch.crossing.any() and \
             abs(united.volume - summed) <= TOUCH_VOLUME_RTOL * abs(summed):
@@ -175,7 +175,7 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
                              "through each other at shared edges): the result is the union, not verified")
             checks = ["edge-balanced", "consistently-oriented", "boolean-union"]
             if kind == "united" and not cavities:
-                lost = _union_lost_volume(shells, united.volume)
+                lost = _union_lost_volume(shells, united.volume, built)
                 if lost is not None and lost > TOUCH_VOLUME_RTOL * abs(summed):
                     kind = "unverified"
                     notes.append(f"the boolean union is {lost:.3g} m³ smaller than the bodies' volumes less the "
@@ -197,7 +197,7 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
 UNION_WITNESS_PAIRS = 64
 
 
-def _union_lost_volume(shells: Shells, union_volume: float) -> float | None:
+def _union_lost_volume(shells: Shells, union_volume: float, solids: PieceSolids | None = None) -> float | None:
     """How far the boolean's union falls below Bonferroni's lower bound, m³ (positive: volume lost), or None where
     the witness is not run.
 
@@ -205,7 +205,8 @@ def _union_lost_volume(shells: Shells, union_volume: float) -> float | None:
     (inclusion-exclusion cut after the pairs), with equality for two bodies.  The pairwise intersections are
     manifold3d's own, taken on the shells as given; pairs whose bounding boxes are apart share nothing.  Review 8
     found two unit boxes touching face to face, turned at random, whose union came back 1/60 m³ short while their
-    intersection was empty: certified united, 0.83 % low.
+    intersection was empty: certified united, 0.83 % low.  ``solids``: the shells' solids the union was formed
+    from (:func:`_unite`), reused rather than built again.
     """
     from .union import common_volumes
     volumes = np.array([m.volume for m in shells.moments])
@@ -222,7 +223,7 @@ def _union_lost_volume(shells: Shells, union_volume: float) -> float | None:
     pairs = np.stack([i[~apart], j[~apart]], axis=1)
     if len(pairs) > UNION_WITNESS_PAIRS:
         return None
-    common = common_volumes(v, f, labels, volumes, pairs) if len(pairs) else np.zeros(0)
+    common = common_volumes(v, f, labels, volumes, pairs, solids=solids) if len(pairs) else np.zeros(0)
     if not np.all(np.isfinite(common)):
         return None
     return float(volumes.sum() - common.sum() - union_volume)
@@ -247,12 +248,14 @@ def _oriented_anew(v: np.ndarray, f: np.ndarray, diag: float, source: str) -> tu
 
 
 def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: np.ndarray, source: str,
-           repair: bool) -> UnionSurface | None:
-    """The union of the closed pieces (a :class:`~.union.UnionSurface`), or None when the boolean refuses.
+           repair: bool) -> tuple[UnionSurface | None, PieceSolids | None]:
+    """The union of the closed pieces (a :class:`~.union.UnionSurface`), or None when the boolean refuses; and the
+    solids of the shells that were whole pieces wound outward (keyed by shell, for :func:`_union_lost_volume`).
 
     Each piece belongs to the body that owns its shell, so cavities are cut from their own body only.
     """
-    from .union import UnionError, closed_groups, two_manifold, union_surface      # on use: overlaps are rare
+    from .union import (PieceSolids, UnionError, closed_groups, piece_solids, two_manifold,   # on use: overlaps
+                        union_surface)                                                          # are rare
     groups, n_groups = closed_groups(faces, len(vertices))
     # within the shells: bodies welded along their crossing (R1b) are closed apart, though one group to closed_groups
     _, groups = np.unique(np.stack([np.asarray(labels, dtype=np.int64), groups], axis=1), axis=0, return_inverse=True)
@@ -267,9 +270,12 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
     keep = solid[groups]
     _, groups = np.unique(groups[keep], return_inverse=True)
     groups = groups.reshape(-1)
+    outward = volume[solid] > 0
     try:
-        united = union_surface(vertices, faces[keep], groups, int(np.count_nonzero(solid)),
-                               volume[solid] > 0, body=np.asarray(owner)[shell_of_group[solid]])
+        built = piece_solids(vertices, faces[keep], groups, int(np.count_nonzero(solid)), outward,
+                             body=np.asarray(owner)[shell_of_group[solid]])
+        united = union_surface(vertices, faces[keep], groups, int(np.count_nonzero(solid)), outward,
+                               body=np.asarray(owner)[shell_of_group[solid]], solids=built)
         summed = float(np.sum(volume[solid]))
         # manifold3d assumes manifold pieces and does not always say when one is not (bodies welded face to face,
         # joined by closed_groups at four-face rims): its union of such a piece is no witness (welded slabs came
@@ -278,13 +284,17 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
                 not two_manifold(faces[keep], groups):
             raise UnionError("a closed piece has non-manifold edges (shared by more than two faces) and the "
                              "boolean's union of it disagrees with the summed integral")
-        return united
     except UnionError as exc:
         if repair:
-            return None
+            return None, None
         raise InvalidMeshError(f"{source}: overlapping bodies whose union cannot be formed ({exc}); "
                                "`overlap` 'sum' adds them (shared volume counted twice), `repair=True` gives a "
                                "bounded estimate") from None
+    # a shell that is one piece, kept and wound outward, has the faces of that piece in the same order: its solid
+    whole = np.bincount(shell_of_group, minlength=1)[shell_of_group[solid]] == 1
+    shells = {int(shell_of_group[solid][g]): built.solids[g] for g in np.flatnonzero(whole & outward).tolist()
+              if g in built.solids}
+    return united, PieceSolids(built.centre, shells)
 
 
 def shared_text(summed: float, united: float) -> str:
