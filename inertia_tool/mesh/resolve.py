@@ -108,15 +108,11 @@ class _Census:
 
 
 def _census(faces: np.ndarray, n_vertices: int) -> _Census:
-    from .edges import edge_keys
     from .orient import EdgeBalance
     if len(faces) == 0:
         none = np.zeros(0, dtype=np.int64)
         return _Census(EdgeBalance(0, 0, 0, 0), 0, none, np.zeros((0, 2), dtype=np.int64), none)
-    key, forward = edge_keys(faces, n_vertices)
-    order = np.argsort(key, kind="stable")
-    key = key[order]
-    fwd = forward[order]
+    key, fwd = _sorted_edges(faces, n_vertices)
     starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
     count = np.diff(np.r_[starts, len(key)])
     net = np.add.reduceat(np.where(fwd, 1, -1).astype(np.int64), starts)
@@ -133,6 +129,33 @@ def _census(faces: np.ndarray, n_vertices: int) -> _Census:
     boundary = np.stack([np.repeat(np.where(k > 0, hi, lo), reps), np.repeat(np.where(k > 0, lo, hi), reps)],
                         axis=1)
     return _Census(balance, misoriented, np.r_[lo, hi], boundary, key[starts[count > 2]])
+
+
+def _sorted_edges(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
+    """The edge keys of :func:`~.edges.edge_keys`, sorted, and the direction bit of each, each key's uses with
+    their bits in ascending order (3m,) int64, (3m,) bool.
+
+    Key and bit packed into one int64 (``2·key + bit``) and sorted in place: a plain sort of one array, which
+    numpy vectorises, instead of a stable argsort and two gathers (0.5 s → 0.2 s of CPU on a soup's 3.9M edges,
+    twice per repair).  The census only counts each key's uses and their net direction, and compares the two
+    bits of a key used twice, none of which depends on the order of a key's uses.  Keys below ``n²`` pack without
+    overflow while ``2·n² < 2⁶³``; beyond that, the stable argsort."""
+    from .edges import edge_keys
+
+    key, forward = edge_keys(faces, n_vertices)
+    if max(int(n_vertices), 1) < _PACKED_EDGE_VERTICES:
+        key <<= 1
+        key |= forward
+        key.sort()
+        bits: np.ndarray = (key & 1).astype(bool)
+        key >>= 1
+        return key, bits
+    order = np.argsort(key, kind="stable")
+    return key[order], forward[order]
+
+
+#: Vertices below which :func:`_sorted_edges` packs an edge's key and direction into one int64 (2·n² < 2⁶³).
+_PACKED_EDGE_VERTICES = 1 << 31
 
 
 def _compact(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
