@@ -30,8 +30,8 @@ def _scipy_cycles(nxt: np.ndarray) -> tuple[np.ndarray, int]:
     return label.astype(np.int64), int(count)
 
 
-@settings(max_examples=80, deadline=None)
-@given(st.integers(1, 300).flatmap(lambda k: st.permutations(list(range(k)))))
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 200).flatmap(lambda k: st.permutations(list(range(k)))))
 def test_cycle_labels_are_scipys_components(perm: list[int]) -> None:
     nxt = np.array(perm, dtype=np.int64)
     got = rims._cycle_labels(nxt)
@@ -85,7 +85,7 @@ def _rims(draw: st.DrawFn) -> tuple[np.ndarray, float]:
     return pts, spread * 10.0 ** draw(st.floats(-2, 2))
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=40, deadline=None)
 @given(_rims())
 def test_no_plane_is_said_only_where_the_svd_plane_fails(case: tuple[np.ndarray, float]) -> None:
     pts, tolerance = case
@@ -108,7 +108,7 @@ def _svd_plane_holds(v: np.ndarray, corners: np.ndarray, tolerance: float) -> bo
 
 def test_no_plane_for_a_sphere_soup_and_a_plane_kept() -> None:
     rng = np.random.default_rng(5)
-    sphere = rng.normal(size=(200_000, 3))
+    sphere = rng.normal(size=(70_000, 3))     # above _PLANE_SAMPLE: the sample is a stride
     sphere = 0.05 * sphere / np.linalg.norm(sphere, axis=1, keepdims=True)
     everything = np.arange(len(sphere))
     tolerance = 1e-12 * 0.05
