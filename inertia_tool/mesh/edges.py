@@ -33,6 +33,15 @@ def edge_keys(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarra
     """
     f = np.asarray(faces, dtype=np.int64)
     a = f.reshape(-1)
-    b = f[:, [1, 2, 0]].reshape(-1)
-    n = np.int64(max(int(n_vertices), 1))
-    return np.minimum(a, b) * n + np.maximum(a, b), a > b
+    # the next corners, then their larger ends in place: two fresh (3m,) arrays fewer than the expression
+    # min(a, b)·n + max(a, b) (each a 31 MB page-faulted allocation for a 1.3M-face soup)
+    b = np.empty_like(f)
+    b[:, :2] = f[:, 1:]
+    b[:, 2] = f[:, 0]
+    b = b.reshape(-1)
+    forward = a > b
+    key = np.minimum(a, b)
+    np.maximum(a, b, out=b)
+    key *= np.int64(max(int(n_vertices), 1))
+    key += b
+    return key, forward
