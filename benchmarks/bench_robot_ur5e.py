@@ -33,7 +33,9 @@ def run_once(tree: str, description: str, out: str) -> tuple[float, float, float
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     with open(out, "w") as sink:
-        subprocess.run(command, env=env, stdout=sink, stderr=subprocess.STDOUT, check=False)
+        # run in the tree: ``python -m`` puts the working folder first on sys.path, ahead of PYTHONPATH, so a run
+        # started from another checkout measured that checkout
+        subprocess.run(command, env=env, cwd=tree, stdout=sink, stderr=subprocess.STDOUT, check=False)
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return (after.ru_utime - before.ru_utime, after.ru_stime - before.ru_stime, wall, after.ru_maxrss)
@@ -47,6 +49,8 @@ def main(argv=None) -> int:
     parser.add_argument("--out", default=".")
     args = parser.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
+    args.description, args.out = os.path.abspath(args.description), os.path.abspath(args.out)
+    args.trees = [os.path.abspath(tree) for tree in args.trees]
     for run in range(1, args.runs + 1):
         for tree in args.trees:
             name = os.path.basename(os.path.normpath(tree))

@@ -7653,7 +7653,8 @@ done:
  * 9. edge_point_candidates -- boundary vertices near the interior of a boundary edge (mesh/seal.py)
  *
  * The candidates of seal.on_edge_vertices and seal._split_t_junctions, which then apply their own tests: every
- * (edge, point) pair, the point not an end of the edge a-b, with
+ * (edge, point) pair, the point not an end of the edge a-b nor a copy of one (equal coordinates: both callers
+ * reject a point at distance 0 from the nearer end; a COLLADA soup's copies were ~9 pairs per edge), with
  *     0 < t = ((m-a).(b-a)) / |b-a|^2 < 1 (widened by 1e-12) and
  *     |m - (a + t (b-a))| <= max(gap, 2 rtol min(|m-a|, |m-b|)) + 64 eps (|b-a| + scale),
  * tested on squares without roots (a superset of the pairs that pass the callers' tests: those are
@@ -8072,6 +8073,12 @@ oe_edge_pairs(const OeGrid *g, const double *v, int64_t ia, int64_t ib, int64_t 
                             continue;
                         }
                         const double w0 = M[0] - A[0], w1 = M[1] - A[1], w2 = M[2] - A[2];
+                        const double b0 = M[0] - B[0], b1 = M[1] - B[1], b2 = M[2] - B[2];
+                        /* a copy of an end (exactly equal coordinates: x - y == 0 only when x == y) is on no
+                         * edge's interior: both callers reject it (distance 0 from the nearer end) */
+                        if ((w0 == 0.0 && w1 == 0.0 && w2 == 0.0) || (b0 == 0.0 && b1 == 0.0 && b2 == 0.0)) {
+                            continue;
+                        }
                         const double dot = (w0 * d0 + w1 * d1) + w2 * d2;
                         if (!(dot > -1e-12 * len2 && dot < (1.0 + 1e-12) * len2)) {
                             continue;
@@ -8081,7 +8088,6 @@ oe_edge_pairs(const OeGrid *g, const double *v, int64_t ia, int64_t ib, int64_t 
                                      e2 = M[2] - (A[2] + t * d2);
                         const double dist2 = (e0 * e0 + e1 * e1) + e2 * e2;
                         const double ta2 = (w0 * w0 + w1 * w1) + w2 * w2;
-                        const double b0 = M[0] - B[0], b1 = M[1] - B[1], b2 = M[2] - B[2];
                         const double tb2 = (b0 * b0 + b1 * b1) + b2 * b2;
                         const double near2 = rtol2 * (ta2 < tb2 ? ta2 : tb2);
                         /* (x + y)^2 <= 2 x^2 + 2 y^2: dist <= max(gap, 2 rtol near) + slop implies this */

@@ -35,7 +35,7 @@ def brute_force(v, edges):
     t = np.einsum("ij,ij->i", p - a, d) / np.maximum(length ** 2, np.finfo(float).tiny)
     dist = np.linalg.norm(p - (a + t[:, None] * d), axis=1)
     near = np.minimum(np.linalg.norm(p - a, axis=1), np.linalg.norm(p - b, axis=1))
-    on = (m != edges[e, 0]) & (m != edges[e, 1]) & (t > 0) & (t < 1) & (dist <= ON_EDGE_RTOL * near)
+    on = (m != edges[e, 0]) & (m != edges[e, 1]) & (t > 0) & (t < 1) & (near > 0) & (dist <= ON_EDGE_RTOL * near)
     return np.unique(m[on])
 
 

@@ -35,7 +35,7 @@ def _accepted(v, edges, e, m, gap):
     if gap > 0:
         ok = (dist <= gap) & (t > 0) & (t < 1) & (to_end > 0) & ((to_end > gap) | on_edge)
     else:
-        ok = (t > 0) & (t < 1) & on_edge
+        ok = (t > 0) & (t < 1) & (to_end > 0) & on_edge
     ok &= (m != edges[e, 0]) & (m != edges[e, 1])
     return sorted(zip(e[ok].tolist(), m[ok].tolist()))
 

@@ -357,7 +357,9 @@ def _split(v: np.ndarray, f: np.ndarray, slack: np.ndarray, gap: float, chain: _
 
 def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
     """Boundary vertices that lie on the interior of another boundary edge to round-off (T-junctions whose
-    vertex is on its edge: ``ON_EDGE_RTOL``), sorted (k,) int.
+    vertex is on its edge: ``ON_EDGE_RTOL``), sorted (k,) int.  A copy of an edge's end (the same coordinates)
+    is not on its interior, however ``t`` rounds (a third of a COLLADA soup's copies were taken for T-vertices
+    and kept out of the weld; issue 23).
 
     The weld before repair leaves these alone: merging such a vertex with a near one (a sliver's apex a hair
     from the edge) would fold the surface, while putting it on its edge (:func:`seal_seams`) changes nothing.
@@ -379,7 +381,9 @@ def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
     t = np.einsum("ij,ij->i", v[m] - a, ab) / np.maximum(length ** 2, np.finfo(float).tiny)
     dist = np.linalg.norm(v[m] - (a + t[:, None] * ab), axis=1)
     to_end = np.minimum(np.linalg.norm(v[m] - a, axis=1), np.linalg.norm(v[m] - b, axis=1))
-    on = (t > 0) & (t < 1) & (dist <= ON_EDGE_RTOL * to_end)
+    # a copy of an end (to_end == 0) is not on the interior, whatever the last bit of t says (t = 1 - 1 ulp for
+    # a copy of b when |b - a|² rounds above (b - a)·(b - a)): as the seal's split test
+    on = (t > 0) & (t < 1) & (to_end > 0) & (dist <= ON_EDGE_RTOL * to_end)
     found: np.ndarray = np.flatnonzero(np.bincount(m[on], minlength=len(v)))    # sorted, each once
     return found
 
