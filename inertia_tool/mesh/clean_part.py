@@ -1,0 +1,111 @@
+"""The clean-part fast path of :func:`~.prepare.prepare_mesh`: one closed, consistently wound, edge-manifold shell
+of positive volume whose faces meet nowhere but where they share corners by index.
+
+Most parts of a catalogue are such a shell, and for them the eight stages of :func:`~.prepare.prepare_mesh` decide
+nothing: R0 (copies), R1b (welded bodies), R2 (flat shells), R3a (folds), R3 (self-crossing), R4 (nesting, flips),
+R5 and R6 (the boolean) have one shell and no face pair to act on.  :func:`prepare_clean` runs the checks that make
+the answer exact, in the order of the full path and with the same functions (so the same arithmetic, bit for bit):
+
+1. the bounding box and the coordinates' safe range, no triangle with a repeated corner, a positive extent;
+2. the edge census and the shells from one adjacency (:func:`~.checks.census_and_shells`): every edge shared by
+   exactly two faces in opposite directions (closed, consistently oriented), one edge-connected shell;
+3. the shell's moments about the bounding-box centre and their round-off bound (R7,
+   :func:`~inertia_tool.integrals.accurate_shells`); a shell enclosing volume above R2's flatness, wound outward;
+4. the exact face-pair check (:func:`~.intersect.surface_contacts`): complete, no pair crossing, no pair coplanar
+   and facing opposite ways (contacts of a shell with itself at a vertex or along an edge change nothing here, as
+   in the full path);
+5. the certificate of :func:`~.certify.certify` (``exact`` with ``edge-balanced``, ``consistently-oriented`` and
+   ``no-crossing-faces`` when the round-off bound is within ``ROUNDOFF_RTOL``, ``unverified`` with its note when
+   not).
+
+Whenever any of these does not hold, :func:`prepare_clean` returns None *before* saying anything (no warning is
+issued, nothing is refused): the caller then runs the full :func:`~.prepare.prepare_mesh`, which decides, warns and
+refuses as it always did.  On a part it accepts, the :class:`~.prepare.PreparedMesh` is the full path's, field for
+field (``tests/test_batch7_fast_path.py`` compares them on generated and adversarial meshes).
+
+Only the face-pair check's diagnostic counters differ in what they describe: the full path's
+:class:`~.intersect.SurfaceContacts` (with ``candidate_pairs`` and ``tested_pairs``) is not kept by either path's
+result; here it is read for its three pair lists and ``complete`` and then dropped.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InvalidMeshError
+from ..integrals import accurate_shells, body_volume_moments, bounding_box
+from ..tolerances import FLAT_RTOL
+from .certify import certify
+from .checks import MeshReport, census_and_shells
+from .intersect import surface_contacts
+from .prepare import PreparedMesh
+from .read import RawMesh
+from .shells import Shells
+from .surface import check_magnitude
+
+__all__ = ["prepare_clean", "CLEAN_MAX_FACES", "CLEAN_CHECKS"]
+
+#: Largest part (faces) the fast path takes: above it the stages' own cost dwarfs what the fast path saves, and
+#: the full path's memory management (streamed weld, released scratch) is the one tuned for it.
+CLEAN_MAX_FACES = 1 << 20
+
+#: The checks of the certificate of a clean part (the full path's ``first_checks`` for one shell, nothing crossing).
+CLEAN_CHECKS = ("edge-balanced", "consistently-oriented", "no-crossing-faces")
+
+
+def prepare_clean(raw: RawMesh, *, max_faces: int = CLEAN_MAX_FACES) -> PreparedMesh | None:
+    """The :class:`~.prepare.PreparedMesh` of a clean one-shell part, or None when the part is anything else.
+
+    Parameters
+    ----------
+    raw : RawMesh
+        Vertices in metres and faces, from :func:`~inertia_tool.mesh.read.load_mesh`.
+    max_faces : int
+        Parts with more faces go to the full path (:data:`CLEAN_MAX_FACES`).
+
+    Returns
+    -------
+    PreparedMesh or None
+        What ``prepare_mesh(raw)`` returns, for any ``repair``, ``merge_tolerance``, ``overlap`` and
+        ``self_crossing`` (none of them acts on such a part); None (nothing warned, nothing raised) when one of the
+        conditions of the module docstring fails.
+    """
+    v, f = raw.vertices, raw.faces
+    m = len(f)
+    if m == 0 or m > max_faces:
+        return None
+    source = raw.source
+    lo, hi = bounding_box(v)
+    try:
+        check_magnitude(lo, hi, source)
+    except InvalidMeshError:
+        return None                                              # the full path refuses it, in its words
+    if ((f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])).any():
+        return None                                              # degenerate triangles: warned by the full path
+    diag = float(np.linalg.norm(hi - lo))
+    if not diag > 0:
+        return None
+    topo, labels, n_shells = census_and_shells(f, len(v), v)
+    if n_shells != 1 or not topo.oriented:
+        return None
+    centre = 0.5 * (lo + hi)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):     # a flat shell's bound is inf or NaN
+        moments = body_volume_moments(v, f, labels, 1, origin=centre)
+        moments, _, bound = accurate_shells(v, f, labels, moments, centre)
+    volume = moments[0].volume
+    if not (volume > 0 and abs(volume) > FLAT_RTOL * diag ** 3):
+        return None                                              # inside out, flat or NaN: the full path decides
+    contacts = surface_contacts(v, f)
+    if not contacts.complete or len(contacts.crossing) or len(contacts.coplanar_opposite):
+        return None
+    shells = Shells(v, f, labels, 1, moments, bound)
+    certified = certify(shells, kind="exact", checks=list(CLEAN_CHECKS), method="exact", patched=None,
+                        arranged=False, verified=False, ambiguous=False, folds=False, sheets_removed=False,
+                        source=source, spread=None)
+    report = MeshReport(vertices=len(v), faces=m, zero_area_faces=moments[0].zero_area_faces, bodies=1, cavities=0,
+                        flipped_shells=0, overlapping_shells=0, repaired=False, repair_actions=(),
+                        repair_volume_change=None, bbox_min=lo, bbox_max=hi, method=certified.method,
+                        uncertainty=certified.uncertainty, notes=certified.notes, certificate=certified.certificate,
+                        source=source, units=raw.units, file_faces=raw.file_faces, degenerate_faces=0,
+                        watertight=True, welded_tolerance=None, flipped_faces=0, nonmanifold_edges=0)
+    return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(moments), owner=np.arange(1), report=report)
