@@ -11,12 +11,12 @@ the answer exact, in the order of the full path and with the same functions (so 
    exactly two faces in opposite directions (closed, consistently oriented), one edge-connected shell;
 3. the shell's moments about the bounding-box centre and their round-off bound (R7,
    :func:`~inertia_tool.integrals.accurate_shells`); a shell enclosing volume above R2's flatness, wound outward;
-4. the exact face-pair check (:func:`~.intersect.surface_contacts`): complete, no pair crossing, no pair coplanar
-   and facing opposite ways (contacts of a shell with itself at a vertex or along an edge change nothing here, as
-   in the full path);
-5. the certificate of :func:`~.certify.certify` (``exact`` with ``edge-balanced``, ``consistently-oriented`` and
-   ``no-crossing-faces`` when the round-off bound is within ``ROUNDOFF_RTOL``, ``unverified`` with its note when
-   not).
+4. the exact face-pair check (the C kernel of :func:`~.intersect.surface_contacts`, with the same arguments):
+   complete, no pair crossing, no pair coplanar and facing opposite ways (contacts of a shell with itself at a
+   vertex or along an edge change nothing here, as in the full path);
+5. R7 of :func:`~.certify.certify`: the round-off bound of the total (:func:`~inertia_tool.integrals.total_roundoff`)
+   within ``ROUNDOFF_RTOL``, so the certificate is ``exact`` with ``edge-balanced``, ``consistently-oriented`` and
+   ``no-crossing-faces`` (beyond it, the full path certifies ``unverified`` with its note).
 
 Whenever any of these does not hold, :func:`prepare_clean` returns None *before* saying anything (no warning is
 issued, nothing is refused): the caller then runs the full :func:`~.prepare.prepare_mesh`, which decides, warns and
@@ -32,25 +32,38 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._native import accel, faces_for_c, threads
 from ..errors import InvalidMeshError
-from ..integrals import accurate_shells, body_volume_moments, bounding_box
-from ..tolerances import FLAT_RTOL
-from .certify import certify
+from ..integrals import accurate_shells, body_volume_moments, bounding_box, total_roundoff
+from ..tolerances import FLAT_RTOL, ROUNDOFF_RTOL
 from .checks import MeshReport, census_and_shells
-from .intersect import surface_contacts
+from .intersect import STAR_MIN_FACES, surface_contacts
+from .policy import Certificate
 from .prepare import PreparedMesh
 from .read import RawMesh
-from .shells import Shells
 from .surface import check_magnitude
 
 __all__ = ["prepare_clean", "CLEAN_MAX_FACES", "CLEAN_CHECKS"]
 
 #: Largest part (faces) the fast path takes: above it the stages' own cost dwarfs what the fast path saves, and
-#: the full path's memory management (streamed weld, released scratch) is the one tuned for it.
-CLEAN_MAX_FACES = 1 << 20
+#: the full path's memory management (chunked passes, released scratch) is the one tuned for it.
+CLEAN_MAX_FACES = 1 << 17
 
 #: The checks of the certificate of a clean part (the full path's ``first_checks`` for one shell, nothing crossing).
 CLEAN_CHECKS = ("edge-balanced", "consistently-oriented", "no-crossing-faces")
+
+#: The certificate of every part the fast path takes (a frozen value: one object serves them all); what
+#: :func:`~.certify.certify` gives a clean shell whose round-off bound is within ``ROUNDOFF_RTOL``.
+_EXACT = Certificate("exact", CLEAN_CHECKS)
+
+#: Nonzero coordinate magnitudes within which the C face-pair kernel's floating-point filters are valid (those of
+#: :func:`~.intersect.surface_contacts`, which scales other coordinates first: the fast path leaves them to it).
+_SAFE_SMALLEST, _SAFE_LARGEST = 2.0 ** -240, 2.0 ** 299
+
+#: The kind the C face-pair kernel gives a pair that meets only on the boundary of one face (``intersect``'s
+#: ``_CONTACT``): the only kind a clean part may have (a crossing or a coplanar opposite pair sends it to the
+#: full path, as does a pair the kernel left undecided, kind < 0).
+_CONTACT_KIND = 3
 
 
 def prepare_clean(raw: RawMesh, *, max_faces: int = CLEAN_MAX_FACES) -> PreparedMesh | None:
@@ -95,17 +108,44 @@ def prepare_clean(raw: RawMesh, *, max_faces: int = CLEAN_MAX_FACES) -> Prepared
     volume = moments[0].volume
     if not (volume > 0 and abs(volume) > FLAT_RTOL * diag ** 3):
         return None                                              # inside out, flat or NaN: the full path decides
-    contacts = surface_contacts(v, f)
-    if not contacts.complete or len(contacts.crossing) or len(contacts.coplanar_opposite):
+    if not _meet_only_in_contacts(v, f, lo, hi):
         return None
-    shells = Shells(v, f, labels, 1, moments, bound)
-    certified = certify(shells, kind="exact", checks=list(CLEAN_CHECKS), method="exact", patched=None,
-                        arranged=False, verified=False, ambiguous=False, folds=False, sheets_removed=False,
-                        source=source, spread=None)
+    if not total_roundoff(moments, bound) <= ROUNDOFF_RTOL:
+        return None                                              # R7 "unverified", with its note: the full path's
     report = MeshReport(vertices=len(v), faces=m, zero_area_faces=moments[0].zero_area_faces, bodies=1, cavities=0,
                         flipped_shells=0, overlapping_shells=0, repaired=False, repair_actions=(),
-                        repair_volume_change=None, bbox_min=lo, bbox_max=hi, method=certified.method,
-                        uncertainty=certified.uncertainty, notes=certified.notes, certificate=certified.certificate,
-                        source=source, units=raw.units, file_faces=raw.file_faces, degenerate_faces=0,
-                        watertight=True, welded_tolerance=None, flipped_faces=0, nonmanifold_edges=0)
+                        repair_volume_change=None, bbox_min=lo, bbox_max=hi, method="exact", uncertainty=None,
+                        notes=(), certificate=_EXACT, source=source, units=raw.units, file_faces=raw.file_faces,
+                        degenerate_faces=0, watertight=True, welded_tolerance=None, flipped_faces=0,
+                        nonmanifold_edges=0)
     return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(moments), owner=np.arange(1), report=report)
+
+
+def _meet_only_in_contacts(v: np.ndarray, f: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
+    """Whether the exact face-pair check finds no pair crossing and none coplanar facing opposite ways (contacts
+    only, or nothing), complete.
+
+    The C kernel of :func:`~.intersect.surface_contacts` (``contact_scan``, no work bound, its certified stars
+    and patches) called directly on coordinates in its safe range, without the wrapper's views, masks and
+    :class:`~.intersect.SurfaceContacts`: this part needs only the kinds of the pairs found.  Anything else (no
+    C extension, coordinates outside the range, a kernel that answers otherwise) asks
+    :func:`~.intersect.surface_contacts` itself.
+    """
+    lib = accel()
+    if lib is not None:
+        corners = lo.tolist() + hi.tolist()
+        largest = max(abs(x) for x in corners)
+        magnitude = np.abs(v.reshape(-1))
+        nonzero = magnitude[magnitude > 0]
+        smallest = float(nonzero.min()) if len(nonzero) else np.inf
+        if largest <= _SAFE_LARGEST and smallest >= _SAFE_SMALLEST and f.min() >= 0 and f.max() < len(v):
+            try:
+                _, _, kinds, _, _, _, complete, _, _ = lib.contact_scan(
+                    np.ascontiguousarray(v, dtype=np.float64), faces_for_c(f), -1, threads(), STAR_MIN_FACES, True)
+            except (TypeError, ValueError):         # a kernel of another signature: the wrapper knows it
+                pass
+            else:
+                kind = np.frombuffer(kinds, dtype=np.int8)
+                return bool(complete) and not (kind != _CONTACT_KIND).any()
+    contacts = surface_contacts(v, f)
+    return bool(contacts.complete) and not len(contacts.crossing) and not len(contacts.coplanar_opposite)
