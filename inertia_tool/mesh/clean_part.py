@@ -9,14 +9,17 @@ the answer exact, in the order of the full path and with the same functions (so 
 1. the bounding box and the coordinates' safe range, no triangle with a repeated corner, a positive extent;
 2. the edge census and the shells from one adjacency (:func:`~.checks.census_and_shells`): every edge shared by
    exactly two faces in opposite directions (closed, consistently oriented), one edge-connected shell;
-3. the shell's moments about the bounding-box centre and their round-off bound (R7,
-   :func:`~inertia_tool.integrals.accurate_shells`); a shell enclosing volume above R2's flatness, wound outward;
+3. the shell's moments about the bounding-box centre and their round-off bound (R7: what
+   :func:`~inertia_tool.integrals.body_volume_moments`, :func:`~inertia_tool.integrals.accurate_shells` and
+   :func:`~inertia_tool.integrals.total_roundoff` give, in one call, :func:`~inertia_tool.integrals.one_shell_moments`;
+   a sliver that R7 would integrate again, or one within a margin of it, goes to the full path); a shell enclosing
+   volume above R2's flatness, wound outward;
 4. the exact face-pair check (the C kernel of :func:`~.intersect.surface_contacts`, with the same arguments):
    complete, no pair crossing, no pair coplanar and facing opposite ways (contacts of a shell with itself at a
    vertex or along an edge change nothing here, as in the full path);
-5. R7 of :func:`~.certify.certify`: the round-off bound of the total (:func:`~inertia_tool.integrals.total_roundoff`)
-   within ``ROUNDOFF_RTOL``, so the certificate is ``exact`` with ``edge-balanced``, ``consistently-oriented`` and
-   ``no-crossing-faces`` (beyond it, the full path certifies ``unverified`` with its note).
+5. R7 of :func:`~.certify.certify`: the round-off bound of the total within ``ROUNDOFF_RTOL`` (by a margin), so
+   the certificate is ``exact`` with ``edge-balanced``, ``consistently-oriented`` and ``no-crossing-faces`` (beyond
+   it, the full path certifies ``unverified`` with its note).
 
 Whenever any of these does not hold, :func:`prepare_clean` returns None *before* saying anything (no warning is
 issued, nothing is refused): the caller then runs the full :func:`~.prepare.prepare_mesh`, which decides, warns and
@@ -34,7 +37,7 @@ import numpy as np
 
 from .._native import accel, faces_for_c, threads
 from ..errors import InvalidMeshError
-from ..integrals import accurate_shells, body_volume_moments, bounding_box, total_roundoff
+from ..integrals import bounding_box, one_shell_moments
 from ..tolerances import FLAT_RTOL, ROUNDOFF_RTOL
 from .checks import MeshReport, census_and_shells
 from .intersect import STAR_MIN_FACES, surface_contacts
@@ -103,22 +106,24 @@ def prepare_clean(raw: RawMesh, *, max_faces: int = CLEAN_MAX_FACES) -> Prepared
         return None
     centre = 0.5 * (lo + hi)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):     # a flat shell's bound is inf or NaN
-        moments = body_volume_moments(v, f, labels, 1, origin=centre)
-        moments, _, bound = accurate_shells(v, f, labels, moments, centre)
-    volume = moments[0].volume
+        found = one_shell_moments(v, f, centre, (lo, hi), rtol=ROUNDOFF_RTOL)
+    if found is None:
+        return None                                              # a sliver R7 integrates again, or no C extension
+    shell, within = found
+    volume = shell.volume
     if not (volume > 0 and abs(volume) > FLAT_RTOL * diag ** 3):
         return None                                              # inside out, flat or NaN: the full path decides
     if not _meet_only_in_contacts(v, f, lo, hi):
         return None
-    if not total_roundoff(moments, bound) <= ROUNDOFF_RTOL:
-        return None                                              # R7 "unverified", with its note: the full path's
-    report = MeshReport(vertices=len(v), faces=m, zero_area_faces=moments[0].zero_area_faces, bodies=1, cavities=0,
+    if not within:
+        return None                                              # R7 may say "unverified", with its note
+    report = MeshReport(vertices=len(v), faces=m, zero_area_faces=shell.zero_area_faces, bodies=1, cavities=0,
                         flipped_shells=0, overlapping_shells=0, repaired=False, repair_actions=(),
                         repair_volume_change=None, bbox_min=lo, bbox_max=hi, method="exact", uncertainty=None,
                         notes=(), certificate=_EXACT, source=source, units=raw.units, file_faces=raw.file_faces,
                         degenerate_faces=0, watertight=True, welded_tolerance=None, flipped_faces=0,
                         nonmanifold_edges=0)
-    return PreparedMesh(vertices=v, faces=f, labels=labels, shells=tuple(moments), owner=np.arange(1), report=report)
+    return PreparedMesh(vertices=v, faces=f, labels=labels, shells=(shell,), owner=np.arange(1), report=report)
 
 
 def _meet_only_in_contacts(v: np.ndarray, f: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
