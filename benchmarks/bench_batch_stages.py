@@ -54,7 +54,7 @@ import trimesh  # noqa: E402
 from bench_batch import SMALL_KINDS, _write_stl, make_small_meshes  # noqa: E402
 from inertia_tool.batch.chunks import POOL_CHUNK_SECONDS  # noqa: E402
 from inertia_tool.batch.rows import format_row  # noqa: E402
-from inertia_tool.batch.runner import BatchOptions, _analyze, discover_files  # noqa: E402
+from inertia_tool.batch.runner import BatchOptions, _analyze, _chunk_context, discover_files  # noqa: E402
 from inertia_tool.integrals import body_volume_moments  # noqa: E402
 from inertia_tool.mass.pipeline import mass_properties  # noqa: E402
 from inertia_tool.mesh import LoadOptions  # noqa: E402
@@ -103,7 +103,7 @@ def _stages(files: list[str], options: BatchOptions, repeat: int) -> dict[str, f
     file.  The least total of each stage over ``repeat`` passes is kept."""
     clock = time.process_time
     cost = _timer_cost()
-    key = options.key()
+    context = _chunk_context(options, [], options.key(), "bench")
     best: dict[str, float] = {}
     rows = []
     for _ in range(repeat):
@@ -131,7 +131,7 @@ def _stages(files: list[str], options: BatchOptions, repeat: int) -> dict[str, f
             t7 = clock()
             _ = mass_properties(raw, density=1240.0).principal
             t8 = clock()
-            row = _analyze(path, options, None, key, "bench")
+            row = _analyze(path, None, context)
             t9 = clock()
             rows.append(row)
             read, digest, parse, census, pairs = t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4

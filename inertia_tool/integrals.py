@@ -40,9 +40,13 @@ from ._native import accel, faces_for_c, threads
 from .tolerances import ROUNDOFF_RTOL
 
 __all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box",
-           "roundoff_bounds", "exact_volume_moments", "RoundoffBound", "accurate_shells", "total_roundoff"]
+           "roundoff_bounds", "exact_volume_moments", "RoundoffBound", "accurate_shells", "total_roundoff",
+           "one_shell_moments"]
 
 _DEFAULT_CHUNK = 1 << 15
+
+#: The labels of a single shell's faces as the C round-off sums take them (none: every face is the shell's).
+_NO_LABELS = np.zeros(0, dtype=np.int64)
 
 #: Largest shell (faces) :func:`accurate_shells` integrates in exact integer arithmetic (about 10 µs a face).
 EXACT_MAX_FACES = 4096
@@ -666,3 +670,90 @@ def _one_shell_shares(s: VolumeMoments, e_vol: np.ndarray, e_cen: np.ndarray, e_
     if only is not None:
         return np.array(e_vol[only]), np.array(share_i[only]), abs(weight), inertia
     return e_vol, share_i, abs(weight), inertia
+
+
+def one_shell_moments(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, box: tuple[np.ndarray, np.ndarray],
+                      *, rtol: float = ROUNDOFF_RTOL, area_rtol: float = 1e-14,
+                      margin: float = 1e-6) -> tuple[VolumeMoments, bool] | None:
+    """One closed shell's moments about ``origin``, as ``body_volume_moments`` (one label) gives them, bit for bit,
+    and whether their round-off is certainly within ``rtol``: the clean-part fast path of
+    :mod:`~inertia_tool.mesh.clean_part`, in one call on the C extension.
+
+    The moments come from the same kernel and the same :func:`_finish` as :func:`volume_moments` (same area floor
+    from ``box``).  The round-off bound is :func:`roundoff_bounds`'s one-shell formula and the shares of
+    :func:`accurate_shells` and :func:`total_roundoff`, evaluated on Python floats; since only decisions are taken
+    from them (never a number of the result), each is taken with a ``margin``: a shell within it of
+    ``accurate_shells``' budget (half of ``rtol``) gives None, and one within it of ``rtol`` says False, so that a
+    difference of summation order (a few units of round-off in the bound itself) can never make this call accept a
+    shell that the general path would treat otherwise.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64, C-contiguous
+        m.
+    faces : (m, 3) int
+        One shell (every face is integrated).
+    origin : (3,) float
+        The reference point (the bounding-box centre, as :func:`body_volume_moments` takes by default).
+    box : ((3,) float, (3,) float)
+        ``bounding_box(vertices)``, already computed (the area floor of ``area_rtol`` is taken from it).
+    rtol, area_rtol
+        As for :func:`accurate_shells` and :func:`volume_moments`.
+    margin : float
+        Relative margin of the decisions (above).
+
+    Returns
+    -------
+    (VolumeMoments, bool) or None
+        The moments, and True when :func:`total_roundoff` of them is within ``rtol`` (by the margin; the general
+        path decides a shell that gets False); None without the C extension, or when :func:`accurate_shells` could
+        integrate the shell again (a sliver), so that the caller takes the general path.
+    """
+    lib = accel()
+    if lib is None:
+        return None
+    lo, hi = box
+    o = np.asarray(origin, dtype=np.float64)
+    vol, first, second, area, zero = _tetra_sums_c(lib, vertices, faces, o, None, 1,
+                                                   area_rtol * float(np.sum((hi - lo) ** 2)))
+    shell = _finish(vol[0], first[0], second[0], area[0], o, zero[0])
+    sp, sps, spq = _roundoff_sums_c(lib, vertices, faces, _NO_LABELS, 1, o, _DEFAULT_CHUNK)[0].tolist()
+    # roundoff_bounds' one-shell tail (_one_shell_bound), on floats
+    count = float(len(faces))
+    summing = (2 + count * count * _U) * _U
+    e_volume = (_U + summing) * sp / 6
+    e_first = (2 * _U + summing) * sps / 24
+    e_second = (3 * _U + summing) * spq / 120
+    volume = shell.volume
+    vol_abs = abs(volume)
+    centroid = shell.centroid.tolist()
+    moment = shell.second_moment.tolist()
+    d = math.sqrt(sum((c - x) ** 2 for c, x in zip(centroid, o.tolist()))) if volume != 0 else 0.0
+    norm_c = math.sqrt(sum(x * x for row in moment for x in row))
+    if not (vol_abs > 0 and math.isfinite(vol_abs) and math.isfinite(norm_c) and norm_c > 0):
+        return None                                    # no volume or no spread: the general path decides
+    first_m = vol_abs * d
+    about_origin = norm_c + vol_abs * d * d
+    e_centroid = (e_first + d * e_volume) / vol_abs
+    e_central = e_second + (2 * first_m * e_first + d * d * vol_abs * e_volume) / vol_abs + \
+        4 * _U * (about_origin + first_m * d)
+    keep = 1 - margin
+
+    def shares(weight: float) -> tuple[float, float, list[float]]:
+        """_one_shell_shares on floats: the shares of the volume and of the inertia, and the shell's offset from
+        the total's centroid (``(w·x)/w``: zero but for rounding)."""
+        delta = [x - (weight * x) / weight for x in centroid]
+        dd = math.sqrt((delta[0] * delta[0] + delta[1] * delta[1]) + delta[2] * delta[2])
+        return e_volume, 3 * (e_central + dd * dd * e_volume + 2 * vol_abs * dd * e_centroid), delta
+
+    share_v, share_i, delta = shares(vol_abs)          # accurate_shells: magnitudes (Σ|V|, Σ‖C‖ + |V| d²)
+    total_i = norm_c + vol_abs * sum(x * x for x in delta)
+    if not (share_v <= keep * 0.5 * rtol * vol_abs and share_i <= keep * 0.5 * rtol * total_i
+            and math.isfinite(share_v) and math.isfinite(share_i)):
+        return None                                    # accurate_shells would integrate it again
+    share_v, share_i, delta = shares(volume)           # total_roundoff: |Σ V| and ‖tr(C') 1 - C'‖
+    about = [[moment[i][j] + volume * (delta[i] * delta[j]) for j in range(3)] for i in range(3)]
+    trace = (about[0][0] + about[1][1]) + about[2][2]
+    norm_i = math.sqrt(sum((trace * (i == j) - about[i][j]) ** 2 for i in range(3) for j in range(3)))
+    within = norm_i > 0 and max(share_v / vol_abs, share_i / norm_i) <= keep * rtol
+    return shell, bool(within)

@@ -349,7 +349,11 @@ def row(v1):
 defs["batch_row"] = d("One row of inertia-tool batch: a flat object (JSON Lines), or a CSV record with the same "
                       "columns in the same order (empty cell = null, booleans true/false). Every number in its "
                       "column's SI unit (see each column); inertia about the centre of mass, mesh axes, tensor "
-                      "convention; i1 <= i2 <= i3 with unit axes axisK_x..z.", row(False))
+                      "convention; i1 <= i2 <= i3 with unit axes axisK_x..z. A row carries what the checks "
+                      "concluded (method, certificate, watertight, faces, bodies, cavities), never the face-pair "
+                      "check's diagnostic counters (candidate_pairs, tested_pairs: they describe the search, and the "
+                      "batch's clean-part fast path does not compute them); a row is the same on either path.",
+                      row(False))
 defs["batch_row_v1"] = d("A row of a results file written before inertia_tool.batch/2 (read back on resume): units "
                          "is the mesh length unit, no method and uncertainty columns.", row(True))
 

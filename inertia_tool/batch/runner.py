@@ -474,7 +474,7 @@ def _analyze(path: str, sha256: str | None, chunk: _Chunk) -> dict:
         # a file that names materials per part is integrated part by part from its path (it is read again:
         # rare); every other file from the mesh just read, as mass_properties(path) would
         props = mass_properties(path if raw.parts else raw, density=options.density, material=options.material,
-                                mass=options.mass, options=load)
+                                mass=options.mass, options=load, fast_path=True)
         pa = props.principal
         tensor = props.inertia.tolist()
         axes = pa.axes.tolist()                     # axis k = column k of `axes`

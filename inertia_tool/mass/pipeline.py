@@ -22,7 +22,8 @@ from ..mesh.classify import classify_shells
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.precision import warn_storage_precision
-from ..mesh.prepare import PreparedMesh, prepare_mesh
+from ..mesh.clean_part import prepare_clean
+from ..mesh.prepare import OVERLAP_MODES, PreparedMesh, prepare_mesh
 from ..mesh.read import RawMesh, load_mesh
 from ..tolerances import NEEDLE_RTOL, PART_OVERLAP_RTOL, TRIANGLE_INEQUALITY_RTOL
 from ..units import material_density
@@ -140,7 +141,8 @@ def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassPrope
 
 def mass_properties(source: MeshSource, *, density: float | None = None, material: str | None = None,
                     mass: float | None = None, name: str | None = None, options: LoadOptions | None = None,
-                    material_map: Mapping[str, float | str] | None = None, **load_options: Any) -> MassProperties:
+                    material_map: Mapping[str, float | str] | None = None, fast_path: bool = False,
+                    **load_options: Any) -> MassProperties:
     """Mass properties of the solid bounded by a triangle mesh, exact for the polyhedron.
 
     Parameters
@@ -164,6 +166,11 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
         is integrated part by part (:mod:`inertia_tool.mass.materials` gives the rule that decides each
         density; ``density``/``material`` are then the default of the parts the file names no material for)
         and the result's ``parts`` are the parts.
+    fast_path : bool
+        Try the clean-part fast path first (:func:`~inertia_tool.mesh.clean_part.prepare_clean`: one closed,
+        consistently wound shell whose faces meet nowhere else, the same checks in fewer steps), falling back to
+        the full checks for any other mesh.  The result is the same either way, field for field; ``inertia-tool
+        batch`` sets it (its per-part cost is mostly such steps).
     **load_options
         Fields of :class:`~inertia_tool.mesh.options.LoadOptions` (``units="mm"``, ``repair=True``, ...),
         a shortcut that overrides those of ``options``.
@@ -198,19 +205,23 @@ def mass_properties(source: MeshSource, *, density: float | None = None, materia
         raise UsageError("`material_map` applies to a file that names parts or materials (give its path), not to "
                          f"{type(source).__name__}")
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):   # non-finite results refused below
-        return _part(source, rho, mass, opts, name=name)[0]
+        return _part(source, rho, mass, opts, name=name, fast_path=fast_path)[0]
 
 
 def _part(source: MeshSource, rho: float | None, mass: float | None, options: LoadOptions, *, name: str | None,
-          warn_principal: bool = True, self_crossing: str = "refuse") -> tuple[MassProperties, PreparedMesh]:
+          warn_principal: bool = True, self_crossing: str = "refuse",
+          fast_path: bool = False) -> tuple[MassProperties, PreparedMesh]:
     """Mass properties of one mesh and its checked mesh (for cross-part checks of an assembly).
 
     ``self_crossing`` is passed to :func:`~inertia_tool.mesh.prepare.prepare_mesh` (``"unverified"`` only for
-    meshes the package made itself by a boolean: spin-it's hollowed parts)."""
+    meshes the package made itself by a boolean: spin-it's hollowed parts); ``fast_path`` tries
+    :func:`~inertia_tool.mesh.clean_part.prepare_clean` first (the same result on the parts it takes)."""
     raw = load_mesh(source, units=options.units, max_faces=options.max_faces,
                     declared_units_win=options.declared_units_win)
-    prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance,
-                            overlap=options.overlap, self_crossing=self_crossing)
+    prepared = prepare_clean(raw) if fast_path and options.overlap in OVERLAP_MODES else None
+    if prepared is None:
+        prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance,
+                                overlap=options.overlap, self_crossing=self_crossing)
     label = name or raw.source
     warn_implausible_size(raw, stacklevel=4)
     if len(prepared.shells) == 1:          # one shell, one body: made once, with its report (what the copy below is)
