@@ -7,8 +7,10 @@ and folded strips; a jittered sphere), then runs ``surface_contacts`` on each in
 this checkout and ``--baseline DIR`` (e.g. a ``git worktree`` of main, its C extension built) — in several
 modes (default; int64 faces; ``_patches=False``; ``_star_faces=0``; a work bound ``max_pairs``; with
 ``INERTIA_TOOL_CT_POISON=1``, which fills every block the C scan takes with 0xA5 bytes, so that a read before a
-write changes the answer) and compares all fields (the three pair lists, ``complete``, the counts).  Prints the
-number of cases and modes compared and every difference; exit status 1 on any.
+write changes the answer; poisoned with the faces across each edge built in three rounds,
+``INERTIA_TOOL_CT_TWIN_ROUNDS=3``, which a build without rounds ignores) and compares all fields (the three
+pair lists, ``complete``, the counts).  Prints the number of cases and modes compared and every difference;
+exit status 1 on any.
 
     python benchmarks/bench_intersect_agree.py --baseline /path/to/main [--cases 1000] [--big 1e6]
 """
@@ -28,7 +30,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 FIELDS = ("crossing", "coplanar_opposite", "contact", "complete", "candidate_pairs", "tested_pairs",
           "exact_evaluations", "degenerate_faces")
-MODES = ("default", "int64", "unpatched", "unpruned", "bounded", "poison")
+MODES = ("default", "int64", "unpatched", "unpruned", "bounded", "poison", "rounds")
 
 
 def _soup(rng, m):
@@ -113,8 +115,10 @@ def run_child(path: str, out: str) -> None:
     for name, v, f in todo:
         row = {}
         for mode in MODES:
-            if mode == "poison":
+            if mode in ("poison", "rounds"):
                 os.environ["INERTIA_TOOL_CT_POISON"] = "1"
+            if mode == "rounds":                # a build without rounds ignores it: its default answer
+                os.environ["INERTIA_TOOL_CT_TWIN_ROUNDS"] = "3"
             kw = {"unpatched": {"_patches": False}, "unpruned": {"_star_faces": 0},
                   "bounded": {"max_pairs": max(1, len(f) // 3)}}.get(mode, {})
             faces = f.astype(np.int64) if mode == "int64" else f
@@ -124,6 +128,7 @@ def run_child(path: str, out: str) -> None:
             except Exception as exc:          # an error is an answer too: it must be the same one
                 row[mode] = (type(exc).__name__, str(exc))
             os.environ.pop("INERTIA_TOOL_CT_POISON", None)
+            os.environ.pop("INERTIA_TOOL_CT_TWIN_ROUNDS", None)
         res.append((name, row))
     with open(out, "wb") as fh:
         pickle.dump(res, fh)

@@ -35,7 +35,7 @@ It refuses to run when the C kernels are not loaded (a missing build, or one fro
 package then falls back to numpy with one warning, and the rows would time another program), unless
 ``INERTIA_TOOL_NO_ACCEL`` asks for numpy on purpose.
 
-    python benchmarks/bench_stages.py [--sizes 1m cad 5m 10m] [--repeat 5] [--json out.json]
+    python benchmarks/bench_stages.py [--sizes 1m cad 5m 10m] [--repeat 5] [--json out.json] [--out /tmp/bench]
 """
 
 from __future__ import annotations
@@ -336,6 +336,7 @@ def measure(path: str, repeat: int) -> dict:
     cpu_best_run = {k: runs[best][0][k] * ns for k in rows}
     wall_best_run = {k: runs[best][1][k] * ns for k in rows}
     cpu_min = {k: min(r[0][k] for r in runs) * ns for k in rows}
+    cpu_median = {k: statistics.median(r[0][k] for r in runs) * ns for k in rows}
     profiled_cpu = sum(runs[best][0].values())
     other = sorted(runs[best][2].items(), key=lambda kv: -kv[1])[:8]
     sys_best_run = {k: runs[best][3][k] * ns for k in rows}
@@ -350,6 +351,7 @@ def measure(path: str, repeat: int) -> dict:
     return {
         "file": os.path.basename(path), "faces": n, "file_bytes": size, "profile_events": clock.events,
         "cpu_ns_per_corner": cpu_best_run, "wall_ns_per_corner": wall_best_run, "cpu_ns_per_corner_min": cpu_min,
+        "cpu_ns_per_corner_median": cpu_median,
         "sys_ns_per_corner": sys_best_run, "faults_per_1000_corners": faults_best_run,
         "other_cpu_ns_per_corner": {k: v * ns for k, v in other},
         "profiled_total_cpu_ns_per_corner": profiled_cpu * ns,
@@ -374,7 +376,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", nargs="+", default=["1m", "5m"], choices=sorted(SIZES))
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--json", help="also write the results here")
+    ap.add_argument("--out", help="where the meshes are written or found (default: $INERTIA_TOOL_BENCH_OUT, else "
+                    "benchmarks/out); e.g. /tmp/bench, outside the repository")
     args = ap.parse_args(argv)
+    if args.out:
+        global OUT
+        OUT = args.out
     require_c_kernels()
     from inertia_tool._native import accel, threads
     print(f"inertia_tool from {_package_root()}")
@@ -392,13 +399,16 @@ def main(argv: list[str] | None = None) -> int:
               f"peak {r['peak_bytes'] / 1e6:.0f} MB = {r['peak_vs_file']:.2f}x the file "
               f"({r['peak_above_imports_vs_file']:.2f}x above the imports)")
         cpu, wall, low = r["cpu_ns_per_corner"], r["wall_ns_per_corner"], r["cpu_ns_per_corner_min"]
+        mid = r["cpu_ns_per_corner_median"]
         kernel, faults = r["sys_ns_per_corner"], r["faults_per_1000_corners"]
-        print(f"  {'ns per corner':<15}{'CPU':>8}{'wall':>8}{'CPU min':>9}{'of CPU: sys':>13}{'faults/1k':>11}   "
-              "(the profiled run with the least CPU; CPU min: each row's least over the runs; sys: the kernel's "
-              "share of CPU, mostly zeroing fresh pages; faults per 1,000 corners)")
+        print(f"  {'ns per corner':<15}{'CPU':>8}{'wall':>8}{'CPU min':>9}{'CPU median':>12}{'of CPU: sys':>13}"
+              f"{'faults/1k':>11}   (the profiled run with the least CPU; CPU min, median: each row's least and "
+              "median over the runs; sys: the kernel's share of CPU, mostly zeroing fresh pages; faults per 1,000 "
+              "corners)")
         for k in cpu:
-            print(f"  {k:<15}{cpu[k]:8.1f}{wall[k]:8.1f}{low[k]:9.1f}{kernel[k]:13.1f}{faults[k]:11.2f}")
-        print(f"  {'sum':<15}{sum(cpu.values()):8.1f}{sum(wall.values()):8.1f}{'':9}{sum(kernel.values()):13.1f}"
+            print(f"  {k:<15}{cpu[k]:8.1f}{wall[k]:8.1f}{low[k]:9.1f}{mid[k]:12.1f}{kernel[k]:13.1f}"
+                  f"{faults[k]:11.2f}")
+        print(f"  {'sum':<15}{sum(cpu.values()):8.1f}{sum(wall.values()):8.1f}{'':21}{sum(kernel.values()):13.1f}"
               f"{sum(faults.values()):11.2f}")
         print(f"  plain total    {r['total_cpu_ns_per_corner']:8.1f}{r['total_wall_ns_per_corner']:8.1f}"
               f"   (least of the unprofiled runs; hook {r['hook_cpu_ns_per_corner']:+.1f} ns CPU, "

@@ -48,6 +48,7 @@
 #endif
 #if defined(__linux__)
 #include <sys/mman.h>
+#include <unistd.h>
 #endif
 
 /* ======================================================================================================
@@ -4404,6 +4405,24 @@ ct_clock(void)
     return 0.0;
 }
 #endif
+
+/* Profiling only (INERTIA_TOOL_CT_PROFILE): the process's resident MB now (VmRSS) and at most so far (VmHWM),
+ * from /proc (0 elsewhere), so that the profile names the phase that sets the check's high point. */
+static void
+ct_resident_mb(double *now, double *peak)
+{
+    *now = *peak = 0.0;
+#if defined(__linux__)
+    FILE *fh = fopen("/proc/self/status", "r");
+    char line[256];
+    if (fh == NULL) return;
+    while (fgets(line, sizeof(line), fh) != NULL) {
+        if (strncmp(line, "VmHWM:", 6) == 0) *peak = atof(line + 6) * 1024.0 / 1e6;
+        if (strncmp(line, "VmRSS:", 6) == 0) *now = atof(line + 6) * 1024.0 / 1e6;
+    }
+    fclose(fh);
+#endif
+}
 #define CONTACT_O3 (10.0 * 1.1102230246251565e-16)
 #define CONTACT_O2 (6.0 * 1.1102230246251565e-16)
 
@@ -5022,7 +5041,8 @@ ct_max3(double a, double b, double c)
 
 /* Corner indices of the faces in blocks of CT_LEAF hierarchy positions, corner by corner: block b holds
  * corners 0, 1, 2 of positions CT_LEAF b .. CT_LEAF b + CT_LEAF - 1, CT_LEAF int32 each (ct_share_mask tests
- * one vertex against a whole block); positions past the last face hold -1 (no vertex). */
+ * one vertex against a whole block); positions past the last face hold -1 (no vertex).  Only the blocks of
+ * the leaves a traversal is at are held (CtIdCache), and the one being boxed in pass 3. */
 #define CT_IDBLOCK (3 * CT_LEAF)
 
 static inline int32_t
@@ -5036,21 +5056,24 @@ ct_id(const int32_t *ids, int64_t i, int c)      /* corner c of the face at posi
  * (none relies on zeroed memory: INERTIA_TOOL_CT_POISON fills each block with 0xA5 bytes, for the tests), so
  * a block of CT_SMALL_BYTES or more is, in this order:
  *   1. a block the same call gave back (CtArena: the smallest that fits; the scan's phases never coexist, so
- *      the boxes take the twins' pages, the hierarchy's leaf boxes the positions', the corner indices the
- *      stars' lists');
+ *      the boxes take the twins' block, the hierarchy's leaf boxes the positions');
  *   2. else a fresh mapping (arena_alloc: the weld's and census's kept mappings unmapped first, then
  *      map_fresh, on 2 MB pages where the kernel offers them); the blocks held meanwhile are the twins' (for
  *      the boxes) under the stars' lists, a few bytes a face, below the traversal's high point.  (Taking the weld's kept mappings instead was tried: a reused block is resident from the
  *      start, while a fresh one only once written, and the analysis's peak rose by 18 MB at 5.24M faces, 32 MB
  *      at 1e7.)
- * The arrays of one size class are asked for in one size (the twins', boxes' and corner indices' 12 bytes a
- * face, the order's and positions' 4, all padded to whole leaves), so that they fit each other's blocks; sizes
+ * The arrays of one size class are asked for in one size (the twins' and boxes' 12 bytes a face, the order's
+ * and positions' 4, all padded to whole leaves), so that they fit each other's blocks; sizes
  * are not rounded up to 2 MB, which would make each array's last huge page resident whole (+23 bytes a face at
  * 3e5 faces).  A block reused for a smaller array has its pages past the request given back (MADV_DONTNEED).
  * The sort's words are unmapped when the twins are made (ct_drop: held under the stars' lists they raised the
  * check's high point by 6 bytes a face), and the blocks no array of the traversal takes are unmapped before
- * the boxes are written (ct_arena_trim): the check's high point is that of the phases alone, as before (37
- * bytes a face on a 300k torus).  At the end the blocks go to the pool (ct_arena_release: pool_give_dropped,
+ * the boxes are written (ct_arena_trim): the check's high point is that of the phases alone.  Since check7
+ * (issue 25: the check set the analysis's peak) the pages of an array whose content is dead until a later
+ * phase writes it again are given back meanwhile (ct_drop_pages: the sort words once the order is unpacked,
+ * the positions during the patches), the twins are built in rounds over ranges of vertices (ct_twins), the
+ * stars' lists are written into the twins' dead block (which the boxes then take) and the traversal keeps no
+ * corner indices (CtIdCache).  At the end the blocks go to the pool (ct_arena_release: pool_give_dropped,
  * for the next weld or census in the process).  Below CT_SMALL_BYTES a heap block (malloc;
  * a small part's scan made five mmap/munmap pairs, most of its time: 12-face box 52 -> 11 us; malloc, not
  * calloc: nothing reads before it writes).  ct_free must be given the size ct_alloc returned in *bytes. */
@@ -5133,6 +5156,22 @@ ct_drop(void *p, size_t bytes)
 {
     if (bytes < CT_SMALL_BYTES) free(p);
     else arena_free(p, bytes);
+}
+
+static void ct_free(CtArena *ar, void *p, size_t bytes);
+
+/* The pages of a mapped block (from CT_SMALL_BYTES up; a heap block is left alone) given back (MADV_DONTNEED):
+ * the block stays mapped and reads as zeros, and whatever is written next faults in fresh pages.  For an array
+ * whose content is dead until a later phase writes it again, so that it is not resident meanwhile. */
+static void
+ct_drop_pages(void *p, size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_DONTNEED)
+    if (p != NULL && bytes >= CT_SMALL_BYTES) madvise(p, bytes, MADV_DONTNEED);
+#else
+    (void)p;
+    (void)bytes;
+#endif
 }
 
 static void
@@ -5584,22 +5623,20 @@ ct_stars_scratch(int64_t n, int64_t m)
     return (size_t)(n > 0 ? n : 1) * sizeof(int64_t) + 3 * (size_t)(m > 0 ? m : 1) * sizeof(int32_t);
 }
 
-static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces,
-                    int64_t total, const int32_t *pos, int32_t *twin, int threads);
+static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t scratch_bytes,
+                    const int32_t *pos, int32_t *twin, int threads, int rounds);
 
 /* The faces of each vertex of at least list_min faces (in scratch, ct_stars_scratch(n, m) bytes, any content):
  * *off (n int64: the start of each kept vertex's range of faces, -1 for the others) and *faces (the faces of
  * each kept vertex, vertex after vertex, *total of them; a face holding v twice is listed twice).  With label
  * (per face, its certified patch or 0) a vertex whose faces all lie in one certified patch is not kept either
  * (ct_star_certs would not try it): on a smooth surface that is nearly every vertex, so the lists of the star
- * certificates take a few bytes a face instead of 16 when they are made after the patches. */
-static void
-ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, const int32_t *label, void *scratch,
-              int64_t **off_out, int32_t **faces_out, int64_t *total_out)
+ * certificates take a few bytes a face instead of 16 when they are made after the patches.  In two steps
+ * (ct_star_count, then ct_star_fill), so that a caller may place the faces once it knows how many there are. */
+static int64_t
+ct_star_count(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, const int32_t *label, int64_t *off)
 {
     size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
-    int64_t *off = (int64_t *)scratch;
-    int32_t *faces = (int32_t *)((char *)scratch + off_bytes);
     memset(off, 0, off_bytes);
     if (label == NULL) {
         for (size_t c = 0; c < 3 * (size_t)m; c++) off[index_at(F, fsize, c)]++;
@@ -5632,6 +5669,13 @@ ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, 
             off[v] = -1;
         }
     }
+    return total;
+}
+
+/* The lists of ct_star_count's off (then each kept vertex's start) into faces (as many as it returned). */
+static void
+ct_star_fill(const void *F, int fsize, int64_t m, int64_t *off, int32_t *faces)
+{
     for (int64_t f = 0; f < m; f++) {
         for (int c = 0; c < 3; c++) {
             int64_t v = index_at(F, fsize, 3 * (size_t)f + (size_t)c);
@@ -5639,6 +5683,18 @@ ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, 
             faces[--off[v]] = (int32_t)f;           /* a face holding v twice is listed twice (then rejected) */
         }
     }
+}
+
+/* Both steps in scratch (ct_stars_scratch(n, m) bytes, any content): off first, the faces after it. */
+static void
+ct_star_lists(int64_t n, const void *F, int fsize, int64_t m, int64_t list_min, const int32_t *label, void *scratch,
+              int64_t **off_out, int32_t **faces_out, int64_t *total_out)
+{
+    size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t);
+    int64_t *off = (int64_t *)scratch;
+    int32_t *faces = (int32_t *)((char *)scratch + off_bytes);
+    int64_t total = ct_star_count(n, F, fsize, m, list_min, label, off);
+    ct_star_fill(F, fsize, m, off, faces);
     *off_out = off;
     *faces_out = faces;
     *total_out = total;
@@ -5965,13 +6021,12 @@ ct_build_tree(CtNode *nodes, int64_t m)
  * boxes rounded outward, as ct_prep_task computed them before cutting the faces' boxes to steps on them) and
  * the apexes from cert (NULL: none), children before parents, on the tree of ct_build_tree. */
 static void
-ct_build_boxes(CtNode *nodes, int64_t n_nodes, const float *LBOX, const int32_t *ids, const uint8_t *cert, int64_t m)
+ct_build_boxes(CtNode *nodes, int64_t n_nodes, const float *LBOX, const int32_t *lapex)
 {
     for (int64_t k = n_nodes - 1; k >= CT_ROOT; k--) {
         CtNode *nd = &nodes[k];
         if (CT_IS_LEAF(nd)) {
-            int64_t start = CT_LEAF * CT_BLOCK_OF(nd), count = ct_leaf_count(nd, m);
-            nd->apex = (int32_t)ct_leaf_apex(ids, cert, start, count);
+            nd->apex = lapex[CT_BLOCK_OF(nd)];
             const float *lb = LBOX + 6 * CT_BLOCK_OF(nd);
             for (int c = 0; c < 3; c++) {
                 nd->lo[c] = lb[c];
@@ -6043,13 +6098,15 @@ ct_edge_hash(uint64_t k)
  * more, run twice one way, a corner held twice, or a vertex whose faces were not listed).  From the faces of
  * each vertex v (ct_stars' lists: off[v] the start of v's range, -1 when v was not kept, ranges in vertex
  * order ending at total): the face across v -> x of f is the face of v's list whose corner before v is x.
- * twin: 3 m int32, all -2 on entry. */
+ * The lists may be those of a range of vertices only (ct_twins' rounds): off and n then count from the range's
+ * first vertex, base.  twin: 3 m int32, all -2 on entry. */
 typedef struct {
     const void *F;
     int fsize;
     const int64_t *off;
     const int32_t *faces;
     int64_t n, total;
+    int64_t base;               /* the vertex of off[0] */
     const int32_t *pos;         /* NULL, or each face's hierarchy position: twin is then indexed and valued by it */
     int32_t *twin;
     int oom[MAX_THREADS];
@@ -6096,12 +6153,13 @@ ct_twin_task(void *ctx, int t, int nt)
             return;
         }
         int ok = 1;
+        int64_t vg = v + jb->base;                  /* the vertex, by index */
         for (int64_t i = 0; i < k; i++) {
             int32_t f = jb->faces[s + i];
             int64_t x[3];
             for (int c = 0; c < 3; c++) x[c] = index_at(jb->F, jb->fsize, 3 * (size_t)f + (size_t)c);
-            int c = x[0] == v ? 0 : x[1] == v ? 1 : 2;
-            if ((x[0] == v) + (x[1] == v) + (x[2] == v) != 1) ok = 0;      /* v twice in f: no twins here */
+            int c = x[0] == vg ? 0 : x[1] == vg ? 1 : 2;
+            if ((x[0] == vg) + (x[1] == vg) + (x[2] == vg) != 1) ok = 0;    /* v twice in f: no twins here */
             lk[i].next = (int32_t)x[(c + 1) % 3];
             lk[i].prev = (int32_t)x[(c + 2) % 3];
             lk[i].face = f;
@@ -6561,25 +6619,90 @@ done:
     return ok;
 }
 
-/* ct_twin_task over the vertices on threads; 0, or -1 when out of memory. */
+/* Meshes of at least this many faces build the twins in CT_TWIN_ROUNDS rounds (ct_twins), smaller ones in one;
+ * INERTIA_TOOL_CT_TWIN_ROUNDS (1 .. 64) sets the count for every mesh (the tests). */
+#define CT_TWIN_ROUNDS_FACES ((int64_t)1 << 19)
+#define CT_TWIN_ROUNDS 4
+
 static int
-ct_twins(const void *F, int fsize, int64_t n, int64_t m, const int64_t *off, const int32_t *faces, int64_t total,
-         const int32_t *pos, int32_t *twin, int threads)
+ct_twin_rounds(int64_t m)
 {
+    const char *env = getenv("INERTIA_TOOL_CT_TWIN_ROUNDS");
+    if (env != NULL && *env) {
+        long r = strtol(env, NULL, 10);
+        if (r >= 1 && r <= 64) return (int)r;
+    }
+    return m >= CT_TWIN_ROUNDS_FACES ? CT_TWIN_ROUNDS : 1;
+}
+
+/* twin (3 m int32, by hierarchy position when pos is given) from the faces of every vertex, in rounds: the
+ * vertices are cut into `rounds` ranges of equal count, and for each range the faces of its vertices are listed
+ * in scratch (as ct_star_lists lists them for list_min 1: off per vertex of the range, -1 for one of no face,
+ * then the faces, each vertex's in decreasing face order) and ct_twin_task run over them.  A face's corner c is
+ * written in the round of its vertex at c and in no other, so the twins are those of one round over every
+ * vertex; the lists take about 1 / rounds of the 8 n + 12 m bytes of one round (issue 25: the lists and the
+ * twins set the check's high point), each round reads the faces twice.  scratch: at least ct_stars_scratch(n,
+ * m) bytes, any content; a mapped one (CT_SMALL_BYTES or more) has its pages given back (MADV_DONTNEED) first
+ * and past each round's lists after its count.  0, or -1 when out of memory. */
+static int
+ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t scratch_bytes, const int32_t *pos,
+         int32_t *twin, int threads, int rounds)
+{
+    /* scratch's pages given back before the twins are written, not after each round's count: else the twins
+     * and the whole of scratch would be resident together */
+    ct_drop_pages(scratch, scratch_bytes);
     for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
-    CtTwinJob jb;
-    memset(&jb, 0, sizeof(jb));
-    jb.F = F;
-    jb.fsize = fsize;
-    jb.off = off;
-    jb.faces = faces;
-    jb.n = n;
-    jb.total = total;
-    jb.pos = pos;
-    jb.twin = twin;
-    run_parallel(thread_count(threads, (size_t)n, 20000), ct_twin_task, &jb);
-    for (int t = 0; t < MAX_THREADS; t++) {
-        if (jb.oom[t]) return -1;
+    if (rounds < 1) rounds = 1;
+    for (int r = 0; r < rounds; r++) {
+        int64_t va = (int64_t)part_start((size_t)n, r, rounds), vb = (int64_t)part_start((size_t)n, r + 1, rounds);
+        int64_t nv = vb - va;
+        if (nv <= 0) continue;
+        int64_t *off = (int64_t *)scratch;
+        int32_t *faces = (int32_t *)((char *)scratch + (size_t)nv * sizeof(int64_t));
+        memset(off, 0, (size_t)nv * sizeof(int64_t));
+        for (size_t c = 0; c < 3 * (size_t)m; c++) {
+            uint64_t v = (uint64_t)(index_at(F, fsize, c) - va);
+            if (v < (uint64_t)nv) off[v]++;
+        }
+        int64_t total = 0;
+        for (int64_t v = 0; v < nv; v++) {          /* end of each listed vertex's range, -1 for one of no face */
+            if (off[v] >= 1) {
+                total += off[v];
+                off[v] = total;
+            }
+            else {
+                off[v] = -1;
+            }
+        }
+#if defined(__linux__) && defined(MADV_DONTNEED)
+        if (scratch_bytes >= CT_SMALL_BYTES) {
+            size_t keep = ((size_t)nv * sizeof(int64_t) + (size_t)total * sizeof(int32_t) + 4095) & ~(size_t)4095;
+            if (keep < scratch_bytes) madvise((char *)scratch + keep, scratch_bytes - keep, MADV_DONTNEED);
+        }
+#else
+        (void)scratch_bytes;
+#endif
+        for (int64_t f = 0; f < m; f++) {
+            for (int c = 0; c < 3; c++) {
+                uint64_t v = (uint64_t)(index_at(F, fsize, 3 * (size_t)f + (size_t)c) - va);
+                if (v < (uint64_t)nv && off[v] >= 0) faces[--off[v]] = (int32_t)f;
+            }
+        }
+        CtTwinJob jb;
+        memset(&jb, 0, sizeof(jb));
+        jb.F = F;
+        jb.fsize = fsize;
+        jb.off = off;
+        jb.faces = faces;
+        jb.n = nv;
+        jb.total = total;
+        jb.base = va;
+        jb.pos = pos;
+        jb.twin = twin;
+        run_parallel(thread_count(threads, (size_t)nv, 20000), ct_twin_task, &jb);
+        for (int t = 0; t < MAX_THREADS; t++) {
+            if (jb.oom[t]) return -1;
+        }
     }
     return 0;
 }
@@ -6712,7 +6835,8 @@ ct_patch_labels(const CtNode *nodes, const uint8_t *patch, const int32_t *order,
 typedef struct {
     const CtQ *BOX;             /* face boxes as steps on their leaf's grid, in blocks of CT_LEAF (ct_block_mask) */
     const int32_t *order;       /* the caller's face index of each hierarchy position */
-    const int32_t *ids;         /* corner indices in hierarchy order, in blocks of CT_LEAF (ct_id) */
+    const void *F;              /* the caller's faces (m, 3), int32 or int64 (fsize bytes an index) */
+    int fsize;
     const uint8_t *flags;       /* projection axis | zero area << 2, in hierarchy order */
     const double *V;            /* vertices (n, 3) */
     const CtNode *nodes;
@@ -6727,15 +6851,56 @@ typedef struct {
     long long node_pairs, leaf_pairs, loads;   /* work counts, printed with INERTIA_TOOL_CT_PROFILE */
 } CtScan;
 
-/* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
- * (the arithmetic of ct_face_normal, when first needed), its corner indices, and the axis and zero-area flag
- * ct_prep_task gave it in the preparation.  No per-face record of 160 bytes is kept: a face is rebuilt from the vertices
- * when a box meets its (16 + 1 bytes per face instead). */
+/* The corner indices of one leaf's block of CT_LEAF hierarchy positions (the layout of ct_id: corner by corner,
+ * -1 past the last face), read from the caller's faces through order when the traversal first needs them
+ * (ct_leaf_ids).  They are not kept for every face (12 bytes a face, a third of the check's high point at the
+ * traversal): each traversal keeps those of the two leaves it is at, so a leaf recurring in consecutive leaf
+ * pairs is read once. */
+typedef struct {
+    int64_t block;              /* the leaf's block, -1 for none */
+    int filled;                 /* id holds that block's corner indices */
+    int32_t id[CT_IDBLOCK];
+} CtIdCache;
+
 static inline void
-ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
+ct_id_cache_at(CtIdCache *c, int64_t block)
 {
+    if (c->block != block) {
+        c->block = block;
+        c->filled = 0;
+    }
+}
+
+static const int32_t *
+ct_leaf_ids(const CtScan *sc, CtIdCache *c)
+{
+    if (!c->filled) {
+        int64_t start = CT_LEAF * c->block;
+        int count = (int)(sc->m - start < CT_LEAF ? sc->m - start : CT_LEAF);
+        for (int j = 0; j < count; j++) {       /* the rows lie at random in the caller's faces: all fetched first */
+            ct_prefetch((const char *)sc->F + (size_t)sc->fsize * 3 * (size_t)sc->order[start + j]);
+        }
+        for (int j = 0; j < CT_LEAF; j++) {
+            size_t g = j < count ? 3 * (size_t)sc->order[start + j] : 0;
+            for (int k = 0; k < 3; k++) {
+                c->id[k * CT_LEAF + j] = j < count ? (int32_t)index_at(sc->F, sc->fsize, g + (size_t)k) : -1;
+            }
+        }
+        c->filled = 1;
+    }
+    return c->id;
+}
+
+/* The face at hierarchy position i as ct_classify reads it: its corners, normal and the normal's permanent
+ * (the arithmetic of ct_face_normal, when first needed), its corner indices (from ci, the cache of its leaf's
+ * block), and the axis and zero-area flag ct_prep_task gave it in the preparation.  No per-face record of 160
+ * bytes is kept: a face is rebuilt from the vertices when a box meets its. */
+static inline void
+ct_face_load(CtFace *F, const CtScan *sc, int64_t i, CtIdCache *ci)
+{
+    const int32_t *ids = ct_leaf_ids(sc, ci);
     for (int k = 0; k < 3; k++) {
-        F->fo[k] = ct_id(sc->ids, i, k);
+        F->fo[k] = ct_id(ids, i % CT_LEAF, k);
     }
     ct_face_geometry(F, sc->V + 3 * (size_t)F->fo[0], sc->V + 3 * (size_t)F->fo[1], sc->V + 3 * (size_t)F->fo[2]);
     F->face = sc->order[i];
@@ -6746,15 +6911,16 @@ ct_face_load(CtFace *F, const CtScan *sc, int64_t i)
 /* A pair of faces (hierarchy positions i, j) whose float32 boxes meet and that share no certified star vertex:
  * the float64 boxes, then the test; returns 0 to go on, 1 to stop (bound reached or out of memory). */
 static int
-ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
+ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j,
+             CtIdCache *ci, CtIdCache *cj)
 {
     sc->loads++;
     if (!*have_i) {                         /* each face of a leaf pair is loaded once, when first needed */
-        ct_face_load(FI, sc, i);
+        ct_face_load(FI, sc, i, ci);
         *have_i = 1;
     }
     if (!*have_j) {
-        ct_face_load(FJ, sc, j);
+        ct_face_load(FJ, sc, j, cj);
         *have_j = 1;
     }
     for (int c = 0; c < 3; c++) {           /* the exact (float64) boxes */
@@ -6794,14 +6960,17 @@ ct_test_pair(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFa
  * "none" by the certificate and counted as tested, without rebuilding either face.  stars[i] says which
  * corners of the face at position i are certified (bit c: small star, bit 3 + c: big star). */
 static inline int
-ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j)
+ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *FJ, uint8_t *have_j,
+         CtIdCache *ci, CtIdCache *cj)
 {
     unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
     if (bits) {
-        int32_t y0 = ct_id(sc->ids, j, 0), y1 = ct_id(sc->ids, j, 1), y2 = ct_id(sc->ids, j, 2);
+        const int32_t *jd = ct_leaf_ids(sc, cj), *id = ct_leaf_ids(sc, ci);
+        int64_t jj = j % CT_LEAF, ii = i % CT_LEAF;
+        int32_t y0 = ct_id(jd, jj, 0), y1 = ct_id(jd, jj, 1), y2 = ct_id(jd, jj, 2);
         unsigned shared = 0;                /* bit c: corner c of face i is a corner of face j */
         for (int c = 0; c < 3; c++) {
-            int32_t x = ct_id(sc->ids, i, c);
+            int32_t x = ct_id(id, ii, c);
             shared |= (unsigned)((x == y0) | (x == y1) | (x == y2)) << c;
         }
         if ((bits >> 3) & shared) return 0;
@@ -6815,7 +6984,7 @@ ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *
             return 0;
         }
     }
-    return ct_test_pair(sc, i, j, FI, have_i, FJ, have_j);
+    return ct_test_pair(sc, i, j, FI, have_i, FJ, have_j, ci, cj);
 }
 
 /* The pairs of the face at position i with the positions base + j of one block, j the bits of mask (their float32
@@ -6826,15 +6995,15 @@ ct_visit(CtScan *sc, int64_t i, int64_t j, CtFace *FI, uint8_t *have_i, CtFace *
  * one by one.  With a work bound (max_pairs >= 0) every pair goes through ct_visit, in order. */
 static inline int
 ct_visit_block(CtScan *sc, int64_t i, int64_t base, unsigned mask, CtFace *FI, uint8_t *have_i, CtFace *leaf,
-               uint8_t *have)
+               uint8_t *have, CtIdCache *ci, CtIdCache *cj)
 {
     unsigned bits = sc->stars != NULL ? sc->stars[i] : 0;
     if (bits && sc->max_pairs < 0) {
-        const int32_t *ids = sc->ids + CT_IDBLOCK * (base / CT_LEAF);
+        const int32_t *ids = ct_leaf_ids(sc, cj), *id = ct_leaf_ids(sc, ci);
         unsigned big = 0, in_small = 0;
         for (int c = 0; c < 3; c++) {
             if (!((bits >> c) & 9u)) continue;
-            unsigned eq = ct_share_mask(ids, ct_id(sc->ids, i, c));
+            unsigned eq = ct_share_mask(ids, ct_id(id, i % CT_LEAF, c));
             if (bits & (8u << c)) big |= eq;
             else in_small |= eq;
         }
@@ -6847,14 +7016,14 @@ ct_visit_block(CtScan *sc, int64_t i, int64_t base, unsigned mask, CtFace *FI, u
         while (mask) {
             int b = ct_ctz(mask);
             mask &= mask - 1;
-            if (ct_test_pair(sc, i, base + b, FI, have_i, &leaf[b], &have[b])) return 1;
+            if (ct_test_pair(sc, i, base + b, FI, have_i, &leaf[b], &have[b], ci, cj)) return 1;
         }
         return 0;
     }
     while (mask) {
         int b = ct_ctz(mask);
         mask &= mask - 1;
-        if (ct_visit(sc, i, base + b, FI, have_i, &leaf[b], &have[b])) return 1;
+        if (ct_visit(sc, i, base + b, FI, have_i, &leaf[b], &have[b], ci, cj)) return 1;
     }
     return 0;
 }
@@ -6882,6 +7051,9 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
     memset(&gp, 0, sizeof(gp));
     memset(&gq, 0, sizeof(gq));
     int64_t gp_node = -1, gq_node = -1;
+    CtIdCache cp, cq;                       /* the corner indices of the leaves p and q, read when first needed */
+    cp.block = cq.block = -1;
+    cp.filled = cq.filled = 0;
     stack[0] = p0;
     stack[1] = q0;
     top = 1;
@@ -6913,12 +7085,14 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 CtFace leaf[CT_LEAF];
                 uint8_t have[CT_LEAF] = {0};
                 const CtQ *blk = sc->BOX + CT_BLOCK * CT_BLOCK_OF(p);
+                ct_id_cache_at(&cp, CT_BLOCK_OF(p));
                 for (int a = 0; a + 1 < pcount; a++) {
                     unsigned ql[3], qh[3];          /* one grid: the steps compare as they are */
                     ct_block_query(blk, a, ql, qh);
                     unsigned mask = ct_block_mask(blk, ql, qh);
                     mask &= ~((2u << a) - 1) & ct_leaf_bits(pcount);     /* the later faces j > i only */
-                    if (mask && ct_visit_block(sc, pstart + a, pstart, mask, &leaf[a], &have[a], leaf, have)) {
+                    if (mask && ct_visit_block(sc, pstart + a, pstart, mask, &leaf[a], &have[a], leaf, have, &cp,
+                                               &cp)) {
                         goto out;
                     }
                 }
@@ -6947,6 +7121,8 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 ct_grid(q, &gq);
                 gq_node = qi;
             }
+            ct_id_cache_at(&cp, CT_BLOCK_OF(p));
+            ct_id_cache_at(&cq, CT_BLOCK_OF(q));
             /* p's faces against q's box first (on p's grid), then each that meets it against q's faces (its
              * bytes mapped back outward, then onto q's grid) */
             unsigned ql[3] = {0, 0, 0}, qh[3] = {0, 0, 0};
@@ -6982,7 +7158,9 @@ ct_traverse(CtScan *sc, int64_t p0, int64_t q0)
                 unsigned mask = meets ? ct_block_mask(qb, ql, qh) & qbits : 0u;
                 CtFace FI;
                 uint8_t have_i = 0;
-                if (mask && ct_visit_block(sc, pstart + a, qstart, mask, &FI, &have_i, leaf, have)) goto out;
+                if (mask && ct_visit_block(sc, pstart + a, qstart, mask, &FI, &have_i, leaf, have, &cp, &cq)) {
+                    goto out;
+                }
             }
             continue;
         }
@@ -7107,8 +7285,10 @@ typedef struct {
     uint8_t *skip;
     CtQ *box;                   /* the faces' boxes as steps on their leaf's grid, in blocks (pass 3) */
     float *lbox;                /* each leaf's float32 box (pass 3; ct_build_boxes) */
+    int32_t *lapex;             /* each leaf's certified vertex common to its faces, or -1 (pass 3; ct_leaf_apex) */
+    const uint8_t *cert;        /* the star certificates per vertex (ct_stars), NULL without them */
+    uint8_t *stars;             /* per position, its certified corners (ct_visit; pass 3), when cert is given */
     int32_t *order;
-    int32_t *ids;
     uint8_t *flags;
     uint8_t *fmask;             /* NULL, or per position the orientations of the face's projections (ct_patches) */
     long exact[MAX_THREADS];
@@ -7196,6 +7376,7 @@ ct_prep_task(void *ctx, int t, int nt)
     e = b1 * CT_LEAF < pr->m ? b1 * CT_LEAF : pr->m;
     for (int64_t blk_i = b0; blk_i < b1; blk_i++) {
         double lo[CT_LEAF][3], hi[CT_LEAF][3];
+        int32_t ids[CT_IDBLOCK];                 /* the block's corner indices (ct_id), for its apex and bits */
         CtNode leaf;
         int64_t start = blk_i * CT_LEAF, count = pr->m - start < CT_LEAF ? pr->m - start : CT_LEAF;
         CtQ *blk = pr->box + CT_BLOCK * blk_i;
@@ -7219,9 +7400,16 @@ ct_prep_task(void *ctx, int t, int nt)
             const double *p1 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 1);
             const double *p2 = pr->V + 3 * index_at(pr->F, pr->size, 3 * (size_t)f + 2);
             pr->flags[i] = (uint8_t)((unsigned)pr->axis[f] | (unsigned)pr->skip[f] << 2);
+            unsigned bits = 0;
             for (int k = 0; k < 3; k++) {
-                pr->ids[CT_IDBLOCK * blk_i + k * CT_LEAF + j] = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
+                int32_t x = (int32_t)index_at(pr->F, pr->size, 3 * (size_t)f + (size_t)k);
+                ids[k * CT_LEAF + j] = x;
+                if (pr->cert != NULL) {
+                    uint8_t q = pr->cert[x];
+                    bits |= q == CT_STAR_BIG ? 8u << k : q == CT_STAR_SMALL_CERT ? 1u << k : 0u;
+                }
             }
+            if (pr->stars != NULL) pr->stars[i] = (uint8_t)bits;
             for (int c = 0; c < 3; c++) {
                 lo[j][c] = ct_min3(p0[c], p1[c], p2[c]);
                 hi[j][c] = ct_max3(p0[c], p1[c], p2[c]);
@@ -7244,10 +7432,10 @@ ct_prep_task(void *ctx, int t, int nt)
                 else {                                  /* past the last face: no box, no vertex */
                     blk[c * CT_LEAF + j] = (CtQ)CT_QMAX;
                     blk[(3 + c) * CT_LEAF + j] = 0;
-                    pr->ids[CT_IDBLOCK * blk_i + c * CT_LEAF + j] = -1;
                 }
             }
         }
+        pr->lapex[blk_i] = (int32_t)ct_leaf_apex(ids, pr->cert, 0, count);
     }
 }
 
@@ -7273,7 +7461,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
     CtQ *box = NULL;
     float *lbox = NULL;
     int32_t *order = NULL;
-    int32_t *ids = NULL;
+    int32_t *lapex = NULL;
     size_t nodes_bytes = 0, code_bytes = 0, box_bytes = 0, lbox_bytes = 0, order_bytes = 0, ids_bytes = 0;
     uint8_t *flags = NULL;
     int8_t *axis_out = NULL;
@@ -7335,6 +7523,8 @@ accel_contact_scan(PyObject *self, PyObject *args)
         box_bytes = n_blocks * CT_BLOCK * sizeof(CtQ);         /* two bytes per bound */
         lbox_bytes = n_blocks * 6 * sizeof(float);
         order_bytes = n_blocks * CT_LEAF * sizeof(int32_t);   /* whole leaves: the size of pos (below) */
+        /* the size of corner indices in blocks (12 bytes a face), no longer kept for the traversal (CtIdCache),
+         * is still the one the twins are asked for in, so that the boxes (the same 12) take their block */
         ids_bytes = n_blocks * CT_IDBLOCK * sizeof(int32_t);
         nodes = (CtNode *)ct_alloc(&ar, &nodes_bytes);
         code = (uint64_t *)ct_alloc(&ar, &code_bytes);
@@ -7349,7 +7539,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         /* the stage clocks only when profiling: CLOCK_PROCESS_CPUTIME_ID is a system call, and reading it at
          * every stage was about half of a 12-face scan's time (15.7 -> 8.6 us a call) */
         int profile = getenv("INERTIA_TOOL_CT_PROFILE") != NULL;
-        double clk[12] = {0};
+        double clk[12] = {0}, rss[12] = {0}, hwm[12] = {0};
         Py_BEGIN_ALLOW_THREADS
         clk[0] = profile ? ct_clock() : 0.0;
         int nt = thread_count(threads, (size_t)m, 20000);
@@ -7384,21 +7574,27 @@ accel_contact_scan(PyObject *self, PyObject *args)
         pr.pass = 0;
         run_parallel(nt, ct_prep_task, &pr);
         clk[1] = profile ? ct_clock() : 0.0;
+        if (profile) ct_resident_mb(&rss[1], &hwm[1]);
         if (ct_radix_sort(code, code + mm, m) < 0) {
             oom = 1;
         }
         else {
             clk[2] = profile ? ct_clock() : 0.0;
+            if (profile) ct_resident_mb(&rss[2], &hwm[2]);
             pr.pass = 1;
             run_parallel(nt, ct_prep_task, &pr);
             pr.pass = 2;
             run_parallel(nt, ct_prep_task, &pr);
             clk[3] = profile ? ct_clock() : 0.0;
+            if (profile) ct_resident_mb(&rss[3], &hwm[3]);
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
                 failed |= pr.failed[t];
             }
-            /* order holds the face indices in hierarchy order: code's memory is the stars' scratch now */
+            /* order holds the face indices in hierarchy order: code's memory is the stars' scratch now, its
+             * pages given back until then (issue 25: resident under the positions and the twins, the sort words
+             * were the check's high point) */
+            ct_drop_pages(code, code_bytes);
         }
         int64_t n_nodes = 0;
         int64_t star_min = star_faces < CT_STAR_MIN ? star_faces : CT_STAR_MIN;
@@ -7430,17 +7626,20 @@ accel_contact_scan(PyObject *self, PyObject *args)
             int64_t *off, total;
             int32_t *vfaces;
             for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
-            ct_star_lists(n, F, fsize, m, 1, NULL, code, &off, &vfaces, &total);
             clk[8] = profile ? ct_clock() : 0.0;
-            if (ct_twins(F, fsize, n, m, off, vfaces, total, pos, twin, nt) < 0) {
+            if (profile) ct_resident_mb(&rss[8], &hwm[8]);
+            if (ct_twins(F, fsize, n, m, code, code_bytes, pos, twin, nt, ct_twin_rounds(m)) < 0) {
                 oom = 1;
             }
+            ct_drop_pages(pos, pos_bytes);      /* dead until it holds the patch labels (below) */
+            if (profile) ct_resident_mb(&rss[0], &hwm[0]);     /* the twins (clk[0] is the start) */
             /* unmapped, not kept for a later phase: held under the stars' lists, the sort words' 16 bytes a face
              * raised the check's high point by 6 (the twins' block, kept for the boxes, is enough to hold) */
             ct_drop(code, code_bytes);
             code = NULL;
             code_bytes = 0;
             clk[9] = profile ? ct_clock() : 0.0;
+            if (profile) ct_resident_mb(&rss[9], &hwm[9]);
             if (!oom) {
                 int32_t *across = twin;
                 for (int64_t i = 0; i < 3 * m; i++) {
@@ -7451,31 +7650,51 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 }
                 n_nodes = ct_build_tree(nodes, m);
                 clk[10] = profile ? ct_clock() : 0.0;
+                if (profile) ct_resident_mb(&rss[10], &hwm[10]);
                 patch = (uint8_t *)malloc((size_t)n_nodes);
                 if (patch == NULL || ct_patches(nodes, n_nodes, F, fsize, order, fmask, across, V, m, patch) < 0) {
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
-                ct_free(&ar, twin, twin_bytes);
-                twin = NULL;
                 clk[7] = profile ? ct_clock() : 0.0;
+                if (profile) ct_resident_mb(&rss[7], &hwm[7]);
                 int32_t *label = pos;                  /* pos is done with: each face's certified patch */
                 if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
-                size_t lists_bytes = ct_stars_scratch(n, m);
-                void *lists = ct_alloc(&ar, &lists_bytes);   /* only the kept vertices' part of it is written */
-                if (lists == NULL) {
+                /* the stars' lists in the twins' block, dead now and kept resident for the boxes (issue 25: a
+                 * block of their own, its offsets written whole, raised the check's high point, and the boxes then
+                 * faulted in fresh pages), each part in a block of its own only where it does not fit */
+                size_t off_bytes = (size_t)(n > 0 ? n : 1) * sizeof(int64_t), faces_bytes = 0;
+                size_t own_off_bytes = off_bytes, own_faces_bytes = 0;
+                void *own_off = NULL, *own_faces = NULL;
+                off = off_bytes <= twin_bytes ? (int64_t *)(void *)twin
+                                              : (int64_t *)(own_off = ct_alloc(&ar, &own_off_bytes));
+                if (off == NULL) {
                     oom = 1;
                 }
                 else {
-                    ct_star_lists(n, F, fsize, m, star_min, patch != NULL ? label : NULL, lists, &off, &vfaces,
-                                  &total);
-                    if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
-                                      patch != NULL ? label : NULL) < 0) {
+                    total = ct_star_count(n, F, fsize, m, star_min, patch != NULL ? label : NULL, off);
+                    faces_bytes = (size_t)(total > 0 ? total : 1) * sizeof(int32_t);
+                    own_faces_bytes = faces_bytes;
+                    vfaces = own_off == NULL && off_bytes + faces_bytes <= twin_bytes
+                             ? (int32_t *)(void *)((char *)twin + off_bytes)
+                             : (int32_t *)(own_faces = ct_alloc(&ar, &own_faces_bytes));
+                    if (vfaces == NULL) {
                         oom = 1;
                     }
-                    ct_free(&ar, lists, lists_bytes);
+                    else {
+                        ct_star_fill(F, fsize, m, off, vfaces);
+                        if (ct_star_certs(V, n, F, fsize, off, vfaces, total, star_min, star_faces, cert, nt,
+                                          patch != NULL ? label : NULL) < 0) {
+                            oom = 1;
+                        }
+                    }
                 }
+                ct_free(&ar, own_faces, own_faces_bytes);
+                ct_free(&ar, own_off, own_off_bytes);
+                ct_free(&ar, twin, twin_bytes);        /* for the boxes (the same 12 bytes a face) */
+                twin = NULL;
                 clk[11] = profile ? ct_clock() : 0.0;
+                if (profile) ct_resident_mb(&rss[11], &hwm[11]);
             }
         }
         else if (!oom && !failed && m >= 2) {
@@ -7495,10 +7714,10 @@ accel_contact_scan(PyObject *self, PyObject *args)
         if (!oom && !failed && m >= 2) {
             box = (CtQ *)ct_alloc(&ar, &box_bytes);
             lbox = (float *)ct_alloc(&ar, &lbox_bytes);
-            ids = (int32_t *)ct_alloc(&ar, &ids_bytes);
+            lapex = (int32_t *)malloc(n_blocks * sizeof(int32_t));
             flags = (uint8_t *)malloc(mm);
             stars = cert != NULL ? (uint8_t *)malloc(mm) : NULL;
-            if (box == NULL || lbox == NULL || ids == NULL || flags == NULL || (cert != NULL && stars == NULL)) {
+            if (box == NULL || lbox == NULL || lapex == NULL || flags == NULL || (cert != NULL && stars == NULL)) {
                 oom = 1;
             }
             ct_arena_trim(&ar);                /* the blocks no array of the traversal took: unmapped before the
@@ -7507,33 +7726,31 @@ accel_contact_scan(PyObject *self, PyObject *args)
         if (!oom && !failed && m >= 2) {
             pr.box = box;
             pr.lbox = lbox;
-            pr.ids = ids;
+            pr.lapex = lapex;
+            pr.cert = cert;
+            pr.stars = stars;
             pr.flags = flags;
             pr.pass = 3;
             run_parallel(thread_count(threads, (size_t)n_blocks, 20000 / CT_LEAF), ct_prep_task, &pr);
-            ct_build_boxes(nodes, n_nodes, lbox, ids, cert, m);
+            ct_build_boxes(nodes, n_nodes, lbox, lapex);
             ct_free(&ar, lbox, lbox_bytes);         /* the leaves' boxes are in the nodes now */
             lbox = NULL;
+            free(lapex);
+            lapex = NULL;
         }
         ct_arena_trim(&ar);                    /* every array of the traversal is taken: the rest unmapped */
         clk[4] = profile ? ct_clock() : 0.0;
+        if (profile) ct_resident_mb(&rss[4], &hwm[4]);
         if (!oom && !failed && m >= 2) {
-            if (cert != NULL) {
-                for (int64_t i = 0; i < m; i++) {
-                    unsigned b = 0;
-                    for (int c = 0; c < 3; c++) {
-                        uint8_t k = cert[ct_id(ids, i, c)];
-                        b |= k == CT_STAR_BIG ? 8u << c : k == CT_STAR_SMALL_CERT ? 1u << c : 0u;
-                    }
-                    stars[i] = (uint8_t)b;
-                }
-            }
+            /* each position's certified corners (stars) were set by pass 3 */
             clk[5] = profile ? ct_clock() : 0.0;
+            if (profile) ct_resident_mb(&rss[5], &hwm[5]);
             sc.stars = cert != NULL ? stars : NULL;
             sc.patch = patch;
             sc.BOX = box;
             sc.order = order;
-            sc.ids = ids;
+            sc.F = F;
+            sc.fsize = fsize;
             sc.flags = flags;
             sc.V = V;
             sc.nodes = nodes;
@@ -7584,6 +7801,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         oom |= sc.oom;
         clk[6] = profile ? ct_clock() : 0.0;
+        if (profile) ct_resident_mb(&rss[6], &hwm[6]);
         Py_END_ALLOW_THREADS
         if (profile) {
             if (clk[11] > 0) {
@@ -7600,6 +7818,12 @@ accel_contact_scan(PyObject *self, PyObject *args)
             fprintf(stderr, "candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld; "
                     "MB mapped %.1f reused %.1f\n", sc.candidates, sc.tested, sc.node_pairs, sc.leaf_pairs,
                     sc.loads, ar.mapped / 1e6, ar.reused / 1e6);
+            static const int at[11] = {1, 2, 3, 8, 0, 9, 10, 7, 11, 4, 6};
+            static const char *const what[11] = {"codes", "sort", "order", "positions", "twins", "sort words",
+                                                 "tree", "patches", "stars", "boxes", "traverse"};
+            fprintf(stderr, "contact_scan resident MB after each stage, now / at most so far (VmRSS / VmHWM):");
+            for (int k = 0; k < 11; k++) fprintf(stderr, " %s %.0f / %.0f", what[k], rss[at[k]], hwm[at[k]]);
+            fprintf(stderr, "\n");
         }
         if (oom) {
             PyErr_NoMemory();
@@ -7634,7 +7858,7 @@ done:
     ct_free(&ar, box, box_bytes);
     ct_free(&ar, lbox, lbox_bytes);
     ct_free(&ar, order, order_bytes);
-    ct_free(&ar, ids, ids_bytes);
+    free(lapex);
     free(flags);
     free(axis_out);
     free(skip_out);

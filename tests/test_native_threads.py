@@ -209,6 +209,26 @@ def test_contact_scan_pairs_are_independent_of_threads(lib, damaged):
         assert got[3:7] == ref[3:7] and got[7:] == ref[7:]
 
 
+def test_contact_scan_with_stars_patches_and_twin_rounds_is_independent_of_threads(lib, monkeypatch):
+    """The same with star certificates and patches (the faces across each edge built in rounds over ranges of
+    vertices, ct_twins; the traversal reading each leaf's corner indices into its own cache): every output on
+    3 threads and 3 rounds is that of one thread and one round, on two tori of 120,000 faces each crossing the
+    other (check7; ThreadSanitizer runs this)."""
+    t = trimesh.creation.torus(50.0, 20.0, major_sections=400, minor_sections=150)
+    tv, tf = np.asarray(t.vertices), np.asarray(t.faces)
+    v = np.concatenate([tv, tv + [135.0, 0.5, 0.25]])
+    f = np.concatenate([tf, tf + len(tv)]).astype(np.int32)
+    monkeypatch.setenv("INERTIA_TOOL_CT_TWIN_ROUNDS", "1")
+    ref = lib.contact_scan(v, f, -1, 1, 8, True)
+    ref_pairs = set(zip(np.frombuffer(ref[0], np.int64), np.frombuffer(ref[1], np.int64), ref[2]))
+    assert ref_pairs
+    for threads, rounds in ((3, "3"),):
+        monkeypatch.setenv("INERTIA_TOOL_CT_TWIN_ROUNDS", rounds)
+        got = lib.contact_scan(v, f, -1, threads, 8, True)
+        assert set(zip(np.frombuffer(got[0], np.int64), np.frombuffer(got[1], np.int64), got[2])) == ref_pairs
+        assert got[3:7] == ref[3:7] and got[7:] == ref[7:]
+
+
 def test_tetra_sums_lanes_match_an_exact_sum(lib):
     """The lane sums against math.fsum of the per-face volume terms (correctly rounded): within 2 ulps."""
     import math

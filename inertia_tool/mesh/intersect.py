@@ -155,14 +155,14 @@ enumerated and counted as a candidate and as tested (exactly as the numpy twin c
 the larger stars and tests such a pair), but decided by the certificate, without rebuilding or testing the two
 faces.  On a clean mesh that is nearly every candidate pair (the faces sharing a corner: six of the 6.4 per
 face of a 1M-face torus); the pairs found are the same, since a certified star's pairs meet only in what they
-share.  Its hierarchy's leaves are blocks of 16 faces whose boxes and corner indices are stored
-coordinate by coordinate, so that one face's box is tested against a whole leaf at once, and so are its
-certified corners: the pairs of a leaf sharing a certified corner are counted a block at a time, and only the
-others are tested one by one.  The star of a vertex whose faces are consistently oriented round it (every
-vertex of a closed, oriented manifold) is ringed by following its link edges, ``x → y`` then ``y → z``, with
-no sort; any other star by matching link vertices as before; either way the certificate is the same.  This
-module's numpy code stays the reference and the fallback (``INERTIA_TOOL_NO_ACCEL=1``); the tests run on
-both.
+share.  Its hierarchy's leaves are blocks of 16 faces whose boxes (and, while the traversal is at the leaf,
+corner indices) are stored coordinate by coordinate, so that one face's box is tested against a whole leaf at
+once, and so are its certified corners: the pairs of a leaf sharing a certified corner are counted a block
+at a time, and only the others are tested one by one.  The star of a vertex whose faces are consistently
+oriented round it (every vertex of a closed, oriented manifold) is ringed by following its link edges,
+``x → y`` then ``y → z``, with no sort; any other star by matching link vertices as before; either way the
+certificate is the same.  This module's numpy code stays the reference and the fallback
+(``INERTIA_TOOL_NO_ACCEL=1``); the tests run on both.
 
 Memory of the C scan (issue 25): a face's box is six 16-bit step numbers on its leaf's grid — the leaf's
 float32 box cut into 65,534 steps per axis by ``T(x) = fl(fl(x − L)·inv)``, a composition of correctly rounded
@@ -173,16 +173,30 @@ widened by a bound of its roundings.  Monotonicity alone makes the test conserva
 ``b`` exchanged, so every pair whose boxes meet is still visited, and its float64 boxes decide whether it is a
 candidate (the pairs, counts and classes are those of float32 or float64 boxes; an axis with an infinite
 float32 bound is not cut).  The scan's arrays are mapped in three phases that never coexist: the sort (16
-bytes a face); the faces across each edge (12) from every vertex's faces (16) and each face's hierarchy
-position (4), the patches on the hierarchy's shape (which depends on the face count alone), the star
-certificates from the lists of the vertices not inside one certified patch; and only then the boxes (12),
-corner indices (12), nodes (4) and flags the traversal reads.  Its high point is about 37–40 bytes a face,
-against about 80 before.  A later phase writes into the pages of an earlier one instead of fresh ones (the
-boxes into the twins', the corner indices into the stars' lists', the leaves' boxes into the positions'): a
-fresh page costs the kernel a fault and a zeroing, a fifth of the scan's CPU time before.  None of the scan's
-arrays is read before it is written (``INERTIA_TOOL_CT_POISON=1`` fills every block it takes with 0xA5 bytes,
-and the tests compare every field with and without it); at the end its blocks are kept for the next weld or
-census in the process.
+bytes a face); the faces across each edge (12) from every vertex's faces and each face's hierarchy position
+(4), the patches on the hierarchy's shape (which depends on the face count alone), the star certificates from
+the lists of the vertices not inside one certified patch; and only then the boxes (12), nodes (4), the order
+(4) and flags the traversal reads.  A later phase writes into the pages of an earlier one instead of fresh
+ones where that does not raise the high point (the boxes into the twins' block, the leaves' boxes into the
+positions'): a fresh page costs the kernel a fault and a zeroing.  Since ``check7`` (issue 25: the check set
+the analysis's peak, 1.50× the file at 1e7 faces) the high point is about 27–31 bytes a face (37–40 before,
+about 80 before that):
+
+* the faces across each edge are built in rounds (four from 2¹⁹ faces up): the vertices are cut into ranges of
+  equal count, and each round lists the faces of its own vertices only (a quarter of the 16 bytes a face of
+  every vertex's list) and finds the face across each edge leaving one of them; every (face, corner) belongs to
+  the round of its vertex, so the twins are those of one round;
+* an array whose content is dead until a later phase writes it again has its pages given back
+  (``MADV_DONTNEED``) instead of staying resident under the next phase: the sort words once the order is
+  unpacked, the positions during the patches, the twins' block (kept for the boxes) during the star
+  certificates;
+* the traversal keeps no corner indices by hierarchy position (12 bytes a face): each traversal reads those of
+  the two leaves it is at from the caller's faces through the order, once per leaf it moves to, and the
+  per-face star bits and the leaves' apexes are made where the boxes are.
+
+None of the scan's arrays is read before it is written (``INERTIA_TOOL_CT_POISON=1`` fills every block it
+takes with 0xA5 bytes, and the tests compare every field with and without it, and for any number of rounds,
+``INERTIA_TOOL_CT_TWIN_ROUNDS``); at the end its blocks are kept for the next weld or census in the process.
 """
 
 from __future__ import annotations
