@@ -38,7 +38,8 @@ from scipy.spatial import ConvexHull, HalfspaceIntersection
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 import adversary_solids as S  # noqa: E402
 
-MODES = ("random", "tiny_turn", "ulp_shift", "tiny_shift", "slab", "nudged_copy", "three")
+MODES = ("random", "tiny_turn", "ulp_shift", "tiny_shift", "slab", "nudged_copy", "three", "hollow_pair",
+         "hollow_turn")
 
 
 def halfspaces(v, f):
@@ -119,6 +120,31 @@ def union_truth(pieces, size):
     return S.Truth(vol, cen, S._inertia(central), "qhull-incl-excl"), err
 
 
+def _moments(piece):
+    vol, cen, central = S.float_moments(*piece)
+    return vol, vol * cen, central + vol * np.outer(cen, cen), 0.0
+
+
+def hollow_truth(a, ca, b, cb, size):
+    """(A − Ca) ∪ (B − Cb) for convex A ⊃ Ca, B ⊃ Cb: M(A) − M(Ca) + M(B) − M(Cb) − M(X ∩ Y) with
+    X ∩ Y = A∩B − A∩B∩Ca − A∩B∩Cb + A∩B∩Ca∩Cb (inclusion–exclusion; every term convex)."""
+    terms = [(1, _moments(a)), (-1, _moments(ca)), (1, _moments(b)), (-1, _moments(cb)),
+             (-1, intersection_moments([a, b], size)), (1, intersection_moments([a, b, ca], size)),
+             (1, intersection_moments([a, b, cb], size)), (-1, intersection_moments([a, b, ca, cb], size))]
+    vol = sum(sg * t[0] for sg, t in terms)
+    first = sum(sg * np.asarray(t[1]) for sg, t in terms)
+    second = sum(sg * t[2] for sg, t in terms)
+    err = sum(t[3] for _, t in terms)
+    cen = first / vol
+    return S.Truth(vol, cen, S._inertia(second - vol * np.outer(cen, cen)), "qhull-incl-excl"), err
+
+
+def _shrunk(piece, factor):
+    v, f = piece
+    c = v.mean(0)
+    return (c + (v - c) * factor, f.copy())
+
+
 def convex_piece(rng):
     choice = rng.integers(3)
     if choice == 0:
@@ -145,6 +171,20 @@ def make(mode, rng):
             pieces.append(S.moved(p, S.random_rotation(rng), rng.normal(size=3) * 0.3))
             names.append(nm)
         return pieces, " ∪ ".join(names)
+    if mode in ("hollow_pair", "hollow_turn"):
+        ca = _shrunk(a, float(rng.uniform(0.3, 0.7)))
+        if mode == "hollow_pair":
+            nm, b = convex_piece(rng)
+            b = S.moved(b, S.random_rotation(rng), rng.normal(size=3) * 0.3)
+            recipe = f"{name} and {nm}, each hollow (a shrunk copy wound inward), overlapping"
+        else:
+            angle = float(10.0 ** rng.uniform(-9, -2))
+            rot = S._axis_rotation(rng.normal(size=3), angle)
+            p = va[rng.integers(len(va))]
+            b = ((va - p) @ rot.T + p, fa.copy())
+            nm, recipe = name, f"{name}, hollow, and a copy turned {angle:.3g} rad about a corner"
+        cb = _shrunk(b, float(rng.uniform(0.3, 0.7)))
+        return [a, ca, b, cb], recipe
     if mode == "tiny_turn":
         angle = float(10.0 ** rng.uniform(-12, -3))
         p = va[rng.integers(len(va))] if rng.random() < 0.5 else va.mean(0)
@@ -234,7 +274,11 @@ def run(mode, seed, i, repair):
     pieces, recipe = make(mode, rng)
     given, local, shift, where = place(pieces, rng)
     size = float(np.linalg.norm(np.ptp(np.vstack([v for v, _ in local]), axis=0)))
-    truth, err = union_truth(local, size)
+    if mode.startswith("hollow"):
+        truth, err = hollow_truth(*local, size)
+        given = [given[0], S.flipped(given[1]), given[2], S.flipped(given[3])]
+    else:
+        truth, err = union_truth(local, size)
     delta = max(float(np.abs((vg - shift) - vl).max()) for (vg, _), (vl, _) in zip(given, local))
     # the δ-neighbourhood of every piece's surface (Steiner, with room for the δ² and δ³ terms)
     err += sum(2.5 * delta * _area(v, f) for v, f in local)

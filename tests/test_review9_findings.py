@@ -63,3 +63,71 @@ def test_curved_fill_is_named_in_the_repair_note():
     said = " ".join(report.repair_actions)
     cones_only = "closed by cones" in said and not any(w in said for w in ("quadric", "curved", "bent"))
     assert not (cones_only and report.faces != report.file_faces + 36), (report.faces, said)
+
+
+def _convex_intersection_volume(pieces):
+    """Volume of the intersection of convex closed pieces, by qhull's half-space intersection (independent of the
+    engine and of manifold3d)."""
+    from scipy.optimize import linprog
+    from scipy.spatial import ConvexHull, HalfspaceIntersection
+
+    rows = []
+    for v, f in pieces:
+        n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        rows.append(np.c_[n, -np.einsum("ij,ij->i", n, v[f[:, 0]])])
+    hs = np.vstack(rows)
+    lp = linprog([0, 0, 0, -1], A_ub=np.c_[hs[:, :3], np.ones(len(hs))], b_ub=-hs[:, 3],
+                 bounds=[(None, None)] * 3 + [(0, None)], method="highs")
+    return float(ConvexHull(HalfspaceIntersection(hs, lp.x[:3]).intersections).volume)
+
+
+def _hollow_copies(angle):
+    """A unit box with a 0.5 m cubic cavity (wound inward), and the same hollow box turned by ``angle`` about the
+    axis (1, 2, 3) through a corner: every cavity lies inside both boxes."""
+    from adversary_solids import _axis_rotation
+
+    a, ca = box((1.0, 1.0, 1.0)), box((0.5, 0.5, 0.5))
+    rot, p = _axis_rotation(np.array([1.0, 2.0, 3.0]), angle), a[0][0]
+    b = ((a[0] - p) @ rot.T + p, a[1].copy())
+    cb = ((ca[0] - p) @ rot.T + p, ca[1].copy())
+    # (A − Ca) ∪ (B − Cb) = A ∪ B − (Ca ∩ Cb) when both cavities lie in A ∩ B: its winding number is 0 only there
+    union = 2.0 - _convex_intersection_volume([a, b])
+    truth = union - _convex_intersection_volume([ca, cb])
+    return concat(a, flipped(ca), b, flipped(cb)), truth
+
+
+def test_hollow_copies_overlapping_are_not_certified_with_their_cavities_filled():
+    """Two overlapping hollow boxes (the second turned 0.1 rad): R4 counted both boxes for the depth of each
+    cavity (depth 2, so the cavities were made bodies) and the union filled them: certified ``united``, 1.0674 m³
+    against 0.9556 (11.7 % high).  Overlapping bodies now count once for the depth, and a cavity inside bodies
+    that overlap is not certified (which body it is cut from, the file does not say)."""
+    mesh, truth = _hollow_copies(0.1)
+    props, said = _run(mesh)
+    kind = props.mesh.certificate.kind
+    assert kind not in ("exact", "united") or abs(props.mass - truth) <= 1e-9 * truth, (kind, props.mass, truth)
+    assert any("inside bodies that overlap" in s for s in said)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "mesh/policy.orient_by_depth gives a cavity inside overlapping bodies to the smallest container (both cavities "
+    "to the first box), so the union fills them from the other box: unverified, but 1.0674 m³ instead of 0.9556 "
+    "(each cavity should be cut from the copy it belongs to, or the solid {winding number ≥ 1} formed)"))
+def test_hollow_copies_overlapping_give_the_solid_meant():
+    mesh, truth = _hollow_copies(0.1)
+    props, _ = _run(mesh)
+    assert abs(props.mass - truth) <= 1e-9 * truth
+
+
+def test_cavities_crossing_each_other_inside_a_box_are_cut():
+    """Two cavities that cross each other inside a box (each wound inward): they crossed no outward shell, so R4
+    gave each to itself as its own body, and the boolean left the box full (64 m³, the cavities lost).  They are
+    now cut from the shell around them: 64 − |C1 ∪ C2|."""
+    from adversary_solids import _axis_rotation, moved
+
+    c1 = box((1.0, 1.0, 1.0))
+    c2 = moved(box((1.0, 1.0, 1.0)), _axis_rotation([1.0, 2.0, 3.0], 0.5), np.array([0.3, 0.2, 0.1]))
+    truth = 64.0 - (2.0 - _convex_intersection_volume([c1, c2]))
+    props, _ = _run(concat(box((4.0, 4.0, 4.0)), flipped(c1), flipped(c2)))
+    assert abs(props.mass - truth) <= 1e-9 * truth, (props.mass, truth)
+    assert props.mesh.cavities >= 1

@@ -17,8 +17,8 @@ import numpy as np
 from ..errors import InsideOutWarning
 from ..integrals import VolumeMoments
 from .intersect import SurfaceContacts, surface_contacts
-from .policy import (MisreadNesting, ShellContacts, inward_crossing_outward, misread_nesting, orient_by_depth,
-                     outward_crossing_groups, shell_contacts, within_up_to_rounding)
+from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward, misread_nesting,
+                     orient_by_depth, outward_crossing_groups, shell_contacts, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
 
@@ -97,9 +97,18 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     shells = apply_flips(shells, flip & quiet, source, warn=False)
     notes = []
     ambiguous = inward_crossing_outward(file_volumes, flip, crossing_with)
-    if ambiguous:
-        plural = ambiguous > 1
-        notes.append(f"{ambiguous} inward-wound shell{'s' if plural else ''} cross{'' if plural else 'es'} "
+    shared = cavities_in_overlap(nest, crossing_with, depth) if touch.complete else 0
+    if shared:
+        plural = shared > 1
+        notes.append(f"{shared} cavit{'ies' if plural else 'y'} lie{'' if plural else 's'} inside bodies that "
+                     "overlap one another: each is cut from one of them, and which one the file does not say "
+                     "(two hollow parts overlapping); the union of the bodies less their cavities is given, not "
+                     "verified")
+        warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+        ambiguous += shared
+    if ambiguous - shared:
+        plural = ambiguous - shared > 1
+        notes.append(f"{ambiguous - shared} inward-wound shell{'s' if plural else ''} cross{'' if plural else 'es'} "
                      "an outward one: read as a cavity cut from it (the solid where the winding number is at least "
                      "one); if it is a body written inside out, fix its winding. Not verified")
         warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=4)

@@ -94,7 +94,9 @@ R3b *A flat open sheet inside a solid encloses nothing* (:func:`~.sheets.open_sh
    (flat sheets outside the solid, perhaps plates meant to have thickness) are not taken: the fin is named in the
    refusal.
 R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is the number of other shells
-   that contain it (whose winding number at a point of it is nonzero and that it does not cross); even depth
+   that contain it (whose winding number at a point of it is nonzero and that it does not cross), shells that
+   cross one another counting once (overlapping bodies are one body for what lies inside them; a cavity inside
+   two of them is not verified: :func:`cavities_in_overlap`); even depth
    is a body, wound outward, odd depth a cavity, wound inward.  A shell wound the other way is flipped, with
    a warning.  Never decided by the sign of the total volume: one inside-out shell must not turn the others.
    So an outward-wound shell inside a body is read as a cavity written with the wrong winding, not as a
@@ -395,7 +397,11 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
     held = inside & ~cross[nest.shell, nest.other]
     pairs = np.unique(np.concatenate([np.c_[nest.shell[held], nest.other[held]], extra]), axis=0)
     s_in, o_in = pairs[:, 0], pairs[:, 1]
-    depth[:] = np.bincount(s_in, minlength=n)
+    # bodies that cross one another are one body for the shells inside them: a shell inside two overlapping
+    # bodies is at depth 1, not 2 (review 9: two hollow copies, one turned, had their cavities made bodies)
+    component = _groups(n, np.argwhere(np.triu(cross)))
+    depth[:] = np.bincount(np.unique(np.c_[s_in, component[o_in]], axis=0)[:, 0], minlength=n) if len(s_in) \
+        else 0
     undecided = np.asarray(nest.undecided, dtype=bool).copy()
     undecided[extra[:, 0]] = False
     depth[undecided] = 0
@@ -408,7 +414,7 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
         owner[s_in[keep]] = o_in[keep]
     crosses = cross.any(axis=1) & ~undecided
     if crosses.any():
-        _orient_crossing(vols, cross, crosses, depth, flip, owner)
+        _orient_crossing(vols, cross, crosses, depth, flip, owner, pairs)
     return flip, owner, depth
 
 
@@ -519,13 +525,16 @@ def _groups(n: int, pairs: np.ndarray) -> np.ndarray:
 
 
 def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, depth: np.ndarray,
-                     flip: np.ndarray, owner: np.ndarray) -> None:
+                     flip: np.ndarray, owner: np.ndarray, contained: np.ndarray) -> None:
     """R4 for shells whose surfaces cross another's (in place): they have no nesting depth of their own.
 
     The file's winding says which of them is material and which a hole (a cavity that pokes through its body's
     wall, a part resting turned on a cavity's floor), and the boolean decides the solid; an inward shell is cut
-    from the outward shell it crosses (the smallest, if several).  A group of crossing shells that are all wound
-    inward and lie in no body (even depth) is a group of bodies written inside out, and is turned as a whole.
+    from the outward shell it crosses (the smallest, if several), or, crossing none (cavities that cross only one
+    another), from the innermost shell containing it (``contained``: (k, 2) ``(shell, container)`` pairs; review 9:
+    two overlapping cavities in a box were their own bodies, and the boolean left the box full).  A group of
+    crossing shells that are all wound inward and lie in no body (even depth) is a group of bodies written inside
+    out, and is turned as a whole.
     """
     component = _groups(len(vols), np.argwhere(np.triu(cross)))     # connected groups of crossing shells
     for root in np.unique(component[crosses]):
@@ -537,6 +546,9 @@ def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, d
             continue
         for k in members[vols[members] < 0]:
             bodies = np.flatnonzero(cross[k] & (vols > 0))
+            if not len(bodies):
+                around = contained[contained[:, 0] == k, 1]
+                bodies = around[depth[around] == depth[k] - 1]
             if len(bodies):
                 owner[k] = bodies[np.argmin(np.abs(vols[bodies]))]
 
@@ -566,6 +578,33 @@ def negligible_flat(shells: Sequence[VolumeMoments], flat: np.ndarray) -> np.nda
             moment = 0.0
         out[k] = abs(s.volume) <= FLAT_MOMENT_RTOL * volume and moment <= FLAT_MOMENT_RTOL * spread
     return out
+
+
+def cavities_in_overlap(nest: Nesting | None, crossing_with: np.ndarray, depth: np.ndarray) -> int:
+    """R4: how many cavities (odd depth) lie inside two or more bodies that cross one another.
+
+    Such bodies count once for the depth (:func:`orient_by_depth`), but the cavity is cut from one of them only
+    (its owner), and which one the file does not say: two hollow copies overlapping give ``(A − Ca) ∪ (B − Cb)``
+    (the solid where the winding number is at least one) only when each cavity goes to its own copy.  The reading
+    is kept and not verified (review 9: it was certified ``united``)."""
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    if nest is None or not len(pairs):
+        return 0
+    n = len(depth)
+    cross = np.zeros((n, n), dtype=bool)
+    cross[pairs[:, 0], pairs[:, 1]] = True
+    cross[pairs[:, 1], pairs[:, 0]] = True
+    component = _groups(n, pairs)
+    held = (np.asarray(nest.winding) != 0) & ~cross[nest.shell, nest.other]
+    shell, other = np.asarray(nest.shell)[held], np.asarray(nest.other)[held]
+    odd = np.asarray(depth) % 2 == 1
+    keep = odd[shell] & cross[other].any(axis=1)
+    found = np.zeros(n, dtype=bool)
+    for k in np.unique(shell[keep]).tolist():
+        around = other[shell == k]
+        groups, counts = np.unique(component[around], return_counts=True)
+        found[k] = bool(np.any(counts > 1))
+    return int(np.count_nonzero(found))
 
 
 def inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with: np.ndarray) -> int:
