@@ -35,7 +35,6 @@ import argparse
 import json
 import os
 import platform
-import subprocess
 import sys
 import tempfile
 import time
@@ -57,6 +56,8 @@ import trimesh  # noqa: E402
 from inertia_tool.mesh import LoadOptions  # noqa: E402
 from inertia_tool.batch.runner import BatchOptions, discover_files, run_batch  # noqa: E402
 from inertia_tool.batch.rows import open_results  # noqa: E402
+
+from _checkouts import in_turn, run_script  # noqa: E402
 
 
 def _require_c_kernels() -> None:
@@ -168,9 +169,9 @@ def _child_round(args, tree: str) -> list[tuple[str, str, tuple[float, float]]]:
     """One round of every configuration on the checkout ``tree``, in a fresh child process running this script
     with ``--tree``: ``(catalogue, configuration, (seconds, CPU seconds))`` of each (configuration ``"startup"``:
     the Dask cluster's start-up, seconds)."""
-    argv = [sys.executable, os.path.abspath(__file__), "--tree", tree, "--repeat", "1", "--json",
+    argv = ["--tree", tree, "--repeat", "1", "--json",
             "--set", args.set, "--small", str(args.small), "--files", str(args.files), "--kinds", args.kinds]
-    done = subprocess.run(argv, capture_output=True, text=True, check=True)
+    done = run_script(__file__, argv, capture=True)
     rows = [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
     return [(r["catalogue"], r["configuration"], (r["seconds"], r["cpu"], r.get("parent", float("nan"))))
             for r in rows]
@@ -220,8 +221,7 @@ def main() -> None:
         # process the rounds after the first ran their single process beside the threads a closed Dask client
         # leaves behind, which the baseline's fresh child did not (0.3-0.6 ms of CPU per file more at load 15)
         for r in range(args.repeat if args.baseline else 0):
-            trees = [(_tree([]), ""), (args.baseline, "[baseline] ")]
-            for tree, tag in trees if r % 2 == 0 else trees[::-1]:
+            for tree, tag in in_turn([(_tree([]), ""), (args.baseline, "[baseline] ")], r):
                 for name, label, got in _child_round(args, tree):
                     if name == "startup":
                         if not tag:

@@ -20,11 +20,12 @@ from __future__ import annotations
 import argparse
 import os
 import pickle
-import subprocess
 import sys
 import tempfile
 
 import numpy as np
+
+from _checkouts import in_turn, run_script
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -154,11 +155,9 @@ def main(argv: list[str] | None = None) -> int:
         path = os.path.join(tmp, "cases.pkl")
         with open(path, "wb") as fh:
             pickle.dump(todo, fh)
-        for tree in (ROOT, os.path.abspath(args.baseline)):
+        for tree in in_turn((ROOT, os.path.abspath(args.baseline)), 0):
             out = os.path.join(tmp, f"out{len(results)}.pkl")
-            env = {**os.environ, "PYTHONPATH": tree}
-            env.pop("INERTIA_TOOL_NO_ACCEL", None)
-            subprocess.run([sys.executable, os.path.abspath(__file__), "--child", path, out], env=env, check=True)
+            run_script(__file__, ["--child", path, out], tree=tree)
             with open(out, "rb") as fh:
                 results[tree] = pickle.load(fh)
     mine, base = results[ROOT], results[os.path.abspath(args.baseline)]

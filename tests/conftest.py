@@ -22,6 +22,12 @@ if os.environ.get("CI"):
 HYPOTHESIS_SCALE = float(os.environ.get("INERTIA_TOOL_HYPOTHESIS_SCALE", "0") or 0)
 
 
+def pytest_configure(config):
+    """Markers of the tests' own (here, not in pyproject.toml: scripts/tsan.sh runs a copy of tests/ without it)."""
+    config.addinivalue_line("markers", "one_thread: a test of one-thread code only (scripts/tsan.sh leaves it out: "
+                            "no data race to find there)")
+
+
 def pytest_collection_modifyitems(items):
     """Apply :data:`HYPOTHESIS_SCALE` to the collected hypothesis tests (their settings are read when they run,
     so the explicit ``@settings(max_examples=...)`` of each is scaled, not replaced)."""

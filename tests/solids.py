@@ -160,3 +160,128 @@ def union_volume(*parts):
     for s in solids[1:]:
         out = out + s
     return float(out.volume())
+
+
+# ------------------------------------------------------------------------------------ stacked trimesh boxes
+
+def crossing_boxes_inside(size, subdivide_outer=False):
+    """A 4 m cube centred at the origin and, inside it, two cubes of side ``size`` crossing each other (the second
+    moved by (0.5, 0.4, 0.3)), all wound outward: three ``(vertices, faces)`` parts to :func:`stack`.  trimesh's
+    boxes (its triangulation, the one the nesting tests were written on); ``subdivide_outer``: the outer cube's
+    faces split in four (trimesh ``subdivide``)."""
+    import trimesh
+
+    outer = trimesh.creation.box(extents=(4.0, 4.0, 4.0))
+    if subdivide_outer:
+        outer = outer.subdivide()
+    a = trimesh.creation.box(extents=(size,) * 3)
+    b = a.copy()
+    b.apply_translation((0.5, 0.4, 0.3))
+    return [(np.asarray(p.vertices), np.asarray(p.faces)) for p in (outer, a, b)]
+
+
+# ------------------------------------------------------------------------ featured boxes and hole cutters
+
+def featured_box(extents, place, size, height):
+    """A box with a rectangular boss (``height`` > 0) or pocket (< 0) on its top face, made by manifold3d,
+    whose flat faces are triangulated with vertices on their loops only (as CAD exporters do).
+
+    Returns the vertices, faces, the feature's faces (walls and top or floor) and its top or floor faces."""
+    import manifold3d as m3d
+
+    w, d, h = extents
+    fw, fd = size[0] * w, size[1] * d
+    x0, y0 = place[0] * (w - fw), place[1] * (d - fd)
+    body = m3d.Manifold.cube([w, d, h])
+    if height > 0:
+        body = body + m3d.Manifold.cube([fw, fd, height]).translate([x0, y0, h])
+    else:
+        body = body - m3d.Manifold.cube([fw, fd, 1.0 - height]).translate([x0, y0, h + height])
+    mesh = body.to_mesh()
+    v = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
+    f = np.asarray(mesh.tri_verts, dtype=np.int64)
+    corners = v[f]
+    tol = 1e-5 * max(extents)
+    inside = np.all((corners[:, :, 0] >= x0 - tol) & (corners[:, :, 0] <= x0 + fw + tol)
+                    & (corners[:, :, 1] >= y0 - tol) & (corners[:, :, 1] <= y0 + fd + tol), axis=1)
+    feature = inside & np.any(np.abs(corners[:, :, 2] - h) > tol, axis=1)
+    end = np.all(np.abs(corners[:, :, 2] - (h + height)) <= tol, axis=1)
+    return v, f, np.flatnonzero(feature), np.flatnonzero(end)
+
+
+def manifold_neighbours(v, f):
+    """Each face's neighbours across its manifold edges (trimesh's ``face_adjacency``, in its order)."""
+    import trimesh
+
+    mesh = trimesh.Trimesh(v, f, process=False)
+    neighbours = [[] for _ in range(len(f))]
+    for a, b in mesh.face_adjacency.tolist():
+        neighbours[a].append(b)
+        neighbours[b].append(a)
+    return neighbours
+
+
+def edge_neighbours(f):
+    """Each face's neighbours across every edge it shares by index (non-manifold edges too: every other face on
+    the edge), in the order of the faces' edges."""
+    f = np.asarray(f)
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    owner = np.tile(np.arange(len(f)), 3)
+    by_edge: dict[tuple[int, int], list[int]] = {}
+    for (a, b), o in zip(edges.tolist(), owner.tolist()):
+        by_edge.setdefault((a, b), []).append(o)
+    neighbours: list[list[int]] = [[] for _ in range(len(f))]
+    for faces in by_edge.values():
+        for x in faces:
+            neighbours[x].extend(y for y in faces if y != x)
+    return neighbours
+
+
+def grown_patch(neighbours, start, count):
+    """Up to ``count`` faces grown breadth-first from face ``start`` through ``neighbours`` (lists per face, e.g.
+    :func:`manifold_neighbours`), sorted: the faces a hole cutter takes out."""
+    seen, queue = {start}, [start]
+    for face in queue:                                # grows to at most len(neighbours)
+        if len(seen) >= count:
+            break
+        for other in neighbours[face]:
+            if other not in seen and len(seen) < count:
+                seen.add(other)
+                queue.append(other)
+    return np.array(sorted(seen), dtype=np.int64)
+
+
+# --------------------------------------------------------------------------------------- T-vertices on edges
+
+def split_at_edge_points(faces, inner):
+    """Every face holding a directed edge ``(a, b)`` of ``inner`` (or its reverse) fanned through the points
+    ``inner[(a, b)]`` (vertex indices, in order from ``a`` to ``b``) from its opposite corner, so that a surface
+    with points put on its edges stays closed by index.  A face is split at one edge at most (the last of its
+    edges found in ``inner``).
+
+    Returns
+    -------
+    rows : list of list of int
+        The faces, split ones replaced by their fans in place.
+    source : list of int
+        The face of ``faces`` each row came from.
+    """
+    rows, source = [], []
+    for i, tri in enumerate(np.asarray(faces).tolist()):
+        hit = None
+        for k in range(3):
+            a, b = tri[k], tri[(k + 1) % 3]
+            if (a, b) in inner:
+                hit = (k, inner[(a, b)])
+            elif (b, a) in inner:
+                hit = (k, inner[(b, a)][::-1])
+        if hit is None:
+            rows.append(tri)
+            source.append(i)
+            continue
+        k, mids = hit
+        a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+        chain = [a, *mids, b]
+        rows.extend([s, t, c] for s, t in zip(chain[:-1], chain[1:]))
+        source.extend([i] * (len(chain) - 1))
+    return rows, source

@@ -20,6 +20,7 @@ import trimesh
 
 import inertia_tool as it
 from inertia_tool.errors import InvalidMeshError
+from solids import crossing_boxes_inside, stack
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -35,15 +36,8 @@ def _coverage_module():
 def _box_with_a_hole_and_two_crossing_boxes_inside(size):
     """A 4 m cube (faces split in four) less one triangle, and inside it two crossing cubes of side ``size``, both
     wound outward (R4: bodies by their winding, cavities by nesting depth; the file does not decide)."""
-    outer = trimesh.creation.box(extents=(4.0, 4.0, 4.0)).subdivide()
-    a = trimesh.creation.box(extents=(size,) * 3)
-    b = a.copy()
-    b.apply_translation((0.5, 0.4, 0.3))
-    parts = [outer, a, b]
-    offset = np.cumsum([0] + [len(p.vertices) for p in parts])
-    v = np.vstack([p.vertices for p in parts])
-    f = np.vstack([outer.faces[1:], a.faces + offset[1], b.faces + offset[2]])
-    return v, f
+    (outer_v, outer_f), a, b = crossing_boxes_inside(size, subdivide_outer=True)
+    return stack((outer_v, outer_f[1:]), a, b)
 
 
 def test_a_bound_widened_past_the_limit_by_an_undecided_reading_says_so():

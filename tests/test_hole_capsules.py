@@ -21,6 +21,7 @@ from inertia_tool.mesh.holes import patched_estimate
 from inertia_tool.mesh.rims import boundary_edges, capsule_volumes, enclosing_balls, enclosing_capsules
 from inertia_tool.tolerances import ESTIMATE_MAX_MASS_RTOL
 
+from damage_cases import case_row, coverage_module
 from test_hole_bounds import _holds
 from test_hole_footprints import _patch, _refused_or_holds, featured_box
 
@@ -99,18 +100,6 @@ def test_a_strip_along_a_cylinder_is_answered_inside_its_bound():
     assert _holds(est, truth)
 
 
-def _coverage():
-    import sys
-    from pathlib import Path
-    here = Path(__file__).resolve().parents[1] / "benchmarks" / "damage"
-    sys.path.insert(0, str(here))
-    try:
-        import coverage
-    finally:
-        sys.path.remove(str(here))
-    return coverage
-
-
 @pytest.mark.parametrize("case, source", [("6-01-hole", "generated/capsule"),
                                           ("6-02-crack_hole", "generated/cylinder")])
 def test_the_benchmarks_strips_along_a_capsule_and_a_cylinder_are_refused_or_inside_their_bound(case, source):
@@ -119,20 +108,11 @@ def test_the_benchmarks_strips_along_a_capsule_and_a_cylinder_are_refused_or_ins
     over the rim is longer than the part; a rim vertex keeps only its facet's two triangles (bare), so neither
     the slab nor the convex bound applies.  The capsule over the strip gives ±33 % and ±47 %: answered, inside
     the bound, and within 1 %/1 %/2 % of the truth."""
-    cov = _coverage()
+    cov = coverage_module()
     names = [name for name, _, _ in cov.generated_sources()]
     index = names.index(source)
     _, v, f = cov.generated_sources()[index]
-    truth = cov.truth_of(v, f)
-    seed, kind = int(case.split("-")[0]), case.split("-", 2)[2]
-    rng = np.random.default_rng([seed, index, cov.KINDS.index(kind), 0])
-    if rng.random() < cov.QUANTISE_SHARE:
-        qv, qf, _ = cov._quantised(v, f, rng, truth["diagonal"])
-        qt = cov.truth_of(qv, qf)
-        if qt is not None:
-            v, f, truth = qv, qf, qt
-    dv, df, _ = cov.make_case(kind, v, f, rng, truth["diagonal"])
-    row = cov.evaluate(dv, df, truth)
+    row = case_row(cov, case, index, v, f)
     # the ball over the strip is larger than the part, so the capsule is not taken (holes4's last guard: what
     # remains might be the small side); before that guard both were answered within tolerance, at ±33 %/±47 %
     assert row["status"] == "refused" or row["holds"], row
@@ -208,20 +188,12 @@ def test_a_band_round_the_washer_keeps_its_balls_not_the_thin_capsules():
     band, which no rim's own disc covers (the stated limit).  Their balls (radius 9.2, 13 apart) meet and held
     the band by luck; the capsules as thin as the rims stated ±6.5 % for an answer 7.0 % off.  The capsule is
     now taken only for a hole whose ball meets no other's (``holes._alone``): refused again, at ±75 %."""
-    cov = _coverage()
+    cov = coverage_module()
     sources = cov.repo_sources()
     names = [name for name, _, _ in sources]
     index = len(cov.generated_sources()) + names.index("repo/washer.stl")
     _, v, f = sources[names.index("repo/washer.stl")]
-    truth = cov.truth_of(v, f)
-    rng = np.random.default_rng([25, index, cov.KINDS.index("crack_hole"), 0])
-    if rng.random() < cov.QUANTISE_SHARE:
-        qv, qf, _ = cov._quantised(v, f, rng, truth["diagonal"])
-        qt = cov.truth_of(qv, qf)
-        if qt is not None:
-            v, f, truth = qv, qf, qt
-    dv, df, _ = cov.make_case("crack_hole", v, f, rng, truth["diagonal"])
-    row = cov.evaluate(dv, df, truth)
+    row = case_row(cov, "25-15-crack_hole", index, v, f)
     assert row["status"] == "refused" or row["holds"], row
 
 
@@ -316,7 +288,7 @@ def test_a_crease_fill_and_a_bent_fill_in_one_surface_do_not_crash(case, part):
     """Coverage cases that raised IndexError (the crease fills masked the cones' caps after the bent fills had
     replaced some): refused or inside the bound.  Needs the robot parts of ``benchmarks/damage/make_cases.py``
     (skipped without them)."""
-    cov = _coverage()
+    cov = coverage_module()
     robots = cov.robot_sources()
     names = [name for name, _, _ in robots]
     match = [i for i, name in enumerate(names) if name.endswith(part)]
@@ -324,16 +296,7 @@ def test_a_crease_fill_and_a_bent_fill_in_one_surface_do_not_crash(case, part):
         pytest.skip("the robot parts are not downloaded (benchmarks/damage/make_cases.py)")
     index = len(cov.generated_sources()) + len(cov.repo_sources()) + match[0]
     _, v, f = robots[match[0]]
-    truth = cov.truth_of(v, f)
-    seed, kind = int(case.split("-")[0]), case.split("-", 2)[2]
-    rng = np.random.default_rng([seed, index, cov.KINDS.index(kind), 0])
-    if rng.random() < cov.QUANTISE_SHARE:
-        qv, qf, _ = cov._quantised(v, f, rng, truth["diagonal"])
-        qt = cov.truth_of(qv, qf)
-        if qt is not None:
-            v, f, truth = qv, qf, qt
-    dv, df, _ = cov.make_case(kind, v, f, rng, truth["diagonal"])
-    row = cov.evaluate(dv, df, truth)
+    row = case_row(cov, case, index, v, f)
     assert row["status"] == "refused" or (row["status"] == "answer" and row["holds"]), row
 
 

@@ -22,6 +22,7 @@ from inertia_tool.tolerances import ESTIMATE_MAX_MASS_RTOL
 
 m3d = pytest.importorskip("manifold3d")
 
+from solids import featured_box, grown_patch, manifold_neighbours  # noqa: E402
 from test_hole_bounds import _holds  # noqa: E402  (the one "inside every bound" test of the hole tests)
 
 
@@ -32,47 +33,9 @@ def _refused_or_holds(est, truth):
     return bool(est.unbounded) or est.uncertainty.mass > ESTIMATE_MAX_MASS_RTOL or _holds(est, truth)
 
 
-def featured_box(extents, place, size, height):
-    """A box with a rectangular boss (``height`` > 0) or pocket (< 0) on its top face, made by manifold3d,
-    whose flat faces are triangulated with vertices on their loops only (as CAD exporters do).
-
-    Returns the vertices, faces, the feature's faces (walls and top or floor) and its top or floor faces."""
-    w, d, h = extents
-    fw, fd = size[0] * w, size[1] * d
-    x0, y0 = place[0] * (w - fw), place[1] * (d - fd)
-    body = m3d.Manifold.cube([w, d, h])
-    if height > 0:
-        body = body + m3d.Manifold.cube([fw, fd, height]).translate([x0, y0, h])
-    else:
-        body = body - m3d.Manifold.cube([fw, fd, 1.0 - height]).translate([x0, y0, h + height])
-    mesh = body.to_mesh()
-    v = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
-    f = np.asarray(mesh.tri_verts, dtype=np.int64)
-    corners = v[f]
-    tol = 1e-5 * max(extents)
-    inside = np.all((corners[:, :, 0] >= x0 - tol) & (corners[:, :, 0] <= x0 + fw + tol)
-                    & (corners[:, :, 1] >= y0 - tol) & (corners[:, :, 1] <= y0 + fd + tol), axis=1)
-    feature = inside & np.any(np.abs(corners[:, :, 2] - h) > tol, axis=1)
-    end = np.all(np.abs(corners[:, :, 2] - (h + height)) <= tol, axis=1)
-    return v, f, np.flatnonzero(feature), np.flatnonzero(end)
-
-
 def _patch(v, f, start, count):
     """``count`` faces grown breadth-first across edges from face ``start``."""
-    mesh = trimesh.Trimesh(v, f, process=False)
-    neighbours = [[] for _ in range(len(f))]
-    for a, b in mesh.face_adjacency.tolist():
-        neighbours[a].append(b)
-        neighbours[b].append(a)
-    seen, queue = {start}, [start]
-    for face in queue:
-        if len(seen) >= count:
-            break
-        for other in neighbours[face]:
-            if other not in seen and len(seen) < count:
-                seen.add(other)
-                queue.append(other)
-    return np.array(sorted(seen), dtype=np.int64)
+    return grown_patch(manifold_neighbours(v, f), start, count)
 
 
 # ------------------------------------------------------------------------------ the xarm7 housing, made small
@@ -200,29 +163,15 @@ def test_the_xarm7_link_base_holes_of_the_damage_benchmark_are_inside_their_boun
     met the flat side or the shoulder there and are gone), so the slab is withdrawn and the ball states the
     bound, which now holds (the missing surface still leaves the ball: the assumption is false, the bound holds
     by its volume).  Needs the robot parts of ``benchmarks/damage/make_cases.py`` (skipped without them)."""
-    import sys
-    from pathlib import Path
-    here = Path(__file__).resolve().parents[1] / "benchmarks" / "damage"
-    sys.path.insert(0, str(here))
-    try:
-        import coverage as cov
-    finally:
-        sys.path.remove(str(here))
+    from damage_cases import case_row, coverage_module
+
+    cov = coverage_module()
     robots = cov.robot_sources()
     match = [(name, v, f) for name, v, f in robots if name.endswith("xarm7/visual/link_base.stl")]
     if not match:
         pytest.skip("the robot parts are not downloaded (benchmarks/damage/make_cases.py)")
     name, v, f = match[0]
-    seed, kind = int(case.split("-")[0]), case.split("-", 2)[2]
-    truth = cov.truth_of(v, f)
-    rng = np.random.default_rng([seed, 38, cov.KINDS.index(kind), 0])
-    if rng.random() < cov.QUANTISE_SHARE:
-        qv, qf, _ = cov._quantised(v, f, rng, truth["diagonal"])
-        qt = cov.truth_of(qv, qf)
-        if qt is not None:
-            v, f, truth = qv, qf, qt
-    dv, df, _ = cov.make_case(kind, v, f, rng, truth["diagonal"])
-    row = cov.evaluate(dv, df, truth)
+    row = case_row(cov, case, 38, v, f)
     assert row["status"] == "answer" and row["holds"], row
 
 

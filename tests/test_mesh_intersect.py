@@ -27,7 +27,10 @@ MESHES = os.path.join(os.path.dirname(__file__), os.pardir, "meshes")
 
 @pytest.fixture(autouse=True, params=["c", "numpy"])
 def kernel(request, monkeypatch):
-    """Every test on both twins: the C kernel (section 8 of _accel.c) and the numpy reference."""
+    """Every test on both twins: the C kernel (section 8 of _accel.c) and the numpy reference.  A test marked by
+    :func:`_each_example_on_both_twins` runs both twins itself, in its ``[numpy]`` run; its ``[c]`` run is skipped."""
+    if request.param == "c" and getattr(request.function, "_both_twins", False):
+        pytest.skip("each example is checked on both twins in the [numpy] run")
     if request.param == "c":
         if not HAVE_ACCEL:
             pytest.skip("inertia_tool._accel is not built")
@@ -313,6 +316,33 @@ def test_orient2d_sign_is_exact_on_the_line_at_any_scale(coords, t, scale):
 
 # -- triangle pairs against the independent classifier ------------------------------------------------------
 
+def _each_example_on_both_twins(test):
+    """Mark a property test that classifies each drawn example on both twins itself (:func:`_on_twins`): the
+    example is drawn and the rational reference run once, not once per twin (the same examples either way: CI's
+    derandomized sequence is the same for both parametrised runs)."""
+    test._both_twins = True
+    return test
+
+
+def _on_twins(v, f):
+    """``surface_contacts(v, f)`` on the numpy twin and, when built, the C twin: ``[(twin, result), ...]``."""
+    results = []
+    saved = os.environ.get(_native.NO_ACCEL_ENV)
+    try:
+        for twin in ("numpy", "c") if HAVE_ACCEL else ("numpy",):
+            if twin == "numpy":
+                os.environ[_native.NO_ACCEL_ENV] = "1"
+            else:
+                os.environ.pop(_native.NO_ACCEL_ENV, None)
+            results.append((twin, surface_contacts(v, f)))
+    finally:
+        if saved is None:
+            os.environ.pop(_native.NO_ACCEL_ENV, None)
+        else:
+            os.environ[_native.NO_ACCEL_ENV] = saved
+    return results
+
+
 _SIGNED_PERMS = [np.eye(3)[list(p)] * s for p in ((0, 1, 2), (1, 2, 0), (2, 0, 1), (1, 0, 2))
                  for s in (np.array([1, 1, 1]), np.array([-1, 1, 1]), np.array([1, -1, -1]))]
 
@@ -362,6 +392,7 @@ def triangle_pairs(draw):
     return v, faces, shared
 
 
+@_each_example_on_both_twins
 @settings(max_examples=3000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(triangle_pairs(), st.booleans(), st.integers(0, 2))
 def test_triangle_pair_matches_the_independent_classifier(case, swap, roll):
@@ -370,14 +401,14 @@ def test_triangle_pair_matches_the_independent_classifier(case, swap, roll):
     f = np.stack([np.roll(faces[0], roll), faces[1]])
     if swap:
         f = f[::-1]
-    result = surface_contacts(v, f)
-    if want is None:                                    # a zero-area triangle: skipped
-        assert result.degenerate_faces >= 1
-        assert len(result.crossing) == len(result.coplanar_opposite) == len(result.contact) == 0
-        return
-    assert result.degenerate_faces == 0
-    got = pair_kinds(result).get((0, 1), NONE)
-    assert got == want
+    for twin, result in _on_twins(v, f):
+        if want is None:                                    # a zero-area triangle: skipped
+            assert result.degenerate_faces >= 1, twin
+            assert len(result.crossing) == len(result.coplanar_opposite) == len(result.contact) == 0, twin
+            continue
+        assert result.degenerate_faces == 0, twin
+        got = pair_kinds(result).get((0, 1), NONE)
+        assert got == want, twin
 
 
 @st.composite
@@ -419,6 +450,7 @@ def adjacent_pairs(draw):
     return v, faces, shared
 
 
+@_each_example_on_both_twins
 @settings(max_examples=2000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(adjacent_pairs(), st.booleans())
 def test_adjacent_pair_near_one_plane_matches_the_independent_classifier(case, swap):
@@ -427,11 +459,11 @@ def test_adjacent_pair_near_one_plane_matches_the_independent_classifier(case, s
     v, faces, shared = case
     want = brute_kind(v[faces[0]], v[faces[1]], shared)
     f = faces[::-1] if swap else faces
-    result = surface_contacts(v, f)
-    if want is None:
-        assert result.degenerate_faces >= 1
-        return
-    assert pair_kinds(result).get((0, 1), NONE) == want
+    for twin, result in _on_twins(v, f):
+        if want is None:
+            assert result.degenerate_faces >= 1, twin
+            continue
+        assert pair_kinds(result).get((0, 1), NONE) == want, twin
 
 
 def test_planar_quad_grid_is_decided_without_exact_arithmetic(kernel):

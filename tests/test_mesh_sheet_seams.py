@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 
 import inertia_tool as it
 from inertia_tool.mesh.sheets import open_sheets
+from solids import split_at_edge_points
 from test_mesh_folds import _assert_matches, _truth
 from test_mesh_sheets import _halves, _on_plane
 
@@ -72,22 +73,7 @@ def _put_t_vertices(hv, hf, on, rng, share):
         inner[(p, q)] = list(range(n, n + len(ts)))
         verts.append(pts)
         n += len(ts)
-    rows = []
-    for tri in hf.tolist():
-        hit = None
-        for k in range(3):
-            a, b = tri[k], tri[(k + 1) % 3]
-            if (a, b) in inner:
-                hit = (k, inner[(a, b)])
-            elif (b, a) in inner:
-                hit = (k, inner[(b, a)][::-1])
-        if hit is None:
-            rows.append(tri)
-            continue
-        k, mids = hit
-        a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
-        chain = [a, *mids, b]
-        rows.extend([s, t, c] for s, t in zip(chain[:-1], chain[1:]))
+    rows, _ = split_at_edge_points(hf, inner)
     new_f = np.array(rows, dtype=np.int64)
     new_on = np.zeros(len(new_f), dtype=bool)
     on_rows = {tuple(t) for t in hf[on].tolist()}

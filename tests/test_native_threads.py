@@ -8,6 +8,8 @@ numbers vertices by first appearance: the one-table Welder's result whatever the
 welder and the shell labels run on one thread; they are checked on the same mesh.
 """
 
+import os
+
 import numpy as np
 import pytest
 import trimesh
@@ -20,6 +22,12 @@ from inertia_tool.mesh.checks import edge_topology, shell_labels
 pytestmark = pytest.mark.skipif(not HAVE_ACCEL and not REQUIRE_ACCEL, reason="inertia_tool._accel is not built")
 
 THREADS = (2, 3, 5)
+
+#: Set by scripts/tsan.sh, which runs this file against a ThreadSanitizer build to look for data races: there the
+#: kernels run on several threads only (a one-thread run has no race to find, and under the sanitizer it costs as
+#: much as the others); every result is still compared with the same reference.  The ordinary run adds one thread.
+UNDER_TSAN = os.environ.get("INERTIA_TOOL_TSAN", "") not in ("", "0")
+RUNS = THREADS if UNDER_TSAN else (1,) + THREADS
 
 
 @pytest.fixture(scope="module")
@@ -49,6 +57,7 @@ def damaged():
     return np.concatenate(vs), np.concatenate(fs)[order].astype(np.int32)
 
 
+@pytest.mark.one_thread
 def test_welder_on_a_large_stream_matches_first_appearance(lib, damaged):
     """The recent-point cache in front of the table must not change the numbering: 1.2M corners (most found in
     the cache), some -0.0, ids in order of first appearance and the right coordinates, in chunks of any size."""
@@ -80,7 +89,7 @@ def test_partition_welder_is_independent_of_threads(lib, damaged):
     w.feed(corners, ref_ids)
     ref = np.empty((w.count, 3))
     w.vertices_into(ref)
-    for threads in (1,) + THREADS:
+    for threads in RUNS:
         ids = np.empty(len(corners), dtype=np.int32)
         p = lib.PartWelder(ids, threads)
         for s in range(0, len(corners), 3 << 17):
@@ -110,6 +119,7 @@ def test_edge_census_threads_match_numpy(monkeypatch, damaged):
     np.testing.assert_array_equal(c.sample, ref.sample)
 
 
+@pytest.mark.one_thread
 def test_shell_labels_match_numpy_on_a_large_mesh(lib, monkeypatch, damaged):
     v, f = damaged
     ref = np.empty(len(f), dtype=np.int64)
@@ -120,6 +130,7 @@ def test_shell_labels_match_numpy_on_a_large_mesh(lib, monkeypatch, damaged):
     np.testing.assert_array_equal(labels, ref)
 
 
+@pytest.mark.one_thread
 def test_shell_labels_many_small_shells(lib):
     """100,000 separate triangles in shuffled order, numbered by the smallest vertex of each."""
     rng = np.random.default_rng(3)
@@ -148,14 +159,16 @@ def test_census_shells_are_independent_of_threads(lib, damaged):
     v, f = damaged
     bowtie = f.copy()
     bowtie[bowtie == int(f[-1, 0])] = int(f[0, 0])       # the last face's shell meets the first's at a vertex
+    separate = []
     for faces in (f, bowtie):
         census, (labels, count) = _separate_kernels(lib, faces, len(v))
-        for threads in (1,) + THREADS:
+        separate.append(labels)
+        for threads in RUNS:
             out = np.empty(len(faces), np.int64)
             got = lib.census_shells(faces, len(v), out, threads)
             assert got == census + (count,)
             np.testing.assert_array_equal(out, labels)
-    assert count == 5 and not np.array_equal(labels, _separate_kernels(lib, f, len(v))[1][0])
+    assert count == 5 and not np.array_equal(separate[1], separate[0])
 
 
 def test_census_shells_many_small_shells(lib):
@@ -163,7 +176,7 @@ def test_census_shells_many_small_shells(lib):
     triangle: numbered by the smallest vertex of each, on 1 to 5 threads."""
     rng = np.random.default_rng(3)
     f = rng.permutation(300_000).reshape(-1, 3).astype(np.int32)
-    for threads in (1,) + THREADS:
+    for threads in RUNS:
         out = np.empty(len(f), np.int32)
         got = lib.census_shells(f, 300_000, out, threads)
         assert got[:4] == (300_000, 300_000, 0, 0) and got[7] == 100_000
@@ -274,6 +287,7 @@ def test_bounds_kernel(lib, damaged):
         lib.bounds(np.zeros((0, 3)))
 
 
+@pytest.mark.one_thread
 @pytest.mark.parametrize("raw, expected", [("3", 3), ("1", 1), ("99", 16), ("0", None), ("abc", None), ("", None),
                                            ("-2", None)])
 def test_threads_setting(monkeypatch, raw, expected):
@@ -332,6 +346,7 @@ def test_welder_refuses_feed_while_vertices_into_runs(lib):
     assert conclusive == 1
 
 
+@pytest.mark.one_thread
 def test_threads_setting_non_ascii_digits(monkeypatch):
     """str.isdigit() accepts '²' but int() does not: a malformed value must count as unset, not raise."""
     monkeypatch.setenv(_native.THREADS_ENV, "²")
@@ -355,7 +370,7 @@ def test_census_shells_unite_across_threads_on_a_torus_in_file_order(lib):
     n = 2 * len(v)
     census, (labels, count) = _separate_kernels(lib, faces, n)
     assert count == 2
-    for threads in (1,) + THREADS:
+    for threads in RUNS:
         out = np.empty(len(faces), np.int64)
         assert lib.census_shells(faces, n, out, threads) == census + (count,)
         np.testing.assert_array_equal(out, labels)

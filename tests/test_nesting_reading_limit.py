@@ -8,24 +8,15 @@ from __future__ import annotations
 
 import warnings
 
-import numpy as np
 import pytest
-import trimesh
 
 import inertia_tool as it
 from inertia_tool.errors import InvalidMeshError
+from solids import crossing_boxes_inside, stack
 
 
 def _closed_box_with_two_crossing_boxes_inside(size):
-    outer = trimesh.creation.box(extents=(4.0, 4.0, 4.0))
-    a = trimesh.creation.box(extents=(size,) * 3)
-    b = a.copy()
-    b.apply_translation((0.5, 0.4, 0.3))
-    parts = [outer, a, b]
-    offset = np.cumsum([0] + [len(p.vertices) for p in parts])
-    v = np.vstack([p.vertices for p in parts])
-    f = np.vstack([p.faces + o for p, o in zip(parts, offset)])
-    return v, f
+    return stack(*crossing_boxes_inside(size))
 
 
 @pytest.mark.parametrize("repair", [False, True])

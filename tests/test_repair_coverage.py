@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from damage_cases import damaged
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -56,13 +58,7 @@ def test_patched_surface_whose_union_is_not_verified_is_not_the_union():
     cid, s, kind, entropy = case
     name, v, f, truth = sources[s]
     assert name == "generated/annulus"
-    rng = np.random.default_rng(entropy)
-    if rng.random() < cov.QUANTISE_SHARE:
-        qv, qf, _ = cov._quantised(v, f, rng, truth["diagonal"])
-        quantised = cov.truth_of(qv, qf)
-        if quantised is not None:
-            v, f, truth = qv, qf, quantised
-    dv, df, _ = cov.make_case(kind, v, f, rng, truth["diagonal"])
+    dv, df, truth = damaged(cov, kind, v, f, truth, np.random.default_rng(entropy))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         p = it.mass_properties((dv, df), density=1.0, repair=True)

@@ -25,6 +25,7 @@ from hypothesis import strategies as st
 
 import adversary_solids as S
 from conftest import HAVE_ACCEL
+from solids import edge_neighbours, grown_patch, split_at_edge_points
 from test_mesh_intersect_patches import _check
 from test_mesh_sheets import _halves, _on_plane
 
@@ -86,24 +87,7 @@ def test_holes_in_a_convex_part_stay_inside_the_convex_hole_bound(seed, share):
 
 def _patch(f, start, size):
     """Up to ``size`` faces grown breadth-first from ``start`` through shared edges (indices into ``f``)."""
-    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
-    owner = np.tile(np.arange(len(f)), 3)
-    by_edge: dict[tuple[int, int], list[int]] = {}
-    for (a, b), o in zip(edges.tolist(), owner.tolist()):
-        by_edge.setdefault((a, b), []).append(o)
-    neighbours: list[list[int]] = [[] for _ in range(len(f))]
-    for faces in by_edge.values():
-        for x in faces:
-            neighbours[x].extend(y for y in faces if y != x)
-    seen, queue = {start}, [start]
-    for face in queue:                                # grows to at most len(f)
-        if len(seen) >= size:
-            break
-        for n in neighbours[face]:
-            if n not in seen and len(seen) < size:
-                seen.add(n)
-                queue.append(n)
-    return np.array(sorted(seen), dtype=np.int64)
+    return grown_patch(edge_neighbours(f), start, size)
 
 
 # ------------------------------------------------------------------------ R3b through T-vertices (seams)
@@ -182,24 +166,8 @@ def _t_vertices(hv, hf, on, rng, share, ends):
         inner[(p, q)] = list(range(n, n + len(pts)))
         verts.append(pts[order])
         n += len(pts)
-    rows, new_on = [], []
-    for tri, is_cut in zip(hf.tolist(), on.tolist()):
-        hit = None
-        for k in range(3):
-            a, b = tri[k], tri[(k + 1) % 3]
-            if (a, b) in inner:
-                hit = (k, inner[(a, b)])
-            elif (b, a) in inner:
-                hit = (k, inner[(b, a)][::-1])
-        if hit is None:
-            rows.append(tri)
-            new_on.append(is_cut)
-            continue
-        k, mids = hit
-        a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
-        chain = [a, *mids, b]
-        rows.extend([s, t, c] for s, t in zip(chain[:-1], chain[1:]))
-        new_on.extend([is_cut] * (len(chain) - 1))
+    rows, source = split_at_edge_points(hf, inner)
+    new_on = np.asarray(on, dtype=bool)[np.asarray(source, dtype=np.int64)]
     return np.vstack(verts), np.array(rows, dtype=np.int64), np.array(new_on, dtype=bool), n - len(hv)
 
 
