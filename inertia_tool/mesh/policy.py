@@ -544,13 +544,22 @@ def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, d
         owner[members] = members
         if inside_out:
             continue
+        given: dict[int, int] = {}         # cavities of this group given to each container so far
         for k in members[vols[members] < 0]:
             bodies = np.flatnonzero(cross[k] & (vols > 0))
-            if not len(bodies):
-                around = contained[contained[:, 0] == k, 1]
-                bodies = around[depth[around] == depth[k] - 1]
             if len(bodies):
                 owner[k] = bodies[np.argmin(np.abs(vols[bodies]))]
+                continue
+            around = contained[contained[:, 0] == k, 1]
+            bodies = around[depth[around] == depth[k] - 1]
+            if len(bodies):
+                # crossing cavities inside several overlapping bodies go to them in turn (the least used, then the
+                # smallest): two hollow copies overlapping keep a cavity each, so (A − Ca) ∪ (B − Cb) is formed,
+                # the solid {winding number ≥ 1} when both cavities lie in both bodies (not verified either way:
+                # cavities_in_overlap)
+                pick = min(bodies.tolist(), key=lambda b: (given.get(b, 0), abs(float(vols[b])), b))
+                owner[k] = pick
+                given[pick] = given.get(pick, 0) + 1
 
 
 def weakest(certificates: Iterable[Certificate]) -> Certificate:
