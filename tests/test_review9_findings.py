@@ -79,6 +79,8 @@ def _convex_intersection_volume(pieces):
     hs = np.vstack(rows)
     lp = linprog([0, 0, 0, -1], A_ub=np.c_[hs[:, :3], np.ones(len(hs))], b_ub=-hs[:, 3],
                  bounds=[(None, None)] * 3 + [(0, None)], method="highs")
+    if lp.x is None or lp.x[3] <= 1e-12:    # no ball fits: empty (here: apart by far more than that)
+        return 0.0
     return float(ConvexHull(HalfspaceIntersection(hs, lp.x[:3]).intersections).volume)
 
 
@@ -109,12 +111,11 @@ def test_hollow_copies_overlapping_are_not_certified_with_their_cavities_filled(
     assert any("inside bodies that overlap" in s for s in said)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "mesh/policy.orient_by_depth gives a cavity inside overlapping bodies to the smallest container (both cavities "
-    "to the first box), so the union fills them from the other box: unverified, but 1.0674 m³ instead of 0.9556 "
-    "(each cavity should be cut from the copy it belongs to, or the solid {winding number ≥ 1} formed)"))
-def test_hollow_copies_overlapping_give_the_solid_meant():
-    mesh, truth = _hollow_copies(0.1)
+@pytest.mark.parametrize("angle", [0.1, 1e-6])
+def test_hollow_copies_overlapping_give_the_solid_meant(angle):
+    """The number too: each crossing cavity goes to one of the bodies around it in turn (both went to the first box,
+    and the second filled them: 1.0674 m³), so (A − Ca) ∪ (B − Cb), the solid {winding number ≥ 1}, is formed."""
+    mesh, truth = _hollow_copies(angle)
     props, _ = _run(mesh)
     assert abs(props.mass - truth) <= 1e-9 * truth
 
@@ -131,3 +132,79 @@ def test_cavities_crossing_each_other_inside_a_box_are_cut():
     props, _ = _run(concat(box((4.0, 4.0, 4.0)), flipped(c1), flipped(c2)))
     assert abs(props.mass - truth) <= 1e-9 * truth, (props.mass, truth)
     assert props.mesh.cavities >= 1
+
+
+def _turned_copy_far_away():
+    """``benchmarks/bench_review9_convex.py --seed 903 --case 1982`` (mode tiny_turn), redrawn: an 11-sided prism
+    (0.208 m³) turned at random, listed with a copy turned 2.1e-9 rad about one of its corners, the pair ~950 km
+    from the origin (one ulp there is 1.2e-10 m)."""
+    from adversary_solids import _axis_rotation, cylinder, moved, random_rotation
+
+    rng = np.random.default_rng([903, 1982])
+    assert rng.integers(3) == 2
+    radius, height, sides = float(rng.uniform(0.2, 0.5)), float(rng.uniform(0.4, 1.0)), int(rng.integers(5, 17))
+    va, fa = moved(cylinder(radius, height, sides), random_rotation(rng), np.zeros(3))
+    angle = float(10.0 ** rng.uniform(-12, -3))
+    p = va[rng.integers(len(va))] if rng.random() < 0.5 else va.mean(0)
+    rot = _axis_rotation(rng.normal(size=3), angle)
+    vb = (va - p) @ rot.T + p
+    scale = 1e-3 if rng.random() < 0.3 else 1.0
+    assert scale == 1.0 and not rng.random() < 0.4
+    far = 10.0 ** rng.uniform(3, 7)
+    shift = np.round(rng.normal(size=3) * far)
+    return concat((va + shift, fa), (vb + shift, fa.copy()))
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "mesh/policy.within_up_to_rounding (R4) finds each of two near copies (beyond R0's 64-ulp budget: turned 2e-9 "
+    "rad, ~950 km out) within the other up to rounding and misread_nesting makes one the other's cavity: the "
+    "answer is 2.09e-10 m³ for a 0.208 m³ part, 'unverified', with '9.96e+10 % more mass' for the other reading "
+    "(honestly labelled, but nothing left of the part; two shells each within the other are one part listed "
+    "twice: counted once or united, as R0 and R5 do)"))
+def test_near_copy_far_away_is_not_read_as_its_own_cavity():
+    v, f = _turned_copy_far_away()
+    props, _ = _run((v, f))
+    corners = v[f[:44]] - v[0]                      # the first prism, about one of its corners
+    one = abs(float(np.einsum("ij,ij->", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])))) / 6
+    assert props.mass > 0.5 * one, (props.mass, one, props.mesh.certificate.kind)
+
+
+def _drawn_hollow_pair():
+    """``benchmarks/bench_review9_convex.py --seed 904 --case 7`` (mode hollow_pair), redrawn: two boxes turned at
+    random and overlapping, each with a cavity (a copy shrunk about its vertex mean, wound inward)."""
+    from adversary_solids import moved, random_rotation
+
+    rng = np.random.default_rng([904, 7])
+
+    def shrunk(piece, factor):
+        c = piece[0].mean(0)
+        return c + (piece[0] - c) * factor, piece[1].copy()
+
+    assert rng.integers(3) == 0
+    ext = rng.uniform(0.3, 1.0, size=3)
+    a = moved(box(ext, subdivide=int(rng.integers(0, 2))), random_rotation(rng), np.zeros(3))
+    ca = shrunk(a, float(rng.uniform(0.3, 0.7)))
+    assert rng.integers(3) == 0
+    ext = rng.uniform(0.3, 1.0, size=3)
+    b = moved(box(ext, subdivide=int(rng.integers(0, 2))), random_rotation(rng), rng.normal(size=3) * 0.3)
+    cb = shrunk(b, float(rng.uniform(0.3, 0.7)))
+    return a, ca, b, cb
+
+
+def test_hollow_bodies_overlapping_a_cavity_crossing_the_other_body():
+    """Two hollow boxes overlapping, a cavity crossing the other box's wall: R4 cut an inward shell from the
+    outward shell it crosses (the other box), not from the box containing it, and the union filled it
+    (``unverified``, 0.42478 m³ for 0.41402, 2.6 % high; 162 of 200 such draws off by 0.4–18 %).  A cavity inside
+    a body is now cut from that body.  Truth: (A − Ca) ∪ (B − Cb) = A + B − Ca − Cb − (A∩B − A∩B∩Ca − A∩B∩Cb +
+    A∩B∩Ca∩Cb), every intersection convex (qhull)."""
+    a, ca, b, cb = _drawn_hollow_pair()
+
+    def volume(piece):
+        v, f = piece
+        return abs(float(np.einsum("ij,ij->", v[f[:, 0]], np.cross(v[f[:, 1]], v[f[:, 2]])))) / 6
+
+    truth = volume(a) - volume(ca) + volume(b) - volume(cb) - (
+        _convex_intersection_volume([a, b]) - _convex_intersection_volume([a, b, ca])
+        - _convex_intersection_volume([a, b, cb]) + _convex_intersection_volume([a, b, ca, cb]))
+    props, _ = _run(concat(a, flipped(ca), b, flipped(cb)))
+    assert abs(props.mass - truth) <= 1e-9 * truth, (props.mass, truth, props.mesh.certificate.kind)

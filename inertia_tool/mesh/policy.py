@@ -101,7 +101,8 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    a warning.  Never decided by the sign of the total volume: one inside-out shell must not turn the others.
    So an outward-wound shell inside a body is read as a cavity written with the wrong winding, not as a
    second body buried in the first.  A shell whose surface crosses another's has no depth of its own: it keeps
-   the file's winding (an inward shell is cut from the outward shell it crosses) and the boolean decides; a
+   the file's winding (an inward shell is cut from the innermost body containing it, or, contained by none,
+   from the outward shell it crosses) and the boolean decides; a
    group of crossing shells all wound inward and lying in no body is turned as a whole.  A shell whose surface
    meets another's only where its solid reaches the other's boundary (all but ``TOUCH_VOLUME_RTOL`` of its
    solid shared with the other's, by the boolean: :func:`within_up_to_rounding`) lies *within* it and takes its
@@ -530,9 +531,10 @@ def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, d
 
     The file's winding says which of them is material and which a hole (a cavity that pokes through its body's
     wall, a part resting turned on a cavity's floor), and the boolean decides the solid; an inward shell is cut
-    from the outward shell it crosses (the smallest, if several), or, crossing none (cavities that cross only one
-    another), from the innermost shell containing it (``contained``: (k, 2) ``(shell, container)`` pairs; review 9:
-    two overlapping cavities in a box were their own bodies, and the boolean left the box full).  A group of
+    from the innermost body containing it (``contained``: (k, 2) ``(shell, container)`` pairs), and only when no
+    body contains it from the outward shell it crosses (the smallest, if several).  Review 9: two overlapping
+    cavities in a box were their own bodies (the boolean left the box full), and the cavity of one of two
+    overlapping hollow bodies that crossed the other was cut from the other (the union filled it).  A group of
     crossing shells that are all wound inward and lie in no body (even depth) is a group of bodies written inside
     out, and is turned as a whole.
     """
@@ -544,13 +546,24 @@ def _orient_crossing(vols: np.ndarray, cross: np.ndarray, crosses: np.ndarray, d
         owner[members] = members
         if inside_out:
             continue
+        given: dict[int, int] = {}         # cavities of this group given to each container so far
         for k in members[vols[members] < 0]:
-            bodies = np.flatnonzero(cross[k] & (vols > 0))
+            around = contained[contained[:, 0] == k, 1]
+            bodies = around[(depth[around] == depth[k] - 1) & (vols[around] > 0)]
             if not len(bodies):
-                around = contained[contained[:, 0] == k, 1]
-                bodies = around[depth[around] == depth[k] - 1]
+                # contained by no body: a cavity poking through its own body's wall, cut from the body it crosses
+                bodies = np.flatnonzero(cross[k] & (vols > 0))
+                if len(bodies):
+                    owner[k] = bodies[np.argmin(np.abs(vols[bodies]))]
+                continue
             if len(bodies):
-                owner[k] = bodies[np.argmin(np.abs(vols[bodies]))]
+                # crossing cavities inside several overlapping bodies go to them in turn (the least used, then the
+                # smallest): two hollow copies overlapping keep a cavity each, so (A − Ca) ∪ (B − Cb) is formed,
+                # the solid {winding number ≥ 1} when both cavities lie in both bodies (not verified either way:
+                # cavities_in_overlap)
+                pick = min(bodies.tolist(), key=lambda b: (given.get(b, 0), abs(float(vols[b])), b))
+                owner[k] = pick
+                given[pick] = given.get(pick, 0) + 1
 
 
 def weakest(certificates: Iterable[Certificate]) -> Certificate:
