@@ -299,13 +299,14 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     turned_tris = np.zeros((0, 3, 3))        # the faces orientation turned (corners, m): either winding may be right
     if found.misoriented_pairs:     # else orienting would turn nothing (each patch already agrees with itself)
         oriented = orient_consistently(f, n, v)
-        found = _census(oriented.faces, n)
-        census = found.balance
-        if census.balanced:
-            notes = (f"{oriented.flipped_faces:,} faces were wound the wrong way and were turned",) + \
-                _touching_note(census)
-            return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
-                              census.nonmanifold_edges)
+        if oriented.flipped_faces:  # else (a patch that cannot be oriented) the faces are f's: so is their census
+            found = _census(oriented.faces, n)
+            census = found.balance
+            if census.balanced:
+                notes = (f"{oriented.flipped_faces:,} faces were wound the wrong way and were turned",) + \
+                    _touching_note(census)
+                return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
+                                  census.nonmanifold_edges)
         current, flipped = oriented.faces, oriented.flipped_faces
         turned_mask = np.any(oriented.faces != f, axis=1)
         turned_tris = v[oriented.faces[turned_mask]]
@@ -335,7 +336,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
             if len(welded_faces):
                 again = _census(welded_faces, n)
                 turned = orient_consistently(welded_faces, n, v) if again.misoriented_pairs else None
-                if turned is not None:
+                if turned is not None and turned.flipped_faces:    # nothing turned: the census stands
                     again = _census(turned.faces, n)
                 census, found = again.balance, again
                 current = turned.faces if turned is not None else welded_faces
