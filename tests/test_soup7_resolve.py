@@ -50,3 +50,26 @@ def test_moebius_band_turns_nothing_and_the_census_is_taken_once(monkeypatch) ->
     details = refused.value.details
     assert details["boundary_edges"] == first.balance.boundary_edges
     assert details["unbalanced_edges"] == first.balance.unbalanced_edges
+
+
+def test_loose_faces_never_outnumber_a_third_of_the_net_boundary() -> None:
+    """The lemma that lets ``sheets._nothing_to_take`` skip counting valences when the net boundary is short: a
+    face sharing no vertex with another puts its three edges in the net boundary, so such faces number at most
+    ``len(boundary) / 3``.  Checked on random face lists (shared, repeated and loose faces), and the early exit
+    still fires on 4·64 + 1 loose triangles (a soup)."""
+    from inertia_tool.mesh import sheets
+    from inertia_tool.mesh.rims import boundary_edges
+
+    rng = np.random.default_rng(17)
+    for _ in range(200):
+        n = int(rng.integers(3, 40))
+        f = rng.integers(0, n, (int(rng.integers(1, 30)), 3))
+        f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
+        if not len(f):
+            continue
+        loose = int(np.count_nonzero((np.bincount(f.reshape(-1), minlength=n)[f] == 1).all(axis=1)))
+        assert 3 * loose <= len(boundary_edges(f, n))
+    k = 4 * sheets.MAX_SHEET_PIECES + 1
+    tri = rng.normal(size=(k, 3, 3))
+    v, f = tri.reshape(-1, 3), np.arange(3 * k).reshape(-1, 3)
+    assert sheets._nothing_to_take(v, f, boundary_edges(f, len(v)), 1e-12, sheets.MAX_SHEET_PIECES)
