@@ -267,7 +267,6 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         Without ``repair`` when no exact reading exists; with it when nothing encloses a volume.
     """
     # imported on use: a surface that passes the manifold check (nearly every file) never comes here
-    from .grid_estimate import closed_surface_estimate, open_surface_estimate
     from .uncertainty import check_useful
     from .merge import merge_close_vertices
     from .orient import edge_balance, orient_consistently
@@ -276,6 +275,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     f = np.asarray(faces)
     n = len(v)
     if force_estimate:
+        from .grid_estimate import closed_surface_estimate, open_surface_estimate   # (only here: its import)
+
         census = edge_balance(f, n)
         # a closed surface has an integer winding number off it: the decided cells bound the solid with no
         # assumption, and the grid is refined once towards CLOSED_TARGET_MASS_RTOL
@@ -437,11 +438,12 @@ def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, 
     """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed, and
     the non-manifold edges of the surface it integrates (``found`` is the census of ``faces``)."""
     from .edges import edge_keys
-    from .grid_estimate import winding_estimate
     from .holes import patched_estimate
     from .seal import seal_seams
     seal = seal_seams(vertices, faces, seam_gap_rtol * diag, boundary=found.boundary)
     if not len(seal.faces) or seal.loose_faces > soup_share * len(seal.faces):
+        from .grid_estimate import winding_estimate           # (the grid's module only for the grid)
+
         return winding_estimate(vertices, faces), found.balance.nonmanifold_edges
     best = patched_estimate(vertices, seal.faces, moments, seal=seal)
     # edges away from the frontier keep their count; the frontier's and the cones' are counted here
