@@ -129,20 +129,31 @@ def _census(faces: np.ndarray, n_vertices: int) -> _Census:
     pair = starts[count == 2]
     misoriented = int(np.count_nonzero(fwd[pair] == fwd[pair + 1]))
     unbalanced = net != 0
-    bad = key[starts[unbalanced]]
+    every = bool(unbalanced.all())                # (a soup: every edge open; no copy of the keys then)
+    bad = (key if len(starts) == len(key) else key[starts]) if every else key[starts[unbalanced]]
+    k = net if every else net[unbalanced]
     nv = np.int64(max(int(n_vertices), 1))
     balance = EdgeBalance(edges=len(starts), boundary_edges=int(np.count_nonzero(count == 1)),
                           nonmanifold_edges=int(np.count_nonzero(count > 2)), unbalanced_edges=len(bad))
+    nonmanifold = key[starts[count > 2]]
+    del starts, count, net, unbalanced
+    # the ends of the unbalanced edges, lower then higher, written in place: (2·edges,) int64
+    ends = np.empty(2 * len(bad), dtype=np.int64)
+    lo, hi = ends[:len(bad)], ends[len(bad):]
+    np.floor_divide(bad, nv, out=lo)
+    np.multiply(lo, nv, out=hi)
+    np.subtract(bad, hi, out=hi)
     # the boundary 1-chain as estimate.boundary_edges gives it: |net| copies of each edge in its net direction
-    lo, k = bad // nv, net[unbalanced]
-    hi = bad - lo * nv
-    start, end = np.where(k > 0, hi, lo), np.where(k > 0, lo, hi)
+    boundary = np.empty((len(bad), 2), dtype=np.int64)
+    boundary[:, 0] = lo
+    boundary[:, 1] = hi
+    positive = k > 0
+    np.copyto(boundary[:, 0], hi, where=positive)
+    np.copyto(boundary[:, 1], lo, where=positive)
     reps = np.abs(k)
-    if bool(np.all(reps == 1)):         # (as np.repeat gives it, without its cost: a soup's 3.9M edges, 0.2 s)
-        boundary = np.stack([start, end], axis=1)
-    else:
-        boundary = np.stack([np.repeat(start, reps), np.repeat(end, reps)], axis=1)
-    return _Census(balance, misoriented, np.concatenate([lo, hi]), boundary, key[starts[count > 2]])
+    if not bool(np.all(reps == 1)):
+        boundary = np.repeat(boundary, reps, axis=0)
+    return _Census(balance, misoriented, ends, boundary, nonmanifold)
 
 
 def _sorted_edges(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
@@ -256,7 +267,6 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         Without ``repair`` when no exact reading exists; with it when nothing encloses a volume.
     """
     # imported on use: a surface that passes the manifold check (nearly every file) never comes here
-    from .grid_estimate import closed_surface_estimate, open_surface_estimate
     from .uncertainty import check_useful
     from .merge import merge_close_vertices
     from .orient import edge_balance, orient_consistently
@@ -265,6 +275,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     f = np.asarray(faces)
     n = len(v)
     if force_estimate:
+        from .grid_estimate import closed_surface_estimate, open_surface_estimate   # (only here: its import)
+
         census = edge_balance(f, n)
         # a closed surface has an integer winding number off it: the decided cells bound the solid with no
         # assumption, and the grid is refined once towards CLOSED_TARGET_MASS_RTOL
@@ -288,13 +300,14 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     turned_tris = np.zeros((0, 3, 3))        # the faces orientation turned (corners, m): either winding may be right
     if found.misoriented_pairs:     # else orienting would turn nothing (each patch already agrees with itself)
         oriented = orient_consistently(f, n, v)
-        found = _census(oriented.faces, n)
-        census = found.balance
-        if census.balanced:
-            notes = (f"{oriented.flipped_faces:,} faces were wound the wrong way and were turned",) + \
-                _touching_note(census)
-            return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
-                              census.nonmanifold_edges)
+        if oriented.flipped_faces:  # else (a patch that cannot be oriented) the faces are f's: so is their census
+            found = _census(oriented.faces, n)
+            census = found.balance
+            if census.balanced:
+                notes = (f"{oriented.flipped_faces:,} faces were wound the wrong way and were turned",) + \
+                    _touching_note(census)
+                return Resolution(v, oriented.faces, "oriented", notes, oriented.flipped_faces, None,
+                                  census.nonmanifold_edges)
         current, flipped = oriented.faces, oriented.flipped_faces
         turned_mask = np.any(oriented.faces != f, axis=1)
         turned_tris = v[oriented.faces[turned_mask]]
@@ -324,7 +337,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
             if len(welded_faces):
                 again = _census(welded_faces, n)
                 turned = orient_consistently(welded_faces, n, v) if again.misoriented_pairs else None
-                if turned is not None:
+                if turned is not None and turned.flipped_faces:    # nothing turned: the census stands
                     again = _census(turned.faces, n)
                 census, found = again.balance, again
                 current = turned.faces if turned is not None else welded_faces
@@ -425,11 +438,12 @@ def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, 
     """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed, and
     the non-manifold edges of the surface it integrates (``found`` is the census of ``faces``)."""
     from .edges import edge_keys
-    from .grid_estimate import winding_estimate
     from .holes import patched_estimate
     from .seal import seal_seams
     seal = seal_seams(vertices, faces, seam_gap_rtol * diag, boundary=found.boundary)
     if not len(seal.faces) or seal.loose_faces > soup_share * len(seal.faces):
+        from .grid_estimate import winding_estimate           # (the grid's module only for the grid)
+
         return winding_estimate(vertices, faces), found.balance.nonmanifold_edges
     best = patched_estimate(vertices, seal.faces, moments, seal=seal)
     # edges away from the frontier keep their count; the frontier's and the cones' are counted here

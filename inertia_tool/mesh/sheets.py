@@ -297,9 +297,13 @@ def _nothing_to_take(v: np.ndarray, f: np.ndarray, boundary: np.ndarray | None, 
         ``_GUARD_EDGES`` unbalanced edges are tested, spread over their keys; no witness among them: False).
     """
     n = len(v)
-    valence = np.bincount(f.reshape(-1), minlength=n)
-    if int(np.count_nonzero((valence[f] == 1).all(axis=1))) > 4 * max_pieces:
-        return True
+    # (a) needs more than 4·max_pieces such faces, each with its three edges in the net boundary: a boundary of
+    # fewer edges cannot hold them, and the valences of every corner (page-faulted arrays the size of the file) are
+    # not counted
+    if boundary is None or len(boundary) > 3 * 4 * max_pieces:
+        valence = np.bincount(f.reshape(-1), minlength=n)
+        if int(np.count_nonzero((valence[f] == 1).all(axis=1))) > 4 * max_pieces:
+            return True
     if boundary is None or not len(boundary):
         return False
     nv = np.int64(max(n, 1))
