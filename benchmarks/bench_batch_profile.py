@@ -45,6 +45,8 @@ STAGES = (
     "inertia_tool.batch.runner:_read_once",
     "inertia_tool.mesh.read:load_mesh",
     "inertia_tool.mass.pipeline:mass_properties",
+    "inertia_tool.mesh.clean_part:prepare_clean",
+    "inertia_tool.integrals:one_shell_moments",
     "inertia_tool.mesh.prepare:prepare_mesh",
     "inertia_tool.mesh.surface:close_surface",
     "inertia_tool.mesh.checks:census_and_shells",

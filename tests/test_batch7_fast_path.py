@@ -169,8 +169,17 @@ def test_fast_path_agrees_with_the_full_checks(mesh):
     _check_both_ways(*mesh)
 
 
+def _tiny_coordinate():
+    """A box with a corner coordinate of 1e-300 m (nonzero, below the C face-pair filters' safe range): the fast
+    path asks ``surface_contacts`` itself, which scales the coordinates first."""
+    v, f = box((1.0, 1.0, 1.0), center=(0.5, 0.5, 0.5))
+    v = v.copy()
+    v[0, 0] = 1e-300
+    return v, f
+
+
 @pytest.mark.parametrize("piece", [box((1.0, 2.0, 3.0)), box((1.0, 1.0, 1.0), subdivide=1), icosphere(0.5, 1),
-                                   cylinder(0.3, 2.0, 24), torus(0.6, 0.2, 12, 6)])
+                                   cylinder(0.3, 2.0, 24), torus(0.6, 0.2, 12, 6), _tiny_coordinate()])
 def test_clean_parts_take_the_fast_path(piece):
     """The parts of a catalogue (closed, outward, one shell, nothing meeting) are the fast path's: not vacuous."""
     assert _check_both_ways(*piece)

@@ -26,9 +26,9 @@ issued, nothing is refused): the caller then runs the full :func:`~.prepare.prep
 refuses as it always did.  On a part it accepts, the :class:`~.prepare.PreparedMesh` is the full path's, field for
 field (``tests/test_batch7_fast_path.py`` compares them on generated and adversarial meshes).
 
-Only the face-pair check's diagnostic counters differ in what they describe: the full path's
-:class:`~.intersect.SurfaceContacts` (with ``candidate_pairs`` and ``tested_pairs``) is not kept by either path's
-result; here it is read for its three pair lists and ``complete`` and then dropped.
+Only the face-pair check's diagnostic counters differ: the full path's :class:`~.intersect.SurfaceContacts`
+(``candidate_pairs``, ``tested_pairs``) is kept by neither path's result, and here only the kinds of the pairs the
+kernel found and ``complete`` are read.
 """
 
 from __future__ import annotations
