@@ -278,7 +278,7 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from .winding import winding_numbers, winding_numbers_bounded, winding_numbers_summed
+    from .winding import winding_integers, winding_numbers, winding_numbers_summed
 
     v, f = vertices, faces
     edges = boundary_edges(f, len(v))
@@ -317,15 +317,16 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
     # first in C order
     first = _first_cells(region, n_regions) if first_cells is None else first_cells
     points = _cell_centres(first, lo, h, dims)
+    w_c = winding_numbers(points, cap_v, cap_f, fast=False) if n_loops else np.zeros(len(first))
     if fast and len(first) * len(f) <= DIRECT_REGION_WORK:
         # one point per region, few enough for the exact sum over every face (its round-off bounded)
         w_s, w_err = winding_numbers_summed(points, v, f)
     elif fast and len(first) <= BOUNDED_REGION_POINTS:
         # one point per region: the treecode's proven error bound instead of libigl's unbounded approximation
-        w_s, w_err = winding_numbers_bounded(points, v, f)
+        # (rounded below: a cheaper first pass where it settles the integer)
+        w_s, w_err = winding_integers(points, v, f, offset=w_c)
     else:
         w_s, w_err = winding_numbers(points, v, f, fast=fast), np.zeros(len(first))
-    w_c = winding_numbers(points, cap_v, cap_f, fast=False) if n_loops else np.zeros(len(first))
     total = w_s + w_c
     whole = np.round(total)
     if np.any(np.abs(total - whole) + w_err > 0.25):
@@ -895,7 +896,7 @@ def _front_numbers(v: np.ndarray, f: np.ndarray, clean: np.ndarray, *,
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from .winding import winding_numbers_bounded
+    from .winding import winding_integers
 
     m, n = len(f), len(v)
     out = np.full(m, np.iinfo(np.int32).min, dtype=np.int64)
@@ -946,7 +947,7 @@ def _front_numbers(v: np.ndarray, f: np.ndarray, clean: np.ndarray, *,
             eps[s:s + per] = np.minimum(r, 0.25 * nearest)
     ok = eps > PROBE_FLOOR_RTOL * diag
     probes = centroid + 0.5 * eps[:, None] * unit
-    w, err = winding_numbers_bounded(probes[ok], v, f)
+    w, err = winding_integers(probes[ok], v, f)
     whole = np.round(w)
     settled = np.abs(w - whole) + err <= 0.25
     value = np.full(len(probe_face), np.iinfo(np.int32).min, dtype=np.int64)
@@ -1039,7 +1040,7 @@ def corrected_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: i
 
     from ..integrals import volume_moments
     from .intersect import surface_contacts
-    from .winding import fast_available, winding_numbers, winding_numbers_bounded
+    from .winding import fast_available, winding_integers, winding_numbers
 
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
@@ -1112,7 +1113,7 @@ def corrected_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: i
         first = first[1:] if region[first[0]] == 0 else first
         pts = lo + h * (np.stack(np.unravel_index(first, dims), axis=1) + 0.5)
         if len(first) <= BOUNDED_REGION_POINTS or not fast_available():
-            w, err = winding_numbers_bounded(pts, v, f)
+            w, err = winding_integers(pts, v, f)
         else:
             w, err = winding_numbers(pts, v, f, fast=True), np.zeros(len(pts))
         whole = np.round(w)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["winding_numbers", "winding_numbers_bounded", "fast_available"]
+__all__ = ["winding_numbers", "winding_numbers_bounded", "winding_integers", "fast_available"]
 
 _BLOCK = 1 << 22     # point-triangle pairs per vectorised block of the direct sum
 
@@ -222,6 +222,34 @@ def _contiguous(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray
     """The query points and the surface as C-contiguous float64 / int64 arrays (the kernels' layout)."""
     return (np.ascontiguousarray(points, dtype=np.float64), np.ascontiguousarray(vertices, dtype=np.float64),
             np.ascontiguousarray(faces, dtype=np.int64))
+
+
+#: Per-cluster error tolerance of the first, cheaper treecode pass of :func:`winding_integers` (10× the
+#: default's: on G1's torso 3,621 region points against 51,420 faces, 10.0 → 5.4 s, 99.6 % of them settled).
+INTEGER_FIRST_TOLERANCE = 1e-3
+
+
+def winding_integers(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, *,
+                     offset: np.ndarray | float = 0.0, margin: float = 0.25, tolerance: float = 1e-4,
+                     first_tolerance: float = INTEGER_FIRST_TOLERANCE) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`winding_numbers_bounded` at points where ``winding + offset`` is known to be an integer (off a
+    closed surface), for callers that only round it: ``(winding, error)``, (p,) float each.
+
+    A first pass runs the treecode at ``first_tolerance``; a point it settles (``|w + offset − round| + error ≤
+    margin``, ``margin < 1/2``) keeps that value and bound, the others are evaluated again at ``tolerance``.
+    Rounded, a settled value is the true integer (it lies within its proven bound of it, and the integer is
+    the only one within ``1/2``), so every caller that rounds points settled at ``tolerance`` gets the same
+    integers as from one pass at ``tolerance`` (each point's value does not depend on the others evaluated
+    with it); a point settled only by the first pass is proven by its own bound.
+    """
+    w, err = winding_numbers_bounded(points, vertices, faces, tolerance=first_tolerance)
+    total = w + offset
+    again = np.flatnonzero(np.abs(total - np.round(total)) + err > margin)
+    if len(again) and first_tolerance != tolerance:
+        w[again], err[again] = winding_numbers_bounded(np.asarray(points)[again], vertices, faces,
+                                                       tolerance=tolerance)
+    return w, err
+
 
 def winding_numbers_bounded(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, *,
                             tolerance: float = 1e-4) -> tuple[np.ndarray, np.ndarray]:
