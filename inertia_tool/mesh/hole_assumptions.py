@@ -58,7 +58,7 @@ CONVEX = HoleAssumption(
     "convex", "the part is convex, as what remains of it is", "a dent, pocket or groove taken whole")
 BEND = HoleAssumption(
     "bend", "the missing surface is a graph over the rim's mean plane and slopes against that plane no more "
-    "steeply than the steepest face sharing an edge with the rim", "a feature taken whole whose walls are "
+    "steeply than the steepest face touching the rim", "a feature taken whole whose walls are "
     "steeper than the faces round its rim (a boss or pocket on a flat or gently curved face)")
 QUADRIC = HoleAssumption(
     "quadric", "(the fill, not the bound) the missing surface continues the quadric its surroundings lie on",

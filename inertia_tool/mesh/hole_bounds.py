@@ -678,8 +678,11 @@ def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     **Assumption** (:data:`~.hole_assumptions.BEND`): the missing surface ``M`` of a hole is the graph of a
     height ``g`` over the region ``Ω`` its rim bounds in the rim's mean plane ``Π`` (through the cone's apex
     ``c``, normal ``n``: the fan's area vector ``Σ (a − c) × (b − c)`` over the rim edges ``a → b``), and slopes
-    against ``Π`` no more than the steepest face sharing an edge with the rim: ``|∇g| ≤ L = tan θ``, ``θ`` the
-    largest angle between such a face's normal and ``n``.  For a small hole on a faceted or smooth part that is
+    against ``Π`` no more than the steepest face touching the rim (at a rim vertex): ``|∇g| ≤ L = tan θ``, ``θ`` the
+    largest angle between such a face's normal and ``n``.  Faces at the rim's corners count, not only those across
+    its edges: a hole whose rim touches a crease or a wall at a corner gets that slope (or none: past
+    ``max_degrees``), which is what keeps a feature taken whole with the faces round its footprint, whose rim
+    reaches the face's border, out of the bound's reach.  For a small hole on a faceted or smooth part that is
     the statement that the surface bends no more inside the hole than round it; it fails for a feature taken whole
     whose walls are steeper than the faces round its rim (a boss on a flat face), as the flat slab does.
 
@@ -695,7 +698,7 @@ def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     over the fan is the hole's volume in doubt, and every point of the region lies within
     ``max|h| + L max dist(c, ab)`` of ``Π`` (``height``).  A round-off margin of 16 ulp of the coordinates is
     added to every height.  Not applied (``inf``): a fan that is not star-shaped, a ring face steeper than
-    ``max_degrees`` or facing against the fan, a loop without a ring face on some edge.
+    ``max_degrees`` or facing against the fan.
 
     Parameters
     ----------
@@ -734,16 +737,26 @@ def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     turn = np.arctan2(2.0 * signed, np.einsum("ij,ij->i", ua, ub))
     turns = np.bincount(label, weights=turn, minlength=n_loops)
     star = ok & ~backward & (np.abs(turns - 2.0 * np.pi) <= 1e-6)
-    # the steepest ring face of each loop: the face holding the rim edge a → b, against the fan's normal
-    face, found = _ring_face_of_edges(f, len(v), e)
-    fa, fb, fc = (v[f[face, k]] for k in range(3))
+    # the steepest face touching each loop's rim (at any rim vertex: a face across a crease met at a rim corner
+    # counts, so a hole whose rim touches a crease or a wall gets that slope), against the fan's normal
+    rim = _sorted_pairs(np.r_[e[:, 0], e[:, 1]], np.r_[label, label], n_loops)      # (vertex, loop), by vertex
+    first = np.searchsorted(rim[:, 0], np.arange(len(v)))
+    count = np.searchsorted(rim[:, 0], np.arange(len(v)), side="right") - first
+    fi, ci = np.nonzero(count[f] > 0)
+    corner_vertex = f[fi, ci]
+    reps = count[corner_vertex]
+    face_of = np.repeat(fi, reps)
+    within = np.arange(int(reps.sum())) - np.repeat(np.cumsum(reps) - reps, reps)
+    which = np.repeat(first[corner_vertex], reps) + within
+    loop_of_face = rim[which, 1]
+    fa, fb, fc = (v[f[face_of, k]] for k in range(3))
     fn = np.cross(fb - fa, fc - fa)
     fsize = np.linalg.norm(fn, axis=1)
-    good = found & (fsize > 0)
-    cosine = np.where(good, -np.einsum("ij,ij->i", fn, nk) / np.where(fsize > 0, fsize, 1.0), -1.0)
+    good = fsize > 0
+    cosine = np.where(good, -np.einsum("ij,ij->i", fn, normal[loop_of_face]) / np.where(good, fsize, 1.0), 1.0)
     least = np.full(n_loops, np.inf)
-    np.minimum.at(least, label, cosine)
-    steep = least < np.cos(np.radians(max_degrees))
+    np.minimum.at(least, loop_of_face, cosine)
+    steep = ~(least >= np.cos(np.radians(max_degrees)))
     usable = star & ~steep
     cos_l = np.clip(least, 1e-300, 1.0)
     slope = np.sqrt(np.maximum(1.0 - cos_l ** 2, 0.0)) / cos_l

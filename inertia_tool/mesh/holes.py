@@ -236,7 +236,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         bent = np.zeros(n_loops, dtype=bool)
         bent[[bend.loop for bend in curved]] = True
         bend_doubt, bend_height = bend_doubt_volumes(v, f, edges, label, n_loops, apex)
-        took_bend = ~withdrawn & ~engulfed & ~crossed & ~bent & (bend_doubt < hole_doubt)
+        took_bend = ~engulfed & ~crossed & ~bent & (bend_doubt < hole_doubt)
         before_bend = float(np.sum(hole_doubt))
         hole_doubt = np.where(took_bend, bend_doubt, hole_doubt)
         ball_volume = 4.0 / 3.0 * np.pi * radius ** 3
