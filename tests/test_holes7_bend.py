@@ -255,7 +255,7 @@ def _taken_whole(kind, seed):
     return v, f, np.array(sorted(grown))
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=30, deadline=None)
 @given(kind=st.sampled_from(KINDS), seed=st.integers(0, 2 ** 31 - 1), share=st.floats(0.0, 0.3),
        quat=st.lists(st.floats(-1, 1), min_size=4, max_size=4).filter(lambda q: np.linalg.norm(q) > 0.1))
 def test_every_answered_hole_is_inside_its_bound_or_names_the_assumption_that_fails(kind, seed, share, quat):

@@ -240,6 +240,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         before_bend = float(np.sum(hole_doubt))
         hole_doubt = np.where(took_bend, bend_doubt, hole_doubt)
         ball_volume = 4.0 / 3.0 * np.pi * radius ** 3
+        took_capsule &= ~took_bend
         took_flat = in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
         used = {"ball"}
         used |= {"flat"} if took_flat.any() else set()
