@@ -56,16 +56,36 @@ def _dented_sphere(subdivisions, depth):
     return v, f[~np.any(f == 0, axis=1)], truth
 
 
-@pytest.mark.xfail(strict=True, reason="convex_hole_bound (fourth hole assumption): a dent taken whole by the hole "
-                   "on a convex remainder; the ball bound (first assumption) held, the convex one replaces it and "
-                   "misses the truth")
-def test_a_dent_taken_whole_stays_inside_the_convex_hole_bound():
+def test_a_dent_taken_whole_is_an_estimate_conditional_on_the_convex_assumption_which_fails():
     """Icosphere (3 subdivisions, radius 1) with one vertex pushed in by 0.05 (a dimple 5 % of the radius deep,
     inside the ball over its rim) and the dimple's six faces removed.  The rest is convex, so the fourth
     assumption takes the part to be convex: stated ±5.7e-5 of the mass, found 1.47e-4 off (centre of mass
-    1.44e-4 m off, bound 5.8e-5 m).  Without the convex bound the ball bound, ±9.7e-4, holds."""
+    1.44e-4 m off, bound 5.8e-5 m).  Without the convex bound the ball bound, ±9.7e-4, holds.
+
+    holes7 (was a strict xfail): the file cannot tell this from the octahedron less a face (pinned at ±25 % by
+    ``test_hole_bounds``), so by the lead's decision on issue 21 the answer is an estimate whose bound is stated
+    conditional on the named assumption, and the test checks that the assumption named is the one that fails:
+    the part is not convex (the dent's vertex lies inside the hull of the others), while the ball over the rim
+    does hold the missing dent."""
+    from scipy.spatial import ConvexHull
+
+    from inertia_tool.integrals import volume_moments
+    from inertia_tool.mesh.hole_assumptions import CONVEX
+    from inertia_tool.mesh.holes import patched_estimate
+    from inertia_tool.mesh.rims import boundary_edges, enclosing_balls
+
     v, f, truth = _dented_sphere(3, 0.05)
-    _assert_honest(_verdict(v, f, truth, "icosphere(3) dented 0.05 at vertex 0, dent's ring removed", repair=True))
+    est = patched_estimate(v, f, volume_moments)
+    assert est.assumptions == ("convex",)
+    assert CONVEX.statement in est.detail
+    assert abs(est.volume - truth.volume) > est.uncertainty.mass * est.volume     # the conditional bound misses
+    hull = ConvexHull(v)
+    assert 0 not in hull.vertices and hull.volume > truth.volume * (1 + 1e-5)     # the part is not convex
+    rim = np.unique(boundary_edges(f, len(v)))
+    centre, radius = enclosing_balls(v[rim], np.zeros(len(rim), dtype=np.int64), 1)
+    assert np.linalg.norm(v[0] - centre[0]) <= radius[0]                          # the ball does hold the dent
+    verdict = _verdict(v, f, truth, "icosphere(3) dented 0.05 at vertex 0, dent's ring removed", repair=True)
+    assert verdict.label == "estimate"
 
 
 @FAST
@@ -380,20 +400,39 @@ def test_the_box_with_a_boss_is_closed_and_exact():
         assert _verdict(v, f, truth).label == "exact"
 
 
-@pytest.mark.xfail(strict=True, reason="slab_contradicted / rim_evidence (second hole assumption): a hole whose rim "
-                   "lies on the outer loop of a flat face took a boss standing inside it whole; every rim vertex keeps "
-                   "a face off the plane, so nothing withdraws the slab, and the bound is round-off")
 @pytest.mark.parametrize("pocket", [False, True])
-def test_a_feature_taken_whole_inside_a_rim_on_the_outer_loop_is_not_bounded_by_the_slab(pocket):
+def test_a_feature_taken_whole_inside_a_rim_on_the_outer_loop_names_the_flat_assumption_that_fails(pocket):
     """The box with a boss (or pocket) 0.5 m high, its top's faces at the footprint and the feature removed: the
     patch closes the top flat (8 m³), stated within ±2.2e-14, truth 8.5 m³ (5.9 % off; the pocket 7.5 m³, 6.7 %).
     The rim (2, 0)-(4, 0)-(4, 2)-(2, 2) lies in the top's plane, and the top's remaining faces beside it put the
     slab's width at round-off; the rim's corners all keep a side face, so ``slab_contradicted`` (a rim vertex
     whose faces all lie in the plane) does not fire, and the hole is no island (``rim_evidence``).  On a CAD
-    tessellation the feature's footprint vertices went with the hole: nothing in the file confirms the slab."""
+    tessellation the feature's footprint vertices went with the hole: nothing in the file confirms the slab.
+
+    holes7 (was a strict xfail): the file shows the same evidence as a missing triangle of a flat face
+    (``test_hole_bounds.test_missing_triangle_of_a_flat_face…``), so by the lead's decision on issue 21 the answer
+    is an estimate (never exact) whose bound is stated conditional on the flat face continuing across the hole
+    (``hole_assumptions.FLAT``, printed among the notes).  The test checks that this named assumption is the one
+    that fails here: the faces the hole took leave the top's plane by the feature's height, far past the slab."""
+    import warnings
+
+    from inertia_tool import mass_properties
+    from inertia_tool.integrals import volume_moments
+    from inertia_tool.mesh.hole_assumptions import FLAT
+    from inertia_tool.mesh.holes import patched_estimate
+
     v, f, hole, truth = _box_with_a_boss(pocket=pocket)
-    _assert_honest(_verdict(v, f[~hole], truth, f"box with a {'pocket' if pocket else 'boss'}, top at the "
-                            "footprint and the feature removed", repair=True))
+    est = patched_estimate(v, f[~hole], volume_moments)
+    assert "flat" in est.assumptions and FLAT.statement in est.detail
+    assert est.uncertainty.volume_in_doubt < 1e-12                         # the slab: round-off wide
+    assert abs(est.volume - truth.volume) == pytest.approx(0.5)            # the conditional bound misses
+    taken = v[f[hole]].reshape(-1, 3)
+    assert np.max(np.abs(taken[:, 2] - 1.0)) == pytest.approx(0.5)          # the flat assumption fails by 0.5 m
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = mass_properties((v, f[~hole]), density=1.0, repair=True)
+    assert p.mesh.certificate.kind == "estimate"
+    assert any(FLAT.statement in note for note in p.mesh.notes)
 
 
 # --------------------------------------------------- the face-pair check's certified patches: pinches

@@ -661,3 +661,123 @@ def _contradicted(evidence: RimEvidence, radius: np.ndarray, size: np.ndarray) -
             "is the footprint of a feature standing on the face or sunk into it (a boss, a pocket) that the hole "
             "took whole, and nothing in the file bounds its height (expected a rim that keeps a face of the "
             "surface beside it)")
+
+
+#: A face beside the rim steeper than this (its normal's angle with the rim's mean plane's normal, degrees) leaves
+#: :func:`bend_doubt_volumes` no slope to bound (the missing surface may fold over itself): that hole keeps the
+#: other bounds.
+BEND_MAX_DEGREES = 80.0
+
+
+def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
+                       n_loops: int, apex: np.ndarray, *, max_degrees: float = BEND_MAX_DEGREES
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Volume in doubt of each hole under the *bend* assumption, and how far its region reaches from the rim's
+    mean plane: ``(doubt, height)``, (n_loops,) m³ and m, ``inf`` where the assumption cannot be applied.
+
+    **Assumption** (:data:`~.hole_assumptions.BEND`): the missing surface ``M`` of a hole is the graph of a
+    height ``g`` over the region ``Ω`` its rim bounds in the rim's mean plane ``Π`` (through the cone's apex
+    ``c``, normal ``n``: the fan's area vector ``Σ (a − c) × (b − c)`` over the rim edges ``a → b``), and slopes
+    against ``Π`` no more than the steepest face touching the rim (at a rim vertex): ``|∇g| ≤ L = tan θ``, ``θ`` the
+    largest angle between such a face's normal and ``n``.  Faces at the rim's corners count, not only those across
+    its edges: a hole whose rim touches a crease or a wall at a corner gets that slope (or none: past
+    ``max_degrees``), which is what keeps a feature taken whole with the faces round its footprint, whose rim
+    reaches the face's border, out of the bound's reach.  For a small hole on a faceted or smooth part that is
+    the statement that the surface bends no more inside the hole than round it; it fails for a feature taken whole
+    whose walls are steeper than the faces round its rim (a boss on a flat face), as the flat slab does.
+
+    The bound.  Where the projected fan is star-shaped round ``c`` (every fan triangle ``T = (a, b, c)`` turns the
+    same way in ``Π`` and the turns add up to one full turn, so the projected fan tiles ``Ω`` once), ``M`` and the
+    cone are two graphs over ``Ω`` with the rim as common boundary, and the patched and true solids differ by
+    ``∫_Ω |g − cone| dA``.  At ``p`` in the projection of ``T``, with ``r`` the nearest point of the rim edge
+    ``ab`` (``g(r)`` the rim's height there, between ``h_a`` and ``h_b``), the Lipschitz bound gives
+    ``|g(p) − g(r)| ≤ L |p − r|``, and the cone's height at ``p`` lies between the least and the largest of
+    ``h_a, h_b, h_c``; so ``|g − cone|(p) ≤ L dist(p, ab) + s_T`` with ``s_T`` that spread.  The right side is a
+    convex function of ``p``; its mean over a triangle is at most the mean of its values at the corners, which
+    are ``s_T`` at ``a`` and ``b``: ``∫_T ≤ A_T (L dist(c, ab) / 3 + s_T)`` (``A_T`` the projected area).  The sum
+    over the fan is the hole's volume in doubt, and every point of the region lies within
+    ``max|h| + L max dist(c, ab)`` of ``Π`` (``height``).  A round-off margin of 16 ulp of the coordinates is
+    added to every height.  Not applied (``inf``): a fan that is not star-shaped, a ring face steeper than
+    ``max_degrees`` or facing against the fan.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    edges : (k, 2) int
+        Boundary edges ``a → b`` (each the edge of one face in that direction), ``label`` (k,) their loop.
+    apex : (n_loops, 3) float
+        The cone's apex of each loop (the centroid of its rim vertices), m.
+    max_degrees : float
+        ``BEND_MAX_DEGREES``.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    e = np.asarray(edges, dtype=np.int64)
+    doubt = np.full(n_loops, np.inf)
+    height = np.full(n_loops, np.inf)
+    if not n_loops or not len(e) or not len(f):
+        return doubt, height
+    margin = _round_off(v)
+    c = apex[label]
+    pa, pb = v[e[:, 0]] - c, v[e[:, 1]] - c
+    area_vec = np.cross(pa, pb)
+    total = np.zeros((n_loops, 3))
+    for axis in range(3):
+        total[:, axis] = np.bincount(label, weights=area_vec[:, axis], minlength=n_loops)
+    size = np.linalg.norm(total, axis=1)
+    ok = size > 0
+    normal = total / np.where(ok, size, 1.0)[:, None]
+    nk = normal[label]
+    ha, hb = np.einsum("ij,ij->i", pa, nk), np.einsum("ij,ij->i", pb, nk)
+    ua, ub = pa - ha[:, None] * nk, pb - hb[:, None] * nk          # projections onto the plane, apex at 0
+    signed = 0.5 * np.einsum("ij,ij->i", np.cross(ua, ub), nk)
+    tiny = 1e-12 * np.bincount(label, weights=np.abs(signed), minlength=n_loops)
+    backward = np.bincount(label, weights=signed < -tiny[label], minlength=n_loops) > 0
+    turn = np.arctan2(2.0 * signed, np.einsum("ij,ij->i", ua, ub))
+    turns = np.bincount(label, weights=turn, minlength=n_loops)
+    star = ok & ~backward & (np.abs(turns - 2.0 * np.pi) <= 1e-6)
+    # the steepest face touching each loop's rim (at any rim vertex: a face across a crease met at a rim corner
+    # counts, so a hole whose rim touches a crease or a wall gets that slope), against the fan's normal
+    rim = _sorted_pairs(np.r_[e[:, 0], e[:, 1]], np.r_[label, label], n_loops)      # (vertex, loop), by vertex
+    first = np.searchsorted(rim[:, 0], np.arange(len(v)))
+    count = np.searchsorted(rim[:, 0], np.arange(len(v)), side="right") - first
+    fi, ci = np.nonzero(count[f] > 0)
+    corner_vertex = f[fi, ci]
+    reps = count[corner_vertex]
+    face_of = np.repeat(fi, reps)
+    within = np.arange(int(reps.sum())) - np.repeat(np.cumsum(reps) - reps, reps)
+    which = np.repeat(first[corner_vertex], reps) + within
+    loop_of_face = rim[which, 1]
+    fa, fb, fc = (v[f[face_of, k]] for k in range(3))
+    fn = np.cross(fb - fa, fc - fa)
+    fsize = np.linalg.norm(fn, axis=1)
+    good = fsize > 0
+    cosine = np.where(good, -np.einsum("ij,ij->i", fn, normal[loop_of_face]) / np.where(good, fsize, 1.0), 1.0)
+    least = np.full(n_loops, np.inf)
+    np.minimum.at(least, loop_of_face, cosine)
+    steep = ~(least >= np.cos(np.radians(max_degrees)))
+    usable = star & ~steep
+    cos_l = np.clip(least, 1e-300, 1.0)
+    slope = np.sqrt(np.maximum(1.0 - cos_l ** 2, 0.0)) / cos_l
+    # the apex's distance from each rim edge's segment, in the plane
+    d = ub - ua
+    dd = np.einsum("ij,ij->i", d, d)
+    t = np.clip(np.where(dd > 0, -np.einsum("ij,ij->i", ua, d) / np.where(dd > 0, dd, 1.0), 0.0), 0.0, 1.0)
+    dist = np.linalg.norm(ua + t[:, None] * d, axis=1)
+    spread = np.maximum(np.maximum(ha, hb), 0.0) - np.minimum(np.minimum(ha, hb), 0.0) + 2.0 * margin
+    per_edge = np.abs(signed) * (slope[label] * dist / 3.0 + spread)
+    total_doubt = np.bincount(label, weights=per_edge, minlength=n_loops)
+    worst_h = np.zeros(n_loops)
+    np.maximum.at(worst_h, label, np.maximum(np.abs(ha), np.abs(hb)))
+    worst_d = np.zeros(n_loops)
+    np.maximum.at(worst_d, label, dist)
+    doubt[usable] = round_up_array(total_doubt[usable] * (1.0 + 1e-9))
+    height[usable] = worst_h[usable] + slope[usable] * worst_d[usable] + 2.0 * margin
+    return doubt, height
+
+
+def round_up_array(values: np.ndarray) -> np.ndarray:
+    """Each value moved one ulp away from zero (a sum of rounded terms, made an upper bound)."""
+    out: np.ndarray = np.nextafter(values, np.inf)
+    return out

@@ -75,6 +75,9 @@ class Estimate:
     unbounded : str
         Empty, or why no bound follows (the surface beside a hole contradicts the assumption the bound needs):
         the caller refuses with this reason.
+    assumptions : tuple of str
+        The names of the assumptions about the missing surface the bound holds under
+        (:mod:`~.hole_assumptions`; also stated in ``detail``); empty where the bound assumes nothing of it.
     """
 
     volume: float
@@ -88,6 +91,7 @@ class Estimate:
     faces: np.ndarray
     far: float = 0.0
     unbounded: str = ""
+    assumptions: tuple[str, ...] = ()
 
 
 def uncertainty_from(volume: float, centroid: np.ndarray, second_moment: np.ndarray, doubt: float,

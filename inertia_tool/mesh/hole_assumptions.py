@@ -1,0 +1,86 @@
+"""The assumptions a hole's bound rests on, each named once (issue 21, "certified answers").
+
+No bound on a hole follows from the file alone: the missing surface can be anything with the rim as its
+boundary.  Every bound :func:`~.holes.patched_estimate` states is therefore *conditional* on assumptions about
+the missing surface, and an estimate names the ones its bound used (:func:`stated`, in its ``detail``, which
+``repair=True`` prints as a note in text and JSON).  Where the file cannot tell a case the assumption covers from
+one it does not (a missing triangle of a flat face and a boss taken whole with the faces round its footprint
+leave the same rim on the same plane), the answer is an estimate whose bound holds *if* the named assumption
+does, never ``exact``: a filled hole is always an estimate (``mesh/policy.py``).
+
+Each :class:`HoleAssumption` has a short ``name`` (what tests and benchmarks match on), the ``statement`` (what
+is assumed of the missing surface ``M`` of a hole) and ``fails_for`` (the damage it cannot see, so a reader knows
+when to distrust the bound).  The evidence that withdraws a narrower assumption when the file contradicts it is in
+:mod:`~.hole_bounds` and :mod:`~.hole_fills`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Iterable
+
+__all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "BEND", "QUADRIC", "ALL", "stated",
+           "named"]
+
+
+@dataclasses.dataclass(frozen=True)
+class HoleAssumption:
+    """One assumption about the surface a hole lost.
+
+    Attributes
+    ----------
+    name : str
+        Short identifier (``"flat"``, ``"ball"``, ...), printed before the statement.
+    statement : str
+        What is assumed of the missing surface ``M`` of a hole.
+    fails_for : str
+        Damage the assumption cannot see (the bound is then wrong, not merely loose).
+    """
+
+    name: str
+    statement: str
+    fails_for: str
+
+
+BALL = HoleAssumption(
+    "ball", "the missing surface of each hole lies within the ball enclosing its rim",
+    "a feature taller than its rim is wide (a pin, a housing) taken whole, or a band joining two rims")
+CAPSULE = HoleAssumption(
+    "capsule", "the missing surface of a long thin hole lies within the capsule round its rim's principal axis "
+    "that holds the rim", "a long slot or rib taken whole")
+FLAT = HoleAssumption(
+    "flat", "the flat face continues across the hole: the missing surface strays from the plane of a face beside "
+    "the hole no farther than the rim does", "a boss, pocket, slot or dimple taken whole with the faces round it")
+CREASE = HoleAssumption(
+    "crease", "the two planes that hold the rim continue across the hole, meeting at one crease",
+    "a feature standing on either face, or a chamfer or fillet along the crease, taken whole")
+CONVEX = HoleAssumption(
+    "convex", "the part is convex, as what remains of it is", "a dent, pocket or groove taken whole")
+BEND = HoleAssumption(
+    "bend", "the missing surface is a graph over the rim's mean plane and slopes against that plane no more "
+    "steeply than the steepest face touching the rim", "a feature taken whole whose walls are "
+    "steeper than the faces round its rim (a boss or pocket on a flat or gently curved face)")
+QUADRIC = HoleAssumption(
+    "quadric", "(the fill, not the bound) the missing surface continues the quadric its surroundings lie on",
+    "nothing: the bound stays that of the other assumptions named")
+
+#: Every assumption, in the order :func:`stated` prints them.
+ALL = (CONVEX, BALL, CAPSULE, FLAT, CREASE, BEND, QUADRIC)
+
+
+def named(names: Iterable[str]) -> tuple[HoleAssumption, ...]:
+    """The assumptions called ``names``, in the order of :data:`ALL` (unknown names raise ``KeyError``)."""
+    wanted = set(names)
+    unknown = wanted - {a.name for a in ALL}
+    if unknown:
+        raise KeyError(f"expected names of hole assumptions ({', '.join(a.name for a in ALL)}), got "
+                       f"{', '.join(sorted(unknown))}")
+    return tuple(a for a in ALL if a.name in wanted)
+
+
+def stated(names: Iterable[str]) -> str:
+    """One line naming the assumptions ``names`` a bound rests on, for the estimate's ``detail``."""
+    chosen = named(names)
+    if not chosen:
+        return ""
+    return "the bound holds only if " + "; and ".join(f"{a.name}: {a.statement}" for a in chosen)
