@@ -123,7 +123,9 @@ def test_hollow_copies_overlapping_give_the_solid_meant(angle):
 def test_cavities_crossing_each_other_inside_a_box_are_cut():
     """Two cavities that cross each other inside a box (each wound inward): they crossed no outward shell, so R4
     gave each to itself as its own body, and the boolean left the box full (64 m³, the cavities lost).  They are
-    now cut from the shell around them: 64 − |C1 ∪ C2|."""
+    now cut from the shell around them: 64 − |C1 ∪ C2|, certified ``united`` (the boolean's union exceeds the
+    summed integral by exactly the cavities' common volume, which the sum takes out twice; it was read as "a shell
+    read as a cavity reaches out of the body around it" and not verified)."""
     from adversary_solids import _axis_rotation, moved
 
     c1 = box((1.0, 1.0, 1.0))
@@ -132,6 +134,8 @@ def test_cavities_crossing_each_other_inside_a_box_are_cut():
     props, _ = _run(concat(box((4.0, 4.0, 4.0)), flipped(c1), flipped(c2)))
     assert abs(props.mass - truth) <= 1e-9 * truth, (props.mass, truth)
     assert props.mesh.cavities >= 1
+    assert props.mesh.certificate.kind == "united"
+    assert not any("reaches out of the body" in n for n in props.mesh.notes)
 
 
 def _turned_copy_far_away():
