@@ -44,14 +44,11 @@ def test_outward_body_inside_a_body_keeps_both_readings():
     assert np.allclose(props.center_of_mass, 0.0)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "mesh/holes.patched_estimate (holes7's stage) writes 'closed by cones to their centroids' whatever fill was "
-    "used: when curved_fills bent the fans onto the quadric the surroundings lie on (here a float32 sphere, so not "
-    "convex to round-off and the cones are not kept), the report says cones while it counts 1,636 faces for a file "
-    "of 1,240 with 36 rim edges (cones add 36): the note and the face count contradict each other"))
 def test_curved_fill_is_named_in_the_repair_note():
     """A 50 mm sphere (icosphere, 1,280 faces) stored in float32, 40 faces gone (4 holes, 36 rim edges), in metres:
-    the note must say how the holes were closed; cones over 36 edges make 1,276 faces."""
+    the note must say how the holes were closed; cones over 36 edges make 1,276 faces.  Review 9 found
+    ``holes.patched_estimate`` saying only "closed by cones to their centroids" while ``curved_fills`` had bent the
+    fans onto the quadric (1,636 faces); holes7's assumptions note (``mesh/hole_assumptions.py``) now names it."""
     import trimesh
 
     sphere = trimesh.creation.icosphere(3, radius=0.05)
