@@ -44,14 +44,11 @@ def test_outward_body_inside_a_body_keeps_both_readings():
     assert np.allclose(props.center_of_mass, 0.0)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "mesh/holes.patched_estimate (holes7's stage) writes 'closed by cones to their centroids' whatever fill was "
-    "used: when curved_fills bent the fans onto the quadric the surroundings lie on (here a float32 sphere, so not "
-    "convex to round-off and the cones are not kept), the report says cones while it counts 1,636 faces for a file "
-    "of 1,240 with 36 rim edges (cones add 36): the note and the face count contradict each other"))
 def test_curved_fill_is_named_in_the_repair_note():
     """A 50 mm sphere (icosphere, 1,280 faces) stored in float32, 40 faces gone (4 holes, 36 rim edges), in metres:
-    the note must say how the holes were closed; cones over 36 edges make 1,276 faces."""
+    the note must say how the holes were closed; cones over 36 edges make 1,276 faces.  Review 9 found
+    ``holes.patched_estimate`` saying only "closed by cones to their centroids" while ``curved_fills`` had bent the
+    fans onto the quadric (1,636 faces); holes7's assumptions note (``mesh/hole_assumptions.py``) now names it."""
     import trimesh
 
     sphere = trimesh.creation.icosphere(3, radius=0.05)
@@ -123,7 +120,9 @@ def test_hollow_copies_overlapping_give_the_solid_meant(angle):
 def test_cavities_crossing_each_other_inside_a_box_are_cut():
     """Two cavities that cross each other inside a box (each wound inward): they crossed no outward shell, so R4
     gave each to itself as its own body, and the boolean left the box full (64 m³, the cavities lost).  They are
-    now cut from the shell around them: 64 − |C1 ∪ C2|."""
+    now cut from the shell around them: 64 − |C1 ∪ C2|, certified ``united`` (the boolean's union exceeds the
+    summed integral by exactly the cavities' common volume, which the sum takes out twice; it was read as "a shell
+    read as a cavity reaches out of the body around it" and not verified)."""
     from adversary_solids import _axis_rotation, moved
 
     c1 = box((1.0, 1.0, 1.0))
@@ -132,6 +131,8 @@ def test_cavities_crossing_each_other_inside_a_box_are_cut():
     props, _ = _run(concat(box((4.0, 4.0, 4.0)), flipped(c1), flipped(c2)))
     assert abs(props.mass - truth) <= 1e-9 * truth, (props.mass, truth)
     assert props.mesh.cavities >= 1
+    assert props.mesh.certificate.kind == "united"
+    assert not any("reaches out of the body" in n for n in props.mesh.notes)
 
 
 def _turned_copy_far_away():
