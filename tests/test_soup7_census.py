@@ -106,12 +106,14 @@ def test_census_beyond_the_packed_range_takes_the_argsort(monkeypatch) -> None:
 
 def test_edge_keys_of_any_layout_match_the_formula() -> None:
     """``edge_keys`` fills its arrays in place (fewer fresh pages): the same keys and bits as
-    ``min(a, b)·n + max(a, b)`` and ``a > b`` for int32, Fortran-ordered and strided face arrays, input untouched."""
+    ``min(a, b)·n + max(a, b)`` and ``a > b`` for int32, unsigned, float, Fortran-ordered and strided face arrays,
+    input untouched."""
     from inertia_tool.mesh.edges import edge_keys
 
     rng = np.random.default_rng(11)
     base = rng.integers(0, 40, (50, 3))
-    for faces in (base.astype(np.int32), np.asfortranarray(base), base[::2], base[:, ::-1], base[:0]):
+    for faces in (base.astype(np.int32), base.astype(np.uint64), base.astype(np.uint16), base.astype(np.float64),
+                  np.asfortranarray(base), base[::2], base[:, ::-1], base[:0]):
         kept = faces.copy()
         a = np.asarray(faces, dtype=np.int64).reshape(-1)
         b = np.asarray(faces, dtype=np.int64)[:, [1, 2, 0]].reshape(-1)

@@ -31,11 +31,15 @@ def edge_keys(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarra
     forward : (3m,) bool
         ``a > b``: the edge runs from the larger index to the smaller.
     """
-    f = np.asarray(faces, dtype=np.int64)
+    f = np.asarray(faces)
+    # int32 faces, as the readers give them, are not copied: the ufuncs below widen them to int64 as they go
+    # (uint64 would promote to float64 against int64, so it is converted, as anything not an integer)
+    if f.dtype.kind not in "iu" or (f.dtype.kind == "u" and f.dtype.itemsize >= 8):
+        f = f.astype(np.int64)
     a = f.reshape(-1)
     # the next corners, then their larger ends in place: two fresh (3m,) arrays fewer than the expression
     # min(a, b)·n + max(a, b) (each a 31 MB page-faulted allocation for a 1.3M-face soup)
-    b = np.empty_like(f)
+    b = np.empty(f.shape, dtype=np.int64)
     b[:, :2] = f[:, 1:]
     b[:, 2] = f[:, 0]
     b = b.reshape(-1)
