@@ -6147,6 +6147,11 @@ ct_twin_task(void *ctx, int t, int nt)
         int64_t w = v + 1;
         while (w < jb->n && jb->off[w] < 0) w++;
         int64_t s = jb->off[v], e = w < jb->n ? jb->off[w] : jb->total, k = e - s;
+        /* the rows of the faces listed a vertex or two ahead (about six a vertex), read at random in the caller's
+         * faces: fetched now, read when their vertex comes */
+        for (int64_t q = e + 6; q < e + 12 && q < jb->total; q++) {
+            ct_prefetch((const char *)jb->F + (size_t)jb->fsize * 3 * (size_t)jb->faces[q]);
+        }
         CtLink *lk = k <= 64 ? local : (CtLink *)malloc((size_t)k * sizeof(CtLink));
         if (lk == NULL) {
             jb->oom[t] = 1;
@@ -6641,7 +6646,8 @@ ct_twin_rounds(int64_t m)
  * then the faces, each vertex's in decreasing face order) and ct_twin_task run over them.  A face's corner c is
  * written in the round of its vertex at c and in no other, so the twins are those of one round over every
  * vertex; the lists take about 1 / rounds of the 8 n + 12 m bytes of one round (issue 25: the lists and the
- * twins set the check's high point), each round reads the faces twice.  scratch: at least ct_stars_scratch(n,
+ * twins set the check's high point).  The faces are read rounds + 1 times: once for the first round's counts,
+ * then once a round, which lists its faces and counts the next round's (8 bytes a vertex of a range, apart).  scratch: at least ct_stars_scratch(n,
  * m) bytes, any content; a mapped one (CT_SMALL_BYTES or more) has its pages given back (MADV_DONTNEED) first
  * and past each round's lists after its count.  0, or -1 when out of memory. */
 static int
@@ -6653,17 +6659,26 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t s
     ct_drop_pages(scratch, scratch_bytes);
     for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
     if (rounds < 1) rounds = 1;
-    for (int r = 0; r < rounds; r++) {
+    if ((int64_t)rounds > n) rounds = n > 0 ? (int)n : 1;
+    /* the next round's counts, made by this round's pass over the faces (each round after the first costs one
+     * pass, not two); a range holds at most ceil(n / rounds) vertices */
+    size_t next_bytes = rounds > 1 ? (size_t)((n + rounds - 1) / rounds) * sizeof(int64_t) : 0;
+    int64_t *next = rounds > 1 ? (int64_t *)malloc(next_bytes) : NULL;
+    if (rounds > 1 && next == NULL) return -1;
+    int64_t *off = (int64_t *)scratch;
+    int64_t n0 = (int64_t)part_start((size_t)n, 1, rounds);
+    memset(off, 0, (size_t)(n0 > 0 ? n0 : 1) * sizeof(int64_t));
+    for (size_t c = 0; c < 3 * (size_t)m; c++) {           /* the first round's counts */
+        uint64_t v = (uint64_t)index_at(F, fsize, c);
+        if (v < (uint64_t)n0) off[v]++;
+    }
+    int rc = 0;
+    for (int r = 0; r < rounds && rc == 0; r++) {
         int64_t va = (int64_t)part_start((size_t)n, r, rounds), vb = (int64_t)part_start((size_t)n, r + 1, rounds);
         int64_t nv = vb - va;
-        if (nv <= 0) continue;
-        int64_t *off = (int64_t *)scratch;
-        int32_t *faces = (int32_t *)((char *)scratch + (size_t)nv * sizeof(int64_t));
-        memset(off, 0, (size_t)nv * sizeof(int64_t));
-        for (size_t c = 0; c < 3 * (size_t)m; c++) {
-            uint64_t v = (uint64_t)(index_at(F, fsize, c) - va);
-            if (v < (uint64_t)nv) off[v]++;
-        }
+        int64_t vc = r + 1 < rounds ? (int64_t)part_start((size_t)n, r + 2, rounds) : vb;   /* next: vb .. vc */
+        int32_t *faces = (int32_t *)((char *)scratch + (size_t)(nv > 0 ? nv : 1) * sizeof(int64_t));
+        if (r > 0) memcpy(off, next, (size_t)nv * sizeof(int64_t));
         int64_t total = 0;
         for (int64_t v = 0; v < nv; v++) {          /* end of each listed vertex's range, -1 for one of no face */
             if (off[v] >= 1) {
@@ -6682,10 +6697,17 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t s
 #else
         (void)scratch_bytes;
 #endif
+        if (vc > vb) memset(next, 0, (size_t)(vc - vb) * sizeof(int64_t));
         for (int64_t f = 0; f < m; f++) {
             for (int c = 0; c < 3; c++) {
-                uint64_t v = (uint64_t)(index_at(F, fsize, 3 * (size_t)f + (size_t)c) - va);
-                if (v < (uint64_t)nv && off[v] >= 0) faces[--off[v]] = (int32_t)f;
+                int64_t x = index_at(F, fsize, 3 * (size_t)f + (size_t)c);
+                uint64_t v = (uint64_t)(x - va);
+                if (v < (uint64_t)nv) {
+                    if (off[v] >= 0) faces[--off[v]] = (int32_t)f;
+                }
+                else if ((uint64_t)(x - vb) < (uint64_t)(vc - vb)) {
+                    next[x - vb]++;
+                }
             }
         }
         CtTwinJob jb;
@@ -6701,10 +6723,11 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t s
         jb.twin = twin;
         run_parallel(thread_count(threads, (size_t)nv, 20000), ct_twin_task, &jb);
         for (int t = 0; t < MAX_THREADS; t++) {
-            if (jb.oom[t]) return -1;
+            if (jb.oom[t]) rc = -1;
         }
     }
-    return 0;
+    free(next);
+    return rc;
 }
 
 /* patch[k] <- 1 for the highest nodes certified as above (their descendants are not tried).  fmask: per
