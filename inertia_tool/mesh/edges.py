@@ -39,10 +39,10 @@ def edge_keys(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarra
     a = f.reshape(-1)
     # the next corners, then their larger ends in place: two fresh (3m,) arrays fewer than the expression
     # min(a, b)·n + max(a, b) (each a 31 MB page-faulted allocation for a 1.3M-face soup)
-    b = np.empty(f.shape, dtype=np.int64)
-    b[:, :2] = f[:, 1:]
-    b[:, 2] = f[:, 0]
-    b = b.reshape(-1)
+    nxt = np.empty(f.shape, dtype=np.int64)
+    nxt[:, :2] = f[:, 1:]
+    nxt[:, 2] = f[:, 0]
+    b: np.ndarray = nxt.reshape(-1)
     forward = a > b
     key = np.minimum(a, b)
     np.maximum(a, b, out=b)
