@@ -165,7 +165,7 @@ def _brute_force(v, f):
     return out
 
 
-@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(mesh=small_meshes(), rounds=st.integers(2, 9))
 def test_rounds_on_small_adversarial_meshes(mesh, rounds):
     """Hypothesis: random lattice meshes (touching boxes, coplanar faces, repeated and reversed faces) give the
