@@ -21,7 +21,7 @@ import inertia_tool as it
 from inertia_tool.mesh.sheets import open_sheets
 from solids import split_at_edge_points
 from test_mesh_folds import _assert_matches, _truth
-from test_mesh_sheets import _halves, _on_plane
+from test_mesh_sheets import _cut_in_two
 
 pytestmark = pytest.mark.usefixtures("engine_path")
 
@@ -91,17 +91,10 @@ def _case(seed, union, along, share, which):
     the same rim edges, as two halves cut apart have them); None when the cut fails."""
     rng = np.random.default_rng(seed)
     v, f = _solid(rng, union)
-    normal = rng.normal(size=3)
-    normal /= np.linalg.norm(normal)
-    lo, hi = (v @ normal).min(), (v @ normal).max()
-    offset = float(lo + along * (hi - lo))
-    halves = _halves(v, f, normal, offset)
-    if len(halves) != 2:
+    cut = _cut_in_two(v, f, rng, along)
+    if cut is None:
         return None
-    (av, af), (bv, bf) = halves
-    on_a, on_b = _on_plane(av, af, normal, offset), _on_plane(bv, bf, normal, offset)
-    if not on_a.any() or not on_b.any():
-        return None
+    normal, _, (av, af, on_a), (bv, bf, on_b) = cut
     points: dict = {}
     if which in (0, 2):
         av, af, on_a, points = _put_t_vertices(av, af, on_a, rng, share)

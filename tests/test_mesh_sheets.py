@@ -102,6 +102,24 @@ def _on_plane(hv, hf, normal, offset):
     return np.all(np.abs(hv[hf] @ normal - offset) <= 1e-12 * scale, axis=1)
 
 
+def _cut_in_two(v, f, rng, along):
+    """``(v, f)`` cut by a plane of random normal (drawn from ``rng``) at the fraction ``along`` of its extent along
+    it: ``(normal, offset, (av, af, on_a), (bv, bf, on_b))``, each half with its cut faces ``on``; None unless the
+    cut gives two halves that both have cut faces."""
+    normal = rng.normal(size=3)
+    normal /= np.linalg.norm(normal)
+    lo, hi = (v @ normal).min(), (v @ normal).max()
+    offset = float(lo + along * (hi - lo))
+    halves = _halves(v, f, normal, offset)
+    if len(halves) != 2:
+        return None
+    (av, af), (bv, bf) = halves
+    on_a, on_b = _on_plane(av, af, normal, offset), _on_plane(bv, bf, normal, offset)
+    if not on_a.any() or not on_b.any():
+        return None
+    return normal, offset, (av, af, on_a), (bv, bf, on_b)
+
+
 def _fan_cut(hv, hf, on, rng):
     """The cut faces ``hf[on]`` triangulated anew: a fan from a random corner of their boundary loop (the cut of
     a convex solid is a convex polygon); None when the boundary is not one loop."""

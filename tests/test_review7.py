@@ -27,7 +27,7 @@ import adversary_solids as S
 from conftest import HAVE_ACCEL
 from solids import edge_neighbours, grown_patch, split_at_edge_points
 from test_mesh_intersect_patches import _check
-from test_mesh_sheets import _halves, _on_plane
+from test_mesh_sheets import _cut_in_two
 
 FAST = settings(max_examples=10, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
@@ -197,17 +197,10 @@ def _seamed_case(seed, shape, along, share, which, ends):
     exact truth of the two closed halves.  None when the cut does not give two halves with cut faces."""
     rng = np.random.default_rng(seed)
     v, f = _solid(rng, shape)
-    normal = rng.normal(size=3)
-    normal /= np.linalg.norm(normal)
-    lo, hi = (v @ normal).min(), (v @ normal).max()
-    offset = float(lo + along * (hi - lo))
-    halves = _halves(v, f, normal, offset)
-    if len(halves) != 2:
+    cut = _cut_in_two(v, f, rng, along)
+    if cut is None:
         return None
-    (av, af), (bv, bf) = halves
-    on_a, on_b = _on_plane(av, af, normal, offset), _on_plane(bv, bf, normal, offset)
-    if not on_a.any() or not on_b.any():
-        return None
+    _, _, (av, af, on_a), (bv, bf, on_b) = cut
     points = 0
     if which in (0, 2):
         av, af, on_a, k = _t_vertices(av, af, on_a, rng, share, ends)
