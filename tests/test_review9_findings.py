@@ -48,7 +48,8 @@ def test_curved_fill_is_named_in_the_repair_note():
     """A 50 mm sphere (icosphere, 1,280 faces) stored in float32, 40 faces gone (4 holes, 36 rim edges), in metres:
     the note must say how the holes were closed; cones over 36 edges make 1,276 faces.  Review 9 found
     ``holes.patched_estimate`` saying only "closed by cones to their centroids" while ``curved_fills`` had bent the
-    fans onto the quadric (1,636 faces); holes7's assumptions note (``mesh/hole_assumptions.py``) now names it."""
+    fans onto the quadric (1,636 faces); holes7's assumptions note (``mesh/hole_assumptions.py``) now names it,
+    and the note says how many holes were filled on the quadric."""
     import trimesh
 
     sphere = trimesh.creation.icosphere(3, radius=0.05)

@@ -6,7 +6,9 @@ For every case of the hole kinds of ``coverage.py`` (same seeds, sources, damage
 - whether the *stated assumption* holds: every corner and centroid of the faces the damage removed lies in the
   region the bound assumes for some hole of the case (:func:`examine`: the ball over its rim, cut to the slab
   around its ring plane unless the slab is withdrawn, to a crease fill's two slabs, to the capsule where it is
-  taken; or the convex polytope, :func:`~inertia_tool.mesh.holes.convex_hole_bound`);
+  taken, to the prism over the rim's projected hull as high as the bend bound states where that is taken (a
+  superset of the bend assumption's region); or the convex polytope,
+  :func:`~inertia_tool.mesh.holes.convex_hole_bound`);
 - what the surface beside each hole says (:func:`~inertia_tool.mesh.holes.rim_evidence`);
 - for a refused case, the patched answer the refusal withheld, checked against the truth (within 1 % volume,
   1 % of the diagonal, 2 % inertia).
@@ -69,12 +71,13 @@ def examine(v, f_before, f_after, truth):
     bounded by the convex polytope instead (fourth assumption), the region of every hole is that polytope.  A
     crease fill withdrawn because it lies over faces of the file (``_crease_contradicted``, read on the patched
     surface) is read here as narrow: stricter than stated."""
-    from scipy.spatial import Delaunay
+    from scipy.spatial import Delaunay, QhullError
 
     from inertia_tool.integrals import volume_moments
+    from inertia_tool.mesh.hole_bounds import bend_doubt_volumes
     from inertia_tool.mesh.holes import (_alone, _engulfing, bare_vertices, convex_hole_bound, crease_fills,
                                          hole_doubt_volumes, patched_estimate, rim_evidence, slab_contradicted)
-    from inertia_tool.mesh.rims import boundary_loops, enclosing_balls, enclosing_capsules
+    from inertia_tool.mesh.rims import boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
     from inertia_tool.mesh.seal import seal_seams
     from inertia_tool.tolerances import SEAM_GAP_RTOL
 
@@ -101,6 +104,18 @@ def examine(v, f_before, f_after, truth):
     start, end, thick = enclosing_capsules(v[vertex_of], loop_of, n_loops)
     capsule = _alone(centre, radius) & ~engulfed & (4.0 / 3.0 * np.pi * radius ** 3 <= abs(float(est.volume)))
     convex = "convex" in est.detail
+    # the bend bound (fifth assumption), where patched_estimate takes it: narrower than the ball, slab or capsule,
+    # no crease fill, no ball holding everything (a fill bent onto a quadric is not told apart here: rare)
+    size = np.bincount(loop_of, minlength=n_loops)
+    apex = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) / np.maximum(size, 1)
+                     for i in range(3)], axis=1)
+    bend, bend_height = bend_doubt_volumes(v, sf, edges, label, n_loops, apex)
+    ball_volume = 4.0 / 3.0 * np.pi * radius ** 3
+    other = np.where(withdrawn, ball_volume,
+                     hole_doubt_volumes(v, sf, edges, label, n_loops, centre, radius, vertex_of, loop_of))
+    other = np.where(capsule, np.minimum(other, capsule_volumes(start, end, thick)), other)
+    crossed = np.array([k in fills for k in range(n_loops)], dtype=bool)
+    took_bend = np.isfinite(bend) & ~engulfed & ~crossed & (bend < other) & ("bend" in est.assumptions)
     flatness = (np.asarray(slabs["half_width"]) / radius).tolist() if "half_width" in slabs else [1.0] * n_loops
     gone = _removed(f_before, f_after)
     pts = np.vstack([v[gone].reshape(-1, 3), v[gone].mean(axis=1)]) if len(gone) else np.zeros((0, 3))
@@ -122,7 +137,22 @@ def examine(v, f_before, f_after, truth):
                 region &= near
         elif slabs.get("has") is not None and slabs["has"][k] and not withdrawn[k]:
             region &= np.abs((pts - slabs["origin"][k]) @ slabs["normal"][k]) <= slabs["half_width"][k] + slack
-        if capsule[k]:
+        if took_bend[k]:                       # the prism over the projected rim, as high as the bend bound states
+            rim_k = v[vertex_of[loop_of == k]]
+            e = edges[label == k]
+            normal = np.cross(v[e[:, 0]] - apex[k], v[e[:, 1]] - apex[k]).sum(axis=0)
+            normal /= np.linalg.norm(normal)
+            u = np.cross(normal, [1.0, 0.0, 0.0] if abs(normal[0]) < 0.9 else [0.0, 1.0, 0.0])
+            u /= np.linalg.norm(u)
+            w = np.cross(normal, u)
+            flat_rim = np.stack([(rim_k - apex[k]) @ u, (rim_k - apex[k]) @ w], axis=1)
+            flat_pts = np.stack([(pts - apex[k]) @ u, (pts - apex[k]) @ w], axis=1)
+            try:                                 # (a superset of the stated region: the rim's hull, not its polygon)
+                over = Delaunay(flat_rim).find_simplex(flat_pts, tol=1e-9) >= 0
+            except (QhullError, ValueError):
+                over = np.ones(len(pts), dtype=bool)
+            region &= over & (np.abs((pts - apex[k]) @ normal) <= bend_height[k] + slack)
+        elif capsule[k]:
             seg = end[k] - start[k]
             t = np.clip((pts - start[k]) @ seg / max(float(seg @ seg), 1e-300), 0.0, 1.0)
             region &= np.linalg.norm(pts - (start[k] + t[:, None] * seg), axis=1) <= thick[k] * (1 + 1e-9) + slack
@@ -143,7 +173,7 @@ def examine(v, f_before, f_after, truth):
             "patched_unbounded": bool(est.unbounded), "convex": bool(convex),
             "per_loop": {"bare": evidence.bare.tolist(), "flat": evidence.flat_all_round.tolist(),
                          "slab_contradicted": contradicted.tolist(), "engulfed": engulfed.tolist(),
-                         "capsule": capsule.tolist(), "flatness": flatness,
+                         "capsule": capsule.tolist(), "flatness": flatness, "bend": took_bend.tolist(),
                          "crease": [k in fills for k in range(n_loops)],
                          "crease_narrow": [bool(k in fills and fills[k].narrow) for k in range(n_loops)],
                          "radius": radius.tolist()},
@@ -197,7 +227,8 @@ def report(rows):
              f"{sum(bool(r.get('convex')) and r['assumption'] for r in answered)}); holes whose slab was withdrawn by "
              f"slab_contradicted: {sum(sum(r['per_loop']['slab_contradicted']) for r in answered)}, by a ball holding "
              f"the whole surface: {sum(sum(r['per_loop']['engulfed']) for r in answered)}; holes under a capsule: "
-             f"{sum(sum(r['per_loop']['capsule']) for r in answered)}; narrow crease fills: "
+             f"{sum(sum(r['per_loop']['capsule']) for r in answered)}; under the bend bound: "
+             f"{sum(sum(r['per_loop'].get('bend', [])) for r in answered)}; narrow crease fills: "
              f"{sum(sum(r['per_loop']['crease_narrow']) for r in answered)}",
              "bounds that fail: " + ", ".join(f"{r['id']} ({r['source']})" for r in certified if not r["holds"]),
              "assumption false (answered): " + ", ".join(f"{r['id']} ({r['source']})" for r in answered

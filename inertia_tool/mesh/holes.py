@@ -297,6 +297,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         if creases:
             detail += (f"; {len(creases)} of them across a crease, filled instead in the two planes that hold "
                        "the rim and bounded by the ball cut to both planes' slabs")
+        if curved:
+            detail += (f"; {len(curved)} of them filled instead on the quadric their surroundings lie on (the cone's "
+                       f"fan bent onto it, {len(pv) - len(v) - n_loops - 2 * len(creases):,} points added), with "
+                       "the same bound")
         if took_bend.any() and not convex:
             detail += (f"; {int(np.count_nonzero(took_bend))} bounded instead by the slope of the faces beside "
                        "their rims")
