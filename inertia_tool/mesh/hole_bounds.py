@@ -591,7 +591,8 @@ def convex_hole_bound(vertices: np.ndarray, faces: np.ndarray, patched_volume: f
         return None
     halfspaces = np.column_stack([planes[:, :3], -(planes[:, 3] + shift)])
     try:
-        region = HalfspaceIntersection(halfspaces, inside)
+        with np.errstate(divide="ignore", invalid="ignore"):     # unbounded regions: non-finite points, refused below
+            region = HalfspaceIntersection(halfspaces, inside)
         points = region.intersections
         if not np.all(np.isfinite(points)) or float(np.abs(points).max()) > 1e6 * max(float(np.abs(v).max()), 1e-300):
             return None                  # the planes left do not close the part in
