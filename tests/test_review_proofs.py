@@ -152,7 +152,24 @@ def test_a_pocket_taken_whole_on_a_grid_box_is_inside_its_bound():
         except ValueError:
             return                                      # refused: fine
     assert p.mesh.certificate.kind != "exact"
-    assert abs(p.volume - truth.volume) <= p.mesh.uncertainty.mass * p.volume * (1 + 1e-12)
+    if abs(p.volume - truth.volume) <= p.mesh.uncertainty.mass * p.volume * (1 + 1e-12):
+        return
+    # holes7's bend bound answers it: by the lead's decision on issue 21 (as for the grid-meshed boss in
+    # test_hole_bounds) the bound is conditional on the assumptions it names, and those must be shown false here.
+    # The note names the ball over the rim and the bend bound; every face touching the rim lies in the top plane
+    # (slope 0) while the pocket's walls are vertical, and the pocket's floor lies 1 m below the 1 x 1 rim,
+    # outside its enclosing ball (radius 0.71 m).
+    from inertia_tool.mesh.hole_assumptions import BALL, BEND
+    from inertia_tool.mesh.rims import boundary_edges
+    note = " ".join(p.mesh.notes)
+    assert BALL.statement in note and BEND.statement in note, note
+    rim = np.unique(boundary_edges(g, len(v)))
+    touching = g[np.isin(g, rim).any(axis=1)]
+    assert np.all(v[touching][:, :, 2] == 2.0)
+    centre = v[rim].mean(axis=0)
+    assert np.linalg.norm(v[rim] - centre, axis=1).max() == pytest.approx(np.sqrt(0.5))
+    floor = np.array([2.5, 2.5, 1.0])
+    assert np.linalg.norm(floor + [0.5, 0.5, 0] - centre) > np.sqrt(0.5)
 
 
 def _square(half, z, lo=(0.0, 0.0)):
