@@ -22,7 +22,6 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import textwrap
 
 import numpy as np
 import pytest
@@ -33,6 +32,7 @@ from conftest import HAVE_ACCEL
 from inertia_tool import _native
 from inertia_tool.mesh.intersect import surface_contacts
 from intersect_reference import pair_kinds, brute_kind
+from test_mesh_intersect_layout import _PEAK_CHILD  # the same 300,000-face torus child as its peak test
 
 pytestmark = pytest.mark.skipif(not HAVE_ACCEL, reason="inertia_tool._accel is not built")
 
@@ -175,39 +175,6 @@ def test_rounds_on_small_adversarial_meshes(mesh, rounds):
     one = _run(v, f, {ROUNDS: "1"})
     assert _fields(_run(v, f, {ROUNDS: str(rounds), POISON: "1"})) == _fields(one)
     assert pair_kinds(one) == _brute_force(v, f)
-
-
-_PEAK_CHILD = textwrap.dedent(r"""
-    import sys
-    import numpy as np
-    from inertia_tool._native import accel
-    from inertia_tool.mesh.intersect import surface_contacts
-
-    def status(key):
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith(key):
-                    return int(line.split()[1]) * 1024
-
-    n_major, n_minor = 600, 250                    # a closed torus of 300,000 faces
-    u = 2 * np.pi * np.arange(n_major) / n_major
-    w = 2 * np.pi * np.arange(n_minor) / n_minor
-    uu, ww = np.meshgrid(u, w, indexing="ij")
-    ring = 50.0 + 20.0 * np.cos(ww)
-    v = np.stack([ring * np.cos(uu), ring * np.sin(uu), 20.0 * np.sin(ww)], axis=-1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(n_major), np.arange(n_minor), indexing="ij")
-    a, b = i * n_minor + j, ((i + 1) % n_major) * n_minor + j
-    c, d = ((i + 1) % n_major) * n_minor + (j + 1) % n_minor, i * n_minor + (j + 1) % n_minor
-    f = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
-    f = f.astype(np.int32)
-    surface_contacts(v[:100], f[:10] % 100)         # imports and first-call allocations
-    with open("/proc/self/clear_refs", "w") as fh:
-        fh.write("5")
-    before = status("VmRSS:")
-    r = surface_contacts(v, f)
-    assert not len(r.crossing) and not len(r.contact) and not len(r.coplanar_opposite)
-    print(len(f), status("VmHWM:") - before, int(accel() is not None))
-""")
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="VmHWM and clear_refs are Linux's")
