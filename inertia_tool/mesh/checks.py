@@ -285,7 +285,7 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
 
     Returns
     -------
-    labels : (m,) int
+    labels : (m,) int32 (int64 from 2**31 faces: :func:`~inertia_tool._native.label_dtype`)
         Shell index of each face, ``0..count-1`` (numbered by the smallest vertex index of the shell when no
         vertex is shared between shells, else in order of each shell's first face).
     count : int
