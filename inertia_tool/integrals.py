@@ -562,7 +562,7 @@ def accurate_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
-    lab = labels_for_c(labels)
+    lab = np.asarray(labels)      # read as it is (one shell: a broadcast zero); the C kernels take labels_for_c
     o = reference_point(v) if origin is None else np.asarray(origin, dtype=np.float64)
     shells = list(shells)
     if not shells:                             # nothing to bound or refine

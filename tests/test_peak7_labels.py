@@ -74,6 +74,7 @@ OVERLAPPING = [((0, 0, 0), (3, 3, 3), False), ((1, 1, 1), (3, 3, 3), False), ((8
 @example(boxes=CORNER_ONLY, inverted=[False] * 4)
 @example(boxes=OVERLAPPING, inverted=[False] * 4)
 @example(boxes=NESTED[:2], inverted=[False, True, False, False])
+@example(boxes=[((0, 0, 0), (1, 2, 3), False)], inverted=[False] * 4)
 def test_int32_labels_give_the_int64_results(boxes, inverted):
     boxes = [(lo, sz, inv or flip) for (lo, sz, inv), flip in zip(boxes, inverted)]
     v, f = _scene(boxes)
@@ -105,3 +106,17 @@ def test_labels_are_int32_and_reach_c_uncopied():
 def test_label_type_widens_where_int32_ends():
     assert _native.label_dtype(2**31 - 1) == np.int32
     assert _native.label_dtype(2**31) == np.int64
+
+
+def test_one_shell_holds_no_label_array():
+    """One shell: the census's labels are a read-only view of one int32 zero (its buffer goes back to the
+    kernels' pool before the check), and the analysis reads them as it read an array of zeros."""
+    v, f = box(extents=(1.0, 2.0, 3.0))
+    topology, labels, count = census_and_shells(f, len(v))
+    assert count == 1 and labels.dtype == np.int32 and labels.shape == (len(f),)
+    if _native.accel() is not None:
+        assert labels.strides == (0,) and not labels.flags.writeable
+    assert np.array_equal(labels, np.zeros(len(f)))
+    prepared = prepare_mesh(RawMesh(vertices=v, faces=f, source="box.stl", file_faces=len(f)))
+    assert prepared.labels.dtype == np.int32 and prepared.report.certificate.kind == "exact"
+    assert prepared.shells[0].volume == pytest.approx(6.0, rel=1e-15)

@@ -328,6 +328,8 @@ def census_and_shells(faces: np.ndarray, n_vertices: int,
     *counts, count = lib.census_shells(faces_for_c(faces), int(n_vertices), labels, threads())
     if len(faces) == 0:
         return EdgeTopology(0, 0, 0, 0, np.zeros((0, 2, 3))), labels, 0
+    if count == 1:        # one shell: every label 0, as a read-only view of one zero; the buffer goes back to the
+        labels = np.broadcast_to(np.zeros(1, dtype=dtype), (len(faces),))   # pool, which the check unmaps
     return _topology_from_census(counts, vertices), labels, int(count)
 
 
