@@ -141,3 +141,18 @@ def faces_for_c(faces) -> np.ndarray:
     if f.dtype not in (np.dtype(np.int32), np.dtype(np.int64)):
         f = f.astype(np.int64)
     return np.ascontiguousarray(f)
+
+
+def label_dtype(n_faces: int) -> np.dtype:
+    """The integer type of per-face shell labels: int32 while the faces fit it (labels are below ``n_faces``),
+    else int64 (issue 25: the labels live through the face-pair check; 4 bytes a face instead of 8)."""
+    return np.dtype(np.int32) if n_faces < 2**31 else np.dtype(np.int64)
+
+
+def labels_for_c(labels) -> np.ndarray:
+    """Labels as a C-contiguous, native-order (m,) int32 or int64 array, the array itself when it is one already
+    (the C kernels read either width; no widening copy)."""
+    lab = np.asarray(labels)
+    if lab.dtype not in (np.dtype(np.int32), np.dtype(np.int64)):
+        lab = lab.astype(np.int64)
+    return np.ascontiguousarray(lab)

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .values import frozen_value
-from ._native import accel, faces_for_c, threads
+from ._native import accel, faces_for_c, labels_for_c, threads
 from .tolerances import ROUNDOFF_RTOL
 
 __all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box",
@@ -159,7 +159,7 @@ def _tetra_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, orig
     zero = np.empty(n_labels, dtype=np.int64)
     lib.tetra_sums(np.ascontiguousarray(vertices, dtype=np.float64), faces_for_c(faces),
                    tuple(float(x) for x in origin), float(area_floor),
-                   None if labels is None else np.ascontiguousarray(labels, dtype=np.int64), sums, zero, threads())
+                   None if labels is None else labels_for_c(labels), sums, zero, threads())
     second = sums[:, _SECOND_COLUMNS].reshape(n_labels, 3, 3)     # one gather instead of twelve assignments
     return sums[:, 0].copy(), sums[:, 1:4].copy(), second, sums[:, 10].copy(), zero
 
@@ -258,7 +258,7 @@ def body_volume_moments(vertices: np.ndarray, faces: np.ndarray, labels: np.ndar
     if n_labels == 1:
         return [volume_moments(vertices, faces, origin=o, chunk_size=chunk_size, area_rtol=area_rtol)]
     vol, first, second, area, zero = _tetra_sums(vertices, np.asarray(faces), o, max(1, int(chunk_size)),
-                                                 labels=np.asarray(labels, dtype=np.intp), n_labels=n_labels,
+                                                 labels=labels_for_c(labels), n_labels=n_labels,
                                                  area_floor=_area_floor(vertices, area_rtol))
     return [_finish(vol[k], first[k], second[k], area[k], o, zero[k]) for k in range(n_labels)]
 
@@ -422,7 +422,7 @@ def _roundoff_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, l
         return np.zeros((0, 3))
     out = np.empty((n, 3))
     lib.roundoff_sums(np.ascontiguousarray(vertices), faces_for_c(faces), (float(origin[0]), float(origin[1]),
-                      float(origin[2])), None if n == 1 else np.ascontiguousarray(labels, dtype=np.int64), out,
+                      float(origin[2])), None if n == 1 else labels_for_c(labels), out,
                       max(1, int(chunk_size)))
     return out
 
@@ -562,7 +562,7 @@ def accurate_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
-    lab = np.asarray(labels, dtype=np.intp)
+    lab = np.asarray(labels)      # read as it is (one shell: a broadcast zero); the C kernels take labels_for_c
     o = reference_point(v) if origin is None else np.asarray(origin, dtype=np.float64)
     shells = list(shells)
     if not shells:                             # nothing to bound or refine

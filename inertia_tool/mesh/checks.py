@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..values import frozen_value
-from .._native import accel, faces_for_c, threads
+from .._native import accel, faces_for_c, label_dtype, threads
 from .edges import edge_keys
 from .policy import Certificate
 
@@ -285,7 +285,7 @@ def shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
 
     Returns
     -------
-    labels : (m,) int
+    labels : (m,) int32 (int64 from 2**31 faces: :func:`~inertia_tool._native.label_dtype`)
         Shell index of each face, ``0..count-1`` (numbered by the smallest vertex index of the shell when no
         vertex is shared between shells, else in order of each shell's first face).
     count : int
@@ -323,10 +323,13 @@ def census_and_shells(faces: np.ndarray, n_vertices: int,
         return edge_topology(faces, n_vertices, vertices), labels, count
     # on a kept mapping of the extension (uninitialised, like numpy.empty): a later analysis in the process
     # writes its labels into pages faulted in already
-    labels = np.frombuffer(lib.Scratch(len(faces) * np.dtype(np.intp).itemsize), dtype=np.intp)
+    dtype = label_dtype(len(faces))     # int32: the C kernel keeps its union-find parents in place
+    labels = np.frombuffer(lib.Scratch(len(faces) * dtype.itemsize), dtype=dtype)
     *counts, count = lib.census_shells(faces_for_c(faces), int(n_vertices), labels, threads())
     if len(faces) == 0:
         return EdgeTopology(0, 0, 0, 0, np.zeros((0, 2, 3))), labels, 0
+    if count == 1:        # one shell: every label 0, as a read-only view of one zero; the buffer goes back to the
+        labels = np.broadcast_to(np.zeros(1, dtype=dtype), (len(faces),))   # pool, which the check unmaps
     return _topology_from_census(counts, vertices), labels, int(count)
 
 
@@ -340,7 +343,7 @@ def _edge_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, 
     m = len(faces)
     lib = accel()
     if lib is not None and m < 2**31 - 1:
-        out = np.empty(m, dtype=np.intp)
+        out = np.empty(m, dtype=label_dtype(m))
         count = lib.edge_shell_labels(faces_for_c(faces), int(n_vertices), out)
         return out, int(count)
     key = edge_keys(faces, n_vertices)[0]
@@ -358,17 +361,17 @@ def _edge_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, 
     _, first = np.unique(label, return_index=True)
     rank = np.empty(n_components, dtype=np.intp)
     rank[np.argsort(first, kind="stable")] = np.arange(n_components)
-    return rank[label].astype(np.intp), int(n_components)
+    return rank[label].astype(label_dtype(m)), int(n_components)
 
 
 def _vertex_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, int]:
     """Connected components of the surface by shared vertices (the C extension when built)."""
     m = len(faces)
     if m == 0:
-        return np.zeros(0, dtype=np.intp), 0
+        return np.zeros(0, dtype=label_dtype(0)), 0
     lib = accel()
     if lib is not None:      # union-find over vertices, the same numbering
-        labels = np.empty(m, dtype=np.intp)
+        labels = np.empty(m, dtype=label_dtype(m))
         count = lib.shell_labels(faces_for_c(faces), int(n_vertices), labels)
         return labels, int(count)
     from scipy.sparse import coo_matrix     # the numpy path only: scipy.sparse costs ~0.2 s to import
@@ -382,11 +385,11 @@ def _vertex_shell_labels(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray
     count, vertex_label = connected_components(graph, directed=True, connection="weak")
     face_label = vertex_label[faces[:, 0]]
     if count == 1:
-        return np.zeros(m, dtype=np.intp), 1
+        return np.zeros(m, dtype=label_dtype(m)), 1
     present = np.zeros(count, dtype=bool)
     present[face_label] = True
     remap = np.cumsum(present) - 1
-    return remap[face_label].astype(np.intp), int(present.sum())
+    return remap[face_label].astype(label_dtype(m)), int(present.sum())
 
 
 def winding_number(point: ArrayLike, vertices: np.ndarray, faces: np.ndarray) -> float:

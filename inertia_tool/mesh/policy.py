@@ -163,6 +163,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._native import label_dtype
 from ..rounding import round_up
 from ..tolerances import COINCIDENT_RTOL, FLAT_MOMENT_RTOL, FLAT_RTOL, ROUNDOFF_RTOL, TOUCH_VOLUME_RTOL
 from ..values import frozen_value
@@ -1132,7 +1133,8 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
         keep = new[fs[i]] != new[fs[j]]
         pairs.append(np.stack([fs[i][keep], fs[j][keep]], axis=1))
     contact = np.unique(np.sort(np.concatenate(pairs), axis=1), axis=0) if pairs else np.zeros((0, 2), np.int64)
-    return WeldedBodies(labels=new.astype(np.intp), n_shells=count_new, split=int(np.count_nonzero(splits)),
+    new = new.astype(label_dtype(len(new)), copy=False)
+    return WeldedBodies(labels=new, n_shells=count_new, split=int(np.count_nonzero(splits)),
                         ambiguous=ambiguous, contact=contact.astype(np.int64), ambiguous_shells=crossed & bad_shell)
 
 
