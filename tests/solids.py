@@ -285,3 +285,18 @@ def split_at_edge_points(faces, inner):
         rows.extend([s, t, c] for s, t in zip(chain[:-1], chain[1:]))
         source.extend([i] * (len(chain) - 1))
     return rows, source
+
+
+def halves_by_plane(v, f, normal, offset):
+    """The closed pieces of the solid ``(v, f)`` on either side of the plane ``x·normal = offset``, by manifold3d's
+    ``split_by_plane``: a list of ``(vertices, faces)``."""
+    import manifold3d as m3d
+
+    solid = m3d.Manifold(m3d.Mesh64(vert_properties=np.ascontiguousarray(v, dtype=np.float64),
+                                    tri_verts=np.ascontiguousarray(f, dtype=np.uint64)))
+    out = []
+    for half in solid.split_by_plane(tuple(float(x) for x in normal), float(offset)):
+        mesh = half.to_mesh64()
+        out.append((np.array(mesh.vert_properties, dtype=np.float64)[:, :3].copy(),
+                    np.array(mesh.tri_verts, dtype=np.int64)))
+    return out

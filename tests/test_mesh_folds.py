@@ -19,7 +19,7 @@ from inertia_tool.mesh.folds import internal_walls, settle_folds, sliver_fans
 from inertia_tool.mesh.intersect import surface_contacts
 
 from intersect_reference import CROSSING, OPPOSITE, pair_kinds
-from solids import random_convex
+from solids import halves_by_plane, random_convex
 
 pytestmark = pytest.mark.usefixtures("engine_path")
 
@@ -143,10 +143,9 @@ def test_a_thick_fan_through_the_part_is_not_taken_for_a_sliver():
 # -- internal walls ---------------------------------------------------------------------------------------------
 
 def _halves(v, f, normal, offset):
-    """The two closed halves by manifold3d: ``tests/test_mesh_sheets.py``'s, imported on use (that module imports
-    this one's truths at load, so a load-time import would be circular)."""
-    from test_mesh_sheets import _halves as halves
-    return halves(v, f, normal, offset)
+    """The two closed halves by manifold3d (``solids.halves_by_plane``, shared with ``tests/test_mesh_sheets.py``;
+    importing that module inside a hypothesis test made hypothesis see its tests as nested)."""
+    return halves_by_plane(v, f, normal, offset)
 
 
 def _retriangulate_cut(hv, hf, normal, offset, rng):

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 import inertia_tool as it
 from inertia_tool.mesh.sheets import open_sheets
-from solids import random_convex
+from solids import halves_by_plane, random_convex
 from test_mesh_folds import _assert_matches, _truth
 
 pytestmark = pytest.mark.usefixtures("engine_path")
@@ -84,17 +84,7 @@ def test_a_flat_sheet_free_inside_leaves_the_part_exact(seed, share):
     _assert_matches(p, truth)
 
 
-def _halves(v, f, normal, offset):
-    import manifold3d as m3d
-
-    solid = m3d.Manifold(m3d.Mesh64(vert_properties=np.ascontiguousarray(v, dtype=np.float64),
-                                    tri_verts=np.ascontiguousarray(f, dtype=np.uint64)))
-    out = []
-    for half in solid.split_by_plane(tuple(float(x) for x in normal), float(offset)):
-        mesh = half.to_mesh64()
-        out.append((np.array(mesh.vert_properties, dtype=np.float64)[:, :3].copy(),
-                    np.array(mesh.tri_verts, dtype=np.int64)))
-    return out
+_halves = halves_by_plane
 
 
 def _on_plane(hv, hf, normal, offset):
