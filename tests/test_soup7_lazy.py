@@ -97,13 +97,7 @@ def test_no_plane_is_said_only_where_the_svd_plane_fails(case: tuple[np.ndarray,
 
 def _svd_plane_holds(v: np.ndarray, corners: np.ndarray, tolerance: float) -> bool:
     """``_seam_plane``'s own test without the early exit (the least-squares plane by singular values)."""
-    p = v[corners]
-    centre = p.mean(axis=0)
-    _, _, vt = np.linalg.svd(p - centre, full_matrices=False)
-    unit = vt[-1] / np.linalg.norm(vt[-1])
-    offset = float(centre @ unit)
-    dist = np.abs(p @ unit - offset) + 8 * 2.0 ** -53 * (np.abs(p) @ np.abs(unit) + abs(offset))
-    return bool(dist.max() <= tolerance)
+    return sheets._least_squares_plane(v, corners, tolerance) is not None
 
 
 def test_no_plane_for_a_sphere_soup_and_a_plane_kept() -> None:

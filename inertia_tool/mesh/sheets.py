@@ -473,10 +473,14 @@ def _seam_plane(v: np.ndarray, corners: np.ndarray, tolerance: float) -> tuple[n
     """Unit normal and offset of the plane holding every corner of the surface's unbalanced edges (``corners``,
     :func:`_seam_corners`) within ``tolerance`` (the rim of one sheet whose faces are joined to the part's through
     T-vertices: the edges left open are the other side's rim), or None."""
-    if len(corners) < 3:
+    if len(corners) < 3 or _no_plane_holds(v, corners, tolerance):
         return None
-    if _no_plane_holds(v, corners, tolerance):
-        return None
+    return _least_squares_plane(v, corners, tolerance)
+
+
+def _least_squares_plane(v: np.ndarray, corners: np.ndarray, tolerance: float) -> tuple[np.ndarray, float] | None:
+    """:func:`_seam_plane`'s test without its early exit: the least-squares plane of the corners (by singular
+    values), kept when every corner lies within ``tolerance`` of it, its rounding included."""
     p = v[corners]
     centre = p.mean(axis=0)
     _, _, vt = np.linalg.svd(p - centre, full_matrices=False)
