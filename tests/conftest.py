@@ -150,3 +150,27 @@ def kill_after_lines(cmd, out, lines, *, env=None, seconds=60.0, poll=0.05):
     finally:
         proc.send_signal(signal.SIGKILL)
         proc.wait()
+
+
+#: ``offset.core_moments`` results by their arguments' bytes, shared by the tests that ask for
+#: :func:`core_moments_memo` (several CLI commands on the same printed part: about 7 s of CPU each).
+_CORE_MOMENTS = {}
+
+
+@pytest.fixture
+def core_moments_memo(monkeypatch):
+    """``thinwall.core_moments`` answered from a cache for arguments seen before (bit for bit the same arrays,
+    depth, origin and band): a pure function, so a repeated call gets what it would compute.  Any difference in
+    what a command passes (another skin, top or bottom, a rounding of a unit) misses the cache and is
+    computed."""
+    from inertia_tool.mass import offset, thinwall
+
+    def memo(vertices, faces, depth, *, origin, band_cells=offset.DEFAULT_BAND_CELLS):
+        v, f, o = (np.ascontiguousarray(a) for a in (vertices, faces, origin))
+        key = (v.dtype.str, v.shape, v.tobytes(), f.dtype.str, f.shape, f.tobytes(), float(depth).hex(),
+               o.tobytes(), int(band_cells))
+        if key not in _CORE_MOMENTS:
+            _CORE_MOMENTS[key] = offset.core_moments(vertices, faces, depth, origin=origin, band_cells=band_cells)
+        return _CORE_MOMENTS[key]
+
+    monkeypatch.setattr(thinwall, "core_moments", memo)

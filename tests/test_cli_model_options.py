@@ -43,7 +43,7 @@ def test_model_options_in_the_same_order_everywhere():
 
 
 @pytest.mark.parametrize("model", [["--model", "shell", "--thickness", "1mm"], ["--shell", "1mm", "--infill", "20%"]])
-def test_spin_and_balance_use_the_thin_walled_models(capsys, model):
+def test_spin_and_balance_use_the_thin_walled_models(capsys, model, core_moments_memo):
     common = [BOX, "--units", "mm", "--material", "aluminium", *model]
     mass = _json(capsys, ["analyze", *common, "--json"])["mass"]
     spin = _json(capsys, ["spin", *common, "--about", "major", "--json"])

@@ -210,7 +210,7 @@ def check_shown_output(command: str, shown: list[str], printed: str) -> None:
 
 
 @pytest.mark.parametrize("page, blocks", _cases())
-def test_docs_example_runs(page, blocks, sandbox, capsys):
+def test_docs_example_runs(page, blocks, sandbox, capsys, core_moments_memo):
     cwd, env = sandbox
     namespace = {"__name__": "__docs__"}
     for b in blocks:
@@ -259,7 +259,7 @@ def _help_examples():
 
 
 @pytest.mark.parametrize("command, examples", _help_examples())
-def test_help_examples_run(command, examples, sandbox, capsys):
+def test_help_examples_run(command, examples, sandbox, capsys, core_moments_memo):
     """The examples at the end of every ``--help`` run as printed, from the repository root."""
     cwd, env = sandbox
     assert examples, f"inertia-tool {command} --help shows no examples"

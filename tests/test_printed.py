@@ -159,7 +159,7 @@ def block_stl(tmp_path):
     return str(p)
 
 
-def test_cli_printed_json_states_the_model(block_stl, capsys):
+def test_cli_printed_json_states_the_model(block_stl, capsys, core_moments_memo):
     import json
     from inertia_tool.cli import main
     assert main(["analyze", block_stl, "--units", "mm", "--material", "pla", "--shell", "1.2mm", "--infill", "20%",
@@ -172,7 +172,7 @@ def test_cli_printed_json_states_the_model(block_stl, capsys):
     assert 0 < out["model"]["mass_error_bound"] < 0.05
 
 
-def test_cli_printed_text_states_the_error(block_stl, capsys):
+def test_cli_printed_text_states_the_error(block_stl, capsys, core_moments_memo):
     from inertia_tool.cli import main
     assert main(["analyze", block_stl, "--units", "mm", "--material", "pla", "--shell", "1.2", "--infill", "0.2"]) == 0
     text = capsys.readouterr().out
@@ -238,7 +238,7 @@ def test_layers_thinner_than_the_wall_change_nothing(block):
 
 
 @pytest.mark.slow
-def test_cli_top_bottom_layers(block_stl, capsys):
+def test_cli_top_bottom_layers(block_stl, capsys, core_moments_memo):
     from inertia_tool.cli import main
     import json
     base = ["analyze", str(block_stl), "--units", "mm", "--material", "pla", "--shell", "0.8mm", "--infill", "20%",
