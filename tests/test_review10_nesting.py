@@ -80,3 +80,11 @@ def test_inward_shell_outside_every_body_is_refused():
     outside = box((0.3, 0.3, 0.3), center=(0.5, 0.0, 0.0))      # half of it beyond both boxes' faces at 0.5
     with pytest.raises(InvalidMeshError, match="outside every body"):
         _run(concat(a, b, flipped(inner), flipped(outside)))
+
+
+def test_cavity_crossing_the_other_part_is_united():
+    """Benchmark seed 904, case 7: two hollow boxes overlapping, a cavity of one crossing the other's wall (inside
+    its own box).  Right since review 9 but ``unverified`` ("an inward-wound shell crosses an outward one"); every
+    such shell lies inside a body, so R4c reads the file's winding as it stands and the result is certified."""
+    case, verdict, _ = review9.run("hollow_pair", 904, 7, False)
+    assert verdict.wrong is None and verdict.label == "united", (verdict, case.recipe)

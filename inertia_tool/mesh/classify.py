@@ -17,7 +17,8 @@ import numpy as np
 from ..errors import InsideOutWarning
 from ..integrals import VolumeMoments
 from .intersect import SurfaceContacts, surface_contacts
-from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward, misread_nesting,
+from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
+                     inward_crossing_shells, misread_nesting,
                      orient_by_depth, outward_crossing_groups, shell_contacts, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
@@ -98,7 +99,9 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     crossed_cavities = _crossing_cavities(crossing_with, depth, owner) if touch.complete else 0
     # R4c: where the depth cannot name a cavity's body (cavities inside overlapping bodies, cavities crossing each
     # other), the solid is {w ≥ 1} of the shells as the file winds them, formed without owners
-    by_winding = bool(shared or crossed_cavities) and misread is None and groups is None
+    inward = inward_crossing_shells(file_volumes, flip, crossing_with) if touch.complete else np.zeros(0, bool)
+    held_cavities = bool(inward.any()) and bool(np.all(depth[inward] % 2 == 1))   # each inside a body, as wound
+    by_winding = bool(shared or crossed_cavities or held_cavities) and misread is None and groups is None
     if by_winding:      # shells inside others keep the file's winding; a body inside out on its own is still turned
         flip = flip & (depth == 0)
     quiet = np.zeros(n_shells, dtype=bool)

@@ -124,7 +124,9 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    sign says instead.
 R4c *Cavities no depth can place: the solid as the file winds it* (:func:`~.union.winding_solid`).  Where a
    cavity lies inside bodies that overlap one another (:func:`cavities_in_overlap`; two hollow parts overlapping),
-   or cavities of one body cross each other, no body can be named for a cavity, and the depth itself misleads (a
+   or cavities of one body cross each other, or every inward shell that crosses an outward one lies inside a body
+   (a hollow part's cavity crossing the wall of another part: :func:`inward_crossing_shells`), no body can be
+   named for a cavity, and the depth itself misleads (a
    smaller cavity inside a larger one is at even depth: a "body").  There the shells keep the file's winding
    (shells inside others are not turned) and the boolean forms ``{w ≥ 1}`` from the sets covered at least ``t``
    times, ``∪_t (L_t(bodies) − L_t(cavities))``, with no owner for any cavity; certified ``united`` by R5's checks
@@ -644,15 +646,20 @@ def cavities_in_overlap(nest: Nesting | None, crossing_with: np.ndarray, depth: 
 def inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with: np.ndarray) -> int:
     """R4: how many shells kept their inward winding although they cross an outward shell (R4 for crossing shells):
     a cavity poking through its body's wall, or a body written inside out: the file cannot say which."""
+    return int(np.count_nonzero(inward_crossing_shells(volumes, flip, crossing_with)))
+
+
+def inward_crossing_shells(volumes: np.ndarray, flip: np.ndarray, crossing_with: np.ndarray) -> np.ndarray:
+    """(s,) bool: the shells :func:`inward_crossing_outward` counts."""
+    inward = np.zeros(len(volumes), dtype=bool)
     if not len(crossing_with):
-        return 0
+        return inward
     wound = np.where(flip, -np.sign(volumes), np.sign(volumes))
     pairs = np.asarray(crossing_with, dtype=np.int64)
-    inward = np.zeros(len(volumes), dtype=bool)
     for a, b in ((0, 1), (1, 0)):
         hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
         inward[pairs[hit, a]] = True
-    return int(np.count_nonzero(inward))
+    return inward
 
 
 @frozen_value
