@@ -41,6 +41,7 @@ from .tolerances import ROUNDOFF_RTOL
 
 __all__ = ["VolumeMoments", "volume_moments", "body_volume_moments", "second_moment_to_inertia", "bounding_box",
            "roundoff_bounds", "exact_volume_moments", "RoundoffBound", "accurate_shells", "total_roundoff",
+           "total_roundoff_parts",
            "one_shell_moments"]
 
 _DEFAULT_CHUNK = 1 << 15
@@ -608,6 +609,28 @@ def total_roundoff(shells: list[VolumeMoments], bounds: RoundoffBound) -> float:
     if not (total_v > 0 and total_i > 0):
         return float("inf")
     return float(max(share_v.sum() / total_v, share_i.sum() / total_i))
+
+
+def total_roundoff_parts(shells: list[VolumeMoments], bounds: RoundoffBound) -> tuple[float, float, float]:
+    """The round-off of the total of oriented ``shells`` as an estimate's bounds are stated
+    (:class:`~inertia_tool.mesh.uncertainty.Uncertainty`): ``(volume relative, centroid m, inertia relative)``.
+
+    The volume and inertia terms are those of :func:`total_roundoff` (the same shares).  The total centroid
+    ``c = Σ Vᵢcᵢ / V`` moves, to first order, by ``Σ (δVᵢ (cᵢ − c) + Vᵢ δcᵢ) / V``, so its error is at most
+    ``Σ (e_Vᵢ dᵢ + |Vᵢ| e_cᵢ) / (|V| − Σ e_Vᵢ)`` (``dᵢ = ‖cᵢ − c‖``; Higham, *Accuracy and Stability of Numerical
+    Algorithms*, §3.1, first order in u as :func:`roundoff_bounds`).  All three are inf when the total is zero."""
+    share_v, share_i, total_v, total_i = _shares(shells, bounds.volume, bounds.centroid, bounds.second_moment)
+    if not (total_v > 0 and total_i > 0):
+        return float("inf"), float("inf"), float("inf")
+    vol = np.array([s.volume for s in shells], dtype=np.float64)
+    cen = np.array([s.centroid if s.volume else np.zeros(3) for s in shells], dtype=np.float64).reshape(-1, 3)
+    c = (vol @ cen) / float(vol.sum())
+    d = np.linalg.norm(cen - c, axis=1)
+    e_vol = np.asarray(bounds.volume, dtype=np.float64)
+    spare = total_v - float(e_vol.sum())
+    centroid = float(np.sum(e_vol * d + np.abs(vol) * np.asarray(bounds.centroid, dtype=np.float64))) / spare \
+        if spare > 0 else float("inf")
+    return float(share_v.sum() / total_v), centroid, float(share_i.sum() / total_i)
 
 
 def _exact_rounding(s: VolumeMoments) -> tuple[float, float, float]:

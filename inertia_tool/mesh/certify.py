@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from ..errors import InsideOutWarning
-from ..integrals import total_roundoff
+from ..integrals import total_roundoff, total_roundoff_parts
 from ..rounding import round_up
 from ..tolerances import ESTIMATE_MAX_MASS_RTOL, ROUNDOFF_RTOL
 from .policy import Certificate, MisreadNesting, ShellContacts, misread_message
@@ -162,12 +162,13 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
                          "exact arithmetic): not verified")
     uncertainty = None
     if patched is not None:
-        from .uncertainty import check_useful, uncertainty_from     # imported on use: repair only
+        from .uncertainty import check_useful, uncertainty_from, with_roundoff   # imported on use: repair only
         whole = total(shells.moments)
         doubt, far = patched.uncertainty.volume_in_doubt, patched.far
         if spread is not None:                # R4: the reading the file does not decide is in doubt as well
             doubt, far = doubt + spread[0], max(far, spread[1])
-        uncertainty = uncertainty_from(whole.volume, whole.centroid, whole.second_moment, doubt, far)
+        uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, doubt, far),
+                                    total_roundoff_parts(shells.moments, shells.bound))
         what = "the patched surface" + (" and a shell wound outward inside another" if spread is not None else "")
         holes_alone = patched.uncertainty.volume_in_doubt / whole.volume if whole.volume > 0 else np.inf
         if spread is not None and holes_alone <= ESTIMATE_MAX_MASS_RTOL:
@@ -183,8 +184,9 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
     elif spread is not None and kind in ("exact", "united"):         # R4: both readings within the bound
         from .uncertainty import uncertainty_from
         whole = total(shells.moments)
-        from .uncertainty import check_useful
-        uncertainty = uncertainty_from(whole.volume, whole.centroid, whole.second_moment, *spread)
+        from .uncertainty import check_useful, with_roundoff
+        uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, *spread),
+                                    total_roundoff_parts(shells.moments, shells.bound))
         # the same ±50 % limit as every estimate (holes6's review: two crossing outward cubes inside a cube were
         # answered at ±61.5 % mass)
         check_useful(whole.volume, uncertainty, source=source, what="the reading by nesting depth", why=_R4_WHY)

@@ -17,7 +17,8 @@ import numpy as np
 from ..errors import InsideOutWarning
 from ..integrals import VolumeMoments
 from .intersect import SurfaceContacts, surface_contacts
-from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward, misread_nesting,
+from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
+                     inward_crossing_shells, misread_nesting,
                      orient_by_depth, outward_crossing_groups, shell_contacts, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
@@ -59,6 +60,9 @@ class Orientation(NamedTuple):
     groups : MisreadNesting or None
         Groups of crossing shells wound outward at odd depth, kept as bodies (``kept="union"``): the same two
         readings (:func:`~.policy.outward_crossing_groups`; labelled by :func:`~.certify.misread_reading`).
+    by_winding : bool
+        R4c: cavities lie inside bodies that overlap, or cross each other, and the file's winding is read as it
+        stands (no shell turned): the boolean forms ``{w ≥ 1}`` without owners (:func:`~.union.winding_solid`).
     """
 
     shells: Shells
@@ -72,6 +76,7 @@ class Orientation(NamedTuple):
     notes: tuple[str, ...]
     misread: MisreadNesting | None = None
     groups: MisreadNesting | None = None
+    by_winding: bool = False
 
 
 def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContacts, *, source: str) -> Orientation:
@@ -90,6 +95,15 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
         if touch.complete else None                                                   # R4: the file does not decide
     groups = outward_crossing_groups(file_volumes, flip, depth, crossing_with) if touch.complete else None
+    shared = cavities_in_overlap(nest, crossing_with, depth) if touch.complete else 0
+    crossed_cavities = _crossing_cavities(crossing_with, depth, owner) if touch.complete else 0
+    # R4c: where the depth cannot name a cavity's body (cavities inside overlapping bodies, cavities crossing each
+    # other), the solid is {w ≥ 1} of the shells as the file winds them, formed without owners
+    inward = inward_crossing_shells(file_volumes, flip, crossing_with) if touch.complete else np.zeros(0, bool)
+    held_cavities = bool(inward.any()) and bool(np.all(depth[inward] % 2 == 1))   # each inside a body, as wound
+    by_winding = bool(shared or crossed_cavities or held_cavities) and misread is None and groups is None
+    if by_winding:      # shells inside others keep the file's winding; a body inside out on its own is still turned
+        flip = flip & (depth == 0)
     quiet = np.zeros(n_shells, dtype=bool)
     if misread is not None:           # warned once, with both readings, by certify.misread_reading
         quiet[misread.shells] = True
@@ -97,8 +111,16 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     shells = apply_flips(shells, flip & quiet, source, warn=False)
     notes = []
     ambiguous = inward_crossing_outward(file_volumes, flip, crossing_with)
-    shared = cavities_in_overlap(nest, crossing_with, depth) if touch.complete else 0
-    if shared:
+    if shared and by_winding:
+        plural = shared > 1
+        notes.append(f"{shared} cavit{'ies' if plural else 'y'} lie{'' if plural else 's'} inside bodies that "
+                     "overlap one another (two hollow parts overlapping): no body can be named for "
+                     f"{'them' if plural else 'it'}, so the solid is formed where the winding number of the shells "
+                     "as the file winds them is at least one")
+        warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+    if by_winding:      # an inward shell crossing an outward one is a cavity as wound; one outside every body is
+        ambiguous = shared = 0                      # refused by the boolean (w < 0 there: unite.unite_overlaps)
+    elif shared:
         plural = shared > 1
         notes.append(f"{shared} cavit{'ies' if plural else 'y'} lie{'' if plural else 's'} inside bodies that "
                      "overlap one another: each is cut from one of them, and which one the file does not say "
@@ -126,7 +148,18 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[crossing_with.reshape(-1)] = True
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
-                       groups)
+                       groups, by_winding)
+
+
+def _crossing_cavities(crossing_with: np.ndarray, depth: np.ndarray, owner: np.ndarray) -> int:
+    """R4c: pairs of cavities of one body whose surfaces cross (their common volume is taken out twice by the
+    summed integral; with three meeting at a point no pairwise correction is right)."""
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    if not len(pairs):
+        return 0
+    odd = np.asarray(depth) % 2 == 1
+    own = np.asarray(owner)
+    return int(np.count_nonzero(odd[pairs[:, 0]] & odd[pairs[:, 1]] & (own[pairs[:, 0]] == own[pairs[:, 1]])))
 
 
 def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n_shells: int,

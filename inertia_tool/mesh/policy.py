@@ -122,6 +122,20 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    outside apart; a pair the points cannot decide goes to the boolean like a crossing one.  When the intersection
    check did not finish (crossings unknown, so "inside" may mean "overlapping"), each shell keeps what its own
    sign says instead.
+R4c *Cavities no depth can place: the solid as the file winds it* (:func:`~.union.winding_solid`).  Where a
+   cavity lies inside bodies that overlap one another (:func:`cavities_in_overlap`; two hollow parts overlapping),
+   or cavities of one body cross each other, or every inward shell that crosses an outward one lies inside a body
+   (a hollow part's cavity crossing the wall of another part: :func:`inward_crossing_shells`), no body can be
+   named for a cavity, and the depth itself misleads (a
+   smaller cavity inside a larger one is at even depth: a "body").  There the shells keep the file's winding
+   (shells inside others are not turned) and the boolean forms ``{w ≥ 1}`` from the sets covered at least ``t``
+   times, ``∪_t (L_t(bodies) − L_t(cavities))``, with no owner for any cavity; certified ``united`` by R5's checks
+   on its output.  When shells wound inward reach outside every body beyond ``TOUCH_VOLUME_RTOL`` of the result
+   (a body written inside out, or a cavity placed wrong), the file does not say which: refused (``repair``: the
+   winding-number estimate).  Not applied when R4 found a shell wound outward that depth reads as a cavity
+   (:func:`misread_nesting`, :func:`outward_crossing_groups`): those readings keep their own labels.  Reason:
+   review 10 found the owner-by-owner union 3–31 % high on every such draw (``unverified``), and three cavities
+   meeting at a point were said to "reach out of the body".
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
    transversally (or overlap coplanar with the same orientation) mean shared volume: the union is integrated
    and the certificate is ``united`` once the face-intersection check finds no crossing in the union itself
@@ -632,15 +646,20 @@ def cavities_in_overlap(nest: Nesting | None, crossing_with: np.ndarray, depth: 
 def inward_crossing_outward(volumes: np.ndarray, flip: np.ndarray, crossing_with: np.ndarray) -> int:
     """R4: how many shells kept their inward winding although they cross an outward shell (R4 for crossing shells):
     a cavity poking through its body's wall, or a body written inside out: the file cannot say which."""
+    return int(np.count_nonzero(inward_crossing_shells(volumes, flip, crossing_with)))
+
+
+def inward_crossing_shells(volumes: np.ndarray, flip: np.ndarray, crossing_with: np.ndarray) -> np.ndarray:
+    """(s,) bool: the shells :func:`inward_crossing_outward` counts."""
+    inward = np.zeros(len(volumes), dtype=bool)
     if not len(crossing_with):
-        return 0
+        return inward
     wound = np.where(flip, -np.sign(volumes), np.sign(volumes))
     pairs = np.asarray(crossing_with, dtype=np.int64)
-    inward = np.zeros(len(volumes), dtype=bool)
     for a, b in ((0, 1), (1, 0)):
         hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
         inward[pairs[hit, a]] = True
-    return int(np.count_nonzero(inward))
+    return inward
 
 
 @frozen_value

@@ -102,7 +102,7 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
     nonmanifold = nonmanifold_edges if nonmanifold_edges is not None else edge_topology(f, len(v), v).nonmanifold_edges
     if not (candidates.any() or nonmanifold):                                    # R5, R6
         return United(shells, owner, cavities, overlaps, method, kind, checks, (), None)
-    united, built = _unite(v, f, labels, owner, source, repair)
+    united, built = _unite(v, f, labels, owner, source, repair, by_winding=oriented.by_winding)
     summed = sum(s.volume for s in shells.moments)
     if united is not None and not touch.crossing.any() and \
             abs(united.volume - summed) <= TOUCH_VOLUME_RTOL * abs(summed):
@@ -152,8 +152,15 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
         else:
             excess = united.volume - summed
             overlap_of_cavities = _cavities_common_volume(oriented, shells) \
-                if excess > TOUCH_VOLUME_RTOL * abs(summed) else 0.0
-            if excess > TOUCH_VOLUME_RTOL * abs(summed) and \
+                if excess > TOUCH_VOLUME_RTOL * abs(summed) and not oriented.by_winding else 0.0
+            if oriented.by_winding:
+                # R4c: {w ≥ 1} formed from the levels of cover, not body by body: a union larger than the summed
+                # integral is the cavities' common volume, which the sum takes out more than once
+                notes.append("cavities inside overlapping bodies or crossing one another: the solid where the "
+                             "winding number of the shells as wound is at least one, formed by the boolean from "
+                             "the regions each covered at least t times by bodies and fewer times by cavities")
+                excess = 0.0
+            elif excess > TOUCH_VOLUME_RTOL * abs(summed) and \
                     abs(excess - overlap_of_cavities) <= TOUCH_VOLUME_RTOL * abs(summed):
                 # cavities of one body that cross each other: the summed integral takes their common volume out
                 # twice, the union once; nothing reaches out of its body (review 9)
@@ -278,14 +285,17 @@ def _oriented_anew(v: np.ndarray, f: np.ndarray, diag: float, source: str) -> tu
 
 
 def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: np.ndarray, source: str,
-           repair: bool) -> tuple[UnionSurface | None, PieceSolids | None]:
+           repair: bool, *, by_winding: bool = False) -> tuple[UnionSurface | None, PieceSolids | None]:
     """The union of the closed pieces (a :class:`~.union.UnionSurface`), or None when the boolean refuses; and the
     solids of the shells that were whole pieces wound outward (keyed by shell, for :func:`_union_lost_volume`).
 
-    Each piece belongs to the body that owns its shell, so cavities are cut from their own body only.
+    Each piece belongs to the body that owns its shell, so cavities are cut from their own body only; with
+    ``by_winding`` (R4c) owners are not used: the solid ``{w ≥ 1}`` of the pieces as wound
+    (:func:`~.union.winding_solid`), refused where shells wound inward reach outside every body beyond
+    ``TOUCH_VOLUME_RTOL`` of the result (a body inside out or a cavity misplaced: the file does not say which).
     """
     from .union import (PieceSolids, UnionError, closed_groups, piece_solids, two_manifold,   # on use: overlaps
-                        union_surface)                                                          # are rare
+                        union_surface, winding_solid)                                           # are rare
     groups, n_groups = closed_groups(faces, len(vertices))
     # within the shells: bodies welded along their crossing (R1b) are closed apart, though one group to closed_groups
     _, groups = np.unique(np.stack([np.asarray(labels, dtype=np.int64), groups], axis=1), axis=0, return_inverse=True)
@@ -304,9 +314,17 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
     try:
         built = piece_solids(vertices, faces[keep], groups, int(np.count_nonzero(solid)), outward,
                              body=np.asarray(owner)[shell_of_group[solid]])
-        united = union_surface(vertices, faces[keep], groups, int(np.count_nonzero(solid)), outward,
-                               body=np.asarray(owner)[shell_of_group[solid]], solids=built)
         summed = float(np.sum(volume[solid]))
+        if by_winding:
+            united, outside = winding_solid(vertices, faces[keep], groups, int(np.count_nonzero(solid)), outward,
+                                            solids=built)
+            if outside > TOUCH_VOLUME_RTOL * abs(united.volume):
+                raise UnionError(f"{outside:.3g} m³ of shells wound inward lies outside every body (a body written "
+                                 "inside out, or a cavity placed wrong, while cavities lie in overlapping bodies): "
+                                 "which the file means it does not say")
+        else:
+            united = union_surface(vertices, faces[keep], groups, int(np.count_nonzero(solid)), outward,
+                                   body=np.asarray(owner)[shell_of_group[solid]], solids=built)
         # manifold3d assumes manifold pieces and does not always say when one is not (bodies welded face to face,
         # joined by closed_groups at four-face rims): its union of such a piece is no witness (welded slabs came
         # back 3 % short); when it disagrees with the summed integral, the union is not formed
