@@ -577,6 +577,17 @@ _MESH_INERTIA_NOTES = {
 }
 
 
+def _fitted_estimate_note(element: GeometryElement, bounds) -> str:
+    """What a link's warnings say of a primitive fitted to a mesh that only a repair could integrate: the mesh's
+    warning calls the mesh an estimate, and the link's ``unverified`` (with no ``uncertainty``) needs its
+    reason beside it, the same in the text table and in ``--json`` (robots10: arx_l5 ``link2``)."""
+    return (f"{element.kind} {element.name!r} is fitted to {os.path.basename(_mesh_label(element))}, whose integrals "
+            f"are an estimate after repair (volume ±{round_up(100 * bounds.mass, 3):.3g} %, inertia "
+            f"±{round_up(100 * bounds.inertia, 3):.3g} %): the fitted {element.kind} "
+            "is exact for those integrals, but no bound on it is derived from theirs, hence 'unverified' and no "
+            "uncertainty")
+
+
 def _mesh_inertia_part(element: GeometryElement, *, cache: dict, budget: list | None) -> tuple:
     """``(element, unit properties in the link frame, method, None)`` of a mesh taken by its MJCF inertia
     mode (:mod:`inertia_tool.robot.mesh_inertia`): ``convex`` is the exact integral of the hull, ``legacy``
@@ -728,6 +739,8 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
             # a primitive fitted to a mesh is a closed form sized by the mesh's integrals: exactly as sure as
             # they are (a united mesh gives a united fit); no bound follows for a fit to a repaired mesh
             method = "unverified" if report.uncertainty is not None else report.certificate.kind
+            if report.uncertainty is not None:
+                notes.append(_fitted_estimate_note(element, report.uncertainty))
         elif report is not None:        # the engine's certificate (a result with bounds is an estimate)
             method = "estimate" if report.uncertainty is not None else report.certificate.kind
             uncertainty = report.uncertainty
