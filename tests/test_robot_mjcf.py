@@ -403,7 +403,16 @@ def test_a_capsule_fitted_to_an_open_mesh_with_repair_is_audited_without_stoppin
     assert results[0].properties is not None and results[1].properties is not None
     audits = audit_links(robot, results)
     assert audits[0].com_inside_geometry is None and audits[0].issues        # no box without repair: unknown
-    assert results[0].method == "unverified"              # no bound follows for a fit to a repaired mesh
+    # a bound follows for a fit to a repaired mesh (robots10: fitted_mass_bound); it holds against the capsule fitted
+    # to the whole mesh
+    assert results[0].method == "estimate" and results[0].uncertainty.inertia is None
+    write_binary_stl(tmp_path / "whole.stl", ball.vertices, ball.faces)
+    whole = tmp_path / "w.xml"
+    whole.write_text(path.read_text().replace("open.stl", "whole.stl"))
+    truth = link_inertials(read_robot(whole), density=1000)[0].properties
+    got = results[0].properties
+    assert abs(got.mass - truth.mass) <= results[0].uncertainty.mass * got.mass
+    assert np.linalg.norm(got.center_of_mass - truth.center_of_mass) <= results[0].uncertainty.center_of_mass + 1e-15
     unrepaired = link_inertials(robot, density=1000)
     assert unrepaired[0].properties is None and "mesh needs repair" in unrepaired[0].problem
 

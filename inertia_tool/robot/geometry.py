@@ -46,18 +46,20 @@ from ..values import frozen_value
 from ..mesh.read import RawMesh
 from .description import GeometryElement, LinkGeometry, RobotDescription
 from ..rounding import round_up
+from ..mesh.uncertainty import Uncertainty
+from ..tolerances import ESTIMATE_MAX_MASS_RTOL
 
 __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", "LinkInertial", "mesh_properties",
            "points_inside_element", "element_bounds", "LinkUncertainty", "METHODS", "MODEL_DENSITY", "fitted_element",
-           "MeshCache"]
+           "MeshCache", "fitted_mass_bound"]
 
 #: What ``LinkInertial.method`` can say: ``"exact"`` (closed forms, and meshes integrated exactly, after
 #: orienting, welding, sealing cracks without moving a point or dropping repeated faces), ``"united"``
 #: (overlapping bodies of a mesh united by a boolean, then exact), ``"summed"`` (overlapping bodies added, the
 #: shared volume counted twice, as asked), ``"unverified"`` (a mesh whose face-intersection check did not prove
 #: it, see ``MeshReport.certificate``; or an MJCF mesh taken by MuJoCo's ``inertia="legacy"`` formula with the
-#: model's densities), ``"estimate"`` (a repaired open mesh: see ``uncertainty``).  For a mesh it
-#: is the kind of the engine's certificate, from the strongest to the weakest.
+#: model's densities), ``"estimate"`` (a repaired open mesh, or a primitive fitted to one: see ``uncertainty``).
+#: For a mesh it is the kind of the engine's certificate, from the strongest to the weakest.
 METHODS = ("exact", "united", "summed", "unverified", "estimate")
 
 #: The value of ``density`` (and of ``robot --density``) that asks for the description's own densities.
@@ -577,6 +579,72 @@ _MESH_INERTIA_NOTES = {
 }
 
 
+def fitted_mass_bound(element: GeometryElement, mesh: MassProperties, bounds) -> float | None:
+    """Relative bound on the mass of the primitive MuJoCo fits to a mesh (:func:`fitted_element`, its default
+    inertia-box fit) whose integrals are an estimate, from the estimate's bounds; None where none follows (an
+    unbounded tensor or volume).
+
+    ``mesh``: the mesh's unit-density properties (volume ``V̂``, tensor ``Î`` about the centre of mass);
+    ``bounds``: its :class:`~inertia_tool.mesh.uncertainty.Uncertainty` — the true volume within ``ε_m V̂``, the
+    true tensor within ``ε_I ‖Î‖_F`` (Frobenius).  By the Hoffman–Wielandt inequality the sorted principal moments
+    move by ``d`` with ``‖d‖₂ ≤ δ = ε_I ‖Î‖_F``, so each ``s_k = I_i + I_j − I_k`` of the fit's half-sizes
+    ``h_k = √(3 s_k / (2 V))`` by ``|d_i + d_j − d_k| ≤ √3 δ`` (Cauchy–Schwarz; reached by an error along the
+    principal axes).  Every fitted primitive's volume (box
+    and ellipsoid ``∝ h_x h_y h_z``, sphere ``∝ mean(h)³``, cylinder ``π r² 2h_z``, capsule
+    ``2π r² max(0, h_z − r/2) + 4/3 π r³`` with ``r = (h_x + h_y)/2``, whose derivative in ``r`` is
+    ``4π r h_z + π r² > 0`` while the cylinder part is there) grows with each ``h_k``, so the true fit's volume
+    lies between the volumes at ``h_k`` from ``(s_k − √3 δ, V̂(1 + ε_m))`` and from ``(s_k + √3 δ, V̂(1 − ε_m))``.  The
+    centre of the fit is the mesh's centre of mass (its bound carries over); no bound on the fit's tensor is
+    derived (its axes are the mesh's principal axes, which a tensor bound does not hold when moments are close).
+    """
+    tensor = 0.5 * (np.asarray(mesh.inertia, dtype=np.float64) + np.asarray(mesh.inertia, dtype=np.float64).T)
+    volume = float(mesh.volume)
+    if not (np.isfinite(bounds.inertia) and np.isfinite(bounds.mass) and volume > 0 and bounds.mass < 1):
+        return None
+    moments = np.linalg.eigvalsh(tensor)[::-1]
+    delta = float(bounds.inertia) * float(np.linalg.norm(tensor))
+    s = np.array([moments[1] + moments[2] - moments[0], moments[0] + moments[2] - moments[1],
+                  moments[0] + moments[1] - moments[2]])
+
+    def fitted_volume(sums: np.ndarray, vol: float) -> float:
+        half = np.sqrt(np.maximum(0.0, 3.0 * sums / (2.0 * vol))) * element.fit_scale
+        if element.kind == "sphere":
+            return 4.0 / 3.0 * np.pi * float(np.mean(half)) ** 3
+        if element.kind in ("cylinder", "capsule"):
+            radius = 0.5 * float(half[0] + half[1])
+            if element.kind == "cylinder":
+                return np.pi * radius ** 2 * 2.0 * float(half[2])
+            return 2.0 * np.pi * radius ** 2 * max(0.0, float(half[2]) - 0.5 * radius) + 4.0 / 3.0 * np.pi * radius ** 3
+        factor = 1.0 if element.kind == "box" else np.pi / 6.0          # box (2h)³·…; ellipsoid 4/3 π h³
+        return factor * 8.0 * float(np.prod(half))
+
+    middle = fitted_volume(s, volume)
+    if not middle > 0:
+        return None
+    low = fitted_volume(s - np.sqrt(3.0) * delta, volume * (1.0 + bounds.mass))
+    high = fitted_volume(s + np.sqrt(3.0) * delta, volume * (1.0 - bounds.mass))
+    return round_up(max(middle - low, high - middle) / middle * (1.0 + 1e-9) + 1e-12)
+
+
+def _fitted_estimate_note(element: GeometryElement, bounds, fitted: float | None) -> str:
+    """What a link's warnings say of a primitive fitted to a mesh that only a repair could integrate: the mesh's
+    warning calls the mesh an estimate, and the link's method says what follows for the fit, the same in the text
+    table and in ``--json`` (robots10: arx_l5 ``link2``): an estimate with the bound of
+    :func:`fitted_mass_bound`, or ``unverified`` with no uncertainty where that bound is past the ±50 % at which an
+    estimate is given, or none follows."""
+    head = (f"{element.kind} {element.name!r} is fitted to {os.path.basename(_mesh_label(element))}, whose integrals "
+            f"are an estimate after repair (volume ±{round_up(100 * bounds.mass, 3):.3g} %, inertia "
+            f"±{round_up(100 * bounds.inertia, 3):.3g} %): ")
+    if fitted is not None and fitted <= ESTIMATE_MAX_MASS_RTOL:
+        return head + (f"the fitted {element.kind}'s mass follows within ±{round_up(100 * fitted, 3):.3g} % and its "
+                       "centre within the mesh's bound (no bound on its tensor is derived)")
+    why = ("no bound on it follows from theirs" if fitted is None else
+           f"the bound that follows for it, ±{round_up(100 * fitted, 3):.3g} % mass, is past the ±"
+           f"{100 * ESTIMATE_MAX_MASS_RTOL:g} % at which an estimate is given")
+    return head + (f"the fitted {element.kind} is exact for those integrals, but {why}, hence 'unverified' and no "
+                   "uncertainty")
+
+
 def _mesh_inertia_part(element: GeometryElement, *, cache: dict, budget: list | None) -> tuple:
     """``(element, unit properties in the link frame, method, None)`` of a mesh taken by its MJCF inertia
     mode (:mod:`inertia_tool.robot.mesh_inertia`): ``convex`` is the exact integral of the hull, ``legacy``
@@ -701,7 +769,8 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
     elements (``model`` mode) are left out and named in the second return value; the third says what the
     link's warnings should: meshes taken by their MJCF ``inertia`` mode, open mesh pieces integrated together
     (:func:`_join_open_pieces`)."""
-    parts, massless, refused, notes = [], [], [], []
+    parts: list[tuple] = []
+    massless, refused, notes = [], [], []
     for element in link.elements:
         if model and (element.mass == 0 or (element.mass is None and element.density == 0)):
             massless.append(element)
@@ -723,11 +792,19 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
         fitted = element.fit_scale is not None
         key = _mesh_key(element) if element.kind == "mesh" or fitted else None
         report = cache[key].mesh if key is not None and key in cache else None
-        method, uncertainty = "exact", None
+        method: str = "exact"
+        uncertainty: Uncertainty | None = None
         if report is not None and fitted:
             # a primitive fitted to a mesh is a closed form sized by the mesh's integrals: exactly as sure as
             # they are (a united mesh gives a united fit); no bound follows for a fit to a repaired mesh
             method = "unverified" if report.uncertainty is not None else report.certificate.kind
+            if report.uncertainty is not None:
+                bound = None if element.fit_aabb else fitted_mass_bound(element, cache[key], report.uncertainty)
+                if bound is not None and bound <= ESTIMATE_MAX_MASS_RTOL:
+                    method = "estimate"
+                    uncertainty = Uncertainty(mass=bound, center_of_mass=report.uncertainty.center_of_mass,
+                                              inertia=float("inf"), volume_in_doubt=bound * props.volume)
+                notes.append(_fitted_estimate_note(element, report.uncertainty, bound))
         elif report is not None:        # the engine's certificate (a result with bounds is an estimate)
             method = "estimate" if report.uncertainty is not None else report.certificate.kind
             uncertainty = report.uncertainty
@@ -783,7 +860,7 @@ class LinkUncertainty:
         bounded with the smallest possible total mass).
     inertia : float or None
         Relative Frobenius bound on the tensor when the link is a single element; None otherwise (no bound
-        is claimed for a sum of estimated and exact parts).
+        is claimed for a sum of estimated and exact parts, nor for a primitive fitted to an estimated mesh).
     """
 
     mass: float
@@ -839,7 +916,7 @@ def _link_uncertainty(parts: list, total: MassProperties, scale: float) -> LinkU
     shift = sum(p.mass * scale * u.center_of_mass for p, u in estimated)
     floor = total.mass - sum(dm)
     com = (shift + spread) / floor if floor > 0 else float("inf")
-    inertia = estimated[0][1].inertia if len(parts) == 1 else None
+    inertia = estimated[0][1].inertia if len(parts) == 1 and np.isfinite(estimated[0][1].inertia) else None
     return LinkUncertainty(mass=sum(dm) / total.mass, center_of_mass=com, inertia=inertia)
 
 
