@@ -73,6 +73,8 @@ def edge_sets(draw):
     e = np.vstack(edges)
     if draw(st.booleans()):       # repeated edges (the boundary chain has |net| copies)
         e = np.vstack([e, e[: max(1, len(e) // 3)]])
+    if draw(st.booleans()):       # consecutive copies (as the census lists them), which the search drops first
+        e = np.repeat(e, rng.integers(1, 4, size=len(e)), axis=0)
     return v, e
 
 

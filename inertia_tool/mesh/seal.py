@@ -369,8 +369,16 @@ def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
     if not len(edges):
         return np.zeros(0, dtype=np.int64)
     # an edge listed again only repeats work (the answer is a set): the copies of the census's boundary, one per
-    # unit of net use, are consecutive, and dropping those needs no sort (0.4 s for a soup's 3.9M edges)
-    edges = edges[np.r_[True, (edges[1:] != edges[:-1]).any(axis=1)]]
+    # unit of net use, are consecutive, and dropping those needs no sort (0.4 s for a soup's 3.9M edges); the
+    # two columns compared one at a time, and no copy when every row differs from the one before (a soup's:
+    # 0.2 s as a (k, 2) comparison reduced by rows and a copy, 0.02 s so)
+    new_row = np.empty(len(edges), dtype=bool)
+    new_row[0] = True
+    np.not_equal(edges[1:, 0], edges[:-1, 0], out=new_row[1:])
+    new_row[1:] |= edges[1:, 1] != edges[:-1, 1]
+    if not new_row.all():
+        edges = edges[new_row]
+    del new_row
     e, m = _edge_point_candidates(v, edges, 0.0)
     if not len(e):
         return np.zeros(0, dtype=np.int64)
@@ -403,7 +411,11 @@ _BOUNDS_CHUNK = 1 << 18
 
 
 def _bounds_of(lib: Any, v: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
-    """``lib.bounds(v[index])`` (lowest and highest coordinates, all finite) a chunk of points at a time."""
+    """``lib.bounds(v[index])`` (lowest and highest coordinates, all finite) a chunk of points at a time, or of
+    ``v`` itself when ``index`` (sorted, each once) is every row (a soup: no gathered copies)."""
+    if len(index) == len(v) and v.flags.c_contiguous:
+        every_lo, every_hi, every_finite = lib.bounds(v)
+        return np.asarray(every_lo), np.asarray(every_hi), bool(every_finite)
     lo, hi, finite = np.full(3, np.inf), np.full(3, -np.inf), True
     for start in range(0, len(index), _BOUNDS_CHUNK):          # bounded by len(index) / _BOUNDS_CHUNK + 1
         part_lo, part_hi, part_finite = lib.bounds(np.ascontiguousarray(v[index[start:start + _BOUNDS_CHUNK]]))
