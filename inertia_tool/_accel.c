@@ -4967,6 +4967,12 @@ ct_classify(CtFace *A, CtFace *B, CtStats *st)
     if (n_shared == 1 && touch1 >= 0) {
         return CT_NONE;
     }
+    /* sharing none, one corner x on B's plane and the two others strictly on one side: A and B meet at most in x,
+     * so they meet iff x lies in the closed B, whatever B's corners say of A's plane (the test below would make
+     * the same call first, and its other touch test finds a common point only if it is x; see ct_touch_first) */
+    if (n_shared == 0 && touch1 >= 0) {
+        return ct_point_in_triangle(t1[(touch1 + 1) % 3], t1[touch1], t2, st) ? CT_CONTACT : CT_NONE;
+    }
     unsure = 0;
     ct_face_normal(A);
     for (int j = 0; j < 3; j++) {
