@@ -4883,6 +4883,41 @@ ct_face_normal(CtFace *F)
     F->na[2] = fabs(e1[0]) * fabs(e2[1]) + fabs(e1[1]) * fabs(e2[0]);
 }
 
+/* Faces A, B sharing no corner or one by index, some corner of A on B's plane undecided by the float filter (the
+ * exact stage would be next): 1 when B's corners against A's plane, all decided by the filter, decide the pair
+ * without that stage, its kind in *kind; 0 to go on as before.  B strictly on one side of A's plane: they do not
+ * meet (NONE).  B on A's plane at one corner x only, its other two corners strictly on one side (a rim corner of
+ * a fan-capped cylinder's side wall on the cap's plane): A and B meet at most in x, so with a corner shared by
+ * index (x itself, the only corner of B on that plane) only there (NONE), and with none they meet iff x lies in
+ * the closed A (CONTACT, else NONE; ct_point_in_triangle, exact).  ct_classify would give the same kinds: a
+ * common point lies on B and on A's plane, so it is x; its touch test of A's corner (when A touches B's plane at
+ * one corner) finds a common point, hence x in A, and its test of x is this one; A in B's plane would put B's
+ * corners on A's plane, and its transversal case needs no corner of B touching alone.  Only the count of exact
+ * evaluations is smaller (the corners of A need none). */
+static int
+ct_touch_first(CtFace *A, const double *const t1[3], const double *const t2[3], const int on2[3], int n_shared,
+               CtStats *st, int *kind)
+{
+    int e2[3];
+    ct_face_normal(A);
+    for (int j = 0; j < 3; j++) {
+        e2[j] = on2[j] ? 0 : ct_side_filter(A, t2[j]);
+        if (e2[j] == 2) return 0;
+    }
+    if ((e2[0] > 0 && e2[1] > 0 && e2[2] > 0) || (e2[0] < 0 && e2[1] < 0 && e2[2] < 0)) {
+        *kind = CT_NONE;
+        return 1;
+    }
+    int touch = ct_touch_corner(e2);
+    if (touch < 0) return 0;
+    if (n_shared > 0) {
+        *kind = CT_NONE;
+        return 1;
+    }
+    *kind = ct_point_in_triangle(t2[(touch + 1) % 3], t2[touch], t1, st) ? CT_CONTACT : CT_NONE;
+    return 1;
+}
+
 /* Kind of the pair of faces A, B (A the lower face index); computes their normals when a side test needs them. */
 static int
 ct_classify(CtFace *A, CtFace *B, CtStats *st)
@@ -4898,7 +4933,7 @@ ct_classify(CtFace *A, CtFace *B, CtStats *st)
         }
     }
     int d1[3], d2[3];
-    int any1 = 0, unsure = 0, separate_tried = 0;
+    int any1 = 0, unsure = 0, separate_tried = 0, kind_early = CT_NONE;
     ct_face_normal(B);
     for (int i = 0; i < 3; i++) {
         d1[i] = on1[i] ? 0 : ct_side_filter(B, t1[i]);
@@ -4910,6 +4945,9 @@ ct_classify(CtFace *A, CtFace *B, CtStats *st)
         separate_tried = 1;
         if (ct_projections_separate(t1, t2, on1, on2, n_shared, A->axis, st)) {
             return CT_NONE;
+        }
+        if (n_shared < 2 && ct_touch_first(A, t1, t2, on2, n_shared, st, &kind_early)) {
+            return kind_early;
         }
     }
     for (int i = 0; i < 3; i++) {
@@ -4928,6 +4966,12 @@ ct_classify(CtFace *A, CtFace *B, CtStats *st)
     /* sharing one corner, the two others strictly on one side of B's plane: A meets that plane only there */
     if (n_shared == 1 && touch1 >= 0) {
         return CT_NONE;
+    }
+    /* sharing none, one corner x on B's plane and the two others strictly on one side: A and B meet at most in x,
+     * so they meet iff x lies in the closed B, whatever B's corners say of A's plane (the test below would make
+     * the same call first, and its other touch test finds a common point only if it is x; see ct_touch_first) */
+    if (n_shared == 0 && touch1 >= 0) {
+        return ct_point_in_triangle(t1[(touch1 + 1) % 3], t1[touch1], t2, st) ? CT_CONTACT : CT_NONE;
     }
     unsure = 0;
     ct_face_normal(A);

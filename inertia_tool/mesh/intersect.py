@@ -44,6 +44,14 @@ first scaled by a power of two (exact, and orientation signs do not change), and
 still too wide every sign is computed exactly.  ``fl(P) = 0`` means every triple product has a zero factor,
 so the determinant is exactly zero.
 
+A touching corner decides a pair without the exact stage where it can (C kernel): when a face ``B`` meets the
+plane of a face ``A`` in one corner ``x`` only (its two other corners strictly on one side, signs the float
+filter decided), ``A`` and ``B`` meet at most in ``x``: not at all beyond what they share if ``x`` is shared by
+index, else exactly when ``x`` lies in the closed ``A`` (``contact``), whatever ``A``'s corners say of ``B``'s
+plane; likewise with the roles swapped once ``A``'s corners are known.  A fan-capped cylinder from an STL file
+has every rim corner exactly on its side walls' planes, which no float filter decides: its pairs needed four
+exact evaluations per section, now none (the kinds found are the same; ``exact_evaluations`` is lower).
+
 Broad phase
 -----------
 A hierarchical uniform grid over the face bounding boxes (closed boxes: touching counts): faces are sorted
