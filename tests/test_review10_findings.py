@@ -14,6 +14,8 @@ and R0/R4's copy rules, by generators written apart from the code they judge.
   slivers near R7's margin, a corner pushed inward to the far side (or exactly onto it), a tiny turn far from the
   origin, a face split at a point a few ulps off it.  Any difference in result, certificate, warning or error is a
   defect (none was found: 4,163 cases of seeds 1000..1299 and 2000..5999).
+* D2: a copy scaled by 1 + 100 ulp lies inside its copy without crossing it; R4's copy rule sees only crossing
+  pairs, so the nesting depth makes it a cavity (honest label, absurd number).
 * A defect found (D1): a vertex no face uses widens the extent the flatness rule (R2) and the units heuristic
   read, so a valid solid with one stray point far away is refused as "encloses no volume".
 """
