@@ -288,6 +288,31 @@ def element_shell_properties(element: GeometryElement) -> MassProperties:
     return local.transformed(rotation=element.rotation, translation=element.translation)
 
 
+def _inertia_box_sums(moments: np.ndarray) -> np.ndarray:
+    """(3,) kg·m² per unit density: ``s_k = I_i + I_j − I_k`` of principal moments sorted from the largest."""
+    m = np.asarray(moments, dtype=np.float64)
+    return np.array([m[1] + m[2] - m[0], m[0] + m[2] - m[1], m[0] + m[1] - m[2]])
+
+
+def _inertia_box_half_sizes(sums: np.ndarray, volume: float) -> np.ndarray:
+    """(3,) m: the half-sizes ``h_k = √(3 s_k / (2 V))`` of the box with the same volume and principal moments
+    (unit density; ``sums`` from :func:`_inertia_box_sums`): MuJoCo's inertia-box fit."""
+    return np.sqrt(np.maximum(0.0, 3.0 * np.asarray(sums, dtype=np.float64) / (2.0 * volume)))
+
+
+def _inertia_box_size(kind: str, half: np.ndarray) -> tuple:
+    """The ``size`` of the primitive of ``kind`` MuJoCo fits to inertia-box half-sizes ``half`` (already times
+    ``fitscale``): a box ``2h``, an ellipsoid ``h``, a sphere the mean of the three, a cylinder radius
+    ``(h_x + h_y)/2`` and length ``2 h_z``, a capsule the same radius and length ``2 max(0, h_z − r/2)``."""
+    if kind == "sphere":
+        return (float(np.mean(half)),)
+    if kind in ("cylinder", "capsule"):
+        radius = 0.5 * float(half[0] + half[1])
+        length = float(half[2]) if kind == "cylinder" else max(0.0, float(half[2]) - 0.5 * radius)
+        return (radius, 2.0 * length)
+    return tuple(2.0 * half) if kind == "box" else tuple(half)
+
+
 def fitted_element(element: GeometryElement, *, cache: dict | None = None, repair: bool = False,
                    budget: list | None = None) -> GeometryElement:
     """The primitive MuJoCo fits to a mesh (``<geom type="capsule" mesh="...">`` without a size).
@@ -335,10 +360,7 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
     axes = axes[:, ::-1]                                 # x: the largest moment, z: the smallest
     if np.linalg.det(axes) < 0:
         axes[:, 2] = -axes[:, 2]
-    m = moments[::-1]
-    volume = props.volume
-    half = np.sqrt(np.maximum(0.0, 3.0 * np.array([m[1] + m[2] - m[0], m[0] + m[2] - m[1],
-                                                     m[0] + m[1] - m[2]]) / (2.0 * volume)))
+    half = _inertia_box_half_sizes(_inertia_box_sums(moments[::-1]), props.volume)
     kind = element.kind
     centre = props.center_of_mass
     if element.fit_aabb:
@@ -357,17 +379,7 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
         return GeometryElement(kind, element.rotation @ axes, element.rotation @ centre + element.translation,
                                size=size_aabb, name=element.name, density=element.density, mass=element.mass,
                                shell=element.shell)
-    half = half * element.fit_scale
-    if kind == "sphere":
-        size: tuple = (float(np.mean(half)),)
-    elif kind in ("cylinder", "capsule"):
-        radius = 0.5 * (half[0] + half[1])
-        length = half[2] if kind == "cylinder" else max(0.0, half[2] - 0.5 * radius)
-        size = (radius, 2.0 * length)
-    elif kind == "box":
-        size = tuple(2.0 * half)
-    else:
-        size = tuple(half)
+    size = _inertia_box_size(kind, half * element.fit_scale)
     return GeometryElement(kind, element.rotation @ axes, element.rotation @ props.center_of_mass + element.translation,
                            size=size, name=element.name, density=element.density, mass=element.mass,
                            shell=element.shell)
@@ -603,20 +615,15 @@ def fitted_mass_bound(element: GeometryElement, mesh: MassProperties, bounds) ->
         return None
     moments = np.linalg.eigvalsh(tensor)[::-1]
     delta = float(bounds.inertia) * float(np.linalg.norm(tensor))
-    s = np.array([moments[1] + moments[2] - moments[0], moments[0] + moments[2] - moments[1],
-                  moments[0] + moments[1] - moments[2]])
+    s = _inertia_box_sums(moments)
 
     def fitted_volume(sums: np.ndarray, vol: float) -> float:
-        half = np.sqrt(np.maximum(0.0, 3.0 * sums / (2.0 * vol))) * element.fit_scale
-        if element.kind == "sphere":
-            return 4.0 / 3.0 * np.pi * float(np.mean(half)) ** 3
-        if element.kind in ("cylinder", "capsule"):
-            radius = 0.5 * float(half[0] + half[1])
-            if element.kind == "cylinder":
-                return np.pi * radius ** 2 * 2.0 * float(half[2])
-            return 2.0 * np.pi * radius ** 2 * max(0.0, float(half[2]) - 0.5 * radius) + 4.0 / 3.0 * np.pi * radius ** 3
-        factor = 1.0 if element.kind == "box" else np.pi / 6.0          # box (2h)³·…; ellipsoid 4/3 π h³
-        return factor * 8.0 * float(np.prod(half))
+        # s_k, V -> h -> the fitted primitive (as fitted_element sizes it) -> its closed-form volume
+        size = _inertia_box_size(element.kind, _inertia_box_half_sizes(sums, vol) * element.fit_scale)
+        if min(size[:1] if element.kind == "capsule" else size) <= 0:       # (a capsule of length 0: a ball)
+            return 0.0
+        return float(element_mass_properties(GeometryElement(element.kind, np.eye(3), np.zeros(3),
+                                                             size=size)).volume)
 
     middle = fitted_volume(s, volume)
     if not middle > 0:
