@@ -112,19 +112,15 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     notes = []
     ambiguous = inward_crossing_outward(file_volumes, flip, crossing_with)
     if shared and by_winding:
-        plural = shared > 1
-        notes.append(f"{shared} cavit{'ies' if plural else 'y'} lie{'' if plural else 's'} inside bodies that "
-                     "overlap one another (two hollow parts overlapping): no body can be named for "
-                     f"{'them' if plural else 'it'}, so the solid is formed where the winding number of the shells "
-                     "as the file winds them is at least one")
+        notes.append(f"{_cavities_in_overlap(shared)} (two hollow parts overlapping): no body can be named for "
+                     f"{'them' if shared > 1 else 'it'}, so the solid is formed where the winding number of the "
+                     "shells as the file winds them is at least one")
         warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=4)
     if by_winding:      # an inward shell crossing an outward one is a cavity as wound; one outside every body is
         ambiguous = shared = 0                      # refused by the boolean (w < 0 there: unite.unite_overlaps)
     elif shared:
-        plural = shared > 1
-        notes.append(f"{shared} cavit{'ies' if plural else 'y'} lie{'' if plural else 's'} inside bodies that "
-                     "overlap one another: each is cut from one of them, and which one the file does not say "
-                     "(two hollow parts overlapping); the union of the bodies less their cavities is given, not "
+        notes.append(f"{_cavities_in_overlap(shared)}: each is cut from one of them, and which one the file does not "
+                     "say (two hollow parts overlapping); the union of the bodies less their cavities is given, not "
                      "verified")
         warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=4)
         ambiguous += shared
@@ -149,6 +145,12 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     crossing[crossing_with.reshape(-1)] = True
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
                        groups, by_winding)
+
+
+def _cavities_in_overlap(count: int) -> str:
+    """The subject of the notes on cavities inside overlapping bodies: "2 cavities lie inside bodies that ..."."""
+    plural = count > 1
+    return f"{count} cavit{'ies' if plural else 'y'} lie{'' if plural else 's'} inside bodies that overlap one another"
 
 
 def _crossing_cavities(crossing_with: np.ndarray, depth: np.ndarray, owner: np.ndarray) -> int:

@@ -343,7 +343,7 @@ def winding_solid(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
     fewer than ``t`` of the ``C_j`` contain the point: ``{w ≥ 1} = ∪_t (L_t(B) − L_t(C))`` with ``L_t`` the set
     covered at least ``t`` times (:func:`_levels`).  Two hollow parts overlapping (a cavity inside both bodies, or
     one cavity inside the other) need no owner for their cavities: review 10 found the owner-by-owner union
-    3–25 % high on every such draw.
+    3–31 % high on every such draw.
 
     Parameters
     ----------
