@@ -349,8 +349,8 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
 
 def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
                       n_loops: int, slabs: dict[str, np.ndarray], radius: np.ndarray, *,
-                      flat_rtol: float = FLAT_RIM_RTOL, flat_cosine: float = FLAT_VERTEX_COSINE
-                      ) -> np.ndarray:
+                      flat_rtol: float = FLAT_RIM_RTOL, flat_cosine: float = FLAT_VERTEX_COSINE,
+                      excused: np.ndarray | None = None) -> np.ndarray:
     """Loops whose flat slab the faces left at the rim contradict, (n_loops,) bool.
 
     Only rims that are flat (within ``flat_rtol`` of the ball's radius of their slab plane ``P``: a hole in a
@@ -372,6 +372,8 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
     ``P`` is the plane the whole rim lies in, not just that face's own.
 
     ``slabs`` is what :func:`hole_doubt_volumes` fills (``has``, ``normal``, ``origin``, ``half_width``).
+    ``excused`` (n,) bool, optional: rim vertices that do not count (the convex reading's vertices inside a flat
+    face, :func:`inner_face_vertices`).
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
@@ -397,7 +399,74 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
     corners = v[f[face]] - slabs["origin"][loop][:, None, :]
     off = np.abs(np.einsum("ijk,ik->ij", corners, slabs["normal"][loop])).max(axis=1)
     off_p = np.bincount(pair, weights=off > tol[loop], minlength=len(pairs)) > 0
+    if excused is not None:
+        off_p |= np.asarray(excused, dtype=bool)[pairs[:, 0]]
     out[pairs[~off_p, 1]] = True
+    return out
+
+
+#: A bare rim vertex is read as inside its flat face (:func:`inner_face_vertices`) when the faces left at it turn
+#: round it by more than π plus this margin, rad (about 0.6°: far above round-off and quantisation of the corner
+#: angles, far below a fan's missing wedge of one triangle on the coarsest cap the benchmarks hold, 7.5°).
+INNER_TURN_MARGIN = 0.01
+
+
+def inner_face_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, bare: np.ndarray, *,
+                        margin: float = INNER_TURN_MARGIN) -> np.ndarray:
+    """Bare rim vertices that the convex reading puts inside their flat face, (n,) bool.
+
+    A bare rim vertex ``x`` (:func:`bare_vertices`: every face left at it lies in one plane ``P``) is read two
+    ways.  On a surface with no vertex inside its flat faces (a CAD tessellation) ``x`` lay on a loop of its flat
+    face, where another surface met it (a feature's footprint), and the hole took that surface.  Under
+    :data:`~.hole_assumptions.CONVEX` (the part ``K`` is convex), ``F = K ∩ P`` is a convex face holding the faces
+    left at ``x``; when those faces turn round ``x`` by more than π, their directions at ``x`` span more than a
+    half-plane, so every direction in ``P`` is a positive combination of two of them, and ``F`` (convex) holds a
+    disc round ``x``: ``x`` is *inside* ``F``, the part's surface near ``x`` is ``F`` itself, and the hole there
+    is a piece of ``F`` (as on a cap triangulated as a fan, whose centre a hole takes a wedge from).  So, with
+    ``K`` convex, such a vertex cannot be a loop vertex of its face, and the two readings contradict each other:
+    **the file cannot tell a convex part with a vertex inside a flat face from a part with a pocket taken whole
+    whose footprint corner kept more than π of the face round it.**  The rule taken here: a bare vertex turning by
+    more than π is read as inside its face (the convex reading, named as ``convex``'s limit) *unless* one of its
+    two rim neighbours is such a vertex too (a run of them along the rim is a footprint's side, as a pocket taken
+    whole with the faces round it leaves: two corners of one footprint edge; a fan's centre has one).  A bare
+    vertex turning by π or less keeps withdrawing the convex bound (a corner of its face, where another face met
+    it: the footprint of a feature, or an edge of the part whose other face the hole took; the file cannot tell).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    edges : (k, 2) int
+        The boundary edges.
+    bare : (n,) bool
+        :func:`bare_vertices`.
+    margin : float
+        ``INNER_TURN_MARGIN``, rad.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    e = np.asarray(edges, dtype=np.int64)
+    n = len(v)
+    out = np.zeros(n, dtype=bool)
+    candidate = np.asarray(bare, dtype=bool)
+    if not candidate.any() or not len(f) or not len(e):
+        return out
+    at = np.flatnonzero(candidate[f].any(axis=1))
+    turn = np.zeros(n)
+    for k in range(3):              # the corner angle at corner k of each face at a bare vertex, summed per vertex
+        corner = f[at, k]
+        keep = candidate[corner]
+        p = v[corner[keep]]
+        a = v[f[at[keep], (k + 1) % 3]] - p
+        b = v[f[at[keep], (k + 2) % 3]] - p
+        angle = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+        turn += np.bincount(corner[keep], weights=angle, minlength=n)
+    wide = candidate & (turn > np.pi + margin)
+    # a wide vertex with a wide rim neighbour: a run along the rim (a footprint's side), not a face's inside
+    paired = np.zeros(n, dtype=bool)
+    both = wide[e[:, 0]] & wide[e[:, 1]]
+    paired[e[both].reshape(-1)] = True
+    out = wide & ~paired
     return out
 
 
