@@ -223,3 +223,37 @@ def test_the_benchmark_cone_is_answered():
     assert p.mesh.certificate.kind == "estimate"
     assert abs(p.volume - truth.volume) <= p.mesh.uncertainty.mass * p.volume
     assert p.mesh.uncertainty.mass < 0.01
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(flat=st.booleans(), scale=st.floats(-3, 6), push=st.floats(-16, -0.7), outward=st.booleans(),
+       which=st.integers(0, 10 ** 6), gone=st.integers(0, 10 ** 6), shift=st.floats(-1e3, 1e3))
+def test_the_reflex_edge_shortcut_never_changes_the_convex_bound(flat, scale, push, outward, which, gone, shift):
+    """``convex_hole_bound`` returns None early where an edge is reflex beyond its tolerance.  On icospheres and
+    subdivided boxes (flat faces: any push inward or outward makes a reflex edge, of about the push) of
+    1e-3..1e6 m, one vertex pushed in or out by 1e-16..0.2 of the size (below the tolerance, round it and far past
+    it), a face gone: the result is the same with the shortcut and without it."""
+    import trimesh
+
+    from inertia_tool.mesh import hole_bounds
+
+    solid = trimesh.creation.box(extents=(1.0, 2.0, 1.5)).subdivide() if flat else \
+        trimesh.creation.icosphere(subdivisions=1)
+    v = np.asarray(solid.vertices, dtype=np.float64) * 10.0 ** scale
+    f = np.asarray(solid.faces, dtype=np.int64)
+    k = which % len(v)
+    v[k] *= 1.0 + (1 if outward else -1) * 10.0 ** push
+    v = v + shift
+    g = np.delete(f, gone % len(f), axis=0)
+    est = patched_estimate(v, g, volume_moments)
+    volume = float(abs(est.volume))
+    with_shortcut = hole_bounds.convex_hole_bound(est.vertices, est.faces[:len(g)], volume)
+    shortcut = hole_bounds._reflex_edge_excess
+    hole_bounds._reflex_edge_excess = lambda *args: float("-inf")
+    try:
+        without = hole_bounds.convex_hole_bound(est.vertices, est.faces[:len(g)], volume)
+    finally:
+        hole_bounds._reflex_edge_excess = shortcut
+    assert (with_shortcut is None) == (without is None)
+    if without is not None:
+        assert with_shortcut[0] == without[0] and np.array_equal(with_shortcut[1], without[1])
