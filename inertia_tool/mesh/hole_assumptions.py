@@ -19,7 +19,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Iterable
 
-__all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "BEND", "QUADRIC", "ALL", "stated",
+__all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "QUADRIC", "ALL", "stated",
            "named"]
 
 
@@ -60,12 +60,18 @@ BEND = HoleAssumption(
     "bend", "the missing surface is a graph over the rim's mean plane and slopes against that plane no more "
     "steeply than the steepest face touching the rim", "a feature taken whole whose walls are "
     "steeper than the faces round its rim (a boss or pocket on a flat or gently curved face)")
+INNER = HoleAssumption(
+    "inner", "a rim vertex whose faces left all lie in one flat face and turn round it by more than 180° lies inside "
+    "that face (as a fan-triangulated cap's centre does), not at a corner of a feature's footprint",
+    "a pocket or boss taken whole whose footprint kept one corner on the rim with more than 180° of the face round "
+    "it and neither rim neighbour of that corner another such (the file cannot tell it from a vertex inside a "
+    "flat face)")
 QUADRIC = HoleAssumption(
     "quadric", "(the fill, not the bound) the missing surface continues the quadric its surroundings lie on",
     "nothing: the bound stays that of the other assumptions named")
 
 #: Every assumption, in the order :func:`stated` prints them.
-ALL = (CONVEX, BALL, CAPSULE, FLAT, CREASE, BEND, QUADRIC)
+ALL = (CONVEX, INNER, BALL, CAPSULE, FLAT, CREASE, BEND, QUADRIC)
 
 
 def named(names: Iterable[str]) -> tuple[HoleAssumption, ...]:

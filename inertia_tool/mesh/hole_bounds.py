@@ -349,8 +349,8 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
 
 def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
                       n_loops: int, slabs: dict[str, np.ndarray], radius: np.ndarray, *,
-                      flat_rtol: float = FLAT_RIM_RTOL, flat_cosine: float = FLAT_VERTEX_COSINE
-                      ) -> np.ndarray:
+                      flat_rtol: float = FLAT_RIM_RTOL, flat_cosine: float = FLAT_VERTEX_COSINE,
+                      excused: np.ndarray | None = None) -> np.ndarray:
     """Loops whose flat slab the faces left at the rim contradict, (n_loops,) bool.
 
     Only rims that are flat (within ``flat_rtol`` of the ball's radius of their slab plane ``P``: a hole in a
@@ -372,6 +372,8 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
     ``P`` is the plane the whole rim lies in, not just that face's own.
 
     ``slabs`` is what :func:`hole_doubt_volumes` fills (``has``, ``normal``, ``origin``, ``half_width``).
+    ``excused`` (n,) bool, optional: rim vertices that do not count (the convex reading's vertices inside a flat
+    face, :func:`inner_face_vertices`).
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
@@ -397,7 +399,74 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
     corners = v[f[face]] - slabs["origin"][loop][:, None, :]
     off = np.abs(np.einsum("ijk,ik->ij", corners, slabs["normal"][loop])).max(axis=1)
     off_p = np.bincount(pair, weights=off > tol[loop], minlength=len(pairs)) > 0
+    if excused is not None:
+        off_p |= np.asarray(excused, dtype=bool)[pairs[:, 0]]
     out[pairs[~off_p, 1]] = True
+    return out
+
+
+#: A bare rim vertex is read as inside its flat face (:func:`inner_face_vertices`) when the faces left at it turn
+#: round it by more than π plus this margin, rad (about 0.6°: far above round-off and quantisation of the corner
+#: angles, far below a fan's missing wedge of one triangle on the coarsest cap the benchmarks hold, 7.5°).
+INNER_TURN_MARGIN = 0.01
+
+
+def inner_face_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, bare: np.ndarray, *,
+                        margin: float = INNER_TURN_MARGIN) -> np.ndarray:
+    """Bare rim vertices that the convex reading puts inside their flat face, (n,) bool.
+
+    A bare rim vertex ``x`` (:func:`bare_vertices`: every face left at it lies in one plane ``P``) is read two
+    ways.  On a surface with no vertex inside its flat faces (a CAD tessellation) ``x`` lay on a loop of its flat
+    face, where another surface met it (a feature's footprint), and the hole took that surface.  Under
+    :data:`~.hole_assumptions.CONVEX` (the part ``K`` is convex), ``F = K ∩ P`` is a convex face holding the faces
+    left at ``x``; when those faces turn round ``x`` by more than π, their directions at ``x`` span more than a
+    half-plane, so every direction in ``P`` is a positive combination of two of them, and ``F`` (convex) holds a
+    disc round ``x``: ``x`` is *inside* ``F``, the part's surface near ``x`` is ``F`` itself, and the hole there
+    is a piece of ``F`` (as on a cap triangulated as a fan, whose centre a hole takes a wedge from).  So, with
+    ``K`` convex, such a vertex cannot be a loop vertex of its face, and the two readings contradict each other:
+    **the file cannot tell a convex part with a vertex inside a flat face from a part with a pocket taken whole
+    whose footprint corner kept more than π of the face round it.**  The rule taken here: a bare vertex turning by
+    more than π is read as inside its face (the convex reading, named as ``convex``'s limit) *unless* one of its
+    two rim neighbours is such a vertex too (a run of them along the rim is a footprint's side, as a pocket taken
+    whole with the faces round it leaves: two corners of one footprint edge; a fan's centre has one).  A bare
+    vertex turning by π or less keeps withdrawing the convex bound (a corner of its face, where another face met
+    it: the footprint of a feature, or an edge of the part whose other face the hole took; the file cannot tell).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    edges : (k, 2) int
+        The boundary edges.
+    bare : (n,) bool
+        :func:`bare_vertices`.
+    margin : float
+        ``INNER_TURN_MARGIN``, rad.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    e = np.asarray(edges, dtype=np.int64)
+    n = len(v)
+    out = np.zeros(n, dtype=bool)
+    candidate = np.asarray(bare, dtype=bool)
+    if not candidate.any() or not len(f) or not len(e):
+        return out
+    at = np.flatnonzero(candidate[f].any(axis=1))
+    turn = np.zeros(n)
+    for k in range(3):              # the corner angle at corner k of each face at a bare vertex, summed per vertex
+        corner = f[at, k]
+        keep = candidate[corner]
+        p = v[corner[keep]]
+        a = v[f[at[keep], (k + 1) % 3]] - p
+        b = v[f[at[keep], (k + 2) % 3]] - p
+        angle = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+        turn += np.bincount(corner[keep], weights=angle, minlength=n)
+    wide = candidate & (turn > np.pi + margin)
+    # a wide vertex with a wide rim neighbour: a run along the rim (a footprint's side), not a face's inside
+    paired = np.zeros(n, dtype=bool)
+    both = wide[e[:, 0]] & wide[e[:, 1]]
+    paired[e[both].reshape(-1)] = True
+    out = wide & ~paired
     return out
 
 
@@ -566,6 +635,18 @@ def convex_hole_bound(vertices: np.ndarray, faces: np.ndarray, patched_volume: f
         return None
     unit = normal[keep] / size[keep, None]
     offset = np.einsum("ij,ij->i", unit, v[f[keep, 0]])
+    tol = CONVEX_ROUND_OFF * _round_off(v)
+    # a reflex edge already shows what remains is not convex: a face's vertex outside a neighbour's plane by more
+    # than the tolerance plus what rounding the planes to 12 decimals below can move it (5e-13 per coefficient,
+    # and a few ulp of the offset and of the products: 1e-12 + 8 ulp of the scale, times the 1-norm of a point
+    # plus one) puts some vertex outside that rounded plane by more than the tolerance, where the full check
+    # returns None too; so the result is the same, without the convex hull and the (planes × corners) test on a
+    # part that is plainly not convex (cover11: parts whose bare rim vertices no longer skip this bound spent
+    # ~0.5 s CPU here)
+    scale = float(np.abs(v[f]).max())
+    slack = (1e-12 + 8.0 * float(np.finfo(np.float64).eps) * max(scale, 1.0)) * (3.0 * scale + 1.0)
+    if _reflex_edge_excess(v, f[keep], unit, offset) > tol + slack:
+        return None
     planes = np.unique(np.round(np.column_stack([unit, offset]), 12), axis=0)
     used = np.unique(f)
     try:
@@ -575,7 +656,6 @@ def convex_hole_bound(vertices: np.ndarray, faces: np.ndarray, patched_volume: f
     corners = v[used][hull.vertices]
     if len(planes) * len(corners) > CONVEX_WORK_LIMIT:
         return None
-    tol = CONVEX_ROUND_OFF * _round_off(v)
     excess = np.full(len(planes), -np.inf)
     for lo in range(0, len(corners), 4096):
         chunk = corners[lo:lo + 4096]
@@ -602,6 +682,24 @@ def convex_hole_bound(vertices: np.ndarray, faces: np.ndarray, patched_volume: f
     if not volume >= patched_volume * (1 - 1e-9):
         return None
     return round_up(max(volume - patched_volume, 0.0) + 1e-12 * volume), points
+
+
+def _reflex_edge_excess(v: np.ndarray, f: np.ndarray, unit: np.ndarray, offset: np.ndarray) -> float:
+    """The farthest any face's vertex lies outside the plane of a face sharing an edge with it, m (−inf where no
+    two faces share an edge): a lower bound of the excess :func:`convex_hole_bound` measures over every vertex and
+    plane, at O(faces).  ``f`` (m, 3) the faces of nonzero area, ``unit`` and ``offset`` their planes."""
+    key, _ = edge_keys(f, len(v))
+    order = np.argsort(key, kind="stable")
+    ranked = key[order]
+    same = np.flatnonzero(ranked[1:] == ranked[:-1])
+    if not len(same):
+        return float("-inf")
+    a, b = order[same] // 3, order[same + 1] // 3
+    worst = float("-inf")
+    for x, y in ((a, b), (b, a)):         # each face's corners against the other face's plane
+        excess = np.einsum("ijk,ik->ij", v[f[y]], unit[x]).max(axis=1) - offset[x]
+        worst = max(worst, float(excess.max()))
+    return worst
 
 
 #: Most (rim vertex, plane it lies on) pairs :func:`_plane_unattested_at_rim` examines (beyond: no convex bound).

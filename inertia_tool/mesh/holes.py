@@ -49,7 +49,8 @@ from .hole_bounds import (CONVEX_ROUND_OFF as CONVEX_ROUND_OFF, CONVEX_WORK_LIMI
                           _alone, _contradicted, _engulfing, _flat_off_rim_nearby as _flat_off_rim_nearby,
                           bend_doubt_volumes,
                           _round_off as _round_off, _vertex_flatness as _vertex_flatness, ball_slab_volume,
-                          bare_vertices, convex_hole_bound, hole_doubt_volumes, rim_evidence, slab_contradicted)
+                          bare_vertices, convex_hole_bound, hole_doubt_volumes, inner_face_vertices,
+                          rim_evidence, slab_contradicted)
 from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES as CREASE_MAX_PLANES,
                          CREASE_SCREEN_PAIRS as CREASE_SCREEN_PAIRS, CURVED_FILL_LEVELS as CURVED_FILL_LEVELS,
                          CURVED_MAX_LOOPS as CURVED_MAX_LOOPS, QUADRIC_FIT_RTOL as QUADRIC_FIT_RTOL, CreaseFill,
@@ -121,11 +122,19 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # near that face's plane; a flat rim whose faces say the missing surface leaves its plane
         # (slab_contradicted): the slab is withdrawn, the ball (first assumption) bounds the hole
         withdrawn = evidence.bare > 0
+        # the convex reading's own evidence: a bare vertex that the faces left turn round by more than π is, if
+        # the part is convex, inside its flat face (inner_face_vertices), so it does not take the convex bound away
+        inner = inner_face_vertices(v, f, edges, bare)
+        against_convex = np.bincount(label, weights=(bare & ~inner)[edges[:, 0]], minlength=n_loops) > 0
         if slabs:
             withdrawn |= slab_contradicted(v, f, edges, label, n_loops, slabs, radius)
+            against_convex |= slab_contradicted(v, f, edges, label, n_loops, slabs, radius, excused=inner)
         engulfed = _engulfing(v, f, centre, radius)
         withdrawn |= engulfed
-        taken = bool(withdrawn.any())      # a feature may have gone with a hole: no convex bound either
+        against_convex |= engulfed
+        # a feature may have gone with a hole: no convex bound either
+        taken = bool(against_convex.any())
+        inside_face = int(np.count_nonzero(inner)) if not taken else 0
         hole_doubt[withdrawn] = 4.0 / 3.0 * np.pi * radius[withdrawn] ** 3
         creases = crease_fills(v, f, edges, label, n_loops, centre, radius, bare=bare)
         unbounded = _contradicted(evidence, radius, size)
@@ -134,6 +143,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         engulfed = np.zeros(0, dtype=bool)
         unbounded = ""
         taken = False
+        inside_face = 0
     cone_doubt = hole_doubt.copy()
     curved: list[CurvedFill] = []
 
@@ -274,6 +284,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             far = float(np.max(np.linalg.norm(corners - closed.centroid, axis=1)))
             convex = True
             used = {"convex"}
+            used |= {"inner"} if inside_face else set()
     sealed = ""
     if seal is not None and (seal.welded or seal.split):
         doubt += seal.doubt(v)
@@ -294,6 +305,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         if convex:
             detail += ("; what remains is convex, so the part is taken to be convex too and the holes bounded "
                        "instead by the polytope its faces' planes enclose")
+            if inside_face:
+                detail += (f" ({inside_face} rim vertex{'es' if inside_face != 1 else ''} with only one flat face "
+                           f"left round {'them' if inside_face != 1 else 'it'}, turning by more than 180°, read as "
+                           "inside that face)")
         if creases:
             detail += (f"; {len(creases)} of them across a crease, filled instead in the two planes that hold "
                        "the rim and bounded by the ball cut to both planes' slabs")
