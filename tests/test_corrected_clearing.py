@@ -49,3 +49,31 @@ def test_a_dense_sampling_comes_within_its_spacing():
     above = grid_estimate._distance_above(points, vertices, faces, 0.01)
     assert np.all(above >= points[:, 2])
     assert np.all(above - points[:, 2] < 0.0072)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), cells=st.integers(4, 24), scale=st.sampled_from([1e-3, 1.0, 1e3]),
+       offset=st.sampled_from([0.0, 1e4, -3e6]), needles=st.booleans())
+def test_cells_two_apart_from_the_marked_ones_are_a_cell_and_a_half_away(seed, cells, scale, offset, needles):
+    # the step of corrected_estimate that clears a centre without measuring its distance to the bad faces rests on
+    # this: _surface_cells marks every cell a face meets, so a centre whose 3x3x3 block of cells holds no marked
+    # cell is at least 1.5 cells from every face
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    n_faces = int(rng.integers(1, 12))
+    vertices = rng.uniform(-1, 1, size=(3 * n_faces, 3))
+    if needles:
+        vertices[2::3] = vertices[0::3] + rng.normal(scale=1e-7, size=(n_faces, 3))
+    vertices = vertices * scale + offset
+    faces = np.arange(3 * n_faces).reshape(-1, 3)
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    h = float(np.max(hi - lo)) / cells
+    lo = lo - 3 * h
+    dims = tuple(int(x) for x in np.ceil((hi + 3 * h - lo) / h).astype(np.int64))
+    marked = grid_estimate._surface_cells(vertices, faces, lo, h, dims).reshape(dims)
+    apart = np.flatnonzero(~ndimage.maximum_filter(marked, size=3, mode="constant", cval=False).reshape(-1))
+    centres = lo + h * (np.stack(np.unravel_index(apart, dims), axis=1) + 0.5)
+    exact = _exact(centres, vertices, faces)
+    slack = 1e-9 * float(np.linalg.norm(hi - lo)) + 1e-6 * h
+    assert np.all(exact >= 1.5 * h - slack)
