@@ -3554,6 +3554,7 @@ static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /
 static PyObject *accel_close_groups(PyObject *self, PyObject *args);    /* section 9b, after the module */
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
 static PyObject *accel_label_cells(PyObject *self, PyObject *args);     /* section 11, after the module */
+static PyObject *accel_certain_parts(PyObject *self, PyObject *args);  /* section 12, after the module */
 
 static PyObject *
 accel_release_buffers(PyObject *self, PyObject *unused)
@@ -3659,6 +3660,11 @@ static PyMethodDef accel_methods[] = {
      "bytes of `mask` (the flat grid dims, C order) 1..count in the order of their first cells, into `out` "
      "((cells,) int32; 0 off the mask), as scipy.ndimage.label with its default structure; `first` and `sizes` "
      "(bytes of int64) are each region's first cell and cell count (grid_estimate._label_regions); section 11."},
+    {"certain_parts", accel_certain_parts, METH_VARARGS,
+     "certain_parts(centres, margins, closest, gap, sub, rho, limit, reach, core, empty)\n\nFor each cell and "
+     "sub-cell, whether a sample's Lipschitz test puts it wholly in the core (`core`, bytes (k, s)) or a "
+     "Lipschitz or closest-point test wholly outside it (`empty`, not where `core` is); "
+     "offset._certain_parts; section 12."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -9189,6 +9195,101 @@ done:
     free(parent);
     free(made);
     free(sizes);
+    for (int i = 0; i < got; i++) {
+        PyBuffer_Release(&views[i]);
+    }
+    return result;
+}
+
+/* ======================================================================================================
+ * 12. certain_parts -- the sub-cells of band cells certainly in or out of a solid's core (mass/offset.py)
+ *
+ * The twin of offset._certain_parts's loop over the samples.  Cell i (centre c_i) has samples j with margins
+ * m_ij = d(x_j) - t and closest surface points q_ij; sub-cell s has centre c_i + sub_s and gap[s, j] =
+ * |c_i + sub_s - x_j| (the same for every cell).  Sub-cell s is in the core when m_ij - gap[s, j] >= rho for
+ * some j; outside it when -m_ij - gap[s, j] >= rho for some j, or (`reach` nonzero, i.e. t > rho) when
+ * |c_i + sub_s - q_ij|^2 <= limit = (t - rho)^2, evaluated as numpy does ((|a|^2 + 2 a.sub_s) + |sub_s|^2 with
+ * a = c_i - q_ij).  `empty` is set only where `core` is not.  The expressions are numpy's but the sums may round
+ * differently from its matrix product: only a sub-cell whose test lands within an ulp or two of its threshold can
+ * be decided otherwise (either decision is sound to that round-off).
+ * ====================================================================================================== */
+
+static PyObject *
+accel_certain_parts(PyObject *self, PyObject *args)
+{
+    PyObject *objs[7];
+    double rho, limit;
+    int reach;
+    if (!PyArg_ParseTuple(args, "OOOOOddpOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &rho, &limit,
+                          &reach, &objs[5], &objs[6])) {
+        return NULL;
+    }
+    Py_buffer views[7];
+    int got = 0;
+    PyObject *result = NULL;
+    for (int i = 0; i < 7; i++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (i >= 5 ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[i], &views[i], flags) < 0) {
+            goto done;
+        }
+        got++;
+    }
+    for (int i = 0; i < 5; i++) {
+        if (native_code(views[i].format) != 'd' || views[i].itemsize != 8) {
+            PyErr_SetString(PyExc_ValueError, "Expected centres, margins, closest, gap and sub as C-contiguous "
+                            "float64 arrays");
+            goto done;
+        }
+    }
+    {
+        const Py_ssize_t k = views[0].len / (3 * 8);
+        const Py_ssize_t ns = views[4].len / (3 * 8);
+        const Py_ssize_t nj = ns > 0 ? views[3].len / (8 * ns) : 0;
+        if (views[0].len != k * 3 * 8 || views[4].len != ns * 3 * 8 || ns < 1 || nj < 1
+            || views[3].len != ns * nj * 8 || views[1].len != k * nj * 8 || views[2].len != k * nj * 3 * 8
+            || views[5].itemsize != 1 || views[6].itemsize != 1 || views[5].len != k * ns || views[6].len != k * ns) {
+            PyErr_SetString(PyExc_ValueError, "Expected centres (k, 3), margins (k, j), closest (k, j, 3), gap (s, j), "
+                            "sub (s, 3) and core, empty as writable byte arrays of k * s");
+            goto done;
+        }
+        const double *centres = (const double *)views[0].buf, *margins = (const double *)views[1].buf;
+        const double *closest = (const double *)views[2].buf, *gap = (const double *)views[3].buf;
+        const double *sub = (const double *)views[4].buf;
+        uint8_t *core = (uint8_t *)views[5].buf, *empty = (uint8_t *)views[6].buf;
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t i = 0; i < k; i++) {
+            const double *c = centres + 3 * i, *m = margins + nj * i, *q = closest + 3 * nj * i;
+            for (Py_ssize_t s = 0; s < ns; s++) {
+                const double *y = sub + 3 * s, *g = gap + nj * s;
+                const double y2 = y[0] * y[0] + y[1] * y[1] + y[2] * y[2];
+                int in = 0, out = 0;
+                for (Py_ssize_t j = 0; j < nj && !in; j++) {
+                    const double mj = m[j];
+                    if (mj - g[j] >= rho) {
+                        in = 1;
+                        break;
+                    }
+                    if (!out && -mj - g[j] >= rho) {
+                        out = 1;
+                    }
+                    if (!out && reach) {
+                        const double a0 = c[0] - q[3 * j], a1 = c[1] - q[3 * j + 1], a2 = c[2] - q[3 * j + 2];
+                        const double r2 = ((a0 * a0 + a1 * a1 + a2 * a2) + 2.0 * (a0 * y[0] + a1 * y[1] + a2 * y[2]))
+                                          + y2;
+                        if (r2 <= limit) {
+                            out = 1;
+                        }
+                    }
+                }
+                core[ns * i + s] = (uint8_t)in;
+                empty[ns * i + s] = (uint8_t)(out && !in);
+            }
+        }
+        Py_END_ALLOW_THREADS
+    }
+    result = Py_None;
+    Py_INCREF(result);
+done:
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
     }

@@ -4,10 +4,13 @@ points; the kernel loops over the samples for speed (a 12-face box's core 8.2 ->
 sub-cell the same way."""
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from inertia_tool.mass import offset
+
+pytestmark = pytest.mark.usefixtures("engine_path")   # the C kernel (_accel.c section 12) and the numpy loop
 
 
 def _direct(centres, size, depth, margins, closest):

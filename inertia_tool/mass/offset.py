@@ -160,6 +160,16 @@ def _certain_parts(centres: np.ndarray, size: float, depth: float, points: np.nd
     core = np.zeros((len(centres), _SUB ** 3), dtype=bool)
     empty = np.zeros_like(core)
     limit = max(depth - rho, 0.0) ** 2
+    from .._native import accel
+    lib = accel()
+    if lib is not None:
+        # the same tests in C (_accel.c section 12), a sub-cell at a time with an early exit once it is in the core
+        lib.certain_parts(np.ascontiguousarray(centres, dtype=np.float64),
+                          np.ascontiguousarray(margins, dtype=np.float64),
+                          np.ascontiguousarray(closest, dtype=np.float64), np.ascontiguousarray(gap),
+                          np.ascontiguousarray(sub), float(rho), float(limit), bool(depth > rho),
+                          core.view(np.uint8), empty.view(np.uint8))
+        return core, empty
     step = 4096
     sub_norm2 = np.einsum("sx,sx->s", sub, sub)[None, :]
     # one sample at a time: (k, 64) arrays, and the cross term a matrix product (the (k, 64, 9) arrays and
