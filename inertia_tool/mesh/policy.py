@@ -109,7 +109,11 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    depth from it like any nested shell, whether the contact is exactly coplanar or coplanar only to rounding
    after a rotation: a cavity flush with its body's face is a cavity (cut from the body by the boolean, certified
    ``united``), an outward-wound one included.  One rule covers a shell strictly inside another and one
-   touching the other's boundary from inside: *the role is the depth of the closed solid*.  A shell the file
+   touching the other's boundary from inside: *the role is the depth of the closed solid*.  Two shells wound
+   alike, each holding all but ``2·TOUCH_VOLUME_RTOL`` of the other's volume, are copies, not a body and its
+   cavity, whether their surfaces cross (:func:`within_up_to_rounding`) or one lies inside the other without
+   crossing or touching it (:func:`nested_copies`: a copy scaled by 1 + k ulp, review 10's D2); they go to the
+   boolean, whose union is the solid.  A shell the file
    winds outward that depth makes a cavity (:func:`misread_nesting`) is a reading the file does not decide: its
    own winding number is 2 there, so ``{w ≥ 1}`` is the union of the bodies, and a cavity written with the wrong
    winding reads the same.  The parity reading is kept, a warning names the other one and its volume, and the
@@ -188,7 +192,7 @@ if TYPE_CHECKING:
     from .nesting import Nesting
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
-           "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
+           "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding", "nested_copies",
            "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
            "near_copies", "NearCopies", "near_copies_message", "MisreadNesting", "misread_nesting",
@@ -523,11 +527,48 @@ def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.nda
         # to 2·rtol (vol(B \ A) ≤ |B| − (1 − rtol)|A|); one just inside the tolerance and the other just outside it
         # is rounding, not nesting (review9: a part and its copy turned 2e-9 rad, ~950 km out, 9.85e-10 and
         # 1.004e-9 of their volumes unshared, read as a body and its cavity)
-        alike = np.sign(signed[p[:, 0]]) == np.sign(signed[p[:, 1]])
-        copies = alike & (c >= (1 - 2 * rtol) * size[p[:, 0]]) & (c >= (1 - 2 * rtol) * size[p[:, 1]])
+        copies = _copies(signed, p, c, rtol)
     one = (a_in_b ^ b_in_a) & ~copies
     within = np.where(a_in_b[one, None], p[one], p[one][:, ::-1])
     return within.reshape(-1, 2), p[~one]
+
+
+def _copies(signed: np.ndarray, pairs: np.ndarray, common: np.ndarray, rtol: float) -> np.ndarray:
+    """(k,) bool: R4's copy rule: the two shells of a pair are wound alike and each shares all but ``2·rtol`` of
+    its volume with the other (``common``: their common volume; NaN: not copies)."""
+    size = np.abs(signed)
+    alike = np.sign(signed[pairs[:, 0]]) == np.sign(signed[pairs[:, 1]])
+    with np.errstate(invalid="ignore"):
+        return np.asarray(alike & (common >= (1 - 2 * rtol) * size[pairs[:, 0]])
+                          & (common >= (1 - 2 * rtol) * size[pairs[:, 1]]))
+
+
+def nested_copies(volumes: np.ndarray, nested: np.ndarray, *, rtol: float = TOUCH_VOLUME_RTOL) -> np.ndarray:
+    """R4: which ``(shell, container)`` pairs of shells nested without crossing are copies, not a body and its
+    cavity.
+
+    A shell lying inside another whose surface it does not cross shares all of its solid with it:
+    ``vol(A ∩ B) = |vol A|``.  The copy rule of :func:`within_up_to_rounding` (two shells wound alike, each within
+    ``2·rtol`` of the other) then reads ``|vol A| ≥ (1 − 2·rtol)·|vol B|``: a copy scaled by rounding (1 + k ulp
+    about a point inside it) that came out just inside its original without touching it.  Depth would make it a
+    cavity, a wall thinner than the coordinates' rounding (review 10, D2: 3e-14 m³ for 0.457 m³); read as
+    copies, the pair goes to the boolean like crossing copies, whose union (the solid where the winding number is
+    at least one: the outer shell's) is the answer.
+
+    Parameters
+    ----------
+    volumes : (s,) float
+        Signed shell volumes as wound in the file.
+    nested : (k, 2) int
+        ``(shell, container)`` pairs: ``shell`` inside ``container``, the surfaces crossing nowhere.
+
+    Returns
+    -------
+    (k,) bool
+    """
+    p = np.asarray(nested, dtype=np.int64).reshape(-1, 2)
+    signed = np.asarray(volumes, dtype=np.float64)
+    return _copies(signed, p, np.abs(signed[p[:, 0]]), rtol)
 
 
 def _groups(n: int, pairs: np.ndarray) -> np.ndarray:

@@ -1,0 +1,75 @@
+"""R4's copy rule on nested shells (``mesh/policy.py``: ``nested_copies``; review 10's D2).
+
+A part listed twice, the copy scaled by 1 + k ulp about a point inside it (as an exporter's transform may leave
+it), lies inside its original without crossing it.  Nesting depth alone would make it a cavity: a wall thinner than
+the coordinates' rounding, ~1e-14 of the part's volume (review 10: 23 of 240 near copies off by ~100 %,
+``unverified``).  Two shells wound alike, one inside the other, each holding all but ``2·TOUCH_VOLUME_RTOL`` of the
+other's volume, are copies: their union (the solid where the winding number is at least one) is the answer.
+
+The truth here is the union of the two pieces formed by manifold3d in float64 (``adversary_solids``, code apart
+from the pipeline's).  Pieces: boxes, icospheres, cylinders and tori, axis-aligned or turned at random, sizes 1e-3
+to 1e3 m, at the origin or moved up to ten sizes, the copy scaled by 1 + k ulp (k 2..400) about the piece's centroid
+(inside it for the convex pieces; in the hole of a torus, where the copy crosses its original), sometimes also
+turned 1e-15..1e-12 rad, listed first or second.  An answer must be the union (or a refusal), whatever its label.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from adversary_solids import box, cylinder, icosphere, torus, truth_from_manifold
+from inertia_tool.errors import InvalidMeshError
+from inertia_tool.mass.pipeline import mass_properties
+from inertia_tool.mesh.policy import nested_copies
+from inertia_tool.tolerances import TOUCH_VOLUME_RTOL
+
+
+def _near_copy(seed):
+    rng = np.random.default_rng(seed)
+    kind = int(rng.integers(4))
+    v, f = (box((1.0, 2.0, 3.0)), icosphere(0.5, 1), cylinder(0.4, 1.0, 12), torus(0.6, 0.2, 12, 6))[kind]
+    v, f = np.asarray(v, dtype=np.float64) * 10.0 ** rng.uniform(-3, 3), np.asarray(f, dtype=np.int64)
+    if rng.random() < 0.5:
+        v = v @ Rotation.random(random_state=int(rng.integers(2 ** 31))).as_matrix().T
+    if rng.random() < 0.6:
+        v = v + rng.normal(size=3) * np.ptp(v, axis=0).max() * rng.uniform(0, 10)
+    centre = v.mean(axis=0)
+    copy = centre + (v - centre) * (1 + int(rng.integers(2, 401)) * 2.0 ** -52)
+    if rng.random() < 0.3:
+        axis = rng.normal(size=3)
+        turn = Rotation.from_rotvec(axis / np.linalg.norm(axis) * 10.0 ** rng.uniform(-15, -12)).as_matrix()
+        copy = centre + (copy - centre) @ turn.T
+    pieces = [(v, f), (copy, f)]
+    if rng.random() < 0.5:
+        pieces.reverse()
+    return pieces
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2 ** 31 - 1))
+def test_a_near_copy_nested_or_crossing_gives_the_union(seed):
+    pieces = _near_copy(seed)
+    truth = truth_from_manifold(pieces).volume
+    (a, fa), (b, fb) = pieces
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            props = mass_properties((np.vstack([a, b]), np.vstack([fa, fb + len(a)])), density=1.0)
+        except InvalidMeshError:
+            return                                               # a refusal is honest
+    assert props.mass == pytest.approx(truth, rel=1e-9), (seed, props.mesh.certificate, props.mesh.notes)
+
+
+def test_the_copy_rule_on_nested_pairs():
+    """Wound alike and within 2·rtol of each other both ways: copies; a cavity (wound the other way), a shell
+    smaller by more than 2·rtol, or a pair wound inward and outward, is not."""
+    r = TOUCH_VOLUME_RTOL
+    volumes = np.array([1.0, 1.0 - 1.5 * r, 1.0 - 2.5 * r, -(1.0 - 1.5 * r), -1.0, -(1.0 - r)])
+    pairs = np.array([[1, 0], [2, 0], [3, 0], [5, 4], [0, 1]])
+    assert nested_copies(volumes, pairs).tolist() == [True, False, False, True, True]
