@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 from adversary_solids import box, cylinder, icosphere, torus, truth_from_manifold
 from inertia_tool.errors import InvalidMeshError
 from inertia_tool.mass.pipeline import mass_properties
-from inertia_tool.mesh.policy import nested_copies
+from inertia_tool.mesh.policy import MisreadNesting, misread_message, nested_copies
 from inertia_tool.tolerances import TOUCH_VOLUME_RTOL
 
 
@@ -73,3 +73,18 @@ def test_the_copy_rule_on_nested_pairs():
     volumes = np.array([1.0, 1.0 - 1.5 * r, 1.0 - 2.5 * r, -(1.0 - 1.5 * r), -1.0, -(1.0 - r)])
     pairs = np.array([[1, 0], [2, 0], [3, 0], [5, 4], [0, 1]])
     assert nested_copies(volumes, pairs).tolist() == [True, False, False, True, True]
+
+
+def test_the_other_reading_of_an_unverified_result_is_no_total_made_from_it():
+    """Review 10 (seed 121 case 138): where the result is not known to be the parity solid (the boolean left it
+    ``unverified``), R4's note said "the union of the bodies: 5.36e8 m³", the result (two copies summed) plus the
+    shell's volume, for a union of 1.787e8.  The other reading is now stated against the parity solid."""
+    found = MisreadNesting(shells=np.array([1]), volume=1.787e8, nested=False)
+    note = misread_message(found, None, proven=False, kept="")
+    assert "1.787e+08 m³ more than the parity solid" in note
+    assert "% more mass" not in note and "5.36" not in note
+    nested = MisreadNesting(shells=np.array([1]), volume=2.0, nested=True)
+    assert "at most 2.01 m³ more than the parity solid" in misread_message(nested, None, proven=False, kept="")
+    # a result that is the parity solid (proven, or an estimate spanning both readings) keeps its computed total
+    assert "8 m³, 33.3 % more mass" in misread_message(MisreadNesting(shells=np.array([1]), volume=2.0,
+                                                                      nested=False), 6.0, proven=True)

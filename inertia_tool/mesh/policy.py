@@ -802,9 +802,14 @@ def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: n
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=True, kept="union")
 
 
-def misread_message(found: MisreadNesting, parity_volume: float, proven: bool, kept: str | None = None) -> str:
+def misread_message(found: MisreadNesting, parity_volume: float | None, proven: bool, kept: str | None = None) -> str:
     """R4's note for :class:`MisreadNesting`: the reading kept, the other one and its volume (``kept``: what is
-    proven of the reading kept, when not the default sentence for ``proven``; "" for nothing)."""
+    proven of the reading kept, when not the default sentence for ``proven``; "" for nothing).
+
+    ``parity_volume``: m³, the parity solid's volume, when the result given is that solid; None when it is not
+    known to be (a result the boolean left ``unverified``): the other reading is then stated against the parity
+    solid, never as a total computed from a result that may be another solid (review 10: "the union of the
+    bodies: 5.36e8 m³" for a union of 1.787e8, the result being the two copies summed)."""
     n = len(found.shells)
     them = "them" if n > 1 else "it"
     if found.kept == "union":
@@ -814,8 +819,12 @@ def misread_message(found: MisreadNesting, parity_volume: float, proven: bool, k
                 "m³ less material. The file does not decide: an estimate whose bounds span both readings. If they "
                 "are bodies, unite them with the body around them in the model; if a cavity, keep one copy wound "
                 "inward")
-    other = (f"at most {round_up(found.volume):.6g} m³ more" if found.nested else
-             f"{parity_volume + found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % more mass")
+    if parity_volume is None:
+        other = (f"at most {round_up(found.volume):.6g} m³ more than the parity solid" if found.nested else
+                 f"{found.volume:.6g} m³ more than the parity solid")
+    else:
+        other = (f"at most {round_up(found.volume):.6g} m³ more" if found.nested else
+                 f"{parity_volume + found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % more mass")
     if kept is None:
         kept = ("the parity solid is proven (exact)" if proven else
                 "the parity solid is not proven apart from that reading (its faces meet the body's only to "
