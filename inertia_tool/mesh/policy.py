@@ -490,7 +490,8 @@ def touching_relations(pairs: np.ndarray, inside: np.ndarray, outside: np.ndarra
 
 
 def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.ndarray, *,
-                          rtol: float = TOUCH_VOLUME_RTOL) -> tuple[np.ndarray, np.ndarray]:
+                          rtol: float = TOUCH_VOLUME_RTOL,
+                          rounding: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """R4: which pairs of crossing shells are one inside the other up to rounding.
 
     Shell ``a`` lies within ``b`` when all but ``rtol`` of its solid (wound outward) is shared with ``b``'s:
@@ -508,6 +509,8 @@ def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.nda
         Crossing pairs.
     common : (k,) float
         ``vol(A ∩ B)`` of each pair (:func:`~.union.common_volumes`; NaN when unknown: the pair stays crossing).
+    rounding : (s,) float or None
+        m³, each shell's rounding neighbourhood (:func:`nested_copies`): copies also when each shares all but it.
 
     Returns
     -------
@@ -527,23 +530,28 @@ def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.nda
         # to 2·rtol (vol(B \ A) ≤ |B| − (1 − rtol)|A|); one just inside the tolerance and the other just outside it
         # is rounding, not nesting (review9: a part and its copy turned 2e-9 rad, ~950 km out, 9.85e-10 and
         # 1.004e-9 of their volumes unshared, read as a body and its cavity)
-        copies = _copies(signed, p, c, rtol)
+        copies = _copies(signed, p, c, rtol, rounding)
     one = (a_in_b ^ b_in_a) & ~copies
     within = np.where(a_in_b[one, None], p[one], p[one][:, ::-1])
     return within.reshape(-1, 2), p[~one]
 
 
-def _copies(signed: np.ndarray, pairs: np.ndarray, common: np.ndarray, rtol: float) -> np.ndarray:
+def _copies(signed: np.ndarray, pairs: np.ndarray, common: np.ndarray, rtol: float,
+            rounding: np.ndarray | None = None) -> np.ndarray:
     """(k,) bool: R4's copy rule: the two shells of a pair are wound alike and each shares all but ``2·rtol`` of
-    its volume with the other (``common``: their common volume; NaN: not copies)."""
+    its volume (or all but its rounding neighbourhood, ``rounding``: (s,) m³) with the other (``common``: their
+    common volume; NaN: not copies)."""
     size = np.abs(signed)
+    slack = np.zeros_like(size) if rounding is None else np.asarray(rounding, dtype=np.float64)
     alike = np.sign(signed[pairs[:, 0]]) == np.sign(signed[pairs[:, 1]])
     with np.errstate(invalid="ignore"):
-        return np.asarray(alike & (common >= (1 - 2 * rtol) * size[pairs[:, 0]])
-                          & (common >= (1 - 2 * rtol) * size[pairs[:, 1]]))
+        a, b = pairs[:, 0], pairs[:, 1]
+        return np.asarray(alike & (common >= np.minimum((1 - 2 * rtol) * size[a], size[a] - slack[a]))
+                          & (common >= np.minimum((1 - 2 * rtol) * size[b], size[b] - slack[b])))
 
 
-def nested_copies(volumes: np.ndarray, nested: np.ndarray, *, rtol: float = TOUCH_VOLUME_RTOL) -> np.ndarray:
+def nested_copies(volumes: np.ndarray, nested: np.ndarray, *, rtol: float = TOUCH_VOLUME_RTOL,
+                  rounding: np.ndarray | None = None) -> np.ndarray:
     """R4: which ``(shell, container)`` pairs of shells nested without crossing are copies, not a body and its
     cavity.
 
@@ -555,12 +563,23 @@ def nested_copies(volumes: np.ndarray, nested: np.ndarray, *, rtol: float = TOUC
     copies, the pair goes to the boolean like crossing copies, whose union (the solid where the winding number is
     at least one: the outer shell's) is the answer.
 
+    *Up to the coordinates' rounding*: far from the origin a part's size can be a few thousand units in the last
+    place of its coordinates, and a copy shifted or turned by less than that nests by rounding with a volume
+    apart by more than ``2·rtol`` (``bench_review9_convex``: a 0.6 mm box 2.5e4 m out and its copy shifted by
+    8e-10 of its size, 5.7e-9 of the volume apart).  The space between two nested surfaces (the parity solid) is
+    then no thicker on average than the rounding: when its volume ``|vol B| − |vol A|`` is at most ``rounding``
+    of each (``2·δ·area``, the δ-neighbourhood of its surface to first order, δ = R0's ``COINCIDENT_RTOL`` times
+    the largest |coordinate|), that solid is a wall the coordinates cannot tell from none, and the pair is read
+    as copies too (crossing pairs likewise, :func:`within_up_to_rounding`).
+
     Parameters
     ----------
     volumes : (s,) float
         Signed shell volumes as wound in the file.
     nested : (k, 2) int
         ``(shell, container)`` pairs: ``shell`` inside ``container``, the surfaces crossing nowhere.
+    rounding : (s,) float or None
+        m³, the volume of each shell's rounding neighbourhood (``2·δ·area``); None: 0.
 
     Returns
     -------
@@ -568,7 +587,7 @@ def nested_copies(volumes: np.ndarray, nested: np.ndarray, *, rtol: float = TOUC
     """
     p = np.asarray(nested, dtype=np.int64).reshape(-1, 2)
     signed = np.asarray(volumes, dtype=np.float64)
-    return _copies(signed, p, np.abs(signed[p[:, 0]]), rtol)
+    return _copies(signed, p, np.abs(signed[p[:, 0]]), rtol, rounding)
 
 
 def _groups(n: int, pairs: np.ndarray) -> np.ndarray:
