@@ -17,7 +17,8 @@ overlap 1e-9..1e-4 thick; a copy with every coordinate nudged by a few ulps (nea
 three pieces.  Each case is also placed far from the origin (1e3..1e7 sizes) or scaled to millimetres at random.
 Far placements round the pieces' corners (by ``delta``); the truth is the union of the unrounded pieces, and
 the two differ within the ``delta``-neighbourhood of the surfaces, whose volume (Steiner) is added to every
-tolerance (so a far case fails only beyond what the rounding of its input allows).
+tolerance (so a far case fails only beyond what the rounding of its input allows).  An ``exact`` answer is
+held to ``tolerances.ROUNDOFF_RTOL`` (R7's round-off claim; other labels to 1e-9).
 
 Run: ``python benchmarks/bench_review9_convex.py --cases 2000 --seed 901 [--repair]``.
 """
@@ -37,6 +38,7 @@ from scipy.spatial import ConvexHull, HalfspaceIntersection
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 import adversary_solids as S  # noqa: E402
+from inertia_tool.tolerances import ROUNDOFF_RTOL  # noqa: E402
 
 MODES = ("random", "tiny_turn", "ulp_shift", "tiny_shift", "slab", "nudged_copy", "three", "hollow_pair",
          "hollow_turn")
@@ -264,7 +266,10 @@ def judged(case, truth, bound_rel, repair):
         ok = u is not None and dvol <= u.mass + 1e-9 + bound_rel and \
             dcom <= u.center_of_mass + (1e-9 + 2 * bound_rel) * diag and din <= u.inertia + 1e-9 + 4 * bound_rel
         return S.Verdict(label, wrong=None if ok else "outside its bounds: " + numbers)
-    if dvol > 1e-9 + bound_rel or dcom > (1e-9 + 2 * bound_rel) * diag or din > 1e-8 + 4 * bound_rel:
+    # "exact" claims the polyhedron's integrals to within R7's round-off bound (at most ROUNDOFF_RTOL of the
+    # result): judged at that, not at the boolean's 1e-9 (an exact answer 5e-10 off would have passed)
+    rtol = ROUNDOFF_RTOL if label == "exact" else 1e-9
+    if dvol > rtol + bound_rel or dcom > (rtol + 2 * bound_rel) * diag or din > 10 * rtol + 4 * bound_rel:
         return S.Verdict(label, wrong=numbers)
     return S.Verdict(label, message=numbers)
 

@@ -213,27 +213,19 @@ def test_fast_path_agrees_on_barely_clean_parts(seed):
 
 
 # ---------------------------------------------------------------------------------------------- defects
-@pytest.mark.xfail(strict=True, raises=InvalidMeshError, reason=(
-    "D1 (review 10): the extent of the flatness rule (R2, FLAT_RTOL · diagonal³) and of the units heuristic is "
-    "the bounding box of every vertex, used or not, so one vertex no face uses 1e5 m from a 1 × 2 × 3 m box "
-    "makes it 'enclose no volume (flat or collapsed surface)'; not a silent wrong answer, a false refusal. The "
-    "fix (the extent of the vertices faces use, or dropping unused vertices when reading) touches the reader "
-    "or close_surface and clean_part together, and the memory peaks tuned at 1e7 faces: not small and local"))
 def test_a_stray_vertex_no_face_uses_does_not_make_a_solid_flat():
+    """D1 (review 10, fixed): the reader leaves out vertices no face uses (``read._used_vertices``), so R2's extent
+    is the surface's; before, one unused vertex 1e5 m from a 1 × 2 × 3 m box made it "enclose no volume"."""
     v, f = box((1.0, 2.0, 3.0))
     v = np.vstack([v, [[1e5, 0.0, 0.0]]])
     props = mass_properties(load_mesh((v, f)), density=1.0)
     assert props.mass == pytest.approx(6.0, rel=1e-12)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "D2 (review 10): a surface listed twice, the copy scaled by 1 + 100 ulp about the origin (every corner within "
-    "2.3e-14 of its size of its match: beyond R0's 64-ulp budget), lies strictly inside its copy without crossing "
-    "it, so R4's copy rule (two shells wound alike, each within 2·rtol of the other: within_up_to_rounding, applied "
-    "to crossing pairs only) never sees it and the nesting depth makes the smaller one a cavity: 3.0e-14 m³ for "
-    "0.457 m³, certified 'unverified' with a note naming the other reading. Honest label, absurd number (a wall "
-    "7e-15 m thick); in m, mm and km alike. The fix belongs to the nesting rule (nest10's stage), not here"))
 def test_a_copy_scaled_by_a_hundred_ulps_is_not_read_as_its_own_cavity():
+    """D2 (review 10, fixed): a copy scaled by 1 + 100 ulp nests inside its original without crossing it; R4's copy
+    rule now reads nested pairs too (``policy.nested_copies``), so the pair is united, not a body and its cavity
+    (before: 3.0e-14 m³ for 0.457 m³, labelled ``unverified``)."""
     v, f = icosphere(0.5, 1)
     v, f = np.asarray(v, dtype=np.float64), np.asarray(f, dtype=np.int64)
     bigger = v * (1 + 100 * 2.0 ** -52)

@@ -85,10 +85,10 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
     if found is None and groups is None:
         return united, None
     if united.forced is not None or united.kind not in ("exact", "united"):
-        # R4 turned those shells without a warning of its own (this is the one): say both readings here too
-        volume = float(total(united.shells.moments).volume)
+        # R4 turned those shells without a warning of its own (this is the one): say both readings here too; the
+        # result is not known to be the parity solid, so no total is computed from it
         for reading in (r for r in (found, groups) if r is not None):
-            note = misread_message(reading, volume, proven=False, kept="")
+            note = misread_message(reading, None, proven=False, kept="")
             said = f"{_turned(reading, oriented)}: " if reading is found else ""        # R4 flipped these: said once
             warnings.warn(InsideOutWarning(f"{source}: {said}{note}"), stacklevel=3)
         return united, None

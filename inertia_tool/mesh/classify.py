@@ -14,11 +14,12 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ..errors import InsideOutWarning
+from ..errors import InsideOutWarning, MeshResolvedWarning
 from ..integrals import VolumeMoments
+from ..tolerances import COINCIDENT_RTOL, TOUCH_VOLUME_RTOL
 from .intersect import SurfaceContacts, surface_contacts
 from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
-                     inward_crossing_shells, misread_nesting,
+                     inward_crossing_shells, misread_nesting, nested_copies,
                      orient_by_depth, outward_crossing_groups, shell_contacts, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
@@ -87,9 +88,13 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     file_volumes = np.array([s.volume for s in shells.moments])
     touch, nest, touch_within = settle_touching(v, f, labels, contacts, touch, nest)
     within, crossing_with = None, touch.crossing_with
+    copies = np.zeros((0, 2), dtype=np.int64)
     if touch.complete:
-        within, crossing_with = _within(v, f, labels, file_volumes, crossing_with)
+        rounding = _rounding_volumes(v, shells.moments)
+        within, crossing_with = _within(v, f, labels, file_volumes, crossing_with, rounding)
         nest = _decide_past_partners(v, f, labels, n_shells, nest, crossing_with)
+        crossing_with, touch_within, copies = _copies_nested(file_volumes, nest, crossing_with, touch_within,
+                                                             rounding)
     flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
                                          within=_both(within, touch_within))
     misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
@@ -130,6 +135,14 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
                      "an outward one: read as a cavity cut from it (the solid where the winding number is at least "
                      "one); if it is a body written inside out, fix its winding. Not verified")
         warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+    if len(copies):
+        n_copies = len(np.unique(copies[:, 0]))
+        notes.append(f"{n_copies} shell{'s' if n_copies > 1 else ''} lie{'' if n_copies > 1 else 's'} inside a shell "
+                     f"wound alike, without crossing it, and hold{'' if n_copies > 1 else 's'} all but "
+                     f"{2 * TOUCH_VOLUME_RTOL:g} of its volume or all but the rounding neighbourhood of its surface "
+                     "(a copy scaled or moved by rounding): read as "
+                     "copies, not as a body and its cavity (R4), and united by the boolean")
+        warnings.warn(MeshResolvedWarning(f"{source}: {notes[-1]}"), stacklevel=4)
     if within is not None and len(within):
         n_within = len(np.unique(within[:, 0]))
         notes.append(f"{n_within} shell{'s' if n_within > 1 else ''} meet{'' if n_within > 1 else 's'} the "
@@ -141,10 +154,49 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
         candidates = touch.crossing | touch.touching | undecided
     else:       # the check gave up: every shell whose box meets another's goes to the boolean
         candidates = boxes_meet(v, shells.faces, labels, n_shells) | undecided
+    candidates[copies.reshape(-1)] = True                 # nested copies: the boolean forms their union
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[crossing_with.reshape(-1)] = True
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
                        groups, by_winding)
+
+
+def _copies_nested(volumes: np.ndarray, nest: Nesting | None, crossing_with: np.ndarray,
+                   touch_within: np.ndarray, rounding: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """R4's copy rule on nested pairs (:func:`~.policy.nested_copies`): ``(crossing_with, touch_within, copies)``
+    with the ``(shell, container)`` pairs that are copies (nested without crossing, by the winding numbers at the
+    probe points or by touching vertices) moved from the nested pairs to the crossing ones.  Only once the
+    face-pair check is complete (a shell inside another then lies wholly inside it)."""
+    cross = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    touching = np.asarray(touch_within, dtype=np.int64).reshape(-1, 2)
+    pairs = [touching]
+    if nest is not None:
+        shell, other = np.asarray(nest.shell, dtype=np.int64), np.asarray(nest.other, dtype=np.int64)
+        undecided = np.asarray(nest.undecided, dtype=bool)
+        held = (np.asarray(nest.winding) != 0) & (shell != other) & ~undecided[shell]
+        pairs.append(np.c_[shell[held], other[held]])
+    nested = np.concatenate(pairs).reshape(-1, 2)
+    if len(cross) and len(nested):              # pairs that cross have no nesting (their copies are R4's already)
+        n = int(max(nested.max(), cross.max())) + 1
+        crossing_keys = np.union1d(cross[:, 0] * n + cross[:, 1], cross[:, 1] * n + cross[:, 0])
+        nested = nested[~np.isin(nested[:, 0] * n + nested[:, 1], crossing_keys)]
+    copies = nested[nested_copies(volumes, nested, rounding=rounding)] if len(nested) else nested
+    if not len(copies):
+        return cross, touching, np.zeros((0, 2), dtype=np.int64)
+    copies = np.unique(np.sort(copies, axis=1), axis=0)
+    if len(touching):
+        n = int(max(touching.max(), copies.max())) + 1
+        keys = np.union1d(copies[:, 0] * n + copies[:, 1], copies[:, 1] * n + copies[:, 0])
+        touching = touching[~np.isin(touching[:, 0] * n + touching[:, 1], keys)]
+    return np.concatenate([cross, copies]), touching, copies
+
+
+def _rounding_volumes(v: np.ndarray, moments: Sequence[VolumeMoments]) -> np.ndarray:
+    """(s,) m³: each shell's rounding neighbourhood, ``2·δ·area`` with δ = ``COINCIDENT_RTOL`` times the largest
+    |coordinate| (R0's rounding radius; :func:`~.policy.nested_copies`)."""
+    delta = COINCIDENT_RTOL * float(np.max(np.abs(v))) if len(v) else 0.0
+    return np.array([2.0 * delta * m.area for m in moments], dtype=np.float64)
 
 
 def _cavities_in_overlap(count: int) -> str:
@@ -197,7 +249,9 @@ def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
     within = None
     if touch is not None and touch.complete:
-        within, crossing_with = _within(vertices, faces, labels, vols, crossing_with)
+        rounding = _rounding_volumes(vertices, shells)
+        within, crossing_with = _within(vertices, faces, labels, vols, crossing_with, rounding)
+        crossing_with, touch_within, _ = _copies_nested(vols, nest, crossing_with, touch_within, rounding)
     flip, owner, depth = orient_by_depth(vols, nest, crossing_with,
                                          crossing_known=touch is not None and touch.complete,
                                          within=_both(within, touch_within))
@@ -276,7 +330,7 @@ MAX_WITHIN_PAIRS = 256
 
 
 def _within(v: np.ndarray, f: np.ndarray, labels: np.ndarray, volumes: np.ndarray,
-            crossing_with: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            crossing_with: np.ndarray, rounding: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """R4: the crossing pairs whose one shell lies within the other up to rounding (``(shell, container)``), and the
     pairs that cross for real (:func:`~.policy.within_up_to_rounding`, volumes shared by manifold3d)."""
     pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
@@ -284,7 +338,8 @@ def _within(v: np.ndarray, f: np.ndarray, labels: np.ndarray, volumes: np.ndarra
         return np.zeros((0, 2), dtype=np.int64), pairs
     from .union import common_volumes            # imported on use: crossings are rare
     tested = pairs[:MAX_WITHIN_PAIRS]
-    within, really = within_up_to_rounding(volumes, tested, common_volumes(v, f, labels, volumes, tested))
+    within, really = within_up_to_rounding(volumes, tested, common_volumes(v, f, labels, volumes, tested),
+                                           rounding=rounding)
     return within, np.concatenate([really, pairs[MAX_WITHIN_PAIRS:]])
 
 

@@ -109,7 +109,11 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    depth from it like any nested shell, whether the contact is exactly coplanar or coplanar only to rounding
    after a rotation: a cavity flush with its body's face is a cavity (cut from the body by the boolean, certified
    ``united``), an outward-wound one included.  One rule covers a shell strictly inside another and one
-   touching the other's boundary from inside: *the role is the depth of the closed solid*.  A shell the file
+   touching the other's boundary from inside: *the role is the depth of the closed solid*.  Two shells wound
+   alike, each holding all but ``2·TOUCH_VOLUME_RTOL`` of the other's volume, are copies, not a body and its
+   cavity, whether their surfaces cross (:func:`within_up_to_rounding`) or one lies inside the other without
+   crossing or touching it (:func:`nested_copies`: a copy scaled by 1 + k ulp, review 10's D2); they go to the
+   boolean, whose union is the solid.  A shell the file
    winds outward that depth makes a cavity (:func:`misread_nesting`) is a reading the file does not decide: its
    own winding number is 2 there, so ``{w ≥ 1}`` is the union of the bodies, and a cavity written with the wrong
    winding reads the same.  The parity reading is kept, a warning names the other one and its volume, and the
@@ -188,7 +192,7 @@ if TYPE_CHECKING:
     from .nesting import Nesting
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
-           "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding",
+           "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding", "nested_copies",
            "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
            "near_copies", "NearCopies", "near_copies_message", "MisreadNesting", "misread_nesting",
@@ -486,7 +490,8 @@ def touching_relations(pairs: np.ndarray, inside: np.ndarray, outside: np.ndarra
 
 
 def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.ndarray, *,
-                          rtol: float = TOUCH_VOLUME_RTOL) -> tuple[np.ndarray, np.ndarray]:
+                          rtol: float = TOUCH_VOLUME_RTOL,
+                          rounding: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """R4: which pairs of crossing shells are one inside the other up to rounding.
 
     Shell ``a`` lies within ``b`` when all but ``rtol`` of its solid (wound outward) is shared with ``b``'s:
@@ -504,6 +509,8 @@ def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.nda
         Crossing pairs.
     common : (k,) float
         ``vol(A ∩ B)`` of each pair (:func:`~.union.common_volumes`; NaN when unknown: the pair stays crossing).
+    rounding : (s,) float or None
+        m³, each shell's rounding neighbourhood (:func:`nested_copies`): copies also when each shares all but it.
 
     Returns
     -------
@@ -523,11 +530,64 @@ def within_up_to_rounding(volumes: np.ndarray, pairs: np.ndarray, common: np.nda
         # to 2·rtol (vol(B \ A) ≤ |B| − (1 − rtol)|A|); one just inside the tolerance and the other just outside it
         # is rounding, not nesting (review9: a part and its copy turned 2e-9 rad, ~950 km out, 9.85e-10 and
         # 1.004e-9 of their volumes unshared, read as a body and its cavity)
-        alike = np.sign(signed[p[:, 0]]) == np.sign(signed[p[:, 1]])
-        copies = alike & (c >= (1 - 2 * rtol) * size[p[:, 0]]) & (c >= (1 - 2 * rtol) * size[p[:, 1]])
+        copies = _copies(signed, p, c, rtol, rounding)
     one = (a_in_b ^ b_in_a) & ~copies
     within = np.where(a_in_b[one, None], p[one], p[one][:, ::-1])
     return within.reshape(-1, 2), p[~one]
+
+
+def _copies(signed: np.ndarray, pairs: np.ndarray, common: np.ndarray, rtol: float,
+            rounding: np.ndarray | None = None) -> np.ndarray:
+    """(k,) bool: R4's copy rule: the two shells of a pair are wound alike and each shares all but ``2·rtol`` of
+    its volume (or all but its rounding neighbourhood, ``rounding``: (s,) m³) with the other (``common``: their
+    common volume; NaN: not copies)."""
+    size = np.abs(signed)
+    slack = np.zeros_like(size) if rounding is None else np.asarray(rounding, dtype=np.float64)
+    alike = np.sign(signed[pairs[:, 0]]) == np.sign(signed[pairs[:, 1]])
+    with np.errstate(invalid="ignore"):
+        a, b = pairs[:, 0], pairs[:, 1]
+        return np.asarray(alike & (common >= np.minimum((1 - 2 * rtol) * size[a], size[a] - slack[a]))
+                          & (common >= np.minimum((1 - 2 * rtol) * size[b], size[b] - slack[b])))
+
+
+def nested_copies(volumes: np.ndarray, nested: np.ndarray, *, rtol: float = TOUCH_VOLUME_RTOL,
+                  rounding: np.ndarray | None = None) -> np.ndarray:
+    """R4: which ``(shell, container)`` pairs of shells nested without crossing are copies, not a body and its
+    cavity.
+
+    A shell lying inside another whose surface it does not cross shares all of its solid with it:
+    ``vol(A ∩ B) = |vol A|``.  The copy rule of :func:`within_up_to_rounding` (two shells wound alike, each within
+    ``2·rtol`` of the other) then reads ``|vol A| ≥ (1 − 2·rtol)·|vol B|``: a copy scaled by rounding (1 + k ulp
+    about a point inside it) that came out just inside its original without touching it.  Depth would make it a
+    cavity, a wall thinner than the coordinates' rounding (review 10, D2: 3e-14 m³ for 0.457 m³); read as
+    copies, the pair goes to the boolean like crossing copies, whose union (the solid where the winding number is
+    at least one: the outer shell's) is the answer.
+
+    *Up to the coordinates' rounding*: far from the origin a part's size can be a few thousand units in the last
+    place of its coordinates, and a copy shifted or turned by less than that nests by rounding with a volume
+    apart by more than ``2·rtol`` (``bench_review9_convex``: a 0.6 mm box 2.5e4 m out and its copy shifted by
+    8e-10 of its size, 5.7e-9 of the volume apart).  The space between two nested surfaces (the parity solid) is
+    then no thicker on average than the rounding: when its volume ``|vol B| − |vol A|`` is at most ``rounding``
+    of each (``2·δ·area``, the δ-neighbourhood of its surface to first order, δ = R0's ``COINCIDENT_RTOL`` times
+    the largest |coordinate|), that solid is a wall the coordinates cannot tell from none, and the pair is read
+    as copies too (crossing pairs likewise, :func:`within_up_to_rounding`).
+
+    Parameters
+    ----------
+    volumes : (s,) float
+        Signed shell volumes as wound in the file.
+    nested : (k, 2) int
+        ``(shell, container)`` pairs: ``shell`` inside ``container``, the surfaces crossing nowhere.
+    rounding : (s,) float or None
+        m³, the volume of each shell's rounding neighbourhood (``2·δ·area``); None: 0.
+
+    Returns
+    -------
+    (k,) bool
+    """
+    p = np.asarray(nested, dtype=np.int64).reshape(-1, 2)
+    signed = np.asarray(volumes, dtype=np.float64)
+    return _copies(signed, p, np.abs(signed[p[:, 0]]), rtol, rounding)
 
 
 def _groups(n: int, pairs: np.ndarray) -> np.ndarray:
@@ -761,9 +821,14 @@ def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: n
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=True, kept="union")
 
 
-def misread_message(found: MisreadNesting, parity_volume: float, proven: bool, kept: str | None = None) -> str:
+def misread_message(found: MisreadNesting, parity_volume: float | None, proven: bool, kept: str | None = None) -> str:
     """R4's note for :class:`MisreadNesting`: the reading kept, the other one and its volume (``kept``: what is
-    proven of the reading kept, when not the default sentence for ``proven``; "" for nothing)."""
+    proven of the reading kept, when not the default sentence for ``proven``; "" for nothing).
+
+    ``parity_volume``: m³, the parity solid's volume, when the result given is that solid; None when it is not
+    known to be (a result the boolean left ``unverified``): the other reading is then stated against the parity
+    solid, never as a total computed from a result that may be another solid (review 10: "the union of the
+    bodies: 5.36e8 m³" for a union of 1.787e8, the result being the two copies summed)."""
     n = len(found.shells)
     them = "them" if n > 1 else "it"
     if found.kept == "union":
@@ -773,8 +838,12 @@ def misread_message(found: MisreadNesting, parity_volume: float, proven: bool, k
                 "m³ less material. The file does not decide: an estimate whose bounds span both readings. If they "
                 "are bodies, unite them with the body around them in the model; if a cavity, keep one copy wound "
                 "inward")
-    other = (f"at most {round_up(found.volume):.6g} m³ more" if found.nested else
-             f"{parity_volume + found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % more mass")
+    if parity_volume is None:
+        other = (f"at most {round_up(found.volume):.6g} m³ more than the parity solid" if found.nested else
+                 f"{found.volume:.6g} m³ more than the parity solid")
+    else:
+        other = (f"at most {round_up(found.volume):.6g} m³ more" if found.nested else
+                 f"{parity_volume + found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % more mass")
     if kept is None:
         kept = ("the parity solid is proven (exact)" if proven else
                 "the parity solid is not proven apart from that reading (its faces meet the body's only to "

@@ -76,7 +76,8 @@ class RawMesh:
     Attributes
     ----------
     vertices : (n, 3) float64
-        m, mesh axes (file coordinates times the unit scale).
+        m, mesh axes (file coordinates times the unit scale): the vertices some face uses, in the file's order
+        (a point no face uses is left out when reading, so that it widens no extent read later).
     faces : (m, 3) int
         Indices into ``vertices``, as wound in the file.
     source : str
@@ -1331,6 +1332,7 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
         owned = False                      # may be the caller's own array: never modified
         rounding = 0.0
         parts = ()
+    vertices, faces, owned = _used_vertices(vertices, faces, owned)
     if scale != 1.0:
         if owned and vertices.dtype == np.float64 and vertices.flags.writeable:
             vertices *= scale
@@ -1338,6 +1340,50 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
             vertices = vertices * scale
     return RawMesh(vertices=vertices, faces=faces, source=name, units=str(units), file_faces=n,
                    units_assumed=assumed, storage_rounding=rounding * abs(scale), parts=parts)
+
+
+#: Faces marked or renumbered per pass by :func:`_used_vertices`: its index temporaries stay a few MB at any size.
+_USED_CHUNK_FACES = 1 << 18
+
+
+def _used_vertices(vertices: np.ndarray, faces: np.ndarray, owned: bool) -> tuple[np.ndarray, np.ndarray, bool]:
+    """``(vertices, faces, owned)`` with every vertex no face uses left out and the faces renumbered to match.
+
+    A point no face uses is not part of the surface: it encloses nothing and moves no integral, but it would
+    widen every extent read from the vertices (R2's flatness scale ``FLAT_RTOL · diagonal³``, the units
+    heuristic, the bounding box reported), so a valid solid with one stray point far away read as "flat"
+    (review 10, D1).  Leaving it out here, where the mesh is read, makes every later stage (the clean-part fast
+    path, :func:`~.surface.close_surface`, the size check) read the same extent.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+        Indices into ``vertices``, all in ``0..n-1``.
+    owned : bool
+        The arrays are this reader's own (else a caller's: never modified; new arrays are made when needed).
+
+    Returns
+    -------
+    vertices : (k, 3) float
+        The used vertices, in their order (the same array when all are used).
+    faces : (m, 3) int
+        Renumbered into them, same dtype (the same array when all are used).
+    owned : bool
+        Whether the arrays returned are this reader's own.
+    """
+    n = len(vertices)
+    used = np.zeros(n, dtype=bool)
+    for start in range(0, len(faces), _USED_CHUNK_FACES):          # bounded: len(faces) / chunk passes
+        used[faces[start:start + _USED_CHUNK_FACES].ravel()] = True
+    if used.all():
+        return vertices, faces, owned
+    renumber = np.cumsum(used, dtype=np.int64) - 1                # new index of each used vertex
+    faces = faces if owned and faces.flags.writeable else faces.copy()
+    for start in range(0, len(faces), _USED_CHUNK_FACES):
+        block = faces[start:start + _USED_CHUNK_FACES]
+        block[...] = renumber[block]
+    return vertices[used], faces, True
 
 
 def _float32_rounding(vertices: np.ndarray) -> float:
