@@ -29,6 +29,13 @@ builds it:
    surface is closed and consistently wound, and no two of its faces cross (:func:`~.intersect.surface_contacts`
    again, exact).
 
+Before step 1, a face written together with its reverse (the same three vertices, opposite cyclic order) is
+taken out as a pair (:func:`_cancel_reversed`): the two are one triangle with opposite orientations, so their
+contributions cancel exactly in every surface integral and in the winding number at every point off that triangle,
+and ``{w ≥ 1}`` changes by a set of measure zero; every directed edge stays matched by its reverse.  Left in, the
+pair would be a patch every point of which lies on the other face of the pair, where no winding number can be
+certified (issue 23: Barkour v0's ``upper_right_2.stl``, four such pairs).
+
 Degenerate crossings (a corner in the plane of a face it crosses, an edge through another edge or a corner,
 coplanar overlapping faces, two crossing curves meeting on an edge) are refused with the reason
 (:class:`~inertia_tool.errors.ArrangementError`), never guessed.
@@ -103,6 +110,8 @@ class Arrangement:
     merged_points : int
         Intersection points merged into a neighbour within ``tolerances.ARRANGE_MERGE_RTOL`` of the diagonal
         because, rounded, they left faces crossing (see :func:`_merge_close_points`).
+    cancelled_faces : int
+        Input faces taken out as pairs of a face and its reverse before arranging (:func:`_cancel_reversed`).
     """
 
     vertices: np.ndarray
@@ -115,6 +124,7 @@ class Arrangement:
     crossings_left: int = 0
     turned: bool = False
     merged_points: int = 0
+    cancelled_faces: int = 0
 
 
 # -- exact helpers ---------------------------------------------------------------------------------------------
@@ -528,6 +538,26 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
     """
     v = np.ascontiguousarray(vertices, dtype=np.float64)
     f = np.ascontiguousarray(faces, dtype=np.int64)
+    keep = _cancel_reversed(f)
+    cancelled = int(len(f) - np.count_nonzero(keep))
+    if cancelled:
+        remap = np.cumsum(keep) - 1
+        if crossing is not None:
+            pairs = np.asarray(crossing, dtype=np.int64).reshape(-1, 2)
+            crossing = remap[pairs[keep[pairs].all(axis=1)]]
+        f = f[keep]
+        if crossing is None or not len(crossing):
+            found = surface_contacts(v, f)
+            if not found.complete:
+                raise ArrangementError("the face-intersection check did not finish")
+            crossing = found.crossing
+        if not len(crossing):                  # the pairs were all that crossed: nothing left to arrange
+            result_v, result_f = _compact(v, f)
+            if not edge_topology(result_f, len(result_v)).oriented:
+                raise ArrangementError("the surface left after taking out the faces written with their reverse "
+                                       "is not closed")
+            return Arrangement(vertices=result_v, faces=result_f, crossing_pairs=0, split_faces=0, new_vertices=0,
+                               patches=0, max_winding=1, cancelled_faces=cancelled)
     try:
         out_v, kept, stats = _arrange(v, f, crossing)
         turned = False
@@ -564,7 +594,36 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
         else:
             merged = 0
     return Arrangement(vertices=result_v, faces=result_f, crossings_left=len(after.crossing), turned=turned,
-                       merged_points=merged, **stats)
+                       merged_points=merged, cancelled_faces=cancelled, **stats)
+
+
+def _cancel_reversed(faces: np.ndarray) -> np.ndarray:
+    """(m,) bool: the faces kept once every face written with its reverse (the same three vertex ids in opposite
+    cyclic order) is taken out with it, pair by pair (``k`` copies one way and ``j`` the other leave ``|k − j|``).
+
+    The pair is the zero chain: its two faces' terms cancel exactly in the divergence-theorem sums (Rigid Body
+    Motion, Ch. 4) and in the solid-angle sum of the winding number at every point off the triangle, so
+    ``{w ≥ 1}`` is the same up to the triangle itself (measure zero); each directed edge loses one use and so
+    does its reverse, so a closed surface stays closed."""
+    f = np.asarray(faces, dtype=np.int64)
+    keep = np.ones(len(f), dtype=bool)
+    if len(f) < 2:
+        return keep
+    canon = np.sort(f, axis=1)
+    _, key, count = np.unique(canon, axis=0, return_inverse=True, return_counts=True)
+    key = key.reshape(-1)
+    repeated = np.flatnonzero(count[key] > 1)
+    if not len(repeated):
+        return keep
+    even = _cyclic_parity(f[repeated])
+    groups: dict[int, tuple[list[int], list[int]]] = {}
+    for idx, k, e in zip(repeated.tolist(), key[repeated].tolist(), even.tolist()):
+        groups.setdefault(k, ([], []))[0 if e else 1].append(idx)
+    for one_way, other_way in groups.values():
+        pairs = min(len(one_way), len(other_way))
+        keep[one_way[:pairs]] = False
+        keep[other_way[:pairs]] = False
+    return keep
 
 
 def _merge_close_points(vertices: np.ndarray, faces: np.ndarray, n_input: int) -> tuple[np.ndarray, np.ndarray, int]:
