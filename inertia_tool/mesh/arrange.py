@@ -23,7 +23,14 @@ builds it:
    lying on its face ``f``, the generalized winding number of every face but ``f`` is ``w_front + ½``
    (``w_back = w_front + 1`` for a face wound outward), evaluated by the solid-angle sum (Van Oosterom and
    Strackee, IEEE Trans. Biomed. Eng. 30, 1983) with a rounding bound: accepted only when the bound keeps the
-   nearest half-integer unique.
+   nearest half-integer unique.  A patch none of whose points tried can be certified so (every one lies within
+   rounding of another face: a pleat of nearly coplanar faces crossing at a tiny angle) is labelled exactly at the
+   exact centroid of one of its pieces (from the pieces' exact corners, so it lies in the piece's cell of its
+   face's plane), by counting the signed crossings of a ray from there into the face's front with exact integer
+   orientation signs (:func:`_ray_front`).  When the labels then fail the check of step 4 (a certified float
+   evaluation is one at the *rounded* centroid of a piece, which rounding can put across a face lying within an
+   ulp of it), every patch is labelled again by exact rays and checked again (work bound
+   ``MAX_EXACT_RAY_WORK``).
 4. *Kept faces.*  The faces with ``w_back ≥ 1`` and ``w_front ≤ 0`` (``w_front = 0``) bound ``{w ≥ 1}`` and are
    wound outward.  Checks: the winding numbers change by exactly one across every intersection curve, the kept
    surface is closed and consistently wound, and no two of its faces cross (:func:`~.intersect.surface_contacts`
@@ -44,7 +51,9 @@ coplanar overlapping faces, two crossing curves meeting on an edge) are refused 
 from __future__ import annotations
 
 from fractions import Fraction
+from collections.abc import Callable
 from itertools import combinations
+from math import gcd
 
 import numpy as np
 
@@ -55,7 +64,8 @@ from .checks import edge_topology
 from .edges import edge_keys
 from .intersect import _integers, orient3d_sign, surface_contacts
 
-__all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells", "WINDING_MARGIN"]
+__all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells", "WINDING_MARGIN",
+           "MAX_EXACT_RAY_WORK"]
 
 #: A patch's winding number is accepted when the rounding bound of its solid-angle sum plus the distance of
 #: the sum from the nearest half-integer stays below this (half a turn would make the rounding ambiguous).
@@ -840,10 +850,28 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
     n_all = len(out_v)
     cut = {min(a, b) * n_all + max(a, b) for _, a, b in cut_edges}
     patch, n_patches = _patches(out_faces, n_all, cut)
-    front = _label_patches(out_v, out_faces, out_source, patch, n_patches, v, f)
+
+    def exact_point(vid: int) -> tuple[Fraction, Fraction, Fraction]:
+        h = hom.get(vid)
+        if h is None:
+            return (Fraction(float(out_v[vid, 0])), Fraction(float(out_v[vid, 1])), Fraction(float(out_v[vid, 2])))
+        den = exact.scale * h[3]
+        return (h[0] / den, h[1] / den, h[2] / den)
+
+    front = _label_patches(out_v, out_faces, out_source, patch, n_patches, v, f, exact_point)
     w_front = front[patch]
     first_piece = len(whole)                  # cut edges border pieces only
-    _check_curves(out_faces[first_piece:], n_all, cut, out_source[first_piece:], w_front[first_piece:])
+    try:
+        _check_curves(out_faces[first_piece:], n_all, cut, out_source[first_piece:], w_front[first_piece:])
+    except ArrangementError as exc:
+        # a float evaluation is certified at the rounded centroid of a piece, which rounding may put on the other
+        # side of a face lying within an ulp of the piece (a pleat): every patch labelled again by exact rays
+        if n_patches * len(f) > MAX_EXACT_RAY_WORK:
+            raise ArrangementError(f"{exc}; labelling the {n_patches:,} patches by exact rays through "
+                                   f"{len(f):,} faces is past the work bound of {MAX_EXACT_RAY_WORK:,}") from None
+        front = _exact_labels(out_faces, out_source, patch, n_patches, v, f, exact_point)
+        w_front = front[patch]
+        _check_curves(out_faces[first_piece:], n_all, cut, out_source[first_piece:], w_front[first_piece:])
 
     # 4. the faces bounding {w ≥ 1}, compacted
     kept = out_faces[w_front == 0]
@@ -892,8 +920,11 @@ def _common_line(exact: _Exact, faces: np.ndarray, trio: tuple[int, ...]) -> boo
 
 
 def _label_patches(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndarray, patch: np.ndarray,
-                   n_patches: int, v: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """(p,) int: the winding number in front of each patch, from one certified evaluation at a face of it."""
+                   n_patches: int, v: np.ndarray, f: np.ndarray,
+                   exact_point: Callable[[int], tuple[Fraction, Fraction, Fraction]] | None = None) -> np.ndarray:
+    """(p,) int: the winding number in front of each patch, from one certified evaluation at a face of it
+    (``exact_point``: a vertex id of the split surface → its exact coordinates, for the exact ray when no float
+    evaluation can be certified; without it the input's float coordinates, which are exact for input vertices)."""
     p0, p1, p2 = out_v[out_faces[:, 0]], out_v[out_faces[:, 1]], out_v[out_faces[:, 2]]
     u, w = p1 - p0, p2 - p0
     area2 = ((u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1]) ** 2 + (u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2]) ** 2
@@ -911,9 +942,126 @@ def _label_patches(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndar
                 front[p] = int(np.floor(total))
                 break
         else:
-            raise ArrangementError(f"the winding number of a patch of {len(members):,} faces could not be certified "
-                                   "(every point tried is too close to another surface for float64)")
+            got = _exact_front(out_faces, out_source, members[:_TRIES], v, f, exact_point)
+            if got is None:
+                raise ArrangementError(f"the winding number of a patch of {len(members):,} faces could not be "
+                                       "certified (every point tried is too close to another surface for float64, "
+                                       "and no exact ray from a piece of it was free of degeneracy)")
+            front[p] = got
     return front
+
+
+#: Work bound of labelling every patch by exact rays (:func:`_exact_labels`): patches × faces of the shell.
+MAX_EXACT_RAY_WORK = 2_000_000
+
+
+def _exact_labels(out_faces: np.ndarray, out_source: np.ndarray, patch: np.ndarray, n_patches: int, v: np.ndarray,
+                  f: np.ndarray, exact_point: Callable[[int], tuple[Fraction, Fraction, Fraction]]) -> np.ndarray:
+    """(p,) int: the winding number in front of each patch, every one from an exact ray (:func:`_exact_front`)."""
+    order = np.argsort(patch, kind="stable")
+    starts = np.searchsorted(patch[order], np.arange(n_patches + 1))
+    front = np.zeros(n_patches, dtype=np.int64)
+    for p in range(n_patches):
+        got = _exact_front(out_faces, out_source, order[starts[p]:starts[p + 1]][:_TRIES], v, f, exact_point)
+        if got is None:
+            raise ArrangementError(f"the winding number of a patch of {starts[p + 1] - starts[p]:,} faces could not "
+                                   "be decided by an exact ray (every ray tried was degenerate)")
+        front[p] = got
+    return front
+
+
+#: Ray directions tried by :func:`_ray_front` (added to the face's normal scaled up), before giving up.
+_RAY_TILTS = ((0, 0, 0), (3, -5, 7), (-11, 2, 5), (7, 13, -3), (-2, -9, -13))
+
+
+def _exact_front(out_faces: np.ndarray, out_source: np.ndarray, members: np.ndarray, v: np.ndarray,
+                 f: np.ndarray, exact_point: Callable[[int], tuple[Fraction, Fraction, Fraction]] | None
+                 ) -> int | None:
+    """The winding number in front of a patch from an exact ray (:func:`_ray_front`) at the exact centroid of one
+    of its pieces, or None when none gives an answer (a piece with a new point and no ``exact_point``, or every
+    ray degenerate)."""
+    n = len(v)
+    for k in members.tolist():
+        corners = out_faces[k].tolist()
+        if exact_point is None and max(corners) >= n:
+            continue
+        pts = [exact_point(c) if exact_point is not None else tuple(Fraction(float(x)) for x in v[c])
+               for c in corners]
+        centroid = tuple((pts[0][i] + pts[1][i] + pts[2][i]) / 3 for i in range(3))
+        got = _ray_front(v, f, int(out_source[k]), centroid)
+        if got is not None:
+            return got
+    return None
+
+
+def _ray_front(v: np.ndarray, f: np.ndarray, face: int,
+               point: tuple[Fraction, Fraction, Fraction] | None = None) -> int | None:
+    """Winding number, exactly, of the closed surface ``(v, f)`` just in front of ``point`` on ``face`` (exact
+    coordinates, m; its centroid when None).
+
+    A ray from ``p`` into the front of ``face`` (direction ``d`` with ``d·n > 0``) leaves ``face`` at ``p`` and
+    crosses every other face it meets once; ``w(x) = Σ ±1`` over those crossings (+1 where the ray leaves a face
+    through its back, from behind to in front, the surface wound outward), since ``w = 0`` far away.  Every test
+    is an exact sign on integers (the coordinates at one power-of-two scale, all multiplied by the denominator of
+    ``p``): the sides of ``p`` and of the ray's far end ``q`` (outside the bounding box) for each face's plane, and
+    the sides of the face's three edges seen along the line ``pq``.  A ray through an edge or a corner, or ``p``
+    lying on another face, is degenerate: the next direction of ``_RAY_TILTS`` is tried; None when all are.
+    ``p`` is assumed to lie on ``face`` (exactly in its plane; only the other faces are counted).
+    """
+    used = np.unique(f)
+    (ints,) = _integers(v[used])
+    flat, ints_flat = v[used].reshape(-1), ints.reshape(-1)
+    nz = np.flatnonzero(flat)
+    scale = Fraction(int(ints_flat[nz[0]])) / Fraction(float(flat[nz[0]])) if len(nz) else Fraction(1)
+    pos = np.full(len(v), -1, dtype=np.int64)
+    pos[used] = np.arange(len(used))
+    if point is None:
+        a, b, c = (v[int(i)] for i in f[face])
+        point = tuple((Fraction(float(a[i])) + Fraction(float(b[i])) + Fraction(float(c[i]))) / 3 for i in range(3))
+    scaled = [x * scale for x in point]
+    den = 1
+    for x in scaled:
+        den = den * x.denominator // gcd(den, x.denominator)
+    p = tuple(int(x * den) for x in scaled)
+    pts = [tuple(den * int(x) for x in row) for row in ints.tolist()]
+    corners = [[pts[pos[int(i)]] for i in row] for row in f.tolist()]
+    a0, b0, c0 = corners[face]
+    normal = _cross(_sub(b0, a0), _sub(c0, a0))
+    reach = 4 * max(abs(x) for pt in pts for x in pt) + 4 * max(abs(x) for x in p) + 1
+    big = max(abs(x) for x in normal)
+    for tilt in _RAY_TILTS:
+        d = tuple(normal[i] * 64 + tilt[i] * big for i in range(3))
+        if _dot(d, normal) <= 0:
+            continue
+        step = reach // max(abs(x) for x in d) + 1
+        q = tuple(p[i] + step * d[i] for i in range(3))
+        total, degenerate = 0, False
+        for g, (a, b, c) in enumerate(corners):
+            if g == face:
+                continue
+            n = _cross(_sub(b, a), _sub(c, a))
+            sp, sq = _sign(_dot(n, _sub(p, a))), _sign(_dot(n, _sub(q, a)))
+            if sp == sq and sp != 0:
+                continue
+            if sq == 0:
+                degenerate = True
+                break
+            ray = _sub(q, p)
+            e = [_sign(_dot(ray, _cross(_sub(x, p), _sub(y, p)))) for x, y in ((a, b), (b, c), (c, a))]
+            if 0 in e:
+                if (1 in e and -1 in e) or (sp != 0 and e.count(0) == 3):
+                    continue                        # the line passes beside the triangle (or ray parallel)
+                degenerate = True
+                break
+            if not (e[0] == e[1] == e[2]):
+                continue
+            if sp == 0:                             # p lies on this face: no winding number there
+                degenerate = True
+                break
+            total += 1 if sp < 0 else -1
+        if not degenerate:
+            return total
+    return None
 
 
 def _check_curves(faces: np.ndarray, n_vertices: int, cut: set[int], source: np.ndarray, w_front: np.ndarray) -> None:
