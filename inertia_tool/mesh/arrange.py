@@ -987,8 +987,8 @@ def _exact_front(out_faces: np.ndarray, out_source: np.ndarray, members: np.ndar
             continue
         pts = [exact_point(c) if exact_point is not None else tuple(Fraction(float(x)) for x in v[c])
                for c in corners]
-        centroid = tuple((pts[0][i] + pts[1][i] + pts[2][i]) / 3 for i in range(3))
-        got = _ray_front(v, f, int(out_source[k]), centroid)
+        x, y, z = ((pts[0][i] + pts[1][i] + pts[2][i]) / 3 for i in range(3))
+        got = _ray_front(v, f, int(out_source[k]), (x, y, z))
         if got is not None:
             return got
     return None
@@ -1017,7 +1017,8 @@ def _ray_front(v: np.ndarray, f: np.ndarray, face: int,
     pos[used] = np.arange(len(used))
     if point is None:
         a, b, c = (v[int(i)] for i in f[face])
-        point = tuple((Fraction(float(a[i])) + Fraction(float(b[i])) + Fraction(float(c[i]))) / 3 for i in range(3))
+        x, y, z = ((Fraction(float(a[i])) + Fraction(float(b[i])) + Fraction(float(c[i]))) / 3 for i in range(3))
+        point = (x, y, z)
     scaled = [x * scale for x in point]
     den = 1
     for x in scaled:
