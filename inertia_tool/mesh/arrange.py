@@ -53,7 +53,6 @@ from __future__ import annotations
 from fractions import Fraction
 from collections.abc import Callable
 from itertools import combinations
-from math import gcd
 
 import numpy as np
 
@@ -151,7 +150,7 @@ def _dot(a: tuple[int, ...], b: tuple[int, ...]) -> int:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-def _sign(x: int) -> int:
+def _sign(x: int | Fraction) -> int:
     return (x > 0) - (x < 0)
 
 
@@ -994,6 +993,21 @@ def _exact_front(out_faces: np.ndarray, out_source: np.ndarray, members: np.ndar
     return None
 
 
+_Q3 = tuple[Fraction, Fraction, Fraction]
+
+
+def _qsub(a: _Q3, b: _Q3) -> _Q3:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _qcross(a: _Q3, b: _Q3) -> _Q3:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _qdot(a: _Q3, b: _Q3) -> Fraction:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
 def _ray_front(v: np.ndarray, f: np.ndarray, face: int,
                point: tuple[Fraction, Fraction, Fraction] | None = None) -> int | None:
     """Winding number, exactly, of the closed surface ``(v, f)`` just in front of ``point`` on ``face`` (exact
@@ -1001,54 +1015,62 @@ def _ray_front(v: np.ndarray, f: np.ndarray, face: int,
 
     A ray from ``p`` into the front of ``face`` (direction ``d`` with ``d·n > 0``) leaves ``face`` at ``p`` and
     crosses every other face it meets once; ``w(x) = Σ ±1`` over those crossings (+1 where the ray leaves a face
-    through its back, from behind to in front, the surface wound outward), since ``w = 0`` far away.  Every test
-    is an exact sign on integers (the coordinates at one power-of-two scale, all multiplied by the denominator of
-    ``p``): the sides of ``p`` and of the ray's far end ``q`` (outside the bounding box) for each face's plane, and
-    the sides of the face's three edges seen along the line ``pq``.  A ray through an edge or a corner, or ``p``
-    lying on another face, is degenerate: the next direction of ``_RAY_TILTS`` is tried; None when all are.
-    ``p`` is assumed to lie on ``face`` (exactly in its plane; only the other faces are counted).
+    through its back, from behind to in front, the surface wound outward), since ``w = 0`` far away.  The ray is
+    the segment to ``q = p + L d`` beyond every vertex.  A float filter keeps the faces whose projection along
+    ``d`` comes within a margin (1e-9 of the mesh's reach from ``p``, far above the filter's rounding) of ``p`` and
+    that reach in front of ``p``; only those can be crossed.  For them every test is an exact sign on rationals:
+    the sides of ``p`` and ``q`` for the face's plane, and the sides of the face's three edges seen along the line
+    ``pq``.  A ray through an edge or a corner, or ``p`` lying on another face, is degenerate: the next direction
+    of ``_RAY_TILTS`` is tried; None when all are.  ``p`` is assumed to lie on ``face`` (exactly in its plane; only
+    the other faces are counted).
     """
-    used = np.unique(f)
-    (ints,) = _integers(v[used])
-    flat, ints_flat = v[used].reshape(-1), ints.reshape(-1)
-    nz = np.flatnonzero(flat)
-    scale = Fraction(int(ints_flat[nz[0]])) / Fraction(float(flat[nz[0]])) if len(nz) else Fraction(1)
-    pos = np.full(len(v), -1, dtype=np.int64)
-    pos[used] = np.arange(len(used))
+    corners_f = v[f]
     if point is None:
-        a, b, c = (v[int(i)] for i in f[face])
+        a, b, c = corners_f[face]
         x, y, z = ((Fraction(float(a[i])) + Fraction(float(b[i])) + Fraction(float(c[i]))) / 3 for i in range(3))
         point = (x, y, z)
-    scaled = [x * scale for x in point]
-    den = 1
-    for x in scaled:
-        den = den * x.denominator // gcd(den, x.denominator)
-    p = tuple(int(x * den) for x in scaled)
-    pts = [tuple(den * int(x) for x in row) for row in ints.tolist()]
-    corners = [[pts[pos[int(i)]] for i in row] for row in f.tolist()]
-    a0, b0, c0 = corners[face]
-    normal = _cross(_sub(b0, a0), _sub(c0, a0))
-    reach = 4 * max(abs(x) for pt in pts for x in pt) + 4 * max(abs(x) for x in p) + 1
-    big = max(abs(x) for x in normal)
+    p = point
+    pf = np.array([float(t) for t in p])
+
+    def exact(row: np.ndarray) -> tuple[Fraction, Fraction, Fraction]:
+        return (Fraction(float(row[0])), Fraction(float(row[1])), Fraction(float(row[2])))
+
+    a0, b0, c0 = (exact(r) for r in corners_f[face])
+    normal = _qcross(_qsub(b0, a0), _qsub(c0, a0))
+    nf = np.array([float(t) for t in normal])
+    if not np.any(nf):
+        return None
+    nf = nf / np.linalg.norm(nf)
+    rel = corners_f - pf
+    reach = float(np.max(np.abs(rel))) * 2.0 + 1e-300
+    margin = 1e-9 * reach
     for tilt in _RAY_TILTS:
-        d = tuple(normal[i] * 64 + tilt[i] * big for i in range(3))
-        if _dot(d, normal) <= 0:
+        df = nf + 0.05 * np.asarray(tilt, dtype=np.float64) / 16.0
+        d = (Fraction(float(df[0])), Fraction(float(df[1])), Fraction(float(df[2])))
+        if _qdot(d, normal) <= 0:
             continue
-        step = reach // max(abs(x) for x in d) + 1
-        q = tuple(p[i] + step * d[i] for i in range(3))
+        unit = df / np.linalg.norm(df)
+        u = np.cross(unit, [1.0, 0.0, 0.0] if abs(unit[0]) < 0.9 else [0.0, 1.0, 0.0])
+        u /= np.linalg.norm(u)
+        w = np.cross(unit, u)
+        along, cu, cw = rel @ unit, rel @ u, rel @ w
+        near = ((cu.min(axis=1) <= margin) & (cu.max(axis=1) >= -margin) & (cw.min(axis=1) <= margin)
+                & (cw.max(axis=1) >= -margin) & (along.max(axis=1) >= -margin))
+        near[face] = False
+        length = Fraction(2.0 ** (int(np.ceil(np.log2(2 * reach / float(np.linalg.norm(df))))) + 1))
+        q = (p[0] + length * d[0], p[1] + length * d[1], p[2] + length * d[2])
+        ray = _qsub(q, p)
         total, degenerate = 0, False
-        for g, (a, b, c) in enumerate(corners):
-            if g == face:
-                continue
-            n = _cross(_sub(b, a), _sub(c, a))
-            sp, sq = _sign(_dot(n, _sub(p, a))), _sign(_dot(n, _sub(q, a)))
+        for g in np.flatnonzero(near).tolist():
+            a, b, c = (exact(r) for r in corners_f[g])
+            n = _qcross(_qsub(b, a), _qsub(c, a))
+            sp, sq = _sign(_qdot(n, _qsub(p, a))), _sign(_qdot(n, _qsub(q, a)))
             if sp == sq and sp != 0:
                 continue
             if sq == 0:
                 degenerate = True
                 break
-            ray = _sub(q, p)
-            e = [_sign(_dot(ray, _cross(_sub(x, p), _sub(y, p)))) for x, y in ((a, b), (b, c), (c, a))]
+            e = [_sign(_qdot(ray, _qcross(_qsub(x, p), _qsub(y, p)))) for x, y in ((a, b), (b, c), (c, a))]
             if 0 in e:
                 if (1 in e and -1 in e) or (sp != 0 and e.count(0) == 3):
                     continue                        # the line passes beside the triangle (or ray parallel)
