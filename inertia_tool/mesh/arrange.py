@@ -23,11 +23,25 @@ builds it:
    lying on its face ``f``, the generalized winding number of every face but ``f`` is ``w_front + ½``
    (``w_back = w_front + 1`` for a face wound outward), evaluated by the solid-angle sum (Van Oosterom and
    Strackee, IEEE Trans. Biomed. Eng. 30, 1983) with a rounding bound: accepted only when the bound keeps the
-   nearest half-integer unique.
+   nearest half-integer unique.  A patch none of whose points tried can be certified so (every one lies within
+   rounding of another face: a pleat of nearly coplanar faces crossing at a tiny angle) is labelled exactly at the
+   exact centroid of one of its pieces (from the pieces' exact corners, so it lies in the piece's cell of its
+   face's plane), by counting the signed crossings of a ray from there into the face's front with exact integer
+   orientation signs (:func:`_ray_front`).  When the labels then fail the check of step 4 (a certified float
+   evaluation is one at the *rounded* centroid of a piece, which rounding can put across a face lying within an
+   ulp of it), every patch is labelled again by exact rays and checked again (work bound
+   ``MAX_EXACT_RAY_WORK``).
 4. *Kept faces.*  The faces with ``w_back ≥ 1`` and ``w_front ≤ 0`` (``w_front = 0``) bound ``{w ≥ 1}`` and are
    wound outward.  Checks: the winding numbers change by exactly one across every intersection curve, the kept
    surface is closed and consistently wound, and no two of its faces cross (:func:`~.intersect.surface_contacts`
    again, exact).
+
+Before step 1, a face written together with its reverse (the same three vertices, opposite cyclic order) is
+taken out as a pair (:func:`_cancel_reversed`): the two are one triangle with opposite orientations, so their
+contributions cancel exactly in every surface integral and in the winding number at every point off that triangle,
+and ``{w ≥ 1}`` changes by a set of measure zero; every directed edge stays matched by its reverse.  Left in, the
+pair would be a patch every point of which lies on the other face of the pair, where no winding number can be
+certified (issue 23: Barkour v0's ``upper_right_2.stl``, four such pairs).
 
 Degenerate crossings (a corner in the plane of a face it crosses, an edge through another edge or a corner,
 coplanar overlapping faces, two crossing curves meeting on an edge) are refused with the reason
@@ -37,6 +51,7 @@ coplanar overlapping faces, two crossing curves meeting on an edge) are refused 
 from __future__ import annotations
 
 from fractions import Fraction
+from collections.abc import Callable
 from itertools import combinations
 
 import numpy as np
@@ -48,7 +63,8 @@ from .checks import edge_topology
 from .edges import edge_keys
 from .intersect import _integers, orient3d_sign, surface_contacts
 
-__all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells", "WINDING_MARGIN"]
+__all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells", "WINDING_MARGIN",
+           "MAX_EXACT_RAY_WORK"]
 
 #: A patch's winding number is accepted when the rounding bound of its solid-angle sum plus the distance of
 #: the sum from the nearest half-integer stays below this (half a turn would make the rounding ambiguous).
@@ -103,6 +119,8 @@ class Arrangement:
     merged_points : int
         Intersection points merged into a neighbour within ``tolerances.ARRANGE_MERGE_RTOL`` of the diagonal
         because, rounded, they left faces crossing (see :func:`_merge_close_points`).
+    cancelled_faces : int
+        Input faces taken out as pairs of a face and its reverse before arranging (:func:`_cancel_reversed`).
     """
 
     vertices: np.ndarray
@@ -115,6 +133,7 @@ class Arrangement:
     crossings_left: int = 0
     turned: bool = False
     merged_points: int = 0
+    cancelled_faces: int = 0
 
 
 # -- exact helpers ---------------------------------------------------------------------------------------------
@@ -131,7 +150,7 @@ def _dot(a: tuple[int, ...], b: tuple[int, ...]) -> int:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-def _sign(x: int) -> int:
+def _sign(x: int | Fraction) -> int:
     return (x > 0) - (x < 0)
 
 
@@ -528,6 +547,26 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
     """
     v = np.ascontiguousarray(vertices, dtype=np.float64)
     f = np.ascontiguousarray(faces, dtype=np.int64)
+    keep = _cancel_reversed(f)
+    cancelled = int(len(f) - np.count_nonzero(keep))
+    if cancelled:
+        remap = np.cumsum(keep) - 1
+        if crossing is not None:
+            pairs = np.asarray(crossing, dtype=np.int64).reshape(-1, 2)
+            crossing = remap[pairs[keep[pairs].all(axis=1)]]
+        f = f[keep]
+        if crossing is None or not len(crossing):
+            found = surface_contacts(v, f)
+            if not found.complete:
+                raise ArrangementError("the face-intersection check did not finish")
+            crossing = found.crossing
+        if not len(crossing):                  # the pairs were all that crossed: nothing left to arrange
+            result_v, result_f = _compact(v, f)
+            if not edge_topology(result_f, len(result_v)).oriented:
+                raise ArrangementError("the surface left after taking out the faces written with their reverse "
+                                       "is not closed")
+            return Arrangement(vertices=result_v, faces=result_f, crossing_pairs=0, split_faces=0, new_vertices=0,
+                               patches=0, max_winding=1, cancelled_faces=cancelled)
     try:
         out_v, kept, stats = _arrange(v, f, crossing)
         turned = False
@@ -564,7 +603,36 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
         else:
             merged = 0
     return Arrangement(vertices=result_v, faces=result_f, crossings_left=len(after.crossing), turned=turned,
-                       merged_points=merged, **stats)
+                       merged_points=merged, cancelled_faces=cancelled, **stats)
+
+
+def _cancel_reversed(faces: np.ndarray) -> np.ndarray:
+    """(m,) bool: the faces kept once every face written with its reverse (the same three vertex ids in opposite
+    cyclic order) is taken out with it, pair by pair (``k`` copies one way and ``j`` the other leave ``|k − j|``).
+
+    The pair is the zero chain: its two faces' terms cancel exactly in the divergence-theorem sums (Rigid Body
+    Motion, Ch. 4) and in the solid-angle sum of the winding number at every point off the triangle, so
+    ``{w ≥ 1}`` is the same up to the triangle itself (measure zero); each directed edge loses one use and so
+    does its reverse, so a closed surface stays closed."""
+    f = np.asarray(faces, dtype=np.int64)
+    keep = np.ones(len(f), dtype=bool)
+    if len(f) < 2:
+        return keep
+    canon = np.sort(f, axis=1)
+    _, key, count = np.unique(canon, axis=0, return_inverse=True, return_counts=True)
+    key = key.reshape(-1)
+    repeated = np.flatnonzero(count[key] > 1)
+    if not len(repeated):
+        return keep
+    even = _cyclic_parity(f[repeated])
+    groups: dict[int, tuple[list[int], list[int]]] = {}
+    for idx, k, e in zip(repeated.tolist(), key[repeated].tolist(), even.tolist()):
+        groups.setdefault(k, ([], []))[0 if e else 1].append(idx)
+    for one_way, other_way in groups.values():
+        pairs = min(len(one_way), len(other_way))
+        keep[one_way[:pairs]] = False
+        keep[other_way[:pairs]] = False
+    return keep
 
 
 def _merge_close_points(vertices: np.ndarray, faces: np.ndarray, n_input: int) -> tuple[np.ndarray, np.ndarray, int]:
@@ -781,10 +849,28 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
     n_all = len(out_v)
     cut = {min(a, b) * n_all + max(a, b) for _, a, b in cut_edges}
     patch, n_patches = _patches(out_faces, n_all, cut)
-    front = _label_patches(out_v, out_faces, out_source, patch, n_patches, v, f)
+
+    def exact_point(vid: int) -> tuple[Fraction, Fraction, Fraction]:
+        h = hom.get(vid)
+        if h is None:
+            return (Fraction(float(out_v[vid, 0])), Fraction(float(out_v[vid, 1])), Fraction(float(out_v[vid, 2])))
+        den = exact.scale * h[3]
+        return (h[0] / den, h[1] / den, h[2] / den)
+
+    front = _label_patches(out_v, out_faces, out_source, patch, n_patches, v, f, exact_point)
     w_front = front[patch]
     first_piece = len(whole)                  # cut edges border pieces only
-    _check_curves(out_faces[first_piece:], n_all, cut, out_source[first_piece:], w_front[first_piece:])
+    try:
+        _check_curves(out_faces[first_piece:], n_all, cut, out_source[first_piece:], w_front[first_piece:])
+    except ArrangementError as exc:
+        # a float evaluation is certified at the rounded centroid of a piece, which rounding may put on the other
+        # side of a face lying within an ulp of the piece (a pleat): every patch labelled again by exact rays
+        if n_patches * len(f) > MAX_EXACT_RAY_WORK:
+            raise ArrangementError(f"{exc}; labelling the {n_patches:,} patches by exact rays through "
+                                   f"{len(f):,} faces is past the work bound of {MAX_EXACT_RAY_WORK:,}") from None
+        front = _exact_labels(out_faces, out_source, patch, n_patches, v, f, exact_point)
+        w_front = front[patch]
+        _check_curves(out_faces[first_piece:], n_all, cut, out_source[first_piece:], w_front[first_piece:])
 
     # 4. the faces bounding {w ≥ 1}, compacted
     kept = out_faces[w_front == 0]
@@ -833,8 +919,11 @@ def _common_line(exact: _Exact, faces: np.ndarray, trio: tuple[int, ...]) -> boo
 
 
 def _label_patches(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndarray, patch: np.ndarray,
-                   n_patches: int, v: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """(p,) int: the winding number in front of each patch, from one certified evaluation at a face of it."""
+                   n_patches: int, v: np.ndarray, f: np.ndarray,
+                   exact_point: Callable[[int], tuple[Fraction, Fraction, Fraction]] | None = None) -> np.ndarray:
+    """(p,) int: the winding number in front of each patch, from one certified evaluation at a face of it
+    (``exact_point``: a vertex id of the split surface → its exact coordinates, for the exact ray when no float
+    evaluation can be certified; without it the input's float coordinates, which are exact for input vertices)."""
     p0, p1, p2 = out_v[out_faces[:, 0]], out_v[out_faces[:, 1]], out_v[out_faces[:, 2]]
     u, w = p1 - p0, p2 - p0
     area2 = ((u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1]) ** 2 + (u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2]) ** 2
@@ -852,9 +941,150 @@ def _label_patches(out_v: np.ndarray, out_faces: np.ndarray, out_source: np.ndar
                 front[p] = int(np.floor(total))
                 break
         else:
-            raise ArrangementError(f"the winding number of a patch of {len(members):,} faces could not be certified "
-                                   "(every point tried is too close to another surface for float64)")
+            got = _exact_front(out_faces, out_source, members[:_TRIES], v, f, exact_point)
+            if got is None:
+                raise ArrangementError(f"the winding number of a patch of {len(members):,} faces could not be "
+                                       "certified (every point tried is too close to another surface for float64, "
+                                       "and no exact ray from a piece of it was free of degeneracy)")
+            front[p] = got
     return front
+
+
+#: Work bound of labelling every patch by exact rays (:func:`_exact_labels`): patches × faces of the shell.
+MAX_EXACT_RAY_WORK = 2_000_000
+
+
+def _exact_labels(out_faces: np.ndarray, out_source: np.ndarray, patch: np.ndarray, n_patches: int, v: np.ndarray,
+                  f: np.ndarray, exact_point: Callable[[int], tuple[Fraction, Fraction, Fraction]]) -> np.ndarray:
+    """(p,) int: the winding number in front of each patch, every one from an exact ray (:func:`_exact_front`)."""
+    order = np.argsort(patch, kind="stable")
+    starts = np.searchsorted(patch[order], np.arange(n_patches + 1))
+    front = np.zeros(n_patches, dtype=np.int64)
+    for p in range(n_patches):
+        got = _exact_front(out_faces, out_source, order[starts[p]:starts[p + 1]][:_TRIES], v, f, exact_point)
+        if got is None:
+            raise ArrangementError(f"the winding number of a patch of {starts[p + 1] - starts[p]:,} faces could not "
+                                   "be decided by an exact ray (every ray tried was degenerate)")
+        front[p] = got
+    return front
+
+
+#: Ray directions tried by :func:`_ray_front` (added to the face's normal scaled up), before giving up.
+_RAY_TILTS = ((0, 0, 0), (3, -5, 7), (-11, 2, 5), (7, 13, -3), (-2, -9, -13))
+
+
+def _exact_front(out_faces: np.ndarray, out_source: np.ndarray, members: np.ndarray, v: np.ndarray,
+                 f: np.ndarray, exact_point: Callable[[int], tuple[Fraction, Fraction, Fraction]] | None
+                 ) -> int | None:
+    """The winding number in front of a patch from an exact ray (:func:`_ray_front`) at the exact centroid of one
+    of its pieces, or None when none gives an answer (a piece with a new point and no ``exact_point``, or every
+    ray degenerate)."""
+    n = len(v)
+    for k in members.tolist():
+        corners = out_faces[k].tolist()
+        if exact_point is None and max(corners) >= n:
+            continue
+        pts = [exact_point(c) if exact_point is not None else tuple(Fraction(float(x)) for x in v[c])
+               for c in corners]
+        x, y, z = ((pts[0][i] + pts[1][i] + pts[2][i]) / 3 for i in range(3))
+        got = _ray_front(v, f, int(out_source[k]), (x, y, z))
+        if got is not None:
+            return got
+    return None
+
+
+_Q3 = tuple[Fraction, Fraction, Fraction]
+
+
+def _qsub(a: _Q3, b: _Q3) -> _Q3:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _qcross(a: _Q3, b: _Q3) -> _Q3:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _qdot(a: _Q3, b: _Q3) -> Fraction:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _ray_front(v: np.ndarray, f: np.ndarray, face: int,
+               point: tuple[Fraction, Fraction, Fraction] | None = None) -> int | None:
+    """Winding number, exactly, of the closed surface ``(v, f)`` just in front of ``point`` on ``face`` (exact
+    coordinates, m; its centroid when None).
+
+    A ray from ``p`` into the front of ``face`` (direction ``d`` with ``d·n > 0``) leaves ``face`` at ``p`` and
+    crosses every other face it meets once; ``w(x) = Σ ±1`` over those crossings (+1 where the ray leaves a face
+    through its back, from behind to in front, the surface wound outward), since ``w = 0`` far away.  The ray is
+    the segment to ``q = p + L d`` beyond every vertex.  A float filter keeps the faces whose projection along
+    ``d`` comes within a margin (1e-9 of the mesh's reach from ``p``, far above the filter's rounding) of ``p`` and
+    that reach in front of ``p``; only those can be crossed.  For them every test is an exact sign on rationals:
+    the sides of ``p`` and ``q`` for the face's plane, and the sides of the face's three edges seen along the line
+    ``pq``.  A ray through an edge or a corner, or ``p`` lying on another face, is degenerate: the next direction
+    of ``_RAY_TILTS`` is tried; None when all are.  ``p`` is assumed to lie on ``face`` (exactly in its plane; only
+    the other faces are counted).
+    """
+    corners_f = v[f]
+    if point is None:
+        a, b, c = corners_f[face]
+        x, y, z = ((Fraction(float(a[i])) + Fraction(float(b[i])) + Fraction(float(c[i]))) / 3 for i in range(3))
+        point = (x, y, z)
+    p = point
+    pf = np.array([float(t) for t in p])
+
+    def exact(row: np.ndarray) -> tuple[Fraction, Fraction, Fraction]:
+        return (Fraction(float(row[0])), Fraction(float(row[1])), Fraction(float(row[2])))
+
+    a0, b0, c0 = (exact(r) for r in corners_f[face])
+    normal = _qcross(_qsub(b0, a0), _qsub(c0, a0))
+    nf = np.array([float(t) for t in normal])
+    if not np.any(nf):
+        return None
+    nf = nf / np.linalg.norm(nf)
+    rel = corners_f - pf
+    reach = float(np.max(np.abs(rel))) * 2.0 + 1e-300
+    margin = 1e-9 * reach
+    for tilt in _RAY_TILTS:
+        df = nf + 0.05 * np.asarray(tilt, dtype=np.float64) / 16.0
+        d = (Fraction(float(df[0])), Fraction(float(df[1])), Fraction(float(df[2])))
+        if _qdot(d, normal) <= 0:
+            continue
+        unit = df / np.linalg.norm(df)
+        u = np.cross(unit, [1.0, 0.0, 0.0] if abs(unit[0]) < 0.9 else [0.0, 1.0, 0.0])
+        u /= np.linalg.norm(u)
+        w = np.cross(unit, u)
+        along, cu, cw = rel @ unit, rel @ u, rel @ w
+        near = ((cu.min(axis=1) <= margin) & (cu.max(axis=1) >= -margin) & (cw.min(axis=1) <= margin)
+                & (cw.max(axis=1) >= -margin) & (along.max(axis=1) >= -margin))
+        near[face] = False
+        length = Fraction(2.0 ** (int(np.ceil(np.log2(2 * reach / float(np.linalg.norm(df))))) + 1))
+        q = (p[0] + length * d[0], p[1] + length * d[1], p[2] + length * d[2])
+        ray = _qsub(q, p)
+        total, degenerate = 0, False
+        for g in np.flatnonzero(near).tolist():
+            a, b, c = (exact(r) for r in corners_f[g])
+            n = _qcross(_qsub(b, a), _qsub(c, a))
+            sp, sq = _sign(_qdot(n, _qsub(p, a))), _sign(_qdot(n, _qsub(q, a)))
+            if sp == sq and sp != 0:
+                continue
+            if sq == 0:
+                degenerate = True
+                break
+            e = [_sign(_qdot(ray, _qcross(_qsub(x, p), _qsub(y, p)))) for x, y in ((a, b), (b, c), (c, a))]
+            if 0 in e:
+                if (1 in e and -1 in e) or (sp != 0 and e.count(0) == 3):
+                    continue                        # the line passes beside the triangle (or ray parallel)
+                degenerate = True
+                break
+            if not (e[0] == e[1] == e[2]):
+                continue
+            if sp == 0:                             # p lies on this face: no winding number there
+                degenerate = True
+                break
+            total += 1 if sp < 0 else -1
+        if not degenerate:
+            return total
+    return None
 
 
 def _check_curves(faces: np.ndarray, n_vertices: int, cut: set[int], source: np.ndarray, w_front: np.ndarray) -> None:
