@@ -158,3 +158,36 @@ def fit_volume(kind: str, tensor: np.ndarray, volume: float, fit_scale: float = 
         return float(np.pi * r * r * 2 * h[2])
     half = max(0.0, float(h[2]) - 0.5 * r)
     return float(np.pi * r * r * 2 * half + 4 / 3 * np.pi * r ** 3)
+
+
+# ------------------------------------------------------------------------------------------ round-off of estimates
+def far_part_with_a_hole(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """``(vertices, closed faces, faces with a hole, recipe)``: a finely divided box or icosphere (so that the
+    hole, its smallest face or that face and a neighbour, is small and the patch's bound is near the round-off),
+    0.1 µm..10 m across, turned, near the origin or 1e3..1e8 of its size away, float32-quantised a third of the
+    time (near placements only: float32 carries ~7 digits), wound outward by its exact rational volume."""
+    from adversary_solids import _outward_exactly, box, icosphere, random_rotation
+    kind = int(rng.integers(2))
+    v, f = box(rng.uniform(0.2, 2.0, size=3), subdivide=int(rng.integers(1, 3))) if kind == 0 else \
+        icosphere(float(rng.uniform(0.3, 1.0)), int(rng.integers(2, 4)))
+    size = float(10.0 ** rng.uniform(-7, 1))
+    single = rng.random() < 0.33
+    far = 0.0 if single or rng.random() < 0.3 else float(10.0 ** rng.uniform(3, 8))
+    v = (v * size) @ random_rotation(rng).T + rng.normal(size=3) * far * size
+    if single:
+        v = v.astype(np.float32).astype(np.float64)
+    f = _outward_exactly(v, f)
+    area = np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+    lost = [int(np.argmin(area))]
+    if rng.random() < 0.5:                       # and a face beside it (sharing an edge)
+        edges = {frozenset(e) for e in ((f[lost[0], 0], f[lost[0], 1]), (f[lost[0], 1], f[lost[0], 2]),
+                                        (f[lost[0], 2], f[lost[0], 0]))}
+        for j, row in enumerate(f):
+            if j != lost[0] and any(frozenset(e) in edges for e in ((row[0], row[1]), (row[1], row[2]),
+                                                                   (row[2], row[0]))):
+                lost.append(j)
+                break
+    holed = np.delete(f, lost, axis=0)
+    recipe = (f"{'box' if kind == 0 else 'icosphere'} {len(f)} faces, size {size:.2g} m, far {far:.2g} sizes, "
+              f"{'float32' if single else 'float64'}, {len(lost)} face(s) lost")
+    return v, f, holed, recipe
