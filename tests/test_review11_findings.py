@@ -194,3 +194,16 @@ def test_d4_a_cavity_crossing_two_bodies_is_the_winding_solid_or_refused():
     assert props.mass == pytest.approx(2.75, rel=1e-12), props.mass
     assert props.mesh.certificate.kind in ("united", "exact", "unverified")
     assert "0.625 m³ of shared volume" not in texts
+
+
+# ------------------------------------------------------------------------------------------ D5
+@pytest.mark.xfail(strict=True, reason="D5 (review 11, open): an outward box (0.015625 m³) flush inside an inward "
+                   "void that crosses a body and reaches outside every body; R4's misread-nesting path (not R4c) "
+                   "answers 'estimate' 1.6875 ±0.93 % for the file's winding solid 1.65625, and its warning calls "
+                   "the union 1.70312 m³ 'the file's own winding' (same before and after D4's fix)")
+def test_d5_grid_boxes_and_voids_meeting_at_faces_hold_their_bounds():
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+    import bench_review11 as bench
+    import adversary_solids as solids
+    recipe, verdict, _, _ = bench.run_winding("grid_boxes", 1303, 71, False)
+    assert not (verdict.wrong is not None and solids.silent(verdict)), (recipe, verdict)
