@@ -274,6 +274,39 @@ def judged(case, truth, bound_rel, repair):
     return S.Verdict(label, message=numbers)
 
 
+def _depth_reading_of_three(local, size, shift):
+    """R4's reading of three pieces of which one lies wholly inside one other (libigl winding numbers of its
+    corners) and meets the third in no volume (qhull): the inner one is a cavity, so the truth is the union of
+    the other two minus it (review 11: seed 133 case 240 is this reading, which the two-piece rule alone did not
+    accept); None for any other arrangement."""
+    inside = S._contained(local)
+    if inside.sum() != 1:
+        return None
+    k = int(np.flatnonzero(inside)[0])
+    rest = [p for j, p in enumerate(local) if j != k]
+    for p in rest:
+        both, _ = union_truth([local[k], p], size)
+        alone = S.float_moments(*local[k])[0] + S.float_moments(*p)[0] - both.volume
+        contains = S._contained([local[k], p])[0]
+        if not contains and abs(alone) > 1e-12 * size ** 3:
+            return None                             # the inner piece also crosses the third: not this reading
+    outer, _ = union_truth(rest, size)
+    vi, ci, si = S.float_moments(*local[k])
+    vol = outer.volume - vi
+    first = outer.volume * (outer.centroid) - vi * ci
+    second_outer = _second_about_origin(outer)
+    second = second_outer - (si + vi * np.outer(ci, ci))
+    cen = first / vol
+    return S.Truth(vol, cen + shift, S._inertia(second - vol * np.outer(cen, cen)), "depth reading of three")
+
+
+def _second_about_origin(truth):
+    """``∫ x xᵀ dV`` of a truth (volume, centroid, tensor about the centroid), from its tensor: the central
+    second moment is ``tr(I)/2·1 − I``."""
+    central = 0.5 * np.trace(truth.inertia) * np.eye(3) - truth.inertia
+    return central + truth.volume * np.outer(truth.centroid, truth.centroid)
+
+
 def run(mode, seed, i, repair):
     rng = np.random.default_rng([seed, i])
     pieces, recipe = make(mode, rng)
@@ -293,6 +326,13 @@ def run(mode, seed, i, repair):
     bound_rel = err / abs(truth.volume)
     verdict = judged(case, truth, bound_rel, repair)
     inside = S._contained(local) if verdict.wrong is not None and len(local) == 2 else np.zeros(0, dtype=bool)
+    if verdict.wrong is not None and len(local) == 3:
+        alt3 = _depth_reading_of_three(local, size, shift)
+        if alt3 is not None:
+            other = judged(case, alt3, bound_rel, repair)
+            if other.wrong is None:
+                return case, other, bound_rel
+            case.recipe += "; one piece wholly inside another (the depth reading misses too)"
     if inside.any() and not inside.all():
         # R4's reading (issue 21: orient by nesting depth): a piece wholly inside the other is its cavity
         outer, inner = (local[1], local[0]) if inside[0] else (local[0], local[1])

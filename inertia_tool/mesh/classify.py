@@ -106,7 +106,8 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     # other), the solid is {w ≥ 1} of the shells as the file winds them, formed without owners
     inward = inward_crossing_shells(file_volumes, flip, crossing_with) if touch.complete else np.zeros(0, bool)
     held_cavities = bool(inward.any()) and bool(np.all(depth[inward] % 2 == 1))   # each inside a body, as wound
-    by_winding = bool(shared or crossed_cavities or held_cavities) and misread is None and groups is None
+    spanning = _cavities_across_bodies(file_volumes, flip, crossing_with) if touch.complete else 0
+    by_winding = bool(shared or crossed_cavities or held_cavities or spanning) and misread is None and groups is None
     if by_winding:      # shells inside others keep the file's winding; a body inside out on its own is still turned
         flip = flip & (depth == 0)
     quiet = np.zeros(n_shells, dtype=bool)
@@ -203,6 +204,22 @@ def _cavities_in_overlap(count: int) -> str:
     """The subject of the notes on cavities inside overlapping bodies: "2 cavities lie inside bodies that ..."."""
     plural = count > 1
     return f"{count} cavit{'ies' if plural else 'y'} lie{'' if plural else 's'} inside bodies that overlap one another"
+
+
+def _cavities_across_bodies(volumes: np.ndarray, flip: np.ndarray, crossing_with: np.ndarray) -> int:
+    """R4c: shells wound inward that cross two or more outward ones.  No one body owns such a cavity, and cut from
+    one owner alone its part in the others stays material while the note says ``{w ≥ 1}`` (review 11, D4: 2.875 m³
+    for 2.75)."""
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    if not len(pairs):
+        return 0
+    wound = np.where(flip, -np.sign(volumes), np.sign(volumes))
+    bodies: dict[int, set] = {}
+    for a, b in ((0, 1), (1, 0)):
+        hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
+        for cavity, body in pairs[hit][:, [a, b]].tolist():
+            bodies.setdefault(cavity, set()).add(body)
+    return sum(1 for crossed in bodies.values() if len(crossed) >= 2)
 
 
 def _crossing_cavities(crossing_with: np.ndarray, depth: np.ndarray, owner: np.ndarray) -> int:

@@ -47,7 +47,7 @@ from ..mesh.read import RawMesh
 from .description import GeometryElement, LinkGeometry, RobotDescription
 from ..rounding import round_up
 from ..mesh.uncertainty import Uncertainty
-from ..tolerances import ESTIMATE_MAX_MASS_RTOL
+from ..tolerances import EIGEN_ROUNDOFF_RTOL, ESTIMATE_MAX_MASS_RTOL
 
 __all__ = ["element_mass_properties", "link_mass_properties", "link_inertials", "LinkInertial", "mesh_properties",
            "points_inside_element", "element_bounds", "LinkUncertainty", "METHODS", "MODEL_DENSITY", "fitted_element",
@@ -601,7 +601,9 @@ def fitted_mass_bound(element: GeometryElement, mesh: MassProperties, bounds) ->
     true tensor within ``ε_I ‖Î‖_F`` (Frobenius).  By the Hoffman–Wielandt inequality the sorted principal moments
     move by ``d`` with ``‖d‖₂ ≤ δ = ε_I ‖Î‖_F``, so each ``s_k = I_i + I_j − I_k`` of the fit's half-sizes
     ``h_k = √(3 s_k / (2 V))`` by ``|d_i + d_j − d_k| ≤ √3 δ`` (Cauchy–Schwarz; reached by an error along the
-    principal axes).  Every fitted primitive's volume (box
+    principal axes); the moments as float64 computes them are a further ``EIGEN_ROUNDOFF_RTOL ‖Î‖_F`` off the exact
+    ones of ``Î``, added to ``δ`` (a flat part's smallest ``s_k`` is below that round-off).  Every fitted
+    primitive's volume (box
     and ellipsoid ``∝ h_x h_y h_z``, sphere ``∝ mean(h)³``, cylinder ``π r² 2h_z``, capsule
     ``2π r² max(0, h_z − r/2) + 4/3 π r³`` with ``r = (h_x + h_y)/2``, whose derivative in ``r`` is
     ``4π r h_z + π r² > 0`` while the cylinder part is there) grows with each ``h_k``, so the true fit's volume
@@ -614,7 +616,8 @@ def fitted_mass_bound(element: GeometryElement, mesh: MassProperties, bounds) ->
     if not (np.isfinite(bounds.inertia) and np.isfinite(bounds.mass) and volume > 0 and bounds.mass < 1):
         return None
     moments = np.linalg.eigvalsh(tensor)[::-1]
-    delta = float(bounds.inertia) * float(np.linalg.norm(tensor))
+    # the moments as computed are within EIGEN_ROUNDOFF_RTOL ‖Î‖_F of the exact ones of Î (review 11, D3)
+    delta = (float(bounds.inertia) + EIGEN_ROUNDOFF_RTOL) * float(np.linalg.norm(tensor))
     s = _inertia_box_sums(moments)
 
     def fitted_volume(sums: np.ndarray, vol: float) -> float:
