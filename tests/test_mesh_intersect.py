@@ -392,8 +392,11 @@ def triangle_pairs(draw):
     return v, faces, shared
 
 
+# 1,000 examples (3,000 until tidy11): each of seven mutants of the numpy twin's classifier (closed point-in-
+# triangle test made open, strict segment overlap, an edge in the other plane counted as proper, ...) fails
+# within the first 462 of CI's derandomized sequence.
 @_each_example_on_both_twins
-@settings(max_examples=3000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=1000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(triangle_pairs(), st.booleans(), st.integers(0, 2))
 def test_triangle_pair_matches_the_independent_classifier(case, swap, roll):
     v, faces, shared = case
@@ -450,8 +453,10 @@ def adjacent_pairs(draw):
     return v, faces, shared
 
 
+# 700 examples (2,000 until tidy11): the same mutants of the numpy twin fail within the first 132 of CI's
+# derandomized sequence here (an "along the shared corner" test loosened from all to any coordinate: 12).
 @_each_example_on_both_twins
-@settings(max_examples=2000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=700, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(adjacent_pairs(), st.booleans())
 def test_adjacent_pair_near_one_plane_matches_the_independent_classifier(case, swap):
     """Faces sharing an edge or a corner, coplanar or within a few ulps of it (folded over, side by side,
