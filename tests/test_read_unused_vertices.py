@@ -151,3 +151,25 @@ def test_the_callers_arrays_are_left_alone():
     raw = load_mesh((v, f))
     assert np.array_equal(v, v0) and np.array_equal(f, f0)
     assert np.array_equal(raw.vertices, v0[1:]) and np.array_equal(raw.faces, f0 - 1)
+
+
+def test_stl_vertices_are_all_used_so_the_reader_skips_the_pass(tmp_path):
+    """The reader leaves out unused vertices on every path but STL's, whose vertices are the weld of the faces'
+    corners (so every one is used): the premise checked on the bundled meshes, a binary soup and an ASCII file."""
+    from pathlib import Path
+
+    import trimesh
+
+    paths = sorted((Path(__file__).resolve().parents[1] / "meshes").glob("*.stl"))
+    v, f = torus(1.0, 0.3, 24, 12)
+    soup = trimesh.Trimesh(v[f].reshape(-1, 3), np.arange(3 * len(f)).reshape(-1, 3), process=False)
+    for name, kind in (("soup.stl", "stl"), ("ascii.stl", "stl_ascii")):
+        data = soup.export(file_type=kind)
+        (tmp_path / name).write_bytes(data if isinstance(data, bytes) else data.encode())
+        paths.append(tmp_path / name)
+    assert len(paths) >= 5
+    for path in paths:
+        raw = load_mesh(str(path))
+        used = np.zeros(len(raw.vertices), dtype=bool)
+        used[raw.faces.ravel()] = True
+        assert used.all(), path

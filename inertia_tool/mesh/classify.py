@@ -16,10 +16,11 @@ import numpy as np
 
 from ..errors import InsideOutWarning, MeshResolvedWarning
 from ..integrals import VolumeMoments
-from ..tolerances import COINCIDENT_RTOL, TOUCH_VOLUME_RTOL
+from ..tolerances import TOUCH_VOLUME_RTOL
 from .intersect import SurfaceContacts, surface_contacts
 from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
                      inward_crossing_shells, misread_nesting, nested_copies,
+                     rounding_volumes,
                      orient_by_depth, outward_crossing_groups, shell_contacts, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
@@ -90,7 +91,7 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     within, crossing_with = None, touch.crossing_with
     copies = np.zeros((0, 2), dtype=np.int64)
     if touch.complete:
-        rounding = _rounding_volumes(v, shells.moments)
+        rounding = rounding_volumes(v, shells.moments)
         within, crossing_with = _within(v, f, labels, file_volumes, crossing_with, rounding)
         nest = _decide_past_partners(v, f, labels, n_shells, nest, crossing_with)
         crossing_with, touch_within, copies = _copies_nested(file_volumes, nest, crossing_with, touch_within,
@@ -178,26 +179,21 @@ def _copies_nested(volumes: np.ndarray, nest: Nesting | None, crossing_with: np.
         held = (np.asarray(nest.winding) != 0) & (shell != other) & ~undecided[shell]
         pairs.append(np.c_[shell[held], other[held]])
     nested = np.concatenate(pairs).reshape(-1, 2)
-    if len(cross) and len(nested):              # pairs that cross have no nesting (their copies are R4's already)
-        n = int(max(nested.max(), cross.max())) + 1
-        crossing_keys = np.union1d(cross[:, 0] * n + cross[:, 1], cross[:, 1] * n + cross[:, 0])
-        nested = nested[~np.isin(nested[:, 0] * n + nested[:, 1], crossing_keys)]
+    nested = _without_pairs(nested, cross)      # pairs that cross have no nesting (their copies are R4's already)
     copies = nested[nested_copies(volumes, nested, rounding=rounding)] if len(nested) else nested
     if not len(copies):
         return cross, touching, np.zeros((0, 2), dtype=np.int64)
     copies = np.unique(np.sort(copies, axis=1), axis=0)
-    if len(touching):
-        n = int(max(touching.max(), copies.max())) + 1
-        keys = np.union1d(copies[:, 0] * n + copies[:, 1], copies[:, 1] * n + copies[:, 0])
-        touching = touching[~np.isin(touching[:, 0] * n + touching[:, 1], keys)]
-    return np.concatenate([cross, copies]), touching, copies
+    return np.concatenate([cross, copies]), _without_pairs(touching, copies), copies
 
 
-def _rounding_volumes(v: np.ndarray, moments: Sequence[VolumeMoments]) -> np.ndarray:
-    """(s,) m³: each shell's rounding neighbourhood, ``2·δ·area`` with δ = ``COINCIDENT_RTOL`` times the largest
-    |coordinate| (R0's rounding radius; :func:`~.policy.nested_copies`)."""
-    delta = COINCIDENT_RTOL * float(np.max(np.abs(v))) if len(v) else 0.0
-    return np.array([2.0 * delta * m.area for m in moments], dtype=np.float64)
+def _without_pairs(pairs: np.ndarray, drop: np.ndarray) -> np.ndarray:
+    """The (k, 2) shell ``pairs`` that are not in ``drop`` (compared unordered)."""
+    if not (len(pairs) and len(drop)):
+        return pairs
+    n = int(max(pairs.max(), drop.max())) + 1
+    keys = np.union1d(drop[:, 0] * n + drop[:, 1], drop[:, 1] * n + drop[:, 0])
+    return pairs[~np.isin(pairs[:, 0] * n + pairs[:, 1], keys)]
 
 
 def _cavities_in_overlap(count: int) -> str:
@@ -266,7 +262,7 @@ def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
     within = None
     if touch is not None and touch.complete:
-        rounding = _rounding_volumes(vertices, shells)
+        rounding = rounding_volumes(vertices, shells)
         within, crossing_with = _within(vertices, faces, labels, vols, crossing_with, rounding)
         crossing_with, touch_within, _ = _copies_nested(vols, nest, crossing_with, touch_within, rounding)
     flip, owner, depth = orient_by_depth(vols, nest, crossing_with,

@@ -193,7 +193,7 @@ if TYPE_CHECKING:
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
            "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding", "nested_copies",
-           "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
+           "rounding_volumes", "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
            "near_copies", "NearCopies", "near_copies_message", "MisreadNesting", "misread_nesting",
            "outward_crossing_groups",
@@ -588,6 +588,13 @@ def nested_copies(volumes: np.ndarray, nested: np.ndarray, *, rtol: float = TOUC
     p = np.asarray(nested, dtype=np.int64).reshape(-1, 2)
     signed = np.asarray(volumes, dtype=np.float64)
     return _copies(signed, p, np.abs(signed[p[:, 0]]), rtol, rounding)
+
+
+def rounding_volumes(vertices: np.ndarray, moments: Sequence[VolumeMoments]) -> np.ndarray:
+    """(s,) m³: each shell's rounding neighbourhood for R4's copy rule (:func:`nested_copies`), ``2·δ·area`` with
+    δ = ``COINCIDENT_RTOL`` times the largest |coordinate| (R0's rounding radius)."""
+    delta = COINCIDENT_RTOL * float(np.max(np.abs(vertices))) if len(vertices) else 0.0
+    return np.array([2.0 * delta * m.area for m in moments], dtype=np.float64)
 
 
 def _groups(n: int, pairs: np.ndarray) -> np.ndarray:

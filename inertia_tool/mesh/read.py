@@ -1279,8 +1279,10 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
             declared = None
             rounding = 0.0                  # file units until scaled below
             parts: tuple[PartTag, ...] = ()
+            welded = False
             if suffix == ".stl":
                 vertices, faces, n, magnitude = _read_stl(path, max_faces, data)
+                welded = True                   # the weld's vertices are the faces' corners: every one is used
                 if magnitude is not None:          # binary: float32 coordinates
                     from .precision import float32_rounding
                     rounding = float32_rounding(magnitude)
@@ -1332,7 +1334,9 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
         owned = False                      # may be the caller's own array: never modified
         rounding = 0.0
         parts = ()
-    vertices, faces, owned = _used_vertices(vertices, faces, owned)
+        welded = False
+    if not welded:                         # a pass over every corner, not paid on the STL hot path
+        vertices, faces, owned = _used_vertices(vertices, faces, owned)
     if scale != 1.0:
         if owned and vertices.dtype == np.float64 and vertices.flags.writeable:
             vertices *= scale
