@@ -145,8 +145,7 @@ def run_winding(mode, seed, i, repair):
         recipe += f"; {len(free)} void(s) meeting no body: read as bodies"
     truth, err = winding_truth(local[:nb], local[nb:], size, lambda w: w >= 1)
     other, err2 = winding_truth(local[:nb], local[nb:], size, lambda w: w != 0)
-    delta = max(float(np.abs((vg - shift) - vl).max()) for (vg, _), (vl, _) in zip(given, local))
-    err += sum(2.5 * delta * C._area(v, f) for v, f in local)
+    err += C.rounding_allowance(given, local, shift)
     given = given[:nb] + [S.flipped(p) for p in given[nb:]]
     v, f = S.concat(*given)
     if truth is None:
@@ -185,15 +184,7 @@ def main_winding(args):
     cols = ("cases", "exact", "united", "estimate", "summed", "unverified", "refused", "no solid", "crashed",
             "silent wrong", "silent wrong (w≠0 reading)", "wrong (honest label)", "truth failed")
     print(f"{args.cases} cases, seed {args.seed}, repair={args.repair}, {time.process_time() - t0:.0f} s CPU")
-    print("| mode | " + " | ".join(cols) + " |")
-    print("|---|" + "---:|" * len(cols))
-    tot: Counter = Counter()
-    for mode in MODES:
-        tot.update(table[mode])
-        print(f"| {mode} | " + " | ".join(str(table[mode][c]) for c in cols) + " |")
-    print("| all | " + " | ".join(str(tot[c]) for c in cols) + " |")
-    for i, mode, text in fails:
-        print(f"- case {i} ({mode}): {text}")
+    C.print_table(table, MODES, cols, fails)
 
 
 def main_pairs(args):

@@ -317,9 +317,7 @@ def run(mode, seed, i, repair):
         given = [given[0], S.flipped(given[1]), given[2], S.flipped(given[3])]
     else:
         truth, err = union_truth(local, size)
-    delta = max(float(np.abs((vg - shift) - vl).max()) for (vg, _), (vl, _) in zip(given, local))
-    # the δ-neighbourhood of every piece's surface (Steiner, with room for the δ² and δ³ terms)
-    err += sum(2.5 * delta * _area(v, f) for v, f in local)
+    err += rounding_allowance(given, local, shift)
     truth = S.Truth(truth.volume, truth.centroid + shift, truth.inertia, truth.source)
     v, f = S.concat(*given)
     case = S.Case(mode, v, f, truth, f"{recipe}; {where}")
@@ -381,16 +379,28 @@ def main(argv=None):
     cols = ("cases", "exact", "united", "estimate", "summed", "unverified", "refused", "crashed", "silent wrong",
             "wrong (honest label)", "truth failed")
     print(f"{args.cases} cases, seed {args.seed}, repair={args.repair}, {time.time() - t0:.0f} s")
+    print_table(table, MODES, cols, fails)
+    return 0
+
+
+def print_table(table, modes, cols, fails):
+    """The counts per mode (and all) as a Markdown table, then one line per failed case."""
     print("| mode | " + " | ".join(cols) + " |")
     print("|---|" + "---:|" * len(cols))
     tot: Counter = Counter()
-    for mode in MODES:
+    for mode in modes:
         tot.update(table[mode])
         print(f"| {mode} | " + " | ".join(str(table[mode][c]) for c in cols) + " |")
     print("| all | " + " | ".join(str(tot[c]) for c in cols) + " |")
     for i, mode, text in fails:
         print(f"- case {i} ({mode}): {text}")
-    return 0
+
+
+def rounding_allowance(given, local, shift):
+    """m³: the δ-neighbourhood of every piece's surface (Steiner, with room for the δ² and δ³ terms), δ the
+    largest move rounding made when the pieces were placed (``given`` less ``shift`` against ``local``)."""
+    delta = max(float(np.abs((vg - shift) - vl).max()) for (vg, _), (vl, _) in zip(given, local))
+    return sum(2.5 * delta * _area(v, f) for v, f in local)
 
 
 if __name__ == "__main__":

@@ -1191,6 +1191,25 @@ def compare(props, truth, density=1.0):
     return dvol, dcom, din
 
 
+def repaired_estimate_errors(vertices, damaged_faces, truth):
+    """The part with ``damaged_faces`` repaired at density 1 and judged against ``truth`` (the part as it was):
+    ``(errors, uncertainty)`` with :func:`compare`'s errors, after checking the answer is an estimate with
+    bounds; None when it is refused with a reason (no number to judge)."""
+    import warnings
+
+    from inertia_tool import mass_properties
+    from inertia_tool.errors import InvalidMeshError
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            props = mass_properties((vertices, damaged_faces), density=1.0, repair=True)
+    except InvalidMeshError:
+        return None
+    unc = props.mesh.uncertainty
+    assert props.mesh.certificate.kind == "estimate" and unc is not None
+    return compare(props, truth), unc
+
+
 def judge(case, repair=False):
     """:func:`judge_truth` against the case's truth, or against an allowed alternative reading when that one
     holds."""
