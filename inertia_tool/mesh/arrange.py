@@ -53,6 +53,7 @@ from __future__ import annotations
 from fractions import Fraction
 from collections.abc import Callable
 from itertools import combinations
+from typing import TypeVar
 
 import numpy as np
 
@@ -138,15 +139,19 @@ class Arrangement:
 
 # -- exact helpers ---------------------------------------------------------------------------------------------
 
-def _cross(a: tuple[int, ...], b: tuple[int, ...]) -> tuple[int, int, int]:
+# Exact 3-vectors: integers (scaled coordinates) or fractions (points found on a face), never mixed in one call.
+_N = TypeVar("_N", int, Fraction)
+
+
+def _cross(a: tuple[_N, ...], b: tuple[_N, ...]) -> tuple[_N, _N, _N]:
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-def _sub(a: tuple[int, ...], b: tuple[int, ...]) -> tuple[int, int, int]:
+def _sub(a: tuple[_N, ...], b: tuple[_N, ...]) -> tuple[_N, _N, _N]:
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-def _dot(a: tuple[int, ...], b: tuple[int, ...]) -> int:
+def _dot(a: tuple[_N, ...], b: tuple[_N, ...]) -> _N:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
@@ -993,20 +998,6 @@ def _exact_front(out_faces: np.ndarray, out_source: np.ndarray, members: np.ndar
     return None
 
 
-_Q3 = tuple[Fraction, Fraction, Fraction]
-
-
-def _qsub(a: _Q3, b: _Q3) -> _Q3:
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _qcross(a: _Q3, b: _Q3) -> _Q3:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _qdot(a: _Q3, b: _Q3) -> Fraction:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
 
 def _ray_front(v: np.ndarray, f: np.ndarray, face: int,
                point: tuple[Fraction, Fraction, Fraction] | None = None) -> int | None:
@@ -1036,7 +1027,7 @@ def _ray_front(v: np.ndarray, f: np.ndarray, face: int,
         return (Fraction(float(row[0])), Fraction(float(row[1])), Fraction(float(row[2])))
 
     a0, b0, c0 = (exact(r) for r in corners_f[face])
-    normal = _qcross(_qsub(b0, a0), _qsub(c0, a0))
+    normal = _cross(_sub(b0, a0), _sub(c0, a0))
     nf = np.array([float(t) for t in normal])
     if not np.any(nf):
         return None
@@ -1047,7 +1038,7 @@ def _ray_front(v: np.ndarray, f: np.ndarray, face: int,
     for tilt in _RAY_TILTS:
         df = nf + 0.05 * np.asarray(tilt, dtype=np.float64) / 16.0
         d = (Fraction(float(df[0])), Fraction(float(df[1])), Fraction(float(df[2])))
-        if _qdot(d, normal) <= 0:
+        if _dot(d, normal) <= 0:
             continue
         unit = df / np.linalg.norm(df)
         u = np.cross(unit, [1.0, 0.0, 0.0] if abs(unit[0]) < 0.9 else [0.0, 1.0, 0.0])
@@ -1059,18 +1050,18 @@ def _ray_front(v: np.ndarray, f: np.ndarray, face: int,
         near[face] = False
         length = Fraction(2.0 ** (int(np.ceil(np.log2(2 * reach / float(np.linalg.norm(df))))) + 1))
         q = (p[0] + length * d[0], p[1] + length * d[1], p[2] + length * d[2])
-        ray = _qsub(q, p)
+        ray = _sub(q, p)
         total, degenerate = 0, False
         for g in np.flatnonzero(near).tolist():
             a, b, c = (exact(r) for r in corners_f[g])
-            n = _qcross(_qsub(b, a), _qsub(c, a))
-            sp, sq = _sign(_qdot(n, _qsub(p, a))), _sign(_qdot(n, _qsub(q, a)))
+            n = _cross(_sub(b, a), _sub(c, a))
+            sp, sq = _sign(_dot(n, _sub(p, a))), _sign(_dot(n, _sub(q, a)))
             if sp == sq and sp != 0:
                 continue
             if sq == 0:
                 degenerate = True
                 break
-            e = [_sign(_qdot(ray, _qcross(_qsub(x, p), _qsub(y, p)))) for x, y in ((a, b), (b, c), (c, a))]
+            e = [_sign(_dot(ray, _cross(_sub(x, p), _sub(y, p)))) for x, y in ((a, b), (b, c), (c, a))]
             if 0 in e:
                 if (1 in e and -1 in e) or (sp != 0 and e.count(0) == 3):
                     continue                        # the line passes beside the triangle (or ray parallel)
