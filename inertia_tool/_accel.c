@@ -33,7 +33,8 @@
  * and split their work so that the result is identical whatever that count is; only the speed changes.  The
  * one-table weld and the separate shell_labels / edge_shell_labels run on one thread; PartWelder (section
  * 2b), the weld of large float32 streams, and census_shells (4c), which the Python side uses for the shell
- * labels, take a `threads` count.
+ * labels, take a `threads` count.  contact_scan (section 8) runs its stages on `threads`, the Morton codes' radix
+ * sort included (in fixed blocks taken by ticket: the order does not depend on the count).
  */
 
 #define PY_SSIZE_T_CLEAN
@@ -3550,6 +3551,7 @@ accel_face_measures(PyObject *self, PyObject *args)
 
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
+static PyObject *accel_sort_codes(PyObject *self, PyObject *args);      /* section 8, after the module */
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
 static PyObject *accel_close_groups(PyObject *self, PyObject *args);    /* section 9b, after the module */
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
@@ -3616,6 +3618,10 @@ static PyMethodDef accel_methods[] = {
      "edge_census and, when `out` ((m,) int32/int64) is not None, each face's shell into `out` as "
      "checks.shell_labels numbers them (count: the shells; -1 without `out`), from one adjacency on `threads` "
      "threads (one below `parallel_min` faces; tests lower it); the result does not depend on either."},
+    {"sort_codes", accel_sort_codes, METH_VARARGS,
+     "sort_codes(words, threads=1)\n\nThe face-pair check's radix sort (section 8, ct_radix_sort), for the "
+     "tests: sorts the (m,) uint64 array `words` in place by their top 33 bits, stable; the result does not "
+     "depend on `threads`."},
     {"tetra_sums", accel_tetra_sums, METH_VARARGS,
      "tetra_sums(vertices, faces, origin, area_floor, labels, sums, zero, threads=1)\n\nCompensated signed-tetrahedron "
      "sums per label into sums (L, 11) float64 [vol, first xyz, second xx yy zz xy xz yz, area] and zero "
@@ -4394,14 +4400,18 @@ done:
 /* Stage timing of contact_scan for profiling: with INERTIA_TOOL_CT_PROFILE set in the environment each call
  * prints the CPU time (all threads) of its stages (Morton codes, sort, preparation, then with patches the
  * vertices' face lists, the faces across each edge, the hierarchy, the patches, the star certificates, the
- * apexes and per-face star bits; else the stars and the hierarchy together; the traversal) to stderr. */
+ * apexes and per-face star bits; else the stars and the hierarchy together; the traversal) to stderr;
+ * INERTIA_TOOL_CT_PROFILE=wall prints wall times instead (what the stages' threads save, on a quiet machine). */
 #if defined(__linux__) || defined(__APPLE__)
 #include <time.h>
+/* INERTIA_TOOL_CT_PROFILE=wall: wall time instead, to see what the stages' threads save */
+static int ct_profile_wall;
+
 static double
 ct_clock(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);     /* CPU time: the machine is shared */
+    clock_gettime(ct_profile_wall ? CLOCK_MONOTONIC : CLOCK_PROCESS_CPUTIME_ID, &ts);  /* CPU: the machine is shared */
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 #else
@@ -5356,11 +5366,95 @@ ct_spread(uint64_t v)
 
 /* key[i] = code << 31 | i (a 33-bit Morton code above a 31-bit face index) sorted by code, stable (LSD radix
  * sort, three passes of 11 bits over the code, key2 m words of scratch): the face indices in hierarchy order
- * are then key & (2^31 - 1).  One 8-byte word per face moves, not a code and an index.  -1 when out of
- * memory. */
-static int
-ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m)
+ * are then key & (2^31 - 1).  One 8-byte word per face moves, not a code and an index.
+ *
+ * Threads (issue 25: the sort was one of the check's largest stages, on one thread): from CT_SORT_THREADS_MIN
+ * words each pass cuts its source into CT_SORT_BLOCKS contiguous blocks (a fixed number, not the thread count),
+ * taken by ticket; each block counts its digits, and its words go, in their order, after those of the same
+ * digit in the blocks before it (slots from the counts in digit order, then block order).  That is the
+ * one-block pass exactly: a stable scatter puts each word after every word of a smaller digit and after the
+ * earlier words of its own, wherever the source is cut, so the result does not depend on the threads
+ * (tests/test_native_threads.py compares it with a stable sort).  -1 when out of memory. */
+#define CT_SORT_BLOCKS 64
+
+typedef struct {
+    uint64_t *src, *dst;
+    int64_t m;
+    int shift;                  /* the digit: (word >> shift) & 2047 */
+    int phase;                  /* 0: count, 1: scatter, 2: copy src to dst (the words back into key) */
+    size_t (*count)[2048];      /* per block: its counts, then its first slot for each digit */
+    int32_t next_block;         /* the next block to take (next_ticket) */
+} CtSortJob;
+
+static void
+ct_sort_task(void *ctx, int t, int nt)
 {
+    CtSortJob *j = (CtSortJob *)ctx;
+    (void)t;
+    (void)nt;
+    const uint64_t *src = j->src;
+    uint64_t *dst = j->dst;
+    const int shift = j->shift;
+    for (int b = next_ticket(&j->next_block); b < CT_SORT_BLOCKS; b = next_ticket(&j->next_block)) {
+        int64_t lo = (int64_t)part_start((size_t)j->m, b, CT_SORT_BLOCKS);
+        int64_t hi = (int64_t)part_start((size_t)j->m, b + 1, CT_SORT_BLOCKS);
+        size_t *c = j->count[b];
+        if (j->phase == 0) {
+            memset(c, 0, 2048 * sizeof(size_t));
+            for (int64_t i = lo; i < hi; i++) c[(src[i] >> shift) & 2047]++;
+        }
+        else if (j->phase == 1) {
+            for (int64_t i = lo; i < hi; i++) dst[c[(src[i] >> shift) & 2047]++] = src[i];
+        }
+        else {
+            memcpy(dst + lo, src + lo, (size_t)(hi - lo) * sizeof(uint64_t));
+        }
+    }
+}
+
+/* Words below which the sort runs on one thread (a pass over 2^16 words takes well under a millisecond). */
+#define CT_SORT_THREADS_MIN ((size_t)1 << 16)
+
+static int
+ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m, int threads)
+{
+    int nt = thread_count(threads, (size_t)m, CT_SORT_THREADS_MIN);
+    if (nt > 1) {
+        size_t (*count)[2048] = (size_t (*)[2048])malloc(CT_SORT_BLOCKS * sizeof(*count));
+        if (count == NULL) {
+            return -1;
+        }
+        CtSortJob jb;
+        memset(&jb, 0, sizeof(jb));
+        jb.m = m;
+        jb.count = count;
+        jb.src = key;
+        jb.dst = key2;
+        for (int p = 0; p < 3; p++) {
+            jb.shift = 31 + 11 * p;
+            jb.phase = 0;
+            jb.next_block = 0;
+            run_parallel(nt, ct_sort_task, &jb);
+            size_t sum = 0;
+            for (int k = 0; k < 2048; k++) {       /* digit order, then block order: the stable slots */
+                for (int b = 0; b < CT_SORT_BLOCKS; b++) {
+                    size_t c = count[b][k];
+                    count[b][k] = sum;
+                    sum += c;
+                }
+            }
+            jb.phase = 1;
+            jb.next_block = 0;
+            run_parallel(nt, ct_sort_task, &jb);
+            uint64_t *tmp = jb.src; jb.src = jb.dst; jb.dst = tmp;
+        }
+        jb.phase = 2;                              /* three passes: the result is in key2 */
+        jb.dst = key;
+        jb.next_block = 0;
+        run_parallel(nt, ct_sort_task, &jb);
+        free(count);
+        return 0;
+    }
     size_t (*count)[2048] = (size_t (*)[2048])calloc(3, sizeof(*count));
     if (count == NULL) {
         return -1;
@@ -5384,6 +5478,46 @@ ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m)
     memcpy(key, src, (size_t)m * sizeof(uint64_t));  /* three passes: the result is in key2 */
     free(count);
     return 0;
+}
+
+static PyObject *
+accel_sort_codes(PyObject *self, PyObject *args)
+{
+    PyObject *obj;
+    int threads = 1;
+    if (!PyArg_ParseTuple(args, "O|i", &obj, &threads)) {
+        return NULL;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        return NULL;
+    }
+    PyObject *result = NULL;
+    char code = native_code(view.format);
+    if (view.ndim != 1 || view.itemsize != 8 || (code != 'Q' && code != 'L')) {
+        PyErr_SetString(PyExc_ValueError, "Expected `words` as a writable contiguous (m,) uint64 array");
+        goto fail;
+    }
+    int64_t m = (int64_t)view.shape[0];
+    uint64_t *scratch = (uint64_t *)malloc((size_t)(m > 0 ? m : 1) * sizeof(uint64_t));
+    if (scratch == NULL) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = ct_radix_sort((uint64_t *)view.buf, scratch, m, threads);
+    Py_END_ALLOW_THREADS
+    free(scratch);
+    if (rc < 0) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    result = Py_None;
+    Py_INCREF(result);
+fail:
+    PyBuffer_Release(&view);
+    return result;
 }
 
 /* ------------------------------------------------------------------------------------------------------
@@ -7611,7 +7745,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
         int oom = 0, failed = 0;
         /* the stage clocks only when profiling: CLOCK_PROCESS_CPUTIME_ID is a system call, and reading it at
          * every stage was about half of a 12-face scan's time (15.7 -> 8.6 us a call) */
-        int profile = getenv("INERTIA_TOOL_CT_PROFILE") != NULL;
+        const char *profile_env = getenv("INERTIA_TOOL_CT_PROFILE");
+        int profile = profile_env != NULL;
+#if defined(__linux__) || defined(__APPLE__)
+        ct_profile_wall = profile && strcmp(profile_env, "wall") == 0;
+#endif
         double clk[12] = {0}, rss[12] = {0}, hwm[12] = {0};
         Py_BEGIN_ALLOW_THREADS
         clk[0] = profile ? ct_clock() : 0.0;
@@ -7648,7 +7786,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
         run_parallel(nt, ct_prep_task, &pr);
         clk[1] = profile ? ct_clock() : 0.0;
         if (profile) ct_resident_mb(&rss[1], &hwm[1]);
-        if (ct_radix_sort(code, code + mm, m) < 0) {
+        if (ct_radix_sort(code, code + mm, m, nt) < 0) {
             oom = 1;
         }
         else {
