@@ -33,8 +33,7 @@
  * and split their work so that the result is identical whatever that count is; only the speed changes.  The
  * one-table weld and the separate shell_labels / edge_shell_labels run on one thread; PartWelder (section
  * 2b), the weld of large float32 streams, and census_shells (4c), which the Python side uses for the shell
- * labels, take a `threads` count.  contact_scan (section 8) runs its stages on `threads`, the Morton codes' radix
- * sort included (in fixed blocks taken by ticket: the order does not depend on the count).
+ * labels, take a `threads` count.
  */
 
 #define PY_SSIZE_T_CLEAN
@@ -3619,9 +3618,8 @@ static PyMethodDef accel_methods[] = {
      "checks.shell_labels numbers them (count: the shells; -1 without `out`), from one adjacency on `threads` "
      "threads (one below `parallel_min` faces; tests lower it); the result does not depend on either."},
     {"sort_codes", accel_sort_codes, METH_VARARGS,
-     "sort_codes(words, threads=1)\n\nThe face-pair check's radix sort (section 8, ct_radix_sort), for the "
-     "tests: sorts the (m,) uint64 array `words` in place by their top 33 bits, stable; the result does not "
-     "depend on `threads`."},
+     "sort_codes(words)\n\nThe face-pair check's radix sort (section 8, ct_radix_sort), for the tests: sorts "
+     "the (m,) uint64 array `words` in place by their top 33 bits, stable."},
     {"tetra_sums", accel_tetra_sums, METH_VARARGS,
      "tetra_sums(vertices, faces, origin, area_floor, labels, sums, zero, threads=1)\n\nCompensated signed-tetrahedron "
      "sums per label into sums (L, 11) float64 [vol, first xyz, second xx yy zz xy xz yz, area] and zero "
@@ -4404,20 +4402,18 @@ done:
  * INERTIA_TOOL_CT_PROFILE=wall prints wall times instead (what the stages' threads save, on a quiet machine). */
 #if defined(__linux__) || defined(__APPLE__)
 #include <time.h>
-/* INERTIA_TOOL_CT_PROFILE=wall: wall time instead, to see what the stages' threads save */
-static int ct_profile_wall;
-
 static double
-ct_clock(void)
+ct_clock(int wall)
 {
     struct timespec ts;
-    clock_gettime(ct_profile_wall ? CLOCK_MONOTONIC : CLOCK_PROCESS_CPUTIME_ID, &ts);  /* CPU: the machine is shared */
+    clock_gettime(wall ? CLOCK_MONOTONIC : CLOCK_PROCESS_CPUTIME_ID, &ts);     /* CPU time: the machine is shared */
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 #else
 static double
-ct_clock(void)
+ct_clock(int wall)
 {
+    (void)wall;
     return 0.0;
 }
 #endif
@@ -5366,95 +5362,13 @@ ct_spread(uint64_t v)
 
 /* key[i] = code << 31 | i (a 33-bit Morton code above a 31-bit face index) sorted by code, stable (LSD radix
  * sort, three passes of 11 bits over the code, key2 m words of scratch): the face indices in hierarchy order
- * are then key & (2^31 - 1).  One 8-byte word per face moves, not a code and an index.
- *
- * Threads (issue 25: the sort was one of the check's largest stages, on one thread): from CT_SORT_THREADS_MIN
- * words each pass cuts its source into CT_SORT_BLOCKS contiguous blocks (a fixed number, not the thread count),
- * taken by ticket; each block counts its digits, and its words go, in their order, after those of the same
- * digit in the blocks before it (slots from the counts in digit order, then block order).  That is the
- * one-block pass exactly: a stable scatter puts each word after every word of a smaller digit and after the
- * earlier words of its own, wherever the source is cut, so the result does not depend on the threads
- * (tests/test_native_threads.py compares it with a stable sort).  -1 when out of memory. */
-#define CT_SORT_BLOCKS 64
-
-typedef struct {
-    uint64_t *src, *dst;
-    int64_t m;
-    int shift;                  /* the digit: (word >> shift) & 2047 */
-    int phase;                  /* 0: count, 1: scatter, 2: copy src to dst (the words back into key) */
-    size_t (*count)[2048];      /* per block: its counts, then its first slot for each digit */
-    int32_t next_block;         /* the next block to take (next_ticket) */
-} CtSortJob;
-
-static void
-ct_sort_task(void *ctx, int t, int nt)
-{
-    CtSortJob *j = (CtSortJob *)ctx;
-    (void)t;
-    (void)nt;
-    const uint64_t *src = j->src;
-    uint64_t *dst = j->dst;
-    const int shift = j->shift;
-    for (int b = next_ticket(&j->next_block); b < CT_SORT_BLOCKS; b = next_ticket(&j->next_block)) {
-        int64_t lo = (int64_t)part_start((size_t)j->m, b, CT_SORT_BLOCKS);
-        int64_t hi = (int64_t)part_start((size_t)j->m, b + 1, CT_SORT_BLOCKS);
-        size_t *c = j->count[b];
-        if (j->phase == 0) {
-            memset(c, 0, 2048 * sizeof(size_t));
-            for (int64_t i = lo; i < hi; i++) c[(src[i] >> shift) & 2047]++;
-        }
-        else if (j->phase == 1) {
-            for (int64_t i = lo; i < hi; i++) dst[c[(src[i] >> shift) & 2047]++] = src[i];
-        }
-        else {
-            memcpy(dst + lo, src + lo, (size_t)(hi - lo) * sizeof(uint64_t));
-        }
-    }
-}
-
-/* Words below which the sort runs on one thread (a pass over 2^16 words takes well under a millisecond). */
-#define CT_SORT_THREADS_MIN ((size_t)1 << 16)
-
+ * are then key & (2^31 - 1).  One 8-byte word per face moves, not a code and an index.  On one thread: the
+ * passes on threads (fixed blocks by ticket, the same order) took ~10 % more CPU and saved no wall time while
+ * the other core was busy (docs/performance.md, "Issue 25, hot12").  tests/test_mesh_intersect_sort.py compares it
+ * (sort_codes) with a stable sort.  -1 when out of memory. */
 static int
-ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m, int threads)
+ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m)
 {
-    int nt = thread_count(threads, (size_t)m, CT_SORT_THREADS_MIN);
-    if (nt > 1) {
-        size_t (*count)[2048] = (size_t (*)[2048])malloc(CT_SORT_BLOCKS * sizeof(*count));
-        if (count == NULL) {
-            return -1;
-        }
-        CtSortJob jb;
-        memset(&jb, 0, sizeof(jb));
-        jb.m = m;
-        jb.count = count;
-        jb.src = key;
-        jb.dst = key2;
-        for (int p = 0; p < 3; p++) {
-            jb.shift = 31 + 11 * p;
-            jb.phase = 0;
-            jb.next_block = 0;
-            run_parallel(nt, ct_sort_task, &jb);
-            size_t sum = 0;
-            for (int k = 0; k < 2048; k++) {       /* digit order, then block order: the stable slots */
-                for (int b = 0; b < CT_SORT_BLOCKS; b++) {
-                    size_t c = count[b][k];
-                    count[b][k] = sum;
-                    sum += c;
-                }
-            }
-            jb.phase = 1;
-            jb.next_block = 0;
-            run_parallel(nt, ct_sort_task, &jb);
-            uint64_t *tmp = jb.src; jb.src = jb.dst; jb.dst = tmp;
-        }
-        jb.phase = 2;                              /* three passes: the result is in key2 */
-        jb.dst = key;
-        jb.next_block = 0;
-        run_parallel(nt, ct_sort_task, &jb);
-        free(count);
-        return 0;
-    }
     size_t (*count)[2048] = (size_t (*)[2048])calloc(3, sizeof(*count));
     if (count == NULL) {
         return -1;
@@ -5484,8 +5398,7 @@ static PyObject *
 accel_sort_codes(PyObject *self, PyObject *args)
 {
     PyObject *obj;
-    int threads = 1;
-    if (!PyArg_ParseTuple(args, "O|i", &obj, &threads)) {
+    if (!PyArg_ParseTuple(args, "O", &obj)) {
         return NULL;
     }
     Py_buffer view;
@@ -5506,7 +5419,7 @@ accel_sort_codes(PyObject *self, PyObject *args)
     }
     int rc;
     Py_BEGIN_ALLOW_THREADS
-    rc = ct_radix_sort((uint64_t *)view.buf, scratch, m, threads);
+    rc = ct_radix_sort((uint64_t *)view.buf, scratch, m);
     Py_END_ALLOW_THREADS
     free(scratch);
     if (rc < 0) {
@@ -7746,13 +7659,10 @@ accel_contact_scan(PyObject *self, PyObject *args)
         /* the stage clocks only when profiling: CLOCK_PROCESS_CPUTIME_ID is a system call, and reading it at
          * every stage was about half of a 12-face scan's time (15.7 -> 8.6 us a call) */
         const char *profile_env = getenv("INERTIA_TOOL_CT_PROFILE");
-        int profile = profile_env != NULL;
-#if defined(__linux__) || defined(__APPLE__)
-        ct_profile_wall = profile && strcmp(profile_env, "wall") == 0;
-#endif
+        int profile = profile_env != NULL, wall = profile && strcmp(profile_env, "wall") == 0;
         double clk[12] = {0}, rss[12] = {0}, hwm[12] = {0};
         Py_BEGIN_ALLOW_THREADS
-        clk[0] = profile ? ct_clock() : 0.0;
+        clk[0] = profile ? ct_clock(wall) : 0.0;
         int nt = thread_count(threads, (size_t)m, 20000);
         CtPrep pr;
         memset(&pr, 0, sizeof(pr));
@@ -7784,19 +7694,19 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         pr.pass = 0;
         run_parallel(nt, ct_prep_task, &pr);
-        clk[1] = profile ? ct_clock() : 0.0;
+        clk[1] = profile ? ct_clock(wall) : 0.0;
         if (profile) ct_resident_mb(&rss[1], &hwm[1]);
-        if (ct_radix_sort(code, code + mm, m, nt) < 0) {
+        if (ct_radix_sort(code, code + mm, m) < 0) {
             oom = 1;
         }
         else {
-            clk[2] = profile ? ct_clock() : 0.0;
+            clk[2] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[2], &hwm[2]);
             pr.pass = 1;
             run_parallel(nt, ct_prep_task, &pr);
             pr.pass = 2;
             run_parallel(nt, ct_prep_task, &pr);
-            clk[3] = profile ? ct_clock() : 0.0;
+            clk[3] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[3], &hwm[3]);
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
@@ -7837,7 +7747,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             int64_t *off, total;
             int32_t *vfaces;
             for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
-            clk[8] = profile ? ct_clock() : 0.0;
+            clk[8] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[8], &hwm[8]);
             if (ct_twins(F, fsize, n, m, code, code_bytes, pos, twin, nt, ct_twin_rounds(m)) < 0) {
                 oom = 1;
@@ -7849,7 +7759,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             ct_drop(code, code_bytes);
             code = NULL;
             code_bytes = 0;
-            clk[9] = profile ? ct_clock() : 0.0;
+            clk[9] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[9], &hwm[9]);
             if (!oom) {
                 int32_t *across = twin;
@@ -7860,14 +7770,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
                     }
                 }
                 n_nodes = ct_build_tree(nodes, m);
-                clk[10] = profile ? ct_clock() : 0.0;
+                clk[10] = profile ? ct_clock(wall) : 0.0;
                 if (profile) ct_resident_mb(&rss[10], &hwm[10]);
                 patch = (uint8_t *)malloc((size_t)n_nodes);
                 if (patch == NULL || ct_patches(nodes, n_nodes, F, fsize, order, fmask, across, V, m, patch) < 0) {
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
-                clk[7] = profile ? ct_clock() : 0.0;
+                clk[7] = profile ? ct_clock(wall) : 0.0;
                 if (profile) ct_resident_mb(&rss[7], &hwm[7]);
                 int32_t *label = pos;                  /* pos is done with: each face's certified patch */
                 if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
@@ -7904,7 +7814,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 ct_free(&ar, own_off, own_off_bytes);
                 ct_free(&ar, twin, twin_bytes);        /* for the boxes (the same 12 bytes a face) */
                 twin = NULL;
-                clk[11] = profile ? ct_clock() : 0.0;
+                clk[11] = profile ? ct_clock(wall) : 0.0;
                 if (profile) ct_resident_mb(&rss[11], &hwm[11]);
             }
         }
@@ -7950,11 +7860,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
             lapex = NULL;
         }
         ct_arena_trim(&ar);                    /* every array of the traversal is taken: the rest unmapped */
-        clk[4] = profile ? ct_clock() : 0.0;
+        clk[4] = profile ? ct_clock(wall) : 0.0;
         if (profile) ct_resident_mb(&rss[4], &hwm[4]);
         if (!oom && !failed && m >= 2) {
             /* each position's certified corners (stars) were set by pass 3 */
-            clk[5] = profile ? ct_clock() : 0.0;
+            clk[5] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[5], &hwm[5]);
             sc.stars = cert != NULL ? stars : NULL;
             sc.patch = patch;
@@ -8011,7 +7921,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
         }
         oom |= sc.oom;
-        clk[6] = profile ? ct_clock() : 0.0;
+        clk[6] = profile ? ct_clock(wall) : 0.0;
         if (profile) ct_resident_mb(&rss[6], &hwm[6]);
         Py_END_ALLOW_THREADS
         if (profile) {

@@ -13,8 +13,6 @@ import os
 import numpy as np
 import pytest
 import trimesh
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL, REQUIRE_ACCEL
 from inertia_tool import _native
@@ -378,57 +376,3 @@ def test_census_shells_unite_across_threads_on_a_torus_in_file_order(lib):
         out = np.empty(len(faces), np.int64)
         assert lib.census_shells(faces, n, out, threads) == census + (count,)
         np.testing.assert_array_equal(out, labels)
-
-
-@st.composite
-def _code_words(draw):
-    """Words ``code << 31 | tag`` as the check sorts them, adversarial for a radix sort cut into blocks: the
-    codes from a few distinct values (long runs of one digit, ties kept in order) to all 2^33 (every digit), in
-    file order, sorted, reversed or in runs; the tags (the face indices in the check) any 31-bit values, so
-    that a tie broken by the tag, or a word moved out of its tie's order, shows.  Sizes around the threshold
-    for threads (2^16 words) and the 64 blocks' edges."""
-    m = draw(st.sampled_from([0, 1, 63, 64, 65, 65_535, 65_536, 65_537, 100_003, 262_144]))
-    seed = draw(st.integers(0, 2**32 - 1))
-    rng = np.random.default_rng(seed)
-    spread = draw(st.sampled_from(["one", "few", "digit", "all"]))
-    if spread == "one":
-        code = np.full(m, rng.integers(0, 2**33), dtype=np.uint64)
-    elif spread == "few":
-        code = rng.choice(rng.integers(0, 2**33, 5, dtype=np.uint64), m)
-    elif spread == "digit":             # only one of the three 11-bit digits varies
-        code = rng.integers(0, 2048, m, dtype=np.uint64) << np.uint64(11 * draw(st.integers(0, 2)))
-    else:
-        code = rng.integers(0, 2**33, m, dtype=np.uint64)
-    layout = draw(st.sampled_from(["as drawn", "sorted", "reversed", "runs"]))
-    if layout == "sorted":
-        code = np.sort(code)
-    elif layout == "reversed":
-        code = np.sort(code)[::-1].copy()
-    elif layout == "runs" and m:
-        code = np.repeat(code[: max(1, m // 997)], 997)[:m]
-        code = np.concatenate([code, np.zeros(m - len(code), dtype=np.uint64)])
-    tag = rng.integers(0, 2**31, m, dtype=np.uint64)
-    return (code << np.uint64(31)) | tag
-
-
-@settings(max_examples=60, deadline=None)
-@given(words=_code_words(), threads=st.sampled_from((1, 2, 3, 5) if not UNDER_TSAN else (2, 5)))
-def test_check_radix_sort_is_a_stable_sort_whatever_the_threads(lib, words, threads):
-    """The face-pair check's radix sort (`sort_codes`, its ct_radix_sort; on threads from 2^16 words, its
-    blocks taken by ticket) orders the words by their top 33 bits and keeps ties in their order: numpy's
-    stable argsort of the codes, bit for bit, on any thread count."""
-    want = words[np.argsort(words >> np.uint64(31), kind="stable")]
-    got = words.copy()
-    lib.sort_codes(got, threads)
-    np.testing.assert_array_equal(got, want)
-
-
-def test_check_radix_sort_refuses_other_arrays(lib):
-    """Only a writable contiguous uint64 vector is sorted: anything else is refused, not reinterpreted."""
-    for bad in (np.zeros(4, np.int64), np.zeros(4, np.uint32), np.zeros((2, 2), np.uint64)):
-        with pytest.raises(ValueError, match="uint64"):
-            lib.sort_codes(bad, 2)
-    frozen = np.zeros(4, np.uint64)
-    frozen.flags.writeable = False
-    with pytest.raises((ValueError, BufferError)):
-        lib.sort_codes(frozen, 2)
