@@ -3550,6 +3550,7 @@ accel_face_measures(PyObject *self, PyObject *args)
 
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
+static PyObject *accel_sort_codes(PyObject *self, PyObject *args);      /* section 8, after the module */
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
 static PyObject *accel_close_groups(PyObject *self, PyObject *args);    /* section 9b, after the module */
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
@@ -3616,6 +3617,9 @@ static PyMethodDef accel_methods[] = {
      "edge_census and, when `out` ((m,) int32/int64) is not None, each face's shell into `out` as "
      "checks.shell_labels numbers them (count: the shells; -1 without `out`), from one adjacency on `threads` "
      "threads (one below `parallel_min` faces; tests lower it); the result does not depend on either."},
+    {"sort_codes", accel_sort_codes, METH_VARARGS,
+     "sort_codes(words)\n\nThe face-pair check's radix sort (section 8, ct_radix_sort), for the tests: sorts "
+     "the (m,) uint64 array `words` in place by their top 33 bits, stable."},
     {"tetra_sums", accel_tetra_sums, METH_VARARGS,
      "tetra_sums(vertices, faces, origin, area_floor, labels, sums, zero, threads=1)\n\nCompensated signed-tetrahedron "
      "sums per label into sums (L, 11) float64 [vol, first xyz, second xx yy zz xy xz yz, area] and zero "
@@ -4394,20 +4398,22 @@ done:
 /* Stage timing of contact_scan for profiling: with INERTIA_TOOL_CT_PROFILE set in the environment each call
  * prints the CPU time (all threads) of its stages (Morton codes, sort, preparation, then with patches the
  * vertices' face lists, the faces across each edge, the hierarchy, the patches, the star certificates, the
- * apexes and per-face star bits; else the stars and the hierarchy together; the traversal) to stderr. */
+ * apexes and per-face star bits; else the stars and the hierarchy together; the traversal) to stderr;
+ * INERTIA_TOOL_CT_PROFILE=wall prints wall times instead (what the stages' threads save, on a quiet machine). */
 #if defined(__linux__) || defined(__APPLE__)
 #include <time.h>
 static double
-ct_clock(void)
+ct_clock(int wall)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);     /* CPU time: the machine is shared */
+    clock_gettime(wall ? CLOCK_MONOTONIC : CLOCK_PROCESS_CPUTIME_ID, &ts);     /* CPU time: the machine is shared */
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 #else
 static double
-ct_clock(void)
+ct_clock(int wall)
 {
+    (void)wall;
     return 0.0;
 }
 #endif
@@ -5356,8 +5362,10 @@ ct_spread(uint64_t v)
 
 /* key[i] = code << 31 | i (a 33-bit Morton code above a 31-bit face index) sorted by code, stable (LSD radix
  * sort, three passes of 11 bits over the code, key2 m words of scratch): the face indices in hierarchy order
- * are then key & (2^31 - 1).  One 8-byte word per face moves, not a code and an index.  -1 when out of
- * memory. */
+ * are then key & (2^31 - 1).  One 8-byte word per face moves, not a code and an index.  On one thread: the
+ * passes on threads (fixed blocks by ticket, the same order) took ~10 % more CPU and saved no wall time while
+ * the other core was busy (docs/performance.md, "Issue 25, hot12").  tests/test_mesh_intersect_sort.py compares it
+ * (sort_codes) with a stable sort.  -1 when out of memory. */
 static int
 ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m)
 {
@@ -5384,6 +5392,45 @@ ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m)
     memcpy(key, src, (size_t)m * sizeof(uint64_t));  /* three passes: the result is in key2 */
     free(count);
     return 0;
+}
+
+static PyObject *
+accel_sort_codes(PyObject *self, PyObject *args)
+{
+    PyObject *obj;
+    if (!PyArg_ParseTuple(args, "O", &obj)) {
+        return NULL;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        return NULL;
+    }
+    PyObject *result = NULL;
+    char code = native_code(view.format);
+    if (view.ndim != 1 || view.itemsize != 8 || (code != 'Q' && code != 'L')) {
+        PyErr_SetString(PyExc_ValueError, "Expected `words` as a writable contiguous (m,) uint64 array");
+        goto fail;
+    }
+    int64_t m = (int64_t)view.shape[0];
+    uint64_t *scratch = (uint64_t *)malloc((size_t)(m > 0 ? m : 1) * sizeof(uint64_t));
+    if (scratch == NULL) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = ct_radix_sort((uint64_t *)view.buf, scratch, m);
+    Py_END_ALLOW_THREADS
+    free(scratch);
+    if (rc < 0) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    result = Py_None;
+    Py_INCREF(result);
+fail:
+    PyBuffer_Release(&view);
+    return result;
 }
 
 /* ------------------------------------------------------------------------------------------------------
@@ -7611,10 +7658,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
         int oom = 0, failed = 0;
         /* the stage clocks only when profiling: CLOCK_PROCESS_CPUTIME_ID is a system call, and reading it at
          * every stage was about half of a 12-face scan's time (15.7 -> 8.6 us a call) */
-        int profile = getenv("INERTIA_TOOL_CT_PROFILE") != NULL;
+        const char *profile_env = getenv("INERTIA_TOOL_CT_PROFILE");
+        int profile = profile_env != NULL, wall = profile && strcmp(profile_env, "wall") == 0;
         double clk[12] = {0}, rss[12] = {0}, hwm[12] = {0};
         Py_BEGIN_ALLOW_THREADS
-        clk[0] = profile ? ct_clock() : 0.0;
+        clk[0] = profile ? ct_clock(wall) : 0.0;
         int nt = thread_count(threads, (size_t)m, 20000);
         CtPrep pr;
         memset(&pr, 0, sizeof(pr));
@@ -7646,19 +7694,19 @@ accel_contact_scan(PyObject *self, PyObject *args)
         }
         pr.pass = 0;
         run_parallel(nt, ct_prep_task, &pr);
-        clk[1] = profile ? ct_clock() : 0.0;
+        clk[1] = profile ? ct_clock(wall) : 0.0;
         if (profile) ct_resident_mb(&rss[1], &hwm[1]);
         if (ct_radix_sort(code, code + mm, m) < 0) {
             oom = 1;
         }
         else {
-            clk[2] = profile ? ct_clock() : 0.0;
+            clk[2] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[2], &hwm[2]);
             pr.pass = 1;
             run_parallel(nt, ct_prep_task, &pr);
             pr.pass = 2;
             run_parallel(nt, ct_prep_task, &pr);
-            clk[3] = profile ? ct_clock() : 0.0;
+            clk[3] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[3], &hwm[3]);
             for (int t = 0; t < MAX_THREADS; t++) {
                 sc.exact += pr.exact[t];
@@ -7699,7 +7747,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             int64_t *off, total;
             int32_t *vfaces;
             for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
-            clk[8] = profile ? ct_clock() : 0.0;
+            clk[8] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[8], &hwm[8]);
             if (ct_twins(F, fsize, n, m, code, code_bytes, pos, twin, nt, ct_twin_rounds(m)) < 0) {
                 oom = 1;
@@ -7711,7 +7759,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             ct_drop(code, code_bytes);
             code = NULL;
             code_bytes = 0;
-            clk[9] = profile ? ct_clock() : 0.0;
+            clk[9] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[9], &hwm[9]);
             if (!oom) {
                 int32_t *across = twin;
@@ -7722,14 +7770,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
                     }
                 }
                 n_nodes = ct_build_tree(nodes, m);
-                clk[10] = profile ? ct_clock() : 0.0;
+                clk[10] = profile ? ct_clock(wall) : 0.0;
                 if (profile) ct_resident_mb(&rss[10], &hwm[10]);
                 patch = (uint8_t *)malloc((size_t)n_nodes);
                 if (patch == NULL || ct_patches(nodes, n_nodes, F, fsize, order, fmask, across, V, m, patch) < 0) {
                     free(patch);
                     patch = NULL;           /* out of memory: the scan without patches, the same pairs */
                 }
-                clk[7] = profile ? ct_clock() : 0.0;
+                clk[7] = profile ? ct_clock(wall) : 0.0;
                 if (profile) ct_resident_mb(&rss[7], &hwm[7]);
                 int32_t *label = pos;                  /* pos is done with: each face's certified patch */
                 if (patch != NULL) ct_patch_labels(nodes, patch, order, m, label);
@@ -7766,7 +7814,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
                 ct_free(&ar, own_off, own_off_bytes);
                 ct_free(&ar, twin, twin_bytes);        /* for the boxes (the same 12 bytes a face) */
                 twin = NULL;
-                clk[11] = profile ? ct_clock() : 0.0;
+                clk[11] = profile ? ct_clock(wall) : 0.0;
                 if (profile) ct_resident_mb(&rss[11], &hwm[11]);
             }
         }
@@ -7812,11 +7860,11 @@ accel_contact_scan(PyObject *self, PyObject *args)
             lapex = NULL;
         }
         ct_arena_trim(&ar);                    /* every array of the traversal is taken: the rest unmapped */
-        clk[4] = profile ? ct_clock() : 0.0;
+        clk[4] = profile ? ct_clock(wall) : 0.0;
         if (profile) ct_resident_mb(&rss[4], &hwm[4]);
         if (!oom && !failed && m >= 2) {
             /* each position's certified corners (stars) were set by pass 3 */
-            clk[5] = profile ? ct_clock() : 0.0;
+            clk[5] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[5], &hwm[5]);
             sc.stars = cert != NULL ? stars : NULL;
             sc.patch = patch;
@@ -7873,7 +7921,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             }
         }
         oom |= sc.oom;
-        clk[6] = profile ? ct_clock() : 0.0;
+        clk[6] = profile ? ct_clock(wall) : 0.0;
         if (profile) ct_resident_mb(&rss[6], &hwm[6]);
         Py_END_ALLOW_THREADS
         if (profile) {
