@@ -33,6 +33,8 @@ kernel found and ``complete`` are read.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .._native import accel, faces_for_c, threads
@@ -98,7 +100,8 @@ def prepare_clean(raw: RawMesh, *, max_faces: int = CLEAN_MAX_FACES) -> Prepared
         return None                                              # the full path refuses it, in its words
     if ((f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])).any():
         return None                                              # degenerate triangles: warned by the full path
-    diag = float(np.linalg.norm(hi - lo))
+    extent = hi - lo
+    diag = math.sqrt(float(extent.dot(extent)))                  # np.linalg.norm(extent), without its checks
     if not diag > 0:
         return None
     topo, labels, n_shells = census_and_shells(f, len(v), v)
@@ -141,7 +144,7 @@ def _meet_only_in_contacts(v: np.ndarray, f: np.ndarray, lo: np.ndarray, hi: np.
         corners = lo.tolist() + hi.tolist()
         largest = max(abs(x) for x in corners)
         magnitude = np.abs(v.reshape(-1))
-        nonzero = magnitude[magnitude > 0]
+        nonzero = magnitude[magnitude > 0]          # (np.min with where= is slower at every size, 24 to 30,000)
         smallest = float(nonzero.min()) if len(nonzero) else np.inf
         if largest <= _SAFE_LARGEST and smallest >= _SAFE_SMALLEST and f.min() >= 0 and f.max() < len(v):
             try:
