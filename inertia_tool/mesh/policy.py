@@ -776,13 +776,12 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
     """
     vols = np.asarray(file_volumes, dtype=np.float64)
     misread = (vols > 0) & np.asarray(flip, dtype=bool) & (np.asarray(depth) % 2 == 1)
-    if misread.any() and nest is not None:
+    if misread.any():
         # the file's winding number just inside such a shell is 1 + the others' there; where the shells around
-        # it are wound inward (the whole nest written inside out) that is 0 or less: the file reads it as a
-        # cavity too (review 9: an inverted hollow box was said to read as "the union of the bodies")
-        around = np.zeros(len(vols), dtype=np.int64)
-        np.add.at(around, np.asarray(nest.shell, dtype=np.int64), np.asarray(nest.winding, dtype=np.int64))
-        misread &= around >= 0
+        # it are wound inward (the whole nest written inside out, or a cavity kept as wound because it crosses a
+        # body) that is 0 or less: the file reads it as a cavity too (review 9: an inverted hollow box was said to
+        # read as "the union of the bodies"; review 11, D5: a box flush inside a void crossing a body)
+        misread &= _winding_around(vols, nest, within) >= 0
     if not misread.any():
         return None
     inside = np.zeros(len(vols), dtype=bool)
@@ -795,6 +794,31 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
         inside[pairs[misread[pairs[:, 1]], 1]] = True
     shells = np.flatnonzero(misread)
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=bool(inside[shells].any()))
+
+
+def _winding_around(file_volumes: np.ndarray, nest: Nesting | None, within: np.ndarray | None) -> np.ndarray:
+    """(s,) int: the winding number, as the file winds them, of the shells around each shell at its probe point.
+
+    From the probes (``nest``) and from the ``(shell, container)`` pairs placed by touching or by the boolean
+    (``within``: a shell flush with its container, whose probe may lie on the container's surface and see
+    nothing), each container counted once with the sign of its own volume (+1 outward, −1 inward).
+    """
+    n = len(file_volumes)
+    shell = np.zeros(0, dtype=np.int64) if nest is None else np.asarray(nest.shell, dtype=np.int64)
+    other = np.zeros(0, dtype=np.int64) if nest is None else np.asarray(nest.other, dtype=np.int64)
+    winding = np.zeros(0, dtype=np.int64) if nest is None else np.asarray(nest.winding, dtype=np.int64)
+    keep = (winding != 0) & (shell != other)
+    shell, other, winding = shell[keep], other[keep], winding[keep]
+    if within is not None and len(within):
+        pairs = np.asarray(within, dtype=np.int64).reshape(-1, 2)
+        pairs = pairs[pairs[:, 0] != pairs[:, 1]]
+        seen = np.isin(pairs[:, 0] * n + pairs[:, 1], shell * n + other)
+        pairs = np.unique(pairs[~seen], axis=0)
+        shell = np.r_[shell, pairs[:, 0]]
+        winding = np.r_[winding, np.sign(file_volumes[pairs[:, 1]]).astype(np.int64)]
+    around = np.zeros(n, dtype=np.int64)
+    np.add.at(around, shell, winding)
+    return around
 
 
 def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray,
