@@ -95,11 +95,19 @@ def _moments(solid):
 
 
 def _readings(boxes):
-    """``{w ≥ 1}`` as wound, and with every inward box meeting no outward box in volume turned."""
+    """``{w ≥ 1}`` as wound, and with every inward box meeting no outward box in volume turned; when no two boxes
+    cross (each pair apart or one inside the other), also R4's depth reading, which is then the parity solid
+    (cells inside an odd number of boxes: an inward box holding outward ones is a hollow part written inside out,
+    review 9)."""
     signs = [s for _, _, s in boxes]
     bodies = _winding([b for b in boxes if b[2] > 0], [1] * sum(s > 0 for s in signs)) > 0
     turned = [1 if s > 0 or not (bodies & (_winding([b], [1]) > 0)).any() else -1 for b, s in zip(boxes, signs)]
     found = [_moments(_winding(boxes, signs) >= 1), _moments(_winding(boxes, turned) >= 1)]
+    cells = [_winding([b], [1]) > 0 for b in boxes]
+    crossing = any(0 < np.count_nonzero(a & b) < min(np.count_nonzero(a), np.count_nonzero(b))
+                   for k, a in enumerate(cells) for b in cells[k + 1:])
+    if not crossing:
+        found.append(_moments(_winding(boxes, [1] * len(boxes)) % 2 == 1))
     return [r for r in found if r is not None]
 
 
