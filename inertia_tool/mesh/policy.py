@@ -116,9 +116,12 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    boolean, whose union is the solid.  A shell the file
    winds outward that depth makes a cavity (:func:`misread_nesting`) is a reading the file does not decide: its
    own winding number is 2 there, so ``{w ≥ 1}`` is the union of the bodies, and a cavity written with the wrong
-   winding reads the same.  The parity reading is kept, a warning names the other one and its volume, and the
+   winding reads the same (the shells around it counted by their file winding at its probe point and, for a
+   shell flush with its container, by the container's: where that sum is below 0, the file reads it as empty
+   too, no misread).  The parity reading is kept, a warning names the other one and its volume, and the
    certificate is never ``united`` for it (:func:`~.certify.misread_reading`): ``exact`` when the turned surface
-   has no crossing face pair (the parity solid proven), otherwise an estimate whose bounds span both readings.
+   has no crossing face pair (the parity solid proven), otherwise an estimate whose bounds span both readings;
+   ``unverified`` when inward shells cross outward ones as well (both readings rest on that unproven cut).
    Shells that touch without a crossing face pair are never placed by one probe point: their surfaces can still
    cross exactly along edges and vertices of both meshes (CAD tessellations sharing the intersection curve), so
    the points of each near the contact and a sample of its vertices decide (:func:`touching_relations`): points
@@ -129,15 +132,19 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
 R4c *Cavities no depth can place: the solid as the file winds it* (:func:`~.union.winding_solid`).  Where a
    cavity lies inside bodies that overlap one another (:func:`cavities_in_overlap`; two hollow parts overlapping),
    or cavities of one body cross each other, or every inward shell that crosses an outward one lies inside a body
-   (a hollow part's cavity crossing the wall of another part: :func:`inward_crossing_shells`), no body can be
-   named for a cavity, and the depth itself misleads (a
+   (a hollow part's cavity crossing the wall of another part: :func:`inward_crossing_shells`), or a shell lies
+   inside a cavity kept as the file winds it because it crosses a body (wound inward at even depth:
+   ``classify._inside_kept_cavities``; the depth of what lies in it counts a cavity as a body, and this trigger
+   takes precedence over :func:`misread_nesting`), no body can be named for a cavity, and the depth itself
+   misleads (a
    smaller cavity inside a larger one is at even depth: a "body").  There the shells keep the file's winding
    (shells inside others are not turned) and the boolean forms ``{w ≥ 1}`` from the sets covered at least ``t``
    times, ``∪_t (L_t(bodies) − L_t(cavities))``, with no owner for any cavity; certified ``united`` by R5's checks
    on its output.  When shells wound inward reach outside every body beyond ``TOUCH_VOLUME_RTOL`` of the result
    (a body written inside out, or a cavity placed wrong), the file does not say which: refused (``repair``: the
    winding-number estimate).  Not applied when R4 found a shell wound outward that depth reads as a cavity
-   (:func:`misread_nesting`, :func:`outward_crossing_groups`): those readings keep their own labels.  Reason:
+   (:func:`misread_nesting`, :func:`outward_crossing_groups`): those readings keep their own labels, except
+   where a shell lies inside a cavity kept as wound (above).  Reason:
    review 10 found the owner-by-owner union 3–31 % high on every such draw (``unverified``), and three cavities
    meeting at a point were said to "reach out of the body".
 R5 *Crossing shells are united* (manifold3d, float64 ``Mesh64``).  Faces of two shells that cross
@@ -776,13 +783,12 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
     """
     vols = np.asarray(file_volumes, dtype=np.float64)
     misread = (vols > 0) & np.asarray(flip, dtype=bool) & (np.asarray(depth) % 2 == 1)
-    if misread.any() and nest is not None:
+    if misread.any():
         # the file's winding number just inside such a shell is 1 + the others' there; where the shells around
-        # it are wound inward (the whole nest written inside out) that is 0 or less: the file reads it as a
-        # cavity too (review 9: an inverted hollow box was said to read as "the union of the bodies")
-        around = np.zeros(len(vols), dtype=np.int64)
-        np.add.at(around, np.asarray(nest.shell, dtype=np.int64), np.asarray(nest.winding, dtype=np.int64))
-        misread &= around >= 0
+        # it are wound inward (the whole nest written inside out, or a cavity kept as wound because it crosses a
+        # body) that is 0 or less: the file reads it as a cavity too (review 9: an inverted hollow box was said to
+        # read as "the union of the bodies"; review 11, D5: a box flush inside a void crossing a body)
+        misread &= _winding_around(vols, nest, within) >= 0
     if not misread.any():
         return None
     inside = np.zeros(len(vols), dtype=bool)
@@ -795,6 +801,31 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
         inside[pairs[misread[pairs[:, 1]], 1]] = True
     shells = np.flatnonzero(misread)
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=bool(inside[shells].any()))
+
+
+def _winding_around(file_volumes: np.ndarray, nest: Nesting | None, within: np.ndarray | None) -> np.ndarray:
+    """(s,) int: the winding number, as the file winds them, of the shells around each shell at its probe point.
+
+    From the probes (``nest``) and from the ``(shell, container)`` pairs placed by touching or by the boolean
+    (``within``: a shell flush with its container, whose probe may lie on the container's surface and see
+    nothing), each container counted once with the sign of its own volume (+1 outward, −1 inward).
+    """
+    n = len(file_volumes)
+    shell = np.zeros(0, dtype=np.int64) if nest is None else np.asarray(nest.shell, dtype=np.int64)
+    other = np.zeros(0, dtype=np.int64) if nest is None else np.asarray(nest.other, dtype=np.int64)
+    winding = np.zeros(0, dtype=np.int64) if nest is None else np.asarray(nest.winding, dtype=np.int64)
+    keep = (winding != 0) & (shell != other)
+    shell, other, winding = shell[keep], other[keep], winding[keep]
+    if within is not None and len(within):
+        pairs = np.asarray(within, dtype=np.int64).reshape(-1, 2)
+        pairs = pairs[pairs[:, 0] != pairs[:, 1]]
+        seen = np.isin(pairs[:, 0] * n + pairs[:, 1], shell * n + other)
+        pairs = np.unique(pairs[~seen], axis=0)
+        shell = np.r_[shell, pairs[:, 0]]
+        winding = np.r_[winding, np.sign(file_volumes[pairs[:, 1]]).astype(np.int64)]
+    around = np.zeros(n, dtype=np.int64)
+    np.add.at(around, shell, winding)
+    return around
 
 
 def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray,

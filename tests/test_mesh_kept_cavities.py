@@ -1,0 +1,173 @@
+"""R4/R4c on boxes and voids meeting at faces (review 11's D5 family, fix12): outward bodies, voids wound inward
+that cross a body's face and reach outside every body, and boxes flush inside a void (one to three faces shared)
+wound either way.  A shell inside a void that keeps the file's winding (it crosses a body, so R4 gives it no depth)
+has a depth that names no role; D5 read such a box as a misread cavity and answered ``estimate`` 1.6875 ±0.93 % for
+``{w ≥ 1}`` = 1.65625, its warning calling 1.70312 m³ "the file's own winding".
+
+The truth knows nothing of the pipeline: every box has its corners on a quarter grid, so the winding number is a sum
+of box indicators on grid cells, and the moments of ``{w ≥ 1}`` are sums over whole cells (a cube of side ``h`` has
+second moment ``h⁵/12`` about its centre on each axis).  An answer labelled ``exact``, ``united`` or ``estimate``
+must be the solid ``{w ≥ 1}`` of the file as wound, or of the file with every inward box that meets no outward box
+in volume turned (R4: a body written inside out), to 1e-9 (``estimate``: within its stated bounds); a refusal or an
+``unverified``/``summed`` label is allowed.  A warning that names "the union of the bodies" must give one of those
+volumes (D5's warning named 1.70312 m³ for 1.65625).
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from adversary_solids import box, certificate_label, concat, flipped
+from inertia_tool import mass_properties
+from inertia_tool.errors import InvalidMeshError
+
+#: Cell size of the grid, m; the grid spans cells LO..HI on each axis.
+H = 0.25
+LO, HI = -12, 16
+
+
+def _draw(rng: np.random.Generator) -> list[tuple[np.ndarray, np.ndarray, int]]:
+    """``[(lo, hi, sign)]`` in cells: 1–3 bodies, 1–2 voids each across a face of a body, 1–2 boxes flush inside a
+    void (never equal to it: a copy of the void is R0's, below), wound outward (+1) or inward (−1)."""
+    boxes = []
+    for _ in range(int(rng.integers(1, 4))):
+        lo = rng.integers(-4, 2, size=3)
+        boxes.append((lo, lo + rng.integers(2, 6, size=3), 1))
+    voids = []
+    for _ in range(int(rng.integers(1, 3))):
+        lo0, hi0, _ = boxes[int(rng.integers(len(boxes)))]
+        axis = int(rng.integers(3))
+        size = rng.integers(1, 4, size=3)
+        size[axis] = int(rng.integers(2, 5))
+        lo = lo0 + np.array([rng.integers(0, max(1, hi0[k] - lo0[k] - size[k] + 1)) for k in range(3)])
+        cut = int(rng.integers(1, size[axis]))           # the void crosses the face: inside by cut, outside by the rest
+        lo[axis] = hi0[axis] - cut if rng.random() < 0.5 else lo0[axis] - size[axis] + cut
+        voids.append((lo, lo + size, -1))
+    boxes += voids
+    for _ in range(int(rng.integers(1, 3))):
+        lo0, hi0, _ = voids[int(rng.integers(len(voids)))]
+        size = np.minimum(rng.integers(1, 3, size=3), hi0 - lo0)
+        if np.array_equal(size, hi0 - lo0):
+            size[int(np.argmax(size))] -= 1
+            if not size.min():
+                continue
+        flush = rng.random(3) < 0.6
+        lo = np.where(flush, np.where(rng.random(3) < 0.5, lo0, hi0 - size),
+                      lo0 + rng.integers(0, hi0 - lo0 - size + 1))
+        boxes.append((lo, lo + size, 1 if rng.random() < 0.5 else -1))
+    return boxes
+
+
+def _mesh(boxes):
+    pieces = []
+    for lo, hi, sign in boxes:
+        v, f = box((hi - lo) * H)
+        piece = (v - v.min(axis=0) + lo * H, f)
+        pieces.append(piece if sign > 0 else flipped(piece))
+    return concat(*pieces)
+
+
+def _winding(boxes, signs):
+    n = HI - LO
+    w = np.zeros((n, n, n), dtype=np.int64)
+    for (lo, hi, _), sign in zip(boxes, signs):
+        w[lo[0] - LO:hi[0] - LO, lo[1] - LO:hi[1] - LO, lo[2] - LO:hi[2] - LO] += sign
+    return w
+
+
+def _moments(solid):
+    """``(volume m³, centroid (3,) m, inertia (3, 3) m⁵ about the centroid)`` of a set of whole cells, or None."""
+    idx = np.argwhere(solid)
+    if not len(idx):
+        return None
+    centres = (idx + LO + 0.5) * H
+    volume = len(idx) * H ** 3
+    centroid = centres.mean(axis=0)
+    d = centres - centroid
+    second = H ** 3 * d.T @ d + len(idx) * H ** 5 / 12 * np.eye(3)
+    return volume, centroid, np.trace(second) * np.eye(3) - second
+
+
+def _readings(boxes):
+    """``{w ≥ 1}`` as wound, and with every inward box meeting no outward box in volume turned; when no two boxes
+    cross (each pair apart or one inside the other), also R4's depth reading, which is then the parity solid
+    (cells inside an odd number of boxes: an inward box holding outward ones is a hollow part written inside out,
+    review 9)."""
+    signs = [s for _, _, s in boxes]
+    bodies = _winding([b for b in boxes if b[2] > 0], [1] * sum(s > 0 for s in signs)) > 0
+    turned = [1 if s > 0 or not (bodies & (_winding([b], [1]) > 0)).any() else -1 for b, s in zip(boxes, signs)]
+    found = [_moments(_winding(boxes, signs) >= 1), _moments(_winding(boxes, turned) >= 1)]
+    cells = [_winding([b], [1]) > 0 for b in boxes]
+    crossing = any(0 < np.count_nonzero(a & b) < min(np.count_nonzero(a), np.count_nonzero(b))
+                   for k, a in enumerate(cells) for b in cells[k + 1:])
+    if not crossing:
+        found.append(_moments(_winding(boxes, [1] * len(boxes)) % 2 == 1))
+    return [r for r in found if r is not None]
+
+
+def _judge(boxes):
+    """None when the answer is right, refused, or honestly labelled; else what is wrong."""
+    v, f = _mesh(boxes)
+    diag = float(np.linalg.norm(np.ptp(v, axis=0)))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            props = mass_properties((v, f), density=1.0)
+        except InvalidMeshError:
+            return None
+    label = certificate_label(props.mesh)
+    readings = _readings(boxes)
+    texts = " ".join(str(w.message) for w in caught)
+    claim = re.search(r"the union of the bodies: ([0-9.eE+-]+) m³(?! more)", texts)      # a total, not a difference
+    if claim and all(abs(float(claim.group(1)) - r[0]) > 1e-5 * r[0] for r in readings):
+        return f"a warning names {claim.group(1)} m³ as the union of the bodies; the readings: " \
+               f"{[r[0] for r in readings]}"
+    if label not in ("exact", "united", "estimate"):
+        return None
+    for volume, centroid, inertia in readings:
+        dv = abs(props.mass - volume) / volume
+        dc = float(np.linalg.norm(props.center_of_mass - centroid))
+        di = float(np.linalg.norm(props.inertia - inertia) / np.linalg.norm(inertia))
+        if label == "estimate":
+            u = props.mesh.uncertainty
+            if dv <= u.mass + 1e-9 and dc <= u.center_of_mass + 1e-9 * diag and di <= u.inertia + 1e-9:
+                return None
+        elif dv <= 1e-9 and dc <= 1e-9 * diag and di <= 1e-8:
+            return None
+    return f"{label} {props.mass} m³ for the readings {[r[0] for r in readings]}"
+
+
+def test_d5_family_judge_catches_the_old_answer():
+    """The judge's readings exclude D5's old answer (1.6875 ±0.93 % for 1.65625) and name the truth: the box
+    flush inside the void has winding 1 − 1 = 0, outside {w ≥ 1}."""
+    lo = lambda *c: np.array(c) * 4                                  # noqa: E731  (m on the grid → cells)
+    d5 = [(lo(-0.75, -0.5, -0.25), lo(0.5, 0.5, 1.0), 1), (lo(-1.0, -0.5, -0.25), lo(-0.25, 0.0, 0.5), 1),
+          (lo(-0.75, 0.0, -0.5), lo(-0.25, 0.5, 0.0), 1), (lo(-0.75, 0.5, -0.5), lo(-0.5, 0.75, -0.25), 1),
+          (lo(-0.75, 0.25, -0.75), lo(-0.5, 0.75, -0.25), -1), (lo(-0.5, -0.25, -0.5), lo(0.0, 0.25, 0.0), -1)]
+    d5 = [(a.astype(int), b.astype(int), s) for a, b, s in d5]
+    assert [round(r[0], 6) for r in _readings(d5)] == [1.65625, 1.65625]
+    assert _judge(d5) is None
+
+
+@settings(max_examples=120, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2 ** 32 - 1))
+def test_boxes_flush_inside_voids_that_cross_bodies_are_right_or_refused(seed):
+    boxes = _draw(np.random.default_rng(seed))
+    wrong = _judge(boxes)
+    assert wrong is None, (wrong, [(lo.tolist(), hi.tolist(), s) for lo, hi, s in boxes])
+
+
+@pytest.mark.xfail(strict=True, reason="open (fix12): a void listed twice with its exact inverted copy; R0 drops the "
+                   "repeat before cancelling the pair (mesh/policy.coincident_surfaces), so both copies of the void go "
+                   "and the body is answered whole, 'exact' 0.9375 m³, where {w ≥ 1} = body − void = 0.90625 m³ "
+                   "(cancelling first would leave one void)")
+def test_a_void_listed_twice_with_its_inverted_copy_keeps_one_void():
+    boxes = [(np.array([-2, 1, -3]), np.array([3, 4, 1]), 1), (np.array([2, 2, -2]), np.array([4, 3, 0]), -1),
+             (np.array([2, 2, -2]), np.array([4, 3, 0]), -1), (np.array([2, 2, -2]), np.array([4, 3, 0]), 1)]
+    assert _judge(boxes) is None
