@@ -115,3 +115,15 @@ def test_a_turned_body_flush_with_the_floor_spans_both_readings(seed, lo, size):
         assert np.linalg.norm(p.center_of_mass - centre) <= u.center_of_mass * (1 + 1e-9) + 1e-12
         assert np.linalg.norm(p.inertia - inertia) <= u.inertia * np.linalg.norm(p.inertia) * (1 + 1e-9)
     assert any("does not decide" in s for s in said)
+
+
+@pytest.mark.parametrize("n", [1, 2, 7])
+def test_misread_note_agrees_in_number(n):
+    """The note's closing advice agrees with the number of shells (it said "If them are bodies" on Barkour v0's
+    ``upper_right_2.stl``, 7 shells)."""
+    from inertia_tool.mesh.policy import MisreadNesting, misread_message
+    found = MisreadNesting(shells=np.arange(n), volume=1e-9, nested=True, kept="parity")
+    text = misread_message(found, parity_volume=1.0, proven=True)
+    assert ("If they are bodies, unite them" in text) == (n > 1)
+    assert ("If it is a body, unite it" in text) == (n == 1)
+    assert "If them" not in text and "If it are" not in text

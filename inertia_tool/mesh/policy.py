@@ -891,7 +891,7 @@ def misread_message(found: MisreadNesting, parity_volume: float | None, proven: 
             f"(free inside it or flush with its boundary): read by nesting depth as cavit{'ies' if n > 1 else 'y'} "
             f"(R4; a cavity written with the wrong winding reads the same), {found.volume:.6g} m³ taken "
             f"out; the file's own winding reads {them} as part of the body, the union of the bodies: {other}. "
-            f"{decide} If {them} {'are bodies' if n > 1 else 'is a body'}, unite "
+            f"{decide} If {'they are bodies' if n > 1 else 'it is a body'}, unite "
             f"{them} with the body around {them} in the model; if a cavity, wind {them} inward")
 
 
