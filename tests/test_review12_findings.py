@@ -70,7 +70,6 @@ def _judge(solid: G.Solid, fmt: str, unit: str, tmp_path: Path) -> G.Verdict:
 
 
 # ------------------------------------------------------------------------------------------ readers
-@pytest.mark.xfail(strict=True, reason="R1: trimesh's OFF reader fails on polygons of 5+ corners")
 @pytest.mark.parametrize("seed", [1201, 1202, 1203])
 def test_off_polygons_of_five_or_more_corners_are_read(tmp_path, seed):
     verdict = _judge(_prism(seed, corners=5), "off", "m", tmp_path)
