@@ -524,15 +524,17 @@ def diagonal(solid: Solid) -> float:
     return float(np.linalg.norm(pts.max(0) - pts.min(0)))
 
 
-def draw(kind: str, rng: np.random.Generator, folder: Path) -> tuple[Solid, str, str, Path, RationalTruth]:
+def draw(kind: str, rng: np.random.Generator, folder: Path,
+         unit: str | None = None) -> tuple[Solid, str, str, Path, RationalTruth]:
     """One case of generator ``kind`` written to ``folder``: ``(solid, format, unit, path, truth)``; STL
-    (float32) only for parts near the origin, 3MF only for triangle-friendly solids (any)."""
+    (float32) only for parts near the origin; ``unit`` forces the file's unit (else m, mm or inch at random)."""
     for _ in range(100):                  # bounded: a draw whose written coordinates enclose nothing is drawn again
         solid = GENERATORS[kind](rng)
         far = float(np.abs(np.array(solid.points)).max()) > 1e5
         choices = [f for f in FORMATS if not (f == "stl" and far)]
         fmt = str(rng.choice(choices))
         unit_name = str(rng.choice(list(UNITS)))
+        unit_name = unit or unit_name
         try:
             path, truth = write(solid, fmt, unit_name, rng, folder)
         except ZeroDivisionError:
