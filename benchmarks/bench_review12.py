@@ -64,8 +64,23 @@ def _cli_verdict(path: Path, unit: str, truth: G.RationalTruth, diag: float, rep
     if unc is not None:
         from types import SimpleNamespace
         u = SimpleNamespace(mass=unc["mass"], center_of_mass=unc["center_of_mass"], inertia=unc["inertia"])
-    return G.judge_numbers(data["certificate"]["kind"], data["mass"], data["center_of_mass"], data["inertia"], u,
-                           truth, diag)
+    v = G.judge_numbers(data["certificate"]["kind"], data["mass"], data["center_of_mass"], data["inertia"], u,
+                        truth, diag)
+    return G.Verdict(v.label, v.wrong, v.message, data["mesh"]["method"])
+
+
+def cause(kind: str, unit: str, verdict: G.Verdict) -> str:
+    """The finding of ``tests/test_review12_findings.py`` a wrong answer falls under, by what produced it (R4 a
+    weld that moved vertices, R6 a unit conversion, R8 the coplanar overlay's union, R5 several shells)."""
+    if verdict.method == "welded":
+        return "R4 weld"
+    if unit != "m":
+        return "R6 unit rounding"
+    if verdict.label == "united":
+        return "R8 overlay rounding"
+    if kind == "touching":
+        return "R5 shells combined"
+    return "unexplained"
 
 
 def _urdf(links: list[tuple[str, str, str, np.ndarray]]) -> str:
@@ -80,17 +95,17 @@ def _urdf(links: list[tuple[str, str, str, np.ndarray]]) -> str:
     return f'<robot name="review12">{"".join(body)}{"".join(joints)}</robot>\n'
 
 
-def robot_case(rng: np.random.Generator, folder: Path) -> list[tuple[str, G.Verdict, str]]:
-    """One URDF of 1-3 links; ``[(generator, verdict, recipe)]`` per link."""
+def robot_case(rng: np.random.Generator, folder: Path, unit: str | None = None) -> list[tuple[str, G.Verdict, str]]:
+    """One URDF of 1-3 links (files in ``unit``, else at random); ``[(generator, verdict, recipe)]`` per link."""
     links, truths = [], []
     for i in range(int(rng.integers(1, 4))):
         kind = str(rng.choice(list(G.GENERATORS)))
-        solid, fmt, unit, path, truth = G.draw(kind, rng, folder)
+        solid, fmt, unit_name, path, truth = G.draw(kind, rng, folder, unit)
         path = path.rename(folder / f"link{i}{path.suffix}")
         xyz = rng.normal(size=3) * float(rng.choice([0.0, 0.1, 10.0]))
         # a 3MF declares its unit and is read in metres (as COLLADA's <unit>): the URDF scales it by 1
-        links.append((f"l{i}", path.name, "m" if fmt == "3mf" else unit, xyz))
-        truths.append((kind, truth, G.diagonal(solid), xyz, f"{fmt} {unit} {solid.recipe}"))
+        links.append((f"l{i}", path.name, "m" if fmt == "3mf" else unit_name, xyz))
+        truths.append((kind, truth, G.diagonal(solid), xyz, f"{fmt} {unit_name} {solid.recipe}"))
     (folder / "r.urdf").write_text(_urdf(links))
     code, out, err = _cli(["robot", str(folder / "r.urdf"), "--density", "1", "--json"])
     if code not in (0, 5):
@@ -128,12 +143,13 @@ def main(argv=None) -> int:
     labels: dict[str, Counter] = defaultdict(Counter)
     wrong: dict[str, list[str]] = defaultdict(list)
     refusals: dict[str, Counter] = defaultdict(Counter)
+    causes: Counter = Counter()
     t0 = time.process_time()
     if args.mode == "robot":
         for i in range(args.cases):
             rng = np.random.default_rng([args.seed, i])
             with tempfile.TemporaryDirectory() as d:
-                for kind, v, recipe in robot_case(rng, Path(d)):
+                for kind, v, recipe in robot_case(rng, Path(d), args.unit):
                     labels[kind][v.label] += 1
                     if v.wrong:
                         wrong[kind].append(f"[{i}] {v.label}{' SILENT' if v.silent else ''}: {recipe}: {v.wrong}")
@@ -150,6 +166,7 @@ def main(argv=None) -> int:
                          else _cli_verdict(path, unit, truth, diag, args.repair))
                 labels[kind][v.label] += 1
                 if v.wrong:
+                    causes[cause(kind, unit, v)] += 1
                     wrong[kind].append(f"[{i}] {v.label}{' SILENT' if v.silent else ''}: {fmt} {unit} "
                                        f"{solid.recipe}: {v.wrong}")
                 if v.label == "refused":
@@ -164,6 +181,8 @@ def main(argv=None) -> int:
         n_silent = sum(" SILENT" in w for w in wrong[kind])
         print(f"{kind:16} {sum(c.values()):6} {c['exact']:6} {c['united']:6} {c['estimate']:6} {c['unverified']:6} "
               f"{c['refused']:7} {c['crashed']:7} {len(wrong[kind]):6} {n_silent:6}")
+    if causes:
+        print("wrong answers by cause:", ", ".join(f"{c} {n}" for c, n in causes.most_common()))
     for kind in labels:
         for line in wrong[kind][:args.show]:
             print("  WRONG", kind, line[:400])

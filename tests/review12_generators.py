@@ -461,6 +461,7 @@ class Verdict:
     label: str
     wrong: str | None = None
     message: str = ""
+    method: str = ""            # the mesh report's method (``welded``, ``union``, ...) when there is an answer
 
     @property
     def silent(self) -> bool:
@@ -514,7 +515,9 @@ def judge_file(path: Path, unit_name: str, truth: RationalTruth, diag: float, re
         return Verdict("crashed", wrong=f"{type(exc).__name__}: {exc}"[:300])
     cert = props.mesh.certificate
     label = cert.kind if cert is not None else props.mesh.method
-    return judge_numbers(label, props.mass, props.center_of_mass, props.inertia, props.mesh.uncertainty, truth, diag)
+    verdict = judge_numbers(label, props.mass, props.center_of_mass, props.inertia, props.mesh.uncertainty, truth,
+                            diag)
+    return Verdict(verdict.label, verdict.wrong, verdict.message, props.mesh.method)
 
 
 def diagonal(solid: Solid) -> float:
