@@ -11,12 +11,12 @@ Found (stage, rule, numbers):
   kwarg is necessary when using the string multiply ufunc directly ...)": trimesh 5.2's ``load_off`` passes the
   face lines to ``triangulate_quads`` as strings, which numpy 2 cannot multiply.  The reader now reads OFF itself
   (``mesh/read._read_off``), polygons cut like OBJ's.
-* R2: a binary PLY whose faces are lists of different lengths (a heptagon cap and quad sides: valid PLY) is
-  refused, "could not be parsed (PLY is unexpected length!)" (trimesh's binary PLY reader assumes one list length);
-  an ASCII PLY whose planar polygon is not convex (a 7-8 corner star) is refused as "the surface passes through
-  itself at 1 face pairs": trimesh fans every polygon from its first corner, and the fan of a non-convex polygon
-  overlaps itself (6 of 250 prisms of seed 1220).  Not fixed: needs PLY polygons read natively and cut like OBJ's
-  (``polygons.clip_polygons``), as OFF's now are.
+* R2 (half fixed): a binary PLY whose faces are lists of different lengths (a heptagon cap and quad sides: valid
+  PLY) is refused, "could not be parsed (PLY is unexpected length!)" (trimesh's binary PLY reader assumes one list
+  length; open: needs binary PLY faces read natively).  An ASCII PLY whose planar polygon is not convex (a 7-8
+  corner star) was refused as "the surface passes through itself at 1 face pairs": trimesh fans every polygon from
+  its first corner, which overlaps itself on a non-convex one (6 of 250 prisms of seed 1220).  Fixed: the raw face
+  lists trimesh keeps are cut as OBJ's (``read._ply_polygons_clipped``).
 * R3 (fixed): an OBJ polygon of more than four corners far from the origin (a 9-gon 0.275 m across 9.2e8 m out)
   was refused as "the surface passes through itself at 2 face pairs": ``polygons.clip_polygon_as_mujoco``
   clips in float32, where the corners 9e8 m out are 64 m apart on the float32 grid, so the clipped triangles
@@ -95,7 +95,6 @@ def test_binary_ply_with_mixed_polygons_is_read(tmp_path):
     assert verdict.label == "exact" and verdict.wrong is None, verdict
 
 
-@pytest.mark.xfail(strict=True, reason="R2: trimesh fans a non-convex PLY polygon into overlapping triangles")
 @pytest.mark.parametrize("draw", [92, 113])
 def test_ascii_ply_with_a_non_convex_polygon_is_read(tmp_path, draw):
     solid = G.prism_case(np.random.default_rng([1220, 0, draw]))

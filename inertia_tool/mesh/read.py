@@ -1234,9 +1234,47 @@ def _read_with_trimesh_rounding(path: str, max_faces: int,
         raise _fail(path, f"contains no triangle mesh (found {type(loaded).__name__}: a point cloud or lines)")
     v, f = _checked_arrays(path, np.asarray(loaded.vertices, dtype=np.float64), np.asarray(loaded.faces), counts,
                            max_faces)
+    if suffix == ".ply":
+        f = _ply_polygons_clipped(path, loaded, v, f)
     if parts_out is not None:
         parts_out.extend(parts)
     return v, f, declared, rounding
+
+
+def _ply_polygons_clipped(path: str, loaded: Any, vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """``faces`` with the PLY's polygons of more than four corners cut as OBJ's are
+    (:func:`.polygons.clip_polygons`) instead of trimesh's first-corner fan, which overlaps itself on a
+    non-convex polygon and would read as a surface passing through itself; triangles and quads as trimesh cut
+    them.  ``faces`` unchanged when the file has no such polygon or trimesh kept no raw face lists."""
+    try:
+        raw = loaded.metadata["_ply_raw"]
+        lists = raw["face"]["data"]["vertex_indices"]
+        if int(raw["vertex"]["length"]) != len(vertices):
+            return faces                   # trimesh split or merged vertices: the lists' indices are not ours
+    except (KeyError, TypeError, AttributeError, ValueError):
+        return faces
+    if not isinstance(lists, np.ndarray) or lists.dtype != object:
+        return faces                       # one list length for every face: no polygon of mixed size
+    sizes = np.fromiter((len(p) for p in lists), dtype=np.int64, count=len(lists))
+    if not np.any(sizes > 4) or int(np.sum(np.maximum(sizes - 2, 0))) != len(faces):
+        return faces
+    rows: list[list[int]] = []
+    polygons: list[tuple[int, list[int]]] = []
+    for corners in lists:
+        idx = [int(i) for i in corners]
+        if len(idx) == 4:
+            rows += [[idx[0], idx[1], idx[2]], [idx[2], idx[3], idx[0]]]
+        else:
+            if len(idx) > 4:
+                polygons.append((len(rows), idx))
+            rows += [[idx[0], idx[j], idx[j + 1]] for j in range(1, len(idx) - 1)]
+    cut = np.array(rows, dtype=np.int64)
+    if cut.min() < 0 or cut.max() >= len(vertices):
+        return faces
+    differs, _, between, dropped = clip_polygons(vertices, cut, polygons)
+    if differs:
+        warn_clipped_polygons(_display(path), vertices, cut, differs, len(polygons), between, dropped)
+    return cut.astype(faces.dtype)
 
 
 def _checked_arrays(path: str, v: np.ndarray, f: np.ndarray, counts: _Counts,
