@@ -158,6 +158,7 @@ def main(argv=None) -> int:
     else:
         for kind in args.kinds.split(","):
             for i in range(args.cases):
+                started = time.process_time()
                 rng = np.random.default_rng([args.seed, list(G.GENERATORS).index(kind), i])
                 with tempfile.TemporaryDirectory() as d:
                     solid, fmt, unit, path, truth = G.draw(kind, rng, Path(d), args.unit)
@@ -172,6 +173,9 @@ def main(argv=None) -> int:
                 if v.label == "refused":
                     words = v.message.split(": ", 1)[-1]
                     refusals[kind][words[:90]] += 1
+                spent = time.process_time() - started
+                if spent > 20:
+                    print(f"  slow: {kind} [{i}] {spent:.1f} s CPU, {v.label}: {fmt} {unit} {solid.recipe}", flush=True)
     print(f"mode {args.mode} seed {args.seed} repair {args.repair} unit {args.unit or 'any'}: "
           f"{time.process_time() - t0:.1f} s CPU")
     print(f"{'generator':16} {'cases':>6} {'exact':>6} {'united':>6} {'estim.':>6} {'unver.':>6} {'refused':>7} "
