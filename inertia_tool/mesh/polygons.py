@@ -153,11 +153,13 @@ def clip_polygons(vertices: np.ndarray, faces: np.ndarray, polygons: list[tuple[
         k = len(idx)
         fan = [(0, j, j + 1) for j in range(1, k - 1)]
         clipped, lost = ([], 0) if k > MAX_CLIPPED_CORNERS else clip_polygon_as_mujoco(corners)
-        dropped += lost
         relative = corners - corners[0]
         normal = np.cross(relative[1:-1], relative[2:]).sum(axis=0)
         if np.any(np.abs(relative @ normal) > 0):
             warped += 1
+        elif clipped and _overlapping(relative, clipped, normal):
+            clipped, lost = _clipped_near_the_origin(relative, clipped, lost, normal)
+        dropped += lost
         if not clipped or clipped == fan:
             continue
         signed = 0.0
@@ -169,6 +171,68 @@ def clip_polygons(vertices: np.ndarray, faces: np.ndarray, polygons: list[tuple[
             six_between += abs(signed)
         faces[row:row + k - 2] = np.asarray(idx, dtype=faces.dtype)[np.array(clipped)]
     return differs, warped, six_between, dropped
+
+
+def _overlapping(relative: np.ndarray, triangles: list[tuple[int, int, int]], normal: np.ndarray) -> bool:
+    """Whether some of ``triangles`` (indices into the planar polygon ``relative``, (k, 3) m about its first
+    corner) face against the polygon's ``normal`` (Newell's sum): then they overlap in its plane."""
+    p = relative[np.array(triangles)]
+    return bool(np.any(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]) @ normal < 0))
+
+
+#: Most corners of a planar polygon cut again by :func:`_ear_clip` (k³/6 point tests at most).
+MAX_EAR_CLIPPED_CORNERS = 256
+
+
+def _ear_clip(relative: np.ndarray, normal: np.ndarray) -> list[tuple[int, int, int]] | None:
+    """Triangles of a simple planar polygon (corners ``relative`` (k, 3) about the first one, counter-clockwise
+    about ``normal``) by ear clipping in float64 on the plane most face-on to it: an ear is a corner turning
+    left whose triangle holds no other remaining corner (on its boundary counts as held).  None when no ear is
+    found (the polygon is not simple in float64) or it has more than :data:`MAX_EAR_CLIPPED_CORNERS` corners."""
+    k = len(relative)
+    if k > MAX_EAR_CLIPPED_CORNERS:
+        return None
+    drop = int(np.argmax(np.abs(normal)))
+    axes = [a for a in range(3) if a != drop]
+    if normal[drop] < 0:
+        axes = axes[::-1]                         # so that the polygon runs counter-clockwise in (u, w)
+    u, w = relative[:, axes[0]], relative[:, axes[1]]
+    remaining = list(range(k))
+    triangles: list[tuple[int, int, int]] = []
+    while len(remaining) > 3:                     # one corner removed per pass: at most k − 3 passes
+        m = len(remaining)
+        for g in range(m):
+            a, b, c = remaining[g - 1], remaining[g], remaining[(g + 1) % m]
+            turn = (u[b] - u[a]) * (w[c] - w[a]) - (w[b] - w[a]) * (u[c] - u[a])
+            if not turn > 0:
+                continue
+            others = np.array([i for i in remaining if i not in (a, b, c)], dtype=np.int64)
+            pu, pw = u[others], w[others]
+            s0 = (u[b] - u[a]) * (pw - w[a]) - (w[b] - w[a]) * (pu - u[a])
+            s1 = (u[c] - u[b]) * (pw - w[b]) - (w[c] - w[b]) * (pu - u[b])
+            s2 = (u[a] - u[c]) * (pw - w[c]) - (w[a] - w[c]) * (pu - u[c])
+            if np.any((s0 >= 0) & (s1 >= 0) & (s2 >= 0)):
+                continue
+            triangles.append((a, b, c))
+            del remaining[g]
+            break
+        else:
+            return None
+    triangles.append((remaining[0], remaining[1], remaining[2]))
+    return triangles
+
+
+def _clipped_near_the_origin(relative: np.ndarray, clipped: list[tuple[int, int, int]], lost: int,
+                             normal: np.ndarray) -> tuple[list[tuple[int, int, int]], int]:
+    """A planar polygon cut again by :func:`_ear_clip` in float64, when MuJoCo's clip (float32, on the file's
+    coordinates) overlapped itself: far from the origin float32 cannot tell the corners apart (9e8 m out they lie
+    on a 64 m grid), and the overlapping triangles would read as a surface passing through itself.  A planar
+    polygon bounds the same solid however it is cut, so this changes no integral, only which triangles carry
+    it; the first cut is kept when the second cannot be made or overlaps too."""
+    again = _ear_clip(relative, normal)
+    if again is None or _overlapping(relative, again, normal):
+        return clipped, lost
+    return again, lost          # what MuJoCo's own clip drops, still reported
 
 
 def _percent_of_volume(vertices: np.ndarray, faces: np.ndarray, six_between: float) -> float | None:

@@ -807,6 +807,84 @@ def _check_off_header(path: str, size: int, max_faces: int) -> _Counts:
     return {"vertex": nv, "face": nf}
 
 
+def _off_ints(path: str, tokens: list[bytes], what: str) -> list[int]:
+    try:
+        return [int(t) for t in tokens]
+    except ValueError:
+        found = b' '.join(tokens)[:60].decode(errors='replace')
+        raise _fail(path, f"{what}: expected integers, found {found!r}") from None
+
+
+def _read_off(path: str, max_faces: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """Read an OFF file (``[C|N|ST…]OFF``, the counts on the keyword's line or the next, ``#`` comments, blank
+    lines, colours after a vertex's three coordinates or a face's corners ignored).
+
+    Faces of three corners are triangles; a quadrilateral ``abcd`` is cut ``abc, cda`` (as trimesh cut it, which
+    read OFF here before); a polygon of more corners is cut as an OBJ polygon (:func:`.polygons.clip_polygons`),
+    so a planar one, convex or not, gives triangles that do not overlap.  Indices are 0-based; one outside
+    ``0..n−1`` is refused with the face named.  Returns ``vertices (n, 3)``, ``faces (m, 3)`` and the number of
+    faces in the file.  (trimesh 5.2's reader fails on polygons of five or more corners under numpy 2.)
+    """
+    with open_regular(path) as fh:
+        text = fh.read()
+    lines = []
+    for raw in text.replace(b"\r", b"\n").split(b"\n"):
+        words = raw.split(b"#", 1)[0].split()
+        if words:
+            lines.append(words)
+    if not lines or b"OFF" not in lines[0][0]:
+        raise _fail(path, "not an OFF file (no 'OFF' keyword at the start)")
+    head = lines[0]
+    rest = head[0][head[0].index(b"OFF") + 3:]
+    counts_words = ([rest] if rest else []) + head[1:]
+    body = 1
+    if not counts_words:
+        if len(lines) < 2:
+            raise _fail(path, "OFF header without vertex and face counts")
+        counts_words, body = lines[1], 2
+    counts = _off_ints(path, counts_words[:2], "OFF header counts")
+    if len(counts) < 2:
+        raise _fail(path, "OFF header without vertex and face counts")
+    nv, nf = counts
+    _check_face_budget(path, nf, max_faces)
+    if len(lines) < body + nv + nf:
+        raise _fail(path, f"OFF header announces {nv:,} vertices and {nf:,} faces but the file has only "
+                          f"{max(len(lines) - body, 0):,} data lines: truncated or lying header")
+    rows = lines[body:body + nv]
+    if any(len(r) < 3 for r in rows):
+        raise _fail(path, "a vertex line has fewer than three coordinates")
+    try:
+        vertices = np.array([[float(x) for x in r[:3]] for r in rows], dtype=np.float64).reshape(-1, 3)
+    except ValueError:
+        raise _fail(path, "a vertex coordinate is not a number") from None
+    tri: list[int] = []
+    polygons: list[tuple[int, list[int]]] = []
+    for j, words in enumerate(lines[body + nv:body + nv + nf]):
+        k = _off_ints(path, words[:1], f"face {j}")[0]
+        if k < 3 or len(words) < k + 1:
+            raise _fail(path, f"face {j} has {k} corners" + ("" if k < 3 else f" but lists {len(words) - 1}"))
+        idx = _off_ints(path, words[1:k + 1], f"face {j}")
+        if min(idx) < 0 or max(idx) >= nv:
+            raise _fail(path, f"face {j} has a vertex index outside 0..{nv - 1}")
+        if k == 4:
+            idx = [idx[0], idx[1], idx[2], idx[2], idx[3], idx[0]]
+        elif k > 4:
+            polygons.append((len(tri) // 3, idx))
+            idx = [c for i in range(1, k - 1) for c in (idx[0], idx[i], idx[i + 1])]
+        tri += idx
+    if not tri:
+        raise _fail(path, "contains no triangles (empty mesh or point cloud)")
+    faces = np.array(tri, dtype=np.int64).reshape(-1, 3)
+    _check_face_budget(path, len(faces), max_faces)
+    if polygons:
+        differs, _, between, dropped = clip_polygons(vertices, faces, polygons)
+        if differs:
+            warn_clipped_polygons(_display(path), vertices, faces, differs, len(polygons), between, dropped)
+    if not np.all(np.isfinite(vertices)):
+        raise _fail(path, "vertices have NaN or infinite coordinates")
+    return vertices, faces, nf
+
+
 def _relationship_targets(data: bytes) -> list[str]:
     """The ``Target`` of every ``Relationship`` of an OPC relationships part, without a leading ``/``."""
     import xml.etree.ElementTree as ET
@@ -1156,9 +1234,47 @@ def _read_with_trimesh_rounding(path: str, max_faces: int,
         raise _fail(path, f"contains no triangle mesh (found {type(loaded).__name__}: a point cloud or lines)")
     v, f = _checked_arrays(path, np.asarray(loaded.vertices, dtype=np.float64), np.asarray(loaded.faces), counts,
                            max_faces)
+    if suffix == ".ply":
+        f = _ply_polygons_clipped(path, loaded, v, f)
     if parts_out is not None:
         parts_out.extend(parts)
     return v, f, declared, rounding
+
+
+def _ply_polygons_clipped(path: str, loaded: Any, vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """``faces`` with the PLY's polygons of more than four corners cut as OBJ's are
+    (:func:`.polygons.clip_polygons`) instead of trimesh's first-corner fan, which overlaps itself on a
+    non-convex polygon and would read as a surface passing through itself; triangles and quads as trimesh cut
+    them.  ``faces`` unchanged when the file has no such polygon or trimesh kept no raw face lists."""
+    try:
+        raw = loaded.metadata["_ply_raw"]
+        lists = raw["face"]["data"]["vertex_indices"]
+        if int(raw["vertex"]["length"]) != len(vertices):
+            return faces                   # trimesh split or merged vertices: the lists' indices are not ours
+    except (KeyError, TypeError, AttributeError, ValueError):
+        return faces
+    if not isinstance(lists, np.ndarray) or lists.dtype != object:
+        return faces                       # one list length for every face: no polygon of mixed size
+    sizes = np.fromiter((len(p) for p in lists), dtype=np.int64, count=len(lists))
+    if not np.any(sizes > 4) or int(np.sum(np.maximum(sizes - 2, 0))) != len(faces):
+        return faces
+    rows: list[list[int]] = []
+    polygons: list[tuple[int, list[int]]] = []
+    for corners in lists:
+        idx = [int(i) for i in corners]
+        if len(idx) == 4:
+            rows += [[idx[0], idx[1], idx[2]], [idx[2], idx[3], idx[0]]]
+        else:
+            if len(idx) > 4:
+                polygons.append((len(rows), idx))
+            rows += [[idx[0], idx[j], idx[j + 1]] for j in range(1, len(idx) - 1)]
+    cut = np.array(rows, dtype=np.int64)
+    if cut.min() < 0 or cut.max() >= len(vertices):
+        return faces
+    differs, _, between, dropped = clip_polygons(vertices, cut, polygons)
+    if differs:
+        warn_clipped_polygons(_display(path), vertices, cut, differs, len(polygons), between, dropped)
+    return cut.astype(faces.dtype)
 
 
 def _checked_arrays(path: str, v: np.ndarray, f: np.ndarray, counts: _Counts,
@@ -1301,6 +1417,9 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                     raise _fail(path, "the tessellation has NaN or infinite coordinates")
                 declared = (1.0, "m")           # the CAD reader converts the file's unit to metres
                 n = len(faces)
+            elif suffix == ".off":
+                _check_off_header(path, st.st_size, max_faces)
+                vertices, faces, n = _read_off(path, max_faces)
             elif suffix == ".3mf":
                 vertices, faces, declared, parts = _read_3mf(path, max_faces)
                 _check_face_budget(path, len(faces), max_faces)

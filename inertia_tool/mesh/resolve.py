@@ -214,9 +214,19 @@ def _describe(census: EdgeBalance, welded: float | None, vertices: np.ndarray, f
     edges = boundary_edges(faces, len(vertices))
     where = ""
     if len(edges):
-        a, b = vertices[edges[0, 0]], vertices[edges[0, 1]]
-        where = f", e.g. the edge ({a[0]:.6g}, {a[1]:.6g}, {a[2]:.6g})–({b[0]:.6g}, {b[1]:.6g}, {b[2]:.6g}) m"
+        where = ", e.g. the edge " + _edge_text(vertices[edges[0, 0]], vertices[edges[0, 1]]) + " m"
     return "; ".join(parts) + after + where
+
+
+def _edge_text(a: np.ndarray, b: np.ndarray) -> str:
+    """``(ax, ay, az)–(bx, by, bz)`` to 6 significant digits of the edge's own length: 6 + log10(largest
+    coordinate / length) digits (at most 17), so that a small part far from the origin (1e8 m out) is not printed
+    as one point twice."""
+    length = float(np.linalg.norm(b - a))
+    reach = float(max(np.abs(a).max(), np.abs(b).max()))
+    extra = int(np.ceil(np.log10(reach / length))) if length > 0 and reach > length else 0
+    digits = min(6 + extra, 17)
+    return "–".join("(" + ", ".join(f"{x:.{digits}g}" for x in p) + ")" for p in (a, b))
 
 
 def _touching_note(census: EdgeBalance) -> tuple[str, ...]:
