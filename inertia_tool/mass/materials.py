@@ -241,7 +241,8 @@ def _unite_same_material(specs: list[dict[str, Any]], rtol: float = PART_OVERLAP
                        faces=np.vstack([np.asarray(specs[k]["source"].faces) + o for k, o in zip(ks, offsets)]),
                        source=f"{first.source.rsplit(' [', 1)[0]} [{name}]", units=first.units,
                        file_faces=sum(len(specs[k]["source"].faces) for k in ks), units_assumed=first.units_assumed,
-                       storage_rounding=first.storage_rounding)
+                       storage_rounding=first.storage_rounding,
+                       scale_rounding=max(specs[k]["source"].scale_rounding for k in ks))
         out.append({**specs[ks[0]], "source": mesh, "name": name})
     return out
 

@@ -123,6 +123,11 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
     return united._replace(notes=(*united.notes, *notes)), spread
 
 
+def _plus(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[float, float, float]:
+    """Two bounds stated as ``(volume relative, centroid m, inertia relative)``, added (triangle inequality)."""
+    return a[0] + b[0], a[1] + b[1], a[2] + b[2]
+
+
 def _turned(found: MisreadNesting, oriented: Orientation) -> str:
     """The flip said once (R4 turned these shells without a warning of its own): the start of the one warning."""
     return flipped_text(len(found.shells), oriented.shells.n_shells)
@@ -130,7 +135,7 @@ def _turned(found: MisreadNesting, oriented: Orientation) -> str:
 
 def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patched: Estimate | None,
             arranged: bool, verified: bool, ambiguous: bool, folds: bool, sheets_removed: bool,
-            source: str, spread: tuple[float, float] | None = None) -> Certified:
+            source: str, spread: tuple[float, float] | None = None, scale_rounding: float = 0.0) -> Certified:
     """R7 and what each earlier stage implies for the certificate of ``shells``.
 
     Parameters
@@ -152,17 +157,35 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
     spread : (float, float) or None
         ``(volume in doubt m³, reach m)`` of a reading the file does not decide (:func:`misread_reading`): the
         result is then an estimate whose bounds cover that volume.
+    scale_rounding : float
+        m: how far the reader's unit conversion moved a coordinate (:attr:`~.read.RawMesh.scale_rounding`): the
+        solid integrated may differ from the file's by :func:`~.precision.conversion_bounds`, counted with the
+        round-off (review 12's R6: a 47.5 nm plate in mm 1.3e8 m out was 2.3 % off, labelled exact).
     """
     notes: list[str] = []
     checks = list(checks)
     roundoff = total_roundoff(shells.moments, shells.bound)
+    converted = (0.0, 0.0, 0.0)
+    if scale_rounding > 0:
+        from .precision import conversion_bounds
+        whole = total(shells.moments)
+        converted = conversion_bounds(shells.vertices, shells.faces, scale_rounding, whole.volume, whole.centroid,
+                                      whole.second_moment)
     if patched is None:                                                          # R7: exact up to round-off
-        if roundoff > ROUNDOFF_RTOL and kind in ("exact", "united"):
+        moved = max(converted[0], converted[2])
+        if roundoff + moved > ROUNDOFF_RTOL and kind in ("exact", "united"):
             kind = "unverified"
-            notes.append("the float64 round-off of the integrals is bounded only by "
-                         f"{round_up(roundoff, 2):.2g} of the result "
-                         f"(above {ROUNDOFF_RTOL:g}: a sliver thinner than its coordinates' rounding, too large for "
-                         "exact arithmetic): not verified")
+            if moved > roundoff:
+                notes.append(f"converting the file's unit to metres rounded its coordinates by up to "
+                             f"{round_up(scale_rounding, 2):.2g} m, which may change the result by "
+                             f"{round_up(moved, 2):.2g} of it (above {ROUNDOFF_RTOL:g}: a part thin or small "
+                             "against its distance from the origin): not verified; give the mesh in metres, or "
+                             "nearer the origin, to prove it")
+            else:
+                notes.append("the float64 round-off of the integrals is bounded only by "
+                             f"{round_up(roundoff, 2):.2g} of the result "
+                             f"(above {ROUNDOFF_RTOL:g}: a sliver thinner than its coordinates' rounding, too large "
+                             "for exact arithmetic): not verified")
     uncertainty = None
     if patched is not None:
         from .uncertainty import check_useful, uncertainty_from, with_roundoff   # imported on use: repair only
@@ -171,7 +194,7 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         if spread is not None:                # R4: the reading the file does not decide is in doubt as well
             doubt, far = doubt + spread[0], max(far, spread[1])
         uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, doubt, far),
-                                    total_roundoff_parts(shells.moments, shells.bound))
+                                    _plus(total_roundoff_parts(shells.moments, shells.bound), converted))
         what = "the patched surface" + (" and a shell wound outward inside another" if spread is not None else "")
         holes_alone = patched.uncertainty.volume_in_doubt / whole.volume if whole.volume > 0 else np.inf
         if spread is not None and holes_alone <= ESTIMATE_MAX_MASS_RTOL:
@@ -189,7 +212,7 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         whole = total(shells.moments)
         from .uncertainty import check_useful, with_roundoff
         uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, *spread),
-                                    total_roundoff_parts(shells.moments, shells.bound))
+                                    _plus(total_roundoff_parts(shells.moments, shells.bound), converted))
         # the same ±50 % limit as every estimate (holes6's review: two crossing outward cubes inside a cube were
         # answered at ±61.5 % mass)
         check_useful(whole.volume, uncertainty, source=source, what="the reading by nesting depth", why=_R4_WHY)

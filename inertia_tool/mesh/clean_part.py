@@ -54,6 +54,10 @@ __all__ = ["prepare_clean", "CLEAN_MAX_FACES", "CLEAN_CHECKS"]
 #: the full path's memory management (chunked passes, released scratch) is the one tuned for it.
 CLEAN_MAX_FACES = 1 << 17
 
+#: The share of ``ROUNDOFF_RTOL`` the fast path leaves to a unit conversion's rounding (R7 counts both: the
+#: round-off is held within the rest, so a part the fast path takes is one the full path certifies exact too).
+_CONVERSION_SHARE = 0.25
+
 #: The checks of the certificate of a clean part (the full path's ``first_checks`` for one shell, nothing crossing).
 CLEAN_CHECKS = ("edge-balanced", "consistently-oriented", "no-crossing-faces")
 
@@ -109,7 +113,8 @@ def prepare_clean(raw: RawMesh, *, max_faces: int = CLEAN_MAX_FACES) -> Prepared
         return None
     centre = 0.5 * (lo + hi)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):     # a flat shell's bound is inf or NaN
-        found = one_shell_moments(v, f, centre, (lo, hi), rtol=ROUNDOFF_RTOL)
+        found = one_shell_moments(v, f, centre, (lo, hi),
+                                  rtol=ROUNDOFF_RTOL * (1.0 - _CONVERSION_SHARE if raw.scale_rounding > 0 else 1.0))
     if found is None:
         return None                                              # a sliver R7 integrates again, or no C extension
     shell, within = found
@@ -120,6 +125,11 @@ def prepare_clean(raw: RawMesh, *, max_faces: int = CLEAN_MAX_FACES) -> Prepared
         return None
     if not within:
         return None                                              # R7 may say "unverified", with its note
+    if raw.scale_rounding > 0:                                   # R7 counts the unit conversion's rounding too
+        from .precision import conversion_bounds
+        moved = conversion_bounds(v, f, raw.scale_rounding, volume, shell.centroid, shell.second_moment)
+        if max(moved[0], moved[2]) > _CONVERSION_SHARE * ROUNDOFF_RTOL:
+            return None                                          # the full path decides, with its note
     report = MeshReport(vertices=len(v), faces=m, zero_area_faces=shell.zero_area_faces, bodies=1, cavities=0,
                         flipped_shells=0, overlapping_shells=0, repaired=False, repair_actions=(),
                         repair_volume_change=None, bbox_min=lo, bbox_max=hi, method="exact", uncertainty=None,

@@ -182,5 +182,5 @@ def split_parts(raw: RawMesh) -> list[tuple[PartTag, RawMesh]]:
         vertices, faces = part_mesh(raw.vertices, raw.faces, tag)
         out.append((tag, RawMesh(vertices=vertices, faces=faces, source=f"{raw.source} [{tag.name}]", units=raw.units,
                                  file_faces=len(faces), units_assumed=raw.units_assumed,
-                                 storage_rounding=raw.storage_rounding)))
+                                 storage_rounding=raw.storage_rounding, scale_rounding=raw.scale_rounding)))
     return out

@@ -43,7 +43,8 @@ from ..rounding import round_up
 if TYPE_CHECKING:
     from .read import RawMesh
 
-__all__ = ["float32_rounding", "volume_rounding_bound", "warn_storage_precision"]
+__all__ = ["conversion_bounds", "float32_rounding", "product_rounding", "volume_rounding_bound",
+           "warn_storage_precision"]
 
 _CHUNK = 1 << 20
 
@@ -88,6 +89,39 @@ def volume_rounding_bound(vertices: np.ndarray, faces: np.ndarray, rounding: flo
     return 3.0 * (2.0 * eps * area + 0.5 * math.pi * eps * eps * perimeter
                   + 4.0 / 3.0 * math.pi * eps ** 3 * len(faces))
 
+
+def product_rounding(vertices: np.ndarray, scale: float) -> float:
+    """Largest error, in the scaled unit, of ``vertices * scale`` rounded to float64 (review 12's R6): 0 when
+    ``scale`` is a power of two (the products are exact barring underflow), else half the float64 spacing at the
+    largest scaled coordinate (round to nearest)."""
+    if not len(vertices) or math.frexp(abs(scale))[0] == 0.5:
+        return 0.0
+    largest = max(float(np.max(vertices)), -float(np.min(vertices))) * abs(scale)   # no |x| temporary
+    return 0.5 * float(np.spacing(largest)) if math.isfinite(largest) else float("inf")
+
+
+def conversion_bounds(vertices: np.ndarray, faces: np.ndarray, rounding: float, volume: float,
+                      centroid: np.ndarray, second_moment: np.ndarray) -> tuple[float, float, float]:
+    """What rounding every coordinate by at most ``rounding`` (m; the reader's unit conversion,
+    :func:`product_rounding`) may change: ``(volume relative, centroid m, inertia relative)``, as an estimate's
+    bounds are stated (:class:`~inertia_tool.mesh.uncertainty.Uncertainty`), for R7's "exact".
+
+    The solids before and after differ only in a region of volume at most ``B`` (:func:`volume_rounding_bound`),
+    within ``ρ = R + ε`` of the centroid (``R`` the farthest vertex, ``ε = √3·rounding``).  The volume moves by at
+    most ``B``; the centroid by at most ``B·ρ / (|V| − B)`` (a region of volume ``B`` added or taken within ``ρ``);
+    the inertia tensor by at most ``√2·B·ρ²`` in Frobenius norm (``‖r²E − r rᵀ‖_F = √2·r²``) against ``‖I‖_F ≥
+    tr I / √3 = 2 tr C / √3`` (``C`` the second moment about the centroid).  Zeros when ``rounding`` is 0; infs
+    for a flat total."""
+    if not rounding > 0:
+        return 0.0, 0.0, 0.0
+    bound = volume_rounding_bound(vertices, faces, rounding)
+    trace = float(np.trace(second_moment))
+    if not (abs(volume) > bound and trace > 0):
+        return float("inf"), float("inf"), float("inf")
+    rel = vertices - centroid
+    reach = math.sqrt(float(np.max(np.einsum("ij,ij->i", rel, rel)))) + math.sqrt(3.0) * rounding
+    return (bound / abs(volume), bound * reach / (abs(volume) - bound),
+            math.sqrt(2.0) * bound * reach ** 2 / (2.0 * trace / math.sqrt(3.0)))
 
 def warn_storage_precision(raw: RawMesh, volume: float, *, rtol: float = STORAGE_PRECISION_RTOL,
                            stacklevel: int = 3) -> float | None:

@@ -155,7 +155,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     certified = certify(shells, kind=united.kind, checks=united.checks, method=united.method, patched=patched,
                         arranged=crossed.arranged is not None, verified=crossed.verified,
                         ambiguous=bool(oriented.ambiguous), folds=met.folds is not None,
-                        sheets_removed=found.method == "sheets-removed", source=source, spread=spread)  # R7
+                        sheets_removed=found.method == "sheets-removed", source=source, spread=spread,
+                        scale_rounding=raw.scale_rounding)                                                # R7
     stages = (first.dropped, crossed.arranged, met.folds.describe() if met.folds is not None else None,
               crossed.unverified)
     notes = (*found.notes, *surface.coincident, *first.coincident, *oriented.notes,

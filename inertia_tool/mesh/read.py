@@ -94,6 +94,11 @@ class RawMesh:
         float32 (binary STL, PLY ``float``, glTF/GLB, COLLADA): half the float32 spacing at the largest
         coordinate (:func:`inertia_tool.mesh.precision.float32_rounding`); 0 for text and float64 formats and
         for arrays.  :func:`inertia_tool.mesh.precision.warn_storage_precision` turns it into a volume bound.
+    scale_rounding : float
+        m: how far the reader's conversion to metres moved a coordinate (each product ``x·scale`` rounded to
+        float64: half the spacing at the largest; 0 when no unit was converted or the scale is a power of two).
+        R7 (:func:`~inertia_tool.mesh.certify.certify`) counts it: the file's polyhedron is exact, the converted
+        one may differ from it by this much (review 12's R6).
     parts : tuple of PartTag
         The parts of a file that names materials per part (:mod:`inertia_tool.mesh.parts`: a 3MF with base
         materials or a slicer's filament assignments, a STEP assembly), each a range of ``faces``; empty for a
@@ -108,6 +113,7 @@ class RawMesh:
     units_assumed: bool = False
     storage_rounding: float = 0.0
     parts: tuple[PartTag, ...] = ()
+    scale_rounding: float = 0.0
 
 
 def _display(path: str | bytes | os.PathLike[str] | os.PathLike[bytes]) -> str:
@@ -1386,7 +1392,8 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
                         raise MeshReadError(str(exc).replace(inner, f"{_display(path)}:{member}", 1)) from None
                 return RawMesh(vertices=raw.vertices, faces=raw.faces, source=_display(path), units=raw.units,
                                file_faces=raw.file_faces, units_assumed=raw.units_assumed,
-                               storage_rounding=raw.storage_rounding, parts=raw.parts)
+                               storage_rounding=raw.storage_rounding, parts=raw.parts,
+                               scale_rounding=raw.scale_rounding)
             if suffix not in SUPPORTED_SUFFIXES:
                 raise _fail(path, f"unsupported file type {_display(suffix) or '(no suffix)'!r}; expected one of "
                                   f"{', '.join(SUPPORTED_SUFFIXES + COMPRESSED_SUFFIXES)}")
@@ -1456,13 +1463,17 @@ def load_mesh(source: object, *, units: str | None = None, max_faces: int = DEFA
         welded = False
     if not welded:                         # a pass over every corner, not paid on the STL hot path
         vertices, faces, owned = _used_vertices(vertices, faces, owned)
+    converted = 0.0
     if scale != 1.0:
+        from .precision import product_rounding
+        converted = product_rounding(vertices, scale)
         if owned and vertices.dtype == np.float64 and vertices.flags.writeable:
             vertices *= scale
         else:
             vertices = vertices * scale
     return RawMesh(vertices=vertices, faces=faces, source=name, units=str(units), file_faces=n,
-                   units_assumed=assumed, storage_rounding=rounding * abs(scale), parts=parts)
+                   units_assumed=assumed, storage_rounding=rounding * abs(scale), parts=parts,
+                   scale_rounding=converted)
 
 
 #: Faces marked or renumbered per pass by :func:`_used_vertices`: its index temporaries stay a few MB at any size.

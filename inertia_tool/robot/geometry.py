@@ -217,11 +217,19 @@ def _placed(raw: RawMesh, element: GeometryElement) -> RawMesh:
     if not moved and np.all(scale == 1.0):
         return raw
     v = raw.vertices
+    reach = math.sqrt(3.0) * max(float(np.max(v)), -float(np.min(v))) if len(v) else 0.0
     if moved:
         v = v @ element.reference_rotation.T + element.reference_translation
+        reach += float(np.max(np.abs(element.reference_translation)))
     f = raw.faces if float(np.prod(np.sign(scale))) > 0 else raw.faces[:, ::-1]
+    largest = float(np.max(np.abs(scale)))
+    exact = not moved and all(math.frexp(float(s))[0] in (0.5, -0.5) for s in scale)
+    # R7 counts how far these products moved a coordinate (review 12's R6): a rotated coordinate is a sum of three
+    # products (γ₃·Σ|vⱼ||Rᵢⱼ| ≤ 3.01·u·√3·max|v|), then the translation and the scale add one rounding each:
+    # below 8·u·(√3·max|v| + max|t|)·max|s| in all, as the reader's own conversion is carried (scaled) too
+    moved_by = raw.scale_rounding * largest + (0.0 if exact else 8.0 * 2.0 ** -53 * reach * largest)
     return replace(raw, vertices=v * scale, faces=np.ascontiguousarray(f),
-                   storage_rounding=raw.storage_rounding * float(np.max(np.abs(scale))))
+                   storage_rounding=raw.storage_rounding * largest, scale_rounding=moved_by)
 
 
 def _capsule(radius: float, length: float) -> MassProperties:
