@@ -907,13 +907,16 @@ class PlanarRims:
     half_width : (n_loops,) float
         m: the rim's largest distance from its plane plus 16 ulp of the coordinates (``inf`` where none).
     normal : (n_loops, 3) float
-        Unit normal of each rim's least-squares plane, through the centroid of its vertices.
+        Unit normal of each rim's least-squares plane.
+    origin : (n_loops, 3) float
+        m: the centroid of each rim's vertices, on that plane.
     """
 
     applies: np.ndarray
     doubt: np.ndarray
     half_width: np.ndarray
     normal: np.ndarray
+    origin: np.ndarray
 
 
 def planar_rim_doubt(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
@@ -957,7 +960,7 @@ def planar_rim_doubt(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray,
     half = np.full(n_loops, np.inf)
     normal = np.zeros((n_loops, 3))
     if not n_loops:
-        return PlanarRims(applies=applies, doubt=doubt, half_width=half, normal=normal)
+        return PlanarRims(applies=applies, doubt=doubt, half_width=half, normal=normal, origin=np.zeros((0, 3)))
     pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
     loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
     count = np.bincount(loop_of, minlength=n_loops).astype(np.float64)
@@ -993,4 +996,5 @@ def planar_rim_doubt(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray,
     candidate &= ~shallow
     offset = np.einsum("ij,ij->i", centre - mean, normal)
     doubt = np.where(candidate, ball_slab_volume(radius, offset, np.where(candidate, half, 0.0)), np.inf)
-    return PlanarRims(applies=candidate, doubt=doubt, half_width=np.where(candidate, half, np.inf), normal=normal)
+    return PlanarRims(applies=candidate, doubt=doubt, half_width=np.where(candidate, half, np.inf), normal=normal,
+                      origin=mean)

@@ -232,6 +232,16 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         crossed[[fill.loop for fill in creases]] = True
         order = np.argsort(-np.where(crossed, -1.0, hole_doubt), kind="stable")
         order = order[~crossed[order]]
+        # the planar-rim reading (PLANAR) is decided before the curved fills: a rim it reads as a lost flat face
+        # keeps its cone (in the rim's hull, so in the slab), unless the surroundings continue round the hole
+        # on one curved quadric (the evidence that withdraws it) or evidence withdrew the narrower assumptions
+        planar = planar_rim_doubt(v, f, edges, label, n_loops, centre, radius)
+        planar_ok = planar.applies & ~withdrawn & ~crossed
+        if planar_ok.any():
+            which = np.flatnonzero(planar_ok)
+            rims = [vertex_of[loop_of == k] for k in which.tolist()]
+            planar_ok[which[curved_surroundings(v, f, rims, centre[which], radius[which])]] = False
+            order = order[~planar_ok[order]]
         curved = curved_fills(v, f, edges, label, n_loops, apex, centre, radius, (start, end, thick), slab, order)
         if curved:
             pv, pf, cap, closed, hole_doubt = build(creases, curved)
@@ -254,16 +264,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         hole_doubt = np.where(took_bend, bend_doubt, hole_doubt)
         ball_volume = 4.0 / 3.0 * np.pi * radius ** 3
         took_capsule &= ~took_bend
-        # the planar-rim reading (PLANAR): a rim in one plane meeting every face beside it at a crease lost a flat
-        # face; only where the cone is the fill (in the rim's hull, so in the slab), no evidence withdrew the
-        # narrower assumptions, and the surroundings do not continue round the hole on one curved quadric
-        planar = planar_rim_doubt(v, f, edges, label, n_loops, centre, radius)
-        planar_ok = planar.applies & ~withdrawn & ~crossed & ~bent & (planar.doubt < hole_doubt)
-        if planar_ok.any():
-            which = np.flatnonzero(planar_ok)
-            rims = [vertex_of[loop_of == k] for k in which.tolist()]
-            planar_ok[which[curved_surroundings(v, f, rims, centre[which], radius[which])]] = False
-        took_planar = planar_ok
+        # the planar-rim reading where it is narrower than the bounds above
+        took_planar = planar_ok & ~bent & (planar.doubt < hole_doubt)
         hole_doubt = np.where(took_planar, planar.doubt, hole_doubt)
         took_bend &= ~took_planar
         took_capsule &= ~took_planar
@@ -297,8 +299,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                 far = float(np.max(reach_of(closed.centroid)))
         # the convex bound where it applies and is narrower than the others before the bend bound: a convex part
         # keeps the polytope (a rule fixed before the bend bound came, which tests/test_hole_bounds.py pins)
-        # (and where the planar-rim reading is not narrower still: a hull that lost a flat face keeps ±δ)
-        if bound is not None and bound[0] < before_bend and not (took_planar.any() and doubt <= bound[0]):
+        if bound is not None and bound[0] < before_bend:
             doubt, corners = bound
             far = float(np.max(np.linalg.norm(corners - closed.centroid, axis=1)))
             convex = True
