@@ -69,8 +69,8 @@ INNER = HoleAssumption(
 PLANAR = HoleAssumption(
     "planar", "a hole whose rim lies in one plane and meets every face beside it at a crease lost a flat face: the "
     "missing surface lies no farther from the rim's plane than the rim does",
-    "a dome, boss or pocket bounded by a crease and taken whole (a capsule that lost its round end reads as a "
-    "cylinder that lost its flat one); a surface that continues round over the hole on one quadric (a sphere cut "
+    "a dome, boss or pocket bounded by a crease and taken whole (a domed lid on a prism reads as a flat lid); "
+    "a surface that continues round over the hole on one quadric (a sphere cut "
     "by a plane) withdraws it")
 QUADRIC = HoleAssumption(
     "quadric", "(the fill, not the bound) the missing surface continues the quadric its surroundings lie on",
