@@ -19,8 +19,8 @@ from __future__ import annotations
 import dataclasses
 from typing import Iterable
 
-__all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "QUADRIC", "ALL", "stated",
-           "named"]
+__all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "PLANAR", "QUADRIC", "ALL",
+           "stated", "named"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -66,12 +66,18 @@ INNER = HoleAssumption(
     "a pocket or boss taken whole whose footprint kept one corner on the rim with more than 180° of the face round "
     "it and neither rim neighbour of that corner another such (the file cannot tell it from a vertex inside a "
     "flat face)")
+PLANAR = HoleAssumption(
+    "planar", "a hole whose rim lies in one plane and meets every face beside it at a crease lost a flat face: the "
+    "missing surface lies no farther from the rim's plane than the rim does",
+    "a dome, boss or pocket bounded by a crease and taken whole (a domed lid on a prism reads as a flat lid); "
+    "a surface that continues round over the hole on one quadric (a sphere cut "
+    "by a plane) withdraws it")
 QUADRIC = HoleAssumption(
     "quadric", "(the fill, not the bound) the missing surface continues the quadric its surroundings lie on",
     "nothing: the bound stays that of the other assumptions named")
 
 #: Every assumption, in the order :func:`stated` prints them.
-ALL = (CONVEX, INNER, BALL, CAPSULE, FLAT, CREASE, BEND, QUADRIC)
+ALL = (CONVEX, INNER, BALL, CAPSULE, FLAT, PLANAR, CREASE, BEND, QUADRIC)
 
 
 def named(names: Iterable[str]) -> tuple[HoleAssumption, ...]:

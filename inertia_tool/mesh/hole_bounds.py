@@ -880,3 +880,121 @@ def round_up_array(values: np.ndarray) -> np.ndarray:
     """Each value moved one ulp away from zero (a sum of rounded terms, made an upper bound)."""
     out: np.ndarray = np.nextafter(values, np.inf)
     return out
+
+
+#: A rim "lies in one plane" for :func:`planar_rim_doubt` when every rim vertex is within this share of the
+#: ball's radius of the rim's least-squares plane (the same share as :data:`FLAT_RIM_RTOL`).
+PLANAR_RIM_RTOL = FLAT_RIM_RTOL
+
+#: The least angle, degrees, between the rim's plane and every face sharing an edge with the rim for
+#: :func:`planar_rim_doubt`: the surface left meets the missing face at a crease of at least this, as the walls of
+#: a prism, a box or a hull meet the face they lost (a hole in a smooth or gently curved surface meets it at the
+#: tessellation's angle and keeps the other bounds).
+PLANAR_MIN_CREASE_DEGREES = 30.0
+
+
+@frozen_value
+class PlanarRims:
+    """Per hole, the planar-rim reading of :func:`planar_rim_doubt`.
+
+    Attributes
+    ----------
+    applies : (n_loops,) bool
+        The rim lies within ``half_width`` of one plane and meets every face beside it at a crease.
+    doubt : (n_loops,) float
+        m³: the volume of the ball over the rim within ``half_width`` of the plane (``inf`` where it does not
+        apply).
+    half_width : (n_loops,) float
+        m: the rim's largest distance from its plane plus 16 ulp of the coordinates (``inf`` where none).
+    normal : (n_loops, 3) float
+        Unit normal of each rim's least-squares plane.
+    origin : (n_loops, 3) float
+        m: the centroid of each rim's vertices, on that plane.
+    """
+
+    applies: np.ndarray
+    doubt: np.ndarray
+    half_width: np.ndarray
+    normal: np.ndarray
+    origin: np.ndarray
+
+
+def planar_rim_doubt(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                     centre: np.ndarray, radius: np.ndarray, *, rim_rtol: float = PLANAR_RIM_RTOL,
+                     min_crease_degrees: float = PLANAR_MIN_CREASE_DEGREES) -> PlanarRims:
+    """The volume in doubt of holes that are a missing flat face (assumption ``planar``), (n_loops,) m³.
+
+    Assumption (``hole_assumptions.PLANAR``): a hole whose rim lies within ``δ`` of one plane ``P`` and whose
+    faces beside the rim all meet ``P`` at a crease of at least ``min_crease_degrees`` lost a flat face: its
+    missing surface ``M`` lies within ``δ`` of ``P`` (and, as every hole's, in the ball over the rim).  ``P`` is
+    the least-squares plane of the rim's vertices (through their centroid ``c̄``, normal the eigenvector of the
+    smallest eigenvalue of ``Σ (x − c̄)(x − c̄)ᵀ``), ``δ`` the rim's largest distance from it plus 16 ulp of the
+    coordinates.  The cone to ``c̄`` lies in the rim's convex hull, hence within ``δ`` of ``P`` too, so the
+    patched and the true solid differ only inside ball ∩ slab, whose volume :func:`ball_slab_volume` gives.
+
+    Unlike the ``flat`` slab (:func:`hole_doubt_volumes`, the plane of a face *beside* the hole), ``P`` is the
+    rim's own plane: a box or prism that lost a whole face, whose walls stand at 90° to the rim's plane, is
+    bounded by ``±δ``.  A planar rim does *not* show that the missing surface is flat (a sphere cut by a plane
+    leaves one): the crease keeps holes in smooth surfaces out, and the caller withdraws the reading where the
+    surroundings lie on one curved quadric (:func:`~.hole_fills.curved_surroundings`) or where another fill than
+    the cone was made.  What no evidence in the file shows (a dome or boss standing on a crease, taken whole)
+    is the assumption's stated limit.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    edges : (k, 2) int
+        Boundary edges; ``label`` (k,) the loop of each.
+    centre, radius : (n_loops, 3), (n_loops,) float
+        The ball over each rim.
+    rim_rtol : float
+        Largest ``δ`` as a share of the ball's radius.
+    min_crease_degrees : float
+        Least angle between ``P`` and each face sharing a rim edge.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    applies = np.zeros(n_loops, dtype=bool)
+    doubt = np.full(n_loops, np.inf)
+    half = np.full(n_loops, np.inf)
+    normal = np.zeros((n_loops, 3))
+    if not n_loops:
+        return PlanarRims(applies=applies, doubt=doubt, half_width=half, normal=normal, origin=np.zeros((0, 3)))
+    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
+    loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
+    count = np.bincount(loop_of, minlength=n_loops).astype(np.float64)
+    mean: np.ndarray = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) for i in range(3)],
+                                axis=1) / np.maximum(count, 1.0)[:, None]
+    d = v[vertex_of] - mean[loop_of]
+    scatter = np.zeros((n_loops, 3, 3))
+    for i in range(3):
+        for j in range(3):
+            scatter[:, i, j] = np.bincount(loop_of, weights=d[:, i] * d[:, j], minlength=n_loops)
+    _, vectors = np.linalg.eigh(scatter)
+    normal = vectors[:, :, 0]
+    dist = np.abs(np.einsum("ij,ij->i", d, normal[loop_of]))
+    delta = np.zeros(n_loops)
+    np.maximum.at(delta, loop_of, dist)
+    half = delta + _round_off(v)
+    # a rim of at least 3 vertices spanning the plane (not a pinch along a line), within rim_rtol of it
+    spread = np.zeros(n_loops)
+    np.maximum.at(spread, loop_of, np.linalg.norm(d, axis=1))
+    candidate = (count >= 3) & (delta <= rim_rtol * radius) & (spread > 0)
+    # the faces sharing a rim edge, each at a crease of at least min_crease_degrees to the rim's plane
+    # (each rim edge's face, found in either direction; a rim edge without one keeps the loop out)
+    forward, found = _ring_face_of_edges(f, len(v), edges)
+    backward, found_back = _ring_face_of_edges(f, len(v), edges[:, ::-1])
+    face_of = np.where(found, forward, backward)
+    a, b, c = (v[f[face_of, k]] for k in range(3)) if len(f) else (np.zeros((len(edges), 3)),) * 3
+    m = np.cross(b - a, c - a)
+    size = np.linalg.norm(m, axis=1)
+    lean = np.abs(np.einsum("ij,ij->i", m, normal[label])) / np.maximum(size, 1e-300)
+    steep_enough = (found | found_back) & (size > 0) & (lean <= np.cos(np.radians(min_crease_degrees)))
+    shallow = np.zeros(n_loops, dtype=bool)
+    shallow[label[~steep_enough]] = True
+    candidate &= ~shallow
+    offset = np.einsum("ij,ij->i", centre - mean, normal)
+    doubt = np.where(candidate, ball_slab_volume(radius, offset, np.where(candidate, half, 0.0)), np.inf)
+    return PlanarRims(applies=candidate, doubt=doubt, half_width=np.where(candidate, half, np.inf), normal=normal,
+                      origin=mean)

@@ -415,24 +415,10 @@ def curved_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         near[rim] = True
         for _ in range(2):
             near[f[near[f].any(axis=1)].reshape(-1)] = True
-        x = (v[near] - centre[k]) / radius[k]
-        if len(x) < 12:
-            continue
-        design = np.column_stack([x * x, x[:, 0] * x[:, 1], x[:, 1] * x[:, 2], x[:, 2] * x[:, 0], x,
-                                  np.ones(len(x))])
-        try:
-            _, sv, vt = np.linalg.svd(design, full_matrices=False)
-        except np.linalg.LinAlgError:
-            continue
-        if not sv[-2] > 1e-6 * sv[0]:
-            continue                               # many quadrics fit (a plane): the cone stays
-        q = vt[-1]
-        a = np.array([[q[0], q[3] / 2, q[5] / 2], [q[3] / 2, q[1], q[4] / 2], [q[5] / 2, q[4] / 2, q[2]]])
-        b = q[6:9]
-        grad = 2 * x @ a + b
-        size = np.linalg.norm(grad, axis=1)
-        if not (size > 0).all() or float(np.max(np.abs(_quadric(x, a, b, q[9])) / size)) > fit_rtol:
-            continue                               # the surroundings are not one quadric
+        fit = _fitted_quadric((v[near] - centre[k]) / radius[k], fit_rtol)
+        if fit is None:
+            continue                               # a plane (many quadrics fit) or no quadric: the cone stays
+        a, b, q9 = fit
         rim_x = (v[rim] - centre[k]) / radius[k]
         _, _, axes = np.linalg.svd(rim_x - rim_x.mean(axis=0), full_matrices=False)
         d = axes[2]
@@ -444,7 +430,7 @@ def curved_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         flat = np.vstack([top[None, :], spoke.reshape(-1, 3)])
         alpha = float(d @ a @ d)
         beta = 2 * flat @ a @ d + float(b @ d)
-        gamma = _quadric(flat, a, b, q[9])
+        gamma = _quadric(flat, a, b, q9)
         if abs(alpha) > 1e-12:
             disc = beta * beta - 4 * alpha * gamma
             if (disc < 0).any():
@@ -484,6 +470,78 @@ def curved_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
                          axis=2).reshape(-1, 3)]
         # the moved spoke points are ordered (rim vertex, level), as the inner indices count them
         out.append(CurvedFill(loop=int(k), apex=moved[0], points=moved[1:], caps=np.vstack(caps)))
+    return out
+
+
+def _fitted_quadric(x: np.ndarray, fit_rtol: float) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """The one quadric ``Q(x) = xᵀ A x + b·x + c = 0`` through the points ``x`` (p, 3), scaled to about unit size,
+    as ``(A, b, c)``; ``None`` when fewer than 12 points, when several quadrics fit (the next singular value is
+    round-off: points on a plane or on two planes) or when some point lies farther than ``fit_rtol`` from it
+    (``|Q|/|∇Q|``).  Ten coefficients: the right singular vector of the smallest singular value of
+    ``[x², y², z², xy, yz, zx, x, y, z, 1]``."""
+    if len(x) < 12:
+        return None
+    design = np.column_stack([x * x, x[:, 0] * x[:, 1], x[:, 1] * x[:, 2], x[:, 2] * x[:, 0], x, np.ones(len(x))])
+    try:
+        _, sv, vt = np.linalg.svd(design, full_matrices=False)
+    except np.linalg.LinAlgError:
+        return None
+    if not sv[-2] > 1e-6 * sv[0]:
+        return None
+    q = vt[-1]
+    a = np.array([[q[0], q[3] / 2, q[5] / 2], [q[3] / 2, q[1], q[4] / 2], [q[5] / 2, q[4] / 2, q[2]]])
+    b = q[6:9]
+    size = np.linalg.norm(2 * x @ a + b, axis=1)
+    if not (size > 0).all() or float(np.max(np.abs(_quadric(x, a, b, q[9])) / size)) > fit_rtol:
+        return None
+    return a, b, float(q[9])
+
+
+#: Least number of points for :func:`curved_surroundings` to read a fit as evidence: twice the quadric's ten
+#: coefficients (12 points of a box-like part fit some ellipsoid to 1e-3 by chance: Stretch ``link_lift_2.obj``).
+CURVED_MIN_POINTS = 20
+
+#: The quadric's 4×4 form is read as curved when its third singular value exceeds this share of the first (a
+#: plane pair has rank 2; a cylinder or cone rank 3, a sphere rank 4).
+CURVED_MIN_RANK_RTOL = 1e-3
+
+
+def curved_surroundings(vertices: np.ndarray, faces: np.ndarray, rims: list[np.ndarray], centre: np.ndarray,
+                        radius: np.ndarray, *, fit_rtol: float = QUADRIC_FIT_RTOL) -> np.ndarray:
+    """Per rim, whether the vertices of the faces within two rings of it lie on one curved quadric, (k,) bool.
+
+    The same fit as :func:`curved_fills` (:func:`_fitted_quadric`, in coordinates centred on the ball over the
+    rim and scaled by its radius), read as evidence only from :data:`CURVED_MIN_POINTS` points up and only for a
+    quadric of rank 3 or more (:data:`CURVED_MIN_RANK_RTOL`): a sphere, cylinder or cone round the rim fits one;
+    a plane, two planes (a prism's wall and the face at its other end) or a faceted part with features does not.
+    The planar-rim reading (:func:`~.hole_bounds.planar_rim_doubt`) is withdrawn where this holds: a sphere cut
+    by a plane leaves a planar rim whose surface continues round over the hole.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    rims : list of (r,) int arrays
+        The vertices of each rim.
+    centre, radius : (k, 3), (k,) float
+        The ball over each rim.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    out = np.zeros(len(rims), dtype=bool)
+    for k, rim in enumerate(rims):
+        near = np.zeros(len(v), dtype=bool)
+        near[rim] = True
+        for _ in range(2):
+            near[f[near[f].any(axis=1)].reshape(-1)] = True
+        x = (v[near] - centre[k]) / radius[k]
+        fit = _fitted_quadric(x, fit_rtol) if len(x) >= CURVED_MIN_POINTS else None
+        if fit is None:
+            continue
+        a, b, c = fit
+        form = np.block([[a, b[:, None] / 2], [b[None, :] / 2, np.array([[c]])]])
+        sv = np.linalg.svd(form, compute_uv=False)
+        out[k] = bool(sv[2] > CURVED_MIN_RANK_RTOL * sv[0])      # rank ≥ 3: not a plane or a pair of planes
     return out
 
 

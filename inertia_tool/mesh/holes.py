@@ -50,13 +50,13 @@ from .hole_bounds import (CONVEX_ROUND_OFF as CONVEX_ROUND_OFF, CONVEX_WORK_LIMI
                           bend_doubt_volumes,
                           _round_off as _round_off, _vertex_flatness as _vertex_flatness, ball_slab_volume,
                           bare_vertices, convex_hole_bound, hole_doubt_volumes, inner_face_vertices,
-                          rim_evidence, slab_contradicted)
+                          planar_rim_doubt, rim_evidence, slab_contradicted)
 from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES as CREASE_MAX_PLANES,
                          CREASE_SCREEN_PAIRS as CREASE_SCREEN_PAIRS, CURVED_FILL_LEVELS as CURVED_FILL_LEVELS,
                          CURVED_MAX_LOOPS as CURVED_MAX_LOOPS, QUADRIC_FIT_RTOL as QUADRIC_FIT_RTOL, CreaseFill,
                          CurvedFill, _crease_contradicted, _crease_rim_contradicts as _crease_rim_contradicts,
                          _may_hold_two_planes as _may_hold_two_planes, _quadric as _quadric,
-                         _ring_faces as _ring_faces, crease_fills, curved_fills)
+                         _ring_faces as _ring_faces, crease_fills, curved_fills, curved_surroundings)
 from .hole_assumptions import named, stated
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal
@@ -214,10 +214,13 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             np.maximum.at(rim_reach, loop_of, np.linalg.norm(v[vertex_of] - point, axis=1))
             bend_reach = rim_reach + 2.0 * np.where(took_bend, bend_height, 0.0)
             nearer = np.where(took_bend, np.minimum(nearer, bend_reach), nearer)
+        # a planar rim's region (ball ∩ slab) is bounded by its ball alone (no capsule is named for it)
+        nearer = np.where(took_planar, ball_reach, nearer)
         return nearer
 
     alone = np.zeros(n_loops, dtype=bool)
     took_bend = np.zeros(n_loops, dtype=bool)
+    took_planar = np.zeros(n_loops, dtype=bool)
     used: set[str] = set()
     before_bend = 0.0
 
@@ -229,6 +232,16 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         crossed[[fill.loop for fill in creases]] = True
         order = np.argsort(-np.where(crossed, -1.0, hole_doubt), kind="stable")
         order = order[~crossed[order]]
+        # the planar-rim reading (PLANAR) is decided before the curved fills: a rim it reads as a lost flat face
+        # keeps its cone (in the rim's hull, so in the slab), unless the surroundings continue round the hole
+        # on one curved quadric (the evidence that withdraws it) or evidence withdrew the narrower assumptions
+        planar = planar_rim_doubt(v, f, edges, label, n_loops, centre, radius)
+        planar_ok = planar.applies & ~withdrawn & ~crossed
+        if planar_ok.any():
+            which = np.flatnonzero(planar_ok)
+            rims = [vertex_of[loop_of == k] for k in which.tolist()]
+            planar_ok[which[curved_surroundings(v, f, rims, centre[which], radius[which])]] = False
+            order = order[~planar_ok[order]]
         curved = curved_fills(v, f, edges, label, n_loops, apex, centre, radius, (start, end, thick), slab, order)
         if curved:
             pv, pf, cap, closed, hole_doubt = build(creases, curved)
@@ -251,8 +264,15 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         hole_doubt = np.where(took_bend, bend_doubt, hole_doubt)
         ball_volume = 4.0 / 3.0 * np.pi * radius ** 3
         took_capsule &= ~took_bend
-        took_flat = in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
+        # the planar-rim reading where it is narrower than the bounds above
+        took_planar = planar_ok & ~bent & (planar.doubt < hole_doubt)
+        hole_doubt = np.where(took_planar, planar.doubt, hole_doubt)
+        took_bend &= ~took_planar
+        took_capsule &= ~took_planar
+        took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
+                     & ~took_planar)
         used = {"ball"}
+        used |= {"planar"} if took_planar.any() else set()
         used |= {"flat"} if took_flat.any() else set()
         used |= {"capsule"} if took_capsule.any() else set()
         used |= {"bend"} if took_bend.any() else set()
@@ -316,6 +336,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             detail += (f"; {len(curved)} of them filled instead on the quadric their surroundings lie on (the cone's "
                        f"fan bent onto it, {len(pv) - len(v) - n_loops - 2 * len(creases):,} points added), with "
                        "the same bound")
+        if took_planar.any() and not convex:
+            detail += (f"; {int(np.count_nonzero(took_planar))} read as a missing flat face (a rim in one plane, "
+                       f"within {round_up(float(planar.half_width[took_planar].max())):.3g} m, meeting the faces "
+                       "beside it at a crease), bounded by the ball cut to that slab")
         if took_bend.any() and not convex:
             detail += (f"; {int(np.count_nonzero(took_bend))} bounded instead by the slope of the faces beside "
                        "their rims")
