@@ -178,7 +178,10 @@ R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only aft
    round-off bound (:func:`~inertia_tool.integrals.roundoff_bounds`) of at most ``tolerances.ROUNDOFF_RTOL``
    of the result: shells whose bound is wider are integrated again about their own centre or in exact integer
    arithmetic (:func:`~inertia_tool.integrals.accurate_shells`), before any sign is read (R2, R4); a result
-   whose bound stays wider is certified ``unverified``.
+   whose bound stays wider is certified ``unverified``.  The bound counts what the reader's unit conversion
+   (and a robot mesh's scale and placement) moved the file's coordinates
+   (:func:`~inertia_tool.mesh.precision.conversion_bounds`) and the rounding of the absolute centroids shells
+   are combined from (review 12's R6, R5): the polyhedron "exact" refers to is the file's, as written.
 """
 
 from __future__ import annotations
