@@ -109,3 +109,50 @@ def test_open_pieces_without_a_common_seam_are_repaired_apart(tmp_path):
     assert not any("together" in w for w in result.warnings)
     truth = 2 * 1000.0 * float(np.prod(SIZE))
     assert abs(result.properties.mass - truth) <= result.uncertainty.mass * result.properties.mass
+
+
+def _refused_pieces(folder, scale="1 1 1"):
+    """A model whose two open pieces share a seam but bound no solid, even repaired (3 of a box's 12 faces)."""
+    (folder / "assets").mkdir(parents=True)
+    _write_piece(folder / "assets" / "ends.obj", [TRIANGLES[4]])
+    _write_piece(folder / "assets" / "sides.obj", [TRIANGLES[5], TRIANGLES[8]])
+    path = folder / "robot.xml"
+    path.write_text(f"""<mujoco model="pieces">
+  <compiler meshdir="assets"/>
+  <asset><mesh file="ends.obj" scale="{scale}"/><mesh file="sides.obj" scale="{scale}"/></asset>
+  <worldbody><body name="link"><geom type="mesh" mesh="ends"/><geom type="mesh" mesh="sides"/></body></worldbody>
+</mujoco>
+""")
+    return str(path)
+
+
+def test_a_refused_join_of_copied_files_is_not_joined_again(tmp_path, monkeypatch):
+    """Issue 25 (corpus12): Stretch and Stretch 3 ship byte-identical pieces whose join is refused after ~17 s.
+    The run's MeshCache keeps the refusal by content and placement: a copy in another folder is refused with the
+    same answer without joining again; the same files at another scale are joined again."""
+    from inertia_tool.robot import geometry
+    from inertia_tool.robot.geometry import MeshCache
+
+    joins = []
+    real = geometry.mass_properties
+
+    def counted(raw, *args, **kwargs):
+        if " + " in str(getattr(raw, "source", "")):
+            joins.append(raw.source)
+        return real(raw, *args, **kwargs)
+
+    monkeypatch.setattr(geometry, "mass_properties", counted)
+    paths = [_refused_pieces(tmp_path / name) for name in ("a", "b")] + [_refused_pieces(tmp_path / "c", "2 2 2")]
+    alone = []
+    for path in paths:                                       # each without a shared cache: the reference
+        (result,) = link_inertials(read_robot(path), density=1000.0, repair=True)
+        alone.append(result)
+    assert len(joins) == 6 and all(r.properties is None and r.problem for r in alone)   # 2 attempts each
+    joins.clear()
+    cache = MeshCache()
+    for path, reference in zip(paths, alone):
+        (result,) = link_inertials(read_robot(path), density=1000.0, repair=True, mesh_cache=cache)
+        assert (result.properties, result.method, result.problem) == (None, reference.method, reference.problem)
+        assert result.warnings == reference.warnings
+    assert len(joins) == 4                 # folder b's copy not joined again; c (scaled) joined again
+    assert all("/b/" not in source for source in joins)

@@ -15,7 +15,7 @@ import trimesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from inertia_tool.mesh.winding import _direct, winding_integers, winding_numbers_bounded
+from inertia_tool.mesh.winding import INTEGER_FIRST_TOLERANCE, _direct, winding_integers, winding_numbers_bounded
 
 
 def _two_spheres(shift: float, inner: float, subdivisions: int) -> tuple[np.ndarray, np.ndarray]:
@@ -65,3 +65,45 @@ def test_a_point_the_first_pass_leaves_is_evaluated_at_the_fine_tolerance():
     np.testing.assert_array_equal(w1, w2)
     np.testing.assert_array_equal(e1, e2)
     np.testing.assert_array_equal(np.round(w2), np.round(_direct(points, v, f)))
+
+
+@settings(max_examples=6, deadline=None)
+@given(shift=st.floats(0.0, 1.2), inner=st.floats(0.3, 0.9), seed=st.integers(0, 2 ** 32 - 1),
+       far=st.sampled_from([1.0, 1e3, 1e6]))
+def test_one_tree_for_several_calls_gives_each_call_its_own_values(shift, inner, seed, far):
+    """Issue 25 (corpus12): ``corrected_estimate`` builds the tree once for its front probes and its regions'
+    integers (``tree=integer_tree(v, f)``).  Every value and bound of each call is the one the call computes with
+    its own tree, to the bit, at both tolerances (points close to the surface reach the second pass), for a
+    surface far from the origin too (the tree is built about the box's centre)."""
+    from inertia_tool.mesh.winding import integer_tree
+    v, f = _two_spheres(shift, inner, 1)
+    v = v + far
+    rng = np.random.default_rng(seed)
+    near = v[rng.integers(0, len(v), 20)] + rng.uniform(-0.02, 0.02, (20, 3))
+    batches = [rng.uniform(-1.5, 2.2, size=(30, 3)) + far, near]
+    tree = integer_tree(v, f)
+    for points in batches:
+        # the two passes written out with winding_numbers_bounded, which builds its own tree each time
+        w, e = winding_numbers_bounded(points, v, f, tolerance=INTEGER_FIRST_TOLERANCE)
+        again = np.abs(w - np.round(w)) + e > 0.25
+        if again.any():
+            w[again], e[again] = winding_numbers_bounded(points[again], v, f)
+        for got in (winding_integers(points, v, f), winding_integers(points, v, f, tree=tree)):
+            np.testing.assert_array_equal(got[0], w)
+            np.testing.assert_array_equal(got[1], e)
+
+
+def test_a_tree_of_another_surface_is_refused():
+    """The tree is checked against the surface it is used for: one built for other vertices or faces is refused
+    rather than giving the winding numbers of the wrong surface."""
+    import pytest
+
+    from inertia_tool.errors import UsageError
+    from inertia_tool.mesh.winding import integer_tree
+    v, f = _two_spheres(0.4, 0.7, 1)
+    tree = integer_tree(v, f)
+    points = np.array([[0.1, 0.0, 0.0]])
+    with pytest.raises(UsageError, match="same vertices and faces"):
+        winding_integers(points, v + 1e-3, f, tree=tree)
+    with pytest.raises(UsageError, match="same vertices and faces"):
+        winding_integers(points, v, f[::-1], tree=tree)

@@ -16,7 +16,7 @@ follow from the volume in doubt as :mod:`~.uncertainty` states.
 
 from __future__ import annotations
 
-from typing import Literal, NamedTuple, overload
+from typing import TYPE_CHECKING, Literal, NamedTuple, overload
 
 import numpy as np
 
@@ -24,6 +24,9 @@ from ..errors import InternalInvariantError, WorkBudgetError
 from ..tolerances import ESTIMATE_MAX_MASS_RTOL
 from .rims import boundary_edges, enclosing_balls
 from .uncertainty import Estimate, Uncertainty, uncertainty_from
+
+if TYPE_CHECKING:
+    from .winding import IntegerTree
 
 __all__ = ["winding_estimate", "closed_surface_estimate", "open_surface_estimate", "corrected_estimate",
            "predicted_resolution", "affordable_resolution", "refusal_proven", "WINDING_EVALUATION_BUDGET"]
@@ -928,7 +931,7 @@ def _distance_above(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
 
 
 def _front_numbers(v: np.ndarray, f: np.ndarray, clean: np.ndarray, *,
-                   max_probes: int = FRONT_PROBES_LIMIT) -> np.ndarray | None:
+                   max_probes: int = FRONT_PROBES_LIMIT, tree: IntegerTree | None = None) -> np.ndarray | None:
     """(m,) int: the winding number just in front of each clean face (−2³¹ for faces not clean or not settled).
 
     Clean faces (no other face meets them beyond the vertices and edges they share by index) joined by edges
@@ -937,7 +940,8 @@ def _front_numbers(v: np.ndarray, f: np.ndarray, clean: np.ndarray, *,
     at ``c + (ε/2) n̂`` in front of the centroid ``c`` of its largest face with ``ε`` a quarter of the distance
     from ``c`` to every other face, lies in that face's front region; the winding number there is an integer
     (the surface is a cycle), found by the bounded treecode and rounded (a component more than 1/4 away,
-    counting the bound, is left unsettled).  Returns None beyond ``max_probes`` components.
+    counting the bound, is left unsettled).  Returns None beyond ``max_probes`` components.  ``tree``: the
+    :func:`~.winding.integer_tree` of ``v, f`` when the caller has built it.
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -993,7 +997,7 @@ def _front_numbers(v: np.ndarray, f: np.ndarray, clean: np.ndarray, *,
             eps[s:s + per] = np.minimum(r, 0.25 * nearest)
     ok = eps > PROBE_FLOOR_RTOL * diag
     probes = centroid + 0.5 * eps[:, None] * unit
-    w, err = winding_integers(probes[ok], v, f)
+    w, err = winding_integers(probes[ok], v, f, tree=tree)
     whole = np.round(w)
     settled = np.abs(w - whole) + err <= 0.25
     value = np.full(len(probe_face), np.iinfo(np.int32).min, dtype=np.int64)
@@ -1086,7 +1090,7 @@ def corrected_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: i
 
     from ..integrals import volume_moments
     from .intersect import surface_contacts
-    from .winding import fast_available, winding_integers, winding_numbers
+    from .winding import fast_available, integer_tree, winding_integers, winding_numbers
 
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
@@ -1101,7 +1105,10 @@ def corrected_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: i
     twice_area = np.linalg.norm(np.cross(b - a, c - a), axis=1)
     diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
     clean = ~touched & (twice_area > 1e-14 * diag ** 2)
-    front = _front_numbers(v, f, clean)
+    # one tree of faces for the front probes and the regions' integers (issue 25: built twice before, ~0.25 s
+    # each on Piper's link2.stl; the same values to the bit)
+    tree = integer_tree(v, f)
+    front = _front_numbers(v, f, clean, tree=tree)
     if front is None:
         return None
     settled_front = front > np.iinfo(np.int32).min
@@ -1181,7 +1188,7 @@ def corrected_estimate(vertices: np.ndarray, faces: np.ndarray, *, resolution: i
         first = _first_cells(region, n_regions) if first_cells is None else first_cells
         pts = lo + h * (np.stack(np.unravel_index(first, dims), axis=1) + 0.5)
         if len(first) <= BOUNDED_REGION_POINTS or not fast_available():
-            w, err = winding_integers(pts, v, f)
+            w, err = winding_integers(pts, v, f, tree=tree)
         else:
             w, err = winding_numbers(pts, v, f, fast=True), np.zeros(len(pts))
         whole = np.round(w)

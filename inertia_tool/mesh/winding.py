@@ -19,7 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["winding_numbers", "winding_numbers_bounded", "winding_integers", "fast_available"]
+from ..errors import UsageError
+
+__all__ = ["winding_numbers", "winding_numbers_bounded", "winding_integers", "integer_tree", "fast_available"]
 
 _BLOCK = 1 << 22     # point-triangle pairs per vectorised block of the direct sum
 
@@ -233,9 +235,50 @@ def _contiguous(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray
 INTEGER_FIRST_TOLERANCE = 1e-3
 
 
+#: Faces per leaf of the tree of :func:`winding_integers`.
+INTEGER_LEAF = 16
+
+
+class IntegerTree:
+    """The tree of faces :func:`winding_integers` evaluates with, built once for several calls on one surface
+    (:func:`integer_tree`).
+
+    Attributes
+    ----------
+    centre : (3,) float
+        m, the centre of the vertices' bounding box; the tree holds the vertices less it.
+    faces : (m, 3) int
+        The faces it was built from (a caller passing other faces is refused).
+    vertices : (n, 3) float
+        m, the vertices it was built from (compared by value with a caller's).
+    shifted : (n, 3) float
+        m, ``vertices − centre``.
+    tree : _Tree
+        ``_Tree(shifted, faces, INTEGER_LEAF)``.
+    """
+
+    __slots__ = ("centre", "faces", "vertices", "shifted", "tree")
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray) -> None:
+        self.vertices, self.faces = vertices, faces
+        self.centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
+        self.shifted = vertices - self.centre
+        self.tree = _Tree(self.shifted, faces, INTEGER_LEAF)
+
+
+def integer_tree(vertices: np.ndarray, faces: np.ndarray) -> IntegerTree:
+    """The tree of :func:`winding_integers` for a surface, to pass to several calls on it (``tree=``): the values
+    are those each call would compute with its own tree, to the bit (the tree depends on the surface only; issue
+    25: :func:`~inertia_tool.mesh.grid_estimate.corrected_estimate` evaluates its front probes and its regions'
+    integers on one surface)."""
+    _, vertices, faces = _contiguous(np.zeros((0, 3)), vertices, faces)
+    return IntegerTree(vertices, faces)
+
+
 def winding_integers(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, *,
                      offset: np.ndarray | float = 0.0, margin: float = 0.25, tolerance: float = 1e-4,
-                     first_tolerance: float = INTEGER_FIRST_TOLERANCE) -> tuple[np.ndarray, np.ndarray]:
+                     first_tolerance: float = INTEGER_FIRST_TOLERANCE, tree: IntegerTree | None = None
+                     ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`winding_numbers_bounded` at points where ``winding + offset`` is known to be an integer (off a
     closed surface), for callers that only round it: ``(winding, error)``, (p,) float each.
 
@@ -245,20 +288,27 @@ def winding_integers(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray
     the only one within ``1/2``), so every caller that rounds points settled at ``tolerance`` gets the same
     integers as from one pass at ``tolerance`` (each point's value does not depend on the others evaluated
     with it); a point settled only by the first pass is proven by its own bound.
+
+    ``tree``: :func:`integer_tree` of the same ``vertices`` and ``faces`` (refused otherwise), built once for
+    several calls; by default each call builds its own.
     """
     points, vertices, faces = _contiguous(points, vertices, faces)
     if len(points) == 0 or len(faces) == 0:
         return np.zeros(len(points)), np.zeros(len(points))
     # winding_numbers_bounded's two calls, with the tree of faces built once (issue 25: ~0.35 s of a 72k-face
     # part's second pass; the same values to the bit)
-    centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
-    shifted = vertices - centre
-    tree = _Tree(shifted, faces, 16)
-    w, err = _treecode(points - centre, shifted, faces, tolerance=first_tolerance, tree=tree)
+    if tree is None:
+        tree = IntegerTree(vertices, faces)
+    elif not (tree.faces is faces or np.array_equal(tree.faces, faces)) or not (
+            tree.vertices is vertices or np.array_equal(tree.vertices, vertices)):
+        raise UsageError("Expected `tree` built from the same vertices and faces, got the tree of another surface")
+    centre, shifted = tree.centre, tree.shifted
+    w, err = _treecode(points - centre, shifted, faces, tolerance=first_tolerance, leaf=INTEGER_LEAF, tree=tree.tree)
     total = w + offset
     again = np.flatnonzero(np.abs(total - np.round(total)) + err > margin)
     if len(again) and first_tolerance != tolerance:
-        w[again], err[again] = _treecode(points[again] - centre, shifted, faces, tolerance=tolerance, tree=tree)
+        w[again], err[again] = _treecode(points[again] - centre, shifted, faces, tolerance=tolerance,
+                                         leaf=INTEGER_LEAF, tree=tree.tree)
     return w, err
 
 

@@ -423,6 +423,10 @@ class MeshCache:
     uses it, so that each link still names what was done to its meshes) and the file's triangle count (taken
     off each robot's ``max_faces`` budget as if it had been read).  Entries are never changed once stored.
 
+    Open mesh pieces joined into one surface and refused together (:func:`_joined_pieces`) are kept by their
+    content too (issue 25: Stretch and Stretch 3 ship byte-identical ``link_arm_l0_{0,1,2}.obj``, ~17 s of CPU
+    each to refuse).
+
     A result (not a refusal) is also kept by the file's *content* (:func:`_content_key` without the path: its
     size and a hash of its bytes, with the file's suffix, the placement and ``repair``), so that a byte-identical
     copy in another folder (TIAGo and TIAGo dual ship the same ``gripper_link.stl``) is integrated once; the copy
@@ -432,6 +436,17 @@ class MeshCache:
     def __init__(self) -> None:
         self._entries: dict = {}
         self._by_content: dict = {}
+        self._refused_joins: set = set()
+
+    def join_refused(self, content) -> bool:
+        """Whether open pieces with this content (:func:`_join_content`) were joined before and refused."""
+        return content is not None and content in self._refused_joins
+
+    def refuse_join(self, content) -> None:
+        """Keep that the pieces with this content do not close together, even repaired (never a refusal by a
+        robot's ``max_faces`` budget: that one is the robot's, not the files')."""
+        if content is not None:
+            self._refused_joins.add(content)
 
     def __len__(self) -> int:
         return len(self._entries)
@@ -703,7 +718,22 @@ def _boundary_edges(vertices: np.ndarray, faces: np.ndarray) -> set:
     return {row.tobytes() for row in ends}
 
 
-def _joined_pieces(pieces: list, *, budget: list | None, repair: bool):
+def _join_content(pieces: list, repair: bool) -> tuple | None:
+    """What a join of ``pieces`` depends on: each file's size and hash (not its path), suffix, sub-mesh and
+    placement (:func:`_mesh_key` without the path), in order, and ``repair``; None when a file is not hashed."""
+    out = []
+    for element in pieces:
+        if element.mesh is None:
+            return None
+        found = _content_key(element.mesh, (element.submesh, bool(element.submesh_center)) if element.submesh
+                             else None)
+        if found is None:
+            return None
+        out.append((found[1:], os.path.splitext(element.mesh)[1].lower(), _mesh_key(element)[1:]))
+    return tuple(out), repair
+
+
+def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: MeshCache | None = None):
     """``(unit-density body, method, uncertainty)`` of the open meshes ``pieces`` (elements of one link, one
     placement) integrated as one surface, or None when together they are not a closed solid either (with
     ``repair``: not even a bounded estimate) or cannot be read.
@@ -712,7 +742,8 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool):
     ``link_arm_l1_1.obj`` printed plastic): each file is open where it meets the other, and together they bound
     the part.  The union of the pieces' triangles is checked and integrated by the engine like any mesh: first
     without repair; if it still has holes and ``repair`` is asked, repaired as one surface (the seams the
-    pieces share are then not taken for holes, which is what refused most of them one by one)."""
+    pieces share are then not taken for holes, which is what refused most of them one by one).  ``shared``: the
+    run's :class:`MeshCache`, which keeps the joins refused (by content), so that a copy is not joined again."""
     first = pieces[0]
     vertices, faces, offset, count = [], [], 0, 0
     seams: list[set] = []
@@ -732,6 +763,9 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool):
     # points); pieces with no seam in common are separate holes, no better repaired together than apart
     if not any(seams[i] & seams[j] for i in range(len(seams)) for j in range(i + 1, len(seams))):
         return None
+    content = _join_content(pieces, repair) if shared is not None else None
+    if shared is not None and shared.join_refused(content):
+        return None                 # the same files, placed alike, refused before (the budget checked above)
     try:
         joined = RawMesh(vertices=np.concatenate(vertices), faces=np.concatenate(faces),
                          source=" + ".join(_mesh_label(e) for e in pieces), units="m", file_faces=count)
@@ -750,11 +784,13 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool):
                   else report.certificate.kind)
         uncertainty = None if report is None else report.uncertainty
         return local.transformed(rotation=first.rotation, translation=first.translation), method, uncertainty
+    if shared is not None:
+        shared.refuse_join(content)
     return None
 
 
 def _join_open_pieces(parts: list, refused: list, *, model: bool, repair: bool,
-                      budget: list | None) -> tuple[list, list, list]:
+                      budget: list | None, shared: MeshCache | None = None) -> tuple[list, list, list]:
     """``parts`` and ``refused`` with each group of at least two open mesh pieces that close together
     (:func:`_joined_pieces`) replaced by one part; the third value names what was joined, for the link's
     warnings.  Open pieces are the meshes refused as needing repair and those repaired into estimates."""
@@ -768,7 +804,7 @@ def _join_open_pieces(parts: list, refused: list, *, model: bool, repair: bool,
         keys = [_mesh_key(e) for e in pieces]
         if len(pieces) < 2 or len(set(keys)) < len(keys):     # one piece, or a mesh twice: nothing to join
             continue
-        found = _joined_pieces(pieces, budget=budget, repair=repair)
+        found = _joined_pieces(pieces, budget=budget, repair=repair, shared=shared)
         if found is None:
             continue
         local, method, uncertainty = found
@@ -829,7 +865,8 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
         parts.append((element, props, method, uncertainty))
     joined: list = []
     if len(refused) + sum(1 for p in parts if p[2] == "estimate") >= 2:
-        parts, refused, joined = _join_open_pieces(parts, refused, model=model, repair=repair, budget=budget)
+        parts, refused, joined = _join_open_pieces(parts, refused, model=model, repair=repair, budget=budget,
+                                                   shared=cache.get(_SHARED))
     if refused:
         raise refused[0][1]
     return parts, massless, notes + joined
