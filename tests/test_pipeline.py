@@ -109,18 +109,24 @@ def test_open_mesh_repaired_on_request():
     assert p.mesh.repaired and p.mesh.repair_actions
 
 
-def test_hole_as_large_as_the_part_is_refused_under_repair():
+def test_hole_as_large_as_the_part_is_answered_only_under_the_named_planar_reading():
     """A whole 2 × 3 side missing: the ball over its rim holds four times the box, and every face beside the
-    hole stands at right angles to it (the slab around their planes is as wide as the hole), so no honest bound
-    exists (issue 21: planar rims used to get a bound of exactly 0).  One triangle of that side missing is
-    answered: the other half of the side lies in the hole's plane (tests/test_hole_bounds.py)."""
+    hole stands at right angles to it, so no bound follows from the ball or the faces' slabs (issue 21: planar
+    rims used to get a bound of exactly 0, unnamed).  The rim lies in one plane and meets every face beside it at
+    a crease, so the ``planar`` reading (a missing flat face, ``hole_assumptions.PLANAR``; cover12) patches it
+    flat: the box, an estimate (never ``exact``) whose tiny bound is stated with that assumption in the answer."""
+    from inertia_tool.mesh.hole_assumptions import PLANAR
     v, f = box_arrays()
     normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     side = np.abs(normals[:, 0]) > 0
     side &= v[f[:, 0], 0] > 0                              # the two triangles of the +x side
     assert side.sum() == 2
-    with pytest.raises(InvalidMeshError, match="cannot be bounded usefully"):
-        mass_properties((v, f[~side]), repair=True)
+    with pytest.warns(MeshRepairedWarning, match="read as a missing flat face"):
+        p = mass_properties((v, f[~side]), repair=True)
+    assert p.mesh.certificate.kind == "estimate"
+    assert abs(p.volume - 6.0) <= p.mesh.uncertainty.mass * 6.0
+    assert 0 < p.mesh.uncertainty.mass < 1e-12
+    assert PLANAR.statement in " ".join(p.mesh.notes)
 
 
 def test_flipped_face_is_turned_and_exact_without_repair():

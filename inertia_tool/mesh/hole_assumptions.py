@@ -67,7 +67,8 @@ INNER = HoleAssumption(
     "it and neither rim neighbour of that corner another such (the file cannot tell it from a vertex inside a "
     "flat face)")
 PLANAR = HoleAssumption(
-    "planar", "a hole whose rim lies in one plane and meets every face beside it at a crease lost a flat face: the "
+    "planar", "a hole whose rim of four or more corners lies in one plane and meets every face beside it at a crease "
+    "lost a flat face: the "
     "missing surface lies no farther from the rim's plane than the rim does",
     "a dome, boss or pocket bounded by a crease and taken whole (a domed lid on a prism reads as a flat lid); "
     "a surface that continues round over the hole on one quadric (a sphere cut "
