@@ -292,11 +292,19 @@ def fraction_moments(v, f):
             cache[i] = [Fraction(float(x)) for x in v[i]]
         return cache[i]
 
+    return fraction_sums((pt(int(i0)), pt(int(i1)), pt(int(i2))) for i0, i1, i2 in f)
+
+
+def fraction_sums(triangles):
+    """Exact (volume, ∫x dV (3,), ∫x_i x_j dV (3, 3)) of the signed tetrahedra ``(0, a, b, c)`` over
+    ``triangles``, an iterable of three exact (Fraction) points each: det/6, det/24·(a+b+c),
+    det/120·(Σ pᵢpⱼ + sᵢsⱼ), s = a+b+c ("Rigid Body Motion" §4.2, the divergence theorem over a closed
+    surface).  The one exact integral of the test generators (:func:`fraction_moments`,
+    ``review12_generators.rational_moments``)."""
     vol = Fraction(0)
     first = [Fraction(0)] * 3
     second = [[Fraction(0)] * 3 for _ in range(3)]
-    for i0, i1, i2 in f:
-        a, b, c = pt(int(i0)), pt(int(i1)), pt(int(i2))
+    for a, b, c in triangles:
         det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
                + a[2] * (b[0] * c[1] - b[1] * c[0]))
         if det == 0:

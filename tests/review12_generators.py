@@ -65,28 +65,19 @@ def rational_moments(points: list[Point], polygons: list[Polygon], scale: Fracti
     first point first, so far-off parts keep small rationals."""
     origin = [Fraction(x) for x in points[0]]
     fr = [[(Fraction(x) - o) * scale for x, o in zip(p, origin)] for p in points]
-    vol = Fraction(0)
-    first = [Fraction(0)] * 3
-    second = [[Fraction(0)] * 3 for _ in range(3)]
-    for poly in polygons:
-        corners = [fr[i] for i in poly]
-        k = len(corners)
-        c = [sum((p[j] for p in corners), Fraction(0)) / k for j in range(3)]
-        for i in range(k):
-            a, b = corners[i], corners[(i + 1) % k]
-            det = (c[0] * (a[1] * b[2] - a[2] * b[1]) - c[1] * (a[0] * b[2] - a[2] * b[0])
-                   + c[2] * (a[0] * b[1] - a[1] * b[0]))
-            if det == 0:
-                continue
-            s = [c[j] + a[j] + b[j] for j in range(3)]
-            vol += det / 6
-            for j in range(3):
-                first[j] += det * s[j] / 24
-            for r in range(3):
-                for q in range(r, 3):
-                    second[r][q] += det * (c[r] * c[q] + a[r] * a[q] + b[r] * b[q] + s[r] * s[q]) / 120
+    from adversary_solids import fraction_sums
+
+    def fan():
+        for poly in polygons:
+            corners = [fr[i] for i in poly]
+            k = len(corners)
+            c = [sum((p[j] for p in corners), Fraction(0)) / k for j in range(3)]
+            for i in range(k):
+                yield c, corners[i], corners[(i + 1) % k]
+
+    vol, first, second = fraction_sums(fan())
     cen = [first[j] / vol for j in range(3)]
-    central = [[second[min(r, q)][max(r, q)] - vol * cen[r] * cen[q] for q in range(3)] for r in range(3)]
+    central = [[second[r][q] - vol * cen[r] * cen[q] for q in range(3)] for r in range(3)]
     tr = central[0][0] + central[1][1] + central[2][2]
     inertia = np.array([[float((tr if r == q else 0) - central[r][q]) for q in range(3)] for r in range(3)])
     centroid = np.array([float(cen[j] + origin[j] * scale) for j in range(3)])
