@@ -174,7 +174,8 @@ def _named_assumption_fails(v, f, gone, est):
     outside every loop's slab (plane of a ring face, half-width as ``hole_doubt_volumes`` states it); ``crease``
     when a removed corner lies on the plane of no face beside a rim; ``bend``
     when, for every loop, a removed corner rises above the loop's mean plane more steeply than the steepest face
-    touching the rim, seen from some rim vertex (or a removed face folds back over that plane)."""
+    touching the rim, seen from some rim vertex (or a removed face folds back over that plane); ``planar`` when a
+    removed corner lies farther from every loop's least-squares plane than that loop's rim does."""
     open_f = np.delete(f, gone, axis=0)
     taken = v[f[gone]].reshape(-1, 3)
     if "convex" in est.assumptions:
@@ -225,6 +226,18 @@ def _named_assumption_fails(v, f, gone, est):
             broken[k] = steep.any() or folds
         if broken.all():
             return "bend"
+    if "planar" in est.assumptions:
+        # each loop's own least-squares plane (SVD), half-width its rim's largest distance from it: a removed
+        # corner farther than that from every loop's plane breaks "the missing surface lies within the rim's slab"
+        near = np.zeros(len(taken), dtype=bool)
+        for k in range(n_loops):
+            rim_pts = v[np.unique(edges[label == k])]
+            mid = rim_pts.mean(axis=0)
+            n = np.linalg.svd(rim_pts - mid)[2][-1]
+            half = np.abs((rim_pts - mid) @ n).max()
+            near |= np.abs((taken - mid) @ n) <= half * (1 + 1e-6) + 1e-9 * (1 + np.abs(v).max())
+        if not near.all():
+            return "planar"
     return ""
 
 
