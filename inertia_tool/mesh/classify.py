@@ -18,7 +18,7 @@ from ..errors import InsideOutWarning, MeshResolvedWarning
 from ..integrals import VolumeMoments
 from ..tolerances import TOUCH_VOLUME_RTOL
 from .intersect import SurfaceContacts, surface_contacts
-from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
+from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, container_windings, inward_crossing_outward,
                      inward_crossing_shells, misread_nesting, nested_copies,
                      rounding_volumes,
                      orient_by_depth, outward_crossing_groups, shell_contacts, within_up_to_rounding)
@@ -236,14 +236,8 @@ def _inside_kept_cavities(volumes: np.ndarray, flip: np.ndarray, depth: np.ndarr
     kept = (wound < 0) & (np.asarray(depth) % 2 == 0)
     if not kept.any():
         return 0
-    pairs = [np.zeros((0, 2), dtype=np.int64)]
-    if nest is not None:
-        shell, other = np.asarray(nest.shell, dtype=np.int64), np.asarray(nest.other, dtype=np.int64)
-        held = (np.asarray(nest.winding) != 0) & (shell != other)
-        pairs.append(np.c_[shell[held], other[held]])
-    if within is not None:
-        pairs.append(np.asarray(within, dtype=np.int64).reshape(-1, 2))
-    found = _without_pairs(np.concatenate(pairs), np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2))
+    shell, other, _ = container_windings(volumes, nest, within)
+    found = _without_pairs(np.c_[shell, other], np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2))
     return len(np.unique(found[kept[found[:, 1]], 0])) if len(found) else 0
 
 

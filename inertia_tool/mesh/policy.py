@@ -206,7 +206,7 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "rounding_volumes", "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
            "near_copies", "NearCopies", "near_copies_message", "MisreadNesting", "misread_nesting",
-           "outward_crossing_groups",
+           "outward_crossing_groups", "container_windings",
            "misread_message"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
@@ -806,27 +806,38 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=bool(inside[shells].any()))
 
 
-def _winding_around(file_volumes: np.ndarray, nest: Nesting | None, within: np.ndarray | None) -> np.ndarray:
-    """(s,) int: the winding number, as the file winds them, of the shells around each shell at its probe point.
+def container_windings(file_volumes: np.ndarray, nest: Nesting | None,
+                       within: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(shell, container, winding)`` int arrays: each shell found inside another, and the container's winding
+    number as the file winds it there.
 
-    From the probes (``nest``) and from the ``(shell, container)`` pairs placed by touching or by the boolean
-    (``within``: a shell flush with its container, whose probe may lie on the container's surface and see
-    nothing), each container counted once with the sign of its own volume (+1 outward, −1 inward).
-    """
+    From the probes (``nest``: the winding each other shell gives a shell's probe point, kept where nonzero) and
+    from the ``(shell, container)`` pairs placed by touching or by the boolean (``within``: a shell flush with its
+    container, whose probe may lie on the container's surface and see nothing; counted with the sign of the
+    container's own volume, +1 outward, −1 inward, and only where the probes did not already count it).  A shell
+    is never its own container."""
     n = len(file_volumes)
-    shell = np.zeros(0, dtype=np.int64) if nest is None else np.asarray(nest.shell, dtype=np.int64)
-    other = np.zeros(0, dtype=np.int64) if nest is None else np.asarray(nest.other, dtype=np.int64)
-    winding = np.zeros(0, dtype=np.int64) if nest is None else np.asarray(nest.winding, dtype=np.int64)
-    keep = (winding != 0) & (shell != other)
-    shell, other, winding = shell[keep], other[keep], winding[keep]
+    if nest is None:
+        shell = other = winding = np.zeros(0, dtype=np.int64)
+    else:
+        shell, other = np.asarray(nest.shell, dtype=np.int64), np.asarray(nest.other, dtype=np.int64)
+        winding = np.asarray(nest.winding, dtype=np.int64)
+        keep = (winding != 0) & (shell != other)
+        shell, other, winding = shell[keep], other[keep], winding[keep]
     if within is not None and len(within):
         pairs = np.asarray(within, dtype=np.int64).reshape(-1, 2)
         pairs = pairs[pairs[:, 0] != pairs[:, 1]]
-        seen = np.isin(pairs[:, 0] * n + pairs[:, 1], shell * n + other)
-        pairs = np.unique(pairs[~seen], axis=0)
-        shell = np.r_[shell, pairs[:, 0]]
+        pairs = np.unique(pairs[~np.isin(pairs[:, 0] * n + pairs[:, 1], shell * n + other)], axis=0)
+        shell, other = np.r_[shell, pairs[:, 0]], np.r_[other, pairs[:, 1]]
         winding = np.r_[winding, np.sign(file_volumes[pairs[:, 1]]).astype(np.int64)]
-    around = np.zeros(n, dtype=np.int64)
+    return shell, other, winding
+
+
+def _winding_around(file_volumes: np.ndarray, nest: Nesting | None, within: np.ndarray | None) -> np.ndarray:
+    """(s,) int: the winding number, as the file winds them, of the shells around each shell at its probe point
+    (each container counted once: :func:`container_windings`)."""
+    shell, _, winding = container_windings(file_volumes, nest, within)
+    around = np.zeros(len(file_volumes), dtype=np.int64)
     np.add.at(around, shell, winding)
     return around
 
