@@ -71,6 +71,7 @@ __all__ = [
     "NonMaterialVolumeWarning",
     "SkippedModelWarning",
     "NonPlanarPolygonWarning",
+    "PackageFolderWarning",
 ]
 
 
@@ -320,6 +321,12 @@ class SkippedModelWarning(InertiaToolWarning):
     """A robot description (a Gazebo world) includes a stock model that is not on disk and has no link with
     mass (``model://sun``, a light; ``model://ground_plane``, a static plane): it is skipped, and the message
     names it."""
+
+
+class PackageFolderWarning(InertiaToolWarning):
+    """A ``package://NAME/...`` URI names no ROS package that can be found, but a plain folder ``NAME`` beside
+    the description holds the file (MuJoCo Menagerie's Barkour vb URDF writes ``package://assets/neck.stl`` for
+    its ``assets/`` folder).  The file is read from that folder; ROS tools would not resolve the URI."""
 
 
 class NonPlanarPolygonWarning(InertiaToolWarning):

@@ -235,3 +235,30 @@ def test_a_package_uri_with_three_slashes_names_the_package_in_its_path(tmp_path
     for uri in ("package:///pkg/meshes/b.stl", "package://pkg/meshes/b.stl"):
         assert resolve_uri(uri, base=str(tmp_path), packages={"pkg": tmp_path / "pkg"}, source="r.urdf",
                            link="l") == expected
+
+
+def test_a_package_uri_naming_a_plain_folder_beside_the_description_is_read_with_a_warning(tmp_path):
+    # MuJoCo Menagerie's Barkour vb URDF: package://assets/neck.stl for the assets/ folder beside it
+    import warnings as _warnings
+
+    from inertia_tool.errors import PackageFolderWarning
+    from inertia_tool.mass import shapes
+    from inertia_tool.robot.resolve import resolve_uri
+    (tmp_path / "assets").mkdir()
+    shapes.write_stl(shapes.box(0.1, 0.2, 0.3), tmp_path / "assets" / "neck.stl")
+    with pytest.warns(PackageFolderWarning, match="no ROS package 'assets' found"):
+        path = resolve_uri("package://assets/neck.stl", base=str(tmp_path), packages={}, source="r.urdf", link="l")
+    assert path == str(tmp_path / "assets" / "neck.stl")
+    # nothing above the description is guessed, a missing file stays an error, and a folder whose package.xml
+    # names another package is not taken for this one
+    (tmp_path / "sub").mkdir()
+    with _warnings.catch_warnings():
+        _warnings.simplefilter("error")
+        with pytest.raises(RobotDescriptionError, match="cannot resolve package 'assets'"):
+            resolve_uri("package://assets/neck.stl", base=str(tmp_path / "sub"), packages={}, source="r.urdf",
+                        link="l")
+        with pytest.raises(RobotDescriptionError, match="cannot resolve package 'assets'"):
+            resolve_uri("package://assets/head.stl", base=str(tmp_path), packages={}, source="r.urdf", link="l")
+        (tmp_path / "assets" / "package.xml").write_text("<package><name>other</name></package>")
+        with pytest.raises(RobotDescriptionError, match="cannot resolve package 'assets'"):
+            resolve_uri("package://assets/neck.stl", base=str(tmp_path), packages={}, source="r.urdf", link="l")

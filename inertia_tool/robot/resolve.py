@@ -10,6 +10,11 @@ Rules, in order (the first that names an existing directory wins; the file must 
   ``package://``, it holds a ``package.xml``; or its ``package.xml`` names ``NAME``) or holds it as
   ``A/NAME`` (a sibling model of a Gazebo model folder, a sibling package of a ROS workspace).
 * ``package:///NAME/rest`` (three slashes) is read as ``package://NAME/rest``.
+* Last, for ``package://`` only: a plain folder ``NAME`` in the description's own directory (``base``) that holds
+  ``rest`` and no ``package.xml`` naming another package (MuJoCo Menagerie's Barkour vb URDF writes
+  ``package://assets/neck.stl`` for the ``assets/`` folder beside it).  ROS would not resolve such a URI, so
+  the file is read with a :class:`~inertia_tool.errors.PackageFolderWarning` saying so; nothing above
+  ``base`` is guessed.
 * ``file:///abs/path`` is the absolute path; ``file://rel/path`` and a plain relative path are relative to
   ``base`` (the description's directory, or MuJoCo's ``meshdir``); an absolute path is itself.
 
@@ -20,9 +25,10 @@ description file, the link and the URI as written.
 from __future__ import annotations
 
 import os
+import warnings
 from urllib.parse import unquote
 
-from ..errors import RobotDescriptionError
+from ..errors import PackageFolderWarning, RobotDescriptionError
 from ..mesh.regular import not_regular_reason
 
 __all__ = ["resolve_uri", "package_directory", "nearby_package", "PACKAGE_PATH_VARIABLES", "MAX_FOLDERS_UP"]
@@ -90,6 +96,19 @@ def package_directory(name: str, packages: dict, *, scheme: str = "package", nea
     return nearby_package(name, near, scheme=scheme) if near is not None else None
 
 
+def _plain_folder(name: str, inner: str, base: str, where: str) -> str | None:
+    """The folder ``base/name`` when it is no package of another name and holds ``inner`` (the last rule of the
+    module docstring), with a :class:`PackageFolderWarning`; None otherwise."""
+    folder = os.path.join(os.path.abspath(base), name)
+    declared = _package_xml_name(folder) if os.path.isdir(folder) else None
+    if not os.path.isdir(folder) or declared not in (None, name) or not os.path.isfile(os.path.join(folder, inner)):
+        return None
+    warnings.warn(PackageFolderWarning(f"{where}: no ROS package {name!r} found; read from the folder {folder} "
+                                       "beside the description (ROS tools would not resolve this URI)"),
+                  stacklevel=4)
+    return folder
+
+
 def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) -> str:
     """Absolute path of the file ``uri`` names (see the module docstring for the rules).
 
@@ -119,6 +138,8 @@ def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) 
         # is the first path component all the same
         name, _, inner = rest.lstrip("/").partition("/")
         directory = package_directory(name, packages, scheme=scheme, near=base)
+        if directory is None and scheme == "package":
+            directory = _plain_folder(name, unquote(inner), base, where)
         if directory is None:
             searched = ("ROS_PACKAGE_PATH" if scheme == "package"
                         else "ROS_PACKAGE_PATH, GZ_SIM_RESOURCE_PATH, GAZEBO_MODEL_PATH")
