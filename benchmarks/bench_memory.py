@@ -225,7 +225,7 @@ for stage in ("close_surface", "find_shells", "settle_welded", "find_contacts", 
     wrap("inertia_tool.mesh.prepare", stage)
 for stage in ("load_mesh", "prepare_mesh", "_bodies"):
     wrap("inertia_tool.mass.pipeline", stage)
-wrap("inertia_tool.mesh.read", "weld_exact_stream")        # the weld inside load_mesh (issue 25)
+wrap("inertia_tool.mesh.read_stl", "weld_exact_stream")        # the weld inside load_mesh (issue 25)
 wrap("inertia_tool.mesh.surface", "census_and_shells")     # the census inside close_surface
 from inertia_tool.cli import main
 rss0 = checkpoint()

@@ -154,8 +154,8 @@ print(base, status("VmHWM:"))
 #: nested functions included; a C kernel is timed inside the function that calls it) whose time, less that of
 #: any stage they call, is the row's.  Whatever runs with none of them on the stack is ``other``.
 STAGES: dict[str, tuple[str, ...]] = {
-    "read": ("inertia_tool.mesh.read:_binary_stl_chunks.<locals>.views",
-             "inertia_tool.mesh.read:_binary_stl_chunks.<locals>.chunks"),
+    "read": ("inertia_tool.mesh.read_stl:_binary_stl_chunks.<locals>.views",
+             "inertia_tool.mesh.read_stl:_binary_stl_chunks.<locals>.chunks"),
     "weld": ("inertia_tool.mesh.weld:weld_exact_stream",),
     "census+shells": ("inertia_tool.mesh.checks:census_and_shells", "inertia_tool.mesh.checks:edge_topology",
                       "inertia_tool.mesh.checks:shell_labels"),
@@ -163,7 +163,7 @@ STAGES: dict[str, tuple[str, ...]] = {
     "integrate": ("inertia_tool.integrals:_tetra_sums",),
     "roundoff": ("inertia_tool.integrals:roundoff_bounds",),
     "precision": ("inertia_tool.mesh.precision:volume_rounding_bound",),
-    "bounds": ("inertia_tool.integrals:bounding_box", "inertia_tool.mesh.read:_finite_magnitude"),
+    "bounds": ("inertia_tool.integrals:bounding_box", "inertia_tool.mesh.read_stl:_finite_magnitude"),
 }
 OTHER = "other"
 

@@ -39,7 +39,7 @@ def _clock() -> tuple[float, float]:
 
 def measure(path: str, threads: list[int], repeat: int) -> dict[str, list[tuple[float, float]]]:
     from inertia_tool._native import accel
-    from inertia_tool.mesh.read import _binary_stl_chunks
+    from inertia_tool.mesh.read_stl import _binary_stl_chunks
 
     lib = accel()
     if lib is None:

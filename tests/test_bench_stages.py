@@ -14,7 +14,7 @@ from bench_stages import OTHER, STAGES, StageClock, _stage_codes, _write_stl, to
 
 import inertia_tool.mass.pipeline as pipeline  # noqa: E402
 import inertia_tool.mesh.checks as checks  # noqa: E402
-import inertia_tool.mesh.read as read  # noqa: E402
+import inertia_tool.mesh.read_stl as read  # noqa: E402
 
 
 def test_every_stage_names_a_function_of_the_package():

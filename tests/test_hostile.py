@@ -111,7 +111,7 @@ def test_non_utf8_file_name_prints_in_one_line(tmp_path, capsys):
 @pytest.mark.parametrize("newline", [b"\n", b"\r\n", b"\r"])
 def test_ascii_stl_streams_across_block_boundaries(tmp_path, monkeypatch, newline):
     """Tiny read blocks split lines (and \\r\\n pairs) everywhere; the result must not change."""
-    import inertia_tool.mesh.read as mesh_io
+    import inertia_tool.mesh.read_base as mesh_io
     v, f = prism(n=20)
     p = tmp_path / "p.stl"
     write_ascii_stl(p, v, f, newline=newline)
@@ -125,7 +125,7 @@ def test_ascii_stl_streams_across_block_boundaries(tmp_path, monkeypatch, newlin
 
 def test_old_mac_file_is_read_in_bounded_blocks(tmp_path, monkeypatch):
     """A CR-only file is many lines, not one giant line: no block ever exceeds the block size + a line."""
-    import inertia_tool.mesh.read as mesh_io
+    import inertia_tool.mesh.read_stl as mesh_io
     v, f = prism(n=200)
     p = tmp_path / "mac.stl"
     write_ascii_stl(p, v, f, newline=b"\r")
@@ -428,6 +428,7 @@ def test_stl_announcing_more_triangles_than_32_bit_indices_hold_is_refused_from_
     """A binary STL claiming 715,827,883 triangles with max_faces raised: refused from the header (a sparse
     file of the right size; nothing read or allocated), not an internal error in the welder."""
     import inertia_tool.mesh.read as io_mod
+    import inertia_tool.mesh.read_stl as stl_mod
     from inertia_tool.mesh.read import MAX_SUPPORTED_FACES, read_stl
     n = MAX_SUPPORTED_FACES + 1
     path = tmp_path / "huge.stl"
@@ -436,7 +437,7 @@ def test_stl_announcing_more_triangles_than_32_bit_indices_hold_is_refused_from_
         fh.truncate(84 + 50 * n)                                   # sparse: ~36 GB that take no space
     def no_weld(*a, **k):
         raise AssertionError("welding started")
-    monkeypatch.setattr(io_mod, "weld_exact_stream", no_weld)
+    monkeypatch.setattr(stl_mod, "weld_exact_stream", no_weld)
     with pytest.raises(MeshReadError, match=r"715,827,883 triangles, more than the 715,827,882 this reader"):
         read_stl(path, max_faces=10**12)
     with pytest.raises(UsageError, match="max_faces"):

@@ -245,7 +245,8 @@ def test_small_binary_stl_read_once_equals_chunked_read(tmp_path, n_faces):
     """A binary STL that fits in the first read (at most 80 triangles: 84 + 50·80 ≤ 4096 bytes) is welded from
     those bytes instead of being opened again: the vertices and faces are the ones the chunked file read gives,
     and a trailing byte after the triangles changes nothing."""
-    from inertia_tool.mesh.read import _binary_stl_chunks, load_mesh
+    from inertia_tool.mesh.read import load_mesh
+    from inertia_tool.mesh.read_stl import _binary_stl_chunks
     from inertia_tool.mesh.weld import weld_exact_stream
 
     rng = np.random.default_rng(n_faces)

@@ -18,6 +18,7 @@ from conftest import HAVE_ACCEL, REQUIRE_ACCEL
 from inertia_tool import _native
 from inertia_tool.errors import MeshReadError
 from inertia_tool.mesh import read as read_mod
+from inertia_tool.mesh import read_stl as stl_mod
 from inertia_tool.mesh import weld as weld_mod
 from inertia_tool.mesh.precision import float32_rounding
 from test_weld_partition import _dict_weld
@@ -41,11 +42,11 @@ def _load_both(path) -> tuple:
     """load_mesh on the C extension (radix partition forced, chunks of 37 faces) and on the numpy reference."""
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(weld_mod, "PARTITION_MIN_POINTS", 1)
-        mp.setattr(read_mod, "_CHUNK_FACES", 37)
+        mp.setattr(stl_mod, "_CHUNK_FACES", 37)
         fast = read_mod.load_mesh(str(path))
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv(_native.NO_ACCEL_ENV, "1")
-        mp.setattr(read_mod, "_CHUNK_FACES", 37)
+        mp.setattr(stl_mod, "_CHUNK_FACES", 37)
         ref = read_mod.load_mesh(str(path))
     return fast, ref
 
@@ -105,7 +106,7 @@ def test_binary_stl_nan_or_infinity_is_refused_on_both_paths(tmp_path, bad, wher
 def test_finite_magnitude_is_numpy_max_abs(values):
     """One C pass (column extremes) gives numpy's max |v| exactly, as a non-negative float."""
     v = np.array(values, dtype=np.float64)
-    got = read_mod._finite_magnitude(v)
+    got = stl_mod._finite_magnitude(v)
     assert got is not None and got == float(np.max(np.abs(v))) and not np.signbit(got)
 
 
@@ -113,8 +114,8 @@ def test_finite_magnitude_is_numpy_max_abs(values):
 def test_finite_magnitude_refuses_nan_and_infinity(bad):
     v = np.zeros((1000, 3))
     v[617, 2] = bad
-    assert read_mod._finite_magnitude(v) is None
-    assert read_mod._finite_magnitude(v[:, ::-1]) is None                   # not contiguous: numpy's pass
+    assert stl_mod._finite_magnitude(v) is None
+    assert stl_mod._finite_magnitude(v[:, ::-1]) is None                   # not contiguous: numpy's pass
 
 
 def test_binary_stl_cut_short_while_read_is_refused(tmp_path, monkeypatch):
@@ -124,8 +125,8 @@ def test_binary_stl_cut_short_while_read_is_refused(tmp_path, monkeypatch):
     corners = np.arange(3 * 3 * 100, dtype=np.float32).reshape(-1, 3, 3)
     path = tmp_path / "cut.stl"
     _write(path, corners)
-    monkeypatch.setattr(read_mod, "_CHUNK_FACES", 30)
-    views = read_mod._binary_stl_chunks(str(path), 130, padded=False)
+    monkeypatch.setattr(stl_mod, "_CHUNK_FACES", 30)
+    views = stl_mod._binary_stl_chunks(str(path), 130, padded=False)
     seen = []
     with pytest.raises(MeshReadError, match=r"ended after 100 of 130 triangles"):
         for v in views():

@@ -10,13 +10,13 @@ Found (stage, rule, numbers):
 * R1 (fixed): an OFF file with a polygon of five or more corners was refused, "could not be parsed (The 'out'
   kwarg is necessary when using the string multiply ufunc directly ...)": trimesh 5.2's ``load_off`` passes the
   face lines to ``triangulate_quads`` as strings, which numpy 2 cannot multiply.  The reader now reads OFF itself
-  (``mesh/read._read_off``), polygons cut like OBJ's.
+  (``mesh/read_off._read_off``), polygons cut like OBJ's.
 * R2 (half fixed): a binary PLY whose faces are lists of different lengths (a heptagon cap and quad sides: valid
   PLY) is refused, "could not be parsed (PLY is unexpected length!)" (trimesh's binary PLY reader assumes one list
   length; open: needs binary PLY faces read natively).  An ASCII PLY whose planar polygon is not convex (a 7-8
   corner star) was refused as "the surface passes through itself at 1 face pairs": trimesh fans every polygon from
   its first corner, which overlaps itself on a non-convex one (6 of 250 prisms of seed 1220).  Fixed: the raw face
-  lists trimesh keeps are cut as OBJ's (``read._ply_polygons_clipped``).
+  lists trimesh keeps are cut as OBJ's (``read_ply._ply_polygons_clipped``).
 * R3 (fixed): an OBJ polygon of more than four corners far from the origin (a 9-gon 0.275 m across 9.2e8 m out)
   was refused as "the surface passes through itself at 2 face pairs": ``polygons.clip_polygon_as_mujoco``
   clips in float32, where the corners 9e8 m out are 64 m apart on the float32 grid, so the clipped triangles

@@ -20,7 +20,8 @@ pytest.importorskip("collada")
 trimesh = pytest.importorskip("trimesh")
 
 from inertia_tool.errors import MeshReadError  # noqa: E402
-from inertia_tool.mesh import read as reader  # noqa: E402
+from inertia_tool.mesh import read_collada, read_trimesh  # noqa: E402
+from inertia_tool.mesh.regular import regular_file_resolver  # noqa: E402
 from inertia_tool.mesh.regular import open_regular  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -37,14 +38,14 @@ def _through_trimesh(path: str):
             warnings.simplefilter("ignore")
             with open_regular(path) as fh:
                 loaded = trimesh.load(fh, file_type="dae", process=False, force=None,
-                                      resolver=reader.regular_file_resolver(path))
+                                      resolver=regular_file_resolver(path))
             if isinstance(loaded, trimesh.Scene) and not loaded.geometry:
-                loaded = trimesh.load(reader._collada_geometry_only(path), file_type="dae", process=False,
+                loaded = trimesh.load(read_collada._collada_geometry_only(path), file_type="dae", process=False,
                                       force=None)
     finally:
         quiet.setLevel(level)
-    declared = reader._declared_scale(path, ".dae", loaded)
-    rounding = reader._scene_rounding(loaded)
+    declared = read_trimesh._declared_scale(path, ".dae", loaded)
+    rounding = read_trimesh._scene_rounding(loaded)
     if isinstance(loaded, trimesh.Scene):
         geoms = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)] if loaded.geometry else []
         if not geoms:
@@ -57,9 +58,9 @@ def _assert_same(path: str) -> None:
     expected = _through_trimesh(path)
     if expected is None:
         with pytest.raises(MeshReadError, match="contains no triangle mesh"):
-            reader._read_collada(path)
+            read_collada._read_collada(path)
         return
-    v, f, declared, rounding = reader._read_collada(path)
+    v, f, declared, rounding = read_collada._read_collada(path)
     assert v.shape == expected[0].shape and f.shape == expected[1].shape
     assert np.array_equal(v, expected[0])            # bit for bit
     assert np.array_equal(f, expected[1])
@@ -249,7 +250,7 @@ def test_a_mirroring_node_reverses_the_faces(tmp_path):
     path = tmp_path / "mirror.dae"
     path.write_text(doc)
     _assert_same(str(path))
-    v, f, _, _ = reader._read_collada(str(path))
+    v, f, _, _ = read_collada._read_collada(str(path))
     assert volume_moments(v, f).volume == pytest.approx(1 / 6, rel=1e-12)
 
 

@@ -226,6 +226,7 @@ def test_binary_stl_from_bytes_is_fed_in_chunks_and_matches_the_file(tmp_path, m
     """load_mesh(path, data=the file's bytes) (the batch's read-once path) feeds the partition weld the same
     chunks as reading the file does (so its output gathers on several threads), with the same result."""
     from inertia_tool.mesh import read as read_mod
+    from inertia_tool.mesh import read_stl
     from inertia_tool.mesh import weld as weld_mod
 
     pts = _torus_soup(40, 30)
@@ -234,7 +235,7 @@ def test_binary_stl_from_bytes_is_fed_in_chunks_and_matches_the_file(tmp_path, m
     path = tmp_path / "torus.stl"
     path.write_bytes(b"x" * 80 + np.uint32(len(rec)).tobytes() + rec.tobytes())
     monkeypatch.setattr(weld_mod, "PARTITION_MIN_POINTS", 1)
-    monkeypatch.setattr(read_mod, "_CHUNK_FACES", 500)
+    monkeypatch.setattr(read_stl, "_CHUNK_FACES", 500)
     sizes = []
     real = _native.accel().PartWelder
 

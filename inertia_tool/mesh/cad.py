@@ -527,7 +527,7 @@ def _cascadio_arrays(path: str, chord: float, angular_deflection: float) -> tupl
         raise _fail(path, "reading STEP needs OCP or cascadio (pip install cadquery-ocp-novtk, or cascadio)") from None
     if os.path.splitext(path)[1].lower() not in (".step", ".stp"):
         raise _fail(path, "reading IGES needs OCP (pip install cadquery-ocp-novtk); cascadio reads STEP only")
-    from .read import _read_with_trimesh
+    from .read_trimesh import _read_with_trimesh
     with tempfile.TemporaryDirectory(prefix="inertia-tool-") as tmp:
         glb = os.path.join(tmp, "part.glb")
         with _quiet():   # cascadio's tolerance is in OpenCASCADE's working unit, mm; its GLB is in metres
