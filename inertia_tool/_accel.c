@@ -3551,6 +3551,7 @@ accel_face_measures(PyObject *self, PyObject *args)
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
 static PyObject *accel_sort_codes(PyObject *self, PyObject *args);      /* section 8, after the module */
+static PyObject *accel_edge_twins(PyObject *self, PyObject *args);      /* section 8, after the module */
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
 static PyObject *accel_close_groups(PyObject *self, PyObject *args);    /* section 9b, after the module */
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
@@ -3617,6 +3618,10 @@ static PyMethodDef accel_methods[] = {
      "edge_census and, when `out` ((m,) int32/int64) is not None, each face's shell into `out` as "
      "checks.shell_labels numbers them (count: the shells; -1 without `out`), from one adjacency on `threads` "
      "threads (one below `parallel_min` faces; tests lower it); the result does not depend on either."},
+    {"edge_twins", accel_edge_twins, METH_VARARGS,
+     "edge_twins(faces, n_vertices, rounds=1)\n\nThe face-pair check's faces across each edge (section 8, ct_twins), "
+     "for the tests: bytes of 3 m int32, twin[3 f + c] the one face running the edge from corner c to c + 1 of f "
+     "the other way, -1 when none does, -2 when it is not one."},
     {"sort_codes", accel_sort_codes, METH_VARARGS,
      "sort_codes(words)\n\nThe face-pair check's radix sort (section 8, ct_radix_sort), for the tests: sorts "
      "the (m,) uint64 array `words` in place by their top 33 bits, stable."},
@@ -5433,6 +5438,67 @@ fail:
     return result;
 }
 
+static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t scratch_bytes,
+                    const int32_t *pos, int32_t *twin, int threads, int rounds);
+static inline size_t ct_stars_scratch(int64_t n, int64_t m);
+
+/* edge_twins(faces, n_vertices, rounds=1) -> bytes of 3 m int32: the face-pair check's faces across each edge
+ * (ct_twins by face, on one thread), for the tests: twin[3 f + c] is the one face running the edge from corner c
+ * to corner c + 1 of face f the other way, -1 when no face does, -2 when it is not one. */
+static PyObject *
+accel_edge_twins(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *fobj;
+    Py_ssize_t n_vertices;
+    int rounds = 1;
+    if (!PyArg_ParseTuple(args, "On|i", &fobj, &n_vertices, &rounds)) {
+        return NULL;
+    }
+    Py_buffer fv;
+    Py_ssize_t m;
+    int fsize;
+    if (get_faces(fobj, &fv, &m, &fsize) < 0) {
+        return NULL;
+    }
+    PyObject *result = NULL;
+    if (n_vertices < 0 || n_vertices >= INT32_MAX || m >= INT32_MAX / 3 || rounds < 1 || rounds > 64) {
+        PyErr_SetString(PyExc_ValueError, "Expected 0 <= n_vertices < 2**31 - 1, fewer than 2**31 / 3 faces and "
+                        "1 <= rounds <= 64");
+        goto done;
+    }
+    int64_t bad = first_bad_index(fv.buf, fsize, 3 * (size_t)m, (int64_t)n_vertices);
+    if (bad >= 0) {
+        PyErr_Format(PyExc_ValueError, "Expected face indices in 0..%lld, found %lld", (long long)n_vertices - 1,
+                     (long long)index_at(fv.buf, fsize, (size_t)bad));
+        goto done;
+    }
+    result = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)(3 * (size_t)m * sizeof(int32_t)));
+    if (result == NULL) {
+        goto done;
+    }
+    size_t scratch_bytes = ct_stars_scratch((int64_t)n_vertices, (int64_t)m);
+    void *scratch = malloc(scratch_bytes);
+    if (scratch == NULL) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+        goto done;
+    }
+    int rc;
+    int32_t *twin = (int32_t *)(void *)PyBytes_AS_STRING(result);
+    Py_BEGIN_ALLOW_THREADS
+    rc = ct_twins(fv.buf, fsize, (int64_t)n_vertices, (int64_t)m, scratch, scratch_bytes, NULL, twin, 1, rounds);
+    Py_END_ALLOW_THREADS
+    free(scratch);
+    if (rc < 0) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+    }
+done:
+    PyBuffer_Release(&fv);
+    return result;
+}
+
 /* ------------------------------------------------------------------------------------------------------
  * Certified stars (the fan pruning of mesh/intersect.py, see its docstring "Stars").  A vertex v of at least
  * min_faces faces is certified when its faces (v, x, y), with x, y and v distinct, form one edge-connected
@@ -5764,9 +5830,6 @@ ct_stars_scratch(int64_t n, int64_t m)
 {
     return (size_t)(n > 0 ? n : 1) * sizeof(int64_t) + 3 * (size_t)(m > 0 ? m : 1) * sizeof(int32_t);
 }
-
-static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t scratch_bytes,
-                    const int32_t *pos, int32_t *twin, int threads, int rounds);
 
 /* The faces of each vertex of at least list_min faces (in scratch, ct_stars_scratch(n, m) bytes, any content):
  * *off (n int64: the start of each kept vertex's range of faces, -1 for the others) and *faces (the faces of
