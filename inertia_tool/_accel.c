@@ -3551,6 +3551,7 @@ accel_face_measures(PyObject *self, PyObject *args)
 static PyObject *accel_split_steps(PyObject *self, PyObject *args);     /* section 7, after the module */
 static PyObject *accel_contact_scan(PyObject *self, PyObject *args);    /* section 8, after the module */
 static PyObject *accel_sort_codes(PyObject *self, PyObject *args);      /* section 8, after the module */
+static PyObject *accel_edge_twins(PyObject *self, PyObject *args);      /* section 8, after the module */
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
 static PyObject *accel_close_groups(PyObject *self, PyObject *args);    /* section 9b, after the module */
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
@@ -3617,6 +3618,10 @@ static PyMethodDef accel_methods[] = {
      "edge_census and, when `out` ((m,) int32/int64) is not None, each face's shell into `out` as "
      "checks.shell_labels numbers them (count: the shells; -1 without `out`), from one adjacency on `threads` "
      "threads (one below `parallel_min` faces; tests lower it); the result does not depend on either."},
+    {"edge_twins", accel_edge_twins, METH_VARARGS,
+     "edge_twins(faces, n_vertices, rounds=1)\n\nThe face-pair check's faces across each edge (section 8, ct_twins), "
+     "for the tests: bytes of 3 m int32, twin[3 f + c] the one face running the edge from corner c to c + 1 of f "
+     "the other way, -1 when none does, -2 when it is not one."},
     {"sort_codes", accel_sort_codes, METH_VARARGS,
      "sort_codes(words)\n\nThe face-pair check's radix sort (section 8, ct_radix_sort), for the tests: sorts "
      "the (m,) uint64 array `words` in place by their top 33 bits, stable."},
@@ -5433,6 +5438,67 @@ fail:
     return result;
 }
 
+static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t scratch_bytes,
+                    const int32_t *pos, int32_t *twin, int threads, int rounds);
+static inline size_t ct_stars_scratch(int64_t n, int64_t m);
+
+/* edge_twins(faces, n_vertices, rounds=1) -> bytes of 3 m int32: the face-pair check's faces across each edge
+ * (ct_twins by face, on one thread), for the tests: twin[3 f + c] is the one face running the edge from corner c
+ * to corner c + 1 of face f the other way, -1 when no face does, -2 when it is not one. */
+static PyObject *
+accel_edge_twins(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *fobj;
+    Py_ssize_t n_vertices;
+    int rounds = 1;
+    if (!PyArg_ParseTuple(args, "On|i", &fobj, &n_vertices, &rounds)) {
+        return NULL;
+    }
+    Py_buffer fv;
+    Py_ssize_t m;
+    int fsize;
+    if (get_faces(fobj, &fv, &m, &fsize) < 0) {
+        return NULL;
+    }
+    PyObject *result = NULL;
+    if (n_vertices < 0 || n_vertices >= INT32_MAX || m >= INT32_MAX / 3 || rounds < 1 || rounds > 64) {
+        PyErr_SetString(PyExc_ValueError, "Expected 0 <= n_vertices < 2**31 - 1, fewer than 2**31 / 3 faces and "
+                        "1 <= rounds <= 64");
+        goto done;
+    }
+    int64_t bad = first_bad_index(fv.buf, fsize, 3 * (size_t)m, (int64_t)n_vertices);
+    if (bad >= 0) {
+        PyErr_Format(PyExc_ValueError, "Expected face indices in 0..%lld, found %lld", (long long)n_vertices - 1,
+                     (long long)index_at(fv.buf, fsize, (size_t)bad));
+        goto done;
+    }
+    result = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)(3 * (size_t)m * sizeof(int32_t)));
+    if (result == NULL) {
+        goto done;
+    }
+    size_t scratch_bytes = ct_stars_scratch((int64_t)n_vertices, (int64_t)m);
+    void *scratch = malloc(scratch_bytes);
+    if (scratch == NULL) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+        goto done;
+    }
+    int rc;
+    int32_t *twin = (int32_t *)(void *)PyBytes_AS_STRING(result);
+    Py_BEGIN_ALLOW_THREADS
+    rc = ct_twins(fv.buf, fsize, (int64_t)n_vertices, (int64_t)m, scratch, scratch_bytes, NULL, twin, 1, rounds);
+    Py_END_ALLOW_THREADS
+    free(scratch);
+    if (rc < 0) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+    }
+done:
+    PyBuffer_Release(&fv);
+    return result;
+}
+
 /* ------------------------------------------------------------------------------------------------------
  * Certified stars (the fan pruning of mesh/intersect.py, see its docstring "Stars").  A vertex v of at least
  * min_faces faces is certified when its faces (v, x, y), with x, y and v distinct, form one edge-connected
@@ -5445,9 +5511,57 @@ fail:
  * and every pair within the star is of kind "none" without being tested.
  * ------------------------------------------------------------------------------------------------------ */
 
+/* The vertex ids of a large fan or star (section 8: ct_star_certify above CT_STAR_SMALL faces, ct_twin_task
+ * above 64), grouped by id in an open-addressing table instead of a comparison sort (qsort with a comparator:
+ * on a fan-capped cylinder of 4,800 faces the two 1,200-face caps' sorts were about a tenth of the check).  Each
+ * id keeps its count and its first two indices in the order added, which is all either caller reads of a
+ * sorted run: the same twins and the same star certificates.  ct_vid_table_make sizes it for k ids (a power
+ * of two of at least 2 k slots, so a probe sequence ends within the table), NULL when out of memory. */
 typedef struct {
-    int32_t vid, slot;
-} CtEnd;
+    int32_t key, count;
+    int32_t first, second;      /* the first two indices added under key (second -1 until there is one) */
+} CtVidSlot;
+
+typedef struct {
+    CtVidSlot *slot;
+    uint32_t mask;
+} CtVidTable;
+
+static int
+ct_vid_table_make(CtVidTable *t, int64_t k)
+{
+    uint64_t size = 16;
+    while (size < 2 * (uint64_t)k) size *= 2;
+    t->slot = (CtVidSlot *)malloc((size_t)size * sizeof(CtVidSlot));
+    if (t->slot == NULL) return -1;
+    t->mask = (uint32_t)(size - 1);
+    for (uint64_t i = 0; i < size; i++) t->slot[i].count = 0;
+    return 0;
+}
+
+/* The slot of key: its own, or the empty one where it would go (count 0). */
+static inline CtVidSlot *
+ct_vid_find(const CtVidTable *t, int32_t key)
+{
+    uint32_t h = (uint32_t)((uint64_t)(uint32_t)key * 0x9E3779B97F4A7C15ULL >> 32) & t->mask;
+    while (t->slot[h].count != 0 && t->slot[h].key != key) h = (h + 1) & t->mask;
+    return &t->slot[h];
+}
+
+static inline void
+ct_vid_add(CtVidTable *t, int32_t key, int32_t index)
+{
+    CtVidSlot *e = ct_vid_find(t, key);
+    if (e->count == 0) {
+        e->key = key;
+        e->first = index;
+        e->second = -1;
+    }
+    else if (e->count == 1) {
+        e->second = index;
+    }
+    e->count++;
+}
 
 /* cert[v]: 0 not certified; CT_STAR_SMALL_CERT certified with fewer than star_faces faces (its pairs are
  * enumerated, counted as candidates and decided by the certificate, not tested one by one: the counts stay
@@ -5458,13 +5572,6 @@ typedef struct {
 /* Stars of fewer faces are not tried (a pair of faces sharing an edge and nothing else is one "fan" of two
  * faces; three is the smallest star worth certifying). */
 #define CT_STAR_MIN 3
-
-static int
-ct_end_cmp(const void *x, const void *y)
-{
-    const CtEnd *a = (const CtEnd *)x, *b = (const CtEnd *)y;
-    return a->vid != b->vid ? (a->vid < b->vid ? -1 : 1) : (a->slot < b->slot ? -1 : a->slot > b->slot);
-}
 
 /* The ring r_0 .. r_k of the star of v from its k link edges (link[2f], link[2f+1]), walked face to face
  * through shared link vertices; partner[s] is the other slot holding the vertex of slot s (-1: an end).  1 and
@@ -5598,40 +5705,44 @@ ct_star_certify(const double *V, int32_t v, const int32_t *link, int64_t k)
         if (!ct_star_ring(v, link, k, partner, free_slot, n_free, ring, &closed)) return 0;
         return ct_star_turns(V, v, ring, k, closed);
     }
-    CtEnd *ends = (CtEnd *)malloc((size_t)(2 * k) * sizeof(CtEnd));
+    /* the link vertices grouped by id (ct_vid_table): a vertex in two link edges pairs its two slots, one in
+     * one is an end of a path, and the walk starts at the end of the smallest id (the first single of the
+     * sorted ids that this replaced, so the ring is the same) */
+    CtVidTable table = {NULL, 0};
     int32_t *partner = (int32_t *)malloc((size_t)(2 * k) * sizeof(int32_t));
     int32_t *ring = (int32_t *)malloc((size_t)(k + 1) * sizeof(int32_t));
     int ok = 0;
-    if (ends == NULL || partner == NULL || ring == NULL) {
+    if (partner == NULL || ring == NULL || ct_vid_table_make(&table, 2 * k) < 0) {
         ok = -1;
         goto done;
     }
     for (int64_t s = 0; s < 2 * k; s++) {
-        ends[s].vid = link[s];
-        ends[s].slot = (int32_t)s;
+        ct_vid_add(&table, link[s], (int32_t)s);
         partner[s] = -1;
     }
-    qsort(ends, (size_t)(2 * k), sizeof(CtEnd), ct_end_cmp);
     int64_t free_slot = -1, n_free = 0;
-    for (int64_t s = 0; s < 2 * k;) {
-        int64_t e = s + 1;
-        while (e < 2 * k && ends[e].vid == ends[s].vid) e++;
-        if (e - s > 2) goto done;                          /* a link vertex in three faces or more */
-        if (e - s == 2) {
-            partner[ends[s].slot] = ends[s + 1].slot;
-            partner[ends[s + 1].slot] = ends[s].slot;
+    int32_t free_vid = 0;
+    for (uint64_t h = 0; h <= (uint64_t)table.mask; h++) {
+        const CtVidSlot *e = &table.slot[h];
+        if (e->count == 0) continue;
+        if (e->count > 2) goto done;                       /* a link vertex in three faces or more */
+        if (e->count == 2) {
+            partner[e->first] = e->second;
+            partner[e->second] = e->first;
         }
         else {
             n_free++;
-            if (free_slot < 0) free_slot = ends[s].slot;
+            if (free_slot < 0 || e->key < free_vid) {
+                free_slot = e->first;
+                free_vid = e->key;
+            }
         }
-        s = e;
     }
     if (ct_star_ring(v, link, k, partner, free_slot, n_free, ring, &closed)) {
         ok = ct_star_turns(V, v, ring, k, closed);
     }
 done:
-    free(ends);
+    free(table.slot);
     free(partner);
     free(ring);
     return ok;
@@ -5719,9 +5830,6 @@ ct_stars_scratch(int64_t n, int64_t m)
 {
     return (size_t)(n > 0 ? n : 1) * sizeof(int64_t) + 3 * (size_t)(m > 0 ? m : 1) * sizeof(int32_t);
 }
-
-static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t scratch_bytes,
-                    const int32_t *pos, int32_t *twin, int threads, int rounds);
 
 /* The faces of each vertex of at least list_min faces (in scratch, ct_stars_scratch(n, m) bytes, any content):
  * *off (n int64: the start of each kept vertex's range of faces, -1 for the others) and *faces (the faces of
@@ -6213,13 +6321,6 @@ typedef struct {
     int32_t prev, next, face, corner;
 } CtLink;
 
-static int
-ct_link_prev_cmp(const void *x, const void *y)
-{
-    const CtLink *a = (const CtLink *)x, *b = (const CtLink *)y;
-    return (a->prev > b->prev) - (a->prev < b->prev);
-}
-
 /* twin of face f across the edge from its corner c: by face, or by hierarchy position when jb->pos is given */
 static inline void
 ct_twin_put(CtTwinJob *jb, int32_t f, int c, int32_t tw)
@@ -6307,21 +6408,22 @@ ct_twin_task(void *ctx, int t, int nt)
                 ct_twin_put(jb, lk[i].face, lk[i].corner, tw);
             }
         }
-        else if (ok) {                             /* a large fan: match by the sorted corners before v */
-            qsort(lk, (size_t)k, sizeof(CtLink), ct_link_prev_cmp);
+        else if (ok) {                             /* a large fan: match by the corners before v, in a table */
+            CtVidTable table;
+            if (ct_vid_table_make(&table, k) < 0) {
+                if (lk != local) free(lk);
+                jb->oom[t] = 1;
+                return;
+            }
+            for (int64_t i = 0; i < k; i++) ct_vid_add(&table, lk[i].prev, (int32_t)i);
             for (int64_t i = 0; i < k; i++) {
-                int64_t lo = 0, hi = k;            /* first entry whose prev is >= lk[i].next */
-                while (lo < hi) {
-                    int64_t mid = (lo + hi) / 2;
-                    if (lk[mid].prev < lk[i].next) lo = mid + 1;
-                    else hi = mid;
-                }
-                int64_t run = 0;
-                while (lo + run < k && lk[lo + run].prev == lk[i].next) run++;
+                const CtVidSlot *e = ct_vid_find(&table, lk[i].next);     /* the faces whose prev is i's next */
+                int32_t run = e->count;
                 /* "run twice one way": another face with the same next; counted through its own prev run */
-                int32_t tw = run == 1 && lk[lo].face != lk[i].face ? lk[lo].face : run == 0 ? -1 : -2;
+                int32_t tw = run == 1 && lk[e->first].face != lk[i].face ? lk[e->first].face : run == 0 ? -1 : -2;
                 ct_twin_put(jb, lk[i].face, lk[i].corner, tw);
             }
+            free(table.slot);
         }
         if (lk != local) free(lk);
         v = w;
@@ -6368,6 +6470,54 @@ ct_sweep_cmp(const void *x, const void *y)
     return a->lo < b->lo ? -1 : a->lo > b->lo ? 1 : (a->i > b->i) - (a->i < b->i);
 }
 
+static inline int
+ct_sweep_before(const CtSweep *a, const CtSweep *b)
+{
+    return a->lo < b->lo || (a->lo == b->lo && a->i < b->i);
+}
+
+/* order[0 .. B) sorted by (lo, i), a total order (the indices are distinct), so any correct sort gives this
+ * one: runs of 16 by insertion, then merged bottom-up through a buffer of B entries (the comparisons inline:
+ * qsort's comparator calls were most of the sort on a fan-capped cylinder's patches); qsort when the buffer
+ * cannot be had. */
+static void
+ct_sweep_sort(CtSweep *order, int64_t B)
+{
+    for (int64_t s = 0; s < B; s += 16) {
+        int64_t e = s + 16 < B ? s + 16 : B;
+        for (int64_t x = s + 1; x < e; x++) {
+            CtSweep key = order[x];
+            int64_t y = x;
+            while (y > s && ct_sweep_before(&key, &order[y - 1])) {
+                order[y] = order[y - 1];
+                y--;
+            }
+            order[y] = key;
+        }
+    }
+    if (B <= 16) return;
+    CtSweep *tmp = (CtSweep *)malloc((size_t)B * sizeof(CtSweep));
+    if (tmp == NULL) {
+        qsort(order, (size_t)B, sizeof(CtSweep), ct_sweep_cmp);
+        return;
+    }
+    CtSweep *src = order, *dst = tmp;
+    for (int64_t w = 16; w < B; w *= 2) {
+        for (int64_t s = 0; s < B; s += 2 * w) {
+            int64_t m = s + w < B ? s + w : B, e = s + 2 * w < B ? s + 2 * w : B;
+            int64_t a = s, b = m, o = s;
+            while (a < m && b < e) dst[o++] = ct_sweep_before(&src[b], &src[a]) ? src[b++] : src[a++];
+            while (a < m) dst[o++] = src[a++];
+            while (b < e) dst[o++] = src[b++];
+        }
+        CtSweep *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != order) memcpy(order, src, (size_t)B * sizeof(CtSweep));
+    free(tmp);
+}
+
 /* 1 when the closed polygons P (2-d points, B of them; the segment of point i runs to point succ[i], every
  * succ cycle of length 3 or more, consecutive points distinct) are simple and pairwise meet only at common
  * vertices: segments meet only where one ends and the next begins (and not folding back along it), two
@@ -6384,7 +6534,7 @@ ct_polygons_simple(const double *P, const int32_t *succ, const int32_t *edges, i
         order[i].lo = a[0] < b[0] ? a[0] : b[0];
         order[i].i = (int32_t)i;
     }
-    qsort(order, (size_t)B, sizeof(CtSweep), ct_sweep_cmp);
+    ct_sweep_sort(order, B);
     int64_t tests = 0;
     for (int64_t x = 0; x < B; x++) {
         int64_t i = order[x].i;
@@ -7926,14 +8076,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
         Py_END_ALLOW_THREADS
         if (profile) {
             if (clk[11] > 0) {
-                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f order %.4f lists %.4f twins %.4f "
-                        "patches %.4f stars %.4f boxes+apex+bits %.4f traverse %.4f s; ",
+                fprintf(stderr, "contact_scan %lld faces: codes %.6f sort %.6f order %.6f lists %.6f twins %.6f "
+                        "patches %.6f stars %.6f boxes+apex+bits %.6f traverse %.6f s; ",
                         (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2], clk[8] - clk[3],
                         clk[10] - clk[8], clk[7] - clk[10], clk[11] - clk[7], clk[5] - clk[11], clk[6] - clk[5]);
             }
             else {
-                fprintf(stderr, "contact_scan %lld faces: codes %.4f sort %.4f order %.4f stars+boxes %.4f "
-                        "traverse %.4f s; ", (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2],
+                fprintf(stderr, "contact_scan %lld faces: codes %.6f sort %.6f order %.6f stars+boxes %.6f "
+                        "traverse %.6f s; ", (long long)m, clk[1] - clk[0], clk[2] - clk[1], clk[3] - clk[2],
                         clk[5] - clk[3], clk[6] - clk[5]);
             }
             fprintf(stderr, "candidates %lld tested %lld; node pairs %lld leaf pairs %lld pair tests %lld; "
