@@ -96,7 +96,6 @@ def test_off_polygons_of_five_or_more_corners_are_read(tmp_path, seed):
     assert verdict.label == "exact" and verdict.wrong is None, verdict
 
 
-@pytest.mark.xfail(strict=True, reason="R2: binary PLY with face lists of different lengths refused by trimesh")
 def test_binary_ply_with_mixed_polygons_is_read(tmp_path):
     verdict = _judge(_prism(1204, corners=5), "ply_binary", "m", tmp_path)
     assert verdict.label == "exact" and verdict.wrong is None, verdict
