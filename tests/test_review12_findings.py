@@ -181,7 +181,6 @@ def test_an_open_edge_far_out_is_named_by_two_different_ends():
         assert np.sort(np.linalg.norm(v - end, axis=1))[0] < 0.5e-3
 
 
-@pytest.mark.xfail(strict=True, reason="R7: R2's flat rule calls a 1 µm × 1 µm × 1 m needle 'no volume'")
 def test_a_needle_is_not_called_flat():
     v, f = box((1e-6, 1e-6, 1.0))
     try:
