@@ -171,3 +171,45 @@ def test_float_face_indices_are_refused(tmp_path):
                      + struct.pack("<B3f", 3, 0, 2, 1) + struct.pack("<B3f", 3, 0, 1, 3))
     with pytest.raises(MeshReadError, match="face lists must hold integers"):
         load_mesh(path)
+
+
+def _dodecahedron() -> tuple[np.ndarray, list[list[int]]]:
+    """A regular dodecahedron of edge ``2/φ`` (corners ``(±1, ±1, ±1)``, ``(0, ±1/φ, ±φ)`` and their cyclic
+    turns) and its twelve pentagons, outward, each ordered by angle about its centre."""
+    phi = (1 + 5 ** 0.5) / 2
+    pts = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    for a in (-1 / phi, 1 / phi):
+        for b in (-phi, phi):
+            pts += [(0.0, a, b), (a, b, 0.0), (b, 0.0, a)]
+    v = np.array(pts, dtype=np.float64)
+    faces = []
+    for axis in range(3):                       # the 12 face normals: (0, ±φ, ±1) and their cyclic turns
+        for s1 in (-1, 1):
+            for s2 in (-1, 1):
+                n = np.roll(np.array([0.0, s1 * phi, s2]), axis)
+                corners = np.flatnonzero(np.abs(v @ n - np.max(v @ n)) < 1e-9)
+                centre = v[corners].mean(axis=0)
+                e1 = v[corners[0]] - centre
+                e2 = np.cross(n, e1)
+                angle = np.arctan2((v[corners] - centre) @ e2, (v[corners] - centre) @ e1)
+                faces.append(corners[np.argsort(angle)].tolist())
+    return v, faces
+
+
+def test_a_ply_of_pentagons_only_is_cut_alike_in_ascii_and_binary(tmp_path):
+    """Every list of one length above four: the ASCII file (trimesh's raw 2-D lists, now cut again by
+    ``_cut_face_lists``) and the binary file (one dtype of 5-corner records) give the same oriented triangles, and
+    the dodecahedron's volume ``(15 + 7√5)/4 · a³``.  A cross-check of both uniform branches, not a regression
+    test: the faces are convex, so trimesh's fan (the old reading of both files) passes it too."""
+    v, faces = _dodecahedron()
+    assert all(len(p) == 5 for p in faces) and len(faces) == 12
+    solid = G.Solid([tuple(p) for p in v.tolist()], faces, faces)
+    text, binary = tmp_path / "d.ply", tmp_path / "b.ply"
+    text.write_bytes(G.write_ply(solid, binary=False))
+    binary.write_bytes(G.write_ply(solid, binary=True))
+    got, want = _read(binary), _read(text)
+    assert np.array_equal(got.vertices, want.vertices)
+    assert np.array_equal(_oriented(got.faces), _oriented(want.faces))
+    edge = 2 / ((1 + 5 ** 0.5) / 2)
+    assert volume_moments(got.vertices, got.faces).volume == pytest.approx((15 + 7 * 5 ** 0.5) / 4 * edge ** 3,
+                                                                          rel=1e-13)
