@@ -96,7 +96,6 @@ def test_off_polygons_of_five_or_more_corners_are_read(tmp_path, seed):
     assert verdict.label == "exact" and verdict.wrong is None, verdict
 
 
-@pytest.mark.xfail(strict=True, reason="R2: binary PLY with face lists of different lengths refused by trimesh")
 def test_binary_ply_with_mixed_polygons_is_read(tmp_path):
     verdict = _judge(_prism(1204, corners=5), "ply_binary", "m", tmp_path)
     assert verdict.label == "exact" and verdict.wrong is None, verdict
@@ -182,7 +181,6 @@ def test_an_open_edge_far_out_is_named_by_two_different_ends():
         assert np.sort(np.linalg.norm(v - end, axis=1))[0] < 0.5e-3
 
 
-@pytest.mark.xfail(strict=True, reason="R7: R2's flat rule calls a 1 µm × 1 µm × 1 m needle 'no volume'")
 def test_a_needle_is_not_called_flat():
     v, f = box((1e-6, 1e-6, 1.0))
     try:

@@ -133,14 +133,16 @@ _BLOCK_BYTES = 1 << 24
 MAX_LINE_BYTES = 1 << 20
 
 
-def _text_blocks(fh: IO[bytes], path: str, *, block_bytes: int = _BLOCK_BYTES,
+def _text_blocks(fh: IO[bytes], path: str, *, block_bytes: int | None = None,
                  max_line: int = MAX_LINE_BYTES) -> Iterator[bytes]:
     """Yield the bytes of a text file in blocks of whole lines, every line ending normalised to ``\n``.
 
     Reads fixed-size byte blocks and splits on any of ``\r\n``, ``\r`` (old Mac) and ``\n`` itself, carrying
     the partial last line into the next block, so memory stays bounded by ``block_bytes + max_line`` however
     the lines end.  A line longer than ``max_line`` is refused (the file is not line-structured text).
+    ``block_bytes`` defaults to :data:`_BLOCK_BYTES` as it is when called (a test may set it smaller).
     """
+    block_bytes = _BLOCK_BYTES if block_bytes is None else block_bytes
     carry = b""
     for _ in range(1 << 40):  # bounded by the file size: each pass consumes up to block_bytes
         chunk = fh.read(block_bytes)

@@ -186,11 +186,28 @@ def drop_flat(shells: Shells, diag: float, source: str, *, warn: bool = True,
               stacklevel: int = 5) -> tuple[Shells, str | None]:
     """R2: leave out closed shells that enclose no volume; refuse when nothing else is left.  The shells' moments
     and round-off bound (R7) are computed anew when some are left out.  Returns the shells and the note (warned
-    when ``warn``, at ``stacklevel``), or None when nothing was left out."""
-    v, f, labels, n_shells, moments, _ = shells
+    when ``warn``, at ``stacklevel``), or None when nothing was left out.
+
+    A shell is a candidate when ``|V| ≤ FLAT_RTOL · diag³`` and is left out only when that changes the rest's
+    moments by no more than round-off (:func:`~.policy.negligible_flat`).  When every shell is a candidate the
+    scale ``diag³`` says nothing (a needle 1 µm × 1 µm × 1 m encloses 1e-12 m³ = ``FLAT_RTOL · diag³``, its volume
+    known to 1e-16 of itself: review 12's R7).  The mesh is then refused only when no shell's volume exceeds its
+    own round-off budget ``b + √3 δ A``: ``b`` the float64 round-off bound of its summed volume
+    (``shells.bound.volume``, R7) and ``√3 δ A`` what rounding the corners of a flat surface of area ``A`` to
+    float64 can enclose (``δ`` half the float64 spacing at the largest coordinate; moving each corner by at most
+    ``√3 δ`` moves a closed surface's volume by at most that times its area, to first order).  Such a shell is a
+    face and its reverse or a collapsed sliver, flat up to rounding; the shells above their budget are the solid
+    and the others candidates as above.  The decision is by each shell's own budget, whatever the aspect ratio."""
+    v, f, labels, n_shells, moments, bound = shells
     flat = np.array([abs(s.volume) <= FLAT_RTOL * diag ** 3 for s in moments], dtype=bool)
     if not flat.any():
         return shells, None
+    if flat.all():
+        delta = 0.5 * float(np.spacing(np.max(np.abs(v)))) if v.size else 0.0
+        flat = np.array([not abs(s.volume) > b + np.sqrt(3.0) * delta * s.area
+                         for s, b in zip(moments, bound.volume)], dtype=bool)
+        if not flat.any():
+            return shells, None
     if flat.all():
         what = "the mesh encloses" if n_shells == 1 else f"all {n_shells} shells enclose"
         raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
