@@ -36,12 +36,13 @@ builds it:
    surface is closed and consistently wound, and no two of its faces cross (:func:`~.intersect.surface_contacts`
    again, exact).
 
-Before step 1, a face written together with its reverse (the same three vertices, opposite cyclic order) is
-taken out as a pair (:func:`_cancel_reversed`): the two are one triangle with opposite orientations, so their
-contributions cancel exactly in every surface integral and in the winding number at every point off that triangle,
-and ``{w ≥ 1}`` changes by a set of measure zero; every directed edge stays matched by its reverse.  Left in, the
-pair would be a patch every point of which lies on the other face of the pair, where no winding number can be
-certified (issue 23: Barkour v0's ``upper_right_2.stl``, four such pairs).
+Before step 1, a face written together with its reverse (the same three vertices, opposite cyclic order) is taken
+out as a pair (:func:`~.policy.cancel_opposite`, R0's count with sign, written once for R0 and both arrangements):
+the two are one triangle with opposite orientations, so their contributions cancel exactly in every surface integral
+and in the winding number at every point off that triangle, and ``{w ≥ 1}`` changes by a set of measure zero; every
+directed edge stays matched by its reverse. Left in, the pair would be a patch every point of which lies on the
+other face of the pair, where no winding number can be certified (issue 23: Barkour v0's ``upper_right_2.stl``, four
+such pairs).
 
 Degenerate crossings (a corner in the plane of a face it crosses, an edge through another edge or a corner,
 coplanar overlapping faces, two crossing curves meeting on an edge) are refused with the reason
@@ -63,6 +64,7 @@ from ..values import frozen_value
 from .checks import edge_topology
 from .edges import edge_keys
 from .intersect import _integers, orient3d_sign, surface_contacts
+from .policy import cancel_opposite
 
 __all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells", "WINDING_MARGIN",
            "MAX_EXACT_RAY_WORK"]
@@ -121,7 +123,7 @@ class Arrangement:
         Intersection points merged into a neighbour within ``tolerances.ARRANGE_MERGE_RTOL`` of the diagonal
         because, rounded, they left faces crossing (see :func:`_merge_close_points`).
     cancelled_faces : int
-        Input faces taken out as pairs of a face and its reverse before arranging (:func:`_cancel_reversed`).
+        Input faces taken out as pairs of a face and its reverse before arranging (:func:`~.policy.cancel_opposite`).
     """
 
     vertices: np.ndarray
@@ -552,7 +554,7 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
     """
     v = np.ascontiguousarray(vertices, dtype=np.float64)
     f = np.ascontiguousarray(faces, dtype=np.int64)
-    keep = _cancel_reversed(f)
+    keep = cancel_opposite(f)
     cancelled = int(len(f) - np.count_nonzero(keep))
     if cancelled:
         remap = np.cumsum(keep) - 1
@@ -609,35 +611,6 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
             merged = 0
     return Arrangement(vertices=result_v, faces=result_f, crossings_left=len(after.crossing), turned=turned,
                        merged_points=merged, cancelled_faces=cancelled, **stats)
-
-
-def _cancel_reversed(faces: np.ndarray) -> np.ndarray:
-    """(m,) bool: the faces kept once every face written with its reverse (the same three vertex ids in opposite
-    cyclic order) is taken out with it, pair by pair (``k`` copies one way and ``j`` the other leave ``|k − j|``).
-
-    The pair is the zero chain: its two faces' terms cancel exactly in the divergence-theorem sums (Rigid Body
-    Motion, Ch. 4) and in the solid-angle sum of the winding number at every point off the triangle, so
-    ``{w ≥ 1}`` is the same up to the triangle itself (measure zero); each directed edge loses one use and so
-    does its reverse, so a closed surface stays closed."""
-    f = np.asarray(faces, dtype=np.int64)
-    keep = np.ones(len(f), dtype=bool)
-    if len(f) < 2:
-        return keep
-    canon = np.sort(f, axis=1)
-    _, key, count = np.unique(canon, axis=0, return_inverse=True, return_counts=True)
-    key = key.reshape(-1)
-    repeated = np.flatnonzero(count[key] > 1)
-    if not len(repeated):
-        return keep
-    even = _cyclic_parity(f[repeated])
-    groups: dict[int, tuple[list[int], list[int]]] = {}
-    for idx, k, e in zip(repeated.tolist(), key[repeated].tolist(), even.tolist()):
-        groups.setdefault(k, ([], []))[0 if e else 1].append(idx)
-    for one_way, other_way in groups.values():
-        pairs = min(len(one_way), len(other_way))
-        keep[one_way[:pairs]] = False
-        keep[other_way[:pairs]] = False
-    return keep
 
 
 def _merge_close_points(vertices: np.ndarray, faces: np.ndarray, n_input: int) -> tuple[np.ndarray, np.ndarray, int]:
