@@ -54,8 +54,8 @@ Found (stage, rule, numbers):
   along the other diagonal, so no face is another's exact reverse; ``coplanar._zero_chains`` takes out, before any
   point is made, coplanar patches whose boundaries are each other's reverse (a 2-chain in one plane with no
   boundary is zero), after ``policy.cancel_opposite`` (R0's count with sign, also the crossing arrangement's);
-  where the overlay still makes points, their rounding is bounded (``coplanar._rounding_bounds``) and the
-  arrangement refused above half of ``ROUNDOFF_RTOL``.
+  where the overlay (or the crossing arrangement) still makes points, their rounding is bounded
+  (``arrange.rounded_points_bounds``) and the arrangement refused above half of ``ROUNDOFF_RTOL``.
 * R9 (fixed): a refusal naming an open edge printed both ends to 6 digits, so 1e8 m out they read the same point
   twice ("(-9.80443e+07, 8.5952e+07, -2.62202e+07)–(-9.80443e+07, 8.5952e+07, -2.62202e+07) m");
   ``resolve._edge_text`` adds digits until the ends differ.

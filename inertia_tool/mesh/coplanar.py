@@ -43,10 +43,9 @@ from math import gcd
 import numpy as np
 
 from ..errors import ArrangementError
-from ..tolerances import ROUNDOFF_RTOL
 from ..values import frozen_value
 from .arrange import (_U, WINDING_MARGIN, _compact, _Exact, _FaceTriangulation, _Hom, _inside_face, _orient2d,
-                      _patches, _projection, _winding_terms, _winding_total)
+                      _patches, _projection, _winding_terms, _winding_total, rounded_points_bounds)
 from .edges import edge_keys
 from .intersect import orient3d_sign, surface_contacts
 from .policy import cancel_opposite, signed_multiplicity
@@ -93,8 +92,8 @@ class CoplanarArrangement:
         coplanar patches whose boundaries are each other's reverse.
     rounding : (float, float, float)
         What rounding the overlay's new points to float64 may change in the result (volume relative, centroid m,
-        inertia relative; :func:`~.precision.conversion_bounds` over the faces at those points); zeros when the
-        result uses no new point.
+        inertia relative; :func:`~.arrange.rounded_points_bounds`, refused above half of ``ROUNDOFF_RTOL``); zeros
+        when the result uses no new point.
     """
 
     vertices: np.ndarray
@@ -428,7 +427,11 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
     if not after.complete:
         raise ArrangementError("the face-intersection check of the surface of winding number ≥ 1 did not finish")
     left = len(after.crossing) + len(after.coplanar_opposite)
-    rounding = _rounding_bounds(out_v, kept, n, result_v, result_f)
+    used = np.unique(kept)
+    new_used = out_v[used[used >= n]]
+    delta = 0.5 * float(np.max(np.spacing(np.abs(new_used)))) if len(new_used) else 0.0
+    at_new = (used >= n)[result_f].any(axis=1)        # faces at a new point (result_v is used, in order)
+    rounding = rounded_points_bounds(result_v, result_f, [(at_new, delta)])   # refused above ROUNDOFF_RTOL/2
     return CoplanarArrangement(vertices=result_v, faces=result_f, coplanar_pairs=len(overlapping),
                                planes=len(groups), split_faces=len(split), new_vertices=len(new_xyz),
                                patches=n_patches, max_winding=int((w_front + mult).max()),
@@ -539,31 +542,6 @@ def _as_it_stands(v: np.ndarray, f: np.ndarray, cancelled: int) -> CoplanarArran
                     "the surface left once the faces written with their reverse are taken out is not closed")
     return CoplanarArrangement(vertices=result_v, faces=result_f, coplanar_pairs=0, planes=0, split_faces=0,
                                new_vertices=0, patches=0, max_winding=1, cancelled_faces=cancelled)
-
-
-def _rounding_bounds(out_v: np.ndarray, kept: np.ndarray, n_input: int, result_v: np.ndarray,
-                     result_f: np.ndarray) -> tuple[float, float, float]:
-    """What rounding the overlay's new points (ids ≥ ``n_input`` of ``out_v``) may change in the result
-    (:func:`~.precision.conversion_bounds`: each new point lies within half a float64 spacing of its exact value
-    per coordinate, and only the faces at a new point move); refused above ``ROUNDOFF_RTOL / 2`` of the result,
-    the other half left to the integrals' round-off (R7), so that ``united`` keeps what "exact" means."""
-    at_new = np.any(kept >= n_input, axis=1)
-    if not at_new.any():
-        return 0.0, 0.0, 0.0
-    from ..integrals import volume_moments
-    from .precision import conversion_bounds
-    new = out_v[np.unique(kept[kept >= n_input])]
-    delta = 0.5 * float(np.max(np.spacing(np.abs(new))))
-    whole = volume_moments(result_v, result_f)
-    bounds = conversion_bounds(result_v, result_f[at_new], delta, whole.volume, whole.centroid,
-                               whole.second_moment)
-    worst = max(bounds[0], bounds[2])
-    if not worst <= 0.5 * ROUNDOFF_RTOL:
-        raise ArrangementError(f"the overlay's {int(np.count_nonzero(np.unique(kept) >= n_input)):,} new points, "
-                               f"rounded to float64 (by up to {delta:.2g} m a coordinate), may change the result "
-                               f"by {worst:.2g} of it, above the {0.5 * ROUNDOFF_RTOL:g} a certified union allows "
-                               "(a part small against its distance from the origin)")
-    return bounds
 
 
 def _touches_inside(exact: _Exact, faces: np.ndarray, g: int, h: int) -> bool:
