@@ -380,7 +380,28 @@ def test_points_split_by_rounding_are_merged_into_the_input_vertex():
     uses = np.flatnonzero(np.any(f == 0, axis=1))
     f2[uses[:2]] = np.where(f2[uses[:2]] == 0, 8, f2[uses[:2]])
     assert not edge_topology(f2, len(v2)).oriented
-    mv, mf, merged = _merge_close_points(v2, f2, n_input=8)
+    mv, mf, merged, moved = _merge_close_points(v2, f2, n_input=8)
     assert merged == 1 and len(mv) == 8
+    # what moved, for the rounding bound: the two faces that used the clone, by the clone's offset
+    assert np.count_nonzero(moved.faces) == 2 and moved.shift == float(np.max(np.abs(clone - v[0])))
+    assert not moved.new.any()
     assert edge_topology(mf, len(mv)).oriented
     assert sorted(map(tuple, np.sort(mf, axis=1).tolist())) == sorted(map(tuple, np.sort(f, axis=1).tolist()))
+
+
+def test_new_points_far_out_are_counted_or_refused():
+    """The crossing points are rounded to float64 once; far from the origin that rounding is a sizeable share of a
+    small part (review 12's R8 found it in the coplanar overlay).  ``rounded_points_bounds`` counts it over the
+    faces at new points (Steiner's bound, half a float64 spacing a coordinate): the two crossing bars turned at
+    random are arranged near the origin with a bound far inside ``ROUNDOFF_RTOL``, and refused 1e7 m out (0.1 mm
+    bars: a spacing of 1.9e-9 m is 1e-5 of them), where the old code answered without counting it."""
+    from scipy.spatial.transform import Rotation
+
+    from inertia_tool.tolerances import ROUNDOFF_RTOL
+    (v, f), _ = _cross_of_boxes()
+    turn = Rotation.from_rotvec([0.3, -0.7, 0.2]).as_matrix()
+    near = arrange_crossings(v @ turn.T, f)
+    assert near.new_vertices > 0 and 0 < max(near.rounding[0], near.rounding[2]) < 1e-3 * ROUNDOFF_RTOL
+    far = v @ turn.T * 1e-4 + np.array([1e7, -3e6, 2e6])
+    with pytest.raises(ArrangementError, match="new points, rounded to float64"):
+        arrange_crossings(far, f)

@@ -265,14 +265,21 @@ def test_zero_area_face_is_refused_by_the_overlay_not_crashed():
     rng = np.random.default_rng(1)
     a, b = _box_cells((0, 0, 0), (2, 1, 1)), _box_cells((1, -1, 0), (1, 2, 1))
     v, f = S._weld_exact(*S.concat(S.cell_body(a, 1.0, rng), S.cell_body(b, 1.0, rng)))
-    # a flat sliver pair on the edge a–b of the first face: (a, b, m) and its reverse, m the edge's midpoint (the
-    # surface stays closed)
+    # the first face (a, b, c) split at m, the midpoint of a–b, into (a, m, c) and (m, b, c), and the flat sliver
+    # (a, b, m) closing the T-vertex (the surface stays closed; no face is another's reverse, so nothing cancels:
+    # a sliver written with its reverse is a zero chain, taken out before the overlay, below)
     m = len(v)
-    first = f[0]
-    v = np.vstack([v, 0.5 * (v[first[0]] + v[first[1]])])
-    f = np.vstack([f, [[first[0], first[1], m], [first[1], first[0], m]]])
+    a_, b_, c_ = (int(x) for x in f[0])
+    v = np.vstack([v, 0.5 * (v[a_] + v[b_])])
+    split = np.vstack([f[1:], [[a_, m, c_], [m, b_, c_], [a_, b_, m]]])
     with pytest.raises(ArrangementError, match="zero area"):
-        arrange_coplanar(v, f)
+        arrange_coplanar(v, split)
+    # the sliver and its reverse on top of the unsplit surface: cancelled first, the union as without them
+    paired = np.vstack([f, [[a_, b_, m], [b_, a_, m]]])
+    with_pair, alone = arrange_coplanar(v, paired), arrange_coplanar(v[:m], f)
+    assert with_pair.cancelled_faces == 2
+    assert abs(volume_moments(with_pair.vertices, with_pair.faces).volume
+               - volume_moments(alone.vertices, alone.faces).volume) <= 1e-12 * 3.0
 
 
 def test_overlap_sum_still_refuses_welded_bodies_sharing_a_plane():

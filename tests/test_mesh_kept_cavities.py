@@ -19,7 +19,6 @@ import re
 import warnings
 
 import numpy as np
-import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -163,11 +162,11 @@ def test_boxes_flush_inside_voids_that_cross_bodies_are_right_or_refused(seed):
     assert wrong is None, (wrong, [(lo.tolist(), hi.tolist(), s) for lo, hi, s in boxes])
 
 
-@pytest.mark.xfail(strict=True, reason="open (fix12): a void listed twice with its exact inverted copy; R0 drops the "
-                   "repeat before cancelling the pair (mesh/policy.coincident_surfaces), so both copies of the void go "
-                   "and the body is answered whole, 'exact' 0.9375 m³, where {w ≥ 1} = body − void = 0.90625 m³ "
-                   "(cancelling first would leave one void)")
 def test_a_void_listed_twice_with_its_inverted_copy_keeps_one_void():
+    """fix12's open case: a void listed twice plus its exact inverted copy.  R0 dropped the repeat before
+    cancelling the pair, so both copies of the void went and the body was answered ``exact`` 0.9375 m³ where
+    {w ≥ 1} = body − void = 0.90625 m³; R0 now counts each class of coincident faces with sign (a repeat adds, a
+    reverse cancels: net −1) before it decides, and one void stays."""
     boxes = [(np.array([-2, 1, -3]), np.array([3, 4, 1]), 1), (np.array([2, 2, -2]), np.array([4, 3, 0]), -1),
              (np.array([2, 2, -2]), np.array([4, 3, 0]), -1), (np.array([2, 2, -2]), np.array([4, 3, 0]), 1)]
     assert _judge(boxes) is None

@@ -36,12 +36,13 @@ builds it:
    surface is closed and consistently wound, and no two of its faces cross (:func:`~.intersect.surface_contacts`
    again, exact).
 
-Before step 1, a face written together with its reverse (the same three vertices, opposite cyclic order) is
-taken out as a pair (:func:`_cancel_reversed`): the two are one triangle with opposite orientations, so their
-contributions cancel exactly in every surface integral and in the winding number at every point off that triangle,
-and ``{w ≥ 1}`` changes by a set of measure zero; every directed edge stays matched by its reverse.  Left in, the
-pair would be a patch every point of which lies on the other face of the pair, where no winding number can be
-certified (issue 23: Barkour v0's ``upper_right_2.stl``, four such pairs).
+Before step 1, a face written together with its reverse (the same three vertices, opposite cyclic order) is taken
+out as a pair (:func:`~.policy.cancel_opposite`, R0's count with sign, written once for R0 and both arrangements):
+the two are one triangle with opposite orientations, so their contributions cancel exactly in every surface integral
+and in the winding number at every point off that triangle, and ``{w ≥ 1}`` changes by a set of measure zero; every
+directed edge stays matched by its reverse. Left in, the pair would be a patch every point of which lies on the
+other face of the pair, where no winding number can be certified (issue 23: Barkour v0's ``upper_right_2.stl``, four
+such pairs).
 
 Degenerate crossings (a corner in the plane of a face it crosses, an edge through another edge or a corner,
 coplanar overlapping faces, two crossing curves meeting on an edge) are refused with the reason
@@ -53,16 +54,17 @@ from __future__ import annotations
 from fractions import Fraction
 from collections.abc import Callable
 from itertools import combinations
-from typing import TypeVar
+from typing import NamedTuple, TypeVar
 
 import numpy as np
 
 from ..errors import ArrangementError
-from ..tolerances import ARRANGE_MERGE_RTOL
+from ..tolerances import ARRANGE_MERGE_RTOL, ROUNDOFF_RTOL
 from ..values import frozen_value
 from .checks import edge_topology
 from .edges import edge_keys
 from .intersect import _integers, orient3d_sign, surface_contacts
+from .policy import cancel_opposite
 
 __all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells", "WINDING_MARGIN",
            "MAX_EXACT_RAY_WORK"]
@@ -121,7 +123,10 @@ class Arrangement:
         Intersection points merged into a neighbour within ``tolerances.ARRANGE_MERGE_RTOL`` of the diagonal
         because, rounded, they left faces crossing (see :func:`_merge_close_points`).
     cancelled_faces : int
-        Input faces taken out as pairs of a face and its reverse before arranging (:func:`_cancel_reversed`).
+        Input faces taken out as pairs of a face and its reverse before arranging (:func:`~.policy.cancel_opposite`).
+    rounding : (float, float, float)
+        What rounding the new points (and merging them) may change in the result (:func:`rounded_points_bounds`);
+        the arrangement is refused above half of ``ROUNDOFF_RTOL``.
     """
 
     vertices: np.ndarray
@@ -135,6 +140,7 @@ class Arrangement:
     turned: bool = False
     merged_points: int = 0
     cancelled_faces: int = 0
+    rounding: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 # -- exact helpers ---------------------------------------------------------------------------------------------
@@ -552,7 +558,7 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
     """
     v = np.ascontiguousarray(vertices, dtype=np.float64)
     f = np.ascontiguousarray(faces, dtype=np.int64)
-    keep = _cancel_reversed(f)
+    keep = cancel_opposite(f)
     cancelled = int(len(f) - np.count_nonzero(keep))
     if cancelled:
         remap = np.cumsum(keep) - 1
@@ -589,6 +595,8 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
         out_v[:len(v)] = v
         turned = True
     result_v, result_f = _compact(out_v, kept)
+    moved = np.unique(kept) >= len(v)                 # the result's vertices that are new points (rounded)
+    merged_faces, merged_shift = np.zeros(len(result_f), dtype=bool), 0.0
     topo = edge_topology(result_f, len(result_v))
     if not topo.oriented:
         raise ArrangementError(f"the surface of winding number ≥ 1 is not closed ({topo.boundary_edges} open, "
@@ -598,59 +606,91 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
         raise ArrangementError("the face-intersection check of the surface of winding number ≥ 1 did not finish")
     merged = 0
     if len(after.crossing):
-        merged_v, merged_f, merged = _merge_close_points(out_v, kept, len(v))
+        merged_v, merged_f, merged, took = _merge_close_points(out_v, kept, len(v))
         if merged and edge_topology(merged_f, len(merged_v)).oriented:
             rechecked = surface_contacts(merged_v, merged_f)
             if rechecked.complete and len(rechecked.crossing) < len(after.crossing):
                 result_v, result_f, after = merged_v, merged_f, rechecked
+                moved, merged_faces, merged_shift = took.new, took.faces, took.shift
             else:
                 merged = 0
         else:
             merged = 0
+    new = out_v[len(v):]
+    delta = 0.5 * float(np.max(np.spacing(np.abs(new)))) if len(new) else 0.0
+    if turned and len(new):                           # turned there and back: a few roundings of |x − centre| each
+        delta += 8 * 2.0 ** -53 * float(np.max(np.abs(new - centre)))
+    tiers = [(moved[result_f].any(axis=1), delta)]
+    if merged:                                        # faces that had a merged point: moved by the merge too
+        tiers.append((merged_faces, merged_shift + delta))
+    rounding = rounded_points_bounds(result_v, result_f, tiers)
     return Arrangement(vertices=result_v, faces=result_f, crossings_left=len(after.crossing), turned=turned,
-                       merged_points=merged, cancelled_faces=cancelled, **stats)
+                       merged_points=merged, cancelled_faces=cancelled, rounding=rounding, **stats)
 
 
-def _cancel_reversed(faces: np.ndarray) -> np.ndarray:
-    """(m,) bool: the faces kept once every face written with its reverse (the same three vertex ids in opposite
-    cyclic order) is taken out with it, pair by pair (``k`` copies one way and ``j`` the other leave ``|k − j|``).
+def rounded_points_bounds(vertices: np.ndarray, faces: np.ndarray,
+                          tiers: list[tuple[np.ndarray, float]]) -> tuple[float, float, float]:
+    """What the rounding of an arrangement's new points may change in its result: ``(volume relative, centroid m,
+    inertia relative)``, the sum over ``tiers`` of :func:`~.precision.conversion_bounds` over the tier's faces (the
+    others are the input's own), every moved corner within the tier's ``delta`` of its exact position; refused
+    (:class:`~inertia_tool.errors.ArrangementError`) above half of ``ROUNDOFF_RTOL`` of the result, the other half
+    left to the integrals' round-off (R7), so that ``united`` keeps what "exact" means (review 12's R8: the coplanar
+    overlay's points 1.5e8 m out, uncounted, left a union 2.3e-7 off).
 
-    The pair is the zero chain: its two faces' terms cancel exactly in the divergence-theorem sums (Rigid Body
-    Motion, Ch. 4) and in the solid-angle sum of the winding number at every point off the triangle, so
-    ``{w ≥ 1}`` is the same up to the triangle itself (measure zero); each directed edge loses one use and so
-    does its reverse, so a closed surface stays closed."""
-    f = np.asarray(faces, dtype=np.int64)
-    keep = np.ones(len(f), dtype=bool)
-    if len(f) < 2:
-        return keep
-    canon = np.sort(f, axis=1)
-    _, key, count = np.unique(canon, axis=0, return_inverse=True, return_counts=True)
-    key = key.reshape(-1)
-    repeated = np.flatnonzero(count[key] > 1)
-    if not len(repeated):
-        return keep
-    even = _cyclic_parity(f[repeated])
-    groups: dict[int, tuple[list[int], list[int]]] = {}
-    for idx, k, e in zip(repeated.tolist(), key[repeated].tolist(), even.tolist()):
-        groups.setdefault(k, ([], []))[0 if e else 1].append(idx)
-    for one_way, other_way in groups.values():
-        pairs = min(len(one_way), len(other_way))
-        keep[one_way[:pairs]] = False
-        keep[other_way[:pairs]] = False
-    return keep
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+        The result, closed.
+    tiers : list of ((m,) bool, float)
+        Faces moved (at a rounded new point; that had a point merged away) and ``delta``, m, the largest distance
+        of their moved corners from their exact positions, per coordinate.
+    """
+    total = [0.0, 0.0, 0.0]
+    whole = None
+    n_moved = 0
+    for at, delta in tiers:
+        at = np.asarray(at, dtype=bool)
+        if not (at.any() and delta > 0):
+            continue
+        from ..integrals import volume_moments
+        from .precision import conversion_bounds
+        whole = whole if whole is not None else volume_moments(vertices, faces)
+        part = conversion_bounds(vertices, faces[at], delta, whole.volume, whole.centroid, whole.second_moment)
+        total = [a + b for a, b in zip(total, part)]
+        n_moved += int(np.count_nonzero(at))
+    worst = max(total[0], total[2])
+    if not worst <= 0.5 * ROUNDOFF_RTOL:
+        raise ArrangementError(f"its new points, rounded to float64 ({n_moved:,} faces at them; by up to "
+                               f"{max(d for _, d in tiers):.2g} m a coordinate), may change the result by "
+                               f"{worst:.2g} of it, above the {0.5 * ROUNDOFF_RTOL:g} a certified union allows (a "
+                               "part small against its distance from the origin)")
+    return total[0], total[1], total[2]
 
 
-def _merge_close_points(vertices: np.ndarray, faces: np.ndarray, n_input: int) -> tuple[np.ndarray, np.ndarray, int]:
+class _Merged(NamedTuple):
+    """What :func:`_merge_close_points` moved: ``new`` (n,) bool, the output's vertices that are new points;
+    ``faces`` (m,) bool, the output's faces that had a point merged away; ``shift`` m, the largest coordinate
+    difference of a merged point and the one it went into."""
+
+    new: np.ndarray
+    faces: np.ndarray
+    shift: float
+
+
+def _merge_close_points(vertices: np.ndarray, faces: np.ndarray,
+                        n_input: int) -> tuple[np.ndarray, np.ndarray, int, _Merged]:
     """Merge intersection points (ids ≥ ``n_input``) lying within ``ARRANGE_MERGE_RTOL`` of the diagonal of
     another point of the surface (into the input's vertex when there is one), drop the faces that collapse and
-    pairs of faces left as one face and its reverse; return the compacted surface and the count merged."""
+    pairs of faces left as one face and its reverse (:func:`~.policy.cancel_opposite`); return the compacted
+    surface, the count merged, and what moved (:class:`_Merged`, for :func:`rounded_points_bounds`)."""
     lo, hi = vertices[faces.reshape(-1)].min(axis=0), vertices[faces.reshape(-1)].max(axis=0)
     limit = ARRANGE_MERGE_RTOL * float(np.linalg.norm(hi - lo))
     from scipy.spatial import cKDTree
     used = np.unique(faces)
     new = used[used >= n_input]
     if not len(new):
-        return vertices, faces, 0
+        return vertices, faces, 0, _Merged(np.zeros(0, dtype=bool), np.zeros(0, dtype=bool), 0.0)
     near = cKDTree(vertices[used]).query_ball_point(vertices[new], r=limit)
     a = np.repeat(new, [len(n) for n in near])
     b = used[np.concatenate([np.asarray(n, dtype=np.int64) for n in near])] if len(a) else a
@@ -671,24 +711,18 @@ def _merge_close_points(vertices: np.ndarray, faces: np.ndarray, n_input: int) -
             target[drop] = keep
             merged += 1
     if not merged:
-        return vertices, faces, 0
+        return vertices, faces, 0, _Merged(np.zeros(0, dtype=bool), np.zeros(0, dtype=bool), 0.0)
     final = np.array([root(i) for i in range(len(vertices))])
+    gone = final != np.arange(len(vertices))
+    shift = float(np.max(np.abs(vertices[gone] - vertices[final[gone]])))
     f = final[faces]
-    f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 2] != f[:, 0])]
-    canon = np.sort(f, axis=1)
-    parity = _cyclic_parity(f)
-    key = np.unique(canon, axis=0, return_inverse=True)[1].reshape(-1)
-    net = np.bincount(key, weights=np.where(parity, 1, -1))
-    count = np.bincount(key)
-    f = f[~((count[key] == 2) & (net[key] == 0))]          # a face and its reverse: a sheet of no volume
+    had = gone[faces].any(axis=1)                           # a face that had a point merged away has moved
+    alive = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 2] != f[:, 0])
+    f, had = f[alive], had[alive]
+    stay = cancel_opposite(f)                               # a face and its reverse: the zero chain
+    f, had = f[stay], had[stay]
     out_v, out_f = _compact(vertices, f)
-    return out_v, out_f, merged
-
-
-def _cyclic_parity(faces: np.ndarray) -> np.ndarray:
-    """(m,) bool: each face's corners are an even (cyclic) permutation of their sorted order."""
-    order = np.argsort(faces, axis=1)
-    return np.asarray([(o[0], o[1], o[2]) in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) for o in order.tolist()])
+    return out_v, out_f, merged, _Merged(np.unique(f) >= n_input, had, shift)
 
 
 def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple[np.ndarray, np.ndarray,

@@ -7,12 +7,19 @@ the surface bounds it exactly once).
 
 Rules
 -----
-R0 *A shell listed twice is one solid* (:func:`coincident_surfaces`).  A closed surface that repeats another
-   corner for corner (the same float64 coordinates, bit for bit, in the same cyclic order; with the same
-   vertex indices or its own) is counted once, with a note naming how many faces were left out.  A closed
-   surface listed together with its exact inverted copy has winding number 0 everywhere: the pair is left out
-   (a mesh that is nothing else is refused with that reason).  Reason: a shell exported twice means the part
-   once; summed, its volume counts twice, and united it only shows as a false overlap.
+R0 *A shell listed twice is one solid* (:func:`coincident_surfaces`).  Coincident copies combine by their
+   windings first: the faces on the same three points (the same float64 coordinates, bit for bit; with the same
+   vertex indices or their own) are counted with sign, +1 one way round and −1 the other
+   (:func:`signed_multiplicity`; a repeat adds, a reverse cancels), and only then decided: a net 0 leaves the
+   face out, a net ±k keeps one face wound by its sign.  A face and its reverse are the zero chain (their terms
+   cancel exactly in every surface integral and in the winding number), so cancelling changes nothing; a net ±2
+   or more counted once is the rule's policy (a closed surface that repeats another corner for corner is
+   counted once, with a note naming how many faces were left out).  A closed surface listed together with its
+   exact inverted copy has winding number 0 everywhere: the pair is left out (a mesh that is nothing else is
+   refused with that reason); a void listed twice with its inverted copy keeps one void (net −1; dropping the
+   repeat first lost both).  Only whole closed surfaces go.  The arrangements take out face pairs by the same
+   count (:func:`cancel_opposite`).  Reason: a shell exported twice means the part once; summed, its volume counts
+   twice, and united it only shows as a false overlap.
    *Up to rounding* (:func:`near_copies`): a closed surface whose every corner lies within
    ``tolerances.COINCIDENT_RTOL`` of the largest |coordinate| of a corner of another, face for face with the same
    winding (a copy whose coordinates were computed apart), is counted once too, when the bound on what it could
@@ -207,7 +214,7 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
            "near_copies", "NearCopies", "near_copies_message", "MisreadNesting", "misread_nesting",
            "outward_crossing_groups", "container_windings",
-           "misread_message"]
+           "misread_message", "signed_multiplicity", "cancel_opposite"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -965,15 +972,90 @@ def _doubled_closed(faces: np.ndarray, n_vertices: int) -> bool:
     return bool(np.all(count >= 4))
 
 
+def signed_multiplicity(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The faces on the same three points, and which way round each is: R0's count and the arrangements' (one rule).
+
+    Parameters
+    ----------
+    corners : (m, 3) int
+        Each face's corners as ids of distinct points (vertex ids of a welded surface, or ids of exact coordinates).
+
+    Returns
+    -------
+    cls : (m,) int
+        The class of each face (faces on the same three points share it), numbered from 0; −1 for a face with two
+        equal corners (no triangle, no orientation).
+    sign : (m,) int
+        +1 or −1: the face's cyclic order is the class's own (from its smallest point, rising) or the reverse.
+        The winding number changes across the triangle by the class's net multiplicity ``Σ sign`` (Rigid Body
+        Motion, Ch. 4: each face is one term of the divergence-theorem sums, and a face and its reverse are the
+        zero chain, their terms cancelling exactly).
+    """
+    g = np.asarray(corners, dtype=np.int64).reshape(-1, 3)
+    cls = np.full(len(g), -1, dtype=np.int64)
+    sign = np.zeros(len(g), dtype=np.int64)
+    if not len(g):
+        return cls, sign
+    rows = np.arange(len(g))[:, None]
+    start = np.argmin(g, axis=1)[:, None]
+    key = g[rows, (start + np.arange(3)) % 3]                       # from the smallest point, same cycle
+    ok = (key[:, 0] != key[:, 1]) & (key[:, 1] != key[:, 2]) & (key[:, 0] != key[:, 2])
+    if ok.any():
+        _, code = np.unique(np.sort(key[ok], axis=1), axis=0, return_inverse=True)
+        cls[ok] = code.reshape(-1)
+        sign[ok] = np.where(key[ok, 1] < key[ok, 2], 1, -1)
+    return cls, sign
+
+
+def cancel_opposite(corners: np.ndarray) -> np.ndarray:
+    """(m,) bool: the faces kept once every face on the same three points as a face wound the other way is taken
+    out with it, pair by pair (``k`` one way and ``j`` the other leave ``|k − j|``, the first listed; classes by
+    :func:`signed_multiplicity`).
+
+    A pair is the zero chain: its terms cancel exactly in the divergence-theorem sums and in the solid-angle sum
+    of the winding number at every point off the triangle, so ``{w ≥ 1}`` is the same up to the triangle itself
+    (measure zero); on a welded surface (``corners`` vertex ids) each directed edge loses one use and so does its
+    reverse, so a closed surface stays closed."""
+    cls, sign = signed_multiplicity(corners)
+    keep = np.ones(len(cls), dtype=bool)
+    members = np.flatnonzero(cls >= 0)
+    if len(members) < 2:
+        return keep
+    order = members[np.lexsort((members, sign[members], cls[members]))]
+    c, s = cls[order], sign[order]
+    n_cls = int(c.max()) + 1
+    plus = np.bincount(c, weights=(s > 0), minlength=n_cls).astype(np.int64)
+    minus = np.bincount(c, weights=(s < 0), minlength=n_cls).astype(np.int64)
+    group = c * 2 + (s > 0)
+    first = np.r_[0, np.flatnonzero(group[1:] != group[:-1]) + 1]
+    rank = np.arange(len(order)) - np.repeat(first, np.diff(np.r_[first, len(order)]))
+    keep[order[rank < np.minimum(plus, minus)[c]]] = False
+    return keep
+
+
+def _point_ids(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(m, 3) int: each face's corners as ids of distinct exact coordinates (a copy with its own vertices gets the
+    same ids)."""
+    used, local = np.unique(faces, return_inverse=True)
+    _, point = np.unique(np.asarray(vertices, dtype=np.float64)[used], axis=0, return_inverse=True)
+    return np.asarray(point.reshape(-1)[local.reshape(-1)].reshape(-1, 3), dtype=np.int64)
+
+
 def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarray | None = None,
                         labels: np.ndarray | None = None) -> Coincident:
-    """R0: find closed surfaces listed twice (same winding) or with their exact inverted copy (opposite winding).
+    """R0: closed surfaces listed more than once, each way round, combined by their windings.
 
     Faces are compared by the exact coordinates of their corners (bit for bit; a copy may use its own vertex
-    indices or the same ones), each face taken from its smallest corner on in its own cyclic order.  A set of
-    repeated faces is left out only when it is closed and balanced on its own (a whole shell, not a face that two
-    overlapping bodies happen to share); a cancelling pair only when each member is closed and balanced and the
-    other's faces are exactly its reverses, so what stays is as closed as before.
+    indices or the same ones).  The faces on the same three points form a class; a face counts ``+1`` wound one
+    way and ``−1`` the other, and the class's net multiplicity ``n`` is what the winding number changes by across
+    that triangle (a repeat adds, a reverse cancels: :func:`signed_multiplicity`).  Every class keeps one face
+    wound by the sign of ``n`` (the one in the lowest-numbered shell) and none when ``n = 0``; the rest are left
+    out.  Left out with them: pairs of opposite faces (a zero chain: nothing changes in any surface integral nor
+    in the winding number off the triangle) and, where ``|n| ≥ 2``, the repeats beyond one (the shell listed twice
+    counted once).  Only whole closed surfaces go: the faces left out must make closed, balanced pieces (a face
+    that two overlapping bodies happen to share stays), and a piece holding both members of a pair must use
+    every edge at least four times (a closed surface and its reverse on the same vertices, not a flat sheet written
+    both ways, which is R2's); the classes of a piece that fails are left as they are.
 
     Parameters
     ----------
@@ -993,57 +1075,60 @@ def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarr
     if len(idx) < 8:                       # a closed surface has at least 4 faces, two of them at least 8
         return none
     f = np.asarray(faces, dtype=np.int64)[idx]
-    used, local = np.unique(f, return_inverse=True)
-    _, point = np.unique(np.asarray(vertices, dtype=np.float64)[used], axis=0, return_inverse=True)
-    g = point.reshape(-1)[local.reshape(-1)].reshape(-1, 3)         # corners as ids of distinct points
-    rows = np.arange(len(g))[:, None]
-    start = np.argmin(g, axis=1)[:, None]
-    key = g[rows, (start + np.arange(3)) % 3]                       # from the smallest corner, same cycle
-    rev = key[:, [0, 2, 1]]                                         # the same face wound the other way
-    _, code = np.unique(np.concatenate([key, rev]), axis=0, return_inverse=True)
-    code = code.reshape(-1)
-    fwd, back = code[:len(g)], code[len(g):]
-    shell = np.zeros(len(g), dtype=np.int64) if labels is None else np.asarray(labels, dtype=np.int64)[idx]
-    order = np.lexsort((shell, fwd))
-    later = np.zeros(len(g), dtype=bool)
-    later[order[1:]] = fwd[order[1:]] == fwd[order[:-1]]            # a repeat of an earlier face
+    shell = np.zeros(len(f), dtype=np.int64) if labels is None else np.asarray(labels, dtype=np.int64)[idx]
+    cls, sign = signed_multiplicity(_point_ids(vertices, f))
+    members = np.flatnonzero(cls >= 0)
+    if not len(members):
+        return none
+    order = members[np.lexsort((members, shell[members], sign[members], cls[members]))]   # class, way, shell, face
+    c, s = cls[order], sign[order]
+    n_cls = int(c.max()) + 1
+    plus = np.bincount(c, weights=(s > 0), minlength=n_cls).astype(np.int64)
+    minus = np.bincount(c, weights=(s < 0), minlength=n_cls).astype(np.int64)
+    net = plus - minus
+    # rank of each face among the faces of its class wound the same way (0 for the first, in shell order)
+    group = c * 2 + (s > 0)
+    start = np.r_[0, np.flatnonzero(group[1:] != group[:-1]) + 1]
+    rank = np.arange(len(order)) - np.repeat(start, np.diff(np.r_[start, len(order)]))
+    kept = (s == np.sign(net[c])) & (rank == 0)
+    pairs = np.minimum(plus, minus)[c]
+    cancel = ~kept & ((s != np.sign(net[c])) | (rank <= pairs))                 # a member of an opposite pair
+    candidate = ~kept & ((plus + minus)[c] >= 2)
     n_v = len(vertices)
-    repeated = repeated_faces = 0
-    if later.any():
-        members = np.flatnonzero(later)
-        comp, closed = _closed_components(f, members, n_v)
-        gone = members[closed[comp]]
-        drop[idx[gone]] = True
-        repeated, repeated_faces = int(np.count_nonzero(closed)), len(gone)
-    cancelled = cancelled_faces = 0
-    first_of = np.full(int(code.max()) + 1, -1, dtype=np.int64)
-    alive = np.flatnonzero(~later)
-    first_of[fwd[alive]] = alive
-    partner = first_of[back]                                         # a face of the reverse, or -1
-    paired = np.flatnonzero((partner >= 0) & ~later)
-    if len(paired):
-        comp, closed = _closed_components(f, paired, n_v)
-        comp_of = np.full(len(g), -1, dtype=np.int64)
-        comp_of[paired] = comp
-        size = np.bincount(comp)
-        other = comp_of[partner[paired]]
-        ok = closed.copy()
-        for c in range(len(closed)):                                 # bounded by the number of components
-            mine = other[comp == c]
-            if not ok[c] or np.any(mine < 0) or np.any(mine != mine[0]) or size[mine[0]] != size[c] \
-                    or not closed[mine[0]]:
-                ok[c] = False
-            elif mine[0] == c:       # both members in one piece: a doubled closed surface, not a flat sheet (R2)
-                ok[c] = _doubled_closed(f[paired[comp == c]], n_v)
-        gone = paired[ok[comp]]
-        drop[idx[gone]] = True
-        twin = np.array([other[comp == c][0] for c in range(len(closed))], dtype=np.int64)
-        cancelled = int(np.count_nonzero(ok & (twin >= np.arange(len(closed)))))   # each pair once
-        cancelled_faces = len(gone)
-    where = np.asarray(vertices, dtype=np.float64)[faces[np.flatnonzero(drop)[0], 0]] if drop.any() \
-        else np.full(3, np.nan)
-    return Coincident(drop=drop, repeated=repeated, repeated_faces=repeated_faces, cancelled=cancelled,
-                      cancelled_faces=cancelled_faces, where=where)
+    touchable = np.ones(n_cls, dtype=bool)
+    gone = np.zeros(0, dtype=np.int64)
+    comp = np.zeros(0, dtype=np.int64)
+    both = np.zeros(0, dtype=bool)
+    for _ in range(n_cls + 1):             # each pass leaves at least one more class as it is, or ends
+        out = np.flatnonzero(candidate & touchable[c])               # positions in ``order``
+        gone = order[out]
+        if not len(gone):
+            break
+        comp, closed = _closed_components(f, gone, n_v)
+        # a piece holding both members of a pair (a class wound both ways in it) is a closed surface and its
+        # reverse on the same vertices only when every edge is used at least four times (else a sheet, R2's)
+        signs_in = np.unique(np.stack([comp, c[out], s[out]], axis=1), axis=0)
+        _, per_class = np.unique(signs_in[:, :2], axis=0, return_counts=True)
+        pieces_of = np.unique(signs_in[:, :2], axis=0)[:, 0]
+        both = np.zeros(len(closed), dtype=bool)
+        both[pieces_of[per_class > 1]] = True
+        for k in np.flatnonzero(both & closed).tolist():            # bounded by the number of pieces
+            closed[k] = _doubled_closed(f[gone[comp == k]], n_v)
+        bad = ~closed[comp]
+        if not bad.any():
+            break
+        touchable[np.unique(c[out][bad])] = False
+    if not len(gone):
+        return none
+    drop[idx[gone]] = True
+    role = cancel[out]                                               # a member of an opposite pair
+    repeated = int(np.count_nonzero(np.bincount(comp, weights=role.astype(np.float64)) == 0))
+    paired = np.zeros(len(both), dtype=bool)
+    paired[comp[role]] = True
+    cancelled = int(np.count_nonzero(paired & both)) + (int(np.count_nonzero(paired & ~both)) + 1) // 2
+    where = np.asarray(vertices, dtype=np.float64)[faces[np.flatnonzero(drop)[0], 0]]
+    return Coincident(drop=drop, repeated=repeated, repeated_faces=int(np.count_nonzero(~role)),
+                      cancelled=cancelled, cancelled_faces=int(np.count_nonzero(role)), where=where)
 
 
 def coincident_message(found: Coincident) -> str:
