@@ -273,7 +273,8 @@ def _swept_faces(vertices: np.ndarray, faces: np.ndarray,
     lo = hi = None
     for start in range(0, len(faces), _CHUNK):
         f = faces[start:start + _CHUNK]
-        d = reach[f].max(axis=1)
+        r = reach[f]
+        d = np.maximum(np.maximum(r[:, 0], r[:, 1]), r[:, 2])     # (a reduce along axis 1 of 3 is slower)
         hit = d > 0
         if not hit.any():
             continue
