@@ -102,3 +102,21 @@ def test_a_weld_that_collapses_a_thin_plate_is_refused_in_one_line():
     message = str(caught.value)
     assert "welding corners closer than" in message and "collapses the part" in message
     assert "\n" not in message
+
+
+def test_a_welded_surface_that_passes_through_itself_is_united_then_bounded():
+    # R3's arrangement of a welded soup: the union is of the welded polyhedron, so the weld's sweep still counts
+    from solids import figure_eight
+
+    v, f = figure_eight(steps=32, sections=8)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        clean = mass_properties((v, f), density=1.0)
+        soup_v, soup_f = _soup(np.asarray(v, dtype=float), np.asarray(f), 1e-9, seed=3)
+        got = mass_properties((soup_v, soup_f), density=1.0, repair=True)
+    assert clean.mesh.certificate.kind == "united"
+    assert got.mesh.certificate.kind == "estimate" and got.mesh.method == "welded"
+    u = got.mesh.uncertainty
+    assert 0 < u.mass < 1e-5
+    assert abs(got.mass - clean.mass) <= u.mass * clean.mass
+    assert np.linalg.norm(got.center_of_mass - clean.center_of_mass) <= u.center_of_mass
