@@ -2,7 +2,10 @@
 :data:`~.policy.CERTIFICATE_KINDS`), and a patched surface's bound.
 
 "exact" is given only when the checks that make it exact ran and passed: the edge census, the exact face-pair
-check (complete, nothing crossing), and the float64 round-off of the integrals within ``ROUNDOFF_RTOL``.
+check (complete, nothing crossing), and the float64 round-off of the integrals within ``ROUNDOFF_RTOL`` — with
+what a unit conversion's rounding and a tolerance weld's moves may change (``B_w`` of :mod:`.precision`, review
+12's R4) counted in it.  A weld whose moves exceed that budget makes the result an estimate within their bound,
+or a refusal when the bound is not useful (it collapses a thin part).
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ..errors import InsideOutWarning
+from ..errors import InsideOutWarning, InvalidMeshError
 from ..integrals import total_roundoff, total_roundoff_parts
 from ..rounding import round_up
 from ..tolerances import ESTIMATE_MAX_MASS_RTOL, ROUNDOFF_RTOL
@@ -21,10 +24,12 @@ from .shells import Shells, flipped_text, total
 
 if TYPE_CHECKING:
     from .classify import Orientation
+    from .precision import WeldSweep
+    from .resolve import Resolution
     from .uncertainty import Estimate, Uncertainty
     from .unite import United
 
-__all__ = ["Certified", "first_checks", "certify", "misread_reading"]
+__all__ = ["Certified", "first_checks", "certify", "misread_reading", "with_weld_doubt"]
 
 
 class Certified(NamedTuple):
@@ -52,6 +57,36 @@ class Certified(NamedTuple):
 _R4_WHY = ("a shell wound outward lies inside another, the file does not say whether it is a body or a cavity, and "
            "the two readings are that far apart; wind the inner shell inward if it is a cavity, or unite the bodies "
            "in a mesh editor if it is a body")
+
+#: What to do when a tolerance weld moved the surface too far to bound the result usefully.
+_WELD_WHY = ("the weld moved corners farther than the result can be bounded from; mesh the part with its vertices "
+             "shared (or its thin walls thicker than the weld), or lower `merge_tolerance` (0 disables the weld)")
+
+
+def _weld_refusal(weld: WeldSweep, volume: float, source: str) -> str:
+    """One line: a weld whose sweep ``B_w`` reaches the whole volume (it may have collapsed the part)."""
+    return (f"{source}: welding corners closer than {round_up(weld.tolerance):.3g} m collapses the part: the weld "
+            f"moved corners by up to {round_up(weld.largest_move):.3g} m, and the solid the file's corners bound "
+            f"may differ from the welded one by {round_up(weld.volume, 2):.2g} m³, against a welded volume of "
+            f"{volume:.3g} m³; " + _WELD_WHY.split("; ", 1)[1])
+
+
+def with_weld_doubt(forced: Resolution, weld: WeldSweep | None, source: str) -> Resolution:
+    """A winding-number estimate forced on a surface the tolerance weld formed (R1b, R3, R6 after step 3 of
+    :mod:`.resolve`), with the weld's sweep added to its doubt: the grid bounds its distance from the welded
+    solid only (as :func:`~.self_crossing.with_patch_doubt` adds a patched surface's).  Unchanged without a
+    sweep; refused when the sum is not useful."""
+    if weld is None or forced.estimate is None:
+        return forced
+    import dataclasses
+
+    from .precision import estimate_with_weld, weld_note
+    from .uncertainty import check_useful
+    est = estimate_with_weld(forced.estimate, weld)
+    check_useful(est.volume, est.uncertainty, source=source,
+                 what=f"the surface welded within {round_up(weld.tolerance):.3g} m", why=_WELD_WHY)
+    return dataclasses.replace(forced, estimate=est, notes=forced.notes + (weld_note(weld),))
+
 
 def first_checks(touch: ShellContacts, unverified: str | None) -> tuple[str, list[str]]:
     """The certificate kind and checks before the boolean (R5, R6): exact when the face-pair check finished and no
@@ -135,7 +170,8 @@ def _turned(found: MisreadNesting, oriented: Orientation) -> str:
 
 def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patched: Estimate | None,
             arranged: bool, verified: bool, ambiguous: bool, folds: bool, sheets_removed: bool,
-            source: str, spread: tuple[float, float] | None = None, scale_rounding: float = 0.0) -> Certified:
+            source: str, spread: tuple[float, float] | None = None, scale_rounding: float = 0.0,
+            weld: WeldSweep | None = None) -> Certified:
     """R7 and what each earlier stage implies for the certificate of ``shells``.
 
     Parameters
@@ -161,6 +197,12 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         m: how far the reader's unit conversion moved a coordinate (:attr:`~.read.RawMesh.scale_rounding`): the
         solid integrated may differ from the file's by :func:`~.precision.conversion_bounds`, counted with the
         round-off (review 12's R6: a 47.5 nm plate in mm 1.3e8 m out was 2.3 % off, labelled exact).
+    weld : WeldSweep or None
+        What a tolerance weld that moved corners may have changed (:func:`~.precision.weld_sweep`; review 12's
+        R4: a 3 nm plate welded shut was 33 % low, labelled exact).  Within the round-off budget the label
+        stands, with a note; beyond it an ``exact`` or ``united`` result becomes an estimate within the weld's
+        bound (added to a patched surface's or R4's doubt), refused when that bound is not useful; an
+        ``unverified`` one stays so, with the note.
     """
     notes: list[str] = []
     checks = list(checks)
@@ -171,7 +213,22 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         whole = total(shells.moments)
         converted = conversion_bounds(shells.vertices, shells.faces, scale_rounding, whole.volume, whole.centroid,
                                       whole.second_moment)
-    if patched is None:                                                          # R7: exact up to round-off
+    welded = None                 # R4's weld: (volume in doubt m³, reach m) when beyond the round-off budget
+    if weld is not None:
+        from .precision import weld_note, weld_reach
+        from .uncertainty import uncertainty_from
+        whole = total(shells.moments)
+        reach = weld_reach(weld, whole.centroid)
+        share = uncertainty_from(whole.volume, whole.centroid, whole.second_moment, weld.volume, reach)
+        relative = max(share.mass, share.inertia)
+        if patched is None and roundoff + max(converted[0], converted[2]) + relative <= ROUNDOFF_RTOL:
+            notes.append(weld_note(weld, relative))          # proven within the budget: the label stands
+        else:
+            welded = (weld.volume, reach)
+            notes.append(weld_note(weld))
+            if kind in ("exact", "united") and not weld.volume < abs(float(whole.volume)):
+                raise InvalidMeshError(_weld_refusal(weld, float(whole.volume), source))
+    if patched is None and (welded is None or kind not in ("exact", "united")):   # R7: exact up to round-off
         moved = max(converted[0], converted[2])
         if roundoff + moved > ROUNDOFF_RTOL and kind in ("exact", "united"):
             kind = "unverified"
@@ -193,6 +250,8 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         doubt, far = patched.uncertainty.volume_in_doubt, patched.far
         if spread is not None:                # R4: the reading the file does not decide is in doubt as well
             doubt, far = doubt + spread[0], max(far, spread[1])
+        if welded is not None:                # the weld's sweep as well (triangle inequality)
+            doubt, far = doubt + welded[0], max(far, welded[1])
         uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, doubt, far),
                                     _plus(total_roundoff_parts(shells.moments, shells.bound), converted))
         what = "the patched surface" + (" and a shell wound outward inside another" if spread is not None else "")
@@ -211,12 +270,24 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         from .uncertainty import uncertainty_from
         whole = total(shells.moments)
         from .uncertainty import check_useful, with_roundoff
-        uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, *spread),
+        doubt, far = spread
+        if welded is not None:                # the weld's sweep as well (triangle inequality)
+            doubt, far = doubt + welded[0], max(far, welded[1])
+        uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, doubt, far),
                                     _plus(total_roundoff_parts(shells.moments, shells.bound), converted))
         # the same ±50 % limit as every estimate (holes6's review: two crossing outward cubes inside a cube were
         # answered at ±61.5 % mass)
         check_useful(whole.volume, uncertainty, source=source, what="the reading by nesting depth", why=_R4_WHY)
         kind, method = "estimate", "nesting"      # a reading by nesting depth, not the surface integral proven
+    elif welded is not None and kind in ("exact", "united"):        # R4's weld: the welded solid, bounded
+        from .uncertainty import check_useful, uncertainty_from, with_roundoff
+        whole = total(shells.moments)
+        uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, *welded),
+                                    _plus(total_roundoff_parts(shells.moments, shells.bound), converted))
+        check_useful(whole.volume, uncertainty, source=source,
+                     what=f"the surface welded within {round_up(weld.tolerance if weld else 0.0):.3g} m",
+                     why=_WELD_WHY)
+        kind = "estimate"                     # the welded polyhedron, within the weld's sweep of the file's
     if arranged:                              # R3: the arrangement's surface, checked like any other
         method = "union" if method == "exact" else method
         kind = {"exact": "united"}.get(kind, kind)

@@ -32,11 +32,15 @@ class Merge:
         Vertices replaced by a representative.
     largest_move : float
         Largest distance between a vertex and its representative, in the units of the vertices.
+    representative : (n,) int or None
+        The vertex each vertex was merged onto (itself when it did not move); None when nothing merged.  The
+        certificate bounds what the moves changed from it (:func:`~.precision.weld_sweep`).
     """
 
     faces: np.ndarray
     merged_vertices: int
     largest_move: float
+    representative: np.ndarray | None = None
 
 
 def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: float, *,
@@ -77,7 +81,7 @@ def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: flo
         block = moved[start:start + _MOVE_BLOCK]
         largest = float(np.max((largest, np.max(np.linalg.norm(points[block] - points[lowest[block]], axis=1)))))
     return Merge(faces=representative[faces].astype(faces.dtype), merged_vertices=len(moved),
-                 largest_move=largest)
+                 largest_move=largest, representative=representative)
 
 
 def lowest_in_group(points: np.ndarray, tolerance: float) -> np.ndarray | None:

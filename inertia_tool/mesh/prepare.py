@@ -28,7 +28,7 @@ from ..errors import InternalInvariantError, InvalidMeshError, UsageError
 from ..integrals import VolumeMoments, bounding_box
 from ..tolerances import MERGE_TOLERANCE
 from ..values import frozen_value
-from .certify import certify, first_checks, misread_reading
+from .certify import certify, first_checks, misread_reading, with_weld_doubt
 from .checks import MeshReport
 from .classify import orient_shells
 from .policy import Certificate
@@ -128,9 +128,10 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                         centre=0.5 * (surface.lo + surface.hi) if as_read else None, diag=diag, source=source)
     welded = settle_welded(first.shells, split_welded=split_welded, overlap=overlap, repair=repair, diag=diag,
                            source=source)                                                           # R1b
+    weld = surface.found.weld          # what the tolerance weld moved: a forced estimate's doubt too (R4)
     if welded.forced is not None:      # on a patched surface the patches' doubt is added (as R3's forced estimate)
         forced = welded.forced if patched is None else with_patch_doubt(welded.forced, patched, source)
-        return _estimated(forced, common)
+        return _estimated(with_weld_doubt(forced, weld, source), common)
     met = find_contacts(welded.shells, welded=welded.welded, patched=patched is not None,
                         split_welded=split_welded, n_read=len(raw.vertices), diag=diag, source=source)   # R3a
     if patched is not None:
@@ -138,7 +139,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     crossed = settle_self_crossing(met.shells, met.contacts, arranged=welded.arranged, self_crossing=self_crossing,
                                    overlap=overlap, repair=repair, patched=patched, diag=diag, source=source)  # R3
     if crossed.forced is not None:
-        return _estimated(crossed.forced, common)
+        return _estimated(with_weld_doubt(crossed.forced, weld, source), common)
     oriented = orient_shells(crossed.shells, crossed.contacts, crossed.touch, source=source)           # R4
     kind, checks = first_checks(oriented.touch, crossed.unverified)
     resolved_edges = found.nonmanifold_edges if met.folds is None and welded.arranged is None else None
@@ -147,7 +148,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                             source=source)                                                     # R5, R6
     if united.forced is not None:
         forced = united.forced if patched is None else with_patch_doubt(united.forced, patched, source)
-        return _estimated(forced, {**common, "overlapping_shells": united.overlaps})
+        return _estimated(with_weld_doubt(forced, weld, source), {**common, "overlapping_shells": united.overlaps})
     united, spread = misread_reading(oriented, united, method=found.method, source=source)     # R4's label
     shells = united.shells
     if not sum(s.volume for s in shells.moments) > 0:        # bodies and cavities cancel: no solid to certify
@@ -156,7 +157,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                         arranged=crossed.arranged is not None, verified=crossed.verified,
                         ambiguous=bool(oriented.ambiguous), folds=met.folds is not None,
                         sheets_removed=found.method == "sheets-removed", source=source, spread=spread,
-                        scale_rounding=raw.scale_rounding)                                                # R7
+                        scale_rounding=raw.scale_rounding, weld=weld)                                     # R7
     stages = (first.dropped, crossed.arranged, met.folds.describe() if met.folds is not None else None,
               crossed.unverified)
     notes = (*found.notes, *surface.coincident, *first.coincident, *oriented.notes,

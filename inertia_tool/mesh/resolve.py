@@ -13,8 +13,10 @@ a closed, consistently wound 2-manifold (clean meshes never come here).  In orde
    number puts every sheet inside — method ``"sheets-removed"``, exact without ``repair``.  A fin (a flat sheet
    outside) is only named in the refusal.
 3. *Welded*: vertices closer than ``merge_tolerance × diagonal`` are merged (a distance query, ``merge.py``),
-   collapsed faces dropped, orientation redone.  Exact for the welded polyhedron (which moved no vertex by
-   more than the stated distance) — method ``"welded"``.
+   collapsed faces dropped, orientation redone — method ``"welded"``.  The welded polyhedron is the file's solid
+   only when no corner moved: what the moves may change (:func:`~.precision.weld_sweep`, review 12's R4) is
+   handed on (``Resolution.weld``) and the certificate keeps ``exact`` only when it is within the round-off
+   budget; else the result is an estimate within it, or refused (a weld that collapses a thin part).
 4. Otherwise the file does not define a solid.  Without ``repair`` this refuses in one line (edges counted
    after welding) and says that ``repair=True`` gives a bounded estimate.  With ``repair``: duplicate faces
    are dropped (exact if that balances the surface — method ``"deduplicated"``), then one estimate of
@@ -38,6 +40,7 @@ from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
 from ..rounding import round_up
 
 if TYPE_CHECKING:
+    from .precision import WeldSweep
     from .uncertainty import Estimate
     from .orient import EdgeBalance
     from .sheets import OpenSheets
@@ -83,6 +86,9 @@ class Resolution:
         Edges shared by more than two faces in the surface integrated (bodies or walls touching).
     estimate : Estimate or None
         The bounded estimate (``"patched"``, ``"winding"``), else None.
+    weld : WeldSweep or None
+        What the tolerance weld moved (its bound ``B_w``, :func:`~.precision.weld_sweep`) when it moved a corner
+        and the result is not an estimate (an estimate carries it in its bounds); else None.
     """
 
     vertices: np.ndarray
@@ -93,6 +99,7 @@ class Resolution:
     welded_tolerance: float | None
     nonmanifold_edges: int
     estimate: Estimate | None = None
+    weld: WeldSweep | None = None
 
 
 @frozen_value
@@ -279,6 +286,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     # imported on use: a surface that passes the manifold check (nearly every file) never comes here
     from .uncertainty import check_useful
     from .merge import merge_close_vertices
+    from .precision import estimate_with_weld, weld_note, weld_sweep
     from .orient import edge_balance, orient_consistently
     from .seal import drop_duplicate_faces, on_edge_vertices
     v = np.asarray(vertices, dtype=np.float64)
@@ -330,6 +338,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         return Resolution(v, sheets.faces, "sheets-removed", notes, flipped, None, kept.nonmanifold_edges)
     fins = _fin_hint(sheets)              # a fin is no internal wall: named in the refusal; repair treats it below
     welded = None
+    sweep = None                          # what the tolerance weld moved (precision.weld_sweep), when it moved
     if merge_tolerance and merge_tolerance > 0:
         tol = merge_tolerance * diag
         # only vertices of unbalanced edges: merging vertices whose edges all balance cannot balance anything;
@@ -344,6 +353,8 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         merged = merge_close_vertices(v, f, tol, among=among)
         if merged.merged_vertices:
             welded_faces = _drop_collapsed(merged.faces)
+            if len(welded_faces) and merged.representative is not None and merged.largest_move > 0:
+                sweep = weld_sweep(v, f, welded_faces, merged.representative, tol)      # R4: what moving changed
             if len(welded_faces):
                 again = _census(welded_faces, n)
                 turned = orient_consistently(welded_faces, n, v) if again.misoriented_pairs else None
@@ -367,7 +378,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                         notes += (f"{flipped:,} faces were wound the wrong way and were turned",)
                     kept_v, kept_f = _compact(v, current)
                     return Resolution(kept_v, kept_f, "welded", notes + _touching_note(census), flipped,
-                                      tol, census.nonmanifold_edges)
+                                      tol, census.nonmanifold_edges, weld=sweep)
     if not repair:
         raise InvalidMeshError(f"{source}: not a closed solid: {_describe(census, welded, v, current)}{fins}; "
                                "`repair=True` gives a bounded estimate",
@@ -375,7 +386,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                                         "unbalanced_edges": census.unbalanced_edges,
                                         "nonmanifold_edges": census.nonmanifold_edges})
     repair_notes = []
-    if welded:
+    if welded and sweep is None:         # (a weld that moved corners is said with its bound: weld_note)
         repair_notes.append(f"vertices within {round_up(welded):.3g} m of another were merged")
     if flipped:
         repair_notes.append(f"{flipped:,} faces were turned to agree with their neighbours")
@@ -388,10 +399,13 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         census = found.balance
         if census.balanced:
             return Resolution(v, unique, "deduplicated", tuple(repair_notes) + _touching_note(census), flipped, welded,
-                              census.nonmanifold_edges)
+                              census.nonmanifold_edges, weld=sweep)
     best, front_nonmanifold = _repaired_estimate(v, unique, found, diag=diag, moments=moments)
     if len(turned_tris):
         best = _with_turned_doubt(best, turned_tris)
+    if sweep is not None and not (best.method == "patched" and best.uncertainty.volume_in_doubt == 0):
+        best = estimate_with_weld(best, sweep)   # R4: the estimate's doubt and the weld's, summed
+        repair_notes.append(weld_note(sweep))
     flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
     if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
@@ -408,7 +422,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     if best.method == "patched" and best.uncertainty.volume_in_doubt == 0:
         # every seam sealed without moving anything and no hole left: the sealed polyhedron is the solid
         return Resolution(best.vertices, best.faces, "sealed", tuple(repair_notes), flipped, welded,
-                          front_nonmanifold)
+                          front_nonmanifold, weld=sweep)
     return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
                       front_nonmanifold if best.method == "patched" else census.nonmanifold_edges, estimate=best)
 
@@ -464,6 +478,8 @@ def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, 
     keys = found.nonmanifold_keys
     away = int(np.count_nonzero(~(region[keys // nv] | region[keys % nv])))
     near = np.vstack([seal.faces[seal.front_start:], best.faces[len(seal.faces):]])
+    if not len(near):        # no frontier face and no cone (a loose triangle left out): nothing more to count
+        return best, away
     key, _ = edge_keys(near, len(best.vertices))
     key = np.sort(key)
     starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])

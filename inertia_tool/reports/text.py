@@ -71,7 +71,8 @@ def method_line(mesh) -> str:
         return f"exact for the polyhedron (method: {mesh.method}){extra}"
     why = ("the printed part's core is integrated numerically" if mesh.method.endswith("inward offset")
            else "the file's winding does not decide whether a shell inside another is a cavity or a body"
-           if mesh.method == "nesting" else "the file does not define a closed solid")
+           if mesh.method == "nesting" else "the tolerance weld moved corners; bounded by how far (the weld's sweep)"
+           if mesh.method in ("welded", "deduplicated", "sealed") else "the file does not define a closed solid")
     return (f"ESTIMATE (method: {mesh.method}; {why}): mass within "
             f"±{round_up(100 * u.mass):.3g}%, centre of mass within {round_up(u.center_of_mass):.3g} m, inertia within "
             f"±{round_up(100 * u.inertia):.3g}% (Frobenius)")
