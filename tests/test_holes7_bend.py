@@ -175,7 +175,9 @@ def _named_assumption_fails(v, f, gone, est):
     when a removed corner lies on the plane of no face beside a rim; ``bend``
     when, for every loop, a removed corner rises above the loop's mean plane more steeply than the steepest face
     touching the rim, seen from some rim vertex (or a removed face folds back over that plane); ``planar`` when a
-    removed corner lies farther from every loop's least-squares plane than that loop's rim does."""
+    removed corner lies farther from every loop's least-squares plane than that loop's rim does; ``graph`` when,
+    for every loop, a removed corner rises from a rim vertex more steeply than the steepest face touching the rim
+    against the plane most face-on to those faces, or a removed face folds back over it."""
     open_f = np.delete(f, gone, axis=0)
     taken = v[f[gone]].reshape(-1, 3)
     if "convex" in est.assumptions:
@@ -226,6 +228,27 @@ def _named_assumption_fails(v, f, gone, est):
             broken[k] = steep.any() or folds
         if broken.all():
             return "bend"
+    if "graph" in est.assumptions:
+        # the plane most face-on to the faces touching each rim (hole_graphs.face_on_direction, the plane the
+        # assumption names), the slope of the steepest of them: a removed corner rising from some rim vertex more
+        # steeply than that, or a removed face folding back over the plane, breaks it for that loop
+        from inertia_tool.mesh.hole_graphs import face_on_direction
+        broken = np.zeros(n_loops, dtype=bool)
+        for k in range(n_loops):
+            e = edges[label == k]
+            ring = open_f[np.isin(open_f, np.unique(e)).any(axis=1)]
+            rn = np.cross(v[ring[:, 1]] - v[ring[:, 0]], v[ring[:, 2]] - v[ring[:, 0]])
+            rn = rn[np.linalg.norm(rn, axis=1) > 0]
+            d, least = face_on_direction(rn / np.linalg.norm(rn, axis=1)[:, None])
+            slope = np.tan(np.arccos(np.clip(least, -1, 1)))
+            rim_pts = v[np.unique(e)]
+            h_rim, h_pts = rim_pts @ d, taken @ d
+            gap = np.linalg.norm((taken - np.outer(h_pts, d))[:, None] - (rim_pts - np.outer(h_rim, d))[None], axis=2)
+            steep = np.abs(h_pts[:, None] - h_rim[None]) > slope * gap * (1 + 1e-6) + 1e-9
+            gn = np.cross(v[f[gone, 1]] - v[f[gone, 0]], v[f[gone, 2]] - v[f[gone, 0]])
+            broken[k] = steep.any() or (gn @ d < -1e-12 * np.linalg.norm(gn, axis=1)).any()
+        if broken.all():
+            return "graph"
     if "planar" in est.assumptions:
         # each loop's own least-squares plane (SVD), half-width its rim's largest distance from it: a removed
         # corner farther than that from every loop's plane breaks "the missing surface lies within the rim's slab"

@@ -19,8 +19,8 @@ from __future__ import annotations
 import dataclasses
 from typing import Iterable
 
-__all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "PLANAR", "QUADRIC", "ALL",
-           "stated", "named"]
+__all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "GRAPH", "PLANAR",
+           "QUADRIC", "ALL", "stated", "named"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,6 +60,10 @@ BEND = HoleAssumption(
     "bend", "the missing surface is a graph over the rim's mean plane and slopes against that plane no more "
     "steeply than the steepest face touching the rim", "a feature taken whole whose walls are "
     "steeper than the faces round its rim (a boss or pocket on a flat or gently curved face)")
+GRAPH = HoleAssumption(
+    "graph", "the missing surface is a graph over the plane most face-on to the faces touching the rim and slopes "
+    "against that plane no more steeply than the steepest of those faces", "a feature taken whole whose walls are "
+    "steeper than the faces round its rim (a boss or pocket), or a surface that folds back over the hole")
 INNER = HoleAssumption(
     "inner", "a rim vertex whose faces left all lie in one flat face and turn round it by more than 180° lies inside "
     "that face (as a fan-triangulated cap's centre does), not at a corner of a feature's footprint",
@@ -78,7 +82,7 @@ QUADRIC = HoleAssumption(
     "nothing: the bound stays that of the other assumptions named")
 
 #: Every assumption, in the order :func:`stated` prints them.
-ALL = (CONVEX, INNER, BALL, CAPSULE, FLAT, PLANAR, CREASE, BEND, QUADRIC)
+ALL = (CONVEX, INNER, BALL, CAPSULE, FLAT, PLANAR, CREASE, BEND, GRAPH, QUADRIC)
 
 
 def named(names: Iterable[str]) -> tuple[HoleAssumption, ...]:

@@ -58,6 +58,7 @@ from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES
                          _may_hold_two_planes as _may_hold_two_planes, _quadric as _quadric,
                          _ring_faces as _ring_faces, crease_fills, curved_fills, curved_surroundings)
 from .hole_assumptions import named, stated
+from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal
 from .uncertainty import Estimate, uncertainty_from
@@ -66,6 +67,12 @@ __all__ = ["patched_estimate", "hole_doubt_volumes", "ball_slab_volume", "crease
            "curved_fills", "CurvedFill",
            "RimEvidence", "bare_vertices", "slab_contradicted",
            "convex_hole_bound"]
+
+
+#: A hole is tried for a graph fill (:func:`~.hole_graphs.graph_fills`) only when its volume in doubt under the
+#: other bounds exceeds this share of the patched volume (below it the answer is already tight; each try costs a
+#: small linear programme and a triangulation).
+GRAPH_TRY_SHARE = 1e-3
 
 
 def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[..., Any], *,
@@ -147,16 +154,17 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     cone_doubt = hole_doubt.copy()
     curved: list[CurvedFill] = []
 
-    def build(creases: list[CreaseFill], curved: list[CurvedFill]
+    def build(creases: list[CreaseFill], curved: list[CurvedFill], graphs: list[GraphFill] | None = None
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any, np.ndarray]:
         cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
         extra = np.zeros((0, 3))
         tops = apex.copy()
-        if curved:            # holes on a quadric: the fan bent onto it (same bound: curved_fills)
+        lifted: list[CurvedFill | GraphFill] = [*curved, *(graphs or [])]
+        if lifted:            # holes on a quadric (the fan bent onto it) or graphs over a face-on plane
             bent = np.zeros(n_loops, dtype=bool)
             base = len(v) + n_loops + 2 * len(creases)
             fills, at = [], 0
-            for bend in curved:
+            for bend in lifted:
                 bent[bend.loop] = True
                 tops[bend.loop] = bend.apex
                 shifted = bend.caps.copy()
@@ -184,7 +192,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             # the cones (and bent fills: label −1) kept, the crease fills last (_crease_contradicted counts on it)
             cap = np.vstack([cap[(label_of < 0) | ~crossed[np.maximum(label_of, 0)]], *fills])
             extra = np.vstack([fill.apexes for fill in creases])
-        pv = np.vstack([v, tops, extra, *[bend.points for bend in curved]])
+        pv = np.vstack([v, tops, extra, *[bend.points for bend in lifted]])
         pf = np.vstack([f, cap])
         closed = moments(pv, pf)
         if closed.volume < 0:
@@ -216,11 +224,19 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             nearer = np.where(took_bend, np.minimum(nearer, bend_reach), nearer)
         # a planar rim's region (ball ∩ slab) is bounded by its ball alone (no capsule is named for it)
         nearer = np.where(took_planar, ball_reach, nearer)
+        if took_graph.any():
+            # the graph region lies over the projected rim within ``height`` of its mean height (hole_graphs)
+            rim_reach = np.zeros(n_loops)
+            np.maximum.at(rim_reach, loop_of, np.linalg.norm(v[vertex_of] - point, axis=1))
+            nearer = np.where(took_graph, rim_reach + 2.0 * graph_height, nearer)
         return nearer
 
     alone = np.zeros(n_loops, dtype=bool)
     took_bend = np.zeros(n_loops, dtype=bool)
     took_planar = np.zeros(n_loops, dtype=bool)
+    took_graph = np.zeros(n_loops, dtype=bool)
+    graph_height = np.zeros(n_loops)
+    graphs: list[GraphFill] = []
     used: set[str] = set()
     before_bend = 0.0
 
@@ -269,13 +285,35 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         hole_doubt = np.where(took_planar, planar.doubt, hole_doubt)
         took_bend &= ~took_planar
         took_capsule &= ~took_planar
+        # the graph fill (GRAPH) over the plane most face-on to the faces at the rim, with its own bound, where
+        # narrower than every bound above; tried on the holes no other fill took, most doubt first, and only where
+        # the doubt is not already negligible (a cost rule: each try solves a small LP and a triangulation)
+        # not where evidence withdrew the narrower assumptions (a bare rim vertex: a surface that met the face
+        # beside the hole there is gone, as a connector housing taken whole leaves; xarm7 ``link_base.stl``,
+        # benchmark case 15-38-t_junction_hole, was outside its graph bound), nor where the ball holds everything
+        tryable = (~crossed & ~bent & ~engulfed & ~withdrawn
+                   & (hole_doubt > GRAPH_TRY_SHARE * abs(float(closed.volume))))
+        if tryable.any():
+            ranked = np.flatnonzero(tryable)[np.argsort(-hole_doubt[tryable], kind="stable")]
+            for fill in graph_fills(v, f, edges, label, ranked, apex):
+                if fill.doubt < hole_doubt[fill.loop]:
+                    graphs.append(fill)
+                    took_graph[fill.loop] = True
+                    graph_height[fill.loop] = fill.height
+                    hole_doubt[fill.loop] = fill.doubt
+            if graphs:
+                pv, pf, cap, closed, _ = build(creases, curved, graphs)
+        took_bend &= ~took_graph
+        took_capsule &= ~took_graph
+        took_planar &= ~took_graph
         took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
-                     & ~took_planar)
+                     & ~took_planar & ~took_graph)
         used = {"ball"}
         used |= {"planar"} if took_planar.any() else set()
         used |= {"flat"} if took_flat.any() else set()
         used |= {"capsule"} if took_capsule.any() else set()
         used |= {"bend"} if took_bend.any() else set()
+        used |= {"graph"} if took_graph.any() else set()
         used |= {"crease"} if any(fill.narrow for fill in creases) else set()
         used |= {"quadric"} if curved else set()
     doubt = float(np.sum(hole_doubt))
@@ -287,14 +325,14 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     if n_loops and doubt > 0 and not taken:
         # fourth assumption, where what remains is convex: the complete part is too (convex_hole_bound)
         outward = pf[:len(f)]
-        bound = convex_hole_bound(pv, outward, float(closed.volume)) if not curved else None
-        if curved:
+        bound = convex_hole_bound(pv, outward, float(closed.volume)) if not (curved or graphs) else None
+        if curved or graphs:
             # where what remains is convex the cones stay: the convex bound needs the patch inside the part, as
             # the cones are (in the rims' hulls) and a bent fill need not be
             cones = build(creases, [])
             bound = convex_hole_bound(cones[0], cones[1][:len(f)], float(cones[3].volume))
             if bound is not None:
-                curved = []
+                curved, graphs = [], []
                 pv, pf, cap, closed, _ = cones
                 far = float(np.max(reach_of(closed.centroid)))
         # the convex bound where it applies and is narrower than the others before the bend bound: a convex part
@@ -340,6 +378,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             detail += (f"; {int(np.count_nonzero(took_planar))} read as a missing flat face (a rim in one plane, "
                        f"within {round_up(float(planar.half_width[took_planar].max())):.3g} m, meeting the faces "
                        "beside it at a crease), bounded by the ball cut to that slab")
+        if graphs and not convex:
+            detail += (f"; {len(graphs)} filled instead as a graph over the plane most face-on to the faces at the "
+                       "rim (a triangulation of the projected rim, lifted), bounded by the steepest of those faces' "
+                       f"slope (largest {max(g.slope for g in graphs):.3g})")
         if took_bend.any() and not convex:
             detail += (f"; {int(np.count_nonzero(took_bend))} bounded instead by the slope of the faces beside "
                        "their rims")
