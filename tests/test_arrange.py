@@ -405,3 +405,21 @@ def test_new_points_far_out_are_counted_or_refused():
     far = v @ turn.T * 1e-4 + np.array([1e7, -3e6, 2e6])
     with pytest.raises(ArrangementError, match="new points, rounded to float64"):
         arrange_crossings(far, f)
+
+
+def test_an_arranged_surface_leaves_its_points_half_the_round_off_budget(monkeypatch):
+    """The arrangement accepts its constructed points' rounding up to half of ``ROUNDOFF_RTOL``
+    (``rounded_points_bounds``); R7 then allows the integrals' round-off only the other half, so that "united"
+    keeps the budget "exact" has.  With the integrals' round-off forced to 0.7 of the budget, a plain box stays
+    exact and the arranged figure-eight is no longer certified (before, each share was checked alone)."""
+    from inertia_tool.mesh import certify as certify_module
+    from inertia_tool.tolerances import ROUNDOFF_RTOL
+    monkeypatch.setattr(certify_module, "total_roundoff", lambda moments, bound: 0.7 * ROUNDOFF_RTOL)
+    box_v, box_f = S.box([1.0, 2.0, 3.0], [0.0, 0.0, 0.0])
+    assert _quiet(box_v, box_f).mesh.certificate.kind == "exact"
+    v, f, _ = S.tube_halves(0.1, 0.2, rings=48, sections=8)
+    props = _quiet(v, f)
+    assert props.mesh.certificate.kind == "unverified"
+    assert any("above 5e-11" in note for note in props.mesh.notes), props.mesh.notes
+    monkeypatch.setattr(certify_module, "total_roundoff", lambda moments, bound: 0.3 * ROUNDOFF_RTOL)
+    assert _quiet(v, f).mesh.certificate.kind == "united"
