@@ -6,10 +6,11 @@ writes them out) every value and every error bound is numpy's **bit for bit**, a
 exactly on the surface (where the sign of a zero numerator decides a solid angle of ±2π).  Anywhere, each value lies
 within its own bound of the exact direct sum (off the surface) and within round-off of numpy's.
 
-Surfaces drawn by hypothesis: two overlapping spheres (winding numbers 0, 1, 2), moved far from the origin and
-scaled, with a stray soup of random triangles (slivers, duplicates, zero-area faces) added; points uniform in the
-box, pushed 10⁻¹²…10⁻² off a face along its normal, on a face, at vertices; tolerances 10⁻⁶…10⁻¹; the vectorised
-block of (point, leaf) pairs shrunk so that one point's leaves span several blocks (numpy's sums split there).
+Surfaces drawn by hypothesis: two overlapping spheres (winding numbers 0, 1, 2) and an axis-aligned box, moved far
+from the origin and scaled, with a stray soup of random triangles (slivers, duplicates, zero-area faces) added;
+points uniform in the box, pushed 10⁻¹²…10⁻² off a face along its normal, on a face, in the plane of a box face
+exactly, at vertices; tolerances 10⁻⁶…10⁻¹; the vectorised block of (point, leaf) pairs shrunk so that one point's
+leaves span several blocks (numpy's sums split there).
 """
 
 from __future__ import annotations
@@ -37,8 +38,10 @@ def _surface(shift: float, inner: float, scale: float, far: float, stray: int, s
              ) -> tuple[np.ndarray, np.ndarray]:
     a = trimesh.creation.icosphere(2)
     b = trimesh.creation.icosphere(1, radius=inner)
-    v = np.vstack([np.asarray(a.vertices), np.asarray(b.vertices) + [shift, 0.0, 0.0]])
-    f = np.vstack([np.asarray(a.faces), np.asarray(b.faces) + len(a.vertices)])
+    box = trimesh.creation.box([1.0, 1.0, 1.0])          # axis-aligned faces: points exactly in their planes
+    v = np.vstack([np.asarray(a.vertices), np.asarray(b.vertices) + [shift, 0.0, 0.0], np.asarray(box.vertices)])
+    f = np.vstack([np.asarray(a.faces), np.asarray(b.faces) + len(a.vertices),
+                   np.asarray(box.faces) + len(a.vertices) + len(b.vertices)])
     rng = np.random.default_rng(seed)
     if stray:
         soup = rng.uniform(-1.2, 1.2 + shift, size=(3 * stray, 3))
@@ -89,8 +92,14 @@ def test_the_c_treecode_is_the_numpy_treecode(shift, inner, scale, far, stray, s
 
 
 def _compare(shift, inner, scale, far, stray, seed, tolerance, leaf, chunk):
-    v, f = _surface(shift, inner, scale, far, stray, seed)
+    v, f = _surface(shift, inner, 1.0, 0.0, stray, seed)
     points, off = _points(v, f, seed)
+    rng = np.random.default_rng(seed)
+    in_plane = rng.uniform(-0.5, 0.5, size=(24, 3))      # on the box's faces, in their planes exactly (a solid
+    in_plane[np.arange(24), rng.integers(0, 3, 24)] = rng.choice([-0.5, 0.5], 24)   # angle's numerator ±0)
+    points = np.vstack([points, in_plane])
+    off = np.concatenate([off, np.zeros(24, bool)])
+    v, points = v * scale + far, points * scale + far
     centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
     tree = winding._Tree(v - centre, f, leaf)
     w_c, e_c = winding._treecode(points - centre, v - centre, f, tolerance=tolerance, leaf=leaf, chunk=chunk,
