@@ -9,11 +9,11 @@ numbers", ACM TOG 32(4) 33, SIGGRAPH 2013).
 
 Evaluation: libigl's hierarchical ``fast_winding_number`` (Barill et al., "Fast winding numbers for soups
 and clouds", ACM TOG 37(4) 43, SIGGRAPH 2018) when the optional ``libigl`` package is installed; otherwise
-a treecode in the same spirit (in C, ``_accel.c`` section 13, when the extension is built; numpy's
-:func:`_treecode_numpy` is the reference, the same values bit for bit on x86-64) (:func:`winding_numbers_bounded`: faces in a binary tree of clusters,
-far clusters replaced by their dipole term where a stated bound on the error allows, near faces summed
-exactly), which returns that bound with each value; the exact direct sum (``points × faces`` work) is
-kept as the reference.
+a treecode in the same spirit (:func:`winding_numbers_bounded`: faces in a binary tree of clusters, far
+clusters replaced by their dipole term where a stated bound on the error allows, near faces summed exactly;
+in C, ``_accel.c`` section 13, when the extension is built, with numpy's :func:`_treecode_numpy` the
+reference, the same values bit for bit on x86-64), which returns that bound with each value; the exact
+direct sum (``points × faces`` work) is kept as the reference.
 """
 
 from __future__ import annotations
