@@ -24,6 +24,7 @@
  *   7. split_steps -- the splitting integrator's step loop (dynamics/splitting.py)
  *   8. contact_scan -- faces meeting beyond what they share: hierarchy of boxes + exact pair classification
  *                      (mesh/intersect.py)
+ *   13. winding_tree -- the generalized winding number by a treecode, with its error bound (mesh/winding.py)
  *
  * Safety: every index read from an array is bounds-checked before use, sizes are checked against
  * overflow before allocation, NaN coordinates are hashed by their bit pattern (never compared as floats),
@@ -3557,6 +3558,7 @@ static PyObject *accel_close_groups(PyObject *self, PyObject *args);    /* secti
 static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
 static PyObject *accel_label_cells(PyObject *self, PyObject *args);     /* section 11, after the module */
 static PyObject *accel_certain_parts(PyObject *self, PyObject *args);  /* section 12, after the module */
+static PyObject *accel_winding_tree(PyObject *self, PyObject *args);   /* section 13, after the module */
 
 static PyObject *
 accel_release_buffers(PyObject *self, PyObject *unused)
@@ -3674,6 +3676,12 @@ static PyMethodDef accel_methods[] = {
      "sub-cell, whether a sample's Lipschitz test puts it wholly in the core (`core`, bytes (k, s)) or a "
      "Lipschitz or closest-point test wholly outside it (`empty`, not where `core` is); "
      "offset._certain_parts; section 12."},
+    {"winding_tree", accel_winding_tree, METH_VARARGS,
+     "winding_tree(points, clusters, levels, triangles, leaf, tolerance, chunk, block, w, err, threads=1)\n\nThe generalized "
+     "winding number at each of the (p, 3) float64 points and the bound on its error, into w and err ((p,) "
+     "float64), by the treecode of mesh/winding._treecode over its tree (clusters (K, 17) float64, levels (L + 1,) "
+     "int64, triangles (m, 9) float64 in the tree's order), its sums split as numpy's chunks of points and blocks of "
+     "(point, leaf) pairs; threads only change the speed; section 13."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -9488,6 +9496,326 @@ accel_certain_parts(PyObject *self, PyObject *args)
     result = Py_None;
     Py_INCREF(result);
 done:
+    for (int i = 0; i < got; i++) {
+        PyBuffer_Release(&views[i]);
+    }
+    return result;
+}
+
+/* ======================================================================================================
+ * 13. winding_tree -- the generalized winding number by the treecode of mesh/winding.py, point by point
+ *
+ * The twin of winding._treecode_numpy (the reference): the same tree of face clusters (built in Python,
+ * winding._Tree; passed flattened, level 0 = the leaves), the same decision per cluster seen from a point q:
+ * with u = centre - q, d = |u|, r = radius, A = area,
+ *     bound = 3 A r^2 / (4 pi max(d - r, 0)^4),   far  <=>  d > 2 r  and  bound <= tolerance,
+ * a far cluster adds its dipole term (N.u / d^3 + (tr M - 3 e^T M e) / d^3) / (4 pi), e = u / d, and its bound;
+ * a near cluster is refined into its children (2i, 2i+1 on the level below, those that exist), and a near leaf
+ * adds the exact solid angle of each of its faces (Van Oosterom & Strackee, as winding._solid_angles).
+ *
+ * The expressions and the order of every sum are numpy's, so the values are its values bit for bit where numpy
+ * evaluates them as measured on x86-64 (numpy 2.x): a 3-vector dot product (einsum) as (x0 y0 + x2 y2) + x1 y1,
+ * the trace as (M00 + M11) + M22, e^T M e as the sum over i then j of (e_i M_ij) e_j in that order, d^3 and
+ * (d - r)^4 by pow(), arctan2 by atan2(); the far terms summed per level in ascending cluster order (the tree is
+ * walked depth first, left child first, which visits each level's clusters in that order) and the levels added
+ * from the top; the leaves' solid angles summed in ascending order per block of `block` (point, leaf) pairs of
+ * each chunk of `chunk` points (numpy's vectorised blocks), each block's sum divided by 4 pi and added in turn.
+ * A first walk counts each point's near leaves to place those block boundaries.  Where numpy's kernels round
+ * differently the values still agree to round-off, each within its own bound of the exact sum.  Each point is
+ * independent of the others: the thread count changes nothing.
+ *
+ * Layout: `clusters` (K, 17) float64 rows [normal xyz, area, centre xyz, radius, moment M row-major 9];
+ * `levels` (L + 1,) int64 the first row of each level (levels[0] = 0, levels[L] = K), level 0 the leaves;
+ * `triangles` (m, 9) float64 [a xyz, b xyz, c xyz] in the tree's (Morton) order; leaf i holds faces
+ * [i leaf, min((i + 1) leaf, m)).
+ * ====================================================================================================== */
+
+#define WT_ROW 17
+#define WT_STACK 512
+#define WT_LEVELS 64
+#define WT_BLOCK 16            /* points per work ticket */
+#define WT_PARTS 64            /* blocks of (point, leaf) pairs one point may span */
+
+typedef struct {
+    const double *points, *clusters, *tri;
+    const int64_t *levels;
+    int64_t n_levels, m, leaf, n_points, chunk, block;
+    double tolerance;
+    double *w, *err;
+    int64_t *near;             /* pass 1: near leaves per point; then each point's first pair in its chunk */
+    int32_t next;
+    int pass;
+    int overflow;              /* set when a stack would overflow (not expected: depth <= L + 8) */
+} WindingTask;
+
+static const double wt_four_pi = 4.0 * 3.14159265358979323846;
+
+/* numpy's einsum of two 3-vectors (two lanes from +0): ((0 + x0 y0) + x2 y2) + (0 + x1 y1), which is
+ * (x0 y0 + x2 y2) + x1 y1 but never -0 (the sign of a zero numerator decides a solid angle of +-2 pi) */
+static inline double
+wt_dot(double x0, double x1, double x2, double y0, double y1, double y2)
+{
+    const double p0 = x0 * y0, p1 = x1 * y1, p2 = x2 * y2;
+    return ((0.0 + p0) + p2) + (0.0 + p1);
+}
+
+/* winding._solid_angles for one triangle t = [a, b, c] and point q, expression by expression */
+static inline double
+wt_solid_angle(const double *q, const double *t)
+{
+    const double ax = t[0] - q[0], ay = t[1] - q[1], az = t[2] - q[2];
+    const double bx = t[3] - q[0], by = t[4] - q[1], bz = t[5] - q[2];
+    const double cx = t[6] - q[0], cy = t[7] - q[1], cz = t[8] - q[2];
+    const double la = sqrt(wt_dot(ax, ay, az, ax, ay, az));
+    const double lb = sqrt(wt_dot(bx, by, bz, bx, by, bz));
+    const double lc = sqrt(wt_dot(cx, cy, cz, cx, cy, cz));
+    /* numpy.cross(b, c): b1 c2 - b2 c1, b2 c0 - b0 c2, b0 c1 - b1 c0 */
+    const double x0 = by * cz - bz * cy, x1 = bz * cx - bx * cz, x2 = bx * cy - by * cx;
+    const double num = wt_dot(ax, ay, az, x0, x1, x2);
+    const double den = ((la * lb * lc + wt_dot(ax, ay, az, bx, by, bz) * lc) + wt_dot(ax, ay, az, cx, cy, cz) * lb)
+                       + wt_dot(bx, by, bz, cx, cy, cz) * la;
+    return 2.0 * atan2(num, den);
+}
+
+/* One point: pass 1 counts its near leaves into *count; pass 2 writes w and err, its (point, leaf) pairs
+ * starting at index `first` of its chunk's list. */
+static int
+wt_point(const WindingTask *c, const double *q, int64_t *count, int64_t first, double *w_out, double *err_out)
+{
+    int64_t stack_level[WT_STACK], stack_index[WT_STACK];
+    double far_sum[WT_LEVELS], bound_sum[WT_LEVELS];
+    int top = 0;
+    const int64_t L = c->n_levels;
+    const int64_t n_top = c->levels[L] - c->levels[L - 1];
+    const int evaluate = c->pass == 2;
+    for (int64_t l = 0; l < L; l++) {
+        far_sum[l] = 0.0;
+        bound_sum[l] = 0.0;
+    }
+    for (int64_t i = n_top - 1; i >= 0; i--) {
+        if (top >= WT_STACK) {
+            return -1;
+        }
+        stack_level[top] = L - 1;
+        stack_index[top] = i;
+        top++;
+    }
+    int64_t pair = first;                       /* index of the next (point, leaf) pair in the chunk's list */
+    int64_t leaves = 0;
+    double parts[WT_PARTS];                     /* the leaves' sum per block, in order */
+    int n_parts = 0;
+    while (top > 0) {
+        top--;
+        const int64_t level = stack_level[top], i = stack_index[top];
+        const double *row = c->clusters + WT_ROW * (c->levels[level] + i);
+        const double ux = row[4] - q[0], uy = row[5] - q[1], uz = row[6] - q[2];
+        const double d = sqrt(wt_dot(ux, uy, uz, ux, uy, uz));
+        const double r = row[7];
+        const double gap = d - r > 0.0 ? d - r : 0.0;    /* numpy.maximum(d - r, 0.0) */
+        const double bound = 3.0 * row[3] * (r * r) / (wt_four_pi * pow(gap, 4.0));   /* inf or NaN at gap 0 */
+        if (d > 2.0 * r && bound <= c->tolerance) {
+            if (evaluate) {
+                const double *M = row + 8;
+                const double e[3] = {ux / d, uy / d, uz / d};
+                double quad = 0.0;
+                for (int a = 0; a < 3; a++) {
+                    for (int b = 0; b < 3; b++) {
+                        quad += (e[a] * M[3 * a + b]) * e[b];
+                    }
+                }
+                const double d3 = pow(d, 3.0);
+                const double first_order = (((M[0] + M[4]) + M[8]) - 3.0 * quad) / d3;
+                far_sum[level] += (wt_dot(row[0], row[1], row[2], ux, uy, uz) / d3 + first_order) / wt_four_pi;
+                bound_sum[level] += bound;
+            }
+        }
+        else if (level > 0) {
+            const int64_t below = c->levels[level] - c->levels[level - 1];
+            if (top + 2 > WT_STACK) {
+                return -1;
+            }
+            if (2 * i + 1 < below) {
+                stack_level[top] = level - 1;
+                stack_index[top] = 2 * i + 1;
+                top++;
+            }
+            if (2 * i < below) {
+                stack_level[top] = level - 1;
+                stack_index[top] = 2 * i;
+                top++;
+            }
+        }
+        else if (!evaluate) {
+            leaves++;
+        }
+        else {
+            if (n_parts == 0 || pair % c->block == 0) {      /* the first pair, or numpy's next block */
+                if (n_parts >= WT_PARTS) {
+                    return -1;
+                }
+                parts[n_parts++] = 0.0;
+            }
+            const int64_t start = i * c->leaf;
+            const int64_t stop = start + c->leaf < c->m ? start + c->leaf : c->m;
+            double sum = parts[n_parts - 1];
+            for (int64_t f = start; f < stop; f++) {
+                sum += wt_solid_angle(q, c->tri + 9 * f);
+            }
+            parts[n_parts - 1] = sum;
+            pair++;
+        }
+    }
+    if (!evaluate) {
+        *count = leaves;
+        return 0;
+    }
+    /* numpy: w = 0, each level's far sum added from the top, then each block's leaf sum / 4 pi in turn */
+    double total = 0.0, error = 0.0;
+    for (int64_t l = L - 1; l >= 0; l--) {
+        total += far_sum[l];
+        error += bound_sum[l];
+    }
+    for (int k = 0; k < n_parts; k++) {
+        total += parts[k] / wt_four_pi;
+    }
+    *w_out = total;
+    *err_out = error;
+    return 0;
+}
+
+static void
+winding_tree_task(void *ctx, int t, int nt)
+{
+    WindingTask *c = (WindingTask *)ctx;
+    (void)t;
+    (void)nt;
+    for (;;) {
+        const int64_t start = (int64_t)next_ticket(&c->next) * WT_BLOCK;
+        if (start >= c->n_points) {
+            break;
+        }
+        const int64_t stop = start + WT_BLOCK < c->n_points ? start + WT_BLOCK : c->n_points;
+        for (int64_t p = start; p < stop; p++) {
+            if (wt_point(c, c->points + 3 * p, c->near + p, c->near[p], c->w + p, c->err + p) < 0) {
+                __atomic_store_n(&c->overflow, 1, __ATOMIC_RELAXED);
+            }
+        }
+    }
+}
+
+static PyObject *
+accel_winding_tree(PyObject *self, PyObject *args)
+{
+    PyObject *objs[6];
+    long long leaf, chunk, block;
+    double tolerance;
+    int threads = 1;
+    if (!PyArg_ParseTuple(args, "OOOOLdLLOO|i", &objs[0], &objs[1], &objs[2], &objs[3], &leaf, &tolerance, &chunk,
+                          &block, &objs[4], &objs[5], &threads)) {
+        return NULL;
+    }
+    Py_buffer views[6];
+    int got = 0;
+    PyObject *result = NULL;
+    int64_t *near = NULL;
+    for (int i = 0; i < 6; i++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (i >= 4 ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[i], &views[i], flags) < 0) {
+            goto done;
+        }
+        got++;
+    }
+    {
+        Py_buffer *pv = &views[0], *cv = &views[1], *lv = &views[2], *tv = &views[3], *wv = &views[4], *ev = &views[5];
+        const int float_ok = native_code(pv->format) == 'd' && pv->itemsize == 8 && native_code(cv->format) == 'd'
+                             && cv->itemsize == 8 && native_code(tv->format) == 'd' && tv->itemsize == 8
+                             && native_code(wv->format) == 'd' && wv->itemsize == 8 && native_code(ev->format) == 'd'
+                             && ev->itemsize == 8;
+        if (!float_ok || signed_int_size(lv) != 8) {
+            PyErr_SetString(PyExc_ValueError, "Expected points, clusters, triangles, w and err as C-contiguous "
+                            "float64 arrays and levels as int64");
+            goto done;
+        }
+        const int64_t n_points = (int64_t)(pv->len / 24), n_rows = (int64_t)(cv->len / (8 * WT_ROW));
+        const int64_t n_bounds = (int64_t)(lv->len / 8), m = (int64_t)(tv->len / 72);
+        if (pv->len != n_points * 24 || cv->len != n_rows * 8 * WT_ROW || tv->len != m * 72
+            || wv->len != n_points * 8 || ev->len != n_points * 8 || n_bounds < 2 || n_bounds > WT_LEVELS + 1
+            || leaf < 1 || m < 1 || chunk < 1 || block < 1) {
+            PyErr_SetString(PyExc_ValueError, "Expected points (p, 3), clusters (K, 17), levels (L + 1,) with "
+                            "1 <= L <= 64, triangles (m >= 1, 9), w and err (p,), leaf, chunk, block >= 1");
+            goto done;
+        }
+        const int64_t *levels = (const int64_t *)lv->buf;
+        /* the tree's shape: levels rising from 0 to K, the leaves cover the m faces, each level's clusters
+           the parents of the halves below (ceil(count / 2) of the level below) */
+        const int64_t n_leaves = (m + leaf - 1) / leaf;
+        int shape_ok = levels[0] == 0 && levels[n_bounds - 1] == n_rows && levels[1] == n_leaves;
+        for (int64_t l = 1; shape_ok && l < n_bounds - 1; l++) {
+            const int64_t below = levels[l] - levels[l - 1], here = levels[l + 1] - levels[l];
+            shape_ok = here >= 1 && here == (below + 1) / 2;
+        }
+        if (!shape_ok) {
+            PyErr_SetString(PyExc_ValueError, "Expected `levels` of a binary tree over ceil(m / leaf) leaves "
+                            "(each level half the one below, rounded up), ending at the clusters' count");
+            goto done;
+        }
+        if (n_leaves / block + 2 > WT_PARTS || n_points / WT_BLOCK >= INT32_MAX) {
+            PyErr_SetString(PyExc_ValueError, "Expected at most (64 - 2) blocks of leaves and fewer than 2**35 points");
+            goto done;
+        }
+        near = (int64_t *)malloc((size_t)(n_points > 0 ? n_points : 1) * sizeof(int64_t));
+        if (near == NULL) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        WindingTask task;
+        task.points = (const double *)pv->buf;
+        task.clusters = (const double *)cv->buf;
+        task.tri = (const double *)tv->buf;
+        task.levels = levels;
+        task.n_levels = n_bounds - 1;
+        task.m = m;
+        task.leaf = (int64_t)leaf;
+        task.n_points = n_points;
+        task.chunk = (int64_t)chunk;
+        task.block = (int64_t)block;
+        task.tolerance = tolerance;
+        task.w = (double *)wv->buf;
+        task.err = (double *)ev->buf;
+        task.near = near;
+        task.overflow = 0;
+        const int nt = thread_count(threads, (size_t)n_points, 4 * WT_BLOCK);
+        Py_BEGIN_ALLOW_THREADS
+        /* pass 1: each point's near leaves; then each point's first pair within its chunk (numpy's list of
+           pairs for the chunk is point by point); pass 2: the values */
+        task.pass = 1;
+        task.next = 0;
+        run_parallel(nt, winding_tree_task, &task);
+        for (int64_t s = 0; s < n_points; s += task.chunk) {
+            int64_t running = 0;
+            const int64_t e = s + task.chunk < n_points ? s + task.chunk : n_points;
+            for (int64_t p = s; p < e; p++) {
+                const int64_t here = near[p];
+                near[p] = running;
+                running += here;
+            }
+        }
+        task.pass = 2;
+        task.next = 0;
+        if (!task.overflow) {
+            run_parallel(nt, winding_tree_task, &task);
+        }
+        Py_END_ALLOW_THREADS
+        if (task.overflow) {
+            PyErr_SetString(PyExc_RuntimeError, "winding_tree: a traversal stack or the blocks of a point overflowed "
+                            "(a tree deeper than expected)");
+            goto done;
+        }
+    }
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    free(near);
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
     }

@@ -37,6 +37,12 @@ def test_the_bound_is_never_below_the_exact_distance(seed, spacing, scale, offse
     exact = _exact(points, vertices, faces)
     above = grid_estimate._distance_above(points, vertices, faces, spacing * scale)
     assert np.all(above >= exact), f"{np.count_nonzero(above < exact)} bounds below the exact distance"
+    # the search stopped at `beyond` (issue 25, corpus13): the same bound where it is finite, inf only beyond
+    beyond = float(np.quantile(above, rng.uniform(0.0, 1.0)))
+    bounded = grid_estimate._distance_above(points, vertices, faces, spacing * scale, beyond=beyond)
+    stopped = ~np.isfinite(bounded)
+    np.testing.assert_array_equal(bounded[~stopped], above[~stopped])
+    assert np.all(above[stopped] > beyond) and np.all(~stopped[above <= beyond])
 
 
 def test_a_dense_sampling_comes_within_its_spacing():

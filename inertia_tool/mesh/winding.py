@@ -9,10 +9,11 @@ numbers", ACM TOG 32(4) 33, SIGGRAPH 2013).
 
 Evaluation: libigl's hierarchical ``fast_winding_number`` (Barill et al., "Fast winding numbers for soups
 and clouds", ACM TOG 37(4) 43, SIGGRAPH 2018) when the optional ``libigl`` package is installed; otherwise
-a numpy treecode in the same spirit (:func:`winding_numbers_bounded`: faces in a binary tree of clusters,
-far clusters replaced by their dipole term where a stated bound on the error allows, near faces summed
-exactly), which returns that bound with each value; the exact direct sum (``points × faces`` work) is
-kept as the reference.
+a treecode in the same spirit (:func:`winding_numbers_bounded`: faces in a binary tree of clusters, far
+clusters replaced by their dipole term where a stated bound on the error allows, near faces summed exactly;
+in C, ``_accel.c`` section 13, when the extension is built, with numpy's :func:`_treecode_numpy` the
+reference, the same values bit for bit on x86-64), which returns that bound with each value; the exact
+direct sum (``points × faces`` work) is kept as the reference.
 """
 
 from __future__ import annotations
@@ -54,6 +55,17 @@ def _direct(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.n
         p = points[s:s + per, None, :]
         out[s:s + per] = _solid_angles(p, a0[None], b0[None], c0[None]).sum(axis=1) / (4 * np.pi)
     return out
+
+
+#: The C kernel's limits (``WT_PARTS``, ``WT_LEVELS`` in ``_accel.c`` section 13): blocks of (point, leaf) pairs
+#: one point's leaves may span, and levels of the tree; beyond them (never below ~60M faces) numpy evaluates.
+_C_PARTS = 64
+_C_LEVELS = 64
+
+
+def _leaf_block(leaf: int) -> int:
+    """(point, leaf) pairs per vectorised block of the treecode's near field (each pair up to ``leaf`` faces)."""
+    return max(1, _BLOCK // (leaf * 4))
 
 
 class _Tree:
@@ -100,6 +112,13 @@ class _Tree:
             if len(starts) <= 8:
                 break
             size *= 2
+        # the same clusters flattened for the C twin (_accel.c section 13): rows [normal, area, centre, radius,
+        # moment] level by level from the leaves, and the first row of each level
+        self.clusters = np.ascontiguousarray(np.concatenate(
+            [np.concatenate([nm, ar[:, None], ce, ra[:, None], mo.reshape(-1, 9)], axis=1)
+             for nm, ar, ce, ra, mo in self.levels]), dtype=np.float64)
+        self.bounds = np.cumsum([0] + [len(level[1]) for level in self.levels]).astype(np.int64)
+        self.triangles = np.ascontiguousarray(np.concatenate([self.a, self.b, self.c], axis=1), dtype=np.float64)
 
 
 def _treecode(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, *, tolerance: float = 1e-4,
@@ -128,7 +147,28 @@ def _treecode(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, *, to
     """
     if tree is None or tree.leaf != leaf:
         tree = _Tree(vertices, faces, leaf)
-    n_faces = len(faces)
+    if len(points) and len(faces):
+        from .._native import accel, threads
+        lib = accel()
+        per = _leaf_block(leaf)
+        if lib is not None and len(tree.levels[0][0]) // per + 2 <= _C_PARTS and len(tree.levels) <= _C_LEVELS:
+            # the same clusters, decisions, terms and order of the sums in C (_accel.c section 13), point by
+            # point: numpy's values bit for bit where its kernels round as measured (x86-64), else to round-off,
+            # each within its own bound (issue 25: the treecode was ~30 % of Piper's link2.stl repair)
+            out = np.empty(len(points))
+            err = np.empty(len(points))
+            lib.winding_tree(np.ascontiguousarray(points, dtype=np.float64), tree.clusters, tree.bounds,
+                             tree.triangles, int(leaf), float(tolerance), int(chunk), per, out, err, threads())
+            return out, err
+    return _treecode_numpy(points, tree, tolerance=tolerance, chunk=chunk)
+
+
+def _treecode_numpy(points: np.ndarray, tree: _Tree, *, tolerance: float, chunk: int = 2048
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_treecode` in numpy, level by level for blocks of ``chunk`` points: the reference of the C kernel
+    and the path without it (``INERTIA_TOOL_NO_ACCEL``)."""
+    leaf = tree.leaf
+    n_faces = len(tree.a)
     top = len(tree.levels) - 1
     out = np.zeros(len(points))
     err = np.zeros(len(points))
@@ -164,7 +204,7 @@ def _treecode(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, *, to
         # leaves still near: every face of them exactly, in blocks
         first = cl * leaf
         count = np.minimum(first + leaf, n_faces) - first
-        per = max(1, _BLOCK // (leaf * 4))
+        per = _leaf_block(leaf)
         for k in range(0, len(pt), per):
             p_, f_, c_ = pt[k:k + per], first[k:k + per], count[k:k + per]
             idx = np.repeat(f_, c_) + (np.arange(int(c_.sum())) - np.repeat(np.cumsum(c_) - c_, c_))
