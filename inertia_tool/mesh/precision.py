@@ -307,14 +307,17 @@ def estimate_with_weld(estimate: Estimate, sweep: WeldSweep | None) -> Estimate:
     return dataclasses.replace(estimate, uncertainty=unc, far=far)
 
 
-def weld_note(sweep: WeldSweep, relative: float | None = None) -> str:
+def weld_note(sweep: WeldSweep, relative: float | None = None, *, with_merge: bool = False) -> str:
     """The certificate's note on a weld that moved corners: how far, and what it may change (``relative``: of
-    the result, when the weld stays within the round-off budget)."""
+    the result, when the weld stays within the round-off budget).  The merge itself (how many vertices, within
+    what) is the resolve stage's note on a welded surface; ``with_merge`` says it here instead (a repaired
+    estimate, which has no such note)."""
     n = sweep.merged
-    said = (f"{n:,} vert{'ex' if n == 1 else 'ices'} within {round_up(sweep.tolerance):.3g} m of another "
-            f"{'was' if n == 1 else 'were'} merged, moving corners by up to {round_up(sweep.largest_move):.3g} m: "
-            f"the solid the file's corners bound differs from the welded one by at most "
-            f"{round_up(sweep.volume, 2):.2g} m³ (the weld's sweep)")
+    merge = (f"{n:,} vert{'ex' if n == 1 else 'ices'} within {round_up(sweep.tolerance):.3g} m of another "
+             f"{'was' if n == 1 else 'were'} merged; " if with_merge else "")
+    said = merge + (f"the weld moved corners by up to {round_up(sweep.largest_move):.3g} m, so the solid the "
+                    f"file's corners bound differs from the welded one by at most {round_up(sweep.volume, 2):.2g} m³ "
+                    "(the weld's sweep)")
     if relative is not None:
         said += f", {round_up(relative, 2):.2g} of the result, within the round-off budget"
     return said

@@ -405,7 +405,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         best = _with_turned_doubt(best, turned_tris)
     if sweep is not None and not (best.method == "patched" and best.uncertainty.volume_in_doubt == 0):
         best = estimate_with_weld(best, sweep)   # R4: the estimate's doubt and the weld's, summed
-        repair_notes.append(weld_note(sweep))
+        repair_notes.append(weld_note(sweep, with_merge=True))
     flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
     if not best.volume > flat:
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
