@@ -47,6 +47,7 @@ import struct
 import warnings
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -297,3 +298,17 @@ def test_a_hole_round_a_saddle_or_on_a_torus_inner_side_keeps_its_bound(seed, ki
     truth = G.rational_moments([tuple(p) for p in v], [list(t) for t in f])
     why = _silent(v, f[keep], truth, repair=True)
     assert why is None, (kind, int((~keep).sum()), why)
+
+
+@pytest.mark.xfail(strict=True, reason="open (review13): a dome taken whole with a flat ring round it, on a grid "
+                   "surface (vertices inside its flat faces), is patched flat and bounded by the ball cut to the "
+                   "ring's slab, whose width is the rim's (0 + 16 ulp): ±3.8e-14 mass while 0.40 % off. The slab "
+                   "assumption's documented limit (hole_bounds.hole_doubt_volumes: 'on a surface with vertices "
+                   "inside its flat faces nothing shows it'), but the issue asks for no bound of ~0 unless exact; "
+                   "review13's fuzzer: 22 of 23 such estimates off 0.1-3 % inside bounds of 1e-13..8e-4")
+def test_a_dome_taken_whole_inside_a_flat_ring_is_not_bounded_by_zero():
+    rb, H = 0.45, 0.05
+    v, f, top = _heightfield(lambda x, y: H * np.clip(1 - (x * x + y * y) / rb ** 2, 0, None), 24)
+    keep = ~(top & (np.linalg.norm(v[f].mean(1)[:, :2], axis=1) < 0.6))
+    truth = G.rational_moments([tuple(p) for p in v], [list(t) for t in f])
+    assert _silent(v, f[keep], truth, repair=True) is None
