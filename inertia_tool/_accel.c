@@ -9542,7 +9542,7 @@ typedef struct {
     int64_t n_levels, m, leaf, n_points, chunk, block;
     double tolerance;
     double *w, *err;
-    int64_t *near;             /* pass 1: near leaves per point; then each point's first pair in its chunk */
+    int64_t *near_count;       /* pass 1: near leaves per point; then each point's first pair in its chunk */
     int32_t next;
     int pass;
     int overflow;              /* set when a stack would overflow (not expected: depth <= L + 8) */
@@ -9696,7 +9696,7 @@ winding_tree_task(void *ctx, int t, int nt)
         }
         const int64_t stop = start + WT_BLOCK < c->n_points ? start + WT_BLOCK : c->n_points;
         for (int64_t p = start; p < stop; p++) {
-            if (wt_point(c, c->points + 3 * p, c->near + p, c->near[p], c->w + p, c->err + p) < 0) {
+            if (wt_point(c, c->points + 3 * p, c->near_count + p, c->near_count[p], c->w + p, c->err + p) < 0) {
                 __atomic_store_n(&c->overflow, 1, __ATOMIC_RELAXED);
             }
         }
@@ -9717,7 +9717,7 @@ accel_winding_tree(PyObject *self, PyObject *args)
     Py_buffer views[6];
     int got = 0;
     PyObject *result = NULL;
-    int64_t *near = NULL;
+    int64_t *near_count = NULL;
     for (int i = 0; i < 6; i++) {
         int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (i >= 4 ? PyBUF_WRITABLE : 0);
         if (PyObject_GetBuffer(objs[i], &views[i], flags) < 0) {
@@ -9763,8 +9763,8 @@ accel_winding_tree(PyObject *self, PyObject *args)
             PyErr_SetString(PyExc_ValueError, "Expected at most (64 - 2) blocks of leaves and fewer than 2**35 points");
             goto done;
         }
-        near = (int64_t *)malloc((size_t)(n_points > 0 ? n_points : 1) * sizeof(int64_t));
-        if (near == NULL) {
+        near_count = (int64_t *)malloc((size_t)(n_points > 0 ? n_points : 1) * sizeof(int64_t));
+        if (near_count == NULL) {
             PyErr_NoMemory();
             goto done;
         }
@@ -9782,7 +9782,7 @@ accel_winding_tree(PyObject *self, PyObject *args)
         task.tolerance = tolerance;
         task.w = (double *)wv->buf;
         task.err = (double *)ev->buf;
-        task.near = near;
+        task.near_count = near_count;
         task.overflow = 0;
         const int nt = thread_count(threads, (size_t)n_points, 4 * WT_BLOCK);
         Py_BEGIN_ALLOW_THREADS
@@ -9795,8 +9795,8 @@ accel_winding_tree(PyObject *self, PyObject *args)
             int64_t running = 0;
             const int64_t e = s + task.chunk < n_points ? s + task.chunk : n_points;
             for (int64_t p = s; p < e; p++) {
-                const int64_t here = near[p];
-                near[p] = running;
+                const int64_t here = near_count[p];
+                near_count[p] = running;
                 running += here;
             }
         }
@@ -9815,7 +9815,7 @@ accel_winding_tree(PyObject *self, PyObject *args)
     result = Py_None;
     Py_INCREF(result);
 done:
-    free(near);
+    free(near_count);
     for (int i = 0; i < got; i++) {
         PyBuffer_Release(&views[i]);
     }
