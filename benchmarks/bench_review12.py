@@ -13,7 +13,8 @@ Modes:
   numbers judged in the link frame (truth shifted by the origin).
 
 Counts: per generator and label; ``wrong`` (numbers off under any label), ``silent`` (wrong under exact/united,
-or an estimate outside its bounds), refusals with their first words, crashes.
+or an estimate outside its bounds), refusals with their first words, crashes.  The wrong answers are then
+filed by what is wrong (:func:`cause`): only silent ones get a finding; honest ones and crashes are counted as such.
 
 Run: ``python benchmarks/bench_review12.py api --cases 100 --seed 1210`` (``cli``, ``robot`` likewise).
 """
@@ -70,8 +71,21 @@ def _cli_verdict(path: Path, unit: str, truth: G.RationalTruth, diag: float, rep
 
 
 def cause(kind: str, unit: str, verdict: G.Verdict) -> str:
-    """The finding of ``tests/test_review12_findings.py`` a wrong answer falls under, by what produced it (R4 a
-    weld that moved vertices, R6 a unit conversion, R8 the coplanar overlay's union, R5 several shells)."""
+    """What is wrong with an answer whose numbers miss the truth (``verdict.wrong`` set), filed by what is wrong
+    rather than by the method that produced it.
+
+    A crash is a defect of its own; an honest answer (numbers off under a label that claims nothing:
+    ``unverified``) is counted as such, whatever its method; only a silent one (a proven label off beyond the
+    judge's tolerances, an estimate outside its own bounds) gets a cause, the finding of
+    ``tests/test_review12_findings.py`` it falls under: R4 a weld that moved vertices, R6 a unit conversion, R8
+    the coplanar overlay's union, R5 several shells.  An estimate of a welded surface within its bounds is not
+    wrong at all (``judge_numbers``) and is never filed here."""
+    if verdict.label == "crashed":
+        return "crashed"
+    if not verdict.silent:
+        return f"honest ({verdict.label})"
+    if verdict.label == "estimate":
+        return f"bounds missed ({verdict.method or 'estimate'})"
     if verdict.method == "welded":
         return "R4 weld"
     if unit != "m":
@@ -185,8 +199,11 @@ def main(argv=None) -> int:
         n_silent = sum(" SILENT" in w for w in wrong[kind])
         print(f"{kind:16} {sum(c.values()):6} {c['exact']:6} {c['united']:6} {c['estimate']:6} {c['unverified']:6} "
               f"{c['refused']:7} {c['crashed']:7} {len(wrong[kind]):6} {n_silent:6}")
+    silent = [(c, n) for c, n in causes.most_common() if not c.startswith(("honest", "crashed"))]
+    others = [(c, n) for c, n in causes.most_common() if c.startswith(("honest", "crashed"))]
     if causes:
-        print("wrong answers by cause:", ", ".join(f"{c} {n}" for c, n in causes.most_common()))
+        print("silent wrong answers by cause:", ", ".join(f"{c} {n}" for c, n in silent) or "none")
+        print("other wrong numbers:", ", ".join(f"{c} {n}" for c, n in others) or "none")
     for kind in labels:
         for line in wrong[kind][:args.show]:
             print("  WRONG", kind, line[:400])

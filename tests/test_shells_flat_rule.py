@@ -109,3 +109,90 @@ def test_a_turned_sheet_is_refused(seed):
     v, f = box((1.0, 0.5, 0.0))
     with pytest.raises(InvalidMeshError, match="encloses no volume"):
         _answer(v @ q.T + 0.25, f)
+
+
+def _staggered_needle(width: float, length: float, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """A box ``width`` × ``width`` × ``length`` (corner at the origin, long along z) whose four long edges carry
+    vertices at staggered heights (``length·j/steps`` on two opposite edges, halfway between on the other two), the
+    sides zigzagged between them: every side triangle's corners are at least ``length / (2 steps)`` apart, so a
+    hole left by one of them has no two corners within the repair's weld tolerance (1e-6 of the diagonal)."""
+    heights = [[length * j / steps for j in range(steps + 1)],
+               [0.0] + [length * (j + 0.5) / steps for j in range(steps)] + [length]]
+    corners = [(0.0, 0.0), (width, 0.0), (width, width), (0.0, width)]
+    vertices, rows = [], []
+    for k, (x, y) in enumerate(corners):
+        rows.append(list(range(len(vertices), len(vertices) + len(heights[k % 2]))))
+        vertices += [(x, y, z) for z in heights[k % 2]]
+    v = np.array(vertices, dtype=np.float64)
+    faces = []
+    for k in range(4):                         # each side: advance along whichever edge has the lower next vertex
+        a, b = rows[k], rows[(k + 1) % 4]
+        i = j = 0
+        while i < len(a) - 1 or j < len(b) - 1:
+            if j == len(b) - 1 or (i < len(a) - 1 and v[a[i + 1], 2] <= v[b[j + 1], 2]):
+                faces.append([a[i], a[i + 1], b[j]])
+                i += 1
+            else:
+                faces.append([a[i], b[j + 1], b[j]])
+                j += 1
+    ends = [r[0] for r in rows], [r[-1] for r in rows]
+    faces += [[ends[0][0], ends[0][2], ends[0][1]], [ends[0][0], ends[0][3], ends[0][2]],
+              [ends[1][0], ends[1][1], ends[1][2]], [ends[1][0], ends[1][2], ends[1][3]]]
+    f = np.array(faces, dtype=np.int64)
+    tri = v[f]                                 # wound outward: each face's normal away from the axis (or the end)
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    inward = np.einsum("ij,ij->i", normal, tri.mean(axis=1) - v.mean(axis=0)) < 0
+    f[inward] = f[inward][:, ::-1]
+    return v, f
+
+
+def _repair_answer(vertices, faces):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return mass_properties((vertices, faces), density=1.0, repair=True)
+
+
+@settings(max_examples=8, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(length=st.floats(1e-2, 1e1), log_aspect=st.floats(6.0, 8.0), which=st.integers(0, 10 ** 6),
+       turned=st.booleans(), seed=st.integers(0, 2 ** 32 - 1))
+def test_a_needle_with_a_hole_is_answered_within_its_bounds(length, log_aspect, which, turned, seed):
+    """A needle of aspect 1e6..1e8 (1 µm × 1 µm × 1 m and thinner) with one side triangle missing, under
+    ``repair=True``: the repair's estimate encloses far more than its round-off, so it is answered (the old rule,
+    ``|V| ≤ FLAT_RTOL · diagonal³``, refused it as "the surface encloses no volume"), and within its bounds
+    against the exact integrals of the undamaged needle."""
+    v, f = _staggered_needle(length * 10.0 ** -log_aspect, length, 50)
+    if turned:
+        q, _ = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+        v = v @ q.T
+    truth = G.rational_moments([tuple(p) for p in v.tolist()], [list(t) for t in f.tolist()])
+    tri = v[f]
+    shortest = np.min(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2), axis=1)
+    sides = np.flatnonzero(shortest > 0.25 * length / 50)                 # a side triangle, no end cap
+    damaged = np.delete(f, sides[which % len(sides)], axis=0)
+    props = _repair_answer(v, damaged)
+    assert props.mesh.certificate.kind == "estimate"
+    diag = float(np.linalg.norm(v.max(0) - v.min(0)))
+    verdict = G.judge_numbers("estimate", props.mass, props.center_of_mass, props.inertia,
+                              props.mesh.uncertainty, truth, diag)
+    assert not verdict.silent and not verdict.wrong, verdict
+
+
+@settings(max_examples=8, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(length=st.floats(1e-2, 1e1), log_aspect=st.floats(6.0, 8.0), shift=st.floats(0.05, 0.95))
+def test_overlapping_needles_are_united(length, log_aspect, shift):
+    """Two needles of aspect 1e6..1e8 on one axis, the second moved ``shift`` of its length along it: the union
+    is one box ``(1 + shift)·length`` long.  Each piece's volume is below ``FLAT_RTOL · diagonal³``, which the
+    union stage's old rule called a sheet (refused: "no outward-wound piece to unite"); by their round-off they
+    are solids, and the union is the box's closed form."""
+    width = length * 10.0 ** -log_aspect
+    v, f = box((width, width, length))
+    step = np.array([0.0, 0.0, shift * length])
+    props = _answer(np.vstack([v, v + step]), np.vstack([f, f + len(v)]))
+    assert props.mesh.certificate.kind in ("united", "exact"), props.mesh.certificate.kind
+    whole = np.array([width, width, (1.0 + shift) * length])
+    volume = float(np.prod(whole))
+    assert props.mass == pytest.approx(volume, rel=1e-9)
+    np.testing.assert_allclose(props.center_of_mass, step / 2, atol=1e-9 * length)
+    expected = np.diag([whole[1] ** 2 + whole[2] ** 2, whole[0] ** 2 + whole[2] ** 2,
+                        whole[0] ** 2 + whole[1] ** 2]) * volume / 12.0
+    np.testing.assert_allclose(props.inertia, expected, rtol=1e-8, atol=1e-9 * float(expected.max()))

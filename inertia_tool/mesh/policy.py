@@ -61,8 +61,12 @@ R2 *Flat pieces carry no volume* (``tolerances.FLAT_RTOL``).  A closed shell who
    ``FLAT_RTOL · diagonal³`` (a face and its reverse, a zero-thickness wall, a collapsed sliver) contributes
    nothing to the integrals, so it is left out with a note and the answer stays exact (:func:`negligible_flat`:
    only when its volume and its second moment about the rest's centroid are below ``FLAT_MOMENT_RTOL`` of the
-   rest's; a thin but real solid far away stays and is integrated).  Only a mesh that is flat everywhere is
-   refused.  Reason: such faces cancel pairwise in every surface integral.
+   rest's; a thin but real solid far away stays and is integrated).  When every shell is below that scale the
+   scale says nothing (a needle 1 µm × 1 µm × 1 m encloses 1e-12 m³, known to 1e-16 of itself), and a shell is
+   flat only when its |volume| is within its own round-off: R7's bound on its summed volume plus ``√3 δ · area``
+   (``δ`` half the float64 spacing at the largest coordinate).  A mesh is refused only when every shell is flat
+   up to that round-off; the repair's estimate and the pieces of a union are judged by the same rule
+   (:func:`~.shells.flat_pieces`).  Reason: such faces cancel pairwise in every surface integral.
 R3 *A surface that passes through itself is not a solid as it stands* (:func:`self_crossing_message`).  A
    crossing between two faces of one shell makes the winding number 2 (or −1) somewhere, and the summed
    integral counts that region twice.  manifold3d does not resolve a self-intersection inside one mesh

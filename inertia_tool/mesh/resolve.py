@@ -35,7 +35,6 @@ import numpy as np
 
 from ..values import frozen_value
 from ..errors import InvalidMeshError, WorkBudgetError
-from ..tolerances import FLAT_RTOL
 from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
 from ..rounding import round_up
 
@@ -406,8 +405,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     if sweep is not None and not (best.method == "patched" and best.uncertainty.volume_in_doubt == 0):
         best = estimate_with_weld(best, sweep)   # R4: the estimate's doubt and the weld's, summed
         repair_notes.append(weld_note(sweep, with_merge=True))
-    flat = FLAT_RTOL * diag ** 3          # less than this encloses nothing (a sheet, a soup of loose triangles)
-    if not best.volume > flat:
+    if not best.volume > 0 or _encloses_nothing(best, diag):     # R2 (a sheet, a soup of loose triangles)
         raise InvalidMeshError(f"{source}: the surface encloses no volume (a single sheet or flat pieces); for a "
                                "thin-walled part use the shell model with a wall `thickness`")
     if best.unbounded:                        # a hole whose surroundings contradict the bound's assumption
@@ -425,6 +423,23 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                           front_nonmanifold, weld=sweep)
     return Resolution(best.vertices, best.faces, best.method, tuple(repair_notes), flipped, welded,
                       front_nonmanifold if best.method == "patched" else census.nonmanifold_edges, estimate=best)
+
+
+def _encloses_nothing(best: Estimate, diag: float) -> bool:
+    """R2 on the repair's estimate: its volume is flat by :func:`~.shells.flat_pieces` (the rule ``drop_flat``
+    applies to shells), with the round-off budget of the surface it integrates (``best.faces``: the patched
+    surface, or the input the winding estimate was taken from) about the integrals' reference point."""
+    from ..integrals import reference_point, roundoff_bounds, volume_moments
+    from .shells import flat_pieces
+
+    def roundoff() -> np.ndarray:
+        v = np.asarray(best.vertices, dtype=np.float64)
+        f = np.asarray(best.faces)
+        origin = reference_point(v)
+        surface = volume_moments(v, f, origin=origin)
+        return roundoff_bounds(v, f, np.zeros(len(f), dtype=np.int64), [surface], origin).volume
+
+    return bool(flat_pieces([best.volume], [best.area], best.vertices, diag, roundoff)[0])
 
 
 def _with_turned_doubt(best: Estimate, turned: np.ndarray) -> Estimate:

@@ -8,7 +8,7 @@ the steps the later stages repeat on a surface they changed (:func:`reshelled`: 
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -20,8 +20,8 @@ from .checks import shell_labels
 from .policy import (coincident_message, coincident_surfaces, copy_candidates, near_copies, near_copies_message,
                      negligible_flat, welded_bodies)
 
-__all__ = ["Shells", "FoundShells", "find_shells", "bodies", "measured", "reshelled", "drop_flat", "apply_flips",
-           "leave_out_coincident", "total"]
+__all__ = ["Shells", "FoundShells", "find_shells", "bodies", "measured", "reshelled", "drop_flat", "flat_pieces",
+           "apply_flips", "leave_out_coincident", "total"]
 
 
 class Shells(NamedTuple):
@@ -188,26 +188,13 @@ def drop_flat(shells: Shells, diag: float, source: str, *, warn: bool = True,
     and round-off bound (R7) are computed anew when some are left out.  Returns the shells and the note (warned
     when ``warn``, at ``stacklevel``), or None when nothing was left out.
 
-    A shell is a candidate when ``|V| ≤ FLAT_RTOL · diag³`` and is left out only when that changes the rest's
-    moments by no more than round-off (:func:`~.policy.negligible_flat`).  When every shell is a candidate the
-    scale ``diag³`` says nothing (a needle 1 µm × 1 µm × 1 m encloses 1e-12 m³ = ``FLAT_RTOL · diag³``, its volume
-    known to 1e-16 of itself: review 12's R7).  The mesh is then refused only when no shell's volume exceeds its
-    own round-off budget ``b + √3 δ A``: ``b`` the float64 round-off bound of its summed volume
-    (``shells.bound.volume``, R7) and ``√3 δ A`` what rounding the corners of a flat surface of area ``A`` to
-    float64 can enclose (``δ`` half the float64 spacing at the largest coordinate; moving each corner by at most
-    ``√3 δ`` moves a closed surface's volume by at most that times its area, to first order).  Such a shell is a
-    face and its reverse or a collapsed sliver, flat up to rounding; the shells above their budget are the solid
-    and the others candidates as above.  The decision is by each shell's own budget, whatever the aspect ratio."""
+    The flat shells are :func:`flat_pieces`'s (R2's rule, written once: the repair's estimate and the union's
+    pieces are judged by it too); one is left out only when that changes the rest's moments by no more than
+    round-off (:func:`~.policy.negligible_flat`)."""
     v, f, labels, n_shells, moments, bound = shells
-    flat = np.array([abs(s.volume) <= FLAT_RTOL * diag ** 3 for s in moments], dtype=bool)
+    flat = flat_pieces([s.volume for s in moments], [s.area for s in moments], v, diag, lambda: bound.volume)
     if not flat.any():
         return shells, None
-    if flat.all():
-        delta = 0.5 * float(np.spacing(np.max(np.abs(v)))) if v.size else 0.0
-        flat = np.array([not abs(s.volume) > b + np.sqrt(3.0) * delta * s.area
-                         for s, b in zip(moments, bound.volume)], dtype=bool)
-        if not flat.any():
-            return shells, None
     if flat.all():
         what = "the mesh encloses" if n_shells == 1 else f"all {n_shells} shells enclose"
         raise InvalidMeshError(f"{source}: {what} no volume (flat or collapsed surface); for a sheet or a "
@@ -226,6 +213,33 @@ def drop_flat(shells: Shells, diag: float, source: str, *, warn: bool = True,
     if warn:
         warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=stacklevel)
     return kept, note
+
+
+def flat_pieces(volumes: Sequence[float] | np.ndarray, areas: Sequence[float] | np.ndarray, vertices: np.ndarray,
+                diag: float, roundoff: Callable[[], Sequence[float] | np.ndarray]) -> np.ndarray:
+    """R2's rule: which closed pieces enclose no volume, (k,) bool.  ``volumes`` (m³, signed) and ``areas`` (m²)
+    of the pieces, ``vertices`` (n, 3) m the corners they are made of, ``diag`` the mesh's diagonal (m);
+    ``roundoff()`` (k,) m³ the float64 round-off bound of each piece's summed volume (R7,
+    :func:`~inertia_tool.integrals.roundoff_bounds`), called only when the scale alone does not decide.
+
+    A piece is flat when ``|V| ≤ FLAT_RTOL · diag³`` while some piece exceeds that: beside a solid such a piece
+    is a face and its reverse, a zero-thickness wall or a collapsed sliver (the caller decides whether leaving it
+    out is negligible).  When every piece is at most ``FLAT_RTOL · diag³`` the scale says nothing (a needle
+    1 µm × 1 µm × 1 m encloses 1e-12 m³ = ``FLAT_RTOL · diag³``, its volume known to 1e-16 of itself: review 12's
+    R7), and a piece is flat only when its volume is within its own round-off budget ``b + √3 δ A``: ``b`` from
+    ``roundoff()`` and ``√3 δ A`` what rounding the corners of a flat surface of area ``A`` to float64 can
+    enclose (``δ`` half the float64 spacing at the largest coordinate; moving each corner by at most ``√3 δ``
+    moves a closed surface's volume by at most that times its area, to first order).  Whatever the aspect ratio,
+    the mesh as a whole is called flat only when every piece is flat up to rounding."""
+    volume = np.abs(np.asarray(volumes, dtype=np.float64)).reshape(-1)
+    flat = volume <= FLAT_RTOL * diag ** 3
+    if not flat.all():
+        return flat
+    v = np.asarray(vertices, dtype=np.float64)
+    delta = 0.5 * float(np.spacing(np.max(np.abs(v)))) if v.size else 0.0
+    budget = np.asarray(roundoff(), dtype=np.float64).reshape(-1) + \
+        np.sqrt(3.0) * delta * np.asarray(areas, dtype=np.float64).reshape(-1)
+    return np.asarray(~(volume > budget), dtype=bool)
 
 
 def apply_flips(shells: Shells, flip: np.ndarray, source: str, *, warn: bool = True) -> Shells:

@@ -13,14 +13,13 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from ..errors import InvalidMeshError, MeshResolvedWarning, OverlapWarning
-from ..integrals import body_volume_moments, bounding_box, volume_moments
-from ..tolerances import FLAT_RTOL
+from ..integrals import body_volume_moments, bounding_box, reference_point, roundoff_bounds, volume_moments
 from .checks import edge_topology
 from .classify import Orientation, shell_nesting_or_none
 from .intersect import SurfaceContacts, surface_contacts
 from .policy import TOUCH_VOLUME_RTOL, orient_by_depth
 from .resolve import Resolution, resolve_surface
-from .shells import Shells, apply_flips, reshelled
+from .shells import Shells, apply_flips, flat_pieces, reshelled
 
 if TYPE_CHECKING:       # imported on use at run time (below)
     from .union import PieceSolids, UnionSurface
@@ -321,7 +320,9 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
     pieces = body_volume_moments(vertices, faces, groups, n_groups)
     volume = np.array([p.volume for p in pieces])
     lo, hi = bounding_box(vertices)
-    solid = np.abs(volume) > FLAT_RTOL * float(np.linalg.norm(hi - lo)) ** 3    # sheets (a face and its reverse)
+    origin = reference_point(vertices)    # (body_volume_moments' default: the bound is of the sums made about it)
+    solid = ~flat_pieces(volume, [p.area for p in pieces], vertices, float(np.linalg.norm(hi - lo)),   # R2: sheets
+                         lambda: roundoff_bounds(vertices, faces, groups, pieces, origin).volume)
     shell_of_group = np.zeros(n_groups, dtype=np.int64)
     shell_of_group[groups] = labels
     keep = solid[groups]
