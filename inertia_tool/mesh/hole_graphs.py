@@ -49,6 +49,7 @@ import numpy as np
 from ..values import frozen_value
 from .hole_bounds import BEND_MAX_DEGREES, _round_off
 from .hole_fills import QUADRIC_FIT_RTOL, _fitted_quadric, _quadric
+from .polygons import ear_clip_2d
 
 __all__ = ["GraphFill", "graph_fills", "face_on_direction", "GRAPH_MAX_LOOPS", "GRAPH_MAX_RIM", "GRAPH_GRID"]
 
@@ -246,33 +247,8 @@ def _ear_clip(poly: np.ndarray) -> np.ndarray | None:
     k = len(poly)
     if k > GRAPH_MAX_CLIPPED:
         return None
-    u, w = poly[:, 0], poly[:, 1]
-    remaining = list(range(k))
-    triangles: list[tuple[int, int, int]] = []
-    start = 0
-    while len(remaining) > 3:                     # one corner removed per pass: at most k − 3 passes
-        m = len(remaining)
-        for step in range(m):
-            g = (start + step) % m
-            a, b, c = remaining[g - 1], remaining[g], remaining[(g + 1) % m]
-            turn = (u[b] - u[a]) * (w[c] - w[a]) - (w[b] - w[a]) * (u[c] - u[a])
-            if not turn > 0:
-                continue
-            others = np.array([i for i in remaining if i not in (a, b, c)], dtype=np.int64)
-            pu, pw = u[others], w[others]
-            s0 = (u[b] - u[a]) * (pw - w[a]) - (w[b] - w[a]) * (pu - u[a])
-            s1 = (u[c] - u[b]) * (pw - w[b]) - (w[c] - w[b]) * (pu - u[b])
-            s2 = (u[a] - u[c]) * (pw - w[c]) - (w[a] - w[c]) * (pu - u[c])
-            if np.any((s0 >= 0) & (s1 >= 0) & (s2 >= 0)):
-                continue
-            triangles.append((a, b, c))
-            del remaining[g]
-            start = g % (m - 1)
-            break
-        else:
-            return None
-    triangles.append((remaining[0], remaining[1], remaining[2]))
-    return np.array(triangles, dtype=np.int64)
+    triangles = ear_clip_2d(poly[:, 0], poly[:, 1], rotate=True)
+    return None if triangles is None else np.array(triangles, dtype=np.int64)
 
 
 def _refined(tri: np.ndarray, points: np.ndarray, k: int, levels: int) -> tuple[np.ndarray, np.ndarray]:

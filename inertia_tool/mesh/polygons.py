@@ -16,8 +16,8 @@ import numpy as np
 from ..errors import NonPlanarPolygonWarning
 from ..rounding import round_up
 
-__all__ = ["split_quads_along_shorter_diagonal", "clip_polygon_as_mujoco", "clip_polygons", "warn_warped_quads",
-           "warn_clipped_polygons", "MAX_CLIPPED_CORNERS"]
+__all__ = ["split_quads_along_shorter_diagonal", "ear_clip_2d", "clip_polygon_as_mujoco", "clip_polygons",
+           "warn_warped_quads", "warn_clipped_polygons", "MAX_CLIPPED_CORNERS"]
 
 
 def split_quads_along_shorter_diagonal(vertices: np.ndarray, faces: np.ndarray,
@@ -184,24 +184,19 @@ def _overlapping(relative: np.ndarray, triangles: list[tuple[int, int, int]], no
 MAX_EAR_CLIPPED_CORNERS = 256
 
 
-def _ear_clip(relative: np.ndarray, normal: np.ndarray) -> list[tuple[int, int, int]] | None:
-    """Triangles of a simple planar polygon (corners ``relative`` (k, 3) about the first one, counter-clockwise
-    about ``normal``) by ear clipping in float64 on the plane most face-on to it: an ear is a corner turning
-    left whose triangle holds no other remaining corner (on its boundary counts as held).  None when no ear is
-    found (the polygon is not simple in float64) or it has more than :data:`MAX_EAR_CLIPPED_CORNERS` corners."""
-    k = len(relative)
-    if k > MAX_EAR_CLIPPED_CORNERS:
-        return None
-    drop = int(np.argmax(np.abs(normal)))
-    axes = [a for a in range(3) if a != drop]
-    if normal[drop] < 0:
-        axes = axes[::-1]                         # so that the polygon runs counter-clockwise in (u, w)
-    u, w = relative[:, axes[0]], relative[:, axes[1]]
-    remaining = list(range(k))
+def ear_clip_2d(u: np.ndarray, w: np.ndarray, *, rotate: bool = False) -> list[tuple[int, int, int]] | None:
+    """Triangles of the simple counter-clockwise polygon with corners ``(u[i], w[i])`` by ear clipping in float64:
+    an ear is a corner turning left whose triangle holds no other remaining corner (on its border counts as held).
+    ``rotate`` starts each pass's search after the last ear cut (ears spread round the polygon instead of fanning
+    from its first corners).  None when no ear is found (the polygon is not simple in float64).  Quadratic passes
+    in Python: callers bound the corner count."""
+    remaining = list(range(len(u)))
     triangles: list[tuple[int, int, int]] = []
+    start = 0
     while len(remaining) > 3:                     # one corner removed per pass: at most k − 3 passes
         m = len(remaining)
-        for g in range(m):
+        for step in range(m):
+            g = (start + step) % m
             a, b, c = remaining[g - 1], remaining[g], remaining[(g + 1) % m]
             turn = (u[b] - u[a]) * (w[c] - w[a]) - (w[b] - w[a]) * (u[c] - u[a])
             if not turn > 0:
@@ -215,11 +210,28 @@ def _ear_clip(relative: np.ndarray, normal: np.ndarray) -> list[tuple[int, int, 
                 continue
             triangles.append((a, b, c))
             del remaining[g]
+            if rotate:
+                start = g % (m - 1)
             break
         else:
             return None
     triangles.append((remaining[0], remaining[1], remaining[2]))
     return triangles
+
+
+def _ear_clip(relative: np.ndarray, normal: np.ndarray) -> list[tuple[int, int, int]] | None:
+    """Triangles of a simple planar polygon (corners ``relative`` (k, 3) about the first one, counter-clockwise
+    about ``normal``) by ear clipping in float64 on the plane most face-on to it: an ear is a corner turning
+    left whose triangle holds no other remaining corner (on its boundary counts as held).  None when no ear is
+    found (the polygon is not simple in float64) or it has more than :data:`MAX_EAR_CLIPPED_CORNERS` corners."""
+    k = len(relative)
+    if k > MAX_EAR_CLIPPED_CORNERS:
+        return None
+    drop = int(np.argmax(np.abs(normal)))
+    axes = [a for a in range(3) if a != drop]
+    if normal[drop] < 0:
+        axes = axes[::-1]                         # so that the polygon runs counter-clockwise in (u, w)
+    return ear_clip_2d(relative[:, axes[0]], relative[:, axes[1]])
 
 
 def _clipped_near_the_origin(relative: np.ndarray, clipped: list[tuple[int, int, int]], lost: int,
