@@ -23,37 +23,22 @@ from hypothesis import strategies as st
 from conftest import HAVE_ACCEL
 from intersect_reference import NONE, brute_kind, pair_kinds
 from inertia_tool import _native
-from inertia_tool.mesh.intersect import SurfaceContacts, surface_contacts
+from inertia_tool.mesh.intersect import SurfaceContacts
+from contact_scans import fan_capped_cylinder, run_scan, same_pairs
 
-FIELDS = ("crossing", "coplanar_opposite", "contact")
 
 pytestmark = pytest.mark.skipif(not HAVE_ACCEL, reason="inertia_tool._accel is not built")
 
 
-def _run(v, f, accel: bool, **kwargs) -> SurfaceContacts:
-    with pytest.MonkeyPatch.context() as mp:
-        if accel:
-            mp.delenv(_native.NO_ACCEL_ENV, raising=False)
-        else:
-            mp.setenv(_native.NO_ACCEL_ENV, "1")
-        return surface_contacts(v, f, **kwargs)
-
-
-def _same_pairs(a: SurfaceContacts, b: SurfaceContacts) -> None:
-    assert a.complete and b.complete
-    for name in FIELDS:
-        assert np.array_equal(getattr(a, name), getattr(b, name)), name
-
-
 def _check(v, f) -> SurfaceContacts:
     """The C scan as used, after comparing it with the C scan without patches or stars and the numpy twin."""
-    fast = _run(v, f, accel=True)
-    unpatched = _run(v, f, accel=True, _patches=False)
-    bare = _run(v, f, accel=True, _patches=False, _star_faces=0)
-    ref = _run(v, f, accel=False)
-    _same_pairs(fast, unpatched)
-    _same_pairs(fast, bare)
-    _same_pairs(fast, ref)
+    fast = run_scan(v, f, accel=True)
+    unpatched = run_scan(v, f, accel=True, _patches=False)
+    bare = run_scan(v, f, accel=True, _patches=False, _star_faces=0)
+    ref = run_scan(v, f, accel=False)
+    same_pairs(fast, unpatched)
+    same_pairs(fast, bare)
+    same_pairs(fast, ref)
     assert (unpatched.candidate_pairs, unpatched.tested_pairs) == (ref.candidate_pairs, ref.tested_pairs)
     assert fast.candidate_pairs <= unpatched.candidate_pairs <= bare.candidate_pairs
     return fast
@@ -79,19 +64,6 @@ def _fan(angles, radii, heights, closed, apex):
     k = len(angles)
     i = np.arange(k if closed else k - 1)
     return v, np.stack([np.zeros_like(i), 1 + i, 1 + (i + 1) % k], axis=1)
-
-
-def _cylinder(n, radius=1.0, height=2.0):
-    """A closed cylinder of n sections with fan caps round a centre vertex at each end (as CAD exports)."""
-    t = 2 * np.pi * np.arange(n) / n
-    ring = np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
-    v = np.concatenate([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, height)], [[0, 0, 0], [0, 0, height]]])
-    i = np.arange(n)
-    j = (i + 1) % n
-    bottom, top = np.full(n, 2 * n), np.full(n, 2 * n + 1)
-    f = np.concatenate([np.stack([bottom, j, i], 1), np.stack([top, n + i, n + j], 1),
-                        np.stack([i, j, n + j], 1), np.stack([i, n + j, n + i], 1)])
-    return v, f
 
 
 @st.composite
@@ -150,7 +122,7 @@ def test_big_fans_find_what_the_unpruned_scan_and_the_numpy_twin_find(fan):
 def test_fan_capped_cylinders_keep_every_defect(sections, defect):
     """A closed cylinder whose caps are fans of 65 or 129 faces, with one defect made on purpose; the scan must
     find it (and nothing else new) on every path."""
-    v, f = _cylinder(sections)
+    v, f = fan_capped_cylinder(sections)
     n = sections
     bottom = 2 * n
     moved = []

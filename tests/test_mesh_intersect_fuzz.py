@@ -18,21 +18,11 @@ from hypothesis import strategies as st
 from conftest import HAVE_ACCEL
 from intersect_reference import NONE, brute_kind, pair_kinds
 from inertia_tool import _native
-from inertia_tool.mesh.intersect import SurfaceContacts, surface_contacts
+from contact_scans import FIELDS, run_scan
 
 pytestmark = pytest.mark.skipif(not HAVE_ACCEL, reason="inertia_tool._accel is not built")
 
-FIELDS = ("crossing", "coplanar_opposite", "contact")
 FUZZ = settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-
-
-def _run(v, f, accel: bool, **kwargs) -> SurfaceContacts:
-    with pytest.MonkeyPatch.context() as mp:
-        if accel:
-            mp.delenv(_native.NO_ACCEL_ENV, raising=False)
-        else:
-            mp.setenv(_native.NO_ACCEL_ENV, "1")
-        return surface_contacts(v, f, **kwargs)
 
 
 @st.composite
@@ -95,12 +85,12 @@ def _layout(f: np.ndarray, how: str) -> np.ndarray:
 
 def _check(v, f, how, brute):
     f = _layout(np.asarray(f), how)
-    ref = _run(v, f, accel=False)
+    ref = run_scan(v, f, accel=False)
     for star_faces in (None, 0, 3):
         for patches in (True, False):
             kwargs = {"_patches": patches} if star_faces is None else {"_star_faces": star_faces,
                                                                        "_patches": patches}
-            fast = _run(v, f, accel=True, **kwargs)
+            fast = run_scan(v, f, accel=True, **kwargs)
             assert fast.complete and ref.complete
             for name in FIELDS:
                 assert np.array_equal(getattr(fast, name), getattr(ref, name)), (name, star_faces, patches)
@@ -146,8 +136,8 @@ def test_c_scan_on_zero_one_and_two_faces(m, dtype):
 def test_c_scan_work_bound_agrees_with_the_numpy_twin(mesh, max_pairs):
     """Under a work bound both scans stop at the same count, and agree on whether they finished."""
     v, f = mesh
-    ref = _run(v, f, accel=False, max_pairs=max_pairs)
-    fast = _run(v, f, accel=True, max_pairs=max_pairs)
+    ref = run_scan(v, f, accel=False, max_pairs=max_pairs)
+    fast = run_scan(v, f, accel=True, max_pairs=max_pairs)
     assert fast.complete == ref.complete
     assert fast.candidate_pairs == ref.candidate_pairs
     if ref.complete:

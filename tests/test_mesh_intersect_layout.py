@@ -26,21 +26,11 @@ from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL
 from inertia_tool import _native
-from inertia_tool.mesh.intersect import SurfaceContacts, surface_contacts
+from contact_scans import FIELDS, run_scan
 
 pytestmark = pytest.mark.skipif(not HAVE_ACCEL, reason="inertia_tool._accel is not built")
 
-FIELDS = ("crossing", "coplanar_opposite", "contact")
 FUZZ = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-
-
-def _run(v, f, accel: bool, **kwargs) -> SurfaceContacts:
-    with pytest.MonkeyPatch.context() as mp:
-        if accel:
-            mp.delenv(_native.NO_ACCEL_ENV, raising=False)
-        else:
-            mp.setenv(_native.NO_ACCEL_ENV, "1")
-        return surface_contacts(v, f, **kwargs)
 
 
 def box_meeting_pairs(v: np.ndarray, f: np.ndarray) -> int:
@@ -81,7 +71,7 @@ def test_every_box_meeting_pair_is_a_candidate(mesh):
     """Unpruned, the C scan's candidates are exactly the pairs whose closed float64 boxes meet (brute force):
     the byte grid loses none, at any scale, far from the origin, beyond float32's range."""
     v, f = mesh
-    fast = _run(v, f, accel=True, _star_faces=0, _patches=False)
+    fast = run_scan(v, f, accel=True, _star_faces=0, _patches=False)
     assert fast.complete
     assert fast.candidate_pairs == box_meeting_pairs(v, f)
 
@@ -93,9 +83,9 @@ def test_c_scan_is_the_numpy_twin_on_lattice_meshes(mesh, dtype):
     without patches the counts are the twin's too."""
     v, f = mesh
     f = f.astype(dtype)
-    ref = _run(v, f, accel=False)
+    ref = run_scan(v, f, accel=False)
     for patches in (True, False):
-        fast = _run(v, f, accel=True, _patches=patches)
+        fast = run_scan(v, f, accel=True, _patches=patches)
         for name in FIELDS:
             assert np.array_equal(getattr(fast, name), getattr(ref, name)), (name, patches)
         if not patches:
@@ -116,9 +106,9 @@ def test_a_row_of_triangles_touching_at_corners_far_from_the_origin(scale):
     v = ((tri + np.array([2.0 ** 40, 0.0, 0.0])) * scale).reshape(-1, 3)
     f = np.arange(len(v)).reshape(-1, 3)
     want = np.stack([np.arange(63), np.arange(1, 64)], axis=1)
-    unpruned = _run(v, f, accel=True, _star_faces=0, _patches=False)
+    unpruned = run_scan(v, f, accel=True, _star_faces=0, _patches=False)
     assert unpruned.candidate_pairs == box_meeting_pairs(v, f) == 63
-    for result in (unpruned, _run(v, f, accel=True), _run(v, f, accel=False)):
+    for result in (unpruned, run_scan(v, f, accel=True), run_scan(v, f, accel=False)):
         assert np.array_equal(result.contact, want)
         assert not len(result.crossing) and not len(result.coplanar_opposite)
 

@@ -21,37 +21,21 @@ from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL
 from intersect_reference import NONE, brute_kind, pair_kinds
-from inertia_tool import _native
-from inertia_tool.mesh.intersect import SurfaceContacts, surface_contacts
+from inertia_tool.mesh.intersect import SurfaceContacts
+from contact_scans import run_scan, same_pairs
 
-FIELDS = ("crossing", "coplanar_opposite", "contact")
 
 pytestmark = pytest.mark.skipif(not HAVE_ACCEL, reason="inertia_tool._accel is not built")
 
 
-def _run(v, f, accel: bool, **kwargs) -> SurfaceContacts:
-    with pytest.MonkeyPatch.context() as mp:
-        if accel:
-            mp.delenv(_native.NO_ACCEL_ENV, raising=False)
-        else:
-            mp.setenv(_native.NO_ACCEL_ENV, "1")
-        return surface_contacts(v, f, **kwargs)
-
-
-def _same_pairs(a: SurfaceContacts, b: SurfaceContacts) -> None:
-    assert a.complete and b.complete
-    for name in FIELDS:
-        assert np.array_equal(getattr(a, name), getattr(b, name)), name
-
-
 def _check(v, f, brute=False) -> tuple[SurfaceContacts, SurfaceContacts]:
     """(patched, unpatched) C scans after comparing both, and the numpy twin, pair for pair."""
-    fast = _run(v, f, accel=True)
-    unpatched = _run(v, f, accel=True, _patches=False)
-    ref = _run(v, f, accel=False)
-    _same_pairs(fast, unpatched)
-    _same_pairs(fast, ref)
-    _same_pairs(fast, _run(v, f, accel=True, _star_faces=0))
+    fast = run_scan(v, f, accel=True)
+    unpatched = run_scan(v, f, accel=True, _patches=False)
+    ref = run_scan(v, f, accel=False)
+    same_pairs(fast, unpatched)
+    same_pairs(fast, ref)
+    same_pairs(fast, run_scan(v, f, accel=True, _star_faces=0))
     assert (unpatched.candidate_pairs, unpatched.tested_pairs) == (ref.candidate_pairs, ref.tested_pairs)
     assert fast.candidate_pairs <= unpatched.candidate_pairs
     if brute:

@@ -22,8 +22,8 @@ from conftest import HAVE_ACCEL
 from intersect_reference import NONE, brute_kind, pair_kinds
 from inertia_tool import _native
 from inertia_tool.mesh.intersect import SurfaceContacts, surface_contacts
+from contact_scans import same_pairs
 
-FIELDS = ("crossing", "coplanar_opposite", "contact")
 
 pytestmark = pytest.mark.skipif(not HAVE_ACCEL, reason="inertia_tool._accel is not built")
 
@@ -40,23 +40,17 @@ def _c(v, f, **kwargs) -> SurfaceContacts:
         return surface_contacts(v, f, **kwargs)
 
 
-def _same_pairs(a: SurfaceContacts, b: SurfaceContacts) -> None:
-    assert a.complete and b.complete
-    for name in FIELDS:
-        assert np.array_equal(getattr(a, name), getattr(b, name)), name
-
-
 def _check_all_paths(v, f, brute=False) -> SurfaceContacts:
     """The C scan against its unpruned and unpatched selves and the numpy twin (pairs; candidate and tested
     counts without the C scan's patches, which only lower them), and optionally every pair against the rational
     classifier."""
     fast = _c(v, f)
-    _same_pairs(fast, _c(v, f, _star_faces=0))
-    _same_pairs(fast, _c(v, f, _star_faces=0, _patches=False))
+    same_pairs(fast, _c(v, f, _star_faces=0))
+    same_pairs(fast, _c(v, f, _star_faces=0, _patches=False))
     unpatched = _c(v, f, _patches=False)
-    _same_pairs(fast, unpatched)
+    same_pairs(fast, unpatched)
     ref = _numpy(v, f)
-    _same_pairs(fast, ref)
+    same_pairs(fast, ref)
     assert (unpatched.candidate_pairs, unpatched.tested_pairs, unpatched.degenerate_faces) == \
         (ref.candidate_pairs, ref.tested_pairs, ref.degenerate_faces)
     assert fast.candidate_pairs <= ref.candidate_pairs and fast.tested_pairs <= ref.tested_pairs

@@ -19,6 +19,7 @@ from conftest import HAVE_ACCEL
 from intersect_reference import NONE, brute_kind, pair_kinds
 from inertia_tool import _native
 from inertia_tool.mesh.intersect import STAR_MIN_FACES, SurfaceContacts, surface_contacts
+from contact_scans import fan_capped_cylinder
 
 FIELDS = ("crossing", "coplanar_opposite", "contact")
 
@@ -42,19 +43,6 @@ def _same(pruned: SurfaceContacts, full: SurfaceContacts) -> None:
     assert pruned.candidate_pairs <= full.candidate_pairs
 
 
-def _cylinder(n, radius=1.0, height=2.0):
-    """A closed cylinder of n sections with fan caps around a centre vertex at each end (as CAD exports)."""
-    t = 2 * np.pi * np.arange(n) / n
-    ring = np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
-    v = np.concatenate([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, height)], [[0, 0, 0], [0, 0, height]]])
-    i = np.arange(n)
-    j = (i + 1) % n
-    bottom, top = np.full(n, 2 * n), np.full(n, 2 * n + 1)
-    f = np.concatenate([np.stack([bottom, j, i], 1), np.stack([top, n + i, n + j], 1),
-                        np.stack([i, j, n + j], 1), np.stack([i, n + j, n + i], 1)])
-    return v, f
-
-
 def _fan(angles, radii, heights, closed, apex=(0.0, 0.0, 0.0)):
     """Vertices (apex first, then the ring) and faces (0, r_i, r_{i+1}) of a fan."""
     ring = np.stack([radii * np.cos(angles), radii * np.sin(angles), heights], axis=1)
@@ -73,7 +61,7 @@ def test_cylinder_of_10000_sections_has_linearly_many_candidates(kernel):
     is linear in the face count (the pairs of side faces with their neighbours and a cap face with the side
     faces at its rim).  The numpy twin still enumerates the grid's raw pairs, so it runs a smaller cylinder."""
     n = 10_000 if kernel == "c" else 600
-    v, f = _cylinder(n)
+    v, f = fan_capped_cylinder(n)
     result = surface_contacts(v, f)
     assert result.complete and not any(len(getattr(result, k)) for k in FIELDS)
     unpruned_at_least = 2 * (n * (n - 1) // 2)               # the pairs within each cap
@@ -88,13 +76,13 @@ def test_cylinder_twins_and_thread_counts_count_the_same_candidates(kernel, monk
     grouping all leave out exactly the pairs within certified stars."""
     if kernel != "c":
         pytest.skip("compares the two paths once")
-    big_v, big_f = _cylinder(6000)                      # 24,000 faces: above the C scan's threading threshold
+    big_v, big_f = fan_capped_cylinder(6000)                      # 24,000 faces: above the C scan's threading threshold
     monkeypatch.setenv(_native.THREADS_ENV, "1")
     one = surface_contacts(big_v, big_f, _patches=False)
     monkeypatch.setenv(_native.THREADS_ENV, "2")
     two = surface_contacts(big_v, big_f, _patches=False)
     assert one.candidate_pairs == two.candidate_pairs == 102_020
-    v, f = _cylinder(300)
+    v, f = fan_capped_cylinder(300)
     c = surface_contacts(v, f, _patches=False)
     monkeypatch.setenv(_native.NO_ACCEL_ENV, "1")
     ref = surface_contacts(v, f)
@@ -151,7 +139,7 @@ def test_open_fan_overlapping_itself_keeps_its_crossings():
 def test_certified_cap_pierced_by_a_face_still_reports_it():
     """A flat certified cap and one extra face piercing it: the cap's own pairs are left out, but the cap
     against the outside face is tested as always."""
-    v, f = _cylinder(64)
+    v, f = fan_capped_cylinder(64)
     spike = np.array([[0.1, 0.2, -0.5], [0.3, 0.1, 0.5], [0.2, 0.4, 0.5]])
     verts, faces = np.r_[v, spike], np.r_[f, [[len(v), len(v) + 1, len(v) + 2]]]
     pruned = surface_contacts(verts, faces)
