@@ -489,9 +489,10 @@ def judge_numbers(label: str, mass: float, com, inertia, uncertainty, truth: Rat
     return Verdict(label)
 
 
-def judge_file(path: Path, unit_name: str, truth: RationalTruth, diag: float, repair: bool = False) -> Verdict:
-    """Run :func:`inertia_tool.mass_properties` on the file at density 1 and judge it (see :func:`judge_numbers`);
-    a named :class:`~inertia_tool.errors.InertiaToolError` is a refusal, anything else a crash."""
+def judge_file(path, unit_name: str, truth: RationalTruth, diag: float, repair: bool = False) -> Verdict:
+    """Run :func:`inertia_tool.mass_properties` on the file (a path, or a ``(vertices, faces)`` pair) at density 1
+    and judge it (see :func:`judge_numbers`); a named :class:`~inertia_tool.errors.InertiaToolError` is a
+    refusal, anything else a crash."""
     import warnings
 
     from inertia_tool import mass_properties
@@ -499,7 +500,8 @@ def judge_file(path: Path, unit_name: str, truth: RationalTruth, diag: float, re
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            props = mass_properties(str(path), density=1.0, units=unit_name, repair=repair)
+            props = mass_properties(str(path) if isinstance(path, (str, Path)) else path, density=1.0, units=unit_name,
+                                    repair=repair)
     except InertiaToolError as exc:
         return Verdict("refused", message=str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     except Exception as exc:           # a traceback on input is a defect: counted, never hidden
@@ -509,6 +511,15 @@ def judge_file(path: Path, unit_name: str, truth: RationalTruth, diag: float, re
     verdict = judge_numbers(label, props.mass, props.center_of_mass, props.inertia, props.mesh.uncertainty, truth,
                             diag)
     return Verdict(verdict.label, verdict.wrong, verdict.message, props.mesh.method)
+
+
+def silent_reason(vertices, faces, truth: RationalTruth, units: str = "m", repair: bool = False) -> str | None:
+    """None when the arrays' answer is a refusal, an unproven label, or honest against ``truth``; else why (a
+    crash counts: a traceback on input is a defect)."""
+    diag = float(np.linalg.norm(vertices.max(0) - vertices.min(0))) * UNITS[units]      # in metres
+    verdict = judge_file((vertices, faces), units, truth, diag, repair=repair)
+    return f"{verdict.label} {verdict.method}: {verdict.wrong}" if verdict.silent or verdict.label == "crashed" \
+        else None
 
 
 def diagonal(solid: Solid) -> float:
