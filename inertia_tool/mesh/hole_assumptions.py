@@ -12,6 +12,13 @@ Each :class:`HoleAssumption` has a short ``name`` (what tests and benchmarks mat
 is assumed of the missing surface ``M`` of a hole) and ``fails_for`` (the damage it cannot see, so a reader knows
 when to distrust the bound).  The evidence that withdraws a narrower assumption when the file contradicts it is in
 :mod:`~.hole_bounds` and :mod:`~.hole_fills`.
+
+One rule holds for all of them: **a slab of (near) zero width is no evidence**.  A hole that is an island in a
+flat face (its rim and every face left at it in one plane) keeps no face that leaves the plane, so the file cannot
+tell a flat lid from a dome or dimple taken whole with a flat ring round it, and every narrower assumption
+(``flat``, ``planar``, ``bend``, ``graph``, ``capsule``, ``convex``) would bound it by round-off: such a hole keeps
+the uncut ball over its rim (:data:`BALL`), or the estimate is refused where that is not useful
+(:func:`~.hole_bounds.flat_islands` states the rule and its reason).
 """
 
 from __future__ import annotations
@@ -59,7 +66,8 @@ CONVEX = HoleAssumption(
 BEND = HoleAssumption(
     "bend", "the missing surface is a graph over the rim's mean plane and slopes against that plane no more "
     "steeply than the steepest face touching the rim", "a feature taken whole whose walls are "
-    "steeper than the faces round its rim (a boss or pocket on a flat or gently curved face)")
+    "steeper than the faces round its rim (a boss or pocket on a gently curved face; on a flat one with its "
+    "surroundings flat the hole keeps its ball: hole_bounds.flat_islands)")
 GRAPH = HoleAssumption(
     "graph", "the missing surface is a graph over the plane most face-on to the faces touching the rim and slopes "
     "against that plane no more steeply than the steepest of those faces", "a feature taken whole whose walls are "

@@ -49,7 +49,7 @@ from .hole_bounds import (CONVEX_ROUND_OFF as CONVEX_ROUND_OFF, CONVEX_WORK_LIMI
                           _alone, _contradicted, _engulfing, _flat_off_rim_nearby as _flat_off_rim_nearby,
                           bend_doubt_volumes,
                           _round_off as _round_off, _vertex_flatness as _vertex_flatness, ball_slab_volume,
-                          bare_vertices, convex_hole_bound, hole_doubt_volumes, inner_face_vertices,
+                          bare_vertices, convex_hole_bound, flat_islands, hole_doubt_volumes, inner_face_vertices,
                           planar_rim_doubt, rim_evidence, slab_contradicted)
 from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES as CREASE_MAX_PLANES,
                          CREASE_SCREEN_PAIRS as CREASE_SCREEN_PAIRS, CURVED_FILL_LEVELS as CURVED_FILL_LEVELS,
@@ -129,6 +129,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # near that face's plane; a flat rim whose faces say the missing surface leaves its plane
         # (slab_contradicted): the slab is withdrawn, the ball (first assumption) bounds the hole
         withdrawn = evidence.bare > 0
+        # an island in a flat face: its flatness is the only evidence of a flat missing surface, which no more
+        # than a dome taken whole with a flat ring round it leaves (flat_islands): every narrower reading is
+        # withdrawn, the uncut ball over the rim bounds it
+        island = flat_islands(evidence)
+        withdrawn |= island
         # the convex reading's own evidence: a bare vertex that the faces left turn round by more than π is, if
         # the part is convex, inside its flat face (inner_face_vertices), so it does not take the convex bound away
         inner = inner_face_vertices(v, f, edges, bare)
@@ -138,7 +143,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             against_convex |= slab_contradicted(v, f, edges, label, n_loops, slabs, radius, excused=inner)
         engulfed = _engulfing(v, f, centre, radius)
         withdrawn |= engulfed
-        against_convex |= engulfed
+        against_convex |= engulfed | island
         # a feature may have gone with a hole: no convex bound either
         taken = bool(against_convex.any())
         inside_face = int(np.count_nonzero(inner)) if not taken else 0
@@ -148,6 +153,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     else:
         centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
         engulfed = np.zeros(0, dtype=bool)
+        island = np.zeros(0, dtype=bool)
         unbounded = ""
         taken = False
         inside_face = 0
@@ -265,7 +271,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # than the solid patched (where it is larger, what remains may be the small side: a box with a slot
         # that lost 17 of its 28 faces kept the slot's walls, and the capsule stated ±37 % for a truth 40 times
         # the estimate; found by tests/test_hole_capsules.py, hypothesis seed 202)
-        alone = _alone(centre, radius) & ~engulfed & (4.0 / 3.0 * np.pi * radius ** 3 <= abs(float(closed.volume)))
+        # (not on a flat island either: a rib taken whole with a flat ring round it leaves the same rim)
+        alone = (_alone(centre, radius) & ~engulfed & ~island
+                 & (4.0 / 3.0 * np.pi * radius ** 3 <= abs(float(closed.volume))))
         capsule = capsule_volumes(start, end, thick)
         took_capsule = alone & (capsule < hole_doubt)
         hole_doubt = np.where(alone, np.minimum(hole_doubt, capsule), hole_doubt)
@@ -275,7 +283,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         bent = np.zeros(n_loops, dtype=bool)
         bent[[bend.loop for bend in curved]] = True
         bend_doubt, bend_height = bend_doubt_volumes(v, f, edges, label, n_loops, apex)
-        took_bend = ~engulfed & ~crossed & ~bent & (bend_doubt < hole_doubt)
+        took_bend = ~engulfed & ~island & ~crossed & ~bent & (bend_doubt < hole_doubt)
         before_bend = float(np.sum(hole_doubt))
         hole_doubt = np.where(took_bend, bend_doubt, hole_doubt)
         ball_volume = 4.0 / 3.0 * np.pi * radius ** 3
@@ -374,6 +382,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             detail += (f"; {len(curved)} of them filled instead on the quadric their surroundings lie on (the cone's "
                        f"fan bent onto it, {len(pv) - len(v) - n_loops - 2 * len(creases):,} points added), with "
                        "the same bound")
+        if island.any() and not convex:
+            detail += (f"; {int(np.count_nonzero(island))} an island in a flat face (its rim and every face at it in "
+                       "one plane): nothing in the file tells a missing flat piece from a dome or dimple taken whole "
+                       "with a flat ring round it, so each keeps the whole ball over its rim")
         if took_planar.any() and not convex:
             detail += (f"; {int(np.count_nonzero(took_planar))} read as a missing flat face (a rim in one plane, "
                        f"within {round_up(float(planar.half_width[took_planar].max())):.3g} m, meeting the faces "
