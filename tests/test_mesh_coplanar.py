@@ -302,7 +302,7 @@ def test_ambiguous_pair_beside_a_splittable_welded_pair():
     connectivity, joining the split bodies again: their sum, 7.8 % high, certified united.  Now R1b runs again
     on the new surface; the answer is the two truths added (the groups are disjoint)."""
     from inertia_tool.mesh.checks import shell_labels
-    from inertia_tool.mesh.policy import welded_bodies
+    from inertia_tool.mesh.nonmanifold import welded_bodies
     for i in range(15, 15 + 17 * 40, 17):
         first = S.make_case("shared_edge_crossing", np.random.default_rng([22, i]))
         if "welded" not in first.recipe or "planes shared" in first.recipe:

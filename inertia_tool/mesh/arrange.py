@@ -37,7 +37,7 @@ builds it:
    again, exact).
 
 Before step 1, a face written together with its reverse (the same three vertices, opposite cyclic order) is taken
-out as a pair (:func:`~.policy.cancel_opposite`, R0's count with sign, written once for R0 and both arrangements):
+out as a pair (:func:`~.multiplicity.cancel_opposite`, R0's count with sign, written once for R0 and both arrangements):
 the two are one triangle with opposite orientations, so their contributions cancel exactly in every surface integral
 and in the winding number at every point off that triangle, and ``{w ≥ 1}`` changes by a set of measure zero; every
 directed edge stays matched by its reverse. Left in, the pair would be a patch every point of which lies on the
@@ -64,7 +64,7 @@ from ..values import frozen_value
 from .checks import edge_topology
 from .edges import edge_keys
 from .intersect import _integers, orient3d_sign, surface_contacts
-from .policy import cancel_opposite
+from .multiplicity import cancel_opposite
 
 __all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells", "WINDING_MARGIN",
            "MAX_EXACT_RAY_WORK"]
@@ -123,7 +123,8 @@ class Arrangement:
         Intersection points merged into a neighbour within ``tolerances.ARRANGE_MERGE_RTOL`` of the diagonal
         because, rounded, they left faces crossing (see :func:`_merge_close_points`).
     cancelled_faces : int
-        Input faces taken out as pairs of a face and its reverse before arranging (:func:`~.policy.cancel_opposite`).
+        Input faces taken out as pairs of a face and its reverse before arranging
+        (:func:`~.multiplicity.cancel_opposite`).
     rounding : (float, float, float)
         What rounding the new points (and merging them) may change in the result (:func:`rounded_points_bounds`);
         the arrangement is refused above half of ``ROUNDOFF_RTOL``.
@@ -682,7 +683,7 @@ def _merge_close_points(vertices: np.ndarray, faces: np.ndarray,
                         n_input: int) -> tuple[np.ndarray, np.ndarray, int, _Merged]:
     """Merge intersection points (ids ≥ ``n_input``) lying within ``ARRANGE_MERGE_RTOL`` of the diagonal of
     another point of the surface (into the input's vertex when there is one), drop the faces that collapse and
-    pairs of faces left as one face and its reverse (:func:`~.policy.cancel_opposite`); return the compacted
+    pairs of faces left as one face and its reverse (:func:`~.multiplicity.cancel_opposite`); return the compacted
     surface, the count merged, and what moved (:class:`_Merged`, for :func:`rounded_points_bounds`)."""
     lo, hi = vertices[faces.reshape(-1)].min(axis=0), vertices[faces.reshape(-1)].max(axis=0)
     limit = ARRANGE_MERGE_RTOL * float(np.linalg.norm(hi - lo))

@@ -48,7 +48,7 @@ from .arrange import (_U, WINDING_MARGIN, _compact, _Exact, _FaceTriangulation, 
                       _patches, _projection, _winding_terms, _winding_total, rounded_points_bounds)
 from .edges import edge_keys
 from .intersect import orient3d_sign, surface_contacts
-from .policy import cancel_opposite, signed_multiplicity
+from .multiplicity import cancel_opposite, signed_multiplicity
 
 __all__ = ["CoplanarArrangement", "arrange_coplanar", "MAX_GROUP_EDGES"]
 

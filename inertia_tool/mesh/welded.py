@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import ArrangementError, InvalidMeshError, MeshRepairedWarning, MeshResolvedWarning
 from ..integrals import volume_moments
-from .policy import WeldedBodies, welded_bodies
+from .nonmanifold import WeldedBodies, welded_bodies
 from .resolve import Resolution, resolve_surface
 from .shells import Shells, measured, reshelled
 
