@@ -195,6 +195,7 @@ R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only aft
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING
 
@@ -214,7 +215,8 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "negligible_flat", "inward_crossing_outward", "within_up_to_rounding", "nested_copies",
            "rounding_volumes", "coincident_message", "TouchRelations", "touching_relations", "self_crossing_message",
            "shell_contacts", "ShellContacts", "weakest", "near_copies", "NearCopies", "near_copies_message",
-           "MisreadNesting", "misread_nesting", "outward_crossing_groups", "misread_message"]
+           "MisreadNesting", "misread_nesting", "outward_crossing_groups", "misread_message", "point_text",
+           "part_size"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -358,6 +360,35 @@ def shell_contacts(contacts: SurfaceContacts, labels: np.ndarray, n_shells: int)
                          complete=bool(contacts.complete))
 
 
+#: Significant digits a point is told to in a message at least (six, as ``:.6g``), and how finely beyond that:
+#: within this fraction of the part's size.
+_POINT_DIGITS, _POINT_RESOLUTION = 6, 1e-3
+
+
+def part_size(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """m: the largest extent of the box around the corners of ``faces`` ((m, 3) int into ``vertices`` (n, 3) m); 0
+    for no face."""
+    f = np.asarray(faces, dtype=np.int64).reshape(-1)
+    if not len(f):
+        return 0.0
+    corners = np.asarray(vertices, dtype=np.float64)[f]
+    return float(np.max(corners.max(axis=0) - corners.min(axis=0)))
+
+
+def point_text(point: np.ndarray, size: float) -> str:
+    """``"(x, y, z) m"`` for a point of a part ``size`` m across (SI, after the unit conversion), with enough
+    significant digits that the last one is worth at most ``_POINT_RESOLUTION × size``: a point of a 1 mm part
+    1e8 m from the origin needs 15 (``:.6g`` told it to 1 km).  Never fewer than six; at most seventeen (float64)."""
+    p = np.asarray(point, dtype=np.float64).reshape(3)
+    far = float(np.max(np.abs(p)))
+    digits = _POINT_DIGITS
+    if size > 0 and far > 0 and np.isfinite(far) and np.isfinite(size):
+        # the last digit of x at d digits is worth 10^(floor(log10 |x|) − d + 1) ≤ 10^(log10 far − d + 1)
+        digits = max(digits, math.ceil(math.log10(far / (_POINT_RESOLUTION * size))) + 1)
+    digits = min(digits, 17)
+    return f"({p[0]:.{digits}g}, {p[1]:.{digits}g}, {p[2]:.{digits}g}) m"
+
+
 def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarray, faces: np.ndarray,
                           crossing: np.ndarray, labels: np.ndarray) -> str:
     """R3's refusal: how many face pairs cross within a shell, and where the first one is (m)."""
@@ -366,7 +397,7 @@ def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarra
     where = ""
     if len(pairs):
         p = vertices[faces[pairs[0]]].reshape(-1, 3).mean(axis=0)
-        where = f", e.g. near ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}) m"
+        where = f", e.g. near {point_text(p, part_size(vertices, faces))}"
     n_shells = int(np.count_nonzero(found.self_crossing))
     shells = "one shell" if n_shells == 1 else f"{n_shells} shells"
     return (f"{source}: the surface passes through itself at {found.self_crossing_pairs:,} face pairs "
@@ -881,11 +912,12 @@ def misread_message(found: MisreadNesting, parity_volume: float | None, proven: 
 
 
 
-def coincident_message(found: Coincident) -> str:
-    """R0's note: what was left out and why, faces counted so that they add up."""
+def coincident_message(found: Coincident, size: float = 0.0) -> str:
+    """R0's note: what was left out and why, faces counted so that they add up (``size``: m, the part's, to tell the
+    point named within it: :func:`point_text`)."""
     parts = []
     p = found.where
-    near = f" (one near ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}) m)" if np.all(np.isfinite(p)) else ""
+    near = f" (one near {point_text(p, size)})" if np.all(np.isfinite(p)) else ""
     if found.repeated:
         n = found.repeated
         parts.append(f"{n} closed surface{'s' if n > 1 else ''} listed twice ({found.repeated_faces:,} faces "

@@ -19,7 +19,8 @@ from ..tolerances import FLAT_RTOL
 from .checks import shell_labels
 from .multiplicity import coincident_surfaces
 from .nonmanifold import welded_bodies
-from .policy import coincident_message, copy_candidates, near_copies, near_copies_message, negligible_flat
+from .policy import (coincident_message, copy_candidates, near_copies, near_copies_message, negligible_flat,
+                     part_size)
 
 __all__ = ["Shells", "FoundShells", "find_shells", "bodies", "measured", "reshelled", "drop_flat", "flat_pieces",
            "apply_flips", "leave_out_coincident", "total"]
@@ -178,7 +179,7 @@ def leave_out_coincident(v: np.ndarray, f: np.ndarray, among: np.ndarray | None,
                                f"({len(f) // 2:,} faces each, same corners, opposite winding): they cancel to "
                                "nothing (winding number 0 everywhere, no volume); remove one copy, or reverse it "
                                "if the surface was meant twice")
-    note = coincident_message(found)
+    note = coincident_message(found, part_size(v, f))
     warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=5)
     return f[~found.drop], note
 
