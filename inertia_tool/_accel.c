@@ -6416,21 +6416,35 @@ ct_twin_task(void *ctx, int t, int nt)
                 ct_twin_put(jb, lk[i].face, lk[i].corner, tw);
             }
         }
-        else if (ok) {                             /* a large fan: match by the corners before v, in a table */
-            CtVidTable table;
+        else if (ok) {          /* a large fan: the same count as above, by the corners before and after v */
+            CtVidTable table, nexts;
             if (ct_vid_table_make(&table, k) < 0) {
                 if (lk != local) free(lk);
                 jb->oom[t] = 1;
                 return;
             }
-            for (int64_t i = 0; i < k; i++) ct_vid_add(&table, lk[i].prev, (int32_t)i);
+            if (ct_vid_table_make(&nexts, k) < 0) {
+                free(table.slot);
+                if (lk != local) free(lk);
+                jb->oom[t] = 1;
+                return;
+            }
+            for (int64_t i = 0; i < k; i++) {
+                ct_vid_add(&table, lk[i].prev, (int32_t)i);
+                ct_vid_add(&nexts, lk[i].next, (int32_t)i);
+            }
             for (int64_t i = 0; i < k; i++) {
                 const CtVidSlot *e = ct_vid_find(&table, lk[i].next);     /* the faces whose prev is i's next */
-                int32_t run = e->count;
-                /* "run twice one way": another face with the same next; counted through its own prev run */
-                int32_t tw = run == 1 && lk[e->first].face != lk[i].face ? lk[e->first].face : run == 0 ? -1 : -2;
+                /* back: the others among them (i is one when its corners after and before v are one vertex);
+                 * same: the other faces run v -> next one way with i (an edge run twice one way: no twin, as at
+                 * 64 faces or fewer, and as the patches' rule says) */
+                int32_t back = e->count - (lk[i].prev == lk[i].next);
+                int32_t other = e->first != (int32_t)i ? e->first : e->second;
+                int32_t same = ct_vid_find(&nexts, lk[i].next)->count - 1;
+                int32_t tw = back == 0 && !same ? -1 : back == 1 && !same ? lk[other].face : -2;
                 ct_twin_put(jb, lk[i].face, lk[i].corner, tw);
             }
+            free(nexts.slot);
             free(table.slot);
         }
         if (lk != local) free(lk);

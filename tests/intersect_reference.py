@@ -114,3 +114,32 @@ def brute_kind(t1, t2, shared_corners):
     if _strictly_inside(mid, T1, n1) and _strictly_inside(mid, T2, n2):
         return CROSSING
     return NONE if _within_shared([lo, hi], shared) else CONTACT
+
+
+def edge_twins(faces, n_vertices):
+    """The faces across each edge (``_accel.c`` section 8, ``ct_twins``), written out per vertex: (m, 3) int, row
+    ``i`` column ``c`` for the edge from corner ``c`` of face ``i`` (at vertex ``v``) to its next corner.
+
+    One rule at every vertex, however many faces it has: -2 for every face of ``v`` when one face holds ``v`` twice;
+    otherwise the one face ``j != i`` of ``v`` whose corner before ``v`` is ``i``'s corner after it (running the
+    edge the other way) when it is the only one and no other face of ``v`` runs the edge ``i``'s way; -1 when there
+    is neither; -2 otherwise (an edge in three faces or more, or run twice one way: no face is *the* one across it,
+    and a patch must not be closed through it).  Until issue 21 a vertex of more than 64 faces gave a twin to an
+    edge run twice one way.  ``n_vertices`` is unused (the C call takes it)."""
+    f = [[int(x) for x in row] for row in faces]
+    twin = [[-2, -2, -2] for _ in f]
+    listed = {}
+    for i, row in enumerate(f):
+        for c, x in enumerate(row):
+            listed.setdefault(x, []).append((i, c))
+    for v, items in listed.items():
+        if any(f[i].count(v) != 1 for i, _ in items):
+            continue
+        nxt = [f[i][(c + 1) % 3] for i, c in items]
+        prv = [f[i][(c + 2) % 3] for i, c in items]
+        for a, (i, c) in enumerate(items):
+            back = [b for b in range(len(items)) if b != a and prv[b] == nxt[a]]
+            same = sum(1 for b in range(len(items)) if b != a and nxt[b] == nxt[a])
+            twin[i][c] = (-1 if not back and not same else items[back[0]][0] if len(back) == 1 and not same
+                          else -2)
+    return twin

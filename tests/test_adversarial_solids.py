@@ -513,7 +513,7 @@ def test_welded_crossing_bodies_are_split_into_the_bodies_not_union_and_core():
     (8 and 2.5 m³), not as the boundary of their union around the boundary of their common part (9 and 1.5 m³,
     which R4 would read as a body with a cavity)."""
     from inertia_tool.mesh.checks import shell_labels
-    from inertia_tool.mesh.policy import welded_bodies
+    from inertia_tool.mesh.nonmanifold import welded_bodies
     case = _welded_boxes_crossing()
     v, f = case.vertices, case.faces
     labels, n = shell_labels(f, len(v))
@@ -705,7 +705,7 @@ def test_welded_grid_of_touching_cubes_is_left_whole_and_exact():
     whose sum is exact, as before R1b.  Reading the faces' direction along the edge the wrong way made every wall a
     crossing: 32 shells, united, 10× the CPU time."""
     from inertia_tool.mesh.checks import shell_labels
-    from inertia_tool.mesh.policy import welded_bodies
+    from inertia_tool.mesh.nonmanifold import welded_bodies
     cubes = [S.box([1, 1, 1], [i, j, k]) for i in range(4) for j in range(4) for k in range(2)]
     v, f = S._weld_exact(*S.concat(*cubes))
     labels, n = shell_labels(f, len(v))

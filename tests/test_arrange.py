@@ -423,3 +423,42 @@ def test_an_arranged_surface_leaves_its_points_half_the_round_off_budget(monkeyp
     assert any("above 5e-11" in note for note in props.mesh.notes), props.mesh.notes
     monkeypatch.setattr(certify_module, "total_roundoff", lambda moments, bound: 0.3 * ROUNDOFF_RTOL)
     assert _quiet(v, f).mesh.certificate.kind == "united"
+
+
+@pytest.mark.parametrize("hollow", [False, True])
+def test_an_arrangements_rounding_is_judged_against_the_solid_certified(hollow):
+    """Issue 21 (the certificate's gaps): an arrangement accepts its new points' rounding up to half of
+    ``ROUNDOFF_RTOL`` *of the shell it built*; a cavity cut from that shell later leaves a smaller solid, of which
+    the same region is a larger share.  R7 (``certify``) now judges the region (``arranged_region``, m³ and the
+    corners it lies at) against the solid it certifies.  A 2 m cube with a region in doubt of 0.2 of half the
+    budget (of its volume) at its corners: ``united`` solid (volume share 0.2, inertia share
+    ``√2·B·ρ²/(2·tr C/√3)`` = 0.73 of the half, closed forms); hollowed to an eighth of its volume the volume share
+    is 1.6 of the half: ``unverified``, with a note.  (The old ``certify`` took no region at all.)"""
+    from inertia_tool.mesh import certify as certify_module
+    from inertia_tool.mesh.precision import RoundedRegion
+    from inertia_tool.mesh.shells import measured
+    from inertia_tool.tolerances import ROUNDOFF_RTOL
+    side, half = 2.0, ROUNDOFF_RTOL / 2
+    outer_v, outer_f = S.box([side] * 3, [0.0, 0.0, 0.0])
+    inner = side * (7 / 8) ** (1 / 3)                       # the cavity leaves an eighth of the volume
+    pieces = [(outer_v, outer_f)] + ([(S.box([inner] * 3, [0.0, 0.0, 0.0])[0],
+                                       S.box([inner] * 3, [0.0, 0.0, 0.0])[1][:, ::-1])] if hollow else [])
+    v, f = S.concat(*pieces)
+    labels = np.repeat(np.arange(len(pieces)), [len(p[1]) for p in pieces])
+    shells = measured(v, f, labels, len(pieces))
+    bound = 0.2 * half * side ** 3
+    region = RoundedRegion(volume=bound, corners=outer_v, spread=0.0)
+    volume = side ** 3 - (inner ** 3 if hollow else 0.0)
+    trace = (side ** 5 - (inner ** 5 if hollow else 0.0)) / 4          # tr C of a cube: V·L²/4
+    rho2 = 3 * side ** 2 / 4
+    closed = (bound / volume, np.sqrt(2) * bound * rho2 / (2 * trace / np.sqrt(3)))
+    whole = certify_module.total(shells.moments)
+    got = region.shares(whole.volume, whole.centroid, whole.second_moment)
+    assert got[0] == pytest.approx(closed[0], rel=1e-9) and got[2] == pytest.approx(closed[1], rel=1e-9)
+    out = certify_module.certify(shells, kind="united", checks=["edge-balanced", "consistently-oriented",
+                                                               "no-crossing-faces"], method="union", patched=None,
+                                 arranged=True, verified=True, ambiguous=False, folds=False, sheets_removed=False,
+                                 source="<test>", arranged_region=region)
+    assert (max(closed) > half) == hollow
+    assert out.certificate.kind == ("unverified" if hollow else "united"), out.notes
+    assert any("new points" in n and "not verified" in n for n in out.notes) == hollow

@@ -302,7 +302,7 @@ def test_ambiguous_pair_beside_a_splittable_welded_pair():
     connectivity, joining the split bodies again: their sum, 7.8 % high, certified united.  Now R1b runs again
     on the new surface; the answer is the two truths added (the groups are disjoint)."""
     from inertia_tool.mesh.checks import shell_labels
-    from inertia_tool.mesh.policy import welded_bodies
+    from inertia_tool.mesh.nonmanifold import welded_bodies
     for i in range(15, 15 + 17 * 40, 17):
         first = S.make_case("shared_edge_crossing", np.random.default_rng([22, i]))
         if "welded" not in first.recipe or "planes shared" in first.recipe:
@@ -324,3 +324,28 @@ def test_ambiguous_pair_beside_a_splittable_welded_pair():
     assert p.mesh.certificate.kind == "united"
     assert p.mass == pytest.approx(volume, rel=1e-12)
     assert np.allclose(p.center_of_mass, centre, rtol=0, atol=1e-10)
+
+
+def test_a_self_overlap_arranged_by_the_overlay_keeps_its_rounding_figure():
+    """Issue 21 (the certificate's gaps): ``arrange._arrange_shell`` sends a shell whose crossings all lie in one
+    plane to the coplanar overlay, but built its ``Arrangement`` without the overlay's ``rounding`` (zeros: the
+    figure was lost before R7).  The shell of the test above, 5e4 m out, where the overlay's new point is rounded
+    by ~4e-12 m: the arrangement carries the overlay's own figure, and its ``region`` (the same region in m³ for R7,
+    :class:`~inertia_tool.mesh.precision.RoundedRegion`) gives that figure's volume share again against the
+    arranged shell."""
+    from inertia_tool.mesh.arrange import arrange_shells
+    rng = np.random.default_rng(7)
+    a, b = _box_cells((0, 0, 0), (3, 1, 1)), _box_cells((1, -1, 0), (1, 3, 2))
+    v, f = S._weld_exact(*S.concat(S.cell_body(a, 0.5, rng), S.cell_body(b, 0.5, rng)))
+    v = v + np.array([5e4 + 0.1, -1.85e4, 1.05e4])
+    found = surface_contacts(v, f)
+    done = arrange_shells(v, f, np.zeros(len(f), dtype=np.int64), found.crossing)
+    overlay = arrange_coplanar(v, f)
+    got = done.arrangements[0]
+    assert max(overlay.rounding) > 0 and got.rounding == overlay.rounding
+    assert got.region is not None and done.region is not None
+    whole = volume_moments(got.vertices, got.faces)
+    assert whole.volume == pytest.approx(0.125 * len(a | b), rel=1e-12)
+    assert done.region.volume == got.region.volume > 0
+    assert got.region.shares(whole.volume, whole.centroid, whole.second_moment)[0] == pytest.approx(
+        overlay.rounding[0], rel=1e-12)

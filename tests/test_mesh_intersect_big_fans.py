@@ -21,7 +21,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL
-from intersect_reference import NONE, brute_kind, pair_kinds
+from intersect_reference import NONE, brute_kind, edge_twins, pair_kinds
 from inertia_tool import _native
 from inertia_tool.mesh.intersect import SurfaceContacts
 from contact_scans import fan_capped_cylinder, run_scan, same_pairs
@@ -151,37 +151,7 @@ def test_fan_capped_cylinders_keep_every_defect(sections, defect):
     _brute(v, f, found, moved)
 
 
-# -- the faces across each edge (ct_twins), against the rule written out --------------------------------------
-
-def _twins_rule(f: np.ndarray, n: int) -> np.ndarray:
-    """The faces across each edge as ``ct_twin_task`` decides them, written out per vertex ``v`` (corner ``c`` of
-    face ``i`` at ``v``: the edge ``v -> next``, ``prev`` the corner before ``v``): -2 for every face of ``v`` when
-    one face holds ``v`` twice; at a vertex of at most 64 face corners, the face ``j != i`` whose ``prev`` is
-    ``i``'s ``next`` when it is the only one and no other face's ``next`` is ``i``'s (-1 when there is neither,
-    -2 otherwise); at a vertex of more, counted among all its faces (``i`` included), the one such face when it is
-    another face, -1 for none, -2 otherwise (a second face run the same way is seen at the edge's other end)."""
-    twin = np.full((len(f), 3), -2, dtype=np.int64)
-    listed: dict[int, list[tuple[int, int]]] = {}
-    for i, row in enumerate(f.tolist()):
-        for c, x in enumerate(row):
-            listed.setdefault(x, []).append((i, c))
-    for v, items in listed.items():
-        if any(list(f[i]).count(v) != 1 for i, _ in items):
-            continue
-        nxt = [int(f[i][(c + 1) % 3]) for i, c in items]
-        prv = [int(f[i][(c + 2) % 3]) for i, c in items]
-        k = len(items)
-        for a, (i, c) in enumerate(items):
-            if k <= 64:
-                back = [b for b in range(k) if b != a and prv[b] == nxt[a]]
-                same = sum(1 for b in range(k) if b != a and nxt[b] == nxt[a])
-                twin[i, c] = -1 if not back and not same else items[back[0]][0] if len(back) == 1 and not same else -2
-            else:
-                run = [b for b in range(k) if prv[b] == nxt[a]]
-                other = len(run) == 1 and items[run[0]][0] != i
-                twin[i, c] = items[run[0]][0] if other else -1 if not run else -2
-    return twin
-
+# -- the faces across each edge (ct_twins), against the rule written out (intersect_reference.edge_twins) -----
 
 @st.composite
 def twin_meshes(draw):
@@ -213,6 +183,28 @@ def test_faces_across_each_edge_follow_the_rule(mesh, dtype):
     f, rounds = mesh
     n = int(f.max()) + 1 if len(f) else 0
     got = np.frombuffer(_native.accel().edge_twins(f.astype(dtype), n, rounds), dtype=np.int32).reshape(-1, 3)
-    want = _twins_rule(f, n)
+    want = np.array(edge_twins(f, n), dtype=np.int64).reshape(-1, 3)
     event("fan above 64" if len(f) and np.bincount(f.ravel()).max() > 64 else "small stars only")
     assert np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("k", [63, 64, 150])
+@pytest.mark.parametrize("closed", [True, False])
+def test_an_edge_run_twice_one_way_has_no_twin_at_any_fan_size(k, closed):
+    """One rule on both sides of 64 faces (issue 21): a fan round vertex 0 with one face listed twice.  Its edges
+    from the apex are then run twice one way, so neither copy nor the face across has a twin there (-2); before,
+    above 64 faces, the copies got the face across as their twin while that face got -2 (the table path counted
+    only the faces running the edge back; k = 63 is 64 faces at the apex, the stack path, which always said -2).
+    Every other edge keeps its one twin (-1 at an open fan's ends)."""
+    i = np.arange(k)
+    fan = np.stack([np.zeros(k, dtype=np.int64), 1 + i, 1 + (i + 1) % k if closed else 2 + i], 1)
+    f = np.ascontiguousarray(np.concatenate([fan, fan[[k // 2]]]))
+    n = int(f.max()) + 1
+    got = np.frombuffer(_native.accel().edge_twins(f, n, 1), dtype=np.int32).reshape(-1, 3)
+    want = np.array(edge_twins(f, n), dtype=np.int64).reshape(-1, 3)
+    assert np.array_equal(got, want)
+    face = k // 2                                            # (0, a, b), listed again as face k
+    assert (got[[face, k]] == -2).all()                      # each of its edges is run twice one way
+    assert got[face - 1, 2] == -2 and got[face + 1, 0] == -2   # a -> 0 and 0 -> b: two faces run them back
+    far = [g for g in range(k) if abs(g - face) > 1]
+    assert (got[far, 0] != -2).all() and (got[far, 2] != -2).all()

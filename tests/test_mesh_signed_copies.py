@@ -1,5 +1,5 @@
-"""R0 by signed multiplicity (issue 21; :func:`inertia_tool.mesh.policy.coincident_surfaces`,
-:func:`~inertia_tool.mesh.policy.cancel_opposite`, the coplanar overlay's zero chains): a solid with extra copies
+"""R0 by signed multiplicity (issue 21; :func:`inertia_tool.mesh.multiplicity.coincident_surfaces`,
+:func:`~inertia_tool.mesh.multiplicity.cancel_opposite`, the coplanar overlay's zero chains): a solid with extra copies
 of its shells and faces, repeated, reversed, both, several times, with its own vertices or the same ones.
 
 The generator: a box body (or a box body with a box void wound inward inside it), moved by a random rigid motion

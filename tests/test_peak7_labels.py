@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from adversary_solids import box
 from inertia_tool import _native
 from inertia_tool.errors import InertiaToolError
-from inertia_tool.mesh import checks, policy
+from inertia_tool.mesh import checks, nonmanifold
 from inertia_tool.mesh.checks import census_and_shells, shell_labels
 from inertia_tool.mesh.prepare import prepare_mesh
 from inertia_tool.mesh.read import RawMesh
@@ -54,8 +54,8 @@ def _outcome(v, f):
 def _as_int64():
     """Patch the label type back to int64, as before issue 25 item 1."""
     wide = mock.patch.object(checks, "label_dtype", lambda n: np.dtype(np.int64))
-    wide_policy = mock.patch.object(policy, "label_dtype", lambda n: np.dtype(np.int64))
-    return wide, wide_policy
+    wide_welded = mock.patch.object(nonmanifold, "label_dtype", lambda n: np.dtype(np.int64))
+    return wide, wide_welded
 
 
 corner = st.tuples(*[st.integers(0, 6)] * 3)
@@ -79,8 +79,8 @@ def test_int32_labels_give_the_int64_results(boxes, inverted):
     boxes = [(lo, sz, inv or flip) for (lo, sz, inv), flip in zip(boxes, inverted)]
     v, f = _scene(boxes)
     narrow = _outcome(v, f)
-    wide, wide_policy = _as_int64()
-    with wide, wide_policy:
+    wide, wide_welded = _as_int64()
+    with wide, wide_welded:
         broad = _outcome(v, f)
     assert broad[0] == narrow[0]
     if narrow[1] is not None:           # not refused: the labels had the type asked for

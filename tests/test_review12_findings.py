@@ -53,7 +53,7 @@ Found (stage, rule, numbers):
   count the rounding of constructed points in the certificate.  Fixed (overlay13): the added quad is triangulated
   along the other diagonal, so no face is another's exact reverse; ``coplanar._zero_chains`` takes out, before any
   point is made, coplanar patches whose boundaries are each other's reverse (a 2-chain in one plane with no
-  boundary is zero), after ``policy.cancel_opposite`` (R0's count with sign, also the crossing arrangement's);
+  boundary is zero), after ``multiplicity.cancel_opposite`` (R0's count with sign, also the crossing arrangement's);
   where the overlay (or the crossing arrangement) still makes points, their rounding is bounded
   (``arrange.rounded_points_bounds``) and the arrangement refused above half of ``ROUNDOFF_RTOL``.
 * R9 (fixed): a refusal naming an open edge printed both ends to 6 digits, so 1e8 m out they read the same point

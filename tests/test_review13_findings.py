@@ -1,6 +1,6 @@
 """Review 13 (issue 21, "certified answers"): an adversarial review of what session 13 merged — the weld
 certificate (``precision.weld_sweep``, ``certify(weld=...)``), coincident faces counted with sign
-(``policy.signed_multiplicity``/``cancel_opposite``, ``coplanar`` zero chains), the binary PLY reader
+(``multiplicity.signed_multiplicity``/``cancel_opposite``, ``coplanar`` zero chains), the binary PLY reader
 (``read_ply._read_binary_ply``) and the graph hole fill (``hole_graphs``, assumption ``graph``).  Truths are exact
 rational integrals of the polygons as written (``review12_generators.rational_moments``), never the engine; a
 silent wrong is an ``exact``/``united`` answer off by more than ``judge_numbers``' tolerances, or an ``estimate``

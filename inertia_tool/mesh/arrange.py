@@ -37,7 +37,7 @@ builds it:
    again, exact).
 
 Before step 1, a face written together with its reverse (the same three vertices, opposite cyclic order) is taken
-out as a pair (:func:`~.policy.cancel_opposite`, R0's count with sign, written once for R0 and both arrangements):
+out as a pair (:func:`~.multiplicity.cancel_opposite`, R0's count with sign, written once for R0 and both arrangements):
 the two are one triangle with opposite orientations, so their contributions cancel exactly in every surface integral
 and in the winding number at every point off that triangle, and ``{w ≥ 1}`` changes by a set of measure zero; every
 directed edge stays matched by its reverse. Left in, the pair would be a patch every point of which lies on the
@@ -64,7 +64,8 @@ from ..values import frozen_value
 from .checks import edge_topology
 from .edges import edge_keys
 from .intersect import _integers, orient3d_sign, surface_contacts
-from .policy import cancel_opposite
+from .multiplicity import cancel_opposite
+from .precision import RoundedRegion, combined_regions, rounded_region
 
 __all__ = ["Arrangement", "ArrangedShells", "arrange_crossings", "arrange_shells", "WINDING_MARGIN",
            "MAX_EXACT_RAY_WORK"]
@@ -123,10 +124,14 @@ class Arrangement:
         Intersection points merged into a neighbour within ``tolerances.ARRANGE_MERGE_RTOL`` of the diagonal
         because, rounded, they left faces crossing (see :func:`_merge_close_points`).
     cancelled_faces : int
-        Input faces taken out as pairs of a face and its reverse before arranging (:func:`~.policy.cancel_opposite`).
+        Input faces taken out as pairs of a face and its reverse before arranging
+        (:func:`~.multiplicity.cancel_opposite`).
     rounding : (float, float, float)
-        What rounding the new points (and merging them) may change in the result (:func:`rounded_points_bounds`);
-        the arrangement is refused above half of ``ROUNDOFF_RTOL``.
+        What rounding the new points (and merging them) may change in the result (:func:`rounded_points_bounds`),
+        relative to this shell; the arrangement is refused above half of ``ROUNDOFF_RTOL``.
+    region : RoundedRegion or None
+        The same figure in absolute units (:class:`~.precision.RoundedRegion`), for R7 to judge against the final
+        solid (a cavity cut later makes it a larger share); None when no point was rounded.
     """
 
     vertices: np.ndarray
@@ -141,6 +146,7 @@ class Arrangement:
     merged_points: int = 0
     cancelled_faces: int = 0
     rounding: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    region: RoundedRegion | None = None
 
 
 # -- exact helpers ---------------------------------------------------------------------------------------------
@@ -625,7 +631,8 @@ def arrange_crossings(vertices: np.ndarray, faces: np.ndarray, crossing: np.ndar
         tiers.append((merged_faces, merged_shift + delta))
     rounding = rounded_points_bounds(result_v, result_f, tiers)
     return Arrangement(vertices=result_v, faces=result_f, crossings_left=len(after.crossing), turned=turned,
-                       merged_points=merged, cancelled_faces=cancelled, rounding=rounding, **stats)
+                       merged_points=merged, cancelled_faces=cancelled, rounding=rounding,
+                       region=rounded_region(result_v, result_f, tiers), **stats)
 
 
 def rounded_points_bounds(vertices: np.ndarray, faces: np.ndarray,
@@ -635,7 +642,9 @@ def rounded_points_bounds(vertices: np.ndarray, faces: np.ndarray,
     others are the input's own), every moved corner within the tier's ``delta`` of its exact position; refused
     (:class:`~inertia_tool.errors.ArrangementError`) above half of ``ROUNDOFF_RTOL`` of the result, the other half
     left to the integrals' round-off (R7), so that ``united`` keeps what "exact" means (review 12's R8: the coplanar
-    overlay's points 1.5e8 m out, uncounted, left a union 2.3e-7 off).
+    overlay's points 1.5e8 m out, uncounted, left a union 2.3e-7 off).  The share is relative to this result; R7
+    judges the same region again against the final solid (:class:`~.precision.RoundedRegion`, carried as
+    ``Arrangement.region``), which a cavity cut later makes smaller.
 
     Parameters
     ----------
@@ -682,7 +691,7 @@ def _merge_close_points(vertices: np.ndarray, faces: np.ndarray,
                         n_input: int) -> tuple[np.ndarray, np.ndarray, int, _Merged]:
     """Merge intersection points (ids ≥ ``n_input``) lying within ``ARRANGE_MERGE_RTOL`` of the diagonal of
     another point of the surface (into the input's vertex when there is one), drop the faces that collapse and
-    pairs of faces left as one face and its reverse (:func:`~.policy.cancel_opposite`); return the compacted
+    pairs of faces left as one face and its reverse (:func:`~.multiplicity.cancel_opposite`); return the compacted
     surface, the count merged, and what moved (:class:`_Merged`, for :func:`rounded_points_bounds`)."""
     lo, hi = vertices[faces.reshape(-1)].min(axis=0), vertices[faces.reshape(-1)].max(axis=0)
     limit = ARRANGE_MERGE_RTOL * float(np.linalg.norm(hi - lo))
@@ -932,7 +941,8 @@ def _arrange_shell(v: np.ndarray, f: np.ndarray, crossing: np.ndarray) -> Arrang
     done = arrange_coplanar(v, f)
     return Arrangement(vertices=done.vertices, faces=done.faces, crossing_pairs=len(crossing),
                        split_faces=done.split_faces, new_vertices=done.new_vertices, patches=done.patches,
-                       max_winding=done.max_winding, crossings_left=done.crossings_left)
+                       max_winding=done.max_winding, crossings_left=done.crossings_left,
+                       cancelled_faces=done.cancelled_faces, rounding=done.rounding, region=done.region)
 
 
 def _compact(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -1158,6 +1168,11 @@ class ArrangedShells:
     def crossings_left(self) -> int:
         """Face pairs of the arranged shells still crossing by rounding (0 certifies them)."""
         return sum(a.crossings_left for a in self.arrangements)
+
+    @property
+    def region(self) -> RoundedRegion | None:
+        """Where the rounding of every arrangement's new points may change the result (m³, m; None: nowhere)."""
+        return combined_regions(*(a.region for a in self.arrangements))
 
 
 def arrange_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,

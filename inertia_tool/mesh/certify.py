@@ -24,7 +24,7 @@ from .shells import Shells, flipped_text, total
 
 if TYPE_CHECKING:
     from .classify import Orientation
-    from .precision import WeldSweep
+    from .precision import RoundedRegion, WeldSweep
     from .resolve import Resolution
     from .uncertainty import Estimate, Uncertainty
     from .unite import United
@@ -171,7 +171,7 @@ def _turned(found: MisreadNesting, oriented: Orientation) -> str:
 def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patched: Estimate | None,
             arranged: bool, verified: bool, ambiguous: bool, folds: bool, sheets_removed: bool,
             source: str, spread: tuple[float, float] | None = None, scale_rounding: float = 0.0,
-            weld: WeldSweep | None = None) -> Certified:
+            weld: WeldSweep | None = None, arranged_region: RoundedRegion | None = None) -> Certified:
     """R7 and what each earlier stage implies for the certificate of ``shells``.
 
     Parameters
@@ -203,6 +203,12 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         stands, with a note; beyond it an ``exact`` or ``united`` result becomes an estimate within the weld's
         bound (added to a patched surface's or R4's doubt), refused when that bound is not useful; an
         ``unverified`` one stays so, with the note.
+    arranged_region : RoundedRegion or None
+        Where rounding the arrangements' new points (R1b, R3) may change the result, in absolute units
+        (:class:`~.precision.RoundedRegion`).  Each arrangement was accepted with it within half the budget of
+        the shell it built; it is judged here again against this solid, the one certified: a cavity cut from the
+        arranged shell later (R4, R5) makes the same region a larger share, and above half the budget an
+        ``exact`` or ``united`` result becomes ``unverified``.  Its shares are added to an estimate's round-off.
     """
     notes: list[str] = []
     checks = list(checks)
@@ -217,6 +223,10 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         whole = total(shells.moments)
         converted = conversion_bounds(shells.vertices, shells.faces, scale_rounding, whole.volume, whole.centroid,
                                       whole.second_moment)
+    placed = (0.0, 0.0, 0.0)      # the arrangements' rounded points, as shares of the solid certified (R1b, R3)
+    if arranged and arranged_region is not None:
+        whole = total(shells.moments)
+        placed = arranged_region.shares(whole.volume, whole.centroid, whole.second_moment)
     welded = None                 # R4's weld: (volume in doubt m³, reach m) when beyond the round-off budget
     if weld is not None:
         from .precision import weld_note, weld_reach
@@ -247,6 +257,12 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
                              f"{round_up(roundoff, 2):.2g} of the result "
                              f"(above {budget:g}: a sliver thinner than its coordinates' rounding, too large "
                              "for exact arithmetic): not verified")
+    if max(placed[0], placed[2]) > ROUNDOFF_RTOL / 2 and kind in ("exact", "united"):
+        kind = "unverified"
+        notes.append(f"rounding the arranged surface's new points to float64 may change the result by "
+                     f"{round_up(max(placed[0], placed[2]), 2):.2g} of it (above {ROUNDOFF_RTOL / 2:g}, the half of "
+                     "the round-off budget the arrangement has; within it for the shell arranged, a larger share "
+                     "of the solid left once a cavity was cut): not verified")
     uncertainty = None
     if patched is not None:
         from .uncertainty import check_useful, uncertainty_from, with_roundoff   # imported on use: repair only
@@ -257,7 +273,7 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         if welded is not None:                # the weld's sweep as well (triangle inequality)
             doubt, far = doubt + welded[0], max(far, welded[1])
         uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, doubt, far),
-                                    _plus(total_roundoff_parts(shells.moments, shells.bound), converted))
+                                    _plus(total_roundoff_parts(shells.moments, shells.bound), _plus(converted, placed)))
         what = "the patched surface" + (" and a shell wound outward inside another" if spread is not None else "")
         holes_alone = patched.uncertainty.volume_in_doubt / whole.volume if whole.volume > 0 else np.inf
         if spread is not None and holes_alone <= ESTIMATE_MAX_MASS_RTOL:
@@ -278,7 +294,7 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         if welded is not None:                # the weld's sweep as well (triangle inequality)
             doubt, far = doubt + welded[0], max(far, welded[1])
         uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, doubt, far),
-                                    _plus(total_roundoff_parts(shells.moments, shells.bound), converted))
+                                    _plus(total_roundoff_parts(shells.moments, shells.bound), _plus(converted, placed)))
         # the same ±50 % limit as every estimate (holes6's review: two crossing outward cubes inside a cube were
         # answered at ±61.5 % mass)
         check_useful(whole.volume, uncertainty, source=source, what="the reading by nesting depth", why=_R4_WHY)
@@ -287,7 +303,7 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         from .uncertainty import check_useful, uncertainty_from, with_roundoff
         whole = total(shells.moments)
         uncertainty = with_roundoff(uncertainty_from(whole.volume, whole.centroid, whole.second_moment, *welded),
-                                    _plus(total_roundoff_parts(shells.moments, shells.bound), converted))
+                                    _plus(total_roundoff_parts(shells.moments, shells.bound), _plus(converted, placed)))
         check_useful(whole.volume, uncertainty, source=source,
                      what=f"the surface welded within {round_up(weld.tolerance if weld else 0.0):.3g} m",
                      why=_WELD_WHY)

@@ -18,10 +18,10 @@ from ..errors import InsideOutWarning, MeshResolvedWarning
 from ..integrals import VolumeMoments
 from ..tolerances import TOUCH_VOLUME_RTOL
 from .intersect import SurfaceContacts, surface_contacts
-from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, container_windings, inward_crossing_outward,
-                     inward_crossing_shells, misread_nesting, nested_copies,
-                     rounding_volumes,
-                     orient_by_depth, outward_crossing_groups, shell_contacts, within_up_to_rounding)
+from .multiplicity import container_windings
+from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
+                     inward_crossing_shells, misread_nesting, nested_copies, orient_by_depth, outward_crossing_groups,
+                     rounding_volumes, shell_contacts, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
 

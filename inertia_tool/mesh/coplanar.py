@@ -48,7 +48,8 @@ from .arrange import (_U, WINDING_MARGIN, _compact, _Exact, _FaceTriangulation, 
                       _patches, _projection, _winding_terms, _winding_total, rounded_points_bounds)
 from .edges import edge_keys
 from .intersect import orient3d_sign, surface_contacts
-from .policy import cancel_opposite, signed_multiplicity
+from .multiplicity import cancel_opposite, signed_multiplicity
+from .precision import RoundedRegion, rounded_region
 
 __all__ = ["CoplanarArrangement", "arrange_coplanar", "MAX_GROUP_EDGES"]
 
@@ -94,6 +95,9 @@ class CoplanarArrangement:
         What rounding the overlay's new points to float64 may change in the result (volume relative, centroid m,
         inertia relative; :func:`~.arrange.rounded_points_bounds`, refused above half of ``ROUNDOFF_RTOL``); zeros
         when the result uses no new point.
+    region : RoundedRegion or None
+        The same figure in absolute units, for R7 to judge against the final solid
+        (:class:`~.precision.RoundedRegion`); None when the result uses no new point.
     """
 
     vertices: np.ndarray
@@ -107,6 +111,7 @@ class CoplanarArrangement:
     crossings_left: int = 0
     cancelled_faces: int = 0
     rounding: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    region: RoundedRegion | None = None
 
 
 def _normal_key(exact: _Exact, faces: np.ndarray, face: int) -> tuple[tuple[int, int, int, int], int]:
@@ -432,10 +437,11 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
     delta = 0.5 * float(np.max(np.spacing(np.abs(new_used)))) if len(new_used) else 0.0
     at_new = (used >= n)[result_f].any(axis=1)        # faces at a new point (result_v is used, in order)
     rounding = rounded_points_bounds(result_v, result_f, [(at_new, delta)])   # refused above ROUNDOFF_RTOL/2
+    region = rounded_region(result_v, result_f, [(at_new, delta)])
     return CoplanarArrangement(vertices=result_v, faces=result_f, coplanar_pairs=len(overlapping),
                                planes=len(groups), split_faces=len(split), new_vertices=len(new_xyz),
                                patches=n_patches, max_winding=int((w_front + mult).max()),
-                               crossings_left=left, cancelled_faces=cancelled, rounding=rounding)
+                               crossings_left=left, cancelled_faces=cancelled, rounding=rounding, region=region)
 
 
 def _overlapping(found, faces: np.ndarray) -> np.ndarray:

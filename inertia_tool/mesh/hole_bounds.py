@@ -879,9 +879,11 @@ def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     cosine = np.where(good, -np.einsum("ij,ij->i", fn, normal[loop_of_face]) / np.where(good, fsize, 1.0), 1.0)
     least = np.full(n_loops, np.inf)
     np.minimum.at(least, loop_of_face, cosine)
-    steep = ~(least >= np.cos(np.radians(max_degrees)))
+    steep = ~(least >= np.cos(np.radians(max_degrees))) | ~(least > 0.0)     # a face at 90° bounds no graph
     usable = star & ~steep
-    cos_l = np.clip(least, 1e-300, 1.0)
+    # L = tan θ for the loops the bound applies to (cos θ ≥ cos max_degrees > 0); 0 for the others, whose doubt is
+    # inf anyway (a ring face at 90° made L ~1e300 here, and L·dist·area overflowed on parts ~1 km across)
+    cos_l = np.where(usable, least, 1.0)
     slope = np.sqrt(np.maximum(1.0 - cos_l ** 2, 0.0)) / cos_l
     # the apex's distance from each rim edge's segment, in the plane
     d = ub - ua

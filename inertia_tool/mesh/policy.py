@@ -7,19 +7,19 @@ the surface bounds it exactly once).
 
 Rules
 -----
-R0 *A shell listed twice is one solid* (:func:`coincident_surfaces`).  Coincident copies combine by their
-   windings first: the faces on the same three points (the same float64 coordinates, bit for bit; with the same
-   vertex indices or their own) are counted with sign, +1 one way round and −1 the other
-   (:func:`signed_multiplicity`; a repeat adds, a reverse cancels), and only then decided: a net 0 leaves the
-   face out, a net ±k keeps one face wound by its sign.  A face and its reverse are the zero chain (their terms
-   cancel exactly in every surface integral and in the winding number), so cancelling changes nothing; a net ±2
-   or more counted once is the rule's policy (a closed surface that repeats another corner for corner is
-   counted once, with a note naming how many faces were left out).  A closed surface listed together with its
-   exact inverted copy has winding number 0 everywhere: the pair is left out (a mesh that is nothing else is
-   refused with that reason); a void listed twice with its inverted copy keeps one void (net −1; dropping the
-   repeat first lost both).  Only whole closed surfaces go.  The arrangements take out face pairs by the same
-   count (:func:`cancel_opposite`).  Reason: a shell exported twice means the part once; summed, its volume counts
-   twice, and united it only shows as a false overlap.
+R0 *A shell listed twice is one solid* (:func:`~.multiplicity.coincident_surfaces`).  Coincident copies combine by their
+   windings first: the faces on the same three points (the same float64 coordinates, bit for bit; with the same vertex
+   indices or their own) are counted with sign, +1 one way round and −1 the other
+   (:func:`~.multiplicity.signed_multiplicity`; a repeat adds, a reverse cancels), and only then decided: a net 0 leaves
+   the face out, a net ±k keeps one face wound by its sign.  A face and its reverse are the zero chain (their terms
+   cancel exactly in every surface integral and in the winding number), so cancelling changes nothing; a net ±2 or more
+   counted once is the rule's policy (a closed surface that repeats another corner for corner is counted once, with a
+   note naming how many faces were left out).  A closed surface listed together with its exact inverted copy has winding
+   number 0 everywhere: the pair is left out (a mesh that is nothing else is refused with that reason); a void listed
+   twice with its inverted copy keeps one void (net −1; dropping the repeat first lost both).  Only whole closed
+   surfaces go.  The arrangements take out face pairs by the same count (:func:`~.multiplicity.cancel_opposite`).
+   Reason: a shell exported twice means the part once; summed, its volume counts twice, and united it only shows as a
+   false overlap.
    *Up to rounding* (:func:`near_copies`): a closed surface whose every corner lies within
    ``tolerances.COINCIDENT_RTOL`` of the largest |coordinate| of a corner of another, face for face with the same
    winding (a copy whose coordinates were computed apart), is counted once too, when the bound on what it could
@@ -34,29 +34,27 @@ R1 *Bodies are edge-connected* (:func:`~.checks.shell_labels`).  Faces that meet
    different shells: a non-manifold vertex is split into its fans of edge-connected faces before anything
    decides what is one body.  Reason: two bodies that share a corner (or are welded there) are two bodies,
    and must be tested against each other for overlap.
-R1b *Bodies welded along their crossing are still separate bodies* (:func:`welded_bodies`).  Where closed
-   surfaces cross exactly along edges of both tessellations and the file shares those edges' vertices (an STL
-   is welded bit-exactly on reading), each crossing edge is used by four faces, two of each body, and edge
-   connectivity would make the bodies one shell whose summed integral counts their common volume twice (the
-   edges still balance, so nothing else notices).  A shell with non-manifold edges is split into the pieces
-   joined through its manifold edges (used by exactly two faces) when every piece is closed and balanced on
-   its own; the face pairs of different pieces along a shared non-manifold edge are contacts for R4 (their
-   points decide crossing, nesting or touching; :func:`touching_relations`).  Around each non-manifold edge the
-   faces are paired first in, first out (:func:`_crossing_pairs_at_edges`): bodies passing through each other stay
-   whole, where pairing last in, first out would give the boundary of their union around the boundary of their
-   common part, which R4 would read as a body with a cavity (both pairings have the same winding number; only
-   this one lets the depth rule agree with it).  Where coplanar faces of two bodies face the same way at such an
-   edge the order is undefined and the bodies overlap there, but the winding number of the whole surface is not:
-   under ``overlap`` 'union' the shell is replaced by the boundary of its {winding number ≥ 1}
-   (:func:`~.coplanar.arrange_coplanar`: the faces overlapping in a common plane split along each other's edges
-   with exact predicates, each cell written once with its net cover, every patch labelled by a certified winding
-   number, the pieces kept where it crosses from 0 to ≥ 1), certified ``united`` with the check
-   ``winding-arrangement`` once the result is closed and no two of its faces cross or overlap.  Where that
-   overlay cannot form it (faces also crossing transversally, a face touching the inside of a face of another
-   plane, a winding number too close to call in float64) the shell is refused with that reason (``repair``: the
-   winding-number estimate); never paired by a tie-break (face order once certified a sum 6 % high as exact).
-   Reason: a body is a closed surface, and the faces meeting at a non-manifold edge say nothing about which of
-   them close together.
+R1b *Bodies welded along their crossing are still separate bodies* (:func:`~.nonmanifold.welded_bodies`).  Where closed
+   surfaces cross exactly along edges of both tessellations and the file shares those edges' vertices (an STL is welded
+   bit-exactly on reading), each crossing edge is used by four faces, two of each body, and edge connectivity would make
+   the bodies one shell whose summed integral counts their common volume twice (the edges still balance, so nothing else
+   notices).  A shell with non-manifold edges is split into the pieces joined through its manifold edges (used by
+   exactly two faces) when every piece is closed and balanced on its own; the face pairs of different pieces along a
+   shared non-manifold edge are contacts for R4 (their points decide crossing, nesting or touching;
+   :func:`touching_relations`).  Around each non-manifold edge the faces are paired first in, first out
+   (:func:`~.nonmanifold._crossing_pairs_at_edges`): bodies passing through each other stay whole, where pairing last
+   in, first out would give the boundary of their union around the boundary of their common part, which R4 would read as
+   a body with a cavity (both pairings have the same winding number; only this one lets the depth rule agree with it).
+   Where coplanar faces of two bodies face the same way at such an edge the order is undefined and the bodies overlap
+   there, but the winding number of the whole surface is not: under ``overlap`` 'union' the shell is replaced by the
+   boundary of its {winding number ≥ 1} (:func:`~.coplanar.arrange_coplanar`: the faces overlapping in a common plane
+   split along each other's edges with exact predicates, each cell written once with its net cover, every patch labelled
+   by a certified winding number, the pieces kept where it crosses from 0 to ≥ 1), certified ``united`` with the check
+   ``winding-arrangement`` once the result is closed and no two of its faces cross or overlap.  Where that overlay
+   cannot form it (faces also crossing transversally, a face touching the inside of a face of another plane, a winding
+   number too close to call in float64) the shell is refused with that reason (``repair``: the winding-number estimate);
+   never paired by a tie-break (face order once certified a sum 6 % high as exact).  Reason: a body is a closed surface,
+   and the faces meeting at a non-manifold edge say nothing about which of them close together.
 R2 *Flat pieces carry no volume* (``tolerances.FLAT_RTOL``).  A closed shell whose |volume| is at most
    ``FLAT_RTOL · diagonal³`` (a face and its reverse, a zero-thickness wall, a collapsed sliver) contributes
    nothing to the integrals, so it is left out with a note and the answer stays exact (:func:`negligible_flat`:
@@ -197,15 +195,16 @@ R7 *Exact only when proven* (:class:`Certificate`).  ``exact`` is given only aft
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._native import label_dtype
 from ..rounding import round_up
 from ..tolerances import COINCIDENT_RTOL, FLAT_MOMENT_RTOL, FLAT_RTOL, ROUNDOFF_RTOL, TOUCH_VOLUME_RTOL
 from ..values import frozen_value
+from .multiplicity import Coincident, winding_around
 
 if TYPE_CHECKING:
     from ..integrals import VolumeMoments
@@ -213,12 +212,11 @@ if TYPE_CHECKING:
     from .nesting import Nesting
 
 __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "FLAT_RTOL", "orient_by_depth",
-           "negligible_flat", "inward_crossing_outward", "Coincident", "within_up_to_rounding", "nested_copies",
-           "rounding_volumes", "coincident_surfaces", "coincident_message", "TouchRelations", "touching_relations",
-           "self_crossing_message", "shell_contacts", "ShellContacts", "weakest", "welded_bodies", "WeldedBodies",
-           "near_copies", "NearCopies", "near_copies_message", "MisreadNesting", "misread_nesting",
-           "outward_crossing_groups", "container_windings",
-           "misread_message", "signed_multiplicity", "cancel_opposite"]
+           "negligible_flat", "inward_crossing_outward", "within_up_to_rounding", "nested_copies",
+           "rounding_volumes", "coincident_message", "TouchRelations", "touching_relations", "self_crossing_message",
+           "shell_contacts", "ShellContacts", "weakest", "near_copies", "NearCopies", "near_copies_message",
+           "MisreadNesting", "misread_nesting", "outward_crossing_groups", "misread_message", "point_text",
+           "part_size"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -362,6 +360,35 @@ def shell_contacts(contacts: SurfaceContacts, labels: np.ndarray, n_shells: int)
                          complete=bool(contacts.complete))
 
 
+#: Significant digits a point is told to in a message at least (six, as ``:.6g``), and how finely beyond that:
+#: within this fraction of the part's size.
+_POINT_DIGITS, _POINT_RESOLUTION = 6, 1e-3
+
+
+def part_size(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """m: the largest extent of the box around the corners of ``faces`` ((m, 3) int into ``vertices`` (n, 3) m); 0
+    for no face."""
+    f = np.asarray(faces, dtype=np.int64).reshape(-1)
+    if not len(f):
+        return 0.0
+    corners = np.asarray(vertices, dtype=np.float64)[f]
+    return float(np.max(corners.max(axis=0) - corners.min(axis=0)))
+
+
+def point_text(point: np.ndarray, size: float) -> str:
+    """``"(x, y, z) m"`` for a point of a part ``size`` m across (SI, after the unit conversion), with enough
+    significant digits that the last one is worth at most ``_POINT_RESOLUTION × size``: a point of a 1 mm part
+    1e8 m from the origin needs 15 (``:.6g`` told it to 1 km).  Never fewer than six; at most seventeen (float64)."""
+    p = np.asarray(point, dtype=np.float64).reshape(3)
+    far = float(np.max(np.abs(p)))
+    digits = _POINT_DIGITS
+    if size > 0 and far > 0 and np.isfinite(far) and np.isfinite(size):
+        # the last digit of x at d digits is worth 10^(floor(log10 |x|) − d + 1) ≤ 10^(log10 far − d + 1)
+        digits = max(digits, math.ceil(math.log10(far / (_POINT_RESOLUTION * size))) + 1)
+    digits = min(digits, 17)
+    return f"({p[0]:.{digits}g}, {p[1]:.{digits}g}, {p[2]:.{digits}g}) m"
+
+
 def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarray, faces: np.ndarray,
                           crossing: np.ndarray, labels: np.ndarray) -> str:
     """R3's refusal: how many face pairs cross within a shell, and where the first one is (m)."""
@@ -370,7 +397,7 @@ def self_crossing_message(source: str, found: ShellContacts, vertices: np.ndarra
     where = ""
     if len(pairs):
         p = vertices[faces[pairs[0]]].reshape(-1, 3).mean(axis=0)
-        where = f", e.g. near ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}) m"
+        where = f", e.g. near {point_text(p, part_size(vertices, faces))}"
     n_shells = int(np.count_nonzero(found.self_crossing))
     shells = "one shell" if n_shells == 1 else f"{n_shells} shells"
     return (f"{source}: the surface passes through itself at {found.self_crossing_pairs:,} face pairs "
@@ -802,7 +829,7 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
         # it are wound inward (the whole nest written inside out, or a cavity kept as wound because it crosses a
         # body) that is 0 or less: the file reads it as a cavity too (review 9: an inverted hollow box was said to
         # read as "the union of the bodies"; review 11, D5: a box flush inside a void crossing a body)
-        misread &= _winding_around(vols, nest, within) >= 0
+        misread &= winding_around(vols, nest, within) >= 0
     if not misread.any():
         return None
     inside = np.zeros(len(vols), dtype=bool)
@@ -815,42 +842,6 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
         inside[pairs[misread[pairs[:, 1]], 1]] = True
     shells = np.flatnonzero(misread)
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=bool(inside[shells].any()))
-
-
-def container_windings(file_volumes: np.ndarray, nest: Nesting | None,
-                       within: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(shell, container, winding)`` int arrays: each shell found inside another, and the container's winding
-    number as the file winds it there.
-
-    From the probes (``nest``: the winding each other shell gives a shell's probe point, kept where nonzero) and
-    from the ``(shell, container)`` pairs placed by touching or by the boolean (``within``: a shell flush with its
-    container, whose probe may lie on the container's surface and see nothing; counted with the sign of the
-    container's own volume, +1 outward, −1 inward, and only where the probes did not already count it).  A shell
-    is never its own container."""
-    n = len(file_volumes)
-    if nest is None:
-        shell = other = winding = np.zeros(0, dtype=np.int64)
-    else:
-        shell, other = np.asarray(nest.shell, dtype=np.int64), np.asarray(nest.other, dtype=np.int64)
-        winding = np.asarray(nest.winding, dtype=np.int64)
-        keep = (winding != 0) & (shell != other)
-        shell, other, winding = shell[keep], other[keep], winding[keep]
-    if within is not None and len(within):
-        pairs = np.asarray(within, dtype=np.int64).reshape(-1, 2)
-        pairs = pairs[pairs[:, 0] != pairs[:, 1]]
-        pairs = np.unique(pairs[~np.isin(pairs[:, 0] * n + pairs[:, 1], shell * n + other)], axis=0)
-        shell, other = np.r_[shell, pairs[:, 0]], np.r_[other, pairs[:, 1]]
-        winding = np.r_[winding, np.sign(file_volumes[pairs[:, 1]]).astype(np.int64)]
-    return shell, other, winding
-
-
-def _winding_around(file_volumes: np.ndarray, nest: Nesting | None, within: np.ndarray | None) -> np.ndarray:
-    """(s,) int: the winding number, as the file winds them, of the shells around each shell at its probe point
-    (each container counted once: :func:`container_windings`)."""
-    shell, _, winding = container_windings(file_volumes, nest, within)
-    around = np.zeros(len(file_volumes), dtype=np.int64)
-    np.add.at(around, shell, winding)
-    return around
 
 
 def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray,
@@ -920,226 +911,13 @@ def misread_message(found: MisreadNesting, parity_volume: float | None, proven: 
             f"{them} with the body around {them} in the model; if a cavity, wind {them} inward")
 
 
-@frozen_value
-class Coincident:
-    """R0: closed surfaces listed twice, and closed surfaces listed with their exact inverted copy.
 
-    Attributes
-    ----------
-    drop : (m,) bool
-        Faces to leave out: the later copy of each surface listed twice, and both members of each cancelling pair.
-    repeated : int
-        Closed surfaces that repeat another face for face (same corners, same winding): counted once.
-    repeated_faces : int
-    cancelled : int
-        Pairs of closed surfaces each the other's exact inverse (same corners, opposite winding).
-    cancelled_faces : int
-        Faces of the cancelling pairs (both members).
-    where : (3,) float
-        A corner of the first surface left out, m (NaN when none).
-    """
-
-    drop: np.ndarray
-    repeated: int
-    repeated_faces: int
-    cancelled: int
-    cancelled_faces: int
-    where: np.ndarray
-
-
-def _closed_components(faces: np.ndarray, members: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
-    """Edge-connected components of the faces ``members`` (indices into ``faces``) and which of them are closed and
-    balanced on their own (every directed edge matched by its reverse within the component)."""
-    from .checks import shell_labels
-    from .edges import edge_keys
-
-    sub = faces[members]
-    comp, n_comp = shell_labels(sub, n_vertices)
-    key, forward = edge_keys(sub, n_vertices)
-    owner = np.repeat(comp, 3).astype(np.int64)          # edge_keys lists each face's three edges in turn
-    _, inverse = np.unique(np.stack([owner, key.astype(np.int64)], axis=1), axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
-    unbalanced = np.zeros(n_comp, dtype=bool)
-    first = np.zeros(len(net), dtype=np.int64)
-    first[inverse] = owner
-    unbalanced[first[net != 0]] = True
-    return comp, ~unbalanced
-
-
-def _doubled_closed(faces: np.ndarray, n_vertices: int) -> bool:
-    """Every edge of ``faces`` is used at least four times (a closed surface and its reverse on the same vertices;
-    a flat sheet's rim edges are used twice)."""
-    from .edges import edge_keys
-
-    _, count = np.unique(edge_keys(faces, n_vertices)[0], return_counts=True)
-    return bool(np.all(count >= 4))
-
-
-def signed_multiplicity(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The faces on the same three points, and which way round each is: R0's count and the arrangements' (one rule).
-
-    Parameters
-    ----------
-    corners : (m, 3) int
-        Each face's corners as ids of distinct points (vertex ids of a welded surface, or ids of exact coordinates).
-
-    Returns
-    -------
-    cls : (m,) int
-        The class of each face (faces on the same three points share it), numbered from 0; −1 for a face with two
-        equal corners (no triangle, no orientation).
-    sign : (m,) int
-        +1 or −1: the face's cyclic order is the class's own (from its smallest point, rising) or the reverse.
-        The winding number changes across the triangle by the class's net multiplicity ``Σ sign`` (Rigid Body
-        Motion, Ch. 4: each face is one term of the divergence-theorem sums, and a face and its reverse are the
-        zero chain, their terms cancelling exactly).
-    """
-    g = np.asarray(corners, dtype=np.int64).reshape(-1, 3)
-    cls = np.full(len(g), -1, dtype=np.int64)
-    sign = np.zeros(len(g), dtype=np.int64)
-    if not len(g):
-        return cls, sign
-    rows = np.arange(len(g))[:, None]
-    start = np.argmin(g, axis=1)[:, None]
-    key = g[rows, (start + np.arange(3)) % 3]                       # from the smallest point, same cycle
-    ok = (key[:, 0] != key[:, 1]) & (key[:, 1] != key[:, 2]) & (key[:, 0] != key[:, 2])
-    if ok.any():
-        _, code = np.unique(np.sort(key[ok], axis=1), axis=0, return_inverse=True)
-        cls[ok] = code.reshape(-1)
-        sign[ok] = np.where(key[ok, 1] < key[ok, 2], 1, -1)
-    return cls, sign
-
-
-def cancel_opposite(corners: np.ndarray) -> np.ndarray:
-    """(m,) bool: the faces kept once every face on the same three points as a face wound the other way is taken
-    out with it, pair by pair (``k`` one way and ``j`` the other leave ``|k − j|``, the first listed; classes by
-    :func:`signed_multiplicity`).
-
-    A pair is the zero chain: its terms cancel exactly in the divergence-theorem sums and in the solid-angle sum
-    of the winding number at every point off the triangle, so ``{w ≥ 1}`` is the same up to the triangle itself
-    (measure zero); on a welded surface (``corners`` vertex ids) each directed edge loses one use and so does its
-    reverse, so a closed surface stays closed."""
-    cls, sign = signed_multiplicity(corners)
-    keep = np.ones(len(cls), dtype=bool)
-    members = np.flatnonzero(cls >= 0)
-    if len(members) < 2:
-        return keep
-    order = members[np.lexsort((members, sign[members], cls[members]))]
-    c, s = cls[order], sign[order]
-    n_cls = int(c.max()) + 1
-    plus = np.bincount(c, weights=(s > 0), minlength=n_cls).astype(np.int64)
-    minus = np.bincount(c, weights=(s < 0), minlength=n_cls).astype(np.int64)
-    group = c * 2 + (s > 0)
-    first = np.r_[0, np.flatnonzero(group[1:] != group[:-1]) + 1]
-    rank = np.arange(len(order)) - np.repeat(first, np.diff(np.r_[first, len(order)]))
-    keep[order[rank < np.minimum(plus, minus)[c]]] = False
-    return keep
-
-
-def _point_ids(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(m, 3) int: each face's corners as ids of distinct exact coordinates (a copy with its own vertices gets the
-    same ids)."""
-    used, local = np.unique(faces, return_inverse=True)
-    _, point = np.unique(np.asarray(vertices, dtype=np.float64)[used], axis=0, return_inverse=True)
-    return np.asarray(point.reshape(-1)[local.reshape(-1)].reshape(-1, 3), dtype=np.int64)
-
-
-def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarray | None = None,
-                        labels: np.ndarray | None = None) -> Coincident:
-    """R0: closed surfaces listed more than once, each way round, combined by their windings.
-
-    Faces are compared by the exact coordinates of their corners (bit for bit; a copy may use its own vertex
-    indices or the same ones).  The faces on the same three points form a class; a face counts ``+1`` wound one
-    way and ``−1`` the other, and the class's net multiplicity ``n`` is what the winding number changes by across
-    that triangle (a repeat adds, a reverse cancels: :func:`signed_multiplicity`).  Every class keeps one face
-    wound by the sign of ``n`` (the one in the lowest-numbered shell) and none when ``n = 0``; the rest are left
-    out.  Left out with them: pairs of opposite faces (a zero chain: nothing changes in any surface integral nor
-    in the winding number off the triangle) and, where ``|n| ≥ 2``, the repeats beyond one (the shell listed twice
-    counted once).  Only whole closed surfaces go: the faces left out must make closed, balanced pieces (a face
-    that two overlapping bodies happen to share stays), and a piece holding both members of a pair must use
-    every edge at least four times (a closed surface and its reverse on the same vertices, not a flat sheet written
-    both ways, which is R2's); the classes of a piece that fails are left as they are.
-
-    Parameters
-    ----------
-    vertices : (n, 3) float
-    faces : (m, 3) int
-    among : (m,) bool, optional
-        Only these faces are compared (the shells that could be copies); default all.
-    labels : (m,) int, optional
-        Shell of each face: of the copies of a face, the one in the lowest-numbered shell is kept, so that a
-        copy with its own vertices is left out whole however the faces are ordered.
-    """
-    m = len(faces)
-    drop = np.zeros(m, dtype=bool)
-    none = Coincident(drop=drop, repeated=0, repeated_faces=0, cancelled=0, cancelled_faces=0,
-                      where=np.full(3, np.nan))
-    idx = np.flatnonzero(np.ones(m, dtype=bool) if among is None else np.asarray(among, dtype=bool))
-    if len(idx) < 8:                       # a closed surface has at least 4 faces, two of them at least 8
-        return none
-    f = np.asarray(faces, dtype=np.int64)[idx]
-    shell = np.zeros(len(f), dtype=np.int64) if labels is None else np.asarray(labels, dtype=np.int64)[idx]
-    cls, sign = signed_multiplicity(_point_ids(vertices, f))
-    members = np.flatnonzero(cls >= 0)
-    if not len(members):
-        return none
-    order = members[np.lexsort((members, shell[members], sign[members], cls[members]))]   # class, way, shell, face
-    c, s = cls[order], sign[order]
-    n_cls = int(c.max()) + 1
-    plus = np.bincount(c, weights=(s > 0), minlength=n_cls).astype(np.int64)
-    minus = np.bincount(c, weights=(s < 0), minlength=n_cls).astype(np.int64)
-    net = plus - minus
-    # rank of each face among the faces of its class wound the same way (0 for the first, in shell order)
-    group = c * 2 + (s > 0)
-    start = np.r_[0, np.flatnonzero(group[1:] != group[:-1]) + 1]
-    rank = np.arange(len(order)) - np.repeat(start, np.diff(np.r_[start, len(order)]))
-    kept = (s == np.sign(net[c])) & (rank == 0)
-    pairs = np.minimum(plus, minus)[c]
-    cancel = ~kept & ((s != np.sign(net[c])) | (rank <= pairs))                 # a member of an opposite pair
-    candidate = ~kept & ((plus + minus)[c] >= 2)
-    n_v = len(vertices)
-    touchable = np.ones(n_cls, dtype=bool)
-    gone = np.zeros(0, dtype=np.int64)
-    comp = np.zeros(0, dtype=np.int64)
-    both = np.zeros(0, dtype=bool)
-    for _ in range(n_cls + 1):             # each pass leaves at least one more class as it is, or ends
-        out = np.flatnonzero(candidate & touchable[c])               # positions in ``order``
-        gone = order[out]
-        if not len(gone):
-            break
-        comp, closed = _closed_components(f, gone, n_v)
-        # a piece holding both members of a pair (a class wound both ways in it) is a closed surface and its
-        # reverse on the same vertices only when every edge is used at least four times (else a sheet, R2's)
-        signs_in = np.unique(np.stack([comp, c[out], s[out]], axis=1), axis=0)
-        _, per_class = np.unique(signs_in[:, :2], axis=0, return_counts=True)
-        pieces_of = np.unique(signs_in[:, :2], axis=0)[:, 0]
-        both = np.zeros(len(closed), dtype=bool)
-        both[pieces_of[per_class > 1]] = True
-        for k in np.flatnonzero(both & closed).tolist():            # bounded by the number of pieces
-            closed[k] = _doubled_closed(f[gone[comp == k]], n_v)
-        bad = ~closed[comp]
-        if not bad.any():
-            break
-        touchable[np.unique(c[out][bad])] = False
-    if not len(gone):
-        return none
-    drop[idx[gone]] = True
-    role = cancel[out]                                               # a member of an opposite pair
-    repeated = int(np.count_nonzero(np.bincount(comp, weights=role.astype(np.float64)) == 0))
-    paired = np.zeros(len(both), dtype=bool)
-    paired[comp[role]] = True
-    cancelled = int(np.count_nonzero(paired & both)) + (int(np.count_nonzero(paired & ~both)) + 1) // 2
-    where = np.asarray(vertices, dtype=np.float64)[faces[np.flatnonzero(drop)[0], 0]]
-    return Coincident(drop=drop, repeated=repeated, repeated_faces=int(np.count_nonzero(~role)),
-                      cancelled=cancelled, cancelled_faces=int(np.count_nonzero(role)), where=where)
-
-
-def coincident_message(found: Coincident) -> str:
-    """R0's note: what was left out and why, faces counted so that they add up."""
+def coincident_message(found: Coincident, size: float = 0.0) -> str:
+    """R0's note: what was left out and why, faces counted so that they add up (``size``: m, the part's, to tell the
+    point named within it: :func:`point_text`)."""
     parts = []
     p = found.where
-    near = f" (one near ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}) m)" if np.all(np.isfinite(p)) else ""
+    near = f" (one near {point_text(p, size)})" if np.all(np.isfinite(p)) else ""
     if found.repeated:
         n = found.repeated
         parts.append(f"{n} closed surface{'s' if n > 1 else ''} listed twice ({found.repeated_faces:,} faces "
@@ -1151,220 +929,6 @@ def coincident_message(found: Coincident) -> str:
                      "pair cancels (winding number 0 everywhere, no volume) and is left out")
     return "; ".join(parts) + near
 
-
-@frozen_value
-class WeldedBodies:
-    """R1b: shells split at their non-manifold edges into the bodies welded there.
-
-    Attributes
-    ----------
-    labels : (m,) int
-        Shell of each face after the split, ``0..n_shells-1``.
-    n_shells : int
-    split : int
-        Shells that were split (0: the labels are the ones given).
-    ambiguous : int
-        Shells with non-manifold edges that could not be split into closed bodies (kept whole).
-    contact : (c, 2) int
-        Face pairs of different shells that share a non-manifold edge by index (R4 tests their points).
-    ambiguous_shells : (s,) bool
-        The given shells counted by ``ambiguous`` (their faces go to the coplanar overlay, :mod:`~.coplanar`).
-    """
-
-    labels: np.ndarray
-    n_shells: int
-    split: int
-    ambiguous: int
-    contact: np.ndarray
-    ambiguous_shells: np.ndarray | None = None
-
-
-def _crossing_pairs_at_edges(vertices: np.ndarray, faces: np.ndarray, at: np.ndarray, edge_faces: np.ndarray,
-                             lo: np.ndarray, hi: np.ndarray,
-                             forward: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """R1b: at each non-manifold edge, the faces that continue one body's surface through the others.
-
-    Around the edge ``lo → hi`` the faces are sorted by angle; crossing a face wound along the edge (``forward``)
-    counter-clockwise leaves a solid (the winding number drops by one), crossing one wound against it enters one.
-    Read from a sector of the smallest winding number, the faces form a sequence of entries and exits, and the
-    first solid entered is the first left: entries and exits are paired first in, first out, so that bodies whose
-    surfaces pass through each other stay whole (paired last in, first out they would read as the boundary of the
-    union around the boundary of the common part, a body inside a body).  Where the winding number around the
-    edge never differs by more than one (bodies only touching there) both readings pair each entry with the next
-    exit.  Two faces at the same angle (within their angles' rounding errors) facing opposite ways (bodies face to
-    face) are read leaving one before entering the other; facing the same way (coplanar faces of two bodies
-    overlapping) the order is undefined and the edge gives no pairs.
-
-    Parameters
-    ----------
-    at : (k,) int
-        Edge of each slot (a face at a non-manifold edge), slots grouped by edge.
-    edge_faces, lo, hi, forward : (k,) arrays
-        The slot's face, the edge's end points (``lo < hi``) and whether the face runs ``lo → hi`` (its outward
-        normal then turns counter-clockwise about ``hi − lo`` from the face, so its solid lies clockwise).
-
-    Returns
-    -------
-    pairs : (p, 2) int
-        Faces paired.
-    crossing : (k,) bool
-        Slots at an edge where surfaces cross (the winding number around it spans two or more).
-    undefined : (k,) bool
-        Slots at an edge whose order is undefined.
-    """
-    v = vertices
-    k = len(at)
-    starts = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
-    size = np.diff(np.r_[starts, k])
-    group = np.repeat(np.arange(len(starts)), size)
-    a, b = v[lo], v[hi]
-    d = b - a
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    third = faces[edge_faces].sum(axis=1) - lo - hi
-    w = v[third] - a
-    w -= np.einsum("ij,ij->i", w, d)[:, None] * d
-    height = np.linalg.norm(w, axis=1)
-    u = w[starts] / np.maximum(height[starts], 1e-300)[:, None]
-    u = u[group]
-    angle = np.arctan2(np.einsum("ij,ij->i", w, np.cross(d, u)), np.einsum("ij,ij->i", w, u)) % (2 * np.pi)
-    # each angle's float64 error is a few units of rounding of the coordinates over the face's height from the edge
-    scale = np.max(np.abs(np.concatenate([a, b, v[third]], axis=1)), axis=1)
-    error = 64 * 2.0 ** -53 * scale / np.maximum(height, 1e-300) + 1e-12
-    order = np.lexsort((~forward, angle, at))          # by edge, by angle, at one angle a face leaving first
-    ang, err, fw = angle[order], error[order], forward[order]
-    nxt = np.arange(k) + 1
-    last = starts + size - 1
-    nxt[last] = starts                                  # the next slot around the edge, cyclically
-    gap = np.where(np.isin(np.arange(k), last), ang[nxt] + 2 * np.pi - ang, ang[nxt] - ang)
-    undefined_slot = (gap <= err + err[nxt]) & (fw == fw[nxt]) & (nxt != np.arange(k))
-    undefined_edge = np.bincount(group, weights=undefined_slot, minlength=len(starts)) > 0
-    step = np.where(fw, -1, 1)
-    level = np.cumsum(step)
-    level -= np.repeat(level[starts] - step[starts], size)     # within each edge, from its first slot
-    low = np.minimum.reduceat(level, starts)
-    high = np.maximum.reduceat(level, starts)
-    crossing_edge = (high - low >= 2) & ~undefined_edge
-    # start just after the first sector of the smallest winding number, each edge's sequence rotated there
-    is_low = level == low[group]
-    first_low = np.minimum.reduceat(np.where(is_low, np.arange(k), k), starts)
-    start = first_low + 1 - starts                      # offset within the edge
-    pos = (np.arange(k) - starts[group] - start[group]) % size[group]
-    rotated = np.empty(k, dtype=np.int64)
-    rotated[starts[group] + pos] = np.arange(k)         # rotated[starts + j] = the j-th slot read
-    pairs = []
-    simple = ~crossing_edge & ~undefined_edge
-    if simple.any():                                    # enter, leave, enter, leave: consecutive slots pair
-        first = starts[group] + pos
-        take = simple[group] & (pos % 2 == 0)
-        entry = order[np.arange(k)[take]]
-        exit_ = order[rotated[first[take] + 1]]
-        pairs.append(np.stack([edge_faces[entry], edge_faces[exit_]], axis=1))
-    for e in np.flatnonzero(crossing_edge):             # surfaces crossing: first in, first out (rare; bounded)
-        seq = order[rotated[starts[e]:starts[e] + size[e]]]
-        entered: list[int] = []
-        for slot in seq.tolist():
-            if not forward[slot]:
-                entered.append(slot)
-            elif entered:
-                pairs.append(np.array([[edge_faces[entered.pop(0)], edge_faces[slot]]]))
-    out = np.concatenate(pairs).astype(np.int64) if pairs else np.zeros((0, 2), dtype=np.int64)
-    return out, crossing_edge[group], undefined_edge[group]
-
-
-def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shells: int,
-                  vertices: np.ndarray) -> WeldedBodies:
-    """R1b: split each shell at its non-manifold edges into the bodies welded there.
-
-    The faces joined through manifold edges (used by exactly two faces) form pieces; at each non-manifold edge the
-    pieces are joined as :func:`_crossing_pairs_at_edges` pairs the faces (bodies passing through each other stay
-    whole).  A shell is split when every group of pieces so joined is closed and balanced on its own; otherwise it
-    stays one shell (``ambiguous`` counts it).
-
-    Parameters
-    ----------
-    faces : (m, 3) int
-        A balanced surface (every directed edge matched by its reverse).
-    n_vertices : int
-    labels : (m,) int
-        Edge-connected shells (:func:`~.checks.shell_labels`).
-    n_shells : int
-    vertices : (n, 3) float
-    """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    from .edges import edge_keys
-
-    f = np.asarray(faces, dtype=np.int64)
-    labels = np.asarray(labels, dtype=np.int64)
-    m = len(f)
-    none = WeldedBodies(labels=labels, n_shells=n_shells, split=0, ambiguous=0,
-                        contact=np.zeros((0, 2), dtype=np.int64))
-    if m < 8:                                     # two closed surfaces need at least eight faces
-        return none
-    key, forward = edge_keys(f, n_vertices)
-    order = np.argsort(key, kind="stable")
-    skey = key[order]
-    starts = np.flatnonzero(np.r_[True, skey[1:] != skey[:-1]])
-    count = np.diff(np.r_[starts, len(skey)])
-    many = np.flatnonzero(count > 2)
-    if not len(many):
-        return none
-    two = starts[count == 2]
-    rows, cols = order[two] // 3, order[two + 1] // 3
-    # the faces around each non-manifold edge, paired so that crossing bodies stay whole
-    at = np.repeat(many, count[many])
-    slots = order[np.concatenate([np.arange(starts[k], starts[k] + count[k]) for k in many])]
-    nv = np.int64(max(int(n_vertices), 1))
-    ekey = key[slots]
-    paired, crossing_slot, undefined_slot = _crossing_pairs_at_edges(
-        np.asarray(vertices, dtype=np.float64), f, at, slots // 3, ekey // nv, ekey % nv, ~forward[slots])
-    rows, cols = np.r_[rows, paired[:, 0]], np.r_[cols, paired[:, 1]]
-    graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(m, m))
-    n_pieces, piece = connected_components(graph, directed=False)
-    # each group balanced on its own: the net direction of every (group, edge) is zero
-    owner = piece[np.arange(3 * m) // 3].astype(np.int64)
-    _, inverse = np.unique(np.stack([owner, key], axis=1), axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
-    first = np.zeros(len(net), dtype=np.int64)
-    first[inverse] = owner
-    unbalanced = np.zeros(n_pieces, dtype=bool)
-    unbalanced[first[net != 0]] = True
-    shell_of_piece = np.zeros(n_pieces, dtype=np.int64)
-    shell_of_piece[piece] = labels
-    bad_shell = np.zeros(n_shells, dtype=bool)
-    bad_shell[shell_of_piece[unbalanced]] = True
-    pieces_per_shell = np.bincount(shell_of_piece, minlength=n_shells)
-    # only shells where surfaces cross at a welded edge need splitting (bodies that only touch sum exactly)
-    crossed = np.zeros(n_shells, dtype=bool)
-    crossed[labels[(slots // 3)[crossing_slot | undefined_slot]]] = True
-    splits = (pieces_per_shell > 1) & ~bad_shell & crossed
-    ambiguous = int(np.count_nonzero(crossed & bad_shell))
-    if splits.any():
-        sub = np.where(splits[labels], piece, -1)
-        _, new = np.unique(np.stack([labels, sub], axis=1), axis=0, return_inverse=True)
-        new = new.reshape(-1)
-        _, first_face = np.unique(new, return_index=True)          # numbered in order of each shell's first face
-        rank = np.empty(len(first_face), dtype=np.int64)
-        rank[np.argsort(first_face, kind="stable")] = np.arange(len(first_face))
-        new, count_new = rank[new], len(first_face)
-    else:                      # already apart (split before): the contacts at their shared edges are still wanted
-        new, count_new = labels, n_shells
-    # face pairs of different new shells around each non-manifold edge: contacts for R4
-    fa = slots // 3
-    groups = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
-    mixed = np.minimum.reduceat(new[fa], groups) != np.maximum.reduceat(new[fa], groups)
-    pairs = []
-    for g0, g1 in zip(groups[mixed], np.r_[groups[1:], len(at)][mixed]):     # edges between shells; bounded
-        fs = fa[g0:g1]
-        i, j = np.triu_indices(len(fs), 1)
-        keep = new[fs[i]] != new[fs[j]]
-        pairs.append(np.stack([fs[i][keep], fs[j][keep]], axis=1))
-    contact = np.unique(np.sort(np.concatenate(pairs), axis=1), axis=0) if pairs else np.zeros((0, 2), np.int64)
-    new = new.astype(label_dtype(len(new)), copy=False)
-    return WeldedBodies(labels=new, n_shells=count_new, split=int(np.count_nonzero(splits)),
-                        ambiguous=ambiguous, contact=contact.astype(np.int64), ambiguous_shells=crossed & bad_shell)
 
 
 @frozen_value

@@ -67,7 +67,8 @@ if TYPE_CHECKING:
     from .uncertainty import Estimate
 
 __all__ = ["conversion_bounds", "float32_rounding", "product_rounding", "volume_rounding_bound",
-           "warn_storage_precision", "WeldSweep", "weld_sweep", "weld_reach", "estimate_with_weld", "weld_note"]
+           "warn_storage_precision", "WeldSweep", "weld_sweep", "weld_reach", "estimate_with_weld", "weld_note",
+           "RoundedRegion", "rounded_region", "combined_regions", "region_shares"]
 
 _CHUNK = 1 << 20
 
@@ -138,13 +139,89 @@ def conversion_bounds(vertices: np.ndarray, faces: np.ndarray, rounding: float, 
     if not rounding > 0:
         return 0.0, 0.0, 0.0
     bound = volume_rounding_bound(vertices, faces, rounding)
-    trace = float(np.trace(second_moment))
-    if not (abs(volume) > bound and trace > 0):
+    if not (abs(volume) > bound and float(np.trace(second_moment)) > 0):
         return float("inf"), float("inf"), float("inf")
     rel = vertices - centroid
     reach = math.sqrt(float(np.max(np.einsum("ij,ij->i", rel, rel)))) + math.sqrt(3.0) * rounding
+    return region_shares(bound, reach, volume, second_moment)
+
+
+def region_shares(bound: float, reach: float, volume: float,
+                  second_moment: np.ndarray) -> tuple[float, float, float]:
+    """What a region of volume at most ``bound`` (m³) lying within ``reach`` (m) of the centroid may change in a
+    solid of signed ``volume`` (m³) and ``second_moment`` (3, 3) m⁵ about that centroid: ``(volume relative,
+    centroid m, inertia relative)``, by the formulas of :func:`conversion_bounds`; infs when ``bound`` is not
+    below ``|volume|`` or the solid is flat."""
+    trace = float(np.trace(second_moment))
+    if not (abs(volume) > bound and trace > 0):
+        return float("inf"), float("inf"), float("inf")
     return (bound / abs(volume), bound * reach / (abs(volume) - bound),
             math.sqrt(2.0) * bound * reach ** 2 / (2.0 * trace / math.sqrt(3.0)))
+
+
+@frozen_value
+class RoundedRegion:
+    """Where a constructed surface (an arrangement's, :mod:`~.arrange`, :mod:`~.coplanar`) may differ from the
+    exact solid it stands for, because its new points were rounded to float64: a region of volume at most
+    ``volume``, lying within ``spread`` of the convex hull of ``corners``.
+
+    Kept in absolute units so that R7 judges it against the solid it certifies (:func:`~.certify.certify`), not
+    only against the shell it was built for: a cavity cut later makes the same region a larger share.
+
+    Attributes
+    ----------
+    volume : float
+        m³, the bound ``B`` of :func:`volume_rounding_bound` over the faces at moved points (their corners moved by
+        at most the tier's ``δ`` a coordinate), summed over tiers and arrangements.
+    corners : (k, 3) float
+        m, the corners of those faces.
+    spread : float
+        m, ``√3`` times the largest per-coordinate move: every point of the region lies within it of the faces.
+    """
+
+    volume: float
+    corners: np.ndarray
+    spread: float
+
+    def shares(self, volume: float, centroid: np.ndarray,
+               second_moment: np.ndarray) -> tuple[float, float, float]:
+        """``(volume relative, centroid m, inertia relative)`` of a solid (``volume`` m³, ``centroid`` (3,) m,
+        ``second_moment`` (3, 3) m⁵ about it) that this region may change (:func:`region_shares`, the reach
+        being the farthest corner from ``centroid`` plus ``spread``); zeros for an empty region."""
+        if not (self.volume > 0 and len(self.corners)):
+            return 0.0, 0.0, 0.0
+        rel = np.asarray(self.corners, dtype=np.float64) - np.asarray(centroid, dtype=np.float64)
+        reach = math.sqrt(float(np.max(np.einsum("ij,ij->i", rel, rel)))) + self.spread
+        return region_shares(self.volume, reach, volume, second_moment)
+
+
+def rounded_region(vertices: np.ndarray, faces: np.ndarray,
+                   tiers: list[tuple[np.ndarray, float]]) -> RoundedRegion | None:
+    """The :class:`RoundedRegion` of a constructed surface (``vertices`` (n, 3) m, ``faces`` (m, 3) int) whose
+    faces ``at`` had corners moved by at most ``delta`` m a coordinate, for each ``(at, delta)`` of ``tiers``
+    (the tiers of :func:`~.arrange.rounded_points_bounds`); None when nothing moved."""
+    volume, spread, corners = 0.0, 0.0, []
+    for at, delta in tiers:
+        at = np.asarray(at, dtype=bool)
+        if not (at.any() and delta > 0):
+            continue
+        volume += volume_rounding_bound(vertices, faces[at], delta)
+        spread = max(spread, math.sqrt(3.0) * float(delta))
+        corners.append(np.asarray(vertices, dtype=np.float64)[np.unique(faces[at])])
+    if not corners:
+        return None
+    return RoundedRegion(volume=volume, corners=np.vstack(corners), spread=spread)
+
+
+def combined_regions(*regions: RoundedRegion | None) -> RoundedRegion | None:
+    """One :class:`RoundedRegion` covering all of ``regions`` (volumes added: the triangle inequality; corners
+    together; the largest spread); None when there is none."""
+    given = [r for r in regions if r is not None]
+    if not given:
+        return None
+    return RoundedRegion(volume=float(sum(r.volume for r in given)),
+                         corners=np.vstack([np.asarray(r.corners, dtype=np.float64) for r in given]),
+                         spread=max(r.spread for r in given))
 
 def warn_storage_precision(raw: RawMesh, volume: float, *, rtol: float = STORAGE_PRECISION_RTOL,
                            stacklevel: int = 3) -> float | None:

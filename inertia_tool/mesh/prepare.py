@@ -137,7 +137,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     if patched is not None:
         found = dataclasses.replace(found, notes=found.notes + met.patch_notes)
     crossed = settle_self_crossing(met.shells, met.contacts, arranged=welded.arranged, self_crossing=self_crossing,
-                                   overlap=overlap, repair=repair, patched=patched, diag=diag, source=source)  # R3
+                                   overlap=overlap, repair=repair, patched=patched, diag=diag, source=source,
+                                   region=welded.region)                                                    # R3
     if crossed.forced is not None:
         return _estimated(with_weld_doubt(crossed.forced, weld, source), common)
     oriented = orient_shells(crossed.shells, crossed.contacts, crossed.touch, source=source)           # R4
@@ -157,7 +158,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                         arranged=crossed.arranged is not None, verified=crossed.verified,
                         ambiguous=bool(oriented.ambiguous), folds=met.folds is not None,
                         sheets_removed=found.method == "sheets-removed", source=source, spread=spread,
-                        scale_rounding=raw.scale_rounding, weld=weld)                                     # R7
+                        scale_rounding=raw.scale_rounding, weld=weld, arranged_region=crossed.region)     # R7
     stages = (first.dropped, crossed.arranged, met.folds.describe() if met.folds is not None else None,
               crossed.unverified)
     notes = (*found.notes, *surface.coincident, *first.coincident, *oriented.notes,

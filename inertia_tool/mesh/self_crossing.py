@@ -18,6 +18,7 @@ from ..errors import (ArrangementError, InternalInvariantError, InvalidMeshError
 from ..integrals import volume_moments
 from .intersect import SurfaceContacts, surface_contacts
 from .policy import ShellContacts, self_crossing_message, shell_contacts
+from .precision import RoundedRegion, combined_regions
 from .resolve import Resolution, resolve_surface
 from .shells import Shells, reshelled
 
@@ -46,6 +47,9 @@ class SettledCrossing(NamedTuple):
         The note when a self-crossing surface is integrated as it stands (``self_crossing`` "unverified").
     forced : Resolution or None
         The estimate that replaces the result (``repair``), else None.
+    region : RoundedRegion or None
+        Where rounding the new points of the arrangements made (R1b's passed in, then R3's) may change the result
+        (:class:`~.precision.RoundedRegion`, judged by R7 against the final solid); None when no point was rounded.
     """
 
     shells: Shells
@@ -55,14 +59,16 @@ class SettledCrossing(NamedTuple):
     verified: bool
     unverified: str | None
     forced: Resolution | None
+    region: RoundedRegion | None = None
 
 
 def settle_self_crossing(shells: Shells, contacts: SurfaceContacts, *, arranged: str | None, self_crossing: str,
                          overlap: str, repair: bool, patched: Estimate | None, diag: float,
-                         source: str) -> SettledCrossing:
+                         source: str, region: RoundedRegion | None = None) -> SettledCrossing:
     """R3 on ``shells`` and their ``contacts`` (``self_crossing``, ``overlap`` and ``repair`` as for
     :func:`~.prepare.prepare_mesh`; ``arranged``: the note of R1b's arrangement, if one was made; ``patched``: the
-    estimate of a patched surface, whose crossings are not arranged and whose doubt an estimate carries on).
+    estimate of a patched surface, whose crossings are not arranged and whose doubt an estimate carries on;
+    ``region``: where R1b's arrangement rounded its points, carried on with R3's).
 
     Raises
     ------
@@ -74,7 +80,9 @@ def settle_self_crossing(shells: Shells, contacts: SurfaceContacts, *, arranged:
     if touch.self_crossing.any() and self_crossing == "refuse" and overlap == "union" and patched is None:   # R3
         try:
             before = arranged
-            shells, contacts, touch, arranged, verified = _arrange_self_crossing(shells, contacts, diag, source)
+            shells, contacts, touch, arranged, verified, made = _arrange_self_crossing(shells, contacts, diag,
+                                                                                        source)
+            region = combined_regions(region, made)
             if before is not None:               # R1b's note stays: both arrangements reach the report
                 arranged = f"{before}; then {arranged}"
         except ArrangementError as exc:
@@ -83,7 +91,7 @@ def settle_self_crossing(shells: Shells, contacts: SurfaceContacts, *, arranged:
         note = (f"the surface passes through itself at {touch.self_crossing_pairs:,} face pairs: "
                 "integrated as it stands (a crossed region counts twice), not verified")
         warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=4)
-        return SettledCrossing(shells, contacts, touch, arranged, verified, note, None)
+        return SettledCrossing(shells, contacts, touch, arranged, verified, note, None, region)
     if touch.self_crossing.any():                                                 # R3
         v, f = shells.vertices, shells.faces
         message = self_crossing_message(source, touch, v, f, contacts.crossing, shells.labels) + arrange_failed
@@ -100,16 +108,18 @@ def settle_self_crossing(shells: Shells, contacts: SurfaceContacts, *, arranged:
             forced = with_patch_doubt(forced, patched, source)
         warnings.warn(MeshRepairedWarning(f"{source}: repaired ({forced.method}, an estimate): "
                                           f"{'; '.join(forced.notes)}"), stacklevel=4)
-        return SettledCrossing(shells, contacts, touch, arranged, verified, None, forced)
-    return SettledCrossing(shells, contacts, touch, arranged, verified, None, None)
+        return SettledCrossing(shells, contacts, touch, arranged, verified, None, forced, region)
+    return SettledCrossing(shells, contacts, touch, arranged, verified, None, None, region)
 
 
 def _arrange_self_crossing(shells: Shells, contacts: SurfaceContacts, diag: float,
-                           source: str) -> tuple[Shells, SurfaceContacts, ShellContacts, str, bool]:
+                           source: str) -> tuple[Shells, SurfaceContacts, ShellContacts, str, bool,
+                                                 RoundedRegion | None]:
     """R3: every shell passing through itself replaced by the boundary of its {winding number ≥ 1}
     (:mod:`~.arrange`), then the stages after R1 run again on the new surface.
 
-    Returns ``(shells, contacts, touch, note, verified)``; raises ArrangementError.
+    Returns ``(shells, contacts, touch, note, verified, region)`` (``region``: where the new points' rounding may
+    change the result, :class:`~.precision.RoundedRegion`); raises ArrangementError.
     Crossings left by rounding the new points (``verified`` False) are taken out of ``touch`` (the result is
     then certified ``unverified``)."""
     from .arrange import arrange_shells      # imported on use: self-crossing shells are rare
@@ -130,7 +140,7 @@ def _arrange_self_crossing(shells: Shells, contacts: SurfaceContacts, diag: floa
         note += (f"; {done.crossings_left:,} face pairs of the result still cross after rounding the intersection "
                  "points to float64 (a crossing in special position): not verified")
     warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=5)
-    return shells, contacts, touch, note, not done.crossings_left
+    return shells, contacts, touch, note, not done.crossings_left, done.region
 
 
 def with_patch_doubt(forced: Resolution, patched: Estimate, source: str) -> Resolution:

@@ -16,7 +16,8 @@ import numpy as np
 from ..errors import MeshResolvedWarning
 from .checks import shell_labels
 from .intersect import SurfaceContacts, surface_contacts
-from .policy import ShellContacts, WeldedBodies, touching_relations, welded_bodies
+from .nonmanifold import WeldedBodies, welded_bodies
+from .policy import ShellContacts, touching_relations
 from .shells import Shells, drop_flat, measured
 
 if TYPE_CHECKING:       # imported on use at run time (below)

@@ -17,8 +17,10 @@ from ..errors import InsideOutWarning, InvalidMeshError, MeshResolvedWarning
 from ..integrals import RoundoffBound, VolumeMoments, accurate_shells, body_volume_moments
 from ..tolerances import FLAT_RTOL
 from .checks import shell_labels
-from .policy import (coincident_message, coincident_surfaces, copy_candidates, near_copies, near_copies_message,
-                     negligible_flat, welded_bodies)
+from .multiplicity import coincident_surfaces
+from .nonmanifold import welded_bodies
+from .policy import (coincident_message, copy_candidates, near_copies, near_copies_message, negligible_flat,
+                     part_size)
 
 __all__ = ["Shells", "FoundShells", "find_shells", "bodies", "measured", "reshelled", "drop_flat", "flat_pieces",
            "apply_flips", "leave_out_coincident", "total"]
@@ -119,7 +121,7 @@ def find_shells(vertices: np.ndarray, faces: np.ndarray, *, split_welded: bool, 
 def bodies(v: np.ndarray, f: np.ndarray, split_welded: bool,
            known: tuple[np.ndarray, int] | None = None) -> tuple[np.ndarray, int]:
     """R1 (edge-connected shells) and, on a surface with non-manifold edges, R1b (bodies welded along their
-    crossing split apart, :func:`~.policy.welded_bodies`).  ``known``: the shell labels of ``f`` if already
+    crossing split apart, :func:`~.nonmanifold.welded_bodies`).  ``known``: the shell labels of ``f`` if already
     taken (with the edge census)."""
     labels, n_shells = known if known is not None else shell_labels(f, len(v))
     if split_welded and n_shells:
@@ -177,7 +179,7 @@ def leave_out_coincident(v: np.ndarray, f: np.ndarray, among: np.ndarray | None,
                                f"({len(f) // 2:,} faces each, same corners, opposite winding): they cancel to "
                                "nothing (winding number 0 everywhere, no volume); remove one copy, or reverse it "
                                "if the surface was meant twice")
-    note = coincident_message(found)
+    note = coincident_message(found, part_size(v, f))
     warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=5)
     return f[~found.drop], note
 

@@ -8,15 +8,18 @@ boundary of their solid {winding number ≥ 1} (:mod:`~.coplanar`), or refused, 
 from __future__ import annotations
 
 import warnings
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from ..errors import ArrangementError, InvalidMeshError, MeshRepairedWarning, MeshResolvedWarning
 from ..integrals import volume_moments
-from .policy import WeldedBodies, welded_bodies
+from .nonmanifold import WeldedBodies, welded_bodies
 from .resolve import Resolution, resolve_surface
 from .shells import Shells, measured, reshelled
+
+if TYPE_CHECKING:
+    from .precision import RoundedRegion
 
 __all__ = ["SettledWelded", "settle_welded"]
 
@@ -34,12 +37,16 @@ class SettledWelded(NamedTuple):
         The note of the arrangement of welded coplanar bodies (warned), or None.
     forced : Resolution or None
         The estimate that replaces the result when the bodies could not be split (``repair``), else None.
+    region : RoundedRegion or None
+        Where rounding the overlay's new points may change the result (:class:`~.precision.RoundedRegion`, judged
+        by R7 against the final solid); None when no point was rounded.
     """
 
     shells: Shells
     welded: WeldedBodies | None
     arranged: str | None
     forced: Resolution | None
+    region: RoundedRegion | None = None
 
 
 def settle_welded(shells: Shells, *, split_welded: bool, overlap: str, repair: bool, diag: float,
@@ -58,10 +65,10 @@ def settle_welded(shells: Shells, *, split_welded: bool, overlap: str, repair: b
     welded = welded_bodies(f, len(v), given, n_shells, v)     # ``welded.ambiguous_shells`` indexes ``given``
     if welded.split:
         shells = measured(v, f, welded.labels, welded.n_shells)
-    arranged, failed = None, ""
+    arranged, failed, region = None, "", None
     if welded.ambiguous and overlap == "union" and welded.ambiguous_shells is not None:   # R1b: {w ≥ 1}
         try:
-            shells, arranged = _arrange_welded(v, f, given, welded.ambiguous_shells, diag, source)
+            shells, arranged, region = _arrange_welded(v, f, given, welded.ambiguous_shells, diag, source)
             # R1b on the new surface: the other shells' welded bodies are split again (R1 joined them)
             welded = welded_bodies(shells.faces, len(shells.vertices), shells.labels, shells.n_shells,
                                    shells.vertices)
@@ -71,7 +78,7 @@ def settle_welded(shells: Shells, *, split_welded: bool, overlap: str, repair: b
                 shells = measured(shells.vertices, shells.faces, welded.labels, welded.n_shells)
         except ArrangementError as exc:
             failed = f"; its solid {{winding number ≥ 1}} could not be built: {exc}"
-            arranged = None
+            arranged, region = None, None
     if welded.ambiguous:                # R1b: coplanar faces of two bodies facing the same way
         n_amb = welded.ambiguous
         reason = (f"{n_amb} shell{'s' if n_amb > 1 else ''} with non-manifold edges where coplanar faces of two "
@@ -86,16 +93,16 @@ def settle_welded(shells: Shells, *, split_welded: bool, overlap: str, repair: b
         warnings.warn(MeshRepairedWarning(f"{source}: repaired ({forced.method}, an estimate): "
                                           f"{'; '.join(forced.notes)}"), stacklevel=4)
         return SettledWelded(shells, welded, None, forced)
-    return SettledWelded(shells, welded, arranged, None)
+    return SettledWelded(shells, welded, arranged, None, region)
 
 
 def _arrange_welded(v: np.ndarray, f: np.ndarray, labels: np.ndarray, chosen: np.ndarray, diag: float,
-                    source: str) -> tuple[Shells, str]:
+                    source: str) -> tuple[Shells, str, RoundedRegion | None]:
     """R1b: the shells whose welded bodies could not be split replaced by the boundary of their {winding number
     ≥ 1} (:mod:`~.coplanar`), then R1 and R2 again on the new surface.
 
-    Returns the new shells and the note (warned); raises ArrangementError (the result must not cross itself, as
-    R7 needs)."""
+    Returns the new shells, the note (warned) and where the overlay's points were rounded; raises ArrangementError
+    (the result must not cross itself, as R7 needs)."""
     from .coplanar import arrange_coplanar_shells      # imported on use: welded coplanar bodies are rare
     v, f, done = arrange_coplanar_shells(v, f, chosen[labels])
     if done.crossings_left:
@@ -106,4 +113,4 @@ def _arrange_welded(v: np.ndarray, f: np.ndarray, labels: np.ndarray, chosen: np
             f"in {done.planes:,} plane{'s' if done.planes != 1 else ''}): the faces bounding the region of winding "
             "number ≥ 1 kept, split along each other's edges (the common volume counts once)")
     warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=5)
-    return shells, note
+    return shells, note, done.region
