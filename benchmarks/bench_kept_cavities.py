@@ -5,7 +5,8 @@ turned, or R4's depth reading when no two boxes cross), which knows nothing of t
 
 Run: ``python benchmarks/bench_kept_cavities.py --cases 800 --seed 1241``: the count of each certificate label, the
 silent wrong answers (labelled exact, united or estimate and matching no reading, or a warning naming a union that
-is no reading) with the boxes that make them.  Case ``i`` is drawn from ``numpy.random.default_rng([seed, i])``.
+is no reading) and the crashes (any exception but ``InvalidMeshError``) with the boxes that make them.  Case ``i``
+is drawn from ``numpy.random.default_rng([seed, i])``.
 """
 from __future__ import annotations
 
@@ -31,9 +32,14 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.process_time()
     for i in range(args.cases):
         boxes = _draw(np.random.default_rng([args.seed, i]))
-        label, why = _verdict(boxes)
+        try:
+            label, why = _verdict(boxes)
+        except Exception as exc:  # noqa: BLE001 - any other exception is a crash, counted and shown
+            label, why = "crashed", f"{type(exc).__name__}: {exc}"
         counts[label] += 1
-        if why is not None:
+        if label == "crashed":
+            wrong.append((i, why, [(lo.tolist(), hi.tolist(), s) for lo, hi, s in boxes]))
+        elif why is not None:
             counts["silent wrong"] += 1
             wrong.append((i, why, [(lo.tolist(), hi.tolist(), s) for lo, hi, s in boxes]))
     print(f"{args.cases} cases, seed {args.seed}, {time.process_time() - t0:.1f} s CPU")
