@@ -9,6 +9,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
 from adversary_solids import certificate_label, torus
@@ -98,15 +99,25 @@ def _kept_cavities_case_118() -> list[tuple[np.ndarray, np.ndarray, int]]:
     return [(np.array(lo), np.array(hi), sign) for lo, hi, sign in cells]
 
 
-def test_r4c_does_not_turn_an_inward_box_and_keep_the_outward_box_it_holds():
+def _kept_cavities_case_1348() -> list[tuple[np.ndarray, np.ndarray, int]]:
+    """``bench_kept_cavities.py --seed 1418`` case 1348: an outward box inside an inward box (flush on three faces),
+    and a second inward box crossing the outward one.  The file's winding is at most 0 everywhere (no solid); R4c
+    turned the outer inward box and kept the outward one: ``united`` 0.5 m³."""
+    cells = [([-4, 0, 1], [-2, 2, 3], 1), ([-4, 0, 0], [-1, 3, 4], -1), ([-3, 0, 1], [-1, 2, 3], -1)]
+    return [(np.array(lo), np.array(hi), sign) for lo, hi, sign in cells]
+
+
+@pytest.mark.parametrize("case", [_kept_cavities_case_118, _kept_cavities_case_1348])
+def test_r4c_does_not_turn_an_inward_box_and_keep_the_outward_box_it_holds(case):
     """R4c keeps the file's winding for shells inside others but still turned a body written inside out when it
     stood alone at depth 0; this one holds an outward box, whose own turn (to a cavity, by depth) R4c drops.
     Turning one and not the other united the two (24 cells), which is neither the file's winding (0: the outward
     box cancels the void around it) nor R4's depth reading (12: the box is the turned body's cavity): certified
-    ``united`` 1.84375 m³ for ``{w ≥ 1}`` = 1.46875.  Now the inward box is not turned while it holds a shell whose
-    turn is dropped; it then lies outside every body and R4c refuses, or with ``repair`` gives an estimate."""
+    ``united`` 1.84375 m³ for ``{w ≥ 1}`` = 1.46875 (case 1348: ``united`` 0.5 m³ where the file has no solid).  Now
+    an inward box at depth 0 is not turned while it holds a shell wound against its depth (which R4c keeps as
+    wound); it then lies outside every body and R4c refuses, or with ``repair`` gives an estimate."""
     from test_mesh_kept_cavities import _mesh, _readings, _verdict
-    boxes = _kept_cavities_case_118()
+    boxes = case()
     label, wrong = _verdict(boxes)
     assert wrong is None, wrong
     v, f = _mesh(boxes)
@@ -114,7 +125,10 @@ def test_r4c_does_not_turn_an_inward_box_and_keep_the_outward_box_it_holds():
         warnings.simplefilter("ignore")
         props = mass_properties((v, f), density=1.0, repair=True)
     label = certificate_label(props.mesh)
-    if label in ("exact", "united", "estimate"):
+    readings = _readings(boxes)
+    # case 1348 has no solid as wound (no reading): its repair estimate (0.497 m³ ±12 %, the grid's winding number of
+    # the shells as R4 turned them) is not judged here (session 14's report)
+    if label in ("exact", "united", "estimate") and readings:
         bound = props.mesh.uncertainty.mass if label == "estimate" else 1e-9
-        assert any(abs(props.mass - r[0]) <= bound * r[0] + 1e-12 for r in _readings(boxes)), \
-            (label, props.mass, [r[0] for r in _readings(boxes)])
+        assert any(abs(props.mass - r[0]) <= bound * r[0] + 1e-12 for r in readings), \
+            (label, props.mass, [r[0] for r in readings])

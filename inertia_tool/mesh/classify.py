@@ -117,10 +117,12 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     by_winding = bool(shared or crossed_cavities or held_cavities or spanning or in_kept) and misread is None \
         and groups is None
     if by_winding:      # shells inside others keep the file's winding; a body inside out on its own is still turned,
-        # but not one holding a shell whose own turn by depth is dropped here: turning the one and not the other is
-        # neither the file's winding nor R4's reading (session 14: an inward box holding an outward one, beside hollow
-        # bodies crossing, was turned and united with it, 24 cells for the file's 0 and the depth reading's 12)
-        flip = flip & (depth == 0) & ~_holds(nest, _both(within, touch_within), flip & (depth > 0), n_shells)
+        # but not one holding a shell wound against its depth (which keeps the file's winding here): turning the one
+        # and not the other is neither the file's winding nor R4's reading (session 14: an inward box holding an
+        # outward one, beside hollow bodies crossing, was turned and united with it, 24 cells for the file's 0 and
+        # the depth reading's 12)
+        against = (depth > 0) & ((file_volumes > 0) != (depth % 2 == 0))
+        flip = flip & (depth == 0) & ~_holds(nest, _both(within, touch_within), against, n_shells)
     quiet = np.zeros(n_shells, dtype=bool)
     if misread is not None:           # warned once, with both readings, by certify.misread_reading
         quiet[misread.shells] = True
