@@ -158,11 +158,12 @@ def test_a_cavity_that_fills_its_body_is_refused_not_a_usage_error():
 @pytest.mark.xfail(strict=True, reason=(
     "open (session 14, bench_kept_cavities seed 1418 case 327): an inward box V holding three outward boxes that "
     "cross one another. R4 turns V (depth 0, wound inward: a body inside out, InsideOutWarning) and the misread "
-    "rule (policy.misread_nesting, certify.misread_reading) then spans two readings that both rest on that turn: "
-    "the three as bodies united with V (48 cells) or as one cavity of V (34). The file's own winding inside V is "
-    "-1 + 1 = 0 (1 where two of the three overlap): {w >= 1} is 26 cells, outside the estimate's +-33 %. Fix "
-    "direction: as in R4c (classify._holds), do not turn a depth-0 inward shell that holds shells wound against "
-    "their depth, or make the reading unverified; not done (the misread path's bound needs the file's reading)"))
+    "rule (policy.misread_nesting, certify.misread_reading) gives an estimate (48 cells +-33 %) spanning two "
+    "readings that both rest on that turn: the three as one cavity of V (34 cells, R4's depth reading, inside the "
+    "bound) or as bodies united with V (48), which its note calls 'read by the file's winding'. The file's own "
+    "winding inside V is -1 + 1 = 0 (1 where two of the three overlap): {w >= 1} is 26 cells, outside the bound. "
+    "The judge offers R4's depth reading only when no boxes cross. Decide: name the union reading truly and widen "
+    "the bound to the file's winding, or refuse as in R4c (classify._holds); not done"))
 def test_a_misread_reading_inside_an_inward_box_holds_its_bound():
     from test_mesh_kept_cavities import _verdict
     boxes = _boxes([([1, -4, 1], [4, 0, 3], 1), ([1, 1, -2], [4, 3, 0], 1), ([0, 1, -2], [4, 4, 0], -1),
