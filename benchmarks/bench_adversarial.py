@@ -107,7 +107,7 @@ def main(argv=None):
     ap.add_argument("--mc", type=int, default=100_000, help="Monte Carlo points for figure-eight cross-checks")
     ap.add_argument("--json", type=Path, default=None, help="write every failure (kind, index, recipe) here")
     ap.add_argument("--kind", choices=S.KINDS, default=None,
-                    help="only the cases of this kind (case indices i with KINDS[i % len(KINDS)] == kind, "
+                    help="only the cases of this kind (case indices i with KINDS[i %% len(KINDS)] == kind, "
                          "--cases of them)")
     args = ap.parse_args(argv)
     require_c_kernels()

@@ -110,8 +110,10 @@ def _readings(boxes):
     return [r for r in found if r is not None]
 
 
-def _judge(boxes):
-    """None when the answer is right, refused, or honestly labelled; else what is wrong."""
+def _verdict(boxes):
+    """``(label, wrong)``: the answer's certificate label (``"refused"`` for an ``InvalidMeshError``) and None when
+    the answer is right, refused, or honestly labelled, else what is wrong (``benchmarks/bench_kept_cavities.py``
+    counts the labels)."""
     v, f = _mesh(boxes)
     diag = float(np.linalg.norm(np.ptp(v, axis=0)))
     with warnings.catch_warnings(record=True) as caught:
@@ -119,16 +121,16 @@ def _judge(boxes):
         try:
             props = mass_properties((v, f), density=1.0)
         except InvalidMeshError:
-            return None
+            return "refused", None
     label = certificate_label(props.mesh)
     readings = _readings(boxes)
     texts = " ".join(str(w.message) for w in caught)
     claim = re.search(r"the union of the bodies: ([0-9.eE+-]+) m³(?! more)", texts)      # a total, not a difference
     if claim and all(abs(float(claim.group(1)) - r[0]) > 1e-5 * r[0] for r in readings):
-        return f"a warning names {claim.group(1)} m³ as the union of the bodies; the readings: " \
-               f"{[r[0] for r in readings]}"
+        return label, f"a warning names {claim.group(1)} m³ as the union of the bodies; the readings: " \
+                      f"{[r[0] for r in readings]}"
     if label not in ("exact", "united", "estimate"):
-        return None
+        return label, None
     for volume, centroid, inertia in readings:
         dv = abs(props.mass - volume) / volume
         dc = float(np.linalg.norm(props.center_of_mass - centroid))
@@ -136,10 +138,15 @@ def _judge(boxes):
         if label == "estimate":
             u = props.mesh.uncertainty
             if dv <= u.mass + 1e-9 and dc <= u.center_of_mass + 1e-9 * diag and di <= u.inertia + 1e-9:
-                return None
+                return label, None
         elif dv <= 1e-9 and dc <= 1e-9 * diag and di <= 1e-8:
-            return None
-    return f"{label} {props.mass} m³ for the readings {[r[0] for r in readings]}"
+            return label, None
+    return label, f"{label} {props.mass} m³ for the readings {[r[0] for r in readings]}"
+
+
+def _judge(boxes):
+    """None when the answer is right, refused, or honestly labelled; else what is wrong."""
+    return _verdict(boxes)[1]
 
 
 def test_d5_family_judge_catches_the_old_answer():

@@ -132,6 +132,11 @@ def _bodies(prepared: PreparedMesh, density: float, name: str) -> list[MassPrope
         if len(props) == 1 and len(owners) == 1:     # one shell: the copy below would equal it field for field
             bodies.append(props[0])
             continue
+        volume = sum(s.volume for s in members)
+        if not volume > 0:      # a cavity as large as its body (session 14: a void split exactly into two boxes
+            raise InvalidMeshError(           # inside it, touching up to rounding; combine() raised a UsageError)
+                f"{name}: a body and its cavities as read by nesting depth enclose no material ({volume:.3g} m³): "
+                "the shells are wound or nested so that a cavity fills its body; fix the winding of the part meant")
         body = props[0] if len(props) == 1 else combine(props, name=name)
         bodies.append(MassProperties(mass=body.mass, volume=body.volume, center_of_mass=body.center_of_mass,
                                      inertia=body.inertia, surface_area=body.surface_area, density=density,

@@ -116,8 +116,13 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
         misread = groups = None
     by_winding = bool(shared or crossed_cavities or held_cavities or spanning or in_kept) and misread is None \
         and groups is None
-    if by_winding:      # shells inside others keep the file's winding; a body inside out on its own is still turned
-        flip = flip & (depth == 0)
+    if by_winding:      # shells inside others keep the file's winding; a body inside out on its own is still turned,
+        # but not one holding a shell wound against its depth (which keeps the file's winding here): turning the one
+        # and not the other is neither the file's winding nor R4's reading (session 14: an inward box holding an
+        # outward one, beside hollow bodies crossing, was turned and united with it, 24 cells for the file's 0 and
+        # the depth reading's 12)
+        against = (depth > 0) & ((file_volumes > 0) != (depth % 2 == 0))
+        flip = flip & (depth == 0) & ~_holds(nest, _both(within, touch_within), against, n_shells)
     quiet = np.zeros(n_shells, dtype=bool)
     if misread is not None:           # warned once, with both readings, by certify.misread_reading
         quiet[misread.shells] = True
@@ -309,6 +314,19 @@ def shell_nesting_or_none(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_sh
         return None
     from .nesting import shell_nesting      # imported on use: one shell needs none
     return shell_nesting(v, f, labels, n_shells)
+
+
+def _holds(nest: Nesting | None, within: np.ndarray | None, held: np.ndarray, n_shells: int) -> np.ndarray:
+    """(s,) bool: shells that hold one of the shells ``held`` ((s,) bool), by the winding number of the holder at
+    the held shell's probe point (``nest``) or as a ``(shell, container)`` pair of ``within`` (flush contact)."""
+    out = np.zeros(n_shells, dtype=bool)
+    if nest is not None:
+        inside = (np.asarray(nest.winding) != 0) & held[np.asarray(nest.shell, dtype=np.int64)]
+        out[np.asarray(nest.other, dtype=np.int64)[inside]] = True
+    if within is not None and len(within):
+        pairs = np.asarray(within, dtype=np.int64).reshape(-1, 2)
+        out[pairs[held[pairs[:, 0]], 1]] = True
+    return out
 
 
 def _both(within: np.ndarray | None, more: np.ndarray) -> np.ndarray | None:
