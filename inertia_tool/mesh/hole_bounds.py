@@ -740,16 +740,21 @@ def _plane_unattested_at_rim(v: np.ndarray, f: np.ndarray, planes: np.ndarray, t
     return False
 
 
-def _contradicted(evidence: RimEvidence, radius: np.ndarray, size: np.ndarray) -> str:
+def _contradicted(evidence: RimEvidence, radius: np.ndarray, size: np.ndarray, *,
+                  assumed: np.ndarray | None = None) -> str:
     """Why the faces left at some hole's rim contradict the bound's assumption (empty when none does).
 
     The bound assumes the missing surface of each hole stays near its rim (the ball, cut to the slab).  A hole
     that is an island in a flat face *and* has a bare rim vertex (:class:`RimEvidence`) contradicts it: on a
     surface with no vertex inside its flat faces the rim was a loop of the face, the footprint of something
     standing on it or sunk into it (a boss, a pocket, a connector housing) that the hole took whole, whose
-    height nothing in the file bounds.
+    height nothing in the file bounds.  ``assumed`` (n_loops,) bool: holes the user stated lost a flat piece of
+    the face (``hole_assumptions.FLAT_ISLANDS``), not refused.  The message ends by naming that option.
     """
-    found = np.flatnonzero(evidence.flat_all_round & (evidence.bare > 0))
+    refused = evidence.flat_all_round & (evidence.bare > 0)
+    if assumed is not None:
+        refused = refused & ~assumed
+    found = np.flatnonzero(refused)
     if not len(found):
         return ""
     k = int(found[np.argmax(radius[found])])
@@ -784,6 +789,47 @@ def flat_islands(evidence: RimEvidence) -> np.ndarray:
     """
     islands: np.ndarray = np.asarray(evidence.flat_all_round, dtype=bool).copy()
     return islands
+
+
+def flat_island_doubt(vertices: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                      centre: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Volume in doubt of each hole under the user's ``flat-islands`` assumption, and the slab's half-width:
+    ``(doubt, half_width)``, (n_loops,) m³ and m.
+
+    Assumption (``hole_assumptions.FLAT_ISLANDS``, stated by the user, never taken by default): a hole that is an
+    island in a flat face lost a flat piece of that face, so its missing surface ``M`` lies within ``δ`` of the
+    rim's least-squares plane ``P`` — the slab the ``planar`` reading uses (:func:`planar_rim_doubt`: ``P``
+    through the rim's centroid ``c̄``, normal the eigenvector of the least eigenvalue of
+    ``Σ (x − c̄)(x − c̄)ᵀ``; ``δ`` the rim's largest distance from ``P`` plus 16 ulp of the coordinates).  The cone
+    to ``c̄`` lies in the rim's convex hull, hence in that slab, so the patched and the true solid differ only
+    inside ball ∩ slab (:func:`ball_slab_volume`).  For an exactly planar rim ``M`` minus the cone is a planar
+    2-cycle, which encloses nothing: the doubt is round-off.  Unlike ``planar``, no crease is asked of the faces
+    beside the rim and a rim of three corners is taken (the flat face round it, not the rim, is the evidence the
+    user relies on); what the assumption cannot see — a boss or pocket taken whole — is its stated limit.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    doubt = np.full(n_loops, np.inf)
+    half = np.full(n_loops, np.inf)
+    if not n_loops:
+        return doubt, half
+    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
+    loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
+    count = np.bincount(loop_of, minlength=n_loops).astype(np.float64)
+    mean = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) for i in range(3)],
+                    axis=1) / np.maximum(count, 1.0)[:, None]
+    d = v[vertex_of] - mean[loop_of]
+    scatter = np.zeros((n_loops, 3, 3))
+    for i in range(3):
+        for j in range(3):
+            scatter[:, i, j] = np.bincount(loop_of, weights=d[:, i] * d[:, j], minlength=n_loops)
+    _, vectors = np.linalg.eigh(scatter)
+    normal = vectors[:, :, 0]
+    delta = np.zeros(n_loops)
+    np.maximum.at(delta, loop_of, np.abs(np.einsum("ij,ij->i", d, normal[loop_of])))
+    half = delta + _round_off(v)
+    offset = np.einsum("ij,ij->i", centre - mean, normal)
+    doubt = ball_slab_volume(radius, offset, half)
+    return doubt, half
 
 
 #: A face beside the rim steeper than this (its normal's angle with the rim's mean plane's normal, degrees) leaves
