@@ -808,15 +808,26 @@ def flat_island_doubt(vertices: np.ndarray, edges: np.ndarray, label: np.ndarray
     user relies on); what the assumption cannot see — a boss or pocket taken whole — is its stated limit.
     """
     v = np.asarray(vertices, dtype=np.float64)
-    doubt = np.full(n_loops, np.inf)
-    half = np.full(n_loops, np.inf)
     if not n_loops:
-        return doubt, half
+        return np.full(0, np.inf), np.full(0, np.inf)
+    _, mean, normal, delta, _, _ = _rim_planes(v, edges, label, n_loops)
+    half = delta + _round_off(v)
+    offset = np.einsum("ij,ij->i", centre - mean, normal)
+    doubt: np.ndarray = ball_slab_volume(radius, offset, half)
+    return doubt, half
+
+
+def _rim_planes(v: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each rim's least-squares plane: ``(count, mean, normal, delta, spread, d)`` — the rim's distinct vertices
+    (n_loops,), their centroid ``c̄`` (n_loops, 3) m, the unit eigenvector of the least eigenvalue of
+    ``Σ (x − c̄)(x − c̄)ᵀ`` (n_loops, 3), the largest distance of a rim vertex from the plane (n_loops,) m, the
+    largest distance from ``c̄`` (n_loops,) m, and each (loop, vertex) pair's offset from its ``c̄``."""
     pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
     loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
     count = np.bincount(loop_of, minlength=n_loops).astype(np.float64)
-    mean = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) for i in range(3)],
-                    axis=1) / np.maximum(count, 1.0)[:, None]
+    mean: np.ndarray = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) for i in range(3)],
+                                axis=1) / np.maximum(count, 1.0)[:, None]
     d = v[vertex_of] - mean[loop_of]
     scatter = np.zeros((n_loops, 3, 3))
     for i in range(3):
@@ -826,10 +837,9 @@ def flat_island_doubt(vertices: np.ndarray, edges: np.ndarray, label: np.ndarray
     normal = vectors[:, :, 0]
     delta = np.zeros(n_loops)
     np.maximum.at(delta, loop_of, np.abs(np.einsum("ij,ij->i", d, normal[loop_of])))
-    half = delta + _round_off(v)
-    offset = np.einsum("ij,ij->i", centre - mean, normal)
-    doubt = ball_slab_volume(radius, offset, half)
-    return doubt, half
+    spread = np.zeros(n_loops)
+    np.maximum.at(spread, loop_of, np.linalg.norm(d, axis=1))
+    return count, mean, normal, delta, spread, d
 
 
 #: A face beside the rim steeper than this (its normal's angle with the rim's mean plane's normal, degrees) leaves
@@ -1033,27 +1043,11 @@ def planar_rim_doubt(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray,
     normal = np.zeros((n_loops, 3))
     if not n_loops:
         return PlanarRims(applies=applies, doubt=doubt, half_width=half, normal=normal, origin=np.zeros((0, 3)))
-    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
-    loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
-    count = np.bincount(loop_of, minlength=n_loops).astype(np.float64)
-    mean: np.ndarray = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) for i in range(3)],
-                                axis=1) / np.maximum(count, 1.0)[:, None]
-    d = v[vertex_of] - mean[loop_of]
-    scatter = np.zeros((n_loops, 3, 3))
-    for i in range(3):
-        for j in range(3):
-            scatter[:, i, j] = np.bincount(loop_of, weights=d[:, i] * d[:, j], minlength=n_loops)
-    _, vectors = np.linalg.eigh(scatter)
-    normal = vectors[:, :, 0]
-    dist = np.abs(np.einsum("ij,ij->i", d, normal[loop_of]))
-    delta = np.zeros(n_loops)
-    np.maximum.at(delta, loop_of, dist)
+    count, mean, normal, delta, spread, _ = _rim_planes(v, edges, label, n_loops)
     half = delta + _round_off(v)
     # a rim of at least 4 vertices spanning the plane (not a pinch along a line), within rim_rtol of it: three
     # points always lie in one plane, so a 3-vertex rim is no evidence of a flat face (a triangular prism that
     # lost the three faces of a corner tetrahedron was 33 % low inside ±1e-14: test_hole_footprints, CI dry run)
-    spread = np.zeros(n_loops)
-    np.maximum.at(spread, loop_of, np.linalg.norm(d, axis=1))
     candidate = (count >= 4) & (delta <= rim_rtol * radius) & (spread > 0)
     # the faces sharing a rim edge, each at a crease of at least min_crease_degrees to the rim's plane
     # (each rim edge's face, found in either direction; a rim edge without one keeps the loop out)
