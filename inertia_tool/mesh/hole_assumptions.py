@@ -19,6 +19,13 @@ tell a flat lid from a dome or dimple taken whole with a flat ring round it, and
 (``flat``, ``planar``, ``bend``, ``graph``, ``capsule``, ``convex``) would bound it by round-off: such a hole keeps
 the uncut ball over its rim (:data:`BALL`), or the estimate is refused where that is not useful
 (:func:`~.hole_bounds.flat_islands` states the rule and its reason).
+
+**The user's assumptions** (:data:`USER_ASSUMPTIONS`, issue 23) are the one exception, never taken by default:
+``LoadOptions.assume`` / ``--assume flat-islands`` states that each such island lost a flat piece of its face
+(:data:`FLAT_ISLANDS`); the island is then filled in its rim's plane and bounded by the rim's own slab
+(:func:`~.hole_bounds.flat_island_doubt`), and the estimate names the assumption as the user's
+(:func:`user_stated`).  It is set for the duration of a mesh's preparation by :func:`assuming` and read in one
+place, :func:`~.holes.patched_estimate`.
 """
 
 from __future__ import annotations

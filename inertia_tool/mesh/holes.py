@@ -30,6 +30,9 @@ flat faces (as CAD exporters do), a rim vertex whose remaining faces all lie in 
 of that face, so the hole took a surface that met the face there: the slab is withdrawn (the ball stays), a
 crease fill is not made, and a hole that is an island of a flat face with a bare rim — the footprint of a
 feature taken whole — is refused (:attr:`~.uncertainty.Estimate.unbounded`), since nothing bounds its height.
+Only where the user states ``flat-islands`` (:data:`~.hole_assumptions.FLAT_ISLANDS`, read here from
+:func:`~.hole_assumptions.user_assumed`) is such an island filled in its rim's plane and bounded by the rim's
+own slab instead (:func:`~.hole_bounds.flat_island_doubt`), the estimate naming the assumption as the user's.
 
 The stage is split by data flow: the fills other than the cone (crease and curved fills) are in
 :mod:`~.hole_fills`, the bounds and the evidence that withdraws or refuses them in :mod:`~.hole_bounds`; this
