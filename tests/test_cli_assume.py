@@ -73,3 +73,21 @@ def test_robot_assume_without_repair_is_a_usage_error(capsys):
     assert "--repair" in _one_line(capsys.readouterr().err)
     assert main([*argv, "--repair", "--assume", "dome"]) == EXIT_USAGE
     assert "flat-islands" in _one_line(capsys.readouterr().err)
+
+
+def test_batch_options_key_changes_only_when_something_is_assumed():
+    """Result files written before `assume` existed resume unchanged (the key of no assumption is the old one:
+    the same hash of the old fields), and a run with the assumption is not mistaken for one without."""
+    import hashlib
+    from dataclasses import asdict
+
+    from inertia_tool.batch.runner import BatchOptions
+    from inertia_tool.mesh.options import LoadOptions
+
+    plain = BatchOptions(load=LoadOptions(repair=True))
+    flat = {**asdict(plain.load), "density": None, "material": None, "mass": None, "units": "m"}
+    for name in ("declared_units_win", "assume"):
+        flat.pop(name)
+    old = hashlib.sha256(json.dumps(flat, sort_keys=True, default=str).encode()).hexdigest()[:16]
+    assert plain.key() == old
+    assert BatchOptions(load=LoadOptions(repair=True, assume=("flat-islands",))).key() != old
