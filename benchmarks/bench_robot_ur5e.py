@@ -4,7 +4,9 @@ trees run alternately, so that they share the machine's load.
 
 Universal Robots' ROS 2 description (``ur_description``, BSD) is not in the repository; give its folder::
 
-    python benchmarks/bench_robot_ur5e.py UR_DESCRIPTION [--trees TREE ...] [--runs N] [--out DIR]
+    python benchmarks/bench_robot_ur5e.py UR_DESCRIPTION [--trees TREE ...] [--runs N] [--out DIR] [--assume NAME]
+
+``--assume flat-islands`` passes the user's assumption on (the wrist links' island holes, issue 23).
 
 Each tree is put first on ``PYTHONPATH`` (a checkout with its compiled ``_accel``); the table and warnings of each
 run are kept in ``--out`` (``TREE-NAME_RUN.txt``) so that the outputs of the trees can be compared byte for byte.
@@ -24,12 +26,14 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def run_once(tree: str, description: str, out: str) -> tuple[float, float, float, int]:
+def run_once(tree: str, description: str, out: str, assume: tuple[str, ...] = ()) -> tuple[float, float, float, int]:
     """(user s, system s, wall s, peak RSS KB) of one command with ``tree`` first on PYTHONPATH."""
     env = dict(os.environ, PYTHONPATH=tree)
     command = [sys.executable, "-m", "inertia_tool", "robot", os.path.join(description, "urdf", "ur.urdf.xacro"),
                "--run-xacro", "--arg", "ur_type:=ur5e", "--arg", "name:=ur", "--package",
                f"ur_description={description}", "--geometry", "visual", "--repair", "--density", "1000"]
+    for name in assume:
+        command += ["--assume", name]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     with open(out, "w") as sink:
@@ -47,6 +51,7 @@ def main(argv=None) -> int:
     parser.add_argument("--trees", nargs="+", default=[os.path.dirname(HERE)])
     parser.add_argument("--runs", type=int, default=2)
     parser.add_argument("--out", default=".")
+    parser.add_argument("--assume", action="append", default=[], metavar="NAME")
     args = parser.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
     args.description, args.out = os.path.abspath(args.description), os.path.abspath(args.out)
@@ -55,7 +60,8 @@ def main(argv=None) -> int:
         for tree in args.trees:
             name = os.path.basename(os.path.normpath(tree))
             load = os.getloadavg()[0]
-            user, system, wall, peak = run_once(tree, args.description, os.path.join(args.out, f"{name}_{run}.txt"))
+            user, system, wall, peak = run_once(tree, args.description, os.path.join(args.out, f"{name}_{run}.txt"),
+                                                 tuple(args.assume))
             print(f"{name} run {run} load {load:.1f}: user {user:.2f} s, system {system:.2f} s, "
                   f"CPU {user + system:.2f} s, wall {wall:.1f} s, largest child RSS so far {peak // 1024} MB",
                   flush=True)

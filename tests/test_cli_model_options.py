@@ -32,14 +32,14 @@ def _option_order(command):
 def test_model_options_in_the_same_order_everywhere():
     model = ["--units", "--density", "--material", "--mass", "--material-map", "--model", "--thickness", "--shell",
              "--infill", "--top-bottom", "--top-layers", "--bottom-layers", "--layer-height",
-             "--repair", "--overlap", "--merge-tolerance", "--max-faces"]
+             "--repair", "--assume", "--overlap", "--merge-tolerance", "--max-faces"]
     for command in MODEL_COMMANDS:
         order = _option_order(command)
         assert order[:len(model)] == model, command
     batch = _option_order("batch")
     printed = ("--material-map", "--model", "--thickness", "--shell", "--infill", "--top-bottom", "--top-layers",
                "--bottom-layers", "--layer-height")
-    assert batch[:8] == [o for o in model if o not in printed]
+    assert batch[:9] == [o for o in model if o not in printed]
 
 
 @pytest.mark.parametrize("model", [["--model", "shell", "--thickness", "1mm"], ["--shell", "1mm", "--infill", "20%"]])

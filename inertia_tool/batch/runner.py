@@ -169,6 +169,8 @@ class BatchOptions:
         # it changes only files that were refused before: keys stay those of result files written before it
         # existed (their error rows for such files are kept on resume; a new results file reads them again)
         flat.pop("declared_units_win", None)
+        if not flat.get("assume"):         # none stated: the keys of result files written before `assume` existed
+            flat.pop("assume", None)
         text = json.dumps(flat, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 

@@ -42,7 +42,7 @@ __all__ = ["add_files_argument", "add_model_options", "add_material_options", "a
            "add_material_map_option", "parse_material_map", "split_part_spec",
            "length_unit", "load_options_from_args", "read_meshes", "load_model",
            "LoadedModel", "model_words", "with_warnings", "command_parser", "recorded_warnings",
-           "shown_with_report"]
+           "shown_with_report", "add_assume_option", "assumed_from_args"]
 
 FILES_HELP = ("mesh file(s): STL, OBJ, PLY, OFF, 3MF; several FILE:material or FILE:density make an "
               "assembly (e.g. a.stl:steel b.stl:1.2g/cm3)")
@@ -123,6 +123,7 @@ def add_mesh_options(parser) -> None:
     g.add_argument("--repair", action="store_true",
                    help="give a bounded estimate (method and uncertainty in the report) for a mesh with holes, "
                         "cracks or stray pieces instead of refusing it")
+    add_assume_option(g)
     g.add_argument("--overlap", choices=("union", "sum"), default="union",
                    help="overlapping bodies: integrate their union (default) or add them, counting shared "
                         "material twice")
@@ -131,6 +132,34 @@ def add_mesh_options(parser) -> None:
                         f"vertices when exact welding leaves the surface open (default {MERGE_TOLERANCE:g}; 0 off)")
     g.add_argument("--max-faces", type=int, default=DEFAULT_MAX_FACES, metavar="N",
                    help=f"refuse meshes with more triangles (default {DEFAULT_MAX_FACES:,})")
+
+
+#: The names ``--assume`` takes, for help without loading the engine (the same as
+#: ``mesh.hole_assumptions.USER_ASSUMPTIONS``: tests/test_cli_assume.py checks it).
+ASSUME_NAMES = ("flat-islands",)
+
+
+def add_assume_option(group) -> None:
+    """``--assume NAME`` (repeatable): an assumption about the holes ``--repair`` fills that only the user can
+    make (``LoadOptions.assume``; :func:`assumed_from_args` checks it)."""
+    group.add_argument("--assume", action="append", default=[], metavar="NAME",
+                       help="with --repair: an assumption about the lost surface that the file cannot show, named "
+                            "in the report as yours; flat-islands: each hole that is an island in a flat face lost "
+                            "a flat piece of that face (filled flat and bounded instead of refused; a boss or "
+                            "pocket taken whole there breaks it). Known: " + ", ".join(ASSUME_NAMES))
+
+
+def assumed_from_args(args) -> tuple[str, ...]:
+    """``--assume`` checked: known names only, and only with ``--repair`` (else :class:`UsageError`, exit 2)."""
+    from ..mesh.hole_assumptions import USER_ASSUMPTIONS
+    names = tuple(getattr(args, "assume", None) or ())
+    known = [a.name for a in USER_ASSUMPTIONS]
+    unknown = sorted(set(names) - set(known))
+    if unknown:
+        raise UsageError(f"--assume: expected one of {', '.join(known)}, got {', '.join(unknown)}")
+    if names and not getattr(args, "repair", False):
+        raise UsageError(f"--assume {' '.join(names)} states what the holes --repair fills lost: give --repair too")
+    return tuple(n for n in known if n in names)
 
 
 def add_model_options(parser, *, thin_walls: bool = True) -> None:
@@ -191,7 +220,9 @@ def load_options_from_args(args) -> LoadOptions:
     """The one :class:`LoadOptions` of a command, from ``--units`` and the mesh-check options."""
     from ..mesh.options import LoadOptions
     check_mesh_options(args)
+    assume = assumed_from_args(args)
     return LoadOptions(units=getattr(args, "units", None), repair=bool(getattr(args, "repair", False)),
+                       assume=assume,
                        overlap=getattr(args, "overlap", "union"),
                        merge_tolerance=getattr(args, "merge_tolerance", MERGE_TOLERANCE),
                        max_faces=getattr(args, "max_faces", DEFAULT_MAX_FACES))

@@ -14,7 +14,7 @@ from . import EXIT_INCOMPLETE, EXIT_OK, speak_options
 from .help import add_command
 from .options import check_option
 from ..reports.escape import escape_terminal
-from .model_options import recorded_warnings, shown_with_report
+from .model_options import add_assume_option, assumed_from_args, recorded_warnings, shown_with_report
 from .report_option import check_output_file
 
 # the readers, the engine and the reports load in run(): ``robot --help`` needs none of them (issue 25 item 4)
@@ -70,6 +70,7 @@ def register(subparsers) -> None:
                         f"{DEFAULT_MAX_FACES:,}; protects memory: each file is checked before it is read in full)")
     p.add_argument("--repair", action="store_true",
                    help="repair open or inconsistently wound link meshes instead of reporting them (warned)")
+    add_assume_option(p)
     p.add_argument("--jobs", "-j", type=int, default=1, metavar="N",
                    help="with several descriptions (a corpus): audit them in N worker processes, the descriptions "
                         "of one folder together (default 1)")
@@ -125,7 +126,8 @@ def _run_corpus(args, packages: dict) -> int:
     density = _density(args)
     with recorded_warnings(args, parser=getattr(args, "robot_parser", None)) as messages:
         models = audit_corpus(args.robot, density=density, material=args.material, keep_mass=args.keep_mass,
-                              repair=args.repair, packages=packages, geometry=args.geometry,
+                              repair=args.repair, assume=assumed_from_args(args), packages=packages,
+                              geometry=args.geometry,
                               max_faces=args.max_faces, run_xacro=args.run_xacro, jobs=args.jobs)
     if not models:
         raise UsageError(f"no robot description found in {', '.join(args.robot)}")
@@ -169,7 +171,7 @@ def run(args) -> int:
         robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings,
                            run_xacro=args.run_xacro)
         inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
-                                   repair=args.repair, max_faces=args.max_faces)
+                                   repair=args.repair, max_faces=args.max_faces, assume=assumed_from_args(args))
         audits = audit_links(robot, inertials, keep_mass=args.keep_mass)
     if args.write:
         basis = next((r.basis for r in inertials if r.properties is not None), "")

@@ -281,6 +281,11 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
             check_useful(whole.volume, uncertainty, source=source, what=what,
                          why=_R4_WHY.replace("far apart;", "far apart (the holes alone are bounded within "
                                              f"±{round_up(100 * holes_alone):.3g} % mass);"))
+        elif patched.islands:     # islands in a flat face kept their ball: the user may state they lost flat pieces
+            from .hole_assumptions import ISLAND_HINT
+            check_useful(whole.volume, uncertainty, source=source, what=what,
+                         why="the holes are too large to guess what fills them; close them in a mesh editor"
+                         + ISLAND_HINT)
         else:
             check_useful(whole.volume, uncertainty, source=source, what=what)
         # a patched surface whose union could not be verified (R6) keeps "unverified": the patches' bound does

@@ -19,15 +19,25 @@ tell a flat lid from a dome or dimple taken whole with a flat ring round it, and
 (``flat``, ``planar``, ``bend``, ``graph``, ``capsule``, ``convex``) would bound it by round-off: such a hole keeps
 the uncut ball over its rim (:data:`BALL`), or the estimate is refused where that is not useful
 (:func:`~.hole_bounds.flat_islands` states the rule and its reason).
+
+**The user's assumptions** (:data:`USER_ASSUMPTIONS`, issue 23) are the one exception, never taken by default:
+``LoadOptions.assume`` / ``--assume flat-islands`` states that each such island lost a flat piece of its face
+(:data:`FLAT_ISLANDS`); the island is then filled in its rim's plane and bounded by the rim's own slab
+(:func:`~.hole_bounds.flat_island_doubt`), and the estimate names the assumption as the user's
+(:func:`user_stated`).  It is set for the duration of a mesh's preparation by :func:`assuming` and read in one
+place, :func:`~.holes.patched_estimate`.
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
-from typing import Iterable
+from typing import Iterable, Iterator
 
 __all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "GRAPH", "PLANAR",
-           "QUADRIC", "ALL", "stated", "named"]
+           "QUADRIC", "ALL", "stated", "named", "FLAT_ISLANDS", "USER_ASSUMPTIONS", "user_named", "assuming",
+           "user_assumed", "user_stated", "ISLAND_HINT"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -109,3 +119,57 @@ def stated(names: Iterable[str]) -> str:
     if not chosen:
         return ""
     return "the bound holds only if " + "; and ".join(f"{a.name}: {a.statement}" for a in chosen)
+
+
+# -- assumptions only the user can make (issue 23: opt-in, never a default) ------------------------------------
+
+FLAT_ISLANDS = HoleAssumption(
+    "flat-islands", "each hole that is an island in a flat face lost a flat piece of that face",
+    "a boss or pocket taken whole there")
+
+#: The assumptions a user may state (``LoadOptions.assume``, ``--assume``): each is what the file cannot show,
+#: so the tool never makes it on its own; with one stated, the holes it covers get the narrower bound it implies
+#: and the estimate names it as the user's (:func:`user_stated`).
+USER_ASSUMPTIONS = (FLAT_ISLANDS,)
+
+#: The end of a refusal of a hole that is an island in a flat face: the option that would take it.
+ISLAND_HINT = " or, if the lost surface was flat, `assume` flat-islands"
+
+#: The user's assumptions in force while a mesh is prepared (set by :func:`assuming` from
+#: ``LoadOptions.assume``, read only by :func:`~.holes.patched_estimate`).
+_USER: contextvars.ContextVar[tuple[str, ...]] = contextvars.ContextVar("inertia_tool_user_assumptions", default=())
+
+
+def user_named(names: Iterable[str]) -> tuple[str, ...]:
+    """``names`` checked against :data:`USER_ASSUMPTIONS`, in their order (``ValueError`` naming the known ones)."""
+    wanted = list(names)
+    known = [a.name for a in USER_ASSUMPTIONS]
+    unknown = sorted({str(n) for n in wanted} - set(known))
+    if unknown:
+        raise ValueError(f"expected assumptions among {', '.join(known)}, got {', '.join(unknown)}")
+    return tuple(n for n in known if n in wanted)
+
+
+@contextlib.contextmanager
+def assuming(names: Iterable[str]) -> Iterator[None]:
+    """Within the block, the hole bounds take the user's assumptions ``names`` (checked by :func:`user_named`).
+
+    The assumptions stated by an enclosing block stay in force (a robot audit states them once for every mesh
+    it reads)."""
+    chosen = user_named([*_USER.get(), *names])
+    token = _USER.set(chosen)
+    try:
+        yield
+    finally:
+        _USER.reset(token)
+
+
+def user_assumed() -> tuple[str, ...]:
+    """The user's assumptions in force (:func:`assuming`), names in :data:`USER_ASSUMPTIONS` order."""
+    return _USER.get()
+
+
+def user_stated(names: Iterable[str]) -> str:
+    """One line naming the user's assumptions an estimate took, with what breaks each (empty when none)."""
+    chosen = [a for a in USER_ASSUMPTIONS if a.name in set(names)]
+    return "; ".join(f"assumed by the user: {a.name}: {a.statement}; {a.fails_for} breaks it" for a in chosen)

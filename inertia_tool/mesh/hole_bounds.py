@@ -740,16 +740,21 @@ def _plane_unattested_at_rim(v: np.ndarray, f: np.ndarray, planes: np.ndarray, t
     return False
 
 
-def _contradicted(evidence: RimEvidence, radius: np.ndarray, size: np.ndarray) -> str:
+def _contradicted(evidence: RimEvidence, radius: np.ndarray, size: np.ndarray, *,
+                  assumed: np.ndarray | None = None) -> str:
     """Why the faces left at some hole's rim contradict the bound's assumption (empty when none does).
 
     The bound assumes the missing surface of each hole stays near its rim (the ball, cut to the slab).  A hole
     that is an island in a flat face *and* has a bare rim vertex (:class:`RimEvidence`) contradicts it: on a
     surface with no vertex inside its flat faces the rim was a loop of the face, the footprint of something
     standing on it or sunk into it (a boss, a pocket, a connector housing) that the hole took whole, whose
-    height nothing in the file bounds.
+    height nothing in the file bounds.  ``assumed`` (n_loops,) bool: holes the user stated lost a flat piece of
+    the face (``hole_assumptions.FLAT_ISLANDS``), not refused.  The message ends by naming that option.
     """
-    found = np.flatnonzero(evidence.flat_all_round & (evidence.bare > 0))
+    refused = evidence.flat_all_round & (evidence.bare > 0)
+    if assumed is not None:
+        refused = refused & ~assumed
+    found = np.flatnonzero(refused)
     if not len(found):
         return ""
     k = int(found[np.argmax(radius[found])])
@@ -784,6 +789,57 @@ def flat_islands(evidence: RimEvidence) -> np.ndarray:
     """
     islands: np.ndarray = np.asarray(evidence.flat_all_round, dtype=bool).copy()
     return islands
+
+
+def flat_island_doubt(vertices: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+                      centre: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Volume in doubt of each hole under the user's ``flat-islands`` assumption, and the slab's half-width:
+    ``(doubt, half_width)``, (n_loops,) m³ and m.
+
+    Assumption (``hole_assumptions.FLAT_ISLANDS``, stated by the user, never taken by default): a hole that is an
+    island in a flat face lost a flat piece of that face, so its missing surface ``M`` lies within ``δ`` of the
+    rim's least-squares plane ``P`` — the slab the ``planar`` reading uses (:func:`planar_rim_doubt`: ``P``
+    through the rim's centroid ``c̄``, normal the eigenvector of the least eigenvalue of
+    ``Σ (x − c̄)(x − c̄)ᵀ``; ``δ`` the rim's largest distance from ``P`` plus 16 ulp of the coordinates).  The cone
+    to ``c̄`` lies in the rim's convex hull, hence in that slab, so the patched and the true solid differ only
+    inside ball ∩ slab (:func:`ball_slab_volume`).  For an exactly planar rim ``M`` minus the cone is a planar
+    2-cycle, which encloses nothing: the doubt is round-off.  Unlike ``planar``, no crease is asked of the faces
+    beside the rim and a rim of three corners is taken (the flat face round it, not the rim, is the evidence the
+    user relies on); what the assumption cannot see — a boss or pocket taken whole — is its stated limit.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    if not n_loops:
+        return np.full(0, np.inf), np.full(0, np.inf)
+    _, mean, normal, delta, _, _ = _rim_planes(v, edges, label, n_loops)
+    half = delta + _round_off(v)
+    offset = np.einsum("ij,ij->i", centre - mean, normal)
+    doubt: np.ndarray = ball_slab_volume(radius, offset, half)
+    return doubt, half
+
+
+def _rim_planes(v: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each rim's least-squares plane: ``(count, mean, normal, delta, spread, d)`` — the rim's distinct vertices
+    (n_loops,), their centroid ``c̄`` (n_loops, 3) m, the unit eigenvector of the least eigenvalue of
+    ``Σ (x − c̄)(x − c̄)ᵀ`` (n_loops, 3), the largest distance of a rim vertex from the plane (n_loops,) m, the
+    largest distance from ``c̄`` (n_loops,) m, and each (loop, vertex) pair's offset from its ``c̄``."""
+    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
+    loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
+    count = np.bincount(loop_of, minlength=n_loops).astype(np.float64)
+    mean: np.ndarray = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) for i in range(3)],
+                                axis=1) / np.maximum(count, 1.0)[:, None]
+    d = v[vertex_of] - mean[loop_of]
+    scatter = np.zeros((n_loops, 3, 3))
+    for i in range(3):
+        for j in range(3):
+            scatter[:, i, j] = np.bincount(loop_of, weights=d[:, i] * d[:, j], minlength=n_loops)
+    _, vectors = np.linalg.eigh(scatter)
+    normal = vectors[:, :, 0]
+    delta = np.zeros(n_loops)
+    np.maximum.at(delta, loop_of, np.abs(np.einsum("ij,ij->i", d, normal[loop_of])))
+    spread = np.zeros(n_loops)
+    np.maximum.at(spread, loop_of, np.linalg.norm(d, axis=1))
+    return count, mean, normal, delta, spread, d
 
 
 #: A face beside the rim steeper than this (its normal's angle with the rim's mean plane's normal, degrees) leaves
@@ -987,27 +1043,11 @@ def planar_rim_doubt(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray,
     normal = np.zeros((n_loops, 3))
     if not n_loops:
         return PlanarRims(applies=applies, doubt=doubt, half_width=half, normal=normal, origin=np.zeros((0, 3)))
-    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
-    loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
-    count = np.bincount(loop_of, minlength=n_loops).astype(np.float64)
-    mean: np.ndarray = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) for i in range(3)],
-                                axis=1) / np.maximum(count, 1.0)[:, None]
-    d = v[vertex_of] - mean[loop_of]
-    scatter = np.zeros((n_loops, 3, 3))
-    for i in range(3):
-        for j in range(3):
-            scatter[:, i, j] = np.bincount(loop_of, weights=d[:, i] * d[:, j], minlength=n_loops)
-    _, vectors = np.linalg.eigh(scatter)
-    normal = vectors[:, :, 0]
-    dist = np.abs(np.einsum("ij,ij->i", d, normal[loop_of]))
-    delta = np.zeros(n_loops)
-    np.maximum.at(delta, loop_of, dist)
+    count, mean, normal, delta, spread, _ = _rim_planes(v, edges, label, n_loops)
     half = delta + _round_off(v)
     # a rim of at least 4 vertices spanning the plane (not a pinch along a line), within rim_rtol of it: three
     # points always lie in one plane, so a 3-vertex rim is no evidence of a flat face (a triangular prism that
     # lost the three faces of a corner tetrahedron was 33 % low inside ±1e-14: test_hole_footprints, CI dry run)
-    spread = np.zeros(n_loops)
-    np.maximum.at(spread, loop_of, np.linalg.norm(d, axis=1))
     candidate = (count >= 4) & (delta <= rim_rtol * radius) & (spread > 0)
     # the faces sharing a rim edge, each at a crease of at least min_crease_degrees to the rim's plane
     # (each rim edge's face, found in either direction; a rim edge without one keeps the loop out)

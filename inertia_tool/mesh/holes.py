@@ -30,6 +30,9 @@ flat faces (as CAD exporters do), a rim vertex whose remaining faces all lie in 
 of that face, so the hole took a surface that met the face there: the slab is withdrawn (the ball stays), a
 crease fill is not made, and a hole that is an island of a flat face with a bare rim — the footprint of a
 feature taken whole — is refused (:attr:`~.uncertainty.Estimate.unbounded`), since nothing bounds its height.
+Only where the user states ``flat-islands`` (:data:`~.hole_assumptions.FLAT_ISLANDS`, read here from
+:func:`~.hole_assumptions.user_assumed`) is such an island filled in its rim's plane and bounded by the rim's
+own slab instead (:func:`~.hole_bounds.flat_island_doubt`), the estimate naming the assumption as the user's.
 
 The stage is split by data flow: the fills other than the cone (crease and curved fills) are in
 :mod:`~.hole_fills`, the bounds and the evidence that withdraws or refuses them in :mod:`~.hole_bounds`; this
@@ -49,15 +52,15 @@ from .hole_bounds import (CONVEX_ROUND_OFF as CONVEX_ROUND_OFF, CONVEX_WORK_LIMI
                           _alone, _contradicted, _engulfing, _flat_off_rim_nearby as _flat_off_rim_nearby,
                           bend_doubt_volumes,
                           _round_off as _round_off, _vertex_flatness as _vertex_flatness, ball_slab_volume,
-                          bare_vertices, convex_hole_bound, flat_islands, hole_doubt_volumes, inner_face_vertices,
-                          planar_rim_doubt, rim_evidence, slab_contradicted)
+                          bare_vertices, convex_hole_bound, flat_island_doubt, flat_islands, hole_doubt_volumes,
+                          inner_face_vertices, planar_rim_doubt, rim_evidence, slab_contradicted)
 from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES as CREASE_MAX_PLANES,
                          CREASE_SCREEN_PAIRS as CREASE_SCREEN_PAIRS, CURVED_FILL_LEVELS as CURVED_FILL_LEVELS,
                          CURVED_MAX_LOOPS as CURVED_MAX_LOOPS, QUADRIC_FIT_RTOL as QUADRIC_FIT_RTOL, CreaseFill,
                          CurvedFill, _crease_contradicted, _crease_rim_contradicts as _crease_rim_contradicts,
                          _may_hold_two_planes as _may_hold_two_planes, _quadric as _quadric,
                          _ring_faces as _ring_faces, crease_fills, curved_fills, curved_surroundings)
-from .hole_assumptions import named, stated
+from .hole_assumptions import named, stated, user_assumed, user_stated
 from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal
@@ -134,6 +137,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # withdrawn, the uncut ball over the rim bounds it
         island = flat_islands(evidence)
         withdrawn |= island
+        # unless the user states that such holes lost a flat piece of the face (FLAT_ISLANDS, opt-in): then each
+        # is filled in its rim's plane (the cone, in the rim's hull) and bounded by the ball cut to the slab of
+        # the rim's own deviation from that plane (flat_island_doubt); read here, nowhere else
+        user_flat = island & ("flat-islands" in user_assumed())
         # the convex reading's own evidence: a bare vertex that the faces left turn round by more than π is, if
         # the part is convex, inside its flat face (inner_face_vertices), so it does not take the convex bound away
         inner = inner_face_vertices(v, f, edges, bare)
@@ -148,12 +155,14 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         taken = bool(against_convex.any())
         inside_face = int(np.count_nonzero(inner)) if not taken else 0
         hole_doubt[withdrawn] = 4.0 / 3.0 * np.pi * radius[withdrawn] ** 3
-        creases = crease_fills(v, f, edges, label, n_loops, centre, radius, bare=bare)
-        unbounded = _contradicted(evidence, radius, size)
+        creases = [fill for fill in crease_fills(v, f, edges, label, n_loops, centre, radius, bare=bare)
+                   if not user_flat[fill.loop]]
+        unbounded = _contradicted(evidence, radius, size, assumed=user_flat)
     else:
         centre, radius, hole_doubt = np.zeros((0, 3)), np.zeros(0), np.zeros(0)
         engulfed = np.zeros(0, dtype=bool)
         island = np.zeros(0, dtype=bool)
+        user_flat = np.zeros(0, dtype=bool)
         unbounded = ""
         taken = False
         inside_face = 0
@@ -229,7 +238,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             bend_reach = rim_reach + 2.0 * np.where(took_bend, bend_height, 0.0)
             nearer = np.where(took_bend, np.minimum(nearer, bend_reach), nearer)
         # a planar rim's region (ball ∩ slab) is bounded by its ball alone (no capsule is named for it)
-        nearer = np.where(took_planar, ball_reach, nearer)
+        nearer = np.where(took_planar | took_island, ball_reach, nearer)
         if took_graph.any():
             # the graph region lies over the projected rim within ``height`` of its mean height (hole_graphs)
             rim_reach = np.zeros(n_loops)
@@ -241,6 +250,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     took_bend = np.zeros(n_loops, dtype=bool)
     took_planar = np.zeros(n_loops, dtype=bool)
     took_graph = np.zeros(n_loops, dtype=bool)
+    took_island = np.zeros(n_loops, dtype=bool)
+    island_width = np.zeros(n_loops)
     graph_height = np.zeros(n_loops)
     graphs: list[GraphFill] = []
     used: set[str] = set()
@@ -264,6 +275,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             rims = [vertex_of[loop_of == k] for k in which.tolist()]
             planar_ok[which[curved_surroundings(v, f, rims, centre[which], radius[which])]] = False
             order = order[~planar_ok[order]]
+        order = order[~user_flat[order]]          # the user's flat islands keep the cone
         curved = curved_fills(v, f, edges, label, n_loops, apex, centre, radius, (start, end, thick), slab, order)
         if curved:
             pv, pf, cap, closed, hole_doubt = build(creases, curved)
@@ -299,7 +311,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # not where evidence withdrew the narrower assumptions (a bare rim vertex: a surface that met the face
         # beside the hole there is gone, as a connector housing taken whole leaves; xarm7 ``link_base.stl``,
         # benchmark case 15-38-t_junction_hole, was outside its graph bound), nor where the ball holds everything
-        tryable = (~crossed & ~bent & ~engulfed & ~withdrawn
+        tryable = (~crossed & ~bent & ~engulfed & ~withdrawn & ~user_flat
                    & (hole_doubt > GRAPH_TRY_SHARE * abs(float(closed.volume))))
         if tryable.any():
             ranked = np.flatnonzero(tryable)[np.argsort(-hole_doubt[tryable], kind="stable")]
@@ -314,6 +326,14 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         took_bend &= ~took_graph
         took_capsule &= ~took_graph
         took_planar &= ~took_graph
+        if user_flat.any():
+            # the user's flat islands (FLAT_ISLANDS): the cone in the rim's plane, the ball cut to the rim's slab
+            took_island = user_flat & ~crossed & ~bent
+            island_doubt, island_width = flat_island_doubt(v, edges, label, n_loops, centre, radius)
+            hole_doubt = np.where(took_island, island_doubt, hole_doubt)
+            took_bend &= ~took_island
+            took_capsule &= ~took_island
+            took_planar &= ~took_island
         took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
                      & ~took_planar & ~took_graph)
         used = {"ball"}
@@ -382,8 +402,14 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             detail += (f"; {len(curved)} of them filled instead on the quadric their surroundings lie on (the cone's "
                        f"fan bent onto it, {len(pv) - len(v) - n_loops - 2 * len(creases):,} points added), with "
                        "the same bound")
-        if island.any() and not convex:
-            detail += (f"; {int(np.count_nonzero(island))} an island in a flat face (its rim and every face at it in "
+        if took_island.any() and not convex:
+            widest = round_up(float(island_width[took_island].max()))
+            detail += (f"; {int(np.count_nonzero(took_island))} an island in a flat face (its rim and every face at "
+                       "it in one plane), filled in its rim's plane and bounded by the ball cut to the slab of the "
+                       f"rim's own deviation from that plane (within {widest:.3g} m), as the user assumed")
+        kept_ball = int(np.count_nonzero(island & ~took_island))
+        if kept_ball and not convex:
+            detail += (f"; {kept_ball} an island in a flat face (its rim and every face at it in "
                        "one plane): nothing in the file tells a missing flat piece from a dome or dimple taken whole "
                        "with a flat ring round it, so each keeps the whole ball over its rim")
         if took_planar.any() and not convex:
@@ -398,8 +424,12 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             detail += (f"; {int(np.count_nonzero(took_bend))} bounded instead by the slope of the faces beside "
                        "their rims")
         detail += "; " + stated(used)
+        if took_island.any():
+            detail += "; " + user_stated(["flat-islands"])
     else:
         detail = f"{sealed}no hole left" if sealed else "no hole"
     return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,
                     uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far,
-                    unbounded=unbounded, assumptions=tuple(a.name for a in named(used)))
+                    unbounded=unbounded, assumptions=tuple(a.name for a in named(used))
+                    + (("flat-islands",) if took_island.any() else ()),
+                    islands=int(np.count_nonzero(island & ~took_island)))

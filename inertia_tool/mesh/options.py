@@ -47,6 +47,12 @@ class LoadOptions:
         (``batch`` over a mixed folder; issue 24).  Default False: a contradiction is refused.
     max_faces : int
         Refuse sources with more triangles than this (a memory guard checked before allocating).
+    assume : tuple of str
+        Assumptions about the surface a hole lost that the user states and the file cannot show
+        (:data:`~inertia_tool.mesh.hole_assumptions.USER_ASSUMPTIONS`), only with ``repair``: ``"flat-islands"``
+        — each hole that is an island in a flat face lost a flat piece of that face (filled flat and bounded by
+        the rim's own deviation from its plane instead of refused; a boss or pocket taken whole there breaks it).
+        The estimate names each one taken as the user's.  Default ``()``: none.
     """
 
     units: str | None = None
@@ -55,8 +61,20 @@ class LoadOptions:
     merge_tolerance: float = MERGE_TOLERANCE
     max_faces: int = DEFAULT_MAX_FACES
     declared_units_win: bool = False
+    assume: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
+        from .hole_assumptions import user_named
+        if isinstance(self.assume, str) or not isinstance(self.assume, (tuple, list)):
+            raise UsageError(f"Expected `assume` to be a tuple of assumption names, got {self.assume!r}")
+        try:
+            names = user_named(self.assume)
+        except ValueError as exc:
+            raise UsageError(f"Expected `assume` {exc}") from None
+        object.__setattr__(self, "assume", names)
+        if names and not self.repair:
+            raise UsageError(f"`assume` ({', '.join(names)}) is an assumption about the holes a repair fills: "
+                             "expected it with `repair=True`")
         if self.units is not None:
             length_scale(self.units)                  # raises UnitsError for an unknown unit
         if not isinstance(self.repair, (bool, np.bool_)):

@@ -37,6 +37,7 @@ from ..values import frozen_value
 from ..errors import InvalidMeshError, WorkBudgetError
 from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
 from ..rounding import round_up
+from .hole_assumptions import ISLAND_HINT
 
 if TYPE_CHECKING:
     from .precision import WeldSweep
@@ -410,7 +411,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
                                "thin-walled part use the shell model with a wall `thickness`")
     if best.unbounded:                        # a hole whose surroundings contradict the bound's assumption
         raise InvalidMeshError(f"{source}: the patched surface cannot be bounded: {best.unbounded}; close the "
-                               "hole in a mesh editor (or from the part's CAD model)",
+                               f"hole in a mesh editor (or from the part's CAD model){ISLAND_HINT}",
                                details={"reason": "hole bound's assumption contradicted"})
     if best.method == "winding":              # a patched estimate is checked on the classified total (prepare)
         check_useful(best.volume, best.uncertainty, source=source, what="the winding-number estimate",

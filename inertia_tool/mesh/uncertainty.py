@@ -78,6 +78,9 @@ class Estimate:
     assumptions : tuple of str
         The names of the assumptions about the missing surface the bound holds under
         (:mod:`~.hole_assumptions`; also stated in ``detail``); empty where the bound assumes nothing of it.
+    islands : int
+        Holes that are an island in a flat face and kept the ball over their rim (the user did not state
+        ``flat-islands``): a refusal for a bound too wide names that option.
     """
 
     volume: float
@@ -92,6 +95,7 @@ class Estimate:
     far: float = 0.0
     unbounded: str = ""
     assumptions: tuple[str, ...] = ()
+    islands: int = 0
 
 
 def uncertainty_from(volume: float, centroid: np.ndarray, second_moment: np.ndarray, doubt: float,

@@ -41,7 +41,8 @@ from ..mass.extrusion import extruded_region
 from ..mass.extrusion import point_in_polygon as _inside_polygon
 from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
-from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES
+from ..mesh.hole_assumptions import assuming
+from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES, LoadOptions
 from ..values import frozen_value
 from ..mesh.read import RawMesh
 from .description import GeometryElement, LinkGeometry, RobotDescription
@@ -1080,7 +1081,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
 
 def link_inertials(robot: RobotDescription, *, density: float | str | None = None, material: str | None = None,
                    keep_mass: bool = False, repair: bool = False, max_faces: int = DEFAULT_MAX_FACES,
-                   mesh_cache: MeshCache | None = None) -> tuple:
+                   mesh_cache: MeshCache | None = None, assume: tuple[str, ...] = ()) -> tuple:
     """Mass properties of every link from its geometry, in the link frame.
 
     Parameters
@@ -1103,7 +1104,11 @@ def link_inertials(robot: RobotDescription, *, density: float | str | None = Non
         remaining budget is refused before it is read into memory (its link reports why).
     mesh_cache : MeshCache, optional
         Mesh bodies shared with other robots of the same run (a corpus); each mesh file placed the same way is
-        then integrated (or refused) once for all of them.  Without it, once per robot.
+        then integrated (or refused) once for all of them.  Without it, once per robot.  Its entries are keyed
+        by ``repair`` but not by ``assume``: share one only between calls with the same ``assume``.
+    assume : tuple of str
+        The user's assumptions about the holes a repair fills (``LoadOptions.assume``: ``("flat-islands",)``),
+        in force for every mesh of the robot; only with ``repair``.
 
     Returns
     -------
@@ -1128,10 +1133,12 @@ def link_inertials(robot: RobotDescription, *, density: float | str | None = Non
         rho, basis = resolve_density(density=density, material=material)
     if not (isinstance(max_faces, (int, np.integer)) and 0 < max_faces <= MAX_SUPPORTED_FACES):
         raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,}, got {max_faces!r}")
+    LoadOptions(repair=bool(repair), assume=tuple(assume))        # the one check of `assume` (UsageError)
     cache: dict = {} if mesh_cache is None else {_SHARED: mesh_cache}
     budget = [int(max_faces), int(max_faces)]
-    return tuple(_one_link(link, rho=rho, basis=basis, keep_mass=keep_mass, model=model, repair=repair,
-                           cache=cache, geometry=robot.geometry, budget=budget) for link in robot.links)
+    with assuming(tuple(assume)):      # every mesh of the robot, read however deep (holes.patched_estimate)
+        return tuple(_one_link(link, rho=rho, basis=basis, keep_mass=keep_mass, model=model, repair=repair,
+                               cache=cache, geometry=robot.geometry, budget=budget) for link in robot.links)
 
 
 # -- where the geometry is (for the audit) -----------------------------------------------------------------
