@@ -403,6 +403,14 @@ _FIT_BODIES: dict = {}
 FIT_BODIES_KEPT = 256
 
 
+def _repair_key(repair: bool) -> tuple[bool, tuple[str, ...]]:
+    """What a cached body depends on besides the file and its placement: ``repair`` and the user's assumptions in
+    force (:func:`~inertia_tool.mesh.hole_assumptions.user_assumed`), so that a body prepared under
+    ``--assume flat-islands`` is never handed to a call without it, or the other way round."""
+    from ..mesh.hole_assumptions import user_assumed
+    return bool(repair), user_assumed()
+
+
 def _fit_memo_key(mesh: GeometryElement, repair: bool) -> tuple | None:
     """The :data:`_FIT_BODIES` key of a fitted geom's mesh element, or None when its file is not kept (too
     large or unreadable: :func:`_content_key`)."""
@@ -412,7 +420,7 @@ def _fit_memo_key(mesh: GeometryElement, repair: bool) -> tuple | None:
         content = _content_key(mesh.mesh, submesh)
         if content is None:
             return None
-    return (content, _mesh_key(mesh), mesh.mesh_inertia, bool(repair))
+    return (content, _mesh_key(mesh), mesh.mesh_inertia, _repair_key(repair))
 
 
 class MeshCache:
@@ -501,13 +509,13 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
             raise found.with_traceback(None)
         return found
     shared = cache.get(_SHARED) if cache is not None else None
-    entry = shared.get((key, repair)) if shared is not None else None
+    entry = shared.get((key, _repair_key(repair))) if shared is not None else None
     content = None
     if shared is not None and entry is None and element.mesh is not None:
         found = _content_key(element.mesh, (element.submesh, bool(element.submesh_center)) if element.submesh
                              else None)
         if found is not None:
-            content = (found[1:], os.path.splitext(element.mesh)[1].lower(), key[1:], repair)
+            content = (found[1:], os.path.splitext(element.mesh)[1].lower(), key[1:], _repair_key(repair))
             entry = shared.get_copy(content, element.mesh)
     if entry is not None:
         outcome, caught, faces = entry
@@ -544,7 +552,7 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
             if budget is not None:
                 budget[0] -= faces
         if shared is not None and not (isinstance(outcome, MeshReadError) and "`max_faces`" in str(outcome)):
-            shared.put((key, repair), outcome, caught, faces,     # a budget refusal is this robot's, not the file's
+            shared.put((key, _repair_key(repair)), outcome, caught, faces,     # a budget refusal is this robot's, not the file's
                        content=content)
     if cache is not None:
         cache[key] = outcome
@@ -731,7 +739,7 @@ def _join_content(pieces: list, repair: bool) -> tuple | None:
         if found is None:
             return None
         out.append((found[1:], os.path.splitext(element.mesh)[1].lower(), _mesh_key(element)[1:]))
-    return tuple(out), repair
+    return tuple(out), _repair_key(repair)
 
 
 def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: MeshCache | None = None):
@@ -1105,7 +1113,7 @@ def link_inertials(robot: RobotDescription, *, density: float | str | None = Non
     mesh_cache : MeshCache, optional
         Mesh bodies shared with other robots of the same run (a corpus); each mesh file placed the same way is
         then integrated (or refused) once for all of them.  Without it, once per robot.  Its entries are keyed
-        by ``repair`` but not by ``assume``: share one only between calls with the same ``assume``.
+        by ``repair`` and ``assume`` (a body prepared under an assumption is never reused without it).
     assume : tuple of str
         The user's assumptions about the holes a repair fills (``LoadOptions.assume``: ``("flat-islands",)``),
         in force for every mesh of the robot; only with ``repair``.
