@@ -1,8 +1,8 @@
 """The user's assumption ``flat-islands`` is part of what a robot's cached mesh bodies are keyed by: a body prepared
 under ``--assume flat-islands`` is never handed to an audit without it (or the other way round) through the run's
 shared :class:`~inertia_tool.robot.geometry.MeshCache` or the process's memo of fitted bodies.  Island14 keyed them
-by ``repair`` alone (documented, not enforced): the second audit of a run could get the first's narrow bound with the first's
-assumption named nowhere in its call."""
+by ``repair`` alone (documented, not enforced): the second audit of a run could get the first's narrow bound with
+the first's assumption named nowhere in its call."""
 
 from __future__ import annotations
 

@@ -552,7 +552,8 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
             if budget is not None:
                 budget[0] -= faces
         if shared is not None and not (isinstance(outcome, MeshReadError) and "`max_faces`" in str(outcome)):
-            shared.put((key, _repair_key(repair)), outcome, caught, faces,     # a budget refusal is this robot's, not the file's
+            # a budget refusal is this robot's, not the file's
+            shared.put((key, _repair_key(repair)), outcome, caught, faces,
                        content=content)
     if cache is not None:
         cache[key] = outcome
