@@ -75,3 +75,36 @@ def test_probe_clearance_is_that_of_every_face(seed, faces, spread, reach, work)
     found = _probe_clearance(points, radius, own, lo, hi, a, b, c, work=work)
     np.testing.assert_array_equal(found, expected)
     assert np.all(found <= radius)
+
+
+def test_a_face_between_two_blocks_is_counted_for_the_cells_on_both_sides():
+    """A face in the plane x = 8 (the boundary of two 8-cell blocks) meets the closed cells 7 and 8; the blocks
+    listed each face only from its own box, so cell 7 (block 0) counted 0 faces before."""
+    from inertia_tool.mesh.grid_estimate import _face_counts
+    lo, h, dims = np.zeros(3), 1.0, (16, 4, 4)
+    v = np.array([[8.0, 0.5, 0.5], [8.0, 1.5, 0.5], [8.0, 0.5, 1.5]])
+    cells = np.ravel_multi_index(([7, 8, 6], [0, 0, 0], [0, 0, 0]), dims)
+    for block in (2, 3, 4, 8):
+        assert _face_counts(v, np.array([[0, 1, 2]]), cells, lo, h, dims, block=block).tolist() == [1, 1, 0]
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2 ** 32 - 1), faces=st.integers(1, 80), block=st.sampled_from([2, 3, 4, 8]),
+       aligned=st.booleans())
+def test_face_counts_are_those_of_every_face_against_every_cell(seed, faces, block, aligned):
+    from inertia_tool.mesh.grid_estimate import _face_counts
+    rng = np.random.default_rng(seed)
+    dims = tuple(int(d) for d in rng.integers(3, 20, size=3))
+    lo, h = rng.normal(size=3), float(10.0 ** rng.uniform(-3, 1))
+    corners = rng.uniform(-1, np.array(dims) + 1, size=(faces, 3, 3))
+    if aligned:                                         # corners on cell boundaries: faces in the grid's planes
+        corners = np.round(corners)
+    v = (lo + h * corners).reshape(-1, 3)
+    f = np.arange(3 * faces).reshape(-1, 3)
+    cells = np.unique(rng.integers(0, int(np.prod(dims)), size=50))
+    found = _face_counts(v, f, cells, lo, h, dims, block=block)
+    flo, fhi = v[f].min(axis=1), v[f].max(axis=1)
+    cell_lo = lo + h * np.stack(np.unravel_index(cells, dims), axis=1)
+    slack = 1e-9 * h
+    meets = np.all((flo[None] <= cell_lo[:, None] + h + slack) & (fhi[None] >= cell_lo[:, None] - slack), axis=2)
+    np.testing.assert_array_equal(found, meets.sum(axis=1))

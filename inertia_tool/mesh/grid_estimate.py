@@ -1063,35 +1063,73 @@ def _raw_moments(centres: np.ndarray, weight: np.ndarray, h: float, origin: np.n
     return m0, m1, m2
 
 
-def _face_counts(v: np.ndarray, f: np.ndarray, cells: np.ndarray, lo: np.ndarray, h: float,
-                 dims: tuple[int, ...], *, block: int = 8, max_work: int = FACE_COUNT_WORK) -> np.ndarray | None:
-    """(k,) for each cell index of ``cells``: how many faces' bounding boxes meet the closed cell (at least
-    the faces that meet it); None past ``max_work`` tests."""
-    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    flo, fhi = np.minimum(np.minimum(a, b), c), np.maximum(np.maximum(a, b), c)
+def _face_blocks(flo: np.ndarray, fhi: np.ndarray, lo: np.ndarray, h: float, dims: tuple[int, ...], block: int
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(blocks per axis, face, block)``: each face listed in every block of ``block`` cells per axis that its
+    bounding box (``flo``, ``fhi``) widened by one cell reaches, so a face whose box meets a cell (within any
+    slack below a cell) is listed in that cell's block whatever the rounding at the blocks' boundaries."""
     nb = np.array([-(-d // block) for d in dims])
     span = h * block
-    b0 = np.clip(np.floor((flo - lo) / span).astype(np.int64), 0, nb - 1)
-    b1 = np.clip(np.floor((fhi - lo) / span).astype(np.int64), 0, nb - 1)
+    b0 = np.clip(np.floor((flo - h - lo) / span).astype(np.int64), 0, nb - 1)
+    b1 = np.clip(np.floor((fhi + h - lo) / span).astype(np.int64), 0, nb - 1)
     size = np.prod(b1 - b0 + 1, axis=1)
-    if int(size.sum()) > max_work:
-        return None
-    face = np.repeat(np.arange(len(f)), size)
+    face = np.repeat(np.arange(len(flo)), size)
     offset = np.arange(int(size.sum())) - np.repeat(np.cumsum(size) - size, size)
     ext = (b1 - b0 + 1)[face]
     k = offset % ext[:, 2]
     j = (offset // ext[:, 2]) % ext[:, 1]
     i = offset // (ext[:, 2] * ext[:, 1])
     blk = ((b0[face, 0] + i) * nb[1] + b0[face, 1] + j) * nb[2] + b0[face, 2] + k
+    return nb, face, blk
+
+
+def _face_counts(v: np.ndarray, f: np.ndarray, cells: np.ndarray, lo: np.ndarray, h: float,
+                 dims: tuple[int, ...], *, block: int = 8, max_work: int = FACE_COUNT_WORK) -> np.ndarray | None:
+    """(k,) for each cell index of ``cells``: how many faces' bounding boxes meet the closed cell (at least
+    the faces that meet it); None past ``max_work`` (face, block) entries or (cell, face) tests on blocks of
+    ``block`` cells.
+
+    Candidates come from blocks of cells (:func:`_face_blocks`: a face's box widened by a cell, so that a face
+    touching a cell at a block's boundary is a candidate: before, a face in the plane between two blocks was not
+    counted for the cells of the block below it); each candidate is tested against the cell, so the counts do
+    not depend on the block size, and blocks of 2 or 4 cells are used when they test fewer pairs (issue 25:
+    Piper's link2.stl 1.06 s → 0.17 s of CPU at 2 cells).  The work bound is counted on ``block``."""
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    flo, fhi = np.minimum(np.minimum(a, b), c), np.maximum(np.maximum(a, b), c)
+    ci, cj, ck = np.unravel_index(cells, dims)
+
+    def cell_blocks(nb: np.ndarray, size: int) -> np.ndarray:
+        found: np.ndarray = ((ci // size) * nb[1] + cj // size) * nb[2] + ck // size
+        return found
+
+    def work(size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int] | None:
+        """(blocks, face, block, pairs) on blocks of ``size`` cells, or None past ``max_work`` entries."""
+        nb = np.array([-(-d // size) for d in dims])
+        b0 = np.clip(np.floor((flo - h - lo) / (h * size)).astype(np.int64), 0, nb - 1)
+        b1 = np.clip(np.floor((fhi + h - lo) / (h * size)).astype(np.int64), 0, nb - 1)
+        if int(np.prod(b1 - b0 + 1, axis=1).sum()) > max_work:
+            return None
+        nb, face, blk = _face_blocks(flo, fhi, lo, h, dims, size)
+        pairs = int(np.bincount(blk, minlength=int(np.prod(nb)))[cell_blocks(nb, size)].sum())
+        return nb, face, blk, pairs
+
+    chosen = work(block)
+    if chosen is None or chosen[3] > max_work:
+        return None
+    for finer in (2, 4):
+        if finer >= block:
+            break
+        other = work(finer)
+        if other is not None and other[3] < chosen[3]:
+            chosen, block = other, finer
+            break
+    nb, face, blk, _ = chosen
     order = np.argsort(blk, kind="stable")
     blk, face = blk[order], face[order]
-    ci, cj, ck = np.unravel_index(cells, dims)
-    cell_block = ((ci // block) * nb[1] + cj // block) * nb[2] + ck // block
+    cell_block = cell_blocks(nb, block)
     start = np.searchsorted(blk, cell_block, side="left")
     stop = np.searchsorted(blk, cell_block, side="right")
     many = stop - start
-    if int(many.sum()) > max_work:
-        return None
     who = np.repeat(np.arange(len(cells)), many)
     idx = np.repeat(start, many) + (np.arange(int(many.sum())) - np.repeat(np.cumsum(many) - many, many))
     cand = face[idx]
