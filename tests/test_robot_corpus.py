@@ -272,3 +272,48 @@ def test_a_byte_identical_copy_in_another_folder_is_integrated_once_with_its_own
         assert refused.properties is None and f"{folder}/open.stl" in refused.problem
     texts = [str(w.message) for w in caught if "inside out" in str(w.message)]
     assert any("tiago_dual/flipped.stl" in t for t in texts) and any("tiago/flipped.stl" in t for t in texts)
+
+
+def test_folders_sharing_mesh_files_are_one_group_and_a_nested_model_folder_is_its_own(tmp_path):
+    """Issue 25: Stretch and Stretch 3 ship 65 byte-identical meshes; in one worker each is integrated (or
+    refused) once.  Folders are grouped by mesh files of the same name and size; a sub-folder holding its own
+    descriptions counts for itself, not for the folder above it; other files do not group."""
+    from inertia_tool.robot.corpus import _shared_groups
+    a, nested, b, c, d = (tmp_path / "a", tmp_path / "a" / "sub", tmp_path / "b", tmp_path / "c", tmp_path / "d")
+    for folder in (a, nested, b, c, d):
+        folder.mkdir()
+    _box_stl(a / "link.stl")
+    _box_stl(b / "LINK.STL")                           # the same name (case aside) and size: grouped
+    _box_stl(c / "link.stl", open_=True)               # the same name, another size: not grouped by it
+    _box_stl(nested / "open.stl", open_=True)
+    _box_stl(c / "open.stl", open_=True)               # c shares with a's sub-folder, not with a
+    (a / "notes.txt").write_text("x")
+    (d / "notes.txt").write_text("x")                  # not a mesh: not grouped
+    folders = [str(a), str(nested), str(b), str(c), str(d)]
+    assert _shared_groups(folders) == [[str(a), str(b)], [str(nested), str(c)], [str(d)]]
+
+
+def test_jobs_2_with_copies_across_folders_gives_the_serial_results_and_warnings(tmp_path):
+    import shutil
+    import warnings
+
+    from inertia_tool.robot.corpus import audit_corpus
+    for name in ("tiago", "tiago_dual", "other"):
+        (tmp_path / name).mkdir()
+    _box_stl(tmp_path / "tiago" / "flipped.stl", inside_out=True)
+    _box_stl(tmp_path / "tiago" / "open.stl", open_=True)
+    for name in ("flipped.stl", "open.stl"):
+        shutil.copyfile(tmp_path / "tiago" / name, tmp_path / "tiago_dual" / name)
+    _box_stl(tmp_path / "other" / "box.stl")
+    for folder in ("tiago", "tiago_dual"):
+        _mjcf_using(tmp_path / folder / "scene.xml", "flipped.stl")
+        _mjcf_using(tmp_path / folder / "more.xml", "open.stl")
+    _mjcf_using(tmp_path / "other" / "scene.xml", "box.stl")
+    runs = []
+    for jobs in (1, 2):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            models = audit_corpus([tmp_path], density=1000, jobs=jobs)
+        runs.append((_summary(models), [str(w.message) for w in caught]))
+    assert runs[1] == runs[0]
+    assert any("tiago_dual/flipped.stl" in w for w in runs[0][1])

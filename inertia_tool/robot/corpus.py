@@ -173,6 +173,55 @@ def _folder_weight(folder: str, limit: int = 100_000) -> int:
     return total
 
 
+#: Suffixes of the files :func:`_shared_groups` compares between folders (the mesh formats a description names).
+_MESH_SUFFIXES = (".stl", ".obj", ".dae", ".ply", ".off", ".msh", ".3mf", ".glb", ".gltf")
+
+
+def _shared_groups(folders: list, limit: int = 100_000) -> list:
+    """``folders`` in groups that hold mesh files of the same name and size (at most ``limit`` files looked at
+    per folder; a sub-folder that is itself one of ``folders`` is left to it): Menagerie's Stretch and Stretch 3
+    ship 65 byte-identical meshes, TIAGo and TIAGo dual 12, the two ToddlerBots 35.  A group goes to one worker of a
+    parallel run, whose :class:`MeshCache` then integrates (or refuses) each shared file once instead of once per
+    worker.  Name and size only choose the grouping; what is shared is still decided by the files' contents.
+    Returns lists of folders, each in the order of ``folders``, the groups in the order of their first folder."""
+    own = {os.path.abspath(folder) for folder in folders}
+    parent = list(range(len(folders)))
+
+    def root(i: int) -> int:
+        for _ in range(len(parent)):                # path halving: a chain never outlasts the folders
+            if parent[i] == i:
+                break
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    seen: dict = {}
+    for index, folder in enumerate(folders):
+        looked = 0
+        for top, subfolders, files in os.walk(folder):
+            subfolders[:] = sorted(d for d in subfolders if os.path.abspath(os.path.join(top, d)) not in own)
+            for name in files:
+                looked += 1
+                if looked > limit:
+                    break
+                if not name.lower().endswith(_MESH_SUFFIXES):
+                    continue
+                try:
+                    key = (name.lower(), os.path.getsize(os.path.join(top, name)))
+                except OSError:
+                    continue
+                other = seen.setdefault(key, index)
+                a, b = root(other), root(index)
+                if a != b:
+                    parent[max(a, b)] = min(a, b)
+            if looked > limit:
+                break
+    groups: dict = {}
+    for index, folder in enumerate(folders):
+        groups.setdefault(root(index), []).append(folder)
+    return list(groups.values())
+
+
 def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass: bool = False,
                  repair: bool = False, packages: dict | None = None, geometry: str = "collision",
                  run_xacro: bool = False, jobs: int = 1, **options) -> tuple:
@@ -183,8 +232,9 @@ def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass:
 
     jobs : int
         Worker processes (default 1: this process).  With more, the descriptions of each folder go to one
-        worker together (a Menagerie folder's scenes share their meshes), the folders holding the most bytes
-        first; each worker keeps one :class:`MeshCache` for the folders it is given.  The results and every
+        worker together (a Menagerie folder's scenes share their meshes), and so do folders holding mesh files
+        of the same name and size (:func:`_shared_groups`: Stretch and Stretch 3), the groups holding the most
+        bytes first; each worker keeps one :class:`MeshCache` for the folders it is given.  The results and every
         model's warnings come back in the order of a serial run, and are the same as its (a mesh shared
         between folders may be integrated once per worker instead of once).
     """
@@ -201,9 +251,12 @@ def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass:
         return tuple(_audit_one(path, meshes, settings) for path in found)
     from ..batch.runner import _process_pool
     done: dict = {}
-    order = sorted(folders, key=lambda folder: -_folder_weight(folder))
-    with _process_pool(min(int(jobs), len(folders))) as pool:
-        futures = [pool.submit(_audit_folder, folders[folder], settings) for folder in order]
+    weight = {folder: _folder_weight(folder) for folder in folders}
+    # the folders sharing mesh files together (each shared file integrated once), the heaviest groups first
+    groups = sorted(_shared_groups(list(folders)), key=lambda group: -sum(weight[folder] for folder in group))
+    tasks = [[item for folder in group for item in folders[folder]] for group in groups]
+    with _process_pool(min(int(jobs), len(tasks))) as pool:
+        futures = [pool.submit(_audit_folder, task, settings) for task in tasks]
         for future in futures:
             for index, audit, caught in future.result():
                 done[index] = (audit, caught)
