@@ -27,8 +27,9 @@ Tried (the generators below; larger runs by the same code with more draws), sile
   back to ``bend``, which bounded a dome by the gentle slope of the ring.  Fixed by the level-ring rule
   (``hole_bounds.level_rings``: every face at the rim within 1.1° of its plane makes the hole an island); a ring
   visibly curved (slopes 0.04..0.14) still lets ``bend`` miss a steeper dome: the strict xfail below.
-  Not found: a dome or dimple taken whole whose removed region reaches the top's border (along an edge or at a corner: the rim on the
-  crease) or stops two cells short of it, on rings flat or curved 1e-4..1e-3: 40 draws, 0 silent (11 refused).
+  Not found: a dome or dimple taken whole whose removed region reaches the top's border (along an edge or at a
+  corner: the rim on the crease) or stops two cells short of it, on rings flat or curved 1e-4..1e-3: 40 draws,
+  0 silent (11 refused).
 * Hunter witness: three to five boxes (dyadic corners) overlapping as a chain, a star (one box meeting all),
   a cycle, or touching face to face (pairwise intersections of zero volume, in a row or a staircase), subdivided
   or not, axis-aligned or turned at random, 0..6e7 m out (turned ones at most 1e6 m out unless they only touch:
