@@ -962,7 +962,7 @@ def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     over the fan is the hole's volume in doubt, and every point of the region lies within
     ``max|h| + L max dist(c, ab)`` of ``Π`` (``height``).  A round-off margin of 16 ulp of the coordinates is
     added to every height.  Not applied (``inf``): a fan that is not star-shaped, a ring face steeper than
-    ``max_degrees`` or facing against the fan, or a *level* ring.
+    ``max_degrees`` or facing against the fan.
 
     Nor to a *level* ring (every face touching the rim within ``acos(level_cosine)`` ≈ 1.1° of ``Π``,
     :func:`level_rings`): a near-zero slope is no evidence, by the rule of :func:`flat_islands` (the caller

@@ -410,8 +410,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         kept_ball = int(np.count_nonzero(island & ~took_island))
         if kept_ball and not convex:
             detail += (f"; {kept_ball} an island in a flat face (its rim and every face at it in "
-                       "one plane): nothing in the file tells a missing flat piece from a dome or dimple taken whole "
-                       "with a flat ring round it, so each keeps the whole ball over its rim")
+                       "one plane, or every face at it within 1.1° of the rim's plane): nothing in the file tells a "
+                       "missing flat piece from a dome or dimple taken whole with a flat ring round it, so each "
+                       "keeps the whole ball over its rim")
         if took_planar.any() and not convex:
             detail += (f"; {int(np.count_nonzero(took_planar))} read as a missing flat face (a rim in one plane, "
                        f"within {round_up(float(planar.half_width[took_planar].max())):.3g} m, meeting the faces "
