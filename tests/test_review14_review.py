@@ -157,7 +157,7 @@ def _dome_on_a_ring(mode: str, curvature: float, rb: float, depth: float, up: bo
     return G.silent_reason(v, f[keep], truth, repair=True)
 
 
-@settings(max_examples=8, **_SETTINGS)
+@settings(max_examples=6, **_SETTINGS)
 @given(mode=st.sampled_from(["bowl", "saddle", "ripple"]), exponent=st.floats(-5.0, -3.0),
        rb=st.floats(0.2, 0.6), depth=st.floats(0.02, 0.8), up=st.booleans(), n=st.integers(10, 20),
        wider=st.floats(0.01, 1.0))
