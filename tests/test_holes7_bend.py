@@ -24,7 +24,7 @@ from test_hole_bounds import _holds
 from test_hole_footprints import featured_box
 from inertia_tool.integrals import volume_moments
 from inertia_tool.mesh.hole_assumptions import ALL, BEND, named, stated
-from inertia_tool.mesh.hole_bounds import bend_doubt_volumes
+from inertia_tool.mesh.hole_bounds import LEVEL_RING_COSINE, bend_doubt_volumes
 from inertia_tool.mesh.holes import hole_doubt_volumes, patched_estimate
 from inertia_tool.mesh.rims import boundary_edges, boundary_loops, enclosing_balls
 from inertia_tool.tolerances import ESTIMATE_MAX_MASS_RTOL
@@ -82,6 +82,38 @@ def test_bend_bound_is_not_applied_to_a_fan_that_is_not_star_shaped_or_a_ring_fa
         edges, label, n_loops, _, apex = _rim(v, open_f)
         doubt, _ = bend_doubt_volumes(v, open_f, edges, label, n_loops, apex)
         assert np.isinf(doubt).all()        # every missing box triangle has a 90° side face on its rim
+
+
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(3, 12), degrees=st.one_of(st.floats(0.01, 1.1), st.floats(1.2, 60.0)),
+       scale=st.sampled_from([1e-3, 1.0, 1e3]), seed=st.integers(0, 2 ** 32 - 1))
+def test_bend_bound_of_a_regular_frustum_top_is_the_closed_form_unless_the_ring_is_level(n, degrees, scale, seed):
+    """A regular ``n``-gon frustum (rim radius ``R``) whose sides lean at ``θ`` (their normals ``θ`` from the
+    rim's plane's normal) less its top, turned and moved at random.  The fan to the centre has ``n`` triangles of
+    projected area ``A/n`` at distance ``R cos(π/n)`` from their rim edge, so the bound is the closed form
+    ``A tan θ R cos(π/n) / 3``, ``A = n R² sin(2π/n) / 2`` (``bend_doubt_volumes``).  Below the level rule's
+    angle (``acos LEVEL_RING_COSINE`` ≈ 1.146°: a near-zero slope is no evidence, review 14) no bound at all:
+    ``inf``; the old code stated ``A tan θ R cos(π/n) / 3`` there too, which is 0 as ``θ`` goes to 0."""
+    rng = np.random.default_rng(seed)
+    t = np.tan(np.radians(degrees))
+    angle = 2 * np.pi * np.arange(n) / n + rng.uniform(0, 2 * np.pi)
+    top = np.c_[np.cos(angle), np.sin(angle), np.zeros(n)]
+    inradius = np.cos(np.pi / n)
+    depth = 0.3
+    bottom = top * (inradius + depth / t) / inradius - [0, 0, depth]
+    hull = trimesh.convex.convex_hull(np.vstack([top, bottom]))
+    v, f = np.asarray(hull.vertices), np.asarray(hull.faces)
+    open_f = f[~np.all(np.abs(v[f][:, :, 2]) < 1e-12, axis=1)]
+    turn = S.random_rotation(rng)
+    moved = (v * scale) @ turn.T + rng.uniform(-10, 10, 3) * scale
+    edges, label, n_loops, _, apex = _rim(moved, open_f)
+    doubt, height = bend_doubt_volumes(moved, open_f, edges, label, n_loops, apex)
+    assert n_loops == 1
+    if np.cos(np.radians(degrees)) >= LEVEL_RING_COSINE:
+        assert np.isinf(doubt[0]) and np.isinf(height[0])
+    else:
+        area = n * np.sin(2 * np.pi / n) / 2
+        assert doubt[0] == pytest.approx(area * t * inradius / 3 * scale ** 3, rel=1e-7, abs=1e-13 * scale ** 3)
 
 
 def test_a_sphere_cap_hole_is_inside_its_bend_bound_and_the_bound_shrinks_with_the_hole():

@@ -18,7 +18,10 @@ flat face (its rim and every face left at it in one plane) keeps no face that le
 tell a flat lid from a dome or dimple taken whole with a flat ring round it, and every narrower assumption
 (``flat``, ``planar``, ``bend``, ``graph``, ``capsule``, ``convex``) would bound it by round-off: such a hole keeps
 the uncut ball over its rim (:data:`BALL`), or the estimate is refused where that is not useful
-(:func:`~.hole_bounds.flat_islands` states the rule and its reason).
+(:func:`~.hole_bounds.flat_islands` states the rule and its reason).  **Nor is a slope of (near) zero**: a hole
+whose every face at the rim lies within 1.1° of the rim's plane (a *level* ring,
+:func:`~.hole_bounds.level_rings`) is an island by the same rule, since ``bend`` and the ``flat`` slab would bound
+a feature taken whole there by the ring's slope.
 
 **The user's assumptions** (:data:`USER_ASSUMPTIONS`, issue 23) are the one exception, never taken by default:
 ``LoadOptions.assume`` / ``--assume flat-islands`` states that each such island lost a flat piece of its face
@@ -77,7 +80,8 @@ BEND = HoleAssumption(
     "bend", "the missing surface is a graph over the rim's mean plane and slopes against that plane no more "
     "steeply than the steepest face touching the rim", "a feature taken whole whose walls are "
     "steeper than the faces round its rim (a boss or pocket on a gently curved face; on a flat one with its "
-    "surroundings flat the hole keeps its ball: hole_bounds.flat_islands)")
+    "surroundings flat, or with every face at the rim within 1.1° of its plane, the hole keeps its ball: "
+    "hole_bounds.flat_islands)")
 GRAPH = HoleAssumption(
     "graph", "the missing surface is a graph over the plane most face-on to the faces touching the rim and slopes "
     "against that plane no more steeply than the steepest of those faces", "a feature taken whole whose walls are "

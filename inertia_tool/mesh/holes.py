@@ -53,7 +53,7 @@ from .hole_bounds import (CONVEX_ROUND_OFF as CONVEX_ROUND_OFF, CONVEX_WORK_LIMI
                           bend_doubt_volumes,
                           _round_off as _round_off, _vertex_flatness as _vertex_flatness, ball_slab_volume,
                           bare_vertices, convex_hole_bound, flat_island_doubt, flat_islands, hole_doubt_volumes,
-                          inner_face_vertices, planar_rim_doubt, rim_evidence, slab_contradicted)
+                          inner_face_vertices, level_rings, planar_rim_doubt, rim_evidence, slab_contradicted)
 from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES as CREASE_MAX_PLANES,
                          CREASE_SCREEN_PAIRS as CREASE_SCREEN_PAIRS, CURVED_FILL_LEVELS as CURVED_FILL_LEVELS,
                          CURVED_MAX_LOOPS as CURVED_MAX_LOOPS, QUADRIC_FIT_RTOL as QUADRIC_FIT_RTOL, CreaseFill,
@@ -135,12 +135,12 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # an island in a flat face: its flatness is the only evidence of a flat missing surface, which no more
         # than a dome taken whole with a flat ring round it leaves (flat_islands): every narrower reading is
         # withdrawn, the uncut ball over the rim bounds it
-        island = flat_islands(evidence)
+        island = flat_islands(evidence, level_rings(v, f, edges, label, n_loops, apex))
         withdrawn |= island
         # unless the user states that such holes lost a flat piece of the face (FLAT_ISLANDS, opt-in): then each
         # is filled in its rim's plane (the cone, in the rim's hull) and bounded by the ball cut to the slab of
         # the rim's own deviation from that plane (flat_island_doubt); read here, nowhere else
-        user_flat = island & ("flat-islands" in user_assumed())
+        user_flat = island & evidence.flat_all_round & ("flat-islands" in user_assumed())
         # the convex reading's own evidence: a bare vertex that the faces left turn round by more than π is, if
         # the part is convex, inside its flat face (inner_face_vertices), so it does not take the convex bound away
         inner = inner_face_vertices(v, f, edges, bare)
@@ -410,8 +410,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         kept_ball = int(np.count_nonzero(island & ~took_island))
         if kept_ball and not convex:
             detail += (f"; {kept_ball} an island in a flat face (its rim and every face at it in "
-                       "one plane): nothing in the file tells a missing flat piece from a dome or dimple taken whole "
-                       "with a flat ring round it, so each keeps the whole ball over its rim")
+                       "one plane, or every face at it within 1.1° of the rim's plane): nothing in the file tells a "
+                       "missing flat piece from a dome or dimple taken whole with a flat ring round it, so each "
+                       "keeps the whole ball over its rim")
         if took_planar.any() and not convex:
             detail += (f"; {int(np.count_nonzero(took_planar))} read as a missing flat face (a rim in one plane, "
                        f"within {round_up(float(planar.half_width[took_planar].max())):.3g} m, meeting the faces "
