@@ -139,6 +139,13 @@ def _boxes(cells) -> list[tuple[np.ndarray, np.ndarray, int]]:
     return [(np.array(lo), np.array(hi), sign) for lo, hi, sign in cells]
 
 
+def _assert_judged_right(boxes) -> None:
+    """The kept-cavities judge (``test_mesh_kept_cavities._verdict``) finds no silent wrong in ``boxes``."""
+    from test_mesh_kept_cavities import _verdict
+    _, wrong = _verdict(boxes)
+    assert wrong is None, wrong
+
+
 def test_a_cavity_that_fills_its_body_is_refused_not_a_usage_error():
     """``bench_kept_cavities.py --seed 1418`` case 335, reduced: an inward box split exactly into two outward boxes
     inside it, and an outward box crossing them (faces touching up to rounding).  R6's "touching up to rounding"
@@ -165,11 +172,8 @@ def test_a_cavity_that_fills_its_body_is_refused_not_a_usage_error():
     "The judge offers R4's depth reading only when no boxes cross. Decide: name the union reading truly and widen "
     "the bound to the file's winding, or refuse as in R4c (classify._holds); not done"))
 def test_a_misread_reading_inside_an_inward_box_holds_its_bound():
-    from test_mesh_kept_cavities import _verdict
-    boxes = _boxes([([1, -4, 1], [4, 0, 3], 1), ([1, 1, -2], [4, 3, 0], 1), ([0, 1, -2], [4, 4, 0], -1),
-                    ([0, 1, -2], [1, 3, -1], 1), ([0, 2, -2], [2, 3, -1], 1)])
-    label, wrong = _verdict(boxes)
-    assert wrong is None, wrong
+    _assert_judged_right(_boxes([([1, -4, 1], [4, 0, 3], 1), ([1, 1, -2], [4, 3, 0], 1), ([0, 1, -2], [4, 4, 0], -1),
+                                 ([0, 1, -2], [1, 3, -1], 1), ([0, 2, -2], [2, 3, -1], 1)]))
 
 
 @pytest.mark.xfail(strict=True, reason=(
@@ -180,11 +184,9 @@ def test_a_misread_reading_inside_an_inward_box_holds_its_bound():
     "bench_kept_cavities seed 1418. A decision for the team (count with multiplicity, or label such answers "
     "unverified), not changed here"))
 def test_a_box_listed_twice_inside_a_void_keeps_the_files_winding():
-    from test_mesh_kept_cavities import _verdict
-    boxes = _boxes([([-2, -4, -4], [3, -2, -1], 1), ([0, -2, -1], [5, 0, 1], 1), ([-1, -1, -1], [1, 0, 0], -1),
-                    ([-1, -1, -1], [0, 0, 0], 1), ([-1, -1, -1], [0, 0, 0], 1)])
-    label, wrong = _verdict(boxes)
-    assert wrong is None, wrong
+    _assert_judged_right(_boxes([([-2, -4, -4], [3, -2, -1], 1), ([0, -2, -1], [5, 0, 1], 1),
+                                 ([-1, -1, -1], [1, 0, 0], -1), ([-1, -1, -1], [0, 0, 0], 1),
+                                 ([-1, -1, -1], [0, 0, 0], 1)]))
 
 
 @pytest.mark.xfail(strict=True, reason=(
@@ -195,10 +197,8 @@ def test_a_box_listed_twice_inside_a_void_keeps_the_files_winding():
     "0 in each box and 1 only where the two overlap: {w >= 1} is 2 cells (0.03125 m3), 18 times less, far outside "
     "the bound. Open with N5; not changed"))
 def test_a_misread_reading_inside_an_inward_box_two_crossing_boxes():
-    from test_mesh_kept_cavities import _verdict
-    boxes = _boxes([([-4, -2, 1], [-2, 0, 3], 1), ([-4, -2, -1], [-1, 1, 3], -1), ([-3, -1, 1], [-2, 1, 3], 1)])
-    label, wrong = _verdict(boxes)
-    assert wrong is None, wrong
+    _assert_judged_right(_boxes([([-4, -2, 1], [-2, 0, 3], 1), ([-4, -2, -1], [-1, 1, 3], -1),
+                                 ([-3, -1, 1], [-2, 1, 3], 1)]))
 
 
 @pytest.mark.xfail(strict=True, reason=(

@@ -175,18 +175,23 @@ def _summary(models):
     return rows
 
 
-def test_jobs_2_gives_the_serial_results_and_warnings_in_the_serial_order(tmp_path):
+def _serial_and_parallel(root) -> list[tuple[list, list[str]]]:
+    """``audit_corpus`` of ``root`` with ``jobs`` 1 and 2: each run's :func:`_summary` and its warnings' texts."""
     import warnings
 
     from inertia_tool.robot.corpus import audit_corpus
-    root = _two_folder_corpus(tmp_path)
     runs = []
     for jobs in (1, 2):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             models = audit_corpus([root], density=1000, jobs=jobs)
         runs.append((_summary(models), [str(w.message) for w in caught]))
-    (serial, serial_warnings), (parallel, parallel_warnings) = runs
+    return runs
+
+
+def test_jobs_2_gives_the_serial_results_and_warnings_in_the_serial_order(tmp_path):
+    root = _two_folder_corpus(tmp_path)
+    (serial, serial_warnings), (parallel, parallel_warnings) = _serial_and_parallel(root)
     assert parallel == serial
     assert parallel_warnings == serial_warnings and any("inside out" in w for w in serial_warnings)
     assert [r[0] for r in serial if r[0].endswith((".xml", ".urdf"))] == \
@@ -295,9 +300,6 @@ def test_folders_sharing_mesh_files_are_one_group_and_a_nested_model_folder_is_i
 
 def test_jobs_2_with_copies_across_folders_gives_the_serial_results_and_warnings(tmp_path):
     import shutil
-    import warnings
-
-    from inertia_tool.robot.corpus import audit_corpus
     for name in ("tiago", "tiago_dual", "other"):
         (tmp_path / name).mkdir()
     _box_stl(tmp_path / "tiago" / "flipped.stl", inside_out=True)
@@ -309,11 +311,6 @@ def test_jobs_2_with_copies_across_folders_gives_the_serial_results_and_warnings
         _mjcf_using(tmp_path / folder / "scene.xml", "flipped.stl")
         _mjcf_using(tmp_path / folder / "more.xml", "open.stl")
     _mjcf_using(tmp_path / "other" / "scene.xml", "box.stl")
-    runs = []
-    for jobs in (1, 2):
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            models = audit_corpus([tmp_path], density=1000, jobs=jobs)
-        runs.append((_summary(models), [str(w.message) for w in caught]))
+    runs = _serial_and_parallel(tmp_path)
     assert runs[1] == runs[0]
     assert any("tiago_dual/flipped.stl" in w for w in runs[0][1])
