@@ -128,8 +128,7 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     is_best = e_face <= best[ring_loop]
     choice[ring_loop[is_best]] = np.flatnonzero(is_best)
     has = choice >= 0
-    scale = float(np.max(np.abs(v))) if n else 0.0
-    margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
+    margin = _round_off(v)
     doubt: np.ndarray = ball.copy()
     k = choice[has]
     offset = np.einsum("ij,ij->i", centre[has] - a[k], unit[k])
@@ -227,8 +226,7 @@ def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         worst = _worst_rim_distance(v, f, loop_at, origin, unit, n_loops)
         pinched = np.zeros(n_loops, dtype=bool)
         pinched[rim_pairs[on_two[rim_pairs[:, 0]], 1]] = True
-        scale = float(np.max(np.abs(v)))
-        margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
+        margin = _round_off(v)
         flat = has & ~pinched & (worst <= flat_rtol * radius + margin)
     if bare is None:
         bare = bare_vertices(v, f, edges, flat_cosine=flat_cosine)

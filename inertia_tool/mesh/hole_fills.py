@@ -13,7 +13,7 @@ from typing import Callable
 import numpy as np
 
 from ..values import frozen_value
-from .hole_bounds import FLAT_RIM_RTOL, FLAT_VERTEX_COSINE, _flat_off_rim_nearby, ball_slab_volume
+from .hole_bounds import FLAT_RIM_RTOL, FLAT_VERTEX_COSINE, _flat_off_rim_nearby, _round_off, ball_slab_volume
 
 
 @frozen_value
@@ -82,8 +82,7 @@ def crease_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     n = len(v)
-    scale = float(np.max(np.abs(v))) if n else 0.0
-    margin = 16.0 * np.finfo(np.float64).eps * max(scale, 1e-300)
+    margin = _round_off(v)
     on_tol = 4.0 * margin                        # a rim vertex "on" a plane: within round-off of it
     candidates = np.flatnonzero(np.bincount(label, minlength=n_loops) >= 4).tolist()
     if not candidates or len(candidates) > CREASE_MAX_LOOPS:
