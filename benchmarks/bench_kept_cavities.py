@@ -19,6 +19,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 from test_mesh_kept_cavities import _draw, _verdict  # noqa: E402
 
 

@@ -9,6 +9,7 @@ nested-copy rule, 0 after.
 """
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 import warnings
@@ -18,6 +19,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 from adversary_solids import box, certificate_label, cylinder, icosphere, torus, truth_from_manifold  # noqa: E402
 from inertia_tool.errors import InvalidMeshError  # noqa: E402
 from inertia_tool.mass.pipeline import mass_properties  # noqa: E402
@@ -81,10 +85,13 @@ def run(seed, n):
     return counts, bad
 
 
-if __name__ == "__main__":
-    seed, n = int(sys.argv[1]), int(sys.argv[2])
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("seed", type=int, nargs="?", default=121, help="the cases are drawn in turn from default_rng(seed)")
+    ap.add_argument("cases", type=int, nargs="?", default=240, help="how many cases")
+    args = ap.parse_args(argv)
     t = time.process_time()
-    counts, bad = run(seed, n)
+    counts, bad = run(args.seed, args.cases)
     for key, c in sorted(counts.items(), key=str):
         print(c, key)
     for b in bad[:40]:
@@ -92,3 +99,8 @@ if __name__ == "__main__":
         for m in b[7]:
             print("   ", m)
     print("cpu", time.process_time() - t)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

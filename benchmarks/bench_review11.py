@@ -32,6 +32,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import adversary_solids as S  # noqa: E402
 import bench_review9_convex as C  # noqa: E402

@@ -34,7 +34,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))     # this checkout's inertia_tool, not an install
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 import review12_generators as G  # noqa: E402
 
 

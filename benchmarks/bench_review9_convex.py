@@ -37,6 +37,9 @@ from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, HalfspaceIntersection
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 import adversary_solids as S  # noqa: E402
 from inertia_tool.tolerances import ROUNDOFF_RTOL  # noqa: E402
 
