@@ -65,6 +65,7 @@ def run(seed, n):
     bad = []
     for i in range(n):
         kind, mode, k, v, w, f = case(rng)
+        started = time.process_time()
         try:
             truth = truth_from_manifold([(v, f), (w, f)]).volume
         except Exception:  # noqa: BLE001 - a truth manifold3d refuses is counted, not judged
@@ -81,6 +82,9 @@ def run(seed, n):
                 bad.append((i, kind, mode, k, label, p.mass, truth, [str(x.message)[:400] for x in caught]))
         except InvalidMeshError as e:
             key = ("refused", str(e)[:80])
+        spent = time.process_time() - started
+        if spent > 10:                     # issue 21: a case over 10 s CPU is named, whatever its verdict
+            print(f"  slow: case {i} (piece {kind}, mode {mode}, k {k}) {spent:.1f} s CPU, {key}", flush=True)
         counts[key] = counts.get(key, 0) + 1
     return counts, bad
 

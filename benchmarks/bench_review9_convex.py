@@ -367,12 +367,16 @@ def main(argv=None):
     t0 = time.time()
     for i in range(args.cases):
         mode = MODES[i % len(MODES)]
+        started = time.process_time()
         try:
             case, verdict, err = run(mode, args.seed, i, args.repair)
         except Exception as exc:           # the truth failed (qhull): skipped, counted
             table[mode]["truth failed"] += 1
             fails.append((i, mode, f"truth failed: {type(exc).__name__}: {str(exc)[:120]}"))
             continue
+        spent = time.process_time() - started
+        if spent > 10:                     # issue 21: a case over 10 s CPU is named, whatever its verdict
+            print(f"  slow: case {i} ({mode}) {spent:.1f} s CPU, {verdict.label}: {case.recipe}", flush=True)
         row = table[mode]
         row["cases"] += 1
         row[verdict.label] += 1
