@@ -1,6 +1,7 @@
-"""The benchmarks of the count of generated cases (``docs/adversarial.md``) import the ``inertia_tool`` of the
-checkout that holds them (``benchmarks/_checkouts.this_checkout_first``), not an installed one, unless
-``PYTHONPATH`` names another; and each answers ``--help``.
+"""The benchmarks of the count of generated cases (``docs/adversarial.md``), and the others that had no way to their
+own checkout, import the ``inertia_tool`` of the checkout that holds them
+(``benchmarks/_checkouts.this_checkout_first``), not an installed one, unless ``PYTHONPATH`` names another; and
+each answers ``--help``.
 
 Each script is run as ``python benchmarks/bench_X.py --help`` would run it (its folder first on ``sys.path``), in
 a fresh interpreter started outside the repository, and the child prints the file of the ``inertia_tool`` it
@@ -18,7 +19,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 BENCHES = ("bench_adversarial", "bench_review11", "bench_review9_convex", "bench_near_copies",
-           "bench_review12", "bench_kept_cavities")
+           "bench_review12", "bench_kept_cavities",
+           # the others that had no way to their own checkout
+           "bench_arrange", "bench_coplanar", "bench_intersect", "bench_review9_damage", "bench_walls")
 
 # the script run as __main__ with --help (argparse exits 0 after printing), then the package it imported (or,
 # where it imports the package only when it runs cases, the one it would import)
