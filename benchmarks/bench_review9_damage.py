@@ -23,9 +23,6 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE / "damage"))
 sys.path.insert(0, str(HERE.parent / "tests"))
-from _checkouts import this_checkout_first  # noqa: E402
-
-this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 import adversary_solids as S  # noqa: E402
 import real_files  # noqa: E402
 
