@@ -1,8 +1,8 @@
 """The count of session 15 (issue 21; ``docs/adversarial.md``, "Session 15"): the cases it flagged that are no
 known finding.  Every answer the judges flagged on ``3062e66`` was a known open finding (N5, N6, in
 ``tests/test_review14_findings.py``; decided by session 15's readings15); here are a case where the judge, not the
-tool, was wrong
-(shown by independent code) and a refusal under a wrong reason found among the count's refusals (C1, fixed).
+tool, was wrong (shown by independent code) and a refusal under a wrong reason found among the count's refusals
+(C1, fixed).
 """
 
 from __future__ import annotations
