@@ -84,13 +84,20 @@ defs["uncertainty"] = d("null when the result is exact for the polyhedron; for a
                          "properties": {"mass": NN, "center_of_mass": NN, "inertia": NN, "volume_in_doubt": NN,
                                         "note": S}})
 CERT_KINDS = ["exact", "united", "summed", "unverified", "estimate"]
+#: The assumptions a user may state (inertia_tool.mesh.hole_assumptions.USER_ASSUMPTIONS; a test checks the two agree).
+USER_ASSUMPTION_NAMES = ["flat-islands"]
+ASSUMPTIONS_SAID = ("optional: the user's assumptions (--assume, assume=) the result rests on: those a repair took "
+                    "(a hole filled under one); empty when none was taken or none stated")
 defs["certificate"] = d("Optional: how far the numbers can be trusted. kind exact (the checks that make the integral "
                         "exact ran and passed), united (overlapping bodies united by a boolean, then exact), summed "
                         "(overlaps counted twice, on request), unverified (a check could not finish) or estimate "
-                        "(bounds in uncertainty); checks lists the checks that ran and passed. null where there is "
+                        "(bounds in uncertainty); checks lists the checks that ran and passed; assumptions the "
+                        "user's assumptions (--assume, assume=) the result rests on. null where there is "
                         "no result (a robot link without geometry).",
                         {"type": ["object", "null"], "required": ["kind", "checks"],
-                         "properties": {"kind": {"enum": CERT_KINDS}, "checks": arr(S)}})
+                         "properties": {"kind": {"enum": CERT_KINDS}, "checks": arr(S),
+                                        "assumptions": d(ASSUMPTIONS_SAID, arr({"enum": USER_ASSUMPTION_NAMES},
+                                                                               uniqueItems=True))}})
 defs["mesh_report"] = obj({
     "source": S, "units": S, "file_faces": COUNT, "vertices": COUNT, "faces": COUNT, "degenerate_faces": COUNT,
     "zero_area_faces": COUNT, "bodies": COUNT, "cavities": COUNT, "flipped_shells": COUNT, "overlapping_shells": COUNT,
