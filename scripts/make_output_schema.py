@@ -244,6 +244,8 @@ defs["robot_link"] = obj({
     "method": d("exact, united, summed or estimate (a link's elements combined: the least certain wins); null "
                 "without a result (see problem).", {"enum": ["exact", "united", "summed", "estimate", None]}),
     "uncertainty": ref("uncertainty"), "certificate": ref("certificate"),
+    "assumptions": d(ASSUMPTIONS_SAID + " (of the link's meshes together)",
+                     arr({"enum": USER_ASSUMPTION_NAMES}, uniqueItems=True)),
     "geometry": arr(obj({"kind": S, "name": SN, "mesh": SN,
                          "submesh": d("SDFormat <submesh><name>: the sub-mesh of the COLLADA file that is the "
                                       "geometry (null: the whole file)", SN)}, ["kind"])),

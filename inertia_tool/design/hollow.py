@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -319,6 +319,8 @@ def _load(source, units: str | None, density, material, mass, repair: bool = Fal
     prepared = prepare_mesh(raw, repair=repair, assume=assumed)
     props = mass_properties((prepared.vertices, prepared.faces), density=rho, mass=mass, name=raw.source,
                             units="m")           # already converted: metres stated, not assumed
+    if prepared.report.uncertainty is not None:   # a repaired estimate: its report (bounds, certificate), not the
+        props = replace(props, mesh=prepared.report)     # re-analysis's of the patched surface
     return prepared.vertices, prepared.faces, props, raw.source
 
 

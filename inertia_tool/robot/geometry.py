@@ -41,7 +41,7 @@ from ..mass.extrusion import extruded_region
 from ..mass.extrusion import point_in_polygon as _inside_polygon
 from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
-from ..mesh.hole_assumptions import NOTHING_ASSUMED, UserAssumptions
+from ..mesh.hole_assumptions import NOTHING_ASSUMED, UserAssumptions, user_named
 from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES, LoadOptions
 from ..values import frozen_value
 from ..mesh.read import RawMesh
@@ -799,7 +799,8 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: M
         method = ("exact" if report is None else "estimate" if report.uncertainty is not None
                   else report.certificate.kind)
         uncertainty = None if report is None else report.uncertainty
-        return local.transformed(rotation=first.rotation, translation=first.translation), method, uncertainty
+        placed = replace(local.transformed(rotation=first.rotation, translation=first.translation), mesh=report)
+        return placed, method, uncertainty          # (the report kept: its certificate, for _users_taken)
     if shared is not None:
         shared.refuse_join(content)
     return None
@@ -967,6 +968,9 @@ class LinkInertial:
         Bounds when ``method == "estimate"``; None when the result is exact for the geometry as described.
     warnings : tuple of str
         What the reader should know about a result (massless geoms left out, a repaired mesh).
+    assumptions : tuple of str
+        The user's assumptions (``assume``) the result rests on: those the certificates of the link's repaired
+        meshes name (:attr:`~inertia_tool.mesh.policy.Certificate.assumptions`); empty when none was taken.
     """
 
     name: str
@@ -977,6 +981,20 @@ class LinkInertial:
     method: str | None = None
     uncertainty: LinkUncertainty | None = None
     warnings: tuple = ()
+    assumptions: tuple[str, ...] = ()
+
+
+def _users_taken(parts: list, cache: dict) -> tuple[str, ...]:
+    """The user's assumptions the link's mesh bodies rest on: those their certificates name (a joined body's
+    report is kept on it, a single mesh's is in the robot's ``cache``)."""
+    names: set[str] = set()
+    for element, props, _, _ in parts:
+        report = props.mesh
+        if report is None and (element.kind == "mesh" or element.fit_scale is not None):
+            report = getattr(cache.get(_mesh_key(element)), "mesh", None)
+        if report is not None:
+            names.update(report.certificate.assumptions)
+    return user_named(names)
 
 
 def _link_uncertainty(parts: list, total: MassProperties, scale: float) -> LinkUncertainty | None:
@@ -1007,8 +1025,7 @@ def _with_engine_warnings(result: LinkInertial, caught: list) -> LinkInertial:
         warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
     if not texts:
         return result
-    return LinkInertial(result.name, result.properties, result.density, result.basis, result.problem,
-                        result.method, result.uncertainty, tuple(result.warnings) + tuple(texts))
+    return replace(result, warnings=tuple(result.warnings) + tuple(texts))
 
 
 def _one_link(link: LinkGeometry, **options) -> LinkInertial:
@@ -1054,6 +1071,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
         return LinkInertial(link.name, None, nan, basis, "every geom is massless in the description",
                             warnings=tuple(warned))
     method = max((m for _, _, m, _ in parts), key=_RANK.__getitem__)
+    taken = _users_taken(parts, cache)
     warned += [f"{e.name or e.kind}: {round_up(u.mass, 2):.2g} relative mass bound from the repaired mesh"
                for e, _, m, u in parts if m == "estimate" and u is not None]
     try:
@@ -1074,7 +1092,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
                                    density=total.mass / volume if volume > 0 else nan, name=link.name)
             uncertainty = _link_uncertainty(parts, props, 1.0) if method == "estimate" else None
             return LinkInertial(link.name, props, props.density, basis, method=method, uncertainty=uncertainty,
-                                warnings=tuple(warned))
+                                warnings=tuple(warned), assumptions=taken)
         units = [u for _, u, _, _ in parts]
         total = units[0] if len(units) == 1 else combine(units, name=link.name)
         unit = MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
@@ -1088,12 +1106,14 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
             props = unit.with_mass(link.declared.mass)
             scale = props.mass / unit.mass
             return LinkInertial(link.name, props, props.mass / props.volume, "declared masses kept", method=method,
-                                uncertainty=_link_uncertainty(parts, props, scale), warnings=tuple(warned))
+                                uncertainty=_link_uncertainty(parts, props, scale), warnings=tuple(warned),
+                                assumptions=taken)
         props = MassProperties(mass=unit.mass * rho, volume=unit.volume, center_of_mass=unit.center_of_mass,
                                inertia=unit.inertia * rho, surface_area=unit.surface_area, density=rho,
                                name=link.name)
         return LinkInertial(link.name, props, rho, basis, method=method,
-                            uncertainty=_link_uncertainty(parts, props, rho), warnings=tuple(warned))
+                            uncertainty=_link_uncertainty(parts, props, rho), warnings=tuple(warned),
+                            assumptions=taken)
     except (InertiaToolError, ValueError, ArithmeticError) as exc:
         return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}", warnings=tuple(warned))
 

@@ -1,0 +1,226 @@
+"""The user's assumptions are a parameter of the repair stage, not hidden state (issues 21/23).
+
+``assume`` travels as a frozen :class:`~inertia_tool.mesh.hole_assumptions.UserAssumptions` from the API through
+``prepare_mesh`` → ``close_surface`` → ``resolve_surface`` → ``holes.patched_estimate``.  Before, a context
+variable carried it (``hole_assumptions.assuming``), and an enclosing block stayed in force inside a call with
+``assume=()``.  Shown here: no module on that chain holds a context variable; a call without the assumption after
+one with it (in one process, on generated plates) gives the default answer; two threads with different
+assumptions each get their own; the certificate names the assumptions taken (``Certificate.assumptions``, JSON
+``certificate.assumptions``, per robot link ``assumptions``, text and HTML "assuming flat-islands"); and
+``spin_it`` takes ``assume`` like ``mass_properties``.
+
+Meshes: the grid plate with a polyomino island hole and the CAD box that lost a pocket of
+``tests/test_hole_flat_islands.py`` (whose truths those tests check); the answers here are compared with each
+other, call against call.
+"""
+
+from __future__ import annotations
+
+import contextvars
+import importlib
+import json
+import threading
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from inertia_tool import mass_properties
+from inertia_tool.errors import InvalidMeshError, UsageError
+from inertia_tool.integrals import volume_moments
+from inertia_tool.mesh.hole_assumptions import NOTHING_ASSUMED, USER_ASSUMPTIONS, UserAssumptions
+from inertia_tool.mesh.holes import patched_estimate
+from inertia_tool.mesh.policy import Certificate
+from inertia_tool.mesh.prepare import prepare_mesh
+from inertia_tool.mesh.read import load_mesh
+
+from test_hole_flat_islands import _polygon, cad_box_with_feature, grid_plate
+
+FLAT = ("flat-islands",)
+
+#: Every module from the API to the one place that reads the assumptions.
+CHAIN = ("inertia_tool.mesh.hole_assumptions", "inertia_tool.mesh.holes", "inertia_tool.mesh.resolve",
+         "inertia_tool.mesh.surface", "inertia_tool.mesh.prepare", "inertia_tool.mass.pipeline",
+         "inertia_tool.mass.thinwall", "inertia_tool.robot.geometry", "inertia_tool.design.hollow")
+
+
+def _answer(v, f, assume):
+    """``(volume, mass bound, certificate)`` of ``mass_properties(repair=True, assume=assume)``, or the refusal's
+    message."""
+    try:
+        props = mass_properties((v, f), density=1.0, repair=True, assume=assume)
+    except InvalidMeshError as exc:
+        return str(exc)
+    return props.volume, props.mesh.uncertainty.mass, props.mesh.certificate
+
+
+def _lidless():
+    """A CAD-tessellated box whose pocket (walls and floor) is gone: an island hole in its top face, refused
+    without ``flat-islands`` (its footprint) and closed flat with it."""
+    extents = (4.0, 3.0, 2.5)
+    v, f, feature = cad_box_with_feature(_polygon(11, extents), extents, -1.0)
+    return v, np.delete(f, feature, axis=0)
+
+
+def test_no_module_on_the_chain_holds_a_context_variable():
+    for name in CHAIN:
+        module = importlib.import_module(name)
+        held = [k for k, value in vars(module).items() if isinstance(value, contextvars.ContextVar)]
+        assert held == [], f"{name} holds {held}"
+    hole_assumptions = importlib.import_module("inertia_tool.mesh.hole_assumptions")
+    assert not hasattr(hole_assumptions, "assuming") and not hasattr(hole_assumptions, "user_assumed")
+
+
+def test_user_assumptions_are_a_checked_frozen_value():
+    assert UserAssumptions(["flat-islands", "flat-islands"]).names == FLAT
+    assert UserAssumptions(FLAT) == UserAssumptions(["flat-islands"])
+    assert hash(UserAssumptions(FLAT)) == hash(UserAssumptions(["flat-islands"]))
+    assert not NOTHING_ASSUMED and UserAssumptions(FLAT) and "flat-islands" in UserAssumptions(FLAT)
+    with pytest.raises(ValueError, match="flat-islands"):
+        UserAssumptions(("flat",))
+    with pytest.raises(TypeError):
+        UserAssumptions("flat-islands")                     # a bare string would be read letter by letter
+    with pytest.raises(AttributeError):
+        UserAssumptions(FLAT).names = ()                    # type: ignore[misc]
+    with pytest.raises(ValueError):
+        Certificate("estimate", assumptions=("dome",))
+    assert Certificate("estimate", assumptions=FLAT).describe() == "estimate, assuming flat-islands"
+
+
+def test_prepare_mesh_takes_only_the_typed_value_and_only_with_repair():
+    v, f = _lidless()
+    raw = load_mesh((v, f))
+    with pytest.raises(UsageError, match="UserAssumptions"):
+        prepare_mesh(raw, repair=True, assume=FLAT)          # type: ignore[arg-type]
+    with pytest.raises(UsageError, match="repair=True"):
+        prepare_mesh(raw, assume=UserAssumptions(FLAT))
+    with pytest.raises(InvalidMeshError, match="`assume` flat-islands"):
+        prepare_mesh(raw, repair=True)
+    taken = prepare_mesh(raw, repair=True, assume=UserAssumptions(FLAT)).report
+    assert taken.certificate.kind == "estimate" and taken.certificate.assumptions == FLAT
+
+
+def test_patched_estimate_reads_the_parameter():
+    v, f = grid_plate(6, 1.0, {(2, 2), (2, 3), (3, 2)})      # an L-shaped island in the top face
+    plain = patched_estimate(v, f, volume_moments)
+    taken = patched_estimate(v, f, volume_moments, assume=UserAssumptions(FLAT))
+    assert "flat-islands" not in plain.assumptions and "flat-islands" in taken.assumptions
+    assert plain.uncertainty.volume_in_doubt > 1e-3 and taken.uncertainty.volume_in_doubt < 1e-9
+    assert abs(taken.volume - 36.0) <= 1e-9
+
+
+@settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(1, 3), st.integers(1, 3), st.integers(0, 2 ** 16), st.sampled_from([(), []]))
+def test_a_call_without_the_assumption_after_one_with_it_gives_the_default_answer(width, depth, seed, nothing):
+    """default → assumed → default, in one process: the third call is the first, bit for bit (the island keeps
+    its ball, or is refused naming the option), and only the second names the assumption."""
+    rng = np.random.default_rng(seed)
+    n = 6
+    x0, y0 = int(rng.integers(1, n - width)), int(rng.integers(1, n - depth))
+    hole = {(x0 + i, y0 + j) for i in range(width) for j in range(depth)}
+    v, f = grid_plate(n, 0.5, hole)
+    first = _answer(v, f, nothing)
+    taken = _answer(v, f, FLAT)
+    again = _answer(v, f, nothing)
+    assert again == first
+    assert not isinstance(taken, str) and taken[2].assumptions == FLAT and taken[1] < 1e-9
+    assert abs(taken[0] - n * n * 0.5) <= 1e-9 * n * n
+    if isinstance(first, str):
+        assert "`assume` flat-islands" in first
+    else:
+        assert first[2].assumptions == () and first[1] > 1e-6
+
+
+def test_two_threads_with_different_assumptions_get_their_own_answers():
+    """Started together (a barrier before each round), three rounds each: every answer is the one the same call
+    gives alone."""
+    v, f = grid_plate(6, 1.0, {(2, 2), (2, 3), (3, 2)})
+    alone = {assume: _answer(v, f, assume) for assume in ((), FLAT)}
+    assert alone[()] != alone[FLAT]
+    barrier = threading.Barrier(2)
+    got: dict = {(): [], FLAT: []}
+
+    def run(assume):
+        for _ in range(3):
+            barrier.wait(timeout=120)
+            got[assume].append(_answer(v, f, assume))
+
+    threads = [threading.Thread(target=run, args=(assume,)) for assume in ((), FLAT)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=600)
+    assert not any(t.is_alive() for t in threads)
+    assert got[()] == [alone[()]] * 3 and got[FLAT] == [alone[FLAT]] * 3
+
+
+# -- the structured field --------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def lidless_stl(tmp_path_factory):
+    import trimesh
+    v, f = _lidless()
+    path = tmp_path_factory.mktemp("assume_json") / "lidless.stl"
+    trimesh.Trimesh(v, f, process=False).export(path)
+    return str(path)
+
+
+def test_the_json_certificate_names_the_assumption_taken(lidless_stl, tmp_path, capsys):
+    from inertia_tool.cli import EXIT_OK, main
+    from inertia_tool.reports.serialize import output_schema
+    assert main(["analyze", lidless_stl, "--repair", "--assume", "flat-islands", "--json"]) == EXIT_OK
+    data = json.loads(capsys.readouterr().out)
+    assert data["certificate"] == {"kind": "estimate", "checks": [], "assumptions": ["flat-islands"]}
+    assert data["mesh"]["certificate"] == data["certificate"]
+    # a patched hole that is no island: an estimate resting on no assumption of the user's, even when stated
+    import trimesh
+    sphere = trimesh.creation.icosphere(subdivisions=2, radius=1.0)
+    open_path = tmp_path / "open.stl"
+    trimesh.Trimesh(sphere.vertices, sphere.faces[1:], process=False).export(open_path)
+    assert main(["analyze", str(open_path), "--repair", "--assume", "flat-islands", "--json"]) == EXIT_OK
+    other = json.loads(capsys.readouterr().out)
+    assert other["certificate"]["kind"] == "estimate" and other["certificate"]["assumptions"] == []
+    jsonschema = pytest.importorskip("jsonschema")
+    validator = jsonschema.Draft202012Validator(output_schema())
+    assert list(validator.iter_errors(data)) == [] and list(validator.iter_errors(other)) == []
+    bad = {**data, "certificate": {**data["certificate"], "assumptions": ["dome"]}}
+    assert list(validator.iter_errors(bad))
+    schema_names = output_schema()["$defs"]["certificate"]["properties"]["assumptions"]["items"]["enum"]
+    assert schema_names == [a.name for a in USER_ASSUMPTIONS]
+
+
+def test_text_and_html_reports_say_the_assumption_with_the_certificate(lidless_stl, tmp_path, capsys):
+    from inertia_tool.cli import EXIT_OK, main
+    report = tmp_path / "r.html"
+    assert main(["analyze", lidless_stl, "--repair", "--assume", "flat-islands", "--report", str(report)]) == EXIT_OK
+    text = capsys.readouterr().out
+    assert "certificate: estimate, assuming flat-islands" in text
+    assert "estimate, assuming flat-islands" in report.read_text("utf-8")
+
+
+def test_robot_links_name_the_assumption_their_meshes_took(tmp_path):
+    from inertia_tool.reports.robot_audit import robot_report_dict
+    from inertia_tool.robot import link_inertials
+    from inertia_tool.robot.audit import audit_links
+    from test_robot_assume_cache import _plate, _robot
+    robot = _robot(tmp_path)
+    taken = link_inertials(robot, density=1000.0, repair=True, assume=FLAT)
+    plain = link_inertials(robot, density=1000.0, repair=True)
+    assert _plate(taken).assumptions == FLAT and _plate(plain).assumptions == ()
+    links = robot_report_dict(robot, taken, audit_links(robot, taken))["links"]
+    assert [link["assumptions"] for link in links if link["name"] == "plate"] == [["flat-islands"]]
+
+
+# -- spin-it ---------------------------------------------------------------------------------------------------
+
+def test_spin_it_takes_the_assumption():
+    from inertia_tool.design.hollow import spin_it
+    v, f = _lidless()
+    with pytest.raises(InvalidMeshError, match="`assume` flat-islands"):
+        spin_it((v, f), axis=(0, 0, 1), wall=0.3, resolution=12, repair=True)
+    with pytest.raises(UsageError, match="repair=True"):
+        spin_it((v, f), axis=(0, 0, 1), wall=0.3, resolution=12, assume=FLAT)
+    result = spin_it((v, f), axis=(0, 0, 1), wall=0.3, resolution=12, repair=True, assume=FLAT)
+    assert abs(result.before.volume - 4.0 * 3.0 * 2.5) <= 1e-9 * 30.0     # the pocket's mouth closed flat
+    assert result.before.mesh.certificate.assumptions == FLAT
