@@ -585,6 +585,8 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
         ``[left, total]``: triangles the meshes still to be read may hold together, of ``total``
         (``robot --max-faces``); each new mesh file is read with ``left`` as its limit and its triangles are
         taken off.
+    assume : UserAssumptions
+        The user's assumptions about the holes a repair fills, passed to :func:`mesh_properties`.
 
     Returns
     -------
@@ -904,6 +906,8 @@ def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repai
         Passed to :func:`mesh_properties`.
     budget : list of one int, optional
         Shared triangle budget (:func:`element_mass_properties`).
+    assume : UserAssumptions
+        The user's assumptions about the holes a repair fills, passed to :func:`mesh_properties`.
 
     Returns
     -------
