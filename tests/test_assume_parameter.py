@@ -224,3 +224,76 @@ def test_spin_it_takes_the_assumption():
     result = spin_it((v, f), axis=(0, 0, 1), wall=0.3, resolution=12, repair=True, assume=FLAT)
     assert abs(result.before.volume - 4.0 * 3.0 * 2.5) <= 1e-9 * 30.0     # the pocket's mouth closed flat
     assert result.before.mesh.certificate.assumptions == FLAT
+
+
+# -- batch rows ------------------------------------------------------------------------------------------------
+
+#: The columns of inertia_tool.batch/2 files (the layout before ``assumptions``), frozen.
+BATCH_V2 = ("schema,path,status,error_type,error,sha256,options_key,mesh_length_unit,density,density_source,method,"
+            "uncertainty_mass,uncertainty_center_of_mass,uncertainty_inertia,uncertainty_volume_in_doubt,mass,volume,"
+            "surface_area,com_x,com_y,com_z,ixx,iyy,izz,ixy,ixz,iyz,i1,i2,i3,axis1_x,axis1_y,axis1_z,axis2_x,"
+            "axis2_y,axis2_z,axis3_x,axis3_y,axis3_z,faces,bodies,cavities,watertight,repaired,certificate,warnings,"
+            "seconds,worker")
+
+
+@pytest.fixture(scope="module")
+def two_parts(lidless_stl, tmp_path_factory):
+    """The lidless box (an island: filled under the assumption) and an icosphere less one face (a hole that is
+    no island: an estimate resting on no assumption of the user's)."""
+    import trimesh
+    sphere = trimesh.creation.icosphere(subdivisions=2, radius=1.0)
+    path = tmp_path_factory.mktemp("assume_batch") / "open.stl"
+    trimesh.Trimesh(sphere.vertices, sphere.faces[1:], process=False).export(path)
+    return lidless_stl, str(path)
+
+
+def _read(path):
+    from inertia_tool.batch.rows import open_results
+    with open_results(path) as results:
+        return {r["path"].rsplit("/", 1)[-1]: r for r in results.previous_rows}
+
+
+@pytest.mark.parametrize("fmt", ["jsonl", "csv"])
+def test_batch_rows_name_the_assumption_taken(two_parts, tmp_path, fmt):
+    from inertia_tool.batch.runner import ROW_FIELDS, SCHEMA
+    from inertia_tool.cli import EXIT_OK, main
+    from inertia_tool.reports.serialize import output_schema
+    out = tmp_path / f"rows.{fmt}"
+    assert main(["batch", *two_parts, "--repair", "--assume", "flat-islands", "--out", str(out), "-q"]) == EXIT_OK
+    rows = _read(out)
+    assert rows["lidless.stl"]["assumptions"] == "flat-islands" and rows["open.stl"]["assumptions"] is None
+    assert all(r["schema"] == SCHEMA and r["certificate"] == "estimate" for r in rows.values())
+    if fmt == "csv":
+        assert out.read_text().splitlines()[0] == ",".join(ROW_FIELDS)
+    jsonschema = pytest.importorskip("jsonschema")
+    validator = jsonschema.Draft202012Validator(output_schema())
+    assert all(list(validator.iter_errors(r)) == [] for r in rows.values())
+
+
+def test_a_batch2_csv_file_resumes_in_its_own_layout(two_parts, tmp_path, capsys):
+    """A results file written before the column: its rows count as done (read back with ``assumptions`` unknown),
+    and the file keeps its header, new rows written in its layout."""
+    import csv
+    import io
+    from inertia_tool.batch.runner import ROW_FIELDS, ROW_FIELDS_V2, SCHEMA_V2, downgrade_row
+    from inertia_tool.cli import main
+    assert ",".join(ROW_FIELDS_V2) == BATCH_V2
+    now = tmp_path / "now.jsonl"
+    main(["batch", two_parts[0], "--repair", "--assume", "flat-islands", "--out", str(now), "-q"])
+    (done,) = [downgrade_row(json.loads(line), SCHEMA_V2) for line in now.read_text().splitlines()]
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(ROW_FIELDS_V2)
+    writer.writerow(["" if done[k] is None else "true" if done[k] is True else "false" if done[k] is False
+                     else repr(done[k]) if isinstance(done[k], float) else str(done[k]) for k in ROW_FIELDS_V2])
+    old = tmp_path / "old.csv"
+    old.write_text(buf.getvalue())
+    capsys.readouterr()
+    assert main(["batch", *two_parts, "--repair", "--assume", "flat-islands", "--out", str(old)]) == 0
+    assert "1 ok, 0 failed in this run" in capsys.readouterr().err          # the old row counted as done
+    text = old.read_text()
+    assert text.startswith(buf.getvalue())
+    table = list(csv.reader(io.StringIO(text)))
+    assert {len(t) for t in table} == {len(ROW_FIELDS_V2)} and table[-1][0] == SCHEMA_V2
+    rows = _read(old)
+    assert all(set(r) == set(ROW_FIELDS) and r["assumptions"] is None for r in rows.values())
