@@ -197,6 +197,18 @@ def test_text_and_html_reports_say_the_assumption_with_the_certificate(lidless_s
     text = capsys.readouterr().out
     assert "certificate: estimate, assuming flat-islands" in text
     assert "estimate, assuming flat-islands" in report.read_text("utf-8")
+    # an assembly: the parts table says it of the part that took it, and only of that one
+    box = tmp_path / "box.stl"
+    import trimesh
+    trimesh.creation.box(extents=(1.0, 1.0, 1.0)).export(box)
+    both = tmp_path / "both.html"
+    assert main(["analyze", f"{lidless_stl}:steel", f"{box}:abs", "--repair", "--assume", "flat-islands",
+                 "--report", str(both)]) == EXIT_OK
+    table = [line.strip() for line in capsys.readouterr().out.splitlines()
+             if line.startswith("    ") and ".stl " in line]
+    assert len(table) == 2 and "lidless.stl" in table[0] and "box.stl" in table[1]
+    assert table[0].endswith("estimate, assuming flat-islands") and table[1].endswith("exact")
+    assert both.read_text("utf-8").count("assuming flat-islands") == 1
 
 
 def test_robot_links_name_the_assumption_their_meshes_took(tmp_path):

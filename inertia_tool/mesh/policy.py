@@ -296,7 +296,14 @@ class Certificate:
     def describe(self) -> str:
         """One line: the kind, the checks and the user's assumptions taken, for text and HTML reports."""
         said = self.kind if not self.checks else f"{self.kind} ({', '.join(self.checks)})"
-        return said + (f", assuming {', '.join(self.assumptions)}" if self.assumptions else "")
+        return said + self._assuming()
+
+    def brief(self) -> str:
+        """The kind and the user's assumptions taken, for a table cell (a part of an assembly)."""
+        return self.kind + self._assuming()
+
+    def _assuming(self) -> str:
+        return f", assuming {', '.join(self.assumptions)}" if self.assumptions else ""
 
 
 @frozen_value
