@@ -105,7 +105,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         How ``faces`` were sealed from the input (their slack enters the bound).
     assume : UserAssumptions
         The user's assumptions (``LoadOptions.assume``): with ``"flat-islands"``, a hole that is an island in a
-        flat face is filled in its rim's plane (:data:`~.hole_assumptions.FLAT_ISLANDS`).  None by default.
+        flat face is filled in its rim's plane (:data:`~.hole_assumptions.FLAT_ISLANDS`).  Default: none
+        (:data:`~.hole_assumptions.NOTHING_ASSUMED`).
 
     Returns
     -------
