@@ -309,3 +309,13 @@ def test_a_batch2_csv_file_resumes_in_its_own_layout(two_parts, tmp_path, capsys
     assert {len(t) for t in table} == {len(ROW_FIELDS_V2)} and table[-1][0] == SCHEMA_V2
     rows = _read(old)
     assert all(set(r) == set(ROW_FIELDS) and r["assumptions"] is None for r in rows.values())
+
+
+def test_a_printed_part_keeps_the_assumption_in_its_certificate():
+    """The skin-and-infill model adds its own bound to a repaired mesh's: the certificate it makes still names
+    the user's assumption the mesh took (it was dropped when the model rebuilt the certificate)."""
+    from inertia_tool.mass.thinwall import printed_part
+    v, f = _lidless()
+    part = printed_part((v, f), skin=0.6, infill=0.3, density=1000.0, repair=True, assume=FLAT)
+    cert = part.properties.mesh.certificate
+    assert cert.kind == "estimate" and "inward-offset-bound" in cert.checks and cert.assumptions == FLAT

@@ -283,7 +283,8 @@ def printed_part(source: MeshSource, *, skin: float, infill: float, density: flo
                                volume_in_doubt=own.volume_in_doubt + mine.volume_in_doubt)
         report = dataclasses.replace(report, method=f"{report.method}, inward offset", uncertainty=mine,
                                      certificate=Certificate("estimate", tuple(report.certificate.checks)
-                                                             + ("inward-offset-bound",)))
+                                                             + ("inward-offset-bound",),
+                                                             report.certificate.assumptions))
     props = MassProperties(mass=total, volume=volume, center_of_mass=com, inertia=inertia,
                            surface_area=area, density=rho_used, name=name or raw.source, mesh=report)
     if rho is None:
