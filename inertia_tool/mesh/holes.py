@@ -30,8 +30,8 @@ flat faces (as CAD exporters do), a rim vertex whose remaining faces all lie in 
 of that face, so the hole took a surface that met the face there: the slab is withdrawn (the ball stays), a
 crease fill is not made, and a hole that is an island of a flat face with a bare rim — the footprint of a
 feature taken whole — is refused (:attr:`~.uncertainty.Estimate.unbounded`), since nothing bounds its height.
-Only where the user states ``flat-islands`` (:data:`~.hole_assumptions.FLAT_ISLANDS`, read here from
-:func:`~.hole_assumptions.user_assumed`) is such an island filled in its rim's plane and bounded by the rim's
+Only where the user states ``flat-islands`` (:data:`~.hole_assumptions.FLAT_ISLANDS`, the parameter ``assume``
+of :func:`patched_estimate`) is such an island filled in its rim's plane and bounded by the rim's
 own slab instead (:func:`~.hole_bounds.flat_island_doubt`), the estimate naming the assumption as the user's.
 
 The stage is split by data flow: the fills other than the cone (crease and curved fills) are in
@@ -60,7 +60,7 @@ from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES
                          CurvedFill, _crease_contradicted, _crease_rim_contradicts as _crease_rim_contradicts,
                          _may_hold_two_planes as _may_hold_two_planes, _quadric as _quadric,
                          _ring_faces as _ring_faces, crease_fills, curved_fills, curved_surroundings)
-from .hole_assumptions import named, stated, user_assumed, user_stated
+from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions, named, stated, user_stated
 from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal
@@ -79,7 +79,7 @@ GRAPH_TRY_SHARE = 1e-3
 
 
 def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[..., Any], *,
-                     seal: Seal | None = None) -> Estimate:
+                     seal: Seal | None = None, assume: UserAssumptions = NOTHING_ASSUMED) -> Estimate:
     """Close each boundary loop by a cone to its centroid and integrate; bound by the balls over the rims.
 
     Assumption (stated in the module docstring): the missing surface of each boundary component lies in the
@@ -103,6 +103,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         ``moments(vertices, faces) -> VolumeMoments`` (the exact integrator, ``volume.volume_moments``).
     seal : Seal, optional
         How ``faces`` were sealed from the input (their slack enters the bound).
+    assume : UserAssumptions
+        The user's assumptions (``LoadOptions.assume``): with ``"flat-islands"``, a hole that is an island in a
+        flat face is filled in its rim's plane (:data:`~.hole_assumptions.FLAT_ISLANDS`).  Default: none
+        (:data:`~.hole_assumptions.NOTHING_ASSUMED`).
 
     Returns
     -------
@@ -140,7 +144,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # unless the user states that such holes lost a flat piece of the face (FLAT_ISLANDS, opt-in): then each
         # is filled in its rim's plane (the cone, in the rim's hull) and bounded by the ball cut to the slab of
         # the rim's own deviation from that plane (flat_island_doubt); read here, nowhere else
-        user_flat = island & evidence.flat_all_round & ("flat-islands" in user_assumed())
+        user_flat = island & evidence.flat_all_round & ("flat-islands" in assume)
         # the convex reading's own evidence: a bare vertex that the faces left turn round by more than π is, if
         # the part is convex, inside its flat face (inner_face_vertices), so it does not take the convex bound away
         inner = inner_face_vertices(v, f, edges, bare)

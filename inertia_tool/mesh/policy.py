@@ -269,10 +269,14 @@ class Certificate:
         One of :data:`CERTIFICATE_KINDS`.
     checks : tuple of str
         The checks that ran and passed (keys of :data:`CHECKS`).
+    assumptions : tuple of str
+        The user's assumptions (``assume``, :data:`~.hole_assumptions.USER_ASSUMPTIONS`) the result rests on:
+        those a repair took (a hole filled under one), empty when none was taken (or none stated).
     """
 
     kind: str
     checks: tuple[str, ...] = ()
+    assumptions: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.kind not in CERTIFICATE_KINDS:
@@ -280,6 +284,9 @@ class Certificate:
         unknown = [c for c in self.checks if c not in CHECKS]
         if unknown:
             raise ValueError(f"Expected checks among {tuple(CHECKS)}, got {unknown}")
+        if self.assumptions:
+            from .hole_assumptions import user_named
+            user_named(self.assumptions)          # ValueError naming the known ones
 
     @property
     def proven(self) -> bool:
@@ -287,10 +294,16 @@ class Certificate:
         return self.kind in ("exact", "united")
 
     def describe(self) -> str:
-        """One line: the kind and the checks, for text and HTML reports."""
-        if not self.checks:
-            return self.kind
-        return f"{self.kind} ({', '.join(self.checks)})"
+        """One line: the kind, the checks and the user's assumptions taken, for text and HTML reports."""
+        said = self.kind if not self.checks else f"{self.kind} ({', '.join(self.checks)})"
+        return said + self._assuming()
+
+    def brief(self) -> str:
+        """The kind and the user's assumptions taken, for a table cell (a part of an assembly)."""
+        return self.kind + self._assuming()
+
+    def _assuming(self) -> str:
+        return f", assuming {', '.join(self.assumptions)}" if self.assumptions else ""
 
 
 @frozen_value

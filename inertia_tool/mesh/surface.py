@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import DegenerateFacesWarning, InvalidMeshError, MeshRepairedWarning, MeshResolvedWarning
 from ..integrals import bounding_box, volume_moments
 from .checks import census_and_shells, repeated_corner_faces
+from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions
 from .read import RawMesh
 from .resolve import Resolution, resolve_surface
 from .shells import leave_out_coincident
@@ -86,8 +87,10 @@ def check_magnitude(lo: np.ndarray, hi: np.ndarray, source: str) -> None:
                                "volume integrals can hold without underflow (check the length `units`)")
 
 
-def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float) -> ClosedSurface:
-    """The surface :func:`~.prepare.prepare_mesh` goes on with (``repair`` and ``merge_tolerance`` as there).
+def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float,
+                  assume: UserAssumptions = NOTHING_ASSUMED) -> ClosedSurface:
+    """The surface :func:`~.prepare.prepare_mesh` goes on with (``repair``, ``merge_tolerance`` and ``assume`` as
+    there).
 
     Raises
     ------
@@ -123,7 +126,7 @@ def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float) -> Clos
     found = Resolution(v, f, "exact", (), 0, None, 0)
     if not topo.oriented:                     # clean meshes skip all of this
         found = resolve_surface(v, f, diag=diag, source=source, repair=repair, merge_tolerance=merge_tolerance,
-                                moments=volume_moments)
+                                moments=volume_moments, assume=assume)
         v, f = found.vertices, found.faces
         if found.method != "exact" or found.notes:
             warning = MeshRepairedWarning if found.estimate is not None else MeshResolvedWarning
