@@ -653,6 +653,17 @@ def _sector_grid(rim_edges: np.ndarray, slot: np.ndarray, levels: int) -> tuple[
     return np.array(caps, dtype=np.int64), np.array(weights, dtype=np.float64).reshape(-1, 4)
 
 
+def _continues_at_rim(v: np.ndarray, f: np.ndarray, rim: np.ndarray, corner_order: np.ndarray,
+                      corner_start: np.ndarray, unit: np.ndarray, offset: float, tol: float) -> bool:
+    """Whether some rim vertex has every face at it within ``tol`` of the plane ``unit · x = offset`` (the flat face
+    goes on across the rim there: the vertex lies inside it, not on its border)."""
+    for x in rim.tolist():
+        at = corner_order[corner_start[x]:corner_start[x + 1]] // 3
+        if len(at) and float(np.abs(v[f[at]] @ unit - offset).max()) <= tol:
+            return True
+    return False
+
+
 def plane_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, loops: np.ndarray,
                 apex: np.ndarray, radius: np.ndarray, inside: Callable[[int, np.ndarray], bool], *,
                 outward: float = 1.0, rtol: float = FLAT_RIM_RTOL, levels: int = PLANE_FILL_LEVELS,
@@ -720,6 +731,8 @@ def plane_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, labe
         unit = normal[keep] / length[keep, None]
         offset = np.einsum("ij,ij->i", unit, a0[keep])
         tol = rtol * float(radius[k]) + margin
+        spread = v[rim] - v[rim].mean(axis=0)
+        planar = float(np.abs(spread @ np.linalg.svd(spread, full_matrices=False)[2][-1]).max()) <= tol
         distinct = np.unique(np.round(np.column_stack([unit, offset / max(float(radius[k]), 1e-300)]) / rtol),
                              axis=0)
         if len(distinct) < 2 or len(distinct) > max_planes:
@@ -733,24 +746,32 @@ def plane_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, labe
         d = d / size
         facing = unit @ d
         carries = facing > wall_cosine                # planes the fill can lie on; the others are walls
-        on_rim = np.isin(f[ring[keep]], rim).sum(axis=1) >= 2
-        if not carries.any() or bool((on_rim & (facing < -wall_cosine)).any()):
-            continue                                   # the rim runs over faces facing away: the hole wraps round
         # each plane's side of the rim: every rim vertex inside it (within tol), or every one outside or on it
         excess = v[rim] @ unit.T - offset[None, :]
+        slot = np.searchsorted(rim, rim_edges)
+        on = (np.abs(excess) <= tol) & carries[None, :]
+        if not carries.any() or not bool((on[slot[:, 0]] & on[slot[:, 1]]).any(axis=1).all()):
+            continue                                   # a rim edge on walls alone: a graph over d cannot go on them
         inner, outer = excess.max(axis=0) <= tol, excess.min(axis=0) >= -tol
         if not (inner | outer).all():
             continue                                   # the rim lies on both sides of a plane: no envelope
         convex = bool(inner[carries].all())
         if not convex and not bool(outer[carries].all()):
             continue                                   # mixed: neither the planes' intersection nor their union
-        slot = np.searchsorted(rim, rim_edges)
         caps, weights = _sector_grid(rim_edges, slot, levels)
         sa, sb = weights[:, 2:3], weights[:, 3:4]
         flat = np.vstack([top[None, :], top + sa * (v[rim[weights[:, 0].astype(np.int64)]] - top)
                           + sb * (v[rim[weights[:, 1].astype(np.int64)]] - top)])
         heights = (offset[carries][None, :] - flat @ unit[carries].T) / facing[carries][None, :]
         lift = heights.min(axis=1) if convex else heights.max(axis=1)
+        if planar:
+            # a planar rim is also what a lost flat face leaves (the octahedron less a face: the cone is exact, the
+            # planes round it make a pyramid): the planes are continued only where the file shows each plane the
+            # fill lies on going on across the rim, at a rim vertex whose every face lies in that plane
+            used = np.flatnonzero(carries)[np.unique(heights.argmin(axis=1) if convex else heights.argmax(axis=1))]
+            if not all(_continues_at_rim(v, f, rim, corner_order, corner_start, unit[j], offset[j], tol)
+                       for j in used.tolist()):
+                continue
         moved = flat + lift[:, None] * d
         if not np.isfinite(moved).all():
             continue
