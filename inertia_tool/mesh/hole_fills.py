@@ -2,8 +2,9 @@
 
 A hole across one crease of a faceted part is filled in the two planes that hold its rim (:func:`crease_fills`,
 the third assumption of :mod:`~.holes`), and withdrawn where the file contradicts it (:func:`_crease_contradicted`);
-a hole whose surroundings lie on one quadric is filled on it (:func:`curved_fills`).  The bounds they keep are in
-:mod:`~.hole_bounds`; :func:`~.holes.patched_estimate` puts the two together.
+a hole whose surroundings lie on one quadric is filled on it (:func:`curved_fills`); a hole on a faceted part is
+filled on the planes of the faces round its rim, continued across it (:func:`plane_fills`).  The bounds they keep
+are in :mod:`~.hole_bounds`; :func:`~.holes.patched_estimate` puts the two together.
 """
 
 from __future__ import annotations

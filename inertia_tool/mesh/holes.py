@@ -34,7 +34,11 @@ Only where the user states ``flat-islands`` (:data:`~.hole_assumptions.FLAT_ISLA
 :func:`~.hole_assumptions.user_assumed`) is such an island filled in its rim's plane and bounded by the rim's
 own slab instead (:func:`~.hole_bounds.flat_island_doubt`), the estimate naming the assumption as the user's.
 
-The stage is split by data flow: the fills other than the cone (crease and curved fills) are in
+A better answer inside the same bound: on a faceted part the planes of the faces round a rim are continued
+across the hole where they close it inside the region its bound states (:func:`~.hole_fills.plane_fills`; no
+assumption is added, every point of the fill is checked to lie in that region).
+
+The stage is split by data flow: the fills other than the cone (crease, curved and plane fills) are in
 :mod:`~.hole_fills`, the bounds and the evidence that withdraws or refuses them in :mod:`~.hole_bounds`; this
 module puts them together (:func:`patched_estimate`) and re-exports their names.
 """
