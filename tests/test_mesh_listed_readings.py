@@ -141,7 +141,7 @@ def _judge(boxes) -> str | None:
     return f"{label} {props.mass} m³ for {[r[0] for r in windings]} (depth {[r[0] for r in depth]})"
 
 
-@settings(max_examples=90, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=150, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 2 ** 32 - 1))
 def test_nested_crossing_and_listed_again_boxes_are_right_or_refused(seed):
     """Certified answers equal a ``{w ≥ 1}`` reading (or R4's depth reading with the file's winding named),
