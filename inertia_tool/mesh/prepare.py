@@ -38,7 +38,7 @@ from .resolve import Resolution
 from .uncertainty import Estimate
 from .self_crossing import with_patch_doubt, settle_self_crossing
 from .settle import find_contacts
-from .shells import find_shells
+from .shells import counted, find_shells
 from .surface import close_surface
 from .unite import NOTHING_LEFT, unite_overlaps
 from .welded import settle_welded
@@ -155,7 +155,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                    region=welded.region)                                                    # R3
     if crossed.forced is not None:
         return _estimated(with_weld_doubt(crossed.forced, weld, source), common, patched)
-    oriented = orient_shells(crossed.shells, crossed.contacts, crossed.touch, source=source)           # R4
+    oriented = orient_shells(crossed.shells, crossed.contacts, crossed.touch, source=source,
+                             multiplicity=counted(crossed.shells, surface.repeated, first.repeated))        # R4, R0
     kind, checks = first_checks(oriented.touch, crossed.unverified)
     resolved_edges = found.nonmanifold_edges if met.folds is None and welded.arranged is None else None
     united = unite_overlaps(oriented, crossed.contacts, nonmanifold_edges=resolved_edges, method=found.method,

@@ -56,6 +56,9 @@ class ClosedSurface(NamedTuple):
         The shell of each face of ``found.faces`` from the edge census, when the faces are the census's.
     coincident : tuple of str
         R0's note (a shell listed twice with the same vertex indices), warned.
+    repeated : (keys, counts) or None
+        The faces R0 kept in place of their repeats and how many times each counts
+        (:func:`~.shells.leave_out_coincident`).
     """
 
     vertices: np.ndarray
@@ -68,6 +71,7 @@ class ClosedSurface(NamedTuple):
     watertight: bool
     census: tuple[np.ndarray, int] | None
     coincident: tuple[str, ...]
+    repeated: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def check_magnitude(lo: np.ndarray, hi: np.ndarray, source: str) -> None:
@@ -118,8 +122,9 @@ def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float,
         raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")
     topo, census_labels, census_shells = census_and_shells(f, len(v), v)   # R1's shells from the same adjacency
     coincident: tuple[str, ...] = ()
+    twice = None
     if topo.nonmanifold_edges:                # R0: a shell listed twice with the same vertex indices
-        f, note = leave_out_coincident(v, f, None, source)
+        f, note, twice = leave_out_coincident(v, f, None, source)
         if note is not None:
             coincident = (note,)
             topo, census_labels, census_shells = census_and_shells(f, len(v), v)
@@ -133,4 +138,4 @@ def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float,
             what = f"repaired ({found.method}, an estimate)" if found.estimate is not None else found.method
             warnings.warn(warning(f"{source}: {what}: {'; '.join(found.notes)}"), stacklevel=4)
     census = (census_labels, census_shells) if topo.oriented else None     # the faces are the census's: unchanged
-    return ClosedSurface(v, f, found, lo, hi, diag, n_repeated, topo.oriented, census, coincident)
+    return ClosedSurface(v, f, found, lo, hi, diag, n_repeated, topo.oriented, census, coincident, twice)
