@@ -405,12 +405,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         if curved or graphs or planes:
             # where what remains is convex the cones stay: the convex bound needs the patch inside the part, as
             # the cones are (in the rims' hulls) and a bent fill need not be
+            # (the fills are swapped for the cones only below, where the convex bound is taken: the doubt of the
+            # readings above bounds their own fills, not the cones)
             cones = build(creases, [])
             bound = convex_hole_bound(cones[0], cones[1][:len(f)], float(cones[3].volume))
-            if bound is not None:
-                curved, graphs = [], []
-                pv, pf, cap, closed, _ = build(creases, [], None, planes) if planes else cones
-                far = float(np.max(reach_of(closed.centroid)))
         # the convex bound where it applies and is narrower than the others before the bend bound: a convex part
         # keeps the polytope (a rule fixed before the bend bound came, which tests/test_hole_bounds.py pins)
         if bound is not None and bound[0] < before_bend:
@@ -425,6 +423,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             pv, pf, cap, closed, _ = build(creases, [], None, planes)
             far = float(np.max(np.linalg.norm(corners - closed.centroid, axis=1)))
             convex = True
+            curved, graphs = [], []
             used = {"convex"}
             used |= {"inner"} if inside_face else set()
     sealed = ""
