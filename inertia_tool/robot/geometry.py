@@ -31,6 +31,7 @@ import hashlib
 import math
 import os
 import warnings
+from typing import NamedTuple
 from dataclasses import replace
 
 import numpy as np
@@ -356,18 +357,31 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
                            reference_rotation=element.reference_rotation,
                            reference_translation=element.reference_translation,
                            mesh_inertia=element.mesh_inertia)
-    memo = _fit_memo_key(mesh, repair, assume) if cache is None else None
+    memo = _fit_memo_key(mesh, repair, assume) if cache is None and budget is None else None
     props = _FIT_BODIES.get(memo) if memo is not None else None
     if props is not None:
         _FIT_BODIES[memo] = _FIT_BODIES.pop(memo)          # most recently used last
+        if isinstance(props, _FitRefusal):
+            _reissue(props.caught)
+            raise props.error.with_traceback(None)
     elif element.mesh_inertia in ("convex", "legacy"):
         props = _mesh_inertia_part(mesh, cache={} if cache is None else cache, budget=budget)[1]
-    else:
+    elif memo is None:
         props = element_mass_properties(mesh, cache=cache, repair=repair, budget=budget, assume=assume)
+    else:
+        with warnings.catch_warnings(record=True) as recorded:
+            warnings.simplefilter("always")
+            try:
+                props = element_mass_properties(mesh, cache=cache, repair=repair, budget=budget, assume=assume)
+            except InertiaToolError as exc:
+                props = _FitRefusal(exc, tuple(recorded))
+        _reissue(recorded)
     if memo is not None and memo not in _FIT_BODIES:
         _FIT_BODIES[memo] = props
         while len(_FIT_BODIES) > FIT_BODIES_KEPT:
             _FIT_BODIES.pop(next(iter(_FIT_BODIES)))
+    if isinstance(props, _FitRefusal):
+        raise props.error.with_traceback(None)
     moments, axes = np.linalg.eigh(0.5 * (props.inertia + props.inertia.T))
     axes = axes[:, ::-1]                                 # x: the largest moment, z: the smallest
     if np.linalg.det(axes) < 0:
@@ -401,9 +415,19 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
 #: without a robot cache (the audit's bounding boxes and inside tests fit every fitted geom again: before this
 #: memo, each such call integrated the mesh anew, 22 of the 57 s of CPU of a Menagerie corpus audit).  Keyed by
 #: :func:`_fit_memo_key` (the file's content, how the element places it, its inertia mode and ``repair``), at
-#: most :data:`FIT_BODIES_KEPT` entries (least recently used dropped first); refusals are not kept.
+#: most :data:`FIT_BODIES_KEPT` entries (least recently used dropped first).  A refusal is kept too, as a
+#: :class:`_FitRefusal` (issues 23/25, corpus15: the audit fits without repair, so a mesh that only a repair
+#: integrates was refused again on every call, Piper's ``link3.stl`` 2.7 s of CPU each time); it is raised
+#: again with the engine's warnings of the first attempt.
 _FIT_BODIES: dict = {}
 FIT_BODIES_KEPT = 256
+
+
+class _FitRefusal(NamedTuple):
+    """A :data:`_FIT_BODIES` entry for a mesh the engine refused: the error and the warnings raised before it."""
+
+    error: InertiaToolError
+    caught: tuple
 
 
 def _repair_key(repair: bool, assume: UserAssumptions) -> tuple[bool, tuple[str, ...]]:
