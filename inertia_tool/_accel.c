@@ -5378,14 +5378,13 @@ ct_spread(uint64_t v)
  * are then key & (2^31 - 1).  One 8-byte word per face moves, not a code and an index.  On one thread: the
  * passes on threads (fixed blocks by ticket, the same order) took ~10 % more CPU and saved no wall time while
  * the other core was busy (docs/performance.md, "Issue 25, hot12").  tests/test_mesh_intersect_sort.py compares it
- * (sort_codes) with a stable sort.  Returns where the sorted words are (key2: three passes), NULL when out of
- * memory. */
-static uint64_t *
-ct_radix_sort_into(uint64_t *key, uint64_t *key2, int64_t m)
+ * (sort_codes) with a stable sort.  -1 when out of memory. */
+static int
+ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m)
 {
     size_t (*count)[2048] = (size_t (*)[2048])calloc(3, sizeof(*count));
     if (count == NULL) {
-        return NULL;
+        return -1;
     }
     for (int64_t i = 0; i < m; i++) {
         for (int p = 0; p < 3; p++) count[p][(key[i] >> (31 + 11 * p)) & 2047]++;
@@ -5403,17 +5402,8 @@ ct_radix_sort_into(uint64_t *key, uint64_t *key2, int64_t m)
         }
         uint64_t *t = src; src = dst; dst = t;
     }
+    memcpy(key, src, (size_t)m * sizeof(uint64_t));  /* three passes: the result is in key2 */
     free(count);
-    return src;                 /* three passes: key2 */
-}
-
-/* The same, the result in key (a copy of key2's), for the tests (sort_codes).  0, or -1 when out of memory. */
-static int
-ct_radix_sort(uint64_t *key, uint64_t *key2, int64_t m)
-{
-    uint64_t *sorted = ct_radix_sort_into(key, key2, m);
-    if (sorted == NULL) return -1;
-    if (sorted != key) memcpy(key, sorted, (size_t)m * sizeof(uint64_t));
     return 0;
 }
 
@@ -5457,7 +5447,7 @@ fail:
 }
 
 static int ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t scratch_bytes,
-                    const int32_t *pos, int32_t *twin, uint8_t *fmask, int threads, int rounds);
+                    const int32_t *pos, int32_t *twin, int threads, int rounds);
 static inline size_t ct_stars_scratch(int64_t n, int64_t m);
 
 /* edge_twins(faces, n_vertices, rounds=1) -> bytes of 3 m int32: the face-pair check's faces across each edge
@@ -5504,11 +5494,8 @@ accel_edge_twins(PyObject *self, PyObject *args)
     }
     int rc;
     int32_t *twin = (int32_t *)(void *)PyBytes_AS_STRING(result);
-    /* INERTIA_TOOL_CT_POISON: the output filled with 0xA5 bytes first, so that a corner ct_twins did not write
-     * shows (it writes every one, with no fill of its own) */
-    if (getenv("INERTIA_TOOL_CT_POISON") != NULL) memset(twin, 0xA5, 3 * (size_t)m * sizeof(int32_t));
     Py_BEGIN_ALLOW_THREADS
-    rc = ct_twins(fv.buf, fsize, (int64_t)n_vertices, (int64_t)m, scratch, scratch_bytes, NULL, twin, NULL, 1, rounds);
+    rc = ct_twins(fv.buf, fsize, (int64_t)n_vertices, (int64_t)m, scratch, scratch_bytes, NULL, twin, 1, rounds);
     Py_END_ALLOW_THREADS
     free(scratch);
     if (rc < 0) {
@@ -6325,9 +6312,7 @@ ct_edge_hash(uint64_t k)
  * each vertex v (ct_stars' lists: off[v] the start of v's range, -1 when v was not kept, ranges in vertex
  * order ending at total): the face across v -> x of f is the face of v's list whose corner before v is x.
  * The lists may be those of a range of vertices only (ct_twins' rounds): off and n then count from the range's
- * first vertex, base.  twin: 3 m int32, any content on entry: every corner of every face is written by the
- * task of its vertex (-2 for all of a vertex's corners when a face holds it twice).  fmask (by hierarchy position,
- * with pos; or NULL): set to 0 for each face with a corner whose twin is -2 (in no patch). */
+ * first vertex, base.  twin: 3 m int32, all -2 on entry. */
 typedef struct {
     const void *F;
     int fsize;
@@ -6337,7 +6322,6 @@ typedef struct {
     int64_t base;               /* the vertex of off[0] */
     const int32_t *pos;         /* NULL, or each face's hierarchy position: twin is then indexed and valued by it */
     int32_t *twin;
-    uint8_t *fmask;             /* NULL, or per hierarchy position (with pos): 0 for a face with a -2 twin */
     int oom[MAX_THREADS];
 } CtTwinJob;
 
@@ -6350,10 +6334,7 @@ static inline void
 ct_twin_put(CtTwinJob *jb, int32_t f, int c, int32_t tw)
 {
     if (jb->pos != NULL) {
-        int32_t p = jb->pos[f];
-        jb->twin[3 * (size_t)p + (size_t)c] = tw >= 0 ? jb->pos[tw] : tw;
-        /* not one face across: in no patch (a byte another thread may clear too: an atomic store) */
-        if (tw == -2 && jb->fmask != NULL) __atomic_store_n(&jb->fmask[p], (uint8_t)0, __ATOMIC_RELAXED);
+        jb->twin[3 * (size_t)jb->pos[f] + (size_t)c] = tw >= 0 ? jb->pos[tw] : tw;
     }
     else {
         jb->twin[3 * (size_t)f + (size_t)c] = tw;
@@ -6417,14 +6398,7 @@ ct_twin_task(void *ctx, int t, int nt)
             hit |= (uint64_t)1 << j;
             first[i] = (int32_t)j;
         }
-        if (all && jb->pos != NULL) {
-            /* by hierarchy position: each face's position read once, the twin's being that of another listed
-             * face (what ct_twin_put writes, with half its reads of pos) */
-            int32_t fpos[64];
-            for (int64_t i = 0; i < k; i++) fpos[i] = jb->pos[lk[i].face];
-            for (int64_t i = 0; i < k; i++) jb->twin[3 * (size_t)fpos[i] + (size_t)lk[i].corner] = fpos[first[i]];
-        }
-        else if (all) {
+        if (all) {
             for (int64_t i = 0; i < k; i++) ct_twin_put(jb, lk[i].face, lk[i].corner, lk[first[i]].face);
         }
         else if (ok && k <= 64) {
@@ -6472,16 +6446,6 @@ ct_twin_task(void *ctx, int t, int nt)
             }
             free(nexts.slot);
             free(table.slot);
-        }
-        else {
-            /* a face holds v twice: no twins at v, -2 at every corner of v (each such face is listed once per
-             * corner at v; its other corners are written at their own vertices) */
-            for (int64_t i = 0; i < k; i++) {
-                int32_t f = lk[i].face;
-                for (int c = 0; c < 3; c++) {
-                    if (index_at(jb->F, jb->fsize, 3 * (size_t)f + (size_t)c) == vg) ct_twin_put(jb, f, c, -2);
-                }
-            }
         }
         if (lk != local) free(lk);
         v = w;
@@ -6954,17 +6918,15 @@ ct_twin_rounds(int64_t m)
  * twins set the check's high point).  The faces are read rounds + 1 times: once for the first round's counts,
  * then once a round, which lists its faces and counts the next round's (8 bytes a vertex of a range, apart).  scratch: at least ct_stars_scratch(n,
  * m) bytes, any content; a mapped one (CT_SMALL_BYTES or more) has its pages given back (MADV_DONTNEED) first
- * and past each round's lists after its count.  Every entry of twin is written (any content on entry); fmask
- * (per hierarchy position, with pos; may be NULL) is cleared for each face with a corner of twin -2.  0, or -1
- * when out of memory. */
+ * and past each round's lists after its count.  0, or -1 when out of memory. */
 static int
 ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t scratch_bytes, const int32_t *pos,
-         int32_t *twin, uint8_t *fmask, int threads, int rounds)
+         int32_t *twin, int threads, int rounds)
 {
     /* scratch's pages given back before the twins are written, not after each round's count: else the twins
-     * and the whole of scratch would be resident together.  twin is not filled first: ct_twin_task writes
-     * every corner (a pass of 12 bytes a face saved) */
+     * and the whole of scratch would be resident together */
     ct_drop_pages(scratch, scratch_bytes);
+    for (size_t i = 0; i < 3 * (size_t)m; i++) twin[i] = -2;
     if (rounds < 1) rounds = 1;
     if ((int64_t)rounds > n) rounds = n > 0 ? (int)n : 1;
     /* the next round's counts, made by this round's pass over the faces (each round after the first costs one
@@ -7028,7 +6990,6 @@ ct_twins(const void *F, int fsize, int64_t n, int64_t m, void *scratch, size_t s
         jb.base = va;
         jb.pos = pos;
         jb.twin = twin;
-        jb.fmask = pos != NULL ? fmask : NULL;
         run_parallel(thread_count(threads, (size_t)nv, 20000), ct_twin_task, &jb);
         for (int t = 0; t < MAX_THREADS; t++) {
             if (jb.oom[t]) rc = -1;
@@ -7907,19 +7868,14 @@ accel_contact_scan(PyObject *self, PyObject *args)
         run_parallel(nt, ct_prep_task, &pr);
         clk[1] = profile ? ct_clock(wall) : 0.0;
         if (profile) ct_resident_mb(&rss[1], &hwm[1]);
-        /* the sorted words are read where the sort leaves them (code + mm), not copied back (8 bytes a face
-         * read and written) */
-        uint64_t *sorted = ct_radix_sort_into(code, code + mm, m);
-        if (sorted == NULL) {
+        if (ct_radix_sort(code, code + mm, m) < 0) {
             oom = 1;
         }
         else {
             clk[2] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[2], &hwm[2]);
             pr.pass = 1;
-            pr.code = sorted;
             run_parallel(nt, ct_prep_task, &pr);
-            pr.code = code;
             pr.pass = 2;
             run_parallel(nt, ct_prep_task, &pr);
             clk[3] = profile ? ct_clock(wall) : 0.0;
@@ -7965,7 +7921,7 @@ accel_contact_scan(PyObject *self, PyObject *args)
             for (int64_t i = 0; i < m; i++) pos[order[i]] = (int32_t)i;
             clk[8] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[8], &hwm[8]);
-            if (ct_twins(F, fsize, n, m, code, code_bytes, pos, twin, fmask, nt, ct_twin_rounds(m)) < 0) {
+            if (ct_twins(F, fsize, n, m, code, code_bytes, pos, twin, nt, ct_twin_rounds(m)) < 0) {
                 oom = 1;
             }
             ct_drop_pages(pos, pos_bytes);      /* dead until it holds the patch labels (below) */
@@ -7978,9 +7934,13 @@ accel_contact_scan(PyObject *self, PyObject *args)
             clk[9] = profile ? ct_clock(wall) : 0.0;
             if (profile) ct_resident_mb(&rss[9], &hwm[9]);
             if (!oom) {
-                /* across: -2 (not one face across) is outside every node's range as -1 (none) is, and ct_twins
-                 * cleared such a face's fmask (in no patch): no pass over the twins here */
-                const int32_t *across = twin;
+                int32_t *across = twin;
+                for (int64_t i = 0; i < 3 * m; i++) {
+                    if (across[i] == -2) {
+                        fmask[i / 3] = 0;          /* not one face across: in no patch */
+                        across[i] = -1;
+                    }
+                }
                 n_nodes = ct_build_tree(nodes, m);
                 clk[10] = profile ? ct_clock(wall) : 0.0;
                 if (profile) ct_resident_mb(&rss[10], &hwm[10]);

@@ -188,24 +188,6 @@ def test_faces_across_each_edge_follow_the_rule(mesh, dtype):
     assert np.array_equal(got, want)
 
 
-@settings(max_examples=100, deadline=None)
-@given(twin_meshes())
-def test_every_corner_of_the_faces_across_is_written(mesh):
-    """``ct_twins`` does not fill its output first (speed15: a pass of 12 bytes a face saved): the task of each
-    vertex writes every corner at it, -2 at a vertex some face holds twice.  With the output filled with 0xA5
-    bytes before the call (``INERTIA_TOOL_CT_POISON``), a corner left unwritten would read -1515870811; the
-    twins must still follow the rule, in one round and in three."""
-    f, _ = mesh
-    n = int(f.max()) + 1 if len(f) else 0
-    want = np.array(edge_twins(f, n), dtype=np.int64).reshape(-1, 3)
-    event("a vertex held twice" if any(len(set(row)) < 3 for row in f.tolist()) else "no vertex held twice")
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("INERTIA_TOOL_CT_POISON", "1")
-        for rounds in (1, 3):
-            raw = _native.accel().edge_twins(f.astype(np.int32), n, rounds)
-            assert np.array_equal(np.frombuffer(raw, dtype=np.int32).reshape(-1, 3), want)
-
-
 @pytest.mark.parametrize("k", [63, 64, 150])
 @pytest.mark.parametrize("closed", [True, False])
 def test_an_edge_run_twice_one_way_has_no_twin_at_any_fan_size(k, closed):
