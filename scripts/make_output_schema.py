@@ -84,13 +84,20 @@ defs["uncertainty"] = d("null when the result is exact for the polyhedron; for a
                          "properties": {"mass": NN, "center_of_mass": NN, "inertia": NN, "volume_in_doubt": NN,
                                         "note": S}})
 CERT_KINDS = ["exact", "united", "summed", "unverified", "estimate"]
+#: The assumptions a user may state (inertia_tool.mesh.hole_assumptions.USER_ASSUMPTIONS; a test checks the two agree).
+USER_ASSUMPTION_NAMES = ["flat-islands"]
+ASSUMPTIONS_SAID = ("optional: the user's assumptions (--assume, assume=) the result rests on: those a repair took "
+                    "(a hole filled under one); empty when none was taken or none stated")
 defs["certificate"] = d("Optional: how far the numbers can be trusted. kind exact (the checks that make the integral "
                         "exact ran and passed), united (overlapping bodies united by a boolean, then exact), summed "
                         "(overlaps counted twice, on request), unverified (a check could not finish) or estimate "
-                        "(bounds in uncertainty); checks lists the checks that ran and passed. null where there is "
+                        "(bounds in uncertainty); checks lists the checks that ran and passed; assumptions the "
+                        "user's assumptions (--assume, assume=) the result rests on. null where there is "
                         "no result (a robot link without geometry).",
                         {"type": ["object", "null"], "required": ["kind", "checks"],
-                         "properties": {"kind": {"enum": CERT_KINDS}, "checks": arr(S)}})
+                         "properties": {"kind": {"enum": CERT_KINDS}, "checks": arr(S),
+                                        "assumptions": d(ASSUMPTIONS_SAID, arr({"enum": USER_ASSUMPTION_NAMES},
+                                                                               uniqueItems=True))}})
 defs["mesh_report"] = obj({
     "source": S, "units": S, "file_faces": COUNT, "vertices": COUNT, "faces": COUNT, "degenerate_faces": COUNT,
     "zero_area_faces": COUNT, "bodies": COUNT, "cavities": COUNT, "flipped_shells": COUNT, "overlapping_shells": COUNT,
@@ -237,6 +244,8 @@ defs["robot_link"] = obj({
     "method": d("exact, united, summed or estimate (a link's elements combined: the least certain wins); null "
                 "without a result (see problem).", {"enum": ["exact", "united", "summed", "estimate", None]}),
     "uncertainty": ref("uncertainty"), "certificate": ref("certificate"),
+    "assumptions": d(ASSUMPTIONS_SAID + " (of the link's meshes together)",
+                     arr({"enum": USER_ASSUMPTION_NAMES}, uniqueItems=True)),
     "geometry": arr(obj({"kind": S, "name": SN, "mesh": SN,
                          "submesh": d("SDFormat <submesh><name>: the sub-mesh of the COLLADA file that is the "
                                       "geometry (null: the whole file)", SN)}, ["kind"])),
@@ -315,8 +324,9 @@ UNCERTAINTY_COLUMNS = {"uncertainty_mass": "relative bound on mass and volume",
                        "uncertainty_center_of_mass": "m, bound on the centre of mass",
                        "uncertainty_inertia": "relative bound on the inertia (Frobenius)",
                        "uncertainty_volume_in_doubt": "m^3 that may or may not be material"}
-def row(v1):
-    p = {"schema": {"const": "inertia_tool.batch/1" if v1 else "inertia_tool.batch/2"},
+def row(version):
+    v1 = version == 1
+    p = {"schema": {"const": f"inertia_tool.batch/{version}"},
          "path": S, "status": {"enum": ["ok", "error", "internal_error"]}, "error_type": SN, "error": SN,
          "sha256": {"type": ["string", "null"], "pattern": "^[0-9a-f]{64}$"},
          "options_key": {"type": "string", "pattern": "^[0-9a-f]{16}$"}}
@@ -335,6 +345,10 @@ def row(v1):
               "repaired": {"type": ["boolean", "null"]}})
     if not v1:
         p["certificate"] = d("optional: the certificate's kind (see certificate)", {"enum": CERT_KINDS + [None]})
+    if version >= 3:
+        p["assumptions"] = d("the user's assumptions (--assume) the result rests on, joined with ','; null when "
+                             "none was taken (and in rows read back from inertia_tool.batch/2 files: unknown)",
+                             {"anyOf": [{"enum": USER_ASSUMPTION_NAMES}, {"type": "null"}]})
     p.update({"warnings": d("the soft problems, joined with ' | '", SN), "seconds": d("s", NN), "worker": SN})
     required = [k for k in p if k != "certificate"]
     o = obj(p, required, extra=False)
@@ -353,9 +367,11 @@ defs["batch_row"] = d("One row of inertia-tool batch: a flat object (JSON Lines)
                       "concluded (method, certificate, watertight, faces, bodies, cavities), never the face-pair "
                       "check's diagnostic counters (candidate_pairs, tested_pairs: they describe the search, and the "
                       "batch's clean-part fast path does not compute them); a row is the same on either path.",
-                      row(False))
+                      row(3))
+defs["batch_row_v2"] = d("A row of a results file written before inertia_tool.batch/3 (read back on resume): no "
+                         "assumptions column.", row(2))
 defs["batch_row_v1"] = d("A row of a results file written before inertia_tool.batch/2 (read back on resume): units "
-                         "is the mesh length unit, no method and uncertainty columns.", row(True))
+                         "is the mesh length unit, no method and uncertainty columns.", row(1))
 
 schema = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
@@ -363,21 +379,23 @@ schema = {
     "title": "inertia-tool JSON output, version inertia_tool/output/v1",
     "description": "Every JSON object printed by inertia-tool (analyze --json, spin --json, top --json, balance "
                    "--json, robot --json, spin-it --json) carries schema = inertia_tool/output/v1 and command; "
-                   "every batch row carries schema = inertia_tool.batch/2 (inertia_tool.batch/1 in older "
+                   "every batch row carries schema = inertia_tool.batch/3 (inertia_tool.batch/2 or /1 in older "
                    "results files). Adding an optional field keeps the version; removing or renaming a field, "
                    "changing its type, unit or meaning, or making a field required makes a new version (a new "
                    "file beside this one). Consumers should ignore fields they do not know. Batch rows are a "
                    "fixed table: any change of their columns makes a new row version.",
     "type": "object",
     "required": ["schema"],
-    "properties": {"schema": {"enum": ["inertia_tool/output/v1", "inertia_tool.batch/2", "inertia_tool.batch/1"]}},
+    "properties": {"schema": {"enum": ["inertia_tool/output/v1", "inertia_tool.batch/3", "inertia_tool.batch/2",
+                                       "inertia_tool.batch/1"]}},
     "allOf": [
         {"if": {"properties": {"schema": {"const": "inertia_tool/output/v1"}}},
          "then": {"required": ["command"], "properties": {"command": {"enum": ["analyze", "spin", "top", "balance",
                                                                                 "robot", "robot-corpus", "spin-it"]}}}},
         *({"if": {"properties": {"command": {"const": c}}, "required": ["command"]}, "then": ref(c)}
           for c in ["analyze", "spin", "top", "balance", "robot", "robot-corpus", "spin-it"]),
-        {"if": {"properties": {"schema": {"const": "inertia_tool.batch/2"}}}, "then": ref("batch_row")},
+        {"if": {"properties": {"schema": {"const": "inertia_tool.batch/3"}}}, "then": ref("batch_row")},
+        {"if": {"properties": {"schema": {"const": "inertia_tool.batch/2"}}}, "then": ref("batch_row_v2")},
         {"if": {"properties": {"schema": {"const": "inertia_tool.batch/1"}}}, "then": ref("batch_row_v1")},
     ],
     "$defs": defs,

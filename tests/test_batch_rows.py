@@ -351,10 +351,10 @@ def test_results_path_that_is_a_symbolic_link_is_refused_exit_2(tmp_path, dangli
 def _format_row_before(row, fmt, layout=SCHEMA):
     """``format_row`` as it was before its fast paths (a new JSON encoder per row, every cell searched for a
     delimiter): the reference its output must equal byte for byte."""
-    from inertia_tool.batch.runner import ROW_FIELDS_V1, SCHEMA_V1, downgrade_row
-    if layout == SCHEMA_V1:
-        row = downgrade_row(row)
-    fields = ROW_FIELDS if layout == SCHEMA else ROW_FIELDS_V1
+    from inertia_tool.batch.runner import ROW_FIELDS_V1, ROW_FIELDS_V2, SCHEMA_V1, SCHEMA_V2, downgrade_row
+    if layout != SCHEMA:
+        row = downgrade_row(row, layout)
+    fields = {SCHEMA: ROW_FIELDS, SCHEMA_V2: ROW_FIELDS_V2, SCHEMA_V1: ROW_FIELDS_V1}[layout]
     if fmt == "jsonl":
         line = json.dumps({k: row.get(k) for k in fields}, ensure_ascii=False, allow_nan=False) + "\n"
     else:
@@ -378,13 +378,13 @@ _cell_values = st.one_of(st.none(), st.booleans(), st.integers(-10**6, 10**6),
 
 @given(fmt=st.sampled_from(["csv", "jsonl"]), k=st.integers(0, 50), path=_names,
        cells=st.dictionaries(st.sampled_from(ROW_FIELDS), _cell_values, max_size=12),
-       shuffle=st.booleans(), extra=st.booleans(), old_layout=st.booleans())
+       shuffle=st.booleans(), extra=st.booleans(), old_layout=st.sampled_from([None, 1, 2]))
 @settings(max_examples=200, deadline=None)
 def test_format_row_writes_the_bytes_it_wrote_before(fmt, k, path, cells, shuffle, extra, old_layout):
     """The row formatter's fast paths (one JSON encoder, a row in column order written as it is, numbers never
     searched for a delimiter) write exactly the bytes of the plain formatter, for rows in or out of column
-    order, with a missing or an extra key, and in the old CSV layout."""
-    from inertia_tool.batch.runner import SCHEMA_V1
+    order, with a missing or an extra key, and in the old CSV layouts."""
+    from inertia_tool.batch.runner import SCHEMA_V1, SCHEMA_V2
     row = _row(k, path=path)
     row.update(cells)
     if shuffle:
@@ -392,5 +392,5 @@ def test_format_row_writes_the_bytes_it_wrote_before(fmt, k, path, cells, shuffl
     if extra:
         row["not_a_column"] = "x"
         row.pop("worker")
-    layout = SCHEMA_V1 if old_layout and fmt == "csv" else SCHEMA
+    layout = {1: SCHEMA_V1, 2: SCHEMA_V2}.get(old_layout, SCHEMA) if fmt == "csv" else SCHEMA
     assert format_row(row, fmt, layout) == _format_row_before(row, fmt, layout)

@@ -387,7 +387,11 @@ def test_the_optional_certificate_is_accepted_where_it_applies(outputs, validato
     lambda r: _with(r, faces=12.5),
     lambda r: _with(r, status="done"),
     lambda r: _with(r, sha256="xyz"),
-    lambda r: _with(r, schema="inertia_tool.batch/3"),
+    lambda r: _with(r, schema="inertia_tool.batch/4"),
+    lambda r: _with(r, schema="inertia_tool.batch/2"),                 # a batch/3 row has the assumptions column
+    lambda r: _with(r, assumptions="dome"),                            # only the user's assumptions
+    lambda r: _with(r, assumptions=["flat-islands"]),                  # rows are flat
+    lambda r: _without(r, "assumptions"),
 ])
 def test_wrong_batch_rows_are_rejected(mutate, batch_dir, tmp_path, validator):
     out = tmp_path / "rows.jsonl"

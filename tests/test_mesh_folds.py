@@ -360,3 +360,23 @@ def test_two_manifold_tells_a_four_face_edge():
     assert two_manifold(joined, np.repeat([0, 1], [len(sf) for _, sf in slabs]))     # each body on its own
     assert not two_manifold(joined, np.zeros(len(joined), dtype=np.int64))
     assert not two_manifold(np.vstack([slabs[0][1], slabs[0][1][:1]]))                # a face listed twice
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2 ** 32 - 1), st.integers(-6, 6), st.booleans())
+def test_fold_search_normals_and_median_are_numpys_bit_for_bit(seed, exponent, rounded):
+    """``folds._face_normals`` and ``folds._median`` (the fold search's per-group plane, without ``np.cross``'s
+    and ``np.median``'s set-up per call) give numpy's floats exactly, signs of zero included: the walls found
+    depend on them only through comparisons, which must not move (issue 25, corpus15)."""
+    from inertia_tool.mesh.folds import _face_normals, _median
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 40))
+    v = rng.normal(size=(n, 3)) * 10.0 ** exponent
+    if rounded:                           # repeated and axis-aligned coordinates: zero components, ties
+        v = np.round(v, 0)
+    f = rng.integers(0, n, size=(int(rng.integers(1, 30)), 3))
+    ours, theirs = _face_normals(v, f), np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    np.testing.assert_array_equal(ours, theirs)
+    assert np.array_equal(np.signbit(ours), np.signbit(theirs))
+    for x in (v[:, 0], v.reshape(-1), v[:1, 0]):
+        assert _median(x) == float(np.median(x))

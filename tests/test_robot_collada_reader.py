@@ -264,3 +264,68 @@ def test_reading_collada_does_not_import_trimesh(tmp_path):
     done = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, check=True,
                           env={**os.environ, "PYTHONPATH": os.path.dirname(HERE)})
     assert done.stdout.split() == ["False", "False"]
+
+
+def _unique_rows(keys):
+    """``np.unique``'s groups of equal rows (the reference ``collada._equal_rows`` stands in for)."""
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    return first, inverse.reshape(-1)
+
+
+def _colliding_pair(rng, width):
+    """Two different rows of ``width`` int64 keys that ``collada._equal_rows`` mixes into the same word."""
+    from inertia_tool.mesh.collada import _ROW_MIX
+    row = [int(x) for x in rng.integers(-10 ** 9, 10 ** 9, size=width)]
+    other = list(row)
+    other[1] += 1                  # then a' M0 = a M0 − M1 (mod 2⁶⁴): M0 is odd, so invertible
+    m0, m1 = int(_ROW_MIX[0]), int(_ROW_MIX[1])
+    shift = (-m1 * pow(m0, -1, 1 << 64)) % (1 << 64)
+    other[0] = (row[0] + shift) % (1 << 64)
+    other[0] -= (1 << 64) if other[0] >= 1 << 63 else 0
+    return np.array([row, other], dtype=np.int64)
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_equal_rows_are_grouped_as_numpy_unique_groups_them(seed):
+    """``_equal_rows`` (a mixed word per row, sorted) groups rows exactly as ``np.unique(axis=0)``: the same
+    groups with the same first index, on rows with many repeats, near-equal rows (one key ±1), the widths the
+    merge uses (3, 5, 6, 8 keys) and rows built to share a word (then it declines and ``_merged`` sorts the rows
+    themselves); the merged vertices and faces are the same either way."""
+    from inertia_tool.mesh import collada
+    rng = np.random.default_rng(seed)
+    width = int(rng.choice([3, 5, 6, 8]))
+    distinct = rng.integers(-3, 4, size=(int(rng.integers(1, 40)), width)) * int(rng.choice([1, 10 ** 8, 2 ** 40]))
+    keys = distinct[rng.integers(0, len(distinct), size=3 * int(rng.integers(1, 60)))]
+    keys[rng.random(len(keys)) < 0.1, 0] += 1                        # neighbours that differ in one key
+    collide = seed % 3 == 0
+    if collide:
+        keys = np.concatenate([keys, _colliding_pair(rng, width)])
+        keys = keys[:len(keys) - len(keys) % 3]
+    found = collada._equal_rows(keys)
+    first, inverse = _unique_rows(keys)
+    if collide and len(np.unique(keys, axis=0)) > 1 and found is None:
+        pass                                                         # declined: _merged sorts the rows instead
+    else:
+        assert found is not None
+        mine_first, mine_inverse = found
+        # the same partition of the rows, each group named by its first row
+        np.testing.assert_array_equal(np.sort(mine_first), np.sort(first))
+        np.testing.assert_array_equal(mine_first[mine_inverse], first[inverse])
+    corners = keys[:, :3].astype(np.float64) * 1e-8
+    real = collada._equal_rows
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(collada, "_equal_rows", lambda k: None)           # the rows sorted by np.unique
+        reference = collada._merged(corners, None, None)
+    merged = collada._merged(corners, None, None)
+    assert collada._equal_rows is real
+    np.testing.assert_array_equal(merged[0], reference[0])
+    np.testing.assert_array_equal(merged[1], reference[1])
+
+
+def test_rows_that_share_a_word_are_not_taken_for_one_vertex():
+    """Two different rows mixed into the same word: ``_equal_rows`` declines (never merges them)."""
+    from inertia_tool.mesh import collada
+    pair = _colliding_pair(np.random.default_rng(7), 3)
+    words = (pair.view(np.uint64) * collada._ROW_MIX[:3]).sum(axis=1, dtype=np.uint64)
+    assert words[0] == words[1] and not np.array_equal(pair[0], pair[1])
+    assert collada._equal_rows(np.concatenate([pair, pair[:1]])) is None

@@ -241,6 +241,41 @@ def test_the_audit_fits_a_primitive_to_a_mesh_once_per_file_content(tmp_path, mo
     assert longer.size > audits[0].size
 
 
+def test_the_audit_refuses_a_fit_to_a_mesh_only_a_repair_reads_once_per_file_content(tmp_path, monkeypatch):
+    """A primitive fitted to an open mesh: the link's integrals repair the mesh, the audit's bounding box and inside
+    test fit the geom again without repair and are refused.  That refusal is kept like a body (issues 23/25,
+    corpus15: Piper's ``link3.stl`` took 2.7 s of CPU to be refused on every call) and raised again with the
+    warnings of the first attempt; the audit says the same each time."""
+    import warnings
+
+    import inertia_tool.robot.geometry as geometry
+    from inertia_tool.robot import audit_links, link_inertials, read_robot
+    calls = []
+    real = geometry.mesh_properties
+    monkeypatch.setattr(geometry, "mesh_properties",
+                        lambda path, **kw: calls.append(bool(kw.get("repair"))) or real(path, **kw))
+    monkeypatch.setattr(geometry, "_FIT_BODIES", {})
+    _box_stl(tmp_path / "open.stl", open_=True)
+    (tmp_path / "fit.xml").write_text('<mujoco><asset><mesh name="m" file="open.stl"/></asset><worldbody>'
+                                      '<body name="c"><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+                                      '<geom type="capsule" mesh="m"/></body></worldbody></mujoco>')
+    robot = read_robot(tmp_path / "fit.xml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")                  # the repair's warning: the link's, not this test's
+        inertials = link_inertials(robot, density=1000, repair=True)
+    assert inertials[0].properties is not None and inertials[0].method == "estimate"
+    seen = []
+    for _ in range(4):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            audit = audit_links(robot, inertials)[0]
+        seen.append((np.isnan(audit.size), audit.com_in_bounding_box, audit.com_inside_geometry, audit.issues,
+                     [(w.category, str(w.message)) for w in caught]))
+    assert calls.count(False) == 1                       # the fit without repair: refused once, not four times
+    assert seen[0][:3] == (True, None, None)             # no box from a mesh read only with repair
+    assert all(s == seen[0] for s in seen[1:])
+
+
 def test_a_byte_identical_copy_in_another_folder_is_integrated_once_with_its_own_warnings(tmp_path, monkeypatch):
     """TIAGo and TIAGo dual ship the same mesh bytes under two paths: a result is shared by content, and each
     model's warnings and result name its own file; a refusal is not shared (each copy is refused by itself)."""

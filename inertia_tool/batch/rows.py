@@ -28,9 +28,10 @@ JSON); booleans are ``true``/``false``; a cell holding the delimiter, a quote or
 may hold any of them) is quoted as the ``csv`` module does by default (``QUOTE_MINIMAL``), so a record can
 span several physical lines.
 
-Rows of an older layout (:data:`~inertia_tool.batch.runner.SCHEMA_V1`) are read back with the current columns
-(:func:`~inertia_tool.batch.runner.upgrade_row`), so an old results file resumes without re-running its files;
-a CSV file with the old header goes on receiving rows of its own layout (its header is never rewritten).
+Rows of an older layout (:data:`~inertia_tool.batch.runner.SCHEMA_V2`, ``SCHEMA_V1``) are read back with the
+current columns (:func:`~inertia_tool.batch.runner.upgrade_row`), so an old results file resumes without
+re-running its files; a CSV file with an old header goes on receiving rows of its own layout (its header is never
+rewritten).
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ import sys
 import time
 from dataclasses import dataclass
 
-from .runner import ROW_FIELDS, ROW_FIELDS_V1, SCHEMA, SCHEMA_V1, downgrade_row, upgrade_row
+from .runner import ROW_FIELDS, ROW_FIELDS_V1, ROW_FIELDS_V2, SCHEMA, SCHEMA_V1, SCHEMA_V2, downgrade_row, upgrade_row
 from ..errors import UsageError
 
 __all__ = ["ResultsFile", "ResultsFileBusy", "ResultsFileDamaged", "ResultsFileWriteError", "read_rows",
@@ -57,9 +58,9 @@ _INT_FIELDS = {"faces", "bodies", "cavities"}
 _BOOL_FIELDS = {"watertight", "repaired"}
 _TEXT_FIELDS = {"schema", "path", "status", "error_type", "error", "sha256", "options_key", "units",
                 "mesh_length_unit", "method",
-                "density_source", "warnings", "worker", "certificate"}
+                "density_source", "warnings", "worker", "certificate", "assumptions"}
 #: The columns of each row layout, by the ``schema`` value that starts its rows.
-_LAYOUTS = {SCHEMA: ROW_FIELDS, SCHEMA_V1: ROW_FIELDS_V1}
+_LAYOUTS = {SCHEMA: ROW_FIELDS, SCHEMA_V2: ROW_FIELDS_V2, SCHEMA_V1: ROW_FIELDS_V1}
 
 
 class ResultsFileBusy(UsageError):
@@ -131,9 +132,10 @@ _JSON_ROW = json.JSONEncoder(ensure_ascii=False, allow_nan=False)
 
 def format_row(row: dict, fmt: str, layout: str = SCHEMA) -> bytes:
     """One row as the bytes of one complete record, ending in ``\\n`` (JSONL: one line; CSV: quoted cells
-    may hold line breaks).  ``layout``: :data:`SCHEMA`, or ``SCHEMA_V1`` for an old CSV file's own layout."""
-    if layout == SCHEMA_V1:
-        row = downgrade_row(row)
+    may hold line breaks).  ``layout``: :data:`SCHEMA`, or ``SCHEMA_V2`` / ``SCHEMA_V1`` for an old CSV file's
+    own layout."""
+    if layout != SCHEMA:
+        row = downgrade_row(row, layout)
     fields = _LAYOUTS[layout]
     if fmt == "jsonl":
         # a row made by the runner holds exactly the columns, in order: written as it is
@@ -396,7 +398,8 @@ class ResultsFile:
     torn_bytes : int
         Length of the torn last record (a killed run) cut off on opening; 0 when there was none.
     layout : str
-        The ``schema`` of the rows written: :data:`SCHEMA`, or ``SCHEMA_V1`` for a CSV file with the old header.
+        The ``schema`` of the rows written: :data:`SCHEMA`, or ``SCHEMA_V2`` / ``SCHEMA_V1`` for a CSV file
+        with an old header.
     sync_seconds : float
         ``fsync`` after a row when at least this many seconds have passed since the last one (0: every row);
         always on :meth:`close`.
@@ -560,8 +563,11 @@ def open_results(path: str | os.PathLike, *, max_bytes: int = 4 << 30, sync_seco
                 raise
         os.fsync(fd)
         end = os.fstat(fd).st_size
-        old_header = (",".join(ROW_FIELDS_V1) + "\n").encode()
-        layout = SCHEMA_V1 if fmt == "csv" and data[:len(old_header)] == old_header else SCHEMA
+        layout = SCHEMA
+        for schema, fields in ((SCHEMA_V2, ROW_FIELDS_V2), (SCHEMA_V1, ROW_FIELDS_V1)):
+            old_header = (",".join(fields) + "\n").encode()
+            if fmt == "csv" and data[:len(old_header)] == old_header:
+                layout = schema
     except UsageError:
         os.close(fd)
         raise

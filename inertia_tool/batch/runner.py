@@ -45,13 +45,19 @@ from ..mass.pipeline import mass_properties, resolve_density
 from .chunks import (DASK_CHUNK_SECONDS, DASK_SHORT_CHUNKS_PER_WORKER, DASK_TAIL_SECONDS, POOL_CHUNK_SECONDS,
                      POOL_SHORT_CHUNKS_PER_WORKER, POOL_TAIL_SECONDS, ChunkSizer, DaskTasks, PoolTasks, file_weights)
 
-__all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "SCHEMA_V1", "ROW_FIELDS_V1", "analyze_chunk",
+__all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "SCHEMA_V1", "ROW_FIELDS_V1", "SCHEMA_V2",
+           "ROW_FIELDS_V2", "analyze_chunk",
            "analyze_file", "discover_files", "file_sha256", "run_batch", "upgrade_row", "downgrade_row",
            "DONE_STATUSES", "counts_as_done", "row_path"]
 
 #: Schema identifier written in every row (``schema`` column); bump it when columns change meaning.  The JSON
 #: Schema of the rows is the ``batch_row`` of ``inertia_tool/schema/output-v1.json`` (docs/json.md).
-SCHEMA = "inertia_tool.batch/2"
+SCHEMA = "inertia_tool.batch/3"
+
+#: The rows of results files written before the ``assumptions`` column (the user's assumptions a result rests
+#: on, issues 21/23) was added; otherwise :data:`SCHEMA`'s.  Read back (:func:`upgrade_row`: ``assumptions``
+#: unknown, ``None``) and appended to in their own layout (:func:`downgrade_row`), as :data:`SCHEMA_V1`'s.
+SCHEMA_V2 = "inertia_tool.batch/2"
 
 #: The rows of results files written before ``units`` was renamed ``mesh_length_unit`` and ``method`` and the
 #: ``uncertainty_*`` columns were added.  They are read back on resume (:func:`upgrade_row`), and a CSV file
@@ -81,8 +87,13 @@ ROW_FIELDS = (
     # principal moments (ascending) and their unit axes (mesh axes, right-handed)
     "i1", "i2", "i3",
     "axis1_x", "axis1_y", "axis1_z", "axis2_x", "axis2_y", "axis2_z", "axis3_x", "axis3_y", "axis3_z",
-    "faces", "bodies", "cavities", "watertight", "repaired", "certificate", "warnings", "seconds", "worker",
+    "faces", "bodies", "cavities", "watertight", "repaired", "certificate",
+    # the user's assumptions the result rests on (Certificate.assumptions), joined with ","; empty when none
+    "assumptions", "warnings", "seconds", "worker",
 )
+
+#: The columns of a :data:`SCHEMA_V2` row, frozen: this version's without ``assumptions``.
+ROW_FIELDS_V2 = tuple(k for k in ROW_FIELDS if k != "assumptions")
 
 #: The columns of a :data:`SCHEMA_V1` row, frozen (files of that version have exactly these): ``units`` (the
 #: mesh's length unit) where ``mesh_length_unit`` is now, no ``method`` and ``uncertainty_*``.
@@ -116,8 +127,11 @@ READ_ONCE_BYTES = 1 << 24
 
 def upgrade_row(row: dict) -> dict:
     """A :data:`SCHEMA_V1` row (of an older results file) with this version's columns: ``mesh_length_unit``
-    from ``units``, ``method`` and ``uncertainty_*`` unknown (``None``); its ``schema`` stays what the file says.
-    Other rows are returned unchanged."""
+    from ``units``, ``method`` and ``uncertainty_*`` unknown (``None``); a :data:`SCHEMA_V2` row with
+    ``assumptions`` unknown (``None``); its ``schema`` stays what the file says.  Other rows are returned
+    unchanged."""
+    if row.get("schema") == SCHEMA_V2:
+        return {k: row.get(k) for k in ROW_FIELDS}
     if row.get("schema") != SCHEMA_V1:
         return row
     new = {k: row.get(k) for k in ROW_FIELDS}
@@ -125,9 +139,14 @@ def upgrade_row(row: dict) -> dict:
     return new
 
 
-def downgrade_row(row: dict) -> dict:
-    """A row in the :data:`SCHEMA_V1` layout, for appending to an old CSV results file (whose header is never
-    rewritten): ``units`` from ``mesh_length_unit``; ``method`` and ``uncertainty_*`` are dropped."""
+def downgrade_row(row: dict, layout: str = SCHEMA_V1) -> dict:
+    """A row in an old ``layout``, for appending to an old CSV results file (whose header is never rewritten):
+    :data:`SCHEMA_V2` drops ``assumptions``; :data:`SCHEMA_V1` (the default) takes ``units`` from
+    ``mesh_length_unit`` and drops ``method``, ``uncertainty_*``, ``certificate`` and ``assumptions``."""
+    if layout == SCHEMA_V2:
+        older = {k: row.get(k) for k in ROW_FIELDS_V2}
+        older["schema"] = SCHEMA_V2
+        return older
     old = {k: row.get(k) for k in ROW_FIELDS_V1}
     old.update(schema=SCHEMA_V1, units=row.get("mesh_length_unit"))
     return old
@@ -491,7 +510,8 @@ def _analyze(path: str, sha256: str | None, chunk: _Chunk) -> dict:
             mesh = props.mesh
             row.update(method=mesh.method, faces=int(mesh.faces), bodies=int(mesh.bodies),
                        cavities=int(mesh.cavities), watertight=bool(mesh.watertight),
-                       repaired=bool(mesh.repaired), certificate=mesh.certificate.kind)
+                       repaired=bool(mesh.repaired), certificate=mesh.certificate.kind,
+                       assumptions=",".join(mesh.certificate.assumptions) or None)
             if mesh.uncertainty is not None:
                 row.update(_bounds(mesh.uncertainty))
         row["status"] = "ok"
@@ -510,6 +530,7 @@ def _parts_fields(props) -> dict:
     """The mesh columns of a file integrated part by part (:mod:`inertia_tool.mass.materials`): counts added,
     ``method`` the parts' common one (``mixed`` when they differ), the weakest part's certificate, and the
     mass bound the parts' give (the largest relative one; the others are per part only)."""
+    from ..mesh.hole_assumptions import user_named
     from ..mesh.policy import CERTIFICATE_KINDS
     reports = [cast(MeshReport, p.mesh) for p in props.parts]
     methods = {r.method for r in reports}
@@ -521,7 +542,8 @@ def _parts_fields(props) -> dict:
                 faces=sum(int(r.faces) for r in reports), bodies=sum(int(r.bodies) for r in reports),
                 cavities=sum(int(r.cavities) for r in reports), watertight=all(r.watertight for r in reports),
                 repaired=any(r.repaired for r in reports),
-                certificate=max((r.certificate.kind for r in reports), key=CERTIFICATE_KINDS.index))
+                certificate=max((r.certificate.kind for r in reports), key=CERTIFICATE_KINDS.index),
+                assumptions=",".join(user_named(a for r in reports for a in r.certificate.assumptions)) or None)
 
 
 def _bounds(uncertainty) -> dict:

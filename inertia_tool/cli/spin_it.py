@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING
 from ..errors import UsageError
 from ..units import length_scale, parse_density, parse_length, parse_vector
 from .help import add_command
-from .model_options import add_material_options, length_unit, recorded_warnings, shown_with_report
+from .model_options import (add_assume_option, add_material_options, assumed_from_args, length_unit, recorded_warnings,
+                            shown_with_report)
 from .options import check_option, density_and_mass
 from .report_option import save_figure, say_written
 
@@ -65,6 +66,7 @@ def register(subparsers) -> None:
     p.add_argument("--repair", action="store_true",
                    help="accept a mesh with holes or cracks: design on the repaired surface (every 'after' number "
                         "is still the exact re-analysis of the hollowed mesh)")
+    add_assume_option(p)
     p.add_argument("--force", action="store_true", help="let --out, --plot and --report replace existing files")
     p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of text")
     p.set_defaults(func=run)
@@ -217,7 +219,8 @@ def run(args) -> int:
                                             pivot=tuple(pivot) if pivot is not None else None, units=args.units,
                                             density=density, material=args.material, mass=mass,
                                             resolution=args.resolution, insert_density=insert_density,
-                                            repair=bool(getattr(args, "repair", False)), storage_scale=storage)
+                                            repair=bool(getattr(args, "repair", False)), storage_scale=storage,
+                                            assume=assumed_from_args(args))
     if args.out and result.insert_vertices is not None:
         _write_two_materials(args.out, result, args.material or "part", args.insert, float(insert_density or 0.0))
     elif args.out and args.out.lower().endswith(".3mf"):

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -296,13 +296,16 @@ def design_metrics(props, mode: str, axis, origin=None, *, gravity: float = 9.80
                              transverse_asymmetry=top.transverse_asymmetry, height=top.length)
 
 
-def _load(source, units: str | None, density, material, mass, repair: bool = False):
+def _load(source, units: str | None, density, material, mass, repair: bool = False, assume: tuple[str, ...] = ()):
     """Checked vertices and faces (m, outward-wound) and the exact mass properties of the solid part."""
     from ..mass.pipeline import mass_properties, resolve_density
+    from ..mesh.hole_assumptions import UserAssumptions
+    from ..mesh.options import LoadOptions
     from ..mesh.prepare import prepare_mesh
     from ..mesh.read import load_mesh
 
     rho, _ = resolve_density(density=density, material=material, mass=mass)
+    assumed = UserAssumptions(LoadOptions(repair=bool(repair), assume=tuple(assume)).assume)   # UsageError
     from ..mesh.plausibility import warn_implausible_size
 
     raw = load_mesh(source, units=units)
@@ -313,9 +316,11 @@ def _load(source, units: str | None, density, material, mass, repair: bool = Fal
         raise UsageError(f"{raw.source}: spin-it designs a part of one material, and the file holds parts of "
                          f"several ({listed}); export the part alone")
     warn_implausible_size(raw, stacklevel=4)
-    prepared = prepare_mesh(raw, repair=repair)
+    prepared = prepare_mesh(raw, repair=repair, assume=assumed)
     props = mass_properties((prepared.vertices, prepared.faces), density=rho, mass=mass, name=raw.source,
                             units="m")           # already converted: metres stated, not assumed
+    if prepared.report.uncertainty is not None:   # a repaired estimate: its report (bounds, certificate), not the
+        props = replace(props, mesh=prepared.report)     # re-analysis's of the patched surface
     return prepared.vertices, prepared.faces, props, raw.source
 
 
@@ -397,7 +402,8 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
             density: float | None = None, material: str | None = None, mass: float | None = None,
             resolution: int = DEFAULT_RESOLUTION, center_weight: float = 1e4, product_weight: float = 1e4,
             gravity: float = 9.80665, insert_density: float | None = None, repair: bool = False,
-            storage_scale: float | None = None, loaded: tuple | None = None) -> SpinItResult:
+            storage_scale: float | None = None, loaded: tuple | None = None,
+            assume: tuple[str, ...] = ()) -> SpinItResult:
     """Hollow a part so that it spins stably about ``axis`` (Bächer et al. 2014; Hafner et al. 2024).
 
     Parameters
@@ -433,6 +439,9 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
     repair : bool
         Read a damaged mesh (holes, cracks) as ``mass_properties(repair=True)`` does, and design on the
         repaired surface; every 'after' number is still the exact re-analysis of the hollowed mesh.
+    assume : tuple of str
+        The user's assumptions about the holes the repair fills, as ``mass_properties(assume=...)``
+        (``("flat-islands",)``); only with ``repair``.  Default ``()``: none.
     storage_scale : float, optional
         m per unit of the file the result will be written to as float32 (an STL in ``units``): the hollowed
         mesh is rounded as that file holds it before it is re-analysed, so that the file analyses to the
@@ -465,7 +474,7 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         pivot = _point(pivot, "pivot")
     elif pivot is not None:
         raise UsageError("`pivot` is for mode 'top'")
-    vertices, faces, before, name = loaded or _load(source, units, density, material, mass, repair)
+    vertices, faces, before, name = loaded or _load(source, units, density, material, mass, repair, assume)
     if insert_density is not None and not (isinstance(insert_density, (int, float)) and math.isfinite(insert_density)
                                            and insert_density > before.density):
         raise UsageError(f"Expected `insert_density` above the part's {before.density:g} kg/m³, got {insert_density!r}")

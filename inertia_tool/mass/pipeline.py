@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import InvalidMeshError, NearlyEqualMomentsWarning, OverlapWarning, PhysicalValidityWarning, UsageError
 from ..mesh.classify import classify_shells
-from ..mesh.hole_assumptions import assuming
+from ..mesh.hole_assumptions import UserAssumptions
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.precision import warn_storage_precision
@@ -226,9 +226,9 @@ def _part(source: MeshSource, rho: float | None, mass: float | None, options: Lo
                     declared_units_win=options.declared_units_win)
     prepared = prepare_clean(raw) if fast_path and options.overlap in OVERLAP_MODES else None
     if prepared is None:
-        with assuming(options.assume):         # the user's hole assumptions, read by holes.patched_estimate
-            prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance,
-                                    overlap=options.overlap, self_crossing=self_crossing)
+        prepared = prepare_mesh(raw, repair=options.repair, merge_tolerance=options.merge_tolerance,
+                                overlap=options.overlap, self_crossing=self_crossing,
+                                assume=UserAssumptions(options.assume))
     label = name or raw.source
     warn_implausible_size(raw, stacklevel=4)
     if len(prepared.shells) == 1:          # one shell, one body: made once, with its report (what the copy below is)

@@ -36,7 +36,7 @@ from ..mesh.checks import MeshReport, edge_topology, repeated_corner_faces, shel
 from ..mesh.policy import Certificate
 from ..errors import InvalidMeshError, UsageError
 from ..mesh.uncertainty import Uncertainty
-from ..mesh.hole_assumptions import assuming
+from ..mesh.hole_assumptions import UserAssumptions
 from ..mesh.options import LoadOptions
 from ..mesh.plausibility import warn_implausible_density, warn_implausible_size
 from ..mesh.prepare import prepare_mesh
@@ -229,8 +229,8 @@ def printed_part(source: MeshSource, *, skin: float, infill: float, density: flo
     opts = LoadOptions.build(options, **load_options)
     rho, _ = resolve_density(density=density, material=material, mass=mass)
     raw = load_mesh(source, units=opts.units, max_faces=opts.max_faces)
-    with assuming(opts.assume):         # the user's hole assumptions, read by holes.patched_estimate
-        prepared = prepare_mesh(raw, repair=opts.repair, merge_tolerance=opts.merge_tolerance, overlap=opts.overlap)
+    prepared = prepare_mesh(raw, repair=opts.repair, merge_tolerance=opts.merge_tolerance, overlap=opts.overlap,
+                            assume=UserAssumptions(opts.assume))
     v, f = prepared.vertices, prepared.faces
     warn_implausible_size(raw)
     solid = volume_moments(v, f)
@@ -283,7 +283,8 @@ def printed_part(source: MeshSource, *, skin: float, infill: float, density: flo
                                volume_in_doubt=own.volume_in_doubt + mine.volume_in_doubt)
         report = dataclasses.replace(report, method=f"{report.method}, inward offset", uncertainty=mine,
                                      certificate=Certificate("estimate", tuple(report.certificate.checks)
-                                                             + ("inward-offset-bound",)))
+                                                             + ("inward-offset-bound",),
+                                                             report.certificate.assumptions))
     props = MassProperties(mass=total, volume=volume, center_of_mass=com, inertia=inertia,
                            surface_area=area, density=rho_used, name=name or raw.source, mesh=report)
     if rho is None:

@@ -17,12 +17,13 @@ from .. import _lazy_names
 
 if TYPE_CHECKING:   # what the names below are, for type checkers and the API docs; loaded on first use
     from .checks import MeshReport
+    from .hole_assumptions import UserAssumptions
     from .options import DEFAULT_MAX_FACES, LoadOptions
     from .prepare import PreparedMesh, prepare_mesh
     from .read import SUPPORTED_SUFFIXES, RawMesh, load_mesh
 
 __all__ = ["LoadOptions", "load_mesh", "RawMesh", "prepare_mesh", "PreparedMesh", "MeshReport",
-           "SUPPORTED_SUFFIXES", "DEFAULT_MAX_FACES"]
+           "SUPPORTED_SUFFIXES", "DEFAULT_MAX_FACES", "UserAssumptions"]
 
 #: The module of each name above; they load on first use (PEP 562), so that a module of this layer can be
 #: imported alone (a command's parser reads ``LoadOptions``' limits without the readers and checks).
@@ -30,7 +31,7 @@ _PUBLIC = {
     "LoadOptions": ".options", "DEFAULT_MAX_FACES": ".options",
     "load_mesh": ".read", "RawMesh": ".read", "SUPPORTED_SUFFIXES": ".read",
     "prepare_mesh": ".prepare", "PreparedMesh": ".prepare",
-    "MeshReport": ".checks",
+    "MeshReport": ".checks", "UserAssumptions": ".hole_assumptions",
 }
 
 __getattr__, __dir__ = _lazy_names(__name__, _PUBLIC, globals())

@@ -346,10 +346,19 @@ class _FaceTriangulation:
 
     def insert(self, p: int) -> None:
         """Insert an interior point: split the triangle holding it (or the two sharing the edge it lies on)."""
+        xy, q = self.xy, self.xy[p]
         for t, tri in enumerate(self.tris):
-            s = [self.orient(tri[e], tri[(e + 1) % 3], p) for e in range(3)]
-            if min(s) < 0:
+            # the three signs, each triangle left at its first negative one (the same triangle is found)
+            s0 = _orient2d(xy[tri[0]], xy[tri[1]], q)
+            if s0 < 0:
                 continue
+            s1 = _orient2d(xy[tri[1]], xy[tri[2]], q)
+            if s1 < 0:
+                continue
+            s2 = _orient2d(xy[tri[2]], xy[tri[0]], q)
+            if s2 < 0:
+                continue
+            s = [s0, s1, s2]
             zeros = s.count(0)
             if zeros == 0:
                 a, b, c = tri
@@ -378,14 +387,22 @@ class _FaceTriangulation:
 
     def constrain(self, u: int, v: int) -> None:
         """Make u–v an edge by flipping the edges that cross it (Sloan 1993)."""
-        edges = {(min(t[e], t[(e + 1) % 3]), max(t[e], t[(e + 1) % 3])) for t in self.tris for e in range(3)}
-        if (min(u, v), max(u, v)) in edges:
+        # the same set, built in the same order as with min/max per edge (its order is the queue's below)
+        edges = {(a, b) if a < b else (b, a)
+                 for t in self.tris for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+        if ((u, v) if u < v else (v, u)) in edges:
             return
+        xy = self.xy
+        pu, pv = xy[u], xy[v]
+        side: dict[int, int] = {}           # orient(u, v, x) of every other point, computed once for the queue
         for x in {i for t in self.tris for i in t} - {u, v}:
-            if self.orient(u, v, x) == 0 and self._between(u, v, x):
+            side[x] = sx = _orient2d(pu, pv, xy[x])
+            if sx == 0 and self._between(u, v, x):
                 raise _Degenerate("an intersection segment passes exactly through another point of its face "
                                        "(a degenerate crossing)")
-        queue = [e for e in edges if u not in e and v not in e and self._crosses(u, v, *e)]
+        # _crosses(u, v, x, y), its first factor taken from `side`
+        queue = [e for e in edges if u not in e and v not in e and side[e[0]] * side[e[1]] < 0
+                 and _orient2d(xy[e[0]], xy[e[1]], pu) * _orient2d(xy[e[0]], xy[e[1]], pv) < 0]
         limit = 20 * (len(queue) + 2) ** 2 + 100
         for _ in range(limit):
             if not queue:

@@ -113,31 +113,34 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
     inside those shells: their volume, within their reach of the centroid).  The note, warned, names the other
     reading and its volume.  Groups of crossing shells wound outward at odd depth (``oriented.groups``, kept as
     bodies by the file's winding) have the same two readings and are never proven: an estimate whose bound spans
-    both.  Returns the result and, for an estimate, ``(volume in doubt, reach)``."""
+    both.  Shells the file winds inward inside a cavity that depth reads as bodies (``oriented.voids``, a void
+    inside a void read as an island) are labelled the same way, their note naming the file's winding reading (the
+    shells empty) and its mass.  Returns the result and, for an estimate, ``(volume in doubt, reach)``."""
     from .intersect import surface_contacts
 
-    found, groups = oriented.misread, oriented.groups
-    if found is None and groups is None:
+    found, voids, groups = oriented.misread, oriented.voids, oriented.groups
+    if found is None and voids is None and groups is None:
         return united, None
+    turned = [r for r in (found, voids) if r is not None]          # R4 flipped these without a warning of its own
     if united.forced is not None or united.kind not in ("exact", "united") or oriented.ambiguous:
         # R4 turned those shells without a warning of its own (this is the one): say both readings here too; the
         # result is not known to be the parity solid, so no total is computed from it.  Nor when inward shells
         # cross outward ones or cavities lie in overlapping bodies (``ambiguous``, certified ``unverified``): the
         # two readings would both rest on that unproven cut, and a bound spanning them says nothing of it (review
         # 11's D5 family, fix12: an estimate 0.9375 ±1.7 % for {w ≥ 1} = 0.90625)
-        for reading in (r for r in (found, groups) if r is not None):
+        for reading in (r for r in (found, voids, groups) if r is not None):
             note = misread_message(reading, None, proven=False, kept="")
-            said = f"{_turned(reading, oriented)}: " if reading is found else ""        # R4 flipped these: said once
+            said = f"{_turned(reading, oriented)}: " if any(reading is r for r in turned) else ""   # said once
             warnings.warn(InsideOutWarning(f"{source}: {said}{note}"), stacklevel=3)
         return united, None
     spread = None
     proven = united.kind == "exact" and groups is None
     if not proven and groups is None:
-        turned = oriented.shells
-        again = surface_contacts(turned.vertices, turned.faces)
+        as_read = oriented.shells
+        again = surface_contacts(as_read.vertices, as_read.faces)
         if again.complete and not len(again.crossing):
             proven = True
-            united = united._replace(shells=turned, owner=oriented.owner, overlaps=0, method=method, kind="exact",
+            united = united._replace(shells=as_read, owner=oriented.owner, overlaps=0, method=method, kind="exact",
                                      checks=["edge-balanced", "consistently-oriented", "no-crossing-faces"],
                                      cavities=int(np.count_nonzero(oriented.depth % 2 == 1)),
                                      notes=tuple(n for n in united.notes if not n.startswith("touching up to")))
@@ -145,15 +148,15 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
     whole = total(shells.moments)
     notes = []
     if not proven:
-        readings = [r for r in (found, groups) if r is not None]
-        turned = oriented.shells
+        readings = [r for r in (found, voids, groups) if r is not None]
+        turned_shells = oriented.shells
         ids = np.concatenate([r.shells for r in readings])
-        corners = np.unique(turned.faces[np.isin(turned.labels, ids)])
-        reach = float(np.sqrt(np.max(np.sum((turned.vertices[corners] - whole.centroid) ** 2, axis=1))))
+        corners = np.unique(turned_shells.faces[np.isin(turned_shells.labels, ids)])
+        reach = float(np.sqrt(np.max(np.sum((turned_shells.vertices[corners] - whole.centroid) ** 2, axis=1))))
         spread = (sum(r.volume for r in readings) * (1 + 1e-9), reach)
-    for reading in (r for r in (found, groups) if r is not None):
+    for reading in (r for r in (found, voids, groups) if r is not None):
         notes.append(misread_message(reading, float(whole.volume), proven))
-        said = f"{_turned(reading, oriented)}: " if reading is found else ""            # R4 flipped these: said once
+        said = f"{_turned(reading, oriented)}: " if any(reading is r for r in turned) else ""    # said once
         warnings.warn(InsideOutWarning(f"{source}: {said}{notes[-1]}"), stacklevel=3)
     return united._replace(notes=(*united.notes, *notes)), spread
 

@@ -14,14 +14,14 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ..errors import InsideOutWarning, MeshResolvedWarning
+from ..errors import InsideOutWarning, InvalidMeshError, MeshResolvedWarning
 from ..integrals import VolumeMoments
 from ..tolerances import TOUCH_VOLUME_RTOL
 from .intersect import SurfaceContacts, surface_contacts
-from .multiplicity import container_windings
+from .multiplicity import container_windings, multiplicity_changes
 from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
-                     inward_crossing_shells, misread_nesting, nested_copies, orient_by_depth, outward_crossing_groups,
-                     rounding_volumes, shell_contacts, within_up_to_rounding)
+                     inward_crossing_shells, misread_nesting, misread_voids, nested_copies, orient_by_depth,
+                     outward_crossing_groups, rounding_volumes, shell_contacts, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
 
@@ -65,6 +65,15 @@ class Orientation(NamedTuple):
     by_winding : bool
         R4c: cavities lie inside bodies that overlap, or cross each other, and the file's winding is read as it
         stands (no shell turned): the boolean forms ``{w ≥ 1}`` without owners (:func:`~.union.winding_solid`).
+    voids : MisreadNesting or None
+        Shells the file winds inward inside a cavity (a void inside a void) that nesting depth reads as bodies
+        (:func:`~.policy.misread_voids`; labelled by :func:`~.certify.misread_reading`, as ``misread``).
+    multiplicity : (s,) int or None
+        How many times R0 found each shell listed (:func:`~.multiplicity.shell_multiplicity`), where that
+        changes ``{w ≥ 1}`` and R4c counts it (:func:`~.union.winding_solid`); None: each shell once.
+    turned_reading : bool
+        R4c was taken because a misread reading rested on a shell R4 turned (:func:`_rests_on_a_turn`): where R4c
+        refuses, ``repair`` refuses too (:func:`~.policy.turned_reading_refusal`).
     """
 
     shells: Shells
@@ -79,11 +88,19 @@ class Orientation(NamedTuple):
     misread: MisreadNesting | None = None
     groups: MisreadNesting | None = None
     by_winding: bool = False
+    voids: MisreadNesting | None = None
+    multiplicity: np.ndarray | None = None
+    turned_reading: bool = False
 
 
-def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContacts, *, source: str) -> Orientation:
+def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContacts, *, source: str,
+                  multiplicity: np.ndarray | None = None) -> Orientation:
     """R4: the shells oriented by nesting depth (touching pairs decided by their vertices, crossing pairs that lie
-    one within the other up to rounding by the boolean), with the overlap candidates of R5 and R6."""
+    one within the other up to rounding by the boolean), with the overlap candidates of R5 and R6.
+
+    ``multiplicity``: (s,) int, how many times R0 found each shell listed (None: once each).  Where counting a
+    shell that many times changes ``{w ≥ 1}`` (:func:`~.multiplicity.multiplicity_changes`), the solid is formed
+    by R4c, which counts it (R0), when R4 turned no shell; otherwise refused."""
     v, f, labels, n_shells = shells.vertices, shells.faces, shells.labels, shells.n_shells
     nest = shell_nesting_or_none(v, f, labels, n_shells)
     file_volumes = np.array([s.volume for s in shells.moments])
@@ -112,20 +129,38 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     # has a depth that means nothing; there R4c takes precedence over the misread readings (review 11's D5 family)
     in_kept = _inside_kept_cavities(file_volumes, flip, depth, nest, _both(within, touch_within), crossing_with) \
         if touch.complete else 0
-    if in_kept:
-        misread = groups = None
-    by_winding = bool(shared or crossed_cavities or held_cavities or spanning or in_kept) and misread is None \
-        and groups is None
+    # R4: a shell inside a void read as an island (the file's winding is −1 there; session 14's N8)
+    voids = misread_voids(file_volumes, flip, depth, nest, _both(within, touch_within)) if touch.complete else None
+    # R4: a misread reading inside a shell R4 turned rests on that turn: neither of its readings is the file's winding
+    # (session 14's N5: three outward boxes crossing inside an inward box, 48 or 34 cells for the file's 26); the
+    # file's winding is read as it stands (R4c), refused where inward shells lie outside every body
+    on_turn = _rests_on_a_turn([r for r in (misread, groups) if r is not None], file_volumes, flip, nest,
+                               _both(within, touch_within))
+    if in_kept or on_turn:
+        misread = groups = voids = None
+    # R0: a shell listed k times counts k times in the winding; where that changes {w ≥ 1} (a box listed twice
+    # inside a void: session 14's N6) R4c forms it, counting each piece that often (union.winding_solid)
+    many = touch.complete and _counted_more_than_once(multiplicity, file_volumes, flip, nest,
+                                                      _both(within, touch_within), crossing_with)
+    by_winding = bool(shared or crossed_cavities or held_cavities or spanning or in_kept or on_turn or many) \
+        and misread is None and groups is None
     if by_winding:      # shells inside others keep the file's winding; a body inside out on its own is still turned,
         # but not one holding a shell wound against its depth (which keeps the file's winding here): turning the one
         # and not the other is neither the file's winding nor R4's reading (session 14: an inward box holding an
         # outward one, beside hollow bodies crossing, was turned and united with it, 24 cells for the file's 0 and
         # the depth reading's 12)
         against = (depth > 0) & ((file_volumes > 0) != (depth % 2 == 0))
-        flip = flip & (depth == 0) & ~_holds(nest, _both(within, touch_within), against, n_shells)
+        kept_turns = flip & (depth == 0) & ~_holds(nest, _both(within, touch_within), against, n_shells)
+        if many and (kept_turns != flip).any():
+            raise InvalidMeshError(_many_refusal(source, multiplicity))
+        flip = kept_turns
+        voids = None                # R4c keeps a void inside a void as wound: the file's winding, no reading
+    elif many:          # a reading by nesting depth (misread, groups, voids) cannot count a shell twice
+        raise InvalidMeshError(_many_refusal(source, multiplicity))
     quiet = np.zeros(n_shells, dtype=bool)
-    if misread is not None:           # warned once, with both readings, by certify.misread_reading
-        quiet[misread.shells] = True
+    for reading in (misread, voids):  # warned once, with both readings, by certify.misread_reading
+        if reading is not None:
+            quiet[reading.shells] = True
     shells = apply_flips(shells, flip & ~quiet, source)
     shells = apply_flips(shells, flip & quiet, source, warn=False)
     notes = []
@@ -172,7 +207,46 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[crossing_with.reshape(-1)] = True
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
-                       groups, by_winding)
+                       groups, by_winding, voids, multiplicity if by_winding else None, on_turn and by_winding)
+
+
+def _rests_on_a_turn(readings: Sequence[MisreadNesting], volumes: np.ndarray, flip: np.ndarray, nest: Nesting | None,
+                     within: np.ndarray | None) -> bool:
+    """R4: a shell around the shells of a misread reading (:func:`~.policy.misread_nesting`,
+    :func:`~.policy.outward_crossing_groups`) was turned by R4, so both readings rest on that turn, and neither is
+    the file's own winding (which the note of the reading says the union is).  By the winding numbers at the
+    shells' probe points or by touching (``within``: ``(shell, container)`` pairs)."""
+    if not readings:
+        return False
+    ids = np.concatenate([r.shells for r in readings])
+    shell, other, _ = container_windings(volumes, nest, within)
+    around = np.isin(shell, ids) & ~np.isin(other, ids)
+    return bool(np.asarray(flip, dtype=bool)[other[around]].any())
+
+
+def _counted_more_than_once(multiplicity: np.ndarray | None, volumes: np.ndarray, flip: np.ndarray,
+                            nest: Nesting | None, within: np.ndarray | None, crossing_with: np.ndarray) -> bool:
+    """R0: some shell listed more than once, and counting it that often may change ``{w ≥ 1}`` of the shells as R4
+    turned them (:func:`~.multiplicity.multiplicity_changes`)."""
+    if multiplicity is None:
+        return False
+    oriented = np.where(np.asarray(flip, dtype=bool), -np.sign(volumes), np.sign(volumes)).astype(np.int64)
+    shell, other, winding = container_windings(volumes, nest, within)
+    turned = np.where(np.asarray(flip, dtype=bool)[other], -winding, winding)
+    return multiplicity_changes(multiplicity, oriented, shell, other, turned,
+                                np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2))
+
+
+def _many_refusal(source: str, multiplicity: np.ndarray | None) -> str:
+    """R0's refusal, one line: shells listed more than once where that count changes ``{w ≥ 1}`` and R4 turned a
+    shell for its nesting depth (no one reading counts both)."""
+    k = np.asarray(multiplicity if multiplicity is not None else [], dtype=np.int64)
+    times = " or ".join(str(int(t)) for t in np.unique(k[k > 1])) or "several"
+    n = int(np.count_nonzero(k > 1))
+    return (f"{source}: {n} closed surface{'s' if n > 1 else ''} listed {times} times, where counted that often "
+            "(R0) the winding number gives another solid than counted once, and a shell is wound against its "
+            "nesting depth: the file does not say which solid it means; remove the copies, or wind every shell as "
+            "its role says")
 
 
 def _copies_nested(volumes: np.ndarray, nest: Nesting | None, crossing_with: np.ndarray,

@@ -113,6 +113,38 @@ def _corners(primitive: Any, bound: bool) -> tuple[np.ndarray, np.ndarray | None
     return corners, uv, normals
 
 
+#: Odd 64-bit multipliers (SplitMix64's and MurmurHash3's constants) that mix a row of keys into one word.
+_ROW_MIX = np.array([0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9, 0xD6E8FEB86659FD93,
+                     0xFF51AFD7ED558CCD, 0xC4CEB9FE1A85EC53, 0x94D049BB133111EB, 0xBF58476D1CE4E5B9], dtype=np.uint64)
+
+
+def _equal_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The groups of equal rows of ``keys`` ((k, c) int64, ``c ≤ 8``) as ``np.unique(keys, axis=0,
+    return_index=True, return_inverse=True)`` gives them, up to the order of the groups: ``(first, inverse)``,
+    ``first[g]`` the smallest index of group ``g``'s rows and ``inverse[i]`` the group of row ``i``.
+
+    Each row is mixed into one word (``Σ keyⱼ·Mⱼ`` modulo 2⁶⁴) and the words sorted stably, so that equal rows
+    are runs of equal words with their smallest index first; every pair of neighbours with equal words is
+    compared whole, and when two different rows share a word (a collision) None is returned and the caller sorts
+    the rows themselves.  ``np.unique`` on rows sorts them as raw bytes (3 times slower on the UR5e's COLLADA
+    corners: 0.55 → 0.19 s of CPU for 365k corners).
+    """
+    count, width = keys.shape
+    if count == 0 or width > len(_ROW_MIX):
+        return None
+    words = (np.ascontiguousarray(keys).view(np.uint64) * _ROW_MIX[:width]).sum(axis=1, dtype=np.uint64)
+    order = np.argsort(words, kind="stable")
+    sorted_words = words[order]
+    same = sorted_words[1:] == sorted_words[:-1]
+    rows = keys[order]
+    if np.any(same & np.any(rows[1:] != rows[:-1], axis=1)):
+        return None                                    # a collision: two different rows, one word
+    start = np.concatenate(([True], ~same))
+    inverse = np.empty(count, dtype=np.int64)
+    inverse[order] = np.cumsum(start) - 1
+    return order[start], inverse
+
+
 def _merged(corners: np.ndarray, uv: np.ndarray | None, normals: np.ndarray | None
             ) -> tuple[np.ndarray, np.ndarray]:
     """``(vertices, faces)`` of one primitive's corners after trimesh's ``merge_vertices`` (run when trimesh
@@ -125,7 +157,11 @@ def _merged(corners: np.ndarray, uv: np.ndarray | None, normals: np.ndarray | No
     if normals is not None and normals.shape == corners.shape:
         stacked.append(normals * (10 ** 2))
     keys = np.column_stack(stacked).round().astype(np.int64)
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    found = _equal_rows(keys)
+    if found is None:
+        _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    else:
+        first, inverse = found
     order = np.argsort(first, kind="stable")
     rank = np.empty(len(order), dtype=np.int64)
     rank[order] = np.arange(len(order))

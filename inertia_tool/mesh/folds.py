@@ -343,13 +343,16 @@ def internal_walls(vertices: np.ndarray, faces: np.ndarray, pairs: np.ndarray, *
     bounds = np.flatnonzero(np.r_[True, groups[order][1:] != groups[order][:-1], True])
     spans = sorted(zip(bounds[:-1].tolist(), bounds[1:].tolist()), key=lambda b: b[0] - b[1])    # largest first
     for s0, s1 in spans[:MAX_WALL_GROUPS]:               # one group per connected set of flagged faces
+        # the group's faces in increasing order (f[ids] is f[members]); a group is mostly left at the plane
+        # test, before its (m,) mask is built (issue 25, corpus15: ~11k groups a Menagerie corpus run)
+        ids = np.sort(flagged[order[s0:s1]])
+        if wall[ids].any():
+            continue
+        plane = _plane(v, f[ids])
+        if plane is None or _distance_bound(v, f[ids], *plane) > tolerance:
+            continue
         members = np.zeros(m, dtype=bool)
-        members[flagged[order[s0:s1]]] = True
-        if (members & wall).any():
-            continue
-        plane = _plane(v, f[members])
-        if plane is None or _distance_bound(v, f[members], *plane) > tolerance:
-            continue
+        members[ids] = True
         if not _closed(key, forward, members):           # the flagged faces alone leave part of the wall out
             grown = _grow(v, f, members, plane, tolerance, key, sorted_keys, key_order)
             if grown is not None:
@@ -556,15 +559,42 @@ def _sheets_cancel(v: np.ndarray, f: np.ndarray, rtol: float = 1e-6) -> bool:
     """Whether the faces' vector areas nearly cancel (``|Σ Aᵢnᵢ| ≤ rtol·Σ Aᵢ``), as those of two sheets of
     opposite orientation over one region do (a closed surface's vector area is zero).  Only a filter: a flat face
     of the part next to a seam is not taken for a wall; what makes the result exact is the volume bound."""
-    normal = 0.5 * np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    normal = 0.5 * _face_normals(v, f)
     total = float(np.sum(np.linalg.norm(normal, axis=1)))
     return bool(total > 0 and float(np.linalg.norm(normal.sum(axis=0))) <= rtol * total)
+
+
+def _face_normals(v: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """(k, 3): ``np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])``, the same floats (each component
+    ``a_i b_j − a_j b_i``, two products and a difference, as ``np.cross`` rounds them), without its set-up per
+    call (the fold search calls it on a few faces thousands of times)."""
+    a = v[f[:, 1]] - v[f[:, 0]]
+    b = v[f[:, 2]] - v[f[:, 0]]
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
+
+
+def _median(x: np.ndarray) -> float:
+    """``np.median`` of a 1-D float array, the same value: the middle of the sorted values, or the two middle ones'
+    sum halved (``np.median`` takes their mean); NaN when one is NaN (sorted last)."""
+    if not len(x):
+        return float(np.median(x))
+    ordered = np.sort(x)
+    half = len(ordered) // 2
+    if np.isnan(ordered[-1]):
+        return float("nan")
+    if len(ordered) % 2:
+        return float(ordered[half])
+    return float((ordered[half - 1] + ordered[half]) / 2)
 
 
 def _plane(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, float] | None:
     """Unit normal and offset of the plane of faces nearly in one plane (normals aligned to the largest face's,
     area-weighted), or None when they have no area."""
-    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    normal = _face_normals(v, f)
     size = np.linalg.norm(normal, axis=1)
     if not len(size) or not size.max() > 0:
         return None
@@ -574,7 +604,7 @@ def _plane(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, float] | None:
     if not norm > 0:
         return None
     unit = total / norm
-    offset = float(np.median(v[np.unique(f.reshape(-1))] @ unit))
+    offset = _median(v[np.unique(f.reshape(-1))] @ unit)
     return unit, offset
 
 
@@ -602,8 +632,7 @@ def _grow(v: np.ndarray, f: np.ndarray, members: np.ndarray, plane: tuple[np.nda
     near_vertex = np.abs(v @ unit - offset) <= tolerance
     # a face is near when its three corners are; judged only for the faces the frontier touches (issue 25: the
     # test of every face on each call was ~4 s of CPU over the ~14k calls of a Menagerie corpus run)
-    edge = np.repeat(grown, 3)
-    frontier_keys = np.unique(key[edge])
+    frontier_keys = np.unique(key[(3 * np.flatnonzero(grown)[:, None] + np.arange(3)).reshape(-1)])
     for _ in range(len(f)):                               # each pass adds at least one face
         lo = np.searchsorted(sorted_keys, frontier_keys, side="left")
         hi = np.searchsorted(sorted_keys, frontier_keys, side="right")

@@ -27,20 +27,22 @@ a feature taken whole there by the ring's slope.
 ``LoadOptions.assume`` / ``--assume flat-islands`` states that each such island lost a flat piece of its face
 (:data:`FLAT_ISLANDS`); the island is then filled in its rim's plane and bounded by the rim's own slab
 (:func:`~.hole_bounds.flat_island_doubt`), and the estimate names the assumption as the user's
-(:func:`user_stated`).  It is set for the duration of a mesh's preparation by :func:`assuming` and read in one
-place, :func:`~.holes.patched_estimate`.
+(:func:`user_stated`).  The user's assumptions travel as a parameter, a frozen :class:`UserAssumptions`, from the
+API (``LoadOptions.assume``) through :func:`~.prepare.prepare_mesh`, :func:`~.surface.close_surface` and
+:func:`~.resolve.resolve_surface` to the one place that reads them, :func:`~.holes.patched_estimate`; no state
+outside the call holds them (issues 21/23: a pure engine), so two calls, in one thread or two, each get the answer
+of their own ``assume``.  The certificate of a result names those it rests on
+(:attr:`~.policy.Certificate.assumptions`).
 """
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import dataclasses
-from typing import Iterable, Iterator
+from typing import Iterable
 
 __all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "GRAPH", "PLANAR",
-           "QUADRIC", "ALL", "stated", "named", "FLAT_ISLANDS", "USER_ASSUMPTIONS", "user_named", "assuming",
-           "user_assumed", "user_stated", "ISLAND_HINT"]
+           "QUADRIC", "ALL", "stated", "named", "FLAT_ISLANDS", "USER_ASSUMPTIONS", "user_named", "UserAssumptions",
+           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -139,10 +141,6 @@ USER_ASSUMPTIONS = (FLAT_ISLANDS,)
 #: The end of a refusal of a hole that is an island in a flat face: the option that would take it.
 ISLAND_HINT = " or, if the lost surface was flat, `assume` flat-islands"
 
-#: The user's assumptions in force while a mesh is prepared (set by :func:`assuming` from
-#: ``LoadOptions.assume``, read only by :func:`~.holes.patched_estimate`).
-_USER: contextvars.ContextVar[tuple[str, ...]] = contextvars.ContextVar("inertia_tool_user_assumptions", default=())
-
 
 def user_named(names: Iterable[str]) -> tuple[str, ...]:
     """``names`` checked against :data:`USER_ASSUMPTIONS`, in their order (``ValueError`` naming the known ones)."""
@@ -154,23 +152,35 @@ def user_named(names: Iterable[str]) -> tuple[str, ...]:
     return tuple(n for n in known if n in wanted)
 
 
-@contextlib.contextmanager
-def assuming(names: Iterable[str]) -> Iterator[None]:
-    """Within the block, the hole bounds take the user's assumptions ``names`` (checked by :func:`user_named`).
+@dataclasses.dataclass(frozen=True)
+class UserAssumptions:
+    """The assumptions the user stated about the holes a repair fills, as the engine takes them (a parameter of
+    every stage from :func:`~.prepare.prepare_mesh` to :func:`~.holes.patched_estimate`; hashable, so caches can
+    be keyed by it).
 
-    The assumptions stated by an enclosing block stay in force (a robot audit states them once for every mesh
-    it reads)."""
-    chosen = user_named([*_USER.get(), *names])
-    token = _USER.set(chosen)
-    try:
-        yield
-    finally:
-        _USER.reset(token)
+    Attributes
+    ----------
+    names : tuple of str
+        Names among :data:`USER_ASSUMPTIONS` (``("flat-islands",)``), each once, in that order: checked and
+        ordered on construction (``ValueError`` for an unknown name, ``TypeError`` for a bare string).
+    """
+
+    names: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if isinstance(self.names, str) or not isinstance(self.names, (tuple, list, frozenset, set)):
+            raise TypeError(f"Expected `names` to be a tuple of assumption names, got {self.names!r}")
+        object.__setattr__(self, "names", user_named(self.names))
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.names
+
+    def __bool__(self) -> bool:
+        return bool(self.names)
 
 
-def user_assumed() -> tuple[str, ...]:
-    """The user's assumptions in force (:func:`assuming`), names in :data:`USER_ASSUMPTIONS` order."""
-    return _USER.get()
+#: No assumption stated (the default of every stage).
+NOTHING_ASSUMED = UserAssumptions()
 
 
 def user_stated(names: Iterable[str]) -> str:

@@ -2,8 +2,9 @@
 
 A hole across one crease of a faceted part is filled in the two planes that hold its rim (:func:`crease_fills`,
 the third assumption of :mod:`~.holes`), and withdrawn where the file contradicts it (:func:`_crease_contradicted`);
-a hole whose surroundings lie on one quadric is filled on it (:func:`curved_fills`).  The bounds they keep are in
-:mod:`~.hole_bounds`; :func:`~.holes.patched_estimate` puts the two together.
+a hole whose surroundings lie on one quadric is filled on it (:func:`curved_fills`); a hole on a faceted part is
+filled on the planes of the faces round its rim, continued across it (:func:`plane_fills`).  The bounds they keep
+are in :mod:`~.hole_bounds`; :func:`~.holes.patched_estimate` puts the two together.
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ from typing import Callable
 import numpy as np
 
 from ..values import frozen_value
-from .hole_bounds import FLAT_RIM_RTOL, FLAT_VERTEX_COSINE, _flat_off_rim_nearby, _round_off, ball_slab_volume
+from .hole_bounds import (BEND_MAX_DEGREES, FLAT_RIM_RTOL, FLAT_VERTEX_COSINE, _flat_off_rim_nearby, _round_off,
+                          ball_slab_volume)
 
 
 @frozen_value
@@ -548,3 +550,244 @@ def _quadric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: float) -> np.ndarra
     """``Q(p) = pᵀ A p + b·p + c`` at each row of ``p`` (k, 3)."""
     value: np.ndarray = np.einsum("ij,jk,ik->i", p, a, p) + p @ b + c
     return value
+
+
+#: Levels of the plane-continuation fill between the cone's apex and the rim (:func:`plane_fills`): each cone
+#: triangle becomes about ``PLANE_FILL_LEVELS²`` triangles, so a crease of the continued planes that crosses it is
+#: followed to a share of about ``1 / PLANE_FILL_LEVELS²`` of the volume the crease lifts.
+PLANE_FILL_LEVELS = 12
+#: Most holes given a plane-continuation fill (those with the most doubt first; the rest keep their fill).
+PLANE_MAX_LOOPS = 32
+#: Most rim corners of a hole given a plane-continuation fill (each adds ``PLANE_FILL_LEVELS²`` points).
+PLANE_MAX_RIM = 256
+#: Most distinct planes of the faces at a rim read as a faceted surface: more are a tessellated curved surface,
+#: whose facets' planes continued overshoot it as far as the cone falls short (and a quadric fill is the one for it).
+PLANE_MAX_PLANES = 24
+
+
+@frozen_value
+class PlaneFill:
+    """A hole filled on the planes of the faces round its rim, continued across it (:func:`plane_fills`).
+
+    Attributes
+    ----------
+    loop : int
+        The boundary loop.
+    apex : (3,) float
+        Where the cone's apex moved to (onto the continued planes), m.
+    points : (p, 3) float
+        The fill's inner points, m.
+    caps : (q, 3) int
+        Its triangles: rim vertices by their index, the apex as ``n_vertices + loop`` (the cone's), the inner
+        points as ``−1 − i`` (the caller numbers them).
+    lift : (p + 1,) float
+        How far the apex and each inner point moved from the cone along the hole's outward direction, m
+        (≥ 0 everywhere where the fill lies outside the cone).
+    planes : int
+        The distinct planes continued.
+    convex : bool
+        True where the surroundings are convex (the solid is the intersection of the planes' half-spaces, the
+        fill their lower envelope), False where concave (their union, the upper envelope).
+    """
+
+    loop: int
+    apex: np.ndarray
+    points: np.ndarray
+    caps: np.ndarray
+    lift: np.ndarray
+    planes: int
+    convex: bool
+
+
+def _sector_grid(rim_edges: np.ndarray, slot: np.ndarray, levels: int) -> tuple[np.ndarray, np.ndarray]:
+    """The cone's fan over a rim, split into ``levels`` rows between the apex and the rim.
+
+    Row ``l = 1 … levels − 1`` of the triangle over rim edge ``i`` (``e0 → e1``, ``slot`` (k, 2) the places of
+    its corners in the sorted rim) holds ``l + 1`` points ``apex + (l / levels) ((1 − t) (e0 − apex) + t (e1 −
+    apex))``, ``t = j / l``; row 0 is the apex and the rim row holds ``e0`` and ``e1`` alone, so the fill's
+    boundary is exactly the rim.  The points on a spoke ``apex → e`` are shared by the two triangles at ``e``.
+
+    Returns
+    -------
+    caps : (q, 3) int
+        The triangles, wound as the cone's ``(e1, e0, apex)``: rim corners by their index, the apex as ``−1``,
+        inner point ``i`` as ``−2 − i``.
+    weights : (p, 4) float
+        Inner point ``i`` as ``[slot a, slot b, s_a, s_b]``: at ``apex + s_a (rim[a] − apex) + s_b (rim[b] −
+        apex)``.
+    """
+    n_edges = len(rim_edges)
+    n_slots = int(slot.max()) + 1 if len(slot) else 0
+    inner = levels - 1                                   # spoke points per rim vertex (rows 1 … levels − 1)
+    weights: list[list[float]] = []
+    for s in range(n_slots):                             # spoke points: slot s, row l at −2 − (s · inner + l − 1)
+        for level in range(1, levels):
+            weights.append([s, s, level / levels, 0.0])
+
+    def spoke(s: int, level: int) -> int:
+        return -1 if level == 0 else -2 - (s * inner + level - 1)
+
+    caps: list[list[int]] = []
+    for i in range(n_edges):
+        a, b = int(slot[i, 0]), int(slot[i, 1])
+        rows: list[list[int]] = [[-1]]
+        for level in range(1, levels):
+            row = [spoke(a, level)]
+            for j in range(1, level):
+                t = j / level
+                weights.append([a, b, level / levels * (1.0 - t), level / levels * t])
+                row.append(-2 - (len(weights) - 1))
+            row.append(spoke(b, level))
+            rows.append(row)
+        for level in range(levels - 1):
+            upper, lower = rows[level], rows[level + 1]
+            for j in range(len(upper)):
+                caps.append([upper[j], lower[j + 1], lower[j]])
+                if j + 1 < len(upper):
+                    caps.append([upper[j], upper[j + 1], lower[j + 1]])
+        last = rows[levels - 1]
+        e0, e1 = int(rim_edges[i, 0]), int(rim_edges[i, 1])
+        half = (len(last) - 1) // 2
+        for j in range(len(last) - 1):
+            caps.append([last[j], last[j + 1], e0 if j < half else e1])
+        caps.append([last[half], e1, e0])
+    return np.array(caps, dtype=np.int64), np.array(weights, dtype=np.float64).reshape(-1, 4)
+
+
+def _continues_at_rim(v: np.ndarray, f: np.ndarray, rim: np.ndarray, corner_order: np.ndarray,
+                      corner_start: np.ndarray, unit: np.ndarray, offset: float, tol: float) -> bool:
+    """Whether some rim vertex has every face at it within ``tol`` of the plane ``unit · x = offset`` (the flat face
+    goes on across the rim there: the vertex lies inside it, not on its border)."""
+    for x in rim.tolist():
+        at = corner_order[corner_start[x]:corner_start[x + 1]] // 3
+        if len(at) and float(np.abs(v[f[at]] @ unit - offset).max()) <= tol:
+            return True
+    return False
+
+
+def plane_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, loops: np.ndarray,
+                apex: np.ndarray, radius: np.ndarray, inside: Callable[[int, np.ndarray], bool], *,
+                outward: float = 1.0, rtol: float = FLAT_RIM_RTOL, levels: int = PLANE_FILL_LEVELS,
+                max_loops: int = PLANE_MAX_LOOPS, max_rim: int = PLANE_MAX_RIM,
+                max_planes: int = PLANE_MAX_PLANES,
+                wall_cosine: float = float(np.cos(np.radians(BEND_MAX_DEGREES)))) -> list[PlaneFill]:
+    """Holes filled on the planes of the faces round their rims, continued across them (a better estimate on a
+    faceted part, the same bound).
+
+    On a faceted part the surface a hole took lies, most often, on the planes of the faces still there round
+    it: a box's side, a cone's facets meeting at its apex, three planes at a corner.  The faces with a corner on
+    the rim (the ring) give planes ``n_j · x = c_j`` (``n_j`` outward, unit).  Where every rim vertex lies inside
+    every one of them (within ``rtol`` of the ball's radius: the surroundings are *convex*) the solid there is
+    their half-spaces' intersection, and its surface over a point ``p`` of the cone, along the hole's outward
+    direction ``d`` (the cone's vector area), is at ``p + λ d``, ``λ = min_j (c_j − n_j·p) / (n_j·d)`` over the
+    planes facing ``d`` (the planes' lower envelope); where every rim vertex lies outside or on every plane
+    (*concave*: a pocket's corner) the union's, ``λ = max_j``, every plane facing ``d``.  Mixed surroundings, a
+    single plane (the cone already lies in it), more than ``max_planes`` distinct planes (a tessellated curved
+    surface, whose facet planes overshoot it) or a pinched rim keep their fill.  The cone's fan, split into
+    ``levels`` rows (:func:`_sector_grid`), is lifted point by point onto that envelope; the rim stays.
+
+    **The bound does not change**: the region in doubt lies where the cycle "fill − missing surface" winds, and
+    both lie in the convex region the hole's bound states (the ball over the rim, with the capsule and the slab
+    where taken) when every point of the fill does: ``inside(loop, points)`` is asked of the apex and the inner
+    points, and a fill with a point outside keeps the cone.  So the planes must *close* the hole inside that
+    region; where they diverge (a face lost with its plane, the octahedron's) the fill leaves it and is not made.
+    ``loops`` lists the loops by decreasing doubt; at most ``max_loops`` are tried, one at a time.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    edges : (k, 2) int
+        Boundary edges ``a → b`` (each the edge of one face in that direction), ``label`` (k,) their loop.
+    loops : (j,) int
+    apex : (n_loops, 3) float
+        The cone's apex of each loop, m.
+    radius : (n_loops,) float
+        The ball's radius over each rim, m (sets the tolerance ``rtol · radius``).
+    inside : callable
+        ``inside(loop, points (p, 3)) -> bool``: whether every point lies in the region the hole's bound states.
+    outward : float
+        +1 where the faces are wound outward, −1 where inward (the patched solid's volume sign).
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    n = len(v)
+    margin = _round_off(v)
+    corner_order = np.argsort(f.reshape(-1), kind="stable")
+    corner_start = np.searchsorted(f.reshape(-1)[corner_order], np.arange(n + 1))
+    out: list[PlaneFill] = []
+    for k in np.asarray(loops, dtype=np.int64)[:max_loops].tolist():
+        rim_edges = edges[label == k]
+        rim = np.unique(rim_edges)
+        if len(rim_edges) < 3 or len(rim) != len(rim_edges) or len(rim) > max_rim:
+            continue                                   # a pinch, or too long to fill point by point
+        ring = np.unique(np.concatenate([corner_order[corner_start[x]:corner_start[x + 1]] // 3
+                                         for x in rim.tolist()]))
+        a0 = v[f[ring, 0]]
+        normal = outward * np.cross(v[f[ring, 1]] - a0, v[f[ring, 2]] - a0)
+        length = np.linalg.norm(normal, axis=1)
+        keep = length > 0
+        if not keep.any():
+            continue
+        unit = normal[keep] / length[keep, None]
+        offset = np.einsum("ij,ij->i", unit, a0[keep])
+        tol = rtol * float(radius[k]) + margin
+        spread = v[rim] - v[rim].mean(axis=0)
+        planar = float(np.abs(spread @ np.linalg.svd(spread, full_matrices=False)[2][-1]).max()) <= tol
+        distinct = np.unique(np.round(np.column_stack([unit, offset / max(float(radius[k]), 1e-300)]) / rtol),
+                             axis=0)
+        if len(distinct) < 2 or len(distinct) > max_planes:
+            continue
+        top = apex[k]
+        e0, e1 = v[rim_edges[:, 0]], v[rim_edges[:, 1]]
+        d = outward * 0.5 * np.cross(e0 - e1, top - e1).sum(axis=0)
+        size = float(np.linalg.norm(d))
+        if not size > 0:
+            continue
+        d = d / size
+        facing = unit @ d
+        carries = facing > wall_cosine                # planes the fill can lie on; the others are walls
+        # each plane's side of the rim: every rim vertex inside it (within tol), or every one outside or on it
+        excess = v[rim] @ unit.T - offset[None, :]
+        slot = np.searchsorted(rim, rim_edges)
+        on = (np.abs(excess) <= tol) & carries[None, :]
+        if not carries.any() or not bool((on[slot[:, 0]] & on[slot[:, 1]]).any(axis=1).all()):
+            continue                                   # a rim edge on walls alone: a graph over d cannot go on them
+        inner, outer = excess.max(axis=0) <= tol, excess.min(axis=0) >= -tol
+        if not (inner | outer).all():
+            continue                                   # the rim lies on both sides of a plane: no envelope
+        convex = bool(inner[carries].all())
+        if not convex and not bool(outer[carries].all()):
+            continue                                   # mixed: neither the planes' intersection nor their union
+        caps, weights = _sector_grid(rim_edges, slot, levels)
+        sa, sb = weights[:, 2:3], weights[:, 3:4]
+        flat = np.vstack([top[None, :], top + sa * (v[rim[weights[:, 0].astype(np.int64)]] - top)
+                          + sb * (v[rim[weights[:, 1].astype(np.int64)]] - top)])
+        heights = (offset[carries][None, :] - flat @ unit[carries].T) / facing[carries][None, :]
+        lift = heights.min(axis=1) if convex else heights.max(axis=1)
+        if planar:
+            # a planar rim is also what a lost flat face leaves (the octahedron less a face: the cone is exact, the
+            # planes round it make a pyramid): the planes are continued only where the file shows each plane the
+            # fill lies on going on across the rim, at a rim vertex whose every face lies in that plane
+            used = np.flatnonzero(carries)[np.unique(heights.argmin(axis=1) if convex else heights.argmax(axis=1))]
+            if not all(_continues_at_rim(v, f, rim, corner_order, corner_start, unit[j], offset[j], tol)
+                       for j in used.tolist()):
+                continue
+        moved = flat + lift[:, None] * d
+        if not np.isfinite(moved).all():
+            continue
+        # the fill keeps every plane's side the rim keeps (a wall's too): else the planes do not close the hole
+        side = moved @ unit.T - offset[None, :]
+        keeps_inside = (inner & ~outer) | (inner & outer & convex)
+        wrong = np.where(keeps_inside, side > tol, side < -tol)
+        if wrong.any():
+            continue
+        if not inside(k, moved):
+            continue                                   # the planes do not close the hole in the bound's region
+        caps = caps.copy()
+        caps[caps == -1] = n + k
+        inner_ids = caps < -1
+        caps[inner_ids] = -1 - (-2 - caps[inner_ids])   # inner point i as −1 − i
+        out.append(PlaneFill(loop=int(k), apex=moved[0], points=moved[1:], caps=caps, lift=lift,
+                             planes=int(len(distinct)), convex=convex))
+    return out

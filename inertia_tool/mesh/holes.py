@@ -30,11 +30,15 @@ flat faces (as CAD exporters do), a rim vertex whose remaining faces all lie in 
 of that face, so the hole took a surface that met the face there: the slab is withdrawn (the ball stays), a
 crease fill is not made, and a hole that is an island of a flat face with a bare rim — the footprint of a
 feature taken whole — is refused (:attr:`~.uncertainty.Estimate.unbounded`), since nothing bounds its height.
-Only where the user states ``flat-islands`` (:data:`~.hole_assumptions.FLAT_ISLANDS`, read here from
-:func:`~.hole_assumptions.user_assumed`) is such an island filled in its rim's plane and bounded by the rim's
+Only where the user states ``flat-islands`` (:data:`~.hole_assumptions.FLAT_ISLANDS`, the parameter ``assume``
+of :func:`patched_estimate`) is such an island filled in its rim's plane and bounded by the rim's
 own slab instead (:func:`~.hole_bounds.flat_island_doubt`), the estimate naming the assumption as the user's.
 
-The stage is split by data flow: the fills other than the cone (crease and curved fills) are in
+A better answer inside the same bound: on a faceted part the planes of the faces round a rim are continued
+across the hole where they close it inside the region its bound states (:func:`~.hole_fills.plane_fills`; no
+assumption is added, every point of the fill is checked to lie in that region).
+
+The stage is split by data flow: the fills other than the cone (crease, curved and plane fills) are in
 :mod:`~.hole_fills`, the bounds and the evidence that withdraws or refuses them in :mod:`~.hole_bounds`; this
 module puts them together (:func:`patched_estimate`) and re-exports their names.
 """
@@ -59,8 +63,9 @@ from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES
                          CURVED_MAX_LOOPS as CURVED_MAX_LOOPS, QUADRIC_FIT_RTOL as QUADRIC_FIT_RTOL, CreaseFill,
                          CurvedFill, _crease_contradicted, _crease_rim_contradicts as _crease_rim_contradicts,
                          _may_hold_two_planes as _may_hold_two_planes, _quadric as _quadric,
-                         _ring_faces as _ring_faces, crease_fills, curved_fills, curved_surroundings)
-from .hole_assumptions import named, stated, user_assumed, user_stated
+                         _ring_faces as _ring_faces, crease_fills, curved_fills, curved_surroundings,
+                         PlaneFill, plane_fills)
+from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions, named, stated, user_stated
 from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal
@@ -77,9 +82,15 @@ __all__ = ["patched_estimate", "hole_doubt_volumes", "ball_slab_volume", "crease
 #: small linear programme and a triangulation).
 GRAPH_TRY_SHARE = 1e-3
 
+#: A plane-continuation fill (:func:`~.hole_fills.plane_fills`) that leaves the capsule over its rim but not the
+#: ball is taken, with the hole's doubt widened back to the ball's, only while the holes' doubt stays within this
+#: share of the patched volume: half the ±50 % within which an estimate is reported, so that the wider bound does
+#: not by itself turn an answer into a refusal.
+PLANE_WIDEN_SHARE = 0.25
+
 
 def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[..., Any], *,
-                     seal: Seal | None = None) -> Estimate:
+                     seal: Seal | None = None, assume: UserAssumptions = NOTHING_ASSUMED) -> Estimate:
     """Close each boundary loop by a cone to its centroid and integrate; bound by the balls over the rims.
 
     Assumption (stated in the module docstring): the missing surface of each boundary component lies in the
@@ -103,6 +114,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         ``moments(vertices, faces) -> VolumeMoments`` (the exact integrator, ``volume.volume_moments``).
     seal : Seal, optional
         How ``faces`` were sealed from the input (their slack enters the bound).
+    assume : UserAssumptions
+        The user's assumptions (``LoadOptions.assume``): with ``"flat-islands"``, a hole that is an island in a
+        flat face is filled in its rim's plane (:data:`~.hole_assumptions.FLAT_ISLANDS`).  Default: none
+        (:data:`~.hole_assumptions.NOTHING_ASSUMED`).
 
     Returns
     -------
@@ -140,7 +155,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # unless the user states that such holes lost a flat piece of the face (FLAT_ISLANDS, opt-in): then each
         # is filled in its rim's plane (the cone, in the rim's hull) and bounded by the ball cut to the slab of
         # the rim's own deviation from that plane (flat_island_doubt); read here, nowhere else
-        user_flat = island & evidence.flat_all_round & ("flat-islands" in user_assumed())
+        user_flat = island & evidence.flat_all_round & ("flat-islands" in assume)
         # the convex reading's own evidence: a bare vertex that the faces left turn round by more than π is, if
         # the part is convex, inside its flat face (inner_face_vertices), so it does not take the convex bound away
         inner = inner_face_vertices(v, f, edges, bare)
@@ -169,13 +184,13 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     cone_doubt = hole_doubt.copy()
     curved: list[CurvedFill] = []
 
-    def build(creases: list[CreaseFill], curved: list[CurvedFill], graphs: list[GraphFill] | None = None
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any, np.ndarray]:
+    def build(creases: list[CreaseFill], curved: list[CurvedFill], graphs: list[GraphFill] | None = None,
+              planes: list[PlaneFill] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any, np.ndarray]:
         cap = np.stack([edges[:, 1], edges[:, 0], len(v) + label], axis=1) if n_loops else np.zeros((0, 3), np.int64)
         extra = np.zeros((0, 3))
         tops = apex.copy()
-        lifted: list[CurvedFill | GraphFill] = [*curved, *(graphs or [])]
-        if lifted:            # holes on a quadric (the fan bent onto it) or graphs over a face-on plane
+        lifted: list[CurvedFill | GraphFill | PlaneFill] = [*curved, *(graphs or []), *(planes or [])]
+        if lifted:            # holes on a quadric (the fan bent onto it), graphs over a face-on plane, planes continued
             bent = np.zeros(n_loops, dtype=bool)
             base = len(v) + n_loops + 2 * len(creases)
             fills, at = [], 0
@@ -254,6 +269,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     island_width = np.zeros(n_loops)
     graph_height = np.zeros(n_loops)
     graphs: list[GraphFill] = []
+    planes: list[PlaneFill] = []
     used: set[str] = set()
     before_bend = 0.0
 
@@ -288,6 +304,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                  & (4.0 / 3.0 * np.pi * radius ** 3 <= abs(float(closed.volume))))
         capsule = capsule_volumes(start, end, thick)
         took_capsule = alone & (capsule < hole_doubt)
+        uncapped = hole_doubt.copy()              # each hole's doubt without the capsule (the ball, cut or not)
         hole_doubt = np.where(alone, np.minimum(hole_doubt, capsule), hole_doubt)
         # the bend bound (BEND): the missing surface slopes no more than the faces beside the rim; only where no
         # evidence withdrew the narrower assumptions (a bare rim vertex, a ball holding everything) and the cone
@@ -334,6 +351,37 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             took_bend &= ~took_island
             took_capsule &= ~took_island
             took_planar &= ~took_island
+        # the plane-continuation fill (a better answer on faceted parts; the bound is unchanged): the planes of the
+        # faces round the rim continued across the hole, where they close it inside the region the hole's bound
+        # states (plane_fills checks every point of the fill against it); only on holes bounded by that region
+        # (ball, capsule, slab: not by the bend, graph, planar or island readings, which bound the cone or their
+        # own fill) and whose doubt is not already negligible (the GRAPH_TRY_SHARE cost rule)
+        fillable = (~crossed & ~bent & ~took_graph & ~took_bend & ~took_planar & ~took_island & ~engulfed
+                    & ~user_flat & (hole_doubt > GRAPH_TRY_SHARE * abs(float(closed.volume))))
+        if fillable.any():
+            ranked = np.flatnonzero(fillable)[np.argsort(-hole_doubt[fillable], kind="stable")]
+            sign = 1.0 if bool(np.array_equal(pf[:len(f)], f)) else -1.0
+            no_capsule = np.zeros(n_loops, dtype=bool)
+            planes = plane_fills(v, f, edges, label, ranked, apex, radius,
+                                 _region_check(centre, radius, (start, end, thick), no_capsule, slab), outward=sign)
+            # a fill that leaves the capsule (a corner's three planes meet beyond a thin rim's axis) is kept only
+            # with the hole's doubt back to its ball's, and only while all the doubt stays within PLANE_WIDEN_SHARE
+            # of the volume (a wider bound, never a refusal of its own making); else the hole keeps its fill
+            strict = _region_check(centre, radius, (start, end, thick), alone, slab)
+            kept: list[PlaneFill] = []
+            for plane in planes:
+                points = np.vstack([plane.apex[None, :], plane.points])
+                if not strict(plane.loop, points):
+                    widened = float(np.sum(hole_doubt)) - hole_doubt[plane.loop] + uncapped[plane.loop]
+                    if widened > PLANE_WIDEN_SHARE * abs(float(closed.volume)):
+                        continue
+                    hole_doubt[plane.loop] = uncapped[plane.loop]
+                    alone[plane.loop] = False
+                    took_capsule[plane.loop] = False
+                kept.append(plane)
+            planes = kept
+            if planes:
+                pv, pf, cap, closed, _ = build(creases, curved, graphs, planes)
         took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
                      & ~took_planar & ~took_graph)
         used = {"ball"}
@@ -353,22 +401,29 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     if n_loops and doubt > 0 and not taken:
         # fourth assumption, where what remains is convex: the complete part is too (convex_hole_bound)
         outward = pf[:len(f)]
-        bound = convex_hole_bound(pv, outward, float(closed.volume)) if not (curved or graphs) else None
-        if curved or graphs:
+        bound = convex_hole_bound(pv, outward, float(closed.volume)) if not (curved or graphs or planes) else None
+        if curved or graphs or planes:
             # where what remains is convex the cones stay: the convex bound needs the patch inside the part, as
             # the cones are (in the rims' hulls) and a bent fill need not be
+            # (the fills are swapped for the cones only below, where the convex bound is taken: the doubt of the
+            # readings above bounds their own fills, not the cones)
             cones = build(creases, [])
             bound = convex_hole_bound(cones[0], cones[1][:len(f)], float(cones[3].volume))
-            if bound is not None:
-                curved, graphs = [], []
-                pv, pf, cap, closed, _ = cones
-                far = float(np.max(reach_of(closed.centroid)))
         # the convex bound where it applies and is narrower than the others before the bend bound: a convex part
         # keeps the polytope (a rule fixed before the bend bound came, which tests/test_hole_bounds.py pins)
         if bound is not None and bound[0] < before_bend:
             doubt, corners = bound
+            # under the convex bound any fill outside the cone and inside every given face's plane keeps the patched
+            # solid between the cones' and the polytope (P ⊂ P' ⊂ U), where the bound holds for it too: the planes
+            # continued over every hole not across a crease, whatever the ball-based readings chose above
+            sign = 1.0 if bool(np.array_equal(pf[:len(f)], f)) else -1.0
+            loops = np.flatnonzero(~crossed)[np.argsort(-hole_doubt[~crossed], kind="stable")]
+            planes = _between_cone_and_planes(plane_fills(v, f, edges, label, loops, apex, radius, _anywhere,
+                                                          outward=sign), v, pf[:len(f)])
+            pv, pf, cap, closed, _ = build(creases, [], None, planes)
             far = float(np.max(np.linalg.norm(corners - closed.centroid, axis=1)))
             convex = True
+            curved, graphs = [], []
             used = {"convex"}
             used |= {"inner"} if inside_face else set()
     sealed = ""
@@ -417,6 +472,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             detail += (f"; {int(np.count_nonzero(took_planar))} read as a missing flat face (a rim in one plane, "
                        f"within {round_up(float(planar.half_width[took_planar].max())):.3g} m, meeting the faces "
                        "beside it at a crease), bounded by the ball cut to that slab")
+        if planes:
+            detail += (f"; {len(planes)} filled instead on the planes of the faces round the rim, continued across "
+                       f"it ({max(fill.planes for fill in planes)} planes at most; the same bound)")
         if graphs and not convex:
             detail += (f"; {len(graphs)} filled instead as a graph over the plane most face-on to the faces at the "
                        "rim (a triangulation of the projected rim, lifted), bounded by the steepest of those faces' "
@@ -434,3 +492,55 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                     unbounded=unbounded, assumptions=tuple(a.name for a in named(used))
                     + (("flat-islands",) if took_island.any() else ()),
                     islands=int(np.count_nonzero(island & ~took_island)))
+
+
+def _region_check(centre: np.ndarray, radius: np.ndarray, capsule: tuple[np.ndarray, np.ndarray, np.ndarray],
+                  alone: np.ndarray, slab: tuple[np.ndarray, np.ndarray, np.ndarray]
+                  ) -> Callable[[int, np.ndarray], bool]:
+    """``inside(loop, points)``: whether every point lies in the region a hole's bound states — its ball, the
+    capsule where the hole is read alone (``alone``), and the slab where it is cut to one (finite half-width) —
+    so that a fill made of them leaves the bound as it is (:func:`~.hole_fills.plane_fills`)."""
+    start, end, thick = capsule
+    normal, origin, half = slab
+
+    def inside(k: int, points: np.ndarray) -> bool:
+        if not bool((np.linalg.norm(points - centre[k], axis=1) <= radius[k]).all()):
+            return False
+        if alone[k]:
+            seg = end[k] - start[k]
+            t = np.clip((points - start[k]) @ seg / max(float(seg @ seg), 1e-300), 0.0, 1.0)
+            if not bool((np.linalg.norm(points - (start[k] + t[:, None] * seg), axis=1) <= thick[k]).all()):
+                return False
+        if np.isfinite(half[k]):
+            return bool((np.abs((points - origin[k]) @ normal[k]) <= half[k]).all())
+        return True
+    return inside
+
+
+def _between_cone_and_planes(planes: list[PlaneFill], vertices: np.ndarray, outward: np.ndarray
+                             ) -> list[PlaneFill]:
+    """The plane fills that lie outside their cone (every lift ≥ 0) and inside the plane of every given face
+    (``outward`` (m, 3), wound outward), within 16 ulp of the coordinates: with them the patched solid lies
+    between the cones' and the polytope the planes enclose, as the convex bound (:func:`convex_hole_bound`)
+    needs of it."""
+    if not planes:
+        return []
+    v = vertices
+    margin = _round_off(v)
+    normal = np.cross(v[outward[:, 1]] - v[outward[:, 0]], v[outward[:, 2]] - v[outward[:, 0]])
+    size = np.linalg.norm(normal, axis=1)
+    unit = normal[size > 0] / size[size > 0, None]
+    offset = np.einsum("ij,ij->i", unit, v[outward[size > 0, 0]])
+    kept = []
+    for fill in planes:
+        points = np.vstack([fill.apex[None, :], fill.points])
+        if float(fill.lift.min()) < -margin:
+            continue
+        if all(float((points[lo:lo + 4096] @ unit.T - offset).max()) <= margin for lo in range(0, len(points), 4096)):
+            kept.append(fill)
+    return kept
+
+
+def _anywhere(loop: int, points: np.ndarray) -> bool:
+    """No region to stay in (the convex bound's fills are checked against the polytope instead)."""
+    return True

@@ -28,7 +28,8 @@ if TYPE_CHECKING:
     from .nesting import Nesting
 
 __all__ = ["Coincident", "coincident_surfaces", "signed_multiplicity", "cancel_opposite", "point_ids",
-           "closed_components", "doubled_closed", "container_windings", "winding_around"]
+           "closed_components", "doubled_closed", "container_windings", "winding_around", "face_keys",
+           "shell_multiplicity", "multiplicity_changes"]
 
 
 @frozen_value
@@ -48,6 +49,9 @@ class Coincident:
         Faces of the cancelling pairs (both members).
     where : (3,) float
         A corner of the first surface left out, m (NaN when none).
+    multiplicity : (m,) int
+        For each face kept in place of its repeats, the net multiplicity ``|n|`` of its class (how many times the
+        winding number counts it); 1 for every other face.
     """
 
     drop: np.ndarray
@@ -56,6 +60,7 @@ class Coincident:
     cancelled: int
     cancelled_faces: int
     where: np.ndarray
+    multiplicity: np.ndarray
 
 
 def closed_components(faces: np.ndarray, members: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
@@ -182,7 +187,7 @@ def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarr
     m = len(faces)
     drop = np.zeros(m, dtype=bool)
     none = Coincident(drop=drop, repeated=0, repeated_faces=0, cancelled=0, cancelled_faces=0,
-                      where=np.full(3, np.nan))
+                      where=np.full(3, np.nan), multiplicity=np.ones(m, dtype=np.int64))
     idx = np.flatnonzero(np.ones(m, dtype=bool) if among is None else np.asarray(among, dtype=bool))
     if len(idx) < 8:                       # a closed surface has at least 4 faces, two of them at least 8
         return none
@@ -239,8 +244,12 @@ def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarr
     paired[comp[role]] = True
     cancelled = int(np.count_nonzero(paired & both)) + (int(np.count_nonzero(paired & ~both)) + 1) // 2
     where = np.asarray(vertices, dtype=np.float64)[faces[np.flatnonzero(drop)[0], 0]]
+    multiplicity = np.ones(m, dtype=np.int64)
+    held = kept & touchable[c] & (np.abs(net[c]) > 1)          # a face standing for its repeats (R0: counted |n| times)
+    multiplicity[idx[order[held]]] = np.abs(net[c[held]])
     return Coincident(drop=drop, repeated=repeated, repeated_faces=int(np.count_nonzero(~role)),
-                      cancelled=cancelled, cancelled_faces=int(np.count_nonzero(role)), where=where)
+                      cancelled=cancelled, cancelled_faces=int(np.count_nonzero(role)), where=where,
+                      multiplicity=multiplicity)
 
 
 def container_windings(file_volumes: np.ndarray, nest: Nesting | None,
@@ -278,3 +287,83 @@ def winding_around(file_volumes: np.ndarray, nest: Nesting | None, within: np.nd
     np.add.at(around, shell, winding)
     return around
 
+
+
+def face_keys(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(m, 9) float: each face's three corners' coordinates, the corners in lexicographic order (the same for a
+    face and its reverse, and for a copy with its own vertex indices): what identifies a face listed again."""
+    corners = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64).reshape(-1, 3)]
+    order = np.lexsort((corners[:, :, 2], corners[:, :, 1], corners[:, :, 0]), axis=1)
+    return np.take_along_axis(corners, order[:, :, None], axis=1).reshape(-1, 9)
+
+
+def shell_multiplicity(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, n_shells: int,
+                       repeated: tuple[np.ndarray, np.ndarray] | None) -> np.ndarray | None:
+    """(s,) int: how many times R0 found each shell listed, or None when every shell counts once.
+
+    ``repeated``: ``(keys (r, 9) float, count (r,) int)``, the faces R0 kept in place of their repeats
+    (:func:`face_keys`) and their net multiplicity.  A shell counts ``k`` times when every one of its faces is such
+    a face with count ``k``; a stage after R0 that changed a shell's faces (an arrangement) leaves it counted once.
+    When every shell counts the same ``k`` times (a part exported twice) the winding number is ``k`` times the
+    winding counted once and ``{k·w ≥ 1} = {w ≥ 1}``: None."""
+    if repeated is None or not len(repeated[0]) or n_shells == 0:
+        return None
+    keys, count = repeated
+    mine = face_keys(vertices, faces)
+    both = np.concatenate([np.asarray(keys, dtype=np.float64).reshape(-1, 9), mine])
+    _, inverse = np.unique(both, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    table = np.zeros(int(inverse.max()) + 1, dtype=np.int64)
+    np.maximum.at(table, inverse[:len(keys)], np.asarray(count, dtype=np.int64))     # a key twice: the larger
+    per_face = np.maximum(table[inverse[len(keys):]], 1)
+    lab = np.asarray(labels, dtype=np.int64)
+    lowest = np.full(n_shells, np.iinfo(np.int64).max, dtype=np.int64)
+    highest = np.zeros(n_shells, dtype=np.int64)
+    np.minimum.at(lowest, lab, per_face)
+    np.maximum.at(highest, lab, per_face)
+    k = np.where(lowest == highest, lowest, 1)
+    k[lowest == np.iinfo(np.int64).max] = 1
+    if np.all(k == k[0]):
+        return None
+    return k
+
+
+def multiplicity_changes(multiplicity: np.ndarray, oriented: np.ndarray, shell: np.ndarray, other: np.ndarray,
+                         winding: np.ndarray, crossing_with: np.ndarray) -> bool:
+    """R0: may counting each shell ``multiplicity`` times give another ``{w ≥ 1}`` than counting it once?
+
+    The two windings differ only inside shells listed more than once.  For each such shell and each shell inside
+    one, ``X``: when ``X`` crosses no shell, the winding number just inside it (off the shells inside it) is
+    ``σ_X + Σ_C w_C`` counted once and ``k_X σ_X + Σ_C k_C w_C`` counted with multiplicity, over the shells ``C``
+    around it (``w_C`` their winding at its probe point, ``σ_X`` its own orientation); every region inside such a
+    shell is just inside one ``X``, so the solids agree when those two sums agree on ``≥ 1`` for every ``X``
+    (the empty region inside a shell filled by others is compared too: the answer errs toward True).  A shell in
+    the count that crosses another makes the answer True (not decided here).
+
+    Parameters
+    ----------
+    multiplicity : (s,) int
+    oriented : (s,) int
+        +1 or −1: each shell's orientation as read (outward or inward).
+    shell, other, winding : (j,) int
+        Each shell found inside another, and the winding number of that container at its probe point as read
+        (:func:`container_windings`, turned where the container was turned).
+    crossing_with : (k, 2) int
+        Pairs of shells whose surfaces cross.
+    """
+    k = np.asarray(multiplicity, dtype=np.int64)
+    if not np.any(k > 1) or np.all(k == k[0]):
+        return False
+    many = k > 1
+    inside_many = np.zeros(len(k), dtype=bool)
+    inside_many[shell[many[other]]] = True
+    look = many | inside_many
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    if len(pairs) and look[pairs.reshape(-1)].any():
+        return True
+    sigma = np.asarray(oriented, dtype=np.int64)
+    once = sigma.copy()
+    counted = k * sigma
+    np.add.at(once, shell, winding)
+    np.add.at(counted, shell, k[other] * winding)
+    return bool(np.any((once[look] >= 1) != (counted[look] >= 1)))

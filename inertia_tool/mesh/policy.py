@@ -7,19 +7,26 @@ the surface bounds it exactly once).
 
 Rules
 -----
-R0 *A shell listed twice is one solid* (:func:`~.multiplicity.coincident_surfaces`).  Coincident copies combine by their
-   windings first: the faces on the same three points (the same float64 coordinates, bit for bit; with the same vertex
-   indices or their own) are counted with sign, +1 one way round and −1 the other
-   (:func:`~.multiplicity.signed_multiplicity`; a repeat adds, a reverse cancels), and only then decided: a net 0 leaves
-   the face out, a net ±k keeps one face wound by its sign.  A face and its reverse are the zero chain (their terms
-   cancel exactly in every surface integral and in the winding number), so cancelling changes nothing; a net ±2 or more
-   counted once is the rule's policy (a closed surface that repeats another corner for corner is counted once, with a
-   note naming how many faces were left out).  A closed surface listed together with its exact inverted copy has winding
-   number 0 everywhere: the pair is left out (a mesh that is nothing else is refused with that reason); a void listed
-   twice with its inverted copy keeps one void (net −1; dropping the repeat first lost both).  Only whole closed
-   surfaces go.  The arrangements take out face pairs by the same count (:func:`~.multiplicity.cancel_opposite`).
-   Reason: a shell exported twice means the part once; summed, its volume counts twice, and united it only shows as a
-   false overlap.
+R0 *A shell listed k times counts k times in the winding number* (:func:`~.multiplicity.coincident_surfaces`).
+   Coincident copies combine by their windings first: the faces on the same three points (the same float64
+   coordinates, bit for bit; with the same vertex indices or their own) are counted with sign, +1 one way round and −1
+   the other (:func:`~.multiplicity.signed_multiplicity`; a repeat adds, a reverse cancels), and only then decided: a
+   net 0 leaves the face out, a net ±k keeps one face wound by its sign, standing for k (a note names how many faces
+   were left out).  A face and its reverse are the zero chain (their terms cancel exactly in every surface integral
+   and in the winding number), so cancelling changes nothing.  A closed surface listed together with its exact
+   inverted copy has winding number 0 everywhere: the pair is left out (a mesh that is nothing else is refused with
+   that reason); a void listed twice with its inverted copy keeps one void (net −1; dropping the repeat first lost
+   both).  Only whole closed surfaces go.  The arrangements take out face pairs by the same count
+   (:func:`~.multiplicity.cancel_opposite`).  The solid is ``{w ≥ 1}`` of the winding number *with* each shell's
+   count (session 15, the team's decision on issue 21): a part exported twice has winding ``2w`` and
+   ``{2w ≥ 1} = {w ≥ 1}``, so wherever every shell is listed alike (:func:`~.multiplicity.shell_multiplicity`), or
+   counting a shell k times changes no region's side of 1 (:func:`~.multiplicity.multiplicity_changes`: checked
+   inside every shell listed more than once), the copy left out is the whole answer and nothing else changes.
+   Where the count does change ``{w ≥ 1}`` (a box listed twice flush inside a void: ``1 − 1 + 1`` in the file, 0
+   counted once; a body listed twice around a cavity listed once) the solid is formed by R4c, each piece counted k
+   times (:func:`~.union.winding_solid`), and refused when R4 turned a shell for its nesting depth (no one reading
+   then counts both).  Reason: a shell exported twice means the part once, and summed its volume would count twice;
+   the winding number is what the issue defines the solid by, and counting the copy keeps it where it decides.
    *Up to rounding* (:func:`near_copies`): a closed surface whose every corner lies within
    ``tolerances.COINCIDENT_RTOL`` of the largest |coordinate| of a corner of another, face for face with the same
    winding (a copy whose coordinates were computed apart), is counted once too, when the bound on what it could
@@ -130,7 +137,14 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    too, no misread).  The parity reading is kept, a warning names the other one and its volume, and the
    certificate is never ``united`` for it (:func:`~.certify.misread_reading`): ``exact`` when the turned surface
    has no crossing face pair (the parity solid proven), otherwise an estimate whose bounds span both readings;
-   ``unverified`` when inward shells cross outward ones as well (both readings rest on that unproven cut).
+   ``unverified`` when inward shells cross outward ones as well (both readings rest on that unproven cut).  The
+   other way round, a shell the file winds inward inside a cavity (a void inside a void, even depth ≥ 2) that depth
+   makes an island (:func:`misread_voids`: the file's winding there is −1, not material) is the same kind of reading
+   and labelled the same way, its note naming the file's winding reading and the mass it gives (one note for both,
+   :func:`misread_message`; session 14's N8).  A misread reading that rests on a shell R4 turned (an inward shell
+   holding outward shells that cross or lie inside it: both readings make it a body, the file's winding a void;
+   session 14's N5) is not given: the file's winding is read as it stands (R4c), refused where it leaves inward
+   shells outside every body, with ``repair`` too (:func:`turned_reading_refusal`).
    Shells that touch without a crossing face pair are never placed by one probe point: their surfaces can still
    cross exactly along edges and vertices of both meshes (CAD tessellations sharing the intersection curve), so
    the points of each near the contact and a sample of its vertices decide (:func:`touching_relations`): points
@@ -215,8 +229,8 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "negligible_flat", "inward_crossing_outward", "within_up_to_rounding", "nested_copies",
            "rounding_volumes", "coincident_message", "TouchRelations", "touching_relations", "self_crossing_message",
            "shell_contacts", "ShellContacts", "weakest", "near_copies", "NearCopies", "near_copies_message",
-           "MisreadNesting", "misread_nesting", "outward_crossing_groups", "misread_message", "point_text",
-           "part_size"]
+           "MisreadNesting", "misread_nesting", "misread_voids", "outward_crossing_groups", "misread_message",
+           "point_text", "part_size", "turned_reading_refusal"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -269,10 +283,14 @@ class Certificate:
         One of :data:`CERTIFICATE_KINDS`.
     checks : tuple of str
         The checks that ran and passed (keys of :data:`CHECKS`).
+    assumptions : tuple of str
+        The user's assumptions (``assume``, :data:`~.hole_assumptions.USER_ASSUMPTIONS`) the result rests on:
+        those a repair took (a hole filled under one), empty when none was taken (or none stated).
     """
 
     kind: str
     checks: tuple[str, ...] = ()
+    assumptions: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.kind not in CERTIFICATE_KINDS:
@@ -280,6 +298,9 @@ class Certificate:
         unknown = [c for c in self.checks if c not in CHECKS]
         if unknown:
             raise ValueError(f"Expected checks among {tuple(CHECKS)}, got {unknown}")
+        if self.assumptions:
+            from .hole_assumptions import user_named
+            user_named(self.assumptions)          # ValueError naming the known ones
 
     @property
     def proven(self) -> bool:
@@ -287,10 +308,16 @@ class Certificate:
         return self.kind in ("exact", "united")
 
     def describe(self) -> str:
-        """One line: the kind and the checks, for text and HTML reports."""
-        if not self.checks:
-            return self.kind
-        return f"{self.kind} ({', '.join(self.checks)})"
+        """One line: the kind, the checks and the user's assumptions taken, for text and HTML reports."""
+        said = self.kind if not self.checks else f"{self.kind} ({', '.join(self.checks)})"
+        return said + self._assuming()
+
+    def brief(self) -> str:
+        """The kind and the user's assumptions taken, for a table cell (a part of an assembly)."""
+        return self.kind + self._assuming()
+
+    def _assuming(self) -> str:
+        return f", assuming {', '.join(self.assumptions)}" if self.assumptions else ""
 
 
 @frozen_value
@@ -798,6 +825,10 @@ class MisreadNesting:
     kept : str
         The reading given: ``"parity"`` (the shells read as cavities, :func:`misread_nesting`), or ``"union"``
         for a group of crossing shells that keep the file's winding (:func:`outward_crossing_groups`).
+    inward : bool
+        The shells are wound inward in the file and lie inside a cavity (a void inside a void, even depth), and
+        nesting depth read them as bodies (:func:`misread_voids`): the file's winding reads them as empty, so the
+        parity solid holds ``volume`` *more* material than ``{w ≥ 1}``, not less.
     """
 
     shells: np.ndarray
@@ -805,6 +836,7 @@ class MisreadNesting:
     nested: bool
     reach: float = 0.0
     kept: str = "parity"
+    inward: bool = False
 
 
 def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray, nest: Nesting | None,
@@ -844,6 +876,39 @@ def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarra
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=bool(inside[shells].any()))
 
 
+def misread_voids(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray, nest: Nesting | None,
+                  within: np.ndarray | None) -> MisreadNesting | None:
+    """R4: the shells the file winds inward that nesting depth made bodies inside a cavity (even depth ≥ 2,
+    flipped: a void inside a void read as an island), or None.
+
+    The file's own winding inside such a shell is its −1 plus the shells around it, 0 for a body and its cavity
+    wound as their depth says: −1, so ``{w ≥ 1}`` leaves it empty, while an island written with the wrong winding
+    reads as R4 reads it (session 14's N8).  The same two readings as :func:`misread_nesting`, the other way
+    round, named by the same note (:func:`misread_message`).  Only where the file's winding around it is at most 1
+    (inside it ≤ 0: the file reads it as empty) and no shell around it was turned: a nest written inside out as a
+    whole (every shell against its depth) is one reading, R4's, as for an outward shell whose containers are wound
+    inward.  Parameters as for :func:`misread_nesting`."""
+    vols = np.asarray(file_volumes, dtype=np.float64)
+    flip = np.asarray(flip, dtype=bool)
+    d = np.asarray(depth)
+    void = (vols < 0) & flip & (d % 2 == 0) & (d >= 2)
+    if not void.any():
+        return None
+    from .multiplicity import container_windings
+    shell, other, _ = container_windings(vols, nest, within)
+    void &= winding_around(vols, nest, within) <= 1
+    turned_around = np.zeros(len(vols), dtype=bool)
+    turned_around[shell[flip[other]]] = True
+    void &= ~turned_around
+    if not void.any():
+        return None
+    inside = np.zeros(len(vols), dtype=bool)
+    inside[other[void[other] & (shell != other)]] = True
+    shells = np.flatnonzero(void)
+    return MisreadNesting(shells=shells, volume=float(np.sum(-vols[shells])), nested=bool(inside[shells].any()),
+                          inward=True)
+
+
 def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray,
                             crossing_with: np.ndarray) -> MisreadNesting | None:
     """R4: groups of shells that cross one another, all wound outward in the file and kept so (bodies by the
@@ -875,16 +940,32 @@ def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: n
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=True, kept="union")
 
 
+def turned_reading_refusal(source: str) -> str:
+    """R4's refusal, one line, where a misread reading rests on a shell R4 turned (an inward shell holding shells
+    wound outward: session 14's N5) and the file's winding, read as it stands (R4c), leaves inward shells outside
+    every body.  Neither reading R4 could name is the file's winding, and an estimate of the surface turned as a
+    whole is neither: refused with ``repair`` too."""
+    return (f"{source}: shells wound outward lie inside a shell wound inward and outside every body: read by nesting "
+            "depth (the outer shell a body written inside out) they are its cavities or bodies united with it, "
+            "read by the file's winding the outer shell is a void and they are material only where they overlap; "
+            "the file does not say which it means: wind the outer shell outward if it is a body, or the inner "
+            "ones inward if they are its cavities")
+
+
 def misread_message(found: MisreadNesting, parity_volume: float | None, proven: bool, kept: str | None = None) -> str:
     """R4's note for :class:`MisreadNesting`: the reading kept, the other one and its volume (``kept``: what is
-    proven of the reading kept, when not the default sentence for ``proven``; "" for nothing).
+    proven of the reading kept, when not the default sentence for ``proven``; "" for nothing).  One note for both
+    ways a shell can be against its depth: wound outward inside a body (read as a cavity; the file's winding holds
+    more material) and wound inward inside a cavity (``found.inward``: read as a body; the file's winding holds
+    less, the shell being empty there), so that each names the file's winding reading and the mass it gives.
 
     ``parity_volume``: m³, the parity solid's volume, when the result given is that solid; None when it is not
     known to be (a result the boolean left ``unverified``): the other reading is then stated against the parity
     solid, never as a total computed from a result that may be another solid (review 10: "the union of the
     bodies: 5.36e8 m³" for a union of 1.787e8, the result being the two copies summed)."""
     n = len(found.shells)
-    them = "them" if n > 1 else "it"
+    many = n > 1
+    them = "them" if many else "it"
     if found.kept == "union":
         return (f"{n} shells wound outward that cross one another lie wholly inside another body: read by the "
                 f"file's winding as bodies and united with it; by nesting depth they would be one cavity (a "
@@ -892,24 +973,37 @@ def misread_message(found: MisreadNesting, parity_volume: float | None, proven: 
                 "m³ less material. The file does not decide: an estimate whose bounds span both readings. If they "
                 "are bodies, unite them with the body around them in the model; if a cavity, keep one copy wound "
                 "inward")
-    if parity_volume is None:
-        other = (f"at most {round_up(found.volume):.6g} m³ more than the parity solid" if found.nested else
-                 f"{found.volume:.6g} m³ more than the parity solid")
+    if found.inward:      # a void inside a void read as an island: the file's winding is −1 there
+        wound, around, role, done = "inward", "a cavity (a void inside a void, ", ("bodies" if many else "a body"), \
+            "added"
+        reading = (f"the file's own winding reads {them} as empty (winding −1 there), the solid where the winding "
+                   "number is at least one")
+        more, sign = "less", -1.0
+        advice = (f"If {'they are islands' if many else 'it is an island'}, wind {them} outward; if a void inside "
+                  f"the cavity, leave {them} out (it removes nothing)")
     else:
-        other = (f"at most {round_up(found.volume):.6g} m³ more" if found.nested else
-                 f"{parity_volume + found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % more mass")
+        wound, around, role, done = "outward", "another body (", ("cavities" if many else "cavity"), "taken out"
+        reading = f"the file's own winding reads {them} as part of the body, the union of the bodies"
+        more, sign = "more", 1.0
+        advice = (f"If {'they are bodies' if many else 'it is a body'}, unite {them} with the body around {them} in "
+                  f"the model; if a cavity, wind {them} inward")
+    if parity_volume is None:
+        other = (f"at most {round_up(found.volume):.6g} m³ {more} than the parity solid" if found.nested else
+                 f"{found.volume:.6g} m³ {more} than the parity solid")
+    else:
+        other = (f"at most {round_up(found.volume):.6g} m³ {more}" if found.nested else
+                 f"{parity_volume + sign * found.volume:.6g} m³, {100 * found.volume / parity_volume:.3g} % {more} "
+                 "mass")
     if kept is None:
         kept = ("the parity solid is proven (exact)" if proven else
-                "the parity solid is not proven apart from that reading (its faces meet the body's only to "
-                "rounding): an estimate whose bounds span both readings")
+                f"the parity solid is not proven apart from that reading (its faces meet the "
+                f"{'cavity' if found.inward else 'body'}'s only to rounding): an estimate whose bounds span both "
+                "readings")
     decide = f"The file does not decide; {kept}." if kept else "The file does not decide."
-    return (f"{n} shell{'s' if n > 1 else ''} wound outward lie{'' if n > 1 else 's'} wholly inside another body "
-            f"(free inside it or flush with its boundary): read by nesting depth as cavit{'ies' if n > 1 else 'y'} "
-            f"(R4; a cavity written with the wrong winding reads the same), {found.volume:.6g} m³ taken "
-            f"out; the file's own winding reads {them} as part of the body, the union of the bodies: {other}. "
-            f"{decide} If {'they are bodies' if n > 1 else 'it is a body'}, unite "
-            f"{them} with the body around {them} in the model; if a cavity, wind {them} inward")
-
+    return (f"{n} shell{'s' if many else ''} wound {wound} lie{'' if many else 's'} wholly inside {around}free "
+            f"inside it or flush with its boundary): read by nesting depth as {role} (R4; "
+            f"{'an island' if found.inward else 'a cavity'} written with the wrong winding reads the same), "
+            f"{found.volume:.6g} m³ {done}; {reading}: {other}. {decide} {advice}")
 
 
 def coincident_message(found: Coincident, size: float = 0.0) -> str:

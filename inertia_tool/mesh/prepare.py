@@ -31,12 +31,14 @@ from ..values import frozen_value
 from .certify import certify, first_checks, misread_reading, with_weld_doubt
 from .checks import MeshReport
 from .classify import orient_shells
+from .hole_assumptions import NOTHING_ASSUMED, USER_ASSUMPTIONS, UserAssumptions
 from .policy import Certificate
 from .read import RawMesh
 from .resolve import Resolution
+from .uncertainty import Estimate
 from .self_crossing import with_patch_doubt, settle_self_crossing
 from .settle import find_contacts
-from .shells import find_shells
+from .shells import counted, find_shells
 from .surface import close_surface
 from .unite import NOTHING_LEFT, unite_overlaps
 from .welded import settle_welded
@@ -76,7 +78,8 @@ class PreparedMesh:
 
 
 def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float = MERGE_TOLERANCE,
-                 overlap: str = "union", self_crossing: str = "refuse") -> PreparedMesh:
+                 overlap: str = "union", self_crossing: str = "refuse",
+                 assume: UserAssumptions = NOTHING_ASSUMED) -> PreparedMesh:
     """Check a raw mesh and classify its shells (see the module docstring for the stages).
 
     Parameters
@@ -96,6 +99,10 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
         A shell that passes through itself (rule R3): refused (default; with ``repair`` estimated), or, for
         meshes made by a boolean whose output crosses itself by rounding (spin-it's hollowed parts),
         integrated as it stands and certified ``unverified`` with a note counting the crossing face pairs.
+    assume : UserAssumptions
+        The user's assumptions about the holes a repair fills (only with ``repair``; ``LoadOptions.assume``),
+        passed to :func:`~.holes.patched_estimate`.  Those the result rests on are named in its certificate
+        (:attr:`~.policy.Certificate.assumptions`).  Default: none.
 
     Returns
     -------
@@ -105,13 +112,20 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     ------
     InvalidMeshError
         Not a solid (and ``repair`` is off), flat, or beyond float64's safe range.
+    UsageError
+        ``assume`` not a :class:`~.hole_assumptions.UserAssumptions`, or stated without ``repair``.
     """
     if overlap not in OVERLAP_MODES:
         raise UsageError(f"Expected `overlap` to be one of {', '.join(OVERLAP_MODES)}, got {overlap!r}")
     if self_crossing not in ("refuse", "unverified"):
         raise UsageError(f"Expected `self_crossing` to be 'refuse' or 'unverified', got {self_crossing!r}")
+    if not isinstance(assume, UserAssumptions):
+        raise UsageError(f"Expected `assume` to be a UserAssumptions, got {assume!r}")
+    if assume and not repair:
+        raise UsageError(f"`assume` ({', '.join(assume.names)}) is an assumption about the holes a repair fills: "
+                         "expected it with `repair=True`")
     source = raw.source
-    surface = close_surface(raw, repair=repair, merge_tolerance=merge_tolerance)
+    surface = close_surface(raw, repair=repair, merge_tolerance=merge_tolerance, assume=assume)
     found, diag = surface.found, surface.diag
     common: dict[str, Any] = dict(source=source, units=raw.units, file_faces=raw.file_faces,
                                   degenerate_faces=surface.degenerate, watertight=surface.watertight,
@@ -119,7 +133,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                   nonmanifold_edges=found.nonmanifold_edges)
     patched = found.estimate if found.estimate is not None and found.estimate.method == "patched" else None
     if found.estimate is not None and patched is None:
-        return _estimated(found, common)
+        return _estimated(found, common, None)
     # a patched surface is closed: its shells are classified and overlaps united like any other, and the bounds of
     # the patches carry over to the result
     split_welded = bool(found.nonmanifold_edges) and patched is None
@@ -131,7 +145,7 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     weld = surface.found.weld          # what the tolerance weld moved: a forced estimate's doubt too (R4)
     if welded.forced is not None:      # on a patched surface the patches' doubt is added (as R3's forced estimate)
         forced = welded.forced if patched is None else with_patch_doubt(welded.forced, patched, source)
-        return _estimated(with_weld_doubt(forced, weld, source), common)
+        return _estimated(with_weld_doubt(forced, weld, source), common, patched)
     met = find_contacts(welded.shells, welded=welded.welded, patched=patched is not None,
                         split_welded=split_welded, n_read=len(raw.vertices), diag=diag, source=source)   # R3a
     if patched is not None:
@@ -140,8 +154,9 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                                    overlap=overlap, repair=repair, patched=patched, diag=diag, source=source,
                                    region=welded.region)                                                    # R3
     if crossed.forced is not None:
-        return _estimated(with_weld_doubt(crossed.forced, weld, source), common)
-    oriented = orient_shells(crossed.shells, crossed.contacts, crossed.touch, source=source)           # R4
+        return _estimated(with_weld_doubt(crossed.forced, weld, source), common, patched)
+    oriented = orient_shells(crossed.shells, crossed.contacts, crossed.touch, source=source,
+                             multiplicity=counted(crossed.shells, surface.repeated, first.repeated))        # R4, R0
     kind, checks = first_checks(oriented.touch, crossed.unverified)
     resolved_edges = found.nonmanifold_edges if met.folds is None and welded.arranged is None else None
     united = unite_overlaps(oriented, crossed.contacts, nonmanifold_edges=resolved_edges, method=found.method,
@@ -149,7 +164,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                             source=source)                                                     # R5, R6
     if united.forced is not None:
         forced = united.forced if patched is None else with_patch_doubt(united.forced, patched, source)
-        return _estimated(with_weld_doubt(forced, weld, source), {**common, "overlapping_shells": united.overlaps})
+        return _estimated(with_weld_doubt(forced, weld, source), {**common, "overlapping_shells": united.overlaps},
+                          patched)
     united, spread = misread_reading(oriented, united, method=found.method, source=source)     # R4's label
     shells = united.shells
     if not sum(s.volume for s in shells.moments) > 0:        # bodies and cavities cancel: no solid to certify
@@ -171,13 +187,22 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                         overlapping_shells=united.overlaps, repaired=patched is not None,
                         repair_actions=notes if patched is not None else (), repair_volume_change=None,
                         bbox_min=bbox_min, bbox_max=bbox_max, method=certified.method,
-                        uncertainty=certified.uncertainty, notes=notes, certificate=certified.certificate, **common)
+                        uncertainty=certified.uncertainty, notes=notes,
+                        certificate=_with_users(certified.certificate, patched), **common)
     return PreparedMesh(vertices=v, faces=f, labels=shells.labels, shells=tuple(shells.moments), owner=united.owner,
                         report=report)
 
 
-def _estimated(found: Resolution, common: dict[str, Any]) -> PreparedMesh:
-    """A PreparedMesh holding one estimated solid (``repair=True``)."""
+def _with_users(certificate: Certificate, patched: Estimate | None) -> Certificate:
+    """``certificate`` naming the user's assumptions the patched surface ``patched`` took (unchanged without)."""
+    users = {a.name for a in USER_ASSUMPTIONS}
+    taken = tuple(name for name in patched.assumptions if name in users) if patched is not None else ()
+    return dataclasses.replace(certificate, assumptions=taken) if taken else certificate
+
+
+def _estimated(found: Resolution, common: dict[str, Any], patched: Estimate | None) -> PreparedMesh:
+    """A PreparedMesh holding one estimated solid (``repair=True``); ``patched``: the patched surface it was
+    formed from, if any (the user's assumptions it took carry over)."""
     est = found.estimate
     if est is None:
         raise InternalInvariantError("an estimated resolution was expected to carry its estimate; found none "
@@ -186,7 +211,8 @@ def _estimated(found: Resolution, common: dict[str, Any]) -> PreparedMesh:
                             area=est.area)
     lo, hi = bounding_box(found.vertices)
     common = {"overlapping_shells": 0, **common}
-    report = MeshReport(certificate=Certificate("estimate"), vertices=len(found.vertices), faces=len(found.faces),
+    taken = _with_users(Certificate("estimate"), patched if patched is not None else est)
+    report = MeshReport(certificate=taken, vertices=len(found.vertices), faces=len(found.faces),
                         zero_area_faces=0, bodies=1,
                         cavities=0, flipped_shells=0, repaired=True, repair_actions=found.notes,
                         repair_volume_change=None, bbox_min=lo, bbox_max=hi, method=est.method,

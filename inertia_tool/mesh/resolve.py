@@ -37,7 +37,7 @@ from ..values import frozen_value
 from ..errors import InvalidMeshError, WorkBudgetError
 from ..tolerances import SEAM_GAP_RTOL, SOUP_BOUNDARY_SHARE
 from ..rounding import round_up
-from .hole_assumptions import ISLAND_HINT
+from .hole_assumptions import ISLAND_HINT, NOTHING_ASSUMED, UserAssumptions
 
 if TYPE_CHECKING:
     from .precision import WeldSweep
@@ -246,7 +246,8 @@ def _touching_note(census: EdgeBalance) -> tuple[str, ...]:
 
 def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, source: str, repair: bool,
                     merge_tolerance: float, moments: Callable[..., Any], force_estimate: bool = False,
-                    reason: str | None = None, added_doubt: float = 0.0) -> Resolution:
+                    reason: str | None = None, added_doubt: float = 0.0,
+                    assume: UserAssumptions = NOTHING_ASSUMED) -> Resolution:
     """Read a surface that failed the manifold check as a solid (exact), as an estimate (repair), or refuse.
 
     Parameters
@@ -273,6 +274,9 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
     added_doubt : float
         m³ the caller will add to a forced estimate's volume in doubt (a patched surface's holes): the grid is
         not refined when that alone would refuse every estimate (:func:`~.grid_estimate.refusal_proven`).
+    assume : UserAssumptions
+        The user's assumptions about the holes a repair fills, for :func:`~.holes.patched_estimate` (the forced
+        winding-number estimate assumes nothing of them).
 
     Returns
     -------
@@ -400,7 +404,7 @@ def resolve_surface(vertices: np.ndarray, faces: np.ndarray, *, diag: float, sou
         if census.balanced:
             return Resolution(v, unique, "deduplicated", tuple(repair_notes) + _touching_note(census), flipped, welded,
                               census.nonmanifold_edges, weld=sweep)
-    best, front_nonmanifold = _repaired_estimate(v, unique, found, diag=diag, moments=moments)
+    best, front_nonmanifold = _repaired_estimate(v, unique, found, diag=diag, moments=moments, assume=assume)
     if len(turned_tris):
         best = _with_turned_doubt(best, turned_tris)
     if sweep is not None and not (best.method == "patched" and best.uncertainty.volume_in_doubt == 0):
@@ -474,9 +478,11 @@ def _fin_hint(found: OpenSheets | None) -> str:
 
 def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, *, diag: float,
                        moments: Callable[..., Any], seam_gap_rtol: float = SEAM_GAP_RTOL,
-                       soup_share: float = SOUP_BOUNDARY_SHARE) -> tuple[Estimate, int]:
+                       soup_share: float = SOUP_BOUNDARY_SHARE,
+                       assume: UserAssumptions = NOTHING_ASSUMED) -> tuple[Estimate, int]:
     """The estimate :data:`REPAIR_RULE` picks, decided from the surface before anything costly is computed, and
-    the non-manifold edges of the surface it integrates (``found`` is the census of ``faces``)."""
+    the non-manifold edges of the surface it integrates (``found`` is the census of ``faces``; ``assume``: the
+    user's assumptions, for :func:`~.holes.patched_estimate`)."""
     from .edges import edge_keys
     from .holes import patched_estimate
     from .seal import seal_seams
@@ -485,7 +491,7 @@ def _repaired_estimate(vertices: np.ndarray, faces: np.ndarray, found: _Census, 
         from .grid_estimate import winding_estimate           # (the grid's module only for the grid)
 
         return winding_estimate(vertices, faces), found.balance.nonmanifold_edges
-    best = patched_estimate(vertices, seal.faces, moments, seal=seal)
+    best = patched_estimate(vertices, seal.faces, moments, seal=seal, assume=assume)
     # edges away from the frontier keep their count; the frontier's and the cones' are counted here
     n = len(vertices)
     region = np.zeros(n, dtype=bool)

@@ -17,13 +17,13 @@ from ..errors import InsideOutWarning, InvalidMeshError, MeshResolvedWarning
 from ..integrals import RoundoffBound, VolumeMoments, accurate_shells, body_volume_moments
 from ..tolerances import FLAT_RTOL
 from .checks import shell_labels
-from .multiplicity import coincident_surfaces
+from .multiplicity import coincident_surfaces, face_keys, shell_multiplicity
 from .nonmanifold import welded_bodies
 from .policy import (coincident_message, copy_candidates, near_copies, near_copies_message, negligible_flat,
                      part_size)
 
 __all__ = ["Shells", "FoundShells", "find_shells", "bodies", "measured", "reshelled", "drop_flat", "flat_pieces",
-           "apply_flips", "leave_out_coincident", "total"]
+           "apply_flips", "leave_out_coincident", "total", "counted"]
 
 
 class Shells(NamedTuple):
@@ -61,11 +61,15 @@ class FoundShells(NamedTuple):
         R0's notes (shells listed twice, or twice up to rounding), each warned.
     dropped : str or None
         R2's note (closed shells enclosing no volume left out), warned.
+    repeated : (keys, counts) or None
+        The faces R0 kept in place of their repeats (:func:`~.multiplicity.face_keys`) and how many times each
+        counts in the winding number (:func:`~.multiplicity.shell_multiplicity` reads it).
     """
 
     shells: Shells
     coincident: tuple[str, ...]
     dropped: str | None
+    repeated: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def find_shells(vertices: np.ndarray, faces: np.ndarray, *, split_welded: bool, known: tuple[np.ndarray, int] | None,
@@ -100,8 +104,9 @@ def find_shells(vertices: np.ndarray, faces: np.ndarray, *, split_welded: bool, 
     moments = body_volume_moments(v, f, labels, n_shells, origin=centre)
     notes: list[str] = []
     twins = _twin_candidates(moments, labels)
+    repeated = None
     if twins is not None:                     # R0: a shell listed twice with its own vertices
-        f, note = leave_out_coincident(v, f, twins, source, labels)
+        f, note, repeated = leave_out_coincident(v, f, twins, source, labels)
         if note is not None:
             notes.append(note)
             labels, n_shells = bodies(v, f, split_welded)
@@ -115,7 +120,7 @@ def find_shells(vertices: np.ndarray, faces: np.ndarray, *, split_welded: bool, 
             moments = body_volume_moments(v, f, labels, n_shells, origin=centre)
     moments, bound = accurate(v, f, labels, moments, centre)    # R7: signs and moments within the round-off bound
     shells, dropped = drop_flat(Shells(v, f, labels, n_shells, moments, bound), diag, source, stacklevel=5)   # R2
-    return FoundShells(shells, tuple(notes), dropped)
+    return FoundShells(shells, tuple(notes), dropped, repeated)
 
 
 def bodies(v: np.ndarray, f: np.ndarray, split_welded: bool,
@@ -167,13 +172,16 @@ def _twin_candidates(shells: Sequence[VolumeMoments], labels: np.ndarray) -> np.
 
 
 def leave_out_coincident(v: np.ndarray, f: np.ndarray, among: np.ndarray | None, source: str,
-                         labels: np.ndarray | None = None) -> tuple[np.ndarray, str | None]:
+                         labels: np.ndarray | None = None
+                         ) -> tuple[np.ndarray, str | None, tuple[np.ndarray, np.ndarray] | None]:
     """R0: the faces without the later copy of each shell listed twice and without shells cancelled by their exact
     inverted copy, with the note (warned); refused when nothing is left.  Called by a stage of
-    :func:`~.prepare.prepare_mesh` (the warning names the latter's caller's caller)."""
+    :func:`~.prepare.prepare_mesh` (the warning names the latter's caller's caller).  The third item: the faces
+    kept in place of repeats that count more than once in the winding number, as ``(face_keys (r, 9), counts
+    (r,))``, or None (R0 counts a shell listed ``k`` times ``k`` times: :func:`~.multiplicity.shell_multiplicity`)."""
     found = coincident_surfaces(v, f, among, labels)
     if not found.drop.any():
-        return f, None
+        return f, None, None
     if found.drop.all():
         raise InvalidMeshError(f"{source}: the mesh is a closed surface listed together with its exact inverted copy "
                                f"({len(f) // 2:,} faces each, same corners, opposite winding): they cancel to "
@@ -181,7 +189,21 @@ def leave_out_coincident(v: np.ndarray, f: np.ndarray, among: np.ndarray | None,
                                "if the surface was meant twice")
     note = coincident_message(found, part_size(v, f))
     warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=5)
-    return f[~found.drop], note
+    many = found.multiplicity > 1
+    repeated = (face_keys(v, f[many]), found.multiplicity[many]) if many.any() else None
+    return f[~found.drop], note, repeated
+
+
+def counted(shells: Shells, *repeated: tuple[np.ndarray, np.ndarray] | None) -> np.ndarray | None:
+    """R0: how many times each of ``shells`` was listed, from the records of :func:`leave_out_coincident` (by vertex
+    index when the surface was closed, with their own vertices here), or None when every shell counts once or all
+    count alike (:func:`~.multiplicity.shell_multiplicity`).  A face in both records counts by the larger."""
+    found = [r for r in repeated if r is not None]
+    if not found:
+        return None
+    keys = np.concatenate([r[0] for r in found])
+    times = np.concatenate([r[1] for r in found])
+    return shell_multiplicity(shells.vertices, shells.faces, shells.labels, shells.n_shells, (keys, times))
 
 
 def drop_flat(shells: Shells, diag: float, source: str, *, warn: bool = True,

@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import DegenerateFacesWarning, InvalidMeshError, MeshRepairedWarning, MeshResolvedWarning
 from ..integrals import bounding_box, volume_moments
 from .checks import census_and_shells, repeated_corner_faces
+from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions
 from .read import RawMesh
 from .resolve import Resolution, resolve_surface
 from .shells import leave_out_coincident
@@ -55,6 +56,9 @@ class ClosedSurface(NamedTuple):
         The shell of each face of ``found.faces`` from the edge census, when the faces are the census's.
     coincident : tuple of str
         R0's note (a shell listed twice with the same vertex indices), warned.
+    repeated : (keys, counts) or None
+        The faces R0 kept in place of their repeats and how many times each counts
+        (:func:`~.shells.leave_out_coincident`).
     """
 
     vertices: np.ndarray
@@ -67,6 +71,7 @@ class ClosedSurface(NamedTuple):
     watertight: bool
     census: tuple[np.ndarray, int] | None
     coincident: tuple[str, ...]
+    repeated: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def check_magnitude(lo: np.ndarray, hi: np.ndarray, source: str) -> None:
@@ -86,8 +91,10 @@ def check_magnitude(lo: np.ndarray, hi: np.ndarray, source: str) -> None:
                                "volume integrals can hold without underflow (check the length `units`)")
 
 
-def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float) -> ClosedSurface:
-    """The surface :func:`~.prepare.prepare_mesh` goes on with (``repair`` and ``merge_tolerance`` as there).
+def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float,
+                  assume: UserAssumptions = NOTHING_ASSUMED) -> ClosedSurface:
+    """The surface :func:`~.prepare.prepare_mesh` goes on with (``repair``, ``merge_tolerance`` and ``assume`` as
+    there).
 
     Raises
     ------
@@ -115,19 +122,20 @@ def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float) -> Clos
         raise InvalidMeshError(f"{source}: all vertices coincide; the mesh has no extent")
     topo, census_labels, census_shells = census_and_shells(f, len(v), v)   # R1's shells from the same adjacency
     coincident: tuple[str, ...] = ()
+    twice = None
     if topo.nonmanifold_edges:                # R0: a shell listed twice with the same vertex indices
-        f, note = leave_out_coincident(v, f, None, source)
+        f, note, twice = leave_out_coincident(v, f, None, source)
         if note is not None:
             coincident = (note,)
             topo, census_labels, census_shells = census_and_shells(f, len(v), v)
     found = Resolution(v, f, "exact", (), 0, None, 0)
     if not topo.oriented:                     # clean meshes skip all of this
         found = resolve_surface(v, f, diag=diag, source=source, repair=repair, merge_tolerance=merge_tolerance,
-                                moments=volume_moments)
+                                moments=volume_moments, assume=assume)
         v, f = found.vertices, found.faces
         if found.method != "exact" or found.notes:
             warning = MeshRepairedWarning if found.estimate is not None else MeshResolvedWarning
             what = f"repaired ({found.method}, an estimate)" if found.estimate is not None else found.method
             warnings.warn(warning(f"{source}: {what}: {'; '.join(found.notes)}"), stacklevel=4)
     census = (census_labels, census_shells) if topo.oriented else None     # the faces are the census's: unchanged
-    return ClosedSurface(v, f, found, lo, hi, diag, n_repeated, topo.oriented, census, coincident)
+    return ClosedSurface(v, f, found, lo, hi, diag, n_repeated, topo.oriented, census, coincident, twice)

@@ -315,27 +315,33 @@ def union_surface(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
 WINDING_PIECES = 24
 
 
-def _levels(m3: ModuleType, pieces: list[_Manifold]) -> list[_Manifold]:
-    """``L_t = {x: at least t of the pieces contain x}`` for ``t = 1, 2, ...`` up to the last non-empty one.
+def _levels(m3: ModuleType, pieces: list[_Manifold], times: list[int] | None = None) -> list[_Manifold]:
+    """``L_t = {x: at least t of the pieces contain x}`` for ``t = 1, 2, ...`` up to the last non-empty one, a piece
+    counted ``times`` over (R0: a shell listed ``k`` times; default once each).
 
-    One pass over the pieces, ``L_t ← L_t ∪ (P ∩ L_{t−1})`` from the deepest level down (``L_0`` everything):
-    at most ``len(pieces) × depth`` booleans, never one per subset."""
+    One pass over the pieces, ``L_t ← L_t ∪ (P ∩ L_{t−k})`` for a piece ``P`` counted ``k`` times (``L_s`` everything
+    for ``s ≤ 0``): at most ``len(pieces) × depth`` booleans, never one per subset, and no piece is cut by itself
+    (a box listed twice is not intersected with its copy, whose faces coincide)."""
     levels: list[_Manifold] = []
-    for piece in pieces:
-        for t in range(len(levels), 0, -1):             # deepest first: L_{t-1} is still the old one
-            met = piece ^ levels[t - 1]
-            if met.is_empty():
+    for piece, k in zip(pieces, times if times is not None else [1] * len(pieces)):
+        grown: list[_Manifold] = []
+        for t in range(1, len(levels) + k + 1):
+            below = t - k                                 # L_{t-k} of the old levels; everything when below 1
+            met = piece if below < 1 else piece ^ levels[below - 1]
+            old = levels[t - 1] if t <= len(levels) else None
+            if below >= 1 and met.is_empty():
+                if old is None:
+                    break                                 # deeper levels are empty too (L_t shrinks with t)
+                grown.append(old)
                 continue
-            if t == len(levels):
-                levels.append(met)
-            else:
-                levels[t] = levels[t] + met
-        levels = [piece] if not levels else [levels[0] + piece, *levels[1:]]
+            grown.append(met if old is None else old + met)
+        levels = grown
     return levels
 
 
 def winding_solid(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n_groups: int,
-                  outward: np.ndarray, *, solids: PieceSolids | None = None) -> tuple[UnionSurface, float]:
+                  outward: np.ndarray, *, solids: PieceSolids | None = None,
+                  multiplicity: np.ndarray | None = None) -> tuple[UnionSurface, float]:
     """The solid ``{w ≥ 1}`` of closed pieces wound as given, without reading which body a cavity belongs to.
 
     With material pieces ``B_i`` (wound outward) and voids ``C_j`` (wound inward) the winding number is
@@ -349,6 +355,9 @@ def winding_solid(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
     ----------
     vertices, faces, groups, n_groups, outward, solids
         As for :func:`union_surface` (``outward``: as the file winds each piece).
+    multiplicity : (n_groups,) int, optional
+        How many times each piece counts in ``w`` (R0: a shell listed ``k`` times is ``k`` of the ``B_i`` or
+        ``C_j``); default once each.
 
     Returns
     -------
@@ -370,11 +379,13 @@ def winding_solid(vertices: np.ndarray, faces: np.ndarray, groups: np.ndarray, n
     m3 = _import_manifold3d()
     if solids is None:
         solids = piece_solids(vertices, faces, groups, n_groups, outward)
-    material = [solids.solids[g] for g in range(n_groups) if g in solids.solids and outward[g]]
-    voids = [solids.solids[g] for g in range(n_groups) if g in solids.solids and not outward[g]]
+    times = np.ones(n_groups, dtype=np.int64) if multiplicity is None else np.asarray(multiplicity, dtype=np.int64)
+    material = [g for g in range(n_groups) if g in solids.solids and outward[g]]
+    voids = [g for g in range(n_groups) if g in solids.solids and not outward[g]]
     if not material:
         raise UnionError("no outward-wound piece to unite")
-    cover, holes = _levels(m3, material), _levels(m3, voids)
+    cover = _levels(m3, [solids.solids[g] for g in material], [int(times[g]) for g in material])
+    holes = _levels(m3, [solids.solids[g] for g in voids], [int(times[g]) for g in voids])
     kept = [level - holes[t] if t < len(holes) else level for t, level in enumerate(cover)]
     outside = float((holes[0] - cover[0]).volume()) if holes else 0.0
     solid = m3.Manifold.batch_boolean(kept, m3.OpType.Add) if len(kept) > 1 else kept[0]

@@ -17,7 +17,7 @@ from ..integrals import body_volume_moments, bounding_box, reference_point, roun
 from .checks import edge_topology
 from .classify import Orientation, shell_nesting_or_none
 from .intersect import SurfaceContacts, surface_contacts
-from .policy import TOUCH_VOLUME_RTOL, orient_by_depth
+from .policy import TOUCH_VOLUME_RTOL, orient_by_depth, turned_reading_refusal
 from .resolve import Resolution, resolve_surface
 from .shells import Shells, apply_flips, flat_pieces, reshelled
 
@@ -101,7 +101,8 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
     nonmanifold = nonmanifold_edges if nonmanifold_edges is not None else edge_topology(f, len(v), v).nonmanifold_edges
     if not (candidates.any() or nonmanifold):                                    # R5, R6
         return United(shells, owner, cavities, overlaps, method, kind, checks, (), None)
-    united, built = _unite(v, f, labels, owner, source, repair, by_winding=oriented.by_winding)
+    united, built = _unite(v, f, labels, owner, source, repair or oriented.turned_reading,   # R4: refused below
+                           by_winding=oriented.by_winding, multiplicity=oriented.multiplicity)
     summed = sum(s.volume for s in shells.moments)
     same = united is not None and _same_solid(united, shells, diag)
     if united is not None and not touch.crossing.any() and same:
@@ -133,9 +134,11 @@ def unite_overlaps(oriented: Orientation, contacts: SurfaceContacts, *, nonmanif
                      f"after a rotation); the boolean union's volume equals the summed volume within "
                      f"{TOUCH_VOLUME_RTOL:g} (difference {abs(united.volume - summed):.3g} m³), so the summed "
                      "integral is given (the solid is ambiguous at the rounding level: not exact)")
-        if oriented.misread is None and oriented.groups is None:     # else R4's reading labels and warns (certify)
+        if oriented.misread is None and oriented.groups is None and oriented.voids is None:   # else certify warns
             warnings.warn(MeshResolvedWarning(f"{source}: {notes[-1]}"), stacklevel=4)
     elif united is None:
+        if oriented.turned_reading:     # R4: the grid would estimate the nest turned as a whole, no reading named
+            raise InvalidMeshError(turned_reading_refusal(source))
         forced = resolve_surface(v, f, diag=diag, source=source, repair=True, merge_tolerance=0.0,
                                  moments=volume_moments, force_estimate=True)
         return United(shells, owner, cavities, max(overlaps, 1), method, kind, checks, tuple(notes), forced)
@@ -348,7 +351,8 @@ def _same_solid(united: UnionSurface, shells: Shells, diag: float) -> bool:
 
 
 def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: np.ndarray, source: str,
-           repair: bool, *, by_winding: bool = False) -> tuple[UnionSurface | None, PieceSolids | None]:
+           repair: bool, *, by_winding: bool = False,
+           multiplicity: np.ndarray | None = None) -> tuple[UnionSurface | None, PieceSolids | None]:
     """The union of the closed pieces (a :class:`~.union.UnionSurface`), or None when the boolean refuses; and the
     solids of the shells that were whole pieces wound outward (keyed by shell, for :func:`_union_lost_volume`).
 
@@ -356,6 +360,7 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
     ``by_winding`` (R4c) owners are not used: the solid ``{w ≥ 1}`` of the pieces as wound
     (:func:`~.union.winding_solid`), refused where shells wound inward reach outside every body beyond
     ``TOUCH_VOLUME_RTOL`` of the result (a body inside out or a cavity misplaced: the file does not say which).
+    ``multiplicity``: (s,) int, how many times R0 found each shell listed, counted so by ``winding_solid``.
     """
     from .union import (PieceSolids, UnionError, closed_groups, piece_solids, two_manifold,   # on use: overlaps
                         union_surface, winding_solid)                                           # are rare
@@ -381,8 +386,9 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
                              body=np.asarray(owner)[shell_of_group[solid]])
         summed = float(np.sum(volume[solid]))
         if by_winding:
+            times = None if multiplicity is None else np.asarray(multiplicity)[shell_of_group[solid]]
             united, outside = winding_solid(vertices, faces[keep], groups, int(np.count_nonzero(solid)), outward,
-                                            solids=built)
+                                            solids=built, multiplicity=times)
             if outside > TOUCH_VOLUME_RTOL * abs(united.volume):
                 raise UnionError(f"{outside:.3g} m³ of shells wound inward lies outside every body (a body written "
                                  "inside out, or a cavity placed wrong, while cavities lie in overlapping bodies): "

@@ -405,7 +405,7 @@ def _core_sections(props: MassProperties, density_source: str | None, semi,
     if props.parts and any(b.mesh is not None for b in props.parts):
         rows = [[_e(b.name), _e(b.material or "-"), _num(b.density), _num(b.mass), _num(b.volume),
                  "(" + ", ".join(_vec_cells(b.center_of_mass)) + ")",
-                 _e(b.mesh.certificate.kind if b.mesh is not None else "-")] for b in props.parts]
+                 _e(b.mesh.certificate.brief() if b.mesh is not None else "-")] for b in props.parts]
         sections.append(HtmlSection(
             f"Parts ({len(props.parts)})",
             _table(["part", "material", "density (kg/m³)", "mass (kg)", "volume (m³)", "centre of mass (m)",

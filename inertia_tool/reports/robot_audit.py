@@ -118,6 +118,7 @@ def robot_report_dict(robot: RobotDescription, inertials, audits) -> dict:
                          for e in geometry.elements],
             "problem": result.problem,
             "method": result.method,
+            "assumptions": list(result.assumptions),
             "uncertainty": None if result.uncertainty is None else {
                 "mass": result.uncertainty.mass, "center_of_mass": result.uncertainty.center_of_mass,
                 "inertia": result.uncertainty.inertia},

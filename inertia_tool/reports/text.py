@@ -44,7 +44,7 @@ def _parts_table(props: MassProperties, size: float) -> list[str]:
     header = ["part", "material", "density (kg/m³)", "mass (kg)", "volume (m³)", "centre of mass (m)", "certificate"]
     rows = [[b.name, b.material or "-", f"{b.density:.6g}", _num(b.mass), _num(b.volume),
              _position(b.center_of_mass, size),
-             b.mesh.certificate.kind if b.mesh is not None else "-"] for b in props.parts]
+             b.mesh.certificate.brief() if b.mesh is not None else "-"] for b in props.parts]
     widths = [max(len(r[k]) for r in [header, *rows]) for k in range(len(header))]
     lines = [f"  parts ({len(props.parts)}), each integrated alone; the totals above are their sum about the common "
              "centre of mass (parallel-axis theorem, Eq. 4.16):"]

@@ -31,6 +31,7 @@ import hashlib
 import math
 import os
 import warnings
+from typing import NamedTuple
 from dataclasses import replace
 
 import numpy as np
@@ -41,7 +42,7 @@ from ..mass.extrusion import extruded_region
 from ..mass.extrusion import point_in_polygon as _inside_polygon
 from ..mass.pipeline import mass_properties, resolve_density
 from ..mass.properties import MassProperties, combine
-from ..mesh.hole_assumptions import assuming
+from ..mesh.hole_assumptions import NOTHING_ASSUMED, UserAssumptions, user_named
 from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES, LoadOptions
 from ..values import frozen_value
 from ..mesh.read import RawMesh
@@ -68,7 +69,8 @@ MODEL_DENSITY = "model"
 
 
 def mesh_properties(path: str | None, *, repair: bool = False, max_faces: int | None = None,
-                    element: GeometryElement | None = None) -> MassProperties:
+                    element: GeometryElement | None = None,
+                    assume: UserAssumptions = NOTHING_ASSUMED) -> MassProperties:
     """Unit-density mass properties of the mesh file ``path`` (metres), placed as ``element`` places it.
 
     The one place where the robot tools call the mesh engine.  The element's reference transform (MJCF
@@ -88,6 +90,8 @@ def mesh_properties(path: str | None, *, repair: bool = False, max_faces: int | 
         Refuse a file of more triangles (the reader's limit, ``LoadOptions.max_faces``); its default when None.
     element : GeometryElement, optional
         The mesh element: its reference transform and scale (none when not given).
+    assume : UserAssumptions
+        The user's assumptions about the holes a repair fills (``LoadOptions.assume``); only with ``repair``.
 
     Returns
     -------
@@ -97,7 +101,7 @@ def mesh_properties(path: str | None, *, repair: bool = False, max_faces: int | 
     raw = _raw_mesh(path, element, max_faces)
     if element is not None:
         raw = _placed(raw, element)
-    return mass_properties(raw, density=1.0, repair=repair)
+    return mass_properties(raw, density=1.0, repair=repair, assume=assume.names)
 
 
 def _mesh_label(element: GeometryElement) -> str:
@@ -323,7 +327,7 @@ def _inertia_box_size(kind: str, half: np.ndarray) -> tuple:
 
 
 def fitted_element(element: GeometryElement, *, cache: dict | None = None, repair: bool = False,
-                   budget: list | None = None) -> GeometryElement:
+                   budget: list | None = None, assume: UserAssumptions = NOTHING_ASSUMED) -> GeometryElement:
     """The primitive MuJoCo fits to a mesh (``<geom type="capsule" mesh="...">`` without a size).
 
     MuJoCo's default fit (``<compiler fitaabb="false">``): the mesh's equivalent inertia box — the box of the
@@ -353,18 +357,31 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
                            reference_rotation=element.reference_rotation,
                            reference_translation=element.reference_translation,
                            mesh_inertia=element.mesh_inertia)
-    memo = _fit_memo_key(mesh, repair) if cache is None else None
+    memo = _fit_memo_key(mesh, repair, assume) if cache is None and budget is None else None
     props = _FIT_BODIES.get(memo) if memo is not None else None
     if props is not None:
         _FIT_BODIES[memo] = _FIT_BODIES.pop(memo)          # most recently used last
+        if isinstance(props, _FitRefusal):
+            _reissue(props.caught)
+            raise props.error.with_traceback(None)
     elif element.mesh_inertia in ("convex", "legacy"):
         props = _mesh_inertia_part(mesh, cache={} if cache is None else cache, budget=budget)[1]
+    elif memo is None:
+        props = element_mass_properties(mesh, cache=cache, repair=repair, budget=budget, assume=assume)
     else:
-        props = element_mass_properties(mesh, cache=cache, repair=repair, budget=budget)
+        with warnings.catch_warnings(record=True) as recorded:
+            warnings.simplefilter("always")
+            try:
+                props = element_mass_properties(mesh, cache=cache, repair=repair, budget=budget, assume=assume)
+            except InertiaToolError as exc:
+                props = _FitRefusal(exc, tuple(recorded))
+        _reissue(recorded)
     if memo is not None and memo not in _FIT_BODIES:
         _FIT_BODIES[memo] = props
         while len(_FIT_BODIES) > FIT_BODIES_KEPT:
             _FIT_BODIES.pop(next(iter(_FIT_BODIES)))
+    if isinstance(props, _FitRefusal):
+        raise props.error.with_traceback(None)
     moments, axes = np.linalg.eigh(0.5 * (props.inertia + props.inertia.T))
     axes = axes[:, ::-1]                                 # x: the largest moment, z: the smallest
     if np.linalg.det(axes) < 0:
@@ -398,20 +415,29 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
 #: without a robot cache (the audit's bounding boxes and inside tests fit every fitted geom again: before this
 #: memo, each such call integrated the mesh anew, 22 of the 57 s of CPU of a Menagerie corpus audit).  Keyed by
 #: :func:`_fit_memo_key` (the file's content, how the element places it, its inertia mode and ``repair``), at
-#: most :data:`FIT_BODIES_KEPT` entries (least recently used dropped first); refusals are not kept.
+#: most :data:`FIT_BODIES_KEPT` entries (least recently used dropped first).  A refusal is kept too, as a
+#: :class:`_FitRefusal` (issues 23/25, corpus15: the audit fits without repair, so a mesh that only a repair
+#: integrates was refused again on every call, Piper's ``link3.stl`` 2.7 s of CPU each time); it is raised
+#: again with the engine's warnings of the first attempt.
 _FIT_BODIES: dict = {}
 FIT_BODIES_KEPT = 256
 
 
-def _repair_key(repair: bool) -> tuple[bool, tuple[str, ...]]:
-    """What a cached body depends on besides the file and its placement: ``repair`` and the user's assumptions in
-    force (:func:`~inertia_tool.mesh.hole_assumptions.user_assumed`), so that a body prepared under
-    ``--assume flat-islands`` is never handed to a call without it, or the other way round."""
-    from ..mesh.hole_assumptions import user_assumed
-    return bool(repair), user_assumed()
+class _FitRefusal(NamedTuple):
+    """A :data:`_FIT_BODIES` entry for a mesh the engine refused: the error and the warnings raised before it."""
+
+    error: InertiaToolError
+    caught: tuple
 
 
-def _fit_memo_key(mesh: GeometryElement, repair: bool) -> tuple | None:
+def _repair_key(repair: bool, assume: UserAssumptions) -> tuple[bool, tuple[str, ...]]:
+    """What a cached body depends on besides the file and its placement: ``repair`` and the user's assumptions
+    ``assume`` (the call's parameter), so that a body prepared under ``--assume flat-islands`` is never handed to
+    a call without it, or the other way round."""
+    return bool(repair), assume.names
+
+
+def _fit_memo_key(mesh: GeometryElement, repair: bool, assume: UserAssumptions) -> tuple | None:
     """The :data:`_FIT_BODIES` key of a fitted geom's mesh element, or None when its file is not kept (too
     large or unreadable: :func:`_content_key`)."""
     content = None
@@ -420,7 +446,7 @@ def _fit_memo_key(mesh: GeometryElement, repair: bool) -> tuple | None:
         content = _content_key(mesh.mesh, submesh)
         if content is None:
             return None
-    return (content, _mesh_key(mesh), mesh.mesh_inertia, _repair_key(repair))
+    return (content, _mesh_key(mesh), mesh.mesh_inertia, _repair_key(repair, assume))
 
 
 class MeshCache:
@@ -498,7 +524,8 @@ def _reissue(caught) -> None:
         warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
 
 
-def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, budget: list | None):
+def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, budget: list | None,
+                 assume: UserAssumptions = NOTHING_ASSUMED):
     """The unit-density body of a mesh element, through the robot's ``cache`` (mesh key → result or the
     exception that refused it, so that a mesh shared by links is read, and refused, once) and the run's shared
     :class:`MeshCache` (``cache["shared"]``, when given)."""
@@ -509,13 +536,13 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
             raise found.with_traceback(None)
         return found
     shared = cache.get(_SHARED) if cache is not None else None
-    entry = shared.get((key, _repair_key(repair))) if shared is not None else None
+    entry = shared.get((key, _repair_key(repair, assume))) if shared is not None else None
     content = None
     if shared is not None and entry is None and element.mesh is not None:
         found = _content_key(element.mesh, (element.submesh, bool(element.submesh_center)) if element.submesh
                              else None)
         if found is not None:
-            content = (found[1:], os.path.splitext(element.mesh)[1].lower(), key[1:], _repair_key(repair))
+            content = (found[1:], os.path.splitext(element.mesh)[1].lower(), key[1:], _repair_key(repair, assume))
             entry = shared.get_copy(content, element.mesh)
     if entry is not None:
         outcome, caught, faces = entry
@@ -535,7 +562,7 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
             warnings.simplefilter("always")
             try:
                 outcome = mesh_properties(element.mesh, repair=repair, element=element,
-                                          max_faces=None if budget is None else budget[0])
+                                          max_faces=None if budget is None else budget[0], assume=assume)
             except MeshReadError as exc:
                 if budget is None or budget[0] == budget[1] or "`max_faces`" not in str(exc):
                     outcome = exc
@@ -553,7 +580,7 @@ def _cached_mesh(element: GeometryElement, *, cache: dict | None, repair: bool, 
                 budget[0] -= faces
         if shared is not None and not (isinstance(outcome, MeshReadError) and "`max_faces`" in str(outcome)):
             # a budget refusal is this robot's, not the file's
-            shared.put((key, _repair_key(repair)), outcome, caught, faces,
+            shared.put((key, _repair_key(repair, assume)), outcome, caught, faces,
                        content=content)
     if cache is not None:
         cache[key] = outcome
@@ -567,7 +594,8 @@ _SHARED = "shared"
 
 
 def element_mass_properties(element: GeometryElement, *, cache: dict | None = None,
-                            repair: bool = False, budget: list | None = None) -> MassProperties:
+                            repair: bool = False, budget: list | None = None,
+                            assume: UserAssumptions = NOTHING_ASSUMED) -> MassProperties:
     """Unit-density mass properties of one geometry element, in the **link frame**.
 
     Parameters
@@ -581,6 +609,8 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
         ``[left, total]``: triangles the meshes still to be read may hold together, of ``total``
         (``robot --max-faces``); each new mesh file is read with ``left`` as its limit and its triangles are
         taken off.
+    assume : UserAssumptions
+        The user's assumptions about the holes a repair fills, passed to :func:`mesh_properties`.
 
     Returns
     -------
@@ -593,7 +623,7 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
         From the mesh engine, for a mesh element.
     """
     if element.fit_scale is not None:
-        element = fitted_element(element, cache=cache, repair=repair, budget=budget)
+        element = fitted_element(element, cache=cache, repair=repair, budget=budget, assume=assume)
     kind, size = element.kind, element.size
     if kind == "box":
         local = shapes.box(*size).exact
@@ -608,7 +638,7 @@ def element_mass_properties(element: GeometryElement, *, cache: dict | None = No
     elif kind == "polyline":
         local = extruded_region(element.polygons, size[0])
     elif kind == "mesh":
-        local = _cached_mesh(element, cache=cache, repair=repair, budget=budget)
+        local = _cached_mesh(element, cache=cache, repair=repair, budget=budget, assume=assume)
     else:
         raise UsageError("Expected a geometry kind among box, cylinder, sphere, capsule, ellipsoid, polyline, mesh, "
                          f"got {kind!r}")
@@ -728,9 +758,10 @@ def _boundary_edges(vertices: np.ndarray, faces: np.ndarray) -> set:
     return {row.tobytes() for row in ends}
 
 
-def _join_content(pieces: list, repair: bool) -> tuple | None:
+def _join_content(pieces: list, repair: bool, assume: UserAssumptions) -> tuple | None:
     """What a join of ``pieces`` depends on: each file's size and hash (not its path), suffix, sub-mesh and
-    placement (:func:`_mesh_key` without the path), in order, and ``repair``; None when a file is not hashed."""
+    placement (:func:`_mesh_key` without the path), in order, ``repair`` and ``assume``; None when a file is not
+    hashed."""
     out = []
     for element in pieces:
         if element.mesh is None:
@@ -740,10 +771,11 @@ def _join_content(pieces: list, repair: bool) -> tuple | None:
         if found is None:
             return None
         out.append((found[1:], os.path.splitext(element.mesh)[1].lower(), _mesh_key(element)[1:]))
-    return tuple(out), _repair_key(repair)
+    return tuple(out), _repair_key(repair, assume)
 
 
-def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: MeshCache | None = None):
+def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: MeshCache | None = None,
+                   assume: UserAssumptions = NOTHING_ASSUMED):
     """``(unit-density body, method, uncertainty)`` of the open meshes ``pieces`` (elements of one link, one
     placement) integrated as one surface, or None when together they are not a closed solid either (with
     ``repair``: not even a bounded estimate) or cannot be read.
@@ -773,7 +805,7 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: M
     # points); pieces with no seam in common are separate holes, no better repaired together than apart
     if not any(seams[i] & seams[j] for i in range(len(seams)) for j in range(i + 1, len(seams))):
         return None
-    content = _join_content(pieces, repair) if shared is not None else None
+    content = _join_content(pieces, repair, assume) if shared is not None else None
     if shared is not None and shared.join_refused(content):
         return None                 # the same files, placed alike, refused before (the budget checked above)
     try:
@@ -785,7 +817,7 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: M
         with warnings.catch_warnings(record=True) as recorded:
             warnings.simplefilter("always")
             try:
-                local = mass_properties(joined, density=1.0, repair=fix)
+                local = mass_properties(joined, density=1.0, repair=fix, assume=assume.names if fix else ())
             except InertiaToolError:
                 continue
         _reissue(recorded)
@@ -793,14 +825,16 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: M
         method = ("exact" if report is None else "estimate" if report.uncertainty is not None
                   else report.certificate.kind)
         uncertainty = None if report is None else report.uncertainty
-        return local.transformed(rotation=first.rotation, translation=first.translation), method, uncertainty
+        placed = replace(local.transformed(rotation=first.rotation, translation=first.translation), mesh=report)
+        return placed, method, uncertainty          # (the report kept: its certificate, for _users_taken)
     if shared is not None:
         shared.refuse_join(content)
     return None
 
 
 def _join_open_pieces(parts: list, refused: list, *, model: bool, repair: bool,
-                      budget: list | None, shared: MeshCache | None = None) -> tuple[list, list, list]:
+                      budget: list | None, shared: MeshCache | None = None,
+                      assume: UserAssumptions = NOTHING_ASSUMED) -> tuple[list, list, list]:
     """``parts`` and ``refused`` with each group of at least two open mesh pieces that close together
     (:func:`_joined_pieces`) replaced by one part; the third value names what was joined, for the link's
     warnings.  Open pieces are the meshes refused as needing repair and those repaired into estimates."""
@@ -814,7 +848,7 @@ def _join_open_pieces(parts: list, refused: list, *, model: bool, repair: bool,
         keys = [_mesh_key(e) for e in pieces]
         if len(pieces) < 2 or len(set(keys)) < len(keys):     # one piece, or a mesh twice: nothing to join
             continue
-        found = _joined_pieces(pieces, budget=budget, repair=repair, shared=shared)
+        found = _joined_pieces(pieces, budget=budget, repair=repair, shared=shared, assume=assume)
         if found is None:
             continue
         local, method, uncertainty = found
@@ -828,7 +862,7 @@ def _join_open_pieces(parts: list, refused: list, *, model: bool, repair: bool,
 
 
 def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool,
-                   budget: list | None = None):
+                   budget: list | None = None, assume: UserAssumptions = NOTHING_ASSUMED):
     """Per element of ``link``: ``(element, unit properties, mesh method, mesh uncertainty)``; massless
     elements (``model`` mode) are left out and named in the second return value; the third says what the
     link's warnings should: meshes taken by their MJCF ``inertia`` mode, open mesh pieces integrated together
@@ -847,7 +881,7 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
             notes.append(_MESH_INERTIA_NOTES[element.mesh_inertia].format(os.path.basename(_mesh_label(element))))
             continue
         try:
-            props = element_mass_properties(element, cache=cache, repair=repair, budget=budget)
+            props = element_mass_properties(element, cache=cache, repair=repair, budget=budget, assume=assume)
         except InvalidMeshError as exc:      # an open piece may close with the link's other pieces: tried below
             if element.kind != "mesh" or element.fit_scale is not None:
                 raise
@@ -876,14 +910,14 @@ def _element_parts(link: LinkGeometry, *, cache: dict, repair: bool, model: bool
     joined: list = []
     if len(refused) + sum(1 for p in parts if p[2] == "estimate") >= 2:
         parts, refused, joined = _join_open_pieces(parts, refused, model=model, repair=repair, budget=budget,
-                                                   shared=cache.get(_SHARED))
+                                                   shared=cache.get(_SHARED), assume=assume)
     if refused:
         raise refused[0][1]
     return parts, massless, notes + joined
 
 
 def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repair: bool = False,
-                         budget: list | None = None) -> MassProperties:
+                         budget: list | None = None, assume: UserAssumptions = NOTHING_ASSUMED) -> MassProperties:
 
     """Unit-density mass properties of all the link's elements together, link frame (parallel-axis sum).
 
@@ -896,6 +930,8 @@ def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repai
         Passed to :func:`mesh_properties`.
     budget : list of one int, optional
         Shared triangle budget (:func:`element_mass_properties`).
+    assume : UserAssumptions
+        The user's assumptions about the holes a repair fills, passed to :func:`mesh_properties`.
 
     Returns
     -------
@@ -904,7 +940,8 @@ def link_mass_properties(link: LinkGeometry, *, cache: dict | None = None, repai
     """
     if not link.elements:
         raise UsageError(f"Expected link {link.name!r} to have geometry, got none")
-    parts = [element_mass_properties(e, cache=cache, repair=repair, budget=budget) for e in link.elements]
+    parts = [element_mass_properties(e, cache=cache, repair=repair, budget=budget, assume=assume)
+             for e in link.elements]
     total = parts[0] if len(parts) == 1 else combine(parts, name=link.name)
     return MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
                           inertia=total.inertia, surface_area=total.surface_area, density=1.0, name=link.name)
@@ -959,6 +996,9 @@ class LinkInertial:
         Bounds when ``method == "estimate"``; None when the result is exact for the geometry as described.
     warnings : tuple of str
         What the reader should know about a result (massless geoms left out, a repaired mesh).
+    assumptions : tuple of str
+        The user's assumptions (``assume``) the result rests on: those the certificates of the link's repaired
+        meshes name (:attr:`~inertia_tool.mesh.policy.Certificate.assumptions`); empty when none was taken.
     """
 
     name: str
@@ -969,6 +1009,20 @@ class LinkInertial:
     method: str | None = None
     uncertainty: LinkUncertainty | None = None
     warnings: tuple = ()
+    assumptions: tuple[str, ...] = ()
+
+
+def _users_taken(parts: list, cache: dict) -> tuple[str, ...]:
+    """The user's assumptions the link's mesh bodies rest on: those their certificates name (a joined body's
+    report is kept on it, a single mesh's is in the robot's ``cache``)."""
+    names: set[str] = set()
+    for element, props, _, _ in parts:
+        report = props.mesh
+        if report is None and (element.kind == "mesh" or element.fit_scale is not None):
+            report = getattr(cache.get(_mesh_key(element)), "mesh", None)
+        if report is not None:
+            names.update(report.certificate.assumptions)
+    return user_named(names)
 
 
 def _link_uncertainty(parts: list, total: MassProperties, scale: float) -> LinkUncertainty | None:
@@ -999,8 +1053,7 @@ def _with_engine_warnings(result: LinkInertial, caught: list) -> LinkInertial:
         warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
     if not texts:
         return result
-    return LinkInertial(result.name, result.properties, result.density, result.basis, result.problem,
-                        result.method, result.uncertainty, tuple(result.warnings) + tuple(texts))
+    return replace(result, warnings=tuple(result.warnings) + tuple(texts))
 
 
 def _one_link(link: LinkGeometry, **options) -> LinkInertial:
@@ -1017,7 +1070,8 @@ REFUSED_REPAIRED = "mesh cannot be read or bounded, even with repair"
 
 
 def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, model: bool, repair: bool,
-                     cache: dict, geometry: str, budget: list | None = None) -> LinkInertial:
+                     cache: dict, geometry: str, budget: list | None = None,
+                     assume: UserAssumptions = NOTHING_ASSUMED) -> LinkInertial:
     """The result for one link, or the reason there is none (never raises for the link's own problems)."""
     nan = float("nan")
     if not link.elements:
@@ -1031,7 +1085,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute
         return LinkInertial(link.name, None, nan, basis, f"mesh file missing: {', '.join(dict.fromkeys(missing))}")
     try:
-        parts, massless, joined = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget)
+        parts, massless, joined = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget,
+                                                 assume=assume)
     except InertiaToolError as exc:
         # with repair on, "needs repair" would contradict the warning that it was tried (review 8)
         return LinkInertial(link.name, None, nan, basis, f"{REFUSED_REPAIRED if repair else REFUSED}: {exc}")
@@ -1044,6 +1099,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
         return LinkInertial(link.name, None, nan, basis, "every geom is massless in the description",
                             warnings=tuple(warned))
     method = max((m for _, _, m, _ in parts), key=_RANK.__getitem__)
+    taken = _users_taken(parts, cache)
     warned += [f"{e.name or e.kind}: {round_up(u.mass, 2):.2g} relative mass bound from the repaired mesh"
                for e, _, m, u in parts if m == "estimate" and u is not None]
     try:
@@ -1064,7 +1120,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
                                    density=total.mass / volume if volume > 0 else nan, name=link.name)
             uncertainty = _link_uncertainty(parts, props, 1.0) if method == "estimate" else None
             return LinkInertial(link.name, props, props.density, basis, method=method, uncertainty=uncertainty,
-                                warnings=tuple(warned))
+                                warnings=tuple(warned), assumptions=taken)
         units = [u for _, u, _, _ in parts]
         total = units[0] if len(units) == 1 else combine(units, name=link.name)
         unit = MassProperties(mass=total.mass, volume=total.volume, center_of_mass=total.center_of_mass,
@@ -1078,12 +1134,14 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
             props = unit.with_mass(link.declared.mass)
             scale = props.mass / unit.mass
             return LinkInertial(link.name, props, props.mass / props.volume, "declared masses kept", method=method,
-                                uncertainty=_link_uncertainty(parts, props, scale), warnings=tuple(warned))
+                                uncertainty=_link_uncertainty(parts, props, scale), warnings=tuple(warned),
+                                assumptions=taken)
         props = MassProperties(mass=unit.mass * rho, volume=unit.volume, center_of_mass=unit.center_of_mass,
                                inertia=unit.inertia * rho, surface_area=unit.surface_area, density=rho,
                                name=link.name)
         return LinkInertial(link.name, props, rho, basis, method=method,
-                            uncertainty=_link_uncertainty(parts, props, rho), warnings=tuple(warned))
+                            uncertainty=_link_uncertainty(parts, props, rho), warnings=tuple(warned),
+                            assumptions=taken)
     except (InertiaToolError, ValueError, ArithmeticError) as exc:
         return LinkInertial(link.name, None, nan, basis, f"cannot be computed: {exc}", warnings=tuple(warned))
 
@@ -1142,12 +1200,12 @@ def link_inertials(robot: RobotDescription, *, density: float | str | None = Non
         rho, basis = resolve_density(density=density, material=material)
     if not (isinstance(max_faces, (int, np.integer)) and 0 < max_faces <= MAX_SUPPORTED_FACES):
         raise UsageError(f"Expected `max_faces` to be an integer from 1 to {MAX_SUPPORTED_FACES:,}, got {max_faces!r}")
-    LoadOptions(repair=bool(repair), assume=tuple(assume))        # the one check of `assume` (UsageError)
+    checked = LoadOptions(repair=bool(repair), assume=tuple(assume))    # the one check of `assume` (UsageError)
     cache: dict = {} if mesh_cache is None else {_SHARED: mesh_cache}
     budget = [int(max_faces), int(max_faces)]
-    with assuming(tuple(assume)):      # every mesh of the robot, read however deep (holes.patched_estimate)
-        return tuple(_one_link(link, rho=rho, basis=basis, keep_mass=keep_mass, model=model, repair=repair,
-                               cache=cache, geometry=robot.geometry, budget=budget) for link in robot.links)
+    assumed = UserAssumptions(checked.assume)        # every mesh of the robot, read however deep, takes them
+    return tuple(_one_link(link, rho=rho, basis=basis, keep_mass=keep_mass, model=model, repair=repair,
+                           cache=cache, geometry=robot.geometry, budget=budget, assume=assumed) for link in robot.links)
 
 
 # -- where the geometry is (for the audit) -----------------------------------------------------------------
