@@ -5,6 +5,9 @@ its C extension built) runs itself once per checkout in a new interpreter, so th
 ``inertia_tool`` (never both in one process) and starts from the same state; in rounds, the checkouts take turns
 in alternating order, so that a change in the machine's load meets both.  Used by ``bench_intersect_agree.py``
 (its child pickles every case's answers) and ``bench_batch.py`` (its child prints JSON lines of timings).
+
+:func:`this_checkout_first` is the one rule by which a benchmark run as ``python benchmarks/bench_X.py`` picks the
+``inertia_tool`` it measures: the checkout holding the script, unless ``PYTHONPATH`` names one.
 """
 
 from __future__ import annotations
@@ -17,6 +20,27 @@ from typing import TypeVar
 
 #: What :func:`in_turn` alternates: a checkout, or a checkout with its label.
 Item = TypeVar("Item")
+
+
+def this_checkout_first() -> str | None:
+    """Put the checkout holding ``benchmarks/`` first on ``sys.path``, so that ``import inertia_tool`` finds this
+    checkout's package and not an installed one (an editable install points at whichever checkout made it);
+    unless ``PYTHONPATH`` is set: then it names the checkout to run (how :func:`run_script` runs another tree,
+    and how a user runs these benchmarks on a baseline: ``PYTHONPATH=/path/to/main python benchmarks/...``).
+
+    Call it before the first import of ``inertia_tool`` (or of a ``tests/`` helper that imports it); calling it
+    again puts the folder first again without a second entry.
+
+    Returns
+    -------
+    str or None
+        The folder put first, or None when ``PYTHONPATH`` decides.
+    """
+    if os.environ.get("PYTHONPATH"):
+        return None
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    sys.path[:] = [root, *(p for p in sys.path if p != root)]
+    return root
 
 
 def in_turn(checkouts: Sequence[Item], round_: int) -> Iterator[Item]:

@@ -29,6 +29,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 import adversary_solids as S  # noqa: E402
 
 LABELS = ("exact", "united", "estimate", "summed", "unverified", "refused", "crashed")
@@ -131,6 +134,7 @@ def main(argv=None):
         first = S.KINDS.index(args.kind)
         indices = range(first, first + len(S.KINDS) * args.cases, len(S.KINDS))
     for i in indices:
+        started = time.process_time()
         case = draw(args.seed, i)
         if case.kind == "figure_eight" and args.mc:
             mc = S.monte_carlo(case.vertices, case.faces, np.random.default_rng([args.seed, i, 1]), args.mc)
@@ -146,6 +150,9 @@ def main(argv=None):
             if S.silent(verdict):
                 row["silent wrong"] += 1
             classes[failure_class(case, verdict)].append((len(case.faces), i, case.recipe, verdict.wrong))
+        spent = time.process_time() - started
+        if spent > 10:                     # issue 21: a case over 10 s CPU is named, whatever its verdict
+            print(f"  slow: case {i} ({case.kind}) {spent:.1f} s CPU, {verdict.label}: {case.recipe}", flush=True)
         if (i + 1) % 1000 == 0 and args.kind is None:
             print(f"# {i + 1} cases, {time.time() - t0:.0f} s", file=sys.stderr, flush=True)
 

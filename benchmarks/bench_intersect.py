@@ -42,6 +42,9 @@ import time
 import warnings
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 
 from _shapes import SHAPES  # noqa: E402  (benchmarks/ is not a package)
 

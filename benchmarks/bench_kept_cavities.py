@@ -19,6 +19,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 from test_mesh_kept_cavities import _draw, _verdict  # noqa: E402
 
 
@@ -32,10 +35,15 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.process_time()
     for i in range(args.cases):
         boxes = _draw(np.random.default_rng([args.seed, i]))
+        started = time.process_time()
         try:
             label, why = _verdict(boxes)
         except Exception as exc:  # noqa: BLE001 - any other exception is a crash, counted and shown
             label, why = "crashed", f"{type(exc).__name__}: {exc}"
+        spent = time.process_time() - started
+        if spent > 10:                     # issue 21: a case over 10 s CPU is named, whatever its verdict
+            cells = [(lo.tolist(), hi.tolist(), s) for lo, hi, s in boxes]
+            print(f"  slow: case {i} {spent:.1f} s CPU, {label}: {cells}", flush=True)
         counts[label] += 1
         if label == "crashed":
             wrong.append((i, why, [(lo.tolist(), hi.tolist(), s) for lo, hi, s in boxes]))

@@ -9,6 +9,7 @@ nested-copy rule, 0 after.
 """
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 import warnings
@@ -18,6 +19,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 from adversary_solids import box, certificate_label, cylinder, icosphere, torus, truth_from_manifold  # noqa: E402
 from inertia_tool.errors import InvalidMeshError  # noqa: E402
 from inertia_tool.mass.pipeline import mass_properties  # noqa: E402
@@ -55,14 +59,23 @@ def case(rng):
     return kind, mode, k, v, w, f
 
 
+def truth(v, w, f) -> float:
+    """Volume of the union of the piece ``(v, f)`` and its copy ``(w, f)`` by manifold3d, formed with both moved by
+    the piece's first corner (the volume does not change; manifold3d's union formed 1e6 sizes out was 7.3e-4 too
+    large, seed 1605 case 1371, ``tests/test_count15_findings.py``)."""
+    origin = v[0].copy()
+    return truth_from_manifold([(v - origin, f), (w - origin, f)]).volume
+
+
 def run(seed, n):
     rng = np.random.default_rng(seed)
     counts: dict = {}
     bad = []
     for i in range(n):
         kind, mode, k, v, w, f = case(rng)
+        started = time.process_time()
         try:
-            truth = truth_from_manifold([(v, f), (w, f)]).volume
+            truth_volume = truth(v, w, f)
         except Exception:  # noqa: BLE001 - a truth manifold3d refuses is counted, not judged
             counts["truth failed"] = counts.get("truth failed", 0) + 1
             continue
@@ -71,20 +84,26 @@ def run(seed, n):
                 warnings.simplefilter("always")
                 p = mass_properties((np.vstack([v, w]), np.vstack([f, f + len(v)])), density=1.0)
             label = certificate_label(p.mesh)
-            ok = abs(p.mass - truth) / truth < 1e-6
+            ok = abs(p.mass - truth_volume) / truth_volume < 1e-6
             key = (label, "right" if ok else "wrong")
             if not ok:
-                bad.append((i, kind, mode, k, label, p.mass, truth, [str(x.message)[:400] for x in caught]))
+                bad.append((i, kind, mode, k, label, p.mass, truth_volume, [str(x.message)[:400] for x in caught]))
         except InvalidMeshError as e:
             key = ("refused", str(e)[:80])
+        spent = time.process_time() - started
+        if spent > 10:                     # issue 21: a case over 10 s CPU is named, whatever its verdict
+            print(f"  slow: case {i} (piece {kind}, mode {mode}, k {k}) {spent:.1f} s CPU, {key}", flush=True)
         counts[key] = counts.get(key, 0) + 1
     return counts, bad
 
 
-if __name__ == "__main__":
-    seed, n = int(sys.argv[1]), int(sys.argv[2])
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("seed", type=int, nargs="?", default=121, help="the cases are drawn in turn from default_rng(seed)")
+    ap.add_argument("cases", type=int, nargs="?", default=240, help="how many cases")
+    args = ap.parse_args(argv)
     t = time.process_time()
-    counts, bad = run(seed, n)
+    counts, bad = run(args.seed, args.cases)
     for key, c in sorted(counts.items(), key=str):
         print(c, key)
     for b in bad[:40]:
@@ -92,3 +111,8 @@ if __name__ == "__main__":
         for m in b[7]:
             print("   ", m)
     print("cpu", time.process_time() - t)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -32,6 +32,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import adversary_solids as S  # noqa: E402
 import bench_review9_convex as C  # noqa: E402
@@ -168,12 +171,16 @@ def main_winding(args):
     t0 = time.process_time()
     for i in range(args.cases):
         mode = MODES[i % len(MODES)]
+        started = time.process_time()
         try:
             recipe, verdict, _, alt = run_winding(mode, args.seed, i, args.repair)
         except Exception as exc:                     # the truth failed (qhull): counted apart
             table[mode]["truth failed"] += 1
             fails.append((i, mode, f"truth failed: {type(exc).__name__}: {str(exc)[:120]}"))
             continue
+        spent = time.process_time() - started
+        if spent > 10:                     # issue 21: a case over 10 s CPU is named, whatever its verdict
+            print(f"  slow: case {i} ({mode}) {spent:.1f} s CPU, {verdict.label}: {recipe}", flush=True)
         row = table[mode]
         row["cases"] += 1
         row[verdict.label] += 1

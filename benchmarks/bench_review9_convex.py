@@ -37,6 +37,9 @@ from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, HalfspaceIntersection
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _checkouts import this_checkout_first  # noqa: E402
+
+this_checkout_first()                  # this checkout's inertia_tool, unless PYTHONPATH names another
 import adversary_solids as S  # noqa: E402
 from inertia_tool.tolerances import ROUNDOFF_RTOL  # noqa: E402
 
@@ -364,12 +367,16 @@ def main(argv=None):
     t0 = time.time()
     for i in range(args.cases):
         mode = MODES[i % len(MODES)]
+        started = time.process_time()
         try:
             case, verdict, err = run(mode, args.seed, i, args.repair)
         except Exception as exc:           # the truth failed (qhull): skipped, counted
             table[mode]["truth failed"] += 1
             fails.append((i, mode, f"truth failed: {type(exc).__name__}: {str(exc)[:120]}"))
             continue
+        spent = time.process_time() - started
+        if spent > 10:                     # issue 21: a case over 10 s CPU is named, whatever its verdict
+            print(f"  slow: case {i} ({mode}) {spent:.1f} s CPU, {verdict.label}: {case.recipe}", flush=True)
         row = table[mode]
         row["cases"] += 1
         row[verdict.label] += 1

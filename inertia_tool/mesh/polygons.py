@@ -228,7 +228,9 @@ def _ear_clip(relative: np.ndarray, normal: np.ndarray) -> list[tuple[int, int, 
     if k > MAX_EAR_CLIPPED_CORNERS:
         return None
     drop = int(np.argmax(np.abs(normal)))
-    axes = [a for a in range(3) if a != drop]
+    # (u, w, dropped axis) in cyclic order, so that a polygon counter-clockwise about +drop runs counter-clockwise
+    # in (u, w); (x, z) about +y would run it clockwise and no ear would be found (count15: a prism's cap in y = 0)
+    axes = ((1, 2), (2, 0), (0, 1))[drop]
     if normal[drop] < 0:
         axes = axes[::-1]                         # so that the polygon runs counter-clockwise in (u, w)
     return ear_clip_2d(relative[:, axes[0]], relative[:, axes[1]])
