@@ -422,13 +422,22 @@ def _budget_refusal(evaluations: int, budget: int, resolution: int, dims: tuple[
                                                        "resolution": resolution, "crossed": crossed})
 
 
+def _inside_out_as_a_whole(positive: float, negative: float) -> bool:
+    """Whether the grid reads the surface turned over: its winding is below −1/2 somewhere and above 1/2 nowhere
+    (``positive``, ``negative``: the sums of the winding numbers above 1/2 and of minus those below −1/2).  Where
+    the winding is positive in some places and negative in others no turn of the whole surface is the file's
+    solid: the solid is where the winding number as wound is at least one (the issue's definition; session 15:
+    a box wound outward holding four crossing boxes wound inward, 0.172 m³, was read turned as 0.261 ±11 %)."""
+    return positive == 0.0 and negative > 0.0
+
+
 def _cell_codes(w: np.ndarray, err: np.ndarray | None, crossed: np.ndarray, w_low: float, w_high: float
                 ) -> tuple[np.ndarray, np.ndarray, int]:
     """The codes of :func:`_winding_grid` from every cell's winding number ``w`` (0.5 on crossed cells; turned
-    over in place when the surface is inside out as a whole) and its error bound ``err`` (or None): twice the
-    material (crossed 1, decided inside 2), twice the density in doubt (crossed 1, ambiguous 2), both (cells,)
-    uint8, and the number of free cells undecided."""
-    if np.sum(w[w > 0.5]) < np.sum(-w[w < -0.5]):
+    over in place when the surface is inside out as a whole, :func:`_inside_out_as_a_whole`) and its error bound
+    ``err`` (or None): twice the material (crossed 1, decided inside 2), twice the density in doubt (crossed 1,
+    ambiguous 2), both (cells,) uint8, and the number of free cells undecided."""
+    if _inside_out_as_a_whole(float(np.sum(w[w > 0.5])), float(np.sum(-w[w < -0.5]))):
         np.negative(w, out=w)                       # the surface is inside out as a whole
     material2 = np.where(crossed, np.uint8(1), (w > 0.5).astype(np.uint8) * np.uint8(2))
     ambiguous = (w > w_low) & (w < w_high)
@@ -450,8 +459,8 @@ def _region_codes(regions: _Regions, w_low: float, w_high: float) -> tuple[np.nd
     else:
         count = np.bincount(region, minlength=len(whole)).astype(np.float64)
     count[0] = 0.0                                  # the crossed cells: w = 1/2, in neither sum
-    if float(np.sum(count * np.where(whole > 0.5, whole, 0.0))) < float(np.sum(count * np.where(whole < -0.5,
-                                                                                                 -whole, 0.0))):
+    if _inside_out_as_a_whole(float(np.sum(count * np.where(whole > 0.5, whole, 0.0))),
+                              float(np.sum(count * np.where(whole < -0.5, -whole, 0.0)))):
         np.negative(whole, out=whole)               # the surface is inside out as a whole
     material = np.where(whole > 0.5, 2, 0).astype(np.uint8)
     ambiguous = (whole > w_low) & (whole < w_high)
