@@ -60,7 +60,7 @@ def test_an_estimate_missing_from_an_estimated_resolution_is_a_named_internal_er
     broken = Resolution(vertices=np.zeros((0, 3)), faces=np.zeros((0, 3), dtype=np.int64), method="winding",
                         notes=(), flipped_faces=0, welded_tolerance=None, nonmanifold_edges=0, estimate=None)
     with pytest.raises(InternalInvariantError, match="expected to carry its estimate; found none"):
-        _estimated(broken, {})
+        _estimated(broken, {}, None)
     with pytest.raises(InternalInvariantError, match="<arrays>: the forced .* found none"):
         with_patch_doubt(broken, None, "<arrays>")
 
