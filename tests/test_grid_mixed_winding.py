@@ -24,9 +24,10 @@ from inertia_tool.errors import InvalidMeshError
 from inertia_tool.mesh import grid_estimate
 
 
-def _holds_for_the_files_winding(boxes) -> bool:
-    """The answer with ``repair=True`` is refused, or certified and equal to ``{w ≥ 1}`` as wound (or to another
-    reading of the judge's), or an estimate whose stated bounds (relative to the estimate) contain one of them."""
+def repaired_verdict(boxes) -> tuple[str, str | None]:
+    """``(label, wrong)`` of the answer with ``repair=True``: None when it is refused, certified and equal to
+    ``{w ≥ 1}`` as wound (or to another reading of the judge's), or an estimate whose stated bounds (relative to
+    the estimate) contain one of them; else what is wrong (``benchmarks/bench_kept_cavities.py --repair``)."""
     v, f = _mesh(boxes)
     diag = float(np.linalg.norm(np.ptp(v, axis=0)))
     with warnings.catch_warnings():
@@ -34,11 +35,12 @@ def _holds_for_the_files_winding(boxes) -> bool:
         try:
             props = mass_properties((v, f), density=1.0, repair=True)
         except InvalidMeshError:
-            return True
+            return "refused", None
     label = certificate_label(props.mesh)
     if label not in ("exact", "united", "estimate"):
-        return True
-    for volume, centroid, inertia in _readings(boxes):
+        return label, None
+    readings = _readings(boxes)
+    for volume, centroid, inertia in readings:
         dc = float(np.linalg.norm(props.center_of_mass - centroid))
         if label == "estimate":
             u = props.mesh.uncertainty
@@ -46,11 +48,15 @@ def _holds_for_the_files_winding(boxes) -> bool:
                     and dc <= u.center_of_mass + 1e-9 * diag
                     and np.linalg.norm(props.inertia - inertia) <= u.inertia * np.linalg.norm(props.inertia)
                     * (1 + 1e-9)):
-                return True
+                return label, None
         elif (abs(props.mass - volume) <= 1e-9 * volume and dc <= 1e-9 * diag
               and np.linalg.norm(props.inertia - inertia) <= 1e-8 * np.linalg.norm(inertia)):
-            return True
-    return False
+            return label, None
+    return label, f"{label} {props.mass} m³ for the readings {[r[0] for r in readings]}"
+
+
+def _holds_for_the_files_winding(boxes) -> bool:
+    return repaired_verdict(boxes)[1] is None
 
 
 def test_boxes_whose_cavities_reach_outside_every_body_are_estimated_by_the_files_winding():
