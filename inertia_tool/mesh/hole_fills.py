@@ -374,6 +374,30 @@ class CurvedFill:
     caps: np.ndarray
 
 
+def region_check(centre: np.ndarray, radius: np.ndarray, capsule: tuple[np.ndarray, np.ndarray, np.ndarray],
+                  alone: np.ndarray, slab: tuple[np.ndarray, np.ndarray, np.ndarray]
+                  ) -> Callable[[int, np.ndarray], bool]:
+    """``inside(loop, points)``: whether every point lies in the region a hole's bound states — its ball, the
+    capsule where the hole is read alone (``alone``), and the slab where it is cut to one (finite half-width) —
+    so that a fill made of them leaves the bound as it is (:func:`plane_fills`; :func:`curved_fills`, with the
+    capsule everywhere)."""
+    start, end, thick = capsule
+    normal, origin, half = slab
+
+    def inside(k: int, points: np.ndarray) -> bool:
+        if not bool((np.linalg.norm(points - centre[k], axis=1) <= radius[k]).all()):
+            return False
+        if alone[k]:
+            seg = end[k] - start[k]
+            t = np.clip((points - start[k]) @ seg / max(float(seg @ seg), 1e-300), 0.0, 1.0)
+            if not bool((np.linalg.norm(points - (start[k] + t[:, None] * seg), axis=1) <= thick[k]).all()):
+                return False
+        if np.isfinite(half[k]):
+            return bool((np.abs((points - origin[k]) @ normal[k]) <= half[k]).all())
+        return True
+    return inside
+
+
 def curved_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
                  apex: np.ndarray, centre: np.ndarray, radius: np.ndarray, capsule: tuple[np.ndarray, ...],
                  slab: tuple[np.ndarray, np.ndarray, np.ndarray], order: np.ndarray, *,
@@ -400,8 +424,8 @@ def curved_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     n = len(v)
-    start, end, thick = capsule
-    normal, origin, half = slab
+    # the fill must lie where the bound looks: in the ball, the capsule and the slab over the rim
+    inside = region_check(centre, radius, (capsule[0], capsule[1], capsule[2]), np.ones(n_loops, dtype=bool), slab)
     out: list[CurvedFill] = []
     tried = 0
     for k in order.tolist():
@@ -447,13 +471,7 @@ def curved_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
         if not np.isfinite(moved).all():
             continue
         # the fill must lie where the bound looks: in the ball, the capsule and the slab over the rim
-        seg = end[k] - start[k]
-        t = np.clip((moved - start[k]) @ seg / max(float(seg @ seg), 1e-300), 0.0, 1.0)
-        inside = ((np.linalg.norm(moved - centre[k], axis=1) <= radius[k])
-                  & (np.linalg.norm(moved - (start[k] + t[:, None] * seg), axis=1) <= thick[k]))
-        if np.isfinite(half[k]):
-            inside &= np.abs((moved - origin[k]) @ normal[k]) <= half[k]
-        if not inside.all():
+        if not inside(k, moved):
             continue
         # spoke points: level 0 is the rim vertex, ``levels`` the apex (n + k), between them inner point
         # −1 − (slot · (levels − 1) + level − 1), ``slot`` the vertex's place in ``rim``

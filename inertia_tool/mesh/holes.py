@@ -64,7 +64,7 @@ from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES
                          CurvedFill, _crease_contradicted, _crease_rim_contradicts as _crease_rim_contradicts,
                          _may_hold_two_planes as _may_hold_two_planes, _quadric as _quadric,
                          _ring_faces as _ring_faces, crease_fills, curved_fills, curved_surroundings,
-                         PlaneFill, plane_fills)
+                         PlaneFill, plane_fills, region_check)
 from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions, named, stated, user_stated
 from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
@@ -363,11 +363,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             sign = 1.0 if bool(np.array_equal(pf[:len(f)], f)) else -1.0
             no_capsule = np.zeros(n_loops, dtype=bool)
             planes = plane_fills(v, f, edges, label, ranked, apex, radius,
-                                 _region_check(centre, radius, (start, end, thick), no_capsule, slab), outward=sign)
+                                 region_check(centre, radius, (start, end, thick), no_capsule, slab), outward=sign)
             # a fill that leaves the capsule (a corner's three planes meet beyond a thin rim's axis) is kept only
             # with the hole's doubt back to its ball's, and only while all the doubt stays within PLANE_WIDEN_SHARE
             # of the volume (a wider bound, never a refusal of its own making); else the hole keeps its fill
-            strict = _region_check(centre, radius, (start, end, thick), alone, slab)
+            strict = region_check(centre, radius, (start, end, thick), alone, slab)
             kept: list[PlaneFill] = []
             for plane in planes:
                 points = np.vstack([plane.apex[None, :], plane.points])
@@ -492,29 +492,6 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                     unbounded=unbounded, assumptions=tuple(a.name for a in named(used))
                     + (("flat-islands",) if took_island.any() else ()),
                     islands=int(np.count_nonzero(island & ~took_island)))
-
-
-def _region_check(centre: np.ndarray, radius: np.ndarray, capsule: tuple[np.ndarray, np.ndarray, np.ndarray],
-                  alone: np.ndarray, slab: tuple[np.ndarray, np.ndarray, np.ndarray]
-                  ) -> Callable[[int, np.ndarray], bool]:
-    """``inside(loop, points)``: whether every point lies in the region a hole's bound states — its ball, the
-    capsule where the hole is read alone (``alone``), and the slab where it is cut to one (finite half-width) —
-    so that a fill made of them leaves the bound as it is (:func:`~.hole_fills.plane_fills`)."""
-    start, end, thick = capsule
-    normal, origin, half = slab
-
-    def inside(k: int, points: np.ndarray) -> bool:
-        if not bool((np.linalg.norm(points - centre[k], axis=1) <= radius[k]).all()):
-            return False
-        if alone[k]:
-            seg = end[k] - start[k]
-            t = np.clip((points - start[k]) @ seg / max(float(seg @ seg), 1e-300), 0.0, 1.0)
-            if not bool((np.linalg.norm(points - (start[k] + t[:, None] * seg), axis=1) <= thick[k]).all()):
-                return False
-        if np.isfinite(half[k]):
-            return bool((np.abs((points - origin[k]) @ normal[k]) <= half[k]).all())
-        return True
-    return inside
 
 
 def _between_cone_and_planes(planes: list[PlaneFill], vertices: np.ndarray, outward: np.ndarray
