@@ -44,9 +44,14 @@ from inertia_tool.mesh import LoadOptions  # noqa: E402
 STAGES = (
     "inertia_tool.batch.runner:_read_once",
     "inertia_tool.mesh.read:load_mesh",
+    "inertia_tool.mesh.read_stl:_read_stl",
+    "inertia_tool.mesh.weld:_weld_stream_c",
     "inertia_tool.mass.pipeline:mass_properties",
     "inertia_tool.mesh.clean_part:prepare_clean",
     "inertia_tool.integrals:one_shell_moments",
+    "inertia_tool.mesh.surface:check_magnitude",
+    "inertia_tool.mesh.clean_part:_meet_only_in_contacts",
+    "inertia_tool.mesh.precision:conversion_bounds",
     "inertia_tool.mesh.prepare:prepare_mesh",
     "inertia_tool.mesh.surface:close_surface",
     "inertia_tool.mesh.checks:census_and_shells",
@@ -62,6 +67,8 @@ STAGES = (
     "inertia_tool.mesh.certify:certify",
     "inertia_tool.mass.pipeline:_bodies",
     "inertia_tool.mass.principal:principal_axes",
+    "inertia_tool.mass.pipeline:_check_physical",
+    "inertia_tool.mass.pipeline:_warn_about_principal",
     "inertia_tool.mesh.precision:warn_storage_precision",
 )
 

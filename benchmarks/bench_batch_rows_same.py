@@ -7,7 +7,10 @@ OBJ file (coordinates printed with 17 significant digits: the float64 values exa
 binary STL (float32, the STL path's own welding), plus a few bad files (empty, truncated, not a mesh, a directory
 named like a mesh, a FIFO).  Then each checkout, in a fresh child process, runs the batch's per-file work
 (``analyze_chunk``) over all of them, once with the default options and once with ``repair=True``, and this script
-compares the rows field by field; ``seconds`` and ``worker`` (the time taken and the process) are left out.
+compares the rows as the batch writes them: each row's bytes in both formats of the results file (JSONL and CSV,
+each checkout's own writer, ``inertia_tool.batch.rows.format_row``), and each field by its JSON text, so that a
+change Python's ``==`` cannot see is a difference (``-0.0`` for ``0.0``, ``1`` or ``True`` for ``1.0``: different
+bytes in the file).  ``seconds`` and ``worker`` (the time taken and the process) are blanked in both.
 
     python benchmarks/bench_batch_rows_same.py --baseline DIR [--small 2000] [--damage DIR ...]
 
@@ -46,11 +49,52 @@ def _child(tree: str, listing: str, out: str) -> None:
     warnings.simplefilter("ignore")
     with open(listing) as fh:
         files = [line.rstrip("\n") for line in fh if line.strip()]
+    from inertia_tool.batch.rows import format_row
+
     with open(out, "w") as fh:
         for label, options in (("default", BatchOptions(load=LoadOptions(units="mm"), density=1240.0)),
                                ("repair", BatchOptions(load=LoadOptions(units="mm", repair=True), material="steel"))):
             for row in analyze_chunk([(path, None) for path in files], options):
-                fh.write(json.dumps({"options": label, **row}, sort_keys=True) + "\n")
+                row.update(dict.fromkeys(VOLATILE))
+                written = {fmt: format_row(row, fmt).decode("utf-8") for fmt in ("jsonl", "csv")}
+                fh.write(json.dumps({"options": label, "row": row, "written": written}) + "\n")
+
+
+def _text(value) -> str:
+    """A field's value as JSON text: what tells ``-0.0`` from ``0.0`` and ``1`` or ``True`` from ``1.0``."""
+    return json.dumps(value)
+
+
+def compare_rows(mine: list[dict], theirs: list[dict]) -> tuple[dict[tuple[str, str], int], list[tuple]]:
+    """Compare two checkouts' records (``{"options", "row", "written"}``, as :func:`_child` writes them), in order.
+
+    Returns
+    -------
+    statuses : dict
+        ``(options, status) -> rows`` of ``mine``.
+    different : list of tuple
+        ``(options, path, what, here, baseline)`` for each field whose JSON text differs (``what`` its name), each
+        written form whose bytes differ (``what`` ``"written jsonl"`` or ``"written csv"``), and one ``"rows"``
+        entry when the numbers of rows differ; empty when every row is the same.  ``seconds`` and ``worker``
+        are not compared.
+    """
+    statuses: dict[tuple[str, str], int] = {}
+    different: list[tuple] = []
+    if len(mine) != len(theirs):
+        different.append(("", "", "rows", len(mine), len(theirs)))
+    for a, b in zip(mine, theirs):
+        ra, rb = a["row"], b["row"]
+        statuses[a["options"], ra.get("status")] = statuses.get((a["options"], ra.get("status")), 0) + 1
+        where = (a["options"], ra.get("path"))
+        if a["options"] != b["options"]:
+            different.append((*where, "options", a["options"], b["options"]))
+        for k in sorted(set(ra) | set(rb)):
+            if k not in VOLATILE and (k not in ra or k not in rb or _text(ra[k]) != _text(rb[k])):
+                different.append((*where, k, ra.get(k, "(absent)"), rb.get(k, "(absent)")))
+        for fmt in sorted(set(a["written"]) | set(b["written"])):
+            if a["written"].get(fmt) != b["written"].get(fmt):
+                different.append((*where, f"written {fmt}", a["written"].get(fmt), b["written"].get(fmt)))
+    return statuses, different
 
 
 def _write_obj(path: str, vertices, faces) -> None:
@@ -149,25 +193,17 @@ def main() -> int:
     mine, theirs = rows["this checkout"], rows["baseline"]
     print("files: " + "; ".join(f"{n} {what}" for what, n in counts.items()) + f"; {len(files)} in all, "
           "each with the default options and with repair=True")
-    if len(mine) != len(theirs):
-        print(f"DIFFERENT: {len(mine)} rows here, {len(theirs)} in the baseline")
-        return 1
-    statuses: dict[tuple[str, str], int] = {}
-    different = []
-    for a, b in zip(mine, theirs):
-        statuses[a["options"], a["status"]] = statuses.get((a["options"], a["status"]), 0) + 1
-        for k in sorted(set(a) | set(b)):
-            if k not in VOLATILE and a.get(k) != b.get(k):
-                different.append((a["options"], a["path"], k, a.get(k), b.get(k)))
-    fields = len(mine[0]) - len(VOLATILE) if mine else 0
-    print(f"{len(mine)} rows of {fields} fields compared (all but {', '.join(VOLATILE)}); statuses: "
+    statuses, different = compare_rows(mine, theirs)
+    fields = len(mine[0]["row"]) - len(VOLATILE) if mine else 0
+    print(f"{len(mine)} rows of {fields} fields compared by their JSON text, and as written (JSONL and CSV bytes; "
+          f"{', '.join(VOLATILE)} blanked); statuses: "
           + ", ".join(f"{o} {s} {n}" for (o, s), n in sorted(statuses.items())))
     if different:
-        print(f"DIFFERENT: {len(different)} fields, the first:")
+        print(f"DIFFERENT: {len(different)} fields or written rows, the first:")
         for d in different[:20]:
             print("  ", d)
         return 1
-    print("identical: every field of every row")
+    print("identical: every field of every row, and every row as written in both formats")
     return 0
 
 
