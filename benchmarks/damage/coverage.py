@@ -363,15 +363,16 @@ def make_case(kind, v, f, rng, diag):
 
 # --------------------------------------------------------------------------------------------- evaluation
 
-def evaluate(v, f, truth):
-    """What repair=True says about a damaged mesh, checked against the truth."""
+def evaluate(v, f, truth, assume=()):
+    """What repair=True says about a damaged mesh, checked against the truth (``assume``: the user's assumptions,
+    ``LoadOptions.assume``)."""
     import inertia_tool as it
 
     start = time.perf_counter()
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            p = it.mass_properties((v, f), density=1.0, repair=True)
+            p = it.mass_properties((v, f), density=1.0, repair=True, assume=tuple(assume))
     except it.errors.InvalidMeshError as exc:
         return {"status": "refused", "seconds": time.perf_counter() - start, "reason": str(exc)[:300]}
     except Exception as exc:       # a bug: reported, never hidden
@@ -394,6 +395,7 @@ def evaluate(v, f, truth):
     certificate = p.mesh.certificate.kind
     # an "unverified" answer claims no bound (its certificate says so): counted apart, never as holding
     return {"status": "answer", "seconds": seconds, "method": p.mesh.method, "certificate": certificate,
+            "assumptions": list(p.mesh.certificate.assumptions),
             "holds": None if certificate == "unverified" else bool(holds),
             "within": bool(within), "mass_bound": float(bounds[0]), "com_bound_of_diag": float(bounds[1] / diag),
             "inertia_bound": float(bounds[2]), "mass_error": err_mass / truth["volume"],
@@ -418,7 +420,8 @@ def cases(sources, seeds, repeats=1, kinds=KINDS):
 
 
 def run_case(args):
-    case_id, source, kind, entropy, (name, v, f, clean_truth) = args
+    case_id, source, kind, entropy, (name, v, f, clean_truth) = args[:5]
+    assume = tuple(args[5]) if len(args) > 5 else ()
     rng = np.random.default_rng(entropy)
     truth, quantum = clean_truth, None
     if rng.random() < QUANTISE_SHARE:
@@ -444,6 +447,11 @@ def run_case(args):
     result["area_lost_share"] = _area_lost(v, f, dv, df)
     if result["status"] == "refused" and refusal_cause(result["reason"]) == BALL_CAUSE:
         result["bypassed"] = bypassed(dv, df, truth)
+    if assume:
+        # the same case with the user's assumptions stated (``--assume``): reported beside the default answer
+        cpu = time.process_time()
+        result["assumed"] = evaluate(dv, df, truth, assume)
+        result["assumed"]["cpu_seconds"] = time.process_time() - cpu
     return {"id": case_id, "source": name, "kind": kind, "faces": int(len(df)), "quantum": quantum, **meta, **result}
 
 
@@ -610,6 +618,11 @@ def bypass_table(rows):
     return "\n".join(lines)
 
 
+def assumed_rows(rows):
+    """The rows as answered with ``--assume`` (each row's ``assumed`` result in place of its default one)."""
+    return [{**r, **r["assumed"]} if "assumed" in r else r for r in rows]
+
+
 def load_sources(names):
     out = []
     for group in names:
@@ -640,6 +653,9 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=OUT / "coverage.json",
                         help="the results file (JSON); a folder given here gets coverage.json in it")
     parser.add_argument("--subset", action="store_true", help="the CI subset only")
+    parser.add_argument("--assume", action="append", default=[], metavar="NAME",
+                        help="also answer every case with this user's assumption stated (LoadOptions.assume) and "
+                             "report both")
     args = parser.parse_args(argv)
     if args.out.is_dir():             # a folder: its coverage.json (a run of minutes must not end unable to write)
         args.out = args.out / "coverage.json"
@@ -650,7 +666,8 @@ def main(argv=None) -> int:
         sources = load_sources(args.sources.split(","))
         seeds = [int(s) for s in args.seeds.split(",")]
         kinds = tuple(args.kinds.split(","))
-        tasks = [(cid, s, kind, ent, sources[s]) for cid, s, kind, ent in cases(sources, seeds, args.repeats, kinds)]
+        tasks = [(cid, s, kind, ent, sources[s], tuple(args.assume))
+                 for cid, s, kind, ent in cases(sources, seeds, args.repeats, kinds)]
         print(f"{len(tasks)} cases from {len(sources)} sources, seeds {seeds}", flush=True)
         with mp.get_context("spawn").Pool(args.workers) as pool:
             rows = []
@@ -661,7 +678,11 @@ def main(argv=None) -> int:
                 if (i + 1) % 100 == 0:
                     print(f"{i + 1}/{len(tasks)}", flush=True)
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps({"summary": summarise(rows), "rows": rows}, indent=1))
+    summary = {"summary": summarise(rows)}
+    if args.assume:
+        summary["summary_assumed"] = summarise(assumed_rows(rows))
+        summary["assumed"] = list(args.assume)
+    args.out.write_text(json.dumps({**summary, "rows": rows}, indent=1))
     print(table(rows))
     print()
     print(refusal_table(rows))
@@ -669,6 +690,13 @@ def main(argv=None) -> int:
         print()
         print(bypass_table(rows))
     print(json.dumps(summarise(rows), indent=1))
+    if args.assume:
+        with_assumption = assumed_rows(rows)
+        print(f"\nWith --assume {' --assume '.join(args.assume)}:")
+        print(table(with_assumption))
+        print()
+        print(refusal_table(with_assumption))
+        print(json.dumps(summarise(with_assumption), indent=1))
     return 0
 
 

@@ -136,7 +136,7 @@ def add_mesh_options(parser) -> None:
 
 #: The names ``--assume`` takes, for help without loading the engine (the same as
 #: ``mesh.hole_assumptions.USER_ASSUMPTIONS``: tests/test_cli_assume.py checks it).
-ASSUME_NAMES = ("flat-islands",)
+ASSUME_NAMES = ("flat-islands", "smooth-holes")
 
 
 def add_assume_option(group) -> None:
@@ -146,7 +146,10 @@ def add_assume_option(group) -> None:
                        help="with --repair: an assumption about the lost surface that the file cannot show, named "
                             "in the report as yours; flat-islands: each hole that is an island in a flat face lost "
                             "a flat piece of that face (filled flat and bounded instead of refused; a boss or "
-                            "pocket taken whole there breaks it). Known: " + ", ".join(ASSUME_NAMES))
+                            "pocket taken whole there breaks it); smooth-holes: each hole lost a piece of a smooth "
+                            "surface continuing the one round it (bounded by how far such a continuation "
+                            "may stray; a feature, edge or corner taken whole breaks it). Known: "
+                            + ", ".join(ASSUME_NAMES))
 
 
 def assumed_from_args(args) -> tuple[str, ...]:

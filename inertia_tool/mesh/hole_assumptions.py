@@ -27,7 +27,11 @@ a feature taken whole there by the ring's slope.
 ``LoadOptions.assume`` / ``--assume flat-islands`` states that each such island lost a flat piece of its face
 (:data:`FLAT_ISLANDS`); the island is then filled in its rim's plane and bounded by the rim's own slab
 (:func:`~.hole_bounds.flat_island_doubt`), and the estimate names the assumption as the user's
-(:func:`user_stated`).  The user's assumptions travel as a parameter, a frozen :class:`UserAssumptions`, from the
+(:func:`user_stated`).  ``smooth-holes`` (:data:`SMOOTH_HOLES`) states that each hole lost a piece of a smooth
+surface continuing the one round it: a hole whose surroundings allow the reading is filled as a graph over the
+plane most face-on to them and bounded by how far that assumption lets the surface stray from the surroundings'
+quadratic (:func:`~.hole_bounds.smooth_doubt`), where that is narrower than its other bound.  The user's
+assumptions travel as a parameter, a frozen :class:`UserAssumptions`, from the
 API (``LoadOptions.assume``) through :func:`~.prepare.prepare_mesh`, :func:`~.surface.close_surface` and
 :func:`~.resolve.resolve_surface` to the one place that reads them, :func:`~.holes.patched_estimate`; no state
 outside the call holds them (issues 21/23: a pure engine), so two calls, in one thread or two, each get the answer
@@ -42,7 +46,7 @@ from typing import Iterable
 
 __all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "GRAPH", "PLANAR",
            "QUADRIC", "ALL", "stated", "named", "FLAT_ISLANDS", "USER_ASSUMPTIONS", "user_named", "UserAssumptions",
-           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT"]
+           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT", "SMOOTH_HOLES"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -133,10 +137,17 @@ FLAT_ISLANDS = HoleAssumption(
     "flat-islands", "each hole that is an island in a flat face lost a flat piece of that face",
     "a boss or pocket taken whole there")
 
+SMOOTH_HOLES = HoleAssumption(
+    "smooth-holes", "each hole lost a piece of a smooth surface continuing the one round it: a graph over the plane "
+    "its fill is a graph over, whose curvature departs from the least-squares quadratic of the faces within two "
+    "rings of the rim by at most twice what their quartic fit shows, with facets no longer than the edges there",
+    "a feature, sharp edge or corner taken whole with the hole (a boss, a pocket, a box's corner), or a surface "
+    "folding back over it")
+
 #: The assumptions a user may state (``LoadOptions.assume``, ``--assume``): each is what the file cannot show,
 #: so the tool never makes it on its own; with one stated, the holes it covers get the narrower bound it implies
 #: and the estimate names it as the user's (:func:`user_stated`).
-USER_ASSUMPTIONS = (FLAT_ISLANDS,)
+USER_ASSUMPTIONS = (FLAT_ISLANDS, SMOOTH_HOLES)
 
 #: The end of a refusal of a hole that is an island in a flat face: the option that would take it.
 ISLAND_HINT = " or, if the lost surface was flat, `assume` flat-islands"

@@ -1124,3 +1124,180 @@ def planar_rim_doubt(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray,
     doubt = np.where(candidate, ball_slab_volume(radius, offset, np.where(candidate, half, 0.0)), np.inf)
     return PlanarRims(applies=candidate, doubt=doubt, half_width=np.where(candidate, half, np.inf), normal=normal,
                       origin=mean)
+
+
+#: The user's ``smooth-holes`` assumption (:data:`~.hole_assumptions.SMOOTH_HOLES`): the missing surface lies
+#: within this many times (the surroundings' largest deviation from their quartic fit, plus the largest gap between
+#: their quartic and quadratic fits over the hole) of the quartic.  2: a margin over what the surroundings show,
+#: fixed before the benchmark's held-out seeds were run.
+SMOOTH_BAND_FACTOR = 2.0
+
+#: Least number of sample points (corners and face centres round the rim) for the quartic fit of
+#: :func:`smooth_doubt`: twice its fifteen coefficients.
+SMOOTH_MIN_POINTS = 30
+
+
+def _height_design(x: np.ndarray, y: np.ndarray, degree: int) -> np.ndarray:
+    """Monomials ``x^i y^j`` with ``i + j <= degree``, ordered by ``(i + j, j)``, as columns, (p, terms)."""
+    return np.column_stack([x ** (total - j) * y ** j for total in range(degree + 1) for j in range(total + 1)])
+
+
+def _hessian_norms(coef: np.ndarray, x: np.ndarray, y: np.ndarray, degree: int) -> np.ndarray:
+    """The spectral norm of the Hessian of the height ``Σ c_ij x^i y^j`` (:func:`_height_design`'s order) at each
+    point, (p,)."""
+    hxx = np.zeros_like(x)
+    hxy = np.zeros_like(x)
+    hyy = np.zeros_like(x)
+    at = 0
+    for total in range(degree + 1):
+        for j in range(total + 1):
+            i = total - j
+            c = coef[at]
+            at += 1
+            if i >= 2:
+                hxx = hxx + c * i * (i - 1) * x ** (i - 2) * y ** j
+            if i >= 1 and j >= 1:
+                hxy = hxy + c * i * j * x ** (i - 1) * y ** (j - 1)
+            if j >= 2:
+                hyy = hyy + c * j * (j - 1) * x ** i * y ** (j - 2)
+    # eigenvalues of [[a, b], [b, c]]: (a + c)/2 ± sqrt(((a − c)/2)² + b²)
+    half = 0.5 * (hxx + hyy)
+    root = np.sqrt((0.5 * (hxx - hyy)) ** 2 + hxy ** 2)
+    out: np.ndarray = np.abs(half) + root
+    return out
+
+
+@frozen_value
+class SmoothFill:
+    """One hole's fill and bound under the user's ``smooth-holes`` assumption (:func:`smooth_doubt`).
+
+    Attributes
+    ----------
+    points : (p, 3) float
+        The fill's inner points, lifted onto the surroundings' quartic, m.
+    doubt : float
+        Volume in doubt, m³ (rounded up).
+    height : float
+        How far the region in doubt reaches from the rim's mean height along the fill's direction, m.
+    band : float
+        ``t``: how far the assumption lets the missing surface stray from the quartic, m.
+    """
+
+    points: np.ndarray
+    doubt: float
+    height: float
+    band: float
+
+
+def smooth_doubt(vertices: np.ndarray, faces: np.ndarray, rim_edges: np.ndarray, points: np.ndarray,
+                 caps: np.ndarray, direction: np.ndarray, *, lift: bool = True, factor: float = SMOOTH_BAND_FACTOR,
+                 min_points: int = SMOOTH_MIN_POINTS) -> SmoothFill | None:
+    """A hole's graph fill lifted onto its surroundings' quartic, and its volume in doubt under ``smooth-holes``;
+    ``None`` where the surroundings do not allow the reading (too few points, a face round the rim facing away
+    from ``direction``, a fit of deficient rank).
+
+    Frame: ``d = direction``, heights ``h = (x − o)·d`` over the plane ``Π ⟂ d`` (``o`` the rim's centroid,
+    lengths scaled by the rim's radius about it).  The surroundings are the faces within two rings of the rim;
+    their corners and centres (the centres carry the facets' sag) are fitted in the least-squares sense by a
+    quadratic height ``S`` and a quartic height ``Q`` over ``Π``.  With ``lift``, the fill's inner points are moved
+    along ``d`` onto ``Q``; else they stay (the caller's rule: where the surroundings lie on one curved quadric,
+    :func:`~.hole_fills.curved_surroundings`, the graph fill's points lie on it, a better continuation of a
+    sphere or cylinder than a quartic).
+
+    **Assumption** (:data:`~.hole_assumptions.SMOOTH_HOLES`): the missing surface ``M`` is the graph of a height
+    ``g`` over the region ``Ω`` the projected rim bounds with ``|g − Q| ≤ t`` on ``Ω``, ``t = factor · (ρ + γ)``:
+    ``ρ`` the surroundings' largest ``|h − Q|`` (how far they stray from the fitted continuation) and ``γ`` the
+    largest ``|Q − S|`` at the fill's points (how much the continuation over the hole depends on the fit: zero on
+    a paraboloid, growing with the hole where the curvature changes).
+
+    **The bound** (follows from it; only ``factor`` is chosen).  The fill ``F`` and ``M`` are graphs over ``Ω``
+    with the rim as common border (``F`` checked to tile ``Ω`` once by :func:`~.hole_graphs.graph_fills`), so the
+    solids differ by ``∫_Ω |g − F| ≤ t |Ω| + ∫_Ω |F − Q|``.  On a fill triangle ``T`` (corners off ``Q`` by
+    ``δ_i``: zero inside, the rim's own deviation on it), ``Q − LQ = ½ Σ λ_i λ_j (q_i − q_j)ᵀ ∇²Q (q_i − q_j)``
+    up to the change of ``∇²Q`` across ``T``, so ``∫_T |F − Q| ≤ A_T (mean |δ_i| + H Σ ℓ_ij² / 24)``, ``H`` the
+    largest ``‖∇²Q‖`` at the sample's and the fill's points (not a bound between them: the one step taken on
+    trust, as :func:`~.hole_fills.region_check` checks a fill at its points).  Plus 16 ulp of the coordinates
+    times the area.  The region in doubt lies within ``height = max |z_i − h̄| + max_T (max |δ_i| + H ℓ_T²/6) +
+    t`` of the rim's mean height ``h̄``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    rim_edges : (r, 2) int
+        The rim's edges (the border of ``Ω``).
+    points : (p, 3) float
+        The graph fill's inner points, m.
+    caps : (q, 3) int
+        The fill's triangles: rim vertices by index, inner points as ``−1 − i``, tiling ``Ω`` once in projection
+        along ``direction`` (:func:`~.hole_graphs.graph_fills` checks it).
+    direction : (3,) float
+        Unit ``d``.
+    lift : bool
+        Move the inner points onto ``Q`` (else keep them; their distance from ``Q`` enters the bound).
+    factor, min_points
+        :data:`SMOOTH_BAND_FACTOR`, :data:`SMOOTH_MIN_POINTS`.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    d = np.asarray(direction, dtype=np.float64)
+    rim = np.unique(np.asarray(rim_edges, dtype=np.int64))
+    e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(d, e1)
+    origin = v[rim].mean(axis=0)
+    scale = float(np.max(np.linalg.norm(v[rim] - origin, axis=1)))
+    if not scale > 0:
+        return None
+
+    def frame(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        rel = (p - origin) / scale
+        return rel @ e1, rel @ e2, rel @ d
+
+    near = np.zeros(len(v), dtype=bool)
+    near[rim] = True
+    for _ in range(2):
+        near[f[near[f].any(axis=1)].reshape(-1)] = True
+    ring = f[near[f].all(axis=1)]
+    if not len(ring):
+        return None
+    normal = np.cross(v[ring[:, 1]] - v[ring[:, 0]], v[ring[:, 2]] - v[ring[:, 0]])
+    if not bool((normal @ d > 0).all()):
+        return None                        # the surroundings fold over Π: not a graph there
+    sample = np.vstack([v[np.unique(ring)], v[ring].mean(axis=1)])
+    if len(sample) < min_points:
+        return None
+    sx, sy, sh = frame(sample)
+    quart = _height_design(sx, sy, 4)
+    if np.linalg.matrix_rank(quart) < quart.shape[1]:
+        return None
+    cs, *_ = np.linalg.lstsq(_height_design(sx, sy, 2), sh, rcond=None)
+    cq, *_ = np.linalg.lstsq(quart, sh, rcond=None)
+    inner = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    ix, iy, _ = frame(inner)
+    lifted = _height_design(ix, iy, 4) @ cq if lift else frame(inner)[2]
+    new_points = origin + scale * (ix[:, None] * e1 + iy[:, None] * e2 + lifted[:, None] * d)
+    all_points = np.vstack([v, new_points])
+    tri = np.where(caps < 0, len(v) + (-1 - caps), caps)
+    px, py, ph = frame(all_points[tri.reshape(-1)])
+    px, py, ph = px.reshape(-1, 3), py.reshape(-1, 3), ph.reshape(-1, 3)
+    flat_x, flat_y = px.reshape(-1), py.reshape(-1)
+    on_q = _height_design(flat_x, flat_y, 4) @ cq
+    delta = np.abs(ph - on_q.reshape(-1, 3))
+    if lift:
+        delta[tri >= len(v)] = 0.0             # the inner points are on Q (their rounding is in the margin)
+    stray = float(np.max(np.abs(sh - quart @ cq)))
+    gap = float(np.max(np.abs(on_q - _height_design(flat_x, flat_y, 2) @ cs)))
+    band = factor * (stray + gap)
+    curvature = float(max(np.max(_hessian_norms(cq, sx, sy, 4)), np.max(_hessian_norms(cq, flat_x, flat_y, 4))))
+    area = 0.5 * np.abs((px[:, 1] - px[:, 0]) * (py[:, 2] - py[:, 0]) - (py[:, 1] - py[:, 0]) * (px[:, 2] - px[:, 0]))
+    sq = (px - np.roll(px, -1, axis=1)) ** 2 + (py - np.roll(py, -1, axis=1)) ** 2
+    margin = _round_off(all_points) / scale
+    doubt = float(np.sum(area * (delta.mean(axis=1) + curvature * sq.sum(axis=1) / 24.0 + band + 2.0 * margin)))
+    rim_h = frame(v[rim])[2]
+    height = (float(np.max(np.abs(ph - float(rim_h.mean()))))
+              + float(np.max(delta.max(axis=1) + curvature * sq.max(axis=1) / 6.0)) + band + 2.0 * margin)
+    if not (np.isfinite(doubt) and np.isfinite(height) and np.isfinite(new_points).all()):
+        return None
+    return SmoothFill(points=new_points, doubt=round_up(doubt * scale ** 3), height=round_up(height * scale),
+                      band=round_up(band * scale))

@@ -57,7 +57,8 @@ from .hole_bounds import (CONVEX_ROUND_OFF as CONVEX_ROUND_OFF, CONVEX_WORK_LIMI
                           bend_doubt_volumes,
                           _round_off as _round_off, _vertex_flatness as _vertex_flatness, ball_slab_volume,
                           bare_vertices, convex_hole_bound, flat_island_doubt, flat_islands, hole_doubt_volumes,
-                          inner_face_vertices, level_rings, planar_rim_doubt, rim_evidence, slab_contradicted)
+                          inner_face_vertices, level_rings, planar_rim_doubt, rim_evidence, slab_contradicted,
+                          smooth_doubt)
 from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES as CREASE_MAX_PLANES,
                          CREASE_SCREEN_PAIRS as CREASE_SCREEN_PAIRS, CURVED_FILL_LEVELS as CURVED_FILL_LEVELS,
                          CURVED_MAX_LOOPS as CURVED_MAX_LOOPS, QUADRIC_FIT_RTOL as QUADRIC_FIT_RTOL, CreaseFill,
@@ -259,6 +260,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             rim_reach = np.zeros(n_loops)
             np.maximum.at(rim_reach, loop_of, np.linalg.norm(v[vertex_of] - point, axis=1))
             nearer = np.where(took_graph, rim_reach + 2.0 * graph_height, nearer)
+        if took_smooth.any():
+            # the smooth-holes region lies over the projected rim within ``smooth_height`` of its mean height
+            rim_reach = np.zeros(n_loops)
+            np.maximum.at(rim_reach, loop_of, np.linalg.norm(v[vertex_of] - point, axis=1))
+            nearer = np.where(took_smooth, rim_reach + 2.0 * smooth_height, nearer)
         return nearer
 
     alone = np.zeros(n_loops, dtype=bool)
@@ -266,9 +272,12 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     took_planar = np.zeros(n_loops, dtype=bool)
     took_graph = np.zeros(n_loops, dtype=bool)
     took_island = np.zeros(n_loops, dtype=bool)
+    took_smooth = np.zeros(n_loops, dtype=bool)
     island_width = np.zeros(n_loops)
     graph_height = np.zeros(n_loops)
+    smooth_height = np.zeros(n_loops)
     graphs: list[GraphFill] = []
+    smooths: list[GraphFill] = []
     planes: list[PlaneFill] = []
     used: set[str] = set()
     before_bend = 0.0
@@ -382,8 +391,41 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             planes = kept
             if planes:
                 pv, pf, cap, closed, _ = build(creases, curved, graphs, planes)
+        if "smooth-holes" in assume:
+            # the user's smooth-holes (SMOOTH_HOLES, opt-in; read here, nowhere else): a hole not across a crease,
+            # not a flat island the user read as flat and not holding the whole surface is filled as a graph over
+            # the plane most face-on to the faces at its rim (hole_graphs.graph_fills) and bounded by how far the
+            # assumption lets the missing surface stray from its surroundings' quadratic (smooth_doubt), where
+            # that is narrower than the bound it had; the answer of every other hole is unchanged
+            candidates = ~crossed & ~engulfed & ~took_island & (hole_doubt > GRAPH_TRY_SHARE
+                                                                 * abs(float(closed.volume)))
+            if candidates.any():
+                ranked = np.flatnonzero(candidates)[np.argsort(-hole_doubt[candidates], kind="stable")]
+                for fill in graph_fills(v, f, edges, label, ranked, apex):
+                    k = fill.loop
+                    rim_k = vertex_of[loop_of == k]
+                    # the graph fill's points stay where the surroundings lie on one curved quadric (they lie on
+                    # it); else they are lifted onto the surroundings' quartic (smooth_doubt)
+                    on_quadric = bool(curved_surroundings(v, f, [rim_k], centre[k:k + 1], radius[k:k + 1])[0])
+                    smooth = smooth_doubt(v, f, edges[label == k], fill.points, fill.caps, fill.direction,
+                                          lift=not on_quadric)
+                    if smooth is None or not smooth.doubt < hole_doubt[fill.loop]:
+                        continue
+                    smooths.append(GraphFill(loop=fill.loop, apex=fill.apex, points=smooth.points, caps=fill.caps,
+                                             doubt=smooth.doubt, height=smooth.height, direction=fill.direction,
+                                             slope=fill.slope))
+                    took_smooth[fill.loop] = True
+                    smooth_height[fill.loop] = smooth.height
+                    hole_doubt[fill.loop] = smooth.doubt
+                for flag in (took_bend, took_capsule, took_planar, took_graph, alone):
+                    flag &= ~took_smooth
+                if smooths:
+                    curved = [fill for fill in curved if not took_smooth[fill.loop]]
+                    graphs = [fill for fill in graphs if not took_smooth[fill.loop]]
+                    planes = [fill for fill in planes if not took_smooth[fill.loop]]
+                    pv, pf, cap, closed, _ = build(creases, curved, [*graphs, *smooths], planes)
         took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
-                     & ~took_planar & ~took_graph)
+                     & ~took_planar & ~took_graph & ~took_smooth)
         used = {"ball"}
         used |= {"planar"} if took_planar.any() else set()
         used |= {"flat"} if took_flat.any() else set()
@@ -401,8 +443,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     if n_loops and doubt > 0 and not taken:
         # fourth assumption, where what remains is convex: the complete part is too (convex_hole_bound)
         outward = pf[:len(f)]
-        bound = convex_hole_bound(pv, outward, float(closed.volume)) if not (curved or graphs or planes) else None
-        if curved or graphs or planes:
+        bound = (convex_hole_bound(pv, outward, float(closed.volume)) if not (curved or graphs or planes or smooths)
+                 else None)
+        if curved or graphs or planes or smooths:
             # where what remains is convex the cones stay: the convex bound needs the patch inside the part, as
             # the cones are (in the rims' hulls) and a bent fill need not be
             # (the fills are swapped for the cones only below, where the convex bound is taken: the doubt of the
@@ -411,7 +454,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             bound = convex_hole_bound(cones[0], cones[1][:len(f)], float(cones[3].volume))
         # the convex bound where it applies and is narrower than the others before the bend bound: a convex part
         # keeps the polytope (a rule fixed before the bend bound came, which tests/test_hole_bounds.py pins)
-        if bound is not None and bound[0] < before_bend:
+        # (under the user's smooth-holes, against the doubt its fills leave: the default rule is unchanged)
+        if bound is not None and bound[0] < (float(np.sum(hole_doubt)) if smooths else before_bend):
             doubt, corners = bound
             # under the convex bound any fill outside the cone and inside every given face's plane keeps the patched
             # solid between the cones' and the polytope (P ⊂ P' ⊂ U), where the bound holds for it too: the planes
@@ -423,7 +467,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             pv, pf, cap, closed, _ = build(creases, [], None, planes)
             far = float(np.max(np.linalg.norm(corners - closed.centroid, axis=1)))
             convex = True
-            curved, graphs = [], []
+            curved, graphs, smooths = [], [], []
+            took_smooth[:] = False
             used = {"convex"}
             used |= {"inner"} if inside_face else set()
     sealed = ""
@@ -482,15 +527,21 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         if took_bend.any() and not convex:
             detail += (f"; {int(np.count_nonzero(took_bend))} bounded instead by the slope of the faces beside "
                        "their rims")
+        if smooths:
+            detail += (f"; {len(smooths)} filled instead as a graph over the plane most face-on to the faces at the "
+                       "rim and bounded by how far a smooth continuation of the surface round it may stray (largest "
+                       f"band {max(float(smooth_height[fill.loop]) for fill in smooths):.3g} m from the rim's "
+                       "height), as the user assumed")
         detail += "; " + stated(used)
-        if took_island.any():
-            detail += "; " + user_stated(["flat-islands"])
+        if took_island.any() or smooths:
+            detail += "; " + user_stated([*(["flat-islands"] if took_island.any() else []),
+                                          *(["smooth-holes"] if smooths else [])])
     else:
         detail = f"{sealed}no hole left" if sealed else "no hole"
     return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,
                     uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far,
                     unbounded=unbounded, assumptions=tuple(a.name for a in named(used))
-                    + (("flat-islands",) if took_island.any() else ()),
+                    + (("flat-islands",) if took_island.any() else ()) + (("smooth-holes",) if smooths else ()),
                     islands=int(np.count_nonzero(island & ~took_island)))
 
 
