@@ -3555,7 +3555,7 @@ static PyObject *accel_sort_codes(PyObject *self, PyObject *args);      /* secti
 static PyObject *accel_edge_twins(PyObject *self, PyObject *args);      /* section 8, after the module */
 static PyObject *accel_edge_point_candidates(PyObject *self, PyObject *args);  /* section 9, after the module */
 static PyObject *accel_close_groups(PyObject *self, PyObject *args);    /* section 9b, after the module */
-static PyObject *accel_sample_cells(PyObject *self, PyObject *args);    /* section 10, after the module */
+static PyObject *accel_surface_cells(PyObject *self, PyObject *args);   /* section 10, after the module */
 static PyObject *accel_label_cells(PyObject *self, PyObject *args);     /* section 11, after the module */
 static PyObject *accel_certain_parts(PyObject *self, PyObject *args);  /* section 12, after the module */
 static PyObject *accel_winding_tree(PyObject *self, PyObject *args);   /* section 13, after the module */
@@ -3662,10 +3662,10 @@ static PyMethodDef accel_methods[] = {
      "close_groups(points, tolerance) -> bytes or None\n\nFor each of the (k, 3) float64 points, the lowest "
      "index in its group of points joined by distances <= tolerance, transitively (bytes of int64); None when the "
      "grid of cells tolerance / 2 would need more than 21 bits per axis (merge.py); section 9b."},
-    {"sample_cells", accel_sample_cells, METH_VARARGS,
-     "sample_cells(vertices, faces, steps, origin, h, dims, out)\n\nMark in `out` (bytes of the flat grid dims, "
-     "C order) the cell floor((p - origin) / h) of every barycentric sample p of each face on its grid of "
-     "steps[f] (grid_estimate._surface_cells); section 10."},
+    {"surface_cells", accel_surface_cells, METH_VARARGS,
+     "surface_cells(vertices, faces, origin, h, dims, out)\n\nMark in `out` (bytes of the flat grid dims, C "
+     "order) every cell of side h from origin whose closed box meets a face, each face clipped to the grid's "
+     "slabs and rows (grid_estimate._surface_cells); section 10."},
     {"label_cells", accel_label_cells, METH_VARARGS,
      "label_cells(mask, dims, out) -> (count, first, sizes)\n\nNumber the face-connected regions of the nonzero "
      "bytes of `mask` (the flat grid dims, C order) 1..count in the order of their first cells, into `out` "
@@ -9097,24 +9097,68 @@ done:
 }
 
 /* ======================================================================================================
- * 10. sample_cells -- the cells a surface passes through, from samples of its triangles (mesh/grid_estimate.py)
+ * 10. surface_cells -- every cell a surface meets, by clipping each triangle to the grid's slabs and rows
+ *     (mesh/grid_estimate.py, _surface_cells)
  *
- * The twin of the sampling loop of grid_estimate._surface_cells, bit for bit: triangle f (corners a, b, c) with
- * n = steps[f] is sampled at s = i/n, t = j/n for i + j <= n, the point ((a (1-s-t) + b s) + c t) per
- * coordinate (1-s-t evaluated as (1 - s) - t), and the cell floor((p - origin) / h) per axis, clamped to
- * 0..dims-1, is marked in `out` (bytes of the flat grid, C order).  numpy evaluated the same expressions on
- * blocks of (triangles, samples, 3) arrays; a needle of length L and no area costs (L / spacing)^2 / 2 samples
- * either way, here without the temporary arrays.
+ * The twin of grid_estimate._clipped_cells, bit for bit (the same operations in the same order).  In grid units
+ * u = (p - origin) / h (cell (i, j, k) is the closed box [i, i+1] x [j, j+1] x [k, k+1]), triangle f is clipped
+ * (Sutherland-Hodgman) to each slab i - eps <= u0 <= i + 1 + eps it reaches, the polygon left to each row
+ * j - eps <= u1 <= j + 1 + eps, and the cells floor(zmin - eps) .. floor(zmax + eps) of the row's polygon
+ * (zmin, zmax its least and greatest u2) are marked in `out` (bytes of the flat grid, C order).  The first and
+ * last slab, row and cell of each axis reach to infinity (a point off the grid marks the cell it is clamped to).
+ * eps = 2^-40 (1 + the largest |u| of the triangle): every computed vertex lies within ~20 units in the last
+ * place of that magnitude of the exact clip's per clip (an intersection is P + t (Q - P), t in [0, 1] rounded
+ * three times), under 2^-46 (1 + |u|) after the four clips, so every cell whose closed box meets the triangle
+ * is marked, and a cell that is marked comes within 2^-39 (1 + |u|) cells of it.  Work: the slabs and rows
+ * the triangle crosses plus the cells marked (not the triangle's length squared, as the samples of before).
  * ====================================================================================================== */
 
-static PyObject *
-accel_sample_cells(PyObject *self, PyObject *args)
+#define SC_MAX 16       /* vertices of a clipped polygon: at most n + n/2 from n (each run outside drops one) */
+
+/* Clip polygon p (n vertices) to u[axis] >= bound (above != 0) or u[axis] <= bound, into q; returns its count. */
+static int
+sc_clip(const double (*p)[3], int n, double (*q)[3], int axis, double bound, int above)
 {
-    PyObject *vert_obj, *faces_obj, *steps_obj, *out_obj;
+    int out = 0;
+    for (int k = 0; k < n; k++) {
+        const double *P = p[k], *Q = p[k + 1 < n ? k + 1 : 0];
+        const int in_p = above ? P[axis] >= bound : P[axis] <= bound;
+        const int in_q = above ? Q[axis] >= bound : Q[axis] <= bound;
+        if (in_p) {
+            q[out][0] = P[0];
+            q[out][1] = P[1];
+            q[out][2] = P[2];
+            out++;
+        }
+        if (in_p != in_q) {
+            const double t = (bound - P[axis]) / (Q[axis] - P[axis]);
+            for (int c = 0; c < 3; c++) {
+                q[out][c] = c == axis ? bound : P[c] + t * (Q[c] - P[c]);
+            }
+            out++;
+        }
+    }
+    return out;
+}
+
+/* The cell range [first, last] along an axis of `cells` cells of the values lo .. hi (eps already applied). */
+static void
+sc_range(double lo, double hi, long long cells, long long *first, long long *last)
+{
+    const double a = floor(lo), b = floor(hi);
+    const double top = (double)(cells - 1);
+    *first = a < 0.0 ? 0 : (a > top ? cells - 1 : (long long)a);
+    *last = b < 0.0 ? 0 : (b > top ? cells - 1 : (long long)b);
+}
+
+static PyObject *
+accel_surface_cells(PyObject *self, PyObject *args)
+{
+    PyObject *vert_obj, *faces_obj, *out_obj;
     double o0, o1, o2, h;
     long long n0, n1, n2;
-    if (!PyArg_ParseTuple(args, "OOO(ddd)d(LLL)O", &vert_obj, &faces_obj, &steps_obj, &o0, &o1, &o2, &h,
-                          &n0, &n1, &n2, &out_obj)) {
+    if (!PyArg_ParseTuple(args, "OO(ddd)d(LLL)O", &vert_obj, &faces_obj, &o0, &o1, &o2, &h, &n0, &n1, &n2,
+                          &out_obj)) {
         return NULL;
     }
     if (!(h > 0.0) || !isfinite(h) || n0 < 1 || n1 < 1 || n2 < 1) {
@@ -9122,7 +9166,7 @@ accel_sample_cells(PyObject *self, PyObject *args)
                      n0, n1, n2);
         return NULL;
     }
-    Py_buffer views[4];
+    Py_buffer views[3];
     int got = 0;
     PyObject *result = NULL;
     Py_ssize_t m;
@@ -9135,21 +9179,13 @@ accel_sample_cells(PyObject *self, PyObject *args)
         goto done;
     }
     got++;
-    if (PyObject_GetBuffer(steps_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
-        goto done;
-    }
-    got++;
     if (PyObject_GetBuffer(out_obj, &views[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
         goto done;
     }
     got++;
-    Py_buffer *vv = &views[0], *fv = &views[1], *sv = &views[2], *ov = &views[3];
+    Py_buffer *vv = &views[0], *fv = &views[1], *ov = &views[2];
     if (native_code(vv->format) != 'd' || vv->itemsize != 8 || vv->ndim != 2 || vv->shape[1] != 3) {
         PyErr_SetString(PyExc_ValueError, "Expected `vertices` as a C-contiguous (n, 3) float64 array");
-        goto done;
-    }
-    if (signed_int_size(sv) != 8 || sv->ndim != 1 || sv->shape[0] != m) {
-        PyErr_SetString(PyExc_ValueError, "Expected `steps` as a C-contiguous (m,) int64 array, one per face");
         goto done;
     }
     if (ov->itemsize != 1 || ov->ndim != 1 || (long long)ov->shape[0] != n0 * n1 * n2) {
@@ -9159,75 +9195,93 @@ accel_sample_cells(PyObject *self, PyObject *args)
     if (check_indices(fv->buf, size, 3 * (size_t)m, (int64_t)vv->shape[0]) < 0) {
         goto done;
     }
-    const int64_t *steps = (const int64_t *)sv->buf;
-    for (Py_ssize_t i = 0; i < m; i++) {
-        if (steps[i] < 1 || steps[i] > (1 << 20)) {
-            PyErr_Format(PyExc_ValueError, "Expected 1 <= steps <= 2**20, got %lld at face %zd",
-                         (long long)steps[i], i);
-            goto done;
-        }
-    }
-    int64_t most = 1;
-    for (Py_ssize_t i = 0; i < m; i++) {
-        most = steps[i] > most ? steps[i] : most;
-    }
-    double *fraction = (double *)malloc((size_t)(most + 1) * sizeof(double));
-    if (fraction == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
+    Py_ssize_t bad_face = -1;
     {
         const double *v = (const double *)vv->buf;
         uint8_t *out = (uint8_t *)ov->buf;
         const double origin[3] = {o0, o1, o2};
         const long long dims[3] = {n0, n1, n2};
-        /* floor((p - origin) / h) without a division per sample: the product with 1/h is within 2.3e-16 of
-           the quotient relatively (two roundings against one), so within 5e-7 absolutely below 2^30, and its
-           floor is the quotient's unless an integer lies within 1e-6 of it; there (and for NaN or far off the
-           grid) the quotient is taken as before */
-        const double inverse = 1.0 / h;
         Py_BEGIN_ALLOW_THREADS
-        int64_t filled = 0;                         /* fraction[j] = j / n for the n filled */
         for (Py_ssize_t f = 0; f < m; f++) {
-            const double *A = v + 3 * index_at(fv->buf, size, 3 * (size_t)f);
-            const double *B = v + 3 * index_at(fv->buf, size, 3 * (size_t)f + 1);
-            const double *C = v + 3 * index_at(fv->buf, size, 3 * (size_t)f + 2);
-            const int64_t n = steps[f];
-            if (n != filled) {
-                for (int64_t j = 0; j <= n; j++) {
-                    fraction[j] = (double)j / (double)n;
+            double tri[3][3], slab[SC_MAX][3], half[SC_MAX][3], row[SC_MAX][3];
+            double most = 0.0;
+            for (int k = 0; k < 3; k++) {
+                const double *p = v + 3 * index_at(fv->buf, size, 3 * (size_t)f + (size_t)k);
+                for (int c = 0; c < 3; c++) {
+                    tri[k][c] = (p[c] - origin[c]) / h;
+                    most = fabs(tri[k][c]) > most ? fabs(tri[k][c]) : most;
                 }
-                filled = n;
             }
-            for (int64_t i = 0; i <= n; i++) {
-                const double s = fraction[i];
-                for (int64_t j = 0; i + j <= n; j++) {
-                    const double t = fraction[j];
-                    const double w = (1.0 - s) - t;
-                    long long idx[3];
-                    for (int c = 0; c < 3; c++) {
-                        const double p = (A[c] * w + B[c] * s) + C[c] * t;
-                        const double d = p - origin[c];
-                        const double guess = d * inverse;
-                        if (fabs(guess) < 1073741824.0) {        /* false for NaN */
-                            long long k = (long long)guess;         /* truncated: floor by one step down */
-                            k -= (double)k > guess;
-                            const double part = guess - (double)k;
-                            if (part > 1e-6 && part < 1.0 - 1e-6) {
-                                idx[c] = k < 0 ? 0 : (k > dims[c] - 1 ? dims[c] - 1 : k);
-                                continue;
-                            }
-                        }
-                        const double q = floor(d / h);
-                        idx[c] = q < 0.0 ? 0 : (q > (double)(dims[c] - 1) ? dims[c] - 1 : (long long)q);
+            if (!isfinite(most)) {
+                bad_face = f;               /* a corner not finite, or (p - origin) / h overflowed */
+                break;
+            }
+            const double eps = ldexp(1.0 + most, -40);
+            double lo0 = tri[0][0], hi0 = tri[0][0];
+            for (int k = 1; k < 3; k++) {
+                lo0 = tri[k][0] < lo0 ? tri[k][0] : lo0;
+                hi0 = tri[k][0] > hi0 ? tri[k][0] : hi0;
+            }
+            long long i0, i1;
+            sc_range(lo0 - eps, hi0 + eps, dims[0], &i0, &i1);
+            for (long long i = i0; i <= i1; i++) {
+                int ns = 3;
+                const double (*cur)[3] = (const double (*)[3])tri;
+                if (i > 0) {
+                    ns = sc_clip(cur, ns, half, 0, (double)i - eps, 1);
+                    cur = (const double (*)[3])half;
+                }
+                if (i < dims[0] - 1 && ns > 0) {
+                    ns = sc_clip(cur, ns, slab, 0, (double)(i + 1) + eps, 0);
+                    cur = (const double (*)[3])slab;
+                }
+                if (ns == 0) {
+                    continue;
+                }
+                double lo1 = cur[0][1], hi1 = cur[0][1];
+                for (int k = 1; k < ns; k++) {
+                    lo1 = cur[k][1] < lo1 ? cur[k][1] : lo1;
+                    hi1 = cur[k][1] > hi1 ? cur[k][1] : hi1;
+                }
+                long long j0, j1;
+                sc_range(lo1 - eps, hi1 + eps, dims[1], &j0, &j1);
+                double part[SC_MAX][3];
+                for (int k = 0; k < ns; k++) {
+                    part[k][0] = cur[k][0];
+                    part[k][1] = cur[k][1];
+                    part[k][2] = cur[k][2];
+                }
+                for (long long j = j0; j <= j1; j++) {
+                    int nr = ns;
+                    const double (*rc)[3] = (const double (*)[3])part;
+                    if (j > 0) {
+                        nr = sc_clip(rc, nr, half, 1, (double)j - eps, 1);
+                        rc = (const double (*)[3])half;
                     }
-                    out[(idx[0] * dims[1] + idx[1]) * dims[2] + idx[2]] = 1;
+                    if (j < dims[1] - 1 && nr > 0) {
+                        nr = sc_clip(rc, nr, row, 1, (double)(j + 1) + eps, 0);
+                        rc = (const double (*)[3])row;
+                    }
+                    if (nr == 0) {
+                        continue;
+                    }
+                    double lo2 = rc[0][2], hi2 = rc[0][2];
+                    for (int k = 1; k < nr; k++) {
+                        lo2 = rc[k][2] < lo2 ? rc[k][2] : lo2;
+                        hi2 = rc[k][2] > hi2 ? rc[k][2] : hi2;
+                    }
+                    long long k0, k1;
+                    sc_range(lo2 - eps, hi2 + eps, dims[2], &k0, &k1);
+                    memset(out + (i * dims[1] + j) * dims[2] + k0, 1, (size_t)(k1 - k0 + 1));
                 }
             }
         }
         Py_END_ALLOW_THREADS
     }
-    free(fraction);
+    if (bad_face >= 0) {
+        PyErr_Format(PyExc_ValueError, "Expected finite corners in cells of the grid, got face %zd", bad_face);
+        goto done;
+    }
     result = Py_None;
     Py_INCREF(result);
 done:

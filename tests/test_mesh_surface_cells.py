@@ -1,11 +1,11 @@
-"""``estimate._surface_cells`` in C (``_accel.sample_cells``, section 10) and in numpy mark the same cells.
+"""``estimate._surface_cells`` in C (``_accel.surface_cells``, section 10) and in numpy mark the same cells.
 
-Issue 25 item 3 (no slow path): the winding-number estimate samples every triangle on a barycentric grid of
-``ceil(longest edge / spacing)`` steps, so a needle (a sliver of the damage benchmark, a long thin triangle of a
-visual mesh) costs the square of its length in samples; numpy built (triangles, samples, 3) blocks for them
-(3.5 of 5.3 s CPU of an so101 sliver case, 2.4 s of the UR5e's visual meshes).  The kernel evaluates the same
+Issue 25 item 3 (no slow path), session 16 (issues 23/25): every triangle is clipped to the grid's slabs and rows
+and the cells its row pieces span are marked (before: sampled on a barycentric grid of ``ceil(longest edge /
+spacing)`` steps, so a needle cost the square of its length in samples).  The kernel evaluates the numpy twin's
 expressions in the same order, so the grids are equal bit for bit; checked on hypothesis-generated triangles
-(needles, slivers, parts far from the origin, cells outside the grid clamped) and on every-point coverage.
+(needles, slivers, parts far from the origin, cells outside the grid clamped).  That the cells are exactly the
+ones the surface meets: ``test_surface_cells_exact``.
 """
 
 from __future__ import annotations
@@ -66,13 +66,32 @@ def test_same_cells_as_numpy(case):
 
 @pytest.mark.skipif(not HAVE_ACCEL, reason="compares the C kernel with numpy")
 def test_needle_marks_its_line():
-    """A needle along the x axis through a 10-cell grid marks the cells along it (and their upper neighbours)
-    and nothing farther, on both paths."""
+    """A needle along the x axis through a 10-cell grid, a hair above the plane y = 0.5, marks the cells along
+    it and nothing else, on both paths (the sampling of before also marked each cell's upper neighbours)."""
     v = np.array([[0.05, 0.5, 0.5], [9.95, 0.5, 0.5], [5.0, 0.5 + 1e-12, 0.5]])
     f = np.array([[0, 1, 2]])
     lo, h, dims = np.zeros(3), 1.0, (10, 3, 3)
     fast, slow = _both(v, f, lo, h, dims)
     np.testing.assert_array_equal(fast, slow)
     grid = fast.reshape(dims)
-    assert grid[:, 0, 0].all() and grid[:, 1, 1].all()      # every cell along it, and each upper neighbour
-    assert not grid[:, 2, :].any()                           # nothing a cell away
+    assert grid[:, 0, 0].all() and grid.sum() == 10
+
+
+@pytest.mark.skipif(not HAVE_ACCEL, reason="compares the C kernel with numpy")
+def test_faces_in_cell_planes_mark_both_sides():
+    """A square in the plane x = 2 (a plane of cell faces) meets the closed cells on both sides of it; one
+    corner on a cell corner meets the 8 cells around it."""
+    v = np.array([[2.0, 0.5, 0.5], [2.0, 2.5, 0.5], [2.0, 2.5, 2.5], [3.0, 3.0, 3.0]])
+    f = np.array([[0, 1, 2]])
+    lo, h, dims = np.zeros(3), 1.0, (5, 4, 4)
+    fast, slow = _both(v, f, lo, h, dims)
+    np.testing.assert_array_equal(fast, slow)
+    grid = fast.reshape(dims)
+    # in (y, z) the triangle is z <= y over [0.5, 2.5]²: the cells under the diagonal, and the two the
+    # diagonal touches at a corner, (1, 1) and (2, 2)
+    below = np.zeros((4, 4), dtype=bool)
+    for j, k in [(0, 0), (1, 0), (2, 0), (1, 1), (2, 1), (2, 2), (0, 1), (1, 2)]:
+        below[j, k] = True
+    assert np.array_equal(grid[1], below) and np.array_equal(grid[2], below) and grid.sum() == 16
+    corner = _both(v, np.array([[3, 3, 3]]), lo, h, dims)[0].reshape(dims)
+    assert corner.sum() == 8 and corner[2:4, 2:4, 2:4].all()

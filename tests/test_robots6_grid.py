@@ -6,9 +6,9 @@
   and size: checked against scipy and a brute-force first cell on hypothesis-generated grids.
 * ``_first_cells`` (scipy's labels without the kernel): the running-maximum shortcut, and the scatter it falls
   back to when labels are not in first-cell order, against a brute force.
-* ``_accel.sample_cells`` skips the division per sample where the product with ``1/h`` is safely away from a cell
-  boundary; vertices on the cell boundaries themselves (lattice coordinates, where the two can differ) mark
-  the cells numpy marks.
+* ``_accel.surface_cells`` (session 16; before, ``sample_cells``, which skipped a division per sample) marks the
+  cells numpy marks with vertices on the cell boundaries themselves (lattice coordinates, where rounding
+  decides which side a corner is on).
 * A grid whose free cells are all settled by their regions takes its codes from the regions
   (``_region_codes``); the estimate equals, field for field and bit for bit, the one built from every cell's
   winding number (``_cell_codes``) on closed self-crossing solids, inside out, and nested (winding number 2).

@@ -85,57 +85,125 @@ def _grid_moments(weight: np.ndarray, lo: np.ndarray, h: float, scale: float = 1
     return vol, c, second
 
 
-def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: float, dims: tuple[int, ...],
-                   spacing: float = 0.5) -> np.ndarray:
-    """(cells,) bool: every cell the surface passes through (and a thin margin around it).
+def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: float, dims: tuple[int, ...]
+                   ) -> np.ndarray:
+    """(cells,) bool: every cell of the grid ``lo``, ``h``, ``dims`` (C order) whose closed box the surface meets.
 
-    Each triangle is sampled on a barycentric grid whose sub-triangles have edges of at most
-    ``δ = spacing · h``, so every point of the surface lies within ``δ`` of a sample; a cell the surface
-    crosses therefore meets the cube of half-side ``δ`` around some sample, and the cells those cubes touch
-    are marked (a cube no larger than a cell touches exactly the cells holding its 8 corners).
+    Each triangle is clipped to the slabs of cells it reaches along x, the pieces to the rows along y, and the
+    cells between each row piece's least and greatest z are marked (:func:`_clipped_cells`; ``_accel.c``
+    section 10 when built, the same operations in the same order).  Clipped with a margin of
+    ``ε = 2⁻⁴⁰ (1 + the largest |coordinate| of the triangle in cells)``, far above the clipping's round-off, so the
+    set holds every cell the triangle meets and no cell farther than ``2ε`` cells from it: a function of the
+    geometry, not of a sampling density, and the work is the slabs, rows and cells the triangle crosses.  A
+    surface off the grid marks the cell it would be clamped to (the first and last cell of each axis reach to
+    infinity).  The marking of a set of faces is the union of its faces' markings.  Before session 16 each
+    triangle was sampled on a lattice of half a cell and the cells within half a cell of a sample were marked
+    (a superset with a margin of up to about a cell; a needle's samples grew as the square of its length).
     """
-    v = vertices
-    a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
-    delta = spacing * h
-    if 2 * delta > h:
-        raise ValueError(f"expected a sample spacing of at most half a cell, got {spacing}")
-    longest = np.max(np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
-                               np.linalg.norm(a - c, axis=1)]), axis=0)
-    steps = np.maximum(1, np.ceil(longest / delta).astype(np.int64))
-    limit = np.array(dims) - 1
-    # the cell of each cube's lowest corner; the cube (side 2δ ≤ h) reaches at most one cell further along
-    # each axis, so marking those cells and then each marked cell's 7 upper neighbours covers every cell
-    # the cube touches (a superset only where a cube ends exactly on a cell face)
-    low = np.zeros(int(np.prod(dims)), dtype=bool)
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    if not np.all(np.isfinite(v[f])):
+        raise ValueError("expected finite vertices for the surface's cells, got NaN or infinity")
+    marked = np.zeros(int(np.prod(dims)), dtype=bool)
     from .._native import accel
     lib = accel()
-    if lib is not None and int(steps.max(initial=1)) <= 1 << 20:
-        # the same samples and cells in C (_accel.c section 10), without the (triangles, samples, 3) blocks
-        origin = lo + delta
-        lib.sample_cells(np.ascontiguousarray(v, dtype=np.float64), np.ascontiguousarray(faces, dtype=np.int64),
-                         np.ascontiguousarray(steps, dtype=np.int64), tuple(float(x) for x in origin), float(h),
-                         tuple(int(d) for d in dims), low.view(np.uint8))
-        steps = steps[:0]                   # done: the numpy loop below (the fallback) has no faces left
-    for n in np.unique(steps):
-        sel = np.flatnonzero(steps == n)
-        i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
-        keep = i + j <= n
-        s, t = (i[keep] / n), (j[keep] / n)
-        per = max(1, (1 << 20) // len(s))
-        for k in range(0, len(sel), per):
-            ids = sel[k:k + per]
-            pts = (a[ids, None] * (1 - s - t)[None, :, None] + b[ids, None] * s[None, :, None]
-                   + c[ids, None] * t[None, :, None]).reshape(-1, 3)
-            idx = np.minimum(np.maximum(np.floor((pts - (lo + delta)) / h).astype(np.int64), 0), limit)
-            low[(idx[:, 0] * dims[1] + idx[:, 1]) * dims[2] + idx[:, 2]] = True
-    grid = low.reshape(dims)
-    for axis in range(3):
-        ahead = [slice(None)] * 3
-        behind = [slice(None)] * 3
-        ahead[axis], behind[axis] = slice(1, None), slice(None, -1)
-        grid[tuple(ahead)] |= grid[tuple(behind)]
-    marked: np.ndarray = grid.reshape(-1)
+    if lib is not None:
+        lib.surface_cells(np.ascontiguousarray(v), np.ascontiguousarray(f), tuple(float(x) for x in lo), float(h),
+                          tuple(int(d) for d in dims), marked.view(np.uint8))
+        return marked
+    for start in range(0, len(f), 4096):
+        tri = (v[f[start:start + 4096]] - np.asarray(lo, dtype=np.float64)) / float(h)
+        if not np.all(np.isfinite(tri)):
+            raise ValueError("expected finite corners in cells of the grid, got an overflow")
+        _clipped_cells(tri, dims, marked)
     return marked
+
+
+def _clip_polygons(poly: np.ndarray, count: np.ndarray, axis: int, bound: np.ndarray, above: bool,
+                   active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sutherland–Hodgman clips of the polygons ``poly`` ((p, K, 3), the first ``count[i]`` rows of each in order)
+    to ``u[axis] ≥ bound`` (``above``) or ``≤ bound``, only where ``active`` ((p,) bool; elsewhere unchanged):
+    ``(polygons (p, K', 3), counts (p,))``.  Each edge ``P → Q`` gives ``P`` when inside and, when it crosses,
+    ``P + t (Q − P)`` with ``t = (bound − P_a) / (Q_a − P_a)`` and that coordinate set to ``bound``: the
+    operations of ``_accel.c``'s ``sc_clip`` in its order, so the vertices are the kernel's to the bit."""
+    p, k = poly.shape[:2]
+    slot = np.arange(k)
+    valid = slot[None, :] < count[:, None]
+    nxt = np.where(slot[None, :] + 1 < count[:, None], slot[None, :] + 1, 0)
+    q = np.take_along_axis(poly, nxt[:, :, None], axis=1)
+    b = bound[:, None]
+    if above:
+        in_p, in_q = poly[:, :, axis] >= b, q[:, :, axis] >= b
+    else:
+        in_p, in_q = poly[:, :, axis] <= b, q[:, :, axis] <= b
+    cross = valid & (in_p != in_q) & active[:, None]
+    keep = valid & (in_p | ~active[:, None])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(cross, (b - poly[:, :, axis]) / np.where(cross, q[:, :, axis] - poly[:, :, axis], 1.0), 0.0)
+    meet = poly + t[:, :, None] * (q - poly)
+    meet[:, :, axis] = np.broadcast_to(b, (p, k))
+    both = np.stack([poly, meet], axis=2).reshape(p, 2 * k, 3)     # P then its crossing, edge by edge
+    emit = np.stack([keep, cross], axis=2).reshape(p, 2 * k)
+    new_count = emit.sum(axis=1)
+    order = np.argsort(~emit, axis=1, kind="stable")               # the emitted ones first, in order
+    width = max(1, int(new_count.max(initial=0)))
+    out = np.take_along_axis(both, order[:, :width, None], axis=1)
+    return out, new_count
+
+
+def _cell_range(low: np.ndarray, high: np.ndarray, cells: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(first, last)`` (int64): the cells ``floor(low)`` … ``floor(high)`` clamped to ``0 … cells − 1``."""
+    top = float(cells - 1)
+    first = np.clip(np.floor(low), 0.0, top).astype(np.int64)
+    last = np.clip(np.floor(high), 0.0, top).astype(np.int64)
+    return first, last
+
+
+def _clipped_cells(tri: np.ndarray, dims: tuple[int, ...], marked: np.ndarray) -> None:
+    """Mark in ``marked`` ((cells,) bool, C order) every cell the triangles ``tri`` ((t, 3, 3), in grid units:
+    ``(p − lo) / h``) meet, as :func:`_surface_cells` states: each triangle clipped to ``i − ε ≤ u₀ ≤ i + 1 + ε``
+    for each slab ``i`` it reaches, each piece to ``j − ε ≤ u₁ ≤ j + 1 + ε`` for each row ``j``, and the cells
+    ``floor(z_min − ε) … floor(z_max + ε)`` of each row piece marked (the first and last slab, row and cell
+    unbounded outward).  The numpy twin of ``_accel.c`` section 10: the same operations in the same order."""
+    n0, n1, n2 = (int(d) for d in dims)
+    if len(tri) == 0:
+        return
+    eps = (1.0 + np.abs(tri).reshape(len(tri), -1).max(axis=1)) * 2.0 ** -40
+    i0, i1 = _cell_range(tri[:, :, 0].min(axis=1) - eps, tri[:, :, 0].max(axis=1) + eps, n0)
+    # (triangle, slab) pairs
+    many = i1 - i0 + 1
+    owner = np.repeat(np.arange(len(tri)), many)
+    slab = np.repeat(i0, many) + (np.arange(int(many.sum())) - np.repeat(np.cumsum(many) - many, many))
+    e = eps[owner]
+    poly, count = tri[owner], np.full(len(owner), 3)
+    poly, count = _clip_polygons(poly, count, 0, slab.astype(np.float64) - e, True, slab > 0)
+    poly, count = _clip_polygons(poly, count, 0, (slab + 1).astype(np.float64) + e, False,
+                                 (slab < n0 - 1) & (count > 0))
+    live = count > 0
+    poly, count, slab, e = poly[live], count[live], slab[live], e[live]
+    width = poly.shape[1]
+    filled = np.arange(width)[None, :] < count[:, None]
+    j0, j1 = _cell_range(np.where(filled, poly[:, :, 1], np.inf).min(axis=1) - e,
+                         np.where(filled, poly[:, :, 1], -np.inf).max(axis=1) + e, n1)
+    # (slab piece, row) pairs
+    many = j1 - j0 + 1
+    owner = np.repeat(np.arange(len(poly)), many)
+    row = np.repeat(j0, many) + (np.arange(int(many.sum())) - np.repeat(np.cumsum(many) - many, many))
+    e, slab = e[owner], slab[owner]
+    poly, count = poly[owner], count[owner]
+    poly, count = _clip_polygons(poly, count, 1, row.astype(np.float64) - e, True, (row > 0) & (count > 0))
+    poly, count = _clip_polygons(poly, count, 1, (row + 1).astype(np.float64) + e, False,
+                                 (row < n1 - 1) & (count > 0))
+    live = count > 0
+    poly, count, slab, row, e = poly[live], count[live], slab[live], row[live], e[live]
+    width = poly.shape[1]
+    filled = np.arange(width)[None, :] < count[:, None]
+    k0, k1 = _cell_range(np.where(filled, poly[:, :, 2], np.inf).min(axis=1) - e,
+                         np.where(filled, poly[:, :, 2], -np.inf).max(axis=1) + e, n2)
+    many = k1 - k0 + 1
+    base = (slab * n1 + row) * n2
+    cell = np.repeat(base + k0, many) + (np.arange(int(many.sum())) - np.repeat(np.cumsum(many) - many, many))
+    marked[cell] = True
 
 
 #: Largest cone cap (triangles) for which :func:`_closed_part_numbers` is tried; beyond it (a soup whose
