@@ -109,3 +109,47 @@ def test_curved_fills_fit_the_same_points_of_the_same_loops(level, seed, share, 
         assert x.tobytes() == ((v[near] - centre[k]) / radius[k]).tobytes()
     assert [fill.loop for fill in fills] == [k for k, _ in want if k in {fill.loop for fill in fills}]
 
+
+
+def _reference_partition(a, b, n):
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    graph = coo_matrix((np.ones(len(a), dtype=np.int8), (a, b)), shape=(n, n))
+    return connected_components(graph, directed=False)[1]
+
+
+def _same_partition(x, y):
+    """Two labellings that group the nodes alike (a bijection between their labels)."""
+    pairs = set(zip(x.tolist(), y.tolist()))
+    return len(pairs) == len(set(x.tolist())) == len(set(y.tolist()))
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(1, 60), st.integers(0, 120), st.integers(0, 2**32 - 1), st.sampled_from(["random", "path", "star"]),
+       st.integers(1, 64))
+def test_fan_components_partition_the_nodes_as_scipy_does(n, n_edges, seed, shape, rounds):
+    rng = np.random.default_rng(seed)
+    if shape == "random":
+        a, b = rng.integers(0, n, n_edges), rng.integers(0, n, n_edges)
+    elif shape == "path":                 # a long path in a shuffled numbering: the most rounds of hooking
+        perm = rng.permutation(n)
+        a, b = perm[:-1], perm[1:]
+    else:                                 # a star whose centre is the highest node
+        a, b = np.full(n - 1, n - 1), np.arange(n - 1)
+    from inertia_tool.mesh import rims
+
+    saved = rims.COMPONENT_ROUNDS
+    rims.COMPONENT_ROUNDS = rounds       # few rounds: scipy takes over, with the same partition
+    try:
+        got = rims._components(a, b, n)
+    finally:
+        rims.COMPONENT_ROUNDS = saved
+    want = _reference_partition(a, b, n)
+    assert got.shape == (n,) and _same_partition(got, want)
+    if rounds == 64:
+        # the hooking's own labels: the lowest node of each component
+        lowest = {}
+        for node, comp in enumerate(want.tolist()):
+            lowest.setdefault(comp, node)
+        assert got.tolist() == [lowest[c] for c in want.tolist()]
