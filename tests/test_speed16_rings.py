@@ -111,6 +111,49 @@ def test_curved_fills_fit_the_same_points_of_the_same_loops(level, seed, share, 
 
 
 
+def _meeting_pairs(centre, radius):
+    gap = np.linalg.norm(centre[:, None, :] - centre[None, :, :], axis=2)
+    meet = gap <= radius[:, None] + radius[None, :]
+    np.fill_diagonal(meet, False)
+    return {(int(i), int(j)) for i, j in zip(*np.nonzero(meet)) if i < j}
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 400), st.sampled_from(["cloud", "shell", "point", "far", "zero"]),
+       st.floats(1e-4, 0.5), st.integers(0, 30))
+def test_meeting_candidates_hold_every_meeting_pair(seed, n, layout, scale, tangent):
+    """The grid's candidates (scipy's k-d tree left out) hold every pair of balls that meet: clouds, balls on a
+    sphere's surface (scattered holes), all at one point (too many pairs: None), tiny balls far apart (cells too
+    fine: None), radius zero (equal centres only); exactly tangent pairs."""
+    from inertia_tool.mesh import hole_bounds
+
+    rng = np.random.default_rng(seed)
+    centre = rng.normal(size=(n, 3))
+    if layout == "shell":
+        centre /= np.linalg.norm(centre, axis=1, keepdims=True)
+    elif layout == "point":
+        centre[:] = centre[0]
+    elif layout == "far":
+        centre *= 1e9
+    radius = rng.exponential(scale, size=n) * (layout != "zero")
+    if layout == "zero":
+        centre = np.round(centre, 0)
+    for k in rng.integers(0, n - 1, size=tangent):      # balls exactly touching (gap == r_i + r_j)
+        d = float(np.linalg.norm(centre[k] - centre[k + 1]))
+        radius[k] = d / 2
+        radius[k + 1] = d - radius[k]
+    pairs = hole_bounds._meeting_candidates(centre, radius)
+    if layout == "point" and n > 2 * hole_bounds.MEETING_PAIRS_PER_BALL:
+        assert pairs is None
+    if pairs is not None:
+        i, j = pairs
+        assert (i != j).all()
+        found = {(min(a, b), max(a, b)) for a, b in zip(i.tolist(), j.tolist())}
+        assert _meeting_pairs(centre, radius) <= found
+    want = ~np.isin(np.arange(n), [k for pair in _meeting_pairs(centre, radius) for k in pair])
+    np.testing.assert_array_equal(hole_bounds._alone(centre, radius, chunk=1), want)
+
+
 def _reference_partition(a, b, n):
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
