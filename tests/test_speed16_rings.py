@@ -196,3 +196,19 @@ def test_fan_components_partition_the_nodes_as_scipy_does(n, n_edges, seed, shap
         for node, comp in enumerate(want.tolist()):
             lowest.setdefault(comp, node)
         assert got.tolist() == [lowest[c] for c in want.tolist()]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 300), st.integers(1, 50), st.integers(1, 40))
+def test_loop_vertex_pairs_are_numpy_uniques_rows(seed, k, n_loops, n_vertices):
+    """The (loop, vertex) pairs of patched_estimate (one edge at least: it asks only when there are loops) by
+    one int64 key per row: numpy.unique(axis=0)'s rows."""
+    from inertia_tool.mesh.seal import _unique_rows
+
+    rng = np.random.default_rng(seed)
+    label = rng.integers(0, n_loops, k)
+    edges = rng.integers(0, n_vertices, (k, 2))
+    rows = np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1)
+    got = _unique_rows(rows, n_vertices)
+    want = np.unique(rows, axis=0)
+    assert got.dtype == want.dtype and got.tobytes() == want.tobytes()
