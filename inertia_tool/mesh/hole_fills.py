@@ -427,19 +427,23 @@ def curved_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
     # the fill must lie where the bound looks: in the ball, the capsule and the slab over the rim
     inside = region_check(centre, radius, (capsule[0], capsule[1], capsule[2]), np.ones(n_loops, dtype=bool), slab)
     out: list[CurvedFill] = []
-    tried = 0
-    for k in order.tolist():
-        if tried >= max_loops:
-            break
-        rim_edges = edges[label == k]
-        rim = np.unique(rim_edges)
-        if len(rim) < 5 or len(rim_edges) != len(rim):
-            continue                               # too short to be curved, or a pinch
-        tried += 1
-        near = np.zeros(n, dtype=bool)
-        near[rim] = True
-        for _ in range(2):
-            near[f[near[f].any(axis=1)].reshape(-1)] = True
+    # the loops tried: the first ``max_loops`` in ``order`` long enough to be curved and not a pinch (decided
+    # before any fit, so known up front: their neighbourhoods are grown over the faces near them alone)
+    tried: list[tuple[int, np.ndarray, np.ndarray]] = []
+    if max_loops > 0:
+        by_loop = np.argsort(label, kind="stable")
+        cuts = np.searchsorted(label[by_loop], np.arange(n_loops + 1))
+        for k in order.tolist():
+            rim_edges = edges[by_loop[cuts[k]:cuts[k + 1]]]
+            rim = np.unique(rim_edges)
+            if len(rim) < 5 or len(rim_edges) != len(rim):
+                continue                               # too short to be curved, or a pinch
+            tried.append((int(k), rim_edges, rim))
+            if len(tried) >= max_loops:
+                break
+    near_faces = _faces_near(f, n, [rim for _, _, rim in tried])
+    for k, rim_edges, rim in tried:
+        near = _two_rings(near_faces, n, rim)
         fit = _fitted_quadric((v[near] - centre[k]) / radius[k], fit_rtol)
         if fit is None:
             continue                               # a plane (many quadrics fit) or no quadric: the cone stays
@@ -548,11 +552,9 @@ def curved_surroundings(vertices: np.ndarray, faces: np.ndarray, rims: list[np.n
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     out = np.zeros(len(rims), dtype=bool)
+    near_faces = _faces_near(f, len(v), rims)
     for k, rim in enumerate(rims):
-        near = np.zeros(len(v), dtype=bool)
-        near[rim] = True
-        for _ in range(2):
-            near[f[near[f].any(axis=1)].reshape(-1)] = True
+        near = _two_rings(near_faces, len(v), rim)
         x = (v[near] - centre[k]) / radius[k]
         fit = _fitted_quadric(x, fit_rtol) if len(x) >= CURVED_MIN_POINTS else None
         if fit is None:
@@ -562,6 +564,38 @@ def curved_surroundings(vertices: np.ndarray, faces: np.ndarray, rims: list[np.n
         sv = np.linalg.svd(form, compute_uv=False)
         out[k] = bool(sv[2] > CURVED_MIN_RANK_RTOL * sv[0])      # rank ≥ 3: not a plane or a pair of planes
     return out
+
+
+def _faces_near(faces: np.ndarray, n_vertices: int, rims: list[np.ndarray]) -> np.ndarray:
+    """The faces with a vertex within one ring of some rim's vertices, (q, 3) int: all the faces that
+    :func:`_two_rings` of any of ``rims`` can reach, so that growing a rim over them marks the same vertices as
+    growing it over every face, at the cost of the neighbourhood instead of the mesh (two passes over all faces
+    once, instead of two per rim).
+
+    Parameters
+    ----------
+    faces : (m, 3) int
+    n_vertices : int
+    rims : list of (r,) int arrays
+        Vertex indices of each rim.
+    """
+    near = np.zeros(n_vertices, dtype=bool)
+    for rim in rims:
+        near[rim] = True
+    near[faces[near[faces].any(axis=1)].reshape(-1)] = True     # the first ring of every rim
+    subset: np.ndarray = faces[near[faces].any(axis=1)]
+    return subset
+
+
+def _two_rings(faces: np.ndarray, n_vertices: int, rim: np.ndarray) -> np.ndarray:
+    """The vertices of the faces within two rings of ``rim``, (n_vertices,) bool: the rim's vertices, those of
+    every face holding one, then those of every face holding one of those.  ``faces`` may be
+    :func:`_faces_near` of a list of rims holding ``rim`` (the same mask)."""
+    near = np.zeros(n_vertices, dtype=bool)
+    near[rim] = True
+    for _ in range(2):
+        near[faces[near[faces].any(axis=1)].reshape(-1)] = True
+    return near
 
 
 def _quadric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: float) -> np.ndarray:

@@ -69,7 +69,7 @@ from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES
 from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions, named, stated, user_stated
 from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
-from .seal import Seal
+from .seal import Seal, _unique_rows
 from .uncertainty import Estimate, uncertainty_from
 
 __all__ = ["patched_estimate", "hole_doubt_volumes", "ball_slab_volume", "crease_fills", "CreaseFill", "rim_evidence",
@@ -128,8 +128,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     f = np.asarray(faces, dtype=np.int64)
     edges = seal.boundary if seal is not None else boundary_edges(f, len(v))
     label, n_loops = boundary_loops(edges, len(v), f, v) if len(edges) else (np.zeros(0, dtype=np.int64), 0)
-    # the distinct vertices of each loop, grouped: (loop, vertex) pairs sorted by loop
-    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0) if n_loops \
+    # the distinct vertices of each loop, grouped: (loop, vertex) pairs sorted by loop (numpy.unique(axis=0)'s
+    # rows, by one int64 key per row: 0.5 s less on 60,574 loops)
+    pairs = _unique_rows(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), len(v)) if n_loops \
         else np.zeros((0, 2), dtype=np.int64)
     loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
     size = np.bincount(loop_of, minlength=n_loops)
