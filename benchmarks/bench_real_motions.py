@@ -16,7 +16,9 @@ two pieces formed by manifold3d in float64 (``adversary_solids.truth_from_manifo
 mesh's first corner first (a union formed far out is less accurate: ``tests/test_count15_findings.py``), its
 moments integrated in float64 and the centroid moved back.  The rule is ``bench_adversarial``'s
 (``adversary_solids.judge``): ``exact`` / ``united`` within 1e-9 volume, 1e-9·diagonal centre of mass, 1e-8
-inertia; an estimate's bounds hold the truth; anything else refused.
+inertia; an estimate's bounds hold the truth; anything else refused.  Where one part lies wholly inside the other
+(``two_parts``: manifold3d's intersection is the smaller part), R4's depth reading (the larger less the smaller, by
+manifold3d) is accepted as well, as ``bench_review9_convex`` does.
 
 The pool: every STL under the Menagerie folder of at most ``--max-faces`` triangles (read by trimesh, not by the
 tool; bit-identical corners merged) that trimesh calls watertight and consistently wound, that manifold3d accepts,
@@ -45,6 +47,8 @@ this_checkout_first()                  # this checkout's inertia_tool, unless PY
 import adversary_solids as S  # noqa: E402
 
 KINDS = ("turned_about_vertex", "two_parts", "apart")
+#: cases per kind where one part lies wholly inside the other (R4's depth reading offered), for the summary
+counts_nested: Counter = Counter()
 MENAGERIE = Path("/work/data/menagerie")
 
 
@@ -92,6 +96,22 @@ def _truth(a, b):
     return t
 
 
+def _depth_reading(a, b):
+    """R4's reading when one piece lies wholly inside the other (manifold3d's intersection is the smaller piece to
+    1e-9): the larger less the smaller, formed near the origin; else None.  The tool reads an outward shell wholly
+    inside another as a cavity and says so (``docs/adversarial.md``, session 15's winding 1703 case 367)."""
+    origin = a[0][0].copy()
+    ma, mb = (S.to_manifold((p[0] - origin, p[1])) for p in (a, b))
+    small = min(ma.volume(), mb.volume())
+    if abs((ma ^ mb).volume() - small) > 1e-9 * small:
+        return None
+    outer, inner = (a, b) if ma.volume() >= mb.volume() else (b, a)
+    t = S.truth_from_manifold([(outer[0] - origin, outer[1])], [(inner[0] - origin, inner[1])])
+    t.centroid = t.centroid + origin
+    t.source = "depth reading"
+    return t
+
+
 def make_case(parts, seed: int, i: int) -> S.Case:
     """Case ``i`` of the family (see the module docstring)."""
     rng = np.random.default_rng([seed, i])
@@ -125,6 +145,11 @@ def make_case(parts, seed: int, i: int) -> S.Case:
     v = mesh[0] @ rot.T + shift
     case = S.Case(kind, v, mesh[1], _truth(a, b),
                   recipe + f"; moved by R={np.round(rot, 3).tolist()}, t={np.round(shift, 4).tolist()}")
+    depth = _depth_reading(a, b) if kind == "two_parts" else None
+    if depth is not None:
+        case.alternatives.append(depth)
+        case.recipe += "; one part wholly inside the other (R4's depth reading accepted too)"
+    counts_nested[kind] += depth is not None
     return case
 
 
@@ -172,6 +197,7 @@ def main(argv: list[str] | None = None) -> int:
         print(kind, row)
     for i, recipe, verdict in flagged:
         print(f"FLAGGED case {i}: {recipe}\n    {verdict.label}: {verdict.wrong}")
+    print(f"one part wholly inside the other (depth reading offered): {dict(counts_nested)}")
     print(f"{len(indices)} cases, seed {args.seed}, repair={args.repair}, {len(flagged)} flagged, "
           f"cpu {time.process_time() - started:.1f} s")
     return 0
