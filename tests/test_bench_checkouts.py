@@ -19,7 +19,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 BENCHES = ("bench_adversarial", "bench_review11", "bench_review9_convex", "bench_near_copies",
-           "bench_review12", "bench_kept_cavities",
+           "bench_review12", "bench_kept_cavities", "bench_real_motions",
            # the others that had no way to their own checkout (bench_review9_damage: through damage/coverage.py)
            "bench_arrange", "bench_coplanar", "bench_intersect", "bench_review9_damage", "bench_walls")
 
