@@ -36,12 +36,18 @@ _SHORT_PROBLEMS = ("mesh needs repair or cannot be read", "mesh cannot be read o
                    "cannot be computed")
 
 
-def left_unchanged(inertials, changed) -> str:
+def left_unchanged(inertials, changed, *, included: tuple[str, ...] = ()) -> str:
     """``"a (no collision geometry), b (mesh needs repair or cannot be read)"``: the links a written copy left
-    as they were, each with the reason; "" when every link was corrected."""
+    as they were, each with the reason; "" when every link was corrected.  ``included``: the files the main file
+    includes when all its bodies are theirs (:func:`~inertia_tool.robot.write.included_files`, a Menagerie
+    ``scene.xml``): the computed links are then named once, with the file to write instead."""
     parts = []
+    elsewhere = []
     for result in inertials:
         if result.name in changed:
+            continue
+        if result.properties is not None and included:
+            elsewhere.append(result.name)
             continue
         if result.properties is not None:
             reason = "no element of its own in the file"          # e.g. a copy made by MJCF <replicate>
@@ -49,6 +55,11 @@ def left_unchanged(inertials, changed) -> str:
             reason = next((short for short in _SHORT_PROBLEMS if (result.problem or "").startswith(short)),
                           result.problem or "no result")
         parts.append(f"{result.name} ({reason})")
+    if elsewhere:
+        files = ", ".join(included)
+        parts.insert(0, f"{len(elsewhere)} computed bod{'y' if len(elsewhere) == 1 else 'ies'} of {files}, which "
+                        f"this file includes (only the main file is written: run --write on {files} to correct "
+                        f"them): {', '.join(elsewhere)}")
     return ", ".join(parts)
 
 
