@@ -61,11 +61,15 @@ def test_spin_it_text_states_the_certificate_before_and_after(tmp_path, capsys):
     v, f = _lidless()
     path = tmp_path / "lidless.stl"
     trimesh.Trimesh(v, f, process=False).export(path)
+    report = tmp_path / "spin.html"
     assert main(["spin-it", str(path), "--axis", "0,0,1", "--wall", "0.3", "--resolution", "12", "--repair",
-                 "--assume", "flat-islands", "--density", "1000"]) == EXIT_OK
+                 "--assume", "flat-islands", "--density", "1000", "--report", str(report)]) == EXIT_OK
     out = capsys.readouterr().out
     (line,) = [x.strip() for x in out.splitlines() if x.strip().startswith("certificate:")]
     # the part is an estimate under the user's assumption, before and after: never called exact
     assert line.startswith("certificate: before estimate, assuming flat-islands (mass ±")
     assert "; after estimate, assuming flat-islands" in line
     assert "exact re-analysis" not in out
+    # the HTML report says the same
+    page = report.read_text("utf-8")
+    assert "exact re-analysis" not in page and "certificate: before estimate, assuming flat-islands" in page

@@ -321,7 +321,7 @@ def spin_it_html(result, *, name: str = "", motion: SpinMotion | None = None, ou
         facts.append(("hollowed part", output))
     body = [_html_table(None, facts, left=2),
             "<h2>Before and after</h2>",
-            "<p>Every “after” number is the exact re-analysis of the hollowed mesh.</p>",
+            f"<p>Every “after” number is the re-analysis of the hollowed mesh; {e(_certificates_text(result))}.</p>",
             _html_table(["quantity", "before", "after"], _rows(result), css="before-after")]
     if motion is not None:
         title = "Free spin about the axis" if result.mode == "yoyo" else "Nutation of the top"
