@@ -149,7 +149,7 @@ def run(args) -> int:
     from ..robot.description import read_robot
     from ..robot.geometry import link_inertials
     from ..robot.mjcf import inertia_from_geometry
-    from ..robot.write import write_corrected
+    from ..robot.write import included_files, write_corrected
 
     packages = parse_packages(args.package)
     if len(args.robot) > 1 or os.path.isdir(args.robot[0]):
@@ -178,7 +178,7 @@ def run(args) -> int:
         note = "declared masses kept" if args.keep_mass else f"density {basis}"
         changed = write_corrected(robot, inertials, args.write, force=args.force, note=note)
         message = f"wrote {args.write}: <inertial> of {len(changed)} link{'' if len(changed) == 1 else 's'} corrected"
-        unchanged = left_unchanged(inertials, changed)
+        unchanged = left_unchanged(inertials, changed, included=included_files(robot))
         if unchanged:
             message += f"; left as they were: {unchanged}"
         if robot.format == "mjcf" and inertia_from_geometry(robot.source, robot.document) == "true":

@@ -36,12 +36,18 @@ _SHORT_PROBLEMS = ("mesh needs repair or cannot be read", "mesh cannot be read o
                    "cannot be computed")
 
 
-def left_unchanged(inertials, changed) -> str:
+def left_unchanged(inertials, changed, *, included: tuple[str, ...] = ()) -> str:
     """``"a (no collision geometry), b (mesh needs repair or cannot be read)"``: the links a written copy left
-    as they were, each with the reason; "" when every link was corrected."""
+    as they were, each with the reason; "" when every link was corrected.  ``included``: the files the main file
+    includes when all its bodies are theirs (:func:`~inertia_tool.robot.write.included_files`, a Menagerie
+    ``scene.xml``): the computed links are then named once, with the file to write instead."""
     parts = []
+    elsewhere = []
     for result in inertials:
         if result.name in changed:
+            continue
+        if result.properties is not None and included:
+            elsewhere.append(result.name)
             continue
         if result.properties is not None:
             reason = "no element of its own in the file"          # e.g. a copy made by MJCF <replicate>
@@ -49,6 +55,11 @@ def left_unchanged(inertials, changed) -> str:
             reason = next((short for short in _SHORT_PROBLEMS if (result.problem or "").startswith(short)),
                           result.problem or "no result")
         parts.append(f"{result.name} ({reason})")
+    if elsewhere:
+        files = ", ".join(included)
+        parts.insert(0, f"{len(elsewhere)} computed bod{'y' if len(elsewhere) == 1 else 'ies'} of {files}, which "
+                        f"this file includes (only the main file is written: run --write on {files} to correct "
+                        f"them): {', '.join(elsewhere)}")
     return ", ".join(parts)
 
 
@@ -147,6 +158,25 @@ def _fmt(x, spec: str, dash: str = "-") -> str:
     return format(x, spec)
 
 
+def _assumed_cell(result: LinkInertial) -> str:
+    """The ``assumed`` cell of a link: the user's assumptions its result rests on (``Certificate.assumptions``
+    of its meshes), ``none`` when it rests on none, ``-`` without a result."""
+    if result.properties is None:
+        return "-"
+    return ", ".join(result.assumptions) or "none"
+
+
+def _bounds_text(result: LinkInertial) -> str:
+    """``"mass ±5.1 %, centre of mass ±0.31 mm, inertia ±8.2 %"``: a link estimate's bounds
+    (:class:`~inertia_tool.robot.geometry.LinkUncertainty`), or why there are none."""
+    u = result.uncertainty
+    if u is None:
+        return "no bounds given"
+    inertia = (f"inertia ±{u.inertia * 100:.3g} %" if u.inertia is not None
+               else "inertia: no bound claimed (several elements, or a primitive fitted to an estimate)")
+    return f"mass ±{u.mass * 100:.3g} %, centre of mass ±{u.center_of_mass * 1e3:.3g} mm, {inertia}"
+
+
 def format_robot_report(robot: RobotDescription, inertials, audits) -> str:
     """A text table (one row per link) followed by the issues, link by link."""
     basis = next((r.basis for r in inertials if r.basis), "")
@@ -156,22 +186,30 @@ def format_robot_report(robot: RobotDescription, inertials, audits) -> str:
              "of the tensors at equal mass",
              ""]
     width = max([4] + [len(r.name) for r in inertials])
-    header = (f"{'link':<{width}} {'method':<10} {'mass kg':>10} {'declared kg':>12} {'ΔCOM mm':>9} {'ΔI':>8} "
-              f"{'implied ρ':>10}  {'COM inside':<10} {'issues':>6}")
+    assumed = [_assumed_cell(r) for r in inertials]
+    a_width = max([len("assumed")] + [len(a) for a in assumed])
+    header = (f"{'link':<{width}} {'method':<10} {'assumed':<{a_width}} {'mass kg':>10} {'declared kg':>12} "
+              f"{'ΔCOM mm':>9} {'ΔI':>8} {'implied ρ':>10}  {'COM inside':<10} {'issues':>6}")
     lines += [header, "-" * len(header)]
     inertial: LinkInertial
     missing = links_without_result(robot, inertials)
-    for inertial, audit in zip(inertials, audits):
+    for inertial, audit, assumed_cell in zip(inertials, audits, assumed):
         props = inertial.properties
         declared = audit.declared
         inside = {True: "yes", False: "no", None: "-"}[audit.com_inside_geometry]
         if audit.com_in_bounding_box is False:
             inside = "no (box)"
         method = inertial.method or ("frame" if inertial not in missing else "none")
-        lines.append(f"{inertial.name:<{width}} {method:<10} {_fmt(props.mass if props else None, '10.4g'):>10} "
+        lines.append(f"{inertial.name:<{width}} {method:<10} {assumed_cell:<{a_width}} "
+                     f"{_fmt(props.mass if props else None, '10.4g'):>10} "
                      f"{_fmt(declared.mass if declared else None, '12.4g'):>12} "
                      f"{_fmt(audit.com_distance * 1e3, '9.1f'):>9} {_fmt(audit.inertia_difference, '8.0%'):>8} "
                      f"{_fmt(audit.implied_density, '10.4g'):>10}  {inside:<10} {len(audit.issues):>6}")
+    bounded = [f"  {r.name}: {_bounds_text(r)}" for r in inertials if r.properties is not None
+               and (r.uncertainty is not None or r.method == "estimate")]
+    if bounded:
+        lines += ["", "bounds of the estimates (as in the JSON 'uncertainty'):"]
+        lines += bounded
     findings = [(r, a) for r, a in zip(inertials, audits) if a.issues]
     if findings:
         lines += ["", "issues:"]

@@ -89,6 +89,24 @@ def _verified(after) -> str:
     return f"after = re-analysis of the hollowed mesh, certificate {cert.kind}: {'; '.join(mesh.notes)}"
 
 
+def _certificate_of(props):
+    """The :class:`~inertia_tool.mesh.policy.Certificate` of a result's mesh report; None without one."""
+    return getattr(getattr(props, "mesh", None), "certificate", None)
+
+
+def _certificates_text(result) -> str:
+    """``"certificate: before estimate, assuming flat-islands (mass ±…); after exact (the re-analysis of the
+    hollowed mesh)"``: how far the part's numbers before and after can be trusted (:meth:`Certificate.brief`: the
+    kind and the user's assumptions taken), for the text report."""
+    before, after = _certificate_of(result.before), _certificate_of(result.after)
+    said_before = "not stated" if before is None else before.brief()
+    bounds = getattr(getattr(result.before, "mesh", None), "uncertainty", None)
+    if before is not None and not before.proven and bounds is not None:
+        said_before += f" (mass ±{bounds.mass * 100:.3g} %)"
+    said_after = "exact" if after is None else after.brief()
+    return f"certificate: before {said_before}; after {said_after} (the re-analysis of the hollowed mesh)"
+
+
 def _mm(x) -> str:
     return "—" if x is None else f"{x * 1e3:.3f} mm"
 
@@ -147,7 +165,7 @@ def format_spin_it_text(result, *, name: str = "", output: str | None = None) ->
              f"optimised in {result.optimisation_seconds:.2f} s "
              f"({result.objective_evaluations} objective evaluations), {result.seconds:.2f} s in all",
              f"  objective {result.objective_before:.4g} → {result.objective_after:.4g} (exact moments)",
-             "  every 'after' number is the exact re-analysis of the hollowed mesh", ""]
+             f"  {_certificates_text(result)}", ""]
     if result.insert is not None:
         lines.insert(5, f"  insert: {result.insert.volume * 1e6:.4g} cm³ of {result.insert_density:g} kg/m³ "
                         f"({result.insert.mass * 1e3:.4g} g), "
@@ -303,7 +321,7 @@ def spin_it_html(result, *, name: str = "", motion: SpinMotion | None = None, ou
         facts.append(("hollowed part", output))
     body = [_html_table(None, facts, left=2),
             "<h2>Before and after</h2>",
-            "<p>Every “after” number is the exact re-analysis of the hollowed mesh.</p>",
+            f"<p>Every “after” number is the re-analysis of the hollowed mesh; {e(_certificates_text(result))}.</p>",
             _html_table(["quantity", "before", "after"], _rows(result), css="before-after")]
     if motion is not None:
         title = "Free spin about the axis" if result.mode == "yoyo" else "Nutation of the top"

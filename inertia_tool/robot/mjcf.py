@@ -157,7 +157,7 @@ def _optional_number(attrs: dict, key: str, what: str, source: str) -> float | N
     return value
 
 
-_MISSING = re.compile(r": resolves to (.+), which does not exist$")
+_MISSING = re.compile(r": resolves to (.+?), which does not exist(?:; near match: .*)?$")
 
 
 def _mesh_path(file: str, folders: list, packages: dict, source: str, link: str, missing_meshes: str) -> str:

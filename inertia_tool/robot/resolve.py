@@ -19,7 +19,11 @@ Rules, in order (the first that names an existing directory wins; the file must 
   ``base`` (the description's directory, or MuJoCo's ``meshdir``); an absolute path is itself.
 
 Any other scheme (``http://`` ...) is refused.  Failures raise :class:`RobotDescriptionError` naming the
-description file, the link and the URI as written.
+description file, the link and the URI as written.  A file that does not exist is never replaced by another
+one, but the message names a near match when there is one (:func:`near_match`): the same path in another case
+(``Meshes/Base.STL`` for ``meshes/base.stl``: the same file on a case-insensitive file system, not on Linux), the
+same name with another mesh extension, or the same file name in a sibling folder of the first folder that does
+not exist (Menagerie's Barkour v0 URDF names ``meshes/head.stl``; the file is ``assets/head.stl``).
 """
 
 from __future__ import annotations
@@ -31,10 +35,17 @@ from urllib.parse import unquote
 from ..errors import PackageFolderWarning, RobotDescriptionError
 from ..mesh.regular import not_regular_reason
 
-__all__ = ["resolve_uri", "package_directory", "nearby_package", "PACKAGE_PATH_VARIABLES", "MAX_FOLDERS_UP"]
+__all__ = ["resolve_uri", "package_directory", "nearby_package", "near_match", "PACKAGE_PATH_VARIABLES",
+           "MAX_FOLDERS_UP", "MESH_EXTENSIONS"]
 
 #: How many folders above a description are searched for a package or model it names.
 MAX_FOLDERS_UP = 8
+
+#: Mesh file extensions :func:`near_match` tries in place of a missing file's own (lower case).
+MESH_EXTENSIONS = (".stl", ".obj", ".dae", ".ply", ".off", ".glb", ".gltf", ".3mf")
+
+#: At most this many entries of one folder are listed by :func:`near_match` (a hint must not cost a scan).
+_NEAR_LISTING = 4096
 
 #: Environment variables searched for ``package://`` (first) and ``model://`` (all three) URIs.
 PACKAGE_PATH_VARIABLES = ("ROS_PACKAGE_PATH", "GZ_SIM_RESOURCE_PATH", "GAZEBO_MODEL_PATH")
@@ -109,6 +120,92 @@ def _plain_folder(name: str, inner: str, base: str, where: str) -> str | None:
     return folder
 
 
+def _listing(folder: str) -> list[str]:
+    """The names in ``folder``, sorted (at most :data:`_NEAR_LISTING`); empty when it cannot be listed."""
+    try:
+        with os.scandir(folder) as entries:
+            names = []
+            for entry in entries:
+                names.append(entry.name)
+                if len(names) >= _NEAR_LISTING:
+                    break
+    except OSError:
+        return []
+    return sorted(names)
+
+
+def _case_walk(folder: str, parts: list[str]) -> str | None:
+    """``folder`` joined with ``parts``, each part matched without regard to case (the first in sorted order
+    when several match); None when a part has no match or the result is not a regular file."""
+    for k, part in enumerate(parts):
+        if part in (".", ".."):
+            folder = os.path.normpath(os.path.join(folder, part))
+            continue
+        names = [n for n in _listing(folder) if n.casefold() == part.casefold()]
+        if not names:
+            return None
+        folder = os.path.join(folder, names[0])
+        if k < len(parts) - 1 and not os.path.isdir(folder):
+            return None
+    return folder if os.path.isfile(folder) else None
+
+
+def near_match(path: str) -> str | None:
+    """A hint for a mesh path that does not exist: ``"near match: P (...)"`` naming an existing file ``P``
+    that the author may have meant, or None.  Tried in order, and never used in place of ``path``:
+
+    1. the same path with every component matched without regard to case;
+    2. in the folder the file should be in (matched without regard to case), the same stem with another
+       extension of :data:`MESH_EXTENSIONS` (``part.STL`` for ``part.obj``);
+    3. the same file name (without regard to case) in a sibling of the first folder of ``path`` that does not
+       exist (``assets/head.stl`` for ``meshes/head.stl``).
+
+    Each folder is listed at most once per rule, and at most :data:`_NEAR_LISTING` of its entries.
+    """
+    path = os.path.abspath(path)
+    existing = path
+    missing: list[str] = []
+    for _ in range(256):                     # bounded: a path has fewer components than this
+        if os.path.isdir(existing) or os.path.dirname(existing) == existing:
+            break
+        existing, tail = os.path.split(existing)
+        missing.insert(0, tail)
+    if not missing:
+        return None
+    found = _case_walk(existing, missing)
+    if found is not None:
+        return f"near match: {found} (differs in case only; this file system tells case apart)"
+    stem, ext = os.path.splitext(missing[-1])
+    folder = _case_walk_folder(existing, missing[:-1])
+    if folder is not None:
+        for name in _listing(folder):
+            other_stem, other_ext = os.path.splitext(name)
+            if (other_stem.casefold() == stem.casefold() and other_ext.lower() in MESH_EXTENSIONS
+                    and other_ext.lower() != ext.lower() and os.path.isfile(os.path.join(folder, name))):
+                return f"near match: {os.path.join(folder, name)} (another extension)"
+    if len(missing) > 1:
+        for sibling in _listing(existing):
+            candidate = os.path.join(existing, sibling)
+            if sibling == missing[0] or not os.path.isdir(candidate):
+                continue
+            found = _case_walk(candidate, missing[1:])
+            if found is not None:
+                return (f"near match: {found} (the folder {missing[0]}/ does not exist beside "
+                        f"{os.path.basename(existing) or existing}/; a file of that name is in {sibling}/)")
+    return None
+
+
+def _case_walk_folder(folder: str, parts: list[str]) -> str | None:
+    """The folder ``folder`` joined with ``parts`` matched without regard to case; None when there is none."""
+    for part in parts:
+        names = [n for n in _listing(folder)
+                 if n.casefold() == part.casefold() and os.path.isdir(os.path.join(folder, n))]
+        if not names:
+            return None
+        folder = os.path.join(folder, names[0])
+    return folder
+
+
 def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) -> str:
     """Absolute path of the file ``uri`` names (see the module docstring for the rules).
 
@@ -158,5 +255,7 @@ def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) 
         if os.path.exists(path):             # a FIFO, a device or a link to one: never opened (no hang)
             reason = not_regular_reason(os.stat(path).st_mode, path) or "is not a regular file"
             raise RobotDescriptionError(f"{where}: resolves to {path}, which {reason}")
-        raise RobotDescriptionError(f"{where}: resolves to {path}, which does not exist")
+        hint = near_match(path)
+        raise RobotDescriptionError(f"{where}: resolves to {path}, which does not exist"
+                                    + (f"; {hint}" if hint else ""))
     return path

@@ -40,7 +40,7 @@ from ..output import check_targets, write_bytes
 from .description import RobotDescription, parse_xml
 from .xmlspans import DocumentText, ElementSpan, XMLSpanError, decode_document, element_spans
 
-__all__ = ["write_corrected", "corrected_document", "rewrite_paths"]
+__all__ = ["write_corrected", "corrected_document", "rewrite_paths", "included_files"]
 
 _ORIENTATION_KEYS = ("quat", "axisangle", "euler", "xyaxes", "zaxis", "diaginertia", "fullinertia")
 
@@ -246,6 +246,19 @@ def _mjcf_included_folders(robot: RobotDescription) -> set:
     except Exception:  # noqa: BLE001 - read_robot already expanded it; this is only a second look
         return set()
     return {key for c in root.iter("compiler") if id(c) not in own for key in c.attrib}
+
+
+def included_files(robot: RobotDescription) -> tuple[str, ...]:
+    """The files an MJCF main file ``<include>``s, as written, when the main file itself holds no ``<body>`` and
+    no ``<replicate>`` (a Menagerie ``scene.xml``): every body of the model is then in one of them, and only the
+    main file is written.  Empty for other formats and for a main file with bodies of its own (which bodies
+    come from where is then not said)."""
+    if robot.format != "mjcf":
+        return ()
+    root = parse_xml(robot.document, robot.source).getroot()
+    if next(root.iter("body", "replicate"), None) is not None:
+        return ()
+    return tuple(dict.fromkeys(i.get("file") or "" for i in root.iter("include")))
 
 
 #: Compiler attributes naming folders, which MuJoCo takes relative to the main model file's folder.
