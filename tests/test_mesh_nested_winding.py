@@ -28,7 +28,7 @@ from adversary_solids import concat as join
 from adversary_solids import flipped as turned_over
 from inertia_tool import mass_properties
 from inertia_tool.errors import InvalidMeshError
-from test_mesh_kept_cavities import H, _mesh, _moments, _winding
+from test_mesh_kept_cavities import H, _by_rule, _mesh, _moments
 
 
 def _children(rng, lo, hi, depth, boxes):
@@ -63,26 +63,6 @@ def _draw_nests(rng):
         boxes.append((lo, hi, 1 if rng.random() < 0.7 else -1))
         _children(rng, lo, hi, 1, boxes)
     return boxes
-
-
-def _by_rule(boxes):
-    """``(solid, parity, every nest stands, depth misreads an outward box)``: the cells of the solid the stated
-    rule gives, the cells of the depth reading, and whether the rule keeps the file's winding everywhere while depth
-    would read some box wound outward as a cavity."""
-    signs = [s for _, _, s in boxes]
-    w = _winding(boxes, signs)
-    cells = [_winding([b], [1]) > 0 for b in boxes]
-    inside = [[j for j in range(len(boxes)) if j != i and not np.any(cells[i] & ~cells[j])] for i in range(len(boxes))]
-    parity = _winding(boxes, [1] * len(boxes)) % 2 == 1
-    solid = np.zeros_like(parity)
-    stands_everywhere = True
-    for root in (i for i in range(len(boxes)) if not inside[i]):
-        region = cells[root]
-        stands = bool(w[region].min() >= 0)
-        stands_everywhere &= stands
-        solid |= region & ((w >= 1) if stands else parity)
-    misread = any(s > 0 and len(inside[i]) % 2 == 1 for i, s in enumerate(signs))
-    return solid, parity, stands_everywhere, misread
 
 
 def _answer(boxes):
