@@ -152,3 +152,19 @@ def test_nested_boxes_wound_either_way_follow_the_stated_rule(seed):
     (or refused / ``unverified``); exact, with the depth reading's volume named, wherever every nest stands and
     depth would misread an outward box."""
     _check(_draw_nests(np.random.default_rng(seed)))
+
+
+def test_a_body_listed_twice_around_a_cavity_listed_once_is_never_the_cavity_cut():
+    """R0 counts a shell listed twice twice (session 15): a 2 m box listed twice around a 0.5 m cavity listed once
+    has winding 2 − 1 = 1 in the cavity, material, so {w ≥ 1} is the box whole, 8 m³.  R4c read it so but, no shell
+    touching another, the boolean never ran and the summed integral was given: ``exact`` 7.875 m³ (found in session
+    16).  Now the boolean forms it (no face crosses, so it is not proven: ``unverified``), or it is proven exact."""
+    lo, hi = np.array([-4, -4, -4]), np.array([4, 4, 4])
+    outer = _mesh([(lo, hi, 1)])
+    cavity = _mesh([(np.array([-1, -1, -1]), np.array([1, 1, 1]), -1)])
+    v, f = join(outer, outer, cavity)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        props = mass_properties((v, f), density=1.0)
+    assert abs(props.mass - 8.0) <= 1e-9 * 8.0, (props.mass, props.mesh.certificate)
+    assert certificate_label(props.mesh) in ("exact", "united", "unverified")

@@ -109,13 +109,26 @@ R3b *A flat open sheet inside a solid encloses nothing* (:func:`~.sheets.open_sh
    whose rims meet another's within ``MERGE_TOLERANCE`` (a cavity cracked into flat facets) and fins
    (flat sheets outside the solid, perhaps plates meant to have thickness) are not taken: the fin is named in the
    refusal.
-R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is the number of other shells
+R4 *Orientation by nesting depth, where the file's winding is evidently wrong* (:func:`orient_by_depth`,
+   :func:`winding_stands`; session 16, the team's decision on issue 21).  The solid is where the winding number is
+   at least one, so the file's own winding is read as it stands wherever it is a solid's: in a *nest* (a shell at
+   depth 0 and every shell inside it) with no shell crossing another, where every region has winding ``≥ 0``, no
+   shell is turned; the shells with winding ``≥ 1`` on both sides (a body wound outward wholly inside another, and
+   whatever lies inside it) bound nothing of ``{w ≥ 1}`` and are left out, and the rest, each with winding 0 on one
+   side and 1 on the other, is integrated as wound: ``exact`` with the check ``interior-shells`` (no boolean; left
+   out as R0's copies and R2's flat pieces are), its note naming the depth reading (a cavity written with the wrong
+   winding) and the volume it gives, exactly (:func:`misread_message`).  Reason: two nested boxes both wound
+   outward (winding 1 and 2) were read by depth as a body and its cavity and certified ``exact``, while the issue's
+   definition gives the outer box (recount15's one flagged answer, winding seed 1703 case 367).  Only where a nest's
+   winding is evidently wrong (some region ≤ −1: the issue's hollow sphere with its outer shell wound inward, whose
+   cavity is right, winding −1 and −2, stays a hollow sphere) or shells cross (the regions are not known from the
+   probes) does depth orient the shells, as follows.  A shell's depth is the number of other shells
    that contain it (whose winding number at a point of it is nonzero and that it does not cross), shells that
    cross one another counting once (overlapping bodies are one body for what lies inside them; a cavity inside
    two of them is not verified: :func:`cavities_in_overlap`); even depth
    is a body, wound outward, odd depth a cavity, wound inward.  A shell wound the other way is flipped, with
    a warning.  Never decided by the sign of the total volume: one inside-out shell must not turn the others.
-   So an outward-wound shell inside a body is read as a cavity written with the wrong winding, not as a
+   There, an outward-wound shell inside a body is read as a cavity written with the wrong winding, not as a
    second body buried in the first.  A shell whose surface crosses another's has no depth of its own: it keeps
    the file's winding (an inward shell is cut from the innermost body containing it, or, contained by none,
    from the outward shell it crosses) and the boolean decides; a
@@ -134,7 +147,9 @@ R4 *Orientation by nesting depth* (:func:`orient_by_depth`).  A shell's depth is
    own winding number is 2 there, so ``{w ≥ 1}`` is the union of the bodies, and a cavity written with the wrong
    winding reads the same (the shells around it counted by their file winding at its probe point and, for a
    shell flush with its container, by the container's: where that sum is below 0, the file reads it as empty
-   too, no misread).  The parity reading is kept, a warning names the other one and its volume, and the
+   too, no misread).  Where that reading is still taken (the nest's winding evidently wrong elsewhere, or shells
+   crossing) the parity reading is kept, a warning names the other one and its volume (exactly where no shell
+   crosses another, :func:`reading_difference`; recount15 saw "at most 0.0637 m³ more" for a known 0.0578), and the
    certificate is never ``united`` for it (:func:`~.certify.misread_reading`): ``exact`` when the turned surface
    has no crossing face pair (the parity solid proven), otherwise an estimate whose bounds span both readings;
    ``unverified`` when inward shells cross outward ones as well (both readings rest on that unproven cut).  The
