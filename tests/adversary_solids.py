@@ -435,6 +435,9 @@ class Case:
     #: other readings of the same mesh that the issue's rules also allow (an answer matching one is right)
     alternatives: list = field(default_factory=list)
     motion: tuple | None = None
+    #: the truth of the same mesh with every face reversed, where the rules read it otherwise than ``truth``
+    #: (a nest whose own winding stands one way round is evidently wrong the other way: R4, session 16)
+    reversed_truth: Truth | None = None
 
 
 def _t(values):
@@ -675,14 +678,40 @@ def _nested(rng):
         names.append(cname)
     wound = []
     mesh_pieces = []
+    outwards = []
     for sign, p in levels:
         right = rng.random() < 0.5
         # right: wound as its depth says (outward for a body, inward for a cavity)
         outward = (sign > 0) == right
         mesh_pieces.append(p if outward else flipped(p))
         wound.append(f"{'outward' if outward else 'inward'}")
+        outwards.append(outward)
     recipe = " ⊃ ".join(f"{n} ({w})" for n, w in zip(names, wound)) + " nested (depth 0 body, 1 cavity, 2 body)"
-    return _finish("nested", rng, levels, concat(*mesh_pieces), recipe)
+    case = _finish("nested", rng, nest_pieces(levels, outwards), concat(*mesh_pieces), recipe)
+    rot, shift = case.motion
+    case.reversed_truth = truth_from_pieces([(s, moved(p, rot, shift))
+                                             for s, p in nest_pieces(levels, [not o for o in outwards])])
+    return case
+
+
+def nest_pieces(levels, outward):
+    """The signed pieces of the solid the rules give a chain of strictly nested shells ``levels`` (``(sign by
+    depth, piece)``, outermost first) wound ``outward`` (bools): where the file's winding is ≥ 0 in every region
+    it stands and the solid is ``{w ≥ 1}`` (R4, session 16: each shell's coefficient ``[w_in ≥ 1] − [w_out ≥ 1]``,
+    ``w_in`` the running sum of ±1 from the outside); otherwise the depth reading, the parity solid."""
+    running, windings = 0, []
+    for o in outward:
+        running += 1 if o else -1
+        windings.append(running)
+    if min(windings) < 0:
+        return list(levels)
+    pieces, before = [], 0
+    for (_, piece), w in zip(levels, windings):
+        now = int(w >= 1)
+        if now != before:
+            pieces.append((now - before, piece))
+        before = now
+    return pieces
 
 
 def _internal_wall(rng):
@@ -779,7 +808,8 @@ def _inside_out(rng):
     base = ("single", "disjoint", "nested", "overlapping", "touching_faces")[rng.integers(5)]
     case = _BUILDERS[base](rng)
     # the base's other allowed readings carry over (an overlapping piece wholly inside another: cavity by depth)
-    return Case("inside_out", case.vertices, case.faces[:, ::-1].copy(), case.truth,
+    truth = case.reversed_truth if case.reversed_truth is not None else case.truth
+    return Case("inside_out", case.vertices, case.faces[:, ::-1].copy(), truth,
                 f"[{base}] {case.recipe}; every face reversed", alternatives=case.alternatives)
 
 

@@ -139,9 +139,13 @@ def test_tube_halves_are_the_tube():
 
 
 def _hollow_sphere(outer_outward, cavity_inward):
+    """A hollow sphere wound four ways.  The solid by the rules (R4, session 16): where every region's winding is
+    ≥ 0 the file's winding stands (both outward: winding 1 and 2, the outer sphere whole), else the depth reading
+    (outer inward: winding −1 somewhere, the hollow sphere, as for the issue's inside-out skin)."""
     outer = S.icosphere(1.0, 2)
     inner = S.icosphere(0.6, 1)
-    truth = S.truth_from_pieces([(1, outer), (-1, inner)])
+    levels = [(1, outer), (-1, inner)]
+    truth = S.truth_from_pieces(S.nest_pieces(levels, [outer_outward, not cavity_inward]))
     mesh = S.concat(outer if outer_outward else S.flipped(outer), S.flipped(inner) if cavity_inward else inner)
     return S.Case("nested", *mesh, truth, f"hollow sphere, outer {'out' if outer_outward else 'in'}ward, "
                                           f"cavity {'in' if cavity_inward else 'out'}ward")
@@ -315,9 +319,10 @@ def test_core_filling_its_cavity_exactly_cancels():
 @given(seed=st.integers(0, 2 ** 32 - 1), cavity_inward=st.booleans(), turned=st.booleans())
 def test_flush_cavity_is_a_cavity_however_turned(seed, cavity_inward, turned):
     """A cavity flush with its body's face, wound either way, axis-aligned or under a random rotation (so the
-    contact is coplanar exactly, or only to rounding): one rule, the depth of the closed solid, makes it a
-    cavity; the answer is the notched box (rational truth) or a label that says it is not proven (an outward-wound
-    one is a reading the file does not decide: exact when proven, else an estimate spanning the union too)."""
+    contact is coplanar exactly, or only to rounding): one rule, the depth of the closed solid, places it within
+    the box; wound inward the answer is the notched box (rational truth), wound outward the file's winding stands
+    (1 and 2, never below 0: R4, session 16) and the answer is the box whole, or a label that says it is not
+    proven; never ``united`` for the outward one (the depth reading is named, not formed by a boolean)."""
     rng = np.random.default_rng(seed)
     ea = rng.integers(4, 9, size=3) * 0.125
     ec = np.minimum(rng.integers(1, 4, size=3) * 0.125, ea - 0.25)
@@ -327,7 +332,9 @@ def test_flush_cavity_is_a_cavity_however_turned(seed, cavity_inward, turned):
     shift = rng.normal(size=3)
     outer, cavity = S.moved(outer, rot, shift), S.moved(cavity, rot, shift)
     mesh = S.concat(outer, S.flipped(cavity) if cavity_inward else cavity)
-    case = S.Case("flush_cavity", *mesh, S.truth_from_pieces([(1, outer), (-1, cavity)]), "flush cavity")
+    # wound outward, the file's winding (1 and 2) stands: the box whole (R4, session 16; before, the notched box)
+    truth = S.truth_from_pieces([(1, outer), (-1, cavity)] if cavity_inward else [(1, outer)])
+    case = S.Case("flush_cavity", *mesh, truth, "flush cavity")
     verdict = _assert_honest(case)
     assert verdict.label in ("exact", "united", "unverified", "estimate")
     assert not (verdict.label == "united" and not cavity_inward)     # issue 21 item 3: never united for R4's reading
@@ -336,15 +343,16 @@ def test_flush_cavity_is_a_cavity_however_turned(seed, cavity_inward, turned):
 
 
 def test_box_standing_inside_another_reads_like_a_flush_cavity():
-    """The same geometry two ways: a small box (outward) standing on the floor inside a big one, and a cavity
-    (outward) flush with a big box's face.  Both are a shell within another touching its boundary, so both read
-    as a cavity (R4), with the same volume as the cavity wound inward."""
+    """The same geometry two ways: a small box standing on the floor inside a big one, wound outward and wound
+    inward.  Both are a shell within another touching its boundary, placed by one rule (R4); wound inward it is a
+    cavity (1 − 0.25³), wound outward the file's winding (1 and 2) stands and it is part of the body (1: session
+    16; before, the cavity's volume both ways)."""
     big = S.box([1.0, 1.0, 1.0])
     small = S.box([0.25, 0.25, 0.25], [0.0, 0.0, -0.375])            # on the floor z = -0.5, from inside
-    for inner in (small, S.flipped(small)):
+    for inner, volume in ((small, 1.0), (S.flipped(small), 1.0 - 0.25 ** 3)):
         p, said = _props(*S.concat(big, inner))
         assert p.mesh.certificate.kind in ("exact", "united")
-        assert abs(p.mass - (1.0 - 0.25 ** 3)) <= 1e-12
+        assert abs(p.mass - volume) <= 1e-12
 
 
 # ------------------------------------------------------- R7: "exact" up to a derived round-off bound (issue 21)

@@ -8,6 +8,9 @@ turned the whole surface over: an estimate of a solid no reading names (0.261 m�
 {w ≥ 1} is 0.172 m³; 11 of 200 generated cases outside their bounds).  A surface is now read turned only where
 its winding is nowhere above 1/2 (``grid_estimate._inside_out_as_a_whole``); otherwise the solid is the file's
 {w ≥ 1}, the issue's definition.  Bounds are judged as the estimate states them: relative to the estimate.
+Where the file's winding is nowhere at least one (``{w ≥ 1}`` empty) the grid reads the surface turned over as a
+whole, and says so in the estimate's note (session 16: ``grid_estimate.TURNED_READING``; seed 1902's cases 26 and
+392 were answered so without a word); the judge accepts that reading, ``{−w ≥ 1}``, only where the note states it.
 """
 from __future__ import annotations
 
@@ -17,7 +20,7 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from test_mesh_kept_cavities import _draw, _mesh, _readings
+from test_mesh_kept_cavities import _draw, _mesh, _moments, _readings, _winding
 from adversary_solids import box, certificate_label, flipped
 from inertia_tool import mass_properties
 from inertia_tool.errors import InvalidMeshError
@@ -40,6 +43,9 @@ def repaired_verdict(boxes) -> tuple[str, str | None]:
     if label not in ("exact", "united", "estimate"):
         return label, None
     readings = _readings(boxes)
+    if label == "estimate" and _says_turned(props.mesh.notes):      # the reading the note states, and only then
+        turned = _moments(_winding(boxes, [-s for _, _, s in boxes]) >= 1)
+        readings = readings + ([turned] if turned is not None else [])
     for volume, centroid, inertia in readings:
         dc = float(np.linalg.norm(props.center_of_mass - centroid))
         if label == "estimate":
@@ -53,6 +59,11 @@ def repaired_verdict(boxes) -> tuple[str, str | None]:
               and np.linalg.norm(props.inertia - inertia) <= 1e-8 * np.linalg.norm(inertia)):
             return label, None
     return label, f"{label} {props.mass} m³ for the readings {[r[0] for r in readings]}"
+
+
+def _says_turned(notes) -> bool:
+    """The report's notes state the grid's turned reading (``grid_estimate.TURNED_READING``)."""
+    return any(grid_estimate.TURNED_READING.lstrip("; ") in note for note in notes)
 
 
 def _holds_for_the_files_winding(boxes) -> bool:
@@ -85,3 +96,37 @@ def test_a_surface_inside_out_as_a_whole_is_still_read_turned():
     assert grid_estimate._inside_out_as_a_whole(0.0, 5.0)
     assert not grid_estimate._inside_out_as_a_whole(1.0, 5.0)
     assert not grid_estimate._inside_out_as_a_whole(0.0, 0.0)
+
+
+def test_a_file_wound_so_that_no_region_is_material_names_the_turned_reading():
+    """Seed 1902 case 26 of the kept-cavities generator with ``repair=True``: every outward box is covered by inward
+    ones, so ``{w ≥ 1}`` as wound is empty.  The grid reads the surface turned over as a whole; the estimate's note
+    now says so (before: nothing said, and the judge flagged it), and its bounds hold the turned reading
+    ``{−w ≥ 1}`` by exact cell counts.  The judge accepts that reading only where the note states it."""
+    boxes = _draw(np.random.default_rng([1902, 26]))
+    assert _moments(_winding(boxes, [s for _, _, s in boxes]) >= 1) is None        # {w ≥ 1} as wound is empty
+    v, f = _mesh(boxes)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        props = mass_properties((v, f), density=1.0, repair=True)
+    assert certificate_label(props.mesh) == "estimate"
+    assert _says_turned(props.mesh.notes)
+    volume, centroid, inertia = _moments(_winding(boxes, [-s for _, _, s in boxes]) >= 1)
+    u = props.mesh.uncertainty
+    assert abs(props.mass - volume) <= u.mass * props.mass * (1 + 1e-9)
+    assert np.linalg.norm(props.center_of_mass - centroid) <= u.center_of_mass + 1e-9
+    assert repaired_verdict(boxes)[1] is None
+
+
+def test_the_turned_reading_is_named_only_where_the_grid_turns():
+    """A box wound outward holding a box wound inward that reaches outside it (winding 1 and −1): not turned, so
+    the note says nothing of a turn; the same boxes with both wound inward (winding −1 only): turned, named."""
+    a = box(np.array([1.0, 1.0, 1.0]))
+    b = box(np.array([0.5, 0.5, 1.5]), np.array([0.5, 0.0, 0.0]))
+    mixed = (np.vstack([a[0], b[0]]), np.vstack([a[1], b[1][:, ::-1] + len(a[0])]))
+    inward = (mixed[0], np.vstack([a[1][:, ::-1], b[1][:, ::-1] + len(a[0])]))
+    said = {}
+    for name, (v, f) in (("mixed", mixed), ("inward", inward)):
+        est = grid_estimate.winding_estimate(v, f, resolution=24)
+        said[name] = grid_estimate.TURNED_READING in est.detail
+    assert said == {"mixed": False, "inward": True}

@@ -124,19 +124,24 @@ def test_manifold3d_does_not_resolve_a_self_crossing_mesh():
 
 @pytest.mark.parametrize("outer_sign, inner_sign", [(1, -1), (-1, -1), (-1, 1), (1, 1)])
 def test_hollow_sphere_in_every_winding_is_the_shell(outer_sign, inner_sign):
+    """Three windings read as the hollow sphere: right, and two with the outer shell inward (winding −1 somewhere:
+    evidently wrong, so R4 turns by depth).  Both wound outward (winding 1 and 2, never below 0) the file's winding
+    stands (session 16): the outer sphere whole, the inner shell left out, nothing turned, the depth reading (the
+    hollow sphere) named in the warning."""
     vo, fo = uv_sphere(1.0)
     vi, fi = uv_sphere(0.6, (0.1, 0.0, -0.05))
-    truth = _volume(vo, fo) - _volume(vi, fi)
+    stands = outer_sign > 0 and inner_sign > 0
+    truth = _volume(vo, fo) - (0.0 if stands else _volume(vi, fi))
     v, f = stack((vo, fo if outer_sign > 0 else fo[:, ::-1]), (vi, fi[:, ::-1] if inner_sign < 0 else fi))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         props = mass_properties((v, f))
     assert props.volume == pytest.approx(truth, rel=1e-12)
     assert props.mesh.certificate.kind == "exact"
-    assert props.mesh.cavities == 1 and props.mesh.overlapping_shells == 0
-    wrong = (outer_sign < 0) + (inner_sign > 0)
+    assert props.mesh.cavities == (0 if stands else 1) and props.mesh.overlapping_shells == 0
+    wrong = 0 if stands else (outer_sign < 0) + (inner_sign > 0)
     assert props.mesh.flipped_shells == wrong
-    assert any(issubclass(w.category, InsideOutWarning) for w in caught) == bool(wrong)
+    assert any(issubclass(w.category, InsideOutWarning) for w in caught) == bool(wrong or stands)
 
 
 def test_body_inside_a_cavity_keeps_its_material():
@@ -325,9 +330,11 @@ def _primitive(draw):
 def scenes(draw):
     """(vertices, faces, truth volume, description): solids composed under random rigid motions.
 
-    Each shell is wound outward or inward at random (a body's truth does not depend on it: rule R4 orients
-    by nesting depth).  Truths: the manifold3d float64 union of the outward shells, or outer − cavity (+ core)
-    by signed-tetrahedron sums of each closed shell alone.
+    Each shell is wound outward or inward at random.  R4 orients by nesting depth where the file's winding is
+    evidently wrong (a region below 0), and where it is not (session 16) the solid is {w ≥ 1}: a nest wound so that
+    every region is ≥ 0 with a shell against its depth (a body wound outward inside another, a cavity wound outward
+    in its body) is the outer body whole.  Truths: the manifold3d float64 union of the outward shells, or outer −
+    cavity (+ core) by signed-tetrahedron sums of each closed shell alone.
     """
     mode = draw(st.sampled_from(["apart", "overlap", "touch", "nested", "shared-vertex", "linked",
                                  "pole-to-pole", "body-in-cavity", "self-crossing"]))
@@ -344,8 +351,8 @@ def scenes(draw):
         parts = [a, (b[0] @ r2.T + 0.3 * t2, b[1])]
         truth = union_volume(*parts)
         sizes = sorted(_volume(*p) for p in parts)
-        if abs(truth - sizes[1]) <= 1e-9 * truth:     # one lies inside the other: a cavity by its depth (R4)
-            truth = sizes[1] - sizes[0]
+        if abs(truth - sizes[1]) <= 1e-9 * truth and (flip[0] or flip[1]):
+            truth = sizes[1] - sizes[0]     # one inside the other, one wound inward: a cavity, or read by depth (R4)
     elif mode == "touch":
         ext = draw(st.tuples(*[st.floats(0.2, 2.0)] * 3))
         side = draw(st.tuples(st.floats(0.2, 2.0), st.floats(0.2, 2.0)))
@@ -357,11 +364,15 @@ def scenes(draw):
         inner = _primitive(draw)
         parts = [outer, (inner[0] * 0.5, inner[1][:, ::-1])]    # fits in the sphere's inscribed polyhedron
         truth = _volume(*outer) - _volume(parts[1][0], inner[1])
+        if not flip[0] and flip[1]:         # both wound outward: winding 1 and 2, the file's winding stands (R4)
+            truth = _volume(*outer)
     elif mode == "body-in-cavity":
         outer, cavity, core = uv_sphere(1.5, segments=16, rings=8), uv_sphere(1.0, segments=16, rings=8), \
             uv_sphere(draw(st.floats(0.2, 0.8)), segments=12, rings=6)
         parts = [outer, (cavity[0], cavity[1][:, ::-1]), core]
         truth = _volume(*outer) - _volume(*cavity) + _volume(*core)
+        if not flip[0] and flip[1]:         # the cavity wound outward: no region below 0, the outer body whole (R4)
+            truth = _volume(*outer)
     elif mode == "linked":
         minor = draw(st.floats(0.1, 0.45))
         a = torus(1.0, minor, steps=24, sections=8)

@@ -8,7 +8,9 @@ The truth knows nothing of the pipeline: every box has its corners on a quarter 
 of box indicators on grid cells, and the moments of ``{w ≥ 1}`` are sums over whole cells (a cube of side ``h`` has
 second moment ``h⁵/12`` about its centre on each axis).  An answer labelled ``exact``, ``united`` or ``estimate``
 must be the solid ``{w ≥ 1}`` of the file as wound, or of the file with every inward box that meets no outward box
-in volume turned (R4: a body written inside out), to 1e-9 (``estimate``: within its stated bounds); a refusal or an
+in volume turned (R4: a body written inside out), or, where no two boxes cross, R4's stated rule (:func:`_by_rule`:
+per nest, ``{w ≥ 1}`` where no cell of the nest is below 0, else the depth reading; session 16, where the depth reading
+was offered for the whole file), to 1e-9 (``estimate``: within its stated bounds); a refusal or an
 ``unverified``/``summed`` label is allowed.  A warning that names "the union of the bodies" must give one of those
 volumes (D5's warning named 1.70312 m³ for 1.65625).
 """
@@ -105,9 +107,31 @@ def _readings(boxes):
     cells = [_winding([b], [1]) > 0 for b in boxes]
     crossing = any(0 < np.count_nonzero(a & b) < min(np.count_nonzero(a), np.count_nonzero(b))
                    for k, a in enumerate(cells) for b in cells[k + 1:])
-    if not crossing:
-        found.append(_moments(_winding(boxes, [1] * len(boxes)) % 2 == 1))
+    if not crossing:         # R4, session 16: the depth reading only in the nests whose winding is evidently wrong
+        found.append(_moments(_by_rule(boxes)[0]))
     return [r for r in found if r is not None]
+
+
+def _by_rule(boxes):
+    """``(solid, parity, every nest stands, depth misreads an outward box)``: the cells of the solid the stated
+    rule gives, the cells of the depth reading, and whether the rule keeps the file's winding everywhere while depth
+    would read some box wound outward as a cavity."""
+    signs = [s for _, _, s in boxes]
+    w = _winding(boxes, signs)
+    cells = [_winding([b], [1]) > 0 for b in boxes]
+    # j holds i: i's cells are j's (of two equal boxes, a copy, the later is inside the earlier)
+    inside = [[j for j in range(len(boxes)) if j != i and not np.any(cells[i] & ~cells[j])
+               and (np.any(cells[j] & ~cells[i]) or j < i)] for i in range(len(boxes))]
+    parity = _winding(boxes, [1] * len(boxes)) % 2 == 1
+    solid = np.zeros_like(parity)
+    stands_everywhere = True
+    for root in (i for i in range(len(boxes)) if not inside[i]):
+        region = cells[root]
+        stands = bool(w[region].min() >= 0)
+        stands_everywhere &= stands
+        solid |= region & ((w >= 1) if stands else parity)
+    misread = any(s > 0 and len(inside[i]) % 2 == 1 for i, s in enumerate(signs))
+    return solid, parity, stands_everywhere, misread
 
 
 def _verdict(boxes):

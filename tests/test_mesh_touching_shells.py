@@ -167,8 +167,9 @@ def test_relations_rule_table():
 def test_boxes_on_a_shared_grid_match_inclusion_exclusion(corner, size, quarter):
     """Random boxes with corners on a half-unit grid (B shifted by a quarter unit, or not: shared planes), each cut
     along every coordinate of both: the answer is inclusion–exclusion's (exactly representable, rel 1e-12) and
-    certified.  One box within the other (touching its boundary or not) is read as a cavity by R4's rule: the
-    difference; two equal boxes are one shell listed twice (R0)."""
+    certified.  One box within the other (touching its boundary or not), both wound outward: winding 1 and 2, never
+    below 0, so the file's winding stands (R4, session 16): the outer box (before: read as a cavity, the
+    difference); two equal boxes are one shell listed twice (R0)."""
     shift = 0.25 if quarter else 0.0
     lo_a = [corner[k] / 2 for k in range(3)]
     hi_a = [lo_a[k] + size[k] / 2 for k in range(3)]
@@ -181,18 +182,17 @@ def test_boxes_on_a_shared_grid_match_inclusion_exclusion(corner, size, quarter)
     a, b = _boxes_on_shared_grid(lo_a, hi_a, lo_b, hi_b)
     props = _quiet(*stack(a, b))
     if vol_a == vol_b == common:                  # the same box twice
-        truth, first, cavities = vol_a, m_a, 0
-    elif common == vol_b:                         # b within a: a cavity wound the wrong way (R4)
-        truth, first, cavities = vol_a - vol_b, m_a - m_b, 1
+        truth, first = vol_a, m_a
+    elif common == vol_b:                         # b within a: {w ≥ 1} is a (R4, session 16)
+        truth, first = vol_a, m_a
     elif common == vol_a:
-        truth, first, cavities = vol_b - vol_a, m_b - m_a, 1
+        truth, first = vol_b, m_b
     else:
-        truth, first, cavities = vol_a + vol_b - common, m_a + m_b - m_i, 0
+        truth, first = vol_a + vol_b - common, m_a + m_b - m_i
     assert props.volume == pytest.approx(truth, rel=1e-12)
     assert np.allclose(props.center_of_mass, first / truth, atol=1e-12)
     assert props.mesh.certificate.kind in ("exact", "united")
-    if not cavities:             # (a cavity's count in the report is the boolean's surface: a box cut from a box)
-        assert props.mesh.flipped_shells == 0
+    assert props.mesh.flipped_shells == 0           # nothing is turned: every box is wound outward
 
 
 def test_go1_thigh_is_the_union_of_its_three_shells():

@@ -22,16 +22,17 @@ def _inside_out_warnings(v, f, **kwargs):
 
 
 @pytest.mark.parametrize("lo", [(0.5, 0.5, 0.5), (0.5, 0.5, 0.0)])
-def test_an_outward_body_read_as_a_cavity_gets_one_warning_naming_both_readings(lo):
+def test_an_outward_body_inside_another_gets_one_warning_naming_both_readings(lo):
     """Before: two InsideOutWarnings, the generic "inside out for its nesting depth ... flipped" and R4's note
-    naming the other reading.  Now R4's note alone, with both readings (the cavity kept, the union of the bodies
-    the file's own winding gives, 8 m³)."""
+    naming the other reading.  Then R4's note alone (the cavity kept, the union named).  Now (session 16: the
+    file's winding, 1 and 2, stands) the union is given and turns nothing, and R4's one note names the depth
+    reading, a cavity, 7 m³."""
     v, f, parity, union = _nested(lo, (1.0, 1.0, 1.0), inward=False)
     p, said = _inside_out_warnings(v, f)
     assert len(said) == 1, said
-    assert "1 of 2 shells are inside out for its nesting depth" in said[0]      # the flip, said once
-    assert "does not decide" in said[0] and "cavit" in said[0] and "8 m³" in said[0] and "union" in said[0]
-    assert p.volume == pytest.approx(parity[0], rel=1e-12)
+    assert "inside out for its nesting depth" not in said[0]                     # nothing turned
+    assert "does not decide" in said[0] and "cavit" in said[0] and "7 m³" in said[0] and "nesting depth" in said[0]
+    assert p.volume == pytest.approx(union[0], rel=1e-12)
 
 
 def test_a_lone_body_wound_inward_still_gets_the_generic_warning():

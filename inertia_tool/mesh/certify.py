@@ -115,7 +115,36 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
     bodies by the file's winding) have the same two readings and are never proven: an estimate whose bound spans
     both.  Shells the file winds inward inside a cavity that depth reads as bodies (``oriented.voids``, a void
     inside a void read as an island) are labelled the same way, their note naming the file's winding reading (the
-    shells empty) and its mass.  Returns the result and, for an estimate, ``(volume in doubt, reach)``."""
+    shells empty) and its mass.  Where the file's winding stands (``oriented.interior``: no region's winding below
+    0, session 16) the shells with winding at least one on both sides were left out and the rest integrated as
+    wound; the note names the depth reading and its volume (:func:`_winding_stands`).  Returns the result and, for
+    an estimate, ``(volume in doubt, reach)``."""
+    united, spread = _depth_readings(oriented, united, method=method, source=source)
+    if oriented.interior is not None:
+        united = _winding_stands(oriented.interior, united, source=source)
+    return united, spread
+
+
+def _winding_stands(found: MisreadNesting, united: United, *, source: str) -> United:
+    """R4 where the file's winding stands (:func:`~.policy.winding_stands`): the shells with winding at least one on
+    both sides were left out, and the shells kept bound ``{w ≥ 1}`` as wound.  The label is the kept surface's
+    (``exact`` when its checks passed: the summed integral of shells the file writes, as for R0's copies and R2's
+    flat pieces, no boolean), with the check ``interior-shells``; the note, warned, names the depth reading (a
+    cavity written with the wrong winding) and the volume it gives, exactly."""
+    proven = united.forced is None and united.kind in ("exact", "united")
+    volume = float(total(united.shells.moments).volume) if proven else None
+    note = misread_message(found, volume, proven,
+                           kept=None if proven else "the solid given is not proven apart from that reading")
+    warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=4)
+    checks = list(united.checks)
+    if proven and "interior-shells" not in checks:
+        checks.insert(min(2, len(checks)), "interior-shells")
+    return united._replace(notes=(*united.notes, note), checks=checks)
+
+
+def _depth_readings(oriented: Orientation, united: United, *, method: str,
+                    source: str) -> tuple[United, tuple[float, float] | None]:
+    """:func:`misread_reading` for the readings by nesting depth (``misread``, ``voids``, ``groups``)."""
     from .intersect import surface_contacts
 
     found, voids, groups = oriented.misread, oriented.voids, oriented.groups

@@ -8,6 +8,7 @@ depth, turning shells wound against it), the body each cavity belongs to, and wh
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, NamedTuple
@@ -15,13 +16,14 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from ..errors import InsideOutWarning, InvalidMeshError, MeshResolvedWarning
-from ..integrals import VolumeMoments
+from ..integrals import RoundoffBound, VolumeMoments
 from ..tolerances import TOUCH_VOLUME_RTOL
 from .intersect import SurfaceContacts, surface_contacts
 from .multiplicity import container_windings, multiplicity_changes
 from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
                      inward_crossing_shells, misread_nesting, misread_voids, nested_copies, orient_by_depth,
-                     outward_crossing_groups, rounding_volumes, shell_contacts, within_up_to_rounding)
+                     outward_crossing_groups, reading_difference, rounding_volumes, shell_contacts, winding_stands,
+                     within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
 
@@ -74,6 +76,14 @@ class Orientation(NamedTuple):
     turned_reading : bool
         R4c was taken because a misread reading rested on a shell R4 turned (:func:`_rests_on_a_turn`): where R4c
         refuses, ``repair`` refuses too (:func:`~.policy.turned_reading_refusal`).
+    interior : MisreadNesting or None
+        Nests whose own winding is a solid's where depth would read a shell wound outward as a cavity
+        (:func:`~.policy.winding_stands`, ``kept="winding"``): the shells ``interior.drop`` (numbered as in the
+        file's shells) were left out of ``shells``, and the depth reading is named by
+        :func:`~.certify.misread_reading`.
+    contacts : SurfaceContacts or None
+        The face pairs of ``shells`` when shells were left out (``interior``), for the later stages; None: the
+        contacts given.
     """
 
     shells: Shells
@@ -91,6 +101,8 @@ class Orientation(NamedTuple):
     voids: MisreadNesting | None = None
     multiplicity: np.ndarray | None = None
     turned_reading: bool = False
+    interior: MisreadNesting | None = None
+    contacts: SurfaceContacts | None = None
 
 
 def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContacts, *, source: str,
@@ -100,7 +112,18 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
 
     ``multiplicity``: (s,) int, how many times R0 found each shell listed (None: once each).  Where counting a
     shell that many times changes ``{w ≥ 1}`` (:func:`~.multiplicity.multiplicity_changes`), the solid is formed
-    by R4c, which counts it (R0), when R4 turned no shell; otherwise refused."""
+    by R4c, which counts it (R0), when R4 turned no shell; otherwise refused.
+
+    Where depth would read a shell the file winds outward as a cavity in a nest whose own winding is a solid's (no
+    region below 0: :func:`~.policy.winding_stands`), the shells with winding at least one on both sides are left
+    out and the rest read again (their winding is then 0 or 1 everywhere in that nest); ``interior`` says so."""
+    return _orient_shells(shells, contacts, touch, source=source, multiplicity=multiplicity, again=False)
+
+
+def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContacts, *, source: str,
+                   multiplicity: np.ndarray | None, again: bool) -> Orientation:
+    """:func:`orient_shells`; ``again``: the shells are what :func:`~.policy.winding_stands` left (not asked
+    again: the nests it kept have winding 0 or 1 everywhere)."""
     v, f, labels, n_shells = shells.vertices, shells.faces, shells.labels, shells.n_shells
     nest = shell_nesting_or_none(v, f, labels, n_shells)
     file_volumes = np.array([s.volume for s in shells.moments])
@@ -115,6 +138,16 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
                                                              rounding)
     flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
                                          within=_both(within, touch_within))
+    # R4 (session 16): where a nest's own winding is a solid's (no region below 0), it stands: the shells with
+    # winding ≥ 1 on both sides are left out and the rest read again (two nested outward boxes: the outer box)
+    stands = winding_stands(file_volumes, depth, nest, _both(within, touch_within), crossing_with, multiplicity) \
+        if touch.complete and not again else None
+    if stands is not None and stands.drop is not None:
+        kept_shells, kept_contacts = _without_shells(shells, contacts, stands.drop)
+        kept_touch = shell_contacts(kept_contacts, kept_shells.labels, kept_shells.n_shells)
+        left = None if multiplicity is None else np.asarray(multiplicity)[~stands.drop]
+        read = _orient_shells(kept_shells, kept_contacts, kept_touch, source=source, multiplicity=left, again=True)
+        return read._replace(interior=stands, contacts=read.contacts if read.contacts is not None else kept_contacts)
     misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
         if touch.complete else None                                                   # R4: the file does not decide
     groups = outward_crossing_groups(file_volumes, flip, depth, crossing_with) if touch.complete else None
@@ -138,6 +171,10 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
                                _both(within, touch_within))
     if in_kept or on_turn:
         misread = groups = voids = None
+    if misread is not None or voids is not None:      # R4: by how much the file's winding differs, where known exactly
+        known = reading_difference(file_volumes, depth, nest, _both(within, touch_within), crossing_with)
+        misread = None if misread is None else dataclasses.replace(misread, difference=known)
+        voids = None if voids is None else dataclasses.replace(voids, difference=known)
     # R0: a shell listed k times counts k times in the winding; where that changes {w ≥ 1} (a box listed twice
     # inside a void: session 14's N6) R4c forms it, counting each piece that often (union.winding_solid)
     many = touch.complete and _counted_more_than_once(multiplicity, file_volumes, flip, nest,
@@ -204,10 +241,37 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
     else:       # the check gave up: every shell whose box meets another's goes to the boolean
         candidates = boxes_meet(v, shells.faces, labels, n_shells) | undecided
     candidates[copies.reshape(-1)] = True                 # nested copies: the boolean forms their union
+    if by_winding:
+        # R4c's solid is formed by the boolean (union.winding_solid) even where no shell touches another: a body
+        # listed twice around a cavity listed once (winding 2 − 1 = 1, material) was the summed integral, the
+        # cavity cut once (session 16: `exact` 7.875 m³ for {w ≥ 1} = 8)
+        candidates[:] = True
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[crossing_with.reshape(-1)] = True
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
                        groups, by_winding, voids, multiplicity if by_winding else None, on_turn and by_winding)
+
+
+def _without_shells(shells: Shells, contacts: SurfaceContacts, drop: np.ndarray) -> tuple[Shells, SurfaceContacts]:
+    """``shells`` without the shells ``drop`` ((s,) bool; the rest numbered in order), their moments and round-off
+    bounds kept as integrated, and ``contacts`` without the face pairs that involve a face left out (the rest
+    numbered as the faces kept)."""
+    keep = ~np.asarray(drop, dtype=bool)
+    keep_face = keep[shells.labels]
+    number = np.cumsum(keep) - 1
+    face_number = np.cumsum(keep_face) - 1
+    bound = shells.bound
+    kept = Shells(shells.vertices, shells.faces[keep_face], number[shells.labels[keep_face]],
+                  int(np.count_nonzero(keep)), [m for m, k in zip(shells.moments, keep) if k],
+                  RoundoffBound(volume=np.asarray(bound.volume)[keep], centroid=np.asarray(bound.centroid)[keep],
+                                second_moment=np.asarray(bound.second_moment)[keep]))
+
+    def pairs(found: np.ndarray) -> np.ndarray:
+        p = np.asarray(found, dtype=np.int64).reshape(-1, 2)
+        return np.asarray(face_number[p[keep_face[p].all(axis=1)]], dtype=np.intp).reshape(-1, 2)
+
+    return kept, dataclasses.replace(contacts, crossing=pairs(contacts.crossing), contact=pairs(contacts.contact),
+                                     coplanar_opposite=pairs(contacts.coplanar_opposite))
 
 
 def _rests_on_a_turn(readings: Sequence[MisreadNesting], volumes: np.ndarray, flip: np.ndarray, nest: Nesting | None,

@@ -29,7 +29,7 @@ if TYPE_CHECKING:
 
 __all__ = ["Coincident", "coincident_surfaces", "signed_multiplicity", "cancel_opposite", "point_ids",
            "closed_components", "doubled_closed", "container_windings", "winding_around", "face_keys",
-           "shell_multiplicity", "multiplicity_changes"]
+           "shell_multiplicity", "multiplicity_changes", "region_windings"]
 
 
 @frozen_value
@@ -287,6 +287,23 @@ def winding_around(file_volumes: np.ndarray, nest: Nesting | None, within: np.nd
     np.add.at(around, shell, winding)
     return around
 
+
+
+def region_windings(file_volumes: np.ndarray, nest: Nesting | None, within: np.ndarray | None,
+                    multiplicity: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``(inside, outside)``, (s,) int each: the file's winding number just inside and just outside each shell, the
+    shells counted as wound (and ``multiplicity`` times each, R0; None: once).
+
+    Valid where no shell crosses another: a shell ``X`` then lies in one region of the others, where their winding
+    is ``Σ_C k_C w_C`` over the shells ``C`` around it (:func:`container_windings`), and crossing ``X`` inward adds
+    ``k_X σ_X`` (``σ_X`` +1 wound outward, −1 inward).  Every region of space off the surfaces is just inside some
+    shell or outside all of them (winding 0), so these numbers are every winding number the file gives."""
+    vols = np.asarray(file_volumes, dtype=np.float64)
+    k = np.ones(len(vols), dtype=np.int64) if multiplicity is None else np.asarray(multiplicity, dtype=np.int64)
+    shell, other, winding = container_windings(vols, nest, within)
+    outside = np.zeros(len(vols), dtype=np.int64)
+    np.add.at(outside, shell, k[other] * winding)
+    return outside + k * np.sign(vols).astype(np.int64), outside
 
 
 def face_keys(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:

@@ -159,7 +159,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                              multiplicity=counted(crossed.shells, surface.repeated, first.repeated))        # R4, R0
     kind, checks = first_checks(oriented.touch, crossed.unverified)
     resolved_edges = found.nonmanifold_edges if met.folds is None and welded.arranged is None else None
-    united = unite_overlaps(oriented, crossed.contacts, nonmanifold_edges=resolved_edges, method=found.method,
+    contacts = oriented.contacts if oriented.contacts is not None else crossed.contacts   # R4 may leave shells out
+    united = unite_overlaps(oriented, contacts, nonmanifold_edges=resolved_edges, method=found.method,
                             kind=kind, checks=checks, overlap=overlap, repair=repair, diag=diag,
                             source=source)                                                     # R5, R6
     if united.forced is not None:
