@@ -141,3 +141,16 @@ def test_smooth_bumpy_spheres_bounds_hold(quadratic, cubic, seed, half_angle):
     except InvalidMeshError:
         return                                   # refused: never wrong
     assert _holds(smooth, truth), (smooth.mesh.uncertainty, smooth.volume, truth.volume)
+
+
+def test_a_refusal_of_holes_too_large_suggests_smooth_holes_only_where_not_stated():
+    """The "ball too large" refusal names the user's `smooth-holes` as a way on, but not to a user who stated it
+    and is refused all the same (a sphere less its upper half: no surface round the hole to continue far enough)."""
+    s = trimesh.creation.icosphere(3)
+    half = trimesh.Trimesh(s.vertices, s.faces[s.triangles_center[:, 2] < 0.0], process=False)
+    with pytest.raises(InvalidMeshError, match="cannot be bounded usefully") as plain:
+        mass_properties(half, repair=True)
+    assert "`assume` smooth-holes" in str(plain.value)
+    with pytest.raises(InvalidMeshError, match="cannot be bounded usefully") as stated:
+        mass_properties(half, repair=True, assume=("smooth-holes",))
+    assert "smooth-holes" not in str(stated.value).split("within ±50 % mass)")[-1]

@@ -203,7 +203,8 @@ def _turned(found: MisreadNesting, oriented: Orientation) -> str:
 def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patched: Estimate | None,
             arranged: bool, verified: bool, ambiguous: bool, folds: bool, sheets_removed: bool,
             source: str, spread: tuple[float, float] | None = None, scale_rounding: float = 0.0,
-            weld: WeldSweep | None = None, arranged_region: RoundedRegion | None = None) -> Certified:
+            weld: WeldSweep | None = None, arranged_region: RoundedRegion | None = None,
+            assumed: tuple[str, ...] = ()) -> Certified:
     """R7 and what each earlier stage implies for the certificate of ``shells``.
 
     Parameters
@@ -241,6 +242,9 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
         the shell it built; it is judged here again against this solid, the one certified: a cavity cut from the
         arranged shell later (R4, R5) makes the same region a larger share, and above half the budget an
         ``exact`` or ``united`` result becomes ``unverified``.  Its shares are added to an estimate's round-off.
+    assumed : tuple of str
+        The names of the assumptions the user stated (``UserAssumptions.names``); a refusal of holes too large
+        to bound suggests ``smooth-holes`` only where the user has not stated it already.
     """
     notes: list[str] = []
     checks = list(checks)
@@ -298,6 +302,7 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
     uncertainty = None
     if patched is not None:
         from .uncertainty import check_useful, uncertainty_from, with_roundoff   # imported on use: repair only
+        from .hole_assumptions import ISLAND_HINT, SMOOTH_HINT, SMOOTH_HOLES
         whole = total(shells.moments)
         doubt, far = patched.uncertainty.volume_in_doubt, patched.far
         if spread is not None:                # R4: the reading the file does not decide is in doubt as well
@@ -314,10 +319,13 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
                          why=_R4_WHY.replace("far apart;", "far apart (the holes alone are bounded within "
                                              f"±{round_up(100 * holes_alone):.3g} % mass);"))
         elif patched.islands:     # islands in a flat face kept their ball: the user may state they lost flat pieces
-            from .hole_assumptions import ISLAND_HINT
             check_useful(whole.volume, uncertainty, source=source, what=what,
                          why="the holes are too large to guess what fills them; close them in a mesh editor"
                          + ISLAND_HINT)
+        elif SMOOTH_HOLES.name not in assumed:   # the user may state the lost surface was smooth (not stated yet)
+            check_useful(whole.volume, uncertainty, source=source, what=what,
+                         why="the holes are too large to guess what fills them; close them in a mesh editor"
+                         + SMOOTH_HINT)
         else:
             check_useful(whole.volume, uncertainty, source=source, what=what)
         # a patched surface whose union could not be verified (R6) keeps "unverified": the patches' bound does

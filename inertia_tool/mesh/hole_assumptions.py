@@ -46,7 +46,7 @@ from typing import Iterable
 
 __all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "GRAPH", "PLANAR",
            "QUADRIC", "ALL", "stated", "named", "FLAT_ISLANDS", "USER_ASSUMPTIONS", "user_named", "UserAssumptions",
-           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT", "SMOOTH_HOLES"]
+           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT", "SMOOTH_HINT", "SMOOTH_HOLES"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -151,6 +151,9 @@ USER_ASSUMPTIONS = (FLAT_ISLANDS, SMOOTH_HOLES)
 
 #: The end of a refusal of a hole that is an island in a flat face: the option that would take it.
 ISLAND_HINT = " or, if the lost surface was flat, `assume` flat-islands"
+
+#: The same for holes that are not islands: the user may know the surface round them went on smoothly.
+SMOOTH_HINT = " or, if the surface round each hole is smooth and went on smoothly across it, `assume` smooth-holes"
 
 
 def user_named(names: Iterable[str]) -> tuple[str, ...]:

@@ -175,7 +175,8 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
                         arranged=crossed.arranged is not None, verified=crossed.verified,
                         ambiguous=bool(oriented.ambiguous), folds=met.folds is not None,
                         sheets_removed=found.method == "sheets-removed", source=source, spread=spread,
-                        scale_rounding=raw.scale_rounding, weld=weld, arranged_region=crossed.region)     # R7
+                        scale_rounding=raw.scale_rounding, weld=weld, arranged_region=crossed.region,
+                        assumed=assume.names)                                                              # R7
     stages = (first.dropped, crossed.arranged, met.folds.describe() if met.folds is not None else None,
               crossed.unverified)
     notes = (*found.notes, *surface.coincident, *first.coincident, *oriented.notes,
