@@ -190,8 +190,9 @@ def test_a_rib_taken_with_faces_round_it_keeps_its_whole_ball_not_the_capsule():
     the box's edge) is 2 m long and 0.24 m wide; three of its vertices are bare (every face left at them in the
     top's plane), which withdraws the narrower readings: the hole took a surface that met the top there.  The
     capsule round the rim was taken all the same: ±1.2 % mass (0.099 m³ in doubt) for an answer of 8 m³ against
-    8.125 (1.5 % low).  No capsule where the narrower readings are withdrawn: the whole ball over the rim,
-    radius 1 (4.19 m³, ±52 %), refused."""
+    8.125 (1.5 % low).  No capsule on a rim in the plane of a face beside it with a bare vertex (the hole took a
+    surface that left the plane there; the rim's width in the plane bounds nothing off it): the whole ball over
+    the rim, radius 1 (4.19 m³, ±52 %), refused."""
     v, f, feature, _ = featured_box((2.0, 2.0, 2.0), (0.5, 0.0625), (0.5, 0.0625), 1.0)
     gone = np.union1d(feature, _patch(v, f, int(feature[1]), len(feature) + 1))
     open_f = np.delete(f, gone, axis=0)
@@ -201,6 +202,29 @@ def test_a_rib_taken_with_faces_round_it_keeps_its_whole_ball_not_the_capsule():
     assert est.uncertainty.volume_in_doubt == pytest.approx(4 / 3 * np.pi, rel=1e-6)
     assert est.uncertainty.mass > ESTIMATE_MAX_MASS_RTOL
     assert _refused_or_holds(est, volume_moments(v, f))
+
+
+@pytest.mark.parametrize("case, source", [("3-06-hole", "generated/torus"), ("4-05-hole", "generated/box")])
+def test_a_bare_rim_vertex_off_the_rims_plane_keeps_the_capsule(case, source):
+    """The other side of the rule above: coverage cases whose rims have bare vertices (a torus's quad, a box's
+    subdivided face) but do not lie in the plane of a face beside them keep the capsule, inside their bounds.
+    Dropping the capsule wherever a rim vertex is bare (hypo16's first fix) widened these ±16 % → ±49 % and
+    ±7.6 % → ±19 %, and on the benchmark's hole kinds (seeds 3-7, generated and repo sources) refused 12 more
+    of 320 cases and widened 52 more, every bound having held."""
+    from damage_cases import damaged
+    from inertia_tool.mesh.holes import bare_vertices
+    cov = coverage_module()
+    names = [name for name, _, _ in cov.generated_sources()]
+    index = names.index(source)
+    _, v, f = cov.generated_sources()[index]
+    seed, kind = int(case.split("-")[0]), case.split("-", 2)[2]
+    rng = np.random.default_rng([seed, index, cov.KINDS.index(kind), 0])
+    dv, df, _ = damaged(cov, kind, v, f, cov.truth_of(v, f), rng)
+    assert bare_vertices(dv, df, boundary_edges(df, len(dv))).any()
+    est = patched_estimate(dv, df, volume_moments)
+    assert "capsule" in est.assumptions
+    row = case_row(cov, case, index, v, f)
+    assert row["status"] == "answer" and row["holds"], row
 
 
 def test_a_band_round_the_washer_keeps_its_balls_not_the_thin_capsules():

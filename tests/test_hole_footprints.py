@@ -300,10 +300,10 @@ def test_holes_across_creases_of_featured_chamfered_boxes_are_refused_or_inside_
 def test_a_tall_boss_taken_whole_by_a_patch_is_refused_or_inside_its_bound():
     """Found by a random run of the test above (session 14; was a strict xfail): a 1 m box with a 0.25 × 0.11 m
     boss 2 m tall, less a patch of 12 of its 28 faces that takes the whole boss.  Three rim vertices are bare
-    (their faces left all in the top's plane), which withdraws the narrower readings and keeps the whole ball,
-    yet the capsule round the 4-edge rim was still taken: ±5.6 % mass, the centre and inertia bounds missed.
-    Diagnosed by hypo16 (the cause of the rib case in ``test_hole_capsules.py`` too): no capsule where the
-    narrower readings are withdrawn; the whole ball states ±23 % and holds."""
+    (their faces left all in the top's plane, the rim in that plane too), which withdraws the slab, yet the
+    capsule round the 4-edge rim was still taken: ±5.6 % mass, the centre and inertia bounds missed.  Diagnosed
+    by hypo16 (the cause of the rib case in ``test_hole_capsules.py`` too): no capsule on a rim in the plane of
+    a face beside it with a bare vertex; the ball states ±23 % and holds."""
     v, f, _, _ = featured_box((1.0, 1.0, 1.0), (0.28125, 0.4375), (0.25, 0.109375), 2.0)
     gone = _patch(v, f, 643 % len(f), int(0.4375 * len(f)))
     est = patched_estimate(v, np.delete(f, gone, axis=0), volume_moments)
