@@ -188,8 +188,12 @@ def ear_clip_2d(u: np.ndarray, w: np.ndarray, *, rotate: bool = False) -> list[t
     """Triangles of the simple counter-clockwise polygon with corners ``(u[i], w[i])`` by ear clipping in float64:
     an ear is a corner turning left whose triangle holds no other remaining corner (on its border counts as held).
     ``rotate`` starts each pass's search after the last ear cut (ears spread round the polygon instead of fanning
-    from its first corners).  None when no ear is found (the polygon is not simple in float64).  Quadratic passes
-    in Python: callers bound the corner count."""
+    from its first corners).  None when no ear is found (the polygon is not simple in float64), or when the last
+    three corners left turn right: the signed areas of the triangles sum to the polygon's (shoelace), and
+    every ear turns left, so a clockwise polygon always ends there and is refused instead of cut into triangles
+    of both orientations (a clockwise dart has one left-turning corner, an ear of the wrong side; found by
+    ``tests/test_hole_graphs.py``, hypothesis seed 3689).  Quadratic passes in Python: callers bound the corner
+    count."""
     remaining = list(range(len(u)))
     triangles: list[tuple[int, int, int]] = []
     start = 0
@@ -215,7 +219,10 @@ def ear_clip_2d(u: np.ndarray, w: np.ndarray, *, rotate: bool = False) -> list[t
             break
         else:
             return None
-    triangles.append((remaining[0], remaining[1], remaining[2]))
+    a, b, c = remaining
+    if (u[b] - u[a]) * (w[c] - w[a]) - (w[b] - w[a]) * (u[c] - u[a]) < 0:
+        return None                               # clockwise (a flat last triangle, area 0, is kept as before)
+    triangles.append((a, b, c))
     return triangles
 
 
