@@ -72,11 +72,16 @@ def test_overlapping_bodies_warn_and_are_united():
     assert p.mesh.certificate.kind == "summed"
 
 
-def test_outward_shell_inside_a_body_is_a_cavity_by_its_depth():
-    """Rule R4: a shell at depth 1 is a cavity whatever its winding (flipped, with a warning)."""
-    with pytest.warns(InsideOutWarning, match="1 of 2 shells are inside out"):
+def test_outward_shell_inside_a_body_is_part_of_it_by_the_files_winding():
+    """Rule R4 (readings16): an outward shell wholly inside another, nothing crossing and no region's winding below
+    0, is part of the body, the solid where the winding number is at least one (the outer box, exact with
+    `interior-shells`); the warning names the nesting-depth reading (a cavity) and its volume.  Before, the inner
+    box was read by depth as a cavity (7 m³)."""
+    with pytest.warns(InsideOutWarning, match=r"read by the file's winding as part of the body.*read by nesting "
+                                              r"depth as a cavity"):
         p = mass_properties(_concat(box_arrays((2.0, 2.0, 2.0)), box_arrays((1.0, 1.0, 1.0))))
-    assert p.volume == pytest.approx(7.0, rel=1e-14) and p.mesh.cavities == 1
+    assert p.volume == pytest.approx(8.0, rel=1e-14) and p.mesh.cavities == 0 and p.mesh.bodies == 1
+    assert p.mesh.certificate.kind == "exact" and "interior-shells" in p.mesh.certificate.checks
 
 
 def test_ball_inside_a_hollow_is_not_an_overlap():
