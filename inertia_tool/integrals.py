@@ -21,8 +21,8 @@ all its digits (a unit cube at 1e8 keeps its central tensor to ~1e-16 relative).
 Memory: faces are processed in chunks of ``chunk_size`` so temporaries stay bounded.
 
 Speed: when the C extension is built (``inertia_tool._native``) the sums run in one pass over the faces
-in C, each sum compensated (TwoSum), so they agree with the numpy path below (the reference) to round-off
-and are, if anything, more accurate.
+in C, each sum compensated (TwoSum); the numpy path below (the reference) sums each column with ``math.fsum``
+(correctly rounded per chunk), so the two agree to round-off and share one round-off bound.
 
 Everything here is pure: SI numpy arrays in, numpy arrays out.  See ``docs/conventions.md``.
 """
@@ -106,10 +106,12 @@ def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chu
     lib = accel()
     if lib is not None:
         return _tetra_sums_c(lib, vertices, faces, origin, labels, n_labels, area_floor)
-    vol = np.zeros(n_labels)
-    first = np.zeros((n_labels, 3))
-    second = np.zeros((n_labels, 3, 3))
-    area = np.zeros(n_labels)
+    # each face's 11 terms in the C kernel's columns and operations (v6/6, v6·s/24, v6·(…)/120 for xx yy zz xy
+    # xz yz, area); each label's column summed by math.fsum (correctly rounded, Shewchuk 1997) per chunk and the
+    # chunks' sums again by fsum: the error is at most 2u·Σ|x|, within the compensated bound (2 + m²u)·u·Σ|x|
+    # that roundoff_bounds charges both paths (issue 21: the plain sequential sum's m·u·Σ|x| made the numpy
+    # path call a needle of aspect 1e7 flat that the C path, by its tighter bound, answered)
+    partials: list[np.ndarray] = []
     zero = np.zeros(n_labels, dtype=np.int64)
     coords = np.ascontiguousarray((vertices - origin).T)      # (3, n): component arrays gather faster
     n_faces = len(faces)
@@ -128,29 +130,30 @@ def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chu
         tri_area = 0.5 * np.sqrt(np.einsum("ij,ij->j", nrm, nrm))
         tiny = tri_area <= 0.5 * area_floor
         s = a + b + c
-        # rows (a_x, b_x, c_x, s_x, a_y, ..., s_z): Σ_f v6 Q Qᵀ holds every Σ v6 (Σ_k p_ki p_kj + s_i s_j)
-        q = np.concatenate([np.stack([a[i], b[i], c[i], s[i]]) for i in range(3)])
+        terms = [v6 / 6.0] + [v6 * s[i] / 24.0 for i in range(3)] + \
+            [v6 * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j]) / 120.0 for i, j in _PAIRS] + [tri_area]
+        part = np.zeros((n_labels, 11))
         if labels is None:
             zero[0] += int(np.count_nonzero(tiny))
-            vol[0] += v6.sum() / 6.0
-            first[0] += s @ v6 / 24.0
-            g = (q * v6) @ q.T
-            second[0] += np.array([[np.trace(g[4 * i:4 * i + 4, 4 * j:4 * j + 4]) for j in range(3)]
-                                   for i in range(3)]) / 120.0
-            area[0] += tri_area.sum()
+            part[0] = [math.fsum(t) for t in terms]
         else:
-            lab = labels[start:start + chunk_size]
+            lab = np.asarray(labels[start:start + chunk_size])
             zero += np.bincount(lab[tiny], minlength=n_labels)
-            vol += np.bincount(lab, weights=v6, minlength=n_labels) / 6.0
-            area += np.bincount(lab, weights=tri_area, minlength=n_labels)
-            for i in range(3):
-                first[:, i] += np.bincount(lab, weights=v6 * s[i], minlength=n_labels) / 24.0
-            for i, j in _PAIRS:
-                w = v6 * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j])
-                second[:, i, j] += np.bincount(lab, weights=w, minlength=n_labels) / 120.0
-                if i != j:
-                    second[:, j, i] = second[:, i, j]
-    return vol, first, second, area, zero
+            order = np.argsort(lab, kind="stable")
+            cuts = np.searchsorted(lab[order], np.arange(n_labels + 1))
+            sorted_terms = [t[order] for t in terms]
+            for k in np.flatnonzero(cuts[1:] > cuts[:-1]).tolist():
+                lo, hi = int(cuts[k]), int(cuts[k + 1])
+                part[k] = [math.fsum(t[lo:hi]) for t in sorted_terms]
+        partials.append(part)
+    if len(partials) == 1:
+        sums = partials[0]
+    else:
+        stacked = np.stack(partials) if partials else np.zeros((1, n_labels, 11))
+        sums = np.array([[math.fsum(stacked[:, k, col]) for col in range(11)] for k in range(n_labels)]) \
+            .reshape(n_labels, 11)
+    second = sums[:, _SECOND_COLUMNS].reshape(n_labels, 3, 3)
+    return sums[:, 0].copy(), sums[:, 1:4].copy(), second, sums[:, 10].copy(), zero
 
 
 def _tetra_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray,
@@ -347,8 +350,9 @@ def roundoff_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     from ``origin`` is charged for its distance once.  The first-moment term ``6v·s/24`` adds the roundings of
     ``s = a + b + c`` and of two products (bound ``2u·P·‖s‖``), the second-moment term
     ``6v·(Σ pₖpₖᵀ + ssᵀ)/120`` those of ``Q`` (``3u·P·tr|Q|``).  Sums over a shell's m faces add
-    ``(2 + m²u)·u·Σ P`` when compensated (the C path; Ogita, Rump and Oishi 2005, Sum2) or ``m·u·Σ P`` when not
-    (numpy's sequential ``bincount``).  The central moment ``C − f fᵀ/V`` carries the errors of its parts to
+    ``(2 + m²u)·u·Σ P``: the C path's compensated sums (Ogita, Rump and Oishi 2005, Sum2) and the numpy path's
+    ``math.fsum`` per chunk and across chunks (at most ``2u·Σ P``) both meet it, so both paths draw the same line
+    (issue 21).  The central moment ``C − f fᵀ/V`` carries the errors of its parts to
     first order plus ``4u·(‖C‖ + ‖f‖²/|V|)`` of its own.  Terms of order u² are left out.
 
     The per-face terms and their sums run in one C pass when the extension is built (``_accel.roundoff_sums``:
@@ -376,8 +380,8 @@ def roundoff_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     else:
         sums = _roundoff_sums(v, f, lab, n, origin, chunk_size)
     if n == 1:
-        return _one_shell_bound(sums[0], len(f), shells[0], origin, compensated=lib is not None)
-    return _shells_bound(sums, np.bincount(lab, minlength=n), shells, origin, compensated=lib is not None)
+        return _one_shell_bound(sums[0], len(f), shells[0], origin, compensated=True)
+    return _shells_bound(sums, np.bincount(lab, minlength=n), shells, origin, compensated=True)
 
 
 def _shells_bound(sums: np.ndarray, counts: np.ndarray, shells: list[VolumeMoments], origin: np.ndarray, *,

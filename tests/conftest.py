@@ -107,6 +107,31 @@ except ImportError:
 REQUIRE_ACCEL = os.environ.get("INERTIA_TOOL_REQUIRE_ACCEL", "") not in ("", "0")
 
 
+def _engine_state():
+    """What selects the engine's path: the two environment variables ``_native`` reads, its ``accel`` function
+    and its cached import (the list and what it holds)."""
+    from inertia_tool import _native
+
+    return (os.environ.get(_native.NO_ACCEL_ENV), os.environ.get(_native.THREADS_ENV), _native.accel,
+            id(_native._MODULE), [id(m) for m in _native._MODULE])
+
+
+@pytest.fixture(autouse=True)
+def _engine_path_restored():
+    """Issue 21 (leak16): a test that leaves the numpy path (or a thread count, or a stand-in for ``accel``)
+    selected changes what every later test in the process runs; this fails the test that did it, after its own
+    fixtures (``monkeypatch``) are undone.  The first import of the extension (an empty cache filled) is not a
+    change."""
+    before = _engine_state()
+    yield
+    after = _engine_state()
+    if before[4] == [] and after[3] == before[3]:
+        after = after[:4] + ([],)
+    if after != before:
+        pytest.fail(f"the test left the engine's path changed: (NO_ACCEL, THREADS, accel, cache, cached) "
+                    f"{before!r} -> {after!r}; restore it (monkeypatch.setenv/delenv, monkeypatch.setattr)")
+
+
 @pytest.fixture(params=["c", "numpy"])
 def engine_path(request, monkeypatch):
     """Run a test on the C extension's kernels and on the pure-numpy path (the reference).
