@@ -45,7 +45,7 @@ def _look_alike(value):
     if isinstance(value, float):
         if value == 0.0:
             return -value                                   # 0.0 <-> -0.0 (== each other)
-        return math.nextafter(value, math.inf)              # one unit in the last place
+        return math.nextafter(value, 0.0)                   # one unit in the last place (finite: toward 0)
     if value is None:
         return ""
     return value + "x"
