@@ -55,6 +55,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("folders", nargs="+", help="folders searched recursively for mesh files")
     parser.add_argument("--numpy-faces", type=int, default=5000,
                         help="also compare the numpy twin on meshes of at most this many faces")
+    parser.add_argument("--each", action="store_true", help="also print one line per mesh compared")
     args = parser.parse_args(argv)
     files = sorted({p for d in args.folders for p in glob.glob(os.path.join(d, "**", "*"), recursive=True)
                     if p.lower().endswith(SUFFIXES) and os.path.isfile(p)})
@@ -96,6 +97,9 @@ def main(argv: list[str] | None = None) -> int:
         if not same:
             differ += 1
             print(f"differ {path} ({len(f):,} faces)", flush=True)
+        elif args.each:
+            print(f"same {path} ({len(f):,} faces, candidate pairs {patched.candidate_pairs:,} / "
+                  f"{plain.candidate_pairs:,})", flush=True)
     print(f"{len(files):,} files, {compared:,} meshes compared ({twin:,} also with the numpy twin), {unread:,} not "
           f"read; pairs found in {found:,}; differences {differ:,}")
     print(f"candidate pairs with patches {cand[0]:,}, without {cand[1]:,}; check CPU with patches {cpu[0]:.2f} s, "
