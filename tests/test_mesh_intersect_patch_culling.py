@@ -195,9 +195,9 @@ def test_duplicated_face_is_found_inside_a_certifiable_sheet():
 
 def test_degenerate_projection_is_never_certified():
     """A sheet in the plane y = z: along x every face projects with one orientation and the sheet is one patch;
-    a face flattened onto a line (a vertex moved to its neighbours' midpoint) makes no face pair meet beyond
-    what it shares by index, so the pairs found stay none, but its node can no longer be certified on any axis
-    (the face has no strict orientation), and more pairs are tested."""
+    with a face flattened onto a line (a vertex moved to its neighbours' midpoint: zero area, no strict
+    orientation along any axis) no node holding that face can be certified, so pairs are enumerated again, and
+    the pairs found are those of the unpatched scan and the numpy twin."""
     v, f = _sheet(6, 6, np.random.default_rng(5))
     v = np.c_[v[:, 0], v[:, 1], v[:, 1]]
     clean, unpatched = _check(v, f)
