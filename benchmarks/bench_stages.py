@@ -41,7 +41,6 @@ package then falls back to numpy with one warning, and the rows would time anoth
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import os
 import resource
@@ -56,9 +55,12 @@ from typing import Any
 
 import numpy as np
 
-if importlib.util.find_spec("inertia_tool") is None:
-    # only as a fallback: a PYTHONPATH or an installed package wins over the checkout holding this script
-    sys.path.append(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _checkouts import this_checkout_first  # noqa: E402  (benchmarks/ is not a package)
+
+# this checkout's inertia_tool, unless PYTHONPATH names another (before, an installed package won: an editable
+# install of another checkout was measured instead of the one holding this script)
+this_checkout_first()
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 #: Where the meshes are written (not committed): ``$INERTIA_TOOL_BENCH_OUT`` if set (e.g. /tmp/bench), else

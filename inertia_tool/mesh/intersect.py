@@ -849,7 +849,10 @@ def _raw_pairs(lo: np.ndarray, hi: np.ndarray, origin: np.ndarray, chunk: int,
     level = np.ceil(np.log2(np.maximum(extent, h0) / h0)).astype(np.int64)
     if group is None:
         group = -1 - np.arange(m, dtype=np.int64)         # every face its own group: nothing left out
-    shift = m + 1                                          # group + shift >= 1
+    # group + shift in [1, 2·shift − 1]: the (cell rank, group) keys below stay ordered.  A group is a vertex
+    # index, which can exceed the face count (unwelded files, vertices no face uses): m + 1 alone was too
+    # small there and the keys of one cell ran into the next's (pairs missed, or negative counts)
+    shift = max(m, int(group.max())) + 1
     for top in np.unique(level):
         h = h0 * 2.0 ** top
         dims = np.full(3, int(np.floor(size / h)) + 2, dtype=np.int64)
