@@ -40,19 +40,20 @@ import signal
 import subprocess
 import sys
 import tempfile
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from collections.abc import Mapping
 from typing import Any, Callable
 
 from .errors import IsolatedProcessError, UsageError
 from .units import DECIMAL
-from .values import frozen_value
 
 __all__ = ["Limits", "run_isolated", "limits_from_environment", "XACRO_LIMITS", "CAD_LIMITS",
            "ENVIRONMENT_ALLOW_LIST"]
 
 
-@frozen_value
+# a plain frozen dataclass, not :func:`~inertia_tool.values.frozen_value`: the child imports this module, and
+# ``values`` imports numpy (~0.15 s of the xacro child's CPU; the fields are numbers, nothing to make read-only)
+@dataclass(frozen=True)
 class Limits:
     """Resource limits of one isolated job.
 

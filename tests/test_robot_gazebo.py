@@ -188,7 +188,7 @@ def test_xacro_failures_are_one_clean_sentence(tmp_path, monkeypatch):
 
 
 def test_xacro_message_drops_class_names_and_repeats():
-    from inertia_tool.robot.description import _xacro_message
+    from inertia_tool.robot.xacro_expand import _xacro_message
     exc = RuntimeError("<class 'xacro.XacroException'>: missing file. <class 'xacro.XacroException'>: missing file.")
     assert _xacro_message(exc) == "missing file."
     assert _xacro_message(ValueError("")) == "unknown failure"

@@ -202,17 +202,22 @@ def _end_program(code: int) -> None:
     """End the process with ``code`` now, skipping the interpreter's teardown, when that loses nothing.
 
     Tearing down an interpreter that has loaded numpy and this package (clearing every module, collecting
-    every object) costs about a tenth of a start-up on a small part; it does nothing a finished command
-    needs.  So, after flushing standard output and error, the process ends with :func:`os._exit` if no
-    ``atexit`` callback is registered (the hooks of ``logging``, ``multiprocessing``, ``weakref.finalize``,
-    temporary directories, ... all register one, and then the normal exit runs them) and no other thread is
-    running.  Files this tool writes are closed by their writer (:mod:`inertia_tool.output`) before the
-    command returns.  When a flush fails (a closed pipe) the normal exit takes over and reports it as usual.
+    every object) costs about a tenth of a start-up on a small part, and ~0.3 s of CPU once a repair has loaded
+    scipy, libigl and pycollada (issue 23: a UR5e run); it does nothing a finished command needs.  So the
+    process ends with :func:`os._exit` once what the normal exit would do first is done: if no other thread is
+    running, the ``atexit`` callbacks are run here, in the order the normal exit runs them (the hooks of
+    ``logging``, ``multiprocessing``, ``weakref.finalize``, temporary directories, Pillow and libigl register
+    one; :func:`atexit._run_exitfuncs` runs each once and clears them), then standard output and error are
+    flushed.  A running thread (before or after the callbacks) means the normal exit, which joins it.  Files
+    this tool writes are closed by their writer (:mod:`inertia_tool.output`) before the command returns.  When
+    a flush fails (a closed pipe) the normal exit takes over and reports it as usual.
     """
     import atexit
-    callbacks = getattr(atexit, "_ncallbacks", None)            # CPython's count; elsewhere: the normal exit
-    threading = sys.modules.get("threading")                   # never imported: no thread was started with it
-    if callbacks is None or callbacks() or (threading is not None and threading.active_count() > 1):
+    run_callbacks = getattr(atexit, "_run_exitfuncs", None)    # CPython's; elsewhere: the normal exit
+    if run_callbacks is None or _other_threads():
+        return
+    run_callbacks()
+    if _other_threads():                                       # a callback started one: let the normal exit join it
         return
     try:
         sys.stdout.flush()
@@ -220,6 +225,12 @@ def _end_program(code: int) -> None:
     except (OSError, ValueError):
         return
     os._exit(code)
+
+
+def _other_threads() -> bool:
+    """Whether a thread besides the main one is running (``threading`` never imported: none was started)."""
+    threading = sys.modules.get("threading")
+    return threading is not None and threading.active_count() > 1
 
 
 def _main(argv) -> int:

@@ -24,7 +24,6 @@ so (``run_xacro=True``): expansion runs code from the file, so it runs in a chil
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
 import re
@@ -38,6 +37,7 @@ from ..mesh.regular import open_regular
 from ..units import DECIMAL
 from ..values import frozen_value
 from .resolve import MAX_FOLDERS_UP, package_directory, resolve_uri
+from .xacro_expand import _fail
 
 __all__ = ["GeometryElement", "DeclaredInertial", "LinkGeometry", "RobotDescription", "read_robot",
            "rpy_to_matrix", "GEOMETRY_KINDS", "ROBOT_SUFFIXES", "PRIMITIVES", "parse_decimal", "MAX_ROBOT_LINKS",
@@ -296,10 +296,6 @@ class RobotDescription:
 
 # -- shared parsing helpers ------------------------------------------------------------------------------
 
-def _fail(source: str, problem: str) -> RobotDescriptionError:
-    return RobotDescriptionError(f"{source}: {problem}")
-
-
 def parse_decimal(token: str) -> float:
     """The value of one number of a robot file, by the grammar :data:`_DECIMAL` (ValueError otherwise).
 
@@ -428,81 +424,14 @@ def _read_bytes(path: str, *, head: int | None = None) -> bytes:
 
 # -- xacro -------------------------------------------------------------------------------------------------
 
-@contextlib.contextmanager
-def _xacro_find(packages: dict, near: str, problems: list):
-    """Make xacro's ``$(find NAME)`` use ``packages``, ROS_PACKAGE_PATH and the folders around ``near`` (the
-    xacro file's folder: a ``package.xml`` naming ``NAME`` up the tree, or beside it) instead of an installed
-    ROS.  A package not found is appended to ``problems`` (xacro wraps the exception in its own words)."""
-    from xacro import substitution_args
-    original = substitution_args._eval_find
-
-    def find(name):
-        directory = package_directory(name, packages, near=near)
-        if directory is None:
-            problem = (f"$(find {name}): package {name!r} is not among the packages given, not on "
-                       f"ROS_PACKAGE_PATH, and no package.xml naming it in the {MAX_FOLDERS_UP} folders above")
-            problems.append(problem)
-            raise RobotDescriptionError(problem)
-        return directory
-
-    substitution_args._eval_find = find
-    try:
-        yield
-    finally:
-        substitution_args._eval_find = original
-
-
-#: Longest xacro failure text quoted in a message (cut at a word, marked with an ellipsis).
-XACRO_MESSAGE_CHARS = 300
-
-
-def _xacro_message(exc: BaseException) -> str:
-    """xacro's failure in one line: without Python class names (``<class '...'>: ``), each sentence once, cut
-    at a word boundary."""
-    text = " ".join(str(exc).split()) or "unknown failure"
-    text = re.sub(r"<class '[\w.]+'>:\s*", "", text)
-    text = re.sub(r"\b[\w.]*(Error|Exception): ", "", text)
-    pieces: list = []
-    for piece in re.split(r"(?<=[.)])\s+|\s+(?=\$\()", text):
-        if piece and piece not in pieces:
-            pieces.append(piece)
-    text = " ".join(pieces)
-    if len(text) > XACRO_MESSAGE_CHARS:
-        cut = text.rfind(" ", 0, XACRO_MESSAGE_CHARS)
-        text = text[:cut if cut > 0 else XACRO_MESSAGE_CHARS].rstrip(" ,;:") + " …"
-    return text
-
-
-def _expand_xacro_here(path: str, mappings: dict, packages: dict) -> bytes:
-    """Expand in this process: only ever called in the isolated child (:func:`_expand_xacro`)."""
-    try:
-        import xacro
-    except ImportError:
-        raise _fail(path, "expanding xacro needs the xacro package (pip install xacro)") from None
-    problems: list = []
-    try:
-        with _xacro_find(packages, os.path.dirname(os.path.abspath(path)), problems):
-            doc = xacro.process_file(path, mappings={str(k): str(v) for k, v in mappings.items()})
-    except RobotDescriptionError as exc:
-        raise _fail(path, problems[0] if problems else str(exc)) from None
-    except MemoryError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - xacro raises many kinds; all mean "cannot expand"
-        if isinstance(exc.__context__, MemoryError) or isinstance(exc.__cause__, MemoryError):
-            raise MemoryError from None     # xacro wraps errors of expressions; a memory limit stays one
-        if problems:                       # our own $(find) failure, wrapped by xacro: say it once, as we said it
-            raise _fail(path, problems[0]) from None
-        raise _fail(path, f"xacro expansion failed: {_xacro_message(exc)}") from None
-    return doc.toxml(encoding="utf-8")
-
-
 def _expand_xacro(path: str, mappings: dict, packages: dict, limits=None) -> bytes:
     """The expanded URDF of a xacro file, expanded in a child process under ``limits`` (xacro runs the
     Python expressions of the file: :mod:`inertia_tool.isolate`, :data:`~inertia_tool.isolate.XACRO_LIMITS`)."""
     from ..errors import IsolatedProcessError
     from ..isolate import XACRO_LIMITS, run_isolated
+    from .xacro_expand import expand_here
     try:
-        data = run_isolated(_expand_xacro_here, path, dict(mappings), dict(packages),
+        data = run_isolated(expand_here, path, dict(mappings), dict(packages),
                             limits=limits or XACRO_LIMITS, what="xacro expansion")
     except IsolatedProcessError as exc:
         raise _fail(path, str(exc)) from None
