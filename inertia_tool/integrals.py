@@ -380,17 +380,18 @@ def roundoff_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     else:
         sums = _roundoff_sums(v, f, lab, n, origin, chunk_size)
     if n == 1:
-        return _one_shell_bound(sums[0], len(f), shells[0], origin, compensated=True)
-    return _shells_bound(sums, np.bincount(lab, minlength=n), shells, origin, compensated=True)
+        return _one_shell_bound(sums[0], len(f), shells[0], origin)
+    return _shells_bound(sums, np.bincount(lab, minlength=n), shells, origin)
 
 
-def _shells_bound(sums: np.ndarray, counts: np.ndarray, shells: list[VolumeMoments], origin: np.ndarray, *,
-                  compensated: bool) -> RoundoffBound:
+def _shells_bound(sums: np.ndarray, counts: np.ndarray, shells: list[VolumeMoments],
+                  origin: np.ndarray) -> RoundoffBound:
     """The tail of :func:`roundoff_bounds`: each shell's bounds from its sums (:func:`_roundoff_sums`) and its
-    face count ``counts`` (s,)."""
+    face count ``counts`` (s,); the sums over a shell's m faces are charged ``(2 + m²u)·u`` of their size
+    (compensated or correctly rounded, on either engine path)."""
     sp, sps, spq = sums.T
     counts = np.asarray(counts).astype(np.float64)
-    summing = (2 + counts * counts * _U) * _U if compensated else counts * _U
+    summing = (2 + counts * counts * _U) * _U
     e_volume = (_U + summing) * sp / 6
     e_first = (2 * _U + summing) * sps / 24
     e_second = (3 * _U + summing) * spq / 120
@@ -454,14 +455,13 @@ def _norm(x: np.ndarray) -> float:
     return math.sqrt(float(flat.dot(flat)))
 
 
-def _one_shell_bound(sums: np.ndarray, m: int, shell: VolumeMoments, origin: np.ndarray, *,
-                     compensated: bool) -> RoundoffBound:
+def _one_shell_bound(sums: np.ndarray, m: int, shell: VolumeMoments, origin: np.ndarray) -> RoundoffBound:
     """The tail of :func:`roundoff_bounds` for one shell of ``m`` faces on Python floats: the same operations
     in the same order as its array form :func:`_shells_bound` (the same bits: ``tests/test_integrals_small.py``),
     without its dozens of numpy calls on arrays of one element (a small part makes this call once or twice)."""
     sp, sps, spq = (float(x) for x in sums)
     count = float(m)
-    summing = (2 + count * count * _U) * _U if compensated else count * _U
+    summing = (2 + count * count * _U) * _U
     e_volume = (_U + summing) * sp / 6
     e_first = (2 * _U + summing) * sps / 24
     e_second = (3 * _U + summing) * spq / 120
