@@ -148,9 +148,11 @@ def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chu
             part_hi, part_lo = _label_sums(terms, np.array([len(f)]))
         else:
             lab = np.asarray(labels[start:start + chunk_size])
+            counts = np.bincount(lab, minlength=n_labels)      # a negative label: numpy's ValueError
+            if len(counts) > n_labels:                         # as the C kernel refuses it
+                raise ValueError(f"Expected labels in 0..{n_labels - 1}, got {int(lab.max())}")
             zero += np.bincount(lab[tiny], minlength=n_labels)
             order = np.argsort(lab, kind="stable")
-            counts = np.bincount(lab, minlength=n_labels)
             ids = np.flatnonzero(counts)
             part_hi, part_lo = _label_sums(terms[:, order], counts[ids])
         if start == 0:

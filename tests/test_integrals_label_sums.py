@@ -200,3 +200,15 @@ def test_the_paths_agree_on_terms_that_overflow(monkeypatch):
         got = integrals.volume_moments(v, f)
     assert math.isnan(got.volume) and math.isnan(got.area)
     assert np.isnan(got.second_moment).all()
+
+
+@pytest.mark.usefixtures("engine_path")
+def test_a_label_out_of_range_is_refused_on_both_paths():
+    """A face labelled past ``n_labels``: a ValueError naming the range on either path (the numpy twin raised an
+    IndexError or a broadcast error, by where the label fell)."""
+    m = trimesh.creation.box((1.0, 1.0, 1.0))
+    v, f = np.asarray(m.vertices), np.asarray(m.faces)
+    labels = np.zeros(len(f), dtype=np.intp)
+    labels[3] = 2
+    with pytest.raises(ValueError, match=r"Expected labels in 0\.\.1"):
+        body_volume_moments(v, f, labels, 2)
