@@ -194,9 +194,10 @@ def _label_sums(x: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarr
     hi, lo : (k, g) float
         Per segment and row: ``hi`` the root of a pairwise tree of float additions, ``lo`` the float sum of every
         addition's rounding error (TwoSum, exact).  ``hi + (the exact sum of the errors)`` is the segment's exact
-        sum, so ``|hi + lo − Σx| ≤ N·u·Σ|e|`` with ``Σ|e| ≤ L·u·Σ|x|`` (each level of the tree errs by at most
-        ``u`` times its partial sums, which add up to ``Σ|x|`` to first order), ``L = ⌈log₂ n⌉`` levels and ``N``
-        error terms (fewer than ``n + L``).
+        sum, so for a segment of ``m`` terms ``|hi + lo − Σx| ≤ N·u·Σ|e|`` with ``Σ|e| ≤ L·u·Σ|x|`` (each level
+        of the tree errs by at most ``u`` times its partial sums, which add up to ``Σ|x|`` to first order),
+        ``L = ⌈log₂ m⌉`` levels and ``N ≤ m + L`` error terms.  A single segment of at most ``_FSUM_MAX_TERMS``
+        finite terms is summed by ``math.fsum`` instead: ``hi`` correctly rounded, ``lo`` zero.
 
     Notes
     -----
