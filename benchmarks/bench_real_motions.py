@@ -26,8 +26,11 @@ and that the tool answers ``exact`` alone (its face-pair check finds no crossing
 no manifold3d truth).  The pool is chosen by the tool's own answer on the part alone; the compositions are judged
 by manifold3d only.  Run::
 
-    python benchmarks/bench_real_motions.py --cases 300 --seed 1911
-    python benchmarks/bench_real_motions.py --seed 1911 --case 17      # one case: recipe and verdict
+    python benchmarks/bench_real_motions.py --root MENAGERIE --cases 300 --seed 1911
+    python benchmarks/bench_real_motions.py --root MENAGERIE --seed 1911 --case 17   # one case: recipe and verdict
+
+``--root`` (required) is the folder of a MuJoCo Menagerie checkout (https://github.com/google-deepmind/
+mujoco_menagerie); without it the run stops with a one-line message rather than guess a path.
 """
 from __future__ import annotations
 
@@ -50,7 +53,6 @@ KINDS = ("turned_about_vertex", "two_parts", "apart")
 #: cases per kind where one part lies wholly inside the other (R4's depth reading offered with --accept-depth-reading),
 #: for the summary
 counts_nested: Counter = Counter()
-MENAGERIE = Path("/work/data/menagerie")
 
 
 def pool(root: Path, max_faces: int) -> list[tuple[str, np.ndarray, np.ndarray]]:
@@ -165,16 +167,9 @@ def make_case(parts, seed: int, i: int) -> S.Case:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cases", type=int, default=300)
-    ap.add_argument("--seed", type=int, default=1911)
-    ap.add_argument("--case", type=int, default=None, help="run one case index and print it")
-    ap.add_argument("--repair", action="store_true")
-    ap.add_argument("--max-faces", type=int, default=1500)
-    ap.add_argument("--root", type=Path, default=MENAGERIE)
-    ap.add_argument("--accept-depth-reading", action="store_true",
-                    help="accept R4's depth reading too (checkouts before the file's winding stood, readings16)")
-    args = ap.parse_args(argv)
+    args = _parser().parse_args(argv)
+    if not args.root.is_dir():
+        _parser().error(f"--root {args.root}: expected the folder of a MuJoCo Menagerie checkout, found no folder")
     global ACCEPT_DEPTH_READING
     ACCEPT_DEPTH_READING = args.accept_depth_reading
     started = time.process_time()
@@ -217,6 +212,22 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{len(indices)} cases, seed {args.seed}, repair={args.repair}, {len(flagged)} flagged, "
           f"cpu {time.process_time() - started:.1f} s")
     return 0
+
+
+def _parser() -> argparse.ArgumentParser:
+    """The command line (see the module docstring)."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--root", type=Path, required=True, metavar="MENAGERIE",
+                    help="required: the folder of a MuJoCo Menagerie checkout; its STL parts of at most --max-faces "
+                         "triangles form the pool (no default: a path on one machine is no default for another)")
+    ap.add_argument("--cases", type=int, default=300)
+    ap.add_argument("--seed", type=int, default=1911)
+    ap.add_argument("--case", type=int, default=None, help="run one case index and print it")
+    ap.add_argument("--repair", action="store_true")
+    ap.add_argument("--max-faces", type=int, default=1500)
+    ap.add_argument("--accept-depth-reading", action="store_true",
+                    help="accept R4's depth reading too (checkouts before the file's winding stood, readings16)")
+    return ap
 
 
 S_LABELS = ("exact", "united", "estimate", "summed", "unverified", "refused", "crashed", "truth failed",

@@ -21,8 +21,9 @@ all its digits (a unit cube at 1e8 keeps its central tensor to ~1e-16 relative).
 Memory: faces are processed in chunks of ``chunk_size`` so temporaries stay bounded.
 
 Speed: when the C extension is built (``inertia_tool._native``) the sums run in one pass over the faces
-in C, each sum compensated (TwoSum); the numpy path below (the reference) sums each column with ``math.fsum``
-(correctly rounded per chunk), so the two agree to round-off and share one round-off bound.
+in C, each sum compensated (TwoSum); the numpy path below (the reference) sums each shell's column by a tree of
+TwoSums whose rounding errors are kept and added back (:func:`_label_sums`, whole-array operations whatever the
+number of shells), so the two agree to round-off and share one round-off bound.
 
 Everything here is pure: SI numpy arrays in, numpy arrays out.  See ``docs/conventions.md``.
 """
@@ -48,6 +49,10 @@ _DEFAULT_CHUNK = 1 << 15
 
 #: The labels of a single shell's faces as the C round-off sums take them (none: every face is the shell's).
 _NO_LABELS = np.zeros(0, dtype=np.int64)
+
+#: Most terms a row that the numpy path sums by ``math.fsum`` rather than by a tree of TwoSums (the tree's ~10 numpy
+#: calls a level cost more below about this; measured in session 17).
+_FSUM_MAX_TERMS = 256
 
 #: Largest shell (faces) :func:`accurate_shells` integrates in exact integer arithmetic (about 10 µs a face).
 EXACT_MAX_FACES = 4096
@@ -107,11 +112,12 @@ def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chu
     if lib is not None:
         return _tetra_sums_c(lib, vertices, faces, origin, labels, n_labels, area_floor)
     # each face's 11 terms in the C kernel's columns and operations (v6/6, v6·s/24, v6·(…)/120 for xx yy zz xy
-    # xz yz, area); each label's column summed by math.fsum (correctly rounded, Shewchuk 1997) per chunk and the
-    # chunks' sums again by fsum: the error is at most 2u·Σ|x|, within the compensated bound (2 + m²u)·u·Σ|x|
-    # that roundoff_bounds charges both paths (issue 21: the plain sequential sum's m·u·Σ|x| made the numpy
-    # path call a needle of aspect 1e7 flat that the C path, by its tighter bound, answered)
-    partials: list[np.ndarray] = []
+    # xz yz, area); each label's column summed without error by a tree of TwoSums per chunk and the chunks'
+    # (sum, error) pairs by TwoSum again (_label_sums, _add_pairs): within the compensated bound
+    # (2 + m²u)·u·Σ|x| that roundoff_bounds charges both paths (issue 21: the plain sequential sum's m·u·Σ|x|
+    # made the numpy path call a needle of aspect 1e7 flat that the C path, by its tighter bound, answered)
+    hi = np.zeros((n_labels, 11))
+    lo = np.zeros((n_labels, 11))
     zero = np.zeros(n_labels, dtype=np.int64)
     coords = np.ascontiguousarray((vertices - origin).T)      # (3, n): component arrays gather faster
     n_faces = len(faces)
@@ -127,33 +133,134 @@ def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chu
         nrm[1] = e1[2] * e2[0] - e1[0] * e2[2]
         nrm[2] = e1[0] * e2[1] - e1[1] * e2[0]
         v6 = np.einsum("ij,ij->j", a, nrm)                      # 6 × signed volume
-        tri_area = 0.5 * np.sqrt(np.einsum("ij,ij->j", nrm, nrm))
-        tiny = tri_area <= 0.5 * area_floor
-        s = a + b + c
-        terms = [v6 / 6.0] + [v6 * s[i] / 24.0 for i in range(3)] + \
-            [v6 * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j]) / 120.0 for i, j in _PAIRS] + [tri_area]
-        part = np.zeros((n_labels, 11))
+        terms = np.empty((11, len(f)))
+        terms[10] = 0.5 * np.sqrt(np.einsum("ij,ij->j", nrm, nrm))     # area
+        tiny = terms[10] <= 0.5 * area_floor
+        sm = a + b + c
+        terms[0] = v6 / 6.0
+        for i in range(3):
+            terms[1 + i] = v6 * sm[i] / 24.0
+        for col, (i, j) in enumerate(_PAIRS, start=4):
+            terms[col] = v6 * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + sm[i] * sm[j]) / 120.0
         if labels is None:
             zero[0] += int(np.count_nonzero(tiny))
-            part[0] = [math.fsum(t) for t in terms]
+            ids = np.zeros(1, dtype=np.intp)
+            part_hi, part_lo = _label_sums(terms, np.array([len(f)]))
         else:
             lab = np.asarray(labels[start:start + chunk_size])
+            counts = np.bincount(lab, minlength=n_labels)      # a negative label: numpy's ValueError
+            if len(counts) > n_labels:                         # as the C kernel refuses it
+                raise ValueError(f"Expected labels in 0..{n_labels - 1}, got {int(lab.max())}")
             zero += np.bincount(lab[tiny], minlength=n_labels)
             order = np.argsort(lab, kind="stable")
-            cuts = np.searchsorted(lab[order], np.arange(n_labels + 1))
-            sorted_terms = [t[order] for t in terms]
-            for k in np.flatnonzero(cuts[1:] > cuts[:-1]).tolist():
-                lo, hi = int(cuts[k]), int(cuts[k + 1])
-                part[k] = [math.fsum(t[lo:hi]) for t in sorted_terms]
-        partials.append(part)
-    if len(partials) == 1:
-        sums = partials[0]
-    else:
-        stacked = np.stack(partials) if partials else np.zeros((1, n_labels, 11))
-        sums = np.array([[math.fsum(stacked[:, k, col]) for col in range(11)] for k in range(n_labels)]) \
-            .reshape(n_labels, 11)
+            ids = np.flatnonzero(counts)
+            part_hi, part_lo = _label_sums(terms[:, order], counts[ids])
+        if start == 0:
+            hi[ids], lo[ids] = part_hi.T, part_lo.T
+        else:
+            hi[ids], lo[ids] = _add_pairs(hi[ids], lo[ids], part_hi.T, part_lo.T)
+    sums = hi + lo                        # one rounding (NaN where a term or a sum is not finite, as on C)
     second = sums[:, _SECOND_COLUMNS].reshape(n_labels, 3, 3)
     return sums[:, 0].copy(), sums[:, 1:4].copy(), second, sums[:, 10].copy(), zero
+
+
+def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(s, e)`` with ``s = fl(a + b)`` and ``a + b = s + e`` exactly (Knuth's TwoSum, six operations, no branch;
+    Ogita, Rump and Oishi 2005, Algorithm 3.1), elementwise; ``e`` is NaN where ``s`` is not finite."""
+    s = a + b
+    b_virtual = s - a
+    return s, (a - (s - b_virtual)) + (b - b_virtual)
+
+
+def _add_pairs(hi: np.ndarray, lo: np.ndarray, more_hi: np.ndarray, more_lo: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Two unevaluated sums ``hi + Σ(errors)`` added: the high parts by TwoSum (exact), the low parts plainly."""
+    s, e = _two_sum(hi, more_hi)
+    return s, lo + (e + more_lo)
+
+
+def _label_sums(x: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each segment's sum of the columns of ``x`` as an unevaluated pair ``hi + lo``, by a tree of TwoSums.
+
+    Parameters
+    ----------
+    x : (k, n) float
+        ``k`` rows of terms; the columns of a segment are contiguous, segments in order.
+    counts : (g,) int
+        The columns of each segment, each at least 1, summing to ``n``.
+
+    Returns
+    -------
+    hi, lo : (k, g) float
+        Per segment and row: ``hi`` the root of a pairwise tree of float additions, ``lo`` the float sum of every
+        addition's rounding error (TwoSum, exact).  ``hi + (the exact sum of the errors)`` is the segment's exact
+        sum, so for a segment of ``m`` terms ``|hi + lo − Σx| ≤ N·u·Σ|e|`` with ``Σ|e| ≤ L·u·Σ|x|`` (each level
+        of the tree errs by at most ``u`` times its partial sums, which add up to ``Σ|x|`` to first order),
+        ``L = ⌈log₂ m⌉`` levels and ``N ≤ m + L`` error terms.  A single segment of at most ``_FSUM_MAX_TERMS``
+        finite terms is summed by ``math.fsum`` instead: ``hi`` correctly rounded, ``lo`` zero.
+
+    Notes
+    -----
+    A level pairs neighbours within each segment: a segment of odd length gets a zero at its end (adding zero is
+    exact), a segment of one column is finished.  Every level is a few whole-array operations, so ``L`` levels cost
+    about twice the first; the same numbers whatever the number of segments (no loop over segments).
+    """
+    k, n = x.shape
+    g = len(counts)
+    hi = np.zeros((k, g))
+    lo = np.zeros((k, g))
+    cnt = np.asarray(counts, dtype=np.intp)
+    where = np.arange(g)                        # the output column of each open segment
+    if g == 1:                                  # one segment (one shell): no gathers, the odd column carried
+        return _one_segment_sum(x, hi, lo)
+    for _ in range(n.bit_length() + 1):         # ⌈log₂ n⌉ levels at most: each halves the longest segment
+        done = cnt == 1
+        if done.any():
+            first = np.cumsum(cnt) - cnt
+            hi[:, where[done]] = x[:, first[done]]
+            if done.all():
+                break
+            x = x[:, np.repeat(~done, cnt)]
+            where, cnt = where[~done], cnt[~done]
+        odd = cnt & 1
+        if odd.any():                           # a zero at the end of each odd segment
+            shift = np.repeat(np.cumsum(odd) - odd, cnt)
+            padded = np.zeros((k, x.shape[1] + int(odd.sum())))
+            padded[:, np.arange(x.shape[1]) + shift] = x
+            x, cnt = padded, cnt + odd
+        s, e = _two_sum(x[:, 0::2], x[:, 1::2])
+        cnt = cnt >> 1
+        lo[:, where] += np.add.reduceat(e, np.cumsum(cnt) - cnt, axis=1)
+        x = s
+    return hi, lo
+
+
+def _one_segment_sum(x: np.ndarray, hi: np.ndarray, lo: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_label_sums` of a single segment (``hi``, ``lo`` its (k, 1) outputs, zero): the same tree, an odd
+    level's last column added to the level's first sum by one more TwoSum; up to ``_FSUM_MAX_TERMS`` finite terms
+    a row (a small part), each row's ``math.fsum`` instead (correctly rounded, Shewchuk 1997; ``lo`` zero), which
+    costs less than the tree's numpy calls there."""
+    if x.shape[1] <= _FSUM_MAX_TERMS and bool(np.isfinite(x).all()):
+        try:
+            hi[:, 0] = [math.fsum(row) for row in x.tolist()]
+            return hi, lo
+        except OverflowError:                       # finite terms whose sum overflows: the tree's NaN, as on C
+            pass
+    carry_lo = np.zeros(x.shape[0])
+    for _ in range(x.shape[1].bit_length() + 1):    # ⌈log₂ n⌉ levels at most
+        n = x.shape[1]
+        if n <= 1:
+            break
+        s, e = _two_sum(x[:, 0:n - 1:2], x[:, 1:n:2])
+        carry_lo += e.sum(axis=1)
+        if n & 1:
+            s[:, 0], e_last = _two_sum(s[:, 0], x[:, n - 1])
+            carry_lo += e_last
+        x = s
+    if x.shape[1]:
+        hi[:, 0] = x[:, 0]
+    lo[:, 0] = carry_lo
+    return hi, lo
 
 
 def _tetra_sums_c(lib: ModuleType, vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray,
@@ -351,8 +458,9 @@ def roundoff_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     ``s = a + b + c`` and of two products (bound ``2u·P·‖s‖``), the second-moment term
     ``6v·(Σ pₖpₖᵀ + ssᵀ)/120`` those of ``Q`` (``3u·P·tr|Q|``).  Sums over a shell's m faces add
     ``(2 + m²u)·u·Σ P``: the C path's compensated sums (Ogita, Rump and Oishi 2005, Sum2) and the numpy path's
-    ``math.fsum`` per chunk and across chunks (at most ``2u·Σ P``) both meet it, so both paths draw the same line
-    (issue 21).  The central moment ``C − f fᵀ/V`` carries the errors of its parts to
+    TwoSum trees (:func:`_label_sums`: at most ``(1 + 3m(L + C)u)·u·Σ P`` with ``L ≤ 16`` levels per chunk and
+    ``C`` chunks of the default size, under ``1.02·u·Σ P`` up to 10⁹ faces) both meet it, so both paths draw the
+    same line (issue 21).  The central moment ``C − f fᵀ/V`` carries the errors of its parts to
     first order plus ``4u·(‖C‖ + ‖f‖²/|V|)`` of its own.  Terms of order u² are left out.
 
     The per-face terms and their sums run in one C pass when the extension is built (``_accel.roundoff_sums``:
@@ -380,17 +488,18 @@ def roundoff_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     else:
         sums = _roundoff_sums(v, f, lab, n, origin, chunk_size)
     if n == 1:
-        return _one_shell_bound(sums[0], len(f), shells[0], origin, compensated=True)
-    return _shells_bound(sums, np.bincount(lab, minlength=n), shells, origin, compensated=True)
+        return _one_shell_bound(sums[0], len(f), shells[0], origin)
+    return _shells_bound(sums, np.bincount(lab, minlength=n), shells, origin)
 
 
-def _shells_bound(sums: np.ndarray, counts: np.ndarray, shells: list[VolumeMoments], origin: np.ndarray, *,
-                  compensated: bool) -> RoundoffBound:
+def _shells_bound(sums: np.ndarray, counts: np.ndarray, shells: list[VolumeMoments],
+                  origin: np.ndarray) -> RoundoffBound:
     """The tail of :func:`roundoff_bounds`: each shell's bounds from its sums (:func:`_roundoff_sums`) and its
-    face count ``counts`` (s,)."""
+    face count ``counts`` (s,); the sums over a shell's m faces are charged ``(2 + m²u)·u`` of their size
+    (compensated or correctly rounded, on either engine path)."""
     sp, sps, spq = sums.T
     counts = np.asarray(counts).astype(np.float64)
-    summing = (2 + counts * counts * _U) * _U if compensated else counts * _U
+    summing = (2 + counts * counts * _U) * _U
     e_volume = (_U + summing) * sp / 6
     e_first = (2 * _U + summing) * sps / 24
     e_second = (3 * _U + summing) * spq / 120
@@ -454,14 +563,13 @@ def _norm(x: np.ndarray) -> float:
     return math.sqrt(float(flat.dot(flat)))
 
 
-def _one_shell_bound(sums: np.ndarray, m: int, shell: VolumeMoments, origin: np.ndarray, *,
-                     compensated: bool) -> RoundoffBound:
+def _one_shell_bound(sums: np.ndarray, m: int, shell: VolumeMoments, origin: np.ndarray) -> RoundoffBound:
     """The tail of :func:`roundoff_bounds` for one shell of ``m`` faces on Python floats: the same operations
     in the same order as its array form :func:`_shells_bound` (the same bits: ``tests/test_integrals_small.py``),
     without its dozens of numpy calls on arrays of one element (a small part makes this call once or twice)."""
     sp, sps, spq = (float(x) for x in sums)
     count = float(m)
-    summing = (2 + count * count * _U) * _U if compensated else count * _U
+    summing = (2 + count * count * _U) * _U
     e_volume = (_U + summing) * sp / 6
     e_first = (2 * _U + summing) * sps / 24
     e_second = (3 * _U + summing) * spq / 120

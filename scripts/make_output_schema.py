@@ -346,9 +346,12 @@ def row(version):
     if not v1:
         p["certificate"] = d("optional: the certificate's kind (see certificate)", {"enum": CERT_KINDS + [None]})
     if version >= 3:
-        p["assumptions"] = d("the user's assumptions (--assume) the result rests on, joined with ','; null when "
-                             "none was taken (and in rows read back from inertia_tool.batch/2 files: unknown)",
-                             {"anyOf": [{"enum": USER_ASSUMPTION_NAMES}, {"type": "null"}]})
+        one = "(" + "|".join(USER_ASSUMPTION_NAMES) + ")"
+        p["assumptions"] = d("the user's assumptions (--assume) the result rests on, joined with ','; 'none' when "
+                             "none was taken; null when not recorded (a failed row, and rows read back from "
+                             "inertia_tool.batch/2 files: unknown, never 'none')",
+                             {"anyOf": [{"type": "string", "pattern": f"^(none|{one}(,{one})*)$"},
+                                        {"type": "null"}]})
     p.update({"warnings": d("the soft problems, joined with ' | '", SN), "seconds": d("s", NN), "worker": SN})
     required = [k for k in p if k != "certificate"]
     o = obj(p, required, extra=False)

@@ -273,7 +273,7 @@ def test_batch_rows_name_the_assumption_taken(two_parts, tmp_path, fmt):
     out = tmp_path / f"rows.{fmt}"
     assert main(["batch", *two_parts, "--repair", "--assume", "flat-islands", "--out", str(out), "-q"]) == EXIT_OK
     rows = _read(out)
-    assert rows["lidless.stl"]["assumptions"] == "flat-islands" and rows["open.stl"]["assumptions"] is None
+    assert rows["lidless.stl"]["assumptions"] == "flat-islands" and rows["open.stl"]["assumptions"] == "none"
     assert all(r["schema"] == SCHEMA and r["certificate"] == "estimate" for r in rows.values())
     if fmt == "csv":
         assert out.read_text().splitlines()[0] == ",".join(ROW_FIELDS)

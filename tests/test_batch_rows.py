@@ -35,7 +35,7 @@ def _row(k, path=None, **extra):
     row.update(schema=SCHEMA, path=path if path is not None else f"/parts/p{k}.stl", status="ok",
                sha256=f"{k:064x}", options_key="0123456789abcdef", mesh_length_unit="m", density=1000.0,
                density_source="1000 kg/m³ (default: water, give a density)", mass=1.5 + k, faces=12, bodies=1,
-               cavities=0, watertight=True, repaired=False, seconds=0.001, worker="host:1")
+               cavities=0, watertight=True, repaired=False, assumptions="none", seconds=0.001, worker="host:1")
     for name in ("volume", "surface_area", "com_x", "com_y", "com_z", "ixx", "iyy", "izz", "ixy", "ixz", "iyz",
                  "i1", "i2", "i3", *(f"axis{a}_{c}" for a in (1, 2, 3) for c in "xyz")):
         row[name] = 0.25 * k - 1.0

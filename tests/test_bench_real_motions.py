@@ -46,3 +46,22 @@ def test_no_depth_reading_where_the_pieces_cross(shift, axis):
     offset[axis] = shift
     b = (a[0] * 0.5 + offset, a[1])               # half the size (±0.25), sticking out of the face at +axis
     assert R._depth_reading(a, b) is None
+
+
+def test_root_is_required_and_named_in_the_help(monkeypatch, capsys):
+    """The bench reads the Menagerie only from a folder the user names (before: a default of one machine's path,
+    read silently wherever the bench ran)."""
+    asked = []
+    monkeypatch.setattr(R, "pool", lambda root, max_faces: asked.append(root) or [])
+    with pytest.raises(SystemExit) as stop:
+        R.main(["--cases", "0"])
+    assert stop.value.code == 2 and not asked
+    assert "--root" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as stop:
+        R.main(["--root", str(Path(__file__).parent / "no such folder"), "--cases", "0"])
+    assert stop.value.code == 2 and not asked
+    assert "expected the folder of a MuJoCo Menagerie checkout" in capsys.readouterr().err
+    assert R.main(["--root", str(Path(__file__).parent), "--cases", "0"]) == 0
+    assert asked == [Path(__file__).parent]
+    help_text = R._parser().format_help()
+    assert "--root MENAGERIE" in help_text and "required" in help_text

@@ -455,3 +455,45 @@ def test_a_plain_grid_that_misses_the_target_is_weighed_against_the_corrected_es
     assert est.uncertainty.mass == min(plain.uncertainty.mass, corrected.uncertainty.mass)
     _truth_within(est, S.truth_from_manifold(pieces))
     _truth_within(corrected, S.truth_from_manifold(pieces))
+
+
+def _plates_meeting_at_an_edge(thickness, overlap, subdivide):
+    """A plate 1 × 1 × ``thickness`` and a plate 1 × ``thickness`` × 1 standing on its edge, the two crossing only
+    in a small box (``overlap`` × ``thickness`` × ``thickness``) at the first plate's edge: thin parts (the plain
+    grid's doubt is all their surface) with a small crossing (the corrected estimate's doubt is near it only)."""
+    a = S.box([1.0, 1.0, thickness], subdivide=subdivide)
+    b = S.box([1.0, thickness, 1.0], [1.0 - overlap, 0.0, 0.5 - overlap], subdivide=subdivide)
+    lo = np.maximum([-0.5, -0.5, -thickness / 2], [0.5 - overlap, -thickness / 2, -overlap])
+    hi = np.minimum([0.5, 0.5, thickness / 2], [1.5 - overlap, thickness / 2, 1.0 - overlap])
+    # the closed form of the union, by inclusion–exclusion of the three boxes (exact rationals; unsubdivided boxes)
+    truth = S.truth_from_pieces([(1, S.box([1.0, 1.0, thickness])),
+                                 (1, S.box([1.0, thickness, 1.0], [1.0 - overlap, 0.0, 0.5 - overlap])),
+                                 (-1, S.box(hi - lo, (lo + hi) / 2))])
+    return S.concat(a, b), truth
+
+
+@pytest.mark.parametrize("thickness, overlap, subdivide, finest", [(0.06, 0.1, 2, 48), (0.04, 0.05, 3, 64)])
+def test_the_corrected_estimate_beats_a_plain_grid_past_the_refusal_bound(thickness, overlap, subdivide, finest,
+                                                                         monkeypatch):
+    """The branch of closed_surface_estimate where the plain grid decides cells inside but its bound is past the
+    refusal's ±50 %, and the corrected estimate's proven bound is narrower: the corrected estimate is the answer,
+    and it holds the closed form.  (Found by a search over plates meeting at an edge, tidy17: thickness 0.02-0.06,
+    overlap 0.05-0.1, 2-3 subdivisions, finest grids of 32-64 cells; 12 of 36 shapes take this branch.  Since
+    session 16's tighter cell marking the crossing plates above no longer reach it: the plain grid wins there.)"""
+    from inertia_tool.mesh import grid_estimate
+    from inertia_tool.tolerances import ESTIMATE_MAX_MASS_RTOL
+    (v, f), truth = _plates_meeting_at_an_edge(thickness, overlap, subdivide)
+    grids, corrected = [], []
+    plain_grid, plain_corrected = grid_estimate.winding_estimate, grid_estimate.corrected_estimate
+    monkeypatch.setattr(grid_estimate, "winding_estimate", lambda *a, **k: grids.append(plain_grid(*a, **k))
+                        or grids[-1])
+    monkeypatch.setattr(grid_estimate, "corrected_estimate",
+                        lambda *a, **k: corrected.append(plain_corrected(*a, **k)) or corrected[-1])
+    est = closed_surface_estimate(v, f, resolution=16, max_resolution=finest)
+    assert grids and grids[-1].volume > 0                             # the plain grid decided cells inside
+    assert grids[-1].uncertainty.mass > ESTIMATE_MAX_MASS_RTOL        # ... and would be refused
+    assert len(corrected) == 1 and est is corrected[0]                # the corrected estimate is the answer
+    assert est.uncertainty.mass < grids[-1].uncertainty.mass <= 1.0
+    assert est.uncertainty.mass < ESTIMATE_MAX_MASS_RTOL              # answered, not refused
+    _truth_within(est, truth)
+    _truth_within(grids[-1], truth)

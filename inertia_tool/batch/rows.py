@@ -30,8 +30,10 @@ span several physical lines.
 
 Rows of an older layout (:data:`~inertia_tool.batch.runner.SCHEMA_V2`, ``SCHEMA_V1``) are read back with the
 current columns (:func:`~inertia_tool.batch.runner.upgrade_row`), so an old results file resumes without
-re-running its files; a CSV file with an old header goes on receiving rows of its own layout (its header is never
-rewritten).
+re-running its files: a column they lack is ``None``, *not recorded* (their ``assumptions`` too: unknown, never
+``"none"``, which an ``ok`` row of this layout writes when its result rests on no assumption of the user's,
+:data:`~inertia_tool.batch.runner.NO_ASSUMPTIONS`); a CSV file with an old header goes on receiving rows of its
+own layout (its header is never rewritten).
 """
 
 from __future__ import annotations

@@ -48,7 +48,7 @@ from .chunks import (DASK_CHUNK_SECONDS, DASK_SHORT_CHUNKS_PER_WORKER, DASK_TAIL
 __all__ = ["BatchOptions", "BatchSummary", "ROW_FIELDS", "SCHEMA", "SCHEMA_V1", "ROW_FIELDS_V1", "SCHEMA_V2",
            "ROW_FIELDS_V2", "analyze_chunk",
            "analyze_file", "discover_files", "file_sha256", "run_batch", "upgrade_row", "downgrade_row",
-           "DONE_STATUSES", "counts_as_done", "row_path"]
+           "DONE_STATUSES", "counts_as_done", "row_path", "NO_ASSUMPTIONS"]
 
 #: Schema identifier written in every row (``schema`` column); bump it when columns change meaning.  The JSON
 #: Schema of the rows is the ``batch_row`` of ``inertia_tool/schema/output-v1.json`` (docs/json.md).
@@ -70,6 +70,12 @@ SCHEMA_V1 = "inertia_tool.batch/1"
 #: ``uncertainty_volume_in_doubt`` (m³); empty (``None``) when the result is exact.
 _UNCERTAINTY = ("mass", "center_of_mass", "inertia", "volume_in_doubt")
 
+#: The ``assumptions`` of an ``ok`` row whose result rests on no assumption of the user's.  An empty cell (``None``)
+#: means *not recorded*: a failed row (no result), or a row read back from an ``inertia_tool.batch/2`` file (written
+#: before the column).  ``inertia_tool.batch/3`` rows of session 16 left it empty for "none": read back as
+#: ``"none"`` (:func:`upgrade_row`; an ``ok`` row of that writer had an empty cell only then).
+NO_ASSUMPTIONS = "none"
+
 #: Row statuses that count as done when resuming (``internal_error`` is retried).
 DONE_STATUSES = ("ok", "error")
 
@@ -88,7 +94,8 @@ ROW_FIELDS = (
     "i1", "i2", "i3",
     "axis1_x", "axis1_y", "axis1_z", "axis2_x", "axis2_y", "axis2_z", "axis3_x", "axis3_y", "axis3_z",
     "faces", "bodies", "cavities", "watertight", "repaired", "certificate",
-    # the user's assumptions the result rests on (Certificate.assumptions), joined with ","; empty when none
+    # the user's assumptions the result rests on (Certificate.assumptions), joined with ","; "none" when none was
+    # taken; empty when not recorded (a failed row, a row of a batch/2 file): NO_ASSUMPTIONS
     "assumptions", "warnings", "seconds", "worker",
 )
 
@@ -128,11 +135,17 @@ READ_ONCE_BYTES = 1 << 24
 def upgrade_row(row: dict) -> dict:
     """A :data:`SCHEMA_V1` row (of an older results file) with this version's columns: ``mesh_length_unit``
     from ``units``, ``method`` and ``uncertainty_*`` unknown (``None``); a :data:`SCHEMA_V2` row with
-    ``assumptions`` unknown (``None``); its ``schema`` stays what the file says.  Other rows are returned
-    unchanged."""
-    if row.get("schema") == SCHEMA_V2:
+    ``assumptions`` unknown (``None``: not recorded, never :data:`NO_ASSUMPTIONS`); its ``schema`` stays what the
+    file says.  A :data:`SCHEMA` row of an earlier writer (session 16) whose ``ok`` result left ``assumptions``
+    empty for "none taken" says :data:`NO_ASSUMPTIONS`.  Other rows are returned unchanged."""
+    schema = row.get("schema")
+    if schema == SCHEMA:
+        if row.get("assumptions") is None and row.get("status") == "ok" and "assumptions" in row:
+            return {**row, "assumptions": NO_ASSUMPTIONS}
+        return row
+    if schema == SCHEMA_V2:
         return {k: row.get(k) for k in ROW_FIELDS}
-    if row.get("schema") != SCHEMA_V1:
+    if schema != SCHEMA_V1:
         return row
     new = {k: row.get(k) for k in ROW_FIELDS}
     new.update(schema=SCHEMA_V1, mesh_length_unit=row.get("units"))
@@ -511,7 +524,7 @@ def _analyze(path: str, sha256: str | None, chunk: _Chunk) -> dict:
             row.update(method=mesh.method, faces=int(mesh.faces), bodies=int(mesh.bodies),
                        cavities=int(mesh.cavities), watertight=bool(mesh.watertight),
                        repaired=bool(mesh.repaired), certificate=mesh.certificate.kind,
-                       assumptions=",".join(mesh.certificate.assumptions) or None)
+                       assumptions=",".join(mesh.certificate.assumptions) or NO_ASSUMPTIONS)
             if mesh.uncertainty is not None:
                 row.update(_bounds(mesh.uncertainty))
         row["status"] = "ok"
@@ -543,7 +556,8 @@ def _parts_fields(props) -> dict:
                 cavities=sum(int(r.cavities) for r in reports), watertight=all(r.watertight for r in reports),
                 repaired=any(r.repaired for r in reports),
                 certificate=max((r.certificate.kind for r in reports), key=CERTIFICATE_KINDS.index),
-                assumptions=",".join(user_named(a for r in reports for a in r.certificate.assumptions)) or None)
+                assumptions=",".join(user_named(a for r in reports for a in r.certificate.assumptions))
+                or NO_ASSUMPTIONS)
 
 
 def _bounds(uncertainty) -> dict:
