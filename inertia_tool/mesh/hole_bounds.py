@@ -90,7 +90,7 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     ring_face = slot // 3
     ring_loop = label[order[pos[slot]]]
     # one (face, loop) pair per ring face of each loop
-    pair = np.unique(np.stack([ring_face, ring_loop], axis=1), axis=0)
+    pair = _sorted_pairs(ring_face, ring_loop, n_loops)      # (numpy.unique(axis=0)'s rows, by one int64 key)
     ring_face, ring_loop = pair[:, 0], pair[:, 1]
     a, b, c = (v[faces[ring_face, k]] for k in range(3))
     normal = np.cross(b - a, c - a)
@@ -263,7 +263,8 @@ def _ring_face_of_edges(f: np.ndarray, n: int, edges: np.ndarray) -> tuple[np.nd
 def _sorted_pairs(vertex: np.ndarray, loop: np.ndarray, n_loops: int) -> np.ndarray:
     """The distinct rows (vertex, loop) in lexicographic order, (k, 2) int64, as ``numpy.unique(axis=0)`` gives
     them (by a sort of one int64 key per row: sorting the rows as a void dtype was 0.34 s of the scattered sphere's
-    1.0 s)."""
+    1.0 s).  Any pair of non-negative int columns whose second is below ``n_loops`` (the key's width): also the
+    (face, loop) and (loop, vertex) rows of the hole bounds (issue 25, soup17)."""
     width = np.int64(max(n_loops, 1))
     key = np.sort(np.asarray(vertex, dtype=np.int64) * width + np.asarray(loop, dtype=np.int64))
     key = key[np.r_[True, key[1:] != key[:-1]]] if len(key) else key    # (numpy's hash-based unique: 0.14 s)
@@ -389,7 +390,7 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
         return out
     e = np.asarray(edges, dtype=np.int64)
     # (rim vertex, loop) pairs of the flat rims, sorted by vertex; each face at such a vertex, once per pair
-    pairs = np.unique(np.stack([e.reshape(-1), np.repeat(label, 2)], axis=1), axis=0)
+    pairs = _sorted_pairs(e.reshape(-1), np.repeat(label, 2), n_loops)
     pairs = pairs[flat[pairs[:, 1]]]
     first = np.searchsorted(pairs[:, 0], np.arange(n))
     count = np.bincount(pairs[:, 0], minlength=n)
@@ -924,7 +925,7 @@ def _rim_planes(v: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: in
     (n_loops,), their centroid ``c̄`` (n_loops, 3) m, the unit eigenvector of the least eigenvalue of
     ``Σ (x − c̄)(x − c̄)ᵀ`` (n_loops, 3), the largest distance of a rim vertex from the plane (n_loops,) m, the
     largest distance from ``c̄`` (n_loops,) m, and each (loop, vertex) pair's offset from its ``c̄``."""
-    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
+    pairs = _sorted_pairs(np.repeat(label, 2), edges.reshape(-1), len(v))    # (numpy.unique(axis=0)'s rows)
     loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
     count = np.bincount(loop_of, minlength=n_loops).astype(np.float64)
     mean: np.ndarray = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) for i in range(3)],
@@ -947,6 +948,48 @@ def _rim_planes(v: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: in
 #: :func:`bend_doubt_volumes` no slope to bound (the missing surface may fold over itself): that hole keeps the
 #: other bounds.
 BEND_MAX_DEGREES = 80.0
+
+
+@frozen_value
+class RimFans:
+    """Each rim's fan and the steepest face touching it, as :func:`level_rings` and :func:`bend_doubt_volumes`
+    read them (:func:`rim_fans`: computed once for both, the same arrays either way).
+
+    Attributes
+    ----------
+    apex_of_edge : (k, 3) float
+        m: per boundary edge ``a → b``, its loop's apex ``c``.
+    to_a, to_b : (k, 3) float
+        m: ``a − c`` and ``b − c``.
+    has_normal : (n_loops,) bool
+        The fan's area vector ``Σ (a − c) × (b − c)`` is non-zero.
+    normal : (n_loops, 3) float
+        Its unit (0 where ``has_normal`` is False).
+    star : (n_loops,) bool
+        The fan projected onto the plane ⟂ ``normal`` is star-shaped round ``c`` (one full turn, none backward).
+    least : (n_loops,) float
+        The least cosine between ``normal`` and the normal of a face touching the rim at a rim vertex (``inf``
+        where none; negative for a face facing against the fan).
+    """
+
+    apex_of_edge: np.ndarray
+    to_a: np.ndarray
+    to_b: np.ndarray
+    has_normal: np.ndarray
+    normal: np.ndarray
+    star: np.ndarray
+    least: np.ndarray
+
+
+def rim_fans(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+             apex: np.ndarray) -> RimFans:
+    """The :class:`RimFans` of the loops ``label`` (k,) of the boundary edges ``edges`` (k, 2) ``a → b``, apexes
+    ``apex`` (n_loops, 3) m: pass it to :func:`level_rings` and :func:`bend_doubt_volumes` (``fans=``), which
+    otherwise each compute it (issue 25: twice 0.5 s on a 1.3M-face sphere with 60,574 holes)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    e = np.asarray(edges, dtype=np.int64)
+    return RimFans(*_fan_and_ring(v, f, e, np.asarray(label, dtype=np.int64), n_loops, np.asarray(apex)))
 
 
 def _fan_and_ring(v: np.ndarray, f: np.ndarray, e: np.ndarray, label: np.ndarray, n_loops: int, apex: np.ndarray
@@ -997,27 +1040,32 @@ def _fan_and_ring(v: np.ndarray, f: np.ndarray, e: np.ndarray, label: np.ndarray
 
 
 def level_rings(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
-                apex: np.ndarray, *, level_cosine: float = LEVEL_RING_COSINE) -> np.ndarray:
+                apex: np.ndarray, *, level_cosine: float = LEVEL_RING_COSINE, fans: RimFans | None = None
+                ) -> np.ndarray:
     """Holes whose every face touching the rim lies within ``acos(level_cosine)`` ≈ 1.1° of the rim's mean plane,
     (n_loops,) bool: a *level* ring (the rule of :func:`flat_islands`, which says why that is no evidence).
 
     The plane is the fan's (normal along ``Σ (a − c) × (b − c)`` over the rim edges ``a → b``, ``c`` the apex:
     the plane :func:`bend_doubt_volumes` measures slopes against), and the faces are those touching the rim at any
-    rim vertex, as there.  Parameters as :func:`bend_doubt_volumes`.
+    rim vertex, as there.  Parameters as :func:`bend_doubt_volumes` (``fans``: :func:`rim_fans` of the same
+    arguments, when the caller has it).
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     e = np.asarray(edges, dtype=np.int64)
     if not n_loops or not len(e) or not len(f):
         return np.zeros(n_loops, dtype=bool)
-    *_, ok, _, _, least = _fan_and_ring(v, f, e, label, n_loops, apex)
+    if fans is None:
+        fans = rim_fans(v, f, e, label, n_loops, apex)
+    ok, least = fans.has_normal, fans.least
     level: np.ndarray = ok & np.isfinite(least) & (least >= level_cosine)
     return level
 
 
 def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
                        n_loops: int, apex: np.ndarray, *, max_degrees: float = BEND_MAX_DEGREES,
-                       level_cosine: float = LEVEL_RING_COSINE) -> tuple[np.ndarray, np.ndarray]:
+                       level_cosine: float = LEVEL_RING_COSINE, fans: RimFans | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
     """Volume in doubt of each hole under the *bend* assumption, and how far its region reaches from the rim's
     mean plane: ``(doubt, height)``, (n_loops,) m³ and m, ``inf`` where the assumption cannot be applied.
 
@@ -1062,6 +1110,9 @@ def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
         ``BEND_MAX_DEGREES``.
     level_cosine : float
         ``LEVEL_RING_COSINE``: a ring whose every face has at least this cosine with ``n`` is level (no bound).
+    fans : RimFans, optional
+        :func:`rim_fans` of the same vertices, faces, edges, labels and apexes, when the caller has it (computed
+        here otherwise).
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
@@ -1071,7 +1122,9 @@ def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     if not n_loops or not len(e) or not len(f):
         return doubt, height
     margin = _round_off(v)
-    c, pa, pb, ok, normal, star, least = _fan_and_ring(v, f, e, label, n_loops, apex)
+    if fans is None:
+        fans = rim_fans(v, f, e, label, n_loops, apex)
+    pa, pb, normal, star, least = fans.to_a, fans.to_b, fans.normal, fans.star, fans.least
     nk = normal[label]
     ha, hb = np.einsum("ij,ij->i", pa, nk), np.einsum("ij,ij->i", pb, nk)
     ua, ub = pa - ha[:, None] * nk, pb - hb[:, None] * nk          # projections onto the plane, apex at 0

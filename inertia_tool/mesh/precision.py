@@ -314,7 +314,8 @@ def weld_sweep(vertices: np.ndarray, faces: np.ndarray, welded_faces: np.ndarray
     move = np.zeros(len(v))
     for start in range(0, len(moved), _CHUNK):       # in blocks: a welded soup moves millions of corners
         block = moved[start:start + _CHUNK]
-        move[block] = np.sqrt(np.einsum("ij,ij->i", v[block] - v[rep[block]], v[block] - v[rep[block]]))
+        step = v[block] - v[rep[block]]              # (formed once: the same products; issue 25)
+        move[block] = np.sqrt(np.einsum("ij,ij->i", step, step))
     move *= 1.0 + 1e-12                               # the norms' rounding (a few ulp), covered
     largest = float(move.max())
     if not largest > 0:
