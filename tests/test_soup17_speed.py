@@ -117,3 +117,84 @@ def test_enclosing_balls_are_the_reading_that_formed_each_difference_twice(seed,
     centre, radius = enclosing_balls(v[vertex_of], loop_of, n_loops, iterations=iterations)
     want_centre, want_radius = _reference_balls(v[vertex_of], loop_of, n_loops, iterations)
     assert centre.tobytes() == want_centre.tobytes() and radius.tobytes() == want_radius.tobytes()
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 2000), st.sampled_from([1, 3, 50, 10**6, 2**40, 2**62]))
+def test_stable_key_order_is_the_stable_argsort(seed, k, top):
+    """Keys with many ties (a few distinct values) to keys so large that the packed form would overflow (the
+    stable argsort then): the sorted keys and the order are ``numpy.argsort(kind="stable")``'s."""
+    from inertia_tool.mesh.edges import stable_key_order
+
+    rng = np.random.default_rng(seed)
+    key = rng.integers(0, top, k, dtype=np.int64)
+    order = np.argsort(key, kind="stable")
+    got_key, got_order = stable_key_order(key)
+    assert got_order.dtype == order.dtype and got_order.tobytes() == order.tobytes()
+    assert got_key.dtype == key.dtype and got_key.tobytes() == key[order].tobytes()
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 3000))
+def test_swept_faces_are_the_reading_with_numpys_cross(seed, m):
+    """``precision._swept_faces`` forms ``ab × ac`` product by product: the total and the box of the reading
+    that called ``numpy.cross``, on faces of any size and place, some with no corner moved."""
+    import math
+
+    from inertia_tool.mesh.precision import _swept_faces
+
+    rng = np.random.default_rng(seed)
+    n = 3 * m
+    v = rng.normal(size=(n, 3)) * 10.0 ** rng.uniform(-6, 3, size=(n, 1)) + rng.uniform(-1e3, 1e3, size=3)
+    f = rng.integers(0, n, size=(m, 3))
+    reach = np.where(rng.random(n) < 0.3, 0.0, rng.uniform(0, 1e-3, n))
+    total, box = _swept_faces(v, f, reach)
+    d = reach[f].max(axis=1)
+    hit = d > 0
+    tri = v[f[hit]]
+    ab, ac, bc = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], tri[:, 2] - tri[:, 1]
+    area = 0.5 * np.linalg.norm(np.cross(ab, ac), axis=1)
+    perimeter = np.linalg.norm(ab, axis=1) + np.linalg.norm(ac, axis=1) + np.linalg.norm(bc, axis=1)
+    dh = d[hit]
+    want = 3.0 * float(np.sum(2.0 * dh * area + 0.5 * math.pi * dh * dh * perimeter + 4.0 / 3.0 * math.pi * dh ** 3))
+    assert total.hex() == want.hex() if hit.any() else total == 0.0
+    if hit.any():
+        corners = tri.reshape(-1, 3)
+        assert box is not None
+        assert box[0].tobytes() == corners.min(axis=0).tobytes() and box[1].tobytes() == corners.max(axis=0).tobytes()
+    else:
+        assert box is None
+
+
+def _reference_rim_edge_slots(f, n, edges):
+    """Every face edge slot keyed (``edge_keys``) and looked up among the rim's sorted keys: the reading before."""
+    from inertia_tool.mesh.edges import edge_keys
+
+    nv = np.int64(max(n, 1))
+    key, _ = edge_keys(f, n)
+    rim_key = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * nv + np.maximum(edges[:, 0], edges[:, 1])
+    order = np.argsort(rim_key, kind="stable")
+    sorted_rim = rim_key[order]
+    pos = np.searchsorted(sorted_rim, key)
+    hit = (pos < len(sorted_rim)) & (sorted_rim[np.minimum(pos, len(sorted_rim) - 1)] == key)
+    slot = np.flatnonzero(hit)
+    return slot, order[pos[slot]]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_rim_edge_slots_are_those_of_every_face_edge(seed, soup):
+    """The slots of the face edges that are rim edges, and their rim edge, from the slots with both ends on a rim:
+    those a lookup of every slot finds, on holed surfaces and on soups of faces on a small vertex pool (edges of
+    three or more faces, repeated rim edges)."""
+    if soup:
+        rng = np.random.default_rng(seed)
+        n = int(rng.integers(4, 40))
+        f = rng.integers(0, n, size=(int(rng.integers(1, 200)), 3))
+        edges = rng.integers(0, n, size=(int(rng.integers(1, 60)), 2))
+    else:
+        v, f, edges, _, _, _, _, _ = _holed(seed)
+        n = len(v)
+    slot, rim_edge = hole_bounds._rim_edge_slots(f, n, edges)
+    want_slot, want_edge = _reference_rim_edge_slots(f, n, edges)
+    assert slot.tobytes() == want_slot.tobytes() and rim_edge.tobytes() == want_edge.tobytes()

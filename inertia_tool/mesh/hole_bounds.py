@@ -15,7 +15,7 @@ import numpy as np
 
 from ..rounding import round_up
 from ..values import frozen_value
-from .edges import edge_keys
+from .edges import edge_keys, stable_key_order
 
 
 def ball_slab_volume(radius: np.ndarray, offset: np.ndarray, half_width: np.ndarray) -> np.ndarray:
@@ -77,18 +77,11 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     v = np.asarray(vertices, dtype=np.float64)
     ball: np.ndarray = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=np.float64) ** 3
     n = len(v)
-    nv = np.int64(max(n, 1))
-    key, _ = edge_keys(faces, n)
-    rim_key = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * nv + np.maximum(edges[:, 0], edges[:, 1])
-    order = np.argsort(rim_key, kind="stable")
-    sorted_rim = rim_key[order]
-    pos = np.searchsorted(sorted_rim, key)
-    hit = (pos < len(sorted_rim)) & (sorted_rim[np.minimum(pos, len(sorted_rim) - 1)] == key)
-    slot = np.flatnonzero(hit)
+    slot, rim_edge = _rim_edge_slots(np.asarray(faces), n, edges)
     if not len(slot):
         return ball
     ring_face = slot // 3
-    ring_loop = label[order[pos[slot]]]
+    ring_loop = label[rim_edge]
     # one (face, loop) pair per ring face of each loop
     pair = _sorted_pairs(ring_face, ring_loop, n_loops)      # (numpy.unique(axis=0)'s rows, by one int64 key)
     ring_face, ring_loop = pair[:, 0], pair[:, 1]
@@ -235,6 +228,31 @@ def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
     return RimEvidence(flat_all_round=flat, bare=count)
 
 
+def _rim_edge_slots(f: np.ndarray, n: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The face edge slots (slot ``3i + j``: ``f[i, j] → f[i, j+1]``, either direction) that are a rim edge of
+    ``edges`` (k, 2), ascending, and for each the first rim edge (in a stable sort of the rim's keys) with its
+    key: ``(slot, rim_edge)``, int.
+
+    Only the slots with both ends on a rim can match: those alone are keyed and looked up (issue 25, soup17: all
+    3m were, by :func:`~.edges.edge_keys`), in slot order, so the slots found and their rim edges are the ones a
+    lookup of every slot finds."""
+    nv = np.int64(max(n, 1))
+    e = np.asarray(edges, dtype=np.int64)
+    rim_key = np.minimum(e[:, 0], e[:, 1]) * nv + np.maximum(e[:, 0], e[:, 1])
+    order = np.argsort(rim_key, kind="stable")
+    sorted_rim = rim_key[order]
+    on_rim = np.zeros(n, dtype=bool)
+    on_rim[e.reshape(-1)] = True
+    start, end = f.reshape(-1), f[:, [1, 2, 0]].reshape(-1)
+    candidate = np.flatnonzero(on_rim[start] & on_rim[end])
+    a_end, b_end = start[candidate].astype(np.int64), end[candidate].astype(np.int64)
+    key = np.minimum(a_end, b_end) * nv + np.maximum(a_end, b_end)      # edge_keys' key of each slot
+    pos = np.searchsorted(sorted_rim, key)
+    hit = np.flatnonzero((pos < len(sorted_rim)) & (sorted_rim[np.minimum(pos, len(sorted_rim) - 1)] == key))
+    found: np.ndarray = order[pos[hit]]
+    return candidate[hit], found
+
+
 def _ring_face_of_edges(f: np.ndarray, n: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each directed edge ``a→b`` of ``edges``, the lowest-numbered face of ``f`` holding it in that direction
     and whether there is one: ``(face, found)``, (k,) int and bool (face 0 where none).
@@ -252,8 +270,7 @@ def _ring_face_of_edges(f: np.ndarray, n: int, edges: np.ndarray) -> tuple[np.nd
     directed = start[slot] * nv + end[slot]
     if not len(slot):
         return np.zeros(len(e), dtype=np.int64), np.zeros(len(e), dtype=bool)
-    order = np.argsort(directed, kind="stable")
-    ranked = directed[order]
+    ranked, order = stable_key_order(directed)
     pos = np.minimum(np.searchsorted(ranked, query), len(order) - 1)
     found = ranked[pos] == query
     face = np.where(found, slot[order[pos]] // 3, 0)
@@ -322,9 +339,7 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
     g, unit, least, size = _vertex_flatness(v, f)
     # a face of a flat *face of the part*: it shares an edge with a face in its plane (a lone triangle of a
     # curved surface is flat trivially and proves nothing)
-    key, _ = edge_keys(g, n)
-    order = np.argsort(key, kind="stable")
-    key = key[order]
+    key, order = stable_key_order(edge_keys(g, n)[0])
     same = key[1:] == key[:-1]
     del key                                       # (the peak of a hole's bounds: temporaries freed on the way)
     first, second = order[:-1][same] // 3, order[1:][same] // 3

@@ -359,7 +359,13 @@ def _swept_faces(vertices: np.ndarray, faces: np.ndarray,
         f, d = f[hit], d[hit]
         tri = vertices[f]
         ab, ac, bc = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], tri[:, 2] - tri[:, 1]
-        area = 0.5 * np.linalg.norm(np.cross(ab, ac), axis=1)
+        # ab × ac as numpy.cross forms it (each product, then the difference), bit for bit, without its axis
+        # shuffling (issue 25, soup17)
+        normal = np.empty_like(ab)
+        for axis, (p, q) in enumerate(((1, 2), (2, 0), (0, 1))):
+            np.multiply(ab[:, p], ac[:, q], out=normal[:, axis])
+            normal[:, axis] -= ab[:, q] * ac[:, p]
+        area = 0.5 * np.linalg.norm(normal, axis=1)
         perimeter = np.linalg.norm(ab, axis=1) + np.linalg.norm(ac, axis=1) + np.linalg.norm(bc, axis=1)
         total += 3.0 * float(np.sum(2.0 * d * area + 0.5 * math.pi * d * d * perimeter
                                     + 4.0 / 3.0 * math.pi * d ** 3))
