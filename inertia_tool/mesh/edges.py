@@ -57,7 +57,20 @@ def stable_key_order(key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     (``key · k + i``: distinct, so any sort gives the stable order) and sorted by value (issue 25, soup17: the
     3.6M edge slots of the scattered-holes sphere, 0.45 → 0.12 s CPU).  For the stages that pair the
     uses of each key (a key of :func:`edge_keys`, below ``n²``); the stable argsort where the packed key
-    would not fit 63 bits."""
+    would not fit 63 bits.
+
+    Parameters
+    ----------
+    key : (k,) int64
+        Non-negative keys (a negative one: the stable argsort).
+
+    Returns
+    -------
+    sorted_key : (k,) int64
+        ``key[order]``.
+    order : (k,) int64
+        ``numpy.argsort(key, kind="stable")``.
+    """
     k = len(key)
     if not k or (int(key.max()) + 1) * k > np.iinfo(np.int64).max or int(key.min()) < 0:
         order = np.argsort(key, kind="stable")

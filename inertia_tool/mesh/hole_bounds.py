@@ -1000,7 +1000,25 @@ def rim_fans(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: 
              apex: np.ndarray) -> RimFans:
     """The :class:`RimFans` of the loops ``label`` (k,) of the boundary edges ``edges`` (k, 2) ``a → b``, apexes
     ``apex`` (n_loops, 3) m: pass it to :func:`level_rings` and :func:`bend_doubt_volumes` (``fans=``), which
-    otherwise each compute it (issue 25: twice 0.5 s on a 1.3M-face sphere with 60,574 holes)."""
+    otherwise each compute it (issue 25: twice 0.5 s on a 1.3M-face sphere with 60,574 holes).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        m.
+    faces : (m, 3) int
+    edges : (k, 2) int
+        Boundary edges ``a → b``.
+    label : (k,) int
+        The loop of each edge, below ``n_loops``.
+    n_loops : int
+    apex : (n_loops, 3) float
+        m: each loop's cone apex.
+
+    Returns
+    -------
+    RimFans
+    """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     e = np.asarray(edges, dtype=np.int64)

@@ -316,6 +316,7 @@ def weld_sweep(vertices: np.ndarray, faces: np.ndarray, welded_faces: np.ndarray
         block = moved[start:start + _CHUNK]
         step = v[block] - v[rep[block]]              # (formed once: the same products; issue 25)
         move[block] = np.sqrt(np.einsum("ij,ij->i", step, step))
+        del step                                      # (not kept through the sweeps below: the peak is there)
     move *= 1.0 + 1e-12                               # the norms' rounding (a few ulp), covered
     largest = float(move.max())
     if not largest > 0:
