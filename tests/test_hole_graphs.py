@@ -156,3 +156,33 @@ def test_large_holes_round_the_curvature_or_a_corner_are_graphs_within_one_perce
     assert est.uncertainty.mass <= ESTIMATE_MAX_MASS_RTOL
     assert abs(est.volume - truth.volume) <= 0.01 * truth.volume
     assert _holds(est, truth)
+
+
+@settings(max_examples=12, deadline=None)
+@given(kind=st.sampled_from(KINDS), seed=st.integers(0, 2 ** 31 - 1), holes=st.integers(1, 4))
+def test_graph_fills_read_only_the_faces_near_the_rims_and_give_what_every_face_gives(kind, seed, holes):
+    """``graph_fills`` reads only the faces within two rings of the rims it tries (issue 25, soup17: three passes
+    over every face per loop before): on generated solids less 1-4 patches, every fill (points, triangles, doubt,
+    height, direction, slope) is the one it gives when handed every face as the faces near the rims (the old
+    reading), bit for bit."""
+    import inertia_tool.mesh.hole_graphs as hg
+    from inertia_tool.mesh.rims import boundary_edges, boundary_loops
+
+    rng = np.random.default_rng([seed, 6])
+    v, f = _solid(kind, rng)
+    gone = np.unique(np.concatenate([_grow(f, int(rng.integers(len(f))), max(1, int(rng.uniform(0.01, 0.08)
+                                                                                          * len(f))))
+                                     for _ in range(holes)]))
+    kept = np.delete(f, gone, axis=0)
+    edges = boundary_edges(kept, len(v))
+    label, n_loops = boundary_loops(edges, len(v), kept, v)
+    apex = np.stack([np.bincount(label, weights=v[edges[:, 0], i], minlength=n_loops) for i in range(3)], axis=1)
+    apex /= np.maximum(np.bincount(label, minlength=n_loops), 1)[:, None]
+    loops = np.argsort(-np.bincount(label, minlength=n_loops), kind="stable")
+    fast = hg.graph_fills(v, kept, edges, label, loops, apex)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(hg, "_faces_near", lambda faces, n, rims: faces)
+        every = hg.graph_fills(v, kept, edges, label, loops, apex)
+    assert len(fast) == len(every)
+    for one, other in zip(fast, every):
+        assert one == other

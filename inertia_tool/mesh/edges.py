@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["edge_keys"]
+__all__ = ["edge_keys", "stable_key_order"]
 
 
 def edge_keys(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
@@ -49,3 +49,34 @@ def edge_keys(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarra
     key *= np.int64(max(int(n_vertices), 1))
     key += b
     return key, forward
+
+
+def stable_key_order(key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``key`` (k,) non-negative int64 sorted and the stable order that sorts it: ``(key[order], order)`` with
+    ``order = numpy.argsort(key, kind="stable")``, bit for bit.  Each key packed with its position into one int64
+    (``key · k + i``: distinct, so any sort gives the stable order) and sorted by value (issue 25, soup17: the
+    3.6M edge slots of the scattered-holes sphere, 0.45 → 0.12 s CPU).  For the stages that pair the
+    uses of each key (a key of :func:`edge_keys`, below ``n²``); the stable argsort where the packed key
+    would not fit 63 bits.
+
+    Parameters
+    ----------
+    key : (k,) int64
+        Non-negative keys (a negative one: the stable argsort).
+
+    Returns
+    -------
+    sorted_key : (k,) int64
+        ``key[order]``.
+    order : (k,) int64
+        ``numpy.argsort(key, kind="stable")``.
+    """
+    k = len(key)
+    if not k or (int(key.max()) + 1) * k > np.iinfo(np.int64).max or int(key.min()) < 0:
+        order = np.argsort(key, kind="stable")
+        return key[order], order
+    slots = np.int64(k)
+    packed = key * slots
+    packed += np.arange(k, dtype=np.int64)
+    packed.sort()
+    return packed // slots, packed % slots

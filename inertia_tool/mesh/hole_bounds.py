@@ -15,7 +15,7 @@ import numpy as np
 
 from ..rounding import round_up
 from ..values import frozen_value
-from .edges import edge_keys
+from .edges import edge_keys, stable_key_order
 
 
 def ball_slab_volume(radius: np.ndarray, offset: np.ndarray, half_width: np.ndarray) -> np.ndarray:
@@ -77,20 +77,13 @@ def hole_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     v = np.asarray(vertices, dtype=np.float64)
     ball: np.ndarray = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=np.float64) ** 3
     n = len(v)
-    nv = np.int64(max(n, 1))
-    key, _ = edge_keys(faces, n)
-    rim_key = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * nv + np.maximum(edges[:, 0], edges[:, 1])
-    order = np.argsort(rim_key, kind="stable")
-    sorted_rim = rim_key[order]
-    pos = np.searchsorted(sorted_rim, key)
-    hit = (pos < len(sorted_rim)) & (sorted_rim[np.minimum(pos, len(sorted_rim) - 1)] == key)
-    slot = np.flatnonzero(hit)
+    slot, rim_edge = _rim_edge_slots(np.asarray(faces), n, edges)
     if not len(slot):
         return ball
     ring_face = slot // 3
-    ring_loop = label[order[pos[slot]]]
+    ring_loop = label[rim_edge]
     # one (face, loop) pair per ring face of each loop
-    pair = np.unique(np.stack([ring_face, ring_loop], axis=1), axis=0)
+    pair = _sorted_pairs(ring_face, ring_loop, n_loops)      # (numpy.unique(axis=0)'s rows, by one int64 key)
     ring_face, ring_loop = pair[:, 0], pair[:, 1]
     a, b, c = (v[faces[ring_face, k]] for k in range(3))
     normal = np.cross(b - a, c - a)
@@ -235,6 +228,31 @@ def rim_evidence(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, lab
     return RimEvidence(flat_all_round=flat, bare=count)
 
 
+def _rim_edge_slots(f: np.ndarray, n: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The face edge slots (slot ``3i + j``: ``f[i, j] → f[i, j+1]``, either direction) that are a rim edge of
+    ``edges`` (k, 2), ascending, and for each the first rim edge (in a stable sort of the rim's keys) with its
+    key: ``(slot, rim_edge)``, int.
+
+    Only the slots with both ends on a rim can match: those alone are keyed and looked up (issue 25, soup17: all
+    3m were, by :func:`~.edges.edge_keys`), in slot order, so the slots found and their rim edges are the ones a
+    lookup of every slot finds."""
+    nv = np.int64(max(n, 1))
+    e = np.asarray(edges, dtype=np.int64)
+    rim_key = np.minimum(e[:, 0], e[:, 1]) * nv + np.maximum(e[:, 0], e[:, 1])
+    order = np.argsort(rim_key, kind="stable")
+    sorted_rim = rim_key[order]
+    on_rim = np.zeros(n, dtype=bool)
+    on_rim[e.reshape(-1)] = True
+    start, end = f.reshape(-1), f[:, [1, 2, 0]].reshape(-1)
+    candidate = np.flatnonzero(on_rim[start] & on_rim[end])
+    a_end, b_end = start[candidate].astype(np.int64), end[candidate].astype(np.int64)
+    key = np.minimum(a_end, b_end) * nv + np.maximum(a_end, b_end)      # edge_keys' key of each slot
+    pos = np.searchsorted(sorted_rim, key)
+    hit = np.flatnonzero((pos < len(sorted_rim)) & (sorted_rim[np.minimum(pos, len(sorted_rim) - 1)] == key))
+    found: np.ndarray = order[pos[hit]]
+    return candidate[hit], found
+
+
 def _ring_face_of_edges(f: np.ndarray, n: int, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each directed edge ``a→b`` of ``edges``, the lowest-numbered face of ``f`` holding it in that direction
     and whether there is one: ``(face, found)``, (k,) int and bool (face 0 where none).
@@ -252,8 +270,7 @@ def _ring_face_of_edges(f: np.ndarray, n: int, edges: np.ndarray) -> tuple[np.nd
     directed = start[slot] * nv + end[slot]
     if not len(slot):
         return np.zeros(len(e), dtype=np.int64), np.zeros(len(e), dtype=bool)
-    order = np.argsort(directed, kind="stable")
-    ranked = directed[order]
+    ranked, order = stable_key_order(directed)
     pos = np.minimum(np.searchsorted(ranked, query), len(order) - 1)
     found = ranked[pos] == query
     face = np.where(found, slot[order[pos]] // 3, 0)
@@ -263,7 +280,8 @@ def _ring_face_of_edges(f: np.ndarray, n: int, edges: np.ndarray) -> tuple[np.nd
 def _sorted_pairs(vertex: np.ndarray, loop: np.ndarray, n_loops: int) -> np.ndarray:
     """The distinct rows (vertex, loop) in lexicographic order, (k, 2) int64, as ``numpy.unique(axis=0)`` gives
     them (by a sort of one int64 key per row: sorting the rows as a void dtype was 0.34 s of the scattered sphere's
-    1.0 s)."""
+    1.0 s).  Any pair of non-negative int columns whose second is below ``n_loops`` (the key's width): also the
+    (face, loop) and (loop, vertex) rows of the hole bounds (issue 25, soup17)."""
     width = np.int64(max(n_loops, 1))
     key = np.sort(np.asarray(vertex, dtype=np.int64) * width + np.asarray(loop, dtype=np.int64))
     key = key[np.r_[True, key[1:] != key[:-1]]] if len(key) else key    # (numpy's hash-based unique: 0.14 s)
@@ -321,9 +339,7 @@ def bare_vertices(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, *,
     g, unit, least, size = _vertex_flatness(v, f)
     # a face of a flat *face of the part*: it shares an edge with a face in its plane (a lone triangle of a
     # curved surface is flat trivially and proves nothing)
-    key, _ = edge_keys(g, n)
-    order = np.argsort(key, kind="stable")
-    key = key[order]
+    key, order = stable_key_order(edge_keys(g, n)[0])
     same = key[1:] == key[:-1]
     del key                                       # (the peak of a hole's bounds: temporaries freed on the way)
     first, second = order[:-1][same] // 3, order[1:][same] // 3
@@ -389,7 +405,7 @@ def slab_contradicted(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray
         return out
     e = np.asarray(edges, dtype=np.int64)
     # (rim vertex, loop) pairs of the flat rims, sorted by vertex; each face at such a vertex, once per pair
-    pairs = np.unique(np.stack([e.reshape(-1), np.repeat(label, 2)], axis=1), axis=0)
+    pairs = _sorted_pairs(e.reshape(-1), np.repeat(label, 2), n_loops)
     pairs = pairs[flat[pairs[:, 1]]]
     first = np.searchsorted(pairs[:, 0], np.arange(n))
     count = np.bincount(pairs[:, 0], minlength=n)
@@ -924,7 +940,7 @@ def _rim_planes(v: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: in
     (n_loops,), their centroid ``c̄`` (n_loops, 3) m, the unit eigenvector of the least eigenvalue of
     ``Σ (x − c̄)(x − c̄)ᵀ`` (n_loops, 3), the largest distance of a rim vertex from the plane (n_loops,) m, the
     largest distance from ``c̄`` (n_loops,) m, and each (loop, vertex) pair's offset from its ``c̄``."""
-    pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
+    pairs = _sorted_pairs(np.repeat(label, 2), edges.reshape(-1), len(v))    # (numpy.unique(axis=0)'s rows)
     loop_of, vertex_of = pairs[:, 0], pairs[:, 1]
     count = np.bincount(loop_of, minlength=n_loops).astype(np.float64)
     mean: np.ndarray = np.stack([np.bincount(loop_of, weights=v[vertex_of, i], minlength=n_loops) for i in range(3)],
@@ -947,6 +963,66 @@ def _rim_planes(v: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: in
 #: :func:`bend_doubt_volumes` no slope to bound (the missing surface may fold over itself): that hole keeps the
 #: other bounds.
 BEND_MAX_DEGREES = 80.0
+
+
+@frozen_value
+class RimFans:
+    """Each rim's fan and the steepest face touching it, as :func:`level_rings` and :func:`bend_doubt_volumes`
+    read them (:func:`rim_fans`: computed once for both, the same arrays either way).
+
+    Attributes
+    ----------
+    apex_of_edge : (k, 3) float
+        m: per boundary edge ``a → b``, its loop's apex ``c``.
+    to_a, to_b : (k, 3) float
+        m: ``a − c`` and ``b − c``.
+    has_normal : (n_loops,) bool
+        The fan's area vector ``Σ (a − c) × (b − c)`` is non-zero.
+    normal : (n_loops, 3) float
+        Its unit (0 where ``has_normal`` is False).
+    star : (n_loops,) bool
+        The fan projected onto the plane ⟂ ``normal`` is star-shaped round ``c`` (one full turn, none backward).
+    least : (n_loops,) float
+        The least cosine between ``normal`` and the normal of a face touching the rim at a rim vertex (``inf``
+        where none; negative for a face facing against the fan).
+    """
+
+    apex_of_edge: np.ndarray
+    to_a: np.ndarray
+    to_b: np.ndarray
+    has_normal: np.ndarray
+    normal: np.ndarray
+    star: np.ndarray
+    least: np.ndarray
+
+
+def rim_fans(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
+             apex: np.ndarray) -> RimFans:
+    """The :class:`RimFans` of the loops ``label`` (k,) of the boundary edges ``edges`` (k, 2) ``a → b``, apexes
+    ``apex`` (n_loops, 3) m: pass it to :func:`level_rings` and :func:`bend_doubt_volumes` (``fans=``), which
+    otherwise each compute it (issue 25: twice 0.5 s on a 1.3M-face sphere with 60,574 holes).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+        m.
+    faces : (m, 3) int
+    edges : (k, 2) int
+        Boundary edges ``a → b``.
+    label : (k,) int
+        The loop of each edge, below ``n_loops``.
+    n_loops : int
+    apex : (n_loops, 3) float
+        m: each loop's cone apex.
+
+    Returns
+    -------
+    RimFans
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    e = np.asarray(edges, dtype=np.int64)
+    return RimFans(*_fan_and_ring(v, f, e, np.asarray(label, dtype=np.int64), n_loops, np.asarray(apex)))
 
 
 def _fan_and_ring(v: np.ndarray, f: np.ndarray, e: np.ndarray, label: np.ndarray, n_loops: int, apex: np.ndarray
@@ -997,27 +1073,32 @@ def _fan_and_ring(v: np.ndarray, f: np.ndarray, e: np.ndarray, label: np.ndarray
 
 
 def level_rings(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray, n_loops: int,
-                apex: np.ndarray, *, level_cosine: float = LEVEL_RING_COSINE) -> np.ndarray:
+                apex: np.ndarray, *, level_cosine: float = LEVEL_RING_COSINE, fans: RimFans | None = None
+                ) -> np.ndarray:
     """Holes whose every face touching the rim lies within ``acos(level_cosine)`` ≈ 1.1° of the rim's mean plane,
     (n_loops,) bool: a *level* ring (the rule of :func:`flat_islands`, which says why that is no evidence).
 
     The plane is the fan's (normal along ``Σ (a − c) × (b − c)`` over the rim edges ``a → b``, ``c`` the apex:
     the plane :func:`bend_doubt_volumes` measures slopes against), and the faces are those touching the rim at any
-    rim vertex, as there.  Parameters as :func:`bend_doubt_volumes`.
+    rim vertex, as there.  Parameters as :func:`bend_doubt_volumes` (``fans``: :func:`rim_fans` of the same
+    arguments, when the caller has it).
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     e = np.asarray(edges, dtype=np.int64)
     if not n_loops or not len(e) or not len(f):
         return np.zeros(n_loops, dtype=bool)
-    *_, ok, _, _, least = _fan_and_ring(v, f, e, label, n_loops, apex)
+    if fans is None:
+        fans = rim_fans(v, f, e, label, n_loops, apex)
+    ok, least = fans.has_normal, fans.least
     level: np.ndarray = ok & np.isfinite(least) & (least >= level_cosine)
     return level
 
 
 def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, label: np.ndarray,
                        n_loops: int, apex: np.ndarray, *, max_degrees: float = BEND_MAX_DEGREES,
-                       level_cosine: float = LEVEL_RING_COSINE) -> tuple[np.ndarray, np.ndarray]:
+                       level_cosine: float = LEVEL_RING_COSINE, fans: RimFans | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
     """Volume in doubt of each hole under the *bend* assumption, and how far its region reaches from the rim's
     mean plane: ``(doubt, height)``, (n_loops,) m³ and m, ``inf`` where the assumption cannot be applied.
 
@@ -1062,6 +1143,9 @@ def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
         ``BEND_MAX_DEGREES``.
     level_cosine : float
         ``LEVEL_RING_COSINE``: a ring whose every face has at least this cosine with ``n`` is level (no bound).
+    fans : RimFans, optional
+        :func:`rim_fans` of the same vertices, faces, edges, labels and apexes, when the caller has it (computed
+        here otherwise).
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
@@ -1071,7 +1155,9 @@ def bend_doubt_volumes(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarra
     if not n_loops or not len(e) or not len(f):
         return doubt, height
     margin = _round_off(v)
-    c, pa, pb, ok, normal, star, least = _fan_and_ring(v, f, e, label, n_loops, apex)
+    if fans is None:
+        fans = rim_fans(v, f, e, label, n_loops, apex)
+    pa, pb, normal, star, least = fans.to_a, fans.to_b, fans.normal, fans.star, fans.least
     nk = normal[label]
     ha, hb = np.einsum("ij,ij->i", pa, nk), np.einsum("ij,ij->i", pb, nk)
     ua, ub = pa - ha[:, None] * nk, pb - hb[:, None] * nk          # projections onto the plane, apex at 0

@@ -48,7 +48,7 @@ import numpy as np
 
 from ..values import frozen_value
 from .hole_bounds import BEND_MAX_DEGREES, _round_off
-from .hole_fills import QUADRIC_FIT_RTOL, _fitted_quadric, _quadric
+from .hole_fills import QUADRIC_FIT_RTOL, _faces_near, _fitted_quadric, _quadric
 from .polygons import ear_clip_2d
 
 __all__ = ["GraphFill", "graph_fills", "face_on_direction", "GRAPH_MAX_LOOPS", "GRAPH_MAX_RIM", "GRAPH_GRID"]
@@ -318,7 +318,15 @@ def graph_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, labe
     margin = _round_off(v)
     cos_max = float(np.cos(np.radians(max_degrees)))
     out: list[GraphFill] = []
-    for k in np.asarray(loops, dtype=np.int64)[:max_loops].tolist():
+    tried = np.asarray(loops, dtype=np.int64)[:max_loops]
+    # only the faces within two rings of a rim tried are read (issue 25: a 1.3M-face part made three passes over
+    # every face for each of up to 16 loops): every face touching a rim, and every face holding a vertex of one,
+    # lies in ``f_near``, which keeps the faces' order, so ``touching`` and ``near`` below are what the whole
+    # surface gives, bit for bit
+    sizes = np.bincount(label, minlength=int(tried.max(initial=-1)) + 1)
+    kept = tried[(sizes[tried] >= 4) & (sizes[tried] <= max_rim)] if len(tried) else tried
+    f_near = _faces_near(f, len(v), [edges[np.isin(label, kept)].reshape(-1)]) if len(kept) else f[:0]
+    for k in tried.tolist():
         raw = edges[label == k]
         if len(raw) < 4 or len(raw) > max_rim:
             continue
@@ -328,7 +336,7 @@ def graph_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, labe
         rim = np.array(walk, dtype=np.int64)
         on_rim = np.zeros(len(v), dtype=bool)
         on_rim[rim] = True
-        touching = f[on_rim[f].any(axis=1)]
+        touching = f_near[on_rim[f_near].any(axis=1)]
         normal = np.cross(v[touching[:, 1]] - v[touching[:, 0]], v[touching[:, 2]] - v[touching[:, 0]])
         size = np.linalg.norm(normal, axis=1)
         if not (size > 0).any():
@@ -400,7 +408,7 @@ def graph_fills(vertices: np.ndarray, faces: np.ndarray, edges: np.ndarray, labe
         if len(cand):
             near = on_rim.copy()
             for _ in range(2):
-                near[f[near[f].any(axis=1)].reshape(-1)] = True
+                near[f_near[near[f_near].any(axis=1)].reshape(-1)] = True
             radius = float(np.max(np.linalg.norm(rel, axis=1)))
             x = (v[near] - ref) / radius
             fit = _fitted_quadric(x, fit_rtol)

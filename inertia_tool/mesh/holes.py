@@ -58,7 +58,8 @@ from .hole_bounds import (CONVEX_ROUND_OFF as CONVEX_ROUND_OFF, CONVEX_WORK_LIMI
                           bend_doubt_volumes,
                           _round_off as _round_off, _vertex_flatness as _vertex_flatness, ball_slab_volume,
                           bare_vertices, convex_hole_bound, flat_island_doubt, flat_islands, hole_doubt_volumes,
-                          inner_face_vertices, level_rings, planar_rim_doubt, rim_evidence, slab_contradicted,
+                          inner_face_vertices, level_rings, planar_rim_doubt, rim_evidence, rim_fans,
+                          slab_contradicted,
                           smooth_doubt)
 from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES as CREASE_MAX_PLANES,
                          CREASE_SCREEN_PAIRS as CREASE_SCREEN_PAIRS, CURVED_FILL_LEVELS as CURVED_FILL_LEVELS,
@@ -153,7 +154,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # an island in a flat face: its flatness is the only evidence of a flat missing surface, which no more
         # than a dome taken whole with a flat ring round it leaves (flat_islands): every narrower reading is
         # withdrawn, the uncut ball over the rim bounds it
-        island = flat_islands(evidence, level_rings(v, f, edges, label, n_loops, apex))
+        fans = rim_fans(v, f, edges, label, n_loops, apex)     # read by level_rings and bend_doubt_volumes
+        island = flat_islands(evidence, level_rings(v, f, edges, label, n_loops, apex, fans=fans))
         withdrawn |= island
         # unless the user states that such holes lost a flat piece of the face (FLAT_ISLANDS, opt-in): then each
         # is filled in its rim's plane (the cone, in the rim's hull) and bounded by the ball cut to the slab of
@@ -333,7 +335,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # is the fill (a crease fill or a bent fill is not a graph the bound knows)
         bent = np.zeros(n_loops, dtype=bool)
         bent[[bend.loop for bend in curved]] = True
-        bend_doubt, bend_height = bend_doubt_volumes(v, f, edges, label, n_loops, apex)
+        bend_doubt, bend_height = bend_doubt_volumes(v, f, edges, label, n_loops, apex, fans=fans)
         took_bend = ~engulfed & ~island & ~crossed & ~bent & (bend_doubt < hole_doubt)
         before_bend = float(np.sum(hole_doubt))
         hole_doubt = np.where(took_bend, bend_doubt, hole_doubt)

@@ -314,7 +314,9 @@ def weld_sweep(vertices: np.ndarray, faces: np.ndarray, welded_faces: np.ndarray
     move = np.zeros(len(v))
     for start in range(0, len(moved), _CHUNK):       # in blocks: a welded soup moves millions of corners
         block = moved[start:start + _CHUNK]
-        move[block] = np.sqrt(np.einsum("ij,ij->i", v[block] - v[rep[block]], v[block] - v[rep[block]]))
+        step = v[block] - v[rep[block]]              # (formed once: the same products; issue 25)
+        move[block] = np.sqrt(np.einsum("ij,ij->i", step, step))
+        del step                                      # (not kept through the sweeps below: the peak is there)
     move *= 1.0 + 1e-12                               # the norms' rounding (a few ulp), covered
     largest = float(move.max())
     if not largest > 0:
@@ -358,7 +360,13 @@ def _swept_faces(vertices: np.ndarray, faces: np.ndarray,
         f, d = f[hit], d[hit]
         tri = vertices[f]
         ab, ac, bc = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], tri[:, 2] - tri[:, 1]
-        area = 0.5 * np.linalg.norm(np.cross(ab, ac), axis=1)
+        # ab × ac as numpy.cross forms it (each product, then the difference), bit for bit, without its axis
+        # shuffling (issue 25, soup17)
+        normal = np.empty_like(ab)
+        for axis, (p, q) in enumerate(((1, 2), (2, 0), (0, 1))):
+            np.multiply(ab[:, p], ac[:, q], out=normal[:, axis])
+            normal[:, axis] -= ab[:, q] * ac[:, p]
+        area = 0.5 * np.linalg.norm(normal, axis=1)
         perimeter = np.linalg.norm(ab, axis=1) + np.linalg.norm(ac, axis=1) + np.linalg.norm(bc, axis=1)
         total += 3.0 * float(np.sum(2.0 * d * area + 0.5 * math.pi * d * d * perimeter
                                     + 4.0 / 3.0 * math.pi * d ** 3))

@@ -240,12 +240,15 @@ def enclosing_balls(points: np.ndarray, group: np.ndarray, n_groups: int, *, ite
         c = centre[big]
         index = np.arange(len(q))
         for k in range(1, iterations + 1):
-            d = np.einsum("ij,ij->i", q - c[local], q - c[local])
+            # (the difference formed once: the same products, a third less work per step; issue 25)
+            diff = q - c[local]
+            d = np.einsum("ij,ij->i", diff, diff)
             top = np.maximum.reduceat(d, local_starts)
             far = np.minimum.reduceat(np.where(d >= top[local], index, len(q)), local_starts)
             c = c + (q[far] - c) / (k + 1)
         centre[big] = c
-    radius = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", p - centre[g], p - centre[g]), starts))
+    rel = p - centre[g]
+    radius = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", rel, rel), starts))
     return centre, radius
 
 

@@ -38,7 +38,7 @@ import numpy as np
 
 from .._native import accel, threads
 from ..values import frozen_value
-from .edges import edge_keys
+from .edges import edge_keys, stable_key_order
 
 __all__ = ["Seal", "seal_seams", "parallel_body_volume", "drop_duplicate_faces", "on_edge_vertices"]
 
@@ -218,9 +218,7 @@ def _loose_faces(faces: np.ndarray, n: int, region: np.ndarray) -> int:
     balanced in the whole surface, so it is shared even if its other face is not in the frontier)."""
     if not len(faces):
         return 0
-    key, _ = edge_keys(faces, n)
-    order = np.argsort(key, kind="stable")
-    sk = key[order]
+    sk, order = stable_key_order(edge_keys(faces, n)[0])
     nn = np.int64(max(n, 1))
     single = region[sk // nn] | region[sk % nn]
     same = sk[1:] == sk[:-1]

@@ -96,7 +96,7 @@ import numpy as np
 
 from ..tolerances import MERGE_TOLERANCE, ROUNDOFF_RTOL, WALL_PLANE_RTOL
 from ..values import frozen_value
-from .edges import edge_keys
+from .edges import edge_keys, stable_key_order
 
 __all__ = ["OpenSheets", "open_sheets", "MAX_SHEET_PIECES"]
 
@@ -325,8 +325,7 @@ def _nothing_to_take(v: np.ndarray, f: np.ndarray, boundary: np.ndarray | None, 
     corner[f[rim_face].reshape(-1)] = True
     around = np.flatnonzero(corner[f].sum(axis=1) >= 2)              # every face using an edge of a rim face
     key, forward = edge_keys(f[around], n)
-    order = np.argsort(key, kind="stable")
-    sk = key[order]
+    sk, order = stable_key_order(key)
     starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
     count = np.diff(np.r_[starts, len(sk)])
     pair = starts[(count == 2) & (forward[order[starts]] != forward[order[np.minimum(starts + 1, len(sk) - 1)]])]
