@@ -140,14 +140,16 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
                                          within=_both(within, touch_within))
     # R4 (session 16): where a nest's own winding is a solid's (no region below 0), it stands: the shells with
     # winding ≥ 1 on both sides are left out and the rest read again (two nested outward boxes: the outer box)
-    stands = winding_stands(file_volumes, depth, nest, _both(within, touch_within), crossing_with, multiplicity) \
-        if touch.complete and not again else None
-    if stands is not None and stands.drop is not None:
-        kept_shells, kept_contacts = _without_shells(shells, contacts, stands.drop)
-        kept_touch = shell_contacts(kept_contacts, kept_shells.labels, kept_shells.n_shells)
-        left = None if multiplicity is None else np.asarray(multiplicity)[~stands.drop]
-        read = _orient_shells(kept_shells, kept_contacts, kept_touch, source=source, multiplicity=left, again=True)
-        return read._replace(interior=stands, contacts=read.contacts if read.contacts is not None else kept_contacts)
+    # (session 17: per nest, a nest none of whose shells crosses any shell, or a sub-nest inside a nest with
+    # crossings, the rest read by the other rules)
+    for inside_crossed in ((True, False) if touch.complete and not again else ()):
+        stands = winding_stands(file_volumes, depth, nest, _both(within, touch_within), crossing_with, multiplicity,
+                                inside_crossed=inside_crossed)
+        if stands is None or stands.drop is None:
+            break
+        read = _read_without(shells, contacts, stands, multiplicity, nest, _both(within, touch_within), source)
+        if read is not None:
+            return read
     misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
         if touch.complete else None                                                   # R4: the file does not decide
     groups = outward_crossing_groups(file_volumes, flip, depth, crossing_with) if touch.complete else None
@@ -250,6 +252,38 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
     crossing[crossing_with.reshape(-1)] = True
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
                        groups, by_winding, voids, multiplicity if by_winding else None, on_turn and by_winding)
+
+
+def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNesting, multiplicity: np.ndarray | None,
+                  nest: Nesting | None, within: np.ndarray | None, source: str) -> Orientation | None:
+    """:func:`orient_shells` of the shells :func:`~.policy.winding_stands` kept (``stands.drop`` left out), or None
+    when the other rules would turn a shell it kept inside a nest with crossings (its sub-nest's winding would then
+    not stand as decided: the caller asks again for the nests apart only).  The shells kept in the nests decided
+    count once in the winding (R0): their winding is 0 or 1 there."""
+    drop = np.asarray(stands.drop, dtype=bool)
+    kept_shells, kept_contacts = _without_shells(shells, contacts, drop)
+    kept_touch = shell_contacts(kept_contacts, kept_shells.labels, kept_shells.n_shells)
+    decided = _in_nests(stands.roots, nest, within, len(drop))
+    left = None
+    if multiplicity is not None:
+        k = np.where(decided, 1, np.asarray(multiplicity, dtype=np.int64))[~drop]
+        left = None if np.all(k == k[0]) else k
+    read = _orient_shells(kept_shells, kept_contacts, kept_touch, source=source, multiplicity=left, again=True)
+    if stands.others and np.asarray(read.flip)[decided[~drop]].any():
+        return None
+    return read._replace(interior=stands, contacts=read.contacts if read.contacts is not None else kept_contacts)
+
+
+def _in_nests(roots: np.ndarray | None, nest: Nesting | None, within: np.ndarray | None, n_shells: int) -> np.ndarray:
+    """(s,) bool: the shells ``roots`` and every shell inside one of them
+    (:func:`~.multiplicity.container_windings`)."""
+    out = np.zeros(n_shells, dtype=bool)
+    if roots is None or not len(roots):
+        return out
+    out[np.asarray(roots, dtype=np.int64)] = True
+    shell, other, _ = container_windings(np.ones(n_shells), nest, within)
+    out[shell[out[other]]] = True
+    return out
 
 
 def _without_shells(shells: Shells, contacts: SurfaceContacts, drop: np.ndarray) -> tuple[Shells, SurfaceContacts]:
