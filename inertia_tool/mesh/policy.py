@@ -1194,12 +1194,32 @@ def _depth_reading_message(found: MisreadNesting, volume: float | None, kept: st
     if kept is None:
         kept = "the file's winding is read as it stands (exact)"
     decide = f" The file does not decide; {kept}." if kept else " The file does not decide."
+    left = f"{dropped} shell{'s' if dropped > 1 else ''} with winding at least one on both sides left out"
+    if not n:           # R0's count decided it (a body listed twice round a cavity listed once): no shell misread
+        return (f"{left}, R0 counting each shell as often as it is listed (the solid is where the winding number is "
+                f"at least one, and no region's winding is below 0, so the file's winding stands: R4, no boolean); "
+                f"read by nesting depth, each shell counted once, the solid would be {other}.{_by_nest(found)}"
+                f"{decide} If a shell listed more than once is meant once, remove its copies")
     return (f"{n} shell{'s' if many else ''} wound outward lie{'' if many else 's'} wholly inside another body (free "
             f"inside it or flush with its boundary): read by the file's winding as part of the body (the solid is "
             f"where the winding number is at least one, and no region's winding is below 0, so the file's winding "
-            f"stands: R4), {dropped} shell{'s' if dropped > 1 else ''} with winding at least one on both sides left "
-            f"out; read by nesting depth as {'cavities' if many else 'a cavity'} written with the wrong winding "
-            f"(R4's reading where the winding is evidently wrong): {other}.{decide} If {role}, wind {them} inward")
+            f"stands: R4), {left}; read by nesting depth as {'cavities' if many else 'a cavity'} written with the "
+            f"wrong winding (R4's reading where the winding is evidently wrong): {other}.{_by_nest(found)}{decide} "
+            f"If {role}, wind {them} inward")
+
+
+def _by_nest(found: MisreadNesting) -> str:
+    """Which nests the file's winding decided and which the other rules read (session 17: " The file's winding
+    decided 1 nest (...); the other 27 shells, in nests with crossing shells, were read by the other rules (R4–R6),
+    ..."); "" when every shell was in a nest decided."""
+    if not found.others:
+        return ""
+    roots = 0 if found.roots is None else len(found.roots)
+    plural = "s" if roots != 1 else ""
+    rest = "s" if found.others != 1 else ""
+    return (f" The file's winding decided {roots} nest{plural} (outer shell{plural} crossing nothing, nothing "
+            f"inside crossing); the other {found.others} shell{rest}, in nests with crossing shells, were read by "
+            "the other rules (R4–R6), and the certificate is the weaker of the two")
 
 
 def coincident_message(found: Coincident, size: float = 0.0) -> str:
