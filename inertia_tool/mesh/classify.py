@@ -130,10 +130,12 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
     touch, nest, touch_within = settle_touching(v, f, labels, contacts, touch, nest)
     within, crossing_with = None, touch.crossing_with
     copies = np.zeros((0, 2), dtype=np.int64)
+    apart = (crossing_with, touch_within)
     if touch.complete:
         rounding = rounding_volumes(v, shells.moments)
         within, crossing_with = _within(v, f, labels, file_volumes, crossing_with, rounding)
         nest = _decide_past_partners(v, f, labels, n_shells, nest, crossing_with)
+        apart = (crossing_with, touch_within)          # nested copies not yet moved to the crossing pairs
         crossing_with, touch_within, copies = _copies_nested(file_volumes, nest, crossing_with, touch_within,
                                                              rounding)
     flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
@@ -142,14 +144,21 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
     # winding ≥ 1 on both sides are left out and the rest read again (two nested outward boxes: the outer box)
     # (session 17: per nest, a nest none of whose shells crosses any shell, or a sub-nest inside a nest with
     # crossings, the rest read by the other rules)
-    for inside_crossed in ((True, False) if touch.complete and not again else ()):
-        stands = winding_stands(file_volumes, depth, nest, _both(within, touch_within), crossing_with, multiplicity,
-                                inside_crossed=inside_crossed)
-        if stands is None or stands.drop is None:
-            break
-        read = _read_without(shells, contacts, stands, multiplicity, nest, _both(within, touch_within), source)
-        if read is not None:
-            return read
+    # Nested copies (a shell inside another wound alike, all but the rounding of its volume) are nested shells for
+    # it, not crossing ones: wound outward, the inner one has winding 1 and 2 on its sides and is left out, exact
+    # (before: united by the boolean, ``unverified``)
+    if touch.complete and not again:
+        s_cross, s_within = apart if len(copies) else (crossing_with, touch_within)
+        s_depth = orient_by_depth(file_volumes, nest, s_cross, within=_both(within, s_within))[2] if len(copies) \
+            else depth
+        for inside_crossed in (True, False):
+            stands = winding_stands(file_volumes, s_depth, nest, _both(within, s_within), s_cross, multiplicity,
+                                    inside_crossed=inside_crossed)
+            if stands is None or stands.drop is None:
+                break
+            read = _read_without(shells, contacts, stands, multiplicity, nest, _both(within, s_within), source)
+            if read is not None:
+                return read
     misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
         if touch.complete else None                                                   # R4: the file does not decide
     groups = outward_crossing_groups(file_volumes, flip, depth, crossing_with) if touch.complete else None

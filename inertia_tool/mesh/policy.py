@@ -23,9 +23,12 @@ R0 *A shell listed k times counts k times in the winding number* (:func:`~.multi
    counting a shell k times changes no region's side of 1 (:func:`~.multiplicity.multiplicity_changes`: checked
    inside every shell listed more than once), the copy left out is the whole answer and nothing else changes.
    Where the count does change ``{w ≥ 1}`` (a box listed twice flush inside a void: ``1 − 1 + 1`` in the file, 0
-   counted once; a body listed twice around a cavity listed once) the solid is formed by R4c, each piece counted k
-   times (:func:`~.union.winding_solid`), and refused when R4 turned a shell for its nesting depth (no one reading
-   then counts both).  Reason: a shell exported twice means the part once, and summed its volume would count twice;
+   counted once; a body listed twice around a cavity listed once) and the shells' nest crosses nothing with no
+   region below 0, the region windings with each count decide it without a boolean (R4, :func:`winding_stands`: the
+   body listed twice round a cavity listed once is the body, ``exact``, the cavity left out); elsewhere the solid is
+   formed by R4c, each piece counted k times (:func:`~.union.winding_solid`), and refused when R4 turned a shell for
+   its nesting depth (no one reading then counts both).
+   Reason: a shell exported twice means the part once, and summed its volume would count twice;
    the winding number is what the issue defines the solid by, and counting the copy keeps it where it decides.
    *Up to rounding* (:func:`near_copies`): a closed surface whose every corner lies within
    ``tolerances.COINCIDENT_RTOL`` of the largest |coordinate| of a corner of another, face for face with the same
@@ -112,8 +115,13 @@ R3b *A flat open sheet inside a solid encloses nothing* (:func:`~.sheets.open_sh
 R4 *Orientation by nesting depth, where the file's winding is evidently wrong* (:func:`orient_by_depth`,
    :func:`winding_stands`; session 16, the team's decision on issue 21).  The solid is where the winding number is
    at least one, so the file's own winding is read as it stands wherever it is a solid's: in a *nest* (a shell at
-   depth 0 and every shell inside it) with no shell crossing another, where every region has winding ``≥ 0``, no
-   shell is turned; the shells with winding ``≥ 1`` on both sides (a body wound outward wholly inside another, and
+   depth 0 and every shell inside it) none of whose shells crosses any shell, where every region has winding
+   ``≥ 0``, no shell is turned, whatever crosses elsewhere in the file (session 17; before, one crossing pair
+   anywhere kept the depth reading for every nest); so also in a *sub-nest* inside a nest with crossings (a shell
+   crossing nothing, with nothing inside it crossing, whose winding just outside is 0 or 1: the shells around it
+   crossing others or not), and the rest of the file is read by the rules below, the certificate the weaker of
+   the parts (the boolean's ``united`` where the rest is united; the note says how many nests went each way);
+   the shells with winding ``≥ 1`` on both sides (a body wound outward wholly inside another, and
    whatever lies inside it) bound nothing of ``{w ≥ 1}`` and are left out, and the rest, each with winding 0 on one
    side and 1 on the other, is integrated as wound: ``exact`` with the check ``interior-shells`` (no boolean; left
    out as R0's copies and R2's flat pieces are), its note naming the depth reading (a cavity written with the wrong
@@ -142,7 +150,8 @@ R4 *Orientation by nesting depth, where the file's winding is evidently wrong* (
    alike, each holding all but ``2·TOUCH_VOLUME_RTOL`` of the other's volume, are copies, not a body and its
    cavity, whether their surfaces cross (:func:`within_up_to_rounding`) or one lies inside the other without
    crossing or touching it (:func:`nested_copies`: a copy scaled by 1 + k ulp, review 10's D2); they go to the
-   boolean, whose union is the solid.  A shell the file
+   boolean, whose union is the solid, except where the file's winding stands (copies wound outward, one inside the
+   other: winding 1 and 2, the inner one left out, ``exact`` with ``interior-shells``; session 17).  A shell the file
    winds outward that depth makes a cavity (:func:`misread_nesting`) is a reading the file does not decide: its
    own winding number is 2 there, so ``{w ≥ 1}`` is the union of the bodies, and a cavity written with the wrong
    winding reads the same (the shells around it counted by their file winding at its probe point and, for a
