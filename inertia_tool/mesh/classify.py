@@ -267,8 +267,9 @@ def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNest
                   nest: Nesting | None, within: np.ndarray | None, source: str) -> Orientation | None:
     """:func:`orient_shells` of the shells :func:`~.policy.winding_stands` kept (``stands.drop`` left out), or None
     when the other rules would turn a shell it kept inside a nest with crossings (its sub-nest's winding would then
-    not stand as decided: the caller asks again for the nests apart only).  The shells kept in the nests decided
-    count once in the winding (R0): their winding is 0 or 1 there."""
+    not stand as decided: the caller asks again for the nests apart only; so also where they refuse the rest read
+    so, their warnings then not given).  The shells kept in the nests decided count once in the winding (R0): their
+    winding is 0 or 1 there."""
     drop = np.asarray(stands.drop, dtype=bool)
     kept_shells, kept_contacts = _without_shells(shells, contacts, drop)
     kept_touch = shell_contacts(kept_contacts, kept_shells.labels, kept_shells.n_shells)
@@ -277,9 +278,19 @@ def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNest
     if multiplicity is not None:
         k = np.where(decided, 1, np.asarray(multiplicity, dtype=np.int64))[~drop]
         left = None if np.all(k == k[0]) else k
-    read = _orient_shells(kept_shells, kept_contacts, kept_touch, source=source, multiplicity=left, again=True)
+    with warnings.catch_warnings(record=True) as said:      # said only if this reading is taken
+        warnings.simplefilter("always")
+        try:
+            read = _orient_shells(kept_shells, kept_contacts, kept_touch, source=source, multiplicity=left,
+                                  again=True)
+        except InvalidMeshError:
+            if stands.others:       # the other rules refuse the rest read so: ask again for the nests apart only
+                return None
+            raise
     if stands.others and np.asarray(read.flip)[decided[~drop]].any():
         return None
+    for found in said:
+        warnings.warn(found.message, stacklevel=4)
     return read._replace(interior=stands, contacts=read.contacts if read.contacts is not None else kept_contacts)
 
 
