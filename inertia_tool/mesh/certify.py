@@ -134,7 +134,8 @@ def _winding_stands(found: MisreadNesting, united: United, *, source: str) -> Un
     proven = united.forced is None and united.kind in ("exact", "united")
     volume = float(total(united.shells.moments).volume) if proven else None
     note = misread_message(found, volume, proven,
-                           kept=None if proven else "the solid given is not proven apart from that reading")
+                           kept=f"the file's winding is read as it stands ({united.kind})" if proven else
+                           "the solid given is not proven apart from that reading")
     warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=4)
     checks = list(united.checks)
     if proven and "interior-shells" not in checks:

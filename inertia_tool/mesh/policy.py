@@ -1228,7 +1228,7 @@ def _by_nest(found: MisreadNesting) -> str:
     rest = "s" if found.others != 1 else ""
     return (f" The file's winding decided {roots} nest{plural} (outer shell{plural} crossing nothing, nothing "
             f"inside crossing); the other {found.others} shell{rest}, in nests with crossing shells, were read by "
-            "the other rules (R4–R6), and the certificate is the weaker of the two")
+            "the other rules (R4–R6), and the certificate is the weaker of the two.")
 
 
 def coincident_message(found: Coincident, size: float = 0.0) -> str:
