@@ -294,3 +294,16 @@ def test_a_nest_inside_a_crossing_box_follows_the_stated_rule_where_it_stands(se
         diag = float(np.linalg.norm(np.ptp(_mesh(boxes)[0], axis=0)))
         truth = _moments(w >= 1)
         assert _matches(props, truth, diag), (certificate_label(props.mesh), props.mass, truth[0])
+
+
+def test_a_box_flush_with_its_container_on_five_faces_is_the_container():
+    """Both wound outward, the inner box sharing five of its faces' planes with the outer one: every probe of the
+    outer box lay on the inner one's surface, so it was undecided and the rule did not apply; R4 read the pair by
+    depth, ``exact`` 0.546875 m³ (the container less the box) where ``{w ≥ 1}`` is the container, 3.828125 m³
+    (found by session 17's judge beside a crossing pair).  Now the undecided shell is probed again without the shell
+    within it: the container, ``exact`` with ``interior-shells``."""
+    boxes = [(np.array([-10, -5, -6]), np.array([-3, 2, -1]), 1), (np.array([-10, -5, -6]), np.array([-3, 1, -1]), 1)]
+    _check(boxes)
+    props, _ = _answer(boxes)
+    assert certificate_label(props.mesh) == "exact"
+    assert abs(props.mass - 245 * H ** 3) <= 1e-12

@@ -134,7 +134,11 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
     if touch.complete:
         rounding = rounding_volumes(v, shells.moments)
         within, crossing_with = _within(v, f, labels, file_volumes, crossing_with, rounding)
-        nest = _decide_past_partners(v, f, labels, n_shells, nest, crossing_with)
+        # R4: a shell left undecided because its probes lay on a shell it touches from inside or outside (a box
+        # flush with its container on five faces) is probed again without that shell, as past crossing partners
+        nest = _decide_past_partners(v, f, labels, n_shells, nest, np.concatenate(
+            [np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2), within.reshape(-1, 2),
+             np.asarray(touch_within, dtype=np.int64).reshape(-1, 2)]))
         apart = (crossing_with, touch_within)          # nested copies not yet moved to the crossing pairs
         crossing_with, touch_within, copies = _copies_nested(file_volumes, nest, crossing_with, touch_within,
                                                              rounding)
@@ -537,7 +541,11 @@ def _decide_past_partners(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_sh
     """R4: shells left undecided because every probe lay on the surface of a shell they cross (a copy listed twice,
     its coordinates rounded apart) probed again with those shells left out.  Their depth never counts the shells
     they cross (:func:`~.policy.orient_by_depth`), so those surfaces need not be kept clear of; the winding numbers
-    of the others at the new probe are added to ``nest`` and the shell is decided."""
+    of the others at the new probe are added to ``nest`` and the shell is decided.  So also past a shell it lies
+    within, or that lies within it, up to touching (``crossing_with`` then holds those ``(shell, container)`` pairs
+    too; session 17: a box flush inside another on five faces left the outer one undecided, and R4 read the pair by
+    depth, ``exact`` 0.55 m³ where the file's winding gives the outer box, 3.83): a shell within another is none of
+    its containers, and the pair's own relation is kept by those pairs."""
     pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
     if nest is None or not len(pairs) or not np.asarray(nest.undecided).any():
         return nest
