@@ -134,3 +134,23 @@ def test_a_far_box_and_its_copy_moved_by_rounding_give_the_union(seed):
         except InvalidMeshError:
             return
     assert props.mass == pytest.approx(truth, rel=1e-9 + slack), (seed, props.mesh.certificate, props.mesh.notes)
+
+
+@pytest.mark.parametrize("scale", [1 - 1e-12, 1 - 64 * 2.0 ** -52])
+def test_a_copy_nested_inside_its_original_wound_outward_is_exact(scale):
+    """Session 17 (the open item "nested copies `exact`"): a copy scaled about the centroid inside its original, both
+    wound outward, has winding 1 between them and 2 inside the copy, so the file's winding stands (R4,
+    ``policy.winding_stands``): the copy is left out and the original is the solid, ``exact`` with
+    ``interior-shells``, its summed integral to round-off (before: the boolean's union, ``unverified``)."""
+    v, f = icosphere(1.0, 2)
+    v, f = np.asarray(v, dtype=np.float64), np.asarray(f, dtype=np.int64)
+    centre = v.mean(axis=0)
+    inner = (v - centre) * scale + centre
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        props = mass_properties((np.vstack([v, inner]), np.vstack([f, f + len(v)])), density=1.0)
+    alone = volume_moments(v, f)
+    assert props.mesh.certificate.kind == "exact", props.mesh.certificate
+    assert "interior-shells" in props.mesh.certificate.checks
+    assert props.volume == pytest.approx(alone.volume, rel=1e-12)
+    assert np.allclose(props.center_of_mass, alone.centroid, rtol=0, atol=1e-12)

@@ -12,6 +12,12 @@ proven, ``exact`` (``united`` where a cavity kept is flush with its body's face:
 ``interior-shells`` (the shells with winding at least one on both sides left out), and its warning must give the
 depth reading's volume exactly (six digits).  Before session 16, two nested boxes wound outward were the parity
 solid, ``exact``.
+
+Session 17 (nest17): the rule per nest.  A nest none of whose shells crosses any shell is decided by the rule even
+where other shells of the file cross (before, one crossing pair anywhere kept the depth reading for every nest); the
+answer's certificate is the weaker of its parts (a crossing pair united: ``united``).  R0's count with the region
+windings decides a body listed twice round a cavity listed once without a boolean (``exact``), and a forced
+estimate after a refused boolean names the shells left out.
 """
 
 from __future__ import annotations
@@ -28,7 +34,7 @@ from adversary_solids import concat as join
 from adversary_solids import flipped as turned_over
 from inertia_tool import mass_properties
 from inertia_tool.errors import InvalidMeshError
-from test_mesh_kept_cavities import H, _by_rule, _mesh, _moments
+from test_mesh_kept_cavities import H, _by_rule, _mesh, _moments, _winding
 
 
 def _children(rng, lo, hi, depth, boxes):
@@ -167,4 +173,137 @@ def test_a_body_listed_twice_around_a_cavity_listed_once_is_never_the_cavity_cut
         warnings.simplefilter("ignore")
         props = mass_properties((v, f), density=1.0)
     assert abs(props.mass - 8.0) <= 1e-9 * 8.0, (props.mass, props.mesh.certificate)
-    assert certificate_label(props.mesh) in ("exact", "united", "unverified")
+    # session 17: R0's count and the region windings decide it with no crossing anywhere: exact, no boolean (before:
+    # the boolean's union, ``unverified``)
+    assert certificate_label(props.mesh) == "exact", props.mesh.certificate
+    assert "interior-shells" in props.mesh.certificate.checks
+    assert any("7.875 m³, 1.56 % less mass" in n for n in props.mesh.notes), props.mesh.notes
+
+
+def _crossing_pair(rng):
+    """Two boxes wound outward whose faces cross (at x ≥ 3, apart from the nest of :func:`_nest_apart`)."""
+    lo = np.array([3, -6, -6]) + rng.integers(0, 2, size=3)
+    hi = lo + rng.integers(3, 6, size=3)
+    shift = np.array([int(rng.integers(1, hi[0] - lo[0])), int(rng.integers(1, 3)), int(rng.integers(-2, 0))])
+    return [(lo, hi, 1), (lo + shift, hi + shift, 1)]
+
+
+def _nest_apart(rng):
+    """One nest at x < 0 (a box with boxes inside it to depth 3, free or flush, each wound either way)."""
+    lo = np.array([-11, -6, -6]) + rng.integers(0, 2, size=3)
+    hi = lo + rng.integers(4, 9, size=3)
+    boxes = [(lo, hi, 1 if rng.random() < 0.7 else -1)]
+    _children(rng, lo, hi, 1, boxes)
+    return boxes
+
+
+def _check_beside_crossing(boxes, n_nest):
+    """The stated rule beside a crossing pair (``boxes[n_nest:]``): the answer is ``{w ≥ 1}`` where the nest stands,
+    its depth reading where it does not (by exact cell counts, :func:`_by_rule`); where the nest stands and depth
+    would misread an outward box, ``united`` (the crossing pair's union: the weaker part) with ``interior-shells``,
+    and the warning names the depth reading of the nest, the crossing pair as given, exactly."""
+    solid, parity, stands, misread = _by_rule(boxes)
+    nest_cells = _winding(boxes[:1], [1]) > 0
+    props, said = _answer(boxes)
+    if stands and misread:
+        assert props is not None, "refused where the nest's winding stands"
+        assert certificate_label(props.mesh) == "united", props.mesh.certificate
+        assert "interior-shells" in props.mesh.certificate.checks
+        named = [re.search(r"read by nesting depth as [^:]*: ([0-9.eE+-]+) m³", s) for s in said]
+        named = [float(m.group(1)) for m in named if m]
+        depth_volume = float(np.count_nonzero(solid & ~nest_cells) + np.count_nonzero(parity & nest_cells)) * H ** 3
+        assert named and all(abs(x - depth_volume) <= 1e-5 * depth_volume for x in named), (named, depth_volume)
+        assert any(f"the other {len(boxes) - n_nest} shells, in nests with crossing shells" in s for s in said), said
+    truth = _moments(solid)
+    if props is None or truth is None or certificate_label(props.mesh) not in ("exact", "united", "estimate"):
+        return
+    diag = float(np.linalg.norm(np.ptp(_mesh(boxes)[0], axis=0)))
+    assert _matches(props, truth, diag), (certificate_label(props.mesh), props.mass, truth[0])
+
+
+@settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2 ** 32 - 1))
+def test_a_nest_beside_crossing_boxes_follows_the_stated_rule(seed):
+    """A nest wound either way, free or flush, beside two outward boxes that cross: the nest is read by its own rule
+    (before session 17 the crossing pair kept R4's depth reading for it: the parity solid within a spanning
+    estimate), the pair is united, and the whole is labelled by its weaker part."""
+    rng = np.random.default_rng(seed)
+    nest = _nest_apart(rng)
+    _check_beside_crossing(nest + _crossing_pair(rng), len(nest))
+
+
+def test_two_nested_outward_boxes_beside_crossing_boxes_are_the_outer_box():
+    """The issue's nested outward boxes (8 and 1 m³... here 6³ and 3³ cells) beside two crossing outward boxes: the
+    outer box and the pair's union, ``united`` with ``interior-shells`` (before: an estimate spanning the parity
+    solid and the file's winding)."""
+    boxes = [(np.array([-10, -4, -4]), np.array([-4, 2, 2]), 1), (np.array([-9, -3, -3]), np.array([-6, 0, 0]), 1),
+             (np.array([3, -4, -4]), np.array([7, 0, 0]), 1), (np.array([5, -2, -2]), np.array([9, 2, 2]), 1)]
+    _check_beside_crossing(boxes, 2)
+    props, _ = _answer(boxes)
+    assert abs(props.mass - (216 + 64 + 64 - 8) * H ** 3) <= 1e-12
+
+
+def test_a_forced_estimate_names_the_shells_left_out():
+    """A nest wound outward twice (the rule leaves the inner box out) beside two crossing outward boxes and an
+    inward box crossing both and reaching out of both: R4c's boolean refuses (a void outside every body) and
+    ``repair`` forces the winding-number estimate; its notes say which shell was left out and what the depth reading
+    gives (before session 17 the estimate's notes did not), and its bounds hold ``{w ≥ 1}`` by exact cells."""
+    boxes = [(np.array([-10, -4, -4]), np.array([-2, 4, 4]), 1), (np.array([-8, -2, -2]), np.array([-4, 2, 2]), 1),
+             (np.array([2, -2, -2]), np.array([6, 2, 2]), 1), (np.array([4, -1, -1]), np.array([8, 3, 3]), 1),
+             (np.array([3, -3, 0]), np.array([7, 4, 1]), -1)]
+    v, f = _mesh(boxes)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        props = mass_properties((v, f), density=1.0, repair=True)
+    assert certificate_label(props.mesh) == "estimate"
+    assert any("1 shell with winding at least one on both sides left out" in n and "estimate of the shells kept" in n
+               for n in props.mesh.notes), props.mesh.notes
+    truth = _moments(_winding(boxes, [s for _, _, s in boxes]) >= 1)
+    assert _matches(props, truth, float(np.linalg.norm(np.ptp(v, axis=0))))
+
+
+def _nest_in_crossing_box(rng):
+    """An outward box crossing another (at x ≥ 3), with a nest inside its part away from the other (free or flush
+    with it, boxes to depth 3 wound either way): a sub-nest inside a nest with crossings (winding 1 just outside)."""
+    lo = np.array([-11, -6, -6]) + rng.integers(0, 2, size=3)
+    hi = np.array([int(rng.integers(4, 6)), int(lo[1] + rng.integers(5, 9)), int(lo[2] + rng.integers(5, 9))])
+    other_lo = np.array([2, lo[1] + 1, lo[2] + 1])
+    boxes = [(lo, hi, 1), (other_lo, other_lo + np.array([4, 3, 3]), 1)]
+    _children(rng, lo, np.array([1, hi[1], hi[2]]), 1, boxes)
+    return boxes
+
+
+@settings(max_examples=20, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2 ** 32 - 1))
+def test_a_nest_inside_a_crossing_box_follows_the_stated_rule_where_it_stands(seed):
+    """A nest inside an outward box that crosses another: where no cell's winding is below 0, the answer is ``{w ≥ 1}``
+    by exact cell counts (the sub-nest decided by the rule, the crossing pair united), ``united`` with
+    ``interior-shells`` wherever depth would misread an outward box.  Where some cell is below 0 the nest is read by
+    the other rules as before (not judged here: :func:`_by_rule` reads a crossing pair's overlap by parity)."""
+    boxes = _nest_in_crossing_box(np.random.default_rng(seed))
+    w = _winding(boxes, [s for _, _, s in boxes])
+    if w.min() < 0:
+        return
+    solid, _, _, misread = _by_rule(boxes)
+    props, _ = _answer(boxes)
+    assert props is not None, "refused where the file's winding stands"
+    if misread:
+        assert certificate_label(props.mesh) == "united", props.mesh.certificate
+        assert "interior-shells" in props.mesh.certificate.checks
+    if certificate_label(props.mesh) in ("exact", "united", "estimate"):
+        diag = float(np.linalg.norm(np.ptp(_mesh(boxes)[0], axis=0)))
+        truth = _moments(w >= 1)
+        assert _matches(props, truth, diag), (certificate_label(props.mesh), props.mass, truth[0])
+
+
+def test_a_box_flush_with_its_container_on_five_faces_is_the_container():
+    """Both wound outward, the inner box sharing five of its faces' planes with the outer one: every probe of the
+    outer box lay on the inner one's surface, so it was undecided and the rule did not apply; R4 read the pair by
+    depth, ``exact`` 0.546875 m³ (the container less the box) where ``{w ≥ 1}`` is the container, 3.828125 m³
+    (found by session 17's judge beside a crossing pair).  Now the undecided shell is probed again without the shell
+    within it: the container, ``exact`` with ``interior-shells``."""
+    boxes = [(np.array([-10, -5, -6]), np.array([-3, 2, -1]), 1), (np.array([-10, -5, -6]), np.array([-3, 1, -1]), 1)]
+    _check(boxes)
+    props, _ = _answer(boxes)
+    assert certificate_label(props.mesh) == "exact"
+    assert abs(props.mass - 245 * H ** 3) <= 1e-12

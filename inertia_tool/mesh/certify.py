@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from .uncertainty import Estimate, Uncertainty
     from .unite import United
 
-__all__ = ["Certified", "first_checks", "certify", "misread_reading", "with_weld_doubt"]
+__all__ = ["Certified", "first_checks", "certify", "misread_reading", "with_weld_doubt", "with_interior_note"]
 
 
 class Certified(NamedTuple):
@@ -134,12 +134,28 @@ def _winding_stands(found: MisreadNesting, united: United, *, source: str) -> Un
     proven = united.forced is None and united.kind in ("exact", "united")
     volume = float(total(united.shells.moments).volume) if proven else None
     note = misread_message(found, volume, proven,
-                           kept=None if proven else "the solid given is not proven apart from that reading")
+                           kept=f"the file's winding is read as it stands ({united.kind})" if proven else
+                           "the solid given is not proven apart from that reading")
     warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=4)
     checks = list(united.checks)
     if proven and "interior-shells" not in checks:
         checks.insert(min(2, len(checks)), "interior-shells")
     return united._replace(notes=(*united.notes, note), checks=checks)
+
+
+def with_interior_note(forced: Resolution, oriented: Orientation, source: str) -> Resolution:
+    """A winding-number estimate forced after the boolean refused (:func:`~.unite.unite_overlaps`), with R4's note
+    on the shells left out where the file's winding stands (``oriented.interior``, :func:`_winding_stands`): the
+    estimate is of the shells kept, whose ``{w ≥ 1}`` is the file's, and the note says which shells were left out
+    and what the depth reading would give (stated against the solid given, not as a total: the estimate is not
+    proven to be the file's winding solid).  Unchanged where no shell was left out."""
+    if oriented.interior is None:
+        return forced
+    import dataclasses
+    note = misread_message(oriented.interior, None, False,
+                           kept="the solid given is an estimate of the shells kept, whose {w ≥ 1} is the file's")
+    warnings.warn(InsideOutWarning(f"{source}: {note}"), stacklevel=3)
+    return dataclasses.replace(forced, notes=(*forced.notes, note))
 
 
 def _depth_readings(oriented: Orientation, united: United, *, method: str,

@@ -130,24 +130,39 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
     touch, nest, touch_within = settle_touching(v, f, labels, contacts, touch, nest)
     within, crossing_with = None, touch.crossing_with
     copies = np.zeros((0, 2), dtype=np.int64)
+    apart = (crossing_with, touch_within)
     if touch.complete:
         rounding = rounding_volumes(v, shells.moments)
         within, crossing_with = _within(v, f, labels, file_volumes, crossing_with, rounding)
-        nest = _decide_past_partners(v, f, labels, n_shells, nest, crossing_with)
+        # R4: a shell left undecided because its probes lay on a shell it touches from inside or outside (a box
+        # flush with its container on five faces) is probed again without that shell, as past crossing partners
+        nest = _decide_past_partners(v, f, labels, n_shells, nest, np.concatenate(
+            [np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2), within.reshape(-1, 2),
+             np.asarray(touch_within, dtype=np.int64).reshape(-1, 2)]))
+        apart = (crossing_with, touch_within)          # nested copies not yet moved to the crossing pairs
         crossing_with, touch_within, copies = _copies_nested(file_volumes, nest, crossing_with, touch_within,
                                                              rounding)
     flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
                                          within=_both(within, touch_within))
     # R4 (session 16): where a nest's own winding is a solid's (no region below 0), it stands: the shells with
     # winding ≥ 1 on both sides are left out and the rest read again (two nested outward boxes: the outer box)
-    stands = winding_stands(file_volumes, depth, nest, _both(within, touch_within), crossing_with, multiplicity) \
-        if touch.complete and not again else None
-    if stands is not None and stands.drop is not None:
-        kept_shells, kept_contacts = _without_shells(shells, contacts, stands.drop)
-        kept_touch = shell_contacts(kept_contacts, kept_shells.labels, kept_shells.n_shells)
-        left = None if multiplicity is None else np.asarray(multiplicity)[~stands.drop]
-        read = _orient_shells(kept_shells, kept_contacts, kept_touch, source=source, multiplicity=left, again=True)
-        return read._replace(interior=stands, contacts=read.contacts if read.contacts is not None else kept_contacts)
+    # (session 17: per nest, a nest none of whose shells crosses any shell, or a sub-nest inside a nest with
+    # crossings, the rest read by the other rules)
+    # Nested copies (a shell inside another wound alike, all but the rounding of its volume) are nested shells for
+    # it, not crossing ones: wound outward, the inner one has winding 1 and 2 on its sides and is left out, exact
+    # (before: united by the boolean, ``unverified``)
+    if touch.complete and not again:
+        s_cross, s_within = apart if len(copies) else (crossing_with, touch_within)
+        s_depth = orient_by_depth(file_volumes, nest, s_cross, within=_both(within, s_within))[2] if len(copies) \
+            else depth
+        for inside_crossed in (True, False):
+            stands = winding_stands(file_volumes, s_depth, nest, _both(within, s_within), s_cross, multiplicity,
+                                    inside_crossed=inside_crossed)
+            if stands is None or stands.drop is None:
+                break
+            read = _read_without(shells, contacts, stands, multiplicity, nest, _both(within, s_within), source)
+            if read is not None:
+                return read
     misread = misread_nesting(file_volumes, flip, depth, nest, _both(within, touch_within)) \
         if touch.complete else None                                                   # R4: the file does not decide
     groups = outward_crossing_groups(file_volumes, flip, depth, crossing_with) if touch.complete else None
@@ -250,6 +265,49 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
     crossing[crossing_with.reshape(-1)] = True
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
                        groups, by_winding, voids, multiplicity if by_winding else None, on_turn and by_winding)
+
+
+def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNesting, multiplicity: np.ndarray | None,
+                  nest: Nesting | None, within: np.ndarray | None, source: str) -> Orientation | None:
+    """:func:`orient_shells` of the shells :func:`~.policy.winding_stands` kept (``stands.drop`` left out), or None
+    when the other rules would turn a shell it kept inside a nest with crossings (its sub-nest's winding would then
+    not stand as decided: the caller asks again for the nests apart only; so also where they refuse the rest read
+    so, their warnings then not given).  The shells kept in the nests decided count once in the winding (R0): their
+    winding is 0 or 1 there."""
+    drop = np.asarray(stands.drop, dtype=bool)
+    kept_shells, kept_contacts = _without_shells(shells, contacts, drop)
+    kept_touch = shell_contacts(kept_contacts, kept_shells.labels, kept_shells.n_shells)
+    decided = _in_nests(stands.roots, nest, within, len(drop))
+    left = None
+    if multiplicity is not None:
+        k = np.where(decided, 1, np.asarray(multiplicity, dtype=np.int64))[~drop]
+        left = None if np.all(k == k[0]) else k
+    with warnings.catch_warnings(record=True) as said:      # said only if this reading is taken
+        warnings.simplefilter("always")
+        try:
+            read = _orient_shells(kept_shells, kept_contacts, kept_touch, source=source, multiplicity=left,
+                                  again=True)
+        except InvalidMeshError:
+            if stands.others:       # the other rules refuse the rest read so: ask again for the nests apart only
+                return None
+            raise
+    if stands.others and np.asarray(read.flip)[decided[~drop]].any():
+        return None
+    for found in said:
+        warnings.warn(found.message, stacklevel=4)
+    return read._replace(interior=stands, contacts=read.contacts if read.contacts is not None else kept_contacts)
+
+
+def _in_nests(roots: np.ndarray | None, nest: Nesting | None, within: np.ndarray | None, n_shells: int) -> np.ndarray:
+    """(s,) bool: the shells ``roots`` and every shell inside one of them
+    (:func:`~.multiplicity.container_windings`)."""
+    out = np.zeros(n_shells, dtype=bool)
+    if roots is None or not len(roots):
+        return out
+    out[np.asarray(roots, dtype=np.int64)] = True
+    shell, other, _ = container_windings(np.ones(n_shells), nest, within)
+    out[shell[out[other]]] = True
+    return out
 
 
 def _without_shells(shells: Shells, contacts: SurfaceContacts, drop: np.ndarray) -> tuple[Shells, SurfaceContacts]:
@@ -483,7 +541,11 @@ def _decide_past_partners(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_sh
     """R4: shells left undecided because every probe lay on the surface of a shell they cross (a copy listed twice,
     its coordinates rounded apart) probed again with those shells left out.  Their depth never counts the shells
     they cross (:func:`~.policy.orient_by_depth`), so those surfaces need not be kept clear of; the winding numbers
-    of the others at the new probe are added to ``nest`` and the shell is decided."""
+    of the others at the new probe are added to ``nest`` and the shell is decided.  So also past a shell it lies
+    within, or that lies within it, up to touching (``crossing_with`` then holds those ``(shell, container)`` pairs
+    too; session 17: a box flush inside another on five faces left the outer one undecided, and R4 read the pair by
+    depth, ``exact`` 0.55 m³ where the file's winding gives the outer box, 3.83): a shell within another is none of
+    its containers, and the pair's own relation is kept by those pairs."""
     pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
     if nest is None or not len(pairs) or not np.asarray(nest.undecided).any():
         return nest

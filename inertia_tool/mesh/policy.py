@@ -23,9 +23,12 @@ R0 *A shell listed k times counts k times in the winding number* (:func:`~.multi
    counting a shell k times changes no region's side of 1 (:func:`~.multiplicity.multiplicity_changes`: checked
    inside every shell listed more than once), the copy left out is the whole answer and nothing else changes.
    Where the count does change ``{w ≥ 1}`` (a box listed twice flush inside a void: ``1 − 1 + 1`` in the file, 0
-   counted once; a body listed twice around a cavity listed once) the solid is formed by R4c, each piece counted k
-   times (:func:`~.union.winding_solid`), and refused when R4 turned a shell for its nesting depth (no one reading
-   then counts both).  Reason: a shell exported twice means the part once, and summed its volume would count twice;
+   counted once; a body listed twice around a cavity listed once) and the shells' nest crosses nothing with no
+   region below 0, the region windings with each count decide it without a boolean (R4, :func:`winding_stands`: the
+   body listed twice round a cavity listed once is the body, ``exact``, the cavity left out); elsewhere the solid is
+   formed by R4c, each piece counted k times (:func:`~.union.winding_solid`), and refused when R4 turned a shell for
+   its nesting depth (no one reading then counts both).
+   Reason: a shell exported twice means the part once, and summed its volume would count twice;
    the winding number is what the issue defines the solid by, and counting the copy keeps it where it decides.
    *Up to rounding* (:func:`near_copies`): a closed surface whose every corner lies within
    ``tolerances.COINCIDENT_RTOL`` of the largest |coordinate| of a corner of another, face for face with the same
@@ -112,8 +115,13 @@ R3b *A flat open sheet inside a solid encloses nothing* (:func:`~.sheets.open_sh
 R4 *Orientation by nesting depth, where the file's winding is evidently wrong* (:func:`orient_by_depth`,
    :func:`winding_stands`; session 16, the team's decision on issue 21).  The solid is where the winding number is
    at least one, so the file's own winding is read as it stands wherever it is a solid's: in a *nest* (a shell at
-   depth 0 and every shell inside it) with no shell crossing another, where every region has winding ``≥ 0``, no
-   shell is turned; the shells with winding ``≥ 1`` on both sides (a body wound outward wholly inside another, and
+   depth 0 and every shell inside it) none of whose shells crosses any shell, where every region has winding
+   ``≥ 0``, no shell is turned, whatever crosses elsewhere in the file (session 17; before, one crossing pair
+   anywhere kept the depth reading for every nest); so also in a *sub-nest* inside a nest with crossings (a shell
+   crossing nothing, with nothing inside it crossing, whose winding just outside is 0 or 1: the shells around it
+   crossing others or not), and the rest of the file is read by the rules below, the certificate the weaker of
+   the parts (the boolean's ``united`` where the rest is united; the note says how many nests went each way);
+   the shells with winding ``≥ 1`` on both sides (a body wound outward wholly inside another, and
    whatever lies inside it) bound nothing of ``{w ≥ 1}`` and are left out, and the rest, each with winding 0 on one
    side and 1 on the other, is integrated as wound: ``exact`` with the check ``interior-shells`` (no boolean; left
    out as R0's copies and R2's flat pieces are), its note naming the depth reading (a cavity written with the wrong
@@ -142,7 +150,8 @@ R4 *Orientation by nesting depth, where the file's winding is evidently wrong* (
    alike, each holding all but ``2·TOUCH_VOLUME_RTOL`` of the other's volume, are copies, not a body and its
    cavity, whether their surfaces cross (:func:`within_up_to_rounding`) or one lies inside the other without
    crossing or touching it (:func:`nested_copies`: a copy scaled by 1 + k ulp, review 10's D2); they go to the
-   boolean, whose union is the solid.  A shell the file
+   boolean, whose union is the solid, except where the file's winding stands (copies wound outward, one inside the
+   other: winding 1 and 2, the inner one left out, ``exact`` with ``interior-shells``; session 17).  A shell the file
    winds outward that depth makes a cavity (:func:`misread_nesting`) is a reading the file does not decide: its
    own winding number is 2 there, so ``{w ≥ 1}`` is the union of the bodies, and a cavity written with the wrong
    winding reads the same (the shells around it counted by their file winding at its probe point and, for a
@@ -857,6 +866,11 @@ class MisreadNesting:
     drop : (s,) bool or None
         ``kept="winding"`` only (:func:`winding_stands`): the shells left out, the file's winding being at least one
         on both sides of each.
+    roots : (r,) int or None
+        ``kept="winding"`` only: the outer shell of each nest the file's winding decided (numbered as in the file's
+        shells).
+    others : int
+        ``kept="winding"`` only: the shells outside those nests, read by the other rules (nests with crossings).
     """
 
     shells: np.ndarray
@@ -867,6 +881,8 @@ class MisreadNesting:
     inward: bool = False
     difference: float | None = None
     drop: np.ndarray | None = None
+    roots: np.ndarray | None = None
+    others: int = 0
 
 
 def misread_nesting(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray, nest: Nesting | None,
@@ -969,50 +985,102 @@ def reading_difference(file_volumes: np.ndarray, depth: np.ndarray, nest: Nestin
 
 
 def winding_stands(file_volumes: np.ndarray, depth: np.ndarray, nest: Nesting | None, within: np.ndarray | None,
-                   crossing_with: np.ndarray, multiplicity: np.ndarray | None = None) -> MisreadNesting | None:
-    """R4 (session 16): the nests whose own winding is a solid's, where nesting depth would read a shell the file
-    winds outward as a cavity; the shells to leave out there (``drop``), or None where the rule does not apply.
+                   crossing_with: np.ndarray, multiplicity: np.ndarray | None = None, *,
+                   inside_crossed: bool = True) -> MisreadNesting | None:
+    """R4 (session 16, per nest since session 17): the nests whose own winding is a solid's, where nesting depth would
+    read a shell the file winds outward as a cavity or R0's count decides; the shells to leave out there (``drop``),
+    or None where the rule applies nowhere.
 
-    A *nest* is a shell at depth 0 with every shell inside it.  With no shell crossing another (and every probe
-    decided), the winding numbers just inside and just outside each shell are every winding number the file gives
-    (:func:`~.multiplicity.region_windings`).  A nest whose regions all have winding ``≥ 0`` defines the solid
-    ``{w ≥ 1}`` as it stands: its winding is not evidently wrong, so R4 turns nothing in it.  There a shell with
-    winding ``≥ 1`` on both sides bounds nothing of ``{w ≥ 1}`` (``[w ≥ 1]`` does not change across it) and is left
-    out; every other shell of the nest has ``{0, 1}`` on its two sides and is kept as wound, so the shells kept
-    bound ``{w ≥ 1}`` exactly, each as its nesting depth among them says (the winding number is 0 or 1
-    everywhere), and the summed integral of the surface left is that solid's (no boolean).  ``shells``: the shells
-    wound outward that depth would read as cavities (odd depth), ``volume`` their summed volume, ``difference``
-    the depth reading less the file's, m³, exactly (as :func:`reading_difference`).
+    A *nest* is a shell at depth 0 with every shell inside it.  In a nest none of whose shells crosses any shell
+    (and every probe decided), the winding numbers just inside and just outside each shell are every winding number
+    the file gives there (:func:`~.multiplicity.region_windings`: the neighbourhood of a shell that crosses nothing
+    lies in one region of the others on each side).  A nest whose regions all have winding ``≥ 0`` defines the
+    solid ``{w ≥ 1}`` as it stands: its winding is not evidently wrong, so R4 turns nothing in it.  There a shell
+    with winding ``≥ 1`` on both sides bounds nothing of ``{w ≥ 1}`` (``[w ≥ 1]`` does not change across it) and is
+    left out; every other shell of the nest has ``{0, 1}`` on its two sides and is kept as wound, so the shells kept
+    bound ``{w ≥ 1}`` exactly (the winding number is 0 or 1 everywhere in the nest), and the summed integral of the
+    surface left is that solid's (no boolean).  Nests with a crossing shell are left to the other rules (R4's depth,
+    R4c, R5, R6), and so is every shell outside the nests decided: a nest that crosses nothing is apart from them
+    (its outer shell crosses nothing and lies in no shell), so the whole is the nests' solids and the rest's.
 
-    ``multiplicity``: (s,) int, R0's count of each shell, counted in the winding (R0); a shell kept has winding 0
-    on one side and 1 on the other, so it is listed once.  Applied only where depth reads some shell the file winds
-    outward as a cavity (``shells`` not empty): elsewhere R0 and R4c read the file's winding already."""
+    ``inside_crossed``: also decide a *sub-nest* inside a nest with crossings: a shell ``X`` crossing nothing, with
+    every shell inside it crossing nothing, whose winding just outside (``c``, the shells around it, crossing
+    others or not, summed at its probe) is 0 or 1.  Inside ``X`` the winding is ``c`` plus the sub-nest's own, so
+    where its regions are all ``≥ 0`` the shells left out as above leave the winding of the rest ``c − [c ≥ 1] +
+    [w ≥ 1]`` inside ``X``: ``{w ≥ 1}`` is unchanged for ``c ≤ 1`` (not for ``c = 2``: two cavities nested inside
+    ``X`` would give 1 where the file has 0), and the rest of the file goes on to the other rules as it would
+    have.  (The caller checks that the other rules then turn none of the shells kept: :mod:`~.classify`.)
+
+    ``shells``: the shells wound outward that depth would read as cavities (odd depth), ``volume`` their summed
+    volume, ``difference`` the depth reading less the file's within the nests decided, m³, exactly (the depth
+    reading of those nests, the rest as given: :func:`reading_difference` restricted to them), ``roots`` the
+    outer shell of each nest decided.
+
+    ``multiplicity``: (s,) int, R0's count of each shell, counted in the winding (R0); a shell kept has winding 0 on
+    one side and ``≥ 1`` on the other, and is integrated once (R0 kept one copy).  Applied to the nests where some
+    shell is left out (depth reads a shell wound outward as a cavity, or R0's count puts ``≥ 1`` on both sides of a
+    shell: a box listed twice round a cavity listed once is the box); elsewhere the other rules read the file."""
     vols = np.asarray(file_volumes, dtype=np.float64)
     d = np.asarray(depth, dtype=np.int64)
     n = len(vols)
-    if nest is None or n < 2 or len(np.asarray(crossing_with).reshape(-1)) or _undecided(nest, within).any():
+    if nest is None or n < 2 or _undecided(nest, within).any():
+        return None
+    crosses = np.zeros(n, dtype=bool)
+    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+    crosses[pairs.reshape(-1)] = True
+    if crosses.all():
         return None
     inside, outside = region_windings(vols, nest, within, multiplicity)
     shell, other, _ = container_windings(vols, nest, within)
-    top = d[other] == 0
-    if np.any(np.bincount(shell[top], minlength=n) > 1) or np.any((d > 0) & (np.bincount(shell[top], minlength=n)
-                                                                           == 0)):
-        return None                                  # not a tree of nests (cannot happen without crossings)
-    root = np.arange(n)
-    root[shell[top]] = other[top]
+    if len(pairs):                                   # a shell crossing another is not inside it
+        shell, other = _without_crossing(shell, other, pairs, n)
+    # a shell is clear when it crosses nothing and nothing inside it crosses anything
+    clear = ~crosses
+    np.logical_and.at(clear, other, ~crosses[shell])
+    contained = np.bincount(shell, minlength=n) > 0
+    candidate = clear & ((outside == 0) | (outside == 1)) if inside_crossed else clear & ~contained
+    holder = np.zeros(n, dtype=bool)                 # inside a candidate: not the outer shell of a nest decided
+    holder[shell[candidate[other]]] = True
+    roots = np.flatnonzero(candidate & ~holder)
+    root = np.full(n, -1, dtype=np.int64)
+    root[roots] = roots
+    for s, o in zip(shell.tolist(), other.tolist()):
+        if candidate[o] and not holder[o]:
+            if root[s] not in (-1, o):
+                return None                          # not a tree of nests (cannot happen without crossings)
+            root[s] = o
+    member = root >= 0
     wrong = np.zeros(n, dtype=bool)
-    np.logical_or.at(wrong, root, inside < 0)        # some region of the nest has winding ≤ −1: evidently wrong
-    stands = ~wrong[root]
+    np.logical_or.at(wrong, root[member], (inside < 0)[member] | (outside < 0)[member])
+    stands = member & ~wrong[np.maximum(root, 0)]
     drop = stands & (inside >= 1) & (outside >= 1)
-    named = stands & (vols > 0) & (d % 2 == 1)
-    if not (drop.any() and named.any()):       # no reading by depth to set aside: the other rules decide (R0, R4c)
+    applies = np.zeros(n, dtype=bool)                # nests where the rule leaves a shell out
+    np.logical_or.at(applies, root[drop], True)
+    decided = member & applies[np.maximum(root, 0)]
+    if not decided.any():       # no reading by depth to set aside: the other rules decide (R0, R4c)
         return None
+    drop &= decided
+    named = decided & (vols > 0) & (d % 2 == 1)
     size = np.abs(vols)
-    parity = float(np.sum(np.where(stands & (d % 2 == 0), size, 0.0) - np.where(stands & (d % 2 == 1), size, 0.0)))
-    winding = float(np.sum(np.where(stands & ~drop, vols, 0.0)))
+    # within the nests decided: the depth reading (material just inside a shell at even depth) less the file's
+    # winding ({w ≥ 1}: the shells kept, as wound); the outer shell's outside counts for a sub-nest (c = 1 inside a
+    # body the depth reading may leave empty)
+    outer = np.flatnonzero(decided & (root == np.arange(n)))
+    parity = float(np.sum(np.where(decided & (d % 2 == 0), size, 0.0) - np.where(decided & (d % 2 == 1), size, 0.0)))
+    parity += float(np.sum(size[outer] * ((d[outer] % 2 == 1).astype(np.float64) -
+                                          (outside[outer] >= 1).astype(np.float64))))
+    winding = float(np.sum(np.where(decided & ~drop, vols, 0.0)))
     shells = np.flatnonzero(named)
     return MisreadNesting(shells=shells, volume=float(np.sum(vols[shells])), nested=False, kept="winding",
-                          difference=parity - winding, drop=drop)
+                          difference=parity - winding, drop=drop, roots=outer,
+                          others=int(np.count_nonzero(~decided)))
+
+
+def _without_crossing(shell: np.ndarray, other: np.ndarray, pairs: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ``(shell, container)`` pairs that are not ``(k, 2)`` crossing ``pairs`` (either way round)."""
+    keys = np.union1d(pairs[:, 0] * n + pairs[:, 1], pairs[:, 1] * n + pairs[:, 0])
+    keep = ~np.isin(shell * n + other, keys)
+    return shell[keep], other[keep]
 
 
 def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray,
@@ -1135,12 +1203,32 @@ def _depth_reading_message(found: MisreadNesting, volume: float | None, kept: st
     if kept is None:
         kept = "the file's winding is read as it stands (exact)"
     decide = f" The file does not decide; {kept}." if kept else " The file does not decide."
+    left = f"{dropped} shell{'s' if dropped > 1 else ''} with winding at least one on both sides left out"
+    if not n:           # R0's count decided it (a body listed twice round a cavity listed once): no shell misread
+        return (f"{left}, R0 counting each shell as often as it is listed (the solid is where the winding number is "
+                f"at least one, and no region's winding is below 0, so the file's winding stands: R4, no boolean); "
+                f"read by nesting depth, each shell counted once, the solid would be {other}.{_by_nest(found)}"
+                f"{decide} If a shell listed more than once is meant once, remove its copies")
     return (f"{n} shell{'s' if many else ''} wound outward lie{'' if many else 's'} wholly inside another body (free "
             f"inside it or flush with its boundary): read by the file's winding as part of the body (the solid is "
             f"where the winding number is at least one, and no region's winding is below 0, so the file's winding "
-            f"stands: R4), {dropped} shell{'s' if dropped > 1 else ''} with winding at least one on both sides left "
-            f"out; read by nesting depth as {'cavities' if many else 'a cavity'} written with the wrong winding "
-            f"(R4's reading where the winding is evidently wrong): {other}.{decide} If {role}, wind {them} inward")
+            f"stands: R4), {left}; read by nesting depth as {'cavities' if many else 'a cavity'} written with the "
+            f"wrong winding (R4's reading where the winding is evidently wrong): {other}.{_by_nest(found)}{decide} "
+            f"If {role}, wind {them} inward")
+
+
+def _by_nest(found: MisreadNesting) -> str:
+    """Which nests the file's winding decided and which the other rules read (session 17: " The file's winding
+    decided 1 nest (...); the other 27 shells, in nests with crossing shells, were read by the other rules (R4–R6),
+    ..."); "" when every shell was in a nest decided."""
+    if not found.others:
+        return ""
+    roots = 0 if found.roots is None else len(found.roots)
+    plural = "s" if roots != 1 else ""
+    rest = "s" if found.others != 1 else ""
+    return (f" The file's winding decided {roots} nest{plural} (outer shell{plural} crossing nothing, nothing "
+            f"inside crossing); the other {found.others} shell{rest}, in nests with crossing shells, were read by "
+            "the other rules (R4–R6), and the certificate is the weaker of the two.")
 
 
 def coincident_message(found: Coincident, size: float = 0.0) -> str:

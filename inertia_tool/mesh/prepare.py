@@ -28,7 +28,7 @@ from ..errors import InternalInvariantError, InvalidMeshError, UsageError
 from ..integrals import VolumeMoments, bounding_box
 from ..tolerances import MERGE_TOLERANCE
 from ..values import frozen_value
-from .certify import certify, first_checks, misread_reading, with_weld_doubt
+from .certify import certify, first_checks, misread_reading, with_interior_note, with_weld_doubt
 from .checks import MeshReport
 from .classify import orient_shells
 from .hole_assumptions import NOTHING_ASSUMED, USER_ASSUMPTIONS, UserAssumptions
@@ -163,8 +163,9 @@ def prepare_mesh(raw: RawMesh, *, repair: bool = False, merge_tolerance: float =
     united = unite_overlaps(oriented, contacts, nonmanifold_edges=resolved_edges, method=found.method,
                             kind=kind, checks=checks, overlap=overlap, repair=repair, diag=diag,
                             source=source)                                                     # R5, R6
-    if united.forced is not None:
-        forced = united.forced if patched is None else with_patch_doubt(united.forced, patched, source)
+    if united.forced is not None:       # R4: the shells left out where the file's winding stands are said too
+        forced = with_interior_note(united.forced, oriented, source)
+        forced = forced if patched is None else with_patch_doubt(forced, patched, source)
         return _estimated(with_weld_doubt(forced, weld, source), {**common, "overlapping_shells": united.overlaps},
                           patched)
     united, spread = misread_reading(oriented, united, method=found.method, source=source)     # R4's label
