@@ -136,7 +136,7 @@ def add_mesh_options(parser) -> None:
 
 #: The names ``--assume`` takes, for help without loading the engine (the same as
 #: ``mesh.hole_assumptions.USER_ASSUMPTIONS``: tests/test_cli_assume.py checks it).
-ASSUME_NAMES = ("flat-islands", "smooth-holes", "faceted-holes", "faces-only")
+ASSUME_NAMES = ("flat-islands", "smooth-holes", "faceted-holes")
 
 
 def add_assume_option(group) -> None:
@@ -151,8 +151,7 @@ def add_assume_option(group) -> None:
                             "may stray; a feature, edge or corner taken whole breaks it); faceted-holes: each hole "
                             "lost a piece of a faceted surface staying inside the planes of the faces round it "
                             "(bounded between the flat fill and those planes continued; a boss or rib taken whole "
-                            "breaks it); faces-only: each hole lost faces only, no vertex (bounded by the convex "
-                            "hull of its rim; a hole that took a vertex breaks it). Known: "
+                            "breaks it). Known: "
                             + ", ".join(ASSUME_NAMES))
 
 

@@ -34,9 +34,7 @@ quadratic (:func:`~.hole_bounds.smooth_doubt`), where that is narrower than its 
 (:data:`FACETED_HOLES`) states that each hole (not an island in a flat face) lost a piece of a faceted surface
 staying inside the planes of the faces round it: the hole is bounded by the region between its cone and those
 planes continued (:func:`~.hole_facets.faceted_doubt`) and filled on them where they close it, where that is
-narrower than its other bound.  ``faces-only`` (:data:`FACES_ONLY`) states that each hole lost faces only, no
-vertex: the cone is kept and the hole bounded by the convex hull of its rim (:func:`~.hole_facets.rim_hull_volumes`),
-where that is narrower; an island in a flat face that lost only faces is then no footprint of a feature.  The user's
+narrower than its other bound.  The user's
 assumptions travel as a parameter, a frozen :class:`UserAssumptions`, from the
 API (``LoadOptions.assume``) through :func:`~.prepare.prepare_mesh`, :func:`~.surface.close_surface` and
 :func:`~.resolve.resolve_surface` to the one place that reads them, :func:`~.holes.patched_estimate`; no state
@@ -52,8 +50,7 @@ from typing import Iterable
 
 __all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "GRAPH", "PLANAR",
            "QUADRIC", "ALL", "stated", "named", "FLAT_ISLANDS", "USER_ASSUMPTIONS", "user_named", "UserAssumptions",
-           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT", "SMOOTH_HINT", "SMOOTH_HOLES", "FACETED_HOLES",
-           "FACES_ONLY"]
+           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT", "SMOOTH_HINT", "SMOOTH_HOLES", "FACETED_HOLES"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -159,16 +156,10 @@ FACETED_HOLES = HoleAssumption(
     "a boss, rib or housing standing out of those planes (or a dent into a pocket's) taken whole with the hole, a "
     "surface folding back over the hole, or a curved surface bulging past the planes of its facets")
 
-FACES_ONLY = HoleAssumption(
-    "faces-only", "each hole lost faces only, no vertex: every corner of the missing surface is a vertex of the "
-    "hole's own rim (as where triangles dropped out of a file), so it lies in the convex hull of the rim",
-    "a hole that took a vertex with every face round it (a patch larger than the faces at one vertex), or a feature "
-    "taken whole")
-
 #: The assumptions a user may state (``LoadOptions.assume``, ``--assume``): each is what the file cannot show,
 #: so the tool never makes it on its own; with one stated, the holes it covers get the narrower bound it implies
 #: and the estimate names it as the user's (:func:`user_stated`).
-USER_ASSUMPTIONS = (FLAT_ISLANDS, SMOOTH_HOLES, FACETED_HOLES, FACES_ONLY)
+USER_ASSUMPTIONS = (FLAT_ISLANDS, SMOOTH_HOLES, FACETED_HOLES)
 
 #: The end of a refusal of a hole that is an island in a flat face: the option that would take it.
 ISLAND_HINT = " or, if the lost surface was flat, `assume` flat-islands"

@@ -1,5 +1,4 @@
-"""Bounding holes under the user's polyhedral assumptions: ``faceted-holes`` (between the cone and the continued planes)
-and ``faces-only`` (the rim's convex hull, :func:`rim_hull_volumes`).
+"""Bounding a hole under the user's ``faceted-holes`` assumption: between the cone and the continued planes.
 
 On a faceted part (a CAD box, an octahedron, a cone's facets, a cylinder's flat cap meeting its side) the surface
 a hole took lies, most often, on the planes of the faces still there round it, continued across the hole until
@@ -45,8 +44,7 @@ from ..rounding import round_up
 from ..values import frozen_value
 from .hole_bounds import BEND_MAX_DEGREES, FLAT_RIM_RTOL, _round_off
 
-__all__ = ["FacetedRegion", "faceted_doubt", "rim_hull_volumes", "FACETED_LEVELS", "FACETED_MAX_RIM", "FACETED_WORK",
-           "FACETED_MAX_LOOPS"]
+__all__ = ["FacetedRegion", "faceted_doubt", "FACETED_LEVELS", "FACETED_MAX_RIM", "FACETED_WORK", "FACETED_MAX_LOOPS"]
 
 #: Most holes of one surface bounded under ``faceted-holes`` (those with the most doubt first; each costs a pass
 #: over the surface's faces and vertices).
@@ -254,55 +252,3 @@ def _file_inside(v: np.ndarray, f: np.ndarray, on_rim: np.ndarray, top: np.ndarr
         if bool((sign * h[q_idx, r_idx] < g - tol).any()):
             return True
     return False
-
-
-def rim_hull_volumes(vertices: np.ndarray, vertex_of: np.ndarray, loop_of: np.ndarray, n_loops: int) -> np.ndarray:
-    """The volume of the convex hull of each hole's rim vertices, (n_loops,) m³ (an upper bound, rounded up): the
-    region in doubt of a hole under the user's ``faces-only`` (:data:`~.hole_assumptions.FACES_ONLY`).
-
-    **Assumption**: the hole lost faces only, no vertex: every corner of its missing surface ``M`` is a vertex of
-    its own rim.  **The bound follows**: each triangle of ``M`` has its corners on the rim, so ``M`` lies in the rim's
-    convex hull ``H``; the cone (its apex the rim's centroid) lies in ``H`` too; ``H`` is convex, so the winding
-    number of the cycle "cone − M" vanishes outside it, and the patched and the true solid differ by at most
-    ``|H|``.  A rim of three vertices (a lost triangle) or in one plane has ``|H| = 0``: the cone is the lost
-    surface.  ``|H|`` is qhull's where the rim spans a volume; else (a flat rim, to round-off) the bound
-    ``2 e · A₂`` of the slab of half-width ``e`` round the rim's least-squares plane times the area of the rim's
-    hull in it.  Plus 16 ulp of the coordinates times the hull's surface.
-
-    Parameters
-    ----------
-    vertices : (n, 3) float
-    vertex_of, loop_of : (p,) int
-        The distinct (vertex, loop) pairs of the rims.
-    n_loops : int
-    """
-    from scipy.spatial import ConvexHull
-    from scipy.spatial import QhullError
-
-    v = np.asarray(vertices, dtype=np.float64)
-    margin = _round_off(v)
-    out = np.zeros(n_loops)
-    order = np.argsort(loop_of, kind="stable")
-    start = np.searchsorted(loop_of[order], np.arange(n_loops + 1))
-    for k in range(n_loops):
-        pts = v[vertex_of[order[start[k]:start[k + 1]]]]
-        if len(pts) < 3:
-            continue
-        centred = pts - pts.mean(axis=0)
-        _, _, axes = np.linalg.svd(centred, full_matrices=False)
-        flat = centred @ axes.T                                     # coordinates in the rim's principal frame
-        extent = float(np.max(np.linalg.norm(centred, axis=1)))
-        half = float(np.max(np.abs(flat[:, 2]))) if flat.shape[1] > 2 else 0.0
-        try:
-            area = float(ConvexHull(flat[:, :2]).volume) if len(pts) >= 3 else 0.0
-        except (QhullError, ValueError):
-            area = np.pi * extent ** 2                              # collinear in projection: the disc over it
-        slab = 2.0 * (half + margin) * area
-        volume = slab
-        if len(pts) >= 4 and half > 4.0 * margin:
-            try:
-                volume = min(slab, float(ConvexHull(pts).volume))
-            except (QhullError, ValueError):
-                volume = slab
-        out[k] = round_up(volume + margin * 4.0 * np.pi * extent ** 2)
-    return out

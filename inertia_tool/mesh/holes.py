@@ -68,7 +68,7 @@ from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES
                          _ring_faces as _ring_faces, crease_fills, curved_fills, curved_surroundings,
                          PlaneFill, plane_fills, region_check)
 from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions, named, stated, user_stated
-from .hole_facets import FACETED_MAX_LOOPS, faceted_doubt, rim_hull_volumes
+from .hole_facets import FACETED_MAX_LOOPS, faceted_doubt
 from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal, _unique_rows
@@ -274,11 +274,6 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             rim_reach = np.zeros(n_loops)
             np.maximum.at(rim_reach, loop_of, np.linalg.norm(v[vertex_of] - point, axis=1))
             nearer = np.where(took_smooth, rim_reach + 2.0 * smooth_height, nearer)
-        if took_faces.any():
-            # the faces-only region is the rim's hull
-            rim_reach = np.zeros(n_loops)
-            np.maximum.at(rim_reach, loop_of, np.linalg.norm(v[vertex_of] - point, axis=1))
-            nearer = np.where(took_faces, rim_reach, nearer)
         if took_faceted.any():
             # the faceted-holes region lies within ``reach`` along d of the cone, which lies in the rim's hull
             rim_reach = np.zeros(n_loops)
@@ -293,7 +288,6 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     took_island = np.zeros(n_loops, dtype=bool)
     took_smooth = np.zeros(n_loops, dtype=bool)
     took_faceted = np.zeros(n_loops, dtype=bool)
-    took_faces = np.zeros(n_loops, dtype=bool)
     faceted_reach = np.zeros(n_loops)
     island_width = np.zeros(n_loops)
     graph_height = np.zeros(n_loops)
@@ -480,25 +474,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                                          outward=sign, max_loops=n_loops)
                     planes = [*planes, *facets]
                     pv, pf, cap, closed, _ = build(creases, curved, [*graphs, *smooths], planes)
-        if "faces-only" in assume:
-            # the user's faces-only (FACES_ONLY, opt-in; read here, nowhere else): a hole not across a crease keeps
-            # its cone (in the rim's hull) and is bounded by the convex hull of its rim (rim_hull_volumes) where
-            # that is narrower than the bound it had; a footprint so bounded is no longer refused (below)
-            hull = rim_hull_volumes(v, vertex_of, loop_of, n_loops)
-            took_faces = ~crossed & (hull < hole_doubt)
-            if took_faces.any():
-                hole_doubt = np.where(took_faces, hull, hole_doubt)
-                for flag in (took_bend, took_capsule, took_planar, took_graph, took_smooth, took_faceted,
-                             took_island, alone):
-                    flag &= ~took_faces
-                curved = [fill for fill in curved if not took_faces[fill.loop]]
-                graphs = [fill for fill in graphs if not took_faces[fill.loop]]
-                smooths = [fill for fill in smooths if not took_faces[fill.loop]]
-                planes = [fill for fill in planes if not took_faces[fill.loop]]
-                pv, pf, cap, closed, _ = build(creases, curved, [*graphs, *smooths], planes)
-                unbounded = _contradicted(evidence, radius, size, assumed=user_flat | took_faces)
         took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
-                     & ~took_planar & ~took_graph & ~took_smooth & ~took_faceted & ~took_faces)
+                     & ~took_planar & ~took_graph & ~took_smooth & ~took_faceted)
         used = {"ball"}
         used |= {"planar"} if took_planar.any() else set()
         used |= {"flat"} if took_flat.any() else set()
@@ -529,7 +506,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # keeps the polytope (a rule fixed before the bend bound came, which tests/test_hole_bounds.py pins)
         # (under the user's smooth-holes, against the doubt its fills leave: the default rule is unchanged)
         if bound is not None and bound[0] < (float(np.sum(hole_doubt)) if smooths or took_faceted.any()
-                                             or took_faces.any() else before_bend):
+                                             else before_bend):
             doubt, corners = bound
             # under the convex bound any fill outside the cone and inside every given face's plane keeps the patched
             # solid between the cones' and the polytope (P ⊂ P' ⊂ U), where the bound holds for it too: the planes
@@ -544,7 +521,6 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             curved, graphs, smooths = [], [], []
             took_smooth[:] = False
             took_faceted[:] = False
-            took_faces[:] = False
             used = {"convex"}
             used |= {"inner"} if inside_face else set()
     sealed = ""
@@ -583,7 +559,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             detail += (f"; {int(np.count_nonzero(took_island))} an island in a flat face (its rim and every face at "
                        "it in one plane), filled in its rim's plane and bounded by the ball cut to the slab of the "
                        f"rim's own deviation from that plane (within {widest:.3g} m), as the user assumed")
-        kept_ball = int(np.count_nonzero(island & ~took_island & ~took_faces))
+        kept_ball = int(np.count_nonzero(island & ~took_island))
         if kept_ball and not convex:
             detail += (f"; {kept_ball} an island in a flat face (its rim and every face at it in "
                        "one plane, or every face at it within 1.1° of the rim's plane): nothing in the file tells a "
@@ -613,24 +589,19 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                        "the planes of the faces round the rim continued across it (reaching at most "
                        f"{round_up(float(faceted_reach[took_faceted].max())):.3g} m from the cone), as the user "
                        "assumed")
-        if took_faces.any():
-            detail += (f"; {int(np.count_nonzero(took_faces))} kept the cone and bounded instead by the convex hull "
-                       "of the rim, as the user assumed the hole lost faces only")
         detail += "; " + stated(used)
-        if took_island.any() or smooths or took_faceted.any() or took_faces.any():
+        if took_island.any() or smooths or took_faceted.any():
             detail += "; " + user_stated([*(["flat-islands"] if took_island.any() else []),
                                           *(["smooth-holes"] if smooths else []),
-                                          *(["faceted-holes"] if took_faceted.any() else []),
-                                          *(["faces-only"] if took_faces.any() else [])])
+                                          *(["faceted-holes"] if took_faceted.any() else [])])
     else:
         detail = f"{sealed}no hole left" if sealed else "no hole"
     return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,
                     uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far,
                     unbounded=unbounded, assumptions=tuple(a.name for a in named(used))
                     + (("flat-islands",) if took_island.any() else ()) + (("smooth-holes",) if smooths else ())
-                    + (("faceted-holes",) if took_faceted.any() else ())
-                    + (("faces-only",) if took_faces.any() else ()),
-                    islands=int(np.count_nonzero(island & ~took_island & ~took_faces)))
+                    + (("faceted-holes",) if took_faceted.any() else ()),
+                    islands=int(np.count_nonzero(island & ~took_island)))
 
 
 def _between_cone_and_planes(planes: list[PlaneFill], vertices: np.ndarray, outward: np.ndarray
