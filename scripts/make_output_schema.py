@@ -85,7 +85,7 @@ defs["uncertainty"] = d("null when the result is exact for the polyhedron; for a
                                         "note": S}})
 CERT_KINDS = ["exact", "united", "summed", "unverified", "estimate"]
 #: The assumptions a user may state (inertia_tool.mesh.hole_assumptions.USER_ASSUMPTIONS; a test checks the two agree).
-USER_ASSUMPTION_NAMES = ["flat-islands", "smooth-holes"]
+USER_ASSUMPTION_NAMES = ["flat-islands", "smooth-holes", "faceted-holes"]
 ASSUMPTIONS_SAID = ("optional: the user's assumptions (--assume, assume=) the result rests on: those a repair took "
                     "(a hole filled under one); empty when none was taken or none stated")
 defs["certificate"] = d("Optional: how far the numbers can be trusted. kind exact (the checks that make the integral "

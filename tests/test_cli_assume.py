@@ -52,7 +52,7 @@ def test_assume_without_repair_or_unknown_is_a_usage_error(lidless, tmp_path, ca
     assert main([command, lidless, "--assume", "flat-islands", *extra]) == EXIT_USAGE
     assert "--repair" in _one_line(capsys.readouterr().err)
     assert main([command, lidless, "--repair", "--assume", "flat", *extra]) == EXIT_USAGE
-    assert "expected one of flat-islands, smooth-holes, got flat" in _one_line(capsys.readouterr().err)
+    assert "expected one of flat-islands, smooth-holes, faceted-holes, got flat" in _one_line(capsys.readouterr().err)
 
 
 def test_batch_takes_the_assumption(lidless, tmp_path, capsys):

@@ -136,7 +136,7 @@ def add_mesh_options(parser) -> None:
 
 #: The names ``--assume`` takes, for help without loading the engine (the same as
 #: ``mesh.hole_assumptions.USER_ASSUMPTIONS``: tests/test_cli_assume.py checks it).
-ASSUME_NAMES = ("flat-islands", "smooth-holes")
+ASSUME_NAMES = ("flat-islands", "smooth-holes", "faceted-holes")
 
 
 def add_assume_option(group) -> None:
@@ -148,7 +148,10 @@ def add_assume_option(group) -> None:
                             "a flat piece of that face (filled flat and bounded instead of refused; a boss or "
                             "pocket taken whole there breaks it); smooth-holes: each hole lost a piece of a smooth "
                             "surface continuing the one round it (bounded by how far such a continuation "
-                            "may stray; a feature, edge or corner taken whole breaks it). Known: "
+                            "may stray; a feature, edge or corner taken whole breaks it); faceted-holes: each hole "
+                            "lost a piece of a faceted surface staying inside the planes of the faces round it "
+                            "(bounded between the flat fill and those planes continued; a boss or rib taken whole "
+                            "breaks it). Known: "
                             + ", ".join(ASSUME_NAMES))
 
 

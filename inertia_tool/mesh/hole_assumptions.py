@@ -30,7 +30,11 @@ a feature taken whole there by the ring's slope.
 (:func:`user_stated`).  ``smooth-holes`` (:data:`SMOOTH_HOLES`) states that each hole lost a piece of a smooth
 surface continuing the one round it: a hole whose surroundings allow the reading is filled as a graph over the
 plane most face-on to them and bounded by how far that assumption lets the surface stray from the surroundings'
-quadratic (:func:`~.hole_bounds.smooth_doubt`), where that is narrower than its other bound.  The user's
+quadratic (:func:`~.hole_bounds.smooth_doubt`), where that is narrower than its other bound.  ``faceted-holes``
+(:data:`FACETED_HOLES`) states that each hole (not an island in a flat face) lost a piece of a faceted surface
+staying inside the planes of the faces round it: the hole is bounded by the region between its cone and those
+planes continued (:func:`~.hole_facets.faceted_doubt`) and filled on them where they close it, where that is
+narrower than its other bound.  The user's
 assumptions travel as a parameter, a frozen :class:`UserAssumptions`, from the
 API (``LoadOptions.assume``) through :func:`~.prepare.prepare_mesh`, :func:`~.surface.close_surface` and
 :func:`~.resolve.resolve_surface` to the one place that reads them, :func:`~.holes.patched_estimate`; no state
@@ -46,7 +50,7 @@ from typing import Iterable
 
 __all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "GRAPH", "PLANAR",
            "QUADRIC", "ALL", "stated", "named", "FLAT_ISLANDS", "USER_ASSUMPTIONS", "user_named", "UserAssumptions",
-           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT", "SMOOTH_HINT", "SMOOTH_HOLES"]
+           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT", "SMOOTH_HINT", "SMOOTH_HOLES", "FACETED_HOLES"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -144,10 +148,18 @@ SMOOTH_HOLES = HoleAssumption(
     "a feature, sharp edge or corner taken whole with the hole (a boss, a pocket, a box's corner), or a surface "
     "folding back over it")
 
+FACETED_HOLES = HoleAssumption(
+    "faceted-holes", "each hole not an island in a flat face lost a piece of a faceted surface that stays inside the "
+    "planes of the faces round its rim (outside them round a pocket): the missing surface is a graph over the plane "
+    "square to the rim's vector area and lies between the cone over the rim and those planes continued across the "
+    "hole until they meet",
+    "a boss, rib or housing standing out of those planes (or a dent into a pocket's) taken whole with the hole, a "
+    "surface folding back over the hole, or a curved surface bulging past the planes of its facets")
+
 #: The assumptions a user may state (``LoadOptions.assume``, ``--assume``): each is what the file cannot show,
 #: so the tool never makes it on its own; with one stated, the holes it covers get the narrower bound it implies
 #: and the estimate names it as the user's (:func:`user_stated`).
-USER_ASSUMPTIONS = (FLAT_ISLANDS, SMOOTH_HOLES)
+USER_ASSUMPTIONS = (FLAT_ISLANDS, SMOOTH_HOLES, FACETED_HOLES)
 
 #: The end of a refusal of a hole that is an island in a flat face: the option that would take it.
 ISLAND_HINT = " or, if the lost surface was flat, `assume` flat-islands"

@@ -69,6 +69,7 @@ from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES
                          _ring_faces as _ring_faces, crease_fills, curved_fills, curved_surroundings,
                          PlaneFill, plane_fills, region_check)
 from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions, named, stated, user_stated
+from .hole_facets import FACETED_MAX_LOOPS, faceted_doubt
 from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal, _unique_rows
@@ -275,6 +276,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             rim_reach = np.zeros(n_loops)
             np.maximum.at(rim_reach, loop_of, np.linalg.norm(v[vertex_of] - point, axis=1))
             nearer = np.where(took_smooth, rim_reach + 2.0 * smooth_height, nearer)
+        if took_faceted.any():
+            # the faceted-holes region lies within ``reach`` along d of the cone, which lies in the rim's hull
+            rim_reach = np.zeros(n_loops)
+            np.maximum.at(rim_reach, loop_of, np.linalg.norm(v[vertex_of] - point, axis=1))
+            nearer = np.where(took_faceted, rim_reach + faceted_reach, nearer)
         return nearer
 
     alone = np.zeros(n_loops, dtype=bool)
@@ -283,6 +289,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     took_graph = np.zeros(n_loops, dtype=bool)
     took_island = np.zeros(n_loops, dtype=bool)
     took_smooth = np.zeros(n_loops, dtype=bool)
+    took_faceted = np.zeros(n_loops, dtype=bool)
+    faceted_reach = np.zeros(n_loops)
     island_width = np.zeros(n_loops)
     graph_height = np.zeros(n_loops)
     smooth_height = np.zeros(n_loops)
@@ -439,8 +447,37 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                     graphs = [fill for fill in graphs if not took_smooth[fill.loop]]
                     planes = [fill for fill in planes if not took_smooth[fill.loop]]
                     pv, pf, cap, closed, _ = build(creases, curved, [*graphs, *smooths], planes)
+        if "faceted-holes" in assume:
+            # the user's faceted-holes (FACETED_HOLES, opt-in; read here, nowhere else): a hole not across a crease,
+            # not an island in a flat face (flat-islands is the user's word for those) is bounded by the region
+            # between its cone and the planes round it continued (hole_facets.faceted_doubt; its evidence checked
+            # there) where that is narrower than the bound it had, and filled on those planes
+            # where they close it (plane_fills, with no region to stay in: the fill lies on the region's far side)
+            # or by the cone (its near side); the answer of every other hole is unchanged
+            candidates = ~crossed & ~island & ~took_island & (hole_doubt > GRAPH_TRY_SHARE * abs(float(closed.volume)))
+            if candidates.any():
+                sign = 1.0 if bool(np.array_equal(pf[:len(f)], f)) else -1.0
+                ranked = np.flatnonzero(candidates)[np.argsort(-hole_doubt[candidates], kind="stable")]
+                for k in ranked[:FACETED_MAX_LOOPS].tolist():
+                    region = faceted_doubt(v, f, edges[label == k], apex[k], float(radius[k]), outward=sign)
+                    if region is None or not region.doubt < hole_doubt[k]:
+                        continue
+                    took_faceted[k] = True
+                    faceted_reach[k] = region.reach
+                    hole_doubt[k] = region.doubt
+                if took_faceted.any():
+                    for flag in (took_bend, took_capsule, took_planar, took_graph, took_smooth, alone):
+                        flag &= ~took_faceted
+                    curved = [fill for fill in curved if not took_faceted[fill.loop]]
+                    graphs = [fill for fill in graphs if not took_faceted[fill.loop]]
+                    smooths = [fill for fill in smooths if not took_faceted[fill.loop]]
+                    planes = [fill for fill in planes if not took_faceted[fill.loop]]
+                    facets = plane_fills(v, f, edges, label, np.flatnonzero(took_faceted), apex, radius, _anywhere,
+                                         outward=sign, max_loops=n_loops)
+                    planes = [*planes, *facets]
+                    pv, pf, cap, closed, _ = build(creases, curved, [*graphs, *smooths], planes)
         took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
-                     & ~took_planar & ~took_graph & ~took_smooth)
+                     & ~took_planar & ~took_graph & ~took_smooth & ~took_faceted)
         used = {"ball"}
         used |= {"planar"} if took_planar.any() else set()
         used |= {"flat"} if took_flat.any() else set()
@@ -470,7 +507,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # the convex bound where it applies and is narrower than the others before the bend bound: a convex part
         # keeps the polytope (a rule fixed before the bend bound came, which tests/test_hole_bounds.py pins)
         # (under the user's smooth-holes, against the doubt its fills leave: the default rule is unchanged)
-        if bound is not None and bound[0] < (float(np.sum(hole_doubt)) if smooths else before_bend):
+        if bound is not None and bound[0] < (float(np.sum(hole_doubt)) if smooths or took_faceted.any()
+                                             else before_bend):
             doubt, corners = bound
             # under the convex bound any fill outside the cone and inside every given face's plane keeps the patched
             # solid between the cones' and the polytope (P ⊂ P' ⊂ U), where the bound holds for it too: the planes
@@ -484,6 +522,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             convex = True
             curved, graphs, smooths = [], [], []
             took_smooth[:] = False
+            took_faceted[:] = False
             used = {"convex"}
             used |= {"inner"} if inside_face else set()
     sealed = ""
@@ -547,16 +586,23 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                        "rim and bounded by how far a smooth continuation of the surface round it may stray (largest "
                        f"band {max(float(smooth_height[fill.loop]) for fill in smooths):.3g} m from the rim's "
                        "height), as the user assumed")
+        if took_faceted.any():
+            detail += (f"; {int(np.count_nonzero(took_faceted))} bounded instead by the region between the cone and "
+                       "the planes of the faces round the rim continued across it (reaching at most "
+                       f"{round_up(float(faceted_reach[took_faceted].max())):.3g} m from the cone), as the user "
+                       "assumed")
         detail += "; " + stated(used)
-        if took_island.any() or smooths:
+        if took_island.any() or smooths or took_faceted.any():
             detail += "; " + user_stated([*(["flat-islands"] if took_island.any() else []),
-                                          *(["smooth-holes"] if smooths else [])])
+                                          *(["smooth-holes"] if smooths else []),
+                                          *(["faceted-holes"] if took_faceted.any() else [])])
     else:
         detail = f"{sealed}no hole left" if sealed else "no hole"
     return Estimate(volume=closed.volume, centroid=closed.centroid, second_moment=closed.second_moment, area=area,
                     uncertainty=unc, method="patched", detail=detail, vertices=pv, faces=pf, far=far,
                     unbounded=unbounded, assumptions=tuple(a.name for a in named(used))
-                    + (("flat-islands",) if took_island.any() else ()) + (("smooth-holes",) if smooths else ()),
+                    + (("flat-islands",) if took_island.any() else ()) + (("smooth-holes",) if smooths else ())
+                    + (("faceted-holes",) if took_faceted.any() else ()),
                     islands=int(np.count_nonzero(island & ~took_island)))
 
 
