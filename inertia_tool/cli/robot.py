@@ -169,7 +169,7 @@ def run(args) -> int:
     density = _density(args)
     with recorded_warnings(args, parser=getattr(args, "robot_parser", None)) as messages:
         robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings,
-                           run_xacro=args.run_xacro)
+                           run_xacro=args.run_xacro, missing_meshes="per-link")
         inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
                                    repair=args.repair, max_faces=args.max_faces, assume=assumed_from_args(args))
         audits = audit_links(robot, inertials, keep_mass=args.keep_mass)

@@ -18,14 +18,15 @@ __all__ = ["robot_report_dict", "format_robot_report", "links_without_result", "
 
 
 def links_without_result(robot: RobotDescription, inertials) -> list:
-    """The results that are missing although the link has geometry or a declared mass (a virtual frame —
-    no geometry, no mass — has nothing to compute and is not counted)."""
+    """The results that are missing although the link has geometry or a declared mass, or could not be read
+    (an included model not on disk); a virtual frame — no geometry, no mass — has nothing to compute and is
+    not counted."""
     geometry = {link.name: link for link in robot.links}
     out = []
     for result in inertials:
         link = geometry[result.name]
         declared_mass = link.declared is not None and link.declared.mass > 0
-        if result.properties is None and (link.elements or declared_mass):
+        if result.properties is None and (link.elements or declared_mass or link.unread):
             out.append(result)
     return out
 

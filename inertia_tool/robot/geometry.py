@@ -1064,6 +1064,17 @@ def _one_link(link: LinkGeometry, **options) -> LinkInertial:
     return _with_engine_warnings(result, caught)
 
 
+def _missing_files(paths: list) -> str:
+    """``"mesh file missing: P"`` for a link's absent mesh files, each with its near match if there is one
+    (:func:`~inertia_tool.robot.resolve.near_match`: nothing is read in its place)."""
+    from .resolve import near_match
+    named = []
+    for path in dict.fromkeys(paths):
+        hint = near_match(path)
+        named.append(f"{path} ({hint})" if hint else path)
+    return f"mesh file missing: {', '.join(named)}"
+
+
 #: The start of a link's problem when its mesh was refused: without ``repair``, and with it.
 REFUSED = "mesh needs repair or cannot be read"
 REFUSED_REPAIRED = "mesh cannot be read or bounded, even with repair"
@@ -1074,6 +1085,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
                      assume: UserAssumptions = NOTHING_ASSUMED) -> LinkInertial:
     """The result for one link, or the reason there is none (never raises for the link's own problems)."""
     nan = float("nan")
+    if link.unread:      # an SDFormat include not on disk (read_robot(missing_meshes="per-link"))
+        return LinkInertial(link.name, None, nan, basis, link.unread)
     if not link.elements:
         other = {"collision": "visual", "visual": "collision"}.get(geometry)
         has = (f"; {link.unselected} {other} element{'s' if link.unselected > 1 else ''}, which --geometry "
@@ -1083,7 +1096,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     missing = [e.mesh for e in link.elements if e.mesh is not None and not os.path.exists(e.mesh)
                and not (model and (e.mass == 0 or (e.mass is None and e.density == 0)))]
     if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute
-        return LinkInertial(link.name, None, nan, basis, f"mesh file missing: {', '.join(dict.fromkeys(missing))}")
+        return LinkInertial(link.name, None, nan, basis, _missing_files(missing))
     try:
         parts, massless, joined = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget,
                                                  assume=assume)

@@ -55,11 +55,9 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import re
 
 import numpy as np
 
-from ..errors import RobotDescriptionError
 from .description import DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive
 from .mjcf_bodies import MAX_REPLICAS, _attached_body, _child_bodies, _replica_poses
 from .mjcf_model import (INERTIA_FROM_GEOMETRY, MAX_INCLUDE_DEPTH, MAX_INCLUDED_FILES, MESH_INERTIA_MODES,
@@ -157,20 +155,12 @@ def _optional_number(attrs: dict, key: str, what: str, source: str) -> float | N
     return value
 
 
-_MISSING = re.compile(r": resolves to (.+?), which does not exist(?:; near match: .*)?$")
-
-
 def _mesh_path(file: str, folders: list, packages: dict, source: str, link: str, missing_meshes: str) -> str:
     """The mesh file of an asset: the first of ``folders`` holding it (else the first folder), resolved; a file
     that does not exist is refused, or with ``missing_meshes="per-link"`` returned as the path it would have."""
     found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
-    try:
-        return resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
-    except RobotDescriptionError as exc:
-        match = _MISSING.search(str(exc))
-        if missing_meshes == "refuse" or match is None:
-            raise
-        return match.group(1)
+    return resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link,
+                       missing=missing_meshes)
 
 
 def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict, compiler,
