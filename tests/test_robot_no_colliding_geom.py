@@ -56,3 +56,20 @@ def test_no_warning_where_a_geom_collides(tmp_path, capsys):
     report = json.loads(capsys.readouterr().out)
     assert not [w for w in report["warnings"] if "no geom collides" in w]
     assert report["links"][1]["mass"] == pytest.approx(8.0, rel=1e-12)
+
+
+def test_a_link_with_only_the_other_kind_of_geometry_is_no_frame(tmp_path, capsys):
+    """A link with a ``<visual>`` only and no ``<inertial>`` was counted "without geometry or mass (frames)" in
+    a collision audit; it has geometry: the summary names it apart, the table says ``none`` and lists why."""
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r"><link name="shown"><visual><geometry><box size="1 1 1"/></geometry></visual>'
+                    '</link><link name="body"><collision><geometry><box size="1 2 1"/></geometry></collision></link>'
+                    '<link name="tool0"/></robot>')
+    assert main(["robot", str(urdf), "--density", "1000"]) == 0
+    out = capsys.readouterr().out
+    assert out.rstrip().endswith("3 links: 1 computed (1 exact); 1 with only visual geometry and no declared mass, "
+                                 "not computed: shown; 1 without geometry or mass (frames)")
+    assert "\nshown none " in out and "\ntool0 frame " in out
+    assert "  shown: no collision geometry; 1 visual element, which --geometry visual reads" in out
+    assert main(["robot", str(urdf), "--density", "1000", "--geometry", "visual"]) == 0
+    assert "1 with only collision geometry and no declared mass, not computed: body" in capsys.readouterr().out
