@@ -38,27 +38,34 @@ sys.path.insert(0, os.path.dirname(HERE))
 _ROOT_TAG = re.compile(rb"<(mujoco|robot|sdf)[\s>/]")
 _BODY_OR_INCLUDE = re.compile(rb"<(body|include)[\s>/]")
 
-#: The child process that loads one file: prints one JSON line {"ok": bool, "error": first line, "bodies": n}.
+#: The child process that loads files: for each ``KIND PATH`` line on stdin it prints one JSON line
+#: {"path", "ok": bool or None, "error": first line, "bodies", "mass"}.
 _LOADER = r"""
 import json, site, sys
-kind, path, extra = sys.argv[1], sys.argv[2], sys.argv[3]
-try:
-    if kind == "mjcf":
-        import mujoco
-        model = mujoco.MjModel.from_xml_path(path)
-        out = {"ok": True, "bodies": int(model.nbody), "mass": float(sum(model.body_mass))}
-    else:
-        if extra:
-            site.addsitedir(extra)
-        import pinocchio
-        model = pinocchio.buildModelFromUrdf(path)
-        out = {"ok": True, "bodies": int(model.nbodies), "mass": float(sum(i.mass for i in model.inertias))}
-except ImportError as exc:
-    out = {"ok": None, "error": f"not importable: {exc}"}
-except Exception as exc:
-    out = {"ok": False, "error": (str(exc).strip().splitlines() or [type(exc).__name__])[0][:300]}
-print(json.dumps(out))
+extra = sys.argv[1]
+if extra:
+    site.addsitedir(extra)
+for line in sys.stdin:
+    kind, path = line.rstrip("\n").split("\t", 1)
+    try:
+        if kind == "mjcf":
+            import mujoco
+            model = mujoco.MjModel.from_xml_path(path)
+            out = {"ok": True, "bodies": int(model.nbody), "mass": float(sum(model.body_mass))}
+        else:
+            import pinocchio
+            model = pinocchio.buildModelFromUrdf(path)
+            out = {"ok": True, "bodies": int(model.nbodies), "mass": float(sum(i.mass for i in model.inertias))}
+    except ImportError as exc:
+        out = {"ok": None, "error": f"not importable: {exc}"}
+    except Exception as exc:
+        out = {"ok": False, "error": (str(exc).strip().splitlines() or [type(exc).__name__])[0][:300]}
+    out["path"] = path
+    print(json.dumps(out), flush=True)
 """
+
+#: Files one loader process takes (a crash or time-out retries them one by one).
+BATCH = 24
 
 
 def descriptions(roots: list) -> list:
@@ -84,6 +91,11 @@ def descriptions(roots: list) -> list:
     return found
 
 
+def _message(error: str) -> str:
+    """An error's first message without the checker's count (``ERROR 7: ...``: the copy may have fewer errors)."""
+    return re.sub(r"^ERROR \d+: ", "", error)
+
+
 def load_sdf(program: str, path: str, timeout: float) -> dict:
     """``{"ok", "error"}`` of the libsdformat checker ``program`` on ``path``."""
     if not program:
@@ -96,18 +108,27 @@ def load_sdf(program: str, path: str, timeout: float) -> dict:
     return {"ok": said.startswith("OK"), "error": "" if said.startswith("OK") else said or done.stderr[-200:]}
 
 
-def load(kind: str, path: str, extra: str, timeout: float) -> dict:
-    if kind == "sdf":
-        return load_sdf(extra, path, timeout)
+def load(items: list, extra: str, timeout: float) -> dict:
+    """``{path: {"ok", "error", ...}}`` for ``items`` [(kind, path)] (MJCF and URDF) in one child process;
+    after a crash or time-out the files without an answer are loaded one by one."""
+    text = "".join(f"{kind}\t{path}\n" for kind, path in items)
     try:
-        done = subprocess.run([sys.executable, "-c", _LOADER, kind, path, extra], capture_output=True, text=True,
-                              timeout=timeout, check=False)
-    except subprocess.TimeoutExpired:
-        return {"ok": False, "error": f"timeout after {timeout:g} s"}
-    lines = done.stdout.strip().splitlines()
-    if not lines:
-        return {"ok": False, "error": f"loader exit {done.returncode}: {done.stderr.strip()[-200:]}"}
-    return json.loads(lines[-1])
+        done = subprocess.run([sys.executable, "-c", _LOADER, extra], input=text, capture_output=True, text=True,
+                              timeout=timeout * len(items), check=False)
+        out = done.stdout
+    except subprocess.TimeoutExpired as exc:
+        out = exc.stdout.decode() if isinstance(exc.stdout, bytes) else (exc.stdout or "")
+    answers = {}
+    for line in out.splitlines():
+        with contextlib.suppress(ValueError):
+            answer = json.loads(line)
+            answers[answer["path"]] = answer
+    left = [(k, p) for k, p in items if p not in answers]
+    if left and len(items) == 1:
+        return {items[0][1]: {"ok": False, "error": "the loader crashed or timed out"}}
+    for item in left:
+        answers.update(load([item], extra, timeout))
+    return answers
 
 
 def write_copy(path: str, out: str) -> tuple[int, str]:
@@ -139,6 +160,7 @@ def main(argv=None) -> int:
     counts: collections.Counter = collections.Counter()
     problems = []
     start = time.process_time()
+    pairs = []
     for kind, path, root in descriptions(args.roots):
         if args.only and not re.search(args.only, path):
             continue
@@ -150,16 +172,24 @@ def main(argv=None) -> int:
             counts[f"{kind} no copy"] += 1
             problems.append(f"no copy (exit {code}): {path}: {said}")
             continue
-        extra = args.sdformat_check if kind == "sdf" else args.pinocchio_site
-        original = load(kind, path, extra, args.timeout)
-        copy = load(kind, target, extra, args.timeout)
+        pairs.append((kind, path, target))
+    print(f"written: {len(pairs)} copies, CPU {time.process_time() - start:.1f} s", flush=True)
+    results = {}
+    python = [(k, p) for kind, path, target in pairs if kind != "sdf" for k, p in ((kind, path), (kind, target))]
+    for first in range(0, len(python), BATCH):
+        results.update(load(python[first:first + BATCH], args.pinocchio_site, args.timeout))
+    for kind, path, target in pairs:
+        if kind == "sdf":
+            results[path] = load_sdf(args.sdformat_check, path, args.timeout)
+            results[target] = load_sdf(args.sdformat_check, target, args.timeout)
+        original, copy = results[path], results[target]
         if copy["ok"] is None:
             counts[f"{kind} loader not available"] += 1
         elif copy["ok"] and original["ok"]:
             counts[f"{kind} loads, as its original"] += 1
         elif copy["ok"]:
             counts[f"{kind} loads (its original does not)"] += 1
-        elif not original["ok"] and copy["error"].replace(target, path) == original["error"]:
+        elif not original["ok"] and _message(copy["error"].replace(target, path)) == _message(original["error"]):
             counts[f"{kind} fails as its original"] += 1
         else:
             counts[f"{kind} FAILS"] += 1

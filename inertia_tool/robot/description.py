@@ -958,6 +958,12 @@ def _read_sdf(root, source: str, base: str, packages: dict, geometry: str,
               missing: str = "refuse") -> tuple[str, tuple]:
     """Links of the SDFormat ``<model>`` (or of every model of a ``<world>``), nested and included models
     read too; their links are named ``model::link`` as SDFormat scopes them."""
+    if root.tag == "gazebo":         # osrf gazebo_models' model-1_2.sdf files
+        newest, _ = model_config_files(os.path.dirname(os.path.abspath(source)))
+        there = (f"; the model.config beside it names {newest} as the newest version, which Gazebo loads"
+                 if newest and os.path.abspath(newest) != os.path.abspath(source) else "")
+        raise _fail(source, f"an SDFormat {root.get('version') or '1.2 or older'} file (root element <gazebo>, the "
+                            f"format before SDFormat 1.3), which this tool does not read; expected <sdf>{there}")
     if root.tag != "sdf":
         raise _fail(source, f"not an SDFormat file: the root element is <{root.tag}>, expected <sdf>")
     models = root.findall("model")
