@@ -92,8 +92,9 @@ def descriptions(roots: list) -> list:
 
 
 def _message(error: str) -> str:
-    """An error's first message without the checker's count (``ERROR 7: ...``: the copy may have fewer errors)."""
-    return re.sub(r"^ERROR \d+: ", "", error)
+    """An error's first message without the checker's count (``ERROR 7: ...``: the copy may have fewer errors) and
+    with quoted paths cut to their file names (the copy names the same file relative to its own folder)."""
+    return re.sub(r"'[^']*/([^'/]+)'", r"'\1'", re.sub(r"^ERROR \d+: ", "", error))
 
 
 def load_sdf(program: str, path: str, timeout: float) -> dict:
@@ -151,6 +152,8 @@ def main(argv=None) -> int:
     parser.add_argument("roots", nargs="+")
     parser.add_argument("--out", required=True)
     parser.add_argument("--pinocchio-site", default="")
+    parser.add_argument("--load-only", action="store_true",
+                        help="write nothing: load the copies already in OUT beside their originals")
     parser.add_argument("--sdformat-check", default="", metavar="PROGRAM")
     parser.add_argument("--timeout", type=float, default=120.0)
     parser.add_argument("--only", default="", help="a regular expression the description path must match")
@@ -165,6 +168,10 @@ def main(argv=None) -> int:
         if args.only and not re.search(args.only, path):
             continue
         target = os.path.join(args.out, os.path.basename(os.path.normpath(root)), os.path.relpath(path, root))
+        if args.load_only:
+            if os.path.exists(target):
+                pairs.append((kind, path, target))
+            continue
         os.makedirs(os.path.dirname(target), exist_ok=True)
         code, said = write_copy(path, target)
         counts[f"{kind} written exit {code}"] += 1
