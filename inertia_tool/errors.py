@@ -71,6 +71,7 @@ __all__ = [
     "NonMaterialVolumeWarning",
     "SkippedModelWarning",
     "NonPlanarPolygonWarning",
+    "NoCollidingGeomWarning",
     "PackageFolderWarning",
 ]
 
@@ -327,6 +328,14 @@ class PackageFolderWarning(InertiaToolWarning):
     """A ``package://NAME/...`` URI names no ROS package that can be found, but a plain folder ``NAME`` beside
     the description holds the file (MuJoCo Menagerie's Barkour vb URDF writes ``package://assets/neck.stl`` for
     its ``assets/`` folder).  The file is read from that folder; ROS tools would not resolve the URI."""
+
+
+class NoCollidingGeomWarning(InertiaToolWarning):
+    """An MJCF description read for its collision geometry has no geom that collides: every geom has
+    ``contype`` and ``conaffinity`` 0 and none is in a ``<contact><pair>`` of the file (MuJoCo Menagerie's
+    Apptronik Apollo: its collision class collides only through the pairs of the ``scene.xml`` that includes
+    it).  MuJoCo finds no contact with the file alone, so no link has collision geometry; the message names the
+    files beside it that include it."""
 
 
 class NonPlanarPolygonWarning(InertiaToolWarning):

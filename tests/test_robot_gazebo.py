@@ -861,3 +861,20 @@ def test_json_geometry_names_the_submesh(tmp_path, capsys):
     entry = json.loads(capsys.readouterr().out)["links"][0]["geometry"][0]
     assert entry["submesh"] is None and entry["mesh"] == "vehicle.dae"
     assert "submesh" in output_schema()["$defs"]["robot_link"]["properties"]["geometry"]["items"]["properties"]
+
+
+def test_an_sdformat_1_2_file_names_the_version_gazebo_loads(tmp_path):
+    """osrf gazebo_models ship ``model-1_2.sdf`` (root ``<gazebo version="1.2">``) beside ``model.sdf``; the
+    refusal said only "not an SDFormat file" (robots17): it names the format and the file Gazebo loads."""
+    (tmp_path / "model.config").write_text('<model><sdf version="1.2">model-1_2.sdf</sdf>'
+                                           '<sdf version="1.6">model.sdf</sdf></model>')
+    (tmp_path / "model-1_2.sdf").write_text('<gazebo version="1.2"><model name="m"/></gazebo>')
+    (tmp_path / "model.sdf").write_text('<sdf version="1.6"><model name="m"><link name="a"/></model></sdf>')
+    with pytest.raises(RobotDescriptionError) as info:
+        read_robot(str(tmp_path / "model-1_2.sdf"))
+    message = str(info.value)
+    assert "an SDFormat 1.2 file (root element <gazebo>" in message and "\n" not in message
+    assert message.endswith(f"names {tmp_path / 'model.sdf'} as the newest version, which Gazebo loads")
+    (tmp_path / "model.config").unlink()
+    with pytest.raises(RobotDescriptionError, match=r"which this tool does not read; expected <sdf>$"):
+        read_robot(str(tmp_path / "model-1_2.sdf"))

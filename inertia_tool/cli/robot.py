@@ -148,7 +148,7 @@ def run(args) -> int:
     from ..robot.audit import audit_links
     from ..robot.description import read_robot
     from ..robot.geometry import link_inertials
-    from ..robot.mjcf import inertia_from_geometry
+    from ..robot.mjcf import inertia_from_geometry, warn_if_nothing_collides
     from ..robot.write import included_files, write_corrected
 
     packages = parse_packages(args.package)
@@ -169,7 +169,8 @@ def run(args) -> int:
     density = _density(args)
     with recorded_warnings(args, parser=getattr(args, "robot_parser", None)) as messages:
         robot = read_robot(args.robot, packages=packages, geometry=args.geometry, mappings=mappings,
-                           run_xacro=args.run_xacro)
+                           run_xacro=args.run_xacro, missing_meshes="per-link")
+        warn_if_nothing_collides(robot)
         inertials = link_inertials(robot, density=density, material=args.material, keep_mass=args.keep_mass,
                                    repair=args.repair, max_faces=args.max_faces, assume=assumed_from_args(args))
         audits = audit_links(robot, inertials, keep_mass=args.keep_mass)

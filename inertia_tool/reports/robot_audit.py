@@ -18,14 +18,15 @@ __all__ = ["robot_report_dict", "format_robot_report", "links_without_result", "
 
 
 def links_without_result(robot: RobotDescription, inertials) -> list:
-    """The results that are missing although the link has geometry or a declared mass (a virtual frame —
-    no geometry, no mass — has nothing to compute and is not counted)."""
+    """The results that are missing although the link has geometry or a declared mass, or could not be read
+    (an included model not on disk); a virtual frame — no geometry, no mass — has nothing to compute and is
+    not counted."""
     geometry = {link.name: link for link in robot.links}
     out = []
     for result in inertials:
         link = geometry[result.name]
         declared_mass = link.declared is not None and link.declared.mass > 0
-        if result.properties is None and (link.elements or declared_mass):
+        if result.properties is None and (link.elements or declared_mass or link.unread):
             out.append(result)
     return out
 
@@ -63,6 +64,15 @@ def left_unchanged(inertials, changed, *, included: tuple[str, ...] = ()) -> str
     return ", ".join(parts)
 
 
+def other_geometry_only(robot: RobotDescription, inertials, missing=None) -> list:
+    """The results missing for links that have geometry only of the kind not read (``<visual>`` in a collision
+    audit) and no declared mass: not frames, and not counted in :func:`links_without_result` (a massless link
+    with a visual is what URDF and SDFormat simulators take it for)."""
+    missing = links_without_result(robot, inertials) if missing is None else missing
+    links = {link.name: link for link in robot.links}
+    return [r for r in inertials if r.properties is None and r not in missing and links[r.name].unselected]
+
+
 def summary_line(robot: RobotDescription, inertials) -> str:
     """One line: how many links were computed, by which method, and which have no result."""
     computed = [r for r in inertials if r.properties is not None]
@@ -75,7 +85,12 @@ def summary_line(robot: RobotDescription, inertials) -> str:
             + (f" ({by_method})" if by_method else ""))
     if missing:
         text += f"; {len(missing)} without a result: {', '.join(r.name for r in missing)}"
-    frames = len(inertials) - len(computed) - len(missing)
+    other = other_geometry_only(robot, inertials, missing)
+    frames = len(inertials) - len(computed) - len(missing) - len(other)
+    if other:
+        kind = {"collision": "visual", "visual": "collision"}.get(robot.geometry, "other")
+        text += (f"; {len(other)} with only {kind} geometry and no declared mass, not computed: "
+                 f"{', '.join(r.name for r in other)}")
     if frames:
         text += f"; {frames} without geometry or mass (frames)"
     return text
@@ -193,13 +208,14 @@ def format_robot_report(robot: RobotDescription, inertials, audits) -> str:
     lines += [header, "-" * len(header)]
     inertial: LinkInertial
     missing = links_without_result(robot, inertials)
+    other = other_geometry_only(robot, inertials, missing)
     for inertial, audit, assumed_cell in zip(inertials, audits, assumed):
         props = inertial.properties
         declared = audit.declared
         inside = {True: "yes", False: "no", None: "-"}[audit.com_inside_geometry]
         if audit.com_in_bounding_box is False:
             inside = "no (box)"
-        method = inertial.method or ("frame" if inertial not in missing else "none")
+        method = inertial.method or ("frame" if inertial not in missing and inertial not in other else "none")
         lines.append(f"{inertial.name:<{width}} {method:<10} {assumed_cell:<{a_width}} "
                      f"{_fmt(props.mass if props else None, '10.4g'):>10} "
                      f"{_fmt(declared.mass if declared else None, '12.4g'):>12} "
@@ -221,7 +237,8 @@ def format_robot_report(robot: RobotDescription, inertials, audits) -> str:
     noted = [(r.name, w) for r in inertials for w in r.warnings]
     if noted:
         lines += ["", "warnings:"] + [f"  {name}: {w}" for name, w in noted]
-    without = [r for r in missing if not any(r.problem in i for a in audits if a.name == r.name for i in a.issues)]
+    without = [r for r in missing + other
+               if not any(r.problem in i for a in audits if a.name == r.name for i in a.issues)]
     if without:
         lines += ["", "no result:"] + [f"  {r.name}: {r.problem}" for r in without]
     lines += ["", summary_line(robot, inertials)]

@@ -127,7 +127,7 @@ def _audit_one(path: str, meshes: MeshCache, settings: dict) -> ModelAudit:
     """Read, compute and audit one description (a refusal is kept as the model's ``problem``)."""
     try:
         robot = read_robot(path, packages=settings["packages"], geometry=settings["geometry"],
-                           run_xacro=settings["run_xacro"])
+                           run_xacro=settings["run_xacro"], missing_meshes="per-link")
         inertials = link_inertials(robot, density=settings["density"], material=settings["material"],
                                    keep_mass=settings["keep_mass"], repair=settings["repair"], mesh_cache=meshes,
                                    **settings["options"])

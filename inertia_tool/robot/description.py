@@ -251,12 +251,17 @@ class LinkGeometry:
         Geometry elements of the link the chosen kind leaves out (``<visual>`` when reading collision geometry
         and the other way round; MJCF: the geoms outside the selection), so that a link without geometry can
         say which kind it has.
+    unread : str
+        Why this entry's geometry could not be read at all, "" otherwise: an SDFormat ``<include>`` whose model
+        is not on disk (``read_robot(missing_meshes="per-link")``) is one entry ``NAME::*`` standing for its
+        unknown links, with no elements; it never gets a result.
     """
 
     name: str
     elements: tuple
     declared: DeclaredInertial | None
     unselected: int = 0
+    unread: str = ""
 
 
 @frozen_value
@@ -481,7 +486,8 @@ def _urdf_inertial(link, source: str) -> DeclaredInertial | None:
     return _declared(mass, rotation, position, _tensor(*values), what, source)
 
 
-def _urdf_geometry(element, link_name: str, label: str, base: str, packages: dict, source: str):
+def _urdf_geometry(element, link_name: str, label: str, base: str, packages: dict, source: str,
+                   missing: str = "refuse"):
     geometry = element.find("geometry")
     what = f"link {link_name!r} {label}"
     shapes = [c for c in geometry if isinstance(c.tag, str)] if geometry is not None else []
@@ -511,12 +517,13 @@ def _urdf_geometry(element, link_name: str, label: str, base: str, packages: dic
             raise _fail(source, f"{what}: <mesh> without a filename")
         scale = _scale(_numbers(shape.get("scale"), 3, f"{what} <mesh scale>", source, default=(1, 1, 1)),
                        f"{what} <mesh scale>", source)
-        path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name)
+        path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name, missing=missing)
         return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name)
     raise _fail(source, f"{what}: unsupported geometry <{kind}> (expected box, cylinder, sphere, capsule or mesh)")
 
 
-def _read_urdf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
+def _read_urdf(root, source: str, base: str, packages: dict, geometry: str,
+               missing: str = "refuse") -> tuple[str, tuple]:
     if root.tag != "robot":
         raise _fail(source, f"not a URDF: the root element is <{root.tag}>, expected <robot>")
     links = []
@@ -526,7 +533,7 @@ def _read_urdf(root, source: str, base: str, packages: dict, geometry: str) -> t
         name = link.get("name")
         if not name:
             raise _fail(source, "a <link> without a name")
-        elements = tuple(_urdf_geometry(el, name, f"{geometry} {k + 1}", base, packages, source)
+        elements = tuple(_urdf_geometry(el, name, f"{geometry} {k + 1}", base, packages, source, missing)
                          for k, el in enumerate(link.findall(geometry)))
         other = len(link.findall(_OTHER_KIND[geometry])) if geometry in _OTHER_KIND else 0
         links.append(LinkGeometry(name=name, elements=elements, declared=_urdf_inertial(link, source),
@@ -576,7 +583,8 @@ def _sdf_inertial(link, source: str) -> DeclaredInertial | None:
     return _declared(mass, rotation, position, _tensor(*values), what, source)
 
 
-def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict, source: str):
+def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict, source: str,
+                  missing: str = "refuse"):
     what = f"link {link_name!r} {label}"
     geometry = element.find("geometry")
     shapes = [c for c in geometry if isinstance(c.tag, str)] if geometry is not None else []
@@ -612,7 +620,7 @@ def _sdf_geometry(element, link_name: str, label: str, base: str, packages: dict
             raise _fail(source, f"{what}: <mesh> without a <uri>")
         scale = _scale(_numbers(shape.findtext("scale"), 3, f"{what} <mesh><scale>", source, default=(1, 1, 1)),
                        f"{what} <mesh><scale>", source)
-        path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name)
+        path = resolve_uri(uri, base=base, packages=packages, source=source, link=link_name, missing=missing)
         submesh, center = _sdf_submesh(shape.find("submesh"), path, what, source)
         return GeometryElement("mesh", rotation, translation, mesh=path, uri=uri, scale=scale, name=name,
                                submesh=submesh, submesh_center=center)
@@ -749,6 +757,11 @@ def model_config_files(folder: str) -> tuple[str | None, list[str]]:
             [os.path.normpath(os.path.join(folder, name)) for _, _, name in listed])
 
 
+#: The messages of :func:`_sdf_include_file` that say its model is not on disk (not that the include is malformed).
+_ABSENT_INCLUDE = re.compile(r"^.*?: <include> .*(?:: cannot find model |, which does not exist$"
+                             r"|: a Gazebo Fuel model )")
+
+
 def _sdf_include_file(include, base: str, packages: dict, source: str) -> str | None:
     """The SDFormat file an ``<include><uri>`` names: a file, or a model folder (the newest version its
     ``model.config`` lists, :func:`model_config_files`, else ``model.sdf``); None for a stock model of
@@ -800,8 +813,12 @@ def _sdf_include_file(include, base: str, packages: dict, source: str) -> str | 
 
 
 def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, source: str, stack: tuple,
-               budget: list | None = None) -> list:
+               budget: list | None = None, missing: str = "refuse") -> list:
     """The links of ``model`` and of its nested and included models (names prefixed ``model::``).
+
+    ``missing="per-link"``: a mesh file that does not exist is kept (its link says so), and an ``<include>``
+    whose model is not on disk becomes one entry ``NAME::*`` without geometry whose ``unread`` says why (its
+    links are unknown).
 
     ``budget``: ``[files, bytes]`` the includes may still read (at most ``MAX_SDF_INCLUDES`` files and
     :data:`MAX_DESCRIPTION_BYTES` bytes in all, so repeated includes cannot multiply without bound)."""
@@ -816,7 +833,8 @@ def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, sou
             name = child.get("name")
             if not name:
                 raise _fail(source, "a <link> without a name")
-            elements = tuple(_sdf_geometry(el, prefix + name, f"{geometry} {k + 1}", base, packages, source)
+            elements = tuple(_sdf_geometry(el, prefix + name, f"{geometry} {k + 1}", base, packages, source,
+                                           missing)
                              for k, el in enumerate(child.findall(geometry)) if not _sdf_without_volume(el))
             other = (sum(1 for el in child.findall(_OTHER_KIND[geometry]) if not _sdf_without_volume(el))
                      if geometry in _OTHER_KIND else 0)
@@ -824,9 +842,15 @@ def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, sou
                                       unselected=other))
         elif child.tag == "model":
             links += _sdf_links(child, f"{prefix}{child.get('name', '')}::", base, packages, geometry, source,
-                                stack + (f"model {child.get('name')}",), budget)
+                                stack + (f"model {child.get('name')}",), budget, missing)
         elif child.tag == "include":
-            path = _sdf_include_file(child, base, packages, source)
+            try:
+                path = _sdf_include_file(child, base, packages, source)
+            except RobotDescriptionError as exc:
+                if missing == "refuse" or not _ABSENT_INCLUDE.search(str(exc)):
+                    raise
+                links.append(_absent_include(child, prefix, str(exc)[len(source) + 2:]))
+                continue
             if path is None:        # a stock light or ground plane that is not on disk: nothing with mass
                 continue
             key = os.path.realpath(path)
@@ -846,23 +870,40 @@ def _sdf_links(model, prefix: str, base: str, packages: dict, geometry: str, sou
                 continue
             name = (child.findtext("name") or "").strip() or inner[0].get("name", "")
             links += _sdf_links(inner[0], f"{prefix}{name}::", os.path.dirname(path), packages, geometry, source,
-                                stack + (key,), budget)
+                                stack + (key,), budget, missing)
     return links
 
 
-def _read_sdf(root, source: str, base: str, packages: dict, geometry: str) -> tuple[str, tuple]:
+def _absent_include(include, prefix: str, reason: str) -> LinkGeometry:
+    """The entry standing for the links of an ``<include>`` whose model is not on disk: ``NAME::*`` (the
+    include's ``<name>``, else the last part of its URI), no geometry, ``unread`` the reason."""
+    uri = (include.findtext("uri") or "").strip()
+    name = (include.findtext("name") or "").strip() or uri.rstrip("/").rsplit("/", 1)[-1] or "include"
+    return LinkGeometry(name=f"{prefix}{name}::*", elements=(), declared=None,
+                        unread=f"included model not read: {reason}")
+
+
+def _read_sdf(root, source: str, base: str, packages: dict, geometry: str,
+              missing: str = "refuse") -> tuple[str, tuple]:
     """Links of the SDFormat ``<model>`` (or of every model of a ``<world>``), nested and included models
     read too; their links are named ``model::link`` as SDFormat scopes them."""
+    if root.tag == "gazebo":         # osrf gazebo_models' model-1_2.sdf files
+        newest, _ = model_config_files(os.path.dirname(os.path.abspath(source)))
+        there = (f"; the model.config beside it names {newest} as the newest version, which Gazebo loads"
+                 if newest and os.path.abspath(newest) != os.path.abspath(source) else "")
+        raise _fail(source, f"an SDFormat {root.get('version') or '1.2 or older'} file (root element <gazebo>, the "
+                            f"format before SDFormat 1.3), which this tool does not read; expected <sdf>{there}")
     if root.tag != "sdf":
         raise _fail(source, f"not an SDFormat file: the root element is <{root.tag}>, expected <sdf>")
     models = root.findall("model")
     worlds = root.findall("world")
     if models and len(models) == 1 and not worlds:
         model = models[0]
-        links = _sdf_links(model, "", base, packages, geometry, source, (os.path.realpath(source),))
+        links = _sdf_links(model, "", base, packages, geometry, source, (os.path.realpath(source),), missing=missing)
         return model.get("name", ""), tuple(links)
     if len(worlds) == 1 and not models:
-        links = _sdf_links(worlds[0], "", base, packages, geometry, source, (os.path.realpath(source),))
+        links = _sdf_links(worlds[0], "", base, packages, geometry, source, (os.path.realpath(source),),
+                           missing=missing)
         return worlds[0].get("name", ""), tuple(links)
     others = sorted({c.tag for c in root if isinstance(c.tag, str)} - {"model", "world"})
     if not models and not worlds and others:          # osrf gazebo_models sun/model.sdf: a <light> only
@@ -904,7 +945,8 @@ def _check_unique_names(links, source: str) -> None:
         seen.add(link.name)
 
 
-#: What :func:`read_robot` does with an MJCF mesh file that does not exist (``missing_meshes``).
+#: What :func:`read_robot` does with a mesh file (or SDFormat included model) that does not exist
+#: (``missing_meshes``).
 MISSING_MESHES = ("refuse", "per-link")
 
 
@@ -935,9 +977,12 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         Limits of the xacro expansion (default :data:`~inertia_tool.isolate.XACRO_LIMITS`; the
         ``INERTIA_TOOL_*_LIMIT`` environment variables override both).
     missing_meshes : {"refuse", "per-link"}
-        MJCF: a mesh file that does not exist refuses the whole description (default, as MuJoCo does), or only
-        its link, whose result then says ``mesh file missing: PATH`` (a corpus with files left out, compared
-        body by body).  URDF and SDFormat always refuse.
+        A mesh file that does not exist refuses the whole description (default, as MuJoCo, urdfdom and
+        SDFormat do), or only its link, whose result then says ``mesh file missing: PATH`` (the command line:
+        every link that can be computed is).  With ``"per-link"`` an SDFormat ``<include>`` whose model is not
+        on disk becomes one entry ``NAME::*`` without geometry, its ``unread`` the reason (its links are
+        unknown).  An unknown package, or a path naming something that is not a regular file, refuses either
+        way.
 
     Returns
     -------
@@ -979,9 +1024,9 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         raise UsageError(f"Expected `geometry` collision or visual for {source} (a {fmt.upper()} link's visual "
                          "and collision elements describe the same part), got 'all' (MJCF only)")
     elif fmt in ("urdf", "xacro"):
-        name, links = _read_urdf(root, source, base, packages, geometry)
+        name, links = _read_urdf(root, source, base, packages, geometry, missing_meshes)
     else:
-        name, links = _read_sdf(root, source, base, packages, geometry)
+        name, links = _read_sdf(root, source, base, packages, geometry, missing_meshes)
     if not links:
         raise _fail(source, "no links found")
     _check_unique_names(links, source)

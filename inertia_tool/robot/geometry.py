@@ -1025,14 +1025,18 @@ def _users_taken(parts: list, cache: dict) -> tuple[str, ...]:
     return user_named(names)
 
 
-def _link_uncertainty(parts: list, total: MassProperties, scale: float) -> LinkUncertainty | None:
-    """Bounds for a link from its elements' (``scale``: mass of each unit part in the link result)."""
-    estimated = [(p, u) for _, p, m, u in parts if m == "estimate" and u is not None]
+def _link_uncertainty(parts: list, total: MassProperties, scale) -> LinkUncertainty | None:
+    """Bounds for a link from its elements'.  ``scale``: the link result's mass per unit of each part's
+    (unit-density) mass, one number for all parts or one per part (``--density model``: each geom's density, or
+    its ``mass`` over its unit mass); a part's absolute mass bound is ``u.mass * p.mass * scale``."""
+    scales = list(scale) if isinstance(scale, (list, tuple)) else [scale] * len(parts)
+    estimated = [(p, u, k) for (_, p, m, u), k in zip(parts, scales, strict=True) if m == "estimate" and u is not None]
     if not estimated:
         return None
-    dm = [u.mass * p.mass * scale for p, u in estimated]
-    spread = sum(d * float(np.linalg.norm(p.center_of_mass - total.center_of_mass)) for d, (p, _) in zip(dm, estimated))
-    shift = sum(p.mass * scale * u.center_of_mass for p, u in estimated)
+    dm = [u.mass * p.mass * k for p, u, k in estimated]
+    spread = sum(d * float(np.linalg.norm(p.center_of_mass - total.center_of_mass))
+                 for d, (p, _, _) in zip(dm, estimated))
+    shift = sum(p.mass * k * u.center_of_mass for p, u, k in estimated)
     floor = total.mass - sum(dm)
     com = (shift + spread) / floor if floor > 0 else float("inf")
     inertia = estimated[0][1].inertia if len(parts) == 1 and np.isfinite(estimated[0][1].inertia) else None
@@ -1064,6 +1068,17 @@ def _one_link(link: LinkGeometry, **options) -> LinkInertial:
     return _with_engine_warnings(result, caught)
 
 
+def _missing_files(paths: list) -> str:
+    """``"mesh file missing: P"`` for a link's absent mesh files, each with its near match if there is one
+    (:func:`~inertia_tool.robot.resolve.near_match`: nothing is read in its place)."""
+    from .resolve import near_match
+    named = []
+    for path in dict.fromkeys(paths):
+        hint = near_match(path)
+        named.append(f"{path} ({hint})" if hint else path)
+    return f"mesh file missing: {', '.join(named)}"
+
+
 #: The start of a link's problem when its mesh was refused: without ``repair``, and with it.
 REFUSED = "mesh needs repair or cannot be read"
 REFUSED_REPAIRED = "mesh cannot be read or bounded, even with repair"
@@ -1074,6 +1089,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
                      assume: UserAssumptions = NOTHING_ASSUMED) -> LinkInertial:
     """The result for one link, or the reason there is none (never raises for the link's own problems)."""
     nan = float("nan")
+    if link.unread:      # an SDFormat include not on disk (read_robot(missing_meshes="per-link"))
+        return LinkInertial(link.name, None, nan, basis, link.unread)
     if not link.elements:
         other = {"collision": "visual", "visual": "collision"}.get(geometry)
         has = (f"; {link.unselected} {other} element{'s' if link.unselected > 1 else ''}, which --geometry "
@@ -1083,7 +1100,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     missing = [e.mesh for e in link.elements if e.mesh is not None and not os.path.exists(e.mesh)
                and not (model and (e.mass == 0 or (e.mass is None and e.density == 0)))]
     if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute
-        return LinkInertial(link.name, None, nan, basis, f"mesh file missing: {', '.join(dict.fromkeys(missing))}")
+        return LinkInertial(link.name, None, nan, basis, _missing_files(missing))
     try:
         parts, massless, joined = _element_parts(link, cache=cache, repair=repair, model=model, budget=budget,
                                                  assume=assume)
@@ -1118,7 +1135,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
             props = MassProperties(mass=total.mass, volume=volume, center_of_mass=total.center_of_mass,
                                    inertia=total.inertia, surface_area=total.surface_area,
                                    density=total.mass / volume if volume > 0 else nan, name=link.name)
-            uncertainty = _link_uncertainty(parts, props, 1.0) if method == "estimate" else None
+            scales = [w.mass / unit.mass if unit.mass else 0.0 for w, (_, unit, _, _) in zip(weighted, parts)]
+            uncertainty = _link_uncertainty(parts, props, scales) if method == "estimate" else None
             return LinkInertial(link.name, props, props.density, basis, method=method, uncertainty=uncertainty,
                                 warnings=tuple(warned), assumptions=taken)
         units = [u for _, u, _, _ in parts]

@@ -56,10 +56,10 @@ from __future__ import annotations
 import dataclasses
 import os
 import re
+import warnings
 
 import numpy as np
 
-from ..errors import RobotDescriptionError
 from .description import DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive
 from .mjcf_bodies import MAX_REPLICAS, _attached_body, _child_bodies, _replica_poses
 from .mjcf_model import (INERTIA_FROM_GEOMETRY, MAX_INCLUDE_DEPTH, MAX_INCLUDED_FILES, MESH_INERTIA_MODES,
@@ -69,7 +69,8 @@ from .resolve import resolve_uri
 
 # orientation_matrix, inertia_from_geometry and the limits are read from here too (the modules they moved to
 # are stages of this reader)
-__all__ = ["read_mjcf", "orientation_matrix", "inertia_from_geometry", "MAX_INCLUDE_DEPTH", "MAX_INCLUDED_FILES",
+__all__ = ["read_mjcf", "orientation_matrix", "inertia_from_geometry", "warn_if_nothing_collides", "files_including",
+           "MAX_INCLUDE_DEPTH", "MAX_INCLUDED_FILES",
            "MAX_REPLICAS", "MESH_INERTIA_MODES", "INERTIA_FROM_GEOMETRY"]
 
 _GEOM_KINDS = {"box": "box", "sphere": "sphere", "cylinder": "cylinder", "capsule": "capsule",
@@ -157,20 +158,12 @@ def _optional_number(attrs: dict, key: str, what: str, source: str) -> float | N
     return value
 
 
-_MISSING = re.compile(r": resolves to (.+?), which does not exist(?:; near match: .*)?$")
-
-
 def _mesh_path(file: str, folders: list, packages: dict, source: str, link: str, missing_meshes: str) -> str:
     """The mesh file of an asset: the first of ``folders`` holding it (else the first folder), resolved; a file
     that does not exist is refused, or with ``missing_meshes="per-link"`` returned as the path it would have."""
     found = [f for f in folders if "://" in file or os.path.isfile(os.path.join(f, file))]
-    try:
-        return resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link)
-    except RobotDescriptionError as exc:
-        match = _MISSING.search(str(exc))
-        if missing_meshes == "refuse" or match is None:
-            raise
-        return match.group(1)
+    return resolve_uri(file, base=(found or folders)[0], packages=packages, source=source, link=link,
+                       missing=missing_meshes)
 
 
 def _geom(attrs: dict, pose, label: str, link: str, meshes: dict, packages: dict, compiler,
@@ -387,3 +380,53 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
         raise _fail(source, "no bodies: every geom is in <worldbody> (a scene: terrain, floor, walls), which MuJoCo "
                             "fixes to the world with no mass; expected a model with at least one <body>")
     return root.get("model", ""), tuple(links)
+
+
+#: :func:`files_including` reads at most this many ``*.xml`` files beside the description, each up to this size.
+MAX_SIBLINGS_READ = (200, 4 << 20)
+
+
+def files_including(source: str) -> tuple[str, ...]:
+    """The ``*.xml`` files in the folder of ``source`` whose ``<include file="...">`` names it (by its file name,
+    as Menagerie's ``scene.xml`` includes the robot beside it), sorted; at most :data:`MAX_SIBLINGS_READ` files
+    of at most its size are looked at."""
+    folder = os.path.dirname(os.path.abspath(source))
+    name = os.path.basename(source)
+    pattern = re.compile(rb"<include\s[^>]*file\s*=\s*[\"'](?:\./)?" + re.escape(name.encode()) + rb"[\"']")
+    count, size = MAX_SIBLINGS_READ
+    found = []
+    try:
+        entries = sorted(os.listdir(folder))
+    except OSError:
+        return ()
+    for entry in [e for e in entries if e.endswith(".xml") and e != name][:count]:
+        path = os.path.join(folder, entry)
+        try:
+            if not os.path.isfile(path) or os.path.getsize(path) > size:
+                continue
+            with open(path, "rb") as fh:
+                if pattern.search(fh.read()):
+                    found.append(path)
+        except OSError:
+            continue
+    return tuple(found)
+
+
+def warn_if_nothing_collides(robot) -> None:
+    """Warn (:class:`~inertia_tool.errors.NoCollidingGeomWarning`) when an MJCF description read for its
+    collision geometry has geoms but none that collides, naming the files beside it that include it: their
+    ``<contact><pair>`` elements may collide its geoms (MuJoCo Menagerie's Apptronik Apollo and ``scene.xml``)."""
+    from ..errors import NoCollidingGeomWarning
+    if robot.format != "mjcf" or robot.geometry != "collision":
+        return
+    if any(link.elements for link in robot.links) or not any(link.unselected for link in robot.links):
+        return
+    others = sum(link.unselected for link in robot.links)
+    scenes = files_including(robot.source)
+    where = (f"; {', '.join(scenes)} include{'s' if len(scenes) == 1 else ''} it and may collide its geoms "
+             "through <contact><pair>: audit that file" if scenes else "")
+    warnings.warn(NoCollidingGeomWarning(
+        f"{robot.source}: no geom collides (all {others} have contype and conaffinity 0 and none is in a "
+        f"<contact><pair> of this file), so no link has collision geometry as MuJoCo counts it{where}; "
+        "--geometry visual reads the geoms that do not collide (visual and collision shapes together)"),
+        stacklevel=2)

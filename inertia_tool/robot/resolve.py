@@ -206,7 +206,7 @@ def _case_walk_folder(folder: str, parts: list[str]) -> str | None:
     return folder
 
 
-def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) -> str:
+def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str, missing: str = "refuse") -> str:
     """Absolute path of the file ``uri`` names (see the module docstring for the rules).
 
     Parameters
@@ -219,11 +219,15 @@ def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) 
         Package name → directory.
     source, link : str
         The description file and the link, for the message.
+    missing : {"refuse", "per-link"}
+        A path that resolves but names nothing on disk: refused (default), or returned as it is, for the link
+        to say which file is absent (``read_robot(missing_meshes="per-link")``).  An unknown package or scheme,
+        and a path that names something other than a regular file, are refused either way.
 
     Raises
     ------
     RobotDescriptionError
-        Unknown scheme, unknown package, or no such file.
+        Unknown scheme, unknown package, or no such file (with ``missing="refuse"``).
     """
     where = f"{source}: link {link!r}: mesh {uri!r}"
     text = uri.strip()
@@ -255,6 +259,8 @@ def resolve_uri(uri: str, *, base: str, packages: dict, source: str, link: str) 
         if os.path.exists(path):             # a FIFO, a device or a link to one: never opened (no hang)
             reason = not_regular_reason(os.stat(path).st_mode, path) or "is not a regular file"
             raise RobotDescriptionError(f"{where}: resolves to {path}, which {reason}")
+        if missing == "per-link":
+            return path
         hint = near_match(path)
         raise RobotDescriptionError(f"{where}: resolves to {path}, which does not exist"
                                     + (f"; {hint}" if hint else ""))
