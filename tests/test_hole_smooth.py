@@ -151,6 +151,11 @@ def test_a_refusal_of_holes_too_large_suggests_smooth_holes_only_where_not_state
     with pytest.raises(InvalidMeshError, match="cannot be bounded usefully") as plain:
         mass_properties(half, repair=True)
     assert "`assume` smooth-holes" in str(plain.value)
+    assert "`assume` faceted-holes" in str(plain.value)
     with pytest.raises(InvalidMeshError, match="cannot be bounded usefully") as stated:
         mass_properties(half, repair=True, assume=("smooth-holes",))
-    assert "smooth-holes" not in str(stated.value).split("within ±50 % mass)")[-1]
+    way_on = str(stated.value).split("within ±50 % mass)")[-1]
+    assert "smooth-holes" not in way_on and "`assume` faceted-holes" in way_on
+    with pytest.raises(InvalidMeshError, match="cannot be bounded usefully") as both:
+        mass_properties(half, repair=True, assume=("smooth-holes", "faceted-holes"))
+    assert "`assume`" not in str(both.value).split("within ±50 % mass)")[-1]

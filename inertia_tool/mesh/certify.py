@@ -318,7 +318,7 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
     uncertainty = None
     if patched is not None:
         from .uncertainty import check_useful, uncertainty_from, with_roundoff   # imported on use: repair only
-        from .hole_assumptions import ISLAND_HINT, SMOOTH_HINT, SMOOTH_HOLES
+        from .hole_assumptions import ISLAND_HINT, holes_hint
         whole = total(shells.moments)
         doubt, far = patched.uncertainty.volume_in_doubt, patched.far
         if spread is not None:                # R4: the reading the file does not decide is in doubt as well
@@ -338,10 +338,10 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
             check_useful(whole.volume, uncertainty, source=source, what=what,
                          why="the holes are too large to guess what fills them; close them in a mesh editor"
                          + ISLAND_HINT)
-        elif SMOOTH_HOLES.name not in assumed:   # the user may state the lost surface was smooth (not stated yet)
+        elif holes_hint(assumed):    # the user may state the lost surface was smooth or faceted (not stated yet)
             check_useful(whole.volume, uncertainty, source=source, what=what,
                          why="the holes are too large to guess what fills them; close them in a mesh editor"
-                         + SMOOTH_HINT)
+                         + holes_hint(assumed))
         else:
             check_useful(whole.volume, uncertainty, source=source, what=what)
         # a patched surface whose union could not be verified (R6) keeps "unverified": the patches' bound does

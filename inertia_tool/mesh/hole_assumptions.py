@@ -50,7 +50,8 @@ from typing import Iterable
 
 __all__ = ["HoleAssumption", "BALL", "CAPSULE", "FLAT", "CREASE", "CONVEX", "INNER", "BEND", "GRAPH", "PLANAR",
            "QUADRIC", "ALL", "stated", "named", "FLAT_ISLANDS", "USER_ASSUMPTIONS", "user_named", "UserAssumptions",
-           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT", "SMOOTH_HINT", "SMOOTH_HOLES", "FACETED_HOLES"]
+           "NOTHING_ASSUMED", "user_stated", "ISLAND_HINT", "SMOOTH_HINT", "FACETED_HINT", "holes_hint", "SMOOTH_HOLES",
+           "FACETED_HOLES"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -166,6 +167,16 @@ ISLAND_HINT = " or, if the lost surface was flat, `assume` flat-islands"
 
 #: The same for holes that are not islands: the user may know the surface round them went on smoothly.
 SMOOTH_HINT = " or, if the surface round each hole is smooth and went on smoothly across it, `assume` smooth-holes"
+FACETED_HINT = (" or, if the part round each hole is flat faces meeting at edges and stays inside their planes, "
+                "`assume` faceted-holes")
+
+
+def holes_hint(assumed: Iterable[str]) -> str:
+    """The "ball too large" refusal's way on: each hole assumption (:data:`SMOOTH_HOLES`, :data:`FACETED_HOLES`)
+    the user has not stated yet, as a clause to append to the refusal's reason ("" when both are stated)."""
+    stated = set(assumed)
+    return "".join(hint for a, hint in ((SMOOTH_HOLES, SMOOTH_HINT), (FACETED_HOLES, FACETED_HINT))
+                   if a.name not in stated)
 
 
 def user_named(names: Iterable[str]) -> tuple[str, ...]:
