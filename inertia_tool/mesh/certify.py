@@ -338,10 +338,10 @@ def certify(shells: Shells, *, kind: str, checks: list[str], method: str, patche
             check_useful(whole.volume, uncertainty, source=source, what=what,
                          why="the holes are too large to guess what fills them; close them in a mesh editor"
                          + ISLAND_HINT)
-        elif holes_hint(assumed):    # the user may state the lost surface was smooth or faceted (not stated yet)
+        elif way_on := holes_hint(assumed):   # the user may state the lost surface was smooth or faceted (not yet)
             check_useful(whole.volume, uncertainty, source=source, what=what,
                          why="the holes are too large to guess what fills them; close them in a mesh editor"
-                         + holes_hint(assumed))
+                         + way_on)
         else:
             check_useful(whole.volume, uncertainty, source=source, what=what)
         # a patched surface whose union could not be verified (R6) keeps "unverified": the patches' bound does

@@ -130,7 +130,6 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
     touch, nest, touch_within = settle_touching(v, f, labels, contacts, touch, nest)
     within, crossing_with = None, touch.crossing_with
     copies = np.zeros((0, 2), dtype=np.int64)
-    apart = (crossing_with, touch_within)
     if touch.complete:
         rounding = rounding_volumes(v, shells.moments)
         within, crossing_with = _within(v, f, labels, file_volumes, crossing_with, rounding)
@@ -152,7 +151,7 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
     # it, not crossing ones: wound outward, the inner one has winding 1 and 2 on its sides and is left out, exact
     # (before: united by the boolean, ``unverified``)
     if touch.complete and not again:
-        s_cross, s_within = apart if len(copies) else (crossing_with, touch_within)
+        s_cross, s_within = apart               # the same pairs as now where no nested copies were found
         s_depth = orient_by_depth(file_volumes, nest, s_cross, within=_both(within, s_within))[2] if len(copies) \
             else depth
         for inside_crossed in (True, False):
