@@ -1,0 +1,94 @@
+"""The weld sweep's faces read column by column (issue 25, soup18) give what the (k, 3, 3) reading gave, bit for bit.
+
+``precision._swept_faces`` sums Steiner's bound ``3 Σ (2 δ A + (π/2) δ² P + (4/3) π δ³)`` over the faces a weld
+moved and boxes their corners.  It now gathers one (k,) column per corner and axis and forms every product and
+sum in the order of ``numpy.cross`` and ``numpy.linalg.norm(·, axis=1)``; the reference below is the code it
+replaced, kept verbatim.  Inputs: random soups and shared-vertex meshes with coordinates over many binades, reach
+zero at some corners (faces left out), none at all, and more faces than one chunk (the chunks' partial sums are
+added in the same order).  No timings here: ``benchmarks/bench_repair.py`` and ``docs/performance.md``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from inertia_tool.mesh import precision
+
+
+def _reference(vertices, faces, reach, chunk):
+    """``_swept_faces`` before soup18 (``numpy.linalg.norm`` of (k, 3) rows of a (k, 3, 3) gather)."""
+    total = 0.0
+    lo = hi = None
+    for start in range(0, len(faces), chunk):
+        f = faces[start:start + chunk]
+        r = reach[f]
+        d = np.maximum(np.maximum(r[:, 0], r[:, 1]), r[:, 2])
+        hit = d > 0
+        if not hit.any():
+            continue
+        f, d = f[hit], d[hit]
+        tri = vertices[f]
+        ab, ac, bc = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], tri[:, 2] - tri[:, 1]
+        normal = np.empty_like(ab)
+        for axis, (p, q) in enumerate(((1, 2), (2, 0), (0, 1))):
+            np.multiply(ab[:, p], ac[:, q], out=normal[:, axis])
+            normal[:, axis] -= ab[:, q] * ac[:, p]
+        area = 0.5 * np.linalg.norm(normal, axis=1)
+        perimeter = np.linalg.norm(ab, axis=1) + np.linalg.norm(ac, axis=1) + np.linalg.norm(bc, axis=1)
+        total += 3.0 * float(np.sum(2.0 * d * area + 0.5 * math.pi * d * d * perimeter
+                                    + 4.0 / 3.0 * math.pi * d ** 3))
+        corners = tri.reshape(-1, 3)
+        a, b = corners.min(axis=0), corners.max(axis=0)
+        lo = a if lo is None else np.minimum(lo, a)
+        hi = b if hi is None else np.maximum(hi, b)
+    return total, (None if lo is None or hi is None else (lo, hi))
+
+
+def _case(seed: int, n_faces: int, soup: bool, scale_exp: int, zero_share: float):
+    rng = np.random.default_rng([seed, 18])
+    if soup:        # every face its own corners, jittered copies of a few points
+        base = rng.standard_normal((max(3, n_faces // 4), 3)) * 10.0 ** scale_exp
+        v = base[rng.integers(0, len(base), 3 * n_faces)]
+        v = v + rng.standard_normal(v.shape) * 10.0 ** (scale_exp - 7)
+        f = np.arange(3 * n_faces, dtype=np.int64).reshape(-1, 3)
+    else:           # shared corners, indices in any order, far off the origin
+        v = rng.standard_normal((max(3, n_faces), 3)) * 10.0 ** scale_exp + rng.uniform(-1e3, 1e3, 3)
+        f = rng.integers(0, len(v), (n_faces, 3)).astype(np.int64)
+    reach = rng.uniform(0, 1, len(v)) * 10.0 ** (scale_exp - rng.integers(3, 9))
+    reach[rng.random(len(v)) < zero_share] = 0.0
+    return v, f, reach
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 400), st.booleans(), st.integers(-6, 6),
+       st.sampled_from([0.0, 0.3, 0.9, 1.0]), st.sampled_from([7, 64, 1 << 20]))
+def test_swept_faces_are_the_row_readings_bit_for_bit(seed, n_faces, soup, scale_exp, zero_share, chunk):
+    v, f, reach = _case(seed, n_faces, soup, scale_exp, zero_share)
+    old_chunk = precision._CHUNK
+    try:
+        precision._CHUNK = chunk                     # several chunks even on small cases
+        got = precision._swept_faces(v, f, reach)
+    finally:
+        precision._CHUNK = old_chunk
+    want = _reference(v, f, reach, chunk)
+    assert got[0].hex() == want[0].hex()
+    if want[1] is None:
+        assert got[1] is None
+    else:
+        assert got[1] is not None
+        assert got[1][0].tobytes() == want[1][0].tobytes() and got[1][1].tobytes() == want[1][1].tobytes()
+
+
+def test_swept_faces_of_one_triangle_is_steiners_formula():
+    # the right triangle (0,0,0), (3,0,0), (0,4,0): A = 6, P = 12; δ = 0.5 at one corner
+    v = np.array([[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [0.0, 4.0, 0.0]])
+    reach = np.array([0.0, 0.5, 0.0])
+    total, box = precision._swept_faces(v, np.array([[0, 1, 2]]), reach)
+    delta = 0.5
+    assert total == 3.0 * (2 * delta * 6.0 + math.pi / 2 * delta ** 2 * 12.0 + 4 / 3 * math.pi * delta ** 3)
+    assert box is not None and box[0].tolist() == [0, 0, 0] and box[1].tolist() == [3, 4, 0]
+    assert precision._swept_faces(v, np.array([[0, 1, 2]]), np.zeros(3)) == (0.0, None)
