@@ -1,11 +1,14 @@
-"""The weld sweep's faces read column by column (issue 25, soup18) give what the (k, 3, 3) reading gave, bit for bit.
+"""The tolerance weld's measures read column by column (issue 25, soup18) give what the row readings gave, bit for bit.
 
 ``precision._swept_faces`` sums Steiner's bound ``3 Σ (2 δ A + (π/2) δ² P + (4/3) π δ³)`` over the faces a weld
 moved and boxes their corners.  It now gathers one (k,) column per corner and axis and forms every product and
 sum in the order of ``numpy.cross`` and ``numpy.linalg.norm(·, axis=1)``; the reference below is the code it
-replaced, kept verbatim.  Inputs: random soups and shared-vertex meshes with coordinates over many binades, reach
-zero at some corners (faces left out), none at all, and more faces than one chunk (the chunks' partial sums are
-added in the same order).  No timings here: ``benchmarks/bench_repair.py`` and ``docs/performance.md``.
+replaced, kept verbatim.  ``merge.merge_close_vertices`` gathers its points with ``numpy.take`` and measures the
+largest move one column at a time (the root of the largest square): the same faces, representatives and largest
+move as the loop of ``numpy.linalg.norm`` it replaced (kept below).  Inputs: random soups and shared-vertex
+meshes with coordinates over many binades, reach zero at some corners (faces left out), none at all, and more
+faces than one chunk (the chunks' partial sums are added in the same order).  No timings here:
+``benchmarks/bench_repair.py`` and ``docs/performance.md``.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from inertia_tool.mesh import precision
+from inertia_tool.mesh import merge, precision
 
 
 def _reference(vertices, faces, reach, chunk):
@@ -92,3 +95,49 @@ def test_swept_faces_of_one_triangle_is_steiners_formula():
     assert total == 3.0 * (2 * delta * 6.0 + math.pi / 2 * delta ** 2 * 12.0 + 4 / 3 * math.pi * delta ** 3)
     assert box is not None and box[0].tolist() == [0, 0, 0] and box[1].tolist() == [3, 4, 0]
     assert precision._swept_faces(v, np.array([[0, 1, 2]]), np.zeros(3)) == (0.0, None)
+
+
+def _merge_reference(vertices, faces, tolerance, among):
+    """``merge_close_vertices`` before soup18 (row gathers, ``numpy.linalg.norm`` in blocks)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    used = np.flatnonzero(np.bincount(np.asarray(among, dtype=np.int64).reshape(-1), minlength=len(v)))
+    points = v[used]
+    lowest = merge.lowest_in_group(points, tolerance)
+    if lowest is None:
+        return faces, 0, 0.0, None
+    representative = np.arange(len(v), dtype=np.int64)
+    representative[used] = used[lowest]
+    moved = np.flatnonzero(lowest != np.arange(len(used)))
+    largest = 0.0
+    for start in range(0, len(moved), merge._MOVE_BLOCK):
+        block = moved[start:start + merge._MOVE_BLOCK]
+        largest = float(np.max((largest, np.max(np.linalg.norm(points[block] - points[lowest[block]], axis=1)))))
+    return representative[faces].astype(faces.dtype), len(moved), largest, representative
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 300), st.integers(-6, 6), st.sampled_from([1e-9, 1e-7, 1e-5]),
+       st.sampled_from([5, 1 << 18]), st.booleans(), st.sampled_from(["int32", "int64"]))
+def test_merge_close_vertices_is_the_row_reading_bit_for_bit(seed, n_faces, scale_exp, jitter, block, some, dtype):
+    rng = np.random.default_rng([seed, 181])
+    v, f, _ = _case(seed, n_faces, True, scale_exp, 0.0)            # a soup: copies 1e-7 of the scale apart
+    v = v + rng.standard_normal(v.shape) * jitter * 10.0 ** scale_exp
+    f = f.astype(dtype)
+    among = rng.choice(len(v), int(rng.integers(1, len(v) + 1)), replace=False) if some else np.arange(len(v))
+    tolerance = float(rng.choice([1e-8, 1e-6, 1e-4])) * 10.0 ** scale_exp
+    old_block = merge._MOVE_BLOCK
+    try:
+        merge._MOVE_BLOCK = block
+        got = merge.merge_close_vertices(v, f, tolerance, among=among)
+        want = _merge_reference(v, f, tolerance, among)
+    finally:
+        merge._MOVE_BLOCK = old_block
+    assert got.merged_vertices == want[1]
+    assert got.largest_move.hex() == want[2].hex()
+    assert got.faces.dtype == want[0].dtype and got.faces.tobytes() == want[0].tobytes()
+    if want[3] is None:
+        assert got.representative is None
+    else:
+        assert got.representative.tobytes() == want[3].tobytes()
+    if want[1]:     # the largest move is a distance between two of the points, within the chains' reach
+        assert 0 < got.largest_move <= tolerance * (len(v) - 1) * (1 + 1e-12)
