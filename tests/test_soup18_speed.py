@@ -141,3 +141,51 @@ def test_merge_close_vertices_is_the_row_reading_bit_for_bit(seed, n_faces, scal
         assert got.representative.tobytes() == want[3].tobytes()
     if want[1]:     # the largest move is a distance between two of the points, within the chains' reach
         assert 0 < got.largest_move <= tolerance * (len(v) - 1) * (1 + 1e-12)
+
+
+def _sweep_reference(v, faces, welded_faces, rep, tolerance):
+    """``weld_sweep`` before soup18 (moves by ``einsum`` of (k, 3) steps; the faces by :func:`_reference`)."""
+    moved = np.flatnonzero(rep != np.arange(len(rep)))
+    if not len(moved):
+        return None
+    move = np.zeros(len(v))
+    step = v[moved] - v[rep[moved]]
+    move[moved] = np.sqrt(np.einsum("ij,ij->i", step, step))
+    move *= 1.0 + 1e-12
+    largest = float(move.max())
+    if not largest > 0:
+        return None
+    group = np.zeros(len(v))
+    np.maximum.at(group, rep[moved], move[moved])
+    written, box_a = _reference(v, faces, move, precision._CHUNK)
+    joined, box_b = _reference(v, welded_faces, group, precision._CHUNK)
+    boxes = [b for b in (box_a, box_b) if b is not None]
+    if not boxes:
+        return None
+    lo = np.min([b[0] for b in boxes], axis=0)
+    hi = np.max([b[1] for b in boxes], axis=0)
+    return max(written, joined) * (1.0 + 1e-9), largest, len(moved), lo, hi
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 300), st.integers(-6, 6), st.sampled_from([7, 1 << 20]))
+def test_weld_sweep_is_the_einsum_reading_bit_for_bit(seed, n_faces, scale_exp, chunk):
+    v, f, _ = _case(seed, n_faces, True, scale_exp, 0.0)
+    welded = merge.merge_close_vertices(v, f, 1e-6 * 10.0 ** scale_exp, among=np.arange(len(v)))
+    rep = welded.representative if welded.representative is not None else np.arange(len(v))
+    kept = welded.faces[(welded.faces[:, 0] != welded.faces[:, 1]) & (welded.faces[:, 1] != welded.faces[:, 2])
+                        & (welded.faces[:, 0] != welded.faces[:, 2])]
+    old_chunk = precision._CHUNK
+    try:
+        precision._CHUNK = chunk
+        got = precision.weld_sweep(v, f, kept, rep, 1.0)
+        want = _sweep_reference(v, f, kept, rep, 1.0)
+    finally:
+        precision._CHUNK = old_chunk
+    if want is None:
+        assert got is None
+        return
+    assert got is not None
+    assert got.volume.hex() == want[0].hex() and got.largest_move.hex() == want[1].hex()
+    assert got.merged == want[2] and got.lo.tobytes() == want[3].tobytes() and got.hi.tobytes() == want[4].tobytes()
+    assert got.volume > 0 and got.largest_move > 0

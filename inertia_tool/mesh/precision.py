@@ -311,20 +311,28 @@ def weld_sweep(vertices: np.ndarray, faces: np.ndarray, welded_faces: np.ndarray
     moved = np.flatnonzero(rep != np.arange(len(rep)))
     if not len(moved):
         return None
+    columns = [np.ascontiguousarray(v[:, axis]) for axis in range(3)]     # read by every pass below
     move = np.zeros(len(v))
     for start in range(0, len(moved), _CHUNK):       # in blocks: a welded soup moves millions of corners
         block = moved[start:start + _CHUNK]
-        step = v[block] - v[rep[block]]              # (formed once: the same products; issue 25)
-        move[block] = np.sqrt(np.einsum("ij,ij->i", step, step))
-        del step                                      # (not kept through the sweeps below: the peak is there)
+        onto = rep[block]
+        # |step|² summed (x² + z²) + y², the order of einsum("ij,ij->i") on (k, 3) rows (the reading this
+        # replaced, bit for bit: tests/test_soup18_speed.py), one column at a time (issue 25, soup18)
+        square = np.zeros(len(block))
+        for axis in (0, 2, 1):
+            step = columns[axis][block] - columns[axis][onto]
+            step *= step
+            square += step
+        move[block] = np.sqrt(square, out=square)
+        del square, step                              # (not kept through the sweeps below: the peak is there)
     move *= 1.0 + 1e-12                               # the norms' rounding (a few ulp), covered
     largest = float(move.max())
     if not largest > 0:
         return None
     group = np.zeros(len(v))             # D_g, held by each representative (W's faces use representatives only)
     np.maximum.at(group, rep[moved], move[moved])
-    written, box_a = _swept_faces(v, np.asarray(faces), move)            # (a): the file's faces
-    joined, box_b = _swept_faces(v, np.asarray(welded_faces), group)     # (b): W's faces
+    written, box_a = _swept_faces(v, np.asarray(faces), move, columns)            # (a): the file's faces
+    joined, box_b = _swept_faces(v, np.asarray(welded_faces), group, columns)     # (b): W's faces
     boxes = [b for b in (box_a, box_b) if b is not None]
     if not boxes:                                     # no face uses a moved corner: nothing changed
         return None
@@ -343,8 +351,8 @@ def weld_reach(sweep: WeldSweep, centroid: np.ndarray) -> float:
     return float(np.sqrt(np.max(np.einsum("ij,ij->i", rel, rel)))) + sweep.largest_move
 
 
-def _swept_faces(vertices: np.ndarray, faces: np.ndarray,
-                 reach: np.ndarray) -> tuple[float, tuple[np.ndarray, np.ndarray] | None]:
+def _swept_faces(vertices: np.ndarray, faces: np.ndarray, reach: np.ndarray,
+                 columns: list[np.ndarray] | None = None) -> tuple[float, tuple[np.ndarray, np.ndarray] | None]:
     """``3 Σ (2 δ A + (π/2) δ² P + (4/3) π δ³)`` over the faces whose corners reach ``δ = max reach[corner] > 0``
     (Steiner's formula for a triangle's δ-neighbourhood, times three crossings; module docstring), and the box
     of those faces' corners (None when there are none).
@@ -352,11 +360,13 @@ def _swept_faces(vertices: np.ndarray, faces: np.ndarray,
     Each coordinate is read as its own column (one gather per corner and axis, no (k, 3, 3) block) and every
     product and sum is formed in the order ``numpy.cross`` and ``numpy.linalg.norm(·, axis=1)`` form them on
     (k, 3) rows (``|x|² = (x₀² + x₁²) + x₂²``), so the sum is the same bit for bit as theirs (issue 25, soup18:
-    1.8 → ~1.0 s for a welded 1.3M-face soup's two calls; ``tests/test_soup18_sweep.py`` holds it to that).
+    1.8 → ~1.0 s for a welded 1.3M-face soup's two calls; ``tests/test_soup18_speed.py`` holds it to that).
+    ``columns``: the vertices' three coordinate columns when the caller has them (else copied here).
     """
     total = 0.0
     lo = hi = None
-    columns = [np.ascontiguousarray(vertices[:, axis]) for axis in range(3)] if len(faces) else []
+    if columns is None:
+        columns = [np.ascontiguousarray(vertices[:, axis]) for axis in range(3)] if len(faces) else []
     for start in range(0, len(faces), _CHUNK):
         f = faces[start:start + _CHUNK]
         r = reach[f]
