@@ -69,19 +69,34 @@ def merge_close_vertices(vertices: np.ndarray, faces: np.ndarray, tolerance: flo
         used = np.flatnonzero(np.bincount(faces.reshape(-1), minlength=len(v)))
     else:
         used = np.flatnonzero(np.bincount(np.asarray(among, dtype=np.int64).reshape(-1), minlength=len(v)))
-    points = v[used]
+    points = np.take(v, used, axis=0)         # (the rows v[used]: numpy's take gathers them ~3x faster)
     lowest = lowest_in_group(points, tolerance)
     if lowest is None:
         return Merge(faces=faces, merged_vertices=0, largest_move=0.0)
     representative = np.arange(len(v), dtype=np.int64)
     representative[used] = used[lowest]
     moved = np.flatnonzero(lowest != np.arange(len(used)))          # only vertices of `used` move
+    return Merge(faces=representative[faces].astype(faces.dtype, copy=False), merged_vertices=len(moved),
+                 largest_move=_largest_move(points, lowest, moved), representative=representative)
+
+
+def _largest_move(points: np.ndarray, lowest: np.ndarray, moved: np.ndarray) -> float:
+    """``max |points[i] − points[lowest[i]]|`` over ``moved``, as ``numpy.linalg.norm(·, axis=1)`` forms each
+    distance (``sqrt((dx² + dy²) + dz²)``), bit for bit: one column per axis, and the root of the largest square
+    (the correctly rounded root is monotone, so it is the largest root; issue 25, soup18: 0.3 → 0.1 s for a soup's
+    3.2M moves).  A NaN anywhere gives NaN, as the maximum of the norms did."""
+    columns = [np.ascontiguousarray(points[:, axis]) for axis in range(3)]
     largest = 0.0
     for start in range(0, len(moved), _MOVE_BLOCK):    # in blocks: a soup moves 3.2M points (300 MB at once)
         block = moved[start:start + _MOVE_BLOCK]
-        largest = float(np.max((largest, np.max(np.linalg.norm(points[block] - points[lowest[block]], axis=1)))))
-    return Merge(faces=representative[faces].astype(faces.dtype), merged_vertices=len(moved),
-                 largest_move=largest, representative=representative)
+        onto = lowest[block]
+        square = np.zeros(len(block))
+        for column in columns:
+            step = column[block] - column[onto]
+            step *= step
+            square += step
+        largest = float(np.max((largest, np.sqrt(np.max(square)))))
+    return largest
 
 
 def lowest_in_group(points: np.ndarray, tolerance: float) -> np.ndarray | None:

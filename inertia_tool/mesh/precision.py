@@ -311,20 +311,28 @@ def weld_sweep(vertices: np.ndarray, faces: np.ndarray, welded_faces: np.ndarray
     moved = np.flatnonzero(rep != np.arange(len(rep)))
     if not len(moved):
         return None
+    columns = [np.ascontiguousarray(v[:, axis]) for axis in range(3)]     # read by every pass below
     move = np.zeros(len(v))
     for start in range(0, len(moved), _CHUNK):       # in blocks: a welded soup moves millions of corners
         block = moved[start:start + _CHUNK]
-        step = v[block] - v[rep[block]]              # (formed once: the same products; issue 25)
-        move[block] = np.sqrt(np.einsum("ij,ij->i", step, step))
-        del step                                      # (not kept through the sweeps below: the peak is there)
+        onto = rep[block]
+        # |step|² summed (x² + z²) + y², the order of einsum("ij,ij->i") on (k, 3) rows (the reading this
+        # replaced, bit for bit: tests/test_soup18_speed.py), one column at a time (issue 25, soup18)
+        square = np.zeros(len(block))
+        for axis in (0, 2, 1):
+            step = columns[axis][block] - columns[axis][onto]
+            step *= step
+            square += step
+        move[block] = np.sqrt(square, out=square)
+        del square, step                              # (not kept through the sweeps below: the peak is there)
     move *= 1.0 + 1e-12                               # the norms' rounding (a few ulp), covered
     largest = float(move.max())
     if not largest > 0:
         return None
     group = np.zeros(len(v))             # D_g, held by each representative (W's faces use representatives only)
     np.maximum.at(group, rep[moved], move[moved])
-    written, box_a = _swept_faces(v, np.asarray(faces), move)            # (a): the file's faces
-    joined, box_b = _swept_faces(v, np.asarray(welded_faces), group)     # (b): W's faces
+    written, box_a = _swept_faces(v, np.asarray(faces), move, columns)            # (a): the file's faces
+    joined, box_b = _swept_faces(v, np.asarray(welded_faces), group, columns)     # (b): W's faces
     boxes = [b for b in (box_a, box_b) if b is not None]
     if not boxes:                                     # no face uses a moved corner: nothing changed
         return None
@@ -343,13 +351,23 @@ def weld_reach(sweep: WeldSweep, centroid: np.ndarray) -> float:
     return float(np.sqrt(np.max(np.einsum("ij,ij->i", rel, rel)))) + sweep.largest_move
 
 
-def _swept_faces(vertices: np.ndarray, faces: np.ndarray,
-                 reach: np.ndarray) -> tuple[float, tuple[np.ndarray, np.ndarray] | None]:
+def _swept_faces(vertices: np.ndarray, faces: np.ndarray, reach: np.ndarray,
+                 columns: list[np.ndarray] | None = None) -> tuple[float, tuple[np.ndarray, np.ndarray] | None]:
     """``3 Σ (2 δ A + (π/2) δ² P + (4/3) π δ³)`` over the faces whose corners reach ``δ = max reach[corner] > 0``
     (Steiner's formula for a triangle's δ-neighbourhood, times three crossings; module docstring), and the box
-    of those faces' corners (None when there are none)."""
+    of those faces' corners (None when there are none).
+
+    Each coordinate is read as its own column (one gather per corner and axis, no (k, 3, 3) block) and every
+    product and sum is formed in the order ``numpy.cross`` and ``numpy.linalg.norm(·, axis=1)`` form them on
+    (k, 3) rows (``|x|² = (x₀² + x₁²) + x₂²``), so the sum is the same bit for bit as theirs (issue 25, soup18:
+    ~0.9 → ~0.4 s a call on a welded 1.3M-face soup; ``tests/test_soup18_speed.py`` holds it to that).
+    ``columns``: the vertices' three coordinate columns when the caller has them (else copied here); the
+    differences overwrite the gathered corners, so a chunk holds no more than the (k, 3, 3) reading did.
+    """
     total = 0.0
     lo = hi = None
+    if columns is None:
+        columns = [np.ascontiguousarray(vertices[:, axis]) for axis in range(3)] if len(faces) else []
     for start in range(0, len(faces), _CHUNK):
         f = faces[start:start + _CHUNK]
         r = reach[f]
@@ -357,24 +375,52 @@ def _swept_faces(vertices: np.ndarray, faces: np.ndarray,
         hit = d > 0
         if not hit.any():
             continue
-        f, d = f[hit], d[hit]
-        tri = vertices[f]
-        ab, ac, bc = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], tri[:, 2] - tri[:, 1]
-        # ab × ac as numpy.cross forms it (each product, then the difference), bit for bit, without its axis
-        # shuffling (issue 25, soup17)
-        normal = np.empty_like(ab)
-        for axis, (p, q) in enumerate(((1, 2), (2, 0), (0, 1))):
-            np.multiply(ab[:, p], ac[:, q], out=normal[:, axis])
-            normal[:, axis] -= ab[:, q] * ac[:, p]
-        area = 0.5 * np.linalg.norm(normal, axis=1)
-        perimeter = np.linalg.norm(ab, axis=1) + np.linalg.norm(ac, axis=1) + np.linalg.norm(bc, axis=1)
-        total += 3.0 * float(np.sum(2.0 * d * area + 0.5 * math.pi * d * d * perimeter
-                                    + 4.0 / 3.0 * math.pi * d ** 3))
-        corners = tri.reshape(-1, 3)
-        a, b = corners.min(axis=0), corners.max(axis=0)
-        lo = a if lo is None else np.minimum(lo, a)
-        hi = b if hi is None else np.maximum(hi, b)
+        if not hit.all():
+            f, d = f[hit], d[hit]
+        del r, hit
+        # the corners a, b, c of each face, one (k,) array per axis
+        a, b, c = ([col[f[:, corner]] for col in columns] for corner in range(3))
+        low = np.min([[a[k].min(), b[k].min(), c[k].min()] for k in range(3)], axis=1)     # (NaN kept, as a
+        high = np.max([[a[k].max(), b[k].max(), c[k].max()] for k in range(3)], axis=1)    # min of the rows)
+        lo = low if lo is None else np.minimum(lo, low)
+        hi = high if hi is None else np.maximum(hi, high)
+        ab = [q - p for p, q in zip(a, b)]
+        ac = [np.subtract(q, p, out=p) for p, q in zip(a, c)]          # (into a's columns)
+        bc = [np.subtract(q, p, out=q) for p, q in zip(b, c)]          # (into c's columns)
+        del a, b, c
+        # ab × ac: each product, then the difference, as numpy.cross forms it
+        normal = []
+        for p, q in ((1, 2), (2, 0), (0, 1)):
+            component = ab[p] * ac[q]
+            component -= ab[q] * ac[p]
+            normal.append(component)
+        area = _row_norm(normal)
+        area *= 0.5
+        del normal
+        perimeter = _row_norm(ab)
+        perimeter += _row_norm(ac)
+        perimeter += _row_norm(bc)
+        del ab, ac, bc
+        # 2.0·d·A + (0.5·π)·d·d·P + ((4/3)·π)·d³, each product in the order written there
+        swept = 2.0 * d
+        swept *= area
+        rim = (0.5 * math.pi) * d
+        rim *= d
+        rim *= perimeter
+        swept += rim
+        swept += 4.0 / 3.0 * math.pi * d ** 3
+        total += 3.0 * float(np.sum(swept))
     return total, (None if lo is None or hi is None else (lo, hi))
+
+
+def _row_norm(x: list[np.ndarray]) -> np.ndarray:
+    """``sqrt((x₀² + x₁²) + x₂²)`` of three (k,) float columns, (k,) float: ``numpy.linalg.norm(·, axis=1)`` of
+    the (k, 3) rows they form, bit for bit (numpy sums a row of three squares in that order)."""
+    square = x[0] * x[0]
+    square += x[1] * x[1]
+    square += x[2] * x[2]
+    root: np.ndarray = np.sqrt(square, out=square)
+    return root
 
 
 def estimate_with_weld(estimate: Estimate, sweep: WeldSweep | None) -> Estimate:
