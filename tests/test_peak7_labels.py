@@ -65,6 +65,7 @@ NESTED = [((0, 0, 0), (6, 6, 6), False), ((2, 2, 2), (2, 2, 2), True), ((2, 2, 2
 TOUCHING = [((0, 0, 0), (2, 2, 2), False), ((2, 0, 0), (2, 2, 2), False), ((4, 2, 2), (1, 1, 1), False)]
 CORNER_ONLY = [((0, 0, 0), (2, 2, 2), False), ((2, 2, 2), (2, 2, 2), False)]
 OVERLAPPING = [((0, 0, 0), (3, 3, 3), False), ((1, 1, 1), (3, 3, 3), False), ((8, 0, 0), (1, 1, 1), False)]
+FLUSH = [((0, 0, 0), (1, 1, 1), False), ((0, 0, 0), (1, 1, 2), False)]     # flush on five faces: one left out (R4)
 
 
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -75,6 +76,7 @@ OVERLAPPING = [((0, 0, 0), (3, 3, 3), False), ((1, 1, 1), (3, 3, 3), False), ((8
 @example(boxes=OVERLAPPING, inverted=[False] * 4)
 @example(boxes=NESTED[:2], inverted=[False, True, False, False])
 @example(boxes=[((0, 0, 0), (1, 2, 3), False)], inverted=[False] * 4)
+@example(boxes=FLUSH, inverted=[False] * 4)
 def test_int32_labels_give_the_int64_results(boxes, inverted):
     boxes = [(lo, sz, inv or flip) for (lo, sz, inv), flip in zip(boxes, inverted)]
     v, f = _scene(boxes)

@@ -318,7 +318,8 @@ def _without_shells(shells: Shells, contacts: SurfaceContacts, drop: np.ndarray)
     number = np.cumsum(keep) - 1
     face_number = np.cumsum(keep_face) - 1
     bound = shells.bound
-    kept = Shells(shells.vertices, shells.faces[keep_face], number[shells.labels[keep_face]],
+    kept = Shells(shells.vertices, shells.faces[keep_face],
+                  number[shells.labels[keep_face]].astype(shells.labels.dtype, copy=False),   # int32 stays int32
                   int(np.count_nonzero(keep)), [m for m, k in zip(shells.moments, keep) if k],
                   RoundoffBound(volume=np.asarray(bound.volume)[keep], centroid=np.asarray(bound.centroid)[keep],
                                 second_moment=np.asarray(bound.second_moment)[keep]))
