@@ -624,8 +624,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                        f"{round_up(float(faceted_reach[took_faceted].max())):.3g} m from the cone), as the user "
                        "assumed")
             if wrapped:
-                detail += (f" ({len(wrapped)} of them reaching round an edge of the part: bounded by the polytope of "
-                           "those planes beyond the rim's lowest corner along its vector area)")
+                detail += (f" ({len(wrapped)} of them reaching round an edge of the part, no graph over one plane: "
+                           "bounded by the part of those planes' polytope beyond the cone)")
         detail += "; " + stated(used)
         if took_island.any() or smooths or took_faceted.any():
             detail += "; " + user_stated([*(["flat-islands"] if took_island.any() else []),
