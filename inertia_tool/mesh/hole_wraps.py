@@ -109,15 +109,24 @@ def _ring_planes(v: np.ndarray, f: np.ndarray, on_rim: np.ndarray, outward: floa
     return unit[np.sort(first)], offset[np.sort(first)]
 
 
-def _polytope(normals: np.ndarray, bounds: np.ndarray, inside: np.ndarray, scale: float
-              ) -> tuple[float, np.ndarray] | None:
-    """Volume and corners of ``{x : normals x ≤ bounds}`` about the point ``inside`` (strictly inside it), or None
-    where it is unbounded (or reaches past ``1e6 · scale``) or qhull cannot build it."""
+def _polytope(normals: np.ndarray, bounds: np.ndarray, scale: float) -> tuple[float, np.ndarray] | None:
+    """Volume and corners of ``{x : normals x ≤ bounds}``: (0, no corners) where it has no inside, None where it is
+    unbounded (or reaches past ``1e6 · scale``)."""
+    from scipy.optimize import linprog
     from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
+    norms = np.linalg.norm(normals, axis=1)
+    res = linprog(np.r_[0.0, 0.0, 0.0, -1.0], A_ub=np.column_stack([normals, norms]), b_ub=bounds,
+                  bounds=[(None, None)] * 3 + [(0.0, None)], method="highs")
+    if res.status == 2:
+        return 0.0, np.zeros((0, 3))                  # empty
+    if res.status != 0:
+        return None                                   # unbounded inradius: the polytope is open
+    if not res.x[3] > 1e-12 * scale:
+        return 0.0, np.zeros((0, 3))                  # flat: no volume
     try:
         with np.errstate(divide="ignore", invalid="ignore"):
-            region = HalfspaceIntersection(np.column_stack([normals, -bounds]), inside)
+            region = HalfspaceIntersection(np.column_stack([normals, -bounds]), np.asarray(res.x[:3]))
         corners = region.intersections
         if not np.all(np.isfinite(corners)) or float(np.abs(corners).max()) > 1e6 * scale:
             return None
@@ -186,12 +195,7 @@ def wrapped_doubt(vertices: np.ndarray, faces: np.ndarray, rim_edges: np.ndarray
             sides.append(n / max(float(np.linalg.norm(n)), 1e-300))
         normals = np.vstack([unit, -fan_unit[i][None, :], np.array(sides)])
         bounds = np.r_[offset + tol, -(float(fan_unit[i] @ top) - tol), np.array(sides) @ view]
-        # T_i's centroid is inside every plane by at least tol (K and T_i's plane are moved out by tol, and it lies
-        # in the rim's hull) and strictly inside C_i
-        inside = corners3.mean(axis=0)
-        if not float((normals @ inside - bounds).max()) < 0:
-            return None
-        piece = _polytope(normals, bounds, inside, scale)
+        piece = _polytope(normals, bounds, scale)
         if piece is None:
             return None                               # R is open there: the planes do not close it
         total += piece[0]
