@@ -111,10 +111,19 @@ def _ring_planes(v: np.ndarray, f: np.ndarray, on_rim: np.ndarray, outward: floa
 
 def _polytope(normals: np.ndarray, bounds: np.ndarray, scale: float) -> tuple[float, np.ndarray] | None:
     """Volume and corners of ``{x : normals x ≤ bounds}``: (0, no corners) where it has no inside, None where it is
-    unbounded (or reaches past ``1e6 · scale``)."""
+    unbounded (the normals do not surround the origin) or reaches past ``1e6 · scale``."""
     from scipy.optimize import linprog
     from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
+    # bounded only where the normals surround the origin (no direction u ≠ 0 with normals u ≤ 0): the origin
+    # strictly inside their hull; a region open along some ray is never given a volume (HalfspaceIntersection
+    # needs a bounded region, and a bounded inscribed ball does not show one)
+    unit_normals = normals / np.linalg.norm(normals, axis=1)[:, None]
+    try:
+        if not float(ConvexHull(unit_normals).equations[:, 3].max()) < -1e-9:
+            return None
+    except (QhullError, ValueError):
+        return None                                   # the normals span no solid: open
     norms = np.linalg.norm(normals, axis=1)
     res = linprog(np.r_[0.0, 0.0, 0.0, -1.0], A_ub=np.column_stack([normals, norms]), b_ub=bounds,
                   bounds=[(None, None)] * 3 + [(0.0, None)], method="highs")
