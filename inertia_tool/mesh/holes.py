@@ -491,16 +491,16 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                     # a hole bounded by its planes' polytope beyond the cone keeps a plane fill outside that region
                     # only with the volume between the fill and the cone added (hole_wraps.fill_excess), and only
                     # while that stays under the doubt it had before; else its cone
-                    kept_facets = []
-                    for fill in facets:
-                        k = fill.loop
-                        if k in wrapped and not in_wrapped(wrapped[k], np.vstack([fill.apex[None, :], fill.points])):
-                            extra, extra_reach = fill_excess(v, fill, apex[k])
+                    kept_facets: list[PlaneFill] = []
+                    for facet in facets:
+                        k = facet.loop
+                        if k in wrapped and not in_wrapped(wrapped[k], np.vstack([facet.apex[None, :], facet.points])):
+                            extra, extra_reach = fill_excess(v, facet, apex[k])
                             if not hole_doubt[k] + extra < unwrapped_from[k]:
                                 continue
                             hole_doubt[k] = round_up(float(hole_doubt[k]) + extra)
                             faceted_reach[k] = max(float(faceted_reach[k]), extra_reach)
-                        kept_facets.append(fill)
+                        kept_facets.append(facet)
                     planes = [*planes, *kept_facets]
                     pv, pf, cap, closed, _ = build(creases, curved, [*graphs, *smooths], planes)
         took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
