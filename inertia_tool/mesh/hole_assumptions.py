@@ -151,9 +151,9 @@ SMOOTH_HOLES = HoleAssumption(
 
 FACETED_HOLES = HoleAssumption(
     "faceted-holes", "each hole not an island in a flat face lost a piece of a faceted surface that stays inside the "
-    "planes of the faces round its rim (outside them round a pocket): the missing surface is a graph over the plane "
-    "square to the rim's vector area and lies between the cone over the rim and those planes continued across the "
-    "hole until they meet",
+    "planes of the faces round its rim (outside them round a pocket): the missing surface lies between the cone over "
+    "the rim and those planes continued across the hole until they meet, as a graph over the plane square to the "
+    "rim's vector area where the rim is one (a hole reaching round an edge of the part need not be)",
     "a boss, rib or housing standing out of those planes (or a dent into a pocket's) taken whole with the hole, a "
     "surface folding back over the hole, or a curved surface bulging past the planes of its facets")
 

@@ -70,6 +70,7 @@ from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES
                          PlaneFill, plane_fills, region_check)
 from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions, named, stated, user_stated
 from .hole_facets import FACETED_MAX_LOOPS, faceted_doubt
+from .hole_wraps import WrappedRegion, fill_excess, in_wrapped, wrapped_doubt
 from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal, _unique_rows
@@ -291,6 +292,8 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
     took_smooth = np.zeros(n_loops, dtype=bool)
     took_faceted = np.zeros(n_loops, dtype=bool)
     faceted_reach = np.zeros(n_loops)
+    wrapped: dict[int, WrappedRegion] = {}
+    unwrapped_from: dict[int, float] = {}     # the doubt each hole had before its wrapped reading (hole_wraps)
     island_width = np.zeros(n_loops)
     graph_height = np.zeros(n_loops)
     smooth_height = np.zeros(n_loops)
@@ -460,7 +463,18 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                 ranked = np.flatnonzero(candidates)[np.argsort(-hole_doubt[candidates], kind="stable")]
                 for k in ranked[:FACETED_MAX_LOOPS].tolist():
                     region = faceted_doubt(v, f, edges[label == k], apex[k], float(radius[k]), outward=sign)
-                    if region is None or not region.doubt < hole_doubt[k]:
+                    if region is None:
+                        # a hole reaching round an edge (no graph over its vector area): the polytope of the
+                        # planes round it beyond its lowest rim corner (hole_wraps.wrapped_doubt)
+                        wrap = wrapped_doubt(v, f, edges[label == k], float(radius[k]), outward=sign)
+                        if wrap is not None and wrap.doubt < hole_doubt[k]:
+                            took_faceted[k] = True
+                            wrapped[k] = wrap
+                            unwrapped_from[k] = float(hole_doubt[k])
+                            faceted_reach[k] = wrap.reach
+                            hole_doubt[k] = wrap.doubt
+                        continue
+                    if not region.doubt < hole_doubt[k]:
                         continue
                     took_faceted[k] = True
                     faceted_reach[k] = region.reach
@@ -474,7 +488,20 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                     planes = [fill for fill in planes if not took_faceted[fill.loop]]
                     facets = plane_fills(v, f, edges, label, np.flatnonzero(took_faceted), apex, radius, _anywhere,
                                          outward=sign, max_loops=n_loops)
-                    planes = [*planes, *facets]
+                    # a hole bounded by its planes' polytope beyond the cone keeps a plane fill outside that region
+                    # only with the volume between the fill and the cone added (hole_wraps.fill_excess), and only
+                    # while that stays under the doubt it had before; else its cone
+                    kept_facets: list[PlaneFill] = []
+                    for facet in facets:
+                        k = facet.loop
+                        if k in wrapped and not in_wrapped(wrapped[k], np.vstack([facet.apex[None, :], facet.points])):
+                            extra, extra_reach = fill_excess(v, facet, apex[k])
+                            if not hole_doubt[k] + extra < unwrapped_from[k]:
+                                continue
+                            hole_doubt[k] = round_up(float(hole_doubt[k]) + extra)
+                            faceted_reach[k] = max(float(faceted_reach[k]), extra_reach)
+                        kept_facets.append(facet)
+                    planes = [*planes, *kept_facets]
                     pv, pf, cap, closed, _ = build(creases, curved, [*graphs, *smooths], planes)
         took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
                      & ~took_planar & ~took_graph & ~took_smooth & ~took_faceted)
@@ -507,7 +534,11 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
         # the convex bound where it applies and is narrower than the others before the bend bound: a convex part
         # keeps the polytope (a rule fixed before the bend bound came, which tests/test_hole_bounds.py pins)
         # (under the user's smooth-holes, against the doubt its fills leave: the default rule is unchanged)
-        if bound is not None and bound[0] < (float(np.sum(hole_doubt)) if smooths or took_faceted.any()
+        # (a hole reaching round an edge, bounded under faceted-holes by its planes' polytope, does not keep the
+        # convex bound away: it is compared with the doubt the hole had before, so where the convex bound was taken
+        # it still is, with its plane fills)
+        unwrapped = float(sum(before - hole_doubt[k] for k, before in unwrapped_from.items()))
+        if bound is not None and bound[0] < (float(np.sum(hole_doubt)) + unwrapped if smooths or took_faceted.any()
                                              else before_bend):
             doubt, corners = bound
             # under the convex bound any fill outside the cone and inside every given face's plane keeps the patched
@@ -523,6 +554,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             curved, graphs, smooths = [], [], []
             took_smooth[:] = False
             took_faceted[:] = False
+            wrapped.clear()
             used = {"convex"}
             used |= {"inner"} if inside_face else set()
     sealed = ""
@@ -591,6 +623,9 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                        "the planes of the faces round the rim continued across it (reaching at most "
                        f"{round_up(float(faceted_reach[took_faceted].max())):.3g} m from the cone), as the user "
                        "assumed")
+            if wrapped:
+                detail += (f" ({len(wrapped)} of them reaching round an edge of the part, no graph over one plane: "
+                           "bounded by the part of those planes' polytope beyond the cone)")
         detail += "; " + stated(used)
         if took_island.any() or smooths or took_faceted.any():
             detail += "; " + user_stated([*(["flat-islands"] if took_island.any() else []),
