@@ -765,6 +765,8 @@ def convex_hole_bound(vertices: np.ndarray, faces: np.ndarray, patched_volume: f
         return None                      # what remains is not convex
     if _plane_unattested_at_rim(v, f, planes, tol + 1e-12 * (1.0 + float(np.abs(v[used]).max()))):
         return None                      # a hole took a flat face up to its border: a feature may have gone too
+    if not normals_surround_origin(planes[:, :3]):
+        return None                      # the planes left do not close the part in (an open direction)
     shift = max(float(excess.max()), 0.0) + _round_off(v)
     inside = v[used].mean(axis=0)
     slack = planes[:, 3] + shift - planes[:, :3] @ inside
@@ -783,6 +785,23 @@ def convex_hole_bound(vertices: np.ndarray, faces: np.ndarray, patched_volume: f
     if not volume >= patched_volume * (1 - 1e-9):
         return None
     return round_up(max(volume - patched_volume, 0.0) + 1e-12 * volume), points
+
+
+def normals_surround_origin(normals: np.ndarray) -> bool:
+    """Whether ``{x : normals x ≤ b}`` is bounded for every ``b`` under which it is not empty: no direction
+    ``u ≠ 0`` with ``normals u ≤ 0``, i.e. the origin strictly inside the convex hull of the unit normals
+    (a margin of 1e-9).  A region open along some ray is never given a volume: ``HalfspaceIntersection``
+    assumes a bounded region, and finite intersection points or a bounded inscribed ball do not show one."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    n = np.asarray(normals, dtype=np.float64)
+    if len(n) < 4:
+        return False
+    unit_normals = n / np.linalg.norm(n, axis=1)[:, None]
+    try:
+        return bool(float(ConvexHull(unit_normals).equations[:, 3].max()) < -1e-9)
+    except (QhullError, ValueError):
+        return False                          # the normals span no solid: open
 
 
 def _reflex_edge_excess(v: np.ndarray, f: np.ndarray, unit: np.ndarray, offset: np.ndarray) -> float:

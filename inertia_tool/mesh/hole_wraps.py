@@ -39,7 +39,7 @@ import numpy as np
 
 from ..rounding import round_up
 from ..values import frozen_value
-from .hole_bounds import FLAT_RIM_RTOL, _round_off
+from .hole_bounds import FLAT_RIM_RTOL, _round_off, normals_surround_origin
 from .hole_fills import PlaneFill
 from .hole_graphs import _walk
 
@@ -115,15 +115,8 @@ def _polytope(normals: np.ndarray, bounds: np.ndarray, scale: float) -> tuple[fl
     from scipy.optimize import linprog
     from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
-    # bounded only where the normals surround the origin (no direction u ≠ 0 with normals u ≤ 0): the origin
-    # strictly inside their hull; a region open along some ray is never given a volume (HalfspaceIntersection
-    # needs a bounded region, and a bounded inscribed ball does not show one)
-    unit_normals = normals / np.linalg.norm(normals, axis=1)[:, None]
-    try:
-        if not float(ConvexHull(unit_normals).equations[:, 3].max()) < -1e-9:
-            return None
-    except (QhullError, ValueError):
-        return None                                   # the normals span no solid: open
+    if not normals_surround_origin(normals):
+        return None                                   # open along some ray: never given a volume
     norms = np.linalg.norm(normals, axis=1)
     res = linprog(np.r_[0.0, 0.0, 0.0, -1.0], A_ub=np.column_stack([normals, norms]), b_ub=bounds,
                   bounds=[(None, None)] * 3 + [(0.0, None)], method="highs")
