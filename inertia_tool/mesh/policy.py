@@ -120,7 +120,10 @@ R4 *Orientation by nesting depth, where the file's winding is evidently wrong* (
    anywhere kept the depth reading for every nest); so also in a *sub-nest* inside a nest with crossings (a shell
    crossing nothing, with nothing inside it crossing, whose winding just outside is 0 or 1: the shells around it
    crossing others or not), and the rest of the file is read by the rules below, the certificate the weaker of
-   the parts (the boolean's ``united`` where the rest is united; the note says how many nests went each way);
+   the parts (the boolean's ``united`` where the rest is united; the note says how many nests went each way); a
+   shell left undecided (every probe on another surface, even probed again past the shells it crosses, lies within
+   or touches) keeps the rule only from the nests it may lie in, not from every nest (session 18:
+   :func:`may_hold_undecided`, by the shells' bounding boxes, and the rest read with it still undecided);
    the shells with winding ``≥ 1`` on both sides (a body wound outward wholly inside another, and
    whatever lies inside it) bound nothing of ``{w ≥ 1}`` and are left out, and the rest, each with winding 0 on one
    side and 1 on the other, is integrated as wound: ``exact`` with the check ``interior-shells`` (no boolean; left
