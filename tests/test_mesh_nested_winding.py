@@ -372,15 +372,19 @@ def test_a_slab_flush_between_two_boxes_inside_an_inward_box_is_a_cavity():
     assert _matches(props, _moments(parity), diag), (props.mass / H ** 3, np.count_nonzero(parity))
 
 
-@pytest.mark.xfail(strict=True, reason="an undecided shell takes its own sign inside a shell turned by depth (beyond "
-                                       "MAX_REPROBED undecided shells): not fixed, tidy18")
-def test_past_max_reprobed_an_undecided_slab_in_an_inward_box_is_not_yet_a_cavity(monkeypatch):
+def test_past_max_reprobed_an_undecided_slab_in_an_inward_box_is_not_certified(monkeypatch):
     """The case above with no re-probing, as for the shells past ``MAX_REPROBED`` (16) undecided ones, or a probe that
     stays on a surface past every partner: the slab keeps its own sign (a body) while the box around it is turned
-    by depth, ``united`` 9 cells above the depth reading (draws 210 and 245 of this session's judge, seed 1818, in
-    that configuration; pre-existing: the same answer on ``efd46cb``)."""
+    by depth, 9 cells above the depth reading; before session 18 ``united`` (draws 210 and 245 of this session's
+    judge, seed 1818, in that configuration; the same answer on ``efd46cb``).  The slab's box lies within the inward
+    box's, so it may lie inside it: the answer rests on an unchecked reading and is ``unverified``, said in a note."""
     monkeypatch.setattr(classify, "MAX_REPROBED", 0)
-    test_a_slab_flush_between_two_boxes_inside_an_inward_box_is_a_cavity()
+    sandwich, slab = _sandwich([5, -2, -1], [3, 3, 1])
+    boxes = sandwich + [(np.array([2, -6, -6]), np.array([12, 6, 6]), -1)]
+    props, said = _answer(boxes, _mesh_with(boxes, [slab]))
+    assert certificate_label(props.mesh) == "unverified", props.mesh.certificate
+    assert any("1 shell whose probe points all lie on other surfaces may lie inside another shell" in n
+               for n in props.mesh.notes), props.mesh.notes
 
 
 def test_a_nest_beside_an_undecided_shell_follows_the_stated_rule(monkeypatch):
@@ -448,8 +452,6 @@ def test_nests_beside_an_undecided_shell_follow_the_stated_rule(seed):
     with pytest.MonkeyPatch.context() as mp:
         if rng.random() < 0.5:          # the shells left undecided (as past MAX_REPROBED of them), or probed again
             mp.setattr(classify, "MAX_REPROBED", 0)
-            if len(boxes) > slab + 3 and boxes[-1][2] < 0:
-                return      # the strict xfail above: an undecided slab inside a box turned by depth, not fixed
         if len(boxes) == slab + 3 and not undecided[:slab].any():   # the sandwich apart: the stated rule everywhere
             _check(boxes, mesh)
             return

@@ -267,6 +267,17 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
         # listed twice around a cavity listed once (winding 2 − 1 = 1, material) was the summed integral, the
         # cavity cut once (session 16: `exact` 7.875 m³ for {w ≥ 1} = 8)
         candidates[:] = True
+    # R4/R7: a shell left undecided is read by its own sign (depth 0), which no probe checked; where its box lies
+    # within another shell's it may lie inside that shell, and the answer rests on an unchecked reading: not proven
+    # (session 18: a slab flush between two boxes inside an inward box was a body, ``united`` 9 cells high)
+    unsure = _maybe_inside(nest, _both(within, touch_within), v, shells.faces, labels, n_shells) \
+        if touch.complete and nest is not None and np.asarray(nest.undecided).any() else 0
+    if unsure:
+        notes.append(f"{unsure} shell{'s' if unsure > 1 else ''} whose probe points all lie on other surfaces "
+                     f"may lie inside another shell (its bounding box within the other's): read by "
+                     f"{'their' if unsure > 1 else 'its'} own winding, not by a nesting depth. Not verified")
+        warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+        ambiguous += unsure
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[crossing_with.reshape(-1)] = True
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
@@ -303,6 +314,23 @@ def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNest
     for found in said:
         warnings.warn(found.message, stacklevel=4)
     return read._replace(interior=stands, contacts=read.contacts if read.contacts is not None else kept_contacts)
+
+
+def _maybe_inside(nest: Nesting, within: np.ndarray | None, v: np.ndarray, f: np.ndarray, labels: np.ndarray,
+                  n_shells: int) -> int:
+    """How many shells left undecided (:func:`~.policy.undecided_shells`) have their bounding box within another
+    shell's (compared exactly: a shell inside another lies within its corners' extremes), so may lie inside it."""
+    unplaced = undecided_shells(nest, within)
+    if not unplaced.any():
+        return 0
+    box = shell_boxes(v, f, labels, n_shells)
+    lo, hi = box[:, 0], box[:, 1]
+    count = 0
+    for u in np.flatnonzero(unplaced)[:MAX_WITHIN_PAIRS].tolist():   # bounded; beyond, counted as inside
+        held = np.all(lo <= lo[u], axis=1) & np.all(hi >= hi[u], axis=1)
+        held[u] = False
+        count += int(held.any())
+    return count + max(0, int(np.count_nonzero(unplaced)) - MAX_WITHIN_PAIRS)
 
 
 def _still_undecided(nest: Nesting | None, unplaced: np.ndarray) -> Nesting | None:
