@@ -21,8 +21,8 @@ import sys
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, os.pardir, "tests"))       # the icosahedron's one table: tests/solids.py
-from solids import icosahedron  # noqa: E402
+sys.path.insert(0, os.path.join(HERE, os.pardir, "tests"))       # one icosahedron and cylinder: tests/solids.py
+from solids import fan_capped_cylinder, icosahedron  # noqa: E402
 
 
 def _torus_grid(nu: int, nv: int, major: float, minor: float, phase: float = 0.0):
@@ -54,16 +54,7 @@ def torus(n_faces: float, major: float = 1.0, minor: float = 0.35) -> tuple[np.n
 
 def cylinder(n_faces: float, radius: float = 1.0, height: float = 2.0) -> tuple[np.ndarray, np.ndarray]:
     """A closed cylinder of about ``n_faces`` triangles (``n_faces/4`` sections), fan caps round a centre."""
-    n = max(8, int(round(n_faces / 4)))
-    t = 2 * np.pi * np.arange(n) / n
-    ring = np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
-    v = np.concatenate([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, height)], [[0, 0, 0], [0, 0, height]]])
-    i = np.arange(n)
-    j = (i + 1) % n
-    bottom, top = np.full(n, 2 * n), np.full(n, 2 * n + 1)
-    f = np.concatenate([np.stack([bottom, j, i], 1), np.stack([top, n + i, n + j], 1),
-                        np.stack([i, j, n + j], 1), np.stack([i, n + j, n + i], 1)])
-    return v, f
+    return fan_capped_cylinder(max(8, int(round(n_faces / 4))), radius, height)
 
 
 def subdivide(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

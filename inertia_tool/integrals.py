@@ -116,10 +116,19 @@ def _tetra_sums(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, chu
     # (sum, error) pairs by TwoSum again (_label_sums, _add_pairs): within the compensated bound
     # (2 + m²u)·u·Σ|x| that roundoff_bounds charges both paths (issue 21: the plain sequential sum's m·u·Σ|x|
     # made the numpy path call a needle of aspect 1e7 flat that the C path, by its tighter bound, answered)
+    coords = np.ascontiguousarray((vertices - origin).T)      # (3, n): component arrays gather faster
+    # terms that overflow give inf and NaN silently, as on C (tidy17 saw numpy's RuntimeWarnings for a box at
+    # 1e100 m): the sums' NaN is the signal, and the pipeline refuses a part whose integrals are not finite
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _tetra_sums_numpy(coords, faces, chunk_size, labels, n_labels, area_floor)
+
+
+def _tetra_sums_numpy(coords: np.ndarray, faces: np.ndarray, chunk_size: int, labels: np.ndarray | None,
+                      n_labels: int, area_floor: float) -> _Sums:
+    """:func:`_tetra_sums` on numpy: ``coords`` (3, n) the corners relative to the origin; same return values."""
     hi = np.zeros((n_labels, 11))
     lo = np.zeros((n_labels, 11))
     zero = np.zeros(n_labels, dtype=np.int64)
-    coords = np.ascontiguousarray((vertices - origin).T)      # (3, n): component arrays gather faster
     n_faces = len(faces)
     for start in range(0, n_faces, chunk_size):
         f = faces[start:start + chunk_size]
@@ -520,23 +529,25 @@ def _roundoff_sums(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, 
     numpy reference: sequential sums per chunk of faces, the chunks added in order)."""
     coords = np.ascontiguousarray((vertices - origin).T)
     sp, sps, spq = (np.zeros(n) for _ in range(3))
-    for start in range(0, len(faces), chunk_size):
-        f = faces[start:start + chunk_size]
-        lab = labels[start:start + chunk_size]
-        a, b, c = (coords[:, f[:, k]] for k in range(3))
-        e1, e2 = np.abs(b - a), np.abs(c - a)
-        a, b, c = np.abs(a), np.abs(b), np.abs(c)
-        # |a|·(|e1| ⊠ |e2|) carries the roundings of the cross and dot products and of a itself; the terms with
-        # |a| + |b| (|a| + |c|) carry the roundings of the corners and of the differences b − a (c − a)
-        p = 8 * _dot_abs_cross(a, e1, e2) + 2 * (_dot_abs_cross(a, a + b, e2) + _dot_abs_cross(a, e1, a + c))
-        # Σ‖pₖ‖², each square norm summed x, y, z in that order (einsum's order depends on the array's shape; a
-        # fixed one is what the C kernel repeats bit for bit)
-        n2 = (_norm2(a) + _norm2(b)) + _norm2(c)
-        s_norm = np.sqrt(3 * n2)                      # ‖|a| + |b| + |c|‖ ≤ √(3 Σ‖pₖ‖²)
-        q = 4 * n2                                    # tr|Q| = Σ‖pₖ‖² + ‖|a| + |b| + |c|‖² ≤ 4 Σ‖pₖ‖²
-        sp += np.bincount(lab, weights=p, minlength=n)
-        sps += np.bincount(lab, weights=p * s_norm, minlength=n)
-        spq += np.bincount(lab, weights=p * q, minlength=n)
+    # sums that overflow are inf silently, as on C (an infinite bound refuses the answer; no RuntimeWarning)
+    with np.errstate(over="ignore", invalid="ignore"):
+        for start in range(0, len(faces), chunk_size):
+            f = faces[start:start + chunk_size]
+            lab = labels[start:start + chunk_size]
+            a, b, c = (coords[:, f[:, k]] for k in range(3))
+            e1, e2 = np.abs(b - a), np.abs(c - a)
+            a, b, c = np.abs(a), np.abs(b), np.abs(c)
+            # |a|·(|e1| ⊠ |e2|) carries the roundings of the cross and dot products and of a itself; the terms with
+            # |a| + |b| (|a| + |c|) carry the roundings of the corners and of the differences b − a (c − a)
+            p = 8 * _dot_abs_cross(a, e1, e2) + 2 * (_dot_abs_cross(a, a + b, e2) + _dot_abs_cross(a, e1, a + c))
+            # Σ‖pₖ‖², each square norm summed x, y, z in that order (einsum's order depends on the array's shape; a
+            # fixed one is what the C kernel repeats bit for bit)
+            n2 = (_norm2(a) + _norm2(b)) + _norm2(c)
+            s_norm = np.sqrt(3 * n2)                      # ‖|a| + |b| + |c|‖ ≤ √(3 Σ‖pₖ‖²)
+            q = 4 * n2                                    # tr|Q| = Σ‖pₖ‖² + ‖|a| + |b| + |c|‖² ≤ 4 Σ‖pₖ‖²
+            sp += np.bincount(lab, weights=p, minlength=n)
+            sps += np.bincount(lab, weights=p * s_norm, minlength=n)
+            spq += np.bincount(lab, weights=p * q, minlength=n)
     return np.stack([sp, sps, spq], axis=1)
 
 

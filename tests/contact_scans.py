@@ -1,5 +1,6 @@
 """Helpers shared by the face-pair check's tests (``test_mesh_intersect_*``): the scan run on either path, the
-comparison of two scans' pairs, and the fan-capped cylinder those tests build (as CAD exports tessellate one)."""
+comparison of two scans' pairs, and the fan-capped cylinder those tests build (``solids.fan_capped_cylinder``, which
+the benchmarks build too)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,9 @@ import pytest
 
 from inertia_tool import _native
 from inertia_tool.mesh.intersect import SurfaceContacts, surface_contacts
+from solids import fan_capped_cylinder
+
+__all__ = ["FIELDS", "run_scan", "same_pairs", "fan_capped_cylinder"]
 
 #: The pair lists of a :class:`SurfaceContacts` that the paths must agree on.
 FIELDS = ("crossing", "coplanar_opposite", "contact")
@@ -28,16 +32,3 @@ def same_pairs(a: SurfaceContacts, b: SurfaceContacts) -> None:
     assert a.complete and b.complete
     for name in FIELDS:
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
-
-
-def fan_capped_cylinder(n: int, radius: float = 1.0, height: float = 2.0) -> tuple[np.ndarray, np.ndarray]:
-    """A closed cylinder of ``n`` sections with fan caps round a centre vertex at each end, outward."""
-    t = 2 * np.pi * np.arange(n) / n
-    ring = np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
-    v = np.concatenate([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, height)], [[0, 0, 0], [0, 0, height]]])
-    i = np.arange(n)
-    j = (i + 1) % n
-    bottom, top = np.full(n, 2 * n), np.full(n, 2 * n + 1)
-    f = np.concatenate([np.stack([bottom, j, i], 1), np.stack([top, n + i, n + j], 1),
-                        np.stack([i, j, n + j], 1), np.stack([i, n + j, n + i], 1)])
-    return v, f

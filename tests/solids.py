@@ -22,6 +22,20 @@ def box(extents=(1.0, 1.0, 1.0), center=(0.0, 0.0, 0.0)):
     return v, f
 
 
+def fan_capped_cylinder(n, radius=1.0, height=2.0):
+    """A closed cylinder of ``n`` sections with fan caps round a centre vertex at each end (as CAD exports
+    tessellate one), outward: ``2n + 2`` vertices, ``4n`` faces (bottom fan, top fan, then the sides)."""
+    t = 2 * np.pi * np.arange(n) / n
+    ring = np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
+    v = np.concatenate([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, height)], [[0, 0, 0], [0, 0, height]]])
+    i = np.arange(n)
+    j = (i + 1) % n
+    bottom, top = np.full(n, 2 * n), np.full(n, 2 * n + 1)
+    f = np.concatenate([np.stack([bottom, j, i], 1), np.stack([top, n + i, n + j], 1),
+                        np.stack([i, j, n + j], 1), np.stack([i, n + j, n + i], 1)])
+    return v, f
+
+
 def uv_sphere(radius=1.0, center=(0.0, 0.0, 0.0), segments=24, rings=12):
     """Latitude–longitude sphere with single pole vertices (outward)."""
     verts = [[0.0, 0.0, radius]]

@@ -189,17 +189,23 @@ def test_each_path_is_within_its_bound_of_the_exact_integrals(mesh, chunk):
             bound.second_moment[k] + 2 * integrals._U * np.linalg.norm(exact.second_moment), k
 
 
-def test_the_paths_agree_on_terms_that_overflow(monkeypatch):
-    """A box at 1e150 m (the pipeline refuses it; the integrals' API does not): every sum is NaN on both paths.
-    Before, the numpy path's math.fsum raised a bare ValueError ("-inf + inf in fsum") where C gave NaN."""
+@pytest.mark.usefixtures("engine_path")
+def test_the_paths_agree_on_terms_that_overflow():
+    """A box at 1e150 m (the pipeline refuses it; the integrals' API does not): every sum is NaN on both paths, and
+    the round-off bound infinite.  Before, the numpy path's math.fsum raised a bare ValueError ("-inf + inf in
+    fsum") where C gave NaN; and until session 18 numpy warned of the overflow (RuntimeWarning) where C is silent."""
     m = trimesh.creation.box((1.0, 2.0, 3.0))
-    v, f = np.asarray(m.vertices) * 1e150, np.asarray(m.faces)
-    monkeypatch.setenv("INERTIA_TOOL_NO_ACCEL", "1")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)       # numpy's overflow warnings (C warns of nothing)
-        got = integrals.volume_moments(v, f)
-    assert math.isnan(got.volume) and math.isnan(got.area)
-    assert np.isnan(got.second_moment).all()
+    labels = np.zeros(len(m.faces), dtype=np.intp)
+    for scale, finite_volume in ((1e100, True), (1e150, False)):
+        v, f = np.asarray(m.vertices) * scale, np.asarray(m.faces)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)
+            got = integrals.volume_moments(v, f)
+            shells = body_volume_moments(v, f, labels, 1)
+            bound = integrals.roundoff_bounds(v, f, labels, shells, integrals.reference_point(v))
+        assert math.isfinite(got.volume) == finite_volume and math.isnan(got.area)      # |n|² overflows at 1e100
+        assert np.isnan(got.second_moment).all()
+        assert not np.isfinite(bound.second_moment).any()
 
 
 @pytest.mark.usefixtures("engine_path")

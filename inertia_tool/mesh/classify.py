@@ -22,8 +22,8 @@ from .intersect import SurfaceContacts, surface_contacts
 from .multiplicity import container_windings, multiplicity_changes
 from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
                      inward_crossing_shells, misread_nesting, misread_voids, nested_copies, orient_by_depth,
-                     outward_crossing_groups, reading_difference, rounding_volumes, shell_contacts, winding_stands,
-                     within_up_to_rounding)
+                     outward_crossing_groups, pairs_without, reading_difference, rounding_volumes, shell_contacts,
+                     undecided_shells, winding_stands, within_up_to_rounding)
 from .settle import settle_touching
 from .shells import Shells, apply_flips
 
@@ -121,13 +121,14 @@ def orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContact
 
 
 def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContacts, *, source: str,
-                   multiplicity: np.ndarray | None, again: bool) -> Orientation:
+                   multiplicity: np.ndarray | None, again: bool, unplaced: np.ndarray | None = None) -> Orientation:
     """:func:`orient_shells`; ``again``: the shells are what :func:`~.policy.winding_stands` left (not asked
-    again: the nests it kept have winding 0 or 1 everywhere)."""
+    again: the nests it kept have winding 0 or 1 everywhere); ``unplaced``: (s,) bool, the shells the whole file
+    left undecided, kept undecided here (:func:`_still_undecided`)."""
     v, f, labels, n_shells = shells.vertices, shells.faces, shells.labels, shells.n_shells
     nest = shell_nesting_or_none(v, f, labels, n_shells)
     file_volumes = np.array([s.volume for s in shells.moments])
-    touch, nest, touch_within = settle_touching(v, f, labels, contacts, touch, nest)
+    touch, nest, touch_within, touch_apart = settle_touching(v, f, labels, contacts, touch, nest)
     within, crossing_with = None, touch.crossing_with
     copies = np.zeros((0, 2), dtype=np.int64)
     if touch.complete:
@@ -135,12 +136,15 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
         within, crossing_with = _within(v, f, labels, file_volumes, crossing_with, rounding)
         # R4: a shell left undecided because its probes lay on a shell it touches from inside or outside (a box
         # flush with its container on five faces) is probed again without that shell, as past crossing partners
+        # (session 18: and past the shells it touches from outside, a slab flush between two boxes)
         nest = _decide_past_partners(v, f, labels, n_shells, nest, np.concatenate(
             [np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2), within.reshape(-1, 2),
-             np.asarray(touch_within, dtype=np.int64).reshape(-1, 2)]))
+             np.asarray(touch_within, dtype=np.int64).reshape(-1, 2), touch_apart]))
         apart = (crossing_with, touch_within)          # nested copies not yet moved to the crossing pairs
         crossing_with, touch_within, copies = _copies_nested(file_volumes, nest, crossing_with, touch_within,
                                                              rounding)
+    if unplaced is not None:
+        nest = _still_undecided(nest, unplaced)
     flip, owner, depth = orient_by_depth(file_volumes, nest, crossing_with, crossing_known=touch.complete,
                                          within=_both(within, touch_within))
     # R4 (session 16): where a nest's own winding is a solid's (no region below 0), it stands: the shells with
@@ -154,9 +158,12 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
         s_cross, s_within = apart               # the same pairs as now where no nested copies were found
         s_depth = orient_by_depth(file_volumes, nest, s_cross, within=_both(within, s_within))[2] if len(copies) \
             else depth
+        # a shell left undecided keeps the rule only from the nests it may lie in (by the shells' boxes; session 18)
+        boxes = shell_boxes(v, f, labels, n_shells) if nest is not None and np.asarray(nest.undecided).any() \
+            else None
         for inside_crossed in (True, False):
             stands = winding_stands(file_volumes, s_depth, nest, _both(within, s_within), s_cross, multiplicity,
-                                    inside_crossed=inside_crossed)
+                                    inside_crossed=inside_crossed, boxes=boxes)
             if stands is None or stands.drop is None:
                 break
             read = _read_without(shells, contacts, stands, multiplicity, nest, _both(within, s_within), source)
@@ -260,6 +267,17 @@ def _orient_shells(shells: Shells, contacts: SurfaceContacts, touch: ShellContac
         # listed twice around a cavity listed once (winding 2 − 1 = 1, material) was the summed integral, the
         # cavity cut once (session 16: `exact` 7.875 m³ for {w ≥ 1} = 8)
         candidates[:] = True
+    # R4/R7: a shell left undecided is read by its own sign (depth 0), which no probe checked; where its box lies
+    # within another shell's it may lie inside that shell, and the answer rests on an unchecked reading: not proven
+    # (session 18: a slab flush between two boxes inside an inward box was a body, ``united`` 9 cells high)
+    unsure = _maybe_inside(nest, _both(within, touch_within), v, shells.faces, labels, n_shells) \
+        if touch.complete and nest is not None and np.asarray(nest.undecided).any() else 0
+    if unsure:
+        notes.append(f"{unsure} shell{'s' if unsure > 1 else ''} whose probe points all lie on other surfaces "
+                     f"may lie inside another shell (its bounding box within the other's): read by "
+                     f"{'their' if unsure > 1 else 'its'} own winding, not by a nesting depth. Not verified")
+        warnings.warn(InsideOutWarning(f"{source}: {notes[-1]}"), stacklevel=4)
+        ambiguous += unsure
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[crossing_with.reshape(-1)] = True
     return Orientation(shells, touch, flip, owner, depth, candidates, crossing, ambiguous, tuple(notes), misread,
@@ -274,6 +292,7 @@ def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNest
     so, their warnings then not given).  The shells kept in the nests decided count once in the winding (R0): their
     winding is 0 or 1 there."""
     drop = np.asarray(stands.drop, dtype=bool)
+    unplaced = None if nest is None else undecided_shells(nest, within)[~drop]
     kept_shells, kept_contacts = _without_shells(shells, contacts, drop)
     kept_touch = shell_contacts(kept_contacts, kept_shells.labels, kept_shells.n_shells)
     decided = _in_nests(stands.roots, nest, within, len(drop))
@@ -285,7 +304,7 @@ def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNest
         warnings.simplefilter("always")
         try:
             read = _orient_shells(kept_shells, kept_contacts, kept_touch, source=source, multiplicity=left,
-                                  again=True)
+                                  again=True, unplaced=unplaced)
         except InvalidMeshError:
             if stands.others:       # the other rules refuse the rest read so: ask again for the nests apart only
                 return None
@@ -295,6 +314,41 @@ def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNest
     for found in said:
         warnings.warn(found.message, stacklevel=4)
     return read._replace(interior=stands, contacts=read.contacts if read.contacts is not None else kept_contacts)
+
+
+def _maybe_inside(nest: Nesting, within: np.ndarray | None, v: np.ndarray, f: np.ndarray, labels: np.ndarray,
+                  n_shells: int) -> int:
+    """How many shells left undecided (:func:`~.policy.undecided_shells`) have their bounding box within another
+    shell's (compared exactly: a shell inside another lies within its corners' extremes), so may lie inside it."""
+    unplaced = undecided_shells(nest, within)
+    if not unplaced.any():
+        return 0
+    box = shell_boxes(v, f, labels, n_shells)
+    lo, hi = box[:, 0], box[:, 1]
+    count = 0
+    for u in np.flatnonzero(unplaced)[:MAX_WITHIN_PAIRS].tolist():   # bounded; beyond, counted as inside
+        held = np.all(lo <= lo[u], axis=1) & np.all(hi >= hi[u], axis=1)
+        held[u] = False
+        count += int(held.any())
+    return count + max(0, int(np.count_nonzero(unplaced)) - MAX_WITHIN_PAIRS)
+
+
+def _still_undecided(nest: Nesting | None, unplaced: np.ndarray) -> Nesting | None:
+    """``nest`` with the shells ``unplaced`` ((s,) bool) undecided, their probes' winding numbers dropped.
+
+    R4 (session 18): a shell the whole file left undecided keeps the rule only from the nests it may lie in
+    (:func:`~.policy.winding_stands`), and the rest of the file is read by the other rules *as it would have been*:
+    with the shells left out, a probe of that shell that lay on one of them (or whose ray met an edge of one) may
+    now be clean, and the depth rule would then place it where the file's reading gave it its own sign (a slab
+    flush between two boxes inside a third, the two boxes left out: read as a cavity, 4 cells short of ``{w ≥ 1}``,
+    ``exact``; found by this session's judge)."""
+    if nest is None or not np.any(unplaced):
+        return nest
+    from .nesting import Nesting as Found
+    keep = ~unplaced[np.asarray(nest.shell, dtype=np.int64)]
+    return Found(shell=np.asarray(nest.shell)[keep], other=np.asarray(nest.other)[keep],
+                 winding=np.asarray(nest.winding)[keep], probes=nest.probes,
+                 undecided=np.asarray(nest.undecided, dtype=bool) | unplaced)
 
 
 def _in_nests(roots: np.ndarray | None, nest: Nesting | None, within: np.ndarray | None, n_shells: int) -> np.ndarray:
@@ -387,21 +441,12 @@ def _copies_nested(volumes: np.ndarray, nest: Nesting | None, crossing_with: np.
         held = (np.asarray(nest.winding) != 0) & (shell != other) & ~undecided[shell]
         pairs.append(np.c_[shell[held], other[held]])
     nested = np.concatenate(pairs).reshape(-1, 2)
-    nested = _without_pairs(nested, cross)      # pairs that cross have no nesting (their copies are R4's already)
+    nested = pairs_without(nested, cross)      # pairs that cross have no nesting (their copies are R4's already)
     copies = nested[nested_copies(volumes, nested, rounding=rounding)] if len(nested) else nested
     if not len(copies):
         return cross, touching, np.zeros((0, 2), dtype=np.int64)
     copies = np.unique(np.sort(copies, axis=1), axis=0)
-    return np.concatenate([cross, copies]), _without_pairs(touching, copies), copies
-
-
-def _without_pairs(pairs: np.ndarray, drop: np.ndarray) -> np.ndarray:
-    """The (k, 2) shell ``pairs`` that are not in ``drop`` (compared unordered)."""
-    if not (len(pairs) and len(drop)):
-        return pairs
-    n = int(max(pairs.max(), drop.max())) + 1
-    keys = np.union1d(drop[:, 0] * n + drop[:, 1], drop[:, 1] * n + drop[:, 0])
-    return pairs[~np.isin(pairs[:, 0] * n + pairs[:, 1], keys)]
+    return np.concatenate([cross, copies]), pairs_without(touching, copies), copies
 
 
 def _cavities_in_overlap(count: int) -> str:
@@ -438,7 +483,7 @@ def _inside_kept_cavities(volumes: np.ndarray, flip: np.ndarray, depth: np.ndarr
     if not kept.any():
         return 0
     shell, other, _ = container_windings(volumes, nest, within)
-    found = _without_pairs(np.c_[shell, other], np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2))
+    found = pairs_without(np.c_[shell, other], np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2))
     return len(np.unique(found[kept[found[:, 1]], 0])) if len(found) else 0
 
 
@@ -482,7 +527,7 @@ def classify_shells(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray,
     nest = shell_nesting_or_none(vertices, faces, labels, n_shells)
     touch_within = np.zeros((0, 2), dtype=np.int64)
     if touch is not None and contacts is not None:
-        touch, nest, touch_within = settle_touching(vertices, faces, labels, contacts, touch, nest)
+        touch, nest, touch_within, _ = settle_touching(vertices, faces, labels, contacts, touch, nest)
     crossing_with = touch.crossing_with if touch is not None else np.zeros((0, 2), dtype=np.int64)
     within = None
     if touch is not None and touch.complete:
@@ -532,21 +577,29 @@ def _both(within: np.ndarray | None, more: np.ndarray) -> np.ndarray | None:
     return np.concatenate([np.asarray(within, dtype=np.int64).reshape(-1, 2), more]).reshape(-1, 2)
 
 
-#: Undecided shells that cross others probed again without those others (R4), at most; beyond, they stay undecided.
+#: Undecided shells probed again without their partners (crossing them, within them, holding them or touching them
+#: from outside; R4), at most; beyond, they stay undecided.
 MAX_REPROBED = 16
 
 
 def _decide_past_partners(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int, nest: Nesting | None,
-                          crossing_with: np.ndarray) -> Nesting | None:
-    """R4: shells left undecided because every probe lay on the surface of a shell they cross (a copy listed twice,
-    its coordinates rounded apart) probed again with those shells left out.  Their depth never counts the shells
-    they cross (:func:`~.policy.orient_by_depth`), so those surfaces need not be kept clear of; the winding numbers
-    of the others at the new probe are added to ``nest`` and the shell is decided.  So also past a shell it lies
-    within, or that lies within it, up to touching (``crossing_with`` then holds those ``(shell, container)`` pairs
-    too; session 17: a box flush inside another on five faces left the outer one undecided, and R4 read the pair by
-    depth, ``exact`` 0.55 m³ where the file's winding gives the outer box, 3.83): a shell within another is none of
-    its containers, and the pair's own relation is kept by those pairs."""
-    pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
+                          partners: np.ndarray) -> Nesting | None:
+    """R4: shells left undecided because every probe lay on the surface of a partner, probed again with their
+    partners left out.
+
+    ``partners``: (k, 2) int shell pairs whose relation is already known from their contact: pairs that cross (a
+    copy listed twice, its coordinates rounded apart), ``(shell, container)`` pairs of a shell lying within
+    another up to touching, placed by the boolean or by touching vertices (session 17: a box flush inside another on
+    five faces left the outer one undecided, and R4 read the pair by depth, ``exact`` 0.55 m³ where the file's
+    winding gives the outer box, 3.83), and pairs touching from outside (session 18: a slab flush between two boxes
+    inside an inward box, its own sign deciding, was a body where every reading makes it a cavity, ``united`` 9
+    cells high).  A shell's depth never counts a shell it crosses (:func:`~.policy.orient_by_depth`), a shell
+    within another is none of its containers, the pair's own relation being kept by those pairs, and a shell
+    touching another from outside lies outside it (its winding is 0 there); so the partners' surfaces need not be
+    kept clear of.  The winding numbers of
+    the other shells at the new probe are added to ``nest`` and the shell is decided.  At most
+    :data:`MAX_REPROBED` shells are probed again; the others stay undecided."""
+    pairs = np.asarray(partners, dtype=np.int64).reshape(-1, 2)
     if nest is None or not len(pairs) or not np.asarray(nest.undecided).any():
         return nest
     undecided = np.asarray(nest.undecided, dtype=bool).copy()
@@ -557,8 +610,8 @@ def _decide_past_partners(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_sh
     shell, other, winding = [nest.shell], [nest.other], [nest.winding]
     probes = np.array(nest.probes, dtype=np.float64, copy=True)
     for s in todo:
-        partners = np.unique(np.concatenate([pairs[pairs[:, 0] == s, 1], pairs[pairs[:, 1] == s, 0]]))
-        keep = ~np.isin(labels, partners)
+        own = np.unique(np.concatenate([pairs[pairs[:, 0] == s, 1], pairs[pairs[:, 1] == s, 0]]))
+        keep = ~np.isin(labels, own)
         kept = np.flatnonzero(np.bincount(labels[keep], minlength=n_shells) > 0)   # old labels, ascending
         if len(kept) < 2:
             undecided[s] = False           # nothing else to lie in: depth 0
@@ -597,13 +650,20 @@ def _within(v: np.ndarray, f: np.ndarray, labels: np.ndarray, volumes: np.ndarra
     return within, np.concatenate([really, pairs[MAX_WITHIN_PAIRS:]])
 
 
-def boxes_meet(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) -> np.ndarray:
-    """(s,) bool: shells whose bounding box meets another shell's."""
+def shell_boxes(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) -> np.ndarray:
+    """(s, 2, 3) float: each shell's bounding box, its lowest and highest corner (m), from its faces' corners."""
     order = np.argsort(labels, kind="stable")
     starts = np.searchsorted(labels[order], np.arange(n_shells))
     tri = v[f[order]]
     lo = np.minimum.reduceat(tri.min(axis=1), starts, axis=0)
     hi = np.maximum.reduceat(tri.max(axis=1), starts, axis=0)
+    return np.stack([lo, hi], axis=1)
+
+
+def boxes_meet(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_shells: int) -> np.ndarray:
+    """(s,) bool: shells whose bounding box meets another shell's."""
+    box = shell_boxes(v, f, labels, n_shells)
+    lo, hi = box[:, 0], box[:, 1]
     meet = np.all(lo[:, None] <= hi[None], axis=2) & np.all(lo[None] <= hi[:, None], axis=2)
     np.fill_diagonal(meet, False)
     return np.asarray(meet.any(axis=1))

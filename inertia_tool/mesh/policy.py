@@ -120,7 +120,10 @@ R4 *Orientation by nesting depth, where the file's winding is evidently wrong* (
    anywhere kept the depth reading for every nest); so also in a *sub-nest* inside a nest with crossings (a shell
    crossing nothing, with nothing inside it crossing, whose winding just outside is 0 or 1: the shells around it
    crossing others or not), and the rest of the file is read by the rules below, the certificate the weaker of
-   the parts (the boolean's ``united`` where the rest is united; the note says how many nests went each way);
+   the parts (the boolean's ``united`` where the rest is united; the note says how many nests went each way); a
+   shell left undecided (every probe on another surface, even probed again past the shells it crosses, lies within
+   or touches) keeps the rule only from the nests it may lie in, not from every nest (session 18:
+   :func:`may_hold_undecided`, by the shells' bounding boxes, and the rest read with it still undecided);
    the shells with winding ``≥ 1`` on both sides (a body wound outward wholly inside another, and
    whatever lies inside it) bound nothing of ``{w ≥ 1}`` and are left out, and the rest, each with winding 0 on one
    side and 1 on the other, is integrated as wound: ``exact`` with the check ``interior-shells`` (no boolean; left
@@ -254,7 +257,8 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "rounding_volumes", "coincident_message", "TouchRelations", "touching_relations", "self_crossing_message",
            "shell_contacts", "ShellContacts", "weakest", "near_copies", "NearCopies", "near_copies_message",
            "MisreadNesting", "misread_nesting", "misread_voids", "outward_crossing_groups", "misread_message",
-           "point_text", "part_size", "turned_reading_refusal", "winding_stands", "reading_difference"]
+           "point_text", "part_size", "turned_reading_refusal", "winding_stands", "reading_difference",
+           "pairs_without", "nest_roots", "may_hold_undecided", "undecided_shells"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -955,7 +959,7 @@ def misread_voids(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray,
                           inward=True)
 
 
-def _undecided(nest: Nesting, within: np.ndarray | None) -> np.ndarray:
+def undecided_shells(nest: Nesting, within: np.ndarray | None) -> np.ndarray:
     """(s,) bool: shells whose probes all lay on other surfaces and that touching or the boolean did not place
     either (``within``: ``(shell, container)`` pairs), as :func:`orient_by_depth` counts them."""
     undecided: np.ndarray = np.asarray(nest.undecided, dtype=bool).copy()
@@ -975,7 +979,7 @@ def reading_difference(file_volumes: np.ndarray, depth: np.ndarray, nest: Nestin
     (Rigid Body Motion, Ch. 4: the volume integral of a solid bounded by nested closed surfaces is the signed sum of
     theirs).  Both are sums of the shells' exact integrals, so their difference is stated, not bounded."""
     vols = np.asarray(file_volumes, dtype=np.float64)
-    if nest is None or len(np.asarray(crossing_with).reshape(-1)) or _undecided(nest, within).any():
+    if nest is None or len(np.asarray(crossing_with).reshape(-1)) or undecided_shells(nest, within).any():
         return None
     inside, outside = region_windings(vols, nest, within)
     size = np.abs(vols)
@@ -986,7 +990,7 @@ def reading_difference(file_volumes: np.ndarray, depth: np.ndarray, nest: Nestin
 
 def winding_stands(file_volumes: np.ndarray, depth: np.ndarray, nest: Nesting | None, within: np.ndarray | None,
                    crossing_with: np.ndarray, multiplicity: np.ndarray | None = None, *,
-                   inside_crossed: bool = True) -> MisreadNesting | None:
+                   inside_crossed: bool = True, boxes: np.ndarray | None = None) -> MisreadNesting | None:
     """R4 (session 16, per nest since session 17): the nests whose own winding is a solid's, where nesting depth would
     read a shell the file winds outward as a cavity or R0's count decides; the shells to leave out there (``drop``),
     or None where the rule applies nowhere.
@@ -1011,6 +1015,23 @@ def winding_stands(file_volumes: np.ndarray, depth: np.ndarray, nest: Nesting | 
     ``X`` would give 1 where the file has 0), and the rest of the file goes on to the other rules as it would
     have.  (The caller checks that the other rules then turn none of the shells kept: :mod:`~.classify`.)
 
+    *A shell left undecided* (every probe on another surface, and not placed by touching or the boolean:
+    :func:`undecided_shells`) has no known containers, so it may lie in any nest; since session 18 it keeps the rule
+    only from the nests it may lie in, given ``boxes`` ((s, 2, 3) float, each shell's bounding box, lowest and highest
+    corner, m; None: the rule applies nowhere while a shell is undecided, as before).  No shell is decided as the
+    outer shell ``X`` of a nest (or sub-nest) where (a) ``X`` is undecided, (b) ``X`` lies inside an undecided shell
+    (its winding at ``X``'s probe is nonzero: the other rules give an undecided shell its own sign and may turn it,
+    which would change the winding ``c`` round ``X``), or (c) an undecided shell's bounding box lies within
+    ``X``'s.  Why that is sound: the rule reads the inside of ``X`` from the shells whose probes lie there; an
+    undecided shell ``U`` adds to the winding inside ``X`` only where its surface enters the interior of ``X``.
+    ``U``'s surface is edge-connected; where its box is not within ``X``'s it has a point outside ``X``'s box, so
+    outside the closed solid of ``X`` (which lies in the convex hull of ``X``'s corners), and reaching the
+    interior of ``X`` from there it would meet ``X``'s surface: a crossing (``X`` would not cross nothing) or a
+    contact the touching rules placed (``U`` within ``X``: then not undecided; ``X`` within ``U``: ``U`` is around
+    ``X``, case (b); apart: the points of ``U`` near the contact all outside ``X``).  So ``U`` adds a constant
+    inside ``X``, its winding at ``X``'s probe, which ``c`` holds.  The comparison of the boxes is exact (floats
+    compared, no tolerance: a point of the closed solid lies within the corners' extremes).
+
     ``shells``: the shells wound outward that depth would read as cavities (odd depth), ``volume`` their summed
     volume, ``difference`` the depth reading less the file's within the nests decided, m³, exactly (the depth
     reading of those nests, the rest as given: :func:`reading_difference` restricted to them), ``roots`` the
@@ -1023,7 +1044,10 @@ def winding_stands(file_volumes: np.ndarray, depth: np.ndarray, nest: Nesting | 
     vols = np.asarray(file_volumes, dtype=np.float64)
     d = np.asarray(depth, dtype=np.int64)
     n = len(vols)
-    if nest is None or n < 2 or _undecided(nest, within).any():
+    if nest is None or n < 2:
+        return None
+    undecided = undecided_shells(nest, within)
+    if undecided.all() or (undecided.any() and boxes is None):
         return None
     crosses = np.zeros(n, dtype=bool)
     pairs = np.asarray(crossing_with, dtype=np.int64).reshape(-1, 2)
@@ -1033,22 +1057,19 @@ def winding_stands(file_volumes: np.ndarray, depth: np.ndarray, nest: Nesting | 
     inside, outside = region_windings(vols, nest, within, multiplicity)
     shell, other, _ = container_windings(vols, nest, within)
     if len(pairs):                                   # a shell crossing another is not inside it
-        shell, other = _without_crossing(shell, other, pairs, n)
+        shell, other = pairs_without(np.c_[shell, other], pairs).T
     # a shell is clear when it crosses nothing and nothing inside it crosses anything
     clear = ~crosses
     np.logical_and.at(clear, other, ~crosses[shell])
     contained = np.bincount(shell, minlength=n) > 0
     candidate = clear & ((outside == 0) | (outside == 1)) if inside_crossed else clear & ~contained
+    if undecided.any() and boxes is not None:      # not the outer shell of a nest an undecided shell may lie in
+        candidate &= ~may_hold_undecided(undecided, shell, other, boxes)
     holder = np.zeros(n, dtype=bool)                 # inside a candidate: not the outer shell of a nest decided
     holder[shell[candidate[other]]] = True
-    roots = np.flatnonzero(candidate & ~holder)
-    root = np.full(n, -1, dtype=np.int64)
-    root[roots] = roots
-    for s, o in zip(shell.tolist(), other.tolist()):
-        if candidate[o] and not holder[o]:
-            if root[s] not in (-1, o):
-                return None                          # not a tree of nests (cannot happen without crossings)
-            root[s] = o
+    root = nest_roots(shell, other, candidate & ~holder)
+    if root is None:
+        return None                                  # not a tree of nests (cannot happen without crossings)
     member = root >= 0
     wrong = np.zeros(n, dtype=bool)
     np.logical_or.at(wrong, root[member], (inside < 0)[member] | (outside < 0)[member])
@@ -1076,11 +1097,57 @@ def winding_stands(file_volumes: np.ndarray, depth: np.ndarray, nest: Nesting | 
                           others=int(np.count_nonzero(~decided)))
 
 
-def _without_crossing(shell: np.ndarray, other: np.ndarray, pairs: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """The ``(shell, container)`` pairs that are not ``(k, 2)`` crossing ``pairs`` (either way round)."""
-    keys = np.union1d(pairs[:, 0] * n + pairs[:, 1], pairs[:, 1] * n + pairs[:, 0])
-    keep = ~np.isin(shell * n + other, keys)
-    return shell[keep], other[keep]
+def may_hold_undecided(undecided: np.ndarray, shell: np.ndarray, other: np.ndarray, boxes: np.ndarray, *,
+                       block: int = 1 << 22) -> np.ndarray:
+    """(s,) bool, R4 (:func:`winding_stands`): the shells that are undecided (``undecided``, (s,) bool), lie inside
+    an undecided shell (``(shell, other)`` pairs, :func:`~.multiplicity.container_windings`), or whose bounding box
+    holds an undecided shell's (``boxes``, (s, 2, 3) float, lowest and highest corner; compared exactly, in blocks
+    of at most ``block`` shell pairs)."""
+    found: np.ndarray = np.asarray(undecided, dtype=bool).copy()
+    found[np.asarray(shell, dtype=np.int64)[found[np.asarray(other, dtype=np.int64)]]] = True
+    b = np.asarray(boxes, dtype=np.float64).reshape(-1, 2, 3)
+    lo, hi = b[:, 0], b[:, 1]
+    ids = np.flatnonzero(undecided)
+    step = max(1, block // max(1, len(lo)))
+    for start in range(0, len(ids), step):                 # bounded: ⌈u / step⌉ blocks
+        u = ids[start:start + step]
+        holds = np.all(lo[:, None] <= lo[None, u], axis=2) & np.all(hi[:, None] >= hi[None, u], axis=2)
+        found |= holds.any(axis=1)
+    return found
+
+
+def pairs_without(pairs: np.ndarray, drop: np.ndarray) -> np.ndarray:
+    """The (k, 2) int shell ``pairs`` that are not in the (j, 2) int ``drop`` pairs, either way round (R4: a shell
+    crossing another is not inside it; nested copies are not nested shells), in their order."""
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    drop = np.asarray(drop, dtype=np.int64).reshape(-1, 2)
+    if not (len(pairs) and len(drop)):
+        return pairs
+    n = int(max(pairs.max(), drop.max())) + 1                  # one key per ordered pair: a * n + b
+    keys = np.union1d(drop[:, 0] * n + drop[:, 1], drop[:, 1] * n + drop[:, 0])
+    return pairs[~np.isin(pairs[:, 0] * n + pairs[:, 1], keys)]
+
+
+def nest_roots(shell: np.ndarray, other: np.ndarray, root: np.ndarray) -> np.ndarray | None:
+    """(s,) int: the outer shell of the nest each shell belongs to (``-1``: none), or None where a shell lies inside
+    two of them (no tree of nests).
+
+    ``shell, other``: (j,) int, each shell found inside another (:func:`~.multiplicity.container_windings`);
+    ``root``: (s,) bool, the outer shells of the nests (lying inside none of them).  A shell's nest is the one
+    whose outer shell contains it, or its own where it is one."""
+    n = len(root)
+    s, o = np.asarray(shell, dtype=np.int64), np.asarray(other, dtype=np.int64)
+    held = root[o]
+    s, o = np.r_[s[held], np.flatnonzero(root)], np.r_[o[held], np.flatnonzero(root)]
+    low = np.full(n, n, dtype=np.int64)
+    high = np.full(n, -1, dtype=np.int64)
+    np.minimum.at(low, s, o)
+    np.maximum.at(high, s, o)
+    found = high >= 0
+    if np.any(low[found] != high[found]):
+        return None
+    roots: np.ndarray = np.where(found, high, -1)
+    return roots
 
 
 def outward_crossing_groups(file_volumes: np.ndarray, flip: np.ndarray, depth: np.ndarray,

@@ -136,7 +136,8 @@ MAX_TOUCHING_PAIRS = 512
 
 
 def settle_touching(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: SurfaceContacts,
-                    touch: ShellContacts, nest: Nesting | None) -> tuple[ShellContacts, Nesting | None, np.ndarray]:
+                    touch: ShellContacts, nest: Nesting | None
+                    ) -> tuple[ShellContacts, Nesting | None, np.ndarray, np.ndarray]:
     """R4 for shells that touch without a crossing face pair: their vertices decide (:func:`~.nesting.touching_sides`,
     :func:`~.policy.touching_relations`), not one probe point.
 
@@ -151,15 +152,17 @@ def settle_touching(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: 
     nest : Nesting or None
     within : (j, 2) int
         ``(shell, container)`` pairs found by the vertices.
+    apart : (k, 2) int
+        Pairs that touch from outside, found by the vertices (neither holds the other).
     """
     none = np.zeros((0, 2), dtype=np.int64)
     if nest is None or not touch.complete:
-        return touch, nest, none
+        return touch, nest, none, none
     faces_touching = np.concatenate([np.asarray(contacts.coplanar_opposite, dtype=np.int64).reshape(-1, 2),
                                      np.asarray(contacts.contact, dtype=np.int64).reshape(-1, 2)])
     faces_touching = faces_touching[labels[faces_touching[:, 0]] != labels[faces_touching[:, 1]]]
     if not len(faces_touching):
-        return touch, nest, none
+        return touch, nest, none, none
     pairs = np.unique(np.sort(labels[faces_touching], axis=1), axis=0)
     n = len(touch.crossing)
     crossed = np.zeros((n, n), dtype=bool)
@@ -167,7 +170,7 @@ def settle_touching(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: 
     crossed[cw[:, 0], cw[:, 1]] = True
     pairs = pairs[~crossed[pairs[:, 0], pairs[:, 1]]]
     if not len(pairs):
-        return touch, nest, none
+        return touch, nest, none, none
     from .nesting import touching_sides      # imported on use: touching shells are rare
     tested, beyond = pairs[:MAX_TOUCHING_PAIRS], pairs[MAX_TOUCHING_PAIRS:]
     sides = touching_sides(v, f, labels, tested, faces_touching)
@@ -184,4 +187,4 @@ def settle_touching(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: 
         drop[decided[:, 0], decided[:, 1]] = drop[decided[:, 1], decided[:, 0]] = True
         keep = ~drop[nest.shell, nest.other]
         nest = dataclasses.replace(nest, shell=nest.shell[keep], other=nest.other[keep], winding=nest.winding[keep])
-    return touch, nest, found.within
+    return touch, nest, found.within, np.asarray(found.apart, dtype=np.int64).reshape(-1, 2)
