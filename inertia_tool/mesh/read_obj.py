@@ -4,6 +4,7 @@ polygons cut as MuJoCo's loader cuts them, :mod:`.polygons`)."""
 from __future__ import annotations
 
 import warnings
+from typing import Any
 
 import numpy as np
 
@@ -54,7 +55,7 @@ def _tokens_per_line(chars: np.ndarray) -> np.ndarray:
     return np.add.reduceat(starts, line_starts, dtype=np.int64)
 
 
-def _plain_block(block: bytes, nv: int, max_vertices: int, faces_left: int):
+def _plain_block(block: bytes, nv: int, max_vertices: int, faces_left: int) -> tuple[Any, ...] | None:
     """One block of an OBJ file read without a Python loop over its ``v`` and ``f`` lines, when every line is
     plain: ``v`` then a space or tab and exactly three coordinates, ``f`` then a space or tab and three or four
     corners with positive vertex indices (digits only) up to ``max_vertices``; any other line a comment, a blank
