@@ -254,7 +254,8 @@ def audit_corpus(paths, *, density=None, material: str | None = None, keep_mass:
         of the same name and size (:func:`_shared_groups`: Stretch and Stretch 3), the groups holding the most
         bytes first; each worker keeps one :class:`MeshCache` for the folders it is given.  The results and every
         model's warnings come back in the order of a serial run, and are the same as its (a mesh shared
-        between folders may be integrated once per worker instead of once).
+        between folders may be integrated once per worker instead of once).  With ``repair`` the parent imports
+        :data:`REPAIR_IMPORTS` before the workers fork.
     """
     if not (isinstance(jobs, (int, np.integer)) and not isinstance(jobs, bool) and jobs >= 1):
         raise UsageError(f"Expected `jobs` to be an integer >= 1, got {jobs!r}")
