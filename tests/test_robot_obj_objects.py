@@ -4,9 +4,11 @@ against MuJoCo itself on generated files."""
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from inertia_tool.robot import link_inertials, read_robot
-from inertia_tool.robot.mjcf import obj_object_triangles
+from inertia_tool.robot.mjcf import _may_hold_objects, _object_triangles, obj_object_triangles
 
 
 def _cube_lines(offset, first_vertex):
@@ -62,3 +64,26 @@ def test_a_single_object_file_has_no_note(tmp_path):
     (link,) = link_inertials(read_robot(str(_model(tmp_path, mesh))), density=1000.0)
     assert not any("first object" in w for w in link.warnings)
     assert np.isclose(link.properties.volume, 1.0)
+
+
+_LINES = ["f 1 2 3", "f 1 2 3 4", "f 1 2", "o a", "g", "g b", " o c", "\to d", "f\t1 2 3", " f 1 2 3", "v 0 0 0",
+          "# o x", "", "fo 1 2 3", "og", "o", "\x0bf 1 2 3", "f\x0c1 2 3 4"]
+
+
+@settings(max_examples=300, deadline=None)
+@given(lines=st.lists(st.sampled_from(_LINES), max_size=12), ending=st.sampled_from(["\n", "\r\n", "\r"]),
+       last=st.sampled_from(["", "\n"]))
+def test_the_quick_look_misses_no_file_of_several_objects(lines, ending, last):
+    """``_may_hold_objects`` (the look that spares most files the line scan) is False only where the scan finds
+    fewer than two objects; on a file of two cubes it is True."""
+    data = (ending.join(lines) + last).encode()
+    if len(_object_triangles(data)) >= 2:
+        assert _may_hold_objects(data)
+
+
+def test_the_quick_look_sees_two_cubes(tmp_path):
+    _two_cubes(tmp_path / "two.obj")
+    data = (tmp_path / "two.obj").read_bytes()
+    assert _may_hold_objects(data) and len(_object_triangles(data)) == 2
+    one = b"".join(line + b"\n" for line in data.splitlines() if not line.startswith(b"o"))
+    assert not _may_hold_objects(one)

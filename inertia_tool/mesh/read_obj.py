@@ -4,11 +4,13 @@ polygons cut as MuJoCo's loader cuts them, :mod:`.polygons`)."""
 from __future__ import annotations
 
 import warnings
+from typing import Any
 
 import numpy as np
 
 from ..errors import MalformedTextWarning
 from .polygons import clip_polygons, split_quads_along_shorter_diagonal, warn_clipped_polygons, warn_warped_quads
+from .options import MAX_SUPPORTED_FACES
 from .read_base import (MAX_LINE_BYTES, _check_face_budget, _display, _fail, _has_odd_bytes, _odd_number, _source_bytes,
                         _text_blocks)
 
@@ -34,7 +36,119 @@ def _obj_vertex_block(path: str, tokens: list[bytes], lines: list[int]) -> np.nd
         raise _fail(path, f"vertex coordinates on lines {lines[0]} to {lines[-1]} are not numbers") from None
 
 
-def _read_obj(path: str, max_faces: int, data: bytes | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+#: Bytes that end a word in :func:`_read_obj`'s ``bytes.split()`` and that :func:`_plain_block` takes as gaps
+#: (space, tab, newline); a line holding another whitespace byte (``\v``, ``\f``) is left to the line loop.
+_GAP = np.zeros(256, dtype=bool)
+_GAP[[32, 9, 10]] = True
+#: Bytes a plain face line may hold once its corners' ``/`` tails are cut: digits and gaps.
+_INDEX_BYTE = _GAP.copy()
+_INDEX_BYTE[48:58] = True
+
+
+def _tokens_per_line(chars: np.ndarray) -> np.ndarray:
+    """``(lines,)`` int: the words (runs of bytes other than space, tab and newline) on each line of ``chars``
+    (the bytes of whole lines, each ending with a newline)."""
+    gap = _GAP[chars]
+    starts = ~gap
+    starts[1:] &= gap[:-1]
+    line_starts = np.concatenate(([0], np.flatnonzero(chars == 10)[:-1] + 1))
+    return np.add.reduceat(starts, line_starts, dtype=np.int64)
+
+
+def _plain_block(block: bytes, nv: int, max_vertices: int, faces_left: int) -> tuple[Any, ...] | None:
+    """One block of an OBJ file read without a Python loop over its ``v`` and ``f`` lines, when every line is
+    plain: ``v`` then a space or tab and exactly three coordinates, ``f`` then a space or tab and three or four
+    corners with positive vertex indices (digits only) up to ``max_vertices``; any other line a comment, a blank
+    line, a statement of :data:`_OBJ_SKIPPED` or an ``l``/``p`` line (each looked at as the line loop looks at
+    it); no ``_`` or non-ASCII byte in a ``v`` or ``f`` line, no continued line, at most ``faces_left``
+    triangles and ``max_vertices − nv`` vertices.  Returns what :func:`_read_obj`'s line loop builds for the
+    same block — ``(coordinates (k, 3) or None, triangles (t, 3) or None, first triangle of each quad,
+    vertices, polygons, triangles, l/p lines)`` — or None for any other block (the loop then reads it, and says
+    what is wrong where it is).
+
+    Both read the same words with the same conversions (``np.array(..., float64)`` of the coordinates, the
+    digits before a corner's first ``/`` as the index), in the file's order, so their arrays are equal; a quad
+    ``a b c d`` is the triangles ``a b c, a c d`` before :func:`~.polygons.split_quads_along_shorter_diagonal`,
+    as in the loop."""
+    if b"\\\n" in block or not block.endswith(b"\n"):
+        return None
+    chars = np.frombuffer(block, dtype=np.uint8)
+    ends = np.flatnonzero(chars == 10)
+    starts = np.concatenate(([0], ends[:-1] + 1))
+    length = ends - starts
+    first = chars[starts]
+    second = chars[np.minimum(starts + 1, len(chars) - 1)]
+    spaced = (length >= 2) & ((second == 32) | (second == 9))
+    is_v = spaced & (first == ord("v"))
+    is_f = spaced & (first == ord("f"))
+    loose = 0
+    others = np.flatnonzero(~(is_v | is_f))
+    # a ``vn``/``vt`` line is skipped by the loop: told apart here without looking at it in Python
+    tex = (length >= 3) & (first == ord("v")) & ((second == ord("n")) | (second == ord("t")))
+    third = chars[np.minimum(starts + 2, len(chars) - 1)]
+    tex &= (third == 32) | (third == 9)
+    for line in others[~tex[others]]:
+        parts = block[starts[line]:ends[line]].split()
+        if not parts or parts[0][:1] == b"#" or parts[0] in _OBJ_SKIPPED:
+            continue
+        if parts[0] in (b"l", b"p"):
+            loose += 1
+            continue
+        return None
+    n_v, n_f = int(np.count_nonzero(is_v)), int(np.count_nonzero(is_f))
+    if nv + n_v > max_vertices:
+        return None
+    keyword = np.zeros(len(chars), dtype=bool)
+    keyword[starts] = True                                      # the 'v' or 'f' itself
+    coords = None
+    if n_v:
+        text = chars[np.repeat(is_v, length + 1) & ~keyword]
+        if not text.tobytes().isascii() or np.any(text == ord("_")) \
+                or np.any(_tokens_per_line(text) != 3):
+            return None
+        try:
+            coords = np.array(text.tobytes().split(), dtype=np.float64).reshape(-1, 3)
+        except ValueError:
+            return None
+    if not n_f:
+        return coords, None, None, n_v, 0, 0, loose
+    text = chars[np.repeat(is_f, length + 1) & ~keyword]
+    gap = _GAP[text]
+    word_start = ~gap
+    word_start[1:] &= gap[:-1]
+    slash = text == ord("/")
+    if np.any(word_start & slash):                              # a corner without a vertex index
+        return None
+    at = np.arange(len(text))
+    tail = np.maximum.accumulate(np.where(slash, at, -1)) > np.maximum.accumulate(np.where(gap, at, -1))
+    text = text[~tail]                                          # each corner's vertex index, its '/...' cut
+    if not np.all(_INDEX_BYTE[text]):
+        return None
+    corners = _tokens_per_line(text)
+    if corners.min() < 3 or corners.max() > 4:
+        return None
+    n_tri = int(np.sum(corners)) - 2 * n_f
+    if n_tri > faces_left:
+        return None
+    try:
+        index = np.array(text.tobytes().split(), dtype=np.int64)
+    except OverflowError:                                      # past int64: the loop says it is past any vertex
+        return None
+    if index.min() < 1 or index.max() > max_vertices:
+        return None
+    index -= 1
+    first_corner = np.cumsum(corners) - corners
+    per_line = corners - 2                                     # each line's triangles
+    first_triangle = np.cumsum(per_line) - per_line
+    line = np.repeat(np.arange(n_f), per_line)
+    second_of = np.arange(n_tri) - first_triangle[line]        # 0, or 1 for a quad's second triangle
+    base = first_corner[line]
+    tri = np.stack([index[base], index[base + 1 + second_of], index[base + 2 + second_of]], axis=1)
+    return coords, tri, first_triangle[corners == 4], n_v, n_f, n_tri, loose
+
+
+def _read_obj(path: str, max_faces: int, data: bytes | None = None,
+              plain_blocks: bool = True) -> tuple[np.ndarray, np.ndarray, int]:
     """Stream a Wavefront OBJ: ``v`` lines and ``f`` polygons (1-based or negative relative indices).
 
     A quadrilateral is split along its shorter diagonal (corners ``a b c d``: ``abc, acd`` when
@@ -48,6 +162,9 @@ def _read_obj(path: str, max_faces: int, data: bytes | None = None) -> tuple[np.
 
     Returns ``vertices (n, 3)``, ``faces (m, 3)`` and the number of polygons in the file.  ``data``: the file's
     bytes if the caller has read them (:func:`load_mesh`), parsed instead of reading the file.
+    ``plain_blocks``: read a block whose every line is plain without the loop over its lines
+    (:func:`_plain_block`: the same arrays; issue 25, the Menagerie corpus read 191 OBJ files); False: every
+    block line by line (the tests compare the two).
     """
     vertex_blocks: list[np.ndarray] = []
     face_blocks: list[np.ndarray] = []
@@ -61,6 +178,20 @@ def _read_obj(path: str, max_faces: int, data: bytes | None = None) -> tuple[np.
     max_vertices = 3 * max_faces + 3
     with _source_bytes(path, data) as fh:
         for block in _text_blocks(fh, path):
+            faces_left = min(max_faces, MAX_SUPPORTED_FACES) - n_tri
+            plain = _plain_block(block, nv, max_vertices, faces_left) if plain_blocks and not pending else None
+            if plain is not None:
+                block_coords, block_tri, block_quads, block_nv, block_poly, block_tri_count, block_loose = plain
+                line_no += block.count(b"\n")
+                if block_coords is not None:
+                    vertex_blocks.append(block_coords)
+                if block_tri is not None:
+                    face_blocks.append(block_tri)
+                    if len(block_quads):
+                        quad_blocks.append((len(face_blocks) - 1, block_quads))
+                nv, n_poly, n_tri, loose = nv + block_nv, n_poly + block_poly, n_tri + block_tri_count, \
+                    loose + block_loose
+                continue
             coords: list[bytes] = []
             coord_lines: list[int] = []                 # the line of each vertex, for an error message
             tri: list[int] = []

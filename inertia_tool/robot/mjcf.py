@@ -115,13 +115,21 @@ def obj_object_triangles(path: str, *, limit: int = OBJ_SCAN_LIMIT) -> list[int]
     """Triangles of each object of an OBJ file, in file order: a new object starts at an ``o`` or ``g`` line
     after at least one face (the grouping of MuJoCo's OBJ loader); a polygon of ``n`` corners counts ``n − 2``.
     An empty list for a file that cannot be read or is larger than ``limit`` bytes."""
+    data = _obj_bytes(path, limit)
+    return [] if data is None else _object_triangles(data)
+
+
+def _obj_bytes(path: str, limit: int) -> bytes | None:
     try:
         if os.path.getsize(path) > limit:
-            return []
+            return None
         with open(path, "rb") as fh:
-            data = fh.read()
+            return fh.read()
     except OSError:
-        return []
+        return None
+
+
+def _object_triangles(data: bytes) -> list[int]:
     counts = [0]
     for line in data.splitlines():
         word = line.split(None, 1)[:1]
@@ -134,13 +142,43 @@ def obj_object_triangles(path: str, *, limit: int = OBJ_SCAN_LIMIT) -> list[int]
     return [c for c in counts if c]
 
 
+#: Whitespace of ``bytes.split()`` within a line, and the line breaks of ``bytes.splitlines()``.
+_BLANK = np.zeros(256, dtype=bool)
+_BLANK[[32, 9, 11, 12]] = True
+_BREAK = np.zeros(256, dtype=bool)
+_BREAK[[10, 13]] = True
+
+
+def _may_hold_objects(data: bytes) -> bool:
+    """False only when no ``o`` or ``g`` line follows a line whose first word is ``f`` (then
+    :func:`_object_triangles` finds at most one object); True when one may, or when a line starts with
+    whitespace (not looked at further).  Without a Python loop over the lines (issue 25: the corpus scanned
+    every OBJ file of every scene, ~2 s of CPU)."""
+    chars = np.frombuffer(data, dtype=np.uint8)
+    if not chars.size:
+        return False
+    breaks = _BREAK[chars]
+    starts = np.flatnonzero(np.concatenate(([True], breaks[:-1])) & ~breaks)   # each non-empty line's first byte
+    if np.any(_BLANK[chars[starts]]):
+        return True
+    after = np.append(chars, 10)[starts + 1]                    # the byte after it (a line break at the end)
+    alone = _BLANK[after] | _BREAK[after]                       # the first word is that one byte
+    first = chars[starts]
+    faces = np.flatnonzero(alone & (first == ord("f")))
+    if not faces.size:
+        return False
+    objects = np.flatnonzero(alone & ((first == ord("o")) | (first == ord("g"))))
+    return bool(objects.size and objects[-1] > faces[0])
+
+
 def _noted_first_object(element: GeometryElement) -> GeometryElement:
     """``element`` with a note when its mesh is an OBJ file of several objects: MuJoCo 4.0 compiles only the
     first (checked: two cubes under ``o a`` / ``o b`` compile to one cube of 12 triangles), the tool the whole
     file, so their inertias of this geom differ."""
     if element.mesh is None or not element.mesh.lower().endswith(".obj"):
         return element
-    objects = obj_object_triangles(element.mesh)
+    data = _obj_bytes(element.mesh, OBJ_SCAN_LIMIT)
+    objects = _object_triangles(data) if data is not None and _may_hold_objects(data) else []
     if len(objects) < 2:
         return element
     note = (f"mesh {os.path.basename(element.mesh)} holds {len(objects)} objects (OBJ 'o'/'g' groups): the whole "
