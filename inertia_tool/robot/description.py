@@ -254,7 +254,9 @@ class LinkGeometry:
     unread : str
         Why this entry's geometry could not be read at all, "" otherwise: an SDFormat ``<include>`` whose model
         is not on disk (``read_robot(missing_meshes="per-link")``) is one entry ``NAME::*`` standing for its
-        unknown links, with no elements; it never gets a result.
+        unknown links, with no elements, and an MJCF ``<attach>`` whose model file is not on disk one entry
+        ``PREFIX*`` (a body that the attached ``<worldbody>`` would have given geoms says so too); it never gets a
+        result.
     """
 
     name: str
@@ -981,7 +983,7 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         SDFormat do), or only its link, whose result then says ``mesh file missing: PATH`` (the command line:
         every link that can be computed is).  With ``"per-link"`` an SDFormat ``<include>`` whose model is not
         on disk becomes one entry ``NAME::*`` without geometry, its ``unread`` the reason (its links are
-        unknown).  An unknown package, or a path naming something that is not a regular file, refuses either
+        unknown), and so does an MJCF ``<attach>`` whose model file is not on disk (``PREFIX*``).  An unknown package, or a path naming something that is not a regular file, refuses either
         way.
 
     Returns

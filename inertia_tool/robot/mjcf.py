@@ -294,7 +294,10 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
     """Bodies of an MJCF ``<mujoco>`` tree as links (see the module docstring); returns ``(model, links)``.
 
     ``missing_meshes="per-link"`` keeps a mesh geom whose file does not exist (its link then has no result and
-    says so) instead of refusing the model."""
+    says so) instead of refusing the model; an ``<attach>`` whose model file does not exist becomes one entry
+    ``PREFIX*`` standing for the bodies it would have brought (all named with its prefix), without geometry, its
+    ``unread`` the reason, and a body that a whole attached ``<worldbody>`` would have given geoms has that
+    reason too (its geometry is unknown)."""
     from .description import MAX_ROBOT_LINKS
     if root.tag != "mujoco":
         raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
@@ -318,16 +321,25 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
         child_class = body.get("childclass", class_name)
         elements: list[GeometryElement] = []
         unselected = [0]
-        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements, model, stack, unselected)
+        absent: list[str] = []          # <attach> frames whose model file is not on disk (missing_meshes="per-link")
+        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements, model, stack, unselected, absent)
+        unread = (f"attached model not read: {absent[0]} (its geoms would be part of this body)" if absent else "")
         links.append(LinkGeometry(name=name, elements=tuple(elements),
                                   declared=_inertial(body, name, model.compiler, model.source),
-                                  unselected=unselected[0]))
+                                  unselected=unselected[0], unread=unread))
         walk_children(body, child_class, suffix, model, prefix, stack)
 
     def walk_children(element, class_name: str, suffix: str, model: _Model, prefix: str, stack: tuple) -> None:
         for child, cls, more in _child_bodies(element, class_name, suffix, model.source, replicas):
             if cls is not None:
                 walk_body(child, cls, more, model, prefix, stack)
+                continue
+            reason = attachments.absent(child, model) if missing_meshes == "per-link" else None
+            if reason is not None:
+                # one entry standing for the attached bodies, all named with the prefix (as SDFormat's NAME::*)
+                counter[0] += 1
+                links.append(LinkGeometry(name=f"{prefix}{child.get('prefix')}*{more}", elements=(), declared=None,
+                                          unread=f"attached model not read: {reason}"))
                 continue
             attached, deeper = attachments.model(child, model, stack)
             inner = prefix + child.get("prefix")
@@ -339,7 +351,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                 walk_body(body, body_class, copy + more, attached, inner, deeper)
 
     def collect(element, link: str, class_name: str, pose, elements: list, model: _Model, stack: tuple,
-                unselected: list) -> None:
+                unselected: list, absent: list) -> None:
         degrees, eulerseq, _ = model.compiler
         for child in element:
             if child.tag == "geom":
@@ -364,15 +376,20 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                 position = _coordinates(_numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", model.source,
                                                  default=(0, 0, 0)), f"body {link!r} frame pos", model.source)
                 composed = (pose[0] @ rotation, pose[0] @ position + pose[1])
-                collect(child, link, child.get("childclass", class_name), composed, elements, model, stack, unselected)
+                collect(child, link, child.get("childclass", class_name), composed, elements, model, stack, unselected,
+                        absent)
             elif child.tag == "replicate":
                 for copy in _replica_poses(child, pose, model, replicas):
-                    collect(child, link, class_name, copy, elements, model, stack, unselected)
+                    collect(child, link, class_name, copy, elements, model, stack, unselected, absent)
             elif child.tag == "attach" and child.get("body") is None:
                 # a whole worldbody attached as a frame: its geoms are this body's, in its own model's terms
+                reason = attachments.absent(child, model) if missing_meshes == "per-link" else None
+                if reason is not None:
+                    absent.append(reason)
+                    continue
                 attached, deeper = attachments.model(child, model, stack)
                 for world in attached.root.findall("worldbody"):
-                    collect(world, link, "main", pose, elements, attached, deeper, unselected)
+                    collect(world, link, "main", pose, elements, attached, deeper, unselected, absent)
 
     for world in root.findall("worldbody"):
         walk_children(world, "main", "", main, "", (os.path.realpath(source),))

@@ -373,6 +373,19 @@ class _Attachments:
         self.packages, self.fitaabb, self.budget = packages, fitaabb, budget
         self.read: dict = {}
 
+    def absent(self, attach, host: _Model) -> str | None:
+        """Why the model file ``attach`` names cannot be read because it is not on disk (with a near match,
+        :func:`~inertia_tool.robot.resolve.near_match`; nothing is read in its place), or None: a file that
+        exists, or a problem of the ``<attach>`` itself (no prefix, an undeclared model), which :meth:`model`
+        refuses."""
+        from .resolve import near_match
+        name = attach.get("model")
+        if attach.get("prefix") is None or name not in host.models or os.path.exists(host.models[name]):
+            return None
+        hint = near_match(host.models[name])
+        return (f"<attach model={name!r}> in {host.source}: the model file {host.models[name]} does not exist"
+                + (f" ({hint})" if hint else ""))
+
     def model(self, attach, host: _Model, stack: tuple) -> tuple[_Model, tuple]:
         """The model asset ``attach`` names (declared in ``host``) and the attach chain extended by it."""
         from .description import MAX_DESCRIPTION_BYTES, _read_bytes, parse_xml
