@@ -273,11 +273,23 @@ def _difference(props, mass: float, com, tensor) -> float:
 _TWIN_MESHES: dict = {}
 
 
+def _as_given(raw):
+    """Unit-density mass properties of the triangles of ``raw`` exactly as read: their signed volume integrals
+    summed (no weld, no orientation, no repair), what MuJoCo's ``inertia="exact"`` integrates.  An overlap of
+    two bodies is counted twice, a crack left open, an inside-out part subtracted."""
+    from inertia_tool.integrals import second_moment_to_inertia, volume_moments
+    from inertia_tool.mass.properties import MassProperties
+    moments = volume_moments(raw.vertices, raw.faces)
+    return MassProperties(mass=moments.volume, volume=moments.volume, center_of_mass=moments.centroid,
+                          inertia=second_moment_to_inertia(moments.second_moment), density=1.0)
+
+
 def twin(link, *, overlap: str = "union", float32: bool = False):
     """The body recomputed from its elements at the model's densities the way MuJoCo's compiler integrates it:
-    ``overlap="sum"`` counts a mesh's overlapping bodies twice (MuJoCo integrates the signed volume of the
-    triangles as given), ``float32`` rounds the file's coordinates to float32 first (MuJoCo stores vertices
-    in float32).  Meshes that need repair raise."""
+    ``overlap="sum"`` counts a mesh's overlapping bodies twice (meshes that need repair raise),
+    ``overlap="given"`` sums the signed integrals of each mesh's triangles exactly as read (:func:`_as_given`:
+    MuJoCo's exact mode; never refuses), ``float32`` rounds the file's coordinates to float32 first (MuJoCo
+    stores vertices in float32)."""
     from dataclasses import replace
 
     from inertia_tool import mass_properties
@@ -297,7 +309,8 @@ def twin(link, *, overlap: str = "union", float32: bool = False):
                 raw = load_mesh(e.mesh, units="m")
                 if float32:
                     raw = replace(raw, vertices=raw.vertices.astype(np.float32).astype(np.float64))
-                _TWIN_MESHES[key] = mass_properties(_placed(raw, e), density=1.0, overlap=overlap)
+                _TWIN_MESHES[key] = (_as_given(_placed(raw, e)) if overlap == "given"
+                                     else mass_properties(_placed(raw, e), density=1.0, overlap=overlap))
             unit = _TWIN_MESHES[key].transformed(rotation=e.rotation, translation=e.translation)
         else:
             unit = element_mass_properties(e)
@@ -358,38 +371,74 @@ def compare_menagerie_file(path: str, *, rtol: float, repair: bool, cache, geome
                          f"{said[0]}: {refused[said[0]]}"))
             continue
         method = result.method
-        if method == "estimate":
-            rows.append((name, "estimate, bounds hold" if _bounds_hold(result, mass, com, tensor)
-                         else "estimate, bounds fail", diff, ""))
+        if method == "estimate" and _bounds_hold(result, mass, com, tensor):
+            rows.append((name, "estimate, bounds hold", diff, ""))
             continue
-        if diff <= rtol:
+        if method != "estimate" and diff <= rtol:
             rows.append((name, f"{method}, agrees", diff, ""))
             continue
-        try:
-            summed = _difference(twin(link, overlap="sum"), mass, com, tensor)
-            rounded = _difference(twin(link, overlap="sum", float32=True), mass, com, tensor)
-        except Exception as exc:   # noqa: BLE001 -- the diagnosis failing is reported, not fatal
-            summed = rounded = float("nan")
-            detail = f"twin failed: {exc}"
+        cause, detail = _mujoco_side(link, result, mass, com, tensor, rtol=rtol, faces=faces)
+        if method == "estimate":
+            bucket = f"estimate, bounds fail: {cause}" if cause else "estimate, bounds fail"
         else:
-            detail = f"summed {summed:.1e}, float32 {rounded:.1e}"
-        dropped = [f for f in files if f in faces and f.lower().endswith(".obj")
-                   and faces[f] < _file_triangles(link, f)]
-        if method != "exact" and summed <= rtol:
-            bucket = f"{method}: MuJoCo counts overlaps twice (summed integral agrees)"
-        elif rounded <= rtol:
-            bucket = f"{method}: MuJoCo approximate (float32 vertices)"
-        elif dropped and all(_first_object_only(link, f, faces[f]) for f in dropped):
-            bucket = (f"{method}: MuJoCo reads only the first object of an OBJ file (the tool the whole file; "
-                      "said in the link's warnings)")
-        elif dropped:
-            bucket = f"{method}: MuJoCo approximate (its OBJ loader keeps fewer triangles: polygons it cannot clip)"
-            detail += (f"; {dropped[0]}: MuJoCo {faces[dropped[0]]} triangles, the file "
-                       f"{_file_triangles(link, dropped[0])}")
-        else:
-            bucket = f"{method}, disagrees"
+            bucket = f"{method}: {cause}" if cause else f"{method}, disagrees"
         rows.append((name, bucket, diff, detail))
     return rows
+
+
+#: How much more mass the summed triangles must carry than the tool's solid before a body whose MuJoCo value is
+#: their sum is said to count an overlap twice (below it the sum differs by round-off, float32 or cracks).
+DOUBLE_COUNT_RTOL = 1e-4
+
+
+def _mujoco_side(link, result, mass: float, com, tensor, *, rtol: float, faces: dict) -> tuple[str, str]:
+    """``(cause, detail)`` of a body where MuJoCo and the tool differ by more than ``rtol``, when MuJoCo's value
+    is shown to be something else than the solid the tool computes ("" for a real disagreement):
+
+    * **double count**: MuJoCo's value equals the summed signed integrals of the meshes' triangles as read
+      (:func:`twin` ``overlap="given"``, float64 or float32 coordinates) to ``rtol``, and that sum carries more
+      than :data:`DOUBLE_COUNT_RTOL` more mass than the tool's solid (overlapping bodies, counted once by the
+      tool's union, twice by MuJoCo);
+    * **triangles as read**: the same agreement, the masses within that: MuJoCo integrates the file's unwelded
+      float32 triangles (cracks, rounding) where the tool integrates the welded solid;
+    * float32 vertices (the overlap-summed solid of float32 coordinates agrees), MuJoCo's OBJ loader keeping
+      the first object only, or fewer triangles."""
+    try:
+        given = min((_difference(twin(link, overlap="given", float32=f32), mass, com, tensor), f32)
+                    for f32 in (False, True))
+        excess = twin(link, overlap="given", float32=given[1]).mass / result.properties.mass - 1.0
+    except Exception as exc:   # noqa: BLE001 -- the diagnosis failing is reported, not fatal
+        given, excess, note = (float("nan"), False), float("nan"), f"as-read sum failed: {exc}"
+    else:
+        note = (f"triangles as read{' (float32)' if given[1] else ''}: {given[0]:.1e} from MuJoCo, "
+                f"{excess:+.1e} mass vs the tool")
+    if given[0] <= rtol:
+        if excess > DOUBLE_COUNT_RTOL:
+            return "MuJoCo counts overlaps twice (its value is the triangles' summed integral)", note
+        return "MuJoCo integrates the triangles as read (unwelded, float32; their summed integral agrees)", note
+    try:
+        summed = _difference(twin(link, overlap="sum"), mass, com, tensor)
+        rounded = _difference(twin(link, overlap="sum", float32=True), mass, com, tensor)
+    except Exception as exc:   # noqa: BLE001 -- a mesh that needs repair has no overlap-summed solid
+        summed = rounded = float("nan")
+        note += f"; twin failed: {str(exc)[:80]}"
+    else:
+        note += f"; summed {summed:.1e}, float32 {rounded:.1e}"
+    files = {os.path.basename(e.mesh) for e in link.elements if e.mesh and not _massless(e)}
+    dropped = [f for f in files if f in faces and f.lower().endswith(".obj") and faces[f] < _file_triangles(link, f)]
+    if result.method != "exact" and summed <= rtol:
+        return "MuJoCo counts overlaps twice (summed integral agrees)", note
+    if rounded <= rtol:
+        return "MuJoCo approximate (float32 vertices)", note
+    if dropped and all(_first_object_only(link, f, faces[f]) for f in dropped):
+        return ("MuJoCo reads only the first object of an OBJ file (the tool the whole file; said in the link's "
+                "warnings)", note)
+    if dropped:
+        return ("MuJoCo approximate (its OBJ loader keeps fewer triangles: polygons it cannot clip)",
+                note + f"; {dropped[0]}: MuJoCo {faces[dropped[0]]} triangles, the file "
+                       f"{_file_triangles(link, dropped[0])}")
+    return "", note
+
 
 
 def _first_object_only(link, basename: str, kept: int) -> bool:

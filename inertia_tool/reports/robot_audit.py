@@ -88,8 +88,9 @@ def summary_line(robot: RobotDescription, inertials) -> str:
     other = other_geometry_only(robot, inertials, missing)
     frames = len(inertials) - len(computed) - len(missing) - len(other)
     if other:
-        kind = {"collision": "visual", "visual": "collision"}.get(robot.geometry, "other")
-        text += (f"; {len(other)} with only {kind} geometry and no declared mass, not computed: "
+        kind = {"collision": "visual geometry", "visual": "collision geometry"}.get(robot.geometry,
+                                                                                 "geoms outside the selection")
+        text += (f"; {len(other)} with only {kind} and no declared mass, not computed: "
                  f"{', '.join(r.name for r in other)}")
     if frames:
         text += f"; {frames} without geometry or mass (frames)"

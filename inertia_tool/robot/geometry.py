@@ -46,7 +46,7 @@ from ..mesh.hole_assumptions import NOTHING_ASSUMED, UserAssumptions, user_named
 from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES, LoadOptions
 from ..values import frozen_value
 from ..mesh.read import RawMesh
-from .description import GeometryElement, LinkGeometry, RobotDescription
+from .description import GeometryElement, LinkGeometry, RobotDescription, geometry_words
 from ..rounding import round_up
 from ..mesh.uncertainty import Uncertainty
 from ..tolerances import EIGEN_ROUNDOFF_RTOL, ESTIMATE_MAX_MASS_RTOL
@@ -1095,8 +1095,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
         other = {"collision": "visual", "visual": "collision"}.get(geometry)
         has = (f"; {link.unselected} {other} element{'s' if link.unselected > 1 else ''}, which --geometry "
                f"{other} reads" if link.unselected and other else "")
-        return LinkInertial(link.name, None, nan, basis, "no geom in <compiler inertiagrouprange>" if geometry == "all"
-                            else f"no {geometry} geometry{has}")
+        return LinkInertial(link.name, None, nan, basis, f"no {geometry_words(geometry)}{has}")
     missing = [e.mesh for e in link.elements if e.mesh is not None and not os.path.exists(e.mesh)
                and not (model and (e.mass == 0 or (e.mass is None and e.density == 0)))]
     if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute

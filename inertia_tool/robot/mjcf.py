@@ -60,7 +60,9 @@ import warnings
 
 import numpy as np
 
-from .description import DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive
+from ..errors import UsageError
+from .description import (DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive,
+                          parse_geometry)
 from .mjcf_bodies import MAX_REPLICAS, _attached_body, _child_bodies, _replica_poses
 from .mjcf_model import (INERTIA_FROM_GEOMETRY, MAX_INCLUDE_DEPTH, MAX_INCLUDED_FILES, MESH_INERTIA_MODES,
                          _Attachments, _InlineMesh, _Model, _model, inertia_from_geometry)
@@ -275,18 +277,23 @@ def _is_collision(attrs: dict, what: str, source: str) -> bool:
     return any(b != 0 for b in bits)
 
 
-def _selected(attrs: dict, geometry: str, groups: tuple, what: str, source: str,
-              paired: frozenset = frozenset()) -> bool:
-    """Whether a geom belongs to the chosen geometry: collision (``contype``/``conaffinity`` not both 0, or
-    named in a ``<contact><pair>``: MuJoCo collides a pair's geoms whatever their bit masks, which is how the MJX
-    models of Menagerie give their contacts), visual (the others), or ``"all"``: every geom whose ``group``
+def _selected(attrs: dict, selection: tuple, groups: tuple, what: str, source: str,
+              paired: frozenset = frozenset(), lineage: tuple = ("main",)) -> bool:
+    """Whether a geom belongs to the chosen geometry (``selection``, from
+    :func:`~inertia_tool.robot.description.parse_geometry`): collision (``contype``/``conaffinity`` not both 0,
+    or named in a ``<contact><pair>``: MuJoCo collides a pair's geoms whatever their bit masks, which is how the
+    MJX models of Menagerie give their contacts), visual (the others), ``"all"``: every geom whose ``group``
     lies in ``<compiler inertiagrouprange>`` (MuJoCo's default 0–5), the geoms MuJoCo's inertia from geometry
-    counts."""
-    if geometry == "all":
+    counts; ``group``: a geom whose ``group`` is listed; ``class``: a geom whose default class (``lineage``: its
+    class and those it is nested in) holds a listed one."""
+    kind, values = selection
+    if kind in ("all", "group"):
         group = _numbers(attrs.get("group", "0"), 1, f"{what} group", source)[0]
-        return groups[0] <= group <= groups[1]
+        return groups[0] <= group <= groups[1] if kind == "all" else group in values
+    if kind == "class":
+        return any(name in values for name in lineage)
     collides = attrs.get("name") in paired or _is_collision(attrs, what, source)
-    return collides == (geometry == "collision")
+    return collides == (kind == "collision")
 
 
 def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
@@ -307,7 +314,9 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
     group_range = next((c.get("inertiagrouprange") for c in reversed(list(root.iter("compiler")))
                         if c.get("inertiagrouprange") is not None), "0 5")
     groups = tuple(_numbers(group_range, 2, "<compiler inertiagrouprange>", source))
+    selection = parse_geometry(geometry)
     attachments = _Attachments(packages, main.compiler[2], budget)
+    classes = set(main.defaults.classes)     # every default class of the models read, for a class= selection
     links = []
     counter = [0]
     replicas = [MAX_REPLICAS]
@@ -342,6 +351,7 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                                           unread=f"attached model not read: {reason}"))
                 continue
             attached, deeper = attachments.model(child, model, stack)
+            classes.update(attached.defaults.classes)
             inner = prefix + child.get("prefix")
             if child.get("body") is None:           # the whole worldbody, as a frame
                 for world in attached.root.findall("worldbody"):
@@ -358,8 +368,9 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                 attrs = model.defaults.attributes(child, class_name, model.source)
                 if attrs.get("type") == "plane":      # MuJoCo gives a plane no mass and no inertia
                     continue
-                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", model.source,
-                             model.paired):
+                lineage = model.defaults.lineage(child.get("class", class_name))
+                if _selected(attrs, selection, groups, f"body {link!r} geom {len(elements) + 1}", model.source,
+                             model.paired, lineage):
                     label = f"geom {len(elements) + 1}"
                     if attrs.get("type") == "hfield":
                         elements.append(_hfield_geom(attrs, pose, label, link, model.hfields, model.compiler,
@@ -393,6 +404,10 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
 
     for world in root.findall("worldbody"):
         walk_children(world, "main", "", main, "", (os.path.realpath(source),))
+    unknown = [name for name in selection[1] if selection[0] == "class" and name not in classes]
+    if unknown:
+        raise UsageError(f"{source} has no <default class={unknown[0]!r}> for `geometry` {geometry!r} (its classes: "
+                         f"{', '.join(sorted(classes))})")
     if not links and any(world.find("geom") is not None for world in root.findall("worldbody")):
         raise _fail(source, "no bodies: every geom is in <worldbody> (a scene: terrain, floor, walls), which MuJoCo "
                             "fixes to the world with no mass; expected a model with at least one <body>")

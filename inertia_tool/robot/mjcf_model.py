@@ -50,20 +50,35 @@ class _Defaults:
 
     def __init__(self, root, source: str):
         self.classes: dict = {"main": {}}
+        self.parents: dict = {}          # class name → the class it is nested in ("main" has none)
         for top in root.findall("default"):
-            self._collect(top, self.classes["main"] if top.get("class", "main") == "main" else {}, source)
+            self._collect(top, self.classes["main"] if top.get("class", "main") == "main" else {}, source, None)
 
-    def _collect(self, element, inherited: dict, source: str) -> None:
+    def _collect(self, element, inherited: dict, source: str, parent: str | None) -> None:
         name = element.get("class", "main")
         merged = {tag: dict(attrs) for tag, attrs in inherited.items()}
         for child in element:
             if isinstance(child.tag, str) and child.tag != "default":
                 merged[child.tag] = _merge_attributes(merged.get(child.tag, {}), child.attrib)
         self.classes[name] = merged
+        if parent is not None:
+            self.parents[name] = parent
         for child in element.findall("default"):
             if not child.get("class"):
                 raise _fail(source, "a nested <default> without a class")
-            self._collect(child, merged, source)
+            self._collect(child, merged, source, name)
+
+    def lineage(self, name: str) -> tuple[str, ...]:
+        """``name`` and the classes it is nested in, innermost first, ending with ``"main"`` (at most one step
+        per class: a name is defined once)."""
+        out = [name]
+        for _ in range(len(self.parents)):
+            if out[-1] not in self.parents:
+                break
+            out.append(self.parents[out[-1]])
+        if out[-1] != "main":
+            out.append("main")
+        return tuple(out)
 
     def attributes(self, element, class_name: str, source: str) -> dict:
         name = element.get("class", class_name)
