@@ -1048,8 +1048,8 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         SDFormat do), or only its link, whose result then says ``mesh file missing: PATH`` (the command line:
         every link that can be computed is).  With ``"per-link"`` an SDFormat ``<include>`` whose model is not
         on disk becomes one entry ``NAME::*`` without geometry, its ``unread`` the reason (its links are
-        unknown), and so does an MJCF ``<attach>`` whose model file is not on disk (``PREFIX*``).  An unknown package, or a path naming something that is not a regular file, refuses either
-        way.
+        unknown), and so does an MJCF ``<attach>`` whose model file is not on disk (``PREFIX*``).  An unknown
+        package, or a path naming something that is not a regular file, refuses either way.
 
     Returns
     -------
