@@ -38,6 +38,10 @@ def test_the_robot_alone_names_the_scene_and_the_scene_computes_the_paired_geom(
     (warning,) = [w for w in report["warnings"] if "no geom collides" in w]
     assert f"{tmp_path / 'scene.xml'} includes it" in warning and "other.xml" not in warning
     assert "all 3 have contype and conaffinity 0" in warning
+    assert warning.endswith("--geometry class=collision reads the geoms of its class 'collision', --geometry visual "
+                            "all the geoms that do not collide (visual and collision shapes together)")
+    assert main(["robot", str(tmp_path / "robot.xml"), "--density", "1000", "--geometry", "class=collision"]) == 0
+    assert capsys.readouterr().out.rstrip().endswith("2 links: 2 computed (2 exact)")
     assert [link["mass"] for link in report["links"]] == [None, None]
     assert all(link["problem"].startswith("no collision geometry") for link in report["links"])
 

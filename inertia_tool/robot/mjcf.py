@@ -457,8 +457,14 @@ def warn_if_nothing_collides(robot) -> None:
     scenes = files_including(robot.source)
     where = (f"; {', '.join(scenes)} include{'s' if len(scenes) == 1 else ''} it and may collide its geoms "
              "through <contact><pair>: audit that file" if scenes else "")
+    from .description import parse_xml
+    root = parse_xml(robot.document, robot.source).getroot() if robot.document else None
+    named = root is not None and any(d.get("class") == "collision" for d in root.iter("default"))
+    instead = ("--geometry class=collision reads the geoms of its class 'collision', --geometry visual all the "
+               "geoms that do not collide (visual and collision shapes together)" if named else
+               "--geometry visual reads the geoms that do not collide (visual and collision shapes together), "
+               "--geometry group=LIST or class=LIST the geoms of some groups or default classes")
     warnings.warn(NoCollidingGeomWarning(
         f"{robot.source}: no geom collides (all {others} have contype and conaffinity 0 and none is in a "
         f"<contact><pair> of this file), so no link has collision geometry as MuJoCo counts it{where}; "
-        "--geometry visual reads the geoms that do not collide (visual and collision shapes together)"),
-        stacklevel=2)
+        f"{instead}"), stacklevel=2)
