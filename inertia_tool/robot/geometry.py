@@ -1079,6 +1079,9 @@ def _missing_files(paths: list) -> str:
     return f"mesh file missing: {', '.join(named)}"
 
 
+#: The problem of a link whose geoms are all massless under ``density="model"``, with the way on.
+MASSLESS = "every geom is massless in the description (--density RHO or --material M gives each geom a density)"
+
 #: The start of a link's problem when its mesh was refused: without ``repair``, and with it.
 REFUSED = "mesh needs repair or cannot be read"
 REFUSED_REPAIRED = "mesh cannot be read or bounded, even with repair"
@@ -1112,7 +1115,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     warned += [f"{e.kind} {e.name!r} is massless in the description "
                f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
     if not parts:
-        return LinkInertial(link.name, None, nan, basis, "every geom is massless in the description",
+        # the file gives its geoms no mass (Fourier N1's collision geoms: mass="0", its <inertial>s hold the masses)
+        return LinkInertial(link.name, None, nan, basis, MASSLESS,
                             warnings=tuple(warned))
     method = max((m for _, _, m, _ in parts), key=_RANK.__getitem__)
     taken = _users_taken(parts, cache)
