@@ -20,6 +20,7 @@ therefore splits the agreement by the tool's method.
 
     python benchmarks/bench_robot_corpus.py DIR [DIR ...] [--repair] [--geometry collision] [--no-mujoco]
         [--package NAME=DIR]
+    python benchmarks/bench_robot_corpus.py --menagerie ROOT [--repair] [--compare-only] [--models-only]
 """
 
 from __future__ import annotations
@@ -470,10 +471,14 @@ def _cli_corpus(root: str, repair: bool) -> tuple[float, float, int]:
 
 
 def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_mode: bool, verbose: bool,
-                  geometry: str = "collision") -> int:
-    """Every model file and scene of a Menagerie checkout through the tool, then every body against MuJoCo."""
+                  geometry: str = "collision", compare_only: bool = False, models_only: bool = False) -> int:
+    """Every model file and scene of a Menagerie checkout through the tool, then every body against MuJoCo
+    (``compare_only``: the comparison alone; ``models_only``: the model files, not the scenes, which repeat
+    their bodies).  The comparison prints each file's line as it ends (a long run cut off keeps what it did)."""
     from inertia_tool.robot.geometry import MeshCache
     models, scenes = menagerie_files(root)
+    if models_only:
+        scenes = []
     folders = sorted({os.path.relpath(p, root).split(os.sep)[0] for p in models + scenes})
     print(f"Menagerie at {root}: {len(folders)} model folders, {len(models)} model files, {len(scenes)} scenes; "
           f"load average {os.getloadavg()[0]:.1f} at start", flush=True)
@@ -484,7 +489,7 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
     causes: collections.Counter = collections.Counter()
     cache = MeshCache()
     cpu0, wall0 = time.process_time(), time.perf_counter()
-    for path in models + scenes:
+    for path in [] if compare_only else models + scenes:
         kind = "scene" if path in scenes else "model"
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -529,6 +534,7 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
     unreadable: list = []
     cpu0 = time.process_time()
     for path in models + scenes:
+        start = time.process_time()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
@@ -537,6 +543,12 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
                 unreadable.append(f"{os.path.relpath(path, root)}: {type(exc).__name__}: "
                                   f"{str(exc).splitlines()[0][:200]}")
                 continue
+        worst = max((d for _, b, d, _ in rows if np.isfinite(d) and b.endswith("agrees")), default=0.0)
+        print(f"  {time.process_time() - start:7.1f} s  {os.path.relpath(path, root)}: {len(rows)} bodies, "
+              f"{sum(b.endswith('agrees') for _, b, _, _ in rows)} agree (max {worst:.1e}); "
+              + "; ".join(f"{body} [{b}] {d:.1e}" for body, b, d, _ in rows
+                          if "disagree" in b or "fail" in b or "approximate" in b or "twice" in b or "as read" in b),
+              flush=True)
         for body, bucket, diff, detail in rows:
             buckets[bucket] += 1
             if np.isfinite(diff):
@@ -570,6 +582,10 @@ def main(argv=None) -> int:
                         "checkout, then every body against MuJoCo")
     parser.add_argument("--no-folder-mode", action="store_true", help="with --menagerie: skip timing the "
                         "folder-mode command")
+    parser.add_argument("--compare-only", action="store_true", help="with --menagerie: only the comparison with "
+                        "MuJoCo (not the first pass at --density 1000)")
+    parser.add_argument("--models-only", action="store_true", help="with --menagerie: the model files, not the "
+                        "scenes (which repeat their bodies)")
     parser.add_argument("--geometry", default="collision")
     parser.add_argument("--density", default="1000")
     parser.add_argument("--repair", action="store_true")
@@ -580,8 +596,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.menagerie:
         return run_menagerie(args.menagerie, repair=args.repair, rtol=args.rtol, mujoco=not args.no_mujoco,
-                             folder_mode=not args.no_folder_mode, verbose=args.verbose,
-                             geometry="all" if args.geometry == "all" else "collision")
+                             folder_mode=not args.no_folder_mode and not args.compare_only, verbose=args.verbose,
+                             geometry="all" if args.geometry == "all" else "collision",
+                             compare_only=args.compare_only, models_only=args.models_only)
     if not args.folders:
         parser.error("give folders, or --menagerie ROOT")
     density = args.density if args.density == "model" else float(args.density)
