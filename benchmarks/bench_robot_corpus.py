@@ -543,9 +543,9 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
                 unreadable.append(f"{os.path.relpath(path, root)}: {type(exc).__name__}: "
                                   f"{str(exc).splitlines()[0][:200]}")
                 continue
-        worst = max((d for _, b, d, _ in rows if np.isfinite(d) and b.endswith("agrees")), default=0.0)
+        worst = max((d for _, b, d, _ in rows if np.isfinite(d) and b.endswith(", agrees")), default=0.0)
         print(f"  {time.process_time() - start:7.1f} s  {os.path.relpath(path, root)}: {len(rows)} bodies, "
-              f"{sum(b.endswith('agrees') for _, b, _, _ in rows)} agree (max {worst:.1e}); "
+              f"{sum(b.endswith(', agrees') for _, b, _, _ in rows)} agree (max {worst:.1e}); "
               + "; ".join(f"{body} [{b}] {d:.1e}" for body, b, d, _ in rows
                           if "disagree" in b or "fail" in b or "approximate" in b or "twice" in b or "as read" in b),
               flush=True)
