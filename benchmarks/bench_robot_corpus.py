@@ -20,7 +20,7 @@ therefore splits the agreement by the tool's method.
 
     python benchmarks/bench_robot_corpus.py DIR [DIR ...] [--repair] [--geometry collision] [--no-mujoco]
         [--package NAME=DIR]
-    python benchmarks/bench_robot_corpus.py --menagerie ROOT [--repair] [--compare-only] [--models-only]
+    python benchmarks/bench_robot_corpus.py --menagerie ROOT [--repair] [--compare-only] [--models-only] [--reverse]
 """
 
 from __future__ import annotations
@@ -471,7 +471,8 @@ def _cli_corpus(root: str, repair: bool) -> tuple[float, float, int]:
 
 
 def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_mode: bool, verbose: bool,
-                  geometry: str = "collision", compare_only: bool = False, models_only: bool = False) -> int:
+                  geometry: str = "collision", compare_only: bool = False, models_only: bool = False,
+                  reverse: bool = False) -> int:
     """Every model file and scene of a Menagerie checkout through the tool, then every body against MuJoCo
     (``compare_only``: the comparison alone; ``models_only``: the model files, not the scenes, which repeat
     their bodies).  The comparison prints each file's line as it ends (a long run cut off keeps what it did)."""
@@ -479,6 +480,8 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
     models, scenes = menagerie_files(root)
     if models_only:
         scenes = []
+    if reverse:            # a second process from the other end: two runs meet in the middle
+        models, scenes = models[::-1], scenes[::-1]
     folders = sorted({os.path.relpath(p, root).split(os.sep)[0] for p in models + scenes})
     print(f"Menagerie at {root}: {len(folders)} model folders, {len(models)} model files, {len(scenes)} scenes; "
           f"load average {os.getloadavg()[0]:.1f} at start", flush=True)
@@ -586,6 +589,8 @@ def main(argv=None) -> int:
                         "MuJoCo (not the first pass at --density 1000)")
     parser.add_argument("--models-only", action="store_true", help="with --menagerie: the model files, not the "
                         "scenes (which repeat their bodies)")
+    parser.add_argument("--reverse", action="store_true", help="with --menagerie: the files in reverse order (a "
+                        "second process from the other end)")
     parser.add_argument("--geometry", default="collision")
     parser.add_argument("--density", default="1000")
     parser.add_argument("--repair", action="store_true")
@@ -598,7 +603,7 @@ def main(argv=None) -> int:
         return run_menagerie(args.menagerie, repair=args.repair, rtol=args.rtol, mujoco=not args.no_mujoco,
                              folder_mode=not args.no_folder_mode and not args.compare_only, verbose=args.verbose,
                              geometry="all" if args.geometry == "all" else "collision",
-                             compare_only=args.compare_only, models_only=args.models_only)
+                             compare_only=args.compare_only, models_only=args.models_only, reverse=args.reverse)
     if not args.folders:
         parser.error("give folders, or --menagerie ROOT")
     density = args.density if args.density == "model" else float(args.density)
