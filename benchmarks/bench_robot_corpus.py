@@ -296,7 +296,7 @@ def twin(link, *, overlap: str = "union", float32: bool = False):
     from inertia_tool import mass_properties
     from inertia_tool.mass.properties import MassProperties, combine
     from inertia_tool.mesh.read import load_mesh
-    from inertia_tool.robot.geometry import _placed, element_mass_properties, element_shell_properties
+    from inertia_tool.robot.geometry import _placed, element_mass_properties, element_shell_properties, fitted_element
     weighted = []
     for e in link.elements:
         if _massless(e):
@@ -313,6 +313,12 @@ def twin(link, *, overlap: str = "union", float32: bool = False):
                 _TWIN_MESHES[key] = (_as_given(_placed(raw, e)) if overlap == "given"
                                      else mass_properties(_placed(raw, e), density=1.0, overlap=overlap))
             unit = _TWIN_MESHES[key].transformed(rotation=e.rotation, translation=e.translation)
+        elif overlap == "given" and e.fit_scale is not None and e.mesh is not None:
+            # a primitive MuJoCo fits to the mesh's moments: fitted to the triangles as it integrates them
+            raw = load_mesh(e.mesh, units="m")
+            if float32:
+                raw = replace(raw, vertices=raw.vertices.astype(np.float32).astype(np.float64))
+            unit = element_mass_properties(fitted_element(e, mesh_properties=_as_given(_placed(raw, e))))
         else:
             unit = element_mass_properties(e)
         if e.mass is not None:

@@ -327,7 +327,8 @@ def _inertia_box_size(kind: str, half: np.ndarray) -> tuple:
 
 
 def fitted_element(element: GeometryElement, *, cache: dict | None = None, repair: bool = False,
-                   budget: list | None = None, assume: UserAssumptions = NOTHING_ASSUMED) -> GeometryElement:
+                   budget: list | None = None, assume: UserAssumptions = NOTHING_ASSUMED,
+                   mesh_properties: MassProperties | None = None) -> GeometryElement:
     """The primitive MuJoCo fits to a mesh (``<geom type="capsule" mesh="...">`` without a size).
 
     MuJoCo's default fit (``<compiler fitaabb="false">``): the mesh's equivalent inertia box — the box of the
@@ -348,7 +349,8 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
     against MuJoCo 4.0's body inertias): ``inertia="convex"`` the convex hull, ``"legacy"`` MuJoCo's legacy
     formula (:mod:`inertia_tool.robot.mesh_inertia`), otherwise (``exact``, no attribute) the solid.  The
     fitted size is the model's geom whatever density the tool is run with.  Elements that are not fitted are
-    returned as they are.
+    returned as they are.  ``mesh_properties``: the mesh's unit-density body to fit instead of the one computed
+    here (the corpus benchmark fits to the triangles as MuJoCo integrates them, to tell its values apart).
     """
     if element.fit_scale is None:
         return element
@@ -357,13 +359,16 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
                            reference_rotation=element.reference_rotation,
                            reference_translation=element.reference_translation,
                            mesh_inertia=element.mesh_inertia)
-    memo = _fit_memo_key(mesh, repair, assume) if cache is None and budget is None else None
-    props = _FIT_BODIES.get(memo) if memo is not None else None
-    if props is not None:
+    memo = (_fit_memo_key(mesh, repair, assume) if cache is None and budget is None and mesh_properties is None
+            else None)
+    props = _FIT_BODIES.get(memo) if memo is not None else mesh_properties
+    if props is not None and memo is not None:
         _FIT_BODIES[memo] = _FIT_BODIES.pop(memo)          # most recently used last
         if isinstance(props, _FitRefusal):
             _reissue(props.caught)
             raise props.error.with_traceback(None)
+    elif props is not None:                               # the caller's body (mesh_properties)
+        pass
     elif element.mesh_inertia in ("convex", "legacy"):
         props = _mesh_inertia_part(mesh, cache={} if cache is None else cache, budget=budget)[1]
     elif memo is None:
