@@ -20,6 +20,7 @@ therefore splits the agreement by the tool's method.
 
     python benchmarks/bench_robot_corpus.py DIR [DIR ...] [--repair] [--geometry collision] [--no-mujoco]
         [--package NAME=DIR]
+    python benchmarks/bench_robot_corpus.py --menagerie ROOT [--repair] [--compare-only] [--models-only] [--reverse]
 """
 
 from __future__ import annotations
@@ -273,17 +274,29 @@ def _difference(props, mass: float, com, tensor) -> float:
 _TWIN_MESHES: dict = {}
 
 
+def _as_given(raw):
+    """Unit-density mass properties of the triangles of ``raw`` exactly as read: their signed volume integrals
+    summed (no weld, no orientation, no repair), what MuJoCo's ``inertia="exact"`` integrates.  An overlap of
+    two bodies is counted twice, a crack left open, an inside-out part subtracted."""
+    from inertia_tool.integrals import second_moment_to_inertia, volume_moments
+    from inertia_tool.mass.properties import MassProperties
+    moments = volume_moments(raw.vertices, raw.faces)
+    return MassProperties(mass=moments.volume, volume=moments.volume, center_of_mass=moments.centroid,
+                          inertia=second_moment_to_inertia(moments.second_moment), density=1.0)
+
+
 def twin(link, *, overlap: str = "union", float32: bool = False):
     """The body recomputed from its elements at the model's densities the way MuJoCo's compiler integrates it:
-    ``overlap="sum"`` counts a mesh's overlapping bodies twice (MuJoCo integrates the signed volume of the
-    triangles as given), ``float32`` rounds the file's coordinates to float32 first (MuJoCo stores vertices
-    in float32).  Meshes that need repair raise."""
+    ``overlap="sum"`` counts a mesh's overlapping bodies twice (meshes that need repair raise),
+    ``overlap="given"`` sums the signed integrals of each mesh's triangles exactly as read (:func:`_as_given`:
+    MuJoCo's exact mode; never refuses), ``float32`` rounds the file's coordinates to float32 first (MuJoCo
+    stores vertices in float32)."""
     from dataclasses import replace
 
     from inertia_tool import mass_properties
     from inertia_tool.mass.properties import MassProperties, combine
     from inertia_tool.mesh.read import load_mesh
-    from inertia_tool.robot.geometry import _placed, element_mass_properties, element_shell_properties
+    from inertia_tool.robot.geometry import _placed, element_mass_properties, element_shell_properties, fitted_element
     weighted = []
     for e in link.elements:
         if _massless(e):
@@ -297,8 +310,15 @@ def twin(link, *, overlap: str = "union", float32: bool = False):
                 raw = load_mesh(e.mesh, units="m")
                 if float32:
                     raw = replace(raw, vertices=raw.vertices.astype(np.float32).astype(np.float64))
-                _TWIN_MESHES[key] = mass_properties(_placed(raw, e), density=1.0, overlap=overlap)
+                _TWIN_MESHES[key] = (_as_given(_placed(raw, e)) if overlap == "given"
+                                     else mass_properties(_placed(raw, e), density=1.0, overlap=overlap))
             unit = _TWIN_MESHES[key].transformed(rotation=e.rotation, translation=e.translation)
+        elif overlap == "given" and e.fit_scale is not None and e.mesh is not None:
+            # a primitive MuJoCo fits to the mesh's moments: fitted to the triangles as it integrates them
+            raw = load_mesh(e.mesh, units="m")
+            if float32:
+                raw = replace(raw, vertices=raw.vertices.astype(np.float32).astype(np.float64))
+            unit = element_mass_properties(fitted_element(e, mesh_properties=_as_given(_placed(raw, e))))
         else:
             unit = element_mass_properties(e)
         if e.mass is not None:
@@ -358,38 +378,82 @@ def compare_menagerie_file(path: str, *, rtol: float, repair: bool, cache, geome
                          f"{said[0]}: {refused[said[0]]}"))
             continue
         method = result.method
-        if method == "estimate":
-            rows.append((name, "estimate, bounds hold" if _bounds_hold(result, mass, com, tensor)
-                         else "estimate, bounds fail", diff, ""))
+        if method == "estimate" and _bounds_hold(result, mass, com, tensor):
+            rows.append((name, "estimate, bounds hold", diff, ""))
             continue
-        if diff <= rtol:
+        if method != "estimate" and diff <= rtol:
             rows.append((name, f"{method}, agrees", diff, ""))
             continue
-        try:
-            summed = _difference(twin(link, overlap="sum"), mass, com, tensor)
-            rounded = _difference(twin(link, overlap="sum", float32=True), mass, com, tensor)
-        except Exception as exc:   # noqa: BLE001 -- the diagnosis failing is reported, not fatal
-            summed = rounded = float("nan")
-            detail = f"twin failed: {exc}"
+        cause, detail = _mujoco_side(link, result, mass, com, tensor, rtol=rtol, faces=faces)
+        if method == "estimate":
+            bucket = f"estimate, bounds fail: {cause}" if cause else "estimate, bounds fail"
         else:
-            detail = f"summed {summed:.1e}, float32 {rounded:.1e}"
-        dropped = [f for f in files if f in faces and f.lower().endswith(".obj")
-                   and faces[f] < _file_triangles(link, f)]
-        if method != "exact" and summed <= rtol:
-            bucket = f"{method}: MuJoCo counts overlaps twice (summed integral agrees)"
-        elif rounded <= rtol:
-            bucket = f"{method}: MuJoCo approximate (float32 vertices)"
-        elif dropped and all(_first_object_only(link, f, faces[f]) for f in dropped):
-            bucket = (f"{method}: MuJoCo reads only the first object of an OBJ file (the tool the whole file; "
-                      "said in the link's warnings)")
-        elif dropped:
-            bucket = f"{method}: MuJoCo approximate (its OBJ loader keeps fewer triangles: polygons it cannot clip)"
-            detail += (f"; {dropped[0]}: MuJoCo {faces[dropped[0]]} triangles, the file "
-                       f"{_file_triangles(link, dropped[0])}")
-        else:
-            bucket = f"{method}, disagrees"
+            bucket = f"{method}: {cause}" if cause else f"{method}, disagrees"
         rows.append((name, bucket, diff, detail))
     return rows
+
+
+#: How much more mass the summed triangles must carry than the tool's solid before a body whose MuJoCo value is
+#: their sum is said to count an overlap twice (below it the sum differs by round-off, float32 or cracks).
+DOUBLE_COUNT_RTOL = 1e-4
+
+
+def _mujoco_side(link, result, mass: float, com, tensor, *, rtol: float, faces: dict) -> tuple[str, str]:
+    """``(cause, detail)`` of a body where MuJoCo and the tool differ by more than ``rtol``, when MuJoCo's value
+    is shown to be something else than the solid the tool computes ("" for a real disagreement):
+
+    * **double count**: MuJoCo's value equals the summed signed integrals of the meshes' triangles as read
+      (:func:`twin` ``overlap="given"``, float64 or float32 coordinates; a fitted primitive fitted to them) to
+      ``rtol`` and to a tenth of the tool's difference from MuJoCo, and that sum carries more
+      than :data:`DOUBLE_COUNT_RTOL` more mass than the tool's solid (overlapping bodies, counted once by the
+      tool's union, twice by MuJoCo);
+    * **triangles as read**: the same agreement, the masses within that: MuJoCo integrates the file's unwelded
+      float32 triangles (cracks, rounding) where the tool integrates the welded solid;
+    * float32 vertices (the overlap-summed solid of float32 coordinates agrees), MuJoCo's OBJ loader keeping
+      the first object only, or fewer triangles."""
+    try:
+        given = min((_difference(twin(link, overlap="given", float32=f32), mass, com, tensor), f32)
+                    for f32 in (False, True))
+        excess = twin(link, overlap="given", float32=given[1]).mass / result.properties.mass - 1.0
+    except Exception as exc:   # noqa: BLE001 -- the diagnosis failing is reported, not fatal
+        given, excess, note = (float("nan"), False), float("nan"), f"as-read sum failed: {exc}"
+    else:
+        note = (f"triangles as read{' (float32)' if given[1] else ''}: {given[0]:.1e} from MuJoCo, "
+                f"{excess:+.1e} mass vs the tool")
+    diff = _difference(result.properties, mass, com, tensor)
+    if given[0] <= min(rtol, 0.1 * diff):       # MuJoCo's value is the sum, ten times closer than the tool's
+        if excess > DOUBLE_COUNT_RTOL:
+            return "MuJoCo counts overlaps twice (its value is the triangles' summed integral)", note
+        return "MuJoCo integrates the triangles as read (unwelded, float32; their summed integral agrees)", note
+    try:
+        summed = _difference(twin(link, overlap="sum"), mass, com, tensor)
+        rounded = _difference(twin(link, overlap="sum", float32=True), mass, com, tensor)
+    except Exception as exc:   # noqa: BLE001 -- a mesh that needs repair has no overlap-summed solid
+        summed = rounded = float("nan")
+        note += f"; twin failed: {str(exc)[:80]}"
+    else:
+        note += f"; summed {summed:.1e}, float32 {rounded:.1e}"
+    files = {os.path.basename(e.mesh) for e in link.elements if e.mesh and not _massless(e)}
+    dropped = [f for f in files if f in faces and f.lower().endswith(".obj") and faces[f] < _file_triangles(link, f)]
+    close = min(rtol, 0.1 * diff)
+    if result.method != "exact" and summed <= close:
+        return "MuJoCo counts overlaps twice (summed integral agrees)", note
+    if rounded <= close:
+        return "MuJoCo approximate (float32 vertices)", note
+    if result.method == "estimate" and np.isfinite(given[0]):
+        sums = twin(link, overlap="given", float32=given[1])
+        if _bounds_hold(result, sums.mass, sums.center_of_mass, sums.inertia):
+            return ("the bounds hold against the triangles' own summed integral; MuJoCo differs from that sum too "
+                    "(its own mesh processing)", note)
+    if dropped and all(_first_object_only(link, f, faces[f]) for f in dropped):
+        return ("MuJoCo reads only the first object of an OBJ file (the tool the whole file; said in the link's "
+                "warnings)", note)
+    if dropped:
+        return ("MuJoCo approximate (its OBJ loader keeps fewer triangles: polygons it cannot clip)",
+                note + f"; {dropped[0]}: MuJoCo {faces[dropped[0]]} triangles, the file "
+                       f"{_file_triangles(link, dropped[0])}")
+    return "", note
+
 
 
 def _first_object_only(link, basename: str, kept: int) -> bool:
@@ -421,10 +485,17 @@ def _cli_corpus(root: str, repair: bool) -> tuple[float, float, int]:
 
 
 def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_mode: bool, verbose: bool,
-                  geometry: str = "collision") -> int:
-    """Every model file and scene of a Menagerie checkout through the tool, then every body against MuJoCo."""
+                  geometry: str = "collision", compare_only: bool = False, models_only: bool = False,
+                  reverse: bool = False) -> int:
+    """Every model file and scene of a Menagerie checkout through the tool, then every body against MuJoCo
+    (``compare_only``: the comparison alone; ``models_only``: the model files, not the scenes, which repeat
+    their bodies).  The comparison prints each file's line as it ends (a long run cut off keeps what it did)."""
     from inertia_tool.robot.geometry import MeshCache
     models, scenes = menagerie_files(root)
+    if models_only:
+        scenes = []
+    if reverse:            # a second process from the other end: two runs meet in the middle
+        models, scenes = models[::-1], scenes[::-1]
     folders = sorted({os.path.relpath(p, root).split(os.sep)[0] for p in models + scenes})
     print(f"Menagerie at {root}: {len(folders)} model folders, {len(models)} model files, {len(scenes)} scenes; "
           f"load average {os.getloadavg()[0]:.1f} at start", flush=True)
@@ -435,7 +506,7 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
     causes: collections.Counter = collections.Counter()
     cache = MeshCache()
     cpu0, wall0 = time.process_time(), time.perf_counter()
-    for path in models + scenes:
+    for path in [] if compare_only else models + scenes:
         kind = "scene" if path in scenes else "model"
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -480,6 +551,7 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
     unreadable: list = []
     cpu0 = time.process_time()
     for path in models + scenes:
+        start = time.process_time()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
@@ -488,6 +560,12 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
                 unreadable.append(f"{os.path.relpath(path, root)}: {type(exc).__name__}: "
                                   f"{str(exc).splitlines()[0][:200]}")
                 continue
+        worst = max((d for _, b, d, _ in rows if np.isfinite(d) and b.endswith(", agrees")), default=0.0)
+        print(f"  {time.process_time() - start:7.1f} s  {os.path.relpath(path, root)}: {len(rows)} bodies, "
+              f"{sum(b.endswith(', agrees') for _, b, _, _ in rows)} agree (max {worst:.1e}); "
+              + "; ".join(f"{body} [{b}] {d:.1e}" for body, b, d, _ in rows
+                          if "disagree" in b or "fail" in b or "approximate" in b or "twice" in b or "as read" in b),
+              flush=True)
         for body, bucket, diff, detail in rows:
             buckets[bucket] += 1
             if np.isfinite(diff):
@@ -521,6 +599,12 @@ def main(argv=None) -> int:
                         "checkout, then every body against MuJoCo")
     parser.add_argument("--no-folder-mode", action="store_true", help="with --menagerie: skip timing the "
                         "folder-mode command")
+    parser.add_argument("--compare-only", action="store_true", help="with --menagerie: only the comparison with "
+                        "MuJoCo (not the first pass at --density 1000)")
+    parser.add_argument("--models-only", action="store_true", help="with --menagerie: the model files, not the "
+                        "scenes (which repeat their bodies)")
+    parser.add_argument("--reverse", action="store_true", help="with --menagerie: the files in reverse order (a "
+                        "second process from the other end)")
     parser.add_argument("--geometry", default="collision")
     parser.add_argument("--density", default="1000")
     parser.add_argument("--repair", action="store_true")
@@ -531,8 +615,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.menagerie:
         return run_menagerie(args.menagerie, repair=args.repair, rtol=args.rtol, mujoco=not args.no_mujoco,
-                             folder_mode=not args.no_folder_mode, verbose=args.verbose,
-                             geometry="all" if args.geometry == "all" else "collision")
+                             folder_mode=not args.no_folder_mode and not args.compare_only, verbose=args.verbose,
+                             geometry="all" if args.geometry == "all" else "collision",
+                             compare_only=args.compare_only, models_only=args.models_only, reverse=args.reverse)
     if not args.folders:
         parser.error("give folders, or --menagerie ROOT")
     density = args.density if args.density == "model" else float(args.density)

@@ -192,4 +192,5 @@ def test_links_left_as_they_were_are_named_with_their_reason(tmp_path, capsys):
     assert main(["robot", str(src), "--density", "model", "--write", str(tmp_path / "out.xml")]) == EXIT_INCOMPLETE
     err = capsys.readouterr().err
     assert ("<inertial> of 1 link corrected; left as they were: ghost (no collision geometry; 1 visual element, "
-            "which --geometry visual reads), pad (every geom is massless in the description)") in err
+            "which --geometry visual reads), pad (every geom is massless in the description (--density RHO or "
+            "--material M gives each geom a density))") in err

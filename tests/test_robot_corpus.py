@@ -53,6 +53,9 @@ def test_corpus_audit_names_the_causes_and_sums_up(tmp_path, capsys):
     assert "unreadable:" in out and "broken.urdf" in out
     assert "mm.urdf: slab: unit slip" in out and "placeholder.urdf: slab: placeholder" in out
     assert "arm/scene.xml: b: placeholder" in out
+    # the table only counts: it says where each model's links, issues and reasons are (mujoco18's user trial)
+    assert ("\neach model's links, issues and reasons without a result: the same command on one FILE, or --json "
+            "here\n") in out
     assert out.rstrip().endswith("4 models (1 unreadable): 3 links, 3 computed, 0 without a result, 3 with issues; "
                                  "likely causes: placeholder 2, unit 1")
     assert main(["robot", str(root / "ros" / "pkg"), str(root / "menagerie"), "--keep-mass", "--json"]) == EXIT_OK

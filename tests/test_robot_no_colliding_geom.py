@@ -38,6 +38,10 @@ def test_the_robot_alone_names_the_scene_and_the_scene_computes_the_paired_geom(
     (warning,) = [w for w in report["warnings"] if "no geom collides" in w]
     assert f"{tmp_path / 'scene.xml'} includes it" in warning and "other.xml" not in warning
     assert "all 3 have contype and conaffinity 0" in warning
+    assert warning.endswith("--geometry class=collision reads the geoms of its class 'collision', --geometry visual "
+                            "all the geoms that do not collide (visual and collision shapes together)")
+    assert main(["robot", str(tmp_path / "robot.xml"), "--density", "1000", "--geometry", "class=collision"]) == 0
+    assert capsys.readouterr().out.rstrip().endswith("2 links: 2 computed (2 exact)")
     assert [link["mass"] for link in report["links"]] == [None, None]
     assert all(link["problem"].startswith("no collision geometry") for link in report["links"])
 
@@ -73,3 +77,22 @@ def test_a_link_with_only_the_other_kind_of_geometry_is_no_frame(tmp_path, capsy
     assert "  shown: no collision geometry; 1 visual element, which --geometry visual reads" in out
     assert main(["robot", str(urdf), "--density", "1000", "--geometry", "visual"]) == 0
     assert "1 with only collision geometry and no declared mass, not computed: body" in capsys.readouterr().out
+
+
+def test_the_corpus_mode_warns_as_the_single_file_command_does(tmp_path, capsys):
+    """The corpus path (several files or a folder) read each model without the single-file command's check, so
+    Apollo's "no collision geometry" ×35 came without the warning saying why (robots17's open item)."""
+    (tmp_path / "robot.xml").write_text(ROBOT)
+    (tmp_path / "scene.xml").write_text(SCENE)
+    box = tmp_path / "box.urdf"
+    box.write_text('<robot name="b"><link name="b"><collision><geometry><box size="1 1 1"/></geometry></collision>'
+                   '</link></robot>')
+    argv = ["robot", str(tmp_path / "robot.xml"), str(box), "--density", "1000", "--json"]
+    assert main(argv) == EXIT_INCOMPLETE
+    report = json.loads(capsys.readouterr().out)
+    (warning,) = [w for w in report["warnings"] if "no geom collides" in w]
+    assert warning.startswith(f"{tmp_path / 'robot.xml'}: no geom collides (all 3 have contype and conaffinity 0")
+    assert f"{tmp_path / 'scene.xml'} includes it" in warning
+    # a folder audits the robot through its scene, whose pair collides a geom: no warning there
+    assert main(["robot", str(tmp_path), "--density", "1000", "--json"]) == EXIT_INCOMPLETE
+    assert not [w for w in json.loads(capsys.readouterr().out)["warnings"] if "no geom collides" in w]

@@ -54,9 +54,12 @@ def register(subparsers) -> None:
                         "only for files you trust. It runs in a child process without your environment "
                         "variables, under CPU, memory and wall-clock limits (INERTIA_TOOL_CPU_LIMIT, "
                         "INERTIA_TOOL_MEMORY_LIMIT, INERTIA_TOOL_WALL_LIMIT). Without it a xacro file is refused")
-    p.add_argument("--geometry", choices=GEOMETRY_KINDS, default="collision",
-                   help="which geometry of each link to integrate (default: collision; MJCF also 'all': every geom "
-                        "in <compiler inertiagrouprange>, as MuJoCo's inertia from geometry)")
+    p.add_argument("--geometry", default="collision", metavar="|".join(GEOMETRY_KINDS) + "|group=LIST|class=LIST",
+                   help="which geometry of each link to integrate (default: collision; MuJoCo MJCF: collision = "
+                        "geoms that can collide, visual = the others; also 'all': every geom in <compiler "
+                        "inertiagrouprange>, as MuJoCo's inertia from geometry; group=3 or group=0-2,5: the geoms "
+                        "of those groups; class=collision: the geoms of that default class or a class nested in "
+                        "it)")
     m = p.add_mutually_exclusive_group(required=True)
     m.add_argument("--density", metavar="RHO",
                    help="density of every link, kg/m³ by default (or e.g. 2.7g/cm3); 'model' takes the MJCF "
@@ -151,6 +154,8 @@ def run(args) -> int:
     from ..robot.mjcf import inertia_from_geometry, warn_if_nothing_collides
     from ..robot.write import included_files, write_corrected
 
+    from ..robot.description import parse_geometry
+    parse_geometry(args.geometry)            # a malformed --geometry is the command's error, not each model's
     packages = parse_packages(args.package)
     if len(args.robot) > 1 or os.path.isdir(args.robot[0]):
         return _run_corpus(args, packages)

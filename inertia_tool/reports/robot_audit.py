@@ -88,8 +88,9 @@ def summary_line(robot: RobotDescription, inertials) -> str:
     other = other_geometry_only(robot, inertials, missing)
     frames = len(inertials) - len(computed) - len(missing) - len(other)
     if other:
-        kind = {"collision": "visual", "visual": "collision"}.get(robot.geometry, "other")
-        text += (f"; {len(other)} with only {kind} geometry and no declared mass, not computed: "
+        kind = {"collision": "visual geometry", "visual": "collision geometry"}.get(robot.geometry,
+                                                                                 "geoms outside the selection")
+        text += (f"; {len(other)} with only {kind} and no declared mass, not computed: "
                  f"{', '.join(r.name for r in other)}")
     if frames:
         text += f"; {frames} without geometry or mass (frames)"
@@ -298,5 +299,10 @@ def format_corpus_report(models) -> str:
     causes = [(m.source, a.name, c) for m in models for a in m.audits for c in a.causes[:1]]
     if causes:
         lines += ["", "likely causes:"] + [f"  {src}: {name}: {c.explanation}" for src, name, c in causes]
+    if any(m.robot is not None and (links_without_result(m.robot, m.inertials) or any(a.issues for a in m.audits))
+           for m in models):
+        # the table counts; a newcomer needs to know where the links, issues and reasons are (user trial)
+        lines += ["", "each model's links, issues and reasons without a result: the same command on one FILE, or "
+                      "--json here"]
     lines += ["", _corpus_summary(models)]
     return "\n".join(lines)

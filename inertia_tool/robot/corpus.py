@@ -27,6 +27,7 @@ from ..values import frozen_value
 from .audit import audit_links
 from .description import MAX_DESCRIPTION_BYTES, RobotDescription, _read_bytes, model_config_files, read_robot
 from .geometry import MeshCache, link_inertials
+from .mjcf import warn_if_nothing_collides
 
 __all__ = ["ModelAudit", "find_descriptions", "audit_corpus", "MAX_CORPUS_FILES", "SNIFF_BYTES"]
 
@@ -128,6 +129,7 @@ def _audit_one(path: str, meshes: MeshCache, settings: dict) -> ModelAudit:
     try:
         robot = read_robot(path, packages=settings["packages"], geometry=settings["geometry"],
                            run_xacro=settings["run_xacro"], missing_meshes="per-link")
+        warn_if_nothing_collides(robot)      # as the single-file command warns (Apollo's geoms collide only in a scene)
         inertials = link_inertials(robot, density=settings["density"], material=settings["material"],
                                    keep_mass=settings["keep_mass"], repair=settings["repair"], mesh_cache=meshes,
                                    **settings["options"])

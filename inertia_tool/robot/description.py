@@ -40,12 +40,73 @@ from .resolve import MAX_FOLDERS_UP, package_directory, resolve_uri
 from .xacro_expand import _fail
 
 __all__ = ["GeometryElement", "DeclaredInertial", "LinkGeometry", "RobotDescription", "read_robot",
-           "rpy_to_matrix", "GEOMETRY_KINDS", "ROBOT_SUFFIXES", "PRIMITIVES", "parse_decimal", "MAX_ROBOT_LINKS",
+           "rpy_to_matrix", "GEOMETRY_KINDS", "GEOMETRY_SELECTORS", "parse_geometry", "geometry_words",
+           "ROBOT_SUFFIXES", "PRIMITIVES", "parse_decimal", "MAX_ROBOT_LINKS",
            "ROBOT_LENGTH_RANGE", "ROBOT_SCALE_RANGE"]
 
 #: Which geometry of a link to take: ``<collision>`` (default; usually simpler, closed meshes) or ``<visual>``;
 #: for MJCF also ``"all"``: every geom in ``<compiler inertiagrouprange>``, as MuJoCo's inertia from geometry.
 GEOMETRY_KINDS = ("collision", "visual", "all")
+
+#: MJCF only, beyond :data:`GEOMETRY_KINDS`: ``"group=LIST"`` takes the geoms whose ``group`` is listed (``3``,
+#: ``0-2,5``: what ``<compiler inertiagrouprange="3 3">`` makes MuJoCo's inertia from geometry count, for one
+#: group), ``"class=LIST"`` the geoms whose default class is named or lies under a named class (``collision``:
+#: Menagerie's collision geoms).  Either replaces the contact rule and ``inertiagrouprange``.
+GEOMETRY_SELECTORS = ("group", "class")
+
+#: Most groups a ``group=`` list may name (ranges expanded): MuJoCo's groups are small integers (0-5 are drawn).
+MAX_GEOMETRY_GROUPS = 1024
+
+_GROUP_ITEM = re.compile(r"(\d{1,9})(?:-(\d{1,9}))?")
+_CLASS_NAME = re.compile(r"[^,\s]+")
+
+
+def parse_geometry(geometry) -> tuple[str, tuple]:
+    """``geometry`` (a :data:`GEOMETRY_KINDS` word, ``"group=LIST"`` or ``"class=LIST"``) as ``(kind, values)``:
+    ``("collision", ())``, ``("group", (2, 3))`` (sorted, without repeats), ``("class", ("collision",))``.
+
+    Raises
+    ------
+    UsageError
+        Anything else, in one sentence saying what was expected.
+    """
+    if geometry in GEOMETRY_KINDS:
+        return geometry, ()
+    kind, sep, listed = str(geometry).partition("=")
+    expected = (f"Expected `geometry` to be one of {', '.join(GEOMETRY_KINDS)}, group=LIST (MJCF geom groups, "
+                "e.g. group=3 or group=0-2,5) or class=LIST (MJCF default classes, e.g. class=collision)")
+    if not sep or kind not in GEOMETRY_SELECTORS or not listed:
+        raise UsageError(f"{expected}, got {str(geometry)[:80]!r}")
+    items = listed.split(",")
+    if kind == "class":
+        if not all(_CLASS_NAME.fullmatch(item) for item in items):
+            raise UsageError(f"{expected}; class names are separated by commas without spaces, got "
+                             f"{str(geometry)[:80]!r}")
+        return kind, tuple(dict.fromkeys(items))
+    groups: set = set()
+    for item in items:
+        match = _GROUP_ITEM.fullmatch(item)
+        low, high = (int(match.group(1)), int(match.group(2) or match.group(1))) if match else (1, 0)
+        if not match or low > high or len(groups) + high - low + 1 > MAX_GEOMETRY_GROUPS:
+            raise UsageError(f"{expected}; a group is a whole number >= 0 or a range A-B with A <= B, at most "
+                             f"{MAX_GEOMETRY_GROUPS} in all, got {item[:40]!r} in {str(geometry)[:80]!r}")
+        groups.update(range(low, high + 1))
+    return kind, tuple(sorted(groups))
+
+
+def geometry_words(geometry: str) -> str:
+    """What ``geometry`` takes, for a link without any: ``"collision geometry"``, ``"geom in <compiler
+    inertiagrouprange>"``, ``"geom in group 2 or 3"``, ``"geom of class 'collision' (or a class under it)"``."""
+    kind, values = parse_geometry(geometry)
+    if kind == "all":
+        return "geom in <compiler inertiagrouprange>"
+    if kind == "group":
+        return f"geom in group {' or '.join(map(str, values))}"
+    if kind == "class":
+        names = " or ".join(repr(v) for v in values)
+        return f"geom of class {names} (or a class under {'it' if len(values) == 1 else 'them'})"
+    return f"{kind} geometry"
+
 
 #: The geometry kind a link without geometry of the chosen kind may have instead.
 _OTHER_KIND = {"collision": "visual", "visual": "collision"}
@@ -254,7 +315,9 @@ class LinkGeometry:
     unread : str
         Why this entry's geometry could not be read at all, "" otherwise: an SDFormat ``<include>`` whose model
         is not on disk (``read_robot(missing_meshes="per-link")``) is one entry ``NAME::*`` standing for its
-        unknown links, with no elements; it never gets a result.
+        unknown links, with no elements, and an MJCF ``<attach>`` whose model file is not on disk one entry
+        ``PREFIX*`` (a body that the attached ``<worldbody>`` would have given geoms says so too); it never gets a
+        result.
     """
 
     name: str
@@ -962,9 +1025,13 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
     packages : dict, optional
         Package name → directory, for ``package://NAME/...`` (and ``model://``, ``$(find NAME)``); looked up
         before ``ROS_PACKAGE_PATH``.
-    geometry : {"collision", "visual"}
-        Which geometry elements to keep (MJCF: geoms that collide, ``contype``/``conaffinity`` not both 0, or
-        the others).
+    geometry : {"collision", "visual", "all"} or str
+        Which geometry elements to keep (MJCF: geoms that collide, ``contype``/``conaffinity`` not both 0 or in
+        a ``<contact><pair>``, or the others).  MJCF only: ``"all"``, every geom in ``<compiler
+        inertiagrouprange>`` (what MuJoCo's inertia from geometry counts); ``"group=LIST"`` (``"group=3"``,
+        ``"group=0-2,5"``), the geoms of those groups; ``"class=LIST"`` (``"class=collision"``), the geoms whose
+        default class (their ``class``, else the ``childclass`` in force) is named or nested in a named
+        ``<default>`` (:data:`GEOMETRY_SELECTORS`).
     mappings : dict, optional
         xacro arguments (``name → value``, the ``name:=value`` of the xacro command line).
     run_xacro : bool
@@ -981,8 +1048,8 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
         SDFormat do), or only its link, whose result then says ``mesh file missing: PATH`` (the command line:
         every link that can be computed is).  With ``"per-link"`` an SDFormat ``<include>`` whose model is not
         on disk becomes one entry ``NAME::*`` without geometry, its ``unread`` the reason (its links are
-        unknown).  An unknown package, or a path naming something that is not a regular file, refuses either
-        way.
+        unknown), and so does an MJCF ``<attach>`` whose model file is not on disk (``PREFIX*``).  An unknown
+        package, or a path naming something that is not a regular file, refuses either way.
 
     Returns
     -------
@@ -996,8 +1063,7 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
     UsageError
         Bad ``geometry``, ``mappings`` for a file that is not xacro, or a xacro file without ``run_xacro``.
     """
-    if geometry not in GEOMETRY_KINDS:
-        raise UsageError(f"Expected `geometry` to be one of {', '.join(GEOMETRY_KINDS)}, got {geometry!r}")
+    selection = parse_geometry(geometry)
     if missing_meshes not in MISSING_MESHES:
         raise UsageError(f"Expected `missing_meshes` to be one of {', '.join(MISSING_MESHES)}, got {missing_meshes!r}")
     source = os.fsdecode(os.fspath(path))
@@ -1020,9 +1086,9 @@ def read_robot(path, *, packages: dict | None = None, geometry: str = "collision
     if fmt == "mjcf":
         from .mjcf import read_mjcf
         name, links = read_mjcf(root, source, base, packages, geometry, missing_meshes=missing_meshes)
-    elif geometry == "all":
+    elif selection[0] not in ("collision", "visual"):
         raise UsageError(f"Expected `geometry` collision or visual for {source} (a {fmt.upper()} link's visual "
-                         "and collision elements describe the same part), got 'all' (MJCF only)")
+                         f"and collision elements describe the same part), got {geometry!r} (MJCF only)")
     elif fmt in ("urdf", "xacro"):
         name, links = _read_urdf(root, source, base, packages, geometry, missing_meshes)
     else:

@@ -46,7 +46,7 @@ from ..mesh.hole_assumptions import NOTHING_ASSUMED, UserAssumptions, user_named
 from ..mesh.options import DEFAULT_MAX_FACES, MAX_SUPPORTED_FACES, LoadOptions
 from ..values import frozen_value
 from ..mesh.read import RawMesh
-from .description import GeometryElement, LinkGeometry, RobotDescription
+from .description import GeometryElement, LinkGeometry, RobotDescription, geometry_words
 from ..rounding import round_up
 from ..mesh.uncertainty import Uncertainty
 from ..tolerances import EIGEN_ROUNDOFF_RTOL, ESTIMATE_MAX_MASS_RTOL
@@ -327,7 +327,8 @@ def _inertia_box_size(kind: str, half: np.ndarray) -> tuple:
 
 
 def fitted_element(element: GeometryElement, *, cache: dict | None = None, repair: bool = False,
-                   budget: list | None = None, assume: UserAssumptions = NOTHING_ASSUMED) -> GeometryElement:
+                   budget: list | None = None, assume: UserAssumptions = NOTHING_ASSUMED,
+                   mesh_properties: MassProperties | None = None) -> GeometryElement:
     """The primitive MuJoCo fits to a mesh (``<geom type="capsule" mesh="...">`` without a size).
 
     MuJoCo's default fit (``<compiler fitaabb="false">``): the mesh's equivalent inertia box — the box of the
@@ -348,7 +349,8 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
     against MuJoCo 4.0's body inertias): ``inertia="convex"`` the convex hull, ``"legacy"`` MuJoCo's legacy
     formula (:mod:`inertia_tool.robot.mesh_inertia`), otherwise (``exact``, no attribute) the solid.  The
     fitted size is the model's geom whatever density the tool is run with.  Elements that are not fitted are
-    returned as they are.
+    returned as they are.  ``mesh_properties``: the mesh's unit-density body to fit instead of the one computed
+    here (the corpus benchmark fits to the triangles as MuJoCo integrates them, to tell its values apart).
     """
     if element.fit_scale is None:
         return element
@@ -357,13 +359,16 @@ def fitted_element(element: GeometryElement, *, cache: dict | None = None, repai
                            reference_rotation=element.reference_rotation,
                            reference_translation=element.reference_translation,
                            mesh_inertia=element.mesh_inertia)
-    memo = _fit_memo_key(mesh, repair, assume) if cache is None and budget is None else None
-    props = _FIT_BODIES.get(memo) if memo is not None else None
-    if props is not None:
+    memo = (_fit_memo_key(mesh, repair, assume) if cache is None and budget is None and mesh_properties is None
+            else None)
+    props = _FIT_BODIES.get(memo) if memo is not None else mesh_properties
+    if props is not None and memo is not None:
         _FIT_BODIES[memo] = _FIT_BODIES.pop(memo)          # most recently used last
         if isinstance(props, _FitRefusal):
             _reissue(props.caught)
             raise props.error.with_traceback(None)
+    elif props is not None:                               # the caller's body (mesh_properties)
+        pass
     elif element.mesh_inertia in ("convex", "legacy"):
         props = _mesh_inertia_part(mesh, cache={} if cache is None else cache, budget=budget)[1]
     elif memo is None:
@@ -1079,6 +1084,9 @@ def _missing_files(paths: list) -> str:
     return f"mesh file missing: {', '.join(named)}"
 
 
+#: The problem of a link whose geoms are all massless under ``density="model"``, with the way on.
+MASSLESS = "every geom is massless in the description (--density RHO or --material M gives each geom a density)"
+
 #: The start of a link's problem when its mesh was refused: without ``repair``, and with it.
 REFUSED = "mesh needs repair or cannot be read"
 REFUSED_REPAIRED = "mesh cannot be read or bounded, even with repair"
@@ -1095,8 +1103,7 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
         other = {"collision": "visual", "visual": "collision"}.get(geometry)
         has = (f"; {link.unselected} {other} element{'s' if link.unselected > 1 else ''}, which --geometry "
                f"{other} reads" if link.unselected and other else "")
-        return LinkInertial(link.name, None, nan, basis, "no geom in <compiler inertiagrouprange>" if geometry == "all"
-                            else f"no {geometry} geometry{has}")
+        return LinkInertial(link.name, None, nan, basis, f"no {geometry_words(geometry)}{has}")
     missing = [e.mesh for e in link.elements if e.mesh is not None and not os.path.exists(e.mesh)
                and not (model and (e.mass == 0 or (e.mass is None and e.density == 0)))]
     if missing:          # read_robot(missing_meshes="per-link"): the link says which file, the others compute
@@ -1113,7 +1120,8 @@ def _one_link_result(link: LinkGeometry, *, rho, basis: str, keep_mass: bool, mo
     warned += [f"{e.kind} {e.name!r} is massless in the description "
                f"({'mass=0' if e.mass == 0 else 'density=0'}): left out" for e in massless]
     if not parts:
-        return LinkInertial(link.name, None, nan, basis, "every geom is massless in the description",
+        # the file gives its geoms no mass (Fourier N1's collision geoms: mass="0", its <inertial>s hold the masses)
+        return LinkInertial(link.name, None, nan, basis, MASSLESS,
                             warnings=tuple(warned))
     method = max((m for _, _, m, _ in parts), key=_RANK.__getitem__)
     taken = _users_taken(parts, cache)

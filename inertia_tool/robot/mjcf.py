@@ -60,7 +60,9 @@ import warnings
 
 import numpy as np
 
-from .description import DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive
+from ..errors import UsageError
+from .description import (DeclaredInertial, GeometryElement, LinkGeometry, _coordinates, _numbers, _positive,
+                          parse_geometry)
 from .mjcf_bodies import MAX_REPLICAS, _attached_body, _child_bodies, _replica_poses
 from .mjcf_model import (INERTIA_FROM_GEOMETRY, MAX_INCLUDE_DEPTH, MAX_INCLUDED_FILES, MESH_INERTIA_MODES,
                          _Attachments, _InlineMesh, _Model, _model, inertia_from_geometry)
@@ -313,18 +315,23 @@ def _is_collision(attrs: dict, what: str, source: str) -> bool:
     return any(b != 0 for b in bits)
 
 
-def _selected(attrs: dict, geometry: str, groups: tuple, what: str, source: str,
-              paired: frozenset = frozenset()) -> bool:
-    """Whether a geom belongs to the chosen geometry: collision (``contype``/``conaffinity`` not both 0, or
-    named in a ``<contact><pair>``: MuJoCo collides a pair's geoms whatever their bit masks, which is how the MJX
-    models of Menagerie give their contacts), visual (the others), or ``"all"``: every geom whose ``group``
+def _selected(attrs: dict, selection: tuple, groups: tuple, what: str, source: str,
+              paired: frozenset = frozenset(), lineage: tuple = ("main",)) -> bool:
+    """Whether a geom belongs to the chosen geometry (``selection``, from
+    :func:`~inertia_tool.robot.description.parse_geometry`): collision (``contype``/``conaffinity`` not both 0,
+    or named in a ``<contact><pair>``: MuJoCo collides a pair's geoms whatever their bit masks, which is how the
+    MJX models of Menagerie give their contacts), visual (the others), ``"all"``: every geom whose ``group``
     lies in ``<compiler inertiagrouprange>`` (MuJoCo's default 0–5), the geoms MuJoCo's inertia from geometry
-    counts."""
-    if geometry == "all":
+    counts; ``group``: a geom whose ``group`` is listed; ``class``: a geom whose default class (``lineage``: its
+    class and those it is nested in) holds a listed one."""
+    kind, values = selection
+    if kind in ("all", "group"):
         group = _numbers(attrs.get("group", "0"), 1, f"{what} group", source)[0]
-        return groups[0] <= group <= groups[1]
+        return groups[0] <= group <= groups[1] if kind == "all" else group in values
+    if kind == "class":
+        return any(name in values for name in lineage)
     collides = attrs.get("name") in paired or _is_collision(attrs, what, source)
-    return collides == (geometry == "collision")
+    return collides == (kind == "collision")
 
 
 def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
@@ -332,7 +339,10 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
     """Bodies of an MJCF ``<mujoco>`` tree as links (see the module docstring); returns ``(model, links)``.
 
     ``missing_meshes="per-link"`` keeps a mesh geom whose file does not exist (its link then has no result and
-    says so) instead of refusing the model."""
+    says so) instead of refusing the model; an ``<attach>`` whose model file does not exist becomes one entry
+    ``PREFIX*`` standing for the bodies it would have brought (all named with its prefix), without geometry, its
+    ``unread`` the reason, and a body that a whole attached ``<worldbody>`` would have given geoms has that
+    reason too (its geometry is unknown)."""
     from .description import MAX_ROBOT_LINKS
     if root.tag != "mujoco":
         raise _fail(source, f"not an MJCF file: the root element is <{root.tag}>, expected <mujoco>")
@@ -342,7 +352,9 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
     group_range = next((c.get("inertiagrouprange") for c in reversed(list(root.iter("compiler")))
                         if c.get("inertiagrouprange") is not None), "0 5")
     groups = tuple(_numbers(group_range, 2, "<compiler inertiagrouprange>", source))
+    selection = parse_geometry(geometry)
     attachments = _Attachments(packages, main.compiler[2], budget)
+    classes = set(main.defaults.classes)     # every default class of the models read, for a class= selection
     links = []
     counter = [0]
     replicas = [MAX_REPLICAS]
@@ -356,10 +368,12 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
         child_class = body.get("childclass", class_name)
         elements: list[GeometryElement] = []
         unselected = [0]
-        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements, model, stack, unselected)
+        absent: list[str] = []          # <attach> frames whose model file is not on disk (missing_meshes="per-link")
+        collect(body, name, child_class, (np.eye(3), np.zeros(3)), elements, model, stack, unselected, absent)
+        unread = (f"attached model not read: {absent[0]} (its geoms would be part of this body)" if absent else "")
         links.append(LinkGeometry(name=name, elements=tuple(elements),
                                   declared=_inertial(body, name, model.compiler, model.source),
-                                  unselected=unselected[0]))
+                                  unselected=unselected[0], unread=unread))
         walk_children(body, child_class, suffix, model, prefix, stack)
 
     def walk_children(element, class_name: str, suffix: str, model: _Model, prefix: str, stack: tuple) -> None:
@@ -367,7 +381,15 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
             if cls is not None:
                 walk_body(child, cls, more, model, prefix, stack)
                 continue
+            reason = attachments.absent(child, model) if missing_meshes == "per-link" else None
+            if reason is not None:
+                # one entry standing for the attached bodies, all named with the prefix (as SDFormat's NAME::*)
+                counter[0] += 1
+                links.append(LinkGeometry(name=f"{prefix}{child.get('prefix')}*{more}", elements=(), declared=None,
+                                          unread=f"attached model not read: {reason}"))
+                continue
             attached, deeper = attachments.model(child, model, stack)
+            classes.update(attached.defaults.classes)
             inner = prefix + child.get("prefix")
             if child.get("body") is None:           # the whole worldbody, as a frame
                 for world in attached.root.findall("worldbody"):
@@ -377,15 +399,16 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                 walk_body(body, body_class, copy + more, attached, inner, deeper)
 
     def collect(element, link: str, class_name: str, pose, elements: list, model: _Model, stack: tuple,
-                unselected: list) -> None:
+                unselected: list, absent: list) -> None:
         degrees, eulerseq, _ = model.compiler
         for child in element:
             if child.tag == "geom":
                 attrs = model.defaults.attributes(child, class_name, model.source)
                 if attrs.get("type") == "plane":      # MuJoCo gives a plane no mass and no inertia
                     continue
-                if _selected(attrs, geometry, groups, f"body {link!r} geom {len(elements) + 1}", model.source,
-                             model.paired):
+                lineage = model.defaults.lineage(child.get("class", class_name))
+                if _selected(attrs, selection, groups, f"body {link!r} geom {len(elements) + 1}", model.source,
+                             model.paired, lineage):
                     label = f"geom {len(elements) + 1}"
                     if attrs.get("type") == "hfield":
                         elements.append(_hfield_geom(attrs, pose, label, link, model.hfields, model.compiler,
@@ -402,18 +425,27 @@ def read_mjcf(root, source: str, base: str, packages: dict, geometry: str, *,
                 position = _coordinates(_numbers(attrs.get("pos"), 3, f"body {link!r} frame pos", model.source,
                                                  default=(0, 0, 0)), f"body {link!r} frame pos", model.source)
                 composed = (pose[0] @ rotation, pose[0] @ position + pose[1])
-                collect(child, link, child.get("childclass", class_name), composed, elements, model, stack, unselected)
+                collect(child, link, child.get("childclass", class_name), composed, elements, model, stack, unselected,
+                        absent)
             elif child.tag == "replicate":
                 for copy in _replica_poses(child, pose, model, replicas):
-                    collect(child, link, class_name, copy, elements, model, stack, unselected)
+                    collect(child, link, class_name, copy, elements, model, stack, unselected, absent)
             elif child.tag == "attach" and child.get("body") is None:
                 # a whole worldbody attached as a frame: its geoms are this body's, in its own model's terms
+                reason = attachments.absent(child, model) if missing_meshes == "per-link" else None
+                if reason is not None:
+                    absent.append(reason)
+                    continue
                 attached, deeper = attachments.model(child, model, stack)
                 for world in attached.root.findall("worldbody"):
-                    collect(world, link, "main", pose, elements, attached, deeper, unselected)
+                    collect(world, link, "main", pose, elements, attached, deeper, unselected, absent)
 
     for world in root.findall("worldbody"):
         walk_children(world, "main", "", main, "", (os.path.realpath(source),))
+    unknown = [name for name in selection[1] if selection[0] == "class" and name not in classes]
+    if unknown:
+        raise UsageError(f"{source} has no <default class={unknown[0]!r}> for `geometry` {geometry!r} (its classes: "
+                         f"{', '.join(sorted(classes))})")
     if not links and any(world.find("geom") is not None for world in root.findall("worldbody")):
         raise _fail(source, "no bodies: every geom is in <worldbody> (a scene: terrain, floor, walls), which MuJoCo "
                             "fixes to the world with no mass; expected a model with at least one <body>")
@@ -463,8 +495,14 @@ def warn_if_nothing_collides(robot) -> None:
     scenes = files_including(robot.source)
     where = (f"; {', '.join(scenes)} include{'s' if len(scenes) == 1 else ''} it and may collide its geoms "
              "through <contact><pair>: audit that file" if scenes else "")
+    from .description import parse_xml
+    root = parse_xml(robot.document, robot.source).getroot() if robot.document else None
+    named = root is not None and any(d.get("class") == "collision" for d in root.iter("default"))
+    instead = ("--geometry class=collision reads the geoms of its class 'collision', --geometry visual all the "
+               "geoms that do not collide (visual and collision shapes together)" if named else
+               "--geometry visual reads the geoms that do not collide (visual and collision shapes together), "
+               "--geometry group=LIST or class=LIST the geoms of some groups or default classes")
     warnings.warn(NoCollidingGeomWarning(
         f"{robot.source}: no geom collides (all {others} have contype and conaffinity 0 and none is in a "
         f"<contact><pair> of this file), so no link has collision geometry as MuJoCo counts it{where}; "
-        "--geometry visual reads the geoms that do not collide (visual and collision shapes together)"),
-        stacklevel=2)
+        f"{instead}"), stacklevel=2)

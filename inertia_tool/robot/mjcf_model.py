@@ -50,20 +50,35 @@ class _Defaults:
 
     def __init__(self, root, source: str):
         self.classes: dict = {"main": {}}
+        self.parents: dict = {}          # class name → the class it is nested in ("main" has none)
         for top in root.findall("default"):
-            self._collect(top, self.classes["main"] if top.get("class", "main") == "main" else {}, source)
+            self._collect(top, self.classes["main"] if top.get("class", "main") == "main" else {}, source, None)
 
-    def _collect(self, element, inherited: dict, source: str) -> None:
+    def _collect(self, element, inherited: dict, source: str, parent: str | None) -> None:
         name = element.get("class", "main")
         merged = {tag: dict(attrs) for tag, attrs in inherited.items()}
         for child in element:
             if isinstance(child.tag, str) and child.tag != "default":
                 merged[child.tag] = _merge_attributes(merged.get(child.tag, {}), child.attrib)
         self.classes[name] = merged
+        if parent is not None:
+            self.parents[name] = parent
         for child in element.findall("default"):
             if not child.get("class"):
                 raise _fail(source, "a nested <default> without a class")
-            self._collect(child, merged, source)
+            self._collect(child, merged, source, name)
+
+    def lineage(self, name: str) -> tuple[str, ...]:
+        """``name`` and the classes it is nested in, innermost first, ending with ``"main"`` (at most one step
+        per class: a name is defined once)."""
+        out = [name]
+        for _ in range(len(self.parents)):
+            if out[-1] not in self.parents:
+                break
+            out.append(self.parents[out[-1]])
+        if out[-1] != "main":
+            out.append("main")
+        return tuple(out)
 
     def attributes(self, element, class_name: str, source: str) -> dict:
         name = element.get("class", class_name)
@@ -372,6 +387,19 @@ class _Attachments:
     def __init__(self, packages: dict, fitaabb: bool, budget: list):
         self.packages, self.fitaabb, self.budget = packages, fitaabb, budget
         self.read: dict = {}
+
+    def absent(self, attach, host: _Model) -> str | None:
+        """Why the model file ``attach`` names cannot be read because it is not on disk (with a near match,
+        :func:`~inertia_tool.robot.resolve.near_match`; nothing is read in its place), or None: a file that
+        exists, or a problem of the ``<attach>`` itself (no prefix, an undeclared model), which :meth:`model`
+        refuses."""
+        from .resolve import near_match
+        name = attach.get("model")
+        if attach.get("prefix") is None or name not in host.models or os.path.exists(host.models[name]):
+            return None
+        hint = near_match(host.models[name])
+        return (f"<attach model={name!r}> in {host.source}: the model file {host.models[name]} does not exist"
+                + (f" ({hint})" if hint else ""))
 
     def model(self, attach, host: _Model, stack: tuple) -> tuple[_Model, tuple]:
         """The model asset ``attach`` names (declared in ``host``) and the attach chain extended by it."""

@@ -27,7 +27,7 @@ import os
 
 import numpy as np
 
-from .description import RobotDescription
+from .description import RobotDescription, parse_geometry
 
 __all__ = ["mujoco_available", "compare_with_mujoco", "builtin_mesh"]
 
@@ -76,11 +76,40 @@ def _shape(rotation, half) -> np.ndarray:
     return rotation @ np.diag(np.square(half)) @ rotation.T
 
 
-def _selected(model, g: int, geometry: str, paired: set, groups) -> bool:
-    if geometry == "all":
+def _selected(model, g: int, geometry: str, paired: set, groups, lineage: tuple = ("main",)) -> bool:
+    """The reader's rule (:func:`inertia_tool.robot.mjcf._selected`) on MuJoCo's compiled values; ``lineage``:
+    the geom's default class (MuJoCo's) and the classes it is nested in."""
+    kind, values = parse_geometry(geometry)
+    if kind == "all":
         return bool(groups[0] <= model.geom_group[g] <= groups[1])
+    if kind == "group":
+        return int(model.geom_group[g]) in values
+    if kind == "class":
+        return any(name in values for name in lineage)
     collides = g in paired or model.geom_contype[g] != 0 or model.geom_conaffinity[g] != 0
-    return bool(collides) == (geometry == "collision")
+    return bool(collides) == (kind == "collision")
+
+
+def _class_lineages(spec, document: bytes | None) -> dict:
+    """Compiled geom index → its default class as MuJoCo gives it (``MjsGeom.classname``) and the classes it is
+    nested in, read from the ``<default>`` elements of the main file (``MjSpec`` keeps no nesting; a class of an
+    included or attached file counts as nested in ``main`` only)."""
+    from .description import parse_xml
+    parents: dict = {}
+    if document:
+        for default in parse_xml(document, "the description").getroot().iter("default"):
+            above = default.getparent()
+            if default.get("class") and above is not None and above.tag == "default":
+                parents[default.get("class")] = above.get("class", "main")
+    out = {}
+    for geom in spec.geoms:
+        chain = [geom.classname.name or "main"]
+        for _ in range(len(parents)):
+            if chain[-1] not in parents:
+                break
+            chain.append(parents[chain[-1]])
+        out[geom.id] = tuple(chain) + (("main",) if chain[-1] != "main" else ())
+    return out
 
 
 def compare_with_mujoco(robot: RobotDescription, *, rtol: float = AGREEMENT_RTOL) -> tuple[str, ...] | None:
@@ -113,6 +142,7 @@ def compare_with_mujoco(robot: RobotDescription, *, rtol: float = AGREEMENT_RTOL
         return (f"MuJoCo has {model.nbody - 1} bodies, the reader {len(robot.links)} links",)
     paired = set(model.pair_geom1.tolist()) | set(model.pair_geom2.tolist())
     groups = tuple(spec.compiler.inertiagrouprange)
+    lineages = _class_lineages(spec, robot.document)
     mesh_kind = mujoco.mjtGeom.mjGEOM_MESH
     kinds = {mujoco.mjtGeom.mjGEOM_BOX: "box", mujoco.mjtGeom.mjGEOM_SPHERE: "sphere",
              mujoco.mjtGeom.mjGEOM_CAPSULE: "capsule", mujoco.mjtGeom.mjGEOM_CYLINDER: "cylinder",
@@ -124,7 +154,7 @@ def compare_with_mujoco(robot: RobotDescription, *, rtol: float = AGREEMENT_RTOL
             out.append(f"body {index}: MuJoCo names it {name!r}, the reader {link.name!r}")
             continue
         theirs = [g for g in range(model.ngeom) if model.geom_bodyid[g] == index
-                  and _selected(model, g, robot.geometry, paired, groups)]
+                  and _selected(model, g, robot.geometry, paired, groups, lineages.get(g, ("main",)))]
         if len(theirs) != len(link.elements):
             out.append(f"body {link.name!r}: MuJoCo selects {len(theirs)} {robot.geometry} geoms, the reader "
                        f"{len(link.elements)}")
