@@ -908,9 +908,13 @@ def _flush_cavity(rng):
         return _finish("flush_cavity", rng, [(1, outer), (-1, cav), (1, core)], mesh,
                        f"box{_t(ea)} with a cavity box{_t(ec)}, a box{_t(ek)} resting on its floor")
     cav = box(ec, c)
-    mesh = concat(outer, flipped(cav) if rng.random() < 0.8 else cav)
-    return _finish("flush_cavity", rng, [(1, outer), (-1, cav)], mesh, f"box{_t(ea)} with a cavity "
-                   f"box{_t(ec)} flush with its +x face")
+    if rng.random() < 0.8:
+        return _finish("flush_cavity", rng, [(1, outer), (-1, cav)], concat(outer, flipped(cav)),
+                       f"box{_t(ea)} with a cavity box{_t(ec)} flush with its +x face")
+    # the inner box wound outward as well: winding 2 inside it, 1 in the rest of the box, so the solid
+    # ({w >= 1}, the rule of docs/meshes.md) is the whole box, not the notched one
+    return _finish("flush_cavity", rng, [(1, outer)], concat(outer, cav),
+                   f"box{_t(ea)} with a box{_t(ec)} inside, flush with its +x face, both wound outward")
 
 
 # ------------------------------------------------------------- bodies crossing exactly along shared edges
