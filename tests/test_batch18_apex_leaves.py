@@ -43,6 +43,18 @@ def _defect(v: np.ndarray, f: np.ndarray, n: int, kind: str, at: int) -> tuple[n
     return v, f
 
 
+def _scans_agree(v, f):
+    """The C scan with and without patches against the numpy twin: the same pairs, and the unpatched scan counts
+    what the twin counts; returns the patched scan."""
+    fast = run_scan(v, f, accel=True)
+    unpatched = run_scan(v, f, accel=True, _patches=False)
+    ref = run_scan(v, f, accel=False)
+    same_pairs(fast, ref)
+    same_pairs(unpatched, ref)
+    assert (unpatched.candidate_pairs, unpatched.tested_pairs) == (ref.candidate_pairs, ref.tested_pairs)
+    return fast
+
+
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(sections=st.integers(16, 160), radius=st.floats(0.5, 40.0), height=st.floats(0.5, 90.0),
        seed=st.integers(0, 2**31 - 1), offset=st.floats(-20.0, 20.0),
@@ -51,12 +63,7 @@ def test_cylinders_find_what_the_numpy_twin_finds(sections, radius, height, seed
     v, f = fan_capped_cylinder(sections, radius=radius, height=height)
     v, f = _defect(v, f, sections, kind, at % sections) if kind != "none" else (v, f)
     v = _turned(v, seed, offset)
-    fast = run_scan(v, f, accel=True)
-    unpatched = run_scan(v, f, accel=True, _patches=False)
-    ref = run_scan(v, f, accel=False)
-    same_pairs(fast, ref)
-    same_pairs(unpatched, ref)
-    assert (unpatched.candidate_pairs, unpatched.tested_pairs) == (ref.candidate_pairs, ref.tested_pairs)
+    fast = _scans_agree(v, f)
     if kind == "none":                # a closed cylinder meets itself nowhere but where faces share corners
         assert not len(fast.crossing) and not len(fast.coplanar_opposite)
 
@@ -80,10 +87,5 @@ def test_catalogue_sized_cylinders_match_the_unpatched_scan_and_the_twin(section
     counts what the unpatched C scan counts."""
     v, f = fan_capped_cylinder(sections, radius=17.0, height=42.0)
     v = _turned(v, sections, 55.0)
-    fast = run_scan(v, f, accel=True)
-    unpatched = run_scan(v, f, accel=True, _patches=False)
-    ref = run_scan(v, f, accel=False)
-    same_pairs(fast, ref)
-    same_pairs(unpatched, ref)
-    assert (unpatched.candidate_pairs, unpatched.tested_pairs) == (ref.candidate_pairs, ref.tested_pairs)
+    fast = _scans_agree(v, f)
     assert not len(fast.crossing) and not len(fast.coplanar_opposite)
