@@ -20,7 +20,7 @@ from ..integrals import RoundoffBound, VolumeMoments
 from ..tolerances import TOUCH_VOLUME_RTOL
 from .intersect import SurfaceContacts, surface_contacts
 from .multiplicity import container_windings, multiplicity_changes
-from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
+from .policy import (MisreadNesting, ShellContacts, boxes_holding, cavities_in_overlap, inward_crossing_outward,
                      inward_crossing_shells, misread_nesting, misread_voids, nested_copies, orient_by_depth,
                      outward_crossing_groups, pairs_without, reading_difference, rounding_volumes, shell_contacts,
                      undecided_shells, winding_stands, within_up_to_rounding)
@@ -319,18 +319,13 @@ def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNest
 def _maybe_inside(nest: Nesting, within: np.ndarray | None, v: np.ndarray, f: np.ndarray, labels: np.ndarray,
                   n_shells: int) -> int:
     """How many shells left undecided (:func:`~.policy.undecided_shells`) have their bounding box within another
-    shell's (compared exactly: a shell inside another lies within its corners' extremes), so may lie inside it."""
-    unplaced = undecided_shells(nest, within)
-    if not unplaced.any():
+    shell's (:func:`~.policy.boxes_holding`, compared exactly: a shell inside another lies within its corners'
+    extremes), so may lie inside it.  The first ``MAX_WITHIN_PAIRS`` are compared; any beyond count as inside."""
+    unplaced = np.flatnonzero(undecided_shells(nest, within))
+    if not len(unplaced):
         return 0
-    box = shell_boxes(v, f, labels, n_shells)
-    lo, hi = box[:, 0], box[:, 1]
-    count = 0
-    for u in np.flatnonzero(unplaced)[:MAX_WITHIN_PAIRS].tolist():   # bounded; beyond, counted as inside
-        held = np.all(lo <= lo[u], axis=1) & np.all(hi >= hi[u], axis=1)
-        held[u] = False
-        count += int(held.any())
-    return count + max(0, int(np.count_nonzero(unplaced)) - MAX_WITHIN_PAIRS)
+    held = boxes_holding(shell_boxes(v, f, labels, n_shells), unplaced[:MAX_WITHIN_PAIRS])[1]
+    return int(np.count_nonzero(held)) + max(0, len(unplaced) - MAX_WITHIN_PAIRS)
 
 
 def _still_undecided(nest: Nesting | None, unplaced: np.ndarray) -> Nesting | None:

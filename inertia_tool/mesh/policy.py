@@ -258,7 +258,7 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "shell_contacts", "ShellContacts", "weakest", "near_copies", "NearCopies", "near_copies_message",
            "MisreadNesting", "misread_nesting", "misread_voids", "outward_crossing_groups", "misread_message",
            "point_text", "part_size", "turned_reading_refusal", "winding_stands", "reading_difference",
-           "pairs_without", "nest_roots", "may_hold_undecided", "undecided_shells"]
+           "pairs_without", "nest_roots", "may_hold_undecided", "boxes_holding", "undecided_shells"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -1101,19 +1101,50 @@ def may_hold_undecided(undecided: np.ndarray, shell: np.ndarray, other: np.ndarr
                        block: int = 1 << 22) -> np.ndarray:
     """(s,) bool, R4 (:func:`winding_stands`): the shells that are undecided (``undecided``, (s,) bool), lie inside
     an undecided shell (``(shell, other)`` pairs, :func:`~.multiplicity.container_windings`), or whose bounding box
-    holds an undecided shell's (``boxes``, (s, 2, 3) float, lowest and highest corner; compared exactly, in blocks
-    of at most ``block`` shell pairs)."""
+    holds an undecided shell's (``boxes``, (s, 2, 3) float, lowest and highest corner; :func:`boxes_holding`, in
+    blocks of at most ``block`` shell pairs)."""
     found: np.ndarray = np.asarray(undecided, dtype=bool).copy()
     found[np.asarray(shell, dtype=np.int64)[found[np.asarray(other, dtype=np.int64)]]] = True
+    found |= boxes_holding(boxes, np.flatnonzero(undecided), block=block)[0]
+    return found
+
+
+def boxes_holding(boxes: np.ndarray, inner: np.ndarray, *, block: int = 1 << 22) -> tuple[np.ndarray, np.ndarray]:
+    """Which shells' bounding boxes hold which (R4: a shell inside another lies within the other's corners'
+    extremes), both ways round.
+
+    Parameters
+    ----------
+    boxes : (s, 2, 3) float
+        Each shell's bounding box, its lowest and highest corner, m (:func:`~.classify.shell_boxes`).
+    inner : (k,) int
+        The shells whose boxes are looked for within the others'.
+    block : int
+        Shell pairs compared at once, at most (the memory of one comparison); at least one inner shell a block.
+
+    Returns
+    -------
+    holding : (s,) bool
+        The shells whose box holds the box of a shell of ``inner`` other than itself.
+    held : (k,) bool
+        The shells of ``inner`` whose box lies within the box of another shell.
+
+    Box ``a`` holds box ``b`` where ``lo_a ≤ lo_b`` and ``hi_a ≥ hi_b`` on all three axes, the floats compared
+    exactly (no tolerance: a point of a shell's closed solid lies within its corners' extremes); equal boxes hold
+    each other, a box is not counted as holding itself."""
     b = np.asarray(boxes, dtype=np.float64).reshape(-1, 2, 3)
     lo, hi = b[:, 0], b[:, 1]
-    ids = np.flatnonzero(undecided)
+    ids = np.asarray(inner, dtype=np.int64).reshape(-1)
+    holding = np.zeros(len(lo), dtype=bool)
+    held = np.zeros(len(ids), dtype=bool)
     step = max(1, block // max(1, len(lo)))
-    for start in range(0, len(ids), step):                 # bounded: ⌈u / step⌉ blocks
+    for start in range(0, len(ids), step):                 # bounded: ⌈k / step⌉ blocks
         u = ids[start:start + step]
         holds = np.all(lo[:, None] <= lo[None, u], axis=2) & np.all(hi[:, None] >= hi[None, u], axis=2)
-        found |= holds.any(axis=1)
-    return found
+        holds[u, np.arange(len(u))] = False                # (s, len(u)); a box holds itself, not another's
+        holding |= holds.any(axis=1)
+        held[start:start + step] = holds.any(axis=0)
+    return holding, held
 
 
 def pairs_without(pairs: np.ndarray, drop: np.ndarray) -> np.ndarray:
