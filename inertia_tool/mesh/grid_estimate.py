@@ -97,9 +97,7 @@ def _surface_cells(vertices: np.ndarray, faces: np.ndarray, lo: np.ndarray, h: f
     set holds every cell the triangle meets and no cell farther than ``2ε`` cells from it: a function of the
     geometry, not of a sampling density, and the work is the slabs, rows and cells the triangle crosses.  A
     surface off the grid marks the cell it would be clamped to (the first and last cell of each axis reach to
-    infinity).  The marking of a set of faces is the union of its faces' markings.  Before session 16 each
-    triangle was sampled on a lattice of half a cell and the cells within half a cell of a sample were marked
-    (a superset with a margin of up to about a cell; a needle's samples grew as the square of its length).
+    infinity).  The marking of a set of faces is the union of its faces' markings.
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
@@ -492,8 +490,7 @@ def _budget_refusal(evaluations: int, budget: int, resolution: int, dims: tuple[
 
 
 #: What the estimate's detail (a note of the report) adds when the grid read the surface turned over as a whole
-#: (:func:`_inside_out_as_a_whole`): the reading named, since ``{w ≥ 1}`` as wound is empty (session 16; session 15
-#: found 2 of 400 repaired files answered so without a word).
+#: (:func:`_inside_out_as_a_whole`): the reading named, since ``{w ≥ 1}`` as wound is empty.
 TURNED_READING = ("; the file's winding number is at least one nowhere (above 1/2 in no cell, below −1/2 in some), "
                   "so the solid {w ≥ 1} as wound is empty: the surface is read turned over as a whole (a body "
                   "written inside out), the solid {−w ≥ 1}")
@@ -503,8 +500,8 @@ def _inside_out_as_a_whole(positive: float, negative: float) -> bool:
     """Whether the grid reads the surface turned over: its winding is below −1/2 somewhere and above 1/2 nowhere
     (``positive``, ``negative``: the sums of the winding numbers above 1/2 and of minus those below −1/2).  Where
     the winding is positive in some places and negative in others no turn of the whole surface is the file's
-    solid: the solid is where the winding number as wound is at least one (the issue's definition; session 15:
-    a box wound outward holding four crossing boxes wound inward, 0.172 m³, was read turned as 0.261 ±11 %)."""
+    solid: the solid is where the winding number as wound is at least one (the issue's definition;
+    turned, a box wound outward holding four crossing boxes wound inward, 0.172 m³, would read 0.261 ±11 %)."""
     return positive == 0.0 and negative > 0.0
 
 
