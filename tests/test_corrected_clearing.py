@@ -1,4 +1,4 @@
-"""``grid_estimate._distance_above``: the upper bound on a point's distance to a surface with which
+"""``grid_corrected._distance_above``: the upper bound on a point's distance to a surface with which
 :func:`corrected_estimate` clears cells without a distance query (issue 25, item 3: Piper's ``link2.stl``).  Each
 bound must be at least the exact distance (libigl's nearest point on every face, an independent computation), on
 slivers and needles, at sizes from 1e-3 to 1e3 m and 3e6 m from the origin; and a dense sampling must come close."""
@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from inertia_tool.mesh import grid_estimate
+from inertia_tool.mesh import grid_cells, grid_corrected
 
 igl = pytest.importorskip("igl")
 
@@ -35,11 +35,11 @@ def test_the_bound_is_never_below_the_exact_distance(seed, spacing, scale, offse
     else:
         points = rng.normal(scale=1.5, size=(200, 3)) * scale + offset
     exact = _exact(points, vertices, faces)
-    above = grid_estimate._distance_above(points, vertices, faces, spacing * scale)
+    above = grid_corrected._distance_above(points, vertices, faces, spacing * scale)
     assert np.all(above >= exact), f"{np.count_nonzero(above < exact)} bounds below the exact distance"
     # the search stopped at `beyond` (issue 25, corpus13): the same bound where it is finite, inf only beyond
     beyond = float(np.quantile(above, rng.uniform(0.0, 1.0)))
-    bounded = grid_estimate._distance_above(points, vertices, faces, spacing * scale, beyond=beyond)
+    bounded = grid_corrected._distance_above(points, vertices, faces, spacing * scale, beyond=beyond)
     stopped = ~np.isfinite(bounded)
     np.testing.assert_array_equal(bounded[~stopped], above[~stopped])
     assert np.all(above[stopped] > beyond) and np.all(~stopped[above <= beyond])
@@ -52,7 +52,7 @@ def test_a_dense_sampling_comes_within_its_spacing():
     faces = np.array([[0, 1, 2], [0, 2, 3]])
     rng = np.random.default_rng(7)
     points = np.column_stack([rng.uniform(0, 1, 500), rng.uniform(0, 1, 500), rng.uniform(0.01, 0.5, 500)])
-    above = grid_estimate._distance_above(points, vertices, faces, 0.01)
+    above = grid_corrected._distance_above(points, vertices, faces, 0.01)
     assert np.all(above >= points[:, 2])
     assert np.all(above - points[:, 2] < 0.0072)
 
@@ -77,7 +77,7 @@ def test_cells_two_apart_from_the_marked_ones_are_a_cell_and_a_half_away(seed, c
     h = float(np.max(hi - lo)) / cells
     lo = lo - 3 * h
     dims = tuple(int(x) for x in np.ceil((hi + 3 * h - lo) / h).astype(np.int64))
-    marked = grid_estimate._surface_cells(vertices, faces, lo, h, dims).reshape(dims)
+    marked = grid_cells._surface_cells(vertices, faces, lo, h, dims).reshape(dims)
     apart = np.flatnonzero(~ndimage.maximum_filter(marked, size=3, mode="constant", cval=False).reshape(-1))
     centres = lo + h * (np.stack(np.unravel_index(apart, dims), axis=1) + 0.5)
     exact = _exact(centres, vertices, faces)

@@ -1,4 +1,4 @@
-"""Two passes of ``grid_estimate.corrected_estimate`` made cheaper without changing a value (issue 25, item 3).
+"""Two passes of ``grid_corrected.corrected_estimate`` made cheaper without changing a value (issue 25, item 3).
 
 * The crossed cells are the union of the cells each class of faces marks (``_surface_cells`` samples every
   face on its own and then grows the marked cells by shifts, which distribute over a union), so the corrected
@@ -17,7 +17,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL
-from inertia_tool.mesh.grid_estimate import _point_triangle_distance, _probe_clearance, _surface_cells
+from inertia_tool.mesh.grid_cells import _surface_cells
+from inertia_tool.mesh.grid_corrected import _point_triangle_distance, _probe_clearance
 from test_mesh_surface_cells import triangle_soups
 
 
@@ -80,7 +81,7 @@ def test_probe_clearance_is_that_of_every_face(seed, faces, spread, reach, work)
 def test_a_face_between_two_blocks_is_counted_for_the_cells_on_both_sides():
     """A face in the plane x = 8 (the boundary of two 8-cell blocks) meets the closed cells 7 and 8; the blocks
     listed each face only from its own box, so cell 7 (block 0) counted 0 faces before."""
-    from inertia_tool.mesh.grid_estimate import _face_counts
+    from inertia_tool.mesh.grid_corrected import _face_counts
     lo, h, dims = np.zeros(3), 1.0, (16, 4, 4)
     v = np.array([[8.0, 0.5, 0.5], [8.0, 1.5, 0.5], [8.0, 0.5, 1.5]])
     cells = np.ravel_multi_index(([7, 8, 6], [0, 0, 0], [0, 0, 0]), dims)
@@ -92,7 +93,7 @@ def test_a_face_between_two_blocks_is_counted_for_the_cells_on_both_sides():
 @given(seed=st.integers(0, 2 ** 32 - 1), faces=st.integers(1, 80), block=st.sampled_from([2, 3, 4, 8]),
        aligned=st.booleans())
 def test_face_counts_are_those_of_every_face_against_every_cell(seed, faces, block, aligned):
-    from inertia_tool.mesh.grid_estimate import _face_counts
+    from inertia_tool.mesh.grid_corrected import _face_counts
     rng = np.random.default_rng(seed)
     dims = tuple(int(d) for d in rng.integers(3, 20, size=3))
     lo, h = rng.normal(size=3), float(10.0 ** rng.uniform(-3, 1))

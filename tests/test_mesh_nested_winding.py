@@ -510,3 +510,81 @@ def test_pairs_without_drops_either_way_round():
     assert policy.pairs_without(pairs, drop).tolist() == [[2, 0], [1, 3]]
     assert policy.pairs_without(pairs, np.zeros((0, 2), dtype=np.int64)).tolist() == pairs.tolist()
     assert policy.pairs_without(np.zeros((0, 2), dtype=np.int64), drop).shape == (0, 2)
+
+
+# Which boxes hold which (R4): ``policy.boxes_holding`` is the one comparison of ``classify._maybe_inside`` and
+# ``policy.may_hold_undecided``; the loops they ran before tidy19 are the references.
+
+#: Coordinates with ties, signed zeros and neighbours one ulp apart: the comparison must be exact.
+_CORNERS = st.sampled_from([-1.0, -0.0, 0.0, 5e-324, np.nextafter(1.0, 0.0), 1.0, np.nextafter(1.0, 2.0), 2.0])
+
+
+def _maybe_inside_by_loop(boxes, unplaced, cap):
+    """The loop ``classify._maybe_inside`` ran before tidy19: for each of the first ``cap`` undecided shells, is its
+    box within another shell's; beyond ``cap``, each counted as inside."""
+    lo, hi = boxes[:, 0], boxes[:, 1]
+    count = 0
+    for u in np.flatnonzero(unplaced)[:cap].tolist():
+        held = np.all(lo <= lo[u], axis=1) & np.all(hi >= hi[u], axis=1)
+        held[u] = False
+        count += int(held.any())
+    return count + max(0, int(np.count_nonzero(unplaced)) - cap)
+
+
+def _may_hold_by_blocks(undecided, shell, other, boxes, block):
+    """The numpy blocks ``policy.may_hold_undecided`` ran before tidy19 (a box holding its own shell's counted)."""
+    found = undecided.copy()
+    found[shell[found[other]]] = True
+    lo, hi = boxes[:, 0], boxes[:, 1]
+    ids = np.flatnonzero(undecided)
+    step = max(1, block // max(1, len(lo)))
+    for start in range(0, len(ids), step):
+        u = ids[start:start + step]
+        holds = np.all(lo[:, None] <= lo[None, u], axis=2) & np.all(hi[:, None] >= hi[None, u], axis=2)
+        found |= holds.any(axis=1)
+    return found
+
+
+@st.composite
+def _shell_boxes(draw):
+    """Boxes of 1 to 12 shells (each an axis-aligned box mesh, possibly flat or a point), each undecided or not, a few
+    ``(shell, container)`` pairs that place a shell and a few container pairs of ``may_hold_undecided``."""
+    n = draw(st.integers(1, 12))
+    corners = draw(st.lists(st.tuples(*[st.tuples(_CORNERS, _CORNERS)] * 3), min_size=n, max_size=n))
+    boxes = np.array([[[min(a) for a in c], [max(a) for a in c]] for c in corners], dtype=np.float64)
+    undecided = np.array(draw(st.lists(st.booleans(), min_size=n, max_size=n)), dtype=bool)
+    pairs = st.lists(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)), max_size=4)
+    within = np.array(draw(pairs), dtype=np.int64).reshape(-1, 2)
+    inside = np.array(draw(pairs), dtype=np.int64).reshape(-1, 2)
+    return boxes, undecided, within, inside
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(drawn=_shell_boxes(), cap=st.integers(0, 13), block=st.integers(1, 200))
+def test_boxes_holding_is_the_old_loops(drawn, cap, block):
+    """``classify._maybe_inside`` and ``policy.may_hold_undecided``, both on ``policy.boxes_holding`` since tidy19,
+    give what their own comparisons gave (the bounded loop, with ``MAX_WITHIN_PAIRS`` drawn; the blocks, with the
+    block size drawn), on boxes of real box meshes whose corners tie, differ by one ulp or are signed zeros."""
+    from unittest import mock
+
+    from inertia_tool.mesh.nesting import Nesting
+
+    boxes, undecided, within, inside = drawn
+    n = len(boxes)
+    faces = solid_box()[1]                             # corners in the order x, y, z from the lowest
+    v = np.array([[b[i, 0], b[j, 1], b[k, 2]] for b in boxes for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+    f = np.concatenate([faces + 8 * k for k in range(n)])
+    labels = np.repeat(np.arange(n), 12)
+    found = classify.shell_boxes(v, f, labels, n)
+    assert np.array_equal(found, boxes)             # the corners exactly (no rounding through the centre)
+    nest = Nesting(shell=inside[:, 0], other=inside[:, 1], winding=np.ones(len(inside), dtype=np.int64),
+                   probes=np.zeros((n, 3)), undecided=undecided)
+    unplaced = policy.undecided_shells(nest, within)
+    with mock.patch.object(classify, "MAX_WITHIN_PAIRS", cap):
+        assert classify._maybe_inside(nest, within, v, f, labels, n) == _maybe_inside_by_loop(boxes, unplaced, cap)
+    got = policy.may_hold_undecided(undecided, inside[:, 0], inside[:, 1], boxes, block=block)
+    assert np.array_equal(got, _may_hold_by_blocks(undecided, inside[:, 0], inside[:, 1], boxes, block))
+    holding, held = policy.boxes_holding(boxes, np.arange(n), block=block)
+    by_pair = np.array([[a != b and np.all(boxes[a, 0] <= boxes[b, 0]) and np.all(boxes[a, 1] >= boxes[b, 1])
+                         for b in range(n)] for a in range(n)])
+    assert np.array_equal(holding, by_pair.any(axis=1)) and np.array_equal(held, by_pair.any(axis=0))

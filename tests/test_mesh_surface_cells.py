@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL
-from inertia_tool.mesh.grid_estimate import _surface_cells
+from inertia_tool.mesh.grid_cells import _surface_cells
 
 
 def _both(v, f, lo, h, dims):

@@ -83,10 +83,10 @@ def test_a_plain_block_is_read_without_the_loop():
              b"f 1/1/1 2/1/1 3/1/1\nf 1//1 3//1 4//1 2\ns off\n\nl 1 2\n")
     plain = _plain_block(block, 0, 100, 100)
     assert plain is not None
-    coords, tri, quads, n_v, n_poly, n_tri, loose = plain
-    assert coords.tolist() == [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
-    assert tri.tolist() == [[0, 1, 2], [0, 2, 3], [0, 3, 1]] and quads.tolist() == [1]
-    assert (n_v, n_poly, n_tri, loose) == (4, 2, 3, 1)
+    assert plain.coordinates is not None and plain.triangles is not None and plain.quads is not None
+    assert plain.coordinates.tolist() == [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    assert plain.triangles.tolist() == [[0, 1, 2], [0, 2, 3], [0, 3, 1]] and plain.quads.tolist() == [1]
+    assert (plain.vertices, plain.polygons, plain.triangle_count, plain.loose) == (4, 2, 3, 1)
     _same(block)
 
 

@@ -1,4 +1,4 @@
-"""``grid_estimate._surface_cells`` marks exactly the cells a surface meets (session 16, issues 23/25).
+"""``grid_cells._surface_cells`` marks exactly the cells a surface meets (session 16, issues 23/25).
 
 The grid estimates' bounds rest on one promise: every cell whose closed box meets a face is marked (a free cell
 holds no surface, so two neighbouring free cells form a box no face crosses).  The cells are now found by
@@ -32,7 +32,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import HAVE_ACCEL
-from inertia_tool.mesh.grid_estimate import _surface_cells
+from inertia_tool.mesh.grid_cells import _surface_cells
 
 PATHS = ["c"] if HAVE_ACCEL else ["numpy"]
 

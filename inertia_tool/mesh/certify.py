@@ -116,7 +116,7 @@ def misread_reading(oriented: Orientation, united: United, *, method: str,
     both.  Shells the file winds inward inside a cavity that depth reads as bodies (``oriented.voids``, a void
     inside a void read as an island) are labelled the same way, their note naming the file's winding reading (the
     shells empty) and its mass.  Where the file's winding stands (``oriented.interior``: no region's winding below
-    0, session 16) the shells with winding at least one on both sides were left out and the rest integrated as
+    0) the shells with winding at least one on both sides were left out and the rest integrated as
     wound; the note names the depth reading and its volume (:func:`_winding_stands`).  Returns the result and, for
     an estimate, ``(volume in doubt, reach)``."""
     united, spread = _depth_readings(oriented, united, method=method, source=source)

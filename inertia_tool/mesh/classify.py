@@ -20,7 +20,7 @@ from ..integrals import RoundoffBound, VolumeMoments
 from ..tolerances import TOUCH_VOLUME_RTOL
 from .intersect import SurfaceContacts, surface_contacts
 from .multiplicity import container_windings, multiplicity_changes
-from .policy import (MisreadNesting, ShellContacts, cavities_in_overlap, inward_crossing_outward,
+from .policy import (MisreadNesting, ShellContacts, boxes_holding, cavities_in_overlap, inward_crossing_outward,
                      inward_crossing_shells, misread_nesting, misread_voids, nested_copies, orient_by_depth,
                      outward_crossing_groups, pairs_without, reading_difference, rounding_volumes, shell_contacts,
                      undecided_shells, winding_stands, within_up_to_rounding)
@@ -319,29 +319,24 @@ def _read_without(shells: Shells, contacts: SurfaceContacts, stands: MisreadNest
 def _maybe_inside(nest: Nesting, within: np.ndarray | None, v: np.ndarray, f: np.ndarray, labels: np.ndarray,
                   n_shells: int) -> int:
     """How many shells left undecided (:func:`~.policy.undecided_shells`) have their bounding box within another
-    shell's (compared exactly: a shell inside another lies within its corners' extremes), so may lie inside it."""
-    unplaced = undecided_shells(nest, within)
-    if not unplaced.any():
+    shell's (:func:`~.policy.boxes_holding`, compared exactly: a shell inside another lies within its corners'
+    extremes), so may lie inside it.  The first ``MAX_WITHIN_PAIRS`` are compared; any beyond count as inside."""
+    unplaced = np.flatnonzero(undecided_shells(nest, within))
+    if not len(unplaced):
         return 0
-    box = shell_boxes(v, f, labels, n_shells)
-    lo, hi = box[:, 0], box[:, 1]
-    count = 0
-    for u in np.flatnonzero(unplaced)[:MAX_WITHIN_PAIRS].tolist():   # bounded; beyond, counted as inside
-        held = np.all(lo <= lo[u], axis=1) & np.all(hi >= hi[u], axis=1)
-        held[u] = False
-        count += int(held.any())
-    return count + max(0, int(np.count_nonzero(unplaced)) - MAX_WITHIN_PAIRS)
+    held = boxes_holding(shell_boxes(v, f, labels, n_shells), unplaced[:MAX_WITHIN_PAIRS])[1]
+    return int(np.count_nonzero(held)) + max(0, len(unplaced) - MAX_WITHIN_PAIRS)
 
 
 def _still_undecided(nest: Nesting | None, unplaced: np.ndarray) -> Nesting | None:
     """``nest`` with the shells ``unplaced`` ((s,) bool) undecided, their probes' winding numbers dropped.
 
-    R4 (session 18): a shell the whole file left undecided keeps the rule only from the nests it may lie in
+    R4: a shell the whole file left undecided keeps the rule only from the nests it may lie in
     (:func:`~.policy.winding_stands`), and the rest of the file is read by the other rules *as it would have been*:
     with the shells left out, a probe of that shell that lay on one of them (or whose ray met an edge of one) may
     now be clean, and the depth rule would then place it where the file's reading gave it its own sign (a slab
     flush between two boxes inside a third, the two boxes left out: read as a cavity, 4 cells short of ``{w ≥ 1}``,
-    ``exact``; found by this session's judge)."""
+    ``exact``)."""
     if nest is None or not np.any(unplaced):
         return nest
     from .nesting import Nesting as Found
@@ -589,10 +584,10 @@ def _decide_past_partners(v: np.ndarray, f: np.ndarray, labels: np.ndarray, n_sh
 
     ``partners``: (k, 2) int shell pairs whose relation is already known from their contact: pairs that cross (a
     copy listed twice, its coordinates rounded apart), ``(shell, container)`` pairs of a shell lying within
-    another up to touching, placed by the boolean or by touching vertices (session 17: a box flush inside another on
-    five faces left the outer one undecided, and R4 read the pair by depth, ``exact`` 0.55 m³ where the file's
-    winding gives the outer box, 3.83), and pairs touching from outside (session 18: a slab flush between two boxes
-    inside an inward box, its own sign deciding, was a body where every reading makes it a cavity, ``united`` 9
+    another up to touching, placed by the boolean or by touching vertices (a box flush inside another on
+    five faces leaves the outer one undecided; not probed again, R4 reads the pair by depth, ``exact`` 0.55 m³ where
+    the file's winding gives the outer box, 3.83), and pairs touching from outside (a slab flush between two boxes
+    inside an inward box, its own sign deciding, is a body where every reading makes it a cavity, ``united`` 9
     cells high).  A shell's depth never counts a shell it crosses (:func:`~.policy.orient_by_depth`), a shell
     within another is none of its containers, the pair's own relation being kept by those pairs, and a shell
     touching another from outside lies outside it (its winding is 0 there); so the partners' surfaces need not be

@@ -18,7 +18,7 @@ R0 *A shell listed k times counts k times in the winding number* (:func:`~.multi
    that reason); a void listed twice with its inverted copy keeps one void (net −1; dropping the repeat first lost
    both).  Only whole closed surfaces go.  The arrangements take out face pairs by the same count
    (:func:`~.multiplicity.cancel_opposite`).  The solid is ``{w ≥ 1}`` of the winding number *with* each shell's
-   count (session 15, the team's decision on issue 21): a part exported twice has winding ``2w`` and
+   count (the team's decision on issue 21): a part exported twice has winding ``2w`` and
    ``{2w ≥ 1} = {w ≥ 1}``, so wherever every shell is listed alike (:func:`~.multiplicity.shell_multiplicity`), or
    counting a shell k times changes no region's side of 1 (:func:`~.multiplicity.multiplicity_changes`: checked
    inside every shell listed more than once), the copy left out is the whole answer and nothing else changes.
@@ -113,17 +113,16 @@ R3b *A flat open sheet inside a solid encloses nothing* (:func:`~.sheets.open_sh
    (flat sheets outside the solid, perhaps plates meant to have thickness) are not taken: the fin is named in the
    refusal.
 R4 *Orientation by nesting depth, where the file's winding is evidently wrong* (:func:`orient_by_depth`,
-   :func:`winding_stands`; session 16, the team's decision on issue 21).  The solid is where the winding number is
+   :func:`winding_stands`; the team's decision on issue 21).  The solid is where the winding number is
    at least one, so the file's own winding is read as it stands wherever it is a solid's: in a *nest* (a shell at
    depth 0 and every shell inside it) none of whose shells crosses any shell, where every region has winding
-   ``≥ 0``, no shell is turned, whatever crosses elsewhere in the file (session 17; before, one crossing pair
-   anywhere kept the depth reading for every nest); so also in a *sub-nest* inside a nest with crossings (a shell
-   crossing nothing, with nothing inside it crossing, whose winding just outside is 0 or 1: the shells around it
-   crossing others or not), and the rest of the file is read by the rules below, the certificate the weaker of
-   the parts (the boolean's ``united`` where the rest is united; the note says how many nests went each way); a
-   shell left undecided (every probe on another surface, even probed again past the shells it crosses, lies within
-   or touches) keeps the rule only from the nests it may lie in, not from every nest (session 18:
-   :func:`may_hold_undecided`, by the shells' bounding boxes, and the rest read with it still undecided);
+   ``≥ 0``, no shell is turned, whatever crosses elsewhere in the file; so also in a *sub-nest* inside a nest with
+   crossings (a shell crossing nothing, with nothing inside it crossing, whose winding just outside is 0 or 1:
+   the shells around it crossing others or not), and the rest of the file is read by the rules below, the
+   certificate the weaker of the parts (the boolean's ``united`` where the rest is united; the note says how many
+   nests went each way); a shell left undecided (every probe on another surface, even probed again past the shells
+   it crosses, lies within or touches) keeps the rule only from the nests it may lie in, not from every nest
+   (:func:`may_hold_undecided`, by the shells' bounding boxes, and the rest read with it still undecided);
    the shells with winding ``≥ 1`` on both sides (a body wound outward wholly inside another, and
    whatever lies inside it) bound nothing of ``{w ≥ 1}`` and are left out, and the rest, each with winding 0 on one
    side and 1 on the other, is integrated as wound: ``exact`` with the check ``interior-shells`` (no boolean; left
@@ -154,7 +153,7 @@ R4 *Orientation by nesting depth, where the file's winding is evidently wrong* (
    cavity, whether their surfaces cross (:func:`within_up_to_rounding`) or one lies inside the other without
    crossing or touching it (:func:`nested_copies`: a copy scaled by 1 + k ulp, review 10's D2); they go to the
    boolean, whose union is the solid, except where the file's winding stands (copies wound outward, one inside the
-   other: winding 1 and 2, the inner one left out, ``exact`` with ``interior-shells``; session 17).  A shell the file
+   other: winding 1 and 2, the inner one left out, ``exact`` with ``interior-shells``).  A shell the file
    winds outward that depth makes a cavity (:func:`misread_nesting`) is a reading the file does not decide: its
    own winding number is 2 there, so ``{w ≥ 1}`` is the union of the bodies, and a cavity written with the wrong
    winding reads the same (the shells around it counted by their file winding at its probe point and, for a
@@ -258,7 +257,7 @@ __all__ = ["Certificate", "CERTIFICATE_KINDS", "CHECKS", "TOUCH_VOLUME_RTOL", "F
            "shell_contacts", "ShellContacts", "weakest", "near_copies", "NearCopies", "near_copies_message",
            "MisreadNesting", "misread_nesting", "misread_voids", "outward_crossing_groups", "misread_message",
            "point_text", "part_size", "turned_reading_refusal", "winding_stands", "reading_difference",
-           "pairs_without", "nest_roots", "may_hold_undecided", "undecided_shells"]
+           "pairs_without", "nest_roots", "may_hold_undecided", "boxes_holding", "undecided_shells"]
 
 #: Kinds of certificate, from the strongest: ``exact`` (the integral of the surface as it stands, every
 #: check passed), ``united`` (the integral of the boolean union formed by manifold3d), ``summed`` (the
@@ -991,9 +990,10 @@ def reading_difference(file_volumes: np.ndarray, depth: np.ndarray, nest: Nestin
 def winding_stands(file_volumes: np.ndarray, depth: np.ndarray, nest: Nesting | None, within: np.ndarray | None,
                    crossing_with: np.ndarray, multiplicity: np.ndarray | None = None, *,
                    inside_crossed: bool = True, boxes: np.ndarray | None = None) -> MisreadNesting | None:
-    """R4 (session 16, per nest since session 17): the nests whose own winding is a solid's, where nesting depth would
-    read a shell the file winds outward as a cavity or R0's count decides; the shells to leave out there (``drop``),
-    or None where the rule applies nowhere.
+    """R4: the nests whose own winding is a solid's, where nesting depth would read a shell the file winds outward as
+    a cavity or R0's count decides; the shells to leave out there (``drop``), or None where the rule applies nowhere.
+    How the rule came to be (for the whole file, then per nest, then past undecided shells): docs/adversarial.md,
+    the sections "readings16", "nest17" and "tidy18".
 
     A *nest* is a shell at depth 0 with every shell inside it.  In a nest none of whose shells crosses any shell
     (and every probe decided), the winding numbers just inside and just outside each shell are every winding number
@@ -1016,9 +1016,9 @@ def winding_stands(file_volumes: np.ndarray, depth: np.ndarray, nest: Nesting | 
     have.  (The caller checks that the other rules then turn none of the shells kept: :mod:`~.classify`.)
 
     *A shell left undecided* (every probe on another surface, and not placed by touching or the boolean:
-    :func:`undecided_shells`) has no known containers, so it may lie in any nest; since session 18 it keeps the rule
-    only from the nests it may lie in, given ``boxes`` ((s, 2, 3) float, each shell's bounding box, lowest and highest
-    corner, m; None: the rule applies nowhere while a shell is undecided, as before).  No shell is decided as the
+    :func:`undecided_shells`) has no known containers, so it may lie in any nest; it keeps the rule only from the
+    nests it may lie in, given ``boxes`` ((s, 2, 3) float, each shell's bounding box, lowest and highest corner, m;
+    None: the rule applies nowhere while a shell is undecided).  No shell is decided as the
     outer shell ``X`` of a nest (or sub-nest) where (a) ``X`` is undecided, (b) ``X`` lies inside an undecided shell
     (its winding at ``X``'s probe is nonzero: the other rules give an undecided shell its own sign and may turn it,
     which would change the winding ``c`` round ``X``), or (c) an undecided shell's bounding box lies within
@@ -1101,19 +1101,50 @@ def may_hold_undecided(undecided: np.ndarray, shell: np.ndarray, other: np.ndarr
                        block: int = 1 << 22) -> np.ndarray:
     """(s,) bool, R4 (:func:`winding_stands`): the shells that are undecided (``undecided``, (s,) bool), lie inside
     an undecided shell (``(shell, other)`` pairs, :func:`~.multiplicity.container_windings`), or whose bounding box
-    holds an undecided shell's (``boxes``, (s, 2, 3) float, lowest and highest corner; compared exactly, in blocks
-    of at most ``block`` shell pairs)."""
+    holds an undecided shell's (``boxes``, (s, 2, 3) float, lowest and highest corner; :func:`boxes_holding`, in
+    blocks of at most ``block`` shell pairs)."""
     found: np.ndarray = np.asarray(undecided, dtype=bool).copy()
     found[np.asarray(shell, dtype=np.int64)[found[np.asarray(other, dtype=np.int64)]]] = True
+    found |= boxes_holding(boxes, np.flatnonzero(undecided), block=block)[0]
+    return found
+
+
+def boxes_holding(boxes: np.ndarray, inner: np.ndarray, *, block: int = 1 << 22) -> tuple[np.ndarray, np.ndarray]:
+    """Which shells' bounding boxes hold which (R4: a shell inside another lies within the other's corners'
+    extremes), both ways round.
+
+    Parameters
+    ----------
+    boxes : (s, 2, 3) float
+        Each shell's bounding box, its lowest and highest corner, m (:func:`~.classify.shell_boxes`).
+    inner : (k,) int
+        The shells whose boxes are looked for within the others'.
+    block : int
+        Shell pairs compared at once, at most (the memory of one comparison); at least one inner shell a block.
+
+    Returns
+    -------
+    holding : (s,) bool
+        The shells whose box holds the box of a shell of ``inner`` other than itself.
+    held : (k,) bool
+        The shells of ``inner`` whose box lies within the box of another shell.
+
+    Box ``a`` holds box ``b`` where ``lo_a ≤ lo_b`` and ``hi_a ≥ hi_b`` on all three axes, the floats compared
+    exactly (no tolerance: a point of a shell's closed solid lies within its corners' extremes); equal boxes hold
+    each other, a box is not counted as holding itself."""
     b = np.asarray(boxes, dtype=np.float64).reshape(-1, 2, 3)
     lo, hi = b[:, 0], b[:, 1]
-    ids = np.flatnonzero(undecided)
+    ids = np.asarray(inner, dtype=np.int64).reshape(-1)
+    holding = np.zeros(len(lo), dtype=bool)
+    held = np.zeros(len(ids), dtype=bool)
     step = max(1, block // max(1, len(lo)))
-    for start in range(0, len(ids), step):                 # bounded: ⌈u / step⌉ blocks
+    for start in range(0, len(ids), step):                 # bounded: ⌈k / step⌉ blocks
         u = ids[start:start + step]
         holds = np.all(lo[:, None] <= lo[None, u], axis=2) & np.all(hi[:, None] >= hi[None, u], axis=2)
-        found |= holds.any(axis=1)
-    return found
+        holds[u, np.arange(len(u))] = False                # (s, len(u)); a box holds itself, not another's
+        holding |= holds.any(axis=1)
+        held[start:start + step] = holds.any(axis=0)
+    return holding, held
 
 
 def pairs_without(pairs: np.ndarray, drop: np.ndarray) -> np.ndarray:
@@ -1285,7 +1316,7 @@ def _depth_reading_message(found: MisreadNesting, volume: float | None, kept: st
 
 
 def _by_nest(found: MisreadNesting) -> str:
-    """Which nests the file's winding decided and which the other rules read (session 17: " The file's winding
+    """Which nests the file's winding decided and which the other rules read (for example " The file's winding
     decided 1 nest (...); the other 27 shells, in nests with crossing shells, were read by the other rules (R4–R6),
     ..."); "" when every shell was in a nest decided."""
     if not found.others:

@@ -4,7 +4,7 @@ polygons cut as MuJoCo's loader cuts them, :mod:`.polygons`)."""
 from __future__ import annotations
 
 import warnings
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -55,16 +55,37 @@ def _tokens_per_line(chars: np.ndarray) -> np.ndarray:
     return np.add.reduceat(starts, line_starts, dtype=np.int64)
 
 
-def _plain_block(block: bytes, nv: int, max_vertices: int, faces_left: int) -> tuple[Any, ...] | None:
+@dataclass(frozen=True)
+class _PlainBlock:
+    """What :func:`_plain_block` read of one block: the arrays and counts :func:`_read_obj`'s line loop builds for
+    the same block."""
+
+    #: (k, 3) float: the ``v`` lines' coordinates, in the file's units; None: no ``v`` line.
+    coordinates: np.ndarray | None
+    #: (t, 3) int: the ``f`` lines' triangles, 0-based vertex indices of the file, a quad ``a b c d`` as ``a b c,
+    #: a c d`` (not split yet); None: no ``f`` line.
+    triangles: np.ndarray | None
+    #: (q,) int: the first of each quad's two triangles in ``triangles``; None: no ``f`` line.
+    quads: np.ndarray | None
+    #: ``v`` lines read (``k``).
+    vertices: int
+    #: ``f`` lines read (polygons).
+    polygons: int
+    #: Triangles read (``t``).
+    triangle_count: int
+    #: ``l`` and ``p`` lines (polylines and points: no solid; counted for a warning).
+    loose: int
+
+
+def _plain_block(block: bytes, nv: int, max_vertices: int, faces_left: int) -> _PlainBlock | None:
     """One block of an OBJ file read without a Python loop over its ``v`` and ``f`` lines, when every line is
     plain: ``v`` then a space or tab and exactly three coordinates, ``f`` then a space or tab and three or four
     corners with positive vertex indices (digits only) up to ``max_vertices``; any other line a comment, a blank
     line, a statement of :data:`_OBJ_SKIPPED` or an ``l``/``p`` line (each looked at as the line loop looks at
     it); no ``_`` or non-ASCII byte in a ``v`` or ``f`` line, no continued line, at most ``faces_left``
     triangles and ``max_vertices − nv`` vertices.  Returns what :func:`_read_obj`'s line loop builds for the
-    same block — ``(coordinates (k, 3) or None, triangles (t, 3) or None, first triangle of each quad,
-    vertices, polygons, triangles, l/p lines)`` — or None for any other block (the loop then reads it, and says
-    what is wrong where it is).
+    same block (:class:`_PlainBlock`), or None for any other block (the loop then reads it, and says what is
+    wrong where it is).
 
     Both read the same words with the same conversions (``np.array(..., float64)`` of the coordinates, the
     digits before a corner's first ``/`` as the index), in the file's order, so their arrays are equal; a quad
@@ -111,7 +132,8 @@ def _plain_block(block: bytes, nv: int, max_vertices: int, faces_left: int) -> t
         except ValueError:
             return None
     if not n_f:
-        return coords, None, None, n_v, 0, 0, loose
+        return _PlainBlock(coordinates=coords, triangles=None, quads=None, vertices=n_v, polygons=0, triangle_count=0,
+                           loose=loose)
     text = chars[np.repeat(is_f, length + 1) & ~keyword]
     gap = _GAP[text]
     word_start = ~gap
@@ -144,7 +166,8 @@ def _plain_block(block: bytes, nv: int, max_vertices: int, faces_left: int) -> t
     second_of = np.arange(n_tri) - first_triangle[line]        # 0, or 1 for a quad's second triangle
     base = first_corner[line]
     tri = np.stack([index[base], index[base + 1 + second_of], index[base + 2 + second_of]], axis=1)
-    return coords, tri, first_triangle[corners == 4], n_v, n_f, n_tri, loose
+    return _PlainBlock(coordinates=coords, triangles=tri, quads=first_triangle[corners == 4], vertices=n_v,
+                       polygons=n_f, triangle_count=n_tri, loose=loose)
 
 
 def _read_obj(path: str, max_faces: int, data: bytes | None = None,
@@ -181,16 +204,15 @@ def _read_obj(path: str, max_faces: int, data: bytes | None = None,
             faces_left = min(max_faces, MAX_SUPPORTED_FACES) - n_tri
             plain = _plain_block(block, nv, max_vertices, faces_left) if plain_blocks and not pending else None
             if plain is not None:
-                block_coords, block_tri, block_quads, block_nv, block_poly, block_tri_count, block_loose = plain
                 line_no += block.count(b"\n")
-                if block_coords is not None:
-                    vertex_blocks.append(block_coords)
-                if block_tri is not None:
-                    face_blocks.append(block_tri)
-                    if len(block_quads):
-                        quad_blocks.append((len(face_blocks) - 1, block_quads))
-                nv, n_poly, n_tri, loose = nv + block_nv, n_poly + block_poly, n_tri + block_tri_count, \
-                    loose + block_loose
+                if plain.coordinates is not None:
+                    vertex_blocks.append(plain.coordinates)
+                if plain.triangles is not None:
+                    face_blocks.append(plain.triangles)
+                    if plain.quads is not None and len(plain.quads):
+                        quad_blocks.append((len(face_blocks) - 1, plain.quads))
+                nv, n_poly, n_tri, loose = nv + plain.vertices, n_poly + plain.polygons, \
+                    n_tri + plain.triangle_count, loose + plain.loose
                 continue
             coords: list[bytes] = []
             coord_lines: list[int] = []                 # the line of each vertex, for an error message

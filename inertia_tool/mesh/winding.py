@@ -309,7 +309,7 @@ class IntegerTree:
 def integer_tree(vertices: np.ndarray, faces: np.ndarray) -> IntegerTree:
     """The tree of :func:`winding_integers` for a surface, to pass to several calls on it (``tree=``): the values
     are those each call would compute with its own tree, to the bit (the tree depends on the surface only; issue
-    25: :func:`~inertia_tool.mesh.grid_estimate.corrected_estimate` evaluates its front probes and its regions'
+    25: :func:`~inertia_tool.mesh.grid_corrected.corrected_estimate` evaluates its front probes and its regions'
     integers on one surface)."""
     _, vertices, faces = _contiguous(np.zeros((0, 3)), vertices, faces)
     return IntegerTree(vertices, faces)
