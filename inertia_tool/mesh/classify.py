@@ -458,7 +458,7 @@ def _cavities_across_bodies(volumes: np.ndarray, flip: np.ndarray, crossing_with
     if not len(pairs):
         return 0
     wound = np.where(flip, -np.sign(volumes), np.sign(volumes))
-    bodies: dict[int, set] = {}
+    bodies: dict[int, set[int]] = {}
     for a, b in ((0, 1), (1, 0)):
         hit = (wound[pairs[:, a]] < 0) & (wound[pairs[:, b]] > 0)
         for cavity, body in pairs[hit][:, [a, b]].tolist():

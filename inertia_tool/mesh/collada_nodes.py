@@ -13,6 +13,8 @@ removed, so the ordinary reader (node transforms, units, checks) reads only the 
 
 from __future__ import annotations
 
+from typing import Any
+
 from ..errors import MeshReadError
 from .regular import open_regular
 
@@ -23,7 +25,7 @@ def _local(tag: object) -> str:
     return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
 
 
-def _gazebo_name(element) -> str | None:
+def _gazebo_name(element: Any) -> str | None:
     """The name Gazebo gives the sub-meshes of ``element`` (an ``<instance_geometry>``): the nearest
     enclosing ``<node>`` with a ``name``; None when no enclosing node has one."""
     parent = element.getparent()
@@ -34,13 +36,13 @@ def _gazebo_name(element) -> str | None:
     return None
 
 
-def _instances(tree) -> list:
+def _instances(tree: Any) -> list[Any]:
     """The ``<instance_geometry>`` elements of the document's visual scenes."""
     return [e for e in tree.iter() if _local(e.tag) == "instance_geometry"
             and any(_local(a.tag) == "library_visual_scenes" for a in e.iterancestors())]
 
 
-def _parse(path: str):
+def _parse(path: str) -> Any:
     from lxml import etree
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False)
     try:

@@ -37,6 +37,7 @@ with that reason (:class:`~inertia_tool.errors.ArrangementError`), never guessed
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from fractions import Fraction
 from math import gcd
 
@@ -47,7 +48,7 @@ from ..values import frozen_value
 from .arrange import (_U, WINDING_MARGIN, _compact, _Exact, _FaceTriangulation, _Hom, _inside_face, _orient2d,
                       _patches, _projection, _winding_terms, _winding_total, rounded_points_bounds)
 from .edges import edge_keys
-from .intersect import orient3d_sign, surface_contacts
+from .intersect import SurfaceContacts, orient3d_sign, surface_contacts
 from .multiplicity import cancel_opposite, signed_multiplicity
 from .precision import RoundedRegion, rounded_region
 
@@ -167,7 +168,7 @@ class _Overlay:
     """The overlay of one plane's faces: points keyed by exact coordinates, each edge's chain of points."""
 
     def __init__(self, exact: _Exact, faces: np.ndarray, hom: dict[int, _Hom], ids: dict[_Hom, int],
-                 on_edge: dict[tuple[int, int], dict[int, Fraction]], new_point) -> None:
+                 on_edge: dict[tuple[int, int], dict[int, Fraction]], new_point: Callable[[_Hom], int]) -> None:
         self.exact, self.faces, self.hom, self.ids, self.on_edge = exact, faces, hom, ids, on_edge
         self.new_point = new_point
 
@@ -444,7 +445,7 @@ def arrange_coplanar(vertices: np.ndarray, faces: np.ndarray) -> CoplanarArrange
                                crossings_left=left, cancelled_faces=cancelled, rounding=rounding, region=region)
 
 
-def _overlapping(found, faces: np.ndarray) -> np.ndarray:
+def _overlapping(found: SurfaceContacts, faces: np.ndarray) -> np.ndarray:
     """(k,) int: the faces in a pair that overlaps in a common plane (either way round, or repeated)."""
     pairs = np.concatenate([np.asarray(found.crossing, dtype=np.int64).reshape(-1, 2),
                             np.asarray(found.coplanar_opposite, dtype=np.int64).reshape(-1, 2),

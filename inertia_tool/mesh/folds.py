@@ -268,7 +268,7 @@ def _thin_fan_vertices(v: np.ndarray, f: np.ndarray, valence: np.ndarray, order:
     det = np.abs(np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])))
     q = np.concatenate([p, np.zeros_like(p[:, :1])], axis=1)
     longest = np.max(np.linalg.norm(q[:, :, None] - q[:, None], axis=3), axis=(1, 2))
-    return c[det / 6 <= 2 * thin * longest ** 3 + 1e-300]
+    return np.asarray(c[det / 6 <= 2 * thin * longest ** 3 + 1e-300])
 
 
 def _tetra_volume_bound(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> float:
@@ -574,7 +574,7 @@ def _face_normals(v: np.ndarray, f: np.ndarray) -> np.ndarray:
     out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
     out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
     out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out
+    return np.asarray(out)
 
 
 def _median(x: np.ndarray) -> float:
@@ -842,4 +842,4 @@ def _kept_pairs(pairs: np.ndarray, keep: np.ndarray, index: np.ndarray) -> np.nd
     """Face pairs with both faces kept, renumbered (k, 2) intp."""
     p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     p = p[keep[p[:, 0]] & keep[p[:, 1]]]
-    return index[p].astype(np.intp).reshape(-1, 2)
+    return np.asarray(index[p].astype(np.intp).reshape(-1, 2))

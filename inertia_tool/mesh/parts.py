@@ -14,7 +14,7 @@ every name ``--material-map`` may use for it (see docs/usage.md).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -22,6 +22,7 @@ from ..errors import MeshReadError
 
 if TYPE_CHECKING:  # pragma: no cover
     from .read import RawMesh
+    from .threemf import PlacedObject
 
 __all__ = ["PartTag", "part_mesh", "split_parts", "threemf_parts", "cad_parts", "scene_parts",
            "unique_names"]
@@ -84,7 +85,7 @@ def _slot_material(slot: int, types: list[str], densities: list[float | None]) -
     return kind, density
 
 
-def threemf_parts(placed: Sequence, slicer: tuple, name: str) -> tuple[PartTag, ...]:
+def threemf_parts(placed: Sequence[PlacedObject], slicer: tuple[Any, ...], name: str) -> tuple[PartTag, ...]:
     """The parts of a 3MF build: one per placed object, split by a slicer's volumes where its config has them.
 
     Parameters
@@ -155,7 +156,7 @@ def cad_parts(found: Sequence[tuple[str, str | None, float | None, int, int]]) -
                          (f[3], f[4])) for n, f in zip(names, found))
 
 
-def scene_parts(geometries: Sequence) -> tuple[PartTag, ...]:
+def scene_parts(geometries: Sequence[Any]) -> tuple[PartTag, ...]:
     """The parts of a glTF scene, one per mesh node (``trimesh.Scene.dump`` order, the order the reader
     concatenates them in): the node's name, the name of its primitive's material (trimesh's
     ``visual.material.name``).  Empty for a single node or when no node's mesh has a named material."""

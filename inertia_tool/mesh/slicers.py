@@ -44,7 +44,7 @@ Everything read here is small; the members are refused above :data:`MAX_CONFIG_B
 from __future__ import annotations
 
 import json
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from ..errors import MeshReadError
 from ..units import DECIMAL
@@ -98,7 +98,7 @@ class SlicerObject(NamedTuple):
     extruder: int = 1
 
 
-def _metadata(element, kind: str | None = None) -> dict[str, str]:
+def _metadata(element: Any, kind: str | None = None) -> dict[str, str]:
     """``key -> value`` of the ``<metadata>`` children of ``element`` (PrusaSlicer's ``type`` must be ``kind``)."""
     out: dict[str, str] = {}
     for child in element:
@@ -118,7 +118,7 @@ def _slot(text: str | None, inherited: int, where: str) -> int:
     return inherited if value == 0 else value
 
 
-def _xml(data: bytes, where: str):
+def _xml(data: bytes, where: str) -> Any:
     from lxml import etree
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False, remove_comments=True)
     try:
@@ -165,7 +165,7 @@ def _bambu_objects(data: bytes, where: str) -> dict[str, SlicerObject]:
     return objects
 
 
-def _densities(values: list, where: str) -> list[float | None]:
+def _densities(values: list[Any], where: str) -> list[float | None]:
     """Filament densities, g/cm³ in the file, as kg/m³ (None where not a positive number)."""
     out: list[float | None] = []
     for value in values:
@@ -193,7 +193,7 @@ def _bambu_filaments(data: bytes, where: str) -> tuple[list[str], list[float | N
     if not isinstance(settings, dict):
         return [], []
 
-    def listed(key: str) -> list:
+    def listed(key: str) -> list[Any]:
         value = settings.get(key, [])
         return value if isinstance(value, list) else [value]
     return [str(t) for t in listed("filament_type")], _densities(listed("filament_density"), where)
