@@ -1,5 +1,9 @@
 """The repair's shortcuts of issue 25 item 3 (soup19) give what the code they replace gives, bit for bit.
 
+- ``rims.enclosing_balls`` runs Bădoiu–Clarkson's steps on blocks of groups of alike sizes (padded with copies
+  of a group's first point): the centres and radii of the reading with one (k, 3) array and ``reduceat`` per step
+  (``test_soup17_speed._reference_balls``), on groups of 1 to 300 points with repeated points (ties for the
+  farthest) and points on a grid (many equal distances);
 - ``seal.seal_seams`` searches each boundary edge once for the points near it (``seal._Pairs``, kept from pass to
   pass; the on-edge passes search with the seal's gap, a superset of the pairs on the edge to round-off) and
   measures only the candidates' edges: the reference below is the seal before (every pass searched every edge of
@@ -21,7 +25,30 @@ from hypothesis import strategies as st
 
 from inertia_tool.mesh import seal
 from inertia_tool.mesh.edges import edge_keys
+from inertia_tool.mesh.rims import enclosing_balls
 from test_mesh_seal_split import t_split_grid
+from test_soup17_speed import _reference_balls
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.sampled_from([4, 9, 40, 300]), st.integers(1, 50),
+       st.booleans(), st.integers(-8, 8))
+def test_enclosing_balls_by_size_class_are_the_reading_with_one_array(seed, n_groups, largest, iterations, grid,
+                                                                      scale_exp):
+    rng = np.random.default_rng(seed)
+    size = rng.integers(1, largest + 1, n_groups)               # (every group holds a point: as the callers')
+    group = rng.permutation(np.repeat(np.arange(n_groups), size))
+    if grid:          # points on a small grid: many ties for the farthest point
+        points = rng.integers(-2, 3, size=(len(group), 3)).astype(float)
+    else:
+        points = rng.normal(size=(len(group), 3))
+        repeat = rng.random(len(group)) < 0.2                 # repeated points
+        if repeat.any() and len(group):
+            points[repeat] = points[rng.integers(len(group), size=int(repeat.sum()))]
+    points = points * 10.0 ** scale_exp + rng.uniform(-1e3, 1e3, size=3) * 10.0 ** scale_exp
+    centre, radius = enclosing_balls(points, group, n_groups, iterations=iterations)
+    want_centre, want_radius = _reference_balls(points, group, n_groups, iterations)
+    assert centre.tobytes() == want_centre.tobytes() and radius.tobytes() == want_radius.tobytes()
 
 
 def _reference_split(v, f, slack, gap, chain, region, on_edge_only):
