@@ -354,17 +354,28 @@ def _split(v: np.ndarray, f: np.ndarray, slack: np.ndarray, gap: float, chain: _
     first = nearest[np.r_[True, m[nearest][1:] != m[nearest][:-1]]]
     e, m, t, dist = e[first], m[first], t[first], dist[first]
     # the face holding each directed edge a→b, and which of its edges it is
-    undirected, forward = edge_keys(f, len(v))            # edge slot j of face i: f[i, j] → f[i, j+1]
-    key = 2 * undirected + forward
     start, end = edges[e, 0].astype(np.int64), edges[e, 1].astype(np.int64)
     want = 2 * edge_keys(np.stack([start, end, end], axis=1), len(v))[0][0::3] + (start > end)
-    # the lowest slot holding each wanted key: only the slots holding one are sorted (not the whole frontier's)
+    # the lowest slot holding each wanted key: only the slots holding one are sorted (not the whole frontier's),
+    # and only the slots whose two ends are ends of a wanted edge are keyed (soup19: every slot of the frontier
+    # was keyed and looked up, each pass)
+    ends = np.zeros(len(v), dtype=bool)
+    ends[start] = True
+    ends[end] = True
+    at_ends = ends[f]
+    # slot 3i + j: f[i, j] → f[i, j+1]
+    slots = np.flatnonzero((at_ends & np.roll(at_ends, -1, axis=1)).reshape(-1))
+    undirected, forward = edge_keys(f[slots // 3], len(v))
+    pick = np.arange(len(slots)) * 3 + slots % 3
+    key = 2 * undirected[pick] + forward[pick]
     targets = np.unique(want)
     at = np.minimum(np.searchsorted(targets, key), len(targets) - 1)
     hit = np.flatnonzero(targets[at] == key)
-    order = hit[np.argsort(key[hit], kind="stable")]
-    pos = np.searchsorted(key[order], want)
-    found = (pos < len(order)) & (key[order][np.minimum(pos, len(order) - 1)] == want)
+    by_key = hit[np.argsort(key[hit], kind="stable")]
+    order = slots[by_key]                   # the slots holding a wanted key, by key (by slot within a key)
+    held = key[by_key]                      # their keys, ascending
+    pos = np.searchsorted(held, want)
+    found = (pos < len(order)) & (held[np.minimum(pos, len(order) - 1)] == want)
     e, m, t, dist, pos = e[found], m[found], t[found], dist[found], pos[found]
     slot = order[pos]
     face, corner = slot // 3, slot % 3
