@@ -6,15 +6,16 @@
   farthest) and points on a grid (many equal distances);
 - ``seal.seal_seams`` searches each boundary edge once for the points near it (``seal._Pairs``, kept from pass to
   pass; the on-edge passes search with the seal's gap, a superset of the pairs on the edge to round-off),
-  measures only the candidates' edges and keys only the face edges whose two ends are ends of an edge to split:
+  measures only the candidates' edges and keys only the face edges whose two ends are ends of an edge to split
+  (and, counting the loose faces, of a boundary edge):
   the reference below is the seal before (every pass searched every edge of the frontier's boundary, the on-edge
   passes with gap 0, every edge was measured and every face edge of the frontier keyed).
 
 Meshes: icospheres and tori off the origin with faces removed (scattered holes), faces split at an edge's
 midpoint with the neighbour left whole (T-junctions, the midpoint on its edge to round-off), some split points
-moved off the edge within the gap, and a crack (a patch cut free, its border corners moved within the gap);
-also the T-split grids of ``test_mesh_seal_split`` (several points on one edge).  No timings here: they are in
-``benchmarks/bench_repair.py`` and ``docs/performance.md``.
+moved off the edge within the gap, loose triangles, and a crack (a patch cut free, its border corners moved
+within the gap); also the T-split grids of ``test_mesh_seal_split`` (several points on one edge).  No timings
+here: they are in ``benchmarks/bench_repair.py`` and ``docs/performance.md``.
 """
 
 from __future__ import annotations
@@ -122,6 +123,21 @@ def _reference_split(v, f, slack, gap, chain, region, on_edge_only):
     return np.vstack([f[keep_face], fan]), np.concatenate([slack[keep_face], fan_slack]), int(len(m)), chain
 
 
+def _reference_loose_faces(faces, n, region):
+    """``seal._loose_faces`` before soup19: every face edge of the frontier keyed."""
+    if not len(faces):
+        return 0
+    sk, order = seal.stable_key_order(edge_keys(faces, n)[0])
+    nn = np.int64(max(n, 1))
+    single = region[sk // nn] | region[sk % nn]
+    same = sk[1:] == sk[:-1]
+    single[1:] &= ~same
+    single[:-1] &= ~same
+    alone = np.empty(len(sk), dtype=bool)
+    alone[order] = single
+    return int(np.count_nonzero(alone.reshape(-1, 3).all(axis=1)))
+
+
 def _reference_seal(v, f, gap):
     """``seal.seal_seams`` before soup19 (its steps and bookkeeping, with the reference split)."""
     n = len(v)
@@ -169,7 +185,7 @@ def _reference_seal(v, f, gap):
     else:
         all_slack = np.concatenate([np.zeros(len(rest)), slack])
         boundary = seal._chain_edges(chain, n) if (welded or split) else edges
-    return seal.Seal(out, all_slack, dropped, welded, split, boundary, seal._loose_faces(front, n, region),
+    return seal.Seal(out, all_slack, dropped, welded, split, boundary, _reference_loose_faces(front, n, region),
                      duplicates, len(rest))
 
 
@@ -212,6 +228,13 @@ def _damaged(seed):
         step = rng.normal(size=(len(border), 3))
         moved = v[border] + rng.uniform(0.0, 0.4) * gap * step / np.linalg.norm(step, axis=1, keepdims=True)
         v = np.vstack([v, moved])
+    if rng.random() < 0.4:                      # loose triangles (a soup's), some touching the rims by a corner
+        some = f[rng.integers(len(f), size=int(rng.integers(1, 20)))]
+        loose = len(v) + np.arange(3 * len(some)).reshape(-1, 3)
+        v = np.vstack([v, v[some].reshape(-1, 3) + rng.normal(size=(3 * len(some), 3)) * 0.01])
+        touch = rng.random(len(some)) < 0.5
+        loose[touch, 0] = some[touch, 0]
+        f = np.vstack([f, loose])
     return v, f, gap
 
 
@@ -241,7 +264,7 @@ def test_the_seal_searching_each_edge_once_on_t_split_grids(seed, n, splits, per
 def test_the_damaged_meshes_exercise_the_kept_pairs():
     """The generator makes seals of several passes (the pairs carried over) that split and weld: else the
     tests above would compare nothing but the first search."""
-    passes = splits = welds = 0
+    passes = splits = welds = loose = 0
     original = seal._candidates
     calls = []
 
@@ -256,7 +279,8 @@ def test_the_damaged_meshes_exercise_the_kept_pairs():
             got = seal.seal_seams(v, f, gap)
             splits += got.split > 0
             welds += got.welded > 0
+            loose += got.loose_faces > 0
     finally:
         seal._candidates = original
     passes = sum(calls)
-    assert passes >= 12 and splits >= 6 and welds >= 2, (passes, splits, welds)
+    assert passes >= 12 and splits >= 6 and welds >= 2 and loose >= 2, (passes, splits, welds, loose)

@@ -213,19 +213,33 @@ def drop_duplicate_faces(faces: np.ndarray) -> tuple[np.ndarray, int]:
     return f[~repeat], int(np.count_nonzero(repeat))
 
 
-def _loose_faces(faces: np.ndarray, n: int, region: np.ndarray) -> int:
+def _loose_faces(faces: np.ndarray, n: int, region: np.ndarray, boundary: np.ndarray | None = None) -> int:
     """Frontier faces none of whose edges is used by another face (an edge without an end in ``region`` is
-    balanced in the whole surface, so it is shared even if its other face is not in the frontier)."""
+    balanced in the whole surface, so it is shared even if its other face is not in the frontier).
+
+    ``boundary`` (k, 2) int, optional: the frontier's boundary edges with an end in ``region`` (as
+    :class:`Seal` holds them).  Then only the face edges whose two ends are ends of those are keyed (soup19: every
+    face edge of the frontier was): an edge used once with an end in ``region`` is unbalanced, so it is one of
+    them, and every use of an edge has the same two ends, so the uses counted are all its uses."""
     if not len(faces):
         return 0
-    sk, order = stable_key_order(edge_keys(faces, n)[0])
+    if boundary is None:
+        slots = None
+        key = edge_keys(faces, n)[0]
+    else:
+        ends = np.zeros(n, dtype=bool)
+        ends[np.asarray(boundary, dtype=np.int64).reshape(-1)] = True
+        at_ends = ends[faces]
+        slots = np.flatnonzero((at_ends & np.roll(at_ends, -1, axis=1)).reshape(-1))   # slot 3i + j: j → j + 1
+        key = edge_keys(faces[slots // 3], n)[0][np.arange(len(slots)) * 3 + slots % 3]
+    sk, order = stable_key_order(key)
     nn = np.int64(max(n, 1))
     single = region[sk // nn] | region[sk % nn]
     same = sk[1:] == sk[:-1]
     single[1:] &= ~same
     single[:-1] &= ~same
-    alone = np.empty(len(sk), dtype=bool)
-    alone[order] = single
+    alone = np.zeros(3 * len(faces), dtype=bool)
+    alone[order if slots is None else slots[order]] = single
     return int(np.count_nonzero(alone.reshape(-1, 3).all(axis=1)))
 
 
@@ -614,5 +628,5 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
         boundary = _frontier_boundary(front, n, region)
     else:
         boundary = _chain_edges(chain, n) if (welded or split) else edges
-    return Seal(out, all_slack, dropped, welded, split, boundary, _loose_faces(front, n, region), duplicates,
-                len(rest))
+    return Seal(out, all_slack, dropped, welded, split, boundary, _loose_faces(front, n, region, boundary),
+                duplicates, len(rest))
