@@ -4,12 +4,11 @@
   of a group's first point): the centres and radii of the reading with one (k, 3) array and ``reduceat`` per step
   (``test_soup17_speed._reference_balls``), on groups of 1 to 300 points with repeated points (ties for the
   farthest) and points on a grid (many equal distances);
-- ``seal.seal_seams`` searches each boundary edge once for the points near it (``seal._Pairs``, kept from pass to
-  pass; the on-edge passes search with the seal's gap, a superset of the pairs on the edge to round-off),
-  measures only the candidates' edges and keys only the face edges whose two ends are ends of an edge to split
-  (and, counting the loose faces, of a boundary edge):
-  the reference below is the seal before (every pass searched every edge of the frontier's boundary, the on-edge
-  passes with gap 0, every edge was measured and every face edge of the frontier keyed).
+- ``seal.seal_seams`` searches each boundary edge once per gap for the points near it (``seal._Pairs``, kept
+  from pass to pass: the on-edge passes' with gap 0, the split passes' with the seal's gap), measures only the
+  candidates' edges and keys only the face edges whose two ends are ends of an edge to split (and, counting the
+  loose faces, of a boundary edge): the reference below is the seal before (every pass searched every edge of
+  the frontier's boundary, every edge was measured and every face edge of the frontier keyed).
 
 Meshes: icospheres and tori off the origin with faces removed (scattered holes), faces split at an edge's
 midpoint with the neighbour left whole (T-junctions, the midpoint on its edge to round-off), some split points

@@ -287,14 +287,15 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
 
 
 class _Pairs(NamedTuple):
-    """The (edge, point) candidates of a seal's searches (:func:`_edge_point_candidates` with the seal's gap),
-    kept from pass to pass so that each pass searches only the edges the one before did not (issue 25, soup19: the
-    passes of a T-split 1.3M-face sphere searched the same ~69k edges four times, ~0.4 s).  ``searched`` (s,)
+    """The (edge, point) candidates of a seal's search (:func:`_edge_point_candidates`) within ``gap``, kept from
+    pass to pass so that a pass with the same gap searches only the edges the one before did not (issue 25, soup19:
+    the on-edge passes of a T-split 1.3M-face sphere searched the same ~69k edges three times).  ``searched`` (s,)
     int64: the keys ``a·n + b`` of the directed edges searched, ascending; ``points`` (n,) bool: the points they
     were searched against; ``edge`` (k,) int64, ascending, and ``point`` (k,) int64: every candidate pair of those
     edges and points (the pairs the search lists depend only on the edge and the point, not on which other edges
     and points are searched with them)."""
 
+    gap: float
     searched: np.ndarray
     points: np.ndarray
     edge: np.ndarray
@@ -303,22 +304,24 @@ class _Pairs(NamedTuple):
 
 def _candidates(v: np.ndarray, edges: np.ndarray, gap: float, known: _Pairs | None
                 ) -> tuple[np.ndarray, np.ndarray, _Pairs]:
-    """(edge row, vertex) candidate pairs of ``edges`` (distinct rows in lexicographic order, as
+    """(edge row, vertex) candidate pairs within ``gap`` of ``edges`` (distinct rows in lexicographic order, as
     :func:`_unique_rows` gives them) and their own boundary vertices, by edge, as :func:`_edge_point_candidates`
-    lists them: those of ``known`` (the previous pass's) whose edge and point are still here, and a search of
-    the edges ``known`` did not search.  Every vertex must then be one ``known`` searched against (a vertex
-    cannot become a boundary vertex by a split or a weld that did not make it one before: else everything is
-    searched again, which gives the same pairs).  The order of the pairs within an edge may differ from a
-    search's; :func:`_split` does not depend on it (it orders what it keeps by vertex, then distance, then edge).
-    Also returns the pairs to hand to the next pass."""
+    lists them: when ``known`` (the previous pass's) was searched with the same gap, those of its pairs whose edge
+    and point are still here, and a search of the edges it did not search.  Every vertex must then be one
+    ``known`` searched against (a vertex cannot become a boundary vertex by a split or a weld that did not make it
+    one before: else everything is searched again, which gives the same pairs).  The order of the pairs within an
+    edge may differ from a search's; :func:`_split` does not depend on it (it orders what it keeps by vertex, then
+    distance, then edge).  Also returns the pairs to hand to the next pass.  (Each pass lists what a search of
+    its own would list, no more: a search with the weld's gap before the weld would list every near copy of an
+    edge's ends on a soup the tolerance weld left alone, ~6 pairs an edge.)"""
     n = len(v)
     nn = np.int64(max(n, 1))
     key = edges[:, 0].astype(np.int64) * nn + edges[:, 1]                  # ascending: the rows' order
     points = np.zeros(n, dtype=bool)
     points[edges.reshape(-1)] = True
-    if known is None or bool(np.any(points & ~known.points)):
+    if known is None or known.gap != gap or bool(np.any(points & ~known.points)):
         e, m = _edge_point_candidates(v, edges, gap)
-        return e, m, _Pairs(key, points, key[e], m)
+        return e, m, _Pairs(gap, key, points, key[e], m)
     pos = np.minimum(np.searchsorted(known.searched, key), max(len(known.searched) - 1, 0))
     new_rows = np.flatnonzero(known.searched[pos] != key) if len(known.searched) else np.arange(len(key))
     at = np.minimum(np.searchsorted(key, known.edge), len(key) - 1)
@@ -329,22 +332,19 @@ def _candidates(v: np.ndarray, edges: np.ndarray, gap: float, known: _Pairs | No
         e, m = np.concatenate([e, new_rows[new_e]]), np.concatenate([m, new_m])
         by_edge = np.argsort(e, kind="stable")
         e, m = e[by_edge], m[by_edge]
-    return e, m, _Pairs(key, points, key[e], m)
+    return e, m, _Pairs(gap, key, points, key[e], m)
 
 
 def _split(v: np.ndarray, f: np.ndarray, slack: np.ndarray, gap: float, chain: _Chain, region: np.ndarray | None,
            on_edge_only: bool, known: _Pairs | None = None
            ) -> tuple[np.ndarray, np.ndarray, int, _Chain, _Pairs | None]:
     """:func:`_split_t_junctions` on the frontier whose boundary is ``chain``; also returns the chain after it and
-    the candidate pairs to hand to the next pass (``known``: those of the pass before, :class:`_Pairs`).
-
-    The candidates are searched with ``gap`` also when ``on_edge_only``: a superset of those within round-off of
-    the edge, and the tests below decide alone which pairs are kept, so the splits are the same."""
+    the candidate pairs to hand to the next pass (``known``: those of the pass before, :class:`_Pairs`)."""
     if not len(chain.key):
         return f, slack, 0, chain, known
     edges = _chain_edges(chain, len(v))
     edges = _unique_rows(edges, len(v))
-    e, m, known = _candidates(v, edges, gap, known)
+    e, m, known = _candidates(v, edges, 0.0 if on_edge_only else gap, known)
     if not len(e):
         return f, slack, 0, chain, known
     # the candidates' edges only (each row as numpy forms it for all edges: the same values)
