@@ -213,19 +213,33 @@ def drop_duplicate_faces(faces: np.ndarray) -> tuple[np.ndarray, int]:
     return f[~repeat], int(np.count_nonzero(repeat))
 
 
-def _loose_faces(faces: np.ndarray, n: int, region: np.ndarray) -> int:
+def _loose_faces(faces: np.ndarray, n: int, region: np.ndarray, boundary: np.ndarray | None = None) -> int:
     """Frontier faces none of whose edges is used by another face (an edge without an end in ``region`` is
-    balanced in the whole surface, so it is shared even if its other face is not in the frontier)."""
+    balanced in the whole surface, so it is shared even if its other face is not in the frontier).
+
+    ``boundary`` (k, 2) int, optional: the frontier's boundary edges with an end in ``region`` (as
+    :class:`Seal` holds them).  Then only the face edges whose two ends are ends of those are keyed (soup19: every
+    face edge of the frontier was): an edge used once with an end in ``region`` is unbalanced, so it is one of
+    them, and every use of an edge has the same two ends, so the uses counted are all its uses."""
     if not len(faces):
         return 0
-    sk, order = stable_key_order(edge_keys(faces, n)[0])
+    if boundary is None:
+        slots = None
+        key = edge_keys(faces, n)[0]
+    else:
+        ends = np.zeros(n, dtype=bool)
+        ends[np.asarray(boundary, dtype=np.int64).reshape(-1)] = True
+        at_ends = ends[faces]
+        slots = np.flatnonzero((at_ends & np.roll(at_ends, -1, axis=1)).reshape(-1))   # slot 3i + j: j → j + 1
+        key = edge_keys(faces[slots // 3], n)[0][np.arange(len(slots)) * 3 + slots % 3]
+    sk, order = stable_key_order(key)
     nn = np.int64(max(n, 1))
     single = region[sk // nn] | region[sk % nn]
     same = sk[1:] == sk[:-1]
     single[1:] &= ~same
     single[:-1] &= ~same
-    alone = np.empty(len(sk), dtype=bool)
-    alone[order] = single
+    alone = np.zeros(3 * len(faces), dtype=bool)
+    alone[order if slots is None else slots[order]] = single
     return int(np.count_nonzero(alone.reshape(-1, 3).all(axis=1)))
 
 
@@ -272,46 +286,110 @@ def _split_t_junctions(v: np.ndarray, f: np.ndarray, slack: np.ndarray,
     return _split(v, f, slack, gap, _chain_of_faces(f, len(v), region), region, on_edge_only)[:3]
 
 
+class _Pairs(NamedTuple):
+    """The (edge, point) candidates of a seal's search (:func:`_edge_point_candidates`) within ``gap``, kept from
+    pass to pass so that a pass with the same gap searches only the edges the one before did not (issue 25, soup19:
+    the on-edge passes of a T-split 1.3M-face sphere searched the same ~69k edges three times).  ``searched`` (s,)
+    int64: the keys ``a·n + b`` of the directed edges searched, ascending; ``points`` (n,) bool: the points they
+    were searched against; ``edge`` (k,) int64, ascending, and ``point`` (k,) int64: every candidate pair of those
+    edges and points (the pairs the search lists depend only on the edge and the point, not on which other edges
+    and points are searched with them)."""
+
+    gap: float
+    searched: np.ndarray
+    points: np.ndarray
+    edge: np.ndarray
+    point: np.ndarray
+
+
+def _candidates(v: np.ndarray, edges: np.ndarray, gap: float, known: _Pairs | None
+                ) -> tuple[np.ndarray, np.ndarray, _Pairs]:
+    """(edge row, vertex) candidate pairs within ``gap`` of ``edges`` (distinct rows in lexicographic order, as
+    :func:`_unique_rows` gives them) and their own boundary vertices, by edge, as :func:`_edge_point_candidates`
+    lists them: when ``known`` (the previous pass's) was searched with the same gap, those of its pairs whose edge
+    and point are still here, and a search of the edges it did not search.  Every vertex must then be one
+    ``known`` searched against (a vertex cannot become a boundary vertex by a split or a weld that did not make it
+    one before: else everything is searched again, which gives the same pairs).  The order of the pairs within an
+    edge may differ from a search's; :func:`_split` does not depend on it (it orders what it keeps by vertex, then
+    distance, then edge).  Also returns the pairs to hand to the next pass.  (Each pass lists what a search of
+    its own would list, no more: a search with the weld's gap before the weld would list every near copy of an
+    edge's ends on a soup the tolerance weld left alone, ~6 pairs an edge.)"""
+    n = len(v)
+    nn = np.int64(max(n, 1))
+    key = edges[:, 0].astype(np.int64) * nn + edges[:, 1]                  # ascending: the rows' order
+    points = np.zeros(n, dtype=bool)
+    points[edges.reshape(-1)] = True
+    if known is None or known.gap != gap or bool(np.any(points & ~known.points)):
+        e, m = _edge_point_candidates(v, edges, gap)
+        return e, m, _Pairs(gap, key, points, key[e], m)
+    pos = np.minimum(np.searchsorted(known.searched, key), max(len(known.searched) - 1, 0))
+    new_rows = np.flatnonzero(known.searched[pos] != key) if len(known.searched) else np.arange(len(key))
+    at = np.minimum(np.searchsorted(key, known.edge), len(key) - 1)
+    keep = (key[at] == known.edge) & points[known.point]
+    e, m = at[keep], known.point[keep]
+    if len(new_rows):
+        new_e, new_m = _edge_point_candidates(v, edges[new_rows], gap, points=np.flatnonzero(points))
+        e, m = np.concatenate([e, new_rows[new_e]]), np.concatenate([m, new_m])
+        by_edge = np.argsort(e, kind="stable")
+        e, m = e[by_edge], m[by_edge]
+    return e, m, _Pairs(gap, key, points, key[e], m)
+
+
 def _split(v: np.ndarray, f: np.ndarray, slack: np.ndarray, gap: float, chain: _Chain, region: np.ndarray | None,
-           on_edge_only: bool) -> tuple[np.ndarray, np.ndarray, int, _Chain]:
-    """:func:`_split_t_junctions` on the frontier whose boundary is ``chain``; also returns the chain after it."""
+           on_edge_only: bool, known: _Pairs | None = None
+           ) -> tuple[np.ndarray, np.ndarray, int, _Chain, _Pairs | None]:
+    """:func:`_split_t_junctions` on the frontier whose boundary is ``chain``; also returns the chain after it and
+    the candidate pairs to hand to the next pass (``known``: those of the pass before, :class:`_Pairs`)."""
     if not len(chain.key):
-        return f, slack, 0, chain
+        return f, slack, 0, chain, known
     edges = _chain_edges(chain, len(v))
     edges = _unique_rows(edges, len(v))
-    a, b = v[edges[:, 0]], v[edges[:, 1]]
+    e, m, known = _candidates(v, edges, 0.0 if on_edge_only else gap, known)
+    if not len(e):
+        return f, slack, 0, chain, known
+    # the candidates' edges only (each row as numpy forms it for all edges: the same values)
+    a = v[edges[e, 0]]
+    b = v[edges[e, 1]]
     ab = b - a
     length = np.linalg.norm(ab, axis=1)
-    e, m = _edge_point_candidates(v, edges, 0.0 if on_edge_only else gap)
-    if not len(e):
-        return f, slack, 0, chain
-    t = np.einsum("ij,ij->i", v[m] - a[e], ab[e]) / np.maximum(length[e] ** 2, np.finfo(float).tiny)
-    foot = a[e] + t[:, None] * ab[e]
+    t = np.einsum("ij,ij->i", v[m] - a, ab) / np.maximum(length ** 2, np.finfo(float).tiny)
+    foot = a + t[:, None] * ab
     dist = np.linalg.norm(v[m] - foot, axis=1)
-    to_end = np.minimum(np.linalg.norm(v[m] - a[e], axis=1), np.linalg.norm(v[m] - b[e], axis=1))
+    to_end = np.minimum(np.linalg.norm(v[m] - a, axis=1), np.linalg.norm(v[m] - b, axis=1))
     # a vertex within the gap of an end is a crack lip to weld, unless it lies on the edge itself (to
     # round-off: a T-junction on a short edge, which welding would move by up to the gap)
     on_edge = dist <= ON_EDGE_RTOL * to_end
     ok = (dist <= gap) & (t > 0) & (t < 1) & (to_end > 0) & (on_edge if on_edge_only else (to_end > gap) | on_edge)
     e, m, t, dist = e[ok], m[ok], t[ok], dist[ok]
     if not len(e):
-        return f, slack, 0, chain
+        return f, slack, 0, chain, known
     # each vertex onto its nearest edge only (a thin part can hold other boundary edges within the gap)
     nearest = np.lexsort((dist, m))
     first = nearest[np.r_[True, m[nearest][1:] != m[nearest][:-1]]]
     e, m, t, dist = e[first], m[first], t[first], dist[first]
     # the face holding each directed edge a→b, and which of its edges it is
-    undirected, forward = edge_keys(f, len(v))            # edge slot j of face i: f[i, j] → f[i, j+1]
-    key = 2 * undirected + forward
     start, end = edges[e, 0].astype(np.int64), edges[e, 1].astype(np.int64)
     want = 2 * edge_keys(np.stack([start, end, end], axis=1), len(v))[0][0::3] + (start > end)
-    # the lowest slot holding each wanted key: only the slots holding one are sorted (not the whole frontier's)
+    # the lowest slot holding each wanted key: only the slots holding one are sorted (not the whole frontier's),
+    # and only the slots whose two ends are ends of a wanted edge are keyed (soup19: every slot of the frontier
+    # was keyed and looked up, each pass)
+    ends = np.zeros(len(v), dtype=bool)
+    ends[start] = True
+    ends[end] = True
+    at_ends = ends[f]
+    # slot 3i + j: f[i, j] → f[i, j+1]
+    slots = np.flatnonzero((at_ends & np.roll(at_ends, -1, axis=1)).reshape(-1))
+    undirected, forward = edge_keys(f[slots // 3], len(v))
+    pick = np.arange(len(slots)) * 3 + slots % 3
+    key = 2 * undirected[pick] + forward[pick]
     targets = np.unique(want)
     at = np.minimum(np.searchsorted(targets, key), len(targets) - 1)
     hit = np.flatnonzero(targets[at] == key)
-    order = hit[np.argsort(key[hit], kind="stable")]
-    pos = np.searchsorted(key[order], want)
-    found = (pos < len(order)) & (key[order][np.minimum(pos, len(order) - 1)] == want)
+    by_key = hit[np.argsort(key[hit], kind="stable")]
+    order = slots[by_key]                   # the slots holding a wanted key, by key (by slot within a key)
+    held = key[by_key]                      # their keys, ascending
+    pos = np.searchsorted(held, want)
+    found = (pos < len(order)) & (held[np.minimum(pos, len(order) - 1)] == want)
     e, m, t, dist, pos = e[found], m[found], t[found], dist[found], pos[found]
     slot = order[pos]
     face, corner = slot // 3, slot % 3
@@ -324,7 +402,7 @@ def _split(v: np.ndarray, f: np.ndarray, slack: np.ndarray, gap: float, chain: _
     sel = slot == first_slot[face]
     face, corner, m, t, dist = face[sel], corner[sel], m[sel], t[sel], dist[sel]
     if not len(face):
-        return f, slack, 0, chain
+        return f, slack, 0, chain, known
     # each (face, vertex) once, in (face, vertex) order (as numpy.unique of the rows, by one int64 key)
     _, unique_m = np.unique(face.astype(np.int64) * np.int64(max(len(v), 1)) + m, return_index=True)
     face, corner, m, t, dist = face[unique_m], corner[unique_m], m[unique_m], t[unique_m], dist[unique_m]
@@ -350,7 +428,8 @@ def _split(v: np.ndarray, f: np.ndarray, slack: np.ndarray, gap: float, chain: _
     keep_face = np.ones(len(f), dtype=bool)
     keep_face[split_faces] = False
     chain = _chain_update(chain, f[split_faces], fan, len(v), region)
-    return np.vstack([f[keep_face], fan]), np.concatenate([slack[keep_face], fan_slack]), int(len(m)), chain
+    return (np.vstack([f[keep_face], fan]), np.concatenate([slack[keep_face], fan_slack]), int(len(m)), chain,
+            known)
 
 
 def on_edge_vertices(vertices: np.ndarray, boundary: np.ndarray) -> np.ndarray:
@@ -422,17 +501,20 @@ def _bounds_of(lib: Any, v: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, 
     return lo, hi, finite
 
 
-def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tuple[np.ndarray, np.ndarray]:
+def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float, *, points: np.ndarray | None = None
+                           ) -> tuple[np.ndarray, np.ndarray]:
     """(edge row, vertex) pairs, by edge, of the edges' own vertices ``m`` (not an end of the edge) that may lie
     within ``gap`` of the edge's interior or on it to ``ON_EDGE_RTOL``: a superset of the pairs the callers'
-    tests accept, which they then apply.
+    tests accept, which they then apply.  ``points`` (sorted, each once), optional: the vertices ``m`` to try
+    instead of the edges' own.
 
     The C kernel (``_accel.edge_point_candidates``, section 9) visits a grid of cells along each edge and keeps
     the pairs within the distance to round-off; without it, a k-d tree lists the vertices in the ball on each
     edge widened by ``gap`` (every pair the tests accept lies in it).  Before the kernel, a soup (every vertex on
     the boundary) spent seconds in the k-d tree's Python lists: ~9 vertices per edge.
     """
-    bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v)))
+    bv = np.flatnonzero(np.bincount(edges.reshape(-1), minlength=len(v))) if points is None else \
+        np.asarray(points, dtype=np.int64)
     lib = accel()
     cell = np.inf
     finite = False
@@ -456,10 +538,10 @@ def _edge_point_candidates(v: np.ndarray, edges: np.ndarray, gap: float) -> tupl
         return np.frombuffer(pe, dtype=np.int64), np.frombuffer(pm, dtype=np.int64)
     from scipy.spatial import cKDTree
 
-    points = v[bv]
+    tried = v[bv]
     a, b = v[edges[:, 0]], v[edges[:, 1]]
     length = np.linalg.norm(b - a, axis=1)
-    near = cKDTree(points, balanced_tree=False, compact_nodes=False).query_ball_point(
+    near = cKDTree(tried, balanced_tree=False, compact_nodes=False).query_ball_point(
         0.5 * (a + b), 0.5 * length * (1 + 1e-9) + gap)
     counts = np.fromiter((len(x) for x in near), dtype=np.int64, count=len(near))
     if not counts.sum():
@@ -512,8 +594,9 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
         # first the T-junctions exactly on their edges (exact splits, nothing moves), until none is left: a
         # vertex that only comes near an edge (a sliver's apex) is not put on it while the exact ones still
         # leave that edge open
+        known: _Pairs | None = None        # the candidate pairs of the passes so far (searched once each)
         for _ in range(3 * MAX_SEAL_ROUNDS):
-            front, slack, more, chain = _split(v, front, slack, gap, chain, region, True)
+            front, slack, more, chain, known = _split(v, front, slack, gap, chain, region, True, known)
             split += more
             if not more:
                 break
@@ -521,7 +604,7 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
             front, slack, lost, merged, chain = _weld(v, front, slack, vertex_slack, gap, chain, region)
             inserted = 0
             for _ in range(3):          # a face splits one edge per pass and has three
-                front, slack, more, chain = _split(v, front, slack, gap, chain, region, False)
+                front, slack, more, chain, known = _split(v, front, slack, gap, chain, region, False, known)
                 inserted += more
                 if not more:
                     break
@@ -545,5 +628,5 @@ def seal_seams(vertices: np.ndarray, faces: np.ndarray, gap: float, *, drop_dupl
         boundary = _frontier_boundary(front, n, region)
     else:
         boundary = _chain_edges(chain, n) if (welded or split) else edges
-    return Seal(out, all_slack, dropped, welded, split, boundary, _loose_faces(front, n, region), duplicates,
-                len(rest))
+    return Seal(out, all_slack, dropped, welded, split, boundary, _loose_faces(front, n, region, boundary),
+                duplicates, len(rest))
