@@ -1331,12 +1331,16 @@ class NearCopies:
         Largest distance between corresponding corners of a copy and the surface kept, m.
     volume_bound : float
         Bound on the volume in which the copies differ from the surfaces kept, m³ (Steiner).
+    times : (s,) int or None
+        For each shell, how many copies of it were left out (R0 counts it that many times more in the winding
+        number, as an exact repeat; review19); None when none was.
     """
 
     drop: np.ndarray
     copies: int
     distance: float
     volume_bound: float
+    times: np.ndarray | None = None
 
 
 #: Pairs of candidate shells compared corner for corner (R0 up to rounding), at most.
@@ -1418,6 +1422,7 @@ def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, she
         return none
     first, second = copy_candidates(shells, labels)
     gone = np.zeros(n, dtype=bool)
+    times = np.zeros(n, dtype=np.int64)
     copies, distance, volume_bound = 0, 0.0, 0.0
     for a, b in zip(first[:MAX_NEAR_COPY_PAIRS].tolist(), second[:MAX_NEAR_COPY_PAIRS].tolist()):
         if gone[a] or gone[b]:
@@ -1453,9 +1458,11 @@ def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, she
             continue
         gone[b] = True
         drop |= labels == b
+        times[a] += 1
         copies += 1
         distance, volume_bound = max(distance, delta), volume_bound + bound
-    return NearCopies(drop=drop, copies=copies, distance=distance, volume_bound=volume_bound)
+    return NearCopies(drop=drop, copies=copies, distance=distance, volume_bound=volume_bound,
+                      times=times if copies else None)
 
 
 def near_copies_message(found: NearCopies) -> str:
