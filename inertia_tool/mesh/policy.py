@@ -32,7 +32,9 @@ R0 *A shell listed k times counts k times in the winding number* (:func:`~.multi
    the winding number is what the issue defines the solid by, and counting the copy keeps it where it decides.
    *Up to rounding* (:func:`near_copies`): a closed surface whose every corner lies within
    ``tolerances.COINCIDENT_RTOL`` of the largest |coordinate| of a corner of another, face for face with the same
-   winding (a copy whose coordinates were computed apart), is counted once too, when the bound on what it could
+   winding (a copy whose coordinates were computed apart), is left out as an exact copy is, and counted in the
+   winding as the repeat it stands for (review19: counted once, a cavity listed twice rounded apart inside a body
+   listed twice bit for bit was read as material, 2 − 1), when the bound on what it could
    add is within ``tolerances.ROUNDOFF_RTOL`` of the result (what "exact" means, R7): the copy differs from the
    surface kept only inside the δ-neighbourhood of that surface (δ the largest distance between corresponding
    corners: moving every corner by at most δ moves every point of every face by at most δ, so a point enclosed by
