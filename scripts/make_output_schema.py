@@ -312,7 +312,8 @@ defs["spin-it"] = command("spin-it", {
         "the design compared with its input (design/verify.py): every attempt, the last one accepted")},
     ["mode", "axis", "origin_m", "wall_m", "before", "after", "method", "uncertainty"],
     "inertia-tool spin-it --json: the hollowed design, before and after (after = exact re-analysis of the "
-    "hollowed mesh; method/uncertainty are the hollowed part's).")
+    "hollowed mesh; method/uncertainty are the hollowed part's: a repaired part's estimate and bounds, carried "
+    "over, where the input was repaired).")
 
 ROW_NUMBERS = {"density": "kg/m^3", "mass": "kg", "volume": "m^3", "surface_area": "m^2",
                **{f"com_{c}": "m, mesh axes" for c in "xyz"},

@@ -475,6 +475,10 @@ class BalanceReport:
         ``achieved_value`` of the drilled body, mm/s (``nan`` without drilling).
     drilled_grade : BalanceGrade or None
         Standard grade the drilled body meets.
+    residual_bound : float or None
+        For a part whose mass properties are an estimate (a repaired surface): the bound on the true static
+        unbalance's distance from the one reported, before and after the correction, kg·m
+        (:func:`_estimate_note`); None for a part proven exact.
     """
 
     name: str
@@ -499,6 +503,7 @@ class BalanceReport:
     drilled: UnbalanceState | None = None
     drilled_value: float = float("nan")
     drilled_grade: BalanceGrade | None = None
+    residual_bound: float | None = None
 
     @property
     def mass(self) -> float:
@@ -647,6 +652,33 @@ def _correction_notes(props: MassProperties, frame, radius: float, planes, corre
     return notes
 
 
+def _estimate_note(props: MassProperties, state: UnbalanceState, omega: float) -> tuple[float | None, str | None]:
+    """``(bound kg·m, note)`` for a part whose mass properties are an estimate (review19: a repaired part was
+    "balanced, meets G 0.4" with its centre of mass known to 0.36 mm only); ``(None, None)`` when proven.
+
+    The true part's first moment about the shaft differs from the reported one by at most
+    ``M (1 + δm) δc + δm M e``: the first term the centre's shift (``|c_T − c_P| ≤ δc``, the true mass at most
+    ``M (1 + δm)``), the second the mass's error at the reported offset ``e``.  Point masses added by the
+    correction are exact, so the same bound holds after it.  An assembly's centre-of-mass bounds are per part
+    (``reports.serialize.method_and_uncertainty``): said, not bounded."""
+    mesh = props.mesh
+    bounds = getattr(mesh, "uncertainty", None) if mesh is not None else None
+    if bounds is None:
+        if any(getattr(getattr(p, "mesh", None), "uncertainty", None) is not None for p in props.parts):
+            return None, ("some parts are estimates (repaired surfaces): the unbalance before and after the "
+                          "correction is not proven, and not bounded here (the parts' own bounds are in the "
+                          "analysis of each part)")
+        return None, None
+    dm, dc = float(bounds.mass), float(bounds.center_of_mass)
+    bound = props.mass * ((1.0 + dm) * dc + dm * float(state.offset))
+    speed = bound / props.mass * omega * 1e3
+    return bound, (f"the part is an estimate (its surface repaired): its centre of mass is known to within "
+                   f"{dc:.3g} m and its mass to ±{100 * dm:.3g} %, so the true static unbalance lies within "
+                   f"{bound:.3g} kg·m ({bound * 1e6:.3g} g·mm; e·Ω {speed:.3g} mm/s) of the one given, before and "
+                   "after the correction: the verification holds for the repaired surface; the couple unbalance "
+                   f"is uncertain as the inertia (±{100 * float(bounds.inertia):.3g} % of its norm)")
+
+
 def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | None = None,
             speed: float | None = None, planes=None, radius: float, grade=None, bearings=None,
             single_plane: bool = False, max_axis_offset: float = 10.0, offset_tol: float | None = None,
@@ -771,6 +803,9 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
                                       removal_position=_readonly(rpos)))
 
     notes += _correction_notes(props, frame, r, planes_t, corrections)
+    residual_bound, estimate_note = _estimate_note(props, state, omega)
+    if estimate_note is not None:
+        notes.append(estimate_note)
     corrected_body = combine([props] + [point_mass(c.mass, c.position, name="correction") for c in corrections],
                              name=props.name)
     corrected = unbalance_state(corrected_body, frame, offset_tol=offset_tol, tilt_tol=tilt_tol)
@@ -799,7 +834,7 @@ def balance(props: MassProperties, *, axis_point, axis_direction, rpm: float | N
                            achieved_grade=achieved, correction_planes=correction_planes,
                            corrections=tuple(corrections), single_plane=single_plane, corrected=corrected,
                            corrected_value=corrected_value, corrected_grade=corrected_grade, notes=tuple(notes),
-                           **drilling)
+                           residual_bound=residual_bound, **drilling)
     for what, value in (("rotating force", report.force), ("torque of the supports", report.torque),
                         ("correction masses", [c.mass for c in corrections]),
                         ("plane loads", [p.force for p in tolerance] or 0.0)):

@@ -53,7 +53,7 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     from ..reports.serialize import command_output, mass_properties_dict, to_jsonable
-    from ..reports.stability import format_stability, stability_dict
+    from ..reports.stability import format_stability, principal_moment_bound, stability_dict
     from ..reports.text import format_mass_properties
     from ..reports.cad import format_cad_report
     from ..reports.models import format_model_note
@@ -132,7 +132,8 @@ def run(args) -> int:
         if cad is not None:
             from ..reports.brep import format_brep_comparison
             print(format_brep_comparison(cad, props.density))
-        print("\n".join(format_stability(stab)) if stab is not None else f"  spin stability: {stab_error}")
+        print("\n".join(format_stability(stab, moment_bound=principal_moment_bound(props))) if stab is not None
+              else f"  spin stability: {stab_error}")
         if system is not None:
             print(format_frame_inertia(system))
         note = format_model_note(model)

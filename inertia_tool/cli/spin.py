@@ -114,7 +114,7 @@ def run(args) -> int:
     from ..dynamics.experiment import spin_experiment
     from ..output import check_targets
     from ..reports.serialize import command_output, method_and_uncertainty
-    from ..reports.stability import format_spin, format_stability, spin_dict, stability_dict
+    from ..reports.stability import format_spin, format_stability, principal_moment_bound, spin_dict, stability_dict
 
     require_range(args.perturbation, "--perturbation", low=0, high=1, low_open=True, high_open=True)
     require_range(args.rtol, "--rtol", low=0, high=1, high_open=True)
@@ -146,7 +146,8 @@ def run(args) -> int:
     else:
         print(with_warnings(f"{props.name}: mass {props.mass:.6g} kg ({described}{model_words(loaded.model)})",
                             loaded.warnings, loaded.notes()))
-        print("\n".join(format_stability(experiment.report, perturbation=args.perturbation)))
+        print("\n".join(format_stability(experiment.report, perturbation=args.perturbation,
+                                          moment_bound=principal_moment_bound(props))))
         print(format_spin(experiment, name=props.name))
     shown_with_report(args, loaded.warnings)
     return 0

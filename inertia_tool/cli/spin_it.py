@@ -65,7 +65,8 @@ def register(subparsers) -> None:
                         "after (yo-yo: body angular velocity of a free spin; top: nutation angle θ(t))")
     p.add_argument("--repair", action="store_true",
                    help="accept a mesh with holes or cracks: design on the repaired surface (every 'after' number "
-                        "is still the exact re-analysis of the hollowed mesh)")
+                        "is the exact re-analysis of the hollowed mesh, an estimate of the hollowed part with the "
+                        "repaired part's bounds carried over)")
     add_assume_option(p)
     p.add_argument("--force", action="store_true", help="let --out, --plot and --report replace existing files")
     p.add_argument("--json", action="store_true", help="print one JSON object (SI) instead of text")

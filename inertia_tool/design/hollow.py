@@ -29,6 +29,7 @@ import numpy as np
 
 from ..errors import AsymmetricTopWarning, NoRoomError, PhysicsError, PivotOffPartWarning, UsageError
 from ..tolerances import EQUAL_MOMENTS_RTOL, PIVOT_GAP_RTOL
+from .carried import carry_repair_bounds
 from .cavity_mesh import DEPTH_MARGIN, cut_pocket  # noqa: F401  (DEPTH_MARGIN: used by the benchmark too)
 from .grid import SurfaceTree, interior_grid, surface_distance
 from .limits import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION
@@ -438,7 +439,8 @@ def spin_it(source, *, axis, mode: str = "yoyo", wall: float, through=None, pivo
         ``design.insert``); it must exceed the part's density.
     repair : bool
         Read a damaged mesh (holes, cracks) as ``mass_properties(repair=True)`` does, and design on the
-        repaired surface; every 'after' number is still the exact re-analysis of the hollowed mesh.
+        repaired surface; every 'after' number is the exact re-analysis of the hollowed mesh, and its
+        certificate the repaired part's: an estimate, with the bounds carried over (``design.carried``).
     assume : tuple of str
         The user's assumptions about the holes the repair fills, as ``mass_properties(assume=...)``
         (``("flat-islands",)``); only with ``repair``.  Default ``()``: none.
@@ -569,6 +571,8 @@ def _made(design, vertices, faces, grid, centres, origin, frame, wall: float, tr
     if not pockets:
         return None
     pocket, after = _first_certified(pockets, rho, f"{name} (hollowed)")
+    # exact for the mesh written; for the user's part, as much an estimate as the repaired part it was cut from
+    after = carry_repair_bounds(before, after)
     insert_props = None
     if pocket.insert_vertices is not None:
         assert insert_density is not None, "an insert is made only when its density is given"

@@ -32,7 +32,9 @@ R0 *A shell listed k times counts k times in the winding number* (:func:`~.multi
    the winding number is what the issue defines the solid by, and counting the copy keeps it where it decides.
    *Up to rounding* (:func:`near_copies`): a closed surface whose every corner lies within
    ``tolerances.COINCIDENT_RTOL`` of the largest |coordinate| of a corner of another, face for face with the same
-   winding (a copy whose coordinates were computed apart), is counted once too, when the bound on what it could
+   winding (a copy whose coordinates were computed apart), is left out as an exact copy is, and counted in the
+   winding as the repeat it stands for (review19: counted once, a cavity listed twice rounded apart inside a body
+   listed twice bit for bit was read as material, 2 − 1), when the bound on what it could
    add is within ``tolerances.ROUNDOFF_RTOL`` of the result (what "exact" means, R7): the copy differs from the
    surface kept only inside the δ-neighbourhood of that surface (δ the largest distance between corresponding
    corners: moving every corner by at most δ moves every point of every face by at most δ, so a point enclosed by
@@ -1362,12 +1364,16 @@ class NearCopies:
         Largest distance between corresponding corners of a copy and the surface kept, m.
     volume_bound : float
         Bound on the volume in which the copies differ from the surfaces kept, m³ (Steiner).
+    times : (s,) int or None
+        For each shell, how many copies of it were left out (R0 counts it that many times more in the winding
+        number, as an exact repeat; review19); None when none was.
     """
 
     drop: np.ndarray
     copies: int
     distance: float
     volume_bound: float
+    times: np.ndarray | None = None
 
 
 #: Pairs of candidate shells compared corner for corner (R0 up to rounding), at most.
@@ -1449,6 +1455,7 @@ def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, she
         return none
     first, second = copy_candidates(shells, labels)
     gone = np.zeros(n, dtype=bool)
+    times = np.zeros(n, dtype=np.int64)
     copies, distance, volume_bound = 0, 0.0, 0.0
     for a, b in zip(first[:MAX_NEAR_COPY_PAIRS].tolist(), second[:MAX_NEAR_COPY_PAIRS].tolist()):
         if gone[a] or gone[b]:
@@ -1484,9 +1491,11 @@ def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, she
             continue
         gone[b] = True
         drop |= labels == b
+        times[a] += 1
         copies += 1
         distance, volume_bound = max(distance, delta), volume_bound + bound
-    return NearCopies(drop=drop, copies=copies, distance=distance, volume_bound=volume_bound)
+    return NearCopies(drop=drop, copies=copies, distance=distance, volume_bound=volume_bound,
+                      times=times if copies else None)
 
 
 def near_copies_message(found: NearCopies) -> str:

@@ -213,7 +213,11 @@ def _verification_text(report: BalanceReport) -> str:
                  if bearings else "")
         return (f"{head}, couple not corrected (a single-plane correction removes the static unbalance only; "
                 f"two correction planes correct both){where}")
-    return f"{head}, meets {_grade_name(report.corrected_grade, report.corrected_value)}"
+    said = f"{head}, meets {_grade_name(report.corrected_grade, report.corrected_value)}"
+    if report.residual_bound is not None:      # an estimated part: the verification is the repaired surface's
+        said += (f" — for the repaired surface; the part's own static unbalance is uncertain by "
+                 f"{_num(report.residual_bound * _G_MM)} g·mm (see the notes)")
+    return said
 
 
 def _header(report: BalanceReport) -> list[tuple[str, str]]:

@@ -82,29 +82,43 @@ def spin_it_dict(result, *, output: str | None = None) -> dict:
 
 def _verified(after) -> str:
     """How the result after hollowing was checked: an exact re-analysis, unless its certificate says less."""
-    mesh = getattr(after, "mesh", None)
-    cert = getattr(mesh, "certificate", None)
-    if mesh is None or cert is None or cert.proven:
+    cert = _certificate_of(after)
+    if cert is None or cert.proven:
         return "after = exact re-analysis of the hollowed mesh"
+    mesh = getattr(after, "mesh", None) or next(p.mesh for p in after.parts if _certificate_of(p) is cert)
     return f"after = re-analysis of the hollowed mesh, certificate {cert.kind}: {'; '.join(mesh.notes)}"
 
 
 def _certificate_of(props):
-    """The :class:`~inertia_tool.mesh.policy.Certificate` of a result's mesh report; None without one."""
-    return getattr(getattr(props, "mesh", None), "certificate", None)
+    """The :class:`~inertia_tool.mesh.policy.Certificate` of a result's mesh report; for a combination (the
+    hollowed part with its insert) the first part's that is not proven; None without one."""
+    cert = getattr(getattr(props, "mesh", None), "certificate", None)
+    if cert is None:
+        for part in getattr(props, "parts", ()):
+            said = _certificate_of(part)
+            if said is not None and not said.proven:
+                return said
+    return cert
 
 
 def _certificates_text(result) -> str:
-    """``"certificate: before estimate, assuming flat-islands (mass ±…); after exact (the re-analysis of the
-    hollowed mesh)"``: how far the part's numbers before and after can be trusted (:meth:`Certificate.brief`: the
-    kind and the user's assumptions taken), for the text report."""
+    """``"certificate: before estimate, assuming flat-islands (mass ±…); after estimate, assuming flat-islands
+    (mass ±…) (the re-analysis of the hollowed mesh)"``: how far the part's numbers before and after can be
+    trusted (:meth:`Certificate.brief`: the kind and the user's assumptions taken), for the text report."""
     before, after = _certificate_of(result.before), _certificate_of(result.after)
-    said_before = "not stated" if before is None else before.brief()
-    bounds = getattr(getattr(result.before, "mesh", None), "uncertainty", None)
-    if before is not None and not before.proven and bounds is not None:
-        said_before += f" (mass ±{bounds.mass * 100:.3g} %)"
-    said_after = "exact" if after is None else after.brief()
+    said_before = "not stated" if before is None else before.brief() + _mass_bound(result.before)
+    said_after = "exact" if after is None else after.brief() + _mass_bound(result.after)
     return f"certificate: before {said_before}; after {said_after} (the re-analysis of the hollowed mesh)"
+
+
+def _mass_bound(props) -> str:
+    """``" (mass ±4.2 %)"`` for an estimate with bounds (a repaired part, and the part hollowed from it); ``""``."""
+    from .serialize import method_and_uncertainty
+
+    cert = _certificate_of(props)
+    bounds = method_and_uncertainty(props)[1] if cert is not None and not cert.proven else None
+    mass = bounds.get("mass") if isinstance(bounds, dict) else getattr(bounds, "mass", None)
+    return "" if mass is None else f" (mass ±{mass * 100:.3g} %)"
 
 
 def _mm(x) -> str:

@@ -69,8 +69,42 @@ def stability_dict(report: StabilityReport, *, perturbation: float = DEFAULT_REP
     return to_jsonable(out)
 
 
-def format_stability(report: StabilityReport, *, perturbation: float = DEFAULT_REPORT_PERTURBATION) -> list[str]:
-    """Lines of the "spin stability" section (§4.4.1)."""
+def principal_moment_bound(props) -> float | None:
+    """kg·m²: how far each principal moment of an estimated part (a repaired surface) may lie from the true one, or
+    None for a part proven exact; ``inf`` for an assembly with estimated parts (whose inertia bounds are per part).
+
+    The estimate's bound is relative to ``‖I‖_F`` about the centre of mass; by Weyl's inequality each eigenvalue of
+    a symmetric matrix moves by at most the perturbation's spectral norm, which is at most its Frobenius norm."""
+    mesh = getattr(props, "mesh", None)
+    if mesh is None:
+        parts = getattr(props, "parts", ())
+        estimated = any(getattr(getattr(p, "mesh", None), "uncertainty", None) is not None for p in parts)
+        return float("inf") if estimated else None
+    bounds = getattr(mesh, "uncertainty", None)
+    if bounds is None:
+        return None
+    return float(bounds.inertia) * float(np.linalg.norm(props.inertia))
+
+
+def _estimate_line(report: StabilityReport, moment_bound: float) -> str:
+    """The caveat of an estimated part's classification (review19): which moments its bound leaves in doubt."""
+    if not np.isfinite(moment_bound):
+        return ("    the part is an estimate with bounds per part only: the moments' order and the classes are not "
+                "proven")
+    close = [(a, b) for a, b in zip(report.axes, report.axes[1:]) if b.moment - a.moment <= 2 * moment_bound]
+    said = (f"    the part is an estimate: each moment within ±{moment_bound:.3e} kg·m² of the true one (the repaired "
+            "part's inertia bound, Weyl's inequality)")
+    if not close:
+        return said + "; the moments are further apart than twice that, so their order and the classes hold"
+    pairs = ", ".join(f"I{a.index + 1} and I{b.index + 1}" for a, b in close)
+    return (said + f"; {pairs} lie within twice that of each other, so which axis is which there, their classes "
+            "and the periods are not certain")
+
+
+def format_stability(report: StabilityReport, *, perturbation: float = DEFAULT_REPORT_PERTURBATION,
+                     moment_bound: float | None = None) -> list[str]:
+    """Lines of the "spin stability" section (§4.4.1); ``moment_bound`` (kg·m², :func:`principal_moment_bound`)
+    adds the caveat of an estimated part."""
     tolerance = getattr(report, "moment_tolerance", None)
     lines = ["  spin stability about the principal axes (§4.4.1; ε̈ = c ω² ε; "
              f"equal moments within {report.rtol:g}"
@@ -95,6 +129,8 @@ def format_stability(report: StabilityReport, *, perturbation: float = DEFAULT_R
     stable = [e for e in report.axes if e.dissipation_stable]
     names = " or ".join(f"I{e.index + 1} ({e.name})" for e in stable)
     lines.append(f"    with energy loss (flexing, fluid): only spin about {names} lasts (major-axis rule)")
+    if moment_bound is not None:
+        lines.append(_estimate_line(report, moment_bound))
     return lines
 
 
