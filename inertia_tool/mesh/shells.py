@@ -19,8 +19,8 @@ from ..tolerances import FLAT_RTOL
 from .checks import shell_labels
 from .multiplicity import coincident_surfaces, face_keys, shell_multiplicity
 from .nonmanifold import welded_bodies
-from .policy import (coincident_message, copy_candidates, near_copies, near_copies_message, negligible_flat,
-                     part_size)
+from .policy import (NearCopies, coincident_message, copy_candidates, near_copies, near_copies_message,
+                     negligible_flat, part_size)
 
 __all__ = ["Shells", "FoundShells", "find_shells", "bodies", "measured", "reshelled", "drop_flat", "flat_pieces",
            "apply_flips", "leave_out_coincident", "total", "counted"]
@@ -124,7 +124,7 @@ def find_shells(vertices: np.ndarray, faces: np.ndarray, *, split_welded: bool, 
     return FoundShells(shells, tuple(notes), dropped, repeated)
 
 
-def _with_near_copies(v: np.ndarray, f: np.ndarray, labels: np.ndarray, near,
+def _with_near_copies(v: np.ndarray, f: np.ndarray, labels: np.ndarray, near: NearCopies,
                       repeated: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray] | None:
     """R0's record of repeats (:func:`leave_out_coincident`'s third item) with the copies up to rounding added: a
     shell whose ``j`` copies rounded apart were left out counts ``j`` times more, as ``j`` exact repeats would (its
