@@ -43,11 +43,13 @@ from .hole_bounds import FLAT_RIM_RTOL, _round_off, normals_surround_origin
 from .hole_fills import PLANE_FILL_LEVELS, CurvedFill, PlaneFill, _sector_grid
 from .hole_graphs import _walk
 
-__all__ = ["WrappedRegion", "wrapped_doubt", "wrapped_reading", "wrapped_fill", "WRAP_DECLINED", "in_wrapped", "fill_excess", "WRAP_MAX_PLANES", "WRAP_MAX_RIM"]
+__all__ = ["WrappedRegion", "wrapped_doubt", "wrapped_reading", "wrapped_fill", "WRAP_DECLINED", "in_wrapped",
+           "fill_excess", "WRAP_MAX_PLANES", "WRAP_MAX_RIM"]
 
-#: Most distinct ring planes :func:`wrapped_doubt` intersects (more: a tessellated curved surface, whose facets'
-#: planes bound little and cost large hulls).
-WRAP_MAX_PLANES = 64
+#: Most distinct ring planes :func:`wrapped_doubt` intersects (a cost limit: each rim corner's piece is a hull of that
+#: many half-spaces).  64 until cover19: a cone whose apex is a rim corner has every side facet in its ring
+#: (``meshes/cone.stl``, 65–130 planes), and under the user's ``faceted-holes`` those planes close the hole.
+WRAP_MAX_PLANES = 256
 #: Most rim corners of a hole :func:`wrapped_doubt` bounds (one small polytope per corner).
 WRAP_MAX_RIM = 512
 #: The viewpoints ``o = a − t d`` tried, ``t`` in units of the rim's ball radius.
