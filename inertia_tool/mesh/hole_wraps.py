@@ -27,6 +27,9 @@ planes close ``R``: a ring of walls alone leaves it open).  ``o`` is tried at ``
 4 times the rim's ball radius, ``w`` the direction every fan triangle faces away from most (a small LP; ``−d``,
 ``d`` the cone's vector area, where every fan triangle faces ``d``); where none qualifies the reading is not made.
 
+**The fill** (:func:`wrapped_fill`): the cone's fan pushed along the rays from ``o`` out to ``∂K``, ``R``'s far
+side (the planes continued, one plane per point); it lies in ``R``, so the bound stands.
+
 **The file's evidence against it** (the reading withdrawn, the hole keeps its other bound): a vertex of the file,
 other than the rim's, in ``R`` farther than ``τ`` beyond the cone (on ``∂K`` too: the file's own surface lies
 where the assumption puts only the lost one), surroundings that are not convex, a pinched rim, a rim or fan that
