@@ -489,18 +489,18 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                     # region bounds "cone − missing surface", the excess "fill − cone"), while that stays under the
                     # doubt it had before; else its quadric fill is dropped for the planes' fill or the cone
                     kept_curved: list[CurvedFill] = []
-                    for fill in curved:
-                        k = fill.loop
+                    for quad in curved:
+                        k = quad.loop
                         if took_faceted[k]:
-                            extra, extra_reach = fill_excess(v, fill, apex[k])
+                            extra, extra_reach = fill_excess(v, quad, apex[k])
                             if not hole_doubt[k] + extra < unfaceted[k]:
                                 continue
                             hole_doubt[k] = round_up(float(hole_doubt[k]) + extra)
                             faceted_reach[k] = max(float(faceted_reach[k]), extra_reach)
-                        kept_curved.append(fill)
+                        kept_curved.append(quad)
                     curved = kept_curved
-                    on_quadric = np.zeros(n_loops, dtype=bool)
-                    on_quadric[[fill.loop for fill in curved]] = True
+                    kept_quadric = np.zeros(n_loops, dtype=bool)
+                    kept_quadric[[quad.loop for quad in curved]] = True
                     graphs = [fill for fill in graphs if not took_faceted[fill.loop]]
                     smooths = [fill for fill in smooths if not took_faceted[fill.loop]]
                     planes = [fill for fill in planes if not took_faceted[fill.loop]]
@@ -510,7 +510,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                     # graph over one direction cannot go on across the edge the hole reaches round
                     radial: list[PlaneFill] = []
                     for k in sorted(wrapped):
-                        ray_fill = None if on_quadric[k] else wrapped_fill(v, wrapped[k], edges[label == k], k)
+                        ray_fill = None if kept_quadric[k] else wrapped_fill(v, wrapped[k], edges[label == k], k)
                         if ray_fill is not None and in_wrapped(wrapped[k], np.vstack([ray_fill.apex[None, :],
                                                                                       ray_fill.points])):
                             radial.append(ray_fill)
@@ -520,7 +520,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                     # default's cap keeps tessellated curved surfaces on their cone or quadric, where the facets'
                     # planes overshoot; here the user stated the surface faceted, the fill lies in the region the
                     # reading bounds (on S's far side) or adds its excess, and a quadric fill found stays above)
-                    facets = plane_fills(v, f, edges, label, np.flatnonzero(took_faceted & ~on_quadric & ~by_ray),
+                    facets = plane_fills(v, f, edges, label, np.flatnonzero(took_faceted & ~kept_quadric & ~by_ray),
                                          apex, radius, _anywhere, outward=sign, max_loops=n_loops,
                                          max_planes=WRAP_MAX_PLANES)
                     # a hole bounded by its planes' polytope beyond the cone keeps a plane fill outside that region
