@@ -623,6 +623,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             detail += (f"; {len(curved)} of them filled instead on the quadric their surroundings lie on (the cone's "
                        f"fan bent onto it, {len(pv) - len(v) - n_loops - 2 * len(creases):,} points added), with "
                        "the same bound")
+            on_faceted = sum(1 for quad in curved if took_faceted[quad.loop])
+            if on_faceted:
+                detail += (f" ({on_faceted} of them bounded by the faceted-holes reading below, with the volume "
+                           "between the fill and the cone added)")
         if took_island.any() and not convex:
             widest = round_up(float(island_width[took_island].max()))
             detail += (f"; {int(np.count_nonzero(took_island))} an island in a flat face (its rim and every face at "
