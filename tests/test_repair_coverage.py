@@ -39,6 +39,12 @@ def test_repair_bounds_hold_on_the_ci_subset():
     assert all(not cov.refusal_cause(r["reason"]).startswith("other") for r in rows if r["status"] == "refused")
     assert {r["kind"] for r in rows} == set(cov.KINDS)
     assert np.isfinite(summary["median_mass_bound"])
+    # both readings of the 95 % target are reported, with the refusals' rate and causes (issue 21 item 3)
+    assert summary["within_share_of_all"] <= summary["within_share_of_answered"]
+    assert sum(summary["refused_by_cause"].values()) == summary["refused"]
+    lines = cov.readings(rows).splitlines()
+    assert "among all cases" in lines[0] and "among answered cases" in lines[1] and "bounds hold" in lines[2]
+    assert f"{summary['within_tolerance']}/{summary['answered']}" in lines[1]
 
 
 def test_patched_surface_whose_union_is_not_verified_is_not_the_union():

@@ -27,6 +27,9 @@ planes close ``R``: a ring of walls alone leaves it open).  ``o`` is tried at ``
 4 times the rim's ball radius, ``w`` the direction every fan triangle faces away from most (a small LP; ``−d``,
 ``d`` the cone's vector area, where every fan triangle faces ``d``); where none qualifies the reading is not made.
 
+**The fill** (:func:`wrapped_fill`): the cone's fan pushed along the rays from ``o`` out to ``∂K``, ``R``'s far
+side (the planes continued, one plane per point); it lies in ``R``, so the bound stands.
+
 **The file's evidence against it** (the reading withdrawn, the hole keeps its other bound): a vertex of the file,
 other than the rim's, in ``R`` farther than ``τ`` beyond the cone (on ``∂K`` too: the file's own surface lies
 where the assumption puts only the lost one), surroundings that are not convex, a pinched rim, a rim or fan that
@@ -40,14 +43,16 @@ import numpy as np
 from ..rounding import round_up
 from ..values import frozen_value
 from .hole_bounds import FLAT_RIM_RTOL, _round_off, normals_surround_origin
-from .hole_fills import PlaneFill
+from .hole_fills import PLANE_FILL_LEVELS, CurvedFill, PlaneFill, _sector_grid
 from .hole_graphs import _walk
 
-__all__ = ["WrappedRegion", "wrapped_doubt", "in_wrapped", "fill_excess", "WRAP_MAX_PLANES", "WRAP_MAX_RIM"]
+__all__ = ["WrappedRegion", "wrapped_doubt", "wrapped_reading", "wrapped_fill", "WRAP_DECLINED", "in_wrapped",
+           "fill_excess", "WRAP_MAX_PLANES", "WRAP_MAX_RIM"]
 
-#: Most distinct ring planes :func:`wrapped_doubt` intersects (more: a tessellated curved surface, whose facets'
-#: planes bound little and cost large hulls).
-WRAP_MAX_PLANES = 64
+#: Most distinct ring planes :func:`wrapped_doubt` intersects (a cost limit: each rim corner's piece is a hull of that
+#: many half-spaces).  64 until cover19: a cone whose apex is a rim corner has every side facet in its ring
+#: (``meshes/cone.stl``, 65–130 planes), and under the user's ``faceted-holes`` those planes close the hole.
+WRAP_MAX_PLANES = 256
 #: Most rim corners of a hole :func:`wrapped_doubt` bounds (one small polytope per corner).
 WRAP_MAX_RIM = 512
 #: The viewpoints ``o = a − t d`` tried, ``t`` in units of the rim's ball radius.
@@ -141,7 +146,30 @@ def wrapped_doubt(vertices: np.ndarray, faces: np.ndarray, rim_edges: np.ndarray
                   outward: float = 1.0, rtol: float = FLAT_RIM_RTOL, max_planes: int = WRAP_MAX_PLANES,
                   max_rim: int = WRAP_MAX_RIM) -> WrappedRegion | None:
     """The region in doubt of one hole reaching round an edge, under ``faceted-holes`` (module docstring), or
-    ``None`` where the reading does not apply or the file contradicts it.
+    ``None`` where the reading does not apply or the file contradicts it (:func:`wrapped_reading` says which).
+    Parameters as :func:`wrapped_reading`."""
+    reading = wrapped_reading(vertices, faces, rim_edges, radius, outward=outward, rtol=rtol, max_planes=max_planes,
+                              max_rim=max_rim)
+    return reading if isinstance(reading, WrappedRegion) else None
+
+
+#: Why :func:`wrapped_reading` does not read a hole, one name per check (in the order they are made).
+WRAP_DECLINED = {
+    "rim": "a pinched rim, several loops, fewer than 3 or more than WRAP_MAX_RIM corners",
+    "planes": "no ring plane, or more than WRAP_MAX_PLANES (a tessellated curved surface)",
+    "not convex": "a rim corner outside a ring plane: the surroundings are not convex",
+    "flat fan": "the cone over the rim has no area, or a fan triangle has none",
+    "no viewpoint": "no point inside K from which the fan is a radial graph turning once round the apex",
+    "open": "the ring planes do not close the region beyond the cone (K open over some fan triangle)",
+    "file inside": "a vertex of the file lies in the region beyond the cone (the file contradicts the reading)",
+}
+
+
+def wrapped_reading(vertices: np.ndarray, faces: np.ndarray, rim_edges: np.ndarray, radius: float, *,
+                    outward: float = 1.0, rtol: float = FLAT_RIM_RTOL, max_planes: int = WRAP_MAX_PLANES,
+                    max_rim: int = WRAP_MAX_RIM) -> WrappedRegion | str:
+    """The region in doubt of one hole reaching round an edge, under ``faceted-holes`` (module docstring), or the
+    key in :data:`WRAP_DECLINED` of the first check that declines the reading.
 
     Parameters
     ----------
@@ -162,15 +190,15 @@ def wrapped_doubt(vertices: np.ndarray, faces: np.ndarray, rim_edges: np.ndarray
     e = np.asarray(rim_edges, dtype=np.int64)
     rim = np.unique(e)
     if len(e) < 3 or len(rim) != len(e) or len(rim) > max_rim or _walk(e) is None:
-        return None                                   # a pinch, several loops, or too long
+        return "rim"                                  # a pinch, several loops, or too long
     on_rim = np.zeros(len(v), dtype=bool)
     on_rim[rim] = True
     unit, offset = _ring_planes(v, f, on_rim, outward, float(radius), rtol)
     if not len(unit) or len(unit) > max_planes:
-        return None
+        return "planes"
     tol = rtol * float(radius) + _round_off(v)
     if float((v[rim] @ unit.T - offset[None, :]).max()) > tol:
-        return None                                   # not convex surroundings: K misses the rim
+        return "not convex"                           # not convex surroundings: K misses the rim
     e0, e1 = v[e[:, 0]], v[e[:, 1]]
     top = v[rim].mean(axis=0)
     fan = outward * 0.5 * np.cross(e0 - e1, top - e1)              # the fan triangles (e1, e0, apex), outward
@@ -178,12 +206,12 @@ def wrapped_doubt(vertices: np.ndarray, faces: np.ndarray, rim_edges: np.ndarray
     size = float(np.linalg.norm(d))
     fan_size = np.linalg.norm(fan, axis=1)
     if not size > 0 or not bool((fan_size > 0).all()):
-        return None
+        return "flat fan"
     d = d / size
     fan_unit = fan / fan_size[:, None]
     view = _viewpoint(top, d, float(radius), unit, offset, tol, fan_unit, e0, e1)
     if view is None:
-        return None
+        return "no viewpoint"
     scale = max(float(np.abs(v[rim]).max()), float(radius), 1e-300)
     total, far = 0.0, []
     for i in range(len(e)):                           # bounded by max_rim
@@ -199,12 +227,12 @@ def wrapped_doubt(vertices: np.ndarray, faces: np.ndarray, rim_edges: np.ndarray
         bounds = np.r_[offset + tol, -(float(fan_unit[i] @ top) - tol), np.array(sides) @ view]
         piece = _polytope(normals, bounds, scale)
         if piece is None:
-            return None                               # R is open there: the planes do not close it
+            return "open"                             # R is open there: the planes do not close it
         total += piece[0]
         if len(piece[1]):
             far.append(piece[1])
     if _file_inside(v, f, on_rim, view, top, e0, e1, fan_unit, unit, offset, tol):
-        return None
+        return "file inside"
     corners = np.vstack([v[rim], *far])
     reach = float(np.min(np.max(np.linalg.norm(corners[None, :, :] - v[rim][:, None, :], axis=2), axis=1)))
     return WrappedRegion(doubt=round_up(total * (1.0 + 1e-9) + 1e-15 * scale ** 3),
@@ -279,8 +307,66 @@ def _file_inside(v: np.ndarray, f: np.ndarray, on_rim: np.ndarray, view: np.ndar
     return False
 
 
-def fill_excess(vertices: np.ndarray, fill: PlaneFill, apex: np.ndarray) -> tuple[float, float]:
-    """What a plane fill outside a hole's wrapped region adds to its doubt: ``(Σ_T |det(T − a)| / 6`` over the fill's
+def wrapped_fill(vertices: np.ndarray, region: WrappedRegion, rim_edges: np.ndarray, loop: int, *,
+                 levels: int = PLANE_FILL_LEVELS) -> PlaneFill | None:
+    """A hole read round an edge (:func:`wrapped_doubt`) filled on ``R``'s far side: the cone's fan, split into
+    ``levels`` rows (:func:`~.hole_fills._sector_grid`), pushed point by point along the ray from the reading's
+    viewpoint ``o`` out to ``∂K``, or None where a ray does not leave ``K`` (R open: not expected of a region read).
+
+    The planes round the rim continued until they meet (the assumption's reading of the lost surface) are ``∂K``
+    over the hole, so this is the fill of :func:`~.hole_fills.plane_fills` with one plane chosen per point along
+    its ray from ``o`` instead of along one direction ``d``: it goes on across an edge the hole reaches round (a
+    cylinder's cap and side, a cone's base and side).  A point ``p`` of fan triangle ``T_i`` lies in ``K`` (the
+    cone does), so its ray leaves ``K`` at ``o + s (p − o)``, ``s = min_j (c_j − n_j·o) / (n_j·(p − o))`` over the
+    planes it moves towards, ``s ≥ 1``: beyond ``T_i``'s plane (``T_i`` faces away from ``o``), inside ``K``'s
+    closure and over ``T_i`` as seen from ``o``, so in ``R``.  The fill and the missing surface both lie in ``R``;
+    the bound (``vol R``) is unchanged.  The rim stays (the rim corners lie on ``∂K`` within the tolerance).  The
+    fill is a radial graph over the directions of the fan, so it does not cross itself.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    region : WrappedRegion
+        The hole's region (its ``frame``).
+    rim_edges : (r, 2) int
+        The hole's boundary edges, as given to :func:`wrapped_doubt`.
+    loop : int
+        The hole's loop (its apex is numbered ``n + loop`` in the fill's ``caps``).
+    levels : int
+        Rows of each fan triangle (:data:`~.hole_fills.PLANE_FILL_LEVELS`).
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    e = np.asarray(rim_edges, dtype=np.int64)
+    view, top, _, _, _, unit, offset, _ = region.frame
+    rim = np.unique(e)
+    slot = np.searchsorted(rim, e)
+    caps, weights = _sector_grid(e, slot, levels)
+    sa, sb = weights[:, 2:3], weights[:, 3:4]
+    flat = np.vstack([top[None, :], top + sa * (v[rim[weights[:, 0].astype(np.int64)]] - top)
+                      + sb * (v[rim[weights[:, 1].astype(np.int64)]] - top)])
+    ray = flat - view                                                     # (p + 1, 3)
+    towards = ray @ unit.T                                                # (p + 1, planes)
+    room = offset[None, :] - (unit @ view)[None, :]                      # > 0: o strictly inside K
+    with np.errstate(divide="ignore", invalid="ignore"):
+        reach = np.where(towards > 0, room / towards, np.inf)
+    scale = reach.min(axis=1)
+    if not bool(np.isfinite(scale).all()):
+        return None
+    scale = np.maximum(scale, 1.0)                                        # never short of the cone (round-off)
+    moved = view + scale[:, None] * ray
+    n = len(v)
+    caps = caps.copy()
+    caps[caps == -1] = n + loop
+    inner = caps < -1
+    caps[inner] = -1 - (-2 - caps[inner])                                 # inner point i as −1 − i
+    lift = (scale - 1.0) * np.linalg.norm(ray, axis=1)
+    return PlaneFill(loop=int(loop), apex=moved[0], points=moved[1:], caps=caps, lift=lift,
+                     planes=int(len(unit)), convex=True)
+
+
+def fill_excess(vertices: np.ndarray, fill: PlaneFill | CurvedFill, apex: np.ndarray) -> tuple[float, float]:
+    """What a fill (a plane fill outside a hole's wrapped region, a quadric fill kept under ``faceted-holes``) adds to
+    its doubt: ``(Σ_T |det(T − a)| / 6`` over the fill's
     triangles ``T`` (m³, rounded up), the farthest the fill's points lie from their nearest rim corner (m)).
 
     The patched and the true solid differ by the winding number of "fill − M" = ("fill − cone") + ("cone − M"); the

@@ -70,7 +70,7 @@ from .hole_fills import (CREASE_MAX_LOOPS as CREASE_MAX_LOOPS, CREASE_MAX_PLANES
                          PlaneFill, plane_fills, region_check)
 from .hole_assumptions import NOTHING_ASSUMED, UserAssumptions, named, stated, user_stated
 from .hole_facets import FACETED_MAX_LOOPS, faceted_doubt
-from .hole_wraps import WrappedRegion, fill_excess, in_wrapped, wrapped_doubt
+from .hole_wraps import WRAP_MAX_PLANES, WrappedRegion, fill_excess, in_wrapped, wrapped_doubt, wrapped_fill
 from .hole_graphs import GraphFill, graph_fills
 from .rims import boundary_edges, boundary_loops, capsule_volumes, enclosing_balls, enclosing_capsules
 from .seal import Seal, _unique_rows
@@ -461,6 +461,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             if candidates.any():
                 sign = 1.0 if bool(np.array_equal(pf[:len(f)], f)) else -1.0
                 ranked = np.flatnonzero(candidates)[np.argsort(-hole_doubt[candidates], kind="stable")]
+                unfaceted = hole_doubt.copy()         # each hole's doubt before faceted-holes read it
                 for k in ranked[:FACETED_MAX_LOOPS].tolist():
                     region = faceted_doubt(v, f, edges[label == k], apex[k], float(radius[k]), outward=sign)
                     if region is None:
@@ -482,12 +483,46 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                 if took_faceted.any():
                     for flag in (took_bend, took_capsule, took_planar, took_graph, took_smooth, alone):
                         flag &= ~took_faceted
-                    curved = [fill for fill in curved if not took_faceted[fill.loop]]
+                    # a hole the default filled on the quadric its surroundings lie on (curved_fills: the file's
+                    # evidence that the surface there is curved, not faceted) keeps that fill, with the volume
+                    # between it and the cone added to the region the reading states (hole_wraps.fill_excess: the
+                    # region bounds "cone − missing surface", the excess "fill − cone"), while that stays under the
+                    # doubt it had before; else its quadric fill is dropped for the planes' fill or the cone
+                    kept_curved: list[CurvedFill] = []
+                    for quad in curved:
+                        k = quad.loop
+                        if took_faceted[k]:
+                            extra, extra_reach = fill_excess(v, quad, apex[k])
+                            if not hole_doubt[k] + extra < unfaceted[k]:
+                                continue
+                            hole_doubt[k] = round_up(float(hole_doubt[k]) + extra)
+                            faceted_reach[k] = max(float(faceted_reach[k]), extra_reach)
+                        kept_curved.append(quad)
+                    curved = kept_curved
+                    kept_quadric = np.zeros(n_loops, dtype=bool)
+                    kept_quadric[[quad.loop for quad in curved]] = True
                     graphs = [fill for fill in graphs if not took_faceted[fill.loop]]
                     smooths = [fill for fill in smooths if not took_faceted[fill.loop]]
                     planes = [fill for fill in planes if not took_faceted[fill.loop]]
-                    facets = plane_fills(v, f, edges, label, np.flatnonzero(took_faceted), apex, radius, _anywhere,
-                                         outward=sign, max_loops=n_loops)
+                    # a hole read round an edge (and on no quadric) is filled on its region's far side: the cone
+                    # pushed along the rays from the reading's viewpoint out to the planes round it continued
+                    # (hole_wraps.wrapped_fill; in the region, so the bound stands), one plane per point where a
+                    # graph over one direction cannot go on across the edge the hole reaches round
+                    radial: list[PlaneFill] = []
+                    for k in sorted(wrapped):
+                        ray_fill = None if kept_quadric[k] else wrapped_fill(v, wrapped[k], edges[label == k], k)
+                        if ray_fill is not None and in_wrapped(wrapped[k], np.vstack([ray_fill.apex[None, :],
+                                                                                      ray_fill.points])):
+                            radial.append(ray_fill)
+                    by_ray = np.zeros(n_loops, dtype=bool)
+                    by_ray[[fill.loop for fill in radial]] = True
+                    # (up to the wrapped reading's WRAP_MAX_PLANES planes, not the default's PLANE_MAX_PLANES: the
+                    # default's cap keeps tessellated curved surfaces on their cone or quadric, where the facets'
+                    # planes overshoot; here the user stated the surface faceted, the fill lies in the region the
+                    # reading bounds (on S's far side) or adds its excess, and a quadric fill found stays above)
+                    facets = plane_fills(v, f, edges, label, np.flatnonzero(took_faceted & ~kept_quadric & ~by_ray),
+                                         apex, radius, _anywhere, outward=sign, max_loops=n_loops,
+                                         max_planes=WRAP_MAX_PLANES)
                     # a hole bounded by its planes' polytope beyond the cone keeps a plane fill outside that region
                     # only with the volume between the fill and the cone added (hole_wraps.fill_excess), and only
                     # while that stays under the doubt it had before; else its cone
@@ -501,7 +536,7 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
                             hole_doubt[k] = round_up(float(hole_doubt[k]) + extra)
                             faceted_reach[k] = max(float(faceted_reach[k]), extra_reach)
                         kept_facets.append(facet)
-                    planes = [*planes, *kept_facets]
+                    planes = [*planes, *radial, *kept_facets]
                     pv, pf, cap, closed, _ = build(creases, curved, [*graphs, *smooths], planes)
         took_flat = (in_slab & ~crossed & (cone_doubt < ball_volume) & ~took_bend & ~took_capsule
                      & ~took_planar & ~took_graph & ~took_smooth & ~took_faceted)
@@ -588,6 +623,10 @@ def patched_estimate(vertices: np.ndarray, faces: np.ndarray, moments: Callable[
             detail += (f"; {len(curved)} of them filled instead on the quadric their surroundings lie on (the cone's "
                        f"fan bent onto it, {len(pv) - len(v) - n_loops - 2 * len(creases):,} points added), with "
                        "the same bound")
+            on_faceted = sum(1 for quad in curved if took_faceted[quad.loop])
+            if on_faceted:
+                detail += (f" ({on_faceted} of them bounded by the faceted-holes reading below, with the volume "
+                           "between the fill and the cone added)")
         if took_island.any() and not convex:
             widest = round_up(float(island_width[took_island].max()))
             detail += (f"; {int(np.count_nonzero(took_island))} an island in a flat face (its rim and every face at "
