@@ -9,6 +9,8 @@ int64 for any mesh below 3·10⁹ vertices) and its direction bit is ``a > b``. 
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 __all__ = ["edge_keys", "stable_key_order", "unique_rows"]
@@ -83,7 +85,7 @@ def stable_key_order(key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def unique_rows(rows: np.ndarray, *, return_index: bool = False, return_inverse: bool = False,
-                return_counts: bool = False):
+                return_counts: bool = False) -> Any:
     """``numpy.unique(rows, axis=0, ...)`` of non-negative integer rows, bit for bit, by one int64 key per row.
 
     The columns are packed into one key, ``((r₀·R₁ + r₁)·R₂ + r₂)…`` with ``Rⱼ`` one more than column ``j``'s
@@ -119,8 +121,9 @@ def unique_rows(rows: np.ndarray, *, return_index: bool = False, return_inverse:
             total *= r
         packable = int(low.min()) >= 0 and total <= np.iinfo(np.int64).max
     if not packable:
-        return np.unique(a, axis=0, return_index=return_index, return_inverse=return_inverse,
-                         return_counts=return_counts)
+        numpy_unique: Any = np.unique              # (its overloads want the flags as literals)
+        return numpy_unique(a, axis=0, return_index=return_index, return_inverse=return_inverse,
+                            return_counts=return_counts)
     key = wide[:, 0].copy()
     for j in range(1, a.shape[1]):
         key *= np.int64(radix[j])
