@@ -280,8 +280,9 @@ def test_the_audit_refuses_a_fit_to_a_mesh_only_a_repair_reads_once_per_file_con
 
 
 def test_a_byte_identical_copy_in_another_folder_is_integrated_once_with_its_own_warnings(tmp_path, monkeypatch):
-    """TIAGo and TIAGo dual ship the same mesh bytes under two paths: a result is shared by content, and each
-    model's warnings and result name its own file; a refusal is not shared (each copy is refused by itself)."""
+    """TIAGo and TIAGo dual ship the same mesh bytes under two paths: a result and a refusal are shared by
+    content (issue 25, corpus19: Stretch and Stretch 3 refused 31 copies twice), and each model's warnings,
+    result and refusal name its own file, exactly as when its folder is audited alone."""
     import shutil
     import warnings
 
@@ -304,7 +305,7 @@ def test_a_byte_identical_copy_in_another_folder_is_integrated_once_with_its_own
         warnings.simplefilter("always")
         models = audit_corpus([tmp_path], density=1000)
     names = sorted(os.path.relpath(p, tmp_path) for p in calls)
-    assert names == ["tiago/flipped.stl", "tiago/open.stl", "tiago_dual/open.stl"]      # the refusal twice
+    assert names == ["tiago/flipped.stl", "tiago/open.stl"]      # the result and the refusal once each
     by_model = {os.path.relpath(m.source, tmp_path): m for m in models}
     for folder in ("tiago", "tiago_dual"):
         left = by_model[f"{folder}/scene.xml"].inertials[0]
@@ -315,6 +316,12 @@ def test_a_byte_identical_copy_in_another_folder_is_integrated_once_with_its_own
         assert refused.properties is None and f"{folder}/open.stl" in refused.problem
     texts = [str(w.message) for w in caught if "inside out" in str(w.message)]
     assert any("tiago_dual/flipped.stl" in t for t in texts) and any("tiago/flipped.stl" in t for t in texts)
+    with warnings.catch_warnings(record=True) as caught_alone:
+        warnings.simplefilter("always")
+        alone = audit_corpus([second], density=1000)        # the copies' folder alone: every mesh its own
+    assert _summary(alone) == _summary([m for m in models if os.path.dirname(m.source) == str(second)])
+    own = [str(w.message) for w in caught if "tiago_dual" in str(w.message)]
+    assert own and own == [str(w.message) for w in caught_alone]
 
 
 def test_folders_sharing_mesh_files_are_one_group_and_a_nested_model_folder_is_its_own(tmp_path):
@@ -352,3 +359,20 @@ def test_jobs_2_with_copies_across_folders_gives_the_serial_results_and_warnings
     runs = _serial_and_parallel(tmp_path)
     assert runs[1] == runs[0]
     assert any("tiago_dual/flipped.stl" in w for w in runs[0][1])
+
+
+def test_a_copy_is_readdressed_only_where_every_mention_of_the_file_is_its_whole_path():
+    """A kept warning or refusal is re-addressed to a copy by replacing whole paths, in one pass (a new path that
+    contains an old one is not replaced again); a text that names the file by its base name alone is not
+    re-addressed (None: the copy is integrated by itself), unless the two base names are the same."""
+    from inertia_tool.errors import InvalidMeshError
+    from inertia_tool.robot.geometry import _moved_error, _readdressed
+    pairs = [("/m/a/x.stl", "/m/b/x.stl"), ("/m/a/y.stl", "/m/a/x.stl.y.stl")]
+    assert _readdressed("/m/a/x.stl + /m/a/y.stl: open", pairs) == "/m/b/x.stl + /m/a/x.stl.y.stl: open"
+    assert _readdressed("x.stl: open (/m/a/x.stl)", pairs[:1]) == "x.stl: open (/m/b/x.stl)"     # same base name
+    assert _readdressed("y.stl: open (/m/a/y.stl)", pairs[1:]) is None                       # base name alone
+    error = InvalidMeshError("/m/a/x.stl: not closed", details={"boundary_edges": 3})
+    moved = _moved_error(error, pairs[:1])
+    assert type(moved) is InvalidMeshError and str(moved) == "/m/b/x.stl: not closed"
+    assert moved.details == {"boundary_edges": 3} and str(error) == "/m/a/x.stl: not closed"
+    assert _moved_error(InvalidMeshError("/m/a/y.stl: y.stl is open"), pairs[1:]) is None

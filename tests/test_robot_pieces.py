@@ -156,3 +156,51 @@ def test_a_refused_join_of_copied_files_is_not_joined_again(tmp_path, monkeypatc
         assert result.warnings == reference.warnings
     assert len(joins) == 4                 # folder b's copy not joined again; c (scaled) joined again
     assert all("/b/" not in source for source in joins)
+
+
+def test_a_join_of_copied_files_that_closes_is_taken_from_the_first_copy_placed_as_its_own(tmp_path, monkeypatch):
+    """Issue 25 (corpus19): Stretch and Stretch 3 join byte-identical pieces that close (``link_arm_l0``,
+    ``link_head_tilt``); the run's MeshCache keeps the join by content: a copy in another folder, placed
+    elsewhere, gets the body placed as its own geoms place it, and its warnings and mesh report name its own
+    files, exactly as when it is joined alone; the same files at another scale are joined again."""
+    from inertia_tool.robot import geometry
+    from inertia_tool.robot.geometry import MeshCache
+
+    joins = []
+    real = geometry.mass_properties
+
+    def counted(raw, *args, **kwargs):
+        if " + " in str(getattr(raw, "source", "")):
+            joins.append(raw.source)
+        return real(raw, *args, **kwargs)
+
+    monkeypatch.setattr(geometry, "mass_properties", counted)
+    placements = {"a": PLACED, "b": 'pos="-0.3 0.05 0.7" euler="10 -20 95"', "c": PLACED}
+    paths = []
+    for name, placed in placements.items():
+        (tmp_path / name).mkdir()
+        scale = ' scale="2 2 2"' if name == "c" else ""
+        path = _model(tmp_path / name, f'<geom type="mesh" mesh="ends" {placed}/>'
+                                       f'<geom type="mesh" mesh="sides" {placed}/>')
+        if scale:
+            text = open(path).read().replace('file="ends.obj"/>', f'file="ends.obj"{scale}/>')
+            open(path, "w").write(text.replace('file="sides.obj"/>', f'file="sides.obj"{scale}/>'))
+        paths.append(path)
+    alone = []
+    for path in paths:                                       # each without a shared cache: the reference
+        (result,) = link_inertials(read_robot(path), density=1000.0, repair=True)
+        alone.append(result)
+    assert len(joins) == 3 and all(r.method == "exact" for r in alone)
+    joins.clear()
+    cache = MeshCache()
+    for path, reference in zip(paths, alone):
+        (result,) = link_inertials(read_robot(path), density=1000.0, repair=True, mesh_cache=cache)
+        assert result.properties.mass == reference.properties.mass
+        np.testing.assert_array_equal(result.properties.center_of_mass, reference.properties.center_of_mass)
+        np.testing.assert_array_equal(result.properties.inertia, reference.properties.inertia)
+        assert (result.method, result.uncertainty, result.warnings) == \
+            (reference.method, reference.uncertainty, reference.warnings)
+    assert len(joins) == 2                 # folder b's copy not joined again; c (scaled) joined again
+    assert all("/b/" not in source for source in joins)
+    assert alone[1].properties.mass == alone[0].properties.mass
+    assert not np.allclose(alone[1].properties.center_of_mass, alone[0].properties.center_of_mass)

@@ -9,9 +9,11 @@ int64 for any mesh below 3·10⁹ vertices) and its direction bit is ``a > b``. 
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-__all__ = ["edge_keys", "stable_key_order"]
+__all__ = ["edge_keys", "stable_key_order", "unique_rows"]
 
 
 def edge_keys(faces: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
@@ -80,3 +82,58 @@ def stable_key_order(key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     packed += np.arange(k, dtype=np.int64)
     packed.sort()
     return packed // slots, packed % slots
+
+
+def unique_rows(rows: np.ndarray, *, return_index: bool = False, return_inverse: bool = False,
+                return_counts: bool = False) -> Any:
+    """``numpy.unique(rows, axis=0, ...)`` of non-negative integer rows, bit for bit, by one int64 key per row.
+
+    The columns are packed into one key, ``((r₀·R₁ + r₁)·R₂ + r₂)…`` with ``Rⱼ`` one more than column ``j``'s
+    largest value, which orders rows as ``numpy.unique`` does (lexicographically), so the unique rows, the first
+    indices (both sorts stable), the inverse and the counts are the same; the packed keys are sorted as plain
+    integers instead of as the structured rows numpy compares field by field (issue 25, corpus19: ~35× less CPU
+    on 210,000 (owner, edge key) pairs of ``nonmanifold.welded_bodies``).  Rows with a negative value, an
+    unsigned 64-bit column, or a key that would not fit 63 bits go to ``numpy.unique`` itself.
+
+    Parameters
+    ----------
+    rows : (k, c) int
+        The rows.
+    return_index, return_inverse, return_counts : bool
+        As ``numpy.unique``.
+
+    Returns
+    -------
+    unique : (u, c) int
+        The distinct rows in lexicographic order, ``rows``' dtype; followed, as asked, by ``index`` (u,) int64
+        (first occurrence of each), ``inverse`` (k,) int64 (the row of ``unique`` each row is) and ``counts``
+        (u,) int64.
+    """
+    a = np.asarray(rows)
+    packable = (a.ndim == 2 and len(a) > 0 and a.shape[1] > 0 and
+                (a.dtype.kind == "i" or (a.dtype.kind == "u" and a.dtype.itemsize < 8)))
+    if packable:
+        wide = a.astype(np.int64, copy=False)
+        low, high = wide.min(axis=0), wide.max(axis=0)
+        radix = [int(h) + 1 for h in high]
+        total = 1
+        for r in radix:
+            total *= r
+        packable = int(low.min()) >= 0 and total <= np.iinfo(np.int64).max
+    if not packable:
+        numpy_unique: Any = np.unique              # (its overloads want the flags as literals)
+        return numpy_unique(a, axis=0, return_index=return_index, return_inverse=return_inverse,
+                            return_counts=return_counts)
+    key = wide[:, 0].copy()
+    for j in range(1, a.shape[1]):
+        key *= np.int64(radix[j])
+        key += wide[:, j]
+    _, index, inverse, counts = np.unique(key, return_index=True, return_inverse=True, return_counts=True)
+    out = [a[index]]
+    if return_index:
+        out.append(index)
+    if return_inverse:
+        out.append(inverse.reshape(-1))
+    if return_counts:
+        out.append(counts)
+    return out[0] if len(out) == 1 else tuple(out)

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..values import frozen_value
-from .edges import edge_keys
+from .edges import edge_keys, unique_rows
 
 if TYPE_CHECKING:
     from .nesting import Nesting
@@ -72,7 +72,7 @@ def closed_components(faces: np.ndarray, members: np.ndarray, n_vertices: int) -
     comp, n_comp = shell_labels(sub, n_vertices)
     key, forward = edge_keys(sub, n_vertices)
     owner = np.repeat(comp, 3).astype(np.int64)          # edge_keys lists each face's three edges in turn
-    _, inverse = np.unique(np.stack([owner, key.astype(np.int64)], axis=1), axis=0, return_inverse=True)
+    _, inverse = unique_rows(np.stack([owner, key.astype(np.int64)], axis=1), return_inverse=True)
     inverse = inverse.reshape(-1)
     net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
     unbalanced = np.zeros(n_comp, dtype=bool)
@@ -118,7 +118,7 @@ def signed_multiplicity(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     key = g[rows, (start + np.arange(3)) % 3]                       # from the smallest point, same cycle
     ok = (key[:, 0] != key[:, 1]) & (key[:, 1] != key[:, 2]) & (key[:, 0] != key[:, 2])
     if ok.any():
-        _, code = np.unique(np.sort(key[ok], axis=1), axis=0, return_inverse=True)
+        _, code = unique_rows(np.sort(key[ok], axis=1), return_inverse=True)
         cls[ok] = code.reshape(-1)
         sign[ok] = np.where(key[ok, 1] < key[ok, 2], 1, -1)
     return cls, sign

@@ -14,7 +14,7 @@ import numpy as np
 
 from .._native import label_dtype
 from ..values import frozen_value
-from .edges import edge_keys
+from .edges import edge_keys, unique_rows
 
 __all__ = ["WeldedBodies", "welded_bodies"]
 
@@ -190,7 +190,7 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
     n_pieces, piece = connected_components(graph, directed=False)
     # each group balanced on its own: the net direction of every (group, edge) is zero
     owner = piece[np.arange(3 * m) // 3].astype(np.int64)
-    _, inverse = np.unique(np.stack([owner, key], axis=1), axis=0, return_inverse=True)
+    _, inverse = unique_rows(np.stack([owner, key], axis=1), return_inverse=True)
     inverse = inverse.reshape(-1)
     net = np.bincount(inverse, weights=np.where(forward, 1.0, -1.0))
     first = np.zeros(len(net), dtype=np.int64)
@@ -209,7 +209,7 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
     ambiguous = int(np.count_nonzero(crossed & bad_shell))
     if splits.any():
         sub = np.where(splits[labels], piece, -1)
-        _, new = np.unique(np.stack([labels, sub], axis=1), axis=0, return_inverse=True)
+        _, new = unique_rows(np.stack([labels, sub + 1], axis=1), return_inverse=True)   # (-1 → 0: same order)
         new = new.reshape(-1)
         _, first_face = np.unique(new, return_index=True)          # numbered in order of each shell's first face
         rank = np.empty(len(first_face), dtype=np.int64)
@@ -227,7 +227,7 @@ def welded_bodies(faces: np.ndarray, n_vertices: int, labels: np.ndarray, n_shel
         i, j = np.triu_indices(len(fs), 1)
         keep = new[fs[i]] != new[fs[j]]
         pairs.append(np.stack([fs[i][keep], fs[j][keep]], axis=1))
-    contact = np.unique(np.sort(np.concatenate(pairs), axis=1), axis=0) if pairs else np.zeros((0, 2), np.int64)
+    contact = unique_rows(np.sort(np.concatenate(pairs), axis=1)) if pairs else np.zeros((0, 2), np.int64)
     new = new.astype(label_dtype(len(new)), copy=False)
     return WeldedBodies(labels=new, n_shells=count_new, split=int(np.count_nonzero(splits)),
                         ambiguous=ambiguous, contact=contact.astype(np.int64), ambiguous_shells=crossed & bad_shell)

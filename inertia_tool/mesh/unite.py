@@ -16,6 +16,7 @@ from ..errors import InvalidMeshError, MeshResolvedWarning, OverlapWarning
 from ..integrals import body_volume_moments, bounding_box, reference_point, roundoff_bounds, volume_moments
 from .checks import edge_topology
 from .classify import Orientation, shell_nesting_or_none
+from .edges import unique_rows
 from .intersect import SurfaceContacts, surface_contacts
 from .policy import TOUCH_VOLUME_RTOL, orient_by_depth, turned_reading_refusal
 from .resolve import Resolution, resolve_surface
@@ -366,7 +367,7 @@ def _unite(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, owner: n
                         union_surface, winding_solid)                                           # are rare
     groups, n_groups = closed_groups(faces, len(vertices))
     # within the shells: bodies welded along their crossing (R1b) are closed apart, though one group to closed_groups
-    _, groups = np.unique(np.stack([np.asarray(labels, dtype=np.int64), groups], axis=1), axis=0, return_inverse=True)
+    _, groups = unique_rows(np.stack([np.asarray(labels, dtype=np.int64), groups], axis=1), return_inverse=True)
     groups = groups.reshape(-1)
     n_groups = int(groups.max()) + 1 if len(groups) else 0
     pieces = body_volume_moments(vertices, faces, groups, n_groups)

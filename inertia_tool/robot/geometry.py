@@ -27,9 +27,11 @@ faces with it, so the surface keeps its outward winding.
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import math
 import os
+import re
 import warnings
 from typing import NamedTuple
 from dataclasses import replace
@@ -467,16 +469,20 @@ class MeshCache:
     content too (issue 25: Stretch and Stretch 3 ship byte-identical ``link_arm_l0_{0,1,2}.obj``, ~17 s of CPU
     each to refuse).
 
-    A result (not a refusal) is also kept by the file's *content* (:func:`_content_key` without the path: its
+    A result or a refusal is also kept by the file's *content* (:func:`_content_key` without the path: its
     size and a hash of its bytes, with the file's suffix, the placement and ``repair``), so that a byte-identical
-    copy in another folder (TIAGo and TIAGo dual ship the same ``gripper_link.stl``) is integrated once; the copy
-    gets the result with every warning addressed to its own file (:meth:`get_copy`).
+    copy in another folder (TIAGo and TIAGo dual ship the same ``gripper_link.stl``) is integrated, or refused,
+    once; the copy gets the result or the refusal with every warning and message addressed to its own file
+    (:meth:`get_copy`; issue 25, corpus19: Stretch and Stretch 3 refused ``link_lift_3.obj`` and 30 other
+    copies twice: 8.4 s of CPU at load 18).  Open pieces joined into one solid are kept by their content the same way
+    (:meth:`joined_copy`).
     """
 
     def __init__(self) -> None:
         self._entries: dict = {}
         self._by_content: dict = {}
         self._refused_joins: set = set()
+        self._joins: dict = {}
 
     def join_refused(self, content) -> bool:
         """Whether open pieces with this content (:func:`_join_content`) were joined before and refused."""
@@ -497,31 +503,103 @@ class MeshCache:
 
     def put(self, key, outcome, caught: tuple, faces: int, content=None) -> None:
         self._entries.setdefault(key, (outcome, caught, faces))
-        if content is not None and not isinstance(outcome, BaseException):
+        if content is not None:
             self._by_content.setdefault(content, (key[0][0], outcome, caught, faces))
 
     def get_copy(self, content, path: str):
-        """``(result, warnings, faces)`` of a file with the same content integrated under another path, the
-        warnings' text and the result's mesh report re-addressed to ``path``; None when there is none (or a
-        warning cannot be rebuilt with the new text)."""
+        """``(result or exception, warnings, faces)`` of a file with the same content integrated (or refused)
+        under another path, the warnings' and the refusal's text and the result's mesh report re-addressed to
+        ``path`` (:func:`_readdressed`); None when there is none, or when a text cannot be re-addressed."""
         found = self._by_content.get(content) if content is not None else None
         if found is None:
             return None
         other, outcome, caught, faces = found
         if other == path:
             return outcome, caught, faces
-        moved = []
-        for item in caught:
-            text = str(item.message).replace(other, path)
-            try:
-                message = item.category(text)
-            except TypeError:                      # a warning class that takes more than its text
-                return None
-            moved.append(warnings.WarningMessage(message, item.category, item.filename, item.lineno))
+        moved = _moved_warnings(caught, [(other, path)])
+        if moved is None:
+            return None
+        if isinstance(outcome, BaseException):
+            outcome = _moved_error(outcome, [(other, path)])
+            return None if outcome is None else (outcome, moved, faces)
         report = outcome.mesh
         if report is not None and getattr(report, "source", None) == other:
             outcome = replace(outcome, mesh=replace(report, source=path))
-        return outcome, tuple(moved), faces
+        return outcome, moved, faces
+
+    def keep_join(self, content, labels: list, found: tuple, caught: tuple) -> None:
+        """Keep a join of open pieces that closed (``found``: :func:`_joined_pieces`'s body before its placement,
+        method and uncertainty; ``caught``: the engine's warnings), by the pieces' content (:func:`_join_content`)
+        with the pieces' ``labels`` (their files, in order)."""
+        if content is not None:
+            self._joins.setdefault(content, (list(labels), found, caught))
+
+    def joined_copy(self, content, labels: list):
+        """``(found, warnings)`` of pieces with this content joined before under other files, the warnings' text
+        and the body's mesh report re-addressed to ``labels``; None when there is none, or when a text cannot be
+        re-addressed."""
+        kept = self._joins.get(content) if content is not None else None
+        if kept is None:
+            return None
+        others, (local, method, uncertainty), caught = kept
+        pairs = [(a, b) for a, b in zip(others, labels) if a != b]
+        if not pairs:
+            return (local, method, uncertainty), caught
+        moved = _moved_warnings(caught, pairs)
+        if moved is None:
+            return None
+        report = local.mesh
+        if report is not None and getattr(report, "source", None) is not None:
+            source = _readdressed(report.source, pairs)
+            if source is None:
+                return None
+            local = replace(local, mesh=replace(report, source=source))
+        return (local, method, uncertainty), moved
+
+
+def _readdressed(text: str, pairs: list) -> str | None:
+    """``text`` with every file ``a`` of ``pairs`` ``[(a, b), ...]`` replaced by ``b``; None when the text may
+    name a file otherwise than by its whole path (its base name appears beyond the whole path's occurrences, and
+    the two base names differ), so that a replacement could leave the old file named."""
+    for a, b in pairs:
+        name = os.path.basename(a)
+        if name != os.path.basename(b) and text.count(name) != text.count(a):
+            return None
+    new = dict(pairs)
+    # one pass, the longest file first: a new name is never taken for an old one
+    pattern = "|".join(re.escape(a) for a in sorted(new, key=len, reverse=True))
+    return re.sub(pattern, lambda match: new[match.group(0)], text)
+
+
+def _moved_warnings(caught, pairs: list) -> tuple | None:
+    """The warnings ``caught`` with their text re-addressed (:func:`_readdressed`); None when one cannot be."""
+    moved = []
+    for item in caught:
+        text = _readdressed(str(item.message), pairs)
+        if text is None:
+            return None
+        try:
+            message = item.category(text)
+        except TypeError:                      # a warning class that takes more than its text
+            return None
+        moved.append(warnings.WarningMessage(message, item.category, item.filename, item.lineno))
+    return tuple(moved)
+
+
+def _moved_error(error: BaseException, pairs: list) -> BaseException | None:
+    """A copy of the refusal ``error`` (its class and attributes, e.g. ``InvalidMeshError.details``) whose
+    message is re-addressed (:func:`_readdressed`); None when it has more than a message or cannot be."""
+    if len(error.args) != 1 or not isinstance(error.args[0], str):
+        return None
+    text = _readdressed(error.args[0], pairs)
+    if text is None:
+        return None
+    try:
+        moved = copy.copy(error)
+    except Exception:                          # an exception class that cannot be rebuilt from its arguments
+        return None
+    moved.args = (text,)
+    return moved
 
 
 def _reissue(caught) -> None:
@@ -813,9 +891,15 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: M
     content = _join_content(pieces, repair, assume) if shared is not None else None
     if shared is not None and shared.join_refused(content):
         return None                 # the same files, placed alike, refused before (the budget checked above)
+    labels = [_mesh_label(e) for e in pieces]
+    kept = shared.joined_copy(content, labels) if shared is not None else None
+    if kept is not None:            # the same files, placed alike, joined before (the budget checked above)
+        (local, method, uncertainty), caught = kept
+        _reissue(caught)
+        return _placed_join(local, first), method, uncertainty
     try:
         joined = RawMesh(vertices=np.concatenate(vertices), faces=np.concatenate(faces),
-                         source=" + ".join(_mesh_label(e) for e in pieces), units="m", file_faces=count)
+                         source=" + ".join(labels), units="m", file_faces=count)
     except InertiaToolError:
         return None
     for fix in (False, True) if repair else (False,):
@@ -830,11 +914,18 @@ def _joined_pieces(pieces: list, *, budget: list | None, repair: bool, shared: M
         method = ("exact" if report is None else "estimate" if report.uncertainty is not None
                   else report.certificate.kind)
         uncertainty = None if report is None else report.uncertainty
-        placed = replace(local.transformed(rotation=first.rotation, translation=first.translation), mesh=report)
-        return placed, method, uncertainty          # (the report kept: its certificate, for _users_taken)
+        if shared is not None:
+            shared.keep_join(content, labels, (local, method, uncertainty), tuple(recorded))
+        return _placed_join(local, first), method, uncertainty
     if shared is not None:
         shared.refuse_join(content)
     return None
+
+
+def _placed_join(local: MassProperties, first: GeometryElement) -> MassProperties:
+    """The body of joined pieces placed as their first element places it, the engine's mesh report kept (its
+    certificate, for :func:`_users_taken`)."""
+    return replace(local.transformed(rotation=first.rotation, translation=first.translation), mesh=local.mesh)
 
 
 def _join_open_pieces(parts: list, refused: list, *, model: bool, repair: bool,
