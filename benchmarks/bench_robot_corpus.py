@@ -191,7 +191,8 @@ def mujoco_reference(path: str, *, geometry: str = "collision", max_rounds: int 
     Returns ``(bodies, refused, missing)``: ``bodies`` [(name, mass, centre, tensor in body axes, faces by mesh
     file basename)], ``refused`` {mesh file basename: MuJoCo's reason}, ``missing`` {body name: [files]} (a
     missing file's geoms are compiled as small spheres, so that the rest of the model compiles; their bodies
-    are not compared).  ``geometry="collision"``: the geoms that do not collide (``contype`` and
+    are not compared unless every such geom is massless: a visual mesh under ``geometry="collision"``).
+    ``geometry="collision"``: the geoms that do not collide (``contype`` and
     ``conaffinity`` 0, in no ``<contact><pair>``) are made massless first, so that MuJoCo's inertia from
     geometry is that of the collision geoms (a body left without mass is bounded by ``boundmass`` and
     ``boundinertia`` 1e-15, which nothing else reaches)."""
@@ -229,7 +230,9 @@ def mujoco_reference(path: str, *, geometry: str = "collision", max_rounds: int 
                     key = mesh.name or os.path.splitext(os.path.basename(mesh.file))[0]
                     for geom in spec.geoms:
                         if geom.meshname == key:
-                            missing[geom.parent.name].append(base)
+                            if not (geom.mass == 0 or (np.isnan(geom.mass) and geom.density == 0)):
+                                # a massless geom's stand-in adds nothing: its body is still compared
+                                missing[geom.parent.name].append(base)
                             geom.type, geom.meshname = mujoco.mjtGeom.mjGEOM_SPHERE, ""
                             geom.size, geom.rgba = [1e-3, 0, 0], list(_SENTINEL_RGBA)
                     spec.delete(mesh)

@@ -114,3 +114,25 @@ def test_the_first_pass_reads_a_file_with_an_absent_part_as_the_command_does(tmp
     assert "read 1/1 model files, 1/1 scenes" in out
     assert "links computed: 4 (exact 4)" in out          # box and holder, in the model and in the scene
     assert re.search(r"\n +2 +mesh file missing\n", out) and re.search(r"\n +2 +attached model not read\n", out)
+
+
+def test_a_missing_visual_mesh_does_not_keep_its_body_from_the_comparison(tmp_path):
+    # Stretch's base_link and link_head: the absent file is a visual mesh (massless under --geometry
+    # collision), so MuJoCo's stand-in adds nothing and the body is compared (or the tool's own reason shown),
+    # not filed under "mesh file missing"; a missing collision mesh still is
+    path = tmp_path / "robot.xml"
+    path.write_text("""<mujoco>
+  <asset><mesh name="look" file="look.stl"/><mesh name="touch" file="touch.stl"/></asset>
+  <worldbody>
+    <body name="seen"><joint/><geom type="box" size="0.1 0.2 0.3"/>
+      <geom type="mesh" mesh="look" contype="0" conaffinity="0"/></body>
+    <body name="gone" pos="1 0 0"><joint/><geom type="box" size="0.1 0.2 0.3"/><geom type="mesh" mesh="touch"/></body>
+  </worldbody>
+</mujoco>
+""")
+    from inertia_tool.robot.geometry import MeshCache
+    bodies, _, missing, _ = mujoco_reference(str(path))
+    assert missing == {"gone": ["touch.stl"]}
+    rows = compare_menagerie_file(str(path), rtol=1e-6, repair=False, cache=MeshCache())
+    assert [r[:2] for r in rows] == [("seen", "exact, agrees"), ("gone", "mesh file missing")]
+    assert rows[0][2] < 1e-12 and bodies[0][1] == pytest.approx(1000 * 0.2 * 0.4 * 0.6, rel=1e-12)
