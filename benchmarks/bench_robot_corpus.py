@@ -46,7 +46,8 @@ from inertia_tool.robot.corpus import find_descriptions  # noqa: E402
 def _cause(problem: str) -> str:
     """A short name for a link's problem (the part before the file name or the first colon)."""
     for key in ("mesh needs repair", "mesh file missing", "every geom is massless", "no collision geometry",
-                "no visual geometry", "no all geometry", "cannot be computed", "no declared mass"):
+                "no visual geometry", "no all geometry", "cannot be computed", "no declared mass",
+                "attached model not read", "included model not read"):
         if problem.startswith(key):
             if key == "mesh needs repair":
                 for detail in ("not a closed solid", "passes through itself", "not closed", "open",
@@ -190,7 +191,8 @@ def mujoco_reference(path: str, *, geometry: str = "collision", max_rounds: int 
     Returns ``(bodies, refused, missing)``: ``bodies`` [(name, mass, centre, tensor in body axes, faces by mesh
     file basename)], ``refused`` {mesh file basename: MuJoCo's reason}, ``missing`` {body name: [files]} (a
     missing file's geoms are compiled as small spheres, so that the rest of the model compiles; their bodies
-    are not compared).  ``geometry="collision"``: the geoms that do not collide (``contype`` and
+    are not compared unless every such geom is massless: a visual mesh under ``geometry="collision"``).
+    ``geometry="collision"``: the geoms that do not collide (``contype`` and
     ``conaffinity`` 0, in no ``<contact><pair>``) are made massless first, so that MuJoCo's inertia from
     geometry is that of the collision geoms (a body left without mass is bounded by ``boundmass`` and
     ``boundinertia`` 1e-15, which nothing else reaches)."""
@@ -228,7 +230,9 @@ def mujoco_reference(path: str, *, geometry: str = "collision", max_rounds: int 
                     key = mesh.name or os.path.splitext(os.path.basename(mesh.file))[0]
                     for geom in spec.geoms:
                         if geom.meshname == key:
-                            missing[geom.parent.name].append(base)
+                            if not (geom.mass == 0 or (np.isnan(geom.mass) and geom.density == 0)):
+                                # a massless geom's stand-in adds nothing: its body is still compared
+                                missing[geom.parent.name].append(base)
                             geom.type, geom.meshname = mujoco.mjtGeom.mjGEOM_SPHERE, ""
                             geom.size, geom.rgba = [1e-3, 0, 0], list(_SENTINEL_RGBA)
                     spec.delete(mesh)
@@ -486,7 +490,7 @@ def _cli_corpus(root: str, repair: bool) -> tuple[float, float, int]:
 
 def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_mode: bool, verbose: bool,
                   geometry: str = "collision", compare_only: bool = False, models_only: bool = False,
-                  reverse: bool = False) -> int:
+                  reverse: bool = False, scenes_only: bool = False, shard: tuple[int, int] = (0, 1)) -> int:
     """Every model file and scene of a Menagerie checkout through the tool, then every body against MuJoCo
     (``compare_only``: the comparison alone; ``models_only``: the model files, not the scenes, which repeat
     their bodies).  The comparison prints each file's line as it ends (a long run cut off keeps what it did)."""
@@ -494,8 +498,12 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
     models, scenes = menagerie_files(root)
     if models_only:
         scenes = []
+    if scenes_only:        # the files people open: each <include>s a model file and adds a floor, lights, objects
+        models = []
     if reverse:            # a second process from the other end: two runs meet in the middle
         models, scenes = models[::-1], scenes[::-1]
+    part, parts = shard    # --shard K/N: every N-th file from the K-th, so that N processes share the list
+    models, scenes = models[part::parts], scenes[part::parts]
     folders = sorted({os.path.relpath(p, root).split(os.sep)[0] for p in models + scenes})
     print(f"Menagerie at {root}: {len(folders)} model folders, {len(models)} model files, {len(scenes)} scenes; "
           f"load average {os.getloadavg()[0]:.1f} at start", flush=True)
@@ -511,7 +519,9 @@ def run_menagerie(root: str, *, repair: bool, rtol: float, mujoco: bool, folder_
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
-                robot = read_robot(path)
+                # as the CLI reads it: a mesh file or an attached model absent from the folder leaves its
+                # links without a result, each with the reason, rather than refusing the whole file
+                robot = read_robot(path, missing_meshes="per-link")
                 results = link_inertials(robot, density=1000.0, repair=repair, mesh_cache=cache)
                 audit_links(robot, results)
             except InertiaToolError as exc:
@@ -592,6 +602,17 @@ def _mujoco_version() -> str:
     return mujoco.__version__
 
 
+def _shard(text: str) -> tuple[int, int]:
+    """``"K/N"`` as ``(K, N)``, 0 <= K < N."""
+    try:
+        part, parts = (int(x) for x in text.split("/"))
+    except ValueError:
+        raise SystemExit(f"--shard: expected K/N (two integers), got {text!r}") from None
+    if not 0 <= part < parts:
+        raise SystemExit(f"--shard: expected 0 <= K < N, got {text!r}")
+    return part, parts
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("folders", nargs="*")
@@ -603,6 +624,9 @@ def main(argv=None) -> int:
                         "MuJoCo (not the first pass at --density 1000)")
     parser.add_argument("--models-only", action="store_true", help="with --menagerie: the model files, not the "
                         "scenes (which repeat their bodies)")
+    parser.add_argument("--scenes-only", action="store_true", help="with --menagerie: the scene files alone")
+    parser.add_argument("--shard", default="0/1", metavar="K/N", help="with --menagerie: every N-th file from "
+                        "the K-th (0-based), for N processes")
     parser.add_argument("--reverse", action="store_true", help="with --menagerie: the files in reverse order (a "
                         "second process from the other end)")
     parser.add_argument("--geometry", default="collision")
@@ -617,7 +641,8 @@ def main(argv=None) -> int:
         return run_menagerie(args.menagerie, repair=args.repair, rtol=args.rtol, mujoco=not args.no_mujoco,
                              folder_mode=not args.no_folder_mode and not args.compare_only, verbose=args.verbose,
                              geometry="all" if args.geometry == "all" else "collision",
-                             compare_only=args.compare_only, models_only=args.models_only, reverse=args.reverse)
+                             compare_only=args.compare_only, models_only=args.models_only, reverse=args.reverse,
+                             scenes_only=args.scenes_only, shard=_shard(args.shard))
     if not args.folders:
         parser.error("give folders, or --menagerie ROOT")
     density = args.density if args.density == "model" else float(args.density)

@@ -3,6 +3,7 @@ refuses is compiled with the model's own mesh inertia instead, mesh by mesh; a b
 overlapping bodies twice is told apart from a real disagreement."""
 
 import os
+import re
 import sys
 
 import numpy as np
@@ -74,3 +75,64 @@ def test_a_double_count_is_told_apart_from_a_real_disagreement(tmp_path):
     assert _mujoco_side(robot.links[0], result, mass, com, tensor, rtol=1e-6, faces=faces)[0].startswith(
         "MuJoCo counts overlaps twice")
     assert _mujoco_side(robot.links[0], result, mass * 1.01, com, tensor * 1.01, rtol=1e-6, faces=faces)[0] == ""
+
+
+def test_an_absent_attached_model_has_its_own_cause():
+    # mujoco18's note: "attached model not read" (MJCF) and "included model not read" (SDFormat) were counted
+    # under their whole first clause, one bucket per file name, instead of one cause each
+    from bench_robot_corpus import _cause
+    assert _cause("attached model not read: <attach model='m'>: the model file /x/m.xml does not exist") == (
+        "attached model not read")
+    assert _cause("attached model not read: <attach model='m'>: the model file /x/m.xml does not exist (its "
+                  "geoms would be part of this body)") == "attached model not read"
+    assert _cause("included model not read: model://iris is not on the path") == "included model not read"
+    assert _cause("mesh needs repair (b.stl): not a closed solid") == "mesh needs repair (not a closed solid)"
+
+
+def test_the_first_pass_reads_a_file_with_an_absent_part_as_the_command_does(tmp_path, capsys):
+    # mujoco18's note: the first pass of run_menagerie read with the API's default (refuse the file), so a
+    # model with one absent mesh file or attached model (RealSense) was counted as refused whole, where the
+    # command line computes every other body and names the reason of each body without a result
+    from bench_robot_corpus import run_menagerie
+    folder = tmp_path / "robot"
+    folder.mkdir()
+    (folder / "robot.xml").write_text("""<mujoco>
+  <asset><mesh name="gone" file="gone.stl"/><model name="m" file="absent.xml"/></asset>
+  <worldbody>
+    <geom type="plane" size="1 1 0.1"/>
+    <body name="box"><joint/><geom type="box" size="0.1 0.2 0.3"/></body>
+    <body name="lost"><joint/><geom type="mesh" mesh="gone"/></body>
+    <body name="holder"><joint/><geom type="sphere" size="0.1"/><attach model="m" body="b" prefix="a_"/></body>
+  </worldbody>
+</mujoco>
+""")
+    (folder / "scene.xml").write_text('<mujoco><include file="robot.xml"/><worldbody><light pos="0 0 1"/>'
+                                      '<geom type="plane" size="5 5 0.1"/></worldbody></mujoco>')
+    assert run_menagerie(str(tmp_path), repair=False, rtol=1e-6, mujoco=False, folder_mode=False,
+                         verbose=False) == 0
+    out = capsys.readouterr().out
+    assert "read 1/1 model files, 1/1 scenes" in out
+    assert "links computed: 4 (exact 4)" in out          # box and holder, in the model and in the scene
+    assert re.search(r"\n +2 +mesh file missing\n", out) and re.search(r"\n +2 +attached model not read\n", out)
+
+
+def test_a_missing_visual_mesh_does_not_keep_its_body_from_the_comparison(tmp_path):
+    # Stretch's base_link and link_head: the absent file is a visual mesh (massless under --geometry
+    # collision), so MuJoCo's stand-in adds nothing and the body is compared (or the tool's own reason shown),
+    # not filed under "mesh file missing"; a missing collision mesh still is
+    path = tmp_path / "robot.xml"
+    path.write_text("""<mujoco>
+  <asset><mesh name="look" file="look.stl"/><mesh name="touch" file="touch.stl"/></asset>
+  <worldbody>
+    <body name="seen"><joint/><geom type="box" size="0.1 0.2 0.3"/>
+      <geom type="mesh" mesh="look" contype="0" conaffinity="0"/></body>
+    <body name="gone" pos="1 0 0"><joint/><geom type="box" size="0.1 0.2 0.3"/><geom type="mesh" mesh="touch"/></body>
+  </worldbody>
+</mujoco>
+""")
+    from inertia_tool.robot.geometry import MeshCache
+    bodies, _, missing, _ = mujoco_reference(str(path))
+    assert missing == {"gone": ["touch.stl"]}
+    rows = compare_menagerie_file(str(path), rtol=1e-6, repair=False, cache=MeshCache())
+    assert [r[:2] for r in rows] == [("seen", "exact, agrees"), ("gone", "mesh file missing")]
+    assert rows[0][2] < 1e-12 and bodies[0][1] == pytest.approx(1000 * 0.2 * 0.4 * 0.6, rel=1e-12)
