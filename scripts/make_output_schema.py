@@ -203,7 +203,20 @@ defs["top"] = command("top", {
                     "duration": N, "samples": COUNT, "theta_min": NN, "theta_max": NN, "nutation_period": NN,
                     "mean_precession_rate": NN, "relative_energy_drift": NN}}},
                ["transverse_moment", "axial_moment", "mass", "length", "theta_min", "theta_max", "nutation_period",
-                "pivot", "symmetry_axis"])},
+                "pivot", "symmetry_axis"]),
+    "top_bounds": {"type": ["object", "null"], "description": (
+        "null for an exact part; for an estimate (a repaired part), its bounds carried to the top "
+        "(dynamics/top_bounds.py): bounded (false: the bounds give none, every result in doubt), moment (kg*m^2, "
+        "each of I1, I3 and the transverse moments about the pivot), length (m), gravity_torque ([lo, hi] N*m), "
+        "asymmetry ([lo, hi] of I1), symmetric (true, false or null: in doubt), sleeping_margin ([lo, hi]), "
+        "steady_possible (true, false or null), precession_rate_slow/_fast ([lo, hi] rad/s or null), in_doubt "
+        "(keys of the results left in doubt)"),
+        "properties": {"bounded": B, "moment": N, "length": N, "gravity_torque": arr(N), "asymmetry": arr(N),
+                       "symmetric": {"type": ["boolean", "null"]}, "sleeping_margin": arr(NN),
+                       "steady_possible": {"type": ["boolean", "null"]},
+                       "precession_rate_slow": {"type": ["array", "null"], "items": N},
+                       "precession_rate_fast": {"type": ["array", "null"], "items": N}, "in_doubt": arr(S)},
+        "required": ["bounded", "in_doubt"]}},
     ["name", "mass", "method", "uncertainty", "top", "units_assumed"],
     "inertia-tool top --json: the heavy symmetric top (Chapter 4, §4.4.3).")
 STATE = {"kind": S, "center_of_mass_shaft": V3, "offset": N, "static_unbalance": V3,

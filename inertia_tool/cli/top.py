@@ -136,13 +136,34 @@ def _check_sampling(top, duration: float, samples: int) -> None:
                          + (f" (at most {MAX_SAMPLES})" if need > MAX_SAMPLES else ""))
 
 
+def _estimate_bounds(props, top, pivot, rtol: float):
+    """``(estimated, per_part, bounds)`` of a top (issue 21, notes19): whether the part is an estimate, whether it
+    is an assembly with bounds per part only, and :func:`~..dynamics.top_bounds.heavy_top_bounds` (None where the
+    part is exact or its bounds give none)."""
+    import numpy as np
+
+    from ..dynamics.top_bounds import heavy_top_bounds
+
+    mesh = props.mesh
+    if mesh is None:
+        estimated = any(getattr(getattr(p, "mesh", None), "uncertainty", None) is not None for p in props.parts)
+        return estimated, estimated, None
+    u = mesh.uncertainty
+    if u is None:
+        return False, False, None
+    bounds = heavy_top_bounds(top, inertia_com=np.asarray(props.inertia),
+                              inertia_pivot=np.asarray(props.inertia_about(pivot).tensor), mass=props.mass,
+                              mass_rtol=u.mass, com_bound=u.center_of_mass, inertia_rtol=u.inertia, rtol=rtol)
+    return True, False, bounds
+
+
 def run(args) -> int:
     import numpy as np
 
     from ..dynamics.top import heavy_top_on_pivot
     from ..output import check_targets
     from ..reports.serialize import command_output, method_and_uncertainty
-    from ..reports.stability import format_heavy_top, heavy_top_dict
+    from ..reports.stability import format_heavy_top, format_top_estimate, heavy_top_dict, top_bounds_dict
 
     tilt = parse_angle(args.tilt, default_unit="deg")
     if not (math.isfinite(tilt) and 0.0 <= tilt <= math.pi):
@@ -169,6 +190,7 @@ def run(args) -> int:
              for name in ("spin", "nutation", "precession")}
     top = heavy_top_on_pivot(props, pivot, theta0=tilt, omega3=rates["spin"], theta_dot0=rates["nutation"],
                              phi_dot0=rates["precession"], g=args.gravity, rtol=args.symmetry_rtol)
+    estimated, per_part, bounds = _estimate_bounds(props, top, pivot, args.symmetry_rtol)
     traj = None
     if not args.no_simulate:
         if duration is not None:
@@ -188,12 +210,15 @@ def run(args) -> int:
         out = command_output("top", {
             "name": props.name, "density_source": described, "mass": props.mass, "method": method,
             "uncertainty": uncertainty, "model": loaded.model, "units_assumed": loaded.units_assumed,
-            "top": heavy_top_dict(top, traj)}, warnings=loaded.warnings)
+            "top": heavy_top_dict(top, traj),
+            "top_bounds": top_bounds_dict(top, bounds, estimated=estimated)}, warnings=loaded.warnings)
         json.dump(out, sys.stdout, indent=2, ensure_ascii=False, allow_nan=False)
         sys.stdout.write("\n")
     else:
         print(with_warnings(f"{props.name}: mass {props.mass:.6g} kg ({described}{model_words(loaded.model)})",
                             loaded.warnings, loaded.notes()))
         print(format_heavy_top(top, traj))
+        for line in format_top_estimate(top, bounds, estimated=estimated, per_part=per_part):
+            print(line)
     shown_with_report(args, loaded.warnings)
     return 0

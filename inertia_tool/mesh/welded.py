@@ -19,6 +19,7 @@ from .resolve import Resolution, resolve_surface
 from .shells import Shells, measured, reshelled
 
 if TYPE_CHECKING:
+    from .coplanar import CoplanarArrangement
     from .precision import RoundedRegion
 
 __all__ = ["SettledWelded", "settle_welded"]
@@ -109,8 +110,24 @@ def _arrange_welded(v: np.ndarray, f: np.ndarray, labels: np.ndarray, chosen: np
         raise ArrangementError(f"{done.crossings_left:,} face pairs of the result cross after rounding the overlay's "
                                "points to float64")
     shells = reshelled(v, f, diag, source)
-    note = (f"bodies welded along edges where faces overlap in a common plane ({done.coplanar_pairs:,} face pairs "
-            f"in {done.planes:,} plane{'s' if done.planes != 1 else ''}): the faces bounding the region of winding "
-            "number ≥ 1 kept, split along each other's edges (the common volume counts once)")
+    note = _arranged_note(done)
     warnings.warn(MeshResolvedWarning(f"{source}: {note}"), stacklevel=5)
     return shells, note, done.region
+
+
+def _arranged_note(done: CoplanarArrangement) -> str:
+    """The note of R1b's arrangement, counting what was done: the faces taken out as zero chains (a face with its
+    reverse, or coplanar patches that cancel, :func:`~.coplanar._zero_chains`), then the overlay of the faces still
+    overlapping in a common plane; where none were left, no overlay ran and no face was split (the surface left is
+    integrated as it stands), so no pair or plane is counted (review19: "0 face pairs in 0 planes" after a weld)."""
+    n_out = done.cancelled_faces
+    out = (f"{n_out:,} face{'s' if n_out != 1 else ''} taken out as zero chains (a face listed with its reverse, or "
+           "coplanar patches whose boundaries are each other's reverse: nothing in any integral)")
+    if not done.coplanar_pairs:
+        what = f"{out}; no faces overlap after that, the rest integrated as it stands (no face split)" if n_out \
+            else "no faces overlap, the surface integrated as it stands (no face split)"
+        return f"non-manifold edges where faces lie in a common plane (R1b): {what}"
+    first = f"; {out} first" if n_out else ""
+    return (f"bodies welded along edges where faces overlap in a common plane ({done.coplanar_pairs:,} face pairs "
+            f"in {done.planes:,} plane{'s' if done.planes != 1 else ''}{first}): the faces bounding the region of "
+            "winding number ≥ 1 kept, split along each other's edges (the common volume counts once)")

@@ -9,12 +9,14 @@ import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover - annotations only; keeps scipy.integrate out of `analyze`
     from ..dynamics.top import HeavyTopReport, TopTrajectory
+    from ..dynamics.top_bounds import HeavyTopBounds
 
 from ..dynamics.spin_stability import StabilityReport
 from .serialize import to_jsonable
 from .numbers import number
 
-__all__ = ["stability_dict", "format_stability", "heavy_top_dict", "format_heavy_top", "spin_dict",
+__all__ = ["stability_dict", "format_stability", "heavy_top_dict", "format_heavy_top", "format_top_estimate",
+           "top_bounds_dict", "spin_dict",
            "format_spin", "DEFAULT_REPORT_PERTURBATION"]
 
 #: Relative perturbation used for the "turns to grow" figure in reports.
@@ -200,6 +202,83 @@ def format_heavy_top(top: HeavyTopReport, trajectory: TopTrajectory | None = Non
                         else "no nutation period seen within the simulated time") + ", mean precession "
                      f"{_precession_text(trajectory.measured_precession_rate())}, energy drift {drift:.1e}")
     return "\n".join(lines)
+
+
+def _range(r: tuple[float, float], fmt: str = ".4g") -> str:
+    return f"{r[0]:{fmt}} and {r[1]:{fmt}}"
+
+
+def format_top_estimate(top: HeavyTopReport, bounds: HeavyTopBounds | None, *, estimated: bool = True,
+                        per_part: bool = False) -> list[str]:
+    """The caveat of a heavy top on an estimated part (issue 21, notes19): which of the results the part's bounds
+    (:func:`~inertia_tool.dynamics.top_bounds.heavy_top_bounds`) leave in doubt; no lines for an exact part.
+
+    ``per_part``: an assembly whose parts carry their own bounds only (nothing bounded for the whole);
+    ``bounds`` None on an estimate: the bounds give none (the centre of mass may lie at the pivot, a moment
+    may vanish)."""
+    if not estimated:
+        return []
+    if per_part or bounds is None:
+        why = ("an assembly with estimated parts, bounds per part only" if per_part else
+               "its bounds reach the pivot or a moment's size")
+        return [f"  the part is an estimate ({why}): none of the results above is proven; the symmetric-top "
+                "reading, the moments, the sleeping-top verdict and the precession rates are not bounded"]
+    b = bounds
+    lines = [f"  the part is an estimate: about the pivot I1 and I3 (and the two transverse moments) each within "
+             f"±{b.moment:.3e} kg·m², l within ±{b.length:.3g} m, M g l between {_range(b.gravity_torque)} N·m "
+             "(the repaired part's bounds, under its assumptions, carried by Eq. 4.16 and Weyl's inequality)"]
+    in_doubt: list[str] = []
+    if b.symmetric is True:
+        lines.append(f"    symmetric top: holds (the true part's asymmetry at most {b.asymmetry[1]:.3g} of I1, within "
+                     "the tolerance)")
+    elif b.symmetric is False:
+        lines.append(f"    symmetric top: NOT one (the true part's asymmetry at least {b.asymmetry[0]:.3g} of I1, "
+                     "beyond the tolerance): the results are those of the mean transverse moment")
+    else:
+        in_doubt.append("the symmetric-top reading")
+        lines.append(f"    symmetric top: in doubt (the true part's asymmetry between {_range(b.asymmetry, '.3g')} "
+                     "of I1; the reading needs two equal transverse moments)")
+    lo, hi = b.sleeping_margin
+    holds = lo > 1.0 if top.sleeping_stable else hi <= 1.0
+    if not holds:
+        in_doubt.append("the sleeping-top verdict")
+    lines.append(f"    upright (sleeping) top: I3²ω3²/(4 I1 M g l) between {_range(b.sleeping_margin)}: the verdict "
+                 + ("holds" if holds else "is in doubt"))
+    if b.steady_possible is None:
+        in_doubt.append("whether steady precession exists")
+        lines.append("    steady precession at θ0: possible for some parts within the bounds, not for others (in "
+                     "doubt)")
+    elif b.steady_possible and b.precession_rate_slow is not None:
+        fast = ("" if b.precession_rate_fast is None else
+                f", fast between {_range(b.precession_rate_fast, '.6g')} rad/s")
+        lines.append(f"    steady precession at θ0: slow between {_range(b.precession_rate_slow, '.6g')} rad/s{fast}")
+    elif not b.steady_possible:
+        lines.append("    steady precession at θ0: impossible for every part within the bounds")
+    in_doubt.append("the nutation limits and period and the path's kind (not bounded: they follow from the same "
+                    "inputs through a cubic's roots)")
+    lines.append("    in doubt: " + "; ".join(in_doubt))
+    return lines
+
+
+def _in_doubt(top: HeavyTopReport, b: HeavyTopBounds) -> list[str]:
+    """Keys of the results the bounds leave in doubt (``top_bounds.in_doubt`` of the JSON)."""
+    lo, hi = b.sleeping_margin
+    return ([] if b.symmetric is not None else ["symmetric_top"]) \
+        + ([] if (lo > 1.0 if top.sleeping_stable else hi <= 1.0) else ["sleeping_top"]) \
+        + ([] if b.steady_possible is not None else ["steady_precession"]) \
+        + ["nutation_limits", "nutation_period", "precession_kind"]
+
+
+def top_bounds_dict(top: HeavyTopReport, bounds: HeavyTopBounds | None, *, estimated: bool) -> dict | None:
+    """JSON-ready ``top_bounds`` (issue 21, notes19): None for an exact part; for an estimate ``bounded`` (False
+    when the bounds give none: every result in doubt), the fields of :class:`HeavyTopBounds` (SI) and
+    ``in_doubt``, the keys of the results they leave in doubt."""
+    if not estimated:
+        return None
+    if bounds is None:
+        return {"bounded": False, "in_doubt": ["symmetric_top", "moments", "sleeping_top", "steady_precession",
+                                               "nutation_limits", "nutation_period", "precession_kind"]}
+    return {"bounded": True, **to_jsonable(bounds), "in_doubt": _in_doubt(top, bounds)}
 
 
 def spin_dict(experiment) -> dict:

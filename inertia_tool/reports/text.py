@@ -66,6 +66,9 @@ def method_line(mesh) -> str:
     if u is None and mesh.certificate.kind == "unverified":
         return (f"NOT VERIFIED (method: {mesh.method}): the integral of the surface as it stands; the check for "
                 "faces crossing each other did not finish, so the surface may pass through itself")
+    if u is None and mesh.certificate.kind == "united":     # review19: said "exact for the polyhedron" above it
+        return (f"exact for the united solid, the region of winding number ≥ 1 (method: {mesh.method}; the "
+                "certificate lists the checks that establish it)")
     if u is None:
         extra = " (shared volume of overlapping bodies counted twice, on request)" if mesh.method == "sum" else ""
         return f"exact for the polyhedron (method: {mesh.method}){extra}"
