@@ -13,7 +13,8 @@ every name ``--material-map`` may use for it (see docs/usage.md).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import re
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
@@ -24,7 +25,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from .read import RawMesh
     from .threemf import PlacedObject
 
-__all__ = ["PartTag", "part_mesh", "split_parts", "threemf_parts", "cad_parts", "scene_parts",
+__all__ = ["PartTag", "part_mesh", "split_parts", "threemf_parts", "cad_parts", "scene_parts", "primitive_frames",
            "unique_names"]
 
 
@@ -156,15 +157,32 @@ def cad_parts(found: Sequence[tuple[str, str | None, float | None, int, int]]) -
                          (f[3], f[4])) for n, f in zip(names, found))
 
 
-def scene_parts(geometries: Sequence[Any]) -> tuple[PartTag, ...]:
+def primitive_frames(nodes: Sequence[str], parents: Mapping[str, str]) -> dict[str, str]:
+    """Stable names for the frames trimesh invents for the primitives of a glTF mesh with more than one: it names
+    each ``{node}_{6 random hex digits}`` (new on every load), so a part name built on it changed from run to run
+    and could not be given back in ``--material-map``.  Such a frame (a child of ``node`` named so) becomes
+    ``{node} primitive {k}``, ``k`` counting from 1 in ``nodes`` order (``Scene.dump``'s); other names are kept."""
+    out: dict[str, str] = {}
+    counts: dict[str, int] = {}
+    for name in nodes:
+        parent = parents.get(name)
+        if parent is not None and re.fullmatch(re.escape(str(parent)) + r"_[0-9a-f]{6}", str(name)):
+            counts[parent] = counts.get(parent, 0) + 1
+            out[name] = f"{parent} primitive {counts[parent]}"
+    return out
+
+
+def scene_parts(geometries: Sequence[Any], renamed: Mapping[str, str] | None = None) -> tuple[PartTag, ...]:
     """The parts of a glTF scene, one per mesh node (``trimesh.Scene.dump`` order, the order the reader
-    concatenates them in): the node's name, the name of its primitive's material (trimesh's
-    ``visual.material.name``).  Empty for a single node or when no node's mesh has a named material."""
+    concatenates them in): the node's name (``renamed``'s where it has one: :func:`primitive_frames`), the name
+    of its primitive's material (trimesh's ``visual.material.name``).  Empty for a single node or when no node's
+    mesh has a named material."""
     rows: list[tuple[str, str | None, tuple[int, int]]] = []
     start = 0
     for geometry in geometries:
         material = getattr(getattr(geometry.visual, "material", None), "name", None)
         node = geometry.metadata.get("node") or geometry.metadata.get("name") or f"node {len(rows) + 1}"
+        node = (renamed or {}).get(node, node)
         rows.append((str(node), str(material) if material else None, (start, start + len(geometry.faces))))
         start += len(geometry.faces)
     if len(rows) < 2 or not any(r[1] for r in rows):

@@ -136,8 +136,10 @@ def _read_with_trimesh_rounding(path: str, max_faces: int,
                 if not geoms:
                     raise _fail(path, "contains no triangle mesh (empty scene or only points/lines)")
                 if suffix in (".glb", ".gltf") and counts.get("named_materials"):
-                    from .parts import scene_parts
-                    parts = scene_parts(geoms)
+                    from .parts import primitive_frames, scene_parts
+                    graph = loaded.graph
+                    parts = scene_parts(geoms, primitive_frames(list(graph.nodes_geometry),
+                                                                dict(graph.transforms.parents)))
                 loaded = trimesh.util.concatenate(geoms) if len(geoms) > 1 else geoms[0]
     except MeshReadError:
         raise
