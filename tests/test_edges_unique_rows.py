@@ -48,9 +48,9 @@ def test_unique_rows_packs_the_pairs_it_is_meant_for():
 @given(st.lists(st.tuples(st.integers(0, 5), st.integers(0, 5), st.sampled_from([-1, 0, 1])), min_size=1,
                 max_size=40))
 def test_pieces_holding_both_ways_of_a_class_as_numpy_finds_them(triples):
-    """``multiplicity.coincident_surfaces``' rows ``(piece, class, sign)`` with the sign shifted by +1 for ``unique_rows``
-    (issue 25, unique19): the (piece, class) rows and their counts are those of the three ``numpy.unique`` calls
-    on the unshifted signs it replaced."""
+    """``multiplicity.coincident_surfaces``' rows ``(piece, class, sign)`` with the sign shifted by +1 for
+    ``unique_rows`` (issue 25, unique19): the (piece, class) rows and their counts are those of the three
+    ``numpy.unique`` calls on the unshifted signs it replaced."""
     comp, c, s = (np.array(x, dtype=np.int64) for x in zip(*triples))
     old = np.unique(np.stack([comp, c, s], axis=1), axis=0)
     _, old_counts = np.unique(old[:, :2], axis=0, return_counts=True)
