@@ -42,3 +42,20 @@ def test_unique_rows_packs_the_pairs_it_is_meant_for():
     rows = rows[rng.integers(0, 5000, 20000)]
     _same(unique_rows(rows, return_index=True, return_inverse=True, return_counts=True),
           np.unique(rows, axis=0, return_index=True, return_inverse=True, return_counts=True))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.integers(0, 5), st.integers(0, 5), st.sampled_from([-1, 0, 1])), min_size=1,
+                max_size=40))
+def test_pieces_holding_both_ways_of_a_class_as_numpy_finds_them(triples):
+    """``multiplicity.coincident_surfaces``' rows ``(piece, class, sign)`` with the sign shifted by +1 for
+    ``unique_rows`` (issue 25, unique19): the (piece, class) rows and their counts are those of the three
+    ``numpy.unique`` calls on the unshifted signs it replaced."""
+    comp, c, s = (np.array(x, dtype=np.int64) for x in zip(*triples))
+    old = np.unique(np.stack([comp, c, s], axis=1), axis=0)
+    _, old_counts = np.unique(old[:, :2], axis=0, return_counts=True)
+    old_pieces = np.unique(old[:, :2], axis=0)[:, 0]
+    new = unique_rows(np.stack([comp, c, s + 1], axis=1))
+    piece_class, counts = unique_rows(new[:, :2], return_counts=True)
+    assert np.array_equal(new[:, :2], old[:, :2]) and np.array_equal(new[:, 2] - 1, old[:, 2])
+    assert np.array_equal(counts, old_counts) and np.array_equal(piece_class[:, 0], old_pieces)

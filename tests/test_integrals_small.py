@@ -257,3 +257,21 @@ def test_accurate_shells_of_no_shells_is_empty_on_both_paths(monkeypatch, no_acc
     shells, refined, bounds = accurate_shells(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
                                               np.zeros(0, dtype=np.int64), [])
     assert shells == [] and refined == 0 and len(bounds.volume) == 0 and len(bounds.second_moment) == 0
+
+
+@FAST
+@given(mesh=small_meshes(max_labels=4), magnitude=st.booleans(),
+       errors=st.lists(st.floats(0, 1e-3, allow_subnormal=False), min_size=3, max_size=3))
+def test_one_shells_shares_of_many_are_the_full_shares_bit_for_bit(mesh, magnitude, errors):
+    """``_many_shares(..., only=k)`` (issue 25, unique19: the total ``‖I‖`` is no longer summed over every shell for
+    each refined one) gives the bits of shell ``k``'s shares in the call without ``only``, and ``|V|`` the same."""
+    v, f, labels, n = mesh
+    if n < 2:
+        return
+    shells = body_volume_moments(v, f, labels, n)
+    e = [x * np.arange(1.0, n + 1) for x in errors]          # (volume, centroid, second moment) per shell
+    full_v, full_i, total_v, total_i = integrals._many_shares(shells, *e, None, magnitude)
+    for k in range(n):
+        sv, si, tv, ti = integrals._many_shares(shells, *e, k, magnitude)
+        assert _bits(sv) == _bits(full_v[k]) and _bits(si) == _bits(full_i[k]) and _bits(tv) == _bits(total_v)
+        assert math.isnan(ti)

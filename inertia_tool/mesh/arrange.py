@@ -62,7 +62,7 @@ from ..errors import ArrangementError
 from ..tolerances import ARRANGE_MERGE_RTOL, ROUNDOFF_RTOL
 from ..values import frozen_value
 from .checks import edge_topology
-from .edges import edge_keys
+from .edges import edge_keys, unique_rows
 from .intersect import _integers, orient3d_sign, surface_contacts
 from .multiplicity import cancel_opposite
 from .precision import RoundedRegion, combined_regions, rounded_region
@@ -760,7 +760,7 @@ def _arrange(v: np.ndarray, f: np.ndarray, crossing: np.ndarray | None) -> tuple
         if not found.complete:
             raise ArrangementError("the face-intersection check did not finish")
         crossing = found.crossing
-    pairs = np.unique(np.sort(np.asarray(crossing, dtype=np.int64).reshape(-1, 2), axis=1), axis=0)
+    pairs = unique_rows(np.sort(np.asarray(crossing, dtype=np.int64).reshape(-1, 2), axis=1))
     if not len(pairs):
         raise ArrangementError("no crossing face pairs to arrange")
     edge_a, edge_b, pierced = _crossing_points(v, f, pairs)

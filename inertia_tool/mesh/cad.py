@@ -37,6 +37,7 @@ import numpy as np
 
 from ..errors import InvalidMeshError, MeshReadError, UsageError
 from ..values import frozen_value
+from .edges import unique_rows
 from .read import BREP_SUFFIXES      # CAD exchange suffixes read as B-reps, defined with the reader's suffixes
 from .weld import weld_exact
 
@@ -436,7 +437,7 @@ def _split_skipped(triangles: np.ndarray, chains: list[list[int]]) -> np.ndarray
         return triangles
     directed = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
     undirected = np.sort(directed, axis=1)
-    _, inverse, uses = np.unique(undirected, axis=0, return_inverse=True, return_counts=True)
+    _, inverse, uses = unique_rows(undirected, return_inverse=True, return_counts=True)
     once = np.flatnonzero(uses[inverse.reshape(-1)] == 1)
     if not len(once):
         return triangles
@@ -482,7 +483,7 @@ RETRY_DEFLECTION_FACTOR = 0.7
 def _open_edges(faces: np.ndarray) -> int:
     """Undirected edges of ``faces`` not used by exactly two triangles."""
     edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    return int(np.count_nonzero(np.unique(edges, axis=0, return_counts=True)[1] != 2))
+    return int(np.count_nonzero(unique_rows(edges, return_counts=True)[1] != 2))
 
 
 def _has_solid(shape: Any) -> bool:

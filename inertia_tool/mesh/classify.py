@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import InsideOutWarning, InvalidMeshError, MeshResolvedWarning
 from ..integrals import RoundoffBound, VolumeMoments
 from ..tolerances import TOUCH_VOLUME_RTOL
+from .edges import unique_rows
 from .intersect import SurfaceContacts, surface_contacts
 from .multiplicity import container_windings, multiplicity_changes
 from .policy import (MisreadNesting, ShellContacts, boxes_holding, cavities_in_overlap, inward_crossing_outward,
@@ -440,7 +441,7 @@ def _copies_nested(volumes: np.ndarray, nest: Nesting | None, crossing_with: np.
     copies = nested[nested_copies(volumes, nested, rounding=rounding)] if len(nested) else nested
     if not len(copies):
         return cross, touching, np.zeros((0, 2), dtype=np.int64)
-    copies = np.unique(np.sort(copies, axis=1), axis=0)
+    copies = unique_rows(np.sort(copies, axis=1))
     return np.concatenate([cross, copies]), pairs_without(touching, copies), copies
 
 

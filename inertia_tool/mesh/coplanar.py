@@ -47,7 +47,7 @@ from ..errors import ArrangementError
 from ..values import frozen_value
 from .arrange import (_U, WINDING_MARGIN, _compact, _Exact, _FaceTriangulation, _Hom, _inside_face, _orient2d,
                       _patches, _projection, _winding_terms, _winding_total, rounded_points_bounds)
-from .edges import edge_keys
+from .edges import edge_keys, unique_rows
 from .intersect import SurfaceContacts, orient3d_sign, surface_contacts
 from .multiplicity import cancel_opposite, signed_multiplicity
 from .precision import RoundedRegion, rounded_region
@@ -145,7 +145,7 @@ def _repeated_pairs(f: np.ndarray) -> np.ndarray:
     """(k, 2) int: pairs of faces with the same three corners (either orientation); the face-pair check does
     not report them (they share everything by index)."""
     canon = np.sort(f, axis=1)
-    _, inverse, counts = np.unique(canon, axis=0, return_inverse=True, return_counts=True)
+    _, inverse, counts = unique_rows(canon, return_inverse=True, return_counts=True)
     inverse = inverse.reshape(-1)
     many = np.flatnonzero(counts[inverse] > 1)
     rows: list[tuple[int, int]] = []

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import InternalInvariantError, WorkBudgetError
 from ..tolerances import ESTIMATE_MAX_MASS_RTOL
+from .edges import unique_rows
 from .grid_cells import (BOUNDED_REGION_POINTS, _cell_centres, _first_cells, _grid_moments, _label_regions,
                          _surface_cells)
 from .grid_corrected import corrected_estimate
@@ -150,7 +151,7 @@ def _closed_part_numbers(vertices: np.ndarray, faces: np.ndarray, crossed: np.nd
         n_loops = int(label.max()) + 1
         if n_loops > CAP_LOOPS_LIMIT:
             return None
-        pairs = np.unique(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1), axis=0)
+        pairs = unique_rows(np.stack([np.repeat(label, 2), edges.reshape(-1)], axis=1))
         size = np.bincount(pairs[:, 0], minlength=n_loops)
         apex = np.stack([np.bincount(pairs[:, 0], weights=v[pairs[:, 1], i], minlength=n_loops)
                          for i in range(3)], axis=1) / size[:, None]

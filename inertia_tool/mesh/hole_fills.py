@@ -14,6 +14,7 @@ from typing import Callable
 import numpy as np
 
 from ..values import frozen_value
+from .edges import unique_rows
 from .hole_bounds import (BEND_MAX_DEGREES, FLAT_RIM_RTOL, FLAT_VERTEX_COSINE, _flat_off_rim_nearby, _round_off,
                           ball_slab_volume)
 
@@ -218,7 +219,7 @@ def _ring_faces(f: np.ndarray, n: int, rim_key: np.ndarray, label: np.ndarray, c
     unique_key, last = np.unique(rim_key[::-1], return_index=True)
     loop_of_key = label[::-1][last]
     loop = loop_of_key[np.searchsorted(unique_key, key)]
-    pairs = np.unique(np.stack([loop, slot // 3], axis=1), axis=0) if len(slot) else np.zeros((0, 2), np.int64)
+    pairs = unique_rows(np.stack([loop, slot // 3], axis=1)) if len(slot) else np.zeros((0, 2), np.int64)
     start = np.searchsorted(pairs[:, 0], np.arange(n_loops + 1))
     return pairs, start
 

@@ -224,9 +224,10 @@ def coincident_surfaces(vertices: np.ndarray, faces: np.ndarray, among: np.ndarr
         comp, closed = closed_components(f, gone, n_v)
         # a piece holding both members of a pair (a class wound both ways in it) is a closed surface and its
         # reverse on the same vertices only when every edge is used at least four times (else a sheet, R2's)
-        signs_in = np.unique(np.stack([comp, c[out], s[out]], axis=1), axis=0)
-        _, per_class = np.unique(signs_in[:, :2], axis=0, return_counts=True)
-        pieces_of = np.unique(signs_in[:, :2], axis=0)[:, 0]
+        # (the sign shifted by +1 keeps the rows' order and makes them non-negative for ``unique_rows``)
+        signs_in = unique_rows(np.stack([comp, c[out], s[out] + 1], axis=1))
+        piece_class, per_class = unique_rows(signs_in[:, :2], return_counts=True)
+        pieces_of = piece_class[:, 0]
         both = np.zeros(len(closed), dtype=bool)
         both[pieces_of[per_class > 1]] = True
         for k in np.flatnonzero(both & closed).tolist():            # bounded by the number of pieces
@@ -273,7 +274,7 @@ def container_windings(file_volumes: np.ndarray, nest: Nesting | None,
     if within is not None and len(within):
         pairs = np.asarray(within, dtype=np.int64).reshape(-1, 2)
         pairs = pairs[pairs[:, 0] != pairs[:, 1]]
-        pairs = np.unique(pairs[~np.isin(pairs[:, 0] * n + pairs[:, 1], shell * n + other)], axis=0)
+        pairs = unique_rows(pairs[~np.isin(pairs[:, 0] * n + pairs[:, 1], shell * n + other)])
         shell, other = np.r_[shell, pairs[:, 0]], np.r_[other, pairs[:, 1]]
         winding = np.r_[winding, np.sign(file_volumes[pairs[:, 1]]).astype(np.int64)]
     return shell, other, winding

@@ -246,6 +246,7 @@ import numpy as np
 from ..rounding import round_up
 from ..tolerances import COINCIDENT_RTOL, FLAT_MOMENT_RTOL, FLAT_RTOL, ROUNDOFF_RTOL, TOUCH_VOLUME_RTOL
 from ..values import frozen_value
+from .edges import unique_rows
 from .multiplicity import Coincident, container_windings, region_windings, winding_around
 
 if TYPE_CHECKING:
@@ -406,7 +407,7 @@ def shell_contacts(contacts: SurfaceContacts, labels: np.ndarray, n_shells: int)
     crossing = np.zeros(n_shells, dtype=bool)
     crossing[la[~same]] = True
     crossing[lb[~same]] = True
-    pairs = np.unique(np.sort(np.c_[la[~same], lb[~same]], axis=1), axis=0) if np.any(~same) \
+    pairs = unique_rows(np.sort(np.c_[la[~same], lb[~same]], axis=1)) if np.any(~same) \
         else np.zeros((0, 2), dtype=np.int64)
     touching = np.zeros(n_shells, dtype=bool)
     for group in (contacts.coplanar_opposite, contacts.contact):
@@ -523,12 +524,12 @@ def orient_by_depth(volumes: np.ndarray, nest: Nesting | None, crossing_with: np
         depth[np.unique(nest.shell[held])] = 1
         return flip, owner, depth
     held = inside & ~cross[nest.shell, nest.other]
-    pairs = np.unique(np.concatenate([np.c_[nest.shell[held], nest.other[held]], extra]), axis=0)
+    pairs = unique_rows(np.concatenate([np.c_[nest.shell[held], nest.other[held]], extra]))
     s_in, o_in = pairs[:, 0], pairs[:, 1]
     # bodies that cross one another are one body for the shells inside them: a shell inside two overlapping
     # bodies is at depth 1, not 2 (review 9: two hollow copies, one turned, had their cavities made bodies)
     component = _groups(n, np.argwhere(np.triu(cross)))
-    depth[:] = np.bincount(np.unique(np.c_[s_in, component[o_in]], axis=0)[:, 0], minlength=n) if len(s_in) \
+    depth[:] = np.bincount(unique_rows(np.c_[s_in, component[o_in]])[:, 0], minlength=n) if len(s_in) \
         else 0
     undecided = np.asarray(nest.undecided, dtype=bool).copy()
     undecided[extra[:, 0]] = False
@@ -1479,7 +1480,7 @@ def near_copies(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray, she
             key: np.ndarray = np.take_along_axis(g, (start + np.arange(3)) % 3, axis=1)
             return key
 
-        ka, kb = np.unique(cyclic(ga), axis=0), np.unique(cyclic(gb), axis=0)
+        ka, kb = unique_rows(cyclic(ga)), unique_rows(cyclic(gb))
         if len(ka) != len(ga) or not np.array_equal(ka, kb):
             continue
         delta = float(dist.max())

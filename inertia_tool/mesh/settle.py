@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import MeshResolvedWarning
 from .checks import shell_labels
+from .edges import unique_rows
 from .intersect import SurfaceContacts, surface_contacts
 from .nonmanifold import WeldedBodies, welded_bodies
 from .policy import ShellContacts, touching_relations
@@ -163,7 +164,7 @@ def settle_touching(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: 
     faces_touching = faces_touching[labels[faces_touching[:, 0]] != labels[faces_touching[:, 1]]]
     if not len(faces_touching):
         return touch, nest, none, none
-    pairs = np.unique(np.sort(labels[faces_touching], axis=1), axis=0)
+    pairs = unique_rows(np.sort(labels[faces_touching], axis=1))
     n = len(touch.crossing)
     crossed = np.zeros((n, n), dtype=bool)
     cw = np.asarray(touch.crossing_with, dtype=np.int64).reshape(-1, 2)
@@ -180,7 +181,7 @@ def settle_touching(v: np.ndarray, f: np.ndarray, labels: np.ndarray, contacts: 
         crossing[found.crossing.reshape(-1)] = True
         touch = dataclasses.replace(touch, crossing=crossing)
     more = np.concatenate([cw, found.crossing, found.unknown, beyond]).reshape(-1, 2)
-    touch = dataclasses.replace(touch, crossing_with=np.unique(np.sort(more, axis=1), axis=0))
+    touch = dataclasses.replace(touch, crossing_with=unique_rows(np.sort(more, axis=1)))
     decided = np.concatenate([found.within, found.apart]).reshape(-1, 2)
     if len(decided):
         drop = np.zeros((n, n), dtype=bool)

@@ -96,7 +96,7 @@ import numpy as np
 
 from ..tolerances import MERGE_TOLERANCE, ROUNDOFF_RTOL, WALL_PLANE_RTOL
 from ..values import frozen_value
-from .edges import edge_keys, stable_key_order
+from .edges import edge_keys, stable_key_order, unique_rows
 
 __all__ = ["OpenSheets", "open_sheets", "MAX_SHEET_PIECES"]
 
@@ -235,7 +235,7 @@ def _rims_meet(v: np.ndarray, f: np.ndarray, piece: np.ndarray, taken: np.ndarra
     _, inverse, counts = np.unique(owner_edge, return_inverse=True, return_counts=True)
     net = np.bincount(inverse.reshape(-1), weights=sign[inside])
     rim_slot = np.flatnonzero(inside)[net[inverse.reshape(-1)] != 0]
-    corners = np.unique(np.stack([f.reshape(-1)[rim_slot], slot_sheet[rim_slot]], axis=1), axis=0)
+    corners = unique_rows(np.stack([f.reshape(-1)[rim_slot], slot_sheet[rim_slot]], axis=1))
     pairs = cKDTree(v[corners[:, 0]]).query_pairs(reach, output_type="ndarray")
     return bool(len(pairs) and np.any(corners[pairs[:, 0], 1] != corners[pairs[:, 1], 1]))
 
