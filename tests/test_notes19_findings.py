@@ -101,3 +101,17 @@ def test_exact_result_line_unchanged():
     props = _analyse(*t_junction_box((0.1, 0.2, 0.3), 0.5, same=1, reverse=0))
     assert props.mesh.certificate.kind == "exact"
     assert method_line(props.mesh) == "exact for the polyhedron (method: exact)"
+
+
+def test_no_warning_says_exact_when_the_certificate_is_united():
+    """notes19's notice: the surface stage's warning began "exact: 3 non-manifold edges ..." (the stage's own
+    method: the surface was closed as read) above a result certified ``united``; no warning of a united answer may
+    call it exact."""
+    dims = (0.1, 0.2, 0.3)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        props = mass_properties(t_junction_box(dims, 0.5), density=1.0)
+    assert props.mesh.certificate.kind == "united"
+    texts = [str(w.message) for w in caught]
+    assert any("closed as read: 3 non-manifold edges" in t for t in texts)
+    assert not any(re.search(r": exact: ", t) for t in texts)

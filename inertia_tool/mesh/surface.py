@@ -135,7 +135,10 @@ def close_surface(raw: RawMesh, *, repair: bool, merge_tolerance: float,
         v, f = found.vertices, found.faces
         if found.method != "exact" or found.notes:
             warning = MeshRepairedWarning if found.estimate is not None else MeshResolvedWarning
-            what = f"repaired ({found.method}, an estimate)" if found.estimate is not None else found.method
+            # the stage's own method: "exact" here says only that the surface was closed as read (the answer's
+            # certificate, which later stages may make "united", is stated apart), so it is not printed as "exact"
+            what = (f"repaired ({found.method}, an estimate)" if found.estimate is not None
+                    else "closed as read" if found.method == "exact" else found.method)
             warnings.warn(warning(f"{source}: {what}: {'; '.join(found.notes)}"), stacklevel=4)
     census = (census_labels, census_shells) if topo.oriented else None     # the faces are the census's: unchanged
     return ClosedSurface(v, f, found, lo, hi, diag, n_repeated, topo.oriented, census, coincident, twice)
