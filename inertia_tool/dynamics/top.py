@@ -30,7 +30,7 @@ from ..mass.properties import MassProperties
 from ..tolerances import MAX_TRAJECTORY_SAMPLES
 from ..units import STANDARD_GRAVITY          # m/s² (re-exported: the top's default gravity)
 
-__all__ = ["HeavyTopReport", "TopTrajectory", "heavy_top", "heavy_top_on_pivot", "simulate_top",
+__all__ = ["HeavyTopReport", "TopTrajectory", "heavy_top", "heavy_top_on_pivot", "simulate_top", "steady_precession",
            "STANDARD_GRAVITY", "PRECESSION_KINDS"]
 
 
@@ -241,7 +241,8 @@ def _nutation_period(u_x: float, u_n: float, u_u: float, alpha: float, beta: flo
     return 4.0 * complete_k(one_minus_m) / math.sqrt(beta * span)
 
 
-def _steady_precession(i1: float, i3: float, omega3: float, mgl: float, theta: float):
+def steady_precession(i1: float, i3: float, omega3: float, mgl: float,
+                      theta: float) -> tuple[float | None, float | None]:
     """Roots φ̇ of ``I1 cos θ φ̇² − I3 ω3 φ̇ + M g l = 0`` (θ-equation of the Lagrangian with θ̇ = θ̈ = 0)."""
     c = math.cos(theta)
     qa, qb, qc = i1 * c, -i3 * omega3, mgl
@@ -330,7 +331,7 @@ def heavy_top(I1: float, I3: float, mass: float, length: float, *, theta0: float
         kind = "undulating"
 
     margin = (i3 * omega3) ** 2 / (4.0 * i1 * mgl) if mgl > 0 else math.inf
-    slow, fast = _steady_precession(i1, i3, omega3, mgl, theta0)
+    slow, fast = steady_precession(i1, i3, omega3, mgl, theta0)
     return HeavyTopReport(transverse_moment=i1, axial_moment=i3, mass=float(mass), length=float(length),
                           gravity=float(g), theta0=float(theta0), omega3=float(omega3),
                           theta_dot0=float(theta_dot0), phi_dot0=float(phi_dot0), a=a, b=b, alpha=alpha,

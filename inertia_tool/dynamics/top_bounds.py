@@ -41,7 +41,7 @@ import math
 import numpy as np
 
 from ..values import frozen_value
-from .top import HeavyTopReport, _steady_precession
+from .top import HeavyTopReport, steady_precession
 
 __all__ = ["HeavyTopBounds", "heavy_top_bounds"]
 
@@ -127,7 +127,7 @@ def heavy_top_bounds(top: HeavyTopReport, *, inertia_com: np.ndarray, inertia_pi
         margin = ((i3s[0] * w) ** 2 / (4.0 * i1s[1] * torque[1]), (i3s[1] * w) ** 2 / (4.0 * i1s[0] * torque[0]))
     else:                                     # no gravity: no torque, the upright top is stable (margin ∞)
         margin = (math.inf, math.inf)
-    roots = [_steady_precession(a, b, w, k, top.theta0) for a, b, k in itertools.product(i1s, i3s, torque)]
+    roots = [steady_precession(a, b, w, k, top.theta0) for a, b, k in itertools.product(i1s, i3s, torque)]
     exists = [r[0] is not None for r in roots]
     steady: bool | None = True if all(exists) else False if not any(exists) else None
     slow = fast = None
