@@ -51,10 +51,9 @@ def _cube(subdivide=3):
     return v, f
 
 
-def test_cube_edge_band_bound_is_the_lost_wedge():
-    """The faces of a 64-per-side cube whose centroids have x > 0.25, z > 0.25 and |y| < 0.25 (round the edge
-    x = z = 0.5) make one hole across the top and the side.  The wrapped region's volume is the cone's true
-    shortfall (the planes continued are the surface lost)."""
+def _cube_less_edge_band():
+    """The 64-per-side cube less the faces whose centroids have x > 0.25, z > 0.25 and |y| < 0.25 (a band round the
+    edge x = z = 0.5): vertices, kept faces, the hole's rim edges and the wrapped region over it."""
     v, f = _cube()
     c = v[f].mean(axis=1)
     gone = (c[:, 0] > 0.25) & (c[:, 2] > 0.25) & (np.abs(c[:, 1]) < 0.25)
@@ -62,13 +61,20 @@ def test_cube_edge_band_bound_is_the_lost_wedge():
     edges = boundary_edges(kept, len(v))
     rim = np.unique(edges)
     _, radius = enclosing_balls(v[rim], np.zeros(len(rim), dtype=np.int64), 1)
-    region = wrapped_doubt(v, kept, edges, float(radius[0]))
+    return v, kept, edges, float(radius[0]), wrapped_doubt(v, kept, edges, float(radius[0]))
+
+
+def test_cube_edge_band_bound_is_the_lost_wedge():
+    """The faces of a 64-per-side cube whose centroids have x > 0.25, z > 0.25 and |y| < 0.25 (round the edge
+    x = z = 0.5) make one hole across the top and the side.  The wrapped region's volume is the cone's true
+    shortfall (the planes continued are the surface lost)."""
+    v, kept, edges, radius, region = _cube_less_edge_band()
     assert region is not None
     error = abs(1.0 - _cone_volume(v, kept))                   # the cube's volume is 1
     assert error > 1e-3                                        # a real shortfall, not round-off
     assert error <= region.doubt <= error * 1.02 + 1e-9
     # this symmetric band is also a graph over its vector area: the graph reading bounds the same error
-    graph = faceted_doubt(v, kept, edges, v[rim].mean(axis=0), float(radius[0]))
+    graph = faceted_doubt(v, kept, edges, v[np.unique(edges)].mean(axis=0), radius)
     assert graph is not None and graph.doubt >= error
 
 
@@ -143,14 +149,7 @@ def test_cube_edge_band_radial_fill_is_the_cube():
     the region."""
     from inertia_tool.mesh.hole_wraps import in_wrapped, wrapped_fill
 
-    v, f = _cube()
-    c = v[f].mean(axis=1)
-    gone = (c[:, 0] > 0.25) & (c[:, 2] > 0.25) & (np.abs(c[:, 1]) < 0.25)
-    kept = f[~gone]
-    edges = boundary_edges(kept, len(v))
-    rim = np.unique(edges)
-    _, radius = enclosing_balls(v[rim], np.zeros(len(rim), dtype=np.int64), 1)
-    region = wrapped_doubt(v, kept, edges, float(radius[0]))
+    v, kept, edges, radius, region = _cube_less_edge_band()
     fill = wrapped_fill(v, region, edges, 0)
     assert fill is not None
     assert in_wrapped(region, np.vstack([fill.apex[None, :], fill.points]))
